@@ -1,0 +1,78 @@
+// Reads light records from the light data texture (layouts: src/cluster/pack.rs).
+// DATA_WIDTH (power of two), LIGHT_TEXELS and LIGHTS_RGBA8 come from Rust as #defines.
+uniform HIGHP sampler2D u_lights;
+uniform int u_lightCount;
+#if GLSL_ES == 100
+// 1 / texture height in rows (ES 2.0 addresses texel centres with normalised coordinates).
+uniform HIGHP float u_lightTexInvHeight;
+#endif
+#if LIGHTS_RGBA8
+// x: positions are fixed point over [-x, x]; y: radii over [0, y].
+uniform HIGHP vec2 u_lightRanges;
+#endif
+
+struct Light {
+    vec3 position;
+    float radius;
+    vec3 radiance;
+    float spotScale;
+    vec3 direction;
+    float spotOffset;
+};
+
+#if GLSL_ES == 100
+vec4 lightTexel(HIGHP float index) {
+    // DATA_WIDTH is a power of two, so this division and floor are exact.
+    HIGHP float row = floor(index / float(DATA_WIDTH));
+    HIGHP float col = index - row * float(DATA_WIDTH);
+    return texture2D(u_lights, vec2((col + 0.5) / float(DATA_WIDTH), (row + 0.5) * u_lightTexInvHeight));
+}
+#define LIGHT_TEXEL(base, k) lightTexel(float(base) * float(LIGHT_TEXELS) + float(k))
+#else
+vec4 lightTexel(int index) {
+    return texelFetch(u_lights, ivec2(index & (DATA_WIDTH - 1), index / DATA_WIDTH), 0);
+}
+#define LIGHT_TEXEL(base, k) lightTexel((base) * LIGHT_TEXELS + (k))
+#endif
+
+#if LIGHTS_RGBA8
+// Two bytes (as 0..1 channels) → 0..1 with 16 bits.
+HIGHP float unpack16(vec2 bytes) {
+    HIGHP vec2 q = floor(bytes * 255.0 + 0.5);
+    return (q.x * 256.0 + q.y) / 65535.0;
+}
+#endif
+
+Light fetchLight(int i) {
+    Light light;
+    vec4 t0 = LIGHT_TEXEL(i, 0);
+    vec4 t1 = LIGHT_TEXEL(i, 1);
+    vec4 t2 = LIGHT_TEXEL(i, 2);
+#if LIGHTS_RGBA8
+    vec4 t3 = LIGHT_TEXEL(i, 3);
+    vec4 t4 = LIGHT_TEXEL(i, 4);
+    vec4 t5 = LIGHT_TEXEL(i, 5);
+    light.position = (vec3(unpack16(t0.xy), unpack16(t0.zw), unpack16(t1.xy)) * 2.0 - 1.0) * u_lightRanges.x;
+    light.radius = unpack16(t1.zw) * u_lightRanges.y;
+    vec4 rgbe = floor(t2 * 255.0 + 0.5);
+    light.radiance = rgbe.rgb / 255.0 * exp2(rgbe.a - 128.0);
+    vec3 dir = vec3(unpack16(t3.xy), unpack16(t3.zw), unpack16(t4.xy)) * 2.0 - 1.0;
+    light.direction = dir / max(length(dir), 1e-6);
+    float outerDeg = unpack16(t5.xy) * 180.0;
+    float innerDeg = unpack16(t5.zw) * 180.0;
+    float cosOuter = cos(radians(outerDeg));
+    float cosInner = cos(radians(innerDeg));
+    float scale = 1.0 / max(cosInner - cosOuter, SPOT_MIN_COS_DELTA);
+    bool omni = innerDeg >= 180.0;
+    light.spotScale = omni ? 0.0 : scale;
+    light.spotOffset = omni ? 1.0 : -cosOuter * scale;
+#else
+    light.position = t0.xyz;
+    light.radius = t0.w;
+    light.radiance = t1.rgb;
+    light.spotScale = t1.w;
+    light.direction = t2.xyz;
+    light.spotOffset = t2.w;
+#endif
+    return light;
+}

@@ -1,0 +1,46 @@
+// Material inputs, sRGB conversions and the output encoding.
+uniform vec3 u_albedo;
+uniform vec3 u_specular;
+uniform float u_shininess;
+uniform vec3 u_ambient;
+// 1.0 for orthographic cameras (view direction +Z), 0.0 for perspective.
+uniform float u_orthographic;
+#if HAS_TEXTURE
+uniform sampler2D u_albedoTex;
+#endif
+
+vec3 srgbToLinear(vec3 c) {
+    vec3 lo = c / 12.92;
+    vec3 hi = pow((c + 0.055) / 1.055, vec3(2.4));
+    return mix(lo, hi, step(vec3(0.04045), c));
+}
+
+vec3 linearToSrgb(vec3 c) {
+    vec3 lo = c * 12.92;
+    vec3 hi = 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055;
+    return mix(lo, hi, step(vec3(0.0031308), c));
+}
+
+vec3 surfaceAlbedo(vec2 uv) {
+    vec3 albedo = u_albedo;
+#if HAS_TEXTURE
+    albedo *= srgbToLinear(TEXTURE2D(u_albedoTex, uv).rgb);
+#endif
+    return albedo;
+}
+
+// Linear radiance → what the framebuffer stores: clamped, then sRGB-encoded unless
+// OUTPUT_LINEAR (no tone map in either case).
+vec4 encodeOutput(vec3 color) {
+    vec3 c = clamp(color, 0.0, 1.0);
+#if OUTPUT_LINEAR
+    return vec4(c, 1.0);
+#else
+    return vec4(linearToSrgb(c), 1.0);
+#endif
+}
+
+// Unit direction from the surface to the eye, in view space.
+vec3 viewDirection(vec3 viewPos) {
+    return normalize(mix(-viewPos, vec3(0.0, 0.0, 1.0), u_orthographic));
+}

@@ -1,0 +1,64 @@
+//! The `manylight` command line: `render` (the default), `info`.
+
+mod info;
+mod render;
+
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand, ValueEnum};
+use manylight::EsVersion;
+
+/// Thousands of dynamic lights on OpenGL ES 2.0 / 3.0, rendered headless through EGL.
+#[derive(Parser)]
+#[command(name = "manylight", version, about)]
+struct Cli {
+    #[command(subcommand)]
+    command: Option<Command>,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Render a scene to a PNG (the default when no subcommand is given).
+    Render(render::RenderArgs),
+    /// Print the capabilities of an ES 2.0 or 3.0 context.
+    Info(info::InfoArgs),
+}
+
+/// `--es 2` or `--es 3`.
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum EsArg {
+    /// OpenGL ES 2.0 (GLSL ES 1.00).
+    #[value(name = "2")]
+    Two,
+    /// OpenGL ES 3.0 (GLSL ES 3.00).
+    #[value(name = "3")]
+    Three,
+}
+
+impl From<EsArg> for EsVersion {
+    fn from(e: EsArg) -> Self {
+        match e {
+            EsArg::Two => EsVersion::Es2,
+            EsArg::Three => EsVersion::Es3,
+        }
+    }
+}
+
+fn main() -> ExitCode {
+    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn"))
+        .format_timestamp(None)
+        .init();
+    let cli = Cli::parse();
+    let result = match cli.command {
+        None => render::run(&render::RenderArgs::parse_from(["render"])),
+        Some(Command::Render(args)) => render::run(&args),
+        Some(Command::Info(args)) => info::run(&args),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}

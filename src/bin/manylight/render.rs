@@ -1,0 +1,108 @@
+//! `manylight render`.
+
+use std::path::PathBuf;
+
+use clap::Parser;
+use manylight::gl::HeadlessContext;
+use manylight::{scene, RenderOptions, Renderer};
+
+use crate::EsArg;
+
+/// Options of `manylight render`.
+#[derive(Parser, Debug)]
+#[command(name = "render")]
+pub struct RenderArgs {
+    /// A built-in scene (courtyard, pillars, plane), an .obj file or a .json scene file.
+    #[arg(long, default_value = scene::builtin::DEFAULT)]
+    pub scene: String,
+    /// Shading method (see `manylight info` for the table).
+    #[arg(long, default_value = manylight::methods::DEFAULT_METHOD)]
+    pub method: String,
+    /// OpenGL ES version to render with.
+    #[arg(long, value_enum, default_value = "3")]
+    pub es: EsArg,
+    /// Number of seeded random lights (for scene files: replaces their random_lights count).
+    /// Default: 512 for built-ins and OBJ files, the file's own lights for scene files.
+    #[arg(long)]
+    pub lights: Option<usize>,
+    /// Seed of the random lights.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Image size as WIDTHxHEIGHT.
+    #[arg(long, default_value = "1280x720", value_parser = parse_size)]
+    pub size: (u32, u32),
+    /// Output PNG.
+    #[arg(long, default_value = "manylight.png")]
+    pub out: PathBuf,
+    /// Write frame statistics as JSON to this file.
+    #[arg(long)]
+    pub stats: Option<PathBuf>,
+    /// Write linear values (clamped, no sRGB encoding, no tone map) for checking pixels
+    /// against the light model.
+    #[arg(long)]
+    pub linear: bool,
+    /// Frames timed after a warm-up frame (the median is reported).
+    #[arg(long, default_value_t = 3)]
+    pub frames: u32,
+}
+
+fn parse_size(s: &str) -> Result<(u32, u32), String> {
+    let (w, h) = s
+        .split_once(['x', 'X', '×'])
+        .ok_or_else(|| format!("`{s}` is not WIDTHxHEIGHT"))?;
+    let parse = |v: &str| v.trim().parse::<u32>().map_err(|e| format!("`{v}`: {e}"));
+    let (w, h) = (parse(w)?, parse(h)?);
+    if w == 0 || h == 0 {
+        return Err(format!("size {w}x{h} is empty"));
+    }
+    Ok((w, h))
+}
+
+/// Runs the command.
+pub fn run(args: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
+    let is_file_scene = args.scene.to_lowercase().ends_with(".json");
+    let lights = match (args.lights, is_file_scene) {
+        (Some(n), _) => Some((n, args.seed)),
+        (None, true) => None,
+        (None, false) => Some((512, args.seed)),
+    };
+    let (scene, report) = scene::load(&args.scene, lights)?;
+    for w in &report.warnings {
+        eprintln!("warning: {w}");
+    }
+    let es = args.es.into();
+    let ctx = HeadlessContext::new(es)?;
+    let mut renderer = Renderer::new(ctx.load_gl(), es)?;
+    if let Some(reason) = renderer.set_method(&args.method)? {
+        eprintln!("warning: method `{}` uses a fallback: {reason}", args.method);
+    }
+    let options = RenderOptions {
+        linear: args.linear,
+        timed_frames: args.frames,
+        ..RenderOptions::default()
+    };
+    let (width, height) = args.size;
+    let result = renderer.render_offscreen(&scene, width, height, &options);
+    renderer.destroy();
+    let (image, stats) = result?;
+    image
+        .save(&args.out)
+        .map_err(|e| format!("cannot write {}: {e}", args.out.display()))?;
+    if let Some(path) = &args.stats {
+        std::fs::write(path, serde_json::to_string_pretty(&stats)? + "\n")
+            .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+    }
+    println!(
+        "{} {}x{} · {} · {} lights · {} on {} · {:.1} ms/frame → {}",
+        args.scene,
+        width,
+        height,
+        stats.method,
+        stats.lights,
+        stats.es,
+        stats.renderer,
+        stats.frame_ms,
+        args.out.display()
+    );
+    Ok(())
+}

@@ -1,0 +1,319 @@
+//! Texel layouts of the light data texture, shared by every method.
+//!
+//! All data textures are [`DATA_TEXTURE_WIDTH`] texels wide (a power of two, so texel
+//! addresses `i % W`, `i / W` and the ES 2.0 coordinates `(x + 0.5) / W` are exact in float
+//! arithmetic) and as many rows high as needed. Light `i` occupies texels
+//! `i·T … i·T + T−1` where `T` = [`LightEncoding::texels_per_light`] (also a power of two, so a
+//! light never straddles a row).
+//!
+//! ```text
+//! Float32 (RGBA32F, 4 texels = 64 bytes per light; ES 3.0, or ES 2.0 with OES_texture_float)
+//!   t0: pos.x   pos.y   pos.z   radius        view-space position (metres)
+//!   t1: rad.r   rad.g   rad.b   spot_scale    radiance = colour × intensity
+//!   t2: dir.x   dir.y   dir.z   spot_offset   unit view-space spot axis
+//!   t3: (unused padding)
+//!
+//! Rgba8 (RGBA8, 8 texels = 32 bytes per light; ES 2.0 without OES_texture_float). Lossy:
+//!   t0: x.hi x.lo y.hi y.lo      16-bit fixed point over [−pos_range, +pos_range]
+//!   t1: z.hi z.lo r.hi r.lo      radius 16-bit over [0, radius_range]
+//!   t2: R    G    B    E         shared-exponent radiance: c = m/255 · 2^(E−128)
+//!   t3: dx.hi dx.lo dy.hi dy.lo  axis 16-bit snorm
+//!   t4: dz.hi dz.lo  -    -
+//!   t5: outer.hi outer.lo inner.hi inner.lo   half-angles, 16-bit over [0°, 180°]
+//!   t6, t7: (unused padding)
+//! ```
+//!
+//! The spot terms are `t = clamp(cos·spot_scale + spot_offset, 0, 1)` (see
+//! [`crate::scene::Light::spot_scale_offset`]); the Rgba8 layout stores angles instead and the
+//! shader rebuilds scale and offset, because `scale` reaches 10⁴ for hard-edged cones.
+
+use glam::{DMat4, Vec3};
+
+use crate::scene::light::SPOT_MIN_COS_DELTA;
+use crate::scene::{Light, LightKind};
+
+/// Width in texels of every data texture (a power of two ≤ 1024: exact under mediump math).
+pub const DATA_TEXTURE_WIDTH: u32 = 1024;
+
+/// How light records are stored in the light texture.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum LightEncoding {
+    /// RGBA32F, exact.
+    Float32,
+    /// RGBA8 fixed point and shared exponent, lossy (the error is measured, not hidden).
+    Rgba8,
+}
+
+impl LightEncoding {
+    /// Texels per light record (a power of two dividing [`DATA_TEXTURE_WIDTH`]).
+    pub const fn texels_per_light(self) -> u32 {
+        match self {
+            LightEncoding::Float32 => 4,
+            LightEncoding::Rgba8 => 8,
+        }
+    }
+
+    /// Bytes per texel.
+    pub const fn bytes_per_texel(self) -> usize {
+        match self {
+            LightEncoding::Float32 => 16,
+            LightEncoding::Rgba8 => 4,
+        }
+    }
+}
+
+/// A light as the shader sees it: view space, radiance premultiplied, spot terms precomputed.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GpuLight {
+    /// View-space position (the camera subtracted in `f64` first).
+    pub position: Vec3,
+    /// Radius of influence.
+    pub radius: f32,
+    /// `color × intensity`.
+    pub radiance: Vec3,
+    /// Spot smoothstep scale (0 for point lights).
+    pub spot_scale: f32,
+    /// Unit view-space spot axis (zero for point lights).
+    pub direction: Vec3,
+    /// Spot smoothstep offset (1 for point lights).
+    pub spot_offset: f32,
+    /// Spot half-angles in degrees (outer, inner); `(180, 180)` for point lights. Only the
+    /// Rgba8 encoding stores these.
+    pub cone_deg: (f32, f32),
+}
+
+impl GpuLight {
+    /// Converts a world-space light with the camera's view matrix (`f64`, so lights far from the
+    /// origin keep their precision relative to the camera).
+    pub fn from_light(light: &Light, view: &DMat4) -> GpuLight {
+        let (spot_scale, spot_offset) = light.spot_scale_offset();
+        let (direction, cone_deg) = match light.kind {
+            LightKind::Point => (Vec3::ZERO, (180.0, 180.0)),
+            LightKind::Spot {
+                direction,
+                inner_deg,
+                outer_deg,
+            } => (
+                view.transform_vector3(direction).normalize().as_vec3(),
+                (outer_deg as f32, inner_deg as f32),
+            ),
+        };
+        GpuLight {
+            position: view.transform_point3(light.position).as_vec3(),
+            radius: light.radius,
+            radiance: light.radiance(),
+            spot_scale,
+            direction,
+            spot_offset,
+            cone_deg,
+        }
+    }
+}
+
+/// A light texture ready to upload.
+#[derive(Clone, Debug)]
+pub struct PackedLights {
+    /// Encoding of the records.
+    pub encoding: LightEncoding,
+    /// Number of lights.
+    pub count: usize,
+    /// Texture width in texels ([`DATA_TEXTURE_WIDTH`]).
+    pub width: u32,
+    /// Texture height in rows (at least 1).
+    pub height: u32,
+    /// Texel bytes, row-major (f32 little-endian for Float32).
+    pub bytes: Vec<u8>,
+    /// Rgba8 only: positions are fixed point over `[−pos_range, pos_range]`.
+    pub pos_range: f32,
+    /// Rgba8 only: radii are fixed point over `[0, radius_range]`.
+    pub radius_range: f32,
+}
+
+/// Packs lights into texels.
+pub fn pack_lights(lights: &[GpuLight], encoding: LightEncoding) -> PackedLights {
+    let tpl = encoding.texels_per_light() as usize;
+    let width = DATA_TEXTURE_WIDTH as usize;
+    let height = (lights.len() * tpl).div_ceil(width).max(1);
+    let mut bytes = vec![0u8; width * height * encoding.bytes_per_texel()];
+    let pos_range = lights
+        .iter()
+        .map(|l| l.position.abs().max_element())
+        .fold(1e-6f32, f32::max);
+    let radius_range = lights.iter().map(|l| l.radius).fold(1e-6f32, f32::max);
+    for (i, l) in lights.iter().enumerate() {
+        match encoding {
+            LightEncoding::Float32 => {
+                let rec: [f32; 16] = [
+                    l.position.x, l.position.y, l.position.z, l.radius, //
+                    l.radiance.x, l.radiance.y, l.radiance.z, l.spot_scale, //
+                    l.direction.x, l.direction.y, l.direction.z, l.spot_offset, //
+                    0.0, 0.0, 0.0, 0.0,
+                ];
+                let start = i * tpl * 16;
+                bytes[start..start + 64].copy_from_slice(bytemuck::cast_slice(&rec));
+            }
+            LightEncoding::Rgba8 => {
+                let p = |v: f32| unorm16(v / pos_range * 0.5 + 0.5);
+                let s = |v: f32| unorm16(v * 0.5 + 0.5);
+                let words = [
+                    p(l.position.x),
+                    p(l.position.y),
+                    p(l.position.z),
+                    unorm16(l.radius / radius_range),
+                ];
+                let start = i * tpl * 4;
+                let rec = &mut bytes[start..start + 32];
+                for (k, w) in words.iter().enumerate() {
+                    rec[k * 2..k * 2 + 2].copy_from_slice(&w.to_be_bytes());
+                }
+                rec[8..12].copy_from_slice(&rgbe(l.radiance));
+                for (k, w) in [s(l.direction.x), s(l.direction.y), s(l.direction.z)].iter().enumerate() {
+                    rec[12 + k * 2..14 + k * 2].copy_from_slice(&w.to_be_bytes());
+                }
+                rec[20..22].copy_from_slice(&unorm16(l.cone_deg.0 / 180.0).to_be_bytes());
+                rec[22..24].copy_from_slice(&unorm16(l.cone_deg.1 / 180.0).to_be_bytes());
+            }
+        }
+    }
+    PackedLights {
+        encoding,
+        count: lights.len(),
+        width: DATA_TEXTURE_WIDTH,
+        height: height as u32,
+        bytes,
+        pos_range,
+        radius_range,
+    }
+}
+
+/// Decodes light `i` exactly as the shader does (used to test round trips and to measure the
+/// Rgba8 error).
+pub fn unpack_light(packed: &PackedLights, i: usize) -> GpuLight {
+    let tpl = packed.encoding.texels_per_light() as usize;
+    match packed.encoding {
+        LightEncoding::Float32 => {
+            let start = i * tpl * 16;
+            let f: &[f32] = bytemuck::cast_slice(&packed.bytes[start..start + 64]);
+            GpuLight {
+                position: Vec3::new(f[0], f[1], f[2]),
+                radius: f[3],
+                radiance: Vec3::new(f[4], f[5], f[6]),
+                spot_scale: f[7],
+                direction: Vec3::new(f[8], f[9], f[10]),
+                spot_offset: f[11],
+                cone_deg: (f32::NAN, f32::NAN),
+            }
+        }
+        LightEncoding::Rgba8 => {
+            let start = i * tpl * 4;
+            let rec = &packed.bytes[start..start + 32];
+            let w = |k: usize| u16::from_be_bytes([rec[k], rec[k + 1]]) as f32 / 65535.0;
+            let pos = |k: usize| (w(k) * 2.0 - 1.0) * packed.pos_range;
+            let snorm = |k: usize| w(k) * 2.0 - 1.0;
+            let e = rec[11] as i32 - 128;
+            let radiance = Vec3::new(rec[8] as f32, rec[9] as f32, rec[10] as f32) / 255.0
+                * 2f32.powi(e);
+            let dir = Vec3::new(snorm(12), snorm(14), snorm(16));
+            let outer = w(20) * 180.0;
+            let inner = w(22) * 180.0;
+            let cos_o = outer.to_radians().cos();
+            let cos_i = inner.to_radians().cos();
+            let (scale, offset) = if inner >= 180.0 {
+                (0.0, 1.0)
+            } else {
+                let scale = 1.0 / (cos_i - cos_o).max(SPOT_MIN_COS_DELTA as f32);
+                (scale, -cos_o * scale)
+            };
+            GpuLight {
+                position: Vec3::new(pos(0), pos(2), pos(4)),
+                radius: w(6) * packed.radius_range,
+                radiance,
+                spot_scale: scale,
+                direction: dir.normalize_or_zero(),
+                spot_offset: offset,
+                cone_deg: (outer, inner),
+            }
+        }
+    }
+}
+
+fn unorm16(x: f32) -> u16 {
+    (x.clamp(0.0, 1.0) * 65535.0).round() as u16
+}
+
+/// Shared-exponent RGB: the largest channel keeps 8 bits of mantissa.
+fn rgbe(c: Vec3) -> [u8; 4] {
+    let m = c.max_element();
+    if m.is_nan() || m < 1e-30 {
+        return [0, 0, 0, 0];
+    }
+    // 2^e > m, so every mantissa is ≤ 255.
+    let e = (m.log2().floor() as i32 + 1).clamp(-128, 127);
+    let scale = 2f32.powi(-e) * 255.0;
+    let q = |v: f32| (v * scale).round().clamp(0.0, 255.0) as u8;
+    [q(c.x), q(c.y), q(c.z), (e + 128) as u8]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::DVec3;
+
+    fn sample_lights() -> Vec<GpuLight> {
+        let view = DMat4::look_at_rh(DVec3::new(1.0, 2.0, 3.0), DVec3::ZERO, DVec3::Y);
+        (0..300)
+            .map(|i| {
+                let f = i as f64;
+                let p = DVec3::new((f * 0.37).sin() * 20.0, (f * 0.11).cos() * 5.0, -(f * 0.05));
+                let light = if i % 3 == 0 {
+                    Light::spot(p, DVec3::new(0.2, -1.0, 0.1), 10.0 + f % 20.0, 30.0 + f % 40.0, 2.0 + (f % 7.0), Vec3::new(1.0, 0.5, 0.25), 1.0 + f)
+                } else {
+                    Light::point(p, 0.5 + (f % 11.0), Vec3::new(0.2, 0.9, 0.4), 0.01 + f * 0.1)
+                };
+                GpuLight::from_light(&light, &view)
+            })
+            .collect()
+    }
+
+    #[test]
+    fn float32_round_trips_exactly() {
+        let lights = sample_lights();
+        let packed = pack_lights(&lights, LightEncoding::Float32);
+        assert_eq!(packed.width, DATA_TEXTURE_WIDTH);
+        assert_eq!(packed.height, 2); // 300 × 4 texels over 1024-wide rows
+        for (i, l) in lights.iter().enumerate() {
+            let u = unpack_light(&packed, i);
+            assert_eq!((u.position, u.radius, u.radiance), (l.position, l.radius, l.radiance));
+            assert_eq!((u.direction, u.spot_scale, u.spot_offset), (l.direction, l.spot_scale, l.spot_offset));
+        }
+    }
+
+    #[test]
+    fn rgba8_error_stays_within_its_quantisation_bounds() {
+        let lights = sample_lights();
+        let packed = pack_lights(&lights, LightEncoding::Rgba8);
+        let pos_step = 2.0 * packed.pos_range / 65535.0;
+        for (i, l) in lights.iter().enumerate() {
+            let u = unpack_light(&packed, i);
+            assert!((u.position - l.position).abs().max_element() <= pos_step * 0.51, "light {i}");
+            assert!((u.radius - l.radius).abs() <= packed.radius_range / 65535.0 * 0.51);
+            // Shared exponent: every channel within half a step of the largest channel's scale.
+            let tol = l.radiance.max_element() / 255.0;
+            assert!((u.radiance - l.radiance).abs().max_element() <= tol, "light {i}: {:?} vs {:?}", u.radiance, l.radiance);
+            if l.spot_scale != 0.0 {
+                assert!((u.direction - l.direction).length() < 1e-4);
+                assert!((u.cone_deg.0 - l.cone_deg.0).abs() < 0.002);
+            }
+        }
+    }
+
+    #[test]
+    fn rgbe_handles_zero_and_extremes() {
+        assert_eq!(rgbe(Vec3::ZERO), [0, 0, 0, 0]);
+        let big = rgbe(Vec3::splat(1e6));
+        assert!(big[0] > 127 && big[3] > 128);
+        let tiny = rgbe(Vec3::splat(1e-6));
+        assert!(tiny[0] > 127 && tiny[3] < 128);
+    }
+}

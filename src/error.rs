@@ -1,0 +1,42 @@
+//! The crate-level error: one variant per layer, plus the renderer's own.
+
+use crate::gl::GlError;
+use crate::scene::SceneError;
+
+/// Anything the library can fail with.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    /// From the GL layer (context, shaders, resources).
+    #[error(transparent)]
+    Gl(#[from] GlError),
+    /// From the scene layer (files, parsing, validation).
+    #[error(transparent)]
+    Scene(#[from] SceneError),
+    /// A method name that is not in the method table.
+    #[error("unknown method `{name}` (available: {available})")]
+    UnknownMethod {
+        /// What was asked for.
+        name: String,
+        /// The table's names.
+        available: String,
+    },
+    /// A method this context cannot run, with what is missing.
+    #[error("method `{method}` is not supported on this context: {reason}")]
+    UnsupportedMethod {
+        /// The method.
+        method: String,
+        /// What is missing.
+        reason: String,
+    },
+    /// A request the renderer cannot satisfy (too many lights for a method, bad size, …).
+    #[error("{0}")]
+    Limit(String),
+    /// Writing an output file failed.
+    #[error("cannot write {path}: {reason}")]
+    Output {
+        /// The file.
+        path: String,
+        /// Why.
+        reason: String,
+    },
+}

@@ -1,0 +1,147 @@
+//! Capability probe: versions, renderer, extensions, limits and fragment precision, read once
+//! when the [`super::Device`] is created.
+#![allow(unsafe_code)]
+
+use std::collections::BTreeSet;
+
+use glow::HasContext;
+use serde::Serialize;
+
+use super::{EsVersion, GlError};
+
+/// A shader precision as `glGetShaderPrecisionFormat` reports it.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+pub struct Precision {
+    /// log2 of the smallest magnitude.
+    pub range_min: i32,
+    /// log2 of the largest magnitude.
+    pub range_max: i32,
+    /// Bits of precision (0 = not supported).
+    pub precision: i32,
+}
+
+/// What the context can do, restricted to the requested ES level.
+#[derive(Clone, Debug, Serialize)]
+pub struct Caps {
+    /// Feature level in use (may be lower than what the driver returned).
+    pub es: EsVersion,
+    /// `major.minor` of the context the driver returned.
+    pub context_version: String,
+    /// `GL_VERSION`.
+    pub gl_version: String,
+    /// `GL_SHADING_LANGUAGE_VERSION`.
+    pub glsl_version: String,
+    /// `GL_RENDERER`.
+    pub renderer: String,
+    /// `GL_VENDOR`.
+    pub vendor: String,
+    /// `GL_MAX_TEXTURE_SIZE`.
+    pub max_texture_size: i32,
+    /// `GL_MAX_FRAGMENT_UNIFORM_VECTORS`.
+    pub max_fragment_uniform_vectors: i32,
+    /// `GL_MAX_TEXTURE_IMAGE_UNITS`.
+    pub max_texture_image_units: i32,
+    /// `GL_MAX_DRAW_BUFFERS` (1 on ES 2.0 without `GL_EXT_draw_buffers`).
+    pub max_draw_buffers: i32,
+    /// `GL_MAX_COLOR_ATTACHMENTS` (1 on ES 2.0 without `GL_EXT_draw_buffers`).
+    pub max_color_attachments: i32,
+    /// Fragment `highp float`; precision 0 means the fragment stage has no highp.
+    pub fragment_highp: Precision,
+    /// Fragment `mediump float` (fp16 on most phones, and on llvmpipe).
+    pub fragment_mediump: Precision,
+    /// RGBA32F data textures can be sampled (ES 3.0, or `GL_OES_texture_float`).
+    pub float_textures: bool,
+    /// 24-bit depth renderbuffers (ES 3.0, or `GL_OES_depth24`).
+    pub depth24: bool,
+    /// `GL_EXT_disjoint_timer_query`.
+    pub timer_query: bool,
+    /// The extension set, sorted.
+    pub extensions: BTreeSet<String>,
+}
+
+impl Caps {
+    /// Probes the current context for feature level `es`. Errors when `es` is ES 3.0 and the
+    /// driver returned less.
+    pub fn probe(gl: &glow::Context, es: EsVersion) -> Result<Caps, GlError> {
+        let v = gl.version();
+        let context_version = format!("{}.{}", v.major, v.minor);
+        if !v.is_embedded {
+            log::warn!("the context is desktop OpenGL {context_version}, not OpenGL ES");
+        }
+        if v.major < es.major() {
+            return Err(GlError::VersionUnavailable {
+                requested: es,
+                reason: format!(
+                    "the driver returned OpenGL ES {context_version}{}",
+                    if std::env::var_os("MESA_GLES_VERSION_OVERRIDE").is_some() {
+                        " (MESA_GLES_VERSION_OVERRIDE is set)"
+                    } else {
+                        ""
+                    }
+                ),
+            });
+        }
+        let extensions: BTreeSet<String> = gl.supported_extensions().iter().cloned().collect();
+        let has = |e: &str| extensions.contains(e);
+        let es3 = es == EsVersion::Es3;
+        let (gl_version, glsl_version, renderer, vendor);
+        let (max_texture_size, max_fragment_uniform_vectors, max_texture_image_units);
+        let (mut max_draw_buffers, mut max_color_attachments) = (1, 1);
+        let (fragment_highp, fragment_mediump);
+        unsafe {
+            gl_version = gl.get_parameter_string(glow::VERSION);
+            glsl_version = gl.get_parameter_string(glow::SHADING_LANGUAGE_VERSION);
+            renderer = gl.get_parameter_string(glow::RENDERER);
+            vendor = gl.get_parameter_string(glow::VENDOR);
+            max_texture_size = gl.get_parameter_i32(glow::MAX_TEXTURE_SIZE);
+            max_fragment_uniform_vectors = gl.get_parameter_i32(glow::MAX_FRAGMENT_UNIFORM_VECTORS);
+            max_texture_image_units = gl.get_parameter_i32(glow::MAX_TEXTURE_IMAGE_UNITS);
+            if es3 || has("GL_EXT_draw_buffers") {
+                max_draw_buffers = gl.get_parameter_i32(glow::MAX_DRAW_BUFFERS);
+                max_color_attachments = gl.get_parameter_i32(glow::MAX_COLOR_ATTACHMENTS);
+            }
+            let precision = |p| {
+                gl.get_shader_precision_format(glow::FRAGMENT_SHADER, p)
+                    .map(|f| Precision {
+                        range_min: f.range_min,
+                        range_max: f.range_max,
+                        precision: f.precision,
+                    })
+                    .unwrap_or_default()
+            };
+            fragment_highp = precision(glow::HIGH_FLOAT);
+            fragment_mediump = precision(glow::MEDIUM_FLOAT);
+            // Querying an unsupported enum must not leave an error behind for later checks.
+            while gl.get_error() != glow::NO_ERROR {}
+        }
+        Ok(Caps {
+            es,
+            context_version,
+            gl_version,
+            glsl_version,
+            renderer,
+            vendor,
+            max_texture_size,
+            max_fragment_uniform_vectors,
+            max_texture_image_units,
+            max_draw_buffers,
+            max_color_attachments,
+            fragment_highp,
+            fragment_mediump,
+            float_textures: es3 || has("GL_OES_texture_float"),
+            depth24: es3 || has("GL_OES_depth24"),
+            timer_query: has("GL_EXT_disjoint_timer_query"),
+            extensions,
+        })
+    }
+
+    /// True when the extension is present.
+    pub fn has_extension(&self, name: &str) -> bool {
+        self.extensions.contains(name)
+    }
+
+    /// True when fragment shaders have highp floats.
+    pub fn fragment_has_highp(&self) -> bool {
+        self.fragment_highp.precision > 0
+    }
+}

@@ -1,0 +1,236 @@
+//! Headless GL contexts through EGL.
+//!
+//! libEGL is loaded at run time (`libEGL.so.1`), so the binary starts — and can say clearly
+//! what is missing — on machines without it. Display choice: the `EGL_MESA_platform_surfaceless`
+//! platform when there is no window system (no `DISPLAY` / `WAYLAND_DISPLAY`) and the client
+//! supports it, else the default display; if the first choice fails, the other is tried.
+//! The context is made current without a surface where EGL ≥ 1.5 or
+//! `EGL_KHR_surfaceless_context` allows, else with a 1×1 pbuffer. Rendering always goes to
+//! the renderer's own framebuffer objects.
+#![allow(unsafe_code)]
+
+use khronos_egl as egl;
+
+use super::{EsVersion, GlError};
+
+type Egl = egl::DynamicInstance<egl::EGL1_4>;
+
+/// `EGL_PLATFORM_SURFACELESS_MESA`.
+const PLATFORM_SURFACELESS_MESA: egl::Enum = 0x31DD;
+
+/// An EGL display + context current on the creating thread. Keep it alive as long as anything
+/// uses the GL context it made (the [`crate::Renderer`] built from [`HeadlessContext::load_gl`]).
+pub struct HeadlessContext {
+    egl: Egl,
+    display: egl::Display,
+    context: egl::Context,
+    surface: Option<egl::Surface>,
+    info: EglInfo,
+}
+
+/// How the context was made, for `manylight info`.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct EglInfo {
+    /// `surfaceless` or `default`.
+    pub platform: String,
+    /// EGL version of the display.
+    pub egl_version: String,
+    /// `EGL_VENDOR`.
+    pub egl_vendor: String,
+    /// True when no surface is bound (surfaceless context).
+    pub surfaceless_context: bool,
+    /// ES version requested from EGL.
+    pub requested: EsVersion,
+}
+
+fn egl_err(call: &'static str) -> impl Fn(egl::Error) -> GlError {
+    move |e| GlError::Egl {
+        call,
+        error: e.to_string(),
+    }
+}
+
+impl HeadlessContext {
+    /// Creates a context for `es` and makes it current on this thread.
+    pub fn new(es: EsVersion) -> Result<Self, GlError> {
+        let egl = unsafe { Egl::load_required_from_filename("libEGL.so.1") }
+            .or_else(|_| unsafe { Egl::load_required_from_filename("libEGL.so") })
+            .map_err(|e| GlError::EglLoad(e.to_string()))?;
+        let client_ext = egl
+            .query_string(None, egl::EXTENSIONS)
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        let window_system = std::env::var_os("DISPLAY").is_some()
+            || std::env::var_os("WAYLAND_DISPLAY").is_some();
+        let surfaceless_ok = client_ext.contains("EGL_MESA_platform_surfaceless");
+        let order: &[&str] = if surfaceless_ok && !window_system {
+            &["surfaceless", "default"]
+        } else if surfaceless_ok {
+            &["default", "surfaceless"]
+        } else {
+            &["default"]
+        };
+        let mut last_err = None;
+        for platform in order {
+            match Self::with_platform(&egl, platform, es) {
+                Ok((display, context, surface, info)) => {
+                    return Ok(HeadlessContext {
+                        egl,
+                        display,
+                        context,
+                        surface,
+                        info,
+                    })
+                }
+                Err(e @ GlError::VersionUnavailable { .. }) => return Err(e),
+                Err(e) => {
+                    log::info!("EGL {platform} display failed: {e}");
+                    last_err = Some(e);
+                }
+            }
+        }
+        Err(last_err.expect("at least one platform tried"))
+    }
+
+    fn open_display(egl: &Egl, platform: &str) -> Result<egl::Display, GlError> {
+        if platform == "surfaceless" {
+            let egl15 = egl.upcast::<egl::EGL1_5>().ok_or_else(|| GlError::Egl {
+                call: "eglGetPlatformDisplay",
+                error: "EGL 1.5 is not available".into(),
+            })?;
+            unsafe {
+                egl15.get_platform_display(
+                    PLATFORM_SURFACELESS_MESA,
+                    egl::DEFAULT_DISPLAY,
+                    &[egl::ATTRIB_NONE],
+                )
+            }
+            .map_err(egl_err("eglGetPlatformDisplay"))
+        } else {
+            unsafe { egl.get_display(egl::DEFAULT_DISPLAY) }.ok_or(GlError::Egl {
+                call: "eglGetDisplay",
+                error: "no default display".into(),
+            })
+        }
+    }
+
+    #[allow(clippy::type_complexity)]
+    fn with_platform(
+        egl: &Egl,
+        platform: &str,
+        es: EsVersion,
+    ) -> Result<(egl::Display, egl::Context, Option<egl::Surface>, EglInfo), GlError> {
+        let display = Self::open_display(egl, platform)?;
+        let (major, minor) = egl.initialize(display).map_err(egl_err("eglInitialize"))?;
+        egl.bind_api(egl::OPENGL_ES_API)
+            .map_err(egl_err("eglBindAPI"))?;
+        let renderable = match es {
+            EsVersion::Es2 => egl::OPENGL_ES2_BIT,
+            EsVersion::Es3 => egl::OPENGL_ES3_BIT,
+        };
+        let with_pbuffer = [
+            egl::RENDERABLE_TYPE,
+            renderable,
+            egl::SURFACE_TYPE,
+            egl::PBUFFER_BIT,
+            egl::NONE,
+        ];
+        let any_surface = [egl::RENDERABLE_TYPE, renderable, egl::NONE];
+        let config = match egl
+            .choose_first_config(display, &with_pbuffer)
+            .map_err(egl_err("eglChooseConfig"))?
+        {
+            Some(c) => Some(c),
+            None => egl
+                .choose_first_config(display, &any_surface)
+                .map_err(egl_err("eglChooseConfig"))?,
+        };
+        let config = config.ok_or_else(|| GlError::VersionUnavailable {
+            requested: es,
+            reason: format!("no EGL config can render OpenGL {es} on the {platform} display"),
+        })?;
+        let context = egl
+            .create_context(
+                display,
+                config,
+                None,
+                &[egl::CONTEXT_CLIENT_VERSION, es.major() as egl::Int, egl::NONE],
+            )
+            .map_err(|e| GlError::VersionUnavailable {
+                requested: es,
+                reason: format!(
+                    "eglCreateContext: {e}{}",
+                    if std::env::var_os("MESA_GLES_VERSION_OVERRIDE").is_some() {
+                        " (MESA_GLES_VERSION_OVERRIDE is set and caps the version)"
+                    } else {
+                        ""
+                    }
+                ),
+            })?;
+        let display_ext = egl
+            .query_string(Some(display), egl::EXTENSIONS)
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        let surfaceless =
+            (major, minor) >= (1, 5) || display_ext.contains("EGL_KHR_surfaceless_context");
+        let surface = if surfaceless {
+            None
+        } else {
+            Some(
+                egl.create_pbuffer_surface(
+                    display,
+                    config,
+                    &[egl::WIDTH, 1, egl::HEIGHT, 1, egl::NONE],
+                )
+                .map_err(egl_err("eglCreatePbufferSurface"))?,
+            )
+        };
+        if let Err(e) = egl.make_current(display, surface, surface, Some(context)) {
+            if let Some(s) = surface {
+                let _ = egl.destroy_surface(display, s);
+            }
+            let _ = egl.destroy_context(display, context);
+            return Err(egl_err("eglMakeCurrent")(e));
+        }
+        let egl_vendor = egl
+            .query_string(Some(display), egl::VENDOR)
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        let info = EglInfo {
+            platform: platform.to_string(),
+            egl_version: format!("{major}.{minor}"),
+            egl_vendor,
+            surfaceless_context: surface.is_none(),
+            requested: es,
+        };
+        Ok((display, context, surface, info))
+    }
+
+    /// A glow context for the current EGL context (cheap: it loads function pointers).
+    pub fn load_gl(&self) -> glow::Context {
+        unsafe {
+            glow::Context::from_loader_function(|name| {
+                self.egl
+                    .get_proc_address(name)
+                    .map_or(std::ptr::null(), |f| f as *const std::ffi::c_void)
+            })
+        }
+    }
+
+    /// How the context was made.
+    pub fn info(&self) -> &EglInfo {
+        &self.info
+    }
+}
+
+impl Drop for HeadlessContext {
+    fn drop(&mut self) {
+        // The display is shared by every context of the process (EGL returns the same handle),
+        // so it is never terminated here: other threads may still be rendering on it.
+        let _ = self.egl.make_current(self.display, None, None, None);
+        if let Some(s) = self.surface {
+            let _ = self.egl.destroy_surface(self.display, s);
+        }
+        let _ = self.egl.destroy_context(self.display, self.context);
+    }
+}

@@ -1,0 +1,95 @@
+//! A glow context plus its capabilities, and the frame-level calls every pass needs.
+#![allow(unsafe_code)]
+
+use glow::HasContext;
+
+use super::{Caps, EsVersion, GlError};
+
+/// The GL context the renderer draws with. Created from a glow context the caller owns (a
+/// game's, or [`super::HeadlessContext::load_gl`]) and the ES level to restrict itself to.
+pub struct Device {
+    pub(crate) gl: glow::Context,
+    caps: Caps,
+}
+
+impl Device {
+    /// Wraps a current glow context and probes its capabilities.
+    pub fn new(gl: glow::Context, es: EsVersion) -> Result<Device, GlError> {
+        let caps = Caps::probe(&gl, es)?;
+        Ok(Device { gl, caps })
+    }
+
+    /// The probed capabilities.
+    pub fn caps(&self) -> &Caps {
+        &self.caps
+    }
+
+    /// The feature level in use.
+    pub fn es(&self) -> EsVersion {
+        self.caps.es
+    }
+
+    /// Sets the viewport.
+    pub fn viewport(&self, x: i32, y: i32, width: i32, height: i32) {
+        unsafe { self.gl.viewport(x, y, width, height) }
+    }
+
+    /// Clears colour and depth of the bound framebuffer.
+    pub fn clear(&self, color: [f32; 4]) {
+        unsafe {
+            self.gl.color_mask(true, true, true, true);
+            self.gl.depth_mask(true);
+            self.gl.clear_color(color[0], color[1], color[2], color[3]);
+            self.gl.clear_depth_f32(1.0);
+            self.gl.clear(glow::COLOR_BUFFER_BIT | glow::DEPTH_BUFFER_BIT);
+        }
+    }
+
+    /// Blocks until the GPU has finished all submitted work (wall-clock frame timing).
+    pub fn finish(&self) {
+        unsafe { self.gl.finish() }
+    }
+
+    /// Binds the default framebuffer (a window's back buffer).
+    pub fn bind_default_framebuffer(&self) {
+        unsafe { self.gl.bind_framebuffer(glow::FRAMEBUFFER, None) }
+    }
+
+    /// Returns the first pending GL error as [`GlError::Driver`], draining the queue.
+    pub fn check(&self, what: &str) -> Result<(), GlError> {
+        let code = unsafe { self.gl.get_error() };
+        if code == glow::NO_ERROR {
+            return Ok(());
+        }
+        unsafe { while self.gl.get_error() != glow::NO_ERROR {} }
+        Err(GlError::Driver {
+            what: what.to_string(),
+            name: error_name(code),
+            code,
+        })
+    }
+}
+
+/// Debug builds check `glGetError` after the wrapped step and panic with its decoded name;
+/// release builds compile it out (one check per frame still runs via [`Device::check`]).
+#[macro_export]
+macro_rules! gl_check {
+    ($device:expr, $what:expr) => {
+        #[cfg(debug_assertions)]
+        if let Err(e) = $device.check($what) {
+            panic!("{e}");
+        }
+    };
+}
+
+/// Name of a `glGetError` code.
+pub fn error_name(code: u32) -> &'static str {
+    match code {
+        glow::INVALID_ENUM => "GL_INVALID_ENUM",
+        glow::INVALID_VALUE => "GL_INVALID_VALUE",
+        glow::INVALID_OPERATION => "GL_INVALID_OPERATION",
+        glow::INVALID_FRAMEBUFFER_OPERATION => "GL_INVALID_FRAMEBUFFER_OPERATION",
+        glow::OUT_OF_MEMORY => "GL_OUT_OF_MEMORY",
+        _ => "unknown GL error",
+    }
+}

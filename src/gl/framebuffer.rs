@@ -1,0 +1,149 @@
+//! Offscreen render targets: an RGBA8 colour texture (renderable in ES 2.0 core, unlike RGBA8
+//! renderbuffers) and a depth renderbuffer (24-bit where available: tiny near planes need it).
+#![allow(unsafe_code)]
+
+use glow::HasContext;
+
+use super::{Device, EsVersion, GlError};
+
+/// An offscreen framebuffer of a fixed size.
+pub struct OffscreenTarget {
+    fbo: glow::Framebuffer,
+    color: glow::Texture,
+    depth: glow::Renderbuffer,
+    width: u32,
+    height: u32,
+    destroyed: bool,
+}
+
+impl OffscreenTarget {
+    /// Creates a `width × height` target.
+    pub fn new(dev: &Device, width: u32, height: u32) -> Result<OffscreenTarget, GlError> {
+        let max = dev.caps().max_texture_size as u32;
+        if width == 0 || height == 0 || width > max || height > max {
+            return Err(GlError::Unsupported(format!(
+                "render target {width}×{height} is outside 1..={max} (GL_MAX_TEXTURE_SIZE)"
+            )));
+        }
+        let gl = &dev.gl;
+        unsafe {
+            let color = gl.create_texture().map_err(GlError::Create)?;
+            gl.bind_texture(glow::TEXTURE_2D, Some(color));
+            let internal = if dev.es() == EsVersion::Es3 { glow::RGBA8 } else { glow::RGBA };
+            gl.tex_image_2d(
+                glow::TEXTURE_2D,
+                0,
+                internal as i32,
+                width as i32,
+                height as i32,
+                0,
+                glow::RGBA,
+                glow::UNSIGNED_BYTE,
+                glow::PixelUnpackData::Slice(None),
+            );
+            for (p, v) in [
+                (glow::TEXTURE_MIN_FILTER, glow::NEAREST),
+                (glow::TEXTURE_MAG_FILTER, glow::NEAREST),
+                (glow::TEXTURE_WRAP_S, glow::CLAMP_TO_EDGE),
+                (glow::TEXTURE_WRAP_T, glow::CLAMP_TO_EDGE),
+            ] {
+                gl.tex_parameter_i32(glow::TEXTURE_2D, p, v as i32);
+            }
+            let depth = gl.create_renderbuffer().map_err(GlError::Create)?;
+            gl.bind_renderbuffer(glow::RENDERBUFFER, Some(depth));
+            let depth_format = if dev.caps().depth24 {
+                glow::DEPTH_COMPONENT24
+            } else {
+                glow::DEPTH_COMPONENT16
+            };
+            gl.renderbuffer_storage(glow::RENDERBUFFER, depth_format, width as i32, height as i32);
+            let fbo = gl.create_framebuffer().map_err(GlError::Create)?;
+            gl.bind_framebuffer(glow::FRAMEBUFFER, Some(fbo));
+            gl.framebuffer_texture_2d(
+                glow::FRAMEBUFFER,
+                glow::COLOR_ATTACHMENT0,
+                glow::TEXTURE_2D,
+                Some(color),
+                0,
+            );
+            gl.framebuffer_renderbuffer(
+                glow::FRAMEBUFFER,
+                glow::DEPTH_ATTACHMENT,
+                glow::RENDERBUFFER,
+                Some(depth),
+            );
+            let status = gl.check_framebuffer_status(glow::FRAMEBUFFER);
+            let mut target = OffscreenTarget {
+                fbo,
+                color,
+                depth,
+                width,
+                height,
+                destroyed: false,
+            };
+            if status != glow::FRAMEBUFFER_COMPLETE {
+                target.destroy(dev);
+                return Err(GlError::FramebufferIncomplete(status));
+            }
+            dev.check("offscreen target creation")?;
+            Ok(target)
+        }
+    }
+
+    /// Binds the target and sets the viewport to cover it.
+    pub fn bind(&self, dev: &Device) {
+        unsafe { dev.gl.bind_framebuffer(glow::FRAMEBUFFER, Some(self.fbo)) };
+        dev.viewport(0, 0, self.width as i32, self.height as i32);
+    }
+
+    /// Size in pixels.
+    pub fn size(&self) -> (u32, u32) {
+        (self.width, self.height)
+    }
+
+    /// Reads the colour buffer, top row first (as image files store it).
+    pub fn read_rgba8(&self, dev: &Device) -> Result<image::RgbaImage, GlError> {
+        let (w, h) = (self.width as usize, self.height as usize);
+        let mut pixels = vec![0u8; w * h * 4];
+        unsafe {
+            dev.gl.bind_framebuffer(glow::FRAMEBUFFER, Some(self.fbo));
+            dev.gl.pixel_store_i32(glow::PACK_ALIGNMENT, 1);
+            dev.gl.read_pixels(
+                0,
+                0,
+                w as i32,
+                h as i32,
+                glow::RGBA,
+                glow::UNSIGNED_BYTE,
+                glow::PixelPackData::Slice(Some(&mut pixels)),
+            );
+        }
+        dev.check("glReadPixels")?;
+        // GL's row 0 is the bottom row.
+        let mut flipped = Vec::with_capacity(pixels.len());
+        for row in pixels.chunks_exact(w * 4).rev() {
+            flipped.extend_from_slice(row);
+        }
+        Ok(image::RgbaImage::from_raw(self.width, self.height, flipped).expect("size matches"))
+    }
+
+    /// Frees the framebuffer and its attachments.
+    pub fn destroy(&mut self, dev: &Device) {
+        if !self.destroyed {
+            unsafe {
+                dev.gl.delete_framebuffer(self.fbo);
+                dev.gl.delete_texture(self.color);
+                dev.gl.delete_renderbuffer(self.depth);
+            }
+            self.destroyed = true;
+        }
+    }
+}
+
+impl Drop for OffscreenTarget {
+    fn drop(&mut self) {
+        if !self.destroyed {
+            log::warn!("OffscreenTarget dropped without destroy(): GL objects leaked");
+        }
+    }
+}

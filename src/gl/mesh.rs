@@ -1,0 +1,158 @@
+//! GPU meshes. ES 2.0 core only has 16-bit indices (32-bit needs `OES_element_index_uint`), so
+//! every mesh is split into chunks of at most 65 536 vertices with `u16` indices: one code
+//! path that works on every device.
+#![allow(unsafe_code)]
+
+use std::collections::HashMap;
+
+use glow::HasContext;
+
+use super::{Device, GlError};
+use crate::scene::Mesh;
+
+/// Floats per interleaved vertex: position (3), normal (3), uv (2).
+pub const VERTEX_FLOATS: usize = 8;
+
+/// One chunk of a mesh, CPU side: interleaved vertices and 16-bit indices.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Chunk {
+    /// `VERTEX_FLOATS` floats per vertex.
+    pub vertices: Vec<f32>,
+    /// Triangle list.
+    pub indices: Vec<u16>,
+}
+
+/// Splits a mesh into chunks whose vertices fit 16-bit indices; triangles stay whole.
+pub fn split_u16(mesh: &Mesh) -> Vec<Chunk> {
+    const LIMIT: usize = u16::MAX as usize + 1;
+    let mut chunks = Vec::new();
+    let mut remap: HashMap<u32, u16> = HashMap::new();
+    let mut cur = Chunk { vertices: Vec::new(), indices: Vec::new() };
+    for tri in mesh.indices.chunks_exact(3) {
+        let new_vertices = tri.iter().filter(|i| !remap.contains_key(i)).count();
+        if remap.len() + new_vertices > LIMIT {
+            chunks.push(std::mem::replace(&mut cur, Chunk { vertices: Vec::new(), indices: Vec::new() }));
+            remap.clear();
+        }
+        for &i in tri {
+            let local = *remap.entry(i).or_insert_with(|| {
+                let v = i as usize;
+                let p = mesh.positions[v];
+                let n = mesh.normals[v];
+                let uv = mesh.uvs.get(v).copied().unwrap_or_default();
+                cur.vertices.extend_from_slice(&[p.x, p.y, p.z, n.x, n.y, n.z, uv.x, uv.y]);
+                (cur.vertices.len() / VERTEX_FLOATS - 1) as u16
+            });
+            cur.indices.push(local);
+        }
+    }
+    if !cur.indices.is_empty() {
+        chunks.push(cur);
+    }
+    chunks
+}
+
+struct GpuChunk {
+    vbo: glow::Buffer,
+    ibo: glow::Buffer,
+    index_count: i32,
+}
+
+/// A mesh uploaded as static vertex and index buffers.
+pub struct GpuMesh {
+    chunks: Vec<GpuChunk>,
+    bytes: usize,
+    destroyed: bool,
+}
+
+impl GpuMesh {
+    /// Uploads a mesh.
+    pub fn new(dev: &Device, mesh: &Mesh) -> Result<GpuMesh, GlError> {
+        let gl = &dev.gl;
+        let mut out = GpuMesh { chunks: Vec::new(), bytes: 0, destroyed: false };
+        for chunk in split_u16(mesh) {
+            unsafe {
+                let vbo = gl.create_buffer().map_err(GlError::Create)?;
+                gl.bind_buffer(glow::ARRAY_BUFFER, Some(vbo));
+                gl.buffer_data_u8_slice(glow::ARRAY_BUFFER, bytemuck::cast_slice(&chunk.vertices), glow::STATIC_DRAW);
+                let ibo = gl.create_buffer().map_err(GlError::Create)?;
+                gl.bind_buffer(glow::ELEMENT_ARRAY_BUFFER, Some(ibo));
+                gl.buffer_data_u8_slice(glow::ELEMENT_ARRAY_BUFFER, bytemuck::cast_slice(&chunk.indices), glow::STATIC_DRAW);
+                out.bytes += chunk.vertices.len() * 4 + chunk.indices.len() * 2;
+                out.chunks.push(GpuChunk { vbo, ibo, index_count: chunk.indices.len() as i32 });
+            }
+        }
+        dev.check("mesh upload")?;
+        Ok(out)
+    }
+
+    /// Draws all chunks with the bound program (attributes at [`super::program::ATTRIBUTES`]).
+    pub fn draw(&self, dev: &Device) {
+        let gl = &dev.gl;
+        let stride = (VERTEX_FLOATS * 4) as i32;
+        unsafe {
+            for c in &self.chunks {
+                gl.bind_buffer(glow::ARRAY_BUFFER, Some(c.vbo));
+                gl.bind_buffer(glow::ELEMENT_ARRAY_BUFFER, Some(c.ibo));
+                for (loc, size, offset) in [(0u32, 3, 0), (1, 3, 12), (2, 2, 24)] {
+                    gl.enable_vertex_attrib_array(loc);
+                    gl.vertex_attrib_pointer_f32(loc, size, glow::FLOAT, false, stride, offset);
+                }
+                gl.draw_elements(glow::TRIANGLES, c.index_count, glow::UNSIGNED_SHORT, 0);
+            }
+        }
+    }
+
+    /// GPU bytes held by the buffers.
+    pub fn gpu_bytes(&self) -> usize {
+        self.bytes
+    }
+
+    /// Frees the buffers.
+    pub fn destroy(&mut self, dev: &Device) {
+        if !self.destroyed {
+            for c in self.chunks.drain(..) {
+                unsafe {
+                    dev.gl.delete_buffer(c.vbo);
+                    dev.gl.delete_buffer(c.ibo);
+                }
+            }
+            self.destroyed = true;
+        }
+    }
+}
+
+impl Drop for GpuMesh {
+    fn drop(&mut self) {
+        if !self.destroyed {
+            log::warn!("GpuMesh dropped without destroy(): GL buffers leaked");
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::Vec3;
+
+    #[test]
+    fn splits_large_meshes_into_u16_chunks_without_losing_triangles() {
+        // 70 000 separate triangles = 210 000 vertices → at least 4 chunks.
+        let n = 70_000u32;
+        let positions: Vec<Vec3> = (0..n * 3).map(|i| Vec3::new(i as f32, (i % 3) as f32, 0.0)).collect();
+        let indices: Vec<u32> = (0..n * 3).collect();
+        let mesh = Mesh::new(positions.clone(), vec![], vec![], indices).unwrap();
+        let chunks = split_u16(&mesh);
+        assert!(chunks.len() >= 4);
+        let mut seen = 0;
+        for c in &chunks {
+            assert!(c.vertices.len() / VERTEX_FLOATS <= 65_536);
+            for (k, &i) in c.indices.iter().enumerate() {
+                let x = c.vertices[i as usize * VERTEX_FLOATS];
+                assert_eq!(x, positions[seen + k].x);
+            }
+            seen += c.indices.len();
+        }
+        assert_eq!(seen, (n * 3) as usize);
+    }
+}

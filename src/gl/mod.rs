@@ -1,0 +1,139 @@
+//! The only module that calls glow (and the only one allowed `unsafe`).
+//!
+//! * [`context`] — headless EGL contexts (khronos-egl, `libEGL.so.1` loaded at run time).
+//! * [`caps`] — what the context can do, probed once.
+//! * [`device`] — a glow context plus its caps; frame-level calls (viewport, clear, finish).
+//! * [`shader_source`] — GLSL assembly from `glsl/` (GL-free, so it is validated offline too).
+//! * [`program`] — compile/link, uniforms, and the program cache.
+//! * [`texture`], [`framebuffer`], [`mesh`], [`state`] — GPU resources and render state.
+//!
+//! Every GL object has an explicit `destroy(&Device)`; `Drop` only warns when it was never
+//! called, because GL objects cannot be freed without the context at hand.
+
+pub mod caps;
+pub mod context;
+pub mod device;
+pub mod framebuffer;
+pub mod mesh;
+pub mod program;
+pub mod shader_source;
+pub mod state;
+pub mod texture;
+
+pub use caps::Caps;
+pub use context::HeadlessContext;
+pub use device::Device;
+
+use serde::Serialize;
+
+/// The OpenGL ES feature level the renderer targets. With [`EsVersion::Es2`] the renderer uses
+/// ES 2.0 core plus probed extensions and compiles GLSL ES 1.00, even on a driver that returns
+/// a 3.x context.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
+pub enum EsVersion {
+    /// OpenGL ES 2.0, GLSL ES 1.00.
+    #[serde(rename = "2.0")]
+    Es2,
+    /// OpenGL ES 3.0, GLSL ES 3.00.
+    #[serde(rename = "3.0")]
+    Es3,
+}
+
+impl EsVersion {
+    /// Major version number.
+    pub fn major(self) -> u32 {
+        match self {
+            EsVersion::Es2 => 2,
+            EsVersion::Es3 => 3,
+        }
+    }
+
+    /// From a major version number (2 or 3).
+    pub fn from_major(major: u32) -> Option<Self> {
+        match major {
+            2 => Some(EsVersion::Es2),
+            3 => Some(EsVersion::Es3),
+            _ => None,
+        }
+    }
+}
+
+impl std::fmt::Display for EsVersion {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "ES {}.0", self.major())
+    }
+}
+
+/// Errors of the GL layer.
+#[derive(Debug, thiserror::Error)]
+pub enum GlError {
+    /// libEGL could not be loaded or lacks EGL 1.4.
+    #[error("cannot load libEGL.so.1 ({0}); install libegl1 and a driver such as libegl-mesa0")]
+    EglLoad(String),
+    /// An EGL call failed.
+    #[error("EGL {call} failed: {error}")]
+    Egl {
+        /// The EGL function.
+        call: &'static str,
+        /// EGL's error.
+        error: String,
+    },
+    /// The driver cannot give the requested ES version.
+    #[error("the driver cannot create an OpenGL {requested} context: {reason}")]
+    VersionUnavailable {
+        /// What was asked for.
+        requested: EsVersion,
+        /// What happened (EGL error or the version the driver returned).
+        reason: String,
+    },
+    /// A shader failed to compile; carries everything needed to find the problem.
+    #[error(
+        "failed to compile {stage} shader `{shader}` ({dialect}, defines: [{defines}]):\n{log}\n--- source ---\n{numbered_source}"
+    )]
+    ShaderCompile {
+        /// Shader name in `glsl/`.
+        shader: String,
+        /// `vertex` or `fragment`.
+        stage: &'static str,
+        /// Dialect it was assembled for.
+        dialect: EsVersion,
+        /// The variant's `#define`s.
+        defines: String,
+        /// The driver's info log.
+        log: String,
+        /// The assembled source with line numbers.
+        numbered_source: String,
+    },
+    /// A program failed to link.
+    #[error("failed to link program `{shader}` (defines: [{defines}]): {log}")]
+    ProgramLink {
+        /// Shader name.
+        shader: String,
+        /// The variant's `#define`s.
+        defines: String,
+        /// The driver's info log.
+        log: String,
+    },
+    /// Shader assembly failed (unknown file or include).
+    #[error("shader assembly: {0}")]
+    ShaderSource(String),
+    /// A required capability is missing.
+    #[error("{0}")]
+    Unsupported(String),
+    /// A framebuffer is incomplete.
+    #[error("framebuffer incomplete: status 0x{0:04x}")]
+    FramebufferIncomplete(u32),
+    /// The driver reported an error.
+    #[error("GL error {name} (0x{code:04x}) after {what}")]
+    Driver {
+        /// Which step.
+        what: String,
+        /// Decoded name.
+        name: &'static str,
+        /// Raw code.
+        code: u32,
+    },
+    /// Object creation failed.
+    #[error("GL object creation failed: {0}")]
+    Create(String),
+}

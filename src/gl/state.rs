@@ -1,0 +1,98 @@
+//! Render state as a value: every pass declares its full state and applies it in one place,
+//! so no pass inherits a stray blend or depth setting from the one before.
+#![allow(unsafe_code)]
+
+use glow::HasContext;
+
+use super::Device;
+
+/// Blending.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Blend {
+    /// Replace.
+    Off,
+    /// `dst + src` (light accumulation).
+    Additive,
+    /// `src·a + dst·(1−a)` (transparency).
+    Alpha,
+}
+
+/// Depth test.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DepthTest {
+    /// No depth test.
+    Off,
+    /// `LESS`.
+    Less,
+    /// `LEQUAL` (passes after an equal-depth prepass).
+    LessEqual,
+}
+
+/// Face culling.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Cull {
+    /// Draw both sides (OBJ files often have inconsistent winding).
+    None,
+    /// Cull back faces.
+    Back,
+}
+
+/// The full fixed-function state of a pass.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct RenderState {
+    /// Depth test function.
+    pub depth_test: DepthTest,
+    /// Depth writes.
+    pub depth_write: bool,
+    /// Blending.
+    pub blend: Blend,
+    /// Culling.
+    pub cull: Cull,
+}
+
+impl RenderState {
+    /// Opaque geometry: depth test and write, no blending, both faces.
+    pub const OPAQUE: RenderState = RenderState {
+        depth_test: DepthTest::Less,
+        depth_write: true,
+        blend: Blend::Off,
+        cull: Cull::None,
+    };
+
+    /// Applies every field.
+    pub fn apply(&self, dev: &Device) {
+        let gl = &dev.gl;
+        unsafe {
+            match self.depth_test {
+                DepthTest::Off => gl.disable(glow::DEPTH_TEST),
+                DepthTest::Less => {
+                    gl.enable(glow::DEPTH_TEST);
+                    gl.depth_func(glow::LESS);
+                }
+                DepthTest::LessEqual => {
+                    gl.enable(glow::DEPTH_TEST);
+                    gl.depth_func(glow::LEQUAL);
+                }
+            }
+            gl.depth_mask(self.depth_write);
+            match self.blend {
+                Blend::Off => gl.disable(glow::BLEND),
+                Blend::Additive => {
+                    gl.enable(glow::BLEND);
+                    gl.blend_func(glow::ONE, glow::ONE);
+                }
+                Blend::Alpha => {
+                    gl.enable(glow::BLEND);
+                    gl.blend_func(glow::SRC_ALPHA, glow::ONE_MINUS_SRC_ALPHA);
+                }
+            }
+            match self.cull {
+                Cull::None => gl.disable(glow::CULL_FACE),
+                Cull::Back => {
+                    gl.enable(glow::CULL_FACE);
+                    gl.cull_face(glow::BACK);
+                }
+            }
+        }
+    }
+}

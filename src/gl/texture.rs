@@ -1,0 +1,221 @@
+//! Textures: data textures (light records, later cluster grids and index lists) read texel by
+//! texel, and image textures (diffuse maps) sampled with filtering.
+#![allow(unsafe_code)]
+
+use glow::HasContext;
+
+use super::{Device, EsVersion, GlError};
+
+/// Texel format of a data texture.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DataFormat {
+    /// Four f32 channels (ES 3.0 `RGBA32F`, ES 2.0 `RGBA` + `FLOAT` with `OES_texture_float`).
+    Rgba32F,
+    /// Four bytes.
+    Rgba8,
+}
+
+impl DataFormat {
+    /// Bytes per texel.
+    pub fn bytes_per_texel(self) -> usize {
+        match self {
+            DataFormat::Rgba32F => 16,
+            DataFormat::Rgba8 => 4,
+        }
+    }
+}
+
+/// A NEAREST, CLAMP_TO_EDGE texture of raw records.
+pub struct DataTexture {
+    raw: glow::Texture,
+    format: DataFormat,
+    size: (u32, u32),
+    destroyed: bool,
+}
+
+fn set_sampling(gl: &glow::Context, filter: u32, wrap: u32, min_filter: u32) {
+    unsafe {
+        gl.tex_parameter_i32(glow::TEXTURE_2D, glow::TEXTURE_MAG_FILTER, filter as i32);
+        gl.tex_parameter_i32(glow::TEXTURE_2D, glow::TEXTURE_MIN_FILTER, min_filter as i32);
+        gl.tex_parameter_i32(glow::TEXTURE_2D, glow::TEXTURE_WRAP_S, wrap as i32);
+        gl.tex_parameter_i32(glow::TEXTURE_2D, glow::TEXTURE_WRAP_T, wrap as i32);
+    }
+}
+
+impl DataTexture {
+    /// Creates an empty data texture; storage is allocated by the first upload.
+    pub fn new(dev: &Device, format: DataFormat) -> Result<DataTexture, GlError> {
+        if format == DataFormat::Rgba32F && !dev.caps().float_textures {
+            return Err(GlError::Unsupported(
+                "float data textures need ES 3.0 or GL_OES_texture_float".into(),
+            ));
+        }
+        let raw = unsafe { dev.gl.create_texture() }.map_err(GlError::Create)?;
+        unsafe { dev.gl.bind_texture(glow::TEXTURE_2D, Some(raw)) };
+        set_sampling(&dev.gl, glow::NEAREST, glow::CLAMP_TO_EDGE, glow::NEAREST);
+        Ok(DataTexture {
+            raw,
+            format,
+            size: (0, 0),
+            destroyed: false,
+        })
+    }
+
+    /// Uploads `bytes` (`width × height` texels); reallocates only when the size changes.
+    pub fn upload(&mut self, dev: &Device, width: u32, height: u32, bytes: &[u8]) -> Result<(), GlError> {
+        let expected = width as usize * height as usize * self.format.bytes_per_texel();
+        if bytes.len() != expected {
+            return Err(GlError::Unsupported(format!(
+                "data texture upload of {} bytes for {width}×{height} texels (expected {expected})",
+                bytes.len()
+            )));
+        }
+        let max = dev.caps().max_texture_size as u32;
+        if width > max || height > max {
+            return Err(GlError::Unsupported(format!(
+                "data texture {width}×{height} exceeds GL_MAX_TEXTURE_SIZE {max}"
+            )));
+        }
+        let gl = &dev.gl;
+        let (internal, ty) = match (self.format, dev.es()) {
+            (DataFormat::Rgba32F, EsVersion::Es3) => (glow::RGBA32F, glow::FLOAT),
+            (DataFormat::Rgba32F, EsVersion::Es2) => (glow::RGBA, glow::FLOAT),
+            (DataFormat::Rgba8, EsVersion::Es3) => (glow::RGBA8, glow::UNSIGNED_BYTE),
+            (DataFormat::Rgba8, EsVersion::Es2) => (glow::RGBA, glow::UNSIGNED_BYTE),
+        };
+        unsafe {
+            gl.bind_texture(glow::TEXTURE_2D, Some(self.raw));
+            gl.pixel_store_i32(glow::UNPACK_ALIGNMENT, 1);
+            if self.size == (width, height) {
+                gl.tex_sub_image_2d(
+                    glow::TEXTURE_2D,
+                    0,
+                    0,
+                    0,
+                    width as i32,
+                    height as i32,
+                    glow::RGBA,
+                    ty,
+                    glow::PixelUnpackData::Slice(Some(bytes)),
+                );
+            } else {
+                gl.tex_image_2d(
+                    glow::TEXTURE_2D,
+                    0,
+                    internal as i32,
+                    width as i32,
+                    height as i32,
+                    0,
+                    glow::RGBA,
+                    ty,
+                    glow::PixelUnpackData::Slice(Some(bytes)),
+                );
+                self.size = (width, height);
+            }
+        }
+        dev.check("data texture upload")
+    }
+
+    /// Binds to texture unit `unit`.
+    pub fn bind(&self, dev: &Device, unit: u32) {
+        unsafe {
+            dev.gl.active_texture(glow::TEXTURE0 + unit);
+            dev.gl.bind_texture(glow::TEXTURE_2D, Some(self.raw));
+        }
+    }
+
+    /// Allocated size in texels.
+    pub fn size(&self) -> (u32, u32) {
+        self.size
+    }
+
+    /// GPU bytes held.
+    pub fn gpu_bytes(&self) -> usize {
+        self.size.0 as usize * self.size.1 as usize * self.format.bytes_per_texel()
+    }
+
+    /// Frees the texture.
+    pub fn destroy(&mut self, dev: &Device) {
+        if !self.destroyed {
+            unsafe { dev.gl.delete_texture(self.raw) };
+            self.destroyed = true;
+        }
+    }
+}
+
+impl Drop for DataTexture {
+    fn drop(&mut self) {
+        if !self.destroyed {
+            log::warn!("DataTexture dropped without destroy(): GL texture leaked");
+        }
+    }
+}
+
+/// A mipmapped, repeating RGBA8 image texture (sRGB-encoded; decoded in the shader because
+/// ES 2.0 has no sRGB textures in core).
+pub struct ImageTexture {
+    raw: glow::Texture,
+    destroyed: bool,
+}
+
+impl ImageTexture {
+    /// Uploads an image. Non-power-of-two images are resized to the next power of two, because
+    /// ES 2.0 allows neither mipmaps nor `REPEAT` on them and OBJ texture coordinates tile.
+    pub fn new(dev: &Device, image: &image::RgbaImage) -> Result<ImageTexture, GlError> {
+        let max = dev.caps().max_texture_size.max(1) as u32;
+        let (w, h) = image.dimensions();
+        let (pw, ph) = (w.next_power_of_two().min(max), h.next_power_of_two().min(max));
+        let resized;
+        let img = if (pw, ph) != (w, h) {
+            resized = image::imageops::resize(image, pw, ph, image::imageops::FilterType::Triangle);
+            &resized
+        } else {
+            image
+        };
+        let gl = &dev.gl;
+        let raw = unsafe { gl.create_texture() }.map_err(GlError::Create)?;
+        unsafe {
+            gl.bind_texture(glow::TEXTURE_2D, Some(raw));
+            gl.pixel_store_i32(glow::UNPACK_ALIGNMENT, 1);
+            gl.tex_image_2d(
+                glow::TEXTURE_2D,
+                0,
+                glow::RGBA as i32,
+                pw as i32,
+                ph as i32,
+                0,
+                glow::RGBA,
+                glow::UNSIGNED_BYTE,
+                glow::PixelUnpackData::Slice(Some(img.as_raw())),
+            );
+            gl.generate_mipmap(glow::TEXTURE_2D);
+        }
+        set_sampling(gl, glow::LINEAR, glow::REPEAT, glow::LINEAR_MIPMAP_LINEAR);
+        dev.check("image texture upload")?;
+        Ok(ImageTexture { raw, destroyed: false })
+    }
+
+    /// Binds to texture unit `unit`.
+    pub fn bind(&self, dev: &Device, unit: u32) {
+        unsafe {
+            dev.gl.active_texture(glow::TEXTURE0 + unit);
+            dev.gl.bind_texture(glow::TEXTURE_2D, Some(self.raw));
+        }
+    }
+
+    /// Frees the texture.
+    pub fn destroy(&mut self, dev: &Device) {
+        if !self.destroyed {
+            unsafe { dev.gl.delete_texture(self.raw) };
+            self.destroyed = true;
+        }
+    }
+}
+
+impl Drop for ImageTexture {
+    fn drop(&mut self) {
+        if !self.destroyed {
+            log::warn!("ImageTexture dropped without destroy(): GL texture leaked");
+        }
+    }
+}

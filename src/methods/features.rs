@@ -1,0 +1,66 @@
+//! Shader feature bits → `#define`s. A variant depends only on what the scene and material
+//! have, never on how many lights there are, so the program cache stays small.
+
+use crate::cluster::pack::{LightEncoding, DATA_TEXTURE_WIDTH};
+use crate::gl::EsVersion;
+use crate::scene::light::SPOT_MIN_COS_DELTA;
+
+/// Feature bitset of a shader variant.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct ShaderFeatures(pub u64);
+
+impl ShaderFeatures {
+    /// The material has a diffuse texture.
+    pub const TEXTURE: u64 = 1 << 0;
+    /// The scene has spot lights (cone code compiled in).
+    pub const SPOT: u64 = 1 << 1;
+    /// The material has a specular term.
+    pub const SPECULAR: u64 = 1 << 2;
+    /// Light records are RGBA8-packed (ES 2.0 without float textures).
+    pub const LIGHTS_RGBA8: u64 = 1 << 3;
+    /// Write linear values (no sRGB encoding).
+    pub const OUTPUT_LINEAR: u64 = 1 << 4;
+
+    /// True when `bit` is set.
+    pub fn has(self, bit: u64) -> bool {
+        self.0 & bit != 0
+    }
+
+    /// With `bit` set or cleared.
+    pub fn with(self, bit: u64, on: bool) -> Self {
+        ShaderFeatures(if on { self.0 | bit } else { self.0 & !bit })
+    }
+
+    /// Light encoding these features select.
+    pub fn light_encoding(self) -> LightEncoding {
+        if self.has(Self::LIGHTS_RGBA8) {
+            LightEncoding::Rgba8
+        } else {
+            LightEncoding::Float32
+        }
+    }
+
+    /// The `#define`s of this variant: feature switches plus the constants shared with Rust.
+    pub fn defines(self, dialect: EsVersion, max_lights: u32) -> Vec<(String, String)> {
+        let flag = |bit| if self.has(bit) { "1" } else { "0" }.to_string();
+        vec![
+            ("HAS_TEXTURE".into(), flag(Self::TEXTURE)),
+            ("HAS_SPOT".into(), flag(Self::SPOT)),
+            ("HAS_SPECULAR".into(), flag(Self::SPECULAR)),
+            ("LIGHTS_RGBA8".into(), flag(Self::LIGHTS_RGBA8)),
+            ("OUTPUT_LINEAR".into(), flag(Self::OUTPUT_LINEAR)),
+            ("DATA_WIDTH".into(), DATA_TEXTURE_WIDTH.to_string()),
+            ("LIGHT_TEXELS".into(), self.light_encoding().texels_per_light().to_string()),
+            ("MAX_LIGHTS".into(), max_lights.to_string()),
+            ("SPOT_MIN_COS_DELTA".into(), format!("{SPOT_MIN_COS_DELTA:e}")),
+            (
+                "ES_DIALECT".into(),
+                match dialect {
+                    EsVersion::Es2 => "2",
+                    EsVersion::Es3 => "3",
+                }
+                .into(),
+            ),
+        ]
+    }
+}

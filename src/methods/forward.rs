@@ -1,0 +1,119 @@
+//! Plain forward shading: every active light evaluated for every fragment, in one geometry
+//! pass. It is also the correctness oracle of the other methods, so it stays simple and runs
+//! at the highest fragment precision available.
+//!
+//! Lights come from a data texture (`cluster::pack`): RGBA32F on ES 3.0 and on ES 2.0 with
+//! `OES_texture_float`, else the lossy RGBA8 packing. On ES 2.0 the loop has the constant bound
+//! [`max_lights`] and exits with `break` (GLSL ES 1.00 Appendix A).
+
+use super::geometry::{self, UNIT_METHOD};
+use super::{FrameContext, MethodDesc, MethodStats, ShadingMethod, Support};
+use crate::cluster::pack::{pack_lights, LightEncoding};
+use crate::gl::texture::{DataFormat, DataTexture};
+use crate::gl::{Caps, Device, EsVersion};
+use crate::Error;
+
+/// The table row.
+pub const DESC: MethodDesc = MethodDesc {
+    name: "forward",
+    summary: "every light for every fragment (the reference)",
+    min_es: EsVersion::Es2,
+    required_extensions: &[],
+    supported,
+    create: |_| Ok(Box::new(Forward::default())),
+};
+
+fn supported(caps: &Caps) -> Support {
+    let mut notes = Vec::new();
+    if !caps.float_textures {
+        notes.push("lights packed as RGBA8 (lossy) because GL_OES_texture_float is missing");
+    }
+    if !caps.fragment_has_highp() {
+        notes.push("fragment shaders run at mediump (no highp in the fragment stage)");
+    }
+    if notes.is_empty() {
+        Support::Supported
+    } else {
+        Support::Fallback(notes.join("; "))
+    }
+}
+
+/// Largest light count one forward draw can loop over on this context. ES 2.0 needs a constant
+/// loop bound that fits the fragment `int` precision: highp ints reach ±2¹⁶, mediump only ±2¹⁰.
+pub fn max_lights(caps: &Caps) -> u32 {
+    let texture_rows = caps.max_texture_size.max(1) as u32;
+    let by_texture = texture_rows
+        * (crate::cluster::pack::DATA_TEXTURE_WIDTH / LightEncoding::Rgba8.texels_per_light());
+    let by_loop = match (caps.es, caps.fragment_has_highp()) {
+        (EsVersion::Es3, _) => u32::MAX,
+        (EsVersion::Es2, true) => 65_535,
+        (EsVersion::Es2, false) => 1_023,
+    };
+    by_texture.min(by_loop)
+}
+
+/// Plain forward's GPU state: the light texture.
+#[derive(Default)]
+pub struct Forward {
+    lights: Option<(DataTexture, LightEncoding)>,
+}
+
+impl ShadingMethod for Forward {
+    fn name(&self) -> &'static str {
+        DESC.name
+    }
+
+    fn render(&mut self, ctx: &mut FrameContext) -> Result<MethodStats, Error> {
+        let dev = ctx.dev;
+        let limit = max_lights(dev.caps());
+        let count = ctx.lights.len();
+        if count > limit as usize {
+            return Err(Error::Limit(format!(
+                "forward can loop over at most {limit} lights on this context, the scene has {count} active lights; use a culling method"
+            )));
+        }
+        let encoding = ctx.features.light_encoding();
+        let mut stats = MethodStats::default();
+        // Recreate the texture when the encoding changes.
+        if self.lights.as_ref().is_some_and(|(_, e)| *e != encoding) {
+            if let Some((mut t, _)) = self.lights.take() {
+                t.destroy(dev);
+            }
+        }
+        let fresh = self.lights.is_none();
+        if fresh {
+            let format = match encoding {
+                LightEncoding::Float32 => DataFormat::Rgba32F,
+                LightEncoding::Rgba8 => DataFormat::Rgba8,
+            };
+            self.lights = Some((DataTexture::new(dev, format)?, encoding));
+        }
+        let (texture, _) = self.lights.as_mut().expect("created above");
+        let packed = pack_lights(ctx.lights, encoding);
+        // With no lights the shader never reads the texture: upload only to give it storage.
+        if count > 0 || fresh {
+            texture.upload(dev, packed.width, packed.height, &packed.bytes)?;
+            stats.upload_bytes = packed.bytes.len();
+        }
+        let inv_height = 1.0 / texture.size().1.max(1) as f32;
+        let texture = &*texture;
+        geometry::draw_objects(ctx, "forward", limit, &mut |program, dev| {
+            texture.bind(dev, UNIT_METHOD);
+            program.set_i32(dev, "u_lights", UNIT_METHOD as i32);
+            program.set_i32(dev, "u_lightCount", count as i32);
+            program.set_f32(dev, "u_lightTexInvHeight", inv_height);
+            program.set_vec2(dev, "u_lightRanges", [packed.pos_range, packed.radius_range]);
+        })?;
+        Ok(stats)
+    }
+
+    fn gpu_bytes(&self) -> usize {
+        self.lights.as_ref().map_or(0, |(t, _)| t.gpu_bytes())
+    }
+
+    fn destroy(&mut self, dev: &Device) {
+        if let Some((mut t, _)) = self.lights.take() {
+            t.destroy(dev);
+        }
+    }
+}

@@ -1,0 +1,65 @@
+//! The geometry pass shared by the forward-style methods: every object drawn once with its
+//! material's shader variant, the method adding its own uniforms and textures.
+
+use glam::DMat3;
+
+use super::{FrameContext, ShaderFeatures};
+use crate::gl::program::{Program, ProgramKey};
+use crate::gl::state::RenderState;
+use crate::gl::Device;
+use crate::Error;
+
+/// Texture unit of the diffuse map.
+pub const UNIT_ALBEDO: u32 = 0;
+/// First texture unit a method may use for its data textures.
+pub const UNIT_METHOD: u32 = 1;
+
+/// Draws every object of the scene with `shader`, calling `bind_method` on each program
+/// before the draw so the method can set its uniforms and bind its textures.
+pub fn draw_objects(
+    ctx: &mut FrameContext,
+    shader: &'static str,
+    max_lights: u32,
+    bind_method: &mut dyn FnMut(&mut Program, &Device),
+) -> Result<(), Error> {
+    let dev = ctx.dev;
+    let dialect = dev.es();
+    RenderState::OPAQUE.apply(dev);
+    let projection = ctx.projection;
+    for (object, mesh) in ctx.scene.objects.iter().zip(ctx.gpu_scene.meshes(ctx.scene)) {
+        let material = &ctx.scene.materials[object.material];
+        let texture = ctx.gpu_scene.texture_for(material);
+        let features = ctx
+            .features
+            .with(ShaderFeatures::TEXTURE, texture.is_some())
+            .with(ShaderFeatures::SPECULAR, material.has_specular());
+        let key = ProgramKey {
+            shader,
+            features: features.0,
+            dialect,
+        };
+        let program = ctx
+            .programs
+            .get_or_build(dev, key, || features.defines(dialect, max_lights))?;
+        program.bind(dev);
+        // The camera is subtracted in f64 here, so far-from-origin scenes stay exact in f32.
+        let model_view = ctx.view * object.transform;
+        let normal_matrix = DMat3::from_mat4(model_view).inverse().transpose();
+        program.set_mat4(dev, "u_modelView", &model_view.as_mat4());
+        program.set_mat3(dev, "u_normalMatrix", &normal_matrix.as_mat3());
+        program.set_mat4(dev, "u_projection", &projection);
+        program.set_vec3(dev, "u_albedo", material.diffuse);
+        program.set_vec3(dev, "u_specular", material.specular);
+        program.set_f32(dev, "u_shininess", material.shading_exponent());
+        program.set_vec3(dev, "u_ambient", ctx.scene.ambient);
+        program.set_f32(dev, "u_orthographic", if ctx.orthographic { 1.0 } else { 0.0 });
+        if let Some(t) = texture {
+            t.bind(dev, UNIT_ALBEDO);
+            program.set_i32(dev, "u_albedoTex", UNIT_ALBEDO as i32);
+        }
+        bind_method(program, dev);
+        mesh.draw(dev);
+    }
+    crate::gl_check!(dev, "geometry pass");
+    Ok(())
+}

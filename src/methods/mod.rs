@@ -1,0 +1,108 @@
+//! Shading methods and the method table.
+//!
+//! Every method implements [`ShadingMethod`]; [`METHODS`] lists them with their minimum ES
+//! version, required extensions and a `supported(&Caps)` check. The CLI, the tests and the
+//! capability matrix all iterate this one table.
+
+pub mod features;
+pub mod forward;
+pub mod geometry;
+
+use crate::cluster::pack::GpuLight;
+use crate::gl::program::ProgramCache;
+use crate::gl::{Caps, Device, EsVersion};
+use crate::renderer::{GpuScene, RenderOptions};
+use crate::scene::Scene;
+use crate::Error;
+
+pub use features::ShaderFeatures;
+
+/// Whether a method can run on a context.
+#[derive(Clone, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(tag = "status", content = "reason", rename_all = "snake_case")]
+pub enum Support {
+    /// Runs as designed.
+    Supported,
+    /// Runs with a documented degradation (the reason says which).
+    Fallback(String),
+    /// Cannot run; the reason names what is missing.
+    Unsupported(String),
+}
+
+/// Everything a method needs for one frame.
+pub struct FrameContext<'a> {
+    /// The GL device.
+    pub dev: &'a Device,
+    /// Shared program cache.
+    pub programs: &'a mut ProgramCache,
+    /// The scene (objects, materials, ambient).
+    pub scene: &'a Scene,
+    /// Uploaded meshes and textures of the scene.
+    pub gpu_scene: &'a GpuScene,
+    /// World → view (`f64`).
+    pub view: glam::DMat4,
+    /// View → clip.
+    pub projection: glam::Mat4,
+    /// True for an orthographic camera.
+    pub orthographic: bool,
+    /// Active lights in view space (radius and radiance > 0).
+    pub lights: &'a [GpuLight],
+    /// Scene-level shader features (spots present, output encoding, light encoding).
+    pub features: ShaderFeatures,
+    /// Viewport size in pixels.
+    pub viewport: (u32, u32),
+    /// Caller's options.
+    pub options: &'a RenderOptions,
+}
+
+/// What a method reports about its frame.
+#[derive(Clone, Debug, Default)]
+pub struct MethodStats {
+    /// Bytes uploaded to the GPU this frame (light data, later grids and index lists).
+    pub upload_bytes: usize,
+}
+
+/// A shading method: owns its GPU resources, renders a frame into the bound framebuffer.
+pub trait ShadingMethod {
+    /// Name as in the table.
+    fn name(&self) -> &'static str;
+    /// Renders one frame (the framebuffer is bound and cleared by the renderer).
+    fn render(&mut self, ctx: &mut FrameContext) -> Result<MethodStats, Error>;
+    /// GPU memory the method holds, in bytes.
+    fn gpu_bytes(&self) -> usize;
+    /// Frees the method's GPU resources.
+    fn destroy(&mut self, dev: &Device);
+}
+
+/// A row of the method table.
+pub struct MethodDesc {
+    /// CLI name.
+    pub name: &'static str,
+    /// One-line description.
+    pub summary: &'static str,
+    /// Lowest ES version it runs on.
+    pub min_es: EsVersion,
+    /// Extensions it needs beyond `min_es` core (none may be listed when it has fallbacks).
+    pub required_extensions: &'static [&'static str],
+    /// Whether it runs on a context, and how.
+    pub supported: fn(&Caps) -> Support,
+    /// Builds the method (only called when `supported` is not `Unsupported`).
+    pub create: fn(&Device) -> Result<Box<dyn ShadingMethod>, Error>,
+}
+
+/// The method table.
+pub static METHODS: &[MethodDesc] = &[forward::DESC];
+
+/// The default method.
+pub const DEFAULT_METHOD: &str = "forward";
+
+/// Finds a method by name.
+pub fn find(name: &str) -> Result<&'static MethodDesc, Error> {
+    METHODS
+        .iter()
+        .find(|m| m.name == name)
+        .ok_or_else(|| Error::UnknownMethod {
+            name: name.to_string(),
+            available: METHODS.iter().map(|m| m.name).collect::<Vec<_>>().join(", "),
+        })
+}

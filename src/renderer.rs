@@ -1,0 +1,317 @@
+//! The renderer: owns the GL device, the program cache, the uploaded scene and the current
+//! shading method; renders a [`Scene`] and reports [`FrameStats`].
+
+use std::collections::HashMap;
+use std::sync::Arc;
+use std::time::Instant;
+
+use glam::DMat4;
+use serde::Serialize;
+
+use crate::cluster::pack::GpuLight;
+use crate::gl::framebuffer::OffscreenTarget;
+use crate::gl::mesh::GpuMesh;
+use crate::gl::program::ProgramCache;
+use crate::gl::texture::ImageTexture;
+use crate::gl::{Caps, Device, EsVersion};
+use crate::methods::{self, FrameContext, ShaderFeatures, ShadingMethod, Support};
+use crate::scene::{LightKind, Material, Mesh, Projection, Scene, Texture};
+use crate::Error;
+
+/// Per-call rendering options.
+#[derive(Clone, Debug)]
+pub struct RenderOptions {
+    /// Write linear values (clamped to [0, 1], no sRGB encoding, no tone map) so pixels can be
+    /// checked against the light model.
+    pub linear: bool,
+    /// Pack lights as RGBA8 even where float textures exist (to measure the packing error).
+    pub force_rgba8_lights: bool,
+    /// Background colour (linear if `linear`, else as stored).
+    pub clear_color: [f32; 4],
+    /// Frames timed after one warm-up frame by [`Renderer::render_offscreen`]; the median is
+    /// reported. 0 times the single (cold) frame.
+    pub timed_frames: u32,
+}
+
+impl Default for RenderOptions {
+    fn default() -> Self {
+        RenderOptions {
+            linear: false,
+            force_rgba8_lights: false,
+            clear_color: [0.0, 0.0, 0.0, 1.0],
+            timed_frames: 0,
+        }
+    }
+}
+
+/// What one frame did.
+#[derive(Clone, Debug, Serialize)]
+pub struct FrameStats {
+    /// Shading method.
+    pub method: String,
+    /// Feature level (`2.0` / `3.0`).
+    pub es: EsVersion,
+    /// `GL_VERSION` of the context.
+    pub gl_version: String,
+    /// `GL_RENDERER`.
+    pub renderer: String,
+    /// Viewport width.
+    pub width: u32,
+    /// Viewport height.
+    pub height: u32,
+    /// Lights in the scene.
+    pub lights: usize,
+    /// Lights uploaded (radius and radiance > 0).
+    pub active_lights: usize,
+    /// Frame time in milliseconds: CPU work plus `glFinish` (median of the timed frames).
+    pub frame_ms: f64,
+    /// Bytes uploaded for the frame.
+    pub upload_bytes: usize,
+    /// `float32` or `rgba8`.
+    pub light_encoding: crate::cluster::pack::LightEncoding,
+    /// The method's support status on this context (fallbacks say what degrades).
+    pub support: Support,
+    /// Triangles drawn.
+    pub triangles: usize,
+    /// GPU memory held by the method.
+    pub method_gpu_bytes: usize,
+    /// `LP_NUM_THREADS` when set (llvmpipe's thread count changes every timing).
+    pub lp_num_threads: Option<String>,
+}
+
+/// Meshes and textures of scenes, uploaded once and found again by identity. The cache holds
+/// an `Arc` of each source, so a key can never be reused by another allocation.
+#[derive(Default)]
+pub struct GpuScene {
+    meshes: HashMap<usize, (Arc<Mesh>, GpuMesh)>,
+    textures: HashMap<usize, (Arc<Texture>, ImageTexture)>,
+}
+
+impl GpuScene {
+    fn upload(&mut self, dev: &Device, scene: &Scene) -> Result<(), Error> {
+        for o in &scene.objects {
+            let key = Arc::as_ptr(&o.mesh) as usize;
+            if !self.meshes.contains_key(&key) {
+                let gpu = GpuMesh::new(dev, &o.mesh)?;
+                self.meshes.insert(key, (o.mesh.clone(), gpu));
+            }
+        }
+        for m in &scene.materials {
+            if let Some(t) = &m.diffuse_texture {
+                let key = Arc::as_ptr(t) as usize;
+                if !self.textures.contains_key(&key) {
+                    let gpu = ImageTexture::new(dev, &t.image)?;
+                    self.textures.insert(key, (t.clone(), gpu));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The uploaded mesh of each object, in object order (the scene must have been uploaded).
+    pub fn meshes<'a>(&'a self, scene: &'a Scene) -> impl Iterator<Item = &'a GpuMesh> + 'a {
+        scene
+            .objects
+            .iter()
+            .map(|o| &self.meshes[&(Arc::as_ptr(&o.mesh) as usize)].1)
+    }
+
+    /// The uploaded diffuse texture of a material, if it has one.
+    pub fn texture_for(&self, material: &Material) -> Option<&ImageTexture> {
+        let t = material.diffuse_texture.as_ref()?;
+        self.textures.get(&(Arc::as_ptr(t) as usize)).map(|(_, g)| g)
+    }
+
+    fn destroy(&mut self, dev: &Device) {
+        for (_, (_, mut m)) in self.meshes.drain() {
+            m.destroy(dev);
+        }
+        for (_, (_, mut t)) in self.textures.drain() {
+            t.destroy(dev);
+        }
+    }
+}
+
+/// Renders scenes with one shading method at a time.
+pub struct Renderer {
+    dev: Device,
+    programs: ProgramCache,
+    gpu_scene: GpuScene,
+    method: Box<dyn ShadingMethod>,
+    support: Support,
+    target: Option<OffscreenTarget>,
+}
+
+impl Renderer {
+    /// Creates a renderer on a current GL context, restricted to feature level `es`. The
+    /// context must stay current (and alive) for the renderer's whole life.
+    pub fn new(gl: glow::Context, es: EsVersion) -> Result<Renderer, Error> {
+        let dev = Device::new(gl, es)?;
+        let desc = methods::find(methods::DEFAULT_METHOD)?;
+        let support = (desc.supported)(dev.caps());
+        let method = (desc.create)(&dev)?;
+        Ok(Renderer {
+            dev,
+            programs: ProgramCache::new(),
+            gpu_scene: GpuScene::default(),
+            method,
+            support,
+            target: None,
+        })
+    }
+
+    /// The probed capabilities.
+    pub fn caps(&self) -> &Caps {
+        self.dev.caps()
+    }
+
+    /// The current method's name.
+    pub fn method(&self) -> &'static str {
+        self.method.name()
+    }
+
+    /// Switches method. Unsupported methods are an error naming what is missing; a fallback
+    /// is returned as `Some(reason)` (also logged as a warning). The previous method's GPU
+    /// resources are freed.
+    pub fn set_method(&mut self, name: &str) -> Result<Option<String>, Error> {
+        let desc = methods::find(name)?;
+        let support = (desc.supported)(self.dev.caps());
+        if let Support::Unsupported(reason) = &support {
+            return Err(Error::UnsupportedMethod {
+                method: name.to_string(),
+                reason: reason.clone(),
+            });
+        }
+        if desc.name != self.method.name() {
+            let new = (desc.create)(&self.dev)?;
+            let mut old = std::mem::replace(&mut self.method, new);
+            old.destroy(&self.dev);
+        }
+        self.support = support.clone();
+        Ok(match support {
+            Support::Fallback(reason) => {
+                log::warn!("method `{name}` runs with a fallback: {reason}");
+                Some(reason)
+            }
+            _ => None,
+        })
+    }
+
+    /// Renders `scene` into the currently bound framebuffer with a `width × height` viewport
+    /// (for embedding: a game binds its own target or the default framebuffer first).
+    pub fn render(
+        &mut self,
+        scene: &Scene,
+        width: u32,
+        height: u32,
+        options: &RenderOptions,
+    ) -> Result<FrameStats, Error> {
+        let start = Instant::now();
+        scene.validate()?;
+        if width == 0 || height == 0 {
+            return Err(Error::Limit(format!("viewport {width}×{height} is empty")));
+        }
+        self.gpu_scene.upload(&self.dev, scene)?;
+        let view: DMat4 = scene.camera.view_matrix();
+        let projection = scene
+            .camera
+            .projection_matrix(width as f64 / height as f64)
+            .as_mat4();
+        let lights: Vec<GpuLight> = scene
+            .lights
+            .iter()
+            .filter(|l| l.is_active())
+            .map(|l| GpuLight::from_light(l, &view))
+            .collect();
+        let has_spots = scene
+            .lights
+            .iter()
+            .any(|l| l.is_active() && matches!(l.kind, LightKind::Spot { .. }));
+        let features = ShaderFeatures::default()
+            .with(ShaderFeatures::SPOT, has_spots)
+            .with(ShaderFeatures::OUTPUT_LINEAR, options.linear)
+            .with(
+                ShaderFeatures::LIGHTS_RGBA8,
+                options.force_rgba8_lights || !self.dev.caps().float_textures,
+            );
+        self.dev.viewport(0, 0, width as i32, height as i32);
+        self.dev.clear(options.clear_color);
+        let mut ctx = FrameContext {
+            dev: &self.dev,
+            programs: &mut self.programs,
+            scene,
+            gpu_scene: &self.gpu_scene,
+            view,
+            projection,
+            orthographic: matches!(scene.camera.projection, Projection::Orthographic { .. }),
+            lights: &lights,
+            features,
+            viewport: (width, height),
+            options,
+        };
+        let method_stats = self.method.render(&mut ctx)?;
+        self.dev.finish();
+        self.dev.check("frame")?;
+        let caps = self.dev.caps();
+        Ok(FrameStats {
+            method: self.method.name().to_string(),
+            es: caps.es,
+            gl_version: caps.gl_version.clone(),
+            renderer: caps.renderer.clone(),
+            width,
+            height,
+            lights: scene.lights.len(),
+            active_lights: lights.len(),
+            frame_ms: start.elapsed().as_secs_f64() * 1e3,
+            upload_bytes: method_stats.upload_bytes,
+            light_encoding: features.light_encoding(),
+            support: self.support.clone(),
+            triangles: scene.objects.iter().map(|o| o.mesh.triangle_count()).sum(),
+            method_gpu_bytes: self.method.gpu_bytes(),
+            lp_num_threads: std::env::var("LP_NUM_THREADS").ok(),
+        })
+    }
+
+    /// Renders into an internal `width × height` target and reads it back (top row first).
+    /// With `options.timed_frames > 0`, renders one warm-up frame and reports the median of
+    /// the timed ones.
+    pub fn render_offscreen(
+        &mut self,
+        scene: &Scene,
+        width: u32,
+        height: u32,
+        options: &RenderOptions,
+    ) -> Result<(image::RgbaImage, FrameStats), Error> {
+        if self.target.as_ref().map(|t| t.size()) != Some((width, height)) {
+            if let Some(mut t) = self.target.take() {
+                t.destroy(&self.dev);
+            }
+            self.target = Some(OffscreenTarget::new(&self.dev, width, height)?);
+        }
+        let target = self.target.as_ref().expect("created above");
+        target.bind(&self.dev);
+        let mut stats = self.render(scene, width, height, options)?;
+        if options.timed_frames > 0 {
+            let mut times = Vec::new();
+            for _ in 0..options.timed_frames {
+                times.push(self.render(scene, width, height, options)?.frame_ms);
+            }
+            times.sort_by(f64::total_cmp);
+            stats.frame_ms = times[times.len() / 2];
+        }
+        let target = self.target.as_ref().expect("created above");
+        let image = target.read_rgba8(&self.dev)?;
+        self.dev.bind_default_framebuffer();
+        Ok((image, stats))
+    }
+
+    /// Frees every GL object the renderer made. Call before dropping the context.
+    pub fn destroy(mut self) {
+        self.method.destroy(&self.dev);
+        self.programs.destroy(&self.dev);
+        self.gpu_scene.destroy(&self.dev);
+        if let Some(mut t) = self.target.take() {
+            t.destroy(&self.dev);
+        }
+    }
+}

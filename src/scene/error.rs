@@ -1,0 +1,54 @@
+//! Errors of the scene layer: file I/O, parsing and validation. Every validation error names
+//! the field it is about (`lights[3].radius`, `materials[2] (stone).shininess`, …).
+
+use std::path::PathBuf;
+
+/// What went wrong while building, loading or validating a scene.
+#[derive(Debug, thiserror::Error)]
+pub enum SceneError {
+    /// A value is out of its valid range (NaN, negative radius, outer < inner, …).
+    #[error("invalid value for `{field}`: {reason}")]
+    Invalid {
+        /// Path of the offending field, e.g. `lights[3].radius`.
+        field: String,
+        /// Why it is rejected.
+        reason: String,
+    },
+    /// A file could not be read.
+    #[error("cannot read {path}: {source}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The OS error.
+        source: std::io::Error,
+    },
+    /// An OBJ file could not be parsed.
+    #[error("malformed OBJ {path}: {reason}")]
+    Obj {
+        /// The file.
+        path: PathBuf,
+        /// What tobj or the loader reported.
+        reason: String,
+    },
+    /// A scene file is not valid JSON for the scene schema.
+    #[error("scene file {path}: {reason}")]
+    SceneFile {
+        /// The file.
+        path: PathBuf,
+        /// serde's message (includes line, column and the unknown or missing field).
+        reason: String,
+    },
+    /// A built-in scene name that does not exist.
+    #[error("unknown built-in scene `{0}` (available: {avail})", avail = crate::scene::builtin::NAMES.join(", "))]
+    UnknownBuiltin(String),
+}
+
+impl SceneError {
+    /// Shorthand for [`SceneError::Invalid`].
+    pub fn invalid(field: impl Into<String>, reason: impl Into<String>) -> Self {
+        SceneError::Invalid {
+            field: field.into(),
+            reason: reason.into(),
+        }
+    }
+}

@@ -1,0 +1,221 @@
+//! Point and spot lights and their validation.
+//!
+//! Every light has a finite radius at which its contribution reaches exactly zero (see
+//! [`super::shading`]), which is what makes conservative culling exact.
+
+use glam::{DVec3, Vec3};
+
+use super::SceneError;
+
+/// Point or spot.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum LightKind {
+    /// Emits in all directions.
+    Point,
+    /// Emits in a cone around `direction`, full intensity inside `inner_deg` (half-angle),
+    /// fading smoothly to zero at `outer_deg`.
+    Spot {
+        /// Cone axis in world space (need not be normalised; must not be zero).
+        direction: DVec3,
+        /// Inner half-angle in degrees, 0 ≤ inner ≤ outer.
+        inner_deg: f64,
+        /// Outer half-angle in degrees, inner ≤ outer ≤ 180.
+        outer_deg: f64,
+    },
+}
+
+/// A dynamic light.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Light {
+    /// Point or spot, with the cone for spots.
+    pub kind: LightKind,
+    /// World position (`f64` for scenes far from the origin).
+    pub position: DVec3,
+    /// Distance at which the contribution reaches exactly zero, >= 0.
+    pub radius: f32,
+    /// Linear RGB colour, each channel >= 0.
+    pub color: Vec3,
+    /// Scalar multiplier of `color`, >= 0.
+    pub intensity: f32,
+}
+
+impl Light {
+    /// A point light.
+    pub fn point(position: DVec3, radius: f32, color: Vec3, intensity: f32) -> Self {
+        Light {
+            kind: LightKind::Point,
+            position,
+            radius,
+            color,
+            intensity,
+        }
+    }
+
+    /// A spot light.
+    pub fn spot(
+        position: DVec3,
+        direction: DVec3,
+        inner_deg: f64,
+        outer_deg: f64,
+        radius: f32,
+        color: Vec3,
+        intensity: f32,
+    ) -> Self {
+        Light {
+            kind: LightKind::Spot {
+                direction,
+                inner_deg,
+                outer_deg,
+            },
+            position,
+            radius,
+            color,
+            intensity,
+        }
+    }
+
+    /// `color × intensity`: what the shader multiplies the falloff with.
+    pub fn radiance(&self) -> Vec3 {
+        self.color * self.intensity
+    }
+
+    /// True when the light can contribute anything at all (radius and radiance non-zero).
+    pub fn is_active(&self) -> bool {
+        self.radius > 0.0 && self.radiance().max_element() > 0.0
+    }
+
+    /// Spot cone as `(scale, offset)` with `t = clamp(cos_angle · scale + offset, 0, 1)`, the
+    /// argument of the smoothstep. Point lights get `(0, 1)` so `t = 1`. Precomputed on the CPU
+    /// (in `f64`) so that `inner == outer`, where GLSL's `smoothstep` is undefined, is still a
+    /// well-defined hard edge.
+    pub fn spot_scale_offset(&self) -> (f32, f32) {
+        match self.kind {
+            LightKind::Point => (0.0, 1.0),
+            // Full intensity in every direction: a point light.
+            LightKind::Spot { inner_deg, .. } if inner_deg >= 180.0 => (0.0, 1.0),
+            LightKind::Spot {
+                inner_deg,
+                outer_deg,
+                ..
+            } => {
+                let cos_outer = outer_deg.to_radians().cos();
+                let cos_inner = inner_deg.to_radians().cos();
+                let scale = 1.0 / (cos_inner - cos_outer).max(SPOT_MIN_COS_DELTA);
+                (scale as f32, (-cos_outer * scale) as f32)
+            }
+        }
+    }
+
+    /// Checks the values the GPU will see; `field` is the path used in the error, e.g.
+    /// `lights[3]`.
+    pub fn validate(&self, field: &str) -> Result<(), SceneError> {
+        if !self.position.is_finite() {
+            return Err(SceneError::invalid(
+                format!("{field}.position"),
+                format!("must be finite, got {:?}", self.position),
+            ));
+        }
+        if !(self.radius.is_finite() && self.radius >= 0.0) {
+            return Err(SceneError::invalid(
+                format!("{field}.radius"),
+                format!("must be finite and >= 0, got {}", self.radius),
+            ));
+        }
+        if !self.color.is_finite() || self.color.min_element() < 0.0 {
+            return Err(SceneError::invalid(
+                format!("{field}.color"),
+                format!("must be finite and >= 0, got {:?}", self.color),
+            ));
+        }
+        if !(self.intensity.is_finite() && self.intensity >= 0.0) {
+            return Err(SceneError::invalid(
+                format!("{field}.intensity"),
+                format!("must be finite and >= 0, got {}", self.intensity),
+            ));
+        }
+        if !self.radiance().is_finite() {
+            return Err(SceneError::invalid(
+                format!("{field}.intensity"),
+                "color × intensity overflows f32",
+            ));
+        }
+        if let LightKind::Spot {
+            direction,
+            inner_deg,
+            outer_deg,
+        } = self.kind
+        {
+            if !direction.is_finite() || direction.length_squared() == 0.0 {
+                return Err(SceneError::invalid(
+                    format!("{field}.direction"),
+                    format!("must be finite and non-zero, got {direction:?}"),
+                ));
+            }
+            if !(inner_deg.is_finite() && (0.0..=180.0).contains(&inner_deg)) {
+                return Err(SceneError::invalid(
+                    format!("{field}.inner_deg"),
+                    format!("must be in [0, 180], got {inner_deg}"),
+                ));
+            }
+            if !(outer_deg.is_finite() && (0.0..=180.0).contains(&outer_deg)) {
+                return Err(SceneError::invalid(
+                    format!("{field}.outer_deg"),
+                    format!("must be in [0, 180], got {outer_deg}"),
+                ));
+            }
+            if outer_deg < inner_deg {
+                return Err(SceneError::invalid(
+                    format!("{field}.outer_deg"),
+                    format!("must be >= inner_deg ({inner_deg}), got {outer_deg}"),
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Smallest `cos(inner) − cos(outer)` used for the spot smoothstep, so a hard-edged cone
+/// (`inner == outer`) has a finite slope.
+pub const SPOT_MIN_COS_DELTA: f64 = 1e-4;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn base() -> Light {
+        Light::point(DVec3::ZERO, 1.0, Vec3::ONE, 1.0)
+    }
+
+    #[test]
+    fn rejects_bad_values_naming_the_field() {
+        let cases: Vec<(Light, &str)> = vec![
+            (Light { radius: f32::NAN, ..base() }, "lights[0].radius"),
+            (Light { radius: -1.0, ..base() }, "lights[0].radius"),
+            (Light { intensity: f32::INFINITY, ..base() }, "lights[0].intensity"),
+            (Light { color: Vec3::new(1.0, -1.0, 0.0), ..base() }, "lights[0].color"),
+            (Light { position: DVec3::new(0.0, f64::NAN, 0.0), ..base() }, "lights[0].position"),
+            (
+                Light::spot(DVec3::ZERO, DVec3::Z, 30.0, 20.0, 1.0, Vec3::ONE, 1.0),
+                "lights[0].outer_deg",
+            ),
+            (
+                Light::spot(DVec3::ZERO, DVec3::ZERO, 10.0, 20.0, 1.0, Vec3::ONE, 1.0),
+                "lights[0].direction",
+            ),
+        ];
+        for (light, field) in cases {
+            let err = light.validate("lights[0]").unwrap_err().to_string();
+            assert!(err.contains(field), "expected {field} in: {err}");
+        }
+        assert!(base().validate("lights[0]").is_ok());
+    }
+
+    #[test]
+    fn spot_scale_offset_is_finite_for_hard_cones() {
+        let l = Light::spot(DVec3::ZERO, DVec3::Z, 10.0, 10.0, 1.0, Vec3::ONE, 1.0);
+        let (s, o) = l.spot_scale_offset();
+        assert!(s.is_finite() && o.is_finite());
+        let (s, o) = base().spot_scale_offset();
+        assert_eq!((s, o), (0.0, 1.0));
+    }
+}

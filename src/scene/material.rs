@@ -1,0 +1,89 @@
+//! Materials (from MTL `Kd`, `map_Kd`, `Ks`, `Ns`) and their textures.
+
+use std::sync::Arc;
+
+use glam::Vec3;
+
+use super::SceneError;
+
+/// An 8-bit sRGB RGBA image used as a diffuse texture (decoded to linear in the shader).
+#[derive(Debug)]
+pub struct Texture {
+    /// Where it came from (file path or a built-in name), for messages.
+    pub name: String,
+    /// Pixels, row 0 at the top as image files store them.
+    pub image: image::RgbaImage,
+}
+
+/// A Lambert + Blinn-Phong material in linear RGB.
+#[derive(Clone, Debug)]
+pub struct Material {
+    /// Name from the MTL file or the built-in scene.
+    pub name: String,
+    /// Diffuse albedo (`Kd`), multiplied by the texture when there is one.
+    pub diffuse: Vec3,
+    /// Diffuse texture (`map_Kd`), sRGB encoded.
+    pub diffuse_texture: Option<Arc<Texture>>,
+    /// Specular colour (`Ks`).
+    pub specular: Vec3,
+    /// Blinn-Phong exponent (`Ns`); values below 1 are shaded as 1 (see [`Material::shading_exponent`]).
+    pub shininess: f32,
+}
+
+impl Default for Material {
+    fn default() -> Self {
+        Material::flat("default", Vec3::splat(0.8))
+    }
+}
+
+impl Material {
+    /// A matte material of one colour with a faint highlight.
+    pub fn flat(name: &str, diffuse: Vec3) -> Self {
+        Material {
+            name: name.to_string(),
+            diffuse,
+            diffuse_texture: None,
+            specular: Vec3::splat(0.04),
+            shininess: 32.0,
+        }
+    }
+
+    /// A material with a specular colour and exponent.
+    pub fn glossy(name: &str, diffuse: Vec3, specular: Vec3, shininess: f32) -> Self {
+        Material {
+            specular,
+            shininess,
+            ..Material::flat(name, diffuse)
+        }
+    }
+
+    /// The exponent the light model uses: `Ns` clamped to [1, 4096]. `pow(0, 0)` is undefined
+    /// in GLSL, and MTL files commonly say `Ns 0` for "no highlight" together with `Ks 0`.
+    pub fn shading_exponent(&self) -> f32 {
+        self.shininess.clamp(1.0, 4096.0)
+    }
+
+    /// True when the material has a non-zero specular term.
+    pub fn has_specular(&self) -> bool {
+        self.specular.max_element() > 0.0
+    }
+
+    /// Checks colours and exponent; `field` names the material in errors.
+    pub fn validate(&self, field: &str) -> Result<(), SceneError> {
+        for (name, v) in [("diffuse", self.diffuse), ("specular", self.specular)] {
+            if !v.is_finite() || v.min_element() < 0.0 {
+                return Err(SceneError::invalid(
+                    format!("{field}.{name}"),
+                    format!("must be finite and >= 0, got {v:?}"),
+                ));
+            }
+        }
+        if !(self.shininess.is_finite() && self.shininess >= 0.0) {
+            return Err(SceneError::invalid(
+                format!("{field}.shininess"),
+                format!("must be finite and >= 0, got {}", self.shininess),
+            ));
+        }
+        Ok(())
+    }
+}

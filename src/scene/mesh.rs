@@ -1,0 +1,181 @@
+//! Triangle meshes in object space and axis-aligned bounds.
+
+use glam::{DMat4, DVec3, Vec2, Vec3};
+
+use super::SceneError;
+
+/// Axis-aligned bounding box in `f64`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Aabb {
+    /// Minimum corner.
+    pub min: DVec3,
+    /// Maximum corner.
+    pub max: DVec3,
+}
+
+impl Aabb {
+    /// Bounds of a point set (`None` when empty).
+    pub fn from_points(points: impl IntoIterator<Item = DVec3>) -> Option<Aabb> {
+        let mut it = points.into_iter();
+        let first = it.next()?;
+        Some(it.fold(Aabb { min: first, max: first }, |b, p| Aabb {
+            min: b.min.min(p),
+            max: b.max.max(p),
+        }))
+    }
+
+    /// Centre point.
+    pub fn center(&self) -> DVec3 {
+        (self.min + self.max) * 0.5
+    }
+
+    /// Edge lengths.
+    pub fn size(&self) -> DVec3 {
+        self.max - self.min
+    }
+
+    /// Smallest box containing both.
+    pub fn union(&self, other: &Aabb) -> Aabb {
+        Aabb {
+            min: self.min.min(other.min),
+            max: self.max.max(other.max),
+        }
+    }
+
+    /// Bounds of this box's eight corners after a transform.
+    pub fn transformed(&self, m: &DMat4) -> Aabb {
+        let corners = (0..8).map(|i| {
+            let pick = |bit: u32, lo: f64, hi: f64| if i & (1 << bit) != 0 { hi } else { lo };
+            m.transform_point3(DVec3::new(
+                pick(0, self.min.x, self.max.x),
+                pick(1, self.min.y, self.max.y),
+                pick(2, self.min.z, self.max.z),
+            ))
+        });
+        Aabb::from_points(corners).expect("eight corners")
+    }
+}
+
+/// An indexed triangle mesh in object space. Normals are always present (computed from the
+/// faces when the source had none); texture coordinates are optional.
+#[derive(Clone, Debug, Default)]
+pub struct Mesh {
+    /// Vertex positions.
+    pub positions: Vec<Vec3>,
+    /// Unit vertex normals, one per position.
+    pub normals: Vec<Vec3>,
+    /// Texture coordinates, one per position, or empty.
+    pub uvs: Vec<Vec2>,
+    /// Triangle list, three indices per triangle.
+    pub indices: Vec<u32>,
+}
+
+impl Mesh {
+    /// Builds a mesh and checks it: indices in range, a multiple of three, finite values.
+    /// Missing normals (`normals` empty) are computed as area-weighted face normals.
+    pub fn new(
+        positions: Vec<Vec3>,
+        normals: Vec<Vec3>,
+        uvs: Vec<Vec2>,
+        indices: Vec<u32>,
+    ) -> Result<Mesh, SceneError> {
+        let n = positions.len();
+        if indices.len() % 3 != 0 {
+            return Err(SceneError::invalid(
+                "mesh.indices",
+                format!("{} indices is not a whole number of triangles", indices.len()),
+            ));
+        }
+        if let Some(bad) = indices.iter().find(|&&i| i as usize >= n) {
+            return Err(SceneError::invalid(
+                "mesh.indices",
+                format!("index {bad} out of range for {n} vertices"),
+            ));
+        }
+        if let Some(i) = positions.iter().position(|p| !p.is_finite()) {
+            return Err(SceneError::invalid(
+                format!("mesh.positions[{i}]"),
+                format!("must be finite, got {:?}", positions[i]),
+            ));
+        }
+        if !uvs.is_empty() && uvs.len() != n {
+            return Err(SceneError::invalid(
+                "mesh.uvs",
+                format!("{} texture coordinates for {n} vertices", uvs.len()),
+            ));
+        }
+        if let Some(i) = uvs.iter().position(|t| !t.is_finite()) {
+            return Err(SceneError::invalid(
+                format!("mesh.uvs[{i}]"),
+                format!("must be finite, got {:?}", uvs[i]),
+            ));
+        }
+        let normals = if normals.len() == n && normals.iter().all(|v| v.is_finite()) {
+            normals
+                .into_iter()
+                .map(|v| v.try_normalize().unwrap_or(Vec3::Y))
+                .collect()
+        } else {
+            compute_normals(&positions, &indices)
+        };
+        Ok(Mesh {
+            positions,
+            normals,
+            uvs,
+            indices,
+        })
+    }
+
+    /// Object-space bounds (`None` for an empty mesh).
+    pub fn bounds(&self) -> Option<Aabb> {
+        Aabb::from_points(self.positions.iter().map(|p| p.as_dvec3()))
+    }
+
+    /// Number of triangles.
+    pub fn triangle_count(&self) -> usize {
+        self.indices.len() / 3
+    }
+}
+
+/// Area-weighted vertex normals from the faces; vertices on no face (or only degenerate ones)
+/// get +Y.
+pub fn compute_normals(positions: &[Vec3], indices: &[u32]) -> Vec<Vec3> {
+    let mut acc = vec![Vec3::ZERO; positions.len()];
+    for tri in indices.chunks_exact(3) {
+        let [a, b, c] = [tri[0], tri[1], tri[2]].map(|i| i as usize);
+        // The cross product's length is twice the area: larger faces weigh more.
+        let n = (positions[b] - positions[a]).cross(positions[c] - positions[a]);
+        acc[a] += n;
+        acc[b] += n;
+        acc[c] += n;
+    }
+    acc.into_iter()
+        .map(|n| n.try_normalize().unwrap_or(Vec3::Y))
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn computes_face_normals_when_missing() {
+        let m = Mesh::new(
+            vec![Vec3::ZERO, Vec3::X, Vec3::Y],
+            vec![],
+            vec![],
+            vec![0, 1, 2],
+        )
+        .unwrap();
+        for n in &m.normals {
+            assert!((*n - Vec3::Z).length() < 1e-6);
+        }
+    }
+
+    #[test]
+    fn rejects_out_of_range_indices_and_nan() {
+        assert!(Mesh::new(vec![Vec3::ZERO], vec![], vec![], vec![0, 0, 1]).is_err());
+        let e = Mesh::new(vec![Vec3::NAN; 3], vec![], vec![], vec![0, 1, 2]).unwrap_err();
+        assert!(e.to_string().contains("positions[0]"));
+    }
+}

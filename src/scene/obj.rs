@@ -1,0 +1,227 @@
+//! OBJ + MTL loading (tobj) with textures (image).
+//!
+//! Real MTL files name textures with other letter case than the file on disk, with Windows
+//! backslashes, or with folders that were flattened when the model was shared. Resolution
+//! tries, in order: the path as written (backslashes turned into `/`) relative to the MTL's
+//! folder; the same path matched case-insensitively component by component; the bare file
+//! name, case-insensitively, in the MTL's folder. A texture that is still not found, or that
+//! does not decode, is a warning and the material falls back to its flat `Kd` colour — the load
+//! never aborts for a texture.
+
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use glam::{DMat4, Vec2, Vec3};
+
+use super::{Material, Mesh, Object, Scene, SceneError, Texture};
+
+/// What an OBJ load produced besides the objects: non-fatal problems, for the caller to show.
+#[derive(Debug, Default)]
+pub struct LoadReport {
+    /// Human-readable warnings (missing textures, missing MTL, …), also logged.
+    pub warnings: Vec<String>,
+}
+
+/// Loads an OBJ file (and its MTL) into `scene`, placing it with `transform`. Returns the
+/// warnings. `texture_override` binds a diffuse texture to every material (for models that
+/// ship a texture but no MTL).
+pub fn load_into(
+    scene: &mut Scene,
+    path: &Path,
+    transform: DMat4,
+    texture_override: Option<&Path>,
+) -> Result<LoadReport, SceneError> {
+    let mut report = LoadReport::default();
+    if !path.is_file() {
+        return Err(SceneError::Io {
+            path: path.to_path_buf(),
+            source: std::io::Error::new(std::io::ErrorKind::NotFound, "no such file"),
+        });
+    }
+    let options = tobj::LoadOptions {
+        triangulate: true,
+        single_index: true,
+        ignore_points: true,
+        ignore_lines: true,
+    };
+    let (models, materials) = tobj::load_obj(path, &options).map_err(|e| SceneError::Obj {
+        path: path.to_path_buf(),
+        reason: e.to_string(),
+    })?;
+    if models.is_empty() || models.iter().all(|m| m.mesh.indices.is_empty()) {
+        return Err(SceneError::Obj {
+            path: path.to_path_buf(),
+            reason: "no faces".into(),
+        });
+    }
+    let base_dir = path.parent().unwrap_or(Path::new("."));
+    let mut textures = TextureCache::default();
+    let override_tex = texture_override.and_then(|p| textures.load(p, &mut report));
+    let mtl = match materials {
+        Ok(m) => m,
+        Err(e) => {
+            report.warn(format!(
+                "{}: materials not loaded ({e}); using a default grey",
+                path.display()
+            ));
+            Vec::new()
+        }
+    };
+    let first = scene.materials.len();
+    for m in &mtl {
+        let texture = match &m.diffuse_texture {
+            Some(name) if !name.trim().is_empty() => match resolve_texture(base_dir, name) {
+                Some(p) => textures.load(&p, &mut report),
+                None => {
+                    report.warn(format!(
+                        "material `{}`: texture `{name}` not found next to {}; using its flat colour",
+                        m.name,
+                        path.display()
+                    ));
+                    None
+                }
+            },
+            _ => None,
+        };
+        scene.materials.push(Material {
+            name: m.name.clone(),
+            diffuse: Vec3::from(m.diffuse.unwrap_or([0.8; 3])),
+            diffuse_texture: override_tex.clone().or(texture),
+            specular: Vec3::from(m.specular.unwrap_or([0.0; 3])),
+            shininess: m.shininess.unwrap_or(1.0),
+        });
+    }
+    let fallback = scene.add_material(Material {
+        diffuse_texture: override_tex.clone(),
+        ..Material::flat("obj-default", Vec3::splat(0.8))
+    });
+    for model in models {
+        let m = model.mesh;
+        if m.indices.is_empty() {
+            continue;
+        }
+        let positions: Vec<Vec3> = m.positions.chunks_exact(3).map(Vec3::from_slice).collect();
+        let normals: Vec<Vec3> = m.normals.chunks_exact(3).map(Vec3::from_slice).collect();
+        // OBJ's v axis points up; images store row 0 at the top: flip once here.
+        let uvs: Vec<Vec2> = m
+            .texcoords
+            .chunks_exact(2)
+            .map(|t| Vec2::new(t[0], 1.0 - t[1]))
+            .collect();
+        let mesh = Mesh::new(positions, normals, uvs, m.indices).map_err(|e| SceneError::Obj {
+            path: path.to_path_buf(),
+            reason: format!("object `{}`: {e}", model.name),
+        })?;
+        let material = match m.material_id {
+            Some(id) if id < mtl.len() => first + id,
+            _ => fallback,
+        };
+        scene.objects.push(Object {
+            mesh: Arc::new(mesh),
+            material,
+            transform,
+        });
+    }
+    Ok(report)
+}
+
+impl LoadReport {
+    fn warn(&mut self, msg: String) {
+        log::warn!("{msg}");
+        self.warnings.push(msg);
+    }
+}
+
+#[derive(Default)]
+struct TextureCache {
+    loaded: HashMap<PathBuf, Option<Arc<Texture>>>,
+}
+
+impl TextureCache {
+    fn load(&mut self, path: &Path, report: &mut LoadReport) -> Option<Arc<Texture>> {
+        if let Some(t) = self.loaded.get(path) {
+            return t.clone();
+        }
+        let tex = match image::open(path) {
+            Ok(img) => Some(Arc::new(Texture {
+                name: path.display().to_string(),
+                image: img.to_rgba8(),
+            })),
+            Err(e) => {
+                report.warn(format!(
+                    "texture {} could not be decoded ({e}); using the flat colour",
+                    path.display()
+                ));
+                None
+            }
+        };
+        self.loaded.insert(path.to_path_buf(), tex.clone());
+        tex
+    }
+}
+
+/// Finds the file an MTL texture reference means (see the module docs for the order).
+pub fn resolve_texture(base_dir: &Path, name: &str) -> Option<PathBuf> {
+    // MTL options such as `-bm 0.5 file.png` put the file name last.
+    let name = name.split_whitespace().last()?.replace('\\', "/");
+    let as_written = base_dir.join(&name);
+    if as_written.is_file() {
+        return Some(as_written);
+    }
+    let mut dir = base_dir.to_path_buf();
+    let mut matched = true;
+    for part in name.split('/').filter(|p| !p.is_empty() && *p != ".") {
+        match find_case_insensitive(&dir, part) {
+            Some(p) => dir = p,
+            None => {
+                matched = false;
+                break;
+            }
+        }
+    }
+    if matched && dir.is_file() {
+        return Some(dir);
+    }
+    let file_name = name.rsplit('/').next()?;
+    find_case_insensitive(base_dir, file_name).filter(|p| p.is_file())
+}
+
+fn find_case_insensitive(dir: &Path, name: &str) -> Option<PathBuf> {
+    if name == ".." {
+        return Some(dir.join(".."));
+    }
+    let lower = name.to_lowercase();
+    std::fs::read_dir(dir)
+        .ok()?
+        .filter_map(Result::ok)
+        .find(|e| e.file_name().to_string_lossy().to_lowercase() == lower)
+        .map(|e| e.path())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn resolves_case_and_backslashes() {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::create_dir(dir.path().join("Textures")).unwrap();
+        std::fs::write(dir.path().join("Textures").join("Brick.PNG"), b"x").unwrap();
+        let want = dir.path().join("Textures").join("Brick.PNG");
+        assert_eq!(resolve_texture(dir.path(), "textures\\brick.png"), Some(want.clone()));
+        assert_eq!(resolve_texture(dir.path(), "TEXTURES/BRICK.png"), Some(want.clone()));
+        assert_eq!(resolve_texture(dir.path(), "-bm 1 Textures/Brick.PNG"), Some(want));
+        assert_eq!(resolve_texture(dir.path(), "missing.png"), None);
+    }
+
+    #[test]
+    fn flattened_folders_fall_back_to_the_file_name() {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join("wood.jpg"), b"x").unwrap();
+        assert_eq!(
+            resolve_texture(dir.path(), "C:\\models\\maps\\Wood.JPG"),
+            Some(dir.path().join("wood.jpg"))
+        );
+    }
+}

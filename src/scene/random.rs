@@ -1,0 +1,84 @@
+//! Seeded random light sets inside a volume (PCG, so a seed gives the same lights on every
+//! platform and crate version).
+
+use glam::{DVec3, Vec3};
+use rand::{Rng, SeedableRng};
+use rand_pcg::Pcg64Mcg;
+
+use super::mesh::Aabb;
+use super::Light;
+
+/// Which kinds of lights a random set contains.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LightSetStyle {
+    /// Point lights only.
+    PointsOnly,
+    /// Three point lights to one spot light, spots aimed mostly downwards.
+    Mixed,
+}
+
+/// Average number of light spheres covering a point of the volume that the radius is chosen
+/// for: enough overlap to look lit, few enough that culling pays.
+const TARGET_OVERLAP: f64 = 6.0;
+
+/// `count` lights inside `volume`. Radii shrink as the count grows so that the average
+/// overlap stays near [`TARGET_OVERLAP`]; intensity grows with the radius so each light is
+/// visible.
+pub fn lights(volume: &Aabb, count: usize, seed: u64, style: LightSetStyle) -> Vec<Light> {
+    let mut rng = Pcg64Mcg::seed_from_u64(seed);
+    let size = volume.size();
+    let diag = size.length();
+    let vol = size.x.max(1e-6) * size.y.max(1e-6) * size.z.max(1e-6);
+    let sphere = |r: f64| 4.0 / 3.0 * std::f64::consts::PI * r * r * r;
+    let radius = if count == 0 {
+        1.0
+    } else {
+        (TARGET_OVERLAP * vol / (count as f64 * sphere(1.0))).cbrt()
+    }
+    .clamp(diag * 0.02, diag * 0.35);
+    (0..count)
+        .map(|i| {
+            let p = DVec3::new(rng.random(), rng.random(), rng.random());
+            let position = volume.min + p * size;
+            let r = (radius * rng.random_range(0.7..1.3)) as f32;
+            let color = hue(rng.random::<f32>());
+            let intensity = 0.6 * (1.0 + r * r / 6.0);
+            let is_spot = style == LightSetStyle::Mixed && i % 4 == 3;
+            if is_spot {
+                let dir = DVec3::new(rng.random_range(-0.6..0.6), -1.0, rng.random_range(-0.6..0.6));
+                let outer = rng.random_range(20.0..60.0);
+                let inner = outer * rng.random_range(0.3..0.9);
+                Light::spot(position, dir, inner, outer, r * 1.5, color, intensity * 2.0)
+            } else {
+                Light::point(position, r, color, intensity)
+            }
+        })
+        .collect()
+}
+
+/// A saturated but not garish colour from a hue in [0, 1).
+fn hue(h: f32) -> Vec3 {
+    let k = |n: f32| {
+        let k = (n + h * 6.0) % 6.0;
+        1.0 - (k.min(4.0 - k).clamp(0.0, 1.0))
+    };
+    let c = Vec3::new(k(5.0), k(3.0), k(1.0));
+    (c * 0.7 + Vec3::splat(0.3)).clamp(Vec3::ZERO, Vec3::ONE)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn lights_stay_inside_the_volume_and_validate() {
+        let v = Aabb { min: DVec3::new(-1.0, 0.0, -2.0), max: DVec3::new(3.0, 1.0, 2.0) };
+        let ls = lights(&v, 500, 3, LightSetStyle::Mixed);
+        assert_eq!(ls.len(), 500);
+        for (i, l) in ls.iter().enumerate() {
+            l.validate(&format!("lights[{i}]")).unwrap();
+            assert!(l.position.cmpge(v.min).all() && l.position.cmple(v.max).all());
+        }
+        assert!(ls.iter().any(|l| matches!(l.kind, crate::scene::LightKind::Spot { .. })));
+    }
+}

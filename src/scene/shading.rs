@@ -1,0 +1,152 @@
+//! The light model evaluated on the CPU in `f64`: the oracle the GPU methods are checked
+//! against. It mirrors `glsl/light_model.glsl` term by term.
+//!
+//! For a surface point `P` with unit normal `N`, unit direction to the eye `V`, and a light at
+//! `Lp` with radius `r` and radiance `c = color × intensity`:
+//!
+//! ```text
+//! d        = |Lp − P|,  L = (Lp − P) / d
+//! falloff  = clamp(1 − (d/r)⁴, 0, 1)² / (d² + 1)          exactly 0 for d ≥ r
+//! spot     = smoothstep over t = clamp(dot(−L, dir)·scale + offset, 0, 1)   (1 for points)
+//! diffuse  = albedo · max(N·L, 0)
+//! specular = Ks · max(N·H, 0)^Ns   with H = normalize(L + V), only where N·L > 0
+//! out      = ambient · albedo + Σ c · falloff · spot · (diffuse + specular)
+//! ```
+//!
+//! Surfaces are two-sided (`N` flipped towards the eye). In view space, `V` is
+//! `normalize(−P)` for perspective cameras and `+Z` for orthographic ones.
+//!
+//! ```text
+//! ```
+
+use glam::{DVec3, Vec3};
+
+use super::light::{Light, LightKind};
+
+/// Surface attributes at one shading point, in linear RGB.
+#[derive(Clone, Copy, Debug)]
+pub struct Surface {
+    /// World position.
+    pub position: DVec3,
+    /// Unit normal.
+    pub normal: DVec3,
+    /// Diffuse albedo (material colour × decoded texture).
+    pub albedo: DVec3,
+    /// Specular colour.
+    pub specular: DVec3,
+    /// Blinn-Phong exponent, already clamped (see `Material::shading_exponent`).
+    pub exponent: f64,
+}
+
+/// `clamp(1 − (d/r)⁴, 0, 1)² / (d² + 1)`; zero for `r <= 0`.
+pub fn falloff(d: f64, r: f64) -> f64 {
+    if r <= 0.0 {
+        return 0.0;
+    }
+    let q = (d / r).powi(4);
+    let w = (1.0 - q).clamp(0.0, 1.0);
+    w * w / (d * d + 1.0)
+}
+
+/// The spot factor for a light-to-surface direction `to_surface` (unit).
+pub fn spot_factor(light: &Light, to_surface: DVec3) -> f64 {
+    match light.kind {
+        LightKind::Point => 1.0,
+        LightKind::Spot { direction, .. } => {
+            let (scale, offset) = light.spot_scale_offset();
+            let cos = to_surface.dot(direction.normalize());
+            let t = (cos * scale as f64 + offset as f64).clamp(0.0, 1.0);
+            t * t * (3.0 - 2.0 * t)
+        }
+    }
+}
+
+/// Radiance one light reflects along `v`, the unit direction from the surface to the eye
+/// (no ambient). The normal is used as given (see [`shade`] for two-sided surfaces).
+pub fn light_contribution(light: &Light, s: &Surface, v: DVec3) -> DVec3 {
+    let to_light = light.position - s.position;
+    let d = to_light.length();
+    let f = falloff(d, light.radius as f64);
+    if f == 0.0 {
+        return DVec3::ZERO;
+    }
+    let l = to_light / d.max(1e-6);
+    let n_dot_l = s.normal.dot(l);
+    if n_dot_l <= 0.0 {
+        return DVec3::ZERO;
+    }
+    let h = (l + v).normalize_or_zero();
+    let n_dot_h = s.normal.dot(h).max(0.0);
+    let spec = s.specular * n_dot_h.powf(s.exponent);
+    let spot = spot_factor(light, -l);
+    light.radiance().as_dvec3() * (f * spot) * (s.albedo * n_dot_l + spec)
+}
+
+/// Total linear radiance along `v` (unit, surface → eye): ambient plus every light. Surfaces
+/// are two-sided: a normal facing away from the eye is flipped, as the shaders do.
+pub fn shade(s: &Surface, v: DVec3, lights: &[Light], ambient: Vec3) -> DVec3 {
+    let mut s = *s;
+    if s.normal.dot(v) < 0.0 {
+        s.normal = -s.normal;
+    }
+    let mut c = ambient.as_dvec3() * s.albedo;
+    for light in lights {
+        c += light_contribution(light, &s, v);
+    }
+    c
+}
+
+/// sRGB transfer function (linear → encoded), input clamped to [0, 1].
+pub fn linear_to_srgb(x: f64) -> f64 {
+    let x = x.clamp(0.0, 1.0);
+    if x <= 0.003_130_8 {
+        12.92 * x
+    } else {
+        1.055 * x.powf(1.0 / 2.4) - 0.055
+    }
+}
+
+/// sRGB decode (encoded → linear).
+pub fn srgb_to_linear(x: f64) -> f64 {
+    if x <= 0.040_45 {
+        x / 12.92
+    } else {
+        ((x + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn falloff_is_exactly_zero_at_and_beyond_the_radius() {
+        assert_eq!(falloff(2.0, 2.0), 0.0);
+        assert_eq!(falloff(3.0, 2.0), 0.0);
+        assert!(falloff(1.9, 2.0) > 0.0);
+        assert_eq!(falloff(0.0, 2.0), 1.0);
+        assert_eq!(falloff(0.0, 0.0), 0.0);
+    }
+
+    #[test]
+    fn srgb_round_trips() {
+        for i in 0..=100 {
+            let x = i as f64 / 100.0;
+            assert!((srgb_to_linear(linear_to_srgb(x)) - x).abs() < 1e-12);
+        }
+    }
+
+    #[test]
+    fn light_at_the_surface_gives_no_nan() {
+        let l = Light::point(DVec3::ZERO, 1.0, Vec3::ONE, 1.0);
+        let s = Surface {
+            position: DVec3::ZERO,
+            normal: DVec3::Z,
+            albedo: DVec3::ONE,
+            specular: DVec3::ONE,
+            exponent: 16.0,
+        };
+        let c = shade(&s, DVec3::Z, &[l], Vec3::ZERO);
+        assert!(c.is_finite());
+    }
+}

@@ -1,0 +1,122 @@
+//! Helpers shared by the integration tests.
+#![allow(dead_code)]
+
+use std::path::PathBuf;
+
+use glam::{DVec3, DVec4};
+use manylight::gl::HeadlessContext;
+use manylight::scene::{shading, Projection, Scene};
+use manylight::{EsVersion, RenderOptions, Renderer};
+
+/// A headless context and a renderer on it (the context must outlive the renderer).
+pub struct Gpu {
+    pub renderer: Option<Renderer>,
+    _ctx: HeadlessContext,
+}
+
+impl Gpu {
+    pub fn new(es: EsVersion) -> Gpu {
+        let ctx = HeadlessContext::new(es).unwrap_or_else(|e| {
+            panic!("no headless {es} context ({e}); install libegl1 libegl-mesa0 libgles2 libgl1-mesa-dri")
+        });
+        let renderer = Renderer::new(ctx.load_gl(), es).expect("renderer");
+        Gpu { renderer: Some(renderer), _ctx: ctx }
+    }
+
+    pub fn r(&mut self) -> &mut Renderer {
+        self.renderer.as_mut().unwrap()
+    }
+
+    pub fn render(&mut self, scene: &Scene, w: u32, h: u32, opts: &RenderOptions) -> image::RgbaImage {
+        self.r().render_offscreen(scene, w, h, opts).expect("render").0
+    }
+}
+
+impl Drop for Gpu {
+    fn drop(&mut self) {
+        if let Some(r) = self.renderer.take() {
+            r.destroy();
+        }
+    }
+}
+
+/// `../shared/assets` or `$MANYLIGHT_ASSETS`, if present.
+pub fn assets_dir() -> Option<PathBuf> {
+    let dir = std::env::var_os("MANYLIGHT_ASSETS")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/assets"));
+    if dir.is_dir() {
+        Some(dir)
+    } else {
+        eprintln!("SKIPPED: assets folder {} not found (set MANYLIGHT_ASSETS)", dir.display());
+        None
+    }
+}
+
+/// CPU oracle for a scene whose only geometry is the plane z = 0 facing +Z (the `plane`
+/// built-in, untransformed): the linear colour of pixel (x, y), top row first, or `None`
+/// where the pixel ray misses the plane.
+pub fn plane_pixel(scene: &Scene, w: u32, h: u32, x: u32, y: u32) -> Option<DVec3> {
+    let cam = &scene.camera;
+    let aspect = w as f64 / h as f64;
+    let inv_vp = (cam.projection_matrix(aspect) * cam.view_matrix()).inverse();
+    let ndc_x = 2.0 * (x as f64 + 0.5) / w as f64 - 1.0;
+    let ndc_y = 1.0 - 2.0 * (y as f64 + 0.5) / h as f64;
+    let unproject = |z: f64| {
+        let p = inv_vp * DVec4::new(ndc_x, ndc_y, z, 1.0);
+        p.truncate() / p.w
+    };
+    let (a, b) = (unproject(-1.0), unproject(1.0));
+    let dir = b - a;
+    if dir.z.abs() < 1e-12 {
+        return None;
+    }
+    let t = -a.z / dir.z;
+    if !(0.0..=1.0).contains(&t) {
+        return None;
+    }
+    let p = a + dir * t;
+    if p.x.abs() > 8.0 || p.y.abs() > 8.0 {
+        return None;
+    }
+    let m = &scene.materials[scene.objects[0].material];
+    let v = match cam.projection {
+        Projection::Perspective { .. } => (cam.position - p).normalize(),
+        Projection::Orthographic { .. } => (cam.position - cam.target).normalize(),
+    };
+    let surface = shading::Surface {
+        position: p,
+        normal: DVec3::Z,
+        albedo: m.diffuse.as_dvec3(),
+        specular: m.specular.as_dvec3(),
+        exponent: m.shading_exponent() as f64,
+    };
+    Some(shading::shade(&surface, v, &scene.lights, scene.ambient))
+}
+
+/// Largest per-channel difference (in 8-bit steps) between the image and the oracle over all
+/// pixels the oracle covers, with the pixel where it happens; `encode` maps linear to stored.
+pub fn max_oracle_error(
+    img: &image::RgbaImage,
+    scene: &Scene,
+    encode: impl Fn(f64) -> f64,
+) -> (f64, (u32, u32), usize) {
+    let (w, h) = img.dimensions();
+    let mut worst = (0.0f64, (0, 0));
+    let mut covered = 0;
+    for y in 0..h {
+        for x in 0..w {
+            let Some(c) = plane_pixel(scene, w, h, x, y) else { continue };
+            covered += 1;
+            let px = img.get_pixel(x, y);
+            for ch in 0..3 {
+                let expected = encode(c[ch]).clamp(0.0, 1.0) * 255.0;
+                let err = (px[ch] as f64 - expected).abs();
+                if err > worst.0 {
+                    worst = (err, (x, y));
+                }
+            }
+        }
+    }
+    (worst.0, worst.1, covered)
+}
