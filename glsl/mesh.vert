@@ -10,6 +10,10 @@ uniform mat3 u_normalMatrix;
 uniform mat4 u_projection;
 
 VARYING vec3 v_viewPos;
+// The depth prepass and the shading pass are different programs: `invariant` guarantees they
+// compute bit-identical depths, so the shading pass's LEQUAL test passes exactly once.
+invariant gl_Position;
+
 VARYING vec3 v_normal;
 VARYING vec2 v_uv;
 

@@ -91,17 +91,15 @@ impl GpuScene {
     fn upload(&mut self, dev: &Device, scene: &Scene) -> Result<(), Error> {
         for o in &scene.objects {
             let key = Arc::as_ptr(&o.mesh) as usize;
-            if !self.meshes.contains_key(&key) {
-                let gpu = GpuMesh::new(dev, &o.mesh)?;
-                self.meshes.insert(key, (o.mesh.clone(), gpu));
+            if let std::collections::hash_map::Entry::Vacant(e) = self.meshes.entry(key) {
+                e.insert((o.mesh.clone(), GpuMesh::new(dev, &o.mesh)?));
             }
         }
         for m in &scene.materials {
             if let Some(t) = &m.diffuse_texture {
                 let key = Arc::as_ptr(t) as usize;
-                if !self.textures.contains_key(&key) {
-                    let gpu = ImageTexture::new(dev, &t.image)?;
-                    self.textures.insert(key, (t.clone(), gpu));
+                if let std::collections::hash_map::Entry::Vacant(e) = self.textures.entry(key) {
+                    e.insert((t.clone(), ImageTexture::new(dev, &t.image)?));
                 }
             }
         }
@@ -119,7 +117,9 @@ impl GpuScene {
     /// The uploaded diffuse texture of a material, if it has one.
     pub fn texture_for(&self, material: &Material) -> Option<&ImageTexture> {
         let t = material.diffuse_texture.as_ref()?;
-        self.textures.get(&(Arc::as_ptr(t) as usize)).map(|(_, g)| g)
+        self.textures
+            .get(&(Arc::as_ptr(t) as usize))
+            .map(|(_, g)| g)
     }
 
     fn destroy(&mut self, dev: &Device) {

@@ -16,10 +16,36 @@ fn lit_plane() -> Scene {
     let mut s = scene::builtin::build("plane", None).unwrap();
     s.ambient = Vec3::splat(0.03);
     s.lights = vec![
-        Light::point(DVec3::new(-1.5, 0.5, 1.0), 3.0, Vec3::new(1.0, 0.9, 0.8), 1.2),
-        Light::point(DVec3::new(2.0, -0.8, 0.3), 2.0, Vec3::new(0.2, 0.5, 1.0), 2.0),
-        Light::spot(DVec3::new(0.5, 1.2, 1.5), DVec3::new(0.1, -0.3, -1.0), 12.0, 25.0, 4.0, Vec3::new(1.0, 0.3, 0.2), 3.0),
-        Light::spot(DVec3::new(-2.5, -1.0, 2.0), DVec3::new(0.0, 0.0, -1.0), 20.0, 20.0, 5.0, Vec3::new(0.3, 1.0, 0.3), 1.5),
+        Light::point(
+            DVec3::new(-1.5, 0.5, 1.0),
+            3.0,
+            Vec3::new(1.0, 0.9, 0.8),
+            1.2,
+        ),
+        Light::point(
+            DVec3::new(2.0, -0.8, 0.3),
+            2.0,
+            Vec3::new(0.2, 0.5, 1.0),
+            2.0,
+        ),
+        Light::spot(
+            DVec3::new(0.5, 1.2, 1.5),
+            DVec3::new(0.1, -0.3, -1.0),
+            12.0,
+            25.0,
+            4.0,
+            Vec3::new(1.0, 0.3, 0.2),
+            3.0,
+        ),
+        Light::spot(
+            DVec3::new(-2.5, -1.0, 2.0),
+            DVec3::new(0.0, 0.0, -1.0),
+            20.0,
+            20.0,
+            5.0,
+            Vec3::new(0.3, 1.0, 0.3),
+            1.5,
+        ),
         Light::point(DVec3::new(0.0, 0.0, -0.5), 3.0, Vec3::ONE, 5.0),
         Light::point(DVec3::new(1.0, 1.0, 1.0), 0.0, Vec3::ONE, 5.0),
     ];
@@ -30,7 +56,13 @@ fn check(es: EsVersion, opts: RenderOptions, tolerance: f64) -> f64 {
     let scene = lit_plane();
     let mut gpu = Gpu::new(es);
     let img = gpu.render(&scene, W, H, &opts);
-    let encode = |x: f64| if opts.linear { x } else { shading::linear_to_srgb(x) };
+    let encode = |x: f64| {
+        if opts.linear {
+            x
+        } else {
+            shading::linear_to_srgb(x)
+        }
+    };
     let (err, at, covered) = max_oracle_error(&img, &scene, encode);
     eprintln!("{es} {opts:?}: max error {err:.3}/255 at {at:?}");
     assert_eq!(covered, (W * H) as usize, "the plane should fill the view");
@@ -43,12 +75,26 @@ fn check(es: EsVersion, opts: RenderOptions, tolerance: f64) -> f64 {
 
 #[test]
 fn es3_linear_pixels_match_the_light_model() {
-    check(EsVersion::Es3, RenderOptions { linear: true, ..Default::default() }, 2.0);
+    check(
+        EsVersion::Es3,
+        RenderOptions {
+            linear: true,
+            ..Default::default()
+        },
+        2.0,
+    );
 }
 
 #[test]
 fn es2_linear_pixels_match_the_light_model() {
-    check(EsVersion::Es2, RenderOptions { linear: true, ..Default::default() }, 2.0);
+    check(
+        EsVersion::Es2,
+        RenderOptions {
+            linear: true,
+            ..Default::default()
+        },
+        2.0,
+    );
 }
 
 #[test]
@@ -60,7 +106,11 @@ fn srgb_output_matches_the_encoded_light_model() {
 /// measured and bounded here (16-bit positions, shared-exponent radiance, 16-bit angles).
 #[test]
 fn rgba8_light_packing_stays_within_its_measured_error() {
-    let opts = RenderOptions { linear: true, force_rgba8_lights: true, ..Default::default() };
+    let opts = RenderOptions {
+        linear: true,
+        force_rgba8_lights: true,
+        ..Default::default()
+    };
     let err = check(EsVersion::Es2, opts, 3.0);
     eprintln!("RGBA8 light packing: max error {err:.2}/255 on the plane scene");
 }
@@ -72,7 +122,15 @@ fn oracle_detects_a_slightly_moved_light() {
     let mut gpu = Gpu::new(EsVersion::Es3);
     let reference = scene.clone();
     scene.lights[0].position.x += 0.05;
-    let img = gpu.render(&scene, W, H, &RenderOptions { linear: true, ..Default::default() });
+    let img = gpu.render(
+        &scene,
+        W,
+        H,
+        &RenderOptions {
+            linear: true,
+            ..Default::default()
+        },
+    );
     let (err, _, _) = max_oracle_error(&img, &reference, |x| x);
     assert!(err > 2.0, "a moved light went unnoticed (error {err})");
 }

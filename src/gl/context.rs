@@ -60,8 +60,8 @@ impl HeadlessContext {
             .query_string(None, egl::EXTENSIONS)
             .map(|s| s.to_string_lossy().into_owned())
             .unwrap_or_default();
-        let window_system = std::env::var_os("DISPLAY").is_some()
-            || std::env::var_os("WAYLAND_DISPLAY").is_some();
+        let window_system =
+            std::env::var_os("DISPLAY").is_some() || std::env::var_os("WAYLAND_DISPLAY").is_some();
         let surfaceless_ok = client_ext.contains("EGL_MESA_platform_surfaceless");
         let order: &[&str] = if surfaceless_ok && !window_system {
             &["surfaceless", "default"]
@@ -154,7 +154,11 @@ impl HeadlessContext {
                 display,
                 config,
                 None,
-                &[egl::CONTEXT_CLIENT_VERSION, es.major() as egl::Int, egl::NONE],
+                &[
+                    egl::CONTEXT_CLIENT_VERSION,
+                    es.major() as egl::Int,
+                    egl::NONE,
+                ],
             )
             .map_err(|e| GlError::VersionUnavailable {
                 requested: es,

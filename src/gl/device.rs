@@ -41,7 +41,8 @@ impl Device {
             self.gl.depth_mask(true);
             self.gl.clear_color(color[0], color[1], color[2], color[3]);
             self.gl.clear_depth_f32(1.0);
-            self.gl.clear(glow::COLOR_BUFFER_BIT | glow::DEPTH_BUFFER_BIT);
+            self.gl
+                .clear(glow::COLOR_BUFFER_BIT | glow::DEPTH_BUFFER_BIT);
         }
     }
 

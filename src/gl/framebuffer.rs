@@ -29,7 +29,11 @@ impl OffscreenTarget {
         unsafe {
             let color = gl.create_texture().map_err(GlError::Create)?;
             gl.bind_texture(glow::TEXTURE_2D, Some(color));
-            let internal = if dev.es() == EsVersion::Es3 { glow::RGBA8 } else { glow::RGBA };
+            let internal = if dev.es() == EsVersion::Es3 {
+                glow::RGBA8
+            } else {
+                glow::RGBA
+            };
             gl.tex_image_2d(
                 glow::TEXTURE_2D,
                 0,
@@ -56,7 +60,12 @@ impl OffscreenTarget {
             } else {
                 glow::DEPTH_COMPONENT16
             };
-            gl.renderbuffer_storage(glow::RENDERBUFFER, depth_format, width as i32, height as i32);
+            gl.renderbuffer_storage(
+                glow::RENDERBUFFER,
+                depth_format,
+                width as i32,
+                height as i32,
+            );
             let fbo = gl.create_framebuffer().map_err(GlError::Create)?;
             gl.bind_framebuffer(glow::FRAMEBUFFER, Some(fbo));
             gl.framebuffer_texture_2d(

@@ -27,11 +27,20 @@ pub fn split_u16(mesh: &Mesh) -> Vec<Chunk> {
     const LIMIT: usize = u16::MAX as usize + 1;
     let mut chunks = Vec::new();
     let mut remap: HashMap<u32, u16> = HashMap::new();
-    let mut cur = Chunk { vertices: Vec::new(), indices: Vec::new() };
+    let mut cur = Chunk {
+        vertices: Vec::new(),
+        indices: Vec::new(),
+    };
     for tri in mesh.indices.chunks_exact(3) {
         let new_vertices = tri.iter().filter(|i| !remap.contains_key(i)).count();
         if remap.len() + new_vertices > LIMIT {
-            chunks.push(std::mem::replace(&mut cur, Chunk { vertices: Vec::new(), indices: Vec::new() }));
+            chunks.push(std::mem::replace(
+                &mut cur,
+                Chunk {
+                    vertices: Vec::new(),
+                    indices: Vec::new(),
+                },
+            ));
             remap.clear();
         }
         for &i in tri {
@@ -40,7 +49,8 @@ pub fn split_u16(mesh: &Mesh) -> Vec<Chunk> {
                 let p = mesh.positions[v];
                 let n = mesh.normals[v];
                 let uv = mesh.uvs.get(v).copied().unwrap_or_default();
-                cur.vertices.extend_from_slice(&[p.x, p.y, p.z, n.x, n.y, n.z, uv.x, uv.y]);
+                cur.vertices
+                    .extend_from_slice(&[p.x, p.y, p.z, n.x, n.y, n.z, uv.x, uv.y]);
                 (cur.vertices.len() / VERTEX_FLOATS - 1) as u16
             });
             cur.indices.push(local);
@@ -69,17 +79,33 @@ impl GpuMesh {
     /// Uploads a mesh.
     pub fn new(dev: &Device, mesh: &Mesh) -> Result<GpuMesh, GlError> {
         let gl = &dev.gl;
-        let mut out = GpuMesh { chunks: Vec::new(), bytes: 0, destroyed: false };
+        let mut out = GpuMesh {
+            chunks: Vec::new(),
+            bytes: 0,
+            destroyed: false,
+        };
         for chunk in split_u16(mesh) {
             unsafe {
                 let vbo = gl.create_buffer().map_err(GlError::Create)?;
                 gl.bind_buffer(glow::ARRAY_BUFFER, Some(vbo));
-                gl.buffer_data_u8_slice(glow::ARRAY_BUFFER, bytemuck::cast_slice(&chunk.vertices), glow::STATIC_DRAW);
+                gl.buffer_data_u8_slice(
+                    glow::ARRAY_BUFFER,
+                    bytemuck::cast_slice(&chunk.vertices),
+                    glow::STATIC_DRAW,
+                );
                 let ibo = gl.create_buffer().map_err(GlError::Create)?;
                 gl.bind_buffer(glow::ELEMENT_ARRAY_BUFFER, Some(ibo));
-                gl.buffer_data_u8_slice(glow::ELEMENT_ARRAY_BUFFER, bytemuck::cast_slice(&chunk.indices), glow::STATIC_DRAW);
+                gl.buffer_data_u8_slice(
+                    glow::ELEMENT_ARRAY_BUFFER,
+                    bytemuck::cast_slice(&chunk.indices),
+                    glow::STATIC_DRAW,
+                );
                 out.bytes += chunk.vertices.len() * 4 + chunk.indices.len() * 2;
-                out.chunks.push(GpuChunk { vbo, ibo, index_count: chunk.indices.len() as i32 });
+                out.chunks.push(GpuChunk {
+                    vbo,
+                    ibo,
+                    index_count: chunk.indices.len() as i32,
+                });
             }
         }
         dev.check("mesh upload")?;
@@ -139,7 +165,9 @@ mod tests {
     fn splits_large_meshes_into_u16_chunks_without_losing_triangles() {
         // 70 000 separate triangles = 210 000 vertices → at least 4 chunks.
         let n = 70_000u32;
-        let positions: Vec<Vec3> = (0..n * 3).map(|i| Vec3::new(i as f32, (i % 3) as f32, 0.0)).collect();
+        let positions: Vec<Vec3> = (0..n * 3)
+            .map(|i| Vec3::new(i as f32, (i % 3) as f32, 0.0))
+            .collect();
         let indices: Vec<u32> = (0..n * 3).collect();
         let mesh = Mesh::new(positions.clone(), vec![], vec![], indices).unwrap();
         let chunks = split_u16(&mesh);

@@ -63,7 +63,11 @@ fn format_defines(defines: &[(String, String)]) -> String {
 
 impl Program {
     /// Assembles, compiles and links `shader` with `defines`.
-    pub fn build(dev: &Device, shader: &str, defines: &[(String, String)]) -> Result<Program, GlError> {
+    pub fn build(
+        dev: &Device,
+        shader: &str,
+        defines: &[(String, String)],
+    ) -> Result<Program, GlError> {
         let gl = &dev.gl;
         let (vs, vs_len) = compile(dev, shader, Stage::Vertex, defines)?;
         let (fs, fs_len) = match compile(dev, shader, Stage::Fragment, defines) {
@@ -110,10 +114,10 @@ impl Program {
 
     fn location(&mut self, dev: &Device, name: &str) -> Option<glow::UniformLocation> {
         if let Some(l) = self.uniforms.get(name) {
-            return l.clone();
+            return *l;
         }
         let l = unsafe { dev.gl.get_uniform_location(self.raw, name) };
-        self.uniforms.insert(name.to_string(), l.clone());
+        self.uniforms.insert(name.to_string(), l);
         l
     }
 
@@ -150,13 +154,19 @@ impl Program {
     /// Sets a `mat3` uniform.
     pub fn set_mat3(&mut self, dev: &Device, name: &str, m: &Mat3) {
         let l = self.location(dev, name);
-        unsafe { dev.gl.uniform_matrix_3_f32_slice(l.as_ref(), false, &m.to_cols_array()) }
+        unsafe {
+            dev.gl
+                .uniform_matrix_3_f32_slice(l.as_ref(), false, &m.to_cols_array())
+        }
     }
 
     /// Sets a `mat4` uniform.
     pub fn set_mat4(&mut self, dev: &Device, name: &str, m: &Mat4) {
         let l = self.location(dev, name);
-        unsafe { dev.gl.uniform_matrix_4_f32_slice(l.as_ref(), false, &m.to_cols_array()) }
+        unsafe {
+            dev.gl
+                .uniform_matrix_4_f32_slice(l.as_ref(), false, &m.to_cols_array())
+        }
     }
 
     /// Frees the program.
@@ -208,11 +218,12 @@ impl ProgramCache {
         key: ProgramKey,
         defines: impl FnOnce() -> Vec<(String, String)>,
     ) -> Result<&mut Program, GlError> {
-        if !self.programs.contains_key(&key) {
-            let p = Program::build(dev, key.shader, &defines())?;
-            self.programs.insert(key, p);
+        match self.programs.entry(key) {
+            std::collections::hash_map::Entry::Occupied(e) => Ok(e.into_mut()),
+            std::collections::hash_map::Entry::Vacant(e) => {
+                Ok(e.insert(Program::build(dev, key.shader, &defines())?))
+            }
         }
-        Ok(self.programs.get_mut(&key).expect("just inserted"))
     }
 
     /// Number of cached programs.

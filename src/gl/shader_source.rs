@@ -44,18 +44,32 @@ pub struct ShaderDesc {
 }
 
 /// Every program the renderer builds.
-pub const SHADERS: &[ShaderDesc] = &[ShaderDesc {
-    name: "forward",
-    vertex: "mesh.vert",
-    fragment: "forward.frag",
-}];
+pub const SHADERS: &[ShaderDesc] = &[
+    ShaderDesc {
+        name: "depth",
+        vertex: "mesh.vert",
+        fragment: "depth.frag",
+    },
+    ShaderDesc {
+        name: "forward",
+        vertex: "mesh.vert",
+        fragment: "forward.frag",
+    },
+];
 
 /// The files of `glsl/`, embedded so the binary needs no data files.
 pub const FILES: &[(&str, &str)] = &[
     ("mesh.vert", include_str!("../../glsl/mesh.vert")),
+    ("depth.frag", include_str!("../../glsl/depth.frag")),
     ("forward.frag", include_str!("../../glsl/forward.frag")),
-    ("light_model.glsl", include_str!("../../glsl/light_model.glsl")),
-    ("light_data.glsl", include_str!("../../glsl/light_data.glsl")),
+    (
+        "light_model.glsl",
+        include_str!("../../glsl/light_model.glsl"),
+    ),
+    (
+        "light_data.glsl",
+        include_str!("../../glsl/light_data.glsl"),
+    ),
     ("surface.glsl", include_str!("../../glsl/surface.glsl")),
 ];
 
@@ -163,7 +177,14 @@ mod tests {
                 for stage in [Stage::Vertex, Stage::Fragment] {
                     let src = assemble(s.name, stage, d, &[("FOO".into(), "1".into())]).unwrap();
                     let first = src.lines().next().unwrap();
-                    assert_eq!(first, if d == EsVersion::Es2 { "#version 100" } else { "#version 300 es" });
+                    assert_eq!(
+                        first,
+                        if d == EsVersion::Es2 {
+                            "#version 100"
+                        } else {
+                            "#version 300 es"
+                        }
+                    );
                     assert!(src.contains("#define FOO 1"));
                     assert!(!src.contains("#include"));
                 }

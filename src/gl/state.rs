@@ -48,15 +48,28 @@ pub struct RenderState {
     pub blend: Blend,
     /// Culling.
     pub cull: Cull,
+    /// Colour writes (off for a depth prepass).
+    pub color_write: bool,
 }
 
 impl RenderState {
-    /// Opaque geometry: depth test and write, no blending, both faces.
-    pub const OPAQUE: RenderState = RenderState {
+    /// Depth prepass: depth test and write, no colour.
+    pub const DEPTH_PREPASS: RenderState = RenderState {
         depth_test: DepthTest::Less,
         depth_write: true,
         blend: Blend::Off,
         cull: Cull::None,
+        color_write: false,
+    };
+
+    /// Opaque shading after a depth prepass: only the visible surface passes `LEQUAL`, so each
+    /// pixel is shaded once however deep the overdraw.
+    pub const OPAQUE_AFTER_PREPASS: RenderState = RenderState {
+        depth_test: DepthTest::LessEqual,
+        depth_write: false,
+        blend: Blend::Off,
+        cull: Cull::None,
+        color_write: true,
     };
 
     /// Applies every field.
@@ -75,6 +88,8 @@ impl RenderState {
                 }
             }
             gl.depth_mask(self.depth_write);
+            let c = self.color_write;
+            gl.color_mask(c, c, c, c);
             match self.blend {
                 Blend::Off => gl.disable(glow::BLEND),
                 Blend::Additive => {

@@ -36,7 +36,11 @@ pub struct DataTexture {
 fn set_sampling(gl: &glow::Context, filter: u32, wrap: u32, min_filter: u32) {
     unsafe {
         gl.tex_parameter_i32(glow::TEXTURE_2D, glow::TEXTURE_MAG_FILTER, filter as i32);
-        gl.tex_parameter_i32(glow::TEXTURE_2D, glow::TEXTURE_MIN_FILTER, min_filter as i32);
+        gl.tex_parameter_i32(
+            glow::TEXTURE_2D,
+            glow::TEXTURE_MIN_FILTER,
+            min_filter as i32,
+        );
         gl.tex_parameter_i32(glow::TEXTURE_2D, glow::TEXTURE_WRAP_S, wrap as i32);
         gl.tex_parameter_i32(glow::TEXTURE_2D, glow::TEXTURE_WRAP_T, wrap as i32);
     }
@@ -62,7 +66,13 @@ impl DataTexture {
     }
 
     /// Uploads `bytes` (`width × height` texels); reallocates only when the size changes.
-    pub fn upload(&mut self, dev: &Device, width: u32, height: u32, bytes: &[u8]) -> Result<(), GlError> {
+    pub fn upload(
+        &mut self,
+        dev: &Device,
+        width: u32,
+        height: u32,
+        bytes: &[u8],
+    ) -> Result<(), GlError> {
         let expected = width as usize * height as usize * self.format.bytes_per_texel();
         if bytes.len() != expected {
             return Err(GlError::Unsupported(format!(
@@ -164,7 +174,10 @@ impl ImageTexture {
     pub fn new(dev: &Device, image: &image::RgbaImage) -> Result<ImageTexture, GlError> {
         let max = dev.caps().max_texture_size.max(1) as u32;
         let (w, h) = image.dimensions();
-        let (pw, ph) = (w.next_power_of_two().min(max), h.next_power_of_two().min(max));
+        let (pw, ph) = (
+            w.next_power_of_two().min(max),
+            h.next_power_of_two().min(max),
+        );
         let resized;
         let img = if (pw, ph) != (w, h) {
             resized = image::imageops::resize(image, pw, ph, image::imageops::FilterType::Triangle);
@@ -192,7 +205,10 @@ impl ImageTexture {
         }
         set_sampling(gl, glow::LINEAR, glow::REPEAT, glow::LINEAR_MIPMAP_LINEAR);
         dev.check("image texture upload")?;
-        Ok(ImageTexture { raw, destroyed: false })
+        Ok(ImageTexture {
+            raw,
+            destroyed: false,
+        })
     }
 
     /// Binds to texture unit `unit`.

@@ -50,9 +50,15 @@ impl ShaderFeatures {
             ("LIGHTS_RGBA8".into(), flag(Self::LIGHTS_RGBA8)),
             ("OUTPUT_LINEAR".into(), flag(Self::OUTPUT_LINEAR)),
             ("DATA_WIDTH".into(), DATA_TEXTURE_WIDTH.to_string()),
-            ("LIGHT_TEXELS".into(), self.light_encoding().texels_per_light().to_string()),
+            (
+                "LIGHT_TEXELS".into(),
+                self.light_encoding().texels_per_light().to_string(),
+            ),
             ("MAX_LIGHTS".into(), max_lights.to_string()),
-            ("SPOT_MIN_COS_DELTA".into(), format!("{SPOT_MIN_COS_DELTA:e}")),
+            (
+                "SPOT_MIN_COS_DELTA".into(),
+                format!("{SPOT_MIN_COS_DELTA:e}"),
+            ),
             (
                 "ES_DIALECT".into(),
                 match dialect {

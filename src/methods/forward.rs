@@ -102,7 +102,11 @@ impl ShadingMethod for Forward {
             program.set_i32(dev, "u_lights", UNIT_METHOD as i32);
             program.set_i32(dev, "u_lightCount", count as i32);
             program.set_f32(dev, "u_lightTexInvHeight", inv_height);
-            program.set_vec2(dev, "u_lightRanges", [packed.pos_range, packed.radius_range]);
+            program.set_vec2(
+                dev,
+                "u_lightRanges",
+                [packed.pos_range, packed.radius_range],
+            );
         })?;
         Ok(stats)
     }

@@ -1,7 +1,7 @@
 //! The geometry pass shared by the forward-style methods: every object drawn once with its
 //! material's shader variant, the method adding its own uniforms and textures.
 
-use glam::DMat3;
+use glam::{DMat3, DMat4, Mat4};
 
 use super::{FrameContext, ShaderFeatures};
 use crate::gl::program::{Program, ProgramKey};
@@ -14,19 +14,62 @@ pub const UNIT_ALBEDO: u32 = 0;
 /// First texture unit a method may use for its data textures.
 pub const UNIT_METHOD: u32 = 1;
 
-/// Draws every object of the scene with `shader`, calling `bind_method` on each program
-/// before the draw so the method can set its uniforms and bind its textures.
+fn set_transforms(program: &mut Program, dev: &Device, model_view: &DMat4, projection: &Mat4) {
+    let normal_matrix = DMat3::from_mat4(*model_view).inverse().transpose();
+    program.set_mat4(dev, "u_modelView", &model_view.as_mat4());
+    program.set_mat3(dev, "u_normalMatrix", &normal_matrix.as_mat3());
+    program.set_mat4(dev, "u_projection", projection);
+}
+
+/// Lays down depth only, so the shading pass runs its light loop once per pixel instead of
+/// once per overlapping surface.
+fn depth_prepass(ctx: &mut FrameContext) -> Result<(), Error> {
+    let dev = ctx.dev;
+    RenderState::DEPTH_PREPASS.apply(dev);
+    let key = ProgramKey {
+        shader: "depth",
+        features: 0,
+        dialect: dev.es(),
+    };
+    let program = ctx.programs.get_or_build(dev, key, Vec::new)?;
+    program.bind(dev);
+    for (object, mesh) in ctx
+        .scene
+        .objects
+        .iter()
+        .zip(ctx.gpu_scene.meshes(ctx.scene))
+    {
+        set_transforms(
+            program,
+            dev,
+            &(ctx.view * object.transform),
+            &ctx.projection,
+        );
+        mesh.draw(dev);
+    }
+    Ok(())
+}
+
+/// Draws every object of the scene with `shader` after a depth prepass, calling
+/// `bind_method` on each program before the draw so the method can set its uniforms and bind
+/// its textures.
 pub fn draw_objects(
     ctx: &mut FrameContext,
     shader: &'static str,
     max_lights: u32,
     bind_method: &mut dyn FnMut(&mut Program, &Device),
 ) -> Result<(), Error> {
+    depth_prepass(ctx)?;
     let dev = ctx.dev;
     let dialect = dev.es();
-    RenderState::OPAQUE.apply(dev);
+    RenderState::OPAQUE_AFTER_PREPASS.apply(dev);
     let projection = ctx.projection;
-    for (object, mesh) in ctx.scene.objects.iter().zip(ctx.gpu_scene.meshes(ctx.scene)) {
+    for (object, mesh) in ctx
+        .scene
+        .objects
+        .iter()
+        .zip(ctx.gpu_scene.meshes(ctx.scene))
+    {
         let material = &ctx.scene.materials[object.material];
         let texture = ctx.gpu_scene.texture_for(material);
         let features = ctx
@@ -43,16 +86,16 @@ pub fn draw_objects(
             .get_or_build(dev, key, || features.defines(dialect, max_lights))?;
         program.bind(dev);
         // The camera is subtracted in f64 here, so far-from-origin scenes stay exact in f32.
-        let model_view = ctx.view * object.transform;
-        let normal_matrix = DMat3::from_mat4(model_view).inverse().transpose();
-        program.set_mat4(dev, "u_modelView", &model_view.as_mat4());
-        program.set_mat3(dev, "u_normalMatrix", &normal_matrix.as_mat3());
-        program.set_mat4(dev, "u_projection", &projection);
+        set_transforms(program, dev, &(ctx.view * object.transform), &projection);
         program.set_vec3(dev, "u_albedo", material.diffuse);
         program.set_vec3(dev, "u_specular", material.specular);
         program.set_f32(dev, "u_shininess", material.shading_exponent());
         program.set_vec3(dev, "u_ambient", ctx.scene.ambient);
-        program.set_f32(dev, "u_orthographic", if ctx.orthographic { 1.0 } else { 0.0 });
+        program.set_f32(
+            dev,
+            "u_orthographic",
+            if ctx.orthographic { 1.0 } else { 0.0 },
+        );
         if let Some(t) = texture {
             t.bind(dev, UNIT_ALBEDO);
             program.set_i32(dev, "u_albedoTex", UNIT_ALBEDO as i32);

@@ -103,6 +103,10 @@ pub fn find(name: &str) -> Result<&'static MethodDesc, Error> {
         .find(|m| m.name == name)
         .ok_or_else(|| Error::UnknownMethod {
             name: name.to_string(),
-            available: METHODS.iter().map(|m| m.name).collect::<Vec<_>>().join(", "),
+            available: METHODS
+                .iter()
+                .map(|m| m.name)
+                .collect::<Vec<_>>()
+                .join(", "),
         })
 }

@@ -38,7 +38,11 @@ pub fn diff(a: &image::RgbaImage, b: &image::RgbaImage) -> ImageDiff {
     ImageDiff {
         max_abs,
         rmse: mse.sqrt(),
-        psnr_db: if mse == 0.0 { f64::INFINITY } else { 10.0 * (255.0f64 * 255.0 / mse).log10() },
+        psnr_db: if mse == 0.0 {
+            f64::INFINITY
+        } else {
+            10.0 * (255.0f64 * 255.0 / mse).log10()
+        },
         over_1: over1 as f64 / n as f64,
         over_2: over2 as f64 / n as f64,
     }
@@ -55,7 +59,7 @@ mod tests {
         b.put_pixel(0, 0, image::Rgba([110, 100, 100, 255])); // one channel off by 10
         let d = diff(&a, &b);
         assert_eq!(d.max_abs, 10);
-        let mse = 100.0 / 48.0;
+        let mse: f64 = 100.0 / 48.0;
         assert!((d.rmse - mse.sqrt()).abs() < 1e-12);
         assert!((d.psnr_db - 10.0 * (65025.0 / mse).log10()).abs() < 1e-9);
         assert_eq!(d.over_2, 1.0 / 16.0);

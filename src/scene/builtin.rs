@@ -11,8 +11,8 @@ use std::sync::Arc;
 
 use glam::{DMat4, DVec3, Vec3};
 
-use super::meshbuild::MeshBuilder;
 use super::mesh::Aabb;
+use super::meshbuild::MeshBuilder;
 use super::random::{self, LightSetStyle};
 use super::{Camera, Material, Mesh, Object, Scene, SceneError};
 
@@ -60,17 +60,45 @@ fn courtyard() -> (Scene, Aabb, LightSetStyle) {
     let mut scene = Scene::empty();
 
     let mut floor = MeshBuilder::new();
-    floor.cuboid(Vec3::new(-HALF_X, -0.2, -HALF_Z), Vec3::new(HALF_X, 0.0, HALF_Z));
-    push(&mut scene, floor.build(), Material::glossy("floor", Vec3::new(0.45, 0.42, 0.38), Vec3::splat(0.25), 48.0));
+    floor.cuboid(
+        Vec3::new(-HALF_X, -0.2, -HALF_Z),
+        Vec3::new(HALF_X, 0.0, HALF_Z),
+    );
+    push(
+        &mut scene,
+        floor.build(),
+        Material::glossy(
+            "floor",
+            Vec3::new(0.45, 0.42, 0.38),
+            Vec3::splat(0.25),
+            48.0,
+        ),
+    );
 
     let mut walls = MeshBuilder::new();
     let h = 2.0 * STOREY + 3.0;
     walls
-        .cuboid(Vec3::new(-HALF_X - 0.5, 0.0, -HALF_Z - 0.5), Vec3::new(HALF_X + 0.5, h, -HALF_Z))
-        .cuboid(Vec3::new(-HALF_X - 0.5, 0.0, HALF_Z), Vec3::new(HALF_X + 0.5, h, HALF_Z + 0.5))
-        .cuboid(Vec3::new(-HALF_X - 0.5, 0.0, -HALF_Z), Vec3::new(-HALF_X, h, HALF_Z))
-        .cuboid(Vec3::new(HALF_X, 0.0, -HALF_Z), Vec3::new(HALF_X + 0.5, h, HALF_Z));
-    push(&mut scene, walls.build(), Material::flat("walls", Vec3::new(0.72, 0.64, 0.52)));
+        .cuboid(
+            Vec3::new(-HALF_X - 0.5, 0.0, -HALF_Z - 0.5),
+            Vec3::new(HALF_X + 0.5, h, -HALF_Z),
+        )
+        .cuboid(
+            Vec3::new(-HALF_X - 0.5, 0.0, HALF_Z),
+            Vec3::new(HALF_X + 0.5, h, HALF_Z + 0.5),
+        )
+        .cuboid(
+            Vec3::new(-HALF_X - 0.5, 0.0, -HALF_Z),
+            Vec3::new(-HALF_X, h, HALF_Z),
+        )
+        .cuboid(
+            Vec3::new(HALF_X, 0.0, -HALF_Z),
+            Vec3::new(HALF_X + 0.5, h, HALF_Z),
+        );
+    push(
+        &mut scene,
+        walls.build(),
+        Material::flat("walls", Vec3::new(0.72, 0.64, 0.52)),
+    );
 
     // Two storeys of arcades on both long sides: columns, arches, and the gallery slab the
     // upper storey stands on.
@@ -87,37 +115,90 @@ fn courtyard() -> (Scene, Aabb, LightSetStyle) {
             let mut x = -HALF_X + 2.0;
             while x <= HALF_X - 2.0 + 1e-3 {
                 columns.cylinder(Vec3::new(x, y0, z), radius, col_h, 14);
-                columns.cuboid(Vec3::new(x - 0.5, y0 + col_h, z - 0.5), Vec3::new(x + 0.5, y0 + col_h + 0.25, z + 0.5));
+                columns.cuboid(
+                    Vec3::new(x - 0.5, y0 + col_h, z - 0.5),
+                    Vec3::new(x + 0.5, y0 + col_h + 0.25, z + 0.5),
+                );
                 if x + spacing <= HALF_X - 2.0 + 1e-3 {
-                    arches.arch_x(Vec3::new(x + spacing * 0.5, y0 + col_h + 0.25, z), spacing * 0.5 - 0.5, 0.45, 0.9, 10);
+                    arches.arch_x(
+                        Vec3::new(x + spacing * 0.5, y0 + col_h + 0.25, z),
+                        spacing * 0.5 - 0.5,
+                        0.45,
+                        0.9,
+                        10,
+                    );
                 }
                 x += spacing;
             }
             // Entablature above the arches.
             let top = y0 + col_h + 0.25 + spacing * 0.5;
-            gallery.cuboid(Vec3::new(-HALF_X, top - 0.05, z - 0.45), Vec3::new(HALF_X, top + 0.4, z + 0.45));
+            gallery.cuboid(
+                Vec3::new(-HALF_X, top - 0.05, z - 0.45),
+                Vec3::new(HALF_X, top + 0.4, z + 0.45),
+            );
         }
         // Gallery floor between the arcade and the wall.
-        let (z0, z1) = if side < 0.0 { (-HALF_Z, z - 0.45) } else { (z + 0.45, HALF_Z) };
-        gallery.cuboid(Vec3::new(-HALF_X, STOREY, z0), Vec3::new(HALF_X, STOREY + 0.4, z1));
+        let (z0, z1) = if side < 0.0 {
+            (-HALF_Z, z - 0.45)
+        } else {
+            (z + 0.45, HALF_Z)
+        };
+        gallery.cuboid(
+            Vec3::new(-HALF_X, STOREY, z0),
+            Vec3::new(HALF_X, STOREY + 0.4, z1),
+        );
         // Balustrade of the gallery.
-        gallery.cuboid(Vec3::new(-HALF_X, STOREY + 0.4, z - 0.15), Vec3::new(HALF_X, STOREY + 1.3, z + 0.15));
+        gallery.cuboid(
+            Vec3::new(-HALF_X, STOREY + 0.4, z - 0.15),
+            Vec3::new(HALF_X, STOREY + 1.3, z + 0.15),
+        );
     }
-    push(&mut scene, columns.build(), Material::glossy("marble", Vec3::new(0.85, 0.84, 0.8), Vec3::splat(0.5), 96.0));
-    push(&mut scene, arches.build(), Material::flat("arches", Vec3::new(0.78, 0.6, 0.45)));
-    push(&mut scene, gallery.build(), Material::flat("gallery", Vec3::new(0.6, 0.58, 0.55)));
+    push(
+        &mut scene,
+        columns.build(),
+        Material::glossy("marble", Vec3::new(0.85, 0.84, 0.8), Vec3::splat(0.5), 96.0),
+    );
+    push(
+        &mut scene,
+        arches.build(),
+        Material::flat("arches", Vec3::new(0.78, 0.6, 0.45)),
+    );
+    push(
+        &mut scene,
+        gallery.build(),
+        Material::flat("gallery", Vec3::new(0.6, 0.58, 0.55)),
+    );
 
     let mut fountain = MeshBuilder::new();
     fountain
         .cylinder(Vec3::new(0.0, 0.0, 0.0), 2.4, 0.6, 32)
         .cylinder(Vec3::new(0.0, 0.6, 0.0), 0.35, 1.6, 16)
         .cylinder(Vec3::new(0.0, 2.2, 0.0), 1.0, 0.25, 24);
-    push(&mut scene, fountain.build(), Material::glossy("fountain", Vec3::new(0.3, 0.45, 0.55), Vec3::splat(0.6), 128.0));
+    push(
+        &mut scene,
+        fountain.build(),
+        Material::glossy(
+            "fountain",
+            Vec3::new(0.3, 0.45, 0.55),
+            Vec3::splat(0.6),
+            128.0,
+        ),
+    );
 
-    scene.camera = Camera::perspective(DVec3::new(-18.5, 3.0, 1.5), DVec3::new(6.0, 3.6, -1.0), 62.0, 0.1, 80.0);
+    scene.camera = Camera::perspective(
+        DVec3::new(-18.5, 3.0, 1.5),
+        DVec3::new(6.0, 3.6, -1.0),
+        62.0,
+        0.1,
+        80.0,
+    );
     let volume = Aabb {
         min: DVec3::new(-HALF_X as f64 + 0.5, 0.3, -HALF_Z as f64 + 0.5),
-        max: DVec3::new(HALF_X as f64 - 0.5, 2.0 * STOREY as f64 + 2.0, HALF_Z as f64 - 0.5),
+        max: DVec3::new(
+            HALF_X as f64 - 0.5,
+            2.0 * STOREY as f64 + 2.0,
+            HALF_Z as f64 - 0.5,
+        ),
     };
     (scene, volume, LightSetStyle::Mixed)
 }
@@ -126,7 +207,11 @@ fn pillars() -> (Scene, Aabb, LightSetStyle) {
     let mut scene = Scene::empty();
     let mut floor = MeshBuilder::new();
     floor.cuboid(Vec3::new(-15.0, -0.2, -20.0), Vec3::new(15.0, 0.0, 15.0));
-    push(&mut scene, floor.build(), Material::flat("floor", Vec3::new(0.5, 0.5, 0.52)));
+    push(
+        &mut scene,
+        floor.build(),
+        Material::flat("floor", Vec3::new(0.5, 0.5, 0.52)),
+    );
     let mut pillars = MeshBuilder::new();
     // A jittered 14 × 16 grid, deterministic (a tiny hash, not the light RNG, so adding lights
     // never moves the pillars).
@@ -136,11 +221,29 @@ fn pillars() -> (Scene, Aabb, LightSetStyle) {
             let x = -13.0 + i as f32 * 2.0 + (hash - 0.5) * 1.2;
             let z = -18.0 + j as f32 * 2.0 + (0.5 - hash) * 1.2;
             let w = 0.12 + 0.1 * hash;
-            pillars.cuboid(Vec3::new(x - w, 0.0, z - w), Vec3::new(x + w, 5.0 + 3.0 * hash, z + w));
+            pillars.cuboid(
+                Vec3::new(x - w, 0.0, z - w),
+                Vec3::new(x + w, 5.0 + 3.0 * hash, z + w),
+            );
         }
     }
-    push(&mut scene, pillars.build(), Material::glossy("pillars", Vec3::new(0.75, 0.72, 0.68), Vec3::splat(0.3), 64.0));
-    scene.camera = Camera::perspective(DVec3::new(0.5, 2.2, 16.0), DVec3::new(0.0, 2.0, 0.0), 60.0, 0.1, 60.0);
+    push(
+        &mut scene,
+        pillars.build(),
+        Material::glossy(
+            "pillars",
+            Vec3::new(0.75, 0.72, 0.68),
+            Vec3::splat(0.3),
+            64.0,
+        ),
+    );
+    scene.camera = Camera::perspective(
+        DVec3::new(0.5, 2.2, 16.0),
+        DVec3::new(0.0, 2.0, 0.0),
+        60.0,
+        0.1,
+        60.0,
+    );
     let volume = Aabb {
         min: DVec3::new(-14.0, 0.2, -19.0),
         max: DVec3::new(14.0, 7.0, 14.0),
@@ -154,8 +257,17 @@ fn plane() -> (Scene, Aabb, LightSetStyle) {
     let mut scene = Scene::empty();
     let mut quad = MeshBuilder::new();
     let s = 8.0;
-    quad.quad(Vec3::new(-s, -s, 0.0), Vec3::new(s, -s, 0.0), Vec3::new(s, s, 0.0), Vec3::new(-s, s, 0.0));
-    push(&mut scene, quad.build(), Material::glossy("plane", Vec3::splat(0.8), Vec3::splat(0.25), 24.0));
+    quad.quad(
+        Vec3::new(-s, -s, 0.0),
+        Vec3::new(s, -s, 0.0),
+        Vec3::new(s, s, 0.0),
+        Vec3::new(-s, s, 0.0),
+    );
+    push(
+        &mut scene,
+        quad.build(),
+        Material::glossy("plane", Vec3::splat(0.8), Vec3::splat(0.25), 24.0),
+    );
     scene.camera = Camera::perspective(DVec3::new(0.0, 0.0, 5.0), DVec3::ZERO, 60.0, 0.1, 50.0);
     let volume = Aabb {
         min: DVec3::new(-5.0, -3.0, 0.1),
@@ -176,7 +288,10 @@ mod tests {
             assert!(!scene.objects.is_empty(), "{name} has no geometry");
             assert_eq!(scene.lights.len(), 100);
         }
-        assert!(matches!(build("nope", None), Err(SceneError::UnknownBuiltin(_))));
+        assert!(matches!(
+            build("nope", None),
+            Err(SceneError::UnknownBuiltin(_))
+        ));
     }
 
     #[test]

@@ -51,7 +51,13 @@ impl Default for Camera {
 
 impl Camera {
     /// A perspective camera at `position` looking at `target` with +Y up.
-    pub fn perspective(position: DVec3, target: DVec3, fov_y_deg: f64, near: f64, far: f64) -> Self {
+    pub fn perspective(
+        position: DVec3,
+        target: DVec3,
+        fov_y_deg: f64,
+        near: f64,
+        far: f64,
+    ) -> Self {
         Camera {
             position,
             target,
@@ -80,7 +86,12 @@ impl Camera {
                 if far.is_infinite() {
                     perspective_infinite_gl(fov_y_deg.to_radians(), aspect, near)
                 } else {
-                    glam::dcamera::rh::proj::opengl::perspective(fov_y_deg.to_radians(), aspect, near, far)
+                    glam::dcamera::rh::proj::opengl::perspective(
+                        fov_y_deg.to_radians(),
+                        aspect,
+                        near,
+                        far,
+                    )
                 }
             }
             Projection::Orthographic { height, near, far } => {
@@ -94,9 +105,8 @@ impl Camera {
     /// Near and far plane distances.
     pub fn near_far(&self) -> (f64, f64) {
         match self.projection {
-            Projection::Perspective { near, far, .. } | Projection::Orthographic { near, far, .. } => {
-                (near, far)
-            }
+            Projection::Perspective { near, far, .. }
+            | Projection::Orthographic { near, far, .. } => (near, far),
         }
     }
 
@@ -108,15 +118,24 @@ impl Camera {
             ("camera.up", self.up),
         ] {
             if !v.is_finite() {
-                return Err(SceneError::invalid(name, format!("must be finite, got {v:?}")));
+                return Err(SceneError::invalid(
+                    name,
+                    format!("must be finite, got {v:?}"),
+                ));
             }
         }
         let forward = self.target - self.position;
         if forward.length_squared() == 0.0 {
-            return Err(SceneError::invalid("camera.target", "equals camera.position"));
+            return Err(SceneError::invalid(
+                "camera.target",
+                "equals camera.position",
+            ));
         }
         if forward.cross(self.up).length_squared() <= 1e-24 * forward.length_squared() {
-            return Err(SceneError::invalid("camera.up", "is parallel to the view direction"));
+            return Err(SceneError::invalid(
+                "camera.up",
+                "is parallel to the view direction",
+            ));
         }
         let (near, far) = self.near_far();
         match self.projection {
@@ -171,10 +190,22 @@ impl Camera {
 fn perspective_infinite_gl(fov_y: f64, aspect: f64, near: f64) -> DMat4 {
     let f = 1.0 / (fov_y * 0.5).tan();
     DMat4::from_cols_array(&[
-        f / aspect, 0.0, 0.0, 0.0, //
-        0.0, f, 0.0, 0.0, //
-        0.0, 0.0, -1.0, -1.0, //
-        0.0, 0.0, -2.0 * near, 0.0,
+        f / aspect,
+        0.0,
+        0.0,
+        0.0, //
+        0.0,
+        f,
+        0.0,
+        0.0, //
+        0.0,
+        0.0,
+        -1.0,
+        -1.0, //
+        0.0,
+        0.0,
+        -2.0 * near,
+        0.0,
     ])
 }
 
@@ -205,15 +236,21 @@ mod tests {
 
     #[test]
     fn validation_names_the_field() {
-        let mut cam = Camera::default();
-        cam.projection = Projection::Perspective {
-            fov_y_deg: 60.0,
-            near: 0.0,
-            far: 10.0,
+        let mut cam = Camera {
+            projection: Projection::Perspective {
+                fov_y_deg: 60.0,
+                near: 0.0,
+                far: 10.0,
+            },
+            ..Camera::default()
         };
         let err = cam.validate().unwrap_err().to_string();
         assert!(err.contains("camera.near"), "{err}");
         cam.position = DVec3::new(f64::NAN, 0.0, 0.0);
-        assert!(cam.validate().unwrap_err().to_string().contains("camera.position"));
+        assert!(cam
+            .validate()
+            .unwrap_err()
+            .to_string()
+            .contains("camera.position"));
     }
 }

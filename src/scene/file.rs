@@ -127,12 +127,20 @@ struct RandomLightsSpec {
 
 /// Loads a scene file. Returns the scene (validated) and the warnings of any OBJ loads.
 /// `random_override` = `Some((count, seed))` replaces the file's `random_lights`.
-pub fn load(path: &Path, random_override: Option<(usize, u64)>) -> Result<(Scene, LoadReport), SceneError> {
+pub fn load(
+    path: &Path,
+    random_override: Option<(usize, u64)>,
+) -> Result<(Scene, LoadReport), SceneError> {
     let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
         path: path.to_path_buf(),
         source,
     })?;
-    parse(&text, path.parent().unwrap_or(Path::new(".")), path, random_override)
+    parse(
+        &text,
+        path.parent().unwrap_or(Path::new(".")),
+        path,
+        random_override,
+    )
 }
 
 /// Parses scene-file text; relative paths are resolved against `base_dir`, `origin` names the
@@ -152,13 +160,20 @@ pub fn parse(
     let mut builtin_camera = None;
     for (i, spec) in file.objects.iter().enumerate() {
         let field = format!("objects[{i}]");
-        let transform = spec.transform.as_ref().map_or(Ok(DMat4::IDENTITY), |t| t.matrix(&field))?;
+        let transform = spec
+            .transform
+            .as_ref()
+            .map_or(Ok(DMat4::IDENTITY), |t| t.matrix(&field))?;
         let first_material = scene.materials.len();
         match (&spec.builtin, &spec.obj) {
             (Some(name), None) => {
-                let built = builtin::geometry(name).ok_or_else(|| SceneError::UnknownBuiltin(name.clone()))?;
+                let built = builtin::geometry(name)
+                    .ok_or_else(|| SceneError::UnknownBuiltin(name.clone()))?;
                 if spec.texture.is_some() {
-                    return Err(SceneError::invalid(format!("{field}.texture"), "only OBJ objects take a texture"));
+                    return Err(SceneError::invalid(
+                        format!("{field}.texture"),
+                        "only OBJ objects take a texture",
+                    ));
                 }
                 builtin_camera.get_or_insert(built.camera);
                 for mut o in built.objects {
@@ -170,7 +185,12 @@ pub fn parse(
             }
             (None, Some(obj_path)) => {
                 let tex = spec.texture.as_ref().map(|t| base_dir.join(t));
-                let r = obj::load_into(&mut scene, &base_dir.join(obj_path), transform, tex.as_deref())?;
+                let r = obj::load_into(
+                    &mut scene,
+                    &base_dir.join(obj_path),
+                    transform,
+                    tex.as_deref(),
+                )?;
                 report.warnings.extend(r.warnings);
             }
             _ => {
@@ -203,7 +223,9 @@ pub fn parse(
         let volume = scene.bounds().ok_or_else(|| {
             SceneError::invalid("random_lights", "needs geometry to place lights in")
         })?;
-        scene.lights.extend(random::lights(&volume, count, seed, LightSetStyle::Mixed));
+        scene
+            .lights
+            .extend(random::lights(&volume, count, seed, LightSetStyle::Mixed));
     }
     scene.validate()?;
     Ok((scene, report))
@@ -272,11 +294,16 @@ impl LightSpec {
             }
             LightKindSpec::Spot => {
                 let need = |v: Option<f64>, name: &str| {
-                    v.ok_or_else(|| SceneError::invalid(format!("{field}.{name}"), "required for a spot light"))
+                    v.ok_or_else(|| {
+                        SceneError::invalid(format!("{field}.{name}"), "required for a spot light")
+                    })
                 };
                 LightKind::Spot {
                     direction: DVec3::from(self.direction.ok_or_else(|| {
-                        SceneError::invalid(format!("{field}.direction"), "required for a spot light")
+                        SceneError::invalid(
+                            format!("{field}.direction"),
+                            "required for a spot light",
+                        )
                     })?),
                     inner_deg: need(self.inner_deg, "inner_deg")?,
                     outer_deg: need(self.outer_deg, "outer_deg")?,
@@ -324,18 +351,36 @@ mod tests {
     fn errors_name_the_field() {
         let cases = [
             (r#"{"objects": [], "lihgts": []}"#, "lihgts"),
-            (r#"{"lights": [{"kind":"point","position":[0,0,0],"radius":-1,"color":[1,1,1]}]}"#, "lights[0].radius"),
+            (
+                r#"{"lights": [{"kind":"point","position":[0,0,0],"radius":-1,"color":[1,1,1]}]}"#,
+                "lights[0].radius",
+            ),
             (
                 r#"{"lights": [{"kind":"spot","position":[0,0,0],"radius":1,"color":[1,1,1],
                    "direction":[0,-1,0],"inner_deg":40,"outer_deg":20}]}"#,
                 "lights[0].outer_deg",
             ),
-            (r#"{"lights": [{"kind":"spot","position":[0,0,0],"radius":1,"color":[1,1,1]}]}"#, "lights[0].direction"),
-            (r#"{"lights": [{"kind":"point","position":[0,0,0],"radius":1,"color":[1,1,1],"inner_deg":3}]}"#, "lights[0].inner_deg"),
-            (r#"{"objects": [{"builtin": "plane", "obj": "x.obj"}]}"#, "objects[0]"),
+            (
+                r#"{"lights": [{"kind":"spot","position":[0,0,0],"radius":1,"color":[1,1,1]}]}"#,
+                "lights[0].direction",
+            ),
+            (
+                r#"{"lights": [{"kind":"point","position":[0,0,0],"radius":1,"color":[1,1,1],"inner_deg":3}]}"#,
+                "lights[0].inner_deg",
+            ),
+            (
+                r#"{"objects": [{"builtin": "plane", "obj": "x.obj"}]}"#,
+                "objects[0]",
+            ),
             (r#"{"objects": [{"builtin": "nope"}]}"#, "nope"),
-            (r#"{"camera": {"position": [0,0,0], "target": [0,0,0]}}"#, "camera.target"),
-            (r#"{"lights": [{"kind":"point","position":[0,0,0],"radius":1,"color":[1,1,1],"intensity":-2}]}"#, "lights[0].intensity"),
+            (
+                r#"{"camera": {"position": [0,0,0], "target": [0,0,0]}}"#,
+                "camera.target",
+            ),
+            (
+                r#"{"lights": [{"kind":"point","position":[0,0,0],"radius":1,"color":[1,1,1],"intensity":-2}]}"#,
+                "lights[0].intensity",
+            ),
         ];
         for (text, needle) in cases {
             let err = parse_str(text).unwrap_err().to_string();

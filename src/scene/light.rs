@@ -189,11 +189,41 @@ mod tests {
     #[test]
     fn rejects_bad_values_naming_the_field() {
         let cases: Vec<(Light, &str)> = vec![
-            (Light { radius: f32::NAN, ..base() }, "lights[0].radius"),
-            (Light { radius: -1.0, ..base() }, "lights[0].radius"),
-            (Light { intensity: f32::INFINITY, ..base() }, "lights[0].intensity"),
-            (Light { color: Vec3::new(1.0, -1.0, 0.0), ..base() }, "lights[0].color"),
-            (Light { position: DVec3::new(0.0, f64::NAN, 0.0), ..base() }, "lights[0].position"),
+            (
+                Light {
+                    radius: f32::NAN,
+                    ..base()
+                },
+                "lights[0].radius",
+            ),
+            (
+                Light {
+                    radius: -1.0,
+                    ..base()
+                },
+                "lights[0].radius",
+            ),
+            (
+                Light {
+                    intensity: f32::INFINITY,
+                    ..base()
+                },
+                "lights[0].intensity",
+            ),
+            (
+                Light {
+                    color: Vec3::new(1.0, -1.0, 0.0),
+                    ..base()
+                },
+                "lights[0].color",
+            ),
+            (
+                Light {
+                    position: DVec3::new(0.0, f64::NAN, 0.0),
+                    ..base()
+                },
+                "lights[0].position",
+            ),
             (
                 Light::spot(DVec3::ZERO, DVec3::Z, 30.0, 20.0, 1.0, Vec3::ONE, 1.0),
                 "lights[0].outer_deg",

@@ -18,10 +18,16 @@ impl Aabb {
     pub fn from_points(points: impl IntoIterator<Item = DVec3>) -> Option<Aabb> {
         let mut it = points.into_iter();
         let first = it.next()?;
-        Some(it.fold(Aabb { min: first, max: first }, |b, p| Aabb {
-            min: b.min.min(p),
-            max: b.max.max(p),
-        }))
+        Some(it.fold(
+            Aabb {
+                min: first,
+                max: first,
+            },
+            |b, p| Aabb {
+                min: b.min.min(p),
+                max: b.max.max(p),
+            },
+        ))
     }
 
     /// Centre point.
@@ -32,6 +38,15 @@ impl Aabb {
     /// Edge lengths.
     pub fn size(&self) -> DVec3 {
         self.max - self.min
+    }
+
+    /// The box grown by `fraction` of its size on every side.
+    pub fn expanded(&self, fraction: f64) -> Aabb {
+        let pad = self.size() * fraction;
+        Aabb {
+            min: self.min - pad,
+            max: self.max + pad,
+        }
     }
 
     /// Smallest box containing both.
@@ -80,10 +95,13 @@ impl Mesh {
         indices: Vec<u32>,
     ) -> Result<Mesh, SceneError> {
         let n = positions.len();
-        if indices.len() % 3 != 0 {
+        if !indices.len().is_multiple_of(3) {
             return Err(SceneError::invalid(
                 "mesh.indices",
-                format!("{} indices is not a whole number of triangles", indices.len()),
+                format!(
+                    "{} indices is not a whole number of triangles",
+                    indices.len()
+                ),
             ));
         }
         if let Some(bad) = indices.iter().find(|&&i| i as usize >= n) {

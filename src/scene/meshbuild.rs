@@ -108,7 +108,12 @@ impl MeshBuilder {
             let a1 = (i + 1) as f32 / segments as f32 * PI;
             let d0 = Vec3::new(a0.cos(), a0.sin(), 0.0);
             let d1 = Vec3::new(a1.cos(), a1.sin(), 0.0);
-            let (i0, i1, o0, o1) = (centre + d0 * r0, centre + d1 * r0, centre + d0 * r1, centre + d1 * r1);
+            let (i0, i1, o0, o1) = (
+                centre + d0 * r0,
+                centre + d1 * r0,
+                centre + d0 * r1,
+                centre + d1 * r1,
+            );
             self.quad(o0 + dz, o1 + dz, i1 + dz, i0 + dz) // front (+Z)
                 .quad(i0 - dz, i1 - dz, o1 - dz, o0 - dz) // back
                 .quad(i0 + dz, i1 + dz, i1 - dz, i0 - dz) // intrados, faces the opening
@@ -155,7 +160,10 @@ mod tests {
         for t in m.indices.chunks(3) {
             let [a, b, c] = [t[0], t[1], t[2]].map(|i| m.positions[i as usize]);
             let face = (b - a).cross(c - a);
-            assert!(face.dot(m.normals[t[0] as usize]) > 0.0, "winding disagrees with normal");
+            assert!(
+                face.dot(m.normals[t[0] as usize]) > 0.0,
+                "winding disagrees with normal"
+            );
         }
     }
 }

@@ -137,7 +137,10 @@ impl Scene {
 /// Loads what the CLI's `--scene` names: a built-in name, an `.obj` file (camera framed on its
 /// bounds) or a `.json` scene file. `lights` = `Some((count, seed))` sets seeded random lights
 /// (for scene files, it replaces their `random_lights` count but keeps explicit lights).
-pub fn load(spec: &str, lights: Option<(usize, u64)>) -> Result<(Scene, obj::LoadReport), SceneError> {
+pub fn load(
+    spec: &str,
+    lights: Option<(usize, u64)>,
+) -> Result<(Scene, obj::LoadReport), SceneError> {
     let path = std::path::Path::new(spec);
     let ext = path
         .extension()
@@ -149,7 +152,9 @@ pub fn load(spec: &str, lights: Option<(usize, u64)>) -> Result<(Scene, obj::Loa
             let report = obj::load_into(&mut scene, path, DMat4::IDENTITY, None)?;
             scene.frame_camera();
             if let (Some((count, seed)), Some(bounds)) = (lights, scene.bounds()) {
-                scene.lights = random::lights(&bounds, count, seed, random::LightSetStyle::Mixed);
+                // Around the model as well as inside it: lights inside a closed model light nothing.
+                let volume = bounds.expanded(0.25);
+                scene.lights = random::lights(&volume, count, seed, random::LightSetStyle::Mixed);
             }
             scene.validate()?;
             Ok((scene, report))

@@ -209,9 +209,18 @@ mod tests {
         std::fs::create_dir(dir.path().join("Textures")).unwrap();
         std::fs::write(dir.path().join("Textures").join("Brick.PNG"), b"x").unwrap();
         let want = dir.path().join("Textures").join("Brick.PNG");
-        assert_eq!(resolve_texture(dir.path(), "textures\\brick.png"), Some(want.clone()));
-        assert_eq!(resolve_texture(dir.path(), "TEXTURES/BRICK.png"), Some(want.clone()));
-        assert_eq!(resolve_texture(dir.path(), "-bm 1 Textures/Brick.PNG"), Some(want));
+        assert_eq!(
+            resolve_texture(dir.path(), "textures\\brick.png"),
+            Some(want.clone())
+        );
+        assert_eq!(
+            resolve_texture(dir.path(), "TEXTURES/BRICK.png"),
+            Some(want.clone())
+        );
+        assert_eq!(
+            resolve_texture(dir.path(), "-bm 1 Textures/Brick.PNG"),
+            Some(want)
+        );
         assert_eq!(resolve_texture(dir.path(), "missing.png"), None);
     }
 

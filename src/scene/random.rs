@@ -45,7 +45,11 @@ pub fn lights(volume: &Aabb, count: usize, seed: u64, style: LightSetStyle) -> V
             let intensity = 0.6 * (1.0 + r * r / 6.0);
             let is_spot = style == LightSetStyle::Mixed && i % 4 == 3;
             if is_spot {
-                let dir = DVec3::new(rng.random_range(-0.6..0.6), -1.0, rng.random_range(-0.6..0.6));
+                let dir = DVec3::new(
+                    rng.random_range(-0.6..0.6),
+                    -1.0,
+                    rng.random_range(-0.6..0.6),
+                );
                 let outer = rng.random_range(20.0..60.0);
                 let inner = outer * rng.random_range(0.3..0.9);
                 Light::spot(position, dir, inner, outer, r * 1.5, color, intensity * 2.0)
@@ -72,13 +76,18 @@ mod tests {
 
     #[test]
     fn lights_stay_inside_the_volume_and_validate() {
-        let v = Aabb { min: DVec3::new(-1.0, 0.0, -2.0), max: DVec3::new(3.0, 1.0, 2.0) };
+        let v = Aabb {
+            min: DVec3::new(-1.0, 0.0, -2.0),
+            max: DVec3::new(3.0, 1.0, 2.0),
+        };
         let ls = lights(&v, 500, 3, LightSetStyle::Mixed);
         assert_eq!(ls.len(), 500);
         for (i, l) in ls.iter().enumerate() {
             l.validate(&format!("lights[{i}]")).unwrap();
             assert!(l.position.cmpge(v.min).all() && l.position.cmple(v.max).all());
         }
-        assert!(ls.iter().any(|l| matches!(l.kind, crate::scene::LightKind::Spot { .. })));
+        assert!(ls
+            .iter()
+            .any(|l| matches!(l.kind, crate::scene::LightKind::Spot { .. })));
     }
 }

@@ -20,15 +20,27 @@ impl Gpu {
             panic!("no headless {es} context ({e}); install libegl1 libegl-mesa0 libgles2 libgl1-mesa-dri")
         });
         let renderer = Renderer::new(ctx.load_gl(), es).expect("renderer");
-        Gpu { renderer: Some(renderer), _ctx: ctx }
+        Gpu {
+            renderer: Some(renderer),
+            _ctx: ctx,
+        }
     }
 
     pub fn r(&mut self) -> &mut Renderer {
         self.renderer.as_mut().unwrap()
     }
 
-    pub fn render(&mut self, scene: &Scene, w: u32, h: u32, opts: &RenderOptions) -> image::RgbaImage {
-        self.r().render_offscreen(scene, w, h, opts).expect("render").0
+    pub fn render(
+        &mut self,
+        scene: &Scene,
+        w: u32,
+        h: u32,
+        opts: &RenderOptions,
+    ) -> image::RgbaImage {
+        self.r()
+            .render_offscreen(scene, w, h, opts)
+            .expect("render")
+            .0
     }
 }
 
@@ -48,7 +60,10 @@ pub fn assets_dir() -> Option<PathBuf> {
     if dir.is_dir() {
         Some(dir)
     } else {
-        eprintln!("SKIPPED: assets folder {} not found (set MANYLIGHT_ASSETS)", dir.display());
+        eprintln!(
+            "SKIPPED: assets folder {} not found (set MANYLIGHT_ASSETS)",
+            dir.display()
+        );
         None
     }
 }
@@ -106,7 +121,9 @@ pub fn max_oracle_error(
     let mut covered = 0;
     for y in 0..h {
         for x in 0..w {
-            let Some(c) = plane_pixel(scene, w, h, x, y) else { continue };
+            let Some(c) = plane_pixel(scene, w, h, x, y) else {
+                continue;
+            };
             covered += 1;
             let px = img.get_pixel(x, y);
             for ch in 0..3 {

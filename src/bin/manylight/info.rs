@@ -35,46 +35,98 @@ pub fn run(args: &InfoArgs) -> Result<(), Box<dyn std::error::Error>> {
             "caps": caps,
             "methods": methods.iter().map(|(name, s)| serde_json::json!({"name": name, "support": s})).collect::<Vec<_>>(),
         });
-        println!("{}", serde_json::to_string_pretty(&value)?);
+        print_stdout(&(serde_json::to_string_pretty(&value)? + "\n"));
     } else {
-        print_text(&caps, ctx.info(), &methods);
+        print_stdout(&format_text(&caps, ctx.info(), &methods));
     }
     Ok(())
 }
 
-fn print_text(caps: &Caps, egl: &manylight::gl::context::EglInfo, methods: &[(&str, Support)]) {
-    println!("feature level      {} (context {})", caps.es, caps.context_version);
-    println!("GL_VERSION         {}", caps.gl_version);
-    println!("GLSL               {}", caps.glsl_version);
-    println!("GL_RENDERER        {}", caps.renderer);
-    println!("GL_VENDOR          {}", caps.vendor);
-    println!(
+/// Writes to stdout, treating a closed pipe (`manylight info | head`) as the end, not a panic.
+fn print_stdout(text: &str) {
+    use std::io::Write;
+    let _ = std::io::stdout().lock().write_all(text.as_bytes());
+}
+
+/// `writeln!` into a String (cannot fail).
+macro_rules! w {
+    ($out:expr, $($arg:tt)*) => {{
+        use std::fmt::Write as _;
+        let _ = writeln!($out, $($arg)*);
+    }};
+}
+
+fn format_text(
+    caps: &Caps,
+    egl: &manylight::gl::context::EglInfo,
+    methods: &[(&str, Support)],
+) -> String {
+    let mut out = String::new();
+    w!(
+        out,
+        "feature level      {} (context {})",
+        caps.es,
+        caps.context_version
+    );
+    w!(out, "GL_VERSION         {}", caps.gl_version);
+    w!(out, "GLSL               {}", caps.glsl_version);
+    w!(out, "GL_RENDERER        {}", caps.renderer);
+    w!(out, "GL_VENDOR          {}", caps.vendor);
+    w!(
+        out,
         "EGL                {} ({}, {} platform, {})",
         egl.egl_version,
         egl.egl_vendor,
         egl.platform,
-        if egl.surfaceless_context { "surfaceless context" } else { "1x1 pbuffer" }
+        if egl.surfaceless_context {
+            "surfaceless context"
+        } else {
+            "1x1 pbuffer"
+        }
     );
-    println!("max texture size   {}", caps.max_texture_size);
-    println!("frag uniform vecs  {}", caps.max_fragment_uniform_vectors);
-    println!("texture units      {}", caps.max_texture_image_units);
-    println!("draw buffers       {} (colour attachments {})", caps.max_draw_buffers, caps.max_color_attachments);
-    let p = |p: &manylight::gl::caps::Precision| format!("2^{}..2^{}, {} bits", -p.range_min, p.range_max, p.precision);
-    println!("fragment highp     {}", if caps.fragment_has_highp() { p(&caps.fragment_highp) } else { "not supported".into() });
-    println!("fragment mediump   {}", p(&caps.fragment_mediump));
-    println!("float textures     {}", caps.float_textures);
-    println!("depth24            {}", caps.depth24);
-    println!("timer queries      {}", caps.timer_query);
-    println!("extensions         {}", caps.extensions.len());
+    w!(out, "max texture size   {}", caps.max_texture_size);
+    w!(
+        out,
+        "frag uniform vecs  {}",
+        caps.max_fragment_uniform_vectors
+    );
+    w!(out, "texture units      {}", caps.max_texture_image_units);
+    w!(
+        out,
+        "draw buffers       {} (colour attachments {})",
+        caps.max_draw_buffers,
+        caps.max_color_attachments
+    );
+    let p = |p: &manylight::gl::caps::Precision| {
+        format!(
+            "2^{}..2^{}, {} bits",
+            -p.range_min, p.range_max, p.precision
+        )
+    };
+    w!(
+        out,
+        "fragment highp     {}",
+        if caps.fragment_has_highp() {
+            p(&caps.fragment_highp)
+        } else {
+            "not supported".into()
+        }
+    );
+    w!(out, "fragment mediump   {}", p(&caps.fragment_mediump));
+    w!(out, "float textures     {}", caps.float_textures);
+    w!(out, "depth24            {}", caps.depth24);
+    w!(out, "timer queries      {}", caps.timer_query);
+    w!(out, "extensions         {}", caps.extensions.len());
     for e in &caps.extensions {
-        println!("  {e}");
+        w!(out, "  {e}");
     }
-    println!("methods");
+    w!(out, "methods");
     for (name, s) in methods {
         match s {
-            Support::Supported => println!("  {name:<10} supported"),
-            Support::Fallback(r) => println!("  {name:<10} fallback: {r}"),
-            Support::Unsupported(r) => println!("  {name:<10} unsupported: {r}"),
+            Support::Supported => w!(out, "  {name:<10} supported"),
+            Support::Fallback(r) => w!(out, "  {name:<10} fallback: {r}"),
+            Support::Unsupported(r) => w!(out, "  {name:<10} unsupported: {r}"),
         }
     }
+    out
 }

@@ -22,14 +22,14 @@ pub struct RenderArgs {
     #[arg(long, value_enum, default_value = "3")]
     pub es: EsArg,
     /// Number of seeded random lights (for scene files: replaces their random_lights count).
-    /// Default: 512 for built-ins and OBJ files, the file's own lights for scene files.
+    /// Default: 256 for built-ins and OBJ files, the file's own lights for scene files.
     #[arg(long)]
     pub lights: Option<usize>,
     /// Seed of the random lights.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
     /// Image size as WIDTHxHEIGHT.
-    #[arg(long, default_value = "1280x720", value_parser = parse_size)]
+    #[arg(long, default_value = "960x540", value_parser = parse_size)]
     pub size: (u32, u32),
     /// Output PNG.
     #[arg(long, default_value = "manylight.png")]
@@ -42,9 +42,12 @@ pub struct RenderArgs {
     #[arg(long)]
     pub linear: bool,
     /// Frames timed after a warm-up frame (the median is reported).
-    #[arg(long, default_value_t = 3)]
+    #[arg(long, default_value_t = 2)]
     pub frames: u32,
 }
+
+/// Random lights for built-ins and OBJ files when `--lights` is not given.
+const DEFAULT_LIGHTS: usize = 256;
 
 fn parse_size(s: &str) -> Result<(u32, u32), String> {
     let (w, h) = s
@@ -64,7 +67,7 @@ pub fn run(args: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
     let lights = match (args.lights, is_file_scene) {
         (Some(n), _) => Some((n, args.seed)),
         (None, true) => None,
-        (None, false) => Some((512, args.seed)),
+        (None, false) => Some((DEFAULT_LIGHTS, args.seed)),
     };
     let (scene, report) = scene::load(&args.scene, lights)?;
     for w in &report.warnings {
@@ -73,9 +76,8 @@ pub fn run(args: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
     let es = args.es.into();
     let ctx = HeadlessContext::new(es)?;
     let mut renderer = Renderer::new(ctx.load_gl(), es)?;
-    if let Some(reason) = renderer.set_method(&args.method)? {
-        eprintln!("warning: method `{}` uses a fallback: {reason}", args.method);
-    }
+    // A fallback is logged as a warning by the renderer.
+    renderer.set_method(&args.method)?;
     let options = RenderOptions {
         linear: args.linear,
         timed_frames: args.frames,

@@ -1,0 +1,226 @@
+//! The command line as a user runs it, including under real driver restrictions
+//! (`MESA_GLES_VERSION_OVERRIDE`, `MESA_EXTENSION_OVERRIDE`) applied to child processes.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+fn manylight(args: &[&str], env: &[(&str, &str)], cwd: &Path) -> Output {
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_manylight"));
+    cmd.args(args).current_dir(cwd);
+    for (k, v) in env {
+        cmd.env(k, v);
+    }
+    cmd.output().expect("run manylight")
+}
+
+fn text(out: &Output) -> String {
+    format!(
+        "{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    )
+}
+
+fn stats(path: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
+#[test]
+fn render_writes_png_and_stats_with_the_documented_fields() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = manylight(
+        &[
+            "render", "--scene", "pillars", "--lights", "32", "--size", "96x64", "--out", "p.png",
+            "--stats", "s.json", "--es", "2",
+        ],
+        &[],
+        dir.path(),
+    );
+    assert!(out.status.success(), "{}", text(&out));
+    let img = image::open(dir.path().join("p.png")).unwrap();
+    assert_eq!((img.width(), img.height()), (96, 64));
+    let s = stats(&dir.path().join("s.json"));
+    for field in [
+        "method",
+        "es",
+        "gl_version",
+        "renderer",
+        "width",
+        "height",
+        "lights",
+        "frame_ms",
+    ] {
+        assert!(s.get(field).is_some(), "stats lack `{field}`: {s}");
+    }
+    assert_eq!(s["es"], "2.0");
+    assert_eq!(s["lights"], 32);
+    assert_eq!(s["method"], "forward");
+    assert!(s["frame_ms"].as_f64().unwrap() > 0.0);
+    assert!(
+        String::from_utf8_lossy(&out.stdout).contains("p.png"),
+        "one-line summary names the output"
+    );
+}
+
+#[test]
+fn no_arguments_renders_the_default_scene_to_manylight_png() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = manylight(&[], &[], dir.path());
+    assert!(out.status.success(), "{}", text(&out));
+    let img = image::open(dir.path().join("manylight.png"))
+        .unwrap()
+        .to_rgba8();
+    let lit = img
+        .pixels()
+        .filter(|p| p[0] as u32 + p[1] as u32 + p[2] as u32 > 60)
+        .count();
+    assert!(
+        lit * 2 > img.pixels().len(),
+        "default render is mostly dark ({lit} lit pixels)"
+    );
+    let line = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        line.contains("courtyard") && line.contains("lights"),
+        "{line}"
+    );
+}
+
+#[test]
+fn info_json_reports_versions_limits_and_precision() {
+    let dir = tempfile::tempdir().unwrap();
+    for es in ["2", "3"] {
+        let out = manylight(&["info", "--es", es, "--json"], &[], dir.path());
+        assert!(out.status.success(), "{}", text(&out));
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        let caps = &v["caps"];
+        assert_eq!(caps["es"], format!("{es}.0"));
+        for field in [
+            "gl_version",
+            "glsl_version",
+            "renderer",
+            "max_texture_size",
+            "max_fragment_uniform_vectors",
+            "max_draw_buffers",
+            "max_color_attachments",
+            "fragment_highp",
+            "extensions",
+        ] {
+            assert!(caps.get(field).is_some(), "caps lack `{field}`");
+        }
+        assert!(caps["max_texture_size"].as_i64().unwrap() >= 64);
+        assert!(v["methods"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|m| m["name"] == "forward"));
+    }
+}
+
+/// ES 2.0 requested on a driver that returns 3.x: the renderer restricts itself to ES 2.0
+/// (draw buffers as ES 2.0 core has them).
+#[test]
+fn es2_request_is_restricted_to_es2_even_on_an_es3_driver() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = manylight(&["info", "--es", "2", "--json"], &[], dir.path());
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let caps = &v["caps"];
+    let has_draw_buffers_ext = caps["extensions"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .any(|e| e == "GL_EXT_draw_buffers");
+    if !has_draw_buffers_ext {
+        assert_eq!(
+            caps["max_draw_buffers"], 1,
+            "ES 2.0 core has one draw buffer: {caps}"
+        );
+    }
+}
+
+#[test]
+fn capped_driver_says_clearly_that_es3_is_unavailable() {
+    let dir = tempfile::tempdir().unwrap();
+    let env = [("MESA_GLES_VERSION_OVERRIDE", "2.0")];
+    let out = manylight(
+        &["render", "--es", "3", "--size", "32x32"],
+        &env,
+        dir.path(),
+    );
+    assert!(!out.status.success());
+    let msg = text(&out);
+    assert!(
+        msg.contains("cannot create an OpenGL ES 3.0 context"),
+        "{msg}"
+    );
+    assert!(!msg.contains("panicked"), "{msg}");
+    // ES 2.0 still works on the capped driver, and the context really is 2.0.
+    let out = manylight(&["info", "--es", "2", "--json"], &env, dir.path());
+    assert!(out.status.success(), "{}", text(&out));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["caps"]["context_version"], "2.0");
+    let out = manylight(
+        &["render", "--es", "2", "--size", "64x36", "--lights", "16"],
+        &env,
+        dir.path(),
+    );
+    assert!(out.status.success(), "{}", text(&out));
+}
+
+#[test]
+fn without_float_textures_es2_falls_back_to_rgba8_lights_with_a_warning() {
+    let dir = tempfile::tempdir().unwrap();
+    let env = [("MESA_EXTENSION_OVERRIDE", "-GL_OES_texture_float")];
+    let out = manylight(
+        &[
+            "render", "--es", "2", "--size", "64x36", "--lights", "16", "--stats", "s.json",
+        ],
+        &env,
+        dir.path(),
+    );
+    assert!(out.status.success(), "{}", text(&out));
+    assert!(
+        text(&out).contains("GL_OES_texture_float"),
+        "the fallback is announced: {}",
+        text(&out)
+    );
+    let s = stats(&dir.path().join("s.json"));
+    assert_eq!(s["light_encoding"], "rgba8");
+    assert_eq!(s["support"]["status"], "fallback");
+}
+
+#[test]
+fn bad_requests_are_clear_errors_not_panics() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(
+        dir.path().join("bad.json"),
+        r#"{"objects": [{"builtin": "plane"}],
+            "lights": [{"kind": "point", "position": [0, 0, 1], "radius": -2, "color": [1, 1, 1]}]}"#,
+    )
+    .unwrap();
+    std::fs::write(
+        dir.path().join("typo.json"),
+        r#"{"objects": [{"builtin": "plane"}], "ambiant": [0, 0, 0]}"#,
+    )
+    .unwrap();
+    let cases: &[(&[&str], &str)] = &[
+        (&["render", "--scene", "bad.json"], "lights[0].radius"),
+        (&["render", "--scene", "typo.json"], "ambiant"),
+        (&["render", "--scene", "nowhere.obj"], "nowhere.obj"),
+        (&["render", "--scene", "atlantis"], "unknown built-in scene"),
+        (
+            &["render", "--method", "raytraced", "--size", "8x8"],
+            "unknown method `raytraced`",
+        ),
+        (&["render", "--size", "0x10"], "empty"),
+    ];
+    for (args, needle) in cases {
+        let out = manylight(args, &[], dir.path());
+        let msg = text(&out);
+        assert!(!out.status.success(), "{args:?} should fail");
+        assert!(
+            msg.contains(needle),
+            "{args:?}: expected `{needle}` in: {msg}"
+        );
+        assert!(!msg.contains("panicked"), "{args:?} panicked: {msg}");
+    }
+}
