@@ -1,6 +1,7 @@
 // Plain forward: every light for every fragment. The correctness oracle of the other methods,
 // so it stays simple and evaluates at the highest precision the fragment stage has.
 #include "surface.glsl"
+#include "data_texture.glsl"
 #include "light_data.glsl"
 #include "light_model.glsl"
 

@@ -1,5 +1,5 @@
-// Reads light records from the light data texture (layouts: src/cluster/pack.rs).
-// DATA_WIDTH (power of two), LIGHT_TEXELS and LIGHTS_RGBA8 come from Rust as #defines.
+// Reads light records from the light data texture (layout: src/cluster/pack.rs).
+// LIGHT_TEXELS and LIGHTS_RGBA8 come from Rust as #defines. Needs data_texture.glsl.
 uniform HIGHP sampler2D u_lights;
 uniform int u_lightCount;
 #if GLSL_ES == 100
@@ -21,25 +21,15 @@ struct Light {
 };
 
 #if GLSL_ES == 100
-vec4 lightTexel(HIGHP float index) {
-    // DATA_WIDTH is a power of two, so this division and floor are exact.
-    HIGHP float row = floor(index / float(DATA_WIDTH));
-    HIGHP float col = index - row * float(DATA_WIDTH);
-    return texture2D(u_lights, vec2((col + 0.5) / float(DATA_WIDTH), (row + 0.5) * u_lightTexInvHeight));
-}
-#define LIGHT_TEXEL(base, k) lightTexel(float(base) * float(LIGHT_TEXELS) + float(k))
+#define LIGHT_TEXEL(base, k) dataTexel(u_lights, float(base) * float(LIGHT_TEXELS) + float(k), u_lightTexInvHeight)
 #else
-vec4 lightTexel(int index) {
-    return texelFetch(u_lights, ivec2(index & (DATA_WIDTH - 1), index / DATA_WIDTH), 0);
-}
-#define LIGHT_TEXEL(base, k) lightTexel((base) * LIGHT_TEXELS + (k))
+#define LIGHT_TEXEL(base, k) texelFetch(u_lights, dataCoord((base) * LIGHT_TEXELS + (k)), 0)
 #endif
 
 #if LIGHTS_RGBA8
 // Two bytes (as 0..1 channels) → 0..1 with 16 bits.
 HIGHP float unpack16(vec2 bytes) {
-    HIGHP vec2 q = floor(bytes * 255.0 + 0.5);
-    return (q.x * 256.0 + q.y) / 65535.0;
+    return u16Of(bytes) / 65535.0;
 }
 #endif
 

@@ -8,7 +8,10 @@ use std::time::Instant;
 use glam::DMat4;
 use serde::Serialize;
 
+use crate::cluster::assign::AssignStats;
+use crate::cluster::grid::GridConfig;
 use crate::cluster::pack::GpuLight;
+use crate::cluster::tiles::TILE_PX;
 use crate::gl::framebuffer::OffscreenTarget;
 use crate::gl::mesh::GpuMesh;
 use crate::gl::program::ProgramCache;
@@ -31,6 +34,16 @@ pub struct RenderOptions {
     /// Frames timed after one warm-up frame by [`Renderer::render_offscreen`]; the median is
     /// reported. 0 times the single (cold) frame.
     pub timed_frames: u32,
+    /// Cluster grid of the clustered method.
+    pub grid: GridConfig,
+    /// Tile size in pixels of the tiled method.
+    pub tile_px: f64,
+    /// Most lights per cell (tiled/clustered); ES 2.0 never exceeds 255. `None`: no cap
+    /// beyond the encoding's.
+    pub cell_cap: Option<u32>,
+    /// Most indices in a frame's light lists (tiled/clustered); `None`: what the index texture
+    /// holds. Lower values exercise the overflow policy.
+    pub max_indices: Option<usize>,
 }
 
 impl Default for RenderOptions {
@@ -40,6 +53,10 @@ impl Default for RenderOptions {
             force_rgba8_lights: false,
             clear_color: [0.0, 0.0, 0.0, 1.0],
             timed_frames: 0,
+            grid: GridConfig::default(),
+            tile_px: TILE_PX,
+            cell_cap: None,
+            max_indices: None,
         }
     }
 }
@@ -67,6 +84,20 @@ pub struct FrameStats {
     pub frame_ms: f64,
     /// Bytes uploaded for the frame.
     pub upload_bytes: usize,
+    /// CPU light-assignment time in milliseconds (0 for forward).
+    pub assign_ms: f64,
+    /// Grid cells (0 for forward).
+    pub clusters: u32,
+    /// Cells holding at least one light.
+    pub nonempty_clusters: u32,
+    /// Mean lights per non-empty cell.
+    pub avg_lights_per_nonempty: f64,
+    /// Most lights any cell touched (before the per-cell cap).
+    pub max_lights_per_cluster: u32,
+    /// Light references dropped by the overflow policy (see `cluster::assign`).
+    pub overflowed_lights: u64,
+    /// Lights that reached the screen (touched at least one cell); all active lights for forward.
+    pub visible_lights: usize,
     /// `float32` or `rgba8`.
     pub light_encoding: crate::cluster::pack::LightEncoding,
     /// The method's support status on this context (fallbacks say what degrades).
@@ -234,6 +265,8 @@ impl Renderer {
                 ShaderFeatures::LIGHTS_RGBA8,
                 options.force_rgba8_lights || !self.dev.caps().float_textures,
             );
+        let (near, far) = scene.camera.near_far();
+        let content_far = content_far(scene, &view, near, far);
         self.dev.viewport(0, 0, width as i32, height as i32);
         self.dev.clear(options.clear_color);
         let mut ctx = FrameContext {
@@ -247,12 +280,16 @@ impl Renderer {
             lights: &lights,
             features,
             viewport: (width, height),
+            near,
+            far,
+            content_far,
             options,
         };
         let method_stats = self.method.render(&mut ctx)?;
         self.dev.finish();
         self.dev.check("frame")?;
         let caps = self.dev.caps();
+        let assign = method_stats.assign.unwrap_or(AssignStats::default());
         Ok(FrameStats {
             method: self.method.name().to_string(),
             es: caps.es,
@@ -264,6 +301,15 @@ impl Renderer {
             active_lights: lights.len(),
             frame_ms: start.elapsed().as_secs_f64() * 1e3,
             upload_bytes: method_stats.upload_bytes,
+            assign_ms: method_stats.assign_ms.unwrap_or(0.0),
+            clusters: assign.clusters,
+            nonempty_clusters: assign.nonempty_clusters,
+            avg_lights_per_nonempty: assign.avg_lights_per_nonempty,
+            max_lights_per_cluster: assign.max_lights_per_cluster,
+            overflowed_lights: assign.overflowed_lights,
+            visible_lights: method_stats
+                .assign
+                .map_or(lights.len(), |a| a.visible_lights),
             light_encoding: features.light_encoding(),
             support: self.support.clone(),
             triangles: scene.objects.iter().map(|o| o.mesh.triangle_count()).sum(),
@@ -313,5 +359,35 @@ impl Renderer {
         if let Some(mut t) = self.target.take() {
             t.destroy(&self.dev);
         }
+    }
+}
+
+/// Farthest view depth of the scene's geometry, clipped to `[near, far]` (never below a little
+/// past the near plane): where a cluster grid should end. Lights beyond it still reach the
+/// last slice, which extends to infinity.
+fn content_far(scene: &Scene, view: &DMat4, near: f64, far: f64) -> f64 {
+    let deepest = scene
+        .bounds()
+        .map(|b| {
+            (0..8)
+                .map(|i| {
+                    let pick =
+                        |bit: u32, lo: f64, hi: f64| if i & (1 << bit) != 0 { hi } else { lo };
+                    let p = glam::DVec3::new(
+                        pick(0, b.min.x, b.max.x),
+                        pick(1, b.min.y, b.max.y),
+                        pick(2, b.min.z, b.max.z),
+                    );
+                    -view.transform_point3(p).z
+                })
+                .fold(f64::MIN, f64::max)
+        })
+        .unwrap_or(far);
+    let floor = if near > 0.0 { near * 2.0 } else { 1e-3 };
+    let d = deepest.min(far).max(floor);
+    if d.is_finite() {
+        d
+    } else {
+        floor.max(1.0)
     }
 }

@@ -54,7 +54,19 @@ fn render_writes_png_and_stats_with_the_documented_fields() {
     }
     assert_eq!(s["es"], "2.0");
     assert_eq!(s["lights"], 32);
-    assert_eq!(s["method"], "forward");
+    assert_eq!(s["method"], "clustered", "clustered is the default method");
+    for field in [
+        "assign_ms",
+        "upload_bytes",
+        "clusters",
+        "nonempty_clusters",
+        "avg_lights_per_nonempty",
+        "max_lights_per_cluster",
+        "overflowed_lights",
+    ] {
+        assert!(s.get(field).is_some(), "stats lack `{field}`: {s}");
+    }
+    assert!(s["clusters"].as_u64().unwrap() > 0 && s["upload_bytes"].as_u64().unwrap() > 0);
     assert!(s["frame_ms"].as_f64().unwrap() > 0.0);
     assert!(
         String::from_utf8_lossy(&out.stdout).contains("p.png"),
@@ -222,5 +234,65 @@ fn bad_requests_are_clear_errors_not_panics() {
             "{args:?}: expected `{needle}` in: {msg}"
         );
         assert!(!msg.contains("panicked"), "{args:?} panicked: {msg}");
+    }
+}
+
+/// ES 2.0 with float textures removed from the driver: clustered still renders, within the
+/// measured error of the RGBA8 light packing against a float-texture forward reference.
+#[test]
+fn clustered_without_float_textures_stays_within_the_packing_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let common = [
+        "--es", "2", "--size", "128x72", "--lights", "128", "--linear", "--frames", "0",
+    ];
+    for scene in ["courtyard", "plane"] {
+        let reference = manylight(
+            &[
+                &[
+                    "render", "--scene", scene, "--method", "forward", "--out", "ref.png",
+                ][..],
+                &common,
+            ]
+            .concat(),
+            &[],
+            dir.path(),
+        );
+        assert!(reference.status.success(), "{}", text(&reference));
+        let env = [("MESA_EXTENSION_OVERRIDE", "-GL_OES_texture_float")];
+        let packed = manylight(
+            &[
+                &[
+                    "render",
+                    "--scene",
+                    scene,
+                    "--method",
+                    "clustered",
+                    "--out",
+                    "rgba8.png",
+                    "--stats",
+                    "s.json",
+                ][..],
+                &common,
+            ]
+            .concat(),
+            &env,
+            dir.path(),
+        );
+        assert!(packed.status.success(), "{}", text(&packed));
+        assert_eq!(stats(&dir.path().join("s.json"))["light_encoding"], "rgba8");
+        let a = image::open(dir.path().join("ref.png")).unwrap().to_rgba8();
+        let b = image::open(dir.path().join("rgba8.png"))
+            .unwrap()
+            .to_rgba8();
+        let d = manylight::metrics::diff(&a, &b);
+        eprintln!(
+            "{scene}: RGBA8 lights vs float forward: max {} rmse {:.3}",
+            d.max_abs, d.rmse
+        );
+        assert!(
+            d.max_abs <= 3,
+            "{scene}: packing error {} exceeds the measured bound 3/255",
+            d.max_abs
+        );
     }
 }

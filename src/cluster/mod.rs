@@ -1,5 +1,13 @@
-//! GL-free CPU light data: the texel layouts the shaders read (`pack`). The cluster grid and
-//! light assignment live here too as they arrive; nothing in this module touches GL, so all of
-//! it is unit-tested without a context.
+//! GL-free CPU light assignment: the cascaded cluster grid (`grid`), 2D screen tiles
+//! (`tiles`), per-frame light → cell assignment with a counting sort (`assign`), and the texel
+//! layouts the shaders read (`pack`). Nothing here touches GL, so all of it is unit-tested
+//! without a context.
 
+pub mod assign;
+pub mod grid;
 pub mod pack;
+pub mod pack_grid;
+pub mod tiles;
+
+#[cfg(test)]
+mod assign_tests;

@@ -55,6 +55,11 @@ pub const SHADERS: &[ShaderDesc] = &[
         vertex: "mesh.vert",
         fragment: "forward.frag",
     },
+    ShaderDesc {
+        name: "clustered",
+        vertex: "mesh.vert",
+        fragment: "clustered.frag",
+    },
 ];
 
 /// The files of `glsl/`, embedded so the binary needs no data files.
@@ -71,6 +76,15 @@ pub const FILES: &[(&str, &str)] = &[
         include_str!("../../glsl/light_data.glsl"),
     ),
     ("surface.glsl", include_str!("../../glsl/surface.glsl")),
+    (
+        "data_texture.glsl",
+        include_str!("../../glsl/data_texture.glsl"),
+    ),
+    ("clustered.frag", include_str!("../../glsl/clustered.frag")),
+    (
+        "cluster_lookup.glsl",
+        include_str!("../../glsl/cluster_lookup.glsl"),
+    ),
 ];
 
 /// Looks up a shader by name.

@@ -13,6 +13,10 @@ pub enum DataFormat {
     Rgba32F,
     /// Four bytes.
     Rgba8,
+    /// Two u32 channels (ES 3.0 only, read with `texelFetch` from a `usampler2D`).
+    Rg32Ui,
+    /// One u16 channel (ES 3.0 only).
+    R16Ui,
 }
 
 impl DataFormat {
@@ -21,6 +25,20 @@ impl DataFormat {
         match self {
             DataFormat::Rgba32F => 16,
             DataFormat::Rgba8 => 4,
+            DataFormat::Rg32Ui => 8,
+            DataFormat::R16Ui => 2,
+        }
+    }
+
+    /// (internal format, format, type) for `glTexImage2D` on the given feature level.
+    fn gl_formats(self, es: EsVersion) -> (u32, u32, u32) {
+        match (self, es) {
+            (DataFormat::Rgba32F, EsVersion::Es3) => (glow::RGBA32F, glow::RGBA, glow::FLOAT),
+            (DataFormat::Rgba32F, EsVersion::Es2) => (glow::RGBA, glow::RGBA, glow::FLOAT),
+            (DataFormat::Rgba8, EsVersion::Es3) => (glow::RGBA8, glow::RGBA, glow::UNSIGNED_BYTE),
+            (DataFormat::Rgba8, EsVersion::Es2) => (glow::RGBA, glow::RGBA, glow::UNSIGNED_BYTE),
+            (DataFormat::Rg32Ui, _) => (glow::RG32UI, glow::RG_INTEGER, glow::UNSIGNED_INT),
+            (DataFormat::R16Ui, _) => (glow::R16UI, glow::RED_INTEGER, glow::UNSIGNED_SHORT),
         }
     }
 }
@@ -54,6 +72,9 @@ impl DataTexture {
                 "float data textures need ES 3.0 or GL_OES_texture_float".into(),
             ));
         }
+        if matches!(format, DataFormat::Rg32Ui | DataFormat::R16Ui) && dev.es() != EsVersion::Es3 {
+            return Err(GlError::Unsupported("integer textures need ES 3.0".into()));
+        }
         let raw = unsafe { dev.gl.create_texture() }.map_err(GlError::Create)?;
         unsafe { dev.gl.bind_texture(glow::TEXTURE_2D, Some(raw)) };
         set_sampling(&dev.gl, glow::NEAREST, glow::CLAMP_TO_EDGE, glow::NEAREST);
@@ -65,7 +86,10 @@ impl DataTexture {
         })
     }
 
-    /// Uploads `bytes` (`width × height` texels); reallocates only when the size changes.
+    /// Uploads `bytes` (`width × height` texels) into the top rows. Storage grows to the next
+    /// power of two of rows and never shrinks, so a list that changes length every frame does
+    /// not reallocate every frame; shaders address rows with the allocated height
+    /// ([`DataTexture::size`]).
     pub fn upload(
         &mut self,
         dev: &Device,
@@ -87,41 +111,36 @@ impl DataTexture {
             )));
         }
         let gl = &dev.gl;
-        let (internal, ty) = match (self.format, dev.es()) {
-            (DataFormat::Rgba32F, EsVersion::Es3) => (glow::RGBA32F, glow::FLOAT),
-            (DataFormat::Rgba32F, EsVersion::Es2) => (glow::RGBA, glow::FLOAT),
-            (DataFormat::Rgba8, EsVersion::Es3) => (glow::RGBA8, glow::UNSIGNED_BYTE),
-            (DataFormat::Rgba8, EsVersion::Es2) => (glow::RGBA, glow::UNSIGNED_BYTE),
-        };
+        let (internal, format, ty) = self.format.gl_formats(dev.es());
         unsafe {
             gl.bind_texture(glow::TEXTURE_2D, Some(self.raw));
             gl.pixel_store_i32(glow::UNPACK_ALIGNMENT, 1);
-            if self.size == (width, height) {
-                gl.tex_sub_image_2d(
-                    glow::TEXTURE_2D,
-                    0,
-                    0,
-                    0,
-                    width as i32,
-                    height as i32,
-                    glow::RGBA,
-                    ty,
-                    glow::PixelUnpackData::Slice(Some(bytes)),
-                );
-            } else {
+            if self.size.0 != width || self.size.1 < height {
+                let rows = height.next_power_of_two().max(self.size.1).min(max);
                 gl.tex_image_2d(
                     glow::TEXTURE_2D,
                     0,
                     internal as i32,
                     width as i32,
-                    height as i32,
+                    rows as i32,
                     0,
-                    glow::RGBA,
+                    format,
                     ty,
-                    glow::PixelUnpackData::Slice(Some(bytes)),
+                    glow::PixelUnpackData::Slice(None),
                 );
-                self.size = (width, height);
+                self.size = (width, rows);
             }
+            gl.tex_sub_image_2d(
+                glow::TEXTURE_2D,
+                0,
+                0,
+                0,
+                width as i32,
+                height as i32,
+                format,
+                ty,
+                glow::PixelUnpackData::Slice(Some(bytes)),
+            );
         }
         dev.check("data texture upload")
     }

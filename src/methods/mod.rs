@@ -4,9 +4,12 @@
 //! version, required extensions and a `supported(&Caps)` check. The CLI, the tests and the
 //! capability matrix all iterate this one table.
 
+pub mod clustered;
+pub mod culled;
 pub mod features;
 pub mod forward;
 pub mod geometry;
+pub mod tiled;
 
 use crate::cluster::pack::GpuLight;
 use crate::gl::program::ProgramCache;
@@ -51,6 +54,13 @@ pub struct FrameContext<'a> {
     pub features: ShaderFeatures,
     /// Viewport size in pixels.
     pub viewport: (u32, u32),
+    /// Near plane distance.
+    pub near: f64,
+    /// Far plane distance (may be infinite).
+    pub far: f64,
+    /// Farthest view depth the scene's geometry reaches, clipped to [near, far]: where a grid
+    /// needs to end.
+    pub content_far: f64,
     /// Caller's options.
     pub options: &'a RenderOptions,
 }
@@ -58,8 +68,12 @@ pub struct FrameContext<'a> {
 /// What a method reports about its frame.
 #[derive(Clone, Debug, Default)]
 pub struct MethodStats {
-    /// Bytes uploaded to the GPU this frame (light data, later grids and index lists).
+    /// Bytes uploaded to the GPU this frame (light data, grids, index lists).
     pub upload_bytes: usize,
+    /// CPU light-assignment time (culling methods).
+    pub assign_ms: Option<f64>,
+    /// Assignment figures (culling methods).
+    pub assign: Option<crate::cluster::assign::AssignStats>,
 }
 
 /// A shading method: owns its GPU resources, renders a frame into the bound framebuffer.
@@ -91,10 +105,10 @@ pub struct MethodDesc {
 }
 
 /// The method table.
-pub static METHODS: &[MethodDesc] = &[forward::DESC];
+pub static METHODS: &[MethodDesc] = &[forward::DESC, tiled::DESC, clustered::DESC];
 
 /// The default method.
-pub const DEFAULT_METHOD: &str = "forward";
+pub const DEFAULT_METHOD: &str = "clustered";
 
 /// Finds a method by name.
 pub fn find(name: &str) -> Result<&'static MethodDesc, Error> {

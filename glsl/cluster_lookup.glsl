@@ -1,0 +1,69 @@
+// Finds a fragment's cell in the cascaded grid and reads its light list
+// (grid: src/cluster/grid.rs; texels: src/cluster/pack_grid.rs). Needs data_texture.glsl.
+// Tiled forward uses the same code with a one-cascade, one-slice grid.
+uniform HIGHP vec2 u_viewport;
+// t = (f(d) - x) * y, with f = log2 when z > 0.5 (perspective) and f(d) = d otherwise.
+uniform HIGHP vec3 u_depthMap;
+uniform HIGHP float u_cascadeCount;
+#if GLSL_ES == 100
+uniform HIGHP sampler2D u_grid;
+uniform HIGHP sampler2D u_indices;
+// x: 1 / grid texture rows, y: 1 / index texture rows.
+uniform HIGHP vec2 u_gridInvHeight;
+#else
+uniform HIGHP usampler2D u_grid;
+uniform HIGHP usampler2D u_indices;
+#endif
+
+HIGHP float clusterT(HIGHP float viewDepth) {
+    HIGHP float f = u_depthMap.z > 0.5 ? log2(max(viewDepth, 1e-30)) : viewDepth;
+    return (f - u_depthMap.x) * u_depthMap.y;
+}
+
+#if GLSL_ES == 100
+// (offset, count) of the fragment's cell. fragXY is a highp copy of gl_FragCoord.xy.
+HIGHP vec2 clusterCell(HIGHP vec2 fragXY, HIGHP float viewDepth) {
+    HIGHP float t = clusterT(viewDepth);
+    HIGHP float k = clamp(floor(t), 0.0, u_cascadeCount - 1.0);
+    vec4 a = dataTexel(u_grid, 2.0 * k, u_gridInvHeight.x);
+    vec4 b = dataTexel(u_grid, 2.0 * k + 1.0, u_gridInvHeight.x);
+    HIGHP float tilesX = u16Of(a.xy);
+    HIGHP float tilesY = u16Of(a.zw);
+    HIGHP float slices = byteOf(b.x);
+    HIGHP float first = byteOf(b.y) * 65536.0 + byteOf(b.z) * 256.0 + byteOf(b.w);
+    HIGHP float s = clamp(floor((t - k) * slices), 0.0, slices - 1.0);
+    HIGHP float x = clamp(floor(fragXY.x * tilesX / u_viewport.x), 0.0, tilesX - 1.0);
+    HIGHP float y = clamp(floor(fragXY.y * tilesY / u_viewport.y), 0.0, tilesY - 1.0);
+    HIGHP float cell = first + (s * tilesY + y) * tilesX + x;
+    vec4 c = dataTexel(u_grid, 2.0 * u_cascadeCount + cell, u_gridInvHeight.x);
+    // 20-bit offset, 12-bit count: [o19..o12][o11..o4][o3..o0 c11..c8][c7..c0].
+    HIGHP float b2 = byteOf(c.z);
+    HIGHP float high = floor(b2 / 16.0);
+    return vec2(byteOf(c.x) * 4096.0 + byteOf(c.y) * 16.0 + high, (b2 - high * 16.0) * 256.0 + byteOf(c.w));
+}
+
+// The light number at position `pos` of the index list (two 16-bit indices per texel).
+int lightIndexAt(HIGHP float pos) {
+    HIGHP float texel = floor(pos * 0.5);
+    vec4 t = dataTexel(u_indices, texel, u_gridInvHeight.y);
+    HIGHP vec2 pair = (pos - 2.0 * texel) > 0.5 ? t.zw : t.xy;
+    return int(u16Of(pair));
+}
+#else
+uvec2 clusterCell(HIGHP vec2 fragXY, HIGHP float viewDepth) {
+    HIGHP float t = clusterT(viewDepth);
+    int k = int(clamp(floor(t), 0.0, u_cascadeCount - 1.0));
+    uvec2 a = texelFetch(u_grid, dataCoord(2 * k), 0).xy;
+    uvec2 b = texelFetch(u_grid, dataCoord(2 * k + 1), 0).xy;
+    HIGHP float slices = float(b.x);
+    int s = int(clamp(floor((t - float(k)) * slices), 0.0, slices - 1.0));
+    int x = int(clamp(floor(fragXY.x * float(a.x) / u_viewport.x), 0.0, float(a.x) - 1.0));
+    int y = int(clamp(floor(fragXY.y * float(a.y) / u_viewport.y), 0.0, float(a.y) - 1.0));
+    int cell = int(b.y) + (s * int(a.y) + y) * int(a.x) + x;
+    return texelFetch(u_grid, dataCoord(2 * int(u_cascadeCount) + cell), 0).xy;
+}
+
+int lightIndexAt(uint pos) {
+    return int(texelFetch(u_indices, dataCoord(int(pos)), 0).x);
+}
+#endif

@@ -1,0 +1,411 @@
+//! Assignment against a brute-force reference: for many random fragment positions, every light
+//! that really reaches the position must be in the list of the cell the shader would pick.
+
+use glam::{DVec3, Vec3};
+use rand::{Rng, SeedableRng};
+use rand_pcg::Pcg64Mcg;
+
+use super::assign::{assign, AssignLimits, Assignment};
+use super::grid::{ClusterGrid, GridConfig, GridProjection};
+use super::pack::GpuLight;
+use crate::scene::Light;
+
+struct Case {
+    name: &'static str,
+    projection: GridProjection,
+    near: f64,
+    far: f64,
+    config: GridConfig,
+}
+
+fn cases() -> Vec<Case> {
+    let t = (30f64).to_radians().tan();
+    let persp = GridProjection::Perspective {
+        tan_x: t * 16.0 / 9.0,
+        tan_y: t,
+    };
+    vec![
+        Case {
+            name: "default",
+            projection: persp,
+            near: 0.1,
+            far: 80.0,
+            config: GridConfig::default(),
+        },
+        Case {
+            name: "tiny near",
+            projection: persp,
+            near: 1e-4,
+            far: 1e5,
+            config: GridConfig::default(),
+        },
+        Case {
+            name: "narrow fov",
+            projection: GridProjection::Perspective {
+                tan_x: 0.02,
+                tan_y: 0.01,
+            },
+            near: 1.0,
+            far: 500.0,
+            config: GridConfig::default(),
+        },
+        Case {
+            name: "ortho near 0",
+            projection: GridProjection::Orthographic {
+                half_x: 16.0,
+                half_y: 9.0,
+            },
+            near: 0.0,
+            far: 60.0,
+            config: GridConfig::default(),
+        },
+        Case {
+            name: "tiles",
+            projection: persp,
+            near: 0.1,
+            far: 80.0,
+            config: GridConfig::tiles(16.0),
+        },
+        Case {
+            name: "fine",
+            projection: persp,
+            near: 0.05,
+            far: 30.0,
+            config: GridConfig {
+                footprint_px: 8.0,
+                min_cell_size: Some(0.0),
+                ..GridConfig::default()
+            },
+        },
+    ]
+}
+
+/// Random lights around, behind and beyond the camera, point and spot, many sizes.
+fn random_lights(rng: &mut Pcg64Mcg, n: usize, scale: f64) -> Vec<GpuLight> {
+    (0..n)
+        .map(|i| {
+            let p = DVec3::new(
+                rng.random_range(-1.0..1.0),
+                rng.random_range(-1.0..1.0),
+                rng.random_range(-1.2..0.3),
+            ) * scale;
+            let r = (scale * rng.random_range(0.005..0.3)) as f32;
+            let light = if i % 3 == 0 {
+                let dir = DVec3::new(
+                    rng.random_range(-1.0..1.0),
+                    rng.random_range(-1.0..1.0),
+                    rng.random_range(-1.0..1.0),
+                );
+                let dir = if dir.length() < 1e-3 { DVec3::Z } else { dir };
+                let outer = rng.random_range(0.5..100.0);
+                Light::spot(p, dir, outer * 0.5, outer, r, Vec3::ONE, 1.0)
+            } else {
+                Light::point(p, r, Vec3::ONE, 1.0)
+            };
+            // Identity view: positions are already in view space.
+            GpuLight::from_light(&light, &glam::DMat4::IDENTITY)
+        })
+        .collect()
+}
+
+fn reaches(light: &GpuLight, p: DVec3) -> bool {
+    let to = p - light.position.as_dvec3();
+    let dist = to.length();
+    if dist >= light.radius as f64 {
+        return false;
+    }
+    if light.spot_scale != 0.0 && dist > 0.0 {
+        let cos = (to / dist).dot(light.direction.as_dvec3());
+        return cos >= (light.cone_deg.0 as f64).to_radians().cos() - 1e-9;
+    }
+    true
+}
+
+fn cell_lights(a: &Assignment, cell: u32) -> Vec<u32> {
+    let (o, n) = (
+        a.offsets[cell as usize] as usize,
+        a.counts[cell as usize] as usize,
+    );
+    a.indices[o..o + n]
+        .iter()
+        .map(|&i| a.visible[i as usize])
+        .collect()
+}
+
+fn check_points(
+    grid: &ClusterGrid,
+    lights: &[GpuLight],
+    a: &Assignment,
+    points: &[(f64, f64, f64)],
+    name: &str,
+) -> usize {
+    let mut checked = 0;
+    for &(px, py, d) in points {
+        let (hx, hy) = grid.projection.half_extent(d);
+        let ndc_x = 2.0 * px / grid.width as f64 - 1.0;
+        let ndc_y = 2.0 * py / grid.height as f64 - 1.0;
+        let p = DVec3::new(ndc_x * hx, ndc_y * hy, -d);
+        let cell = grid.cell_index(grid.cell_of_fragment(px, py, d));
+        let list = cell_lights(a, cell);
+        for (i, l) in lights.iter().enumerate() {
+            if reaches(l, p) {
+                checked += 1;
+                assert!(list.contains(&(i as u32)), "{name}: light {i} {l:?} reaches {p:?} (pixel {px},{py}, depth {d}) but is not in cell {cell}");
+            }
+        }
+    }
+    checked
+}
+
+#[test]
+fn never_misses_a_light_that_reaches_a_fragment() {
+    let mut rng = Pcg64Mcg::seed_from_u64(42);
+    for case in cases() {
+        let grid = ClusterGrid::new(320, 180, case.projection, case.near, case.far, &case.config);
+        let scale = case.far.min(200.0) * 0.5;
+        let lights = random_lights(&mut rng, 1500, scale);
+        let a = assign(
+            &grid,
+            &lights,
+            case.far,
+            &AssignLimits {
+                cell_cap: u32::MAX,
+                ..Default::default()
+            },
+        );
+        assert_eq!(a.stats.overflowed_lights, 0);
+        let log_range = (case.near.max(1e-4).ln(), case.far.min(scale * 3.0).ln());
+        let points: Vec<_> = (0..6000)
+            .map(|_| {
+                let d = if case.near == 0.0 {
+                    rng.random_range(0.0..case.far)
+                } else {
+                    rng.random_range(log_range.0..log_range.1).exp()
+                };
+                (
+                    rng.random_range(0.0..320.0),
+                    rng.random_range(0.0..180.0),
+                    d,
+                )
+            })
+            .collect();
+        let checked = check_points(&grid, &lights, &a, &points, case.name);
+        assert!(
+            checked > 500,
+            "{}: only {checked} light-fragment pairs checked",
+            case.name
+        );
+    }
+}
+
+/// Fragments exactly on column, row and slice boundaries, and one ulp either side.
+#[test]
+fn never_misses_on_cell_boundaries() {
+    let mut rng = Pcg64Mcg::seed_from_u64(7);
+    for case in cases() {
+        let grid = ClusterGrid::new(320, 180, case.projection, case.near, case.far, &case.config);
+        let scale = case.far.min(200.0) * 0.5;
+        let lights = random_lights(&mut rng, 800, scale);
+        let a = assign(
+            &grid,
+            &lights,
+            case.far,
+            &AssignLimits {
+                cell_cap: u32::MAX,
+                ..Default::default()
+            },
+        );
+        let mut points = Vec::new();
+        for (k, c) in grid.cascades.iter().enumerate() {
+            for s in 0..c.slices {
+                let (z0, _) = grid.slice_depth_range(k as u32, s);
+                if z0 > scale * 3.0 || z0 <= 0.0 {
+                    continue;
+                }
+                for _ in 0..20 {
+                    let i = rng.random_range(0..=c.tiles_x);
+                    let j = rng.random_range(0..=c.tiles_y);
+                    let px = (i as f64 * 320.0 / c.tiles_x as f64).min(319.999);
+                    let py = (j as f64 * 180.0 / c.tiles_y as f64).min(179.999);
+                    for z in [z0, z0.next_up(), z0.next_down()] {
+                        for (x, y) in [
+                            (px, py),
+                            (px.next_up(), py),
+                            (px.next_down(), py.next_down()),
+                        ] {
+                            points.push((
+                                x.clamp(0.0, 319.999),
+                                y.clamp(0.0, 179.999),
+                                z.max(case.near),
+                            ));
+                        }
+                    }
+                }
+            }
+        }
+        check_points(&grid, &lights, &a, &points, case.name);
+    }
+}
+
+#[test]
+fn lights_behind_the_camera_or_beyond_far_are_culled() {
+    let t = (30f64).to_radians().tan();
+    let grid = ClusterGrid::new(
+        320,
+        180,
+        GridProjection::Perspective { tan_x: t, tan_y: t },
+        0.1,
+        50.0,
+        &GridConfig::default(),
+    );
+    let mk = |z: f64, r: f32| {
+        GpuLight::from_light(
+            &Light::point(DVec3::new(0.0, 0.0, z), r, Vec3::ONE, 1.0),
+            &glam::DMat4::IDENTITY,
+        )
+    };
+    let lights = vec![
+        mk(5.0, 2.0),   // entirely behind
+        mk(-60.0, 5.0), // entirely beyond far
+        mk(0.5, 1.0),   // centre behind, sphere crosses the near plane: visible
+        mk(-10.0, 1.0), // in front
+        GpuLight::from_light(
+            &Light::point(DVec3::new(100.0, 0.0, -10.0), 1.0, Vec3::ONE, 1.0),
+            &glam::DMat4::IDENTITY,
+        ), // far off to the side
+    ];
+    let a = assign(&grid, &lights, 50.0, &AssignLimits::default());
+    assert_eq!(a.visible, vec![2, 3]);
+    // The light around the eye covers every column of the nearest slice.
+    let c0 = &grid.cascades[0];
+    let near_cells: Vec<u32> = (0..c0.tiles_x * c0.tiles_y).collect();
+    for cell in near_cells {
+        assert!(
+            cell_lights(&a, cell).contains(&2),
+            "cell {cell} lacks the light around the eye"
+        );
+    }
+}
+
+#[test]
+fn overflow_keeps_the_cap_counts_the_rest_and_stays_in_range() {
+    let t = (30f64).to_radians().tan();
+    let grid = ClusterGrid::new(
+        256,
+        144,
+        GridProjection::Perspective { tan_x: t, tan_y: t },
+        0.1,
+        50.0,
+        &GridConfig::default(),
+    );
+    // 300 small lights in one spot: one cell gets all of them.
+    let lights: Vec<GpuLight> = (0..300)
+        .map(|i| {
+            GpuLight::from_light(
+                &Light::point(
+                    DVec3::new(0.001 * i as f64, 0.0, -20.0),
+                    0.01,
+                    Vec3::splat(1.0 + i as f32),
+                    1.0,
+                ),
+                &glam::DMat4::IDENTITY,
+            )
+        })
+        .collect();
+    let a = assign(
+        &grid,
+        &lights,
+        50.0,
+        &AssignLimits {
+            cell_cap: 255,
+            ..Default::default()
+        },
+    );
+    assert!(a.stats.max_lights_per_cluster >= 300);
+    assert!(a.counts.iter().all(|&n| n <= 255));
+    assert!(a.stats.overflowed_lights >= 45);
+    let kept = a.indices.len() as u64;
+    let total: u64 = a.counts.iter().map(|&n| n as u64).sum();
+    assert_eq!(kept, total);
+    for (o, n) in a.offsets.iter().zip(&a.counts) {
+        assert!((*o + *n) as usize <= a.indices.len());
+    }
+    assert!(a.indices.iter().all(|&i| (i as usize) < a.visible.len()));
+    // The brightest lights are the ones kept.
+    let full = a.counts.iter().position(|&n| n == 255).unwrap() as u32;
+    let kept_lights = cell_lights(&a, full);
+    assert!(kept_lights.contains(&299) && !kept_lights.contains(&0));
+
+    // An index budget smaller than the lists lowers the cap until it fits.
+    let b = assign(
+        &grid,
+        &lights,
+        50.0,
+        &AssignLimits {
+            cell_cap: 255,
+            max_indices: 100,
+            ..Default::default()
+        },
+    );
+    assert!(b.indices.len() <= 100);
+    assert_eq!(
+        b.stats.overflowed_lights as usize + b.indices.len(),
+        a.stats.overflowed_lights as usize + a.indices.len()
+    );
+}
+
+#[test]
+fn parallel_and_sequential_assignment_agree() {
+    let mut rng = Pcg64Mcg::seed_from_u64(3);
+    let t = (30f64).to_radians().tan();
+    let grid = ClusterGrid::new(
+        640,
+        360,
+        GridProjection::Perspective {
+            tan_x: t * 16.0 / 9.0,
+            tan_y: t,
+        },
+        0.1,
+        80.0,
+        &GridConfig::default(),
+    );
+    let lights = random_lights(&mut rng, 5000, 40.0);
+    let seq = assign(
+        &grid,
+        &lights,
+        80.0,
+        &AssignLimits {
+            parallel_threshold: usize::MAX,
+            ..Default::default()
+        },
+    );
+    let par = assign(
+        &grid,
+        &lights,
+        80.0,
+        &AssignLimits {
+            parallel_threshold: 1,
+            ..Default::default()
+        },
+    );
+    assert_eq!(seq.visible, par.visible);
+    assert_eq!(seq.offsets, par.offsets);
+    assert_eq!(seq.counts, par.counts);
+    assert_eq!(seq.indices, par.indices);
+}
+
+#[test]
+fn zero_lights_do_no_work() {
+    let t = (30f64).to_radians().tan();
+    let grid = ClusterGrid::new(
+        64,
+        64,
+        GridProjection::Perspective { tan_x: t, tan_y: t },
+        0.1,
+        10.0,
+        &GridConfig::default(),
+    );
+    let a = assign(&grid, &[], 10.0, &AssignLimits::default());
+    assert!(a.indices.is_empty() && a.visible.is_empty());
+    assert!(a.counts.iter().all(|&n| n == 0));
+}

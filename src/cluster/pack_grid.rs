@@ -1,0 +1,252 @@
+//! Texel layouts of the cluster grid and the light index list.
+//!
+//! Both textures are [`DATA_TEXTURE_WIDTH`] texels wide, rows as needed.
+//!
+//! ```text
+//! Grid texture: a cascade table, then one texel per cell.
+//!   texel 2k     cascade k: tiles_x, tiles_y
+//!   texel 2k+1   cascade k: slices, first cell
+//!   texel 2C+i   cell i: offset into the index list, light count
+//!
+//!   ES 2.0, RGBA8 (4 bytes per texel)            ES 3.0, RG32UI (8 bytes per texel)
+//!     table 2k:   tx.hi tx.lo ty.hi ty.lo           (tiles_x, tiles_y)
+//!     table 2k+1: slices first.hi first.mid first.lo (slices, first_cell)
+//!     cell:       20-bit offset, 12-bit count        (offset, count)
+//!                 [o19..o12][o11..o4][o3..o0 c11..c8][c7..c0]
+//!   → counts ≤ 4 095, offsets < 2²⁰, cells < 2²⁴      → 32-bit everything
+//!
+//! Index texture: light numbers (positions in the uploaded light texture), grouped by cell.
+//!   ES 2.0, RGBA8: two 16-bit indices per texel (i.hi i.lo j.hi j.lo)    2 bytes per index
+//!   ES 3.0, R16UI: one index per texel                                 2 bytes per index
+//!   → at most 65 536 lights per frame
+//! ```
+//!
+//! Budget at 1280×720 with the default grid (about 20 000 cells, 1 024 lights, ~40 000
+//! indices): ES 2.0 80 KB grid + 80 KB indices per frame; ES 3.0 160 KB + 80 KB.
+
+use super::assign::Assignment;
+use super::grid::ClusterGrid;
+use super::pack::DATA_TEXTURE_WIDTH;
+
+/// Texels per cascade in the grid texture's table.
+pub const TABLE_TEXELS_PER_CASCADE: u32 = 2;
+
+/// Most lights a cell can hold in the RGBA8 grid (12-bit count) — also the ES 2.0 loop bound.
+pub const RGBA8_CELL_CAP: u32 = 4095;
+
+/// Most lights per frame the 16-bit index lists can name.
+pub const MAX_INDEXED_LIGHTS: usize = 1 << 16;
+
+/// Most indices the RGBA8 grid's 20-bit offsets can address.
+pub const RGBA8_OFFSET_LIMIT: usize = 1 << 20;
+
+/// How grid and index texels are stored.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum GridEncoding {
+    /// RGBA8 bytes (ES 2.0).
+    Rgba8,
+    /// Integer textures read with `texelFetch` (ES 3.0).
+    Uint,
+}
+
+/// Texels ready to upload.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PackedTexels {
+    /// Width in texels.
+    pub width: u32,
+    /// Rows.
+    pub height: u32,
+    /// Bytes, row-major.
+    pub bytes: Vec<u8>,
+}
+
+fn rows_for(texels: usize) -> u32 {
+    texels.div_ceil(DATA_TEXTURE_WIDTH as usize).max(1) as u32
+}
+
+fn be24(v: u32) -> [u8; 3] {
+    let b = v.to_be_bytes();
+    [b[1], b[2], b[3]]
+}
+
+/// Packs the cascade table and the per-cell (offset, count).
+pub fn pack_grid(grid: &ClusterGrid, a: &Assignment, encoding: GridEncoding) -> PackedTexels {
+    let table = grid.cascades.len() * TABLE_TEXELS_PER_CASCADE as usize;
+    let texels = table + grid.total_cells as usize;
+    let height = rows_for(texels);
+    let bpt = match encoding {
+        GridEncoding::Rgba8 => 4,
+        GridEncoding::Uint => 8,
+    };
+    let mut bytes = vec![0u8; DATA_TEXTURE_WIDTH as usize * height as usize * bpt];
+    let mut put = |texel: usize, pair: (u32, u32), rgba8: [u8; 4]| {
+        let at = texel * bpt;
+        match encoding {
+            GridEncoding::Rgba8 => bytes[at..at + 4].copy_from_slice(&rgba8),
+            GridEncoding::Uint => {
+                bytes[at..at + 4].copy_from_slice(&pair.0.to_le_bytes());
+                bytes[at + 4..at + 8].copy_from_slice(&pair.1.to_le_bytes());
+            }
+        }
+    };
+    for (k, c) in grid.cascades.iter().enumerate() {
+        let [xh, xl] = (c.tiles_x as u16).to_be_bytes();
+        let [yh, yl] = (c.tiles_y as u16).to_be_bytes();
+        put(2 * k, (c.tiles_x, c.tiles_y), [xh, xl, yh, yl]);
+        let [f0, f1, f2] = be24(c.first_cell);
+        put(
+            2 * k + 1,
+            (c.slices, c.first_cell),
+            [c.slices.min(255) as u8, f0, f1, f2],
+        );
+    }
+    for (cell, (&offset, &count)) in a.offsets.iter().zip(&a.counts).enumerate() {
+        let packed = (offset.min((1 << 20) - 1) << 12) | count.min(RGBA8_CELL_CAP);
+        put(table + cell, (offset, count), packed.to_be_bytes());
+    }
+    PackedTexels {
+        width: DATA_TEXTURE_WIDTH,
+        height,
+        bytes,
+    }
+}
+
+/// Packs the index list (16-bit light numbers).
+pub fn pack_indices(indices: &[u32], encoding: GridEncoding) -> PackedTexels {
+    let per_texel = match encoding {
+        GridEncoding::Rgba8 => 2,
+        GridEncoding::Uint => 1,
+    };
+    let height = rows_for(indices.len().div_ceil(per_texel));
+    let texel_bytes = match encoding {
+        GridEncoding::Rgba8 => 4,
+        GridEncoding::Uint => 2,
+    };
+    let mut bytes = vec![0u8; DATA_TEXTURE_WIDTH as usize * height as usize * texel_bytes];
+    for (i, &light) in indices.iter().enumerate() {
+        let v = light as u16;
+        match encoding {
+            // Big-endian pairs: texel i/2 holds index i in .xy (i even) or .zw (i odd).
+            GridEncoding::Rgba8 => bytes[i * 2..i * 2 + 2].copy_from_slice(&v.to_be_bytes()),
+            GridEncoding::Uint => bytes[i * 2..i * 2 + 2].copy_from_slice(&v.to_le_bytes()),
+        }
+    }
+    PackedTexels {
+        width: DATA_TEXTURE_WIDTH,
+        height,
+        bytes,
+    }
+}
+
+/// Reads a cell's (offset, count) back exactly as the shader decodes it.
+pub fn unpack_cell(
+    packed: &PackedTexels,
+    grid: &ClusterGrid,
+    cell: u32,
+    encoding: GridEncoding,
+) -> (u32, u32) {
+    let t = grid.cascades.len() * TABLE_TEXELS_PER_CASCADE as usize + cell as usize;
+    match encoding {
+        GridEncoding::Rgba8 => {
+            let b = &packed.bytes[t * 4..t * 4 + 4];
+            let v = u32::from_be_bytes([b[0], b[1], b[2], b[3]]);
+            (v >> 12, v & 0xFFF)
+        }
+        GridEncoding::Uint => {
+            let b = &packed.bytes[t * 8..t * 8 + 8];
+            (
+                u32::from_le_bytes(b[0..4].try_into().unwrap()),
+                u32::from_le_bytes(b[4..8].try_into().unwrap()),
+            )
+        }
+    }
+}
+
+/// Reads index `i` back exactly as the shader decodes it.
+pub fn unpack_index(packed: &PackedTexels, i: usize, encoding: GridEncoding) -> u32 {
+    let b = &packed.bytes[i * 2..i * 2 + 2];
+    match encoding {
+        GridEncoding::Rgba8 => u16::from_be_bytes([b[0], b[1]]) as u32,
+        GridEncoding::Uint => u16::from_le_bytes([b[0], b[1]]) as u32,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cluster::assign::{assign, AssignLimits};
+    use crate::cluster::grid::{GridConfig, GridProjection};
+    use crate::cluster::pack::GpuLight;
+    use crate::scene::Light;
+    use glam::{DVec3, Vec3};
+
+    #[test]
+    fn grid_and_indices_round_trip_exactly_in_both_encodings() {
+        let grid = ClusterGrid::new(
+            640,
+            360,
+            GridProjection::Perspective {
+                tan_x: 1.0,
+                tan_y: 0.6,
+            },
+            0.1,
+            60.0,
+            &GridConfig::default(),
+        );
+        let lights: Vec<GpuLight> = (0..2000)
+            .map(|i| {
+                let f = i as f64;
+                let p = DVec3::new(
+                    (f * 0.7).sin() * 20.0,
+                    (f * 0.3).cos() * 8.0,
+                    -1.0 - (f * 0.013) % 55.0,
+                );
+                GpuLight::from_light(
+                    &Light::point(p, 1.0 + (i % 5) as f32, Vec3::ONE, 1.0),
+                    &glam::DMat4::IDENTITY,
+                )
+            })
+            .collect();
+        let a = assign(&grid, &lights, 60.0, &AssignLimits::default());
+        assert!(a.indices.len() > 1000);
+        for enc in [GridEncoding::Rgba8, GridEncoding::Uint] {
+            let g = pack_grid(&grid, &a, enc);
+            let ix = pack_indices(&a.indices, enc);
+            for cell in 0..grid.total_cells {
+                assert_eq!(
+                    unpack_cell(&g, &grid, cell, enc),
+                    (a.offsets[cell as usize], a.counts[cell as usize])
+                );
+            }
+            for (i, &v) in a.indices.iter().enumerate() {
+                assert_eq!(unpack_index(&ix, i, enc), v);
+            }
+            assert_eq!(g.width, DATA_TEXTURE_WIDTH);
+        }
+    }
+
+    #[test]
+    fn table_holds_the_cascades() {
+        let grid = ClusterGrid::new(
+            640,
+            360,
+            GridProjection::Perspective {
+                tan_x: 1.0,
+                tan_y: 0.6,
+            },
+            0.1,
+            60.0,
+            &GridConfig::default(),
+        );
+        let a = assign(&grid, &[], 60.0, &AssignLimits::default());
+        let g = pack_grid(&grid, &a, GridEncoding::Rgba8);
+        for (k, c) in grid.cascades.iter().enumerate() {
+            let t = &g.bytes[k * 8..k * 8 + 8];
+            assert_eq!(u16::from_be_bytes([t[0], t[1]]) as u32, c.tiles_x);
+            assert_eq!(u16::from_be_bytes([t[2], t[3]]) as u32, c.tiles_y);
+            assert_eq!(t[4] as u32, c.slices);
+            assert_eq!(u32::from_be_bytes([0, t[5], t[6], t[7]]), c.first_cell);
+        }
+    }
+}

@@ -1,0 +1,51 @@
+//! Clustered forward (the default): lights assigned on the CPU every frame to the dense,
+//! cascaded cluster grid (`cluster::grid`), uploaded as textures, one geometry pass.
+
+use super::culled::{CulledForward, Culling};
+use super::{FrameContext, MethodDesc, MethodStats, ShadingMethod, Support};
+use crate::gl::{Caps, Device, EsVersion};
+use crate::Error;
+
+/// The table row.
+pub const DESC: MethodDesc = MethodDesc {
+    name: "clustered",
+    summary: "cascaded clustered forward: each fragment loops over its 3D cell's lights",
+    min_es: EsVersion::Es2,
+    required_extensions: &[],
+    supported: culled_support,
+    create: |_| Ok(Box::new(Clustered(CulledForward::new(Culling::Clustered)))),
+};
+
+/// Support of both culled methods: ES 2.0 needs highp fragments (cell lookup and texel
+/// addressing), and without float textures lights are RGBA8-packed.
+pub fn culled_support(caps: &Caps) -> Support {
+    if caps.es == EsVersion::Es2 && !caps.fragment_has_highp() {
+        return Support::Unsupported(
+            "the fragment stage has no highp floats, needed to find cells and address data textures exactly".into(),
+        );
+    }
+    if !caps.float_textures {
+        return Support::Fallback(
+            "lights packed as RGBA8 (lossy) because GL_OES_texture_float is missing".into(),
+        );
+    }
+    Support::Supported
+}
+
+/// Clustered forward.
+pub struct Clustered(CulledForward);
+
+impl ShadingMethod for Clustered {
+    fn name(&self) -> &'static str {
+        DESC.name
+    }
+    fn render(&mut self, ctx: &mut FrameContext) -> Result<MethodStats, Error> {
+        self.0.render(ctx)
+    }
+    fn gpu_bytes(&self) -> usize {
+        self.0.gpu_bytes()
+    }
+    fn destroy(&mut self, dev: &Device) {
+        self.0.destroy(dev)
+    }
+}

@@ -1,0 +1,257 @@
+//! The shared engine of tiled and clustered forward: assign lights to a grid on the CPU every
+//! frame, upload three data textures (lights, grid, indices), and shade in one geometry pass
+//! where each fragment loops over its cell's lights only.
+//!
+//! Uploads are ring-buffered over [`RING`] texture sets: a frame writes the set the GPU used
+//! `RING` frames ago, never one an in-flight frame may still read (drivers would otherwise stall
+//! or copy on a rewrite).
+
+use std::time::Instant;
+
+use super::geometry::{self, UNIT_METHOD};
+use super::{FrameContext, MethodStats};
+use crate::cluster::assign::{assign, AssignLimits};
+use crate::cluster::grid::{ClusterGrid, GridConfig, GridProjection};
+use crate::cluster::pack::{pack_lights, GpuLight, LightEncoding, DATA_TEXTURE_WIDTH};
+use crate::cluster::pack_grid::{
+    pack_grid, pack_indices, GridEncoding, MAX_INDEXED_LIGHTS, RGBA8_CELL_CAP, RGBA8_OFFSET_LIMIT,
+};
+use crate::gl::texture::{DataFormat, DataTexture};
+use crate::gl::{Device, EsVersion};
+use crate::Error;
+
+/// Texture sets in the upload ring.
+pub const RING: usize = 3;
+
+/// Which grid the method builds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Culling {
+    /// 2D screen tiles, one slice over the whole depth range.
+    Tiled,
+    /// The dense cascaded cluster grid.
+    Clustered,
+}
+
+struct TextureSet {
+    lights: DataTexture,
+    light_encoding: LightEncoding,
+    grid: DataTexture,
+    indices: DataTexture,
+}
+
+impl TextureSet {
+    fn new(dev: &Device, light_encoding: LightEncoding) -> Result<TextureSet, Error> {
+        let light_format = match light_encoding {
+            LightEncoding::Float32 => DataFormat::Rgba32F,
+            LightEncoding::Rgba8 => DataFormat::Rgba8,
+        };
+        let (grid, indices) = match dev.es() {
+            EsVersion::Es2 => (DataFormat::Rgba8, DataFormat::Rgba8),
+            EsVersion::Es3 => (DataFormat::Rg32Ui, DataFormat::R16Ui),
+        };
+        Ok(TextureSet {
+            lights: DataTexture::new(dev, light_format)?,
+            light_encoding,
+            grid: DataTexture::new(dev, grid)?,
+            indices: DataTexture::new(dev, indices)?,
+        })
+    }
+
+    fn destroy(mut self, dev: &Device) {
+        self.lights.destroy(dev);
+        self.grid.destroy(dev);
+        self.indices.destroy(dev);
+    }
+
+    fn gpu_bytes(&self) -> usize {
+        self.lights.gpu_bytes() + self.grid.gpu_bytes() + self.indices.gpu_bytes()
+    }
+}
+
+/// Tiled or clustered forward.
+pub struct CulledForward {
+    culling: Culling,
+    ring: Vec<Option<TextureSet>>,
+    frame: usize,
+    grid: Option<(GridKey, ClusterGrid)>,
+}
+
+/// What the grid depends on; it is rebuilt only when this changes.
+#[derive(Clone, Debug, PartialEq)]
+struct GridKey {
+    size: (u32, u32),
+    projection: [u64; 4],
+    near: u64,
+    far: u64,
+    config: GridConfig,
+}
+
+impl CulledForward {
+    /// A method with no GPU resources yet (created on first render).
+    pub fn new(culling: Culling) -> Self {
+        CulledForward {
+            culling,
+            ring: (0..RING).map(|_| None).collect(),
+            frame: 0,
+            grid: None,
+        }
+    }
+
+    fn grid_for(&mut self, ctx: &FrameContext) -> &ClusterGrid {
+        let projection = GridProjection::from_matrix(&ctx.projection.as_dmat4());
+        let config = match self.culling {
+            Culling::Clustered => ctx.options.grid.clone(),
+            Culling::Tiled => GridConfig::tiles(ctx.options.tile_px),
+        };
+        let proj_bits = match projection {
+            GridProjection::Perspective { tan_x, tan_y } => {
+                [0, tan_x.to_bits(), tan_y.to_bits(), 0]
+            }
+            GridProjection::Orthographic { half_x, half_y } => {
+                [1, half_x.to_bits(), half_y.to_bits(), 0]
+            }
+        };
+        let key = GridKey {
+            size: ctx.viewport,
+            projection: proj_bits,
+            near: ctx.near.to_bits(),
+            far: ctx.content_far.to_bits(),
+            config: config.clone(),
+        };
+        if self.grid.as_ref().map(|(k, _)| k) != Some(&key) {
+            let (w, h) = ctx.viewport;
+            let grid = ClusterGrid::new(w, h, projection, ctx.near, ctx.content_far, &config);
+            self.grid = Some((key, grid));
+        }
+        &self.grid.as_ref().expect("built above").1
+    }
+
+    /// Renders one frame (see the module docs).
+    pub fn render(&mut self, ctx: &mut FrameContext) -> Result<MethodStats, Error> {
+        let dev = ctx.dev;
+        let es = dev.es();
+        let (grid_encoding, per_index_texel) = match es {
+            EsVersion::Es2 => (GridEncoding::Rgba8, 2),
+            EsVersion::Es3 => (GridEncoding::Uint, 1),
+        };
+        let max_rows = dev.caps().max_texture_size.max(1) as usize;
+        let mut max_indices = max_rows * DATA_TEXTURE_WIDTH as usize * per_index_texel;
+        let mut cell_cap = ctx.options.cell_cap.unwrap_or(u32::MAX);
+        if es == EsVersion::Es2 {
+            cell_cap = cell_cap.min(RGBA8_CELL_CAP);
+            max_indices = max_indices.min(RGBA8_OFFSET_LIMIT);
+        }
+        if let Some(m) = ctx.options.max_indices {
+            max_indices = max_indices.min(m);
+        }
+        let limits = AssignLimits {
+            cell_cap,
+            max_indices,
+            ..AssignLimits::default()
+        };
+        let camera_far = ctx.far;
+        let lights = ctx.lights;
+        let grid = self.grid_for(ctx).clone();
+        let started = Instant::now();
+        let assignment = assign(&grid, lights, camera_far, &limits);
+        let assign_ms = started.elapsed().as_secs_f64() * 1e3;
+        if assignment.visible.len() > MAX_INDEXED_LIGHTS {
+            return Err(Error::Limit(format!(
+                "{} lights are visible in this frame; tiled and clustered shading index at most {MAX_INDEXED_LIGHTS}",
+                assignment.visible.len()
+            )));
+        }
+        let visible: Vec<GpuLight> = assignment
+            .visible
+            .iter()
+            .map(|&i| lights[i as usize])
+            .collect();
+        let encoding = ctx.features.light_encoding();
+        let packed_lights = pack_lights(&visible, encoding);
+        let packed_grid = pack_grid(&grid, &assignment, grid_encoding);
+        let packed_indices = pack_indices(&assignment.indices, grid_encoding);
+
+        let slot = self.frame % RING;
+        self.frame += 1;
+        if self.ring[slot]
+            .as_ref()
+            .is_some_and(|s| s.light_encoding != encoding)
+        {
+            if let Some(old) = self.ring[slot].take() {
+                old.destroy(dev);
+            }
+        }
+        if self.ring[slot].is_none() {
+            self.ring[slot] = Some(TextureSet::new(dev, encoding)?);
+        }
+        let set = self.ring[slot].as_mut().expect("created above");
+        set.lights.upload(
+            dev,
+            packed_lights.width,
+            packed_lights.height,
+            &packed_lights.bytes,
+        )?;
+        set.grid.upload(
+            dev,
+            packed_grid.width,
+            packed_grid.height,
+            &packed_grid.bytes,
+        )?;
+        set.indices.upload(
+            dev,
+            packed_indices.width,
+            packed_indices.height,
+            &packed_indices.bytes,
+        )?;
+        let upload_bytes =
+            packed_lights.bytes.len() + packed_grid.bytes.len() + packed_indices.bytes.len();
+
+        let set = &*set;
+        let inv = |t: &DataTexture| 1.0 / t.size().1.max(1) as f32;
+        let (light_inv, grid_inv, index_inv) =
+            (inv(&set.lights), inv(&set.grid), inv(&set.indices));
+        let (w, h) = ctx.viewport;
+        let depth_map = [
+            grid.a as f32,
+            grid.b as f32,
+            if grid.mapping == crate::cluster::grid::DepthMapping::Log2 {
+                1.0
+            } else {
+                0.0
+            },
+        ];
+        let cascades = grid.cascades.len() as f32;
+        let ranges = [packed_lights.pos_range, packed_lights.radius_range];
+        geometry::draw_objects(ctx, "clustered", RGBA8_CELL_CAP, &mut |program, dev| {
+            set.lights.bind(dev, UNIT_METHOD);
+            set.grid.bind(dev, UNIT_METHOD + 1);
+            set.indices.bind(dev, UNIT_METHOD + 2);
+            program.set_i32(dev, "u_lights", UNIT_METHOD as i32);
+            program.set_i32(dev, "u_grid", UNIT_METHOD as i32 + 1);
+            program.set_i32(dev, "u_indices", UNIT_METHOD as i32 + 2);
+            program.set_f32(dev, "u_lightTexInvHeight", light_inv);
+            program.set_vec2(dev, "u_gridInvHeight", [grid_inv, index_inv]);
+            program.set_vec2(dev, "u_lightRanges", ranges);
+            program.set_vec2(dev, "u_viewport", [w as f32, h as f32]);
+            program.set_vec3(dev, "u_depthMap", glam::Vec3::from(depth_map));
+            program.set_f32(dev, "u_cascadeCount", cascades);
+        })?;
+        Ok(MethodStats {
+            upload_bytes,
+            assign_ms: Some(assign_ms),
+            assign: Some(assignment.stats),
+        })
+    }
+
+    /// GPU bytes of all ring sets.
+    pub fn gpu_bytes(&self) -> usize {
+        self.ring.iter().flatten().map(TextureSet::gpu_bytes).sum()
+    }
+
+    /// Frees the ring.
+    pub fn destroy(&mut self, dev: &Device) {
+        for set in self.ring.iter_mut().filter_map(Option::take) {
+            set.destroy(dev);
+        }
+    }
+}
