@@ -149,18 +149,18 @@ pub fn for_each_cell(
         for s in sa..=sb {
             for y in y0..=y1 {
                 for x in x0..=x1 {
-                    let coord = CellCoord {
+                    let cell = grid.cell_index(CellCoord {
                         cascade: k,
                         slice: s,
                         x,
                         y,
-                    };
+                    });
                     if let Some(cone) = &cone {
-                        if !cone.may_touch(grid, coord, r) {
+                        if !cone.may_touch(grid, cell, r) {
                             continue;
                         }
                     }
-                    emit(grid.cell_index(coord));
+                    emit(cell);
                 }
             }
         }
@@ -215,10 +215,11 @@ fn axis_range(
         return None;
     }
     let to_tile =
-        |ndc: f64| (((ndc + 1.0) * 0.5 * tiles as f64).floor().max(0.0) as u32).min(tiles - 1);
+        |ndc: f64| (((ndc + 1.0) * 0.5 * tiles as f64).max(0.0) as u32).min(tiles - 1);
     let (mut t0, mut t1) = (to_tile(lo), to_tile(hi));
-    // Tighten the ends against the tile planes (perspective; orthographic is exact already).
-    if let GridProjection::Perspective { tan_x, tan_y } = projection {
+    // Tighten the ends against the tile planes where the tangent bounds do not apply (sphere
+    // reaching behind the eye; with `d > r` they are exact already, as is orthographic).
+    if let (GridProjection::Perspective { tan_x, tan_y }, true) = (projection, d <= r) {
         let tan = match axis {
             Axis::X => tan_x,
             Axis::Y => tan_y,
@@ -270,25 +271,12 @@ impl Cone {
     }
 
     /// False only when the cell's bounding sphere is certainly outside the cone of `range`.
-    fn may_touch(&self, grid: &ClusterGrid, cell: CellCoord, range: f64) -> bool {
-        let b = grid.cell_bounds(cell);
-        if b.depth.1.is_infinite() {
+    fn may_touch(&self, grid: &ClusterGrid, cell: u32, range: f64) -> bool {
+        let [x, y, z, radius] = grid.cell_sphere(cell);
+        if radius.is_infinite() {
             return true;
         }
-        let mut corners = [glam::DVec3::ZERO; 8];
-        for (i, corner) in corners.iter_mut().enumerate() {
-            let z = if i & 4 != 0 { b.depth.1 } else { b.depth.0 };
-            let (hx, hy) = grid.projection.half_extent(z);
-            let nx = if i & 1 != 0 { b.ndc_x.1 } else { b.ndc_x.0 };
-            let ny = if i & 2 != 0 { b.ndc_y.1 } else { b.ndc_y.0 };
-            *corner = glam::DVec3::new(nx * hx, ny * hy, -z);
-        }
-        let center = corners.iter().sum::<glam::DVec3>() / 8.0;
-        let radius = corners
-            .iter()
-            .map(|p| p.distance(center))
-            .fold(0.0, f64::max);
-        let v = center - self.apex;
+        let v = glam::DVec3::new(x, y, z) - self.apex;
         let v_len_sq = v.length_squared();
         let v1 = v.dot(self.axis);
         let closest = self.cos * (v_len_sq - v1 * v1).max(0.0).sqrt() - v1 * self.sin;

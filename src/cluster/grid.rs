@@ -184,6 +184,9 @@ pub struct ClusterGrid {
     pub cascades: Vec<Cascade>,
     /// Total cells.
     pub total_cells: u32,
+    /// Bounding sphere (view-space centre, radius) of every cell, built on first use (the
+    /// cone-vs-cell test of spot lights); infinite radius for cells reaching infinity.
+    cell_spheres: std::sync::OnceLock<Vec<[f64; 4]>>,
 }
 
 impl ClusterGrid {
@@ -275,7 +278,46 @@ impl ClusterGrid {
             b,
             cascades,
             total_cells: first_cell,
+            cell_spheres: std::sync::OnceLock::new(),
         }
+    }
+
+    /// Bounding sphere `[x, y, z, radius]` of a cell (see `cell_spheres`).
+    pub fn cell_sphere(&self, index: u32) -> [f64; 4] {
+        self.cell_spheres.get_or_init(|| self.build_cell_spheres())[index as usize]
+    }
+
+    fn build_cell_spheres(&self) -> Vec<[f64; 4]> {
+        let mut out = Vec::with_capacity(self.total_cells as usize);
+        for (k, c) in self.cascades.iter().enumerate() {
+            for slice in 0..c.slices {
+                for y in 0..c.tiles_y {
+                    for x in 0..c.tiles_x {
+                        let coord = CellCoord { cascade: k as u32, slice, x, y };
+                        out.push(self.bounding_sphere(coord));
+                    }
+                }
+            }
+        }
+        out
+    }
+
+    fn bounding_sphere(&self, cell: CellCoord) -> [f64; 4] {
+        let b = self.cell_bounds(cell);
+        if b.depth.1.is_infinite() {
+            return [0.0, 0.0, 0.0, f64::INFINITY];
+        }
+        let mut corners = [glam::DVec3::ZERO; 8];
+        for (i, corner) in corners.iter_mut().enumerate() {
+            let z = if i & 4 != 0 { b.depth.1 } else { b.depth.0 };
+            let (hx, hy) = self.projection.half_extent(z);
+            let nx = if i & 1 != 0 { b.ndc_x.1 } else { b.ndc_x.0 };
+            let ny = if i & 2 != 0 { b.ndc_y.1 } else { b.ndc_y.0 };
+            *corner = glam::DVec3::new(nx * hx, ny * hy, -z);
+        }
+        let center = corners.iter().sum::<glam::DVec3>() / 8.0;
+        let radius = corners.iter().map(|p| p.distance(center)).fold(0.0, f64::max);
+        [center.x, center.y, center.z, radius]
     }
 
     /// `f(d)` of the depth mapping (`d` clamped to a positive value for the log).
@@ -298,19 +340,12 @@ impl ClusterGrid {
 
     /// Cascade and slice of a grid coordinate, clamped into the grid.
     pub fn t_to_cascade_slice(&self, t: f64) -> (u32, u32) {
+        // Clamping to ≥ 0 first makes the truncating cast a floor (and maps NaN to 0); this is
+        // the hot path of the assignment, and `f64::floor` is a libm call on baseline x86-64.
         let last = self.cascades.len() as u32 - 1;
-        let k = if t.is_nan() {
-            0
-        } else {
-            t.floor().clamp(0.0, last as f64) as u32
-        };
+        let k = t.clamp(0.0, last as f64) as u32;
         let slices = self.cascades[k as usize].slices;
-        let s = ((t - k as f64) * slices as f64).floor();
-        let s = if s.is_nan() {
-            0
-        } else {
-            s.clamp(0.0, (slices - 1) as f64) as u32
-        };
+        let s = ((t - k as f64) * slices as f64).clamp(0.0, (slices - 1) as f64) as u32;
         (k, s)
     }
 
@@ -340,13 +375,13 @@ impl ClusterGrid {
     /// Column of a window x coordinate (pixels, from the left) in a cascade.
     pub fn column(&self, cascade: u32, x_px: f64) -> u32 {
         let tx = self.cascades[cascade as usize].tiles_x;
-        ((x_px * tx as f64 / self.width as f64).floor().max(0.0) as u32).min(tx - 1)
+        ((x_px * tx as f64 / self.width as f64).max(0.0) as u32).min(tx - 1)
     }
 
     /// Row of a window y coordinate (pixels, from the bottom) in a cascade.
     pub fn row(&self, cascade: u32, y_px: f64) -> u32 {
         let ty = self.cascades[cascade as usize].tiles_y;
-        ((y_px * ty as f64 / self.height as f64).floor().max(0.0) as u32).min(ty - 1)
+        ((y_px * ty as f64 / self.height as f64).max(0.0) as u32).min(ty - 1)
     }
 
     /// Linear index of a cell.

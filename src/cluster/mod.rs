@@ -8,6 +8,7 @@ pub mod grid;
 pub mod pack;
 pub mod pack_grid;
 pub mod tiles;
+pub mod workload;
 
 #[cfg(test)]
 mod assign_tests;

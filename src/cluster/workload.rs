@@ -1,0 +1,69 @@
+//! The light-assignment workload of the benchmarks: the default scene's view at 1280×720 with
+//! N seeded random lights, converted to view space once, so only `assign` is timed.
+
+use std::time::Instant;
+
+use super::assign::{assign, AssignLimits, Assignment};
+use super::grid::{ClusterGrid, GridConfig, GridProjection};
+use super::pack::GpuLight;
+use crate::scene;
+
+/// Viewport of the benchmark view.
+pub const BENCH_SIZE: (u32, u32) = (1280, 720);
+
+/// A prepared assignment problem.
+pub struct AssignWorkload {
+    /// The default clustered grid for the view.
+    pub grid: ClusterGrid,
+    /// Lights in view space.
+    pub lights: Vec<GpuLight>,
+    /// Camera far plane.
+    pub far: f64,
+}
+
+impl AssignWorkload {
+    /// The default scene's camera with `count` random lights (seed `seed`).
+    pub fn default_view(count: usize, seed: u64) -> AssignWorkload {
+        let scene = scene::builtin::build(scene::builtin::DEFAULT, Some((count, seed)))
+            .expect("the default scene builds");
+        let (w, h) = BENCH_SIZE;
+        let view = scene.camera.view_matrix();
+        let projection = scene.camera.projection_matrix(w as f64 / h as f64);
+        let (near, far) = scene.camera.near_far();
+        let grid = ClusterGrid::new(
+            w,
+            h,
+            GridProjection::from_matrix(&projection),
+            near,
+            far,
+            &GridConfig::default(),
+        );
+        let lights = scene
+            .lights
+            .iter()
+            .map(|l| GpuLight::from_light(l, &view))
+            .collect();
+        AssignWorkload { grid, lights, far }
+    }
+
+    /// One assignment.
+    pub fn assign(&self) -> Assignment {
+        assign(&self.grid, &self.lights, self.far, &AssignLimits { cell_cap: u32::MAX, ..AssignLimits::default() })
+    }
+
+    /// Median wall time in milliseconds over `runs` assignments (after one warm-up), and the
+    /// number of indices produced.
+    pub fn time(&self, runs: usize) -> (f64, usize) {
+        let indices = self.assign().indices.len();
+        let mut times: Vec<f64> = (0..runs.max(1))
+            .map(|_| {
+                let t = Instant::now();
+                let a = self.assign();
+                std::hint::black_box(&a);
+                t.elapsed().as_secs_f64() * 1e3
+            })
+            .collect();
+        times.sort_by(f64::total_cmp);
+        (times[times.len() / 2], indices)
+    }
+}
