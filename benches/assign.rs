@@ -13,7 +13,9 @@ fn assignment(c: &mut Criterion) {
         if count >= 65_536 {
             group.sample_size(10);
         }
-        group.bench_with_input(BenchmarkId::from_parameter(count), &work, |b, w| b.iter(|| w.assign()));
+        group.bench_with_input(BenchmarkId::from_parameter(count), &work, |b, w| {
+            b.iter(|| w.assign())
+        });
     }
     group.finish();
 }

@@ -296,3 +296,30 @@ fn clustered_without_float_textures_stays_within_the_packing_error() {
         );
     }
 }
+
+#[test]
+fn bench_assign_prints_json_for_scripts() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = manylight(
+        &[
+            "bench-assign",
+            "--lights",
+            "16,256",
+            "--runs",
+            "3",
+            "--json",
+        ],
+        &[],
+        dir.path(),
+    );
+    assert!(out.status.success(), "{}", text(&out));
+    let rows: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let rows = rows.as_array().unwrap();
+    assert_eq!(rows.len(), 2);
+    assert_eq!(rows[0]["lights"], 16);
+    assert_eq!(rows[1]["lights"], 256);
+    for r in rows {
+        assert!(r["assign_ms"].as_f64().unwrap() > 0.0);
+        assert!(r["indices"].as_u64().unwrap() > 0);
+    }
+}

@@ -110,6 +110,14 @@ pub fn for_each_cell(
     let (k0, s0) = grid.view_z_to_cascade_slice(dmin);
     let (k1, s1) = grid.view_z_to_cascade_slice(dmax);
     let cone = Cone::of(light);
+    // Exact tangent slopes (view x/d and y/d) of the whole sphere, when it is in front of the
+    // eye; computed once per light, intersected with each cascade's box bounds below.
+    let tangent = |center: f64| {
+        let den = d * d - r * r;
+        let root = r * (d * d + center * center - r * r).sqrt();
+        ((center * d - root) / den, (center * d + root) / den)
+    };
+    let tangents = (d > r).then(|| (tangent(c.x), tangent(c.y)));
     for k in k0..=k1 {
         let cascade = &grid.cascades[k as usize];
         let za = if k == 0 {
@@ -128,6 +136,7 @@ pub fn for_each_cell(
             d,
             r,
             (za, zb),
+            tangents.map(|t| t.0),
             Axis::X,
             cascade.tiles_x,
         ) else {
@@ -139,6 +148,7 @@ pub fn for_each_cell(
             d,
             r,
             (za, zb),
+            tangents.map(|t| t.1),
             Axis::Y,
             cascade.tiles_y,
         ) else {
@@ -174,12 +184,15 @@ enum Axis {
 }
 
 /// Column (or row) range a sphere can touch within the depth slab `[za, zb]`, or `None`.
+/// `tangent` holds the sphere's exact slope range when it lies in front of the eye.
+#[allow(clippy::too_many_arguments)] // one call site per axis; a struct would only rename them
 fn axis_range(
     projection: GridProjection,
     center: f64,
     d: f64,
     r: f64,
     (za, zb): (f64, f64),
+    tangent: Option<(f64, f64)>,
     axis: Axis,
     tiles: u32,
 ) -> Option<(u32, u32)> {
@@ -194,12 +207,9 @@ fn axis_range(
             let (vmin, vmax) = (center - r, center + r);
             let mut lo = slope(vmin, za).min(slope(vmin, zb));
             let mut hi = slope(vmax, za).max(slope(vmax, zb));
-            // Exact tangent slopes when the whole sphere is in front of the eye.
-            if d > r {
-                let den = d * d - r * r;
-                let root = r * (d * d + center * center - r * r).sqrt();
-                lo = lo.max((center * d - root) / den);
-                hi = hi.min((center * d + root) / den);
+            if let Some((tlo, thi)) = tangent {
+                lo = lo.max(tlo);
+                hi = hi.min(thi);
             }
             (lo / tan, hi / tan)
         }
@@ -214,8 +224,7 @@ fn axis_range(
     if lo.is_nan() || hi.is_nan() || hi < -1.0 || lo > 1.0 || lo > hi {
         return None;
     }
-    let to_tile =
-        |ndc: f64| (((ndc + 1.0) * 0.5 * tiles as f64).max(0.0) as u32).min(tiles - 1);
+    let to_tile = |ndc: f64| (((ndc + 1.0) * 0.5 * tiles as f64).max(0.0) as u32).min(tiles - 1);
     let (mut t0, mut t1) = (to_tile(lo), to_tile(hi));
     // Tighten the ends against the tile planes where the tangent bounds do not apply (sphere
     // reaching behind the eye; with `d > r` they are exact already, as is orthographic).
@@ -252,21 +261,22 @@ struct Cone {
 
 impl Cone {
     fn of(light: &GpuLight) -> Option<Cone> {
-        let outer = light.cone_deg.0 as f64;
-        if light.spot_scale == 0.0
-            || outer.is_nan()
-            || outer >= 89.0
-            || light.direction.length_squared() == 0.0
-        {
+        // cos(outer) = −offset / scale (see `Light::spot_scale_offset`): no trigonometry per
+        // light. Cones of 89° and wider are not worth testing.
+        if light.spot_scale == 0.0 || light.direction.length_squared() == 0.0 {
             return None;
         }
-        // Pad the angle a little: the shader's cone edge is evaluated in f32.
-        let angle = (outer + 0.01).to_radians();
+        let cos_outer = -(light.spot_offset as f64) / light.spot_scale as f64;
+        // Pad the angle a little: the shader evaluates the cone edge in f32.
+        let cos = cos_outer - 2e-4;
+        if cos.is_nan() || cos < 0.0175 {
+            return None;
+        }
         Some(Cone {
             apex: light.position.as_dvec3(),
             axis: light.direction.as_dvec3().normalize(),
-            cos: angle.cos(),
-            sin: angle.sin(),
+            cos,
+            sin: (1.0 - cos * cos).max(0.0).sqrt(),
         })
     }
 
@@ -320,21 +330,73 @@ fn cell_center(grid: &ClusterGrid, index: u32) -> glam::DVec3 {
     )
 }
 
-/// (cell, light) pairs of a range of lights, and how many lights each cell got.
-type Pairs = (Vec<(u32, u32)>, Vec<u32>);
+/// One thread's share of phase 1: its lights' cells, sorted by cell (a local counting sort).
+struct Chunk {
+    /// Per cell: how many of this chunk's lights touch it.
+    counts: Vec<u32>,
+    /// Per cell: where its run starts in `sorted`.
+    offsets: Vec<u32>,
+    /// Light numbers local to the chunk (0-based), grouped by cell, ascending inside a cell.
+    sorted: Vec<u32>,
+    /// Per light of the chunk: its position among the chunk's visible lights, or `u32::MAX`.
+    local_visible: Vec<u32>,
+}
 
-/// Collects the [`Pairs`] of `lights`, numbering them from `first`.
-fn collect_pairs(grid: &ClusterGrid, lights: &[GpuLight], first: u32, camera_far: f64) -> Pairs {
-    let mut pairs = Vec::with_capacity(lights.len() * 4);
-    let mut counts = vec![0u32; grid.total_cells as usize];
+/// Phase 1 for a contiguous range of lights.
+fn assign_chunk(grid: &ClusterGrid, lights: &[GpuLight], camera_far: f64) -> Chunk {
+    let cells = grid.total_cells as usize;
+    let mut pairs: Vec<(u32, u32)> = Vec::with_capacity(lights.len() * 4);
+    let mut counts = vec![0u32; cells];
+    let mut local_visible = vec![u32::MAX; lights.len()];
+    let mut visible_count = 0u32;
     for (i, light) in lights.iter().enumerate() {
-        let id = first + i as u32;
+        let before = pairs.len();
         for_each_cell(grid, light, camera_far, &mut |cell| {
             counts[cell as usize] += 1;
-            pairs.push((cell, id));
+            pairs.push((cell, i as u32));
         });
+        if pairs.len() > before {
+            local_visible[i] = visible_count;
+            visible_count += 1;
+        }
     }
-    (pairs, counts)
+    let mut offsets = vec![0u32; cells];
+    let mut running = 0u32;
+    for (o, n) in offsets.iter_mut().zip(&counts) {
+        *o = running;
+        running += n;
+    }
+    let mut cursor = offsets.clone();
+    let mut sorted = vec![0u32; pairs.len()];
+    for (cell, light) in pairs {
+        let at = &mut cursor[cell as usize];
+        sorted[*at as usize] = local_visible[light as usize];
+        *at += 1;
+    }
+    Chunk {
+        counts,
+        offsets,
+        sorted,
+        local_visible,
+    }
+}
+
+/// Runs `f` on each item, on scoped threads when there is more than one.
+fn parallel_map<T: Send, R: Send>(items: Vec<T>, f: impl Fn(T) -> R + Sync) -> Vec<R> {
+    if items.len() <= 1 {
+        return items.into_iter().map(f).collect();
+    }
+    std::thread::scope(|scope| {
+        let f = &f;
+        let handles: Vec<_> = items
+            .into_iter()
+            .map(|item| scope.spawn(move || f(item)))
+            .collect();
+        handles
+            .into_iter()
+            .map(|h| h.join().expect("assignment thread"))
+            .collect()
+    })
 }
 
 /// Assigns `lights` (view space) to the cells of `grid`. `camera_far` may be infinite.
@@ -356,8 +418,8 @@ pub fn assign(
             ..Default::default()
         };
     }
-    // Phase 1: per-thread pairs and counts (lights split into contiguous chunks so the final
-    // order inside a cell is ascending light index).
+    // Phase 1, in parallel: each thread takes a contiguous range of lights, finds their cells
+    // and sorts them by cell locally.
     let threads = if lights.len() >= limits.parallel_threshold {
         std::thread::available_parallelism()
             .map_or(1, |n| n.get())
@@ -365,60 +427,65 @@ pub fn assign(
     } else {
         1
     };
-    let chunk = lights.len().div_ceil(threads);
-    let parts: Vec<Pairs> = if threads == 1 {
-        vec![collect_pairs(grid, lights, 0, camera_far)]
-    } else {
-        std::thread::scope(|scope| {
-            let handles: Vec<_> = lights
-                .chunks(chunk)
-                .enumerate()
-                .map(|(t, part)| {
-                    scope.spawn(move || collect_pairs(grid, part, (t * chunk) as u32, camera_far))
-                })
-                .collect();
-            handles
-                .into_iter()
-                .map(|h| h.join().expect("assignment thread"))
-                .collect()
-        })
-    };
-    // Visible lights and their compact numbering.
-    let mut remap = vec![u32::MAX; lights.len()];
-    for (pairs, _) in &parts {
-        for &(_, l) in pairs {
-            remap[l as usize] = 0;
-        }
-    }
+    let chunk_len = lights.len().div_ceil(threads);
+    let ranges: Vec<&[GpuLight]> = lights.chunks(chunk_len).collect();
+    let chunks = parallel_map(ranges, |part| assign_chunk(grid, part, camera_far));
+    // Visible lights are numbered chunk after chunk, so the numbering is ascending.
     let mut visible = Vec::new();
-    for (i, slot) in remap.iter_mut().enumerate() {
-        if *slot == 0 {
-            *slot = visible.len() as u32;
-            visible.push(i as u32);
-        }
+    let mut visible_base = Vec::with_capacity(chunks.len());
+    for (t, chunk) in chunks.iter().enumerate() {
+        visible_base.push(visible.len() as u32);
+        let first = (t * chunk_len) as u32;
+        visible.extend(
+            chunk
+                .local_visible
+                .iter()
+                .enumerate()
+                .filter(|(_, v)| **v != u32::MAX)
+                .map(|(i, _)| first + i as u32),
+        );
     }
-    // Phase 2: prefix sum over the uncapped counts, then scatter.
+    // Phase 2: global counts and offsets.
     let mut counts = vec![0u32; cells];
-    for (_, c) in &parts {
-        for (total, n) in counts.iter_mut().zip(c) {
+    for chunk in &chunks {
+        for (total, n) in counts.iter_mut().zip(&chunk.counts) {
             *total += n;
         }
     }
     let mut offsets = vec![0u32; cells];
-    let mut running = 0u64;
+    let mut running = 0usize;
     for (o, n) in offsets.iter_mut().zip(&counts) {
         *o = running as u32;
-        running += *n as u64;
+        running += *n as usize;
     }
-    let mut cursor = offsets.clone();
-    let mut indices = vec![0u32; running as usize];
-    for (pairs, _) in &parts {
-        for &(cell, l) in pairs {
-            let pos = &mut cursor[cell as usize];
-            indices[*pos as usize] = remap[l as usize];
-            *pos += 1;
+    // Phase 3, in parallel: every thread fills a contiguous block of cells of the final list
+    // (disjoint slices), concatenating the chunks' runs for each cell.
+    let mut indices = vec![0u32; running];
+    let blocks = split_cells(&offsets, running, threads);
+    let mut rest: &mut [u32] = &mut indices;
+    let mut jobs = Vec::with_capacity(blocks.len());
+    for &(c0, c1) in &blocks {
+        let len = if c1 < cells {
+            offsets[c1] as usize
+        } else {
+            running
+        } - offsets[c0] as usize;
+        let (head, tail) = rest.split_at_mut(len);
+        jobs.push((c0, c1, head));
+        rest = tail;
+    }
+    parallel_map(jobs, |(c0, c1, out)| {
+        let mut at = 0;
+        for cell in c0..c1 {
+            for (chunk, base) in chunks.iter().zip(&visible_base) {
+                let (o, n) = (chunk.offsets[cell] as usize, chunk.counts[cell] as usize);
+                for (dst, src) in out[at..at + n].iter_mut().zip(&chunk.sorted[o..o + n]) {
+                    *dst = src + base;
+                }
+                at += n;
+            }
         }
-    }
+    });
     let max_lights_per_cluster = counts.iter().copied().max().unwrap_or(0);
     let mut stats = AssignStats {
         clusters: grid.total_cells,
@@ -465,6 +532,21 @@ pub fn assign(
         indices,
         stats,
     }
+}
+
+/// Splits the cells into `parts` contiguous blocks with about equal numbers of indices.
+fn split_cells(offsets: &[u32], total: usize, parts: usize) -> Vec<(usize, usize)> {
+    let cells = offsets.len();
+    let mut blocks = Vec::with_capacity(parts);
+    let mut start = 0;
+    for p in 1..parts {
+        let target = (total * p / parts) as u32;
+        let end = offsets.partition_point(|&o| o < target).clamp(start, cells);
+        blocks.push((start, end));
+        start = end;
+    }
+    blocks.push((start, cells));
+    blocks
 }
 
 /// The largest per-cell cap ≤ `cap` whose capped total fits `budget`.

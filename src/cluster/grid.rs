@@ -293,7 +293,12 @@ impl ClusterGrid {
             for slice in 0..c.slices {
                 for y in 0..c.tiles_y {
                     for x in 0..c.tiles_x {
-                        let coord = CellCoord { cascade: k as u32, slice, x, y };
+                        let coord = CellCoord {
+                            cascade: k as u32,
+                            slice,
+                            x,
+                            y,
+                        };
                         out.push(self.bounding_sphere(coord));
                     }
                 }
@@ -316,7 +321,10 @@ impl ClusterGrid {
             *corner = glam::DVec3::new(nx * hx, ny * hy, -z);
         }
         let center = corners.iter().sum::<glam::DVec3>() / 8.0;
-        let radius = corners.iter().map(|p| p.distance(center)).fold(0.0, f64::max);
+        let radius = corners
+            .iter()
+            .map(|p| p.distance(center))
+            .fold(0.0, f64::max);
         [center.x, center.y, center.z, radius]
     }
 

@@ -48,7 +48,15 @@ impl AssignWorkload {
 
     /// One assignment.
     pub fn assign(&self) -> Assignment {
-        assign(&self.grid, &self.lights, self.far, &AssignLimits { cell_cap: u32::MAX, ..AssignLimits::default() })
+        assign(
+            &self.grid,
+            &self.lights,
+            self.far,
+            &AssignLimits {
+                cell_cap: u32::MAX,
+                ..AssignLimits::default()
+            },
+        )
     }
 
     /// Median wall time in milliseconds over `runs` assignments (after one warm-up), and the

@@ -1,5 +1,6 @@
 //! The `manylight` command line: `render` (the default), `info`.
 
+mod bench_assign;
 mod info;
 mod render;
 
@@ -10,10 +11,18 @@ use manylight::EsVersion;
 
 /// Thousands of dynamic lights on OpenGL ES 2.0 / 3.0, rendered headless through EGL.
 #[derive(Parser)]
-#[command(name = "manylight", version, about)]
+#[command(
+    name = "manylight",
+    version,
+    about,
+    args_conflicts_with_subcommands = true
+)]
 struct Cli {
     #[command(subcommand)]
     command: Option<Command>,
+    /// With no subcommand, `render`'s options apply: `manylight --lights 64` renders.
+    #[command(flatten)]
+    render: render::RenderArgs,
 }
 
 #[derive(Subcommand)]
@@ -22,6 +31,8 @@ enum Command {
     Render(render::RenderArgs),
     /// Print the capabilities of an ES 2.0 or 3.0 context.
     Info(info::InfoArgs),
+    /// Time CPU light assignment alone on the default view.
+    BenchAssign(bench_assign::BenchAssignArgs),
 }
 
 /// `--es 2` or `--es 3`.
@@ -50,9 +61,10 @@ fn main() -> ExitCode {
         .init();
     let cli = Cli::parse();
     let result = match cli.command {
-        None => render::run(&render::RenderArgs::parse_from(["render"])),
+        None => render::run(&cli.render),
         Some(Command::Render(args)) => render::run(&args),
         Some(Command::Info(args)) => info::run(&args),
+        Some(Command::BenchAssign(args)) => bench_assign::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -22,14 +22,14 @@ pub struct RenderArgs {
     #[arg(long, value_enum, default_value = "3")]
     pub es: EsArg,
     /// Number of seeded random lights (for scene files: replaces their random_lights count).
-    /// Default: 256 for built-ins and OBJ files, the file's own lights for scene files.
+    /// Default: 1024 for built-ins and OBJ files, the file's own lights for scene files.
     #[arg(long)]
     pub lights: Option<usize>,
     /// Seed of the random lights.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
     /// Image size as WIDTHxHEIGHT.
-    #[arg(long, default_value = "960x540", value_parser = parse_size)]
+    #[arg(long, default_value = "1280x720", value_parser = parse_size)]
     pub size: (u32, u32),
     /// Output PNG.
     #[arg(long, default_value = "manylight.png")]
@@ -47,7 +47,7 @@ pub struct RenderArgs {
 }
 
 /// Random lights for built-ins and OBJ files when `--lights` is not given.
-const DEFAULT_LIGHTS: usize = 256;
+const DEFAULT_LIGHTS: usize = 1024;
 
 fn parse_size(s: &str) -> Result<(u32, u32), String> {
     let (w, h) = s

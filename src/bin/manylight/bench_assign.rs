@@ -1,0 +1,59 @@
+//! `manylight bench-assign`: light assignment alone on the default view, for scripts.
+
+use clap::Parser;
+use manylight::cluster::workload::{AssignWorkload, BENCH_SIZE};
+
+/// Options of `manylight bench-assign`.
+#[derive(Parser, Debug)]
+pub struct BenchAssignArgs {
+    /// Light counts, comma separated.
+    #[arg(
+        long,
+        value_delimiter = ',',
+        default_value = "1,64,1024,16384,65536,1048576"
+    )]
+    pub lights: Vec<usize>,
+    /// Timed runs per count (the median is reported).
+    #[arg(long, default_value_t = 21)]
+    pub runs: usize,
+    /// Seed of the random lights.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Print JSON (an array of {lights, assign_ms, indices}) instead of a table.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Runs the command.
+pub fn run(args: &BenchAssignArgs) -> Result<(), Box<dyn std::error::Error>> {
+    let mut rows = Vec::new();
+    for &count in &args.lights {
+        let work = AssignWorkload::default_view(count, args.seed);
+        // Fewer runs for the huge counts keep the command quick; the median is robust.
+        let runs = if count > 100_000 {
+            args.runs.min(7)
+        } else {
+            args.runs
+        };
+        let (ms, indices) = work.time(runs);
+        rows.push(serde_json::json!({
+            "lights": count,
+            "assign_ms": ms,
+            "indices": indices,
+            "clusters": work.grid.total_cells,
+        }));
+        if !args.json {
+            println!("{count:>9} lights  {ms:>9.3} ms  {indices:>9} indices");
+        }
+    }
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&rows)?);
+    } else {
+        let (w, h) = BENCH_SIZE;
+        println!(
+            "default view ({w}x{h}), {} threads available, LP_NUM_THREADS does not apply (CPU only)",
+            std::thread::available_parallelism().map_or(1, |n| n.get())
+        );
+    }
+    Ok(())
+}
