@@ -44,6 +44,10 @@ pub struct RenderOptions {
     /// Most indices in a frame's light lists (tiled/clustered); `None`: what the index texture
     /// holds. Lower values exercise the overflow policy.
     pub max_indices: Option<usize>,
+    /// Wait for the GPU (`glFinish`) at the end of [`Renderer::render`] so `frame_ms` is the
+    /// full frame time. Offscreen rendering and benchmarks want this; a game presenting to a
+    /// window sets it to `false` and `frame_ms` is then the CPU submission time only.
+    pub wait_for_gpu: bool,
 }
 
 impl Default for RenderOptions {
@@ -57,6 +61,7 @@ impl Default for RenderOptions {
             tile_px: TILE_PX,
             cell_cap: None,
             max_indices: None,
+            wait_for_gpu: true,
         }
     }
 }
@@ -286,7 +291,9 @@ impl Renderer {
             options,
         };
         let method_stats = self.method.render(&mut ctx)?;
-        self.dev.finish();
+        if options.wait_for_gpu {
+            self.dev.finish();
+        }
         self.dev.check("frame")?;
         let caps = self.dev.caps();
         let assign = method_stats.assign.unwrap_or(AssignStats::default());
