@@ -18,7 +18,9 @@ void main() {
     }
     vec3 albedo = surfaceAlbedo(v_uv);
     vec3 color = u_ambient * albedo;
-#if GLSL_ES == 100
+#if NO_LIGHTS
+    // Ambient only: no light data is bound.
+#elif GLSL_ES == 100
     // GLSL ES 1.00 Appendix A: constant loop bound, exit with break.
     for (int i = 0; i < MAX_LIGHTS; i++) {
         if (i >= u_lightCount) {

@@ -32,11 +32,13 @@ vec3 surfaceAlbedo(vec2 uv) {
 // Linear radiance → what the framebuffer stores: clamped, then sRGB-encoded unless
 // OUTPUT_LINEAR (no tone map in either case).
 vec4 encodeOutput(vec3 color) {
-    vec3 c = clamp(color, 0.0, 1.0);
-#if OUTPUT_LINEAR
-    return vec4(c, 1.0);
+#if OUTPUT_HDR
+    // Float targets: unclamped, so NaN and Inf stay visible to the stability tests.
+    return vec4(color, 1.0);
+#elif OUTPUT_LINEAR
+    return vec4(clamp(color, 0.0, 1.0), 1.0);
 #else
-    return vec4(linearToSrgb(c), 1.0);
+    return vec4(linearToSrgb(clamp(color, 0.0, 1.0)), 1.0);
 #endif
 }
 

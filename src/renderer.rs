@@ -12,7 +12,7 @@ use crate::cluster::assign::AssignStats;
 use crate::cluster::grid::GridConfig;
 use crate::cluster::pack::GpuLight;
 use crate::cluster::tiles::TILE_PX;
-use crate::gl::framebuffer::OffscreenTarget;
+use crate::gl::framebuffer::{ColorFormat, OffscreenTarget};
 use crate::gl::mesh::GpuMesh;
 use crate::gl::program::ProgramCache;
 use crate::gl::texture::ImageTexture;
@@ -48,6 +48,9 @@ pub struct RenderOptions {
     /// full frame time. Offscreen rendering and benchmarks want this; a game presenting to a
     /// window sets it to `false` and `frame_ms` is then the CPU submission time only.
     pub wait_for_gpu: bool,
+    /// Write linear, unclamped radiance (for float targets; see
+    /// [`Renderer::render_offscreen_hdr`]).
+    pub hdr: bool,
 }
 
 impl Default for RenderOptions {
@@ -62,6 +65,7 @@ impl Default for RenderOptions {
             cell_cap: None,
             max_indices: None,
             wait_for_gpu: true,
+            hdr: false,
         }
     }
 }
@@ -201,6 +205,11 @@ impl Renderer {
         self.dev.caps()
     }
 
+    /// Whether the fragment stage evaluates `mediump` as fp16 (measured with a tiny render).
+    pub fn mediump_is_fp16(&self) -> Result<bool, Error> {
+        Ok(crate::gl::precision_probe::mediump_is_fp16(&self.dev)?)
+    }
+
     /// The current method's name.
     pub fn method(&self) -> &'static str {
         self.method.name()
@@ -266,6 +275,7 @@ impl Renderer {
         let features = ShaderFeatures::default()
             .with(ShaderFeatures::SPOT, has_spots)
             .with(ShaderFeatures::OUTPUT_LINEAR, options.linear)
+            .with(ShaderFeatures::OUTPUT_HDR, options.hdr)
             .with(
                 ShaderFeatures::LIGHTS_RGBA8,
                 options.force_rgba8_lights || !self.dev.caps().float_textures,
@@ -290,7 +300,13 @@ impl Renderer {
             content_far,
             options,
         };
-        let method_stats = self.method.render(&mut ctx)?;
+        // No lights: no assignment, no uploads, the light loop compiled out — whatever the
+        // method (a scene pays only for what it has).
+        let method_stats = if lights.is_empty() {
+            methods::geometry::draw_ambient_only(&mut ctx)?
+        } else {
+            self.method.render(&mut ctx)?
+        };
         if options.wait_for_gpu {
             self.dev.finish();
         }
@@ -335,14 +351,48 @@ impl Renderer {
         height: u32,
         options: &RenderOptions,
     ) -> Result<(image::RgbaImage, FrameStats), Error> {
-        if self.target.as_ref().map(|t| t.size()) != Some((width, height)) {
+        let stats = self.render_into_target(scene, width, height, options, ColorFormat::Rgba8)?;
+        let image = self.target.as_ref().expect("rendered").read_rgba8(&self.dev)?;
+        self.dev.bind_default_framebuffer();
+        Ok((image, stats))
+    }
+
+    /// Renders linear, unclamped radiance into an RGBA16F target and reads it back as f32,
+    /// top row first: NaN and Inf stay visible (an 8-bit target shows them as black or white).
+    /// Errors when the context cannot render to half floats.
+    pub fn render_offscreen_hdr(
+        &mut self,
+        scene: &Scene,
+        width: u32,
+        height: u32,
+        options: &RenderOptions,
+    ) -> Result<(Vec<[f32; 4]>, FrameStats), Error> {
+        let options = RenderOptions {
+            hdr: true,
+            ..options.clone()
+        };
+        let stats = self.render_into_target(scene, width, height, &options, ColorFormat::Rgba16F)?;
+        let pixels = self.target.as_ref().expect("rendered").read_rgba_f32(&self.dev)?;
+        self.dev.bind_default_framebuffer();
+        Ok((pixels, stats))
+    }
+
+    fn render_into_target(
+        &mut self,
+        scene: &Scene,
+        width: u32,
+        height: u32,
+        options: &RenderOptions,
+        format: ColorFormat,
+    ) -> Result<FrameStats, Error> {
+        let current = self.target.as_ref().map(|t| (t.size(), t.format()));
+        if current != Some(((width, height), format)) {
             if let Some(mut t) = self.target.take() {
                 t.destroy(&self.dev);
             }
-            self.target = Some(OffscreenTarget::new(&self.dev, width, height)?);
+            self.target = Some(OffscreenTarget::with_format(&self.dev, width, height, format)?);
         }
-        let target = self.target.as_ref().expect("created above");
-        target.bind(&self.dev);
+        self.target.as_ref().expect("created above").bind(&self.dev);
         let mut stats = self.render(scene, width, height, options)?;
         if options.timed_frames > 0 {
             // The warm-up frame compiled shaders and uploaded meshes; report the timed ones.
@@ -360,10 +410,7 @@ impl Renderer {
             stats.frame_ms = frame_ms;
             stats.assign_ms = assign_ms;
         }
-        let target = self.target.as_ref().expect("created above");
-        let image = target.read_rgba8(&self.dev)?;
-        self.dev.bind_default_framebuffer();
-        Ok((image, stats))
+        Ok(stats)
     }
 
     /// Frees every GL object the renderer made. Call before dropping the context.

@@ -1,5 +1,6 @@
 //! Offscreen render targets: an RGBA8 colour texture (renderable in ES 2.0 core, unlike RGBA8
-//! renderbuffers) and a depth renderbuffer (24-bit where available: tiny near planes need it).
+//! renderbuffers) or an RGBA16F one (to see NaN and Inf, which an 8-bit target hides), and a
+//! depth renderbuffer (24-bit where available: tiny near planes need it).
 #![allow(unsafe_code)]
 
 use glow::HasContext;
@@ -13,12 +14,51 @@ pub struct OffscreenTarget {
     depth: glow::Renderbuffer,
     width: u32,
     height: u32,
+    format: ColorFormat,
     destroyed: bool,
+}
+
+/// Colour buffer format of an offscreen target.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ColorFormat {
+    /// 8 bits per channel (what a window shows).
+    Rgba8,
+    /// Half floats: keeps values above 1, NaN and Inf (needs `GL_EXT_color_buffer_float` or
+    /// `GL_EXT_color_buffer_half_float`).
+    Rgba16F,
+}
+
+impl ColorFormat {
+    /// Whether the context can render to this format.
+    pub fn supported(self, dev: &Device) -> bool {
+        let caps = dev.caps();
+        match self {
+            ColorFormat::Rgba8 => true,
+            ColorFormat::Rgba16F => match dev.es() {
+                EsVersion::Es3 => {
+                    caps.has_extension("GL_EXT_color_buffer_float")
+                        || caps.has_extension("GL_EXT_color_buffer_half_float")
+                }
+                EsVersion::Es2 => {
+                    caps.has_extension("GL_OES_texture_half_float")
+                        && caps.has_extension("GL_EXT_color_buffer_half_float")
+                }
+            },
+        }
+    }
 }
 
 impl OffscreenTarget {
     /// Creates a `width × height` target.
     pub fn new(dev: &Device, width: u32, height: u32) -> Result<OffscreenTarget, GlError> {
+        Self::with_format(dev, width, height, ColorFormat::Rgba8)
+    }
+
+    /// Creates a `width × height` target with the given colour format.
+    pub fn with_format(dev: &Device, width: u32, height: u32, format: ColorFormat) -> Result<OffscreenTarget, GlError> {
+        if !format.supported(dev) {
+            return Err(GlError::Unsupported(format!("{format:?} render targets are not supported on this context")));
+        }
         let max = dev.caps().max_texture_size as u32;
         if width == 0 || height == 0 || width > max || height > max {
             return Err(GlError::Unsupported(format!(
@@ -29,10 +69,13 @@ impl OffscreenTarget {
         unsafe {
             let color = gl.create_texture().map_err(GlError::Create)?;
             gl.bind_texture(glow::TEXTURE_2D, Some(color));
-            let internal = if dev.es() == EsVersion::Es3 {
-                glow::RGBA8
-            } else {
-                glow::RGBA
+            /// `GL_HALF_FLOAT_OES` (ES 2.0's half-float type differs from ES 3.0's).
+            const HALF_FLOAT_OES: u32 = 0x8D61;
+            let (internal, ty) = match (format, dev.es()) {
+                (ColorFormat::Rgba8, EsVersion::Es3) => (glow::RGBA8, glow::UNSIGNED_BYTE),
+                (ColorFormat::Rgba8, EsVersion::Es2) => (glow::RGBA, glow::UNSIGNED_BYTE),
+                (ColorFormat::Rgba16F, EsVersion::Es3) => (glow::RGBA16F, glow::HALF_FLOAT),
+                (ColorFormat::Rgba16F, EsVersion::Es2) => (glow::RGBA, HALF_FLOAT_OES),
             };
             gl.tex_image_2d(
                 glow::TEXTURE_2D,
@@ -42,7 +85,7 @@ impl OffscreenTarget {
                 height as i32,
                 0,
                 glow::RGBA,
-                glow::UNSIGNED_BYTE,
+                ty,
                 glow::PixelUnpackData::Slice(None),
             );
             for (p, v) in [
@@ -88,6 +131,7 @@ impl OffscreenTarget {
                 depth,
                 width,
                 height,
+                format,
                 destroyed: false,
             };
             if status != glow::FRAMEBUFFER_COMPLETE {
@@ -108,6 +152,34 @@ impl OffscreenTarget {
     /// Size in pixels.
     pub fn size(&self) -> (u32, u32) {
         (self.width, self.height)
+    }
+
+    /// Colour format.
+    pub fn format(&self) -> ColorFormat {
+        self.format
+    }
+
+    /// Reads a float colour buffer as f32 RGBA, top row first.
+    pub fn read_rgba_f32(&self, dev: &Device) -> Result<Vec<[f32; 4]>, GlError> {
+        let (w, h) = (self.width as usize, self.height as usize);
+        // f32 storage so the byte view is aligned for the cast back.
+        let mut floats = vec![0f32; w * h * 4];
+        unsafe {
+            dev.gl.bind_framebuffer(glow::FRAMEBUFFER, Some(self.fbo));
+            dev.gl.pixel_store_i32(glow::PACK_ALIGNMENT, 4);
+            dev.gl.read_pixels(
+                0,
+                0,
+                w as i32,
+                h as i32,
+                glow::RGBA,
+                glow::FLOAT,
+                glow::PixelPackData::Slice(Some(bytemuck::cast_slice_mut(&mut floats))),
+            );
+        }
+        dev.check("glReadPixels (float)")?;
+        let texels: &[[f32; 4]] = bytemuck::cast_slice(&floats);
+        Ok(texels.chunks_exact(w).rev().flatten().copied().collect())
     }
 
     /// Reads the colour buffer, top row first (as image files store it).

@@ -15,6 +15,7 @@ pub mod context;
 pub mod device;
 pub mod framebuffer;
 pub mod mesh;
+pub mod precision_probe;
 pub mod program;
 pub mod shader_source;
 pub mod state;

@@ -60,6 +60,11 @@ pub const SHADERS: &[ShaderDesc] = &[
         vertex: "mesh.vert",
         fragment: "clustered.frag",
     },
+    ShaderDesc {
+        name: "precision_probe",
+        vertex: "fullscreen.vert",
+        fragment: "precision_probe.frag",
+    },
 ];
 
 /// The files of `glsl/`, embedded so the binary needs no data files.
@@ -76,6 +81,8 @@ pub const FILES: &[(&str, &str)] = &[
         include_str!("../../glsl/light_data.glsl"),
     ),
     ("surface.glsl", include_str!("../../glsl/surface.glsl")),
+    ("fullscreen.vert", include_str!("../../glsl/fullscreen.vert")),
+    ("precision_probe.frag", include_str!("../../glsl/precision_probe.frag")),
     (
         "data_texture.glsl",
         include_str!("../../glsl/data_texture.glsl"),

@@ -20,6 +20,10 @@ impl ShaderFeatures {
     pub const LIGHTS_RGBA8: u64 = 1 << 3;
     /// Write linear values (no sRGB encoding).
     pub const OUTPUT_LINEAR: u64 = 1 << 4;
+    /// Write linear values without clamping (float targets: NaN and Inf stay visible).
+    pub const OUTPUT_HDR: u64 = 1 << 5;
+    /// No lights at all: the light loop and its data are compiled out.
+    pub const NO_LIGHTS: u64 = 1 << 6;
 
     /// True when `bit` is set.
     pub fn has(self, bit: u64) -> bool {
@@ -49,6 +53,8 @@ impl ShaderFeatures {
             ("HAS_SPECULAR".into(), flag(Self::SPECULAR)),
             ("LIGHTS_RGBA8".into(), flag(Self::LIGHTS_RGBA8)),
             ("OUTPUT_LINEAR".into(), flag(Self::OUTPUT_LINEAR)),
+            ("OUTPUT_HDR".into(), flag(Self::OUTPUT_HDR)),
+            ("NO_LIGHTS".into(), flag(Self::NO_LIGHTS)),
             ("DATA_WIDTH".into(), DATA_TEXTURE_WIDTH.to_string()),
             (
                 "LIGHT_TEXELS".into(),

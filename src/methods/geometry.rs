@@ -106,3 +106,10 @@ pub fn draw_objects(
     crate::gl_check!(dev, "geometry pass");
     Ok(())
 }
+
+/// A frame without lights: ambient only, with the light loop compiled out and nothing uploaded.
+pub fn draw_ambient_only(ctx: &mut FrameContext) -> Result<super::MethodStats, Error> {
+    ctx.features = ctx.features.with(ShaderFeatures::NO_LIGHTS, true);
+    draw_objects(ctx, "forward", 1, &mut |_, _| {})?;
+    Ok(super::MethodStats::default())
+}

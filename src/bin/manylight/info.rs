@@ -24,7 +24,9 @@ pub fn run(args: &InfoArgs) -> Result<(), Box<dyn std::error::Error>> {
     let ctx = HeadlessContext::new(es)?;
     let renderer = Renderer::new(ctx.load_gl(), es)?;
     let caps = renderer.caps().clone();
+    let fp16 = renderer.mediump_is_fp16();
     renderer.destroy();
+    let fp16 = fp16?;
     let methods: Vec<_> = METHODS
         .iter()
         .map(|m| (m.name, (m.supported)(&caps)))
@@ -33,11 +35,14 @@ pub fn run(args: &InfoArgs) -> Result<(), Box<dyn std::error::Error>> {
         let value = serde_json::json!({
             "egl": ctx.info(),
             "caps": caps,
+            "mediump_is_fp16": fp16,
             "methods": methods.iter().map(|(name, s)| serde_json::json!({"name": name, "support": s})).collect::<Vec<_>>(),
         });
         print_stdout(&(serde_json::to_string_pretty(&value)? + "\n"));
     } else {
-        print_stdout(&format_text(&caps, ctx.info(), &methods));
+        let mut text = format_text(&caps, ctx.info(), &methods);
+        text.push_str(&format!("mediump runs as      {}\n", if fp16 { "fp16 (measured)" } else { "fp32 (measured)" }));
+        print_stdout(&text);
     }
     Ok(())
 }

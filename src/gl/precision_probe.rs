@@ -1,0 +1,44 @@
+//! Measures how the fragment stage really evaluates `mediump`: phones (and llvmpipe on this
+//! Mesa) use fp16, desktop drivers fp32. The stability tests use it as a canary, so they keep
+//! testing fp16 behaviour rather than silently passing on an fp32 driver.
+#![allow(unsafe_code)]
+
+use glow::HasContext;
+
+use super::framebuffer::OffscreenTarget;
+use super::program::Program;
+use super::{Device, GlError};
+
+/// True when `mediump` arithmetic in the fragment stage rounds like fp16.
+pub fn mediump_is_fp16(dev: &Device) -> Result<bool, GlError> {
+    let mut target = OffscreenTarget::new(dev, 1, 1)?;
+    let mut program = Program::build(dev, "precision_probe", &[])?;
+    let gl = &dev.gl;
+    // One clip-space triangle covering the pixel.
+    let vertices: [f32; 9] = [-1.0, -1.0, 0.0, 3.0, -1.0, 0.0, -1.0, 3.0, 0.0];
+    let result = unsafe {
+        let buffer = gl.create_buffer().map_err(GlError::Create)?;
+        gl.bind_buffer(glow::ARRAY_BUFFER, Some(buffer));
+        gl.buffer_data_u8_slice(glow::ARRAY_BUFFER, bytemuck::cast_slice(&vertices), glow::STATIC_DRAW);
+        target.bind(dev);
+        gl.disable(glow::DEPTH_TEST);
+        gl.disable(glow::BLEND);
+        gl.color_mask(true, true, true, true);
+        program.bind(dev);
+        program.set_f32(dev, "u_big", 2048.0);
+        program.set_f32(dev, "u_one", 1.0);
+        gl.enable_vertex_attrib_array(0);
+        gl.vertex_attrib_pointer_f32(0, 3, glow::FLOAT, false, 12, 0);
+        for loc in 1..3 {
+            gl.disable_vertex_attrib_array(loc);
+        }
+        gl.draw_arrays(glow::TRIANGLES, 0, 3);
+        let pixel = target.read_rgba8(dev);
+        gl.delete_buffer(buffer);
+        pixel
+    };
+    program.destroy(dev);
+    target.destroy(dev);
+    dev.bind_default_framebuffer();
+    Ok(result?.get_pixel(0, 0)[0] < 128)
+}
