@@ -1,0 +1,401 @@
+//! Numerical stability on stiff and extreme cases: each case renders through every method on
+//! ES 2.0 and ES 3.0 and must match plain forward within 2/255, and renders into an RGBA16F
+//! target where every value must be finite (an 8-bit target hides NaN as black).
+
+mod common;
+
+use common::{max_oracle_error, Gpu};
+use glam::{DVec3, Vec3};
+use manylight::scene::{self, shading, Camera, Light, Projection, Scene};
+use manylight::{EsVersion, RenderOptions};
+
+const METHODS: [&str; 3] = ["forward", "tiled", "clustered"];
+
+/// Renders `scene` with every method on both ES versions: each within 2/255 of forward, and
+/// all HDR values finite. Returns the ES 3.0 forward image for case-specific checks.
+fn check(name: &str, scene: &Scene, w: u32, h: u32) -> image::RgbaImage {
+    let mut es3_forward = None;
+    for es in [EsVersion::Es2, EsVersion::Es3] {
+        let mut gpu = Gpu::new(es);
+        let opts = RenderOptions::default();
+        gpu.r().set_method("forward").unwrap();
+        let (reference, _) = gpu.r().render_offscreen(scene, w, h, &opts).unwrap();
+        for method in METHODS {
+            gpu.r().set_method(method).unwrap();
+            let (img, stats) = gpu
+                .r()
+                .render_offscreen(scene, w, h, &opts)
+                .unwrap_or_else(|e| panic!("{name} {es} {method}: {e}"));
+            let d = manylight::metrics::diff(&reference, &img);
+            assert!(
+                d.max_abs <= 2,
+                "{name} {es} {method}: {} / 255 from forward (rmse {:.3})",
+                d.max_abs,
+                d.rmse
+            );
+            assert_eq!(stats.overflowed_lights, 0, "{name} {es} {method}");
+            let (hdr, _) = gpu.r().render_offscreen_hdr(scene, w, h, &opts).unwrap();
+            if let Some((i, p)) = hdr
+                .iter()
+                .enumerate()
+                .find(|(_, p)| !p.iter().all(|c| c.is_finite()))
+            {
+                panic!("{name} {es} {method}: non-finite value {p:?} at pixel {i}");
+            }
+        }
+        if es == EsVersion::Es3 {
+            es3_forward = Some(reference);
+        }
+    }
+    es3_forward.unwrap()
+}
+
+fn plane() -> Scene {
+    let mut s = scene::builtin::build("plane", None).unwrap();
+    s.ambient = Vec3::splat(0.05);
+    s
+}
+
+fn point(p: [f64; 3], r: f32, i: f32) -> Light {
+    Light::point(DVec3::from(p), r, Vec3::new(1.0, 0.8, 0.6), i)
+}
+
+/// Forward itself against the f64 light model, for the plane cases.
+fn assert_matches_oracle(name: &str, scene: &Scene, w: u32, h: u32) {
+    let mut gpu = Gpu::new(EsVersion::Es3);
+    let img = gpu.render(
+        scene,
+        w,
+        h,
+        &RenderOptions {
+            linear: true,
+            ..Default::default()
+        },
+    );
+    let (err, at, _) = max_oracle_error(&img, scene, |x| x);
+    assert!(
+        err <= 2.0,
+        "{name}: forward is {err:.2}/255 from the light model at {at:?}"
+    );
+}
+
+#[test]
+fn zero_lights_is_exactly_ambient_and_does_no_grid_work() {
+    let s = plane();
+    let img = check("zero lights", &s, 64, 36);
+    let expected = (shading::linear_to_srgb(0.05 * 0.8) * 255.0).round() as u8;
+    assert!(
+        img.pixels().all(|p| p[0] == expected && p[1] == expected),
+        "not exactly ambient"
+    );
+    let mut gpu = Gpu::new(EsVersion::Es3);
+    for method in METHODS {
+        gpu.r().set_method(method).unwrap();
+        let (_, stats) = gpu
+            .r()
+            .render_offscreen(&s, 64, 36, &RenderOptions::default())
+            .unwrap();
+        assert_eq!(
+            (stats.upload_bytes, stats.clusters, stats.assign_ms),
+            (0, 0, 0.0),
+            "{method} did grid work"
+        );
+    }
+}
+
+#[test]
+fn camera_inside_a_light_and_a_fragment_exactly_at_a_light() {
+    let mut s = plane();
+    // Camera at (0, 0, 5) inside a light of radius 8; a second light sits on the plane itself.
+    s.lights = vec![
+        point([0.0, 0.0, 4.0], 8.0, 0.5),
+        point([0.0, 0.0, 0.0], 1.5, 1.0),
+    ];
+    // Odd sizes put a pixel centre exactly on the axis, where the surface point is the light.
+    check("camera inside / light on surface", &s, 97, 55);
+    assert_matches_oracle("camera inside / light on surface", &s, 97, 55);
+}
+
+#[test]
+fn lights_behind_the_camera_and_beyond_far() {
+    let mut s = plane();
+    s.camera = Camera::perspective(DVec3::new(0.0, 0.0, 5.0), DVec3::ZERO, 60.0, 0.1, 20.0);
+    s.lights = vec![
+        point([0.5, 0.2, 5.5], 5.4, 1.0), // centre behind the eye, sphere crosses the near plane
+        point([0.0, 0.0, 12.0], 3.0, 5.0), // entirely behind: nothing
+        point([0.0, 0.0, -40.0], 10.0, 5.0), // entirely beyond far: nothing
+        point([-1.0, 0.5, 1.0], 2.0, 1.0),
+    ];
+    check("behind / beyond", &s, 96, 54);
+    assert_matches_oracle("behind / beyond", &s, 96, 54);
+    let mut gpu = Gpu::new(EsVersion::Es3);
+    gpu.r().set_method("clustered").unwrap();
+    let (_, stats) = gpu
+        .r()
+        .render_offscreen(&s, 96, 54, &RenderOptions::default())
+        .unwrap();
+    assert_eq!(
+        stats.visible_lights, 2,
+        "lights behind the camera or beyond far must be counted nowhere"
+    );
+}
+
+#[test]
+fn extreme_near_and_far_planes_and_orthographic() {
+    let base = scene::builtin::build("pillars", Some((200, 3))).unwrap();
+    let mut tiny = base.clone();
+    if let Projection::Perspective {
+        ref mut near,
+        ref mut far,
+        ..
+    } = tiny.camera.projection
+    {
+        *near = 1e-4;
+        *far = 1e5;
+    }
+    check("near 1e-4 far 1e5", &tiny, 128, 72);
+    let mut infinite = base.clone();
+    if let Projection::Perspective { ref mut far, .. } = infinite.camera.projection {
+        *far = f64::INFINITY;
+    }
+    check("infinite far", &infinite, 128, 72);
+    let mut ortho = base;
+    ortho.camera.projection = Projection::Orthographic {
+        height: 14.0,
+        near: 0.0,
+        far: 60.0,
+    };
+    check("orthographic near 0", &ortho, 128, 72);
+}
+
+#[test]
+fn lights_on_cell_boundaries_and_one_ulp_either_side() {
+    use manylight::cluster::grid::{ClusterGrid, GridConfig, GridProjection};
+    let mut s = plane();
+    let (w, h) = (128u32, 72u32);
+    let proj = s.camera.projection_matrix(w as f64 / h as f64);
+    let (near, far) = s.camera.near_far();
+    let grid = ClusterGrid::new(
+        w,
+        h,
+        GridProjection::from_matrix(&proj),
+        near,
+        5.0,
+        &GridConfig::default(),
+    );
+    let c = grid.cascades.last().unwrap();
+    let (z0, _) = grid.slice_depth_range(grid.cascades.len() as u32 - 1, 1);
+    let _ = far;
+    let (hx, hy) = grid.projection.half_extent(z0);
+    let x = (-1.0 + 2.0 * (c.tiles_x / 2) as f64 / c.tiles_x as f64) * hx;
+    let y = (-1.0 + 2.0 * (c.tiles_y / 2) as f64 / c.tiles_y as f64) * hy;
+    // View space = world space shifted by the camera at z = 5.
+    let on = DVec3::new(x, y, 5.0 - z0);
+    for p in [
+        on,
+        DVec3::new(on.x.next_up(), on.y.next_down(), on.z.next_up()),
+        DVec3::new(on.x.next_down(), on.y.next_up(), on.z.next_down()),
+    ] {
+        s.lights.push(Light::point(p, 0.6, Vec3::ONE, 0.4));
+    }
+    check("cell boundaries", &s, w, h);
+    assert_matches_oracle("cell boundaries", &s, w, h);
+}
+
+#[test]
+fn degenerate_and_huge_radii_and_intensities() {
+    let mut s = plane();
+    s.lights = vec![
+        point([0.0, 0.0, 1.0], 0.0, 1.0),
+        point([0.5, 0.0, 1e-7], 1e-6, 1.0),
+        point([-1.0, 0.5, 0.5], 2.0, 1e-6),
+        // 1e6 intensity 2 km away: the result is moderate, and must not overflow on the way.
+        point([0.0, 0.0, 2000.0], 3000.0, 1e6),
+    ];
+    check("radius 0 / 1e-6, intensity 1e-6 / 1e6", &s, 96, 54);
+    assert_matches_oracle("radius 0 / 1e-6, intensity 1e-6 / 1e6", &s, 96, 54);
+    // 1 000 lights whose spheres cover the whole frustum.
+    let mut big = plane();
+    big.lights = (0..1000)
+        .map(|i| {
+            point(
+                [(i % 10) as f64 - 5.0, (i / 100) as f64 - 5.0, 1.0],
+                200.0,
+                0.0005,
+            )
+        })
+        .collect();
+    check("1000 frustum-covering lights", &big, 64, 36);
+}
+
+#[test]
+fn crowded_cells_and_index_lists_past_16_bits() {
+    for n in [255usize, 256, 257] {
+        let mut s = plane();
+        s.lights = (0..n)
+            .map(|i| point([0.3 + 1e-4 * i as f64, 0.2, 0.3], 0.5, 0.01))
+            .collect();
+        check(&format!("{n} lights in one cell"), &s, 64, 36);
+    }
+    // Enough big lights that the index list passes 65 536 entries.
+    let mut s = plane();
+    s.lights = (0..3000)
+        .map(|i| {
+            let f = i as f64;
+            point(
+                [
+                    (f * 0.37).sin() * 4.0,
+                    (f * 0.61).cos() * 2.5,
+                    0.2 + (f * 0.13).sin().abs() * 2.0,
+                ],
+                2.5,
+                0.002,
+            )
+        })
+        .collect();
+    let mut gpu = Gpu::new(EsVersion::Es2);
+    gpu.r().set_method("clustered").unwrap();
+    let (_, stats) = gpu
+        .r()
+        .render_offscreen(&s, 256, 144, &RenderOptions::default())
+        .unwrap();
+    assert!(stats.nonempty_clusters > 0);
+    let indices = (stats.avg_lights_per_nonempty * stats.nonempty_clusters as f64).round() as usize;
+    assert!(
+        indices > 65_536,
+        "only {indices} indices: the case does not reach past 16 bits"
+    );
+    check("index list past 65 536", &s, 256, 144);
+}
+
+#[test]
+fn scene_far_from_the_origin_and_a_distant_light() {
+    let offset = DVec3::new(10_000.0, 0.0, -10_000.0);
+    let mut s = plane();
+    for o in &mut s.objects {
+        o.transform = glam::DMat4::from_translation(offset) * o.transform;
+    }
+    s.camera.position += offset;
+    s.camera.target += offset;
+    s.lights = vec![
+        point([0.75, 0.0, 0.5], 1.5, 1.0),
+        point([-0.5, 0.3, 300.0], 310.0, 3000.0),
+    ];
+    for l in &mut s.lights {
+        l.position += offset;
+    }
+    let img = check("10 km from the origin", &s, 96, 54);
+    // And it looks like the same scene at the origin (view space makes the offset vanish).
+    let mut at_origin = plane();
+    at_origin.lights = vec![
+        point([0.75, 0.0, 0.5], 1.5, 1.0),
+        point([-0.5, 0.3, 300.0], 310.0, 3000.0),
+    ];
+    let mut gpu = Gpu::new(EsVersion::Es3);
+    let reference = gpu.render(&at_origin, 96, 54, &RenderOptions::default());
+    let d = manylight::metrics::diff(&reference, &img);
+    assert!(
+        d.max_abs <= 2,
+        "far from the origin differs by {} / 255",
+        d.max_abs
+    );
+}
+
+#[test]
+fn wide_odd_and_tiny_framebuffers() {
+    let s = scene::builtin::build("courtyard", Some((128, 9))).unwrap();
+    for (w, h) in [(2600, 8), (333, 77), (1, 1), (4096, 8)] {
+        check(&format!("{w}x{h}"), &s, w, h);
+    }
+}
+
+#[test]
+fn spot_cones_of_zero_half_and_179_degrees() {
+    let mut s = plane();
+    for (i, outer) in [0.0, 0.5, 179.0].into_iter().enumerate() {
+        let x = -2.0 + 2.0 * i as f64;
+        s.lights.push(Light::spot(
+            DVec3::new(x, 0.0, 1.0),
+            DVec3::new(0.0, 0.0, -1.0),
+            outer * 0.5,
+            outer,
+            3.0,
+            Vec3::ONE,
+            2.0,
+        ));
+    }
+    check("spot cones 0 / 0.5 / 179 deg", &s, 128, 72);
+    assert_matches_oracle("spot cones 0 / 0.5 / 179 deg", &s, 128, 72);
+}
+
+#[test]
+fn invalid_values_are_rejected_before_upload() {
+    let mut gpu = Gpu::new(EsVersion::Es3);
+    let cases: Vec<(Box<dyn Fn(&mut Scene)>, &str)> = vec![
+        (
+            Box::new(|s: &mut Scene| s.lights[0].radius = f32::NAN),
+            "lights[0].radius",
+        ),
+        (
+            Box::new(|s: &mut Scene| s.lights[0].intensity = f32::INFINITY),
+            "lights[0].intensity",
+        ),
+        (
+            Box::new(|s: &mut Scene| s.lights[0].color = Vec3::new(-1.0, 0.0, 0.0)),
+            "lights[0].color",
+        ),
+        (
+            Box::new(|s: &mut Scene| s.lights[0].position.x = f64::NAN),
+            "lights[0].position",
+        ),
+        (
+            Box::new(|s: &mut Scene| s.ambient = Vec3::splat(f32::NAN)),
+            "ambient",
+        ),
+        (
+            Box::new(|s: &mut Scene| s.materials[0].shininess = -1.0),
+            "shininess",
+        ),
+    ];
+    for (break_it, field) in cases {
+        let mut s = plane();
+        s.lights = vec![point([0.0, 0.0, 1.0], 2.0, 1.0)];
+        break_it(&mut s);
+        for method in METHODS {
+            gpu.r().set_method(method).unwrap();
+            let err = gpu
+                .r()
+                .render_offscreen(&s, 16, 16, &RenderOptions::default())
+                .unwrap_err()
+                .to_string();
+            assert!(
+                err.contains(field),
+                "{method}: expected `{field}` in: {err}"
+            );
+        }
+    }
+}
+
+/// The precision canary: whether this driver's fragment `mediump` is really fp16. Reported,
+/// so a change of driver behaviour is visible in the test log; the shaders run every light
+/// computation at highp where the fragment stage has it, so either answer must render the
+/// cases above correctly.
+#[test]
+fn mediump_precision_canary() {
+    for es in [EsVersion::Es2, EsVersion::Es3] {
+        let gpu = Gpu::new(es);
+        let r = gpu.renderer.as_ref().unwrap();
+        let fp16 = r.mediump_is_fp16().unwrap();
+        let reported_bits = r.caps().fragment_mediump.precision;
+        eprintln!(
+            "{es}: fragment mediump evaluates as {}; the driver reports {reported_bits} bits",
+            if fp16 { "fp16" } else { "fp32" }
+        );
+        if fp16 {
+            assert!(
+                reported_bits <= 10,
+                "fp16 behaviour but {reported_bits} bits reported"
+            );
+        }
+    }
+}
