@@ -18,9 +18,8 @@ void main() {
     }
     vec3 albedo = surfaceAlbedo(v_uv);
     vec3 color = u_ambient * albedo;
-#if NO_LIGHTS
-    // Ambient only: no light data is bound.
-#elif GLSL_ES == 100
+#if !NO_LIGHTS
+#if GLSL_ES == 100
     // GLSL ES 1.00 Appendix A: constant loop bound, exit with break.
     for (int i = 0; i < MAX_LIGHTS; i++) {
         if (i >= u_lightCount) {
@@ -32,6 +31,7 @@ void main() {
     for (int i = 0; i < u_lightCount; i++) {
         color += shadeLight(fetchLight(i), v_viewPos, N, V, albedo);
     }
+#endif
 #endif
     FRAG_COLOR = encodeOutput(color);
 }

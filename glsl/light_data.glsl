@@ -15,9 +15,11 @@ struct Light {
     vec3 position;
     float radius;
     vec3 radiance;
+#if HAS_SPOT
     float spotScale;
     vec3 direction;
     float spotOffset;
+#endif
 };
 
 #if GLSL_ES == 100
@@ -33,19 +35,22 @@ HIGHP float unpack16(vec2 bytes) {
 }
 #endif
 
+// Spot data is only read when the scene has spot lights (HAS_SPOT); otherwise the variant
+// fetches fewer texels and has no cone code at all.
 Light fetchLight(int i) {
     Light light;
     vec4 t0 = LIGHT_TEXEL(i, 0);
     vec4 t1 = LIGHT_TEXEL(i, 1);
-    vec4 t2 = LIGHT_TEXEL(i, 2);
 #if LIGHTS_RGBA8
-    vec4 t3 = LIGHT_TEXEL(i, 3);
-    vec4 t4 = LIGHT_TEXEL(i, 4);
-    vec4 t5 = LIGHT_TEXEL(i, 5);
+    vec4 t2 = LIGHT_TEXEL(i, 2);
     light.position = (vec3(unpack16(t0.xy), unpack16(t0.zw), unpack16(t1.xy)) * 2.0 - 1.0) * u_lightRanges.x;
     light.radius = unpack16(t1.zw) * u_lightRanges.y;
     vec4 rgbe = floor(t2 * 255.0 + 0.5);
     light.radiance = rgbe.rgb / 255.0 * exp2(rgbe.a - 128.0);
+#if HAS_SPOT
+    vec4 t3 = LIGHT_TEXEL(i, 3);
+    vec4 t4 = LIGHT_TEXEL(i, 4);
+    vec4 t5 = LIGHT_TEXEL(i, 5);
     vec3 dir = vec3(unpack16(t3.xy), unpack16(t3.zw), unpack16(t4.xy)) * 2.0 - 1.0;
     light.direction = dir / max(length(dir), 1e-6);
     float outerDeg = unpack16(t5.xy) * 180.0;
@@ -56,13 +61,17 @@ Light fetchLight(int i) {
     bool omni = innerDeg >= 180.0;
     light.spotScale = omni ? 0.0 : scale;
     light.spotOffset = omni ? 1.0 : -cosOuter * scale;
+#endif
 #else
     light.position = t0.xyz;
     light.radius = t0.w;
     light.radiance = t1.rgb;
+#if HAS_SPOT
+    vec4 t2 = LIGHT_TEXEL(i, 2);
     light.spotScale = t1.w;
     light.direction = t2.xyz;
     light.spotOffset = t2.w;
+#endif
 #endif
     return light;
 }

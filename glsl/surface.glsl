@@ -2,6 +2,8 @@
 uniform vec3 u_albedo;
 uniform vec3 u_specular;
 uniform float u_shininess;
+// Material opacity (1 for opaque objects; blended when below 1).
+uniform float u_alpha;
 uniform vec3 u_ambient;
 // 1.0 for orthographic cameras (view direction +Z), 0.0 for perspective.
 uniform float u_orthographic;
@@ -34,11 +36,11 @@ vec3 surfaceAlbedo(vec2 uv) {
 vec4 encodeOutput(vec3 color) {
 #if OUTPUT_HDR
     // Float targets: unclamped, so NaN and Inf stay visible to the stability tests.
-    return vec4(color, 1.0);
+    return vec4(color, u_alpha);
 #elif OUTPUT_LINEAR
-    return vec4(clamp(color, 0.0, 1.0), 1.0);
+    return vec4(clamp(color, 0.0, 1.0), u_alpha);
 #else
-    return vec4(linearToSrgb(clamp(color, 0.0, 1.0)), 1.0);
+    return vec4(linearToSrgb(clamp(color, 0.0, 1.0)), u_alpha);
 #endif
 }
 

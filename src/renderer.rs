@@ -146,12 +146,9 @@ impl GpuScene {
         Ok(())
     }
 
-    /// The uploaded mesh of each object, in object order (the scene must have been uploaded).
-    pub fn meshes<'a>(&'a self, scene: &'a Scene) -> impl Iterator<Item = &'a GpuMesh> + 'a {
-        scene
-            .objects
-            .iter()
-            .map(|o| &self.meshes[&(Arc::as_ptr(&o.mesh) as usize)].1)
+    /// The uploaded mesh of an object (the scene must have been uploaded).
+    pub fn mesh(&self, object: &crate::scene::Object) -> &GpuMesh {
+        &self.meshes[&(Arc::as_ptr(&object.mesh) as usize)].1
     }
 
     /// The uploaded diffuse texture of a material, if it has one.
@@ -352,7 +349,11 @@ impl Renderer {
         options: &RenderOptions,
     ) -> Result<(image::RgbaImage, FrameStats), Error> {
         let stats = self.render_into_target(scene, width, height, options, ColorFormat::Rgba8)?;
-        let image = self.target.as_ref().expect("rendered").read_rgba8(&self.dev)?;
+        let image = self
+            .target
+            .as_ref()
+            .expect("rendered")
+            .read_rgba8(&self.dev)?;
         self.dev.bind_default_framebuffer();
         Ok((image, stats))
     }
@@ -371,8 +372,13 @@ impl Renderer {
             hdr: true,
             ..options.clone()
         };
-        let stats = self.render_into_target(scene, width, height, &options, ColorFormat::Rgba16F)?;
-        let pixels = self.target.as_ref().expect("rendered").read_rgba_f32(&self.dev)?;
+        let stats =
+            self.render_into_target(scene, width, height, &options, ColorFormat::Rgba16F)?;
+        let pixels = self
+            .target
+            .as_ref()
+            .expect("rendered")
+            .read_rgba_f32(&self.dev)?;
         self.dev.bind_default_framebuffer();
         Ok((pixels, stats))
     }
@@ -390,7 +396,9 @@ impl Renderer {
             if let Some(mut t) = self.target.take() {
                 t.destroy(&self.dev);
             }
-            self.target = Some(OffscreenTarget::with_format(&self.dev, width, height, format)?);
+            self.target = Some(OffscreenTarget::with_format(
+                &self.dev, width, height, format,
+            )?);
         }
         self.target.as_ref().expect("created above").bind(&self.dev);
         let mut stats = self.render(scene, width, height, options)?;

@@ -95,7 +95,11 @@ fn all_features() -> Vec<ShaderFeatures> {
 /// The source without `#define` lines of macros the body never mentions: two variants that
 /// differ only there compile to the same program.
 fn strip_unused_defines(src: &str) -> String {
-    let body: String = src.lines().filter(|l| !l.starts_with("#define ")).collect::<Vec<_>>().join("\n");
+    let body: String = src
+        .lines()
+        .filter(|l| !l.starts_with("#define "))
+        .collect::<Vec<_>>()
+        .join("\n");
     src.lines()
         .filter(|l| match l.strip_prefix("#define ") {
             Some(rest) => {
@@ -145,8 +149,15 @@ fn every_shader_variant_passes_the_strict_validator() {
             }
         }
     }
-    assert!(checked >= SHADERS.len() * 4 * 128, "only {checked} variants checked");
-    assert!(seen.len() > SHADERS.len() * 4, "only {} distinct sources", seen.len());
+    assert!(
+        checked >= SHADERS.len() * 4 * 128,
+        "only {checked} variants checked"
+    );
+    assert!(
+        seen.len() > SHADERS.len() * 4,
+        "only {} distinct sources",
+        seen.len()
+    );
     assert!(
         failures.is_empty(),
         "{} variants failed:\n{}",

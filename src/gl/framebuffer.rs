@@ -55,9 +55,16 @@ impl OffscreenTarget {
     }
 
     /// Creates a `width × height` target with the given colour format.
-    pub fn with_format(dev: &Device, width: u32, height: u32, format: ColorFormat) -> Result<OffscreenTarget, GlError> {
+    pub fn with_format(
+        dev: &Device,
+        width: u32,
+        height: u32,
+        format: ColorFormat,
+    ) -> Result<OffscreenTarget, GlError> {
         if !format.supported(dev) {
-            return Err(GlError::Unsupported(format!("{format:?} render targets are not supported on this context")));
+            return Err(GlError::Unsupported(format!(
+                "{format:?} render targets are not supported on this context"
+            )));
         }
         let max = dev.caps().max_texture_size as u32;
         if width == 0 || height == 0 || width > max || height > max {

@@ -19,7 +19,11 @@ pub fn mediump_is_fp16(dev: &Device) -> Result<bool, GlError> {
     let result = unsafe {
         let buffer = gl.create_buffer().map_err(GlError::Create)?;
         gl.bind_buffer(glow::ARRAY_BUFFER, Some(buffer));
-        gl.buffer_data_u8_slice(glow::ARRAY_BUFFER, bytemuck::cast_slice(&vertices), glow::STATIC_DRAW);
+        gl.buffer_data_u8_slice(
+            glow::ARRAY_BUFFER,
+            bytemuck::cast_slice(&vertices),
+            glow::STATIC_DRAW,
+        );
         target.bind(dev);
         gl.disable(glow::DEPTH_TEST);
         gl.disable(glow::BLEND);

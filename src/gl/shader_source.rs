@@ -81,8 +81,14 @@ pub const FILES: &[(&str, &str)] = &[
         include_str!("../../glsl/light_data.glsl"),
     ),
     ("surface.glsl", include_str!("../../glsl/surface.glsl")),
-    ("fullscreen.vert", include_str!("../../glsl/fullscreen.vert")),
-    ("precision_probe.frag", include_str!("../../glsl/precision_probe.frag")),
+    (
+        "fullscreen.vert",
+        include_str!("../../glsl/fullscreen.vert"),
+    ),
+    (
+        "precision_probe.frag",
+        include_str!("../../glsl/precision_probe.frag"),
+    ),
     (
         "data_texture.glsl",
         include_str!("../../glsl/data_texture.glsl"),
@@ -153,7 +159,110 @@ pub fn assemble(
         out.push_str(&format!("#define {name} {value}\n"));
     }
     let mut stack = Vec::new();
-    expand(body, &mut out, &mut stack)?;
+    let mut body_text = String::new();
+    expand(body, &mut body_text, &mut stack)?;
+    out.push_str(&strip_feature_blocks(&body_text, defines)?);
+    Ok(out)
+}
+
+/// Removes `#if FLAG` / `#if !FLAG` blocks whose flag is a `#define`d 0 or 1, keeping only the
+/// taken branch, so a variant's source holds no code for features the scene lacks (what the
+/// tests check, and what a driver has to parse). Other conditionals (`GLSL_ES == 100`,
+/// `GL_FRAGMENT_PRECISION_HIGH`) are left for the GLSL preprocessor.
+pub fn strip_feature_blocks(source: &str, defines: &[(String, String)]) -> Result<String, GlError> {
+    let flag = |cond: &str| -> Option<bool> {
+        let cond = cond.trim();
+        let (negate, name) = match cond.strip_prefix('!') {
+            Some(rest) => (true, rest.trim()),
+            None => (false, cond),
+        };
+        let value = defines.iter().find(|(n, _)| n == name)?.1.trim();
+        let on = match value {
+            "0" => false,
+            "1" => true,
+            _ => return None,
+        };
+        Some(on != negate)
+    };
+    enum Frame {
+        Known { parent: bool, taken: bool },
+        Unknown { parent: bool },
+    }
+    let mut out = String::with_capacity(source.len());
+    let mut stack: Vec<Frame> = Vec::new();
+    let mut active = true;
+    for line in source.lines() {
+        let t = line.trim_start();
+        let directive = |d: &str| t.strip_prefix(d).filter(|r| r.is_empty() || r.starts_with(char::is_whitespace));
+        if let Some(cond) = directive("#if") {
+            match flag(cond) {
+                Some(on) => {
+                    stack.push(Frame::Known { parent: active, taken: on });
+                    active = active && on;
+                }
+                None => {
+                    stack.push(Frame::Unknown { parent: active });
+                    if active {
+                        out.push_str(line);
+                        out.push('\n');
+                    }
+                }
+            }
+            continue;
+        }
+        if directive("#ifdef").is_some() || directive("#ifndef").is_some() {
+            stack.push(Frame::Unknown { parent: active });
+            if active {
+                out.push_str(line);
+                out.push('\n');
+            }
+            continue;
+        }
+        let elif = directive("#elif");
+        let is_else = directive("#else").is_some();
+        let is_endif = directive("#endif").is_some();
+        if elif.is_none() && !is_else && !is_endif {
+            if active {
+                out.push_str(line);
+                out.push('\n');
+            }
+            continue;
+        }
+        let top = stack
+            .last_mut()
+            .ok_or_else(|| GlError::ShaderSource(format!("unmatched `{}`", t.trim())))?;
+        match top {
+            Frame::Known { parent, taken } => {
+                if let Some(cond) = elif {
+                    let on = flag(cond).ok_or_else(|| {
+                        GlError::ShaderSource(format!("`{}` mixes a feature flag with another condition", t.trim()))
+                    })?;
+                    active = *parent && !*taken && on;
+                    *taken |= on;
+                } else if is_else {
+                    active = *parent && !*taken;
+                    *taken = true;
+                } else {
+                    active = *parent;
+                    stack.pop();
+                }
+            }
+            Frame::Unknown { parent } => {
+                let parent = *parent;
+                if parent {
+                    out.push_str(line);
+                    out.push('\n');
+                }
+                if is_endif {
+                    active = parent;
+                    stack.pop();
+                }
+            }
+        }
+    }
+    if !stack.is_empty() {
+        return Err(GlError::ShaderSource("unterminated #if".into()));
+    }
     Ok(out)
 }
 
@@ -211,6 +320,20 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn feature_blocks_are_stripped_and_others_kept() {
+        let src = "a\n#if HAS_X\nx\n#if GLSL_ES == 100\nx100\n#else\nx300\n#endif\n#else\nnox\n#endif\n#if !HAS_X\nnotx\n#endif\n#if HAS_Y\ny\n#elif HAS_X\nyx\n#else\nnone\n#endif\nb\n";
+        let d = |x: &str, y: &str| vec![("HAS_X".to_string(), x.to_string()), ("HAS_Y".to_string(), y.to_string())];
+        assert_eq!(
+            strip_feature_blocks(src, &d("1", "0")).unwrap(),
+            "a\nx\n#if GLSL_ES == 100\nx100\n#else\nx300\n#endif\nyx\nb\n"
+        );
+        assert_eq!(strip_feature_blocks(src, &d("0", "0")).unwrap(), "a\nnox\nnotx\nnone\nb\n");
+        assert_eq!(strip_feature_blocks(src, &d("0", "1")).unwrap(), "a\nnox\nnotx\ny\nb\n");
+        assert!(strip_feature_blocks("#endif\n", &[]).is_err());
+        assert!(strip_feature_blocks("#if HAS_X\n", &d("1", "1")).is_err());
     }
 
     #[test]

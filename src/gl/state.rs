@@ -35,6 +35,8 @@ pub enum Cull {
     None,
     /// Cull back faces.
     Back,
+    /// Cull front faces (draw the far side of a transparent object first).
+    Front,
 }
 
 /// The full fixed-function state of a pass.
@@ -72,6 +74,22 @@ impl RenderState {
         color_write: true,
     };
 
+    /// Transparent objects, first pass: their far side, blended over what is behind, tested
+    /// against (but not writing) the opaque depth.
+    pub const TRANSPARENT_BACK_FACES: RenderState = RenderState {
+        depth_test: DepthTest::Less,
+        depth_write: false,
+        blend: Blend::Alpha,
+        cull: Cull::Front,
+        color_write: true,
+    };
+
+    /// Transparent objects, second pass: their near side.
+    pub const TRANSPARENT_FRONT_FACES: RenderState = RenderState {
+        cull: Cull::Back,
+        ..Self::TRANSPARENT_BACK_FACES
+    };
+
     /// Applies every field.
     pub fn apply(&self, dev: &Device) {
         let gl = &dev.gl;
@@ -98,7 +116,8 @@ impl RenderState {
                 }
                 Blend::Alpha => {
                     gl.enable(glow::BLEND);
-                    gl.blend_func(glow::SRC_ALPHA, glow::ONE_MINUS_SRC_ALPHA);
+                    // The framebuffer's alpha stays opaque: images are read back as they show.
+                    gl.blend_func_separate(glow::SRC_ALPHA, glow::ONE_MINUS_SRC_ALPHA, glow::ZERO, glow::ONE);
                 }
             }
             match self.cull {
@@ -106,6 +125,10 @@ impl RenderState {
                 Cull::Back => {
                     gl.enable(glow::CULL_FACE);
                     gl.cull_face(glow::BACK);
+                }
+                Cull::Front => {
+                    gl.enable(glow::CULL_FACE);
+                    gl.cull_face(glow::FRONT);
                 }
             }
         }

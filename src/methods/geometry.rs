@@ -21,9 +21,30 @@ fn set_transforms(program: &mut Program, dev: &Device, model_view: &DMat4, proje
     program.set_mat4(dev, "u_projection", projection);
 }
 
-/// Lays down depth only, so the shading pass runs its light loop once per pixel instead of
-/// once per overlapping surface.
-fn depth_prepass(ctx: &mut FrameContext) -> Result<(), Error> {
+/// Opaque objects in scene order, then transparent ones back to front (by the view depth of
+/// their bounds' centre).
+fn draw_order(ctx: &FrameContext) -> (Vec<usize>, Vec<usize>) {
+    let scene = ctx.scene;
+    let (mut opaque, mut transparent) = (Vec::new(), Vec::new());
+    for (i, o) in scene.objects.iter().enumerate() {
+        if scene.materials[o.material].is_transparent() {
+            transparent.push(i);
+        } else {
+            opaque.push(i);
+        }
+    }
+    let depth = |i: &usize| {
+        let o = &scene.objects[*i];
+        let centre = o.mesh.bounds().map_or(glam::DVec3::ZERO, |b| b.center());
+        -(ctx.view * o.transform).transform_point3(centre).z
+    };
+    transparent.sort_by(|a, b| depth(b).total_cmp(&depth(a)));
+    (opaque, transparent)
+}
+
+/// Lays down the opaque objects' depth only, so the shading pass runs its light loop once per
+/// pixel instead of once per overlapping surface.
+fn depth_prepass(ctx: &mut FrameContext, opaque: &[usize]) -> Result<(), Error> {
     let dev = ctx.dev;
     RenderState::DEPTH_PREPASS.apply(dev);
     let key = ProgramKey {
@@ -33,77 +54,82 @@ fn depth_prepass(ctx: &mut FrameContext) -> Result<(), Error> {
     };
     let program = ctx.programs.get_or_build(dev, key, Vec::new)?;
     program.bind(dev);
-    for (object, mesh) in ctx
-        .scene
-        .objects
-        .iter()
-        .zip(ctx.gpu_scene.meshes(ctx.scene))
-    {
-        set_transforms(
-            program,
-            dev,
-            &(ctx.view * object.transform),
-            &ctx.projection,
-        );
-        mesh.draw(dev);
+    for &i in opaque {
+        let object = &ctx.scene.objects[i];
+        set_transforms(program, dev, &(ctx.view * object.transform), &ctx.projection);
+        ctx.gpu_scene.mesh(object).draw(dev);
     }
     Ok(())
 }
 
-/// Draws every object of the scene with `shader` after a depth prepass, calling
-/// `bind_method` on each program before the draw so the method can set its uniforms and bind
-/// its textures.
+/// Draws the scene with `shader`: a depth prepass of the opaque objects, the opaque objects,
+/// then the transparent ones back to front — each in two passes, back faces then front faces,
+/// so a closed convex object blends in the right order. `bind_method` is called on each
+/// program before a draw so the method can set its uniforms and bind its textures; transparent
+/// surfaces are lit by the same data (the dense grid covers every depth, not just the visible
+/// surface).
 pub fn draw_objects(
     ctx: &mut FrameContext,
     shader: &'static str,
     max_lights: u32,
     bind_method: &mut dyn FnMut(&mut Program, &Device),
 ) -> Result<(), Error> {
-    depth_prepass(ctx)?;
+    let (opaque, transparent) = draw_order(ctx);
+    depth_prepass(ctx, &opaque)?;
+    RenderState::OPAQUE_AFTER_PREPASS.apply(ctx.dev);
+    for &i in &opaque {
+        shade_object(ctx, i, shader, max_lights, bind_method)?;
+    }
+    for &i in &transparent {
+        for state in [RenderState::TRANSPARENT_BACK_FACES, RenderState::TRANSPARENT_FRONT_FACES] {
+            state.apply(ctx.dev);
+            shade_object(ctx, i, shader, max_lights, bind_method)?;
+        }
+    }
+    crate::gl_check!(ctx.dev, "geometry pass");
+    Ok(())
+}
+
+/// One object with its material's shader variant.
+fn shade_object(
+    ctx: &mut FrameContext,
+    index: usize,
+    shader: &'static str,
+    max_lights: u32,
+    bind_method: &mut dyn FnMut(&mut Program, &Device),
+) -> Result<(), Error> {
     let dev = ctx.dev;
     let dialect = dev.es();
-    RenderState::OPAQUE_AFTER_PREPASS.apply(dev);
-    let projection = ctx.projection;
-    for (object, mesh) in ctx
-        .scene
-        .objects
-        .iter()
-        .zip(ctx.gpu_scene.meshes(ctx.scene))
-    {
-        let material = &ctx.scene.materials[object.material];
-        let texture = ctx.gpu_scene.texture_for(material);
-        let features = ctx
-            .features
-            .with(ShaderFeatures::TEXTURE, texture.is_some())
-            .with(ShaderFeatures::SPECULAR, material.has_specular());
-        let key = ProgramKey {
-            shader,
-            features: features.0,
-            dialect,
-        };
-        let program = ctx
-            .programs
-            .get_or_build(dev, key, || features.defines(dialect, max_lights))?;
-        program.bind(dev);
-        // The camera is subtracted in f64 here, so far-from-origin scenes stay exact in f32.
-        set_transforms(program, dev, &(ctx.view * object.transform), &projection);
-        program.set_vec3(dev, "u_albedo", material.diffuse);
-        program.set_vec3(dev, "u_specular", material.specular);
-        program.set_f32(dev, "u_shininess", material.shading_exponent());
-        program.set_vec3(dev, "u_ambient", ctx.scene.ambient);
-        program.set_f32(
-            dev,
-            "u_orthographic",
-            if ctx.orthographic { 1.0 } else { 0.0 },
-        );
-        if let Some(t) = texture {
-            t.bind(dev, UNIT_ALBEDO);
-            program.set_i32(dev, "u_albedoTex", UNIT_ALBEDO as i32);
-        }
-        bind_method(program, dev);
-        mesh.draw(dev);
+    let object = &ctx.scene.objects[index];
+    let material = &ctx.scene.materials[object.material];
+    let texture = ctx.gpu_scene.texture_for(material);
+    let features = ctx
+        .features
+        .with(ShaderFeatures::TEXTURE, texture.is_some())
+        .with(ShaderFeatures::SPECULAR, material.has_specular());
+    let key = ProgramKey {
+        shader,
+        features: features.0,
+        dialect,
+    };
+    let program = ctx
+        .programs
+        .get_or_build(dev, key, || features.defines(dialect, max_lights))?;
+    program.bind(dev);
+    // The camera is subtracted in f64 here, so far-from-origin scenes stay exact in f32.
+    set_transforms(program, dev, &(ctx.view * object.transform), &ctx.projection);
+    program.set_vec3(dev, "u_albedo", material.diffuse);
+    program.set_vec3(dev, "u_specular", material.specular);
+    program.set_f32(dev, "u_shininess", material.shading_exponent());
+    program.set_f32(dev, "u_alpha", material.alpha);
+    program.set_vec3(dev, "u_ambient", ctx.scene.ambient);
+    program.set_f32(dev, "u_orthographic", if ctx.orthographic { 1.0 } else { 0.0 });
+    if let Some(t) = texture {
+        t.bind(dev, UNIT_ALBEDO);
+        program.set_i32(dev, "u_albedoTex", UNIT_ALBEDO as i32);
     }
-    crate::gl_check!(dev, "geometry pass");
+    bind_method(program, dev);
+    ctx.gpu_scene.mesh(object).draw(dev);
     Ok(())
 }
 

@@ -6,6 +6,8 @@
 //! * `pillars` — a forest of thin pillars: many depth discontinuities per tile, the worst case
 //!   for 2D tiling.
 //! * `plane` — one flat quad facing the camera, for analytic checks against the light model.
+//! * `bubbles` — the courtyard with translucent spheres floating in it: transparency lit by the
+//!   same light lists as the opaque surfaces.
 
 use std::sync::Arc;
 
@@ -17,7 +19,7 @@ use super::random::{self, LightSetStyle};
 use super::{Camera, Material, Mesh, Object, Scene, SceneError};
 
 /// Names accepted by [`build`], default first.
-pub const NAMES: &[&str] = &["courtyard", "pillars", "plane"];
+pub const NAMES: &[&str] = &["courtyard", "pillars", "plane", "bubbles"];
 
 /// The default scene's name.
 pub const DEFAULT: &str = "courtyard";
@@ -29,6 +31,7 @@ pub fn build(name: &str, lights: Option<(usize, u64)>) -> Result<Scene, SceneErr
         "courtyard" => courtyard(),
         "pillars" => pillars(),
         "plane" => plane(),
+        "bubbles" => bubbles(),
         other => return Err(SceneError::UnknownBuiltin(other.to_string())),
     };
     if let Some((count, seed)) = lights {
@@ -201,6 +204,25 @@ fn courtyard() -> (Scene, Aabb, LightSetStyle) {
         ),
     };
     (scene, volume, LightSetStyle::Mixed)
+}
+
+fn bubbles() -> (Scene, Aabb, LightSetStyle) {
+    let (mut scene, volume, style) = courtyard();
+    // Deterministic placement along the view down the courtyard, nearest first.
+    for i in 0..14 {
+        let f = i as f32;
+        let centre = Vec3::new(-13.0 + f * 1.9, 1.6 + (f * 1.3).sin().abs() * 3.5, (f * 2.1).sin() * 4.5);
+        let radius = 0.6 + 0.5 * (f * 0.7).cos().abs();
+        let tint = Vec3::new(0.4 + 0.5 * (f * 0.9).sin().abs(), 0.6, 0.4 + 0.5 * (f * 0.5).cos().abs());
+        let mut mesh = MeshBuilder::new();
+        mesh.sphere(centre, radius, 24, 12);
+        let material = Material {
+            alpha: 0.3 + 0.04 * (i % 5) as f32,
+            ..Material::glossy(&format!("bubble{i}"), tint, Vec3::splat(0.8), 128.0)
+        };
+        push(&mut scene, mesh.build(), material);
+    }
+    (scene, volume, style)
 }
 
 fn pillars() -> (Scene, Aabb, LightSetStyle) {

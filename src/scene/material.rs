@@ -28,6 +28,9 @@ pub struct Material {
     pub specular: Vec3,
     /// Blinn-Phong exponent (`Ns`); values below 1 are shaded as 1 (see [`Material::shading_exponent`]).
     pub shininess: f32,
+    /// Opacity (`d` in MTL): 1 is opaque; below 1 the object is drawn after the opaque ones,
+    /// back to front, alpha-blended.
+    pub alpha: f32,
 }
 
 impl Default for Material {
@@ -45,6 +48,7 @@ impl Material {
             diffuse_texture: None,
             specular: Vec3::splat(0.04),
             shininess: 32.0,
+            alpha: 1.0,
         }
     }
 
@@ -63,6 +67,11 @@ impl Material {
         self.shininess.clamp(1.0, 4096.0)
     }
 
+    /// True when the material is see-through (alpha below 1).
+    pub fn is_transparent(&self) -> bool {
+        self.alpha < 1.0
+    }
+
     /// True when the material has a non-zero specular term.
     pub fn has_specular(&self) -> bool {
         self.specular.max_element() > 0.0
@@ -77,6 +86,12 @@ impl Material {
                     format!("must be finite and >= 0, got {v:?}"),
                 ));
             }
+        }
+        if !(self.alpha.is_finite() && (0.0..=1.0).contains(&self.alpha)) {
+            return Err(SceneError::invalid(
+                format!("{field}.alpha"),
+                format!("must be in [0, 1], got {}", self.alpha),
+            ));
         }
         if !(self.shininess.is_finite() && self.shininess >= 0.0) {
             return Err(SceneError::invalid(

@@ -90,6 +90,34 @@ impl MeshBuilder {
         self
     }
 
+    /// A UV sphere with smooth normals, counter-clockwise seen from outside.
+    pub fn sphere(&mut self, centre: Vec3, radius: f32, segments: u32, rings: u32) -> &mut Self {
+        let first = self.positions.len() as u32;
+        for ring in 0..=rings {
+            let theta = ring as f32 / rings as f32 * PI;
+            for seg in 0..=segments {
+                let phi = seg as f32 / segments as f32 * 2.0 * PI;
+                let n = Vec3::new(theta.sin() * phi.cos(), theta.cos(), -theta.sin() * phi.sin());
+                self.vertex(centre + n * radius, n, Vec2::new(seg as f32 / segments as f32, ring as f32 / rings as f32));
+            }
+        }
+        let row = segments + 1;
+        for ring in 0..rings {
+            for seg in 0..segments {
+                let a = first + ring * row + seg;
+                let (b, c, d) = (a + row, a + row + 1, a + 1);
+                // Skip the degenerate triangles at the poles.
+                if ring != 0 {
+                    self.indices.extend_from_slice(&[a, b, d]);
+                }
+                if ring != rings - 1 {
+                    self.indices.extend_from_slice(&[d, b, c]);
+                }
+            }
+        }
+        self
+    }
+
     /// A semicircular arch in the XY plane (spanning along X) centred at `centre` (the
     /// springing line's midpoint), made of `segments` voussoir blocks of the given thickness
     /// (radial) and depth (along Z).
@@ -149,6 +177,19 @@ mod tests {
             let [a, b, c] = [t[0], t[1], t[2]].map(|i| m.positions[i as usize]);
             let face = (b - a).cross(c - a);
             assert!(face.dot(m.normals[t[0] as usize]) > 0.0);
+        }
+    }
+
+    #[test]
+    fn sphere_winding_faces_outwards() {
+        let mut b = MeshBuilder::new();
+        b.sphere(Vec3::new(1.0, 2.0, 3.0), 0.5, 16, 8);
+        let m = b.build();
+        for t in m.indices.chunks(3) {
+            let [a, b, c] = [t[0], t[1], t[2]].map(|i| m.positions[i as usize]);
+            let face = (b - a).cross(c - a);
+            let outward = (a + b + c) / 3.0 - Vec3::new(1.0, 2.0, 3.0);
+            assert!(face.dot(outward) > 0.0, "inward triangle");
         }
     }
 

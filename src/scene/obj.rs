@@ -90,6 +90,7 @@ pub fn load_into(
             diffuse_texture: override_tex.clone().or(texture),
             specular: Vec3::from(m.specular.unwrap_or([0.0; 3])),
             shininess: m.shininess.unwrap_or(1.0),
+            alpha: m.dissolve.unwrap_or(1.0).clamp(0.0, 1.0),
         });
     }
     let fallback = scene.add_material(Material {
