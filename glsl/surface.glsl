@@ -9,13 +9,13 @@ uniform vec3 u_ambient;
 uniform float u_orthographic;
 #if HAS_TEXTURE
 uniform sampler2D u_albedoTex;
-#endif
 
 vec3 srgbToLinear(vec3 c) {
     vec3 lo = c / 12.92;
     vec3 hi = pow((c + 0.055) / 1.055, vec3(2.4));
     return mix(lo, hi, step(vec3(0.04045), c));
 }
+#endif
 
 vec3 linearToSrgb(vec3 c) {
     vec3 lo = c * 12.92;

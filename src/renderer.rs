@@ -18,7 +18,8 @@ use crate::gl::program::ProgramCache;
 use crate::gl::texture::ImageTexture;
 use crate::gl::{Caps, Device, EsVersion};
 use crate::methods::{self, FrameContext, ShaderFeatures, ShadingMethod, Support};
-use crate::scene::{LightKind, Material, Mesh, Projection, Scene, Texture};
+use crate::scene::features::SceneFeatures;
+use crate::scene::{Material, Mesh, Projection, Scene, Texture};
 use crate::Error;
 
 /// Per-call rendering options.
@@ -51,6 +52,10 @@ pub struct RenderOptions {
     /// Write linear, unclamped radiance (for float targets; see
     /// [`Renderer::render_offscreen_hdr`]).
     pub hdr: bool,
+    /// Compile every variant with spot, specular and texture code even where the scene lacks
+    /// them (a white texture stands in) — to measure what leaving features out saves, and to
+    /// test that it changes nothing in the image.
+    pub full_variants: bool,
 }
 
 impl Default for RenderOptions {
@@ -66,6 +71,7 @@ impl Default for RenderOptions {
             max_indices: None,
             wait_for_gpu: true,
             hdr: false,
+            full_variants: false,
         }
     }
 }
@@ -117,6 +123,8 @@ pub struct FrameStats {
     pub method_gpu_bytes: usize,
     /// `LP_NUM_THREADS` when set (llvmpipe's thread count changes every timing).
     pub lp_num_threads: Option<String>,
+    /// What the scene uses (and so what the shader variants were built with).
+    pub scene_features: SceneFeatures,
 }
 
 /// Meshes and textures of scenes, uploaded once and found again by identity. The cache holds
@@ -125,10 +133,16 @@ pub struct FrameStats {
 pub struct GpuScene {
     meshes: HashMap<usize, (Arc<Mesh>, GpuMesh)>,
     textures: HashMap<usize, (Arc<Texture>, ImageTexture)>,
+    /// 1×1 white texture for full variants on untextured materials (made on first use).
+    white: Option<ImageTexture>,
 }
 
 impl GpuScene {
-    fn upload(&mut self, dev: &Device, scene: &Scene) -> Result<(), Error> {
+    fn upload(&mut self, dev: &Device, scene: &Scene, full_variants: bool) -> Result<(), Error> {
+        if full_variants && self.white.is_none() {
+            let white = image::RgbaImage::from_pixel(1, 1, image::Rgba([255, 255, 255, 255]));
+            self.white = Some(ImageTexture::new(dev, &white)?);
+        }
         for o in &scene.objects {
             let key = Arc::as_ptr(&o.mesh) as usize;
             if let std::collections::hash_map::Entry::Vacant(e) = self.meshes.entry(key) {
@@ -159,12 +173,20 @@ impl GpuScene {
             .map(|(_, g)| g)
     }
 
+    /// The white stand-in texture (only after an upload with full variants).
+    pub fn white(&self) -> Option<&ImageTexture> {
+        self.white.as_ref()
+    }
+
     fn destroy(&mut self, dev: &Device) {
         for (_, (_, mut m)) in self.meshes.drain() {
             m.destroy(dev);
         }
         for (_, (_, mut t)) in self.textures.drain() {
             t.destroy(dev);
+        }
+        if let Some(mut w) = self.white.take() {
+            w.destroy(dev);
         }
     }
 }
@@ -205,6 +227,16 @@ impl Renderer {
     /// Whether the fragment stage evaluates `mediump` as fp16 (measured with a tiny render).
     pub fn mediump_is_fp16(&self) -> Result<bool, Error> {
         Ok(crate::gl::precision_probe::mediump_is_fp16(&self.dev)?)
+    }
+
+    /// GL objects the renderer holds now.
+    pub fn live_gl_objects(&self) -> crate::gl::device::LiveObjects {
+        self.dev.live_objects()
+    }
+
+    /// Every shader variant built so far: shader, feature bits and assembled source size.
+    pub fn program_report(&self) -> Vec<crate::gl::program::ProgramInfo> {
+        self.programs.report()
     }
 
     /// The current method's name.
@@ -253,7 +285,8 @@ impl Renderer {
         if width == 0 || height == 0 {
             return Err(Error::Limit(format!("viewport {width}×{height} is empty")));
         }
-        self.gpu_scene.upload(&self.dev, scene)?;
+        self.gpu_scene
+            .upload(&self.dev, scene, options.full_variants)?;
         let view: DMat4 = scene.camera.view_matrix();
         let projection = scene
             .camera
@@ -265,12 +298,12 @@ impl Renderer {
             .filter(|l| l.is_active())
             .map(|l| GpuLight::from_light(l, &view))
             .collect();
-        let has_spots = scene
-            .lights
-            .iter()
-            .any(|l| l.is_active() && matches!(l.kind, LightKind::Spot { .. }));
+        let scene_features = SceneFeatures::of(scene);
         let features = ShaderFeatures::default()
-            .with(ShaderFeatures::SPOT, has_spots)
+            .with(
+                ShaderFeatures::SPOT,
+                scene_features.spot_lights || options.full_variants,
+            )
             .with(ShaderFeatures::OUTPUT_LINEAR, options.linear)
             .with(ShaderFeatures::OUTPUT_HDR, options.hdr)
             .with(
@@ -335,6 +368,7 @@ impl Renderer {
             triangles: scene.objects.iter().map(|o| o.mesh.triangle_count()).sum(),
             method_gpu_bytes: self.method.gpu_bytes(),
             lp_num_threads: std::env::var("LP_NUM_THREADS").ok(),
+            scene_features,
         })
     }
 

@@ -331,7 +331,8 @@ fn spot_cones_of_zero_half_and_179_degrees() {
 #[test]
 fn invalid_values_are_rejected_before_upload() {
     let mut gpu = Gpu::new(EsVersion::Es3);
-    let cases: Vec<(Box<dyn Fn(&mut Scene)>, &str)> = vec![
+    type Breaker = Box<dyn Fn(&mut Scene)>;
+    let cases: Vec<(Breaker, &str)> = vec![
         (
             Box::new(|s: &mut Scene| s.lights[0].radius = f32::NAN),
             "lights[0].radius",

@@ -10,14 +10,77 @@ use super::{Caps, EsVersion, GlError};
 pub struct Device {
     pub(crate) gl: glow::Context,
     caps: Caps,
+    live: std::cell::Cell<LiveObjects>,
+}
+
+/// GL objects currently alive, as counted by the renderer's own create/delete calls: what
+/// tests use to check that switching methods frees the previous method's resources.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+pub struct LiveObjects {
+    /// Textures.
+    pub textures: i64,
+    /// Buffers.
+    pub buffers: i64,
+    /// Framebuffers.
+    pub framebuffers: i64,
+    /// Renderbuffers.
+    pub renderbuffers: i64,
+    /// Programs.
+    pub programs: i64,
+}
+
+macro_rules! tracked {
+    ($create:ident, $delete:ident, $ty:ty, $field:ident) => {
+        pub(crate) fn $create(&self) -> Result<$ty, GlError> {
+            let object = unsafe { self.gl.$create() }.map_err(GlError::Create)?;
+            self.count(|l| l.$field += 1);
+            Ok(object)
+        }
+
+        pub(crate) fn $delete(&self, object: $ty) {
+            unsafe { self.gl.$delete(object) };
+            self.count(|l| l.$field -= 1);
+        }
+    };
 }
 
 impl Device {
     /// Wraps a current glow context and probes its capabilities.
     pub fn new(gl: glow::Context, es: EsVersion) -> Result<Device, GlError> {
         let caps = Caps::probe(&gl, es)?;
-        Ok(Device { gl, caps })
+        Ok(Device {
+            gl,
+            caps,
+            live: std::cell::Cell::new(LiveObjects::default()),
+        })
     }
+
+    /// GL objects alive now (created and not yet deleted by this crate).
+    pub fn live_objects(&self) -> LiveObjects {
+        self.live.get()
+    }
+
+    fn count(&self, f: impl FnOnce(&mut LiveObjects)) {
+        let mut l = self.live.get();
+        f(&mut l);
+        self.live.set(l);
+    }
+
+    tracked!(create_texture, delete_texture, glow::Texture, textures);
+    tracked!(create_buffer, delete_buffer, glow::Buffer, buffers);
+    tracked!(
+        create_framebuffer,
+        delete_framebuffer,
+        glow::Framebuffer,
+        framebuffers
+    );
+    tracked!(
+        create_renderbuffer,
+        delete_renderbuffer,
+        glow::Renderbuffer,
+        renderbuffers
+    );
+    tracked!(create_program, delete_program, glow::Program, programs);
 
     /// The probed capabilities.
     pub fn caps(&self) -> &Caps {

@@ -74,7 +74,7 @@ impl OffscreenTarget {
         }
         let gl = &dev.gl;
         unsafe {
-            let color = gl.create_texture().map_err(GlError::Create)?;
+            let color = dev.create_texture()?;
             gl.bind_texture(glow::TEXTURE_2D, Some(color));
             /// `GL_HALF_FLOAT_OES` (ES 2.0's half-float type differs from ES 3.0's).
             const HALF_FLOAT_OES: u32 = 0x8D61;
@@ -103,7 +103,7 @@ impl OffscreenTarget {
             ] {
                 gl.tex_parameter_i32(glow::TEXTURE_2D, p, v as i32);
             }
-            let depth = gl.create_renderbuffer().map_err(GlError::Create)?;
+            let depth = dev.create_renderbuffer()?;
             gl.bind_renderbuffer(glow::RENDERBUFFER, Some(depth));
             let depth_format = if dev.caps().depth24 {
                 glow::DEPTH_COMPONENT24
@@ -116,7 +116,7 @@ impl OffscreenTarget {
                 width as i32,
                 height as i32,
             );
-            let fbo = gl.create_framebuffer().map_err(GlError::Create)?;
+            let fbo = dev.create_framebuffer()?;
             gl.bind_framebuffer(glow::FRAMEBUFFER, Some(fbo));
             gl.framebuffer_texture_2d(
                 glow::FRAMEBUFFER,
@@ -218,11 +218,9 @@ impl OffscreenTarget {
     /// Frees the framebuffer and its attachments.
     pub fn destroy(&mut self, dev: &Device) {
         if !self.destroyed {
-            unsafe {
-                dev.gl.delete_framebuffer(self.fbo);
-                dev.gl.delete_texture(self.color);
-                dev.gl.delete_renderbuffer(self.depth);
-            }
+            dev.delete_framebuffer(self.fbo);
+            dev.delete_texture(self.color);
+            dev.delete_renderbuffer(self.depth);
             self.destroyed = true;
         }
     }

@@ -86,14 +86,14 @@ impl GpuMesh {
         };
         for chunk in split_u16(mesh) {
             unsafe {
-                let vbo = gl.create_buffer().map_err(GlError::Create)?;
+                let vbo = dev.create_buffer()?;
                 gl.bind_buffer(glow::ARRAY_BUFFER, Some(vbo));
                 gl.buffer_data_u8_slice(
                     glow::ARRAY_BUFFER,
                     bytemuck::cast_slice(&chunk.vertices),
                     glow::STATIC_DRAW,
                 );
-                let ibo = gl.create_buffer().map_err(GlError::Create)?;
+                let ibo = dev.create_buffer()?;
                 gl.bind_buffer(glow::ELEMENT_ARRAY_BUFFER, Some(ibo));
                 gl.buffer_data_u8_slice(
                     glow::ELEMENT_ARRAY_BUFFER,
@@ -138,10 +138,8 @@ impl GpuMesh {
     pub fn destroy(&mut self, dev: &Device) {
         if !self.destroyed {
             for c in self.chunks.drain(..) {
-                unsafe {
-                    dev.gl.delete_buffer(c.vbo);
-                    dev.gl.delete_buffer(c.ibo);
-                }
+                dev.delete_buffer(c.vbo);
+                dev.delete_buffer(c.ibo);
             }
             self.destroyed = true;
         }

@@ -17,7 +17,7 @@ pub fn mediump_is_fp16(dev: &Device) -> Result<bool, GlError> {
     // One clip-space triangle covering the pixel.
     let vertices: [f32; 9] = [-1.0, -1.0, 0.0, 3.0, -1.0, 0.0, -1.0, 3.0, 0.0];
     let result = unsafe {
-        let buffer = gl.create_buffer().map_err(GlError::Create)?;
+        let buffer = dev.create_buffer()?;
         gl.bind_buffer(glow::ARRAY_BUFFER, Some(buffer));
         gl.buffer_data_u8_slice(
             glow::ARRAY_BUFFER,
@@ -38,7 +38,7 @@ pub fn mediump_is_fp16(dev: &Device) -> Result<bool, GlError> {
         }
         gl.draw_arrays(glow::TRIANGLES, 0, 3);
         let pixel = target.read_rgba8(dev);
-        gl.delete_buffer(buffer);
+        dev.delete_buffer(buffer);
         pixel
     };
     program.destroy(dev);

@@ -78,7 +78,7 @@ impl Program {
             }
         };
         unsafe {
-            let raw = gl.create_program().map_err(GlError::Create)?;
+            let raw = dev.create_program()?;
             gl.attach_shader(raw, vs);
             gl.attach_shader(raw, fs);
             for (loc, name) in ATTRIBUTES {
@@ -91,7 +91,7 @@ impl Program {
             gl.delete_shader(fs);
             if !gl.get_program_link_status(raw) {
                 let log = gl.get_program_info_log(raw);
-                gl.delete_program(raw);
+                dev.delete_program(raw);
                 return Err(GlError::ProgramLink {
                     shader: shader.to_string(),
                     defines: format_defines(defines),
@@ -172,7 +172,7 @@ impl Program {
     /// Frees the program.
     pub fn destroy(&mut self, dev: &Device) {
         if !self.destroyed {
-            unsafe { dev.gl.delete_program(self.raw) };
+            dev.delete_program(self.raw);
             self.destroyed = true;
         }
     }
@@ -204,6 +204,19 @@ pub struct ProgramCache {
     programs: HashMap<ProgramKey, Program>,
 }
 
+/// One built variant, for reports.
+#[derive(Clone, Debug, PartialEq, Eq, serde::Serialize)]
+pub struct ProgramInfo {
+    /// Shader name.
+    pub shader: &'static str,
+    /// Feature bits.
+    pub features: u64,
+    /// Dialect.
+    pub dialect: EsVersion,
+    /// Assembled vertex + fragment source size in bytes.
+    pub source_bytes: usize,
+}
+
 impl ProgramCache {
     /// An empty cache.
     pub fn new() -> Self {
@@ -224,6 +237,22 @@ impl ProgramCache {
                 Ok(e.insert(Program::build(dev, key.shader, &defines())?))
             }
         }
+    }
+
+    /// Every cached variant, sorted by shader and features.
+    pub fn report(&self) -> Vec<ProgramInfo> {
+        let mut v: Vec<ProgramInfo> = self
+            .programs
+            .iter()
+            .map(|(k, p)| ProgramInfo {
+                shader: k.shader,
+                features: k.features,
+                dialect: k.dialect,
+                source_bytes: p.source_bytes,
+            })
+            .collect();
+        v.sort_by_key(|p| (p.shader, p.features));
+        v
     }
 
     /// Number of cached programs.

@@ -193,11 +193,17 @@ pub fn strip_feature_blocks(source: &str, defines: &[(String, String)]) -> Resul
     let mut active = true;
     for line in source.lines() {
         let t = line.trim_start();
-        let directive = |d: &str| t.strip_prefix(d).filter(|r| r.is_empty() || r.starts_with(char::is_whitespace));
+        let directive = |d: &str| {
+            t.strip_prefix(d)
+                .filter(|r| r.is_empty() || r.starts_with(char::is_whitespace))
+        };
         if let Some(cond) = directive("#if") {
             match flag(cond) {
                 Some(on) => {
-                    stack.push(Frame::Known { parent: active, taken: on });
+                    stack.push(Frame::Known {
+                        parent: active,
+                        taken: on,
+                    });
                     active = active && on;
                 }
                 None => {
@@ -235,7 +241,10 @@ pub fn strip_feature_blocks(source: &str, defines: &[(String, String)]) -> Resul
             Frame::Known { parent, taken } => {
                 if let Some(cond) = elif {
                     let on = flag(cond).ok_or_else(|| {
-                        GlError::ShaderSource(format!("`{}` mixes a feature flag with another condition", t.trim()))
+                        GlError::ShaderSource(format!(
+                            "`{}` mixes a feature flag with another condition",
+                            t.trim()
+                        ))
                     })?;
                     active = *parent && !*taken && on;
                     *taken |= on;
@@ -325,13 +334,24 @@ mod tests {
     #[test]
     fn feature_blocks_are_stripped_and_others_kept() {
         let src = "a\n#if HAS_X\nx\n#if GLSL_ES == 100\nx100\n#else\nx300\n#endif\n#else\nnox\n#endif\n#if !HAS_X\nnotx\n#endif\n#if HAS_Y\ny\n#elif HAS_X\nyx\n#else\nnone\n#endif\nb\n";
-        let d = |x: &str, y: &str| vec![("HAS_X".to_string(), x.to_string()), ("HAS_Y".to_string(), y.to_string())];
+        let d = |x: &str, y: &str| {
+            vec![
+                ("HAS_X".to_string(), x.to_string()),
+                ("HAS_Y".to_string(), y.to_string()),
+            ]
+        };
         assert_eq!(
             strip_feature_blocks(src, &d("1", "0")).unwrap(),
             "a\nx\n#if GLSL_ES == 100\nx100\n#else\nx300\n#endif\nyx\nb\n"
         );
-        assert_eq!(strip_feature_blocks(src, &d("0", "0")).unwrap(), "a\nnox\nnotx\nnone\nb\n");
-        assert_eq!(strip_feature_blocks(src, &d("0", "1")).unwrap(), "a\nnox\nnotx\ny\nb\n");
+        assert_eq!(
+            strip_feature_blocks(src, &d("0", "0")).unwrap(),
+            "a\nnox\nnotx\nnone\nb\n"
+        );
+        assert_eq!(
+            strip_feature_blocks(src, &d("0", "1")).unwrap(),
+            "a\nnox\nnotx\ny\nb\n"
+        );
         assert!(strip_feature_blocks("#endif\n", &[]).is_err());
         assert!(strip_feature_blocks("#if HAS_X\n", &d("1", "1")).is_err());
     }

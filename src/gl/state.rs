@@ -117,7 +117,12 @@ impl RenderState {
                 Blend::Alpha => {
                     gl.enable(glow::BLEND);
                     // The framebuffer's alpha stays opaque: images are read back as they show.
-                    gl.blend_func_separate(glow::SRC_ALPHA, glow::ONE_MINUS_SRC_ALPHA, glow::ZERO, glow::ONE);
+                    gl.blend_func_separate(
+                        glow::SRC_ALPHA,
+                        glow::ONE_MINUS_SRC_ALPHA,
+                        glow::ZERO,
+                        glow::ONE,
+                    );
                 }
             }
             match self.cull {

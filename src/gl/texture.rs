@@ -75,7 +75,7 @@ impl DataTexture {
         if matches!(format, DataFormat::Rg32Ui | DataFormat::R16Ui) && dev.es() != EsVersion::Es3 {
             return Err(GlError::Unsupported("integer textures need ES 3.0".into()));
         }
-        let raw = unsafe { dev.gl.create_texture() }.map_err(GlError::Create)?;
+        let raw = dev.create_texture()?;
         unsafe { dev.gl.bind_texture(glow::TEXTURE_2D, Some(raw)) };
         set_sampling(&dev.gl, glow::NEAREST, glow::CLAMP_TO_EDGE, glow::NEAREST);
         Ok(DataTexture {
@@ -166,7 +166,7 @@ impl DataTexture {
     /// Frees the texture.
     pub fn destroy(&mut self, dev: &Device) {
         if !self.destroyed {
-            unsafe { dev.gl.delete_texture(self.raw) };
+            dev.delete_texture(self.raw);
             self.destroyed = true;
         }
     }
@@ -205,7 +205,7 @@ impl ImageTexture {
             image
         };
         let gl = &dev.gl;
-        let raw = unsafe { gl.create_texture() }.map_err(GlError::Create)?;
+        let raw = dev.create_texture()?;
         unsafe {
             gl.bind_texture(glow::TEXTURE_2D, Some(raw));
             gl.pixel_store_i32(glow::UNPACK_ALIGNMENT, 1);
@@ -241,7 +241,7 @@ impl ImageTexture {
     /// Frees the texture.
     pub fn destroy(&mut self, dev: &Device) {
         if !self.destroyed {
-            unsafe { dev.gl.delete_texture(self.raw) };
+            dev.delete_texture(self.raw);
             self.destroyed = true;
         }
     }

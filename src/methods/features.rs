@@ -25,6 +25,26 @@ impl ShaderFeatures {
     /// No lights at all: the light loop and its data are compiled out.
     pub const NO_LIGHTS: u64 = 1 << 6;
 
+    /// Every flag with its name.
+    pub const NAMED: [(u64, &'static str); 7] = [
+        (Self::TEXTURE, "texture"),
+        (Self::SPOT, "spot"),
+        (Self::SPECULAR, "specular"),
+        (Self::LIGHTS_RGBA8, "lights_rgba8"),
+        (Self::OUTPUT_LINEAR, "output_linear"),
+        (Self::OUTPUT_HDR, "output_hdr"),
+        (Self::NO_LIGHTS, "no_lights"),
+    ];
+
+    /// Names of the set flags.
+    pub fn names(self) -> Vec<&'static str> {
+        Self::NAMED
+            .iter()
+            .filter(|(b, _)| self.has(*b))
+            .map(|(_, n)| *n)
+            .collect()
+    }
+
     /// True when `bit` is set.
     pub fn has(self, bit: u64) -> bool {
         self.0 & bit != 0

@@ -56,7 +56,12 @@ fn depth_prepass(ctx: &mut FrameContext, opaque: &[usize]) -> Result<(), Error> 
     program.bind(dev);
     for &i in opaque {
         let object = &ctx.scene.objects[i];
-        set_transforms(program, dev, &(ctx.view * object.transform), &ctx.projection);
+        set_transforms(
+            program,
+            dev,
+            &(ctx.view * object.transform),
+            &ctx.projection,
+        );
         ctx.gpu_scene.mesh(object).draw(dev);
     }
     Ok(())
@@ -81,7 +86,10 @@ pub fn draw_objects(
         shade_object(ctx, i, shader, max_lights, bind_method)?;
     }
     for &i in &transparent {
-        for state in [RenderState::TRANSPARENT_BACK_FACES, RenderState::TRANSPARENT_FRONT_FACES] {
+        for state in [
+            RenderState::TRANSPARENT_BACK_FACES,
+            RenderState::TRANSPARENT_FRONT_FACES,
+        ] {
             state.apply(ctx.dev);
             shade_object(ctx, i, shader, max_lights, bind_method)?;
         }
@@ -102,11 +110,15 @@ fn shade_object(
     let dialect = dev.es();
     let object = &ctx.scene.objects[index];
     let material = &ctx.scene.materials[object.material];
-    let texture = ctx.gpu_scene.texture_for(material);
+    let full = ctx.options.full_variants;
+    let texture = ctx
+        .gpu_scene
+        .texture_for(material)
+        .or_else(|| full.then(|| ctx.gpu_scene.white()).flatten());
     let features = ctx
         .features
         .with(ShaderFeatures::TEXTURE, texture.is_some())
-        .with(ShaderFeatures::SPECULAR, material.has_specular());
+        .with(ShaderFeatures::SPECULAR, material.has_specular() || full);
     let key = ProgramKey {
         shader,
         features: features.0,
@@ -117,13 +129,22 @@ fn shade_object(
         .get_or_build(dev, key, || features.defines(dialect, max_lights))?;
     program.bind(dev);
     // The camera is subtracted in f64 here, so far-from-origin scenes stay exact in f32.
-    set_transforms(program, dev, &(ctx.view * object.transform), &ctx.projection);
+    set_transforms(
+        program,
+        dev,
+        &(ctx.view * object.transform),
+        &ctx.projection,
+    );
     program.set_vec3(dev, "u_albedo", material.diffuse);
     program.set_vec3(dev, "u_specular", material.specular);
     program.set_f32(dev, "u_shininess", material.shading_exponent());
     program.set_f32(dev, "u_alpha", material.alpha);
     program.set_vec3(dev, "u_ambient", ctx.scene.ambient);
-    program.set_f32(dev, "u_orthographic", if ctx.orthographic { 1.0 } else { 0.0 });
+    program.set_f32(
+        dev,
+        "u_orthographic",
+        if ctx.orthographic { 1.0 } else { 0.0 },
+    );
     if let Some(t) = texture {
         t.bind(dev, UNIT_ALBEDO);
         program.set_i32(dev, "u_albedoTex", UNIT_ALBEDO as i32);

@@ -211,9 +211,17 @@ fn bubbles() -> (Scene, Aabb, LightSetStyle) {
     // Deterministic placement along the view down the courtyard, nearest first.
     for i in 0..14 {
         let f = i as f32;
-        let centre = Vec3::new(-13.0 + f * 1.9, 1.6 + (f * 1.3).sin().abs() * 3.5, (f * 2.1).sin() * 4.5);
+        let centre = Vec3::new(
+            -13.0 + f * 1.9,
+            1.6 + (f * 1.3).sin().abs() * 3.5,
+            (f * 2.1).sin() * 4.5,
+        );
         let radius = 0.6 + 0.5 * (f * 0.7).cos().abs();
-        let tint = Vec3::new(0.4 + 0.5 * (f * 0.9).sin().abs(), 0.6, 0.4 + 0.5 * (f * 0.5).cos().abs());
+        let tint = Vec3::new(
+            0.4 + 0.5 * (f * 0.9).sin().abs(),
+            0.6,
+            0.4 + 0.5 * (f * 0.5).cos().abs(),
+        );
         let mut mesh = MeshBuilder::new();
         mesh.sphere(centre, radius, 24, 12);
         let material = Material {

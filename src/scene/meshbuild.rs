@@ -97,8 +97,16 @@ impl MeshBuilder {
             let theta = ring as f32 / rings as f32 * PI;
             for seg in 0..=segments {
                 let phi = seg as f32 / segments as f32 * 2.0 * PI;
-                let n = Vec3::new(theta.sin() * phi.cos(), theta.cos(), -theta.sin() * phi.sin());
-                self.vertex(centre + n * radius, n, Vec2::new(seg as f32 / segments as f32, ring as f32 / rings as f32));
+                let n = Vec3::new(
+                    theta.sin() * phi.cos(),
+                    theta.cos(),
+                    -theta.sin() * phi.sin(),
+                );
+                self.vertex(
+                    centre + n * radius,
+                    n,
+                    Vec2::new(seg as f32 / segments as f32, ring as f32 / rings as f32),
+                );
             }
         }
         let row = segments + 1;

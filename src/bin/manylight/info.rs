@@ -2,7 +2,7 @@
 
 use clap::Parser;
 use manylight::gl::{Caps, HeadlessContext};
-use manylight::methods::{Support, METHODS};
+use manylight::methods::{ShaderFeatures, Support, METHODS};
 use manylight::Renderer;
 
 use crate::EsArg;
@@ -16,17 +16,62 @@ pub struct InfoArgs {
     /// Print JSON instead of text.
     #[arg(long)]
     pub json: bool,
+    /// Also render this scene (built-in, .obj or .json) once with every supported method and
+    /// report the shader variants built (features, source size) and each method's GPU memory.
+    #[arg(long)]
+    pub scene: Option<String>,
+}
+
+/// Renders `spec` with every supported method at a small size; returns per-method GPU bytes,
+/// the scene's features and every variant built.
+fn scene_report(
+    renderer: &mut Renderer,
+    spec: &str,
+) -> Result<serde_json::Value, Box<dyn std::error::Error>> {
+    let (scene, _) = manylight::scene::load(spec, Some((256, 1)))?;
+    let mut methods = Vec::new();
+    let mut features = None;
+    for m in METHODS {
+        if matches!((m.supported)(renderer.caps()), Support::Unsupported(_)) {
+            continue;
+        }
+        renderer.set_method(m.name)?;
+        let (_, stats) =
+            renderer.render_offscreen(&scene, 64, 36, &manylight::RenderOptions::default())?;
+        features = Some(stats.scene_features);
+        methods.push(serde_json::json!({"method": m.name, "gpu_bytes": stats.method_gpu_bytes}));
+    }
+    let variants: Vec<_> = renderer
+        .program_report()
+        .into_iter()
+        .map(|p| {
+            serde_json::json!({
+                "shader": p.shader,
+                "features": ShaderFeatures(p.features).names(),
+                "source_bytes": p.source_bytes,
+            })
+        })
+        .collect();
+    Ok(
+        serde_json::json!({"scene": spec, "features": features, "methods": methods, "variants": variants}),
+    )
 }
 
 /// Runs the command.
 pub fn run(args: &InfoArgs) -> Result<(), Box<dyn std::error::Error>> {
     let es = args.es.into();
     let ctx = HeadlessContext::new(es)?;
-    let renderer = Renderer::new(ctx.load_gl(), es)?;
+    let mut renderer = Renderer::new(ctx.load_gl(), es)?;
+    let report = args
+        .scene
+        .as_deref()
+        .map(|s| scene_report(&mut renderer, s))
+        .transpose();
     let caps = renderer.caps().clone();
     let fp16 = renderer.mediump_is_fp16();
     renderer.destroy();
     let fp16 = fp16?;
+    let report = report?;
     let methods: Vec<_> = METHODS
         .iter()
         .map(|m| (m.name, (m.supported)(&caps)))
@@ -36,12 +81,23 @@ pub fn run(args: &InfoArgs) -> Result<(), Box<dyn std::error::Error>> {
             "egl": ctx.info(),
             "caps": caps,
             "mediump_is_fp16": fp16,
+            "scene": report,
             "methods": methods.iter().map(|(name, s)| serde_json::json!({"name": name, "support": s})).collect::<Vec<_>>(),
         });
         print_stdout(&(serde_json::to_string_pretty(&value)? + "\n"));
     } else {
         let mut text = format_text(&caps, ctx.info(), &methods);
-        text.push_str(&format!("mediump runs as      {}\n", if fp16 { "fp16 (measured)" } else { "fp32 (measured)" }));
+        text.push_str(&format!(
+            "mediump runs as      {}\n",
+            if fp16 {
+                "fp16 (measured)"
+            } else {
+                "fp32 (measured)"
+            }
+        ));
+        if let Some(r) = &report {
+            text.push_str(&format_scene_report(r));
+        }
         print_stdout(&text);
     }
     Ok(())
@@ -132,6 +188,35 @@ fn format_text(
             Support::Fallback(r) => w!(out, "  {name:<10} fallback: {r}"),
             Support::Unsupported(r) => w!(out, "  {name:<10} unsupported: {r}"),
         }
+    }
+    out
+}
+
+fn format_scene_report(r: &serde_json::Value) -> String {
+    let mut out = String::new();
+    w!(
+        out,
+        "scene {}: features {}",
+        r["scene"].as_str().unwrap_or("?"),
+        r["features"]
+    );
+    for m in r["methods"].as_array().into_iter().flatten() {
+        w!(
+            out,
+            "  {:<10} holds {} bytes of GPU memory",
+            m["method"].as_str().unwrap_or("?"),
+            m["gpu_bytes"]
+        );
+    }
+    w!(out, "shader variants built");
+    for v in r["variants"].as_array().into_iter().flatten() {
+        w!(
+            out,
+            "  {:<10} {:>6} bytes  {}",
+            v["shader"].as_str().unwrap_or("?"),
+            v["source_bytes"],
+            v["features"]
+        );
     }
     out
 }

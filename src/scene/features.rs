@@ -1,0 +1,55 @@
+//! What a scene actually uses, so shaders and resources can leave out the rest.
+
+use serde::Serialize;
+
+use super::{LightKind, Scene};
+
+/// Features present in a scene. Shader variants are compiled with only these (see
+/// `methods::ShaderFeatures`), and a scene without lights does no light work at all.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+pub struct SceneFeatures {
+    /// At least one active point light.
+    pub point_lights: bool,
+    /// At least one active spot light (cone code compiled in).
+    pub spot_lights: bool,
+    /// At least one material with a diffuse texture.
+    pub textures: bool,
+    /// At least one material with a specular term.
+    pub specular: bool,
+    /// At least one transparent material (alpha below 1).
+    pub transparency: bool,
+    /// Any active light at all.
+    pub lights: bool,
+}
+
+impl SceneFeatures {
+    /// The features of `scene` (only lights that can contribute count).
+    pub fn of(scene: &Scene) -> SceneFeatures {
+        let active = || scene.lights.iter().filter(|l| l.is_active());
+        SceneFeatures {
+            point_lights: active().any(|l| matches!(l.kind, LightKind::Point)),
+            spot_lights: active().any(|l| matches!(l.kind, LightKind::Spot { .. })),
+            textures: scene.materials.iter().any(|m| m.diffuse_texture.is_some()),
+            specular: scene.materials.iter().any(|m| m.has_specular()),
+            transparency: scene.materials.iter().any(|m| m.is_transparent()),
+            lights: active().next().is_some(),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::builtin;
+
+    #[test]
+    fn features_follow_the_scene() {
+        let plane = builtin::build("plane", None).unwrap();
+        let f = SceneFeatures::of(&plane);
+        assert!(!f.lights && !f.spot_lights && !f.textures && !f.transparency && f.specular);
+        let court = builtin::build("courtyard", Some((8, 1))).unwrap();
+        let f = SceneFeatures::of(&court);
+        assert!(f.lights && f.point_lights && f.spot_lights && !f.transparency);
+        assert!(SceneFeatures::of(&builtin::build("bubbles", None).unwrap()).transparency);
+    }
+}

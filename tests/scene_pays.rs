@@ -1,0 +1,223 @@
+//! A scene pays only for what it uses: variants leave out absent features (checked on the
+//! assembled source) without changing the image, methods free their resources when switched
+//! away, zero lights cost nothing, and transparency is lit like everything else.
+
+mod common;
+
+use common::Gpu;
+use glam::{DVec3, Vec3};
+use manylight::gl::shader_source::{assemble, Stage};
+use manylight::methods::ShaderFeatures;
+use manylight::scene::{self, Light};
+use manylight::{EsVersion, RenderOptions};
+
+#[test]
+fn variants_without_spots_or_textures_contain_no_such_code() {
+    for es in [EsVersion::Es2, EsVersion::Es3] {
+        for shader in ["forward", "clustered"] {
+            for rgba8 in [false, true] {
+                let base = ShaderFeatures::default().with(ShaderFeatures::LIGHTS_RGBA8, rgba8);
+                let lean = assemble(shader, Stage::Fragment, es, &base.defines(es, 1024)).unwrap();
+                let full_features = base
+                    .with(ShaderFeatures::SPOT, true)
+                    .with(ShaderFeatures::TEXTURE, true);
+                let full = assemble(
+                    shader,
+                    Stage::Fragment,
+                    es,
+                    &full_features.defines(es, 1024),
+                )
+                .unwrap();
+                for needle in ["spotScale", "spotOffset", "light.direction"] {
+                    assert!(
+                        !lean.contains(needle),
+                        "{shader} {es}: `{needle}` in a variant without spots"
+                    );
+                    assert!(
+                        full.contains(needle),
+                        "{shader} {es}: `{needle}` missing from the spot variant"
+                    );
+                }
+                for needle in ["u_albedoTex", "srgbToLinear"] {
+                    assert!(
+                        !lean.contains(needle),
+                        "{shader} {es}: `{needle}` in a variant without textures"
+                    );
+                    assert!(
+                        full.contains(needle),
+                        "{shader} {es}: `{needle}` missing from the texture variant"
+                    );
+                }
+                assert!(lean.len() < full.len());
+            }
+        }
+    }
+}
+
+fn point_light_scene() -> scene::Scene {
+    let mut s = scene::builtin::build("pillars", None).unwrap();
+    s.lights = (0..200)
+        .map(|i| {
+            let f = i as f64;
+            Light::point(
+                DVec3::new(
+                    (f * 0.7).sin() * 12.0,
+                    0.5 + (f * 0.3).cos().abs() * 5.0,
+                    (f * 0.11).sin() * 15.0,
+                ),
+                3.0,
+                Vec3::new(1.0, 0.7, 0.4),
+                1.5,
+            )
+        })
+        .collect();
+    s
+}
+
+#[test]
+fn lean_variants_render_exactly_like_the_full_ones() {
+    let s = point_light_scene();
+    for es in [EsVersion::Es2, EsVersion::Es3] {
+        let mut gpu = Gpu::new(es);
+        for method in ["forward", "tiled", "clustered"] {
+            gpu.r().set_method(method).unwrap();
+            let (lean, stats) = gpu
+                .r()
+                .render_offscreen(&s, 128, 72, &RenderOptions::default())
+                .unwrap();
+            assert!(!stats.scene_features.spot_lights && !stats.scene_features.textures);
+            let full_opts = RenderOptions {
+                full_variants: true,
+                ..Default::default()
+            };
+            let (full, _) = gpu.r().render_offscreen(&s, 128, 72, &full_opts).unwrap();
+            let d = manylight::metrics::diff(&lean, &full);
+            assert!(
+                d.max_abs <= 1,
+                "{es} {method}: lean and full variants differ by {} / 255",
+                d.max_abs
+            );
+        }
+        let report = gpu.r().program_report();
+        let with_spot = report
+            .iter()
+            .filter(|p| ShaderFeatures(p.features).has(ShaderFeatures::SPOT))
+            .count();
+        let without = report
+            .iter()
+            .filter(|p| {
+                p.shader != "depth" && !ShaderFeatures(p.features).has(ShaderFeatures::SPOT)
+            })
+            .count();
+        assert!(with_spot > 0 && without > 0, "both variants were built");
+        let size = |spot: bool| {
+            report
+                .iter()
+                .filter(|p| {
+                    p.shader == "clustered"
+                        && ShaderFeatures(p.features).has(ShaderFeatures::SPOT) == spot
+                })
+                .map(|p| p.source_bytes)
+                .min()
+                .unwrap()
+        };
+        assert!(size(false) < size(true), "the lean variant is smaller");
+    }
+}
+
+#[test]
+fn switching_methods_frees_the_previous_methods_resources() {
+    let s = point_light_scene();
+    let mut gpu = Gpu::new(EsVersion::Es3);
+    let opts = RenderOptions::default();
+    gpu.r().set_method("forward").unwrap();
+    gpu.r().render_offscreen(&s, 64, 36, &opts).unwrap();
+    let baseline = gpu.r().live_gl_objects();
+    for method in ["clustered", "tiled"] {
+        gpu.r().set_method(method).unwrap();
+        for _ in 0..4 {
+            gpu.r().render_offscreen(&s, 64, 36, &opts).unwrap();
+        }
+        let during = gpu.r().live_gl_objects();
+        assert!(
+            during.textures > baseline.textures,
+            "{method} allocated no textures?"
+        );
+    }
+    gpu.r().set_method("forward").unwrap();
+    gpu.r().render_offscreen(&s, 64, 36, &opts).unwrap();
+    let after = gpu.r().live_gl_objects();
+    // Programs stay cached; every texture, buffer and framebuffer returns to the baseline.
+    assert_eq!(
+        (
+            after.textures,
+            after.buffers,
+            after.framebuffers,
+            after.renderbuffers
+        ),
+        (
+            baseline.textures,
+            baseline.buffers,
+            baseline.framebuffers,
+            baseline.renderbuffers
+        )
+    );
+}
+
+#[test]
+fn a_method_allocates_nothing_before_it_has_lights_to_draw() {
+    let mut s = point_light_scene();
+    let lights = std::mem::take(&mut s.lights);
+    let mut gpu = Gpu::new(EsVersion::Es2);
+    gpu.r().set_method("clustered").unwrap();
+    let (_, stats) = gpu
+        .r()
+        .render_offscreen(&s, 64, 36, &RenderOptions::default())
+        .unwrap();
+    assert_eq!(
+        (stats.upload_bytes, stats.assign_ms, stats.method_gpu_bytes),
+        (0, 0.0, 0),
+        "zero lights did light work"
+    );
+    s.lights = lights;
+    let (_, stats) = gpu
+        .r()
+        .render_offscreen(&s, 64, 36, &RenderOptions::default())
+        .unwrap();
+    assert!(stats.upload_bytes > 0 && stats.method_gpu_bytes > 0);
+}
+
+#[test]
+fn bubbles_match_forward_with_every_forward_method() {
+    let s = scene::builtin::build("bubbles", Some((256, 4))).unwrap();
+    for es in [EsVersion::Es2, EsVersion::Es3] {
+        let mut gpu = Gpu::new(es);
+        let opts = RenderOptions::default();
+        gpu.r().set_method("forward").unwrap();
+        let (reference, stats) = gpu.r().render_offscreen(&s, 192, 108, &opts).unwrap();
+        assert!(stats.scene_features.transparency);
+        for method in ["tiled", "clustered"] {
+            gpu.r().set_method(method).unwrap();
+            let (img, _) = gpu.r().render_offscreen(&s, 192, 108, &opts).unwrap();
+            let d = manylight::metrics::diff(&reference, &img);
+            assert!(
+                d.max_abs <= 2,
+                "{es} {method}: bubbles differ from forward by {} / 255",
+                d.max_abs
+            );
+        }
+        // The bubbles are really there: the same view without them differs.
+        let mut opaque = s.clone();
+        opaque.objects.retain(|o| !opaque_is_transparent(&s, o));
+        gpu.r().set_method("forward").unwrap();
+        let (without, _) = gpu.r().render_offscreen(&opaque, 192, 108, &opts).unwrap();
+        assert!(
+            manylight::metrics::diff(&reference, &without).over_2 > 0.02,
+            "{es}: bubbles invisible"
+        );
+    }
+}
+
+fn opaque_is_transparent(s: &scene::Scene, o: &scene::Object) -> bool {
+    s.materials[o.material].is_transparent()
+}
