@@ -28,12 +28,12 @@ void main() {
         if (float(n) >= cell.y) {
             break;
         }
-        color += shadeLight(fetchLight(lightIndexAt(cell.x + float(n))), v_viewPos, N, V, albedo);
+        color += shadeLight(fetchLight(lightIndexAt(cell.x + float(n))), v_viewPos, N, V, albedo, u_specular, u_shininess);
     }
 #else
     uvec2 cell = clusterCell(fragXY, viewDepth);
     for (uint n = 0u; n < cell.y; n++) {
-        color += shadeLight(fetchLight(lightIndexAt(cell.x + n)), v_viewPos, N, V, albedo);
+        color += shadeLight(fetchLight(lightIndexAt(cell.x + n)), v_viewPos, N, V, albedo, u_specular, u_shininess);
     }
 #endif
     FRAG_COLOR = encodeOutput(color);

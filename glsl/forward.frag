@@ -25,11 +25,11 @@ void main() {
         if (i >= u_lightCount) {
             break;
         }
-        color += shadeLight(fetchLight(i), v_viewPos, N, V, albedo);
+        color += shadeLight(fetchLight(i), v_viewPos, N, V, albedo, u_specular, u_shininess);
     }
 #else
     for (int i = 0; i < u_lightCount; i++) {
-        color += shadeLight(fetchLight(i), v_viewPos, N, V, albedo);
+        color += shadeLight(fetchLight(i), v_viewPos, N, V, albedo, u_specular, u_shininess);
     }
 #endif
 #endif

@@ -11,16 +11,7 @@ uniform HIGHP float u_lightTexInvHeight;
 uniform HIGHP vec2 u_lightRanges;
 #endif
 
-struct Light {
-    vec3 position;
-    float radius;
-    vec3 radiance;
-#if HAS_SPOT
-    float spotScale;
-    vec3 direction;
-    float spotOffset;
-#endif
-};
+#include "light_struct.glsl"
 
 #if GLSL_ES == 100
 #define LIGHT_TEXEL(base, k) dataTexel(u_lights, float(base) * float(LIGHT_TEXELS) + float(k), u_lightTexInvHeight)

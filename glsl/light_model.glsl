@@ -1,7 +1,7 @@
 // The light model, shared by every method (CPU twin: src/scene/shading.rs).
 // P, N, V in view space; N and V unit; the light's radius is > 0 (inactive lights are never
-// uploaded).
-vec3 shadeLight(Light light, vec3 P, vec3 N, vec3 V, vec3 albedo) {
+// uploaded). Ks and Ns are parameters so deferred shading can pass them from its G-buffer.
+vec3 shadeLight(Light light, vec3 P, vec3 N, vec3 V, vec3 albedo, vec3 Ks, float Ns) {
     vec3 toLight = light.position - P;
     float d2 = dot(toLight, toLight);
     float d = sqrt(d2);
@@ -25,7 +25,7 @@ vec3 shadeLight(Light light, vec3 P, vec3 N, vec3 V, vec3 albedo) {
 #if HAS_SPECULAR
     vec3 halfSum = L + V;
     vec3 H = halfSum / max(length(halfSum), 1e-6);
-    vec3 spec = u_specular * pow(max(dot(N, H), 0.0), u_shininess);
+    vec3 spec = Ks * pow(max(dot(N, H), 0.0), Ns);
 #else
     vec3 spec = vec3(0.0);
 #endif

@@ -121,6 +121,8 @@ pub struct FrameStats {
     pub triangles: usize,
     /// GPU memory held by the method.
     pub method_gpu_bytes: usize,
+    /// G-buffer memory (deferred only; 0 otherwise).
+    pub gbuffer_bytes: usize,
     /// `LP_NUM_THREADS` when set (llvmpipe's thread count changes every timing).
     pub lp_num_threads: Option<String>,
     /// What the scene uses (and so what the shader variants were built with).
@@ -367,6 +369,7 @@ impl Renderer {
             support: self.support.clone(),
             triangles: scene.objects.iter().map(|o| o.mesh.triangle_count()).sum(),
             method_gpu_bytes: self.method.gpu_bytes(),
+            gbuffer_bytes: method_stats.gbuffer_bytes,
             lp_num_threads: std::env::var("LP_NUM_THREADS").ok(),
             scene_features,
         })

@@ -14,6 +14,7 @@ pub mod caps;
 pub mod context;
 pub mod device;
 pub mod framebuffer;
+pub mod gbuffer;
 pub mod mesh;
 pub mod precision_probe;
 pub mod program;

@@ -41,6 +41,11 @@ pub struct ShaderDesc {
     pub vertex: &'static str,
     /// Fragment file in `glsl/`.
     pub fragment: &'static str,
+    /// Needs GLSL ES 3.00 (`texelFetch` on float G-buffers, multiple outputs).
+    pub es3_only: bool,
+    /// Declares its own fragment outputs (multiple render targets), so the prelude's single
+    /// `o_color` is left out.
+    pub mrt: bool,
 }
 
 /// Every program the renderer builds.
@@ -49,21 +54,57 @@ pub const SHADERS: &[ShaderDesc] = &[
         name: "depth",
         vertex: "mesh.vert",
         fragment: "depth.frag",
+        es3_only: false,
+        mrt: false,
     },
     ShaderDesc {
         name: "forward",
         vertex: "mesh.vert",
         fragment: "forward.frag",
+        es3_only: false,
+        mrt: false,
     },
     ShaderDesc {
         name: "clustered",
         vertex: "mesh.vert",
         fragment: "clustered.frag",
+        es3_only: false,
+        mrt: false,
     },
     ShaderDesc {
         name: "precision_probe",
         vertex: "fullscreen.vert",
         fragment: "precision_probe.frag",
+        es3_only: false,
+        mrt: false,
+    },
+    ShaderDesc {
+        name: "gbuffer",
+        vertex: "mesh.vert",
+        fragment: "gbuffer.frag",
+        es3_only: true,
+        mrt: true,
+    },
+    ShaderDesc {
+        name: "deferred_light",
+        vertex: "light_volume.vert",
+        fragment: "deferred_light.frag",
+        es3_only: true,
+        mrt: false,
+    },
+    ShaderDesc {
+        name: "deferred_light_fullscreen",
+        vertex: "fullscreen.vert",
+        fragment: "deferred_light.frag",
+        es3_only: true,
+        mrt: false,
+    },
+    ShaderDesc {
+        name: "deferred_composite",
+        vertex: "fullscreen.vert",
+        fragment: "deferred_composite.frag",
+        es3_only: true,
+        mrt: false,
     },
 ];
 
@@ -81,6 +122,27 @@ pub const FILES: &[(&str, &str)] = &[
         include_str!("../../glsl/light_data.glsl"),
     ),
     ("surface.glsl", include_str!("../../glsl/surface.glsl")),
+    (
+        "light_struct.glsl",
+        include_str!("../../glsl/light_struct.glsl"),
+    ),
+    ("gbuffer.frag", include_str!("../../glsl/gbuffer.frag")),
+    (
+        "deferred_common.glsl",
+        include_str!("../../glsl/deferred_common.glsl"),
+    ),
+    (
+        "deferred_light.frag",
+        include_str!("../../glsl/deferred_light.frag"),
+    ),
+    (
+        "deferred_composite.frag",
+        include_str!("../../glsl/deferred_composite.frag"),
+    ),
+    (
+        "light_volume.vert",
+        include_str!("../../glsl/light_volume.vert"),
+    ),
     (
         "fullscreen.vert",
         include_str!("../../glsl/fullscreen.vert"),
@@ -116,8 +178,12 @@ fn file(name: &str) -> Result<&'static str, GlError> {
         .ok_or_else(|| GlError::ShaderSource(format!("no file `{name}` in glsl/")))
 }
 
-fn prelude(stage: Stage, dialect: EsVersion) -> &'static str {
+fn prelude(stage: Stage, dialect: EsVersion, mrt: bool) -> &'static str {
     match (dialect, stage) {
+        (EsVersion::Es3, Stage::Fragment) if mrt => {
+            "#version 300 es\n#define GLSL_ES 300\nprecision highp float;\nprecision highp int;\n\
+             #define HIGHP highp\n#define VARYING in\n#define TEXTURE2D texture\n"
+        }
         (EsVersion::Es2, Stage::Vertex) => {
             "#version 100\n#define GLSL_ES 100\nprecision highp float;\nprecision highp int;\n\
              #define HIGHP highp\n#define ATTRIBUTE attribute\n#define VARYING varying\n"
@@ -154,7 +220,12 @@ pub fn assemble(
         Stage::Vertex => desc.vertex,
         Stage::Fragment => desc.fragment,
     };
-    let mut out = String::from(prelude(stage, dialect));
+    if desc.es3_only && dialect == EsVersion::Es2 {
+        return Err(GlError::ShaderSource(format!(
+            "shader `{shader_name}` needs GLSL ES 3.00"
+        )));
+    }
+    let mut out = String::from(prelude(stage, dialect, desc.mrt));
     for (name, value) in defines {
         out.push_str(&format!("#define {name} {value}\n"));
     }
@@ -313,6 +384,10 @@ mod tests {
     fn assembles_every_shader_in_both_dialects() {
         for s in SHADERS {
             for d in [EsVersion::Es2, EsVersion::Es3] {
+                if s.es3_only && d == EsVersion::Es2 {
+                    assert!(assemble(s.name, Stage::Vertex, d, &[]).is_err());
+                    continue;
+                }
                 for stage in [Stage::Vertex, Stage::Fragment] {
                     let src = assemble(s.name, stage, d, &[("FOO".into(), "1".into())]).unwrap();
                     let first = src.lines().next().unwrap();

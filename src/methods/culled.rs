@@ -240,6 +240,7 @@ impl CulledForward {
             upload_bytes,
             assign_ms: Some(assign_ms),
             assign: Some(assignment.stats),
+            ..MethodStats::default()
         })
     }
 

@@ -23,7 +23,7 @@ fn set_transforms(program: &mut Program, dev: &Device, model_view: &DMat4, proje
 
 /// Opaque objects in scene order, then transparent ones back to front (by the view depth of
 /// their bounds' centre).
-fn draw_order(ctx: &FrameContext) -> (Vec<usize>, Vec<usize>) {
+pub(crate) fn draw_order(ctx: &FrameContext) -> (Vec<usize>, Vec<usize>) {
     let scene = ctx.scene;
     let (mut opaque, mut transparent) = (Vec::new(), Vec::new());
     for (i, o) in scene.objects.iter().enumerate() {
@@ -99,7 +99,7 @@ pub fn draw_objects(
 }
 
 /// One object with its material's shader variant.
-fn shade_object(
+pub(crate) fn shade_object(
     ctx: &mut FrameContext,
     index: usize,
     shader: &'static str,

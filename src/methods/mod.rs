@@ -6,6 +6,7 @@
 
 pub mod clustered;
 pub mod culled;
+pub mod deferred;
 pub mod features;
 pub mod forward;
 pub mod geometry;
@@ -74,6 +75,8 @@ pub struct MethodStats {
     pub assign_ms: Option<f64>,
     /// Assignment figures (culling methods).
     pub assign: Option<crate::cluster::assign::AssignStats>,
+    /// G-buffer memory (deferred).
+    pub gbuffer_bytes: usize,
 }
 
 /// A shading method: owns its GPU resources, renders a frame into the bound framebuffer.
@@ -105,7 +108,7 @@ pub struct MethodDesc {
 }
 
 /// The method table.
-pub static METHODS: &[MethodDesc] = &[forward::DESC, tiled::DESC, clustered::DESC];
+pub static METHODS: &[MethodDesc] = &[forward::DESC, tiled::DESC, clustered::DESC, deferred::DESC];
 
 /// The default method.
 pub const DEFAULT_METHOD: &str = "clustered";

@@ -1,0 +1,15 @@
+// Deferred, pass 3: ambient plus the accumulated lights, encoded like every other method.
+#include "surface.glsl"
+#include "deferred_common.glsl"
+
+uniform HIGHP sampler2D u_accum;
+
+void main() {
+    ivec2 px = ivec2(gl_FragCoord.xy);
+    if (texelFetch(u_gNormalDepth, px, 0).w <= 0.0) {
+        discard;
+    }
+    vec3 albedo = texelFetch(u_gAlbedo, px, 0).rgb;
+    vec3 color = u_ambient * albedo + texelFetch(u_accum, px, 0).rgb;
+    FRAG_COLOR = encodeOutput(color);
+}

@@ -1,0 +1,34 @@
+// Deferred, pass 2: one light, drawn as a proxy volume (or a full-screen triangle when the eye
+// is inside it), added to the accumulation buffer.
+#include "surface.glsl"
+#include "light_struct.glsl"
+#include "light_model.glsl"
+#include "deferred_common.glsl"
+
+// x y z: view-space position, w: radius.
+uniform HIGHP vec4 u_light0;
+// rgb: radiance, a: spot scale.
+uniform vec4 u_light1;
+// xyz: spot axis, w: spot offset.
+uniform vec4 u_light2;
+
+void main() {
+    ivec2 px = ivec2(gl_FragCoord.xy);
+    HIGHP vec4 nd = texelFetch(u_gNormalDepth, px, 0);
+    if (nd.w <= 0.0) {
+        discard;
+    }
+    HIGHP vec3 P = viewPosition(gl_FragCoord.xy, nd.w);
+    vec4 spec = texelFetch(u_gSpecular, px, 0);
+    Light light;
+    light.position = u_light0.xyz;
+    light.radius = u_light0.w;
+    light.radiance = u_light1.rgb;
+#if HAS_SPOT
+    light.spotScale = u_light1.a;
+    light.direction = u_light2.xyz;
+    light.spotOffset = u_light2.w;
+#endif
+    vec3 albedo = texelFetch(u_gAlbedo, px, 0).rgb;
+    FRAG_COLOR = vec4(shadeLight(light, P, nd.xyz, viewDirection(P), albedo, spec.rgb, spec.a), 1.0);
+}

@@ -1,0 +1,249 @@
+//! The G-buffer and light accumulation buffer of traditional deferred shading (ES 3.0).
+//!
+//! ```text
+//! attachment        format     bytes  contents
+//! colour 0 albedo   RGBA16F      8    linear albedo (Kd × decoded texture)
+//! colour 1 normal   RGBA32F     16    view-space normal (two-sided, facing the eye), view depth
+//! colour 2 specular RGBA16F      8    Ks, Blinn-Phong exponent
+//! depth             DEPTH24      4    for the geometry pass's depth test
+//! accumulation      RGBA16F      8    Σ light radiance (additive blending)
+//!                              ----
+//!                               44 bytes per pixel (1280×720: 40.6 MB)
+//! ```
+//!
+//! Float formats everywhere so the G-buffer loses almost nothing against forward: the normal
+//! and depth are exact f32, albedo and specular keep 11 significant bits. Rendering to float
+//! textures needs `GL_EXT_color_buffer_float`.
+#![allow(unsafe_code)]
+
+use glow::HasContext;
+
+use super::{Device, EsVersion, GlError};
+
+/// Bytes of GPU memory per pixel (see the module docs).
+pub const BYTES_PER_PIXEL: usize = 44;
+
+/// Why deferred cannot run on this context, if it cannot.
+pub fn unsupported_reason(dev_caps: &super::Caps) -> Option<String> {
+    if dev_caps.es != EsVersion::Es3 {
+        return Some(if dev_caps.has_extension("GL_EXT_draw_buffers") {
+            "needs OpenGL ES 3.0 (GL_EXT_draw_buffers exists, but float G-buffers and texelFetch do not on ES 2.0)".into()
+        } else {
+            "needs OpenGL ES 3.0 multiple render targets (ES 2.0 has one colour attachment)".into()
+        });
+    }
+    if !dev_caps.has_extension("GL_EXT_color_buffer_float") {
+        return Some("needs GL_EXT_color_buffer_float to render the float G-buffer".into());
+    }
+    if dev_caps.max_draw_buffers < 3 || dev_caps.max_color_attachments < 3 {
+        return Some(format!(
+            "needs 3 draw buffers, the context has {}",
+            dev_caps.max_draw_buffers
+        ));
+    }
+    None
+}
+
+/// G-buffer plus accumulation buffer of one size.
+pub struct GBuffer {
+    geometry_fbo: glow::Framebuffer,
+    accum_fbo: glow::Framebuffer,
+    /// albedo, normal+depth, specular, accumulation
+    color: [glow::Texture; 4],
+    depth: glow::Texture,
+    size: (u32, u32),
+    destroyed: bool,
+}
+
+fn texture(dev: &Device, w: u32, h: u32, internal: u32) -> Result<glow::Texture, GlError> {
+    let t = dev.create_texture()?;
+    let gl = &dev.gl;
+    unsafe {
+        gl.bind_texture(glow::TEXTURE_2D, Some(t));
+        gl.tex_storage_2d(glow::TEXTURE_2D, 1, internal, w as i32, h as i32);
+        for (p, v) in [
+            (glow::TEXTURE_MIN_FILTER, glow::NEAREST),
+            (glow::TEXTURE_MAG_FILTER, glow::NEAREST),
+            (glow::TEXTURE_WRAP_S, glow::CLAMP_TO_EDGE),
+            (glow::TEXTURE_WRAP_T, glow::CLAMP_TO_EDGE),
+        ] {
+            gl.tex_parameter_i32(glow::TEXTURE_2D, p, v as i32);
+        }
+    }
+    Ok(t)
+}
+
+impl GBuffer {
+    /// Allocates the buffers for a `width × height` viewport.
+    pub fn new(dev: &Device, width: u32, height: u32) -> Result<GBuffer, GlError> {
+        if let Some(reason) = unsupported_reason(dev.caps()) {
+            return Err(GlError::Unsupported(reason));
+        }
+        let (w, h) = (width, height);
+        let albedo = texture(dev, w, h, glow::RGBA16F)?;
+        let normal = texture(dev, w, h, glow::RGBA32F)?;
+        let specular = texture(dev, w, h, glow::RGBA16F)?;
+        let accum = texture(dev, w, h, glow::RGBA16F)?;
+        let depth = texture(dev, w, h, glow::DEPTH_COMPONENT24)?;
+        let geometry_fbo = dev.create_framebuffer()?;
+        let accum_fbo = dev.create_framebuffer()?;
+        let gb = GBuffer {
+            geometry_fbo,
+            accum_fbo,
+            color: [albedo, normal, specular, accum],
+            depth,
+            size: (w, h),
+            destroyed: false,
+        };
+        let gl = &dev.gl;
+        unsafe {
+            gl.bind_framebuffer(glow::FRAMEBUFFER, Some(geometry_fbo));
+            for (i, t) in gb.color[..3].iter().enumerate() {
+                gl.framebuffer_texture_2d(
+                    glow::FRAMEBUFFER,
+                    glow::COLOR_ATTACHMENT0 + i as u32,
+                    glow::TEXTURE_2D,
+                    Some(*t),
+                    0,
+                );
+            }
+            gl.framebuffer_texture_2d(
+                glow::FRAMEBUFFER,
+                glow::DEPTH_ATTACHMENT,
+                glow::TEXTURE_2D,
+                Some(depth),
+                0,
+            );
+            gl.draw_buffers(&[
+                glow::COLOR_ATTACHMENT0,
+                glow::COLOR_ATTACHMENT1,
+                glow::COLOR_ATTACHMENT2,
+            ]);
+            let status = gl.check_framebuffer_status(glow::FRAMEBUFFER);
+            gl.bind_framebuffer(glow::FRAMEBUFFER, Some(accum_fbo));
+            gl.framebuffer_texture_2d(
+                glow::FRAMEBUFFER,
+                glow::COLOR_ATTACHMENT0,
+                glow::TEXTURE_2D,
+                Some(accum),
+                0,
+            );
+            let accum_status = gl.check_framebuffer_status(glow::FRAMEBUFFER);
+            for s in [status, accum_status] {
+                if s != glow::FRAMEBUFFER_COMPLETE {
+                    let mut gb = gb;
+                    gb.destroy(dev);
+                    return Err(GlError::FramebufferIncomplete(s));
+                }
+            }
+        }
+        dev.check("G-buffer creation")?;
+        Ok(gb)
+    }
+
+    /// Size in pixels.
+    pub fn size(&self) -> (u32, u32) {
+        self.size
+    }
+
+    /// GPU bytes held.
+    pub fn gpu_bytes(&self) -> usize {
+        self.size.0 as usize * self.size.1 as usize * BYTES_PER_PIXEL
+    }
+
+    /// Binds the G-buffer for the geometry pass and clears it (depth 0 in the normal buffer's
+    /// `w` marks uncovered pixels).
+    pub fn begin_geometry(&self, dev: &Device) {
+        let gl = &dev.gl;
+        unsafe {
+            gl.bind_framebuffer(glow::FRAMEBUFFER, Some(self.geometry_fbo));
+        }
+        dev.viewport(0, 0, self.size.0 as i32, self.size.1 as i32);
+        dev.clear([0.0; 4]);
+    }
+
+    /// Binds the accumulation buffer, cleared to black.
+    pub fn begin_accumulation(&self, dev: &Device) {
+        unsafe {
+            dev.gl
+                .bind_framebuffer(glow::FRAMEBUFFER, Some(self.accum_fbo));
+        }
+        dev.viewport(0, 0, self.size.0 as i32, self.size.1 as i32);
+        dev.clear([0.0; 4]);
+    }
+
+    /// Binds albedo, normal+depth, specular and accumulation to units `first..first + 4`.
+    pub fn bind_textures(&self, dev: &Device, first: u32) {
+        for (i, t) in self.color.iter().enumerate() {
+            unsafe {
+                dev.gl.active_texture(glow::TEXTURE0 + first + i as u32);
+                dev.gl.bind_texture(glow::TEXTURE_2D, Some(*t));
+            }
+        }
+    }
+
+    /// Frees everything.
+    pub fn destroy(&mut self, dev: &Device) {
+        if !self.destroyed {
+            dev.delete_framebuffer(self.geometry_fbo);
+            dev.delete_framebuffer(self.accum_fbo);
+            for t in self.color {
+                dev.delete_texture(t);
+            }
+            dev.delete_texture(self.depth);
+            self.destroyed = true;
+        }
+    }
+}
+
+impl Drop for GBuffer {
+    fn drop(&mut self) {
+        if !self.destroyed {
+            log::warn!("GBuffer dropped without destroy(): GL objects leaked");
+        }
+    }
+}
+
+impl GBuffer {
+    /// Copies the geometry pass's depth into `target` (same size; DEPTH24 on both sides), so
+    /// forward-rendered transparent objects are hidden behind opaque ones.
+    pub fn blit_depth_to(
+        &self,
+        dev: &Device,
+        target: Option<glow::Framebuffer>,
+    ) -> Result<(), GlError> {
+        let (w, h) = (self.size.0 as i32, self.size.1 as i32);
+        unsafe {
+            dev.gl
+                .bind_framebuffer(glow::READ_FRAMEBUFFER, Some(self.geometry_fbo));
+            dev.gl.bind_framebuffer(glow::DRAW_FRAMEBUFFER, target);
+            dev.gl.blit_framebuffer(
+                0,
+                0,
+                w,
+                h,
+                0,
+                0,
+                w,
+                h,
+                glow::DEPTH_BUFFER_BIT,
+                glow::NEAREST,
+            );
+            dev.gl.bind_framebuffer(glow::FRAMEBUFFER, target);
+        }
+        dev.check("G-buffer depth blit")
+    }
+}
+
+/// The framebuffer bound for drawing now (to restore after offscreen passes).
+pub fn current_draw_framebuffer(dev: &Device) -> Option<glow::Framebuffer> {
+    unsafe {
+        dev.gl
+            .get_parameter_framebuffer(glow::DRAW_FRAMEBUFFER_BINDING)
+    }
+}
+
+/// Binds a framebuffer previously returned by [`current_draw_framebuffer`].
+pub fn bind_framebuffer(dev: &Device, fbo: Option<glow::Framebuffer>) {
+    unsafe { dev.gl.bind_framebuffer(glow::FRAMEBUFFER, fbo) }
+}
