@@ -123,6 +123,10 @@ pub struct FrameStats {
     pub method_gpu_bytes: usize,
     /// G-buffer memory (deferred only; 0 otherwise).
     pub gbuffer_bytes: usize,
+    /// The method `auto` picked for this frame (`None` for the other methods).
+    pub auto_choice: Option<String>,
+    /// Why `auto` picked it.
+    pub auto_reason: Option<String>,
     /// `LP_NUM_THREADS` when set (llvmpipe's thread count changes every timing).
     pub lp_num_threads: Option<String>,
     /// What the scene uses (and so what the shader variants were built with).
@@ -370,6 +374,8 @@ impl Renderer {
             triangles: scene.objects.iter().map(|o| o.mesh.triangle_count()).sum(),
             method_gpu_bytes: self.method.gpu_bytes(),
             gbuffer_bytes: method_stats.gbuffer_bytes,
+            auto_choice: method_stats.auto_choice.as_ref().map(|(c, _)| c.to_string()),
+            auto_reason: method_stats.auto_choice.map(|(_, r)| r),
             lp_num_threads: std::env::var("LP_NUM_THREADS").ok(),
             scene_features,
         })

@@ -4,6 +4,7 @@
 //! version, required extensions and a `supported(&Caps)` check. The CLI, the tests and the
 //! capability matrix all iterate this one table.
 
+pub mod auto;
 pub mod clustered;
 pub mod culled;
 pub mod deferred;
@@ -77,6 +78,8 @@ pub struct MethodStats {
     pub assign: Option<crate::cluster::assign::AssignStats>,
     /// G-buffer memory (deferred).
     pub gbuffer_bytes: usize,
+    /// What `auto` picked, and why.
+    pub auto_choice: Option<(&'static str, String)>,
 }
 
 /// A shading method: owns its GPU resources, renders a frame into the bound framebuffer.
@@ -108,7 +111,13 @@ pub struct MethodDesc {
 }
 
 /// The method table.
-pub static METHODS: &[MethodDesc] = &[forward::DESC, tiled::DESC, clustered::DESC, deferred::DESC];
+pub static METHODS: &[MethodDesc] = &[
+    forward::DESC,
+    tiled::DESC,
+    clustered::DESC,
+    deferred::DESC,
+    auto::DESC,
+];
 
 /// The default method.
 pub const DEFAULT_METHOD: &str = "clustered";

@@ -1,0 +1,84 @@
+//! `auto`: picks a method per frame from the context and the scene, and says which and why in
+//! the frame's stats. Few lights → plain forward (one short loop beats assigning and uploading
+//! a grid); many → clustered; clustered unsupported → forward. The method not in use holds no
+//! GPU resources.
+
+use super::clustered::culled_support;
+use super::culled::{CulledForward, Culling};
+use super::forward::Forward;
+use super::{FrameContext, MethodDesc, MethodStats, ShadingMethod, Support};
+use crate::gl::{Device, EsVersion};
+use crate::Error;
+
+/// The table row.
+pub const DESC: MethodDesc = MethodDesc {
+    name: "auto",
+    summary: "forward for few lights, clustered for many (the choice is in the stats)",
+    min_es: EsVersion::Es2,
+    required_extensions: &[],
+    supported: |_| Support::Supported,
+    create: |_| Ok(Box::new(Auto::default())),
+};
+
+/// Up to this many visible lights, plain forward is chosen.
+pub const FORWARD_UP_TO: usize = 32;
+
+/// The adaptive method.
+#[derive(Default)]
+pub struct Auto {
+    forward: Forward,
+    clustered: Option<CulledForward>,
+}
+
+impl Auto {
+    fn choose(&self, ctx: &FrameContext) -> (&'static str, String) {
+        let n = ctx.lights.len();
+        if n <= FORWARD_UP_TO {
+            return ("forward", format!("{n} lights ≤ {FORWARD_UP_TO}: one short loop costs less than assigning and uploading a grid"));
+        }
+        match culled_support(ctx.dev.caps()) {
+            Support::Unsupported(reason) => (
+                "forward",
+                format!("{n} lights, but clustered is unsupported here: {reason}"),
+            ),
+            _ => (
+                "clustered",
+                format!("{n} lights > {FORWARD_UP_TO}: per-cell lists keep the loop short"),
+            ),
+        }
+    }
+}
+
+impl ShadingMethod for Auto {
+    fn name(&self) -> &'static str {
+        DESC.name
+    }
+
+    fn render(&mut self, ctx: &mut FrameContext) -> Result<MethodStats, Error> {
+        let (choice, reason) = self.choose(ctx);
+        let mut stats = if choice == "clustered" {
+            self.forward.destroy(ctx.dev);
+            self.clustered
+                .get_or_insert_with(|| CulledForward::new(Culling::Clustered))
+                .render(ctx)?
+        } else {
+            if let Some(mut c) = self.clustered.take() {
+                c.destroy(ctx.dev);
+            }
+            self.forward.render(ctx)?
+        };
+        stats.auto_choice = Some((choice, reason));
+        Ok(stats)
+    }
+
+    fn gpu_bytes(&self) -> usize {
+        self.forward.gpu_bytes() + self.clustered.as_ref().map_or(0, CulledForward::gpu_bytes)
+    }
+
+    fn destroy(&mut self, dev: &Device) {
+        self.forward.destroy(dev);
+        if let Some(mut c) = self.clustered.take() {
+            c.destroy(dev);
+        }
+    }
+}
