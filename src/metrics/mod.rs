@@ -1,5 +1,7 @@
 //! Image comparison: the numbers every correctness claim is stated in.
 
+pub mod sheet;
+
 use serde::Serialize;
 
 /// Differences between two images of the same size, per channel (RGB; alpha ignored), in

@@ -2,7 +2,10 @@
 
 mod bench_assign;
 mod info;
+mod matrix;
 mod render;
+#[cfg(feature = "window")]
+mod view;
 
 use std::process::ExitCode;
 
@@ -33,6 +36,14 @@ enum Command {
     Info(info::InfoArgs),
     /// Time CPU light assignment alone on the default view.
     BenchAssign(bench_assign::BenchAssignArgs),
+    /// The ES capability matrix: every method under real driver restrictions.
+    Matrix(matrix::MatrixArgs),
+    /// One configuration of the matrix (run by `matrix` in a restricted child process).
+    #[command(hide = true)]
+    MatrixCell(matrix::MatrixCellArgs),
+    /// Open an interactive window (fly camera, method and light-count keys).
+    #[cfg(feature = "window")]
+    View(view::ViewArgs),
 }
 
 /// `--es 2` or `--es 3`.
@@ -65,6 +76,10 @@ fn main() -> ExitCode {
         Some(Command::Render(args)) => render::run(&args),
         Some(Command::Info(args)) => info::run(&args),
         Some(Command::BenchAssign(args)) => bench_assign::run(&args),
+        Some(Command::Matrix(args)) => matrix::run(&args),
+        Some(Command::MatrixCell(args)) => matrix::run_cell(&args),
+        #[cfg(feature = "window")]
+        Some(Command::View(args)) => view::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

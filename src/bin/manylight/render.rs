@@ -49,7 +49,7 @@ pub struct RenderArgs {
 /// Random lights for built-ins and OBJ files when `--lights` is not given.
 const DEFAULT_LIGHTS: usize = 1024;
 
-fn parse_size(s: &str) -> Result<(u32, u32), String> {
+pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
     let (w, h) = s
         .split_once(['x', 'X', '×'])
         .ok_or_else(|| format!("`{s}` is not WIDTHxHEIGHT"))?;

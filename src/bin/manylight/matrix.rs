@@ -1,0 +1,259 @@
+//! `manylight matrix`: the ES capability matrix a team runs in CI. Every configuration is a
+//! real driver restriction applied to a child process (`MESA_GLES_VERSION_OVERRIDE`,
+//! `MESA_EXTENSION_OVERRIDE`), never a flag the renderer sets on itself; each child renders
+//! every method and compares it with plain forward on the same configuration.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use clap::Parser;
+use manylight::gl::HeadlessContext;
+use manylight::methods::{Support, METHODS};
+use manylight::{scene, EsVersion, RenderOptions, Renderer};
+use serde_json::{json, Value};
+
+use crate::EsArg;
+
+/// Options of `manylight matrix`.
+#[derive(Parser, Debug)]
+pub struct MatrixArgs {
+    /// Scene rendered in every cell.
+    #[arg(long, default_value = scene::builtin::DEFAULT)]
+    pub scene: String,
+    /// Seeded random lights.
+    #[arg(long, default_value_t = 256)]
+    pub lights: usize,
+    /// Thumbnail size as WIDTHxHEIGHT.
+    #[arg(long, default_value = "192x108", value_parser = crate::render::parse_size)]
+    pub size: (u32, u32),
+    /// Write the results as JSON to this file.
+    #[arg(long)]
+    pub json: Option<PathBuf>,
+    /// Write each cell's image and a labelled contact sheet (`matrix.png`) into this folder.
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+}
+
+/// One configuration: a name, the ES version asked for, and the environment that restricts
+/// the driver.
+struct Config {
+    name: &'static str,
+    slug: &'static str,
+    es: &'static str,
+    env: &'static [(&'static str, &'static str)],
+}
+
+const CONFIGS: &[Config] = &[
+    Config {
+        name: "ES 2.0",
+        slug: "es2",
+        es: "2",
+        env: &[],
+    },
+    Config {
+        name: "ES 2.0 without float textures",
+        slug: "es2-nofloat",
+        es: "2",
+        env: &[(
+            "MESA_EXTENSION_OVERRIDE",
+            "-GL_OES_texture_float -GL_OES_texture_half_float",
+        )],
+    },
+    Config {
+        name: "ES 2.0 driver (capped)",
+        slug: "es2-capped",
+        es: "2",
+        env: &[("MESA_GLES_VERSION_OVERRIDE", "2.0")],
+    },
+    Config {
+        name: "ES 3.0 driver (capped)",
+        slug: "es3-capped",
+        es: "3",
+        env: &[("MESA_GLES_VERSION_OVERRIDE", "3.0")],
+    },
+    Config {
+        name: "ES 3.x as the driver gives it",
+        slug: "es3",
+        es: "3",
+        env: &[],
+    },
+];
+
+/// Runs the matrix: one child process per configuration.
+pub fn run(args: &MatrixArgs) -> Result<(), Box<dyn std::error::Error>> {
+    let exe = std::env::current_exe()?;
+    let out = args.out.clone().unwrap_or_else(std::env::temp_dir);
+    std::fs::create_dir_all(&out).map_err(|e| format!("cannot create {}: {e}", out.display()))?;
+    let size = format!("{}x{}", args.size.0, args.size.1);
+    let mut rows = Vec::new();
+    for config in CONFIGS {
+        let mut cmd = Command::new(&exe);
+        cmd.args([
+            "matrix-cell",
+            "--es",
+            config.es,
+            "--scene",
+            &args.scene,
+            "--size",
+            &size,
+        ])
+        .args(["--lights", &args.lights.to_string(), "--tag", config.slug])
+        .arg("--out")
+        .arg(&out);
+        for (k, v) in config.env {
+            cmd.env(k, v);
+        }
+        let output = cmd.output()?;
+        let mut row = match serde_json::from_slice::<Value>(&output.stdout) {
+            Ok(v) if output.status.success() => v,
+            _ => json!({
+                "error": String::from_utf8_lossy(&output.stderr).trim().replace("error: ", ""),
+                "methods": [],
+            }),
+        };
+        row["config"] = json!(config.name);
+        row["env"] = json!(config
+            .env
+            .iter()
+            .map(|(k, v)| format!("{k}={v}"))
+            .collect::<Vec<_>>());
+        rows.push(row);
+    }
+    rows.push(json!({
+        "config": "desktop GL (OSMesa)",
+        "error": "not built: the renderer emits GLSL ES only; desktop GL through OSMesa is not implemented yet",
+        "methods": [],
+    }));
+    print!("{}", markdown(&rows));
+    if let Some(path) = &args.json {
+        std::fs::write(path, serde_json::to_string_pretty(&rows)? + "\n")
+            .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+    }
+    if args.out.is_some() {
+        let sheet = sheet(&rows, &out);
+        let path = out.join("matrix.png");
+        sheet
+            .save(&path)
+            .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+        eprintln!("contact sheet: {}", path.display());
+    }
+    Ok(())
+}
+
+fn markdown(rows: &[Value]) -> String {
+    let mut s = String::from("| configuration | context | method | support | max abs vs forward | pixels > 2/255 | frame ms |\n|---|---|---|---|---|---|---|\n");
+    for row in rows {
+        let config = row["config"].as_str().unwrap_or("?");
+        if let Some(err) = row["error"].as_str() {
+            s += &format!("| {config} | — | — | unavailable: {err} | | | |\n");
+            continue;
+        }
+        let context = row["gl_version"].as_str().unwrap_or("?");
+        for m in row["methods"].as_array().into_iter().flatten() {
+            let status = m["support"]["status"].as_str().unwrap_or("?");
+            let support = match m["support"]["reason"].as_str() {
+                Some(r) => format!("{status}: {r}"),
+                None => status.to_string(),
+            };
+            let num = |k: &str, digits: usize| {
+                m[k].as_f64()
+                    .map_or(String::new(), |v| format!("{v:.digits$}"))
+            };
+            s += &format!(
+                "| {config} | {context} | {} | {support} | {} | {} | {} |\n",
+                m["name"].as_str().unwrap_or("?"),
+                num("max_abs", 0),
+                m["over_2"]
+                    .as_f64()
+                    .map_or(String::new(), |v| format!("{:.3} %", v * 100.0)),
+                num("frame_ms", 1),
+            );
+        }
+    }
+    s
+}
+
+fn sheet(rows: &[Value], out: &Path) -> image::RgbaImage {
+    let mut cells = Vec::new();
+    for row in rows {
+        let config = row["config"].as_str().unwrap_or("?").to_string();
+        if row["error"].is_string() {
+            cells.push((vec![config, "unavailable".to_string()], None));
+            continue;
+        }
+        for m in row["methods"].as_array().into_iter().flatten() {
+            let name = m["name"].as_str().unwrap_or("?");
+            let thumb = m["image"]
+                .as_str()
+                .and_then(|f| image::open(out.join(f)).ok())
+                .map(|i| i.to_rgba8());
+            let detail = match (m["support"]["status"].as_str(), m["max_abs"].as_f64()) {
+                (Some("unsupported"), _) => "unsupported".to_string(),
+                (Some(status), Some(err)) => format!("{status}, max err {err:.0}"),
+                (status, _) => status.unwrap_or("?").to_string(),
+            };
+            cells.push((vec![config.clone(), format!("{name}: {detail}")], thumb));
+        }
+    }
+    manylight::metrics::sheet::contact_sheet(&cells, METHODS.len())
+}
+
+/// Options of the hidden per-configuration child.
+#[derive(Parser, Debug)]
+pub struct MatrixCellArgs {
+    #[arg(long, value_enum)]
+    es: EsArg,
+    #[arg(long)]
+    scene: String,
+    #[arg(long, value_parser = crate::render::parse_size)]
+    size: (u32, u32),
+    #[arg(long)]
+    lights: usize,
+    #[arg(long)]
+    tag: String,
+    #[arg(long)]
+    out: PathBuf,
+}
+
+/// Renders every method in this (restricted) process and prints one JSON row.
+pub fn run_cell(args: &MatrixCellArgs) -> Result<(), Box<dyn std::error::Error>> {
+    let es: EsVersion = args.es.into();
+    let (scene, _) = scene::load(&args.scene, Some((args.lights, 1)))?;
+    let ctx = HeadlessContext::new(es)?;
+    let mut renderer = Renderer::new(ctx.load_gl(), es)?;
+    let (w, h) = args.size;
+    let opts = RenderOptions {
+        timed_frames: 3,
+        ..RenderOptions::default()
+    };
+    renderer.set_method("forward")?;
+    let (reference, _) = renderer.render_offscreen(&scene, w, h, &opts)?;
+    let mut methods = Vec::new();
+    for m in METHODS {
+        let support = (m.supported)(renderer.caps());
+        let mut entry = json!({"name": m.name, "support": support});
+        if !matches!(support, Support::Unsupported(_)) {
+            renderer.set_method(m.name)?;
+            let (img, stats) = renderer.render_offscreen(&scene, w, h, &opts)?;
+            let d = manylight::metrics::diff(&reference, &img);
+            let file = format!("{}-{}.png", args.tag, m.name);
+            img.save(args.out.join(&file))?;
+            entry["max_abs"] = json!(d.max_abs);
+            entry["over_2"] = json!(d.over_2);
+            entry["frame_ms"] = json!(stats.frame_ms);
+            entry["image"] = json!(file);
+        }
+        methods.push(entry);
+    }
+    let caps = renderer.caps().clone();
+    renderer.destroy();
+    let row = json!({
+        "es": caps.es,
+        "gl_version": caps.gl_version,
+        "renderer": caps.renderer,
+        "float_textures": caps.float_textures,
+        "methods": methods,
+    });
+    println!("{row}");
+    Ok(())
+}

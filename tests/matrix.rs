@@ -1,0 +1,78 @@
+//! `manylight matrix` as CI runs it: real driver restrictions in child processes.
+
+use std::process::Command;
+
+#[test]
+fn matrix_covers_es2_es2_without_float_and_es3_and_every_supported_cell_matches_forward() {
+    let dir = tempfile::tempdir().unwrap();
+    let json = dir.path().join("m.json");
+    let out = Command::new(env!("CARGO_BIN_EXE_manylight"))
+        .args(["matrix", "--size", "64x36", "--lights", "64", "--json"])
+        .arg(&json)
+        .arg("--out")
+        .arg(dir.path())
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{stdout}{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(
+        stdout.starts_with("| configuration |"),
+        "a Markdown table on stdout: {stdout}"
+    );
+    let rows: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let row = |name: &str| {
+        rows.as_array()
+            .unwrap()
+            .iter()
+            .find(|r| r["config"] == name)
+            .unwrap_or_else(|| panic!("no row {name}"))
+            .clone()
+    };
+    for name in [
+        "ES 2.0",
+        "ES 2.0 without float textures",
+        "ES 2.0 driver (capped)",
+        "ES 3.x as the driver gives it",
+    ] {
+        let r = row(name);
+        assert!(r["error"].is_null(), "{name}: {}", r["error"]);
+        for m in r["methods"].as_array().unwrap() {
+            let status = m["support"]["status"].as_str().unwrap();
+            if m["name"] == "deferred" && name.starts_with("ES 2.0") {
+                assert_eq!(
+                    status, "unsupported",
+                    "{name}: deferred must be unsupported on ES 2.0"
+                );
+                assert!(m["support"]["reason"].as_str().unwrap().contains("ES 3.0"));
+                continue;
+            }
+            assert_ne!(status, "unsupported", "{name} {}", m["name"]);
+            assert!(
+                m["max_abs"].as_u64().unwrap() <= 2,
+                "{name} {}: {} / 255 from forward",
+                m["name"],
+                m["max_abs"]
+            );
+            assert!(dir.path().join(m["image"].as_str().unwrap()).is_file());
+        }
+    }
+    // The restriction is real: without float textures the context reports none.
+    assert_eq!(
+        row("ES 2.0 without float textures")["float_textures"],
+        false
+    );
+    assert!(row("ES 2.0 driver (capped)")["gl_version"]
+        .as_str()
+        .unwrap()
+        .contains("ES 2.0"));
+    let sheet = image::open(dir.path().join("matrix.png")).unwrap();
+    assert!(
+        sheet.width() > 64 * 5 && sheet.height() > 36 * 5,
+        "contact sheet too small"
+    );
+}
