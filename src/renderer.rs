@@ -374,7 +374,10 @@ impl Renderer {
             triangles: scene.objects.iter().map(|o| o.mesh.triangle_count()).sum(),
             method_gpu_bytes: self.method.gpu_bytes(),
             gbuffer_bytes: method_stats.gbuffer_bytes,
-            auto_choice: method_stats.auto_choice.as_ref().map(|(c, _)| c.to_string()),
+            auto_choice: method_stats
+                .auto_choice
+                .as_ref()
+                .map(|(c, _)| c.to_string()),
             auto_reason: method_stats.auto_choice.map(|(_, r)| r),
             lp_num_threads: std::env::var("LP_NUM_THREADS").ok(),
             scene_features,
