@@ -95,14 +95,7 @@ impl OffscreenTarget {
                 ty,
                 glow::PixelUnpackData::Slice(None),
             );
-            for (p, v) in [
-                (glow::TEXTURE_MIN_FILTER, glow::NEAREST),
-                (glow::TEXTURE_MAG_FILTER, glow::NEAREST),
-                (glow::TEXTURE_WRAP_S, glow::CLAMP_TO_EDGE),
-                (glow::TEXTURE_WRAP_T, glow::CLAMP_TO_EDGE),
-            ] {
-                gl.tex_parameter_i32(glow::TEXTURE_2D, p, v as i32);
-            }
+            super::texture::set_nearest_clamp(gl);
             let depth = dev.create_renderbuffer()?;
             gl.bind_renderbuffer(glow::RENDERBUFFER, Some(depth));
             let depth_format = if dev.caps().depth24 {

@@ -61,14 +61,7 @@ fn texture(dev: &Device, w: u32, h: u32, internal: u32) -> Result<glow::Texture,
     unsafe {
         gl.bind_texture(glow::TEXTURE_2D, Some(t));
         gl.tex_storage_2d(glow::TEXTURE_2D, 1, internal, w as i32, h as i32);
-        for (p, v) in [
-            (glow::TEXTURE_MIN_FILTER, glow::NEAREST),
-            (glow::TEXTURE_MAG_FILTER, glow::NEAREST),
-            (glow::TEXTURE_WRAP_S, glow::CLAMP_TO_EDGE),
-            (glow::TEXTURE_WRAP_T, glow::CLAMP_TO_EDGE),
-        ] {
-            gl.tex_parameter_i32(glow::TEXTURE_2D, p, v as i32);
-        }
+        super::texture::set_nearest_clamp(gl);
     }
     Ok(t)
 }

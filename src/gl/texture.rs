@@ -51,6 +51,12 @@ pub struct DataTexture {
     destroyed: bool,
 }
 
+/// NEAREST filtering and CLAMP_TO_EDGE on the bound 2D texture: what data textures and render
+/// targets read texel by texel need.
+pub(crate) fn set_nearest_clamp(gl: &glow::Context) {
+    set_sampling(gl, glow::NEAREST, glow::CLAMP_TO_EDGE, glow::NEAREST);
+}
+
 fn set_sampling(gl: &glow::Context, filter: u32, wrap: u32, min_filter: u32) {
     unsafe {
         gl.tex_parameter_i32(glow::TEXTURE_2D, glow::TEXTURE_MAG_FILTER, filter as i32);
@@ -77,7 +83,7 @@ impl DataTexture {
         }
         let raw = dev.create_texture()?;
         unsafe { dev.gl.bind_texture(glow::TEXTURE_2D, Some(raw)) };
-        set_sampling(&dev.gl, glow::NEAREST, glow::CLAMP_TO_EDGE, glow::NEAREST);
+        set_nearest_clamp(&dev.gl);
         Ok(DataTexture {
             raw,
             format,
