@@ -20,7 +20,8 @@ fn check(name: &str, scene: &Scene, w: u32, h: u32) -> image::RgbaImage {
         let opts = RenderOptions::default();
         gpu.r().set_method("forward").unwrap();
         let (reference, _) = gpu.r().render_offscreen(scene, w, h, &opts).unwrap();
-        for method in METHODS {
+        let deferred: &[&str] = if es == EsVersion::Es3 { &["deferred"] } else { &[] };
+        for &method in METHODS.iter().chain(deferred) {
             gpu.r().set_method(method).unwrap();
             let (img, stats) = gpu
                 .r()

@@ -6,10 +6,14 @@
 //! colour 1 normal   RGBA32F     16    view-space normal (two-sided, facing the eye), view depth
 //! colour 2 specular RGBA16F      8    Ks, Blinn-Phong exponent
 //! depth             DEPTH24      4    for the geometry pass's depth test
-//! accumulation      RGBA16F      8    Σ light radiance (additive blending)
+//! accumulation      RGBA32F     16    Σ light radiance (additive blending; RGBA16F, 8 bytes,
+//!                                     where GL_EXT_float_blend is missing)
 //!                              ----
-//!                               44 bytes per pixel (1280×720: 40.6 MB)
+//!                               52 bytes per pixel (1280×720: 47.9 MB), 44 with RGBA16F
 //! ```
+//!
+//! The accumulation buffer is 32-bit where float blending allows: hundreds of small
+//! contributions summed in fp16 drift by several 8-bit steps (measured in the stability tests).
 //!
 //! Float formats everywhere so the G-buffer loses almost nothing against forward: the normal
 //! and depth are exact f32, albedo and specular keep 11 significant bits. Rendering to float
@@ -20,8 +24,14 @@ use glow::HasContext;
 
 use super::{Device, EsVersion, GlError};
 
-/// Bytes of GPU memory per pixel (see the module docs).
-pub const BYTES_PER_PIXEL: usize = 44;
+/// Bytes of GPU memory per pixel on this context (see the module docs).
+pub fn bytes_per_pixel(caps: &super::Caps) -> usize {
+    if caps.has_extension("GL_EXT_float_blend") {
+        52
+    } else {
+        44
+    }
+}
 
 /// Why deferred cannot run on this context, if it cannot.
 pub fn unsupported_reason(dev_caps: &super::Caps) -> Option<String> {
@@ -52,6 +62,7 @@ pub struct GBuffer {
     color: [glow::Texture; 4],
     depth: glow::Texture,
     size: (u32, u32),
+    bytes_per_pixel: usize,
     destroyed: bool,
 }
 
@@ -76,7 +87,12 @@ impl GBuffer {
         let albedo = texture(dev, w, h, glow::RGBA16F)?;
         let normal = texture(dev, w, h, glow::RGBA32F)?;
         let specular = texture(dev, w, h, glow::RGBA16F)?;
-        let accum = texture(dev, w, h, glow::RGBA16F)?;
+        let accum_format = if dev.caps().has_extension("GL_EXT_float_blend") {
+            glow::RGBA32F
+        } else {
+            glow::RGBA16F
+        };
+        let accum = texture(dev, w, h, accum_format)?;
         let depth = texture(dev, w, h, glow::DEPTH_COMPONENT24)?;
         let geometry_fbo = dev.create_framebuffer()?;
         let accum_fbo = dev.create_framebuffer()?;
@@ -86,6 +102,7 @@ impl GBuffer {
             color: [albedo, normal, specular, accum],
             depth,
             size: (w, h),
+            bytes_per_pixel: bytes_per_pixel(dev.caps()),
             destroyed: false,
         };
         let gl = &dev.gl;
@@ -141,7 +158,7 @@ impl GBuffer {
 
     /// GPU bytes held.
     pub fn gpu_bytes(&self) -> usize {
-        self.size.0 as usize * self.size.1 as usize * BYTES_PER_PIXEL
+        self.size.0 as usize * self.size.1 as usize * self.bytes_per_pixel
     }
 
     /// Binds the G-buffer for the geometry pass and clears it (depth 0 in the normal buffer's

@@ -126,9 +126,10 @@ impl Deferred {
         };
         for light in ctx.lights {
             let radius = light.radius * VOLUME_SCALE;
-            // Eye inside (or the near plane cutting) the proxy: a full-screen triangle instead,
-            // since a sphere's faces would be clipped away. Orthographic views always use it.
-            let fullscreen = ortho || light.position.length() < radius + 2.0 * ctx.near as f32;
+            // A proxy reaching the near plane (the eye inside it, or beside it in a wide view)
+            // would lose faces to clipping: a full-screen triangle instead. Orthographic views
+            // always use it.
+            let fullscreen = ortho || -light.position.z - radius < 2.0 * ctx.near as f32;
             let (shader, mesh, cull) = if fullscreen {
                 (
                     "deferred_light_fullscreen",
