@@ -35,5 +35,10 @@ pub mod renderer;
 pub mod scene;
 
 pub use error::Error;
+
+/// The README's Rust examples, compiled as doc tests so they stay true.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+pub struct ReadmeDoctests;
 pub use gl::EsVersion;
 pub use renderer::{FrameStats, RenderOptions, Renderer};

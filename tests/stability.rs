@@ -20,7 +20,11 @@ fn check(name: &str, scene: &Scene, w: u32, h: u32) -> image::RgbaImage {
         let opts = RenderOptions::default();
         gpu.r().set_method("forward").unwrap();
         let (reference, _) = gpu.r().render_offscreen(scene, w, h, &opts).unwrap();
-        let deferred: &[&str] = if es == EsVersion::Es3 { &["deferred"] } else { &[] };
+        let deferred: &[&str] = if es == EsVersion::Es3 {
+            &["deferred"]
+        } else {
+            &[]
+        };
         for &method in METHODS.iter().chain(deferred) {
             gpu.r().set_method(method).unwrap();
             let (img, stats) = gpu

@@ -534,7 +534,8 @@ pub fn assign(
     }
 }
 
-/// Splits the cells into `parts` contiguous blocks with about equal numbers of indices.
+/// Splits the cells into at most `parts` contiguous, non-empty blocks with about equal numbers
+/// of indices (fewer blocks when there are fewer cells).
 fn split_cells(offsets: &[u32], total: usize, parts: usize) -> Vec<(usize, usize)> {
     let cells = offsets.len();
     let mut blocks = Vec::with_capacity(parts);
@@ -542,11 +543,24 @@ fn split_cells(offsets: &[u32], total: usize, parts: usize) -> Vec<(usize, usize
     for p in 1..parts {
         let target = (total * p / parts) as u32;
         let end = offsets.partition_point(|&o| o < target).clamp(start, cells);
-        blocks.push((start, end));
-        start = end;
+        if end > start {
+            blocks.push((start, end));
+            start = end;
+        }
     }
-    blocks.push((start, cells));
+    if start < cells {
+        blocks.push((start, cells));
+    }
     blocks
+}
+
+#[cfg(test)]
+pub(crate) fn split_cells_for_tests(
+    offsets: &[u32],
+    total: usize,
+    parts: usize,
+) -> Vec<(usize, usize)> {
+    split_cells(offsets, total, parts)
 }
 
 /// The largest per-cell cap ≤ `cap` whose capped total fits `budget`.

@@ -409,3 +409,60 @@ fn zero_lights_do_no_work() {
     assert!(a.indices.is_empty() && a.visible.is_empty());
     assert!(a.counts.iter().all(|&n| n == 0));
 }
+
+/// Many lights on a grid with fewer cells than threads' worth of blocks: the parallel fill must
+/// not hand out empty or out-of-range cell blocks (a panic seen from the viewer).
+#[test]
+fn parallel_fill_on_a_tiny_grid() {
+    let t = (30f64).to_radians().tan();
+    let grid = ClusterGrid::new(
+        32,
+        24,
+        GridProjection::Perspective { tan_x: t, tan_y: t },
+        0.1,
+        10.0,
+        &GridConfig::default(),
+    );
+    assert!(grid.total_cells < 64);
+    let mut rng = Pcg64Mcg::seed_from_u64(9);
+    let lights = random_lights(&mut rng, 20_000, 5.0);
+    let par = assign(
+        &grid,
+        &lights,
+        10.0,
+        &AssignLimits {
+            parallel_threshold: 1,
+            ..Default::default()
+        },
+    );
+    let seq = assign(
+        &grid,
+        &lights,
+        10.0,
+        &AssignLimits {
+            parallel_threshold: usize::MAX,
+            ..Default::default()
+        },
+    );
+    assert_eq!(par.indices, seq.indices);
+    assert_eq!(par.offsets, seq.offsets);
+}
+
+#[test]
+fn split_cells_never_returns_empty_or_out_of_range_blocks() {
+    for (offsets, total, parts) in [
+        (vec![0u32; 12], 0usize, 4usize),
+        (vec![0, 0, 0, 5], 9, 3),
+        (vec![0, 100], 200, 8),
+        (vec![], 0, 2),
+    ] {
+        let blocks = super::assign::split_cells_for_tests(&offsets, total, parts);
+        let mut next = 0;
+        for (a, b) in &blocks {
+            assert!(a < b && *b <= offsets.len(), "{blocks:?}");
+            assert_eq!(*a, next);
+            next = *b;
+        }
+        assert_eq!(next, offsets.len());
+    }
+}

@@ -157,7 +157,13 @@ mod tests {
     use super::*;
 
     fn camera() -> Camera {
-        Camera::perspective(DVec3::new(0.0, 1.0, 5.0), DVec3::new(0.0, 1.0, 0.0), 60.0, 0.1, 100.0)
+        Camera::perspective(
+            DVec3::new(0.0, 1.0, 5.0),
+            DVec3::new(0.0, 1.0, 0.0),
+            60.0,
+            0.1,
+            100.0,
+        )
     }
 
     #[test]
@@ -184,7 +190,10 @@ mod tests {
         fly.cursor_moved(100.0, -10_000.0); // a huge drag upwards
         fly.update(0.016, &mut cam);
         let f = (cam.target - cam.position).normalize();
-        assert!(f.y > 0.99 && f.y < 1.0, "pitch clamped below straight up: {f}");
+        assert!(
+            f.y > 0.99 && f.y < 1.0,
+            "pitch clamped below straight up: {f}"
+        );
         assert!(((cam.target - cam.position).length() - 5.0).abs() < 1e-9);
         // Motion without a drag does nothing.
         fly.set_dragging(false);

@@ -12,7 +12,7 @@ use crate::EsArg;
 #[derive(Parser, Debug)]
 #[command(name = "render")]
 pub struct RenderArgs {
-    /// A built-in scene (courtyard, pillars, plane), an .obj file or a .json scene file.
+    /// A built-in scene (courtyard, pillars, plane, bubbles), an .obj file or a .json scene file.
     #[arg(long, default_value = scene::builtin::DEFAULT)]
     pub scene: String,
     /// Shading method (see `manylight info` for the table).

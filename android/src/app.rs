@@ -1,0 +1,381 @@
+//! The winit application: EGL setup, suspend/resume, touch input and the frame loop.
+
+use std::ffi::CStr;
+use std::num::NonZeroU32;
+use std::time::Instant;
+
+use android_activity::AndroidApp;
+use glutin::config::{Api, Config, ConfigTemplateBuilder, GlConfig};
+use glutin::context::{ContextApi, ContextAttributesBuilder, Version};
+use glutin::context::{NotCurrentContext, NotCurrentGlContext};
+use glutin::context::{PossiblyCurrentContext, PossiblyCurrentGlContext};
+use glutin::display::{Display, DisplayApiPreference, GlDisplay};
+use glutin::surface::{GlSurface, Surface, SurfaceAttributesBuilder, SwapInterval, WindowSurface};
+use manylight::methods::{DEFAULT_METHOD, METHODS};
+use manylight::scene::{self, Scene};
+use manylight::{EsVersion, RenderOptions, Renderer};
+use winit::application::ApplicationHandler;
+use winit::dpi::PhysicalPosition;
+use winit::event::{Touch, TouchPhase, WindowEvent};
+use winit::event_loop::{ActiveEventLoop, EventLoop};
+use winit::platform::android::EventLoopBuilderExtAndroid;
+use winit::raw_window_handle::{HasDisplayHandle, HasWindowHandle};
+use winit::window::{Window, WindowId};
+
+use crate::orbit::Orbit;
+
+/// Seeded random lights in the default scene.
+const LIGHTS: usize = 1024;
+/// Seconds between frame-statistics lines in logcat.
+const LOG_EVERY_S: f64 = 2.0;
+
+/// Sets up logging and runs the event loop until the activity is destroyed.
+pub fn run(activity: AndroidApp) {
+    android_logger::init_once(
+        android_logger::Config::default()
+            .with_max_level(log::LevelFilter::Info)
+            .with_tag("manylight"),
+    );
+    let scene = match scene::builtin::build(scene::builtin::DEFAULT, Some((LIGHTS, 1))) {
+        Ok(s) => s,
+        Err(e) => return log::error!("cannot build the default scene: {e}"),
+    };
+    let event_loop = match EventLoop::builder().with_android_app(activity).build() {
+        Ok(l) => l,
+        Err(e) => return log::error!("cannot create the event loop: {e}"),
+    };
+    let center = scene.bounds().map_or(scene.camera.target, |b| b.center());
+    let mut shell = Shell {
+        orbit: Orbit::around(center, &scene.camera),
+        scene,
+        egl: None,
+        parked: None,
+        live: None,
+        renderer: None,
+        touch: None,
+        frames: 0,
+        since: Instant::now(),
+    };
+    if let Err(e) = event_loop.run_app(&mut shell) {
+        log::error!("event loop failed: {e}");
+    }
+}
+
+/// The EGL display and the config and version chosen on it (kept for the process).
+struct Egl {
+    display: Display,
+    config: Config,
+    es: EsVersion,
+}
+
+/// What exists only while the activity is resumed. Fields drop in order: surface first.
+struct Live {
+    surface: Surface<WindowSurface>,
+    context: PossiblyCurrentContext,
+    window: Window,
+}
+
+struct Shell {
+    scene: Scene,
+    orbit: Orbit,
+    egl: Option<Egl>,
+    /// The context while suspended (not current, no surface).
+    parked: Option<NotCurrentContext>,
+    live: Option<Live>,
+    /// Lives as long as its context (across suspend/resume).
+    renderer: Option<Renderer>,
+    /// The finger that orbits and where it was last.
+    touch: Option<(u64, PhysicalPosition<f64>)>,
+    frames: u32,
+    since: Instant,
+}
+
+impl ApplicationHandler for Shell {
+    fn resumed(&mut self, event_loop: &ActiveEventLoop) {
+        if let Err(e) = self.show(event_loop) {
+            log::error!("{e}");
+            event_loop.exit();
+        }
+    }
+
+    fn suspended(&mut self, _: &ActiveEventLoop) {
+        // The native window goes away: drop the surface (and window), keep the context.
+        if let Some(Live {
+            surface,
+            context,
+            window,
+        }) = self.live.take()
+        {
+            match context.make_not_current() {
+                Ok(c) => self.parked = Some(c),
+                Err(e) => log::warn!("cannot release the context ({e}); it will be rebuilt"),
+            }
+            drop(surface);
+            drop(window);
+        }
+    }
+
+    fn window_event(&mut self, event_loop: &ActiveEventLoop, _: WindowId, event: WindowEvent) {
+        match event {
+            WindowEvent::CloseRequested => event_loop.exit(),
+            WindowEvent::Resized(size) => {
+                if let (Some(live), Some(w), Some(h)) = (
+                    &self.live,
+                    NonZeroU32::new(size.width),
+                    NonZeroU32::new(size.height),
+                ) {
+                    live.surface.resize(&live.context, w, h);
+                }
+            }
+            WindowEvent::Touch(touch) => self.touch(touch),
+            WindowEvent::RedrawRequested => {
+                if let Err(e) = self.frame() {
+                    log::error!("{e}");
+                    event_loop.exit();
+                }
+            }
+            _ => {}
+        }
+    }
+
+    fn exiting(&mut self, _: &ActiveEventLoop) {
+        // GL objects can only be freed with the context current, i.e. while shown.
+        if self.live.is_some() {
+            if let Some(r) = self.renderer.take() {
+                r.destroy();
+            }
+        }
+    }
+}
+
+impl Shell {
+    /// Makes the display and context on first use, a surface for the new native window, and
+    /// the renderer when there is none.
+    fn show(&mut self, event_loop: &ActiveEventLoop) -> Result<(), String> {
+        if self.live.is_some() {
+            return Ok(());
+        }
+        if self.egl.is_none() {
+            let (egl, context) = open_egl(event_loop)?;
+            self.egl = Some(egl);
+            self.parked = Some(context);
+        }
+        let egl = self.egl.as_ref().ok_or("no EGL display")?;
+        // The kept context, or a new one (first start, or the old one could not be released).
+        let (parked, kept) = match self.parked.take() {
+            Some(c) => (c, true),
+            None => {
+                self.renderer = None; // its objects went with the old context
+                (create_context(egl)?, false)
+            }
+        };
+        let window = event_loop
+            .create_window(Window::default_attributes())
+            .map_err(|e| format!("cannot create the window: {e}"))?;
+        let size = window.inner_size();
+        let handle = window
+            .window_handle()
+            .map_err(|e| format!("no native window: {e}"))?
+            .as_raw();
+        let attributes = SurfaceAttributesBuilder::<WindowSurface>::new().build(
+            handle,
+            NonZeroU32::new(size.width).unwrap_or(NonZeroU32::MIN),
+            NonZeroU32::new(size.height).unwrap_or(NonZeroU32::MIN),
+        );
+        // SAFETY: the native window outlives the surface (`Live` drops the surface first and
+        // `suspended` drops both before Android destroys the window).
+        let surface = unsafe { egl.display.create_window_surface(&egl.config, &attributes) }
+            .map_err(|e| format!("cannot create the window surface: {e}"))?;
+        let context = match parked.make_current(&surface) {
+            Ok(c) => c,
+            Err(e) if kept => {
+                // Context loss while suspended: start over with a new context and renderer.
+                log::warn!("the kept context is gone ({e}); rebuilding it");
+                self.renderer = None;
+                create_context(egl)?
+                    .make_current(&surface)
+                    .map_err(|e| format!("cannot make the context current: {e}"))?
+            }
+            Err(e) => return Err(format!("cannot make the context current: {e}")),
+        };
+        if let Err(e) = surface.set_swap_interval(&context, SwapInterval::Wait(NonZeroU32::MIN)) {
+            log::info!("no vsync: {e}");
+        }
+        if self.renderer.is_none() {
+            // SAFETY: glutin returns EGL's entry points (or null); glow stores them, and the
+            // context stays current on this thread whenever the renderer draws.
+            let gl = unsafe {
+                glow::Context::from_loader_function_cstr(|name: &CStr| {
+                    egl.display.get_proc_address(name)
+                })
+            };
+            let mut renderer = Renderer::new(gl, egl.es).map_err(|e| e.to_string())?;
+            pick_method(&mut renderer)?;
+            let caps = renderer.caps();
+            log::info!(
+                "{} on {} ({}), method {}",
+                egl.es,
+                caps.renderer,
+                caps.gl_version,
+                renderer.method()
+            );
+            self.renderer = Some(renderer);
+        }
+        window.request_redraw();
+        self.live = Some(Live {
+            surface,
+            context,
+            window,
+        });
+        Ok(())
+    }
+
+    /// One finger orbits; others are ignored.
+    fn touch(&mut self, touch: Touch) {
+        let Touch {
+            id,
+            phase,
+            location,
+            ..
+        } = touch;
+        match (phase, self.touch) {
+            (TouchPhase::Started, None) => self.touch = Some((id, location)),
+            (TouchPhase::Moved, Some((finger, last))) if finger == id => {
+                let width = self
+                    .live
+                    .as_ref()
+                    .map_or(1.0, |l| f64::from(l.window.inner_size().width));
+                self.orbit
+                    .drag(location.x - last.x, location.y - last.y, width);
+                self.touch = Some((id, location));
+            }
+            (TouchPhase::Ended | TouchPhase::Cancelled, Some((finger, _))) if finger == id => {
+                self.touch = None
+            }
+            _ => {}
+        }
+    }
+
+    /// Renders and presents one frame, then asks for the next.
+    fn frame(&mut self) -> Result<(), String> {
+        let (Some(live), Some(renderer)) = (&self.live, self.renderer.as_mut()) else {
+            return Ok(()); // suspended
+        };
+        let size = live.window.inner_size();
+        if size.width == 0 || size.height == 0 {
+            return Ok(());
+        }
+        self.orbit.apply(&mut self.scene.camera);
+        let options = RenderOptions {
+            wait_for_gpu: false,
+            ..RenderOptions::default()
+        };
+        let stats = renderer
+            .render(&self.scene, size.width, size.height, &options)
+            .map_err(|e| format!("render failed: {e}"))?;
+        if let Err(e) = live.surface.swap_buffers(&live.context) {
+            // A surface that went away mid-frame; the next resume makes a new one.
+            log::warn!("eglSwapBuffers: {e}");
+        }
+        live.window.request_redraw();
+        self.frames += 1;
+        let elapsed = self.since.elapsed().as_secs_f64();
+        if elapsed >= LOG_EVERY_S {
+            log::info!(
+                "{} · {} lights · {}x{} · {:.1} ms/frame · assign {:.2} ms",
+                stats.method,
+                stats.lights,
+                size.width,
+                size.height,
+                elapsed * 1e3 / f64::from(self.frames),
+                stats.assign_ms
+            );
+            self.frames = 0;
+            self.since = Instant::now();
+        }
+        Ok(())
+    }
+}
+
+/// The default method, else the first of the table this device runs (an ES 2.0 GPU without
+/// fragment `highp` cannot run the culling methods).
+fn pick_method(renderer: &mut Renderer) -> Result<(), String> {
+    let names = std::iter::once(DEFAULT_METHOD).chain(METHODS.iter().map(|m| m.name));
+    let mut failures = Vec::new();
+    for name in names {
+        match renderer.set_method(name) {
+            Ok(_) => return Ok(()),
+            Err(e) => failures.push(e.to_string()),
+        }
+    }
+    Err(format!(
+        "no shading method runs here: {}",
+        failures.join("; ")
+    ))
+}
+
+/// The EGL display of the event loop, the first of ES 3.0 / ES 2.0 that has a usable config
+/// and gives a context, and that context.
+fn open_egl(event_loop: &ActiveEventLoop) -> Result<(Egl, NotCurrentContext), String> {
+    let raw = event_loop
+        .display_handle()
+        .map_err(|e| format!("no display handle: {e}"))?
+        .as_raw();
+    // SAFETY: an Android display handle carries no pointer; EGL's default display is used.
+    let display = unsafe { Display::new(raw, DisplayApiPreference::Egl) }
+        .map_err(|e| format!("cannot open the EGL display: {e}"))?;
+    let mut failures = Vec::new();
+    for es in [EsVersion::Es3, EsVersion::Es2] {
+        let api = match es {
+            EsVersion::Es2 => Api::GLES2,
+            EsVersion::Es3 => Api::GLES3,
+        };
+        let template = ConfigTemplateBuilder::new()
+            .with_api(api)
+            .with_alpha_size(0)
+            .with_depth_size(16)
+            .build();
+        // SAFETY: only queries the display's configs.
+        let config = unsafe { display.find_configs(template) }
+            .ok()
+            .and_then(|configs| {
+                // No multisampling, then a 24-bit depth buffer if there is one.
+                configs.max_by_key(|c| (c.num_samples() == 0, c.depth_size().min(24)))
+            });
+        let Some(config) = config else {
+            failures.push(format!("{es}: no window config with a depth buffer"));
+            continue;
+        };
+        let egl = Egl {
+            display: display.clone(),
+            config,
+            es,
+        };
+        match create_context(&egl) {
+            Ok(context) => {
+                if !failures.is_empty() {
+                    log::warn!("falling back to {es}: {}", failures.join("; "));
+                }
+                return Ok((egl, context));
+            }
+            Err(e) => failures.push(format!("{es}: {e}")),
+        }
+    }
+    Err(format!(
+        "no OpenGL ES context available: {}",
+        failures.join("; ")
+    ))
+}
+
+/// A not-yet-current context for the chosen config and version.
+fn create_context(egl: &Egl) -> Result<NotCurrentContext, String> {
+    let attributes = ContextAttributesBuilder::new()
+        .with_context_api(ContextApi::Gles(Some(Version::new(
+            egl.es.major() as u8,
+            0,
+        ))))
+        .build(None);
+    // SAFETY: a plain context, shared with nothing and not tied to a window handle.
+    unsafe { egl.display.create_context(&egl.config, &attributes) }
+        .map_err(|e| format!("eglCreateContext: {e}"))
+}

@@ -1,0 +1,402 @@
+//! `manylight view`: an interactive window (feature `window`).
+//!
+//! A winit window with an OpenGL ES context from glutin over EGL (X11 or Wayland; GLX is not
+//! used because it cannot create ES contexts). ES 3.0 is preferred and ES 2.0 taken when the
+//! driver has no ES 3.0 config or context; the [`manylight::Renderer`] is told which one it
+//! got. Every frame renders the scene into the window's default framebuffer without waiting
+//! for the GPU, then swaps buffers (vsync where the driver allows it).
+//!
+//! Controls: WASD move, Q/E down/up, Shift faster, left-drag looks around, 1–9 pick a method
+//! from [`manylight::methods::METHODS`], +/- double/halve the random lights, Esc quits.
+//! A change that the renderer rejects (say, plain forward over more lights than it can loop
+//! over) is reported on stderr and undone. `--frames N` quits after N frames and
+//! `--screenshot FILE` saves the last one, read back from the window's framebuffer.
+
+// Submodules live next to this file (src/bin/manylight/), hence the paths.
+#[path = "fly_camera.rs"]
+mod fly_camera;
+#[path = "window_gl.rs"]
+mod window_gl;
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use clap::Parser;
+use fly_camera::{FlyCamera, Move};
+use manylight::methods::METHODS;
+use manylight::scene::{self, Scene};
+use manylight::{EsVersion, FrameStats, RenderOptions};
+use window_gl::Gfx;
+use winit::application::ApplicationHandler;
+use winit::event::{ElementState, KeyEvent, MouseButton, WindowEvent};
+use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop};
+use winit::keyboard::{Key, KeyCode, NamedKey, PhysicalKey};
+use winit::window::WindowId;
+
+use crate::EsArg;
+
+/// Options of `manylight view`.
+#[derive(Parser, Debug)]
+#[command(name = "view")]
+pub struct ViewArgs {
+    /// A built-in scene (an unknown name lists them), an .obj file or a .json scene file.
+    #[arg(long, default_value = scene::builtin::DEFAULT)]
+    pub scene: String,
+    /// Shading method to start with (keys 1–9 switch).
+    #[arg(long, default_value = manylight::methods::DEFAULT_METHOD)]
+    pub method: String,
+    /// OpenGL ES version. Default: 3, or 2 where the driver has no ES 3.0.
+    #[arg(long, value_enum)]
+    pub es: Option<EsArg>,
+    /// Number of seeded random lights (default: 1024; a scene file's own lights).
+    #[arg(long)]
+    pub lights: Option<usize>,
+    /// Seed of the random lights.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Initial window size as WIDTHxHEIGHT.
+    #[arg(long, default_value = "1280x720", value_parser = crate::render::parse_size)]
+    pub size: (u32, u32),
+    /// Quit after this many frames (for scripts and tests).
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
+    pub frames: Option<u64>,
+    /// Save the last frame (read back from the window) to this PNG; needs --frames.
+    #[arg(long, requires = "frames")]
+    pub screenshot: Option<PathBuf>,
+}
+
+/// Random lights for built-ins and OBJ files when `--lights` is not given.
+const DEFAULT_LIGHTS: usize = 1024;
+/// Most random lights `+` goes to.
+const MAX_LIGHTS: usize = 1 << 20;
+/// Seconds between title-bar updates.
+const TITLE_EVERY_S: f64 = 0.25;
+
+/// Runs the viewer until the window closes, Esc, or `--frames`.
+pub fn run(args: &ViewArgs) -> Result<(), Box<dyn std::error::Error>> {
+    let is_file_scene = args.scene.to_lowercase().ends_with(".json");
+    let lights = match (args.lights, is_file_scene) {
+        (Some(n), _) => Some(n),
+        (None, true) => None,
+        (None, false) => Some(DEFAULT_LIGHTS),
+    };
+    let (scene, report) = scene::load(&args.scene, lights.map(|n| (n, args.seed)))?;
+    for w in &report.warnings {
+        eprintln!("warning: {w}");
+    }
+    // Validate the method name before opening a window.
+    manylight::methods::find(&args.method)?;
+    let extent = scene.bounds().map_or(10.0, |b| b.size().length());
+    let event_loop = EventLoop::new().map_err(|e| format!("cannot open a window: {e}"))?;
+    event_loop.set_control_flow(ControlFlow::Poll);
+    println!(
+        "controls: WASD move, Q/E down/up, Shift faster, drag to look, 1-{} method, +/- lights, Esc quit",
+        METHODS.len()
+    );
+    let mut app = App {
+        args,
+        light_count: lights.unwrap_or(scene.lights.len()),
+        good: (String::new(), lights.unwrap_or(scene.lights.len())),
+        scene,
+        fly: FlyCamera::new(FlyCamera::speed_for_extent(extent)),
+        gfx: None,
+        frames: 0,
+        last_frame: Instant::now(),
+        title: TitleStats::default(),
+        done: false,
+        result: Ok(()),
+    };
+    event_loop.run_app(&mut app)?;
+    app.result.map_err(Into::into)
+}
+
+/// Title-bar figures averaged since the last update.
+#[derive(Default)]
+struct TitleStats {
+    since: Option<Instant>,
+    frames: u32,
+    wall_s: f64,
+    cpu_ms: f64,
+    assign_ms: f64,
+}
+
+/// The viewer between events: scene, input, window (once resumed) and the exit status.
+struct App<'a> {
+    args: &'a ViewArgs,
+    scene: Scene,
+    /// Random lights asked for (`+`/`-` change it).
+    light_count: usize,
+    /// Method and light count of the last frame that rendered, to undo a rejected change.
+    good: (String, usize),
+    fly: FlyCamera,
+    gfx: Option<Gfx>,
+    frames: u64,
+    last_frame: Instant,
+    title: TitleStats,
+    /// Set once exit was requested: no more frames.
+    done: bool,
+    result: Result<(), String>,
+}
+
+impl ApplicationHandler for App<'_> {
+    fn resumed(&mut self, event_loop: &ActiveEventLoop) {
+        if self.gfx.is_some() {
+            return;
+        }
+        let es = self.args.es.map(EsVersion::from);
+        let made = Gfx::create(event_loop, "manylight", self.args.size, es).and_then(|mut g| {
+            if let Some(r) = g.renderer.as_mut() {
+                // A fallback is logged as a warning by the renderer.
+                r.set_method(&self.args.method).map_err(|e| e.to_string())?;
+            }
+            Ok(g)
+        });
+        match made {
+            Ok(g) => {
+                self.good.0 = self.args.method.clone();
+                g.window.request_redraw();
+                self.gfx = Some(g);
+                self.last_frame = Instant::now();
+            }
+            Err(e) => self.fail(event_loop, e),
+        }
+    }
+
+    fn window_event(&mut self, event_loop: &ActiveEventLoop, _: WindowId, event: WindowEvent) {
+        match event {
+            WindowEvent::CloseRequested => self.quit(event_loop),
+            WindowEvent::Resized(size) => {
+                if let Some(g) = &self.gfx {
+                    g.resize(size);
+                }
+            }
+            WindowEvent::Focused(false) => self.fly.release_all(),
+            WindowEvent::KeyboardInput { event, .. } => self.key(event_loop, &event),
+            WindowEvent::MouseInput {
+                state,
+                button: MouseButton::Left,
+                ..
+            } => self.fly.set_dragging(state == ElementState::Pressed),
+            WindowEvent::CursorMoved { position, .. } => {
+                self.fly.cursor_moved(position.x, position.y)
+            }
+            WindowEvent::RedrawRequested => {
+                if let Err(e) = self.redraw(event_loop) {
+                    self.fail(event_loop, e);
+                }
+            }
+            _ => {}
+        }
+    }
+
+    fn about_to_wait(&mut self, _: &ActiveEventLoop) {
+        if let (false, Some(g)) = (self.done, &self.gfx) {
+            g.window.request_redraw();
+        }
+    }
+
+    fn exiting(&mut self, _: &ActiveEventLoop) {
+        // Free GL objects while the window and its context still exist.
+        if let Some(r) = self.gfx.as_mut().and_then(|g| g.renderer.take()) {
+            r.destroy();
+        }
+    }
+}
+
+impl App<'_> {
+    /// Stops the loop; the first error is the one reported.
+    fn fail(&mut self, event_loop: &ActiveEventLoop, error: String) {
+        if self.result.is_ok() {
+            self.result = Err(error);
+        }
+        self.quit(event_loop);
+    }
+
+    /// Stops the loop after this event; no frame is drawn after it.
+    fn quit(&mut self, event_loop: &ActiveEventLoop) {
+        self.done = true;
+        event_loop.exit();
+    }
+
+    /// Movement keys (held), method digits, light count and Esc.
+    fn key(&mut self, event_loop: &ActiveEventLoop, event: &KeyEvent) {
+        let pressed = event.state == ElementState::Pressed;
+        let PhysicalKey::Code(code) = event.physical_key else {
+            return;
+        };
+        // Physical keys for movement and digits, so they sit in the same place on any layout.
+        let movement = match code {
+            KeyCode::KeyW => Some(Move::Forward),
+            KeyCode::KeyS => Some(Move::Back),
+            KeyCode::KeyA => Some(Move::Left),
+            KeyCode::KeyD => Some(Move::Right),
+            KeyCode::KeyQ => Some(Move::Down),
+            KeyCode::KeyE => Some(Move::Up),
+            KeyCode::ShiftLeft | KeyCode::ShiftRight => {
+                self.fly.set_fast(pressed);
+                None
+            }
+            _ => None,
+        };
+        if let Some(m) = movement {
+            self.fly.set_key(m, pressed);
+        }
+        if !pressed || event.repeat {
+            return;
+        }
+        // Digits 1–9 by position (physical), so they work on layouts with shifted digits.
+        const DIGITS: [KeyCode; 9] = [
+            KeyCode::Digit1,
+            KeyCode::Digit2,
+            KeyCode::Digit3,
+            KeyCode::Digit4,
+            KeyCode::Digit5,
+            KeyCode::Digit6,
+            KeyCode::Digit7,
+            KeyCode::Digit8,
+            KeyCode::Digit9,
+        ];
+        // `+`/`-` by character, wherever the layout puts them (`=` is `+` unshifted on US).
+        let typed = |chars: &[&str]| matches!(&event.logical_key, Key::Character(c) if chars.contains(&c.as_str()));
+        if let Some(i) = DIGITS.iter().position(|&d| d == code) {
+            self.switch_method(i);
+        } else if code == KeyCode::NumpadAdd || typed(&["+", "="]) {
+            self.set_lights(self.light_count.saturating_mul(2).clamp(1, MAX_LIGHTS));
+        } else if code == KeyCode::NumpadSubtract || typed(&["-"]) {
+            self.set_lights(self.light_count / 2);
+        } else if event.logical_key == Key::Named(NamedKey::Escape) {
+            self.quit(event_loop);
+        }
+    }
+
+    /// Switches to the `index`-th method of the table; problems go to stderr.
+    fn switch_method(&mut self, index: usize) {
+        let (Some(desc), Some(r)) = (
+            METHODS.get(index),
+            self.gfx.as_mut().and_then(|g| g.renderer.as_mut()),
+        ) else {
+            eprintln!("no method {}: there are {}", index + 1, METHODS.len());
+            return;
+        };
+        match r.set_method(desc.name) {
+            Ok(None) => eprintln!("method: {}", desc.name),
+            Ok(Some(reason)) => eprintln!("warning: {} runs with a fallback: {reason}", desc.name),
+            Err(e) => eprintln!("error: {e}"),
+        }
+    }
+
+    /// Regenerates the random lights with a new count (same seed); problems go to stderr.
+    fn set_lights(&mut self, count: usize) {
+        match scene::load(&self.args.scene, Some((count, self.args.seed))) {
+            // Keep geometry (already uploaded) and camera; only the lights change.
+            Ok((new, _)) => {
+                self.scene.lights = new.lights;
+                self.light_count = count;
+                eprintln!("lights: {}", self.scene.lights.len());
+            }
+            Err(e) => eprintln!("error: cannot regenerate lights: {e}"),
+        }
+    }
+
+    /// Moves the camera, renders one frame, handles `--frames`/`--screenshot`, swaps.
+    fn redraw(&mut self, event_loop: &ActiveEventLoop) -> Result<(), String> {
+        let Some(g) = self.gfx.as_mut().filter(|_| !self.done) else {
+            return Ok(());
+        };
+        let size = g.window.inner_size();
+        if size.width == 0 || size.height == 0 {
+            return Ok(()); // minimised
+        }
+        let now = Instant::now();
+        let dt = now.duration_since(self.last_frame).as_secs_f64();
+        self.last_frame = now;
+        self.fly.update(dt, &mut self.scene.camera);
+        let options = RenderOptions {
+            wait_for_gpu: false,
+            ..RenderOptions::default()
+        };
+        let renderer = g.renderer.as_mut().ok_or("renderer already destroyed")?;
+        let stats = match renderer.render(&self.scene, size.width, size.height, &options) {
+            Ok(s) => s,
+            Err(e) => return self.undo_change(e.to_string()),
+        };
+        self.good = (stats.method.clone(), self.light_count);
+        self.frames += 1;
+        if Some(self.frames) == self.args.frames {
+            let mut line = format!(
+                "{} · {}x{} · {} frames",
+                summary(&stats, g.es),
+                size.width,
+                size.height,
+                self.frames
+            );
+            if let Some(path) = &self.args.screenshot {
+                let image = g.read_back(size)?;
+                image
+                    .save(path)
+                    .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+                line += &format!(" → {}", path.display());
+            }
+            println!("{line}");
+            self.done = true;
+            event_loop.exit();
+        }
+        g.swap()?;
+        update_title(&mut self.title, g, &stats, dt);
+        Ok(())
+    }
+
+    /// A frame failed: undo the last interactive change if there was one, else give up.
+    fn undo_change(&mut self, error: String) -> Result<(), String> {
+        let Some(r) = self.gfx.as_mut().and_then(|g| g.renderer.as_mut()) else {
+            return Err(error);
+        };
+        let (method, lights) = self.good.clone();
+        if self.frames == 0 || (r.method() == method && self.light_count == lights) {
+            return Err(error);
+        }
+        eprintln!("error: {error}; back to {method} with {lights} lights");
+        r.set_method(&method).map_err(|e| e.to_string())?;
+        if self.light_count != lights {
+            self.set_lights(lights);
+        }
+        Ok(())
+    }
+}
+
+/// `manylight · method · ES x · N lights`.
+fn summary(stats: &FrameStats, es: EsVersion) -> String {
+    format!(
+        "manylight · {} · {es} · {} lights",
+        stats.method, stats.lights
+    )
+}
+
+/// The summary plus wall-clock frame time, CPU submission time and light assignment time.
+fn title(stats: &FrameStats, es: EsVersion, frame_ms: f64) -> String {
+    format!(
+        "{} · {frame_ms:.1} ms/frame · cpu {:.1} ms · assign {:.2} ms",
+        summary(stats, es),
+        stats.frame_ms,
+        stats.assign_ms
+    )
+}
+
+/// Accumulates one frame and rewrites the title every [`TITLE_EVERY_S`].
+fn update_title(t: &mut TitleStats, g: &Gfx, stats: &FrameStats, dt: f64) {
+    let since = *t.since.get_or_insert_with(Instant::now);
+    t.frames += 1;
+    t.wall_s += dt;
+    t.cpu_ms += stats.frame_ms;
+    t.assign_ms += stats.assign_ms;
+    if since.elapsed().as_secs_f64() >= TITLE_EVERY_S {
+        let n = f64::from(t.frames);
+        let mean = FrameStats {
+            frame_ms: t.cpu_ms / n,
+            assign_ms: t.assign_ms / n,
+            ..stats.clone()
+        };
+        g.window.set_title(&title(&mean, g.es, t.wall_s * 1e3 / n));
+        *t = TitleStats::default();
+    }
+}

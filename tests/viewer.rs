@@ -1,0 +1,229 @@
+//! `manylight view` (feature `window`) in a virtual X server: the built binary opens a real
+//! window with an EGL OpenGL ES context, renders 5 frames, reads the last one back from the
+//! window's framebuffer and quits. The screenshot must have the window's size, show a lit
+//! scene, and match the same view rendered offscreen by `manylight render`.
+//!
+//! Needs Xvfb (`apt-get install xvfb xauth`). Each test starts its own `Xvfb -displayfd`,
+//! which picks a free display itself, so tests running in parallel never race for a display
+//! number the way concurrent `xvfb-run -a` calls can. Without Xvfb the tests print
+//! `SKIPPED: …` and pass.
+#![cfg(feature = "window")]
+
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Output, Stdio};
+use std::time::{Duration, Instant};
+
+const BIN: &str = env!("CARGO_BIN_EXE_manylight");
+/// Window size asked for (Xvfb has no window manager, so the window gets exactly this).
+const SIZE: (u32, u32) = (320, 240);
+/// X screen of the virtual server: 24-bit colour so EGL finds RGB8 configs.
+const SCREEN: &str = "1024x768x24";
+/// Longest a viewer run may take before the test gives up on it.
+const TIMEOUT: Duration = Duration::from_secs(180);
+
+/// An executable named `name` on `PATH`.
+fn which(name: &str) -> Option<PathBuf> {
+    std::env::split_paths(&std::env::var_os("PATH")?)
+        .map(|dir| dir.join(name))
+        .find(|p| p.is_file())
+}
+
+/// Waits for `child` at most [`TIMEOUT`]; kills it (our own child) when it runs over. Its
+/// output is read at the end: the viewer prints a few lines, far below a pipe's buffer.
+fn wait_with_timeout(mut child: Child, what: &str) -> Output {
+    let start = Instant::now();
+    while child.try_wait().expect("try_wait").is_none() {
+        if start.elapsed() > TIMEOUT {
+            let _ = child.kill();
+            let out = child.wait_with_output().expect("wait");
+            panic!(
+                "{what} ran over {TIMEOUT:?}; stderr:\n{}",
+                String::from_utf8_lossy(&out.stderr)
+            );
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    child.wait_with_output().expect("wait_with_output")
+}
+
+/// An `Xvfb` this test started; stopped with SIGTERM when dropped, so it removes its socket
+/// and lock file.
+struct Server(Child);
+
+impl Drop for Server {
+    fn drop(&mut self) {
+        let terminated = Command::new("kill")
+            .arg(self.0.id().to_string())
+            .status()
+            .is_ok_and(|s| s.success());
+        if !terminated {
+            let _ = self.0.kill();
+        }
+        let _ = self.0.wait();
+    }
+}
+
+/// Starts `Xvfb` on a display it picks itself (`-displayfd`) and returns it once it accepts
+/// connections.
+fn start_xvfb(xvfb: &Path) -> (Server, String) {
+    let child = Command::new(xvfb)
+        .args([
+            "-displayfd",
+            "1",
+            "-screen",
+            "0",
+            SCREEN,
+            "-nolisten",
+            "tcp",
+        ])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::null())
+        .spawn()
+        .expect("spawn Xvfb");
+    let mut server = Server(child);
+    // Xvfb writes the display number to fd 1 when it is ready (EOF if it failed).
+    // The pipe stays open (in `server.0`): Xvfb must not die of SIGPIPE before it cleans up.
+    let mut line = String::new();
+    let stdout = server.0.stdout.as_mut().expect("piped stdout");
+    std::io::BufRead::read_line(&mut std::io::BufReader::new(stdout), &mut line)
+        .expect("read Xvfb's display number");
+    let number: u32 = line
+        .trim()
+        .parse()
+        .unwrap_or_else(|_| panic!("Xvfb did not start (printed {line:?})"));
+    (server, format!(":{number}"))
+}
+
+/// Runs `manylight view ARGS` with extra environment in a virtual X server; `None` when no
+/// Xvfb exists.
+fn run_view(args: &[&str], env: &[(&str, &str)]) -> Option<Output> {
+    let Some(xvfb) = which("Xvfb") else {
+        println!("SKIPPED: no Xvfb on PATH (apt-get install xvfb xauth)");
+        return None;
+    };
+    let (_server, display) = start_xvfb(&xvfb);
+    let mut cmd = Command::new(BIN);
+    cmd.env("DISPLAY", display);
+    // X11 only: a Wayland session in the caller's environment would win otherwise.
+    cmd.env_remove("WAYLAND_DISPLAY")
+        .envs(env.iter().copied())
+        .arg("view")
+        .args(args)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped());
+    let child = cmd.spawn().expect("spawn manylight view");
+    Some(wait_with_timeout(child, "manylight view"))
+}
+
+/// The fraction of `image`'s pixels for which `keep(x, y)` holds.
+fn fraction(image: &image::RgbaImage, keep: impl Fn(u32, u32) -> bool) -> f64 {
+    let kept = image
+        .enumerate_pixels()
+        .filter(|(x, y, _)| keep(*x, *y))
+        .count();
+    kept as f64 / (image.width() * image.height()) as f64
+}
+
+/// Renders 5 frames of the default scene in a window (`extra` arguments and `env`), checks
+/// the screenshot and compares it with `manylight render` of the same view (`render_extra`
+/// arguments). Returns the viewer's stdout and stderr, or `None` when skipped.
+fn check_window_frame(
+    extra: &[&str],
+    render_extra: &[&str],
+    env: &[(&str, &str)],
+) -> Option<(String, String)> {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let shot = dir.path().join("view.png");
+    let size = format!("{}x{}", SIZE.0, SIZE.1);
+    let shot_arg = shot.to_str().expect("utf-8 temp path");
+    let mut args = vec!["--frames", "5", "--screenshot", shot_arg, "--lights", "256"];
+    args.extend(["--size", &size]);
+    args.extend(extra);
+    let out = run_view(&args, env)?;
+    let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
+    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert!(out.status.success(), "manylight view failed:\n{stderr}");
+    assert!(stdout.contains("5 frames"), "stdout: {stdout}");
+
+    let image = image::open(&shot)
+        .unwrap_or_else(|e| panic!("screenshot {}: {e}", shot.display()))
+        .to_rgba8();
+    assert_eq!(image.dimensions(), SIZE, "screenshot has the window's size");
+    let lit = fraction(&image, |x, y| {
+        image.get_pixel(x, y).0[..3].iter().any(|&c| c > 8)
+    });
+    println!("{:.1}% of the pixels are lit", lit * 100.0);
+    assert!(lit > 0.5, "only {:.1}% lit: {stdout}", lit * 100.0);
+
+    // The same view rendered offscreen through headless EGL must look the same.
+    let reference = dir.path().join("render.png");
+    let out = Command::new(BIN)
+        .args([
+            "render", "--lights", "256", "--frames", "0", "--size", &size,
+        ])
+        .args(render_extra)
+        .arg("--out")
+        .arg(&reference)
+        .envs(env.iter().copied())
+        .output()
+        .expect("run manylight render");
+    assert!(
+        out.status.success(),
+        "manylight render failed:\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let reference = image::open(&reference).expect("render.png").to_rgba8();
+    assert_eq!(reference.dimensions(), SIZE);
+    let same = fraction(&image, |x, y| {
+        let (a, b) = (image.get_pixel(x, y), reference.get_pixel(x, y));
+        (0..3).all(|c| a.0[c].abs_diff(b.0[c]) <= 2)
+    });
+    println!(
+        "{:.2}% of the pixels match the offscreen render",
+        same * 100.0
+    );
+    assert!(
+        same > 0.99,
+        "window and offscreen renders differ: {:.2}% match",
+        same * 100.0
+    );
+    Some((stdout, stderr))
+}
+
+#[test]
+fn view_renders_a_lit_frame_into_the_window() {
+    if let Some((stdout, _)) = check_window_frame(&[], &[], &[]) {
+        assert!(
+            stdout.contains("clustered · ES 3.0 · 256 lights"),
+            "{stdout}"
+        );
+    }
+}
+
+#[test]
+fn view_renders_on_es2() {
+    let es2_tiled = ["--es", "2", "--method", "tiled"];
+    if let Some((stdout, _)) = check_window_frame(&es2_tiled, &es2_tiled, &[]) {
+        assert!(stdout.contains("tiled · ES 2.0"), "{stdout}");
+    }
+}
+
+#[test]
+fn view_falls_back_to_es2_where_the_driver_has_no_es3() {
+    let capped = [("MESA_GLES_VERSION_OVERRIDE", "2.0")];
+    if let Some((stdout, stderr)) = check_window_frame(&[], &["--es", "2"], &capped) {
+        assert!(stdout.contains("ES 2.0"), "{stdout}");
+        assert!(stderr.contains("falling back to ES 2.0"), "{stderr}");
+    }
+}
+
+#[test]
+fn view_rejects_bad_input_without_panicking() {
+    let Some(out) = run_view(&["--frames", "1", "--method", "no-such-method"], &[]) else {
+        return;
+    };
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "stderr: {stderr}");
+    assert!(stderr.contains("unknown method"), "stderr: {stderr}");
+    assert!(!stderr.contains("panicked"), "stderr: {stderr}");
+}
