@@ -2,9 +2,8 @@
 //! cascaded cluster grid (`cluster::grid`), uploaded as textures, one geometry pass.
 
 use super::culled::{CulledForward, Culling};
-use super::{FrameContext, MethodDesc, MethodStats, ShadingMethod, Support};
-use crate::gl::{Caps, Device, EsVersion};
-use crate::Error;
+use super::{MethodDesc, Support};
+use crate::gl::{Caps, EsVersion};
 
 /// The table row.
 pub const DESC: MethodDesc = MethodDesc {
@@ -13,7 +12,7 @@ pub const DESC: MethodDesc = MethodDesc {
     min_es: EsVersion::Es2,
     required_extensions: &[],
     supported: culled_support,
-    create: |_| Ok(Box::new(Clustered(CulledForward::new(Culling::Clustered)))),
+    create: |_| Ok(Box::new(CulledForward::new(Culling::Clustered))),
 };
 
 /// Support of both culled methods: ES 2.0 needs highp fragments (cell lookup and texel
@@ -30,22 +29,4 @@ pub fn culled_support(caps: &Caps) -> Support {
         );
     }
     Support::Supported
-}
-
-/// Clustered forward.
-pub struct Clustered(CulledForward);
-
-impl ShadingMethod for Clustered {
-    fn name(&self) -> &'static str {
-        DESC.name
-    }
-    fn render(&mut self, ctx: &mut FrameContext) -> Result<MethodStats, Error> {
-        self.0.render(ctx)
-    }
-    fn gpu_bytes(&self) -> usize {
-        self.0.gpu_bytes()
-    }
-    fn destroy(&mut self, dev: &Device) {
-        self.0.destroy(dev)
-    }
 }

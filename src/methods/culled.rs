@@ -9,7 +9,7 @@
 use std::time::Instant;
 
 use super::geometry::{self, UNIT_METHOD};
-use super::{FrameContext, MethodStats};
+use super::{FrameContext, MethodStats, ShadingMethod};
 use crate::cluster::assign::{assign, AssignLimits};
 use crate::cluster::grid::{ClusterGrid, GridConfig, GridProjection};
 use crate::cluster::pack::{pack_lights, GpuLight, LightEncoding, DATA_TEXTURE_WIDTH};
@@ -125,9 +125,18 @@ impl CulledForward {
         }
         &self.grid.as_ref().expect("built above").1
     }
+}
+
+impl ShadingMethod for CulledForward {
+    fn name(&self) -> &'static str {
+        match self.culling {
+            Culling::Tiled => "tiled",
+            Culling::Clustered => "clustered",
+        }
+    }
 
     /// Renders one frame (see the module docs).
-    pub fn render(&mut self, ctx: &mut FrameContext) -> Result<MethodStats, Error> {
+    fn render(&mut self, ctx: &mut FrameContext) -> Result<MethodStats, Error> {
         let dev = ctx.dev;
         let es = dev.es();
         let (grid_encoding, per_index_texel) = match es {
@@ -245,12 +254,12 @@ impl CulledForward {
     }
 
     /// GPU bytes of all ring sets.
-    pub fn gpu_bytes(&self) -> usize {
+    fn gpu_bytes(&self) -> usize {
         self.ring.iter().flatten().map(TextureSet::gpu_bytes).sum()
     }
 
     /// Frees the ring.
-    pub fn destroy(&mut self, dev: &Device) {
+    fn destroy(&mut self, dev: &Device) {
         for set in self.ring.iter_mut().filter_map(Option::take) {
             set.destroy(dev);
         }

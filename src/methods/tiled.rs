@@ -3,9 +3,8 @@
 
 use super::clustered::culled_support;
 use super::culled::{CulledForward, Culling};
-use super::{FrameContext, MethodDesc, MethodStats, ShadingMethod};
-use crate::gl::{Device, EsVersion};
-use crate::Error;
+use super::MethodDesc;
+use crate::gl::EsVersion;
 
 /// The table row.
 pub const DESC: MethodDesc = MethodDesc {
@@ -14,23 +13,5 @@ pub const DESC: MethodDesc = MethodDesc {
     min_es: EsVersion::Es2,
     required_extensions: &[],
     supported: culled_support,
-    create: |_| Ok(Box::new(Tiled(CulledForward::new(Culling::Tiled)))),
+    create: |_| Ok(Box::new(CulledForward::new(Culling::Tiled))),
 };
-
-/// Tiled forward.
-pub struct Tiled(CulledForward);
-
-impl ShadingMethod for Tiled {
-    fn name(&self) -> &'static str {
-        DESC.name
-    }
-    fn render(&mut self, ctx: &mut FrameContext) -> Result<MethodStats, Error> {
-        self.0.render(ctx)
-    }
-    fn gpu_bytes(&self) -> usize {
-        self.0.gpu_bytes()
-    }
-    fn destroy(&mut self, dev: &Device) {
-        self.0.destroy(dev)
-    }
-}
