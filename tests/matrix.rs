@@ -70,6 +70,27 @@ fn matrix_covers_es2_es2_without_float_and_es3_and_every_supported_cell_matches_
         .as_str()
         .unwrap()
         .contains("ES 2.0"));
+    // Desktop GL through OSMesa runs the same methods (skipped where libOSMesa is missing).
+    let osmesa = row("desktop GL (OSMesa)");
+    match osmesa["error"].as_str() {
+        Some(err) if err.contains("not available") => eprintln!("SKIPPED: OSMesa row: {err}"),
+        Some(err) => panic!("OSMesa row failed: {err}"),
+        None => {
+            assert!(osmesa["gl_version"]
+                .as_str()
+                .unwrap()
+                .contains("Core Profile"));
+            for m in osmesa["methods"].as_array().unwrap() {
+                assert_eq!(m["support"]["status"], "supported", "OSMesa {}", m["name"]);
+                assert!(
+                    m["max_abs"].as_u64().unwrap() <= 2,
+                    "OSMesa {}: {}",
+                    m["name"],
+                    m["max_abs"]
+                );
+            }
+        }
+    }
     let sheet = image::open(dir.path().join("matrix.png")).unwrap();
     assert!(
         sheet.width() > 64 * 5 && sheet.height() > 36 * 5,

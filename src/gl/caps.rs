@@ -27,6 +27,9 @@ pub struct Caps {
     pub es: EsVersion,
     /// `major.minor` of the context the driver returned.
     pub context_version: String,
+    /// Desktop OpenGL (OSMesa) rather than OpenGL ES: shaders are assembled as GLSL 3.30 core
+    /// and the ES 3.0 feature level is used.
+    pub desktop: bool,
     /// `GL_VERSION`.
     pub gl_version: String,
     /// `GL_SHADING_LANGUAGE_VERSION`.
@@ -65,10 +68,14 @@ impl Caps {
     pub fn probe(gl: &glow::Context, es: EsVersion) -> Result<Caps, GlError> {
         let v = gl.version();
         let context_version = format!("{}.{}", v.major, v.minor);
-        if !v.is_embedded {
-            log::warn!("the context is desktop OpenGL {context_version}, not OpenGL ES");
+        let desktop = !v.is_embedded;
+        if desktop && (es != EsVersion::Es3 || (v.major, v.minor) < (3, 3)) {
+            return Err(GlError::VersionUnavailable {
+                requested: es,
+                reason: format!("desktop OpenGL {context_version} runs only the ES 3.0 feature level, and needs 3.3"),
+            });
         }
-        if v.major < es.major() {
+        if !desktop && v.major < es.major() {
             return Err(GlError::VersionUnavailable {
                 requested: es,
                 reason: format!(
@@ -81,7 +88,13 @@ impl Caps {
                 ),
             });
         }
-        let extensions: BTreeSet<String> = gl.supported_extensions().iter().cloned().collect();
+        let mut extensions: BTreeSet<String> = gl.supported_extensions().iter().cloned().collect();
+        if desktop {
+            // Float colour buffers and float blending are core in desktop GL 3.0, so drivers do
+            // not list the ES extensions; record them so one check serves both.
+            extensions.insert("GL_EXT_color_buffer_float".into());
+            extensions.insert("GL_EXT_float_blend".into());
+        }
         let has = |e: &str| extensions.contains(e);
         let es3 = es == EsVersion::Es3;
         let (gl_version, glsl_version, renderer, vendor);
@@ -117,6 +130,7 @@ impl Caps {
         Ok(Caps {
             es,
             context_version,
+            desktop,
             gl_version,
             glsl_version,
             renderer,

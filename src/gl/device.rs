@@ -48,6 +48,13 @@ impl Device {
     /// Wraps a current glow context and probes its capabilities.
     pub fn new(gl: glow::Context, es: EsVersion) -> Result<Device, GlError> {
         let caps = Caps::probe(&gl, es)?;
+        if caps.desktop {
+            // A core profile draws nothing without a bound vertex array object; ES needs none.
+            unsafe {
+                let vao = gl.create_vertex_array().map_err(GlError::Create)?;
+                gl.bind_vertex_array(Some(vao));
+            }
+        }
         Ok(Device {
             gl,
             caps,

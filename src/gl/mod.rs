@@ -16,6 +16,8 @@ pub mod device;
 pub mod framebuffer;
 pub mod gbuffer;
 pub mod mesh;
+#[cfg(feature = "osmesa")]
+pub mod osmesa;
 pub mod precision_probe;
 pub mod program;
 pub mod shader_source;

@@ -28,7 +28,7 @@ fn compile(
     defines: &[(String, String)],
 ) -> Result<(glow::Shader, usize), GlError> {
     let gl = &dev.gl;
-    let source = shader_source::assemble(name, stage, dev.es(), defines)?;
+    let source = shader_source::assemble_for(name, stage, dev.es(), dev.caps().desktop, defines)?;
     let kind = match stage {
         Stage::Vertex => glow::VERTEX_SHADER,
         Stage::Fragment => glow::FRAGMENT_SHADER,

@@ -215,6 +215,32 @@ pub fn assemble(
     dialect: EsVersion,
     defines: &[(String, String)],
 ) -> Result<String, GlError> {
+    assemble_for(shader_name, stage, dialect, false, defines)
+}
+
+/// [`assemble`] for a desktop GL context when `desktop`: the GLSL ES 3.00 source with a
+/// `#version 330 core` line (the two languages agree on everything the shaders use).
+pub fn assemble_for(
+    shader_name: &str,
+    stage: Stage,
+    dialect: EsVersion,
+    desktop: bool,
+    defines: &[(String, String)],
+) -> Result<String, GlError> {
+    let source = assemble_es(shader_name, stage, dialect, defines)?;
+    Ok(if desktop {
+        source.replacen("#version 300 es", "#version 330 core", 1)
+    } else {
+        source
+    })
+}
+
+fn assemble_es(
+    shader_name: &str,
+    stage: Stage,
+    dialect: EsVersion,
+    defines: &[(String, String)],
+) -> Result<String, GlError> {
     let desc = shader(shader_name)?;
     let body = match stage {
         Stage::Vertex => desc.vertex,

@@ -119,11 +119,7 @@ pub fn run(args: &MatrixArgs) -> Result<(), Box<dyn std::error::Error>> {
             .collect::<Vec<_>>());
         rows.push(row);
     }
-    rows.push(json!({
-        "config": "desktop GL (OSMesa)",
-        "error": "not built: the renderer emits GLSL ES only; desktop GL through OSMesa is not implemented yet",
-        "methods": [],
-    }));
+    rows.push(osmesa_row(&exe, args, &size, &out)?);
     print!("{}", markdown(&rows));
     if let Some(path) = &args.json {
         std::fs::write(path, serde_json::to_string_pretty(&rows)? + "\n")
@@ -138,6 +134,46 @@ pub fn run(args: &MatrixArgs) -> Result<(), Box<dyn std::error::Error>> {
         eprintln!("contact sheet: {}", path.display());
     }
     Ok(())
+}
+
+/// Desktop GL through OSMesa, when built with the `osmesa` feature.
+fn osmesa_row(
+    exe: &Path,
+    args: &MatrixArgs,
+    size: &str,
+    out: &Path,
+) -> Result<Value, Box<dyn std::error::Error>> {
+    if !cfg!(feature = "osmesa") {
+        return Ok(json!({
+            "config": "desktop GL (OSMesa)",
+            "error": "not built: rebuild with `--features osmesa`",
+            "methods": [],
+        }));
+    }
+    let output = Command::new(exe)
+        .args([
+            "matrix-cell",
+            "--es",
+            "3",
+            "--osmesa",
+            "--scene",
+            &args.scene,
+            "--size",
+            size,
+        ])
+        .args(["--lights", &args.lights.to_string(), "--tag", "osmesa"])
+        .arg("--out")
+        .arg(out)
+        .output()?;
+    let mut row = match serde_json::from_slice::<Value>(&output.stdout) {
+        Ok(v) if output.status.success() => v,
+        _ => json!({
+            "error": String::from_utf8_lossy(&output.stderr).trim().replace("error: ", ""),
+            "methods": [],
+        }),
+    };
+    row["config"] = json!("desktop GL (OSMesa)");
+    Ok(row)
 }
 
 fn markdown(rows: &[Value]) -> String {
@@ -213,13 +249,45 @@ pub struct MatrixCellArgs {
     tag: String,
     #[arg(long)]
     out: PathBuf,
+    /// Desktop GL through OSMesa instead of EGL (needs the `osmesa` feature).
+    #[arg(long)]
+    osmesa: bool,
+}
+
+/// The context a matrix cell renders with (kept alive for the renderer's life).
+enum CellContext {
+    Egl(Box<HeadlessContext>),
+    #[cfg(feature = "osmesa")]
+    OsMesa(manylight::gl::osmesa::OsMesaContext),
+}
+
+impl CellContext {
+    fn new(es: EsVersion, osmesa: bool) -> Result<CellContext, Box<dyn std::error::Error>> {
+        if osmesa {
+            #[cfg(feature = "osmesa")]
+            return Ok(CellContext::OsMesa(
+                manylight::gl::osmesa::OsMesaContext::new()?,
+            ));
+            #[cfg(not(feature = "osmesa"))]
+            return Err("this build has no OSMesa support (cargo feature `osmesa`)".into());
+        }
+        Ok(CellContext::Egl(Box::new(HeadlessContext::new(es)?)))
+    }
+
+    fn load_gl(&self) -> glow::Context {
+        match self {
+            CellContext::Egl(c) => c.load_gl(),
+            #[cfg(feature = "osmesa")]
+            CellContext::OsMesa(c) => c.load_gl(),
+        }
+    }
 }
 
 /// Renders every method in this (restricted) process and prints one JSON row.
 pub fn run_cell(args: &MatrixCellArgs) -> Result<(), Box<dyn std::error::Error>> {
     let es: EsVersion = args.es.into();
     let (scene, _) = scene::load(&args.scene, Some((args.lights, 1)))?;
-    let ctx = HeadlessContext::new(es)?;
+    let ctx = CellContext::new(es, args.osmesa)?;
     let mut renderer = Renderer::new(ctx.load_gl(), es)?;
     let (w, h) = args.size;
     let opts = RenderOptions {

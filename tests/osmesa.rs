@@ -1,0 +1,48 @@
+//! Desktop OpenGL through OSMesa renders the default scene through the same methods, matching
+//! plain forward there and the ES 3.0 render on EGL. Skipped with a message where libOSMesa is
+//! not installed.
+#![cfg(feature = "osmesa")]
+
+use manylight::gl::osmesa::OsMesaContext;
+use manylight::gl::HeadlessContext;
+use manylight::methods::METHODS;
+use manylight::{scene, EsVersion, RenderOptions, Renderer};
+
+#[test]
+fn osmesa_renders_the_default_scene_through_every_method() {
+    let ctx = match OsMesaContext::new() {
+        Ok(c) => c,
+        Err(e) => {
+            eprintln!("SKIPPED: {e}");
+            return;
+        }
+    };
+    let s = scene::builtin::build(scene::builtin::DEFAULT, Some((256, 5))).unwrap();
+    let opts = RenderOptions::default();
+    let mut r = Renderer::new(ctx.load_gl(), EsVersion::Es3).unwrap();
+    assert!(r.caps().desktop, "OSMesa gives desktop GL");
+    r.set_method("forward").unwrap();
+    let (reference, _) = r.render_offscreen(&s, 160, 90, &opts).unwrap();
+    for m in METHODS {
+        r.set_method(m.name)
+            .unwrap_or_else(|e| panic!("{}: {e}", m.name));
+        let (img, _) = r.render_offscreen(&s, 160, 90, &opts).unwrap();
+        let d = manylight::metrics::diff(&reference, &img);
+        assert!(
+            d.max_abs <= 2,
+            "OSMesa {}: {} / 255 from forward",
+            m.name,
+            d.max_abs
+        );
+    }
+    r.destroy();
+    drop(ctx);
+    // The same picture as ES 3.0 on EGL.
+    let egl = HeadlessContext::new(EsVersion::Es3).unwrap();
+    let mut r = Renderer::new(egl.load_gl(), EsVersion::Es3).unwrap();
+    r.set_method("forward").unwrap();
+    let (es3, _) = r.render_offscreen(&s, 160, 90, &opts).unwrap();
+    r.destroy();
+    let d = manylight::metrics::diff(&reference, &es3);
+    assert!(d.max_abs <= 2, "OSMesa vs EGL ES 3.0: {} / 255", d.max_abs);
+}
