@@ -14,10 +14,15 @@ const METHODS: [&str; 3] = ["forward", "tiled", "clustered"];
 /// Renders `scene` with every method on both ES versions: each within 2/255 of forward, and
 /// all HDR values finite. Returns the ES 3.0 forward image for case-specific checks.
 fn check(name: &str, scene: &Scene, w: u32, h: u32) -> image::RgbaImage {
+    check_with(name, scene, w, h, &RenderOptions::default())
+}
+
+/// [`check`] with explicit options (a finer grid, say).
+fn check_with(name: &str, scene: &Scene, w: u32, h: u32, opts: &RenderOptions) -> image::RgbaImage {
     let mut es3_forward = None;
     for es in [EsVersion::Es2, EsVersion::Es3] {
         let mut gpu = Gpu::new(es);
-        let opts = RenderOptions::default();
+        let opts = opts.clone();
         gpu.r().set_method("forward").unwrap();
         let (reference, _) = gpu.r().render_offscreen(scene, w, h, &opts).unwrap();
         let deferred: &[&str] = if es == EsVersion::Es3 {
@@ -188,9 +193,15 @@ fn lights_on_cell_boundaries_and_one_ulp_either_side() {
         5.0,
         &GridConfig::default(),
     );
-    let c = grid.cascades.last().unwrap();
-    let (z0, _) = grid.slice_depth_range(grid.cascades.len() as u32 - 1, 1);
     let _ = far;
+    // The slice boundary nearest to 4.6 (just in front of the plane at depth 5), so lights on
+    // it reach the plane and a miss shows in the image.
+    let (k, z0) = (0..grid.cascades.len() as u32)
+        .flat_map(|k| (0..grid.cascades[k as usize].slices).map(move |sl| (k, sl)))
+        .map(|(k, sl)| (k, grid.slice_depth_range(k, sl).0))
+        .min_by(|a, b| (a.1 - 4.6).abs().total_cmp(&(b.1 - 4.6).abs()))
+        .unwrap();
+    let c = &grid.cascades[k as usize];
     let (hx, hy) = grid.projection.half_extent(z0);
     let x = (-1.0 + 2.0 * (c.tiles_x / 2) as f64 / c.tiles_x as f64) * hx;
     let y = (-1.0 + 2.0 * (c.tiles_y / 2) as f64 / c.tiles_y as f64) * hy;
@@ -201,7 +212,7 @@ fn lights_on_cell_boundaries_and_one_ulp_either_side() {
         DVec3::new(on.x.next_up(), on.y.next_down(), on.z.next_up()),
         DVec3::new(on.x.next_down(), on.y.next_up(), on.z.next_down()),
     ] {
-        s.lights.push(Light::point(p, 0.6, Vec3::ONE, 0.4));
+        s.lights.push(Light::point(p, 0.9, Vec3::ONE, 0.4));
     }
     check("cell boundaries", &s, w, h);
     assert_matches_oracle("cell boundaries", &s, w, h);
@@ -275,35 +286,39 @@ fn crowded_cells_and_index_lists_past_16_bits() {
 
 #[test]
 fn scene_far_from_the_origin_and_a_distant_light() {
-    let offset = DVec3::new(10_000.0, 0.0, -10_000.0);
-    let mut s = plane();
-    for o in &mut s.objects {
-        o.transform = glam::DMat4::from_translation(offset) * o.transform;
-    }
-    s.camera.position += offset;
-    s.camera.target += offset;
-    s.lights = vec![
-        point([0.75, 0.0, 0.5], 1.5, 1.0),
-        point([-0.5, 0.3, 300.0], 310.0, 3000.0),
-    ];
-    for l in &mut s.lights {
-        l.position += offset;
-    }
-    let img = check("10 km from the origin", &s, 96, 54);
-    // And it looks like the same scene at the origin (view space makes the offset vanish).
+    // 10 km as the issue asks, and 1 000 km, where f32 world coordinates are 6 cm apart: only
+    // the f64 camera subtraction keeps the image identical to the same scene at the origin.
+    let lights = || {
+        vec![
+            point([0.75, 0.0, 0.5], 1.5, 1.0),
+            point([-0.5, 0.3, 300.0], 310.0, 3000.0),
+        ]
+    };
     let mut at_origin = plane();
-    at_origin.lights = vec![
-        point([0.75, 0.0, 0.5], 1.5, 1.0),
-        point([-0.5, 0.3, 300.0], 310.0, 3000.0),
-    ];
+    at_origin.lights = lights();
     let mut gpu = Gpu::new(EsVersion::Es3);
     let reference = gpu.render(&at_origin, 96, 54, &RenderOptions::default());
-    let d = manylight::metrics::diff(&reference, &img);
-    assert!(
-        d.max_abs <= 2,
-        "far from the origin differs by {} / 255",
-        d.max_abs
-    );
+    for km in [10.0, 1000.0] {
+        // Fractions that are not short binary ones, so f32 world positions really round.
+        let offset = DVec3::new(km * 1000.0 + 0.3, 0.17, -km * 1000.0 - 0.7);
+        let mut s = plane();
+        for o in &mut s.objects {
+            o.transform = glam::DMat4::from_translation(offset) * o.transform;
+        }
+        s.camera.position += offset;
+        s.camera.target += offset;
+        s.lights = lights();
+        for l in &mut s.lights {
+            l.position += offset;
+        }
+        let img = check(&format!("{km} km from the origin"), &s, 96, 54);
+        let d = manylight::metrics::diff(&reference, &img);
+        assert!(
+            d.max_abs <= 2,
+            "{km} km from the origin differs by {} / 255",
+            d.max_abs
+        );
+    }
 }
 
 #[test]
@@ -317,8 +332,10 @@ fn wide_odd_and_tiny_framebuffers() {
 #[test]
 fn spot_cones_of_zero_half_and_179_degrees() {
     let mut s = plane();
-    for (i, outer) in [0.0, 0.5, 179.0].into_iter().enumerate() {
-        let x = -2.0 + 2.0 * i as f64;
+    // 0°, 0.5° and 179° are the extremes; the 35° cone, seen from close by, is where a cone
+    // test that culls too much shows.
+    for (i, outer) in [0.0, 0.5, 179.0, 35.0].into_iter().enumerate() {
+        let x = -3.0 + 2.0 * i as f64;
         s.lights.push(Light::spot(
             DVec3::new(x, 0.0, 1.0),
             DVec3::new(0.0, 0.0, -1.0),
@@ -329,7 +346,17 @@ fn spot_cones_of_zero_half_and_179_degrees() {
             2.0,
         ));
     }
-    check("spot cones 0 / 0.5 / 179 deg", &s, 128, 72);
+    // A fine grid (8-pixel cells, no minimum size), so the cone-vs-cell test decides cells.
+    let fine = RenderOptions {
+        grid: manylight::cluster::grid::GridConfig {
+            footprint_px: 8.0,
+            min_cell_size: Some(0.0),
+            ..Default::default()
+        },
+        tile_px: 8.0,
+        ..Default::default()
+    };
+    check_with("spot cones 0 / 0.5 / 179 / 35 deg", &s, 256, 144, &fine);
     assert_matches_oracle("spot cones 0 / 0.5 / 179 deg", &s, 128, 72);
 }
 
