@@ -345,7 +345,9 @@ struct Chunk {
 /// Phase 1 for a contiguous range of lights.
 fn assign_chunk(grid: &ClusterGrid, lights: &[GpuLight], camera_far: f64) -> Chunk {
     let cells = grid.total_cells as usize;
-    let mut pairs: Vec<(u32, u32)> = Vec::with_capacity(lights.len() * 4);
+    // Typical lights touch a handful to a few dozen cells; growing from 8 per light avoids
+    // most reallocation copies.
+    let mut pairs: Vec<(u32, u32)> = Vec::with_capacity(lights.len() * 8);
     let mut counts = vec![0u32; cells];
     let mut local_visible = vec![u32::MAX; lights.len()];
     let mut visible_count = 0u32;
@@ -445,47 +447,13 @@ pub fn assign(
                 .map(|(i, _)| first + i as u32),
         );
     }
-    // Phase 2: global counts and offsets.
-    let mut counts = vec![0u32; cells];
-    for chunk in &chunks {
-        for (total, n) in counts.iter_mut().zip(&chunk.counts) {
-            *total += n;
-        }
-    }
-    let mut offsets = vec![0u32; cells];
-    let mut running = 0usize;
-    for (o, n) in offsets.iter_mut().zip(&counts) {
-        *o = running as u32;
-        running += *n as usize;
-    }
-    // Phase 3, in parallel: every thread fills a contiguous block of cells of the final list
-    // (disjoint slices), concatenating the chunks' runs for each cell.
-    let mut indices = vec![0u32; running];
-    let blocks = split_cells(&offsets, running, threads);
-    let mut rest: &mut [u32] = &mut indices;
-    let mut jobs = Vec::with_capacity(blocks.len());
-    for &(c0, c1) in &blocks {
-        let len = if c1 < cells {
-            offsets[c1] as usize
-        } else {
-            running
-        } - offsets[c0] as usize;
-        let (head, tail) = rest.split_at_mut(len);
-        jobs.push((c0, c1, head));
-        rest = tail;
-    }
-    parallel_map(jobs, |(c0, c1, out)| {
-        let mut at = 0;
-        for cell in c0..c1 {
-            for (chunk, base) in chunks.iter().zip(&visible_base) {
-                let (o, n) = (chunk.offsets[cell] as usize, chunk.counts[cell] as usize);
-                for (dst, src) in out[at..at + n].iter_mut().zip(&chunk.sorted[o..o + n]) {
-                    *dst = src + base;
-                }
-                at += n;
-            }
-        }
-    });
+    let (mut offsets, mut counts, mut indices) = if chunks.len() == 1 {
+        // One chunk is already the final list: no merge pass.
+        let chunk = chunks.into_iter().next().expect("one chunk");
+        (chunk.offsets, chunk.counts, chunk.sorted)
+    } else {
+        merge_chunks(&chunks, &visible_base, cells, threads)
+    };
     let max_lights_per_cluster = counts.iter().copied().max().unwrap_or(0);
     let mut stats = AssignStats {
         clusters: grid.total_cells,
@@ -532,6 +500,56 @@ pub fn assign(
         indices,
         stats,
     }
+}
+
+/// Phases 2 and 3 for several chunks: global counts and offsets, then every thread fills a
+/// contiguous block of cells of the final list (disjoint slices), concatenating the chunks'
+/// runs for each cell.
+fn merge_chunks(
+    chunks: &[Chunk],
+    visible_base: &[u32],
+    cells: usize,
+    threads: usize,
+) -> (Vec<u32>, Vec<u32>, Vec<u32>) {
+    let mut counts = vec![0u32; cells];
+    for chunk in chunks {
+        for (total, n) in counts.iter_mut().zip(&chunk.counts) {
+            *total += n;
+        }
+    }
+    let mut offsets = vec![0u32; cells];
+    let mut running = 0usize;
+    for (o, n) in offsets.iter_mut().zip(&counts) {
+        *o = running as u32;
+        running += *n as usize;
+    }
+    let mut indices = vec![0u32; running];
+    let blocks = split_cells(&offsets, running, threads);
+    let mut rest: &mut [u32] = &mut indices;
+    let mut jobs = Vec::with_capacity(blocks.len());
+    for &(c0, c1) in &blocks {
+        let len = if c1 < cells {
+            offsets[c1] as usize
+        } else {
+            running
+        } - offsets[c0] as usize;
+        let (head, tail) = rest.split_at_mut(len);
+        jobs.push((c0, c1, head));
+        rest = tail;
+    }
+    parallel_map(jobs, |(c0, c1, out)| {
+        let mut at = 0;
+        for cell in c0..c1 {
+            for (chunk, base) in chunks.iter().zip(visible_base) {
+                let (o, n) = (chunk.offsets[cell] as usize, chunk.counts[cell] as usize);
+                for (dst, src) in out[at..at + n].iter_mut().zip(&chunk.sorted[o..o + n]) {
+                    *dst = src + base;
+                }
+                at += n;
+            }
+        }
+    });
+    (offsets, counts, indices)
 }
 
 /// Splits the cells into at most `parts` contiguous, non-empty blocks with about equal numbers
