@@ -286,8 +286,9 @@ fn crowded_cells_and_index_lists_past_16_bits() {
 
 #[test]
 fn scene_far_from_the_origin_and_a_distant_light() {
-    // 10 km as the issue asks, and 1 000 km, where f32 world coordinates are 6 cm apart: only
-    // the f64 camera subtraction keeps the image identical to the same scene at the origin.
+    // 10 km as the issue asks, and 1 000 and 10 000 km, where f32 world coordinates are 6 cm
+    // and 1 m apart: only the f64 camera subtraction keeps the image identical to the same
+    // scene at the origin.
     let lights = || {
         vec![
             point([0.75, 0.0, 0.5], 1.5, 1.0),
@@ -298,7 +299,7 @@ fn scene_far_from_the_origin_and_a_distant_light() {
     at_origin.lights = lights();
     let mut gpu = Gpu::new(EsVersion::Es3);
     let reference = gpu.render(&at_origin, 96, 54, &RenderOptions::default());
-    for km in [10.0, 1000.0] {
+    for km in [10.0, 1000.0, 10_000.0] {
         // Fractions that are not short binary ones, so f32 world positions really round.
         let offset = DVec3::new(km * 1000.0 + 0.3, 0.17, -km * 1000.0 - 0.7);
         let mut s = plane();
