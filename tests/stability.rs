@@ -191,7 +191,7 @@ fn lights_on_cell_boundaries_and_one_ulp_either_side() {
         GridProjection::from_matrix(&proj),
         near,
         5.0,
-        &GridConfig::default(),
+        &fine_grid(),
     );
     let _ = far;
     // The slice boundary nearest to 4.6 (just in front of the plane at depth 5), so lights on
@@ -214,8 +214,24 @@ fn lights_on_cell_boundaries_and_one_ulp_either_side() {
     ] {
         s.lights.push(Light::point(p, 0.9, Vec3::ONE, 0.4));
     }
-    check("cell boundaries", &s, w, h);
+    // Small cells (the same configuration as the grid above), so a light that misses a cell
+    // it touches shows in the image.
+    let opts = RenderOptions {
+        grid: fine_grid(),
+        tile_px: 8.0,
+        ..Default::default()
+    };
+    check_with("cell boundaries", &s, w, h, &opts);
     assert_matches_oracle("cell boundaries", &s, w, h);
+}
+
+/// 8-pixel cells without a minimum size: cells small enough that culling decides pixels.
+fn fine_grid() -> manylight::cluster::grid::GridConfig {
+    manylight::cluster::grid::GridConfig {
+        footprint_px: 8.0,
+        min_cell_size: Some(0.0),
+        ..Default::default()
+    }
 }
 
 #[test]
