@@ -180,7 +180,7 @@ fn extreme_near_and_far_planes_and_orthographic() {
 
 #[test]
 fn lights_on_cell_boundaries_and_one_ulp_either_side() {
-    use manylight::cluster::grid::{ClusterGrid, GridConfig, GridProjection};
+    use manylight::cluster::grid::{ClusterGrid, GridProjection};
     let mut s = plane();
     let (w, h) = (128u32, 72u32);
     let proj = s.camera.projection_matrix(w as f64 / h as f64);
