@@ -19,7 +19,7 @@ use crate::gl::texture::ImageTexture;
 use crate::gl::{Caps, Device, EsVersion};
 use crate::methods::{self, FrameContext, ShaderFeatures, ShadingMethod, Support};
 use crate::scene::features::SceneFeatures;
-use crate::scene::{Material, Mesh, Projection, Scene, Texture};
+use crate::scene::{Aabb, Material, Mesh, Projection, Scene, Texture};
 use crate::Error;
 
 /// Per-call rendering options.
@@ -137,7 +137,8 @@ pub struct FrameStats {
 /// an `Arc` of each source, so a key can never be reused by another allocation.
 #[derive(Default)]
 pub struct GpuScene {
-    meshes: HashMap<usize, (Arc<Mesh>, GpuMesh)>,
+    /// Uploaded meshes with their object-space bounds (computed once, not every frame).
+    meshes: HashMap<usize, (Arc<Mesh>, GpuMesh, Option<Aabb>)>,
     textures: HashMap<usize, (Arc<Texture>, ImageTexture)>,
     /// 1×1 white texture for full variants on untextured materials (made on first use).
     white: Option<ImageTexture>,
@@ -152,7 +153,7 @@ impl GpuScene {
         for o in &scene.objects {
             let key = Arc::as_ptr(&o.mesh) as usize;
             if let std::collections::hash_map::Entry::Vacant(e) = self.meshes.entry(key) {
-                e.insert((o.mesh.clone(), GpuMesh::new(dev, &o.mesh)?));
+                e.insert((o.mesh.clone(), GpuMesh::new(dev, &o.mesh)?, o.mesh.bounds()));
             }
         }
         for m in &scene.materials {
@@ -171,6 +172,22 @@ impl GpuScene {
         &self.meshes[&(Arc::as_ptr(&object.mesh) as usize)].1
     }
 
+    /// World-space bounds of an object, from its mesh's cached bounds (the scene must have
+    /// been uploaded).
+    pub fn world_bounds(&self, object: &crate::scene::Object) -> Option<Aabb> {
+        let (_, _, bounds) = &self.meshes[&(Arc::as_ptr(&object.mesh) as usize)];
+        bounds.map(|b| b.transformed(&object.transform))
+    }
+
+    /// World-space bounds of the whole scene ([`Scene::bounds`] without walking every vertex).
+    pub fn scene_bounds(&self, scene: &Scene) -> Option<Aabb> {
+        scene
+            .objects
+            .iter()
+            .filter_map(|o| self.world_bounds(o))
+            .reduce(|a, b| a.union(&b))
+    }
+
     /// The uploaded diffuse texture of a material, if it has one.
     pub fn texture_for(&self, material: &Material) -> Option<&ImageTexture> {
         let t = material.diffuse_texture.as_ref()?;
@@ -185,7 +202,7 @@ impl GpuScene {
     }
 
     fn destroy(&mut self, dev: &Device) {
-        for (_, (_, mut m)) in self.meshes.drain() {
+        for (_, (_, mut m, _)) in self.meshes.drain() {
             m.destroy(dev);
         }
         for (_, (_, mut t)) in self.textures.drain() {
@@ -317,7 +334,7 @@ impl Renderer {
                 options.force_rgba8_lights || !self.dev.caps().float_textures,
             );
         let (near, far) = scene.camera.near_far();
-        let content_far = content_far(scene, &view, near, far);
+        let content_far = content_far(self.gpu_scene.scene_bounds(scene), &view, near, far);
         self.dev.viewport(0, 0, width as i32, height as i32);
         self.dev.clear(options.clear_color);
         let mut ctx = FrameContext {
@@ -481,24 +498,9 @@ impl Renderer {
 /// Farthest view depth of the scene's geometry, clipped to `[near, far]` (never below a little
 /// past the near plane): where a cluster grid should end. Lights beyond it still reach the
 /// last slice, which extends to infinity.
-fn content_far(scene: &Scene, view: &DMat4, near: f64, far: f64) -> f64 {
-    let deepest = scene
-        .bounds()
-        .map(|b| {
-            (0..8)
-                .map(|i| {
-                    let pick =
-                        |bit: u32, lo: f64, hi: f64| if i & (1 << bit) != 0 { hi } else { lo };
-                    let p = glam::DVec3::new(
-                        pick(0, b.min.x, b.max.x),
-                        pick(1, b.min.y, b.max.y),
-                        pick(2, b.min.z, b.max.z),
-                    );
-                    -view.transform_point3(p).z
-                })
-                .fold(f64::MIN, f64::max)
-        })
-        .unwrap_or(far);
+fn content_far(bounds: Option<Aabb>, view: &DMat4, near: f64, far: f64) -> f64 {
+    // View space looks down −Z: the deepest point has the smallest z.
+    let deepest = bounds.map_or(far, |b| -b.transformed(view).min.z);
     let floor = if near > 0.0 { near * 2.0 } else { 1e-3 };
     let d = deepest.min(far).max(floor);
     if d.is_finite() {

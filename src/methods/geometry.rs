@@ -35,8 +35,11 @@ pub(crate) fn draw_order(ctx: &FrameContext) -> (Vec<usize>, Vec<usize>) {
     }
     let depth = |i: &usize| {
         let o = &scene.objects[*i];
-        let centre = o.mesh.bounds().map_or(glam::DVec3::ZERO, |b| b.center());
-        -(ctx.view * o.transform).transform_point3(centre).z
+        let centre = ctx
+            .gpu_scene
+            .world_bounds(o)
+            .map_or(glam::DVec3::ZERO, |b| b.center());
+        -ctx.view.transform_point3(centre).z
     };
     transparent.sort_by(|a, b| depth(b).total_cmp(&depth(a)));
     (opaque, transparent)
