@@ -21,7 +21,7 @@ use super::{FrameContext, MethodDesc, MethodStats, ShaderFeatures, ShadingMethod
 use crate::cluster::grid::GridProjection;
 use crate::gl::gbuffer::{self, GBuffer};
 use crate::gl::mesh::GpuMesh;
-use crate::gl::program::ProgramKey;
+use crate::gl::program::{Program, ProgramKey};
 use crate::gl::state::{Blend, Cull, DepthTest, RenderState};
 use crate::gl::{Caps, Device, EsVersion};
 use crate::scene::meshbuild::MeshBuilder;
@@ -156,17 +156,7 @@ impl Deferred {
                 .programs
                 .get_or_build(dev, key, || features.defines(dev.es(), 1))?;
             program.bind(dev);
-            for (i, name) in ["u_gAlbedo", "u_gNormalDepth", "u_gSpecular"]
-                .iter()
-                .enumerate()
-            {
-                program.set_i32(dev, name, (UNIT_METHOD + i as u32) as i32);
-            }
-            program.set_vec2(
-                dev,
-                "u_viewport",
-                [ctx.viewport.0 as f32, ctx.viewport.1 as f32],
-            );
+            set_gbuffer_uniforms(program, dev, ctx.viewport);
             program.set_vec2(dev, "u_halfExtent", half);
             program.set_f32(dev, "u_orthographic", if ortho { 1.0 } else { 0.0 });
             program.set_mat4(dev, "u_projection", &ctx.projection);
@@ -209,19 +199,9 @@ impl Deferred {
             .as_ref()
             .expect("allocated")
             .bind_textures(dev, UNIT_METHOD);
-        for (i, name) in ["u_gAlbedo", "u_gNormalDepth", "u_gSpecular", "u_accum"]
-            .iter()
-            .enumerate()
-        {
-            program.set_i32(dev, name, (UNIT_METHOD + i as u32) as i32);
-        }
+        set_gbuffer_uniforms(program, dev, ctx.viewport);
         program.set_vec3(dev, "u_ambient", ctx.scene.ambient);
         program.set_f32(dev, "u_alpha", 1.0);
-        program.set_vec2(
-            dev,
-            "u_viewport",
-            [ctx.viewport.0 as f32, ctx.viewport.1 as f32],
-        );
         program.set_f32(
             dev,
             "u_orthographic",
@@ -230,6 +210,18 @@ impl Deferred {
         self.fullscreen.as_ref().expect("allocated").draw(dev);
         Ok(())
     }
+}
+
+/// The G-buffer samplers (units from [`UNIT_METHOD`], in `GBuffer::bind_textures` order; the
+/// light pass has no `u_accum`, so setting it there is a no-op) and the viewport size.
+fn set_gbuffer_uniforms(program: &mut Program, dev: &Device, viewport: (u32, u32)) {
+    for (i, name) in ["u_gAlbedo", "u_gNormalDepth", "u_gSpecular", "u_accum"]
+        .iter()
+        .enumerate()
+    {
+        program.set_i32(dev, name, (UNIT_METHOD + i as u32) as i32);
+    }
+    program.set_vec2(dev, "u_viewport", [viewport.0 as f32, viewport.1 as f32]);
 }
 
 impl ShadingMethod for Deferred {
