@@ -1,15 +1,17 @@
-//! Development aid: one workload assigned repeatedly (for profilers).
+//! Development aid: one workload assigned repeatedly with reused buffers (for profilers):
+//! `cargo run --release --example assign_profile -- LIGHTS [REPEATS]`.
+use manylight::cluster::assign::Assigner;
 use manylight::cluster::workload::AssignWorkload;
 
 fn main() {
-    let count: usize = std::env::args()
-        .nth(1)
-        .and_then(|a| a.parse().ok())
-        .unwrap_or(65_536);
+    let mut args = std::env::args().skip(1).map(|a| a.parse::<usize>().ok());
+    let count = args.next().flatten().unwrap_or(65_536);
+    let repeats = args.next().flatten().unwrap_or(20);
     let w = AssignWorkload::default_view(count, 1);
+    let mut assigner = Assigner::new();
     let mut total = 0;
-    for _ in 0..20 {
-        total += w.assign().indices.len();
+    for _ in 0..repeats {
+        total += w.assign_with(&mut assigner).indices.len();
     }
     println!("{total}");
 }

@@ -394,6 +394,32 @@ fn parallel_and_sequential_assignment_agree() {
     assert_eq!(seq.indices, par.indices);
 }
 
+/// One assigner over frames of different sizes, grids and light sets gives what fresh buffers
+/// give (nothing stale survives from an earlier frame).
+#[test]
+fn reused_buffers_match_fresh_ones() {
+    let mut rng = Pcg64Mcg::seed_from_u64(11);
+    let mut assigner = super::assign::Assigner::new();
+    let cases = cases();
+    for (frame, case) in cases.iter().cycle().take(12).enumerate() {
+        let grid = ClusterGrid::new(320, 180, case.projection, case.near, case.far, &case.config);
+        let n = [5000, 0, 700, 9000][frame % 4];
+        let lights = random_lights(&mut rng, n, case.far.min(200.0) * 0.5);
+        let limits = AssignLimits {
+            cell_cap: if frame % 3 == 0 { 40 } else { u32::MAX },
+            parallel_threshold: if frame % 2 == 0 { 1 } else { usize::MAX },
+            ..Default::default()
+        };
+        let fresh = assign(&grid, &lights, case.far, &limits);
+        let reused = assigner.assign(&grid, &lights, case.far, &limits);
+        assert_eq!(fresh.visible, reused.visible, "{}", case.name);
+        assert_eq!(fresh.offsets, reused.offsets, "{}", case.name);
+        assert_eq!(fresh.counts, reused.counts, "{}", case.name);
+        assert_eq!(fresh.indices, reused.indices, "{}", case.name);
+        assert_eq!(fresh.stats, reused.stats, "{}", case.name);
+    }
+}
+
 #[test]
 fn zero_lights_do_no_work() {
     let t = (30f64).to_radians().tan();

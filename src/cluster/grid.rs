@@ -184,6 +184,10 @@ pub struct ClusterGrid {
     pub cascades: Vec<Cascade>,
     /// Total cells.
     pub total_cells: u32,
+    /// NDC per unit of view-space slope (perspective: `1 / tan`) or of view-space offset
+    /// (orthographic: `1 / half extent`), for x and y: multiplied instead of divided by in the
+    /// assignment's hot path.
+    pub(crate) ndc_scale: [f64; 2],
     /// Bounding sphere (view-space centre, radius) of every cell, built on first use (the
     /// cone-vs-cell test of spot lights); infinite radius for cells reaching infinity.
     cell_spheres: std::sync::OnceLock<Vec<[f64; 4]>>,
@@ -278,13 +282,22 @@ impl ClusterGrid {
             b,
             cascades,
             total_cells: first_cell,
+            ndc_scale: match projection {
+                GridProjection::Perspective { tan_x, tan_y } => [1.0 / tan_x, 1.0 / tan_y],
+                GridProjection::Orthographic { half_x, half_y } => [1.0 / half_x, 1.0 / half_y],
+            },
             cell_spheres: std::sync::OnceLock::new(),
         }
     }
 
     /// Bounding sphere `[x, y, z, radius]` of a cell (see `cell_spheres`).
     pub fn cell_sphere(&self, index: u32) -> [f64; 4] {
-        self.cell_spheres.get_or_init(|| self.build_cell_spheres())[index as usize]
+        self.cell_spheres()[index as usize]
+    }
+
+    /// Bounding spheres `[x, y, z, radius]` of every cell, in cell order (built on first use).
+    pub fn cell_spheres(&self) -> &[[f64; 4]] {
+        self.cell_spheres.get_or_init(|| self.build_cell_spheres())
     }
 
     fn build_cell_spheres(&self) -> Vec<[f64; 4]> {
@@ -344,6 +357,29 @@ impl ClusterGrid {
     /// Cascade and slice of a view depth (the mapping the shader evaluates).
     pub fn view_z_to_cascade_slice(&self, d: f64) -> (u32, u32) {
         self.t_to_cascade_slice(self.depth_to_t(d))
+    }
+
+    /// First and last (cascade, slice) a depth range `[dmin, dmax]` can touch: the hot path of
+    /// the assignment. The logarithm is [`fast_log2`] (a quarter of the cost of `f64::log2`)
+    /// and the range is widened by far more than its error, so the result never misses a
+    /// slice that [`view_z_to_cascade_slice`](Self::view_z_to_cascade_slice) gives a depth
+    /// inside the range; at worst it includes one neighbour slice more.
+    pub fn depth_range_to_slices(&self, dmin: f64, dmax: f64) -> ((u32, u32), (u32, u32)) {
+        match self.mapping {
+            DepthMapping::Linear => (
+                self.view_z_to_cascade_slice(dmin),
+                self.view_z_to_cascade_slice(dmax),
+            ),
+            DepthMapping::Log2 => {
+                const WIDEN: f64 = 1e-5;
+                let l0 = fast_log2(dmin) - WIDEN;
+                let l1 = fast_log2(dmax) + WIDEN;
+                (
+                    self.t_to_cascade_slice((l0 - self.a) * self.b),
+                    self.t_to_cascade_slice((l1 - self.a) * self.b),
+                )
+            }
+        }
     }
 
     /// Cascade and slice of a grid coordinate, clamped into the grid.
@@ -423,6 +459,28 @@ impl ClusterGrid {
     }
 }
 
+/// `log2(d)` within 10⁻⁸ (absolute) for every `d`, clamped to `[1e-300, 1e300]` (so 0 and
+/// infinity map to finite values, like the shader's clamp), with no libm call and no
+/// division: the exponent from the bits; the mantissa `m` split as `m = mᵢ·(1 + ρ)` with
+/// `mᵢ = 1 + i/64` from its top 6 bits (a table holds `log2 mᵢ` and `1/mᵢ`) and
+/// `|ρ| < 1/64`; `log2(1 + ρ)` by four terms of its series (error below `ρ⁵/(5 ln 2)`).
+pub fn fast_log2(d: f64) -> f64 {
+    static TABLE: std::sync::LazyLock<[(f64, f64); 64]> = std::sync::LazyLock::new(|| {
+        std::array::from_fn(|i| {
+            let m = 1.0 + i as f64 / 64.0;
+            (m.log2(), 1.0 / m)
+        })
+    });
+    const LOG2_E: f64 = std::f64::consts::LOG2_E;
+    let bits = d.clamp(1e-300, 1e300).to_bits();
+    let exponent = ((bits >> 52) & 0x7ff) as i64 - 1023;
+    let m = f64::from_bits((bits & ((1u64 << 52) - 1)) | (1023u64 << 52));
+    let (log_mi, inv_mi) = TABLE[((bits >> 46) & 63) as usize];
+    let rho = m * inv_mi - 1.0;
+    let series = rho * (1.0 - rho * (0.5 - rho * (1.0 / 3.0 - rho * 0.25)));
+    exponent as f64 + log_mi + series * LOG2_E
+}
+
 /// A cell's extent (see [`ClusterGrid::cell_bounds`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CellBounds {
@@ -451,6 +509,53 @@ mod tests {
             far,
             &GridConfig::default(),
         )
+    }
+
+    #[test]
+    fn fast_log2_is_within_its_stated_error() {
+        let mut worst = 0.0f64;
+        let mut d = 1e-12f64;
+        while d < 1e12 {
+            for x in [d, d.next_up(), d * 1.000_173, d * std::f64::consts::SQRT_2] {
+                worst = worst.max((fast_log2(x) - x.log2()).abs());
+            }
+            d *= 1.003_7;
+        }
+        assert!(worst < 1e-8, "fast_log2 off by {worst}");
+        assert!(
+            worst > 0.0,
+            "the approximation is not exact; the test must see its error"
+        );
+        assert!(fast_log2(0.0).is_finite() && fast_log2(f64::INFINITY).is_finite());
+    }
+
+    #[test]
+    fn depth_ranges_never_miss_a_slice() {
+        for g in [persp(1e-4, 1e5), persp(0.1, 80.0), persp(0.5, 0.6)] {
+            let mut d = g.near;
+            while d < g.far * 2.0 {
+                for x in [d, d.next_up(), d.next_down()] {
+                    let exact = g.view_z_to_cascade_slice(x);
+                    let (lo, hi) = g.depth_range_to_slices(x, x);
+                    assert!(
+                        lo <= exact && exact <= hi,
+                        "{x}: {exact:?} not in {lo:?}..{hi:?}"
+                    );
+                }
+                // On every slice boundary too.
+                let (k, s) = g.view_z_to_cascade_slice(d);
+                let (z0, _) = g.slice_depth_range(k, s);
+                for x in [z0, z0.next_up(), z0.next_down()] {
+                    let exact = g.view_z_to_cascade_slice(x);
+                    let (lo, hi) = g.depth_range_to_slices(x, x);
+                    assert!(
+                        lo <= exact && exact <= hi,
+                        "{x}: {exact:?} not in {lo:?}..{hi:?}"
+                    );
+                }
+                d *= 1.013;
+            }
+        }
     }
 
     #[test]

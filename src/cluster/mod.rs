@@ -1,9 +1,10 @@
 //! GL-free CPU light assignment: the cascaded cluster grid (`grid`), 2D screen tiles
-//! (`tiles`), per-frame light → cell assignment with a counting sort (`assign`), and the texel
-//! layouts the shaders read (`pack`). Nothing here touches GL, so all of it is unit-tested
+//! (`tiles`), which cells one light touches (`cells`), per-frame light → cell assignment with
+//! a counting sort (`assign`), and the texel layouts the shaders read (`pack`). Nothing here touches GL, so all of it is unit-tested
 //! without a context.
 
 pub mod assign;
+pub mod cells;
 pub mod grid;
 pub mod pack;
 pub mod pack_grid;

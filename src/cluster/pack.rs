@@ -70,6 +70,9 @@ pub struct GpuLight {
     pub position: Vec3,
     /// Radius of influence.
     pub radius: f32,
+    /// Radius the light is culled with (CPU only, never uploaded): `radius` unless a light
+    /// cut-off trims the faint tail (`RenderOptions::light_cutoff`), trading error for time.
+    pub cull_radius: f32,
     /// `color × intensity`.
     pub radiance: Vec3,
     /// Spot smoothstep scale (0 for point lights).
@@ -102,6 +105,7 @@ impl GpuLight {
         GpuLight {
             position: view.transform_point3(light.position).as_vec3(),
             radius: light.radius,
+            cull_radius: light.radius,
             radiance: light.radiance(),
             spot_scale,
             direction,
@@ -213,6 +217,7 @@ pub fn unpack_light(packed: &PackedLights, i: usize) -> GpuLight {
             GpuLight {
                 position: Vec3::new(f[0], f[1], f[2]),
                 radius: f[3],
+                cull_radius: f[3],
                 radiance: Vec3::new(f[4], f[5], f[6]),
                 spot_scale: f[7],
                 direction: Vec3::new(f[8], f[9], f[10]),
@@ -243,6 +248,7 @@ pub fn unpack_light(packed: &PackedLights, i: usize) -> GpuLight {
             GpuLight {
                 position: Vec3::new(pos(0), pos(2), pos(4)),
                 radius: w(6) * packed.radius_range,
+                cull_radius: w(6) * packed.radius_range,
                 radiance,
                 spot_scale: scale,
                 direction: dir.normalize_or_zero(),

@@ -3,7 +3,7 @@
 
 use std::time::Instant;
 
-use super::assign::{assign, AssignLimits, Assignment};
+use super::assign::{AssignLimits, Assigner, Assignment};
 use super::grid::{ClusterGrid, GridConfig, GridProjection};
 use super::pack::GpuLight;
 use crate::scene;
@@ -46,9 +46,9 @@ impl AssignWorkload {
         AssignWorkload { grid, lights, far }
     }
 
-    /// One assignment.
-    pub fn assign(&self) -> Assignment {
-        assign(
+    /// One assignment with `assigner`'s buffers (as a renderer does every frame).
+    pub fn assign_with<'a>(&self, assigner: &'a mut Assigner) -> &'a Assignment {
+        assigner.assign(
             &self.grid,
             &self.lights,
             self.far,
@@ -59,15 +59,23 @@ impl AssignWorkload {
         )
     }
 
-    /// Median wall time in milliseconds over `runs` assignments (after one warm-up), and the
-    /// number of indices produced.
+    /// One assignment with fresh buffers.
+    pub fn assign(&self) -> Assignment {
+        let mut assigner = Assigner::new();
+        self.assign_with(&mut assigner);
+        assigner.into_assignment()
+    }
+
+    /// Median wall time in milliseconds over `runs` assignments (after one warm-up that sizes
+    /// the reused buffers, as the first frame of a renderer does), and the number of indices
+    /// produced.
     pub fn time(&self, runs: usize) -> (f64, usize) {
-        let indices = self.assign().indices.len();
+        let mut assigner = Assigner::new();
+        let indices = self.assign_with(&mut assigner).indices.len();
         let mut times: Vec<f64> = (0..runs.max(1))
             .map(|_| {
                 let t = Instant::now();
-                let a = self.assign();
-                std::hint::black_box(&a);
+                std::hint::black_box(self.assign_with(&mut assigner));
                 t.elapsed().as_secs_f64() * 1e3
             })
             .collect();

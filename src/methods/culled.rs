@@ -10,7 +10,7 @@ use std::time::Instant;
 
 use super::geometry::{self, UNIT_METHOD};
 use super::{FrameContext, MethodStats, ShadingMethod};
-use crate::cluster::assign::{assign, AssignLimits};
+use crate::cluster::assign::{AssignLimits, Assigner};
 use crate::cluster::grid::{ClusterGrid, GridConfig, GridProjection};
 use crate::cluster::pack::{pack_lights, GpuLight, LightEncoding, DATA_TEXTURE_WIDTH};
 use crate::cluster::pack_grid::{
@@ -74,6 +74,8 @@ pub struct CulledForward {
     ring: Vec<Option<TextureSet>>,
     frame: usize,
     grid: Option<(GridKey, ClusterGrid)>,
+    /// Assignment buffers, reused frame after frame.
+    assigner: Assigner,
 }
 
 /// What the grid depends on; it is rebuilt only when this changes.
@@ -94,10 +96,12 @@ impl CulledForward {
             ring: (0..RING).map(|_| None).collect(),
             frame: 0,
             grid: None,
+            assigner: Assigner::new(),
         }
     }
 
-    fn grid_for(&mut self, ctx: &FrameContext) -> &ClusterGrid {
+    /// Rebuilds the grid when the viewport, projection or grid settings changed.
+    fn update_grid(&mut self, ctx: &FrameContext) {
         let projection = GridProjection::from_matrix(&ctx.projection.as_dmat4());
         let config = match self.culling {
             Culling::Clustered => ctx.options.grid.clone(),
@@ -123,7 +127,6 @@ impl CulledForward {
             let grid = ClusterGrid::new(w, h, projection, ctx.near, ctx.content_far, &config);
             self.grid = Some((key, grid));
         }
-        &self.grid.as_ref().expect("built above").1
     }
 }
 
@@ -160,9 +163,10 @@ impl ShadingMethod for CulledForward {
         };
         let camera_far = ctx.far;
         let lights = ctx.lights;
-        let grid = self.grid_for(ctx).clone();
+        self.update_grid(ctx);
+        let grid = &self.grid.as_ref().expect("updated above").1;
         let started = Instant::now();
-        let assignment = assign(&grid, lights, camera_far, &limits);
+        let assignment = self.assigner.assign(grid, lights, camera_far, &limits);
         let assign_ms = started.elapsed().as_secs_f64() * 1e3;
         if assignment.visible.len() > MAX_INDEXED_LIGHTS {
             return Err(Error::Limit(format!(
@@ -177,7 +181,7 @@ impl ShadingMethod for CulledForward {
             .collect();
         let encoding = ctx.features.light_encoding();
         let packed_lights = pack_lights(&visible, encoding);
-        let packed_grid = pack_grid(&grid, &assignment, grid_encoding);
+        let packed_grid = pack_grid(grid, assignment, grid_encoding);
         let packed_indices = pack_indices(&assignment.indices, grid_encoding);
 
         let slot = self.frame % RING;
