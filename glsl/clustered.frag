@@ -16,8 +16,8 @@ void main() {
     if (dot(N, V) < 0.0) {
         N = -N;
     }
-    vec3 albedo = surfaceAlbedo(v_uv);
-    vec3 color = u_ambient * albedo;
+    MEDP vec3 albedo = surfaceAlbedo(v_uv);
+    HIGHP vec3 color = u_ambient * albedo;
     // A highp copy: gl_FragCoord may be mediump on ES 2.0, too coarse past 2048 pixels.
     HIGHP vec2 fragXY = gl_FragCoord.xy;
     HIGHP float viewDepth = -v_viewPos.z;

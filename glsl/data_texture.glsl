@@ -12,12 +12,16 @@ HIGHP float u16Of(HIGHP vec2 channels) {
 }
 
 #if GLSL_ES == 100
-// ES 2.0: texel number → normalised coordinates of the texel centre. `invHeight` is 1 / the
-// texture's allocated rows.
-vec4 dataTexel(HIGHP sampler2D tex, HIGHP float index, HIGHP float invHeight) {
-    HIGHP float row = floor(index / float(DATA_WIDTH));
-    HIGHP float col = index - row * float(DATA_WIDTH);
+// ES 2.0: the texel at column `col`, row `row`, read at its centre. `invHeight` is 1 / the
+// texture's allocated rows (a power of two, like DATA_WIDTH, so the coordinates are exact).
+HIGHP vec4 dataTexelAt(HIGHP sampler2D tex, HIGHP float col, HIGHP float row, HIGHP float invHeight) {
     return texture2D(tex, vec2((col + 0.5) / float(DATA_WIDTH), (row + 0.5) * invHeight));
+}
+
+// ES 2.0: texel number → its texel.
+HIGHP vec4 dataTexel(HIGHP sampler2D tex, HIGHP float index, HIGHP float invHeight) {
+    HIGHP float row = floor(index / float(DATA_WIDTH));
+    return dataTexelAt(tex, index - row * float(DATA_WIDTH), row, invHeight);
 }
 #else
 ivec2 dataCoord(int index) {

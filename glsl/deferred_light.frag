@@ -29,6 +29,6 @@ void main() {
     light.direction = u_light2.xyz;
     light.spotOffset = u_light2.w;
 #endif
-    vec3 albedo = texelFetch(u_gAlbedo, px, 0).rgb;
+    MEDP vec3 albedo = texelFetch(u_gAlbedo, px, 0).rgb;
     FRAG_COLOR = vec4(shadeLight(light, P, nd.xyz, viewDirection(P), albedo, spec.rgb, spec.a), 1.0);
 }

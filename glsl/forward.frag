@@ -16,8 +16,8 @@ void main() {
     if (dot(N, V) < 0.0) {
         N = -N;
     }
-    vec3 albedo = surfaceAlbedo(v_uv);
-    vec3 color = u_ambient * albedo;
+    MEDP vec3 albedo = surfaceAlbedo(v_uv);
+    HIGHP vec3 color = u_ambient * albedo;
 #if !NO_LIGHTS
 #if GLSL_ES == 100
     // GLSL ES 1.00 Appendix A: constant loop bound, exit with break.

@@ -14,15 +14,24 @@ uniform HIGHP vec2 u_lightRanges;
 #include "light_struct.glsl"
 
 #if GLSL_ES == 100
-#define LIGHT_TEXEL(base, k) dataTexel(u_lights, float(base) * float(LIGHT_TEXELS) + float(k), u_lightTexInvHeight)
+// Texel k of light i, its row and column found from the light number without forming the
+// texel number i·LIGHT_TEXELS + k: where HIGHP is mediump (no fragment highp), fp16 holds
+// integers exactly only up to 2048, and light 512's texels are already past that.
+HIGHP vec4 lightTexel(HIGHP float i, HIGHP float k) {
+    HIGHP float perRow = float(DATA_WIDTH / LIGHT_TEXELS);
+    HIGHP float row = floor(i / perRow);
+    return dataTexelAt(u_lights, (i - row * perRow) * float(LIGHT_TEXELS) + k, row, u_lightTexInvHeight);
+}
+#define LIGHT_TEXEL(base, k) lightTexel(float(base), float(k))
 #else
 #define LIGHT_TEXEL(base, k) texelFetch(u_lights, dataCoord((base) * LIGHT_TEXELS + (k)), 0)
 #endif
 
 #if LIGHTS_RGBA8
-// Two bytes (as 0..1 channels) → 0..1 with 16 bits.
+// Two bytes (as 0..1 channels) → 0..1 with 16 bits, without forming the 16-bit integer
+// (65 535 is past fp16's largest value where HIGHP is mediump).
 HIGHP float unpack16(vec2 bytes) {
-    return u16Of(bytes) / 65535.0;
+    return byteOf(bytes.x) * (256.0 / 65535.0) + byteOf(bytes.y) * (1.0 / 65535.0);
 }
 #endif
 
@@ -37,7 +46,14 @@ Light fetchLight(int i) {
     light.position = (vec3(unpack16(t0.xy), unpack16(t0.zw), unpack16(t1.xy)) * 2.0 - 1.0) * u_lightRanges.x;
     light.radius = unpack16(t1.zw) * u_lightRanges.y;
     vec4 rgbe = floor(t2 * 255.0 + 0.5);
+#if FP16_LIGHTS
+    // The fp16-range form (see light_struct.glsl): the exponent split as 2e + rest, e ≥ 0.
+    HIGHP float e = max(0.0, ceil((rgbe.a - 128.0) * 0.5));
+    light.radiance = rgbe.rgb / 255.0 * exp2(rgbe.a - 128.0 - 2.0 * e);
+    light.radianceRoot = exp2(e);
+#else
     light.radiance = rgbe.rgb / 255.0 * exp2(rgbe.a - 128.0);
+#endif
 #if HAS_SPOT
     vec4 t3 = LIGHT_TEXEL(i, 3);
     vec4 t4 = LIGHT_TEXEL(i, 4);
@@ -56,7 +72,13 @@ Light fetchLight(int i) {
 #else
     light.position = t0.xyz;
     light.radius = t0.w;
+#if FP16_LIGHTS
+    vec4 t3 = LIGHT_TEXEL(i, 3);
+    light.radiance = t3.rgb;
+    light.radianceRoot = t3.a;
+#else
     light.radiance = t1.rgb;
+#endif
 #if HAS_SPOT
     vec4 t2 = LIGHT_TEXEL(i, 2);
     light.spotScale = t1.w;

@@ -1,33 +1,55 @@
 // The light model, shared by every method (CPU twin: src/scene/shading.rs).
 // P, N, V in view space; N and V unit; the light's radius is > 0 (inactive lights are never
 // uploaded). Ks and Ns are parameters so deferred shading can pass them from its G-buffer.
-vec3 shadeLight(Light light, vec3 P, vec3 N, vec3 V, vec3 albedo, vec3 Ks, float Ns) {
-    vec3 toLight = light.position - P;
-    float d2 = dot(toLight, toLight);
-    float d = sqrt(d2);
-    float ratio = d / light.radius;
-    float q = ratio * ratio;
-    q = q * q;
-    // Windowed inverse square: exactly zero at and beyond the radius.
-    float w = clamp(1.0 - q, 0.0, 1.0);
-    float falloff = w * w / (d2 + 1.0);
-    vec3 L = toLight / max(d, 1e-6);
-    float nDotL = dot(N, L);
+//
+// Precision, mobile first. What fp16 cannot hold stays HIGHP: positions and light vectors
+// (a light 300 m away), the cone cosine (a 0.5° cone is 4e-5 from 1, below fp16's step there),
+// N·H before a power of up to 4096, and the radiometric scale (radiance reaches 1e6). The
+// colour factors (albedo, Ks, the diffuse cosine) are MEDP: mediump (fp16 on phones, and on
+// llvmpipe, so the tests see it), or highp in the reference variant.
+//
+// Devices without fragment highp turn HIGHP into mediump too; the falloff is written so it
+// survives that: the distance is r·|u| with u = (Lp − P)/r (|u| < 1 wherever the light
+// reaches), and 1/(d² + 1) is (1/d)²/(1 + (1/d)²) past d = 1, so no intermediate exceeds the
+// light's radius (d² would overflow fp16 past 256 m).
+vec3 shadeLight(Light light, HIGHP vec3 P, vec3 N, vec3 V, MEDP vec3 albedo, MEDP vec3 Ks, HIGHP float Ns) {
+    HIGHP vec3 u = (light.position - P) / light.radius;
+    HIGHP float u2 = dot(u, u);
+    if (u2 >= 1.0) {
+        return vec3(0.0);
+    }
+    // Windowed inverse square: w² / (d² + 1) with w = 1 − (d/r)⁴, exactly zero at the radius.
+    HIGHP float w = 1.0 - u2 * u2;
+    HIGHP float d = light.radius * sqrt(u2);
+    HIGHP float inv = 1.0 / max(d, 1.0);
+#if FP16_LIGHTS
+    // Radiance came divided by k² (light_struct.glsl): k² goes into the falloff as (k/d)², and
+    // the product is capped where only a saturated pixel could come out (no Inf, no Inf·0).
+    HIGHP float k = light.radianceRoot;
+    HIGHP float kInv = k * inv;
+    HIGHP float falloff = min(w * w * (d > 1.0 ? kInv * kInv / (1.0 + inv * inv) : k * k / (d * d + 1.0)), 60000.0);
+#else
+    HIGHP float falloff = w * w * (d > 1.0 ? inv * inv / (1.0 + inv * inv) : 1.0 / (d * d + 1.0));
+#endif
+    // Unit direction to the light (zero for a fragment exactly at the light: no contribution).
+    HIGHP vec3 L = u2 > 0.0 ? u * inversesqrt(u2) : vec3(0.0);
+    MEDP float nDotL = dot(N, L);
     if (falloff <= 0.0 || nDotL <= 0.0) {
         return vec3(0.0);
     }
 #if HAS_SPOT
-    float t = clamp(dot(-L, light.direction) * light.spotScale + light.spotOffset, 0.0, 1.0);
-    float spot = t * t * (3.0 - 2.0 * t);
+    HIGHP float t = clamp(dot(-L, light.direction) * light.spotScale + light.spotOffset, 0.0, 1.0);
+    HIGHP float spot = t * t * (3.0 - 2.0 * t);
 #else
-    float spot = 1.0;
+    HIGHP float spot = 1.0;
 #endif
 #if HAS_SPECULAR
-    vec3 halfSum = L + V;
-    vec3 H = halfSum / max(length(halfSum), 1e-6);
-    vec3 spec = Ks * pow(max(dot(N, H), 0.0), Ns);
+    HIGHP vec3 halfSum = L + V;
+    HIGHP vec3 H = halfSum / max(length(halfSum), 1e-6);
+    MEDP vec3 spec = Ks * pow(max(dot(N, H), 0.0), Ns);
 #else
-    vec3 spec = vec3(0.0);
+    MEDP vec3 spec = vec3(0.0);
 #endif
-    return light.radiance * (falloff * spot) * (albedo * nDotL + spec);
+    MEDP vec3 reflectance = albedo * nDotL + spec;
+    return light.radiance * (falloff * spot) * reflectance;
 }

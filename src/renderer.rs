@@ -52,6 +52,10 @@ pub struct RenderOptions {
     /// Write linear, unclamped radiance (for float targets; see
     /// [`Renderer::render_offscreen_hdr`]).
     pub hdr: bool,
+    /// Evaluate the light model's mediump tier at highp as well (the `reference_precision`
+    /// variant): the reference image error is measured against. Off, colour factors run at
+    /// mediump as a mobile build wants (see `glsl/light_model.glsl`).
+    pub reference_precision: bool,
     /// Compile every variant with spot, specular and texture code even where the scene lacks
     /// them (a white texture stands in) — to measure what leaving features out saves, and to
     /// test that it changes nothing in the image.
@@ -71,6 +75,7 @@ impl Default for RenderOptions {
             max_indices: None,
             wait_for_gpu: true,
             hdr: false,
+            reference_precision: false,
             full_variants: false,
         }
     }
@@ -228,9 +233,31 @@ impl Renderer {
     /// Creates a renderer on a current GL context, restricted to feature level `es`. The
     /// context must stay current (and alive) for the renderer's whole life.
     pub fn new(gl: glow::Context, es: EsVersion) -> Result<Renderer, Error> {
-        let dev = Device::new(gl, es)?;
-        let desc = methods::find(methods::DEFAULT_METHOD)?;
-        let support = (desc.supported)(dev.caps());
+        Renderer::restricted(gl, es, &crate::gl::Restrictions::default())
+    }
+
+    /// [`Renderer::new`] playing a weaker device than the driver (see
+    /// [`crate::gl::Restrictions`]): for example one without fragment highp, where only
+    /// methods that need no highp run (the default method falls back to forward).
+    pub fn restricted(
+        gl: glow::Context,
+        es: EsVersion,
+        restrictions: &crate::gl::Restrictions,
+    ) -> Result<Renderer, Error> {
+        let dev = Device::restricted(gl, es, restrictions)?;
+        let mut desc = methods::find(methods::DEFAULT_METHOD)?;
+        let mut support = (desc.supported)(dev.caps());
+        if let Support::Unsupported(reason) = &support {
+            log::warn!(
+                "the default method `{}` is unsupported here ({reason}); starting with `forward`",
+                desc.name
+            );
+            desc = methods::find("forward")?;
+            support = (desc.supported)(dev.caps());
+        }
+        if let Support::Fallback(reason) = &support {
+            log::warn!("method `{}` runs with a fallback: {reason}", desc.name);
+        }
         let method = (desc.create)(&dev)?;
         Ok(Renderer {
             dev,
@@ -279,7 +306,8 @@ impl Renderer {
                 reason: reason.clone(),
             });
         }
-        if desc.name != self.method.name() {
+        let switching = desc.name != self.method.name();
+        if switching {
             let new = (desc.create)(&self.dev)?;
             let mut old = std::mem::replace(&mut self.method, new);
             old.destroy(&self.dev);
@@ -287,7 +315,10 @@ impl Renderer {
         self.support = support.clone();
         Ok(match support {
             Support::Fallback(reason) => {
-                log::warn!("method `{name}` runs with a fallback: {reason}");
+                // Announced once, when the method is taken up (here or at creation).
+                if switching {
+                    log::warn!("method `{name}` runs with a fallback: {reason}");
+                }
                 Some(reason)
             }
             _ => None,
@@ -329,6 +360,14 @@ impl Renderer {
             )
             .with(ShaderFeatures::OUTPUT_LINEAR, options.linear)
             .with(ShaderFeatures::OUTPUT_HDR, options.hdr)
+            .with(
+                ShaderFeatures::REFERENCE_PRECISION,
+                options.reference_precision,
+            )
+            .with(
+                ShaderFeatures::FP16_LIGHTS,
+                !self.dev.caps().fragment_has_highp(),
+            )
             .with(
                 ShaderFeatures::LIGHTS_RGBA8,
                 options.force_rgba8_lights || !self.dev.caps().float_textures,

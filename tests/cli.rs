@@ -200,6 +200,38 @@ fn without_float_textures_es2_falls_back_to_rgba8_lights_with_a_warning() {
     assert_eq!(s["support"]["status"], "fallback");
 }
 
+/// A played device without fragment highp starts with forward (the default method needs
+/// highp), says so, and renders a lit image.
+#[test]
+fn without_fragment_highp_es2_renders_with_forward_and_says_why() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = manylight(
+        &[
+            "render",
+            "--es",
+            "2",
+            "--no-fragment-highp",
+            "--size",
+            "64x36",
+            "--lights",
+            "64",
+            "--stats",
+            "s.json",
+        ],
+        &[],
+        dir.path(),
+    );
+    assert!(out.status.success(), "{}", text(&out));
+    assert!(text(&out).contains("no highp"), "{}", text(&out));
+    let s = stats(&dir.path().join("s.json"));
+    assert_eq!(s["method"], "forward");
+    assert_eq!(s["support"]["status"], "fallback");
+    let img = image::open(dir.path().join("manylight.png"))
+        .unwrap()
+        .to_rgba8();
+    assert!(img.pixels().any(|p| p[0] > 40), "a lit image");
+}
+
 #[test]
 fn bad_requests_are_clear_errors_not_panics() {
     let dir = tempfile::tempdir().unwrap();
@@ -224,6 +256,23 @@ fn bad_requests_are_clear_errors_not_panics() {
             "unknown method `raytraced`",
         ),
         (&["render", "--size", "0x10"], "empty"),
+        (
+            &["render", "--no-fragment-highp", "--size", "8x8"],
+            "only at the OpenGL ES 2.0 level",
+        ),
+        (
+            &[
+                "render",
+                "--es",
+                "2",
+                "--no-fragment-highp",
+                "--method",
+                "clustered",
+                "--size",
+                "8x8",
+            ],
+            "no highp",
+        ),
     ];
     for (args, needle) in cases {
         let out = manylight(args, &[], dir.path());

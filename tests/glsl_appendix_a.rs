@@ -6,7 +6,7 @@
 use std::path::Path;
 use std::process::Command;
 
-use manylight::gl::shader_source::{assemble, Stage, SHADERS};
+use manylight::gl::shader_source::{assemble, assemble_without_fragment_highp, Stage, SHADERS};
 use manylight::methods::ShaderFeatures;
 use manylight::EsVersion;
 
@@ -79,6 +79,7 @@ fn all_features() -> Vec<ShaderFeatures> {
         ShaderFeatures::OUTPUT_LINEAR,
         ShaderFeatures::OUTPUT_HDR,
         ShaderFeatures::NO_LIGHTS,
+        ShaderFeatures::REFERENCE_PRECISION,
     ];
     (0..1u64 << bits.len())
         .map(|mask| {
@@ -126,26 +127,52 @@ fn every_shader_variant_passes_the_strict_validator() {
             if shader.es3_only && es == EsVersion::Es2 {
                 continue;
             }
-            for features in all_features() {
-                let defines = features.defines(es, 65_535);
+            // On ES 2.0 also as a device without fragment highp compiles them: every float
+            // mediump, radiance in its fp16-range form, the loop bound mediump ints allow.
+            let targets: &[bool] = if es == EsVersion::Es2 {
+                &[false, true]
+            } else {
+                &[false]
+            };
+            for (features, &mediump_only) in all_features()
+                .into_iter()
+                .flat_map(|f| targets.iter().map(move |t| (f, t)))
+            {
+                let (features, max_lights) = if mediump_only {
+                    (features.with(ShaderFeatures::FP16_LIGHTS, true), 1_023)
+                } else {
+                    (features, 65_535)
+                };
+                let defines = features.defines(es, max_lights);
                 for (stage, ext) in [(Stage::Vertex, "vert"), (Stage::Fragment, "frag")] {
-                    let src = assemble(shader.name, stage, es, &defines).unwrap();
+                    let src = if mediump_only {
+                        assemble_without_fragment_highp(shader.name, stage, &defines).unwrap()
+                    } else {
+                        assemble(shader.name, stage, es, &defines).unwrap()
+                    };
                     checked += 1;
                     if !seen.insert(strip_unused_defines(&src)) {
                         continue;
                     }
                     let file = dir.path().join(format!(
-                        "{}_{}_{:x}.{ext}",
+                        "{}_{}_{:x}{}.{ext}",
                         shader.name,
                         es.major(),
-                        features.0
+                        features.0,
+                        if mediump_only { "_mediump" } else { "" }
                     ));
                     std::fs::write(&file, &src).unwrap();
                     let conf = (es == EsVersion::Es2).then_some(conf.as_path());
                     if let Err(log) = validate(conf, &file) {
                         failures.push(format!(
-                            "{} {es} {stage:?} features {:#x}:\n{log}",
-                            shader.name, features.0
+                            "{} {es}{} {stage:?} features {:#x}:\n{log}",
+                            shader.name,
+                            if mediump_only {
+                                " (no fragment highp)"
+                            } else {
+                                ""
+                            },
+                            features.0
                         ));
                     }
                 }
@@ -153,7 +180,7 @@ fn every_shader_variant_passes_the_strict_validator() {
         }
     }
     assert!(
-        checked >= (SHADERS.len() + SHADERS.iter().filter(|s| !s.es3_only).count()) * 2 * 128,
+        checked >= (SHADERS.len() + 2 * SHADERS.iter().filter(|s| !s.es3_only).count()) * 2 * 256,
         "only {checked} variants checked"
     );
     assert!(

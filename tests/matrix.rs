@@ -61,6 +61,21 @@ fn matrix_covers_es2_es2_without_float_and_es3_and_every_supported_cell_matches_
             assert!(dir.path().join(m["image"].as_str().unwrap()).is_file());
         }
     }
+    // A device without fragment highp: only the methods that need no highp run, forward
+    // (and auto choosing it) within the measured fp16 bounds of tests/stability.rs.
+    let mediump = row("ES 2.0 without fragment highp (played)");
+    assert!(mediump["error"].is_null(), "{}", mediump["error"]);
+    assert_eq!(mediump["fragment_highp"], false);
+    for m in mediump["methods"].as_array().unwrap() {
+        let status = m["support"]["status"].as_str().unwrap();
+        match m["name"].as_str().unwrap() {
+            "forward" | "auto" => {
+                assert_ne!(status, "unsupported", "{}", m["name"]);
+                assert!(m["max_abs"].as_u64().unwrap() <= 32, "{}", m["name"]);
+            }
+            other => assert_eq!(status, "unsupported", "{other} needs fragment highp"),
+        }
+    }
     // The restriction is real: without float textures the context reports none.
     assert_eq!(
         row("ES 2.0 without float textures")["float_textures"],

@@ -11,7 +11,9 @@
 //!   t0: pos.x   pos.y   pos.z   radius        view-space position (metres)
 //!   t1: rad.r   rad.g   rad.b   spot_scale    radiance = colour × intensity
 //!   t2: dir.x   dir.y   dir.z   spot_offset   unit view-space spot axis
-//!   t3: (unused padding)
+//!   t3: rad.r/k² rad.g/k² rad.b/k² k          radiance in fp16 range: k = 2^e, e ≥ 0 the
+//!                                             least with max(rad)/k² ≤ 1 (read only by
+//!                                             devices without fragment highp, FP16_LIGHTS)
 //!
 //! Rgba8 (RGBA8, 8 texels = 32 bytes per light; ES 2.0 without OES_texture_float). Lossy:
 //!   t0: x.hi x.lo y.hi y.lo      16-bit fixed point over [−pos_range, +pos_range]
@@ -148,6 +150,7 @@ pub fn pack_lights(lights: &[GpuLight], encoding: LightEncoding) -> PackedLights
     for (i, l) in lights.iter().enumerate() {
         match encoding {
             LightEncoding::Float32 => {
+                let (fp16_radiance, root) = fp16_radiance(l.radiance);
                 let rec: [f32; 16] = [
                     l.position.x,
                     l.position.y,
@@ -161,10 +164,10 @@ pub fn pack_lights(lights: &[GpuLight], encoding: LightEncoding) -> PackedLights
                     l.direction.y,
                     l.direction.z,
                     l.spot_offset, //
-                    0.0,
-                    0.0,
-                    0.0,
-                    0.0,
+                    fp16_radiance.x,
+                    fp16_radiance.y,
+                    fp16_radiance.z,
+                    root,
                 ];
                 let start = i * tpl * 16;
                 bytes[start..start + 64].copy_from_slice(bytemuck::cast_slice(&rec));
@@ -259,6 +262,21 @@ pub fn unpack_light(packed: &PackedLights, i: usize) -> GpuLight {
     }
 }
 
+/// Radiance in a range fp16 holds, for devices without fragment highp: `(c / k², k)` with
+/// `k = 2^e`, `e ≥ 0` the least with `max(c) / k² ≤ 1`. The shader multiplies `k²` back into
+/// the falloff, which is small wherever the light is not saturating the pixel anyway (see
+/// `glsl/light_model.glsl`).
+pub fn fp16_radiance(c: Vec3) -> (Vec3, f32) {
+    let m = c.max_element();
+    let e = if m > 1.0 {
+        (m.log2() * 0.5).ceil() as i32
+    } else {
+        0
+    };
+    let k = 2f32.powi(e);
+    (c / (k * k), k)
+}
+
 fn unorm16(x: f32) -> u16 {
     (x.clamp(0.0, 1.0) * 65535.0).round() as u16
 }
@@ -326,6 +344,33 @@ mod tests {
             assert_eq!(
                 (u.direction, u.spot_scale, u.spot_offset),
                 (l.direction, l.spot_scale, l.spot_offset)
+            );
+        }
+    }
+
+    #[test]
+    fn fp16_radiance_fits_fp16_and_scales_back_exactly() {
+        let lights = sample_lights();
+        let packed = pack_lights(&lights, LightEncoding::Float32);
+        for (i, l) in lights.iter().enumerate() {
+            let f: &[f32] = bytemuck::cast_slice(&packed.bytes[i * 64..i * 64 + 64]);
+            let (scaled, k) = (Vec3::new(f[12], f[13], f[14]), f[15]);
+            assert!(scaled.max_element() <= 1.0 && k >= 1.0 && k.log2().fract() == 0.0);
+            // Powers of two scale exactly.
+            assert_eq!(scaled * (k * k), l.radiance, "light {i}");
+        }
+        for (c, k) in [
+            (0.5, 1.0),
+            (1.0, 1.0),
+            (1.01, 2.0),
+            (4.0, 2.0),
+            (1e6, 1024.0),
+        ] {
+            let (scaled, root) = fp16_radiance(Vec3::splat(c));
+            assert_eq!(root, k, "radiance {c}");
+            assert!(
+                scaled.x <= 1.0 && (c <= 1.0 || scaled.x > 0.25),
+                "radiance {c}"
             );
         }
     }

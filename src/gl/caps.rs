@@ -158,4 +158,20 @@ impl Caps {
     pub fn fragment_has_highp(&self) -> bool {
         self.fragment_highp.precision > 0
     }
+
+    /// Applies `restrictions` (see [`super::Restrictions`]). ES 3.0 requires fragment highp,
+    /// so taking it away is only possible at the ES 2.0 level.
+    pub fn restrict(&mut self, restrictions: &super::Restrictions) -> Result<(), GlError> {
+        if restrictions.no_fragment_highp {
+            if self.es != EsVersion::Es2 || self.desktop {
+                return Err(GlError::VersionUnavailable {
+                    requested: self.es,
+                    reason: "a fragment stage without highp exists only at the OpenGL ES 2.0 level"
+                        .into(),
+                });
+            }
+            self.fragment_highp = Precision::default();
+        }
+        Ok(())
+    }
 }

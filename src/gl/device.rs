@@ -3,7 +3,7 @@
 
 use glow::HasContext;
 
-use super::{Caps, EsVersion, GlError};
+use super::{Caps, EsVersion, GlError, Restrictions};
 
 /// The GL context the renderer draws with. Created from a glow context the caller owns (a
 /// game's, or [`super::HeadlessContext::load_gl`]) and the ES level to restrict itself to.
@@ -47,7 +47,17 @@ macro_rules! tracked {
 impl Device {
     /// Wraps a current glow context and probes its capabilities.
     pub fn new(gl: glow::Context, es: EsVersion) -> Result<Device, GlError> {
-        let caps = Caps::probe(&gl, es)?;
+        Device::restricted(gl, es, &Restrictions::default())
+    }
+
+    /// [`Device::new`] playing a weaker device (see [`Restrictions`]).
+    pub fn restricted(
+        gl: glow::Context,
+        es: EsVersion,
+        restrictions: &Restrictions,
+    ) -> Result<Device, GlError> {
+        let mut caps = Caps::probe(&gl, es)?;
+        caps.restrict(restrictions)?;
         if caps.desktop {
             // A core profile draws nothing without a bound vertex array object; ES needs none.
             unsafe {

@@ -30,6 +30,17 @@ pub use device::Device;
 
 use serde::Serialize;
 
+/// Restrictions a renderer puts on itself to play a weaker device than the driver it runs on
+/// (the shader-level counterpart of `MESA_GLES_VERSION_OVERRIDE` and
+/// `MESA_EXTENSION_OVERRIDE`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+pub struct Restrictions {
+    /// Behave as a device whose fragment stage has no `highp` (Mali-400 class, ES 2.0 only):
+    /// the caps report none, and fragment shaders are compiled with every float at `mediump`,
+    /// which llvmpipe evaluates in fp16 as such a device does.
+    pub no_fragment_highp: bool,
+}
+
 /// The OpenGL ES feature level the renderer targets. With [`EsVersion::Es2`] the renderer uses
 /// ES 2.0 core plus probed extensions and compiles GLSL ES 1.00, even on a driver that returns
 /// a 3.x context.

@@ -28,7 +28,12 @@ fn compile(
     defines: &[(String, String)],
 ) -> Result<(glow::Shader, usize), GlError> {
     let gl = &dev.gl;
-    let source = shader_source::assemble_for(name, stage, dev.es(), dev.caps().desktop, defines)?;
+    let caps = dev.caps();
+    let source = if caps.fragment_has_highp() {
+        shader_source::assemble_for(name, stage, dev.es(), caps.desktop, defines)?
+    } else {
+        shader_source::assemble_without_fragment_highp(name, stage, defines)?
+    };
     let kind = match stage {
         Stage::Vertex => glow::VERTEX_SHADER,
         Stage::Fragment => glow::FRAGMENT_SHADER,

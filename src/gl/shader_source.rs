@@ -178,6 +178,13 @@ fn file(name: &str) -> Result<&'static str, GlError> {
         .ok_or_else(|| GlError::ShaderSource(format!("no file `{name}` in glsl/")))
 }
 
+/// The ES 2.0 fragment prelude of a device without fragment highp: what the preprocessor
+/// branch of the normal prelude picks on such a device, chosen outright so a driver that has
+/// highp can play one that has not.
+const ES2_FRAGMENT_MEDIUMP_ONLY: &str = "#version 100\n#define GLSL_ES 100\n\
+     precision mediump float;\nprecision mediump int;\n#define HIGHP mediump\n\
+     #define VARYING varying\n#define TEXTURE2D texture2D\n#define FRAG_COLOR gl_FragColor\n";
+
 fn prelude(stage: Stage, dialect: EsVersion, mrt: bool) -> &'static str {
     match (dialect, stage) {
         (EsVersion::Es3, Stage::Fragment) if mrt => {
@@ -192,8 +199,8 @@ fn prelude(stage: Stage, dialect: EsVersion, mrt: bool) -> &'static str {
             "#version 300 es\n#define GLSL_ES 300\nprecision highp float;\nprecision highp int;\n\
              #define HIGHP highp\n#define ATTRIBUTE in\n#define VARYING out\n"
         }
-        // ES 2.0 fragment stages may lack highp; everything then runs at mediump, which the
-        // caps report and the stability tests measure.
+        // ES 2.0 fragment stages may lack highp; everything then runs at mediump (see
+        // ES2_FRAGMENT_MEDIUMP_ONLY), which the caps report and the stability tests measure.
         (EsVersion::Es2, Stage::Fragment) => {
             "#version 100\n#define GLSL_ES 100\n#ifdef GL_FRAGMENT_PRECISION_HIGH\n\
              precision highp float;\nprecision highp int;\n#define HIGHP highp\n#else\n\
@@ -235,10 +242,35 @@ pub fn assemble_for(
     })
 }
 
+/// [`assemble`] at the ES 2.0 level for a device without fragment highp (see
+/// [`super::Restrictions`]): fragment shaders get the all-`mediump` prelude.
+pub fn assemble_without_fragment_highp(
+    shader_name: &str,
+    stage: Stage,
+    defines: &[(String, String)],
+) -> Result<String, GlError> {
+    let prelude = match stage {
+        Stage::Fragment => Some(ES2_FRAGMENT_MEDIUMP_ONLY),
+        Stage::Vertex => None,
+    };
+    assemble_with(shader_name, stage, EsVersion::Es2, prelude, defines)
+}
+
 fn assemble_es(
     shader_name: &str,
     stage: Stage,
     dialect: EsVersion,
+    defines: &[(String, String)],
+) -> Result<String, GlError> {
+    assemble_with(shader_name, stage, dialect, None, defines)
+}
+
+/// Assembly with the dialect's prelude, or `prelude` instead when given.
+fn assemble_with(
+    shader_name: &str,
+    stage: Stage,
+    dialect: EsVersion,
+    prelude_override: Option<&str>,
     defines: &[(String, String)],
 ) -> Result<String, GlError> {
     let desc = shader(shader_name)?;
@@ -251,7 +283,8 @@ fn assemble_es(
             "shader `{shader_name}` needs GLSL ES 3.00"
         )));
     }
-    let mut out = String::from(prelude(stage, dialect, desc.mrt));
+    let mut out =
+        String::from(prelude_override.unwrap_or_else(|| prelude(stage, dialect, desc.mrt)));
     for (name, value) in defines {
         out.push_str(&format!("#define {name} {value}\n"));
     }

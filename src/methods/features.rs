@@ -24,9 +24,15 @@ impl ShaderFeatures {
     pub const OUTPUT_HDR: u64 = 1 << 5;
     /// No lights at all: the light loop and its data are compiled out.
     pub const NO_LIGHTS: u64 = 1 << 6;
+    /// The reference variant: the light model's mediump tier (`MEDP`) at highp too, so the
+    /// image is what the light model gives at the best precision the device has.
+    pub const REFERENCE_PRECISION: u64 = 1 << 7;
+    /// The device has no fragment highp: light radiance is read in its fp16-range form (see
+    /// `cluster::pack`), so a bright light does not overflow to infinity.
+    pub const FP16_LIGHTS: u64 = 1 << 8;
 
     /// Every flag with its name.
-    pub const NAMED: [(u64, &'static str); 7] = [
+    pub const NAMED: [(u64, &'static str); 9] = [
         (Self::TEXTURE, "texture"),
         (Self::SPOT, "spot"),
         (Self::SPECULAR, "specular"),
@@ -34,6 +40,8 @@ impl ShaderFeatures {
         (Self::OUTPUT_LINEAR, "output_linear"),
         (Self::OUTPUT_HDR, "output_hdr"),
         (Self::NO_LIGHTS, "no_lights"),
+        (Self::REFERENCE_PRECISION, "reference_precision"),
+        (Self::FP16_LIGHTS, "fp16_lights"),
     ];
 
     /// Names of the set flags.
@@ -75,6 +83,16 @@ impl ShaderFeatures {
             ("OUTPUT_LINEAR".into(), flag(Self::OUTPUT_LINEAR)),
             ("OUTPUT_HDR".into(), flag(Self::OUTPUT_HDR)),
             ("NO_LIGHTS".into(), flag(Self::NO_LIGHTS)),
+            ("FP16_LIGHTS".into(), flag(Self::FP16_LIGHTS)),
+            (
+                "MEDP".into(),
+                if self.has(Self::REFERENCE_PRECISION) {
+                    "HIGHP"
+                } else {
+                    "mediump"
+                }
+                .into(),
+            ),
             ("DATA_WIDTH".into(), DATA_TEXTURE_WIDTH.to_string()),
             (
                 "LIGHT_TEXELS".into(),

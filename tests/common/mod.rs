@@ -16,10 +16,15 @@ pub struct Gpu {
 
 impl Gpu {
     pub fn new(es: EsVersion) -> Gpu {
+        Gpu::restricted(es, &manylight::gl::Restrictions::default())
+    }
+
+    /// A renderer playing a weaker device (see `manylight::gl::Restrictions`).
+    pub fn restricted(es: EsVersion, restrictions: &manylight::gl::Restrictions) -> Gpu {
         let ctx = HeadlessContext::new(es).unwrap_or_else(|e| {
             panic!("no headless {es} context ({e}); install libegl1 libegl-mesa0 libgles2 libgl1-mesa-dri")
         });
-        let renderer = Renderer::new(ctx.load_gl(), es).expect("renderer");
+        let renderer = Renderer::restricted(ctx.load_gl(), es, restrictions).expect("renderer");
         Gpu {
             renderer: Some(renderer),
             _ctx: ctx,

@@ -20,6 +20,9 @@ pub struct InfoArgs {
     /// report the shader variants built (features, source size) and each method's GPU memory.
     #[arg(long)]
     pub scene: Option<String>,
+    /// Play a device whose fragment stage has no highp (needs `--es 2`; see `render`).
+    #[arg(long)]
+    pub no_fragment_highp: bool,
 }
 
 /// Renders `spec` with every supported method at a small size; returns per-method GPU bytes,
@@ -61,7 +64,10 @@ fn scene_report(
 pub fn run(args: &InfoArgs) -> Result<(), Box<dyn std::error::Error>> {
     let es = args.es.into();
     let ctx = HeadlessContext::new(es)?;
-    let mut renderer = Renderer::new(ctx.load_gl(), es)?;
+    let restrictions = manylight::gl::Restrictions {
+        no_fragment_highp: args.no_fragment_highp,
+    };
+    let mut renderer = Renderer::restricted(ctx.load_gl(), es, &restrictions)?;
     let report = args
         .scene
         .as_deref()

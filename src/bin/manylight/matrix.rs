@@ -1,7 +1,10 @@
 //! `manylight matrix`: the ES capability matrix a team runs in CI. Every configuration is a
 //! real driver restriction applied to a child process (`MESA_GLES_VERSION_OVERRIDE`,
-//! `MESA_EXTENSION_OVERRIDE`), never a flag the renderer sets on itself; each child renders
-//! every method and compares it with plain forward on the same configuration.
+//! `MESA_EXTENSION_OVERRIDE`), except where no driver switch exists: a fragment stage without
+//! highp is played by the renderer itself (`--no-fragment-highp`, shaders compiled all
+//! mediump, which llvmpipe runs in fp16). Each child renders every method and compares it
+//! with the reference (plain forward, light model at the best precision the configuration
+//! has) on the same configuration.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -41,6 +44,8 @@ struct Config {
     slug: &'static str,
     es: &'static str,
     env: &'static [(&'static str, &'static str)],
+    /// Extra arguments of the child (restrictions the renderer plays itself).
+    args: &'static [&'static str],
 }
 
 const CONFIGS: &[Config] = &[
@@ -49,6 +54,14 @@ const CONFIGS: &[Config] = &[
         slug: "es2",
         es: "2",
         env: &[],
+        args: &[],
+    },
+    Config {
+        name: "ES 2.0 without fragment highp (played)",
+        slug: "es2-mediump",
+        es: "2",
+        env: &[],
+        args: &["--no-fragment-highp"],
     },
     Config {
         name: "ES 2.0 without float textures",
@@ -58,24 +71,28 @@ const CONFIGS: &[Config] = &[
             "MESA_EXTENSION_OVERRIDE",
             "-GL_OES_texture_float -GL_OES_texture_half_float",
         )],
+        args: &[],
     },
     Config {
         name: "ES 2.0 driver (capped)",
         slug: "es2-capped",
         es: "2",
         env: &[("MESA_GLES_VERSION_OVERRIDE", "2.0")],
+        args: &[],
     },
     Config {
         name: "ES 3.0 driver (capped)",
         slug: "es3-capped",
         es: "3",
         env: &[("MESA_GLES_VERSION_OVERRIDE", "3.0")],
+        args: &[],
     },
     Config {
         name: "ES 3.x as the driver gives it",
         slug: "es3",
         es: "3",
         env: &[],
+        args: &[],
     },
 ];
 
@@ -98,6 +115,7 @@ pub fn run(args: &MatrixArgs) -> Result<(), Box<dyn std::error::Error>> {
             &size,
         ])
         .args(["--lights", &args.lights.to_string(), "--tag", config.slug])
+        .args(config.args)
         .arg("--out")
         .arg(&out);
         for (k, v) in config.env {
@@ -116,6 +134,7 @@ pub fn run(args: &MatrixArgs) -> Result<(), Box<dyn std::error::Error>> {
             .env
             .iter()
             .map(|(k, v)| format!("{k}={v}"))
+            .chain(config.args.iter().map(|a| a.to_string()))
             .collect::<Vec<_>>());
         rows.push(row);
     }
@@ -177,7 +196,7 @@ fn osmesa_row(
 }
 
 fn markdown(rows: &[Value]) -> String {
-    let mut s = String::from("| configuration | context | method | support | max abs vs forward | pixels > 2/255 | frame ms |\n|---|---|---|---|---|---|---|\n");
+    let mut s = String::from("| configuration | context | method | support | max abs vs reference | pixels > 2/255 | frame ms |\n|---|---|---|---|---|---|---|\n");
     for row in rows {
         let config = row["config"].as_str().unwrap_or("?");
         if let Some(err) = row["error"].as_str() {
@@ -252,6 +271,9 @@ pub struct MatrixCellArgs {
     /// Desktop GL through OSMesa instead of EGL (needs the `osmesa` feature).
     #[arg(long)]
     osmesa: bool,
+    /// Play a device without fragment highp.
+    #[arg(long)]
+    no_fragment_highp: bool,
 }
 
 /// The context a matrix cell renders with (kept alive for the renderer's life).
@@ -287,15 +309,31 @@ impl CellContext {
 pub fn run_cell(args: &MatrixCellArgs) -> Result<(), Box<dyn std::error::Error>> {
     let es: EsVersion = args.es.into();
     let (scene, _) = scene::load(&args.scene, Some((args.lights, 1)))?;
-    let ctx = CellContext::new(es, args.osmesa)?;
-    let mut renderer = Renderer::new(ctx.load_gl(), es)?;
     let (w, h) = args.size;
     let opts = RenderOptions {
         timed_frames: 3,
         ..RenderOptions::default()
     };
-    renderer.set_method("forward")?;
-    let (reference, _) = renderer.render_offscreen(&scene, w, h, &opts)?;
+    // The reference comes from an unrestricted renderer of its own (made, used and dropped
+    // before the cell's context, since creating a context makes it current): under a played
+    // restriction the driver underneath is unrestricted, so the row shows what it costs.
+    let reference = {
+        let ctx = CellContext::new(es, args.osmesa)?;
+        let mut full = Renderer::new(ctx.load_gl(), es)?;
+        full.set_method("forward")?;
+        let reference_opts = RenderOptions {
+            reference_precision: true,
+            ..RenderOptions::default()
+        };
+        let result = full.render_offscreen(&scene, w, h, &reference_opts);
+        full.destroy();
+        result?.0
+    };
+    let ctx = CellContext::new(es, args.osmesa)?;
+    let restrictions = manylight::gl::Restrictions {
+        no_fragment_highp: args.no_fragment_highp,
+    };
+    let mut renderer = Renderer::restricted(ctx.load_gl(), es, &restrictions)?;
     let mut methods = Vec::new();
     for m in METHODS {
         let support = (m.supported)(renderer.caps());
@@ -320,6 +358,7 @@ pub fn run_cell(args: &MatrixCellArgs) -> Result<(), Box<dyn std::error::Error>>
         "gl_version": caps.gl_version,
         "renderer": caps.renderer,
         "float_textures": caps.float_textures,
+        "fragment_highp": caps.fragment_has_highp(),
         "methods": methods,
     });
     println!("{row}");

@@ -15,9 +15,10 @@ pub struct RenderArgs {
     /// A built-in scene (courtyard, pillars, plane, bubbles), an .obj file or a .json scene file.
     #[arg(long, default_value = scene::builtin::DEFAULT)]
     pub scene: String,
-    /// Shading method (see `manylight info` for the table).
-    #[arg(long, default_value = manylight::methods::DEFAULT_METHOD)]
-    pub method: String,
+    /// Shading method (see `manylight info` for the table). Default: clustered, or forward
+    /// on a context where clustered cannot run.
+    #[arg(long)]
+    pub method: Option<String>,
     /// OpenGL ES version to render with.
     #[arg(long, value_enum, default_value = "3")]
     pub es: EsArg,
@@ -44,6 +45,11 @@ pub struct RenderArgs {
     /// Frames timed after a warm-up frame (the median is reported).
     #[arg(long, default_value_t = 2)]
     pub frames: u32,
+    /// Play a device whose fragment stage has no highp (Mali-400 class; needs `--es 2`):
+    /// every fragment float runs at mediump, fp16 on llvmpipe. Methods that need highp are
+    /// unsupported there.
+    #[arg(long)]
+    pub no_fragment_highp: bool,
 }
 
 /// Random lights for built-ins and OBJ files when `--lights` is not given.
@@ -75,9 +81,14 @@ pub fn run(args: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
     }
     let es = args.es.into();
     let ctx = HeadlessContext::new(es)?;
-    let mut renderer = Renderer::new(ctx.load_gl(), es)?;
+    let restrictions = manylight::gl::Restrictions {
+        no_fragment_highp: args.no_fragment_highp,
+    };
+    let mut renderer = Renderer::restricted(ctx.load_gl(), es, &restrictions)?;
     // A fallback is logged as a warning by the renderer.
-    renderer.set_method(&args.method)?;
+    if let Some(method) = &args.method {
+        renderer.set_method(method)?;
+    }
     let options = RenderOptions {
         linear: args.linear,
         timed_frames: args.frames,
