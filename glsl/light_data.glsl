@@ -62,12 +62,14 @@ Light fetchLight(int i) {
     light.direction = dir / max(length(dir), 1e-6);
     float outerDeg = unpack16(t5.xy) * 180.0;
     float innerDeg = unpack16(t5.zw) * 180.0;
-    float cosOuter = cos(radians(outerDeg));
-    float cosInner = cos(radians(innerDeg));
-    float scale = 1.0 / max(cosInner - cosOuter, SPOT_MIN_COS_DELTA);
+    // 1 − cos α as 2 sin²(α/2), as Light::spot_scale_offset computes it.
+    float sinOuter = sin(radians(outerDeg) * 0.5);
+    float sinInner = sin(radians(innerDeg) * 0.5);
+    float oneMinusCosOuter = 2.0 * sinOuter * sinOuter;
+    float scale = 1.0 / max(oneMinusCosOuter - 2.0 * sinInner * sinInner, SPOT_MIN_COS_DELTA);
     bool omni = innerDeg >= 180.0;
     light.spotScale = omni ? 0.0 : scale;
-    light.spotOffset = omni ? 1.0 : -cosOuter * scale;
+    light.spotOffset = omni ? 1.0 : oneMinusCosOuter * scale;
 #endif
 #else
     light.position = t0.xyz;

@@ -3,7 +3,7 @@
 // uploaded). Ks and Ns are parameters so deferred shading can pass them from its G-buffer.
 //
 // Precision, mobile first. What fp16 cannot hold stays HIGHP: positions and light vectors
-// (a light 300 m away), the cone cosine (a 0.5° cone is 4e-5 from 1, below fp16's step there),
+// (a light 300 m away), the spot term,
 // N·H before a power of up to 4096, and the radiometric scale (radiance reaches 1e6). The
 // colour factors (albedo, Ks, the diffuse cosine) are MEDP: mediump (fp16 on phones, and on
 // llvmpipe, so the tests see it), or highp in the reference variant.
@@ -38,7 +38,10 @@ vec3 shadeLight(Light light, HIGHP vec3 P, vec3 N, vec3 V, MEDP vec3 albedo, MED
         return vec3(0.0);
     }
 #if HAS_SPOT
-    HIGHP float t = clamp(dot(-L, light.direction) * light.spotScale + light.spotOffset, 0.0, 1.0);
+    // 1 − cos of the angle off the axis as half the squared chord |L + axis|²: small and
+    // accurate for narrow cones even in fp16 (see Light::spot_scale_offset).
+    HIGHP vec3 chord = L + light.direction;
+    HIGHP float t = clamp(light.spotOffset - 0.5 * light.spotScale * dot(chord, chord), 0.0, 1.0);
     HIGHP float spot = t * t * (3.0 - 2.0 * t);
 #else
     HIGHP float spot = 1.0;

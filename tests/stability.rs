@@ -49,7 +49,7 @@ fn check_with(name: &str, scene: &Scene, w: u32, h: u32, opts: &RenderOptions) -
             let d = manylight::metrics::diff(&reference, &img);
             assert!(
                 d.max_abs <= 2,
-                "{name} {es} {method}: {} / 255 from forward (rmse {:.3})",
+                "{name} {es} {method}: {} / 255 from the reference (rmse {:.3})",
                 d.max_abs,
                 d.rmse
             );
@@ -75,12 +75,13 @@ fn check_with(name: &str, scene: &Scene, w: u32, h: u32, opts: &RenderOptions) -
     es3_forward.unwrap()
 }
 
-/// Measured bounds of a device without fragment highp (every float fp16): fp16 positions are
-/// 2⁻¹¹ of the view distance apart, so a light a few centimetres from a surface 20 m away
-/// lands visibly off on a handful of pixels (worst seen: 21/255 on the courtyard), and a sum of a thousand
-/// faint lights in an fp16 accumulator drifts by a few steps (RMSE 1.7/255). Asserted with a
-/// margin, as regression bounds rather than a derivation.
-const MEDIUMP_ONLY_MAX: u8 = 32;
+/// Bound of a device without fragment highp (every float fp16), as an RMSE over the image:
+/// fp16 positions are 2⁻¹¹ of the view distance apart, so a light a few centimetres from a
+/// surface 20 m away lands visibly off on a handful of pixels (up to 21/255 seen), a
+/// hard-edged cone's rim moves by a pixel (full scale on those pixels), and a sum of a
+/// thousand faint lights in an fp16 accumulator drifts by a few steps everywhere (RMSE
+/// 1.7/255, the worst case here). What fp16 must not do, overflow or lose a light, costs an
+/// RMSE of 35 to 150 (seen with each deliberate break of the fp16 safeguards).
 const MEDIUMP_ONLY_RMSE: f64 = 2.0;
 
 /// A device without fragment highp (every float fp16 on llvmpipe, as on a Mali-400): forward,
@@ -110,11 +111,17 @@ fn check_without_fragment_highp(
     }
     let (img, _) = result.unwrap_or_else(|e| panic!("{name} mediump-only: {e}"));
     let d = manylight::metrics::diff(reference, &img);
-    assert!(
-        d.max_abs <= MEDIUMP_ONLY_MAX && d.rmse <= MEDIUMP_ONLY_RMSE,
-        "{name} without fragment highp: {} / 255 from the reference (rmse {:.3})",
+    eprintln!(
+        "{name} without fragment highp: RMSE {:.3} / 255, max {} / 255, {:.3} % over 2 / 255",
+        d.rmse,
         d.max_abs,
-        d.rmse
+        d.over_2 * 100.0
+    );
+    assert!(
+        d.rmse <= MEDIUMP_ONLY_RMSE,
+        "{name} without fragment highp: RMSE {:.3} / 255 from the reference (max {})",
+        d.rmse,
+        d.max_abs
     );
     let (hdr, _) = gpu.r().render_offscreen_hdr(scene, w, h, opts).unwrap();
     if let Some((i, p)) = hdr
@@ -418,6 +425,12 @@ fn wide_odd_and_tiny_framebuffers() {
 #[test]
 fn spot_cones_of_zero_half_and_179_degrees() {
     let mut s = plane();
+    // A second plane 10 m behind the first (hidden by it) moves the grid's far end past the
+    // lit plane: cells there are finite, so the cone-vs-cell test decides them (the grid's
+    // last slice reaches to infinity and is never culled).
+    let mut back = s.objects[0].clone();
+    back.transform = glam::DMat4::from_translation(DVec3::new(0.0, 0.0, -10.0)) * back.transform;
+    s.objects.push(back);
     // 0°, 0.5° and 179° are the extremes; the 35° cone, seen from close by, is where a cone
     // test that culls too much shows.
     for (i, outer) in [0.0, 0.5, 179.0, 35.0].into_iter().enumerate() {
@@ -432,6 +445,49 @@ fn spot_cones_of_zero_half_and_179_degrees() {
             2.0,
         ));
     }
+    // Hard-edged cones (inner = outer) are bright right up to their edge, so a cone-vs-cell
+    // test that trims the cone shows: a 0.5° cone from 20 m (a 17 cm disc, several pixels
+    // wide) and a 35° cone from close by.
+    s.lights.push(Light::spot(
+        DVec3::new(2.5, 2.0, 20.0),
+        DVec3::new(0.0, 0.0, -1.0),
+        0.5,
+        0.5,
+        25.0,
+        Vec3::ONE,
+        1500.0,
+    ));
+    s.lights.push(Light::spot(
+        DVec3::new(-2.0, 2.0, 0.8),
+        DVec3::new(0.0, 0.0, -1.0),
+        35.0,
+        35.0,
+        2.0,
+        Vec3::new(0.2, 1.0, 0.4),
+        2.0,
+    ));
+    // A soft 35° cone (17.5° inner) from 3 m: its bright annulus spans many cells, so a cone
+    // test that confuses the inner and the outer angle drops lit cells.
+    s.lights.push(Light::spot(
+        DVec3::new(1.5, -1.0, 3.0),
+        DVec3::new(0.0, 0.0, -1.0),
+        17.5,
+        35.0,
+        5.0,
+        Vec3::new(0.5, 0.5, 1.0),
+        20.0,
+    ));
+    // A spot grazing the plane: its apex 5 cm above it, so the plane is lit from right by
+    // the apex outward. A bound of the cone that drops the region near the apex shows here.
+    s.lights.push(Light::spot(
+        DVec3::new(-4.0, -2.5, 0.05),
+        DVec3::new(0.3, 1.0, -0.08),
+        20.0,
+        20.0,
+        4.0,
+        Vec3::new(1.0, 0.3, 0.2),
+        3.0,
+    ));
     // A fine grid (8-pixel cells, no minimum size), so the cone-vs-cell test decides cells.
     let fine = RenderOptions {
         grid: manylight::cluster::grid::GridConfig {

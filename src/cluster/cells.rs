@@ -199,12 +199,12 @@ impl Cone {
     /// The cone of a spot light of (padded) radius `range`; `None` for point lights and cones
     /// too wide to be worth testing.
     fn of(light: &GpuLight, range: f64) -> Option<Cone> {
-        // cos(outer) = −offset / scale (see `Light::spot_scale_offset`): no trigonometry per
-        // light. Cones of 89° and wider are not worth testing.
+        // 1 − cos(outer) = offset / scale (see `Light::spot_scale_offset`): no trigonometry
+        // per light. Cones of 89° and wider are not worth testing.
         if light.spot_scale == 0.0 || light.direction.length_squared() == 0.0 {
             return None;
         }
-        let cos_outer = -(light.spot_offset as f64) / light.spot_scale as f64;
+        let cos_outer = 1.0 - light.spot_offset as f64 / light.spot_scale as f64;
         // Pad the angle a little: the shader evaluates the cone edge in f32.
         let cos = cos_outer - 2e-4;
         if cos.is_nan() || cos < 0.0175 {

@@ -25,13 +25,13 @@
 //!   t6, t7: (unused padding)
 //! ```
 //!
-//! The spot terms are `t = clamp(cos·spot_scale + spot_offset, 0, 1)` (see
+//! The spot terms are `t = clamp(spot_offset − spot_scale·(1 − cos), 0, 1)` (see
 //! [`crate::scene::Light::spot_scale_offset`]); the Rgba8 layout stores angles instead and the
 //! shader rebuilds scale and offset, because `scale` reaches 10⁴ for hard-edged cones.
 
 use glam::{DMat4, Vec3};
 
-use crate::scene::light::SPOT_MIN_COS_DELTA;
+use crate::scene::light::spot_terms;
 use crate::scene::{Light, LightKind};
 
 /// Width in texels of every data texture (a power of two ≤ 1024: exact under mediump math).
@@ -240,13 +240,11 @@ pub fn unpack_light(packed: &PackedLights, i: usize) -> GpuLight {
             let dir = Vec3::new(snorm(12), snorm(14), snorm(16));
             let outer = w(20) * 180.0;
             let inner = w(22) * 180.0;
-            let cos_o = outer.to_radians().cos();
-            let cos_i = inner.to_radians().cos();
             let (scale, offset) = if inner >= 180.0 {
                 (0.0, 1.0)
             } else {
-                let scale = 1.0 / (cos_i - cos_o).max(SPOT_MIN_COS_DELTA as f32);
-                (scale, -cos_o * scale)
+                let (scale, offset) = spot_terms(outer as f64, inner as f64);
+                (scale as f32, offset as f32)
             };
             GpuLight {
                 position: Vec3::new(pos(0), pos(2), pos(4)),

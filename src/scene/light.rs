@@ -84,10 +84,17 @@ impl Light {
         self.radius > 0.0 && self.radiance().max_element() > 0.0
     }
 
-    /// Spot cone as `(scale, offset)` with `t = clamp(cos_angle · scale + offset, 0, 1)`, the
-    /// argument of the smoothstep. Point lights get `(0, 1)` so `t = 1`. Precomputed on the CPU
-    /// (in `f64`) so that `inner == outer`, where GLSL's `smoothstep` is undefined, is still a
-    /// well-defined hard edge.
+    /// Spot cone as `(scale, offset)` with `t = clamp(offset − scale · (1 − cos θ), 0, 1)`, the
+    /// argument of the smoothstep, θ the angle off the axis: `scale = 1 / (cos inner − cos
+    /// outer)` and `offset = scale · (1 − cos outer)`. Point lights get `(0, 1)` so `t = 1`.
+    /// Precomputed on the CPU (in `f64`) so that `inner == outer`, where GLSL's `smoothstep`
+    /// is undefined, is still a well-defined (steep) edge.
+    ///
+    /// Written with `1 − cos`, not `cos`, because the shaders get `1 − cos θ` as half the
+    /// squared chord `|L + axis|²` between two unit vectors: small for a narrow cone and exact
+    /// to a few bits even in fp16, where `cos θ` of a 0.5° cone (1 − 4·10⁻⁵) is not
+    /// representable at all. Both differences of cosines here are taken as `2 sin²(α/2)` for
+    /// the same reason.
     pub fn spot_scale_offset(&self) -> (f32, f32) {
         match self.kind {
             LightKind::Point => (0.0, 1.0),
@@ -98,10 +105,8 @@ impl Light {
                 outer_deg,
                 ..
             } => {
-                let cos_outer = outer_deg.to_radians().cos();
-                let cos_inner = inner_deg.to_radians().cos();
-                let scale = 1.0 / (cos_inner - cos_outer).max(SPOT_MIN_COS_DELTA);
-                (scale as f32, (-cos_outer * scale) as f32)
+                let (scale, offset) = spot_terms(outer_deg, inner_deg);
+                (scale as f32, offset as f32)
             }
         }
     }
@@ -177,6 +182,16 @@ impl Light {
 /// Smallest `cos(inner) − cos(outer)` used for the spot smoothstep, so a hard-edged cone
 /// (`inner == outer`) has a finite slope.
 pub const SPOT_MIN_COS_DELTA: f64 = 1e-4;
+
+/// `(scale, offset)` of a cone of half-angles `outer_deg` ≥ `inner_deg` (see
+/// [`Light::spot_scale_offset`]); also what the RGBA8 light decoder rebuilds from angles.
+pub fn spot_terms(outer_deg: f64, inner_deg: f64) -> (f64, f64) {
+    // 1 − cos α = 2 sin²(α/2), precise for small angles.
+    let one_minus_cos = |deg: f64| 2.0 * (deg.to_radians() * 0.5).sin().powi(2);
+    let (outer, inner) = (one_minus_cos(outer_deg), one_minus_cos(inner_deg));
+    let scale = 1.0 / (outer - inner).max(SPOT_MIN_COS_DELTA);
+    (scale, scale * outer)
+}
 
 #[cfg(test)]
 mod tests {

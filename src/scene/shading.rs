@@ -7,7 +7,7 @@
 //! ```text
 //! d        = |Lp − P|,  L = (Lp − P) / d
 //! falloff  = clamp(1 − (d/r)⁴, 0, 1)² / (d² + 1)          exactly 0 for d ≥ r
-//! spot     = smoothstep over t = clamp(dot(−L, dir)·scale + offset, 0, 1)   (1 for points)
+//! spot     = smoothstep over t = clamp(offset − scale·(1 − dot(−L, dir)), 0, 1)   (1 for points)
 //! diffuse  = albedo · max(N·L, 0)
 //! specular = Ks · max(N·H, 0)^Ns   with H = normalize(L + V), only where N·L > 0
 //! out      = ambient · albedo + Σ c · falloff · spot · (diffuse + specular)
@@ -54,8 +54,8 @@ pub fn spot_factor(light: &Light, to_surface: DVec3) -> f64 {
         LightKind::Point => 1.0,
         LightKind::Spot { direction, .. } => {
             let (scale, offset) = light.spot_scale_offset();
-            let cos = to_surface.dot(direction.normalize());
-            let t = (cos * scale as f64 + offset as f64).clamp(0.0, 1.0);
+            let one_minus_cos = 1.0 - to_surface.dot(direction.normalize());
+            let t = (offset as f64 - scale as f64 * one_minus_cos).clamp(0.0, 1.0);
             t * t * (3.0 - 2.0 * t)
         }
     }
