@@ -319,6 +319,19 @@ fn degenerate_and_huge_radii_and_intensities() {
     ];
     check("radius 0 / 1e-6, intensity 1e-6 / 1e6", &s, 96, 54);
     assert_matches_oracle("radius 0 / 1e-6, intensity 1e-6 / 1e6", &s, 96, 54);
+    // The radius-0 light is never uploaded: it is not active, and no method sees it.
+    let mut gpu = Gpu::new(EsVersion::Es3);
+    for method in METHODS {
+        gpu.r().set_method(method).unwrap();
+        let (_, stats) = gpu
+            .r()
+            .render_offscreen(&s, 32, 18, &RenderOptions::default())
+            .unwrap();
+        assert_eq!(
+            stats.active_lights, 3,
+            "{method}: the radius-0 light is inactive"
+        );
+    }
     // 1 000 lights whose spheres cover the whole frustum.
     let mut big = plane();
     big.lights = (0..1000)
