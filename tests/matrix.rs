@@ -76,15 +76,24 @@ fn matrix_covers_es2_es2_without_float_and_es3_and_every_supported_cell_matches_
             other => assert_eq!(status, "unsupported", "{other} needs fragment highp"),
         }
     }
-    // The restriction is real: without float textures the context reports none.
-    assert_eq!(
-        row("ES 2.0 without float textures")["float_textures"],
-        false
-    );
-    assert!(row("ES 2.0 driver (capped)")["gl_version"]
+    // The restriction is real: without float textures the context reports none. (Only
+    // Mesa reads MESA_* overrides; on another driver these rows run unrestricted.)
+    let mesa = row("ES 2.0")["gl_version"]
         .as_str()
         .unwrap()
-        .contains("ES 2.0"));
+        .contains("Mesa");
+    if mesa {
+        assert_eq!(
+            row("ES 2.0 without float textures")["float_textures"],
+            false
+        );
+        assert!(row("ES 2.0 driver (capped)")["gl_version"]
+            .as_str()
+            .unwrap()
+            .contains("ES 2.0"));
+    } else {
+        eprintln!("SKIPPED: the driver is not Mesa: MESA_* override rows are not restricted");
+    }
     // Desktop GL through OSMesa runs the same methods (skipped where libOSMesa is missing).
     let osmesa = row("desktop GL (OSMesa)");
     match osmesa["error"].as_str() {
