@@ -11,6 +11,13 @@ VARYING vec3 v_normal;
 VARYING vec2 v_uv;
 
 void main() {
+    // A highp copy: gl_FragCoord may be mediump on ES 2.0, too coarse past 2048 pixels.
+    HIGHP vec2 fragXY = gl_FragCoord.xy;
+    HIGHP float viewDepth = -v_viewPos.z;
+#if COUNT_EVALS
+    // The loop below runs over the cell's list: its length is the evaluation count.
+    FRAG_COLOR = encodeCount(float(clusterCell(fragXY, viewDepth).y));
+#else
     vec3 N = normalize(v_normal);
     vec3 V = viewDirection(v_viewPos);
     if (dot(N, V) < 0.0) {
@@ -18,9 +25,6 @@ void main() {
     }
     MEDP vec3 albedo = surfaceAlbedo(v_uv);
     HIGHP vec3 color = u_ambient * albedo;
-    // A highp copy: gl_FragCoord may be mediump on ES 2.0, too coarse past 2048 pixels.
-    HIGHP vec2 fragXY = gl_FragCoord.xy;
-    HIGHP float viewDepth = -v_viewPos.z;
 #if GLSL_ES == 100
     HIGHP vec2 cell = clusterCell(fragXY, viewDepth);
     // Appendix A: constant bound (the per-cell cap), exit with break.
@@ -37,4 +41,5 @@ void main() {
     }
 #endif
     FRAG_COLOR = encodeOutput(color);
+#endif
 }

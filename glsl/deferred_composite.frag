@@ -9,7 +9,11 @@ void main() {
     if (texelFetch(u_gNormalDepth, px, 0).w <= 0.0) {
         discard;
     }
+#if COUNT_EVALS
+    FRAG_COLOR = encodeCount(texelFetch(u_accum, px, 0).r);
+#else
     vec3 albedo = texelFetch(u_gAlbedo, px, 0).rgb;
     vec3 color = u_ambient * albedo + texelFetch(u_accum, px, 0).rgb;
     FRAG_COLOR = encodeOutput(color);
+#endif
 }

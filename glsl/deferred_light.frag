@@ -18,6 +18,10 @@ void main() {
     if (nd.w <= 0.0) {
         discard;
     }
+#if COUNT_EVALS
+    // One evaluation of this light here, summed by the additive blend.
+    FRAG_COLOR = vec4(1.0);
+#else
     HIGHP vec3 P = viewPosition(gl_FragCoord.xy, nd.w);
     vec4 spec = texelFetch(u_gSpecular, px, 0);
     Light light;
@@ -31,4 +35,5 @@ void main() {
 #endif
     MEDP vec3 albedo = texelFetch(u_gAlbedo, px, 0).rgb;
     FRAG_COLOR = vec4(shadeLight(light, P, nd.xyz, viewDirection(P), albedo, spec.rgb, spec.a), 1.0);
+#endif
 }

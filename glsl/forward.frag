@@ -1,5 +1,6 @@
 // Plain forward: every light for every fragment. The correctness oracle of the other methods,
-// so it stays simple and evaluates at the highest precision the fragment stage has.
+// so it stays simple; its reference variant evaluates at the highest precision the fragment
+// stage has.
 #include "surface.glsl"
 #include "data_texture.glsl"
 #include "light_data.glsl"
@@ -10,6 +11,30 @@ VARYING vec3 v_normal;
 VARYING vec2 v_uv;
 
 void main() {
+#if COUNT_REACHING
+    // The lower bound of culling: lights whose sphere (and cone) contains this point.
+    HIGHP float reaching = 0.0;
+#if GLSL_ES == 100
+    for (int i = 0; i < MAX_LIGHTS; i++) {
+        if (i >= u_lightCount) {
+            break;
+        }
+        reaching += lightReaches(fetchLight(i), v_viewPos) ? 1.0 : 0.0;
+    }
+#else
+    for (int i = 0; i < u_lightCount; i++) {
+        reaching += lightReaches(fetchLight(i), v_viewPos) ? 1.0 : 0.0;
+    }
+#endif
+    FRAG_COLOR = encodeCount(reaching);
+#elif COUNT_EVALS
+    // Every light is evaluated for every fragment.
+#if NO_LIGHTS
+    FRAG_COLOR = encodeCount(0.0);
+#else
+    FRAG_COLOR = encodeCount(float(u_lightCount));
+#endif
+#else
     vec3 N = normalize(v_normal);
     vec3 V = viewDirection(v_viewPos);
     // Two-sided surfaces: light the side the eye sees.
@@ -34,4 +59,5 @@ void main() {
 #endif
 #endif
     FRAG_COLOR = encodeOutput(color);
+#endif
 }

@@ -56,3 +56,22 @@ vec3 shadeLight(Light light, HIGHP vec3 P, vec3 N, vec3 V, MEDP vec3 albedo, MED
     MEDP vec3 reflectance = albedo * nDotL + spec;
     return light.radiance * (falloff * spot) * reflectance;
 }
+
+#if COUNT_REACHING
+// Whether the light can contribute at P at all, whatever the surface's orientation: P inside
+// its sphere and (spots) inside its cone. What a perfect per-pixel culler would keep.
+bool lightReaches(Light light, HIGHP vec3 P) {
+    HIGHP vec3 u = (light.position - P) / light.radius;
+    HIGHP float u2 = dot(u, u);
+    if (u2 >= 1.0) {
+        return false;
+    }
+#if HAS_SPOT
+    HIGHP vec3 L = u2 > 0.0 ? u * inversesqrt(u2) : vec3(0.0);
+    HIGHP vec3 chord = L + light.direction;
+    return light.spotOffset - 0.5 * light.spotScale * dot(chord, chord) > 0.0;
+#else
+    return true;
+#endif
+}
+#endif

@@ -44,6 +44,17 @@ vec4 encodeOutput(vec3 color) {
 #endif
 }
 
+#if COUNT_EVALS || COUNT_REACHING
+// A light count written exactly into an RGBA8 target: low, middle and high byte in r, g, b;
+// alpha 1 marks a covered pixel (the target is cleared to 0). Read back by the renderer.
+vec4 encodeCount(HIGHP float n) {
+    HIGHP float high = floor(n / 65536.0);
+    HIGHP float rest = n - high * 65536.0;
+    HIGHP float middle = floor(rest / 256.0);
+    return vec4(rest - middle * 256.0, middle, high, 255.0) / 255.0;
+}
+#endif
+
 // Unit direction from the surface to the eye, in view space.
 vec3 viewDirection(vec3 viewPos) {
     return normalize(mix(-viewPos, vec3(0.0, 0.0, 1.0), u_orthographic));

@@ -56,6 +56,14 @@ pub struct RenderOptions {
     /// variant): the reference image error is measured against. Off, colour factors run at
     /// mediump as a mobile build wants (see `glsl/light_model.glsl`).
     pub reference_precision: bool,
+    /// What the frame writes: colour, or per-pixel light counts (see
+    /// [`Renderer::render_light_counts`], which sets this).
+    pub count: CountKind,
+    /// Light cut-off in linear radiance: each light is culled (assigned to cells, or given a
+    /// proxy volume) only out to where its contribution falls below this, instead of to its
+    /// radius, trading error for time (tiled, clustered, deferred; forward loops over every
+    /// light regardless). `None`: cull at the radius, exactly.
+    pub light_cutoff: Option<f32>,
     /// Compile every variant with spot, specular and texture code even where the scene lacks
     /// them (a white texture stands in) — to measure what leaving features out saves, and to
     /// test that it changes nothing in the image.
@@ -76,8 +84,69 @@ impl Default for RenderOptions {
             wait_for_gpu: true,
             hdr: false,
             reference_precision: false,
+            count: CountKind::None,
+            light_cutoff: None,
             full_variants: false,
         }
+    }
+}
+
+/// Per-pixel light counts instead of colour.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum CountKind {
+    /// Colour (a normal frame).
+    #[default]
+    None,
+    /// Lights the method evaluates per pixel (its loop length, or its proxy volumes there).
+    Evals,
+    /// Lights whose sphere (and cone) reaches the pixel's surface point: the lower bound of
+    /// any culling, evaluated by a plain-forward pass whatever the method.
+    Reaching,
+}
+
+/// Per-pixel light counts of one frame (opaque surfaces; see [`Renderer::render_light_counts`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct LightCounts {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// Count per pixel, row-major, top row first (0 where nothing is drawn).
+    pub counts: Vec<u32>,
+    /// Whether a surface covers the pixel.
+    pub covered: Vec<bool>,
+}
+
+impl LightCounts {
+    /// Sum over covered pixels.
+    pub fn total(&self) -> u64 {
+        self.counts.iter().map(|&n| n as u64).sum()
+    }
+
+    /// Covered pixels.
+    pub fn covered_pixels(&self) -> usize {
+        self.covered.iter().filter(|&&c| c).count()
+    }
+
+    /// Mean per covered pixel (0 when nothing is covered).
+    pub fn mean(&self) -> f64 {
+        let n = self.covered_pixels();
+        if n == 0 {
+            0.0
+        } else {
+            self.total() as f64 / n as f64
+        }
+    }
+
+    /// Largest count.
+    pub fn max(&self) -> u32 {
+        self.counts.iter().copied().max().unwrap_or(0)
+    }
+
+    /// Count at pixel (x, y), top row first.
+    pub fn at(&self, x: u32, y: u32) -> u32 {
+        self.counts[(y * self.width + x) as usize]
     }
 }
 
@@ -102,6 +171,10 @@ pub struct FrameStats {
     pub active_lights: usize,
     /// Frame time in milliseconds: CPU work plus `glFinish` (median of the timed frames).
     pub frame_ms: f64,
+    /// GPU time of the frame's GL work from a `GL_EXT_disjoint_timer_query` elapsed-time query
+    /// (median of the timed frames); `None` without the extension, when the GPU reported a
+    /// disjoint event, or when the frame does not wait for the GPU.
+    pub gpu_ms: Option<f64>,
     /// Bytes uploaded for the frame.
     pub upload_bytes: usize,
     /// CPU light-assignment time in milliseconds (0 for forward).
@@ -227,6 +300,9 @@ pub struct Renderer {
     method: Box<dyn ShadingMethod>,
     support: Support,
     target: Option<OffscreenTarget>,
+    /// The GPU timer: `None` until first needed, then `Some(None)` where the context has no
+    /// timer queries.
+    timer: Option<Option<crate::gl::timer::GpuTimer>>,
 }
 
 impl Renderer {
@@ -266,6 +342,7 @@ impl Renderer {
             method,
             support,
             target: None,
+            timer: None,
         })
     }
 
@@ -350,7 +427,17 @@ impl Renderer {
             .lights
             .iter()
             .filter(|l| l.is_active())
-            .map(|l| GpuLight::from_light(l, &view))
+            .map(|l| {
+                let mut g = GpuLight::from_light(l, &view);
+                if let Some(cutoff) = options.light_cutoff {
+                    g.cull_radius = crate::scene::shading::cutoff_distance(
+                        g.radiance.max_element() as f64,
+                        g.radius as f64,
+                        cutoff as f64,
+                    ) as f32;
+                }
+                g
+            })
             .collect();
         let scene_features = SceneFeatures::of(scene);
         let features = ShaderFeatures::default()
@@ -367,6 +454,14 @@ impl Renderer {
             .with(
                 ShaderFeatures::FP16_LIGHTS,
                 !self.dev.caps().fragment_has_highp(),
+            )
+            .with(
+                ShaderFeatures::COUNT_EVALS,
+                options.count == CountKind::Evals,
+            )
+            .with(
+                ShaderFeatures::COUNT_REACHING,
+                options.count == CountKind::Reaching,
             )
             .with(
                 ShaderFeatures::LIGHTS_RGBA8,
@@ -394,11 +489,24 @@ impl Renderer {
         };
         // No lights: no assignment, no uploads, the light loop compiled out — whatever the
         // method (a scene pays only for what it has).
+        // GPU time only where the frame waits anyway: reading the query result stalls.
+        let timer = if options.wait_for_gpu {
+            if self.timer.is_none() {
+                self.timer = Some(crate::gl::timer::GpuTimer::new(&self.dev)?);
+            }
+            self.timer.as_ref().and_then(Option::as_ref)
+        } else {
+            None
+        };
+        if let Some(t) = timer {
+            t.begin(&self.dev);
+        }
         let method_stats = if lights.is_empty() {
             methods::geometry::draw_ambient_only(&mut ctx)?
         } else {
             self.method.render(&mut ctx)?
         };
+        let gpu_ms = timer.and_then(|t| t.end(&self.dev));
         if options.wait_for_gpu {
             self.dev.finish();
         }
@@ -415,6 +523,7 @@ impl Renderer {
             lights: scene.lights.len(),
             active_lights: lights.len(),
             frame_ms: start.elapsed().as_secs_f64() * 1e3,
+            gpu_ms,
             upload_bytes: method_stats.upload_bytes,
             assign_ms: method_stats.assign_ms.unwrap_or(0.0),
             clusters: assign.clusters,
@@ -516,15 +625,87 @@ impl Renderer {
                 v[v.len() / 2]
             };
             let (frame_ms, assign_ms) = (median(|s| s.frame_ms), median(|s| s.assign_ms));
+            let gpu_ms = frames
+                .iter()
+                .all(|s| s.gpu_ms.is_some())
+                .then(|| median(|s| s.gpu_ms.unwrap_or(0.0)));
             stats = frames.pop().expect("at least one timed frame");
             stats.frame_ms = frame_ms;
             stats.assign_ms = assign_ms;
+            stats.gpu_ms = gpu_ms;
         }
         Ok(stats)
     }
 
+    /// Per-pixel light counts of the opaque visible surfaces instead of colour: `Evals`, the
+    /// lights the current method evaluates at each pixel (its loop length, or for deferred its
+    /// proxy volumes covering the pixel), or `Reaching`, the lights whose sphere (and cone)
+    /// contains the pixel's surface point, the lower bound of any culling (always evaluated
+    /// by a plain-forward pass). Counts are exact (24 bits in an RGBA8 target).
+    pub fn render_light_counts(
+        &mut self,
+        scene: &Scene,
+        width: u32,
+        height: u32,
+        options: &RenderOptions,
+        kind: CountKind,
+    ) -> Result<(LightCounts, FrameStats), Error> {
+        let options = RenderOptions {
+            count: kind,
+            clear_color: [0.0; 4],
+            timed_frames: 0,
+            ..options.clone()
+        };
+        let stats = if kind == CountKind::Reaching {
+            // A plain-forward pass whatever the method: swap one in for this frame.
+            let forward = (methods::find("forward")?.create)(&self.dev)?;
+            let current = std::mem::replace(&mut self.method, forward);
+            let result =
+                self.render_into_target(scene, width, height, &options, ColorFormat::Rgba8);
+            let mut forward = std::mem::replace(&mut self.method, current);
+            forward.destroy(&self.dev);
+            result?
+        } else {
+            self.render_into_target(scene, width, height, &options, ColorFormat::Rgba8)?
+        };
+        let image = self
+            .target
+            .as_ref()
+            .expect("rendered")
+            .read_rgba8(&self.dev)?;
+        self.dev.bind_default_framebuffer();
+        let counts = image
+            .pixels()
+            .map(|p| p[0] as u32 | (p[1] as u32) << 8 | (p[2] as u32) << 16)
+            .collect();
+        let covered = image.pixels().map(|p| p[3] > 127).collect();
+        Ok((
+            LightCounts {
+                width,
+                height,
+                counts,
+                covered,
+            },
+            stats,
+        ))
+    }
+
+    /// The cell grid and light lists of the last tiled or clustered frame (for tests and
+    /// tools that check what the shader read); `None` for other methods.
+    pub fn last_light_lists(
+        &self,
+    ) -> Option<(
+        &crate::cluster::grid::ClusterGrid,
+        &crate::cluster::assign::Assignment,
+    )> {
+        self.method.light_lists()
+    }
+
     /// Frees every GL object the renderer made. Call before dropping the context.
     pub fn destroy(mut self) {
+        if let Some(Some(t)) = self.timer.take() {
+            t.destroy(&self.dev);
+        }
         self.method.destroy(&self.dev);
         self.programs.destroy(&self.dev);
         self.gpu_scene.destroy(&self.dev);

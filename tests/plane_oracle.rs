@@ -4,7 +4,8 @@ mod common;
 
 use common::{max_oracle_error, Gpu};
 use glam::{DVec3, Vec3};
-use manylight::scene::{self, shading, Light, Scene};
+use manylight::metrics::cpu_reference::Encoding;
+use manylight::scene::{self, Light, Scene};
 use manylight::{EsVersion, RenderOptions};
 
 const W: u32 = 256;
@@ -56,16 +57,18 @@ fn check(es: EsVersion, opts: RenderOptions, tolerance: f64) -> f64 {
     let scene = lit_plane();
     let mut gpu = Gpu::new(es);
     let img = gpu.render(&scene, W, H, &opts);
-    let encode = |x: f64| {
-        if opts.linear {
-            x
-        } else {
-            shading::linear_to_srgb(x)
-        }
+    let encoding = if opts.linear {
+        Encoding::Linear
+    } else {
+        Encoding::Srgb
     };
-    let (err, at, covered) = max_oracle_error(&img, &scene, encode);
+    let (err, at, covered) = max_oracle_error(&img, &scene, encoding);
     eprintln!("{es} {opts:?}: max error {err:.3}/255 at {at:?}");
-    assert_eq!(covered, (W * H) as usize, "the plane should fill the view");
+    // The plane fills the view; only pixels on its diagonal edge are left out.
+    assert!(
+        covered > (W * H) as usize * 95 / 100,
+        "only {covered} pixels compared"
+    );
     assert!(
         err <= tolerance,
         "{es}: max error {err:.2}/255 at {at:?} exceeds {tolerance}/255 (opts {opts:?})"
@@ -131,6 +134,6 @@ fn oracle_detects_a_slightly_moved_light() {
             ..Default::default()
         },
     );
-    let (err, _, _) = max_oracle_error(&img, &reference, |x| x);
+    let (err, _, _) = max_oracle_error(&img, &reference, Encoding::Linear);
     assert!(err > 2.0, "a moved light went unnoticed (error {err})");
 }

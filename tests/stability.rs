@@ -9,6 +9,7 @@ mod common;
 
 use common::{max_oracle_error, Gpu};
 use glam::{DVec3, Vec3};
+use manylight::metrics::cpu_reference::Encoding;
 use manylight::scene::{self, shading, Camera, Light, Projection, Scene};
 use manylight::{EsVersion, RenderOptions};
 
@@ -155,7 +156,7 @@ fn assert_matches_oracle(name: &str, scene: &Scene, w: u32, h: u32) {
             ..Default::default()
         },
     );
-    let (err, at, _) = max_oracle_error(&img, scene, |x| x);
+    let (err, at, _) = max_oracle_error(&img, scene, Encoding::Linear);
     assert!(
         err <= 2.0,
         "{name}: forward is {err:.2}/255 from the light model at {at:?}"

@@ -126,6 +126,15 @@ impl Device {
         }
     }
 
+    /// Clears only the colour of the bound framebuffer (its depth, if any, is kept).
+    pub fn clear_color_only(&self, color: [f32; 4]) {
+        unsafe {
+            self.gl.color_mask(true, true, true, true);
+            self.gl.clear_color(color[0], color[1], color[2], color[3]);
+            self.gl.clear(glow::COLOR_BUFFER_BIT);
+        }
+    }
+
     /// Blocks until the GPU has finished all submitted work (wall-clock frame timing).
     pub fn finish(&self) {
         unsafe { self.gl.finish() }

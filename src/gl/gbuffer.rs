@@ -138,6 +138,14 @@ impl GBuffer {
                 Some(accum),
                 0,
             );
+            // The geometry pass's depth, tested (never written) by the light volumes.
+            gl.framebuffer_texture_2d(
+                glow::FRAMEBUFFER,
+                glow::DEPTH_ATTACHMENT,
+                glow::TEXTURE_2D,
+                Some(depth),
+                0,
+            );
             let accum_status = gl.check_framebuffer_status(glow::FRAMEBUFFER);
             for s in [status, accum_status] {
                 if s != glow::FRAMEBUFFER_COMPLETE {
@@ -172,14 +180,15 @@ impl GBuffer {
         dev.clear([0.0; 4]);
     }
 
-    /// Binds the accumulation buffer, cleared to black.
+    /// Binds the accumulation buffer, cleared to black, with the geometry pass's depth
+    /// attached (kept) for the light volumes' depth test.
     pub fn begin_accumulation(&self, dev: &Device) {
         unsafe {
             dev.gl
                 .bind_framebuffer(glow::FRAMEBUFFER, Some(self.accum_fbo));
         }
         dev.viewport(0, 0, self.size.0 as i32, self.size.1 as i32);
-        dev.clear([0.0; 4]);
+        dev.clear_color_only([0.0; 4]);
     }
 
     /// Binds albedo, normal+depth, specular and accumulation to units `first..first + 4`.

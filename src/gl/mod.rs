@@ -23,6 +23,7 @@ pub mod program;
 pub mod shader_source;
 pub mod state;
 pub mod texture;
+pub mod timer;
 
 pub use caps::Caps;
 pub use context::HeadlessContext;

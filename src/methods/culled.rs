@@ -257,6 +257,15 @@ impl ShadingMethod for CulledForward {
         })
     }
 
+    fn light_lists(
+        &self,
+    ) -> Option<(
+        &crate::cluster::grid::ClusterGrid,
+        &crate::cluster::assign::Assignment,
+    )> {
+        Some((&self.grid.as_ref()?.1, self.assigner.assignment()))
+    }
+
     /// GPU bytes of all ring sets.
     fn gpu_bytes(&self) -> usize {
         self.ring.iter().flatten().map(TextureSet::gpu_bytes).sum()

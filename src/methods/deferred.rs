@@ -124,8 +124,10 @@ impl Deferred {
                 ([half_x as f32, half_y as f32], true)
             }
         };
-        for light in ctx.lights {
-            let radius = light.radius * VOLUME_SCALE;
+        for light in ctx.lights.iter().filter(|l| l.cull_radius > 0.0) {
+            // The proxy bounds the light's reach: its culling radius (the radius, or less
+            // under a light cut-off).
+            let radius = light.cull_radius * VOLUME_SCALE;
             // A proxy reaching the near plane (the eye inside it, or beside it in a wide view)
             // would lose faces to clipping: a full-screen triangle instead. Orthographic views
             // always use it.
@@ -139,8 +141,15 @@ impl Deferred {
             } else {
                 ("deferred_light", self.sphere.as_ref(), Cull::Back)
             };
+            // A proxy's front faces are depth tested against the surfaces: where a surface
+            // lies in front of the whole sphere, the light cannot reach it and the pixel is
+            // skipped. (Surfaces behind the sphere still pass: a one-sided test, no stencil.)
             RenderState {
-                depth_test: DepthTest::Off,
+                depth_test: if fullscreen {
+                    DepthTest::Off
+                } else {
+                    DepthTest::LessEqual
+                },
                 depth_write: false,
                 blend: Blend::Additive,
                 cull,
@@ -241,7 +250,7 @@ impl ShadingMethod for Deferred {
             gbuffer_bytes: self.gbuffer.as_ref().map_or(0, GBuffer::gpu_bytes),
             ..MethodStats::default()
         };
-        if !transparent.is_empty() {
+        if !transparent.is_empty() && !ctx.features.counting() {
             // Forward fallback for what a G-buffer cannot hold.
             self.gbuffer
                 .as_ref()

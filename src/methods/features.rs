@@ -30,9 +30,15 @@ impl ShaderFeatures {
     /// The device has no fragment highp: light radiance is read in its fp16-range form (see
     /// `cluster::pack`), so a bright light does not overflow to infinity.
     pub const FP16_LIGHTS: u64 = 1 << 8;
+    /// Instead of a colour, write the number of lights the fragment's loop runs over (the
+    /// light-evaluation count; see [`crate::renderer::CountKind`]).
+    pub const COUNT_EVALS: u64 = 1 << 9;
+    /// Instead of a colour, write the number of lights whose sphere (and cone) reaches the
+    /// fragment: the lower bound of any per-pixel culling (forward only).
+    pub const COUNT_REACHING: u64 = 1 << 10;
 
     /// Every flag with its name.
-    pub const NAMED: [(u64, &'static str); 9] = [
+    pub const NAMED: [(u64, &'static str); 11] = [
         (Self::TEXTURE, "texture"),
         (Self::SPOT, "spot"),
         (Self::SPECULAR, "specular"),
@@ -42,6 +48,8 @@ impl ShaderFeatures {
         (Self::NO_LIGHTS, "no_lights"),
         (Self::REFERENCE_PRECISION, "reference_precision"),
         (Self::FP16_LIGHTS, "fp16_lights"),
+        (Self::COUNT_EVALS, "count_evals"),
+        (Self::COUNT_REACHING, "count_reaching"),
     ];
 
     /// Names of the set flags.
@@ -61,6 +69,11 @@ impl ShaderFeatures {
     /// With `bit` set or cleared.
     pub fn with(self, bit: u64, on: bool) -> Self {
         ShaderFeatures(if on { self.0 | bit } else { self.0 & !bit })
+    }
+
+    /// True for the count variants (light evaluations or reaching lights instead of colour).
+    pub fn counting(self) -> bool {
+        self.has(Self::COUNT_EVALS) || self.has(Self::COUNT_REACHING)
     }
 
     /// Light encoding these features select.
@@ -84,6 +97,8 @@ impl ShaderFeatures {
             ("OUTPUT_HDR".into(), flag(Self::OUTPUT_HDR)),
             ("NO_LIGHTS".into(), flag(Self::NO_LIGHTS)),
             ("FP16_LIGHTS".into(), flag(Self::FP16_LIGHTS)),
+            ("COUNT_EVALS".into(), flag(Self::COUNT_EVALS)),
+            ("COUNT_REACHING".into(), flag(Self::COUNT_REACHING)),
             (
                 "MEDP".into(),
                 if self.has(Self::REFERENCE_PRECISION) {

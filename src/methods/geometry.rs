@@ -88,6 +88,12 @@ pub fn draw_objects(
     for &i in &opaque {
         shade_object(ctx, i, shader, max_lights, bind_method)?;
     }
+    // Counts are of the visible opaque surface: blending would mix two counts in 8 bits.
+    let transparent = if ctx.features.counting() {
+        Vec::new()
+    } else {
+        transparent
+    };
     for &i in &transparent {
         for state in [
             RenderState::TRANSPARENT_BACK_FACES,

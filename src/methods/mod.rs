@@ -90,6 +90,15 @@ pub trait ShadingMethod {
     fn render(&mut self, ctx: &mut FrameContext) -> Result<MethodStats, Error>;
     /// GPU memory the method holds, in bytes.
     fn gpu_bytes(&self) -> usize;
+    /// The grid and light lists of the last frame, for methods that build them.
+    fn light_lists(
+        &self,
+    ) -> Option<(
+        &crate::cluster::grid::ClusterGrid,
+        &crate::cluster::assign::Assignment,
+    )> {
+        None
+    }
     /// Frees the method's GPU resources.
     fn destroy(&mut self, dev: &Device);
 }

@@ -1,5 +1,10 @@
 //! Image comparison: the numbers every correctness claim is stated in.
 
+pub mod cpu_reference;
+pub mod heatmap;
+pub mod plot;
+pub mod raycast;
+pub mod report;
 pub mod sheet;
 
 use serde::Serialize;
@@ -66,5 +71,16 @@ mod tests {
         assert!((d.psnr_db - 10.0 * (65025.0 / mse).log10()).abs() < 1e-9);
         assert_eq!(d.over_2, 1.0 / 16.0);
         assert_eq!(diff(&a, &a).psnr_db, f64::INFINITY);
+    }
+
+    #[test]
+    fn a_uniform_offset_of_one_step_gives_the_textbook_psnr() {
+        let a = image::RgbaImage::from_pixel(8, 8, image::Rgba([10, 20, 30, 255]));
+        let b = image::RgbaImage::from_pixel(8, 8, image::Rgba([11, 21, 31, 255]));
+        let d = diff(&a, &b);
+        assert_eq!((d.max_abs, d.rmse), (1, 1.0));
+        // 20·log10(255 / 1).
+        assert!((d.psnr_db - 48.130_803_608_679_1).abs() < 1e-9);
+        assert_eq!((d.over_1, d.over_2), (0.0, 0.0));
     }
 }

@@ -48,6 +48,31 @@ pub fn falloff(d: f64, r: f64) -> f64 {
     w * w / (d * d + 1.0)
 }
 
+/// Distance out to which a light of peak radiance `radiance` (its largest channel) and
+/// radius `radius` contributes at least `cutoff` (linear radiance, before the surface's
+/// reflectance): the light cut-off knob. Its falloff decreases monotonically, so a bisection
+/// finds the distance; 0 when even the peak is below the cut-off, `radius` for a cut-off of
+/// 0.
+pub fn cutoff_distance(radiance: f64, radius: f64, cutoff: f64) -> f64 {
+    if cutoff <= 0.0 {
+        return radius;
+    }
+    if radiance * falloff(0.0, radius) < cutoff {
+        return 0.0;
+    }
+    let (mut lo, mut hi) = (0.0, radius);
+    // 60 halvings take any radius below an f64 ulp of itself.
+    for _ in 0..60 {
+        let mid = 0.5 * (lo + hi);
+        if radiance * falloff(mid, radius) >= cutoff {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    hi
+}
+
 /// The spot factor for a light-to-surface direction `to_surface` (unit).
 pub fn spot_factor(light: &Light, to_surface: DVec3) -> f64 {
     match light.kind {
@@ -126,6 +151,19 @@ mod tests {
         assert!(falloff(1.9, 2.0) > 0.0);
         assert_eq!(falloff(0.0, 2.0), 1.0);
         assert_eq!(falloff(0.0, 0.0), 0.0);
+    }
+
+    #[test]
+    fn cutoff_distance_is_where_the_contribution_meets_the_cutoff() {
+        let (c, r) = (2.0, 5.0);
+        for cutoff in [1e-4, 1e-2, 0.3] {
+            let d = cutoff_distance(c, r, cutoff);
+            assert!(d > 0.0 && d < r, "{cutoff}: {d}");
+            assert!((c * falloff(d, r) - cutoff).abs() < 1e-9, "{cutoff}: {d}");
+        }
+        assert_eq!(cutoff_distance(c, r, 0.0), r);
+        assert_eq!(cutoff_distance(c, r, 3.0), 0.0, "peak below the cut-off");
+        assert!(cutoff_distance(c, r, 1e-3) > cutoff_distance(c, r, 1e-2));
     }
 
     #[test]

@@ -1,5 +1,7 @@
-//! The `manylight` command line: `render` (the default), `info`.
+//! The `manylight` command line: `render` (the default), `info`, `bench`, `bench-assign`,
+//! `matrix`, `view`.
 
+mod bench;
 mod bench_assign;
 mod info;
 mod matrix;
@@ -34,6 +36,9 @@ enum Command {
     Render(render::RenderArgs),
     /// Print the capabilities of an ES 2.0 or 3.0 context.
     Info(info::InfoArgs),
+    /// Error against run time: sweep methods, light counts, scenes, ES versions and knobs,
+    /// and write a report with tables, charts and light-evaluation heatmaps.
+    Bench(bench::BenchArgs),
     /// Time CPU light assignment alone on the default view.
     BenchAssign(bench_assign::BenchAssignArgs),
     /// The ES capability matrix: every method under real driver restrictions.
@@ -47,7 +52,7 @@ enum Command {
 }
 
 /// `--es 2` or `--es 3`.
-#[derive(Clone, Copy, Debug, ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum EsArg {
     /// OpenGL ES 2.0 (GLSL ES 1.00).
     #[value(name = "2")]
@@ -75,6 +80,7 @@ fn main() -> ExitCode {
         None => render::run(&cli.render),
         Some(Command::Render(args)) => render::run(&args),
         Some(Command::Info(args)) => info::run(&args),
+        Some(Command::Bench(args)) => bench::run(&args),
         Some(Command::BenchAssign(args)) => bench_assign::run(&args),
         Some(Command::Matrix(args)) => matrix::run(&args),
         Some(Command::MatrixCell(args)) => matrix::run_cell(&args),

@@ -1,0 +1,437 @@
+//! `manylight bench`: error against run time. Sweeps scenes × light counts × ES versions ×
+//! methods, plus the knobs that trade error for time, and writes the report (see
+//! `manylight::metrics::report`).
+//!
+//! For every (scene, light count, ES version) it renders the reference once (plain forward over
+//! all lights, light model at highp), the lower bound of light evaluations (lights that really
+//! reach each pixel) and the f64 CPU reference at sampled pixels; then each configuration is
+//! timed, counted and compared against them.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use clap::Parser;
+use indicatif::{ProgressBar, ProgressStyle};
+use manylight::gl::HeadlessContext;
+use manylight::methods::{Support, METHODS};
+use manylight::metrics::cpu_reference::{self, Encoding, ReferenceSet};
+use manylight::metrics::report::{self, BenchRow, Report};
+use manylight::renderer::{CountKind, LightCounts};
+use manylight::scene::{self, Scene};
+use manylight::{EsVersion, RenderOptions, Renderer};
+
+use crate::EsArg;
+
+/// Options of `manylight bench`.
+#[derive(Parser, Debug)]
+pub struct BenchArgs {
+    /// A small sweep that finishes in well under a minute: the default scene at 0, 64 and
+    /// 1 024 lights on ES 2.0 and 3.0 at 320×180, one timed frame, the main knobs.
+    #[arg(long)]
+    pub quick: bool,
+    /// Folder for report.json, report.md, the charts, heatmaps and diff images.
+    #[arg(long, default_value = "bench-report")]
+    pub out: PathBuf,
+    /// Scenes (built-in names, .obj or .json files), comma separated. Default: the built-ins,
+    /// and the conference room when ../shared/assets (or $MANYLIGHT_ASSETS) has it.
+    #[arg(long, value_delimiter = ',')]
+    pub scenes: Vec<String>,
+    /// Light counts, comma separated (default 0,8,64,256,1024,4096).
+    #[arg(long, value_delimiter = ',')]
+    pub lights: Vec<usize>,
+    /// Methods, comma separated (default: every method in the table).
+    #[arg(long, value_delimiter = ',')]
+    pub methods: Vec<String>,
+    /// ES versions, comma separated (default 2,3).
+    #[arg(long, value_delimiter = ',', value_enum)]
+    pub es: Vec<EsArg>,
+    /// Image size as WIDTHxHEIGHT (default 640x360).
+    #[arg(long, value_parser = crate::render::parse_size)]
+    pub size: Option<(u32, u32)>,
+    /// Timed frames per configuration after a warm-up frame (default 3).
+    #[arg(long)]
+    pub frames: Option<u32>,
+    /// Pixels sampled for the f64 CPU reference (default 256).
+    #[arg(long, default_value_t = 256)]
+    pub cpu_samples: usize,
+    /// Skip the knob sweeps.
+    #[arg(long)]
+    pub no_knobs: bool,
+    /// Seed of the random lights.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+}
+
+/// The sweep, with the `--quick` or full defaults filled in.
+struct Plan {
+    scenes: Vec<String>,
+    lights: Vec<usize>,
+    methods: Vec<String>,
+    es: Vec<EsVersion>,
+    size: (u32, u32),
+    frames: u32,
+    knobs: bool,
+}
+
+impl Plan {
+    fn from(args: &BenchArgs) -> Plan {
+        let or = |given: &[String], default: Vec<String>| {
+            if given.is_empty() {
+                default
+            } else {
+                given.to_vec()
+            }
+        };
+        let scenes = if args.quick {
+            vec![scene::builtin::DEFAULT.to_string()]
+        } else {
+            let mut s: Vec<String> = scene::builtin::NAMES
+                .iter()
+                .map(|n| n.to_string())
+                .collect();
+            if let Some(c) = conference() {
+                s.push(c);
+            }
+            s
+        };
+        let lights = match (&args.lights[..], args.quick) {
+            ([], true) => vec![0, 64, 1024],
+            ([], false) => vec![0, 8, 64, 256, 1024, 4096],
+            (given, _) => given.to_vec(),
+        };
+        let es = match (&args.es[..], args.quick) {
+            ([], true) => vec![EsVersion::Es2, EsVersion::Es3],
+            ([], false) => vec![EsVersion::Es2, EsVersion::Es3],
+            (given, _) => given.iter().map(|&e| e.into()).collect(),
+        };
+        let default_size = if args.quick { (320, 180) } else { (640, 360) };
+        Plan {
+            scenes: or(&args.scenes, scenes),
+            lights,
+            methods: or(
+                &args.methods,
+                METHODS.iter().map(|m| m.name.to_string()).collect(),
+            ),
+            es,
+            size: args.size.unwrap_or(default_size),
+            frames: args.frames.unwrap_or(if args.quick { 1 } else { 3 }),
+            knobs: !args.no_knobs,
+        }
+    }
+}
+
+/// The conference room of ../shared/assets (or $MANYLIGHT_ASSETS), when present.
+fn conference() -> Option<String> {
+    let dir = std::env::var_os("MANYLIGHT_ASSETS")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| PathBuf::from("../shared/assets"));
+    let obj = dir.join("conference/conference.obj");
+    obj.is_file().then(|| obj.to_string_lossy().into_owned())
+}
+
+/// A knob varied from the defaults, on one method.
+struct Knob {
+    name: String,
+    method: &'static str,
+    apply: fn(&mut RenderOptions, f64),
+    value: f64,
+}
+
+fn knobs(quick: bool) -> Vec<Knob> {
+    let mut k = Vec::new();
+    let mut add = |name: &str, method, apply: fn(&mut RenderOptions, f64), values: &[f64]| {
+        for &value in values {
+            k.push(Knob {
+                name: format!("{name}={value}"),
+                method,
+                apply,
+                value,
+            });
+        }
+    };
+    let pick = |full: &'static [f64], q: &'static [f64]| if quick { q } else { full };
+    add(
+        "cutoff",
+        "clustered",
+        |o, v| o.light_cutoff = Some(v as f32),
+        pick(&[0.001, 0.01, 0.05], &[0.01]),
+    );
+    add(
+        "cutoff",
+        "tiled",
+        |o, v| o.light_cutoff = Some(v as f32),
+        pick(&[0.01], &[]),
+    );
+    add(
+        "cell_cap",
+        "clustered",
+        |o, v| o.cell_cap = Some(v as u32),
+        pick(&[64.0, 16.0], &[16.0]),
+    );
+    add(
+        "footprint_px",
+        "clustered",
+        |o, v| o.grid.footprint_px = v,
+        pick(&[32.0, 128.0], &[32.0]),
+    );
+    add(
+        "cascades",
+        "clustered",
+        |o, v| o.grid.cascades = v as u32,
+        pick(&[4.0, 8.0, 16.0], &[4.0]),
+    );
+    add(
+        "rgba8_lights",
+        "clustered",
+        |o, _| o.force_rgba8_lights = true,
+        &[1.0],
+    );
+    k
+}
+
+/// Everything one configuration is measured against.
+struct Baseline {
+    reference: image::RgbaImage,
+    bound: LightCounts,
+    cpu: ReferenceSet,
+}
+
+/// Runs the command.
+pub fn run(args: &BenchArgs) -> Result<(), Box<dyn std::error::Error>> {
+    let started = Instant::now();
+    let plan = Plan::from(args);
+    let knob_list = if plan.knobs {
+        knobs(args.quick)
+    } else {
+        Vec::new()
+    };
+    // The knobs run on the default scene at the light count nearest 1 024.
+    let knob_lights = plan
+        .lights
+        .iter()
+        .copied()
+        .min_by_key(|&n| (n as i64 - 1024).abs())
+        .unwrap_or(0);
+    let knob_scene = plan.scenes.first().cloned().unwrap_or_default();
+    let steps = plan.es.len() * plan.scenes.len() * plan.lights.len() * plan.methods.len()
+        + plan.es.len() * knob_list.len();
+    let progress = ProgressBar::new(steps as u64).with_style(
+        ProgressStyle::with_template("{bar:40} {pos}/{len} {elapsed_precise} {msg}")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    let mut rows = Vec::new();
+    for &es in &plan.es {
+        // One context per ES version, made current for its renderer's whole life.
+        let ctx = HeadlessContext::new(es)?;
+        let mut renderer = Renderer::new(ctx.load_gl(), es)?;
+        for spec in &plan.scenes {
+            for &count in &plan.lights {
+                let (scene, _) = scene::load(spec, Some((count, args.seed)))?;
+                let name = scene_name(spec);
+                progress.set_message(format!("ES {es} {name} {count} lights: reference"));
+                let base = baseline(&mut renderer, &scene, plan.size, args.cpu_samples)?;
+                let measure = Measure {
+                    scene: &scene,
+                    name: &name,
+                    base: &base,
+                    size: plan.size,
+                    frames: plan.frames,
+                };
+                for method in &plan.methods {
+                    progress.set_message(format!("ES {es} {name} {count} lights: {method}"));
+                    if let Some(row) = measure.run(&mut renderer, method, "default", |_| {})? {
+                        rows.push(row);
+                    }
+                    progress.inc(1);
+                }
+                if spec == &knob_scene && count == knob_lights {
+                    for knob in &knob_list {
+                        progress.set_message(format!("ES {es} {name}: {}", knob.name));
+                        let row = measure.run(&mut renderer, knob.method, &knob.name, |o| {
+                            (knob.apply)(o, knob.value)
+                        })?;
+                        rows.extend(row);
+                        progress.inc(1);
+                    }
+                    write_pictures(&mut renderer, &scene, &base, &plan, es, &args.out)?;
+                }
+            }
+        }
+        renderer.destroy();
+        drop(ctx);
+    }
+    progress.finish_and_clear();
+    let report = Report {
+        command: std::env::args().collect::<Vec<_>>().join(" "),
+        cpus: std::thread::available_parallelism().map_or(1, |n| n.get()),
+        seconds: started.elapsed().as_secs_f64(),
+        rows,
+    };
+    report::write(&report, &args.out)?;
+    eprintln!(
+        "{} configurations in {:.0} s → {}",
+        report.rows.len(),
+        report.seconds,
+        args.out.display()
+    );
+    Ok(())
+}
+
+fn scene_name(spec: &str) -> String {
+    std::path::Path::new(spec)
+        .file_stem()
+        .map_or(spec.to_string(), |s| s.to_string_lossy().into_owned())
+}
+
+fn baseline(
+    renderer: &mut Renderer,
+    scene: &Scene,
+    (w, h): (u32, u32),
+    cpu_samples: usize,
+) -> Result<Baseline, Box<dyn std::error::Error>> {
+    renderer.set_method("forward")?;
+    let reference_opts = RenderOptions {
+        reference_precision: true,
+        ..RenderOptions::default()
+    };
+    let (reference, _) = renderer.render_offscreen(scene, w, h, &reference_opts)?;
+    let (bound, _) =
+        renderer.render_light_counts(scene, w, h, &reference_opts, CountKind::Reaching)?;
+    let cpu = cpu_reference::reference_samples(scene, w, h, cpu_samples, Encoding::Srgb);
+    Ok(Baseline {
+        reference,
+        bound,
+        cpu,
+    })
+}
+
+/// What every configuration of one (scene, light count, ES version) shares.
+struct Measure<'a> {
+    scene: &'a Scene,
+    name: &'a str,
+    base: &'a Baseline,
+    size: (u32, u32),
+    frames: u32,
+}
+
+impl Measure<'_> {
+    /// Times, counts and compares one configuration; `None` when the method cannot run here.
+    fn run(
+        &self,
+        renderer: &mut Renderer,
+        method: &str,
+        knob: &str,
+        adjust: impl Fn(&mut RenderOptions),
+    ) -> Result<Option<BenchRow>, Box<dyn std::error::Error>> {
+        let desc = manylight::methods::find(method)?;
+        if matches!((desc.supported)(renderer.caps()), Support::Unsupported(_)) {
+            return Ok(None);
+        }
+        renderer.set_method(method)?;
+        let mut opts = RenderOptions {
+            timed_frames: self.frames,
+            ..RenderOptions::default()
+        };
+        adjust(&mut opts);
+        let (w, h) = self.size;
+        let (image, stats) = match renderer.render_offscreen(self.scene, w, h, &opts) {
+            Ok(r) => r,
+            // A configuration past a method's limits (forward's loop bound, say) is skipped.
+            Err(manylight::Error::Limit(reason)) => {
+                log::warn!("{} {method} {knob}: skipped: {reason}", self.name);
+                return Ok(None);
+            }
+            Err(e) => return Err(e.into()),
+        };
+        let (evals, _) = renderer.render_light_counts(self.scene, w, h, &opts, CountKind::Evals)?;
+        let d = manylight::metrics::diff(&self.base.reference, &image);
+        let cpu = cpu_reference::compare(&image, &self.base.cpu);
+        let bound = self.base.bound.total();
+        Ok(Some(BenchRow {
+            scene: self.name.to_string(),
+            method: method.to_string(),
+            es: format!("{}.0", stats.es.major()),
+            lights: self.scene.lights.len(),
+            width: w,
+            height: h,
+            knob: knob.to_string(),
+            frame_ms: stats.frame_ms,
+            gpu_ms: stats.gpu_ms,
+            assign_ms: stats.assign_ms,
+            upload_bytes: stats.upload_bytes,
+            light_evals: evals.total(),
+            evals_per_pixel: evals.mean(),
+            max_evals: evals.max(),
+            lower_bound_evals: bound,
+            lower_bound_per_pixel: self.base.bound.mean(),
+            evals_ratio: (bound > 0).then(|| evals.total() as f64 / bound as f64),
+            max_abs_err: d.max_abs,
+            rmse: d.rmse,
+            psnr_db: d.psnr_db.is_finite().then_some(d.psnr_db),
+            over_2: d.over_2,
+            cpu_max_abs_err: (cpu.samples > 0).then_some(cpu.max_abs),
+            cpu_samples: cpu.samples,
+            overflowed_lights: stats.overflowed_lights,
+            renderer: stats.renderer.clone(),
+            lp_num_threads: stats.lp_num_threads.clone(),
+        }))
+    }
+}
+
+/// Heatmaps of every method and of the lower bound, and each method's difference from the
+/// reference, for the knob configuration (the default scene near 1 024 lights).
+fn write_pictures(
+    renderer: &mut Renderer,
+    scene: &Scene,
+    base: &Baseline,
+    plan: &Plan,
+    es: EsVersion,
+    out: &std::path::Path,
+) -> Result<(), Box<dyn std::error::Error>> {
+    use manylight::metrics::heatmap;
+    std::fs::create_dir_all(out)?;
+    let (w, h) = plan.size;
+    let tag = format!("es{}", es.major());
+    let mut maps = vec![("lower-bound".to_string(), base.bound.clone())];
+    let mut images = Vec::new();
+    for method in &plan.methods {
+        let desc = manylight::methods::find(method)?;
+        if matches!((desc.supported)(renderer.caps()), Support::Unsupported(_)) {
+            continue;
+        }
+        renderer.set_method(method)?;
+        let opts = RenderOptions::default();
+        let Ok((counts, _)) = renderer.render_light_counts(scene, w, h, &opts, CountKind::Evals)
+        else {
+            continue;
+        };
+        let (image, _) = renderer.render_offscreen(scene, w, h, &opts)?;
+        maps.push((method.clone(), counts));
+        images.push((method.clone(), image));
+    }
+    // One colour scale for the maps, so they compare at a glance: the largest count of the
+    // culling methods (forward, every light everywhere, saturates above it).
+    let scale = maps
+        .iter()
+        .filter(|(name, _)| name != "forward")
+        .map(|(_, c)| c.max())
+        .max()
+        .unwrap_or(1)
+        .max(1);
+    for (name, c) in &maps {
+        let title = format!(
+            "{name}: {:.1} light evaluations per pixel ({es}, {} lights)",
+            c.mean(),
+            scene.lights.len()
+        );
+        heatmap::heatmap(&c.counts, &c.covered, c.width, c.height, scale, &title)
+            .save(out.join(format!("heatmap-{tag}-{name}.png")))?;
+    }
+    for (name, image) in &images {
+        heatmap::diff_image(&base.reference, image, 8)
+            .save(out.join(format!("diff-{tag}-{name}.png")))?;
+    }
+    base.reference
+        .save(out.join(format!("reference-{tag}.png")))?;
+    Ok(())
+}

@@ -1,0 +1,138 @@
+//! Light-evaluation counts (the papers' efficiency metric): what each method loops over per
+//! pixel, checked against the lower bound (lights that really reach the pixel) pixel by pixel,
+//! against the cluster lists on the CPU, and against each other.
+
+mod common;
+
+use common::Gpu;
+use manylight::renderer::{CountKind, LightCounts};
+use manylight::scene::{self, Scene};
+use manylight::{EsVersion, RenderOptions};
+
+fn counts(gpu: &mut Gpu, scene: &Scene, method: &str, kind: CountKind) -> LightCounts {
+    gpu.r().set_method(method).unwrap();
+    gpu.r()
+        .render_light_counts(scene, 256, 144, &RenderOptions::default(), kind)
+        .unwrap_or_else(|e| panic!("{method} {kind:?}: {e}"))
+        .0
+}
+
+/// Conservative culling means no method evaluates fewer lights at a pixel than reach it; and
+/// forward evaluates every light everywhere.
+#[test]
+fn every_method_evaluates_at_least_the_lights_that_reach_each_pixel() {
+    for (name, lights) in [("courtyard", 256), ("pillars", 1024), ("bubbles", 64)] {
+        let scene = scene::builtin::build(name, Some((lights, 5))).unwrap();
+        for es in [EsVersion::Es2, EsVersion::Es3] {
+            let mut gpu = Gpu::new(es);
+            let bound = counts(&mut gpu, &scene, "forward", CountKind::Reaching);
+            assert!(
+                bound.covered_pixels() > 1000,
+                "{name}: the view shows little"
+            );
+            assert!(bound.total() > 0, "{name}: no light reaches anything");
+            let methods: &[&str] = match es {
+                EsVersion::Es2 => &["forward", "tiled", "clustered"],
+                EsVersion::Es3 => &["forward", "tiled", "clustered", "deferred"],
+            };
+            for &method in methods {
+                let evals = counts(&mut gpu, &scene, method, CountKind::Evals);
+                assert_eq!(
+                    evals.covered, bound.covered,
+                    "{name} {es} {method}: coverage"
+                );
+                for (i, (&e, &b)) in evals.counts.iter().zip(&bound.counts).enumerate() {
+                    assert!(
+                        e >= b,
+                        "{name} {es} {method}: pixel {i} evaluates {e} lights, {b} reach it"
+                    );
+                }
+                if method == "forward" {
+                    assert!(
+                        evals
+                            .counts
+                            .iter()
+                            .zip(&evals.covered)
+                            .all(|(&n, &c)| !c || n as usize == lights),
+                        "{name} {es}: forward evaluates every light at every covered pixel"
+                    );
+                }
+                eprintln!(
+                    "{name} {es} {method}: {:.1} evals per pixel (max {}), bound {:.1}",
+                    evals.mean(),
+                    evals.max(),
+                    bound.mean()
+                );
+            }
+        }
+    }
+}
+
+/// The papers' result: on a scene of many small lights, clustered evaluates no more lights
+/// than tiled, and far fewer than forward.
+#[test]
+fn clustered_evaluates_fewer_lights_than_tiled_and_far_fewer_than_forward() {
+    let scene = scene::builtin::build("pillars", Some((1024, 1))).unwrap();
+    let mut gpu = Gpu::new(EsVersion::Es3);
+    let total = |gpu: &mut Gpu, m| counts(gpu, &scene, m, CountKind::Evals).total();
+    let (forward, tiled, clustered) = (
+        total(&mut gpu, "forward"),
+        total(&mut gpu, "tiled"),
+        total(&mut gpu, "clustered"),
+    );
+    eprintln!("pillars, 1024 lights: forward {forward}, tiled {tiled}, clustered {clustered}");
+    assert!(clustered <= tiled, "clustered {clustered} > tiled {tiled}");
+    assert!(
+        clustered * 10 < forward,
+        "clustered {clustered} is not far below forward {forward}"
+    );
+}
+
+/// The evaluation counts the shader writes are the lengths of the cell lists the CPU built:
+/// at sampled pixels, the surface point found by a CPU ray cast gives the cell, and its list
+/// length must equal the GPU's count. Pixels whose point lies within float rounding of a cell
+/// boundary (where CPU and GPU may rightly pick neighbours) are skipped.
+#[test]
+fn counts_equal_the_cpu_cluster_lists_at_sampled_pixels() {
+    use manylight::metrics::raycast::{pixel_ray, SceneRaycaster};
+    let scene = scene::builtin::build("pillars", Some((512, 3))).unwrap();
+    let (w, h) = (256u32, 144u32);
+    let caster = SceneRaycaster::new(&scene);
+    let view = scene.camera.view_matrix();
+    for es in [EsVersion::Es2, EsVersion::Es3] {
+        let mut gpu = Gpu::new(es);
+        for method in ["tiled", "clustered"] {
+            let gpu_counts = counts(&mut gpu, &scene, method, CountKind::Evals);
+            let (grid, lists) = gpu.r().last_light_lists().expect("lists of the last frame");
+            let (mut checked, mut nonzero) = (0, 0);
+            for y in (0..h).step_by(5) {
+                for x in (0..w).step_by(5) {
+                    let (o, d) = pixel_ray(&scene.camera, w, h, x as f64 + 0.5, y as f64 + 0.5);
+                    let Some(hit) = caster.hit(o, d) else {
+                        continue;
+                    };
+                    let depth = -view.transform_point3(hit.position).z;
+                    // GL window coordinates count rows from the bottom.
+                    let (fx, fy) = (x as f64 + 0.5, (h - y) as f64 - 0.5);
+                    let cell = |z: f64| grid.cell_index(grid.cell_of_fragment(fx, fy, z));
+                    let here = cell(depth);
+                    if cell(depth * (1.0 + 1e-5)) != here || cell(depth * (1.0 - 1e-5)) != here {
+                        continue;
+                    }
+                    let expected = lists.counts[here as usize];
+                    assert_eq!(
+                        gpu_counts.at(x, y),
+                        expected,
+                        "{es} {method}: pixel ({x}, {y}) at depth {depth} in cell {here}"
+                    );
+                    checked += 1;
+                    nonzero += usize::from(expected > 0);
+                }
+            }
+            assert!(
+                checked > 800 && nonzero > 400,
+                "{es} {method}: only {checked} pixels checked ({nonzero} with lights)"
+            );
+        }
+    }
+}
