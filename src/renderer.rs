@@ -656,24 +656,17 @@ impl Renderer {
             timed_frames: 0,
             ..options.clone()
         };
-        let stats = if kind == CountKind::Reaching {
+        let (image, stats) = if kind == CountKind::Reaching {
             // A plain-forward pass whatever the method: swap one in for this frame.
             let forward = (methods::find("forward")?.create)(&self.dev)?;
             let current = std::mem::replace(&mut self.method, forward);
-            let result =
-                self.render_into_target(scene, width, height, &options, ColorFormat::Rgba8);
+            let result = self.render_offscreen(scene, width, height, &options);
             let mut forward = std::mem::replace(&mut self.method, current);
             forward.destroy(&self.dev);
             result?
         } else {
-            self.render_into_target(scene, width, height, &options, ColorFormat::Rgba8)?
+            self.render_offscreen(scene, width, height, &options)?
         };
-        let image = self
-            .target
-            .as_ref()
-            .expect("rendered")
-            .read_rgba8(&self.dev)?;
-        self.dev.bind_default_framebuffer();
         let counts = image
             .pixels()
             .map(|p| p[0] as u32 | (p[1] as u32) << 8 | (p[2] as u32) << 16)
@@ -692,12 +685,7 @@ impl Renderer {
 
     /// The cell grid and light lists of the last tiled or clustered frame (for tests and
     /// tools that check what the shader read); `None` for other methods.
-    pub fn last_light_lists(
-        &self,
-    ) -> Option<(
-        &crate::cluster::grid::ClusterGrid,
-        &crate::cluster::assign::Assignment,
-    )> {
+    pub fn last_light_lists(&self) -> Option<methods::LightLists<'_>> {
         self.method.light_lists()
     }
 

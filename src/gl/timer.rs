@@ -2,6 +2,11 @@
 //! frame's GL work), where the context has it. Without the extension, or when the GPU reports a
 //! disjoint event (a clock change or a context switch invalidates the figure), there is no GPU
 //! time and callers fall back to wall time around `glFinish`.
+//!
+//! A query is only as good as the driver's: llvmpipe reports the whole frame for plain forward
+//! but a few milliseconds for tiled and clustered frames that take 75 ms by the wall clock
+//! (their per-frame texture uploads split llvmpipe's work, and the query sees only part), so
+//! on llvmpipe the wall-clock `frame_ms` is the figure to quote.
 #![allow(unsafe_code)]
 
 use glow::HasContext;

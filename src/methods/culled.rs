@@ -257,12 +257,7 @@ impl ShadingMethod for CulledForward {
         })
     }
 
-    fn light_lists(
-        &self,
-    ) -> Option<(
-        &crate::cluster::grid::ClusterGrid,
-        &crate::cluster::assign::Assignment,
-    )> {
+    fn light_lists(&self) -> Option<super::LightLists<'_>> {
         Some((&self.grid.as_ref()?.1, self.assigner.assignment()))
     }
 

@@ -82,6 +82,12 @@ pub struct MethodStats {
     pub auto_choice: Option<(&'static str, String)>,
 }
 
+/// A cell grid and the light lists assigned to it.
+pub type LightLists<'a> = (
+    &'a crate::cluster::grid::ClusterGrid,
+    &'a crate::cluster::assign::Assignment,
+);
+
 /// A shading method: owns its GPU resources, renders a frame into the bound framebuffer.
 pub trait ShadingMethod {
     /// Name as in the table.
@@ -91,12 +97,7 @@ pub trait ShadingMethod {
     /// GPU memory the method holds, in bytes.
     fn gpu_bytes(&self) -> usize;
     /// The grid and light lists of the last frame, for methods that build them.
-    fn light_lists(
-        &self,
-    ) -> Option<(
-        &crate::cluster::grid::ClusterGrid,
-        &crate::cluster::assign::Assignment,
-    )> {
+    fn light_lists(&self) -> Option<LightLists<'_>> {
         None
     }
     /// Frees the method's GPU resources.

@@ -67,6 +67,10 @@ pub struct ReferenceSet {
     pub samples: Vec<ReferenceSample>,
     /// Skipped: the sub-pixel rays hit different triangles or some missed (edge, silhouette).
     pub skipped_edge: usize,
+    /// Skipped: another opaque surface lies within [`COPLANAR`](super::raycast::COPLANAR) of
+    /// the one hit (coplanar or doubled faces, a ray exactly on a shared edge: the GPU's depth
+    /// test may pick either).
+    pub skipped_coplanar: usize,
     /// Skipped: the surface has a diffuse texture.
     pub skipped_texture: usize,
     /// Skipped: a transparent surface lies in front of (or instead of) the opaque one.
@@ -124,6 +128,7 @@ pub fn reference_samples_with(
         match outcome {
             Outcome::Sample(s) => set.samples.push(s),
             Outcome::Edge => set.skipped_edge += 1,
+            Outcome::Coplanar => set.skipped_coplanar += 1,
             Outcome::Texture => set.skipped_texture += 1,
             Outcome::Transparent => set.skipped_transparent += 1,
             Outcome::Missed => set.missed += 1,
@@ -170,6 +175,7 @@ pub fn compare(image: &image::RgbaImage, set: &ReferenceSet) -> CpuError {
 enum Outcome {
     Sample(ReferenceSample),
     Edge,
+    Coplanar,
     Texture,
     Transparent,
     Missed,
@@ -179,6 +185,8 @@ enum Outcome {
 enum RaySees {
     Nothing,
     Transparent,
+    /// An opaque surface with another just behind it.
+    Ambiguous,
     Opaque(Hit),
 }
 
@@ -230,10 +238,11 @@ fn evaluate(
             let (origin, dir) = pixel_ray(&scene.camera, width, height, cx + dx, cy + dy);
             let t_far = far_plane_t(&scene.camera, origin, dir);
             let r = raycaster.first_opaque_hit(origin, dir, t_far, is_opaque);
-            match (r.hit, r.transparent_t) {
-                (_, Some(_)) => RaySees::Transparent,
-                (Some(h), None) => RaySees::Opaque(h),
-                (None, None) => RaySees::Nothing,
+            match (r.hit, r.transparent_t, r.runner_up_t) {
+                (_, Some(_), _) => RaySees::Transparent,
+                (Some(_), None, Some(_)) => RaySees::Ambiguous,
+                (Some(h), None, None) => RaySees::Opaque(h),
+                (None, None, _) => RaySees::Nothing,
             }
         })
         .collect();
@@ -242,6 +251,9 @@ fn evaluate(
     }
     if sees.iter().any(|s| matches!(s, RaySees::Transparent)) {
         return Outcome::Transparent;
+    }
+    if sees.iter().any(|s| matches!(s, RaySees::Ambiguous)) {
+        return Outcome::Coplanar;
     }
     let hits: Vec<Hit> = sees
         .into_iter()
@@ -373,7 +385,10 @@ mod tests {
         let count = 500;
         let set = reference_samples(scene, W, H, count, encoding);
         // The quad's diagonal is the only edge; the plane fills the view.
-        assert_eq!(set.samples.len() + set.skipped_edge, count);
+        assert_eq!(
+            set.samples.len() + set.skipped_edge + set.skipped_coplanar,
+            count
+        );
         assert!(set.samples.len() > count * 9 / 10, "{set:?}");
         for s in &set.samples {
             let (cx, cy) = (s.x as f64 + 0.5, s.y as f64 + 0.5);
@@ -453,7 +468,10 @@ mod tests {
         }));
         let set = reference_samples(&scene, W, H, 200, Encoding::Srgb);
         assert!(set.samples.is_empty());
-        assert_eq!(set.skipped_texture + set.skipped_edge, 200);
+        assert_eq!(
+            set.skipped_texture + set.skipped_edge + set.skipped_coplanar,
+            200
+        );
         assert!(set.skipped_texture > 150);
     }
 
@@ -483,7 +501,7 @@ mod tests {
         let count = 400;
         let set = reference_samples(&scene, W, H, count, Encoding::Srgb);
         assert_eq!(
-            set.samples.len() + set.skipped_edge + set.skipped_transparent,
+            set.samples.len() + set.skipped_edge + set.skipped_coplanar + set.skipped_transparent,
             count
         );
         // Where the centre ray crosses z = 1 well inside the pane, the pixel is skipped.
@@ -511,7 +529,10 @@ mod tests {
         };
         let set = reference_samples(&scene, W, H, 300, Encoding::Linear);
         assert!(set.missed > 150 && !set.samples.is_empty(), "{set:?}");
-        assert_eq!(set.samples.len() + set.skipped_edge + set.missed, 300);
+        assert_eq!(
+            set.samples.len() + set.skipped_edge + set.skipped_coplanar + set.missed,
+            300
+        );
         // The far plane in front of the quad: everything is clipped.
         scene.camera.projection = Projection::Perspective {
             fov_y_deg: 60.0,

@@ -36,7 +36,15 @@ pub struct FirstOpaque {
     /// Ray parameter of the nearest non-opaque surface no farther than `hit` (anywhere on the
     /// ray when there is no opaque hit).
     pub transparent_t: Option<f64>,
+    /// Ray parameter of the next opaque surface (another triangle) when it lies within
+    /// [`COPLANAR`] of `hit` (relative): a depth buffer may resolve the two either way.
+    pub runner_up_t: Option<f64>,
 }
+
+/// Relative distance within which a second opaque surface makes the nearest one ambiguous for
+/// a GPU: 24-bit depth at a far plane thousands of times the near plane resolves about 10⁻⁴ of
+/// the distance; ten times that, for coplanar decals and doubled faces in real models.
+pub const COPLANAR: f64 = 1e-3;
 
 /// One triangle in world space with what is needed to rebuild a hit on it.
 #[derive(Clone, Copy, Debug)]
@@ -125,16 +133,25 @@ impl SceneRaycaster {
     ) -> FirstOpaque {
         let mut best: Option<(f64, f64, f64, usize)> = None; // (t, u, v, triangle slot)
         let mut best_t = t_max;
+        let mut runner_up = f64::INFINITY;
+        // Boxes are pruned a little beyond the best hit, so a near runner-up is still found.
+        let reach = |t: f64| {
+            if t.is_finite() {
+                t * (1.0 + COPLANAR)
+            } else {
+                t
+            }
+        };
         let mut transparent_t = f64::INFINITY;
         let inv = dir.recip();
         let mut stack: Vec<u32> = Vec::with_capacity(64);
-        if !self.nodes.is_empty() && slab(&self.nodes[0], origin, inv, best_t).is_some() {
+        if !self.nodes.is_empty() && slab(&self.nodes[0], origin, inv, reach(best_t)).is_some() {
             stack.push(0);
         }
         while let Some(ni) = stack.pop() {
             let node = &self.nodes[ni as usize];
             // The box was entered when pushed; a nearer opaque hit found since may rule it out.
-            if slab(node, origin, inv, best_t).is_none() {
+            if slab(node, origin, inv, reach(best_t)).is_none() {
                 continue;
             }
             if node.count > 0 {
@@ -144,21 +161,26 @@ impl SceneRaycaster {
                     let Some((t, u, v)) = intersect(tri, origin, dir) else {
                         continue;
                     };
-                    if t > best_t {
+                    if t > reach(best_t) {
                         continue;
                     }
-                    if is_opaque(tri.object as usize) {
+                    if !is_opaque(tri.object as usize) {
+                        if t <= best_t {
+                            transparent_t = transparent_t.min(t);
+                        }
+                    } else if t < best_t {
+                        runner_up = best_t;
                         best_t = t;
                         best = Some((t, u, v, slot));
                     } else {
-                        transparent_t = transparent_t.min(t);
+                        runner_up = runner_up.min(t);
                     }
                 }
                 continue;
             }
             let (a, b) = (node.first, node.first + 1);
-            let ta = slab(&self.nodes[a as usize], origin, inv, best_t);
-            let tb = slab(&self.nodes[b as usize], origin, inv, best_t);
+            let ta = slab(&self.nodes[a as usize], origin, inv, reach(best_t));
+            let tb = slab(&self.nodes[b as usize], origin, inv, reach(best_t));
             // Push the farther child first so the nearer one is traversed first.
             match (ta, tb) {
                 (Some(ta), Some(tb)) if ta <= tb => stack.extend([b, a]),
@@ -174,6 +196,7 @@ impl SceneRaycaster {
         FirstOpaque {
             hit,
             transparent_t: (transparent_t <= limit).then_some(transparent_t),
+            runner_up_t: hit.filter(|h| runner_up <= reach(h.t)).map(|_| runner_up),
         }
     }
 
@@ -415,6 +438,29 @@ mod tests {
             o == 1
         });
         assert_eq!((r.hit.unwrap().object, r.transparent_t), (1, None));
+    }
+
+    /// A face doubled within the depth a GPU can resolve is ambiguous; one 1 % behind is not.
+    #[test]
+    fn a_nearly_coplanar_second_surface_is_reported() {
+        let doubled = SceneRaycaster::new(&scene_of(vec![
+            (triangle_at(0.0), DMat4::IDENTITY),
+            (triangle_at(-0.0001), DMat4::IDENTITY),
+        ]));
+        let r =
+            doubled.first_opaque_hit(DVec3::new(0.0, 0.0, 5.0), -DVec3::Z, f64::INFINITY, |_| {
+                true
+            });
+        assert_eq!(r.hit.unwrap().object, 0);
+        assert!((r.runner_up_t.unwrap() - 5.0001).abs() < 1e-9);
+        let apart = SceneRaycaster::new(&scene_of(vec![
+            (triangle_at(0.0), DMat4::IDENTITY),
+            (triangle_at(-0.05), DMat4::IDENTITY),
+        ]));
+        let r = apart.first_opaque_hit(DVec3::new(0.0, 0.0, 5.0), -DVec3::Z, f64::INFINITY, |_| {
+            true
+        });
+        assert_eq!((r.hit.unwrap().object, r.runner_up_t), (0, None));
     }
 
     fn brute_force(

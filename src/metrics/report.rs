@@ -153,15 +153,20 @@ pub fn error_vs_time(rows: &[BenchRow]) -> Chart {
     }
 }
 
-/// Light evaluations per pixel against the light count, one line per method on the most
-/// common scene and ES version of the run, with the lower bound.
+/// Light evaluations per pixel against the light count, one line per method on the run's
+/// first scene (the default scene, unless the run names others) at ES 3.0 where the run has
+/// it, with the lower bound.
 pub fn evals_vs_lights(rows: &[BenchRow]) -> Chart {
     let base: Vec<&BenchRow> = rows
         .iter()
         .filter(|r| r.knob == "default" && r.lights > 0)
         .collect();
-    let scene = most_common(base.iter().map(|r| r.scene.as_str()));
-    let es = most_common(base.iter().map(|r| r.es.as_str()));
+    let scene = base.first().map(|r| r.scene.as_str());
+    let es = base
+        .iter()
+        .map(|r| r.es.as_str())
+        .find(|&e| e == "3.0")
+        .or_else(|| base.first().map(|r| r.es.as_str()));
     let base: Vec<&BenchRow> = base
         .into_iter()
         .filter(|r| Some(r.scene.as_str()) == scene && Some(r.es.as_str()) == es)
@@ -302,11 +307,4 @@ fn distinct<'a>(values: impl Iterator<Item = &'a str>) -> Vec<&'a str> {
         }
     }
     out
-}
-
-fn most_common<'a>(values: impl Iterator<Item = &'a str>) -> Option<&'a str> {
-    let values: Vec<&str> = values.collect();
-    distinct(values.iter().copied())
-        .into_iter()
-        .max_by_key(|v| values.iter().filter(|w| *w == v).count())
 }
