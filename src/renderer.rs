@@ -18,6 +18,7 @@ use crate::gl::program::ProgramCache;
 use crate::gl::texture::ImageTexture;
 use crate::gl::{Caps, Device, EsVersion};
 use crate::methods::{self, FrameContext, ShaderFeatures, ShadingMethod, Support};
+pub use crate::metrics::counts::LightCounts;
 use crate::scene::features::SceneFeatures;
 use crate::scene::{Aabb, Material, Mesh, Projection, Scene, Texture};
 use crate::Error;
@@ -103,51 +104,6 @@ pub enum CountKind {
     /// Lights whose sphere (and cone) reaches the pixel's surface point: the lower bound of
     /// any culling, evaluated by a plain-forward pass whatever the method.
     Reaching,
-}
-
-/// Per-pixel light counts of one frame (opaque surfaces; see [`Renderer::render_light_counts`]).
-#[derive(Clone, Debug, PartialEq)]
-pub struct LightCounts {
-    /// Width in pixels.
-    pub width: u32,
-    /// Height in pixels.
-    pub height: u32,
-    /// Count per pixel, row-major, top row first (0 where nothing is drawn).
-    pub counts: Vec<u32>,
-    /// Whether a surface covers the pixel.
-    pub covered: Vec<bool>,
-}
-
-impl LightCounts {
-    /// Sum over covered pixels.
-    pub fn total(&self) -> u64 {
-        self.counts.iter().map(|&n| n as u64).sum()
-    }
-
-    /// Covered pixels.
-    pub fn covered_pixels(&self) -> usize {
-        self.covered.iter().filter(|&&c| c).count()
-    }
-
-    /// Mean per covered pixel (0 when nothing is covered).
-    pub fn mean(&self) -> f64 {
-        let n = self.covered_pixels();
-        if n == 0 {
-            0.0
-        } else {
-            self.total() as f64 / n as f64
-        }
-    }
-
-    /// Largest count.
-    pub fn max(&self) -> u32 {
-        self.counts.iter().copied().max().unwrap_or(0)
-    }
-
-    /// Count at pixel (x, y), top row first.
-    pub fn at(&self, x: u32, y: u32) -> u32 {
-        self.counts[(y * self.width + x) as usize]
-    }
 }
 
 /// What one frame did.
@@ -487,8 +443,6 @@ impl Renderer {
             content_far,
             options,
         };
-        // No lights: no assignment, no uploads, the light loop compiled out — whatever the
-        // method (a scene pays only for what it has).
         // GPU time only where the frame waits anyway: reading the query result stalls.
         let timer = if options.wait_for_gpu {
             if self.timer.is_none() {
@@ -501,6 +455,8 @@ impl Renderer {
         if let Some(t) = timer {
             t.begin(&self.dev);
         }
+        // No lights: no assignment, no uploads, the light loop compiled out — whatever the
+        // method (a scene pays only for what it has).
         let method_stats = if lights.is_empty() {
             methods::geometry::draw_ambient_only(&mut ctx)?
         } else {
@@ -667,20 +623,7 @@ impl Renderer {
         } else {
             self.render_offscreen(scene, width, height, &options)?
         };
-        let counts = image
-            .pixels()
-            .map(|p| p[0] as u32 | (p[1] as u32) << 8 | (p[2] as u32) << 16)
-            .collect();
-        let covered = image.pixels().map(|p| p[3] > 127).collect();
-        Ok((
-            LightCounts {
-                width,
-                height,
-                counts,
-                covered,
-            },
-            stats,
-        ))
+        Ok((LightCounts::decode(&image), stats))
     }
 
     /// The cell grid and light lists of the last tiled or clustered frame (for tests and

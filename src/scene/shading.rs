@@ -16,8 +16,9 @@
 //! Surfaces are two-sided (`N` flipped towards the eye). In view space, `V` is
 //! `normalize(−P)` for perspective cameras and `+Z` for orthographic ones.
 //!
-//! ```text
-//! ```
+//! The shaders compute the same quantities in forms that survive fp16 (the distance as
+//! `r·|u|`, `1 − cos` as half a squared chord; see `glsl/light_model.glsl`); here, in `f64`,
+//! the direct forms are exact enough.
 
 use glam::{DVec3, Vec3};
 
