@@ -44,14 +44,30 @@ vec4 encodeOutput(vec3 color) {
 #endif
 }
 
+#if COUNT_HEATMAP
+// Lights at which the heatmap's colour map tops out.
+uniform float u_heatScale;
+#endif
+
 #if COUNT_EVALS || COUNT_REACHING
 // A light count written exactly into an RGBA8 target: low, middle and high byte in r, g, b;
 // alpha 1 marks a covered pixel (the target is cleared to 0). Read back by the renderer.
+// The heatmap variant draws it through viridis instead (five stops, as in
+// src/metrics/heatmap.rs's picture of the same counts), for looking at.
 vec4 encodeCount(HIGHP float n) {
+#if COUNT_HEATMAP
+    float t = clamp(n / u_heatScale, 0.0, 1.0) * 4.0;
+    vec3 c = mix(vec3(0.267, 0.005, 0.329), vec3(0.230, 0.322, 0.546), clamp(t, 0.0, 1.0));
+    c = mix(c, vec3(0.128, 0.567, 0.551), clamp(t - 1.0, 0.0, 1.0));
+    c = mix(c, vec3(0.369, 0.789, 0.383), clamp(t - 2.0, 0.0, 1.0));
+    c = mix(c, vec3(0.993, 0.906, 0.144), clamp(t - 3.0, 0.0, 1.0));
+    return vec4(c, 1.0);
+#else
     HIGHP float high = floor(n / 65536.0);
     HIGHP float rest = n - high * 65536.0;
     HIGHP float middle = floor(rest / 256.0);
     return vec4(rest - middle * 256.0, middle, high, 255.0) / 255.0;
+#endif
 }
 #endif
 

@@ -65,6 +65,8 @@ pub struct RenderOptions {
     /// radius, trading error for time (tiled, clustered, deferred; forward loops over every
     /// light regardless). `None`: cull at the radius, exactly.
     pub light_cutoff: Option<f32>,
+    /// Lights at which [`CountKind::Heatmap`]'s colour map tops out.
+    pub heat_scale: f32,
     /// Compile every variant with spot, specular and texture code even where the scene lacks
     /// them (a white texture stands in) — to measure what leaving features out saves, and to
     /// test that it changes nothing in the image.
@@ -87,6 +89,7 @@ impl Default for RenderOptions {
             reference_precision: false,
             count: CountKind::None,
             light_cutoff: None,
+            heat_scale: 64.0,
             full_variants: false,
         }
     }
@@ -104,6 +107,9 @@ pub enum CountKind {
     /// Lights whose sphere (and cone) reaches the pixel's surface point: the lower bound of
     /// any culling, evaluated by a plain-forward pass whatever the method.
     Reaching,
+    /// `Evals` drawn through a colour map (viridis, 0 to [`RenderOptions::heat_scale`]
+    /// lights) into whatever target is bound, for looking at: the viewer's heatmap.
+    Heatmap,
 }
 
 /// What one frame did.
@@ -413,7 +419,11 @@ impl Renderer {
             )
             .with(
                 ShaderFeatures::COUNT_EVALS,
-                options.count == CountKind::Evals,
+                matches!(options.count, CountKind::Evals | CountKind::Heatmap),
+            )
+            .with(
+                ShaderFeatures::COUNT_HEATMAP,
+                options.count == CountKind::Heatmap,
             )
             .with(
                 ShaderFeatures::COUNT_REACHING,

@@ -69,8 +69,30 @@ fn validate(conf: Option<&Path>, file: &Path) -> Result<(), String> {
     }
 }
 
-/// Every combination of feature bits a variant can have.
+/// Every combination of feature bits a colour variant can have, and the count variants
+/// (evaluations, reaching lights, heatmap) with and without spots and RGBA8 light data.
 fn all_features() -> Vec<ShaderFeatures> {
+    let mut all = colour_features();
+    for count in [
+        ShaderFeatures::COUNT_EVALS,
+        ShaderFeatures::COUNT_REACHING,
+        ShaderFeatures::COUNT_EVALS | ShaderFeatures::COUNT_HEATMAP,
+    ] {
+        for extra in [
+            0,
+            ShaderFeatures::SPOT,
+            ShaderFeatures::LIGHTS_RGBA8,
+            ShaderFeatures::SPOT | ShaderFeatures::LIGHTS_RGBA8,
+            ShaderFeatures::NO_LIGHTS,
+        ] {
+            all.push(ShaderFeatures(count | extra));
+        }
+    }
+    all
+}
+
+/// Every combination of the colour variants' feature bits.
+fn colour_features() -> Vec<ShaderFeatures> {
     let bits = [
         ShaderFeatures::TEXTURE,
         ShaderFeatures::SPOT,

@@ -227,3 +227,71 @@ fn view_rejects_bad_input_without_panicking() {
     assert!(stderr.contains("unknown method"), "stderr: {stderr}");
     assert!(!stderr.contains("panicked"), "stderr: {stderr}");
 }
+
+/// The heatmap view (`--heatmap`, H in the window): every covered pixel is a colour of the
+/// viridis map the shader draws counts with, and the counts vary across the clustered view.
+#[test]
+fn view_draws_the_light_evaluation_heatmap() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let shot = dir.path().join("heat.png");
+    let size = format!("{}x{}", SIZE.0, SIZE.1);
+    let args = [
+        "--frames",
+        "3",
+        "--heatmap",
+        "--lights",
+        "256",
+        "--size",
+        &size,
+        "--screenshot",
+        shot.to_str().expect("utf-8 temp path"),
+    ];
+    let Some(out) = run_view(&args, &[]) else {
+        return;
+    };
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let image = image::open(&shot).expect("screenshot").to_rgba8();
+    // The five stops of the shader's map (glsl/surface.glsl), in 8-bit steps.
+    let stops: Vec<[f64; 3]> = [
+        [0.267, 0.005, 0.329],
+        [0.230, 0.322, 0.546],
+        [0.128, 0.567, 0.551],
+        [0.369, 0.789, 0.383],
+        [0.993, 0.906, 0.144],
+    ]
+    .iter()
+    .map(|c| c.map(|v| v * 255.0))
+    .collect();
+    let off_map = |p: [f64; 3]| {
+        stops
+            .windows(2)
+            .map(|w| {
+                let d: Vec<f64> = (0..3).map(|i| w[1][i] - w[0][i]).collect();
+                let len2: f64 = d.iter().map(|v| v * v).sum();
+                let t =
+                    ((0..3).map(|i| (p[i] - w[0][i]) * d[i]).sum::<f64>() / len2).clamp(0.0, 1.0);
+                (0..3)
+                    .map(|i| (p[i] - w[0][i] - t * d[i]).powi(2))
+                    .sum::<f64>()
+                    .sqrt()
+            })
+            .fold(f64::INFINITY, f64::min)
+    };
+    let (mut on_map, mut colours) = (0usize, std::collections::HashSet::new());
+    for p in image.pixels() {
+        let c = [p[0] as f64, p[1] as f64, p[2] as f64];
+        if p.0[..3] == [0, 0, 0] {
+            continue; // background
+        }
+        assert!(off_map(c) <= 3.0, "pixel {p:?} is not a heatmap colour");
+        on_map += 1;
+        colours.insert(p.0);
+    }
+    let total = (image.width() * image.height()) as usize;
+    assert!(on_map * 2 > total, "only {on_map} of {total} pixels drawn");
+    assert!(colours.len() > 5, "a flat heatmap: {colours:?}");
+}

@@ -211,6 +211,7 @@ impl Deferred {
         set_gbuffer_uniforms(program, dev, ctx.viewport);
         program.set_vec3(dev, "u_ambient", ctx.scene.ambient);
         program.set_f32(dev, "u_alpha", 1.0);
+        program.set_f32(dev, "u_heatScale", ctx.options.heat_scale.max(1.0));
         program.set_f32(
             dev,
             "u_orthographic",

@@ -36,9 +36,12 @@ impl ShaderFeatures {
     /// Instead of a colour, write the number of lights whose sphere (and cone) reaches the
     /// fragment: the lower bound of any per-pixel culling (forward only).
     pub const COUNT_REACHING: u64 = 1 << 10;
+    /// With [`Self::COUNT_EVALS`]: draw the count through a colour map (0 to `u_heatScale`
+    /// lights) instead of encoding it exactly, for looking at (the viewer's heatmap).
+    pub const COUNT_HEATMAP: u64 = 1 << 11;
 
     /// Every flag with its name.
-    pub const NAMED: [(u64, &'static str); 11] = [
+    pub const NAMED: [(u64, &'static str); 12] = [
         (Self::TEXTURE, "texture"),
         (Self::SPOT, "spot"),
         (Self::SPECULAR, "specular"),
@@ -50,6 +53,7 @@ impl ShaderFeatures {
         (Self::FP16_LIGHTS, "fp16_lights"),
         (Self::COUNT_EVALS, "count_evals"),
         (Self::COUNT_REACHING, "count_reaching"),
+        (Self::COUNT_HEATMAP, "count_heatmap"),
     ];
 
     /// Names of the set flags.
@@ -99,6 +103,7 @@ impl ShaderFeatures {
             ("FP16_LIGHTS".into(), flag(Self::FP16_LIGHTS)),
             ("COUNT_EVALS".into(), flag(Self::COUNT_EVALS)),
             ("COUNT_REACHING".into(), flag(Self::COUNT_REACHING)),
+            ("COUNT_HEATMAP".into(), flag(Self::COUNT_HEATMAP)),
             (
                 "MEDP".into(),
                 if self.has(Self::REFERENCE_PRECISION) {

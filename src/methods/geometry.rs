@@ -148,6 +148,9 @@ pub(crate) fn shade_object(
     program.set_vec3(dev, "u_specular", material.specular);
     program.set_f32(dev, "u_shininess", material.shading_exponent());
     program.set_f32(dev, "u_alpha", material.alpha);
+    if features.has(ShaderFeatures::COUNT_HEATMAP) {
+        program.set_f32(dev, "u_heatScale", ctx.options.heat_scale.max(1.0));
+    }
     program.set_vec3(dev, "u_ambient", ctx.scene.ambient);
     program.set_f32(
         dev,

@@ -7,7 +7,8 @@
 //! for the GPU, then swaps buffers (vsync where the driver allows it).
 //!
 //! Controls: WASD move, Q/E down/up, Shift faster, left-drag looks around, 1–9 pick a method
-//! from [`manylight::methods::METHODS`], +/- double/halve the random lights, Esc quits.
+//! from [`manylight::methods::METHODS`], +/- double/halve the random lights, H toggles the
+//! light-evaluation heatmap (lights each pixel evaluates, viridis from 0 to 64), Esc quits.
 //! A change that the renderer rejects (say, plain forward over more lights than it can loop
 //! over) is reported on stderr and undone. `--frames N` quits after N frames and
 //! `--screenshot FILE` saves the last one, read back from the window's framebuffer.
@@ -24,6 +25,7 @@ use std::time::Instant;
 use clap::Parser;
 use fly_camera::{FlyCamera, Move};
 use manylight::methods::METHODS;
+use manylight::renderer::CountKind;
 use manylight::scene::{self, Scene};
 use manylight::{EsVersion, FrameStats, RenderOptions};
 use window_gl::Gfx;
@@ -63,6 +65,9 @@ pub struct ViewArgs {
     /// Save the last frame (read back from the window) to this PNG; needs --frames.
     #[arg(long, requires = "frames")]
     pub screenshot: Option<PathBuf>,
+    /// Start with the light-evaluation heatmap on (H toggles it).
+    #[arg(long)]
+    pub heatmap: bool,
 }
 
 /// Random lights for built-ins and OBJ files when `--lights` is not given.
@@ -90,13 +95,14 @@ pub fn run(args: &ViewArgs) -> Result<(), Box<dyn std::error::Error>> {
     let event_loop = EventLoop::new().map_err(|e| format!("cannot open a window: {e}"))?;
     event_loop.set_control_flow(ControlFlow::Poll);
     println!(
-        "controls: WASD move, Q/E down/up, Shift faster, drag to look, 1-{} method, +/- lights, Esc quit",
+        "controls: WASD move, Q/E down/up, Shift faster, drag to look, 1-{} method, +/- lights, H heatmap, Esc quit",
         METHODS.len()
     );
     let mut app = App {
         args,
         light_count: lights.unwrap_or(scene.lights.len()),
         good: (String::new(), lights.unwrap_or(scene.lights.len())),
+        heatmap: args.heatmap,
         scene,
         fly: FlyCamera::new(FlyCamera::speed_for_extent(extent)),
         gfx: None,
@@ -128,6 +134,8 @@ struct App<'a> {
     light_count: usize,
     /// Method and light count of the last frame that rendered, to undo a rejected change.
     good: (String, usize),
+    /// Show light evaluations per pixel instead of the image (H).
+    heatmap: bool,
     fly: FlyCamera,
     gfx: Option<Gfx>,
     frames: u64,
@@ -264,6 +272,16 @@ impl App<'_> {
             self.set_lights(self.light_count.saturating_mul(2).clamp(1, MAX_LIGHTS));
         } else if code == KeyCode::NumpadSubtract || typed(&["-"]) {
             self.set_lights(self.light_count / 2);
+        } else if code == KeyCode::KeyH {
+            self.heatmap = !self.heatmap;
+            eprintln!(
+                "heatmap: {}",
+                if self.heatmap {
+                    "light evaluations per pixel, 0 (purple) to 64 (yellow) lights"
+                } else {
+                    "off"
+                }
+            );
         } else if event.logical_key == Key::Named(NamedKey::Escape) {
             self.quit(event_loop);
         }
@@ -313,6 +331,11 @@ impl App<'_> {
         self.fly.update(dt, &mut self.scene.camera);
         let options = RenderOptions {
             wait_for_gpu: false,
+            count: if self.heatmap {
+                CountKind::Heatmap
+            } else {
+                CountKind::None
+            },
             ..RenderOptions::default()
         };
         let renderer = g.renderer.as_mut().ok_or("renderer already destroyed")?;
