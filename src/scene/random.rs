@@ -22,7 +22,7 @@ pub enum LightSetStyle {
 const TARGET_OVERLAP: f64 = 6.0;
 
 /// `count` lights inside `volume`. Radii shrink as the count grows so that the average
-/// overlap stays near [`TARGET_OVERLAP`]; intensity grows with the radius so each light is
+/// overlap stays near `TARGET_OVERLAP` (6); intensity grows with the radius so each light is
 /// visible.
 pub fn lights(volume: &Aabb, count: usize, seed: u64, style: LightSetStyle) -> Vec<Light> {
     let mut rng = Pcg64Mcg::seed_from_u64(seed);
