@@ -71,6 +71,8 @@ fn a_small_sweep_writes_the_report_charts_and_heatmaps() {
             "max_abs_err",
             "rmse",
             "psnr_db",
+            "over_1",
+            "over_2",
         ] {
             assert!(row.get(field).is_some(), "{field} missing in {row}");
         }

@@ -54,6 +54,8 @@ pub struct BenchRow {
     pub rmse: f64,
     /// Peak signal-to-noise ratio in dB (`None` for an image identical to the reference).
     pub psnr_db: Option<f64>,
+    /// Fraction of pixels more than 1/255 off.
+    pub over_1: f64,
     /// Fraction of pixels more than 2/255 off.
     pub over_2: f64,
     /// Against the light model on the CPU in f64 at sampled pixels: largest error (8-bit

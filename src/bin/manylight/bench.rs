@@ -368,6 +368,7 @@ impl Measure<'_> {
             max_abs_err: d.max_abs,
             rmse: d.rmse,
             psnr_db: d.psnr_db.is_finite().then_some(d.psnr_db),
+            over_1: d.over_1,
             over_2: d.over_2,
             cpu_max_abs_err: (cpu.samples > 0).then_some(cpu.max_abs),
             cpu_samples: cpu.samples,
