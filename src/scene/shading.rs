@@ -62,8 +62,9 @@ pub fn cutoff_distance(radiance: f64, radius: f64, cutoff: f64) -> f64 {
         return 0.0;
     }
     let (mut lo, mut hi) = (0.0, radius);
-    // 60 halvings take any radius below an f64 ulp of itself.
-    for _ in 0..60 {
+    // 32 halvings: within 2.3·10⁻¹⁰ of the radius, far below what culling can tell apart, and
+    // half the CPU cost of running to an f64 ulp (it runs for every light every frame).
+    for _ in 0..32 {
         let mid = 0.5 * (lo + hi);
         if radiance * falloff(mid, radius) >= cutoff {
             lo = mid;
@@ -160,7 +161,7 @@ mod tests {
         for cutoff in [1e-4, 1e-2, 0.3] {
             let d = cutoff_distance(c, r, cutoff);
             assert!(d > 0.0 && d < r, "{cutoff}: {d}");
-            assert!((c * falloff(d, r) - cutoff).abs() < 1e-9, "{cutoff}: {d}");
+            assert!((c * falloff(d, r) - cutoff).abs() < 1e-8, "{cutoff}: {d}");
         }
         assert_eq!(cutoff_distance(c, r, 0.0), r);
         assert_eq!(cutoff_distance(c, r, 3.0), 0.0, "peak below the cut-off");
