@@ -151,12 +151,33 @@ impl Chunk {
         self.offsets[cell + 1] - self.offsets[cell]
     }
 
+    /// Phase 2 when this is the only chunk, in one pass over the cells: the final counts and
+    /// offsets into `out`, and the scatter's cursor. Returns the list's length.
+    fn totals_into(&mut self, out: &mut Assignment) -> usize {
+        let cells = self.deltas.len() - 1;
+        out.counts.resize(cells, 0);
+        out.offsets.resize(cells, 0);
+        self.cursor.resize(cells, 0);
+        let (mut running, mut total) = (0i32, 0u32);
+        let columns = out
+            .counts
+            .iter_mut()
+            .zip(&mut out.offsets)
+            .zip(&mut self.cursor);
+        for (((count, offset), cursor), delta) in columns.zip(&self.deltas) {
+            running += delta;
+            *count = running as u32;
+            *offset = total;
+            *cursor = total;
+            total += running as u32;
+        }
+        total as usize
+    }
+
     /// Phase 3: writes the chunk's visible lights, numbered from `first_id`, into `out`
-    /// grouped by cell, each cell's run starting at `starts[cell]`. Light order is kept, so
-    /// every cell's list is ascending.
-    fn scatter(&mut self, first_id: u32, starts: &[u32], out: &mut [u32]) {
-        self.cursor.clear();
-        self.cursor.extend_from_slice(starts);
+    /// grouped by cell, each cell's run starting where `self.cursor` says (advanced as it
+    /// goes). Light order is kept, so every cell's list is ascending.
+    fn scatter(&mut self, first_id: u32, out: &mut [u32]) {
         let mut id = first_id;
         let mut prev = 0usize;
         for &end in &self.ends {
@@ -180,9 +201,9 @@ impl Chunk {
     fn sort_locally(&mut self, first_id: u32, cells: usize) {
         let mut sorted = std::mem::take(&mut self.sorted);
         sorted.resize(self.offsets[cells] as usize, 0);
-        let starts = std::mem::take(&mut self.offsets);
-        self.scatter(first_id, &starts[..cells], &mut sorted);
-        self.offsets = starts;
+        self.cursor.clear();
+        self.cursor.extend_from_slice(&self.offsets[..cells]);
+        self.scatter(first_id, &mut sorted);
         self.sorted = sorted;
     }
 }
@@ -252,11 +273,9 @@ impl Assigner {
                 .zip(lights.par_chunks(chunk_len))
                 .for_each(|(chunk, part)| chunk.find(grid, part, camera_far));
         }
-        // Phase 2: per-chunk and total counts, offsets, the visible lights (numbered chunk
-        // after chunk).
+        // Phase 2: the visible lights (numbered chunk after chunk), then counts and offsets.
         let mut first_ids = Vec::with_capacity(threads);
-        for (t, chunk) in self.chunks.iter_mut().enumerate() {
-            chunk.prefix();
+        for (t, chunk) in self.chunks.iter().enumerate() {
             first_ids.push(out.visible.len() as u32);
             let first = (t * chunk_len) as u32;
             let mut prev = 0;
@@ -267,26 +286,28 @@ impl Assigner {
                 prev = end;
             }
         }
-        let chunks = &self.chunks;
-        out.counts.clear();
-        out.counts
-            .extend((0..cells).map(|c| chunks.iter().map(|k| k.count(c)).sum::<u32>()));
-        out.offsets.clear();
-        let mut total = 0u32;
-        out.offsets.extend(out.counts.iter().map(|&n| {
-            let o = total;
-            total += n;
-            o
-        }));
-        let total = total as usize;
-        // Phase 3: scatter. Every entry is written, so the list is not cleared first: only
-        // growth is zero-filled.
-        out.indices.resize(total, 0);
         if threads == 1 {
-            self.chunks[0].scatter(0, &out.offsets, &mut out.indices);
+            let total = self.chunks[0].totals_into(out);
+            // Phase 3. Every entry is written, so the list is not cleared first: only growth
+            // is zero-filled.
+            out.indices.resize(total, 0);
+            self.chunks[0].scatter(0, &mut out.indices);
         } else {
-            // Each chunk sorts its lights locally, then blocks of cells gather the chunks'
-            // runs into the final list (contiguous, disjoint slices: no sharing).
+            self.chunks.iter_mut().for_each(Chunk::prefix);
+            let chunks = &self.chunks;
+            out.counts.clear();
+            out.counts
+                .extend((0..cells).map(|c| chunks.iter().map(|k| k.count(c)).sum::<u32>()));
+            out.offsets.clear();
+            let mut total = 0u32;
+            out.offsets.extend(out.counts.iter().map(|&n| {
+                let o = total;
+                total += n;
+                o
+            }));
+            out.indices.resize(total as usize, 0);
+            // Phase 3: each chunk sorts its lights locally, then blocks of cells gather the
+            // chunks' runs into the final list (contiguous, disjoint slices: no sharing).
             self.chunks
                 .par_iter_mut()
                 .zip(first_ids.par_iter())

@@ -233,23 +233,20 @@ impl Cone {
         })
     }
 
-    /// Emits the sub-runs of `[start, start + len)` whose cells the cone may touch.
+    /// Emits the part of the run `[start, start + len)` the cone may touch: from the first
+    /// cell that may touch it to the last. The cone is convex, so along a row the cells it
+    /// touches are (nearly) one interval; a gap inside would only be assigned too, which is
+    /// conservative. Scanning in from both ends tests few cells where the cone fills the row.
     fn emit_runs(&self, grid: &ClusterGrid, start: u32, len: u32, emit: &mut impl FnMut(u32, u32)) {
         let spheres = &grid.cell_spheres()[start as usize..(start + len) as usize];
-        let mut open: Option<u32> = None;
-        for (cell, sphere) in (start..).zip(spheres) {
-            match (self.may_touch(sphere), open) {
-                (true, None) => open = Some(cell),
-                (false, Some(first)) => {
-                    emit(first, cell - first);
-                    open = None;
-                }
-                _ => {}
-            }
-        }
-        if let Some(first) = open {
-            emit(first, start + len - first);
-        }
+        let Some(first) = spheres.iter().position(|s| self.may_touch(s)) else {
+            return;
+        };
+        let last = spheres
+            .iter()
+            .rposition(|s| self.may_touch(s))
+            .unwrap_or(first);
+        emit(start + first as u32, (last - first + 1) as u32);
     }
 
     /// False only when the cell's bounding sphere is certainly outside the cone (up to the
