@@ -15,6 +15,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use manylight::gl::HeadlessContext;
 use manylight::methods::{Support, METHODS};
 use manylight::metrics::cpu_reference::{self, Encoding, ReferenceSet};
+use manylight::metrics::raycast::SceneRaycaster;
 use manylight::metrics::report::{self, BenchRow, Report};
 use manylight::renderer::{CountKind, LightCounts};
 use manylight::scene::{self, Scene};
@@ -220,6 +221,7 @@ pub fn run(args: &BenchArgs) -> Result<(), Box<dyn std::error::Error>> {
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
     let mut rows = Vec::new();
+    let mut casters = std::collections::HashMap::new();
     for &es in &plan.es {
         // One context per ES version, made current for its renderer's whole life.
         let ctx = HeadlessContext::new(es)?;
@@ -229,7 +231,11 @@ pub fn run(args: &BenchArgs) -> Result<(), Box<dyn std::error::Error>> {
                 let (scene, _) = scene::load(spec, Some((count, args.seed)))?;
                 let name = scene_name(spec);
                 progress.set_message(format!("ES {es} {name} {count} lights: reference"));
-                let base = baseline(&mut renderer, &scene, plan.size, args.cpu_samples)?;
+                // The geometry, and so its ray caster, is the same at every light count.
+                let caster = casters
+                    .entry(spec.clone())
+                    .or_insert_with(|| SceneRaycaster::new(&scene));
+                let base = baseline(&mut renderer, &scene, caster, plan.size, args.cpu_samples)?;
                 let measure = Measure {
                     scene: &scene,
                     name: &name,
@@ -237,23 +243,28 @@ pub fn run(args: &BenchArgs) -> Result<(), Box<dyn std::error::Error>> {
                     size: plan.size,
                     frames: plan.frames,
                 };
+                let knob_workload = spec == &knob_scene && count == knob_lights;
+                let mut pictured = Vec::new();
                 for method in &plan.methods {
                     progress.set_message(format!("ES {es} {name} {count} lights: {method}"));
-                    if let Some(row) = measure.run(&mut renderer, method, "default", |_| {})? {
-                        rows.push(row);
+                    if let Some(m) = measure.run(&mut renderer, method, "default", |_| {})? {
+                        rows.push(m.row.clone());
+                        if knob_workload {
+                            pictured.push((method.clone(), m));
+                        }
                     }
                     progress.inc(1);
                 }
-                if spec == &knob_scene && count == knob_lights {
+                if knob_workload {
                     for knob in &knob_list {
                         progress.set_message(format!("ES {es} {name}: {}", knob.name));
-                        let row = measure.run(&mut renderer, knob.method, &knob.name, |o| {
+                        let m = measure.run(&mut renderer, knob.method, &knob.name, |o| {
                             (knob.apply)(o, knob.value)
                         })?;
-                        rows.extend(row);
+                        rows.extend(m.map(|m| m.row));
                         progress.inc(1);
                     }
-                    write_pictures(&mut renderer, &scene, &base, &plan, es, &args.out)?;
+                    write_pictures(&pictured, &base, es, &args.out)?;
                 }
             }
         }
@@ -286,6 +297,7 @@ fn scene_name(spec: &str) -> String {
 fn baseline(
     renderer: &mut Renderer,
     scene: &Scene,
+    caster: &SceneRaycaster,
     (w, h): (u32, u32),
     cpu_samples: usize,
 ) -> Result<Baseline, Box<dyn std::error::Error>> {
@@ -297,12 +309,20 @@ fn baseline(
     let (reference, _) = renderer.render_offscreen(scene, w, h, &reference_opts)?;
     let (bound, _) =
         renderer.render_light_counts(scene, w, h, &reference_opts, CountKind::Reaching)?;
-    let cpu = cpu_reference::reference_samples(scene, w, h, cpu_samples, Encoding::Srgb);
+    let cpu =
+        cpu_reference::reference_samples_with(caster, scene, w, h, cpu_samples, Encoding::Srgb);
     Ok(Baseline {
         reference,
         bound,
         cpu,
     })
+}
+
+/// One configuration's row, with its image and light counts (kept for the pictures).
+struct Measured {
+    row: BenchRow,
+    image: image::RgbaImage,
+    evals: LightCounts,
 }
 
 /// What every configuration of one (scene, light count, ES version) shares.
@@ -322,7 +342,7 @@ impl Measure<'_> {
         method: &str,
         knob: &str,
         adjust: impl Fn(&mut RenderOptions),
-    ) -> Result<Option<BenchRow>, Box<dyn std::error::Error>> {
+    ) -> Result<Option<Measured>, Box<dyn std::error::Error>> {
         let desc = manylight::methods::find(method)?;
         if matches!((desc.supported)(renderer.caps()), Support::Unsupported(_)) {
             return Ok(None);
@@ -347,7 +367,7 @@ impl Measure<'_> {
         let d = manylight::metrics::diff(&self.base.reference, &image);
         let cpu = cpu_reference::compare(&image, &self.base.cpu);
         let bound = self.base.bound.total();
-        Ok(Some(BenchRow {
+        let row = BenchRow {
             scene: self.name.to_string(),
             method: method.to_string(),
             es: format!("{}.0", stats.es.major()),
@@ -375,61 +395,45 @@ impl Measure<'_> {
             overflowed_lights: stats.overflowed_lights,
             renderer: stats.renderer.clone(),
             lp_num_threads: stats.lp_num_threads.clone(),
-        }))
+        };
+        Ok(Some(Measured { row, image, evals }))
     }
 }
 
 /// Heatmaps of every method and of the lower bound, and each method's difference from the
-/// reference, for the knob configuration (the default scene near 1 024 lights).
+/// reference, for the knob workload (the default scene near 1 024 lights): from the images and
+/// counts its default configurations already measured.
 fn write_pictures(
-    renderer: &mut Renderer,
-    scene: &Scene,
+    measured: &[(String, Measured)],
     base: &Baseline,
-    plan: &Plan,
     es: EsVersion,
     out: &std::path::Path,
 ) -> Result<(), Box<dyn std::error::Error>> {
     use manylight::metrics::heatmap;
     std::fs::create_dir_all(out)?;
-    let (w, h) = plan.size;
     let tag = format!("es{}", es.major());
-    let mut maps = vec![("lower-bound".to_string(), base.bound.clone())];
-    let mut images = Vec::new();
-    for method in &plan.methods {
-        let desc = manylight::methods::find(method)?;
-        if matches!((desc.supported)(renderer.caps()), Support::Unsupported(_)) {
-            continue;
-        }
-        renderer.set_method(method)?;
-        let opts = RenderOptions::default();
-        let Ok((counts, _)) = renderer.render_light_counts(scene, w, h, &opts, CountKind::Evals)
-        else {
-            continue;
-        };
-        let (image, _) = renderer.render_offscreen(scene, w, h, &opts)?;
-        maps.push((method.clone(), counts));
-        images.push((method.clone(), image));
-    }
+    let maps = std::iter::once(("lower-bound", &base.bound))
+        .chain(measured.iter().map(|(name, m)| (name.as_str(), &m.evals)));
     // One colour scale for the maps, so they compare at a glance: the largest count of the
     // culling methods (forward, every light everywhere, saturates above it).
     let scale = maps
-        .iter()
-        .filter(|(name, _)| name != "forward")
+        .clone()
+        .filter(|(name, _)| *name != "forward")
         .map(|(_, c)| c.max())
         .max()
         .unwrap_or(1)
         .max(1);
-    for (name, c) in &maps {
+    for (name, c) in maps {
+        let lights = measured.first().map_or(0, |(_, m)| m.row.lights);
         let title = format!(
-            "{name}: {:.1} light evaluations per pixel ({es}, {} lights)",
-            c.mean(),
-            scene.lights.len()
+            "{name}: {:.1} light evaluations per pixel ({es}, {lights} lights)",
+            c.mean()
         );
         heatmap::heatmap(&c.counts, &c.covered, c.width, c.height, scale, &title)
             .save(out.join(format!("heatmap-{tag}-{name}.png")))?;
     }
-    for (name, image) in &images {
-        heatmap::diff_image(&base.reference, image, 8)
+    for (name, m) in measured {
+        heatmap::diff_image(&base.reference, &m.image, 8)
             .save(out.join(format!("diff-{tag}-{name}.png")))?;
     }
     base.reference
