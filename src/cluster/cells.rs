@@ -102,19 +102,6 @@ pub fn for_each_run(
     }
 }
 
-/// Calls `emit(cell)` for every cell `light` may touch, in ascending order (tests and tools;
-/// the assignment itself works on runs).
-pub fn for_each_cell(
-    grid: &ClusterGrid,
-    light: &GpuLight,
-    camera_far: f64,
-    emit: &mut impl FnMut(u32),
-) {
-    for_each_run(grid, light, camera_far, &mut |start, len| {
-        (start..start + len).for_each(&mut *emit)
-    });
-}
-
 /// The sphere the cell tests start from, in view space: its depth `d` (= −z), radius, and its
 /// exact tangent slopes (x, y) when it lies in front of the eye.
 struct Sphere {

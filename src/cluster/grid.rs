@@ -290,11 +290,6 @@ impl ClusterGrid {
         }
     }
 
-    /// Bounding sphere `[x, y, z, radius]` of a cell (see `cell_spheres`).
-    pub fn cell_sphere(&self, index: u32) -> [f64; 4] {
-        self.cell_spheres()[index as usize]
-    }
-
     /// Bounding spheres `[x, y, z, radius]` of every cell, in cell order (built on first use).
     pub fn cell_spheres(&self) -> &[[f64; 4]] {
         self.cell_spheres.get_or_init(|| self.build_cell_spheres())
