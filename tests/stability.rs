@@ -55,14 +55,14 @@ fn check_with(name: &str, scene: &Scene, w: u32, h: u32, opts: &RenderOptions) -
                 d.rmse
             );
             assert_eq!(stats.overflowed_lights, 0, "{name} {es} {method}");
-            let (hdr, _) = gpu.r().render_offscreen_hdr(scene, w, h, &opts).unwrap();
-            if let Some((i, p)) = hdr
-                .iter()
-                .enumerate()
-                .find(|(_, p)| !p.iter().all(|c| c.is_finite()))
-            {
-                panic!("{name} {es} {method}: non-finite value {p:?} at pixel {i}");
-            }
+            assert_finite_hdr(
+                &mut gpu,
+                scene,
+                w,
+                h,
+                &opts,
+                &format!("{name} {es} {method}"),
+            );
         }
         // Creating a context makes it current: this one is done before the next is made.
         drop(gpu);
@@ -124,13 +124,33 @@ fn check_without_fragment_highp(
         d.rmse,
         d.max_abs
     );
+    assert_finite_hdr(
+        &mut gpu,
+        scene,
+        w,
+        h,
+        opts,
+        &format!("{name} without fragment highp"),
+    );
+}
+
+/// Renders into an RGBA16F target (an 8-bit one hides NaN as black) with the current method:
+/// every value must be finite.
+fn assert_finite_hdr(
+    gpu: &mut Gpu,
+    scene: &Scene,
+    w: u32,
+    h: u32,
+    opts: &RenderOptions,
+    what: &str,
+) {
     let (hdr, _) = gpu.r().render_offscreen_hdr(scene, w, h, opts).unwrap();
     if let Some((i, p)) = hdr
         .iter()
         .enumerate()
         .find(|(_, p)| !p.iter().all(|c| c.is_finite()))
     {
-        panic!("{name} without fragment highp: non-finite value {p:?} at pixel {i}");
+        panic!("{what}: non-finite value {p:?} at pixel {i}");
     }
 }
 
