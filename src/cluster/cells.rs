@@ -18,6 +18,7 @@
 //! The radius is padded by a relative 10⁻⁴ so a fragment that float rounding puts in the
 //! neighbouring cell still finds every light that reaches it: the assignment is conservative.
 
+use super::depth_lookup::CascadeConstants;
 use super::grid::{ClusterGrid, GridProjection};
 use super::pack::GpuLight;
 
@@ -34,15 +35,14 @@ pub fn for_each_run(
 ) {
     let p = light.position.as_dvec3();
     let r0 = light.cull_radius as f64;
-    if r0 <= 0.0 || !p.is_finite() {
+    if r0.is_nan() || r0 <= 0.0 || !p.is_finite() {
         return;
     }
     let range = r0 + RADIUS_PAD * (p.z.abs() + r0);
     let cone = Cone::of(light, range);
     // The sphere every cell test starts from: the light's, or the tighter bound of a spot's
     // cone.
-    let c = cone.as_ref().map_or(p, |cone| cone.bound.0);
-    let r = cone.as_ref().map_or(range, |cone| cone.bound.1);
+    let (c, r) = cone.as_ref().map_or((p, range), |cone| cone.bound);
     let d = -c.z;
     // 1. Clip the depth range before projecting.
     let dmin = (d - r).max(grid.near);
@@ -51,106 +51,144 @@ pub fn for_each_run(
         return;
     }
     let ((k0, s0), (k1, s1)) = grid.depth_range_to_slices(dmin, dmax);
-    // Exact tangent slopes (view x/d and y/d) of the whole sphere, when it is in front of the
-    // eye; computed once per light, intersected with each cascade's box bounds below.
-    let tangents = (d > r).then(|| {
-        let inv_den = 1.0 / (d * d - r * r);
-        let tangent = |center: f64| {
-            let root = r * (d * d + center * center - r * r).sqrt();
-            ((center * d - root) * inv_den, (center * d + root) * inv_den)
-        };
-        [tangent(c.x), tangent(c.y)]
-    });
-    let sphere = Sphere { d, r, tangents };
+    let extent = ScreenExtent::new(grid, c, r, dmin, dmax);
+    let spheres = if cone.is_some() {
+        grid.cell_spheres()
+    } else {
+        &[]
+    };
     for k in k0..=k1 {
         let cascade = &grid.cascades[k as usize];
-        let za = if k == 0 {
-            dmin
-        } else {
-            dmin.max(cascade.z_near)
-        };
-        let zb = if k as usize == grid.cascades.len() - 1 {
-            dmax
-        } else {
-            dmax.min(cascade.z_far)
-        };
-        // Reciprocal depths of the slab (0 for an infinite end: its slope is 0) for the box
-        // projection; none needed when the slab is the whole sphere in front of the eye, whose
-        // tangent bounds are then exact on their own (the common case: one call in three).
-        let slab = (k0 != k1 || sphere.tangents.is_none())
-            .then(|| (1.0 / za, if zb.is_infinite() { 0.0 } else { 1.0 / zb }));
-        let x_range = axis_range(grid, &sphere, c.x, slab, 0, cascade.tiles_x);
-        let Some((x0, x1)) = x_range else {
+        let constants = &grid.cascade_constants[k as usize];
+        // The whole sphere's tangent bounds are exact on their own when the depth range
+        // lies in one cascade (the common case); otherwise each cascade's slab tightens them.
+        let slab = k0 != k1;
+        let Some((x0, x1)) = extent.tile_range(grid, constants, slab, 0, cascade.tiles_x) else {
             continue;
         };
-        let y_range = axis_range(grid, &sphere, c.y, slab, 1, cascade.tiles_y);
-        let Some((y0, y1)) = y_range else {
+        let Some((y0, y1)) = extent.tile_range(grid, constants, slab, 1, cascade.tiles_y) else {
             continue;
         };
         let sa = if k == k0 { s0 } else { 0 };
         let sb = if k == k1 { s1 } else { cascade.slices - 1 };
         let width = x1 - x0 + 1;
-        for s in sa..=sb {
-            for y in y0..=y1 {
-                let row = cascade.first_cell + (s * cascade.tiles_y + y) * cascade.tiles_x;
+        let slice_cells = cascade.tiles_x * cascade.tiles_y;
+        let mut slice_start = cascade.first_cell + sa * slice_cells + y0 * cascade.tiles_x + x0;
+        for _ in sa..=sb {
+            let mut run_start = slice_start;
+            for _ in y0..=y1 {
                 match &cone {
-                    None => emit(row + x0, width),
-                    Some(cone) => cone.emit_runs(grid, row + x0, width, emit),
+                    None => emit(run_start, width),
+                    Some(cone) => cone.emit_runs(spheres, run_start, width, emit),
                 }
+                run_start += cascade.tiles_x;
             }
+            slice_start += slice_cells;
         }
     }
 }
 
-/// The sphere the cell tests start from, in view space: its depth `d` (= −z), radius, and its
-/// exact tangent slopes (x, y) when it lies in front of the eye.
-struct Sphere {
+/// Where on screen the sphere a light's cells are tested against can be, computed once per
+/// light and narrowed per cascade: view-space bounds pre-multiplied by the grid's NDC scale.
+struct ScreenExtent {
+    perspective: bool,
+    /// Per axis: `(centre − r) · scale` and `(centre + r) · scale` (perspective: to be divided
+    /// by a depth, orthographic: NDC already).
+    low: [f64; 2],
+    high: [f64; 2],
+    /// Per axis: the exact NDC bounds of the sphere's tangent planes, when it lies in front
+    /// of the eye (perspective only).
+    tangents: Option<[(f64, f64); 2]>,
+    /// `1 / dmin`, `1 / dmax` of the clipped depth range (0 for an infinite end).
+    inv_depth: (f64, f64),
+    /// Centre (view x, y), depth and radius, for the plane tests of a sphere around the eye.
+    center: [f64; 2],
     d: f64,
     r: f64,
-    tangents: Option<[(f64, f64); 2]>,
 }
 
-/// Column (`axis` 0, centre `center` = view x) or row (`axis` 1, view y) range a sphere can
-/// touch within the depth slab whose reciprocal depths are `slab = (1/za, 1/zb)`, or `None`.
-/// Without `slab` (perspective only), the sphere's tangent bounds alone.
-fn axis_range(
-    grid: &ClusterGrid,
-    sphere: &Sphere,
-    center: f64,
-    slab: Option<(f64, f64)>,
-    axis: usize,
-    tiles: u32,
-) -> Option<(u32, u32)> {
-    let (d, r) = (sphere.d, sphere.r);
-    let scale = grid.ndc_scale[axis];
-    let (vmin, vmax) = (center - r, center + r);
-    let (lo, hi) = match (grid.projection, slab) {
-        (GridProjection::Perspective { .. }, Some((inv_za, inv_zb))) => {
-            // Box projection: extreme slopes of the sphere's bounding box within the slab.
-            let mut lo = (vmin * inv_za).min(vmin * inv_zb);
-            let mut hi = (vmax * inv_za).max(vmax * inv_zb);
-            if let Some(tangents) = &sphere.tangents {
-                let (tlo, thi) = tangents[axis];
-                lo = lo.max(tlo);
-                hi = hi.min(thi);
-            }
-            (lo * scale, hi * scale)
+impl ScreenExtent {
+    fn new(grid: &ClusterGrid, c: glam::DVec3, r: f64, dmin: f64, dmax: f64) -> ScreenExtent {
+        let perspective = matches!(grid.projection, GridProjection::Perspective { .. });
+        let d = -c.z;
+        let scale = grid.ndc_scale;
+        // Exact tangent slopes (view x/d and y/d) of the sphere, when it is in front of the
+        // eye.
+        let tangents = (perspective && d > r).then(|| {
+            let inv_den = 1.0 / (d * d - r * r);
+            let tangent = |center: f64, scale: f64| {
+                let root = r * (d * d + center * center - r * r).sqrt();
+                let k = scale * inv_den;
+                ((center * d - root) * k, (center * d + root) * k)
+            };
+            [tangent(c.x, scale[0]), tangent(c.y, scale[1])]
+        });
+        ScreenExtent {
+            perspective,
+            low: [(c.x - r) * scale[0], (c.y - r) * scale[1]],
+            high: [(c.x + r) * scale[0], (c.y + r) * scale[1]],
+            tangents,
+            inv_depth: (1.0 / dmin, 1.0 / dmax),
+            center: [c.x, c.y],
+            d,
+            r,
         }
-        (GridProjection::Perspective { .. }, None) => {
-            let (tlo, thi) = sphere.tangents.expect("no slab only with tangent bounds")[axis];
-            (tlo * scale, thi * scale)
-        }
-        (GridProjection::Orthographic { .. }, _) => (vmin * scale, vmax * scale),
-    };
-    if lo.is_nan() || hi.is_nan() || hi < -1.0 || lo > 1.0 || lo > hi {
-        return None;
     }
-    let to_tile = |ndc: f64| (((ndc + 1.0) * 0.5 * tiles as f64).max(0.0) as u32).min(tiles - 1);
-    let (mut t0, mut t1) = (to_tile(lo), to_tile(hi));
-    // Tighten the ends against the tile planes where the tangent bounds do not apply (sphere
-    // reaching behind the eye; with `d > r` they are exact already, as is orthographic).
-    if let (GridProjection::Perspective { .. }, true) = (grid.projection, d <= r) {
-        let tan = 1.0 / scale;
+
+    /// Column (`axis` 0) or row (`axis` 1) range of the cascade with `constants` and `tiles`
+    /// columns or rows the sphere can touch, or `None`. With `slab`, the box projection over
+    /// the cascade's part of the depth range narrows the tangent bounds.
+    fn tile_range(
+        &self,
+        grid: &ClusterGrid,
+        constants: &CascadeConstants,
+        slab: bool,
+        axis: usize,
+        tiles: u32,
+    ) -> Option<(u32, u32)> {
+        let (lo, hi) = match (self.perspective, self.tangents) {
+            (false, _) => (self.low[axis], self.high[axis]),
+            (true, Some(tangents)) if !slab => tangents[axis],
+            (true, tangents) => {
+                // Box projection: extreme slopes of the sphere's bounding box within the
+                // cascade's slab [max(dmin, z_near), min(dmax, z_far)].
+                let inv_za = self.inv_depth.0.min(constants.inv_near);
+                let inv_zb = self.inv_depth.1.max(constants.inv_far);
+                let (low, high) = (self.low[axis], self.high[axis]);
+                let lo = (low * inv_za).min(low * inv_zb);
+                let hi = (high * inv_za).max(high * inv_zb);
+                match tangents {
+                    Some(t) => (lo.max(t[axis].0), hi.min(t[axis].1)),
+                    None => (lo, hi),
+                }
+            }
+        };
+        // Also false for NaN.
+        if !(lo <= hi && hi >= -1.0 && lo <= 1.0) {
+            return None;
+        }
+        let half = constants.half_tiles[axis];
+        let to_tile = |ndc: f64| (((ndc + 1.0) * half).max(0.0) as u32).min(tiles - 1);
+        let (t0, t1) = (to_tile(lo), to_tile(hi));
+        if self.perspective && self.tangents.is_none() {
+            // A sphere reaching behind the eye: its box bounds are loose, tighten the ends.
+            return self.tighten_around_eye(grid, axis, tiles, t0, t1);
+        }
+        Some((t0, t1))
+    }
+
+    /// Narrows `[t0, t1]` to the columns or rows whose planes through the eye the sphere
+    /// touches, for a sphere reaching behind the eye; `None` when it touches none.
+    fn tighten_around_eye(
+        &self,
+        grid: &ClusterGrid,
+        axis: usize,
+        tiles: u32,
+        mut t0: u32,
+        mut t1: u32,
+    ) -> Option<(u32, u32)> {
+        let (center, d, r) = (self.center[axis], self.d, self.r);
+        let tan = 1.0 / grid.ndc_scale[axis];
         // Signed distance of the centre to the plane through the eye at NDC `u`, positive on
         // the +u side.
         let dist = |u: f64| (center - u * tan * d) / (1.0 + u * u * tan * tan).sqrt();
@@ -162,11 +200,8 @@ fn axis_range(
         while t1 > t0 && !touches(t1) {
             t1 -= 1;
         }
-        if !touches(t0) {
-            return None;
-        }
+        touches(t0).then_some((t0, t1))
     }
-    Some((t0, t1))
 }
 
 /// A spot light's cone, for the cone-vs-cell test (Wronski's "cull that cone"), and the
@@ -224,8 +259,14 @@ impl Cone {
     /// cell that may touch it to the last. The cone is convex, so along a row the cells it
     /// touches are (nearly) one interval; a gap inside would only be assigned too, which is
     /// conservative. Scanning in from both ends tests few cells where the cone fills the row.
-    fn emit_runs(&self, grid: &ClusterGrid, start: u32, len: u32, emit: &mut impl FnMut(u32, u32)) {
-        let spheres = &grid.cell_spheres()[start as usize..(start + len) as usize];
+    fn emit_runs(
+        &self,
+        cell_spheres: &[[f64; 4]],
+        start: u32,
+        len: u32,
+        emit: &mut impl FnMut(u32, u32),
+    ) {
+        let spheres = &cell_spheres[start as usize..(start + len) as usize];
         let Some(first) = spheres.iter().position(|s| self.may_touch(s)) else {
             return;
         };

@@ -29,6 +29,8 @@
 
 use glam::DMat4;
 
+use super::depth_lookup::{CascadeConstants, SliceLookup};
+
 /// Tunables of the grid.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct GridConfig {
@@ -191,6 +193,10 @@ pub struct ClusterGrid {
     /// Bounding sphere (view-space centre, radius) of every cell, built on first use (the
     /// cone-vs-cell test of spot lights); infinite radius for cells reaching infinity.
     cell_spheres: std::sync::OnceLock<Vec<[f64; 4]>>,
+    /// Slice of a depth without a logarithm (log2 mapping only).
+    slice_lookup: SliceLookup,
+    /// Per cascade: constants of the assignment's box projection and tile conversion.
+    pub(crate) cascade_constants: Vec<CascadeConstants>,
 }
 
 impl ClusterGrid {
@@ -271,7 +277,7 @@ impl ClusterGrid {
             first_cell += cascade.cells();
             cascades.push(cascade);
         }
-        ClusterGrid {
+        let mut grid = ClusterGrid {
             width,
             height,
             projection,
@@ -287,7 +293,14 @@ impl ClusterGrid {
                 GridProjection::Orthographic { half_x, half_y } => [1.0 / half_x, 1.0 / half_y],
             },
             cell_spheres: std::sync::OnceLock::new(),
+            slice_lookup: SliceLookup::default(),
+            cascade_constants: Vec::new(),
+        };
+        if mapping == DepthMapping::Log2 {
+            grid.slice_lookup = SliceLookup::new(&grid);
         }
+        grid.cascade_constants = CascadeConstants::of(&grid);
+        grid
     }
 
     /// Bounding spheres `[x, y, z, radius]` of every cell, in cell order (built on first use).
@@ -355,10 +368,12 @@ impl ClusterGrid {
     }
 
     /// First and last (cascade, slice) a depth range `[dmin, dmax]` can touch: the hot path of
-    /// the assignment. The logarithm is [`fast_log2`] (a quarter of the cost of `f64::log2`)
-    /// and the range is widened by far more than its error, so the result never misses a
-    /// slice that [`view_z_to_cascade_slice`](Self::view_z_to_cascade_slice) gives a depth
-    /// inside the range; at worst it includes one neighbour slice more.
+    /// the assignment. Under the log2 mapping the slices come from a table (no logarithm; see
+    /// `depth_lookup`) and the range is first widened by a relative 7·10⁻⁶ (10⁻⁵ in log2
+    /// units), far more than the table's rounding at a boundary and than the shader's `f32`
+    /// evaluation of the mapping; so the result never misses a slice that
+    /// [`view_z_to_cascade_slice`](Self::view_z_to_cascade_slice) gives a depth inside the
+    /// range, and at worst includes one neighbour slice more.
     pub fn depth_range_to_slices(&self, dmin: f64, dmax: f64) -> ((u32, u32), (u32, u32)) {
         match self.mapping {
             DepthMapping::Linear => (
@@ -366,12 +381,10 @@ impl ClusterGrid {
                 self.view_z_to_cascade_slice(dmax),
             ),
             DepthMapping::Log2 => {
-                const WIDEN: f64 = 1e-5;
-                let l0 = fast_log2(dmin) - WIDEN;
-                let l1 = fast_log2(dmax) + WIDEN;
+                const WIDEN: f64 = 7e-6;
                 (
-                    self.t_to_cascade_slice((l0 - self.a) * self.b),
-                    self.t_to_cascade_slice((l1 - self.a) * self.b),
+                    self.slice_lookup.find(dmin * (1.0 - WIDEN)),
+                    self.slice_lookup.find(dmax * (1.0 + WIDEN)),
                 )
             }
         }
@@ -454,28 +467,6 @@ impl ClusterGrid {
     }
 }
 
-/// `log2(d)` within 10⁻⁸ (absolute) for every `d`, clamped to `[1e-300, 1e300]` (so 0 and
-/// infinity map to finite values, like the shader's clamp), with no libm call and no
-/// division: the exponent from the bits; the mantissa `m` split as `m = mᵢ·(1 + ρ)` with
-/// `mᵢ = 1 + i/64` from its top 6 bits (a table holds `log2 mᵢ` and `1/mᵢ`) and
-/// `|ρ| < 1/64`; `log2(1 + ρ)` by four terms of its series (error below `ρ⁵/(5 ln 2)`).
-pub fn fast_log2(d: f64) -> f64 {
-    static TABLE: std::sync::LazyLock<[(f64, f64); 64]> = std::sync::LazyLock::new(|| {
-        std::array::from_fn(|i| {
-            let m = 1.0 + i as f64 / 64.0;
-            (m.log2(), 1.0 / m)
-        })
-    });
-    const LOG2_E: f64 = std::f64::consts::LOG2_E;
-    let bits = d.clamp(1e-300, 1e300).to_bits();
-    let exponent = ((bits >> 52) & 0x7ff) as i64 - 1023;
-    let m = f64::from_bits((bits & ((1u64 << 52) - 1)) | (1023u64 << 52));
-    let (log_mi, inv_mi) = TABLE[((bits >> 46) & 63) as usize];
-    let rho = m * inv_mi - 1.0;
-    let series = rho * (1.0 - rho * (0.5 - rho * (1.0 / 3.0 - rho * 0.25)));
-    exponent as f64 + log_mi + series * LOG2_E
-}
-
 /// A cell's extent (see [`ClusterGrid::cell_bounds`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CellBounds {
@@ -504,24 +495,6 @@ mod tests {
             far,
             &GridConfig::default(),
         )
-    }
-
-    #[test]
-    fn fast_log2_is_within_its_stated_error() {
-        let mut worst = 0.0f64;
-        let mut d = 1e-12f64;
-        while d < 1e12 {
-            for x in [d, d.next_up(), d * 1.000_173, d * std::f64::consts::SQRT_2] {
-                worst = worst.max((fast_log2(x) - x.log2()).abs());
-            }
-            d *= 1.003_7;
-        }
-        assert!(worst < 1e-8, "fast_log2 off by {worst}");
-        assert!(
-            worst > 0.0,
-            "the approximation is not exact; the test must see its error"
-        );
-        assert!(fast_log2(0.0).is_finite() && fast_log2(f64::INFINITY).is_finite());
     }
 
     #[test]

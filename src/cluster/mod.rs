@@ -1,10 +1,12 @@
-//! GL-free CPU light assignment: the cascaded cluster grid (`grid`), 2D screen tiles
-//! (`tiles`), which cells one light touches (`cells`), per-frame light → cell assignment with
-//! a counting sort (`assign`), and the texel layouts the shaders read (`pack`). Nothing here touches GL, so all of it is unit-tested
-//! without a context.
+//! GL-free CPU light assignment: the cascaded cluster grid (`grid`) and its hot-path lookups
+//! (`depth_lookup`), 2D screen tiles (`tiles`), which cells one light touches (`cells`),
+//! per-frame light → cell assignment with a counting sort (`assign`), and the texel layouts
+//! the shaders read (`pack`). Nothing here touches GL, so all of it is unit-tested without a
+//! context.
 
 pub mod assign;
 pub mod cells;
+mod depth_lookup;
 pub mod grid;
 pub mod pack;
 pub mod pack_grid;

@@ -1,0 +1,193 @@
+//! The assignment's hot-path view of a [`ClusterGrid`]'s depth mapping: which slice a view
+//! depth lies in without a logarithm, and per-cascade constants that turn divisions into
+//! multiplications.
+//!
+//! **Slices by table.** Along the log2 mapping, slice boundaries are fixed depths. A depth's
+//! slice is found from the top bits of its `f64` pattern (exponent and 6 mantissa bits: a
+//! bucket spanning a ratio of at most 1 + 1/64) through a table holding each bucket's first
+//! slice, then stepping past the boundaries the depth has crossed inside its bucket (slices
+//! span a ratio of 1.1 or more at the default settings, so one comparison decides). The
+//! result is exactly "the last slice whose start is ≤ d"; the boundaries come from
+//! [`ClusterGrid::slice_depth_range`], so it agrees with
+//! [`ClusterGrid::view_z_to_cascade_slice`] up to its rounding at a boundary, which the caller's
+//! widening of the depth range absorbs.
+//!
+//! ```text
+//! bits(d) >> 46 ─ base ─► first_slice[bucket] ─► while d ≥ start[g + 1]: g += 1 ─► (k, s)
+//! ```
+
+use super::grid::ClusterGrid;
+
+/// Bits below the bucket: 52 mantissa bits − 6 kept.
+const BUCKET_SHIFT: u32 = 46;
+
+/// Bucket number of a depth: its bit pattern as a signed number, less the low mantissa bits
+/// (monotone in `d` for `d` ≥ 0, negative for negative patterns).
+fn bucket(d: f64) -> i64 {
+    (d.to_bits() as i64) >> BUCKET_SHIFT
+}
+
+/// Slice lookup for the log2 depth mapping (see the module docs).
+#[derive(Clone, Debug, Default)]
+pub(crate) struct SliceLookup {
+    /// Bucket number of `first_slice[0]`.
+    base: i64,
+    /// Per bucket: the global slice (slices numbered across cascades) its smallest depth is in.
+    first_slice: Vec<u32>,
+    /// Per global slice: the depth where it starts (0 for the first).
+    start: Vec<f64>,
+    /// Per global slice: (cascade, slice within the cascade).
+    address: Vec<(u32, u32)>,
+}
+
+impl SliceLookup {
+    /// The lookup of `grid`'s slices. Buckets cover the grid's first split to its far end:
+    /// nearer depths all lie in the first slice and farther ones reach the last through
+    /// the steps.
+    pub(crate) fn new(grid: &ClusterGrid) -> SliceLookup {
+        let mut start = Vec::new();
+        let mut address = Vec::new();
+        for (k, cascade) in grid.cascades.iter().enumerate() {
+            for s in 0..cascade.slices {
+                let z0 = grid.slice_depth_range(k as u32, s).0;
+                start.push(if start.is_empty() { 0.0 } else { z0 });
+                address.push((k as u32, s));
+            }
+        }
+        let far = grid.far.max(f64::MIN_POSITIVE);
+        // Every depth before the second slice's start is in the first slice.
+        let base = bucket(start.get(1).copied().unwrap_or(far).min(far));
+        let last = bucket(far).max(base);
+        let first_slice = (base..=last)
+            .map(|b| {
+                let d = f64::from_bits((b as u64) << BUCKET_SHIFT);
+                (start.partition_point(|&z| z <= d) - 1) as u32
+            })
+            .collect();
+        SliceLookup {
+            base,
+            first_slice,
+            start,
+            address,
+        }
+    }
+
+    /// (cascade, slice) of the last slice starting at or before `d` (`d` ≥ 0, not NaN).
+    #[inline]
+    pub(crate) fn find(&self, d: f64) -> (u32, u32) {
+        // Negative patterns (−0 included) clamp to the first bucket, +∞ to the last.
+        let bucket = (bucket(d) - self.base).clamp(0, self.first_slice.len() as i64 - 1);
+        let mut g = self.first_slice[bucket as usize] as usize;
+        while g + 1 < self.start.len() && d >= self.start[g + 1] {
+            g += 1;
+        }
+        self.address[g]
+    }
+}
+
+/// Per-cascade constants of the box projection and of the NDC → tile conversion.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct CascadeConstants {
+    /// `1 / z_near`, or +∞ for the first cascade (which also takes depths in front of its
+    /// start): `1 / max(d, z_near) = min(1 / d, inv_near)`.
+    pub inv_near: f64,
+    /// `1 / z_far`, or 0 for the last cascade (which extends to infinity):
+    /// `1 / min(d, z_far) = max(1 / d, inv_far)`.
+    pub inv_far: f64,
+    /// Half the columns and half the rows: tile coordinate `(ndc + 1) · half`.
+    pub half_tiles: [f64; 2],
+}
+
+impl CascadeConstants {
+    /// The constants of every cascade of `grid`.
+    pub(crate) fn of(grid: &ClusterGrid) -> Vec<CascadeConstants> {
+        let last = grid.cascades.len() - 1;
+        grid.cascades
+            .iter()
+            .enumerate()
+            .map(|(k, c)| CascadeConstants {
+                inv_near: if k == 0 {
+                    f64::INFINITY
+                } else {
+                    1.0 / c.z_near
+                },
+                inv_far: if k == last { 0.0 } else { 1.0 / c.z_far },
+                half_tiles: [0.5 * c.tiles_x as f64, 0.5 * c.tiles_y as f64],
+            })
+            .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cluster::grid::{GridConfig, GridProjection};
+
+    fn grids() -> Vec<ClusterGrid> {
+        let t = 30f64.to_radians().tan();
+        let persp = |near, far, w, h| {
+            ClusterGrid::new(
+                w,
+                h,
+                GridProjection::Perspective {
+                    tan_x: t * w as f64 / h as f64,
+                    tan_y: t,
+                },
+                near,
+                far,
+                &GridConfig::default(),
+            )
+        };
+        vec![
+            persp(0.1, 80.0, 1280, 720),
+            persp(1e-4, 1e5, 256, 144),
+            persp(0.5, 0.6, 640, 480),
+            persp(0.0, 10.0, 64, 64),
+        ]
+    }
+
+    /// The lookup equals a search over the slice starts, at and around every boundary and
+    /// across the whole depth range (0 and beyond the far end included).
+    #[test]
+    fn lookup_matches_a_search_over_slice_starts() {
+        for grid in grids() {
+            let lookup = SliceLookup::new(&grid);
+            let search =
+                |d: f64| lookup.address[lookup.start.partition_point(|&z| z <= d).max(1) - 1];
+            let mut depths = vec![-0.0, 0.0, f64::MIN_POSITIVE, grid.far * 1e3, f64::INFINITY];
+            for &z in &lookup.start[1..] {
+                depths.extend([z, z.next_up(), z.next_down(), z * 1.01, z * 0.99]);
+            }
+            let mut d = 1e-6;
+            while d < grid.far * 4.0 {
+                depths.push(d);
+                d *= 1.001;
+            }
+            for d in depths {
+                assert_eq!(lookup.find(d), search(d), "depth {d}");
+            }
+        }
+    }
+
+    /// Away from boundaries, the lookup agrees with the mapping the shader evaluates.
+    #[test]
+    fn lookup_agrees_with_the_depth_mapping() {
+        for grid in grids() {
+            let lookup = SliceLookup::new(&grid);
+            let mut d = grid.near.max(1e-6);
+            let mut checked = 0;
+            while d < grid.far * 2.0 {
+                let (lo, hi) = (
+                    grid.view_z_to_cascade_slice(d * (1.0 - 1e-9)),
+                    grid.view_z_to_cascade_slice(d * (1.0 + 1e-9)),
+                );
+                if lo == hi {
+                    assert_eq!(lookup.find(d), lo, "depth {d}");
+                    checked += 1;
+                }
+                d *= 1.003;
+            }
+            assert!(checked > 100, "only {checked} depths checked");
+        }
+    }
+}
