@@ -1,7 +1,8 @@
 //! Which cells one light can touch: the per-light half of the assignment (`assign` does the
 //! sorting). All in view space and `f64`.
 //!
-//! 1. The light's depth range `[d − r, d + r]` is clipped to `[near, far]` **before** anything
+//! 1. A light wholly outside one of the frustum's side planes touches nothing. Otherwise its
+//!    depth range `[d − r, d + r]` is clipped to `[near, far]` **before** anything
 //!    is projected, so lights behind or around the camera never flip to the wrong side; a light
 //!    whose range misses the frustum touches nothing.
 //! 2. The clipped range gives the first and last (cascade, slice).
@@ -43,8 +44,11 @@ pub fn for_each_run(
     // The sphere every cell test starts from: the light's, or the tighter bound of a spot's
     // cone.
     let (c, r) = cone.as_ref().map_or((p, range), |cone| cone.bound);
+    // 1. Cull against the frustum's sides, then clip the depth range before projecting.
+    if grid.sphere_outside_sides(c, r) {
+        return;
+    }
     let d = -c.z;
-    // 1. Clip the depth range before projecting.
     let dmin = (d - r).max(grid.near);
     let dmax = (d + r).min(camera_far);
     if dmin > dmax {
@@ -57,7 +61,8 @@ pub fn for_each_run(
     } else {
         &[]
     };
-    for k in k0..=k1 {
+    // Exclusive ranges in the loops below: inclusive ones cost a flag check per step.
+    for k in k0..k1 + 1 {
         let cascade = &grid.cascades[k as usize];
         let constants = &grid.cascade_constants[k as usize];
         // The whole sphere's tangent bounds are exact on their own when the depth range
@@ -74,9 +79,9 @@ pub fn for_each_run(
         let width = x1 - x0 + 1;
         let slice_cells = cascade.tiles_x * cascade.tiles_y;
         let mut slice_start = cascade.first_cell + sa * slice_cells + y0 * cascade.tiles_x + x0;
-        for _ in sa..=sb {
+        for _ in sa..sb + 1 {
             let mut run_start = slice_start;
-            for _ in y0..=y1 {
+            for _ in y0..y1 + 1 {
                 match &cone {
                     None => emit(run_start, width),
                     Some(cone) => cone.emit_runs(spheres, run_start, width, emit),
@@ -189,11 +194,21 @@ impl ScreenExtent {
     ) -> Option<(u32, u32)> {
         let (center, d, r) = (self.center[axis], self.d, self.r);
         let tan = 1.0 / grid.ndc_scale[axis];
-        // Signed distance of the centre to the plane through the eye at NDC `u`, positive on
-        // the +u side.
-        let dist = |u: f64| (center - u * tan * d) / (1.0 + u * u * tan * tan).sqrt();
-        let ndc = |i: u32| -1.0 + 2.0 * i as f64 / tiles as f64;
-        let touches = |i: u32| dist(ndc(i)) >= -r && dist(ndc(i + 1)) <= r;
+        let step = 2.0 * tan / tiles as f64;
+        // The plane through the eye at NDC `u` has the normal (1, −s) (in the axis and depth
+        // coordinates) with `s = u · tan`; the centre's signed distance to it, positive on the
+        // +u side, is `(center − s·d) / √(1 + s²)`. Compared with ±r squared, so no root.
+        let slope = |i: u32| -tan + i as f64 * step;
+        let within = |s: f64, a: f64| a * a <= r * r * (1.0 + s * s);
+        let above_low = |i: u32| {
+            let (s, a) = (slope(i), center - slope(i) * d);
+            a >= 0.0 || within(s, a)
+        };
+        let below_high = |i: u32| {
+            let (s, a) = (slope(i + 1), center - slope(i + 1) * d);
+            a <= 0.0 || within(s, a)
+        };
+        let touches = |i: u32| above_low(i) && below_high(i);
         while t0 < t1 && !touches(t0) {
             t0 += 1;
         }

@@ -197,6 +197,9 @@ pub struct ClusterGrid {
     slice_lookup: SliceLookup,
     /// Per cascade: constants of the assignment's box projection and tile conversion.
     pub(crate) cascade_constants: Vec<CascadeConstants>,
+    /// Perspective: `1 / √(1 + tan²)` for x and y, the length of the side planes' normals
+    /// `(1, 0, tan)` taken out (see [`ClusterGrid::sphere_outside_sides`]).
+    side_plane_norm: [f64; 2],
 }
 
 impl ClusterGrid {
@@ -293,6 +296,12 @@ impl ClusterGrid {
                 GridProjection::Orthographic { half_x, half_y } => [1.0 / half_x, 1.0 / half_y],
             },
             cell_spheres: std::sync::OnceLock::new(),
+            side_plane_norm: match projection {
+                GridProjection::Perspective { tan_x, tan_y } => {
+                    [tan_x, tan_y].map(|t| 1.0 / (1.0 + t * t).sqrt())
+                }
+                GridProjection::Orthographic { .. } => [1.0; 2],
+            },
             slice_lookup: SliceLookup::default(),
             cascade_constants: Vec::new(),
         };
@@ -301,6 +310,22 @@ impl ClusterGrid {
         }
         grid.cascade_constants = CascadeConstants::of(&grid);
         grid
+    }
+
+    /// True when the view-space sphere (`center`, `radius`) lies wholly outside one of the
+    /// view frustum's four side planes, so it touches no cell (the assignment's first cull).
+    pub fn sphere_outside_sides(&self, center: glam::DVec3, radius: f64) -> bool {
+        // By symmetry the nearer of the two planes of an axis decides: |x| against the right.
+        match self.projection {
+            GridProjection::Perspective { tan_x, tan_y } => {
+                let d = -center.z;
+                (center.x.abs() - tan_x * d) * self.side_plane_norm[0] > radius
+                    || (center.y.abs() - tan_y * d) * self.side_plane_norm[1] > radius
+            }
+            GridProjection::Orthographic { half_x, half_y } => {
+                center.x.abs() - half_x > radius || center.y.abs() - half_y > radius
+            }
+        }
     }
 
     /// Bounding spheres `[x, y, z, radius]` of every cell, in cell order (built on first use).
