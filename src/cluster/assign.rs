@@ -152,13 +152,14 @@ impl Chunk {
     }
 
     /// Phase 2 when this is the only chunk, in one pass over the cells: the final counts and
-    /// offsets into `out`, and the scatter's cursor. Returns the list's length.
-    fn totals_into(&mut self, out: &mut Assignment) -> usize {
+    /// offsets into `out`, the scatter's cursor, and the list's [`Totals`].
+    fn totals_into(&mut self, out: &mut Assignment) -> Totals {
         let cells = self.deltas.len() - 1;
         out.counts.resize(cells, 0);
         out.offsets.resize(cells, 0);
         self.cursor.resize(cells, 0);
         let (mut running, mut total) = (0i32, 0u32);
+        let (mut max, mut nonempty) = (0u32, 0u32);
         let columns = out
             .counts
             .iter_mut()
@@ -166,12 +167,19 @@ impl Chunk {
             .zip(&mut self.cursor);
         for (((count, offset), cursor), delta) in columns.zip(&self.deltas) {
             running += delta;
-            *count = running as u32;
+            let n = running as u32;
+            *count = n;
             *offset = total;
             *cursor = total;
-            total += running as u32;
+            total += n;
+            max = max.max(n);
+            nonempty += u32::from(n > 0);
         }
-        total as usize
+        Totals {
+            indices: total as usize,
+            max,
+            nonempty,
+        }
     }
 
     /// Phase 3: writes the chunk's visible lights, numbered from `first_id`, into `out`
@@ -205,6 +213,35 @@ impl Chunk {
         self.cursor.extend_from_slice(&self.offsets[..cells]);
         self.scatter(first_id, &mut sorted);
         self.sorted = sorted;
+    }
+}
+
+/// Figures of the per-cell counts, gathered in the pass that makes the offsets.
+#[derive(Clone, Copy, Debug)]
+struct Totals {
+    /// Length of the index list.
+    indices: usize,
+    /// Largest count.
+    max: u32,
+    /// Cells with a light.
+    nonempty: u32,
+}
+
+impl Totals {
+    /// The figures of `counts` (the several-chunk path, which sums counts itself).
+    fn of(counts: &[u32]) -> Totals {
+        counts.iter().fold(
+            Totals {
+                indices: 0,
+                max: 0,
+                nonempty: 0,
+            },
+            |t, &n| Totals {
+                indices: t.indices + n as usize,
+                max: t.max.max(n),
+                nonempty: t.nonempty + u32::from(n > 0),
+            },
+        )
     }
 }
 
@@ -286,12 +323,13 @@ impl Assigner {
                 prev = end;
             }
         }
-        if threads == 1 {
-            let total = self.chunks[0].totals_into(out);
+        let totals = if threads == 1 {
+            let totals = self.chunks[0].totals_into(out);
             // Phase 3. Every entry is written, so the list is not cleared first: only growth
             // is zero-filled.
-            out.indices.resize(total, 0);
+            out.indices.resize(totals.indices, 0);
             self.chunks[0].scatter(0, &mut out.indices);
+            totals
         } else {
             self.chunks.iter_mut().for_each(Chunk::prefix);
             let chunks = &self.chunks;
@@ -313,12 +351,16 @@ impl Assigner {
                 .zip(first_ids.par_iter())
                 .for_each(|(chunk, &first_id)| chunk.sort_locally(first_id, cells));
             merge(&self.chunks, &out.offsets, &mut out.indices, threads);
-        }
+            Totals::of(&out.counts)
+        };
         // Overflow, then the figures.
-        out.stats.max_lights_per_cluster = out.counts.iter().copied().max().unwrap_or(0);
+        out.stats.max_lights_per_cluster = totals.max;
         out.stats.visible_lights = out.visible.len();
-        apply_cap(out, grid, lights, limits);
-        let nonempty = out.counts.iter().filter(|&&n| n > 0).count() as u32;
+        let nonempty = if apply_cap(out, grid, lights, limits) {
+            Totals::of(&out.counts).nonempty
+        } else {
+            totals.nonempty
+        };
         out.stats.nonempty_clusters = nonempty;
         out.stats.indices = out.indices.len();
         out.stats.avg_lights_per_nonempty = if nonempty > 0 {
@@ -393,11 +435,20 @@ pub fn assign(
     assigner.into_assignment()
 }
 
-/// Applies the overflow policy in place (see the module docs).
-fn apply_cap(out: &mut Assignment, grid: &ClusterGrid, lights: &[GpuLight], limits: &AssignLimits) {
+/// Applies the overflow policy in place (see the module docs); true if it dropped any light.
+fn apply_cap(
+    out: &mut Assignment,
+    grid: &ClusterGrid,
+    lights: &[GpuLight],
+    limits: &AssignLimits,
+) -> bool {
+    let max = out.stats.max_lights_per_cluster;
+    if max <= limits.cell_cap && out.indices.len() <= limits.max_indices {
+        return false;
+    }
     let cap = effective_cap(&out.counts, limits.cell_cap, limits.max_indices);
-    if out.stats.max_lights_per_cluster <= cap {
-        return;
+    if max <= cap {
+        return false;
     }
     let mut kept = Vec::with_capacity(out.indices.len().min(limits.max_indices));
     for cell in 0..out.counts.len() {
@@ -419,6 +470,7 @@ fn apply_cap(out: &mut Assignment, grid: &ClusterGrid, lights: &[GpuLight], limi
         kept.extend_from_slice(&out.indices[o..o + keep]);
     }
     out.indices = kept;
+    true
 }
 
 /// Importance of a light for a cell under overflow: brighter and closer first.

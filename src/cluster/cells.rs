@@ -143,6 +143,7 @@ impl ScreenExtent {
     /// Column (`axis` 0) or row (`axis` 1) range of the cascade with `constants` and `tiles`
     /// columns or rows the sphere can touch, or `None`. With `slab`, the box projection over
     /// the cascade's part of the depth range narrows the tangent bounds.
+    #[inline(always)]
     fn tile_range(
         &self,
         grid: &ClusterGrid,
