@@ -174,7 +174,8 @@ impl ScreenExtent {
             return None;
         }
         let half = constants.half_tiles[axis];
-        let to_tile = |ndc: f64| (((ndc + 1.0) * half).max(0.0) as u32).min(tiles - 1);
+        // `as u32` saturates: negative coordinates (and NaN) give column 0.
+        let to_tile = |ndc: f64| (((ndc + 1.0) * half) as u32).min(tiles - 1);
         let (t0, t1) = (to_tile(lo), to_tile(hi));
         if self.perspective && self.tangents.is_none() {
             // A sphere reaching behind the eye: its box bounds are loose, tighten the ends.
