@@ -226,7 +226,8 @@ impl ScreenExtent {
 struct Cone {
     apex: glam::DVec3,
     axis: glam::DVec3,
-    cos: f64,
+    /// cos² and sin of the (padded) outer half-angle.
+    cos_sq: f64,
     sin: f64,
     /// The light's (padded) radius.
     range: f64,
@@ -265,7 +266,7 @@ impl Cone {
         Some(Cone {
             apex,
             axis,
-            cos,
+            cos_sq: cos * cos,
             sin,
             range,
             bound: (apex + axis * along, radius),
@@ -296,10 +297,8 @@ impl Cone {
 
     /// False only when the cell's bounding sphere is certainly outside the cone (up to the
     /// light's range).
+    /// A cell reaching infinity (radius +∞) passes every comparison below by IEEE rules.
     fn may_touch(&self, &[x, y, z, radius]: &[f64; 4]) -> bool {
-        if radius.is_infinite() {
-            return true;
-        }
         let v = glam::DVec3::new(x, y, z) - self.apex;
         let v1 = v.dot(self.axis);
         if v1 > radius + self.range || v1 < -radius {
@@ -309,6 +308,6 @@ impl Cone {
         // cell is outside when that exceeds its radius. Squared (both sides are then ≥ 0) so
         // the hot loop has no square root.
         let bound = radius + v1 * self.sin;
-        bound >= 0.0 && self.cos * self.cos * (v.length_squared() - v1 * v1) <= bound * bound
+        bound >= 0.0 && self.cos_sq * (v.length_squared() - v1 * v1) <= bound * bound
     }
 }
