@@ -13,8 +13,8 @@ pub struct BenchAssignArgs {
         default_value = "1,64,1024,16384,65536,1048576"
     )]
     pub lights: Vec<usize>,
-    /// Timed runs per count (the median is reported).
-    #[arg(long, default_value_t = 21)]
+    /// Timed runs per count, after 0.1 s of untimed ones (the median is reported).
+    #[arg(long, default_value_t = 101)]
     pub runs: usize,
     /// Seed of the random lights.
     #[arg(long, default_value_t = 1)]
