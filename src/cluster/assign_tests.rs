@@ -392,6 +392,35 @@ fn parallel_and_sequential_assignment_agree() {
     assert_eq!(seq.offsets, par.offsets);
     assert_eq!(seq.counts, par.counts);
     assert_eq!(seq.indices, par.indices);
+    assert_eq!(seq.stats, par.stats);
+    check_stats(&seq, None);
+    // Capped, on both paths: the figures describe the lists after the cap, the largest count
+    // the lists before it.
+    for parallel_threshold in [usize::MAX, 1] {
+        let limits = AssignLimits {
+            cell_cap: 3,
+            parallel_threshold,
+            ..Default::default()
+        };
+        let capped = assign(&grid, &lights, 80.0, &limits);
+        assert!(capped.stats.overflowed_lights > 0);
+        check_stats(&capped, Some(seq.stats.max_lights_per_cluster));
+    }
+}
+
+/// The figures of an assignment against counts taken from its lists here; `uncapped_max` is
+/// the largest count before a cap (`None`: no cap applied).
+fn check_stats(a: &Assignment, uncapped_max: Option<u32>) {
+    let nonempty = a.counts.iter().filter(|&&n| n > 0).count() as u32;
+    let max = a.counts.iter().copied().max().unwrap();
+    assert!(nonempty > 0);
+    assert_eq!(a.stats.nonempty_clusters, nonempty);
+    assert_eq!(a.stats.max_lights_per_cluster, uncapped_max.unwrap_or(max));
+    assert_eq!(a.stats.indices, a.indices.len());
+    assert_eq!(a.stats.clusters as usize, a.counts.len());
+    assert_eq!(a.stats.visible_lights, a.visible.len());
+    let avg = a.indices.len() as f64 / nonempty as f64;
+    assert!((a.stats.avg_lights_per_nonempty - avg).abs() < 1e-12);
 }
 
 /// One assigner over frames of different sizes, grids and light sets gives what fresh buffers
