@@ -136,3 +136,53 @@ fn counts_equal_the_cpu_cluster_lists_at_sampled_pixels() {
         }
     }
 }
+
+/// Deferred's proxies skip the surfaces a light cannot reach: a sphere behind the wall by its
+/// near side, a sphere around the eye by its far side — which replaced a full-screen pass, so
+/// a light around the eye short of the wall now evaluates nowhere, and one reaching the wall
+/// evaluates where it reaches, not at every pixel.
+#[test]
+fn deferred_proxies_skip_what_a_light_cannot_reach_and_need_no_full_screen_pass_near_the_eye() {
+    use glam::{DVec3, Vec3};
+    use manylight::scene::Light;
+    let base = scene::builtin::build("plane", None).unwrap();
+    let mut gpu = Gpu::new(EsVersion::Es3);
+    // The camera is at z = 5 looking at the plane z = 0; near 0.1.
+    let cases = [
+        ("behind the wall", DVec3::new(0.5, 0.3, -2.0), 1.5, false),
+        (
+            "around the eye, short of the wall",
+            DVec3::new(0.0, 0.0, 4.8),
+            3.0,
+            false,
+        ),
+        (
+            "around the eye, reaching the wall",
+            DVec3::new(0.0, 0.0, 4.8),
+            5.2,
+            true,
+        ),
+    ];
+    for (name, position, radius, reaches) in cases {
+        let mut scene = base.clone();
+        scene.lights = vec![Light::point(position, radius, Vec3::ONE, 1.0)];
+        let bound = counts(&mut gpu, &scene, "forward", CountKind::Reaching);
+        let evals = counts(&mut gpu, &scene, "deferred", CountKind::Evals);
+        assert!(
+            bound.covered_pixels() > 30_000,
+            "{name}: the wall fills the view"
+        );
+        assert_eq!(bound.total() > 0, reaches, "{name}: reaching pixels");
+        if reaches {
+            assert!(evals.total() >= bound.total(), "{name}");
+            assert!(
+                (evals.total() as usize) < evals.covered_pixels() * 3 / 4,
+                "{name}: {} of {} pixels evaluated (a full-screen pass?)",
+                evals.total(),
+                evals.covered_pixels()
+            );
+        } else {
+            assert_eq!(evals.total(), 0, "{name}: evaluated where it cannot reach");
+        }
+    }
+}

@@ -26,6 +26,8 @@ pub enum DepthTest {
     Less,
     /// `LEQUAL` (passes after an equal-depth prepass).
     LessEqual,
+    /// `GEQUAL` (a light volume's far side behind or on a surface).
+    GreaterEqual,
 }
 
 /// Face culling.
@@ -103,6 +105,10 @@ impl RenderState {
                 DepthTest::LessEqual => {
                     gl.enable(glow::DEPTH_TEST);
                     gl.depth_func(glow::LEQUAL);
+                }
+                DepthTest::GreaterEqual => {
+                    gl.enable(glow::DEPTH_TEST);
+                    gl.depth_func(glow::GEQUAL);
                 }
             }
             gl.depth_mask(self.depth_write);
