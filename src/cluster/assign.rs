@@ -158,8 +158,8 @@ impl Chunk {
         out.counts.resize(cells, 0);
         out.offsets.resize(cells, 0);
         self.cursor.resize(cells, 0);
-        let (mut running, mut total) = (0i32, 0u32);
-        let (mut max, mut nonempty) = (0u32, 0u32);
+        let mut running = 0i32;
+        let mut totals = Totals::default();
         let columns = out
             .counts
             .iter_mut()
@@ -169,17 +169,11 @@ impl Chunk {
             running += delta;
             let n = running as u32;
             *count = n;
-            *offset = total;
-            *cursor = total;
-            total += n;
-            max = max.max(n);
-            nonempty += u32::from(n > 0);
+            *offset = totals.indices as u32;
+            *cursor = totals.indices as u32;
+            totals.add(n);
         }
-        Totals {
-            indices: total as usize,
-            max,
-            nonempty,
-        }
+        totals
     }
 
     /// Phase 3: writes the chunk's visible lights, numbered from `first_id`, into `out`
@@ -217,7 +211,7 @@ impl Chunk {
 }
 
 /// Figures of the per-cell counts, gathered in the pass that makes the offsets.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, Default)]
 struct Totals {
     /// Length of the index list.
     indices: usize,
@@ -228,20 +222,18 @@ struct Totals {
 }
 
 impl Totals {
+    /// Takes one cell's count in.
+    fn add(&mut self, n: u32) {
+        self.indices += n as usize;
+        self.max = self.max.max(n);
+        self.nonempty += u32::from(n > 0);
+    }
+
     /// The figures of `counts` (the several-chunk path, which sums counts itself).
     fn of(counts: &[u32]) -> Totals {
-        counts.iter().fold(
-            Totals {
-                indices: 0,
-                max: 0,
-                nonempty: 0,
-            },
-            |t, &n| Totals {
-                indices: t.indices + n as usize,
-                max: t.max.max(n),
-                nonempty: t.nonempty + u32::from(n > 0),
-            },
-        )
+        let mut totals = Totals::default();
+        counts.iter().for_each(|&n| totals.add(n));
+        totals
     }
 }
 

@@ -417,8 +417,8 @@ impl ClusterGrid {
 
     /// Cascade and slice of a grid coordinate, clamped into the grid.
     pub fn t_to_cascade_slice(&self, t: f64) -> (u32, u32) {
-        // Clamping to ≥ 0 first makes the truncating cast a floor (and maps NaN to 0); this is
-        // the hot path of the assignment, and `f64::floor` is a libm call on baseline x86-64.
+        // Clamping to ≥ 0 first makes the truncating cast a floor (and maps NaN to 0);
+        // `f64::floor` is a libm call on baseline x86-64.
         let last = self.cascades.len() as u32 - 1;
         let k = t.clamp(0.0, last as f64) as u32;
         let slices = self.cascades[k as usize].slices;

@@ -1,11 +1,13 @@
 //! GL-free CPU light assignment: the cascaded cluster grid (`grid`) and its hot-path lookups
-//! (`depth_lookup`), 2D screen tiles (`tiles`), which cells one light touches (`cells`),
+//! (`depth_lookup`), 2D screen tiles (`tiles`), which cells one light touches (`cells`, with spot lights'
+//! cones in `cone`),
 //! per-frame light → cell assignment with a counting sort (`assign`), and the texel layouts
 //! the shaders read (`pack`). Nothing here touches GL, so all of it is unit-tested without a
 //! context.
 
 pub mod assign;
 pub mod cells;
+mod cone;
 mod depth_lookup;
 pub mod grid;
 pub mod pack;
