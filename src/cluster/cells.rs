@@ -201,17 +201,16 @@ impl ScreenExtent {
         // The plane through the eye at NDC `u` has the normal (1, −s) (in the axis and depth
         // coordinates) with `s = u · tan`; the centre's signed distance to it, positive on the
         // +u side, is `(center − s·d) / √(1 + s²)`. Compared with ±r squared, so no root.
-        let slope = |i: u32| -tan + i as f64 * step;
-        let within = |s: f64, a: f64| a * a <= r * r * (1.0 + s * s);
-        let above_low = |i: u32| {
-            let (s, a) = (slope(i), center - slope(i) * d);
-            a >= 0.0 || within(s, a)
+        // Per plane `i` (slope `s`): `a = centre − s·d` and whether |a| ≤ r·√(1 + s²).
+        let plane = |i: u32| {
+            let s = -tan + i as f64 * step;
+            let a = center - s * d;
+            (a, a * a <= r * r * (1.0 + s * s))
         };
-        let below_high = |i: u32| {
-            let (s, a) = (slope(i + 1), center - slope(i + 1) * d);
-            a <= 0.0 || within(s, a)
+        let touches = |i: u32| {
+            let ((low, low_within), (high, high_within)) = (plane(i), plane(i + 1));
+            (low >= 0.0 || low_within) && (high <= 0.0 || high_within)
         };
-        let touches = |i: u32| above_low(i) && below_high(i);
         while t0 < t1 && !touches(t0) {
             t0 += 1;
         }
