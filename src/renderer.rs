@@ -171,6 +171,13 @@ pub struct FrameStats {
     pub lp_num_threads: Option<String>,
     /// What the scene uses (and so what the shader variants were built with).
     pub scene_features: SceneFeatures,
+    /// Cell footprint in pixels of the grid the frame used (tiled, clustered).
+    pub grid_footprint_px: Option<f64>,
+    /// Cells of that grid (0 without one).
+    pub grid_cells: u32,
+    /// Why the grid is what it is: the automatic choice's prediction and costs, or the fixed
+    /// setting.
+    pub grid_reason: Option<String>,
 }
 
 /// Meshes and textures of scenes, uploaded once and found again by identity. The cache holds
@@ -477,6 +484,14 @@ impl Renderer {
             self.dev.finish();
         }
         self.dev.check("frame")?;
+        let frame_ms = start.elapsed().as_secs_f64() * 1e3;
+        // Only colour frames that waited for the GPU (or were timed on it) say what shading
+        // costs: count passes run other shaders.
+        if options.count == CountKind::None {
+            let waited = options.wait_for_gpu.then_some(frame_ms);
+            self.method.observe_frame(waited, gpu_ms);
+        }
+        let grid = method_stats.grid.clone();
         let caps = self.dev.caps();
         let assign = method_stats.assign.unwrap_or(AssignStats::default());
         Ok(FrameStats {
@@ -488,7 +503,7 @@ impl Renderer {
             height,
             lights: scene.lights.len(),
             active_lights: lights.len(),
-            frame_ms: start.elapsed().as_secs_f64() * 1e3,
+            frame_ms,
             gpu_ms,
             upload_bytes: method_stats.upload_bytes,
             assign_ms: method_stats.assign_ms.unwrap_or(0.0),
@@ -512,6 +527,9 @@ impl Renderer {
             auto_reason: method_stats.auto_choice.map(|(_, r)| r),
             lp_num_threads: std::env::var("LP_NUM_THREADS").ok(),
             scene_features,
+            grid_footprint_px: grid.as_ref().map(|g| g.footprint_px),
+            grid_cells: grid.as_ref().map_or(0, |g| g.cells),
+            grid_reason: grid.map(|g| g.reason),
         })
     }
 

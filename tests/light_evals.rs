@@ -186,3 +186,49 @@ fn deferred_proxies_skip_what_a_light_cannot_reach_and_need_no_full_screen_pass_
         }
     }
 }
+
+/// The per-slice, per-row coverage never makes a pixel evaluate more lights than the
+/// per-cascade rectangle of earlier versions with the same grid, and saves many evaluations
+/// overall (tiled and clustered, each fixed footprint).
+#[test]
+fn tight_coverage_never_evaluates_more_than_the_cascade_box() {
+    use manylight::cluster::grid::{Coverage, GridConfig};
+    let scene = scene::builtin::build("courtyard", Some((1024, 3))).unwrap();
+    let mut gpu = Gpu::new(EsVersion::Es3);
+    for (method, footprint) in [("clustered", 64.0), ("clustered", 16.0), ("tiled", 16.0)] {
+        gpu.r().set_method(method).unwrap();
+        let evals = |gpu: &mut Gpu, coverage| {
+            let mut options = RenderOptions::default();
+            options.grid = GridConfig::fixed(footprint);
+            options.grid.coverage = coverage;
+            options.tile_px = footprint;
+            gpu.r()
+                .render_light_counts(&scene, 256, 144, &options, CountKind::Evals)
+                .unwrap()
+                .0
+        };
+        let tight = evals(&mut gpu, Coverage::SliceRows);
+        let loose = evals(&mut gpu, Coverage::CascadeBox);
+        for (i, (&t, &l)) in tight.counts.iter().zip(&loose.counts).enumerate() {
+            assert!(t <= l, "{method} {footprint}: pixel {i}: {t} against {l}");
+        }
+        // At 256×144 a 64-pixel footprint leaves 4 × 3 tiles, and tiles span every depth:
+        // less to cut there.
+        let saved = match (method, footprint) {
+            ("clustered", f) if f < 64.0 => 0.85,
+            ("clustered", _) => 0.95,
+            _ => 0.99,
+        };
+        assert!(
+            (tight.total() as f64) < loose.total() as f64 * saved,
+            "{method} {footprint}: {} evaluations against {}",
+            tight.total(),
+            loose.total()
+        );
+        eprintln!(
+            "{method} {footprint}: {} evaluations against {}",
+            tight.total(),
+            loose.total()
+        );
+    }
+}

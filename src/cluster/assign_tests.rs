@@ -6,7 +6,7 @@ use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 
 use super::assign::{assign, AssignLimits, Assignment};
-use super::grid::{ClusterGrid, GridConfig, GridProjection};
+use super::grid::{ClusterGrid, Coverage, GridConfig, GridProjection};
 use super::pack::GpuLight;
 use crate::scene::Light;
 
@@ -520,4 +520,159 @@ fn split_cells_never_returns_empty_or_out_of_range_blocks() {
         }
         assert_eq!(next, offsets.len());
     }
+}
+
+/// Points just inside each light's reach, where a loose bound is most tempting to cut: on its
+/// sphere's surface in every direction and, for spots, on the cone's edge. Every grid mode,
+/// both coverages.
+#[test]
+fn never_misses_where_a_light_barely_reaches() {
+    let mut rng = Pcg64Mcg::seed_from_u64(99);
+    for case in cases() {
+        for coverage in [Coverage::SliceRows, Coverage::CascadeBox] {
+            let config = GridConfig {
+                coverage,
+                ..case.config.clone()
+            };
+            let grid = ClusterGrid::new(320, 180, case.projection, case.near, case.far, &config);
+            let lights = lights_in_view(&mut rng, &grid, 300);
+            let limits = AssignLimits {
+                cell_cap: u32::MAX,
+                ..Default::default()
+            };
+            let a = assign(&grid, &lights, case.far, &limits);
+            let mut points = Vec::new();
+            for l in &lights {
+                let c = l.position.as_dvec3();
+                let r = l.radius as f64 * (1.0 - 1e-7);
+                for _ in 0..40 {
+                    let u = random_unit(&mut rng);
+                    let dir = if l.spot_scale != 0.0 && rng.random_bool(0.5) {
+                        cone_edge(l, u)
+                    } else {
+                        u
+                    };
+                    let t = if rng.random_bool(0.5) {
+                        r
+                    } else {
+                        r * rng.random_range(0.0..1.0)
+                    };
+                    if let Some(p) = to_window(&grid, c + dir * t) {
+                        points.push(p);
+                    }
+                }
+            }
+            let checked = check_points(&grid, &lights, &a, &points, case.name);
+            assert!(checked > 1000, "{}: only {checked} pairs", case.name);
+        }
+    }
+}
+
+/// The per-slice, per-row bound only removes cells from the per-cascade rectangle, and removes
+/// many of them.
+#[test]
+fn slice_rows_are_a_subset_of_the_cascade_box() {
+    let mut rng = Pcg64Mcg::seed_from_u64(5);
+    let (mut tight_total, mut loose_total) = (0, 0);
+    for case in cases() {
+        let view = ClusterGrid::new(320, 180, case.projection, case.near, case.far, &case.config);
+        let lights = lights_in_view(&mut rng, &view, 400);
+        let limits = AssignLimits {
+            cell_cap: u32::MAX,
+            ..Default::default()
+        };
+        let build = |coverage| {
+            let config = GridConfig {
+                coverage,
+                ..case.config.clone()
+            };
+            let grid = ClusterGrid::new(320, 180, case.projection, case.near, case.far, &config);
+            assign(&grid, &lights, case.far, &limits)
+        };
+        let (tight, loose) = (build(Coverage::SliceRows), build(Coverage::CascadeBox));
+        for cell in 0..tight.counts.len() as u32 {
+            let loose_list = cell_lights(&loose, cell);
+            for light in cell_lights(&tight, cell) {
+                assert!(
+                    loose_list.contains(&light),
+                    "{}: light {light} in cell {cell} only with the tight bound",
+                    case.name
+                );
+            }
+        }
+        let (t, l) = (tight.indices.len(), loose.indices.len());
+        assert!(t < l, "{}: {t} indices against {l}", case.name);
+        tight_total += t;
+        loose_total += l;
+    }
+    assert!(
+        tight_total * 4 < loose_total * 3,
+        "{tight_total} indices against {loose_total}"
+    );
+}
+
+/// Lights around the view frustum (a little beyond its sides, some around the eye), with radii
+/// from a cell's size to much of the view: the random lights of [`random_lights`] moved so the
+/// narrow and deep frusta get as many as the others.
+fn lights_in_view(rng: &mut Pcg64Mcg, grid: &ClusterGrid, n: usize) -> Vec<GpuLight> {
+    let mut lights = random_lights(rng, n, 1.0);
+    let (near, far) = (
+        grid.near.max(grid.far * 1e-4),
+        grid.far.min(grid.near.max(1.0) * 1e3),
+    );
+    for l in &mut lights {
+        let d = (rng.random_range(near.ln()..far.ln())).exp();
+        let (hx, hy) = grid.projection.half_extent(d);
+        let p = DVec3::new(
+            rng.random_range(-1.2..1.2) * hx,
+            rng.random_range(-1.2..1.2) * hy,
+            -d,
+        );
+        let r = hy * rng.random_range(0.02..0.6);
+        l.position = p.as_vec3();
+        l.radius = r as f32;
+        l.cull_radius = r as f32;
+    }
+    lights
+}
+
+fn random_unit(rng: &mut Pcg64Mcg) -> DVec3 {
+    loop {
+        let v = DVec3::new(
+            rng.random_range(-1.0..1.0),
+            rng.random_range(-1.0..1.0),
+            rng.random_range(-1.0..1.0),
+        );
+        let n = v.length();
+        if n > 0.1 && n <= 1.0 {
+            return v / n;
+        }
+    }
+}
+
+/// A unit direction on a spot's cone edge (just inside), turned from its axis towards `u`.
+fn cone_edge(light: &GpuLight, u: DVec3) -> DVec3 {
+    let axis = light.direction.as_dvec3().normalize();
+    let side = (u - axis * u.dot(axis)).normalize_or(axis.any_orthonormal_vector());
+    let angle = (light.cone_deg.0 as f64).to_radians() * (1.0 - 1e-6);
+    axis * angle.cos() + side * angle.sin()
+}
+
+/// Window position (pixels, y up) and depth of a view-space point, if it is on screen and
+/// between the near and far planes.
+fn to_window(grid: &ClusterGrid, p: DVec3) -> Option<(f64, f64, f64)> {
+    let d = -p.z;
+    if !(d >= grid.near.max(1e-9) && d <= grid.far * 3.0) {
+        return None;
+    }
+    let (hx, hy) = grid.projection.half_extent(d);
+    let (nx, ny) = (p.x / hx, p.y / hy);
+    if nx.abs() >= 1.0 || ny.abs() >= 1.0 {
+        return None;
+    }
+    Some((
+        (nx + 1.0) * 0.5 * grid.width as f64,
+        (ny + 1.0) * 0.5 * grid.height as f64,
+        d,
+    ))
 }

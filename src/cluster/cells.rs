@@ -7,8 +7,12 @@
 //!    whose range misses the frustum touches nothing.
 //! 2. The clipped range gives the first and last (cascade, slice).
 //! 3. Per cascade, the sphere's screen extent (box projection over the cascade's depth slab,
-//!    tightened by the exact tangent bounds when the sphere is in front of the eye) gives a
-//!    column and row range, whose ends are then tested against the tile planes.
+//!    tightened by the exact tangent bounds when the sphere is in front of the eye) bounds the
+//!    columns and rows, whose ends are then tested against the tile planes. Inside that
+//!    rectangle, per slice, the sphere is cut to its largest cross-section over the slice's
+//!    depths (radius `ρ`), and per row of cells to that cross-section's chord where the row's
+//!    band comes nearest (half-width `√(ρ² − δ²)`): each row gets the columns that chord can
+//!    reach ([`Coverage::SliceRows`]). The rectangle alone is [`Coverage::CascadeBox`].
 //! 4. Spot lights start from the bounding sphere of their cone's reach instead of their whole
 //!    sphere, and each cell is then tested cone-vs-cell (against the cell's bounding sphere).
 //!
@@ -21,7 +25,7 @@
 
 use super::cone::Cone;
 use super::depth_lookup::CascadeConstants;
-use super::grid::{ClusterGrid, GridProjection};
+use super::grid::{ClusterGrid, Coverage, GridProjection};
 use super::pack::GpuLight;
 
 /// Relative padding of light radii (see the module docs).
@@ -62,35 +66,196 @@ pub fn for_each_run(
     } else {
         &[]
     };
+    let sphere = SlabSphere {
+        center: [c.x, c.y],
+        d,
+        r_sq: r * r,
+        perspective: extent.perspective,
+        dmin,
+        dmax,
+    };
     // Exclusive ranges in the loops below: inclusive ones cost a flag check per step.
     for k in k0..k1 + 1 {
         let cascade = &grid.cascades[k as usize];
         let constants = &grid.cascade_constants[k as usize];
         // The whole sphere's tangent bounds are exact on their own when the depth range
         // lies in one cascade (the common case); otherwise each cascade's slab tightens them.
+        // Every slice and row below stays inside these ranges, so the refinement can only
+        // remove cells.
         let slab = k0 != k1;
-        let Some((x0, x1)) = extent.tile_range(grid, constants, slab, 0, cascade.tiles_x) else {
+        let Some(columns) = extent.tile_range(grid, constants, slab, 0, cascade.tiles_x) else {
             continue;
         };
-        let Some((y0, y1)) = extent.tile_range(grid, constants, slab, 1, cascade.tiles_y) else {
+        let Some(rows) = extent.tile_range(grid, constants, slab, 1, cascade.tiles_y) else {
             continue;
         };
         let sa = if k == k0 { s0 } else { 0 };
         let sb = if k == k1 { s1 } else { cascade.slices - 1 };
-        let width = x1 - x0 + 1;
         let slice_cells = cascade.tiles_x * cascade.tiles_y;
-        let mut slice_start = cascade.first_cell + sa * slice_cells + y0 * cascade.tiles_x + x0;
-        for _ in sa..sb + 1 {
-            let mut run_start = slice_start;
-            for _ in y0..y1 + 1 {
-                match &cone {
-                    None => emit(run_start, width),
-                    Some(cone) => cone.emit_runs(spheres, run_start, width, emit),
+        let tiles = CascadeTiles {
+            grid,
+            constants,
+            tiles_x: cascade.tiles_x,
+            tiles_y: cascade.tiles_y,
+            columns,
+            rows,
+        };
+        let mut slice_start = cascade.first_cell + sa * slice_cells;
+        let mut emit_row = |slice_start: u32, row: u32, x0: u32, x1: u32| {
+            let start = slice_start + row * cascade.tiles_x + x0;
+            match &cone {
+                None => emit(start, x1 - x0 + 1),
+                Some(cone) => cone.emit_runs(spheres, start, x1 - x0 + 1, emit),
+            }
+        };
+        for s in sa..sb + 1 {
+            match grid.coverage {
+                Coverage::SliceRows => {
+                    let slab = grid.slice_slabs[(constants.first_slice + s) as usize];
+                    sphere.for_each_row_run(&tiles, slab, &mut |row, x0, x1| {
+                        emit_row(slice_start, row, x0, x1)
+                    });
                 }
-                run_start += cascade.tiles_x;
+                Coverage::CascadeBox => {
+                    for row in rows.0..rows.1 + 1 {
+                        emit_row(slice_start, row, columns.0, columns.1);
+                    }
+                }
             }
             slice_start += slice_cells;
         }
+    }
+}
+
+/// One cascade's tiling as the per-slice refinement sees it, with the column and row ranges
+/// the whole cascade's bound allows.
+struct CascadeTiles<'a> {
+    grid: &'a ClusterGrid,
+    constants: &'a CascadeConstants,
+    tiles_x: u32,
+    tiles_y: u32,
+    columns: (u32, u32),
+    rows: (u32, u32),
+}
+
+/// The sphere cells are tested against, for the per-slice, per-row refinement (Persson's
+/// "practical clustered", Bevy's assigner): inside a slice's depth slab the sphere is no wider
+/// than its largest cross-section there, and inside one row's band no wider than that
+/// cross-section's chord at the band's nearest point.
+struct SlabSphere {
+    /// View x, y of the centre.
+    center: [f64; 2],
+    /// View depth of the centre.
+    d: f64,
+    r_sq: f64,
+    perspective: bool,
+    /// The light's depth range clipped to the frustum.
+    dmin: f64,
+    dmax: f64,
+}
+
+impl SlabSphere {
+    /// Calls `emit(row, first_column, last_column)` for every row of the cascade whose cells
+    /// in the depth slab `[z0, z1]` the sphere may reach, with the columns it may reach there.
+    ///
+    /// In the slab (clipped to the sphere's depth range, `za ≤ z ≤ zb`) the sphere's points
+    /// lie within `ρ` of its axis, `ρ` the radius of its cross-section at the depth of the
+    /// slab nearest the centre. A row is the band of view `y` between `t0·z` and `t1·z`
+    /// (perspective; `t0` and `t1` in orthographic); over the slab the band comes no closer to
+    /// the centre than `δ`, a lower bound of the distance taken over the slab's two ends, so
+    /// inside the row the sphere's points lie within `√(ρ² − δ²)` of the centre in `x`. Each
+    /// extent becomes a tile range by the box projection over `[za, zb]`.
+    #[inline(always)]
+    fn for_each_row_run(
+        &self,
+        tiles: &CascadeTiles,
+        [z0, z1]: [f64; 2],
+        emit: &mut impl FnMut(u32, u32, u32),
+    ) {
+        // Kept above 0 so a perspective slab at the eye gives huge slopes rather than
+        // `0 · ∞ = NaN`.
+        let za = z0.max(self.dmin).max(f64::MIN_POSITIVE);
+        // Never below `za`: the slice came from the widened depth range, so the slab meets it
+        // up to rounding.
+        let zb = z1.min(self.dmax).max(za);
+        let nearest = self.d.clamp(za, zb) - self.d;
+        let rho_sq = (self.r_sq - nearest * nearest).max(0.0);
+        let rho = rho_sq.sqrt();
+        let (inv_a, inv_b) = (1.0 / za, 1.0 / zb);
+        let constants = tiles.constants;
+        let [cx, cy] = self.center;
+        let Some((y0, y1)) = self.tiles_of(tiles, 1, cy - rho, cy + rho, inv_a, inv_b) else {
+            return;
+        };
+        let (y0, y1) = (y0.max(tiles.rows.0), y1.min(tiles.rows.1));
+        if y0 > y1 {
+            return;
+        }
+        let step = constants.tile_step[1];
+        let origin = -0.5 * step * tiles.tiles_y as f64;
+        for row in y0..y1 + 1 {
+            let t0 = origin + row as f64 * step;
+            let t1 = t0 + step;
+            // The band's nearest approach to the centre over the slab (a lower bound).
+            let gap = if self.perspective {
+                let below = (t0 * za).min(t0 * zb) - cy;
+                let above = cy - (t1 * za).max(t1 * zb);
+                below.max(above)
+            } else {
+                (t0 - cy).max(cy - t1)
+            };
+            let half_sq = if gap > 0.0 {
+                rho_sq - gap * gap
+            } else {
+                rho_sq
+            };
+            if half_sq < 0.0 {
+                continue;
+            }
+            let half = half_sq.sqrt();
+            if let Some((x0, x1)) = self.tiles_of(tiles, 0, cx - half, cx + half, inv_a, inv_b) {
+                let (x0, x1) = (x0.max(tiles.columns.0), x1.min(tiles.columns.1));
+                if x0 <= x1 {
+                    emit(row, x0, x1);
+                }
+            }
+        }
+    }
+
+    /// Tile range along `axis` of the view-space extent `[low, high]` over the depths with
+    /// reciprocals `inv_a` ≥ `inv_b` (box projection), or `None` when it misses the screen.
+    #[inline(always)]
+    fn tiles_of(
+        &self,
+        tiles: &CascadeTiles,
+        axis: usize,
+        low: f64,
+        high: f64,
+        inv_a: f64,
+        inv_b: f64,
+    ) -> Option<(u32, u32)> {
+        let scale = tiles.grid.ndc_scale[axis];
+        let (lo, hi) = if self.perspective {
+            (
+                (low * inv_a).min(low * inv_b) * scale,
+                (high * inv_a).max(high * inv_b) * scale,
+            )
+        } else {
+            (low * scale, high * scale)
+        };
+        // Also false for NaN.
+        if !(lo <= hi && hi >= -1.0 && lo <= 1.0) {
+            return None;
+        }
+        let half = tiles.constants.half_tiles[axis];
+        let count = if axis == 0 {
+            tiles.tiles_x
+        } else {
+            tiles.tiles_y
+        };
+        // `as u32` saturates: negative coordinates give tile 0.
+        let to_tile = |ndc: f64| (((ndc + 1.0) * half) as u32).min(count - 1);
+        Some((to_tile(lo), to_tile(hi)))
     }
 }
 

@@ -96,23 +96,39 @@ pub(crate) struct CascadeConstants {
     pub inv_far: f64,
     /// Half the columns and half the rows: tile coordinate `(ndc + 1) · half`.
     pub half_tiles: [f64; 2],
+    /// Width of one column and height of one row in view-space slope (perspective) or view
+    /// units (orthographic): `2 / (tiles · ndc_scale)`.
+    pub tile_step: [f64; 2],
+    /// Index of the cascade's first slice among all the grid's slices (for
+    /// `ClusterGrid::slice_slabs`).
+    pub first_slice: u32,
 }
 
 impl CascadeConstants {
     /// The constants of every cascade of `grid`.
     pub(crate) fn of(grid: &ClusterGrid) -> Vec<CascadeConstants> {
         let last = grid.cascades.len() - 1;
+        let mut first_slice = 0;
         grid.cascades
             .iter()
             .enumerate()
-            .map(|(k, c)| CascadeConstants {
-                inv_near: if k == 0 {
-                    f64::INFINITY
-                } else {
-                    1.0 / c.z_near
-                },
-                inv_far: if k == last { 0.0 } else { 1.0 / c.z_far },
-                half_tiles: [0.5 * c.tiles_x as f64, 0.5 * c.tiles_y as f64],
+            .map(|(k, c)| {
+                let constants = CascadeConstants {
+                    inv_near: if k == 0 {
+                        f64::INFINITY
+                    } else {
+                        1.0 / c.z_near
+                    },
+                    inv_far: if k == last { 0.0 } else { 1.0 / c.z_far },
+                    half_tiles: [0.5 * c.tiles_x as f64, 0.5 * c.tiles_y as f64],
+                    tile_step: [
+                        2.0 / (c.tiles_x as f64 * grid.ndc_scale[0]),
+                        2.0 / (c.tiles_y as f64 * grid.ndc_scale[1]),
+                    ],
+                    first_slice,
+                };
+                first_slice += c.slices;
+                constants
             })
             .collect()
     }

@@ -31,43 +31,102 @@ use glam::DMat4;
 
 use super::depth_lookup::{CascadeConstants, SliceLookup};
 
+/// Relative widening of depth ranges against slice boundaries: far more than the CPU table's
+/// rounding at a boundary and than the shader's `f32` evaluation of the mapping (10⁻⁵ in log2
+/// units).
+pub(crate) const SLICE_WIDEN: f64 = 7e-6;
+
 /// Tunables of the grid.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct GridConfig {
+    /// Whether the clustered method picks the footprint itself every so often
+    /// ([`GridMode::Auto`], the default) or always uses `footprint_px`. [`ClusterGrid::new`]
+    /// always builds `footprint_px`: the choice is the method's (see [`super::auto`]).
+    pub mode: GridMode,
     /// Number of depth cascades (Billeter uses 12).
     pub cascades: u32,
-    /// Target cell footprint in pixels (cells are about this wide and as deep as wide).
+    /// Target cell footprint in pixels (cells are about this wide and as deep as wide): the
+    /// fixed mode's, and where the automatic mode starts.
     pub footprint_px: f64,
-    /// Minimum cell width in world units at a cascade's near end; `None` = 1/64 of the depth
-    /// range the grid spans.
+    /// Where the first cascade starts (perspective: depths nearer than it share the first
+    /// slice); `None`: at the near plane, or 1/4096 of the far end for a tiny near plane. The
+    /// automatic mode sets it a little before the nearest surface, so no slice is spent on the
+    /// empty space in front of the camera.
+    pub first_split: Option<f64>,
+    /// Minimum cell width in world units at a cascade's near end; `None`: no minimum, every
+    /// cascade has cells of `footprint_px` (the grid starts at the first geometry, see
+    /// [`GridConfig::first_split`], so near cascades are not wasted on empty space).
     pub min_cell_size: Option<f64>,
     /// Upper bound on slices per cascade.
     pub max_slices: u32,
     /// Upper bound on columns or rows of a cascade.
     pub max_tiles: u32,
+    /// How tightly a light's cells are found (the default is the tight one; the other is kept
+    /// to measure what it saves).
+    pub coverage: Coverage,
+}
+
+/// Who picks the cell footprint.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum GridMode {
+    /// The clustered method measures candidate footprints against a cost model calibrated on
+    /// the device and switches with hysteresis (see [`super::auto`]).
+    #[default]
+    Auto,
+    /// Always `footprint_px` (tests, and users who want one grid).
+    Fixed,
+}
+
+/// How the assignment bounds the cells a light's sphere reaches.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Coverage {
+    /// Per slice, the sphere's cross-section over the slice's depths, and per row of cells the
+    /// columns that cross-section reaches inside the row.
+    #[default]
+    SliceRows,
+    /// One screen rectangle per cascade, every slice and row of it (earlier versions): kept
+    /// as a yardstick for the bench and the tests.
+    CascadeBox,
 }
 
 impl Default for GridConfig {
     fn default() -> Self {
         GridConfig {
+            mode: GridMode::Auto,
             cascades: 12,
             footprint_px: 64.0,
+            first_split: None,
             min_cell_size: None,
             max_slices: 32,
             max_tiles: 256,
+            coverage: Coverage::default(),
         }
     }
 }
 
 impl GridConfig {
+    /// A fixed grid of `footprint_px` with the other settings at their defaults.
+    pub fn fixed(footprint_px: f64) -> Self {
+        GridConfig {
+            mode: GridMode::Fixed,
+            footprint_px,
+            ..GridConfig::default()
+        }
+    }
+
     /// A 2D tiling for tiled forward: one cascade, one slice, square tiles of `tile_px`.
     pub fn tiles(tile_px: f64) -> Self {
         GridConfig {
+            mode: GridMode::Fixed,
             cascades: 1,
             footprint_px: tile_px,
+            first_split: None,
             min_cell_size: Some(0.0),
             max_slices: 1,
             max_tiles: 1024,
+            coverage: Coverage::default(),
         }
     }
 }
@@ -186,6 +245,8 @@ pub struct ClusterGrid {
     pub cascades: Vec<Cascade>,
     /// Total cells.
     pub total_cells: u32,
+    /// How the assignment bounds a light's cells.
+    pub coverage: Coverage,
     /// NDC per unit of view-space slope (perspective: `1 / tan`) or of view-space offset
     /// (orthographic: `1 / half extent`), for x and y: multiplied instead of divided by in the
     /// assignment's hot path.
@@ -197,6 +258,10 @@ pub struct ClusterGrid {
     slice_lookup: SliceLookup,
     /// Per cascade: constants of the assignment's box projection and tile conversion.
     pub(crate) cascade_constants: Vec<CascadeConstants>,
+    /// Per slice (numbered across cascades): the view depths `[z0, z1]` a fragment the shader
+    /// puts in that slice can have, the slice's bounds widened by [`SLICE_WIDEN`] for the
+    /// shader's `f32` evaluation of the mapping (see [`ClusterGrid::depth_range_to_slices`]).
+    pub(crate) slice_slabs: Vec<[f64; 2]>,
     /// Perspective: `1 / √(1 + tan²)` for x and y, the length of the side planes' normals
     /// `(1, 0, tan)` taken out (see [`ClusterGrid::sphere_outside_sides`]).
     side_plane_norm: [f64; 2],
@@ -223,15 +288,27 @@ impl ClusterGrid {
             near + 1.0
         };
         let c = config.cascades.max(1);
-        let min_cell = config.min_cell_size.unwrap_or((far - near) / 64.0).max(0.0);
+        let min_cell = config.min_cell_size.unwrap_or(0.0).max(0.0);
         let (mapping, d0) = match projection {
             // The first split is moved back from a tiny near plane (Olsson's remedy) but
             // never past 1/4096 of the far end: a 1e-4 near plane does not make 12 cascades
             // of microscopic cells.
-            GridProjection::Perspective { .. } => {
-                (DepthMapping::Log2, near.max(far / 4096.0).min(far * 0.5))
-            }
-            GridProjection::Orthographic { .. } => (DepthMapping::Linear, near),
+            GridProjection::Perspective { .. } => (
+                DepthMapping::Log2,
+                config
+                    .first_split
+                    .filter(|d| d.is_finite())
+                    .unwrap_or(far / 4096.0)
+                    .max(near)
+                    .min(far * 0.5),
+            ),
+            GridProjection::Orthographic { .. } => (
+                DepthMapping::Linear,
+                config
+                    .first_split
+                    .filter(|d| d.is_finite())
+                    .map_or(near, |d| d.max(near).min(near + (far - near) * 0.5)),
+            ),
         };
         let (fa, ff) = match mapping {
             DepthMapping::Log2 => (d0.log2(), far.log2()),
@@ -291,6 +368,7 @@ impl ClusterGrid {
             b,
             cascades,
             total_cells: first_cell,
+            coverage: config.coverage,
             ndc_scale: match projection {
                 GridProjection::Perspective { tan_x, tan_y } => [1.0 / tan_x, 1.0 / tan_y],
                 GridProjection::Orthographic { half_x, half_y } => [1.0 / half_x, 1.0 / half_y],
@@ -304,12 +382,29 @@ impl ClusterGrid {
             },
             slice_lookup: SliceLookup::default(),
             cascade_constants: Vec::new(),
+            slice_slabs: Vec::new(),
         };
         if mapping == DepthMapping::Log2 {
             grid.slice_lookup = SliceLookup::new(&grid);
         }
         grid.cascade_constants = CascadeConstants::of(&grid);
+        grid.slice_slabs = grid.build_slice_slabs();
         grid
+    }
+
+    fn build_slice_slabs(&self) -> Vec<[f64; 2]> {
+        let mut slabs = Vec::new();
+        for (k, c) in self.cascades.iter().enumerate() {
+            for s in 0..c.slices {
+                let (z0, z1) = self.slice_depth_range(k as u32, s);
+                let first = k == 0 && s == 0;
+                slabs.push([
+                    if first { 0.0 } else { z0 * (1.0 - SLICE_WIDEN) },
+                    z1 * (1.0 + SLICE_WIDEN),
+                ]);
+            }
+        }
+        slabs
     }
 
     /// True when the view-space sphere (`center`, `radius`) lies wholly outside one of the
@@ -405,13 +500,10 @@ impl ClusterGrid {
                 self.view_z_to_cascade_slice(dmin),
                 self.view_z_to_cascade_slice(dmax),
             ),
-            DepthMapping::Log2 => {
-                const WIDEN: f64 = 7e-6;
-                (
-                    self.slice_lookup.find(dmin * (1.0 - WIDEN)),
-                    self.slice_lookup.find(dmax * (1.0 + WIDEN)),
-                )
-            }
+            DepthMapping::Log2 => (
+                self.slice_lookup.find(dmin * (1.0 - SLICE_WIDEN)),
+                self.slice_lookup.find(dmax * (1.0 + SLICE_WIDEN)),
+            ),
         }
     }
 
@@ -600,8 +692,28 @@ mod tests {
                 );
             }
         }
-        // The minimum cell size keeps near cascades coarse.
-        assert!(g.cascades[0].tiles_y < g.cascades[11].tiles_y || g.cascades[0].tiles_y == 1);
+        // Without a minimum cell size every cascade has the footprint's tiles; with one, the
+        // near cascades are coarser.
+        assert!(g
+            .cascades
+            .iter()
+            .all(|c| c.tiles_y == g.cascades[0].tiles_y));
+        let t = (30f64).to_radians().tan();
+        let coarse = ClusterGrid::new(
+            1280,
+            720,
+            GridProjection::Perspective {
+                tan_x: t * 16.0 / 9.0,
+                tan_y: t,
+            },
+            0.1,
+            80.0,
+            &GridConfig {
+                min_cell_size: Some(80.0 / 64.0),
+                ..GridConfig::default()
+            },
+        );
+        assert!(coarse.cascades[0].tiles_y < coarse.cascades[11].tiles_y);
     }
 
     #[test]

@@ -6,6 +6,7 @@
 //! context.
 
 pub mod assign;
+pub mod auto;
 pub mod cells;
 mod cone;
 mod depth_lookup;

@@ -71,6 +71,12 @@ impl ShadingMethod for Auto {
         Ok(stats)
     }
 
+    fn observe_frame(&mut self, frame_ms: Option<f64>, gpu_ms: Option<f64>) {
+        if let Some(c) = &mut self.clustered {
+            c.observe_frame(frame_ms, gpu_ms);
+        }
+    }
+
     fn gpu_bytes(&self) -> usize {
         self.forward.gpu_bytes() + self.clustered.as_ref().map_or(0, CulledForward::gpu_bytes)
     }

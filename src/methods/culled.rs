@@ -9,9 +9,12 @@
 use std::time::Instant;
 
 use super::geometry::{self, UNIT_METHOD};
+use super::grid_choice::{self, AutoGrid};
+use super::GridReport;
 use super::{FrameContext, MethodStats, ShadingMethod};
 use crate::cluster::assign::{AssignLimits, Assigner};
-use crate::cluster::grid::{ClusterGrid, GridConfig, GridProjection};
+use crate::cluster::auto::FrameCost;
+use crate::cluster::grid::{ClusterGrid, GridConfig, GridMode, GridProjection};
 use crate::cluster::pack::{pack_lights, GpuLight, LightEncoding, DATA_TEXTURE_WIDTH};
 use crate::cluster::pack_grid::{
     pack_grid, pack_indices, GridEncoding, MAX_INDEXED_LIGHTS, RGBA8_CELL_CAP, RGBA8_OFFSET_LIMIT,
@@ -76,6 +79,10 @@ pub struct CulledForward {
     grid: Option<(GridKey, ClusterGrid)>,
     /// Assignment buffers, reused frame after frame.
     assigner: Assigner,
+    /// The automatic grid's choice and calibration (clustered, [`GridMode::Auto`]).
+    auto: AutoGrid,
+    /// Why the current grid is what it is.
+    grid_reason: String,
 }
 
 /// What the grid depends on; it is rebuilt only when this changes.
@@ -97,15 +104,33 @@ impl CulledForward {
             frame: 0,
             grid: None,
             assigner: Assigner::new(),
+            auto: AutoGrid::default(),
+            grid_reason: String::new(),
         }
     }
 
-    /// Rebuilds the grid when the viewport, projection or grid settings changed.
-    fn update_grid(&mut self, ctx: &FrameContext) {
+    /// Rebuilds the grid when the viewport, projection or grid settings changed (the
+    /// automatic grid's included).
+    fn update_grid(&mut self, ctx: &FrameContext, limits: &AssignLimits, bytes: (usize, usize)) {
         let projection = GridProjection::from_matrix(&ctx.projection.as_dmat4());
         let config = match self.culling {
-            Culling::Clustered => ctx.options.grid.clone(),
-            Culling::Tiled => GridConfig::tiles(ctx.options.tile_px),
+            Culling::Clustered if ctx.options.grid.mode == GridMode::Auto => {
+                let choice = self.auto.config(ctx, projection, limits, bytes);
+                self.grid_reason.clone_from(&choice.reason);
+                choice.config.clone()
+            }
+            Culling::Clustered => {
+                self.grid_reason = grid_choice::fixed_reason(&ctx.options.grid);
+                ctx.options.grid.clone()
+            }
+            // Tiled shares the clustered grid's coverage setting (to measure it).
+            Culling::Tiled => {
+                self.grid_reason = format!("tiled: tile_px = {}", ctx.options.tile_px);
+                GridConfig {
+                    coverage: ctx.options.grid.coverage,
+                    ..GridConfig::tiles(ctx.options.tile_px)
+                }
+            }
         };
         let proj_bits = match projection {
             GridProjection::Perspective { tan_x, tan_y } => {
@@ -163,8 +188,12 @@ impl ShadingMethod for CulledForward {
         };
         let camera_far = ctx.far;
         let lights = ctx.lights;
-        self.update_grid(ctx);
-        let grid = &self.grid.as_ref().expect("updated above").1;
+        let bytes = match es {
+            EsVersion::Es2 => (4, 2),
+            EsVersion::Es3 => (8, 2),
+        };
+        self.update_grid(ctx, &limits, bytes);
+        let (grid_key, grid) = self.grid.as_ref().expect("updated above");
         let started = Instant::now();
         let assignment = self.assigner.assign(grid, lights, camera_far, &limits);
         let assign_ms = started.elapsed().as_secs_f64() * 1e3;
@@ -174,6 +203,7 @@ impl ShadingMethod for CulledForward {
                 assignment.visible.len()
             )));
         }
+        let upload_started = Instant::now();
         let visible: Vec<GpuLight> = assignment
             .visible
             .iter()
@@ -218,6 +248,21 @@ impl ShadingMethod for CulledForward {
         )?;
         let upload_bytes =
             packed_lights.bytes.len() + packed_grid.bytes.len() + packed_indices.bytes.len();
+        let upload_ms = upload_started.elapsed().as_secs_f64() * 1e3;
+        if self.culling == Culling::Clustered && ctx.options.grid.mode == GridMode::Auto {
+            let work = (assignment.indices.len() + grid.total_cells as usize) as f64;
+            self.auto.record(
+                grid,
+                &assignment.counts,
+                FrameCost {
+                    assign_ms,
+                    assign_work: work,
+                    upload_ms,
+                    upload_bytes: upload_bytes as f64,
+                    ..FrameCost::default()
+                },
+            );
+        }
 
         let set = &*set;
         let inv = |t: &DataTexture| 1.0 / t.size().1.max(1) as f32;
@@ -253,8 +298,17 @@ impl ShadingMethod for CulledForward {
             upload_bytes,
             assign_ms: Some(assign_ms),
             assign: Some(assignment.stats),
+            grid: Some(GridReport {
+                footprint_px: grid_key.config.footprint_px,
+                cells: grid.total_cells,
+                reason: self.grid_reason.clone(),
+            }),
             ..MethodStats::default()
         })
+    }
+
+    fn observe_frame(&mut self, frame_ms: Option<f64>, gpu_ms: Option<f64>) {
+        self.auto.observe(frame_ms, gpu_ms);
     }
 
     fn light_lists(&self) -> Option<super::LightLists<'_>> {

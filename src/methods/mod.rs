@@ -11,6 +11,7 @@ pub mod deferred;
 pub mod features;
 pub mod forward;
 pub mod geometry;
+mod grid_choice;
 pub mod tiled;
 
 use crate::cluster::pack::GpuLight;
@@ -67,6 +68,17 @@ pub struct FrameContext<'a> {
     pub options: &'a RenderOptions,
 }
 
+/// Which grid a tiled or clustered frame used, and why.
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
+pub struct GridReport {
+    /// Cell footprint in pixels.
+    pub footprint_px: f64,
+    /// Cells of the grid.
+    pub cells: u32,
+    /// Why: the automatic choice's prediction, or the fixed setting.
+    pub reason: String,
+}
+
 /// What a method reports about its frame.
 #[derive(Clone, Debug, Default)]
 pub struct MethodStats {
@@ -78,6 +90,8 @@ pub struct MethodStats {
     pub assign: Option<crate::cluster::assign::AssignStats>,
     /// G-buffer memory (deferred).
     pub gbuffer_bytes: usize,
+    /// The grid the frame used (tiled, clustered).
+    pub grid: Option<GridReport>,
     /// What `auto` picked, and why.
     pub auto_choice: Option<(&'static str, String)>,
 }
@@ -100,6 +114,10 @@ pub trait ShadingMethod {
     fn light_lists(&self) -> Option<LightLists<'_>> {
         None
     }
+    /// The whole frame's time after it finished (`frame_ms`: wall time including the GPU's
+    /// work, only when the frame waited for it; `gpu_ms` from a timer query): methods that
+    /// calibrate a cost model take it in.
+    fn observe_frame(&mut self, _frame_ms: Option<f64>, _gpu_ms: Option<f64>) {}
     /// Frees the method's GPU resources.
     fn destroy(&mut self, dev: &Device);
 }

@@ -66,6 +66,12 @@ pub struct BenchRow {
     pub cpu_samples: usize,
     /// Light references dropped by the overflow policy.
     pub overflowed_lights: u64,
+    /// Cell footprint of the grid the frame used (tiled, clustered).
+    pub grid_footprint_px: Option<f64>,
+    /// Cells of that grid (0 without one).
+    pub grid_cells: u32,
+    /// Why the grid is what it is (the automatic choice's prediction, or the fixed setting).
+    pub grid_reason: Option<String>,
     /// `GL_RENDERER`.
     pub renderer: String,
     /// `LP_NUM_THREADS`, when set.
@@ -262,21 +268,52 @@ pub fn markdown(report: &Report) -> String {
     let knobs: Vec<&BenchRow> = rows.iter().filter(|r| r.knob != "default").collect();
     if !knobs.is_empty() {
         s += "## Knobs that trade error for time\n\n\
-              | scene | ES | method | lights | knob | frame ms | evals/px | RMSE | max |\n\
-              |---|---|---|---|---|---|---|---|---|\n";
-        for r in knobs {
+              Each knob changes one setting from the defaults; `footprint_px` rows are fixed \
+              grids, to compare with the automatic grid of the default clustered rows (shown \
+              again here as `auto`).\n\n\
+              | scene | ES | method | lights | knob | grid px | cells | frame ms | assign ms | evals/px | × bound | RMSE | max |\n\
+              |---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+        let auto_rows = rows
+            .iter()
+            .filter(|r| r.knob == "default" && r.method == "clustered")
+            .filter(|r| {
+                knobs
+                    .iter()
+                    .any(|k| k.scene == r.scene && k.es == r.es && k.lights == r.lights)
+            });
+        for r in auto_rows.chain(knobs.iter().copied()) {
+            let knob = if r.knob == "default" { "auto" } else { &r.knob };
+            let opt =
+                |v: Option<f64>, digits: usize| v.map_or("—".into(), |v| format!("{v:.digits$}"));
             let _ = writeln!(
                 s,
-                "| {} | {} | {} | {} | {} | {:.1} | {:.1} | {:.3} | {} |",
+                "| {} | {} | {} | {} | {} | {} | {} | {:.1} | {:.2} | {:.1} | {} | {:.3} | {} |",
                 r.scene,
                 r.es,
                 r.method,
                 r.lights,
-                r.knob,
+                knob,
+                opt(r.grid_footprint_px, 0),
+                r.grid_cells,
                 r.frame_ms,
+                r.assign_ms,
                 r.evals_per_pixel,
+                opt(r.evals_ratio, 2),
                 r.rmse,
                 r.max_abs_err
+            );
+        }
+        s += "\n";
+        let reasons = rows
+            .iter()
+            .filter(|r| r.knob == "default" && r.method == "clustered")
+            .filter_map(|r| Some((r, r.grid_reason.as_deref()?)));
+        s += "## Why the automatic grid is what it is\n\n";
+        for (r, reason) in reasons {
+            let _ = writeln!(
+                s,
+                "- {}, ES {}, {} lights: {reason}",
+                r.scene, r.es, r.lights
             );
         }
         s += "\n";

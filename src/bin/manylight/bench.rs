@@ -12,6 +12,7 @@ use std::time::Instant;
 
 use clap::Parser;
 use indicatif::{ProgressBar, ProgressStyle};
+use manylight::cluster::grid::{Coverage, GridConfig};
 use manylight::gl::HeadlessContext;
 use manylight::methods::{Support, METHODS};
 use manylight::metrics::cpu_reference::{self, Encoding, ReferenceSet};
@@ -136,6 +137,8 @@ struct Knob {
     method: &'static str,
     apply: fn(&mut RenderOptions, f64),
     value: f64,
+    /// Run on every scene of the plan (the grid knobs), not only the first.
+    every_scene: bool,
 }
 
 fn knobs(quick: bool) -> Vec<Knob> {
@@ -147,6 +150,7 @@ fn knobs(quick: bool) -> Vec<Knob> {
                 method,
                 apply,
                 value,
+                every_scene: name == "footprint_px" || name == "coverage",
             });
         }
     };
@@ -169,11 +173,19 @@ fn knobs(quick: bool) -> Vec<Knob> {
         |o, v| o.cell_cap = Some(v as u32),
         pick(&[64.0, 16.0], &[16.0]),
     );
+    // Fixed grids against the automatic one (the default rows), on every scene.
     add(
         "footprint_px",
         "clustered",
-        |o, v| o.grid.footprint_px = v,
-        pick(&[32.0, 128.0], &[32.0]),
+        |o, v| o.grid = GridConfig::fixed(v),
+        pick(&[8.0, 16.0, 32.0, 64.0], &[16.0, 64.0]),
+    );
+    // The per-cascade rectangle of earlier versions (1 = cascade box), automatic grid.
+    add(
+        "coverage",
+        "clustered",
+        |o, _| o.grid.coverage = Coverage::CascadeBox,
+        pick(&[1.0], &[]),
     );
     add(
         "cascades",
@@ -214,8 +226,12 @@ pub fn run(args: &BenchArgs) -> Result<(), Box<dyn std::error::Error>> {
         .min_by_key(|&n| (n as i64 - 1024).abs())
         .unwrap_or(0);
     let knob_scene = plan.scenes.first().cloned().unwrap_or_default();
+    let knob_runs: usize = knob_list
+        .iter()
+        .map(|k| if k.every_scene { plan.scenes.len() } else { 1 })
+        .sum();
     let steps = plan.es.len() * plan.scenes.len() * plan.lights.len() * plan.methods.len()
-        + plan.es.len() * knob_list.len();
+        + plan.es.len() * knob_runs;
     let progress = ProgressBar::new(steps as u64).with_style(
         ProgressStyle::with_template("{bar:40} {pos}/{len} {elapsed_precise} {msg}")
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
@@ -244,6 +260,7 @@ pub fn run(args: &BenchArgs) -> Result<(), Box<dyn std::error::Error>> {
                     frames: plan.frames,
                 };
                 let knob_workload = spec == &knob_scene && count == knob_lights;
+                let grid_workload = count == knob_lights;
                 let mut pictured = Vec::new();
                 for method in &plan.methods {
                     progress.set_message(format!("ES {es} {name} {count} lights: {method}"));
@@ -255,8 +272,9 @@ pub fn run(args: &BenchArgs) -> Result<(), Box<dyn std::error::Error>> {
                     }
                     progress.inc(1);
                 }
-                if knob_workload {
-                    for knob in &knob_list {
+                if grid_workload {
+                    let here = knob_list.iter().filter(|k| k.every_scene || knob_workload);
+                    for knob in here {
                         progress.set_message(format!("ES {es} {name}: {}", knob.name));
                         let m = measure.run(&mut renderer, knob.method, &knob.name, |o| {
                             (knob.apply)(o, knob.value)
@@ -264,6 +282,8 @@ pub fn run(args: &BenchArgs) -> Result<(), Box<dyn std::error::Error>> {
                         rows.extend(m.map(|m| m.row));
                         progress.inc(1);
                     }
+                }
+                if knob_workload {
                     write_pictures(&pictured, &base, es, &args.out)?;
                 }
             }
@@ -393,6 +413,9 @@ impl Measure<'_> {
             cpu_max_abs_err: (cpu.samples > 0).then_some(cpu.max_abs),
             cpu_samples: cpu.samples,
             overflowed_lights: stats.overflowed_lights,
+            grid_footprint_px: stats.grid_footprint_px,
+            grid_cells: stats.grid_cells,
+            grid_reason: stats.grid_reason.clone(),
             renderer: stats.renderer.clone(),
             lp_num_threads: stats.lp_num_threads.clone(),
         };

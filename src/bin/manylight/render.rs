@@ -50,6 +50,32 @@ pub struct RenderArgs {
     /// unsupported there.
     #[arg(long)]
     pub no_fragment_highp: bool,
+    /// Cell footprint of the clustered grid in pixels, or `auto` (chosen per frame from a
+    /// cost model calibrated on this device; `--stats` says which and why).
+    #[arg(long, default_value = "auto", value_parser = parse_grid)]
+    pub grid: GridArg,
+}
+
+/// `--grid`: `auto` or a footprint in pixels.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum GridArg {
+    /// The automatic grid.
+    Auto,
+    /// A fixed footprint.
+    Fixed(f64),
+}
+
+/// Parses `--grid`.
+pub fn parse_grid(s: &str) -> Result<GridArg, String> {
+    if s == "auto" {
+        return Ok(GridArg::Auto);
+    }
+    match s.parse::<f64>() {
+        Ok(px) if px.is_finite() && (1.0..=4096.0).contains(&px) => Ok(GridArg::Fixed(px)),
+        _ => Err(format!(
+            "`{s}` is neither `auto` nor a footprint from 1 to 4096 pixels"
+        )),
+    }
 }
 
 /// Random lights for built-ins and OBJ files when `--lights` is not given.
@@ -92,6 +118,10 @@ pub fn run(args: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
     let options = RenderOptions {
         linear: args.linear,
         timed_frames: args.frames,
+        grid: match args.grid {
+            GridArg::Auto => manylight::cluster::grid::GridConfig::default(),
+            GridArg::Fixed(px) => manylight::cluster::grid::GridConfig::fixed(px),
+        },
         ..RenderOptions::default()
     };
     let (width, height) = args.size;

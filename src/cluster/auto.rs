@@ -1,0 +1,558 @@
+//! The automatic grid: which cell footprint a frame should use, chosen by a cost model over
+//! measured candidates.
+//!
+//! A finer grid makes every fragment loop over fewer lights but costs more assignment (more
+//! light·cell pairs and cells to count) and more bytes to upload; the best footprint depends on
+//! the resolution, the lights, the view and the device. So the choice is made by measuring, not
+//! by a constant:
+//!
+//! ```text
+//! predicted frame cost(f) = shade · E(f) · P  +  assign · (indices(f) + cells(f))  +  upload · bytes(f)
+//! ```
+//!
+//! * `E(f)`: light evaluations per covered pixel, counted exactly at [`SurfaceSamples`] (the
+//!   surfaces a coarse ray cast of the frame found) in the candidate's real light lists;
+//!   `P` the covered pixels.
+//! * `indices(f)`, `cells(f)`, `bytes(f)`: from the candidate's real assignment.
+//! * `shade`, `assign`, `upload`: [`GridCosts`], nanoseconds per unit, calibrated on the running
+//!   device from the frames it renders ([`GridCosts::observe`]): starting from priors measured
+//!   on llvmpipe.
+//!
+//! Candidates run from coarse to fine (`64 / √2ⁿ` pixels, down to 8) and stop once the
+//! prediction has risen twice in a row or a grid would pass the cell budget. The choice is
+//! deterministic for given samples, lights and costs. A new choice replaces the current grid
+//! only when it is predicted at least [`HYSTERESIS`] cheaper, so a static scene never
+//! flip-flops between two near-equal grids.
+
+use super::assign::{AssignLimits, Assigner};
+use super::grid::{ClusterGrid, GridConfig, GridProjection};
+use super::pack::GpuLight;
+
+/// A new grid must be predicted this much cheaper (relative) than the current one to replace it.
+pub const HYSTERESIS: f64 = 0.1;
+
+/// Footprints tried, coarse to fine.
+pub const CANDIDATE_FOOTPRINTS: [f64; 7] = [64.0, 45.0, 32.0, 23.0, 16.0, 11.0, 8.0];
+
+/// Most cells a chosen grid may have (a grid texture of 1 024 × 1 024 texels).
+pub const CELL_BUDGET: u32 = 1 << 20;
+
+/// Cost per unit in nanoseconds: what the model multiplies its counts by.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct GridCosts {
+    /// One light evaluation by one fragment.
+    pub shade_ns: f64,
+    /// One light·cell pair or cell of the assignment.
+    pub assign_ns: f64,
+    /// One byte uploaded.
+    pub upload_ns: f64,
+    /// Frames these figures were calibrated from (0: the priors).
+    pub frames: u32,
+}
+
+impl Default for GridCosts {
+    /// The priors, measured with llvmpipe on a 2-core machine (courtyard, 1 024 lights,
+    /// 640×360): a device's own frames replace them within a few frames.
+    fn default() -> Self {
+        GridCosts {
+            shade_ns: 20.0,
+            assign_ns: 7.0,
+            upload_ns: 0.3,
+            frames: 0,
+        }
+    }
+}
+
+/// Weight of a new frame in the calibration's running average.
+const CALIBRATION_WEIGHT: f64 = 0.25;
+
+impl GridCosts {
+    /// Takes one rendered frame in: `shade_ms` the time of its shading (GPU time, or wall time
+    /// less the CPU work), `evals` its estimated light evaluations, `assign_ms` and `work`
+    /// (indices + cells) its assignment, `upload_ms` and `bytes` its uploads. Frames with
+    /// nothing to measure leave a figure as it was.
+    pub fn observe(&mut self, frame: &FrameCost) {
+        let blend = |old: &mut f64, ms: f64, units: f64| {
+            if units > 0.0 && ms.is_finite() && ms > 0.0 {
+                let ns = ms * 1e6 / units;
+                *old = if self.frames == 0 {
+                    ns
+                } else {
+                    *old + CALIBRATION_WEIGHT * (ns - *old)
+                };
+            }
+        };
+        let first = self.frames;
+        blend(&mut self.shade_ns, frame.shade_ms, frame.evals);
+        blend(&mut self.assign_ns, frame.assign_ms, frame.assign_work);
+        blend(&mut self.upload_ns, frame.upload_ms, frame.upload_bytes);
+        self.frames = first + 1;
+    }
+
+    /// Predicted cost in milliseconds of `evals` light evaluations, `work` assignment units
+    /// and `bytes` uploaded.
+    pub fn predict_ms(&self, evals: f64, work: f64, bytes: f64) -> f64 {
+        (self.shade_ns * evals + self.assign_ns * work + self.upload_ns * bytes) * 1e-6
+    }
+}
+
+/// What one frame cost, for [`GridCosts::observe`].
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct FrameCost {
+    /// Shading time in milliseconds.
+    pub shade_ms: f64,
+    /// Light evaluations (estimated from the samples).
+    pub evals: f64,
+    /// Assignment time in milliseconds.
+    pub assign_ms: f64,
+    /// Indices + cells of the assignment.
+    pub assign_work: f64,
+    /// Upload time in milliseconds.
+    pub upload_ms: f64,
+    /// Bytes uploaded.
+    pub upload_bytes: f64,
+}
+
+/// Visible surface points of a frame, found by a coarse ray cast: where fragments will be.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SurfaceSamples {
+    /// Window position (pixels, y from the bottom) and view depth of each surface hit.
+    pub points: Vec<[f64; 3]>,
+    /// Rays cast (hits and misses).
+    pub rays: usize,
+    /// Pixels of the viewport.
+    pub pixels: f64,
+}
+
+impl SurfaceSamples {
+    /// Estimated pixels covered by geometry.
+    pub fn covered_pixels(&self) -> f64 {
+        if self.rays == 0 {
+            0.0
+        } else {
+            self.pixels * self.points.len() as f64 / self.rays as f64
+        }
+    }
+
+    /// The nearest sampled surface depth, if any surface was hit.
+    pub fn nearest_depth(&self) -> Option<f64> {
+        self.points
+            .iter()
+            .map(|p| p[2])
+            .filter(|d| d.is_finite() && *d > 0.0)
+            .reduce(f64::min)
+    }
+
+    /// Mean light evaluations per sampled surface point with `grid`'s lists `counts`.
+    pub fn evals_per_pixel(&self, grid: &ClusterGrid, counts: &[u32]) -> f64 {
+        if self.points.is_empty() {
+            return 0.0;
+        }
+        let total: u64 = self
+            .points
+            .iter()
+            .map(|&[x, y, d]| {
+                let cell = grid.cell_index(grid.cell_of_fragment(x, y, d));
+                counts.get(cell as usize).copied().unwrap_or(0) as u64
+            })
+            .sum();
+        total as f64 / self.points.len() as f64
+    }
+}
+
+/// One candidate grid as measured.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct Candidate {
+    /// Cell footprint in pixels.
+    pub footprint_px: f64,
+    /// Cells of the grid.
+    pub cells: u32,
+    /// Light indices of its assignment.
+    pub indices: usize,
+    /// Estimated light evaluations per covered pixel.
+    pub evals_per_pixel: f64,
+    /// Bytes its textures upload.
+    pub bytes: usize,
+    /// Predicted frame cost in milliseconds.
+    pub predicted_ms: f64,
+    /// Light references the overflow policy would drop with this grid.
+    pub overflowed_lights: u64,
+}
+
+/// The grid chosen, and why.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct GridChoice {
+    /// The grid's settings (fixed footprint, first split from the samples).
+    pub config: GridConfig,
+    /// One line: the prediction that decided it.
+    pub reason: String,
+    /// Every candidate measured, coarse to fine.
+    pub candidates: Vec<Candidate>,
+}
+
+/// What a candidate grid is built and assigned with.
+pub struct ChoiceInputs<'a> {
+    /// Viewport.
+    pub size: (u32, u32),
+    /// Projection.
+    pub projection: GridProjection,
+    /// Near plane and the grid's far end.
+    pub near: f64,
+    /// Far end of the grid (the content's).
+    pub far: f64,
+    /// The camera's far plane (may be infinite).
+    pub camera_far: f64,
+    /// The user's settings; `footprint_px` and `first_split` are what the choice sets.
+    pub base: GridConfig,
+    /// Lights in view space.
+    pub lights: &'a [GpuLight],
+    /// Assignment limits.
+    pub limits: AssignLimits,
+    /// Bytes per cell and per index of the grid encoding.
+    pub bytes_per_cell: usize,
+    /// Bytes per light index.
+    pub bytes_per_index: usize,
+}
+
+/// The first split of a grid for these samples: a little before the nearest surface, rounded
+/// down to a power of 2^(1/4) so small camera moves keep the same grid. `None` (start at the
+/// near plane) without samples.
+pub fn first_split(samples: &SurfaceSamples, near: f64) -> Option<f64> {
+    let d = samples.nearest_depth()? * 0.8;
+    let quantised = (d.log2() * 4.0).floor() / 4.0;
+    let split = quantised.exp2();
+    (split.is_finite() && split > near).then_some(split)
+}
+
+/// Measures the candidates and picks the cheapest under `costs` (see the module docs).
+pub fn choose(
+    inputs: &ChoiceInputs,
+    samples: &SurfaceSamples,
+    costs: &GridCosts,
+    assigner: &mut Assigner,
+) -> GridChoice {
+    let split = first_split(samples, inputs.near);
+    let covered = samples.covered_pixels();
+    let mut candidates = Vec::new();
+    let mut rises = 0;
+    for &footprint_px in &CANDIDATE_FOOTPRINTS {
+        let config = GridConfig {
+            footprint_px,
+            first_split: split,
+            ..inputs.base.clone()
+        };
+        let (w, h) = inputs.size;
+        let grid = ClusterGrid::new(w, h, inputs.projection, inputs.near, inputs.far, &config);
+        if grid.total_cells > CELL_BUDGET {
+            break;
+        }
+        let a = assigner.assign(&grid, inputs.lights, inputs.camera_far, &inputs.limits);
+        let evals_per_pixel = samples.evals_per_pixel(&grid, &a.counts);
+        let bytes = grid.total_cells as usize * inputs.bytes_per_cell
+            + a.indices.len() * inputs.bytes_per_index;
+        let work = (a.indices.len() + grid.total_cells as usize) as f64;
+        let predicted_ms = costs.predict_ms(evals_per_pixel * covered, work, bytes as f64);
+        let rising = candidates
+            .last()
+            .is_some_and(|c: &Candidate| predicted_ms > c.predicted_ms);
+        let overflowed_lights = a.stats.overflowed_lights;
+        candidates.push(Candidate {
+            footprint_px,
+            cells: grid.total_cells,
+            indices: a.indices.len(),
+            evals_per_pixel,
+            bytes,
+            predicted_ms,
+            overflowed_lights,
+        });
+        rises = if rising { rises + 1 } else { 0 };
+        // Finer grids only rise further, or overflow more.
+        if rises == 2 || overflowed_lights > 0 {
+            break;
+        }
+    }
+    // A grid whose lists overflow drops lights from the image: the least overflow first, then
+    // the smallest prediction.
+    let best = candidates
+        .iter()
+        .min_by(|a, b| {
+            (a.overflowed_lights, a.predicted_ms)
+                .partial_cmp(&(b.overflowed_lights, b.predicted_ms))
+                .unwrap_or(std::cmp::Ordering::Equal)
+        })
+        .cloned()
+        .unwrap_or(Candidate {
+            footprint_px: inputs.base.footprint_px,
+            cells: 0,
+            indices: 0,
+            evals_per_pixel: 0.0,
+            bytes: 0,
+            predicted_ms: 0.0,
+            overflowed_lights: 0,
+        });
+    let reason = format!(
+        "auto: {} px predicted {:.2} ms ({:.1} evaluations per pixel, {} cells, {} indices) \
+         with costs per evaluation {:.1} ns, per assignment unit {:.1} ns, per byte {:.2} ns \
+         ({}) over {} samples",
+        best.footprint_px,
+        best.predicted_ms,
+        best.evals_per_pixel,
+        best.cells,
+        best.indices,
+        costs.shade_ns,
+        costs.assign_ns,
+        costs.upload_ns,
+        if costs.frames == 0 {
+            "priors".to_string()
+        } else {
+            format!("calibrated over {} frames", costs.frames)
+        },
+        samples.points.len(),
+    );
+    GridChoice {
+        config: GridConfig {
+            footprint_px: best.footprint_px,
+            first_split: split,
+            ..inputs.base.clone()
+        },
+        reason,
+        candidates,
+    }
+}
+
+/// Whether `new` should replace `current`: only when predicted at least [`HYSTERESIS`] cheaper
+/// than the current footprint under the same measurement (or when the current one was not
+/// measured this time, overflows where the new one does not, or its first split moved).
+pub fn should_switch(current: &GridConfig, new: &GridChoice) -> bool {
+    if current.first_split != new.config.first_split {
+        return true;
+    }
+    let measured = |f: f64| new.candidates.iter().find(|c| c.footprint_px == f);
+    match (
+        measured(current.footprint_px),
+        measured(new.config.footprint_px),
+    ) {
+        (Some(now), Some(best)) => {
+            best.overflowed_lights < now.overflowed_lights
+                || best.predicted_ms < now.predicted_ms * (1.0 - HYSTERESIS)
+        }
+        _ => true,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::Light;
+    use glam::{DMat4, DVec3, Vec3};
+    use rand::{Rng, SeedableRng};
+
+    const SIZE: (u32, u32) = (320, 180);
+
+    fn projection() -> GridProjection {
+        let t = 30f64.to_radians().tan();
+        GridProjection::Perspective {
+            tan_x: t * 16.0 / 9.0,
+            tan_y: t,
+        }
+    }
+
+    /// Lights over a floor seen from above, and surface samples on that floor.
+    fn workload(lights: usize) -> (Vec<GpuLight>, SurfaceSamples) {
+        let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(3);
+        let lights = (0..lights)
+            .map(|_| {
+                let p = DVec3::new(
+                    rng.random_range(-12.0..12.0),
+                    rng.random_range(-7.0..7.0),
+                    -rng.random_range(6.0..30.0),
+                );
+                let light = Light::point(p, rng.random_range(0.5..2.5), Vec3::ONE, 1.0);
+                GpuLight::from_light(&light, &DMat4::IDENTITY)
+            })
+            .collect();
+        let mut samples = SurfaceSamples {
+            rays: 0,
+            pixels: (SIZE.0 * SIZE.1) as f64,
+            ..SurfaceSamples::default()
+        };
+        for j in 0..18 {
+            for i in 0..32 {
+                samples.rays += 1;
+                samples.points.push([
+                    (i as f64 + 0.5) * 10.0,
+                    (j as f64 + 0.5) * 10.0,
+                    8.0 + j as f64,
+                ]);
+            }
+        }
+        (lights, samples)
+    }
+
+    fn inputs(lights: &[GpuLight]) -> ChoiceInputs<'_> {
+        ChoiceInputs {
+            size: SIZE,
+            projection: projection(),
+            near: 0.1,
+            far: 40.0,
+            camera_far: 100.0,
+            base: GridConfig::default(),
+            lights,
+            limits: AssignLimits {
+                cell_cap: u32::MAX,
+                ..AssignLimits::default()
+            },
+            bytes_per_cell: 8,
+            bytes_per_index: 2,
+        }
+    }
+
+    /// Same samples, lights and costs: the same choice, candidate for candidate.
+    #[test]
+    fn the_choice_is_deterministic_for_given_costs() {
+        let (lights, samples) = workload(600);
+        let costs = GridCosts::default();
+        let a = choose(&inputs(&lights), &samples, &costs, &mut Assigner::new());
+        let b = choose(&inputs(&lights), &samples, &costs, &mut Assigner::new());
+        assert_eq!(a, b);
+        assert!(a.candidates.len() >= 3, "{:?}", a.candidates);
+    }
+
+    /// Finer grids evaluate fewer lights and cost more assignment: cheap shading favours
+    /// coarse grids, expensive shading fine ones, and the choice is the candidate with the
+    /// smallest prediction.
+    #[test]
+    fn the_choice_follows_the_costs() {
+        let (lights, samples) = workload(600);
+        let pick = |shade_ns: f64| {
+            let costs = GridCosts {
+                shade_ns,
+                ..GridCosts::default()
+            };
+            let choice = choose(&inputs(&lights), &samples, &costs, &mut Assigner::new());
+            let best = choice
+                .candidates
+                .iter()
+                .min_by(|a, b| a.predicted_ms.total_cmp(&b.predicted_ms))
+                .unwrap();
+            assert_eq!(best.footprint_px, choice.config.footprint_px);
+            for pair in choice.candidates.windows(2) {
+                assert!(pair[1].evals_per_pixel <= pair[0].evals_per_pixel * 1.01);
+                assert!(pair[1].indices >= pair[0].indices);
+            }
+            choice.config.footprint_px
+        };
+        let (cheap, dear) = (pick(0.01), pick(1000.0));
+        assert_eq!(cheap, CANDIDATE_FOOTPRINTS[0]);
+        assert!(dear < cheap, "{dear} px against {cheap} px");
+    }
+
+    /// A new choice within the hysteresis band of the current grid does not replace it, one
+    /// clearly cheaper does; so a static scene measured again keeps its grid.
+    #[test]
+    fn switching_needs_a_clear_gain() {
+        let (lights, samples) = workload(600);
+        let choice = choose(
+            &inputs(&lights),
+            &samples,
+            &GridCosts::default(),
+            &mut Assigner::new(),
+        );
+        assert!(!should_switch(&choice.config, &choice));
+        for c in &choice.candidates {
+            let current = GridConfig {
+                footprint_px: c.footprint_px,
+                ..choice.config.clone()
+            };
+            let best = choice
+                .candidates
+                .iter()
+                .find(|b| b.footprint_px == choice.config.footprint_px)
+                .unwrap();
+            let clear = best.predicted_ms < c.predicted_ms * (1.0 - HYSTERESIS);
+            assert_eq!(should_switch(&current, &choice), clear, "{c:?}");
+        }
+        // Measured again with costs a little off, the grid stays.
+        let mut costs = GridCosts::default();
+        for (k, shade) in [19.0, 21.0, 20.5, 19.5].into_iter().enumerate() {
+            costs.shade_ns = shade;
+            let again = choose(&inputs(&lights), &samples, &costs, &mut Assigner::new());
+            assert!(
+                !should_switch(&choice.config, &again)
+                    || again.config.footprint_px == choice.config.footprint_px,
+                "measurement {k} flipped the grid"
+            );
+        }
+    }
+
+    /// A grid whose lists would not fit loses to one that fits, however cheap it looks.
+    #[test]
+    fn a_grid_that_overflows_is_not_chosen() {
+        let (lights, samples) = workload(600);
+        let roomy = choose(
+            &inputs(&lights),
+            &samples,
+            &GridCosts::default(),
+            &mut Assigner::new(),
+        );
+        let coarsest = roomy.candidates[0].indices;
+        let mut tight = inputs(&lights);
+        tight.limits.max_indices = coarsest + 1;
+        let costs = GridCosts {
+            shade_ns: 1000.0,
+            ..GridCosts::default()
+        };
+        let choice = choose(&tight, &samples, &costs, &mut Assigner::new());
+        assert_eq!(choice.config.footprint_px, CANDIDATE_FOOTPRINTS[0]);
+        assert!(choice.candidates.len() >= 2, "a finer grid was measured");
+        assert!(choice.candidates[1].overflowed_lights > 0);
+    }
+
+    /// The grid starts a little before the nearest surface, on a coarse ladder of depths, and
+    /// never before the near plane.
+    #[test]
+    fn the_first_split_comes_from_the_nearest_surface() {
+        let (_, samples) = workload(1);
+        let split = first_split(&samples, 0.1).unwrap();
+        assert!(split <= 8.0 * 0.8 && split > 8.0 * 0.8 / 2f64.powf(0.25));
+        let mut moved = samples.clone();
+        moved.points[0][2] = 8.05;
+        assert_eq!(
+            first_split(&moved, 0.1),
+            Some(split),
+            "a small move keeps it"
+        );
+        assert_eq!(first_split(&samples, 10.0), None);
+        assert_eq!(first_split(&SurfaceSamples::default(), 0.1), None);
+    }
+
+    /// The calibration moves towards what frames measure and ignores what they cannot say.
+    #[test]
+    fn calibration_follows_measured_frames() {
+        let mut costs = GridCosts::default();
+        let frame = FrameCost {
+            shade_ms: 10.0,
+            evals: 1e6,
+            assign_ms: 1.0,
+            assign_work: 1e5,
+            upload_ms: 0.0,
+            upload_bytes: 0.0,
+        };
+        costs.observe(&frame);
+        assert_eq!((costs.shade_ns, costs.assign_ns), (10.0, 10.0));
+        assert_eq!(costs.upload_ns, GridCosts::default().upload_ns);
+        for _ in 0..40 {
+            costs.observe(&FrameCost {
+                shade_ms: 20.0,
+                ..frame
+            });
+        }
+        assert!((costs.shade_ns - 20.0).abs() < 0.01, "{costs:?}");
+        let before = costs;
+        costs.observe(&FrameCost {
+            shade_ms: f64::NAN,
+            ..frame
+        });
+        assert_eq!(costs.shade_ns, before.shade_ns);
+    }
+}

@@ -1,0 +1,219 @@
+//! The clustered method's automatic grid ([`crate::cluster::auto`]) wired to frames: when to
+//! choose again, where the surface samples come from (a coarse ray cast of the scene, its
+//! hierarchy built once per geometry), and the calibration fed by every rendered frame.
+
+use glam::{DMat4, DVec3, DVec4};
+
+use super::FrameContext;
+use crate::cluster::assign::{AssignLimits, Assigner};
+use crate::cluster::auto::{self, ChoiceInputs, FrameCost, GridChoice, GridCosts, SurfaceSamples};
+use crate::cluster::grid::{ClusterGrid, GridConfig, GridProjection};
+use crate::metrics::raycast::SceneRaycaster;
+
+/// Rays of the surface sample, across and down (1 296 rays).
+const SAMPLE_GRID: (u32, u32) = (48, 27);
+
+/// A view or light set that changed is chosen for again after at most this many frames.
+const RECHOOSE_AFTER_CHANGE: u32 = 30;
+
+/// A static frame is chosen for again (with the costs calibrated since) this often.
+const RECHOOSE_PERIOD: u32 = 240;
+
+/// The first re-choice comes this many frames after the first, once the costs have been
+/// calibrated on the device.
+const FIRST_CALIBRATED_CHOICE: u32 = 4;
+
+/// The scene's geometry by identity: each object's mesh and transform bits.
+type GeometryKey = Vec<(usize, [u64; 16])>;
+
+/// What makes the current choice stale at once.
+#[derive(Clone, Debug, PartialEq)]
+struct Layout {
+    size: (u32, u32),
+    projection: [u64; 2],
+    near: u64,
+    /// The user's grid settings (what the choice does not set).
+    base: GridConfig,
+}
+
+/// The automatic grid's state across frames.
+#[derive(Default)]
+pub(crate) struct AutoGrid {
+    costs: GridCosts,
+    choice: Option<GridChoice>,
+    layout: Option<Layout>,
+    /// View matrix and light count at the last choice.
+    view_at_choice: Option<(DMat4, usize)>,
+    frames_since_choice: u32,
+    choices: u32,
+    samples: SurfaceSamples,
+    /// Ray caster of the scene's geometry, with the identity of the meshes and transforms it
+    /// was built from.
+    caster: Option<(GeometryKey, SceneRaycaster)>,
+    /// Spare buffers for the candidates' assignments.
+    assigner: Assigner,
+    /// The frame rendered and not yet observed.
+    pending: Option<FrameCost>,
+}
+
+impl AutoGrid {
+    /// The grid settings for this frame: the current choice, or a new one when it is stale.
+    pub(crate) fn config(
+        &mut self,
+        ctx: &FrameContext,
+        projection: GridProjection,
+        limits: &AssignLimits,
+        bytes: (usize, usize),
+    ) -> &GridChoice {
+        let layout = Layout {
+            size: ctx.viewport,
+            projection: match projection {
+                GridProjection::Perspective { tan_x, tan_y } => [tan_x.to_bits(), tan_y.to_bits()],
+                GridProjection::Orthographic { half_x, half_y } => {
+                    [half_x.to_bits(), half_y.to_bits()]
+                }
+            },
+            near: ctx.near.to_bits(),
+            base: ctx.options.grid.clone(),
+        };
+        let moved = self
+            .view_at_choice
+            .is_none_or(|(view, n)| view != ctx.view || changed_much(n, ctx.lights.len()));
+        let due = self.choice.is_none()
+            || self.layout.as_ref() != Some(&layout)
+            || (moved && self.frames_since_choice >= RECHOOSE_AFTER_CHANGE)
+            || (self.choices == 1 && self.frames_since_choice >= FIRST_CALIBRATED_CHOICE)
+            || self.frames_since_choice >= RECHOOSE_PERIOD;
+        self.frames_since_choice += 1;
+        if due {
+            self.samples = self.sample(ctx);
+            let inputs = ChoiceInputs {
+                size: ctx.viewport,
+                projection,
+                near: ctx.near,
+                far: ctx.content_far,
+                camera_far: ctx.far,
+                base: ctx.options.grid.clone(),
+                lights: ctx.lights,
+                limits: *limits,
+                bytes_per_cell: bytes.0,
+                bytes_per_index: bytes.1,
+            };
+            let new = auto::choose(&inputs, &self.samples, &self.costs, &mut self.assigner);
+            let keep = self.layout.as_ref() == Some(&layout)
+                && self
+                    .choice
+                    .as_ref()
+                    .is_some_and(|current| !auto::should_switch(&current.config, &new));
+            if keep {
+                // The grid stays; the reason says it was measured again.
+                let current = self.choice.as_mut().expect("kept");
+                current.reason = if current.config.footprint_px == new.config.footprint_px {
+                    new.reason
+                } else {
+                    format!(
+                        "kept {} px (predicted within {:.0} % of the best): {}",
+                        current.config.footprint_px,
+                        auto::HYSTERESIS * 100.0,
+                        new.reason
+                    )
+                };
+                current.candidates = new.candidates;
+            } else {
+                self.choice = Some(new);
+            }
+            self.layout = Some(layout);
+            self.view_at_choice = Some((ctx.view, ctx.lights.len()));
+            self.frames_since_choice = 0;
+            self.choices += 1;
+        }
+        self.choice.as_ref().expect("chosen above")
+    }
+
+    /// Records what this frame's CPU side cost; the shading time follows in
+    /// [`AutoGrid::observe`].
+    pub(crate) fn record(&mut self, grid: &ClusterGrid, counts: &[u32], cost: FrameCost) {
+        let evals = self.samples.evals_per_pixel(grid, counts) * self.samples.covered_pixels();
+        self.pending = Some(FrameCost { evals, ..cost });
+    }
+
+    /// Takes the frame's time in and calibrates the costs: the wall time less the CPU work
+    /// when the frame waited for the GPU (`frame_ms`), else the GPU timer's. The wall time
+    /// wins where both exist: it bounds the GPU's work from above, while some timers
+    /// (llvmpipe's) undercount a frame that samples textures in the fragment loop.
+    pub(crate) fn observe(&mut self, frame_ms: Option<f64>, gpu_ms: Option<f64>) {
+        let Some(mut cost) = self.pending.take() else {
+            return;
+        };
+        let Some(shade_ms) = frame_ms
+            .map(|ms| ms - cost.assign_ms - cost.upload_ms)
+            .or(gpu_ms)
+        else {
+            return;
+        };
+        cost.shade_ms = shade_ms;
+        self.costs.observe(&cost);
+    }
+
+    /// Surface points of the frame from a coarse ray cast.
+    fn sample(&mut self, ctx: &FrameContext) -> SurfaceSamples {
+        let scene = ctx.scene;
+        let key: GeometryKey = scene
+            .objects
+            .iter()
+            .map(|o| {
+                (
+                    std::sync::Arc::as_ptr(&o.mesh) as usize,
+                    o.transform.to_cols_array().map(f64::to_bits),
+                )
+            })
+            .collect();
+        if self.caster.as_ref().is_none_or(|(k, _)| *k != key) {
+            self.caster = Some((key, SceneRaycaster::new(scene)));
+        }
+        let caster = &self.caster.as_ref().expect("built above").1;
+        let (w, h) = ctx.viewport;
+        let aspect = w as f64 / h as f64;
+        let view = ctx.view;
+        let inv = (scene.camera.projection_matrix(aspect) * view).inverse();
+        let unproject = |x: f64, y: f64, z: f64| {
+            let p = inv * DVec4::new(x, y, z, 1.0);
+            p.truncate() / p.w
+        };
+        let (nx, ny) = SAMPLE_GRID;
+        let mut samples = SurfaceSamples {
+            points: Vec::with_capacity((nx * ny) as usize),
+            rays: (nx * ny) as usize,
+            pixels: w as f64 * h as f64,
+        };
+        for j in 0..ny {
+            for i in 0..nx {
+                let ndc_x = -1.0 + 2.0 * (i as f64 + 0.5) / nx as f64;
+                let ndc_y = -1.0 + 2.0 * (j as f64 + 0.5) / ny as f64;
+                let origin = unproject(ndc_x, ndc_y, -1.0);
+                // A point between the planes gives the ray's line even for an infinite far.
+                let dir: DVec3 = (unproject(ndc_x, ndc_y, 0.0) - origin).normalize();
+                if !dir.is_finite() {
+                    continue;
+                }
+                if let Some(hit) = caster.hit(origin, dir) {
+                    let depth = -(view * hit.position.extend(1.0)).z;
+                    let x = (ndc_x + 1.0) * 0.5 * w as f64;
+                    let y = (ndc_y + 1.0) * 0.5 * h as f64;
+                    samples.points.push([x, y, depth]);
+                }
+            }
+        }
+        samples
+    }
+}
+
+/// A light count changed by more than a quarter.
+fn changed_much(then: usize, now: usize) -> bool {
+    now * 4 > then * 5 || now * 5 < then * 4
+}
+
+/// The reason a fixed grid reports.
+pub(crate) fn fixed_reason(config: &GridConfig) -> String {
+    format!("fixed: footprint_px = {} (GridConfig)", config.footprint_px)
+}
