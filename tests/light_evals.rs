@@ -198,10 +198,14 @@ fn tight_coverage_never_evaluates_more_than_the_cascade_box() {
     for (method, footprint) in [("clustered", 64.0), ("clustered", 16.0), ("tiled", 16.0)] {
         gpu.r().set_method(method).unwrap();
         let evals = |gpu: &mut Gpu, coverage| {
-            let mut options = RenderOptions::default();
-            options.grid = GridConfig::fixed(footprint);
-            options.grid.coverage = coverage;
-            options.tile_px = footprint;
+            let options = RenderOptions {
+                grid: GridConfig {
+                    coverage,
+                    ..GridConfig::fixed(footprint)
+                },
+                tile_px: footprint,
+                ..RenderOptions::default()
+            };
             gpu.r()
                 .render_light_counts(&scene, 256, 144, &options, CountKind::Evals)
                 .unwrap()
