@@ -31,6 +31,12 @@ use super::cells::for_each_run;
 use super::grid::{CellCoord, ClusterGrid};
 use super::pack::GpuLight;
 
+/// An assignment whose previous frame listed this many indices runs on all cores whatever its
+/// light count: fine grids give each light hundreds of cells, and at about 3 ns an index such
+/// a frame's work (a millisecond or more) dwarfs the tens of microseconds of waking rayon's
+/// workers.
+pub const PARALLEL_INDICES: usize = 1 << 17;
+
 /// Limits of one assignment.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct AssignLimits {
@@ -38,7 +44,9 @@ pub struct AssignLimits {
     pub cell_cap: u32,
     /// Most indices in total.
     pub max_indices: usize,
-    /// Lights from this count up are assigned on all cores (rayon's pool).
+    /// Lights from this count up are assigned on all cores (rayon's pool); so is any
+    /// assignment whose previous one (same [`Assigner`]) listed [`PARALLEL_INDICES`] or more,
+    /// unless this is `usize::MAX` (never in parallel).
     pub parallel_threshold: usize,
 }
 
@@ -285,7 +293,9 @@ impl Assigner {
         }
         // Waking rayon's workers costs tens of microseconds on some machines: small light
         // counts stay on the calling thread.
-        let threads = if lights.len() >= limits.parallel_threshold {
+        let heavy =
+            out.indices.len() >= PARALLEL_INDICES && limits.parallel_threshold != usize::MAX;
+        let threads = if lights.len() >= limits.parallel_threshold || heavy {
             rayon::current_num_threads().clamp(1, 8)
         } else {
             1

@@ -256,6 +256,9 @@ pub fn choose(
             .last()
             .is_some_and(|c: &Candidate| predicted_ms > c.predicted_ms);
         let overflowed_lights = a.stats.overflowed_lights;
+        let overflow_grew = candidates
+            .last()
+            .is_some_and(|c: &Candidate| overflowed_lights > c.overflowed_lights);
         candidates.push(Candidate {
             footprint_px,
             cells: grid.total_cells,
@@ -266,8 +269,9 @@ pub fn choose(
             overflowed_lights,
         });
         rises = if rising { rises + 1 } else { 0 };
-        // Finer grids only rise further, or overflow more.
-        if rises == 2 || overflowed_lights > 0 {
+        // Past here finer grids only rise further, or overflow the index list more (a per-cell
+        // cap overflows less in finer cells, so overflow alone does not stop the search).
+        if rises == 2 || overflow_grew {
             break;
         }
     }

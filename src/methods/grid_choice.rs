@@ -54,6 +54,9 @@ pub(crate) struct AutoGrid {
     assigner: Assigner,
     /// The frame rendered and not yet observed.
     pending: Option<FrameCost>,
+    /// The current frame made a choice: its time holds the candidates' assignments and
+    /// (first frame) shader compiles, so it calibrates nothing.
+    chose_this_frame: bool,
 }
 
 impl AutoGrid {
@@ -85,6 +88,7 @@ impl AutoGrid {
             || (self.choices == 1 && self.frames_since_choice >= FIRST_CALIBRATED_CHOICE)
             || self.frames_since_choice >= RECHOOSE_PERIOD;
         self.frames_since_choice += 1;
+        self.chose_this_frame = due;
         if due {
             self.samples = self.sample(ctx);
             let inputs = ChoiceInputs {
@@ -133,6 +137,10 @@ impl AutoGrid {
     /// Records what this frame's CPU side cost; the shading time follows in
     /// [`AutoGrid::observe`].
     pub(crate) fn record(&mut self, grid: &ClusterGrid, counts: &[u32], cost: FrameCost) {
+        if self.chose_this_frame {
+            self.pending = None;
+            return;
+        }
         let evals = self.samples.evals_per_pixel(grid, counts) * self.samples.covered_pixels();
         self.pending = Some(FrameCost { evals, ..cost });
     }
