@@ -73,6 +73,8 @@ pub fn for_each_run(
         perspective: extent.perspective,
         dmin,
         dmax,
+        inv_dmin: 1.0 / dmin,
+        inv_dmax: 1.0 / dmax,
     };
     // Exclusive ranges in the loops below: inclusive ones cost a flag check per step.
     for k in k0..k1 + 1 {
@@ -108,8 +110,16 @@ pub fn for_each_run(
                 Some(cone) => cone.emit_runs(spheres, start, x1 - x0 + 1, emit),
             }
         };
+        // A rectangle of at most 2 × 2 cells per slice has little to trim (a corner cell at
+        // most) and the per-row arithmetic would cost more than the cells it saves.
+        let small = columns.1 - columns.0 < 2 && rows.1 - rows.0 < 2;
+        let coverage = if small {
+            Coverage::CascadeBox
+        } else {
+            grid.coverage
+        };
         for s in sa..sb + 1 {
-            match grid.coverage {
+            match coverage {
                 Coverage::SliceRows => {
                     let slab = grid.slice_slabs[(constants.first_slice + s) as usize];
                     sphere.for_each_row_run(&tiles, slab, &mut |row, x0, x1| {
@@ -149,10 +159,16 @@ struct SlabSphere {
     d: f64,
     r_sq: f64,
     perspective: bool,
-    /// The light's depth range clipped to the frustum.
+    /// The light's depth range clipped to the frustum, and its reciprocals.
     dmin: f64,
     dmax: f64,
+    inv_dmin: f64,
+    inv_dmax: f64,
 }
+
+/// Largest reciprocal depth used: `1 / f64::MIN_POSITIVE`, so a slab at the eye gives huge
+/// slopes rather than `0 · ∞ = NaN`.
+const MAX_INV_DEPTH: f64 = 1.0 / f64::MIN_POSITIVE;
 
 impl SlabSphere {
     /// Calls `emit(row, first_column, last_column)` for every row of the cascade whose cells
@@ -169,19 +185,19 @@ impl SlabSphere {
     fn for_each_row_run(
         &self,
         tiles: &CascadeTiles,
-        [z0, z1]: [f64; 2],
+        [z0, z1, inv_z0, inv_z1]: [f64; 4],
         emit: &mut impl FnMut(u32, u32, u32),
     ) {
-        // Kept above 0 so a perspective slab at the eye gives huge slopes rather than
-        // `0 · ∞ = NaN`.
-        let za = z0.max(self.dmin).max(f64::MIN_POSITIVE);
+        let za = z0.max(self.dmin);
         // Never below `za`: the slice came from the widened depth range, so the slab meets it
         // up to rounding.
         let zb = z1.min(self.dmax).max(za);
+        // Their reciprocals without a division: `1/max(a, b) = min(1/a, 1/b)`.
+        let inv_a = inv_z0.min(self.inv_dmin).min(MAX_INV_DEPTH);
+        let inv_b = inv_z1.max(self.inv_dmax).min(inv_a);
         let nearest = self.d.clamp(za, zb) - self.d;
         let rho_sq = (self.r_sq - nearest * nearest).max(0.0);
         let rho = rho_sq.sqrt();
-        let (inv_a, inv_b) = (1.0 / za, 1.0 / zb);
         let constants = tiles.constants;
         let [cx, cy] = self.center;
         let Some((y0, y1)) = self.tiles_of(tiles, 1, cy - rho, cy + rho, inv_a, inv_b) else {
@@ -189,6 +205,13 @@ impl SlabSphere {
         };
         let (y0, y1) = (y0.max(tiles.rows.0), y1.min(tiles.rows.1));
         if y0 > y1 {
+            return;
+        }
+        if tiles.columns.0 == tiles.columns.1 {
+            // One column: no chord can narrow it further.
+            for row in y0..y1 + 1 {
+                emit(row, tiles.columns.0, tiles.columns.1);
+            }
             return;
         }
         let step = constants.tile_step[1];

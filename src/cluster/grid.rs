@@ -260,8 +260,9 @@ pub struct ClusterGrid {
     pub(crate) cascade_constants: Vec<CascadeConstants>,
     /// Per slice (numbered across cascades): the view depths `[z0, z1]` a fragment the shader
     /// puts in that slice can have, the slice's bounds widened by [`SLICE_WIDEN`] for the
-    /// shader's `f32` evaluation of the mapping (see [`ClusterGrid::depth_range_to_slices`]).
-    pub(crate) slice_slabs: Vec<[f64; 2]>,
+    /// shader's `f32` evaluation of the mapping (see [`ClusterGrid::depth_range_to_slices`]),
+    /// and their reciprocals `1/z0`, `1/z1` (+∞ for 0, 0 for +∞).
+    pub(crate) slice_slabs: Vec<[f64; 4]>,
     /// Perspective: `1 / √(1 + tan²)` for x and y, the length of the side planes' normals
     /// `(1, 0, tan)` taken out (see [`ClusterGrid::sphere_outside_sides`]).
     side_plane_norm: [f64; 2],
@@ -392,16 +393,15 @@ impl ClusterGrid {
         grid
     }
 
-    fn build_slice_slabs(&self) -> Vec<[f64; 2]> {
+    fn build_slice_slabs(&self) -> Vec<[f64; 4]> {
         let mut slabs = Vec::new();
         for (k, c) in self.cascades.iter().enumerate() {
             for s in 0..c.slices {
                 let (z0, z1) = self.slice_depth_range(k as u32, s);
                 let first = k == 0 && s == 0;
-                slabs.push([
-                    if first { 0.0 } else { z0 * (1.0 - SLICE_WIDEN) },
-                    z1 * (1.0 + SLICE_WIDEN),
-                ]);
+                let z0 = if first { 0.0 } else { z0 * (1.0 - SLICE_WIDEN) };
+                let z1 = z1 * (1.0 + SLICE_WIDEN);
+                slabs.push([z0, z1, 1.0 / z0, 1.0 / z1]);
             }
         }
         slabs
