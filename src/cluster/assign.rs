@@ -460,7 +460,8 @@ fn apply_cap(
             let center = cell_center(grid, cell as u32);
             let visible = &out.visible;
             let key = |i: &u32| importance(&lights[visible[*i as usize] as usize], center);
-            list.select_nth_unstable_by(cap as usize - 1 + usize::from(cap == 0), |a, b| {
+            // A cap of 0 (a budget smaller than the non-empty cells) still needs a valid index.
+            list.select_nth_unstable_by((cap as usize).max(1) - 1, |a, b| {
                 key(b).total_cmp(&key(a))
             });
             list[..cap as usize].sort_unstable();
