@@ -66,16 +66,6 @@ pub fn for_each_run(
     } else {
         &[]
     };
-    let sphere = SlabSphere {
-        center: [c.x, c.y],
-        d,
-        r_sq: r * r,
-        perspective: extent.perspective,
-        dmin,
-        dmax,
-        inv_dmin: 1.0 / dmin,
-        inv_dmax: 1.0 / dmax,
-    };
     // Exclusive ranges in the loops below: inclusive ones cost a flag check per step.
     for k in k0..k1 + 1 {
         let cascade = &grid.cascades[k as usize];
@@ -85,10 +75,10 @@ pub fn for_each_run(
         // Every slice and row below stays inside these ranges, so the refinement can only
         // remove cells.
         let slab = k0 != k1;
-        let Some(columns) = extent.tile_range(grid, constants, slab, 0, cascade.tiles_x) else {
+        let Some(columns) = extent.tile_range(constants, slab, 0, cascade.tiles_x) else {
             continue;
         };
-        let Some(rows) = extent.tile_range(grid, constants, slab, 1, cascade.tiles_y) else {
+        let Some(rows) = extent.tile_range(constants, slab, 1, cascade.tiles_y) else {
             continue;
         };
         let sa = if k == k0 { s0 } else { 0 };
@@ -122,7 +112,7 @@ pub fn for_each_run(
             match coverage {
                 Coverage::SliceRows => {
                     let slab = grid.slice_slabs[(constants.first_slice + s) as usize];
-                    sphere.for_each_row_run(&tiles, slab, &mut |row, x0, x1| {
+                    extent.for_each_row_run(&tiles, slab, &mut |row, x0, x1| {
                         emit_row(slice_start, row, x0, x1)
                     });
                 }
@@ -148,29 +138,37 @@ struct CascadeTiles<'a> {
     rows: (u32, u32),
 }
 
-/// The sphere cells are tested against, for the per-slice, per-row refinement (Persson's
-/// "practical clustered", Bevy's assigner): inside a slice's depth slab the sphere is no wider
-/// than its largest cross-section there, and inside one row's band no wider than that
-/// cross-section's chord at the band's nearest point.
-struct SlabSphere {
-    /// View x, y of the centre.
-    center: [f64; 2],
-    /// View depth of the centre.
-    d: f64,
-    r_sq: f64,
-    perspective: bool,
-    /// The light's depth range clipped to the frustum, and its reciprocals.
-    dmin: f64,
-    dmax: f64,
-    inv_dmin: f64,
-    inv_dmax: f64,
-}
-
 /// Largest reciprocal depth used: `1 / f64::MIN_POSITIVE`, so a slab at the eye gives huge
 /// slopes rather than `0 · ∞ = NaN`.
 const MAX_INV_DEPTH: f64 = 1.0 / f64::MIN_POSITIVE;
 
-impl SlabSphere {
+/// Extreme view-space slopes of the extent `[low, high]` over the depths whose reciprocals
+/// are `inv_a` and `inv_b` (the box projection: the extremes lie at the slab's ends).
+#[inline(always)]
+fn box_slopes(low: f64, high: f64, inv_a: f64, inv_b: f64) -> (f64, f64) {
+    (
+        (low * inv_a).min(low * inv_b),
+        (high * inv_a).max(high * inv_b),
+    )
+}
+
+/// Tile range `[t0, t1]` of `count` tiles (`half` = count / 2) covering the NDC range
+/// `[lo, hi]`, or `None` when it misses the screen (or is NaN).
+#[inline(always)]
+fn ndc_to_tiles(lo: f64, hi: f64, half: f64, count: u32) -> Option<(u32, u32)> {
+    if !(lo <= hi && hi >= -1.0 && lo <= 1.0) {
+        return None;
+    }
+    // `as u32` saturates: negative coordinates give tile 0.
+    let to_tile = |ndc: f64| (((ndc + 1.0) * half) as u32).min(count - 1);
+    Some((to_tile(lo), to_tile(hi)))
+}
+
+/// The per-slice, per-row refinement (Persson's "practical clustered", Bevy's assigner):
+/// inside a slice's depth slab the sphere is no wider than its largest cross-section there,
+/// and inside one row's band no wider than that cross-section's chord at the band's nearest
+/// point.
+impl ScreenExtent {
     /// Calls `emit(row, first_column, last_column)` for every row of the cascade whose cells
     /// in the depth slab `[z0, z1]` the sphere may reach, with the columns it may reach there.
     ///
@@ -188,15 +186,16 @@ impl SlabSphere {
         [z0, z1, inv_z0, inv_z1]: [f64; 4],
         emit: &mut impl FnMut(u32, u32, u32),
     ) {
-        let za = z0.max(self.dmin);
+        let (dmin, dmax) = self.depth;
+        let za = z0.max(dmin);
         // Never below `za`: the slice came from the widened depth range, so the slab meets it
         // up to rounding.
-        let zb = z1.min(self.dmax).max(za);
+        let zb = z1.min(dmax).max(za);
         // Their reciprocals without a division: `1/max(a, b) = min(1/a, 1/b)`.
-        let inv_a = inv_z0.min(self.inv_dmin).min(MAX_INV_DEPTH);
-        let inv_b = inv_z1.max(self.inv_dmax).min(inv_a);
+        let inv_a = inv_z0.min(self.inv_depth.0).min(MAX_INV_DEPTH);
+        let inv_b = inv_z1.max(self.inv_depth.1).min(inv_a);
         let nearest = self.d.clamp(za, zb) - self.d;
-        let rho_sq = (self.r_sq - nearest * nearest).max(0.0);
+        let rho_sq = (self.r * self.r - nearest * nearest).max(0.0);
         let rho = rho_sq.sqrt();
         let constants = tiles.constants;
         let [cx, cy] = self.center;
@@ -214,11 +213,9 @@ impl SlabSphere {
             }
             return;
         }
-        let step = constants.tile_step[1];
-        let origin = -0.5 * step * tiles.tiles_y as f64;
         for row in y0..y1 + 1 {
-            let t0 = origin + row as f64 * step;
-            let t1 = t0 + step;
+            let t0 = constants.tile_edge(1, row);
+            let t1 = t0 + constants.tile_step[1];
             // The band's nearest approach to the centre over the slab (a lower bound).
             let gap = if self.perspective {
                 let below = (t0 * za).min(t0 * zb) - cy;
@@ -259,26 +256,21 @@ impl SlabSphere {
     ) -> Option<(u32, u32)> {
         let scale = tiles.grid.ndc_scale[axis];
         let (lo, hi) = if self.perspective {
-            (
-                (low * inv_a).min(low * inv_b) * scale,
-                (high * inv_a).max(high * inv_b) * scale,
-            )
+            box_slopes(low, high, inv_a, inv_b)
         } else {
-            (low * scale, high * scale)
+            (low, high)
         };
-        // Also false for NaN.
-        if !(lo <= hi && hi >= -1.0 && lo <= 1.0) {
-            return None;
-        }
-        let half = tiles.constants.half_tiles[axis];
         let count = if axis == 0 {
             tiles.tiles_x
         } else {
             tiles.tiles_y
         };
-        // `as u32` saturates: negative coordinates give tile 0.
-        let to_tile = |ndc: f64| (((ndc + 1.0) * half) as u32).min(count - 1);
-        Some((to_tile(lo), to_tile(hi)))
+        ndc_to_tiles(
+            lo * scale,
+            hi * scale,
+            tiles.constants.half_tiles[axis],
+            count,
+        )
     }
 }
 
@@ -293,7 +285,8 @@ struct ScreenExtent {
     /// Per axis: the exact NDC bounds of the sphere's tangent planes, when it lies in front
     /// of the eye (perspective only).
     tangents: Option<[(f64, f64); 2]>,
-    /// `1 / dmin`, `1 / dmax` of the clipped depth range (0 for an infinite end).
+    /// The clipped depth range `dmin`, `dmax`, and their reciprocals (0 for an infinite end).
+    depth: (f64, f64),
     inv_depth: (f64, f64),
     /// Centre (view x, y), depth and radius, for the plane tests of a sphere around the eye.
     center: [f64; 2],
@@ -322,6 +315,7 @@ impl ScreenExtent {
             low: [(c.x - r) * scale[0], (c.y - r) * scale[1]],
             high: [(c.x + r) * scale[0], (c.y + r) * scale[1]],
             tangents,
+            depth: (dmin, dmax),
             inv_depth: (1.0 / dmin, 1.0 / dmax),
             center: [c.x, c.y],
             d,
@@ -335,7 +329,6 @@ impl ScreenExtent {
     #[inline(always)]
     fn tile_range(
         &self,
-        grid: &ClusterGrid,
         constants: &CascadeConstants,
         slab: bool,
         axis: usize,
@@ -349,26 +342,17 @@ impl ScreenExtent {
                 // cascade's slab [max(dmin, z_near), min(dmax, z_far)].
                 let inv_za = self.inv_depth.0.min(constants.inv_near);
                 let inv_zb = self.inv_depth.1.max(constants.inv_far);
-                let (low, high) = (self.low[axis], self.high[axis]);
-                let lo = (low * inv_za).min(low * inv_zb);
-                let hi = (high * inv_za).max(high * inv_zb);
+                let (lo, hi) = box_slopes(self.low[axis], self.high[axis], inv_za, inv_zb);
                 match tangents {
                     Some(t) => (lo.max(t[axis].0), hi.min(t[axis].1)),
                     None => (lo, hi),
                 }
             }
         };
-        // Also false for NaN.
-        if !(lo <= hi && hi >= -1.0 && lo <= 1.0) {
-            return None;
-        }
-        let half = constants.half_tiles[axis];
-        // `as u32` saturates: negative coordinates (and NaN) give column 0.
-        let to_tile = |ndc: f64| (((ndc + 1.0) * half) as u32).min(tiles - 1);
-        let (t0, t1) = (to_tile(lo), to_tile(hi));
+        let (t0, t1) = ndc_to_tiles(lo, hi, constants.half_tiles[axis], tiles)?;
         if self.perspective && self.tangents.is_none() {
             // A sphere reaching behind the eye: its box bounds are loose, tighten the ends.
-            return self.tighten_around_eye(grid, axis, tiles, t0, t1);
+            return self.tighten_around_eye(constants, axis, t0, t1);
         }
         Some((t0, t1))
     }
@@ -377,21 +361,18 @@ impl ScreenExtent {
     /// touches, for a sphere reaching behind the eye; `None` when it touches none.
     fn tighten_around_eye(
         &self,
-        grid: &ClusterGrid,
+        constants: &CascadeConstants,
         axis: usize,
-        tiles: u32,
         mut t0: u32,
         mut t1: u32,
     ) -> Option<(u32, u32)> {
         let (center, d, r) = (self.center[axis], self.d, self.r);
-        let tan = 1.0 / grid.ndc_scale[axis];
-        let step = 2.0 * tan / tiles as f64;
         // The plane through the eye at NDC `u` has the normal (1, −s) (in the axis and depth
         // coordinates) with `s = u · tan`; the centre's signed distance to it, positive on the
         // +u side, is `(center − s·d) / √(1 + s²)`. Compared with ±r squared, so no root.
         // Per plane `i` (slope `s`): `a = centre − s·d` and whether |a| ≤ r·√(1 + s²).
         let plane = |i: u32| {
-            let s = -tan + i as f64 * step;
+            let s = constants.tile_edge(axis, i);
             let a = center - s * d;
             (a, a * a <= r * r * (1.0 + s * s))
         };

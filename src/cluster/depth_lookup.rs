@@ -97,14 +97,24 @@ pub(crate) struct CascadeConstants {
     /// Half the columns and half the rows: tile coordinate `(ndc + 1) · half`.
     pub half_tiles: [f64; 2],
     /// Width of one column and height of one row in view-space slope (perspective) or view
-    /// units (orthographic): `2 / (tiles · ndc_scale)`.
+    /// units (orthographic): `2 · extent / tiles`, `extent = 1 / ndc_scale`.
     pub tile_step: [f64; 2],
+    /// `1 / ndc_scale` per axis: `tan` of the half field of view (perspective) or the half
+    /// width and height (orthographic); column or row `i` starts at `−extent + i · step`.
+    pub extent: [f64; 2],
     /// Index of the cascade's first slice among all the grid's slices (for
     /// `ClusterGrid::slice_slabs`).
     pub first_slice: u32,
 }
 
 impl CascadeConstants {
+    /// View-space slope (perspective) or offset (orthographic) where column (`axis` 0) or row
+    /// (`axis` 1) `i` starts; `i = tiles` is where the last one ends.
+    #[inline(always)]
+    pub(crate) fn tile_edge(&self, axis: usize, i: u32) -> f64 {
+        -self.extent[axis] + i as f64 * self.tile_step[axis]
+    }
+
     /// The constants of every cascade of `grid`.
     pub(crate) fn of(grid: &ClusterGrid) -> Vec<CascadeConstants> {
         let last = grid.cascades.len() - 1;
@@ -122,9 +132,10 @@ impl CascadeConstants {
                     inv_far: if k == last { 0.0 } else { 1.0 / c.z_far },
                     half_tiles: [0.5 * c.tiles_x as f64, 0.5 * c.tiles_y as f64],
                     tile_step: [
-                        2.0 / (c.tiles_x as f64 * grid.ndc_scale[0]),
-                        2.0 / (c.tiles_y as f64 * grid.ndc_scale[1]),
+                        2.0 * (1.0 / grid.ndc_scale[0]) / c.tiles_x as f64,
+                        2.0 * (1.0 / grid.ndc_scale[1]) / c.tiles_y as f64,
                     ],
+                    extent: grid.ndc_scale.map(|s| 1.0 / s),
                     first_slice,
                 };
                 first_slice += c.slices;
