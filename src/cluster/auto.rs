@@ -27,6 +27,7 @@
 use super::assign::{AssignLimits, Assigner};
 use super::grid::{ClusterGrid, GridConfig, GridProjection};
 use super::pack::GpuLight;
+use super::pack_grid::GridEncoding;
 
 /// A new grid must be predicted this much cheaper (relative) than the current one to replace it.
 pub const HYSTERESIS: f64 = 0.1;
@@ -208,10 +209,8 @@ pub struct ChoiceInputs<'a> {
     pub lights: &'a [GpuLight],
     /// Assignment limits.
     pub limits: AssignLimits,
-    /// Bytes per cell and per index of the grid encoding.
-    pub bytes_per_cell: usize,
-    /// Bytes per light index.
-    pub bytes_per_index: usize,
+    /// How the grid and index textures store cells and indices (their bytes).
+    pub encoding: GridEncoding,
 }
 
 /// The first split of a grid for these samples: a little before the nearest surface, rounded
@@ -224,16 +223,19 @@ pub fn first_split(samples: &SurfaceSamples, near: f64) -> Option<f64> {
     (split.is_finite() && split > near).then_some(split)
 }
 
-/// Measures the candidates and picks the cheapest under `costs` (see the module docs).
+/// Measures the candidates and picks the cheapest under `costs` (see the module docs); also
+/// returns the chosen grid as built for its measurement (`None` when no candidate fitted the
+/// cell budget), so the caller need not build it again.
 pub fn choose(
     inputs: &ChoiceInputs,
     samples: &SurfaceSamples,
     costs: &GridCosts,
     assigner: &mut Assigner,
-) -> GridChoice {
+) -> (GridChoice, Option<ClusterGrid>) {
     let split = first_split(samples, inputs.near);
     let covered = samples.covered_pixels();
-    let mut candidates = Vec::new();
+    let mut candidates: Vec<Candidate> = Vec::new();
+    let mut best: Option<(usize, ClusterGrid)> = None;
     let mut rises = 0;
     for &footprint_px in &CANDIDATE_FOOTPRINTS {
         let config = GridConfig {
@@ -248,26 +250,31 @@ pub fn choose(
         }
         let a = assigner.assign(&grid, inputs.lights, inputs.camera_far, &inputs.limits);
         let evals_per_pixel = samples.evals_per_pixel(&grid, &a.counts);
-        let bytes = grid.total_cells as usize * inputs.bytes_per_cell
-            + a.indices.len() * inputs.bytes_per_index;
+        let bytes = grid.total_cells as usize * inputs.encoding.cell_bytes()
+            + a.indices.len() * inputs.encoding.index_bytes();
         let work = (a.indices.len() + grid.total_cells as usize) as f64;
-        let predicted_ms = costs.predict_ms(evals_per_pixel * covered, work, bytes as f64);
-        let rising = candidates
-            .last()
-            .is_some_and(|c: &Candidate| predicted_ms > c.predicted_ms);
-        let overflowed_lights = a.stats.overflowed_lights;
-        let overflow_grew = candidates
-            .last()
-            .is_some_and(|c: &Candidate| overflowed_lights > c.overflowed_lights);
-        candidates.push(Candidate {
+        let candidate = Candidate {
             footprint_px,
             cells: grid.total_cells,
             indices: a.indices.len(),
             evals_per_pixel,
             bytes,
-            predicted_ms,
-            overflowed_lights,
+            predicted_ms: costs.predict_ms(evals_per_pixel * covered, work, bytes as f64),
+            overflowed_lights: a.stats.overflowed_lights,
+        };
+        let (rising, overflow_grew) = candidates.last().map_or((false, false), |last| {
+            (
+                candidate.predicted_ms > last.predicted_ms,
+                candidate.overflowed_lights > last.overflowed_lights,
+            )
         });
+        if best
+            .as_ref()
+            .is_none_or(|(b, _)| better(&candidate, &candidates[*b]))
+        {
+            best = Some((candidates.len(), grid));
+        }
+        candidates.push(candidate);
         rises = if rising { rises + 1 } else { 0 };
         // Past here finer grids only rise further, or overflow the index list more (a per-cell
         // cap overflows less in finer cells, so overflow alone does not stop the search).
@@ -275,25 +282,21 @@ pub fn choose(
             break;
         }
     }
-    // A grid whose lists overflow drops lights from the image: the least overflow first, then
-    // the smallest prediction.
-    let best = candidates
-        .iter()
-        .min_by(|a, b| {
-            (a.overflowed_lights, a.predicted_ms)
-                .partial_cmp(&(b.overflowed_lights, b.predicted_ms))
-                .unwrap_or(std::cmp::Ordering::Equal)
-        })
-        .cloned()
-        .unwrap_or(Candidate {
-            footprint_px: inputs.base.footprint_px,
-            cells: 0,
-            indices: 0,
-            evals_per_pixel: 0.0,
-            bytes: 0,
-            predicted_ms: 0.0,
-            overflowed_lights: 0,
-        });
+    let (best, grid) = match best {
+        Some((i, grid)) => (candidates[i].clone(), Some(grid)),
+        None => (
+            Candidate {
+                footprint_px: inputs.base.footprint_px,
+                cells: 0,
+                indices: 0,
+                evals_per_pixel: 0.0,
+                bytes: 0,
+                predicted_ms: 0.0,
+                overflowed_lights: 0,
+            },
+            None,
+        ),
+    };
     let reason = format!(
         "auto: {} px predicted {:.2} ms ({:.1} evaluations per pixel, {} cells, {} indices) \
          with costs per evaluation {:.1} ns, per assignment unit {:.1} ns, per byte {:.2} ns \
@@ -313,7 +316,7 @@ pub fn choose(
         },
         samples.points.len(),
     );
-    GridChoice {
+    let choice = GridChoice {
         config: GridConfig {
             footprint_px: best.footprint_px,
             first_split: split,
@@ -321,7 +324,14 @@ pub fn choose(
         },
         reason,
         candidates,
-    }
+    };
+    (choice, grid)
+}
+
+/// Whether candidate `a` beats `b`: a grid whose lists overflow drops lights from the image,
+/// so the least overflow first, then the smallest prediction.
+fn better(a: &Candidate, b: &Candidate) -> bool {
+    (a.overflowed_lights, a.predicted_ms) < (b.overflowed_lights, b.predicted_ms)
 }
 
 /// Whether `new` should replace `current`: only when predicted at least [`HYSTERESIS`] cheaper
@@ -406,8 +416,7 @@ mod tests {
                 cell_cap: u32::MAX,
                 ..AssignLimits::default()
             },
-            bytes_per_cell: 8,
-            bytes_per_index: 2,
+            encoding: GridEncoding::Uint,
         }
     }
 
@@ -416,8 +425,8 @@ mod tests {
     fn the_choice_is_deterministic_for_given_costs() {
         let (lights, samples) = workload(600);
         let costs = GridCosts::default();
-        let a = choose(&inputs(&lights), &samples, &costs, &mut Assigner::new());
-        let b = choose(&inputs(&lights), &samples, &costs, &mut Assigner::new());
+        let a = choose(&inputs(&lights), &samples, &costs, &mut Assigner::new()).0;
+        let b = choose(&inputs(&lights), &samples, &costs, &mut Assigner::new()).0;
         assert_eq!(a, b);
         assert!(a.candidates.len() >= 3, "{:?}", a.candidates);
     }
@@ -433,7 +442,7 @@ mod tests {
                 shade_ns,
                 ..GridCosts::default()
             };
-            let choice = choose(&inputs(&lights), &samples, &costs, &mut Assigner::new());
+            let choice = choose(&inputs(&lights), &samples, &costs, &mut Assigner::new()).0;
             let best = choice
                 .candidates
                 .iter()
@@ -461,7 +470,8 @@ mod tests {
             &samples,
             &GridCosts::default(),
             &mut Assigner::new(),
-        );
+        )
+        .0;
         assert!(!should_switch(&choice.config, &choice));
         for c in &choice.candidates {
             let current = GridConfig {
@@ -480,7 +490,7 @@ mod tests {
         let mut costs = GridCosts::default();
         for (k, shade) in [19.0, 21.0, 20.5, 19.5].into_iter().enumerate() {
             costs.shade_ns = shade;
-            let again = choose(&inputs(&lights), &samples, &costs, &mut Assigner::new());
+            let again = choose(&inputs(&lights), &samples, &costs, &mut Assigner::new()).0;
             assert!(
                 !should_switch(&choice.config, &again)
                     || again.config.footprint_px == choice.config.footprint_px,
@@ -498,7 +508,8 @@ mod tests {
             &samples,
             &GridCosts::default(),
             &mut Assigner::new(),
-        );
+        )
+        .0;
         let coarsest = roomy.candidates[0].indices;
         let mut tight = inputs(&lights);
         tight.limits.max_indices = coarsest + 1;
@@ -506,7 +517,7 @@ mod tests {
             shade_ns: 1000.0,
             ..GridCosts::default()
         };
-        let choice = choose(&tight, &samples, &costs, &mut Assigner::new());
+        let choice = choose(&tight, &samples, &costs, &mut Assigner::new()).0;
         assert_eq!(choice.config.footprint_px, CANDIDATE_FOOTPRINTS[0]);
         assert!(choice.candidates.len() >= 2, "a finer grid was measured");
         assert!(choice.candidates[1].overflowed_lights > 0);

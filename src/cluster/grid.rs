@@ -290,25 +290,18 @@ impl ClusterGrid {
         };
         let c = config.cascades.max(1);
         let min_cell = config.min_cell_size.unwrap_or(0.0).max(0.0);
+        let split = config.first_split.filter(|d| d.is_finite());
         let (mapping, d0) = match projection {
             // The first split is moved back from a tiny near plane (Olsson's remedy) but
             // never past 1/4096 of the far end: a 1e-4 near plane does not make 12 cascades
             // of microscopic cells.
             GridProjection::Perspective { .. } => (
                 DepthMapping::Log2,
-                config
-                    .first_split
-                    .filter(|d| d.is_finite())
-                    .unwrap_or(far / 4096.0)
-                    .max(near)
-                    .min(far * 0.5),
+                split.unwrap_or(far / 4096.0).max(near).min(far * 0.5),
             ),
             GridProjection::Orthographic { .. } => (
                 DepthMapping::Linear,
-                config
-                    .first_split
-                    .filter(|d| d.is_finite())
-                    .map_or(near, |d| d.max(near).min(near + (far - near) * 0.5)),
+                split.map_or(near, |d| d.max(near).min(near + (far - near) * 0.5)),
             ),
         };
         let (fa, ff) = match mapping {
@@ -600,6 +593,10 @@ mod tests {
     use super::*;
 
     fn persp(near: f64, far: f64) -> ClusterGrid {
+        persp_with(near, far, &GridConfig::default())
+    }
+
+    fn persp_with(near: f64, far: f64, config: &GridConfig) -> ClusterGrid {
         let t = (30f64).to_radians().tan();
         ClusterGrid::new(
             1280,
@@ -610,7 +607,7 @@ mod tests {
             },
             near,
             far,
-            &GridConfig::default(),
+            config,
         )
     }
 
@@ -698,14 +695,7 @@ mod tests {
             .cascades
             .iter()
             .all(|c| c.tiles_y == g.cascades[0].tiles_y));
-        let t = (30f64).to_radians().tan();
-        let coarse = ClusterGrid::new(
-            1280,
-            720,
-            GridProjection::Perspective {
-                tan_x: t * 16.0 / 9.0,
-                tan_y: t,
-            },
+        let coarse = persp_with(
             0.1,
             80.0,
             &GridConfig {

@@ -50,6 +50,21 @@ pub enum GridEncoding {
     Uint,
 }
 
+impl GridEncoding {
+    /// Bytes per cell in the grid texture.
+    pub fn cell_bytes(self) -> usize {
+        match self {
+            GridEncoding::Rgba8 => 4,
+            GridEncoding::Uint => 8,
+        }
+    }
+
+    /// Bytes per light index in the index texture (16-bit light numbers either way).
+    pub fn index_bytes(self) -> usize {
+        2
+    }
+}
+
 /// Texels ready to upload.
 #[derive(Clone, Debug, PartialEq)]
 pub struct PackedTexels {
@@ -75,10 +90,7 @@ pub fn pack_grid(grid: &ClusterGrid, a: &Assignment, encoding: GridEncoding) -> 
     let table = grid.cascades.len() * TABLE_TEXELS_PER_CASCADE as usize;
     let texels = table + grid.total_cells as usize;
     let height = rows_for(texels);
-    let bpt = match encoding {
-        GridEncoding::Rgba8 => 4,
-        GridEncoding::Uint => 8,
-    };
+    let bpt = encoding.cell_bytes();
     let mut bytes = vec![0u8; DATA_TEXTURE_WIDTH as usize * height as usize * bpt];
     let mut put = |texel: usize, pair: (u32, u32), rgba8: [u8; 4]| {
         let at = texel * bpt;

@@ -81,15 +81,13 @@ pub struct CulledForward {
     assigner: Assigner,
     /// The automatic grid's choice and calibration (clustered, [`GridMode::Auto`]).
     auto: AutoGrid,
-    /// Why the current grid is what it is.
-    grid_reason: String,
 }
 
 /// What the grid depends on; it is rebuilt only when this changes.
 #[derive(Clone, Debug, PartialEq)]
 struct GridKey {
     size: (u32, u32),
-    projection: [u64; 4],
+    projection: GridProjection,
     near: u64,
     far: u64,
     config: GridConfig,
@@ -105,52 +103,55 @@ impl CulledForward {
             grid: None,
             assigner: Assigner::new(),
             auto: AutoGrid::default(),
-            grid_reason: String::new(),
         }
     }
 
     /// Rebuilds the grid when the viewport, projection or grid settings changed (the
     /// automatic grid's included).
-    fn update_grid(&mut self, ctx: &FrameContext, limits: &AssignLimits, bytes: (usize, usize)) {
+    fn update_grid(&mut self, ctx: &FrameContext, limits: &AssignLimits, encoding: GridEncoding) {
         let projection = GridProjection::from_matrix(&ctx.projection.as_dmat4());
-        let config = match self.culling {
-            Culling::Clustered if ctx.options.grid.mode == GridMode::Auto => {
-                let choice = self.auto.config(ctx, projection, limits, bytes);
-                self.grid_reason.clone_from(&choice.reason);
-                choice.config.clone()
+        let (config, fresh) = match self.culling {
+            Culling::Clustered if self.automatic(ctx) => {
+                let choice = self.auto.config(ctx, projection, limits, encoding);
+                (choice.config.clone(), self.auto.take_fresh_grid())
             }
-            Culling::Clustered => {
-                self.grid_reason = grid_choice::fixed_reason(&ctx.options.grid);
-                ctx.options.grid.clone()
-            }
+            Culling::Clustered => (ctx.options.grid.clone(), None),
             // Tiled shares the clustered grid's coverage setting (to measure it).
-            Culling::Tiled => {
-                self.grid_reason = format!("tiled: tile_px = {}", ctx.options.tile_px);
+            Culling::Tiled => (
                 GridConfig {
                     coverage: ctx.options.grid.coverage,
                     ..GridConfig::tiles(ctx.options.tile_px)
-                }
-            }
-        };
-        let proj_bits = match projection {
-            GridProjection::Perspective { tan_x, tan_y } => {
-                [0, tan_x.to_bits(), tan_y.to_bits(), 0]
-            }
-            GridProjection::Orthographic { half_x, half_y } => {
-                [1, half_x.to_bits(), half_y.to_bits(), 0]
-            }
+                },
+                None,
+            ),
         };
         let key = GridKey {
             size: ctx.viewport,
-            projection: proj_bits,
+            projection,
             near: ctx.near.to_bits(),
             far: ctx.content_far.to_bits(),
             config: config.clone(),
         };
         if self.grid.as_ref().map(|(k, _)| k) != Some(&key) {
             let (w, h) = ctx.viewport;
-            let grid = ClusterGrid::new(w, h, projection, ctx.near, ctx.content_far, &config);
+            let grid = fresh.unwrap_or_else(|| {
+                ClusterGrid::new(w, h, projection, ctx.near, ctx.content_far, &config)
+            });
             self.grid = Some((key, grid));
+        }
+    }
+
+    /// Whether this frame's grid is the automatic one.
+    fn automatic(&self, ctx: &FrameContext) -> bool {
+        self.culling == Culling::Clustered && ctx.options.grid.mode == GridMode::Auto
+    }
+
+    /// Why the grid is what it is, for the frame's stats.
+    fn grid_reason(&self, ctx: &FrameContext) -> String {
+        match self.culling {
+            Culling::Tiled => format!("tiled: tile_px = {}", ctx.options.tile_px),
+            Culling::Clustered if self.automatic(ctx) => self.auto.reason().to_string(),
+            Culling::Clustered => grid_choice::fixed_reason(&ctx.options.grid),
         }
     }
 }
@@ -188,11 +189,9 @@ impl ShadingMethod for CulledForward {
         };
         let camera_far = ctx.far;
         let lights = ctx.lights;
-        let bytes = match es {
-            EsVersion::Es2 => (4, 2),
-            EsVersion::Es3 => (8, 2),
-        };
-        self.update_grid(ctx, &limits, bytes);
+        self.update_grid(ctx, &limits, grid_encoding);
+        let automatic = self.automatic(ctx);
+        let grid_reason = self.grid_reason(ctx);
         let (grid_key, grid) = self.grid.as_ref().expect("updated above");
         let started = Instant::now();
         let assignment = self.assigner.assign(grid, lights, camera_far, &limits);
@@ -249,7 +248,7 @@ impl ShadingMethod for CulledForward {
         let upload_bytes =
             packed_lights.bytes.len() + packed_grid.bytes.len() + packed_indices.bytes.len();
         let upload_ms = upload_started.elapsed().as_secs_f64() * 1e3;
-        if self.culling == Culling::Clustered && ctx.options.grid.mode == GridMode::Auto {
+        if automatic {
             let work = (assignment.indices.len() + grid.total_cells as usize) as f64;
             self.auto.record(
                 grid,
@@ -301,7 +300,7 @@ impl ShadingMethod for CulledForward {
             grid: Some(GridReport {
                 footprint_px: grid_key.config.footprint_px,
                 cells: grid.total_cells,
-                reason: self.grid_reason.clone(),
+                reason: grid_reason,
             }),
             ..MethodStats::default()
         })

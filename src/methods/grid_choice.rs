@@ -8,6 +8,7 @@ use super::FrameContext;
 use crate::cluster::assign::{AssignLimits, Assigner};
 use crate::cluster::auto::{self, ChoiceInputs, FrameCost, GridChoice, GridCosts, SurfaceSamples};
 use crate::cluster::grid::{ClusterGrid, GridConfig, GridProjection};
+use crate::cluster::pack_grid::GridEncoding;
 use crate::metrics::raycast::SceneRaycaster;
 
 /// Rays of the surface sample, across and down (1 296 rays).
@@ -30,7 +31,7 @@ type GeometryKey = Vec<(usize, [u64; 16])>;
 #[derive(Clone, Debug, PartialEq)]
 struct Layout {
     size: (u32, u32),
-    projection: [u64; 2],
+    projection: GridProjection,
     near: u64,
     /// The user's grid settings (what the choice does not set).
     base: GridConfig,
@@ -57,6 +58,9 @@ pub(crate) struct AutoGrid {
     /// The current frame made a choice: its time holds the candidates' assignments and
     /// (first frame) shader compiles, so it calibrates nothing.
     chose_this_frame: bool,
+    /// The grid of a choice just made, as built to measure it (see
+    /// [`AutoGrid::take_fresh_grid`]).
+    fresh_grid: Option<ClusterGrid>,
 }
 
 impl AutoGrid {
@@ -66,16 +70,11 @@ impl AutoGrid {
         ctx: &FrameContext,
         projection: GridProjection,
         limits: &AssignLimits,
-        bytes: (usize, usize),
+        encoding: GridEncoding,
     ) -> &GridChoice {
         let layout = Layout {
             size: ctx.viewport,
-            projection: match projection {
-                GridProjection::Perspective { tan_x, tan_y } => [tan_x.to_bits(), tan_y.to_bits()],
-                GridProjection::Orthographic { half_x, half_y } => {
-                    [half_x.to_bits(), half_y.to_bits()]
-                }
-            },
+            projection,
             near: ctx.near.to_bits(),
             base: ctx.options.grid.clone(),
         };
@@ -100,10 +99,9 @@ impl AutoGrid {
                 base: ctx.options.grid.clone(),
                 lights: ctx.lights,
                 limits: *limits,
-                bytes_per_cell: bytes.0,
-                bytes_per_index: bytes.1,
+                encoding,
             };
-            let new = auto::choose(&inputs, &self.samples, &self.costs, &mut self.assigner);
+            let (new, grid) = auto::choose(&inputs, &self.samples, &self.costs, &mut self.assigner);
             let keep = self.layout.as_ref() == Some(&layout)
                 && self
                     .choice
@@ -125,6 +123,7 @@ impl AutoGrid {
                 current.candidates = new.candidates;
             } else {
                 self.choice = Some(new);
+                self.fresh_grid = grid;
             }
             self.layout = Some(layout);
             self.view_at_choice = Some((ctx.view, ctx.lights.len()));
@@ -132,6 +131,19 @@ impl AutoGrid {
             self.choices += 1;
         }
         self.choice.as_ref().expect("chosen above")
+    }
+
+    /// The grid of the choice [`AutoGrid::config`] just made, built from the same viewport,
+    /// projection, depths and settings the caller builds its grid from: taking it saves
+    /// building that grid (and its cell spheres) a second time. `None` when this frame kept
+    /// the grid it had.
+    pub(crate) fn take_fresh_grid(&mut self) -> Option<ClusterGrid> {
+        self.fresh_grid.take()
+    }
+
+    /// Why the current grid is what it is.
+    pub(crate) fn reason(&self) -> &str {
+        self.choice.as_ref().map_or("", |c| c.reason.as_str())
     }
 
     /// Records what this frame's CPU side cost; the shading time follows in
