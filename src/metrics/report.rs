@@ -283,8 +283,6 @@ pub fn markdown(report: &Report) -> String {
             });
         for r in auto_rows.chain(knobs.iter().copied()) {
             let knob = if r.knob == "default" { "auto" } else { &r.knob };
-            let opt =
-                |v: Option<f64>, digits: usize| v.map_or("—".into(), |v| format!("{v:.digits$}"));
             let _ = writeln!(
                 s,
                 "| {} | {} | {} | {} | {} | {} | {} | {:.1} | {:.2} | {:.1} | {} | {:.3} | {} |",
@@ -321,8 +319,12 @@ pub fn markdown(report: &Report) -> String {
     s
 }
 
+/// A figure with `digits` decimals, or "—" when there is none.
+fn opt(v: Option<f64>, digits: usize) -> String {
+    v.map_or("—".into(), |v| format!("{v:.digits$}"))
+}
+
 fn table_row(r: &BenchRow) -> String {
-    let opt = |v: Option<f64>, digits: usize| v.map_or("—".into(), |v| format!("{v:.digits$}"));
     format!(
         "| {} | {} | {:.1} | {:.2} | {:.1} | {} | {:.3} | {} | {} |\n",
         r.method,
