@@ -1,4 +1,4 @@
-//! OBJ + MTL loading: real scenes from ../shared/assets render lit, and bad files give the
+//! OBJ + MTL loading: real scenes from $MANYLIGHT_ASSETS render lit, and bad files give the
 //! errors and warnings the loader promises.
 
 mod common;

@@ -57,16 +57,18 @@ impl Drop for Gpu {
     }
 }
 
-/// `../shared/assets` or `$MANYLIGHT_ASSETS`, if present.
+/// The folder of third-party scenes named by `$MANYLIGHT_ASSETS`, if set and present (nothing
+/// outside the repository is assumed: CI sets the variable).
 pub fn assets_dir() -> Option<PathBuf> {
-    let dir = std::env::var_os("MANYLIGHT_ASSETS")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/assets"));
+    let Some(dir) = std::env::var_os("MANYLIGHT_ASSETS").map(PathBuf::from) else {
+        eprintln!("SKIPPED: MANYLIGHT_ASSETS is not set (a folder with the real OBJ scenes)");
+        return None;
+    };
     if dir.is_dir() {
         Some(dir)
     } else {
         eprintln!(
-            "SKIPPED: assets folder {} not found (set MANYLIGHT_ASSETS)",
+            "SKIPPED: MANYLIGHT_ASSETS folder {} not found",
             dir.display()
         );
         None

@@ -35,7 +35,7 @@ pub struct BenchArgs {
     #[arg(long, default_value = "bench-report")]
     pub out: PathBuf,
     /// Scenes (built-in names, .obj or .json files), comma separated. Default: the built-ins,
-    /// and the conference room when ../shared/assets (or $MANYLIGHT_ASSETS) has it.
+    /// and the conference room when $MANYLIGHT_ASSETS has it.
     #[arg(long, value_delimiter = ',')]
     pub scenes: Vec<String>,
     /// Light counts, comma separated (default 0,8,64,256,1024,4096).
@@ -122,11 +122,9 @@ impl Plan {
     }
 }
 
-/// The conference room of ../shared/assets (or $MANYLIGHT_ASSETS), when present.
+/// The conference room of $MANYLIGHT_ASSETS, when set and present.
 fn conference() -> Option<String> {
-    let dir = std::env::var_os("MANYLIGHT_ASSETS")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from("../shared/assets"));
+    let dir = PathBuf::from(std::env::var_os("MANYLIGHT_ASSETS")?);
     let obj = dir.join("conference/conference.obj");
     obj.is_file().then(|| obj.to_string_lossy().into_owned())
 }
