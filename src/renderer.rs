@@ -474,12 +474,15 @@ impl Renderer {
         }
         // No lights: no assignment, no uploads, the light loop compiled out — whatever the
         // method (a scene pays only for what it has).
-        let method_stats = if lights.is_empty() {
-            methods::geometry::draw_ambient_only(&mut ctx)?
+        let rendered = if lights.is_empty() {
+            methods::geometry::draw_ambient_only(&mut ctx)
         } else {
-            self.method.render(&mut ctx)?
+            self.method.render(&mut ctx)
         };
+        // The query ends on the error path too: one left active makes the next frame's
+        // `glBeginQuery` fail.
         let gpu_ms = timer.and_then(|t| t.end(&self.dev));
+        let method_stats = rendered?;
         if options.wait_for_gpu {
             self.dev.finish();
         }
