@@ -135,3 +135,38 @@ fn overflow_policy_holds_in_a_real_render() {
     let (_, stats) = render(&mut gpu, "clustered", &scene, &tight);
     assert!(stats.overflowed_lights > 0);
 }
+
+/// A fixed grid too fine for the context's grid texture is refused before anything is
+/// assigned, naming the setting; the automatic grid never builds one.
+#[test]
+fn a_grid_the_texture_cannot_hold_is_a_clear_error() {
+    use manylight::cluster::grid::GridConfig;
+    let scene = scene::builtin::build("pillars", Some((64, 1))).unwrap();
+    let mut gpu = Gpu::new(EsVersion::Es3);
+    gpu.r().set_method("clustered").unwrap();
+    // 640 × 360 one-pixel cells, 64 slices in each of 12 cascades: 177 million cells, more
+    // than any texture of 1 024-texel rows holds (32 768 rows would be 33.5 million).
+    let options = RenderOptions {
+        grid: GridConfig {
+            max_tiles: 1024,
+            max_slices: 64,
+            ..GridConfig::fixed(1.0)
+        },
+        ..RenderOptions::default()
+    };
+    match gpu.r().render_offscreen(&scene, 640, 360, &options) {
+        Err(manylight::Error::Limit(message)) => {
+            assert!(message.contains("grid.footprint_px"), "{message}")
+        }
+        other => panic!(
+            "expected a limit error, got {:?}",
+            other.map(|(_, s)| s.grid_cells)
+        ),
+    }
+    let (_, stats) = gpu
+        .r()
+        .render_offscreen(&scene, 640, 360, &RenderOptions::default())
+        .unwrap();
+    assert!(stats.grid_cells <= manylight::cluster::auto::CELL_BUDGET);
+    assert!(stats.grid_reason.unwrap().starts_with("auto"));
+}

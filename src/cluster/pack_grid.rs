@@ -85,10 +85,15 @@ fn be24(v: u32) -> [u8; 3] {
     [b[1], b[2], b[3]]
 }
 
+/// Texels of `grid`'s grid texture: the cascade table, then one per cell.
+pub fn grid_texels(grid: &ClusterGrid) -> usize {
+    grid.cascades.len() * TABLE_TEXELS_PER_CASCADE as usize + grid.total_cells as usize
+}
+
 /// Packs the cascade table and the per-cell (offset, count).
 pub fn pack_grid(grid: &ClusterGrid, a: &Assignment, encoding: GridEncoding) -> PackedTexels {
     let table = grid.cascades.len() * TABLE_TEXELS_PER_CASCADE as usize;
-    let texels = table + grid.total_cells as usize;
+    let texels = grid_texels(grid);
     let height = rows_for(texels);
     let bpt = encoding.cell_bytes();
     let mut bytes = vec![0u8; DATA_TEXTURE_WIDTH as usize * height as usize * bpt];

@@ -17,7 +17,8 @@ use crate::cluster::auto::FrameCost;
 use crate::cluster::grid::{ClusterGrid, GridConfig, GridMode, GridProjection};
 use crate::cluster::pack::{pack_lights, GpuLight, LightEncoding, DATA_TEXTURE_WIDTH};
 use crate::cluster::pack_grid::{
-    pack_grid, pack_indices, GridEncoding, MAX_INDEXED_LIGHTS, RGBA8_CELL_CAP, RGBA8_OFFSET_LIMIT,
+    grid_texels, pack_grid, pack_indices, GridEncoding, MAX_INDEXED_LIGHTS, RGBA8_CELL_CAP,
+    RGBA8_OFFSET_LIMIT,
 };
 use crate::gl::texture::{DataFormat, DataTexture};
 use crate::gl::{Device, EsVersion};
@@ -193,6 +194,18 @@ impl ShadingMethod for CulledForward {
         let automatic = self.automatic(ctx);
         let grid_reason = self.grid_reason(ctx);
         let (grid_key, grid) = self.grid.as_ref().expect("updated above");
+        // Refused before any assignment: a grid the texture cannot hold would only fail at the
+        // upload, after allocating its lists.
+        let texels = grid_texels(grid);
+        if texels > max_rows * DATA_TEXTURE_WIDTH as usize {
+            return Err(Error::Limit(format!(
+                "a {} px cell footprint (grid.footprint_px) makes {} grid cells; this context's \
+                 grid texture holds {}: use a larger footprint or the automatic grid",
+                grid_key.config.footprint_px,
+                grid.total_cells,
+                max_rows * DATA_TEXTURE_WIDTH as usize - (texels - grid.total_cells as usize)
+            )));
+        }
         let started = Instant::now();
         let assignment = self.assigner.assign(grid, lights, camera_far, &limits);
         let assign_ms = started.elapsed().as_secs_f64() * 1e3;
