@@ -6,6 +6,7 @@
 //!
 //! ```text
 //!  renderer ──► methods/ (forward, …)   one file per shading method + the METHODS table
+//!           ├─► options, gpu_scene  what a frame is asked to do; the scene's uploaded meshes
 //!           ├─► cluster/  GL-free CPU light data (texel packing, later the cluster grid)
 //!           ├─► scene/    GL-free scenes: camera, lights, meshes, materials, OBJ, built-ins
 //!           ├─► metrics/  image comparison
@@ -29,8 +30,10 @@
 pub mod cluster;
 pub mod error;
 pub mod gl;
+pub mod gpu_scene;
 pub mod methods;
 pub mod metrics;
+pub mod options;
 pub mod renderer;
 pub mod scene;
 
@@ -41,4 +44,5 @@ pub use error::Error;
 #[doc = include_str!("../README.md")]
 pub struct ReadmeDoctests;
 pub use gl::EsVersion;
-pub use renderer::{FrameStats, RenderOptions, Renderer};
+pub use options::{CountKind, RenderOptions};
+pub use renderer::{FrameStats, Renderer};

@@ -1,116 +1,23 @@
 //! The renderer: owns the GL device, the program cache, the uploaded scene and the current
 //! shading method; renders a [`Scene`] and reports [`FrameStats`].
 
-use std::collections::HashMap;
-use std::sync::Arc;
 use std::time::Instant;
 
 use glam::DMat4;
 use serde::Serialize;
 
 use crate::cluster::assign::AssignStats;
-use crate::cluster::grid::GridConfig;
 use crate::cluster::pack::GpuLight;
-use crate::cluster::tiles::TILE_PX;
 use crate::gl::framebuffer::{ColorFormat, OffscreenTarget};
-use crate::gl::mesh::GpuMesh;
 use crate::gl::program::ProgramCache;
-use crate::gl::texture::ImageTexture;
 use crate::gl::{Caps, Device, EsVersion};
+pub use crate::gpu_scene::GpuScene;
 use crate::methods::{self, FrameContext, ShaderFeatures, ShadingMethod, Support};
 pub use crate::metrics::counts::LightCounts;
+pub use crate::options::{CountKind, RenderOptions};
 use crate::scene::features::SceneFeatures;
-use crate::scene::{Aabb, Material, Mesh, Projection, Scene, Texture};
+use crate::scene::{Aabb, Projection, Scene};
 use crate::Error;
-
-/// Per-call rendering options.
-#[derive(Clone, Debug)]
-pub struct RenderOptions {
-    /// Write linear values (clamped to [0, 1], no sRGB encoding, no tone map) so pixels can be
-    /// checked against the light model.
-    pub linear: bool,
-    /// Pack lights as RGBA8 even where float textures exist (to measure the packing error).
-    pub force_rgba8_lights: bool,
-    /// Background colour (linear if `linear`, else as stored).
-    pub clear_color: [f32; 4],
-    /// Frames timed after one warm-up frame by [`Renderer::render_offscreen`]; the median is
-    /// reported. 0 times the single (cold) frame.
-    pub timed_frames: u32,
-    /// Cluster grid of the clustered method.
-    pub grid: GridConfig,
-    /// Tile size in pixels of the tiled method.
-    pub tile_px: f64,
-    /// Most lights per cell (tiled/clustered); ES 2.0 never exceeds 255. `None`: no cap
-    /// beyond the encoding's.
-    pub cell_cap: Option<u32>,
-    /// Most indices in a frame's light lists (tiled/clustered); `None`: what the index texture
-    /// holds. Lower values exercise the overflow policy.
-    pub max_indices: Option<usize>,
-    /// Wait for the GPU (`glFinish`) at the end of [`Renderer::render`] so `frame_ms` is the
-    /// full frame time. Offscreen rendering and benchmarks want this; a game presenting to a
-    /// window sets it to `false` and `frame_ms` is then the CPU submission time only.
-    pub wait_for_gpu: bool,
-    /// Write linear, unclamped radiance (for float targets; see
-    /// [`Renderer::render_offscreen_hdr`]).
-    pub hdr: bool,
-    /// Evaluate the light model's mediump tier at highp as well (the `reference_precision`
-    /// variant): the reference image error is measured against. Off, colour factors run at
-    /// mediump as a mobile build wants (see `glsl/light_model.glsl`).
-    pub reference_precision: bool,
-    /// What the frame writes: colour, or per-pixel light counts (see
-    /// [`Renderer::render_light_counts`], which sets this).
-    pub count: CountKind,
-    /// Light cut-off in linear radiance: each light is culled (assigned to cells, or given a
-    /// proxy volume) only out to where its contribution falls below this, instead of to its
-    /// radius, trading error for time (tiled, clustered, deferred; forward loops over every
-    /// light regardless). `None`: cull at the radius, exactly.
-    pub light_cutoff: Option<f32>,
-    /// Lights at which [`CountKind::Heatmap`]'s colour map tops out.
-    pub heat_scale: f32,
-    /// Compile every variant with spot, specular and texture code even where the scene lacks
-    /// them (a white texture stands in) — to measure what leaving features out saves, and to
-    /// test that it changes nothing in the image.
-    pub full_variants: bool,
-}
-
-impl Default for RenderOptions {
-    fn default() -> Self {
-        RenderOptions {
-            linear: false,
-            force_rgba8_lights: false,
-            clear_color: [0.0, 0.0, 0.0, 1.0],
-            timed_frames: 0,
-            grid: GridConfig::default(),
-            tile_px: TILE_PX,
-            cell_cap: None,
-            max_indices: None,
-            wait_for_gpu: true,
-            hdr: false,
-            reference_precision: false,
-            count: CountKind::None,
-            light_cutoff: None,
-            heat_scale: 64.0,
-            full_variants: false,
-        }
-    }
-}
-
-/// Per-pixel light counts instead of colour.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum CountKind {
-    /// Colour (a normal frame).
-    #[default]
-    None,
-    /// Lights the method evaluates per pixel (its loop length, or its proxy volumes there).
-    Evals,
-    /// Lights whose sphere (and cone) reaches the pixel's surface point: the lower bound of
-    /// any culling, evaluated by a plain-forward pass whatever the method.
-    Reaching,
-    /// `Evals` drawn through a colour map (viridis, 0 to [`RenderOptions::heat_scale`]
-    /// lights) into whatever target is bound, for looking at: the viewer's heatmap.
-    Heatmap,
-}
 
 /// What one frame did.
 #[derive(Clone, Debug, Serialize)]
@@ -178,87 +85,6 @@ pub struct FrameStats {
     /// Why the grid is what it is: the automatic choice's prediction and costs, or the fixed
     /// setting.
     pub grid_reason: Option<String>,
-}
-
-/// Meshes and textures of scenes, uploaded once and found again by identity. The cache holds
-/// an `Arc` of each source, so a key can never be reused by another allocation.
-#[derive(Default)]
-pub struct GpuScene {
-    /// Uploaded meshes with their object-space bounds (computed once, not every frame).
-    meshes: HashMap<usize, (Arc<Mesh>, GpuMesh, Option<Aabb>)>,
-    textures: HashMap<usize, (Arc<Texture>, ImageTexture)>,
-    /// 1×1 white texture for full variants on untextured materials (made on first use).
-    white: Option<ImageTexture>,
-}
-
-impl GpuScene {
-    fn upload(&mut self, dev: &Device, scene: &Scene, full_variants: bool) -> Result<(), Error> {
-        if full_variants && self.white.is_none() {
-            let white = image::RgbaImage::from_pixel(1, 1, image::Rgba([255, 255, 255, 255]));
-            self.white = Some(ImageTexture::new(dev, &white)?);
-        }
-        for o in &scene.objects {
-            let key = Arc::as_ptr(&o.mesh) as usize;
-            if let std::collections::hash_map::Entry::Vacant(e) = self.meshes.entry(key) {
-                e.insert((o.mesh.clone(), GpuMesh::new(dev, &o.mesh)?, o.mesh.bounds()));
-            }
-        }
-        for m in &scene.materials {
-            if let Some(t) = &m.diffuse_texture {
-                let key = Arc::as_ptr(t) as usize;
-                if let std::collections::hash_map::Entry::Vacant(e) = self.textures.entry(key) {
-                    e.insert((t.clone(), ImageTexture::new(dev, &t.image)?));
-                }
-            }
-        }
-        Ok(())
-    }
-
-    /// The uploaded mesh of an object (the scene must have been uploaded).
-    pub fn mesh(&self, object: &crate::scene::Object) -> &GpuMesh {
-        &self.meshes[&(Arc::as_ptr(&object.mesh) as usize)].1
-    }
-
-    /// World-space bounds of an object, from its mesh's cached bounds (the scene must have
-    /// been uploaded).
-    pub fn world_bounds(&self, object: &crate::scene::Object) -> Option<Aabb> {
-        let (_, _, bounds) = &self.meshes[&(Arc::as_ptr(&object.mesh) as usize)];
-        bounds.map(|b| b.transformed(&object.transform))
-    }
-
-    /// World-space bounds of the whole scene ([`Scene::bounds`] without walking every vertex).
-    pub fn scene_bounds(&self, scene: &Scene) -> Option<Aabb> {
-        scene
-            .objects
-            .iter()
-            .filter_map(|o| self.world_bounds(o))
-            .reduce(|a, b| a.union(&b))
-    }
-
-    /// The uploaded diffuse texture of a material, if it has one.
-    pub fn texture_for(&self, material: &Material) -> Option<&ImageTexture> {
-        let t = material.diffuse_texture.as_ref()?;
-        self.textures
-            .get(&(Arc::as_ptr(t) as usize))
-            .map(|(_, g)| g)
-    }
-
-    /// The white stand-in texture (only after an upload with full variants).
-    pub fn white(&self) -> Option<&ImageTexture> {
-        self.white.as_ref()
-    }
-
-    fn destroy(&mut self, dev: &Device) {
-        for (_, (_, mut m, _)) in self.meshes.drain() {
-            m.destroy(dev);
-        }
-        for (_, (_, mut t)) in self.textures.drain() {
-            t.destroy(dev);
-        }
-        if let Some(mut w) = self.white.take() {
-            w.destroy(dev);
-        }
-    }
 }
 
 /// Renders scenes with one shading method at a time.

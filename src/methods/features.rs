@@ -31,7 +31,7 @@ impl ShaderFeatures {
     /// `cluster::pack`), so a bright light does not overflow to infinity.
     pub const FP16_LIGHTS: u64 = 1 << 8;
     /// Instead of a colour, write the number of lights the fragment's loop runs over (the
-    /// light-evaluation count; see [`crate::renderer::CountKind`]).
+    /// light-evaluation count; see [`crate::options::CountKind`]).
     pub const COUNT_EVALS: u64 = 1 << 9;
     /// Instead of a colour, write the number of lights whose sphere (and cone) reaches the
     /// fragment: the lower bound of any per-pixel culling (forward only).

@@ -17,7 +17,8 @@ pub mod tiled;
 use crate::cluster::pack::GpuLight;
 use crate::gl::program::ProgramCache;
 use crate::gl::{Caps, Device, EsVersion};
-use crate::renderer::{GpuScene, RenderOptions};
+use crate::gpu_scene::GpuScene;
+use crate::options::RenderOptions;
 use crate::scene::Scene;
 use crate::Error;
 

@@ -1,0 +1,96 @@
+//! Per-call rendering options: what a caller asks of a frame. Below the shading methods and
+//! the renderer, which both read them.
+
+use serde::Serialize;
+
+use crate::cluster::grid::GridConfig;
+use crate::cluster::tiles::TILE_PX;
+
+/// Per-call rendering options.
+#[derive(Clone, Debug)]
+pub struct RenderOptions {
+    /// Write linear values (clamped to [0, 1], no sRGB encoding, no tone map) so pixels can be
+    /// checked against the light model.
+    pub linear: bool,
+    /// Pack lights as RGBA8 even where float textures exist (to measure the packing error).
+    pub force_rgba8_lights: bool,
+    /// Background colour (linear if `linear`, else as stored).
+    pub clear_color: [f32; 4],
+    /// Frames timed after one warm-up frame by [`Renderer::render_offscreen`](crate::Renderer::render_offscreen); the median is
+    /// reported. 0 times the single (cold) frame.
+    pub timed_frames: u32,
+    /// Cluster grid of the clustered method.
+    pub grid: GridConfig,
+    /// Tile size in pixels of the tiled method.
+    pub tile_px: f64,
+    /// Most lights per cell (tiled/clustered); ES 2.0 never exceeds 255. `None`: no cap
+    /// beyond the encoding's.
+    pub cell_cap: Option<u32>,
+    /// Most indices in a frame's light lists (tiled/clustered); `None`: what the index texture
+    /// holds. Lower values exercise the overflow policy.
+    pub max_indices: Option<usize>,
+    /// Wait for the GPU (`glFinish`) at the end of [`Renderer::render`](crate::Renderer::render) so `frame_ms` is the
+    /// full frame time. Offscreen rendering and benchmarks want this; a game presenting to a
+    /// window sets it to `false` and `frame_ms` is then the CPU submission time only.
+    pub wait_for_gpu: bool,
+    /// Write linear, unclamped radiance (for float targets; see
+    /// [`Renderer::render_offscreen_hdr`](crate::Renderer::render_offscreen_hdr)).
+    pub hdr: bool,
+    /// Evaluate the light model's mediump tier at highp as well (the `reference_precision`
+    /// variant): the reference image error is measured against. Off, colour factors run at
+    /// mediump as a mobile build wants (see `glsl/light_model.glsl`).
+    pub reference_precision: bool,
+    /// What the frame writes: colour, or per-pixel light counts (see
+    /// [`Renderer::render_light_counts`](crate::Renderer::render_light_counts), which sets this).
+    pub count: CountKind,
+    /// Light cut-off in linear radiance: each light is culled (assigned to cells, or given a
+    /// proxy volume) only out to where its contribution falls below this, instead of to its
+    /// radius, trading error for time (tiled, clustered, deferred; forward loops over every
+    /// light regardless). `None`: cull at the radius, exactly.
+    pub light_cutoff: Option<f32>,
+    /// Lights at which [`CountKind::Heatmap`]'s colour map tops out.
+    pub heat_scale: f32,
+    /// Compile every variant with spot, specular and texture code even where the scene lacks
+    /// them (a white texture stands in) — to measure what leaving features out saves, and to
+    /// test that it changes nothing in the image.
+    pub full_variants: bool,
+}
+
+impl Default for RenderOptions {
+    fn default() -> Self {
+        RenderOptions {
+            linear: false,
+            force_rgba8_lights: false,
+            clear_color: [0.0, 0.0, 0.0, 1.0],
+            timed_frames: 0,
+            grid: GridConfig::default(),
+            tile_px: TILE_PX,
+            cell_cap: None,
+            max_indices: None,
+            wait_for_gpu: true,
+            hdr: false,
+            reference_precision: false,
+            count: CountKind::None,
+            light_cutoff: None,
+            heat_scale: 64.0,
+            full_variants: false,
+        }
+    }
+}
+
+/// Per-pixel light counts instead of colour.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum CountKind {
+    /// Colour (a normal frame).
+    #[default]
+    None,
+    /// Lights the method evaluates per pixel (its loop length, or its proxy volumes there).
+    Evals,
+    /// Lights whose sphere (and cone) reaches the pixel's surface point: the lower bound of
+    /// any culling, evaluated by a plain-forward pass whatever the method.
+    Reaching,
+    /// `Evals` drawn through a colour map (viridis, 0 to [`RenderOptions::heat_scale`]
+    /// lights) into whatever target is bound, for looking at: the viewer's heatmap.
+    Heatmap,
+}
