@@ -1,6 +1,8 @@
 //! The command line as a user runs it, including under real driver restrictions
 //! (`MESA_GLES_VERSION_OVERRIDE`, `MESA_EXTENSION_OVERRIDE`) applied to child processes.
 
+mod common;
+
 use std::path::Path;
 use std::process::{Command, Output};
 
@@ -34,7 +36,9 @@ fn mesa_driver(cwd: &Path) -> bool {
     if version.contains("Mesa") {
         true
     } else {
-        eprintln!("SKIPPED: the driver is not Mesa ({version}): MESA_* overrides do not apply");
+        common::skip(&format!(
+            "the driver is not Mesa ({version}): MESA_* overrides do not apply"
+        ));
         false
     }
 }

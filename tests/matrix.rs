@@ -1,5 +1,7 @@
 //! `manylight matrix` as CI runs it: real driver restrictions in child processes.
 
+mod common;
+
 use std::process::Command;
 
 #[test]
@@ -92,12 +94,12 @@ fn matrix_covers_es2_es2_without_float_and_es3_and_every_supported_cell_matches_
             .unwrap()
             .contains("ES 2.0"));
     } else {
-        eprintln!("SKIPPED: the driver is not Mesa: MESA_* override rows are not restricted");
+        common::skip("the driver is not Mesa: MESA_* override rows are not restricted");
     }
     // Desktop GL through OSMesa runs the same methods (skipped where libOSMesa is missing).
     let osmesa = row("desktop GL (OSMesa)");
     match osmesa["error"].as_str() {
-        Some(err) if err.contains("not available") => eprintln!("SKIPPED: OSMesa row: {err}"),
+        Some(err) if err.contains("not available") => common::skip(&format!("OSMesa row: {err}")),
         Some(err) => panic!("OSMesa row failed: {err}"),
         None => {
             assert!(osmesa["gl_version"]

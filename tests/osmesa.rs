@@ -3,6 +3,8 @@
 //! not installed.
 #![cfg(feature = "osmesa")]
 
+mod common;
+
 use manylight::gl::osmesa::OsMesaContext;
 use manylight::gl::HeadlessContext;
 use manylight::methods::METHODS;
@@ -13,7 +15,7 @@ fn osmesa_renders_the_default_scene_through_every_method() {
     let ctx = match OsMesaContext::new() {
         Ok(c) => c,
         Err(e) => {
-            eprintln!("SKIPPED: {e}");
+            common::skip(&e.to_string());
             return;
         }
     };

@@ -6,8 +6,11 @@
 //! Needs Xvfb (`apt-get install xvfb xauth`). Each test starts its own `Xvfb -displayfd`,
 //! which picks a free display itself, so tests running in parallel never race for a display
 //! number the way concurrent `xvfb-run -a` calls can. Without Xvfb the tests print
-//! `SKIPPED: …` and pass.
+//! `SKIPPED: …` and pass (they fail instead where `MANYLIGHT_REQUIRE_ALL_TESTS` is set, as CI
+//! sets it).
 #![cfg(feature = "window")]
+
+mod common;
 
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Output, Stdio};
@@ -98,7 +101,7 @@ fn start_xvfb(xvfb: &Path) -> (Server, String) {
 /// Xvfb exists.
 fn run_view(args: &[&str], env: &[(&str, &str)]) -> Option<Output> {
     let Some(xvfb) = which("Xvfb") else {
-        println!("SKIPPED: no Xvfb on PATH (apt-get install xvfb xauth)");
+        common::skip("no Xvfb on PATH (apt-get install xvfb xauth)");
         return None;
     };
     let (_server, display) = start_xvfb(&xvfb);

@@ -57,22 +57,32 @@ impl Drop for Gpu {
     }
 }
 
-/// The folder of third-party scenes named by `$MANYLIGHT_ASSETS`, if set and present (nothing
-/// outside the repository is assumed: CI sets the variable).
-pub fn assets_dir() -> Option<PathBuf> {
-    let Some(dir) = std::env::var_os("MANYLIGHT_ASSETS").map(PathBuf::from) else {
-        eprintln!("SKIPPED: MANYLIGHT_ASSETS is not set (a folder with the real OBJ scenes)");
-        return None;
-    };
-    if dir.is_dir() {
-        Some(dir)
-    } else {
-        eprintln!(
-            "SKIPPED: MANYLIGHT_ASSETS folder {} not found",
-            dir.display()
-        );
-        None
-    }
+/// The folder of third-party scenes named by `$MANYLIGHT_ASSETS` (nothing outside the
+/// repository is assumed: CI sets the variable; `scripts/fetch-assets` makes such a folder).
+/// Only called by tests marked `#[cfg_attr(not(manylight_assets), ignore = …)]`, which run
+/// only when the variable was set at build time: a set variable naming no folder is a failure,
+/// not a skip.
+pub fn assets_dir() -> PathBuf {
+    let dir = std::env::var_os("MANYLIGHT_ASSETS")
+        .map(PathBuf::from)
+        .expect("MANYLIGHT_ASSETS was set when the tests were built but is not set now");
+    assert!(
+        dir.is_dir(),
+        "MANYLIGHT_ASSETS names {}, which is not a folder (scripts/fetch-assets makes one)",
+        dir.display()
+    );
+    dir
+}
+
+/// A file of the real scenes, which must exist when `MANYLIGHT_ASSETS` is set.
+pub fn asset(relative: &str) -> PathBuf {
+    let path = assets_dir().join(relative);
+    assert!(
+        path.is_file(),
+        "{} is missing from MANYLIGHT_ASSETS (scripts/fetch-assets makes the folder)",
+        path.display()
+    );
+    path
 }
 
 /// The image against the light model evaluated on the CPU in f64 at every pixel the
@@ -88,4 +98,14 @@ pub fn max_oracle_error(
     let set = cpu_reference::reference_samples(scene, w, h, (w * h) as usize, encoding);
     let e = cpu_reference::compare(img, &set);
     (e.max_abs, e.worst, e.samples)
+}
+
+/// A test that cannot run in this environment (no Xvfb, no libOSMesa, a driver without Mesa's
+/// overrides) says so on stderr and returns. With `MANYLIGHT_REQUIRE_ALL_TESTS` set (CI sets
+/// it, where everything is installed) a skip is a failure instead, so nothing passes unrun.
+pub fn skip(reason: &str) {
+    if std::env::var_os("MANYLIGHT_REQUIRE_ALL_TESTS").is_some() {
+        panic!("would skip ({reason}), but MANYLIGHT_REQUIRE_ALL_TESTS is set");
+    }
+    eprintln!("SKIPPED: {reason}");
 }
