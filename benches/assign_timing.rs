@@ -1,4 +1,4 @@
-//! Quick assignment timings for development: `cargo run --release --example assign_timing`.
+//! Quick assignment timings for development: `cargo bench --bench assign_timing`.
 use manylight::cluster::workload::AssignWorkload;
 
 fn main() {

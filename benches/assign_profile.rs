@@ -1,10 +1,14 @@
 //! Development aid: one workload assigned repeatedly with reused buffers (for profilers):
-//! `cargo run --release --example assign_profile -- LIGHTS [REPEATS]`.
+//! `cargo bench --bench assign_profile -- LIGHTS [REPEATS]` (or run its binary under a
+//! profiler).
 use manylight::cluster::assign::Assigner;
 use manylight::cluster::workload::AssignWorkload;
 
 fn main() {
-    let mut args = std::env::args().skip(1).map(|a| a.parse::<usize>().ok());
+    let mut args = std::env::args()
+        .skip(1)
+        .filter(|a| !a.starts_with("--"))
+        .map(|a| a.parse::<usize>().ok());
     let count = args.next().flatten().unwrap_or(65_536);
     let repeats = args.next().flatten().unwrap_or(20);
     let w = AssignWorkload::default_view(count, 1);

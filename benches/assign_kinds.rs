@@ -1,10 +1,11 @@
 //! Development aid: assignment time of the default workload's point lights alone and spot
-//! lights alone: `cargo run --release --example assign_kinds -- [LIGHTS]`.
+//! lights alone: `cargo bench --bench assign_kinds -- [LIGHTS]`.
 use manylight::cluster::workload::AssignWorkload;
 
 fn main() {
     let count = std::env::args()
-        .nth(1)
+        .skip(1)
+        .find(|a| !a.starts_with("--"))
         .and_then(|a| a.parse().ok())
         .unwrap_or(1024);
     let all = AssignWorkload::default_view(count, 1);
