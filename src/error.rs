@@ -21,12 +21,14 @@ pub enum Error {
         available: String,
     },
     /// A method this context cannot run, with what is missing.
-    #[error("method `{method}` is not supported on this context: {reason}")]
+    #[error("method `{method}` is not supported on this context: {reason} (methods that run here: {runnable})")]
     UnsupportedMethod {
         /// The method.
         method: String,
         /// What is missing.
         reason: String,
+        /// The methods this context can run, comma-separated.
+        runnable: String,
     },
     /// A request the renderer cannot satisfy (too many lights for a method, bad size, …).
     #[error("{0}")]

@@ -56,7 +56,8 @@ pub struct FrameStats {
     pub avg_lights_per_nonempty: f64,
     /// Most lights any cell touched (before the per-cell cap).
     pub max_lights_per_cluster: u32,
-    /// Light references dropped by the overflow policy (see `cluster::assign`).
+    /// Light references dropped by the overflow policy (see `cluster::assign`), or lights
+    /// forward left out beyond its loop cap (see `methods::forward_cap`).
     pub overflowed_lights: u64,
     /// Lights that reached the screen (touched at least one cell); all active lights for forward.
     pub visible_lights: usize,
@@ -98,6 +99,9 @@ pub struct Renderer {
     /// The GPU timer: `None` until first needed, then `Some(None)` where the context has no
     /// timer queries.
     timer: Option<Option<crate::gl::timer::GpuTimer>>,
+    /// What the default method's support would warn about: said at the first frame, unless
+    /// the caller picks a method first (whose own support is then what is said).
+    pending_warning: Option<String>,
 }
 
 impl Renderer {
@@ -118,16 +122,21 @@ impl Renderer {
         let dev = Device::restricted(gl, es, restrictions)?;
         let mut desc = methods::find(methods::DEFAULT_METHOD)?;
         let mut support = (desc.supported)(dev.caps());
+        let mut pending_warning = None;
         if let Support::Unsupported(reason) = &support {
-            log::warn!(
-                "the default method `{}` is unsupported here ({reason}); starting with `forward`",
+            pending_warning = Some(format!(
+                "the default method `{}` is unsupported here ({reason}); rendering with `forward`",
                 desc.name
-            );
+            ));
             desc = methods::find("forward")?;
             support = (desc.supported)(dev.caps());
         }
         if let Support::Fallback(reason) = &support {
-            log::warn!("method `{}` runs with a fallback: {reason}", desc.name);
+            let note = format!("method `{}` runs with a fallback: {reason}", desc.name);
+            pending_warning = Some(match pending_warning {
+                Some(first) => format!("{first}; {note}"),
+                None => note,
+            });
         }
         let method = (desc.create)(&dev)?;
         Ok(Renderer {
@@ -138,6 +147,7 @@ impl Renderer {
             support,
             target: None,
             timer: None,
+            pending_warning,
         })
     }
 
@@ -170,12 +180,21 @@ impl Renderer {
     /// is returned as `Some(reason)` (also logged as a warning). The previous method's GPU
     /// resources are freed.
     pub fn set_method(&mut self, name: &str) -> Result<Option<String>, Error> {
+        // An explicit choice replaces what the default method would have warned about.
+        let unannounced = self.pending_warning.take().is_some();
         let desc = methods::find(name)?;
         let support = (desc.supported)(self.dev.caps());
         if let Support::Unsupported(reason) = &support {
+            let caps = self.dev.caps();
+            let runnable: Vec<&str> = methods::METHODS
+                .iter()
+                .filter(|m| !matches!((m.supported)(caps), Support::Unsupported(_)))
+                .map(|m| m.name)
+                .collect();
             return Err(Error::UnsupportedMethod {
                 method: name.to_string(),
                 reason: reason.clone(),
+                runnable: runnable.join(", "),
             });
         }
         let switching = desc.name != self.method.name();
@@ -187,8 +206,8 @@ impl Renderer {
         self.support = support.clone();
         Ok(match support {
             Support::Fallback(reason) => {
-                // Announced once, when the method is taken up (here or at creation).
-                if switching {
+                // Announced once, when the method is taken up (here or at the first frame).
+                if switching || unannounced {
                     log::warn!("method `{name}` runs with a fallback: {reason}");
                 }
                 Some(reason)
@@ -207,6 +226,9 @@ impl Renderer {
         options: &RenderOptions,
     ) -> Result<FrameStats, Error> {
         let start = Instant::now();
+        if let Some(warning) = self.pending_warning.take() {
+            log::warn!("{warning}");
+        }
         scene.validate()?;
         if width == 0 || height == 0 {
             return Err(Error::Limit(format!("viewport {width}×{height} is empty")));
@@ -340,7 +362,7 @@ impl Renderer {
             nonempty_clusters: assign.nonempty_clusters,
             avg_lights_per_nonempty: assign.avg_lights_per_nonempty,
             max_lights_per_cluster: assign.max_lights_per_cluster,
-            overflowed_lights: assign.overflowed_lights,
+            overflowed_lights: assign.overflowed_lights + method_stats.dropped_lights,
             visible_lights: method_stats
                 .assign
                 .map_or(lights.len(), |a| a.visible_lights),

@@ -164,11 +164,16 @@ impl Caps {
     pub fn restrict(&mut self, restrictions: &super::Restrictions) -> Result<(), GlError> {
         if restrictions.no_fragment_highp {
             if self.es != EsVersion::Es2 || self.desktop {
-                return Err(GlError::VersionUnavailable {
-                    requested: self.es,
-                    reason: "a fragment stage without highp exists only at the OpenGL ES 2.0 level"
-                        .into(),
-                });
+                // The restriction is the caller's contradiction, not the driver's limit.
+                let context = if self.desktop {
+                    "desktop OpenGL".to_string()
+                } else {
+                    format!("OpenGL ES {}", self.es)
+                };
+                return Err(GlError::Unsupported(format!(
+                    "no_fragment_highp needs an OpenGL ES 2.0 context (a fragment stage without \
+                     highp exists only there: ES 3.0 requires it); this is {context}"
+                )));
             }
             self.fragment_highp = Precision::default();
         }

@@ -4,7 +4,9 @@
 //!
 //! Lights come from a data texture (`cluster::pack`): RGBA32F on ES 3.0 and on ES 2.0 with
 //! `OES_texture_float`, else the lossy RGBA8 packing. On ES 2.0 the loop has the constant bound
-//! [`max_lights`] and exits with `break` (GLSL ES 1.00 Appendix A).
+//! [`max_lights`] and exits with `break` (GLSL ES 1.00 Appendix A). A scene with more active
+//! lights than that (only reachable without fragment highp: 1 023) keeps the ones that matter
+//! most to the view ([`super::forward_cap`]), with a warning and the rest counted.
 
 use super::geometry::{self, UNIT_METHOD};
 use super::{FrameContext, MethodDesc, MethodStats, ShadingMethod, Support};
@@ -56,6 +58,8 @@ pub fn max_lights(caps: &Caps) -> u32 {
 #[derive(Default)]
 pub struct Forward {
     lights: Option<(DataTexture, LightEncoding)>,
+    /// The light cap was announced (once per renderer: it holds frame after frame).
+    warned_cap: bool,
 }
 
 impl ShadingMethod for Forward {
@@ -66,14 +70,29 @@ impl ShadingMethod for Forward {
     fn render(&mut self, ctx: &mut FrameContext) -> Result<MethodStats, Error> {
         let dev = ctx.dev;
         let limit = max_lights(dev.caps());
-        let count = ctx.lights.len();
-        if count > limit as usize {
-            return Err(Error::Limit(format!(
-                "forward can loop over at most {limit} lights on this context, the scene has {count} active lights; use a culling method"
-            )));
-        }
+        let capped;
+        let lights = if ctx.lights.len() > limit as usize {
+            capped = super::forward_cap::keep_most_important(ctx.lights, limit as usize);
+            if !self.warned_cap {
+                log::warn!(
+                    "forward loops over at most {limit} lights on this context; {} of the \
+                     scene's {} active lights, those that matter least to the view, are left \
+                     out (FrameStats::overflowed_lights counts them each frame)",
+                    ctx.lights.len() - limit as usize,
+                    ctx.lights.len()
+                );
+                self.warned_cap = true;
+            }
+            &capped[..]
+        } else {
+            ctx.lights
+        };
+        let count = lights.len();
         let encoding = ctx.features.light_encoding();
-        let mut stats = MethodStats::default();
+        let mut stats = MethodStats {
+            dropped_lights: (ctx.lights.len() - count) as u64,
+            ..MethodStats::default()
+        };
         // Recreate the texture when the encoding changes.
         if self.lights.as_ref().is_some_and(|(_, e)| *e != encoding) {
             if let Some((mut t, _)) = self.lights.take() {
@@ -89,7 +108,7 @@ impl ShadingMethod for Forward {
             self.lights = Some((DataTexture::new(dev, format)?, encoding));
         }
         let (texture, _) = self.lights.as_mut().expect("created above");
-        let packed = pack_lights(ctx.lights, encoding);
+        let packed = pack_lights(lights, encoding);
         // With no lights the shader never reads the texture: upload only to give it storage.
         if count > 0 || fresh {
             texture.upload(dev, packed.width, packed.height, &packed.bytes)?;

@@ -10,6 +10,7 @@ pub mod culled;
 pub mod deferred;
 pub mod features;
 pub mod forward;
+pub mod forward_cap;
 pub mod geometry;
 mod grid_choice;
 pub mod tiled;
@@ -95,6 +96,8 @@ pub struct MethodStats {
     pub grid: Option<GridReport>,
     /// What `auto` picked, and why.
     pub auto_choice: Option<(&'static str, String)>,
+    /// Lights left out of the whole frame (forward beyond its loop cap).
+    pub dropped_lights: u64,
 }
 
 /// A cell grid and the light lists assigned to it.

@@ -11,7 +11,8 @@ mod view;
 
 use std::process::ExitCode;
 
-use clap::{Parser, Subcommand, ValueEnum};
+use clap::error::ErrorKind;
+use clap::{CommandFactory, Parser, Subcommand, ValueEnum};
 use manylight::EsVersion;
 
 /// Thousands of dynamic lights on OpenGL ES 2.0 / 3.0, rendered headless through EGL.
@@ -49,6 +50,13 @@ enum Command {
     /// Open an interactive window (fly camera, method and light-count keys).
     #[cfg(feature = "window")]
     View(view::ViewArgs),
+    /// In a build without the `window` feature: says how to get the viewer.
+    #[cfg(not(feature = "window"))]
+    #[command(hide = true)]
+    View {
+        #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
+        _args: Vec<String>,
+    },
 }
 
 /// `--es 2` or `--es 3`.
@@ -71,11 +79,42 @@ impl From<EsArg> for EsVersion {
     }
 }
 
+/// Usage errors clap's attributes cannot express, reported the way clap reports its own
+/// (exit status 2).
+fn check_usage(cli: &Cli) {
+    let no_highp_es = match &cli.command {
+        None => Some((cli.render.no_fragment_highp, cli.render.es)),
+        Some(Command::Render(a)) => Some((a.no_fragment_highp, a.es)),
+        Some(Command::Info(a)) => Some((a.no_fragment_highp, a.es)),
+        _ => None,
+    };
+    if let Some((true, EsArg::Three)) = no_highp_es {
+        Cli::command()
+            .error(
+                ErrorKind::ArgumentConflict,
+                "--no-fragment-highp plays an OpenGL ES 2.0 device (ES 3.0 requires fragment \
+                 highp): add `--es 2`",
+            )
+            .exit();
+    }
+    #[cfg(not(feature = "window"))]
+    if let Some(Command::View { .. }) = cli.command {
+        Cli::command()
+            .error(
+                ErrorKind::InvalidSubcommand,
+                "`view` needs the `window` feature, which this build left out: \
+                 cargo run --release --features window -- view",
+            )
+            .exit();
+    }
+}
+
 fn main() -> ExitCode {
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn"))
         .format_timestamp(None)
         .init();
     let cli = Cli::parse();
+    check_usage(&cli);
     let result = match cli.command {
         None => render::run(&cli.render),
         Some(Command::Render(args)) => render::run(&args),
@@ -86,6 +125,8 @@ fn main() -> ExitCode {
         Some(Command::MatrixCell(args)) => matrix::run_cell(&args),
         #[cfg(feature = "window")]
         Some(Command::View(args)) => view::run(&args),
+        #[cfg(not(feature = "window"))]
+        Some(Command::View { .. }) => unreachable!("check_usage refuses `view` in this build"),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
