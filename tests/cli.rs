@@ -468,3 +468,26 @@ fn bench_assign_prints_json_for_scripts() {
         assert!(r["indices"].as_u64().unwrap() > 0);
     }
 }
+
+#[test]
+fn a_missing_texture_is_warned_once() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(
+        dir.path().join("m.mtl"),
+        "newmtl red\nKd 0.9 0.1 0.1\nmap_Kd nothere.png\n",
+    )
+    .unwrap();
+    std::fs::write(
+        dir.path().join("t.obj"),
+        "mtllib m.mtl\nv -1 -1 0\nv 1 -1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nusemtl red\nf 1/1 2/2 3/3\n",
+    )
+    .unwrap();
+    let out = manylight(
+        &["render", "--scene", "t.obj", "--size", "16x9", "--lights", "2"],
+        &[],
+        dir.path(),
+    );
+    let msg = text(&out);
+    assert!(out.status.success(), "{msg}");
+    assert_eq!(msg.matches("nothere.png").count(), 1, "{msg}");
+}

@@ -19,7 +19,7 @@ pub struct BenchAssignArgs {
     /// Seed of the random lights.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// Print JSON (an array of {lights, assign_ms, indices}) instead of a table.
+    /// Print JSON (an array of {lights, assign_ms, indices, clusters}) instead of a table.
     #[arg(long)]
     pub json: bool,
 }

@@ -101,10 +101,8 @@ pub fn run(args: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
         (None, true) => None,
         (None, false) => Some((DEFAULT_LIGHTS, args.seed)),
     };
-    let (scene, report) = scene::load(&args.scene, lights)?;
-    for w in &report.warnings {
-        eprintln!("warning: {w}");
-    }
+    // The loader logs each warning (at `warn`, shown by default): not printed again here.
+    let (scene, _logged_warnings) = scene::load(&args.scene, lights)?;
     let es = args.es.into();
     let ctx = HeadlessContext::new(es)?;
     let restrictions = manylight::gl::Restrictions {

@@ -85,10 +85,8 @@ pub fn run(args: &ViewArgs) -> Result<(), Box<dyn std::error::Error>> {
         (None, true) => None,
         (None, false) => Some(DEFAULT_LIGHTS),
     };
-    let (scene, report) = scene::load(&args.scene, lights.map(|n| (n, args.seed)))?;
-    for w in &report.warnings {
-        eprintln!("warning: {w}");
-    }
+    // The loader logs each warning (at `warn`, shown by default): not printed again here.
+    let (scene, _logged_warnings) = scene::load(&args.scene, lights.map(|n| (n, args.seed)))?;
     // Validate the method name before opening a window.
     manylight::methods::find(&args.method)?;
     let extent = scene.bounds().map_or(10.0, |b| b.size().length());
