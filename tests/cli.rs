@@ -483,11 +483,87 @@ fn a_missing_texture_is_warned_once() {
     )
     .unwrap();
     let out = manylight(
-        &["render", "--scene", "t.obj", "--size", "16x9", "--lights", "2"],
+        &[
+            "render", "--scene", "t.obj", "--size", "16x9", "--lights", "2",
+        ],
         &[],
         dir.path(),
     );
     let msg = text(&out);
     assert!(out.status.success(), "{msg}");
     assert_eq!(msg.matches("nothere.png").count(), 1, "{msg}");
+}
+
+/// Hostile files and counts end in one clear error or a documented fallback: no panic, no
+/// hang on a FIFO, no endless read of `/dev/zero`, no allocation for 2⁶⁴ lights.
+#[test]
+fn hostile_files_and_counts_are_refused_quickly_and_clearly() {
+    let dir = tempfile::tempdir().unwrap();
+    let write = |name: &str, text: &str| std::fs::write(dir.path().join(name), text).unwrap();
+    let triangle = "v -1 -1 0\nv 1 -1 0\nv 0 1 0\nusemtl m\nf 1 2 3\n";
+    write("zero.obj", &format!("mtllib /dev/zero\n{triangle}"));
+    write("short.mtl", "newmtl m\nKd 1\n");
+    write("short.obj", &format!("mtllib short.mtl\n{triangle}"));
+    write(
+        "many.json",
+        r#"{"objects": [{"builtin": "plane"}], "random_lights": {"count": 18446744073709551615, "seed": 1}}"#,
+    );
+    write("plain.obj", triangle);
+    let fifo = dir.path().join("fifo.obj");
+    let made = Command::new("mkfifo").arg(&fifo).status();
+    let small = ["--size", "16x9"];
+    let mut cases: Vec<(Vec<&str>, &[(&str, &str)], &str, i32)> = vec![
+        // A material library that never ends: a warning, the flat default, a rendered frame.
+        (
+            vec!["render", "--scene", "zero.obj", "--lights", "2"],
+            &[],
+            "/dev/zero",
+            0,
+        ),
+        // A truncated colour line (tobj would panic): a warning naming the line.
+        (
+            vec!["render", "--scene", "short.obj", "--lights", "2"],
+            &[],
+            "line 2",
+            0,
+        ),
+        (
+            vec!["render", "--scene", "many.json"],
+            &[],
+            "random_lights.count",
+            1,
+        ),
+        (vec!["render", "--lights", "4294967296"], &[], "lights", 1),
+        (
+            vec!["render", "--lights", "18446744073709551615"],
+            &[],
+            "lights",
+            1,
+        ),
+        (
+            vec!["render", "--scene", "plain.obj", "--lights", "2"],
+            &[("MANYLIGHT_MAX_FILE_MB", "0")],
+            "MANYLIGHT_MAX_FILE_MB",
+            1,
+        ),
+    ];
+    if made.is_ok_and(|s| s.success()) {
+        cases.push((
+            vec!["render", "--scene", "fifo.obj"],
+            &[],
+            "not a regular file",
+            1,
+        ));
+    }
+    for (args, env, needle, code) in cases {
+        let args = [&args[..], &small[..]].concat();
+        let out = manylight(&args, env, dir.path());
+        let msg = text(&out);
+        assert_eq!(out.status.code(), Some(code), "{args:?}: {msg}");
+        assert!(
+            msg.contains(needle),
+            "{args:?}: expected `{needle}` in: {msg}"
+        );
+        assert!(!msg.contains("panicked"), "{args:?}: {msg}");
+    }
 }

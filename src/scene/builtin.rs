@@ -35,6 +35,7 @@ pub fn build(name: &str, lights: Option<(usize, u64)>) -> Result<Scene, SceneErr
         other => return Err(SceneError::UnknownBuiltin(other.to_string())),
     };
     if let Some((count, seed)) = lights {
+        super::input::check_light_count(count, "lights")?;
         scene.lights = random::lights(&volume, count, seed, style);
     }
     Ok(scene)

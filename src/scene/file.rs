@@ -131,9 +131,10 @@ pub fn load(
     path: &Path,
     random_override: Option<(usize, u64)>,
 ) -> Result<(Scene, LoadReport), SceneError> {
-    let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
+    let bytes = super::input::read_bounded(path, super::input::FileKind::SceneFile)?;
+    let text = String::from_utf8(bytes).map_err(|e| SceneError::SceneFile {
         path: path.to_path_buf(),
-        source,
+        reason: format!("not UTF-8 text (byte {})", e.utf8_error().valid_up_to()),
     })?;
     parse(
         &text,
@@ -218,8 +219,14 @@ pub fn parse(
         (None, Some(c)) if file.objects.len() == 1 => scene.camera = c,
         _ => scene.frame_camera(),
     }
-    let random = random_override.or(file.random_lights.as_ref().map(|r| (r.count, r.seed)));
-    if let Some((count, seed)) = random {
+    let random = match (random_override, &file.random_lights) {
+        (Some(r), _) => Some((r, "lights")),
+        (None, Some(r)) => Some(((r.count, r.seed), "random_lights.count")),
+        (None, None) => None,
+    };
+    if let Some(((count, seed), field)) = random {
+        let total = count.saturating_add(scene.lights.len());
+        super::input::check_light_count(total, field)?;
         let volume = scene.bounds().ok_or_else(|| {
             SceneError::invalid("random_lights", "needs geometry to place lights in")
         })?;

@@ -10,6 +10,7 @@ pub mod camera;
 pub mod error;
 pub mod features;
 pub mod file;
+pub mod input;
 pub mod light;
 pub mod material;
 pub mod mesh;
@@ -149,6 +150,9 @@ pub fn load(
         .unwrap_or_default();
     match ext.as_str() {
         "obj" => {
+            if let Some((count, _)) = lights {
+                input::check_light_count(count, "lights")?;
+            }
             let mut scene = Scene::empty();
             let report = obj::load_into(&mut scene, path, DMat4::IDENTITY, None)?;
             scene.frame_camera();

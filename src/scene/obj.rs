@@ -14,6 +14,7 @@ use std::sync::Arc;
 
 use glam::{DMat4, Vec2, Vec3};
 
+use super::input::{read_bounded, FileKind};
 use super::{Material, Mesh, Object, Scene, SceneError, Texture};
 
 /// What an OBJ load produced besides the objects: non-fatal problems, for the caller to show.
@@ -33,22 +34,7 @@ pub fn load_into(
     texture_override: Option<&Path>,
 ) -> Result<LoadReport, SceneError> {
     let mut report = LoadReport::default();
-    if !path.is_file() {
-        return Err(SceneError::Io {
-            path: path.to_path_buf(),
-            source: std::io::Error::new(std::io::ErrorKind::NotFound, "no such file"),
-        });
-    }
-    let options = tobj::LoadOptions {
-        triangulate: true,
-        single_index: true,
-        ignore_points: true,
-        ignore_lines: true,
-    };
-    let (models, materials) = tobj::load_obj(path, &options).map_err(|e| SceneError::Obj {
-        path: path.to_path_buf(),
-        reason: e.to_string(),
-    })?;
+    let (models, materials) = parse_obj(path)?;
     if models.is_empty() || models.iter().all(|m| m.mesh.indices.is_empty()) {
         return Err(SceneError::Obj {
             path: path.to_path_buf(),
@@ -127,6 +113,90 @@ pub fn load_into(
     Ok(report)
 }
 
+/// Parses an OBJ read within its size limit, its MTL libraries read the same way and checked
+/// first for what tobj would panic on. tobj runs under `catch_unwind` as a last guard: a panic
+/// inside it becomes an error naming the file, never an abort of the caller.
+type Parsed = (
+    Vec<tobj::Model>,
+    Result<Vec<tobj::Material>, tobj::LoadError>,
+);
+
+fn parse_obj(path: &Path) -> Result<Parsed, SceneError> {
+    let bytes = read_bounded(path, FileKind::Model)?;
+    let base_dir = path.parent().unwrap_or(Path::new(".")).to_path_buf();
+    let options = tobj::LoadOptions {
+        triangulate: true,
+        single_index: true,
+        ignore_points: true,
+        ignore_lines: true,
+    };
+    let load_mtl = |name: &Path| -> tobj::MTLLoadResult {
+        let mtl_path = base_dir.join(name);
+        let bytes = read_bounded(&mtl_path, FileKind::Materials).map_err(|e| {
+            log::warn!("{e}");
+            tobj::LoadError::OpenFileFailed
+        })?;
+        if let Err(line) = check_mtl(&bytes) {
+            log::warn!("{}: {line}", mtl_path.display());
+            return Err(tobj::LoadError::MaterialParseError);
+        }
+        tobj::load_mtl_buf(&mut std::io::BufReader::new(&bytes[..]))
+    };
+    let parsed = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        tobj::load_obj_buf(&mut std::io::BufReader::new(&bytes[..]), &options, load_mtl)
+    }));
+    let obj_error = |reason: String| SceneError::Obj {
+        path: path.to_path_buf(),
+        reason,
+    };
+    match parsed {
+        Ok(result) => result.map_err(|e| obj_error(e.to_string())),
+        Err(_) => Err(obj_error(
+            "the OBJ parser (tobj) failed on this file; it is malformed".into(),
+        )),
+    }
+}
+
+/// The first MTL line tobj would panic on or misread (a colour with fewer than three numbers,
+/// as a truncated file has), as a message naming the line.
+fn check_mtl(bytes: &[u8]) -> Result<(), String> {
+    let text = String::from_utf8_lossy(bytes);
+    for (number, line) in text.lines().enumerate() {
+        let mut words = line.split_whitespace();
+        let Some(key @ ("Ka" | "Kd" | "Ks" | "Ke")) = words.next() else {
+            continue;
+        };
+        let numbers = words.take(3).filter(|w| w.parse::<f32>().is_ok()).count();
+        if numbers < 3 {
+            return Err(format!(
+                "line {}: `{key}` needs three numbers, got `{}`",
+                number + 1,
+                line.trim()
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Decodes a texture file read within its size limit, refusing images whose decoded size
+/// would pass [`MAX_TEXTURE_SIDE`] on a side (a small PNG can claim 100 000² pixels).
+fn decode_texture(path: &Path) -> Result<image::DynamicImage, String> {
+    let bytes = read_bounded(path, FileKind::Texture).map_err(|e| e.to_string())?;
+    let mut reader = image::ImageReader::new(std::io::Cursor::new(bytes))
+        .with_guessed_format()
+        .map_err(|e| e.to_string())?;
+    let mut limits = image::Limits::default();
+    limits.max_image_width = Some(MAX_TEXTURE_SIDE);
+    limits.max_image_height = Some(MAX_TEXTURE_SIDE);
+    limits.max_alloc = Some(u64::from(MAX_TEXTURE_SIDE).pow(2) * 4);
+    reader.limits(limits);
+    reader.decode().map_err(|e| e.to_string())
+}
+
+/// Largest texture side decoded, in pixels (the largest `GL_MAX_TEXTURE_SIZE` common on phones;
+/// the renderer downscales further to what its context supports).
+pub const MAX_TEXTURE_SIDE: u32 = 16_384;
+
 impl LoadReport {
     fn warn(&mut self, msg: String) {
         log::warn!("{msg}");
@@ -144,7 +214,7 @@ impl TextureCache {
         if let Some(t) = self.loaded.get(path) {
             return t.clone();
         }
-        let tex = match image::open(path) {
+        let tex = match decode_texture(path) {
             Ok(img) => Some(Arc::new(Texture {
                 name: path.display().to_string(),
                 image: img.to_rgba8(),

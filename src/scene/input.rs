@@ -1,0 +1,155 @@
+//! Bounded reads of the files a scene names (scene JSON, OBJ, MTL, textures) and the limits
+//! that keep hostile input from hanging the loader or exhausting memory.
+//!
+//! Only regular files are read: a FIFO would block `open` forever and `/dev/zero` never ends,
+//! so anything else (device, FIFO, socket, folder) is refused before it is opened. A file
+//! larger than its kind's limit is refused from its size, and the read itself stops one byte
+//! past the limit, so a file that grows while it is read cannot get around it. The limits can
+//! be raised (or lowered) for every kind at once with `MANYLIGHT_MAX_FILE_MB`.
+
+use std::io::Read;
+use std::path::Path;
+
+use super::SceneError;
+
+/// Most lights a scene may hold (file lights plus random ones; `--lights`). Checked before
+/// anything is allocated: 4 Mi lights are about 400 MB of light data on the CPU, and at most
+/// 65 536 of them can be visible in a frame anyway.
+pub const MAX_LIGHTS: usize = 1 << 22;
+
+/// What a file is, for its size limit and the error message.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FileKind {
+    /// A JSON scene file (default limit 16 MiB).
+    SceneFile,
+    /// An OBJ model (1 GiB: the largest real scene tried, the conference room, is 27 MB).
+    Model,
+    /// An MTL material library (16 MiB).
+    Materials,
+    /// A texture image file (256 MiB; its decoded size is limited separately).
+    Texture,
+}
+
+/// The environment variable that replaces every file-size limit, in MiB.
+pub const LIMIT_VARIABLE: &str = "MANYLIGHT_MAX_FILE_MB";
+
+impl FileKind {
+    /// The default size limit in bytes.
+    pub fn default_limit(self) -> u64 {
+        match self {
+            FileKind::SceneFile | FileKind::Materials => 16 << 20,
+            FileKind::Model => 1 << 30,
+            FileKind::Texture => 256 << 20,
+        }
+    }
+
+    /// The limit in force: `MANYLIGHT_MAX_FILE_MB` if set to a number, else the default.
+    pub fn limit(self) -> u64 {
+        std::env::var(LIMIT_VARIABLE)
+            .ok()
+            .and_then(|v| v.trim().parse::<u64>().ok())
+            .map_or(self.default_limit(), |mb| mb.saturating_mul(1 << 20))
+    }
+
+    fn name(self) -> &'static str {
+        match self {
+            FileKind::SceneFile => "scene file",
+            FileKind::Model => "OBJ file",
+            FileKind::Materials => "MTL file",
+            FileKind::Texture => "texture",
+        }
+    }
+}
+
+fn refuse(path: &Path, kind: std::io::ErrorKind, reason: String) -> SceneError {
+    SceneError::Io {
+        path: path.to_path_buf(),
+        source: std::io::Error::new(kind, reason),
+    }
+}
+
+/// Reads a whole file of `kind`, refusing anything but a regular file within the limit.
+pub fn read_bounded(path: &Path, kind: FileKind) -> Result<Vec<u8>, SceneError> {
+    let io = |source| SceneError::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    // `metadata` follows symlinks and does not open the file: a FIFO is refused unopened.
+    let meta = std::fs::metadata(path).map_err(io)?;
+    if !meta.is_file() {
+        return Err(refuse(
+            path,
+            std::io::ErrorKind::InvalidInput,
+            format!(
+                "not a regular file (a {} must be a file, not a folder, device or FIFO)",
+                kind.name()
+            ),
+        ));
+    }
+    let limit = kind.limit();
+    let too_big = |size: u64| {
+        refuse(
+            path,
+            std::io::ErrorKind::FileTooLarge,
+            format!(
+                "{} of {size} bytes exceeds the limit of {limit} bytes (set {LIMIT_VARIABLE} \
+                 to raise it)",
+                kind.name()
+            ),
+        )
+    };
+    if meta.len() > limit {
+        return Err(too_big(meta.len()));
+    }
+    let file = std::fs::File::open(path).map_err(io)?;
+    let mut bytes = Vec::with_capacity(meta.len() as usize);
+    file.take(limit.saturating_add(1))
+        .read_to_end(&mut bytes)
+        .map_err(io)?;
+    if bytes.len() as u64 > limit {
+        return Err(too_big(bytes.len() as u64));
+    }
+    Ok(bytes)
+}
+
+/// Checks a light count before lights are made: `field` names where it came from.
+pub fn check_light_count(count: usize, field: &str) -> Result<(), SceneError> {
+    if count > MAX_LIGHTS {
+        return Err(SceneError::invalid(
+            field,
+            format!("{count} lights is more than the {MAX_LIGHTS} a scene may hold"),
+        ));
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_folder_is_refused_and_a_small_file_read() {
+        let dir = tempfile::tempdir().unwrap();
+        let err = read_bounded(dir.path(), FileKind::Model).unwrap_err();
+        assert!(err.to_string().contains("not a regular file"), "{err}");
+        let file = dir.path().join("a.obj");
+        std::fs::write(&file, b"v 0 0 0\n").unwrap();
+        assert_eq!(read_bounded(&file, FileKind::Model).unwrap(), b"v 0 0 0\n");
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn devices_are_refused_without_reading() {
+        for device in ["/dev/zero", "/dev/null"] {
+            let err = read_bounded(Path::new(device), FileKind::Materials).unwrap_err();
+            assert!(err.to_string().contains("not a regular file"), "{err}");
+        }
+    }
+
+    #[test]
+    fn light_counts_past_the_limit_name_the_field() {
+        assert!(check_light_count(MAX_LIGHTS, "n").is_ok());
+        let err = check_light_count(usize::MAX, "random_lights.count").unwrap_err();
+        assert!(err.to_string().contains("random_lights.count"), "{err}");
+    }
+}
