@@ -287,3 +287,44 @@ fn texture_with_other_case_and_backslashes_is_found() {
     assert!(report.warnings.is_empty(), "{:?}", report.warnings);
     assert!(scene.materials[0].diffuse_texture.is_some());
 }
+
+/// MTL factors beyond what the fp16 colour tier holds (they turned the lit surface black):
+/// clamped with a warning naming the material and key, and the surface renders lit and finite.
+#[test]
+fn material_factors_beyond_fp16_are_clamped_with_a_warning_and_render_lit() {
+    let dir = tempfile::tempdir().unwrap();
+    write(
+        dir.path(),
+        "hot.mtl",
+        "newmtl hot\nKd 30000 30000 30000\nKs 1e20 1e20 1e20\nNs 10\n",
+    );
+    let path = write(
+        dir.path(),
+        "hot.obj",
+        "mtllib hot.mtl\nv -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nusemtl hot\nf 1 2 3 4\n",
+    );
+    let (scene, report) = scene::load(path.to_str().unwrap(), Some((8, 2))).unwrap();
+    assert_eq!(report.warnings.len(), 2, "{:?}", report.warnings);
+    assert!(report.warnings.iter().all(|w| w.contains("`hot`")));
+    let hot = &scene.materials[0];
+    assert_eq!(hot.diffuse, glam::Vec3::splat(1024.0));
+    assert_eq!(hot.specular, glam::Vec3::splat(1024.0));
+    for es in [EsVersion::Es2, EsVersion::Es3] {
+        let mut gpu = Gpu::new(es);
+        let img = gpu.render(&scene, 64, 64, &RenderOptions::default());
+        // Ambient alone (0.02 × 1024) saturates the surface: its middle is white, not black.
+        let centre = img.get_pixel(32, 32);
+        assert!(
+            centre.0[..3].iter().all(|&c| c >= 250),
+            "{es}: the surface went dark: {centre:?}"
+        );
+        let (hdr, _) = gpu
+            .r()
+            .render_offscreen_hdr(&scene, 64, 64, &RenderOptions::default())
+            .unwrap();
+        assert!(
+            hdr.iter().flatten().all(|v| v.is_finite()),
+            "{es}: NaN or Inf in the frame"
+        );
+    }
+}

@@ -39,6 +39,12 @@ impl Default for Material {
     }
 }
 
+/// Largest diffuse or specular factor a material may have. The colour factors run at
+/// `mediump` (fp16 on phones, max 65 504): `albedo·cosθ + Ks·spec` and the ambient term must
+/// stay finite there, so each factor is capped far below that; reflectances above 1 are not
+/// physical anyway (MTL files with `Kd 30000` or `Ks 1e20` exist, and turned surfaces black).
+pub const MAX_COLOR_FACTOR: f32 = 1024.0;
+
 impl Material {
     /// A matte material of one colour with a faint highlight.
     pub fn flat(name: &str, diffuse: Vec3) -> Self {
@@ -80,10 +86,13 @@ impl Material {
     /// Checks colours and exponent; `field` names the material in errors.
     pub fn validate(&self, field: &str) -> Result<(), SceneError> {
         for (name, v) in [("diffuse", self.diffuse), ("specular", self.specular)] {
-            if !v.is_finite() || v.min_element() < 0.0 {
+            if !v.is_finite() || v.min_element() < 0.0 || v.max_element() > MAX_COLOR_FACTOR {
                 return Err(SceneError::invalid(
                     format!("{field}.{name}"),
-                    format!("must be finite and >= 0, got {v:?}"),
+                    format!(
+                        "must be in [0, {MAX_COLOR_FACTOR}] (the range the fp16 colour tier \
+                         holds), got {v:?}"
+                    ),
                 ));
             }
         }
@@ -100,5 +109,21 @@ impl Material {
             ));
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn factors_past_the_fp16_colour_range_are_refused_naming_the_field() {
+        let mut m = Material::glossy("m", Vec3::ONE, Vec3::splat(0.5), 8.0);
+        assert!(m.validate("materials[0]").is_ok());
+        m.specular = Vec3::new(0.0, 2000.0, 0.0);
+        let err = m.validate("materials[0]").unwrap_err().to_string();
+        assert!(err.contains("materials[0].specular"), "{err}");
+        m.specular = Vec3::splat(MAX_COLOR_FACTOR);
+        assert!(m.validate("materials[0]").is_ok());
     }
 }

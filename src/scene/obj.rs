@@ -15,6 +15,7 @@ use std::sync::Arc;
 use glam::{DMat4, Vec2, Vec3};
 
 use super::input::{read_bounded, FileKind};
+use super::material::MAX_COLOR_FACTOR;
 use super::{Material, Mesh, Object, Scene, SceneError, Texture};
 
 /// What an OBJ load produced besides the objects: non-fatal problems, for the caller to show.
@@ -70,11 +71,26 @@ pub fn load_into(
             },
             _ => None,
         };
+        let mut factor = |key: &str, value: Option<[f32; 3]>, default: f32| {
+            let v = Vec3::from(value.unwrap_or([default; 3]));
+            // NaN becomes 0: f32::clamp keeps NaN, max/min do not.
+            let clamped = v.max(Vec3::ZERO).min(Vec3::splat(MAX_COLOR_FACTOR));
+            if clamped != v {
+                report.warn(format!(
+                    "material `{}`: {key} {v} clamped to {clamped} (factors are limited to \
+                     [0, {MAX_COLOR_FACTOR}], the range the fp16 colour tier holds)",
+                    m.name
+                ));
+            }
+            clamped
+        };
+        let diffuse = factor("Kd", m.diffuse, 0.8);
+        let specular = factor("Ks", m.specular, 0.0);
         scene.materials.push(Material {
             name: m.name.clone(),
-            diffuse: Vec3::from(m.diffuse.unwrap_or([0.8; 3])),
+            diffuse,
             diffuse_texture: override_tex.clone().or(texture),
-            specular: Vec3::from(m.specular.unwrap_or([0.0; 3])),
+            specular,
             shininess: m.shininess.unwrap_or(1.0),
             alpha: m.dissolve.unwrap_or(1.0).clamp(0.0, 1.0),
         });
