@@ -512,7 +512,9 @@ fn hostile_files_and_counts_are_refused_quickly_and_clearly() {
     let fifo = dir.path().join("fifo.obj");
     let made = Command::new("mkfifo").arg(&fifo).status();
     let small = ["--size", "16x9"];
-    let mut cases: Vec<(Vec<&str>, &[(&str, &str)], &str, i32)> = vec![
+    // (arguments, environment, text the output must contain, exit status)
+    type Case<'a> = (Vec<&'a str>, &'a [(&'a str, &'a str)], &'a str, i32);
+    let mut cases: Vec<Case> = vec![
         // A material library that never ends: a warning, the flat default, a rendered frame.
         (
             vec!["render", "--scene", "zero.obj", "--lights", "2"],

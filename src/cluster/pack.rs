@@ -65,6 +65,12 @@ impl LightEncoding {
     }
 }
 
+/// Largest radius a light is given on the GPU. The shader divides by the radius, and past
+/// about 10¹⁹ times the distance to a surface the quotient's square underflows f32 and the
+/// light vanishes (a radius of 10²⁰ lit nothing); capped here, the window term `1 − (d/r)⁴`
+/// still differs from 1 by under 10⁻¹² anywhere within 1 000 km of the light.
+pub const MAX_EFFECTIVE_RADIUS: f32 = 1e12;
+
 /// A light as the shader sees it: view space, radiance premultiplied, spot terms precomputed.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct GpuLight {
@@ -106,8 +112,8 @@ impl GpuLight {
         };
         GpuLight {
             position: view.transform_point3(light.position).as_vec3(),
-            radius: light.radius,
-            cull_radius: light.radius,
+            radius: light.radius.min(MAX_EFFECTIVE_RADIUS),
+            cull_radius: light.radius.min(MAX_EFFECTIVE_RADIUS),
             radiance: light.radiance(),
             spot_scale,
             direction,

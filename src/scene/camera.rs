@@ -30,6 +30,17 @@ pub enum Projection {
     },
 }
 
+/// Largest camera position or target coordinate, in world units: f64 keeps 10⁻⁴ there, and
+/// positions relative to the camera are formed in f64 before they become f32.
+pub const MAX_CAMERA_COORD: f64 = 1e12;
+
+/// Smallest orthographic view height: a pixel of a smaller view is finer than f32 view-space
+/// coordinates resolve (10⁻⁹ rendered half the frame black).
+pub const MIN_ORTHO_HEIGHT: f64 = 1e-6;
+
+/// A perspective far plane this many near planes away or more is treated as infinite.
+pub const FAR_AS_INFINITE: f64 = 1e20;
+
 /// A look-at camera. World positions are `f64` so scenes far from the origin keep precision.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Camera {
@@ -83,7 +94,9 @@ impl Camera {
                 near,
                 far,
             } => {
-                if far.is_infinite() {
+                // Past 10²⁰ near planes the finite formula's terms round to the infinite
+                // projection's, or overflow (far near f64::MAX gave an all-black frame).
+                if far.is_infinite() || far / near > FAR_AS_INFINITE {
                     perspective_infinite_gl(fov_y_deg.to_radians(), aspect, near)
                 } else {
                     glam::dcamera::rh::proj::opengl::perspective(
@@ -124,6 +137,20 @@ impl Camera {
                 ));
             }
         }
+        for (name, v) in [
+            ("camera.position", self.position),
+            ("camera.target", self.target),
+        ] {
+            if v.abs().max_element() > MAX_CAMERA_COORD {
+                return Err(SceneError::invalid(
+                    name,
+                    format!(
+                        "must be within ±{MAX_CAMERA_COORD:e} (the view maths keeps \
+                         centimetres only up to there), got {v:?}"
+                    ),
+                ));
+            }
+        }
         let forward = self.target - self.position;
         if forward.length_squared() == 0.0 {
             return Err(SceneError::invalid(
@@ -131,7 +158,16 @@ impl Camera {
                 "equals camera.position",
             ));
         }
-        if forward.cross(self.up).length_squared() <= 1e-24 * forward.length_squared() {
+        if self.up.length_squared() == 0.0 {
+            return Err(SceneError::invalid("camera.up", "must be non-zero"));
+        }
+        // Unit vectors first: the squared lengths of raw ones can overflow or underflow.
+        if forward
+            .normalize()
+            .cross(self.up.normalize())
+            .length_squared()
+            <= 1e-24
+        {
             return Err(SceneError::invalid(
                 "camera.up",
                 "is parallel to the view direction",
@@ -154,10 +190,13 @@ impl Camera {
                 }
             }
             Projection::Orthographic { height, .. } => {
-                if !(height > 0.0 && height.is_finite()) {
+                if !(height >= MIN_ORTHO_HEIGHT && height.is_finite()) {
                     return Err(SceneError::invalid(
                         "camera.height",
-                        format!("must be finite and > 0, got {height}"),
+                        format!(
+                            "must be finite and >= {MIN_ORTHO_HEIGHT:e} (smaller views fall \
+                             between f32 view-space values), got {height}"
+                        ),
                     ));
                 }
                 if !(near >= 0.0 && near.is_finite()) {

@@ -4,6 +4,12 @@ use glam::{DMat4, DVec3, Vec2, Vec3};
 
 use super::SceneError;
 
+/// Largest object-space vertex coordinate. Vertices are f32 (their spacing there is 64 units)
+/// and a model framed at that size still leaves the camera inside its own limit
+/// ([`super::camera::MAX_CAMERA_COORD`]); coordinates near f32's limit made lights overflow
+/// and were reported as a bad light intensity.
+pub const MAX_VERTEX_COORD: f32 = 1e9;
+
 /// Axis-aligned bounding box in `f64`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Aabb {
@@ -114,6 +120,19 @@ impl Mesh {
             return Err(SceneError::invalid(
                 format!("mesh.positions[{i}]"),
                 format!("must be finite, got {:?}", positions[i]),
+            ));
+        }
+        if let Some(i) = positions
+            .iter()
+            .position(|p| p.abs().max_element() > MAX_VERTEX_COORD)
+        {
+            return Err(SceneError::invalid(
+                format!("mesh.positions[{i}]"),
+                format!(
+                    "must be within ±{MAX_VERTEX_COORD:e} (object space is f32; place far \
+                     objects with their transform, which is f64), got {:?}",
+                    positions[i]
+                ),
             ));
         }
         if !uvs.is_empty() && uvs.len() != n {

@@ -1,0 +1,128 @@
+//! Finite values so large or small that the maths overflows, underflows or loses the
+//! surface: each either renders what the light model says (the renderer changed its maths) or
+//! is refused with the real field named — never a silent black frame or a misleading field.
+
+mod common;
+
+use common::Gpu;
+use glam::{DVec3, Vec3};
+use manylight::scene::{self, Camera, Light, Projection, Scene};
+use manylight::{EsVersion, RenderOptions};
+
+fn plane(lights: Vec<Light>) -> Scene {
+    let mut s = scene::builtin::build("plane", None).unwrap();
+    s.ambient = Vec3::splat(0.02);
+    s.lights = lights;
+    s
+}
+
+fn point(radius: f32) -> Light {
+    Light::point(
+        DVec3::new(0.0, 0.0, 1.0),
+        radius,
+        Vec3::new(1.0, 0.8, 0.6),
+        1.0,
+    )
+}
+
+fn mean(img: &image::RgbaImage) -> f64 {
+    let sum: u64 = img
+        .pixels()
+        .map(|p| p[0] as u64 + p[1] as u64 + p[2] as u64)
+        .sum();
+    sum as f64 / (3 * img.width() * img.height()) as f64
+}
+
+#[test]
+fn a_light_whose_radius_dwarfs_the_scene_lights_it_as_a_large_one_does() {
+    for es in [EsVersion::Es2, EsVersion::Es3] {
+        let mut gpu = Gpu::new(es);
+        for method in ["forward", "clustered"] {
+            gpu.r().set_method(method).unwrap();
+            let opts = RenderOptions::default();
+            // At 10⁶ the window term is 1 to 10⁻²⁰ across the plane: the same picture as any
+            // larger radius, which must not underflow to nothing.
+            let large = gpu.render(&plane(vec![point(1e6)]), 64, 36, &opts);
+            assert!(mean(&large) > 40.0, "{es} {method}: radius 1e6 too dark");
+            for radius in [1e20, 1e30, f32::MAX] {
+                let huge = gpu.render(&plane(vec![point(radius)]), 64, 36, &opts);
+                let d = manylight::metrics::diff(&large, &huge);
+                assert!(
+                    d.max_abs <= 1,
+                    "{es} {method}: radius {radius:e} differs by {} / 255",
+                    d.max_abs
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn a_far_plane_near_the_top_of_f64_renders_as_an_infinite_one() {
+    let mut gpu = Gpu::new(EsVersion::Es3);
+    let with_far = |far: f64| {
+        let mut s = plane(vec![point(4.0)]);
+        s.camera = Camera::perspective(DVec3::new(0.0, 0.0, 5.0), DVec3::ZERO, 60.0, 0.1, far);
+        s
+    };
+    let infinite = gpu.render(&with_far(f64::INFINITY), 64, 36, &RenderOptions::default());
+    assert!(mean(&infinite) > 20.0);
+    for far in [1e300, f64::MAX] {
+        let img = gpu.render(&with_far(far), 64, 36, &RenderOptions::default());
+        assert_eq!(img, infinite, "far {far:e}");
+    }
+}
+
+#[test]
+fn values_the_maths_cannot_carry_are_refused_naming_the_real_field() {
+    let mut gpu = Gpu::new(EsVersion::Es3);
+    type Breaker = Box<dyn Fn(&mut Scene)>;
+    let cases: Vec<(Breaker, &str)> = vec![
+        // Squared lengths of these overflow f64: it used to say camera.up was parallel.
+        (
+            Box::new(|s: &mut Scene| s.camera.position = DVec3::new(1e200, 0.0, 5.0)),
+            "camera.position",
+        ),
+        (
+            Box::new(|s: &mut Scene| s.camera.target = DVec3::new(0.0, -1e300, 0.0)),
+            "camera.target",
+        ),
+        (
+            Box::new(|s: &mut Scene| s.camera.up = DVec3::ZERO),
+            "camera.up",
+        ),
+        // A view finer than f32 view-space coordinates resolve (rendered half black).
+        (
+            Box::new(|s: &mut Scene| {
+                s.camera.projection = Projection::Orthographic {
+                    height: 1e-9,
+                    near: 0.0,
+                    far: 10.0,
+                }
+            }),
+            "camera.height",
+        ),
+    ];
+    for (break_it, field) in cases {
+        let mut s = plane(vec![point(3.0)]);
+        break_it(&mut s);
+        let err = gpu
+            .r()
+            .render_offscreen(&s, 16, 16, &RenderOptions::default())
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains(field), "expected `{field}` in: {err}");
+    }
+}
+
+#[test]
+fn obj_vertices_near_the_f32_limit_are_refused_as_vertices_not_as_lights() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("huge.obj");
+    std::fs::write(&path, "v -3e38 0 0\nv 3e38 0 0\nv 0 3e38 0\nf 1 2 3\n").unwrap();
+    let err = scene::load(path.to_str().unwrap(), Some((16, 1)))
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("positions[0]"), "{err}");
+    assert!(!err.contains("lights"), "{err}");
+}
