@@ -125,6 +125,25 @@ struct RandomLightsSpec {
     seed: u64,
 }
 
+/// Parses the JSON, naming the field at fault: serde's own messages lack the path, and for an
+/// array with too many values say only "trailing characters".
+fn deserialize(text: &str) -> Result<SceneFile, String> {
+    let mut json = serde_json::Deserializer::from_str(text);
+    serde_path_to_error::deserialize(&mut json).map_err(|e| {
+        let path = e.path().to_string();
+        let inner = e.inner().to_string();
+        let inner = match inner.strip_prefix("trailing characters") {
+            Some(position) if path != "." => format!("too many values{position}"),
+            _ => inner,
+        };
+        if path == "." {
+            inner
+        } else {
+            format!("{path}: {inner}")
+        }
+    })
+}
+
 /// Loads a scene file. Returns the scene (validated) and the warnings of any OBJ loads.
 /// `random_override` = `Some((count, seed))` replaces the file's `random_lights`.
 pub fn load(
@@ -152,9 +171,9 @@ pub fn parse(
     origin: &Path,
     random_override: Option<(usize, u64)>,
 ) -> Result<(Scene, LoadReport), SceneError> {
-    let file: SceneFile = serde_json::from_str(text).map_err(|e| SceneError::SceneFile {
+    let file: SceneFile = deserialize(text).map_err(|reason| SceneError::SceneFile {
         path: origin.to_path_buf(),
-        reason: e.to_string(),
+        reason,
     })?;
     let mut scene = Scene::empty();
     let mut report = LoadReport::default();
@@ -335,6 +354,25 @@ mod tests {
 
     fn parse_str(s: &str) -> Result<Scene, SceneError> {
         parse(s, Path::new("."), Path::new("test.json"), None).map(|(s, _)| s)
+    }
+
+    #[test]
+    fn json_errors_name_the_field_and_too_many_values_say_so() {
+        let err = parse_str(
+            r#"{"objects": [{"builtin": "plane"}],
+                "lights": [{"kind": "spot", "position": [0, 0, 1], "radius": 2,
+                            "color": [1, 1, 1], "direction": [0, 0, -1, 0, 0]}]}"#,
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(
+            err.contains("lights[0].direction: too many values"),
+            "{err}"
+        );
+        let err = parse_str(r#"{"objects": [{"builtin": "plane"}], "ambient": [1, "x", 0]}"#)
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("ambient"), "{err}");
     }
 
     #[test]

@@ -81,7 +81,7 @@ pub fn read_bounded(path: &Path, kind: FileKind) -> Result<Vec<u8>, SceneError> 
             path,
             std::io::ErrorKind::InvalidInput,
             format!(
-                "not a regular file (a {} must be a file, not a folder, device or FIFO)",
+                "not a regular file (the {} must be a file, not a folder, device or FIFO)",
                 kind.name()
             ),
         ));

@@ -139,6 +139,10 @@ type Parsed = (
 
 fn parse_obj(path: &Path) -> Result<Parsed, SceneError> {
     let bytes = read_bounded(path, FileKind::Model)?;
+    check_face_indices(&bytes).map_err(|reason| SceneError::Obj {
+        path: path.to_path_buf(),
+        reason,
+    })?;
     let base_dir = path.parent().unwrap_or(Path::new(".")).to_path_buf();
     let options = tobj::LoadOptions {
         triangulate: true,
@@ -171,6 +175,69 @@ fn parse_obj(path: &Path) -> Result<Parsed, SceneError> {
             "the OBJ parser (tobj) failed on this file; it is malformed".into(),
         )),
     }
+}
+
+/// Every index of every face, line and point refers to a vertex, texture coordinate or normal
+/// defined before it (negative indices count back from the last one): what tobj assumes —
+/// an index beyond them overflowed its arithmetic (a panic in debug builds, a read of the wrong
+/// element in release ones). Errors name the line.
+fn check_face_indices(bytes: &[u8]) -> Result<(), String> {
+    let text = String::from_utf8_lossy(bytes);
+    // Defined so far: positions, texture coordinates, normals.
+    let mut defined = [0i64; 3];
+    for (number, line) in text.lines().enumerate() {
+        let mut words = line.split_whitespace();
+        let key = words.next();
+        let needs = match key {
+            Some("v") | Some("vn") => 3,
+            Some("vt") => 2,
+            _ => 0,
+        };
+        // The numbers first, so a bad one is named rather than the face that uses it.
+        if needs > 0
+            && words
+                .clone()
+                .take(needs)
+                .filter(|w| w.parse::<f32>().is_ok())
+                .count()
+                < needs
+        {
+            return Err(format!(
+                "line {}: `{}` needs {needs} numbers, got `{}`",
+                number + 1,
+                key.unwrap_or_default(),
+                line.trim()
+            ));
+        }
+        match key {
+            Some("v") => defined[0] += 1,
+            Some("vt") => defined[1] += 1,
+            Some("vn") => defined[2] += 1,
+            Some(key @ ("f" | "l" | "p")) => {
+                for word in words {
+                    for (kind, part) in word.split('/').enumerate().take(3) {
+                        if part.is_empty() && kind > 0 {
+                            continue;
+                        }
+                        let resolves = part.parse::<i64>().is_ok_and(|i| {
+                            i != 0 && i.unsigned_abs() <= defined[kind].unsigned_abs()
+                        });
+                        if !resolves {
+                            let what = ["vertex", "texture coordinate", "normal"][kind];
+                            return Err(format!(
+                                "line {}: `{key}` refers to {what} `{part}`, but {} are \
+                                 defined before it",
+                                number + 1,
+                                defined[kind]
+                            ));
+                        }
+                    }
+                }
+            }
+            _ => {}
+        }
+    }
+    Ok(())
 }
 
 /// The first MTL line tobj would panic on or misread (a colour with fewer than three numbers,
