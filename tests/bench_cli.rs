@@ -3,12 +3,30 @@
 
 use std::process::Command;
 
+/// Runs `manylight bench` with `args` and the output folder; panics with its output if it
+/// fails.
+fn bench(args: &[&str], dir: &std::path::Path) -> String {
+    let out = Command::new(env!("CARGO_BIN_EXE_manylight"))
+        .arg("bench")
+        .args(args)
+        .arg("--out")
+        .arg(dir)
+        .output()
+        .unwrap();
+    let log = format!(
+        "{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(out.status.success(), "{log}");
+    log
+}
+
 #[test]
 fn a_small_sweep_writes_the_report_charts_and_heatmaps() {
     let dir = tempfile::tempdir().unwrap();
-    let out = Command::new(env!("CARGO_BIN_EXE_manylight"))
-        .args([
-            "bench",
+    let log = bench(
+        &[
             "--scenes",
             "plane",
             "--lights",
@@ -21,34 +39,37 @@ fn a_small_sweep_writes_the_report_charts_and_heatmaps() {
             "0",
             "--cpu-samples",
             "64",
-            "--out",
-        ])
-        .arg(dir.path())
-        .output()
-        .unwrap();
-    let log = format!(
-        "{}{}",
-        String::from_utf8_lossy(&out.stdout),
-        String::from_utf8_lossy(&out.stderr)
+        ],
+        dir.path(),
     );
-    assert!(out.status.success(), "{log}");
     for file in [
         "report.json",
         "report.md",
-        "error_vs_time.png",
-        "evals_vs_lights.png",
-        "heatmap-es3-clustered.png",
-        "heatmap-es3-lower-bound.png",
-        "diff-es3-clustered.png",
+        "error_vs_time-plane.png",
+        "evals_vs_lights-plane.png",
+        "heatmap-plane-es3-clustered.png",
+        "heatmap-plane-es3-lower-bound.png",
+        "diff-plane-es3-clustered.png",
+        "reference-plane-es3.png",
     ] {
         assert!(dir.path().join(file).is_file(), "{file} missing: {log}");
     }
-    for chart in ["error_vs_time.png", "evals_vs_lights.png"] {
+    for chart in ["error_vs_time-plane.png", "evals_vs_lights-plane.png"] {
         let img = image::open(dir.path().join(chart)).unwrap();
         assert!(
             img.width() >= 640 && img.height() >= 400,
             "{chart} too small"
         );
+    }
+    // The 64×36 maps are enlarged 4× to 256 pixels wide, with a legend panel under them and
+    // nothing beside them (a long caption wraps rather than widening the image).
+    for picture in [
+        "heatmap-plane-es3-forward.png",
+        "diff-plane-es3-clustered.png",
+    ] {
+        let img = image::open(dir.path().join(picture)).unwrap();
+        assert_eq!(img.width(), 256, "{picture}");
+        assert!(img.height() > 144 + 40, "{picture} has no legend");
     }
     let report: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.path().join("report.json")).unwrap())
@@ -103,4 +124,69 @@ fn a_small_sweep_writes_the_report_charts_and_heatmaps() {
     assert_eq!(row("clustered", 0)["max_abs_err"].as_u64(), Some(0));
     let md = std::fs::read_to_string(dir.path().join("report.md")).unwrap();
     assert!(md.contains("| method | lights | frame ms |"), "{md}");
+}
+
+#[test]
+fn every_scene_gets_its_own_charts_heatmaps_and_differences() {
+    let dir = tempfile::tempdir().unwrap();
+    let log = bench(
+        &[
+            "--scenes",
+            "plane,pillars",
+            "--lights",
+            "0,16",
+            "--es",
+            "3",
+            "--methods",
+            "forward,clustered,auto",
+            "--size",
+            "48x27",
+            "--frames",
+            "0",
+            "--cpu-samples",
+            "16",
+        ],
+        dir.path(),
+    );
+    let md = std::fs::read_to_string(dir.path().join("report.md")).unwrap();
+    for scene in ["plane", "pillars"] {
+        let mut files = vec![
+            format!("error_vs_time-{scene}.png"),
+            format!("evals_vs_lights-{scene}.png"),
+            format!("reference-{scene}-es3.png"),
+            format!("heatmap-{scene}-es3-lower-bound.png"),
+        ];
+        for method in ["forward", "clustered", "auto"] {
+            files.push(format!("heatmap-{scene}-es3-{method}.png"));
+            files.push(format!("diff-{scene}-es3-{method}.png"));
+        }
+        for file in &files {
+            assert!(dir.path().join(file).is_file(), "{file} missing: {log}");
+            assert!(
+                md.contains(&format!("]({file})")),
+                "report.md misses {file}:\n{md}"
+            );
+        }
+    }
+    // Nothing is left under the old, scene-less names.
+    for old in [
+        "error_vs_time.png",
+        "heatmap-es3-clustered.png",
+        "diff-es3-clustered.png",
+    ] {
+        assert!(!dir.path().join(old).exists(), "{old}");
+    }
+    // The two scenes' pictures are different pictures.
+    let read = |f: &str| std::fs::read(dir.path().join(f)).unwrap();
+    assert_ne!(
+        read("reference-plane-es3.png"),
+        read("reference-pillars-es3.png")
+    );
+    assert_ne!(
+        read("heatmap-plane-es3-clustered.png"),
+        read("heatmap-pillars-es3-clustered.png")
+    );
+    // The "—" of the 0-light rows (no lower bound to divide by) is explained.
+    assert!(md.contains("| — |"), "{md}");
+    assert!(md.contains("A \"—\" means"), "{md}");
 }

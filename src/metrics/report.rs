@@ -1,15 +1,20 @@
 //! The error-against-run-time report of `manylight bench`: one row per configuration (scene,
-//! method, ES version, light count, knob), the tables a person reads, and the two charts.
+//! method, ES version, light count, knob), the tables a person reads, and two charts per
+//! scene.
 //!
 //! Every row carries the machine facts its figures depend on (renderer string,
 //! `LP_NUM_THREADS`), so a figure is never quoted without them.
+//!
+//! Each method has one colour and marker in every chart, from its place in
+//! [`METHODS`] (see [`method_style`]).
 
 use std::fmt::Write as _;
 use std::path::Path;
 
 use serde::Serialize;
 
-use super::plot::{self, Chart, Series};
+use super::plot::{self, Chart, Marker, Series};
+use crate::methods::{auto, METHODS};
 
 /// One configuration's measurements.
 #[derive(Clone, Debug, Serialize)]
@@ -89,58 +94,171 @@ pub struct Report {
     pub seconds: f64,
     /// The rows.
     pub rows: Vec<BenchRow>,
+    /// The pictures written beside the report, listed in report.md (not in report.json,
+    /// whose fields are the rows').
+    #[serde(skip)]
+    pub pictures: Vec<Pictures>,
 }
 
-/// Writes `report.json`, `report.md`, `error_vs_time.png` and `evals_vs_lights.png` into `dir`.
+/// The pictures of one scene on one ES version at the light count its knobs run at: file
+/// names in the report folder (see [`heatmap_file`], [`diff_file`], [`reference_file`]).
+#[derive(Clone, Debug, Default)]
+pub struct Pictures {
+    /// Scene name, as in the rows.
+    pub scene: String,
+    /// Feature level, "2.0" or "3.0".
+    pub es: String,
+    /// Lights in the scene.
+    pub lights: usize,
+    /// The reference image (plain forward over all lights, light model at highp).
+    pub reference: String,
+    /// Light-evaluation heatmaps: (method, or "lower-bound"; file).
+    pub heatmaps: Vec<(String, String)>,
+    /// Differences from the reference: (method, file).
+    pub diffs: Vec<(String, String)>,
+}
+
+/// `name` (a scene or method) as it appears in file names: ASCII letters, digits, `-`, `_`
+/// and `.` kept, anything else (spaces, slashes, non-ASCII) becomes `_`.
+pub fn file_tag(name: &str) -> String {
+    let keep = |c: char| c.is_ascii_alphanumeric() || matches!(c, '-' | '_' | '.');
+    let tag: String = name
+        .chars()
+        .map(|c| if keep(c) { c } else { '_' })
+        .collect();
+    if tag.is_empty() {
+        "scene".to_string()
+    } else {
+        tag
+    }
+}
+
+/// "3.0" → "es3".
+fn es_tag(es: &str) -> String {
+    format!("es{}", es.split('.').next().unwrap_or(es))
+}
+
+/// A chart of `scene`: `error_vs_time-<scene>.png`, say.
+pub fn chart_file(chart: &str, scene: &str) -> String {
+    format!("{chart}-{}.png", file_tag(scene))
+}
+
+/// The light-evaluation heatmap of `what` (a method or "lower-bound") on `scene`, ES `es`.
+pub fn heatmap_file(scene: &str, es: &str, what: &str) -> String {
+    format!(
+        "heatmap-{}-{}-{}.png",
+        file_tag(scene),
+        es_tag(es),
+        file_tag(what)
+    )
+}
+
+/// The difference of `method` from the reference on `scene`, ES `es`.
+pub fn diff_file(scene: &str, es: &str, method: &str) -> String {
+    format!(
+        "diff-{}-{}-{}.png",
+        file_tag(scene),
+        es_tag(es),
+        file_tag(method)
+    )
+}
+
+/// The reference image of `scene`, ES `es`.
+pub fn reference_file(scene: &str, es: &str) -> String {
+    format!("reference-{}-{}.png", file_tag(scene), es_tag(es))
+}
+
+/// The two charts of every scene, by base name.
+const CHARTS: [&str; 2] = ["error_vs_time", "evals_vs_lights"];
+
+/// Writes `report.json`, `report.md` and, for every scene, `error_vs_time-<scene>.png` and
+/// `evals_vs_lights-<scene>.png` into `dir` (the pictures are written by the caller).
 pub fn write(report: &Report, dir: &Path) -> Result<(), String> {
     let io = |what: &str, e: &dyn std::fmt::Display| format!("cannot write {what}: {e}");
     std::fs::create_dir_all(dir).map_err(|e| io(&dir.display().to_string(), &e))?;
     let json = serde_json::to_string_pretty(report).map_err(|e| e.to_string())? + "\n";
     std::fs::write(dir.join("report.json"), json).map_err(|e| io("report.json", &e))?;
     std::fs::write(dir.join("report.md"), markdown(report)).map_err(|e| io("report.md", &e))?;
-    for (name, chart) in [
-        ("error_vs_time.png", error_vs_time(&report.rows)),
-        ("evals_vs_lights.png", evals_vs_lights(&report.rows)),
-    ] {
-        plot::render(&chart, 960, 640)?
-            .save(dir.join(name))
-            .map_err(|e| io(name, &e))?;
+    for scene in distinct(report.rows.iter().map(|r| r.scene.as_str())) {
+        let lights = workload_lights(report, scene);
+        let charts = [
+            error_vs_time(&report.rows, scene, lights),
+            evals_vs_lights(&report.rows, scene),
+        ];
+        for (base, chart) in CHARTS.iter().zip(charts) {
+            let name = chart_file(base, scene);
+            plot::render(&chart, 960, 640)?
+                .save(dir.join(&name))
+                .map_err(|e| io(&name, &e))?;
+        }
     }
     Ok(())
 }
 
-/// Error against frame time on the knob workload (the run's first scene at the light count
-/// its knobs ran at, every ES version): one point per configuration — each method, each knob —
-/// coloured by method, with the Pareto front (no other configuration both faster and more
-/// accurate) drawn through them. Other workloads differ in what they render, so their points
-/// would not trade against these; they are in the tables.
-pub fn error_vs_time(rows: &[BenchRow]) -> Chart {
-    let workload = rows
-        .iter()
-        .find(|r| r.knob != "default")
-        .or_else(|| {
-            rows.iter()
-                .filter(|r| r.lights > 0)
-                .max_by_key(|r| r.lights)
-        })
-        .map(|r| (r.scene.clone(), r.lights));
+/// The light count of `scene`'s knob workload: where its pictures were taken, else where its
+/// knobs ran, else its largest light count.
+fn workload_lights(report: &Report, scene: &str) -> usize {
+    let pictured = report.pictures.iter().find(|p| p.scene == scene);
+    let knob = || {
+        report
+            .rows
+            .iter()
+            .find(|r| r.scene == scene && r.knob != "default")
+    };
+    let largest = || {
+        report
+            .rows
+            .iter()
+            .filter(|r| r.scene == scene)
+            .map(|r| r.lights)
+            .max()
+    };
+    pictured
+        .map(|p| p.lights)
+        .or_else(|| knob().map(|r| r.lights))
+        .or_else(largest)
+        .unwrap_or(0)
+}
+
+/// Colour and marker of `method` in every chart: [`plot::style`] of its place in
+/// [`METHODS`] (a name not in the table gets the style after the table's), so a method looks
+/// the same whichever methods a chart shows and in whatever order.
+pub fn method_style(method: &str) -> ((u8, u8, u8), Marker) {
+    let i = METHODS.iter().position(|m| m.name == method);
+    plot::style(i.unwrap_or(METHODS.len()))
+}
+
+/// The series of `method`. `auto` usually picks clustered, so its points lie on clustered's:
+/// it is drawn hollow (a larger outline around clustered's filled marker, its line dashed)
+/// so that both stay visible.
+fn method_series(method: &str, points: Vec<(f64, f64)>, line: bool) -> Series {
+    let (color, marker) = method_style(method);
+    Series {
+        label: method.to_string(),
+        points,
+        color,
+        marker,
+        line,
+        hollow: method == auto::DESC.name,
+    }
+}
+
+/// Error against frame time on `scene`'s knob workload (`lights` lights, every ES version):
+/// one point per configuration (each method, each knob), with the Pareto front (no other
+/// configuration both faster and more accurate) drawn through them. Other workloads differ
+/// in what they render, so their points would not trade against these; they are in the
+/// tables.
+pub fn error_vs_time(rows: &[BenchRow], scene: &str, lights: usize) -> Chart {
     let rows: Vec<&BenchRow> = rows
         .iter()
-        .filter(|r| workload.as_ref() == Some(&(r.scene.clone(), r.lights)))
+        .filter(|r| r.scene == scene && r.lights == lights)
         .collect();
     let methods = distinct(rows.iter().map(|r| r.method.as_str()));
     let series = methods
         .iter()
-        .enumerate()
-        .map(|(i, m)| Series {
-            label: m.to_string(),
-            points: rows
-                .iter()
-                .filter(|r| r.method == *m)
-                .map(|r| (r.frame_ms, r.rmse))
-                .collect(),
-            color: plot::palette(i),
-            line: false,
+        .map(|m| {
+            let these = rows.iter().filter(|r| r.method == *m);
+            method_series(m, these.map(|r| (r.frame_ms, r.rmse)).collect(), false)
         })
         .collect();
     let all: Vec<(f64, f64)> = rows.iter().map(|r| (r.frame_ms, r.rmse)).collect();
@@ -148,7 +266,6 @@ pub fn error_vs_time(rows: &[BenchRow]) -> Chart {
         .into_iter()
         .map(|i| all[i])
         .collect();
-    let (scene, lights) = workload.unwrap_or_default();
     Chart {
         title: format!("Error against frame time: {scene}, {lights} lights"),
         x_label: "frame time (ms, log)".into(),
@@ -156,20 +273,19 @@ pub fn error_vs_time(rows: &[BenchRow]) -> Chart {
         x_log: true,
         y_log: true,
         series,
+        // Left out of the chart when it has fewer than two points (see `Chart::front`).
         front: Some(front),
         y_floor: None,
     }
 }
 
-/// Light evaluations per pixel against the light count, one line per method on the run's
-/// first scene (the default scene, unless the run names others) at ES 3.0 where the run has
-/// it, with the lower bound.
-pub fn evals_vs_lights(rows: &[BenchRow]) -> Chart {
+/// Light evaluations per pixel against the light count on `scene`, one line per method at
+/// ES 3.0 where the run has it, with the lower bound (black).
+pub fn evals_vs_lights(rows: &[BenchRow], scene: &str) -> Chart {
     let base: Vec<&BenchRow> = rows
         .iter()
-        .filter(|r| r.knob == "default" && r.lights > 0)
+        .filter(|r| r.scene == scene && r.knob == "default" && r.lights > 0)
         .collect();
-    let scene = base.first().map(|r| r.scene.as_str());
     let es = base
         .iter()
         .map(|r| r.es.as_str())
@@ -177,27 +293,15 @@ pub fn evals_vs_lights(rows: &[BenchRow]) -> Chart {
         .or_else(|| base.first().map(|r| r.es.as_str()));
     let base: Vec<&BenchRow> = base
         .into_iter()
-        .filter(|r| Some(r.scene.as_str()) == scene && Some(r.es.as_str()) == es)
+        .filter(|r| Some(r.es.as_str()) == es)
         .collect();
     let methods = distinct(base.iter().map(|r| r.method.as_str()));
-    let line = |points: Vec<(f64, f64)>, label: String, color| Series {
-        label,
-        points,
-        color,
-        line: true,
-    };
     let mut series: Vec<Series> = methods
         .iter()
-        .enumerate()
-        .map(|(i, m)| {
-            line(
-                base.iter()
-                    .filter(|r| r.method == *m)
-                    .map(|r| (r.lights as f64, r.evals_per_pixel))
-                    .collect(),
-                m.to_string(),
-                plot::palette(i),
-            )
+        .map(|m| {
+            let these = base.iter().filter(|r| r.method == *m);
+            let points = these.map(|r| (r.lights as f64, r.evals_per_pixel));
+            method_series(m, points.collect(), true)
         })
         .collect();
     let mut bound: Vec<(f64, f64)> = Vec::new();
@@ -207,11 +311,17 @@ pub fn evals_vs_lights(rows: &[BenchRow]) -> Chart {
             bound.push(point);
         }
     }
-    series.push(line(bound, "lower bound".into(), (0, 0, 0)));
+    series.push(Series {
+        label: "lower bound".into(),
+        points: bound,
+        color: (0, 0, 0),
+        marker: Marker::Circle,
+        line: true,
+        hollow: false,
+    });
     Chart {
         title: format!(
-            "Light evaluations per pixel ({}, ES {})",
-            scene.unwrap_or("-"),
+            "Light evaluations per pixel ({scene}, ES {})",
             es.unwrap_or("-")
         ),
         x_label: "lights (log)".into(),
@@ -246,6 +356,7 @@ pub fn markdown(report: &Report) -> String {
           lights that really reach each pixel; error is against plain forward over all lights \
           with the light model at highp on the same context (RMSE and max, 8-bit steps) and \
           against the light model in f64 at sampled pixels.\n\n";
+    s += COLUMNS;
     let defaults: Vec<&BenchRow> = rows.iter().filter(|r| r.knob == "default").collect();
     for scene in distinct(defaults.iter().map(|r| r.scene.as_str())) {
         for es in distinct(defaults.iter().map(|r| r.es.as_str())) {
@@ -316,6 +427,66 @@ pub fn markdown(report: &Report) -> String {
         }
         s += "\n";
     }
+    s += "## Charts and pictures\n\n\
+          Each method has the same colour and marker in every chart; `auto`, which usually \
+          picks clustered, is a larger hollow marker (and a dashed line) around clustered's. \
+          The error chart of a scene has every configuration run at its knobs' light count; \
+          the Pareto front joins those no other is both faster and more accurate than.\n\n";
+    if !report.pictures.is_empty() {
+        s += "Heatmaps of one scene and ES version share a logarithmic colour scale up to the \
+              largest count of any of them (forward's: every light at every pixel), so \
+              forward's does not clip and the culling methods' stay readable. Difference \
+              images show the largest RGB difference from the reference per pixel, amplified \
+              as their caption says; black is identical. The lower bound is a count, not an \
+              image: it has no difference image (—).\n\n";
+    }
+    for scene in distinct(rows.iter().map(|r| r.scene.as_str())) {
+        s += &pictures_section(report, scene);
+    }
+    s
+}
+
+/// What the table columns hold, and what a "—" in one means.
+const COLUMNS: &str = "Columns: *frame ms* and *assign ms* (CPU light assignment) are medians; \
+    *evals/px* is light evaluations per covered pixel and *× bound* its ratio to the lower \
+    bound (1 is perfect culling); *RMSE* and *max* are against the reference image and \
+    *f64 max* the largest error against the f64 light model at sampled pixels, all in 8-bit \
+    steps; *grid px* and *cells* (knob table) are the cell grid the frame used.\n\n\
+    A \"—\" means the figure does not exist for that row, not that it is zero: in *× bound*, \
+    no light reaches any covered pixel (a lower bound of 0, as at 0 lights), so there is no \
+    ratio; in *f64 max*, no sampled pixel could be checked against the f64 reference (every \
+    sample fell on a triangle edge, a textured or transparent surface or the background, or \
+    `--cpu-samples 0`); in *grid px*, the frame used no cell grid.\n\n";
+
+/// The charts of `scene` and, per ES version, its reference image, heatmaps and difference
+/// images.
+fn pictures_section(report: &Report, scene: &str) -> String {
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "### {scene}\n\n\
+         ![Error against frame time, {scene}]({})\n\n\
+         ![Light evaluations per pixel, {scene}]({})\n",
+        chart_file(CHARTS[0], scene),
+        chart_file(CHARTS[1], scene),
+    );
+    for p in report.pictures.iter().filter(|p| p.scene == scene) {
+        let _ = writeln!(
+            s,
+            "{scene}, ES {}, {} lights. Reference (plain forward over all lights, light model \
+             at highp): [{}]({})\n\n\
+             | method | light evaluations per pixel | difference from the reference |\n\
+             |---|---|---|",
+            p.es, p.lights, p.reference, p.reference
+        );
+        for (what, heatmap) in &p.heatmaps {
+            let diff = p.diffs.iter().find(|d| d.0 == *what);
+            let diff = diff.map_or("—".to_string(), |d| format!("[{}]({})", d.1, d.1));
+            let what = what.replace('-', " ");
+            let _ = writeln!(s, "| {what} | [{heatmap}]({heatmap}) | {diff} |");
+        }
+        s += "\n";
+    }
     s
 }
 
@@ -348,4 +519,193 @@ fn distinct<'a>(values: impl Iterator<Item = &'a str>) -> Vec<&'a str> {
         }
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn row(scene: &str, method: &str, lights: usize, knob: &str, ms: f64, rmse: f64) -> BenchRow {
+        BenchRow {
+            scene: scene.into(),
+            method: method.into(),
+            es: "3.0".into(),
+            lights,
+            width: 64,
+            height: 36,
+            knob: knob.into(),
+            frame_ms: ms,
+            gpu_ms: None,
+            assign_ms: 0.0,
+            upload_bytes: 0,
+            light_evals: 0,
+            evals_per_pixel: lights as f64 / 4.0 + 1.0,
+            max_evals: 0,
+            lower_bound_evals: 0,
+            lower_bound_per_pixel: 1.0,
+            evals_ratio: None,
+            max_abs_err: 0,
+            rmse,
+            psnr_db: None,
+            over_1: 0.0,
+            over_2: 0.0,
+            cpu_max_abs_err: None,
+            cpu_samples: 0,
+            overflowed_lights: 0,
+            grid_footprint_px: None,
+            grid_cells: 0,
+            grid_reason: None,
+            renderer: "llvmpipe".into(),
+            lp_num_threads: None,
+        }
+    }
+
+    /// Two scenes: "a" with every method, "b" with a few in another order.
+    fn rows() -> Vec<BenchRow> {
+        let mut rows = Vec::new();
+        for lights in [8, 64] {
+            for (i, m) in ["forward", "tiled", "clustered", "deferred", "auto"]
+                .iter()
+                .enumerate()
+            {
+                rows.push(row(
+                    "a",
+                    m,
+                    lights,
+                    "default",
+                    10.0 + i as f64,
+                    0.1 * i as f64,
+                ));
+            }
+            for (i, m) in ["auto", "clustered"].iter().enumerate() {
+                rows.push(row("b", m, lights, "default", 5.0 + i as f64, 0.2));
+            }
+        }
+        rows.push(row("a", "clustered", 64, "cutoff=0.01", 9.0, 0.5));
+        rows.push(row("b", "clustered", 64, "footprint_px=16", 4.0, 0.3));
+        rows
+    }
+
+    fn report() -> Report {
+        Report {
+            command: "manylight bench".into(),
+            cpus: 1,
+            seconds: 1.0,
+            rows: rows(),
+            pictures: vec![Pictures {
+                scene: "a".into(),
+                es: "3.0".into(),
+                lights: 64,
+                reference: reference_file("a", "3.0"),
+                heatmaps: vec![
+                    (
+                        "lower-bound".into(),
+                        heatmap_file("a", "3.0", "lower-bound"),
+                    ),
+                    ("clustered".into(), heatmap_file("a", "3.0", "clustered")),
+                ],
+                diffs: vec![("clustered".into(), diff_file("a", "3.0", "clustered"))],
+            }],
+        }
+    }
+
+    #[test]
+    fn a_method_looks_the_same_in_every_chart() {
+        let rows = rows();
+        let charts = [
+            error_vs_time(&rows, "a", 64),
+            evals_vs_lights(&rows, "a"),
+            error_vs_time(&rows, "b", 64),
+            evals_vs_lights(&rows, "b"),
+        ];
+        for chart in &charts {
+            for s in chart.series.iter().filter(|s| s.label != "lower bound") {
+                // Its place in METHODS, not in the chart.
+                let i = METHODS.iter().position(|m| m.name == s.label).unwrap();
+                assert_eq!((s.color, s.marker), plot::style(i), "{}", s.label);
+                assert_eq!(s.hollow, s.label == "auto", "{}", s.label);
+            }
+        }
+        // "b" lists auto first, yet clustered keeps its look.
+        assert_eq!(charts[2].series[0].label, "auto");
+        let clustered = |c: &Chart| {
+            let s = c.series.iter().find(|s| s.label == "clustered").unwrap();
+            (s.color, s.marker)
+        };
+        assert!(charts.iter().all(|c| clustered(c) == clustered(&charts[0])));
+        let (forward, tiled) = (method_style("forward"), method_style("tiled"));
+        assert!(forward.0 != tiled.0 && forward.1 != tiled.1);
+        let bound = charts[1].series.last().unwrap();
+        assert_eq!(
+            (bound.label.as_str(), bound.color),
+            ("lower bound", (0, 0, 0))
+        );
+    }
+
+    #[test]
+    fn each_scene_gets_its_own_charts_from_its_own_rows() {
+        let rows = rows();
+        let b = error_vs_time(&rows, "b", 64);
+        let points: usize = b.series.iter().map(|s| s.points.len()).sum();
+        assert_eq!(points, 3, "b's two methods and its knob row at 64 lights");
+        assert!(b.title.contains("b, 64 lights"), "{}", b.title);
+        let evals = evals_vs_lights(&rows, "b");
+        let labels: Vec<&str> = evals.series.iter().map(|s| s.label.as_str()).collect();
+        assert_eq!(labels, ["auto", "clustered", "lower bound"]);
+        // The picture workload, else the knobs', else the largest light count.
+        let mut r = report();
+        assert_eq!(workload_lights(&r, "a"), 64);
+        assert_eq!(workload_lights(&r, "b"), 64);
+        r.rows.retain(|r| r.knob == "default");
+        r.pictures.clear();
+        assert_eq!(workload_lights(&r, "b"), 64);
+        r.rows.retain(|r| r.lights == 8);
+        assert_eq!(workload_lights(&r, "b"), 8);
+    }
+
+    #[test]
+    fn file_names_carry_the_scene_sanitised() {
+        assert_eq!(file_tag("courtyard"), "courtyard");
+        assert_eq!(file_tag("my scene/ü"), "my_scene__");
+        assert_eq!(file_tag(""), "scene");
+        assert_eq!(chart_file("error_vs_time", "a b"), "error_vs_time-a_b.png");
+        assert_eq!(
+            heatmap_file("x", "3.0", "lower-bound"),
+            "heatmap-x-es3-lower-bound.png"
+        );
+        assert_eq!(diff_file("x", "2.0", "tiled"), "diff-x-es2-tiled.png");
+        assert_eq!(reference_file("x", "3.0"), "reference-x-es3.png");
+    }
+
+    #[test]
+    fn markdown_lists_every_picture_and_explains_the_dashes() {
+        let md = markdown(&report());
+        for file in [
+            "error_vs_time-a.png",
+            "evals_vs_lights-a.png",
+            "error_vs_time-b.png",
+            "evals_vs_lights-b.png",
+            "reference-a-es3.png",
+            "heatmap-a-es3-lower-bound.png",
+            "heatmap-a-es3-clustered.png",
+            "diff-a-es3-clustered.png",
+        ] {
+            assert!(
+                md.contains(&format!("]({file})")),
+                "{file} not linked:\n{md}"
+            );
+        }
+        assert!(md.contains("### a\n") && md.contains("### b\n"), "{md}");
+        assert!(
+            md.contains("| lower bound | [heatmap-a-es3-lower-bound.png]"),
+            "{md}"
+        );
+        // The rows have no ratio and no f64 figure: their "—" is explained.
+        assert!(md.contains("| — | 0.000 | 0 | — |"), "{md}");
+        assert!(md.contains("A \"—\" means"), "{md}");
+        for column in ["*× bound*", "*f64 max*", "*grid px*"] {
+            let why = md.split("A \"—\" means").nth(1).unwrap();
+            assert!(why.contains(column), "{column} not explained");
+        }
+    }
 }

@@ -17,7 +17,7 @@ use manylight::gl::HeadlessContext;
 use manylight::methods::{Support, METHODS};
 use manylight::metrics::cpu_reference::{self, Encoding, ReferenceSet};
 use manylight::metrics::raycast::SceneRaycaster;
-use manylight::metrics::report::{self, BenchRow, Report};
+use manylight::metrics::report::{self, BenchRow, Pictures, Report};
 use manylight::renderer::{CountKind, LightCounts};
 use manylight::scene::{self, Scene};
 use manylight::{EsVersion, RenderOptions, Renderer};
@@ -216,7 +216,8 @@ pub fn run(args: &BenchArgs) -> Result<(), Box<dyn std::error::Error>> {
     } else {
         Vec::new()
     };
-    // The knobs run on the default scene at the light count nearest 1 024.
+    // The knobs run at the light count nearest 1 024: the grid knobs on every scene, the
+    // others on the first. Every scene's pictures are taken there too.
     let knob_lights = plan
         .lights
         .iter()
@@ -235,6 +236,7 @@ pub fn run(args: &BenchArgs) -> Result<(), Box<dyn std::error::Error>> {
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
     let mut rows = Vec::new();
+    let mut pictures = Vec::new();
     let mut casters = std::collections::HashMap::new();
     for &es in &plan.es {
         // One context per ES version, made current for its renderer's whole life.
@@ -258,19 +260,20 @@ pub fn run(args: &BenchArgs) -> Result<(), Box<dyn std::error::Error>> {
                     frames: plan.frames,
                 };
                 let knob_workload = spec == &knob_scene && count == knob_lights;
-                let grid_workload = count == knob_lights;
+                // The grid knobs and the pictures: every scene at the knobs' light count.
+                let at_knob_lights = count == knob_lights;
                 let mut pictured = Vec::new();
                 for method in &plan.methods {
                     progress.set_message(format!("ES {es} {name} {count} lights: {method}"));
                     if let Some(m) = measure.run(&mut renderer, method, "default", |_| {})? {
                         rows.push(m.row.clone());
-                        if knob_workload {
+                        if at_knob_lights {
                             pictured.push((method.clone(), m));
                         }
                     }
                     progress.inc(1);
                 }
-                if grid_workload {
+                if at_knob_lights {
                     let here = knob_list.iter().filter(|k| k.every_scene || knob_workload);
                     for knob in here {
                         progress.set_message(format!("ES {es} {name}: {}", knob.name));
@@ -281,8 +284,13 @@ pub fn run(args: &BenchArgs) -> Result<(), Box<dyn std::error::Error>> {
                         progress.inc(1);
                     }
                 }
-                if knob_workload {
-                    write_pictures(&pictured, &base, es, &args.out)?;
+                if at_knob_lights {
+                    let workload = Workload {
+                        scene: &name,
+                        es,
+                        lights: scene.lights.len(),
+                    };
+                    pictures.push(write_pictures(&workload, &pictured, &base, &args.out)?);
                 }
             }
         }
@@ -295,6 +303,7 @@ pub fn run(args: &BenchArgs) -> Result<(), Box<dyn std::error::Error>> {
         cpus: std::thread::available_parallelism().map_or(1, |n| n.get()),
         seconds: started.elapsed().as_secs_f64(),
         rows,
+        pictures,
     };
     report::write(&report, &args.out)?;
     eprintln!(
@@ -421,43 +430,68 @@ impl Measure<'_> {
     }
 }
 
-/// Heatmaps of every method and of the lower bound, and each method's difference from the
-/// reference, for the knob workload (the default scene near 1 024 lights): from the images and
-/// counts its default configurations already measured.
+/// The scene, ES version and light count a set of pictures shows.
+struct Workload<'a> {
+    scene: &'a str,
+    es: EsVersion,
+    lights: usize,
+}
+
+/// How far difference images amplify: an error of this many 8-bit steps or more gets the top
+/// colour (×32).
+const DIFF_FULL_SCALE: u8 = 8;
+
+/// Heatmaps of every method and of the lower bound, each method's difference from the
+/// reference, and the reference, for one scene's picture workload (its knobs' light count):
+/// from the images and counts its default configurations already measured. Returns the file
+/// names for the report.
 fn write_pictures(
+    at: &Workload,
     measured: &[(String, Measured)],
     base: &Baseline,
-    es: EsVersion,
     out: &std::path::Path,
-) -> Result<(), Box<dyn std::error::Error>> {
-    use manylight::metrics::heatmap;
+) -> Result<Pictures, Box<dyn std::error::Error>> {
+    use manylight::metrics::heatmap::{self, Scale};
     std::fs::create_dir_all(out)?;
-    let tag = format!("es{}", es.major());
+    let (scene, es, lights) = (at.scene, format!("{}.0", at.es.major()), at.lights);
     let maps = std::iter::once(("lower-bound", &base.bound))
         .chain(measured.iter().map(|(name, m)| (name.as_str(), &m.evals)));
-    // One colour scale for the maps, so they compare at a glance: the largest count of the
-    // culling methods (forward, every light everywhere, saturates above it).
-    let scale = maps
-        .clone()
-        .filter(|(name, _)| *name != "forward")
-        .map(|(_, c)| c.max())
-        .max()
-        .unwrap_or(1)
-        .max(1);
+    // One colour scale for all the maps, so they compare at a glance. It must reach forward's
+    // count (every light at every pixel) or forward's map clips to one flat colour; but on a
+    // linear scale that high, the culling methods' few to few hundred evaluations would all
+    // be the same dark purple. A log scale does both: forward's count is the top, and 3, 30
+    // and 300 evaluations are equal steps below it.
+    let scale = Scale::Log(maps.clone().map(|(_, c)| c.max()).max().unwrap_or(1));
+    let mut pictures = Pictures {
+        scene: scene.to_string(),
+        es: es.clone(),
+        lights,
+        reference: report::reference_file(scene, &es),
+        ..Pictures::default()
+    };
     for (name, c) in maps {
-        let lights = measured.first().map_or(0, |(_, m)| m.row.lights);
         let title = format!(
-            "{name}: {:.1} light evaluations per pixel ({es}, {lights} lights)",
-            c.mean()
+            "{name}: {:.1} light evaluations per pixel ({scene}, ES {es}, {lights} lights).\n\
+             Colour: evaluations at each pixel on a log scale shared by all maps of this \
+             scene and ES version, up to the largest ({}), so none clips; dark grey: \
+             background.",
+            c.mean(),
+            scale.max()
         );
+        let file = report::heatmap_file(scene, &es, name);
         heatmap::heatmap(&c.counts, &c.covered, c.width, c.height, scale, &title)
-            .save(out.join(format!("heatmap-{tag}-{name}.png")))?;
+            .save(out.join(&file))?;
+        pictures.heatmaps.push((name.to_string(), file));
     }
     for (name, m) in measured {
-        heatmap::diff_image(&base.reference, &m.image, 8)
-            .save(out.join(format!("diff-{tag}-{name}.png")))?;
+        let what = format!(
+            "{name} vs reference (forward, all lights, highp): {scene}, ES {es}, {lights} lights."
+        );
+        let file = report::diff_file(scene, &es, name);
+        heatmap::diff_image(&base.reference, &m.image, DIFF_FULL_SCALE, &what)
+            .save(out.join(&file))?;
+        pictures.diffs.push((name.clone(), file));
     }
-    base.reference
-        .save(out.join(format!("reference-{tag}.png")))?;
-    Ok(())
+    base.reference.save(out.join(&pictures.reference))?;
+    Ok(pictures)
 }

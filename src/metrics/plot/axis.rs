@@ -93,21 +93,23 @@ impl Axis {
     }
 }
 
-/// The most x ticks whose labels do not collide on a plot `pw` pixels wide.
-pub(super) fn x_ticks_that_fit(xa: &Axis, pw: u32, s: u32) -> Ticks {
-    let mut max = (pw / (8 * s * 4 + 12)).max(2) as usize;
+/// The most x ticks whose labels (in `face` at scale `s`) do not collide on a plot `pw`
+/// pixels wide.
+pub(super) fn x_ticks_that_fit(xa: &Axis, pw: u32, s: u32, face: Face) -> Ticks {
+    let glyph = face.line(s);
+    let mut max = (pw / (glyph * 4 + 12)).max(2) as usize;
     loop {
-        let ticks = xa.ticks(max, pw, 8 * s);
+        let ticks = xa.ticks(max, pw, glyph);
         let mut pos: Vec<(f64, u32)> = ticks
             .0
             .iter()
-            .map(|(v, l)| (*v, text_width(l, s)))
+            .map(|(v, l)| (*v, face.width(l, s)))
             .collect();
         pos.sort_by(|a, b| a.0.total_cmp(&b.0));
         let px_per_unit = pw as f64 / (xa.hi - xa.lo);
         let fits = pos.windows(2).all(|w| {
             let gap = (w[1].0 - w[0].0) * px_per_unit;
-            gap >= (w[0].1 + w[1].1) as f64 / 2.0 + 8.0 * s as f64
+            gap >= (w[0].1 + w[1].1) as f64 / 2.0 + glyph as f64
         });
         if fits || max <= 2 {
             return ticks;

@@ -78,8 +78,10 @@ pub(super) const MARKER_WEIGHT: usize = 100;
 /// Pixels the legend should not cover, each with the cost of covering it.
 pub(super) type Avoid = Vec<((i32, i32), usize)>;
 
-/// Draws the front, the series lines and the markers (in that order, so markers stay on
-/// top); returns the pixels they cover (lines sampled every few pixels) with their weights.
+/// Draws the front, the series lines (solid, then dashed) and the markers (hollow, then
+/// filled), in that order so markers stay on top and a hollow series stays visible around
+/// the filled markers it shares points with; returns the pixels they cover (lines sampled
+/// every few pixels) with their weights.
 pub(super) fn draw_data<DB: DrawingBackend>(
     root: &DrawingArea<DB, plotters::coord::Shift>,
     chart: &Chart,
@@ -101,7 +103,7 @@ pub(super) fn draw_data<DB: DrawingBackend>(
             .collect::<Vec<_>>()
     };
     let mut covered = Vec::new();
-    if let Some(front) = &chart.front {
+    if let Some(front) = drawn_front(chart) {
         // A staircase: the boundary of the region the front dominates (minimising both).
         let pts = to_px(front, true);
         let mut path = Vec::new();
@@ -114,18 +116,92 @@ pub(super) fn draw_data<DB: DrawingBackend>(
         covered.extend(sample_path(&path));
         root.draw(&PathElement::new(path, FRONT_COLOR.stroke_width(3)))?;
     }
-    for sr in chart.series.iter().filter(|sr| sr.line) {
-        let pts = to_px(&sr.points, true);
-        covered.extend(sample_path(&pts));
-        root.draw(&PathElement::new(pts, rgb(sr.color).stroke_width(2)))?;
+    for hollow in [false, true] {
+        for sr in chart
+            .series
+            .iter()
+            .filter(|sr| sr.line && sr.hollow == hollow)
+        {
+            let pts = to_px(&sr.points, true);
+            covered.extend(sample_path(&pts));
+            draw_line(root, &pts, rgb(sr.color), hollow)?;
+        }
     }
-    for (i, sr) in chart.series.iter().enumerate() {
-        for p in to_px(&sr.points, false) {
-            covered.push((p, MARKER_WEIGHT));
-            draw_marker(root, p, i, rgb(sr.color), 2 + s as i32)?;
+    for hollow in [true, false] {
+        for sr in chart.series.iter().filter(|sr| sr.hollow == hollow) {
+            for p in to_px(&sr.points, false) {
+                covered.push((p, MARKER_WEIGHT));
+                draw_marker(root, p, sr.marker, rgb(sr.color), 2 + s as i32, hollow)?;
+            }
         }
     }
     Ok(covered)
+}
+
+/// A series line, 2 pixels wide: solid, or `dashed` (8 on, 6 off) so that a solid line it
+/// lies on shows through the gaps.
+pub(super) fn draw_line<DB: DrawingBackend>(
+    root: &DrawingArea<DB, plotters::coord::Shift>,
+    path: &[(i32, i32)],
+    color: RGBColor,
+    dashed: bool,
+) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+    let style = color.stroke_width(2);
+    if !dashed {
+        return root.draw(&PathElement::new(path.to_vec(), style));
+    }
+    for dash in dashes(path, 8.0, 6.0) {
+        root.draw(&PathElement::new(dash, style))?;
+    }
+    Ok(())
+}
+
+/// The pieces of a polyline drawn as dashes `on` pixels long with `off`-pixel gaps, the
+/// pattern running on across corners.
+pub(super) fn dashes(path: &[(i32, i32)], on: f64, off: f64) -> Vec<Vec<(i32, i32)>> {
+    let period = on + off;
+    let mut out: Vec<Vec<(i32, i32)>> = Vec::new();
+    let mut current: Vec<(i32, i32)> = Vec::new();
+    // Distance along the path at the start of the current segment.
+    let mut at = 0.0;
+    for w in path.windows(2) {
+        let (a, b) = (
+            (w[0].0 as f64, w[0].1 as f64),
+            (w[1].0 as f64, w[1].1 as f64),
+        );
+        let len = (b.0 - a.0).hypot(b.1 - a.1);
+        let point = |d: f64| {
+            let t = if len > 0.0 { (d - at) / len } else { 0.0 };
+            let p = (a.0 + (b.0 - a.0) * t, a.1 + (b.1 - a.1) * t);
+            (p.0.round() as i32, p.1.round() as i32)
+        };
+        // Walk the pattern's switch points on this segment. A dash still open at its end
+        // goes on into the next segment, round the corner.
+        let mut d = at;
+        while d < at + len {
+            let period_start = d - d.rem_euclid(period);
+            let dash_end = period_start + on;
+            if d < dash_end {
+                let next = dash_end.min(at + len);
+                if current.is_empty() {
+                    current.push(point(d));
+                }
+                current.push(point(next));
+                if next >= dash_end {
+                    out.push(std::mem::take(&mut current));
+                }
+                d = next;
+            } else {
+                // At least a step on: rounding may put `d` a hair short of the boundary.
+                d = (period_start + period).min(at + len).max(d + 1e-9);
+            }
+        }
+        at += len;
+    }
+    if current.len() > 1 {
+        out.push(current);
+    }
+    out
 }
 
 /// Points every few pixels along a polyline, each of weight 1.
@@ -143,70 +219,133 @@ pub(super) fn rgb(c: (u8, u8, u8)) -> RGBColor {
     RGBColor(c.0, c.1, c.2)
 }
 
-/// Series `i` gets marker shape `i % 5` (circle, square, triangle, diamond, cross), so
-/// series stay apart in grey-scale prints too.
+/// The corners of a marker's polygon around (x, y) with "radius" `r`; `None` for the shapes
+/// that are not polygons (circle, cross, plus).
+pub(super) fn marker_polygon(
+    marker: Marker,
+    (x, y): (i32, i32),
+    r: i32,
+) -> Option<Vec<(i32, i32)>> {
+    // Triangles and the diamond are a pixel larger, so their area is close to the square's.
+    let t = r + 1;
+    let half_w = (t as f64 * 0.866).round() as i32;
+    Some(match marker {
+        Marker::Square => vec![
+            (x - r, y - r),
+            (x + r, y - r),
+            (x + r, y + r),
+            (x - r, y + r),
+        ],
+        Marker::Triangle => vec![(x, y - t), (x + half_w, y + t / 2), (x - half_w, y + t / 2)],
+        Marker::TriangleDown => vec![(x, y + t), (x + half_w, y - t / 2), (x - half_w, y - t / 2)],
+        Marker::Diamond => vec![(x, y - t), (x + t, y), (x, y + t), (x - t, y)],
+        Marker::Circle | Marker::Cross | Marker::Plus => return None,
+    })
+}
+
+/// Extra radius of a hollow marker, so it rings a filled marker at the same point.
+pub(super) const HOLLOW_GROW: i32 = 3;
+
+/// Draws a `marker` at (x, y) with radius `r`: filled, or (`hollow`) as a 2-pixel outline
+/// [`HOLLOW_GROW`] pixels larger. Crosses and pluses are strokes either way.
 pub(super) fn draw_marker<DB: DrawingBackend>(
     root: &DrawingArea<DB, plotters::coord::Shift>,
     (x, y): (i32, i32),
-    i: usize,
+    marker: Marker,
     color: RGBColor,
     r: i32,
+    hollow: bool,
 ) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
-    match i % 5 {
-        0 => root.draw(&Circle::new((x, y), r, color.filled())),
-        1 => root.draw(&Rectangle::new(
-            [(x - r, y - r), (x + r, y + r)],
-            color.filled(),
-        )),
-        2 => root.draw(&TriangleMarker::new((x, y), r + 1, color.filled())),
-        3 => root.draw(&Polygon::new(
-            vec![
-                (x, y - r - 1),
-                (x + r + 1, y),
-                (x, y + r + 1),
-                (x - r - 1, y),
-            ],
-            color.filled(),
-        )),
-        _ => root.draw(&Cross::new((x, y), r, color.stroke_width(2))),
+    let r = if hollow { r + HOLLOW_GROW } else { r };
+    let stroke = color.stroke_width(2);
+    let fill = if hollow { stroke } else { color.filled() };
+    if let Some(mut corners) = marker_polygon(marker, (x, y), r) {
+        if !hollow {
+            return root.draw(&Polygon::new(corners, fill));
+        }
+        corners.push(corners[0]);
+        return root.draw(&PathElement::new(corners, stroke));
     }
+    match marker {
+        Marker::Cross => {
+            root.draw(&PathElement::new([(x - r, y - r), (x + r, y + r)], stroke))?;
+            root.draw(&PathElement::new([(x - r, y + r), (x + r, y - r)], stroke))
+        }
+        Marker::Plus => {
+            let r = r + 1;
+            root.draw(&PathElement::new([(x - r, y), (x + r, y)], stroke))?;
+            root.draw(&PathElement::new([(x, y - r), (x, y + r)], stroke))
+        }
+        _ => root.draw(&Circle::new((x, y), r, fill)),
+    }
+}
+
+/// One legend row: a series (its marker, and its line if it has one) or the Pareto front.
+pub(super) struct Entry {
+    pub(super) label: String,
+    pub(super) color: RGBColor,
+    /// A sample line (dashed for a hollow series; thick for the front).
+    pub(super) line: bool,
+    /// The series' marker; `None` for the front.
+    pub(super) marker: Option<Marker>,
+    pub(super) hollow: bool,
 }
 
 /// Legend entries and their layout.
 pub(super) struct Legend {
-    /// (label, series index or `None` for the Pareto front, line?, colour)
-    pub(super) entries: Vec<(String, Option<usize>, bool, RGBColor)>,
+    pub(super) entries: Vec<Entry>,
     pub(super) w: i32,
     pub(super) h: i32,
+    /// Height of a text line.
+    line: i32,
 }
 
 /// Width of the sample line or marker at the left of a legend row.
 pub(super) const SWATCH: i32 = 24;
 
 impl Legend {
-    pub(super) fn new(chart: &Chart, s: u32) -> Legend {
-        let mut entries: Vec<_> = chart
+    /// The labelled series, then the front when one is drawn; sized for text at scale `s`.
+    pub(super) fn new(chart: &Chart, s: u32, face: Face) -> Legend {
+        let mut entries: Vec<Entry> = chart
             .series
             .iter()
-            .enumerate()
-            .filter(|(_, sr)| !sr.label.is_empty())
-            .map(|(i, sr)| (sr.label.clone(), Some(i), sr.line, rgb(sr.color)))
+            .filter(|sr| !sr.label.is_empty())
+            .map(|sr| Entry {
+                label: sr.label.clone(),
+                color: rgb(sr.color),
+                line: sr.line,
+                marker: Some(sr.marker),
+                hollow: sr.hollow,
+            })
             .collect();
-        if chart.front.as_ref().is_some_and(|f| !f.is_empty()) {
-            entries.push(("Pareto front".to_string(), None, true, FRONT_COLOR));
+        if drawn_front(chart).is_some() {
+            entries.push(Entry {
+                label: "Pareto front".to_string(),
+                color: FRONT_COLOR,
+                line: true,
+                marker: None,
+                hollow: false,
+            });
         }
         let text_w = entries
             .iter()
-            .map(|e| text_width(&e.0, s))
+            .map(|e| face.width(&e.label, s))
             .max()
             .unwrap_or(0);
+        let line = face.line(s) as i32;
         let w = PAD as i32 * 3 + SWATCH + text_w as i32;
-        let h = PAD as i32 * 2 + entries.len() as i32 * Self::row(s) - 4;
-        Legend { entries, w, h }
+        let h = PAD as i32 * 2 + entries.len() as i32 * Self::row(line) - 4;
+        Legend {
+            entries,
+            w,
+            h,
+            line,
+        }
     }
 
-    pub(super) fn row(s: u32) -> i32 {
-        8 * s as i32 + 4
+    /// Height of a row for text lines `line` pixels high.
+    pub(super) fn row(line: i32) -> i32 {
+        line + 4
     }
 
     /// Top-left corner of the legend: the corner of the plot whose box covers the least
@@ -245,28 +384,29 @@ impl Legend {
             corners,
             RGBColor(150, 150, 150).stroke_width(1),
         ))?;
-        for (k, (_, series, line, color)) in self.entries.iter().enumerate() {
-            let cy = y + PAD as i32 + k as i32 * Self::row(s) + 4 * s as i32;
+        for (k, e) in self.entries.iter().enumerate() {
+            let cy = y + PAD as i32 + k as i32 * Self::row(self.line) + self.line / 2;
             let (x0, x1) = (x + PAD as i32, x + PAD as i32 + SWATCH);
-            if *line {
-                let width = if series.is_none() { 3 } else { 2 };
-                root.draw(&PathElement::new(
-                    [(x0, cy), (x1, cy)],
-                    color.stroke_width(width),
-                ))?;
+            if e.line && e.marker.is_none() {
+                let path = [(x0, cy), (x1, cy)];
+                root.draw(&PathElement::new(path, e.color.stroke_width(3)))?;
+            } else if e.line {
+                draw_line(root, &[(x0, cy), (x1, cy)], e.color, e.hollow)?;
             }
-            if let Some(i) = series {
-                draw_marker(root, ((x0 + x1) / 2, cy), *i, *color, 2 + s as i32)?;
+            if let Some(marker) = e.marker {
+                let at = ((x0 + x1) / 2, cy);
+                draw_marker(root, at, marker, e.color, 2 + s as i32, e.hollow)?;
             }
         }
         Ok(())
     }
 
-    pub(super) fn draw_text(&self, img: &mut RgbImage, (x, y): (i32, i32), s: u32) {
-        for (k, (label, ..)) in self.entries.iter().enumerate() {
+    /// The labels, right of their swatches.
+    pub(super) fn draw_text(&self, img: &mut RgbImage, (x, y): (i32, i32), s: u32, face: Face) {
+        for (k, e) in self.entries.iter().enumerate() {
             let tx = x + 2 * PAD as i32 + SWATCH;
-            let ty = y + PAD as i32 + k as i32 * Self::row(s);
-            draw_str(img, tx, ty, label, s, TEXT, false);
+            let ty = y + PAD as i32 + k as i32 * Self::row(self.line);
+            face.draw(img, (tx, ty), &e.label, s, TEXT, false);
         }
     }
 }

@@ -1,15 +1,13 @@
 //! Charts for the benchmark report: scatter and line series on linear or log axes, with an
 //! optional Pareto front, rendered to an `RgbImage`.
 //!
-//! Text. This build of plotters has no font feature, and its fallback font panics when asked
-//! to draw a glyph. The usual cure, a `DrawingBackend` wrapper that draws text itself, cannot
-//! be written here: the trait's method signatures name `BackendColor`, `BackendStyle`,
-//! `BackendTextStyle` and `DrawingErrorKind`, which plotters does not re-export, and
-//! `plotters-backend` is not a direct dependency. Plotters' legend also sizes its box with the
-//! font's own estimate rather than asking the backend. So plotters is used only to rasterise
-//! shapes (grid, series, markers, legend box), never text; this module does the layout and
-//! mapping itself and draws every label (title, axis descriptions, tick labels, legend) with
-//! the font8x8 glyphs, scaled by an integer factor.
+//! Text. Plotters' legend sizes its box with the font's own estimate rather than asking the
+//! backend, and a `DrawingBackend` wrapper cannot be written here (the trait's signatures name
+//! types plotters does not re-export). So plotters rasterises the shapes (grid, series,
+//! markers, legend box) and this module does the layout and mapping itself and draws every
+//! label (title, axis descriptions, tick labels, legend) afterwards: in a TrueType font found
+//! on the system (plotters' `ab_glyph` feature draws it), or with the font8x8 glyphs scaled by
+//! an integer factor where no font file is found (see `text.rs`).
 
 use image::{Rgb, RgbImage};
 use plotters::prelude::*;
@@ -38,8 +36,47 @@ pub struct Series {
     pub points: Vec<(f64, f64)>,
     /// Colour of markers and line, e.g. from [`palette`].
     pub color: (u8, u8, u8),
+    /// Marker shape, e.g. from [`style`].
+    pub marker: Marker,
     /// Connect the points in x order.
     pub line: bool,
+    /// Draw the markers as larger outlines under the filled ones (and the line dashed over
+    /// the solid ones), for a series whose points often coincide with another's: both stay
+    /// visible, this one around (and through) the other.
+    pub hollow: bool,
+}
+
+/// The shape of a series' markers.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Marker {
+    /// A disc.
+    #[default]
+    Circle,
+    /// A square.
+    Square,
+    /// A triangle pointing up.
+    Triangle,
+    /// A square on its corner.
+    Diamond,
+    /// An ×.
+    Cross,
+    /// A triangle pointing down.
+    TriangleDown,
+    /// A +.
+    Plus,
+}
+
+impl Marker {
+    /// Every shape, in the order [`style`] hands them out.
+    pub const ALL: [Marker; 7] = [
+        Marker::Circle,
+        Marker::Square,
+        Marker::Triangle,
+        Marker::Diamond,
+        Marker::Cross,
+        Marker::TriangleDown,
+        Marker::Plus,
+    ];
 }
 
 /// A 2-D chart. Log axes draw zero and negative values at a floor (see [`LOG_FLOOR`] and
@@ -59,7 +96,8 @@ pub struct Chart {
     pub y_log: bool,
     /// The data.
     pub series: Vec<Series>,
-    /// Points drawn as a thick dark staircase labelled "Pareto front" (any order).
+    /// Points drawn as a thick dark staircase labelled "Pareto front" (any order); a front of
+    /// fewer than two distinct points is no front and is neither drawn nor listed.
     pub front: Option<Vec<(f64, f64)>>,
     /// On a log y axis, where zero and negative y values are drawn; it should lie below the
     /// smallest positive y. `None`: one decade below the smallest positive y.
@@ -111,6 +149,13 @@ pub fn palette(i: usize) -> (u8, u8, u8) {
     COLORS[i % COLORS.len()]
 }
 
+/// Colour and marker number `i`: [`palette`]`(i)` with [`Marker::ALL`]`[i % 7]`, so series
+/// stay apart in grey-scale prints too. A caller that gives each thing drawn (a method, say)
+/// a fixed `i` gets the same look for it in every chart.
+pub fn style(i: usize) -> ((u8, u8, u8), Marker) {
+    (palette(i), Marker::ALL[i % Marker::ALL.len()])
+}
+
 /// Gap in pixels between text, axes and the image edge.
 const PAD: u32 = 6;
 /// Length of a tick mark outside the plot frame.
@@ -118,14 +163,29 @@ const TICK: u32 = 5;
 const TEXT: Rgb<u8> = Rgb([25, 25, 25]);
 const FRONT_COLOR: RGBColor = RGBColor(30, 30, 30);
 
-/// Renders `chart` into a `width`×`height` image. Text is 2× font8x8 (title 3×) on images at
-/// least 480×300, 1× (title 2×) below that; long titles shrink to fit. Fails only if the image
-/// is too small to hold the axes or plotters reports an error.
+/// The front as drawn: `None` unless it has at least two distinct finite points (one point,
+/// or copies of one, is no line and no trade-off to show).
+fn drawn_front(chart: &Chart) -> Option<&[(f64, f64)]> {
+    let front = chart.front.as_deref()?;
+    let mut finite = front.iter().filter(|p| p.0.is_finite() && p.1.is_finite());
+    let first = finite.next()?;
+    finite.any(|p| p != first).then_some(front)
+}
+
+/// Renders `chart` into a `width`×`height` image. Text is at scale 2 (title 3) on images at
+/// least 480×300, 1 (title 2) below that, in the system's TrueType font (lines of 11, 18 and
+/// 25 pixels at scales 1 to 3) or else the 8×8 bitmap font scaled; long titles shrink to fit. Fails only if the
+/// image is too small to hold the axes or plotters reports an error.
 pub fn render(chart: &Chart, width: u32, height: u32) -> Result<RgbImage, String> {
+    render_with(chart, width, height, Face::system())
+}
+
+/// [`render`] with the text in `face`.
+fn render_with(chart: &Chart, width: u32, height: u32, face: Face) -> Result<RgbImage, String> {
     let s = if width >= 480 && height >= 300 { 2 } else { 1 };
-    let title_s = fit_scale(&chart.title, s + 1, width.saturating_sub(2 * PAD));
-    let xdesc_s = fit_scale(&chart.x_label, s, width.saturating_sub(2 * PAD));
-    let ydesc_s = fit_scale(&chart.y_label, s, height.saturating_sub(2 * PAD));
+    let title_s = face.fit_scale(&chart.title, s + 1, width.saturating_sub(2 * PAD));
+    let xdesc_s = face.fit_scale(&chart.x_label, s, width.saturating_sub(2 * PAD));
+    let ydesc_s = face.fit_scale(&chart.y_label, s, height.saturating_sub(2 * PAD));
 
     let all = || {
         let front = chart.front.iter().flatten();
@@ -136,18 +196,18 @@ pub fn render(chart: &Chart, width: u32, height: u32) -> Result<RgbImage, String
 
     // Vertical layout first: the plot height fixes the y ticks, whose label width fixes the
     // left margin, which fixes the plot width and so the x ticks.
-    let glyph = 8 * s;
+    let glyph = face.line(s);
     let title_h = if chart.title.is_empty() {
         0
     } else {
-        8 * title_s + PAD
+        face.line(title_s) + PAD
     };
     // The top y tick label is centred on the frame and pokes above it by half a line.
     let top = PAD + title_h + glyph / 2;
     let xdesc_h = if chart.x_label.is_empty() {
         0
     } else {
-        8 * xdesc_s + PAD
+        face.line(xdesc_s) + PAD
     };
     let bottom = TICK + PAD / 2 + glyph + PAD + xdesc_h;
     let ph = height
@@ -155,11 +215,11 @@ pub fn render(chart: &Chart, width: u32, height: u32) -> Result<RgbImage, String
         .filter(|&h| h >= 16)
         .ok_or_else(|| format!("{width}x{height} is too small for a chart"))?;
     let y_ticks = ya.ticks((ph / (3 * glyph)).max(2) as usize, ph, glyph);
-    let ylabel_w = y_ticks.0.iter().map(|t| text_width(&t.1, s)).max();
+    let ylabel_w = y_ticks.0.iter().map(|t| face.width(&t.1, s)).max();
     let ydesc_w = if chart.y_label.is_empty() {
         0
     } else {
-        8 * ydesc_s + PAD
+        face.line(ydesc_s) + PAD
     };
     let left = PAD + ydesc_w + ylabel_w.unwrap_or(0) + PAD / 2 + TICK;
     let right = PAD + 2 * glyph; // room for half of the last x tick label
@@ -167,7 +227,7 @@ pub fn render(chart: &Chart, width: u32, height: u32) -> Result<RgbImage, String
         .checked_sub(left + right)
         .filter(|&w| w >= 16)
         .ok_or_else(|| format!("{width}x{height} is too small for a chart"))?;
-    let x_ticks = x_ticks_that_fit(&xa, pw, s);
+    let x_ticks = x_ticks_that_fit(&xa, pw, s, face);
     let frame = Frame {
         left: left as i32,
         top: top as i32,
@@ -175,7 +235,7 @@ pub fn render(chart: &Chart, width: u32, height: u32) -> Result<RgbImage, String
         h: ph as i32,
     };
 
-    let legend = Legend::new(chart, s);
+    let legend = Legend::new(chart, s, face);
     let mut buf = vec![255u8; width as usize * height as usize * 3];
     let legend_at;
     {
@@ -186,8 +246,14 @@ pub fn render(chart: &Chart, width: u32, height: u32) -> Result<RgbImage, String
         let mut avoid = paths;
         if ya.floor.is_some() {
             // Keep the legend off the "exact" label drawn above the y floor line.
-            let (x, y) = exact_label_at(&frame, &xa, &ya, s);
-            avoid.extend((0..5).map(|i| ((x + i * 8 * s as i32, y + 4), MARKER_WEIGHT)));
+            let (x, y) = exact_label_at(&frame, &xa, &ya, s, face);
+            let w = face.width(EXACT, s) as i32;
+            let half = glyph as i32 / 2;
+            avoid.extend(
+                (0..=w)
+                    .step_by(8)
+                    .map(|i| ((x + i, y + half), MARKER_WEIGHT)),
+            );
         }
         legend_at = legend.place(&frame, &avoid);
         if let Some(at) = legend_at {
@@ -200,58 +266,44 @@ pub fn render(chart: &Chart, width: u32, height: u32) -> Result<RgbImage, String
     // Tick labels: x centred under its tick, y right-aligned and centred on its tick, both
     // kept inside the image.
     for (v, label) in &x_ticks.0 {
-        let lw = text_width(label, s) as i32;
+        let lw = face.width(label, s) as i32;
         let x = (frame.x(*v, &xa) - lw / 2).clamp(0, (width as i32 - lw).max(0));
         let y = frame.top + frame.h + (TICK + PAD / 2) as i32;
-        draw_str(&mut img, x, y, label, s, TEXT, false);
+        face.draw(&mut img, (x, y), label, s, TEXT, false);
     }
     for (v, label) in &y_ticks.0 {
-        let x = frame.left - (TICK + PAD / 2 + text_width(label, s)) as i32;
+        let x = frame.left - (TICK + PAD / 2 + face.width(label, s)) as i32;
         let y = (frame.y(*v, &ya) - glyph as i32 / 2).clamp(0, (height - glyph) as i32);
-        draw_str(&mut img, x, y, label, s, TEXT, false);
+        face.draw(&mut img, (x, y), label, s, TEXT, false);
     }
     if ya.floor.is_some() {
-        let (x, y) = exact_label_at(&frame, &xa, &ya, s);
-        draw_str(&mut img, x, y, "exact", s, Rgb([90, 90, 90]), false);
+        let at = exact_label_at(&frame, &xa, &ya, s, face);
+        face.draw(&mut img, at, EXACT, s, Rgb([90, 90, 90]), false);
     }
     let centre_x = |text: &str, scale| {
-        let w = text_width(text, scale) as i32;
+        let w = face.width(text, scale) as i32;
         (frame.left + frame.w / 2 - w / 2).clamp(0, (width as i32 - w).max(0))
     };
-    let title_x = (width as i32 - text_width(&chart.title, title_s) as i32).max(0) / 2;
-    draw_str(
+    let title_x = (width as i32 - face.width(&chart.title, title_s) as i32).max(0) / 2;
+    let black = Rgb([0, 0, 0]);
+    face.draw(
         &mut img,
-        title_x,
-        PAD as i32,
+        (title_x, PAD as i32),
         &chart.title,
         title_s,
-        Rgb([0, 0, 0]),
+        black,
         false,
     );
-    let xdesc_y = (height - PAD - 8 * xdesc_s) as i32;
+    let xdesc_y = (height - PAD - face.line(xdesc_s)) as i32;
     let xdesc_x = centre_x(&chart.x_label, xdesc_s);
-    draw_str(
-        &mut img,
-        xdesc_x,
-        xdesc_y,
-        &chart.x_label,
-        xdesc_s,
-        TEXT,
-        false,
-    );
-    let ydesc_len = text_width(&chart.y_label, ydesc_s) as i32;
+    let xdesc_at = (xdesc_x, xdesc_y);
+    face.draw(&mut img, xdesc_at, &chart.x_label, xdesc_s, TEXT, false);
+    let ydesc_len = face.width(&chart.y_label, ydesc_s) as i32;
     let ydesc_y = (frame.top + frame.h / 2 + ydesc_len / 2).clamp(0, height as i32 - 1);
-    draw_str(
-        &mut img,
-        PAD as i32,
-        ydesc_y,
-        &chart.y_label,
-        ydesc_s,
-        TEXT,
-        true,
-    );
+    let ydesc_at = (PAD as i32, ydesc_y);
+    face.draw(&mut img, ydesc_at, &chart.y_label, ydesc_s, TEXT, true);
     if let Some(at) = legend_at {
-        legend.draw_text(&mut img, at, s);
+        legend.draw_text(&mut img, at, s, face);
     }
     Ok(img)
 }
@@ -286,10 +338,13 @@ impl Frame {
     }
 }
 
+/// The note on the y floor line of a log axis.
+const EXACT: &str = "exact";
+
 /// Top-left of the "exact" note: just above the y floor line, at the left of the plot or
 /// right of the x floor line.
-fn exact_label_at(frame: &Frame, xa: &Axis, ya: &Axis, s: u32) -> (i32, i32) {
+fn exact_label_at(frame: &Frame, xa: &Axis, ya: &Axis, s: u32, face: Face) -> (i32, i32) {
     let floor = ya.floor.map_or(ya.lo, f64::log10);
     let x = xa.floor.map_or(frame.left, |f| frame.x(f.log10(), xa));
-    (x + 4, frame.y(floor, ya) - 8 * s as i32 - 3)
+    (x + 4, frame.y(floor, ya) - face.line(s) as i32 - 3)
 }
