@@ -102,6 +102,8 @@ pub struct Renderer {
     /// What the default method's support would warn about: said at the first frame, unless
     /// the caller picks a method first (whose own support is then what is said).
     pending_warning: Option<String>,
+    /// GL objects already freed (by `destroy`; dropping then does nothing more).
+    freed: bool,
 }
 
 impl Renderer {
@@ -148,6 +150,7 @@ impl Renderer {
             target: None,
             timer: None,
             pending_warning,
+            freed: false,
         })
     }
 
@@ -511,8 +514,18 @@ impl Renderer {
         self.method.light_lists()
     }
 
-    /// Frees every GL object the renderer made. Call before dropping the context.
+    /// Frees every GL object the renderer made, while its context is still current.
+    /// Dropping the renderer does the same (so an early return on an error frees everything
+    /// quietly); `destroy` only makes the moment explicit.
     pub fn destroy(mut self) {
+        self.free_gl();
+    }
+
+    fn free_gl(&mut self) {
+        if self.freed {
+            return;
+        }
+        self.freed = true;
         if let Some(Some(t)) = self.timer.take() {
             t.destroy(&self.dev);
         }
@@ -522,6 +535,14 @@ impl Renderer {
         if let Some(mut t) = self.target.take() {
             t.destroy(&self.dev);
         }
+    }
+}
+
+impl Drop for Renderer {
+    /// The context must still be current, as [`Renderer::new`] requires for the renderer's
+    /// whole life.
+    fn drop(&mut self) {
+        self.free_gl();
     }
 }
 

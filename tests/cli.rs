@@ -569,3 +569,40 @@ fn hostile_files_and_counts_are_refused_quickly_and_clearly() {
         assert!(!msg.contains("panicked"), "{args:?}: {msg}");
     }
 }
+
+/// Errors found before or during a bench name what is at fault and print nothing else: no
+/// "GL … leaked" warnings from the error path.
+#[test]
+fn bench_errors_name_the_fault_without_leak_warnings() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("file"), b"").unwrap();
+    let cases: &[(&[&str], &str)] = &[
+        (
+            &["bench", "--quick", "--methods", "raytraced"],
+            "unknown method `raytraced`",
+        ),
+        (&["bench", "--quick", "--out", "file/sub"], "file/sub"),
+        (
+            &[
+                "bench",
+                "--quick",
+                "--no-knobs",
+                "--es",
+                "3",
+                "--scenes",
+                "plane,nowhere.obj",
+            ],
+            "nowhere.obj",
+        ),
+    ];
+    for (args, needle) in cases {
+        let out = manylight(args, &[], dir.path());
+        let msg = text(&out);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {msg}");
+        assert!(
+            msg.contains(needle),
+            "{args:?}: expected `{needle}` in: {msg}"
+        );
+        assert!(!msg.contains("leaked"), "{args:?}: {msg}");
+    }
+}

@@ -122,11 +122,19 @@ impl Plan {
     }
 }
 
-/// The conference room of $MANYLIGHT_ASSETS, when set and present.
+/// The conference room of $MANYLIGHT_ASSETS, when set and present; otherwise says how to get
+/// the row.
 fn conference() -> Option<String> {
-    let dir = PathBuf::from(std::env::var_os("MANYLIGHT_ASSETS")?);
-    let obj = dir.join("conference/conference.obj");
-    obj.is_file().then(|| obj.to_string_lossy().into_owned())
+    let obj = std::env::var_os("MANYLIGHT_ASSETS")
+        .map(|dir| PathBuf::from(dir).join("conference/conference.obj"))
+        .filter(|obj| obj.is_file());
+    if obj.is_none() {
+        eprintln!(
+            "bench: the conference-room rows are left out: set MANYLIGHT_ASSETS to a folder \
+             with the real scenes (scripts/fetch-assets; docs/assets.md)"
+        );
+    }
+    obj.map(|o| o.to_string_lossy().into_owned())
 }
 
 /// A knob varied from the defaults, on one method.
@@ -211,6 +219,20 @@ struct Baseline {
 pub fn run(args: &BenchArgs) -> Result<(), Box<dyn std::error::Error>> {
     let started = Instant::now();
     let plan = Plan::from(args);
+    // What can be checked before any rendering is: the methods' names, the output folder.
+    for method in &plan.methods {
+        manylight::methods::find(method)?;
+    }
+    std::fs::create_dir_all(&args.out).map_err(|e| {
+        format!(
+            "cannot create the output folder {}: {e}",
+            args.out.display()
+        )
+    })?;
+    let probe = args.out.join(".manylight-write-test");
+    std::fs::write(&probe, b"")
+        .and_then(|()| std::fs::remove_file(&probe))
+        .map_err(|e| format!("cannot write into {}: {e}", args.out.display()))?;
     let knob_list = if plan.knobs {
         knobs(args.quick)
     } else {
