@@ -186,6 +186,23 @@ impl Drop for DataTexture {
     }
 }
 
+/// The size an image of `size` is uploaded at: each side within `max` (the context's
+/// `GL_MAX_TEXTURE_SIZE`), and with `power_of_two` (ES 2.0, which allows neither mipmaps nor
+/// `REPEAT` on other sizes, and OBJ texture coordinates tile) the largest power of two not above
+/// that. Images are only ever scaled down: rounding up made a 12 000² PNG a 16 384² texture,
+/// minutes of resizing and 4.7 GB.
+pub fn upload_size((w, h): (u32, u32), max: u32, power_of_two: bool) -> (u32, u32) {
+    let fit = |side: u32| {
+        let side = side.clamp(1, max.max(1));
+        if power_of_two {
+            1 << (31 - side.leading_zeros())
+        } else {
+            side
+        }
+    };
+    (fit(w), fit(h))
+}
+
 /// A mipmapped, repeating RGBA8 image texture (sRGB-encoded; decoded in the shader because
 /// ES 2.0 has no sRGB textures in core).
 pub struct ImageTexture {
@@ -194,15 +211,12 @@ pub struct ImageTexture {
 }
 
 impl ImageTexture {
-    /// Uploads an image. Non-power-of-two images are resized to the next power of two, because
-    /// ES 2.0 allows neither mipmaps nor `REPEAT` on them and OBJ texture coordinates tile.
+    /// Uploads an image, downscaled where it is larger than the context's texture limit and,
+    /// on ES 2.0, to a power of two (see [`upload_size`]).
     pub fn new(dev: &Device, image: &image::RgbaImage) -> Result<ImageTexture, GlError> {
         let max = dev.caps().max_texture_size.max(1) as u32;
         let (w, h) = image.dimensions();
-        let (pw, ph) = (
-            w.next_power_of_two().min(max),
-            h.next_power_of_two().min(max),
-        );
+        let (pw, ph) = upload_size((w, h), max, dev.es() == EsVersion::Es2);
         let resized;
         let img = if (pw, ph) != (w, h) {
             resized = image::imageops::resize(image, pw, ph, image::imageops::FilterType::Triangle);
@@ -258,5 +272,23 @@ impl Drop for ImageTexture {
         if !self.destroyed {
             log::warn!("ImageTexture dropped without destroy(): GL texture leaked");
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::upload_size;
+
+    #[test]
+    fn images_are_scaled_down_never_up() {
+        // ES 2.0: the largest power of two not above the side, within the limit.
+        assert_eq!(upload_size((12_000, 12_000), 16_384, true), (8_192, 8_192));
+        assert_eq!(upload_size((1_000, 513), 16_384, true), (512, 512));
+        assert_eq!(upload_size((256, 64), 16_384, true), (256, 64));
+        assert_eq!(upload_size((5_000, 3), 2_048, true), (2_048, 2));
+        // ES 3.0: any size within the limit.
+        assert_eq!(upload_size((12_000, 700), 16_384, false), (12_000, 700));
+        assert_eq!(upload_size((40_000, 700), 16_384, false), (16_384, 700));
+        assert_eq!(upload_size((0, 1), 4_096, false), (1, 1));
     }
 }
