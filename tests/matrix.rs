@@ -93,6 +93,15 @@ fn matrix_covers_es2_es2_without_float_and_es3_and_every_supported_cell_matches_
             .as_str()
             .unwrap()
             .contains("ES 2.0"));
+        // The second Mesa driver really ran (GALLIUM_DRIVER is Mesa's too).
+        let softpipe = row("ES 3.x on softpipe (second Mesa driver)");
+        assert!(
+            softpipe["renderer"]
+                .as_str()
+                .unwrap_or("")
+                .contains("softpipe"),
+            "{softpipe}"
+        );
     } else {
         common::skip("the driver is not Mesa: MESA_* override rows are not restricted");
     }

@@ -46,6 +46,8 @@ struct Config {
     env: &'static [(&'static str, &'static str)],
     /// Extra arguments of the child (restrictions the renderer plays itself).
     args: &'static [&'static str],
+    /// Image size instead of the matrix's (a slow driver renders a smaller image).
+    size: Option<&'static str>,
 }
 
 const CONFIGS: &[Config] = &[
@@ -55,6 +57,7 @@ const CONFIGS: &[Config] = &[
         es: "2",
         env: &[],
         args: &[],
+        size: None,
     },
     Config {
         name: "ES 2.0 without fragment highp (played)",
@@ -62,6 +65,7 @@ const CONFIGS: &[Config] = &[
         es: "2",
         env: &[],
         args: &["--no-fragment-highp"],
+        size: None,
     },
     Config {
         name: "ES 2.0 without float textures",
@@ -72,6 +76,7 @@ const CONFIGS: &[Config] = &[
             "-GL_OES_texture_float -GL_OES_texture_half_float",
         )],
         args: &[],
+        size: None,
     },
     Config {
         name: "ES 2.0 driver (capped)",
@@ -79,6 +84,7 @@ const CONFIGS: &[Config] = &[
         es: "2",
         env: &[("MESA_GLES_VERSION_OVERRIDE", "2.0")],
         args: &[],
+        size: None,
     },
     Config {
         name: "ES 3.0 driver (capped)",
@@ -86,6 +92,7 @@ const CONFIGS: &[Config] = &[
         es: "3",
         env: &[("MESA_GLES_VERSION_OVERRIDE", "3.0")],
         args: &[],
+        size: None,
     },
     Config {
         name: "ES 3.x as the driver gives it",
@@ -93,6 +100,17 @@ const CONFIGS: &[Config] = &[
         es: "3",
         env: &[],
         args: &[],
+        size: None,
+    },
+    // A second Mesa rasterizer (mediump at fp32, no LLVM): slow, so a small image. Where it
+    // and llvmpipe differ, it is on triangle edges only (tests/second_driver.rs).
+    Config {
+        name: "ES 3.x on softpipe (second Mesa driver)",
+        slug: "es3-softpipe",
+        es: "3",
+        env: &[("GALLIUM_DRIVER", "softpipe")],
+        args: &[],
+        size: Some("96x54"),
     },
 ];
 
@@ -112,7 +130,7 @@ pub fn run(args: &MatrixArgs) -> Result<(), Box<dyn std::error::Error>> {
             "--scene",
             &args.scene,
             "--size",
-            &size,
+            config.size.unwrap_or(&size),
         ])
         .args(["--lights", &args.lights.to_string(), "--tag", config.slug])
         .args(config.args)

@@ -1,0 +1,99 @@
+//! A second Mesa driver, softpipe (another rasterizer; `mediump` at fp32), against llvmpipe and
+//! the light model: where the two drivers' images differ, the difference must be one the GL
+//! spec allows — a pixel on a triangle edge or silhouette, whose coverage is the rasterizer's
+//! choice (sub-pixel precision is implementation-defined) — and every other pixel of each
+//! driver must match the f64 light model. The renders run in child processes, because
+//! `GALLIUM_DRIVER` is read when EGL loads.
+
+mod common;
+
+use std::collections::HashSet;
+use std::path::Path;
+use std::process::Command;
+
+use manylight::metrics::cpu_reference::{self, Encoding};
+use manylight::scene;
+
+const SIZE: (u32, u32) = (160, 90);
+
+/// Renders the courtyard with `method` under `driver` (`None`: the default, llvmpipe).
+fn render(dir: &Path, driver: Option<&str>, method: &str) -> Option<image::RgbaImage> {
+    let out = dir.join(format!("{}-{method}.png", driver.unwrap_or("default")));
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_manylight"));
+    cmd.args([
+        "render", "--lights", "64", "--seed", "3", "--linear", "--frames", "0",
+    ])
+    .args([
+        "--method",
+        method,
+        "--size",
+        &format!("{}x{}", SIZE.0, SIZE.1),
+    ])
+    .arg("--out")
+    .arg(&out);
+    if let Some(d) = driver {
+        cmd.env("GALLIUM_DRIVER", d);
+    }
+    let output = cmd.output().expect("run manylight");
+    let text = String::from_utf8_lossy(&output.stdout).to_string()
+        + &String::from_utf8_lossy(&output.stderr);
+    if driver.is_some() && !text.contains(driver.unwrap()) {
+        common::skip(&format!("{driver:?} is not available here: {text}"));
+        return None;
+    }
+    assert!(output.status.success(), "{text}");
+    Some(image::open(&out).unwrap().to_rgba8())
+}
+
+#[test]
+fn softpipe_differs_from_llvmpipe_only_where_rasterization_may() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = scene::builtin::build("courtyard", Some((64, 3))).unwrap();
+    let oracle = cpu_reference::reference_samples(
+        &scene,
+        SIZE.0,
+        SIZE.1,
+        (SIZE.0 * SIZE.1) as usize,
+        Encoding::Linear,
+    );
+    // The pixels the oracle speaks for: not on an edge, silhouette or coplanar pair.
+    let interior: HashSet<(u32, u32)> = oracle.samples.iter().map(|s| (s.x, s.y)).collect();
+    assert!(
+        interior.len() > (SIZE.0 * SIZE.1 / 2) as usize,
+        "oracle covers too little"
+    );
+    for method in ["forward", "clustered"] {
+        let Some(llvmpipe) = render(dir.path(), None, method) else {
+            return;
+        };
+        let Some(softpipe) = render(dir.path(), Some("softpipe"), method) else {
+            return;
+        };
+        for (name, img) in [("llvmpipe", &llvmpipe), ("softpipe", &softpipe)] {
+            let e = cpu_reference::compare(img, &oracle);
+            assert!(
+                e.max_abs <= 2.0,
+                "{name} {method}: {:.2} / 255 from the light model at {:?}",
+                e.max_abs,
+                e.worst
+            );
+        }
+        let mut differing = 0;
+        for (x, y, p) in llvmpipe.enumerate_pixels() {
+            let q = softpipe.get_pixel(x, y);
+            let worst = (0..3).map(|c| p[c].abs_diff(q[c])).max().unwrap();
+            if worst > 2 {
+                differing += 1;
+                assert!(
+                    !interior.contains(&(x, y)),
+                    "{method}: drivers differ by {worst} / 255 at interior pixel ({x}, {y})"
+                );
+            }
+        }
+        eprintln!(
+            "{method}: {differing} pixels differ by more than 2 / 255, all on edges or \
+             silhouettes ({} interior pixels compared)",
+            interior.len()
+        );
+    }
+}
