@@ -19,7 +19,8 @@
 //!
 //! **Overflow policy.** A cell never holds more than `cell_cap` lights (the shader's loop bound
 //! on ES 2.0 and the count field of the grid texel): it keeps the `cell_cap` lights with the
-//! largest `max(radiance) / (1 + distance²)` to the cell centre and drops the rest. If the
+//! largest `max(radiance) / (1 + distance²)` to the cell centre (of equal ones, the earlier)
+//! and drops the rest, in one selection and one pass (no sort per cell). If the
 //! whole list would exceed `max_indices` (what the index texture holds), the per-cell cap is
 //! lowered until it fits. Nothing wraps and nothing reads out of range; every dropped light is
 //! counted in [`AssignStats::overflowed_lights`], and the image degrades by exactly those
@@ -469,7 +470,7 @@ fn apply_cap(
 }
 
 /// Moves the `cap` most important lights of every cell holding more to the front of its list,
-/// in ascending order. Each light's importance is computed once (the comparisons of a
+/// in ascending order (of equally important ones, the earlier). Each light's importance is computed once (the comparisons of a
 /// selection would otherwise recompute it, through two random reads, several times per
 /// entry: 4 M lights took 2 s), and cells are trimmed in parallel: their lists are disjoint.
 fn trim_overfull_cells(out: &mut Assignment, grid: &ClusterGrid, lights: &[GpuLight], cap: u32) {
@@ -501,20 +502,40 @@ fn trim_overfull_cells(out: &mut Assignment, grid: &ClusterGrid, lights: &[GpuLi
         })
         .collect();
     let trim = |(cell, list): &mut (usize, &mut [u32])| {
+        if cap == 0 {
+            return;
+        }
         let center = cell_center(grid, *cell as u32);
-        let mut keyed: Vec<(f64, u32)> = list
+        let keys: Vec<f64> = list
             .iter()
             .map(|&i| {
                 let [x, y, z, brightness] = packed[i as usize];
                 let position = glam::DVec3::new(x as f64, y as f64, z as f64);
-                (brightness_over_distance(brightness, position, center), i)
+                brightness_over_distance(brightness, position, center)
             })
             .collect();
-        // A cap of 0 (a budget smaller than the non-empty cells) still needs a valid index.
-        keyed.select_nth_unstable_by(cap.max(1) - 1, |a, b| b.0.total_cmp(&a.0));
-        let mut top: Vec<u32> = keyed[..cap].iter().map(|k| k.1).collect();
-        top.sort_unstable();
-        list[..cap].copy_from_slice(&top);
+        // The cap-th largest key is the threshold: every light above it stays, and of those
+        // equal to it the earliest, until the cap is reached. One selection and one pass in
+        // list order, so the kept lights stay in ascending order without a sort.
+        let mut order = keys.clone();
+        let (_, &mut threshold, _) = order.select_nth_unstable_by(cap - 1, |a, b| b.total_cmp(a));
+        let mut ties = cap - keys.iter().filter(|&&k| k > threshold).count();
+        let mut kept = 0;
+        for at in 0..list.len() {
+            let keep = match keys[at].total_cmp(&threshold) {
+                std::cmp::Ordering::Greater => true,
+                std::cmp::Ordering::Equal if ties > 0 => {
+                    ties -= 1;
+                    true
+                }
+                _ => false,
+            };
+            if keep {
+                list[kept] = list[at];
+                kept += 1;
+            }
+        }
+        debug_assert_eq!(kept, cap);
     };
     if lists.iter().map(|(_, l)| l.len()).sum::<usize>() >= PARALLEL_INDICES {
         lists.par_iter_mut().for_each(trim);
