@@ -20,11 +20,11 @@
 //! **Overflow policy.** A cell never holds more than `cell_cap` lights (the shader's loop bound
 //! on ES 2.0 and the count field of the grid texel): it keeps the `cell_cap` lights with the
 //! largest `max(radiance) / (1 + distance²)` to the cell centre (of equal ones, the earlier)
-//! and drops the rest, in one selection and one pass (no sort per cell). If the
-//! whole list would exceed `max_indices` (what the index texture holds), the per-cell cap is
-//! lowered to the largest that fits (a binary search over the counts). Nothing wraps and nothing reads out of range; every dropped light is
-//! counted in [`AssignStats::overflowed_lights`], and the image degrades by exactly those
-//! lights' contributions (measurable against plain forward).
+//! and drops the rest, in one selection and one pass (no sort per cell). If the whole list
+//! would exceed `max_indices` (what the index texture holds), the per-cell cap is lowered to
+//! the largest that fits (a binary search over the counts). Nothing wraps and nothing reads
+//! out of range; every dropped light is counted in [`AssignStats::overflowed_lights`], and the
+//! image degrades by exactly those lights' contributions (measurable against plain forward).
 
 use rayon::prelude::*;
 
