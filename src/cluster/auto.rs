@@ -223,6 +223,26 @@ pub fn first_split(samples: &SurfaceSamples, near: f64) -> Option<f64> {
     (split.is_finite() && split > near).then_some(split)
 }
 
+/// The footprints to try, coarse to fine: [`CANDIDATE_FOOTPRINTS`], preceded by coarser
+/// powers of two where even its coarsest grid passes the cell budget (a 16 384² target at
+/// 64 px cells has 25 M cells), so a huge framebuffer still gets a grid that fits.
+fn candidate_footprints(inputs: &ChoiceInputs) -> Vec<f64> {
+    let (w, h) = inputs.size;
+    let cells = |footprint_px: f64| {
+        let config = GridConfig {
+            footprint_px,
+            ..inputs.base.clone()
+        };
+        ClusterGrid::new(w, h, inputs.projection, inputs.near, inputs.far, &config).total_cells
+    };
+    let mut footprints = CANDIDATE_FOOTPRINTS.to_vec();
+    let longest = f64::from(w.max(h));
+    while footprints[0] < longest && cells(footprints[0]) > CELL_BUDGET {
+        footprints.insert(0, footprints[0] * 2.0);
+    }
+    footprints
+}
+
 /// Measures the candidates and picks the cheapest under `costs` (see the module docs); also
 /// returns the chosen grid as built for its measurement (`None` when no candidate fitted the
 /// cell budget), so the caller need not build it again.
@@ -237,7 +257,7 @@ pub fn choose(
     let mut candidates: Vec<Candidate> = Vec::new();
     let mut best: Option<(usize, ClusterGrid)> = None;
     let mut rises = 0;
-    for &footprint_px in &CANDIDATE_FOOTPRINTS {
+    for footprint_px in candidate_footprints(inputs) {
         let config = GridConfig {
             footprint_px,
             first_split: split,
@@ -418,6 +438,27 @@ mod tests {
             },
             encoding: GridEncoding::Uint,
         }
+    }
+
+    /// A framebuffer whose every standard candidate passes the cell budget still gets a grid:
+    /// a coarser one.
+    #[test]
+    fn a_huge_framebuffer_gets_coarser_cells_than_the_standard_candidates() {
+        let (lights, samples) = workload(50);
+        let mut huge = inputs(&lights);
+        huge.size = (16_384, 16_384);
+        let (choice, grid) = choose(&huge, &samples, &GridCosts::default(), &mut Assigner::new());
+        let grid = grid.expect("a grid within the budget");
+        assert!(grid.total_cells <= CELL_BUDGET);
+        assert!(
+            choice.config.footprint_px > CANDIDATE_FOOTPRINTS[0],
+            "{choice:?}"
+        );
+        // Where the standard list fits, it is the list.
+        assert_eq!(
+            candidate_footprints(&inputs(&lights)),
+            CANDIDATE_FOOTPRINTS.to_vec()
+        );
     }
 
     /// Same samples, lights and costs: the same choice, candidate for candidate.
