@@ -31,16 +31,56 @@ vec3 surfaceAlbedo(vec2 uv) {
     return albedo;
 }
 
-// Linear radiance → what the framebuffer stores: clamped, then sRGB-encoded unless
-// OUTPUT_LINEAR (no tone map in either case).
+#if !OUTPUT_HDR
+// 2^exposure (stops), applied before the tone map (1 by default).
+uniform HIGHP float u_exposure;
+#endif
+
+#if TONEMAP
+// Exposed linear radiance → [0, 1] (CPU twin: scene::shading::tone_map). The input is capped
+// at 1000 first: every curve is 1 to within 0.2/255 there, and the polynomials below would
+// overflow fp16 on a device without highp long before infinity.
+HIGHP vec3 toneMap(HIGHP vec3 c) {
+    c = clamp(c, 0.0, 1000.0);
+#if TONEMAP == 1
+    // Reinhard.
+    return c / (1.0 + c);
+#elif TONEMAP == 2
+    // ACES filmic, Narkowicz's fit.
+    return clamp((c * (2.51 * c + 0.03)) / (c * (2.43 * c + 0.59) + 0.14), 0.0, 1.0);
+#else
+    // Khronos PBR Neutral.
+    HIGHP float x = min(c.r, min(c.g, c.b));
+    HIGHP float offset = x < 0.08 ? x - 6.25 * x * x : 0.04;
+    c -= offset;
+    HIGHP float peak = max(c.r, max(c.g, c.b));
+    if (peak < 0.76) {
+        return c;
+    }
+    HIGHP float newPeak = 1.0 - 0.24 * 0.24 / (peak - 0.52);
+    c *= newPeak / peak;
+    HIGHP float g = 1.0 - 1.0 / (0.15 * (peak - newPeak) + 1.0);
+    return mix(c, vec3(newPeak), g);
+#endif
+}
+#endif
+
+// Linear radiance → what the framebuffer stores: exposed and tone-mapped when asked, clamped,
+// then sRGB-encoded unless OUTPUT_LINEAR.
 vec4 encodeOutput(vec3 color) {
 #if OUTPUT_HDR
     // Float targets: unclamped, so NaN and Inf stay visible to the stability tests.
     return vec4(color, u_alpha);
-#elif OUTPUT_LINEAR
-    return vec4(clamp(color, 0.0, 1.0), u_alpha);
 #else
-    return vec4(linearToSrgb(clamp(color, 0.0, 1.0)), u_alpha);
+    HIGHP vec3 exposed = color * u_exposure;
+#if TONEMAP
+    exposed = toneMap(exposed);
+#endif
+#if OUTPUT_LINEAR
+    return vec4(clamp(exposed, 0.0, 1.0), u_alpha);
+#else
+    return vec4(linearToSrgb(clamp(exposed, 0.0, 1.0)), u_alpha);
+#endif
 #endif
 }
 

@@ -50,6 +50,12 @@ pub struct RenderOptions {
     pub light_cutoff: Option<f32>,
     /// Lights at which [`CountKind::Heatmap`]'s colour map tops out.
     pub heat_scale: f32,
+    /// The tone map applied to the exposed radiance before it is clamped and encoded (not in
+    /// HDR output). [`ToneMap::None`], the default, keeps images the light model's own.
+    pub tone_map: ToneMap,
+    /// Exposure in stops: radiance is multiplied by 2^`exposure_ev` before the tone map.
+    /// Within ±32.
+    pub exposure_ev: f32,
     /// Compile every variant with spot, specular and texture code even where the scene lacks
     /// them (a white texture stands in) — to measure what leaving features out saves, and to
     /// test that it changes nothing in the image.
@@ -74,8 +80,27 @@ impl Default for RenderOptions {
             light_cutoff: None,
             heat_scale: 64.0,
             full_variants: false,
+            tone_map: ToneMap::None,
+            exposure_ev: 0.0,
         }
     }
+}
+
+/// The curve that maps exposed linear radiance (0 to ∞) into the displayable [0, 1], applied
+/// per pixel before the sRGB encode; CPU twin: [`crate::scene::shading::tone_map`].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ToneMap {
+    /// None: the value is clamped to [0, 1], so bright lights clip to white.
+    #[default]
+    None,
+    /// Reinhard, `c / (1 + c)` per channel: never clips, compresses everything.
+    Reinhard,
+    /// The ACES filmic curve in Narkowicz's fit, per channel: contrast and a soft shoulder.
+    Aces,
+    /// Khronos PBR Neutral: colours below 0.76 unchanged, highlights compressed and desaturated
+    /// towards white, hue kept.
+    Neutral,
 }
 
 /// Per-pixel light counts instead of colour.

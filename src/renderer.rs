@@ -14,7 +14,7 @@ use crate::gl::{Caps, Device, EsVersion};
 pub use crate::gpu_scene::GpuScene;
 use crate::methods::{self, FrameContext, ShaderFeatures, ShadingMethod, Support};
 pub use crate::metrics::counts::LightCounts;
-pub use crate::options::{CountKind, RenderOptions};
+pub use crate::options::{CountKind, RenderOptions, ToneMap};
 use crate::scene::features::SceneFeatures;
 use crate::scene::{Aabb, Projection, Scene};
 use crate::Error;
@@ -233,6 +233,12 @@ impl Renderer {
             log::warn!("{warning}");
         }
         scene.validate()?;
+        if !(options.exposure_ev.is_finite() && options.exposure_ev.abs() <= 32.0) {
+            return Err(Error::Scene(crate::scene::SceneError::invalid(
+                "exposure_ev",
+                format!("must be within ±32 stops, got {}", options.exposure_ev),
+            )));
+        }
         if width == 0 || height == 0 {
             return Err(Error::Limit(format!("viewport {width}×{height} is empty")));
         }
@@ -266,6 +272,18 @@ impl Renderer {
                 scene_features.spot_lights || options.full_variants,
             )
             .with(ShaderFeatures::OUTPUT_LINEAR, options.linear)
+            .with(
+                ShaderFeatures::TONEMAP_REINHARD,
+                options.tone_map == ToneMap::Reinhard,
+            )
+            .with(
+                ShaderFeatures::TONEMAP_ACES,
+                options.tone_map == ToneMap::Aces,
+            )
+            .with(
+                ShaderFeatures::TONEMAP_NEUTRAL,
+                options.tone_map == ToneMap::Neutral,
+            )
             .with(ShaderFeatures::OUTPUT_HDR, options.hdr)
             .with(
                 ShaderFeatures::REFERENCE_PRECISION,

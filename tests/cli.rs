@@ -606,3 +606,28 @@ fn bench_errors_name_the_fault_without_leak_warnings() {
         assert!(!msg.contains("leaked"), "{args:?}: {msg}");
     }
 }
+
+#[test]
+fn tone_map_flags_render_and_bad_values_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let base = ["render", "--size", "16x9", "--lights", "8", "--frames", "0"];
+    let out = manylight(
+        &[&base[..], &["--tonemap", "neutral", "--exposure", "-1.5"]].concat(),
+        &[],
+        dir.path(),
+    );
+    assert!(out.status.success(), "{}", text(&out));
+    let out = manylight(
+        &[&base[..], &["--tonemap", "filmic"]].concat(),
+        &[],
+        dir.path(),
+    );
+    assert_eq!(out.status.code(), Some(2), "{}", text(&out));
+    let out = manylight(
+        &[&base[..], &["--exposure", "40"]].concat(),
+        &[],
+        dir.path(),
+    );
+    assert_eq!(out.status.code(), Some(1), "{}", text(&out));
+    assert!(text(&out).contains("exposure_ev"), "{}", text(&out));
+}

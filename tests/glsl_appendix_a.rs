@@ -69,8 +69,9 @@ fn validate(conf: Option<&Path>, file: &Path) -> Result<(), String> {
     }
 }
 
-/// Every combination of feature bits a colour variant can have, and the count variants
-/// (evaluations, reaching lights, heatmap) with and without spots and RGBA8 light data.
+/// Every combination of feature bits a colour variant can have, the count variants
+/// (evaluations, reaching lights, heatmap) with and without spots and RGBA8 light data, and the
+/// tone-mapped variants.
 fn all_features() -> Vec<ShaderFeatures> {
     let mut all = colour_features();
     for count in [
@@ -86,6 +87,22 @@ fn all_features() -> Vec<ShaderFeatures> {
             ShaderFeatures::NO_LIGHTS,
         ] {
             all.push(ShaderFeatures(count | extra));
+        }
+    }
+    // The tone maps, each with linear output and with the material and light features.
+    for curve in [
+        ShaderFeatures::TONEMAP_REINHARD,
+        ShaderFeatures::TONEMAP_ACES,
+        ShaderFeatures::TONEMAP_NEUTRAL,
+    ] {
+        for extra in [
+            0,
+            ShaderFeatures::OUTPUT_LINEAR,
+            ShaderFeatures::TEXTURE | ShaderFeatures::SPOT | ShaderFeatures::SPECULAR,
+            ShaderFeatures::LIGHTS_RGBA8 | ShaderFeatures::REFERENCE_PRECISION,
+            ShaderFeatures::NO_LIGHTS,
+        ] {
+            all.push(ShaderFeatures(curve | extra));
         }
     }
     all

@@ -232,6 +232,7 @@ impl Deferred {
             .bind_textures(dev, UNIT_METHOD);
         set_gbuffer_uniforms(program, dev, ctx.viewport);
         program.set_vec3(dev, "u_ambient", ctx.scene.ambient);
+        program.set_f32(dev, "u_exposure", ctx.options.exposure_ev.exp2());
         program.set_f32(dev, "u_alpha", 1.0);
         program.set_f32(dev, "u_heatScale", ctx.options.heat_scale.max(1.0));
         program.set_f32(

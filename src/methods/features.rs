@@ -39,9 +39,15 @@ impl ShaderFeatures {
     /// With [`Self::COUNT_EVALS`]: draw the count through a colour map (0 to `u_heatScale`
     /// lights) instead of encoding it exactly, for looking at (the viewer's heatmap).
     pub const COUNT_HEATMAP: u64 = 1 << 11;
+    /// Reinhard tone map before the encode (see [`crate::options::ToneMap`]).
+    pub const TONEMAP_REINHARD: u64 = 1 << 12;
+    /// ACES (Narkowicz fit) tone map before the encode.
+    pub const TONEMAP_ACES: u64 = 1 << 13;
+    /// Khronos PBR Neutral tone map before the encode.
+    pub const TONEMAP_NEUTRAL: u64 = 1 << 14;
 
     /// Every flag with its name.
-    pub const NAMED: [(u64, &'static str); 12] = [
+    pub const NAMED: [(u64, &'static str); 15] = [
         (Self::TEXTURE, "texture"),
         (Self::SPOT, "spot"),
         (Self::SPECULAR, "specular"),
@@ -54,6 +60,9 @@ impl ShaderFeatures {
         (Self::COUNT_EVALS, "count_evals"),
         (Self::COUNT_REACHING, "count_reaching"),
         (Self::COUNT_HEATMAP, "count_heatmap"),
+        (Self::TONEMAP_REINHARD, "tonemap_reinhard"),
+        (Self::TONEMAP_ACES, "tonemap_aces"),
+        (Self::TONEMAP_NEUTRAL, "tonemap_neutral"),
     ];
 
     /// Names of the set flags.
@@ -104,6 +113,19 @@ impl ShaderFeatures {
             ("COUNT_EVALS".into(), flag(Self::COUNT_EVALS)),
             ("COUNT_REACHING".into(), flag(Self::COUNT_REACHING)),
             ("COUNT_HEATMAP".into(), flag(Self::COUNT_HEATMAP)),
+            (
+                "TONEMAP".into(),
+                if self.has(Self::TONEMAP_REINHARD) {
+                    "1"
+                } else if self.has(Self::TONEMAP_ACES) {
+                    "2"
+                } else if self.has(Self::TONEMAP_NEUTRAL) {
+                    "3"
+                } else {
+                    "0"
+                }
+                .into(),
+            ),
             (
                 "MEDP".into(),
                 if self.has(Self::REFERENCE_PRECISION) {

@@ -152,6 +152,7 @@ pub(crate) fn shade_object(
         program.set_f32(dev, "u_heatScale", ctx.options.heat_scale.max(1.0));
     }
     program.set_vec3(dev, "u_ambient", ctx.scene.ambient);
+    program.set_f32(dev, "u_exposure", ctx.options.exposure_ev.exp2());
     program.set_f32(
         dev,
         "u_orthographic",

@@ -123,6 +123,32 @@ pub fn shade(s: &Surface, v: DVec3, lights: &[Light], ambient: Vec3) -> DVec3 {
     c
 }
 
+/// The tone map of `glsl/surface.glsl` in f64: exposed linear RGB (the caller multiplies by
+/// 2^EV) → [0, 1]. Inputs are capped at 1 000 as the shader caps them.
+pub fn tone_map(rgb: [f64; 3], curve: crate::options::ToneMap) -> [f64; 3] {
+    use crate::options::ToneMap;
+    let c = rgb.map(|v| v.clamp(0.0, 1000.0));
+    match curve {
+        ToneMap::None => c,
+        ToneMap::Reinhard => c.map(|v| v / (1.0 + v)),
+        ToneMap::Aces => {
+            c.map(|v| ((v * (2.51 * v + 0.03)) / (v * (2.43 * v + 0.59) + 0.14)).clamp(0.0, 1.0))
+        }
+        ToneMap::Neutral => {
+            let x = c[0].min(c[1]).min(c[2]);
+            let offset = if x < 0.08 { x - 6.25 * x * x } else { 0.04 };
+            let c = c.map(|v| v - offset);
+            let peak = c[0].max(c[1]).max(c[2]);
+            if peak < 0.76 {
+                return c;
+            }
+            let new_peak = 1.0 - 0.24 * 0.24 / (peak - 0.52);
+            let g = 1.0 - 1.0 / (0.15 * (peak - new_peak) + 1.0);
+            c.map(|v| v * new_peak / peak * (1.0 - g) + new_peak * g)
+        }
+    }
+}
+
 /// sRGB transfer function (linear → encoded), input clamped to [0, 1].
 pub fn linear_to_srgb(x: f64) -> f64 {
     let x = x.clamp(0.0, 1.0);

@@ -50,10 +50,41 @@ pub struct RenderArgs {
     /// unsupported there.
     #[arg(long)]
     pub no_fragment_highp: bool,
+    /// Tone map applied before the sRGB encode: `none` (the default: the light model's own
+    /// values, clipped at 1), `reinhard`, `aces` or `neutral` (Khronos PBR Neutral).
+    #[arg(long, value_enum, default_value_t = ToneMapArg::None)]
+    pub tonemap: ToneMapArg,
+    /// Exposure in stops (radiance × 2^EV before the tone map), within ±32.
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    pub exposure: f32,
     /// Cell footprint of the clustered grid in pixels, or `auto` (chosen per frame from a
     /// cost model calibrated on this device; `--stats` says which and why).
     #[arg(long, default_value = "auto", value_parser = parse_grid)]
     pub grid: GridArg,
+}
+
+/// `--tonemap`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum ToneMapArg {
+    /// No tone map: clamped at 1.
+    None,
+    /// `c / (1 + c)`.
+    Reinhard,
+    /// ACES filmic (Narkowicz's fit).
+    Aces,
+    /// Khronos PBR Neutral.
+    Neutral,
+}
+
+impl From<ToneMapArg> for manylight::ToneMap {
+    fn from(t: ToneMapArg) -> Self {
+        match t {
+            ToneMapArg::None => manylight::ToneMap::None,
+            ToneMapArg::Reinhard => manylight::ToneMap::Reinhard,
+            ToneMapArg::Aces => manylight::ToneMap::Aces,
+            ToneMapArg::Neutral => manylight::ToneMap::Neutral,
+        }
+    }
 }
 
 /// `--grid`: `auto` or a footprint in pixels.
@@ -116,6 +147,8 @@ pub fn run(args: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
     let options = RenderOptions {
         linear: args.linear,
         timed_frames: args.frames,
+        tone_map: args.tonemap.into(),
+        exposure_ev: args.exposure,
         grid: match args.grid {
             GridArg::Auto => manylight::cluster::grid::GridConfig::default(),
             GridArg::Fixed(px) => manylight::cluster::grid::GridConfig::fixed(px),
