@@ -8,7 +8,8 @@
 //!
 //! Controls: WASD move, Q/E down/up, Shift faster, left-drag looks around, 1–9 pick a method
 //! from [`manylight::methods::METHODS`], +/- double/halve the random lights, H toggles the
-//! light-evaluation heatmap (lights each pixel evaluates, viridis from 0 to 64), Esc quits.
+//! light-evaluation heatmap (lights each pixel evaluates, viridis from 0 to 64), T cycles the
+//! tone map (none, Reinhard, ACES, Neutral), Esc quits.
 //! A change that the renderer rejects (say, plain forward over more lights than it can loop
 //! over) is reported on stderr and undone. `--frames N` quits after N frames and
 //! `--screenshot FILE` saves the last one, read back from the window's framebuffer.
@@ -74,6 +75,17 @@ pub struct ViewArgs {
 const DEFAULT_LIGHTS: usize = 1024;
 /// Most random lights `+` goes to.
 const MAX_LIGHTS: usize = 1 << 20;
+/// The tone map after `current`, in a cycle.
+fn next_tone_map(current: manylight::ToneMap) -> manylight::ToneMap {
+    use manylight::ToneMap;
+    match current {
+        ToneMap::None => ToneMap::Reinhard,
+        ToneMap::Reinhard => ToneMap::Aces,
+        ToneMap::Aces => ToneMap::Neutral,
+        ToneMap::Neutral => ToneMap::None,
+    }
+}
+
 /// Seconds between title-bar updates.
 const TITLE_EVERY_S: f64 = 0.25;
 
@@ -93,7 +105,7 @@ pub fn run(args: &ViewArgs) -> Result<(), Box<dyn std::error::Error>> {
     let event_loop = EventLoop::new().map_err(|e| format!("cannot open a window: {e}"))?;
     event_loop.set_control_flow(ControlFlow::Poll);
     println!(
-        "controls: WASD move, Q/E down/up, Shift faster, drag to look, 1-{} method, +/- lights, H heatmap, Esc quit",
+        "controls: WASD move, Q/E down/up, Shift faster, drag to look, 1-{} method, +/- lights, H heatmap, T tone map, Esc quit",
         METHODS.len()
     );
     let mut app = App {
@@ -101,6 +113,7 @@ pub fn run(args: &ViewArgs) -> Result<(), Box<dyn std::error::Error>> {
         light_count: lights.unwrap_or(scene.lights.len()),
         good: (String::new(), lights.unwrap_or(scene.lights.len())),
         heatmap: args.heatmap,
+        tone_map: manylight::ToneMap::None,
         scene,
         fly: FlyCamera::new(FlyCamera::speed_for_extent(extent)),
         gfx: None,
@@ -134,6 +147,8 @@ struct App<'a> {
     good: (String, usize),
     /// Show light evaluations per pixel instead of the image (H).
     heatmap: bool,
+    /// The output stage's curve (T cycles it).
+    tone_map: manylight::ToneMap,
     fly: FlyCamera,
     gfx: Option<Gfx>,
     frames: u64,
@@ -280,6 +295,9 @@ impl App<'_> {
                     "off"
                 }
             );
+        } else if code == KeyCode::KeyT {
+            self.tone_map = next_tone_map(self.tone_map);
+            eprintln!("tone map: {:?}", self.tone_map);
         } else if event.logical_key == Key::Named(NamedKey::Escape) {
             self.quit(event_loop);
         }
@@ -334,6 +352,7 @@ impl App<'_> {
             } else {
                 CountKind::None
             },
+            tone_map: self.tone_map,
             ..RenderOptions::default()
         };
         let renderer = g.renderer.as_mut().ok_or("renderer already destroyed")?;
