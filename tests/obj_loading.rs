@@ -339,3 +339,65 @@ fn material_factors_beyond_fp16_are_clamped_with_a_warning_and_render_lit() {
         );
     }
 }
+
+/// A PNG whose header claims 100 000 × 100 000 pixels (a decompression bomb, or a texture far
+/// past any GPU's limit) is refused from its header: a warning and the flat colour, at once.
+#[test]
+fn a_texture_claiming_a_huge_size_is_refused_from_its_header() {
+    let dir = tempfile::tempdir().unwrap();
+    // A real 1×1 PNG, its IHDR rewritten to 100 000 × 100 000 (and its CRC fixed).
+    let mut png = Vec::new();
+    image::RgbaImage::from_pixel(1, 1, image::Rgba([9, 9, 9, 255]))
+        .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+        .unwrap();
+    let ihdr = 8 + 4; // signature, chunk length
+    png[ihdr + 4..ihdr + 8].copy_from_slice(&100_000u32.to_be_bytes());
+    png[ihdr + 8..ihdr + 12].copy_from_slice(&100_000u32.to_be_bytes());
+    let crc = crc32(&png[ihdr..ihdr + 4 + 13]);
+    png[ihdr + 4 + 13..ihdr + 4 + 17].copy_from_slice(&crc.to_be_bytes());
+    std::fs::write(dir.path().join("bomb.png"), &png).unwrap();
+    write(
+        dir.path(),
+        "m.mtl",
+        "newmtl m\nKd 0.5 0.5 0.5\nmap_Kd bomb.png\n",
+    );
+    let path = write(
+        dir.path(),
+        "t.obj",
+        "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nusemtl m\nf 1/1 2/2 3/3\n",
+    );
+    let started = std::time::Instant::now();
+    let (scene, report) = load_obj(&path).unwrap();
+    assert!(
+        started.elapsed().as_secs() < 5,
+        "decoded instead of refused"
+    );
+    assert_eq!(report.warnings.len(), 1, "{:?}", report.warnings);
+    assert!(
+        report.warnings[0].contains("bomb.png"),
+        "{:?}",
+        report.warnings
+    );
+    assert!(
+        report.warnings[0].contains("limit"),
+        "{:?}",
+        report.warnings
+    );
+    assert!(scene.materials[0].diffuse_texture.is_none());
+}
+
+/// CRC-32 (ISO-HDLC, as PNG chunks use), bit by bit: small and only for the test above.
+fn crc32(bytes: &[u8]) -> u32 {
+    let mut crc = 0xFFFF_FFFFu32;
+    for &b in bytes {
+        crc ^= b as u32;
+        for _ in 0..8 {
+            crc = if crc & 1 != 0 {
+                (crc >> 1) ^ 0xEDB8_8320
+            } else {
+                crc >> 1
+            };
+        }
+    }
+    !crc
+}
