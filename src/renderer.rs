@@ -86,6 +86,10 @@ pub struct FrameStats {
     /// Why the grid is what it is: the automatic choice's prediction and costs, or the fixed
     /// setting.
     pub grid_reason: Option<String>,
+    /// Samples per pixel of the offscreen target (1: no MSAA).
+    pub samples: u32,
+    /// GPU memory of the multisampled target (0 without MSAA).
+    pub msaa_bytes: usize,
 }
 
 /// Renders scenes with one shading method at a time.
@@ -96,6 +100,8 @@ pub struct Renderer {
     method: Box<dyn ShadingMethod>,
     support: Support,
     target: Option<OffscreenTarget>,
+    /// The multisampled target `render_offscreen` draws into with `RenderOptions::samples`.
+    msaa: Option<crate::gl::multisample::MultisampleTarget>,
     /// The GPU timer: `None` until first needed, then `Some(None)` where the context has no
     /// timer queries.
     timer: Option<Option<crate::gl::timer::GpuTimer>>,
@@ -148,6 +154,7 @@ impl Renderer {
             method,
             support,
             target: None,
+            msaa: None,
             timer: None,
             pending_warning,
             freed: false,
@@ -402,6 +409,8 @@ impl Renderer {
             grid_footprint_px: grid.as_ref().map(|g| g.footprint_px),
             grid_cells: grid.as_ref().map_or(0, |g| g.cells),
             grid_reason: grid.map(|g| g.reason),
+            samples: 1,
+            msaa_bytes: 0,
         })
     }
 
@@ -467,13 +476,21 @@ impl Renderer {
                 &self.dev, width, height, format,
             )?);
         }
-        self.target.as_ref().expect("created above").bind(&self.dev);
-        let mut stats = self.render(scene, width, height, options)?;
+        // Light counts are exact per pixel: never averaged over samples.
+        let samples = if options.count == CountKind::None {
+            options.samples.max(1)
+        } else {
+            1
+        };
+        if samples > 1 {
+            self.prepare_msaa(width, height, samples, format)?;
+        }
+        let mut stats = self.render_sampled(scene, width, height, options, samples)?;
         if options.timed_frames > 0 {
             // The warm-up frame compiled shaders and uploaded meshes; report the timed ones.
             let mut frames = Vec::new();
             for _ in 0..options.timed_frames {
-                frames.push(self.render(scene, width, height, options)?);
+                frames.push(self.render_sampled(scene, width, height, options, samples)?);
             }
             let median = |f: fn(&FrameStats) -> f64| {
                 let mut v: Vec<f64> = frames.iter().map(f).collect();
@@ -490,6 +507,72 @@ impl Renderer {
             stats.assign_ms = assign_ms;
             stats.gpu_ms = gpu_ms;
         }
+        Ok(stats)
+    }
+
+    /// Checks that MSAA can run here with the current method and output, and (re)creates the
+    /// multisampled target for this size.
+    fn prepare_msaa(
+        &mut self,
+        width: u32,
+        height: u32,
+        samples: u32,
+        format: ColorFormat,
+    ) -> Result<(), Error> {
+        let refuse = |reason: String| {
+            Err(Error::Limit(format!(
+                "RenderOptions::samples = {samples} (MSAA): {reason}"
+            )))
+        };
+        if let Some(reason) = crate::gl::multisample::unsupported_reason(&self.dev, samples) {
+            return refuse(reason);
+        }
+        if self.method.name() == "deferred" {
+            return refuse(
+                "deferred shading does not support it (its G-buffer would need every \
+                 attachment per sample); use forward, tiled or clustered"
+                    .into(),
+            );
+        }
+        if format != ColorFormat::Rgba8 {
+            return refuse("only 8-bit output is multisampled, not HDR".into());
+        }
+        let shape = ((width, height), samples);
+        if self.msaa.as_ref().map(|m| m.shape()) != Some(shape) {
+            if let Some(mut m) = self.msaa.take() {
+                m.destroy(&self.dev);
+            }
+            self.msaa = Some(crate::gl::multisample::MultisampleTarget::new(
+                &self.dev, width, height, samples,
+            )?);
+        }
+        Ok(())
+    }
+
+    /// One frame into the offscreen target, through the multisampled one when `samples` > 1.
+    fn render_sampled(
+        &mut self,
+        scene: &Scene,
+        width: u32,
+        height: u32,
+        options: &RenderOptions,
+        samples: u32,
+    ) -> Result<FrameStats, Error> {
+        let target = self.target.as_ref().expect("created by render_into_target");
+        if samples <= 1 {
+            target.bind(&self.dev);
+            return self.render(scene, width, height, options);
+        }
+        self.msaa
+            .as_ref()
+            .expect("created by prepare_msaa")
+            .bind(&self.dev);
+        let mut stats = self.render(scene, width, height, options)?;
+        let msaa = self.msaa.as_ref().expect("created by prepare_msaa");
+        let target = self.target.as_ref().expect("created by render_into_target");
+        msaa.resolve(&self.dev, target)?;
+        stats.samples = samples;
+        stats.msaa_bytes = msaa.gpu_bytes();
         Ok(stats)
     }
 
@@ -551,6 +634,9 @@ impl Renderer {
         self.programs.destroy(&self.dev);
         self.gpu_scene.destroy(&self.dev);
         if let Some(mut t) = self.target.take() {
+            t.destroy(&self.dev);
+        }
+        if let Some(mut t) = self.msaa.take() {
             t.destroy(&self.dev);
         }
     }

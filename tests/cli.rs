@@ -631,3 +631,23 @@ fn tone_map_flags_render_and_bad_values_are_refused() {
     assert_eq!(out.status.code(), Some(1), "{}", text(&out));
     assert!(text(&out).contains("exposure_ev"), "{}", text(&out));
 }
+
+#[test]
+fn msaa_flag_renders_and_says_where_it_cannot() {
+    let dir = tempfile::tempdir().unwrap();
+    let base = ["render", "--size", "16x9", "--lights", "8", "--frames", "0"];
+    let out = manylight(
+        &[&base[..], &["--msaa", "4", "--stats", "s.json"]].concat(),
+        &[],
+        dir.path(),
+    );
+    assert!(out.status.success(), "{}", text(&out));
+    assert_eq!(stats(&dir.path().join("s.json"))["samples"], 4);
+    let out = manylight(
+        &[&base[..], &["--msaa", "4", "--method", "deferred"]].concat(),
+        &[],
+        dir.path(),
+    );
+    assert_eq!(out.status.code(), Some(1), "{}", text(&out));
+    assert!(text(&out).contains("deferred"), "{}", text(&out));
+}

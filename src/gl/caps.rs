@@ -48,6 +48,9 @@ pub struct Caps {
     pub max_draw_buffers: i32,
     /// `GL_MAX_COLOR_ATTACHMENTS` (1 on ES 2.0 without `GL_EXT_draw_buffers`).
     pub max_color_attachments: i32,
+    /// `GL_MAX_SAMPLES` of multisampled renderbuffers at the ES 3.0 level (0 at ES 2.0, where
+    /// MSAA offscreen is not implemented).
+    pub max_samples: i32,
     /// Fragment `highp float`; precision 0 means the fragment stage has no highp.
     pub fragment_highp: Precision,
     /// Fragment `mediump float` (fp16 on most phones, and on llvmpipe).
@@ -100,6 +103,7 @@ impl Caps {
         let (gl_version, glsl_version, renderer, vendor);
         let (max_texture_size, max_fragment_uniform_vectors, max_texture_image_units);
         let (mut max_draw_buffers, mut max_color_attachments) = (1, 1);
+        let mut max_samples = 0;
         let (fragment_highp, fragment_mediump);
         unsafe {
             gl_version = gl.get_parameter_string(glow::VERSION);
@@ -109,6 +113,9 @@ impl Caps {
             max_texture_size = gl.get_parameter_i32(glow::MAX_TEXTURE_SIZE);
             max_fragment_uniform_vectors = gl.get_parameter_i32(glow::MAX_FRAGMENT_UNIFORM_VECTORS);
             max_texture_image_units = gl.get_parameter_i32(glow::MAX_TEXTURE_IMAGE_UNITS);
+            if es3 {
+                max_samples = gl.get_parameter_i32(glow::MAX_SAMPLES);
+            }
             if es3 || has("GL_EXT_draw_buffers") {
                 max_draw_buffers = gl.get_parameter_i32(glow::MAX_DRAW_BUFFERS);
                 max_color_attachments = gl.get_parameter_i32(glow::MAX_COLOR_ATTACHMENTS);
@@ -140,6 +147,7 @@ impl Caps {
             max_texture_image_units,
             max_draw_buffers,
             max_color_attachments,
+            max_samples,
             fragment_highp,
             fragment_mediump,
             float_textures: es3 || has("GL_OES_texture_float"),

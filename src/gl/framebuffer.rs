@@ -149,6 +149,11 @@ impl OffscreenTarget {
         dev.viewport(0, 0, self.width as i32, self.height as i32);
     }
 
+    /// The framebuffer object (to resolve a multisampled target into).
+    pub fn framebuffer(&self) -> glow::Framebuffer {
+        self.fbo
+    }
+
     /// Size in pixels.
     pub fn size(&self) -> (u32, u32) {
         (self.width, self.height)

@@ -16,6 +16,7 @@ pub mod device;
 pub mod framebuffer;
 pub mod gbuffer;
 pub mod mesh;
+pub mod multisample;
 #[cfg(feature = "osmesa")]
 pub mod osmesa;
 pub mod precision_probe;

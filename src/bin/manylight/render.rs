@@ -54,6 +54,10 @@ pub struct RenderArgs {
     /// values, clipped at 1), `reinhard`, `aces` or `neutral` (Khronos PBR Neutral).
     #[arg(long, value_enum, default_value_t = ToneMapArg::None)]
     pub tonemap: ToneMapArg,
+    /// Samples per pixel (MSAA) of the offscreen image: 1 (none), 2, 4 or 8; ES 3.0, not with
+    /// deferred.
+    #[arg(long, default_value_t = 1)]
+    pub msaa: u32,
     /// Exposure in stops (radiance × 2^EV before the tone map), within ±32.
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     pub exposure: f32,
@@ -148,6 +152,7 @@ pub fn run(args: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
         linear: args.linear,
         timed_frames: args.frames,
         tone_map: args.tonemap.into(),
+        samples: args.msaa,
         exposure_ev: args.exposure,
         grid: match args.grid {
             GridArg::Auto => manylight::cluster::grid::GridConfig::default(),
