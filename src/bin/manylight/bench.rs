@@ -193,6 +193,13 @@ fn knobs(quick: bool) -> Vec<Knob> {
         |o, _| o.grid.coverage = Coverage::CascadeBox,
         pick(&[1.0], &[]),
     );
+    // 4× MSAA against none: cost against edge error (ES 3.0; skipped where unsupported).
+    add(
+        "msaa",
+        "clustered",
+        |o, v| o.samples = v as u32,
+        pick(&[4.0], &[]),
+    );
     add(
         "cascades",
         "clustered",

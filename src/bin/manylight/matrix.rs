@@ -221,7 +221,13 @@ fn markdown(rows: &[Value]) -> String {
             s += &format!("| {config} | — | — | unavailable: {err} | | | |\n");
             continue;
         }
-        let context = row["gl_version"].as_str().unwrap_or("?");
+        let context = match row["max_samples"].as_i64() {
+            Some(n) if n > 1 => format!(
+                "{}, MSAA up to {n}×",
+                row["gl_version"].as_str().unwrap_or("?")
+            ),
+            _ => format!("{}, no MSAA", row["gl_version"].as_str().unwrap_or("?")),
+        };
         for m in row["methods"].as_array().into_iter().flatten() {
             let status = m["support"]["status"].as_str().unwrap_or("?");
             let support = match m["support"]["reason"].as_str() {
@@ -377,6 +383,7 @@ pub fn run_cell(args: &MatrixCellArgs) -> Result<(), Box<dyn std::error::Error>>
         "renderer": caps.renderer,
         "float_textures": caps.float_textures,
         "fragment_highp": caps.fragment_has_highp(),
+        "max_samples": caps.max_samples,
         "methods": methods,
     });
     println!("{row}");
