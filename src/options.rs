@@ -56,11 +56,10 @@ pub struct RenderOptions {
     /// Exposure in stops: radiance is multiplied by 2^`exposure_ev` before the tone map.
     /// Within ±32.
     pub exposure_ev: f32,
-    /// Samples per pixel of [`Renderer::render_offscreen`](crate::Renderer::render_offscreen)'s
-    /// target: 1 (the default) for none, 2, 4 or 8 for MSAA, resolved into the image (ES 3.0;
-    /// forward, tiled, clustered and auto; not deferred, not HDR output, not light counts).
-    /// [`Renderer::render`](crate::Renderer::render) draws into the caller's framebuffer,
-    /// multisampled or not, and ignores it.
+    /// Samples per pixel: 1 (the default) for none, up to `GL_MAX_SAMPLES` for MSAA. The frame
+    /// is drawn into the renderer's multisampled target and resolved into the framebuffer
+    /// that was bound (ES 3.0; forward, tiled, clustered and auto; not deferred, not HDR output;
+    /// light counts are never multisampled).
     pub samples: u32,
     /// Compile every variant with spot, specular and texture code even where the scene lacks
     /// them (a white texture stands in) — to measure what leaving features out saves, and to

@@ -227,8 +227,48 @@ impl Renderer {
     }
 
     /// Renders `scene` into the currently bound framebuffer with a `width × height` viewport
-    /// (for embedding: a game binds its own target or the default framebuffer first).
+    /// (for embedding: a game binds its own target or the default framebuffer first). With
+    /// `options.samples` > 1 the frame is drawn into the renderer's own multisampled target
+    /// and resolved into the bound framebuffer, which must then be RGBA8 of that size.
     pub fn render(
+        &mut self,
+        scene: &Scene,
+        width: u32,
+        height: u32,
+        options: &RenderOptions,
+    ) -> Result<FrameStats, Error> {
+        // Light counts are exact per pixel: never averaged over samples.
+        let samples = if options.count == CountKind::None {
+            options.samples.max(1)
+        } else {
+            1
+        };
+        if samples <= 1 {
+            return self.render_frame(scene, width, height, options);
+        }
+        let destination = self.dev.bound_framebuffer();
+        let format = if options.hdr {
+            ColorFormat::Rgba16F
+        } else {
+            ColorFormat::Rgba8
+        };
+        self.prepare_msaa(width, height, samples, format)?;
+        let msaa = self.msaa.as_ref().expect("created by prepare_msaa");
+        msaa.bind(&self.dev);
+        let mut stats = self.render_frame(scene, width, height, options);
+        let msaa = self.msaa.as_ref().expect("created by prepare_msaa");
+        // Resolve even after a failed frame, so the caller's framebuffer is bound again.
+        let resolved = msaa.resolve(&self.dev, destination);
+        if let Ok(stats) = &mut stats {
+            resolved?;
+            stats.samples = samples;
+            stats.msaa_bytes = msaa.gpu_bytes();
+        }
+        stats
+    }
+
+    /// One frame into the bound framebuffer (see [`Renderer::render`]).
+    fn render_frame(
         &mut self,
         scene: &Scene,
         width: u32,
@@ -476,21 +516,13 @@ impl Renderer {
                 &self.dev, width, height, format,
             )?);
         }
-        // Light counts are exact per pixel: never averaged over samples.
-        let samples = if options.count == CountKind::None {
-            options.samples.max(1)
-        } else {
-            1
-        };
-        if samples > 1 {
-            self.prepare_msaa(width, height, samples, format)?;
-        }
-        let mut stats = self.render_sampled(scene, width, height, options, samples)?;
+        self.target.as_ref().expect("created above").bind(&self.dev);
+        let mut stats = self.render(scene, width, height, options)?;
         if options.timed_frames > 0 {
             // The warm-up frame compiled shaders and uploaded meshes; report the timed ones.
             let mut frames = Vec::new();
             for _ in 0..options.timed_frames {
-                frames.push(self.render_sampled(scene, width, height, options, samples)?);
+                frames.push(self.render(scene, width, height, options)?);
             }
             let median = |f: fn(&FrameStats) -> f64| {
                 let mut v: Vec<f64> = frames.iter().map(f).collect();
@@ -547,33 +579,6 @@ impl Renderer {
             )?);
         }
         Ok(())
-    }
-
-    /// One frame into the offscreen target, through the multisampled one when `samples` > 1.
-    fn render_sampled(
-        &mut self,
-        scene: &Scene,
-        width: u32,
-        height: u32,
-        options: &RenderOptions,
-        samples: u32,
-    ) -> Result<FrameStats, Error> {
-        let target = self.target.as_ref().expect("created by render_into_target");
-        if samples <= 1 {
-            target.bind(&self.dev);
-            return self.render(scene, width, height, options);
-        }
-        self.msaa
-            .as_ref()
-            .expect("created by prepare_msaa")
-            .bind(&self.dev);
-        let mut stats = self.render(scene, width, height, options)?;
-        let msaa = self.msaa.as_ref().expect("created by prepare_msaa");
-        let target = self.target.as_ref().expect("created by render_into_target");
-        msaa.resolve(&self.dev, target)?;
-        stats.samples = samples;
-        stats.msaa_bytes = msaa.gpu_bytes();
-        Ok(stats)
     }
 
     /// Per-pixel light counts of the opaque visible surfaces instead of colour: `Evals`, the

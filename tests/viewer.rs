@@ -203,6 +203,15 @@ fn view_renders_a_lit_frame_into_the_window() {
     }
 }
 
+/// 4× MSAA resolved into the window's back buffer matches `render --msaa 4`.
+#[test]
+fn view_resolves_msaa_into_the_window() {
+    let msaa = ["--msaa", "4"];
+    if let Some((_, stderr)) = check_window_frame(&msaa, &msaa, &[]) {
+        assert!(!stderr.contains("MSAA off"), "{stderr}");
+    }
+}
+
 #[test]
 fn view_renders_on_es2() {
     let es2_tiled = ["--es", "2", "--method", "tiled"];

@@ -140,6 +140,16 @@ impl Device {
         unsafe { self.gl.finish() }
     }
 
+    /// The framebuffer bound now (`None`: the default one, a window's back buffer).
+    pub fn bound_framebuffer(&self) -> Option<glow::Framebuffer> {
+        unsafe { self.gl.get_parameter_framebuffer(glow::FRAMEBUFFER_BINDING) }
+    }
+
+    /// Binds `fbo` (`None`: the default framebuffer).
+    pub fn bind_framebuffer(&self, fbo: Option<glow::Framebuffer>) {
+        unsafe { self.gl.bind_framebuffer(glow::FRAMEBUFFER, fbo) }
+    }
+
     /// Binds the default framebuffer (a window's back buffer).
     pub fn bind_default_framebuffer(&self) {
         unsafe { self.gl.bind_framebuffer(glow::FRAMEBUFFER, None) }

@@ -1,12 +1,12 @@
 //! A multisampled offscreen target (ES 3.0: RGBA8 and depth renderbuffers with N samples),
-//! rendered into and then resolved by a blit into a single-sampled [`OffscreenTarget`].
+//! rendered into and then resolved by a blit into a single-sampled framebuffer: the
+//! renderer's offscreen target, or the caller's (a window's back buffer).
 //! ES 2.0 core has no multisampled renderbuffers; its extensions for it are not used yet, so
 //! MSAA is unsupported there with that reason.
 #![allow(unsafe_code)]
 
 use glow::HasContext;
 
-use super::framebuffer::OffscreenTarget;
 use super::{Device, EsVersion, GlError};
 
 /// A framebuffer of multisampled colour and depth renderbuffers.
@@ -115,14 +115,15 @@ impl MultisampleTarget {
         dev.viewport(0, 0, self.size.0 as i32, self.size.1 as i32);
     }
 
-    /// Resolves the samples into `into` (same size): each pixel the average of its samples.
-    pub fn resolve(&self, dev: &Device, into: &OffscreenTarget) -> Result<(), GlError> {
+    /// Resolves the samples into the framebuffer `into` (`None`: the default one) of the same
+    /// size: each pixel the average of its samples. Leaves `into` bound. The destination's
+    /// colour format must be RGBA8, as ES 3.0's multisample resolve needs identical formats.
+    pub fn resolve(&self, dev: &Device, into: Option<glow::Framebuffer>) -> Result<(), GlError> {
         let (w, h) = (self.size.0 as i32, self.size.1 as i32);
         unsafe {
             dev.gl
                 .bind_framebuffer(glow::READ_FRAMEBUFFER, Some(self.fbo));
-            dev.gl
-                .bind_framebuffer(glow::DRAW_FRAMEBUFFER, Some(into.framebuffer()));
+            dev.gl.bind_framebuffer(glow::DRAW_FRAMEBUFFER, into);
             dev.gl.blit_framebuffer(
                 0,
                 0,
@@ -135,10 +136,9 @@ impl MultisampleTarget {
                 glow::COLOR_BUFFER_BIT,
                 glow::NEAREST,
             );
-            dev.gl
-                .bind_framebuffer(glow::FRAMEBUFFER, Some(into.framebuffer()));
         }
-        dev.check("MSAA resolve")
+        dev.bind_framebuffer(into);
+        dev.check("MSAA resolve (the destination must be RGBA8 and the same size)")
     }
 
     /// Frees the framebuffer and its renderbuffers.

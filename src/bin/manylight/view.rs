@@ -8,8 +8,9 @@
 //!
 //! Controls: WASD move, Q/E down/up, Shift faster, left-drag looks around, 1–9 pick a method
 //! from [`manylight::methods::METHODS`], +/- double/halve the random lights, H toggles the
-//! light-evaluation heatmap (lights each pixel evaluates, viridis from 0 to 64), T cycles the
-//! tone map (none, Reinhard, ACES, Neutral), Esc quits.
+//! light-evaluation heatmap (lights each pixel evaluates, viridis from 0 to 64), M toggles 4×
+//! MSAA (resolved into the window), T cycles the tone map (none, Reinhard, ACES, Neutral), Esc
+//! quits.
 //! A change that the renderer rejects (say, plain forward over more lights than it can loop
 //! over) is reported on stderr and undone. `--frames N` quits after N frames and
 //! `--screenshot FILE` saves the last one, read back from the window's framebuffer.
@@ -69,6 +70,9 @@ pub struct ViewArgs {
     /// Start with the light-evaluation heatmap on (H toggles it).
     #[arg(long)]
     pub heatmap: bool,
+    /// Samples per pixel to start with (M toggles between 1 and 4): ES 3.0, not deferred.
+    #[arg(long, default_value_t = 1)]
+    pub msaa: u32,
 }
 
 /// Random lights for built-ins and OBJ files when `--lights` is not given.
@@ -105,7 +109,7 @@ pub fn run(args: &ViewArgs) -> Result<(), Box<dyn std::error::Error>> {
     let event_loop = EventLoop::new().map_err(|e| format!("cannot open a window: {e}"))?;
     event_loop.set_control_flow(ControlFlow::Poll);
     println!(
-        "controls: WASD move, Q/E down/up, Shift faster, drag to look, 1-{} method, +/- lights, H heatmap, T tone map, Esc quit",
+        "controls: WASD move, Q/E down/up, Shift faster, drag to look, 1-{} method, +/- lights, H heatmap, M MSAA, T tone map, Esc quit",
         METHODS.len()
     );
     let mut app = App {
@@ -114,6 +118,7 @@ pub fn run(args: &ViewArgs) -> Result<(), Box<dyn std::error::Error>> {
         good: (String::new(), lights.unwrap_or(scene.lights.len())),
         heatmap: args.heatmap,
         tone_map: manylight::ToneMap::None,
+        samples: args.msaa.max(1),
         scene,
         fly: FlyCamera::new(FlyCamera::speed_for_extent(extent)),
         gfx: None,
@@ -149,6 +154,8 @@ struct App<'a> {
     heatmap: bool,
     /// The output stage's curve (T cycles it).
     tone_map: manylight::ToneMap,
+    /// Samples per pixel (M toggles MSAA).
+    samples: u32,
     fly: FlyCamera,
     gfx: Option<Gfx>,
     frames: u64,
@@ -295,6 +302,9 @@ impl App<'_> {
                     "off"
                 }
             );
+        } else if code == KeyCode::KeyM {
+            self.samples = if self.samples > 1 { 1 } else { 4 };
+            eprintln!("MSAA: {} samples", self.samples);
         } else if code == KeyCode::KeyT {
             self.tone_map = next_tone_map(self.tone_map);
             eprintln!("tone map: {:?}", self.tone_map);
@@ -353,11 +363,18 @@ impl App<'_> {
                 CountKind::None
             },
             tone_map: self.tone_map,
+            samples: self.samples,
             ..RenderOptions::default()
         };
         let renderer = g.renderer.as_mut().ok_or("renderer already destroyed")?;
         let stats = match renderer.render(&self.scene, size.width, size.height, &options) {
             Ok(s) => s,
+            // MSAA this context or method cannot do: said once, and off again.
+            Err(e) if self.samples > 1 => {
+                eprintln!("error: {e}; MSAA off");
+                self.samples = 1;
+                return Ok(());
+            }
             Err(e) => return self.undo_change(e.to_string()),
         };
         self.good = (stats.method.clone(), self.light_count);
