@@ -46,7 +46,9 @@ HIGHP vec3 toneMap(HIGHP vec3 c) {
     // Reinhard.
     return c / (1.0 + c);
 #elif TONEMAP == 2
-    // ACES filmic, Narkowicz's fit.
+    // ACES filmic, Narkowicz's fit. It reaches 1 at c = 7.24, so c is capped at 8 first: the
+    // result is the same, and the squares cannot overflow fp16 (at c = 165 they would).
+    c = min(c, 8.0);
     return clamp((c * (2.51 * c + 0.03)) / (c * (2.43 * c + 0.59) + 0.14), 0.0, 1.0);
 #else
     // Khronos PBR Neutral.

@@ -9,8 +9,8 @@ use crate::cluster::tiles::TILE_PX;
 /// Per-call rendering options.
 #[derive(Clone, Debug)]
 pub struct RenderOptions {
-    /// Write linear values (clamped to [0, 1], no sRGB encoding, no tone map) so pixels can be
-    /// checked against the light model.
+    /// Write linear values (clamped to [0, 1], no sRGB encoding; exposure and tone map still
+    /// apply when set, and are off by default) so pixels can be checked against the light model.
     pub linear: bool,
     /// Pack lights as RGBA8 even where float textures exist (to measure the packing error).
     pub force_rgba8_lights: bool,
@@ -54,7 +54,7 @@ pub struct RenderOptions {
     /// HDR output). [`ToneMap::None`], the default, keeps images the light model's own.
     pub tone_map: ToneMap,
     /// Exposure in stops: radiance is multiplied by 2^`exposure_ev` before the tone map.
-    /// Within ±32.
+    /// Within ±15 (2^15 is what fp16 holds, on devices without fragment highp).
     pub exposure_ev: f32,
     /// Samples per pixel: 1 (the default) for none, up to `GL_MAX_SAMPLES` for MSAA. The frame
     /// is drawn into the renderer's multisampled target and resolved into the framebuffer

@@ -246,25 +246,36 @@ impl Renderer {
         if samples <= 1 {
             return self.render_frame(scene, width, height, options);
         }
+        if width == 0 || height == 0 {
+            return Err(Error::Limit(format!("viewport {width}×{height} is empty")));
+        }
         let destination = self.dev.bound_framebuffer();
         let format = if options.hdr {
             ColorFormat::Rgba16F
         } else {
             ColorFormat::Rgba8
         };
-        self.prepare_msaa(width, height, samples, format)?;
+        let prepared = self.prepare_msaa(width, height, samples, format);
+        // Creating the target binds (then leaves) framebuffers: the caller's comes back.
+        self.dev.bind_framebuffer(destination);
+        prepared?;
         let msaa = self.msaa.as_ref().expect("created by prepare_msaa");
         msaa.bind(&self.dev);
-        let mut stats = self.render_frame(scene, width, height, options);
+        let stats = self.render_frame(scene, width, height, options);
         let msaa = self.msaa.as_ref().expect("created by prepare_msaa");
-        // Resolve even after a failed frame, so the caller's framebuffer is bound again.
-        let resolved = msaa.resolve(&self.dev, destination);
-        if let Ok(stats) = &mut stats {
-            resolved?;
-            stats.samples = samples;
-            stats.msaa_bytes = msaa.gpu_bytes();
+        match stats {
+            Ok(mut stats) => {
+                msaa.resolve(&self.dev, destination)?;
+                stats.samples = samples;
+                stats.msaa_bytes = msaa.gpu_bytes();
+                Ok(stats)
+            }
+            // A failed frame is not resolved over the caller's picture.
+            Err(e) => {
+                self.dev.bind_framebuffer(destination);
+                Err(e)
+            }
         }
-        stats
     }
 
     /// One frame into the bound framebuffer (see [`Renderer::render`]).
@@ -280,10 +291,11 @@ impl Renderer {
             log::warn!("{warning}");
         }
         scene.validate()?;
-        if !(options.exposure_ev.is_finite() && options.exposure_ev.abs() <= 32.0) {
+        // 2^15 stays finite in fp16, where a device without fragment highp holds it.
+        if !(options.exposure_ev.is_finite() && options.exposure_ev.abs() <= 15.0) {
             return Err(Error::Scene(crate::scene::SceneError::invalid(
                 "exposure_ev",
-                format!("must be within ±32 stops, got {}", options.exposure_ev),
+                format!("must be within ±15 stops, got {}", options.exposure_ev),
             )));
         }
         if width == 0 || height == 0 {

@@ -401,3 +401,35 @@ fn crc32(bytes: &[u8]) -> u32 {
     }
     !crc
 }
+
+/// What tobj accepts, the pre-checks accept too: faces before their vertices, texture and
+/// normal indices in a file that has none, `p` lines; and TGA textures, which have no magic
+/// bytes, decode by their extension.
+#[test]
+fn files_tobj_accepts_are_not_refused_by_the_checks() {
+    let dir = tempfile::tempdir().unwrap();
+    let tga = image::DynamicImage::ImageRgba8(image::RgbaImage::from_pixel(
+        2,
+        2,
+        image::Rgba([10, 200, 30, 255]),
+    ));
+    tga.save(dir.path().join("grass.tga")).unwrap();
+    write(
+        dir.path(),
+        "m.mtl",
+        "newmtl m\nKd 1 1 1\nmap_Kd grass.tga\n",
+    );
+    let path = write(
+        dir.path(),
+        "lenient.obj",
+        "mtllib m.mtl\nmtllib m.mtl\nusemtl m\np 1\nf 1/1/1 2/2/2 3/3/3\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf -3 -2 -1\n",
+    );
+    let (scene, report) = load_obj(&path).unwrap();
+    assert!(report.warnings.is_empty(), "{:?}", report.warnings);
+    let triangles: usize = scene.objects.iter().map(|o| o.mesh.indices.len() / 3).sum();
+    assert_eq!(triangles, 2);
+    assert!(
+        scene.materials.iter().any(|m| m.diffuse_texture.is_some()),
+        "grass.tga bound"
+    );
+}

@@ -142,3 +142,45 @@ fn an_exposure_out_of_range_is_refused_naming_the_field() {
         assert!(err.contains("exposure_ev"), "{err}");
     }
 }
+
+/// On a device without fragment highp the output stage runs in fp16: the curves must not
+/// overflow there (ACES's squares pass 65 504 at c ≈ 165, and Inf/Inf is NaN) — a strongly
+/// exposed bright scene comes out white where it is bright. llvmpipe happens to clamp that NaN
+/// to 1, so here this guards the other curves and the exposure; drivers that keep NaN (black)
+/// also check ACES's cap.
+#[test]
+fn tone_maps_do_not_overflow_without_fragment_highp() {
+    let scene = bright_plane();
+    let mut full = Gpu::new(EsVersion::Es2);
+    full.r().set_method("forward").unwrap();
+    let (radiance, _) = full
+        .r()
+        .render_offscreen_hdr(&scene, 64, 36, &RenderOptions::default())
+        .unwrap();
+    drop(full);
+    let mut gpu = Gpu::restricted(
+        EsVersion::Es2,
+        &manylight::gl::Restrictions {
+            no_fragment_highp: true,
+        },
+    );
+    for curve in [ToneMap::Reinhard, ToneMap::Aces, ToneMap::Neutral] {
+        let opts = RenderOptions {
+            tone_map: curve,
+            exposure_ev: 12.0,
+            linear: true,
+            ..RenderOptions::default()
+        };
+        let img = gpu.render(&scene, 64, 36, &opts);
+        for (i, p) in img.pixels().enumerate() {
+            let r = radiance[i];
+            // 2^12 × radiance past 1000 in every channel: every curve gives (nearly) 1.
+            if r.iter().take(3).all(|&v| v * 4096.0 > 1000.0) {
+                assert!(
+                    p.0[..3].iter().all(|&c| c >= 250),
+                    "{curve:?}: pixel {i} with radiance {r:?} came out {p:?}"
+                );
+            }
+        }
+    }
+}

@@ -519,7 +519,11 @@ fn trim_overfull_cells(out: &mut Assignment, grid: &ClusterGrid, lights: &[GpuLi
         // list order, so the kept lights stay in ascending order without a sort.
         let mut order = keys.clone();
         let (_, &mut threshold, _) = order.select_nth_unstable_by(cap - 1, |a, b| b.total_cmp(a));
-        let mut ties = cap - keys.iter().filter(|&&k| k > threshold).count();
+        let mut ties = cap
+            - keys
+                .iter()
+                .filter(|k| k.total_cmp(&threshold) == std::cmp::Ordering::Greater)
+                .count();
         let mut kept = 0;
         for at in 0..list.len() {
             let keep = match keys[at].total_cmp(&threshold) {

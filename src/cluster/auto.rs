@@ -226,11 +226,14 @@ pub fn first_split(samples: &SurfaceSamples, near: f64) -> Option<f64> {
 /// The footprints to try, coarse to fine: [`CANDIDATE_FOOTPRINTS`], preceded by coarser
 /// powers of two where even its coarsest grid passes the cell budget (a 16 384² target at
 /// 64 px cells has 25 M cells), so a huge framebuffer still gets a grid that fits.
-fn candidate_footprints(inputs: &ChoiceInputs) -> Vec<f64> {
+fn candidate_footprints(inputs: &ChoiceInputs, first_split: Option<f64>) -> Vec<f64> {
     let (w, h) = inputs.size;
+    // Counted with the first split the candidates are built with: a nearer split means more
+    // slices.
     let cells = |footprint_px: f64| {
         let config = GridConfig {
             footprint_px,
+            first_split,
             ..inputs.base.clone()
         };
         ClusterGrid::new(w, h, inputs.projection, inputs.near, inputs.far, &config).total_cells
@@ -257,7 +260,7 @@ pub fn choose(
     let mut candidates: Vec<Candidate> = Vec::new();
     let mut best: Option<(usize, ClusterGrid)> = None;
     let mut rises = 0;
-    for footprint_px in candidate_footprints(inputs) {
+    for footprint_px in candidate_footprints(inputs, split) {
         let config = GridConfig {
             footprint_px,
             first_split: split,
@@ -456,7 +459,7 @@ mod tests {
         );
         // Where the standard list fits, it is the list.
         assert_eq!(
-            candidate_footprints(&inputs(&lights)),
+            candidate_footprints(&inputs(&lights), first_split(&samples, 0.1)),
             CANDIDATE_FOOTPRINTS.to_vec()
         );
     }

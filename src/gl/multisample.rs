@@ -95,7 +95,10 @@ impl MultisampleTarget {
                 return Err(GlError::FramebufferIncomplete(status));
             }
         }
-        dev.check("multisampled target creation")?;
+        if let Err(e) = dev.check("multisampled target creation") {
+            target.destroy(dev);
+            return Err(e);
+        }
         Ok(target)
     }
 

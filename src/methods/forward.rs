@@ -71,6 +71,14 @@ impl ShadingMethod for Forward {
         let dev = ctx.dev;
         let limit = max_lights(dev.caps());
         let capped;
+        if ctx.lights.len() > limit as usize && ctx.features.counting() {
+            // A count over a subset of the lights is no lower bound and no evaluation count.
+            return Err(Error::Limit(format!(
+                "light counts need every light in one forward loop, which holds at most \
+                 {limit} here; the scene has {}",
+                ctx.lights.len()
+            )));
+        }
         let lights = if ctx.lights.len() > limit as usize {
             capped = super::forward_cap::keep_most_important(ctx.lights, limit as usize);
             if !self.warned_cap {

@@ -140,6 +140,7 @@ impl Camera {
         for (name, v) in [
             ("camera.position", self.position),
             ("camera.target", self.target),
+            ("camera.up", self.up),
         ] {
             if v.abs().max_element() > MAX_CAMERA_COORD {
                 return Err(SceneError::invalid(

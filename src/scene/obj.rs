@@ -150,8 +150,14 @@ fn parse_obj(path: &Path) -> Result<Parsed, SceneError> {
         ignore_points: true,
         ignore_lines: true,
     };
+    // Each library is read once: tobj reads and merges one again for every `mtllib` line, so
+    // a file repeating the line millions of times would exhaust memory.
+    let seen = std::cell::RefCell::new(std::collections::HashSet::new());
     let load_mtl = |name: &Path| -> tobj::MTLLoadResult {
         let mtl_path = base_dir.join(name);
+        if !seen.borrow_mut().insert(mtl_path.clone()) {
+            return Ok(Default::default());
+        }
         let bytes = read_bounded(&mtl_path, FileKind::Materials).map_err(|e| {
             log::warn!("{e}");
             tobj::LoadError::OpenFileFailed
@@ -177,13 +183,27 @@ fn parse_obj(path: &Path) -> Result<Parsed, SceneError> {
     }
 }
 
-/// Every index of every face, line and point refers to a vertex, texture coordinate or normal
-/// defined before it (negative indices count back from the last one): what tobj assumes —
-/// an index beyond them overflowed its arithmetic (a panic in debug builds, a read of the wrong
-/// element in release ones). Errors name the line.
+/// Every index of every face and line refers to a vertex, texture coordinate or normal the file
+/// defines (negative indices count back from the last one defined before the line): what tobj
+/// assumes — an index beyond them overflowed its arithmetic (a panic in debug builds, a read of
+/// the wrong element in release ones). Errors name the line.
 fn check_face_indices(bytes: &[u8]) -> Result<(), String> {
     let text = String::from_utf8_lossy(bytes);
-    // Defined so far: positions, texture coordinates, normals.
+    let kind_of = |key: Option<&str>| match key {
+        Some("v") => Some(0),
+        Some("vt") => Some(1),
+        Some("vn") => Some(2),
+        _ => None,
+    };
+    // tobj resolves positive indices once the whole object is read (a face may come before
+    // its vertices) and negative ones against what is defined so far; it ignores texture and
+    // normal indices when the file has none of them, and `p` lines altogether.
+    let mut totals = [0i64; 3];
+    for line in text.lines() {
+        if let Some(kind) = kind_of(line.split_whitespace().next()) {
+            totals[kind] += 1;
+        }
+    }
     let mut defined = [0i64; 3];
     for (number, line) in text.lines().enumerate() {
         let mut words = line.split_whitespace();
@@ -209,32 +229,34 @@ fn check_face_indices(bytes: &[u8]) -> Result<(), String> {
                 line.trim()
             ));
         }
-        match key {
-            Some("v") => defined[0] += 1,
-            Some("vt") => defined[1] += 1,
-            Some("vn") => defined[2] += 1,
-            Some(key @ ("f" | "l" | "p")) => {
-                for word in words {
-                    for (kind, part) in word.split('/').enumerate().take(3) {
-                        if part.is_empty() && kind > 0 {
-                            continue;
-                        }
-                        let resolves = part.parse::<i64>().is_ok_and(|i| {
-                            i != 0 && i.unsigned_abs() <= defined[kind].unsigned_abs()
-                        });
-                        if !resolves {
-                            let what = ["vertex", "texture coordinate", "normal"][kind];
-                            return Err(format!(
-                                "line {}: `{key}` refers to {what} `{part}`, but {} are \
-                                 defined before it",
-                                number + 1,
-                                defined[kind]
-                            ));
-                        }
-                    }
+        if let Some(kind) = kind_of(key) {
+            defined[kind] += 1;
+            continue;
+        }
+        let Some(key @ ("f" | "l")) = key else {
+            continue;
+        };
+        for word in words {
+            for (kind, part) in word.split('/').enumerate().take(3) {
+                if kind > 0 && (part.is_empty() || totals[kind] == 0) {
+                    continue;
+                }
+                let resolves = part.parse::<i64>().is_ok_and(|i| match i {
+                    0 => false,
+                    i if i > 0 => i <= totals[kind],
+                    i => i.unsigned_abs() <= defined[kind].unsigned_abs(),
+                });
+                if !resolves {
+                    let what = ["vertex", "texture coordinate", "normal"][kind];
+                    return Err(format!(
+                        "line {}: `{key}` refers to {what} `{part}`, but the file defines {} \
+                         ({} before this line)",
+                        number + 1,
+                        totals[kind],
+                        defined[kind]
+                    ));
                 }
             }
-            _ => {}
         }
     }
     Ok(())
@@ -265,9 +287,12 @@ fn check_mtl(bytes: &[u8]) -> Result<(), String> {
 /// would pass [`MAX_TEXTURE_SIDE`] on a side (a small PNG can claim 100 000² pixels).
 fn decode_texture(path: &Path) -> Result<image::DynamicImage, String> {
     let bytes = read_bounded(path, FileKind::Texture).map_err(|e| e.to_string())?;
-    let mut reader = image::ImageReader::new(std::io::Cursor::new(bytes))
-        .with_guessed_format()
-        .map_err(|e| e.to_string())?;
+    let mut reader = image::ImageReader::new(std::io::Cursor::new(bytes));
+    // The extension first: TGA has no magic bytes to guess from; the contents decide otherwise.
+    if let Ok(format) = image::ImageFormat::from_path(path) {
+        reader.set_format(format);
+    }
+    let mut reader = reader.with_guessed_format().map_err(|e| e.to_string())?;
     let mut limits = image::Limits::default();
     limits.max_image_width = Some(MAX_TEXTURE_SIDE);
     limits.max_image_height = Some(MAX_TEXTURE_SIDE);

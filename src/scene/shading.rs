@@ -131,9 +131,10 @@ pub fn tone_map(rgb: [f64; 3], curve: crate::options::ToneMap) -> [f64; 3] {
     match curve {
         ToneMap::None => c,
         ToneMap::Reinhard => c.map(|v| v / (1.0 + v)),
-        ToneMap::Aces => {
-            c.map(|v| ((v * (2.51 * v + 0.03)) / (v * (2.43 * v + 0.59) + 0.14)).clamp(0.0, 1.0))
-        }
+        ToneMap::Aces => c.map(|v| {
+            let v = v.min(8.0);
+            ((v * (2.51 * v + 0.03)) / (v * (2.43 * v + 0.59) + 0.14)).clamp(0.0, 1.0)
+        }),
         ToneMap::Neutral => {
             let x = c[0].min(c[1]).min(c[2]);
             let offset = if x < 0.08 { x - 6.25 * x * x } else { 0.04 };

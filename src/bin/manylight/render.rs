@@ -58,7 +58,7 @@ pub struct RenderArgs {
     /// deferred.
     #[arg(long, default_value_t = 1)]
     pub msaa: u32,
-    /// Exposure in stops (radiance × 2^EV before the tone map), within ±32.
+    /// Exposure in stops (radiance × 2^EV before the tone map), within ±15.
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     pub exposure: f32,
     /// Cell footprint of the clustered grid in pixels, or `auto` (chosen per frame from a

@@ -370,7 +370,7 @@ impl App<'_> {
         let stats = match renderer.render(&self.scene, size.width, size.height, &options) {
             Ok(s) => s,
             // MSAA this context or method cannot do: said once, and off again.
-            Err(e) if self.samples > 1 => {
+            Err(e) if self.samples > 1 && e.to_string().contains("MSAA") => {
                 eprintln!("error: {e}; MSAA off");
                 self.samples = 1;
                 return Ok(());
