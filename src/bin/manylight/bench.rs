@@ -84,7 +84,9 @@ impl Plan {
                 given.to_vec()
             }
         };
-        let scenes = if args.quick {
+        let scenes = if !args.scenes.is_empty() {
+            args.scenes.clone()
+        } else if args.quick {
             vec![scene::builtin::DEFAULT.to_string()]
         } else {
             let mut s: Vec<String> = scene::builtin::NAMES
@@ -108,7 +110,7 @@ impl Plan {
         };
         let default_size = if args.quick { (320, 180) } else { (640, 360) };
         Plan {
-            scenes: or(&args.scenes, scenes),
+            scenes,
             lights,
             methods: or(
                 &args.methods,
