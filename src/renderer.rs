@@ -14,6 +14,7 @@ use crate::gl::{Caps, Device, EsVersion};
 pub use crate::gpu_scene::GpuScene;
 use crate::methods::{self, FrameContext, ShaderFeatures, ShadingMethod, Support};
 pub use crate::metrics::counts::LightCounts;
+use crate::metrics::spread::Spread;
 pub use crate::options::{CountKind, RenderOptions, ToneMap};
 use crate::scene::features::SceneFeatures;
 use crate::scene::{Aabb, Projection, Scene};
@@ -86,6 +87,11 @@ pub struct FrameStats {
     /// Why the grid is what it is: the automatic choice's prediction and costs, or the fixed
     /// setting.
     pub grid_reason: Option<String>,
+    /// Frame time over the timed frames of
+    /// [`Renderer::render_offscreen`] (`timed_frames` > 0): p50, p95, p99, max.
+    pub frame_ms_spread: Option<Spread>,
+    /// CPU assignment time over the same frames.
+    pub assign_ms_spread: Option<Spread>,
     /// Samples per pixel of the offscreen target (1: no MSAA).
     pub samples: u32,
     /// GPU memory of the multisampled target (0 without MSAA).
@@ -463,6 +469,8 @@ impl Renderer {
             grid_reason: grid.map(|g| g.reason),
             samples: 1,
             msaa_bytes: 0,
+            frame_ms_spread: None,
+            assign_ms_spread: None,
         })
     }
 
@@ -546,10 +554,15 @@ impl Renderer {
                 .iter()
                 .all(|s| s.gpu_ms.is_some())
                 .then(|| median(|s| s.gpu_ms.unwrap_or(0.0)));
+            let frame_spread = Spread::of(frames.iter().map(|s| s.frame_ms));
+            let assign_spread = Spread::of(frames.iter().map(|s| s.assign_ms));
             stats = frames.pop().expect("at least one timed frame");
-            stats.frame_ms = frame_ms;
-            stats.assign_ms = assign_ms;
+            // The reported figure is the spread's median (nearest rank), so the two agree.
+            stats.frame_ms = frame_spread.map_or(frame_ms, |s| s.p50);
+            stats.assign_ms = assign_spread.map_or(assign_ms, |s| s.p50);
             stats.gpu_ms = gpu_ms;
+            stats.frame_ms_spread = frame_spread;
+            stats.assign_ms_spread = assign_spread;
         }
         Ok(stats)
     }

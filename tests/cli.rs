@@ -651,3 +651,26 @@ fn msaa_flag_renders_and_says_where_it_cannot() {
     assert_eq!(out.status.code(), Some(1), "{}", text(&out));
     assert!(text(&out).contains("deferred"), "{}", text(&out));
 }
+
+#[test]
+fn timed_frames_report_their_spread() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = manylight(
+        &[
+            "render", "--size", "32x18", "--lights", "64", "--frames", "12", "--stats", "s.json",
+        ],
+        &[],
+        dir.path(),
+    );
+    let msg = text(&out);
+    assert!(out.status.success(), "{msg}");
+    assert!(msg.contains("p99"), "{msg}");
+    let s = stats(&dir.path().join("s.json"));
+    for key in ["frame_ms_spread", "assign_ms_spread"] {
+        let spread = &s[key];
+        assert_eq!(spread["frames"], 12, "{key}: {spread}");
+        let at = |q: &str| spread[q].as_f64().unwrap();
+        assert!(at("p50") <= at("p95") && at("p95") <= at("p99") && at("p99") <= at("max"));
+    }
+    assert_eq!(s["frame_ms"], s["frame_ms_spread"]["p50"]);
+}

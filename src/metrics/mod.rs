@@ -7,6 +7,7 @@ pub mod plot;
 pub mod raycast;
 pub mod report;
 pub mod sheet;
+pub mod spread;
 
 use serde::Serialize;
 

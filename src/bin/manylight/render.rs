@@ -42,7 +42,8 @@ pub struct RenderArgs {
     /// against the light model.
     #[arg(long)]
     pub linear: bool,
-    /// Frames timed after a warm-up frame (the median is reported).
+    /// Frames timed after a warm-up frame: the median is reported, and from 10 frames also
+    /// p95, p99 and the slowest (`--stats` has them from 1).
     #[arg(long, default_value_t = 2)]
     pub frames: u32,
     /// Play a device whose fragment stage has no highp (Mali-400 class; needs `--es 2`):
@@ -171,8 +172,15 @@ pub fn run(args: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
         std::fs::write(path, serde_json::to_string_pretty(&stats)? + "\n")
             .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
     }
+    // The slow frames too, where enough frames were timed for them to mean something.
+    let tail = match stats.frame_ms_spread {
+        Some(s) if s.frames >= 10 => {
+            format!(" (p95 {:.1}, p99 {:.1}, max {:.1})", s.p95, s.p99, s.max)
+        }
+        _ => String::new(),
+    };
     println!(
-        "{} {}x{} · {} · {} lights · {} on {} · {:.1} ms/frame → {}",
+        "{} {}x{} · {} · {} lights · {} on {} · {:.1} ms/frame{tail} → {}",
         args.scene,
         width,
         height,
