@@ -164,6 +164,15 @@ fn format_text(
         caps.max_draw_buffers,
         caps.max_color_attachments
     );
+    if caps.max_samples > 1 {
+        w!(
+            out,
+            "MSAA               up to {}× (--msaa)",
+            caps.max_samples
+        );
+    } else {
+        w!(out, "MSAA               unsupported here (needs ES 3.0)");
+    }
     let p = |p: &manylight::gl::caps::Precision| {
         format!(
             "2^{}..2^{}, {} bits",
