@@ -14,6 +14,7 @@ use std::path::Path;
 
 use glam::DVec3;
 use manylight::gl::HeadlessContext;
+use manylight::metrics::spread::Spread;
 use manylight::scene::{self, Scene};
 use manylight::{EsVersion, RenderOptions, Renderer};
 
@@ -41,6 +42,7 @@ pub struct Timings {
 }
 
 /// Renders `frames` frames of `lights` moving lights at `width × height` into `out_dir`.
+/// (The renderer frees its GL objects when it is dropped, before the context, on every path.)
 pub fn run(
     out_dir: &Path,
     frames: u32,
@@ -51,19 +53,6 @@ pub fn run(
     std::fs::create_dir_all(out_dir)?;
     let ctx = HeadlessContext::new(EsVersion::Es3)?;
     let mut renderer = Renderer::new(ctx.load_gl(), EsVersion::Es3)?;
-    let result = render_frames(&mut renderer, out_dir, frames, lights, width, height);
-    renderer.destroy();
-    result
-}
-
-fn render_frames(
-    renderer: &mut Renderer,
-    out_dir: &Path,
-    frames: u32,
-    lights: usize,
-    width: u32,
-    height: u32,
-) -> Result<Timings, Box<dyn std::error::Error>> {
     let mut scene = scene::builtin::build("courtyard", Some((lights, 7)))?;
     let start: Vec<DVec3> = scene.lights.iter().map(|l| l.position).collect();
     let options = RenderOptions::default();
@@ -77,21 +66,12 @@ fn render_frames(
         frame_ms.push(stats.frame_ms);
         assign_ms.push(stats.assign_ms);
     }
+    let frame = Spread::of(frame_ms);
     Ok(Timings {
-        p50_ms: percentile(&mut frame_ms, 0.50),
-        p95_ms: percentile(&mut frame_ms, 0.95),
-        assign_p50_ms: percentile(&mut assign_ms, 0.50),
+        p50_ms: frame.map_or(0.0, |s| s.p50),
+        p95_ms: frame.map_or(0.0, |s| s.p95),
+        assign_p50_ms: Spread::of(assign_ms).map_or(0.0, |s| s.p50),
     })
-}
-
-/// The `q` quantile (nearest rank) of `values`; 0 for none.
-fn percentile(values: &mut [f64], q: f64) -> f64 {
-    if values.is_empty() {
-        return 0.0;
-    }
-    values.sort_by(f64::total_cmp);
-    let rank = ((values.len() as f64 * q).ceil() as usize).clamp(1, values.len());
-    values[rank - 1]
 }
 
 #[allow(dead_code)] // `tests/examples.rs` includes this file and calls `run` itself.

@@ -544,22 +544,21 @@ impl Renderer {
             for _ in 0..options.timed_frames {
                 frames.push(self.render(scene, width, height, options)?);
             }
-            let median = |f: fn(&FrameStats) -> f64| {
-                let mut v: Vec<f64> = frames.iter().map(f).collect();
-                v.sort_by(f64::total_cmp);
-                v[v.len() / 2]
-            };
-            let (frame_ms, assign_ms) = (median(|s| s.frame_ms), median(|s| s.assign_ms));
+            // GPU time where every frame has it: its median.
             let gpu_ms = frames
                 .iter()
-                .all(|s| s.gpu_ms.is_some())
-                .then(|| median(|s| s.gpu_ms.unwrap_or(0.0)));
+                .map(|s| s.gpu_ms)
+                .collect::<Option<Vec<f64>>>()
+                .map(|mut v| {
+                    v.sort_by(f64::total_cmp);
+                    v[v.len() / 2]
+                });
             let frame_spread = Spread::of(frames.iter().map(|s| s.frame_ms));
             let assign_spread = Spread::of(frames.iter().map(|s| s.assign_ms));
             stats = frames.pop().expect("at least one timed frame");
-            // The reported figure is the spread's median (nearest rank), so the two agree.
-            stats.frame_ms = frame_spread.map_or(frame_ms, |s| s.p50);
-            stats.assign_ms = assign_spread.map_or(assign_ms, |s| s.p50);
+            // The reported figures are the spreads' medians (nearest rank), so the two agree.
+            stats.frame_ms = frame_spread.map_or(stats.frame_ms, |s| s.p50);
+            stats.assign_ms = assign_spread.map_or(stats.assign_ms, |s| s.p50);
             stats.gpu_ms = gpu_ms;
             stats.frame_ms_spread = frame_spread;
             stats.assign_ms_spread = assign_spread;

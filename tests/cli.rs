@@ -23,6 +23,20 @@ fn text(out: &Output) -> String {
     )
 }
 
+/// Runs `manylight ARGS`, asserting its exit status, that its output names `needle`, and that
+/// nothing panicked; returns the output.
+fn expect_exit(args: &[&str], env: &[(&str, &str)], cwd: &Path, code: i32, needle: &str) -> String {
+    let out = manylight(args, env, cwd);
+    let msg = text(&out);
+    assert_eq!(out.status.code(), Some(code), "{args:?}: {msg}");
+    assert!(
+        msg.contains(needle),
+        "{args:?}: expected `{needle}` in: {msg}"
+    );
+    assert!(!msg.contains("panicked"), "{args:?} panicked: {msg}");
+    msg
+}
+
 fn stats(path: &Path) -> serde_json::Value {
     serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
 }
@@ -294,14 +308,7 @@ fn bad_requests_are_clear_errors_not_panics() {
         ),
     ];
     for (args, needle) in cases {
-        let out = manylight(args, &[], dir.path());
-        let msg = text(&out);
-        assert_eq!(out.status.code(), Some(1), "{args:?}: {msg}");
-        assert!(
-            msg.contains(needle),
-            "{args:?}: expected `{needle}` in: {msg}"
-        );
-        assert!(!msg.contains("panicked"), "{args:?} panicked: {msg}");
+        expect_exit(args, &[], dir.path(), 1, needle);
     }
 }
 
@@ -320,13 +327,7 @@ fn usage_errors_exit_2_and_name_the_flags() {
         (&["render", "--bogus"], "--bogus"),
     ];
     for (args, needle) in cases {
-        let out = manylight(args, &[], dir.path());
-        let msg = text(&out);
-        assert_eq!(out.status.code(), Some(2), "{args:?}: {msg}");
-        assert!(
-            msg.contains(needle),
-            "{args:?}: expected `{needle}` in: {msg}"
-        );
+        expect_exit(args, &[], dir.path(), 2, needle);
     }
 }
 
@@ -334,9 +335,7 @@ fn usage_errors_exit_2_and_name_the_flags() {
 #[test]
 fn view_in_a_build_without_the_window_feature_says_how_to_get_it() {
     let dir = tempfile::tempdir().unwrap();
-    let out = manylight(&["view"], &[], dir.path());
-    assert_eq!(out.status.code(), Some(2), "{}", text(&out));
-    assert!(text(&out).contains("--features window"), "{}", text(&out));
+    expect_exit(&["view"], &[], dir.path(), 2, "--features window");
 }
 
 /// A device without fragment highp runs the default command at its default light count:
@@ -365,16 +364,12 @@ fn without_fragment_highp_the_default_light_count_renders_and_errors_suggest_wha
     let s = stats(&dir.path().join("s.json"));
     assert_eq!(s["lights"], 1024);
     assert_eq!(s["overflowed_lights"], 1);
-    let out = manylight(
+    let msg = expect_exit(
         &[&base[..], &["--method", "tiled"]].concat(),
         &[],
         dir.path(),
-    );
-    let msg = text(&out);
-    assert_eq!(out.status.code(), Some(1), "{msg}");
-    assert!(
-        msg.contains("methods that run here: forward, auto"),
-        "{msg}"
+        1,
+        "methods that run here: forward, auto",
     );
     assert!(!msg.contains("WARN"), "a warning before the error: {msg}");
 }
@@ -559,14 +554,7 @@ fn hostile_files_and_counts_are_refused_quickly_and_clearly() {
     }
     for (args, env, needle, code) in cases {
         let args = [&args[..], &small[..]].concat();
-        let out = manylight(&args, env, dir.path());
-        let msg = text(&out);
-        assert_eq!(out.status.code(), Some(code), "{args:?}: {msg}");
-        assert!(
-            msg.contains(needle),
-            "{args:?}: expected `{needle}` in: {msg}"
-        );
-        assert!(!msg.contains("panicked"), "{args:?}: {msg}");
+        expect_exit(&args, env, dir.path(), code, needle);
     }
 }
 
@@ -596,13 +584,7 @@ fn bench_errors_name_the_fault_without_leak_warnings() {
         ),
     ];
     for (args, needle) in cases {
-        let out = manylight(args, &[], dir.path());
-        let msg = text(&out);
-        assert_eq!(out.status.code(), Some(1), "{args:?}: {msg}");
-        assert!(
-            msg.contains(needle),
-            "{args:?}: expected `{needle}` in: {msg}"
-        );
+        let msg = expect_exit(args, &[], dir.path(), 1, needle);
         assert!(!msg.contains("leaked"), "{args:?}: {msg}");
     }
 }
@@ -617,19 +599,10 @@ fn tone_map_flags_render_and_bad_values_are_refused() {
         dir.path(),
     );
     assert!(out.status.success(), "{}", text(&out));
-    let out = manylight(
-        &[&base[..], &["--tonemap", "filmic"]].concat(),
-        &[],
-        dir.path(),
-    );
-    assert_eq!(out.status.code(), Some(2), "{}", text(&out));
-    let out = manylight(
-        &[&base[..], &["--exposure", "40"]].concat(),
-        &[],
-        dir.path(),
-    );
-    assert_eq!(out.status.code(), Some(1), "{}", text(&out));
-    assert!(text(&out).contains("exposure_ev"), "{}", text(&out));
+    let args = [&base[..], &["--tonemap", "filmic"]].concat();
+    expect_exit(&args, &[], dir.path(), 2, "filmic");
+    let args = [&base[..], &["--exposure", "40"]].concat();
+    expect_exit(&args, &[], dir.path(), 1, "exposure_ev");
 }
 
 #[test]
@@ -643,13 +616,8 @@ fn msaa_flag_renders_and_says_where_it_cannot() {
     );
     assert!(out.status.success(), "{}", text(&out));
     assert_eq!(stats(&dir.path().join("s.json"))["samples"], 4);
-    let out = manylight(
-        &[&base[..], &["--msaa", "4", "--method", "deferred"]].concat(),
-        &[],
-        dir.path(),
-    );
-    assert_eq!(out.status.code(), Some(1), "{}", text(&out));
-    assert!(text(&out).contains("deferred"), "{}", text(&out));
+    let args = [&base[..], &["--msaa", "4", "--method", "deferred"]].concat();
+    expect_exit(&args, &[], dir.path(), 1, "deferred");
 }
 
 #[test]
