@@ -583,12 +583,17 @@ impl Renderer {
         if let Some(reason) = crate::gl::multisample::unsupported_reason(&self.dev, samples) {
             return refuse(reason);
         }
-        if self.method.name() == "deferred" {
-            return refuse(
-                "deferred shading does not support it (its G-buffer would need every \
-                 attachment per sample); use forward, tiled or clustered"
-                    .into(),
-            );
+        if !methods::find(self.method.name())?.multisample {
+            let able: Vec<&str> = methods::METHODS
+                .iter()
+                .filter(|m| m.multisample)
+                .map(|m| m.name)
+                .collect();
+            return refuse(format!(
+                "{} shading does not support it; methods that do: {}",
+                self.method.name(),
+                able.join(", ")
+            ));
         }
         if format != ColorFormat::Rgba8 {
             return refuse("only 8-bit output is multisampled, not HDR".into());

@@ -17,6 +17,7 @@ pub const DESC: MethodDesc = MethodDesc {
     min_es: EsVersion::Es2,
     required_extensions: &[],
     supported: |_| Support::Supported,
+    multisample: true,
     create: |_| Ok(Box::new(Auto::default())),
 };
 

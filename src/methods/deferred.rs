@@ -37,6 +37,8 @@ pub const DESC: MethodDesc = MethodDesc {
     min_es: EsVersion::Es3,
     required_extensions: &["GL_EXT_color_buffer_float"],
     supported,
+    // The G-buffer would need every attachment per sample.
+    multisample: false,
     create: |_| Ok(Box::new(Deferred::default())),
 };
 

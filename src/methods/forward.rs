@@ -22,6 +22,7 @@ pub const DESC: MethodDesc = MethodDesc {
     min_es: EsVersion::Es2,
     required_extensions: &[],
     supported,
+    multisample: true,
     create: |_| Ok(Box::new(Forward::default())),
 };
 

@@ -138,6 +138,8 @@ pub struct MethodDesc {
     pub required_extensions: &'static [&'static str],
     /// Whether it runs on a context, and how.
     pub supported: fn(&Caps) -> Support,
+    /// Whether it can draw into a multisampled target (MSAA, `RenderOptions::samples`).
+    pub multisample: bool,
     /// Builds the method (only called when `supported` is not `Unsupported`).
     pub create: fn(&Device) -> Result<Box<dyn ShadingMethod>, Error>,
 }

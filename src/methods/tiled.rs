@@ -13,5 +13,6 @@ pub const DESC: MethodDesc = MethodDesc {
     min_es: EsVersion::Es2,
     required_extensions: &[],
     supported: culled_support,
+    multisample: true,
     create: |_| Ok(Box::new(CulledForward::new(Culling::Tiled))),
 };
