@@ -5,29 +5,54 @@
 //! ```
 //!
 //! Per-frame light assignment is the point of the design: nothing about the lights is baked,
-//! so moving all of them costs the same as moving none. Each of the courtyard's lights circles
-//! its starting point at its own speed; the renderer re-assigns them to the cluster grid every
-//! frame. The frames go to `OUT_DIR/frame_000.png` … (turn them into a video with, say,
-//! `ffmpeg -i OUT_DIR/frame_%03d.png out.mp4`).
+//! so moving all of them costs the same as moving none. The courtyard's random lights come with
+//! the built-in scenes' motion (they wander, flicker, spots sweep); this example adds a bright
+//! spot light that circles the fountain, built in code. `Scene::set_time(t)` poses every light
+//! at time `t`, a pure function of time, so a frame can be recomputed on its own. The frames go
+//! to `OUT_DIR/frame_000.png` … (turn them into a video with, say,
+//! `ffmpeg -i OUT_DIR/frame_%03d.png out.mp4`, or use `manylight --record DIR|FILE.gif`).
 
 use std::path::Path;
 
-use glam::DVec3;
+use glam::{DVec3, Vec3};
 use manylight::gl::HeadlessContext;
 use manylight::metrics::spread::Spread;
-use manylight::scene::{self, Scene};
+use manylight::scene::motion::{Motion, Orbit, OrbitAbout};
+use manylight::scene::{self, Light, Scene};
 use manylight::{EsVersion, RenderOptions, Renderer};
 
-/// Moves each light on a horizontal circle around where it started: light `i` at time `t`
-/// (seconds) is `start + r·(cos, 0, sin)(ω_i·t + φ_i)`, so the motion is a pure function of
-/// time and a frame can be recomputed on its own.
-pub fn place_lights(scene: &mut Scene, start: &[DVec3], t: f64) {
-    for (i, (light, origin)) in scene.lights.iter_mut().zip(start).enumerate() {
-        let speed = 0.5 + (i % 7) as f64 * 0.25; // radians per second
-        let phase = i as f64 * 2.399_963; // the golden angle spreads the phases
-        let angle = speed * t + phase;
-        light.position = *origin + DVec3::new(angle.cos(), 0.0, angle.sin()) * 1.5;
-    }
+/// Animation time of frame `frame`: 24 frames per second.
+pub fn time_of(frame: u32) -> f64 {
+    f64::from(frame) / 24.0
+}
+
+/// The courtyard with `lights` moving random lights and a spot light circling the fountain.
+pub fn build_scene(lights: usize) -> Result<Scene, Box<dyn std::error::Error>> {
+    let mut scene = scene::builtin::build("courtyard", Some((lights, 7)))?;
+    scene.lights.push(Light::spot(
+        DVec3::new(4.0, 6.0, 0.0),
+        DVec3::new(-0.5, -1.0, 0.0),
+        12.0,
+        25.0,
+        14.0,
+        Vec3::new(1.0, 0.9, 0.7),
+        40.0,
+    ));
+    let spot = scene.lights.len() - 1;
+    scene.animate_light(
+        spot,
+        Motion {
+            orbit: Some(Orbit {
+                about: OrbitAbout::Point(DVec3::ZERO),
+                axis: DVec3::Y,
+                period_s: 3.0,
+                phase_deg: 0.0,
+            }),
+            ..Motion::default()
+        },
+    );
+    scene.validate()?;
+    Ok(scene)
 }
 
 /// Frame-time figures of a run, in milliseconds.
@@ -53,14 +78,12 @@ pub fn run(
     std::fs::create_dir_all(out_dir)?;
     let ctx = HeadlessContext::new(EsVersion::Es3)?;
     let mut renderer = Renderer::new(ctx.load_gl(), EsVersion::Es3)?;
-    let mut scene = scene::builtin::build("courtyard", Some((lights, 7)))?;
-    let start: Vec<DVec3> = scene.lights.iter().map(|l| l.position).collect();
+    let mut scene = build_scene(lights)?;
     let options = RenderOptions::default();
     let mut frame_ms = Vec::new();
     let mut assign_ms = Vec::new();
     for frame in 0..frames {
-        let t = frame as f64 / 24.0; // 24 frames per second of animation time
-        place_lights(&mut scene, &start, t);
+        scene.set_time(time_of(frame));
         let (image, stats) = renderer.render_offscreen(&scene, width, height, &options)?;
         image.save(out_dir.join(format!("frame_{frame:03}.png")))?;
         frame_ms.push(stats.frame_ms);

@@ -96,6 +96,9 @@ pub struct FrameStats {
     pub samples: u32,
     /// GPU memory of the multisampled target (0 without MSAA).
     pub msaa_bytes: usize,
+    /// Bytes uploaded per frame over the timed frames of an animated sequence (lights that
+    /// move change what is uploaded); `None` for a single frame.
+    pub upload_bytes_spread: Option<Spread>,
 }
 
 /// Renders scenes with one shading method at a time.
@@ -469,6 +472,7 @@ impl Renderer {
             grid_reason: grid.map(|g| g.reason),
             samples: 1,
             msaa_bytes: 0,
+            upload_bytes_spread: None,
             frame_ms_spread: None,
             assign_ms_spread: None,
         })

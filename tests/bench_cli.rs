@@ -39,6 +39,8 @@ fn a_small_sweep_writes_the_report_charts_and_heatmaps() {
             "0",
             "--cpu-samples",
             "64",
+            "--animated-frames",
+            "6",
         ],
         dir.path(),
     );
@@ -124,6 +126,25 @@ fn a_small_sweep_writes_the_report_charts_and_heatmaps() {
     assert_eq!(row("clustered", 0)["max_abs_err"].as_u64(), Some(0));
     let md = std::fs::read_to_string(dir.path().join("report.md")).unwrap();
     assert!(md.contains("| method | lights | frame ms |"), "{md}");
+    // The animated workload: every method, at the knobs' light count (16), with its spread
+    // and, for the culled methods, an error against forward within 2/255.
+    let animated = report["animated"].as_array().unwrap();
+    assert_eq!(animated.len(), 5, "{animated:?}");
+    for r in animated {
+        assert_eq!(r["lights"], 16);
+        let spread = &r["frame_ms"];
+        assert_eq!(spread["frames"], 6, "{r}");
+        assert!(spread["p50"].as_f64() <= spread["p99"].as_f64());
+        assert!(r["p99_over_p50"].as_f64().unwrap() >= 1.0, "{r}");
+        match r["max_abs_err_vs_forward"].as_u64() {
+            None => assert_eq!(r["method"], "forward"),
+            Some(e) => assert!(e <= 2, "{r}"),
+        }
+    }
+    assert!(
+        md.contains("## Animated workload") && md.contains("| p99/p50 |"),
+        "{md}"
+    );
 }
 
 #[test]

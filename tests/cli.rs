@@ -642,3 +642,91 @@ fn timed_frames_report_their_spread() {
     }
     assert_eq!(s["frame_ms"], s["frame_ms_spread"]["p50"]);
 }
+
+#[test]
+fn record_writes_the_sequence_and_a_frame_alone_matches_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let base = ["render", "--size", "64x36", "--lights", "48", "--fps", "2"];
+    let out = manylight(
+        &[
+            &base[..],
+            &["--frames", "5", "--record", "seq", "--stats", "s.json"],
+        ]
+        .concat(),
+        &[],
+        dir.path(),
+    );
+    let msg = text(&out);
+    assert!(out.status.success(), "{msg}");
+    assert!(msg.contains("moving lights"), "{msg}");
+    let frame = |k: u32| {
+        image::open(dir.path().join(format!("seq/frame_{k:05}.png")))
+            .unwrap()
+            .to_rgba8()
+    };
+    assert!(!dir.path().join("seq/frame_00005.png").exists());
+    let s = stats(&dir.path().join("s.json"));
+    for key in ["frame_ms_spread", "assign_ms_spread", "upload_bytes_spread"] {
+        assert_eq!(s[key]["frames"], 5, "{key}: {}", s[key]);
+    }
+    // Frame 3 of the sequence (t = 1.5 s at 2 fps) rendered alone with --time.
+    let out = manylight(
+        &[
+            &base[..],
+            &["--frames", "0", "--time", "1.5", "--out", "alone.png"],
+        ]
+        .concat(),
+        &[],
+        dir.path(),
+    );
+    assert!(out.status.success(), "{}", text(&out));
+    let alone = image::open(dir.path().join("alone.png"))
+        .unwrap()
+        .to_rgba8();
+    assert!(
+        alone == frame(3),
+        "--time 1.5 differs from frame 3 of the sequence"
+    );
+    assert!(
+        alone != frame(0),
+        "the lights did not move between t = 0 and 1.5 s"
+    );
+    // The default --out is the first frame of the sequence.
+    let first = image::open(dir.path().join("manylight.png"))
+        .unwrap()
+        .to_rgba8();
+    assert!(first == frame(0));
+}
+
+#[test]
+fn record_to_a_gif_writes_every_frame() {
+    use image::AnimationDecoder;
+    let dir = tempfile::tempdir().unwrap();
+    let args = [
+        "render", "--size", "32x18", "--lights", "16", "--frames", "4", "--record", "a.gif",
+    ];
+    let out = manylight(&args, &[], dir.path());
+    assert!(out.status.success(), "{}", text(&out));
+    let file = std::io::BufReader::new(std::fs::File::open(dir.path().join("a.gif")).unwrap());
+    let frames = image::codecs::gif::GifDecoder::new(file)
+        .unwrap()
+        .into_frames()
+        .collect_frames()
+        .unwrap();
+    assert_eq!(frames.len(), 4);
+    assert_eq!(frames[0].buffer().dimensions(), (32, 18));
+}
+
+#[test]
+fn bad_animation_flags_are_usage_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    for (flag, value) in [("--fps", "0"), ("--fps", "nan"), ("--time", "inf")] {
+        expect_exit(&["render", flag, value], &[], dir.path(), 2, flag);
+    }
+    // A file where the recording directory should go.
+    std::fs::write(dir.path().join("taken"), b"x").unwrap();
+    let args = [
+        "render", "--size", "8x8", "--frames", "1", "--record", "taken",
+    ];
+    expect_exit(&args, &[], dir.path(), 1, "--record");
+}

@@ -54,9 +54,8 @@ fn animated_lights_move_every_frame_and_each_frame_depends_on_its_time_only() {
     // is a function of time, and assignment keeps nothing of the frames before.
     let ctx = HeadlessContext::new(EsVersion::Es3).unwrap();
     let mut renderer = Renderer::new(ctx.load_gl(), EsVersion::Es3).unwrap();
-    let mut scene = scene::builtin::build("courtyard", Some((128, 7))).unwrap();
-    let start: Vec<_> = scene.lights.iter().map(|l| l.position).collect();
-    animated_lights::place_lights(&mut scene, &start, 2.0 / 24.0);
+    let mut scene = animated_lights::build_scene(128).unwrap();
+    scene.set_time(animated_lights::time_of(2));
     let (alone, _) = renderer
         .render_offscreen(&scene, 160, 90, &RenderOptions::default())
         .unwrap();

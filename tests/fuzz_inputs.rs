@@ -381,3 +381,272 @@ fn the_corpus_loads_or_is_refused_and_renders_finite() {
         load_and_check(&file, true);
     }
 }
+
+// glTF: proptest mutations of a valid file — values replaced anywhere in its JSON, bytes of a
+// GLB flipped, cut short or inserted — each loads or is refused with a message, never a panic
+// (nor the loader's last guard turning a panic inside the `gltf` crate into an error); what
+// loads renders finite frames.
+
+fn gltf_base64(bytes: &[u8]) -> String {
+    const ABC: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    let mut out = String::new();
+    for chunk in bytes.chunks(3) {
+        let b = [
+            chunk[0],
+            *chunk.get(1).unwrap_or(&0),
+            *chunk.get(2).unwrap_or(&0),
+        ];
+        let n = (u32::from(b[0]) << 16) | (u32::from(b[1]) << 8) | u32::from(b[2]);
+        for i in 0..4 {
+            out.push(if i <= chunk.len() {
+                ABC[(n >> (18 - 6 * i) & 63) as usize] as char
+            } else {
+                '='
+            });
+        }
+    }
+    out
+}
+
+/// A valid glTF document (without its buffer's `uri`) and its binary buffer: an indexed,
+/// textured quad placed twice through a node hierarchy, a second material that blends, a
+/// point and a spot light, a camera.
+fn gltf_valid() -> (serde_json::Value, Vec<u8>) {
+    let mut bin = Vec::new();
+    let mut views = Vec::new();
+    let mut push = |bytes: Vec<u8>| {
+        views.push(
+            serde_json::json!({"buffer": 0, "byteOffset": bin.len(), "byteLength": bytes.len()}),
+        );
+        bin.extend(bytes);
+        while !bin.len().is_multiple_of(4) {
+            bin.push(0);
+        }
+    };
+    let f = |v: &[f32]| v.iter().flat_map(|x| x.to_le_bytes()).collect::<Vec<u8>>();
+    push(f(&[
+        -1.0, -1.0, 0.0, 1.0, -1.0, 0.0, 1.0, 1.0, 0.0, -1.0, 1.0, 0.0,
+    ]));
+    push(f(&[0.0, 0.0, 1.0].repeat(4)));
+    push(f(&[0.0, 1.0, 1.0, 1.0, 1.0, 0.0, 0.0, 0.0]));
+    push(
+        [0u16, 1, 2, 0, 2, 3]
+            .iter()
+            .flat_map(|i| i.to_le_bytes())
+            .collect(),
+    );
+    let tex = image::RgbaImage::from_pixel(2, 2, image::Rgba([200, 100, 50, 255]));
+    let mut png = Vec::new();
+    tex.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+        .unwrap();
+    push(png);
+    let doc = serde_json::json!({
+        "asset": {"version": "2.0"},
+        "extensionsUsed": ["KHR_lights_punctual"],
+        "extensions": {"KHR_lights_punctual": {"lights": [
+            {"type": "point", "color": [1, 0.8, 0.6], "intensity": 3, "range": 5},
+            {"type": "spot", "intensity": 4, "spot": {"innerConeAngle": 0.2, "outerConeAngle": 0.5}}
+        ]}},
+        "scene": 0,
+        "scenes": [{"nodes": [0, 3]}],
+        "nodes": [
+            {"translation": [0, 1, 0], "rotation": [0, 0.38268343, 0, 0.9238795], "children": [1, 2]},
+            {"mesh": 0, "scale": [2, 2, 2]},
+            {"mesh": 0, "matrix": [1,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,-2,1],
+             "extensions": {"KHR_lights_punctual": {"light": 0}}},
+            {"translation": [0, 1, 6], "camera": 0, "children": [4]},
+            {"translation": [1, 2, 0], "extensions": {"KHR_lights_punctual": {"light": 1}}}
+        ],
+        "cameras": [{"type": "perspective", "perspective": {"yfov": 0.8, "znear": 0.1, "zfar": 100}}],
+        "meshes": [{"primitives": [
+            {"attributes": {"POSITION": 0, "NORMAL": 1, "TEXCOORD_0": 2}, "indices": 3, "material": 0},
+            {"attributes": {"POSITION": 0}, "material": 1, "mode": 5}
+        ]}],
+        "materials": [
+            {"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}, "roughnessFactor": 0.4}},
+            {"alphaMode": "BLEND", "doubleSided": true,
+             "pbrMetallicRoughness": {"baseColorFactor": [0.2, 0.4, 1, 0.5]}}
+        ],
+        "textures": [{"source": 0}],
+        "images": [{"bufferView": 4, "mimeType": "image/png"}],
+        "buffers": [{"byteLength": bin.len()}],
+        "bufferViews": views,
+        "accessors": [
+            {"bufferView": 0, "componentType": 5126, "type": "VEC3", "count": 4,
+             "min": [-1, -1, 0], "max": [1, 1, 0]},
+            {"bufferView": 1, "componentType": 5126, "type": "VEC3", "count": 4},
+            {"bufferView": 2, "componentType": 5126, "type": "VEC2", "count": 4},
+            {"bufferView": 3, "componentType": 5123, "type": "SCALAR", "count": 6}
+        ]
+    });
+    (doc, bin)
+}
+
+fn gltf_glb(json: &[u8], bin: &[u8]) -> Vec<u8> {
+    let mut json = json.to_vec();
+    while !json.len().is_multiple_of(4) {
+        json.push(b' ');
+    }
+    let mut out = b"glTF".to_vec();
+    out.extend(2u32.to_le_bytes());
+    out.extend(((12 + 8 + json.len() + 8 + bin.len()) as u32).to_le_bytes());
+    out.extend((json.len() as u32).to_le_bytes());
+    out.extend(b"JSON");
+    out.extend(&json);
+    out.extend((bin.len() as u32).to_le_bytes());
+    out.extend(b"BIN\0");
+    out.extend(bin);
+    out
+}
+
+/// JSON pointers of every value in `v` (objects' members and arrays' elements, at any depth).
+fn gltf_pointers(v: &serde_json::Value, at: String, out: &mut Vec<String>) {
+    match v {
+        serde_json::Value::Object(m) => {
+            for (k, child) in m {
+                let p = format!("{at}/{k}");
+                out.push(p.clone());
+                gltf_pointers(child, p, out);
+            }
+        }
+        serde_json::Value::Array(a) => {
+            for (i, child) in a.iter().enumerate() {
+                let p = format!("{at}/{i}");
+                out.push(p.clone());
+                gltf_pointers(child, p, out);
+            }
+        }
+        _ => {}
+    }
+}
+
+fn gltf_replacement() -> impl Strategy<Value = serde_json::Value> {
+    prop::sample::select(vec![
+        serde_json::json!(0),
+        serde_json::json!(1),
+        serde_json::json!(2),
+        serde_json::json!(3),
+        serde_json::json!(5),
+        serde_json::json!(-1),
+        serde_json::json!(0.5),
+        serde_json::json!(1e9),
+        serde_json::json!(4294967295u64),
+        serde_json::json!(4294967296u64),
+        serde_json::json!(1e39),
+        serde_json::json!(-1e300),
+        serde_json::json!(null),
+        serde_json::json!("x"),
+        serde_json::json!("BLEND"),
+        serde_json::json!("MASK"),
+        serde_json::json!("spot"),
+        serde_json::json!("directional"),
+        serde_json::json!("orthographic"),
+        serde_json::json!("missing.bin"),
+        serde_json::json!("data:application/octet-stream;base64,AAAA"),
+        serde_json::json!([]),
+        serde_json::json!([0]),
+        serde_json::json!([1, 0]),
+        serde_json::json!([0, 0, 0, 0]),
+        serde_json::json!({}),
+    ])
+}
+
+/// Loads a mutated glTF file: no panic, a message on refusal, a valid scene otherwise (rendered
+/// when `render` is set).
+fn gltf_check(file: &Path, render: bool, what: &str) {
+    let spec = file.to_str().unwrap();
+    match catch_unwind(AssertUnwindSafe(|| scene::load(spec, Some((2, 1))))) {
+        Err(_) => panic!("loading panicked: {what}"),
+        Ok(Err(e)) => {
+            let message = e.to_string();
+            assert!(!message.is_empty());
+            assert!(
+                !message.contains("(gltf crate) failed"),
+                "the gltf crate panicked: {message}\n{what}"
+            );
+        }
+        Ok(Ok((scene, _))) => {
+            scene.validate().expect("a loaded scene validates");
+            if render {
+                render_finite(&scene, what);
+            }
+        }
+    }
+}
+
+proptest! {
+    #![proptest_config(config(600))]
+
+    #[test]
+    fn mutated_gltf_json_loads_or_is_refused(
+        picks in prop::collection::vec((any::<prop::sample::Index>(), gltf_replacement()), 1..4),
+        as_glb in any::<bool>(),
+        render in prop::bool::weighted(0.3),
+    ) {
+        let (mut doc, bin) = gltf_valid();
+        let mut pointers = Vec::new();
+        gltf_pointers(&doc, String::new(), &mut pointers);
+        for (index, value) in picks {
+            let pointer = index.get(&pointers);
+            if let Some(slot) = doc.pointer_mut(pointer) {
+                *slot = value;
+            }
+        }
+        let dir = workspace();
+        let file = if as_glb {
+            let file = dir.path().join("m.glb");
+            std::fs::write(&file, gltf_glb(doc.to_string().as_bytes(), &bin)).unwrap();
+            file
+        } else {
+            if let Some(buffer) = doc.pointer_mut("/buffers/0") {
+                if buffer.is_object() && buffer.get("uri").is_none() {
+                    buffer["uri"] = serde_json::Value::from(format!(
+                        "data:application/octet-stream;base64,{}",
+                        gltf_base64(&bin)
+                    ));
+                }
+            }
+            let file = dir.path().join("m.gltf");
+            std::fs::write(&file, doc.to_string()).unwrap();
+            file
+        };
+        gltf_check(&file, render, &doc.to_string());
+    }
+
+    #[test]
+    fn mutated_glb_bytes_load_or_are_refused(
+        flips in prop::collection::vec((any::<prop::sample::Index>(), any::<u8>()), 0..6),
+        cut in prop::option::weighted(0.2, any::<prop::sample::Index>()),
+        insert in prop::option::weighted(0.1, (any::<prop::sample::Index>(), prop::collection::vec(any::<u8>(), 1..9))),
+    ) {
+        let (doc, bin) = gltf_valid();
+        let mut bytes = gltf_glb(doc.to_string().as_bytes(), &bin);
+        for (at, value) in flips {
+            let i = at.index(bytes.len());
+            bytes[i] = value;
+        }
+        if let Some((at, extra)) = insert {
+            let i = at.index(bytes.len());
+            bytes.splice(i..i, extra);
+        }
+        if let Some(at) = cut {
+            bytes.truncate(at.index(bytes.len()));
+        }
+        let dir = workspace();
+        let file = dir.path().join("m.glb");
+        std::fs::write(&file, &bytes).unwrap();
+        gltf_check(&file, false, &format!("{} bytes", bytes.len()));
+    }
+}
+
+#[test]
+fn the_valid_gltf_the_fuzzer_mutates_loads_and_renders() {
+    let (doc, bin) = gltf_valid();
+    let dir = workspace();
+    let file = dir.path().join("m.glb");
+    std::fs::write(&file, gltf_glb(doc.to_string().as_bytes(), &bin)).unwrap();
+    let (scene, report) = scene::load(file.to_str().unwrap(), Some((0, 1))).unwrap();
+    assert!(report.warnings.is_empty(), "{:?}", report.warnings);
+    assert_eq!((scene.objects.len(), scene.lights.len()), (4, 2));
+    render_finite(&scene, "the valid glTF");
+}

@@ -139,7 +139,16 @@ fn check_window_frame(
     let shot = dir.path().join("view.png");
     let size = format!("{}x{}", SIZE.0, SIZE.1);
     let shot_arg = shot.to_str().expect("utf-8 temp path");
-    let mut args = vec!["--frames", "5", "--screenshot", shot_arg, "--lights", "256"];
+    // Paused: the lights hold their pose at t = 0, the frame `render` draws.
+    let mut args = vec![
+        "--frames",
+        "5",
+        "--screenshot",
+        shot_arg,
+        "--lights",
+        "256",
+        "--paused",
+    ];
     args.extend(["--size", &size]);
     args.extend(extra);
     let out = run_view(&args, env)?;
@@ -210,6 +219,14 @@ fn view_resolves_msaa_into_the_window() {
     if let Some((_, stderr)) = check_window_frame(&msaa, &msaa, &[]) {
         assert!(!stderr.contains("MSAA off"), "{stderr}");
     }
+}
+
+/// The window posed at `--time` (paused) is `render --time`'s frame: the moving lights are
+/// where the same function of time puts them.
+#[test]
+fn view_poses_moving_lights_at_the_given_time() {
+    let at = ["--time", "2.5"];
+    check_window_frame(&at, &at, &[]);
 }
 
 #[test]

@@ -1,5 +1,6 @@
 //! Image comparison: the numbers every correctness claim is stated in.
 
+pub mod animated;
 pub mod counts;
 pub mod cpu_reference;
 pub mod heatmap;

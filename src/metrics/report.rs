@@ -94,6 +94,8 @@ pub struct Report {
     pub seconds: f64,
     /// The rows.
     pub rows: Vec<BenchRow>,
+    /// The animated workload's rows (frame-time spreads over moving frames).
+    pub animated: Vec<super::animated::AnimatedRow>,
     /// The pictures written beside the report, listed in report.md (not in report.json,
     /// whose fields are the rows').
     #[serde(skip)]
@@ -427,6 +429,7 @@ pub fn markdown(report: &Report) -> String {
         }
         s += "\n";
     }
+    s += &super::animated::markdown(&report.animated);
     s += "## Charts and pictures\n\n\
           Each method has the same colour and marker in every chart; `auto`, which usually \
           picks clustered, is a larger hollow marker (and a dashed line) around clustered's. \
@@ -592,6 +595,7 @@ mod tests {
             cpus: 1,
             seconds: 1.0,
             rows: rows(),
+            animated: Vec::new(),
             pictures: vec![Pictures {
                 scene: "a".into(),
                 es: "3.0".into(),

@@ -15,6 +15,7 @@ use glam::{DMat4, DVec3, Vec3};
 
 use super::mesh::Aabb;
 use super::meshbuild::MeshBuilder;
+use super::motion::{Flicker, Motion, Orbit, OrbitAbout, Sweep, Wander};
 use super::random::{self, LightSetStyle};
 use super::{Camera, Material, Mesh, Object, Scene, SceneError};
 
@@ -37,8 +38,47 @@ pub fn build(name: &str, lights: Option<(usize, u64)>) -> Result<Scene, SceneErr
     if let Some((count, seed)) = lights {
         super::input::check_light_count(count, "lights")?;
         scene.lights = random::lights(&volume, count, seed, style);
+        scene.animate_set(0, lively_motion(name, &volume), seed);
     }
     Ok(scene)
+}
+
+/// The built-in scenes' random lights move (`t = 0` is the still scene, so stills are
+/// unchanged): they wander about a metre or two on slow seeded paths, flicker a little, spots
+/// sweep; the plane's lights circle in planes parallel to the quad, so its analytic checks
+/// hold on every frame.
+pub fn lively_motion(name: &str, volume: &Aabb) -> Motion {
+    let reach = (volume.size().length() * 0.035).clamp(0.05, 2.0);
+    if name == "plane" {
+        return Motion {
+            orbit: Some(Orbit {
+                about: OrbitAbout::Radius(reach * 2.0),
+                axis: DVec3::Z,
+                period_s: 5.0,
+                phase_deg: 0.0,
+            }),
+            ..Motion::default()
+        };
+    }
+    Motion {
+        wander: Some(Wander {
+            radius: reach,
+            period_s: 6.0,
+            seed: 0,
+        }),
+        flicker: Some(Flicker {
+            amount: 0.2,
+            rate_hz: 1.5,
+            seed: 0,
+        }),
+        sweep: Some(Sweep {
+            axis: DVec3::X,
+            angle_deg: 15.0,
+            period_s: 5.0,
+            phase_deg: 0.0,
+        }),
+        ..Motion::default()
+    }
 }
 
 /// Geometry of a built-in as objects and materials only (for scene files that place a

@@ -30,6 +30,15 @@ pub enum SceneError {
         /// What tobj or the loader reported.
         reason: String,
     },
+    /// A glTF file (`.gltf` or `.glb`) is malformed or cannot be shown; `reason` names the
+    /// part of the file at fault, e.g. `meshes[2].primitives[0]: index 9 out of range …`.
+    #[error("malformed glTF {path}: {reason}")]
+    Gltf {
+        /// The `.gltf` or `.glb` file.
+        path: PathBuf,
+        /// What is wrong, starting with the glTF path of the object at fault.
+        reason: String,
+    },
     /// A scene file is not valid JSON for the scene schema.
     #[error("scene file {path}: {reason}")]
     SceneFile {

@@ -7,16 +7,25 @@
 //!   "objects": [
 //!     {"builtin": "plane"},
 //!     {"obj": "models/teapot.obj", "transform": {"translate": [0, 0, -2], "rotate_y_deg": 30, "scale": 0.5},
-//!      "color": [0.8, 0.2, 0.2]}
+//!      "color": [0.8, 0.2, 0.2]},
+//!     {"gltf": "models/lamp.glb", "transform": {"translate": [2, 0, 0]}}
 //!   ],
 //!   "lights": [
-//!     {"kind": "point", "position": [0, 1, 1], "radius": 4, "color": [1, 0.9, 0.8], "intensity": 2},
+//!     {"kind": "point", "position": [0, 1, 1], "radius": 4, "color": [1, 0.9, 0.8], "intensity": 2,
+//!      "motion": {"orbit": {"center": [0, 1, 0], "period_s": 6},
+//!                 "flicker": {"amount": 0.3, "rate_hz": 3}}},
 //!     {"kind": "spot", "position": [2, 3, 0], "radius": 6, "color": [1, 1, 1], "intensity": 3,
-//!      "direction": [0, -1, 0], "inner_deg": 15, "outer_deg": 30}
+//!      "direction": [0, -1, 0], "inner_deg": 15, "outer_deg": 30,
+//!      "motion": {"sweep": {"axis": [1, 0, 0], "angle_deg": 25, "period_s": 4}}}
 //!   ],
-//!   "random_lights": {"count": 256, "seed": 7}
+//!   "random_lights": {"count": 256, "seed": 7,
+//!                     "motion": {"wander": {"radius": 1.5, "period_s": 6}}}
 //! }
 //! ```
+//!
+//! Motions (`orbit` round a `center` or on a circle of `radius` through the light, `bob`,
+//! `wander`, `flicker`, `sweep`; see [`super::motion`]) are functions of time that start at
+//! the light as written; a random set gives each light its own variation.
 //!
 //! Paths are relative to the scene file. Unknown fields are errors; so are invalid values,
 //! which are reported with the path of the field (`lights[1].outer_deg`).
@@ -27,6 +36,7 @@ use glam::{DMat4, DVec3, Vec3};
 use serde::Deserialize;
 
 use super::camera::Projection;
+use super::motion::{Bob, Flicker, Motion, Orbit, OrbitAbout, Sweep, Wander};
 use super::obj::{self, LoadReport};
 use super::random::{self, LightSetStyle};
 use super::{builtin, Camera, Light, LightKind, Scene, SceneError};
@@ -70,6 +80,9 @@ enum ProjectionKind {
 struct ObjectSpec {
     builtin: Option<String>,
     obj: Option<PathBuf>,
+    /// A `.gltf` or `.glb` file: its meshes, materials and lights (placed by `transform`),
+    /// and its camera when it is the file's only object and the file names no camera.
+    gltf: Option<PathBuf>,
     texture: Option<PathBuf>,
     transform: Option<TransformSpec>,
     color: Option<[f32; 3]>,
@@ -104,10 +117,75 @@ struct LightSpec {
     direction: Option<[f64; 3]>,
     inner_deg: Option<f64>,
     outer_deg: Option<f64>,
+    motion: Option<MotionSpec>,
 }
 
 fn one() -> f32 {
     1.0
+}
+
+fn up() -> [f64; 3] {
+    [0.0, 1.0, 0.0]
+}
+
+/// `"motion"` of a light or a random set (see [`super::motion`]).
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct MotionSpec {
+    orbit: Option<OrbitSpec>,
+    bob: Option<BobSpec>,
+    wander: Option<WanderSpec>,
+    flicker: Option<FlickerSpec>,
+    sweep: Option<SweepSpec>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct OrbitSpec {
+    center: Option<[f64; 3]>,
+    radius: Option<f64>,
+    #[serde(default = "up")]
+    axis: [f64; 3],
+    period_s: f64,
+    #[serde(default)]
+    phase_deg: f64,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct BobSpec {
+    amplitude: [f64; 3],
+    period_s: f64,
+    #[serde(default)]
+    phase_deg: f64,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct WanderSpec {
+    radius: f64,
+    period_s: f64,
+    #[serde(default)]
+    seed: u64,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct FlickerSpec {
+    amount: f32,
+    rate_hz: f64,
+    #[serde(default)]
+    seed: u64,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SweepSpec {
+    axis: [f64; 3],
+    angle_deg: f64,
+    period_s: f64,
+    #[serde(default)]
+    phase_deg: f64,
 }
 
 #[derive(Deserialize)]
@@ -123,6 +201,7 @@ struct RandomLightsSpec {
     count: usize,
     #[serde(default)]
     seed: u64,
+    motion: Option<MotionSpec>,
 }
 
 /// Parses the JSON, naming the field at fault: serde's own messages lack the path, and for an
@@ -185,8 +264,8 @@ pub fn parse(
             .as_ref()
             .map_or(Ok(DMat4::IDENTITY), |t| t.matrix(&field))?;
         let first_material = scene.materials.len();
-        match (&spec.builtin, &spec.obj) {
-            (Some(name), None) => {
+        match (&spec.builtin, &spec.obj, &spec.gltf) {
+            (Some(name), None, None) => {
                 let built = builtin::geometry(name)
                     .ok_or_else(|| SceneError::UnknownBuiltin(name.clone()))?;
                 if spec.texture.is_some() {
@@ -203,7 +282,7 @@ pub fn parse(
                 }
                 scene.materials.extend(built.materials);
             }
-            (None, Some(obj_path)) => {
+            (None, Some(obj_path), None) => {
                 let tex = spec.texture.as_ref().map(|t| base_dir.join(t));
                 let r = obj::load_into(
                     &mut scene,
@@ -213,10 +292,24 @@ pub fn parse(
                 )?;
                 report.warnings.extend(r.warnings);
             }
+            (None, None, Some(gltf_path)) => {
+                if spec.texture.is_some() {
+                    return Err(SceneError::invalid(
+                        format!("{field}.texture"),
+                        "only OBJ objects take a texture",
+                    ));
+                }
+                let loaded =
+                    super::gltf::load_into(&mut scene, &base_dir.join(gltf_path), transform)?;
+                if let Some(camera) = loaded.camera {
+                    builtin_camera.get_or_insert(camera);
+                }
+                report.warnings.extend(loaded.report.warnings);
+            }
             _ => {
                 return Err(SceneError::invalid(
                     field,
-                    "needs exactly one of `builtin` or `obj`",
+                    "needs exactly one of `builtin`, `obj` or `gltf`",
                 ))
             }
         }
@@ -231,7 +324,13 @@ pub fn parse(
         scene.ambient = Vec3::from(a);
     }
     for (i, l) in file.lights.iter().enumerate() {
-        scene.lights.push(l.to_light(&format!("lights[{i}]"))?);
+        let field = format!("lights[{i}]");
+        scene.lights.push(l.to_light(&field)?);
+        if let Some(m) = &l.motion {
+            let is_spot = matches!(l.kind, LightKindSpec::Spot);
+            let motion = m.to_motion(&format!("{field}.motion"), is_spot)?;
+            scene.animate_light(scene.lights.len() - 1, motion);
+        }
     }
     match (&file.camera, builtin_camera) {
         (Some(c), _) => scene.camera = c.to_camera(),
@@ -249,9 +348,15 @@ pub fn parse(
         let volume = scene.bounds().ok_or_else(|| {
             SceneError::invalid("random_lights", "needs geometry to place lights in")
         })?;
+        let first = scene.lights.len();
         scene
             .lights
             .extend(random::lights(&volume, count, seed, LightSetStyle::Mixed));
+        if let Some(m) = file.random_lights.as_ref().and_then(|r| r.motion.as_ref()) {
+            // A set's sweep moves its spots only.
+            let motion = m.to_motion("random_lights.motion", true)?;
+            scene.animate_set(first, motion, seed);
+        }
     }
     scene.validate()?;
     Ok((scene, report))
@@ -273,6 +378,56 @@ impl TransformSpec {
         Ok(DMat4::from_translation(DVec3::from(self.translate))
             * DMat4::from_rotation_y(self.rotate_y_deg.to_radians())
             * DMat4::from_scale(scale))
+    }
+}
+
+impl MotionSpec {
+    fn to_motion(&self, field: &str, is_spot: bool) -> Result<Motion, SceneError> {
+        let orbit = match &self.orbit {
+            None => None,
+            Some(o) => Some(Orbit {
+                about: match (o.center, o.radius) {
+                    (Some(c), None) => OrbitAbout::Point(DVec3::from(c)),
+                    (None, Some(r)) => OrbitAbout::Radius(r),
+                    _ => {
+                        return Err(SceneError::invalid(
+                            format!("{field}.orbit"),
+                            "needs exactly one of `center` (go round a point) or `radius` \
+                             (a circle through the light)",
+                        ))
+                    }
+                },
+                axis: DVec3::from(o.axis),
+                period_s: o.period_s,
+                phase_deg: o.phase_deg,
+            }),
+        };
+        let motion = Motion {
+            orbit,
+            bob: self.bob.as_ref().map(|b| Bob {
+                amplitude: DVec3::from(b.amplitude),
+                period_s: b.period_s,
+                phase_deg: b.phase_deg,
+            }),
+            wander: self.wander.as_ref().map(|w| Wander {
+                radius: w.radius,
+                period_s: w.period_s,
+                seed: w.seed,
+            }),
+            flicker: self.flicker.as_ref().map(|f| Flicker {
+                amount: f.amount,
+                rate_hz: f.rate_hz,
+                seed: f.seed,
+            }),
+            sweep: self.sweep.as_ref().map(|s| Sweep {
+                axis: DVec3::from(s.axis),
+                angle_deg: s.angle_deg,
+                period_s: s.period_s,
+                phase_deg: s.phase_deg,
+            }),
+        };
+        motion.validate(field, is_spot)?;
+        Ok(motion)
     }
 }
 
@@ -390,6 +545,90 @@ mod tests {
         assert_eq!(s.lights.len(), 7);
         assert_eq!(s.materials[0].diffuse, Vec3::new(1.0, 0.0, 0.0));
         assert_eq!(s.ambient, Vec3::splat(0.1));
+    }
+
+    #[test]
+    fn motions_parse_animate_and_start_at_the_written_state() {
+        let mut s = parse_str(
+            r#"{"objects": [{"builtin": "plane"}],
+                "lights": [{"kind":"point","position":[0,0,1],"radius":3,"color":[1,1,1],
+                            "motion": {"orbit": {"center": [0,0,0], "period_s": 4},
+                                       "flicker": {"amount": 0.5, "rate_hz": 2}}},
+                           {"kind":"spot","position":[0,0,2],"radius":3,"color":[1,1,1],
+                            "direction":[0,0,-1],"inner_deg":10,"outer_deg":20,
+                            "motion": {"sweep": {"axis": [1,0,0], "angle_deg": 30, "period_s": 2}}},
+                           {"kind":"point","position":[1,1,1],"radius":3,"color":[1,1,1]}],
+                "random_lights": {"count": 8, "seed": 3,
+                                  "motion": {"wander": {"radius": 0.5, "period_s": 3},
+                                             "sweep": {"axis": [1,0,0], "angle_deg": 10, "period_s": 2}}}}"#,
+        )
+        .unwrap();
+        assert_eq!(s.lights.len(), 11);
+        // Two single-light tracks and one for the random set; the third light stands still.
+        assert_eq!(s.animation.len(), 2 + 1);
+        let written = s.lights.clone();
+        s.set_time(0.0);
+        for (a, b) in s.lights.iter().zip(&written) {
+            assert!((a.position - b.position).length() < 1e-12);
+        }
+        s.set_time(1.0);
+        // A quarter turn round the origin about +Y: (0, 0, 1) → (1, 0, 0).
+        assert!(
+            (s.lights[0].position - DVec3::X).length() < 1e-9,
+            "{:?}",
+            s.lights[0].position
+        );
+        assert_ne!(s.lights[1].kind, written[1].kind, "the spot swept");
+        assert_eq!(s.lights[2], written[2], "a light without motion stays");
+        assert!(s.lights[3..]
+            .iter()
+            .zip(&written[3..])
+            .all(|(a, b)| a.position != b.position));
+        s.validate().unwrap();
+    }
+
+    #[test]
+    fn motion_errors_name_the_field() {
+        let light = |motion: &str| {
+            format!(
+                r#"{{"objects": [{{"builtin": "plane"}}],
+                     "lights": [{{"kind":"point","position":[0,0,1],"radius":3,"color":[1,1,1],
+                                  "motion": {motion}}}]}}"#
+            )
+        };
+        let cases = [
+            (
+                light(r#"{"orbit": {"period_s": 2}}"#),
+                "lights[0].motion.orbit",
+            ),
+            (
+                light(r#"{"orbit": {"center": [0,0,0], "radius": 1, "period_s": 2}}"#),
+                "lights[0].motion.orbit",
+            ),
+            (
+                light(r#"{"bob": {"amplitude": [0,1,0], "period_s": -1}}"#),
+                "lights[0].motion.bob.period_s",
+            ),
+            (
+                light(r#"{"sweep": {"axis": [1,0,0], "angle_deg": 5, "period_s": 1}}"#),
+                "lights[0].motion.sweep",
+            ),
+            (
+                light(r#"{"flicker": {"amount": 2, "rate_hz": 1}}"#),
+                "lights[0].motion.flicker.amount",
+            ),
+            (light(r#"{"spin": {}}"#), "lights[0].motion"),
+            (
+                r#"{"objects": [{"builtin": "plane"}], "random_lights": {"count": 2,
+                    "motion": {"wander": {"radius": 1e300, "period_s": 1}}}}"#
+                    .to_string(),
+                "random_lights.motion.wander.radius",
+            ),
+        ];
+        for (text, needle) in cases {
+            let err = parse_str(&text).unwrap_err().to_string();
+            assert!(err.contains(needle), "expected `{needle}` in: {err}");
+        }
     }
 
     #[test]

@@ -10,11 +10,13 @@ pub mod camera;
 pub mod error;
 pub mod features;
 pub mod file;
+pub mod gltf;
 pub mod input;
 pub mod light;
 pub mod material;
 pub mod mesh;
 pub mod meshbuild;
+pub mod motion;
 pub mod obj;
 pub mod random;
 pub mod shading;
@@ -28,6 +30,7 @@ pub use error::SceneError;
 pub use light::{Light, LightKind};
 pub use material::{Material, Texture};
 pub use mesh::{Aabb, Mesh};
+pub use motion::Motion;
 
 /// One placed mesh: shared geometry, its material and a model transform (`f64`, so objects
 /// can be placed far from the origin).
@@ -54,6 +57,9 @@ pub struct Scene {
     pub ambient: Vec3,
     /// The viewpoint.
     pub camera: Camera,
+    /// Lights that move: [`Scene::set_time`] poses them (empty: a still scene). A track names
+    /// its light by index, so replacing `lights` calls for clearing (or rebuilding) this.
+    pub animation: Vec<motion::LightTrack>,
 }
 
 impl Scene {
@@ -65,6 +71,7 @@ impl Scene {
             lights: Vec::new(),
             ambient: Vec3::splat(0.02),
             camera: Camera::default(),
+            animation: Vec::new(),
         }
     }
 
@@ -82,6 +89,68 @@ impl Scene {
         self.materials.len() - 1
     }
 
+    /// True when some light moves.
+    pub fn is_animated(&self) -> bool {
+        !self.animation.is_empty()
+    }
+
+    /// Gives light `index` a motion starting from its current state (a later track wins over
+    /// an earlier one for the same light). Does nothing for a still motion or a missing light.
+    pub fn animate_light(&mut self, index: usize, motion: motion::Motion) {
+        if let (false, Some(rest)) = (motion.is_still(), self.lights.get(index)) {
+            self.animation.push(motion::LightTrack {
+                first: index,
+                rest: vec![*rest],
+                motion,
+                vary: None,
+            });
+        }
+    }
+
+    /// Gives the lights from `first` on (to the end) each its own variation of `motion`
+    /// (seeded: phases, periods within ±25 %, wander and flicker seeds; see
+    /// [`motion::Motion::varied`]), starting from their current state.
+    pub fn animate_set(&mut self, first: usize, motion: motion::Motion, seed: u64) {
+        if let (false, Some(rest)) = (motion.is_still(), self.lights.get(first..)) {
+            self.animation.push(motion::LightTrack {
+                first,
+                rest: rest.to_vec(),
+                motion,
+                vary: Some(seed),
+            });
+        }
+    }
+
+    /// Poses every animated light at time `t` (seconds; 0 is the scene as built). A pure
+    /// function of `t`: frames can be rendered in any order. Allocates nothing; the part of a
+    /// track past the end of `lights` is skipped. Large sets are posed in parallel.
+    pub fn set_time(&mut self, t: f64) {
+        /// Below this many lights a thread hand-off costs more than it saves.
+        const PARALLEL_FROM: usize = 4096;
+        for track in &self.animation {
+            let Some(lights) = self.lights.get_mut(track.first..) else {
+                continue;
+            };
+            let n = track.rest.len().min(lights.len());
+            let lights = &mut lights[..n];
+            if lights.len() < PARALLEL_FROM {
+                track.pose(lights, t);
+            } else {
+                use rayon::prelude::*;
+                const CHUNK: usize = 1024;
+                lights
+                    .par_chunks_mut(CHUNK)
+                    .enumerate()
+                    .for_each(|(c, chunk)| {
+                        for (j, light) in chunk.iter_mut().enumerate() {
+                            let k = c * CHUNK + j;
+                            *light = track.motion_of(k).apply(&track.rest[k], t);
+                        }
+                    });
+            }
+        }
+    }
+
     /// Checks every value the GPU will see: lights (finite, non-negative radius, valid cones),
     /// ambient colour, camera, material indices and material values. Errors name the field.
     pub fn validate(&self) -> Result<(), SceneError> {
@@ -94,6 +163,27 @@ impl Scene {
         }
         for (i, light) in self.lights.iter().enumerate() {
             light.validate(&format!("lights[{i}]"))?;
+        }
+        for track in &self.animation {
+            let field = format!("lights[{}].motion", track.first);
+            if track.first.saturating_add(track.rest.len()) > self.lights.len() {
+                return Err(SceneError::invalid(
+                    field,
+                    format!(
+                        "moves lights {}..{} but the scene has {}",
+                        track.first,
+                        track.first.saturating_add(track.rest.len()),
+                        self.lights.len()
+                    ),
+                ));
+            }
+            // A set's sweep applies to its spots only; a single light's must have a cone.
+            let is_spot = track.vary.is_some()
+                || track
+                    .rest
+                    .iter()
+                    .all(|l| matches!(l.kind, LightKind::Spot { .. }));
+            track.motion.validate(&field, is_spot)?;
         }
         for (i, m) in self.materials.iter().enumerate() {
             m.validate(&format!("materials[{i}] ({})", m.name))?;
@@ -136,8 +226,16 @@ impl Scene {
     }
 }
 
+/// True when `spec` names a file that brings its own lights (a `.json` scene file, a `.gltf`
+/// or `.glb` file): the CLI then adds random lights only when asked to.
+pub fn brings_own_lights(spec: &str) -> bool {
+    let spec = spec.to_lowercase();
+    [".json", ".gltf", ".glb"].iter().any(|e| spec.ends_with(e))
+}
+
 /// Loads what the CLI's `--scene` names: a built-in name, an `.obj` file (camera framed on its
-/// bounds) or a `.json` scene file. `lights` = `Some((count, seed))` sets seeded random lights
+/// bounds), a `.gltf` or `.glb` file (its own camera and lights; see [`gltf::load`]) or a
+/// `.json` scene file. `lights` = `Some((count, seed))` sets seeded random lights
 /// (for scene files, it replaces their `random_lights` count but keeps explicit lights).
 pub fn load(
     spec: &str,
@@ -164,6 +262,7 @@ pub fn load(
             scene.validate()?;
             Ok((scene, report))
         }
+        "gltf" | "glb" => gltf::load(path, lights),
         "json" => file::load(path, lights),
         _ => Ok((builtin::build(spec, lights)?, obj::LoadReport::default())),
     }

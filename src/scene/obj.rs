@@ -287,9 +287,19 @@ fn check_mtl(bytes: &[u8]) -> Result<(), String> {
 /// would pass [`MAX_TEXTURE_SIDE`] on a side (a small PNG can claim 100 000² pixels).
 fn decode_texture(path: &Path) -> Result<image::DynamicImage, String> {
     let bytes = read_bounded(path, FileKind::Texture).map_err(|e| e.to_string())?;
+    // The extension first: TGA has no magic bytes to guess from.
+    decode_texture_bytes(bytes, image::ImageFormat::from_path(path).ok())
+}
+
+/// Decodes an encoded texture (OBJ and glTF alike): the stated format first, the contents
+/// decide otherwise; at most [`MAX_TEXTURE_SIDE`] pixels a side and that many squared RGBA
+/// bytes, so a header claiming a giant image fails before any allocation.
+pub(crate) fn decode_texture_bytes(
+    bytes: impl AsRef<[u8]>,
+    format: Option<image::ImageFormat>,
+) -> Result<image::DynamicImage, String> {
     let mut reader = image::ImageReader::new(std::io::Cursor::new(bytes));
-    // The extension first: TGA has no magic bytes to guess from; the contents decide otherwise.
-    if let Ok(format) = image::ImageFormat::from_path(path) {
+    if let Some(format) = format {
         reader.set_format(format);
     }
     let mut reader = reader.with_guessed_format().map_err(|e| e.to_string())?;

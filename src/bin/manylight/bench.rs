@@ -15,6 +15,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use manylight::cluster::grid::{Coverage, GridConfig};
 use manylight::gl::HeadlessContext;
 use manylight::methods::{Support, METHODS};
+use manylight::metrics::animated::AnimatedRow;
 use manylight::metrics::cpu_reference::{self, Encoding, ReferenceSet};
 use manylight::metrics::raycast::SceneRaycaster;
 use manylight::metrics::report::{self, BenchRow, Pictures, Report};
@@ -62,6 +63,11 @@ pub struct BenchArgs {
     /// Seed of the random lights.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
+    /// Frames of the animated workload (lights and camera moving, at 30 fps of animation
+    /// time; the first scene at the knobs' light count; 0 leaves it out). Default 120, 20
+    /// with --quick.
+    #[arg(long)]
+    pub animated_frames: Option<u32>,
 }
 
 /// The sweep, with the `--quick` or full defaults filled in.
@@ -73,6 +79,7 @@ struct Plan {
     size: (u32, u32),
     frames: u32,
     knobs: bool,
+    animated_frames: u32,
 }
 
 impl Plan {
@@ -120,6 +127,9 @@ impl Plan {
             size: args.size.unwrap_or(default_size),
             frames: args.frames.unwrap_or(if args.quick { 1 } else { 3 }),
             knobs: !args.no_knobs,
+            animated_frames: args
+                .animated_frames
+                .unwrap_or(if args.quick { 20 } else { 120 }),
         }
     }
 }
@@ -260,13 +270,19 @@ pub fn run(args: &BenchArgs) -> Result<(), Box<dyn std::error::Error>> {
         .iter()
         .map(|k| if k.every_scene { plan.scenes.len() } else { 1 })
         .sum();
+    let animated_runs = if plan.animated_frames > 0 {
+        plan.methods.len()
+    } else {
+        0
+    };
     let steps = plan.es.len() * plan.scenes.len() * plan.lights.len() * plan.methods.len()
-        + plan.es.len() * knob_runs;
+        + plan.es.len() * (knob_runs + animated_runs);
     let progress = ProgressBar::new(steps as u64).with_style(
         ProgressStyle::with_template("{bar:40} {pos}/{len} {elapsed_precise} {msg}")
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
     let mut rows = Vec::new();
+    let mut animated = Vec::new();
     let mut pictures = Vec::new();
     let mut casters = std::collections::HashMap::new();
     for &es in &plan.es {
@@ -325,6 +341,21 @@ pub fn run(args: &BenchArgs) -> Result<(), Box<dyn std::error::Error>> {
                 }
             }
         }
+        if plan.animated_frames > 0 && !knob_scene.is_empty() {
+            let (scene, _) = scene::load(&knob_scene, Some((knob_lights, args.seed)))?;
+            let workload = AnimatedWorkload {
+                scene,
+                name: scene_name(&knob_scene),
+                size: plan.size,
+                frames: plan.animated_frames,
+            };
+            for method in &plan.methods {
+                let name = &workload.name;
+                progress.set_message(format!("ES {es} {name} animated: {method}"));
+                animated.extend(workload.run(&mut renderer, method, es)?);
+                progress.inc(1);
+            }
+        }
         renderer.destroy();
         drop(ctx);
     }
@@ -334,6 +365,7 @@ pub fn run(args: &BenchArgs) -> Result<(), Box<dyn std::error::Error>> {
         cpus: std::thread::available_parallelism().map_or(1, |n| n.get()),
         seconds: started.elapsed().as_secs_f64(),
         rows,
+        animated,
         pictures,
     };
     report::write(&report, &args.out)?;
@@ -458,6 +490,97 @@ impl Measure<'_> {
             lp_num_threads: stats.lp_num_threads.clone(),
         };
         Ok(Some(Measured { row, image, evals }))
+    }
+}
+
+/// Frames per second of animation time in the animated workload.
+const ANIMATED_FPS: f64 = 30.0;
+
+/// The animated workload: the scene's lights moving (the lively default where the scene has
+/// no motion of its own) and the camera panning ±8° about its target every 4 s.
+struct AnimatedWorkload {
+    scene: Scene,
+    name: String,
+    size: (u32, u32),
+    frames: u32,
+}
+
+impl AnimatedWorkload {
+    /// One method's row; `None` where it cannot run here.
+    fn run(
+        &self,
+        renderer: &mut Renderer,
+        method: &str,
+        es: EsVersion,
+    ) -> Result<Option<AnimatedRow>, Box<dyn std::error::Error>> {
+        let desc = manylight::methods::find(method)?;
+        if matches!((desc.supported)(renderer.caps()), Support::Unsupported(_)) {
+            return Ok(None);
+        }
+        let mut scene = self.scene.clone();
+        if !scene.is_animated() {
+            if let Some(bounds) = scene.bounds() {
+                let motion = scene::builtin::lively_motion(&self.name, &bounds);
+                scene.animate_set(0, motion, 1);
+            }
+        }
+        let start = scene.camera;
+        let mut pose = move |s: &mut Scene, t: f64| {
+            s.set_time(t);
+            let swing = 8f64.to_radians() * (std::f64::consts::TAU * t / 4.0).sin();
+            let turn = glam::DQuat::from_rotation_y(swing);
+            s.camera.position = start.target + turn * (start.position - start.target);
+        };
+        let timeline = crate::sequence::Timeline {
+            start_s: 0.0,
+            fps: ANIMATED_FPS,
+            frames: self.frames,
+        };
+        renderer.set_method(method)?;
+        let options = RenderOptions::default();
+        let rendered = match crate::sequence::render(
+            renderer, &mut scene, self.size, &options, &timeline, &mut pose, None,
+        ) {
+            Ok(r) => r,
+            // Past a method's limits (forward's loop bound, say): skipped, as in the sweep.
+            Err(e) if matches!(e.downcast_ref(), Some(manylight::Error::Limit(_))) => {
+                log::warn!("{} animated {method}: skipped: {e}", self.name);
+                return Ok(None);
+            }
+            Err(e) => return Err(e),
+        };
+        let stats = rendered.stats;
+        // The last frame against plain forward at the same time (scene already posed there).
+        let error = if method == "forward" {
+            None
+        } else {
+            renderer.set_method("forward")?;
+            let (w, h) = self.size;
+            let (reference, _) = renderer.render_offscreen(&scene, w, h, &options)?;
+            Some(manylight::metrics::diff(&reference, &rendered.last).max_abs)
+        };
+        let (Some(frame_ms), Some(assign_ms), Some(upload_bytes)) = (
+            stats.frame_ms_spread,
+            stats.assign_ms_spread,
+            stats.upload_bytes_spread,
+        ) else {
+            return Ok(None);
+        };
+        Ok(Some(AnimatedRow {
+            scene: self.name.clone(),
+            method: method.to_string(),
+            es: format!("{}.0", es.major()),
+            lights: scene.lights.len(),
+            width: self.size.0,
+            height: self.size.1,
+            frames: frame_ms.frames,
+            fps: ANIMATED_FPS,
+            p99_over_p50: AnimatedRow::tail_ratio(&frame_ms),
+            frame_ms,
+            assign_ms,
+            upload_bytes,
+            max_abs_err_vs_forward: error,
+        }))
     }
 }
 

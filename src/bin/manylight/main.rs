@@ -6,6 +6,7 @@ mod bench_assign;
 mod info;
 mod matrix;
 mod render;
+mod sequence;
 #[cfg(feature = "window")]
 mod view;
 

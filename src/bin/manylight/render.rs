@@ -12,7 +12,8 @@ use crate::EsArg;
 #[derive(Parser, Debug)]
 #[command(name = "render")]
 pub struct RenderArgs {
-    /// A built-in scene (courtyard, pillars, plane, bubbles), an .obj file or a .json scene file.
+    /// A built-in scene (courtyard, pillars, plane, bubbles), an .obj file, a .gltf/.glb file or a
+    /// .json scene file.
     #[arg(long, default_value = scene::builtin::DEFAULT)]
     pub scene: String,
     /// Shading method (see `manylight info` for the table). Default: clustered, or forward
@@ -23,7 +24,7 @@ pub struct RenderArgs {
     #[arg(long, value_enum, default_value = "3")]
     pub es: EsArg,
     /// Number of seeded random lights (for scene files: replaces their random_lights count).
-    /// Default: 1024 for built-ins and OBJ files, the file's own lights for scene files.
+    /// Default: 1024 for built-ins and OBJ files; a scene file or glTF file keeps its own lights.
     #[arg(long)]
     pub lights: Option<usize>,
     /// Seed of the random lights.
@@ -43,9 +44,21 @@ pub struct RenderArgs {
     #[arg(long)]
     pub linear: bool,
     /// Frames timed after a warm-up frame: the median is reported, and from 10 frames also
-    /// p95, p99 and the slowest (`--stats` has them from 1).
+    /// p95, p99 and the slowest (`--stats` has them from 1). In a scene whose lights move
+    /// (the built-ins' do), frame k shows time `--time` + k / `--fps`.
     #[arg(long, default_value_t = 2)]
     pub frames: u32,
+    /// Animation time of the picture written to `--out` and of the first timed frame, in
+    /// seconds (0: the scene as built).
+    #[arg(long, default_value_t = 0.0, value_parser = parse_time)]
+    pub time: f64,
+    /// Frames per second of animation time between timed frames.
+    #[arg(long, default_value_t = 30.0, value_parser = parse_fps)]
+    pub fps: f64,
+    /// Write every timed frame: into a directory as `frame_00000.png` …, or, for a path
+    /// ending in `.gif`, as one animated GIF.
+    #[arg(long)]
+    pub record: Option<PathBuf>,
     /// Play a device whose fragment stage has no highp (Mali-400 class; needs `--es 2`):
     /// every fragment float runs at mediump, fp16 on llvmpipe. Methods that need highp are
     /// unsupported there.
@@ -114,6 +127,22 @@ pub fn parse_grid(s: &str) -> Result<GridArg, String> {
     }
 }
 
+/// Parses `--time`: finite seconds.
+pub fn parse_time(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(t) if t.is_finite() && t.abs() <= 1e9 => Ok(t),
+        _ => Err(format!("`{s}` is not a time in seconds within ±1e9")),
+    }
+}
+
+/// Parses `--fps`: a positive, finite rate.
+pub fn parse_fps(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(f) if f.is_finite() && (1e-3..=1e4).contains(&f) => Ok(f),
+        _ => Err(format!("`{s}` is not a frame rate from 0.001 to 10000")),
+    }
+}
+
 /// Random lights for built-ins and OBJ files when `--lights` is not given.
 const DEFAULT_LIGHTS: usize = 1024;
 
@@ -131,14 +160,14 @@ pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
 
 /// Runs the command.
 pub fn run(args: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
-    let is_file_scene = args.scene.to_lowercase().ends_with(".json");
+    let is_file_scene = scene::brings_own_lights(&args.scene);
     let lights = match (args.lights, is_file_scene) {
         (Some(n), _) => Some((n, args.seed)),
         (None, true) => None,
         (None, false) => Some((DEFAULT_LIGHTS, args.seed)),
     };
     // The loader logs each warning (at `warn`, shown by default): not printed again here.
-    let (scene, _logged_warnings) = scene::load(&args.scene, lights)?;
+    let (mut scene, _logged_warnings) = scene::load(&args.scene, lights)?;
     let es = args.es.into();
     let ctx = HeadlessContext::new(es)?;
     let restrictions = manylight::gl::Restrictions {
@@ -162,7 +191,30 @@ pub fn run(args: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
         ..RenderOptions::default()
     };
     let (width, height) = args.size;
-    let result = renderer.render_offscreen(&scene, width, height, &options);
+    let result = if scene.is_animated() || args.record.is_some() || args.time != 0.0 {
+        let timeline = crate::sequence::Timeline {
+            start_s: args.time,
+            fps: args.fps,
+            frames: args.frames,
+        };
+        let size = (width, height);
+        let record = args.record.as_deref();
+        let mut pose = |s: &mut scene::Scene, t| s.set_time(t);
+        crate::sequence::render(
+            &mut renderer,
+            &mut scene,
+            size,
+            &options,
+            &timeline,
+            &mut pose,
+            record,
+        )
+        .map(|r| (r.first, r.stats))
+    } else {
+        renderer
+            .render_offscreen(&scene, width, height, &options)
+            .map_err(Into::into)
+    };
     renderer.destroy();
     let (image, stats) = result?;
     image
@@ -173,12 +225,22 @@ pub fn run(args: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
             .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
     }
     // The slow frames too, where enough frames were timed for them to mean something.
-    let tail = match stats.frame_ms_spread {
+    let mut tail = match stats.frame_ms_spread {
         Some(s) if s.frames >= 10 => {
             format!(" (p95 {:.1}, p99 {:.1}, max {:.1})", s.p95, s.p99, s.max)
         }
         _ => String::new(),
     };
+    if scene.is_animated() {
+        tail += &format!(
+            " · moving lights, t = {:.3} to {:.3} s",
+            args.time,
+            args.time + f64::from(args.frames.saturating_sub(1)) / args.fps
+        );
+    }
+    if let Some(path) = &args.record {
+        tail += &format!(" · {} frames → {}", args.frames, path.display());
+    }
     println!(
         "{} {}x{} · {} · {} lights · {} on {} · {:.1} ms/frame{tail} → {}",
         args.scene,

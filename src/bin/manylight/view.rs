@@ -9,8 +9,9 @@
 //! Controls: WASD move, Q/E down/up, Shift faster, left-drag looks around, 1–9 pick a method
 //! from [`manylight::methods::METHODS`], +/- double/halve the random lights, H toggles the
 //! light-evaluation heatmap (lights each pixel evaluates, viridis from 0 to 64), M toggles 4×
-//! MSAA (resolved into the window), T cycles the tone map (none, Reinhard, ACES, Neutral), Esc
-//! quits.
+//! MSAA (resolved into the window), T cycles the tone map (none, Reinhard, ACES, Neutral),
+//! Space pauses and resumes the lights' motion (built-in scenes' lights move; scene files
+//! say how theirs do), Esc quits.
 //! A change that the renderer rejects (say, plain forward over more lights than it can loop
 //! over) is reported on stderr and undone. `--frames N` quits after N frames and
 //! `--screenshot FILE` saves the last one, read back from the window's framebuffer.
@@ -43,7 +44,7 @@ use crate::EsArg;
 #[derive(Parser, Debug)]
 #[command(name = "view")]
 pub struct ViewArgs {
-    /// A built-in scene (an unknown name lists them), an .obj file or a .json scene file.
+    /// A built-in scene (an unknown name lists them), an .obj, .gltf/.glb or .json scene file.
     #[arg(long, default_value = scene::builtin::DEFAULT)]
     pub scene: String,
     /// Shading method to start with (keys 1–9 switch).
@@ -52,7 +53,7 @@ pub struct ViewArgs {
     /// OpenGL ES version. Default: 3, or 2 where the driver has no ES 3.0.
     #[arg(long, value_enum)]
     pub es: Option<EsArg>,
-    /// Number of seeded random lights (default: 1024; a scene file's own lights).
+    /// Number of seeded random lights (default: 1024; a scene or glTF file's own lights).
     #[arg(long)]
     pub lights: Option<usize>,
     /// Seed of the random lights.
@@ -70,6 +71,13 @@ pub struct ViewArgs {
     /// Start with the light-evaluation heatmap on (H toggles it).
     #[arg(long)]
     pub heatmap: bool,
+    /// Animation time to start at, in seconds (0: the scene as built).
+    #[arg(long, default_value_t = 0.0, value_parser = crate::render::parse_time)]
+    pub time: f64,
+    /// Start with the lights' motion paused (Space resumes it); with `--frames` and
+    /// `--screenshot`, the picture is then the frame at `--time`, as `render --time` draws it.
+    #[arg(long)]
+    pub paused: bool,
     /// Samples per pixel to start with (M toggles between 1 and 4): ES 3.0, not deferred.
     #[arg(long, default_value_t = 1)]
     pub msaa: u32,
@@ -95,21 +103,23 @@ const TITLE_EVERY_S: f64 = 0.25;
 
 /// Runs the viewer until the window closes, Esc, or `--frames`.
 pub fn run(args: &ViewArgs) -> Result<(), Box<dyn std::error::Error>> {
-    let is_file_scene = args.scene.to_lowercase().ends_with(".json");
+    let is_file_scene = scene::brings_own_lights(&args.scene);
     let lights = match (args.lights, is_file_scene) {
         (Some(n), _) => Some(n),
         (None, true) => None,
         (None, false) => Some(DEFAULT_LIGHTS),
     };
     // The loader logs each warning (at `warn`, shown by default): not printed again here.
-    let (scene, _logged_warnings) = scene::load(&args.scene, lights.map(|n| (n, args.seed)))?;
+    let (mut scene, _logged_warnings) =
+        scene::load(&args.scene, lights.map(|n| (n, args.seed)))?;
+    scene.set_time(args.time);
     // Validate the method name before opening a window.
     manylight::methods::find(&args.method)?;
     let extent = scene.bounds().map_or(10.0, |b| b.size().length());
     let event_loop = EventLoop::new().map_err(|e| format!("cannot open a window: {e}"))?;
     event_loop.set_control_flow(ControlFlow::Poll);
     println!(
-        "controls: WASD move, Q/E down/up, Shift faster, drag to look, 1-{} method, +/- lights, H heatmap, M MSAA, T tone map, Esc quit",
+        "controls: WASD move, Q/E down/up, Shift faster, drag to look, 1-{} method, +/- lights, H heatmap, M MSAA, T tone map, Space pause, Esc quit",
         METHODS.len()
     );
     let mut app = App {
@@ -119,6 +129,8 @@ pub fn run(args: &ViewArgs) -> Result<(), Box<dyn std::error::Error>> {
         heatmap: args.heatmap,
         tone_map: manylight::ToneMap::None,
         samples: args.msaa.max(1),
+        time_s: args.time,
+        paused: args.paused,
         scene,
         fly: FlyCamera::new(FlyCamera::speed_for_extent(extent)),
         gfx: None,
@@ -156,6 +168,10 @@ struct App<'a> {
     tone_map: manylight::ToneMap,
     /// Samples per pixel (M toggles MSAA).
     samples: u32,
+    /// Animation time in seconds: the lights' pose ([`Scene::set_time`]).
+    time_s: f64,
+    /// Space stops the animation clock.
+    paused: bool,
     fly: FlyCamera,
     gfx: Option<Gfx>,
     frames: u64,
@@ -305,6 +321,16 @@ impl App<'_> {
         } else if code == KeyCode::KeyM {
             self.samples = if self.samples > 1 { 1 } else { 4 };
             eprintln!("MSAA: {} samples", self.samples);
+        } else if code == KeyCode::Space {
+            self.paused = !self.paused;
+            eprintln!(
+                "motion: {}",
+                match (self.paused, self.scene.is_animated()) {
+                    (_, false) => "none (the scene's lights stand still)",
+                    (true, true) => "paused",
+                    (false, true) => "playing",
+                }
+            );
         } else if code == KeyCode::KeyT {
             self.tone_map = next_tone_map(self.tone_map);
             eprintln!("tone map: {:?}", self.tone_map);
@@ -335,6 +361,8 @@ impl App<'_> {
             // Keep geometry (already uploaded) and camera; only the lights change.
             Ok((new, _)) => {
                 self.scene.lights = new.lights;
+                self.scene.animation = new.animation;
+                self.scene.set_time(self.time_s);
                 self.light_count = count;
                 eprintln!("lights: {}", self.scene.lights.len());
             }
@@ -355,6 +383,10 @@ impl App<'_> {
         let dt = now.duration_since(self.last_frame).as_secs_f64();
         self.last_frame = now;
         self.fly.update(dt, &mut self.scene.camera);
+        if !self.paused && self.scene.is_animated() {
+            self.time_s += dt;
+            self.scene.set_time(self.time_s);
+        }
         let options = RenderOptions {
             wait_for_gpu: false,
             count: if self.heatmap {

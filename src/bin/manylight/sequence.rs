@@ -1,0 +1,163 @@
+//! `render`'s animated path: frames of a moving scene at a fixed frame rate, timed one by one
+//! (p50/p95/p99/max of frame time, assignment time and upload bytes) and optionally recorded
+//! as a numbered PNG sequence or an animated GIF.
+
+use std::fs::File;
+use std::io::BufWriter;
+use std::path::{Path, PathBuf};
+
+use image::codecs::gif::{GifEncoder, Repeat};
+use image::{Delay, Frame, RgbaImage};
+use manylight::metrics::spread::Spread;
+use manylight::renderer::FrameStats;
+use manylight::scene::Scene;
+use manylight::{RenderOptions, Renderer};
+
+/// When and how many frames.
+pub struct Timeline {
+    /// Time of the first frame, seconds.
+    pub start_s: f64,
+    /// Frames per second of animation time.
+    pub fps: f64,
+    /// Frames after the warm-up.
+    pub frames: u32,
+}
+
+impl Timeline {
+    /// Animation time of frame `k`.
+    pub fn time_of(&self, k: u32) -> f64 {
+        self.start_s + f64::from(k) / self.fps
+    }
+}
+
+/// Where recorded frames go.
+enum Recorder {
+    /// `DIR/frame_00000.png` …
+    Pngs { dir: PathBuf, digits: usize },
+    /// One animated GIF.
+    Gif(Box<GifEncoder<BufWriter<File>>>, PathBuf),
+}
+
+impl Recorder {
+    /// A `.gif` path records an animated GIF, anything else is a directory for PNGs.
+    fn open(path: &Path, timeline: &Timeline) -> Result<Recorder, String> {
+        let is_gif = path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("gif"));
+        if is_gif {
+            let file = File::create(path)
+                .map_err(|e| format!("--record: cannot create {}: {e}", path.display()))?;
+            let mut encoder = GifEncoder::new_with_speed(BufWriter::new(file), 10);
+            encoder
+                .set_repeat(Repeat::Infinite)
+                .map_err(|e| format!("--record {}: {e}", path.display()))?;
+            return Ok(Recorder::Gif(Box::new(encoder), path.to_path_buf()));
+        }
+        std::fs::create_dir_all(path)
+            .map_err(|e| format!("--record: cannot create {}: {e}", path.display()))?;
+        let last = timeline.frames.saturating_sub(1);
+        Ok(Recorder::Pngs {
+            dir: path.to_path_buf(),
+            digits: last.to_string().len().max(5),
+        })
+    }
+
+    fn add(&mut self, k: u32, image: RgbaImage, fps: f64) -> Result<(), String> {
+        match self {
+            Recorder::Pngs { dir, digits } => {
+                let path = dir.join(format!("frame_{k:0width$}.png", width = *digits));
+                image
+                    .save(&path)
+                    .map_err(|e| format!("cannot write {}: {e}", path.display()))
+            }
+            Recorder::Gif(encoder, path) => {
+                // GIF delays are in hundredths of a second: the nearest to 1/fps.
+                let centis = (100.0 / fps).round().clamp(1.0, 65_535.0) as u32;
+                let frame =
+                    Frame::from_parts(image, 0, 0, Delay::from_numer_denom_ms(centis * 10, 1));
+                encoder
+                    .encode_frame(frame)
+                    .map_err(|e| format!("cannot write {}: {e}", path.display()))
+            }
+        }
+    }
+}
+
+/// What a sequence produced.
+pub struct Rendered {
+    /// The warm-up frame, at `start_s`.
+    pub first: RgbaImage,
+    /// The last timed frame (the first one when none was timed).
+    pub last: RgbaImage,
+    /// The last frame's stats, frame and assignment time replaced by the medians and the
+    /// spreads (frame, assignment, upload bytes) filled in.
+    pub stats: FrameStats,
+}
+
+/// Renders the warm-up frame at `start_s` and then `timeline.frames` timed frames, each after
+/// `pose(scene, t)` (for instance [`Scene::set_time`]), recording them into `record` when
+/// given.
+pub fn render(
+    renderer: &mut Renderer,
+    scene: &mut Scene,
+    (width, height): (u32, u32),
+    options: &RenderOptions,
+    timeline: &Timeline,
+    pose: &mut dyn FnMut(&mut Scene, f64),
+    record: Option<&Path>,
+) -> Result<Rendered, Box<dyn std::error::Error>> {
+    let one_frame = RenderOptions {
+        timed_frames: 0,
+        ..options.clone()
+    };
+    let mut recorder = record.map(|p| Recorder::open(p, timeline)).transpose()?;
+    pose(scene, timeline.start_s);
+    // The warm-up frame compiles shaders and uploads meshes: its picture, not its time.
+    let (first, mut stats) = renderer.render_offscreen(scene, width, height, &one_frame)?;
+    let mut last = None;
+    let capacity = timeline.frames.min(1 << 20) as usize;
+    let (mut frame_ms, mut assign_ms, mut upload) = (
+        Vec::with_capacity(capacity),
+        Vec::with_capacity(capacity),
+        Vec::with_capacity(capacity),
+    );
+    let mut gpu_ms = Vec::with_capacity(capacity);
+    for k in 0..timeline.frames {
+        pose(scene, timeline.time_of(k));
+        let (image, s) = renderer.render_offscreen(scene, width, height, &one_frame)?;
+        if k + 1 == timeline.frames {
+            if let Some(r) = &mut recorder {
+                r.add(k, image.clone(), timeline.fps)?;
+            }
+            last = Some(image);
+        } else if let Some(r) = &mut recorder {
+            r.add(k, image, timeline.fps)?;
+        }
+        frame_ms.push(s.frame_ms);
+        assign_ms.push(s.assign_ms);
+        upload.push(s.upload_bytes as f64);
+        gpu_ms.push(s.gpu_ms);
+        stats = s;
+    }
+    if let Some(Recorder::Gif(encoder, _)) = recorder {
+        // Dropping the encoder writes the trailer; flush errors surface here.
+        drop(encoder);
+    }
+    let frame_spread = Spread::of(frame_ms);
+    let assign_spread = Spread::of(assign_ms);
+    stats.frame_ms = frame_spread.map_or(stats.frame_ms, |s| s.p50);
+    stats.assign_ms = assign_spread.map_or(stats.assign_ms, |s| s.p50);
+    stats.gpu_ms = gpu_ms
+        .into_iter()
+        .collect::<Option<Vec<f64>>>()
+        .and_then(Spread::of)
+        .map(|s| s.p50);
+    stats.frame_ms_spread = frame_spread;
+    stats.assign_ms_spread = assign_spread;
+    stats.upload_bytes_spread = Spread::of(upload);
+    Ok(Rendered {
+        last: last.unwrap_or_else(|| first.clone()),
+        first,
+        stats,
+    })
+}

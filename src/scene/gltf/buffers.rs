@@ -1,0 +1,128 @@
+//! The bytes of a glTF file's buffers: the GLB's BIN chunk, `data:` URIs and files next to the
+//! `.gltf`, each read once, when first used, within the model size limit.
+//!
+//! Files are read through [`read_bounded`] (regular files only, [`FileKind::Model`]'s limit),
+//! and all buffers together may hold at most that same limit: a file cannot name the same
+//! 1 GiB file a thousand times.
+
+use std::borrow::Cow;
+use std::path::Path;
+
+use super::uri::{self, Uri};
+use crate::scene::input::{read_bounded, FileKind};
+
+/// Lazily loaded buffer contents of one glTF document.
+pub(super) struct Buffers<'a> {
+    document: &'a gltf::Document,
+    bin: Option<&'a [u8]>,
+    base_dir: &'a Path,
+    loaded: Vec<Option<Cow<'a, [u8]>>>,
+    /// Bytes still allowed to be read or decoded into buffers.
+    budget: u64,
+}
+
+impl<'a> Buffers<'a> {
+    /// Buffers of `document`; `bin` is the GLB's BIN chunk, `base_dir` the folder relative
+    /// file URIs start from.
+    pub fn new(document: &'a gltf::Document, bin: Option<&'a [u8]>, base_dir: &'a Path) -> Self {
+        Buffers {
+            document,
+            bin,
+            base_dir,
+            loaded: vec![None; document.buffers().len()],
+            budget: FileKind::Model.limit(),
+        }
+    }
+
+    /// The document the buffers belong to.
+    pub fn document(&self) -> &'a gltf::Document {
+        self.document
+    }
+
+    /// The whole of buffer `index` (exactly its `byteLength` bytes).
+    pub fn buffer(&mut self, index: usize) -> Result<&[u8], String> {
+        if self.loaded.get(index).is_none() {
+            return Err(format!("buffers[{index}] does not exist"));
+        }
+        if self.loaded[index].is_none() {
+            let data = self.load(index)?;
+            self.loaded[index] = Some(data);
+        }
+        Ok(self.loaded[index].as_deref().unwrap_or_default())
+    }
+
+    /// The bytes of a buffer view, checked to lie within its buffer.
+    pub fn view(&mut self, view: &gltf::buffer::View) -> Result<&[u8], String> {
+        let (offset, length) = (view.offset(), view.length());
+        let buffer = view.buffer().index();
+        let data = self.buffer(buffer)?;
+        let end = offset.checked_add(length).filter(|&e| e <= data.len());
+        match end {
+            Some(end) => Ok(&data[offset..end]),
+            None => Err(format!(
+                "bufferViews[{}]: bytes {offset}..{} lie past the end of buffers[{buffer}] ({} \
+                 bytes)",
+                view.index(),
+                offset as u128 + length as u128,
+                data.len()
+            )),
+        }
+    }
+
+    fn load(&mut self, index: usize) -> Result<Cow<'a, [u8]>, String> {
+        let field = format!("buffers[{index}]");
+        let buffer = self
+            .document
+            .buffers()
+            .nth(index)
+            .ok_or_else(|| format!("{field} does not exist"))?;
+        let length = buffer.length();
+        let too_short = |what: String, got: usize| {
+            format!("{field}: byteLength is {length} but {what} holds only {got} bytes")
+        };
+        let bytes: Cow<'a, [u8]> = match buffer.source() {
+            gltf::buffer::Source::Bin => {
+                let bin = self.bin.ok_or_else(|| {
+                    format!("{field} refers to the GLB's BIN chunk, but there is none")
+                })?;
+                if bin.len() < length {
+                    return Err(too_short("the GLB's BIN chunk".into(), bin.len()));
+                }
+                // The chunk is padded to 4 bytes: the buffer is its first byteLength bytes.
+                return Ok(Cow::Borrowed(&bin[..length]));
+            }
+            gltf::buffer::Source::Uri(text) => {
+                if length as u64 > self.budget {
+                    return Err(format!(
+                        "{field}: byteLength {length} exceeds the {} bytes left of the {}-byte \
+                         limit on a model's buffers (set {} to raise it)",
+                        self.budget,
+                        FileKind::Model.limit(),
+                        crate::scene::input::LIMIT_VARIABLE
+                    ));
+                }
+                match uri::parse(text).map_err(|e| format!("{field}.uri: {e}"))? {
+                    Uri::Data { bytes, .. } => {
+                        if bytes.len() < length {
+                            return Err(too_short("its data URI".into(), bytes.len()));
+                        }
+                        Cow::Owned(bytes)
+                    }
+                    Uri::File(name) => {
+                        let path = self.base_dir.join(&name);
+                        let bytes = read_bounded(&path, FileKind::Model)
+                            .map_err(|e| format!("{field}: {e}"))?;
+                        if bytes.len() < length {
+                            return Err(too_short(path.display().to_string(), bytes.len()));
+                        }
+                        Cow::Owned(bytes)
+                    }
+                }
+            }
+        };
+        self.budget = self.budget.saturating_sub(length as u64);
+        let mut bytes = bytes.into_owned();
+        bytes.truncate(length);
+        Ok(Cow::Owned(bytes))
+    }
+}

@@ -1,0 +1,67 @@
+//! glTF cameras → the renderer's look-at [`Camera`]: the node's world origin is the eye, its
+//! world −Z the view direction, its world +Y the up direction (scale ignored, as glTF says).
+//! Perspective: `yfov` (radians) → `fov_y_deg`, `znear`, `zfar` (absent: an infinite far
+//! plane, which the renderer supports). Orthographic: `ymag` is half the view's height →
+//! `height = 2 · ymag`. `aspectRatio` and `xmag` are not used: the viewport decides the
+//! aspect, as it does for every camera of the renderer.
+
+use glam::{DMat4, DVec3};
+use gltf::camera::Projection as GltfProjection;
+
+use crate::scene::{Camera, Projection};
+
+/// Converts `camera` of `document` on a node with world transform `world`; `field` names it
+/// in errors.
+pub(super) fn convert(
+    document: &gltf::Document,
+    camera: &gltf::Camera,
+    world: &DMat4,
+    field: &str,
+) -> Result<Camera, String> {
+    // The crate's `projection()` assumes the object its `type` names is there.
+    if let Some(json) = document.as_json().cameras.get(camera.index()) {
+        use gltf::json::camera::Type;
+        use gltf::json::validation::Checked;
+        let present = match json.type_ {
+            Checked::Valid(Type::Perspective) => json.perspective.is_some(),
+            Checked::Valid(Type::Orthographic) => json.orthographic.is_some(),
+            Checked::Invalid => false,
+        };
+        if !present {
+            return Err(format!(
+                "{field}: its `type` names a projection the camera does not define"
+            ));
+        }
+    }
+    let position = world.transform_point3(DVec3::ZERO);
+    let forward = world.transform_vector3(DVec3::NEG_Z).try_normalize();
+    let up = world.transform_vector3(DVec3::Y).try_normalize();
+    let (Some(forward), Some(up)) = (forward, up) else {
+        return Err(format!(
+            "{field}: the node's transform has no direction (zero scale)"
+        ));
+    };
+    // Any look-at distance gives the same view; one proportionate to the position keeps the
+    // direction exact in f64 far from the origin.
+    let distance = (position.abs().max_element() * 1e-3).max(1.0);
+    let projection = match camera.projection() {
+        GltfProjection::Perspective(p) => Projection::Perspective {
+            fov_y_deg: f64::from(p.yfov()).to_degrees(),
+            near: f64::from(p.znear()),
+            far: p.zfar().map_or(f64::INFINITY, f64::from),
+        },
+        GltfProjection::Orthographic(o) => Projection::Orthographic {
+            height: 2.0 * f64::from(o.ymag()).abs(),
+            near: f64::from(o.znear()),
+            far: f64::from(o.zfar()),
+        },
+    };
+    let camera = Camera {
+        position,
+        target: position + forward * distance,
+        up,
+        projection,
+    };
+    camera.validate().map_err(|e| format!("{field}: {e}"))?;
+    Ok(camera)
+}

@@ -1,0 +1,176 @@
+//! glTF materials (metallic-roughness) → the renderer's Lambert + Blinn-Phong [`Material`].
+//!
+//! - `baseColorFactor.rgb` → `diffuse`, `baseColorTexture` → `diffuse_texture` (sRGB, as the
+//!   renderer decodes it); factors clamped to [0, [`MAX_COLOR_FACTOR`]] with a warning, as
+//!   OBJ's are.
+//! - `specular` is the dielectric 0.04 grey; `shininess` comes from `roughnessFactor` through
+//!   the Blinn-Phong ↔ Beckmann match `Ns = 2/α² − 2` with `α = roughness²` ([`shininess`]).
+//!   `metallicFactor` and the metallic-roughness, normal, occlusion and emissive textures are
+//!   not used (the renderer has no reflections for metals to show).
+//! - `alphaMode`: `OPAQUE` ignores alpha; `BLEND` takes `baseColorFactor.a` as the material's
+//!   opacity (below 1: the renderer's transparent path, back to front, alpha-blended);
+//!   `MASK` cuts the whole material — invisible (opacity 0) when `baseColorFactor.a` is below
+//!   `alphaCutoff`, else opaque. Per-texel alpha is not used by the renderer: a texture's
+//!   alpha neither blends nor cuts (a warning says so where it would matter).
+//! - `doubleSided`: the renderer draws every surface from both sides (no culling, the normal
+//!   turned towards the eye), so `doubleSided: false` surfaces are visible from behind too.
+
+use std::collections::HashMap;
+use std::path::Path;
+
+use glam::Vec3;
+use gltf::material::AlphaMode;
+
+use super::buffers::Buffers;
+use super::texture::Textures;
+use crate::scene::material::MAX_COLOR_FACTOR;
+use crate::scene::Material;
+
+/// Specular reflectance of dielectrics (4 %), the `specular` every glTF material gets.
+pub const DIELECTRIC_SPECULAR: f32 = 0.04;
+
+/// Blinn-Phong exponent for a glTF `roughness` in [0, 1]: `2/α² − 2`, `α = roughness²`,
+/// capped at 4 096 (what [`Material::shading_exponent`] allows); roughness 1 gives 0.
+pub fn shininess(roughness: f32) -> f32 {
+    let r = if roughness.is_nan() {
+        1.0
+    } else {
+        roughness.clamp(0.0, 1.0)
+    };
+    let alpha2 = r.powi(4);
+    if alpha2 <= 2.0 / 4098.0 {
+        return 4096.0;
+    }
+    (2.0 / alpha2 - 2.0).clamp(0.0, 4096.0)
+}
+
+/// The materials of one glTF file, converted when a primitive first uses them.
+#[derive(Default)]
+pub(super) struct Materials {
+    /// Converted materials, in the order first used.
+    pub list: Vec<Material>,
+    /// glTF material index (`None`: the default material) → index in `list`.
+    by_index: HashMap<Option<usize>, usize>,
+    textures: Textures,
+}
+
+impl Materials {
+    /// Index in [`Materials::list`] of `m`, converting it on first use.
+    pub fn get(
+        &mut self,
+        m: &gltf::Material,
+        buffers: &mut Buffers,
+        gltf_path: &Path,
+        warnings: &mut Vec<String>,
+    ) -> Result<usize, String> {
+        if let Some(&i) = self.by_index.get(&m.index()) {
+            return Ok(i);
+        }
+        let material = self.convert(m, buffers, gltf_path, warnings)?;
+        self.list.push(material);
+        self.by_index.insert(m.index(), self.list.len() - 1);
+        Ok(self.list.len() - 1)
+    }
+
+    fn convert(
+        &mut self,
+        m: &gltf::Material,
+        buffers: &mut Buffers,
+        gltf_path: &Path,
+        warnings: &mut Vec<String>,
+    ) -> Result<Material, String> {
+        let field = match m.index() {
+            Some(i) => format!("materials[{i}]"),
+            None => "the default material".to_string(),
+        };
+        let name = match (m.index(), m.name()) {
+            (_, Some(n)) => n.to_string(),
+            (Some(i), None) => format!("gltf-material-{i}"),
+            (None, None) => "gltf-default".to_string(),
+        };
+        let pbr = m.pbr_metallic_roughness();
+        let [r, g, b, a] = pbr.base_color_factor();
+        let base = Vec3::new(r, g, b);
+        // NaN becomes 0: f32::clamp keeps NaN, max/min do not.
+        let diffuse = base.max(Vec3::ZERO).min(Vec3::splat(MAX_COLOR_FACTOR));
+        if diffuse != base {
+            warnings.push(format!(
+                "{field} (`{name}`): baseColorFactor {base} clamped to {diffuse} (factors are \
+                 limited to [0, {MAX_COLOR_FACTOR}], the range the fp16 colour tier holds)"
+            ));
+        }
+        let factor_alpha = if a.is_nan() { 1.0 } else { a.clamp(0.0, 1.0) };
+        let mut diffuse_texture = None;
+        if let Some(info) = pbr.base_color_texture() {
+            if info.tex_coord() != 0 {
+                warnings.push(format!(
+                    "{field} (`{name}`): baseColorTexture uses TEXCOORD_{}; only TEXCOORD_0 is \
+                     read, so it is not bound (flat colour)",
+                    info.tex_coord()
+                ));
+            } else {
+                let image = info.texture().source();
+                diffuse_texture = self
+                    .textures
+                    .load(&image, buffers, gltf_path, warnings)
+                    .map_err(|e| format!("{field}.pbrMetallicRoughness.baseColorTexture: {e}"))?;
+            }
+        }
+        let alpha = match m.alpha_mode() {
+            AlphaMode::Opaque => 1.0,
+            AlphaMode::Blend => {
+                if factor_alpha >= 1.0 && diffuse_texture.is_some() {
+                    warnings.push(format!(
+                        "{field} (`{name}`): alphaMode BLEND with its opacity only in the \
+                         texture; drawn opaque (the renderer blends by one opacity per material)"
+                    ));
+                }
+                factor_alpha
+            }
+            AlphaMode::Mask => {
+                let cutoff = m.alpha_cutoff().unwrap_or(0.5);
+                if diffuse_texture.is_some() && factor_alpha >= cutoff {
+                    warnings.push(format!(
+                        "{field} (`{name}`): alphaMode MASK cut out by the texture's alpha is \
+                         not supported; drawn opaque"
+                    ));
+                }
+                if factor_alpha < cutoff {
+                    0.0
+                } else {
+                    1.0
+                }
+            }
+        };
+        let emissive = m.emissive_factor();
+        if emissive.iter().any(|&e| e > 0.0) || m.emissive_texture().is_some() {
+            warnings.push(format!(
+                "{field} (`{name}`): emission is not rendered (no emissive term)"
+            ));
+        }
+        Ok(Material {
+            name,
+            diffuse,
+            diffuse_texture,
+            specular: Vec3::splat(DIELECTRIC_SPECULAR),
+            shininess: shininess(pbr.roughness_factor()),
+            alpha,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn roughness_maps_to_a_bounded_exponent() {
+        assert_eq!(shininess(1.0), 0.0);
+        assert_eq!(shininess(0.0), 4096.0);
+        assert_eq!(shininess(f32::NAN), 0.0);
+        assert_eq!(shininess(7.0), 0.0);
+        let mid = shininess(0.5);
+        assert!((mid - 30.0).abs() < 1e-3, "{mid}");
+        assert!(shininess(0.3) > shininess(0.5));
+    }
+}

@@ -1,0 +1,268 @@
+//! Mesh primitives → [`Mesh`]: positions, normals (flat ones computed when the primitive has
+//! none, as glTF asks), `TEXCOORD_0`, indices (u8, u16, u32 or none), triangle strips and fans
+//! unrolled into lists. Every index is checked against the vertex count and every position
+//! against [`MAX_VERTEX_COORD`], with the glTF path in the message.
+
+use glam::{Vec2, Vec3};
+use gltf::accessor::DataType;
+use gltf::mesh::Mode;
+
+use super::accessor::{self, describe};
+use super::buffers::Buffers;
+use crate::scene::mesh::MAX_VERTEX_COORD;
+use crate::scene::Mesh;
+
+/// How many vertices and indices the file's primitives may still decode into.
+#[derive(Debug)]
+pub(super) struct Budget {
+    /// Vertices left.
+    pub vertices: usize,
+    /// Indices left.
+    pub indices: usize,
+}
+
+impl Budget {
+    fn take(&mut self, what: &str, n: usize, field: &str) -> Result<(), String> {
+        let (left, limit) = match what {
+            "vertices" => (&mut self.vertices, super::MAX_VERTICES),
+            _ => (&mut self.indices, super::MAX_INDICES),
+        };
+        *left = left.checked_sub(n).ok_or_else(|| {
+            format!("{field}: {n} {what} would pass the limit of {limit} {what} per file")
+        })?;
+        Ok(())
+    }
+}
+
+/// The outcome for one primitive.
+pub(super) enum Built {
+    /// A triangle mesh.
+    Mesh(Mesh),
+    /// Nothing to draw (points, lines, no triangles); the reason for a warning.
+    Skipped(String),
+}
+
+/// Builds primitive `p` of its mesh; `field` is its glTF path (`meshes[2].primitives[0]`).
+pub(super) fn build(
+    p: &gltf::Primitive,
+    field: &str,
+    buffers: &mut Buffers,
+    budget: &mut Budget,
+    warnings: &mut Vec<String>,
+) -> Result<Built, String> {
+    let mode = p.mode();
+    if !matches!(
+        mode,
+        Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan
+    ) {
+        return Ok(Built::Skipped(format!(
+            "{field}: mode {mode:?} is not drawn (only triangles are)"
+        )));
+    }
+    let position = p
+        .get(&gltf::Semantic::Positions)
+        .ok_or_else(|| format!("{field}: has no POSITION attribute"))?;
+    let attr = |name: &str, a: &gltf::Accessor| {
+        format!("{field}.attributes.{name} (accessors[{}])", a.index())
+    };
+    let pos_field = attr("POSITION", &position);
+    if position.dimensions() != gltf::accessor::Dimensions::Vec3
+        || position.data_type() != DataType::F32
+    {
+        return Err(format!(
+            "{pos_field}: is {}; positions must be VEC3 of FLOAT",
+            describe(&position)
+        ));
+    }
+    let n = position.count();
+    budget.take("vertices", n, &pos_field)?;
+    let raw = accessor::read_f32(&position, buffers, n).map_err(|e| format!("{pos_field}: {e}"))?;
+    let positions: Vec<Vec3> = raw.chunks_exact(3).map(Vec3::from_slice).collect();
+    for (i, v) in positions.iter().enumerate() {
+        if !v.is_finite() {
+            return Err(format!(
+                "{pos_field}: element {i} is {v:?}; positions must be finite"
+            ));
+        }
+        if v.abs().max_element() > MAX_VERTEX_COORD {
+            return Err(format!(
+                "{pos_field}: element {i} is {v:?}, past ±{MAX_VERTEX_COORD:e} (object space \
+                 is f32; place far objects with their node's transform)"
+            ));
+        }
+    }
+    let same_count = |a: &gltf::Accessor, name: &str| -> Result<(), String> {
+        if a.count() != n {
+            return Err(format!(
+                "{}: {} elements but POSITION has {n}",
+                attr(name, a),
+                a.count()
+            ));
+        }
+        Ok(())
+    };
+    let mut normals = Vec::new();
+    if let Some(a) = p.get(&gltf::Semantic::Normals) {
+        same_count(&a, "NORMAL")?;
+        if a.dimensions() == gltf::accessor::Dimensions::Vec3 && a.data_type() == DataType::F32 {
+            let raw = accessor::read_f32(&a, buffers, n)
+                .map_err(|e| format!("{}: {e}", attr("NORMAL", &a)))?;
+            normals = raw.chunks_exact(3).map(Vec3::from_slice).collect();
+        } else {
+            warnings.push(format!(
+                "{}: is {}, not VEC3 of FLOAT; normals computed instead",
+                attr("NORMAL", &a),
+                describe(&a)
+            ));
+        }
+    }
+    let mut uvs = Vec::new();
+    if let Some(a) = p.get(&gltf::Semantic::TexCoords(0)) {
+        same_count(&a, "TEXCOORD_0")?;
+        let ok_type = match a.data_type() {
+            DataType::F32 => true,
+            DataType::U8 | DataType::U16 => a.normalized(),
+            _ => false,
+        };
+        if a.dimensions() == gltf::accessor::Dimensions::Vec2 && ok_type {
+            let raw = accessor::read_f32(&a, buffers, n)
+                .map_err(|e| format!("{}: {e}", attr("TEXCOORD_0", &a)))?;
+            // glTF's (0, 0) is the image's top-left corner, as the renderer's is: no flip.
+            uvs = raw.chunks_exact(2).map(Vec2::from_slice).collect();
+            if let Some(i) = uvs.iter().position(|t| !t.is_finite()) {
+                return Err(format!(
+                    "{}: element {i} is {:?}; texture coordinates must be finite",
+                    attr("TEXCOORD_0", &a),
+                    uvs[i]
+                ));
+            }
+        } else {
+            warnings.push(format!(
+                "{}: is {}, not VEC2 of FLOAT or normalized UNSIGNED_BYTE/SHORT; ignored",
+                attr("TEXCOORD_0", &a),
+                describe(&a)
+            ));
+        }
+    }
+    let listed: Vec<u32> = match p.indices() {
+        Some(a) => {
+            let ifield = format!("{field}.indices (accessors[{}])", a.index());
+            let integer = matches!(a.data_type(), DataType::U8 | DataType::U16 | DataType::U32);
+            if a.dimensions() != gltf::accessor::Dimensions::Scalar || !integer {
+                return Err(format!(
+                    "{ifield}: is {}; indices must be SCALAR of UNSIGNED_BYTE, SHORT or INT",
+                    describe(&a)
+                ));
+            }
+            budget.take("indices", a.count(), &ifield)?;
+            let indices =
+                accessor::read_u32(&a, buffers, a.count()).map_err(|e| format!("{ifield}: {e}"))?;
+            if let Some(k) = indices.iter().position(|&i| i as usize >= n) {
+                return Err(format!(
+                    "{ifield}: element {k} is {}, out of range for {n} vertices",
+                    indices[k]
+                ));
+            }
+            indices
+        }
+        None => {
+            budget.take("indices", n, field)?;
+            (0..n as u32).collect()
+        }
+    };
+    // Strips and fans unroll into up to three indices per listed one: counted before.
+    if mode != Mode::Triangles {
+        let unrolled = listed.len().saturating_sub(2).saturating_mul(3);
+        budget.take("indices", unrolled.saturating_sub(listed.len()), field)?;
+    }
+    let indices = triangles(mode, &listed).map_err(|e| format!("{field}: {e}"))?;
+    if indices.is_empty() {
+        return Ok(Built::Skipped(format!("{field}: has no triangles")));
+    }
+    let (positions, uvs, indices) = if normals.is_empty() {
+        // glTF asks for flat normals when a primitive has none: each triangle gets its own
+        // three vertices, and the mesh's area-weighted normals are then the face normals.
+        budget.take("vertices", indices.len(), field)?;
+        let pick = |i: &u32| positions[*i as usize];
+        let flat_uvs = if uvs.is_empty() {
+            Vec::new()
+        } else {
+            indices.iter().map(|&i| uvs[i as usize]).collect()
+        };
+        (
+            indices.iter().map(pick).collect(),
+            flat_uvs,
+            (0..indices.len() as u32).collect(),
+        )
+    } else {
+        (positions, uvs, indices)
+    };
+    Mesh::new(positions, normals, uvs, indices)
+        .map(Built::Mesh)
+        .map_err(|e| format!("{field}: {e}"))
+}
+
+/// A triangle list from the primitive's mode and its (checked) vertex sequence.
+fn triangles(mode: Mode, v: &[u32]) -> Result<Vec<u32>, String> {
+    match mode {
+        Mode::Triangles => {
+            if !v.len().is_multiple_of(3) {
+                return Err(format!(
+                    "{} indices is not a whole number of triangles",
+                    v.len()
+                ));
+            }
+            Ok(v.to_vec())
+        }
+        // Triangle i is (i, i+1, i+2) for even i and (i, i+2, i+1) for odd i: every one keeps
+        // the strip's winding.
+        Mode::TriangleStrip => Ok((0..v.len().saturating_sub(2))
+            .flat_map(|i| {
+                if i % 2 == 0 {
+                    [v[i], v[i + 1], v[i + 2]]
+                } else {
+                    [v[i], v[i + 2], v[i + 1]]
+                }
+            })
+            .collect()),
+        Mode::TriangleFan => Ok((0..v.len().saturating_sub(2))
+            .flat_map(|i| [v[i + 1], v[i + 2], v[0]])
+            .collect()),
+        _ => Ok(Vec::new()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn strips_and_fans_unroll_with_their_winding() {
+        assert_eq!(
+            triangles(Mode::TriangleStrip, &[0, 1, 2, 3, 4]).unwrap(),
+            [0, 1, 2, 1, 3, 2, 2, 3, 4]
+        );
+        assert_eq!(
+            triangles(Mode::TriangleFan, &[0, 1, 2, 3]).unwrap(),
+            [1, 2, 0, 2, 3, 0]
+        );
+        assert!(triangles(Mode::TriangleStrip, &[0, 1]).unwrap().is_empty());
+        assert!(triangles(Mode::Triangles, &[0, 1, 2, 3])
+            .unwrap_err()
+            .contains("4 indices"));
+    }
+
+    #[test]
+    fn the_budget_refuses_past_the_limit() {
+        let mut b = Budget {
+            vertices: 10,
+            indices: 10,
+        };
+        assert!(b.take("vertices", 10, "m").is_ok());
+        let err = b.take("vertices", 1, "meshes[0]").unwrap_err();
+        assert!(
+            err.starts_with("meshes[0]") && err.contains("limit"),
+            "{err}"
+        );
+    }
+}

@@ -1,0 +1,341 @@
+//! glTF 2.0 loading: `.gltf` (JSON with external or `data:` URI buffers) and `.glb`.
+//!
+//! The `gltf` crate parses and validates the JSON; everything it would read from disk
+//! (buffers, images) is read here through [`crate::scene::input::read_bounded`], so the
+//! size limits of OBJ files and textures hold for glTF too. What a file holds maps onto a
+//! [`Scene`] as follows (details in `docs/gltf.md` and in each submodule):
+//!
+//! - the default scene (or scene 0; with no scene, the nodes without a parent), its node
+//!   hierarchy composed in `f64` ([`nodes`]);
+//! - each triangle primitive of each placed mesh → one [`Object`] sharing its [`Mesh`] with
+//!   every other node that places it ([`mesh`]); points and lines are skipped with a warning;
+//! - materials → Lambert + Blinn-Phong ([`material`]), base colour textures ([`texture`]);
+//! - the first camera a node instances (depth first, in order) ([`camera`]);
+//! - `KHR_lights_punctual` point and spot lights ([`lights`]).
+//!
+//! Malformed files are [`SceneError::Gltf`] errors naming the file and the glTF path
+//! (`meshes[2].primitives[0].indices (accessors[5]): element 7 is 9, out of range for 4
+//! vertices`). The crate runs under `catch_unwind` as a last guard: a panic inside it becomes
+//! such an error, never an abort of the caller.
+
+mod accessor;
+mod buffers;
+pub mod camera;
+mod glb;
+pub mod lights;
+pub mod material;
+pub mod mesh;
+pub mod nodes;
+pub mod texture;
+mod uri;
+
+use std::collections::hash_map::Entry;
+use std::collections::HashMap;
+use std::path::Path;
+use std::sync::Arc;
+
+use glam::DMat4;
+
+pub use lights::{unbounded_radius, CANDELA_TO_INTENSITY, UNBOUNDED_CUTOFF};
+pub use material::{shininess, DIELECTRIC_SPECULAR};
+
+use super::camera::MAX_CAMERA_COORD;
+use super::input::{self, read_bounded, FileKind};
+use super::obj::LoadReport;
+use super::{random, Aabb, Camera, Light, Material, Mesh, Object, Scene, SceneError};
+
+/// Most vertices one glTF file may decode into (33.5 M, about 1 GiB of vertex data: what
+/// the largest OBJ file allowed holds). Checked before each accessor is allocated.
+pub const MAX_VERTICES: usize = 1 << 25;
+
+/// Most indices one glTF file may decode into (three per vertex of [`MAX_VERTICES`]).
+pub const MAX_INDICES: usize = 3 << 25;
+
+/// Most objects (placed primitives) one glTF file may make.
+pub const MAX_OBJECTS: usize = 1 << 20;
+
+/// Extensions the loader implements; a file *requiring* another is refused (by the `gltf`
+/// crate's validation), one merely *using* another gets a warning that it is ignored.
+pub const SUPPORTED_EXTENSIONS: &[&str] = &["KHR_lights_punctual"];
+
+/// What a glTF load produced besides what went into the scene.
+#[derive(Debug, Default)]
+pub struct GltfLoad {
+    /// Warnings (unsupported features, missing textures, skipped lights), also logged.
+    pub report: LoadReport,
+    /// The first camera a node instances, in world space (the caller's transform applied).
+    pub camera: Option<Camera>,
+}
+
+/// Loads what `--scene file.gltf|file.glb` names: the file's objects, materials and lights,
+/// its camera (or one framing its bounds, as for OBJ), and `lights` = `Some((count, seed))`
+/// seeded random lights added to the file's own (`count` 0: the file's lights only).
+pub fn load(path: &Path, lights: Option<(usize, u64)>) -> Result<(Scene, LoadReport), SceneError> {
+    if let Some((count, _)) = lights {
+        input::check_light_count(count, "lights")?;
+    }
+    let mut scene = Scene::empty();
+    let loaded = load_into(&mut scene, path, DMat4::IDENTITY)?;
+    match loaded.camera {
+        Some(camera) => scene.camera = camera,
+        None => scene.frame_camera(),
+    }
+    if let (Some((count, seed)), Some(bounds)) = (lights, scene.bounds()) {
+        input::check_light_count(count.saturating_add(scene.lights.len()), "lights")?;
+        // Around the model as well as inside it, as for OBJ.
+        let volume = bounds.expanded(0.25);
+        scene.lights.extend(random::lights(
+            &volume,
+            count,
+            seed,
+            random::LightSetStyle::Mixed,
+        ));
+    }
+    scene.validate()?;
+    Ok((scene, loaded.report))
+}
+
+/// Loads a glTF file into `scene`, placing it with `transform`: objects and materials are
+/// appended, lights appended in world space (moved and turned by `transform`; their radius is
+/// not scaled). The scene's camera is left alone: the file's own comes back in the result.
+/// On error `scene` is unchanged.
+pub fn load_into(scene: &mut Scene, path: &Path, transform: DMat4) -> Result<GltfLoad, SceneError> {
+    let bytes = read_bounded(path, FileKind::Model)?;
+    let error = |reason: String| SceneError::Gltf {
+        path: path.to_path_buf(),
+        reason,
+    };
+    if !transform.is_finite() {
+        return Err(error("the placing transform is not finite".into()));
+    }
+    let imported = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        import(&bytes, path, transform)
+    }));
+    let imported = match imported {
+        Ok(result) => result.map_err(error)?,
+        Err(_) => {
+            return Err(error(
+                "the glTF parser (gltf crate) failed on this file; it is malformed".into(),
+            ))
+        }
+    };
+    let total_lights = scene.lights.len().saturating_add(imported.lights.len());
+    input::check_light_count(total_lights, &format!("{} lights", path.display()))?;
+    let first_material = scene.materials.len();
+    scene.materials.extend(imported.materials);
+    scene
+        .objects
+        .extend(imported.objects.into_iter().map(|mut o| {
+            o.material += first_material;
+            o
+        }));
+    scene.lights.extend(imported.lights);
+    let mut report = LoadReport::default();
+    for w in imported.warnings {
+        let msg = format!("{}: {w}", path.display());
+        log::warn!("{msg}");
+        report.warnings.push(msg);
+    }
+    Ok(GltfLoad {
+        report,
+        camera: imported.camera,
+    })
+}
+
+/// A built primitive and its object-space bounds.
+type BuiltMesh = (Arc<Mesh>, Option<Aabb>);
+
+/// A file's contents, converted; material indices start at 0.
+struct Imported {
+    objects: Vec<Object>,
+    materials: Vec<Material>,
+    lights: Vec<Light>,
+    camera: Option<Camera>,
+    warnings: Vec<String>,
+}
+
+fn import(bytes: &[u8], path: &Path, transform: DMat4) -> Result<Imported, String> {
+    let (json, bin) = if bytes.starts_with(glb::MAGIC) {
+        let g = glb::split(bytes)?;
+        (g.json, g.bin)
+    } else {
+        (bytes, None)
+    };
+    let root = gltf::json::deserialize::from_slice(json).map_err(|e| format!("JSON: {e}"))?;
+    validate(&root)?;
+    let document = gltf::Document::from_json_without_validation(root);
+    let locals = nodes::local_transforms(json)?;
+    if locals.len() != document.nodes().len() {
+        return Err(format!(
+            "nodes: {} read in f64 but {} parsed",
+            locals.len(),
+            document.nodes().len()
+        ));
+    }
+    let mut warnings = Vec::new();
+    let unsupported: Vec<&str> = document
+        .extensions_used()
+        .filter(|e| !SUPPORTED_EXTENSIONS.contains(e))
+        .collect();
+    if !unsupported.is_empty() {
+        warnings.push(format!(
+            "extensions used but not supported, ignored: {}",
+            unsupported.join(", ")
+        ));
+    }
+    let base_dir = path.parent().unwrap_or(Path::new("."));
+    let mut buffers = buffers::Buffers::new(&document, bin, base_dir);
+    let (roots, from) = nodes::roots(&document);
+    let placed = nodes::walk(&document, &roots, &locals, transform)?;
+
+    let mut budget = mesh::Budget {
+        vertices: MAX_VERTICES,
+        indices: MAX_INDICES,
+    };
+    // Each primitive is built once, with its object-space bounds, however many nodes place it.
+    let mut meshes: HashMap<(usize, usize), Option<BuiltMesh>> = HashMap::new();
+    let mut materials = material::Materials::default();
+    let mut out = Imported {
+        objects: Vec::new(),
+        materials: Vec::new(),
+        lights: Vec::new(),
+        camera: None,
+        warnings: Vec::new(),
+    };
+    let (mut skinned, mut morphed) = (false, false);
+    for p in &placed {
+        let Some(node) = document.nodes().nth(p.node) else {
+            continue;
+        };
+        let field = format!("nodes[{}]", p.node);
+        skinned |= node.skin().is_some();
+        if let Some(m) = node.mesh() {
+            morphed |= m.primitives().any(|pr| pr.morph_targets().next().is_some());
+            for prim in m.primitives() {
+                let key = (m.index(), prim.index());
+                let pfield = format!("meshes[{}].primitives[{}]", key.0, key.1);
+                let cached = match meshes.entry(key) {
+                    Entry::Occupied(e) => e.into_mut(),
+                    Entry::Vacant(e) => {
+                        let built =
+                            mesh::build(&prim, &pfield, &mut buffers, &mut budget, &mut warnings)?;
+                        e.insert(match built {
+                            mesh::Built::Mesh(mesh) => {
+                                let bounds = mesh.bounds();
+                                Some((Arc::new(mesh), bounds))
+                            }
+                            mesh::Built::Skipped(why) => {
+                                warnings.push(format!("{why}; skipped"));
+                                None
+                            }
+                        })
+                    }
+                };
+                let Some((mesh, bounds)) = cached.clone() else {
+                    continue;
+                };
+                check_placement(bounds, &p.world)
+                    .map_err(|e| format!("{field} placing {pfield}: {e}"))?;
+                let material =
+                    materials.get(&prim.material(), &mut buffers, path, &mut warnings)?;
+                if out.objects.len() >= MAX_OBJECTS {
+                    return Err(format!(
+                        "{field}: more than {MAX_OBJECTS} placed primitives (the limit per file)"
+                    ));
+                }
+                out.objects.push(Object {
+                    mesh,
+                    material,
+                    transform: p.world,
+                });
+            }
+        }
+        if let Some(light) = node.light() {
+            let lfield = format!(
+                "{field} (extensions.KHR_lights_punctual.lights[{}])",
+                light.index()
+            );
+            match lights::convert(&light, &p.world, &lfield)? {
+                lights::Converted::Light(l) => out.lights.push(l),
+                lights::Converted::Skipped(why) => warnings.push(why),
+            }
+        }
+        if let (Some(cam), None) = (node.camera(), &out.camera) {
+            let cfield = format!("{field} (cameras[{}])", cam.index());
+            out.camera = Some(camera::convert(&document, &cam, &p.world, &cfield)?);
+        }
+    }
+    if skinned || morphed {
+        warnings.push("skins and morph targets are not applied: meshes are drawn as bound".into());
+    }
+    if out.objects.is_empty() && out.lights.is_empty() {
+        return Err(format!(
+            "nothing to show: {from} place no triangle mesh and no light"
+        ));
+    }
+    out.materials = materials.list;
+    out.warnings = warnings;
+    Ok(out)
+}
+
+/// The `gltf` crate's validation (every index in range, every enum value known, required
+/// extensions supported), except that accessors may lack `min` and `max` or have malformed
+/// ones: the spec asks exporters for them on positions, many omit them, and the loader does
+/// not use them.
+fn validate(root: &gltf::json::Root) -> Result<(), String> {
+    use gltf::json::validation::{Checked, Error, Validate};
+    // The crate's own check of `min`/`max` indexes the accessors with POSITION's index
+    // before it checks that index: checked here first.
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for (p, primitive) in mesh.primitives.iter().enumerate() {
+            let position = primitive
+                .attributes
+                .get(&Checked::Valid(gltf::Semantic::Positions));
+            if let Some(index) = position.filter(|i| i.value() >= root.accessors.len()) {
+                return Err(format!(
+                    "meshes[{m}].primitives[{p}].attributes.POSITION: accessors[{}] does not \
+                     exist ({} accessors)",
+                    index.value(),
+                    root.accessors.len()
+                ));
+            }
+        }
+    }
+    let mut errors = Vec::new();
+    root.validate(root, gltf::json::Path::new, &mut |path, error| {
+        let path = path().to_string();
+        let bounds = path.ends_with(".min") || path.ends_with(".max");
+        if !(bounds && matches!(error, Error::Missing | Error::Invalid)) {
+            errors.push(format!("{path}: {error}"));
+        }
+    });
+    if errors.is_empty() {
+        return Ok(());
+    }
+    let shown = errors.len().min(8);
+    let more = match errors.len() - shown {
+        0 => String::new(),
+        n => format!("; and {n} more"),
+    };
+    Err(format!(
+        "invalid glTF: {}{more}",
+        errors[..shown].join("; ")
+    ))
+}
+
+/// A placed mesh's world bounds must stay within the camera's coordinate limit (the view
+/// maths keeps precision only up to there), and its transform finite.
+fn check_placement(bounds: Option<Aabb>, world: &DMat4) -> Result<(), String> {
+    if !world.is_finite() {
+        return Err("the world transform is not finite".into());
+    }
+    if let Some(b) = bounds.map(|b| b.transformed(world)) {
+        let reach = b.min.abs().max(b.max.abs()).max_element();
+        if !reach.is_finite() || reach > MAX_CAMERA_COORD {
+            return Err(format!(
+                "world-space bounds reach {reach:e}, past ±{MAX_CAMERA_COORD:e}"
+            ));
+        }
+    }
+    Ok(())
+}

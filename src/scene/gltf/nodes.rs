@@ -1,0 +1,201 @@
+//! The node hierarchy: local transforms read in `f64` from the JSON (the `gltf` crate keeps
+//! them as `f32`, which loses centimetres a few hundred kilometres out), composed parent to
+//! child in `f64`, walked without recursion. Each node may be reached once: a cycle, or a node
+//! with two parents, is an error naming the node.
+
+use glam::{DMat4, DQuat, DVec3};
+use serde::Deserialize;
+
+#[derive(Deserialize)]
+struct RawRoot {
+    #[serde(default)]
+    nodes: Vec<RawNode>,
+}
+
+#[derive(Deserialize)]
+struct RawNode {
+    matrix: Option<[f64; 16]>,
+    translation: Option<[f64; 3]>,
+    rotation: Option<[f64; 4]>,
+    scale: Option<[f64; 3]>,
+}
+
+/// Every node's local transform (`matrix`, or translation × rotation × scale), from the JSON
+/// text in `f64`. Errors name the node and the field.
+pub(super) fn local_transforms(json: &[u8]) -> Result<Vec<DMat4>, String> {
+    let root: RawRoot = serde_json::from_slice(json).map_err(|e| format!("nodes: {e}"))?;
+    root.nodes
+        .iter()
+        .enumerate()
+        .map(|(i, n)| {
+            let field = format!("nodes[{i}]");
+            if let Some(m) = n.matrix {
+                let m = DMat4::from_cols_array(&m);
+                if !m.is_finite() {
+                    return Err(format!("{field}.matrix: must be finite"));
+                }
+                return Ok(m);
+            }
+            let t = DVec3::from(n.translation.unwrap_or([0.0; 3]));
+            let s = DVec3::from(n.scale.unwrap_or([1.0; 3]));
+            let [x, y, z, w] = n.rotation.unwrap_or([0.0, 0.0, 0.0, 1.0]);
+            let q = DQuat::from_xyzw(x, y, z, w);
+            if !t.is_finite() {
+                return Err(format!("{field}.translation: must be finite, got {t:?}"));
+            }
+            if !s.is_finite() {
+                return Err(format!("{field}.scale: must be finite, got {s:?}"));
+            }
+            // Exporters round: a quaternion of nearly unit length is normalised; one of no
+            // length has no rotation to give.
+            let length = q.length();
+            if !(length.is_finite() && length > 1e-12) {
+                return Err(format!(
+                    "{field}.rotation: must be a finite non-zero quaternion, got {q:?}"
+                ));
+            }
+            let q = q / length;
+            Ok(DMat4::from_scale_rotation_translation(s, q, t))
+        })
+        .collect()
+}
+
+/// A node reached from the scene's roots, with its world transform.
+#[derive(Clone, Debug)]
+pub(super) struct Placed {
+    /// Node index.
+    pub node: usize,
+    /// Node space → world space (the caller's root transform included).
+    pub world: DMat4,
+}
+
+/// The nodes to place: the default scene's (`scene`), else the first scene's, else — a file
+/// without scenes — every node that is no other node's child. Returns the roots and what they
+/// came from (for messages).
+pub(super) fn roots(document: &gltf::Document) -> (Vec<usize>, String) {
+    if let Some(s) = document.default_scene() {
+        return (
+            s.nodes().map(|n| n.index()).collect(),
+            format!("scenes[{}]", s.index()),
+        );
+    }
+    if let Some(s) = document.scenes().next() {
+        return (s.nodes().map(|n| n.index()).collect(), "scenes[0]".into());
+    }
+    let mut is_child = vec![false; document.nodes().len()];
+    for n in document.nodes() {
+        for c in n.children() {
+            is_child[c.index()] = true;
+        }
+    }
+    let roots = (0..is_child.len()).filter(|&i| !is_child[i]).collect();
+    (
+        roots,
+        "the nodes without a parent (the file has no scene)".into(),
+    )
+}
+
+/// Walks the hierarchy from `roots` depth first (children in order), composing `root` ×
+/// parents × node. `locals` are the nodes' local transforms.
+pub(super) fn walk(
+    document: &gltf::Document,
+    roots: &[usize],
+    locals: &[DMat4],
+    root: DMat4,
+) -> Result<Vec<Placed>, String> {
+    let count = locals.len();
+    // Who reached each node first (`usize::MAX`: a root), to tell a cycle from two parents.
+    let mut parent: Vec<Option<usize>> = vec![None; count];
+    let mut placed = Vec::new();
+    let mut stack: Vec<(usize, usize, DMat4)> = Vec::new();
+    for &r in roots.iter().rev() {
+        stack.push((r, usize::MAX, root));
+    }
+    while let Some((node, from, parent_world)) = stack.pop() {
+        let local = locals
+            .get(node)
+            .ok_or_else(|| format!("nodes[{node}] does not exist ({count} nodes)"))?;
+        if let Some(first) = parent[node] {
+            return Err(reached_twice(node, first, from, &parent));
+        }
+        parent[node] = Some(from);
+        let world = parent_world * *local;
+        placed.push(Placed { node, world });
+        let Some(n) = document.nodes().nth(node) else {
+            continue;
+        };
+        let children: Vec<usize> = n.children().map(|c| c.index()).collect();
+        for &c in children.iter().rev() {
+            stack.push((c, node, world));
+        }
+    }
+    Ok(placed)
+}
+
+fn reached_twice(node: usize, first: usize, now: usize, parent: &[Option<usize>]) -> String {
+    let via = |p: usize| {
+        if p == usize::MAX {
+            "the scene's roots".to_string()
+        } else {
+            format!("nodes[{p}]")
+        }
+    };
+    // A cycle when the node is an ancestor of the one that reached it again.
+    let mut at = now;
+    let mut steps = 0;
+    while at != usize::MAX && steps <= parent.len() {
+        if at == node {
+            return format!(
+                "nodes[{node}] is its own ancestor (through {}): the node hierarchy has a \
+                 cycle",
+                via(now)
+            );
+        }
+        at = parent[at].unwrap_or(usize::MAX);
+        steps += 1;
+    }
+    format!(
+        "nodes[{node}] is reached from both {} and {}: a node may have only one parent",
+        via(first),
+        via(now)
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn transforms_are_read_in_f64_and_checked() {
+        let json = br#"{"nodes": [
+            {"translation": [6378137.123456789, 0, 0]},
+            {"matrix": [2,0,0,0, 0,2,0,0, 0,0,2,0, 1,2,3,1]},
+            {"rotation": [0, 0, 0, 2], "scale": [1, 2, 3]},
+            {"rotation": [0, 0, 0, 0]}
+        ]}"#;
+        let err = local_transforms(json).unwrap_err();
+        assert!(err.starts_with("nodes[3].rotation"), "{err}");
+        let json = br#"{"nodes": [
+            {"translation": [6378137.123456789, 0, 0]},
+            {"matrix": [2,0,0,0, 0,2,0,0, 0,0,2,0, 1,2,3,1]},
+            {"rotation": [0, 0, 0, 2], "scale": [1, 2, 3]}
+        ]}"#;
+        let m = local_transforms(json).unwrap();
+        assert_eq!(m[0].w_axis.x, 6378137.123456789);
+        assert_eq!(m[1].transform_point3(DVec3::ONE), DVec3::new(3.0, 4.0, 5.0));
+        assert_eq!(
+            m[2].transform_vector3(DVec3::ONE),
+            DVec3::new(1.0, 2.0, 3.0)
+        );
+        assert!(local_transforms(b"{}").unwrap().is_empty());
+    }
+
+    #[test]
+    fn cycles_and_second_parents_are_told_apart() {
+        let parent = vec![Some(usize::MAX), Some(0), Some(1)];
+        assert!(reached_twice(0, usize::MAX, 2, &parent).contains("cycle"));
+        let parent = vec![Some(usize::MAX), Some(usize::MAX), Some(0)];
+        let msg = reached_twice(2, 0, 1, &parent);
+        assert!(msg.contains("only one parent"), "{msg}");
+    }
+}

@@ -1,0 +1,187 @@
+//! glTF images → [`Texture`]s: embedded in a GLB buffer view, in a `data:` URI, or a file next
+//! to the `.gltf`. Decoded with the limits the OBJ loader's textures have (at most
+//! [`MAX_TEXTURE_SIDE`](crate::scene::obj::MAX_TEXTURE_SIDE) pixels a side, files within [`FileKind::Texture`]'s limit); an image
+//! that is missing or does not decode is a warning and its material keeps its flat colour,
+//! never an abort — as with OBJ.
+
+use std::collections::HashMap;
+use std::path::Path;
+use std::sync::Arc;
+
+use super::buffers::Buffers;
+use super::uri::{self, Uri};
+use crate::scene::input::{read_bounded, FileKind, LIMIT_VARIABLE};
+use crate::scene::obj::{decode_texture_bytes, resolve_texture};
+use crate::scene::Texture;
+
+/// Decoded images of one glTF file, by image index (`None`: failed, warned once).
+#[derive(Default)]
+pub(super) struct Textures {
+    loaded: HashMap<usize, Option<Arc<Texture>>>,
+}
+
+/// Where an image's encoded bytes came from, for names and messages.
+struct Encoded {
+    bytes: Vec<u8>,
+    name: String,
+    format: Option<image::ImageFormat>,
+}
+
+impl Textures {
+    /// The texture of `image`, decoded once. Problems with the image data itself are warnings
+    /// (`None`); a buffer view past its buffer is an error, as anywhere else in the file.
+    pub fn load(
+        &mut self,
+        image: &gltf::Image,
+        buffers: &mut Buffers,
+        gltf_path: &Path,
+        warnings: &mut Vec<String>,
+    ) -> Result<Option<Arc<Texture>>, String> {
+        if let Some(t) = self.loaded.get(&image.index()) {
+            return Ok(t.clone());
+        }
+        let field = format!("images[{}]", image.index());
+        let texture = match encoded(image, buffers, gltf_path, &field)? {
+            Ok(enc) => match decode(&enc.bytes, enc.format) {
+                Ok(img) => Some(Arc::new(Texture {
+                    name: enc.name,
+                    image: img.to_rgba8(),
+                })),
+                Err(e) => {
+                    warnings.push(format!(
+                        "texture {} could not be decoded ({e}); using the flat colour",
+                        enc.name
+                    ));
+                    None
+                }
+            },
+            Err(warning) => {
+                warnings.push(warning);
+                None
+            }
+        };
+        self.loaded.insert(image.index(), texture.clone());
+        Ok(texture)
+    }
+}
+
+fn format_of(media_type: &str) -> Option<image::ImageFormat> {
+    image::ImageFormat::from_mime_type(media_type)
+}
+
+/// The image's encoded bytes (outer `Err`: a malformed file; inner `Err`: a warning).
+fn encoded(
+    image: &gltf::Image,
+    buffers: &mut Buffers,
+    gltf_path: &Path,
+    field: &str,
+) -> Result<Result<Encoded, String>, String> {
+    let limit = FileKind::Texture.limit();
+    let embedded_name = format!("{}#{field}", gltf_path.display());
+    let too_big = |n: usize| {
+        format!(
+            "texture {embedded_name} of {n} bytes exceeds the limit of {limit} bytes (set \
+             {LIMIT_VARIABLE} to raise it); using the flat colour"
+        )
+    };
+    // From the JSON rather than `image.source()`, which assumes a `uri` where there is no
+    // `bufferView` and a `mimeType` where there is one.
+    let Some(json) = buffers.document().as_json().images.get(image.index()) else {
+        return Ok(Err(format!(
+            "{field} does not exist; using the flat colour"
+        )));
+    };
+    let mime_type = json.mime_type.as_ref().map(|m| m.0.clone());
+    if let Some(view_index) = json.buffer_view {
+        let Some(view) = buffers.document().views().nth(view_index.value()) else {
+            return Err(format!(
+                "{field}.bufferView: no bufferViews[{}]",
+                view_index.value()
+            ));
+        };
+        let bytes = buffers.view(&view).map_err(|e| format!("{field}: {e}"))?;
+        if bytes.len() as u64 > limit {
+            return Ok(Err(too_big(bytes.len())));
+        }
+        return Ok(Ok(Encoded {
+            bytes: bytes.to_vec(),
+            name: embedded_name,
+            format: mime_type.as_deref().and_then(format_of),
+        }));
+    }
+    let Some(text) = json.uri.as_deref() else {
+        return Ok(Err(format!(
+            "{field} has neither a uri nor a bufferView; using the flat colour"
+        )));
+    };
+    match uri::parse(text) {
+        Err(e) => Ok(Err(format!("{field}.uri: {e}; using the flat colour"))),
+        Ok(Uri::Data { media_type, bytes }) => {
+            if bytes.len() as u64 > limit {
+                return Ok(Err(too_big(bytes.len())));
+            }
+            Ok(Ok(Encoded {
+                bytes,
+                name: embedded_name,
+                format: format_of(mime_type.as_deref().unwrap_or(&media_type)),
+            }))
+        }
+        Ok(Uri::File(name)) => {
+            let base_dir = gltf_path.parent().unwrap_or(Path::new("."));
+            let as_written = base_dir.join(&name);
+            // As written first (names may hold spaces); then in other letter case or
+            // flattened folders, as OBJ textures are found.
+            let path = if as_written.is_file() {
+                Some(as_written)
+            } else {
+                resolve_texture(base_dir, &name)
+            };
+            let Some(path) = path else {
+                return Ok(Err(format!(
+                    "{field}: texture `{name}` not found next to {}; using its flat colour",
+                    gltf_path.display()
+                )));
+            };
+            let format = mime_type
+                .as_deref()
+                .and_then(format_of)
+                .or_else(|| image::ImageFormat::from_path(&path).ok());
+            match read_bounded(&path, FileKind::Texture) {
+                Ok(bytes) => Ok(Ok(Encoded {
+                    bytes,
+                    name: path.display().to_string(),
+                    format,
+                })),
+                Err(e) => Ok(Err(format!(
+                    "texture {} could not be decoded ({e}); using the flat colour",
+                    path.display()
+                ))),
+            }
+        }
+    }
+}
+
+/// Decodes with the OBJ loader's limits ([`decode_texture_bytes`]).
+fn decode(bytes: &[u8], format: Option<image::ImageFormat>) -> Result<image::DynamicImage, String> {
+    decode_texture_bytes(bytes, format)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn decodes_a_png_and_refuses_a_claimed_giant() {
+        let img = image::RgbaImage::from_pixel(3, 2, image::Rgba([10, 20, 30, 255]));
+        let mut png = Vec::new();
+        img.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+            .unwrap();
+        let decoded = decode(&png, format_of("image/png")).unwrap();
+        assert_eq!((decoded.width(), decoded.height()), (3, 2));
+        // The same PNG with its header claiming 100 000 × 2 pixels.
+        let mut giant = png.clone();
+        giant[16..20].copy_from_slice(&100_000u32.to_be_bytes());
+        assert!(decode(&giant, None).is_err());
+        assert!(decode(b"not an image", format_of("image/jpeg")).is_err());
+    }
+}

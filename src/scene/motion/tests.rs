@@ -1,0 +1,302 @@
+use glam::Vec3;
+
+use super::*;
+
+fn point() -> Light {
+    Light::point(DVec3::new(1.0, 2.0, 3.0), 2.0, Vec3::ONE, 4.0)
+}
+
+fn spot() -> Light {
+    Light::spot(
+        DVec3::new(0.0, 5.0, 0.0),
+        DVec3::NEG_Y,
+        10.0,
+        25.0,
+        8.0,
+        Vec3::ONE,
+        2.0,
+    )
+}
+
+fn every_motion() -> Motion {
+    Motion {
+        orbit: Some(Orbit {
+            about: OrbitAbout::Radius(1.5),
+            axis: DVec3::Y,
+            period_s: 4.0,
+            phase_deg: 70.0,
+        }),
+        bob: Some(Bob {
+            amplitude: DVec3::new(0.0, 0.5, 0.0),
+            period_s: 1.7,
+            phase_deg: 30.0,
+        }),
+        wander: Some(Wander {
+            radius: 2.0,
+            period_s: 5.0,
+            seed: 11,
+        }),
+        flicker: Some(Flicker {
+            amount: 0.4,
+            rate_hz: 6.0,
+            seed: 3,
+        }),
+        sweep: Some(Sweep {
+            axis: DVec3::X,
+            angle_deg: 20.0,
+            period_s: 3.0,
+            phase_deg: 45.0,
+        }),
+    }
+}
+
+fn times() -> impl Iterator<Item = f64> {
+    (0..2000).map(|i| i as f64 * 0.0137)
+}
+
+#[test]
+fn every_motion_starts_at_the_rest_state() {
+    let m = every_motion();
+    for rest in [point(), spot()] {
+        let at_zero = m.apply(&rest, 0.0);
+        assert!((at_zero.position - rest.position).length() < 1e-12);
+        assert_eq!(at_zero.intensity, rest.intensity);
+        if let (LightKind::Spot { direction: a, .. }, LightKind::Spot { direction: b, .. }) =
+            (at_zero.kind, rest.kind)
+        {
+            assert!((a - b).length() < 1e-12);
+        }
+    }
+}
+
+#[test]
+fn motions_move_and_stay_within_their_bounds() {
+    let rest = point();
+    let only = |m: Motion| move |t: f64| m.apply(&rest, t);
+    let wander = only(Motion {
+        wander: every_motion().wander,
+        ..Motion::default()
+    });
+    let bob = only(Motion {
+        bob: every_motion().bob,
+        ..Motion::default()
+    });
+    let flicker = only(Motion {
+        flicker: every_motion().flicker,
+        ..Motion::default()
+    });
+    let (mut wander_far, mut dimmest) = (0.0f64, f32::MAX);
+    for t in times() {
+        let d = (wander(t).position - rest.position).length();
+        assert!(d <= 2.0 + 1e-9, "wander left its radius: {d} at t = {t}");
+        wander_far = wander_far.max(d);
+        let b = bob(t).position - rest.position;
+        assert!(
+            b.x == 0.0 && b.z == 0.0 && b.y.abs() <= 1.0 + 1e-12,
+            "{b:?}"
+        );
+        let i = flicker(t).intensity;
+        assert!(
+            (rest.intensity * 0.6 - 1e-6..=rest.intensity).contains(&i),
+            "{i}"
+        );
+        dimmest = dimmest.min(i);
+    }
+    // It really moves and flickers, not only stays in bounds.
+    assert!(wander_far > 0.5, "wander reached only {wander_far}");
+    assert!(
+        dimmest < rest.intensity * 0.85,
+        "flicker dipped only to {dimmest}"
+    );
+}
+
+#[test]
+fn orbits_are_circles_with_the_given_period() {
+    let rest = point();
+    let centre = DVec3::new(-1.0, 0.0, 0.5);
+    let about_point = Motion {
+        orbit: Some(Orbit {
+            about: OrbitAbout::Point(centre),
+            axis: DVec3::Y,
+            period_s: 2.0,
+            phase_deg: 0.0,
+        }),
+        ..Motion::default()
+    };
+    let radius = Motion {
+        orbit: every_motion().orbit,
+        ..Motion::default()
+    };
+    let horizontal = |v: DVec3| DVec3::new(v.x, 0.0, v.z).length();
+    let start_r = horizontal(rest.position - centre);
+    // The radius orbit's centre: on the far side of the rest position, 1.5 away.
+    let phase = 70f64.to_radians();
+    let (u, v) = DVec3::Y.any_orthonormal_pair();
+    let circle_centre = rest.position - (u * phase.cos() + v * phase.sin()) * 1.5;
+    for t in times() {
+        let p = about_point.apply(&rest, t).position;
+        assert!((horizontal(p - centre) - start_r).abs() < 1e-9);
+        assert!((p.y - rest.position.y).abs() < 1e-9);
+        let q = radius.apply(&rest, t).position;
+        assert!(((q - circle_centre).length() - 1.5).abs() < 1e-9, "{q:?}");
+    }
+    let half_turn = about_point.apply(&rest, 1.0).position;
+    assert!((half_turn - (2.0 * centre - rest.position).with_y(rest.position.y)).length() < 1e-9);
+    let full_turn = about_point.apply(&rest, 2.0).position;
+    assert!((full_turn - rest.position).length() < 1e-9);
+}
+
+#[test]
+fn sweep_turns_the_cone_within_its_angle() {
+    let rest = spot();
+    let m = Motion {
+        sweep: every_motion().sweep,
+        ..Motion::default()
+    };
+    let mut widest = 0.0f64;
+    for t in times() {
+        let LightKind::Spot { direction, .. } = m.apply(&rest, t).kind else {
+            unreachable!()
+        };
+        let off = direction.angle_between(DVec3::NEG_Y).to_degrees();
+        assert!(off <= 40.0 + 1e-9, "{off}");
+        assert!(direction.x.abs() < 1e-12, "turns about X only");
+        widest = widest.max(off);
+    }
+    assert!(widest > 25.0, "{widest}");
+}
+
+#[test]
+fn late_frames_stay_finite_and_periodic() {
+    let m = every_motion();
+    for t in [1e6, 1e9, 1e15, f64::MAX, f64::NAN, f64::INFINITY] {
+        let l = m.apply(&spot(), t);
+        l.validate("late").unwrap();
+    }
+    // A period-2 orbit one million turns on is where it started, to float precision of t.
+    let orbit = Motion {
+        orbit: Some(Orbit {
+            about: OrbitAbout::Point(DVec3::ZERO),
+            axis: DVec3::Y,
+            period_s: 2.0,
+            phase_deg: 0.0,
+        }),
+        ..Motion::default()
+    };
+    assert!((orbit.apply(&point(), 2e6).position - point().position).length() < 1e-6);
+}
+
+#[test]
+fn validation_names_the_field() {
+    let base = every_motion();
+    let cases: Vec<(Motion, bool, &str)> = vec![
+        (base, false, "m.sweep"),
+        (
+            Motion {
+                bob: Some(Bob {
+                    period_s: 0.0,
+                    ..base.bob.unwrap()
+                }),
+                ..base
+            },
+            true,
+            "m.bob.period_s",
+        ),
+        (
+            Motion {
+                wander: Some(Wander {
+                    radius: f64::NAN,
+                    ..base.wander.unwrap()
+                }),
+                ..base
+            },
+            true,
+            "m.wander.radius",
+        ),
+        (
+            Motion {
+                flicker: Some(Flicker {
+                    amount: 1.5,
+                    ..base.flicker.unwrap()
+                }),
+                ..base
+            },
+            true,
+            "m.flicker.amount",
+        ),
+        (
+            Motion {
+                flicker: Some(Flicker {
+                    rate_hz: 0.0,
+                    ..base.flicker.unwrap()
+                }),
+                ..base
+            },
+            true,
+            "m.flicker.rate_hz",
+        ),
+        (
+            Motion {
+                orbit: Some(Orbit {
+                    axis: DVec3::ZERO,
+                    ..base.orbit.unwrap()
+                }),
+                ..base
+            },
+            true,
+            "m.orbit.axis",
+        ),
+        (
+            Motion {
+                orbit: Some(Orbit {
+                    about: OrbitAbout::Point(DVec3::splat(1e300)),
+                    ..base.orbit.unwrap()
+                }),
+                ..base
+            },
+            true,
+            "m.orbit.center",
+        ),
+        (
+            Motion {
+                sweep: Some(Sweep {
+                    angle_deg: 200.0,
+                    ..base.sweep.unwrap()
+                }),
+                ..base
+            },
+            true,
+            "m.sweep.angle_deg",
+        ),
+        (
+            Motion {
+                bob: Some(Bob {
+                    amplitude: DVec3::splat(f64::MAX),
+                    ..base.bob.unwrap()
+                }),
+                ..base
+            },
+            true,
+            "m.bob.amplitude",
+        ),
+    ];
+    for (motion, is_spot, field) in cases {
+        let err = motion.validate("m", is_spot).unwrap_err().to_string();
+        assert!(err.contains(field), "expected {field} in: {err}");
+    }
+    base.validate("m", true).unwrap();
+}
+
+#[test]
+fn varied_motions_differ_per_light_and_repeat_per_seed() {
+    let m = every_motion();
+    let a = m.varied(5, 0, true);
+    assert_eq!(a, m.varied(5, 0, true));
+    assert_ne!(a, m.varied(5, 1, true));
+    assert_ne!(a, m.varied(6, 0, true));
+    assert!(m.varied(5, 0, false).sweep.is_none());
+    a.validate("varied", true).unwrap();
+    // Still zero at t = 0 after the variation.
+    let rest = spot();
+    assert!((a.apply(&rest, 0.0).position - rest.position).length() < 1e-12);
+}

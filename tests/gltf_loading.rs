@@ -1,0 +1,1103 @@
+//! glTF 2.0 loading, on files the tests write (JSON with base64 data-URI buffers, GLBs
+//! assembled here, PNGs written with `image`): meshes, the node hierarchy, materials and
+//! textures, cameras, `KHR_lights_punctual`, glTF objects in JSON scene files, malformed files
+//! (each a clear error naming the file and the glTF path at fault) and a render of a glTF
+//! scene against the same scene written as JSON + OBJ.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+
+use common::Gpu;
+use glam::{DMat4, DQuat, DVec3, Vec3};
+use manylight::scene::{self, LightKind, Scene};
+use manylight::{EsVersion, RenderOptions};
+use serde_json::{json, Value};
+
+const FLOAT: u32 = 5126;
+const UNSIGNED_SHORT: u32 = 5123;
+const UNSIGNED_INT: u32 = 5125;
+
+fn base64(bytes: &[u8]) -> String {
+    const ABC: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    let mut out = String::new();
+    for chunk in bytes.chunks(3) {
+        let b = [
+            chunk[0],
+            *chunk.get(1).unwrap_or(&0),
+            *chunk.get(2).unwrap_or(&0),
+        ];
+        let n = (u32::from(b[0]) << 16) | (u32::from(b[1]) << 8) | u32::from(b[2]);
+        for i in 0..4 {
+            if i <= chunk.len() {
+                out.push(ABC[(n >> (18 - 6 * i) & 63) as usize] as char);
+            } else {
+                out.push('=');
+            }
+        }
+    }
+    out
+}
+
+/// Accumulates one binary buffer with its views and accessors, then writes a `.gltf` (the
+/// buffer as a data URI) or a `.glb` (the buffer as its BIN chunk).
+#[derive(Default)]
+struct Builder {
+    bin: Vec<u8>,
+    views: Vec<Value>,
+    accessors: Vec<Value>,
+}
+
+impl Builder {
+    fn view(&mut self, bytes: &[u8]) -> usize {
+        while !self.bin.len().is_multiple_of(4) {
+            self.bin.push(0);
+        }
+        self.views
+            .push(json!({"buffer": 0, "byteOffset": self.bin.len(), "byteLength": bytes.len()}));
+        self.bin.extend_from_slice(bytes);
+        self.views.len() - 1
+    }
+
+    fn accessor(&mut self, bytes: &[u8], component: u32, ty: &str, count: usize) -> usize {
+        let view = self.view(bytes);
+        self.accessors.push(
+            json!({"bufferView": view, "componentType": component, "type": ty, "count": count}),
+        );
+        self.accessors.len() - 1
+    }
+
+    fn floats(&mut self, values: &[f32], ty: &str) -> usize {
+        let per = match ty {
+            "VEC2" => 2,
+            "VEC3" => 3,
+            _ => 1,
+        };
+        let bytes: Vec<u8> = values.iter().flat_map(|v| v.to_le_bytes()).collect();
+        self.accessor(&bytes, FLOAT, ty, values.len() / per)
+    }
+
+    fn u16s(&mut self, values: &[u16]) -> usize {
+        let bytes: Vec<u8> = values.iter().flat_map(|v| v.to_le_bytes()).collect();
+        self.accessor(&bytes, UNSIGNED_SHORT, "SCALAR", values.len())
+    }
+
+    /// A primitive (positions, normals, uvs, u16 indices) as glTF JSON.
+    fn primitive(&mut self, quad: &Quad, material: Option<usize>) -> Value {
+        let p = self.floats(&quad.positions, "VEC3");
+        let n = self.floats(&quad.normals, "VEC3");
+        let t = self.floats(&quad.uvs, "VEC2");
+        let i = self.u16s(&[0, 1, 2, 0, 2, 3]);
+        let mut v =
+            json!({"attributes": {"POSITION": p, "NORMAL": n, "TEXCOORD_0": t}, "indices": i});
+        if let Some(m) = material {
+            v["material"] = json!(m);
+        }
+        v
+    }
+
+    fn document(&self, mut rest: Value, buffer_uri: Option<String>) -> Value {
+        let mut buffer = json!({"byteLength": self.bin.len()});
+        if let Some(uri) = buffer_uri {
+            buffer["uri"] = json!(uri);
+        }
+        rest["asset"] = json!({"version": "2.0"});
+        if !self.bin.is_empty() {
+            rest["buffers"] = json!([buffer]);
+            rest["bufferViews"] = json!(self.views);
+            rest["accessors"] = json!(self.accessors);
+        }
+        rest
+    }
+
+    fn gltf(&self, rest: Value) -> String {
+        let uri = format!("data:application/octet-stream;base64,{}", base64(&self.bin));
+        self.document(rest, Some(uri)).to_string()
+    }
+
+    fn glb(&self, rest: Value) -> Vec<u8> {
+        glb(
+            self.document(rest, None).to_string().as_bytes(),
+            Some(&self.bin),
+        )
+    }
+}
+
+fn glb(json: &[u8], bin: Option<&[u8]>) -> Vec<u8> {
+    let padded = |v: &[u8], with: u8| {
+        let mut v = v.to_vec();
+        while !v.len().is_multiple_of(4) {
+            v.push(with);
+        }
+        v
+    };
+    let mut body = Vec::new();
+    let json = padded(json, b' ');
+    body.extend((json.len() as u32).to_le_bytes());
+    body.extend(b"JSON");
+    body.extend(&json);
+    if let Some(bin) = bin {
+        let bin = padded(bin, 0);
+        body.extend((bin.len() as u32).to_le_bytes());
+        body.extend(b"BIN\0");
+        body.extend(&bin);
+    }
+    let mut out = b"glTF".to_vec();
+    out.extend(2u32.to_le_bytes());
+    out.extend(((body.len() + 12) as u32).to_le_bytes());
+    out.extend(body);
+    out
+}
+
+/// A unit quad's vertex data: four corners, their normals and texture coordinates (glTF's:
+/// v down from the image's top).
+struct Quad {
+    positions: Vec<f32>,
+    normals: Vec<f32>,
+    uvs: Vec<f32>,
+}
+
+/// The floor: 4 × 4 in XZ at y = 0, facing +Y.
+fn floor() -> Quad {
+    Quad {
+        positions: vec![
+            -2.0, 0.0, 2.0, 2.0, 0.0, 2.0, 2.0, 0.0, -2.0, -2.0, 0.0, -2.0,
+        ],
+        normals: [0.0, 1.0, 0.0].repeat(4),
+        uvs: vec![0.0, 1.0, 1.0, 1.0, 1.0, 0.0, 0.0, 0.0],
+    }
+}
+
+/// A wall or pane: `w` × `h` in XY from the origin's bottom edge, facing +Z.
+fn pane(w: f32, h: f32) -> Quad {
+    Quad {
+        positions: vec![
+            -w / 2.0,
+            0.0,
+            0.0,
+            w / 2.0,
+            0.0,
+            0.0,
+            w / 2.0,
+            h,
+            0.0,
+            -w / 2.0,
+            h,
+            0.0,
+        ],
+        normals: [0.0, 0.0, 1.0].repeat(4),
+        uvs: vec![0.0, 1.0, 1.0, 1.0, 1.0, 0.0, 0.0, 0.0],
+    }
+}
+
+/// The same quad as OBJ text (texture v flipped: OBJ's v points up) with its MTL.
+fn quad_obj(q: &Quad, material: &str) -> String {
+    let mut s = format!("mtllib {material}.mtl\nusemtl {material}\n");
+    for p in q.positions.chunks(3) {
+        s += &format!("v {} {} {}\n", p[0], p[1], p[2]);
+    }
+    for n in q.normals.chunks(3) {
+        s += &format!("vn {} {} {}\n", n[0], n[1], n[2]);
+    }
+    for t in q.uvs.chunks(2) {
+        s += &format!("vt {} {}\n", t[0], 1.0 - t[1]);
+    }
+    s + "f 1/1/1 2/2/2 3/3/3\nf 1/1/1 3/3/3 4/4/4\n"
+}
+
+/// A 4 × 4 checker with one odd corner, so a flipped or mirrored mapping shows.
+fn checker_png() -> Vec<u8> {
+    let img = image::RgbaImage::from_fn(4, 4, |x, y| {
+        if (x, y) == (0, 0) {
+            image::Rgba([250, 30, 30, 255])
+        } else if (x + y) % 2 == 0 {
+            image::Rgba([220, 220, 200, 255])
+        } else {
+            image::Rgba([40, 70, 120, 255])
+        }
+    });
+    let mut png = Vec::new();
+    img.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+        .unwrap();
+    png
+}
+
+fn write(dir: &Path, name: &str, bytes: impl AsRef<[u8]>) -> PathBuf {
+    let p = dir.join(name);
+    std::fs::write(&p, bytes).unwrap();
+    p
+}
+
+fn load(path: &Path) -> Result<(Scene, manylight::scene::obj::LoadReport), scene::SceneError> {
+    // No random lights: the file's own only.
+    scene::load(path.to_str().unwrap(), Some((0, 1)))
+}
+
+fn quat(q: DQuat) -> Value {
+    json!([q.x, q.y, q.z, q.w])
+}
+
+#[test]
+fn a_textured_mesh_loads_from_gltf_with_a_side_file_and_from_glb() {
+    let dir = tempfile::tempdir().unwrap();
+    let png = checker_png();
+    write(dir.path(), "checker.png", &png);
+    let mut b = Builder::default();
+    let prim = b.primitive(&floor(), Some(0));
+    let material = json!([{"name": "checker", "pbrMetallicRoughness":
+        {"baseColorFactor": [0.5, 1, 1, 1], "baseColorTexture": {"index": 0}, "roughnessFactor": 0.5}}]);
+    let rest = json!({
+        "scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+        "meshes": [{"primitives": [prim]}], "materials": material,
+        "textures": [{"source": 0}], "images": [{"uri": "checker.png"}],
+    });
+    let gltf = write(dir.path(), "floor.gltf", b.gltf(rest.clone()));
+    // The GLB embeds the image in a buffer view.
+    let image_view = b.view(&png);
+    let mut embedded = rest;
+    embedded["images"] = json!([{"bufferView": image_view, "mimeType": "image/png"}]);
+    let glb_path = write(dir.path(), "floor.glb", b.glb(embedded.clone()));
+    // And a data URI image in a .gltf.
+    embedded["images"] = json!([{"uri": format!("data:image/png;base64,{}", base64(&png))}]);
+    let data_uri = write(dir.path(), "floor-data.gltf", b.gltf(embedded));
+    for path in [gltf, glb_path, data_uri] {
+        let (scene, report) = load(&path).unwrap();
+        assert!(
+            report.warnings.is_empty(),
+            "{}: {:?}",
+            path.display(),
+            report.warnings
+        );
+        assert_eq!(scene.objects.len(), 1);
+        let o = &scene.objects[0];
+        assert_eq!(o.mesh.positions.len(), 4);
+        assert_eq!(o.mesh.indices, [0, 1, 2, 0, 2, 3]);
+        assert_eq!(
+            o.mesh.uvs[0],
+            glam::Vec2::new(0.0, 1.0),
+            "glTF uvs are not flipped"
+        );
+        let m = &scene.materials[o.material];
+        assert_eq!(m.name, "checker");
+        assert_eq!(m.diffuse, Vec3::new(0.5, 1.0, 1.0));
+        assert!(!m.is_transparent());
+        assert!(
+            (m.shininess - 30.0).abs() < 1e-3,
+            "roughness 0.5: {}",
+            m.shininess
+        );
+        let t = m.diffuse_texture.as_ref().expect("texture bound");
+        assert_eq!(t.image.dimensions(), (4, 4));
+        assert_eq!(t.image.get_pixel(0, 0).0, [250, 30, 30, 255]);
+    }
+}
+
+#[test]
+fn missing_normals_become_flat_ones_and_strips_unroll() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut b = Builder::default();
+    // A bent strip: two triangles at a right angle, sharing an edge.
+    let p = b.floats(
+        &[0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, -1.0, 1.0, 1.0, 0.0],
+        "VEC3",
+    );
+    let rest = json!({"scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": p}, "mode": 5}]}]});
+    let path = write(dir.path(), "strip.gltf", b.gltf(rest));
+    let (scene, report) = load(&path).unwrap();
+    assert!(report.warnings.is_empty(), "{:?}", report.warnings);
+    let mesh = &scene.objects[0].mesh;
+    assert_eq!(mesh.triangle_count(), 2);
+    assert_eq!(mesh.positions.len(), 6, "each triangle its own vertices");
+    for tri in mesh.indices.chunks(3) {
+        let n = mesh.normals[tri[0] as usize];
+        for &i in tri {
+            assert_eq!(mesh.normals[i as usize], n, "flat: one normal per triangle");
+        }
+    }
+    let (a, b) = (mesh.normals[0], mesh.normals[3]);
+    assert!(
+        a.dot(b).abs() < 1e-6,
+        "the two faces are at a right angle: {a} {b}"
+    );
+}
+
+#[test]
+fn the_node_hierarchy_places_a_child_mesh_with_its_parents_transforms() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut b = Builder::default();
+    let p = b.floats(&[1.0, 0.0, 0.0, 0.0, 2.0, 0.0, 0.0, 0.0, 3.0], "VEC3");
+    let half = std::f64::consts::FRAC_1_SQRT_2;
+    let rest = json!({
+        "scene": 1,
+        "scenes": [{"nodes": []}, {"nodes": [0]}],
+        "nodes": [
+            // Parent: translate, then a quarter turn about +Y, then scale 2.
+            {"translation": [10, 0, 0], "rotation": [0, half, 0, half], "scale": [2, 2, 2],
+             "children": [1]},
+            // Child: a column-major matrix translating by (0, 1, 0) and scaling x by 3.
+            {"matrix": [3,0,0,0, 0,1,0,0, 0,0,1,0, 0,1,0,1], "children": [2]},
+            {"mesh": 0, "translation": [0, 0, 5]}
+        ],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": p}}]}],
+    });
+    let path = write(dir.path(), "tree.gltf", b.gltf(rest));
+    let (scene, _) = load(&path).unwrap();
+    assert_eq!(scene.objects.len(), 1);
+    let o = &scene.objects[0];
+    // By hand: grandchild local p → +(0,0,5) → child: x·3, +(0,1,0) → parent: ·2, then a
+    // quarter turn about Y ((x, y, z) → (z, y, −x)), then +(10, 0, 0).
+    let by_hand = |p: DVec3| {
+        let p = p + DVec3::new(0.0, 0.0, 5.0);
+        let p = DVec3::new(p.x * 3.0, p.y + 1.0, p.z);
+        let p = p * 2.0;
+        DVec3::new(p.z, p.y, -p.x) + DVec3::new(10.0, 0.0, 0.0)
+    };
+    for v in &o.mesh.positions {
+        let got = o.transform.transform_point3(v.as_dvec3());
+        let want = by_hand(v.as_dvec3());
+        assert!((got - want).length() < 1e-9, "{v}: got {got}, want {want}");
+    }
+    // The first vertex worked through once more, as numbers: (1,0,0) → (1,0,5) → (3,1,5) →
+    // (6,2,10) → (10,2,−6) → (20,2,−6).
+    let first = o.transform.transform_point3(DVec3::X);
+    assert!(
+        (first - DVec3::new(20.0, 2.0, -6.0)).length() < 1e-9,
+        "{first}"
+    );
+}
+
+fn lights_document(b: &mut Builder) -> Value {
+    let p = b.floats(&[0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0], "VEC3");
+    json!({
+        "extensionsUsed": ["KHR_lights_punctual"],
+        "extensions": {"KHR_lights_punctual": {"lights": [
+            {"type": "point", "color": [1, 0.5, 0.25], "intensity": 3, "range": 7},
+            {"type": "point", "intensity": 1},
+            {"type": "spot", "intensity": 5, "range": 9,
+             "spot": {"innerConeAngle": 0.25, "outerConeAngle": 0.5}},
+            {"type": "directional", "intensity": 100}
+        ]}},
+        "scenes": [{"nodes": [0, 1, 2, 3, 4]}],
+        "nodes": [
+            {"translation": [1, 2, 3], "extensions": {"KHR_lights_punctual": {"light": 0}}},
+            {"translation": [-1, 0, 0], "scale": [5, 5, 5],
+             "extensions": {"KHR_lights_punctual": {"light": 1}}},
+            // Aimed down: a quarter turn about +X takes −Z to −Y.
+            {"translation": [0, 4, 0], "rotation": quat(DQuat::from_rotation_x(-std::f64::consts::FRAC_PI_2)),
+             "extensions": {"KHR_lights_punctual": {"light": 2}}},
+            {"extensions": {"KHR_lights_punctual": {"light": 3}}},
+            {"mesh": 0}
+        ],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": p}}]}],
+    })
+}
+
+#[test]
+fn point_and_spot_lights_come_with_positions_directions_radii_and_cones() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut b = Builder::default();
+    let doc = lights_document(&mut b);
+    let path = write(dir.path(), "lights.gltf", b.gltf(doc));
+    let (scene, report) = load(&path).unwrap();
+    assert_eq!(scene.lights.len(), 3, "the directional light is skipped");
+    assert!(
+        report
+            .warnings
+            .iter()
+            .any(|w| w.contains("directional") && w.contains("lights[3]")),
+        "{:?}",
+        report.warnings
+    );
+    let point = &scene.lights[0];
+    assert_eq!(point.kind, LightKind::Point);
+    assert_eq!(point.position, DVec3::new(1.0, 2.0, 3.0));
+    assert_eq!(point.radius, 7.0);
+    assert_eq!(point.color, Vec3::new(1.0, 0.5, 0.25));
+    assert_eq!(point.intensity, 3.0);
+    // No range: where 1 / (d² + 1) falls to the cut-off; scale does not change it.
+    let unbounded = &scene.lights[1];
+    let want = (1.0 / scene::gltf::UNBOUNDED_CUTOFF - 1.0).sqrt();
+    assert!(
+        (f64::from(unbounded.radius) - want).abs() < 1e-4,
+        "{}",
+        unbounded.radius
+    );
+    assert!((unbounded.radius - 31.98).abs() < 0.01);
+    let spot = &scene.lights[2];
+    assert_eq!(spot.position, DVec3::new(0.0, 4.0, 0.0));
+    assert_eq!(spot.radius, 9.0);
+    let LightKind::Spot {
+        direction,
+        inner_deg,
+        outer_deg,
+    } = spot.kind
+    else {
+        panic!("not a spot: {spot:?}");
+    };
+    assert!((direction - DVec3::NEG_Y).length() < 1e-9, "{direction}");
+    assert!(
+        (inner_deg - 0.25f32.to_degrees() as f64).abs() < 1e-4,
+        "{inner_deg}"
+    );
+    assert!((outer_deg - 28.6479).abs() < 1e-3, "{outer_deg}");
+}
+
+#[test]
+fn a_gltf_object_in_a_json_scene_brings_its_lights_and_camera_placed_by_its_transform() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut b = Builder::default();
+    let mut doc = lights_document(&mut b);
+    doc["cameras"] = json!([{"type": "perspective", "perspective": {"yfov": 0.8, "znear": 0.1}}]);
+    doc["nodes"][4]["camera"] = json!(0);
+    doc["nodes"][4]["translation"] = json!([0, 0, 5]);
+    write(dir.path(), "lamps.gltf", b.gltf(doc));
+    let json_path = write(
+        dir.path(),
+        "scene.json",
+        r#"{"objects": [{"gltf": "lamps.gltf",
+             "transform": {"translate": [10, 0, 0], "rotate_y_deg": 90}}],
+            "lights": [{"kind": "point", "position": [0, 0, 0], "radius": 1, "color": [1, 1, 1]}]}"#,
+    );
+    let (scene, _) = scene::load(json_path.to_str().unwrap(), None).unwrap();
+    assert_eq!(
+        scene.lights.len(),
+        4,
+        "three from the glTF, one from the JSON"
+    );
+    let place = DMat4::from_translation(DVec3::new(10.0, 0.0, 0.0))
+        * DMat4::from_rotation_y(90f64.to_radians());
+    let want = place.transform_point3(DVec3::new(1.0, 2.0, 3.0));
+    assert!((scene.lights[0].position - want).length() < 1e-9);
+    assert!((scene.lights[0].position - DVec3::new(13.0, 2.0, -1.0)).length() < 1e-9);
+    assert_eq!(scene.lights[0].radius, 7.0, "radius not scaled");
+    // The camera: the only object's own, placed too, looking down the turned −Z (−X).
+    let cam = scene.camera;
+    assert!((cam.position - place.transform_point3(DVec3::new(0.0, 0.0, 5.0))).length() < 1e-9);
+    let forward = (cam.target - cam.position).normalize();
+    assert!((forward - DVec3::NEG_X).length() < 1e-9, "{forward}");
+    // Both `obj` and `gltf` on one object is an error naming it.
+    let both = write(
+        dir.path(),
+        "both.json",
+        r#"{"objects": [{"gltf": "lamps.gltf", "obj": "x.obj"}]}"#,
+    );
+    let err = scene::load(both.to_str().unwrap(), None)
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("objects[0]") && err.contains("gltf"), "{err}");
+}
+
+#[test]
+fn cameras_perspective_with_infinite_far_and_orthographic() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut b = Builder::default();
+    let p = b.floats(&[0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0], "VEC3");
+    let turn = DQuat::from_rotation_y(std::f64::consts::FRAC_PI_2);
+    let doc = |camera: Value| {
+        json!({
+            "scenes": [{"nodes": [0, 1, 2]}],
+            "cameras": [camera, {"type": "perspective", "perspective": {"yfov": 1.5, "znear": 1}}],
+            "nodes": [
+                {"mesh": 0},
+                // A parent moves the camera's node; a second camera later is not used.
+                {"translation": [0, 1, 0], "children": [3]},
+                {"camera": 1},
+                {"camera": 0, "translation": [4, 0, 0], "rotation": quat(turn), "scale": [3, 3, 3]}
+            ],
+            "meshes": [{"primitives": [{"attributes": {"POSITION": p}}]}],
+        })
+    };
+    let persp = doc(json!({"type": "perspective", "perspective": {"yfov": 0.7, "znear": 0.05}}));
+    let path = write(dir.path(), "persp.gltf", b.gltf(persp));
+    let (scene, _) = load(&path).unwrap();
+    let cam = scene.camera;
+    assert_eq!(cam.position, DVec3::new(4.0, 1.0, 0.0));
+    let forward = (cam.target - cam.position).normalize();
+    assert!(
+        (forward - DVec3::NEG_X).length() < 1e-12,
+        "−Z turned a quarter about Y: {forward}"
+    );
+    assert!((cam.up - DVec3::Y).length() < 1e-12);
+    match cam.projection {
+        scene::Projection::Perspective {
+            fov_y_deg,
+            near,
+            far,
+        } => {
+            assert!((fov_y_deg - 0.7f32.to_degrees() as f64).abs() < 1e-4);
+            assert_eq!(near, 0.05f32 as f64);
+            assert!(far.is_infinite(), "no zfar: an infinite far plane");
+        }
+        p => panic!("{p:?}"),
+    }
+    let ortho = doc(json!({"type": "orthographic",
+        "orthographic": {"xmag": 3, "ymag": 2, "znear": 0.5, "zfar": 40}}));
+    let path = write(dir.path(), "ortho.gltf", b.gltf(ortho));
+    let (scene, _) = load(&path).unwrap();
+    assert_eq!(
+        scene.camera.projection,
+        scene::Projection::Orthographic {
+            height: 4.0,
+            near: 0.5,
+            far: 40.0
+        }
+    );
+    // No camera: framed on the bounds as for OBJ.
+    let mut none = doc(json!({"type": "perspective", "perspective": {"yfov": 0.7, "znear": 0.05}}));
+    none["nodes"] = json!([{"mesh": 0}]);
+    none["scenes"] = json!([{"nodes": [0]}]);
+    none.as_object_mut().unwrap().remove("cameras");
+    let path = write(dir.path(), "framed.gltf", b.gltf(none));
+    let (mut scene, _) = load(&path).unwrap();
+    let camera = scene.camera;
+    scene.frame_camera();
+    assert_eq!(camera, scene.camera);
+}
+
+/// The comparison scene: a textured floor, a red wall placed through a parent node, a
+/// half-transparent blue pane (BLEND), a point and a spot light and a camera.
+struct Comparison {
+    gltf: Value,
+    builder: Builder,
+    json: Value,
+}
+
+fn comparison(dir: &Path) -> Comparison {
+    let png = checker_png();
+    write(dir, "checker.png", &png);
+    let mut b = Builder::default();
+    let floor_prim = b.primitive(&floor(), Some(0));
+    let wall_prim = b.primitive(&pane(2.0, 1.5), Some(1));
+    let glass_prim = b.primitive(&pane(1.0, 1.0), Some(2));
+    let image_view = b.view(&png);
+    let wall_turn = DQuat::from_rotation_y(30f64.to_radians());
+    let spot_turn = DQuat::from_rotation_x(-std::f64::consts::FRAC_PI_2);
+    let cam_turn = DQuat::from_rotation_x(-20f64.to_radians());
+    let gltf = json!({
+        "extensionsUsed": ["KHR_lights_punctual"],
+        "extensions": {"KHR_lights_punctual": {"lights": [
+            {"type": "point", "color": [1, 0.9, 0.8], "intensity": 8, "range": 6},
+            {"type": "spot", "intensity": 12, "range": 8,
+             "spot": {"innerConeAngle": 0.3, "outerConeAngle": 0.6}}
+        ]}},
+        "scene": 0,
+        "scenes": [{"nodes": [0, 1, 3, 4, 5, 6]}],
+        "nodes": [
+            {"mesh": 0},
+            {"translation": [0, 0.5, 0], "children": [2]},
+            {"mesh": 1, "translation": [0.5, 0, -1], "rotation": quat(wall_turn), "scale": [0.8, 0.8, 0.8]},
+            {"mesh": 2, "translation": [0, 0.6, 2.2]},
+            {"translation": [-1, 1.2, 0.5], "extensions": {"KHR_lights_punctual": {"light": 0}}},
+            {"translation": [1.2, 2.5, 0.5], "rotation": quat(spot_turn),
+             "extensions": {"KHR_lights_punctual": {"light": 1}}},
+            {"camera": 0, "translation": [0, 2, 5], "rotation": quat(cam_turn)}
+        ],
+        "cameras": [{"type": "perspective", "perspective": {"yfov": 0.9, "znear": 0.05, "zfar": 50}}],
+        "meshes": [{"primitives": [floor_prim]}, {"primitives": [wall_prim]}, {"primitives": [glass_prim]}],
+        "materials": [
+            {"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}},
+            {"pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.1, 0.1, 1]}},
+            {"alphaMode": "BLEND", "pbrMetallicRoughness": {"baseColorFactor": [0.1, 0.2, 0.9, 0.5]}}
+        ],
+        "textures": [{"source": 0}],
+        "images": [{"bufferView": image_view, "mimeType": "image/png"}],
+    });
+    // The same as OBJ files and a JSON scene.
+    write(dir, "floor.obj", quad_obj(&floor(), "floor"));
+    write(dir, "wall.obj", quad_obj(&pane(2.0, 1.5), "wall"));
+    write(dir, "glass.obj", quad_obj(&pane(1.0, 1.0), "glass"));
+    write(
+        dir,
+        "floor.mtl",
+        "newmtl floor\nKd 1 1 1\nKs 0.04 0.04 0.04\nNs 0\nmap_Kd checker.png\n",
+    );
+    write(
+        dir,
+        "wall.mtl",
+        "newmtl wall\nKd 0.8 0.1 0.1\nKs 0.04 0.04 0.04\nNs 0\n",
+    );
+    write(
+        dir,
+        "glass.mtl",
+        "newmtl glass\nKd 0.1 0.2 0.9\nKs 0.04 0.04 0.04\nNs 0\nd 0.5\n",
+    );
+    let spot_dir = spot_turn * DVec3::NEG_Z;
+    let cam_pos = DVec3::new(0.0, 2.0, 5.0);
+    let json = json!({
+        "camera": {"position": cam_pos.to_array(), "target": (cam_pos + cam_turn * DVec3::NEG_Z).to_array(),
+                   "up": (cam_turn * DVec3::Y).to_array(), "fov_y_deg": (0.9f32 as f64).to_degrees(),
+                   "near": 0.05f32 as f64, "far": 50.0},
+        "objects": [
+            {"obj": "floor.obj"},
+            {"obj": "wall.obj", "transform": {"translate": [0.5, 0.5, -1], "rotate_y_deg": 30, "scale": 0.8}},
+            {"obj": "glass.obj", "transform": {"translate": [0, 0.6, 2.2]}}
+        ],
+        "lights": [
+            {"kind": "point", "position": [-1, 1.2, 0.5], "radius": 6, "color": [1, 0.9, 0.8], "intensity": 8},
+            {"kind": "spot", "position": [1.2, 2.5, 0.5], "radius": 8, "color": [1, 1, 1], "intensity": 12,
+             "direction": spot_dir.to_array(), "inner_deg": (0.3f32 as f64).to_degrees(),
+             "outer_deg": (0.6f32 as f64).to_degrees()}
+        ]
+    });
+    Comparison {
+        gltf,
+        builder: b,
+        json,
+    }
+}
+
+#[test]
+fn a_gltf_scene_renders_as_the_same_scene_written_as_json_and_obj() {
+    let dir = tempfile::tempdir().unwrap();
+    let c = comparison(dir.path());
+    let glb_path = write(dir.path(), "scene.glb", c.builder.glb(c.gltf.clone()));
+    let json_path = write(dir.path(), "scene.json", c.json.to_string());
+    let (from_gltf, report) = load(&glb_path).unwrap();
+    assert!(report.warnings.is_empty(), "{:?}", report.warnings);
+    let (from_json, _) = scene::load(json_path.to_str().unwrap(), None).unwrap();
+    let glass = from_gltf
+        .objects
+        .iter()
+        .map(|o| &from_gltf.materials[o.material])
+        .find(|m| m.is_transparent())
+        .expect("the BLEND material is transparent");
+    assert_eq!(glass.alpha, 0.5);
+    let mut gpu = Gpu::new(EsVersion::Es3);
+    for method in ["forward", "clustered"] {
+        gpu.r().set_method(method).unwrap();
+        let a = gpu.render(&from_gltf, 160, 96, &RenderOptions::default());
+        let b = gpu.render(&from_json, 160, 96, &RenderOptions::default());
+        let d = manylight::metrics::diff(&a, &b);
+        assert!(
+            d.max_abs <= 2,
+            "{method}: glTF and JSON/OBJ differ by {d:?}"
+        );
+        // Not a black frame: the comparison means something.
+        let lit = a.pixels().filter(|p| p[0].max(p[1]).max(p[2]) > 40).count();
+        assert!(lit > 160 * 96 / 6, "{method}: only {lit} lit pixels");
+    }
+}
+
+#[test]
+fn a_blend_material_is_drawn_through_the_transparent_path() {
+    let dir = tempfile::tempdir().unwrap();
+    let c = comparison(dir.path());
+    let path = write(dir.path(), "scene.gltf", c.builder.gltf(c.gltf.clone()));
+    let (scene, _) = load(&path).unwrap();
+    let glass = scene
+        .objects
+        .iter()
+        .position(|o| scene.materials[o.material].is_transparent())
+        .unwrap();
+    // Where the pane's centre lands on screen.
+    let (w, h) = (160u32, 96u32);
+    let centre = scene.objects[glass]
+        .transform
+        .transform_point3(DVec3::new(0.0, 0.5, 0.0));
+    let clip = scene.camera.projection_matrix(w as f64 / h as f64)
+        * scene.camera.view_matrix()
+        * centre.extend(1.0);
+    let (x, y) = (clip.x / clip.w, clip.y / clip.w);
+    let (px, py) = (
+        ((x + 1.0) / 2.0 * w as f64) as u32,
+        ((1.0 - y) / 2.0 * h as f64) as u32,
+    );
+    let mut gpu = Gpu::new(EsVersion::Es3);
+    let opts = RenderOptions::default();
+    let blended = *gpu.render(&scene, w, h, &opts).get_pixel(px, py);
+    let mut opaque = scene.clone();
+    let m = opaque.objects[glass].material;
+    opaque.materials[m].alpha = 1.0;
+    let solid = *gpu.render(&opaque, w, h, &opts).get_pixel(px, py);
+    let mut without = scene.clone();
+    without.objects.remove(glass);
+    let behind = *gpu.render(&without, w, h, &opts).get_pixel(px, py);
+    assert_ne!(blended, solid, "alpha 0.5 is not drawn opaque");
+    assert_ne!(blended, behind, "the pane is drawn");
+    // Blue pane over what is behind: bluer than behind, less blue than the solid pane.
+    for c in 0..3 {
+        let (lo, hi) = (solid[c].min(behind[c]), solid[c].max(behind[c]));
+        assert!(
+            blended[c] + 2 >= lo && blended[c] <= hi + 2,
+            "channel {c}: {blended:?} not between {solid:?} and {behind:?}"
+        );
+    }
+}
+
+#[test]
+fn a_mask_material_below_its_cutoff_is_invisible_and_above_is_opaque() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut b = Builder::default();
+    let prim = b.primitive(&floor(), Some(0));
+    let prim2 = b.primitive(&floor(), Some(1));
+    let doc = json!({
+        "scenes": [{"nodes": [0, 1]}], "nodes": [{"mesh": 0}, {"mesh": 1}],
+        "meshes": [{"primitives": [prim]}, {"primitives": [prim2]}],
+        "materials": [
+            {"alphaMode": "MASK", "alphaCutoff": 0.6, "pbrMetallicRoughness": {"baseColorFactor": [1, 1, 1, 0.5]}},
+            {"alphaMode": "MASK", "pbrMetallicRoughness": {"baseColorFactor": [1, 1, 1, 0.5]}}
+        ],
+    });
+    let path = write(dir.path(), "mask.gltf", b.gltf(doc));
+    let (scene, _) = load(&path).unwrap();
+    let alphas: Vec<f32> = scene
+        .objects
+        .iter()
+        .map(|o| scene.materials[o.material].alpha)
+        .collect();
+    assert_eq!(alphas, [0.0, 1.0]);
+}
+
+/// A minimal valid triangle, for the malformed variants below.
+fn triangle(b: &mut Builder) -> Value {
+    let p = b.floats(&[0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0], "VEC3");
+    let i = b.u16s(&[0, 1, 2]);
+    json!({"scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+           "meshes": [{"primitives": [{"attributes": {"POSITION": p}, "indices": i}]}]})
+}
+
+#[test]
+fn malformed_files_are_errors_naming_the_file_and_what_is_wrong() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut cases: Vec<(&str, Vec<u8>, Vec<&str>)> = Vec::new();
+    // Truncated GLB.
+    {
+        let mut b = Builder::default();
+        let doc = triangle(&mut b);
+        let full = b.glb(doc);
+        cases.push((
+            "truncated.glb",
+            full[..full.len() / 2].to_vec(),
+            vec!["truncated GLB"],
+        ));
+        cases.push((
+            "header.glb",
+            full[..10].to_vec(),
+            vec!["truncated GLB", "header"],
+        ));
+    }
+    // Index out of range.
+    {
+        let mut b = Builder::default();
+        let p = b.floats(&[0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0], "VEC3");
+        let i = b.u16s(&[0, 1, 9]);
+        let doc = json!({"scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+            "meshes": [{"primitives": [{"attributes": {"POSITION": p}, "indices": i}]}]});
+        cases.push((
+            "index.gltf",
+            b.gltf(doc).into_bytes(),
+            vec![
+                "meshes[0].primitives[0].indices",
+                "is 9, out of range for 3 vertices",
+            ],
+        ));
+    }
+    // An accessor past the end of its buffer view; a view past its buffer.
+    {
+        let mut b = Builder::default();
+        let mut doc = triangle(&mut b);
+        b.accessors[0]["count"] = json!(100);
+        cases.push((
+            "accessor.gltf",
+            b.gltf(doc.clone()).into_bytes(),
+            vec!["POSITION (accessors[0])", "past the end of bufferViews[0]"],
+        ));
+        b.accessors[0]["count"] = json!(3);
+        b.views[1]["byteLength"] = json!(4000);
+        b.accessors[1]["count"] = json!(3);
+        doc["meshes"][0]["primitives"][0]["indices"] = json!(1);
+        cases.push((
+            "view.gltf",
+            b.gltf(doc).into_bytes(),
+            vec!["bufferViews[1]", "past the end of buffers[0]"],
+        ));
+    }
+    // A node cycle, and a node with two parents.
+    {
+        let mut b = Builder::default();
+        let mut doc = triangle(&mut b);
+        doc["nodes"] = json!([{"children": [1]}, {"children": [2]}, {"mesh": 0, "children": [0]}]);
+        cases.push((
+            "cycle.gltf",
+            b.gltf(doc.clone()).into_bytes(),
+            vec!["nodes[0]", "cycle"],
+        ));
+        doc["nodes"] = json!([{"children": [2]}, {"children": [2]}, {"mesh": 0}]);
+        doc["scenes"] = json!([{"nodes": [0, 1]}]);
+        cases.push((
+            "parents.gltf",
+            b.gltf(doc).into_bytes(),
+            vec!["nodes[2]", "one parent"],
+        ));
+    }
+    // A NaN position.
+    {
+        let mut b = Builder::default();
+        let p = b.floats(&[0.0, 0.0, 0.0, f32::NAN, 0.0, 0.0, 0.0, 1.0, 0.0], "VEC3");
+        let doc = json!({"scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+            "meshes": [{"primitives": [{"attributes": {"POSITION": p}}]}]});
+        cases.push((
+            "nan.gltf",
+            b.gltf(doc).into_bytes(),
+            vec![
+                "meshes[0].primitives[0].attributes.POSITION",
+                "element 1",
+                "finite",
+            ],
+        ));
+    }
+    // A huge position (past the object-space limit).
+    {
+        let mut b = Builder::default();
+        let p = b.floats(&[0.0, 0.0, 0.0, 3e30, 0.0, 0.0, 0.0, 1.0, 0.0], "VEC3");
+        let doc = json!({"scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+            "meshes": [{"primitives": [{"attributes": {"POSITION": p}}]}]});
+        cases.push((
+            "huge.gltf",
+            b.gltf(doc).into_bytes(),
+            vec!["POSITION", "element 1", "past"],
+        ));
+    }
+    // A missing buffer file.
+    {
+        let mut b = Builder::default();
+        let doc = triangle(&mut b);
+        let mut doc = b.document(doc, Some("missing.bin".into()));
+        doc["asset"] = json!({"version": "2.0"});
+        cases.push((
+            "nobuffer.gltf",
+            doc.to_string().into_bytes(),
+            vec!["buffers[0]", "missing.bin"],
+        ));
+    }
+    // A huge count, with no buffer view behind it (all zeros): refused before allocating.
+    {
+        let mut b = Builder::default();
+        let doc = triangle(&mut b);
+        b.accessors[0]["count"] = json!(4_000_000_000u64);
+        cases.push((
+            "count.gltf",
+            b.gltf(doc).into_bytes(),
+            vec!["accessors[0]", "4000000000", "limit"],
+        ));
+    }
+    // Node transforms, lights, structure.
+    {
+        let mut b = Builder::default();
+        let mut doc = triangle(&mut b);
+        doc["nodes"][0]["scale"] = json!([1e300, 1e300, 1e300]);
+        cases.push((
+            "scale.gltf",
+            b.gltf(doc.clone()).into_bytes(),
+            vec!["nodes[0]", "bounds"],
+        ));
+        doc["nodes"][0] = json!({"mesh": 0, "rotation": [0, 0, 0, 0]});
+        cases.push((
+            "rotation.gltf",
+            b.gltf(doc.clone()).into_bytes(),
+            vec!["nodes[0].rotation"],
+        ));
+        doc["nodes"][0] = json!({"mesh": 0, "extensions": {"KHR_lights_punctual": {"light": 0}}});
+        doc["extensions"] = json!({"KHR_lights_punctual": {"lights": [
+            {"type": "spot", "spot": {"innerConeAngle": 0.7, "outerConeAngle": 0.2}}]}});
+        cases.push((
+            "cone.gltf",
+            b.gltf(doc.clone()).into_bytes(),
+            vec!["lights[0]", "outer_deg"],
+        ));
+        doc.as_object_mut().unwrap().remove("extensions");
+        doc["nodes"][0] = json!({"mesh": 0});
+        doc["extensionsRequired"] = json!(["KHR_draco_mesh_compression"]);
+        cases.push((
+            "draco.gltf",
+            b.gltf(doc.clone()).into_bytes(),
+            vec!["extensionsRequired"],
+        ));
+        doc.as_object_mut().unwrap().remove("extensionsRequired");
+        doc["nodes"] = json!([{}]);
+        cases.push((
+            "empty.gltf",
+            b.gltf(doc.clone()).into_bytes(),
+            vec!["nothing to show"],
+        ));
+        doc["nodes"] = json!([{"mesh": 7}]);
+        cases.push((
+            "dangling.gltf",
+            b.gltf(doc).into_bytes(),
+            vec!["nodes[0].mesh"],
+        ));
+    }
+    {
+        let mut b = Builder::default();
+        let doc = triangle(&mut b);
+        let mut doc = b.document(
+            doc,
+            Some("data:application/octet-stream;base64,AA*A".into()),
+        );
+        doc["asset"] = json!({"version": "2.0"});
+        cases.push((
+            "base64.gltf",
+            doc.to_string().into_bytes(),
+            vec!["buffers[0].uri", "base64"],
+        ));
+    }
+    cases.push(("json.gltf", b"{\"asset\": ".to_vec(), vec!["JSON"]));
+    for (name, bytes, needles) in cases {
+        let path = write(dir.path(), name, &bytes);
+        let err = match load(&path) {
+            Ok(_) => panic!("{name} loaded"),
+            Err(e) => e.to_string(),
+        };
+        assert!(err.contains(name), "the error should name the file: {err}");
+        for needle in needles {
+            assert!(
+                err.contains(needle),
+                "{name}: expected `{needle}` in: {err}"
+            );
+        }
+    }
+}
+
+#[test]
+fn a_missing_texture_is_a_warning_and_the_flat_colour() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut b = Builder::default();
+    let prim = b.primitive(&floor(), Some(0));
+    let doc = json!({
+        "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+        "meshes": [{"primitives": [prim]}],
+        "materials": [{"name": "m", "pbrMetallicRoughness":
+            {"baseColorFactor": [0.2, 0.4, 0.6, 1], "baseColorTexture": {"index": 0}}}],
+        "textures": [{"source": 0}, {"source": 1}],
+        "images": [{"uri": "absent.png"}, {"uri": "data:image/png;base64,AAAA"}],
+    });
+    let path = write(dir.path(), "notex.gltf", b.gltf(doc.clone()));
+    let (scene, report) = load(&path).unwrap();
+    let m = &scene.materials[scene.objects[0].material];
+    assert!(m.diffuse_texture.is_none());
+    assert_eq!(m.diffuse, Vec3::new(0.2, 0.4, 0.6));
+    assert!(
+        report
+            .warnings
+            .iter()
+            .any(|w| w.contains("absent.png") && w.contains("flat colour")),
+        "{:?}",
+        report.warnings
+    );
+    // An image that does not decode: the same.
+    let mut doc = doc;
+    doc["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"]["index"] = json!(1);
+    let path = write(dir.path(), "badtex.gltf", b.gltf(doc));
+    let (_, report) = load(&path).unwrap();
+    assert!(
+        report
+            .warnings
+            .iter()
+            .any(|w| w.contains("could not be decoded")),
+        "{:?}",
+        report.warnings
+    );
+}
+
+#[test]
+fn indices_of_every_width_and_none_give_the_same_mesh() {
+    let dir = tempfile::tempdir().unwrap();
+    let corners = [
+        0.0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 1.0, 0.0,
+    ];
+    let list = [0u32, 1, 2, 0, 2, 3];
+    let mut meshes = Vec::new();
+    for width in [1, 2, 4, 0] {
+        let mut b = Builder::default();
+        let p = b.floats(&corners, "VEC3");
+        let n = b.floats(&[0.0, 0.0, 1.0].repeat(4), "VEC3");
+        let mut prim = json!({"attributes": {"POSITION": p, "NORMAL": n}});
+        if width > 0 {
+            let bytes: Vec<u8> = list
+                .iter()
+                .flat_map(|&i| i.to_le_bytes()[..width].to_vec())
+                .collect();
+            let component = [0, 5121, UNSIGNED_SHORT, 0, UNSIGNED_INT][width];
+            prim["indices"] = json!(b.accessor(&bytes, component, "SCALAR", list.len()));
+        } else {
+            // No indices: the vertices in order, two triangles' worth.
+            let p = b.floats(
+                &list
+                    .iter()
+                    .flat_map(|&i| corners[i as usize * 3..i as usize * 3 + 3].to_vec())
+                    .collect::<Vec<_>>(),
+                "VEC3",
+            );
+            let n = b.floats(&[0.0, 0.0, 1.0].repeat(6), "VEC3");
+            prim = json!({"attributes": {"POSITION": p, "NORMAL": n}});
+        }
+        let doc = json!({"scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+            "meshes": [{"primitives": [prim]}]});
+        let path = write(dir.path(), &format!("w{width}.gltf"), b.gltf(doc));
+        let (scene, _) = load(&path).unwrap();
+        let m = &scene.objects[0].mesh;
+        let triangles: Vec<[Vec3; 3]> = m
+            .indices
+            .chunks(3)
+            .map(|t| [0, 1, 2].map(|k| m.positions[t[k] as usize]))
+            .collect();
+        meshes.push(triangles);
+    }
+    assert!(meshes.windows(2).all(|w| w[0] == w[1]), "{meshes:?}");
+}
+
+#[test]
+fn an_external_buffer_file_and_a_sparse_accessor_are_read() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut b = Builder::default();
+    let p = b.floats(&[0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0], "VEC3");
+    // Sparse: vertex 2 replaced by (0, 5, 0).
+    let indices = b.view(&2u16.to_le_bytes());
+    let values = b.view(&[0.0f32, 5.0, 0.0].map(f32::to_le_bytes).concat());
+    b.accessors[p]["sparse"] = json!({"count": 1,
+        "indices": {"bufferView": indices, "componentType": UNSIGNED_SHORT},
+        "values": {"bufferView": values}});
+    // And a sparse accessor with no buffer view at all: zeros, then the substitution.
+    b.accessors
+        .push(json!({"componentType": FLOAT, "type": "VEC3", "count": 3,
+        "sparse": {"count": 1,
+            "indices": {"bufferView": indices, "componentType": UNSIGNED_SHORT},
+            "values": {"bufferView": values}}}));
+    let doc = json!({"scenes": [{"nodes": [0, 1]}], "nodes": [{"mesh": 0}, {"mesh": 1}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": p}}]},
+                   {"primitives": [{"attributes": {"POSITION": 1 + p}}]}]});
+    std::fs::write(dir.path().join("mesh data.bin"), &b.bin).unwrap();
+    let path = write(
+        dir.path(),
+        "external.gltf",
+        b.document(doc, Some("mesh%20data.bin".into())).to_string(),
+    );
+    let (scene, _) = load(&path).unwrap();
+    // Flat normals: the triangle's three vertices in order.
+    assert_eq!(
+        scene.objects[0].mesh.positions,
+        [Vec3::ZERO, Vec3::X, Vec3::new(0.0, 5.0, 0.0)]
+    );
+    assert_eq!(
+        scene.objects[1].mesh.positions,
+        [Vec3::ZERO, Vec3::ZERO, Vec3::new(0.0, 5.0, 0.0)]
+    );
+    // A sparse index past the accessor's count is an error naming it.
+    b.views[indices]["byteLength"] = json!(2);
+    let bad_index = b.view(&7u16.to_le_bytes());
+    b.accessors[p]["sparse"]["indices"]["bufferView"] = json!(bad_index);
+    std::fs::write(dir.path().join("mesh data.bin"), &b.bin).unwrap();
+    let doc = json!({"scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": p}}]}]});
+    let path = write(
+        dir.path(),
+        "sparse.gltf",
+        b.document(doc, Some("mesh%20data.bin".into())).to_string(),
+    );
+    let err = load(&path).unwrap_err().to_string();
+    assert!(
+        err.contains("accessors[0].sparse.indices") && err.contains("is 7, out of range"),
+        "{err}"
+    );
+}
