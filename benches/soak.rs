@@ -1,6 +1,7 @@
 //! Soak: many frames per method with moving lights, resident memory sampled as it goes, to
-//! show that memory stays flat. `cargo bench --bench soak -- [FRAMES] [WxH] [LIGHTS] [METHOD]`
-//! (default 2 000 frames at 160x90, the courtyard with 256 lights, every method, ES 3.0).
+//! show that memory stays flat, and the mean frame time after the first 100 frames.
+//! `cargo bench --bench soak -- [FRAMES] [WxH] [LIGHTS] [METHOD]` (default 2 000 frames at
+//! 160x90, the courtyard with 256 lights, every method, ES 3.0).
 
 use glam::DVec3;
 use manylight::gl::HeadlessContext;
@@ -36,7 +37,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut scene = scene::builtin::build("courtyard", Some((lights, 7)))?;
     let start: Vec<DVec3> = scene.lights.iter().map(|l| l.position).collect();
     let options = RenderOptions::default();
-    println!("method     frames  RSS (MiB) after 100 frames, then every quarter      growth");
+    println!(
+        "method     frames  RSS (MiB) after 100 frames, then every quarter      growth  ms/frame"
+    );
     let methods = METHODS
         .iter()
         .map(|m| m.name)
@@ -45,13 +48,19 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         renderer.set_method(method)?;
         let mut after_warmup = 0.0;
         let mut samples = Vec::new();
+        let (mut timed, mut timed_frames) = (std::time::Duration::ZERO, 0u32);
         for frame in 0..frames {
             let t = frame as f64 / 30.0;
             for (i, (light, origin)) in scene.lights.iter_mut().zip(&start).enumerate() {
                 let a = t + i as f64;
                 light.position = *origin + DVec3::new(a.cos(), 0.0, a.sin());
             }
+            let started = std::time::Instant::now();
             renderer.render_offscreen(&scene, w, h, &options)?;
+            if frame >= 100.min(frames - 1) {
+                timed += started.elapsed();
+                timed_frames += 1;
+            }
             if frame + 1 == 100.min(frames) {
                 after_warmup = rss_mib();
             }
@@ -61,9 +70,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }
         let end = rss_mib();
         println!(
-            "{method:10} {frames:6}  {after_warmup:6.1} | {:40} {:+.1}",
+            "{method:10} {frames:6}  {after_warmup:6.1} | {:40} {:+.1}  {:8.3}",
             samples.join(" "),
-            end - after_warmup
+            end - after_warmup,
+            timed.as_secs_f64() * 1e3 / f64::from(timed_frames.max(1))
         );
     }
     renderer.destroy();

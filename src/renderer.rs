@@ -101,6 +101,86 @@ pub struct FrameStats {
     pub upload_bytes_spread: Option<Spread>,
 }
 
+impl Default for FrameStats {
+    /// Empty figures: what [`Renderer::render_reusing`] fills in (a game keeps one and passes
+    /// it every frame).
+    fn default() -> Self {
+        FrameStats {
+            method: String::new(),
+            es: EsVersion::Es3,
+            gl_version: String::new(),
+            renderer: String::new(),
+            width: 0,
+            height: 0,
+            lights: 0,
+            active_lights: 0,
+            frame_ms: 0.0,
+            gpu_ms: None,
+            upload_bytes: 0,
+            assign_ms: 0.0,
+            clusters: 0,
+            nonempty_clusters: 0,
+            avg_lights_per_nonempty: 0.0,
+            max_lights_per_cluster: 0,
+            overflowed_lights: 0,
+            visible_lights: 0,
+            light_encoding: crate::cluster::pack::LightEncoding::Float32,
+            support: Support::Supported,
+            triangles: 0,
+            method_gpu_bytes: 0,
+            gbuffer_bytes: 0,
+            auto_choice: None,
+            auto_reason: None,
+            lp_num_threads: None,
+            scene_features: SceneFeatures::default(),
+            grid_footprint_px: None,
+            grid_cells: 0,
+            grid_reason: None,
+            frame_ms_spread: None,
+            assign_ms_spread: None,
+            samples: 1,
+            msaa_bytes: 0,
+            upload_bytes_spread: None,
+        }
+    }
+}
+
+/// Copies `src` into `dst`, keeping `dst`'s buffer: no allocation unless `src` is longer than
+/// any text `dst` held before (and then room for half as much again, so a reason a few digits
+/// longer next frame fits).
+fn copy_str(dst: &mut String, src: &str) {
+    if dst.as_str() != src {
+        dst.clear();
+        if dst.capacity() < src.len() {
+            dst.reserve(src.len() + src.len() / 2);
+        }
+        dst.push_str(src);
+    }
+}
+
+/// [`copy_str`] for optional texts (`None` frees the buffer).
+fn copy_opt_str(dst: &mut Option<String>, src: Option<&str>) {
+    match (dst.as_mut(), src) {
+        (Some(d), Some(s)) => copy_str(d, s),
+        (None, Some(s)) => {
+            let mut d = String::new();
+            copy_str(&mut d, s);
+            *dst = Some(d);
+        }
+        (_, None) => *dst = None,
+    }
+}
+
+/// [`copy_str`] for a support status.
+fn copy_support(dst: &mut Support, src: &Support) {
+    match (&mut *dst, src) {
+        (Support::Supported, Support::Supported) => {}
+        (Support::Fallback(d), Support::Fallback(s))
+        | (Support::Unsupported(d), Support::Unsupported(s)) => copy_str(d, s),
+        _ => *dst = src.clone(),
+    }
+}
+
 /// Renders scenes with one shading method at a time.
 pub struct Renderer {
     dev: Device,
@@ -119,6 +199,13 @@ pub struct Renderer {
     pending_warning: Option<String>,
     /// GL objects already freed (by `destroy`; dropping then does nothing more).
     freed: bool,
+    /// The frame's active lights in view space (kept: a frame fills it without allocating).
+    lights: Vec<GpuLight>,
+    /// The frame's objects in draw order (kept likewise).
+    draw_order: methods::geometry::DrawOrder,
+    /// `LP_NUM_THREADS` when the renderer was made (llvmpipe reads it when the context is
+    /// made; reading it every frame would allocate).
+    lp_num_threads: Option<String>,
 }
 
 impl Renderer {
@@ -167,6 +254,9 @@ impl Renderer {
             timer: None,
             pending_warning,
             freed: false,
+            lights: Vec::new(),
+            draw_order: methods::geometry::DrawOrder::default(),
+            lp_num_threads: std::env::var("LP_NUM_THREADS").ok(),
         })
     }
 
@@ -239,6 +329,10 @@ impl Renderer {
     /// (for embedding: a game binds its own target or the default framebuffer first). With
     /// `options.samples` > 1 the frame is drawn into the renderer's own multisampled target
     /// and resolved into the bound framebuffer, which must then be RGBA8 of that size.
+    ///
+    /// The returned stats own their texts (method, GL strings, reasons): in steady state they
+    /// are all the renderer allocates for a frame. A game's per-frame loop calls
+    /// [`Renderer::render_reusing`] instead, which allocates nothing.
     pub fn render(
         &mut self,
         scene: &Scene,
@@ -246,6 +340,25 @@ impl Renderer {
         height: u32,
         options: &RenderOptions,
     ) -> Result<FrameStats, Error> {
+        let mut stats = FrameStats::default();
+        self.render_reusing(scene, width, height, options, &mut stats)?;
+        Ok(stats)
+    }
+
+    /// [`Renderer::render`], writing the frame's figures into `stats` and reusing its
+    /// strings. In steady state (the same method and scene shape for a few frames: shaders
+    /// built, buffers grown) the renderer makes no heap allocation for a frame, lights moving
+    /// or not (`tests/soak.rs` counts them; what still allocates, the automatic grid's
+    /// periodic re-choice, is listed in docs/performance.md). Keep one `FrameStats` and pass it every frame. After an error,
+    /// `stats` holds no meaningful figures.
+    pub fn render_reusing(
+        &mut self,
+        scene: &Scene,
+        width: u32,
+        height: u32,
+        options: &RenderOptions,
+        stats: &mut FrameStats,
+    ) -> Result<(), Error> {
         // Light counts are exact per pixel: never averaged over samples.
         let samples = if options.count == CountKind::None {
             options.samples.max(1)
@@ -253,7 +366,7 @@ impl Renderer {
             1
         };
         if samples <= 1 {
-            return self.render_frame(scene, width, height, options);
+            return self.render_frame(scene, width, height, options, stats);
         }
         if width == 0 || height == 0 {
             return Err(Error::Limit(format!("viewport {width}×{height} is empty")));
@@ -270,14 +383,14 @@ impl Renderer {
         prepared?;
         let msaa = self.msaa.as_ref().expect("created by prepare_msaa");
         msaa.bind(&self.dev);
-        let stats = self.render_frame(scene, width, height, options);
+        let rendered = self.render_frame(scene, width, height, options, stats);
         let msaa = self.msaa.as_ref().expect("created by prepare_msaa");
-        match stats {
-            Ok(mut stats) => {
+        match rendered {
+            Ok(()) => {
                 msaa.resolve(&self.dev, destination)?;
                 stats.samples = samples;
                 stats.msaa_bytes = msaa.gpu_bytes();
-                Ok(stats)
+                Ok(())
             }
             // A failed frame is not resolved over the caller's picture.
             Err(e) => {
@@ -287,15 +400,17 @@ impl Renderer {
         }
     }
 
-    /// One frame into the bound framebuffer (see [`Renderer::render`]).
+    /// One frame into the bound framebuffer (see [`Renderer::render_reusing`]).
     fn render_frame(
         &mut self,
         scene: &Scene,
         width: u32,
         height: u32,
         options: &RenderOptions,
-    ) -> Result<FrameStats, Error> {
+        stats: &mut FrameStats,
+    ) -> Result<(), Error> {
         let start = Instant::now();
+        let method_name = self.method.name();
         if let Some(warning) = self.pending_warning.take() {
             log::warn!("{warning}");
         }
@@ -317,11 +432,9 @@ impl Renderer {
             .camera
             .projection_matrix(width as f64 / height as f64)
             .as_mat4();
-        let lights: Vec<GpuLight> = scene
-            .lights
-            .iter()
-            .filter(|l| l.is_active())
-            .map(|l| {
+        self.lights.clear();
+        self.lights
+            .extend(scene.lights.iter().filter(|l| l.is_active()).map(|l| {
                 let mut g = GpuLight::from_light(l, &view);
                 if let Some(cutoff) = options.light_cutoff {
                     g.cull_radius = crate::scene::shading::cutoff_distance(
@@ -331,8 +444,7 @@ impl Renderer {
                     ) as f32;
                 }
                 g
-            })
-            .collect();
+            }));
         let scene_features = SceneFeatures::of(scene);
         let features = ShaderFeatures::default()
             .with(
@@ -389,13 +501,15 @@ impl Renderer {
             view,
             projection,
             orthographic: matches!(scene.camera.projection, Projection::Orthographic { .. }),
-            lights: &lights,
+            lights: &self.lights,
             features,
             viewport: (width, height),
             near,
             far,
             content_far,
             options,
+            order: &mut self.draw_order,
+            transparent_only: false,
         };
         // GPU time only where the frame waits anyway: reading the query result stalls.
         let timer = if options.wait_for_gpu {
@@ -411,7 +525,7 @@ impl Renderer {
         }
         // No lights: no assignment, no uploads, the light loop compiled out — whatever the
         // method (a scene pays only for what it has).
-        let rendered = if lights.is_empty() {
+        let rendered = if self.lights.is_empty() {
             methods::geometry::draw_ambient_only(&mut ctx)
         } else {
             self.method.render(&mut ctx)
@@ -425,57 +539,59 @@ impl Renderer {
         }
         self.dev.check("frame")?;
         let frame_ms = start.elapsed().as_secs_f64() * 1e3;
+        let caps = self.dev.caps();
+        let assign = method_stats.assign.unwrap_or(AssignStats::default());
+        let grid = method_stats.grid.as_ref();
+        copy_str(&mut stats.method, method_name);
+        stats.es = caps.es;
+        copy_str(&mut stats.gl_version, &caps.gl_version);
+        copy_str(&mut stats.renderer, &caps.renderer);
+        stats.width = width;
+        stats.height = height;
+        stats.lights = scene.lights.len();
+        stats.active_lights = self.lights.len();
+        stats.frame_ms = frame_ms;
+        stats.gpu_ms = gpu_ms;
+        stats.upload_bytes = method_stats.upload_bytes;
+        stats.assign_ms = method_stats.assign_ms.unwrap_or(0.0);
+        stats.clusters = assign.clusters;
+        stats.nonempty_clusters = assign.nonempty_clusters;
+        stats.avg_lights_per_nonempty = assign.avg_lights_per_nonempty;
+        stats.max_lights_per_cluster = assign.max_lights_per_cluster;
+        stats.overflowed_lights = assign.overflowed_lights + method_stats.dropped_lights;
+        stats.visible_lights = method_stats
+            .assign
+            .map_or(self.lights.len(), |a| a.visible_lights);
+        stats.light_encoding = features.light_encoding();
+        copy_support(&mut stats.support, &self.support);
+        stats.triangles = scene.objects.iter().map(|o| o.mesh.triangle_count()).sum();
+        stats.gbuffer_bytes = method_stats.gbuffer_bytes;
+        copy_opt_str(
+            &mut stats.auto_choice,
+            method_stats.auto_choice.map(|(c, _)| c),
+        );
+        copy_opt_str(
+            &mut stats.auto_reason,
+            method_stats.auto_choice.map(|(_, r)| r),
+        );
+        copy_opt_str(&mut stats.lp_num_threads, self.lp_num_threads.as_deref());
+        stats.scene_features = scene_features;
+        stats.grid_footprint_px = grid.map(|g| g.footprint_px);
+        stats.grid_cells = grid.map_or(0, |g| g.cells);
+        copy_opt_str(&mut stats.grid_reason, grid.map(|g| g.reason));
+        stats.samples = 1;
+        stats.msaa_bytes = 0;
+        stats.upload_bytes_spread = None;
+        stats.frame_ms_spread = None;
+        stats.assign_ms_spread = None;
         // Only colour frames that waited for the GPU (or were timed on it) say what shading
         // costs: count passes run other shaders.
         if options.count == CountKind::None {
             let waited = options.wait_for_gpu.then_some(frame_ms);
             self.method.observe_frame(waited, gpu_ms);
         }
-        let grid = method_stats.grid.clone();
-        let caps = self.dev.caps();
-        let assign = method_stats.assign.unwrap_or(AssignStats::default());
-        Ok(FrameStats {
-            method: self.method.name().to_string(),
-            es: caps.es,
-            gl_version: caps.gl_version.clone(),
-            renderer: caps.renderer.clone(),
-            width,
-            height,
-            lights: scene.lights.len(),
-            active_lights: lights.len(),
-            frame_ms,
-            gpu_ms,
-            upload_bytes: method_stats.upload_bytes,
-            assign_ms: method_stats.assign_ms.unwrap_or(0.0),
-            clusters: assign.clusters,
-            nonempty_clusters: assign.nonempty_clusters,
-            avg_lights_per_nonempty: assign.avg_lights_per_nonempty,
-            max_lights_per_cluster: assign.max_lights_per_cluster,
-            overflowed_lights: assign.overflowed_lights + method_stats.dropped_lights,
-            visible_lights: method_stats
-                .assign
-                .map_or(lights.len(), |a| a.visible_lights),
-            light_encoding: features.light_encoding(),
-            support: self.support.clone(),
-            triangles: scene.objects.iter().map(|o| o.mesh.triangle_count()).sum(),
-            method_gpu_bytes: self.method.gpu_bytes(),
-            gbuffer_bytes: method_stats.gbuffer_bytes,
-            auto_choice: method_stats
-                .auto_choice
-                .as_ref()
-                .map(|(c, _)| c.to_string()),
-            auto_reason: method_stats.auto_choice.map(|(_, r)| r),
-            lp_num_threads: std::env::var("LP_NUM_THREADS").ok(),
-            scene_features,
-            grid_footprint_px: grid.as_ref().map(|g| g.footprint_px),
-            grid_cells: grid.as_ref().map_or(0, |g| g.cells),
-            grid_reason: grid.map(|g| g.reason),
-            samples: 1,
-            msaa_bytes: 0,
-            upload_bytes_spread: None,
-            frame_ms_spread: None,
-            assign_ms_spread: None,
-        })
+        stats.method_gpu_bytes = self.method.gpu_bytes();
+        Ok(())
     }
 
     /// Renders into an internal `width × height` target and reads it back (top row first).

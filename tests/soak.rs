@@ -1,33 +1,95 @@
-//! Memory stays flat over many frames: with lights moving every frame, after a warm-up the
-//! renderer's live heap bytes (counted by this test binary's allocator) and its live GL objects
-//! do not grow, for every method. `cargo bench --bench soak` runs the long version (2 000
-//! frames a method, resident memory sampled; docs/performance.md has its figures).
+//! Memory over many frames, with lights moving every frame, for every method:
+//!
+//! * the renderer's live heap bytes (counted by this test binary's allocator) and its live GL
+//!   objects do not grow after a warm-up;
+//! * in steady state a frame allocates nothing: [`Renderer::render_reusing`] into a framebuffer
+//!   the test binds itself (a game's path) makes no heap allocation of its own over the
+//!   measured frames, on ES 3.0 and ES 2.0 contexts; [`Renderer::render`] makes exactly the
+//!   allocations of the strings in the `FrameStats` it returns besides. What `Scene::validate`
+//!   allocates (it runs every frame, and builds each light's and material's field name before
+//!   it knows whether there is an error to name) is counted separately and allowed for: that
+//!   is `src/scene`'s to fix, and once it allocates nothing the test demands zero outright.
+//!
+//! `cargo bench --bench soak` runs the long version (2 000 frames a method, resident memory
+//! sampled; docs/performance.md has its figures). To find an allocation that crept into the
+//! frame, run `MANYLIGHT_ALLOC_TRACE=TEXT cargo test --test soak -- --nocapture` (TEXT: part of
+//! the cases' names, as printed, e.g. `ES 3.0 courtyard 128`, or `all`): every allocation in
+//! those cases' `render_reusing` frames prints its backtrace (but `Scene::validate`'s).
 
 mod common;
 
 use std::alloc::{GlobalAlloc, Layout, System};
-use std::sync::atomic::{AtomicIsize, Ordering};
+use std::cell::Cell;
+use std::sync::atomic::{AtomicBool, AtomicIsize, AtomicUsize, Ordering};
+use std::sync::Mutex;
 
 use common::Gpu;
 use glam::DVec3;
-use manylight::methods::METHODS;
-use manylight::{scene, EsVersion, RenderOptions};
+use manylight::cluster::grid::GridConfig;
+use manylight::gl::framebuffer::OffscreenTarget;
+use manylight::gl::{Device, HeadlessContext, Restrictions};
+use manylight::methods::{Support, METHODS};
+use manylight::scene::Scene;
+use manylight::{scene, EsVersion, FrameStats, RenderOptions, Renderer};
 
-/// The system allocator, keeping a count of the bytes live.
+/// The system allocator, keeping a count of the bytes live and of the calls that allocate.
 struct Counting;
 
+/// Bytes allocated and not yet freed.
 static LIVE: AtomicIsize = AtomicIsize::new(0);
+/// `alloc`, `alloc_zeroed` and `realloc` calls of the frames: on the thread that renders them
+/// and on rayon's workers (not on the test harness's threads, which print results and start
+/// other tests meanwhile).
+static CALLS: AtomicUsize = AtomicUsize::new(0);
+/// While set, every counted call prints its backtrace.
+static TRACING: AtomicBool = AtomicBool::new(false);
+
+thread_local! {
+    /// This thread is printing a backtrace: what that allocates is neither counted nor traced.
+    static IN_TRACE: Cell<bool> = const { Cell::new(false) };
+    /// This thread renders the counted frames.
+    static RENDERS: Cell<bool> = const { Cell::new(false) };
+}
+
+fn count_call() {
+    if IN_TRACE.try_with(Cell::get).unwrap_or(true) {
+        return;
+    }
+    let renders = RENDERS.try_with(Cell::get).unwrap_or(false);
+    if !renders && rayon::current_thread_index().is_none() {
+        return;
+    }
+    CALLS.fetch_add(1, Ordering::Relaxed);
+    if TRACING.load(Ordering::Relaxed) {
+        IN_TRACE.with(|t| t.set(true));
+        let trace = std::backtrace::Backtrace::force_capture().to_string();
+        if !trace.contains("Scene::validate") {
+            eprintln!(
+                "allocation on thread {:?}:\n{trace}",
+                std::thread::current().name()
+            );
+        }
+        IN_TRACE.with(|t| t.set(false));
+    }
+}
 
 unsafe impl GlobalAlloc for Counting {
     unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        count_call();
         LIVE.fetch_add(layout.size() as isize, Ordering::Relaxed);
         unsafe { System.alloc(layout) }
+    }
+    unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
+        count_call();
+        LIVE.fetch_add(layout.size() as isize, Ordering::Relaxed);
+        unsafe { System.alloc_zeroed(layout) }
     }
     unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
         LIVE.fetch_sub(layout.size() as isize, Ordering::Relaxed);
         unsafe { System.dealloc(ptr, layout) }
     }
     unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        count_call();
         LIVE.fetch_add(
             new_size as isize - layout.size() as isize,
             Ordering::Relaxed,
@@ -39,8 +101,32 @@ unsafe impl GlobalAlloc for Counting {
 #[global_allocator]
 static ALLOCATOR: Counting = Counting;
 
+/// The counters are global: the tests of this file run one at a time.
+static SERIAL: Mutex<()> = Mutex::new(());
+
+fn serial() -> std::sync::MutexGuard<'static, ()> {
+    SERIAL.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// Moves every light in place along its own small orbit (nothing is allocated).
+fn move_lights(scene: &mut Scene, start: &[DVec3], frame: usize) {
+    let t = frame as f64 / 30.0;
+    for (i, (light, origin)) in scene.lights.iter_mut().zip(start).enumerate() {
+        let a = t * (1.0 + (i % 5) as f64) + i as f64;
+        light.position = *origin + DVec3::new(a.cos(), 0.2 * a.sin(), a.sin());
+    }
+}
+
+/// Sways the camera around `eye`, a whole sway every 38 frames (the grid's depth range, and so
+/// the grid, changes every frame).
+fn move_camera(scene: &mut Scene, eye: DVec3, frame: usize) {
+    let a = frame as f64 / 6.0;
+    scene.camera.position = eye + DVec3::new(0.6 * a.sin(), 0.2 * a.cos(), 0.4 * a.cos());
+}
+
 #[test]
 fn live_heap_and_gl_objects_stay_flat_over_frames_of_moving_lights() {
+    let _serial = serial();
     let mut gpu = Gpu::new(EsVersion::Es3);
     let mut scene = scene::builtin::build("courtyard", Some((128, 5))).unwrap();
     let start: Vec<DVec3> = scene.lights.iter().map(|l| l.position).collect();
@@ -50,11 +136,7 @@ fn live_heap_and_gl_objects_stay_flat_over_frames_of_moving_lights() {
         gpu.r().set_method(method).unwrap();
         let mut at_warm_up = None;
         for frame in 0..warm_up + measured {
-            let t = frame as f64 / 30.0;
-            for (i, (light, origin)) in scene.lights.iter_mut().zip(&start).enumerate() {
-                let a = t * (1.0 + (i % 5) as f64) + i as f64;
-                light.position = *origin + DVec3::new(a.cos(), 0.2 * a.sin(), a.sin());
-            }
+            move_lights(&mut scene, &start, frame);
             gpu.r()
                 .render_offscreen(&scene, 48, 27, &options)
                 .unwrap_or_else(|e| panic!("{method} frame {frame}: {e}"));
@@ -78,4 +160,328 @@ fn live_heap_and_gl_objects_stay_flat_over_frames_of_moving_lights() {
             heap_after - heap_before
         );
     }
+}
+
+/// Frames before counting: shaders built, buffers grown, the automatic grid chosen and
+/// calibrated, a whole sway of the moving camera seen.
+const WARM_UP: usize = 40;
+/// Frames counted with [`Renderer::render`], after the warm-up.
+const MEASURED_RENDER: usize = 10;
+/// Frames counted with [`Renderer::render_reusing`], after those. They end (frame 150) well
+/// before the automatic grid's periodic re-choice (240 frames after its calibrated choice at
+/// frame 5, with a still camera; every 30 frames once the view moves, so the moving-camera
+/// cases use a fixed grid): a frame that measures candidate grids allocates (the ray cast of
+/// its surface samples; see docs/performance.md).
+const MEASURED: usize = 100;
+
+/// Allocations `Renderer::render` makes for the `FrameStats` it returns: one per non-empty
+/// string in it.
+fn owned_strings(s: &FrameStats) -> usize {
+    let reason = match &s.support {
+        Support::Supported => None,
+        Support::Fallback(r) | Support::Unsupported(r) => Some(r),
+    };
+    [&s.method, &s.gl_version, &s.renderer]
+        .into_iter()
+        .chain(reason)
+        .chain(s.auto_choice.as_ref())
+        .chain(s.auto_reason.as_ref())
+        .chain(s.lp_num_threads.as_ref())
+        .chain(s.grid_reason.as_ref())
+        .filter(|s| !s.is_empty())
+        .count()
+}
+
+/// One workload of [`allocations_per_frame`].
+struct Case {
+    scene: &'static str,
+    lights: usize,
+    /// Whether frames wait for the GPU (a game's do not; the timer query and the automatic
+    /// grid's calibration run only when they do).
+    wait_for_gpu: bool,
+    /// Whether the camera moves too (with a fixed grid then, see [`MEASURED`]).
+    camera_moves: bool,
+    /// The methods (none named: all).
+    methods: &'static [&'static str],
+    /// Samples per pixel (MSAA above 1).
+    samples: u32,
+    /// Viewport (and the application's target).
+    size: (u32, u32),
+    /// Most lights a cell keeps (`RenderOptions::cell_cap`): the overflow policy's path.
+    cell_cap: Option<u32>,
+    /// Whether the assignment runs on all cores: then one allocation of rayon's injector is
+    /// allowed in every [`RAYON_INJECTOR_BLOCK`] frames.
+    parallel: bool,
+}
+
+/// A case with still camera, waiting for the GPU, every method, nothing allowed.
+const CASE: Case = Case {
+    scene: "courtyard",
+    lights: 128,
+    wait_for_gpu: true,
+    camera_moves: false,
+    methods: &[],
+    samples: 1,
+    size: (48, 27),
+    cell_cap: None,
+    parallel: false,
+};
+
+/// Jobs rayon's global injector holds per block: every this many entries into the pool from
+/// outside it (one per parallel assignment), it allocates a block.
+const RAYON_INJECTOR_BLOCK: usize = 63;
+
+/// The workloads of both ES versions.
+fn common_cases() -> Vec<Case> {
+    vec![
+        CASE,
+        Case {
+            wait_for_gpu: false,
+            ..CASE
+        },
+        // `auto` picks forward.
+        Case { lights: 16, ..CASE },
+        // Ambient only.
+        Case { lights: 0, ..CASE },
+        // Transparent objects, drawn back to front (deferred draws them with forward).
+        Case {
+            scene: "bubbles",
+            lights: 64,
+            ..CASE
+        },
+        Case {
+            wait_for_gpu: false,
+            camera_moves: true,
+            ..CASE
+        },
+        Case {
+            scene: "bubbles",
+            lights: 64,
+            wait_for_gpu: false,
+            camera_moves: true,
+            ..CASE
+        },
+        // Cells holding more lights than the cap: the overflow policy trims them.
+        Case {
+            wait_for_gpu: false,
+            cell_cap: Some(4),
+            methods: &["tiled", "clustered"],
+            ..CASE
+        },
+        // Enough lights for the assignment to run on all cores: one entry into rayon's pool a
+        // frame, and so one allocation of its injector every 63 frames (see
+        // RAYON_INJECTOR_BLOCK).
+        Case {
+            lights: 5000,
+            wait_for_gpu: false,
+            methods: &["clustered"],
+            parallel: true,
+            ..CASE
+        },
+    ]
+}
+
+/// Renders every method through `Renderer::render_reusing` and `Renderer::render` into a
+/// framebuffer the test made and bound (as a game does), lights moving every frame, and counts
+/// allocation calls per method after the warm-up. Returns the rows that allocated.
+fn allocations_per_frame(
+    es: EsVersion,
+    restrictions: &Restrictions,
+    cases: &[Case],
+) -> Vec<String> {
+    RENDERS.with(|r| r.set(true));
+    let ctx = HeadlessContext::new(es).unwrap_or_else(|e| {
+        panic!(
+            "no headless {es} context ({e}); install libegl1 libegl-mesa0 libgles2 libgl1-mesa-dri"
+        )
+    });
+    // The application's own GL objects, made with its own glow context on the same GL context.
+    let app = Device::new(ctx.load_gl(), es).expect("application device");
+    let mut renderer = Renderer::restricted(ctx.load_gl(), es, restrictions).expect("renderer");
+    let trace_cases = std::env::var("MANYLIGHT_ALLOC_TRACE").ok();
+    let mut failures = Vec::new();
+    for c in cases {
+        let &Case {
+            scene: name,
+            lights,
+            wait_for_gpu,
+            camera_moves,
+            methods: only,
+            samples,
+            size: (width, height),
+            cell_cap,
+            parallel,
+        } = c;
+        let mut target = OffscreenTarget::new(&app, width, height).expect("application target");
+        // Allocations allowed over `frames` frames.
+        let allowed = |frames: usize| {
+            if parallel {
+                frames.div_ceil(RAYON_INJECTOR_BLOCK) as i64
+            } else {
+                0
+            }
+        };
+        let mut scene = scene::builtin::build(name, Some((lights, 5))).unwrap();
+        let start: Vec<DVec3> = scene.lights.iter().map(|l| l.position).collect();
+        let eye = scene.camera.position;
+        let options = RenderOptions {
+            wait_for_gpu,
+            grid: if camera_moves {
+                GridConfig::fixed(32.0)
+            } else {
+                GridConfig::default()
+            },
+            samples,
+            cell_cap,
+            ..RenderOptions::default()
+        };
+        let methods = METHODS
+            .iter()
+            .map(|m| m.name)
+            .filter(|m| only.is_empty() || only.contains(m));
+        for method in methods {
+            let case = format!(
+                "{es}{} {name} {lights} lights wait_for_gpu={wait_for_gpu} \
+                 camera_moves={camera_moves} samples={samples} cell_cap={cell_cap:?} \
+                 {width}x{height} {method}",
+                if restrictions.no_fragment_highp {
+                    " without fragment highp"
+                } else {
+                    ""
+                }
+            );
+            if let Err(e) = renderer.set_method(method) {
+                assert!(
+                    matches!(
+                        (METHODS.iter().find(|m| m.name == method).unwrap().supported)(
+                            renderer.caps()
+                        ),
+                        Support::Unsupported(_)
+                    ),
+                    "{case}: {e}"
+                );
+                eprintln!("{case}: not supported here");
+                continue;
+            }
+            // Scene::validate's own allocations, allowed for in every frame (see the top).
+            let before = CALLS.load(Ordering::Relaxed);
+            scene.validate().unwrap();
+            let validate = CALLS.load(Ordering::Relaxed) - before;
+            let mut frame = 0;
+            let mut next_frame = |scene: &mut Scene| {
+                move_lights(scene, &start, frame);
+                if camera_moves {
+                    move_camera(scene, eye, frame);
+                }
+                frame += 1;
+                target.bind(&app);
+                frame
+            };
+            let mut stats = FrameStats::default();
+            for _ in 0..WARM_UP {
+                let frame = next_frame(&mut scene);
+                renderer
+                    .render_reusing(&scene, width, height, &options, &mut stats)
+                    .unwrap_or_else(|e| panic!("{case} frame {frame}: {e}"));
+            }
+            // `render` returns its stats by value: their strings are new each frame.
+            let mut expected = 0i64;
+            let before = CALLS.load(Ordering::Relaxed);
+            for _ in 0..MEASURED_RENDER {
+                let frame = next_frame(&mut scene);
+                let stats = renderer
+                    .render(&scene, width, height, &options)
+                    .unwrap_or_else(|e| panic!("{case} frame {frame}: {e}"));
+                expected += owned_strings(&stats) as i64;
+            }
+            let by_render = (CALLS.load(Ordering::Relaxed) - before) as i64
+                - (MEASURED_RENDER * validate) as i64;
+            // The game's path.
+            let before = CALLS.load(Ordering::Relaxed);
+            let trace = trace_cases
+                .as_deref()
+                .is_some_and(|t| t == "all" || case.contains(t));
+            TRACING.store(trace, Ordering::Relaxed);
+            for _ in 0..MEASURED {
+                let frame = next_frame(&mut scene);
+                renderer
+                    .render_reusing(&scene, width, height, &options, &mut stats)
+                    .unwrap_or_else(|e| panic!("{case} frame {frame}: {e}"));
+            }
+            TRACING.store(false, Ordering::Relaxed);
+            if cell_cap.is_some() {
+                assert!(
+                    stats.overflowed_lights > 0,
+                    "{case}: the cap trimmed no cell"
+                );
+            }
+            let reusing =
+                (CALLS.load(Ordering::Relaxed) - before) as i64 - (MEASURED * validate) as i64;
+            eprintln!(
+                "{case}: {reusing} allocations over {MEASURED} frames (render_reusing); \
+                 render: {by_render} over {MEASURED_RENDER} frames, {expected} of them its stats' \
+                 strings; besides, Scene::validate: {validate} a frame"
+            );
+            if reusing > allowed(MEASURED)
+                || by_render < expected
+                || by_render > expected + allowed(MEASURED_RENDER)
+            {
+                failures.push(format!(
+                    "{case}: {reusing} allocations in {MEASURED} frames of render_reusing, \
+                     {by_render} in {MEASURED_RENDER} of render (its stats' strings: {expected})"
+                ));
+            }
+        }
+        target.destroy(&app);
+    }
+    renderer.destroy();
+    RENDERS.with(|r| r.set(false));
+    failures
+}
+
+#[test]
+fn no_heap_allocation_per_frame_in_steady_state_es3() {
+    let _serial = serial();
+    let mut cases = common_cases();
+    // MSAA: drawn into the renderer's multisampled target, resolved into the application's.
+    cases.push(Case {
+        wait_for_gpu: false,
+        samples: 4,
+        methods: &["forward", "tiled", "clustered", "auto"],
+        size: (16, 9),
+        ..CASE
+    });
+    let failures = allocations_per_frame(EsVersion::Es3, &Restrictions::default(), &cases);
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+#[test]
+fn no_heap_allocation_per_frame_in_steady_state_es2() {
+    let _serial = serial();
+    let failures = allocations_per_frame(EsVersion::Es2, &Restrictions::default(), &common_cases());
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+/// A device without fragment highp: only forward (and `auto`, which then always picks it)
+/// runs, and past 1 023 lights forward keeps the ones that matter most (the cap's selection).
+#[test]
+fn no_heap_allocation_per_frame_in_steady_state_es2_without_fragment_highp() {
+    let _serial = serial();
+    let cases = [
+        Case {
+            size: (16, 9),
+            ..CASE
+        },
+        Case {
+            lights: 1100,
+            wait_for_gpu: false,
+            size: (16, 9),
+            ..CASE
+        },
+    ];
+    let restrictions = Restrictions {
+        no_fragment_highp: true,
+    };
+    let failures = allocations_per_frame(EsVersion::Es2, &restrictions, &cases);
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
 }

@@ -26,6 +26,8 @@
 //! out of range; every dropped light is counted in [`AssignStats::overflowed_lights`], and the
 //! image degrades by exactly those lights' contributions (measurable against plain forward).
 
+use std::cell::RefCell;
+
 use rayon::prelude::*;
 
 use super::cells::for_each_run;
@@ -247,10 +249,28 @@ impl Totals {
 }
 
 /// Light assignment with buffers kept from frame to frame. One per renderer (or per thread).
+/// Once its buffers have grown to a frame's size, an assignment allocates nothing.
 #[derive(Default)]
 pub struct Assigner {
     chunks: Vec<Chunk>,
     out: Assignment,
+    /// Per chunk: the visible number of its first visible light (phase 2).
+    first_ids: Vec<u32>,
+    /// Blocks of cells the several-chunk merge gathers in parallel.
+    blocks: Vec<(usize, usize)>,
+    /// The overflow policy's buffers.
+    overflow: Overflow,
+}
+
+/// Buffers of the overflow policy, kept between frames.
+#[derive(Default)]
+struct Overflow {
+    /// The compacted list, swapped with the assignment's (which becomes the next spare).
+    kept: Vec<u32>,
+    /// The overfull cells: (cell, offset, count).
+    lists: Vec<(u32, usize, usize)>,
+    /// What importance reads of each visible light (see [`trim_overfull_cells`]).
+    packed: Vec<[f32; 4]>,
 }
 
 impl Assigner {
@@ -290,7 +310,7 @@ impl Assigner {
             out.offsets.resize(cells, 0);
             out.counts.clear();
             out.counts.resize(cells, 0);
-            return out;
+            return &self.out;
         }
         // Waking rayon's workers costs tens of microseconds on some machines: small light
         // counts stay on the calling thread.
@@ -301,6 +321,29 @@ impl Assigner {
         } else {
             1
         };
+        if threads == 1 {
+            self.assign_in_chunks(grid, lights, camera_far, limits, 1);
+        } else {
+            // One entry into rayon's pool for all the phases: every entry from outside the
+            // pool queues a job in rayon's global injector, which allocates a block of slots
+            // every 63 jobs (so a parallel frame allocates once in 63 frames, not 3 times).
+            rayon::scope(|_| self.assign_in_chunks(grid, lights, camera_far, limits, threads));
+        }
+        &self.out
+    }
+
+    /// Phases 1 to 3 and the overflow policy over `threads` chunks of lights (in parallel when
+    /// more than one: called inside rayon's pool then).
+    fn assign_in_chunks(
+        &mut self,
+        grid: &ClusterGrid,
+        lights: &[GpuLight],
+        camera_far: f64,
+        limits: &AssignLimits,
+        threads: usize,
+    ) {
+        let cells = grid.total_cells as usize;
+        let out = &mut self.out;
         // Phase 1: runs and counts per chunk of lights.
         let chunk_len = lights.len().div_ceil(threads);
         self.chunks.resize_with(threads, Chunk::default);
@@ -314,7 +357,8 @@ impl Assigner {
                 .for_each(|(chunk, part)| chunk.find(grid, part, camera_far));
         }
         // Phase 2: the visible lights (numbered chunk after chunk), then counts and offsets.
-        let mut first_ids = Vec::with_capacity(threads);
+        let first_ids = &mut self.first_ids;
+        first_ids.clear();
         for (t, chunk) in self.chunks.iter().enumerate() {
             first_ids.push(out.visible.len() as u32);
             let first = (t * chunk_len) as u32;
@@ -353,13 +397,19 @@ impl Assigner {
                 .par_iter_mut()
                 .zip(first_ids.par_iter())
                 .for_each(|(chunk, &first_id)| chunk.sort_locally(first_id, cells));
-            merge(&self.chunks, &out.offsets, &mut out.indices, threads);
+            merge(
+                &self.chunks,
+                &out.offsets,
+                &mut out.indices,
+                threads,
+                &mut self.blocks,
+            );
             Totals::of(&out.counts)
         };
         // Overflow, then the figures.
         out.stats.max_lights_per_cluster = totals.max;
         out.stats.visible_lights = out.visible.len();
-        let nonempty = if apply_cap(out, grid, lights, limits) {
+        let nonempty = if apply_cap(out, grid, lights, limits, &mut self.overflow) {
             Totals::of(&out.counts).nonempty
         } else {
             totals.nonempty
@@ -371,45 +421,63 @@ impl Assigner {
         } else {
             0.0
         };
-        out
     }
 }
 
 /// Concatenates the chunks' per-cell runs into `indices`, in parallel over blocks of cells
-/// with about equal numbers of indices.
-fn merge(chunks: &[Chunk], offsets: &[u32], indices: &mut [u32], threads: usize) {
-    let cells = offsets.len();
-    let total = indices.len();
-    let blocks = split_cells(offsets, total, threads * 2);
-    let mut jobs = Vec::with_capacity(blocks.len());
-    let mut rest = indices;
-    for &(c0, c1) in &blocks {
-        let end = if c1 < cells {
-            offsets[c1] as usize
-        } else {
-            total
-        };
-        let (head, tail) = rest.split_at_mut(end - offsets[c0] as usize);
-        jobs.push((c0, c1, head));
-        rest = tail;
-    }
-    jobs.into_par_iter().for_each(|(c0, c1, out)| {
-        let mut at = 0;
-        for cell in c0..c1 {
-            for chunk in chunks {
-                let (o, n) = (chunk.offsets[cell] as usize, chunk.count(cell) as usize);
-                out[at..at + n].copy_from_slice(&chunk.sorted[o..o + n]);
-                at += n;
+/// with about equal numbers of indices (`blocks` is the buffer they are listed in).
+fn merge(
+    chunks: &[Chunk],
+    offsets: &[u32],
+    indices: &mut [u32],
+    threads: usize,
+    blocks: &mut Vec<(usize, usize)>,
+) {
+    split_cells_into(offsets, indices.len(), threads * 2, blocks);
+    merge_blocks(chunks, offsets, blocks, indices);
+}
+
+/// Gathers the cells of `blocks` (contiguous, in cell order) into `out`, which starts at the
+/// first block's first index: the two halves of the blocks in parallel (`rayon::join` keeps
+/// its jobs on the stack, so no list of jobs is allocated).
+fn merge_blocks(chunks: &[Chunk], offsets: &[u32], blocks: &[(usize, usize)], out: &mut [u32]) {
+    match blocks {
+        [] => {}
+        &[(c0, c1)] => {
+            let mut at = 0;
+            for cell in c0..c1 {
+                for chunk in chunks {
+                    let (o, n) = (chunk.offsets[cell] as usize, chunk.count(cell) as usize);
+                    out[at..at + n].copy_from_slice(&chunk.sorted[o..o + n]);
+                    at += n;
+                }
             }
         }
-    });
+        _ => {
+            let (left, right) = blocks.split_at(blocks.len() / 2);
+            let split = (offsets[right[0].0] - offsets[left[0].0]) as usize;
+            let (out_left, out_right) = out.split_at_mut(split);
+            rayon::join(
+                || merge_blocks(chunks, offsets, left, out_left),
+                || merge_blocks(chunks, offsets, right, out_right),
+            );
+        }
+    }
 }
 
 /// Splits the cells into at most `parts` contiguous, non-empty blocks with about equal numbers
 /// of indices (fewer blocks when there are fewer cells).
+#[cfg(test)]
 fn split_cells(offsets: &[u32], total: usize, parts: usize) -> Vec<(usize, usize)> {
+    let mut blocks = Vec::new();
+    split_cells_into(offsets, total, parts, &mut blocks);
+    blocks
+}
+
+/// [`split_cells`] into `blocks` (cleared first).
+fn split_cells_into(offsets: &[u32], total: usize, parts: usize, blocks: &mut Vec<(usize, usize)>) {
     let cells = offsets.len();
-    let mut blocks = Vec::with_capacity(parts);
+    blocks.clear();
     let mut start = 0;
     for p in 1..parts {
         let target = (total * p / parts) as u32;
@@ -422,7 +490,6 @@ fn split_cells(offsets: &[u32], total: usize, parts: usize) -> Vec<(usize, usize
     if start < cells {
         blocks.push((start, cells));
     }
-    blocks
 }
 
 /// Assigns `lights` (view space) to the cells of `grid` with fresh buffers (see [`Assigner`]
@@ -444,6 +511,7 @@ fn apply_cap(
     grid: &ClusterGrid,
     lights: &[GpuLight],
     limits: &AssignLimits,
+    scratch: &mut Overflow,
 ) -> bool {
     let max = out.stats.max_lights_per_cluster;
     if max <= limits.cell_cap && out.indices.len() <= limits.max_indices {
@@ -453,10 +521,12 @@ fn apply_cap(
     if max <= cap {
         return false;
     }
-    trim_overfull_cells(out, grid, lights, cap);
+    trim_overfull_cells(out, grid, lights, cap, scratch);
     // Compact: every cell keeps the first `cap` entries of its list (the trim put the kept
     // lights there, in ascending order).
-    let mut kept = Vec::with_capacity(out.indices.len().min(limits.max_indices));
+    let kept = &mut scratch.kept;
+    kept.clear();
+    kept.reserve(out.indices.len().min(limits.max_indices));
     for cell in 0..out.counts.len() {
         let (o, n) = (out.offsets[cell] as usize, out.counts[cell] as usize);
         let keep = n.min(cap as usize);
@@ -465,87 +535,119 @@ fn apply_cap(
         out.counts[cell] = keep as u32;
         kept.extend_from_slice(&out.indices[o..o + keep]);
     }
-    out.indices = kept;
+    std::mem::swap(&mut out.indices, kept);
     true
+}
+
+thread_local! {
+    /// One trimmed cell's keys and the selection's copy of them, kept per thread from cell to
+    /// cell and frame to frame.
+    static TRIM_KEYS: RefCell<(Vec<f64>, Vec<f64>)> = const { RefCell::new((Vec::new(), Vec::new())) };
 }
 
 /// Moves the `cap` most important lights of every cell holding more to the front of its list,
 /// in ascending order (of equally important ones, the earlier). Each light's importance is computed once (the comparisons of a
 /// selection would otherwise recompute it, through two random reads, several times per
 /// entry: 4 M lights took 2 s), and cells are trimmed in parallel: their lists are disjoint.
-fn trim_overfull_cells(out: &mut Assignment, grid: &ClusterGrid, lights: &[GpuLight], cap: u32) {
+fn trim_overfull_cells(
+    out: &mut Assignment,
+    grid: &ClusterGrid,
+    lights: &[GpuLight],
+    cap: u32,
+    scratch: &mut Overflow,
+) {
     let cap = cap as usize;
-    let visible = &out.visible;
-    // The overfull cells' lists as disjoint slices (lists lie in cell order).
-    let mut lists: Vec<(usize, &mut [u32])> = Vec::new();
-    let mut rest: &mut [u32] = &mut out.indices[..];
-    let mut consumed = 0;
+    // The overfull cells' lists (lists lie in cell order, so they are disjoint and ascending).
+    let lists = &mut scratch.lists;
+    lists.clear();
     for (cell, (&o, &n)) in out.offsets.iter().zip(&out.counts).enumerate() {
-        let (o, n) = (o as usize, n as usize);
-        if n <= cap {
-            continue;
+        if n as usize > cap {
+            lists.push((cell as u32, o as usize, n as usize));
         }
-        let tail = std::mem::take(&mut rest).split_at_mut(o - consumed).1;
-        let (list, tail) = tail.split_at_mut(n);
-        lists.push((cell, list));
-        rest = tail;
-        consumed = o + n;
     }
     // What importance reads of each visible light, packed in list-index order: one 16-byte
     // read per entry instead of two random reads into the full lights.
-    let packed: Vec<[f32; 4]> = visible
-        .iter()
-        .map(|&l| {
-            let light = &lights[l as usize];
-            let p = light.position;
-            [p.x, p.y, p.z, light.radiance.max_element()]
-        })
-        .collect();
-    let trim = |(cell, list): &mut (usize, &mut [u32])| {
+    let packed = &mut scratch.packed;
+    packed.clear();
+    packed.extend(out.visible.iter().map(|&l| {
+        let light = &lights[l as usize];
+        let p = light.position;
+        [p.x, p.y, p.z, light.radiance.max_element()]
+    }));
+    let packed = &scratch.packed[..];
+    let trim = |cell: u32, list: &mut [u32]| {
         if cap == 0 {
             return;
         }
-        let center = cell_center(grid, *cell as u32);
-        let keys: Vec<f64> = list
-            .iter()
-            .map(|&i| {
+        let center = cell_center(grid, cell);
+        TRIM_KEYS.with_borrow_mut(|(keys, order)| {
+            keys.clear();
+            keys.extend(list.iter().map(|&i| {
                 let [x, y, z, brightness] = packed[i as usize];
                 let position = glam::DVec3::new(x as f64, y as f64, z as f64);
                 brightness_over_distance(brightness, position, center)
-            })
-            .collect();
-        // The cap-th largest key is the threshold: every light above it stays, and of those
-        // equal to it the earliest, until the cap is reached. One selection and one pass in
-        // list order, so the kept lights stay in ascending order without a sort.
-        let mut order = keys.clone();
-        let (_, &mut threshold, _) = order.select_nth_unstable_by(cap - 1, |a, b| b.total_cmp(a));
-        let mut ties = cap
-            - keys
-                .iter()
-                .filter(|k| k.total_cmp(&threshold) == std::cmp::Ordering::Greater)
-                .count();
-        let mut kept = 0;
-        for at in 0..list.len() {
-            let keep = match keys[at].total_cmp(&threshold) {
-                std::cmp::Ordering::Greater => true,
-                std::cmp::Ordering::Equal if ties > 0 => {
-                    ties -= 1;
-                    true
+            }));
+            // The cap-th largest key is the threshold: every light above it stays, and of
+            // those equal to it the earliest, until the cap is reached. One selection and one
+            // pass in list order, so the kept lights stay in ascending order without a sort.
+            order.clear();
+            order.extend_from_slice(keys);
+            let (_, &mut threshold, _) =
+                order.select_nth_unstable_by(cap - 1, |a, b| b.total_cmp(a));
+            let mut ties = cap
+                - keys
+                    .iter()
+                    .filter(|k| k.total_cmp(&threshold) == std::cmp::Ordering::Greater)
+                    .count();
+            let mut kept = 0;
+            for at in 0..list.len() {
+                let keep = match keys[at].total_cmp(&threshold) {
+                    std::cmp::Ordering::Greater => true,
+                    std::cmp::Ordering::Equal if ties > 0 => {
+                        ties -= 1;
+                        true
+                    }
+                    _ => false,
+                };
+                if keep {
+                    list[kept] = list[at];
+                    kept += 1;
                 }
-                _ => false,
-            };
-            if keep {
-                list[kept] = list[at];
-                kept += 1;
             }
-        }
-        debug_assert_eq!(kept, cap);
+            debug_assert_eq!(kept, cap);
+        });
     };
-    if lists.iter().map(|(_, l)| l.len()).sum::<usize>() >= PARALLEL_INDICES {
-        lists.par_iter_mut().for_each(trim);
-    } else {
-        lists.iter_mut().for_each(trim);
+    let parallel = scratch.lists.iter().map(|&(_, _, n)| n).sum::<usize>() >= PARALLEL_INDICES;
+    trim_lists(&scratch.lists, &mut out.indices, 0, parallel, &trim);
+}
+
+/// Entries of the index list below which [`trim_lists`] trims its lists on one thread.
+const TRIM_GRAIN: usize = 1 << 14;
+
+/// Trims the lists `lists` (cell, offset, count; in cell order) of `indices`, whose first
+/// entry is list entry `base`: on the calling thread, or with `parallel` the two halves of
+/// the lists at once (`rayon::join` keeps its jobs on the stack), down to [`TRIM_GRAIN`].
+fn trim_lists(
+    lists: &[(u32, usize, usize)],
+    indices: &mut [u32],
+    base: usize,
+    parallel: bool,
+    trim: &(dyn Fn(u32, &mut [u32]) + Sync),
+) {
+    let span = lists.last().map_or(0, |&(_, o, n)| o + n) - lists.first().map_or(0, |l| l.1);
+    if !parallel || lists.len() < 2 || span < TRIM_GRAIN {
+        for &(cell, o, n) in lists {
+            trim(cell, &mut indices[o - base..o - base + n]);
+        }
+        return;
     }
+    let (left, right) = lists.split_at(lists.len() / 2);
+    let split = right[0].1 - base;
+    let (head, tail) = indices.split_at_mut(split);
+    rayon::join(
+        || trim_lists(left, head, base, true, trim),
+        || trim_lists(right, tail, base + split, true, trim),
+    );
 }
 
 /// Importance of a light for a cell under overflow: brighter and closer first — its brightest

@@ -44,9 +44,18 @@ impl SliceLookup {
     /// The lookup of `grid`'s slices. Buckets cover the grid's first split to its far end:
     /// nearer depths all lie in the first slice and farther ones reach the last through
     /// the steps.
+    #[cfg(test)]
     pub(crate) fn new(grid: &ClusterGrid) -> SliceLookup {
-        let mut start = Vec::new();
-        let mut address = Vec::new();
+        let mut lookup = SliceLookup::default();
+        lookup.rebuild(grid);
+        lookup
+    }
+
+    /// Makes this the lookup of `grid`'s slices, reusing its buffers.
+    pub(crate) fn rebuild(&mut self, grid: &ClusterGrid) {
+        let (start, address) = (&mut self.start, &mut self.address);
+        start.clear();
+        address.clear();
         for (k, cascade) in grid.cascades.iter().enumerate() {
             for s in 0..cascade.slices {
                 let z0 = grid.slice_depth_range(k as u32, s).0;
@@ -58,18 +67,21 @@ impl SliceLookup {
         // Every depth before the second slice's start is in the first slice.
         let base = bucket(start.get(1).copied().unwrap_or(far).min(far));
         let last = bucket(far).max(base);
-        let first_slice = (base..=last)
-            .map(|b| {
-                let d = f64::from_bits((b as u64) << BUCKET_SHIFT);
-                (start.partition_point(|&z| z <= d) - 1) as u32
-            })
-            .collect();
-        SliceLookup {
-            base,
-            first_slice,
-            start,
-            address,
-        }
+        self.first_slice.clear();
+        self.first_slice.extend((base..=last).map(|b| {
+            let d = f64::from_bits((b as u64) << BUCKET_SHIFT);
+            (start.partition_point(|&z| z <= d) - 1) as u32
+        }));
+        self.base = base;
+    }
+
+    /// Empty, as [`SliceLookup::default`], keeping the buffers (for the linear mapping, which
+    /// needs no table).
+    pub(crate) fn clear(&mut self) {
+        self.base = 0;
+        self.first_slice.clear();
+        self.start.clear();
+        self.address.clear();
     }
 
     /// (cascade, slice) of the last slice starting at or before `d` (`d` ≥ 0, not NaN).
@@ -115,33 +127,30 @@ impl CascadeConstants {
         -self.extent[axis] + i as f64 * self.tile_step[axis]
     }
 
-    /// The constants of every cascade of `grid`.
-    pub(crate) fn of(grid: &ClusterGrid) -> Vec<CascadeConstants> {
+    /// The constants of every cascade of `grid`, into `out` (cleared first).
+    pub(crate) fn of_into(grid: &ClusterGrid, out: &mut Vec<CascadeConstants>) {
         let last = grid.cascades.len() - 1;
         let mut first_slice = 0;
-        grid.cascades
-            .iter()
-            .enumerate()
-            .map(|(k, c)| {
-                let constants = CascadeConstants {
-                    inv_near: if k == 0 {
-                        f64::INFINITY
-                    } else {
-                        1.0 / c.z_near
-                    },
-                    inv_far: if k == last { 0.0 } else { 1.0 / c.z_far },
-                    half_tiles: [0.5 * c.tiles_x as f64, 0.5 * c.tiles_y as f64],
-                    tile_step: [
-                        2.0 * (1.0 / grid.ndc_scale[0]) / c.tiles_x as f64,
-                        2.0 * (1.0 / grid.ndc_scale[1]) / c.tiles_y as f64,
-                    ],
-                    extent: grid.ndc_scale.map(|s| 1.0 / s),
-                    first_slice,
-                };
-                first_slice += c.slices;
-                constants
-            })
-            .collect()
+        out.clear();
+        out.extend(grid.cascades.iter().enumerate().map(|(k, c)| {
+            let constants = CascadeConstants {
+                inv_near: if k == 0 {
+                    f64::INFINITY
+                } else {
+                    1.0 / c.z_near
+                },
+                inv_far: if k == last { 0.0 } else { 1.0 / c.z_far },
+                half_tiles: [0.5 * c.tiles_x as f64, 0.5 * c.tiles_y as f64],
+                tile_step: [
+                    2.0 * (1.0 / grid.ndc_scale[0]) / c.tiles_x as f64,
+                    2.0 * (1.0 / grid.ndc_scale[1]) / c.tiles_y as f64,
+                ],
+                extent: grid.ndc_scale.map(|s| 1.0 / s),
+                first_slice,
+            };
+            first_slice += c.slices;
+            constants
+        }));
     }
 }
 

@@ -254,6 +254,8 @@ pub struct ClusterGrid {
     /// Bounding sphere (view-space centre, radius) of every cell, built on first use (the
     /// cone-vs-cell test of spot lights); infinite radius for cells reaching infinity.
     cell_spheres: std::sync::OnceLock<Vec<[f64; 4]>>,
+    /// The buffer of an earlier grid's spheres, for the next build (see [`ClusterGrid::rebuild`]).
+    spare_spheres: SpareSpheres,
     /// Slice of a depth without a logarithm (log2 mapping only).
     slice_lookup: SliceLookup,
     /// Per cascade: constants of the assignment's box projection and tile conversion.
@@ -268,6 +270,17 @@ pub struct ClusterGrid {
     side_plane_norm: [f64; 2],
 }
 
+/// A buffer kept for the next build of a grid's cell spheres (behind a lock because the spheres
+/// are built on first use through `&self`, possibly on several threads). A clone starts without.
+#[derive(Debug, Default)]
+struct SpareSpheres(std::sync::Mutex<Vec<[f64; 4]>>);
+
+impl Clone for SpareSpheres {
+    fn clone(&self) -> Self {
+        SpareSpheres::default()
+    }
+}
+
 impl ClusterGrid {
     /// Builds the grid. `depth_range` is the span of view depths the scene can occupy
     /// (already clipped to [near, far] by the caller; it bounds the grid for infinite or huge
@@ -280,6 +293,42 @@ impl ClusterGrid {
         far: f64,
         config: &GridConfig,
     ) -> ClusterGrid {
+        let mut grid = ClusterGrid {
+            width: 0,
+            height: 0,
+            projection,
+            near: 0.0,
+            far: 0.0,
+            mapping: DepthMapping::Linear,
+            a: 0.0,
+            b: 0.0,
+            cascades: Vec::new(),
+            total_cells: 0,
+            coverage: config.coverage,
+            ndc_scale: [0.0; 2],
+            cell_spheres: std::sync::OnceLock::new(),
+            spare_spheres: SpareSpheres::default(),
+            side_plane_norm: [0.0; 2],
+            slice_lookup: SliceLookup::default(),
+            cascade_constants: Vec::new(),
+            slice_slabs: Vec::new(),
+        };
+        grid.rebuild(width, height, projection, near, far, config);
+        grid
+    }
+
+    /// Makes this grid what [`ClusterGrid::new`] builds from these arguments, in place: its
+    /// buffers are reused, so a grid rebuilt every frame (a moving camera changes its depth
+    /// range) allocates nothing once they have grown.
+    pub fn rebuild(
+        &mut self,
+        width: u32,
+        height: u32,
+        projection: GridProjection,
+        near: f64,
+        far: f64,
+        config: &GridConfig,
+    ) {
         let width = width.max(1);
         let height = height.max(1);
         let near = near.max(0.0);
@@ -314,7 +363,8 @@ impl ClusterGrid {
             DepthMapping::Log2 => f.exp2(),
             DepthMapping::Linear => f,
         };
-        let mut cascades = Vec::with_capacity(c as usize);
+        let mut cascades = std::mem::take(&mut self.cascades);
+        cascades.clear();
         let mut first_cell = 0u32;
         for k in 0..c {
             let z_near = inverse(fa + (ff - fa) * k as f64 / c as f64);
@@ -351,43 +401,53 @@ impl ClusterGrid {
             first_cell += cascade.cells();
             cascades.push(cascade);
         }
-        let mut grid = ClusterGrid {
-            width,
-            height,
-            projection,
-            near,
-            far,
-            mapping,
-            a,
-            b,
-            cascades,
-            total_cells: first_cell,
-            coverage: config.coverage,
-            ndc_scale: match projection {
-                GridProjection::Perspective { tan_x, tan_y } => [1.0 / tan_x, 1.0 / tan_y],
-                GridProjection::Orthographic { half_x, half_y } => [1.0 / half_x, 1.0 / half_y],
-            },
-            cell_spheres: std::sync::OnceLock::new(),
-            side_plane_norm: match projection {
-                GridProjection::Perspective { tan_x, tan_y } => {
-                    [tan_x, tan_y].map(|t| 1.0 / (1.0 + t * t).sqrt())
-                }
-                GridProjection::Orthographic { .. } => [1.0; 2],
-            },
-            slice_lookup: SliceLookup::default(),
-            cascade_constants: Vec::new(),
-            slice_slabs: Vec::new(),
+        self.width = width;
+        self.height = height;
+        self.projection = projection;
+        self.near = near;
+        self.far = far;
+        self.mapping = mapping;
+        self.a = a;
+        self.b = b;
+        self.cascades = cascades;
+        self.total_cells = first_cell;
+        self.coverage = config.coverage;
+        self.ndc_scale = match projection {
+            GridProjection::Perspective { tan_x, tan_y } => [1.0 / tan_x, 1.0 / tan_y],
+            GridProjection::Orthographic { half_x, half_y } => [1.0 / half_x, 1.0 / half_y],
         };
-        if mapping == DepthMapping::Log2 {
-            grid.slice_lookup = SliceLookup::new(&grid);
+        // The spheres are of the old cells: dropped, their buffer kept for the next build.
+        if let Some(mut spheres) = self.cell_spheres.take() {
+            spheres.clear();
+            *self
+                .spare_spheres
+                .0
+                .get_mut()
+                .unwrap_or_else(|e| e.into_inner()) = spheres;
         }
-        grid.cascade_constants = CascadeConstants::of(&grid);
-        grid.slice_slabs = grid.build_slice_slabs();
-        grid
+        self.side_plane_norm = match projection {
+            GridProjection::Perspective { tan_x, tan_y } => {
+                [tan_x, tan_y].map(|t| 1.0 / (1.0 + t * t).sqrt())
+            }
+            GridProjection::Orthographic { .. } => [1.0; 2],
+        };
+        let mut lookup = std::mem::take(&mut self.slice_lookup);
+        if mapping == DepthMapping::Log2 {
+            lookup.rebuild(self);
+        } else {
+            lookup.clear();
+        }
+        self.slice_lookup = lookup;
+        let mut constants = std::mem::take(&mut self.cascade_constants);
+        CascadeConstants::of_into(self, &mut constants);
+        self.cascade_constants = constants;
+        let mut slabs = std::mem::take(&mut self.slice_slabs);
+        self.build_slice_slabs(&mut slabs);
+        self.slice_slabs = slabs;
     }
 
-    fn build_slice_slabs(&self) -> Vec<[f64; 4]> {
-        let mut slabs = Vec::new();
+    fn build_slice_slabs(&self, slabs: &mut Vec<[f64; 4]>) {
+        slabs.clear();
         for (k, c) in self.cascades.iter().enumerate() {
             for s in 0..c.slices {
                 let (z0, z1) = self.slice_depth_range(k as u32, s);
@@ -397,7 +457,6 @@ impl ClusterGrid {
                 slabs.push([z0, z1, 1.0 / z0, 1.0 / z1]);
             }
         }
-        slabs
     }
 
     /// True when the view-space sphere (`center`, `radius`) lies wholly outside one of the
@@ -418,11 +477,22 @@ impl ClusterGrid {
 
     /// Bounding spheres `[x, y, z, radius]` of every cell, in cell order (built on first use).
     pub fn cell_spheres(&self) -> &[[f64; 4]] {
-        self.cell_spheres.get_or_init(|| self.build_cell_spheres())
+        self.cell_spheres.get_or_init(|| {
+            let mut spheres = std::mem::take(
+                &mut *self
+                    .spare_spheres
+                    .0
+                    .lock()
+                    .unwrap_or_else(|e| e.into_inner()),
+            );
+            self.build_cell_spheres(&mut spheres);
+            spheres
+        })
     }
 
-    fn build_cell_spheres(&self) -> Vec<[f64; 4]> {
-        let mut out = Vec::with_capacity(self.total_cells as usize);
+    fn build_cell_spheres(&self, out: &mut Vec<[f64; 4]>) {
+        out.clear();
+        out.reserve(self.total_cells as usize);
         for (k, c) in self.cascades.iter().enumerate() {
             for slice in 0..c.slices {
                 for y in 0..c.tiles_y {
@@ -438,7 +508,6 @@ impl ClusterGrid {
                 }
             }
         }
-        out
     }
 
     fn bounding_sphere(&self, cell: CellCoord) -> [f64; 4] {

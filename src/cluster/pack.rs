@@ -142,12 +142,44 @@ pub struct PackedLights {
     pub radius_range: f32,
 }
 
+impl Default for PackedLights {
+    /// [`PackedLights::empty`] for float records.
+    fn default() -> Self {
+        PackedLights::empty(LightEncoding::Float32)
+    }
+}
+
+impl PackedLights {
+    /// No lights, and no bytes yet: a buffer for [`pack_lights_into`] to fill frame after frame.
+    pub fn empty(encoding: LightEncoding) -> PackedLights {
+        PackedLights {
+            encoding,
+            count: 0,
+            width: DATA_TEXTURE_WIDTH,
+            height: 0,
+            bytes: Vec::new(),
+            pos_range: 0.0,
+            radius_range: 0.0,
+        }
+    }
+}
+
 /// Packs lights into texels.
 pub fn pack_lights(lights: &[GpuLight], encoding: LightEncoding) -> PackedLights {
+    let mut packed = PackedLights::empty(encoding);
+    pack_lights_into(lights, encoding, &mut packed);
+    packed
+}
+
+/// [`pack_lights`] into `packed`, reusing its bytes: once they have grown to a frame's size,
+/// packing allocates nothing.
+pub fn pack_lights_into(lights: &[GpuLight], encoding: LightEncoding, packed: &mut PackedLights) {
     let tpl = encoding.texels_per_light() as usize;
     let width = DATA_TEXTURE_WIDTH as usize;
     let height = (lights.len() * tpl).div_ceil(width).max(1);
-    let mut bytes = vec![0u8; width * height * encoding.bytes_per_texel()];
+    let bytes = &mut packed.bytes;
+    bytes.clear();
+    bytes.resize(width * height * encoding.bytes_per_texel(), 0);
     let pos_range = lights
         .iter()
         .map(|l| l.position.abs().max_element())
@@ -204,15 +236,12 @@ pub fn pack_lights(lights: &[GpuLight], encoding: LightEncoding) -> PackedLights
             }
         }
     }
-    PackedLights {
-        encoding,
-        count: lights.len(),
-        width: DATA_TEXTURE_WIDTH,
-        height: height as u32,
-        bytes,
-        pos_range,
-        radius_range,
-    }
+    packed.encoding = encoding;
+    packed.count = lights.len();
+    packed.width = DATA_TEXTURE_WIDTH;
+    packed.height = height as u32;
+    packed.pos_range = pos_range;
+    packed.radius_range = radius_range;
 }
 
 /// Decodes light `i` exactly as the shader does (used to test round trips and to measure the

@@ -90,13 +90,45 @@ pub fn grid_texels(grid: &ClusterGrid) -> usize {
     grid.cascades.len() * TABLE_TEXELS_PER_CASCADE as usize + grid.total_cells as usize
 }
 
+impl Default for PackedTexels {
+    fn default() -> Self {
+        PackedTexels::empty()
+    }
+}
+
+impl PackedTexels {
+    /// No texels yet: a buffer for [`pack_grid_into`] or [`pack_indices_into`] to fill frame
+    /// after frame.
+    pub fn empty() -> PackedTexels {
+        PackedTexels {
+            width: DATA_TEXTURE_WIDTH,
+            height: 0,
+            bytes: Vec::new(),
+        }
+    }
+}
+
 /// Packs the cascade table and the per-cell (offset, count).
 pub fn pack_grid(grid: &ClusterGrid, a: &Assignment, encoding: GridEncoding) -> PackedTexels {
+    let mut packed = PackedTexels::empty();
+    pack_grid_into(grid, a, encoding, &mut packed);
+    packed
+}
+
+/// [`pack_grid`] into `packed`, reusing its bytes (no allocation once they have grown).
+pub fn pack_grid_into(
+    grid: &ClusterGrid,
+    a: &Assignment,
+    encoding: GridEncoding,
+    packed: &mut PackedTexels,
+) {
     let table = grid.cascades.len() * TABLE_TEXELS_PER_CASCADE as usize;
     let texels = grid_texels(grid);
     let height = rows_for(texels);
     let bpt = encoding.cell_bytes();
-    let mut bytes = vec![0u8; DATA_TEXTURE_WIDTH as usize * height as usize * bpt];
+    let bytes = &mut packed.bytes;
+    bytes.clear();
+    bytes.resize(DATA_TEXTURE_WIDTH as usize * height as usize * bpt, 0);
     let mut put = |texel: usize, pair: (u32, u32), rgba8: [u8; 4]| {
         let at = texel * bpt;
         match encoding {
@@ -119,18 +151,22 @@ pub fn pack_grid(grid: &ClusterGrid, a: &Assignment, encoding: GridEncoding) -> 
         );
     }
     for (cell, (&offset, &count)) in a.offsets.iter().zip(&a.counts).enumerate() {
-        let packed = (offset.min((1 << 20) - 1) << 12) | count.min(RGBA8_CELL_CAP);
-        put(table + cell, (offset, count), packed.to_be_bytes());
+        let rgba8 = (offset.min((1 << 20) - 1) << 12) | count.min(RGBA8_CELL_CAP);
+        put(table + cell, (offset, count), rgba8.to_be_bytes());
     }
-    PackedTexels {
-        width: DATA_TEXTURE_WIDTH,
-        height,
-        bytes,
-    }
+    packed.width = DATA_TEXTURE_WIDTH;
+    packed.height = height;
 }
 
 /// Packs the index list (16-bit light numbers).
 pub fn pack_indices(indices: &[u32], encoding: GridEncoding) -> PackedTexels {
+    let mut packed = PackedTexels::empty();
+    pack_indices_into(indices, encoding, &mut packed);
+    packed
+}
+
+/// [`pack_indices`] into `packed`, reusing its bytes (no allocation once they have grown).
+pub fn pack_indices_into(indices: &[u32], encoding: GridEncoding, packed: &mut PackedTexels) {
     let per_texel = match encoding {
         GridEncoding::Rgba8 => 2,
         GridEncoding::Uint => 1,
@@ -140,7 +176,12 @@ pub fn pack_indices(indices: &[u32], encoding: GridEncoding) -> PackedTexels {
         GridEncoding::Rgba8 => 4,
         GridEncoding::Uint => 2,
     };
-    let mut bytes = vec![0u8; DATA_TEXTURE_WIDTH as usize * height as usize * texel_bytes];
+    let bytes = &mut packed.bytes;
+    bytes.clear();
+    bytes.resize(
+        DATA_TEXTURE_WIDTH as usize * height as usize * texel_bytes,
+        0,
+    );
     for (i, &light) in indices.iter().enumerate() {
         let v = light as u16;
         match encoding {
@@ -149,11 +190,8 @@ pub fn pack_indices(indices: &[u32], encoding: GridEncoding) -> PackedTexels {
             GridEncoding::Uint => bytes[i * 2..i * 2 + 2].copy_from_slice(&v.to_le_bytes()),
         }
     }
-    PackedTexels {
-        width: DATA_TEXTURE_WIDTH,
-        height,
-        bytes,
-    }
+    packed.width = DATA_TEXTURE_WIDTH;
+    packed.height = height;
 }
 
 /// Reads a cell's (offset, count) back exactly as the shader decodes it.

@@ -3,6 +3,8 @@
 //! a grid); many → clustered; clustered unsupported → forward. The method not in use holds no
 //! GPU resources.
 
+use std::fmt::Write as _;
+
 use super::clustered::culled_support;
 use super::culled::{CulledForward, Culling};
 use super::forward::Forward;
@@ -29,23 +31,40 @@ pub const FORWARD_UP_TO: usize = 32;
 pub struct Auto {
     forward: Forward,
     clustered: Option<CulledForward>,
+    /// Why this frame's method was chosen (rewritten every frame, its buffer kept).
+    reason: String,
+    /// Whether clustered runs on this context (asked once: the context does not change).
+    clustered_support: Option<Support>,
 }
 
 impl Auto {
-    fn choose(&self, ctx: &FrameContext) -> (&'static str, String) {
+    /// The method for this frame; the reason is left in `self.reason`.
+    fn choose(&mut self, ctx: &FrameContext) -> &'static str {
         let n = ctx.lights.len();
+        let reason = &mut self.reason;
+        reason.clear();
         if n <= FORWARD_UP_TO {
-            return ("forward", format!("{n} lights ≤ {FORWARD_UP_TO}: one short loop costs less than assigning and uploading a grid"));
+            let _ = write!(reason, "{n} lights ≤ {FORWARD_UP_TO}: one short loop costs less than assigning and uploading a grid");
+            return "forward";
         }
-        match culled_support(ctx.dev.caps()) {
-            Support::Unsupported(reason) => (
-                "forward",
-                format!("{n} lights, but clustered is unsupported here: {reason}"),
-            ),
-            _ => (
-                "clustered",
-                format!("{n} lights > {FORWARD_UP_TO}: per-cell lists keep the loop short"),
-            ),
+        let support = self
+            .clustered_support
+            .get_or_insert_with(|| culled_support(ctx.dev.caps()));
+        match support {
+            Support::Unsupported(why) => {
+                let _ = write!(
+                    reason,
+                    "{n} lights, but clustered is unsupported here: {why}"
+                );
+                "forward"
+            }
+            _ => {
+                let _ = write!(
+                    reason,
+                    "{n} lights > {FORWARD_UP_TO}: per-cell lists keep the loop short"
+                );
+                "clustered"
+            }
         }
     }
 }
@@ -55,8 +74,8 @@ impl ShadingMethod for Auto {
         DESC.name
     }
 
-    fn render(&mut self, ctx: &mut FrameContext) -> Result<MethodStats, Error> {
-        let (choice, reason) = self.choose(ctx);
+    fn render(&mut self, ctx: &mut FrameContext) -> Result<MethodStats<'_>, Error> {
+        let choice = self.choose(ctx);
         let mut stats = if choice == "clustered" {
             self.forward.destroy(ctx.dev);
             self.clustered
@@ -68,7 +87,7 @@ impl ShadingMethod for Auto {
             }
             self.forward.render(ctx)?
         };
-        stats.auto_choice = Some((choice, reason));
+        stats.auto_choice = Some((choice, &self.reason));
         Ok(stats)
     }
 

@@ -6,6 +6,7 @@
 //! `RING` frames ago, never one an in-flight frame may still read (drivers would otherwise stall
 //! or copy on a rewrite).
 
+use std::fmt::Write as _;
 use std::time::Instant;
 
 use super::geometry::{self, UNIT_METHOD};
@@ -15,10 +16,12 @@ use super::{FrameContext, MethodStats, ShadingMethod};
 use crate::cluster::assign::{AssignLimits, Assigner};
 use crate::cluster::auto::FrameCost;
 use crate::cluster::grid::{ClusterGrid, GridConfig, GridMode, GridProjection};
-use crate::cluster::pack::{pack_lights, GpuLight, LightEncoding, DATA_TEXTURE_WIDTH};
+use crate::cluster::pack::{
+    pack_lights_into, GpuLight, LightEncoding, PackedLights, DATA_TEXTURE_WIDTH,
+};
 use crate::cluster::pack_grid::{
-    grid_texels, pack_grid, pack_indices, GridEncoding, MAX_INDEXED_LIGHTS, RGBA8_CELL_CAP,
-    RGBA8_OFFSET_LIMIT,
+    grid_texels, pack_grid_into, pack_indices_into, GridEncoding, PackedTexels, MAX_INDEXED_LIGHTS,
+    RGBA8_CELL_CAP, RGBA8_OFFSET_LIMIT,
 };
 use crate::gl::texture::{DataFormat, DataTexture};
 use crate::gl::{Device, EsVersion};
@@ -82,6 +85,14 @@ pub struct CulledForward {
     assigner: Assigner,
     /// The automatic grid's choice and calibration (clustered, [`GridMode::Auto`]).
     auto: AutoGrid,
+    /// What a frame fills and uploads, kept so a frame allocates nothing once they have grown:
+    /// the visible lights, their texels, the grid's and the index list's texels.
+    visible: Vec<GpuLight>,
+    packed_lights: PackedLights,
+    packed_grid: PackedTexels,
+    packed_indices: PackedTexels,
+    /// Why a tiled or fixed grid is what it is (the automatic grid keeps its own reason).
+    reason: String,
 }
 
 /// What the grid depends on; it is rebuilt only when this changes.
@@ -104,6 +115,11 @@ impl CulledForward {
             grid: None,
             assigner: Assigner::new(),
             auto: AutoGrid::default(),
+            visible: Vec::new(),
+            packed_lights: PackedLights::default(),
+            packed_grid: PackedTexels::default(),
+            packed_indices: PackedTexels::default(),
+            reason: String::new(),
         }
     }
 
@@ -135,10 +151,20 @@ impl CulledForward {
         };
         if self.grid.as_ref().map(|(k, _)| k) != Some(&key) {
             let (w, h) = ctx.viewport;
-            let grid = fresh.unwrap_or_else(|| {
-                ClusterGrid::new(w, h, projection, ctx.near, ctx.content_far, &config)
-            });
-            self.grid = Some((key, grid));
+            match (fresh, &mut self.grid) {
+                (Some(grid), _) => self.grid = Some((key, grid)),
+                // In place: a moving camera changes the depth range, and so the grid, every
+                // frame.
+                (None, Some((old_key, grid))) => {
+                    grid.rebuild(w, h, projection, ctx.near, ctx.content_far, &config);
+                    *old_key = key;
+                }
+                (None, None) => {
+                    let grid =
+                        ClusterGrid::new(w, h, projection, ctx.near, ctx.content_far, &config);
+                    self.grid = Some((key, grid));
+                }
+            }
         }
     }
 
@@ -147,12 +173,18 @@ impl CulledForward {
         self.culling == Culling::Clustered && ctx.options.grid.mode == GridMode::Auto
     }
 
-    /// Why the grid is what it is, for the frame's stats.
-    fn grid_reason(&self, ctx: &FrameContext) -> String {
+    /// Writes why a tiled or fixed grid is what it is into `self.reason` (the automatic grid
+    /// says it in [`AutoGrid::reason`]).
+    fn write_grid_reason(&mut self, ctx: &FrameContext) {
+        self.reason.clear();
         match self.culling {
-            Culling::Tiled => format!("tiled: tile_px = {}", ctx.options.tile_px),
-            Culling::Clustered if self.automatic(ctx) => self.auto.reason().to_string(),
-            Culling::Clustered => grid_choice::fixed_reason(&ctx.options.grid),
+            Culling::Tiled => {
+                let _ = write!(self.reason, "tiled: tile_px = {}", ctx.options.tile_px);
+            }
+            Culling::Clustered if self.automatic(ctx) => {}
+            Culling::Clustered => {
+                grid_choice::write_fixed_reason(&mut self.reason, &ctx.options.grid)
+            }
         }
     }
 }
@@ -166,7 +198,7 @@ impl ShadingMethod for CulledForward {
     }
 
     /// Renders one frame (see the module docs).
-    fn render(&mut self, ctx: &mut FrameContext) -> Result<MethodStats, Error> {
+    fn render(&mut self, ctx: &mut FrameContext) -> Result<MethodStats<'_>, Error> {
         let dev = ctx.dev;
         let es = dev.es();
         let (grid_encoding, per_index_texel) = match es {
@@ -192,7 +224,7 @@ impl ShadingMethod for CulledForward {
         let lights = ctx.lights;
         self.update_grid(ctx, &limits, grid_encoding);
         let automatic = self.automatic(ctx);
-        let grid_reason = self.grid_reason(ctx);
+        self.write_grid_reason(ctx);
         let (grid_key, grid) = self.grid.as_ref().expect("updated above");
         // Refused before any assignment: a grid the texture cannot hold would only fail at the
         // upload, after allocating its lists.
@@ -216,15 +248,18 @@ impl ShadingMethod for CulledForward {
             )));
         }
         let upload_started = Instant::now();
-        let visible: Vec<GpuLight> = assignment
-            .visible
-            .iter()
-            .map(|&i| lights[i as usize])
-            .collect();
+        self.visible.clear();
+        self.visible
+            .extend(assignment.visible.iter().map(|&i| lights[i as usize]));
         let encoding = ctx.features.light_encoding();
-        let packed_lights = pack_lights(&visible, encoding);
-        let packed_grid = pack_grid(grid, assignment, grid_encoding);
-        let packed_indices = pack_indices(&assignment.indices, grid_encoding);
+        let (packed_lights, packed_grid, packed_indices) = (
+            &mut self.packed_lights,
+            &mut self.packed_grid,
+            &mut self.packed_indices,
+        );
+        pack_lights_into(&self.visible, encoding, packed_lights);
+        pack_grid_into(grid, assignment, grid_encoding, packed_grid);
+        pack_indices_into(&assignment.indices, grid_encoding, packed_indices);
 
         let slot = self.frame % RING;
         self.frame += 1;
@@ -313,7 +348,11 @@ impl ShadingMethod for CulledForward {
             grid: Some(GridReport {
                 footprint_px: grid_key.config.footprint_px,
                 cells: grid.total_cells,
-                reason: grid_reason,
+                reason: if automatic {
+                    self.auto.reason()
+                } else {
+                    &self.reason
+                },
             }),
             ..MethodStats::default()
         })

@@ -18,7 +18,7 @@
 use glam::Vec3;
 
 use super::forward::Forward;
-use super::geometry::{draw_order, shade_object, UNIT_METHOD};
+use super::geometry::{shade_object, sort_objects, UNIT_METHOD};
 use super::{FrameContext, MethodDesc, MethodStats, ShaderFeatures, ShadingMethod, Support};
 use crate::cluster::grid::GridProjection;
 use crate::gl::gbuffer::{self, GBuffer};
@@ -27,7 +27,7 @@ use crate::gl::program::{Program, ProgramKey};
 use crate::gl::state::{Blend, Cull, DepthTest, RenderState};
 use crate::gl::{Caps, Device, EsVersion};
 use crate::scene::meshbuild::MeshBuilder;
-use crate::scene::{Mesh, Scene};
+use crate::scene::Mesh;
 use crate::Error;
 
 /// The table row.
@@ -99,7 +99,8 @@ impl Deferred {
         Ok(())
     }
 
-    fn geometry_pass(&self, ctx: &mut FrameContext, opaque: &[usize]) -> Result<(), Error> {
+    /// Draws the opaque objects of `ctx.order` into the G-buffer.
+    fn geometry_pass(&self, ctx: &mut FrameContext) -> Result<(), Error> {
         self.gbuffer
             .as_ref()
             .expect("allocated")
@@ -114,7 +115,8 @@ impl Deferred {
             color_write: true,
         }
         .apply(ctx.dev);
-        for &i in opaque {
+        for k in 0..ctx.order.opaque.len() {
+            let i = ctx.order.opaque[k];
             shade_object(ctx, i, "gbuffer", 1, &mut |_, _| {})?;
         }
         Ok(())
@@ -264,35 +266,29 @@ impl ShadingMethod for Deferred {
         DESC.name
     }
 
-    fn render(&mut self, ctx: &mut FrameContext) -> Result<MethodStats, Error> {
+    fn render(&mut self, ctx: &mut FrameContext) -> Result<MethodStats<'_>, Error> {
         let dev = ctx.dev;
         let target = gbuffer::current_draw_framebuffer(dev);
         self.ensure_resources(dev, ctx.viewport)?;
-        let (opaque, transparent) = draw_order(ctx);
-        self.geometry_pass(ctx, &opaque)?;
+        sort_objects(ctx);
+        self.geometry_pass(ctx)?;
         self.light_pass(ctx)?;
         self.composite(ctx, target)?;
         let mut stats = MethodStats {
             gbuffer_bytes: self.gbuffer.as_ref().map_or(0, GBuffer::gpu_bytes),
             ..MethodStats::default()
         };
-        if !transparent.is_empty() && !ctx.features.counting() {
-            // Forward fallback for what a G-buffer cannot hold.
+        if !ctx.order.transparent.is_empty() && !ctx.features.counting() {
+            // Forward fallback for what a G-buffer cannot hold: plain forward over the
+            // transparent objects only.
             self.gbuffer
                 .as_ref()
                 .expect("allocated")
                 .blit_depth_to(dev, target)?;
-            let mut only = Scene {
-                objects: Vec::new(),
-                ..ctx.scene.clone()
-            };
-            only.objects = transparent
-                .iter()
-                .map(|&i| ctx.scene.objects[i].clone())
-                .collect();
             let mut sub = FrameContext {
-                scene: &only,
                 programs: &mut *ctx.programs,
+                order: &mut *ctx.order,
+                transparent_only: true,
                 ..*ctx
             };
             stats.upload_bytes += self.transparent.render(&mut sub)?.upload_bytes;

@@ -10,7 +10,7 @@
 
 use super::geometry::{self, UNIT_METHOD};
 use super::{FrameContext, MethodDesc, MethodStats, ShadingMethod, Support};
-use crate::cluster::pack::{pack_lights, LightEncoding};
+use crate::cluster::pack::{pack_lights_into, GpuLight, LightEncoding, PackedLights};
 use crate::gl::texture::{DataFormat, DataTexture};
 use crate::gl::{Caps, Device, EsVersion};
 use crate::Error;
@@ -55,12 +55,18 @@ pub fn max_lights(caps: &Caps) -> u32 {
     by_texture.min(by_loop)
 }
 
-/// Plain forward's GPU state: the light texture.
+/// Plain forward's GPU state: the light texture, and the buffers a frame fills (kept, so a
+/// frame allocates nothing once they have grown).
 #[derive(Default)]
 pub struct Forward {
     lights: Option<(DataTexture, LightEncoding)>,
     /// The light cap was announced (once per renderer: it holds frame after frame).
     warned_cap: bool,
+    /// The lights packed for upload.
+    packed: PackedLights,
+    /// The lights kept under the cap, and the selection's buffer.
+    capped: Vec<GpuLight>,
+    cap_order: Vec<usize>,
 }
 
 impl ShadingMethod for Forward {
@@ -68,10 +74,9 @@ impl ShadingMethod for Forward {
         DESC.name
     }
 
-    fn render(&mut self, ctx: &mut FrameContext) -> Result<MethodStats, Error> {
+    fn render(&mut self, ctx: &mut FrameContext) -> Result<MethodStats<'_>, Error> {
         let dev = ctx.dev;
         let limit = max_lights(dev.caps());
-        let capped;
         if ctx.lights.len() > limit as usize && ctx.features.counting() {
             // A count over a subset of the lights is no lower bound and no evaluation count.
             return Err(Error::Limit(format!(
@@ -81,7 +86,12 @@ impl ShadingMethod for Forward {
             )));
         }
         let lights = if ctx.lights.len() > limit as usize {
-            capped = super::forward_cap::keep_most_important(ctx.lights, limit as usize);
+            super::forward_cap::keep_most_important_into(
+                ctx.lights,
+                limit as usize,
+                &mut self.cap_order,
+                &mut self.capped,
+            );
             if !self.warned_cap {
                 log::warn!(
                     "forward loops over at most {limit} lights on this context; {} of the \
@@ -92,7 +102,7 @@ impl ShadingMethod for Forward {
                 );
                 self.warned_cap = true;
             }
-            &capped[..]
+            &self.capped[..]
         } else {
             ctx.lights
         };
@@ -117,12 +127,14 @@ impl ShadingMethod for Forward {
             self.lights = Some((DataTexture::new(dev, format)?, encoding));
         }
         let (texture, _) = self.lights.as_mut().expect("created above");
-        let packed = pack_lights(lights, encoding);
+        let packed = &mut self.packed;
+        pack_lights_into(lights, encoding, packed);
         // With no lights the shader never reads the texture: upload only to give it storage.
         if count > 0 || fresh {
             texture.upload(dev, packed.width, packed.height, &packed.bytes)?;
             stats.upload_bytes = packed.bytes.len();
         }
+        let ranges = [packed.pos_range, packed.radius_range];
         let inv_height = 1.0 / texture.size().1.max(1) as f32;
         let texture = &*texture;
         geometry::draw_objects(ctx, "forward", limit, &mut |program, dev| {
@@ -130,11 +142,7 @@ impl ShadingMethod for Forward {
             program.set_i32(dev, "u_lights", UNIT_METHOD as i32);
             program.set_i32(dev, "u_lightCount", count as i32);
             program.set_f32(dev, "u_lightTexInvHeight", inv_height);
-            program.set_vec2(
-                dev,
-                "u_lightRanges",
-                [packed.pos_range, packed.radius_range],
-            );
+            program.set_vec2(dev, "u_lightRanges", ranges);
         })?;
         Ok(stats)
     }

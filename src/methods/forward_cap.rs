@@ -19,15 +19,35 @@ pub fn importance(light: &GpuLight) -> f32 {
 /// The `limit` most important lights of `lights`, in their original order (the order forward
 /// adds them in, so the image is forward's over exactly those lights). Ties keep the earlier.
 pub fn keep_most_important(lights: &[GpuLight], limit: usize) -> Vec<GpuLight> {
-    most_important_indices(lights, limit)
-        .into_iter()
-        .map(|i| lights[i])
-        .collect()
+    let mut kept = Vec::new();
+    keep_most_important_into(lights, limit, &mut Vec::new(), &mut kept);
+    kept
+}
+
+/// [`keep_most_important`] into `kept`, with `order` as the selection's buffer: both reused,
+/// so a frame allocates nothing once they have grown.
+pub fn keep_most_important_into(
+    lights: &[GpuLight],
+    limit: usize,
+    order: &mut Vec<usize>,
+    kept: &mut Vec<GpuLight>,
+) {
+    most_important_indices_into(lights, limit, order);
+    kept.clear();
+    kept.extend(order.iter().map(|&i| lights[i]));
 }
 
 /// The positions in `lights` that [`keep_most_important`] keeps, ascending.
 pub fn most_important_indices(lights: &[GpuLight], limit: usize) -> Vec<usize> {
-    let mut order: Vec<usize> = (0..lights.len()).collect();
+    let mut order = Vec::new();
+    most_important_indices_into(lights, limit, &mut order);
+    order
+}
+
+/// [`most_important_indices`] into `order` (cleared first).
+pub fn most_important_indices_into(lights: &[GpuLight], limit: usize, order: &mut Vec<usize>) {
+    order.clear();
+    order.extend(0..lights.len());
     if lights.len() > limit {
         // Descending importance; the index breaks ties so the choice is deterministic.
         order.select_nth_unstable_by(limit, |&a, &b| {
@@ -38,7 +58,6 @@ pub fn most_important_indices(lights: &[GpuLight], limit: usize) -> Vec<usize> {
         order.truncate(limit);
         order.sort_unstable();
     }
-    order
 }
 
 #[cfg(test)]

@@ -21,33 +21,51 @@ fn set_transforms(program: &mut Program, dev: &Device, model_view: &DMat4, proje
     program.set_mat4(dev, "u_projection", projection);
 }
 
-/// Opaque objects in scene order, then transparent ones back to front (by the view depth of
-/// their bounds' centre).
-pub(crate) fn draw_order(ctx: &FrameContext) -> (Vec<usize>, Vec<usize>) {
+/// The objects of a frame in draw order: indices into the scene's objects, in buffers the
+/// renderer keeps from frame to frame (so ordering them allocates nothing once they have
+/// grown to the scene's object count).
+#[derive(Debug, Default)]
+pub struct DrawOrder {
+    /// Opaque objects, in scene order.
+    pub opaque: Vec<usize>,
+    /// Transparent objects, back to front.
+    pub transparent: Vec<usize>,
+    /// (view depth, object) of the transparent objects, to sort them.
+    depths: Vec<(f64, usize)>,
+}
+
+/// Puts the frame's opaque objects in scene order, then the transparent ones back to front (by
+/// the view depth of their bounds' centre; equal depths in scene order), into `ctx.order`.
+/// With `ctx.transparent_only` the opaque list stays empty.
+pub(crate) fn sort_objects(ctx: &mut FrameContext) {
     let scene = ctx.scene;
-    let (mut opaque, mut transparent) = (Vec::new(), Vec::new());
+    let order = &mut *ctx.order;
+    order.opaque.clear();
+    order.depths.clear();
     for (i, o) in scene.objects.iter().enumerate() {
         if scene.materials[o.material].is_transparent() {
-            transparent.push(i);
-        } else {
-            opaque.push(i);
+            let centre = ctx
+                .gpu_scene
+                .world_bounds(o)
+                .map_or(glam::DVec3::ZERO, |b| b.center());
+            order.depths.push((-ctx.view.transform_point3(centre).z, i));
+        } else if !ctx.transparent_only {
+            order.opaque.push(i);
         }
     }
-    let depth = |i: &usize| {
-        let o = &scene.objects[*i];
-        let centre = ctx
-            .gpu_scene
-            .world_bounds(o)
-            .map_or(glam::DVec3::ZERO, |b| b.center());
-        -ctx.view.transform_point3(centre).z
-    };
-    transparent.sort_by(|a, b| depth(b).total_cmp(&depth(a)));
-    (opaque, transparent)
+    // Farthest first; the index makes the order that of a stable sort without its buffer.
+    order
+        .depths
+        .sort_unstable_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
+    order.transparent.clear();
+    order
+        .transparent
+        .extend(order.depths.iter().map(|&(_, i)| i));
 }
 
 /// Lays down the opaque objects' depth only, so the shading pass runs its light loop once per
 /// pixel instead of once per overlapping surface.
-fn depth_prepass(ctx: &mut FrameContext, opaque: &[usize]) -> Result<(), Error> {
+fn depth_prepass(ctx: &mut FrameContext) -> Result<(), Error> {
     let dev = ctx.dev;
     RenderState::DEPTH_PREPASS.apply(dev);
     let key = ProgramKey {
@@ -57,7 +75,7 @@ fn depth_prepass(ctx: &mut FrameContext, opaque: &[usize]) -> Result<(), Error> 
     };
     let program = ctx.programs.get_or_build(dev, key, Vec::new)?;
     program.bind(dev);
-    for &i in opaque {
+    for &i in &ctx.order.opaque {
         let object = &ctx.scene.objects[i];
         set_transforms(
             program,
@@ -82,19 +100,21 @@ pub fn draw_objects(
     max_lights: u32,
     bind_method: &mut dyn FnMut(&mut Program, &Device),
 ) -> Result<(), Error> {
-    let (opaque, transparent) = draw_order(ctx);
-    depth_prepass(ctx, &opaque)?;
+    sort_objects(ctx);
+    depth_prepass(ctx)?;
     RenderState::OPAQUE_AFTER_PREPASS.apply(ctx.dev);
-    for &i in &opaque {
+    for k in 0..ctx.order.opaque.len() {
+        let i = ctx.order.opaque[k];
         shade_object(ctx, i, shader, max_lights, bind_method)?;
     }
     // Counts are of the visible opaque surface: blending would mix two counts in 8 bits.
     let transparent = if ctx.features.counting() {
-        Vec::new()
+        0
     } else {
-        transparent
+        ctx.order.transparent.len()
     };
-    for &i in &transparent {
+    for k in 0..transparent {
+        let i = ctx.order.transparent[k];
         for state in [
             RenderState::TRANSPARENT_BACK_FACES,
             RenderState::TRANSPARENT_FRONT_FACES,
@@ -168,7 +188,7 @@ pub(crate) fn shade_object(
 }
 
 /// A frame without lights: ambient only, with the light loop compiled out and nothing uploaded.
-pub fn draw_ambient_only(ctx: &mut FrameContext) -> Result<super::MethodStats, Error> {
+pub fn draw_ambient_only(ctx: &mut FrameContext) -> Result<super::MethodStats<'static>, Error> {
     ctx.features = ctx.features.with(ShaderFeatures::NO_LIGHTS, true);
     draw_objects(ctx, "forward", 1, &mut |_, _| {})?;
     Ok(super::MethodStats::default())

@@ -233,7 +233,12 @@ fn changed_much(then: usize, now: usize) -> bool {
     now * 4 > then * 5 || now * 5 < then * 4
 }
 
-/// The reason a fixed grid reports.
-pub(crate) fn fixed_reason(config: &GridConfig) -> String {
-    format!("fixed: footprint_px = {} (GridConfig)", config.footprint_px)
+/// Writes the reason a fixed grid reports into `out`.
+pub(crate) fn write_fixed_reason(out: &mut String, config: &GridConfig) {
+    use std::fmt::Write as _;
+    let _ = write!(
+        out,
+        "fixed: footprint_px = {} (GridConfig)",
+        config.footprint_px
+    );
 }

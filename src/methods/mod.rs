@@ -68,22 +68,30 @@ pub struct FrameContext<'a> {
     pub content_far: f64,
     /// Caller's options.
     pub options: &'a RenderOptions,
+    /// The frame's objects in draw order (buffers kept between frames: see
+    /// [`geometry::DrawOrder`]).
+    pub order: &'a mut geometry::DrawOrder,
+    /// Draw only the transparent objects (deferred's forward fallback for them).
+    pub transparent_only: bool,
 }
 
 /// Which grid a tiled or clustered frame used, and why.
 #[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
-pub struct GridReport {
+pub struct GridReport<'a> {
     /// Cell footprint in pixels.
     pub footprint_px: f64,
     /// Cells of the grid.
     pub cells: u32,
-    /// Why: the automatic choice's prediction, or the fixed setting.
-    pub reason: String,
+    /// Why: the automatic choice's prediction, or the fixed setting (the method's own text,
+    /// borrowed: a frame makes no string).
+    pub reason: &'a str,
 }
 
-/// What a method reports about its frame.
+/// What a method reports about its frame. Its texts are borrowed from the method, so a
+/// frame's report allocates nothing; the renderer copies them into the reused
+/// [`crate::FrameStats`].
 #[derive(Clone, Debug, Default)]
-pub struct MethodStats {
+pub struct MethodStats<'a> {
     /// Bytes uploaded to the GPU this frame (light data, grids, index lists).
     pub upload_bytes: usize,
     /// CPU light-assignment time (culling methods).
@@ -93,9 +101,9 @@ pub struct MethodStats {
     /// G-buffer memory (deferred).
     pub gbuffer_bytes: usize,
     /// The grid the frame used (tiled, clustered).
-    pub grid: Option<GridReport>,
+    pub grid: Option<GridReport<'a>>,
     /// What `auto` picked, and why.
-    pub auto_choice: Option<(&'static str, String)>,
+    pub auto_choice: Option<(&'static str, &'a str)>,
     /// Lights left out of the whole frame (forward beyond its loop cap).
     pub dropped_lights: u64,
 }
@@ -110,8 +118,10 @@ pub type LightLists<'a> = (
 pub trait ShadingMethod {
     /// Name as in the table.
     fn name(&self) -> &'static str;
-    /// Renders one frame (the framebuffer is bound and cleared by the renderer).
-    fn render(&mut self, ctx: &mut FrameContext) -> Result<MethodStats, Error>;
+    /// Renders one frame (the framebuffer is bound and cleared by the renderer). In steady
+    /// state (buffers grown, shaders built) a frame should allocate nothing on the heap:
+    /// keep per-frame buffers in the method and texts in its own strings.
+    fn render(&mut self, ctx: &mut FrameContext) -> Result<MethodStats<'_>, Error>;
     /// GPU memory the method holds, in bytes.
     fn gpu_bytes(&self) -> usize;
     /// The grid and light lists of the last frame, for methods that build them.

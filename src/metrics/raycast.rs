@@ -144,7 +144,13 @@ impl SceneRaycaster {
         };
         let mut transparent_t = f64::INFINITY;
         let inv = dir.recip();
-        let mut stack: Vec<u32> = Vec::with_capacity(64);
+        // The traversal stack is kept per thread: the automatic grid casts rays during a frame,
+        // and a frame in steady state allocates nothing.
+        thread_local! {
+            static STACK: std::cell::RefCell<Vec<u32>> = const { std::cell::RefCell::new(Vec::new()) };
+        }
+        let mut stack = STACK.with(|s| std::mem::take(&mut *s.borrow_mut()));
+        stack.clear();
         if !self.nodes.is_empty() && slab(&self.nodes[0], origin, inv, reach(best_t)).is_some() {
             stack.push(0);
         }
@@ -190,6 +196,7 @@ impl SceneRaycaster {
                 (None, None) => {}
             }
         }
+        STACK.with(|s| *s.borrow_mut() = stack);
         let hit = best.map(|(t, u, v, slot)| self.make_hit(slot, origin, dir, t, u, v));
         // Ties count as in front: a transparent surface coplanar with an opaque one is blended.
         let limit = hit.map_or(t_max, |h| h.t);

@@ -161,14 +161,18 @@ impl Scene {
                 format!("must be finite and >= 0, got {:?}", self.ambient),
             ));
         }
+        // Checked without a name first and named only on failure: a scene is validated every
+        // frame, and a valid one costs no allocation.
         for (i, light) in self.lights.iter().enumerate() {
-            light.validate(&format!("lights[{i}]"))?;
+            if light.validate("").is_err() {
+                light.validate(&format!("lights[{i}]"))?;
+            }
         }
         for track in &self.animation {
-            let field = format!("lights[{}].motion", track.first);
+            let field = || format!("lights[{}].motion", track.first);
             if track.first.saturating_add(track.rest.len()) > self.lights.len() {
                 return Err(SceneError::invalid(
-                    field,
+                    field(),
                     format!(
                         "moves lights {}..{} but the scene has {}",
                         track.first,
@@ -183,10 +187,14 @@ impl Scene {
                     .rest
                     .iter()
                     .all(|l| matches!(l.kind, LightKind::Spot { .. }));
-            track.motion.validate(&field, is_spot)?;
+            if track.motion.validate("", is_spot).is_err() {
+                track.motion.validate(&field(), is_spot)?;
+            }
         }
         for (i, m) in self.materials.iter().enumerate() {
-            m.validate(&format!("materials[{i}] ({})", m.name))?;
+            if m.validate("").is_err() {
+                m.validate(&format!("materials[{i}] ({})", m.name))?;
+            }
         }
         for (i, o) in self.objects.iter().enumerate() {
             if o.material >= self.materials.len() {

@@ -237,11 +237,11 @@ impl Motion {
     /// Checks every parameter; `field` is the path used in errors (`lights[3].motion`).
     /// `is_spot` says whether a sweep has a cone to move.
     pub fn validate(&self, field: &str, is_spot: bool) -> Result<(), SceneError> {
-        let period = |value: f64, name: &str| check_period(value, &format!("{field}.{name}"));
+        let period = |value: f64, name: &str| check_period(value, field, name);
         if let Some(o) = &self.orbit {
             period(o.period_s, "orbit.period_s")?;
-            check_axis(o.axis, &format!("{field}.orbit.axis"))?;
-            check_finite(o.phase_deg, &format!("{field}.orbit.phase_deg"))?;
+            check_axis(o.axis, field, "orbit.axis")?;
+            check_finite(o.phase_deg, field, "orbit.phase_deg")?;
             match o.about {
                 OrbitAbout::Point(c) => {
                     if !(c.is_finite() && c.abs().max_element() <= MAX_DISPLACEMENT) {
@@ -251,12 +251,12 @@ impl Motion {
                         ));
                     }
                 }
-                OrbitAbout::Radius(r) => check_length(r, &format!("{field}.orbit.radius"))?,
+                OrbitAbout::Radius(r) => check_length(r, field, "orbit.radius")?,
             }
         }
         if let Some(b) = &self.bob {
             period(b.period_s, "bob.period_s")?;
-            check_finite(b.phase_deg, &format!("{field}.bob.phase_deg"))?;
+            check_finite(b.phase_deg, field, "bob.phase_deg")?;
             if !(b.amplitude.is_finite() && b.amplitude.length() <= MAX_DISPLACEMENT) {
                 return Err(SceneError::invalid(
                     format!("{field}.bob.amplitude"),
@@ -269,7 +269,7 @@ impl Motion {
         }
         if let Some(w) = &self.wander {
             period(w.period_s, "wander.period_s")?;
-            check_length(w.radius, &format!("{field}.wander.radius"))?;
+            check_length(w.radius, field, "wander.radius")?;
         }
         if let Some(f) = &self.flicker {
             if !(f.amount.is_finite() && (0.0..=1.0).contains(&f.amount)) {
@@ -297,8 +297,8 @@ impl Motion {
                 ));
             }
             period(s.period_s, "sweep.period_s")?;
-            check_axis(s.axis, &format!("{field}.sweep.axis"))?;
-            check_finite(s.phase_deg, &format!("{field}.sweep.phase_deg"))?;
+            check_axis(s.axis, field, "sweep.axis")?;
+            check_finite(s.phase_deg, field, "sweep.phase_deg")?;
             if !(s.angle_deg.is_finite() && (0.0..=180.0).contains(&s.angle_deg)) {
                 return Err(SceneError::invalid(
                     format!("{field}.sweep.angle_deg"),
@@ -356,45 +356,48 @@ impl Motion {
     }
 }
 
-fn check_period(value: f64, field: &str) -> Result<(), SceneError> {
+// The checks take the field's path in two parts and join them only for an error: a scene is
+// validated every frame, and a valid one must cost no allocation.
+
+fn check_period(value: f64, field: &str, name: &str) -> Result<(), SceneError> {
     if value.is_finite() && (MIN_PERIOD_S..=MAX_PERIOD_S).contains(&value) {
         Ok(())
     } else {
         Err(SceneError::invalid(
-            field,
+            format!("{field}.{name}"),
             format!("must be within [{MIN_PERIOD_S:e}, {MAX_PERIOD_S:e}] seconds, got {value}"),
         ))
     }
 }
 
-fn check_axis(axis: DVec3, field: &str) -> Result<(), SceneError> {
+fn check_axis(axis: DVec3, field: &str, name: &str) -> Result<(), SceneError> {
     if axis.is_finite() && axis.length() > 1e-12 && axis.length().is_finite() {
         Ok(())
     } else {
         Err(SceneError::invalid(
-            field,
+            format!("{field}.{name}"),
             format!("must be finite and non-zero, got {axis:?}"),
         ))
     }
 }
 
-fn check_length(value: f64, field: &str) -> Result<(), SceneError> {
+fn check_length(value: f64, field: &str, name: &str) -> Result<(), SceneError> {
     if value.is_finite() && (0.0..=MAX_DISPLACEMENT).contains(&value) {
         Ok(())
     } else {
         Err(SceneError::invalid(
-            field,
+            format!("{field}.{name}"),
             format!("must be within [0, {MAX_DISPLACEMENT:e}], got {value}"),
         ))
     }
 }
 
-fn check_finite(value: f64, field: &str) -> Result<(), SceneError> {
+fn check_finite(value: f64, field: &str, name: &str) -> Result<(), SceneError> {
     if value.is_finite() {
         Ok(())
     } else {
         Err(SceneError::invalid(
-            field,
+            format!("{field}.{name}"),
             format!("must be finite, got {value}"),
         ))
     }

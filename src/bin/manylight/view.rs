@@ -110,8 +110,7 @@ pub fn run(args: &ViewArgs) -> Result<(), Box<dyn std::error::Error>> {
         (None, false) => Some(DEFAULT_LIGHTS),
     };
     // The loader logs each warning (at `warn`, shown by default): not printed again here.
-    let (mut scene, _logged_warnings) =
-        scene::load(&args.scene, lights.map(|n| (n, args.seed)))?;
+    let (mut scene, _logged_warnings) = scene::load(&args.scene, lights.map(|n| (n, args.seed)))?;
     scene.set_time(args.time);
     // Validate the method name before opening a window.
     manylight::methods::find(&args.method)?;
@@ -131,6 +130,7 @@ pub fn run(args: &ViewArgs) -> Result<(), Box<dyn std::error::Error>> {
         samples: args.msaa.max(1),
         time_s: args.time,
         paused: args.paused,
+        stats: FrameStats::default(),
         scene,
         fly: FlyCamera::new(FlyCamera::speed_for_extent(extent)),
         gfx: None,
@@ -172,6 +172,8 @@ struct App<'a> {
     time_s: f64,
     /// Space stops the animation clock.
     paused: bool,
+    /// The last frame's figures, refilled in place every frame.
+    stats: FrameStats,
     fly: FlyCamera,
     gfx: Option<Gfx>,
     frames: u64,
@@ -399,8 +401,12 @@ impl App<'_> {
             ..RenderOptions::default()
         };
         let renderer = g.renderer.as_mut().ok_or("renderer already destroyed")?;
-        let stats = match renderer.render(&self.scene, size.width, size.height, &options) {
-            Ok(s) => s,
+        // One FrameStats kept across frames: a steady frame allocates nothing.
+        let mut stats = std::mem::take(&mut self.stats);
+        let rendered =
+            renderer.render_reusing(&self.scene, size.width, size.height, &options, &mut stats);
+        match rendered {
+            Ok(()) => {}
             // MSAA this context or method cannot do: said once, and off again.
             Err(e) if self.samples > 1 && e.to_string().contains("MSAA") => {
                 eprintln!("error: {e}; MSAA off");
@@ -409,7 +415,9 @@ impl App<'_> {
             }
             Err(e) => return self.undo_change(e.to_string()),
         };
-        self.good = (stats.method.clone(), self.light_count);
+        if self.good.0 != stats.method || self.good.1 != self.light_count {
+            self.good = (stats.method.clone(), self.light_count);
+        }
         self.frames += 1;
         if Some(self.frames) == self.args.frames {
             let mut line = format!(
@@ -432,6 +440,7 @@ impl App<'_> {
         }
         g.swap()?;
         update_title(&mut self.title, g, &stats, dt);
+        self.stats = stats;
         Ok(())
     }
 
