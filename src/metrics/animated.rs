@@ -66,12 +66,12 @@ pub fn markdown(rows: &[AnimatedRow]) -> String {
          plain forward at the same time.\n",
         first.frames, first.fps, first.width, first.height
     );
-    s += "| scene | ES | method | lights | frame p50 | p95 | p99 | max | p99/p50 | assign p50 | assign p99 | upload KiB p50 | max err |\n\
-          |---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+    s += "| scene | ES | method | lights | frame p50 | p95 | p99 | max | p99/p50 | assign p50 | assign p99 | upload KiB p50 | upload KiB max | max err |\n\
+          |---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
     for r in rows {
         let _ = writeln!(
             s,
-            "| {} | {} | {} | {} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} | {:.3} | {:.3} | {:.0} | {} |",
+            "| {} | {} | {} | {} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} | {:.3} | {:.3} | {:.0} | {:.0} | {} |",
             r.scene,
             r.es,
             r.method,
@@ -84,6 +84,7 @@ pub fn markdown(rows: &[AnimatedRow]) -> String {
             r.assign_ms.p50,
             r.assign_ms.p99,
             r.upload_bytes.p50 / 1024.0,
+            r.upload_bytes.max / 1024.0,
             r.max_abs_err_vs_forward
                 .map_or("-".to_string(), |e| e.to_string()),
         );
@@ -125,7 +126,7 @@ mod tests {
             max_abs_err_vs_forward: err,
         };
         let md = markdown(&[row("forward", None), row("clustered", Some(1))]);
-        assert!(md.contains("| courtyard | 3.0 | clustered | 1024 | 10.00 | 12.50 | 15.00 | 16.50 | 1.50 | 0.500 | 0.900 | 2 | 1 |"), "{md}");
+        assert!(md.contains("| courtyard | 3.0 | clustered | 1024 | 10.00 | 12.50 | 15.00 | 16.50 | 1.50 | 0.500 | 0.900 | 2 | 4 | 1 |"), "{md}");
         assert!(md.contains("| forward |") && md.contains("| - |"), "{md}");
         assert!(markdown(&[]).is_empty());
         assert_eq!(AnimatedRow::tail_ratio(&spread(0.0, 1.0)), 0.0);
