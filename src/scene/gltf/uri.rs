@@ -87,39 +87,37 @@ pub(super) fn percent_decode(s: &str) -> Result<Vec<u8>, String> {
 }
 
 /// Standard base64 (RFC 4648, `+` and `/`; the URL-safe `-` and `_` accepted too), padding
-/// optional. Errors name the first bad character's position.
+/// optional, stray bits in the last character ignored. Errors name the first bad character's
+/// position.
 pub(super) fn decode_base64(s: &str) -> Result<Vec<u8>, String> {
-    let s = s.trim_end_matches('=');
-    let mut out = Vec::with_capacity(s.len() / 4 * 3 + 3);
-    let mut acc: u32 = 0;
-    let mut bits = 0;
-    for (i, c) in s.bytes().enumerate() {
-        let v = match c {
-            b'A'..=b'Z' => c - b'A',
-            b'a'..=b'z' => c - b'a' + 26,
-            b'0'..=b'9' => c - b'0' + 52,
-            b'+' | b'-' => 62,
-            b'/' | b'_' => 63,
-            _ => {
-                return Err(format!(
-                    "base64 payload has an invalid character {:?} at position {i}",
-                    c as char
-                ))
-            }
-        };
-        acc = (acc << 6) | u32::from(v);
-        bits += 6;
-        if bits >= 8 {
-            bits -= 8;
-            out.push((acc >> bits) as u8);
-            acc &= (1 << bits) - 1;
+    use base64::engine::{DecodePaddingMode, GeneralPurpose, GeneralPurposeConfig};
+    use base64::{alphabet, DecodeError, Engine};
+    const LENIENT: GeneralPurpose = GeneralPurpose::new(
+        &alphabet::STANDARD,
+        GeneralPurposeConfig::new()
+            .with_decode_padding_mode(DecodePaddingMode::Indifferent)
+            .with_decode_allow_trailing_bits(true),
+    );
+    // The URL-safe alphabet's two characters, mapped to the standard ones: exporters mix them.
+    let standard: Vec<u8> = s
+        .trim_end_matches('=')
+        .bytes()
+        .map(|c| match c {
+            b'-' => b'+',
+            b'_' => b'/',
+            c => c,
+        })
+        .collect();
+    LENIENT.decode(standard).map_err(|e| match e {
+        DecodeError::InvalidByte(i, c) => format!(
+            "base64 payload has an invalid character {:?} at position {i}",
+            c as char
+        ),
+        DecodeError::InvalidLength(_) | DecodeError::InvalidLastSymbol(..) => {
+            "base64 payload is truncated (its length is not valid)".into()
         }
-    }
-    if bits >= 6 {
-        // One character left over: it cannot hold a whole byte.
-        return Err("base64 payload is truncated (its length is not valid)".into());
-    }
-    Ok(out)
+        DecodeError::InvalidPadding => "base64 payload has invalid padding".into(),
+    })
 }
 
 #[cfg(test)]
