@@ -181,6 +181,29 @@ fn copy_support(dst: &mut Support, src: &Support) {
     }
 }
 
+impl FrameStats {
+    /// The last of `frames` with frame, assignment and GPU time replaced by their medians over
+    /// all of them and the frame and assignment spreads filled in (nearest rank, so median and
+    /// spread agree; GPU time only where every frame has it). `None` for no frames.
+    pub fn summarize(mut frames: Vec<FrameStats>) -> Option<FrameStats> {
+        let frame_spread = Spread::of(frames.iter().map(|s| s.frame_ms));
+        let assign_spread = Spread::of(frames.iter().map(|s| s.assign_ms));
+        let gpu_ms = frames
+            .iter()
+            .map(|s| s.gpu_ms)
+            .collect::<Option<Vec<f64>>>()
+            .and_then(Spread::of)
+            .map(|s| s.p50);
+        let mut last = frames.pop()?;
+        last.frame_ms = frame_spread.map_or(last.frame_ms, |s| s.p50);
+        last.assign_ms = assign_spread.map_or(last.assign_ms, |s| s.p50);
+        last.gpu_ms = gpu_ms;
+        last.frame_ms_spread = frame_spread;
+        last.assign_ms_spread = assign_spread;
+        Some(last)
+    }
+}
+
 /// Renders scenes with one shading method at a time.
 pub struct Renderer {
     dev: Device,
@@ -664,24 +687,7 @@ impl Renderer {
             for _ in 0..options.timed_frames {
                 frames.push(self.render(scene, width, height, options)?);
             }
-            // GPU time where every frame has it: its median.
-            let gpu_ms = frames
-                .iter()
-                .map(|s| s.gpu_ms)
-                .collect::<Option<Vec<f64>>>()
-                .map(|mut v| {
-                    v.sort_by(f64::total_cmp);
-                    v[v.len() / 2]
-                });
-            let frame_spread = Spread::of(frames.iter().map(|s| s.frame_ms));
-            let assign_spread = Spread::of(frames.iter().map(|s| s.assign_ms));
-            stats = frames.pop().expect("at least one timed frame");
-            // The reported figures are the spreads' medians (nearest rank), so the two agree.
-            stats.frame_ms = frame_spread.map_or(stats.frame_ms, |s| s.p50);
-            stats.assign_ms = assign_spread.map_or(stats.assign_ms, |s| s.p50);
-            stats.gpu_ms = gpu_ms;
-            stats.frame_ms_spread = frame_spread;
-            stats.assign_ms_spread = assign_spread;
+            stats = FrameStats::summarize(frames).expect("at least one timed frame");
         }
         Ok(stats)
     }

@@ -113,15 +113,9 @@ pub fn render(
     let mut recorder = record.map(|p| Recorder::open(p, timeline)).transpose()?;
     pose(scene, timeline.start_s);
     // The warm-up frame compiles shaders and uploads meshes: its picture, not its time.
-    let (first, mut stats) = renderer.render_offscreen(scene, width, height, &one_frame)?;
+    let (first, warm_up) = renderer.render_offscreen(scene, width, height, &one_frame)?;
     let mut last = None;
-    let capacity = timeline.frames.min(1 << 20) as usize;
-    let (mut frame_ms, mut assign_ms, mut upload) = (
-        Vec::with_capacity(capacity),
-        Vec::with_capacity(capacity),
-        Vec::with_capacity(capacity),
-    );
-    let mut gpu_ms = Vec::with_capacity(capacity);
+    let mut timed = Vec::with_capacity(timeline.frames.min(1 << 20) as usize);
     for k in 0..timeline.frames {
         pose(scene, timeline.time_of(k));
         let (image, s) = renderer.render_offscreen(scene, width, height, &one_frame)?;
@@ -133,28 +127,15 @@ pub fn render(
         } else if let Some(r) = &mut recorder {
             r.add(k, image, timeline.fps)?;
         }
-        frame_ms.push(s.frame_ms);
-        assign_ms.push(s.assign_ms);
-        upload.push(s.upload_bytes as f64);
-        gpu_ms.push(s.gpu_ms);
-        stats = s;
+        timed.push(s);
     }
     if let Some(Recorder::Gif(encoder, _)) = recorder {
         // Dropping the encoder writes the trailer; flush errors surface here.
         drop(encoder);
     }
-    let frame_spread = Spread::of(frame_ms);
-    let assign_spread = Spread::of(assign_ms);
-    stats.frame_ms = frame_spread.map_or(stats.frame_ms, |s| s.p50);
-    stats.assign_ms = assign_spread.map_or(stats.assign_ms, |s| s.p50);
-    stats.gpu_ms = gpu_ms
-        .into_iter()
-        .collect::<Option<Vec<f64>>>()
-        .and_then(Spread::of)
-        .map(|s| s.p50);
-    stats.frame_ms_spread = frame_spread;
-    stats.assign_ms_spread = assign_spread;
-    stats.upload_bytes_spread = Spread::of(upload);
+    let upload = Spread::of(timed.iter().map(|s| s.upload_bytes as f64));
+    let mut stats = FrameStats::summarize(timed).unwrap_or(warm_up);
+    stats.upload_bytes_spread = upload;
     Ok(Rendered {
         last: last.unwrap_or_else(|| first.clone()),
         first,
