@@ -1,0 +1,187 @@
+//! Building a grid: [`ClusterGrid::new`] and the in-place [`ClusterGrid::rebuild`], which lay
+//! out the cascades, slices and tiles and fill the per-frame lookup tables (slice table, box
+//! projection constants, widened slice slabs).
+
+use super::{
+    Cascade, CascadeConstants, ClusterGrid, DepthMapping, GridConfig, GridProjection, SliceLookup,
+    SpareSpheres, SLICE_WIDEN,
+};
+
+impl ClusterGrid {
+    /// Builds the grid. `depth_range` is the span of view depths the scene can occupy
+    /// (already clipped to [near, far] by the caller; it bounds the grid for infinite or huge
+    /// far planes).
+    pub fn new(
+        width: u32,
+        height: u32,
+        projection: GridProjection,
+        near: f64,
+        far: f64,
+        config: &GridConfig,
+    ) -> ClusterGrid {
+        let mut grid = ClusterGrid {
+            width: 0,
+            height: 0,
+            projection,
+            near: 0.0,
+            far: 0.0,
+            mapping: DepthMapping::Linear,
+            a: 0.0,
+            b: 0.0,
+            cascades: Vec::new(),
+            total_cells: 0,
+            coverage: config.coverage,
+            ndc_scale: [0.0; 2],
+            cell_spheres: std::sync::OnceLock::new(),
+            spare_spheres: SpareSpheres::default(),
+            side_plane_norm: [0.0; 2],
+            slice_lookup: SliceLookup::default(),
+            cascade_constants: Vec::new(),
+            slice_slabs: Vec::new(),
+        };
+        grid.rebuild(width, height, projection, near, far, config);
+        grid
+    }
+
+    /// Makes this grid what [`ClusterGrid::new`] builds from these arguments, in place: its
+    /// buffers are reused, so a grid rebuilt every frame (a moving camera changes its depth
+    /// range) allocates nothing once they have grown.
+    pub fn rebuild(
+        &mut self,
+        width: u32,
+        height: u32,
+        projection: GridProjection,
+        near: f64,
+        far: f64,
+        config: &GridConfig,
+    ) {
+        let width = width.max(1);
+        let height = height.max(1);
+        let near = near.max(0.0);
+        let far = if far.is_finite() && far > near {
+            far
+        } else {
+            near + 1.0
+        };
+        let c = config.cascades.max(1);
+        let min_cell = config.min_cell_size.unwrap_or(0.0).max(0.0);
+        let split = config.first_split.filter(|d| d.is_finite());
+        let (mapping, d0) = match projection {
+            // The first split is moved back from a tiny near plane (Olsson's remedy) but
+            // never past 1/4096 of the far end: a 1e-4 near plane does not make 12 cascades
+            // of microscopic cells.
+            GridProjection::Perspective { .. } => (
+                DepthMapping::Log2,
+                split.unwrap_or(far / 4096.0).max(near).min(far * 0.5),
+            ),
+            GridProjection::Orthographic { .. } => (
+                DepthMapping::Linear,
+                split.map_or(near, |d| d.max(near).min(near + (far - near) * 0.5)),
+            ),
+        };
+        let (fa, ff) = match mapping {
+            DepthMapping::Log2 => (d0.log2(), far.log2()),
+            DepthMapping::Linear => (d0, far),
+        };
+        let a = fa;
+        let b = c as f64 / (ff - fa).max(1e-12);
+        let inverse = |f: f64| match mapping {
+            DepthMapping::Log2 => f.exp2(),
+            DepthMapping::Linear => f,
+        };
+        let mut cascades = std::mem::take(&mut self.cascades);
+        cascades.clear();
+        let mut first_cell = 0u32;
+        for k in 0..c {
+            let z_near = inverse(fa + (ff - fa) * k as f64 / c as f64);
+            let z_far = inverse(fa + (ff - fa) * (k + 1) as f64 / c as f64);
+            // World size of one pixel (vertically) at the cascade's near end.
+            let (_, half_y) = projection.half_extent(z_near.max(near).max(1e-30));
+            let pixel = 2.0 * half_y / height as f64;
+            let footprint = config
+                .footprint_px
+                .max(1.0)
+                .max(min_cell / pixel.max(1e-300));
+            let tiles =
+                |px: u32| ((px as f64 / footprint).ceil() as u32).clamp(1, config.max_tiles.max(1));
+            let (tiles_x, tiles_y) = (tiles(width), tiles(height));
+            // Slices about as deep as a cell is wide (Olsson 2012, Eq. 2).
+            let cell_width = footprint * pixel;
+            let slices = match mapping {
+                DepthMapping::Log2 => {
+                    let rho = 1.0 + 2.0 * half_y / z_near.max(1e-300) / height as f64 * footprint;
+                    ((z_far / z_near).ln() / rho.ln()).ceil()
+                }
+                DepthMapping::Linear => ((z_far - z_near) / cell_width.max(1e-300)).ceil(),
+            };
+            let slices = if slices.is_finite() { slices as u32 } else { 1 }
+                .clamp(1, config.max_slices.max(1));
+            let cascade = Cascade {
+                z_near,
+                z_far,
+                tiles_x,
+                tiles_y,
+                slices,
+                first_cell,
+            };
+            first_cell += cascade.cells();
+            cascades.push(cascade);
+        }
+        self.width = width;
+        self.height = height;
+        self.projection = projection;
+        self.near = near;
+        self.far = far;
+        self.mapping = mapping;
+        self.a = a;
+        self.b = b;
+        self.cascades = cascades;
+        self.total_cells = first_cell;
+        self.coverage = config.coverage;
+        self.ndc_scale = match projection {
+            GridProjection::Perspective { tan_x, tan_y } => [1.0 / tan_x, 1.0 / tan_y],
+            GridProjection::Orthographic { half_x, half_y } => [1.0 / half_x, 1.0 / half_y],
+        };
+        // The spheres are of the old cells: dropped, their buffer kept for the next build.
+        if let Some(mut spheres) = self.cell_spheres.take() {
+            spheres.clear();
+            *self
+                .spare_spheres
+                .0
+                .get_mut()
+                .unwrap_or_else(|e| e.into_inner()) = spheres;
+        }
+        self.side_plane_norm = match projection {
+            GridProjection::Perspective { tan_x, tan_y } => {
+                [tan_x, tan_y].map(|t| 1.0 / (1.0 + t * t).sqrt())
+            }
+            GridProjection::Orthographic { .. } => [1.0; 2],
+        };
+        let mut lookup = std::mem::take(&mut self.slice_lookup);
+        if mapping == DepthMapping::Log2 {
+            lookup.rebuild(self);
+        } else {
+            lookup.clear();
+        }
+        self.slice_lookup = lookup;
+        let mut constants = std::mem::take(&mut self.cascade_constants);
+        CascadeConstants::of_into(self, &mut constants);
+        self.cascade_constants = constants;
+        let mut slabs = std::mem::take(&mut self.slice_slabs);
+        self.build_slice_slabs(&mut slabs);
+        self.slice_slabs = slabs;
+    }
+
+    fn build_slice_slabs(&self, slabs: &mut Vec<[f64; 4]>) {
+        slabs.clear();
+        for (k, c) in self.cascades.iter().enumerate() {
+            for s in 0..c.slices {
+                let (z0, z1) = self.slice_depth_range(k as u32, s);
+                let first = k == 0 && s == 0;
+                let z0 = if first { 0.0 } else { z0 * (1.0 - SLICE_WIDEN) };
+                let z1 = z1 * (1.0 + SLICE_WIDEN);
+                slabs.push([z0, z1, 1.0 / z0, 1.0 / z1]);
+            }
+        }
+    }
+}

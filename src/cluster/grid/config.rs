@@ -1,0 +1,99 @@
+//! What a grid is asked to be: [`GridConfig`] (cascades, cell footprint, first split, limits),
+//! who picks the footprint ([`GridMode`]) and how tightly a light's cells are bounded
+//! ([`Coverage`]).
+
+/// Tunables of the grid.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct GridConfig {
+    /// Whether the clustered method picks the footprint itself every so often
+    /// ([`GridMode::Auto`], the default) or always uses `footprint_px`.
+    /// [`ClusterGrid::new`](super::ClusterGrid::new) always builds `footprint_px`: the choice
+    /// is the method's (see [`super::auto`](crate::cluster::auto)).
+    pub mode: GridMode,
+    /// Number of depth cascades (Billeter uses 12).
+    pub cascades: u32,
+    /// Target cell footprint in pixels (cells are about this wide and as deep as wide): the
+    /// fixed mode's, and where the automatic mode starts.
+    pub footprint_px: f64,
+    /// Where the first cascade starts (perspective: depths nearer than it share the first
+    /// slice); `None`: at the near plane, or 1/4096 of the far end for a tiny near plane. The
+    /// automatic mode sets it a little before the nearest surface, so no slice is spent on the
+    /// empty space in front of the camera.
+    pub first_split: Option<f64>,
+    /// Minimum cell width in world units at a cascade's near end; `None`: no minimum, every
+    /// cascade has cells of `footprint_px` (the grid starts at the first geometry, see
+    /// [`GridConfig::first_split`], so near cascades are not wasted on empty space).
+    pub min_cell_size: Option<f64>,
+    /// Upper bound on slices per cascade.
+    pub max_slices: u32,
+    /// Upper bound on columns or rows of a cascade.
+    pub max_tiles: u32,
+    /// How tightly a light's cells are found (the default is the tight one; the other is kept
+    /// to measure what it saves).
+    pub coverage: Coverage,
+}
+
+/// Who picks the cell footprint.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum GridMode {
+    /// The clustered method measures candidate footprints against a cost model calibrated on
+    /// the device and switches with hysteresis (see [`super::auto`](crate::cluster::auto)).
+    #[default]
+    Auto,
+    /// Always `footprint_px` (tests, and users who want one grid).
+    Fixed,
+}
+
+/// How the assignment bounds the cells a light's sphere reaches.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Coverage {
+    /// Per slice, the sphere's cross-section over the slice's depths, and per row of cells the
+    /// columns that cross-section reaches inside the row.
+    #[default]
+    SliceRows,
+    /// One screen rectangle per cascade, every slice and row of it (earlier versions): kept
+    /// as a yardstick for the bench and the tests.
+    CascadeBox,
+}
+
+impl Default for GridConfig {
+    fn default() -> Self {
+        GridConfig {
+            mode: GridMode::Auto,
+            cascades: 12,
+            footprint_px: 64.0,
+            first_split: None,
+            min_cell_size: None,
+            max_slices: 32,
+            max_tiles: 256,
+            coverage: Coverage::default(),
+        }
+    }
+}
+
+impl GridConfig {
+    /// A fixed grid of `footprint_px` with the other settings at their defaults.
+    pub fn fixed(footprint_px: f64) -> Self {
+        GridConfig {
+            mode: GridMode::Fixed,
+            footprint_px,
+            ..GridConfig::default()
+        }
+    }
+
+    /// A 2D tiling for tiled forward: one cascade, one slice, square tiles of `tile_px`.
+    pub fn tiles(tile_px: f64) -> Self {
+        GridConfig {
+            mode: GridMode::Fixed,
+            cascades: 1,
+            footprint_px: tile_px,
+            first_split: None,
+            min_cell_size: Some(0.0),
+            max_slices: 1,
+            max_tiles: 1024,
+            coverage: Coverage::default(),
+        }
+    }
+}

@@ -1,0 +1,172 @@
+//! Unit tests of the grid layout and its depth / pixel lookups.
+
+use super::*;
+
+fn persp(near: f64, far: f64) -> ClusterGrid {
+    persp_with(near, far, &GridConfig::default())
+}
+
+fn persp_with(near: f64, far: f64, config: &GridConfig) -> ClusterGrid {
+    let t = (30f64).to_radians().tan();
+    ClusterGrid::new(
+        1280,
+        720,
+        GridProjection::Perspective {
+            tan_x: t * 16.0 / 9.0,
+            tan_y: t,
+        },
+        near,
+        far,
+        config,
+    )
+}
+
+#[test]
+fn depth_ranges_never_miss_a_slice() {
+    for g in [persp(1e-4, 1e5), persp(0.1, 80.0), persp(0.5, 0.6)] {
+        let mut d = g.near;
+        while d < g.far * 2.0 {
+            // Around `d`, and on every slice boundary too.
+            let (k, s) = g.view_z_to_cascade_slice(d);
+            let (z0, _) = g.slice_depth_range(k, s);
+            for x in [
+                d,
+                d.next_up(),
+                d.next_down(),
+                z0,
+                z0.next_up(),
+                z0.next_down(),
+            ] {
+                let exact = g.view_z_to_cascade_slice(x);
+                let (lo, hi) = g.depth_range_to_slices(x, x);
+                assert!(
+                    lo <= exact && exact <= hi,
+                    "{x}: {exact:?} not in {lo:?}..{hi:?}"
+                );
+            }
+            d *= 1.013;
+        }
+    }
+}
+
+#[test]
+fn cells_are_contiguous_and_counted() {
+    let g = persp(0.1, 80.0);
+    let mut next = 0;
+    for c in &g.cascades {
+        assert_eq!(c.first_cell, next);
+        next += c.cells();
+        assert!(c.tiles_x >= 1 && c.tiles_y >= 1 && c.slices >= 1);
+    }
+    assert_eq!(next, g.total_cells);
+    assert_eq!(g.cascades.len(), 12);
+}
+
+#[test]
+fn depth_mapping_is_monotonic_and_covers_near_to_infinity() {
+    for g in [persp(1e-4, 1e5), persp(0.1, 80.0), persp(0.5, 0.6)] {
+        let mut last = (0, 0);
+        let mut d = g.near;
+        while d < g.far * 4.0 {
+            let cs = g.view_z_to_cascade_slice(d);
+            assert!(cs >= last, "not monotonic at {d}");
+            let (z0, z1) = g.slice_depth_range(cs.0, cs.1);
+            assert!(
+                z0 <= d * (1.0 + 1e-9) && d <= z1 * (1.0 + 1e-9),
+                "{d} outside slice {cs:?} [{z0}, {z1}]"
+            );
+            last = cs;
+            d *= 1.01;
+        }
+        assert_eq!(g.view_z_to_cascade_slice(g.near * 0.5).0, 0);
+        let lastc = g.cascades.len() as u32 - 1;
+        assert_eq!(g.view_z_to_cascade_slice(f64::INFINITY).0, lastc);
+    }
+}
+
+#[test]
+fn cells_are_roughly_cubical_or_clamped_to_the_minimum() {
+    let g = persp(0.1, 80.0);
+    for (k, c) in g.cascades.iter().enumerate() {
+        let (z0, z1) = g.slice_depth_range(k as u32, 0);
+        let z0 = z0.max(c.z_near);
+        let width = 2.0 * z0 * (30f64).to_radians().tan() / c.tiles_y as f64;
+        let depth = z1 - z0;
+        if c.slices < GridConfig::default().max_slices {
+            assert!(
+                depth / width < 2.5 && width / depth < 2.5,
+                "cascade {k}: {width} × {depth}"
+            );
+        }
+    }
+    // Without a minimum cell size every cascade has the footprint's tiles; with one, the
+    // near cascades are coarser.
+    assert!(g
+        .cascades
+        .iter()
+        .all(|c| c.tiles_y == g.cascades[0].tiles_y));
+    let coarse = persp_with(
+        0.1,
+        80.0,
+        &GridConfig {
+            min_cell_size: Some(80.0 / 64.0),
+            ..GridConfig::default()
+        },
+    );
+    assert!(coarse.cascades[0].tiles_y < coarse.cascades[11].tiles_y);
+}
+
+#[test]
+fn orthographic_uses_linear_slices_and_allows_near_zero() {
+    let g = ClusterGrid::new(
+        256,
+        144,
+        GridProjection::Orthographic {
+            half_x: 8.0,
+            half_y: 4.5,
+        },
+        0.0,
+        20.0,
+        &GridConfig::default(),
+    );
+    assert_eq!(g.mapping, DepthMapping::Linear);
+    assert_eq!(g.view_z_to_cascade_slice(0.0), (0, 0));
+    let (k, _) = g.view_z_to_cascade_slice(10.0);
+    assert_eq!(k, 6);
+}
+
+#[test]
+fn tiles_config_gives_one_slice_spanning_everything() {
+    let t = (30f64).to_radians().tan();
+    let g = ClusterGrid::new(
+        256,
+        144,
+        GridProjection::Perspective { tan_x: t, tan_y: t },
+        0.1,
+        50.0,
+        &GridConfig::tiles(16.0),
+    );
+    assert_eq!(g.cascades.len(), 1);
+    assert_eq!(g.cascades[0].slices, 1);
+    assert_eq!((g.cascades[0].tiles_x, g.cascades[0].tiles_y), (16, 9));
+    assert_eq!(g.slice_depth_range(0, 0), (0.1, f64::INFINITY));
+}
+
+#[test]
+fn fragment_cells_match_bounds() {
+    let g = persp(0.1, 80.0);
+    for &(x, y, d) in &[
+        (0.5, 0.5, 0.1),
+        (1279.5, 719.5, 79.0),
+        (640.0, 360.0, 5.0),
+        (100.2, 600.7, 30.0),
+    ] {
+        let c = g.cell_of_fragment(x, y, d);
+        let b = g.cell_bounds(c);
+        let nx = 2.0 * x / 1280.0 - 1.0;
+        let ny = 2.0 * y / 720.0 - 1.0;
+        assert!(b.ndc_x.0 <= nx && nx <= b.ndc_x.1);
+        assert!(b.ndc_y.0 <= ny && ny <= b.ndc_y.1);
+        assert!(b.depth.0 <= d * (1.0 + 1e-12) && d <= b.depth.1 * (1.0 + 1e-12));
+    }
+}

@@ -1,0 +1,280 @@
+//! Drawing one frame into the bound framebuffer: [`Renderer::render`], the allocation-free
+//! [`Renderer::render_reusing`] (through the renderer's multisampled target when MSAA is
+//! asked for) and the frame itself: validation, setup, the method's draw, GPU timing and the
+//! frame's figures.
+
+use std::time::Instant;
+
+use glam::DMat4;
+
+use super::frame_setup::{content_far, gather_lights, shader_features};
+use super::stats::{copy_opt_str, copy_str, copy_support};
+use super::{FrameStats, Renderer};
+use crate::cluster::assign::AssignStats;
+use crate::gl::framebuffer::ColorFormat;
+use crate::methods::{self, FrameContext};
+use crate::options::{CountKind, RenderOptions};
+use crate::scene::features::SceneFeatures;
+use crate::scene::{Projection, Scene};
+use crate::Error;
+
+impl Renderer {
+    /// Renders `scene` into the currently bound framebuffer with a `width × height` viewport
+    /// (for embedding: a game binds its own target or the default framebuffer first). With
+    /// `options.samples` > 1 the frame is drawn into the renderer's own multisampled target
+    /// and resolved into the bound framebuffer, which must then be RGBA8 of that size.
+    ///
+    /// The returned stats own their texts (method, GL strings, reasons): in steady state they
+    /// are all the renderer allocates for a frame. A game's per-frame loop calls
+    /// [`Renderer::render_reusing`] instead, which allocates nothing.
+    pub fn render(
+        &mut self,
+        scene: &Scene,
+        width: u32,
+        height: u32,
+        options: &RenderOptions,
+    ) -> Result<FrameStats, Error> {
+        let mut stats = FrameStats::default();
+        self.render_reusing(scene, width, height, options, &mut stats)?;
+        Ok(stats)
+    }
+
+    /// [`Renderer::render`], writing the frame's figures into `stats` and reusing its
+    /// strings. In steady state (the same method and scene shape for a few frames: shaders
+    /// built, buffers grown) the renderer makes no heap allocation for a frame, lights moving
+    /// or not (`tests/soak.rs` counts them; what still allocates, the automatic grid's
+    /// periodic re-choice, is listed in docs/performance.md). Keep one `FrameStats` and pass it every frame. After an error,
+    /// `stats` holds no meaningful figures.
+    pub fn render_reusing(
+        &mut self,
+        scene: &Scene,
+        width: u32,
+        height: u32,
+        options: &RenderOptions,
+        stats: &mut FrameStats,
+    ) -> Result<(), Error> {
+        // Light counts are exact per pixel: never averaged over samples.
+        let samples = if options.count == CountKind::None {
+            options.samples.max(1)
+        } else {
+            1
+        };
+        if samples <= 1 {
+            return self.render_frame(scene, width, height, options, stats);
+        }
+        if width == 0 || height == 0 {
+            return Err(Error::Limit(format!("viewport {width}×{height} is empty")));
+        }
+        let destination = self.dev.bound_framebuffer();
+        let format = if options.hdr {
+            ColorFormat::Rgba16F
+        } else {
+            ColorFormat::Rgba8
+        };
+        let prepared = self.prepare_msaa(width, height, samples, format);
+        // Creating the target binds (then leaves) framebuffers: the caller's comes back.
+        self.dev.bind_framebuffer(destination);
+        prepared?;
+        let msaa = self.msaa.as_ref().expect("created by prepare_msaa");
+        msaa.bind(&self.dev);
+        let rendered = self.render_frame(scene, width, height, options, stats);
+        let msaa = self.msaa.as_ref().expect("created by prepare_msaa");
+        match rendered {
+            Ok(()) => {
+                msaa.resolve(&self.dev, destination)?;
+                stats.samples = samples;
+                stats.msaa_bytes = msaa.gpu_bytes();
+                Ok(())
+            }
+            // A failed frame is not resolved over the caller's picture.
+            Err(e) => {
+                self.dev.bind_framebuffer(destination);
+                Err(e)
+            }
+        }
+    }
+
+    /// One frame into the bound framebuffer (see [`Renderer::render_reusing`]).
+    fn render_frame(
+        &mut self,
+        scene: &Scene,
+        width: u32,
+        height: u32,
+        options: &RenderOptions,
+        stats: &mut FrameStats,
+    ) -> Result<(), Error> {
+        let start = Instant::now();
+        let method_name = self.method.name();
+        if let Some(warning) = self.pending_warning.take() {
+            log::warn!("{warning}");
+        }
+        scene.validate()?;
+        // 2^15 stays finite in fp16, where a device without fragment highp holds it.
+        if !(options.exposure_ev.is_finite() && options.exposure_ev.abs() <= 15.0) {
+            return Err(Error::Scene(crate::scene::SceneError::invalid(
+                "exposure_ev",
+                format!("must be within ±15 stops, got {}", options.exposure_ev),
+            )));
+        }
+        if width == 0 || height == 0 {
+            return Err(Error::Limit(format!("viewport {width}×{height} is empty")));
+        }
+        self.gpu_scene
+            .upload(&self.dev, scene, options.full_variants)?;
+        let view: DMat4 = scene.camera.view_matrix();
+        let projection = scene
+            .camera
+            .projection_matrix(width as f64 / height as f64)
+            .as_mat4();
+        gather_lights(&mut self.lights, scene, &view, options);
+        let scene_features = SceneFeatures::of(scene);
+        let features = shader_features(&scene_features, options, self.dev.caps());
+        let (near, far) = scene.camera.near_far();
+        let content_far = content_far(self.gpu_scene.scene_bounds(scene), &view, near, far);
+        self.dev.viewport(0, 0, width as i32, height as i32);
+        self.dev.clear(options.clear_color);
+        let mut ctx = FrameContext {
+            dev: &self.dev,
+            programs: &mut self.programs,
+            scene,
+            gpu_scene: &self.gpu_scene,
+            view,
+            projection,
+            orthographic: matches!(scene.camera.projection, Projection::Orthographic { .. }),
+            lights: &self.lights,
+            features,
+            viewport: (width, height),
+            near,
+            far,
+            content_far,
+            options,
+            order: &mut self.draw_order,
+            transparent_only: false,
+        };
+        // GPU time only where the frame waits anyway: reading the query result stalls.
+        let timer = if options.wait_for_gpu {
+            if self.timer.is_none() {
+                self.timer = Some(crate::gl::timer::GpuTimer::new(&self.dev)?);
+            }
+            self.timer.as_ref().and_then(Option::as_ref)
+        } else {
+            None
+        };
+        if let Some(t) = timer {
+            t.begin(&self.dev);
+        }
+        // No lights: no assignment, no uploads, the light loop compiled out — whatever the
+        // method (a scene pays only for what it has).
+        let rendered = if self.lights.is_empty() {
+            methods::geometry::draw_ambient_only(&mut ctx)
+        } else {
+            self.method.render(&mut ctx)
+        };
+        // The query ends on the error path too: one left active makes the next frame's
+        // `glBeginQuery` fail.
+        let gpu_ms = timer.and_then(|t| t.end(&self.dev));
+        let method_stats = rendered?;
+        if options.wait_for_gpu {
+            self.dev.finish();
+        }
+        self.dev.check("frame")?;
+        let frame_ms = start.elapsed().as_secs_f64() * 1e3;
+        let caps = self.dev.caps();
+        let assign = method_stats.assign.unwrap_or(AssignStats::default());
+        let grid = method_stats.grid.as_ref();
+        copy_str(&mut stats.method, method_name);
+        stats.es = caps.es;
+        copy_str(&mut stats.gl_version, &caps.gl_version);
+        copy_str(&mut stats.renderer, &caps.renderer);
+        stats.width = width;
+        stats.height = height;
+        stats.lights = scene.lights.len();
+        stats.active_lights = self.lights.len();
+        stats.frame_ms = frame_ms;
+        stats.gpu_ms = gpu_ms;
+        stats.upload_bytes = method_stats.upload_bytes;
+        stats.assign_ms = method_stats.assign_ms.unwrap_or(0.0);
+        stats.clusters = assign.clusters;
+        stats.nonempty_clusters = assign.nonempty_clusters;
+        stats.avg_lights_per_nonempty = assign.avg_lights_per_nonempty;
+        stats.max_lights_per_cluster = assign.max_lights_per_cluster;
+        stats.overflowed_lights = assign.overflowed_lights + method_stats.dropped_lights;
+        stats.visible_lights = method_stats
+            .assign
+            .map_or(self.lights.len(), |a| a.visible_lights);
+        stats.light_encoding = features.light_encoding();
+        copy_support(&mut stats.support, &self.support);
+        stats.triangles = scene.objects.iter().map(|o| o.mesh.triangle_count()).sum();
+        stats.gbuffer_bytes = method_stats.gbuffer_bytes;
+        copy_opt_str(
+            &mut stats.auto_choice,
+            method_stats.auto_choice.map(|(c, _)| c),
+        );
+        copy_opt_str(
+            &mut stats.auto_reason,
+            method_stats.auto_choice.map(|(_, r)| r),
+        );
+        copy_opt_str(&mut stats.lp_num_threads, self.lp_num_threads.as_deref());
+        stats.scene_features = scene_features;
+        stats.grid_footprint_px = grid.map(|g| g.footprint_px);
+        stats.grid_cells = grid.map_or(0, |g| g.cells);
+        copy_opt_str(&mut stats.grid_reason, grid.map(|g| g.reason));
+        stats.samples = 1;
+        stats.msaa_bytes = 0;
+        stats.upload_bytes_spread = None;
+        stats.frame_ms_spread = None;
+        stats.assign_ms_spread = None;
+        // Only colour frames that waited for the GPU (or were timed on it) say what shading
+        // costs: count passes run other shaders.
+        if options.count == CountKind::None {
+            let waited = options.wait_for_gpu.then_some(frame_ms);
+            self.method.observe_frame(waited, gpu_ms);
+        }
+        stats.method_gpu_bytes = self.method.gpu_bytes();
+        Ok(())
+    }
+
+    /// Checks that MSAA can run here with the current method and output, and (re)creates the
+    /// multisampled target for this size.
+    fn prepare_msaa(
+        &mut self,
+        width: u32,
+        height: u32,
+        samples: u32,
+        format: ColorFormat,
+    ) -> Result<(), Error> {
+        let refuse = |reason: String| {
+            Err(Error::Limit(format!(
+                "RenderOptions::samples = {samples} (MSAA): {reason}"
+            )))
+        };
+        if let Some(reason) = crate::gl::multisample::unsupported_reason(&self.dev, samples) {
+            return refuse(reason);
+        }
+        if !methods::find(self.method.name())?.multisample {
+            let able: Vec<&str> = methods::METHODS
+                .iter()
+                .filter(|m| m.multisample)
+                .map(|m| m.name)
+                .collect();
+            return refuse(format!(
+                "{} shading does not support it; methods that do: {}",
+                self.method.name(),
+                able.join(", ")
+            ));
+        }
+        if format != ColorFormat::Rgba8 {
+            return refuse("only 8-bit output is multisampled, not HDR".into());
+        }
+        let shape = ((width, height), samples);
+        if self.msaa.as_ref().map(|m| m.shape()) != Some(shape) {
+            if let Some(mut m) = self.msaa.take() {
+                m.destroy(&self.dev);
+            }
+            self.msaa = Some(crate::gl::multisample::MultisampleTarget::new(
+                &self.dev, width, height, samples,
+            )?);
+        }
+        Ok(())
+    }
+}

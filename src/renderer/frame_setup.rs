@@ -1,0 +1,100 @@
+//! Per-frame setup that depends only on the scene, the options and the device: the frame's
+//! active lights in view space, the shader features the frame is drawn with, and how deep the
+//! scene's content reaches (where a cluster grid should end).
+
+use glam::DMat4;
+
+use crate::cluster::pack::GpuLight;
+use crate::gl::Caps;
+use crate::methods::ShaderFeatures;
+use crate::options::{CountKind, RenderOptions, ToneMap};
+use crate::scene::features::SceneFeatures;
+use crate::scene::{Aabb, Scene};
+
+/// Refills `lights` (keeping its buffer) with the scene's active lights in view space, each
+/// light's cull radius shortened to where it falls below `options.light_cutoff` when one is
+/// set.
+pub(super) fn gather_lights(
+    lights: &mut Vec<GpuLight>,
+    scene: &Scene,
+    view: &DMat4,
+    options: &RenderOptions,
+) {
+    lights.clear();
+    lights.extend(scene.lights.iter().filter(|l| l.is_active()).map(|l| {
+        let mut g = GpuLight::from_light(l, view);
+        if let Some(cutoff) = options.light_cutoff {
+            g.cull_radius = crate::scene::shading::cutoff_distance(
+                g.radiance.max_element() as f64,
+                g.radius as f64,
+                cutoff as f64,
+            ) as f32;
+        }
+        g
+    }));
+}
+
+/// The shader features a frame is drawn with: the scene's (spot lights), the options' (output,
+/// tone map, counts, precision) and the device's (fp16 lights without fragment highp, RGBA8
+/// light texels without float textures).
+pub(super) fn shader_features(
+    scene_features: &SceneFeatures,
+    options: &RenderOptions,
+    caps: &Caps,
+) -> ShaderFeatures {
+    ShaderFeatures::default()
+        .with(
+            ShaderFeatures::SPOT,
+            scene_features.spot_lights || options.full_variants,
+        )
+        .with(ShaderFeatures::OUTPUT_LINEAR, options.linear)
+        .with(
+            ShaderFeatures::TONEMAP_REINHARD,
+            options.tone_map == ToneMap::Reinhard,
+        )
+        .with(
+            ShaderFeatures::TONEMAP_ACES,
+            options.tone_map == ToneMap::Aces,
+        )
+        .with(
+            ShaderFeatures::TONEMAP_NEUTRAL,
+            options.tone_map == ToneMap::Neutral,
+        )
+        .with(ShaderFeatures::OUTPUT_HDR, options.hdr)
+        .with(
+            ShaderFeatures::REFERENCE_PRECISION,
+            options.reference_precision,
+        )
+        .with(ShaderFeatures::FP16_LIGHTS, !caps.fragment_has_highp())
+        .with(
+            ShaderFeatures::COUNT_EVALS,
+            matches!(options.count, CountKind::Evals | CountKind::Heatmap),
+        )
+        .with(
+            ShaderFeatures::COUNT_HEATMAP,
+            options.count == CountKind::Heatmap,
+        )
+        .with(
+            ShaderFeatures::COUNT_REACHING,
+            options.count == CountKind::Reaching,
+        )
+        .with(
+            ShaderFeatures::LIGHTS_RGBA8,
+            options.force_rgba8_lights || !caps.float_textures,
+        )
+}
+
+/// Farthest view depth of the scene's geometry, clipped to `[near, far]` (never below a little
+/// past the near plane): where a cluster grid should end. Lights beyond it still reach the
+/// last slice, which extends to infinity.
+pub(super) fn content_far(bounds: Option<Aabb>, view: &DMat4, near: f64, far: f64) -> f64 {
+    // View space looks down −Z: the deepest point has the smallest z.
+    let deepest = bounds.map_or(far, |b| -b.transformed(view).min.z);
+    let floor = if near > 0.0 { near * 2.0 } else { 1e-3 };
+    let d = deepest.min(far).max(floor);
+    if d.is_finite() {
+        d
+    } else {
+        floor.max(1.0)
+    }
+}

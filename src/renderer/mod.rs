@@ -1,0 +1,208 @@
+//! The renderer: owns the GL device, the program cache, the uploaded scene and the current
+//! shading method; renders a [`Scene`](crate::scene::Scene) and reports [`FrameStats`].
+//!
+//! Layout: the [`Renderer`] itself (creation, method choice, teardown) here; what a frame
+//! reports in `stats`; drawing a frame into the bound framebuffer (with MSAA) in `frame`, with
+//! its light gathering, shader features and grid depth in `frame_setup`; offscreen renders
+//! read back to the CPU (colour, HDR, light counts) in `offscreen`.
+
+mod frame;
+mod frame_setup;
+mod offscreen;
+mod stats;
+
+use crate::cluster::pack::GpuLight;
+use crate::gl::framebuffer::OffscreenTarget;
+use crate::gl::program::ProgramCache;
+use crate::gl::{Caps, Device, EsVersion};
+pub use crate::gpu_scene::GpuScene;
+use crate::methods::{self, ShadingMethod, Support};
+pub use crate::metrics::counts::LightCounts;
+pub use crate::options::{CountKind, RenderOptions, ToneMap};
+use crate::Error;
+pub use stats::FrameStats;
+
+/// Renders scenes with one shading method at a time.
+pub struct Renderer {
+    dev: Device,
+    programs: ProgramCache,
+    gpu_scene: GpuScene,
+    method: Box<dyn ShadingMethod>,
+    support: Support,
+    target: Option<OffscreenTarget>,
+    /// The multisampled target `render_offscreen` draws into with `RenderOptions::samples`.
+    msaa: Option<crate::gl::multisample::MultisampleTarget>,
+    /// The GPU timer: `None` until first needed, then `Some(None)` where the context has no
+    /// timer queries.
+    timer: Option<Option<crate::gl::timer::GpuTimer>>,
+    /// What the default method's support would warn about: said at the first frame, unless
+    /// the caller picks a method first (whose own support is then what is said).
+    pending_warning: Option<String>,
+    /// GL objects already freed (by `destroy`; dropping then does nothing more).
+    freed: bool,
+    /// The frame's active lights in view space (kept: a frame fills it without allocating).
+    lights: Vec<GpuLight>,
+    /// The frame's objects in draw order (kept likewise).
+    draw_order: methods::geometry::DrawOrder,
+    /// `LP_NUM_THREADS` when the renderer was made (llvmpipe reads it when the context is
+    /// made; reading it every frame would allocate).
+    lp_num_threads: Option<String>,
+}
+
+impl Renderer {
+    /// Creates a renderer on a current GL context, restricted to feature level `es`. The
+    /// context must stay current (and alive) for the renderer's whole life.
+    pub fn new(gl: glow::Context, es: EsVersion) -> Result<Renderer, Error> {
+        Renderer::restricted(gl, es, &crate::gl::Restrictions::default())
+    }
+
+    /// [`Renderer::new`] playing a weaker device than the driver (see
+    /// [`crate::gl::Restrictions`]): for example one without fragment highp, where only
+    /// methods that need no highp run (the default method falls back to forward).
+    pub fn restricted(
+        gl: glow::Context,
+        es: EsVersion,
+        restrictions: &crate::gl::Restrictions,
+    ) -> Result<Renderer, Error> {
+        let dev = Device::restricted(gl, es, restrictions)?;
+        let mut desc = methods::find(methods::DEFAULT_METHOD)?;
+        let mut support = (desc.supported)(dev.caps());
+        let mut pending_warning = None;
+        if let Support::Unsupported(reason) = &support {
+            pending_warning = Some(format!(
+                "the default method `{}` is unsupported here ({reason}); rendering with `forward`",
+                desc.name
+            ));
+            desc = methods::find("forward")?;
+            support = (desc.supported)(dev.caps());
+        }
+        if let Support::Fallback(reason) = &support {
+            let note = format!("method `{}` runs with a fallback: {reason}", desc.name);
+            pending_warning = Some(match pending_warning {
+                Some(first) => format!("{first}; {note}"),
+                None => note,
+            });
+        }
+        let method = (desc.create)(&dev)?;
+        Ok(Renderer {
+            dev,
+            programs: ProgramCache::new(),
+            gpu_scene: GpuScene::default(),
+            method,
+            support,
+            target: None,
+            msaa: None,
+            timer: None,
+            pending_warning,
+            freed: false,
+            lights: Vec::new(),
+            draw_order: methods::geometry::DrawOrder::default(),
+            lp_num_threads: std::env::var("LP_NUM_THREADS").ok(),
+        })
+    }
+
+    /// The probed capabilities.
+    pub fn caps(&self) -> &Caps {
+        self.dev.caps()
+    }
+
+    /// Whether the fragment stage evaluates `mediump` as fp16 (measured with a tiny render).
+    pub fn mediump_is_fp16(&self) -> Result<bool, Error> {
+        Ok(crate::gl::precision_probe::mediump_is_fp16(&self.dev)?)
+    }
+
+    /// GL objects the renderer holds now.
+    pub fn live_gl_objects(&self) -> crate::gl::device::LiveObjects {
+        self.dev.live_objects()
+    }
+
+    /// Every shader variant built so far: shader, feature bits and assembled source size.
+    pub fn program_report(&self) -> Vec<crate::gl::program::ProgramInfo> {
+        self.programs.report()
+    }
+
+    /// The current method's name.
+    pub fn method(&self) -> &'static str {
+        self.method.name()
+    }
+
+    /// Switches method. Unsupported methods are an error naming what is missing; a fallback
+    /// is returned as `Some(reason)` (also logged as a warning). The previous method's GPU
+    /// resources are freed.
+    pub fn set_method(&mut self, name: &str) -> Result<Option<String>, Error> {
+        // An explicit choice replaces what the default method would have warned about.
+        let unannounced = self.pending_warning.take().is_some();
+        let desc = methods::find(name)?;
+        let support = (desc.supported)(self.dev.caps());
+        if let Support::Unsupported(reason) = &support {
+            let caps = self.dev.caps();
+            let runnable: Vec<&str> = methods::METHODS
+                .iter()
+                .filter(|m| !matches!((m.supported)(caps), Support::Unsupported(_)))
+                .map(|m| m.name)
+                .collect();
+            return Err(Error::UnsupportedMethod {
+                method: name.to_string(),
+                reason: reason.clone(),
+                runnable: runnable.join(", "),
+            });
+        }
+        let switching = desc.name != self.method.name();
+        if switching {
+            let new = (desc.create)(&self.dev)?;
+            let mut old = std::mem::replace(&mut self.method, new);
+            old.destroy(&self.dev);
+        }
+        self.support = support.clone();
+        Ok(match support {
+            Support::Fallback(reason) => {
+                // Announced once, when the method is taken up (here or at the first frame).
+                if switching || unannounced {
+                    log::warn!("method `{name}` runs with a fallback: {reason}");
+                }
+                Some(reason)
+            }
+            _ => None,
+        })
+    }
+
+    /// The cell grid and light lists of the last tiled or clustered frame (for tests and
+    /// tools that check what the shader read); `None` for other methods.
+    pub fn last_light_lists(&self) -> Option<methods::LightLists<'_>> {
+        self.method.light_lists()
+    }
+
+    /// Frees every GL object the renderer made, while its context is still current.
+    /// Dropping the renderer does the same (so an early return on an error frees everything
+    /// quietly); `destroy` only makes the moment explicit.
+    pub fn destroy(mut self) {
+        self.free_gl();
+    }
+
+    fn free_gl(&mut self) {
+        if self.freed {
+            return;
+        }
+        self.freed = true;
+        if let Some(Some(t)) = self.timer.take() {
+            t.destroy(&self.dev);
+        }
+        self.method.destroy(&self.dev);
+        self.programs.destroy(&self.dev);
+        self.gpu_scene.destroy(&self.dev);
+        if let Some(mut t) = self.target.take() {
+            t.destroy(&self.dev);
+        }
+        if let Some(mut t) = self.msaa.take() {
+            t.destroy(&self.dev);
+        }
+    }
+}
+
+impl Drop for Renderer {
+    /// The context must still be current, as [`Renderer::new`] requires for the renderer's
+    /// whole life.
+    fn drop(&mut self) {
+        self.free_gl();
+    }
+}

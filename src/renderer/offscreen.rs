@@ -1,0 +1,121 @@
+//! Offscreen renders read back to the CPU: 8-bit colour ([`Renderer::render_offscreen`], with
+//! warm-up and timed frames), linear HDR ([`Renderer::render_offscreen_hdr`]) and per-pixel
+//! light counts ([`Renderer::render_light_counts`]), all into the renderer's own target.
+
+use super::{FrameStats, Renderer};
+use crate::gl::framebuffer::{ColorFormat, OffscreenTarget};
+use crate::methods;
+use crate::metrics::counts::LightCounts;
+use crate::options::{CountKind, RenderOptions};
+use crate::scene::Scene;
+use crate::Error;
+
+impl Renderer {
+    /// Renders into an internal `width × height` target and reads it back (top row first).
+    /// With `options.timed_frames > 0`, renders one warm-up frame and reports the median of
+    /// the timed ones.
+    pub fn render_offscreen(
+        &mut self,
+        scene: &Scene,
+        width: u32,
+        height: u32,
+        options: &RenderOptions,
+    ) -> Result<(image::RgbaImage, FrameStats), Error> {
+        let stats = self.render_into_target(scene, width, height, options, ColorFormat::Rgba8)?;
+        let image = self
+            .target
+            .as_ref()
+            .expect("rendered")
+            .read_rgba8(&self.dev)?;
+        self.dev.bind_default_framebuffer();
+        Ok((image, stats))
+    }
+
+    /// Renders linear, unclamped radiance into an RGBA16F target and reads it back as f32,
+    /// top row first: NaN and Inf stay visible (an 8-bit target shows them as black or white).
+    /// Errors when the context cannot render to half floats.
+    pub fn render_offscreen_hdr(
+        &mut self,
+        scene: &Scene,
+        width: u32,
+        height: u32,
+        options: &RenderOptions,
+    ) -> Result<(Vec<[f32; 4]>, FrameStats), Error> {
+        let options = RenderOptions {
+            hdr: true,
+            ..options.clone()
+        };
+        let stats =
+            self.render_into_target(scene, width, height, &options, ColorFormat::Rgba16F)?;
+        let pixels = self
+            .target
+            .as_ref()
+            .expect("rendered")
+            .read_rgba_f32(&self.dev)?;
+        self.dev.bind_default_framebuffer();
+        Ok((pixels, stats))
+    }
+
+    fn render_into_target(
+        &mut self,
+        scene: &Scene,
+        width: u32,
+        height: u32,
+        options: &RenderOptions,
+        format: ColorFormat,
+    ) -> Result<FrameStats, Error> {
+        let current = self.target.as_ref().map(|t| (t.size(), t.format()));
+        if current != Some(((width, height), format)) {
+            if let Some(mut t) = self.target.take() {
+                t.destroy(&self.dev);
+            }
+            self.target = Some(OffscreenTarget::with_format(
+                &self.dev, width, height, format,
+            )?);
+        }
+        self.target.as_ref().expect("created above").bind(&self.dev);
+        let mut stats = self.render(scene, width, height, options)?;
+        if options.timed_frames > 0 {
+            // The warm-up frame compiled shaders and uploaded meshes; report the timed ones.
+            let mut frames = Vec::new();
+            for _ in 0..options.timed_frames {
+                frames.push(self.render(scene, width, height, options)?);
+            }
+            stats = FrameStats::summarize(frames).expect("at least one timed frame");
+        }
+        Ok(stats)
+    }
+
+    /// Per-pixel light counts of the opaque visible surfaces instead of colour: `Evals`, the
+    /// lights the current method evaluates at each pixel (its loop length, or for deferred its
+    /// proxy volumes covering the pixel), or `Reaching`, the lights whose sphere (and cone)
+    /// contains the pixel's surface point, the lower bound of any culling (always evaluated
+    /// by a plain-forward pass). Counts are exact (24 bits in an RGBA8 target).
+    pub fn render_light_counts(
+        &mut self,
+        scene: &Scene,
+        width: u32,
+        height: u32,
+        options: &RenderOptions,
+        kind: CountKind,
+    ) -> Result<(LightCounts, FrameStats), Error> {
+        let options = RenderOptions {
+            count: kind,
+            clear_color: [0.0; 4],
+            timed_frames: 0,
+            ..options.clone()
+        };
+        let (image, stats) = if kind == CountKind::Reaching {
+            // A plain-forward pass whatever the method: swap one in for this frame.
+            let forward = (methods::find("forward")?.create)(&self.dev)?;
+            let current = std::mem::replace(&mut self.method, forward);
+            let result = self.render_offscreen(scene, width, height, &options);
+            let mut forward = std::mem::replace(&mut self.method, current);
+            forward.destroy(&self.dev);
+            result?
+        } else {
+            self.render_offscreen(scene, width, height, &options)?
+        };
+        Ok((LightCounts::decode(&image), stats))
+    }
+}
