@@ -1,6 +1,6 @@
 //! Development aid: one workload assigned repeatedly with reused buffers (for profilers):
-//! `cargo bench --bench assign_profile -- LIGHTS [REPEATS]` (or run its binary under a
-//! profiler).
+//! `cargo bench --bench assign_profile -- LIGHTS [REPEATS] [--fine]` (or run its binary under
+//! a profiler); `--fine` takes the fine grid of [`AssignWorkload::fine_grid`].
 use manylight::cluster::assign::Assigner;
 use manylight::cluster::workload::AssignWorkload;
 
@@ -11,7 +11,11 @@ fn main() {
         .map(|a| a.parse::<usize>().ok());
     let count = args.next().flatten().unwrap_or(65_536);
     let repeats = args.next().flatten().unwrap_or(20);
-    let w = AssignWorkload::default_view(count, 1);
+    let w = if std::env::args().any(|a| a == "--fine") {
+        AssignWorkload::fine_grid(count, 1)
+    } else {
+        AssignWorkload::default_view(count, 1)
+    };
     let mut assigner = Assigner::new();
     let mut total = 0;
     for _ in 0..repeats {

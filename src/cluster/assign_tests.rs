@@ -503,6 +503,51 @@ fn parallel_fill_on_a_tiny_grid() {
     assert_eq!(par.offsets, seq.offsets);
 }
 
+/// The parallel paths (bands of slices, one per thread of the pool, or chunks of lights) give
+/// what one band gives, for pools of 2 to 8 threads, and when the bands are balanced by an
+/// earlier assignment to the same grid (measured times) or to another (cells).
+#[test]
+fn any_number_of_bands_gives_what_one_band_gives() {
+    let mut rng = Pcg64Mcg::seed_from_u64(21);
+    let sequential = AssignLimits {
+        parallel_threshold: usize::MAX,
+        cell_cap: 24,
+        ..Default::default()
+    };
+    let parallel = AssignLimits {
+        parallel_threshold: 1,
+        ..sequential
+    };
+    for threads in [2, 3, 5, 8] {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .expect("a thread pool");
+        let mut assigner = super::assign::Assigner::new();
+        for case in cases() {
+            let grid = ClusterGrid::new(96, 54, case.projection, case.near, case.far, &case.config);
+            // Fewer lights than cells: bands; more: chunks of lights (see `Assigner::assign`).
+            // Each count twice: the second split follows the first one's measured times.
+            let counts = [grid.total_cells as usize / 4, grid.total_cells as usize * 2];
+            let mut listed = 0;
+            for count in counts.into_iter().flat_map(|n| [n, n]) {
+                let lights = random_lights(&mut rng, count, case.far.min(200.0) * 0.5);
+                let one = assign(&grid, &lights, case.far, &sequential);
+                let bands =
+                    pool.install(|| assigner.assign(&grid, &lights, case.far, &parallel).clone());
+                let what = format!("{threads} threads, {}, {count} lights", case.name);
+                assert_eq!(one.visible, bands.visible, "{what}");
+                assert_eq!(one.offsets, bands.offsets, "{what}");
+                assert_eq!(one.counts, bands.counts, "{what}");
+                assert_eq!(one.indices, bands.indices, "{what}");
+                assert_eq!(one.stats, bands.stats, "{what}");
+                listed += one.stats.indices;
+            }
+            assert!(listed > 0, "{}", case.name);
+        }
+    }
+}
+
 #[test]
 fn split_cells_never_returns_empty_or_out_of_range_blocks() {
     for (offsets, total, parts) in [
@@ -511,7 +556,7 @@ fn split_cells_never_returns_empty_or_out_of_range_blocks() {
         (vec![0, 100], 200, 8),
         (vec![], 0, 2),
     ] {
-        let blocks = super::assign::split_cells_for_tests(&offsets, total, parts);
+        let blocks = super::assign_chunks::split_cells(&offsets, total, parts);
         let mut next = 0;
         for (a, b) in &blocks {
             assert!(a < b && *b <= offsets.len(), "{blocks:?}");

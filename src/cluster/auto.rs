@@ -24,7 +24,9 @@
 //! only when it is predicted at least [`HYSTERESIS`] cheaper, so a static scene never
 //! flip-flops between two near-equal grids.
 
-use super::assign::{AssignLimits, Assigner};
+pub use super::auto_search::{choose, ChoiceSearch};
+
+use super::assign::AssignLimits;
 use super::grid::{ClusterGrid, GridConfig, GridProjection};
 use super::pack::GpuLight;
 use super::pack_grid::GridEncoding;
@@ -223,137 +225,9 @@ pub fn first_split(samples: &SurfaceSamples, near: f64) -> Option<f64> {
     (split.is_finite() && split > near).then_some(split)
 }
 
-/// The footprints to try, coarse to fine: [`CANDIDATE_FOOTPRINTS`], preceded by coarser
-/// powers of two where even its coarsest grid passes the cell budget (a 16 384² target at
-/// 64 px cells has 25 M cells), so a huge framebuffer still gets a grid that fits.
-fn candidate_footprints(inputs: &ChoiceInputs, first_split: Option<f64>) -> Vec<f64> {
-    let (w, h) = inputs.size;
-    // Counted with the first split the candidates are built with: a nearer split means more
-    // slices.
-    let cells = |footprint_px: f64| {
-        let config = GridConfig {
-            footprint_px,
-            first_split,
-            ..inputs.base.clone()
-        };
-        ClusterGrid::new(w, h, inputs.projection, inputs.near, inputs.far, &config).total_cells
-    };
-    let mut footprints = CANDIDATE_FOOTPRINTS.to_vec();
-    let longest = f64::from(w.max(h));
-    while footprints[0] < longest && cells(footprints[0]) > CELL_BUDGET {
-        footprints.insert(0, footprints[0] * 2.0);
-    }
-    footprints
-}
-
-/// Measures the candidates and picks the cheapest under `costs` (see the module docs); also
-/// returns the chosen grid as built for its measurement (`None` when no candidate fitted the
-/// cell budget), so the caller need not build it again.
-pub fn choose(
-    inputs: &ChoiceInputs,
-    samples: &SurfaceSamples,
-    costs: &GridCosts,
-    assigner: &mut Assigner,
-) -> (GridChoice, Option<ClusterGrid>) {
-    let split = first_split(samples, inputs.near);
-    let covered = samples.covered_pixels();
-    let mut candidates: Vec<Candidate> = Vec::new();
-    let mut best: Option<(usize, ClusterGrid)> = None;
-    let mut rises = 0;
-    for footprint_px in candidate_footprints(inputs, split) {
-        let config = GridConfig {
-            footprint_px,
-            first_split: split,
-            ..inputs.base.clone()
-        };
-        let (w, h) = inputs.size;
-        let grid = ClusterGrid::new(w, h, inputs.projection, inputs.near, inputs.far, &config);
-        if grid.total_cells > CELL_BUDGET {
-            break;
-        }
-        let a = assigner.assign(&grid, inputs.lights, inputs.camera_far, &inputs.limits);
-        let evals_per_pixel = samples.evals_per_pixel(&grid, &a.counts);
-        let bytes = grid.total_cells as usize * inputs.encoding.cell_bytes()
-            + a.indices.len() * inputs.encoding.index_bytes();
-        let work = (a.indices.len() + grid.total_cells as usize) as f64;
-        let candidate = Candidate {
-            footprint_px,
-            cells: grid.total_cells,
-            indices: a.indices.len(),
-            evals_per_pixel,
-            bytes,
-            predicted_ms: costs.predict_ms(evals_per_pixel * covered, work, bytes as f64),
-            overflowed_lights: a.stats.overflowed_lights,
-        };
-        let (rising, overflow_grew) = candidates.last().map_or((false, false), |last| {
-            (
-                candidate.predicted_ms > last.predicted_ms,
-                candidate.overflowed_lights > last.overflowed_lights,
-            )
-        });
-        if best
-            .as_ref()
-            .is_none_or(|(b, _)| better(&candidate, &candidates[*b]))
-        {
-            best = Some((candidates.len(), grid));
-        }
-        candidates.push(candidate);
-        rises = if rising { rises + 1 } else { 0 };
-        // Past here finer grids only rise further, or overflow the index list more (a per-cell
-        // cap overflows less in finer cells, so overflow alone does not stop the search).
-        if rises == 2 || overflow_grew {
-            break;
-        }
-    }
-    let (best, grid) = match best {
-        Some((i, grid)) => (candidates[i].clone(), Some(grid)),
-        None => (
-            Candidate {
-                footprint_px: inputs.base.footprint_px,
-                cells: 0,
-                indices: 0,
-                evals_per_pixel: 0.0,
-                bytes: 0,
-                predicted_ms: 0.0,
-                overflowed_lights: 0,
-            },
-            None,
-        ),
-    };
-    let reason = format!(
-        "auto: {} px predicted {:.2} ms ({:.1} evaluations per pixel, {} cells, {} indices) \
-         with costs per evaluation {:.1} ns, per assignment unit {:.1} ns, per byte {:.2} ns \
-         ({}) over {} samples",
-        best.footprint_px,
-        best.predicted_ms,
-        best.evals_per_pixel,
-        best.cells,
-        best.indices,
-        costs.shade_ns,
-        costs.assign_ns,
-        costs.upload_ns,
-        if costs.frames == 0 {
-            "priors".to_string()
-        } else {
-            format!("calibrated over {} frames", costs.frames)
-        },
-        samples.points.len(),
-    );
-    let choice = GridChoice {
-        config: GridConfig {
-            footprint_px: best.footprint_px,
-            first_split: split,
-            ..inputs.base.clone()
-        },
-        reason,
-        candidates,
-    };
-    (choice, grid)
-}
-
 /// Whether candidate `a` beats `b`: a grid whose lists overflow drops lights from the image,
 /// so the least overflow first, then the smallest prediction.
-fn better(a: &Candidate, b: &Candidate) -> bool {
+pub(super) fn better(a: &Candidate, b: &Candidate) -> bool {
     (a.overflowed_lights, a.predicted_ms) < (b.overflowed_lights, b.predicted_ms)
 }
 
@@ -380,6 +254,7 @@ pub fn should_switch(current: &GridConfig, new: &GridChoice) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::cluster::assign::Assigner;
     use crate::scene::Light;
     use glam::{DMat4, DVec3, Vec3};
     use rand::{Rng, SeedableRng};
@@ -450,18 +325,28 @@ mod tests {
         let (lights, samples) = workload(50);
         let mut huge = inputs(&lights);
         huge.size = (16_384, 16_384);
-        let (choice, grid) = choose(&huge, &samples, &GridCosts::default(), &mut Assigner::new());
-        let grid = grid.expect("a grid within the budget");
-        assert!(grid.total_cells <= CELL_BUDGET);
+        let choice = choose(&huge, &samples, &GridCosts::default(), &mut Assigner::new());
+        let chosen = choice
+            .candidates
+            .iter()
+            .find(|c| c.footprint_px == choice.config.footprint_px)
+            .expect("the chosen footprint was measured");
+        assert!(
+            chosen.cells > 0 && chosen.cells <= CELL_BUDGET,
+            "{chosen:?}"
+        );
         assert!(
             choice.config.footprint_px > CANDIDATE_FOOTPRINTS[0],
             "{choice:?}"
         );
         // Where the standard list fits, it is the list.
-        assert_eq!(
-            candidate_footprints(&inputs(&lights), first_split(&samples, 0.1)),
-            CANDIDATE_FOOTPRINTS.to_vec()
+        let standard = choose(
+            &inputs(&lights),
+            &samples,
+            &GridCosts::default(),
+            &mut Assigner::new(),
         );
+        assert_eq!(standard.candidates[0].footprint_px, CANDIDATE_FOOTPRINTS[0]);
     }
 
     /// Same samples, lights and costs: the same choice, candidate for candidate.
@@ -469,8 +354,8 @@ mod tests {
     fn the_choice_is_deterministic_for_given_costs() {
         let (lights, samples) = workload(600);
         let costs = GridCosts::default();
-        let a = choose(&inputs(&lights), &samples, &costs, &mut Assigner::new()).0;
-        let b = choose(&inputs(&lights), &samples, &costs, &mut Assigner::new()).0;
+        let a = choose(&inputs(&lights), &samples, &costs, &mut Assigner::new());
+        let b = choose(&inputs(&lights), &samples, &costs, &mut Assigner::new());
         assert_eq!(a, b);
         assert!(a.candidates.len() >= 3, "{:?}", a.candidates);
     }
@@ -486,7 +371,7 @@ mod tests {
                 shade_ns,
                 ..GridCosts::default()
             };
-            let choice = choose(&inputs(&lights), &samples, &costs, &mut Assigner::new()).0;
+            let choice = choose(&inputs(&lights), &samples, &costs, &mut Assigner::new());
             let best = choice
                 .candidates
                 .iter()
@@ -504,6 +389,29 @@ mod tests {
         assert!(dear < cheap, "{dear} px against {cheap} px");
     }
 
+    /// A search stepped one candidate per call (as frames do) measures the same candidates and
+    /// makes the same choice as one made whole; a new start drops a search in progress.
+    #[test]
+    fn a_search_spread_over_calls_chooses_what_one_call_does() {
+        let (lights, samples) = workload(600);
+        let costs = GridCosts::default();
+        let whole = choose(&inputs(&lights), &samples, &costs, &mut Assigner::new());
+        assert!(whole.candidates.len() >= 3, "{:?}", whole.candidates);
+        let mut search = ChoiceSearch::default();
+        let mut assigner = Assigner::new();
+        // A search abandoned after one step leaves nothing behind.
+        search.start(&inputs(&lights[..100]), &samples);
+        assert!(!search.step(&inputs(&lights[..100]), &samples, &costs, &mut assigner));
+        search.start(&inputs(&lights), &samples);
+        let mut steps = 0;
+        while search.in_progress() {
+            search.step(&inputs(&lights), &samples, &costs, &mut assigner);
+            steps += 1;
+        }
+        assert_eq!(steps, whole.candidates.len());
+        assert_eq!(search.finish(&inputs(&lights), &samples, &costs), whole);
+    }
+
     /// A new choice within the hysteresis band of the current grid does not replace it, one
     /// clearly cheaper does; so a static scene measured again keeps its grid.
     #[test]
@@ -514,8 +422,7 @@ mod tests {
             &samples,
             &GridCosts::default(),
             &mut Assigner::new(),
-        )
-        .0;
+        );
         assert!(!should_switch(&choice.config, &choice));
         for c in &choice.candidates {
             let current = GridConfig {
@@ -534,7 +441,7 @@ mod tests {
         let mut costs = GridCosts::default();
         for (k, shade) in [19.0, 21.0, 20.5, 19.5].into_iter().enumerate() {
             costs.shade_ns = shade;
-            let again = choose(&inputs(&lights), &samples, &costs, &mut Assigner::new()).0;
+            let again = choose(&inputs(&lights), &samples, &costs, &mut Assigner::new());
             assert!(
                 !should_switch(&choice.config, &again)
                     || again.config.footprint_px == choice.config.footprint_px,
@@ -552,8 +459,7 @@ mod tests {
             &samples,
             &GridCosts::default(),
             &mut Assigner::new(),
-        )
-        .0;
+        );
         let coarsest = roomy.candidates[0].indices;
         let mut tight = inputs(&lights);
         tight.limits.max_indices = coarsest + 1;
@@ -561,7 +467,7 @@ mod tests {
             shade_ns: 1000.0,
             ..GridCosts::default()
         };
-        let choice = choose(&tight, &samples, &costs, &mut Assigner::new()).0;
+        let choice = choose(&tight, &samples, &costs, &mut Assigner::new());
         assert_eq!(choice.config.footprint_px, CANDIDATE_FOOTPRINTS[0]);
         assert!(choice.candidates.len() >= 2, "a finer grid was measured");
         assert!(choice.candidates[1].overflowed_lights > 0);

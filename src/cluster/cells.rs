@@ -31,10 +31,74 @@ use super::pack::GpuLight;
 /// Relative padding of light radii (see the module docs).
 const RADIUS_PAD: f64 = 1e-4;
 
+/// A slice whose cross-section spans fewer columns than this plus one emits its rows without
+/// a chord each (see [`ScreenExtent::for_each_row_run`]).
+const ROW_CHORD_MIN_COLUMNS: u32 = 3;
+
+/// A band of consecutive slices (numbered across cascades, `first..end`), the part of the grid
+/// one thread of the assignment fills, and the view depths a light must reach to touch it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SliceWindow {
+    /// First slice.
+    pub first: u32,
+    /// One past the last slice.
+    pub end: u32,
+    /// A light whose depth range misses `[near, far]` touches none of the band's cells
+    /// (conservative: widened beyond the slices' own widened bounds; unbounded at the grid's
+    /// two ends, which take every depth in front of and behind it).
+    near: f64,
+    far: f64,
+}
+
+impl SliceWindow {
+    /// Every slice of `grid`.
+    pub fn all(grid: &ClusterGrid) -> SliceWindow {
+        SliceWindow::of(grid, 0, grid.slice_slabs.len() as u32)
+    }
+
+    /// Slices `first..end` of `grid` (`first < end ≤` its slice count).
+    pub fn of(grid: &ClusterGrid, first: u32, end: u32) -> SliceWindow {
+        let slabs = &grid.slice_slabs;
+        let near = if first == 0 {
+            f64::NEG_INFINITY
+        } else {
+            slabs[first as usize][0] * (1.0 - WINDOW_MARGIN)
+        };
+        let far = if end as usize >= slabs.len() {
+            f64::INFINITY
+        } else {
+            slabs[end as usize - 1][1] * (1.0 + WINDOW_MARGIN)
+        };
+        SliceWindow {
+            first,
+            end,
+            near,
+            far,
+        }
+    }
+}
+
+/// Relative widening of a [`SliceWindow`]'s depth bounds: its depth test only skips lights
+/// early, the slice numbers decide, so it may be generous.
+const WINDOW_MARGIN: f64 = 1e-3;
+
 /// Calls `emit(first_cell, cells)` for every run of consecutive cells `light` may touch, in
 /// ascending cell order.
 pub fn for_each_run(
     grid: &ClusterGrid,
+    light: &GpuLight,
+    camera_far: f64,
+    emit: &mut impl FnMut(u32, u32),
+) {
+    for_each_run_in(grid, &SliceWindow::all(grid), light, camera_far, emit)
+}
+
+/// [`for_each_run`] restricted to the cells of `window`'s slices: exactly the runs
+/// [`for_each_run`] emits there.
+#[inline(always)]
+pub fn for_each_run_in(
+    grid: &ClusterGrid,
+    window: &SliceWindow,
     light: &GpuLight,
     camera_far: f64,
     emit: &mut impl FnMut(u32, u32),
@@ -45,6 +109,15 @@ pub fn for_each_run(
         return;
     }
     let range = r0 + RADIUS_PAD * (p.z.abs() + r0);
+    // A spot's cone bound (below) lies within √2 · range of the light: 2 · range bounds it.
+    let reach = if light.spot_scale == 0.0 {
+        range
+    } else {
+        2.0 * range
+    };
+    if -p.z + reach < window.near || -p.z - reach > window.far {
+        return;
+    }
     let cone = Cone::of(light, range);
     // The sphere every cell test starts from: the light's, or the tighter bound of a spot's
     // cone.
@@ -70,6 +143,19 @@ pub fn for_each_run(
     for k in k0..k1 + 1 {
         let cascade = &grid.cascades[k as usize];
         let constants = &grid.cascade_constants[k as usize];
+        // The light's slices of this cascade, cut to the window's (numbered within the
+        // cascade, inclusive).
+        let sa = if k == k0 { s0 } else { 0 };
+        let sb = if k == k1 { s1 } else { cascade.slices - 1 };
+        let sa = sa.max(window.first.saturating_sub(constants.first_slice));
+        let Some(last) = window.end.checked_sub(constants.first_slice + 1) else {
+            // The window ends before this cascade (and every later one).
+            break;
+        };
+        let sb = sb.min(last);
+        if sa > sb {
+            continue;
+        }
         // The whole sphere's tangent bounds are exact on their own when the depth range
         // lies in one cascade (the common case); otherwise each cascade's slab tightens them.
         // Every slice and row below stays inside these ranges, so the refinement can only
@@ -81,8 +167,6 @@ pub fn for_each_run(
         let Some(rows) = extent.tile_range(constants, slab, 1, cascade.tiles_y) else {
             continue;
         };
-        let sa = if k == k0 { s0 } else { 0 };
-        let sb = if k == k1 { s1 } else { cascade.slices - 1 };
         let slice_cells = cascade.tiles_x * cascade.tiles_y;
         let tiles = CascadeTiles {
             grid,
@@ -206,10 +290,19 @@ impl ScreenExtent {
         if y0 > y1 {
             return;
         }
-        if tiles.columns.0 == tiles.columns.1 {
-            // One column: no chord can narrow it further.
+        // The cross-section's own columns bound every row's chord.
+        let Some((x0, x1)) = self.tiles_of(tiles, 0, cx - rho, cx + rho, inv_a, inv_b) else {
+            return;
+        };
+        let columns = (x0.max(tiles.columns.0), x1.min(tiles.columns.1));
+        if columns.0 > columns.1 {
+            return;
+        }
+        if columns.1 - columns.0 < ROW_CHORD_MIN_COLUMNS {
+            // Too narrow for a chord to trim more than a corner cell: the per-row arithmetic
+            // would cost more than the cells it saves.
             for row in y0..y1 + 1 {
-                emit(row, tiles.columns.0, tiles.columns.1);
+                emit(row, columns.0, columns.1);
             }
             return;
         }
@@ -234,7 +327,7 @@ impl ScreenExtent {
             }
             let half = half_sq.sqrt();
             if let Some((x0, x1)) = self.tiles_of(tiles, 0, cx - half, cx + half, inv_a, inv_b) {
-                let (x0, x1) = (x0.max(tiles.columns.0), x1.min(tiles.columns.1));
+                let (x0, x1) = (x0.max(columns.0), x1.min(columns.1));
                 if x0 <= x1 {
                     emit(row, x0, x1);
                 }

@@ -6,11 +6,15 @@
 //! context.
 
 pub mod assign;
+mod assign_bands;
+mod assign_chunks;
 pub mod auto;
+mod auto_search;
 pub mod cells;
 mod cone;
 mod depth_lookup;
 pub mod grid;
+mod overflow;
 pub mod pack;
 pub mod pack_grid;
 pub mod tiles;

@@ -127,20 +127,17 @@ impl CulledForward {
     /// automatic grid's included).
     fn update_grid(&mut self, ctx: &FrameContext, limits: &AssignLimits, encoding: GridEncoding) {
         let projection = GridProjection::from_matrix(&ctx.projection.as_dmat4());
-        let (config, fresh) = match self.culling {
+        let config = match self.culling {
             Culling::Clustered if self.automatic(ctx) => {
                 let choice = self.auto.config(ctx, projection, limits, encoding);
-                (choice.config.clone(), self.auto.take_fresh_grid())
+                choice.config.clone()
             }
-            Culling::Clustered => (ctx.options.grid.clone(), None),
+            Culling::Clustered => ctx.options.grid.clone(),
             // Tiled shares the clustered grid's coverage setting (to measure it).
-            Culling::Tiled => (
-                GridConfig {
-                    coverage: ctx.options.grid.coverage,
-                    ..GridConfig::tiles(ctx.options.tile_px)
-                },
-                None,
-            ),
+            Culling::Tiled => GridConfig {
+                coverage: ctx.options.grid.coverage,
+                ..GridConfig::tiles(ctx.options.tile_px)
+            },
         };
         let key = GridKey {
             size: ctx.viewport,
@@ -151,15 +148,14 @@ impl CulledForward {
         };
         if self.grid.as_ref().map(|(k, _)| k) != Some(&key) {
             let (w, h) = ctx.viewport;
-            match (fresh, &mut self.grid) {
-                (Some(grid), _) => self.grid = Some((key, grid)),
+            match &mut self.grid {
                 // In place: a moving camera changes the depth range, and so the grid, every
                 // frame.
-                (None, Some((old_key, grid))) => {
+                Some((old_key, grid)) => {
                     grid.rebuild(w, h, projection, ctx.near, ctx.content_far, &config);
                     *old_key = key;
                 }
-                (None, None) => {
+                None => {
                     let grid =
                         ClusterGrid::new(w, h, projection, ctx.near, ctx.content_far, &config);
                     self.grid = Some((key, grid));

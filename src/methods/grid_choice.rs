@@ -6,7 +6,9 @@ use glam::{DMat4, DVec3, DVec4};
 
 use super::FrameContext;
 use crate::cluster::assign::{AssignLimits, Assigner};
-use crate::cluster::auto::{self, ChoiceInputs, FrameCost, GridChoice, GridCosts, SurfaceSamples};
+use crate::cluster::auto::{
+    self, ChoiceInputs, ChoiceSearch, FrameCost, GridChoice, GridCosts, SurfaceSamples,
+};
 use crate::cluster::grid::{ClusterGrid, GridConfig, GridProjection};
 use crate::cluster::pack_grid::GridEncoding;
 use crate::metrics::raycast::SceneRaycaster;
@@ -55,16 +57,21 @@ pub(crate) struct AutoGrid {
     assigner: Assigner,
     /// The frame rendered and not yet observed.
     pending: Option<FrameCost>,
-    /// The current frame made a choice: its time holds the candidates' assignments and
-    /// (first frame) shader compiles, so it calibrates nothing.
+    /// The current frame measured a candidate: its time holds the candidate's assignment (and
+    /// on the first frame shader compiles), so it calibrates nothing.
     chose_this_frame: bool,
-    /// The grid of a choice just made, as built to measure it (see
-    /// [`AutoGrid::take_fresh_grid`]).
-    fresh_grid: Option<ClusterGrid>,
+    /// The search over candidate footprints (one per frame while it runs).
+    search: ChoiceSearch,
 }
 
 impl AutoGrid {
     /// The grid settings for this frame: the current choice, or a new one when it is stale.
+    ///
+    /// A grid is needed at once on the first frame and when the viewport, projection, near
+    /// plane or settings change: those choices measure every candidate in this frame. The
+    /// others (the view or the lights moved, the period passed, the costs got calibrated)
+    /// only refine a grid that works: they measure one candidate per frame, so no frame pays
+    /// for seven assignments, and switch when the last is measured.
     pub(crate) fn config(
         &mut self,
         ctx: &FrameContext,
@@ -78,67 +85,80 @@ impl AutoGrid {
             near: ctx.near.to_bits(),
             base: ctx.options.grid.clone(),
         };
+        let inputs = ChoiceInputs {
+            size: ctx.viewport,
+            projection,
+            near: ctx.near,
+            far: ctx.content_far,
+            camera_far: ctx.far,
+            base: ctx.options.grid.clone(),
+            lights: ctx.lights,
+            limits: *limits,
+            encoding,
+        };
+        self.frames_since_choice += 1;
+        let urgent = self.choice.is_none() || self.layout.as_ref() != Some(&layout);
+        if urgent {
+            self.samples = self.sample(ctx);
+            self.search.start(&inputs, &self.samples);
+            while !self
+                .search
+                .step(&inputs, &self.samples, &self.costs, &mut self.assigner)
+            {}
+            self.conclude(&inputs, layout, ctx);
+            self.chose_this_frame = true;
+            return self.choice.as_ref().expect("chosen above");
+        }
         let moved = self
             .view_at_choice
             .is_none_or(|(view, n)| view != ctx.view || changed_much(n, ctx.lights.len()));
-        let due = self.choice.is_none()
-            || self.layout.as_ref() != Some(&layout)
-            || (moved && self.frames_since_choice >= RECHOOSE_AFTER_CHANGE)
+        let due = (moved && self.frames_since_choice >= RECHOOSE_AFTER_CHANGE)
             || (self.choices == 1 && self.frames_since_choice >= FIRST_CALIBRATED_CHOICE)
             || self.frames_since_choice >= RECHOOSE_PERIOD;
-        self.frames_since_choice += 1;
-        self.chose_this_frame = due;
-        if due {
+        self.chose_this_frame = self.search.in_progress() || due;
+        if !self.search.in_progress() && due {
             self.samples = self.sample(ctx);
-            let inputs = ChoiceInputs {
-                size: ctx.viewport,
-                projection,
-                near: ctx.near,
-                far: ctx.content_far,
-                camera_far: ctx.far,
-                base: ctx.options.grid.clone(),
-                lights: ctx.lights,
-                limits: *limits,
-                encoding,
-            };
-            let (new, grid) = auto::choose(&inputs, &self.samples, &self.costs, &mut self.assigner);
-            let keep = self.layout.as_ref() == Some(&layout)
-                && self
-                    .choice
-                    .as_ref()
-                    .is_some_and(|current| !auto::should_switch(&current.config, &new));
-            if keep {
-                // The grid stays; the reason says it was measured again.
-                let current = self.choice.as_mut().expect("kept");
-                current.reason = if current.config.footprint_px == new.config.footprint_px {
-                    new.reason
-                } else {
-                    format!(
-                        "kept {} px (predicted within {:.0} % of the best): {}",
-                        current.config.footprint_px,
-                        auto::HYSTERESIS * 100.0,
-                        new.reason
-                    )
-                };
-                current.candidates = new.candidates;
-            } else {
-                self.choice = Some(new);
-                self.fresh_grid = grid;
-            }
-            self.layout = Some(layout);
-            self.view_at_choice = Some((ctx.view, ctx.lights.len()));
-            self.frames_since_choice = 0;
-            self.choices += 1;
+            self.search.start(&inputs, &self.samples);
         }
-        self.choice.as_ref().expect("chosen above")
+        if self.chose_this_frame
+            && self
+                .search
+                .step(&inputs, &self.samples, &self.costs, &mut self.assigner)
+        {
+            self.conclude(&inputs, layout, ctx);
+        }
+        self.choice.as_ref().expect("chosen on the first frame")
     }
 
-    /// The grid of the choice [`AutoGrid::config`] just made, built from the same viewport,
-    /// projection, depths and settings the caller builds its grid from: taking it saves
-    /// building that grid (and its cell spheres) a second time. `None` when this frame kept
-    /// the grid it had.
-    pub(crate) fn take_fresh_grid(&mut self) -> Option<ClusterGrid> {
-        self.fresh_grid.take()
+    /// Ends the search: its choice replaces the current grid unless the hysteresis keeps it.
+    fn conclude(&mut self, inputs: &ChoiceInputs, layout: Layout, ctx: &FrameContext) {
+        let new = self.search.finish(inputs, &self.samples, &self.costs);
+        let keep = self.layout.as_ref() == Some(&layout)
+            && self
+                .choice
+                .as_ref()
+                .is_some_and(|current| !auto::should_switch(&current.config, &new));
+        if keep {
+            // The grid stays; the reason says it was measured again.
+            let current = self.choice.as_mut().expect("kept");
+            current.reason = if current.config.footprint_px == new.config.footprint_px {
+                new.reason
+            } else {
+                format!(
+                    "kept {} px (predicted within {:.0} % of the best): {}",
+                    current.config.footprint_px,
+                    auto::HYSTERESIS * 100.0,
+                    new.reason
+                )
+            };
+            current.candidates = new.candidates;
+        } else {
+            self.choice = Some(new);
+        }
+        self.layout = Some(layout);
+        self.view_at_choice = Some((ctx.view, ctx.lights.len()));
+        self.frames_since_choice = 0;
+        self.choices += 1;
     }
 
     /// Why the current grid is what it is.

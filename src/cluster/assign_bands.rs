@@ -1,0 +1,363 @@
+//! The assignment by **bands** of slices (see [`super::assign`]): each thread fills one band
+//! of consecutive slices, whose cells are consecutive cell numbers, so it owns one contiguous
+//! part of every output array and no thread writes where another does.
+
+use std::time::Instant;
+
+use super::assign::{Assignment, Run, Totals};
+use super::cells::{for_each_run_in, SliceWindow};
+use super::grid::ClusterGrid;
+use super::pack::GpuLight;
+
+/// The bands and their buffers, kept between frames.
+#[derive(Default)]
+pub(super) struct Bands {
+    bands: Vec<Band>,
+    /// Per light: its visible number (phase 2, several bands).
+    numbers: Vec<u32>,
+}
+
+impl Bands {
+    /// Cuts the grid's slices into at most `threads` non-empty bands of about equal work.
+    ///
+    /// The work is what the last assignment measured when it was to a grid of as many cells
+    /// and slices in as many bands: each band's time spread evenly over its cells. So the
+    /// bands follow the work from frame to frame whatever it is made of (per-light setup for
+    /// many small lights, per-index scatter for a fine grid), which a fixed measure does not:
+    /// split by indices, 65 536 small lights ran at half the speed-up of a split by lights.
+    /// Failing that, the last assignment's indices, else cells. Only the speed depends on
+    /// where the bands are cut, never the lists.
+    fn split(&mut self, grid: &ClusterGrid, threads: usize, out: &Assignment) {
+        let cells = grid.total_cells as usize;
+        let slices = grid.slice_slabs.len() as u32;
+        let threads = threads.clamp(1, slices.max(1) as usize);
+        let previous = out;
+        let timed = self.bands.len() == threads
+            && threads > 1
+            && previous.offsets.len() == cells
+            && self.bands.last().and_then(|b| b.window).map(|w| w.end) == Some(slices)
+            && self.bands.iter().all(|b| b.seconds > 0.0);
+        let by_indices = previous.offsets.len() == cells && !previous.indices.is_empty();
+        // Seconds per cell of each band's cells, from the last split.
+        let density: [(usize, usize, f64); 8] = std::array::from_fn(|b| match self.bands.get(b) {
+            Some(band) if timed => (
+                band.first_cell,
+                band.end_cell,
+                band.seconds / (band.end_cell - band.first_cell).max(1) as f64,
+            ),
+            _ => (0, 0, 0.0),
+        });
+        // The work in front of `cell`.
+        let work_before = |cell: usize| -> f64 {
+            if timed {
+                density
+                    .iter()
+                    .map(|&(a, b, d)| (cell.clamp(a, b) - a) as f64 * d)
+                    .sum()
+            } else if cell >= cells {
+                if by_indices {
+                    previous.indices.len() as f64
+                } else {
+                    cells as f64
+                }
+            } else if by_indices {
+                previous.offsets[cell] as f64
+            } else {
+                cell as f64
+            }
+        };
+        let total = work_before(cells);
+        self.bands.resize_with(threads, Band::default);
+        let (mut first, mut used) = (0u32, 0usize);
+        for t in 0..threads {
+            if first >= slices {
+                break;
+            }
+            // At least one slice per band; the last band takes the rest.
+            let end = if t + 1 == threads {
+                slices
+            } else {
+                let target = total * (t + 1) as f64 / threads as f64;
+                let mut end = first + 1;
+                while end < slices && work_before(slice_first_cell(grid, end)) < target {
+                    end += 1;
+                }
+                end
+            };
+            let band = &mut self.bands[used];
+            band.window = Some(SliceWindow::of(grid, first, end));
+            band.first_cell = slice_first_cell(grid, first);
+            band.end_cell = slice_first_cell(grid, end);
+            band.seconds = 0.0;
+            used += 1;
+            first = end;
+        }
+        self.bands.truncate(used);
+    }
+
+    /// Phases 1 to 3 over at most `threads` bands (in parallel when more than one: called
+    /// inside rayon's pool then), into `out`; the list's totals before any cap.
+    pub(super) fn assign(
+        &mut self,
+        grid: &ClusterGrid,
+        lights: &[GpuLight],
+        camera_far: f64,
+        out: &mut Assignment,
+        threads: usize,
+    ) -> Totals {
+        self.split(grid, threads, out);
+        let parallel = self.bands.len() > 1;
+        let cells = grid.total_cells as usize;
+        let bands = &mut self.bands[..];
+        // Phase 1.
+        for_bands(bands, parallel, &|band| band.find(grid, lights, camera_far));
+        // Phase 2: the visible lights and their numbers, then counts, offsets and totals.
+        number_visible(
+            bands,
+            lights.len(),
+            &mut out.visible,
+            &mut self.numbers,
+            parallel,
+        );
+        out.counts.resize(cells, 0);
+        out.offsets.resize(cells, 0);
+        count_bands(bands, &mut out.counts, &mut out.offsets, parallel);
+        let mut totals = Totals::default();
+        for band in bands.iter_mut() {
+            band.base = totals.indices;
+            totals.indices += band.totals.indices;
+            totals.max = totals.max.max(band.totals.max);
+            totals.nonempty += band.totals.nonempty;
+        }
+        // Phase 3. Every entry is written, so the list is not cleared first: only growth is
+        // zero-filled.
+        out.indices.resize(totals.indices, 0);
+        scatter_bands(bands, &mut out.offsets, &mut out.indices, parallel);
+        totals
+    }
+}
+
+/// One band of slices and its buffers. Aligned to two cache lines: the bands sit side by side
+/// in a `Vec` and their buffers' lengths change with every push, so unaligned neighbours would
+/// bounce a shared cache line between the threads (false sharing doubled a phase's time).
+#[derive(Default)]
+#[repr(align(128))]
+struct Band {
+    /// The band's slices.
+    window: Option<SliceWindow>,
+    /// The band's cells, `first_cell..end_cell`.
+    first_cell: usize,
+    end_cell: usize,
+    /// Per cell (plus one): a difference array of the band's runs, `+1` where a run starts and
+    /// `−1` where it ends, so a run costs two additions whatever its length; its running sum
+    /// over cells is the number of lights touching each cell.
+    deltas: Vec<i32>,
+    /// The runs, light after light.
+    runs: Vec<Run>,
+    /// Every light with a run in the band, ascending: (light, end of its runs in `runs`).
+    lights: Vec<(u32, u32)>,
+    /// Per entry of `lights`: the light's visible number (phase 2).
+    ids: Vec<u32>,
+    /// Per cell: phase 3's write position in the band's part of the list.
+    cursor: Vec<u32>,
+    /// The band's [`Totals`] (phase 2).
+    totals: Totals,
+    /// Seconds its phases 1 and 3 took (the next split's balance).
+    seconds: f64,
+    /// Where the band's part of the list starts (phase 2).
+    base: usize,
+}
+
+impl Band {
+    /// Phase 1: the band's runs of every light, and their per-cell difference counts.
+    fn find(&mut self, grid: &ClusterGrid, lights: &[GpuLight], camera_far: f64) {
+        let started = Instant::now();
+        let window = self.window.expect("a band has a window");
+        let first = self.first_cell as u32;
+        self.deltas.clear();
+        self.deltas.resize(self.end_cell - self.first_cell + 1, 0);
+        self.runs.clear();
+        self.lights.clear();
+        let (deltas, runs) = (&mut self.deltas, &mut self.runs);
+        for (i, light) in lights.iter().enumerate() {
+            let before = runs.len();
+            for_each_run_in(grid, &window, light, camera_far, &mut |start, len| {
+                let start = start - first;
+                deltas[start as usize] += 1;
+                deltas[(start + len) as usize] -= 1;
+                runs.push(Run { start, len });
+            });
+            if runs.len() > before {
+                self.lights.push((i as u32, runs.len() as u32));
+            }
+        }
+        self.seconds = started.elapsed().as_secs_f64();
+    }
+
+    /// Phase 2: the band's counts into `counts` (its cells' part), its own offsets into
+    /// `cursor`, and its totals. The first band's part of the list starts at 0, so it also
+    /// writes its final `offsets` here (a single band then makes one pass over the cells).
+    fn count(&mut self, counts: &mut [u32], offsets: &mut [u32]) {
+        let cells = self.end_cell - self.first_cell;
+        self.cursor.resize(cells, 0);
+        let mut running = 0i32;
+        let mut totals = Totals::default();
+        let columns = counts.iter_mut().zip(&mut self.cursor).zip(&self.deltas);
+        if self.first_cell == 0 {
+            for (((count, cursor), delta), offset) in columns.zip(offsets) {
+                running += delta;
+                let n = running as u32;
+                *count = n;
+                *cursor = totals.indices as u32;
+                *offset = totals.indices as u32;
+                totals.add(n);
+            }
+        } else {
+            for ((count, cursor), delta) in columns {
+                running += delta;
+                let n = running as u32;
+                *count = n;
+                *cursor = totals.indices as u32;
+                totals.add(n);
+            }
+        }
+        self.totals = totals;
+    }
+
+    /// Phase 3: the band's final offsets (its own plus `base`), then its lights' visible
+    /// numbers written into `list` (the band's part of the index list) grouped by cell. Light
+    /// order is kept, so every cell's list is ascending.
+    fn scatter(&mut self, offsets: &mut [u32], list: &mut [u32]) {
+        let started = Instant::now();
+        if self.first_cell != 0 {
+            let base = self.base as u32;
+            for (offset, &local) in offsets.iter_mut().zip(&self.cursor) {
+                *offset = local + base;
+            }
+        }
+        let mut prev = 0usize;
+        for (&(_, end), &id) in self.lights.iter().zip(&self.ids) {
+            let end = end as usize;
+            for run in &self.runs[prev..end] {
+                let a = run.start as usize;
+                for at in &mut self.cursor[a..a + run.len as usize] {
+                    list[*at as usize] = id;
+                    *at += 1;
+                }
+            }
+            prev = end;
+        }
+        self.seconds += started.elapsed().as_secs_f64();
+    }
+}
+
+/// The first cell of slice `g` (numbered across cascades), or the grid's cell count past the
+/// last slice.
+fn slice_first_cell(grid: &ClusterGrid, g: u32) -> usize {
+    let mut first_slice = 0;
+    for c in &grid.cascades {
+        if g < first_slice + c.slices {
+            return (c.first_cell + (g - first_slice) * c.tiles_x * c.tiles_y) as usize;
+        }
+        first_slice += c.slices;
+    }
+    grid.total_cells as usize
+}
+
+/// Runs `f` on every band: the two halves at once with `parallel` (`rayon::join` keeps its
+/// jobs on the stack, so no list of jobs is allocated).
+fn for_bands(bands: &mut [Band], parallel: bool, f: &(dyn Fn(&mut Band) + Sync)) {
+    if !parallel || bands.len() < 2 {
+        bands.iter_mut().for_each(f);
+        return;
+    }
+    let (left, right) = bands.split_at_mut(bands.len() / 2);
+    rayon::join(|| for_bands(left, true, f), || for_bands(right, true, f));
+}
+
+/// Phase 2's numbering: the lights listed by any band, ascending, into `visible`, and each
+/// band's lights' positions there into its `ids`. `numbers` (one entry per light) is scratch.
+fn number_visible(
+    bands: &mut [Band],
+    lights: usize,
+    visible: &mut Vec<u32>,
+    numbers: &mut Vec<u32>,
+    parallel: bool,
+) {
+    visible.clear();
+    if let [band] = bands {
+        visible.extend(band.lights.iter().map(|&(light, _)| light));
+        band.ids.clear();
+        band.ids.extend(0..band.lights.len() as u32);
+        return;
+    }
+    // Mark the listed lights, number the marks in light order, and look the numbers up (a
+    // merge of the bands' lists cost more: a comparison per band per light).
+    numbers.clear();
+    numbers.resize(lights, u32::MAX);
+    for band in bands.iter() {
+        for &(light, _) in &band.lights {
+            numbers[light as usize] = 0;
+        }
+    }
+    for (light, number) in numbers.iter_mut().enumerate() {
+        if *number == 0 {
+            *number = visible.len() as u32;
+            visible.push(light as u32);
+        }
+    }
+    let numbers = &numbers[..];
+    for_bands(bands, parallel, &|band| {
+        band.ids.clear();
+        band.ids.extend(
+            band.lights
+                .iter()
+                .map(|&(light, _)| numbers[light as usize]),
+        );
+    });
+}
+
+/// Phase 2's per-band counts ([`Band::count`]) over `counts` and `offsets` (the grid's), the
+/// halves of the bands at once with `parallel`.
+fn count_bands(bands: &mut [Band], counts: &mut [u32], offsets: &mut [u32], parallel: bool) {
+    if let [band] = bands {
+        band.count(counts, offsets);
+        return;
+    }
+    let (left, right) = bands.split_at_mut(bands.len() / 2);
+    let split = right[0].first_cell - left[0].first_cell;
+    let (counts_left, counts_right) = counts.split_at_mut(split);
+    let (offsets_left, offsets_right) = offsets.split_at_mut(split);
+    if parallel {
+        rayon::join(
+            || count_bands(left, counts_left, offsets_left, true),
+            || count_bands(right, counts_right, offsets_right, true),
+        );
+    } else {
+        count_bands(left, counts_left, offsets_left, false);
+        count_bands(right, counts_right, offsets_right, false);
+    }
+}
+
+/// Phase 3 ([`Band::scatter`]) over `offsets` and the index list `list` (from the first band's
+/// cell and entry on), the halves of the bands at once with `parallel`.
+fn scatter_bands(bands: &mut [Band], offsets: &mut [u32], list: &mut [u32], parallel: bool) {
+    if let [band] = bands {
+        band.scatter(offsets, list);
+        return;
+    }
+    let (left, right) = bands.split_at_mut(bands.len() / 2);
+    let split = right[0].first_cell - left[0].first_cell;
+    let entries = right[0].base - left[0].base;
+    let (offsets_left, offsets_right) = offsets.split_at_mut(split);
+    let (list_left, list_right) = list.split_at_mut(entries);
+    if parallel {
+        rayon::join(
+            || scatter_bands(left, offsets_left, list_left, true),
+            || scatter_bands(right, offsets_right, list_right, true),
+        );
+    } else {
+        scatter_bands(left, offsets_left, list_left, false);
+        scatter_bands(right, offsets_right, list_right, false);
+    }
+}

@@ -1,0 +1,244 @@
+//! The assignment by **chunks** of lights (see [`super::assign`]): each thread finds and sorts
+//! the runs of its own lights, then blocks of cells gather the chunks' per-cell runs in chunk
+//! order. Several threads only; one thread takes a single band ([`super::assign_bands`]).
+
+use rayon::prelude::*;
+
+use super::assign::{Assignment, Run, Totals};
+use super::cells::for_each_run;
+use super::grid::ClusterGrid;
+use super::pack::GpuLight;
+
+/// The chunks and their buffers, kept between frames.
+#[derive(Default)]
+pub(super) struct Chunks {
+    chunks: Vec<Chunk>,
+    /// Per chunk: the visible number of its first visible light (phase 2).
+    first_ids: Vec<u32>,
+    /// Blocks of cells the merge gathers in parallel.
+    blocks: Vec<(usize, usize)>,
+}
+
+impl Chunks {
+    /// Phases 1 to 3 over `threads` (at least two) chunks of lights, in parallel (called
+    /// inside rayon's pool), into `out`; the list's totals before any cap.
+    pub(super) fn assign(
+        &mut self,
+        grid: &ClusterGrid,
+        lights: &[GpuLight],
+        camera_far: f64,
+        out: &mut Assignment,
+        threads: usize,
+    ) -> Totals {
+        let cells = grid.total_cells as usize;
+        // Phase 1: runs and counts per chunk of lights.
+        let chunk_len = lights.len().div_ceil(threads);
+        self.chunks.resize_with(threads, Chunk::default);
+        self.chunks.truncate(threads);
+        self.chunks
+            .par_iter_mut()
+            .zip(lights.par_chunks(chunk_len))
+            .for_each(|(chunk, part)| chunk.find(grid, part, camera_far));
+        // Phase 2: the visible lights (numbered chunk after chunk), then counts and offsets.
+        let first_ids = &mut self.first_ids;
+        first_ids.clear();
+        for (t, chunk) in self.chunks.iter().enumerate() {
+            first_ids.push(out.visible.len() as u32);
+            let first = (t * chunk_len) as u32;
+            let mut prev = 0;
+            for (i, &end) in chunk.ends.iter().enumerate() {
+                if end > prev {
+                    out.visible.push(first + i as u32);
+                }
+                prev = end;
+            }
+        }
+        self.chunks.iter_mut().for_each(Chunk::prefix);
+        let chunks = &self.chunks;
+        out.counts.clear();
+        out.counts
+            .extend((0..cells).map(|c| chunks.iter().map(|k| k.count(c)).sum::<u32>()));
+        out.offsets.clear();
+        let mut total = 0u32;
+        out.offsets.extend(out.counts.iter().map(|&n| {
+            let o = total;
+            total += n;
+            o
+        }));
+        out.indices.resize(total as usize, 0);
+        // Phase 3: each chunk sorts its lights locally, then blocks of cells gather the
+        // chunks' runs into the final list (contiguous, disjoint slices: no sharing).
+        self.chunks
+            .par_iter_mut()
+            .zip(first_ids.par_iter())
+            .for_each(|(chunk, &first_id)| chunk.sort_locally(first_id, cells));
+        merge(
+            &self.chunks,
+            &out.offsets,
+            &mut out.indices,
+            threads,
+            &mut self.blocks,
+        );
+        Totals::of(&out.counts)
+    }
+}
+
+/// One chunk of lights: phase 1's runs and counts, phase 3's locally sorted list. Aligned to
+/// two cache lines: the chunks sit side by side in a `Vec` and their buffers' lengths change
+/// with every push, so unaligned neighbours would bounce a shared cache line between the
+/// threads (false sharing doubled the phase's time).
+#[derive(Default)]
+#[repr(align(128))]
+struct Chunk {
+    /// Per cell (plus one): a difference array of the chunk's runs, `+1` where a run starts
+    /// and `−1` where it ends, so a run costs two additions whatever its length; its running
+    /// sum over cells is the number of the chunk's lights touching each cell.
+    deltas: Vec<i32>,
+    /// The chunk's runs, light after light.
+    runs: Vec<Run>,
+    /// Per light of the chunk: the end of its runs in `runs`.
+    ends: Vec<u32>,
+    /// Per cell (plus one): where the cell's run starts in `sorted` (phase 2).
+    offsets: Vec<u32>,
+    /// The chunk's lights (global visible numbers) grouped by cell (phase 3, several chunks
+    /// only; a single chunk writes the final list directly).
+    sorted: Vec<u32>,
+    /// Phase 3's write positions, per cell.
+    cursor: Vec<u32>,
+}
+
+impl Chunk {
+    /// Phase 1: the runs of `lights` and their per-cell difference counts.
+    fn find(&mut self, grid: &ClusterGrid, lights: &[GpuLight], camera_far: f64) {
+        self.deltas.clear();
+        self.deltas.resize(grid.total_cells as usize + 1, 0);
+        self.runs.clear();
+        self.ends.clear();
+        let (deltas, runs) = (&mut self.deltas, &mut self.runs);
+        for light in lights {
+            for_each_run(grid, light, camera_far, &mut |start, len| {
+                deltas[start as usize] += 1;
+                deltas[(start + len) as usize] -= 1;
+                runs.push(Run { start, len });
+            });
+            self.ends.push(runs.len() as u32);
+        }
+    }
+
+    /// Phase 2: per-cell offsets into the chunk's own sorted list.
+    fn prefix(&mut self) {
+        self.offsets.clear();
+        let (mut running, mut total) = (0i32, 0u32);
+        for delta in &self.deltas {
+            self.offsets.push(total);
+            running += delta;
+            total += running as u32;
+        }
+    }
+
+    /// Lights of the chunk touching `cell`.
+    fn count(&self, cell: usize) -> u32 {
+        self.offsets[cell + 1] - self.offsets[cell]
+    }
+
+    /// Phase 3: writes the chunk's visible lights, numbered from `first_id`, into `out`
+    /// grouped by cell, each cell's run starting where `self.cursor` says (advanced as it
+    /// goes). Light order is kept, so every cell's list is ascending.
+    fn scatter(&mut self, first_id: u32, out: &mut [u32]) {
+        let mut id = first_id;
+        let mut prev = 0usize;
+        for &end in &self.ends {
+            let end = end as usize;
+            if end == prev {
+                continue;
+            }
+            for run in &self.runs[prev..end] {
+                let a = run.start as usize;
+                for at in &mut self.cursor[a..a + run.len as usize] {
+                    out[*at as usize] = id;
+                    *at += 1;
+                }
+            }
+            id += 1;
+            prev = end;
+        }
+    }
+
+    /// Phase 3 of one of several chunks: scatters into the chunk's own list.
+    fn sort_locally(&mut self, first_id: u32, cells: usize) {
+        let mut sorted = std::mem::take(&mut self.sorted);
+        sorted.resize(self.offsets[cells] as usize, 0);
+        self.cursor.clear();
+        self.cursor.extend_from_slice(&self.offsets[..cells]);
+        self.scatter(first_id, &mut sorted);
+        self.sorted = sorted;
+    }
+}
+
+/// Concatenates the chunks' per-cell runs into `indices`, in parallel over blocks of cells
+/// with about equal numbers of indices (`blocks` is the buffer they are listed in).
+fn merge(
+    chunks: &[Chunk],
+    offsets: &[u32],
+    indices: &mut [u32],
+    threads: usize,
+    blocks: &mut Vec<(usize, usize)>,
+) {
+    split_cells_into(offsets, indices.len(), threads * 2, blocks);
+    merge_blocks(chunks, offsets, blocks, indices);
+}
+
+/// Gathers the cells of `blocks` (contiguous, in cell order) into `out`, which starts at the
+/// first block's first index: the two halves of the blocks in parallel (`rayon::join` keeps
+/// its jobs on the stack, so no list of jobs is allocated).
+fn merge_blocks(chunks: &[Chunk], offsets: &[u32], blocks: &[(usize, usize)], out: &mut [u32]) {
+    match blocks {
+        [] => {}
+        &[(c0, c1)] => {
+            let mut at = 0;
+            for cell in c0..c1 {
+                for chunk in chunks {
+                    let (o, n) = (chunk.offsets[cell] as usize, chunk.count(cell) as usize);
+                    out[at..at + n].copy_from_slice(&chunk.sorted[o..o + n]);
+                    at += n;
+                }
+            }
+        }
+        _ => {
+            let (left, right) = blocks.split_at(blocks.len() / 2);
+            let split = (offsets[right[0].0] - offsets[left[0].0]) as usize;
+            let (out_left, out_right) = out.split_at_mut(split);
+            rayon::join(
+                || merge_blocks(chunks, offsets, left, out_left),
+                || merge_blocks(chunks, offsets, right, out_right),
+            );
+        }
+    }
+}
+
+/// Splits the cells into at most `parts` contiguous, non-empty blocks with about equal numbers
+/// of indices (fewer blocks when there are fewer cells).
+#[cfg(test)]
+pub(super) fn split_cells(offsets: &[u32], total: usize, parts: usize) -> Vec<(usize, usize)> {
+    let mut blocks = Vec::new();
+    split_cells_into(offsets, total, parts, &mut blocks);
+    blocks
+}
+
+/// [`split_cells`] into `blocks` (cleared first).
+fn split_cells_into(offsets: &[u32], total: usize, parts: usize, blocks: &mut Vec<(usize, usize)>) {
+    let cells = offsets.len();
+    blocks.clear();
+    let mut start = 0;
+    for p in 1..parts {
+        let target = (total * p / parts) as u32;
+        let end = offsets.partition_point(|&o| o < target).clamp(start, cells);
+        if end > start {
+            blocks.push((start, end));
+            start = end;
+        }
+    }
+    if start < cells {
+        blocks.push((start, cells));
+    }
+}
