@@ -134,11 +134,6 @@ pub fn for_each_run_in(
     }
     let ((k0, s0), (k1, s1)) = grid.depth_range_to_slices(dmin, dmax);
     let extent = ScreenExtent::new(grid, c, r, dmin, dmax);
-    let spheres = if cone.is_some() {
-        grid.cell_spheres()
-    } else {
-        &[]
-    };
     // Exclusive ranges in the loops below: inclusive ones cost a flag check per step.
     for k in k0..k1 + 1 {
         let cascade = &grid.cascades[k as usize];
@@ -177,11 +172,15 @@ pub fn for_each_run_in(
             rows,
         };
         let mut slice_start = cascade.first_cell + sa * slice_cells;
-        let mut emit_row = |slice_start: u32, row: u32, x0: u32, x1: u32| {
+        let mut emit_row = |slice: u32, slice_start: u32, row: u32, x0: u32, x1: u32| {
             let start = slice_start + row * cascade.tiles_x + x0;
             match &cone {
                 None => emit(start, x1 - x0 + 1),
-                Some(cone) => cone.emit_runs(spheres, start, x1 - x0 + 1, emit),
+                Some(cone) => {
+                    let global = constants.first_slice + slice;
+                    let sphere_of = |i: u32| grid.cell_sphere(k, global, x0 + i, row);
+                    cone.emit_runs(sphere_of, start, x1 - x0 + 1, emit)
+                }
             }
         };
         // A rectangle of at most 2 × 2 cells per slice has little to trim (a corner cell at
@@ -197,12 +196,12 @@ pub fn for_each_run_in(
                 Coverage::SliceRows => {
                     let slab = grid.slice_slabs[(constants.first_slice + s) as usize];
                     extent.for_each_row_run(&tiles, slab, &mut |row, x0, x1| {
-                        emit_row(slice_start, row, x0, x1)
+                        emit_row(s, slice_start, row, x0, x1)
                     });
                 }
                 Coverage::CascadeBox => {
                     for row in rows.0..rows.1 + 1 {
-                        emit_row(slice_start, row, columns.0, columns.1);
+                        emit_row(s, slice_start, row, columns.0, columns.1);
                     }
                 }
             }

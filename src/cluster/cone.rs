@@ -56,26 +56,26 @@ impl Cone {
         })
     }
 
-    /// Emits the part of the run `[start, start + len)` the cone may touch: from the first
+    /// Emits the part of the run `[start, start + len)` the cone may touch (`sphere_of(i)`:
+    /// the bounding sphere of its cell `start + i`): from the first
     /// cell that may touch it to the last. The cone is convex, so along a row the cells it
     /// touches are (nearly) one interval; a gap inside would only be assigned too, which is
     /// conservative. Scanning in from both ends tests few cells where the cone fills the row.
     pub fn emit_runs(
         &self,
-        cell_spheres: &[[f64; 4]],
+        sphere_of: impl Fn(u32) -> [f64; 4],
         start: u32,
         len: u32,
         emit: &mut impl FnMut(u32, u32),
     ) {
-        let spheres = &cell_spheres[start as usize..(start + len) as usize];
-        let Some(first) = spheres.iter().position(|s| self.may_touch(s)) else {
+        let Some(first) = (0..len).find(|&i| self.may_touch(&sphere_of(i))) else {
             return;
         };
-        let last = spheres
-            .iter()
-            .rposition(|s| self.may_touch(s))
+        let last = (first + 1..len)
+            .rev()
+            .find(|&i| self.may_touch(&sphere_of(i)))
             .unwrap_or(first);
-        emit(start + first as u32, (last - first + 1) as u32);
+        emit(start + first, last - first + 1);
     }
 
     /// False only when the cell's bounding sphere is certainly outside the cone (up to the

@@ -4,7 +4,7 @@
 
 use super::{
     Cascade, CascadeConstants, ClusterGrid, DepthMapping, GridConfig, GridProjection, SliceLookup,
-    SpareSpheres, SLICE_WIDEN,
+    SLICE_WIDEN,
 };
 
 impl ClusterGrid {
@@ -32,8 +32,7 @@ impl ClusterGrid {
             total_cells: 0,
             coverage: config.coverage,
             ndc_scale: [0.0; 2],
-            cell_spheres: std::sync::OnceLock::new(),
-            spare_spheres: SpareSpheres::default(),
+            slice_frusta: Vec::new(),
             side_plane_norm: [0.0; 2],
             slice_lookup: SliceLookup::default(),
             cascade_constants: Vec::new(),
@@ -142,15 +141,6 @@ impl ClusterGrid {
             GridProjection::Perspective { tan_x, tan_y } => [1.0 / tan_x, 1.0 / tan_y],
             GridProjection::Orthographic { half_x, half_y } => [1.0 / half_x, 1.0 / half_y],
         };
-        // The spheres are of the old cells: dropped, their buffer kept for the next build.
-        if let Some(mut spheres) = self.cell_spheres.take() {
-            spheres.clear();
-            *self
-                .spare_spheres
-                .0
-                .get_mut()
-                .unwrap_or_else(|e| e.into_inner()) = spheres;
-        }
         self.side_plane_norm = match projection {
             GridProjection::Perspective { tan_x, tan_y } => {
                 [tan_x, tan_y].map(|t| 1.0 / (1.0 + t * t).sqrt())
@@ -170,6 +160,9 @@ impl ClusterGrid {
         let mut slabs = std::mem::take(&mut self.slice_slabs);
         self.build_slice_slabs(&mut slabs);
         self.slice_slabs = slabs;
+        let mut frusta = std::mem::take(&mut self.slice_frusta);
+        self.build_slice_frusta(&mut frusta);
+        self.slice_frusta = frusta;
     }
 
     fn build_slice_slabs(&self, slabs: &mut Vec<[f64; 4]>) {

@@ -42,7 +42,7 @@ pub use config::{Coverage, GridConfig, GridMode};
 pub use projection::{DepthMapping, GridProjection};
 
 use super::depth_lookup::{CascadeConstants, SliceLookup};
-use spheres::SpareSpheres;
+pub(crate) use spheres::SliceFrustum;
 
 /// Relative widening of depth ranges against slice boundaries: far more than the CPU table's
 /// rounding at a boundary and than the shader's `f32` evaluation of the mapping (10⁻⁵ in log2
@@ -116,11 +116,10 @@ pub struct ClusterGrid {
     /// (orthographic: `1 / half extent`), for x and y: multiplied instead of divided by in the
     /// assignment's hot path.
     pub(crate) ndc_scale: [f64; 2],
-    /// Bounding sphere (view-space centre, radius) of every cell, built on first use (the
-    /// cone-vs-cell test of spot lights); infinite radius for cells reaching infinity.
-    cell_spheres: std::sync::OnceLock<Vec<[f64; 4]>>,
-    /// The buffer of an earlier grid's spheres, for the next build (see [`ClusterGrid::rebuild`]).
-    spare_spheres: SpareSpheres,
+    /// Per slice (numbered across cascades): its exact view depths `[z0, z1]` and the view
+    /// half extents at each (`z1` infinite for the last slice of an infinite grid): what a
+    /// cell's bounding sphere is made from ([`ClusterGrid::cell_sphere`]).
+    pub(crate) slice_frusta: Vec<SliceFrustum>,
     /// Slice of a depth without a logarithm (log2 mapping only).
     slice_lookup: SliceLookup,
     /// Per cascade: constants of the assignment's box projection and tile conversion.

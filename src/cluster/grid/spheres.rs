@@ -1,18 +1,15 @@
 //! Cell bounding volumes for culling: the frustum side-plane test of a light's sphere and the
-//! lazily built bounding sphere of every cell (the spot-cone test), with the buffer a rebuilt
-//! grid keeps for them.
+//! bounding sphere of a cell (the spot-cone test), from a per-slice table.
 
-use super::{CellCoord, ClusterGrid, GridProjection};
+use super::{ClusterGrid, GridProjection};
 
-/// A buffer kept for the next build of a grid's cell spheres (behind a lock because the spheres
-/// are built on first use through `&self`, possibly on several threads). A clone starts without.
-#[derive(Debug, Default)]
-pub(super) struct SpareSpheres(pub(super) std::sync::Mutex<Vec<[f64; 4]>>);
-
-impl Clone for SpareSpheres {
-    fn clone(&self) -> Self {
-        SpareSpheres::default()
-    }
+/// One slice's exact depths and the view half extents at them (see
+/// [`ClusterGrid::cell_sphere`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct SliceFrustum {
+    depths: (f64, f64),
+    near: (f64, f64),
+    far: (f64, f64),
 }
 
 impl ClusterGrid {
@@ -32,59 +29,72 @@ impl ClusterGrid {
         }
     }
 
-    /// Bounding spheres `[x, y, z, radius]` of every cell, in cell order (built on first use).
-    pub fn cell_spheres(&self) -> &[[f64; 4]] {
-        self.cell_spheres.get_or_init(|| {
-            let mut spheres = std::mem::take(
-                &mut *self
-                    .spare_spheres
-                    .0
-                    .lock()
-                    .unwrap_or_else(|e| e.into_inner()),
-            );
-            self.build_cell_spheres(&mut spheres);
-            spheres
-        })
+    /// The bounding sphere `[x, y, z, radius]` (view space) of the cell in column `x` and row
+    /// `y` of slice `slice` (numbered across cascades) of cascade `cascade`: the centre of its
+    /// eight corners and the farthest corner; an infinite radius for a cell reaching infinity.
+    /// Computed when asked (the cone-vs-cell test of spot lights) from a per-slice table: a
+    /// table of every cell's sphere, rebuilt with the grid whenever a moving camera changed
+    /// its depth range, cost more than the whole assignment it served.
+    #[inline]
+    pub fn cell_sphere(&self, cascade: u32, slice: u32, x: u32, y: u32) -> [f64; 4] {
+        let c = &self.cascades[cascade as usize];
+        let f = &self.slice_frusta[slice as usize];
+        if f.depths.1.is_infinite() {
+            return [0.0, 0.0, 0.0, f64::INFINITY];
+        }
+        let ndc = |i: u32, n: u32| -1.0 + 2.0 * i as f64 / n as f64;
+        bounding_sphere(
+            (ndc(x, c.tiles_x), ndc(x + 1, c.tiles_x)),
+            (ndc(y, c.tiles_y), ndc(y + 1, c.tiles_y)),
+            f.depths,
+            f.near,
+            f.far,
+        )
     }
 
-    fn build_cell_spheres(&self, out: &mut Vec<[f64; 4]>) {
+    /// Every slice's [`SliceFrustum`], in order, into `out` (cleared first).
+    pub(super) fn build_slice_frusta(&self, out: &mut Vec<SliceFrustum>) {
         out.clear();
-        out.reserve(self.total_cells as usize);
         for (k, c) in self.cascades.iter().enumerate() {
             for slice in 0..c.slices {
-                for y in 0..c.tiles_y {
-                    for x in 0..c.tiles_x {
-                        let coord = CellCoord {
-                            cascade: k as u32,
-                            slice,
-                            x,
-                            y,
-                        };
-                        out.push(self.bounding_sphere(coord));
-                    }
-                }
+                let (z0, z1) = self.slice_depth_range(k as u32, slice);
+                out.push(SliceFrustum {
+                    depths: (z0, z1),
+                    near: self.projection.half_extent(z0),
+                    far: self.projection.half_extent(z1),
+                });
             }
         }
     }
+}
 
-    fn bounding_sphere(&self, cell: CellCoord) -> [f64; 4] {
-        let b = self.cell_bounds(cell);
-        if b.depth.1.is_infinite() {
-            return [0.0, 0.0, 0.0, f64::INFINITY];
-        }
-        let mut corners = [glam::DVec3::ZERO; 8];
-        for (i, corner) in corners.iter_mut().enumerate() {
-            let z = if i & 4 != 0 { b.depth.1 } else { b.depth.0 };
-            let (hx, hy) = self.projection.half_extent(z);
-            let nx = if i & 1 != 0 { b.ndc_x.1 } else { b.ndc_x.0 };
-            let ny = if i & 2 != 0 { b.ndc_y.1 } else { b.ndc_y.0 };
-            *corner = glam::DVec3::new(nx * hx, ny * hy, -z);
-        }
-        let center = corners.iter().sum::<glam::DVec3>() / 8.0;
-        let radius = corners
-            .iter()
-            .map(|p| p.distance(center))
-            .fold(0.0, f64::max);
-        [center.x, center.y, center.z, radius]
+/// The bounding sphere `[x, y, z, radius]` of the cell between NDC `columns` and `rows` and
+/// view depths `depths`, whose view half extents are `near` at the first depth and `far` at
+/// the second: the centre of its eight corners and the farthest corner.
+fn bounding_sphere(
+    columns: (f64, f64),
+    rows: (f64, f64),
+    depths: (f64, f64),
+    near: (f64, f64),
+    far: (f64, f64),
+) -> [f64; 4] {
+    let mut corners = [glam::DVec3::ZERO; 8];
+    for (i, corner) in corners.iter_mut().enumerate() {
+        let (z, (hx, hy)) = if i & 4 != 0 {
+            (depths.1, far)
+        } else {
+            (depths.0, near)
+        };
+        let nx = if i & 1 != 0 { columns.1 } else { columns.0 };
+        let ny = if i & 2 != 0 { rows.1 } else { rows.0 };
+        *corner = glam::DVec3::new(nx * hx, ny * hy, -z);
     }
+    let center = corners.iter().sum::<glam::DVec3>() / 8.0;
+    // One root of the largest squared distance (the root is monotonic and correctly rounded,
+    // so this is the largest distance exactly).
+    let farthest = corners
+        .iter()
+        .map(|p| p.distance_squared(center))
+        .fold(0.0, f64::max);
+    [center.x, center.y, center.z, farthest.sqrt()]
 }

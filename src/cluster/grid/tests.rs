@@ -170,3 +170,50 @@ fn fragment_cells_match_bounds() {
         assert!(b.depth.0 <= d * (1.0 + 1e-12) && d <= b.depth.1 * (1.0 + 1e-12));
     }
 }
+
+/// Every cell's bounding sphere holds the cell's eight corners (from `cell_bounds`), and is
+/// not much larger than they need; cells reaching infinity get an infinite one.
+#[test]
+fn cell_spheres_hold_their_cells() {
+    for grid in [
+        persp(0.1, 80.0),
+        persp_with(0.5, 300.0, &GridConfig::fixed(11.0)),
+        persp(0.1, f64::INFINITY),
+    ] {
+        let mut first_slice = 0;
+        for (k, c) in grid.cascades.iter().enumerate() {
+            for slice in 0..c.slices {
+                for y in 0..c.tiles_y {
+                    for x in 0..c.tiles_x {
+                        let cell = CellCoord {
+                            cascade: k as u32,
+                            slice,
+                            x,
+                            y,
+                        };
+                        let [sx, sy, sz, r] = grid.cell_sphere(k as u32, first_slice + slice, x, y);
+                        let b = grid.cell_bounds(cell);
+                        if b.depth.1.is_infinite() {
+                            assert!(r.is_infinite());
+                            continue;
+                        }
+                        let mut farthest: f64 = 0.0;
+                        for z in [b.depth.0, b.depth.1] {
+                            let (hx, hy) = grid.projection.half_extent(z);
+                            for nx in [b.ndc_x.0, b.ndc_x.1] {
+                                for ny in [b.ndc_y.0, b.ndc_y.1] {
+                                    let d = glam::DVec3::new(nx * hx - sx, ny * hy - sy, -z - sz)
+                                        .length();
+                                    farthest = farthest.max(d);
+                                }
+                            }
+                        }
+                        assert!(farthest <= r * (1.0 + 1e-12), "{cell:?}: {farthest} > {r}");
+                        assert!(r <= farthest * (1.0 + 1e-9), "{cell:?}: {r} ≫ {farthest}");
+                    }
+                }
+            }
+            first_slice += c.slices;
+        }
+    }
+}
