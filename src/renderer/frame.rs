@@ -43,8 +43,8 @@ impl Renderer {
     /// strings. In steady state (the same method and scene shape for a few frames: shaders
     /// built, buffers grown) the renderer makes no heap allocation for a frame, lights moving
     /// or not (`tests/soak.rs` counts them; what still allocates, the automatic grid's
-    /// periodic re-choice, is listed in docs/performance.md). Keep one `FrameStats` and pass it every frame. After an error,
-    /// `stats` holds no meaningful figures.
+    /// periodic re-choice, is listed in docs/performance.md). Keep one `FrameStats` and pass
+    /// it every frame. After an error, `stats` holds no meaningful figures.
     pub fn render_reusing(
         &mut self,
         scene: &Scene,
