@@ -48,9 +48,14 @@ pub struct Caps {
     pub max_draw_buffers: i32,
     /// `GL_MAX_COLOR_ATTACHMENTS` (1 on ES 2.0 without `GL_EXT_draw_buffers`).
     pub max_color_attachments: i32,
-    /// `GL_MAX_SAMPLES` of multisampled renderbuffers at the ES 3.0 level (0 at ES 2.0, where
-    /// MSAA offscreen is not implemented).
+    /// Most samples of the offscreen MSAA target: `GL_MAX_SAMPLES` at the ES 3.0 level, and at
+    /// ES 2.0 `GL_MAX_SAMPLES_EXT` where `GL_EXT_multisampled_render_to_texture` is present
+    /// (0 without it).
     pub max_samples: i32,
+    /// ES 2.0 with `GL_EXT_multisampled_render_to_texture`: MSAA renders into a texture whose
+    /// samples the driver averages on flush (tile-based GPUs keep them on chip), instead of
+    /// ES 3.0's multisampled renderbuffers and blit.
+    pub msaa_render_to_texture: bool,
     /// Fragment `highp float`; precision 0 means the fragment stage has no highp.
     pub fragment_highp: Precision,
     /// Fragment `mediump float` (fp16 on most phones, and on llvmpipe).
@@ -64,6 +69,9 @@ pub struct Caps {
     /// The extension set, sorted.
     pub extensions: BTreeSet<String>,
 }
+
+/// The ES 2.0 extension MSAA renders through.
+pub const MSAA_RENDER_TO_TEXTURE: &str = "GL_EXT_multisampled_render_to_texture";
 
 impl Caps {
     /// Probes the current context for feature level `es`. Errors when `es` is ES 3.0 and the
@@ -113,7 +121,8 @@ impl Caps {
             max_texture_size = gl.get_parameter_i32(glow::MAX_TEXTURE_SIZE);
             max_fragment_uniform_vectors = gl.get_parameter_i32(glow::MAX_FRAGMENT_UNIFORM_VECTORS);
             max_texture_image_units = gl.get_parameter_i32(glow::MAX_TEXTURE_IMAGE_UNITS);
-            if es3 {
+            if es3 || (!desktop && has(MSAA_RENDER_TO_TEXTURE)) {
+                // GL_MAX_SAMPLES_EXT has the value of GL_MAX_SAMPLES.
                 max_samples = gl.get_parameter_i32(glow::MAX_SAMPLES);
             }
             if es3 || has("GL_EXT_draw_buffers") {
@@ -148,6 +157,7 @@ impl Caps {
             max_draw_buffers,
             max_color_attachments,
             max_samples,
+            msaa_render_to_texture: !es3 && !desktop && has(MSAA_RENDER_TO_TEXTURE),
             fragment_highp,
             fragment_mediump,
             float_textures: es3 || has("GL_OES_texture_float"),

@@ -11,6 +11,10 @@ pub struct Device {
     pub(crate) gl: glow::Context,
     caps: Caps,
     live: std::cell::Cell<LiveObjects>,
+    /// `glRenderbufferStorageMultisampleEXT`, on ES 2.0 with
+    /// `GL_EXT_multisampled_render_to_texture` (see [`super::ext_fns`]).
+    pub(crate) renderbuffer_storage_multisample_ext:
+        Option<super::ext_fns::RenderbufferStorageMultisampleExt>,
 }
 
 /// GL objects currently alive, as counted by the renderer's own create/delete calls: what
@@ -65,10 +69,26 @@ impl Device {
                 gl.bind_vertex_array(Some(vao));
             }
         }
+        let renderbuffer_storage_multisample_ext = if caps.msaa_render_to_texture {
+            let f = super::ext_fns::renderbuffer_storage_multisample_ext();
+            if f.is_none() {
+                log::warn!(
+                    "GL_EXT_multisampled_render_to_texture is listed but \
+                     glRenderbufferStorageMultisampleEXT could not be loaded through EGL: \
+                     no MSAA on this context"
+                );
+                caps.msaa_render_to_texture = false;
+                caps.max_samples = 0;
+            }
+            f
+        } else {
+            None
+        };
         Ok(Device {
             gl,
             caps,
             live: std::cell::Cell::new(LiveObjects::default()),
+            renderbuffer_storage_multisample_ext,
         })
     }
 

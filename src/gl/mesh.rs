@@ -154,6 +154,16 @@ impl Drop for GpuMesh {
     }
 }
 
+/// One triangle covering the whole viewport in clip space (full-screen passes).
+pub fn fullscreen_triangle() -> Mesh {
+    let p = vec![
+        glam::Vec3::new(-1.0, -1.0, 0.0),
+        glam::Vec3::new(3.0, -1.0, 0.0),
+        glam::Vec3::new(-1.0, 3.0, 0.0),
+    ];
+    Mesh::new(p, vec![], vec![], vec![0, 1, 2]).expect("valid triangle")
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -13,6 +13,7 @@
 pub mod caps;
 pub mod context;
 pub mod device;
+pub mod ext_fns;
 pub mod framebuffer;
 pub mod gbuffer;
 pub mod mesh;

@@ -1,22 +1,44 @@
-//! A multisampled offscreen target (ES 3.0: RGBA8 and depth renderbuffers with N samples),
-//! rendered into and then resolved by a blit into a single-sampled framebuffer: the
-//! renderer's offscreen target, or the caller's (a window's back buffer).
-//! ES 2.0 core has no multisampled renderbuffers; its extensions for it are not used yet, so
-//! MSAA is unsupported there with that reason.
+//! A multisampled offscreen target, rendered into and then resolved into a single-sampled
+//! framebuffer: the renderer's offscreen target, or the caller's (a window's back buffer).
+//!
+//! * ES 3.0: RGBA8 and 24-bit depth renderbuffers with N samples, resolved by a blit.
+//! * ES 2.0 with `GL_EXT_multisampled_render_to_texture` (Mali, Adreno, PowerVR): an RGBA8
+//!   texture attached with N samples — a tile-based GPU keeps the samples on chip and writes
+//!   only their average to the texture — and a 16-bit depth renderbuffer with N samples
+//!   (`glRenderbufferStorageMultisampleEXT`); the texture is then copied onto the
+//!   destination by a full-screen triangle. Without the extension MSAA is unsupported there,
+//!   with that reason.
 #![allow(unsafe_code)]
 
 use glow::HasContext;
 
+use super::caps::MSAA_RENDER_TO_TEXTURE;
+use super::mesh::{fullscreen_triangle, GpuMesh};
+use super::program::{ProgramCache, ProgramKey};
+use super::state::{Blend, Cull, DepthTest, RenderState};
 use super::{Device, EsVersion, GlError};
 
-/// A framebuffer of multisampled colour and depth renderbuffers.
+/// A framebuffer whose colour and depth have several samples per pixel.
 pub struct MultisampleTarget {
     fbo: glow::Framebuffer,
-    color: glow::Renderbuffer,
+    color: Color,
     depth: glow::Renderbuffer,
     size: (u32, u32),
     samples: u32,
     destroyed: bool,
+}
+
+/// Where the colour samples live.
+enum Color {
+    /// ES 3.0: a multisampled renderbuffer, resolved by a blit.
+    Renderbuffer(glow::Renderbuffer),
+    /// ES 2.0 with `GL_EXT_multisampled_render_to_texture`: a single-sampled texture the driver
+    /// averages the samples into when the framebuffer is flushed, then copied to the
+    /// destination by a full-screen triangle (ES 2.0 has no blit).
+    Texture {
+        texture: glow::Texture,
+        triangle: GpuMesh,
+    },
 }
 
 /// Why `samples` cannot be used on this context, if it cannot (1 always can).
@@ -24,14 +46,14 @@ pub fn unsupported_reason(dev: &Device, samples: u32) -> Option<String> {
     if samples <= 1 {
         return None;
     }
-    if dev.es() != EsVersion::Es3 {
-        return Some(
-            "MSAA needs OpenGL ES 3.0 multisampled renderbuffers (ES 2.0's \
-             EXT_multisampled_render_to_texture is not used yet)"
-                .into(),
-        );
+    let caps = dev.caps();
+    if dev.es() != EsVersion::Es3 && !caps.msaa_render_to_texture {
+        return Some(format!(
+            "MSAA needs OpenGL ES 3.0 multisampled renderbuffers, or on ES 2.0 {MSAA_RENDER_TO_TEXTURE}, \
+             which this context does not have"
+        ));
     }
-    let max = dev.caps().max_samples.max(0) as u32;
+    let max = caps.max_samples.max(0) as u32;
     if samples > max {
         return Some(format!(
             "{samples} samples is more than this context's GL_MAX_SAMPLES ({max})"
@@ -48,7 +70,19 @@ impl MultisampleTarget {
         }
         let gl = &dev.gl;
         let (w, h) = (width as i32, height as i32);
-        let color = dev.create_renderbuffer()?;
+        let color = if dev.es() == EsVersion::Es3 {
+            Color::Renderbuffer(dev.create_renderbuffer()?)
+        } else {
+            let triangle = GpuMesh::new(dev, &fullscreen_triangle())?;
+            match dev.create_texture() {
+                Ok(texture) => Color::Texture { texture, triangle },
+                Err(e) => {
+                    let mut triangle = triangle;
+                    triangle.destroy(dev);
+                    return Err(e);
+                }
+            }
+        };
         let depth = dev.create_renderbuffer()?;
         let fbo = dev.create_framebuffer()?;
         let mut target = MultisampleTarget {
@@ -60,29 +94,75 @@ impl MultisampleTarget {
             destroyed: false,
         };
         unsafe {
-            gl.bind_renderbuffer(glow::RENDERBUFFER, Some(color));
-            gl.renderbuffer_storage_multisample(
-                glow::RENDERBUFFER,
-                samples as i32,
-                glow::RGBA8,
-                w,
-                h,
-            );
-            gl.bind_renderbuffer(glow::RENDERBUFFER, Some(depth));
-            gl.renderbuffer_storage_multisample(
-                glow::RENDERBUFFER,
-                samples as i32,
-                glow::DEPTH_COMPONENT24,
-                w,
-                h,
-            );
             gl.bind_framebuffer(glow::FRAMEBUFFER, Some(fbo));
-            gl.framebuffer_renderbuffer(
-                glow::FRAMEBUFFER,
-                glow::COLOR_ATTACHMENT0,
-                glow::RENDERBUFFER,
-                Some(color),
-            );
+            match &target.color {
+                Color::Renderbuffer(color) => {
+                    gl.bind_renderbuffer(glow::RENDERBUFFER, Some(*color));
+                    gl.renderbuffer_storage_multisample(
+                        glow::RENDERBUFFER,
+                        samples as i32,
+                        glow::RGBA8,
+                        w,
+                        h,
+                    );
+                    gl.framebuffer_renderbuffer(
+                        glow::FRAMEBUFFER,
+                        glow::COLOR_ATTACHMENT0,
+                        glow::RENDERBUFFER,
+                        Some(*color),
+                    );
+                    gl.bind_renderbuffer(glow::RENDERBUFFER, Some(depth));
+                    gl.renderbuffer_storage_multisample(
+                        glow::RENDERBUFFER,
+                        samples as i32,
+                        glow::DEPTH_COMPONENT24,
+                        w,
+                        h,
+                    );
+                }
+                Color::Texture { texture, .. } => {
+                    gl.bind_texture(glow::TEXTURE_2D, Some(*texture));
+                    gl.tex_image_2d(
+                        glow::TEXTURE_2D,
+                        0,
+                        glow::RGBA as i32,
+                        w,
+                        h,
+                        0,
+                        glow::RGBA,
+                        glow::UNSIGNED_BYTE,
+                        glow::PixelUnpackData::Slice(None),
+                    );
+                    for (name, value) in [
+                        (glow::TEXTURE_MIN_FILTER, glow::NEAREST),
+                        (glow::TEXTURE_MAG_FILTER, glow::NEAREST),
+                        (glow::TEXTURE_WRAP_S, glow::CLAMP_TO_EDGE),
+                        (glow::TEXTURE_WRAP_T, glow::CLAMP_TO_EDGE),
+                    ] {
+                        gl.tex_parameter_i32(glow::TEXTURE_2D, name, value as i32);
+                    }
+                    gl.framebuffer_texture_2d_multisample(
+                        glow::FRAMEBUFFER,
+                        glow::COLOR_ATTACHMENT0,
+                        glow::TEXTURE_2D,
+                        Some(*texture),
+                        0,
+                        samples as i32,
+                    );
+                    let storage = dev
+                        .renderbuffer_storage_multisample_ext
+                        .expect("loaded with the extension (see unsupported_reason)");
+                    gl.bind_renderbuffer(glow::RENDERBUFFER, Some(depth));
+                    // 16-bit depth: ES 2.0's one required depth format (OES_depth24 is not).
+                    storage(
+                        glow::RENDERBUFFER,
+                        samples as i32,
+                        glow::DEPTH_COMPONENT16,
+                        w,
+                        h,
+                    );
+                }
+            }
             gl.framebuffer_renderbuffer(
                 glow::FRAMEBUFFER,
                 glow::DEPTH_ATTACHMENT,
@@ -107,9 +187,16 @@ impl MultisampleTarget {
         (self.size, self.samples)
     }
 
-    /// GPU memory of its buffers: 4 bytes of colour and 4 of depth per sample.
+    /// GPU memory of its buffers: ES 3.0, 4 bytes of colour and 4 of depth per sample; ES 2.0,
+    /// 4 of colour and 2 of depth per sample (what an immediate-mode GPU allocates; a
+    /// tile-based one keeps the samples on chip) plus the 4-byte resolved texel.
     pub fn gpu_bytes(&self) -> usize {
-        self.size.0 as usize * self.size.1 as usize * self.samples as usize * 8
+        let pixels = self.size.0 as usize * self.size.1 as usize;
+        let samples = self.samples as usize;
+        match self.color {
+            Color::Renderbuffer(_) => pixels * samples * 8,
+            Color::Texture { .. } => pixels * (samples * 6 + 4),
+        }
     }
 
     /// Binds the target and sets the viewport to cover it.
@@ -119,36 +206,78 @@ impl MultisampleTarget {
     }
 
     /// Resolves the samples into the framebuffer `into` (`None`: the default one) of the same
-    /// size: each pixel the average of its samples. Leaves `into` bound. The destination's
-    /// colour format must be RGBA8, as ES 3.0's multisample resolve needs identical formats.
-    pub fn resolve(&self, dev: &Device, into: Option<glow::Framebuffer>) -> Result<(), GlError> {
+    /// size: each pixel the average of its samples. Leaves `into` bound. ES 3.0 blits, so the
+    /// destination's colour format must be RGBA8 (its multisample resolve needs identical
+    /// formats); ES 2.0 draws the averaged texture over it with a program from `programs`.
+    pub fn resolve(
+        &self,
+        dev: &Device,
+        programs: &mut ProgramCache,
+        into: Option<glow::Framebuffer>,
+    ) -> Result<(), GlError> {
         let (w, h) = (self.size.0 as i32, self.size.1 as i32);
-        unsafe {
-            dev.gl
-                .bind_framebuffer(glow::READ_FRAMEBUFFER, Some(self.fbo));
-            dev.gl.bind_framebuffer(glow::DRAW_FRAMEBUFFER, into);
-            dev.gl.blit_framebuffer(
-                0,
-                0,
-                w,
-                h,
-                0,
-                0,
-                w,
-                h,
-                glow::COLOR_BUFFER_BIT,
-                glow::NEAREST,
-            );
+        match &self.color {
+            Color::Renderbuffer(_) => unsafe {
+                dev.gl
+                    .bind_framebuffer(glow::READ_FRAMEBUFFER, Some(self.fbo));
+                dev.gl.bind_framebuffer(glow::DRAW_FRAMEBUFFER, into);
+                dev.gl.blit_framebuffer(
+                    0,
+                    0,
+                    w,
+                    h,
+                    0,
+                    0,
+                    w,
+                    h,
+                    glow::COLOR_BUFFER_BIT,
+                    glow::NEAREST,
+                );
+                dev.bind_framebuffer(into);
+            },
+            Color::Texture { texture, triangle } => {
+                // Unbinding the framebuffer is what makes the driver average the samples into
+                // the texture.
+                dev.bind_framebuffer(into);
+                dev.viewport(0, 0, w, h);
+                RenderState {
+                    depth_test: DepthTest::Off,
+                    depth_write: false,
+                    blend: Blend::Off,
+                    cull: Cull::None,
+                    color_write: true,
+                }
+                .apply(dev);
+                let key = ProgramKey {
+                    shader: "msaa_resolve",
+                    features: 0,
+                    dialect: dev.es(),
+                };
+                let program = programs.get_or_build(dev, key, Vec::new)?;
+                program.bind(dev);
+                unsafe {
+                    dev.gl.active_texture(glow::TEXTURE0);
+                    dev.gl.bind_texture(glow::TEXTURE_2D, Some(*texture));
+                }
+                program.set_i32(dev, "u_resolved", 0);
+                program.set_vec2(dev, "u_invSize", [1.0 / w as f32, 1.0 / h as f32]);
+                triangle.draw(dev);
+            }
         }
-        dev.bind_framebuffer(into);
-        dev.check("MSAA resolve (the destination must be RGBA8 and the same size)")
+        dev.check("MSAA resolve (ES 3.0: the destination must be RGBA8 and the same size)")
     }
 
-    /// Frees the framebuffer and its renderbuffers.
+    /// Frees the framebuffer and its buffers.
     pub fn destroy(&mut self, dev: &Device) {
         if !self.destroyed {
             dev.delete_framebuffer(self.fbo);
-            dev.delete_renderbuffer(self.color);
+            match &mut self.color {
+                Color::Renderbuffer(color) => dev.delete_renderbuffer(*color),
+                Color::Texture { texture, triangle } => {
+                    dev.delete_texture(*texture);
+                    triangle.destroy(dev);
+                }
+            }
             dev.delete_renderbuffer(self.depth);
             self.destroyed = true;
         }

@@ -79,6 +79,13 @@ pub const SHADERS: &[ShaderDesc] = &[
         mrt: false,
     },
     ShaderDesc {
+        name: "msaa_resolve",
+        vertex: "fullscreen.vert",
+        fragment: "msaa_resolve.frag",
+        es3_only: false,
+        mrt: false,
+    },
+    ShaderDesc {
         name: "gbuffer",
         vertex: "mesh.vert",
         fragment: "gbuffer.frag",
@@ -112,6 +119,10 @@ pub const SHADERS: &[ShaderDesc] = &[
 pub const FILES: &[(&str, &str)] = &[
     ("mesh.vert", include_str!("../../glsl/mesh.vert")),
     ("depth.frag", include_str!("../../glsl/depth.frag")),
+    (
+        "msaa_resolve.frag",
+        include_str!("../../glsl/msaa_resolve.frag"),
+    ),
     ("forward.frag", include_str!("../../glsl/forward.frag")),
     (
         "light_model.glsl",

@@ -75,15 +75,6 @@ fn unit_sphere() -> Mesh {
     b.build()
 }
 
-fn fullscreen_triangle() -> Mesh {
-    let p = vec![
-        Vec3::new(-1.0, -1.0, 0.0),
-        Vec3::new(3.0, -1.0, 0.0),
-        Vec3::new(-1.0, 3.0, 0.0),
-    ];
-    Mesh::new(p, vec![], vec![], vec![0, 1, 2]).expect("valid triangle")
-}
-
 impl Deferred {
     fn ensure_resources(&mut self, dev: &Device, size: (u32, u32)) -> Result<(), Error> {
         if self.gbuffer.as_ref().map(|g| g.size()) != Some(size) {
@@ -94,7 +85,7 @@ impl Deferred {
         }
         if self.sphere.is_none() {
             self.sphere = Some(GpuMesh::new(dev, &unit_sphere())?);
-            self.fullscreen = Some(GpuMesh::new(dev, &fullscreen_triangle())?);
+            self.fullscreen = Some(GpuMesh::new(dev, &crate::gl::mesh::fullscreen_triangle())?);
         }
         Ok(())
     }

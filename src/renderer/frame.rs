@@ -81,7 +81,7 @@ impl Renderer {
         let msaa = self.msaa.as_ref().expect("created by prepare_msaa");
         match rendered {
             Ok(()) => {
-                msaa.resolve(&self.dev, destination)?;
+                msaa.resolve(&self.dev, &mut self.programs, destination)?;
                 stats.samples = samples;
                 stats.msaa_bytes = msaa.gpu_bytes();
                 Ok(())

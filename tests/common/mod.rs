@@ -5,7 +5,11 @@ use std::path::PathBuf;
 
 use manylight::gl::HeadlessContext;
 use manylight::metrics::cpu_reference::{self, Encoding};
-use manylight::scene::Scene;
+use std::sync::Arc;
+
+use glam::{DMat4, DVec3, Vec3};
+use manylight::scene::meshbuild::MeshBuilder;
+use manylight::scene::{Camera, Material, Object, Scene};
 use manylight::{EsVersion, RenderOptions, Renderer};
 
 /// A headless context and a renderer on it (the context must outlive the renderer).
@@ -108,4 +112,53 @@ pub fn skip(reason: &str) {
         panic!("would skip ({reason}), but MANYLIGHT_REQUIRE_ALL_TESTS is set");
     }
     eprintln!("SKIPPED: {reason}");
+}
+
+/// A white square turned 30° about the view axis on black, lit by ambient light alone: each
+/// pixel's value is its coverage.
+pub fn turned_square() -> Scene {
+    let mut s = Scene::empty();
+    let white = s.add_material(Material::flat("white", Vec3::ONE));
+    let mut square = MeshBuilder::new();
+    square.quad(
+        Vec3::new(-1.0, -1.0, 0.0),
+        Vec3::new(1.0, -1.0, 0.0),
+        Vec3::new(1.0, 1.0, 0.0),
+        Vec3::new(-1.0, 1.0, 0.0),
+    );
+    s.objects.push(Object {
+        mesh: Arc::new(square.build()),
+        material: white,
+        transform: DMat4::from_rotation_z(30f64.to_radians()),
+    });
+    s.ambient = Vec3::ONE;
+    s.camera = Camera::perspective(DVec3::new(0.0, 0.0, 4.0), DVec3::ZERO, 60.0, 0.1, 10.0);
+    s
+}
+
+/// Asserts that `img` (of [`turned_square`], linear, 4 samples) resolved every pixel to a
+/// coverage of 4 samples, k/4 of white, with the square's edges partly covered and its inside
+/// and outside untouched.
+pub fn assert_coverage_of_4_samples(img: &image::RgbaImage) {
+    let mut partial = 0;
+    for p in img.pixels() {
+        // The resolve averages 4 samples: k/4 of white, k = 0..=4.
+        let k = (p[0] as f64 / 255.0 * 4.0).round();
+        assert!(
+            (p[0] as f64 - k * 255.0 / 4.0).abs() <= 1.0,
+            "{} is not a coverage of 4 samples",
+            p[0]
+        );
+        partial += usize::from(k > 0.0 && k < 4.0);
+    }
+    // The square's outline is about 166 pixels long at 96×96 (sides of 41.6 px); with 4
+    // samples 100 of the pixels it crosses come out partly covered on llvmpipe.
+    assert!(
+        partial > 60,
+        "only {partial} edge pixels are partly covered"
+    );
+    // Away from the edges nothing changes.
+    let (w, h) = img.dimensions();
+    assert_eq!(img.get_pixel(w / 2, h / 2)[0], 255);
+    assert_eq!(img.get_pixel(2, 2)[0], 0);
 }

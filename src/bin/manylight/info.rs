@@ -171,7 +171,10 @@ fn format_text(
             caps.max_samples
         );
     } else {
-        w!(out, "MSAA               unsupported here (needs ES 3.0)");
+        w!(
+            out,
+            "MSAA               unsupported here (needs ES 3.0, or GL_EXT_multisampled_render_to_texture on ES 2.0)"
+        );
     }
     let p = |p: &manylight::gl::caps::Precision| {
         format!(

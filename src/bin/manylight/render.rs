@@ -68,8 +68,8 @@ pub struct RenderArgs {
     /// values, clipped at 1), `reinhard`, `aces` or `neutral` (Khronos PBR Neutral).
     #[arg(long, value_enum, default_value_t = ToneMapArg::None)]
     pub tonemap: ToneMapArg,
-    /// Samples per pixel (MSAA) of the offscreen image: 1 (none), 2, 4 or 8; ES 3.0, not with
-    /// deferred.
+    /// Samples per pixel (MSAA) of the offscreen image: 1 (none), 2, 4 or 8; ES 3.0, or ES 2.0
+    /// with GL_EXT_multisampled_render_to_texture; not with deferred.
     #[arg(long, default_value_t = 1)]
     pub msaa: u32,
     /// Exposure in stops (radiance × 2^EV before the tone map), within ±15.
