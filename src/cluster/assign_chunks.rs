@@ -33,8 +33,11 @@ impl Chunks {
         let cells = grid.total_cells as usize;
         // Phase 1: runs and counts per chunk of lights.
         let chunk_len = lights.len().div_ceil(threads);
-        self.chunks.resize_with(threads, Chunk::default);
-        self.chunks.truncate(threads);
+        // Fewer chunks than threads when lights are few (49 lights in chunks of 7 make 7, not
+        // 8): a chunk past the last would keep an earlier frame's runs.
+        let chunks = lights.len().div_ceil(chunk_len);
+        self.chunks.resize_with(chunks, Chunk::default);
+        self.chunks.truncate(chunks);
         self.chunks
             .par_iter_mut()
             .zip(lights.par_chunks(chunk_len))

@@ -548,6 +548,48 @@ fn any_number_of_bands_gives_what_one_band_gives() {
     }
 }
 
+/// Chunks of lights when lights are few for the threads (49 lights on 8 threads make 7 chunks
+/// of 7): after a frame with more lights, no chunk keeps that frame's runs.
+#[test]
+fn fewer_chunks_than_threads_keep_nothing_stale() {
+    let t = (30f64).to_radians().tan();
+    let grid = ClusterGrid::new(
+        32,
+        16,
+        GridProjection::Perspective { tan_x: t, tan_y: t },
+        0.1,
+        10.0,
+        &GridConfig::tiles(16.0),
+    );
+    assert!(
+        grid.total_cells < 49,
+        "{} cells: not the chunk path",
+        grid.total_cells
+    );
+    let mut rng = Pcg64Mcg::seed_from_u64(5);
+    let parallel = AssignLimits {
+        parallel_threshold: 1,
+        ..Default::default()
+    };
+    let sequential = AssignLimits {
+        parallel_threshold: usize::MAX,
+        ..Default::default()
+    };
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(8)
+        .build()
+        .expect("a thread pool");
+    let mut assigner = super::assign::Assigner::new();
+    for count in [400, 49, 9, 400] {
+        let lights = random_lights(&mut rng, count, 5.0);
+        let one = assign(&grid, &lights, 10.0, &sequential);
+        let chunks = pool.install(|| assigner.assign(&grid, &lights, 10.0, &parallel).clone());
+        assert_eq!(one.visible, chunks.visible, "{count} lights");
+        assert_eq!(one.counts, chunks.counts, "{count} lights");
+        assert_eq!(one.indices, chunks.indices, "{count} lights");
+    }
+}
+
 #[test]
 fn split_cells_never_returns_empty_or_out_of_range_blocks() {
     for (offsets, total, parts) in [

@@ -38,7 +38,7 @@ const ROW_CHORD_MIN_COLUMNS: u32 = 3;
 /// A band of consecutive slices (numbered across cascades, `first..end`), the part of the grid
 /// one thread of the assignment fills, and the view depths a light must reach to touch it.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct SliceWindow {
+pub(crate) struct SliceWindow {
     /// First slice.
     pub first: u32,
     /// One past the last slice.
@@ -96,7 +96,7 @@ pub fn for_each_run(
 /// [`for_each_run`] restricted to the cells of `window`'s slices: exactly the runs
 /// [`for_each_run`] emits there.
 #[inline(always)]
-pub fn for_each_run_in(
+pub(crate) fn for_each_run_in(
     grid: &ClusterGrid,
     window: &SliceWindow,
     light: &GpuLight,

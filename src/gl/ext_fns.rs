@@ -15,11 +15,19 @@ pub type RenderbufferStorageMultisampleExt =
 /// Loads `glRenderbufferStorageMultisampleEXT` from `libEGL`, if it is there.
 pub fn renderbuffer_storage_multisample_ext() -> Option<RenderbufferStorageMultisampleExt> {
     type Egl = khronos_egl::DynamicInstance<khronos_egl::EGL1_4>;
-    let egl = unsafe { Egl::load_required_from_filename("libEGL.so.1") }
-        .or_else(|_| unsafe { Egl::load_required_from_filename("libEGL.so") })
-        .ok()?;
+    // Kept loaded for the whole process: the pointer it hands out must outlive every Device
+    // (dropping the instance would unload the library it points into, were it the last user).
+    static EGL: std::sync::OnceLock<Option<Egl>> = std::sync::OnceLock::new();
+    let egl = EGL
+        .get_or_init(|| {
+            unsafe { Egl::load_required_from_filename("libEGL.so.1") }
+                .or_else(|_| unsafe { Egl::load_required_from_filename("libEGL.so") })
+                .ok()
+        })
+        .as_ref()?;
     let f = egl.get_proc_address("glRenderbufferStorageMultisampleEXT")?;
-    // SAFETY: the extension specifies this signature for the entry point of that name.
+    // SAFETY: the extension specifies this signature for the entry point of that name, and
+    // the library stays loaded (above).
     Some(unsafe {
         std::mem::transmute::<extern "system" fn(), RenderbufferStorageMultisampleExt>(f)
     })

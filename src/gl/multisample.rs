@@ -4,10 +4,12 @@
 //! * ES 3.0: RGBA8 and 24-bit depth renderbuffers with N samples, resolved by a blit.
 //! * ES 2.0 with `GL_EXT_multisampled_render_to_texture` (Mali, Adreno, PowerVR): an RGBA8
 //!   texture attached with N samples — a tile-based GPU keeps the samples on chip and writes
-//!   only their average to the texture — and a 16-bit depth renderbuffer with N samples
-//!   (`glRenderbufferStorageMultisampleEXT`); the texture is then copied onto the
-//!   destination by a full-screen triangle. Without the extension MSAA is unsupported there,
-//!   with that reason.
+//!   only their average to the texture — and a depth renderbuffer with N samples
+//!   (`glRenderbufferStorageMultisampleEXT`; 24-bit with `OES_depth24`, else 16); the
+//!   texture is then copied onto the destination by a full-screen triangle, which leaves the
+//!   destination bound with the copy's viewport, program, texture unit 0 and depth state (the
+//!   renderer restores none of those after any pass). Without the extension MSAA is
+//!   unsupported there, with that reason.
 #![allow(unsafe_code)]
 
 use glow::HasContext;
@@ -25,6 +27,8 @@ pub struct MultisampleTarget {
     depth: glow::Renderbuffer,
     size: (u32, u32),
     samples: u32,
+    /// Bytes of one depth sample.
+    depth_bytes: usize,
     destroyed: bool,
 }
 
@@ -39,6 +43,23 @@ enum Color {
         texture: glow::Texture,
         triangle: GpuMesh,
     },
+}
+
+impl Color {
+    /// The colour storage this context uses (its storage is allocated by the caller).
+    fn new(dev: &Device) -> Result<Color, GlError> {
+        if dev.es() == EsVersion::Es3 {
+            return Ok(Color::Renderbuffer(dev.create_renderbuffer()?));
+        }
+        let mut triangle = GpuMesh::new(dev, &fullscreen_triangle())?;
+        match dev.create_texture() {
+            Ok(texture) => Ok(Color::Texture { texture, triangle }),
+            Err(e) => {
+                triangle.destroy(dev);
+                Err(e)
+            }
+        }
+    }
 }
 
 /// Why `samples` cannot be used on this context, if it cannot (1 always can).
@@ -70,27 +91,34 @@ impl MultisampleTarget {
         }
         let gl = &dev.gl;
         let (w, h) = (width as i32, height as i32);
-        let color = if dev.es() == EsVersion::Es3 {
-            Color::Renderbuffer(dev.create_renderbuffer()?)
-        } else {
-            let triangle = GpuMesh::new(dev, &fullscreen_triangle())?;
-            match dev.create_texture() {
-                Ok(texture) => Color::Texture { texture, triangle },
-                Err(e) => {
-                    let mut triangle = triangle;
-                    triangle.destroy(dev);
-                    return Err(e);
-                }
+        // Created one by one; whatever was made is freed if a later one fails.
+        let depth = dev.create_renderbuffer()?;
+        let fbo = match dev.create_framebuffer() {
+            Ok(fbo) => fbo,
+            Err(e) => {
+                dev.delete_renderbuffer(depth);
+                return Err(e);
             }
         };
-        let depth = dev.create_renderbuffer()?;
-        let fbo = dev.create_framebuffer()?;
+        let color = match Color::new(dev) {
+            Ok(color) => color,
+            Err(e) => {
+                dev.delete_framebuffer(fbo);
+                dev.delete_renderbuffer(depth);
+                return Err(e);
+            }
+        };
         let mut target = MultisampleTarget {
             fbo,
             color,
             depth,
             size: (width, height),
             samples,
+            depth_bytes: if dev.es() == EsVersion::Es3 || dev.caps().depth24 {
+                4
+            } else {
+                2
+            },
             destroyed: false,
         };
         unsafe {
@@ -153,14 +181,14 @@ impl MultisampleTarget {
                         .renderbuffer_storage_multisample_ext
                         .expect("loaded with the extension (see unsupported_reason)");
                     gl.bind_renderbuffer(glow::RENDERBUFFER, Some(depth));
-                    // 16-bit depth: ES 2.0's one required depth format (OES_depth24 is not).
-                    storage(
-                        glow::RENDERBUFFER,
-                        samples as i32,
-                        glow::DEPTH_COMPONENT16,
-                        w,
-                        h,
-                    );
+                    // 24-bit depth where OES_depth24 is (as the single-sampled target), else
+                    // ES 2.0's one required format: the same precision with MSAA as without.
+                    let format = if dev.caps().depth24 {
+                        glow::DEPTH_COMPONENT24
+                    } else {
+                        glow::DEPTH_COMPONENT16
+                    };
+                    storage(glow::RENDERBUFFER, samples as i32, format, w, h);
                 }
             }
             gl.framebuffer_renderbuffer(
@@ -187,15 +215,15 @@ impl MultisampleTarget {
         (self.size, self.samples)
     }
 
-    /// GPU memory of its buffers: ES 3.0, 4 bytes of colour and 4 of depth per sample; ES 2.0,
-    /// 4 of colour and 2 of depth per sample (what an immediate-mode GPU allocates; a
-    /// tile-based one keeps the samples on chip) plus the 4-byte resolved texel.
+    /// GPU memory of its buffers: 4 bytes of colour and 4 of depth per sample (2 of depth on
+    /// ES 2.0 without `OES_depth24`), and on ES 2.0 the 4-byte resolved texel — what an
+    /// immediate-mode GPU allocates; a tile-based one keeps the samples on chip.
     pub fn gpu_bytes(&self) -> usize {
         let pixels = self.size.0 as usize * self.size.1 as usize;
-        let samples = self.samples as usize;
+        let per_sample = 4 + self.depth_bytes;
         match self.color {
-            Color::Renderbuffer(_) => pixels * samples * 8,
-            Color::Texture { .. } => pixels * (samples * 6 + 4),
+            Color::Renderbuffer(_) => pixels * self.samples as usize * per_sample,
+            Color::Texture { .. } => pixels * (self.samples as usize * per_sample + 4),
         }
     }
 
@@ -260,7 +288,6 @@ impl MultisampleTarget {
                     dev.gl.bind_texture(glow::TEXTURE_2D, Some(*texture));
                 }
                 program.set_i32(dev, "u_resolved", 0);
-                program.set_vec2(dev, "u_invSize", [1.0 / w as f32, 1.0 / h as f32]);
                 triangle.draw(dev);
             }
         }

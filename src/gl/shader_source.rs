@@ -80,7 +80,7 @@ pub const SHADERS: &[ShaderDesc] = &[
     },
     ShaderDesc {
         name: "msaa_resolve",
-        vertex: "fullscreen.vert",
+        vertex: "msaa_resolve.vert",
         fragment: "msaa_resolve.frag",
         es3_only: false,
         mrt: false,
@@ -119,6 +119,10 @@ pub const SHADERS: &[ShaderDesc] = &[
 pub const FILES: &[(&str, &str)] = &[
     ("mesh.vert", include_str!("../../glsl/mesh.vert")),
     ("depth.frag", include_str!("../../glsl/depth.frag")),
+    (
+        "msaa_resolve.vert",
+        include_str!("../../glsl/msaa_resolve.vert"),
+    ),
     (
         "msaa_resolve.frag",
         include_str!("../../glsl/msaa_resolve.frag"),

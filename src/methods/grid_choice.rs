@@ -62,6 +62,8 @@ pub(crate) struct AutoGrid {
     chose_this_frame: bool,
     /// The search over candidate footprints (one per frame while it runs).
     search: ChoiceSearch,
+    /// The light count when the running search started.
+    lights_at_search_start: usize,
 }
 
 impl AutoGrid {
@@ -115,10 +117,15 @@ impl AutoGrid {
         let due = (moved && self.frames_since_choice >= RECHOOSE_AFTER_CHANGE)
             || (self.choices == 1 && self.frames_since_choice >= FIRST_CALIBRATED_CHOICE)
             || self.frames_since_choice >= RECHOOSE_PERIOD;
+        // A search whose candidates would be measured with a light set changed by more than a
+        // quarter since its start compares unlike frames: it starts again.
+        let stale_search = self.search.in_progress()
+            && changed_much(self.lights_at_search_start, ctx.lights.len());
         self.chose_this_frame = self.search.in_progress() || due;
-        if !self.search.in_progress() && due {
+        if (!self.search.in_progress() && due) || stale_search {
             self.samples = self.sample(ctx);
             self.search.start(&inputs, &self.samples);
+            self.lights_at_search_start = ctx.lights.len();
         }
         if self.chose_this_frame
             && self

@@ -36,7 +36,7 @@ impl ClusterGrid {
     /// table of every cell's sphere, rebuilt with the grid whenever a moving camera changed
     /// its depth range, cost more than the whole assignment it served.
     #[inline]
-    pub fn cell_sphere(&self, cascade: u32, slice: u32, x: u32, y: u32) -> [f64; 4] {
+    pub(crate) fn cell_sphere(&self, cascade: u32, slice: u32, x: u32, y: u32) -> [f64; 4] {
         let c = &self.cascades[cascade as usize];
         let f = &self.slice_frusta[slice as usize];
         if f.depths.1.is_infinite() {
