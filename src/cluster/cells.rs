@@ -177,8 +177,8 @@ pub(crate) fn for_each_run_in(
             match &cone {
                 None => emit(start, x1 - x0 + 1),
                 Some(cone) => {
-                    let global = constants.first_slice + slice;
-                    let sphere_of = |i: u32| grid.cell_sphere(k, global, x0 + i, row);
+                    let spheres = grid.row_spheres(k, constants.first_slice + slice, row);
+                    let sphere_of = |i: u32| spheres.cell(x0 + i);
                     cone.emit_runs(sphere_of, start, x1 - x0 + 1, emit)
                 }
             }

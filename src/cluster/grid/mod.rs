@@ -118,7 +118,7 @@ pub struct ClusterGrid {
     pub(crate) ndc_scale: [f64; 2],
     /// Per slice (numbered across cascades): its exact view depths `[z0, z1]` and the view
     /// half extents at each (`z1` infinite for the last slice of an infinite grid): what a
-    /// cell's bounding sphere is made from ([`ClusterGrid::cell_sphere`]).
+    /// cell's bounding sphere is made from ([`ClusterGrid::row_spheres`]).
     pub(crate) slice_frusta: Vec<SliceFrustum>,
     /// Slice of a depth without a logarithm (log2 mapping only).
     slice_lookup: SliceLookup,

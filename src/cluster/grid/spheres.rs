@@ -4,7 +4,7 @@
 use super::{ClusterGrid, GridProjection};
 
 /// One slice's exact depths and the view half extents at them (see
-/// [`ClusterGrid::cell_sphere`]).
+/// [`ClusterGrid::row_spheres`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct SliceFrustum {
     depths: (f64, f64),
@@ -29,27 +29,39 @@ impl ClusterGrid {
         }
     }
 
-    /// The bounding sphere `[x, y, z, radius]` (view space) of the cell in column `x` and row
-    /// `y` of slice `slice` (numbered across cascades) of cascade `cascade`: the centre of its
-    /// eight corners and the farthest corner; an infinite radius for a cell reaching infinity.
-    /// Computed when asked (the cone-vs-cell test of spot lights) from a per-slice table: a
-    /// table of every cell's sphere, rebuilt with the grid whenever a moving camera changed
-    /// its depth range, cost more than the whole assignment it served.
+    /// The bounding spheres of the cells of row `y` of slice `slice` (numbered across
+    /// cascades) of cascade `cascade`, one column at a time ([`RowSpheres::cell`]): what the
+    /// cone-vs-cell test of spot lights asks for, computed when asked from a per-slice table
+    /// (a table of every cell's sphere, rebuilt with the grid whenever a moving camera changed
+    /// its depth range, cost more than the whole assignment it served), with the row's and
+    /// the slice's share worked out once per row.
     #[inline]
-    pub(crate) fn cell_sphere(&self, cascade: u32, slice: u32, x: u32, y: u32) -> [f64; 4] {
+    pub(crate) fn row_spheres(&self, cascade: u32, slice: u32, y: u32) -> RowSpheres {
         let c = &self.cascades[cascade as usize];
         let f = &self.slice_frusta[slice as usize];
-        if f.depths.1.is_infinite() {
-            return [0.0, 0.0, 0.0, f64::INFINITY];
+        let (z0, z1) = f.depths;
+        let step_y = 2.0 / c.tiles_y as f64;
+        let (ny0, ny1) = (-1.0 + y as f64 * step_y, -1.0 + (y + 1) as f64 * step_y);
+        // The centre of the eight corners: the mean of the NDC bounds times the mean half
+        // extent (x, y), the middle depth (z).
+        let cy = 0.25 * (ny0 + ny1) * (f.near.1 + f.far.1);
+        let half_depth = 0.5 * (z1 - z0);
+        // The farthest corner, per depth end: the farther of the two NDC bounds in x and in y
+        // (the squared distance separates into the three axes).
+        let y_and_z = |hy: f64| {
+            (ny0 * hy - cy).powi(2).max((ny1 * hy - cy).powi(2)) + half_depth * half_depth
+        };
+        RowSpheres {
+            infinite: z1.is_infinite(),
+            cy,
+            cz: -0.5 * (z0 + z1),
+            near_x: f.near.0,
+            far_x: f.far.0,
+            mean_x: 0.5 * (f.near.0 + f.far.0),
+            near_rest: y_and_z(f.near.1),
+            far_rest: y_and_z(f.far.1),
+            step_x: 2.0 / c.tiles_x as f64,
         }
-        let ndc = |i: u32, n: u32| -1.0 + 2.0 * i as f64 / n as f64;
-        bounding_sphere(
-            (ndc(x, c.tiles_x), ndc(x + 1, c.tiles_x)),
-            (ndc(y, c.tiles_y), ndc(y + 1, c.tiles_y)),
-            f.depths,
-            f.near,
-            f.far,
-        )
     }
 
     /// Every slice's [`SliceFrustum`], in order, into `out` (cleared first).
@@ -68,33 +80,37 @@ impl ClusterGrid {
     }
 }
 
-/// The bounding sphere `[x, y, z, radius]` of the cell between NDC `columns` and `rows` and
-/// view depths `depths`, whose view half extents are `near` at the first depth and `far` at
-/// the second: the centre of its eight corners and the farthest corner.
-fn bounding_sphere(
-    columns: (f64, f64),
-    rows: (f64, f64),
-    depths: (f64, f64),
-    near: (f64, f64),
-    far: (f64, f64),
-) -> [f64; 4] {
-    let mut corners = [glam::DVec3::ZERO; 8];
-    for (i, corner) in corners.iter_mut().enumerate() {
-        let (z, (hx, hy)) = if i & 4 != 0 {
-            (depths.1, far)
-        } else {
-            (depths.0, near)
-        };
-        let nx = if i & 1 != 0 { columns.1 } else { columns.0 };
-        let ny = if i & 2 != 0 { rows.1 } else { rows.0 };
-        *corner = glam::DVec3::new(nx * hx, ny * hy, -z);
+/// The bounding spheres of one row of cells (see [`ClusterGrid::row_spheres`]).
+pub(crate) struct RowSpheres {
+    infinite: bool,
+    cy: f64,
+    cz: f64,
+    /// View half width at the slice's near and far depths, and their mean.
+    near_x: f64,
+    far_x: f64,
+    mean_x: f64,
+    /// Per depth end: the farthest corner's squared distance in y plus that in z.
+    near_rest: f64,
+    far_rest: f64,
+    /// NDC width of a column.
+    step_x: f64,
+}
+
+impl RowSpheres {
+    /// The bounding sphere `[x, y, z, radius]` (view space) of the row's cell in column `x`:
+    /// the centre of its eight corners and the farthest corner; an infinite radius for a cell
+    /// reaching infinity.
+    #[inline]
+    pub(crate) fn cell(&self, x: u32) -> [f64; 4] {
+        if self.infinite {
+            return [0.0, 0.0, 0.0, f64::INFINITY];
+        }
+        let nx0 = -1.0 + x as f64 * self.step_x;
+        let nx1 = -1.0 + (x + 1) as f64 * self.step_x;
+        let cx = 0.5 * (nx0 + nx1) * self.mean_x;
+        let farthest_x = |hx: f64| (nx0 * hx - cx).powi(2).max((nx1 * hx - cx).powi(2));
+        let near = farthest_x(self.near_x) + self.near_rest;
+        let far = farthest_x(self.far_x) + self.far_rest;
+        [cx, self.cy, self.cz, near.max(far).sqrt()]
     }
-    let center = corners.iter().sum::<glam::DVec3>() / 8.0;
-    // One root of the largest squared distance (the root is monotonic and correctly rounded,
-    // so this is the largest distance exactly).
-    let farthest = corners
-        .iter()
-        .map(|p| p.distance_squared(center))
-        .fold(0.0, f64::max);
-    [center.x, center.y, center.z, farthest.sqrt()]
 }

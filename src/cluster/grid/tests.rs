@@ -191,7 +191,8 @@ fn cell_spheres_hold_their_cells() {
                             x,
                             y,
                         };
-                        let [sx, sy, sz, r] = grid.cell_sphere(k as u32, first_slice + slice, x, y);
+                        let [sx, sy, sz, r] =
+                            grid.row_spheres(k as u32, first_slice + slice, y).cell(x);
                         let b = grid.cell_bounds(cell);
                         if b.depth.1.is_infinite() {
                             assert!(r.is_infinite());
