@@ -167,11 +167,10 @@ fn live_heap_and_gl_objects_stay_flat_over_frames_of_moving_lights() {
 const WARM_UP: usize = 40;
 /// Frames counted with [`Renderer::render`], after the warm-up.
 const MEASURED_RENDER: usize = 10;
-/// Frames counted with [`Renderer::render_reusing`], after those. They end (frame 150) well
-/// before the automatic grid's periodic re-choice (240 frames after its calibrated choice at
-/// frame 5, with a still camera; every 30 frames once the view moves, so the moving-camera
-/// cases use a fixed grid): a frame that measures candidate grids allocates (the ray cast of
-/// its surface samples; see docs/performance.md).
+/// Frames counted with [`Renderer::render_reusing`], after those. With a still camera they
+/// end (frame 150) before the automatic grid's periodic re-choice (240 frames after its
+/// calibrated choice at frame 5); the case with a moving camera and the automatic grid counts
+/// three re-choices (every 30 frames once the view moves), which allocate nothing either.
 const MEASURED: usize = 100;
 
 /// Allocations `Renderer::render` makes for the `FrameStats` it returns: one per non-empty
@@ -199,8 +198,11 @@ struct Case {
     /// Whether frames wait for the GPU (a game's do not; the timer query and the automatic
     /// grid's calibration run only when they do).
     wait_for_gpu: bool,
-    /// Whether the camera moves too (with a fixed grid then, see [`MEASURED`]).
+    /// Whether the camera moves too (with a fixed grid then, unless `auto_grid`).
     camera_moves: bool,
+    /// With a moving camera, keep the automatic grid: it re-chooses every 30 frames then, so
+    /// the counted frames include re-choices.
+    auto_grid: bool,
     /// The methods (none named: all).
     methods: &'static [&'static str],
     /// Samples per pixel (MSAA above 1).
@@ -220,6 +222,7 @@ const CASE: Case = Case {
     lights: 128,
     wait_for_gpu: true,
     camera_moves: false,
+    auto_grid: false,
     methods: &[],
     samples: 1,
     size: (48, 27),
@@ -259,6 +262,14 @@ fn common_cases() -> Vec<Case> {
             lights: 64,
             wait_for_gpu: false,
             camera_moves: true,
+            ..CASE
+        },
+        // The automatic grid with a moving camera: a re-choice every 30 frames, each
+        // measuring one candidate per frame, three of them in the counted frames.
+        Case {
+            camera_moves: true,
+            auto_grid: true,
+            methods: &["clustered", "auto"],
             ..CASE
         },
         // Cells holding more lights than the cap: the overflow policy trims them.
@@ -306,6 +317,7 @@ fn allocations_per_frame(
             lights,
             wait_for_gpu,
             camera_moves,
+            auto_grid,
             methods: only,
             samples,
             size: (width, height),
@@ -326,7 +338,7 @@ fn allocations_per_frame(
         let eye = scene.camera.position;
         let options = RenderOptions {
             wait_for_gpu,
-            grid: if camera_moves {
+            grid: if camera_moves && !auto_grid {
                 GridConfig::fixed(32.0)
             } else {
                 GridConfig::default()
@@ -342,7 +354,8 @@ fn allocations_per_frame(
         for method in methods {
             let case = format!(
                 "{es}{} {name} {lights} lights wait_for_gpu={wait_for_gpu} \
-                 camera_moves={camera_moves} samples={samples} cell_cap={cell_cap:?} \
+                 camera_moves={camera_moves} auto_grid={auto_grid} samples={samples} \
+                 cell_cap={cell_cap:?} \
                  {width}x{height} {method}",
                 if restrictions.no_fragment_highp {
                     " without fragment highp"

@@ -183,7 +183,7 @@ pub struct Candidate {
 }
 
 /// The grid chosen, and why.
-#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
 pub struct GridChoice {
     /// The grid's settings (fixed footprint, first split from the samples).
     pub config: GridConfig,

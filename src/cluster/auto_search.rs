@@ -117,6 +117,25 @@ impl ChoiceSearch {
         samples: &SurfaceSamples,
         costs: &GridCosts,
     ) -> GridChoice {
+        let mut choice = GridChoice {
+            config: inputs.base.clone(),
+            reason: String::new(),
+            candidates: Vec::new(),
+        };
+        self.finish_into(inputs, samples, costs, &mut choice);
+        choice
+    }
+
+    /// [`ChoiceSearch::finish`] into `out`, reusing its reason's and candidates' buffers (a
+    /// re-choice then allocates nothing once they have grown).
+    pub fn finish_into(
+        &mut self,
+        inputs: &ChoiceInputs,
+        samples: &SurfaceSamples,
+        costs: &GridCosts,
+        out: &mut GridChoice,
+    ) {
+        use std::fmt::Write as _;
         self.done = true;
         let best = match self.best {
             Some(i) => self.candidates[i].clone(),
@@ -130,10 +149,11 @@ impl ChoiceSearch {
                 overflowed_lights: 0,
             },
         };
-        let reason = format!(
+        out.reason.clear();
+        let _ = write!(
+            out.reason,
             "auto: {} px predicted {:.2} ms ({:.1} evaluations per pixel, {} cells, {} indices) \
-             with costs per evaluation {:.1} ns, per assignment unit {:.1} ns, per byte {:.2} ns \
-             ({}) over {} samples",
+             with costs per evaluation {:.1} ns, per assignment unit {:.1} ns, per byte {:.2} ns (",
             best.footprint_px,
             best.predicted_ms,
             best.evals_per_pixel,
@@ -142,22 +162,20 @@ impl ChoiceSearch {
             costs.shade_ns,
             costs.assign_ns,
             costs.upload_ns,
-            if costs.frames == 0 {
-                "priors".to_string()
-            } else {
-                format!("calibrated over {} frames", costs.frames)
-            },
-            samples.points.len(),
         );
-        GridChoice {
-            config: GridConfig {
-                footprint_px: best.footprint_px,
-                first_split: self.split,
-                ..inputs.base.clone()
-            },
-            reason,
-            candidates: self.candidates.clone(),
-        }
+        let _ = if costs.frames == 0 {
+            write!(out.reason, "priors")
+        } else {
+            write!(out.reason, "calibrated over {} frames", costs.frames)
+        };
+        let _ = write!(out.reason, ") over {} samples", samples.points.len());
+        out.config = GridConfig {
+            footprint_px: best.footprint_px,
+            first_split: self.split,
+            ..inputs.base.clone()
+        };
+        out.candidates.clear();
+        out.candidates.extend_from_slice(&self.candidates);
     }
 
     /// The scratch grid rebuilt for `footprint_px` from the search's first split.

@@ -64,6 +64,9 @@ pub(crate) struct AutoGrid {
     search: ChoiceSearch,
     /// The light count when the running search started.
     lights_at_search_start: usize,
+    /// The choice a search finishes into before it is kept or swapped in (its buffers
+    /// reused).
+    scratch: GridChoice,
 }
 
 impl AutoGrid {
@@ -101,7 +104,7 @@ impl AutoGrid {
         self.frames_since_choice += 1;
         let urgent = self.choice.is_none() || self.layout.as_ref() != Some(&layout);
         if urgent {
-            self.samples = self.sample(ctx);
+            self.sample(ctx);
             self.search.start(&inputs, &self.samples);
             while !self
                 .search
@@ -123,7 +126,7 @@ impl AutoGrid {
             && changed_much(self.lights_at_search_start, ctx.lights.len());
         self.chose_this_frame = self.search.in_progress() || due;
         if (!self.search.in_progress() && due) || stale_search {
-            self.samples = self.sample(ctx);
+            self.sample(ctx);
             self.search.start(&inputs, &self.samples);
             self.lights_at_search_start = ctx.lights.len();
         }
@@ -138,31 +141,36 @@ impl AutoGrid {
     }
 
     /// Ends the search: its choice replaces the current grid unless the hysteresis keeps it.
+    /// Written through kept buffers (the scratch choice, the current one's reason and
+    /// candidates), so a re-choice allocates nothing once they have grown.
     fn conclude(&mut self, inputs: &ChoiceInputs, layout: Layout, ctx: &FrameContext) {
-        let new = self.search.finish(inputs, &self.samples, &self.costs);
-        let keep = self.layout.as_ref() == Some(&layout)
-            && self
-                .choice
-                .as_ref()
-                .is_some_and(|current| !auto::should_switch(&current.config, &new));
-        if keep {
-            // The grid stays; the reason says it was measured again.
-            let current = self.choice.as_mut().expect("kept");
-            current.reason = if current.config.footprint_px == new.config.footprint_px {
-                new.reason
-            } else {
-                format!(
-                    "kept {} px (predicted within {:.0} % of the best): {}",
-                    current.config.footprint_px,
-                    auto::HYSTERESIS * 100.0,
-                    new.reason
-                )
-            };
-            current.candidates = new.candidates;
-        } else {
-            self.choice = Some(new);
+        use std::fmt::Write as _;
+        let new = &mut self.scratch;
+        self.search
+            .finish_into(inputs, &self.samples, &self.costs, new);
+        let same_layout = self.layout.as_ref() == Some(&layout);
+        match &mut self.choice {
+            Some(current) if same_layout && !auto::should_switch(&current.config, new) => {
+                // The grid stays; the reason says it was measured again.
+                current.reason.clear();
+                if current.config.footprint_px != new.config.footprint_px {
+                    let _ = write!(
+                        current.reason,
+                        "kept {} px (predicted within {:.0} % of the best): ",
+                        current.config.footprint_px,
+                        auto::HYSTERESIS * 100.0,
+                    );
+                }
+                current.reason.push_str(&new.reason);
+                current.candidates.clear();
+                current.candidates.extend_from_slice(&new.candidates);
+            }
+            Some(current) => std::mem::swap(current, new),
+            None => self.choice = Some(new.clone()),
         }
-        self.layout = Some(layout);
+        if self.layout.as_ref() != Some(&layout) {
+            self.layout = Some(layout);
+        }
         self.view_at_choice = Some((ctx.view, ctx.lights.len()));
         self.frames_since_choice = 0;
         self.choices += 1;
@@ -202,20 +210,27 @@ impl AutoGrid {
         self.costs.observe(&cost);
     }
 
-    /// Surface points of the frame from a coarse ray cast.
-    fn sample(&mut self, ctx: &FrameContext) -> SurfaceSamples {
+    /// Casts the frame's sample rays into `self.samples` (its buffer reused): the surface
+    /// points where fragments will be.
+    fn sample(&mut self, ctx: &FrameContext) {
         let scene = ctx.scene;
-        let key: GeometryKey = scene
-            .objects
-            .iter()
-            .map(|o| {
-                (
-                    std::sync::Arc::as_ptr(&o.mesh) as usize,
-                    o.transform.to_cols_array().map(f64::to_bits),
-                )
-            })
-            .collect();
-        if self.caster.as_ref().is_none_or(|(k, _)| *k != key) {
+        let identity = |o: &crate::scene::Object| {
+            (
+                std::sync::Arc::as_ptr(&o.mesh) as usize,
+                o.transform.to_cols_array().map(f64::to_bits),
+            )
+        };
+        // The caster is rebuilt only when the geometry changed (compared without collecting
+        // a key, which would allocate every re-choice).
+        let same_geometry = self.caster.as_ref().is_some_and(|(key, _)| {
+            key.len() == scene.objects.len()
+                && key
+                    .iter()
+                    .zip(&scene.objects)
+                    .all(|(k, o)| *k == identity(o))
+        });
+        if !same_geometry {
+            let key: GeometryKey = scene.objects.iter().map(identity).collect();
             self.caster = Some((key, SceneRaycaster::new(scene)));
         }
         let caster = &self.caster.as_ref().expect("built above").1;
@@ -228,11 +243,10 @@ impl AutoGrid {
             p.truncate() / p.w
         };
         let (nx, ny) = SAMPLE_GRID;
-        let mut samples = SurfaceSamples {
-            points: Vec::with_capacity((nx * ny) as usize),
-            rays: (nx * ny) as usize,
-            pixels: w as f64 * h as f64,
-        };
+        let samples = &mut self.samples;
+        samples.points.clear();
+        samples.rays = (nx * ny) as usize;
+        samples.pixels = w as f64 * h as f64;
         for j in 0..ny {
             for i in 0..nx {
                 let ndc_x = -1.0 + 2.0 * (i as f64 + 0.5) / nx as f64;
@@ -251,7 +265,6 @@ impl AutoGrid {
                 }
             }
         }
-        samples
     }
 }
 
