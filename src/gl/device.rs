@@ -170,6 +170,26 @@ impl Device {
         unsafe { self.gl.bind_framebuffer(glow::FRAMEBUFFER, fbo) }
     }
 
+    /// Copies the buffers of `mask` (`glow::COLOR_BUFFER_BIT`, `DEPTH_BUFFER_BIT`) of the
+    /// framebuffer `from` into `into` (`None`: the default one), both `size` pixels, nearest
+    /// (ES 3.0: a multisampled source is resolved); leaves `into` bound.
+    pub fn blit(
+        &self,
+        from: glow::Framebuffer,
+        into: Option<glow::Framebuffer>,
+        (width, height): (u32, u32),
+        mask: u32,
+    ) {
+        let (w, h) = (width as i32, height as i32);
+        unsafe {
+            self.gl.bind_framebuffer(glow::READ_FRAMEBUFFER, Some(from));
+            self.gl.bind_framebuffer(glow::DRAW_FRAMEBUFFER, into);
+            self.gl
+                .blit_framebuffer(0, 0, w, h, 0, 0, w, h, mask, glow::NEAREST);
+        }
+        self.bind_framebuffer(into);
+    }
+
     /// Binds the default framebuffer (a window's back buffer).
     pub fn bind_default_framebuffer(&self) {
         unsafe { self.gl.bind_framebuffer(glow::FRAMEBUFFER, None) }

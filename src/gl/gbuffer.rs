@@ -231,38 +231,7 @@ impl GBuffer {
         dev: &Device,
         target: Option<glow::Framebuffer>,
     ) -> Result<(), GlError> {
-        let (w, h) = (self.size.0 as i32, self.size.1 as i32);
-        unsafe {
-            dev.gl
-                .bind_framebuffer(glow::READ_FRAMEBUFFER, Some(self.geometry_fbo));
-            dev.gl.bind_framebuffer(glow::DRAW_FRAMEBUFFER, target);
-            dev.gl.blit_framebuffer(
-                0,
-                0,
-                w,
-                h,
-                0,
-                0,
-                w,
-                h,
-                glow::DEPTH_BUFFER_BIT,
-                glow::NEAREST,
-            );
-            dev.gl.bind_framebuffer(glow::FRAMEBUFFER, target);
-        }
+        dev.blit(self.geometry_fbo, target, self.size, glow::DEPTH_BUFFER_BIT);
         dev.check("G-buffer depth blit")
     }
-}
-
-/// The framebuffer bound for drawing now (to restore after offscreen passes).
-pub fn current_draw_framebuffer(dev: &Device) -> Option<glow::Framebuffer> {
-    unsafe {
-        dev.gl
-            .get_parameter_framebuffer(glow::DRAW_FRAMEBUFFER_BINDING)
-    }
-}
-
-/// Binds a framebuffer previously returned by [`current_draw_framebuffer`].
-pub fn bind_framebuffer(dev: &Device, fbo: Option<glow::Framebuffer>) {
-    unsafe { dev.gl.bind_framebuffer(glow::FRAMEBUFFER, fbo) }
 }

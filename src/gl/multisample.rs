@@ -17,7 +17,7 @@ use glow::HasContext;
 use super::caps::MSAA_RENDER_TO_TEXTURE;
 use super::mesh::{fullscreen_triangle, GpuMesh};
 use super::program::{ProgramCache, ProgramKey};
-use super::state::{Blend, Cull, DepthTest, RenderState};
+use super::state::RenderState;
 use super::{Device, EsVersion, GlError};
 
 /// A framebuffer whose colour and depth have several samples per pixel.
@@ -245,37 +245,13 @@ impl MultisampleTarget {
     ) -> Result<(), GlError> {
         let (w, h) = (self.size.0 as i32, self.size.1 as i32);
         match &self.color {
-            Color::Renderbuffer(_) => unsafe {
-                dev.gl
-                    .bind_framebuffer(glow::READ_FRAMEBUFFER, Some(self.fbo));
-                dev.gl.bind_framebuffer(glow::DRAW_FRAMEBUFFER, into);
-                dev.gl.blit_framebuffer(
-                    0,
-                    0,
-                    w,
-                    h,
-                    0,
-                    0,
-                    w,
-                    h,
-                    glow::COLOR_BUFFER_BIT,
-                    glow::NEAREST,
-                );
-                dev.bind_framebuffer(into);
-            },
+            Color::Renderbuffer(_) => dev.blit(self.fbo, into, self.size, glow::COLOR_BUFFER_BIT),
             Color::Texture { texture, triangle } => {
                 // Unbinding the framebuffer is what makes the driver average the samples into
                 // the texture.
                 dev.bind_framebuffer(into);
                 dev.viewport(0, 0, w, h);
-                RenderState {
-                    depth_test: DepthTest::Off,
-                    depth_write: false,
-                    blend: Blend::Off,
-                    cull: Cull::None,
-                    color_write: true,
-                }
-                .apply(dev);
+                RenderState::FULL_SCREEN.apply(dev);
                 let key = ProgramKey {
                     shader: "msaa_resolve",
                     features: 0,

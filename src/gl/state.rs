@@ -57,6 +57,15 @@ pub struct RenderState {
 }
 
 impl RenderState {
+    /// A full-screen pass (composite, copy): every pixel written, no depth, no blending.
+    pub const FULL_SCREEN: RenderState = RenderState {
+        depth_test: DepthTest::Off,
+        depth_write: false,
+        blend: Blend::Off,
+        cull: Cull::None,
+        color_write: true,
+    };
+
     /// Depth prepass: depth test and write, no colour.
     pub const DEPTH_PREPASS: RenderState = RenderState {
         depth_test: DepthTest::Less,

@@ -201,16 +201,9 @@ impl Deferred {
         target: Option<glow::Framebuffer>,
     ) -> Result<(), Error> {
         let dev = ctx.dev;
-        gbuffer::bind_framebuffer(dev, target);
+        dev.bind_framebuffer(target);
         dev.viewport(0, 0, ctx.viewport.0 as i32, ctx.viewport.1 as i32);
-        RenderState {
-            depth_test: DepthTest::Off,
-            depth_write: false,
-            blend: Blend::Off,
-            cull: Cull::None,
-            color_write: true,
-        }
-        .apply(dev);
+        RenderState::FULL_SCREEN.apply(dev);
         let features = ctx.features;
         let key = ProgramKey {
             shader: "deferred_composite",
@@ -259,7 +252,7 @@ impl ShadingMethod for Deferred {
 
     fn render(&mut self, ctx: &mut FrameContext) -> Result<MethodStats<'_>, Error> {
         let dev = ctx.dev;
-        let target = gbuffer::current_draw_framebuffer(dev);
+        let target = dev.bound_framebuffer();
         self.ensure_resources(dev, ctx.viewport)?;
         sort_objects(ctx);
         self.geometry_pass(ctx)?;
