@@ -9,7 +9,7 @@
 
 mod common;
 
-use common::Gpu;
+use common::{msaa, Gpu};
 use manylight::scene;
 use manylight::{EsVersion, RenderOptions};
 
@@ -34,30 +34,14 @@ fn es2_with_the_extension() -> Gpu {
     gpu
 }
 
-fn msaa(samples: u32) -> RenderOptions {
-    RenderOptions {
-        samples,
-        ..RenderOptions::default()
-    }
-}
-
 #[test]
 fn every_method_with_msaa_matches_forward_with_msaa_on_es2() {
-    let scene = scene::builtin::build("courtyard", Some((64, 2))).unwrap();
     let mut gpu = es2_with_the_extension();
-    gpu.r().set_method("forward").unwrap();
-    let reference = gpu.render(&scene, 128, 72, &msaa(4));
-    for method in ["tiled", "clustered", "auto"] {
-        gpu.r().set_method(method).unwrap();
-        let (img, stats) = gpu.r().render_offscreen(&scene, 128, 72, &msaa(4)).unwrap();
-        assert_eq!(stats.samples, 4);
-        // 4 bytes of colour and 4 of depth (llvmpipe has OES_depth24) per sample, plus the
-        // resolved texel.
-        assert!(gpu.r().caps().depth24);
-        assert_eq!(stats.msaa_bytes, 128 * 72 * (4 * 8 + 4));
-        let d = manylight::metrics::diff(&reference, &img);
-        assert!(d.max_abs <= 2, "{method}: {} / 255 from forward", d.max_abs);
-    }
+    // 4 bytes of colour and 4 of depth (llvmpipe has OES_depth24) per sample, plus the
+    // resolved texel.
+    assert!(gpu.r().caps().depth24);
+    common::assert_methods_match_forward_with_4_samples(&mut gpu, 4 * 8 + 4);
+    let scene = scene::builtin::build("courtyard", Some((64, 2))).unwrap();
     // Deferred is ES 3.0 only; more samples than the context has are refused by name.
     let err = gpu
         .r()

@@ -162,3 +162,32 @@ pub fn assert_coverage_of_4_samples(img: &image::RgbaImage) {
     assert_eq!(img.get_pixel(w / 2, h / 2)[0], 255);
     assert_eq!(img.get_pixel(2, 2)[0], 0);
 }
+
+/// Options asking for `samples` samples per pixel (MSAA above 1), the rest default.
+pub fn msaa(samples: u32) -> RenderOptions {
+    RenderOptions {
+        samples,
+        ..RenderOptions::default()
+    }
+}
+
+/// Renders the courtyard (64 lights) at 128×72 with 4 samples through every method that
+/// supports MSAA and asserts each within 2/255 of forward with 4 samples, reporting 4 samples
+/// and `bytes_per_pixel` bytes of MSAA target per pixel; returns forward's picture.
+pub fn assert_methods_match_forward_with_4_samples(
+    gpu: &mut Gpu,
+    bytes_per_pixel: usize,
+) -> image::RgbaImage {
+    let scene = manylight::scene::builtin::build("courtyard", Some((64, 2))).unwrap();
+    gpu.r().set_method("forward").unwrap();
+    let reference = gpu.render(&scene, 128, 72, &msaa(4));
+    for method in ["tiled", "clustered", "auto"] {
+        gpu.r().set_method(method).unwrap();
+        let (img, stats) = gpu.r().render_offscreen(&scene, 128, 72, &msaa(4)).unwrap();
+        assert_eq!(stats.samples, 4);
+        assert_eq!(stats.msaa_bytes, 128 * 72 * bytes_per_pixel);
+        let d = manylight::metrics::diff(&reference, &img);
+        assert!(d.max_abs <= 2, "{method}: {} / 255 from forward", d.max_abs);
+    }
+    reference
+}
