@@ -28,37 +28,31 @@ pub struct AssignWorkload {
 impl AssignWorkload {
     /// The default scene's camera with `count` random lights (seed `seed`).
     pub fn default_view(count: usize, seed: u64) -> AssignWorkload {
-        let (near, far) = scene::builtin::build(scene::builtin::DEFAULT, Some((0, seed)))
-            .expect("the default scene builds")
-            .camera
-            .near_far();
         // The grid this workload has always timed (64-pixel cells, never narrower than 1/64
         // of the depth range), so figures compare across versions.
-        let config = GridConfig {
+        Self::view_with(count, seed, BENCH_SIZE, |near, far| GridConfig {
             min_cell_size: Some((far - near) / 64.0),
             ..GridConfig::fixed(64.0)
-        };
-        Self::view_with(count, seed, BENCH_SIZE, &config)
+        })
     }
 
     /// The grid the automatic choice picks for the default scene at 640×360 with 1 024 lights
     /// (11-pixel cells from a first split at 4 m, ~140 000 cells): the fine-grid case, where
     /// each light covers hundreds of cells.
     pub fn fine_grid(count: usize, seed: u64) -> AssignWorkload {
-        let config = GridConfig {
+        Self::view_with(count, seed, (640, 360), |_, _| GridConfig {
             first_split: Some(4.0),
             ..GridConfig::fixed(11.0)
-        };
-        Self::view_with(count, seed, (640, 360), &config)
+        })
     }
 
-    /// The default scene's camera with `count` random lights at `size` with the grid of
-    /// `config`.
+    /// The default scene's camera with `count` random lights at `size` with the grid that
+    /// `config` makes of the camera's near and far planes.
     pub fn view_with(
         count: usize,
         seed: u64,
         (w, h): (u32, u32),
-        config: &GridConfig,
+        config: impl FnOnce(f64, f64) -> GridConfig,
     ) -> AssignWorkload {
         let scene = scene::builtin::build(scene::builtin::DEFAULT, Some((count, seed)))
             .expect("the default scene builds");
@@ -71,7 +65,7 @@ impl AssignWorkload {
             GridProjection::from_matrix(&projection),
             near,
             far,
-            config,
+            &config(near, far),
         );
         let lights = scene
             .lights

@@ -157,24 +157,27 @@ impl ClusterGrid {
         let mut constants = std::mem::take(&mut self.cascade_constants);
         CascadeConstants::of_into(self, &mut constants);
         self.cascade_constants = constants;
-        let mut slabs = std::mem::take(&mut self.slice_slabs);
-        self.build_slice_slabs(&mut slabs);
-        self.slice_slabs = slabs;
         let mut frusta = std::mem::take(&mut self.slice_frusta);
         self.build_slice_frusta(&mut frusta);
         self.slice_frusta = frusta;
+        let mut slabs = std::mem::take(&mut self.slice_slabs);
+        self.build_slice_slabs(&mut slabs);
+        self.slice_slabs = slabs;
     }
 
+    /// The slabs of [`ClusterGrid::slice_slabs`] from the slices' exact depths (the frusta,
+    /// built first).
     fn build_slice_slabs(&self, slabs: &mut Vec<[f64; 4]>) {
         slabs.clear();
-        for (k, c) in self.cascades.iter().enumerate() {
-            for s in 0..c.slices {
-                let (z0, z1) = self.slice_depth_range(k as u32, s);
-                let first = k == 0 && s == 0;
-                let z0 = if first { 0.0 } else { z0 * (1.0 - SLICE_WIDEN) };
-                let z1 = z1 * (1.0 + SLICE_WIDEN);
-                slabs.push([z0, z1, 1.0 / z0, 1.0 / z1]);
-            }
-        }
+        slabs.extend(self.slice_frusta.iter().enumerate().map(|(g, f)| {
+            let (z0, z1) = f.depths;
+            let z0 = if g == 0 {
+                0.0
+            } else {
+                z0 * (1.0 - SLICE_WIDEN)
+            };
+            let z1 = z1 * (1.0 + SLICE_WIDEN);
+            [z0, z1, 1.0 / z0, 1.0 / z1]
+        }));
     }
 }

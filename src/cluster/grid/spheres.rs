@@ -7,7 +7,8 @@ use super::{ClusterGrid, GridProjection};
 /// [`ClusterGrid::row_spheres`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct SliceFrustum {
-    depths: (f64, f64),
+    /// The slice's view depths (exact: [`ClusterGrid::slice_depth_range`]).
+    pub(super) depths: (f64, f64),
     near: (f64, f64),
     far: (f64, f64),
 }
