@@ -14,7 +14,9 @@
 //!    band comes nearest (half-width `√(ρ² − δ²)`): each row gets the columns that chord can
 //!    reach ([`Coverage::SliceRows`]). The rectangle alone is [`Coverage::CascadeBox`].
 //! 4. Spot lights start from the bounding sphere of their cone's reach instead of their whole
-//!    sphere, and each cell is then tested cone-vs-cell (against the cell's bounding sphere).
+//!    sphere, and each row's columns are then cut to those whose cells' bounding spheres the
+//!    cone may touch, solved per row in closed form (`cone.rs`); a rectangle of at most 2 × 2
+//!    cells per slice is kept whole.
 //!
 //! The cells come out as **runs**: a run is consecutive columns of one row of one slice, which
 //! are consecutive cell numbers. Emitting runs instead of single cells lets the counting sort
@@ -23,7 +25,7 @@
 //! The radius is padded by a relative 10⁻⁴ so a fragment that float rounding puts in the
 //! neighbouring cell still finds every light that reaches it: the assignment is conservative.
 
-use super::cone::Cone;
+use super::cone::{Cone, ConeSlice};
 use super::depth_lookup::CascadeConstants;
 use super::grid::{ClusterGrid, Coverage, GridProjection};
 use super::pack::GpuLight;
@@ -172,19 +174,19 @@ pub(crate) fn for_each_run_in(
             rows,
         };
         let mut slice_start = cascade.first_cell + sa * slice_cells;
-        let mut emit_row = |slice: u32, slice_start: u32, row: u32, x0: u32, x1: u32| {
-            let start = slice_start + row * cascade.tiles_x + x0;
-            match &cone {
-                None => emit(start, x1 - x0 + 1),
-                Some(cone) => {
-                    let spheres = grid.row_spheres(k, constants.first_slice + slice, row);
-                    let sphere_of = |i: u32| spheres.cell(x0 + i);
-                    cone.emit_runs(sphere_of, start, x1 - x0 + 1, emit)
-                }
-            }
+        let mut emit_row = |cone: &Option<ConeSlice>, slice_start: u32, row: u32, x0, x1| {
+            let (x0, x1) = match cone {
+                None => (x0, x1),
+                Some(cone) => match cone.columns(row, x0, x1) {
+                    Some(span) => span,
+                    None => return,
+                },
+            };
+            emit(slice_start + row * cascade.tiles_x + x0, x1 - x0 + 1)
         };
         // A rectangle of at most 2 × 2 cells per slice has little to trim (a corner cell at
-        // most) and the per-row arithmetic would cost more than the cells it saves.
+        // most) and the per-row arithmetic, or a spot's cone test, would cost more than the
+        // cells it saves (a spot's bounding sphere already fits its cone).
         let small = columns.1 - columns.0 < 2 && rows.1 - rows.0 < 2;
         let coverage = if small {
             Coverage::CascadeBox
@@ -192,16 +194,24 @@ pub(crate) fn for_each_run_in(
             grid.coverage
         };
         for s in sa..sb + 1 {
+            // A spot's cone against the slice's cells, worked out once per slice.
+            let cone = match &cone {
+                Some(cone) if !small => {
+                    let g = constants.first_slice + s;
+                    Some(cone.slice(&grid.slice_cells(k, g, columns, rows)))
+                }
+                _ => None,
+            };
             match coverage {
                 Coverage::SliceRows => {
                     let slab = grid.slice_slabs[(constants.first_slice + s) as usize];
                     extent.for_each_row_run(&tiles, slab, &mut |row, x0, x1| {
-                        emit_row(s, slice_start, row, x0, x1)
+                        emit_row(&cone, slice_start, row, x0, x1)
                     });
                 }
                 Coverage::CascadeBox => {
                     for row in rows.0..rows.1 + 1 {
-                        emit_row(s, slice_start, row, columns.0, columns.1);
+                        emit_row(&cone, slice_start, row, columns.0, columns.1);
                     }
                 }
             }

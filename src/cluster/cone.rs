@@ -1,7 +1,9 @@
 //! A spot light's cone as the assignment tests it against cells (see [`super::cells`]): the
-//! bounding sphere of the part of the light's sphere inside the cone, and a square-root-free
-//! cone-vs-cell-sphere test that trims each row of cells to those the cone may touch.
+//! bounding sphere of the part of the light's sphere inside the cone, and the cone-vs-cell
+//! test that trims each row of cells to those the cone may touch, solved for the whole row at
+//! once (one quadratic) rather than cell by cell.
 
+use super::grid::SliceCells;
 use super::pack::GpuLight;
 
 /// A spot light's cone, for the cone-vs-cell test (Wronski's "cull that cone"), and the
@@ -56,32 +58,33 @@ impl Cone {
         })
     }
 
-    /// Emits the part of the run `[start, start + len)` the cone may touch (`sphere_of(i)`:
-    /// the bounding sphere of its cell `start + i`): from the first
-    /// cell that may touch it to the last. The cone is convex, so along a row the cells it
-    /// touches are (nearly) one interval; a gap inside would only be assigned too, which is
-    /// conservative. Scanning in from both ends tests few cells where the cone fills the row.
-    pub fn emit_runs(
-        &self,
-        sphere_of: impl Fn(u32) -> [f64; 4],
-        start: u32,
-        len: u32,
-        emit: &mut impl FnMut(u32, u32),
-    ) {
-        let Some(first) = (0..len).find(|&i| self.may_touch(&sphere_of(i))) else {
-            return;
-        };
-        let last = (first + 1..len)
-            .rev()
-            .find(|&i| self.may_touch(&sphere_of(i)))
-            .unwrap_or(first);
-        emit(start + first, last - first + 1);
+    /// The cone against the cells of one slice (see [`ConeSlice::columns`]).
+    #[inline]
+    pub fn slice(&self, cells: &SliceCells) -> ConeSlice<'_> {
+        let r = cells.radius;
+        let [sx, sy] = cells.step;
+        let ax = self.axis.x;
+        // Along a row `t` counts columns: v(t) = v₀ + t·(sx, 0, 0) from the apex.
+        let q = sx * ax;
+        ConeSlice {
+            whole: !(r.is_finite() && cells.origin.is_finite() && sx.is_finite() && sy.is_finite()),
+            origin: cells.origin - self.apex,
+            row_step: sy,
+            r,
+            sx,
+            q,
+            inv_q: 1.0 / q,
+            a: sx * sx * (self.cos_sq - ax * ax),
+            slack: 1e-12 * (cells.origin.length() + self.apex.length() + r + self.range),
+            cone: self,
+        }
     }
 
     /// False only when the cell's bounding sphere is certainly outside the cone (up to the
-    /// light's range).
-    /// A cell reaching infinity (radius +∞) passes every comparison below by IEEE rules.
-    fn may_touch(&self, &[x, y, z, radius]: &[f64; 4]) -> bool {
+    /// light's range): the test [`Cone::touched_span`] solves for a whole row at once, kept
+    /// as its yardstick in the tests.
+    #[cfg(test)]
+    pub(crate) fn may_touch(&self, &[x, y, z, radius]: &[f64; 4]) -> bool {
         let v = glam::DVec3::new(x, y, z) - self.apex;
         let v1 = v.dot(self.axis);
         if v1 > radius + self.range || v1 < -radius {
@@ -92,5 +95,233 @@ impl Cone {
         // the hot loop has no square root.
         let bound = radius + v1 * self.sin;
         bound >= 0.0 && self.cos_sq * (v.length_squared() - v1 * v1) <= bound * bound
+    }
+}
+
+/// A cone against the cells of one slice: what [`ConeSlice::columns`] needs for every row,
+/// worked out once per slice.
+pub(crate) struct ConeSlice<'a> {
+    cone: &'a Cone,
+    /// Not finite (a slice reaching infinity): every cell is kept.
+    whole: bool,
+    /// Centre of the cell in column 0, row 0, from the apex; view y between rows.
+    origin: glam::DVec3,
+    row_step: f64,
+    /// Radius bounding every cell, view x between columns, its part along the axis (and
+    /// reciprocal), and the quadratic's leading coefficient (the same in every row).
+    r: f64,
+    sx: f64,
+    q: f64,
+    inv_q: f64,
+    a: f64,
+    /// Absolute slack of the linear conditions (rounding of the axial distance).
+    slack: f64,
+}
+
+impl ConeSlice<'_> {
+    /// The first and last of the columns `x0..=x1` of row `row` whose cells the cone may
+    /// touch, or `None`: a superset of the cells whose bounding sphere of radius `r` (every
+    /// cell's, see [`SliceCells`]) [`Cone::may_touch`] passes, in closed form instead of cell
+    /// by cell.
+    ///
+    /// Along the row the centre is `v(t) = v₀ + t·(sx, 0, 0)` from the apex (`t` the column),
+    /// and with `v₁ = v·axis` and `w = v − v₁·axis` (the part off the axis) a cell passes where
+    /// `−r ≤ v₁ ≤ r + range` (two linear conditions in `t`) and `cos·|w| ≤ r + sin·v₁`: the
+    /// distance outside the cone is convex in `t`, so the cells passing are one interval, and
+    /// squared the condition is the quadratic `a·t² + b·t + c ≤ 0` whose roots bound it. It is
+    /// widened by a millionth of a cell so that rounding never removes a cell.
+    #[inline]
+    pub fn columns(&self, row: u32, x0: u32, x1: u32) -> Option<(u32, u32)> {
+        if self.whole {
+            return Some((x0, x1));
+        }
+        let cone = self.cone;
+        let mut v0 = self.origin;
+        v0.y += row as f64 * self.row_step;
+        let p = v0.dot(cone.axis);
+        let w0 = v0 - cone.axis * p;
+        let h0 = self.r + cone.sin * p;
+        // −r ≤ v₁ = p + q·t ≤ r + range.
+        let low = -(p + self.r + self.slack);
+        let high = self.r + cone.range + self.slack - p;
+        let mut span = (x0 as f64, x1 as f64);
+        if self.q != 0.0 {
+            let (ta, tb) = (low * self.inv_q, high * self.inv_q);
+            span = (span.0.max(ta.min(tb)), span.1.min(ta.max(tb)));
+        } else if low > 0.0 || high < 0.0 {
+            return None;
+        }
+        if span.0 > span.1 {
+            return None;
+        }
+        let b = 2.0 * self.sx * (cone.cos_sq * w0.x - cone.sin * cone.axis.x * h0);
+        let c = cone.cos_sq * w0.length_squared() - h0 * h0;
+        let (lo, hi) = quadratic_nonpositive(self.a, b, c, span)?;
+        // Widened, then the whole cells inside.
+        let margin = |t: f64| 1e-6 * (1.0 + t.abs());
+        let first = (lo - margin(lo)).ceil().max(x0 as f64);
+        let last = (hi + margin(hi)).floor().min(x1 as f64);
+        // Also false for NaN: a NaN bound keeps the whole span instead.
+        if first <= last {
+            Some((first as u32, last as u32))
+        } else if lo.is_nan() || hi.is_nan() {
+            Some((x0, x1))
+        } else {
+            None
+        }
+    }
+}
+
+/// The part of `span` (`lo ≤ hi`) where `a + b·t ≥ 0`, or `None` when there is none.
+fn keep_nonnegative((lo, hi): (f64, f64), a: f64, b: f64) -> Option<(f64, f64)> {
+    let (lo, hi) = if b > 0.0 {
+        (lo.max(-a / b), hi)
+    } else if b < 0.0 {
+        (lo, hi.min(-a / b))
+    } else if a >= 0.0 {
+        (lo, hi)
+    } else {
+        return None;
+    };
+    (lo <= hi).then_some((lo, hi))
+}
+
+/// The smallest interval holding every `t` of `span` where `a·t² + b·t + c ≤ 0` (with a
+/// tolerance: the inequality is loosened by a billionth of its terms' size over the span, so
+/// a rounding error in the coefficients cannot make a touching row look empty), or `None`.
+fn quadratic_nonpositive(a: f64, b: f64, c: f64, (lo, hi): (f64, f64)) -> Option<(f64, f64)> {
+    let t = lo.abs().max(hi.abs()).max(1.0);
+    let c = c - 1e-9 * (c.abs() + b.abs() * t + a.abs() * t * t);
+    if a == 0.0 {
+        // b·t + c ≤ 0.
+        return keep_nonnegative((lo, hi), -c, -b);
+    }
+    let disc = b * b - 4.0 * a * c;
+    if !disc.is_finite() {
+        // Overflowed: keep everything.
+        return Some((lo, hi));
+    }
+    if disc < 0.0 {
+        // No real root: one sign everywhere, that of `a`.
+        return (a < 0.0).then_some((lo, hi));
+    }
+    // The two roots without cancellation (Numerical Recipes §5.6).
+    let k = -0.5 * (b + disc.sqrt().copysign(b));
+    let (r1, r2) = if k == 0.0 {
+        (0.0, 0.0)
+    } else {
+        let (x, y) = (k / a, c / k);
+        (x.min(y), x.max(y))
+    };
+    if a > 0.0 {
+        let (lo, hi) = (lo.max(r1), hi.min(r2));
+        return (lo <= hi).then_some((lo, hi));
+    }
+    // Non-positive outside the roots: the hull of what is left of the span on either side.
+    let left = (lo <= r1).then_some((lo, hi.min(r1)));
+    let right = (hi >= r2).then_some((lo.max(r2), hi));
+    match (left, right) {
+        (Some((l, _)), Some((_, h))) => Some((l, h)),
+        (one, other) => one.or(other),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::{DVec3, Vec3};
+    use rand::{Rng, SeedableRng};
+    use rand_pcg::Pcg64Mcg;
+
+    use super::Cone;
+    use crate::cluster::grid::{ClusterGrid, GridConfig, GridProjection};
+    use crate::cluster::pack::GpuLight;
+    use crate::scene::Light;
+
+    /// Random spots in and around the view of `grid`: every size of cone, from a few cells
+    /// to most of the view, pointing every way (some at or away from the eye).
+    fn spots(rng: &mut Pcg64Mcg, grid: &ClusterGrid, n: usize) -> Vec<GpuLight> {
+        (0..n)
+            .map(|_| {
+                let d = rng
+                    .random_range(grid.near.max(0.05).ln()..grid.far.ln())
+                    .exp();
+                let (hx, hy) = grid.projection.half_extent(d);
+                let p = DVec3::new(
+                    rng.random_range(-1.3..1.3) * hx,
+                    rng.random_range(-1.3..1.3) * hy,
+                    -d,
+                );
+                let dir = DVec3::new(
+                    rng.random_range(-1.0..1.0),
+                    rng.random_range(-1.0..1.0),
+                    rng.random_range(-1.0..1.0),
+                );
+                let dir = if dir.length() < 1e-3 { DVec3::Z } else { dir };
+                let outer = rng.random_range(1.0..120.0);
+                let r = hy * rng.random_range(0.05..1.5);
+                let light = Light::spot(p, dir, outer * 0.5, outer, r as f32, Vec3::ONE, 1.0);
+                GpuLight::from_light(&light, &glam::DMat4::IDENTITY)
+            })
+            .collect()
+    }
+
+    /// Every cell of every row that the cell-by-cell test passes (with the cell's own sphere)
+    /// lies inside the closed-form span, and the span is not much wider than those cells.
+    #[test]
+    fn row_spans_hold_every_cell_the_cell_test_passes() {
+        let t = (30f64).to_radians().tan();
+        let projection = GridProjection::Perspective {
+            tan_x: t * 16.0 / 9.0,
+            tan_y: t,
+        };
+        let mut rng = Pcg64Mcg::seed_from_u64(17);
+        let (mut passed, mut spanned, mut rows) = (0u64, 0u64, 0u64);
+        for (footprint, far) in [(24.0, 60.0), (11.0, 30.0), (64.0, f64::INFINITY)] {
+            let grid = ClusterGrid::new(
+                320,
+                180,
+                projection,
+                0.1,
+                far,
+                &GridConfig::fixed(footprint),
+            );
+            for light in spots(&mut rng, &grid, 120) {
+                let range = light.cull_radius as f64;
+                let Some(cone) = Cone::of(&light, range) else {
+                    continue;
+                };
+                let mut first_slice = 0;
+                for (k, c) in grid.cascades.iter().enumerate() {
+                    let (columns, all_rows) = ((0, c.tiles_x - 1), (0, c.tiles_y - 1));
+                    for slice in first_slice..first_slice + c.slices {
+                        let cells = grid.slice_cells(k as u32, slice, columns, all_rows);
+                        let cone_slice = cone.slice(&cells);
+                        for y in 0..c.tiles_y {
+                            let spheres = grid.row_spheres(k as u32, slice, y);
+                            let touched: Vec<u32> = (0..c.tiles_x)
+                                .filter(|&x| cone.may_touch(&spheres.cell(x)))
+                                .collect();
+                            let span = cone_slice.columns(y, 0, c.tiles_x - 1);
+                            if let (Some(&a), Some(&b)) = (touched.first(), touched.last()) {
+                                let (lo, hi) = span.unwrap_or_else(|| {
+                                    panic!("{light:?}: row {y} of slice {slice} lost {touched:?}")
+                                });
+                                assert!(lo <= a && b <= hi, "{light:?}: {touched:?} ⊄ {lo}..={hi}");
+                                passed += (b - a + 1) as u64;
+                                rows += 1;
+                            }
+                            spanned += span.map_or(0, |(lo, hi)| (hi - lo + 1) as u64);
+                        }
+                    }
+                    first_slice += c.slices;
+                }
+            }
+        }
+        assert!(rows > 2_000, "only {rows} rows touched");
+        // The span takes one radius for the whole slice (its largest cell's): a little wider.
+        assert!(
+            (spanned as f64) < passed as f64 * 1.15,
+            "{spanned} cells spanned against {passed}"
+        );
     }
 }

@@ -42,7 +42,7 @@ pub use config::{Coverage, GridConfig, GridMode};
 pub use projection::{DepthMapping, GridProjection};
 
 use super::depth_lookup::{CascadeConstants, SliceLookup};
-pub(crate) use spheres::SliceFrustum;
+pub(crate) use spheres::{SliceCells, SliceFrustum};
 
 /// Relative widening of depth ranges against slice boundaries: far more than the CPU table's
 /// rounding at a boundary and than the shader's `f32` evaluation of the mapping (10⁻⁵ in log2

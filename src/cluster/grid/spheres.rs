@@ -81,7 +81,10 @@ impl ClusterGrid {
     }
 }
 
-/// The bounding spheres of one row of cells (see [`ClusterGrid::row_spheres`]).
+/// The bounding spheres of one row of cells (see [`ClusterGrid::row_spheres`]). The
+/// assignment reads only their radii ([`ClusterGrid::slice_cells`]); the whole spheres are for
+/// the tests.
+#[cfg_attr(not(test), allow(dead_code))]
 pub(crate) struct RowSpheres {
     infinite: bool,
     cy: f64,
@@ -101,17 +104,78 @@ impl RowSpheres {
     /// The bounding sphere `[x, y, z, radius]` (view space) of the row's cell in column `x`:
     /// the centre of its eight corners and the farthest corner; an infinite radius for a cell
     /// reaching infinity.
-    #[inline]
+    #[cfg(test)]
     pub(crate) fn cell(&self, x: u32) -> [f64; 4] {
         if self.infinite {
             return [0.0, 0.0, 0.0, f64::INFINITY];
         }
+        let (cx, radius_sq) = self.centre_x_and_radius_sq(x);
+        [cx, self.cy, self.cz, radius_sq.sqrt()]
+    }
+
+    /// The view x of the centre of the row's cell in column `x`, and its squared radius.
+    #[inline(always)]
+    fn centre_x_and_radius_sq(&self, x: u32) -> (f64, f64) {
         let nx0 = -1.0 + x as f64 * self.step_x;
         let nx1 = -1.0 + (x + 1) as f64 * self.step_x;
         let cx = 0.5 * (nx0 + nx1) * self.mean_x;
         let farthest_x = |hx: f64| (nx0 * hx - cx).powi(2).max((nx1 * hx - cx).powi(2));
         let near = farthest_x(self.near_x) + self.near_rest;
         let far = farthest_x(self.far_x) + self.far_rest;
-        [cx, self.cy, self.cz, near.max(far).sqrt()]
+        (cx, near.max(far))
+    }
+}
+
+/// The cells of one slice as the spot-cone test sees them (see [`ClusterGrid::slice_cells`]):
+/// the centre of the cell in column `x`, row `y` is `origin + (x·step[0], y·step[1], 0)`, and
+/// every cell of the columns and rows asked for lies within `radius` of its centre (infinite
+/// for cells reaching infinity).
+pub(crate) struct SliceCells {
+    pub origin: glam::DVec3,
+    pub step: [f64; 2],
+    pub radius: f64,
+}
+
+impl ClusterGrid {
+    /// The cells of slice `slice` (numbered across cascades) of cascade `cascade`, with a
+    /// radius that bounds every cell of `columns` × `rows` (inclusive ranges).
+    #[inline]
+    pub(crate) fn slice_cells(
+        &self,
+        cascade: u32,
+        slice: u32,
+        columns: (u32, u32),
+        rows: (u32, u32),
+    ) -> SliceCells {
+        let c = &self.cascades[cascade as usize];
+        let f = &self.slice_frusta[slice as usize];
+        let (z0, z1) = f.depths;
+        let step_x = 2.0 / c.tiles_x as f64;
+        let step_y = 2.0 / c.tiles_y as f64;
+        let mean = [0.5 * (f.near.0 + f.far.0), 0.5 * (f.near.1 + f.far.1)];
+        let radius = if z1.is_infinite() {
+            f64::INFINITY
+        } else {
+            // A cell's squared radius is a sum of per-axis terms, each a maximum of squares of
+            // functions affine in the column or row (see `RowSpheres::cell`): convex over the
+            // rectangle, so largest at one of its corners.
+            let mut largest: f64 = 0.0;
+            for y in [rows.0, rows.1] {
+                let spheres = self.row_spheres(cascade, slice, y);
+                for x in [columns.0, columns.1] {
+                    largest = largest.max(spheres.centre_x_and_radius_sq(x).1);
+                }
+            }
+            largest.sqrt()
+        };
+        SliceCells {
+            origin: glam::DVec3::new(
+                (-1.0 + 0.5 * step_x) * mean[0],
+                (-1.0 + 0.5 * step_y) * mean[1],
+                -0.5 * (z0 + z1),
+            ),
+            step: [step_x * mean[0], step_y * mean[1]],
+            radius,
+        }
     }
 }
