@@ -154,12 +154,10 @@ struct Band {
     deltas: Vec<i32>,
     /// The runs, light after light.
     runs: Vec<Run>,
-    /// Every light with a run in the band, ascending: (light, end of its runs in `runs`).
+    /// Every light with a run in the band, ascending: (light, start of its runs in `runs`).
     lights: Vec<(u32, u32)>,
     /// Per entry of `lights`: the light's visible number (phase 2).
     ids: Vec<u32>,
-    /// Per cell: phase 3's write position in the band's part of the list.
-    cursor: Vec<u32>,
     /// The band's [`Totals`] (phase 2).
     totals: Totals,
     /// Seconds its phases 1 and 3 took (the next split's balance).
@@ -188,64 +186,52 @@ impl Band {
                 runs.push(Run { start, len });
             });
             if runs.len() > before {
-                self.lights.push((i as u32, runs.len() as u32));
+                self.lights.push((i as u32, before as u32));
             }
         }
         self.seconds = started.elapsed().as_secs_f64();
     }
 
-    /// Phase 2: the band's counts into `counts` (its cells' part), its own offsets into
-    /// `cursor`, and its totals. The first band's part of the list starts at 0, so it also
-    /// writes its final `offsets` here (a single band then makes one pass over the cells).
+    /// Phase 2: the band's counts into `counts` (its cells' part), where each cell's list
+    /// ends in the band's part of the list into `offsets` (phase 3 moves them to where the
+    /// lists start), and its totals.
     fn count(&mut self, counts: &mut [u32], offsets: &mut [u32]) {
-        let cells = self.end_cell - self.first_cell;
-        self.cursor.resize(cells, 0);
         let mut running = 0i32;
         let mut totals = Totals::default();
-        let columns = counts.iter_mut().zip(&mut self.cursor).zip(&self.deltas);
-        if self.first_cell == 0 {
-            for (((count, cursor), delta), offset) in columns.zip(offsets) {
-                running += delta;
-                let n = running as u32;
-                *count = n;
-                *cursor = totals.indices as u32;
-                *offset = totals.indices as u32;
-                totals.add(n);
-            }
-        } else {
-            for ((count, cursor), delta) in columns {
-                running += delta;
-                let n = running as u32;
-                *count = n;
-                *cursor = totals.indices as u32;
-                totals.add(n);
-            }
+        for ((count, offset), delta) in counts.iter_mut().zip(offsets).zip(&self.deltas) {
+            running += delta;
+            let n = running as u32;
+            *count = n;
+            totals.add(n);
+            *offset = totals.indices as u32;
         }
         self.totals = totals;
     }
 
-    /// Phase 3: the band's final offsets (its own plus `base`), then its lights' visible
-    /// numbers written into `list` (the band's part of the index list) grouped by cell. Light
-    /// order is kept, so every cell's list is ascending.
+    /// Phase 3: the band's lights' visible numbers written into `list` (the band's part of the
+    /// index list) grouped by cell, then the band's final offsets (its own plus `base`).
+    ///
+    /// The offsets serve as the write cursors: they start where each cell's list ends and
+    /// the runs are taken in reverse, each write one place before the last, so every cell's
+    /// list comes out ascending in light order and each offset ends where its list starts
+    /// (no cursor array: a fine grid's assignment runs cache-cold in a renderer).
     fn scatter(&mut self, offsets: &mut [u32], list: &mut [u32]) {
         let started = Instant::now();
-        if self.first_cell != 0 {
-            let base = self.base as u32;
-            for (offset, &local) in offsets.iter_mut().zip(&self.cursor) {
-                *offset = local + base;
-            }
-        }
-        let mut prev = 0usize;
-        for (&(_, end), &id) in self.lights.iter().zip(&self.ids) {
-            let end = end as usize;
-            for run in &self.runs[prev..end] {
+        let mut end = self.runs.len();
+        for (&(_, start), &id) in self.lights.iter().rev().zip(self.ids.iter().rev()) {
+            let start = start as usize;
+            for run in &self.runs[start..end] {
                 let a = run.start as usize;
-                for at in &mut self.cursor[a..a + run.len as usize] {
+                for at in &mut offsets[a..a + run.len as usize] {
+                    *at -= 1;
                     list[*at as usize] = id;
-                    *at += 1;
                 }
             }
-            prev = end;
+            end = start;
+        }
+        if self.first_cell != 0 {
+            let base = self.base as u32;
+            offsets.iter_mut().for_each(|offset| *offset += base);
         }
         self.seconds += started.elapsed().as_secs_f64();
     }
