@@ -130,7 +130,7 @@ impl ConeSlice<'_> {
     /// distance outside the cone is convex in `t`, so the cells passing are one interval, and
     /// squared the condition is the quadratic `a·t² + b·t + c ≤ 0` whose roots bound it. It is
     /// widened by a millionth of a cell so that rounding never removes a cell.
-    #[inline]
+    #[inline(always)]
     pub fn columns(&self, row: u32, x0: u32, x1: u32) -> Option<(u32, u32)> {
         if self.whole {
             return Some((x0, x1));
@@ -157,18 +157,19 @@ impl ConeSlice<'_> {
         let b = 2.0 * self.sx * (cone.cos_sq * w0.x - cone.sin * cone.axis.x * h0);
         let c = cone.cos_sq * w0.length_squared() - h0 * h0;
         let (lo, hi) = quadratic_nonpositive(self.a, b, c, span)?;
-        // Widened, then the whole cells inside.
+        // Widened, then the whole cells inside (by conversions: `ceil` and `floor` are library
+        // calls on a baseline x86-64 target).
         let margin = |t: f64| 1e-6 * (1.0 + t.abs());
-        let first = (lo - margin(lo)).ceil().max(x0 as f64);
-        let last = (hi + margin(hi)).floor().min(x1 as f64);
-        // Also false for NaN: a NaN bound keeps the whole span instead.
-        if first <= last {
-            Some((first as u32, last as u32))
-        } else if lo.is_nan() || hi.is_nan() {
-            Some((x0, x1))
-        } else {
-            None
+        let (lo, hi) = (lo - margin(lo), hi + margin(hi));
+        if !(hi >= x0 as f64 && lo <= x1 as f64) {
+            // Also for NaN, which keeps the whole span.
+            return (lo.is_nan() || hi.is_nan()).then_some((x0, x1));
         }
+        // `as u32` truncates, and saturates below 0; `hi ≥ x0 ≥ 0` here.
+        let truncated = lo as u32;
+        let first = (truncated + u32::from((truncated as f64) < lo)).max(x0);
+        let last = (hi as u32).min(x1);
+        (first <= last).then_some((first, last))
     }
 }
 
@@ -189,6 +190,7 @@ fn keep_nonnegative((lo, hi): (f64, f64), a: f64, b: f64) -> Option<(f64, f64)> 
 /// The smallest interval holding every `t` of `span` where `a·t² + b·t + c ≤ 0` (with a
 /// tolerance: the inequality is loosened by a billionth of its terms' size over the span, so
 /// a rounding error in the coefficients cannot make a touching row look empty), or `None`.
+#[inline(always)]
 fn quadratic_nonpositive(a: f64, b: f64, c: f64, (lo, hi): (f64, f64)) -> Option<(f64, f64)> {
     let t = lo.abs().max(hi.abs()).max(1.0);
     let c = c - 1e-9 * (c.abs() + b.abs() * t + a.abs() * t * t);
