@@ -621,6 +621,31 @@ fn msaa_flag_renders_and_says_where_it_cannot() {
 }
 
 #[test]
+fn slice_depth_flag_makes_thinner_slices_and_refuses_bad_ratios() {
+    let dir = tempfile::tempdir().unwrap();
+    let base = [
+        "render", "--size", "160x90", "--lights", "8", "--frames", "0",
+    ];
+    let cells = |extra: &[&str]| {
+        let args = [&base[..], &["--grid", "8", "--stats", "s.json"], extra].concat();
+        let out = manylight(&args, &[], dir.path());
+        assert!(out.status.success(), "{}", text(&out));
+        stats(&dir.path().join("s.json"))["grid_cells"]
+            .as_f64()
+            .unwrap()
+    };
+    let (cubical, thin) = (cells(&[]), cells(&["--slice-depth", "0.5"]));
+    assert!(
+        (1.4..2.4).contains(&(thin / cubical)),
+        "{thin} cells against {cubical}"
+    );
+    for bad in ["0", "nan", "-0.5", "100"] {
+        let args = [&base[..], &["--slice-depth", bad]].concat();
+        expect_exit(&args, &[], dir.path(), 2, "slice depth");
+    }
+}
+
+#[test]
 fn timed_frames_report_their_spread() {
     let dir = tempfile::tempdir().unwrap();
     let out = manylight(

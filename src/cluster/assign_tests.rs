@@ -67,6 +67,16 @@ fn cases() -> Vec<Case> {
             config: GridConfig::tiles(16.0),
         },
         Case {
+            name: "half-depth slices",
+            projection: persp,
+            near: 0.1,
+            far: 80.0,
+            config: GridConfig {
+                slice_depth: 0.5,
+                ..GridConfig::fixed(16.0)
+            },
+        },
+        Case {
             name: "fine",
             projection: persp,
             near: 0.05,

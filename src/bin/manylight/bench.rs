@@ -168,7 +168,9 @@ fn knobs(quick: bool) -> Vec<Knob> {
                 method,
                 apply,
                 value,
-                every_scene: name == "footprint_px" || name == "coverage",
+                every_scene: name.starts_with("footprint_px")
+                    || name == "coverage"
+                    || name == "slice_depth",
             });
         }
     };
@@ -197,6 +199,25 @@ fn knobs(quick: bool) -> Vec<Knob> {
         "clustered",
         |o, v| o.grid = GridConfig::fixed(v),
         pick(&[8.0, 16.0, 32.0, 64.0], &[16.0, 64.0]),
+    );
+    // Slices half as deep as a cell is wide: on the automatic grid, and on the finest fixed
+    // one (what the finest cells can get out of a grazing floor).
+    add(
+        "slice_depth",
+        "clustered",
+        |o, v| o.grid.slice_depth = v,
+        pick(&[0.5], &[]),
+    );
+    add(
+        "footprint_px=8,slice_depth",
+        "clustered",
+        |o, v| {
+            o.grid = GridConfig {
+                slice_depth: v,
+                ..GridConfig::fixed(8.0)
+            }
+        },
+        pick(&[0.5], &[]),
     );
     // The per-cascade rectangle of earlier versions (1 = cascade box), automatic grid.
     add(

@@ -65,6 +65,11 @@ impl ClusterGrid {
         let c = config.cascades.max(1);
         let min_cell = config.min_cell_size.unwrap_or(0.0).max(0.0);
         let split = config.first_split.filter(|d| d.is_finite());
+        let slice_depth = if config.slice_depth.is_finite() {
+            config.slice_depth.clamp(1.0 / 16.0, 16.0)
+        } else {
+            1.0
+        };
         let (mapping, d0) = match projection {
             // The first split is moved back from a tiny near plane (Olsson's remedy) but
             // never past 1/4096 of the far end: a 1e-4 near plane does not make 12 cascades
@@ -104,14 +109,17 @@ impl ClusterGrid {
             let tiles =
                 |px: u32| ((px as f64 / footprint).ceil() as u32).clamp(1, config.max_tiles.max(1));
             let (tiles_x, tiles_y) = (tiles(width), tiles(height));
-            // Slices about as deep as a cell is wide (Olsson 2012, Eq. 2).
-            let cell_width = footprint * pixel;
+            // Slices `slice_depth` times as deep as a cell is wide (1: Olsson 2012, Eq. 2).
+            let slice = footprint * pixel * slice_depth;
             let slices = match mapping {
                 DepthMapping::Log2 => {
-                    let rho = 1.0 + 2.0 * half_y / z_near.max(1e-300) / height as f64 * footprint;
+                    let rho = 1.0
+                        + 2.0 * half_y / z_near.max(1e-300) / height as f64
+                            * footprint
+                            * slice_depth;
                     ((z_far / z_near).ln() / rho.ln()).ceil()
                 }
-                DepthMapping::Linear => ((z_far - z_near) / cell_width.max(1e-300)).ceil(),
+                DepthMapping::Linear => ((z_far - z_near) / slice.max(1e-300)).ceil(),
             };
             let slices = if slices.is_finite() { slices as u32 } else { 1 }
                 .clamp(1, config.max_slices.max(1));

@@ -12,9 +12,15 @@ pub struct GridConfig {
     pub mode: GridMode,
     /// Number of depth cascades (Billeter uses 12).
     pub cascades: u32,
-    /// Target cell footprint in pixels (cells are about this wide and as deep as wide): the
-    /// fixed mode's, and where the automatic mode starts.
+    /// Target cell footprint in pixels (cells are about this wide, and `slice_depth` times as
+    /// deep): the fixed mode's, and where the automatic mode starts.
     pub footprint_px: f64,
+    /// Depth of a slice relative to a cell's width at its near end (1: cells about as deep as
+    /// wide, Olsson's choice). Thinner slices tighten the lists where surfaces are seen at a
+    /// grazing angle (a floor: a tile's fragments spread over many depths) at the cost of
+    /// proportionally more cells. Values outside `1/16..=16` are clamped, non-finite ones
+    /// read as 1. See docs/grid.md for what it buys.
+    pub slice_depth: f64,
     /// Where the first cascade starts (perspective: depths nearer than it share the first
     /// slice); `None`: at the near plane, or 1/4096 of the far end for a tiny near plane. The
     /// automatic mode sets it a little before the nearest surface, so no slice is spent on the
@@ -64,6 +70,7 @@ impl Default for GridConfig {
             mode: GridMode::Auto,
             cascades: 12,
             footprint_px: 64.0,
+            slice_depth: 1.0,
             first_split: None,
             min_cell_size: None,
             max_slices: 32,
@@ -89,6 +96,7 @@ impl GridConfig {
             mode: GridMode::Fixed,
             cascades: 1,
             footprint_px: tile_px,
+            slice_depth: 1.0,
             first_split: None,
             min_cell_size: Some(0.0),
             max_slices: 1,

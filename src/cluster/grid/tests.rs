@@ -84,6 +84,55 @@ fn depth_mapping_is_monotonic_and_covers_near_to_infinity() {
     }
 }
 
+/// `slice_depth` sets how deep a slice is against a cell's width (below the slice cap), and
+/// thinner slices make proportionally more of them.
+#[test]
+fn slice_depth_sets_the_depth_to_width_ratio() {
+    let cubical = persp_with(0.1, 80.0, &GridConfig::fixed(32.0));
+    for ratio in [0.5, 2.0] {
+        let config = GridConfig {
+            slice_depth: ratio,
+            ..GridConfig::fixed(32.0)
+        };
+        let g = persp_with(0.1, 80.0, &config);
+        for (k, c) in g.cascades.iter().enumerate() {
+            let (z0, z1) = g.slice_depth_range(k as u32, 0);
+            let z0 = z0.max(c.z_near);
+            // The footprint's width (the tiles round it down a little).
+            let width = 2.0 * z0 * (30f64).to_radians().tan() / g.height as f64 * 32.0;
+            let r = (z1 - z0) / width;
+            if c.slices > 1 && c.slices < config.max_slices {
+                assert!(
+                    (0.45 * ratio..=1.01 * ratio).contains(&r),
+                    "slice_depth {ratio}, cascade {k}: depth / width = {r}"
+                );
+            }
+        }
+        let slices = |g: &ClusterGrid| g.cascades.iter().map(|c| c.slices).sum::<u32>() as f64;
+        let more = slices(&g) / slices(&cubical);
+        assert!(
+            (0.7 / ratio..=1.3 / ratio).contains(&more),
+            "slice_depth {ratio}: {more}× the slices"
+        );
+    }
+    // Hostile values read as 1 (not finite) or clamp to 1/16 (zero, negative, tiny): never
+    // zero-depth slices or a division by zero.
+    let slices_with = |slice_depth: f64| {
+        let config = GridConfig {
+            slice_depth,
+            ..GridConfig::fixed(32.0)
+        };
+        let g = persp_with(0.1, 80.0, &config);
+        g.cascades.iter().map(|c| c.slices).collect::<Vec<_>>()
+    };
+    for hostile in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+        assert_eq!(slices_with(hostile), slices_with(1.0), "{hostile}");
+    }
+    for hostile in [0.0, -1.0, 1e-300] {
+        assert_eq!(slices_with(hostile), slices_with(1.0 / 16.0), "{hostile}");
+    }
+}
+
 #[test]
 fn cells_are_roughly_cubical_or_clamped_to_the_minimum() {
     let g = persp(0.1, 80.0);
