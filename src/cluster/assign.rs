@@ -43,6 +43,7 @@
 use super::assign_bands::Bands;
 use super::assign_chunks::Chunks;
 use super::grid::ClusterGrid;
+use super::index_list::IndexList;
 use super::overflow::{apply_cap, Overflow};
 use super::pack::GpuLight;
 
@@ -103,8 +104,8 @@ pub struct Assignment {
     pub offsets: Vec<u32>,
     /// Per cell: number of lights (≤ the cap).
     pub counts: Vec<u32>,
-    /// Positions in `visible`, grouped by cell.
-    pub indices: Vec<u32>,
+    /// Positions in `visible`, grouped by cell (16-bit while they fit).
+    pub indices: IndexList,
     /// Figures.
     pub stats: AssignStats,
 }

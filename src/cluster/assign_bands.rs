@@ -7,6 +7,7 @@ use std::time::Instant;
 use super::assign::{Assignment, Run, Totals};
 use super::cells::{for_each_run_in, SliceWindow};
 use super::grid::ClusterGrid;
+use super::index_list::{EntriesMut, LightIndex};
 use super::pack::GpuLight;
 
 /// The bands and their buffers, kept between frames.
@@ -131,8 +132,10 @@ impl Bands {
         }
         // Phase 3. Every entry is written, so the list is not cleared first: only growth is
         // zero-filled.
-        out.indices.resize(totals.indices, 0);
-        scatter_bands(bands, &mut out.offsets, &mut out.indices, parallel);
+        match out.indices.prepare(totals.indices, out.visible.len()) {
+            EntriesMut::Narrow(list) => scatter_bands(bands, &mut out.offsets, list, parallel),
+            EntriesMut::Wide(list) => scatter_bands(bands, &mut out.offsets, list, parallel),
+        }
         totals
     }
 }
@@ -215,7 +218,7 @@ impl Band {
     /// the runs are taken in reverse, each write one place before the last, so every cell's
     /// list comes out ascending in light order and each offset ends where its list starts
     /// (no cursor array: a fine grid's assignment runs cache-cold in a renderer).
-    fn scatter(&mut self, offsets: &mut [u32], list: &mut [u32]) {
+    fn scatter<T: LightIndex>(&mut self, offsets: &mut [u32], list: &mut [T]) {
         let started = Instant::now();
         let mut end = self.runs.len();
         for (&(_, start), &id) in self.lights.iter().rev().zip(self.ids.iter().rev()) {
@@ -224,7 +227,7 @@ impl Band {
                 let a = run.start as usize;
                 for at in &mut offsets[a..a + run.len as usize] {
                     *at -= 1;
-                    list[*at as usize] = id;
+                    list[*at as usize] = T::from_u32(id);
                 }
             }
             end = start;
@@ -327,7 +330,12 @@ fn count_bands(bands: &mut [Band], counts: &mut [u32], offsets: &mut [u32], para
 
 /// Phase 3 ([`Band::scatter`]) over `offsets` and the index list `list` (from the first band's
 /// cell and entry on), the halves of the bands at once with `parallel`.
-fn scatter_bands(bands: &mut [Band], offsets: &mut [u32], list: &mut [u32], parallel: bool) {
+fn scatter_bands<T: LightIndex>(
+    bands: &mut [Band],
+    offsets: &mut [u32],
+    list: &mut [T],
+    parallel: bool,
+) {
     if let [band] = bands {
         band.scatter(offsets, list);
         return;

@@ -7,6 +7,7 @@ use rayon::prelude::*;
 use super::assign::{Assignment, Run, Totals};
 use super::cells::for_each_run;
 use super::grid::ClusterGrid;
+use super::index_list::{EntriesMut, LightIndex};
 use super::pack::GpuLight;
 
 /// The chunks and their buffers, kept between frames.
@@ -68,20 +69,17 @@ impl Chunks {
             total += n;
             o
         }));
-        out.indices.resize(total as usize, 0);
         // Phase 3: each chunk sorts its lights locally, then blocks of cells gather the
         // chunks' runs into the final list (contiguous, disjoint slices: no sharing).
         self.chunks
             .par_iter_mut()
             .zip(first_ids.par_iter())
             .for_each(|(chunk, &first_id)| chunk.sort_locally(first_id, cells));
-        merge(
-            &self.chunks,
-            &out.offsets,
-            &mut out.indices,
-            threads,
-            &mut self.blocks,
-        );
+        let (chunks, blocks) = (&self.chunks, &mut self.blocks);
+        match out.indices.prepare(total as usize, out.visible.len()) {
+            EntriesMut::Narrow(list) => merge(chunks, &out.offsets, list, threads, blocks),
+            EntriesMut::Wide(list) => merge(chunks, &out.offsets, list, threads, blocks),
+        }
         Totals::of(&out.counts)
     }
 }
@@ -180,10 +178,10 @@ impl Chunk {
 
 /// Concatenates the chunks' per-cell runs into `indices`, in parallel over blocks of cells
 /// with about equal numbers of indices (`blocks` is the buffer they are listed in).
-fn merge(
+fn merge<T: LightIndex>(
     chunks: &[Chunk],
     offsets: &[u32],
-    indices: &mut [u32],
+    indices: &mut [T],
     threads: usize,
     blocks: &mut Vec<(usize, usize)>,
 ) {
@@ -194,7 +192,12 @@ fn merge(
 /// Gathers the cells of `blocks` (contiguous, in cell order) into `out`, which starts at the
 /// first block's first index: the two halves of the blocks in parallel (`rayon::join` keeps
 /// its jobs on the stack, so no list of jobs is allocated).
-fn merge_blocks(chunks: &[Chunk], offsets: &[u32], blocks: &[(usize, usize)], out: &mut [u32]) {
+fn merge_blocks<T: LightIndex>(
+    chunks: &[Chunk],
+    offsets: &[u32],
+    blocks: &[(usize, usize)],
+    out: &mut [T],
+) {
     match blocks {
         [] => {}
         &[(c0, c1)] => {
@@ -202,7 +205,10 @@ fn merge_blocks(chunks: &[Chunk], offsets: &[u32], blocks: &[(usize, usize)], ou
             for cell in c0..c1 {
                 for chunk in chunks {
                     let (o, n) = (chunk.offsets[cell] as usize, chunk.count(cell) as usize);
-                    out[at..at + n].copy_from_slice(&chunk.sorted[o..o + n]);
+                    let from = &chunk.sorted[o..o + n];
+                    for (entry, &id) in out[at..at + n].iter_mut().zip(from) {
+                        *entry = T::from_u32(id);
+                    }
                     at += n;
                 }
             }

@@ -136,9 +136,10 @@ fn cell_lights(a: &Assignment, cell: u32) -> Vec<u32> {
         a.offsets[cell as usize] as usize,
         a.counts[cell as usize] as usize,
     );
-    a.indices[o..o + n]
-        .iter()
-        .map(|&i| a.visible[i as usize])
+    a.indices
+        .range(o..o + n)
+        .into_iter()
+        .map(|i| a.visible[i as usize])
         .collect()
 }
 
@@ -340,7 +341,11 @@ fn overflow_keeps_the_cap_counts_the_rest_and_stays_in_range() {
     for (o, n) in a.offsets.iter().zip(&a.counts) {
         assert!((*o + *n) as usize <= a.indices.len());
     }
-    assert!(a.indices.iter().all(|&i| (i as usize) < a.visible.len()));
+    assert!(a
+        .indices
+        .to_vec()
+        .iter()
+        .all(|&i| (i as usize) < a.visible.len()));
     // The brightest lights are the ones kept.
     let full = a.counts.iter().position(|&n| n == 255).unwrap() as u32;
     let kept_lights = cell_lights(&a, full);
@@ -597,6 +602,88 @@ fn fewer_chunks_than_threads_keep_nothing_stale() {
         assert_eq!(one.visible, chunks.visible, "{count} lights");
         assert_eq!(one.counts, chunks.counts, "{count} lights");
         assert_eq!(one.indices, chunks.indices, "{count} lights");
+    }
+}
+
+/// Past 65 536 visible lights the list is 32-bit, on both parallel paths and one thread,
+/// with and without the overflow policy trimming it, and every cell lists exactly the lights
+/// whose runs cover it, ascending; at most 65 536 it is 16-bit with the same lists.
+#[test]
+fn past_65536_visible_lights_the_list_is_32_bit_and_the_same() {
+    let t = (30f64).to_radians().tan();
+    let projection = GridProjection::Perspective {
+        tan_x: t * 16.0 / 9.0,
+        tan_y: t,
+    };
+    let mut rng = Pcg64Mcg::seed_from_u64(65_537);
+    // Small lights spread over the view, nearly all visible.
+    let lights: Vec<GpuLight> = (0..70_000)
+        .map(|_| {
+            let d = rng.random_range(1.0..40.0);
+            let p = DVec3::new(
+                rng.random_range(-0.9..0.9) * t * 16.0 / 9.0 * d,
+                rng.random_range(-0.9..0.9) * t * d,
+                -d,
+            );
+            let light = Light::point(p, rng.random_range(0.05..0.4) as f32, Vec3::ONE, 1.0);
+            GpuLight::from_light(&light, &glam::DMat4::IDENTITY)
+        })
+        .collect();
+    // A grid with more cells than lights (bands) and one with fewer (chunks of lights).
+    for footprint in [8.0, 64.0] {
+        let config = GridConfig::fixed(footprint);
+        let grid = ClusterGrid::new(640, 360, projection, 0.1, 50.0, &config);
+        let mut reference = vec![Vec::new(); grid.total_cells as usize];
+        for (i, light) in lights.iter().enumerate() {
+            super::cells::for_each_run(&grid, light, 50.0, &mut |start, len| {
+                for cell in start..start + len {
+                    reference[cell as usize].push(i as u32);
+                }
+            });
+        }
+        for (threshold, cap) in [(1, u32::MAX), (usize::MAX, u32::MAX), (1, 3)] {
+            let limits = AssignLimits {
+                parallel_threshold: threshold,
+                cell_cap: cap,
+                max_indices: usize::MAX,
+            };
+            let a = assign(&grid, &lights, 50.0, &limits);
+            let what = format!(
+                "{footprint} px, threshold {threshold}, cap {cap}, {:?}",
+                a.stats
+            );
+            assert!(a.visible.len() > 65_536, "{what}: {}", a.visible.len());
+            assert!(
+                a.indices.as_u32().is_some() && a.indices.as_u16().is_none(),
+                "{what}"
+            );
+            for (cell, listed) in reference.iter().enumerate() {
+                let got = cell_lights(&a, cell as u32);
+                if cap == u32::MAX {
+                    assert_eq!(&got, listed, "{what}: cell {cell}");
+                } else {
+                    assert_eq!(got.len(), listed.len().min(cap as usize), "{what}");
+                    assert!(got.windows(2).all(|w| w[0] < w[1]), "{what}: {got:?}");
+                    assert!(got.iter().all(|l| listed.contains(l)), "{what}: {got:?}");
+                }
+            }
+        }
+        // The same grid with the first 60 000 lights: 16-bit, the same lists.
+        let few = &lights[..60_000];
+        let limits = AssignLimits {
+            cell_cap: u32::MAX,
+            max_indices: usize::MAX,
+            ..Default::default()
+        };
+        let a = assign(&grid, few, 50.0, &limits);
+        assert!(
+            a.indices.as_u16().is_some(),
+            "{footprint} px, 60 000 lights"
+        );
+        for (cell, listed) in reference.iter().enumerate() {
+            let expected: Vec<u32> = listed.iter().copied().filter(|&l| l < 60_000).collect();
+            assert_eq!(cell_lights(&a, cell as u32), expected, "cell {cell}");
+        }
     }
 }
 

@@ -14,6 +14,7 @@ pub mod cells;
 mod cone;
 mod depth_lookup;
 pub mod grid;
+pub mod index_list;
 mod overflow;
 pub mod pack;
 pub mod pack_grid;

@@ -5,13 +5,14 @@ use std::cell::RefCell;
 
 use super::assign::{AssignLimits, Assignment, PARALLEL_INDICES};
 use super::grid::{CellCoord, ClusterGrid};
+use super::index_list::{EntriesMut, IndexList, LightIndex};
 use super::pack::GpuLight;
 
 /// Buffers of the overflow policy, kept between frames.
 #[derive(Default)]
 pub(super) struct Overflow {
     /// The compacted list, swapped with the assignment's (which becomes the next spare).
-    kept: Vec<u32>,
+    kept: IndexList,
     /// The overfull cells: (cell, offset, count).
     lists: Vec<(u32, usize, usize)>,
     /// What importance reads of each visible light (see [`trim_overfull_cells`]).
@@ -37,19 +38,42 @@ pub(super) fn apply_cap(
     trim_overfull_cells(out, grid, lights, cap, scratch);
     // Compact: every cell keeps the first `cap` entries of its list (the trim put the kept
     // lights there, in ascending order).
-    let kept = &mut scratch.kept;
-    kept.clear();
-    kept.reserve(out.indices.len().min(limits.max_indices));
-    for cell in 0..out.counts.len() {
-        let (o, n) = (out.offsets[cell] as usize, out.counts[cell] as usize);
-        let keep = n.min(cap as usize);
-        out.stats.overflowed_lights += (n - keep) as u64;
-        out.offsets[cell] = kept.len() as u32;
-        out.counts[cell] = keep as u32;
-        kept.extend_from_slice(&out.indices[o..o + keep]);
-    }
-    std::mem::swap(&mut out.indices, kept);
+    let total: usize = out.counts.iter().map(|&n| n.min(cap) as usize).sum();
+    let (offsets, counts) = (&mut out.offsets, &mut out.counts);
+    let dropped = match (
+        scratch.kept.prepare(total, out.visible.len()),
+        out.indices.as_u16(),
+        out.indices.as_u32(),
+    ) {
+        (EntriesMut::Narrow(kept), Some(list), _) => compact(list, kept, offsets, counts, cap),
+        (EntriesMut::Wide(kept), _, Some(list)) => compact(list, kept, offsets, counts, cap),
+        _ => unreachable!("a list's width follows its visible lights, the same for both"),
+    };
+    out.stats.overflowed_lights += dropped;
+    std::mem::swap(&mut out.indices, &mut scratch.kept);
     true
+}
+
+/// Copies the first `cap` entries of every cell's list of `list` into `kept` (as long as
+/// their sum), moving `offsets` and `counts` with them; the entries dropped.
+fn compact<T: LightIndex>(
+    list: &[T],
+    kept: &mut [T],
+    offsets: &mut [u32],
+    counts: &mut [u32],
+    cap: u32,
+) -> u64 {
+    let (mut at, mut dropped) = (0, 0);
+    for (offset, count) in offsets.iter_mut().zip(counts.iter_mut()) {
+        let (o, n) = (*offset as usize, *count as usize);
+        let keep = n.min(cap as usize);
+        dropped += (n - keep) as u64;
+        kept[at..at + keep].copy_from_slice(&list[o..o + keep]);
+        *offset = at as u32;
+        *count = keep as u32;
+        at += keep;
+    }
+    dropped
 }
 
 thread_local! {
@@ -88,50 +112,66 @@ fn trim_overfull_cells(
         [p.x, p.y, p.z, light.radiance.max_element()]
     }));
     let packed = &scratch.packed[..];
-    let trim = |cell: u32, list: &mut [u32]| {
-        if cap == 0 {
-            return;
-        }
-        let center = cell_center(grid, cell);
-        TRIM_KEYS.with_borrow_mut(|(keys, order)| {
-            keys.clear();
-            keys.extend(list.iter().map(|&i| {
-                let [x, y, z, brightness] = packed[i as usize];
-                let position = glam::DVec3::new(x as f64, y as f64, z as f64);
-                brightness_over_distance(brightness, position, center)
-            }));
-            // The cap-th largest key is the threshold: every light above it stays, and of
-            // those equal to it the earliest, until the cap is reached. One selection and one
-            // pass in list order, so the kept lights stay in ascending order without a sort.
-            order.clear();
-            order.extend_from_slice(keys);
-            let (_, &mut threshold, _) =
-                order.select_nth_unstable_by(cap - 1, |a, b| b.total_cmp(a));
-            let mut ties = cap
-                - keys
-                    .iter()
-                    .filter(|k| k.total_cmp(&threshold) == std::cmp::Ordering::Greater)
-                    .count();
-            let mut kept = 0;
-            for at in 0..list.len() {
-                let keep = match keys[at].total_cmp(&threshold) {
-                    std::cmp::Ordering::Greater => true,
-                    std::cmp::Ordering::Equal if ties > 0 => {
-                        ties -= 1;
-                        true
-                    }
-                    _ => false,
-                };
-                if keep {
-                    list[kept] = list[at];
-                    kept += 1;
-                }
-            }
-            debug_assert_eq!(kept, cap);
-        });
-    };
     let parallel = scratch.lists.iter().map(|&(_, _, n)| n).sum::<usize>() >= PARALLEL_INDICES;
-    trim_lists(&scratch.lists, &mut out.indices, 0, parallel, &trim);
+    let lists = &scratch.lists[..];
+    match out.indices.entries_mut() {
+        EntriesMut::Narrow(list) => trim_lists(lists, list, 0, parallel, &|cell, list| {
+            trim_cell(grid, packed, cap, cell, list)
+        }),
+        EntriesMut::Wide(list) => trim_lists(lists, list, 0, parallel, &|cell, list| {
+            trim_cell(grid, packed, cap, cell, list)
+        }),
+    }
+}
+
+/// Moves the `cap` most important of `list`'s lights (cell `cell`'s; `packed` is what
+/// importance reads of each visible light) to its front, in ascending order.
+fn trim_cell<T: LightIndex>(
+    grid: &ClusterGrid,
+    packed: &[[f32; 4]],
+    cap: usize,
+    cell: u32,
+    list: &mut [T],
+) {
+    if cap == 0 {
+        return;
+    }
+    let center = cell_center(grid, cell);
+    TRIM_KEYS.with_borrow_mut(|(keys, order)| {
+        keys.clear();
+        keys.extend(list.iter().map(|&i| {
+            let [x, y, z, brightness] = packed[i.to_usize()];
+            let position = glam::DVec3::new(x as f64, y as f64, z as f64);
+            brightness_over_distance(brightness, position, center)
+        }));
+        // The cap-th largest key is the threshold: every light above it stays, and of
+        // those equal to it the earliest, until the cap is reached. One selection and one
+        // pass in list order, so the kept lights stay in ascending order without a sort.
+        order.clear();
+        order.extend_from_slice(keys);
+        let (_, &mut threshold, _) = order.select_nth_unstable_by(cap - 1, |a, b| b.total_cmp(a));
+        let mut ties = cap
+            - keys
+                .iter()
+                .filter(|k| k.total_cmp(&threshold) == std::cmp::Ordering::Greater)
+                .count();
+        let mut kept = 0;
+        for at in 0..list.len() {
+            let keep = match keys[at].total_cmp(&threshold) {
+                std::cmp::Ordering::Greater => true,
+                std::cmp::Ordering::Equal if ties > 0 => {
+                    ties -= 1;
+                    true
+                }
+                _ => false,
+            };
+            if keep {
+                list[kept] = list[at];
+                kept += 1;
+            }
+        }
+        debug_assert_eq!(kept, cap);
+    });
 }
 
 /// Entries of the index list below which [`trim_lists`] trims its lists on one thread.
@@ -140,12 +180,12 @@ const TRIM_GRAIN: usize = 1 << 14;
 /// Trims the lists `lists` (cell, offset, count; in cell order) of `indices`, whose first
 /// entry is list entry `base`: on the calling thread, or with `parallel` the two halves of
 /// the lists at once (`rayon::join` keeps its jobs on the stack), down to [`TRIM_GRAIN`].
-fn trim_lists(
+fn trim_lists<T: LightIndex>(
     lists: &[(u32, usize, usize)],
-    indices: &mut [u32],
+    indices: &mut [T],
     base: usize,
     parallel: bool,
-    trim: &(dyn Fn(u32, &mut [u32]) + Sync),
+    trim: &(dyn Fn(u32, &mut [T]) + Sync),
 ) {
     let span = lists.last().map_or(0, |&(_, o, n)| o + n) - lists.first().map_or(0, |l| l.1);
     if !parallel || lists.len() < 2 || span < TRIM_GRAIN {

@@ -26,6 +26,7 @@
 
 use super::assign::Assignment;
 use super::grid::ClusterGrid;
+use super::index_list::IndexList;
 use super::pack::DATA_TEXTURE_WIDTH;
 
 /// Texels per cascade in the grid texture's table.
@@ -158,15 +159,16 @@ pub fn pack_grid_into(
     packed.height = height;
 }
 
-/// Packs the index list (16-bit light numbers).
-pub fn pack_indices(indices: &[u32], encoding: GridEncoding) -> PackedTexels {
+/// Packs the index list (16-bit light numbers; entries of a 32-bit list keep their low 16
+/// bits: a renderer refuses more than [`MAX_INDEXED_LIGHTS`] visible lights before packing).
+pub fn pack_indices(indices: &IndexList, encoding: GridEncoding) -> PackedTexels {
     let mut packed = PackedTexels::empty();
     pack_indices_into(indices, encoding, &mut packed);
     packed
 }
 
 /// [`pack_indices`] into `packed`, reusing its bytes (no allocation once they have grown).
-pub fn pack_indices_into(indices: &[u32], encoding: GridEncoding, packed: &mut PackedTexels) {
+pub fn pack_indices_into(indices: &IndexList, encoding: GridEncoding, packed: &mut PackedTexels) {
     let per_texel = match encoding {
         GridEncoding::Rgba8 => 2,
         GridEncoding::Uint => 1,
@@ -182,16 +184,23 @@ pub fn pack_indices_into(indices: &[u32], encoding: GridEncoding, packed: &mut P
         DATA_TEXTURE_WIDTH as usize * height as usize * texel_bytes,
         0,
     );
-    for (i, &light) in indices.iter().enumerate() {
-        let v = light as u16;
-        match encoding {
-            // Big-endian pairs: texel i/2 holds index i in .xy (i even) or .zw (i odd).
-            GridEncoding::Rgba8 => bytes[i * 2..i * 2 + 2].copy_from_slice(&v.to_be_bytes()),
-            GridEncoding::Uint => bytes[i * 2..i * 2 + 2].copy_from_slice(&v.to_le_bytes()),
-        }
+    match (indices.as_u16(), indices.as_u32()) {
+        (Some(list), _) => put_indices(bytes, list.iter().copied(), encoding),
+        (_, Some(list)) => put_indices(bytes, list.iter().map(|&v| v as u16), encoding),
+        _ => {}
     }
     packed.width = DATA_TEXTURE_WIDTH;
     packed.height = height;
+}
+
+/// Writes `values` two bytes each: big-endian pairs for RGBA8 (texel i/2 holds index i in .xy
+/// when i is even, .zw when odd), little-endian for R16UI.
+fn put_indices(bytes: &mut [u8], values: impl Iterator<Item = u16>, encoding: GridEncoding) {
+    let pairs = bytes.chunks_exact_mut(2).zip(values);
+    match encoding {
+        GridEncoding::Rgba8 => pairs.for_each(|(pair, v)| pair.copy_from_slice(&v.to_be_bytes())),
+        GridEncoding::Uint => pairs.for_each(|(pair, v)| pair.copy_from_slice(&v.to_le_bytes())),
+    }
 }
 
 /// Reads a cell's (offset, count) back exactly as the shader decodes it.
@@ -274,7 +283,7 @@ mod tests {
                     (a.offsets[cell as usize], a.counts[cell as usize])
                 );
             }
-            for (i, &v) in a.indices.iter().enumerate() {
+            for (i, v) in a.indices.to_vec().into_iter().enumerate() {
                 assert_eq!(unpack_index(&ix, i, enc), v);
             }
             assert_eq!(g.width, DATA_TEXTURE_WIDTH);
