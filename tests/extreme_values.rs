@@ -115,6 +115,39 @@ fn values_the_maths_cannot_carry_are_refused_naming_the_real_field() {
     }
 }
 
+/// Grid settings the grid cannot be built from are refused naming the field (a NaN would never
+/// equal itself, so the grid would be rebuilt and re-chosen every frame).
+#[test]
+fn grid_settings_that_are_not_finite_are_refused_naming_the_field() {
+    let mut gpu = Gpu::new(EsVersion::Es3);
+    let s = plane(vec![point(3.0)]);
+    for (field, value) in [
+        ("grid.slice_depth", f64::NAN),
+        ("grid.slice_depth", f64::INFINITY),
+        ("grid.slice_depth", 0.0),
+        ("grid.footprint_px", f64::NAN),
+        ("grid.footprint_px", -8.0),
+    ] {
+        let mut options = RenderOptions::default();
+        match field {
+            "grid.slice_depth" => options.grid.slice_depth = value,
+            _ => options.grid.footprint_px = value,
+        }
+        let err = gpu
+            .r()
+            .render_offscreen(&s, 16, 16, &options)
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains(field), "{field} = {value}: {err}");
+    }
+    // In range, or clamped into it: renders.
+    for slice_depth in [0.5, 100.0] {
+        let mut options = RenderOptions::default();
+        options.grid.slice_depth = slice_depth;
+        assert!(gpu.r().render_offscreen(&s, 16, 16, &options).is_ok());
+    }
+}
+
 #[test]
 fn obj_vertices_near_the_f32_limit_are_refused_as_vertices_not_as_lights() {
     let dir = tempfile::tempdir().unwrap();

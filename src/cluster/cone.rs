@@ -81,7 +81,7 @@ impl Cone {
     }
 
     /// False only when the cell's bounding sphere is certainly outside the cone (up to the
-    /// light's range): the test [`Cone::touched_span`] solves for a whole row at once, kept
+    /// light's range): the test [`ConeSlice::columns`] solves for a whole row at once, kept
     /// as its yardstick in the tests.
     #[cfg(test)]
     pub(crate) fn may_touch(&self, &[x, y, z, radius]: &[f64; 4]) -> bool {
@@ -121,8 +121,8 @@ pub(crate) struct ConeSlice<'a> {
 impl ConeSlice<'_> {
     /// The first and last of the columns `x0..=x1` of row `row` whose cells the cone may
     /// touch, or `None`: a superset of the cells whose bounding sphere of radius `r` (every
-    /// cell's, see [`SliceCells`]) [`Cone::may_touch`] passes, in closed form instead of cell
-    /// by cell.
+    /// cell's, see [`SliceCells`]) passes the cell-by-cell cone test (`Cone::may_touch`, kept
+    /// for the tests), in closed form instead of cell by cell.
     ///
     /// Along the row the centre is `v(t) = v₀ + t·(sx, 0, 0)` from the apex (`t` the column),
     /// and with `v₁ = v·axis` and `w = v − v₁·axis` (the part off the axis) a cell passes where
@@ -155,8 +155,8 @@ impl ConeSlice<'_> {
             return None;
         }
         let b = 2.0 * self.sx * (cone.cos_sq * w0.x - cone.sin * cone.axis.x * h0);
-        let c = cone.cos_sq * w0.length_squared() - h0 * h0;
-        let (lo, hi) = quadratic_nonpositive(self.a, b, c, span)?;
+        let (off_axis, reach) = (cone.cos_sq * w0.length_squared(), h0 * h0);
+        let (lo, hi) = quadratic_nonpositive(self.a, b, off_axis - reach, off_axis + reach, span)?;
         // Widened, then the whole cells inside (by conversions: `ceil` and `floor` are library
         // calls on a baseline x86-64 target).
         let margin = |t: f64| 1e-6 * (1.0 + t.abs());
@@ -179,7 +179,8 @@ fn keep_nonnegative((lo, hi): (f64, f64), a: f64, b: f64) -> Option<(f64, f64)> 
         (lo.max(-a / b), hi)
     } else if b < 0.0 {
         (lo, hi.min(-a / b))
-    } else if a >= 0.0 {
+    } else if a >= 0.0 || a.is_nan() {
+        // Also for NaN (an overflowed coefficient): keep the span.
         (lo, hi)
     } else {
         return None;
@@ -188,12 +189,19 @@ fn keep_nonnegative((lo, hi): (f64, f64), a: f64, b: f64) -> Option<(f64, f64)> 
 }
 
 /// The smallest interval holding every `t` of `span` where `a·t² + b·t + c ≤ 0` (with a
-/// tolerance: the inequality is loosened by a billionth of its terms' size over the span, so
-/// a rounding error in the coefficients cannot make a touching row look empty), or `None`.
+/// tolerance: the inequality is loosened by a billionth of its terms' size over the span —
+/// `c_terms` is the size of what `c` was computed from, before any cancellation — so a
+/// rounding error in the coefficients cannot make a touching row look empty), or `None`.
 #[inline(always)]
-fn quadratic_nonpositive(a: f64, b: f64, c: f64, (lo, hi): (f64, f64)) -> Option<(f64, f64)> {
+fn quadratic_nonpositive(
+    a: f64,
+    b: f64,
+    c: f64,
+    c_terms: f64,
+    (lo, hi): (f64, f64),
+) -> Option<(f64, f64)> {
     let t = lo.abs().max(hi.abs()).max(1.0);
-    let c = c - 1e-9 * (c.abs() + b.abs() * t + a.abs() * t * t);
+    let c = c - 1e-9 * (c_terms.abs() + b.abs() * t + a.abs() * t * t);
     if a == 0.0 {
         // b·t + c ≤ 0.
         return keep_nonnegative((lo, hi), -c, -b);

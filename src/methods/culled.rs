@@ -228,7 +228,8 @@ impl ShadingMethod for CulledForward {
         if texels > max_rows * DATA_TEXTURE_WIDTH as usize {
             return Err(Error::Limit(format!(
                 "a {} px cell footprint (grid.footprint_px) makes {} grid cells; this context's \
-                 grid texture holds {}: use a larger footprint or the automatic grid",
+                 grid texture holds {}: use a larger footprint, deeper slices (grid.slice_depth) \
+                 or the automatic grid",
                 grid_key.config.footprint_px,
                 grid.total_cells,
                 max_rows * DATA_TEXTURE_WIDTH as usize - (texels - grid.total_cells as usize)

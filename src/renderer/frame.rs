@@ -62,6 +62,19 @@ impl Renderer {
         if samples <= 1 {
             return self.render_frame(scene, width, height, options, stats);
         }
+        // Non-finite grid settings: a NaN never equals itself, so the grid would be rebuilt and
+        // re-chosen every frame.
+        for (field, value) in [
+            ("grid.footprint_px", options.grid.footprint_px),
+            ("grid.slice_depth", options.grid.slice_depth),
+        ] {
+            if !(value.is_finite() && value > 0.0) {
+                return Err(Error::Scene(crate::scene::SceneError::invalid(
+                    field,
+                    format!("must be a finite number above 0, got {value}"),
+                )));
+            }
+        }
         if width == 0 || height == 0 {
             return Err(Error::Limit(format!("viewport {width}×{height} is empty")));
         }
@@ -115,6 +128,19 @@ impl Renderer {
                 "exposure_ev",
                 format!("must be within ±15 stops, got {}", options.exposure_ev),
             )));
+        }
+        // Non-finite grid settings: a NaN never equals itself, so the grid would be rebuilt and
+        // re-chosen every frame.
+        for (field, value) in [
+            ("grid.footprint_px", options.grid.footprint_px),
+            ("grid.slice_depth", options.grid.slice_depth),
+        ] {
+            if !(value.is_finite() && value > 0.0) {
+                return Err(Error::Scene(crate::scene::SceneError::invalid(
+                    field,
+                    format!("must be a finite number above 0, got {value}"),
+                )));
+            }
         }
         if width == 0 || height == 0 {
             return Err(Error::Limit(format!("viewport {width}×{height} is empty")));

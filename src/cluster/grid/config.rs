@@ -18,8 +18,9 @@ pub struct GridConfig {
     /// Depth of a slice relative to a cell's width at its near end (1: cells about as deep as
     /// wide, Olsson's choice). Thinner slices tighten the lists where surfaces are seen at a
     /// grazing angle (a floor: a tile's fragments spread over many depths) at the cost of
-    /// proportionally more cells. Values outside `1/16..=16` are clamped, non-finite ones
-    /// read as 1. See docs/grid.md for what it buys.
+    /// proportionally more cells. Values outside `1/16..=16` are clamped; a non-finite one is
+    /// refused by the renderer (`ClusterGrid::new` reads it as 1). See docs/grid.md for what
+    /// it buys.
     pub slice_depth: f64,
     /// Where the first cascade starts (perspective: depths nearer than it share the first
     /// slice); `None`: at the near plane, or 1/4096 of the far end for a tiny near plane. The
@@ -30,7 +31,8 @@ pub struct GridConfig {
     /// cascade has cells of `footprint_px` (the grid starts at the first geometry, see
     /// [`GridConfig::first_split`], so near cascades are not wasted on empty space).
     pub min_cell_size: Option<f64>,
-    /// Upper bound on slices per cascade.
+    /// Upper bound on slices per cascade (never above 255, what the ES 2.0 grid texture's byte
+    /// holds).
     pub max_slices: u32,
     /// Upper bound on columns or rows of a cascade.
     pub max_tiles: u32,

@@ -3,10 +3,10 @@
 //! The view frustum is split in depth into `C` cascades. Perspective cameras space the cascade
 //! boundaries geometrically between a first split `d₀` and the far end `d_F` of what the scene
 //! can put on screen; orthographic cameras space them linearly. Every cascade has its own x/y
-//! resolution, chosen so cells are roughly cubical with an N×N pixel footprint at the
-//! cascade's near end, but never smaller than a minimum world size (no swarm of tiny cells
-//! near the camera), and its own number of slices, exponential inside the cascade (Olsson 2012
-//! Eq. 2: each slice about as deep as it is wide).
+//! resolution, chosen so cells have an N×N pixel footprint at the cascade's near end, but never
+//! smaller than a minimum world size when one is set, and its own number of slices,
+//! exponential inside the cascade (Olsson 2012 Eq. 2: each slice about as deep as it is wide,
+//! or `slice_depth` times that).
 //!
 //! One mapping serves CPU and GPU: with `f(d) = log2(d)` (perspective) or `f(d) = d`
 //! (orthographic), a view depth `d` has the continuous coordinate

@@ -133,6 +133,20 @@ fn slice_depth_sets_the_depth_to_width_ratio() {
     }
 }
 
+/// However many slices the settings ask for, a cascade has at most 255: the ES 2.0 grid
+/// texture stores the count in a byte.
+#[test]
+fn a_cascade_never_has_more_slices_than_a_byte_holds() {
+    let config = GridConfig {
+        cascades: 1,
+        slice_depth: 1.0 / 16.0,
+        max_slices: 100_000,
+        ..GridConfig::fixed(1.0)
+    };
+    let g = persp_with(0.1, 1e4, &config);
+    assert_eq!(g.cascades[0].slices, 255);
+}
+
 #[test]
 fn cells_are_roughly_cubical_or_clamped_to_the_minimum() {
     let g = persp(0.1, 80.0);
