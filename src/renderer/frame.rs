@@ -62,19 +62,6 @@ impl Renderer {
         if samples <= 1 {
             return self.render_frame(scene, width, height, options, stats);
         }
-        // Non-finite grid settings: a NaN never equals itself, so the grid would be rebuilt and
-        // re-chosen every frame.
-        for (field, value) in [
-            ("grid.footprint_px", options.grid.footprint_px),
-            ("grid.slice_depth", options.grid.slice_depth),
-        ] {
-            if !(value.is_finite() && value > 0.0) {
-                return Err(Error::Scene(crate::scene::SceneError::invalid(
-                    field,
-                    format!("must be a finite number above 0, got {value}"),
-                )));
-            }
-        }
         if width == 0 || height == 0 {
             return Err(Error::Limit(format!("viewport {width}×{height} is empty")));
         }
@@ -122,26 +109,7 @@ impl Renderer {
             log::warn!("{warning}");
         }
         scene.validate()?;
-        // 2^15 stays finite in fp16, where a device without fragment highp holds it.
-        if !(options.exposure_ev.is_finite() && options.exposure_ev.abs() <= 15.0) {
-            return Err(Error::Scene(crate::scene::SceneError::invalid(
-                "exposure_ev",
-                format!("must be within ±15 stops, got {}", options.exposure_ev),
-            )));
-        }
-        // Non-finite grid settings: a NaN never equals itself, so the grid would be rebuilt and
-        // re-chosen every frame.
-        for (field, value) in [
-            ("grid.footprint_px", options.grid.footprint_px),
-            ("grid.slice_depth", options.grid.slice_depth),
-        ] {
-            if !(value.is_finite() && value > 0.0) {
-                return Err(Error::Scene(crate::scene::SceneError::invalid(
-                    field,
-                    format!("must be a finite number above 0, got {value}"),
-                )));
-            }
-        }
+        check_options(options)?;
         if width == 0 || height == 0 {
             return Err(Error::Limit(format!("viewport {width}×{height} is empty")));
         }
@@ -303,4 +271,28 @@ impl Renderer {
         }
         Ok(())
     }
+}
+
+/// Refuses render options the frame cannot be made from, naming the field.
+fn check_options(options: &RenderOptions) -> Result<(), Error> {
+    let invalid = |field, why| Err(Error::Scene(crate::scene::SceneError::invalid(field, why)));
+    // 2^15 stays finite in fp16, where a device without fragment highp holds it.
+    if !(options.exposure_ev.is_finite() && options.exposure_ev.abs() <= 15.0) {
+        let why = format!("must be within ±15 stops, got {}", options.exposure_ev);
+        return invalid("exposure_ev", why);
+    }
+    // Non-finite grid settings: a NaN never equals itself, so the grid would be rebuilt and
+    // re-chosen every frame.
+    for (field, value) in [
+        ("grid.footprint_px", options.grid.footprint_px),
+        ("grid.slice_depth", options.grid.slice_depth),
+    ] {
+        if !(value.is_finite() && value > 0.0) {
+            return invalid(
+                field,
+                format!("must be a finite number above 0, got {value}"),
+            );
+        }
+    }
+    Ok(())
 }
