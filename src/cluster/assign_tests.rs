@@ -19,11 +19,7 @@ struct Case {
 }
 
 fn cases() -> Vec<Case> {
-    let t = (30f64).to_radians().tan();
-    let persp = GridProjection::Perspective {
-        tan_x: t * 16.0 / 9.0,
-        tan_y: t,
-    };
+    let persp = GridProjection::test_view();
     vec![
         Case {
             name: "default",
@@ -372,14 +368,10 @@ fn overflow_keeps_the_cap_counts_the_rest_and_stays_in_range() {
 #[test]
 fn parallel_and_sequential_assignment_agree() {
     let mut rng = Pcg64Mcg::seed_from_u64(3);
-    let t = (30f64).to_radians().tan();
     let grid = ClusterGrid::new(
         640,
         360,
-        GridProjection::Perspective {
-            tan_x: t * 16.0 / 9.0,
-            tan_y: t,
-        },
+        GridProjection::test_view(),
         0.1,
         80.0,
         &GridConfig::default(),
@@ -611,10 +603,7 @@ fn fewer_chunks_than_threads_keep_nothing_stale() {
 #[test]
 fn past_65536_visible_lights_the_list_is_32_bit_and_the_same() {
     let t = (30f64).to_radians().tan();
-    let projection = GridProjection::Perspective {
-        tan_x: t * 16.0 / 9.0,
-        tan_y: t,
-    };
+    let projection = GridProjection::test_view();
     let mut rng = Pcg64Mcg::seed_from_u64(65_537);
     // Small lights spread over the view, nearly all visible.
     let lights: Vec<GpuLight> = (0..70_000)

@@ -261,14 +261,6 @@ mod tests {
 
     const SIZE: (u32, u32) = (320, 180);
 
-    fn projection() -> GridProjection {
-        let t = 30f64.to_radians().tan();
-        GridProjection::Perspective {
-            tan_x: t * 16.0 / 9.0,
-            tan_y: t,
-        }
-    }
-
     /// Lights over a floor seen from above, and surface samples on that floor.
     fn workload(lights: usize) -> (Vec<GpuLight>, SurfaceSamples) {
         let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(3);
@@ -304,7 +296,7 @@ mod tests {
     fn inputs(lights: &[GpuLight]) -> ChoiceInputs<'_> {
         ChoiceInputs {
             size: SIZE,
-            projection: projection(),
+            projection: GridProjection::test_view(),
             near: 0.1,
             far: 40.0,
             camera_far: 100.0,

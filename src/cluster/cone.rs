@@ -279,11 +279,7 @@ mod tests {
     /// lies inside the closed-form span, and the span is not much wider than those cells.
     #[test]
     fn row_spans_hold_every_cell_the_cell_test_passes() {
-        let t = (30f64).to_radians().tan();
-        let projection = GridProjection::Perspective {
-            tan_x: t * 16.0 / 9.0,
-            tan_y: t,
-        };
+        let projection = GridProjection::test_view();
         let mut rng = Pcg64Mcg::seed_from_u64(17);
         let (mut passed, mut spanned, mut rows) = (0u64, 0u64, 0u64);
         for (footprint, far) in [(24.0, 60.0), (11.0, 30.0), (64.0, f64::INFINITY)] {

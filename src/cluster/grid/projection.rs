@@ -55,3 +55,15 @@ impl GridProjection {
         }
     }
 }
+
+#[cfg(test)]
+impl GridProjection {
+    /// The view the unit tests share: a 60° vertical field of view at 16:9.
+    pub(crate) fn test_view() -> GridProjection {
+        let t = 30f64.to_radians().tan();
+        GridProjection::Perspective {
+            tan_x: t * 16.0 / 9.0,
+            tan_y: t,
+        }
+    }
+}

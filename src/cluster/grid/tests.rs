@@ -7,18 +7,7 @@ fn persp(near: f64, far: f64) -> ClusterGrid {
 }
 
 fn persp_with(near: f64, far: f64, config: &GridConfig) -> ClusterGrid {
-    let t = (30f64).to_radians().tan();
-    ClusterGrid::new(
-        1280,
-        720,
-        GridProjection::Perspective {
-            tan_x: t * 16.0 / 9.0,
-            tan_y: t,
-        },
-        near,
-        far,
-        config,
-    )
+    ClusterGrid::new(1280, 720, GridProjection::test_view(), near, far, config)
 }
 
 #[test]
