@@ -22,4 +22,6 @@ pub mod tiles;
 pub mod workload;
 
 #[cfg(test)]
+mod assign_paths_tests;
+#[cfg(test)]
 mod assign_tests;

@@ -1,0 +1,344 @@
+//! The assignment's paths against each other: one thread, bands of slices and chunks of
+//! lights in pools of several sizes, reused buffers against fresh ones, 16- and 32-bit index
+//! lists, and the figures each reports (the lists themselves are checked against brute force
+//! in `assign_tests.rs`).
+
+use glam::{DVec3, Vec3};
+use rand::{Rng, SeedableRng};
+use rand_pcg::Pcg64Mcg;
+
+use super::assign::{assign, AssignLimits, Assignment};
+use super::assign_tests::{cases, cell_lights, random_lights};
+use super::grid::{ClusterGrid, GridConfig, GridProjection};
+use super::pack::GpuLight;
+use crate::scene::Light;
+
+#[test]
+fn parallel_and_sequential_assignment_agree() {
+    let mut rng = Pcg64Mcg::seed_from_u64(3);
+    let grid = ClusterGrid::new(
+        640,
+        360,
+        GridProjection::test_view(),
+        0.1,
+        80.0,
+        &GridConfig::default(),
+    );
+    let lights = random_lights(&mut rng, 5000, 40.0);
+    let seq = assign(
+        &grid,
+        &lights,
+        80.0,
+        &AssignLimits {
+            parallel_threshold: usize::MAX,
+            ..Default::default()
+        },
+    );
+    let par = assign(
+        &grid,
+        &lights,
+        80.0,
+        &AssignLimits {
+            parallel_threshold: 1,
+            ..Default::default()
+        },
+    );
+    assert_eq!(seq.visible, par.visible);
+    assert_eq!(seq.offsets, par.offsets);
+    assert_eq!(seq.counts, par.counts);
+    assert_eq!(seq.indices, par.indices);
+    assert_eq!(seq.stats, par.stats);
+    check_stats(&seq, None);
+    // Capped, on both paths: the figures describe the lists after the cap, the largest count
+    // the lists before it.
+    for parallel_threshold in [usize::MAX, 1] {
+        let limits = AssignLimits {
+            cell_cap: 3,
+            parallel_threshold,
+            ..Default::default()
+        };
+        let capped = assign(&grid, &lights, 80.0, &limits);
+        assert!(capped.stats.overflowed_lights > 0);
+        check_stats(&capped, Some(seq.stats.max_lights_per_cluster));
+    }
+}
+
+/// The figures of an assignment against counts taken from its lists here; `uncapped_max` is
+/// the largest count before a cap (`None`: no cap applied).
+fn check_stats(a: &Assignment, uncapped_max: Option<u32>) {
+    let nonempty = a.counts.iter().filter(|&&n| n > 0).count() as u32;
+    let max = a.counts.iter().copied().max().unwrap();
+    assert!(nonempty > 0);
+    assert_eq!(a.stats.nonempty_clusters, nonempty);
+    assert_eq!(a.stats.max_lights_per_cluster, uncapped_max.unwrap_or(max));
+    assert_eq!(a.stats.indices, a.indices.len());
+    assert_eq!(a.stats.clusters as usize, a.counts.len());
+    assert_eq!(a.stats.visible_lights, a.visible.len());
+    let avg = a.indices.len() as f64 / nonempty as f64;
+    assert!((a.stats.avg_lights_per_nonempty - avg).abs() < 1e-12);
+}
+
+/// One assigner over frames of different sizes, grids and light sets gives what fresh buffers
+/// give (nothing stale survives from an earlier frame).
+#[test]
+fn reused_buffers_match_fresh_ones() {
+    let mut rng = Pcg64Mcg::seed_from_u64(11);
+    let mut assigner = super::assign::Assigner::new();
+    let cases = cases();
+    for (frame, case) in cases.iter().cycle().take(12).enumerate() {
+        let grid = ClusterGrid::new(320, 180, case.projection, case.near, case.far, &case.config);
+        let n = [5000, 0, 700, 9000][frame % 4];
+        let lights = random_lights(&mut rng, n, case.far.min(200.0) * 0.5);
+        let limits = AssignLimits {
+            cell_cap: if frame % 3 == 0 { 40 } else { u32::MAX },
+            parallel_threshold: if frame % 2 == 0 { 1 } else { usize::MAX },
+            ..Default::default()
+        };
+        let fresh = assign(&grid, &lights, case.far, &limits);
+        let reused = assigner.assign(&grid, &lights, case.far, &limits);
+        assert_eq!(fresh.visible, reused.visible, "{}", case.name);
+        assert_eq!(fresh.offsets, reused.offsets, "{}", case.name);
+        assert_eq!(fresh.counts, reused.counts, "{}", case.name);
+        assert_eq!(fresh.indices, reused.indices, "{}", case.name);
+        assert_eq!(fresh.stats, reused.stats, "{}", case.name);
+    }
+}
+
+#[test]
+fn zero_lights_do_no_work() {
+    let t = (30f64).to_radians().tan();
+    let grid = ClusterGrid::new(
+        64,
+        64,
+        GridProjection::Perspective { tan_x: t, tan_y: t },
+        0.1,
+        10.0,
+        &GridConfig::default(),
+    );
+    let a = assign(&grid, &[], 10.0, &AssignLimits::default());
+    assert!(a.indices.is_empty() && a.visible.is_empty());
+    assert!(a.counts.iter().all(|&n| n == 0));
+}
+
+/// Many lights on a grid with fewer cells than threads' worth of blocks: the parallel fill must
+/// not hand out empty or out-of-range cell blocks (a panic seen from the viewer).
+#[test]
+fn parallel_fill_on_a_tiny_grid() {
+    let t = (30f64).to_radians().tan();
+    let grid = ClusterGrid::new(
+        32,
+        24,
+        GridProjection::Perspective { tan_x: t, tan_y: t },
+        0.1,
+        10.0,
+        &GridConfig::default(),
+    );
+    assert!(grid.total_cells < 64);
+    let mut rng = Pcg64Mcg::seed_from_u64(9);
+    let lights = random_lights(&mut rng, 20_000, 5.0);
+    let par = assign(
+        &grid,
+        &lights,
+        10.0,
+        &AssignLimits {
+            parallel_threshold: 1,
+            ..Default::default()
+        },
+    );
+    let seq = assign(
+        &grid,
+        &lights,
+        10.0,
+        &AssignLimits {
+            parallel_threshold: usize::MAX,
+            ..Default::default()
+        },
+    );
+    assert_eq!(par.indices, seq.indices);
+    assert_eq!(par.offsets, seq.offsets);
+}
+
+/// The parallel paths (bands of slices, one per thread of the pool, or chunks of lights) give
+/// what one band gives, for pools of 2 to 8 threads, and when the bands are balanced by an
+/// earlier assignment to the same grid (measured times) or to another (cells).
+#[test]
+fn any_number_of_bands_gives_what_one_band_gives() {
+    let mut rng = Pcg64Mcg::seed_from_u64(21);
+    let sequential = AssignLimits {
+        parallel_threshold: usize::MAX,
+        cell_cap: 24,
+        ..Default::default()
+    };
+    let parallel = AssignLimits {
+        parallel_threshold: 1,
+        ..sequential
+    };
+    for threads in [2, 3, 5, 8] {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .expect("a thread pool");
+        let mut assigner = super::assign::Assigner::new();
+        for case in cases() {
+            let grid = ClusterGrid::new(96, 54, case.projection, case.near, case.far, &case.config);
+            // Fewer lights than cells: bands; more: chunks of lights (see `Assigner::assign`).
+            // Each count twice: the second split follows the first one's measured times.
+            let counts = [grid.total_cells as usize / 4, grid.total_cells as usize * 2];
+            let mut listed = 0;
+            for count in counts.into_iter().flat_map(|n| [n, n]) {
+                let lights = random_lights(&mut rng, count, case.far.min(200.0) * 0.5);
+                let one = assign(&grid, &lights, case.far, &sequential);
+                let bands =
+                    pool.install(|| assigner.assign(&grid, &lights, case.far, &parallel).clone());
+                let what = format!("{threads} threads, {}, {count} lights", case.name);
+                assert_eq!(one.visible, bands.visible, "{what}");
+                assert_eq!(one.offsets, bands.offsets, "{what}");
+                assert_eq!(one.counts, bands.counts, "{what}");
+                assert_eq!(one.indices, bands.indices, "{what}");
+                assert_eq!(one.stats, bands.stats, "{what}");
+                listed += one.stats.indices;
+            }
+            assert!(listed > 0, "{}", case.name);
+        }
+    }
+}
+
+/// Chunks of lights when lights are few for the threads (49 lights on 8 threads make 7 chunks
+/// of 7): after a frame with more lights, no chunk keeps that frame's runs.
+#[test]
+fn fewer_chunks_than_threads_keep_nothing_stale() {
+    let t = (30f64).to_radians().tan();
+    let grid = ClusterGrid::new(
+        32,
+        16,
+        GridProjection::Perspective { tan_x: t, tan_y: t },
+        0.1,
+        10.0,
+        &GridConfig::tiles(16.0),
+    );
+    assert!(
+        grid.total_cells < 49,
+        "{} cells: not the chunk path",
+        grid.total_cells
+    );
+    let mut rng = Pcg64Mcg::seed_from_u64(5);
+    let parallel = AssignLimits {
+        parallel_threshold: 1,
+        ..Default::default()
+    };
+    let sequential = AssignLimits {
+        parallel_threshold: usize::MAX,
+        ..Default::default()
+    };
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(8)
+        .build()
+        .expect("a thread pool");
+    let mut assigner = super::assign::Assigner::new();
+    for count in [400, 49, 9, 400] {
+        let lights = random_lights(&mut rng, count, 5.0);
+        let one = assign(&grid, &lights, 10.0, &sequential);
+        let chunks = pool.install(|| assigner.assign(&grid, &lights, 10.0, &parallel).clone());
+        assert_eq!(one.visible, chunks.visible, "{count} lights");
+        assert_eq!(one.counts, chunks.counts, "{count} lights");
+        assert_eq!(one.indices, chunks.indices, "{count} lights");
+    }
+}
+
+/// Past 65 536 visible lights the list is 32-bit, on both parallel paths and one thread,
+/// with and without the overflow policy trimming it, and every cell lists exactly the lights
+/// whose runs cover it, ascending; at most 65 536 it is 16-bit with the same lists.
+#[test]
+fn past_65536_visible_lights_the_list_is_32_bit_and_the_same() {
+    let t = (30f64).to_radians().tan();
+    let projection = GridProjection::test_view();
+    let mut rng = Pcg64Mcg::seed_from_u64(65_537);
+    // Small lights spread over the view, nearly all visible.
+    let lights: Vec<GpuLight> = (0..70_000)
+        .map(|_| {
+            let d = rng.random_range(1.0..40.0);
+            let p = DVec3::new(
+                rng.random_range(-0.9..0.9) * t * 16.0 / 9.0 * d,
+                rng.random_range(-0.9..0.9) * t * d,
+                -d,
+            );
+            let light = Light::point(p, rng.random_range(0.05..0.4) as f32, Vec3::ONE, 1.0);
+            GpuLight::from_light(&light, &glam::DMat4::IDENTITY)
+        })
+        .collect();
+    // A grid with more cells than lights (bands) and one with fewer (chunks of lights).
+    for footprint in [8.0, 64.0] {
+        let config = GridConfig::fixed(footprint);
+        let grid = ClusterGrid::new(640, 360, projection, 0.1, 50.0, &config);
+        let mut reference = vec![Vec::new(); grid.total_cells as usize];
+        for (i, light) in lights.iter().enumerate() {
+            super::cells::for_each_run(&grid, light, 50.0, &mut |start, len| {
+                for cell in start..start + len {
+                    reference[cell as usize].push(i as u32);
+                }
+            });
+        }
+        for (threshold, cap) in [(1, u32::MAX), (usize::MAX, u32::MAX), (1, 3)] {
+            let limits = AssignLimits {
+                parallel_threshold: threshold,
+                cell_cap: cap,
+                max_indices: usize::MAX,
+            };
+            let a = assign(&grid, &lights, 50.0, &limits);
+            let what = format!(
+                "{footprint} px, threshold {threshold}, cap {cap}, {:?}",
+                a.stats
+            );
+            assert!(a.visible.len() > 65_536, "{what}: {}", a.visible.len());
+            assert!(
+                a.indices.as_u32().is_some() && a.indices.as_u16().is_none(),
+                "{what}"
+            );
+            for (cell, listed) in reference.iter().enumerate() {
+                let got = cell_lights(&a, cell as u32);
+                if cap == u32::MAX {
+                    assert_eq!(&got, listed, "{what}: cell {cell}");
+                } else {
+                    assert_eq!(got.len(), listed.len().min(cap as usize), "{what}");
+                    assert!(got.windows(2).all(|w| w[0] < w[1]), "{what}: {got:?}");
+                    assert!(got.iter().all(|l| listed.contains(l)), "{what}: {got:?}");
+                }
+            }
+        }
+        // The same grid with the first 60 000 lights: 16-bit, the same lists.
+        let few = &lights[..60_000];
+        let limits = AssignLimits {
+            cell_cap: u32::MAX,
+            max_indices: usize::MAX,
+            ..Default::default()
+        };
+        let a = assign(&grid, few, 50.0, &limits);
+        assert!(
+            a.indices.as_u16().is_some(),
+            "{footprint} px, 60 000 lights"
+        );
+        for (cell, listed) in reference.iter().enumerate() {
+            let expected: Vec<u32> = listed.iter().copied().filter(|&l| l < 60_000).collect();
+            assert_eq!(cell_lights(&a, cell as u32), expected, "cell {cell}");
+        }
+    }
+}
+
+#[test]
+fn split_cells_never_returns_empty_or_out_of_range_blocks() {
+    for (offsets, total, parts) in [
+        (vec![0u32; 12], 0usize, 4usize),
+        (vec![0, 0, 0, 5], 9, 3),
+        (vec![0, 100], 200, 8),
+        (vec![], 0, 2),
+    ] {
+        let blocks = super::assign_chunks::split_cells(&offsets, total, parts);
+        let mut next = 0;
+        for (a, b) in &blocks {
+            assert!(a < b && *b <= offsets.len(), "{blocks:?}");
+            assert_eq!(*a, next);
+            next = *b;
+        }
+        assert_eq!(next, offsets.len());
+    }
+}
