@@ -31,8 +31,8 @@ impl ClusterGrid {
     }
 
     /// The bounding spheres of the cells of row `y` of slice `slice` (numbered across
-    /// cascades) of cascade `cascade`, one column at a time ([`RowSpheres::cell`]): what the
-    /// cone-vs-cell test of spot lights asks for, computed when asked from a per-slice table
+    /// cascades) of cascade `cascade`, one column at a time: what the spot-cone test's cell
+    /// radius is taken from ([`ClusterGrid::slice_cells`]), computed when asked from a per-slice table
     /// (a table of every cell's sphere, rebuilt with the grid whenever a moving camera changed
     /// its depth range, cost more than the whole assignment it served), with the row's and
     /// the slice's share worked out once per row.
@@ -53,8 +53,11 @@ impl ClusterGrid {
             (ny0 * hy - cy).powi(2).max((ny1 * hy - cy).powi(2)) + half_depth * half_depth
         };
         RowSpheres {
+            #[cfg(test)]
             infinite: z1.is_infinite(),
+            #[cfg(test)]
             cy,
+            #[cfg(test)]
             cz: -0.5 * (z0 + z1),
             near_x: f.near.0,
             far_x: f.far.0,
@@ -82,12 +85,14 @@ impl ClusterGrid {
 }
 
 /// The bounding spheres of one row of cells (see [`ClusterGrid::row_spheres`]). The
-/// assignment reads only their radii ([`ClusterGrid::slice_cells`]); the whole spheres are for
-/// the tests.
-#[cfg_attr(not(test), allow(dead_code))]
+/// assignment reads only their radii ([`ClusterGrid::slice_cells`]); the centres are for the
+/// tests ([`RowSpheres::cell`]).
 pub(crate) struct RowSpheres {
+    #[cfg(test)]
     infinite: bool,
+    #[cfg(test)]
     cy: f64,
+    #[cfg(test)]
     cz: f64,
     /// View half width at the slice's near and far depths, and their mean.
     near_x: f64,
