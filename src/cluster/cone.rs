@@ -142,18 +142,10 @@ impl ConeSlice<'_> {
         let w0 = v0 - cone.axis * p;
         let h0 = self.r + cone.sin * p;
         // −r ≤ v₁ = p + q·t ≤ r + range.
-        let low = -(p + self.r + self.slack);
-        let high = self.r + cone.range + self.slack - p;
-        let mut span = (x0 as f64, x1 as f64);
-        if self.q != 0.0 {
-            let (ta, tb) = (low * self.inv_q, high * self.inv_q);
-            span = (span.0.max(ta.min(tb)), span.1.min(ta.max(tb)));
-        } else if low > 0.0 || high < 0.0 {
-            return None;
-        }
-        if span.0 > span.1 {
-            return None;
-        }
+        let span = (x0 as f64, x1 as f64);
+        let span = keep_nonnegative(span, p + self.r + self.slack, self.q, self.inv_q)?;
+        let above = self.r + cone.range + self.slack - p;
+        let span = keep_nonnegative(span, above, -self.q, -self.inv_q)?;
         let b = 2.0 * self.sx * (cone.cos_sq * w0.x - cone.sin * cone.axis.x * h0);
         let (off_axis, reach) = (cone.cos_sq * w0.length_squared(), h0 * h0);
         let (lo, hi) = quadratic_nonpositive(self.a, b, off_axis - reach, off_axis + reach, span)?;
@@ -173,12 +165,14 @@ impl ConeSlice<'_> {
     }
 }
 
-/// The part of `span` (`lo ≤ hi`) where `a + b·t ≥ 0`, or `None` when there is none.
-fn keep_nonnegative((lo, hi): (f64, f64), a: f64, b: f64) -> Option<(f64, f64)> {
+/// The part of `span` (`lo ≤ hi`) where `a + b·t ≥ 0`, or `None` when there is none;
+/// `inv_b` is `1 / b` (a row's reciprocal is worked out once per slice).
+#[inline(always)]
+fn keep_nonnegative((lo, hi): (f64, f64), a: f64, b: f64, inv_b: f64) -> Option<(f64, f64)> {
     let (lo, hi) = if b > 0.0 {
-        (lo.max(-a / b), hi)
+        (lo.max(-a * inv_b), hi)
     } else if b < 0.0 {
-        (lo, hi.min(-a / b))
+        (lo, hi.min(-a * inv_b))
     } else if a >= 0.0 || a.is_nan() {
         // Also for NaN (an overflowed coefficient): keep the span.
         (lo, hi)
@@ -204,7 +198,7 @@ fn quadratic_nonpositive(
     let c = c - 1e-9 * (c_terms.abs() + b.abs() * t + a.abs() * t * t);
     if a == 0.0 {
         // b·t + c ≤ 0.
-        return keep_nonnegative((lo, hi), -c, -b);
+        return keep_nonnegative((lo, hi), -c, -b, -1.0 / b);
     }
     let disc = b * b - 4.0 * a * c;
     if !disc.is_finite() {
