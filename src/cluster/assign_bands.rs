@@ -110,8 +110,12 @@ impl Bands {
         let parallel = self.bands.len() > 1;
         let cells = grid.total_cells as usize;
         let bands = &mut self.bands[..];
-        // Phase 1.
-        for_bands(bands, parallel, &|band| band.find(grid, lights, camera_far));
+        // Phase 1, its difference counts straight into the counts' array (phase 2 sums them
+        // in place: one cold array less than a separate one).
+        out.counts.resize(cells, 0);
+        find_bands(bands, &mut out.counts, parallel, &|band, counts| {
+            band.find(grid, lights, camera_far, counts)
+        });
         // Phase 2: the visible lights and their numbers, then counts, offsets and totals.
         number_visible(
             bands,
@@ -120,7 +124,6 @@ impl Bands {
             &mut self.numbers,
             parallel,
         );
-        out.counts.resize(cells, 0);
         out.offsets.resize(cells, 0);
         count_bands(bands, &mut out.counts, &mut out.offsets, parallel);
         let mut totals = Totals::default();
@@ -151,10 +154,6 @@ struct Band {
     /// The band's cells, `first_cell..end_cell`.
     first_cell: usize,
     end_cell: usize,
-    /// Per cell (plus one): a difference array of the band's runs, `+1` where a run starts and
-    /// `−1` where it ends, so a run costs two additions whatever its length; its running sum
-    /// over cells is the number of lights touching each cell.
-    deltas: Vec<i32>,
     /// The runs, light after light.
     runs: Vec<Run>,
     /// Every light with a run in the band, ascending: (light, start of its runs in `runs`).
@@ -170,22 +169,35 @@ struct Band {
 }
 
 impl Band {
-    /// Phase 1: the band's runs of every light, and their per-cell difference counts.
-    fn find(&mut self, grid: &ClusterGrid, lights: &[GpuLight], camera_far: f64) {
+    /// Phase 1: the band's runs of every light, and into `deltas` (the band's cells' part of
+    /// the counts) their difference counts: `+1` where a run starts and `−1` (wrapping) where
+    /// it ends, so a run costs two additions whatever its length and the running sum over
+    /// the cells is the number of lights touching each ([`Band::count`]).
+    fn find(
+        &mut self,
+        grid: &ClusterGrid,
+        lights: &[GpuLight],
+        camera_far: f64,
+        deltas: &mut [u32],
+    ) {
         let started = Instant::now();
         let window = self.window.expect("a band has a window");
         let first = self.first_cell as u32;
-        self.deltas.clear();
-        self.deltas.resize(self.end_cell - self.first_cell + 1, 0);
+        deltas.fill(0);
+        let cells = deltas.len() as u32;
         self.runs.clear();
         self.lights.clear();
-        let (deltas, runs) = (&mut self.deltas, &mut self.runs);
+        let runs = &mut self.runs;
         for (i, light) in lights.iter().enumerate() {
             let before = runs.len();
             for_each_run_in(grid, &window, light, camera_far, &mut |start, len| {
                 let start = start - first;
-                deltas[start as usize] += 1;
-                deltas[(start + len) as usize] -= 1;
+                deltas[start as usize] = deltas[start as usize].wrapping_add(1);
+                // A run ending at the band's last cell has no cell after it to end in.
+                let end = start + len;
+                if end < cells {
+                    deltas[end as usize] = deltas[end as usize].wrapping_sub(1);
+                }
                 runs.push(Run { start, len });
             });
             if runs.len() > before {
@@ -195,15 +207,15 @@ impl Band {
         self.seconds = started.elapsed().as_secs_f64();
     }
 
-    /// Phase 2: the band's counts into `counts` (its cells' part), where each cell's list
-    /// ends in the band's part of the list into `offsets` (phase 3 moves them to where the
-    /// lists start), and its totals.
+    /// Phase 2: the band's difference counts in `counts` (its cells' part, from phase 1)
+    /// summed into counts, where each cell's list ends in the band's part of the list into
+    /// `offsets` (phase 3 moves them to where the lists start), and its totals.
     fn count(&mut self, counts: &mut [u32], offsets: &mut [u32]) {
-        let mut running = 0i32;
+        let mut running = 0u32;
         let mut totals = Totals::default();
-        for ((count, offset), delta) in counts.iter_mut().zip(offsets).zip(&self.deltas) {
-            running += delta;
-            let n = running as u32;
+        for (count, offset) in counts.iter_mut().zip(offsets) {
+            running = running.wrapping_add(*count);
+            let n = running;
             *count = n;
             totals.add(n);
             *offset = totals.indices as u32;
@@ -262,6 +274,31 @@ fn for_bands(bands: &mut [Band], parallel: bool, f: &(dyn Fn(&mut Band) + Sync))
     }
     let (left, right) = bands.split_at_mut(bands.len() / 2);
     rayon::join(|| for_bands(left, true, f), || for_bands(right, true, f));
+}
+
+/// Phase 1 ([`Band::find`]) on every band with its cells' part of `counts`, the halves of
+/// the bands at once with `parallel`.
+fn find_bands(
+    bands: &mut [Band],
+    counts: &mut [u32],
+    parallel: bool,
+    f: &(dyn Fn(&mut Band, &mut [u32]) + Sync),
+) {
+    if let [band] = bands {
+        f(band, &mut counts[..band.end_cell - band.first_cell]);
+        return;
+    }
+    let (left, right) = bands.split_at_mut(bands.len() / 2);
+    let (counts_left, counts_right) = counts.split_at_mut(right[0].first_cell - left[0].first_cell);
+    if parallel {
+        rayon::join(
+            || find_bands(left, counts_left, true, f),
+            || find_bands(right, counts_right, true, f),
+        );
+    } else {
+        find_bands(left, counts_left, false, f);
+        find_bands(right, counts_right, false, f);
+    }
 }
 
 /// Phase 2's numbering: the lights listed by any band, ascending, into `visible`, and each
