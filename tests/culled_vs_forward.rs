@@ -12,6 +12,41 @@ use manylight::{EsVersion, FrameStats, RenderOptions};
 const W: u32 = 256;
 const H: u32 = 144;
 
+/// The warnings this test binary's renderers log (a logger of its own: the library logs
+/// through `log`, and a warning is what a user is told).
+struct Warnings(std::sync::Mutex<Vec<String>>);
+
+impl log::Log for Warnings {
+    fn enabled(&self, metadata: &log::Metadata) -> bool {
+        metadata.level() <= log::Level::Warn
+    }
+
+    fn log(&self, record: &log::Record) {
+        if self.enabled(record.metadata()) {
+            self.0.lock().unwrap().push(record.args().to_string());
+        }
+    }
+
+    fn flush(&self) {}
+}
+
+static WARNINGS: Warnings = Warnings(std::sync::Mutex::new(Vec::new()));
+
+/// The warnings logged so far that contain `text` (installs the logger on first use).
+fn warnings_containing(text: &str) -> Vec<String> {
+    static INSTALL: std::sync::Once = std::sync::Once::new();
+    INSTALL.call_once(|| {
+        log::set_logger(&WARNINGS).expect("no other logger in this test binary");
+        log::set_max_level(log::LevelFilter::Warn);
+    });
+    let logged = WARNINGS.0.lock().unwrap();
+    logged
+        .iter()
+        .filter(|w| w.contains(text))
+        .cloned()
+        .collect()
+}
+
 fn render(
     gpu: &mut Gpu,
     method: &str,
@@ -69,9 +104,12 @@ fn clustered_lists_are_short() {
 }
 
 /// 300 lights in one cell with a per-cell cap of 255: the overflow is counted, the image stays
-/// right away from the overcrowded cell, and no GL error or out-of-range read happens.
+/// right away from the overcrowded cell, no GL error or out-of-range read happens, and the
+/// user is warned once (not every frame) naming the settings that avoid it.
 #[test]
 fn overflow_policy_holds_in_a_real_render() {
+    let warning = "light references left out";
+    assert!(warnings_containing(warning).is_empty());
     let mut gpu = Gpu::new(EsVersion::Es2);
     let mut scene = scene::builtin::build("plane", None).unwrap();
     scene.lights = (0..300)
@@ -134,6 +172,15 @@ fn overflow_policy_holds_in_a_real_render() {
     };
     let (_, stats) = render(&mut gpu, "clustered", &scene, &tight);
     assert!(stats.overflowed_lights > 0);
+    let said = warnings_containing(warning);
+    assert_eq!(said.len(), 1, "warned once for two frames: {said:?}");
+    assert!(
+        said[0].starts_with("clustered:")
+            && said[0].contains("at most 255 lights")
+            && said[0].contains("grid.footprint_px"),
+        "{}",
+        said[0]
+    );
 }
 
 /// A fixed grid too fine for the context's grid texture is refused before anything is

@@ -93,6 +93,9 @@ pub struct CulledForward {
     packed_indices: PackedTexels,
     /// Why a tiled or fixed grid is what it is (the automatic grid keeps its own reason).
     reason: String,
+    /// Whether the overflow policy's dropping lights has been warned about (once per method:
+    /// `FrameStats::overflowed_lights` counts every frame's).
+    warned_overflow: bool,
 }
 
 /// What the grid depends on; it is rebuilt only when this changes.
@@ -120,6 +123,7 @@ impl CulledForward {
             packed_grid: PackedTexels::default(),
             packed_indices: PackedTexels::default(),
             reason: String::new(),
+            warned_overflow: false,
         }
     }
 
@@ -195,6 +199,7 @@ impl ShadingMethod for CulledForward {
 
     /// Renders one frame (see the module docs).
     fn render(&mut self, ctx: &mut FrameContext) -> Result<MethodStats<'_>, Error> {
+        let method = self.name();
         let dev = ctx.dev;
         let es = dev.es();
         let (grid_encoding, per_index_texel) = match es {
@@ -238,6 +243,21 @@ impl ShadingMethod for CulledForward {
         let started = Instant::now();
         let assignment = self.assigner.assign(grid, lights, camera_far, &limits);
         let assign_ms = started.elapsed().as_secs_f64() * 1e3;
+        let dropped = assignment.stats.overflowed_lights;
+        if dropped > 0 && !self.warned_overflow {
+            self.warned_overflow = true;
+            log::warn!(
+                "{}: {dropped} light references left out of this frame's cell lists, so the \
+                 image lacks those lights where they reach (a cell keeps at most {} lights and \
+                 this context's index texture holds {} references; each cell keeps the lights \
+                 that matter most to it, and FrameStats::overflowed_lights counts the dropped \
+                 ones every frame): a coarser grid (grid.footprint_px), deeper slices \
+                 (grid.slice_depth) or the automatic grid avoid it",
+                method,
+                limits.cell_cap,
+                limits.max_indices
+            );
+        }
         if assignment.visible.len() > MAX_INDEXED_LIGHTS {
             return Err(Error::Limit(format!(
                 "{} lights are visible in this frame; tiled and clustered shading index at most {MAX_INDEXED_LIGHTS}",
