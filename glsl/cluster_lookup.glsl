@@ -63,7 +63,9 @@ uvec2 clusterCell(HIGHP vec2 fragXY, HIGHP float viewDepth) {
     return texelFetch(u_grid, dataCoord(2 * int(u_cascadeCount) + cell), 0).xy;
 }
 
+// The light number at position `pos` of the index list (four 16-bit indices per texel).
 int lightIndexAt(uint pos) {
-    return int(texelFetch(u_indices, dataCoord(int(pos)), 0).x);
+    uvec4 t = texelFetch(u_indices, dataCoord(int(pos >> 2u)), 0);
+    return int(t[pos & 3u]);
 }
 #endif

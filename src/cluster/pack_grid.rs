@@ -17,8 +17,10 @@
 //!
 //! Index texture: light numbers (positions in the uploaded light texture), grouped by cell.
 //!   ES 2.0, RGBA8: two 16-bit indices per texel (i.hi i.lo j.hi j.lo)    2 bytes per index
-//!   ES 3.0, R16UI: one index per texel                                 2 bytes per index
-//!   → at most 65 536 lights per frame
+//!   ES 3.0, RGBA16UI: four indices per texel (index i in channel i mod 4)   2 bytes per index
+//!   → at most 65 536 lights per frame; the ES 3.0 texture holds twice the references of the
+//!     ES 2.0 one for the same rows (four times those of one index a texel: a fine grid at
+//!     1280×720 lists tens of millions)
 //! ```
 //!
 //! Budget at 1280×720 with the default grid (about 20 000 cells, 1 024 lights, ~40 000
@@ -63,6 +65,14 @@ impl GridEncoding {
     /// Bytes per light index in the index texture (16-bit light numbers either way).
     pub fn index_bytes(self) -> usize {
         2
+    }
+
+    /// Light indices per texel of the index texture (RGBA8: two, RGBA16UI: four).
+    pub fn indices_per_texel(self) -> usize {
+        match self {
+            GridEncoding::Rgba8 => 2,
+            GridEncoding::Uint => 4,
+        }
     }
 }
 
@@ -169,14 +179,11 @@ pub fn pack_indices(indices: &IndexList, encoding: GridEncoding) -> PackedTexels
 
 /// [`pack_indices`] into `packed`, reusing its bytes (no allocation once they have grown).
 pub fn pack_indices_into(indices: &IndexList, encoding: GridEncoding, packed: &mut PackedTexels) {
-    let per_texel = match encoding {
-        GridEncoding::Rgba8 => 2,
-        GridEncoding::Uint => 1,
-    };
+    let per_texel = encoding.indices_per_texel();
     let height = rows_for(indices.len().div_ceil(per_texel));
     let texel_bytes = match encoding {
         GridEncoding::Rgba8 => 4,
-        GridEncoding::Uint => 2,
+        GridEncoding::Uint => 8,
     };
     let bytes = &mut packed.bytes;
     bytes.clear();
@@ -194,7 +201,7 @@ pub fn pack_indices_into(indices: &IndexList, encoding: GridEncoding, packed: &m
 }
 
 /// Writes `values` two bytes each: big-endian pairs for RGBA8 (texel i/2 holds index i in .xy
-/// when i is even, .zw when odd), little-endian for R16UI.
+/// when i is even, .zw when odd), little-endian for RGBA16UI (texel i/4, channel i mod 4).
 fn put_indices(bytes: &mut [u8], values: impl Iterator<Item = u16>, encoding: GridEncoding) {
     let pairs = bytes.chunks_exact_mut(2).zip(values);
     match encoding {
@@ -227,9 +234,13 @@ pub fn unpack_cell(
     }
 }
 
-/// Reads index `i` back exactly as the shader decodes it.
+/// Reads index `i` back exactly as the shader decodes it: from texel `i / n`, channel pair or
+/// channel `i mod n` (`n` indices a texel).
 pub fn unpack_index(packed: &PackedTexels, i: usize, encoding: GridEncoding) -> u32 {
-    let b = &packed.bytes[i * 2..i * 2 + 2];
+    let per_texel = encoding.indices_per_texel();
+    let (texel, slot) = (i / per_texel, i % per_texel);
+    let at = texel * 2 * per_texel + slot * 2;
+    let b = &packed.bytes[at..at + 2];
     match encoding {
         GridEncoding::Rgba8 => u16::from_be_bytes([b[0], b[1]]) as u32,
         GridEncoding::Uint => u16::from_le_bytes([b[0], b[1]]) as u32,
@@ -287,6 +298,20 @@ mod tests {
                 assert_eq!(unpack_index(&ix, i, enc), v);
             }
             assert_eq!(g.width, DATA_TEXTURE_WIDTH);
+            // RGBA8 holds two indices a texel, RGBA16UI four: the rows the list needs.
+            let (per_texel, texel_bytes) = match enc {
+                GridEncoding::Rgba8 => (2, 4),
+                GridEncoding::Uint => (4, 8),
+            };
+            let rows = a
+                .indices
+                .len()
+                .div_ceil(per_texel * DATA_TEXTURE_WIDTH as usize);
+            assert_eq!(ix.height as usize, rows);
+            assert_eq!(
+                ix.bytes.len(),
+                rows * DATA_TEXTURE_WIDTH as usize * texel_bytes
+            );
         }
     }
 

@@ -17,6 +17,8 @@ pub enum DataFormat {
     Rg32Ui,
     /// One u16 channel (ES 3.0 only).
     R16Ui,
+    /// Four u16 channels (ES 3.0 only): the index list, four light numbers a texel.
+    Rgba16Ui,
 }
 
 impl DataFormat {
@@ -27,6 +29,7 @@ impl DataFormat {
             DataFormat::Rgba8 => 4,
             DataFormat::Rg32Ui => 8,
             DataFormat::R16Ui => 2,
+            DataFormat::Rgba16Ui => 8,
         }
     }
 
@@ -39,6 +42,7 @@ impl DataFormat {
             (DataFormat::Rgba8, EsVersion::Es2) => (glow::RGBA, glow::RGBA, glow::UNSIGNED_BYTE),
             (DataFormat::Rg32Ui, _) => (glow::RG32UI, glow::RG_INTEGER, glow::UNSIGNED_INT),
             (DataFormat::R16Ui, _) => (glow::R16UI, glow::RED_INTEGER, glow::UNSIGNED_SHORT),
+            (DataFormat::Rgba16Ui, _) => (glow::RGBA16UI, glow::RGBA_INTEGER, glow::UNSIGNED_SHORT),
         }
     }
 }
@@ -78,7 +82,11 @@ impl DataTexture {
                 "float data textures need ES 3.0 or GL_OES_texture_float".into(),
             ));
         }
-        if matches!(format, DataFormat::Rg32Ui | DataFormat::R16Ui) && dev.es() != EsVersion::Es3 {
+        let integer = matches!(
+            format,
+            DataFormat::Rg32Ui | DataFormat::R16Ui | DataFormat::Rgba16Ui
+        );
+        if integer && dev.es() != EsVersion::Es3 {
             return Err(GlError::Unsupported("integer textures need ES 3.0".into()));
         }
         let raw = dev.create_texture()?;

@@ -54,7 +54,7 @@ impl TextureSet {
         };
         let (grid, indices) = match dev.es() {
             EsVersion::Es2 => (DataFormat::Rgba8, DataFormat::Rgba8),
-            EsVersion::Es3 => (DataFormat::Rg32Ui, DataFormat::R16Ui),
+            EsVersion::Es3 => (DataFormat::Rg32Ui, DataFormat::Rgba16Ui),
         };
         Ok(TextureSet {
             lights: DataTexture::new(dev, light_format)?,
@@ -202,10 +202,11 @@ impl ShadingMethod for CulledForward {
         let method = self.name();
         let dev = ctx.dev;
         let es = dev.es();
-        let (grid_encoding, per_index_texel) = match es {
-            EsVersion::Es2 => (GridEncoding::Rgba8, 2),
-            EsVersion::Es3 => (GridEncoding::Uint, 1),
+        let grid_encoding = match es {
+            EsVersion::Es2 => GridEncoding::Rgba8,
+            EsVersion::Es3 => GridEncoding::Uint,
         };
+        let per_index_texel = grid_encoding.indices_per_texel();
         let max_rows = dev.caps().max_texture_size.max(1) as usize;
         let mut max_indices = max_rows * DATA_TEXTURE_WIDTH as usize * per_index_texel;
         let mut cell_cap = ctx.options.cell_cap.unwrap_or(u32::MAX);
@@ -246,15 +247,17 @@ impl ShadingMethod for CulledForward {
         let dropped = assignment.stats.overflowed_lights;
         if dropped > 0 && !self.warned_overflow {
             self.warned_overflow = true;
+            let cap = match limits.cell_cap {
+                u32::MAX => "no cap per cell".to_string(),
+                cap => format!("a cell keeps at most {cap} lights"),
+            };
             log::warn!(
-                "{}: {dropped} light references left out of this frame's cell lists, so the \
-                 image lacks those lights where they reach (a cell keeps at most {} lights and \
-                 this context's index texture holds {} references; each cell keeps the lights \
-                 that matter most to it, and FrameStats::overflowed_lights counts the dropped \
-                 ones every frame): a coarser grid (grid.footprint_px), deeper slices \
-                 (grid.slice_depth) or the automatic grid avoid it",
-                method,
-                limits.cell_cap,
+                "{method}: {dropped} light references left out of this frame's cell lists, so \
+                 the image lacks those lights where they reach ({cap}, and the index texture \
+                 holds {} references on this context; each cell keeps the lights that matter \
+                 most to it, and FrameStats::overflowed_lights counts the dropped ones every \
+                 frame): a coarser grid (grid.footprint_px), deeper slices (grid.slice_depth) \
+                 or the automatic grid avoid it",
                 limits.max_indices
             );
         }
