@@ -53,10 +53,14 @@ pub(crate) struct SliceWindow {
 }
 
 impl SliceWindow {
-    /// Every slice of `grid`.
-    pub fn all(grid: &ClusterGrid) -> SliceWindow {
-        SliceWindow::of(grid, 0, grid.slice_slabs.len() as u32)
-    }
+    /// Every slice of any grid: no depth bound, and an end past any grid's last slice (a
+    /// constant, so a light's runs over the whole grid pay nothing for the window).
+    pub const ALL: SliceWindow = SliceWindow {
+        first: 0,
+        end: u32::MAX,
+        near: f64::NEG_INFINITY,
+        far: f64::INFINITY,
+    };
 
     /// Slices `first..end` of `grid` (`first < end ≤` its slice count).
     pub fn of(grid: &ClusterGrid, first: u32, end: u32) -> SliceWindow {
@@ -92,7 +96,7 @@ pub fn for_each_run(
     camera_far: f64,
     emit: &mut impl FnMut(u32, u32),
 ) {
-    for_each_run_in(grid, &SliceWindow::all(grid), light, camera_far, emit)
+    for_each_run_in(grid, &SliceWindow::ALL, light, camera_far, emit)
 }
 
 /// [`for_each_run`] restricted to the cells of `window`'s slices: exactly the runs
