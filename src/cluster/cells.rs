@@ -341,11 +341,14 @@ impl ScreenExtent {
             } else {
                 (t0 - cy).max(cy - t1)
             };
-            let half_sq = if gap > 0.0 {
-                rho_sq - gap * gap
-            } else {
-                rho_sq
-            };
+            if !(gap > 0.0) {
+                // The row's band holds the centre (or the gap is NaN): its chord is the whole
+                // cross-section, whose columns are `columns` (the same arithmetic, done once
+                // per slice).
+                emit(row, columns.0, columns.1);
+                continue;
+            }
+            let half_sq = rho_sq - gap * gap;
             if half_sq < 0.0 {
                 continue;
             }
