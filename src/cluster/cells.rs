@@ -194,7 +194,7 @@ pub(crate) fn for_each_run_in(
         if columns.1 - columns.0 < 2 && rows.1 - rows.0 < 2 {
             // The common case of many small lights, kept to the plain loops: with the
             // refinement's code in the same loop the compiler spilled and called per row,
-            // which cost a small light a third more.
+            // which cost a small light about 7 ns more (a fifth).
             let width = columns.1 - columns.0 + 1;
             let mut first = slice_start + rows.0 * cascade.tiles_x + columns.0;
             for _ in sa..sb + 1 {
