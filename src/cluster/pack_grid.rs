@@ -3,17 +3,22 @@
 //! Both textures are [`DATA_TEXTURE_WIDTH`] texels wide, rows as needed.
 //!
 //! ```text
-//! Grid texture: a cascade table, then one texel per cell.
-//!   texel 2k     cascade k: tiles_x, tiles_y
-//!   texel 2k+1   cascade k: slices, first cell
-//!   texel 2C+i   cell i: offset into the index list, light count
+//! Grid texture: a cascade table (T texels a cascade), then one texel per cell.
 //!
-//!   ES 2.0, RGBA8 (4 bytes per texel)            ES 3.0, RG32UI (8 bytes per texel)
-//!     table 2k:   tx.hi tx.lo ty.hi ty.lo           (tiles_x, tiles_y)
-//!     table 2k+1: slices first.hi first.mid first.lo (slices, first_cell)
-//!     cell:       20-bit offset, 12-bit count        (offset, count)
-//!                 [o19..o12][o11..o4][o3..o0 c11..c8][c7..c0]
-//!   → counts ≤ 4 095, offsets < 2²⁰, cells < 2²⁴      → 32-bit everything
+//!   ES 2.0, RGBA8 (4 bytes per texel, T = 2)
+//!     texel 2k     cascade k: tx.hi tx.lo ty.hi ty.lo                 (tiles_x, tiles_y)
+//!     texel 2k+1   cascade k: slices first.hi first.mid first.lo      (slices, first cell)
+//!     texel 2C+i   cell i: 20-bit offset, 12-bit count
+//!                  [o19..o12][o11..o4][o3..o0 c11..c8][c7..c0]
+//!     → counts ≤ 4 095, offsets < 2²⁰, cells < 2²⁴
+//!
+//!   ES 3.0, R32UI (4 bytes per texel, T = 4)
+//!     texels 4k..4k+3   cascade k: tiles_x, tiles_y, slices, first cell
+//!     texel 4C+i        cell i: where its list starts in the index list
+//!     texel 4C+N        where the last cell's list ends (N cells)
+//!     → a cell's count is the next texel's offset less its own (the lists are contiguous,
+//!       cell after cell): half the bytes of an (offset, count) pair a cell, for one more
+//!       fetch a fragment (not a light); 32-bit everything
 //!
 //! Index texture: light numbers (positions in the uploaded light texture), grouped by cell.
 //!   ES 2.0, RGBA8: two 16-bit indices per texel (i.hi i.lo j.hi j.lo)    2 bytes per index
@@ -23,16 +28,13 @@
 //!     1280×720 lists tens of millions)
 //! ```
 //!
-//! Budget at 1280×720 with the default grid (about 20 000 cells, 1 024 lights, ~40 000
-//! indices): ES 2.0 80 KB grid + 80 KB indices per frame; ES 3.0 160 KB + 80 KB.
+//! Budget at 640×360 with the automatic grid on the courtyard (about 140 000 cells, 1 024
+//! lights, ~660 000 indices): 560 KB grid + 1.3 MB indices per frame on either version.
 
 use super::assign::Assignment;
 use super::grid::ClusterGrid;
 use super::index_list::IndexList;
 use super::pack::DATA_TEXTURE_WIDTH;
-
-/// Texels per cascade in the grid texture's table.
-pub const TABLE_TEXELS_PER_CASCADE: u32 = 2;
 
 /// Most lights a cell can hold in the RGBA8 grid (12-bit count) — also the ES 2.0 loop bound.
 pub const RGBA8_CELL_CAP: u32 = 4095;
@@ -56,9 +58,14 @@ pub enum GridEncoding {
 impl GridEncoding {
     /// Bytes per cell in the grid texture.
     pub fn cell_bytes(self) -> usize {
+        4
+    }
+
+    /// Texels per cascade in the grid texture's table.
+    pub fn table_texels_per_cascade(self) -> usize {
         match self {
-            GridEncoding::Rgba8 => 4,
-            GridEncoding::Uint => 8,
+            GridEncoding::Rgba8 => 2,
+            GridEncoding::Uint => 4,
         }
     }
 
@@ -96,9 +103,14 @@ fn be24(v: u32) -> [u8; 3] {
     [b[1], b[2], b[3]]
 }
 
-/// Texels of `grid`'s grid texture: the cascade table, then one per cell.
-pub fn grid_texels(grid: &ClusterGrid) -> usize {
-    grid.cascades.len() * TABLE_TEXELS_PER_CASCADE as usize + grid.total_cells as usize
+/// Texels of `grid`'s grid texture in `encoding`: the cascade table, then one per cell (and
+/// on ES 3.0 one more, where the last cell's list ends).
+pub fn grid_texels(grid: &ClusterGrid, encoding: GridEncoding) -> usize {
+    let end = match encoding {
+        GridEncoding::Rgba8 => 0,
+        GridEncoding::Uint => 1,
+    };
+    grid.cascades.len() * encoding.table_texels_per_cascade() + grid.total_cells as usize + end
 }
 
 impl Default for PackedTexels {
@@ -133,37 +145,47 @@ pub fn pack_grid_into(
     encoding: GridEncoding,
     packed: &mut PackedTexels,
 ) {
-    let table = grid.cascades.len() * TABLE_TEXELS_PER_CASCADE as usize;
-    let texels = grid_texels(grid);
-    let height = rows_for(texels);
-    let bpt = encoding.cell_bytes();
+    let table = grid.cascades.len() * encoding.table_texels_per_cascade();
+    let height = rows_for(grid_texels(grid, encoding));
     let bytes = &mut packed.bytes;
     bytes.clear();
-    bytes.resize(DATA_TEXTURE_WIDTH as usize * height as usize * bpt, 0);
-    let mut put = |texel: usize, pair: (u32, u32), rgba8: [u8; 4]| {
-        let at = texel * bpt;
-        match encoding {
-            GridEncoding::Rgba8 => bytes[at..at + 4].copy_from_slice(&rgba8),
-            GridEncoding::Uint => {
-                bytes[at..at + 4].copy_from_slice(&pair.0.to_le_bytes());
-                bytes[at + 4..at + 8].copy_from_slice(&pair.1.to_le_bytes());
+    bytes.resize(DATA_TEXTURE_WIDTH as usize * height as usize * 4, 0);
+    let mut put =
+        |texel: usize, value: [u8; 4]| bytes[texel * 4..texel * 4 + 4].copy_from_slice(&value);
+    match encoding {
+        GridEncoding::Rgba8 => {
+            for (k, c) in grid.cascades.iter().enumerate() {
+                let [xh, xl] = (c.tiles_x as u16).to_be_bytes();
+                let [yh, yl] = (c.tiles_y as u16).to_be_bytes();
+                put(2 * k, [xh, xl, yh, yl]);
+                let [f0, f1, f2] = be24(c.first_cell);
+                put(2 * k + 1, [c.slices.min(255) as u8, f0, f1, f2]);
+            }
+            for (cell, (&offset, &count)) in a.offsets.iter().zip(&a.counts).enumerate() {
+                let rgba8 = (offset.min((1 << 20) - 1) << 12) | count.min(RGBA8_CELL_CAP);
+                put(table + cell, rgba8.to_be_bytes());
             }
         }
-    };
-    for (k, c) in grid.cascades.iter().enumerate() {
-        let [xh, xl] = (c.tiles_x as u16).to_be_bytes();
-        let [yh, yl] = (c.tiles_y as u16).to_be_bytes();
-        put(2 * k, (c.tiles_x, c.tiles_y), [xh, xl, yh, yl]);
-        let [f0, f1, f2] = be24(c.first_cell);
-        put(
-            2 * k + 1,
-            (c.slices, c.first_cell),
-            [c.slices.min(255) as u8, f0, f1, f2],
-        );
-    }
-    for (cell, (&offset, &count)) in a.offsets.iter().zip(&a.counts).enumerate() {
-        let rgba8 = (offset.min((1 << 20) - 1) << 12) | count.min(RGBA8_CELL_CAP);
-        put(table + cell, (offset, count), rgba8.to_be_bytes());
+        GridEncoding::Uint => {
+            for (k, c) in grid.cascades.iter().enumerate() {
+                for (i, v) in [c.tiles_x, c.tiles_y, c.slices, c.first_cell]
+                    .into_iter()
+                    .enumerate()
+                {
+                    put(4 * k + i, v.to_le_bytes());
+                }
+            }
+            for (cell, &offset) in a.offsets.iter().enumerate() {
+                put(table + cell, offset.to_le_bytes());
+            }
+            // Where the last list ends (the lists are contiguous: each cell's starts where the
+            // one before it ends, also after the overflow policy compacted them).
+            let end = match (a.offsets.last(), a.counts.last()) {
+                (Some(&o), Some(&n)) => o + n,
+                _ => 0,
+            };
+            put(table + a.offsets.len(), end.to_le_bytes());
+        }
     }
     packed.width = DATA_TEXTURE_WIDTH;
     packed.height = height;
@@ -217,19 +239,19 @@ pub fn unpack_cell(
     cell: u32,
     encoding: GridEncoding,
 ) -> (u32, u32) {
-    let t = grid.cascades.len() * TABLE_TEXELS_PER_CASCADE as usize + cell as usize;
+    let t = grid.cascades.len() * encoding.table_texels_per_cascade() + cell as usize;
+    let texel = |t: usize| -> [u8; 4] { packed.bytes[t * 4..t * 4 + 4].try_into().unwrap() };
     match encoding {
         GridEncoding::Rgba8 => {
-            let b = &packed.bytes[t * 4..t * 4 + 4];
-            let v = u32::from_be_bytes([b[0], b[1], b[2], b[3]]);
+            let v = u32::from_be_bytes(texel(t));
             (v >> 12, v & 0xFFF)
         }
         GridEncoding::Uint => {
-            let b = &packed.bytes[t * 8..t * 8 + 8];
-            (
-                u32::from_le_bytes(b[0..4].try_into().unwrap()),
-                u32::from_le_bytes(b[4..8].try_into().unwrap()),
-            )
+            let (start, end) = (
+                u32::from_le_bytes(texel(t)),
+                u32::from_le_bytes(texel(t + 1)),
+            );
+            (start, end.wrapping_sub(start))
         }
     }
 }
@@ -283,10 +305,26 @@ mod tests {
                 )
             })
             .collect();
-        let a = assign(&grid, &lights, 60.0, &AssignLimits::default());
-        assert!(a.indices.len() > 1000);
-        for enc in [GridEncoding::Rgba8, GridEncoding::Uint] {
-            let g = pack_grid(&grid, &a, enc);
+        let full = assign(&grid, &lights, 60.0, &AssignLimits::default());
+        assert!(full.indices.len() > 1000);
+        // Also lists the overflow policy trimmed and compacted (ES 3.0 derives each count
+        // from the next cell's start, so the lists must stay contiguous).
+        let capped = assign(
+            &grid,
+            &lights,
+            60.0,
+            &AssignLimits {
+                cell_cap: 2,
+                ..AssignLimits::default()
+            },
+        );
+        assert!(capped.stats.overflowed_lights > 0);
+        for (a, enc) in [
+            (&full, GridEncoding::Rgba8),
+            (&full, GridEncoding::Uint),
+            (&capped, GridEncoding::Uint),
+        ] {
+            let g = pack_grid(&grid, a, enc);
             let ix = pack_indices(&a.indices, enc);
             for cell in 0..grid.total_cells {
                 assert_eq!(
@@ -337,5 +375,25 @@ mod tests {
             assert_eq!(t[4] as u32, c.slices);
             assert_eq!(u32::from_be_bytes([0, t[5], t[6], t[7]]), c.first_cell);
         }
+        // ES 3.0: four 32-bit texels a cascade, then the cells' starts and the end.
+        let g = pack_grid(&grid, &a, GridEncoding::Uint);
+        let word = |t: usize| u32::from_le_bytes(g.bytes[t * 4..t * 4 + 4].try_into().unwrap());
+        for (k, c) in grid.cascades.iter().enumerate() {
+            let table = [
+                word(4 * k),
+                word(4 * k + 1),
+                word(4 * k + 2),
+                word(4 * k + 3),
+            ];
+            assert_eq!(table, [c.tiles_x, c.tiles_y, c.slices, c.first_cell]);
+        }
+        assert_eq!(
+            g.bytes.len(),
+            g.height as usize * DATA_TEXTURE_WIDTH as usize * 4
+        );
+        assert!(
+            g.height as usize * DATA_TEXTURE_WIDTH as usize
+                >= grid_texels(&grid, GridEncoding::Uint)
+        );
     }
 }

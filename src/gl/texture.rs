@@ -17,6 +17,8 @@ pub enum DataFormat {
     Rg32Ui,
     /// One u16 channel (ES 3.0 only).
     R16Ui,
+    /// One u32 channel (ES 3.0 only): the cluster grid, a list start a cell.
+    R32Ui,
     /// Four u16 channels (ES 3.0 only): the index list, four light numbers a texel.
     Rgba16Ui,
 }
@@ -29,6 +31,7 @@ impl DataFormat {
             DataFormat::Rgba8 => 4,
             DataFormat::Rg32Ui => 8,
             DataFormat::R16Ui => 2,
+            DataFormat::R32Ui => 4,
             DataFormat::Rgba16Ui => 8,
         }
     }
@@ -42,6 +45,7 @@ impl DataFormat {
             (DataFormat::Rgba8, EsVersion::Es2) => (glow::RGBA, glow::RGBA, glow::UNSIGNED_BYTE),
             (DataFormat::Rg32Ui, _) => (glow::RG32UI, glow::RG_INTEGER, glow::UNSIGNED_INT),
             (DataFormat::R16Ui, _) => (glow::R16UI, glow::RED_INTEGER, glow::UNSIGNED_SHORT),
+            (DataFormat::R32Ui, _) => (glow::R32UI, glow::RED_INTEGER, glow::UNSIGNED_INT),
             (DataFormat::Rgba16Ui, _) => (glow::RGBA16UI, glow::RGBA_INTEGER, glow::UNSIGNED_SHORT),
         }
     }
@@ -84,7 +88,7 @@ impl DataTexture {
         }
         let integer = matches!(
             format,
-            DataFormat::Rg32Ui | DataFormat::R16Ui | DataFormat::Rgba16Ui
+            DataFormat::Rg32Ui | DataFormat::R16Ui | DataFormat::R32Ui | DataFormat::Rgba16Ui
         );
         if integer && dev.es() != EsVersion::Es3 {
             return Err(GlError::Unsupported("integer textures need ES 3.0".into()));

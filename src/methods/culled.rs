@@ -54,7 +54,7 @@ impl TextureSet {
         };
         let (grid, indices) = match dev.es() {
             EsVersion::Es2 => (DataFormat::Rgba8, DataFormat::Rgba8),
-            EsVersion::Es3 => (DataFormat::Rg32Ui, DataFormat::Rgba16Ui),
+            EsVersion::Es3 => (DataFormat::R32Ui, DataFormat::Rgba16Ui),
         };
         Ok(TextureSet {
             lights: DataTexture::new(dev, light_format)?,
@@ -230,7 +230,7 @@ impl ShadingMethod for CulledForward {
         let (grid_key, grid) = self.grid.as_ref().expect("updated above");
         // Refused before any assignment: a grid the texture cannot hold would only fail at the
         // upload, after allocating its lists.
-        let texels = grid_texels(grid);
+        let texels = grid_texels(grid, grid_encoding);
         if texels > max_rows * DATA_TEXTURE_WIDTH as usize {
             return Err(Error::Limit(format!(
                 "a {} px cell footprint (grid.footprint_px) makes {} grid cells; this context's \
