@@ -341,7 +341,7 @@ impl ScreenExtent {
             } else {
                 (t0 - cy).max(cy - t1)
             };
-            if !(gap > 0.0) {
+            if gap.is_nan() || gap <= 0.0 {
                 // The row's band holds the centre (or the gap is NaN): its chord is the whole
                 // cross-section, whose columns are `columns` (the same arithmetic, done once
                 // per slice).
