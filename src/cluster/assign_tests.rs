@@ -519,3 +519,48 @@ fn to_window(grid: &ClusterGrid, p: DVec3) -> Option<(f64, f64, f64)> {
         d,
     ))
 }
+
+/// The plain loops that small lights (at most 2 × 2 cells a cascade) take emit exactly what
+/// the general slice loop emits for them (the cascade's rectangle, no cone), for points and
+/// spots, in every grid mode, over the whole grid and over windows of slices (bands).
+#[test]
+fn small_lights_plain_loops_match_the_general_loop() {
+    use super::cells::{for_each_run_in, SliceWindow, SMALL_PATH_OFF};
+    let mut rng = Pcg64Mcg::seed_from_u64(17);
+    let mut small_rects = 0;
+    for case in cases() {
+        let grid = ClusterGrid::new(320, 180, case.projection, case.near, case.far, &case.config);
+        let slices = grid.slice_slabs.len() as u32;
+        let mut lights = lights_in_view(&mut rng, &grid, 300);
+        // Mostly small: radii of a few pixels to a cell or two.
+        for l in &mut lights {
+            let d = -l.position.z as f64;
+            let (_, hy) = grid.projection.half_extent(d.max(case.near));
+            let r = (hy * rng.random_range(0.002..0.08)) as f32;
+            l.radius = r;
+            l.cull_radius = r;
+        }
+        let windows = [
+            SliceWindow::ALL,
+            SliceWindow::of(&grid, 0, slices.div_ceil(2)),
+            SliceWindow::of(&grid, slices / 3, slices),
+        ];
+        for light in &lights {
+            for window in &windows {
+                let runs = |off: bool| {
+                    SMALL_PATH_OFF.with(|flag| flag.set(off));
+                    let mut runs = Vec::new();
+                    for_each_run_in(&grid, window, light, case.far, &mut |start, len| {
+                        runs.push((start, len))
+                    });
+                    SMALL_PATH_OFF.with(|flag| flag.set(false));
+                    runs
+                };
+                let (plain, general) = (runs(false), runs(true));
+                assert_eq!(plain, general, "{}: {light:?}", case.name);
+                small_rects += usize::from(!plain.is_empty() && plain.iter().all(|r| r.1 <= 2));
+            }
+        }
+    }
+    assert!(small_rects > 500, "only {small_rects} small lights tried");
+}

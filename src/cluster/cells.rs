@@ -191,7 +191,8 @@ pub(crate) fn for_each_run_in(
         // A rectangle of at most 2 × 2 cells per slice has little to trim (a corner cell at
         // most) and the per-row arithmetic, or a spot's cone test, would cost more than the
         // cells it saves (a spot's bounding sphere already fits its cone).
-        if columns.1 - columns.0 < 2 && rows.1 - rows.0 < 2 {
+        let small = columns.1 - columns.0 < 2 && rows.1 - rows.0 < 2;
+        if small && small_path_enabled() {
             // The common case of many small lights, kept to the plain loops: with the
             // refinement's code in the same loop the compiler spilled and called per row,
             // which cost a small light about 7 ns more (a fifth).
@@ -207,11 +208,17 @@ pub(crate) fn for_each_run_in(
             }
             continue;
         }
-        let coverage = grid.coverage;
+        // A small rectangle reaches this loop only in the tests that check the plain loops
+        // above against it (the whole rectangle, no cone): outside tests `small` is false here.
+        let coverage = if small {
+            Coverage::CascadeBox
+        } else {
+            grid.coverage
+        };
         for s in sa..sb + 1 {
             // A spot's cone against the slice's cells, worked out once per slice.
             let cone = match &cone {
-                Some(cone) => {
+                Some(cone) if !small => {
                     let g = constants.first_slice + s;
                     Some(cone.slice(&grid.slice_cells(k, g, columns, rows)))
                 }
@@ -233,6 +240,22 @@ pub(crate) fn for_each_run_in(
             slice_start += slice_cells;
         }
     }
+}
+
+#[cfg(test)]
+thread_local! {
+    /// Set by the tests that compare the small-light loops with the general slice loop.
+    pub(crate) static SMALL_PATH_OFF: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+}
+
+/// Whether lights of at most 2 × 2 cells a cascade take their own plain loops (always,
+/// outside tests).
+#[inline(always)]
+fn small_path_enabled() -> bool {
+    #[cfg(test)]
+    return !SMALL_PATH_OFF.with(|off| off.get());
+    #[cfg(not(test))]
+    true
 }
 
 /// One cascade's tiling as the per-slice refinement sees it, with the column and row ranges

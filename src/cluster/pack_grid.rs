@@ -131,7 +131,8 @@ impl PackedTexels {
     }
 }
 
-/// Packs the cascade table and the per-cell (offset, count).
+/// Packs the cascade table and each cell's list: (offset, count) on ES 2.0, its start (and
+/// after the last cell the end) on ES 3.0.
 pub fn pack_grid(grid: &ClusterGrid, a: &Assignment, encoding: GridEncoding) -> PackedTexels {
     let mut packed = PackedTexels::empty();
     pack_grid_into(grid, a, encoding, &mut packed);

@@ -253,8 +253,9 @@ impl ShadingMethod for CulledForward {
             };
             log::warn!(
                 "{method}: {dropped} light references left out of this frame's cell lists, so \
-                 the image lacks those lights where they reach ({cap}, and the index texture \
-                 holds {} references on this context; each cell keeps the lights that matter \
+                 the image lacks those lights where they reach ({cap}, and at most {} \
+                 references fit in the index list here: the index texture's capacity on this \
+                 context or RenderOptions::max_indices; each cell keeps the lights that matter \
                  most to it, and FrameStats::overflowed_lights counts the dropped ones every \
                  frame): a coarser grid (grid.footprint_px), deeper slices (grid.slice_depth) \
                  or the automatic grid avoid it",
