@@ -50,20 +50,22 @@ int lightIndexAt(HIGHP float pos) {
     return int(u16Of(pair));
 }
 #else
-// (offset, count) of the fragment's cell: cascade k's table is texels 4k..4k+3 (tiles_x,
-// tiles_y, slices, first cell); a cell's texel holds where its list starts, the next texel
-// where it ends.
+// (offset, count) of the fragment's cell: cascade k's table is texel 2k (tiles_x | tiles_y
+// << 16) and 2k+1 (slices | first cell << 8); a cell's texel holds where its list starts,
+// the next texel where it ends.
 uvec2 clusterCell(HIGHP vec2 fragXY, HIGHP float viewDepth) {
     HIGHP float t = clusterT(viewDepth);
     int k = int(clamp(floor(t), 0.0, u_cascadeCount - 1.0));
-    uint tilesX = texelFetch(u_grid, dataCoord(4 * k), 0).x;
-    uint tilesY = texelFetch(u_grid, dataCoord(4 * k + 1), 0).x;
-    HIGHP float slices = float(texelFetch(u_grid, dataCoord(4 * k + 2), 0).x);
-    uint first = texelFetch(u_grid, dataCoord(4 * k + 3), 0).x;
+    uint a = texelFetch(u_grid, dataCoord(2 * k), 0).x;
+    uint b = texelFetch(u_grid, dataCoord(2 * k + 1), 0).x;
+    uint tilesX = a & 0xFFFFu;
+    uint tilesY = a >> 16u;
+    HIGHP float slices = float(b & 0xFFu);
+    uint first = b >> 8u;
     int s = int(clamp(floor((t - float(k)) * slices), 0.0, slices - 1.0));
     int x = int(clamp(floor(fragXY.x * float(tilesX) / u_viewport.x), 0.0, float(tilesX) - 1.0));
     int y = int(clamp(floor(fragXY.y * float(tilesY) / u_viewport.y), 0.0, float(tilesY) - 1.0));
-    int texel = 4 * int(u_cascadeCount) + int(first) + (s * int(tilesY) + y) * int(tilesX) + x;
+    int texel = 2 * int(u_cascadeCount) + int(first) + (s * int(tilesY) + y) * int(tilesX) + x;
     uint start = texelFetch(u_grid, dataCoord(texel), 0).x;
     uint end = texelFetch(u_grid, dataCoord(texel + 1), 0).x;
     return uvec2(start, end - start);

@@ -3,22 +3,25 @@
 //! Both textures are [`DATA_TEXTURE_WIDTH`] texels wide, rows as needed.
 //!
 //! ```text
-//! Grid texture: a cascade table (T texels a cascade), then one texel per cell.
+//! Grid texture: a cascade table (two texels a cascade), then one texel per cell.
 //!
-//!   ES 2.0, RGBA8 (4 bytes per texel, T = 2)
+//!   ES 2.0, RGBA8 (4 bytes per texel)
 //!     texel 2k     cascade k: tx.hi tx.lo ty.hi ty.lo                 (tiles_x, tiles_y)
 //!     texel 2k+1   cascade k: slices first.hi first.mid first.lo      (slices, first cell)
 //!     texel 2C+i   cell i: 20-bit offset, 12-bit count
 //!                  [o19..o12][o11..o4][o3..o0 c11..c8][c7..c0]
-//!     → counts ≤ 4 095, offsets < 2²⁰, cells < 2²⁴
+//!     → counts ≤ 4 095, offsets < 2²⁰
 //!
-//!   ES 3.0, R32UI (4 bytes per texel, T = 4)
-//!     texels 4k..4k+3   cascade k: tiles_x, tiles_y, slices, first cell
-//!     texel 4C+i        cell i: where its list starts in the index list
-//!     texel 4C+N        where the last cell's list ends (N cells)
-//!     → a cell's count is the next texel's offset less its own (the lists are contiguous,
+//!   ES 3.0, R32UI (4 bytes per texel)
+//!     texel 2k     cascade k: tiles_x | tiles_y << 16
+//!     texel 2k+1   cascade k: slices | first cell << 8
+//!     texel 2C+i   cell i: where its list starts in the index list
+//!     texel 2C+N   where the last cell's list ends (N cells)
+//!     → a cell's count is the next texel's start less its own (the lists are contiguous,
 //!       cell after cell): half the bytes of an (offset, count) pair a cell, for one more
-//!       fetch a fragment (not a light); 32-bit everything
+//!       fetch a fragment (not a light); offsets 32-bit
+//!
+//!   Both: tiles < 2¹⁶ a side, slices ≤ 255 a cascade, cells < 2²⁴ ([`grid_fits_table`]).
 //!
 //! Index texture: light numbers (positions in the uploaded light texture), grouped by cell.
 //!   ES 2.0, RGBA8: two 16-bit indices per texel (i.hi i.lo j.hi j.lo)    2 bytes per index
@@ -35,6 +38,33 @@ use super::assign::Assignment;
 use super::grid::ClusterGrid;
 use super::index_list::IndexList;
 use super::pack::DATA_TEXTURE_WIDTH;
+
+/// Texels per cascade in the grid texture's table.
+pub const TABLE_TEXELS_PER_CASCADE: u32 = 2;
+
+/// Most cells a grid's table can address (the first cell of a cascade has 24 bits).
+pub const MAX_TABLE_CELLS: u32 = 1 << 24;
+
+/// `None` when the cascade table can describe `grid` (see the module docs), else what does
+/// not fit.
+pub fn grid_fits_table(grid: &ClusterGrid) -> Option<String> {
+    if grid.total_cells >= MAX_TABLE_CELLS {
+        return Some(format!(
+            "{} cells (the grid texture's table addresses fewer than {MAX_TABLE_CELLS})",
+            grid.total_cells
+        ));
+    }
+    grid.cascades
+        .iter()
+        .find(|c| c.tiles_x > 0xFFFF || c.tiles_y > 0xFFFF || c.slices > 255)
+        .map(|c| {
+            format!(
+                "a cascade of {} × {} tiles and {} slices (the table holds at most 65 535 tiles \
+                 a side and 255 slices)",
+                c.tiles_x, c.tiles_y, c.slices
+            )
+        })
+}
 
 /// Most lights a cell can hold in the RGBA8 grid (12-bit count) — also the ES 2.0 loop bound.
 pub const RGBA8_CELL_CAP: u32 = 4095;
@@ -59,14 +89,6 @@ impl GridEncoding {
     /// Bytes per cell in the grid texture.
     pub fn cell_bytes(self) -> usize {
         4
-    }
-
-    /// Texels per cascade in the grid texture's table.
-    pub fn table_texels_per_cascade(self) -> usize {
-        match self {
-            GridEncoding::Rgba8 => 2,
-            GridEncoding::Uint => 4,
-        }
     }
 
     /// Bytes per light index in the index texture (16-bit light numbers either way).
@@ -110,7 +132,7 @@ pub fn grid_texels(grid: &ClusterGrid, encoding: GridEncoding) -> usize {
         GridEncoding::Rgba8 => 0,
         GridEncoding::Uint => 1,
     };
-    grid.cascades.len() * encoding.table_texels_per_cascade() + grid.total_cells as usize + end
+    grid.cascades.len() * TABLE_TEXELS_PER_CASCADE as usize + grid.total_cells as usize + end
 }
 
 impl Default for PackedTexels {
@@ -146,7 +168,7 @@ pub fn pack_grid_into(
     encoding: GridEncoding,
     packed: &mut PackedTexels,
 ) {
-    let table = grid.cascades.len() * encoding.table_texels_per_cascade();
+    let table = grid.cascades.len() * TABLE_TEXELS_PER_CASCADE as usize;
     let height = rows_for(grid_texels(grid, encoding));
     let bytes = &mut packed.bytes;
     bytes.clear();
@@ -169,12 +191,11 @@ pub fn pack_grid_into(
         }
         GridEncoding::Uint => {
             for (k, c) in grid.cascades.iter().enumerate() {
-                for (i, v) in [c.tiles_x, c.tiles_y, c.slices, c.first_cell]
-                    .into_iter()
-                    .enumerate()
-                {
-                    put(4 * k + i, v.to_le_bytes());
-                }
+                put(2 * k, (c.tiles_x | c.tiles_y << 16).to_le_bytes());
+                put(
+                    2 * k + 1,
+                    (c.slices.min(255) | c.first_cell << 8).to_le_bytes(),
+                );
             }
             for (cell, &offset) in a.offsets.iter().enumerate() {
                 put(table + cell, offset.to_le_bytes());
@@ -240,7 +261,7 @@ pub fn unpack_cell(
     cell: u32,
     encoding: GridEncoding,
 ) -> (u32, u32) {
-    let t = grid.cascades.len() * encoding.table_texels_per_cascade() + cell as usize;
+    let t = grid.cascades.len() * TABLE_TEXELS_PER_CASCADE as usize + cell as usize;
     let texel = |t: usize| -> [u8; 4] { packed.bytes[t * 4..t * 4 + 4].try_into().unwrap() };
     match encoding {
         GridEncoding::Rgba8 => {
@@ -376,18 +397,35 @@ mod tests {
             assert_eq!(t[4] as u32, c.slices);
             assert_eq!(u32::from_be_bytes([0, t[5], t[6], t[7]]), c.first_cell);
         }
-        // ES 3.0: four 32-bit texels a cascade, then the cells' starts and the end.
+        // ES 3.0: two 32-bit texels a cascade (decoded as the shader does), then the cells'
+        // starts and the end.
         let g = pack_grid(&grid, &a, GridEncoding::Uint);
         let word = |t: usize| u32::from_le_bytes(g.bytes[t * 4..t * 4 + 4].try_into().unwrap());
         for (k, c) in grid.cascades.iter().enumerate() {
-            let table = [
-                word(4 * k),
-                word(4 * k + 1),
-                word(4 * k + 2),
-                word(4 * k + 3),
-            ];
+            let (a, b) = (word(2 * k), word(2 * k + 1));
+            let table = [a & 0xFFFF, a >> 16, b & 0xFF, b >> 8];
             assert_eq!(table, [c.tiles_x, c.tiles_y, c.slices, c.first_cell]);
         }
+        assert_eq!(grid_fits_table(&grid), None);
+        // One-pixel cells over a large frame: more cells than the table's 24-bit first cells
+        // address (a texture of 32 768 rows would otherwise take them).
+        let huge = ClusterGrid::new(
+            8192,
+            4096,
+            GridProjection::Perspective {
+                tan_x: 1.0,
+                tan_y: 0.5,
+            },
+            0.1,
+            60.0,
+            &GridConfig {
+                max_tiles: 8192,
+                ..GridConfig::fixed(1.0)
+            },
+        );
+        assert!(huge.total_cells >= MAX_TABLE_CELLS);
+        let said = grid_fits_table(&huge).expect("refused");
+        assert!(said.contains("cells"), "{said}");
         assert_eq!(
             g.bytes.len(),
             g.height as usize * DATA_TEXTURE_WIDTH as usize * 4

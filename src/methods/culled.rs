@@ -20,8 +20,8 @@ use crate::cluster::pack::{
     pack_lights_into, GpuLight, LightEncoding, PackedLights, DATA_TEXTURE_WIDTH,
 };
 use crate::cluster::pack_grid::{
-    grid_texels, pack_grid_into, pack_indices_into, GridEncoding, PackedTexels, MAX_INDEXED_LIGHTS,
-    RGBA8_CELL_CAP, RGBA8_OFFSET_LIMIT,
+    grid_fits_table, grid_texels, pack_grid_into, pack_indices_into, GridEncoding, PackedTexels,
+    MAX_INDEXED_LIGHTS, RGBA8_CELL_CAP, RGBA8_OFFSET_LIMIT,
 };
 use crate::gl::texture::{DataFormat, DataTexture};
 use crate::gl::{Device, EsVersion};
@@ -231,6 +231,13 @@ impl ShadingMethod for CulledForward {
         // Refused before any assignment: a grid the texture cannot hold would only fail at the
         // upload, after allocating its lists.
         let texels = grid_texels(grid, grid_encoding);
+        if let Some(what) = grid_fits_table(grid) {
+            return Err(Error::Limit(format!(
+                "a {} px cell footprint (grid.footprint_px) with these limits (grid.max_tiles, \
+                 grid.max_slices) makes {what}: use a larger footprint or the automatic grid",
+                grid_key.config.footprint_px
+            )));
+        }
         if texels > max_rows * DATA_TEXTURE_WIDTH as usize {
             return Err(Error::Limit(format!(
                 "a {} px cell footprint (grid.footprint_px) makes {} grid cells; this context's \

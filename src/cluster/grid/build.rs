@@ -132,7 +132,7 @@ impl ClusterGrid {
                 slices,
                 first_cell,
             };
-            first_cell += cascade.cells();
+            first_cell = first_cell.saturating_add(cascade.cells());
             cascades.push(cascade);
         }
         self.width = width;

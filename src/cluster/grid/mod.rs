@@ -68,9 +68,12 @@ pub struct Cascade {
 }
 
 impl Cascade {
-    /// Cells in this cascade.
+    /// Cells in this cascade, saturating at `u32::MAX` (which a renderer refuses by name).
     pub fn cells(&self) -> u32 {
-        self.tiles_x * self.tiles_y * self.slices
+        // Saturating: a large frame with raised limits (`max_tiles`, `max_slices`) can make
+        // more than 2³² cells, which the renderer then refuses by name instead of wrapping.
+        let cells = u64::from(self.tiles_x) * u64::from(self.tiles_y) * u64::from(self.slices);
+        cells.min(u64::from(u32::MAX)) as u32
     }
 }
 
