@@ -21,6 +21,11 @@ HIGHP float clusterT(HIGHP float viewDepth) {
 }
 
 #if GLSL_ES == 100
+// A grid texel's 32-bit big-endian list start.
+HIGHP float listStart(HIGHP vec4 t) {
+    return ((byteOf(t.x) * 256.0 + byteOf(t.y)) * 256.0 + byteOf(t.z)) * 256.0 + byteOf(t.w);
+}
+
 // (offset, count) of the fragment's cell. fragXY is a highp copy of gl_FragCoord.xy.
 HIGHP vec2 clusterCell(HIGHP vec2 fragXY, HIGHP float viewDepth) {
     HIGHP float t = clusterT(viewDepth);
@@ -34,12 +39,12 @@ HIGHP vec2 clusterCell(HIGHP vec2 fragXY, HIGHP float viewDepth) {
     HIGHP float s = clamp(floor((t - k) * slices), 0.0, slices - 1.0);
     HIGHP float x = clamp(floor(fragXY.x * tilesX / u_viewport.x), 0.0, tilesX - 1.0);
     HIGHP float y = clamp(floor(fragXY.y * tilesY / u_viewport.y), 0.0, tilesY - 1.0);
-    HIGHP float cell = first + (s * tilesY + y) * tilesX + x;
-    vec4 c = dataTexel(u_grid, 2.0 * u_cascadeCount + cell, u_gridInvHeight.x);
-    // 20-bit offset, 12-bit count: [o19..o12][o11..o4][o3..o0 c11..c8][c7..c0].
-    HIGHP float b2 = byteOf(c.z);
-    HIGHP float high = floor(b2 / 16.0);
-    return vec2(byteOf(c.x) * 4096.0 + byteOf(c.y) * 16.0 + high, (b2 - high * 16.0) * 256.0 + byteOf(c.w));
+    HIGHP float texel = 2.0 * u_cascadeCount + first + (s * tilesY + y) * tilesX + x;
+    // The cell's list starts at its texel's 32-bit big-endian number and ends at the next's
+    // (at most 2^24: exact in a highp float).
+    HIGHP float start = listStart(dataTexel(u_grid, texel, u_gridInvHeight.x));
+    HIGHP float end = listStart(dataTexel(u_grid, texel + 1.0, u_gridInvHeight.x));
+    return vec2(start, end - start);
 }
 
 // The light number at position `pos` of the index list (two 16-bit indices per texel).

@@ -8,20 +8,22 @@
 //!   ES 2.0, RGBA8 (4 bytes per texel)
 //!     texel 2k     cascade k: tx.hi tx.lo ty.hi ty.lo                 (tiles_x, tiles_y)
 //!     texel 2k+1   cascade k: slices first.hi first.mid first.lo      (slices, first cell)
-//!     texel 2C+i   cell i: 20-bit offset, 12-bit count
-//!                  [o19..o12][o11..o4][o3..o0 c11..c8][c7..c0]
-//!     → counts ≤ 4 095, offsets < 2²⁰
+//!     texel 2C+i   cell i: where its list starts, 32-bit big-endian
+//!     texel 2C+N   where the last cell's list ends (N cells)
+//!     → starts ≤ 2²⁴ (exact integers in the shader's highp float), counts ≤ 4 095 (the
+//!       shader's constant loop bound)
 //!
 //!   ES 3.0, R32UI (4 bytes per texel)
 //!     texel 2k     cascade k: tiles_x | tiles_y << 16
 //!     texel 2k+1   cascade k: slices | first cell << 8
 //!     texel 2C+i   cell i: where its list starts in the index list
 //!     texel 2C+N   where the last cell's list ends (N cells)
-//!     → a cell's count is the next texel's start less its own (the lists are contiguous,
-//!       cell after cell): half the bytes of an (offset, count) pair a cell, for one more
-//!       fetch a fragment (not a light); offsets 32-bit
 //!
-//!   Both: tiles < 2¹⁶ a side, slices ≤ 255 a cascade, cells < 2²⁴ ([`grid_fits_table`]).
+//!   Both: a cell's count is the next texel's start less its own (the lists are contiguous,
+//!   cell after cell): one fetch more a fragment (not a light) than an (offset, count) texel,
+//!   for half the bytes on ES 3.0 and 16 times the indices on ES 2.0 (a 20-bit offset beside a
+//!   12-bit count addressed 2²⁰). Tiles < 2¹⁶ a side, slices ≤ 255 a cascade, cells < 2²⁴
+//!   ([`grid_fits_table`]).
 //!
 //! Index texture: light numbers (positions in the uploaded light texture), grouped by cell.
 //!   ES 2.0, RGBA8: two 16-bit indices per texel (i.hi i.lo j.hi j.lo)    2 bytes per index
@@ -72,8 +74,9 @@ pub const RGBA8_CELL_CAP: u32 = 4095;
 /// Most lights per frame the 16-bit index lists can name.
 pub const MAX_INDEXED_LIGHTS: usize = 1 << 16;
 
-/// Most indices the RGBA8 grid's 20-bit offsets can address.
-pub const RGBA8_OFFSET_LIMIT: usize = 1 << 20;
+/// Most indices the RGBA8 grid's list starts can address: integers a highp (fp32) float holds
+/// exactly, as the ES 2.0 shader decodes them.
+pub const RGBA8_OFFSET_LIMIT: usize = 1 << 24;
 
 /// How grid and index texels are stored.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize)]
@@ -126,13 +129,9 @@ fn be24(v: u32) -> [u8; 3] {
 }
 
 /// Texels of `grid`'s grid texture in `encoding`: the cascade table, then one per cell (and
-/// on ES 3.0 one more, where the last cell's list ends).
-pub fn grid_texels(grid: &ClusterGrid, encoding: GridEncoding) -> usize {
-    let end = match encoding {
-        GridEncoding::Rgba8 => 0,
-        GridEncoding::Uint => 1,
-    };
-    grid.cascades.len() * TABLE_TEXELS_PER_CASCADE as usize + grid.total_cells as usize + end
+/// one more, where the last cell's list ends).
+pub fn grid_texels(grid: &ClusterGrid) -> usize {
+    grid.cascades.len() * TABLE_TEXELS_PER_CASCADE as usize + grid.total_cells as usize + 1
 }
 
 impl Default for PackedTexels {
@@ -153,8 +152,8 @@ impl PackedTexels {
     }
 }
 
-/// Packs the cascade table and each cell's list: (offset, count) on ES 2.0, its start (and
-/// after the last cell the end) on ES 3.0.
+/// Packs the cascade table and where each cell's list starts (and, after the last cell, where
+/// its list ends).
 pub fn pack_grid(grid: &ClusterGrid, a: &Assignment, encoding: GridEncoding) -> PackedTexels {
     let mut packed = PackedTexels::empty();
     pack_grid_into(grid, a, encoding, &mut packed);
@@ -169,7 +168,7 @@ pub fn pack_grid_into(
     packed: &mut PackedTexels,
 ) {
     let table = grid.cascades.len() * TABLE_TEXELS_PER_CASCADE as usize;
-    let height = rows_for(grid_texels(grid, encoding));
+    let height = rows_for(grid_texels(grid));
     let bytes = &mut packed.bytes;
     bytes.clear();
     bytes.resize(DATA_TEXTURE_WIDTH as usize * height as usize * 4, 0);
@@ -184,10 +183,6 @@ pub fn pack_grid_into(
                 let [f0, f1, f2] = be24(c.first_cell);
                 put(2 * k + 1, [c.slices.min(255) as u8, f0, f1, f2]);
             }
-            for (cell, (&offset, &count)) in a.offsets.iter().zip(&a.counts).enumerate() {
-                let rgba8 = (offset.min((1 << 20) - 1) << 12) | count.min(RGBA8_CELL_CAP);
-                put(table + cell, rgba8.to_be_bytes());
-            }
         }
         GridEncoding::Uint => {
             for (k, c) in grid.cascades.iter().enumerate() {
@@ -197,18 +192,22 @@ pub fn pack_grid_into(
                     (c.slices.min(255) | c.first_cell << 8).to_le_bytes(),
                 );
             }
-            for (cell, &offset) in a.offsets.iter().enumerate() {
-                put(table + cell, offset.to_le_bytes());
-            }
-            // Where the last list ends (the lists are contiguous: each cell's starts where the
-            // one before it ends, also after the overflow policy compacted them).
-            let end = match (a.offsets.last(), a.counts.last()) {
-                (Some(&o), Some(&n)) => o + n,
-                _ => 0,
-            };
-            put(table + a.offsets.len(), end.to_le_bytes());
         }
     }
+    // Each cell's list start, then where the last list ends (the lists are contiguous, cell
+    // after cell, also after the overflow policy compacted them).
+    let end = match (a.offsets.last(), a.counts.last()) {
+        (Some(&o), Some(&n)) => o + n,
+        _ => 0,
+    };
+    let word = |v: u32| match encoding {
+        GridEncoding::Rgba8 => v.to_be_bytes(),
+        GridEncoding::Uint => v.to_le_bytes(),
+    };
+    for (cell, &offset) in a.offsets.iter().enumerate() {
+        put(table + cell, word(offset));
+    }
+    put(table + a.offsets.len(), word(end));
     packed.width = DATA_TEXTURE_WIDTH;
     packed.height = height;
 }
@@ -262,20 +261,15 @@ pub fn unpack_cell(
     encoding: GridEncoding,
 ) -> (u32, u32) {
     let t = grid.cascades.len() * TABLE_TEXELS_PER_CASCADE as usize + cell as usize;
-    let texel = |t: usize| -> [u8; 4] { packed.bytes[t * 4..t * 4 + 4].try_into().unwrap() };
-    match encoding {
-        GridEncoding::Rgba8 => {
-            let v = u32::from_be_bytes(texel(t));
-            (v >> 12, v & 0xFFF)
+    let start_at = |t: usize| {
+        let texel: [u8; 4] = packed.bytes[t * 4..t * 4 + 4].try_into().unwrap();
+        match encoding {
+            GridEncoding::Rgba8 => u32::from_be_bytes(texel),
+            GridEncoding::Uint => u32::from_le_bytes(texel),
         }
-        GridEncoding::Uint => {
-            let (start, end) = (
-                u32::from_le_bytes(texel(t)),
-                u32::from_le_bytes(texel(t + 1)),
-            );
-            (start, end.wrapping_sub(start))
-        }
-    }
+    };
+    let (start, end) = (start_at(t), start_at(t + 1));
+    (start, end.wrapping_sub(start))
 }
 
 /// Reads index `i` back exactly as the shader decodes it: from texel `i / n`, channel pair or
@@ -344,6 +338,7 @@ mod tests {
         for (a, enc) in [
             (&full, GridEncoding::Rgba8),
             (&full, GridEncoding::Uint),
+            (&capped, GridEncoding::Rgba8),
             (&capped, GridEncoding::Uint),
         ] {
             let g = pack_grid(&grid, a, enc);
@@ -430,9 +425,6 @@ mod tests {
             g.bytes.len(),
             g.height as usize * DATA_TEXTURE_WIDTH as usize * 4
         );
-        assert!(
-            g.height as usize * DATA_TEXTURE_WIDTH as usize
-                >= grid_texels(&grid, GridEncoding::Uint)
-        );
+        assert!(g.height as usize * DATA_TEXTURE_WIDTH as usize >= grid_texels(&grid));
     }
 }

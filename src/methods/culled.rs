@@ -230,7 +230,7 @@ impl ShadingMethod for CulledForward {
         let (grid_key, grid) = self.grid.as_ref().expect("updated above");
         // Refused before any assignment: a grid the texture cannot hold would only fail at the
         // upload, after allocating its lists.
-        let texels = grid_texels(grid, grid_encoding);
+        let texels = grid_texels(grid);
         if let Some(what) = grid_fits_table(grid) {
             return Err(Error::Limit(format!(
                 "a {} px cell footprint (grid.footprint_px) with these limits (grid.max_tiles, \
