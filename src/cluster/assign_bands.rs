@@ -113,7 +113,9 @@ impl Bands {
         // Phase 1, its difference counts straight into the counts' array (phase 2 sums them
         // in place: one cold array less than a separate one).
         out.counts.resize(cells, 0);
-        find_bands(bands, &mut out.counts, parallel, &|band, counts| {
+        out.offsets.resize(cells, 0);
+        let (counts, offsets) = (&mut out.counts[..], &mut out.offsets[..]);
+        for_band_cells(bands, counts, offsets, parallel, &|band, counts, _| {
             band.find(grid, lights, camera_far, counts)
         });
         // Phase 2: the visible lights and their numbers, then counts, offsets and totals.
@@ -124,8 +126,14 @@ impl Bands {
             &mut self.numbers,
             parallel,
         );
-        out.offsets.resize(cells, 0);
-        count_bands(bands, &mut out.counts, &mut out.offsets, parallel);
+        let (counts, offsets) = (&mut out.counts[..], &mut out.offsets[..]);
+        for_band_cells(
+            bands,
+            counts,
+            offsets,
+            parallel,
+            &|band, counts, offsets| band.count(counts, offsets),
+        );
         let mut totals = Totals::default();
         for band in bands.iter_mut() {
             band.base = totals.indices;
@@ -276,28 +284,37 @@ fn for_bands(bands: &mut [Band], parallel: bool, f: &(dyn Fn(&mut Band) + Sync))
     rayon::join(|| for_bands(left, true, f), || for_bands(right, true, f));
 }
 
-/// Phase 1 ([`Band::find`]) on every band with its cells' part of `counts`, the halves of
-/// the bands at once with `parallel`.
-fn find_bands(
+/// What [`for_band_cells`] runs on a band: the band, then its cells' parts of the counts and
+/// the offsets.
+type BandCellsFn<'a> = dyn Fn(&mut Band, &mut [u32], &mut [u32]) + Sync + 'a;
+
+/// Runs `f` on every band with its cells' parts of `counts` and `offsets` (the grid's): phase
+/// 1 ([`Band::find`]) and phase 2's counts ([`Band::count`]); the halves of the bands at once
+/// with `parallel`.
+fn for_band_cells(
     bands: &mut [Band],
     counts: &mut [u32],
+    offsets: &mut [u32],
     parallel: bool,
-    f: &(dyn Fn(&mut Band, &mut [u32]) + Sync),
+    f: &BandCellsFn<'_>,
 ) {
     if let [band] = bands {
-        f(band, &mut counts[..band.end_cell - band.first_cell]);
+        let cells = band.end_cell - band.first_cell;
+        f(band, &mut counts[..cells], &mut offsets[..cells]);
         return;
     }
     let (left, right) = bands.split_at_mut(bands.len() / 2);
-    let (counts_left, counts_right) = counts.split_at_mut(right[0].first_cell - left[0].first_cell);
+    let split = right[0].first_cell - left[0].first_cell;
+    let (counts_left, counts_right) = counts.split_at_mut(split);
+    let (offsets_left, offsets_right) = offsets.split_at_mut(split);
     if parallel {
         rayon::join(
-            || find_bands(left, counts_left, true, f),
-            || find_bands(right, counts_right, true, f),
+            || for_band_cells(left, counts_left, offsets_left, true, f),
+            || for_band_cells(right, counts_right, offsets_right, true, f),
         );
     } else {
-        find_bands(left, counts_left, false, f);
-        find_bands(right, counts_right, false, f);
+        for_band_cells(left, counts_left, offsets_left, false, f);
+        for_band_cells(right, counts_right, offsets_right, false, f);
     }
 }
 
@@ -341,28 +358,6 @@ fn number_visible(
                 .map(|&(light, _)| numbers[light as usize]),
         );
     });
-}
-
-/// Phase 2's per-band counts ([`Band::count`]) over `counts` and `offsets` (the grid's), the
-/// halves of the bands at once with `parallel`.
-fn count_bands(bands: &mut [Band], counts: &mut [u32], offsets: &mut [u32], parallel: bool) {
-    if let [band] = bands {
-        band.count(counts, offsets);
-        return;
-    }
-    let (left, right) = bands.split_at_mut(bands.len() / 2);
-    let split = right[0].first_cell - left[0].first_cell;
-    let (counts_left, counts_right) = counts.split_at_mut(split);
-    let (offsets_left, offsets_right) = offsets.split_at_mut(split);
-    if parallel {
-        rayon::join(
-            || count_bands(left, counts_left, offsets_left, true),
-            || count_bands(right, counts_right, offsets_right, true),
-        );
-    } else {
-        count_bands(left, counts_left, offsets_left, false);
-        count_bands(right, counts_right, offsets_right, false);
-    }
 }
 
 /// Phase 3 ([`Band::scatter`]) over `offsets` and the index list `list` (from the first band's
