@@ -211,7 +211,10 @@ fn a_grid_the_texture_cannot_hold_is_a_clear_error() {
     };
     match gpu.r().render_offscreen(&scene, 640, 360, &options) {
         Err(manylight::Error::Limit(message)) => {
-            assert!(message.contains("grid.footprint_px"), "{message}")
+            assert!(
+                message.contains("grid.footprint_px") && message.contains("grid texture holds"),
+                "{message}"
+            )
         }
         other => panic!(
             "expected a limit error, got {:?}",

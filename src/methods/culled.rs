@@ -231,13 +231,6 @@ impl ShadingMethod for CulledForward {
         // Refused before any assignment: a grid the texture cannot hold would only fail at the
         // upload, after allocating its lists.
         let texels = grid_texels(grid);
-        if let Some(what) = grid_fits_table(grid) {
-            return Err(Error::Limit(format!(
-                "a {} px cell footprint (grid.footprint_px) with these limits (grid.max_tiles, \
-                 grid.max_slices) makes {what}: use a larger footprint or the automatic grid",
-                grid_key.config.footprint_px
-            )));
-        }
         if texels > max_rows * DATA_TEXTURE_WIDTH as usize {
             return Err(Error::Limit(format!(
                 "a {} px cell footprint (grid.footprint_px) makes {} grid cells; this context's \
@@ -246,6 +239,15 @@ impl ShadingMethod for CulledForward {
                 grid_key.config.footprint_px,
                 grid.total_cells,
                 max_rows * DATA_TEXTURE_WIDTH as usize - (texels - grid.total_cells as usize)
+            )));
+        }
+        // The table's 24-bit first cells: a limit only where the texture holds more cells
+        // (16 384 rows of 1 024 texels hold 2²⁴ texels, table included).
+        if let Some(what) = grid_fits_table(grid) {
+            return Err(Error::Limit(format!(
+                "a {} px cell footprint (grid.footprint_px) with these limits (grid.max_tiles, \
+                 grid.max_slices) makes {what}: use a larger footprint or the automatic grid",
+                grid_key.config.footprint_px
             )));
         }
         let started = Instant::now();
