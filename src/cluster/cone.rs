@@ -138,6 +138,17 @@ impl ConeSlice<'_> {
         let cone = self.cone;
         let mut v0 = self.origin;
         v0.y += row as f64 * self.row_step;
+        if x1 - x0 < NARROW_ROW {
+            // A few cells: each tested on its own is cheaper than the row's quadratic.
+            let mut kept = None;
+            for x in x0..x1 + 1 {
+                let v = glam::DVec3::new(v0.x + x as f64 * self.sx, v0.y, v0.z);
+                if self.cell_may_touch(v) {
+                    kept = Some((kept.map_or(x, |(first, _)| first), x));
+                }
+            }
+            return kept;
+        }
         let p = v0.dot(cone.axis);
         let w0 = v0 - cone.axis * p;
         let h0 = self.r + cone.sin * p;
@@ -162,6 +173,29 @@ impl ConeSlice<'_> {
         let first = (truncated + u32::from((truncated as f64) < lo)).max(x0);
         let last = (hi as u32).min(x1);
         (first <= last).then_some((first, last))
+    }
+}
+
+/// Rows of fewer than this many columns plus one test their cells one by one
+/// ([`ConeSlice::cell_may_touch`]) instead of solving the row's quadratic.
+const NARROW_ROW: u32 = 3;
+
+impl ConeSlice<'_> {
+    /// False only when the sphere of radius `r` (every cell's bound) at `v` from the apex is
+    /// certainly outside the cone: the conditions [`ConeSlice::columns`] solves for a row,
+    /// loosened as it loosens them (the linear ones by the slack, the quadratic one by a
+    /// billionth of its terms). NaN keeps the cell.
+    #[inline(always)]
+    fn cell_may_touch(&self, v: glam::DVec3) -> bool {
+        let cone = self.cone;
+        let v1 = v.dot(cone.axis);
+        let bound = self.r + v1 * cone.sin;
+        let (off_axis, reach) = (cone.cos_sq * (v.length_squared() - v1 * v1), bound * bound);
+        let outside = v1 > self.r + cone.range + self.slack
+            || v1 < -self.r - self.slack
+            || bound < -self.slack
+            || off_axis - reach > 1e-9 * (off_axis.abs() + reach + cone.cos_sq * v1 * v1);
+        !outside
     }
 }
 
@@ -275,7 +309,7 @@ mod tests {
     fn row_spans_hold_every_cell_the_cell_test_passes() {
         let projection = GridProjection::test_view();
         let mut rng = Pcg64Mcg::seed_from_u64(17);
-        let (mut passed, mut spanned, mut rows) = (0u64, 0u64, 0u64);
+        let (mut passed, mut spanned, mut rows, mut narrow_rows) = (0u64, 0u64, 0u64, 0u64);
         for (footprint, far) in [(24.0, 60.0), (11.0, 30.0), (64.0, f64::INFINITY)] {
             let grid = ClusterGrid::new(
                 320,
@@ -310,6 +344,30 @@ mod tests {
                                 passed += (b - a + 1) as u64;
                                 rows += 1;
                             }
+                            // Windows of one to three columns (tested cell by cell): every
+                            // touched cell inside one is kept, and nothing outside it.
+                            for x0 in 0..c.tiles_x {
+                                for x1 in x0..(x0 + 3).min(c.tiles_x) {
+                                    let inside: Vec<u32> = touched
+                                        .iter()
+                                        .copied()
+                                        .filter(|x| (x0..=x1).contains(x))
+                                        .collect();
+                                    let narrow = cone_slice.columns(y, x0, x1);
+                                    if let Some((lo, hi)) = narrow {
+                                        assert!(x0 <= lo && lo <= hi && hi <= x1);
+                                    }
+                                    if let (Some(&a), Some(&b)) = (inside.first(), inside.last()) {
+                                        let (lo, hi) = narrow.unwrap_or_else(|| {
+                                            panic!(
+                                                "{light:?}: row {y} lost {inside:?} in {x0}..={x1}"
+                                            )
+                                        });
+                                        assert!(lo <= a && b <= hi, "{light:?}: {inside:?}");
+                                        narrow_rows += 1;
+                                    }
+                                }
+                            }
                             spanned += span.map_or(0, |(lo, hi)| (hi - lo + 1) as u64);
                         }
                     }
@@ -318,6 +376,10 @@ mod tests {
             }
         }
         assert!(rows > 2_000, "only {rows} rows touched");
+        assert!(
+            narrow_rows > 5_000,
+            "only {narrow_rows} narrow windows touched"
+        );
         // The span takes one radius for the whole slice (its largest cell's): a little wider.
         assert!(
             (spanned as f64) < passed as f64 * 1.15,
