@@ -174,13 +174,7 @@ impl ConeSlice<'_> {
         let last = (hi as u32).min(x1);
         (first <= last).then_some((first, last))
     }
-}
 
-/// Rows of fewer than this many columns plus one test their cells one by one
-/// ([`ConeSlice::cell_may_touch`]) instead of solving the row's quadratic.
-const NARROW_ROW: u32 = 3;
-
-impl ConeSlice<'_> {
     /// False only when the sphere of radius `r` (every cell's bound) at `v` from the apex is
     /// certainly outside the cone: the conditions [`ConeSlice::columns`] solves for a row,
     /// loosened as it loosens them (the linear ones by the slack, the quadratic one by a
@@ -198,6 +192,10 @@ impl ConeSlice<'_> {
         !outside
     }
 }
+
+/// Rows of fewer than this many columns plus one test their cells one by one
+/// ([`ConeSlice::cell_may_touch`]) instead of solving the row's quadratic.
+const NARROW_ROW: u32 = 3;
 
 /// The part of `span` (`lo ≤ hi`) where `a + b·t ≥ 0`, or `None` when there is none;
 /// `inv_b` is `1 / b` (a row's reciprocal is worked out once per slice).

@@ -68,7 +68,7 @@ pub fn grid_fits_table(grid: &ClusterGrid) -> Option<String> {
         })
 }
 
-/// Most lights a cell can hold in the RGBA8 grid (12-bit count) — also the ES 2.0 loop bound.
+/// Most lights a cell can hold on ES 2.0: the shader's constant loop bound.
 pub const RGBA8_CELL_CAP: u32 = 4095;
 
 /// Most lights per frame the 16-bit index lists can name.
@@ -128,8 +128,8 @@ fn be24(v: u32) -> [u8; 3] {
     [b[1], b[2], b[3]]
 }
 
-/// Texels of `grid`'s grid texture in `encoding`: the cascade table, then one per cell (and
-/// one more, where the last cell's list ends).
+/// Texels of `grid`'s grid texture: the cascade table, then one per cell (and one more, where
+/// the last cell's list ends).
 pub fn grid_texels(grid: &ClusterGrid) -> usize {
     grid.cascades.len() * TABLE_TEXELS_PER_CASCADE as usize + grid.total_cells as usize + 1
 }
@@ -224,10 +224,7 @@ pub fn pack_indices(indices: &IndexList, encoding: GridEncoding) -> PackedTexels
 pub fn pack_indices_into(indices: &IndexList, encoding: GridEncoding, packed: &mut PackedTexels) {
     let per_texel = encoding.indices_per_texel();
     let height = rows_for(indices.len().div_ceil(per_texel));
-    let texel_bytes = match encoding {
-        GridEncoding::Rgba8 => 4,
-        GridEncoding::Uint => 8,
-    };
+    let texel_bytes = per_texel * encoding.index_bytes();
     let bytes = &mut packed.bytes;
     bytes.clear();
     bytes.resize(
