@@ -645,6 +645,33 @@ fn slice_depth_flag_makes_thinner_slices_and_refuses_bad_ratios() {
     }
 }
 
+/// `--assign-budget` reaches the automatic grid (its reason states the budget; what the budget
+/// does to the choice is tested in `cluster::auto`); bad shares are refused.
+#[test]
+fn assign_budget_flag_bounds_the_automatic_grid() {
+    let dir = tempfile::tempdir().unwrap();
+    let base = [
+        "render", "--size", "160x90", "--lights", "64", "--frames", "0",
+    ];
+    let reason = |budget: &str| {
+        let args = [&base[..], &["--assign-budget", budget, "--stats", "s.json"]].concat();
+        let out = manylight(&args, &[], dir.path());
+        assert!(out.status.success(), "{}", text(&out));
+        stats(&dir.path().join("s.json"))["grid_reason"]
+            .as_str()
+            .unwrap()
+            .to_string()
+    };
+    for (budget, said) in [("0.05", "(budget 5.0 %)"), ("1", "(budget 100.0 %)")] {
+        let why = reason(budget);
+        assert!(why.starts_with("auto") && why.contains(said), "{why}");
+    }
+    for bad in ["-0.1", "nan", "1.5", "x"] {
+        let args = [&base[..], &["--assign-budget", bad]].concat();
+        expect_exit(&args, &[], dir.path(), 2, "share of the frame");
+    }
+}
+
 #[test]
 fn timed_frames_report_their_spread() {
     let dir = tempfile::tempdir().unwrap();

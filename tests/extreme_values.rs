@@ -127,10 +127,14 @@ fn grid_settings_that_are_not_finite_are_refused_naming_the_field() {
         ("grid.slice_depth", 0.0),
         ("grid.footprint_px", f64::NAN),
         ("grid.footprint_px", -8.0),
+        ("grid.assign_budget", f64::NAN),
+        ("grid.assign_budget", -0.05),
+        ("grid.assign_budget", f64::INFINITY),
     ] {
         let mut options = RenderOptions::default();
         match field {
             "grid.slice_depth" => options.grid.slice_depth = value,
+            "grid.assign_budget" => options.grid.assign_budget = value,
             _ => options.grid.footprint_px = value,
         }
         let err = gpu

@@ -93,6 +93,9 @@ pub struct AssignStats {
     pub indices: usize,
     /// Lights that touch at least one cell.
     pub visible_lights: usize,
+    /// Runs of consecutive cells the lights were found to touch (before the cap): the
+    /// per-run part of the assignment's work, beside the per-index and per-cell parts.
+    pub runs: usize,
 }
 
 /// The result: per-cell offset and count into `indices`, and the visible lights.
@@ -126,6 +129,8 @@ pub(super) struct Totals {
     pub(super) max: u32,
     /// Cells with a light.
     pub(super) nonempty: u32,
+    /// Runs of consecutive cells found (before any cap).
+    pub(super) runs: usize,
 }
 
 impl Totals {
@@ -221,6 +226,7 @@ impl Assigner {
         };
         // Overflow, then the figures.
         out.stats.max_lights_per_cluster = totals.max;
+        out.stats.runs = totals.runs;
         out.stats.visible_lights = out.visible.len();
         let nonempty = if apply_cap(out, grid, lights, limits, &mut self.overflow) {
             Totals::of(&out.counts).nonempty

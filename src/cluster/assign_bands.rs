@@ -140,6 +140,7 @@ impl Bands {
             totals.indices += band.totals.indices;
             totals.max = totals.max.max(band.totals.max);
             totals.nonempty += band.totals.nonempty;
+            totals.runs += band.runs.len();
         }
         // Phase 3. Every entry is written, so the list is not cleared first: only growth is
         // zero-filled.

@@ -80,7 +80,10 @@ impl Chunks {
             EntriesMut::Narrow(list) => merge(chunks, &out.offsets, list, threads, blocks),
             EntriesMut::Wide(list) => merge(chunks, &out.offsets, list, threads, blocks),
         }
-        Totals::of(&out.counts)
+        Totals {
+            runs: self.chunks.iter().map(|c| c.runs.len()).sum(),
+            ..Totals::of(&out.counts)
+        }
     }
 }
 

@@ -7,23 +7,32 @@
 //! by a constant:
 //!
 //! ```text
-//! predicted frame cost(f) = shade · E(f) · P  +  assign · (indices(f) + cells(f))  +  upload · bytes(f)
+//! predicted frame cost(f) = shade · E(f) · P  +  assign · work(f)  +  upload · bytes(f)
 //! ```
 //!
 //! * `E(f)`: light evaluations per covered pixel, counted exactly at [`SurfaceSamples`] (the
 //!   surfaces a coarse ray cast of the frame found) in the candidate's real light lists;
 //!   `P` the covered pixels.
-//! * `indices(f)`, `cells(f)`, `bytes(f)`: from the candidate's real assignment.
+//! * `work(f)` ([`assign_work`]: its runs of cells, and a little for its indices and cells)
+//!   and `bytes(f)`: from the candidate's real assignment.
 //! * `shade`, `assign`, `upload`: [`GridCosts`], nanoseconds per unit, calibrated on the running
 //!   device from the frames it renders ([`GridCosts::observe`]): starting from priors measured
 //!   on llvmpipe.
 //!
-//! Candidates run from coarse to fine (`64 / √2ⁿ` pixels, down to 8) and stop once the
-//! prediction has risen twice in a row or a grid would pass the cell budget. The choice is
-//! deterministic for given samples, lights and costs. A new choice replaces the current grid
-//! only when it is predicted at least [`HYSTERESIS`] cheaper, so a static scene never
-//! flip-flops between two near-equal grids.
+//! Candidates run from coarse to fine (`64 / 2^(n/4)` pixels, a quarter octave apart, down to
+//! 8) and stop once the prediction has risen twice in a row, a grid would pass the cell budget,
+//! or a grid's predicted assignment passes the CPU budget ([`GridConfig::assign_budget`], 5 % of
+//! the predicted frame) after a coarser one kept within it. The choice is the cheapest predicted
+//! frame among the grids that fit the index list, then among those within the CPU budget:
+//! near the optimum the frame barely changes with the footprint while the assignment grows
+//! about as its inverse square, so a finer grid there buys a fraction of a percent of frame
+//! for tens of percent more CPU (measured in docs/grid.md). The choice is deterministic for
+//! given samples, lights and costs. A new choice replaces the current grid only when it is
+//! predicted at least [`HYSTERESIS`] cheaper (or the current one overflows or passes the CPU
+//! budget where the new one does not), so a static scene never flip-flops between two
+//! near-equal grids.
 
+pub use super::auto_costs::{assign_work, FrameCost, GridCosts};
 pub use super::auto_search::{choose, ChoiceSearch};
 
 use super::assign::AssignLimits;
@@ -34,87 +43,14 @@ use super::pack_grid::GridEncoding;
 /// A new grid must be predicted this much cheaper (relative) than the current one to replace it.
 pub const HYSTERESIS: f64 = 0.1;
 
-/// Footprints tried, coarse to fine.
-pub const CANDIDATE_FOOTPRINTS: [f64; 7] = [64.0, 45.0, 32.0, 23.0, 16.0, 11.0, 8.0];
+/// Footprints tried, coarse to fine: `64 / 2^(n/4)`, rounded (a half octave apart the CPU
+/// budget jumped from a grid just over it to one with a third more evaluations).
+pub const CANDIDATE_FOOTPRINTS: [f64; 13] = [
+    64.0, 54.0, 45.0, 38.0, 32.0, 27.0, 23.0, 19.0, 16.0, 13.5, 11.0, 9.5, 8.0,
+];
 
 /// Most cells a chosen grid may have (a grid texture of 1 024 × 1 024 texels).
 pub const CELL_BUDGET: u32 = 1 << 20;
-
-/// Cost per unit in nanoseconds: what the model multiplies its counts by.
-#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
-pub struct GridCosts {
-    /// One light evaluation by one fragment.
-    pub shade_ns: f64,
-    /// One light·cell pair or cell of the assignment.
-    pub assign_ns: f64,
-    /// One byte uploaded.
-    pub upload_ns: f64,
-    /// Frames these figures were calibrated from (0: the priors).
-    pub frames: u32,
-}
-
-impl Default for GridCosts {
-    /// The priors, measured with llvmpipe on a 2-core machine (courtyard, 1 024 lights,
-    /// 640×360): a device's own frames replace them within a few frames.
-    fn default() -> Self {
-        GridCosts {
-            shade_ns: 20.0,
-            assign_ns: 7.0,
-            upload_ns: 0.3,
-            frames: 0,
-        }
-    }
-}
-
-/// Weight of a new frame in the calibration's running average.
-const CALIBRATION_WEIGHT: f64 = 0.25;
-
-impl GridCosts {
-    /// Takes one rendered frame in: `shade_ms` the time of its shading (GPU time, or wall time
-    /// less the CPU work), `evals` its estimated light evaluations, `assign_ms` and `work`
-    /// (indices + cells) its assignment, `upload_ms` and `bytes` its uploads. Frames with
-    /// nothing to measure leave a figure as it was.
-    pub fn observe(&mut self, frame: &FrameCost) {
-        let blend = |old: &mut f64, ms: f64, units: f64| {
-            if units > 0.0 && ms.is_finite() && ms > 0.0 {
-                let ns = ms * 1e6 / units;
-                *old = if self.frames == 0 {
-                    ns
-                } else {
-                    *old + CALIBRATION_WEIGHT * (ns - *old)
-                };
-            }
-        };
-        let first = self.frames;
-        blend(&mut self.shade_ns, frame.shade_ms, frame.evals);
-        blend(&mut self.assign_ns, frame.assign_ms, frame.assign_work);
-        blend(&mut self.upload_ns, frame.upload_ms, frame.upload_bytes);
-        self.frames = first + 1;
-    }
-
-    /// Predicted cost in milliseconds of `evals` light evaluations, `work` assignment units
-    /// and `bytes` uploaded.
-    pub fn predict_ms(&self, evals: f64, work: f64, bytes: f64) -> f64 {
-        (self.shade_ns * evals + self.assign_ns * work + self.upload_ns * bytes) * 1e-6
-    }
-}
-
-/// What one frame cost, for [`GridCosts::observe`].
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct FrameCost {
-    /// Shading time in milliseconds.
-    pub shade_ms: f64,
-    /// Light evaluations (estimated from the samples).
-    pub evals: f64,
-    /// Assignment time in milliseconds.
-    pub assign_ms: f64,
-    /// Indices + cells of the assignment.
-    pub assign_work: f64,
-    /// Upload time in milliseconds.
-    pub upload_ms: f64,
-    /// Bytes uploaded.
-    pub upload_bytes: f64,
-}
 
 /// Visible surface points of a frame, found by a coarse ray cast: where fragments will be.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -178,6 +114,10 @@ pub struct Candidate {
     pub bytes: usize,
     /// Predicted frame cost in milliseconds.
     pub predicted_ms: f64,
+    /// Predicted assignment time in milliseconds (part of `predicted_ms`).
+    pub assign_ms: f64,
+    /// Its predicted assignment passes the CPU budget ([`GridConfig::assign_budget`]).
+    pub over_budget: bool,
     /// Light references the overflow policy would drop with this grid.
     pub overflowed_lights: u64,
 }
@@ -226,14 +166,18 @@ pub fn first_split(samples: &SurfaceSamples, near: f64) -> Option<f64> {
 }
 
 /// Whether candidate `a` beats `b`: a grid whose lists overflow drops lights from the image,
-/// so the least overflow first, then the smallest prediction.
+/// so the least overflow first, then one within the CPU budget, then the smallest prediction.
 pub(super) fn better(a: &Candidate, b: &Candidate) -> bool {
-    (a.overflowed_lights, a.predicted_ms) < (b.overflowed_lights, b.predicted_ms)
+    (a.overflowed_lights, a.over_budget, a.predicted_ms)
+        < (b.overflowed_lights, b.over_budget, b.predicted_ms)
 }
 
 /// Whether `new` should replace `current`: only when predicted at least [`HYSTERESIS`] cheaper
 /// than the current footprint under the same measurement (or when the current one was not
-/// measured this time, overflows where the new one does not, or its first split moved).
+/// measured this time, overflows or passes the CPU budget where the new one does not, or its
+/// first split moved). The current grid has to pass the budget by more than [`HYSTERESIS`]
+/// (relative) to be left for it, and a grid left for the budget is not taken back until it is
+/// predicted clearly cheaper, so a grid near the budget does not alternate with its neighbour.
 pub fn should_switch(current: &GridConfig, new: &GridChoice) -> bool {
     if current.first_split != new.config.first_split {
         return true;
@@ -244,7 +188,14 @@ pub fn should_switch(current: &GridConfig, new: &GridChoice) -> bool {
         measured(new.config.footprint_px),
     ) {
         (Some(now), Some(best)) => {
+            // The current grid must pass the budget clearly too, or a grid whose share sits
+            // at the budget would be swapped out whenever a measurement put it a hair over.
+            let clearly_over =
+                now.assign_ms > current.assign_budget * (1.0 + HYSTERESIS) * now.predicted_ms;
             best.overflowed_lights < now.overflowed_lights
+                || (best.overflowed_lights == now.overflowed_lights
+                    && clearly_over
+                    && !best.over_budget)
                 || best.predicted_ms < now.predicted_ms * (1.0 - HYSTERESIS)
         }
         _ => true,
@@ -353,17 +304,18 @@ mod tests {
     }
 
     /// Finer grids evaluate fewer lights and cost more assignment: cheap shading favours
-    /// coarse grids, expensive shading fine ones, and the choice is the candidate with the
-    /// smallest prediction.
+    /// coarse grids, expensive shading fine ones, and without a CPU budget the choice is the
+    /// candidate with the smallest prediction.
     #[test]
     fn the_choice_follows_the_costs() {
         let (lights, samples) = workload(600);
+        let mut unbudgeted = inputs(&lights);
+        unbudgeted.base.assign_budget = 1.0;
         let pick = |shade_ns: f64| {
-            let costs = GridCosts {
-                shade_ns,
-                ..GridCosts::default()
-            };
-            let choice = choose(&inputs(&lights), &samples, &costs, &mut Assigner::new());
+            let prior = GridCosts::default();
+            let costs = GridCosts::new(shade_ns, prior.assign_ns, prior.upload_ns);
+            let choice = choose(&unbudgeted, &samples, &costs, &mut Assigner::new());
+            assert!(choice.candidates.iter().all(|c| !c.over_budget));
             let best = choice
                 .candidates
                 .iter()
@@ -376,7 +328,7 @@ mod tests {
             }
             choice.config.footprint_px
         };
-        let (cheap, dear) = (pick(0.01), pick(1000.0));
+        let (cheap, dear) = (pick(1e-4), pick(1000.0));
         assert_eq!(cheap, CANDIDATE_FOOTPRINTS[0]);
         assert!(dear < cheap, "{dear} px against {cheap} px");
     }
@@ -426,20 +378,92 @@ mod tests {
                 .iter()
                 .find(|b| b.footprint_px == choice.config.footprint_px)
                 .unwrap();
-            let clear = best.predicted_ms < c.predicted_ms * (1.0 - HYSTERESIS);
+            let budget = choice.config.assign_budget * (1.0 + HYSTERESIS);
+            let clear = best.predicted_ms < c.predicted_ms * (1.0 - HYSTERESIS)
+                || (c.assign_ms > budget * c.predicted_ms && !best.over_budget);
             assert_eq!(should_switch(&current, &choice), clear, "{c:?}");
         }
-        // Measured again with costs a little off, the grid stays.
+        // Measured again and again with costs a little off (the shading's cost moving the
+        // shares, so a grid near the budget goes in and out of it), the grid changes at most
+        // once and never goes back.
+        let mut current = choice.config.clone();
+        let mut footprints = vec![current.footprint_px];
         let mut costs = GridCosts::default();
-        for (k, shade) in [19.0, 21.0, 20.5, 19.5].into_iter().enumerate() {
+        for shade in [17.0, 19.0, 18.5, 17.5, 19.0, 17.0, 18.0, 19.0, 17.5] {
             costs.shade_ns = shade;
             let again = choose(&inputs(&lights), &samples, &costs, &mut Assigner::new());
-            assert!(
-                !should_switch(&choice.config, &again)
-                    || again.config.footprint_px == choice.config.footprint_px,
-                "measurement {k} flipped the grid"
-            );
+            if should_switch(&current, &again) {
+                current = again.config.clone();
+            }
+            if footprints.last() != Some(&current.footprint_px) {
+                footprints.push(current.footprint_px);
+            }
         }
+        assert!(
+            footprints.len() <= 2,
+            "the grid flip-flopped: {footprints:?}"
+        );
+    }
+
+    /// The CPU budget: the choice is the cheapest predicted frame among the grids whose
+    /// predicted assignment keeps within the budget's share of it, the search stops at the
+    /// first grid past it, and a current grid past it gives way to one within it even when
+    /// that one is predicted slower; the reason says what the budget turned down.
+    #[test]
+    fn the_cpu_budget_bounds_the_assignment() {
+        let (lights, samples) = workload(600);
+        // Dear shading: without a budget the finest grids win.
+        let prior = GridCosts::default();
+        let costs = GridCosts::new(200.0, prior.assign_ns, prior.upload_ns);
+        let mut free = inputs(&lights);
+        free.base.assign_budget = 1.0;
+        let unbounded = choose(&free, &samples, &costs, &mut Assigner::new());
+        let share = |c: &Candidate| c.assign_ms / c.predicted_ms;
+        let chosen = |choice: &GridChoice| {
+            choice
+                .candidates
+                .iter()
+                .find(|c| c.footprint_px == choice.config.footprint_px)
+                .unwrap()
+                .clone()
+        };
+        let free_pick = chosen(&unbounded);
+        assert!(share(&free_pick) > 0.0, "{free_pick:?}");
+        // A budget between the coarsest grid's share and the free choice's.
+        let coarsest = share(&unbounded.candidates[0]);
+        assert!(coarsest < share(&free_pick), "{unbounded:?}");
+        let budget = 0.5 * (coarsest + share(&free_pick));
+        let mut tight = inputs(&lights);
+        tight.base.assign_budget = budget;
+        let bounded = choose(&tight, &samples, &costs, &mut Assigner::new());
+        let pick = chosen(&bounded);
+        assert!(!pick.over_budget && share(&pick) <= budget, "{bounded:?}");
+        assert!(pick.footprint_px > free_pick.footprint_px, "{bounded:?}");
+        let within = bounded.candidates.iter().filter(|c| !c.over_budget);
+        let cheapest = within
+            .min_by(|a, b| a.predicted_ms.total_cmp(&b.predicted_ms))
+            .unwrap();
+        assert_eq!(cheapest.footprint_px, pick.footprint_px);
+        // Every candidate flagged as the budget says, and none measured past the first over.
+        for (k, c) in bounded.candidates.iter().enumerate() {
+            assert_eq!(c.over_budget, share(c) > budget, "{c:?}");
+            if c.over_budget {
+                assert_eq!(k, bounded.candidates.len() - 1, "{bounded:?}");
+            }
+        }
+        assert!(bounded.reason.contains("but assigns"), "{}", bounded.reason);
+        // The grid the free choice would keep is over the budget: the bounded choice replaces
+        // it although it is predicted slower; the other way the hysteresis decides.
+        let free_config = GridConfig {
+            assign_budget: budget,
+            ..unbounded.config.clone()
+        };
+        assert!(should_switch(&free_config, &bounded));
+        // No candidate within a zero budget: the cheapest prediction, as without one.
+        let mut none = inputs(&lights);
+        none.base.assign_budget = 0.0;
+        let zero = choose(&none, &samples, &costs, &mut Assigner::new());
+        assert_eq!(zero.config.footprint_px, free_pick.footprint_px);
     }
 
     /// A grid whose lists would not fit loses to one that fits, however cheap it looks.
@@ -455,10 +479,8 @@ mod tests {
         let coarsest = roomy.candidates[0].indices;
         let mut tight = inputs(&lights);
         tight.limits.max_indices = coarsest + 1;
-        let costs = GridCosts {
-            shade_ns: 1000.0,
-            ..GridCosts::default()
-        };
+        let mut costs = GridCosts::default();
+        costs.shade_ns = 1000.0;
         let choice = choose(&tight, &samples, &costs, &mut Assigner::new());
         assert_eq!(choice.config.footprint_px, CANDIDATE_FOOTPRINTS[0]);
         assert!(choice.candidates.len() >= 2, "a finer grid was measured");
@@ -481,35 +503,5 @@ mod tests {
         );
         assert_eq!(first_split(&samples, 10.0), None);
         assert_eq!(first_split(&SurfaceSamples::default(), 0.1), None);
-    }
-
-    /// The calibration moves towards what frames measure and ignores what they cannot say.
-    #[test]
-    fn calibration_follows_measured_frames() {
-        let mut costs = GridCosts::default();
-        let frame = FrameCost {
-            shade_ms: 10.0,
-            evals: 1e6,
-            assign_ms: 1.0,
-            assign_work: 1e5,
-            upload_ms: 0.0,
-            upload_bytes: 0.0,
-        };
-        costs.observe(&frame);
-        assert_eq!((costs.shade_ns, costs.assign_ns), (10.0, 10.0));
-        assert_eq!(costs.upload_ns, GridCosts::default().upload_ns);
-        for _ in 0..40 {
-            costs.observe(&FrameCost {
-                shade_ms: 20.0,
-                ..frame
-            });
-        }
-        assert!((costs.shade_ns - 20.0).abs() < 0.01, "{costs:?}");
-        let before = costs;
-        costs.observe(&FrameCost {
-            shade_ms: f64::NAN,
-            ..frame
-        });
-        assert_eq!(costs.shade_ns, before.shade_ns);
     }
 }

@@ -6,6 +6,7 @@
 use super::assign::Assigner;
 use super::auto::{better, Candidate, ChoiceInputs, GridChoice, GridCosts, SurfaceSamples};
 use super::auto::{first_split, CANDIDATE_FOOTPRINTS, CELL_BUDGET};
+use super::auto_costs::assign_work;
 use super::grid::{ClusterGrid, GridConfig};
 
 /// A search over the candidate footprints, coarse to fine, kept between frames (its buffers
@@ -79,17 +80,23 @@ impl ChoiceSearch {
         let evals_per_pixel = samples.evals_per_pixel(grid, &a.counts);
         let bytes = grid.total_cells as usize * inputs.encoding.cell_bytes()
             + a.indices.len() * inputs.encoding.index_bytes();
-        let work = (a.indices.len() + grid.total_cells as usize) as f64;
+        let work = assign_work(a.stats.runs, a.indices.len(), grid.total_cells);
         let covered = samples.covered_pixels();
+        let predicted_ms = costs.predict_ms(evals_per_pixel * covered, work, bytes as f64);
+        let assign_ms = costs.assign_ms(work);
         let candidate = Candidate {
             footprint_px,
             cells: grid.total_cells,
             indices: a.indices.len(),
             evals_per_pixel,
             bytes,
-            predicted_ms: costs.predict_ms(evals_per_pixel * covered, work, bytes as f64),
+            predicted_ms,
+            assign_ms,
+            // Not `<=` negated: a NaN budget (refused by the renderer) keeps every grid in.
+            over_budget: assign_ms > inputs.base.assign_budget * predicted_ms,
             overflowed_lights: a.stats.overflowed_lights,
         };
+        let over_budget = candidate.over_budget;
         let (rising, overflow_grew) = self.candidates.last().map_or((false, false), |last| {
             (
                 candidate.predicted_ms > last.predicted_ms,
@@ -105,8 +112,14 @@ impl ChoiceSearch {
         self.candidates.push(candidate);
         self.rises = if rising { self.rises + 1 } else { 0 };
         // Past here finer grids only rise further, or overflow the index list more (a per-cell
-        // cap overflows less in finer cells, so overflow alone does not stop the search).
-        self.done = self.rises == 2 || overflow_grew || self.next == self.footprints.len();
+        // cap overflows less in finer cells, so overflow alone does not stop the search), or
+        // assign more than a coarser grid that kept within the CPU budget (finer grids only
+        // assign more, so they cannot win).
+        let kept_budget = self.candidates.iter().any(|c| !c.over_budget);
+        self.done = self.rises == 2
+            || overflow_grew
+            || (over_budget && kept_budget)
+            || self.next == self.footprints.len();
         self.done
     }
 
@@ -146,6 +159,8 @@ impl ChoiceSearch {
                 evals_per_pixel: 0.0,
                 bytes: 0,
                 predicted_ms: 0.0,
+                assign_ms: 0.0,
+                over_budget: false,
                 overflowed_lights: 0,
             },
         };
@@ -169,6 +184,31 @@ impl ChoiceSearch {
             write!(out.reason, "calibrated over {} frames", costs.frames)
         };
         let _ = write!(out.reason, ") over {} samples", samples.points.len());
+        // The budget's part: the chosen grid's assignment against it, and the finer grid it
+        // turned down (predicted cheaper but over the budget), if any.
+        let budget = inputs.base.assign_budget;
+        let share = |c: &Candidate| 100.0 * c.assign_ms / c.predicted_ms.max(f64::MIN_POSITIVE);
+        let _ = write!(
+            out.reason,
+            "; assignment {:.2} ms, {:.1} % of the frame (budget {:.1} %)",
+            best.assign_ms,
+            share(&best),
+            100.0 * budget
+        );
+        let turned_down = self.candidates.iter().find(|c| {
+            c.over_budget
+                && c.overflowed_lights <= best.overflowed_lights
+                && c.predicted_ms < best.predicted_ms
+        });
+        if let (Some(c), false) = (turned_down, best.over_budget) {
+            let _ = write!(
+                out.reason,
+                "; {} px was predicted {:.2} ms faster but assigns {:.1} %",
+                c.footprint_px,
+                best.predicted_ms - c.predicted_ms,
+                share(c)
+            );
+        }
         out.config = GridConfig {
             footprint_px: best.footprint_px,
             first_split: self.split,

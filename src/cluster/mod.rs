@@ -9,6 +9,7 @@ pub mod assign;
 mod assign_bands;
 mod assign_chunks;
 pub mod auto;
+mod auto_costs;
 mod auto_search;
 pub mod cells;
 mod cone;

@@ -14,7 +14,7 @@ use super::grid_choice::{self, AutoGrid};
 use super::GridReport;
 use super::{FrameContext, MethodStats, ShadingMethod};
 use crate::cluster::assign::{AssignLimits, Assigner};
-use crate::cluster::auto::FrameCost;
+use crate::cluster::auto::{assign_work, FrameCost};
 use crate::cluster::grid::{ClusterGrid, GridConfig, GridMode, GridProjection};
 use crate::cluster::pack::{
     pack_lights_into, GpuLight, LightEncoding, PackedLights, DATA_TEXTURE_WIDTH,
@@ -327,7 +327,11 @@ impl ShadingMethod for CulledForward {
             packed_lights.bytes.len() + packed_grid.bytes.len() + packed_indices.bytes.len();
         let upload_ms = upload_started.elapsed().as_secs_f64() * 1e3;
         if automatic {
-            let work = (assignment.indices.len() + grid.total_cells as usize) as f64;
+            let work = assign_work(
+                assignment.stats.runs,
+                assignment.indices.len(),
+                grid.total_cells,
+            );
             self.auto.record(
                 grid,
                 &assignment.counts,

@@ -23,8 +23,9 @@ const RECHOOSE_AFTER_CHANGE: u32 = 30;
 const RECHOOSE_PERIOD: u32 = 240;
 
 /// The first re-choice comes this many frames after the first, once the costs have been
-/// calibrated on the device.
-const FIRST_CALIBRATED_CHOICE: u32 = 4;
+/// calibrated on the device: seven frames, whose median outvotes the slow first frames of a
+/// new grid (its buffers growing, its pool threads waking).
+const FIRST_CALIBRATED_CHOICE: u32 = 8;
 
 /// The scene's geometry by identity: each object's mesh and transform bits.
 type GeometryKey = Vec<(usize, [u64; 16])>;
@@ -67,6 +68,8 @@ pub(crate) struct AutoGrid {
     /// The choice a search finishes into before it is kept or swapped in (its buffers
     /// reused).
     scratch: GridChoice,
+    /// The current choice was made with the priors, before any frame was measured.
+    choice_from_priors: bool,
 }
 
 impl AutoGrid {
@@ -149,8 +152,13 @@ impl AutoGrid {
         self.search
             .finish_into(inputs, &self.samples, &self.costs, new);
         let same_layout = self.layout.as_ref() == Some(&layout);
+        // A grid chosen with the priors was not chosen with this device's figures: the first
+        // calibrated choice replaces it without the hysteresis (once, so no flip-flop).
+        let from_priors = std::mem::replace(&mut self.choice_from_priors, self.costs.frames == 0);
         match &mut self.choice {
-            Some(current) if same_layout && !auto::should_switch(&current.config, new) => {
+            Some(current)
+                if same_layout && !from_priors && !auto::should_switch(&current.config, new) =>
+            {
                 // The grid stays; the reason says it was measured again.
                 current.reason.clear();
                 if current.config.footprint_px != new.config.footprint_px {

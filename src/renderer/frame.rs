@@ -191,6 +191,7 @@ impl Renderer {
         stats.clusters = assign.clusters;
         stats.nonempty_clusters = assign.nonempty_clusters;
         stats.avg_lights_per_nonempty = assign.avg_lights_per_nonempty;
+        stats.assign_runs = assign.runs;
         stats.max_lights_per_cluster = assign.max_lights_per_cluster;
         stats.overflowed_lights = assign.overflowed_lights + method_stats.dropped_lights;
         stats.visible_lights = method_stats
@@ -293,6 +294,11 @@ fn check_options(options: &RenderOptions) -> Result<(), Error> {
                 format!("must be a finite number above 0, got {value}"),
             );
         }
+    }
+    let budget = options.grid.assign_budget;
+    if !(budget.is_finite() && budget >= 0.0) {
+        let why = format!("must be a finite share of the frame from 0 up, got {budget}");
+        return invalid("grid.assign_budget", why);
     }
     Ok(())
 }

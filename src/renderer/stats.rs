@@ -45,6 +45,9 @@ pub struct FrameStats {
     pub avg_lights_per_nonempty: f64,
     /// Most lights any cell touched (before the per-cell cap).
     pub max_lights_per_cluster: u32,
+    /// Runs of consecutive cells the assignment found (0 for forward): with the indices and
+    /// cells, what the assignment's time grows with.
+    pub assign_runs: usize,
     /// Light references dropped by the overflow policy (see `cluster::assign`), or lights
     /// forward left out beyond its loop cap (see `methods::forward_cap`).
     pub overflowed_lights: u64,
@@ -110,6 +113,7 @@ impl Default for FrameStats {
             clusters: 0,
             nonempty_clusters: 0,
             avg_lights_per_nonempty: 0.0,
+            assign_runs: 0,
             max_lights_per_cluster: 0,
             overflowed_lights: 0,
             visible_lights: 0,

@@ -170,7 +170,8 @@ fn knobs(quick: bool) -> Vec<Knob> {
                 value,
                 every_scene: name.starts_with("footprint_px")
                     || name == "coverage"
-                    || name == "slice_depth",
+                    || name == "slice_depth"
+                    || name == "assign_budget",
             });
         }
     };
@@ -199,6 +200,14 @@ fn knobs(quick: bool) -> Vec<Knob> {
         "clustered",
         |o, v| o.grid = GridConfig::fixed(v),
         pick(&[8.0, 16.0, 32.0, 64.0], &[16.0, 64.0]),
+    );
+    // The automatic grid without its CPU budget (the frame time alone decides): what the
+    // budget's share of the frame costs in frame time and buys in assignment time.
+    add(
+        "assign_budget",
+        "clustered",
+        |o, v| o.grid.assign_budget = v,
+        pick(&[1.0], &[]),
     );
     // Slices half as deep as a cell is wide: on the automatic grid, and on the finest fixed
     // one (what the finest cells can get out of a grazing floor).

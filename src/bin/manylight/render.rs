@@ -84,6 +84,10 @@ pub struct RenderArgs {
     /// seen at a grazing angle, at twice the cells).
     #[arg(long, default_value_t = 1.0, value_parser = parse_slice_depth, allow_hyphen_values = true)]
     pub slice_depth: f64,
+    /// With `--grid auto`: the largest share of the predicted frame time the CPU light
+    /// assignment may take (0.05: 5 %; 1 lets the frame time alone decide).
+    #[arg(long, default_value_t = manylight::cluster::grid::DEFAULT_ASSIGN_BUDGET, value_parser = parse_assign_budget, allow_hyphen_values = true)]
+    pub assign_budget: f64,
 }
 
 /// `--tonemap`.
@@ -138,6 +142,16 @@ pub fn parse_slice_depth(s: &str) -> Result<f64, String> {
         Ok(r) if (1.0 / 16.0..=16.0).contains(&r) => Ok(r),
         _ => Err(format!(
             "`{s}` is not a slice depth from 0.0625 to 16 (times a cell's width)"
+        )),
+    }
+}
+
+/// Parses `--assign-budget`: a share of the frame from 0 to 1.
+pub fn parse_assign_budget(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(b) if (0.0..=1.0).contains(&b) => Ok(b),
+        _ => Err(format!(
+            "`{s}` is not a share of the frame from 0 to 1 (0.05: 5 %)"
         )),
     }
 }
@@ -201,6 +215,7 @@ pub fn run(args: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
         exposure_ev: args.exposure,
         grid: manylight::cluster::grid::GridConfig {
             slice_depth: args.slice_depth,
+            assign_budget: args.assign_budget,
             ..match args.grid {
                 GridArg::Auto => manylight::cluster::grid::GridConfig::default(),
                 GridArg::Fixed(px) => manylight::cluster::grid::GridConfig::fixed(px),

@@ -2,6 +2,9 @@
 //! who picks the footprint ([`GridMode`]) and how tightly a light's cells are bounded
 //! ([`Coverage`]).
 
+/// The automatic grid's default [`GridConfig::assign_budget`]: 5 % of the frame.
+pub const DEFAULT_ASSIGN_BUDGET: f64 = 0.05;
+
 /// Tunables of the grid.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct GridConfig {
@@ -39,6 +42,15 @@ pub struct GridConfig {
     /// How tightly a light's cells are found (the default is the tight one; the other is kept
     /// to measure what it saves).
     pub coverage: Coverage,
+    /// Automatic mode: the largest share of the predicted frame time the CPU light assignment
+    /// may take (0.05: 5 %). Among the candidate grids whose predicted assignment stays within
+    /// it, the cheapest predicted frame wins; a finer grid that would save a little frame time
+    /// for much more CPU is not taken (near its optimum the frame time barely changes with the
+    /// footprint, while the assignment's time grows about as the inverse square of it). The CPU
+    /// a game spends here is taken from its own work, and on a phone the GPU's frame does not
+    /// pay it back. 1 (or more) leaves the frame time alone to decide; when no candidate fits,
+    /// the cheapest predicted frame wins. Values from 0 up; the fixed mode ignores it.
+    pub assign_budget: f64,
 }
 
 /// Who picks the cell footprint.
@@ -78,6 +90,7 @@ impl Default for GridConfig {
             max_slices: 32,
             max_tiles: 256,
             coverage: Coverage::default(),
+            assign_budget: DEFAULT_ASSIGN_BUDGET,
         }
     }
 }
@@ -104,6 +117,7 @@ impl GridConfig {
             max_slices: 1,
             max_tiles: 1024,
             coverage: Coverage::default(),
+            assign_budget: DEFAULT_ASSIGN_BUDGET,
         }
     }
 }
