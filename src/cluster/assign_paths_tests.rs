@@ -76,6 +76,11 @@ fn check_stats(a: &Assignment, uncapped_max: Option<u32>) {
     assert_eq!(a.stats.visible_lights, a.visible.len());
     let avg = a.indices.len() as f64 / nonempty as f64;
     assert!((a.stats.avg_lights_per_nonempty - avg).abs() < 1e-12);
+    // Every visible light has a run, and every run at least one cell (before any cap).
+    assert!(a.stats.runs >= a.visible.len(), "{:?}", a.stats);
+    if uncapped_max.is_none() {
+        assert!(a.stats.runs <= a.indices.len(), "{:?}", a.stats);
+    }
 }
 
 /// One assigner over frames of different sizes, grids and light sets gives what fresh buffers

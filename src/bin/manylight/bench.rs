@@ -51,7 +51,9 @@ pub struct BenchArgs {
     /// Image size as WIDTHxHEIGHT (default 640x360).
     #[arg(long, value_parser = crate::render::parse_size)]
     pub size: Option<(u32, u32)>,
-    /// Timed frames per configuration after a warm-up frame (default 3).
+    /// Timed frames per configuration after a warm-up frame (default 9: their median, the
+    /// row's figure, outvotes the few slow frames a pool wake-up or the first frames after a
+    /// grid change make; 1 with `--quick`).
     #[arg(long)]
     pub frames: Option<u32>,
     /// Pixels sampled for the f64 CPU reference (default 256).
@@ -125,7 +127,7 @@ impl Plan {
             ),
             es,
             size: args.size.unwrap_or(default_size),
-            frames: args.frames.unwrap_or(if args.quick { 1 } else { 3 }),
+            frames: args.frames.unwrap_or(if args.quick { 1 } else { 9 }),
             knobs: !args.no_knobs,
             animated_frames: args
                 .animated_frames
