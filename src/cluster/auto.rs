@@ -32,7 +32,7 @@
 //! budget where the new one does not), so a static scene never flip-flops between two
 //! near-equal grids.
 
-pub use super::auto_costs::{assign_work, FrameCost, GridCosts};
+pub use super::auto_costs::{assign_work, FrameCost, GridCosts, CALIBRATION_WINDOW, INDEX_WEIGHT};
 pub use super::auto_search::{choose, ChoiceSearch};
 
 use super::assign::AssignLimits;
