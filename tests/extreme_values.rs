@@ -163,3 +163,39 @@ fn obj_vertices_near_the_f32_limit_are_refused_as_vertices_not_as_lights() {
     assert!(err.contains("positions[0]"), "{err}");
     assert!(!err.contains("lights"), "{err}");
 }
+
+/// A cascade count near 2³² (a corrupt or hostile setting) is refused naming the field, not
+/// looped over (a grid built with it would push four billion cascades); counts in range
+/// render, and the grid builder itself never makes more than its documented maximum.
+#[test]
+fn a_huge_cascade_count_is_refused_naming_the_field() {
+    use manylight::cluster::grid::{ClusterGrid, GridConfig, GridProjection, MAX_CASCADES};
+    let mut gpu = Gpu::new(EsVersion::Es3);
+    let s = plane(vec![point(3.0)]);
+    for cascades in [u32::MAX, MAX_CASCADES + 1] {
+        let mut options = RenderOptions::default();
+        options.grid.cascades = cascades;
+        let err = gpu
+            .r()
+            .render_offscreen(&s, 16, 16, &options)
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("grid.cascades"), "{cascades}: {err}");
+    }
+    for cascades in [1, 12, MAX_CASCADES] {
+        let mut options = RenderOptions::default();
+        options.grid.cascades = cascades;
+        assert!(gpu.r().render_offscreen(&s, 16, 16, &options).is_ok());
+    }
+    let config = GridConfig {
+        cascades: u32::MAX,
+        ..GridConfig::default()
+    };
+    let tan = 0.5;
+    let projection = GridProjection::Perspective {
+        tan_x: tan,
+        tan_y: tan,
+    };
+    let grid = ClusterGrid::new(64, 64, projection, 0.1, 100.0, &config);
+    assert_eq!(grid.cascades.len(), MAX_CASCADES as usize);
+}

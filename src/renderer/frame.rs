@@ -295,6 +295,14 @@ fn check_options(options: &RenderOptions) -> Result<(), Error> {
             );
         }
     }
+    let cascades = options.grid.cascades;
+    if cascades > crate::cluster::grid::MAX_CASCADES {
+        let why = format!(
+            "must be from 1 to {}, got {cascades}",
+            crate::cluster::grid::MAX_CASCADES
+        );
+        return invalid("grid.cascades", why);
+    }
     let budget = options.grid.assign_budget;
     if !(budget.is_finite() && budget >= 0.0) {
         let why = format!("must be a finite share of the frame from 0 up, got {budget}");

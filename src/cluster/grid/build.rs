@@ -62,7 +62,7 @@ impl ClusterGrid {
         } else {
             near + 1.0
         };
-        let c = config.cascades.max(1);
+        let c = config.cascades.clamp(1, super::MAX_CASCADES);
         let min_cell = config.min_cell_size.unwrap_or(0.0).max(0.0);
         let split = config.first_split.filter(|d| d.is_finite());
         let slice_depth = if config.slice_depth.is_finite() {

@@ -2,6 +2,10 @@
 //! who picks the footprint ([`GridMode`]) and how tightly a light's cells are bounded
 //! ([`Coverage`]).
 
+/// Most depth cascades a grid has ([`GridConfig::cascades`]): far more than a depth range
+/// needs (12 cover a 4096:1 range), and a bound on the per-cascade tables.
+pub const MAX_CASCADES: u32 = 64;
+
 /// The automatic grid's default [`GridConfig::assign_budget`]: 5 % of the frame.
 pub const DEFAULT_ASSIGN_BUDGET: f64 = 0.05;
 
@@ -13,7 +17,9 @@ pub struct GridConfig {
     /// [`ClusterGrid::new`](super::ClusterGrid::new) always builds `footprint_px`: the choice
     /// is the method's (see [`super::auto`](crate::cluster::auto)).
     pub mode: GridMode,
-    /// Number of depth cascades (Billeter uses 12).
+    /// Number of depth cascades (Billeter uses 12), from 1 to [`MAX_CASCADES`]: the renderer
+    /// refuses more, naming `grid.cascades`; [`ClusterGrid::new`](super::ClusterGrid::new)
+    /// clamps into that range.
     pub cascades: u32,
     /// Target cell footprint in pixels (cells are about this wide, and `slice_depth` times as
     /// deep): the fixed mode's, and where the automatic mode starts.

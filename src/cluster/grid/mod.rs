@@ -38,7 +38,7 @@ mod spheres;
 #[cfg(test)]
 mod tests;
 
-pub use config::{Coverage, GridConfig, GridMode, DEFAULT_ASSIGN_BUDGET};
+pub use config::{Coverage, GridConfig, GridMode, DEFAULT_ASSIGN_BUDGET, MAX_CASCADES};
 pub use projection::{DepthMapping, GridProjection};
 
 use super::depth_lookup::{CascadeConstants, SliceLookup};
