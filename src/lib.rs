@@ -45,5 +45,5 @@ pub use error::Error;
 #[doc = include_str!("../README.md")]
 pub struct ReadmeDoctests;
 pub use gl::EsVersion;
-pub use options::{CountKind, RenderOptions, ToneMap};
+pub use options::{CountKind, RenderOptions, ToneMap, MAX_TIMED_FRAMES};
 pub use renderer::{FrameStats, Renderer};

@@ -6,6 +6,11 @@ use serde::Serialize;
 use crate::cluster::grid::GridConfig;
 use crate::cluster::tiles::TILE_PX;
 
+/// Most frames one call times ([`RenderOptions::timed_frames`], `render --frames`): each
+/// timed frame's figures are kept until the percentiles are taken, so a count near 2³² would
+/// grow memory for as long as it ran (65 536 frames are 18 minutes at 60 frames a second).
+pub const MAX_TIMED_FRAMES: u32 = 1 << 16;
+
 /// Per-call rendering options.
 #[derive(Clone, Debug)]
 pub struct RenderOptions {
@@ -17,7 +22,8 @@ pub struct RenderOptions {
     /// Background colour (linear if `linear`, else as stored).
     pub clear_color: [f32; 4],
     /// Frames timed after one warm-up frame by [`Renderer::render_offscreen`](crate::Renderer::render_offscreen); the median is
-    /// reported. 0 times the single (cold) frame.
+    /// reported. 0 times the single (cold) frame. At most [`MAX_TIMED_FRAMES`] (the frames'
+    /// figures are kept for the percentiles): more is refused naming `timed_frames`.
     pub timed_frames: u32,
     /// Cluster grid of the clustered method.
     pub grid: GridConfig,

@@ -672,6 +672,21 @@ fn assign_budget_flag_bounds_the_automatic_grid() {
     }
 }
 
+/// Frame counts past what a run keeps figures for are usage errors, not a process that grows
+/// until it is killed.
+#[test]
+fn frame_counts_near_two_to_the_32_are_usage_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    for args in [
+        &["render", "--frames", "4294967295"][..],
+        &["render", "--frames", "65537"],
+        &["bench", "--frames", "4294967295"],
+        &["bench", "--animated-frames", "65537"],
+    ] {
+        expect_exit(args, &[], dir.path(), 2, "is not in 0..=65536");
+    }
+}
+
 #[test]
 fn timed_frames_report_their_spread() {
     let dir = tempfile::tempdir().unwrap();

@@ -199,3 +199,29 @@ fn a_huge_cascade_count_is_refused_naming_the_field() {
     let grid = ClusterGrid::new(64, 64, projection, 0.1, 100.0, &config);
     assert_eq!(grid.cascades.len(), MAX_CASCADES as usize);
 }
+
+/// A timed-frame count near 2³² is refused naming the field before any frame (each timed
+/// frame's figures are kept for the percentiles, so it would grow memory as long as it ran).
+#[test]
+fn a_huge_timed_frame_count_is_refused_naming_the_field() {
+    let mut gpu = Gpu::new(EsVersion::Es3);
+    let s = plane(vec![point(3.0)]);
+    for frames in [u32::MAX, manylight::MAX_TIMED_FRAMES + 1] {
+        let options = RenderOptions {
+            timed_frames: frames,
+            ..RenderOptions::default()
+        };
+        let err = gpu
+            .r()
+            .render_offscreen(&s, 16, 16, &options)
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("timed_frames"), "{frames}: {err}");
+    }
+    let options = RenderOptions {
+        timed_frames: 3,
+        ..RenderOptions::default()
+    };
+    let (_, stats) = gpu.r().render_offscreen(&s, 16, 16, &options).unwrap();
+    assert_eq!(stats.frame_ms_spread.map(|s| s.frames), Some(3));
+}

@@ -295,6 +295,14 @@ fn check_options(options: &RenderOptions) -> Result<(), Error> {
             );
         }
     }
+    if options.timed_frames > crate::options::MAX_TIMED_FRAMES {
+        let why = format!(
+            "must be at most {}, got {}",
+            crate::options::MAX_TIMED_FRAMES,
+            options.timed_frames
+        );
+        return invalid("timed_frames", why);
+    }
     let cascades = options.grid.cascades;
     if cascades > crate::cluster::grid::MAX_CASCADES {
         let why = format!(

@@ -54,7 +54,7 @@ pub struct BenchArgs {
     /// Timed frames per configuration after a warm-up frame (default 9: their median, the
     /// row's figure, outvotes the few slow frames a pool wake-up or the first frames after a
     /// grid change make; 1 with `--quick`).
-    #[arg(long)]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(0..=i64::from(manylight::MAX_TIMED_FRAMES)))]
     pub frames: Option<u32>,
     /// Pixels sampled for the f64 CPU reference (default 256).
     #[arg(long, default_value_t = 256)]
@@ -68,7 +68,7 @@ pub struct BenchArgs {
     /// Frames of the animated workload (lights and camera moving, at 30 fps of animation
     /// time; the first scene at the knobs' light count; 0 leaves it out). Default 120, 20
     /// with --quick.
-    #[arg(long)]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(0..=i64::from(manylight::MAX_TIMED_FRAMES)))]
     pub animated_frames: Option<u32>,
 }
 

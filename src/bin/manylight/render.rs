@@ -46,7 +46,7 @@ pub struct RenderArgs {
     /// Frames timed after a warm-up frame: the median is reported, and from 10 frames also
     /// p95, p99 and the slowest (`--stats` has them from 1). In a scene whose lights move
     /// (the built-ins' do), frame k shows time `--time` + k / `--fps`.
-    #[arg(long, default_value_t = 2)]
+    #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u32).range(0..=i64::from(manylight::MAX_TIMED_FRAMES)))]
     pub frames: u32,
     /// Animation time of the picture written to `--out` and of the first timed frame, in
     /// seconds (0: the scene as built).
