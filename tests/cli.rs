@@ -672,10 +672,10 @@ fn assign_budget_flag_bounds_the_automatic_grid() {
     }
 }
 
-/// Frame counts past what a run keeps figures for are usage errors, not a process that grows
-/// until it is killed.
+/// Frame, light and run counts past what a run can hold are usage errors, not a process that
+/// grows until it is killed or panics.
 #[test]
-fn frame_counts_near_two_to_the_32_are_usage_errors() {
+fn counts_near_two_to_the_32_or_64_are_usage_errors() {
     let dir = tempfile::tempdir().unwrap();
     for args in [
         &["render", "--frames", "4294967295"][..],
@@ -684,6 +684,25 @@ fn frame_counts_near_two_to_the_32_are_usage_errors() {
         &["bench", "--animated-frames", "65537"],
     ] {
         expect_exit(args, &[], dir.path(), 2, "is not in 0..=65536");
+    }
+    // bench-assign built a scene of 2⁶⁴ lights (a panic) and collected 2⁶⁴ run times (a
+    // capacity overflow panic).
+    let huge = "18446744073709551615";
+    expect_exit(
+        &["bench-assign", "--lights", huge],
+        &[],
+        dir.path(),
+        2,
+        "not a light count",
+    );
+    for runs in [huge, "0"] {
+        expect_exit(
+            &["bench-assign", "--lights", "8", "--runs", runs],
+            &[],
+            dir.path(),
+            2,
+            "not a number of runs",
+        );
     }
 }
 

@@ -25,8 +25,16 @@ pub struct AssignWorkload {
     pub far: f64,
 }
 
+/// Most timed runs [`AssignWorkload::time`] makes (their times are kept for the median).
+pub const MAX_RUNS: usize = 1 << 20;
+
 impl AssignWorkload {
     /// The default scene's camera with `count` random lights (seed `seed`).
+    ///
+    /// # Panics
+    ///
+    /// When `count` is past [`crate::scene::input::MAX_LIGHTS`] (a benchmark helper: the
+    /// `bench-assign` command refuses such counts first).
     pub fn default_view(count: usize, seed: u64) -> AssignWorkload {
         // The grid this workload has always timed (64-pixel cells, never narrower than 1/64
         // of the depth range), so figures compare across versions.
@@ -95,17 +103,18 @@ impl AssignWorkload {
         assigner.into_assignment()
     }
 
-    /// Median wall time in milliseconds over `runs` assignments, after [`WARM_UP`] of untimed
-    /// ones (at least one, which sizes the reused buffers as a renderer's first frame does),
-    /// and the number of indices produced.
+    /// Median wall time in milliseconds over `runs` assignments (1 to [`MAX_RUNS`]; outside,
+    /// the nearest), after [`WARM_UP`] of untimed ones (at least one, which sizes the reused
+    /// buffers as a renderer's first frame does), and the number of indices produced.
     pub fn time(&self, runs: usize) -> (f64, usize) {
+        let runs = runs.clamp(1, MAX_RUNS);
         let mut assigner = Assigner::new();
         let indices = self.assign_with(&mut assigner).indices.len();
         let start = Instant::now();
         while start.elapsed() < WARM_UP {
             std::hint::black_box(self.assign_with(&mut assigner));
         }
-        let mut times: Vec<f64> = (0..runs.max(1))
+        let mut times: Vec<f64> = (0..runs)
             .map(|_| {
                 let t = Instant::now();
                 std::hint::black_box(self.assign_with(&mut assigner));

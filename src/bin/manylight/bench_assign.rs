@@ -1,7 +1,7 @@
 //! `manylight bench-assign`: light assignment alone on the default view, for scripts.
 
 use clap::Parser;
-use manylight::cluster::workload::{AssignWorkload, BENCH_SIZE};
+use manylight::cluster::workload::{AssignWorkload, BENCH_SIZE, MAX_RUNS};
 
 /// Options of `manylight bench-assign`.
 #[derive(Parser, Debug)]
@@ -10,11 +10,13 @@ pub struct BenchAssignArgs {
     #[arg(
         long,
         value_delimiter = ',',
-        default_value = "1,64,1024,16384,65536,1048576"
+        default_value = "1,64,1024,16384,65536,1048576",
+        value_parser = parse_light_count
     )]
     pub lights: Vec<usize>,
-    /// Timed runs per count, after 0.1 s of untimed ones (the median is reported).
-    #[arg(long, default_value_t = 101)]
+    /// Timed runs per count, after 0.1 s of untimed ones (the median is reported), from 1 to
+    /// 1 048 576.
+    #[arg(long, default_value_t = 101, value_parser = parse_runs)]
     pub runs: usize,
     /// Seed of the random lights.
     #[arg(long, default_value_t = 1)]
@@ -22,6 +24,25 @@ pub struct BenchAssignArgs {
     /// Print JSON (an array of {lights, assign_ms, indices, clusters}) instead of a table.
     #[arg(long)]
     pub json: bool,
+}
+
+/// Parses a light count of `--lights`: at most what a scene may hold.
+fn parse_light_count(s: &str) -> Result<usize, String> {
+    let max = manylight::scene::input::MAX_LIGHTS;
+    match s.parse::<usize>() {
+        Ok(n) if n <= max => Ok(n),
+        _ => Err(format!("`{s}` is not a light count from 0 to {max}")),
+    }
+}
+
+/// Parses `--runs`: from 1 to [`MAX_RUNS`] timed runs.
+fn parse_runs(s: &str) -> Result<usize, String> {
+    match s.parse::<usize>() {
+        Ok(n) if (1..=MAX_RUNS).contains(&n) => Ok(n),
+        _ => Err(format!(
+            "`{s}` is not a number of runs from 1 to {MAX_RUNS}"
+        )),
+    }
 }
 
 /// Runs the command.
