@@ -42,22 +42,20 @@ impl Chunks {
         self.chunks
             .par_iter_mut()
             .zip(lights.par_chunks(chunk_len))
-            .for_each(|(chunk, part)| chunk.find(grid, part, camera_far));
-        // Phase 2: the visible lights (numbered chunk after chunk), then counts and offsets.
+            .for_each(|(chunk, part)| {
+                chunk.find(grid, part, camera_far);
+                chunk.prefix();
+            });
+        // Phase 2: the visible lights (numbered chunk after chunk: each chunk listed its own
+        // in phase 1, so this is a copy, not a pass over every light), then counts and
+        // offsets.
         let first_ids = &mut self.first_ids;
         first_ids.clear();
         for (t, chunk) in self.chunks.iter().enumerate() {
             first_ids.push(out.visible.len() as u32);
             let first = (t * chunk_len) as u32;
-            let mut prev = 0;
-            for (i, &end) in chunk.ends.iter().enumerate() {
-                if end > prev {
-                    out.visible.push(first + i as u32);
-                }
-                prev = end;
-            }
+            out.visible.extend(chunk.visible.iter().map(|&i| first + i));
         }
-        self.chunks.iter_mut().for_each(Chunk::prefix);
         let chunks = &self.chunks;
         out.counts.clear();
         out.counts
@@ -102,6 +100,8 @@ struct Chunk {
     runs: Vec<Run>,
     /// Per light of the chunk: the end of its runs in `runs`.
     ends: Vec<u32>,
+    /// The chunk's lights with a run (positions in the chunk), ascending.
+    visible: Vec<u32>,
     /// Per cell (plus one): where the cell's run starts in `sorted` (phase 2).
     offsets: Vec<u32>,
     /// The chunk's lights (global visible numbers) grouped by cell (phase 3, several chunks
@@ -118,13 +118,18 @@ impl Chunk {
         self.deltas.resize(grid.total_cells as usize + 1, 0);
         self.runs.clear();
         self.ends.clear();
+        self.visible.clear();
         let (deltas, runs) = (&mut self.deltas, &mut self.runs);
-        for light in lights {
+        for (i, light) in lights.iter().enumerate() {
+            let before = runs.len();
             for_each_run(grid, light, camera_far, &mut |start, len| {
                 deltas[start as usize] += 1;
                 deltas[(start + len) as usize] -= 1;
                 runs.push(Run { start, len });
             });
+            if runs.len() > before {
+                self.visible.push(i as u32);
+            }
             self.ends.push(runs.len() as u32);
         }
     }

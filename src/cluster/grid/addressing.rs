@@ -30,6 +30,7 @@ impl ClusterGrid {
     /// evaluation of the mapping; so the result never misses a slice that
     /// [`view_z_to_cascade_slice`](Self::view_z_to_cascade_slice) gives a depth inside the
     /// range, and at worst includes one neighbour slice more.
+    #[inline]
     pub fn depth_range_to_slices(&self, dmin: f64, dmax: f64) -> ((u32, u32), (u32, u32)) {
         match self.mapping {
             DepthMapping::Linear => (
