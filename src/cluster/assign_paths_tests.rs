@@ -59,6 +59,8 @@ fn parallel_and_sequential_assignment_agree() {
         };
         let capped = assign(&grid, &lights, 80.0, &limits);
         assert!(capped.stats.overflowed_lights > 0);
+        // The runs are what the lights were found to touch, before the cap.
+        assert_eq!(capped.stats.runs, seq.stats.runs);
         check_stats(&capped, Some(seq.stats.max_lights_per_cluster));
     }
 }

@@ -2,7 +2,7 @@
 //! measured candidates.
 //!
 //! A finer grid makes every fragment loop over fewer lights but costs more assignment (more
-//! light·cell pairs and cells to count) and more bytes to upload; the best footprint depends on
+//! runs of cells to find, more indices and cells to count) and more bytes to upload; the best footprint depends on
 //! the resolution, the lights, the view and the device. So the choice is made by measuring, not
 //! by a constant:
 //!
@@ -389,9 +389,17 @@ mod tests {
         let mut current = choice.config.clone();
         let mut footprints = vec![current.footprint_px];
         let mut costs = GridCosts::default();
-        for shade in [17.0, 19.0, 18.5, 17.5, 19.0, 17.0, 18.0, 19.0, 17.5] {
+        // Per footprint, whether it was over the budget in each measurement.
+        let mut verdicts: Vec<(f64, Vec<bool>)> = Vec::new();
+        for shade in [13.0, 14.5, 13.5, 14.0, 13.2, 14.8, 13.8, 14.2, 13.4] {
             costs.shade_ns = shade;
             let again = choose(&inputs(&lights), &samples, &costs, &mut Assigner::new());
+            for c in &again.candidates {
+                match verdicts.iter_mut().find(|(f, _)| *f == c.footprint_px) {
+                    Some((_, v)) => v.push(c.over_budget),
+                    None => verdicts.push((c.footprint_px, vec![c.over_budget])),
+                }
+            }
             if should_switch(&current, &again) {
                 current = again.config.clone();
             }
@@ -400,9 +408,60 @@ mod tests {
             }
         }
         assert!(
+            verdicts
+                .iter()
+                .any(|(_, v)| v.contains(&true) && v.contains(&false)),
+            "no grid went in and out of the budget, so this tested nothing: {verdicts:?} {:?}",
+            choice
+                .candidates
+                .iter()
+                .map(|c| (c.footprint_px, c.assign_ms / c.predicted_ms))
+                .collect::<Vec<_>>()
+        );
+        assert!(
             footprints.len() <= 2,
             "the grid flip-flopped: {footprints:?}"
         );
+    }
+
+    /// The budget's hysteresis on hand-made figures: a current grid a little over the budget
+    /// (less than [`HYSTERESIS`] past it) stays when the best grid is not clearly cheaper; one
+    /// clearly over gives way to a grid within it even when that one is predicted slower.
+    #[test]
+    fn a_grid_just_over_the_budget_is_kept() {
+        let candidate = |footprint_px: f64, predicted_ms: f64, assign_ms: f64| Candidate {
+            footprint_px,
+            cells: 1000,
+            indices: 1000,
+            evals_per_pixel: 1.0,
+            bytes: 1000,
+            predicted_ms,
+            assign_ms,
+            over_budget: assign_ms > 0.05 * predicted_ms,
+            overflowed_lights: 0,
+        };
+        let choice = |current_assign_ms: f64| GridChoice {
+            config: GridConfig {
+                footprint_px: 13.5,
+                ..GridConfig::default()
+            },
+            reason: String::new(),
+            candidates: vec![
+                candidate(13.5, 10.2, 0.45),
+                candidate(11.0, 10.0, current_assign_ms),
+            ],
+        };
+        let current = GridConfig {
+            footprint_px: 11.0,
+            ..GridConfig::default()
+        };
+        // 5.2 % of the frame: over the 5 % budget, not by 10 %.
+        assert!(choice(0.52).candidates[1].over_budget);
+        assert!(!should_switch(&current, &choice(0.52)));
+        // 6 %: clearly over.
+        assert!(should_switch(&current, &choice(0.6)));
+        // Within the budget, the faster current grid stays.
+        assert!(!should_switch(&current, &choice(0.4)));
     }
 
     /// The CPU budget: the choice is the cheapest predicted frame among the grids whose
@@ -464,6 +523,47 @@ mod tests {
         none.base.assign_budget = 0.0;
         let zero = choose(&none, &samples, &costs, &mut Assigner::new());
         assert_eq!(zero.config.footprint_px, free_pick.footprint_px);
+    }
+
+    /// Overflow outranks the budget: with a per-cell cap that coarse cells overflow, a grid
+    /// past the budget that drops fewer lights does not end the search, and the choice is
+    /// the grid that drops the fewest.
+    #[test]
+    fn overflow_outranks_the_cpu_budget() {
+        let (lights, samples) = workload(600);
+        let mut capped = inputs(&lights);
+        capped.limits.cell_cap = 12;
+        capped.base.assign_budget = 0.05;
+        let choice = choose(
+            &capped,
+            &samples,
+            &GridCosts::default(),
+            &mut Assigner::new(),
+        );
+        let c = &choice.candidates;
+        let first_over = c
+            .iter()
+            .position(|c| c.over_budget)
+            .expect("a grid past 1 %");
+        let least_within = c[..first_over]
+            .iter()
+            .map(|c| c.overflowed_lights)
+            .min()
+            .expect("a coarse grid within 5 %");
+        assert!(
+            c[first_over].overflowed_lights < least_within,
+            "this workload must overflow less past the budget: {c:?}"
+        );
+        assert!(
+            c.len() > first_over + 1,
+            "the search stopped at the budget: {c:?}"
+        );
+        let fewest = c.iter().map(|c| c.overflowed_lights).min().unwrap();
+        let chosen = c
+            .iter()
+            .find(|c| c.footprint_px == choice.config.footprint_px)
+            .unwrap();
+        assert_eq!(chosen.overflowed_lights, fewest, "{c:?}");
     }
 
     /// A grid whose lists would not fit loses to one that fits, however cheap it looks.

@@ -30,6 +30,11 @@ pub fn assign_work(runs: usize, indices: usize, cells: u32) -> f64 {
 }
 
 /// Cost per unit in nanoseconds: what the model multiplies its counts by.
+///
+/// Made by [`Default`] (the priors) or [`GridCosts::new`] (priors of one's own); its figures
+/// are public to read and to set, but each is the median of the frames it last measured
+/// (a private window, which equality compares too), so the next [`GridCosts::observe`] that
+/// measures a figure replaces a value set by hand.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct GridCosts {
     /// One light evaluation by one fragment.

@@ -96,7 +96,7 @@ impl ChoiceSearch {
             over_budget: assign_ms > inputs.base.assign_budget * predicted_ms,
             overflowed_lights: a.stats.overflowed_lights,
         };
-        let over_budget = candidate.over_budget;
+        let (over_budget, overflowed_lights) = (candidate.over_budget, candidate.overflowed_lights);
         let (rising, overflow_grew) = self.candidates.last().map_or((false, false), |last| {
             (
                 candidate.predicted_ms > last.predicted_ms,
@@ -113,13 +113,16 @@ impl ChoiceSearch {
         self.rises = if rising { self.rises + 1 } else { 0 };
         // Past here finer grids only rise further, or overflow the index list more (a per-cell
         // cap overflows less in finer cells, so overflow alone does not stop the search), or
-        // assign more than a coarser grid that kept within the CPU budget (finer grids only
-        // assign more, so they cannot win).
-        let kept_budget = self.candidates.iter().any(|c| !c.over_budget);
-        self.done = self.rises == 2
-            || overflow_grew
-            || (over_budget && kept_budget)
-            || self.next == self.footprints.len();
+        // assign more than a coarser grid that kept within the CPU budget without overflowing
+        // more than this one (finer grids only assign more, so they can win only by
+        // overflowing less: then the search goes on).
+        let budget_passed = over_budget
+            && self
+                .candidates
+                .iter()
+                .any(|c| !c.over_budget && c.overflowed_lights <= overflowed_lights);
+        self.done =
+            self.rises == 2 || overflow_grew || budget_passed || self.next == self.footprints.len();
         self.done
     }
 

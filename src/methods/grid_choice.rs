@@ -76,10 +76,11 @@ impl AutoGrid {
     /// The grid settings for this frame: the current choice, or a new one when it is stale.
     ///
     /// A grid is needed at once on the first frame and when the viewport, projection, near
-    /// plane or settings change: those choices measure every candidate in this frame. The
-    /// others (the view or the lights moved, the period passed, the costs got calibrated)
-    /// only refine a grid that works: they measure one candidate per frame, so no frame pays
-    /// for seven assignments, and switch when the last is measured.
+    /// plane or settings change: those choices measure every candidate in this frame (up to
+    /// thirteen assignments; the search's stops usually end it sooner). The others (the view
+    /// or the lights moved, the period passed, the costs got calibrated) only refine a grid
+    /// that works: they measure one candidate per frame, so no frame pays for many
+    /// assignments, and switch when the last is measured.
     pub(crate) fn config(
         &mut self,
         ctx: &FrameContext,
@@ -154,7 +155,7 @@ impl AutoGrid {
         let same_layout = self.layout.as_ref() == Some(&layout);
         // A grid chosen with the priors was not chosen with this device's figures: the first
         // calibrated choice replaces it without the hysteresis (once, so no flip-flop).
-        let from_priors = std::mem::replace(&mut self.choice_from_priors, self.costs.frames == 0);
+        let from_priors = first_calibrated(&mut self.choice_from_priors, self.costs.frames > 0);
         match &mut self.choice {
             Some(current)
                 if same_layout && !from_priors && !auto::should_switch(&current.config, new) =>
@@ -208,13 +209,12 @@ impl AutoGrid {
         let Some(mut cost) = self.pending.take() else {
             return;
         };
-        let Some(shade_ms) = frame_ms
+        // Without either (a frame that did not wait for the GPU on a device without timer
+        // queries) the shading is not measured, but the CPU's assignment and uploads are.
+        cost.shade_ms = frame_ms
             .map(|ms| ms - cost.assign_ms - cost.upload_ms)
             .or(gpu_ms)
-        else {
-            return;
-        };
-        cost.shade_ms = shade_ms;
+            .unwrap_or(f64::NAN);
         self.costs.observe(&cost);
     }
 
@@ -276,6 +276,16 @@ impl AutoGrid {
     }
 }
 
+/// Whether a choice concluded now is the first made with calibrated figures (`calibrated`)
+/// after one made with the priors alone, and so replaces the current grid without the
+/// hysteresis; `chosen_with_priors` tracks whether the current choice was made with the
+/// priors. While nothing calibrates, every choice keeps the hysteresis.
+fn first_calibrated(chosen_with_priors: &mut bool, calibrated: bool) -> bool {
+    let first = *chosen_with_priors && calibrated;
+    *chosen_with_priors = !calibrated;
+    first
+}
+
 /// A light count changed by more than a quarter.
 fn changed_much(then: usize, now: usize) -> bool {
     now * 4 > then * 5 || now * 5 < then * 4
@@ -289,4 +299,27 @@ pub(crate) fn write_fixed_reason(out: &mut String, config: &GridConfig) {
         "fixed: footprint_px = {} (GridConfig)",
         config.footprint_px
     );
+}
+
+#[cfg(test)]
+mod tests {
+    use super::first_calibrated;
+
+    /// The hysteresis is skipped once, for the first calibrated choice after the priors' one,
+    /// and never while no frame calibrates (a game that does not wait for the GPU on a device
+    /// without timers would otherwise switch grids at every near-equal re-choice).
+    #[test]
+    fn only_the_first_calibrated_choice_skips_the_hysteresis() {
+        let mut with_priors = false;
+        // The first choice (priors), then choices that never calibrate.
+        assert!(!first_calibrated(&mut with_priors, false));
+        for _ in 0..5 {
+            assert!(!first_calibrated(&mut with_priors, false));
+        }
+        // Calibrated at last: once, then the hysteresis again.
+        assert!(first_calibrated(&mut with_priors, true));
+        for _ in 0..5 {
+            assert!(!first_calibrated(&mut with_priors, true));
+        }
+    }
 }

@@ -306,7 +306,7 @@ fn check_options(options: &RenderOptions) -> Result<(), Error> {
     let cascades = options.grid.cascades;
     if cascades > crate::cluster::grid::MAX_CASCADES {
         let why = format!(
-            "must be from 1 to {}, got {cascades}",
+            "must be at most {} (0 counts as 1), got {cascades}",
             crate::cluster::grid::MAX_CASCADES
         );
         return invalid("grid.cascades", why);

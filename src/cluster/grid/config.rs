@@ -17,9 +17,9 @@ pub struct GridConfig {
     /// [`ClusterGrid::new`](super::ClusterGrid::new) always builds `footprint_px`: the choice
     /// is the method's (see [`super::auto`](crate::cluster::auto)).
     pub mode: GridMode,
-    /// Number of depth cascades (Billeter uses 12), from 1 to [`MAX_CASCADES`]: the renderer
-    /// refuses more, naming `grid.cascades`; [`ClusterGrid::new`](super::ClusterGrid::new)
-    /// clamps into that range.
+    /// Number of depth cascades (Billeter uses 12), from 1 to [`MAX_CASCADES`] (0 counts as
+    /// 1): the renderer refuses more, naming `grid.cascades`;
+    /// [`ClusterGrid::new`](super::ClusterGrid::new) clamps into that range.
     pub cascades: u32,
     /// Target cell footprint in pixels (cells are about this wide, and `slice_depth` times as
     /// deep): the fixed mode's, and where the automatic mode starts.
@@ -55,7 +55,9 @@ pub struct GridConfig {
     /// footprint, while the assignment's time grows about as the inverse square of it). The CPU
     /// a game spends here is taken from its own work, and on a phone the GPU's frame does not
     /// pay it back. 1 (or more) leaves the frame time alone to decide; when no candidate fits,
-    /// the cheapest predicted frame wins. Values from 0 up; the fixed mode ignores it.
+    /// the cheapest predicted frame wins. A finite value from 0 up: the renderer refuses a
+    /// NaN, infinite or negative one naming `grid.assign_budget` (in the fixed mode too, which
+    /// otherwise ignores it).
     pub assign_budget: f64,
 }
 
