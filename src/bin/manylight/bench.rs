@@ -53,7 +53,9 @@ pub struct BenchArgs {
     pub size: Option<(u32, u32)>,
     /// Timed frames per configuration after a warm-up frame (default 9: their median, the
     /// row's figure, outvotes the few slow frames a pool wake-up or the first frames after a
-    /// grid change make; 1 with `--quick`).
+    /// grid change make; 3 for a configuration whose first frame took over 400 ms, forward
+    /// over thousands of lights, whose frames vary little against their length; 1 with
+    /// `--quick`).
     #[arg(long, value_parser = clap::value_parser!(u32).range(0..=i64::from(manylight::MAX_TIMED_FRAMES)))]
     pub frames: Option<u32>,
     /// Pixels sampled for the f64 CPU reference (default 256).
@@ -79,10 +81,25 @@ struct Plan {
     methods: Vec<String>,
     es: Vec<EsVersion>,
     size: (u32, u32),
-    frames: u32,
+    frames: Frames,
     knobs: bool,
     animated_frames: u32,
 }
+
+/// How many frames a configuration times.
+#[derive(Clone, Copy, Debug)]
+enum Frames {
+    /// What `--frames` (or `--quick`) says.
+    Fixed(u32),
+    /// Nine, or three for a configuration whose first (untimed) frame took over
+    /// [`SLOW_FRAME_MS`]: the median of three let one slow pool wake-up decide a fast row's
+    /// assignment time about one row in five, while nine frames of forward over 4 096 lights
+    /// would take over a minute a row.
+    Adaptive,
+}
+
+/// A first frame slower than this makes an adaptive row time three frames, not nine.
+const SLOW_FRAME_MS: f64 = 400.0;
 
 impl Plan {
     fn from(args: &BenchArgs) -> Plan {
@@ -127,7 +144,11 @@ impl Plan {
             ),
             es,
             size: args.size.unwrap_or(default_size),
-            frames: args.frames.unwrap_or(if args.quick { 1 } else { 9 }),
+            frames: match args.frames {
+                Some(n) => Frames::Fixed(n),
+                None if args.quick => Frames::Fixed(1),
+                None => Frames::Adaptive,
+            },
             knobs: !args.no_knobs,
             animated_frames: args
                 .animated_frames
@@ -453,7 +474,7 @@ struct Measure<'a> {
     name: &'a str,
     base: &'a Baseline,
     size: (u32, u32),
-    frames: u32,
+    frames: Frames,
 }
 
 impl Measure<'_> {
@@ -470,13 +491,21 @@ impl Measure<'_> {
             return Ok(None);
         }
         renderer.set_method(method)?;
-        let mut opts = RenderOptions {
-            timed_frames: self.frames,
-            ..RenderOptions::default()
-        };
+        let mut opts = RenderOptions::default();
         adjust(&mut opts);
         let (w, h) = self.size;
-        let (image, stats) = match renderer.render_offscreen(self.scene, w, h, &opts) {
+        let rendered = match self.frames {
+            Frames::Fixed(n) => Ok(n),
+            // One untimed frame says how slow the configuration is.
+            Frames::Adaptive => renderer
+                .render_offscreen(self.scene, w, h, &opts)
+                .map(|(_, first)| if first.frame_ms > SLOW_FRAME_MS { 3 } else { 9 }),
+        }
+        .and_then(|frames| {
+            opts.timed_frames = frames;
+            renderer.render_offscreen(self.scene, w, h, &opts)
+        });
+        let (image, stats) = match rendered {
             Ok(r) => r,
             // A configuration past a method's limits (forward's loop bound, say) is skipped.
             Err(manylight::Error::Limit(reason)) => {
