@@ -53,9 +53,9 @@ pub struct BenchArgs {
     pub size: Option<(u32, u32)>,
     /// Timed frames per configuration after a warm-up frame (default 9: their median, the
     /// row's figure, outvotes the few slow frames a pool wake-up or the first frames after a
-    /// grid change make; 3 for a configuration whose first frame took over 400 ms, forward
-    /// over thousands of lights, whose frames vary little against their length; 1 with
-    /// `--quick`).
+    /// grid change make; 3 for a configuration whose first frame took over 100 ms, whose
+    /// frames vary little against their length: forward, tiled and deferred over hundreds of
+    /// lights; 1 with `--quick`).
     #[arg(long, value_parser = clap::value_parser!(u32).range(0..=i64::from(manylight::MAX_TIMED_FRAMES)))]
     pub frames: Option<u32>,
     /// Pixels sampled for the f64 CPU reference (default 256).
@@ -93,13 +93,13 @@ enum Frames {
     Fixed(u32),
     /// Nine, or three for a configuration whose first (untimed) frame took over
     /// [`SLOW_FRAME_MS`]: the median of three let one slow pool wake-up decide a fast row's
-    /// assignment time about one row in five, while nine frames of forward over 4 096 lights
-    /// would take over a minute a row.
+    /// assignment time about one row in five, while nine frames of every slow row doubled
+    /// the full sweep's time (20 minutes instead of 9 on the dev VM).
     Adaptive,
 }
 
 /// A first frame slower than this makes an adaptive row time three frames, not nine.
-const SLOW_FRAME_MS: f64 = 400.0;
+const SLOW_FRAME_MS: f64 = 100.0;
 
 impl Plan {
     fn from(args: &BenchArgs) -> Plan {
