@@ -122,6 +122,19 @@ pub struct Candidate {
     pub overflowed_lights: u64,
 }
 
+impl Candidate {
+    /// Whether its predicted assignment takes more than `share` of its predicted frame (never
+    /// for a NaN share): the CPU budget's test.
+    pub fn assigns_over(&self, share: f64) -> bool {
+        self.assign_ms > share * self.predicted_ms
+    }
+
+    /// Its predicted assignment as a share of its predicted frame.
+    pub fn assign_share(&self) -> f64 {
+        self.assign_ms / self.predicted_ms.max(f64::MIN_POSITIVE)
+    }
+}
+
 /// The grid chosen, and why.
 #[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
 pub struct GridChoice {
@@ -190,8 +203,7 @@ pub fn should_switch(current: &GridConfig, new: &GridChoice) -> bool {
         (Some(now), Some(best)) => {
             // The current grid must pass the budget clearly too, or a grid whose share sits
             // at the budget would be swapped out whenever a measurement put it a hair over.
-            let clearly_over =
-                now.assign_ms > current.assign_budget * (1.0 + HYSTERESIS) * now.predicted_ms;
+            let clearly_over = now.assigns_over(current.assign_budget * (1.0 + HYSTERESIS));
             best.overflowed_lights < now.overflowed_lights
                 || (best.overflowed_lights == now.overflowed_lights
                     && clearly_over

@@ -82,21 +82,27 @@ impl ChoiceSearch {
             + a.indices.len() * inputs.encoding.index_bytes();
         let work = assign_work(a.stats.runs, a.indices.len(), grid.total_cells);
         let covered = samples.covered_pixels();
-        let predicted_ms = costs.predict_ms(evals_per_pixel * covered, work, bytes as f64);
-        let assign_ms = costs.assign_ms(work);
-        let candidate = Candidate {
+        let mut candidate = Candidate {
             footprint_px,
             cells: grid.total_cells,
             indices: a.indices.len(),
             evals_per_pixel,
             bytes,
-            predicted_ms,
-            assign_ms,
-            // Not `<=` negated: a NaN budget (refused by the renderer) keeps every grid in.
-            over_budget: assign_ms > inputs.base.assign_budget * predicted_ms,
+            predicted_ms: costs.predict_ms(evals_per_pixel * covered, work, bytes as f64),
+            assign_ms: costs.assign_ms(work),
+            over_budget: false,
             overflowed_lights: a.stats.overflowed_lights,
         };
-        let (over_budget, overflowed_lights) = (candidate.over_budget, candidate.overflowed_lights);
+        // A NaN budget (refused by the renderer) keeps every grid in.
+        candidate.over_budget = candidate.assigns_over(inputs.base.assign_budget);
+        // Past here finer grids only assign more than a coarser grid that kept within the CPU
+        // budget without overflowing more than this one: they can win only by overflowing
+        // less, and then the search goes on.
+        let budget_passed = candidate.over_budget
+            && self
+                .candidates
+                .iter()
+                .any(|c| !c.over_budget && c.overflowed_lights <= candidate.overflowed_lights);
         let (rising, overflow_grew) = self.candidates.last().map_or((false, false), |last| {
             (
                 candidate.predicted_ms > last.predicted_ms,
@@ -113,14 +119,7 @@ impl ChoiceSearch {
         self.rises = if rising { self.rises + 1 } else { 0 };
         // Past here finer grids only rise further, or overflow the index list more (a per-cell
         // cap overflows less in finer cells, so overflow alone does not stop the search), or
-        // assign more than a coarser grid that kept within the CPU budget without overflowing
-        // more than this one (finer grids only assign more, so they can win only by
-        // overflowing less: then the search goes on).
-        let budget_passed = over_budget
-            && self
-                .candidates
-                .iter()
-                .any(|c| !c.over_budget && c.overflowed_lights <= overflowed_lights);
+        // pass the CPU budget (above).
         self.done =
             self.rises == 2 || overflow_grew || budget_passed || self.next == self.footprints.len();
         self.done
@@ -190,12 +189,11 @@ impl ChoiceSearch {
         // The budget's part: the chosen grid's assignment against it, and the finer grid it
         // turned down (predicted cheaper but over the budget), if any.
         let budget = inputs.base.assign_budget;
-        let share = |c: &Candidate| 100.0 * c.assign_ms / c.predicted_ms.max(f64::MIN_POSITIVE);
         let _ = write!(
             out.reason,
             "; assignment {:.2} ms, {:.1} % of the frame (budget {:.1} %)",
             best.assign_ms,
-            share(&best),
+            100.0 * best.assign_share(),
             100.0 * budget
         );
         let turned_down = self.candidates.iter().find(|c| {
@@ -209,7 +207,7 @@ impl ChoiceSearch {
                 "; {} px was predicted {:.2} ms faster but assigns {:.1} %",
                 c.footprint_px,
                 best.predicted_ms - c.predicted_ms,
-                share(c)
+                100.0 * c.assign_share()
             );
         }
         out.config = GridConfig {

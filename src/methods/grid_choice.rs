@@ -155,10 +155,12 @@ impl AutoGrid {
         let same_layout = self.layout.as_ref() == Some(&layout);
         // A grid chosen with the priors was not chosen with this device's figures: the first
         // calibrated choice replaces it without the hysteresis (once, so no flip-flop).
-        let from_priors = first_calibrated(&mut self.choice_from_priors, self.costs.frames > 0);
+        let replaces_priors = first_calibrated(&mut self.choice_from_priors, self.costs.frames > 0);
         match &mut self.choice {
             Some(current)
-                if same_layout && !from_priors && !auto::should_switch(&current.config, new) =>
+                if same_layout
+                    && !replaces_priors
+                    && !auto::should_switch(&current.config, new) =>
             {
                 // The grid stays; the reason says it was measured again.
                 current.reason.clear();
