@@ -25,6 +25,15 @@ fn point(radius: f32) -> Light {
     )
 }
 
+/// The error a 16 × 16 frame of `s` with `options` is refused with (a test failure if it
+/// renders).
+fn refusal(gpu: &mut Gpu, s: &Scene, options: &RenderOptions) -> String {
+    gpu.r()
+        .render_offscreen(s, 16, 16, options)
+        .unwrap_err()
+        .to_string()
+}
+
 fn mean(img: &image::RgbaImage) -> f64 {
     let sum: u64 = img
         .pixels()
@@ -106,11 +115,7 @@ fn values_the_maths_cannot_carry_are_refused_naming_the_real_field() {
     for (break_it, field) in cases {
         let mut s = plane(vec![point(3.0)]);
         break_it(&mut s);
-        let err = gpu
-            .r()
-            .render_offscreen(&s, 16, 16, &RenderOptions::default())
-            .unwrap_err()
-            .to_string();
+        let err = refusal(&mut gpu, &s, &RenderOptions::default());
         assert!(err.contains(field), "expected `{field}` in: {err}");
     }
 }
@@ -137,11 +142,7 @@ fn grid_settings_that_are_not_finite_are_refused_naming_the_field() {
             "grid.assign_budget" => options.grid.assign_budget = value,
             _ => options.grid.footprint_px = value,
         }
-        let err = gpu
-            .r()
-            .render_offscreen(&s, 16, 16, &options)
-            .unwrap_err()
-            .to_string();
+        let err = refusal(&mut gpu, &s, &options);
         assert!(err.contains(field), "{field} = {value}: {err}");
     }
     // In range, or clamped into it: renders.
@@ -175,11 +176,7 @@ fn a_huge_cascade_count_is_refused_naming_the_field() {
     for cascades in [u32::MAX, MAX_CASCADES + 1] {
         let mut options = RenderOptions::default();
         options.grid.cascades = cascades;
-        let err = gpu
-            .r()
-            .render_offscreen(&s, 16, 16, &options)
-            .unwrap_err()
-            .to_string();
+        let err = refusal(&mut gpu, &s, &options);
         assert!(err.contains("grid.cascades"), "{cascades}: {err}");
     }
     for cascades in [1, 12, MAX_CASCADES] {
@@ -211,11 +208,7 @@ fn a_huge_timed_frame_count_is_refused_naming_the_field() {
             timed_frames: frames,
             ..RenderOptions::default()
         };
-        let err = gpu
-            .r()
-            .render_offscreen(&s, 16, 16, &options)
-            .unwrap_err()
-            .to_string();
+        let err = refusal(&mut gpu, &s, &options);
         assert!(err.contains("timed_frames"), "{frames}: {err}");
     }
     let options = RenderOptions {

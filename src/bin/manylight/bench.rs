@@ -56,7 +56,7 @@ pub struct BenchArgs {
     /// grid change make; 3 for a configuration whose first frame took over 100 ms, whose
     /// frames vary little against their length: forward, tiled and deferred over hundreds of
     /// lights; 1 with `--quick`).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(0..=i64::from(manylight::MAX_TIMED_FRAMES)))]
+    #[arg(long, value_parser = crate::render::frame_count())]
     pub frames: Option<u32>,
     /// Pixels sampled for the f64 CPU reference (default 256).
     #[arg(long, default_value_t = 256)]
@@ -70,7 +70,7 @@ pub struct BenchArgs {
     /// Frames of the animated workload (lights and camera moving, at 30 fps of animation
     /// time; the first scene at the knobs' light count; 0 leaves it out). Default 120, 20
     /// with --quick.
-    #[arg(long, value_parser = clap::value_parser!(u32).range(0..=i64::from(manylight::MAX_TIMED_FRAMES)))]
+    #[arg(long, value_parser = crate::render::frame_count())]
     pub animated_frames: Option<u32>,
 }
 
@@ -93,8 +93,9 @@ enum Frames {
     Fixed(u32),
     /// Nine, or three for a configuration whose first (untimed) frame took over
     /// [`SLOW_FRAME_MS`]: the median of three let one slow pool wake-up decide a fast row's
-    /// assignment time about one row in five, while nine frames of every slow row doubled
-    /// the full sweep's time (20 minutes instead of 9 on the dev VM).
+    /// assignment time about one row in five, while nine frames of every slow row made the
+    /// full sweep much longer (dev VM: 20 minutes with this split at 400 ms, 18 at 100 ms,
+    /// 16 with three frames everywhere).
     Adaptive,
 }
 

@@ -46,7 +46,7 @@ pub struct RenderArgs {
     /// Frames timed after a warm-up frame: the median is reported, and from 10 frames also
     /// p95, p99 and the slowest (`--stats` has them from 1). In a scene whose lights move
     /// (the built-ins' do), frame k shows time `--time` + k / `--fps`.
-    #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u32).range(0..=i64::from(manylight::MAX_TIMED_FRAMES)))]
+    #[arg(long, default_value_t = 2, value_parser = frame_count())]
     pub frames: u32,
     /// Animation time of the picture written to `--out` and of the first timed frame, in
     /// seconds (0: the scene as built).
@@ -144,6 +144,12 @@ pub fn parse_slice_depth(s: &str) -> Result<f64, String> {
             "`{s}` is not a slice depth from 0.0625 to 16 (times a cell's width)"
         )),
     }
+}
+
+/// Parses a frame count (`render --frames`, `bench --frames`, `--animated-frames`): at most
+/// [`manylight::MAX_TIMED_FRAMES`], whose figures a run keeps.
+pub fn frame_count() -> clap::builder::RangedI64ValueParser<u32> {
+    clap::value_parser!(u32).range(0..=i64::from(manylight::MAX_TIMED_FRAMES))
 }
 
 /// Parses `--assign-budget`: a share of the frame from 0 to 1.
