@@ -7,7 +7,7 @@ use rayon::prelude::*;
 use super::assign::{Assignment, Run, Totals};
 use super::cells::for_each_run;
 use super::grid::ClusterGrid;
-use super::index_list::{EntriesMut, LightIndex};
+use super::index_list::{EntriesMut, IndexList, LightIndex};
 use super::pack::GpuLight;
 
 /// The chunks and their buffers, kept between frames.
@@ -69,10 +69,11 @@ impl Chunks {
         }));
         // Phase 3: each chunk sorts its lights locally, then blocks of cells gather the
         // chunks' runs into the final list (contiguous, disjoint slices: no sharing).
+        let visible = out.visible.len();
         self.chunks
             .par_iter_mut()
             .zip(first_ids.par_iter())
-            .for_each(|(chunk, &first_id)| chunk.sort_locally(first_id, cells));
+            .for_each(|(chunk, &first_id)| chunk.sort_locally(first_id, cells, visible));
         let (chunks, blocks) = (&self.chunks, &mut self.blocks);
         match out.indices.prepare(total as usize, out.visible.len()) {
             EntriesMut::Narrow(list) => merge(chunks, &out.offsets, list, threads, blocks),
@@ -104,9 +105,10 @@ struct Chunk {
     visible: Vec<u32>,
     /// Per cell (plus one): where the cell's run starts in `sorted` (phase 2).
     offsets: Vec<u32>,
-    /// The chunk's lights (global visible numbers) grouped by cell (phase 3, several chunks
-    /// only; a single chunk writes the final list directly).
-    sorted: Vec<u32>,
+    /// The chunk's lights (global visible numbers) grouped by cell (phase 3), at the final
+    /// list's width, so the merge copies slices (and the scatter writes half the bytes while
+    /// the visible lights fit 16 bits).
+    sorted: IndexList,
     /// Phase 3's write positions, per cell.
     cursor: Vec<u32>,
 }
@@ -153,7 +155,7 @@ impl Chunk {
     /// Phase 3: writes the chunk's visible lights, numbered from `first_id`, into `out`
     /// grouped by cell, each cell's run starting where `self.cursor` says (advanced as it
     /// goes). Light order is kept, so every cell's list is ascending.
-    fn scatter(&mut self, first_id: u32, out: &mut [u32]) {
+    fn scatter<T: LightIndex>(&mut self, first_id: u32, out: &mut [T]) {
         let mut id = first_id;
         let mut prev = 0usize;
         for &end in &self.ends {
@@ -164,7 +166,7 @@ impl Chunk {
             for run in &self.runs[prev..end] {
                 let a = run.start as usize;
                 for at in &mut self.cursor[a..a + run.len as usize] {
-                    out[*at as usize] = id;
+                    out[*at as usize] = T::from_u32(id);
                     *at += 1;
                 }
             }
@@ -173,13 +175,16 @@ impl Chunk {
         }
     }
 
-    /// Phase 3 of one of several chunks: scatters into the chunk's own list.
-    fn sort_locally(&mut self, first_id: u32, cells: usize) {
+    /// Phase 3 of one of several chunks: scatters into the chunk's own list, at the width of
+    /// a list of `visible` lights.
+    fn sort_locally(&mut self, first_id: u32, cells: usize, visible: usize) {
         let mut sorted = std::mem::take(&mut self.sorted);
-        sorted.resize(self.offsets[cells] as usize, 0);
         self.cursor.clear();
         self.cursor.extend_from_slice(&self.offsets[..cells]);
-        self.scatter(first_id, &mut sorted);
+        match sorted.prepare(self.offsets[cells] as usize, visible) {
+            EntriesMut::Narrow(list) => self.scatter(first_id, list),
+            EntriesMut::Wide(list) => self.scatter(first_id, list),
+        }
         self.sorted = sorted;
     }
 }
@@ -213,10 +218,7 @@ fn merge_blocks<T: LightIndex>(
             for cell in c0..c1 {
                 for chunk in chunks {
                     let (o, n) = (chunk.offsets[cell] as usize, chunk.count(cell) as usize);
-                    let from = &chunk.sorted[o..o + n];
-                    for (entry, &id) in out[at..at + n].iter_mut().zip(from) {
-                        *entry = T::from_u32(id);
-                    }
+                    out[at..at + n].copy_from_slice(&T::entries(&chunk.sorted)[o..o + n]);
                     at += n;
                 }
             }

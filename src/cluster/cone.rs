@@ -16,6 +16,8 @@ pub(crate) struct Cone {
     sin: f64,
     /// The light's (padded) radius.
     range: f64,
+    /// `|apex| + range`: the cone's share of every slice's slack (worked out once per light).
+    slack_terms: f64,
     /// Bounding sphere (centre, radius) of the spherical sector the light reaches.
     pub bound: (glam::DVec3, f64),
 }
@@ -23,6 +25,7 @@ pub(crate) struct Cone {
 impl Cone {
     /// The cone of a spot light of (padded) radius `range`; `None` for point lights and cones
     /// too wide to be worth testing.
+    #[inline(always)]
     pub fn of(light: &GpuLight, range: f64) -> Option<Cone> {
         // 1 − cos(outer) = offset / scale (see `Light::spot_scale_offset`): no trigonometry
         // per light. Cones of 89° and wider are not worth testing.
@@ -54,6 +57,7 @@ impl Cone {
             cos_sq: cos * cos,
             sin,
             range,
+            slack_terms: apex.length() + range,
             bound: (apex + axis * along, radius),
         })
     }
@@ -75,7 +79,8 @@ impl Cone {
             q,
             inv_q: 1.0 / q,
             a: sx * sx * (self.cos_sq - ax * ax),
-            slack: 1e-12 * (cells.origin.length() + self.apex.length() + r + self.range),
+            // The origin's size by its coordinates' sum (≥ its length, no root per slice).
+            slack: 1e-12 * (cells.origin.abs().element_sum() + self.slack_terms + r),
             cone: self,
         }
     }

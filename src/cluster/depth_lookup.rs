@@ -36,7 +36,8 @@ pub(crate) struct SliceLookup {
     base: i64,
     /// Per bucket: the global slice (slices numbered across cascades) its smallest depth is in.
     first_slice: Vec<u32>,
-    /// Per global slice: the depth where it starts (0 for the first).
+    /// Per global slice: the depth where it starts (0 for the first), then a NaN that no
+    /// depth is `≥`, which ends the steps of [`SliceLookup::find`] without a length check.
     start: Vec<f64>,
     /// Per global slice: (cascade, slice within the cascade).
     address: Vec<(u32, u32)>,
@@ -74,6 +75,7 @@ impl SliceLookup {
             let d = f64::from_bits((b as u64) << BUCKET_SHIFT);
             (start.partition_point(|&z| z <= d) - 1) as u32
         }));
+        self.start.push(f64::NAN);
         self.base = base;
     }
 
@@ -92,7 +94,11 @@ impl SliceLookup {
         // Negative patterns (−0 included) clamp to the first bucket, +∞ to the last.
         let bucket = (bucket(d) - self.base).clamp(0, self.first_slice.len() as i64 - 1);
         let mut g = self.first_slice[bucket as usize] as usize;
-        while g + 1 < self.start.len() && d >= self.start[g + 1] {
+        // The first step without a branch: on all but the finest grids a bucket holds one
+        // boundary at most, and whether a depth lies past it is a coin toss that a branch
+        // predictor loses (the loop's test was the assignment's hottest line).
+        g += usize::from(d >= self.start[g + 1]);
+        while d >= self.start[g + 1] {
             g += 1;
         }
         self.address[g]
@@ -110,6 +116,9 @@ pub(crate) struct CascadeConstants {
     pub inv_far: f64,
     /// Half the columns and half the rows: tile coordinate `(ndc + 1) · half`.
     pub half_tiles: [f64; 2],
+    /// NDC width of one column and height of one row, `2 / tiles` (divided once here: the
+    /// spot-cone test asks for them in every slice).
+    pub ndc_step: [f64; 2],
     /// Width of one column and height of one row in view-space slope (perspective) or view
     /// units (orthographic): `2 · extent / tiles`, `extent = 1 / ndc_scale`.
     pub tile_step: [f64; 2],
@@ -143,6 +152,7 @@ impl CascadeConstants {
                 },
                 inv_far: if k == last { 0.0 } else { 1.0 / c.z_far },
                 half_tiles: [0.5 * c.tiles_x as f64, 0.5 * c.tiles_y as f64],
+                ndc_step: [2.0 / c.tiles_x as f64, 2.0 / c.tiles_y as f64],
                 tile_step: [
                     2.0 * (1.0 / grid.ndc_scale[0]) / c.tiles_x as f64,
                     2.0 * (1.0 / grid.ndc_scale[1]) / c.tiles_y as f64,
@@ -193,7 +203,7 @@ mod tests {
             let search =
                 |d: f64| lookup.address[lookup.start.partition_point(|&z| z <= d).max(1) - 1];
             let mut depths = vec![-0.0, 0.0, f64::MIN_POSITIVE, grid.far * 1e3, f64::INFINITY];
-            for &z in &lookup.start[1..] {
+            for &z in lookup.start[1..].iter().filter(|z| !z.is_nan()) {
                 depths.extend([z, z.next_up(), z.next_down(), z * 1.01, z * 0.99]);
             }
             let mut d = 1e-6;

@@ -112,6 +112,8 @@ pub(super) trait LightIndex: Copy + Default + Send + Sync + 'static {
     fn from_u32(value: u32) -> Self;
     /// The entry as a position in the visible lights.
     fn to_usize(self) -> usize;
+    /// `list`'s entries at this width (empty when the list is at the other width).
+    fn entries(list: &IndexList) -> &[Self];
 }
 
 impl LightIndex for u16 {
@@ -124,6 +126,11 @@ impl LightIndex for u16 {
     fn to_usize(self) -> usize {
         self as usize
     }
+
+    #[inline(always)]
+    fn entries(list: &IndexList) -> &[Self] {
+        &list.narrow
+    }
 }
 
 impl LightIndex for u32 {
@@ -135,6 +142,11 @@ impl LightIndex for u32 {
     #[inline(always)]
     fn to_usize(self) -> usize {
         self as usize
+    }
+
+    #[inline(always)]
+    fn entries(list: &IndexList) -> &[Self] {
+        &list.wide
     }
 }
 

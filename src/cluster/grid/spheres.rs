@@ -38,10 +38,9 @@ impl ClusterGrid {
     /// the slice's share worked out once per row.
     #[inline]
     pub(crate) fn row_spheres(&self, cascade: u32, slice: u32, y: u32) -> RowSpheres {
-        let c = &self.cascades[cascade as usize];
+        let [step_x, step_y] = self.cascade_constants[cascade as usize].ndc_step;
         let f = &self.slice_frusta[slice as usize];
         let (z0, z1) = f.depths;
-        let step_y = 2.0 / c.tiles_y as f64;
         let (ny0, ny1) = (-1.0 + y as f64 * step_y, -1.0 + (y + 1) as f64 * step_y);
         // The centre of the eight corners: the mean of the NDC bounds times the mean half
         // extent (x, y), the middle depth (z).
@@ -64,7 +63,7 @@ impl ClusterGrid {
             mean_x: 0.5 * (f.near.0 + f.far.0),
             near_rest: y_and_z(f.near.1),
             far_rest: y_and_z(f.far.1),
-            step_x: 2.0 / c.tiles_x as f64,
+            step_x,
         }
     }
 
@@ -152,11 +151,9 @@ impl ClusterGrid {
         columns: (u32, u32),
         rows: (u32, u32),
     ) -> SliceCells {
-        let c = &self.cascades[cascade as usize];
+        let [step_x, step_y] = self.cascade_constants[cascade as usize].ndc_step;
         let f = &self.slice_frusta[slice as usize];
         let (z0, z1) = f.depths;
-        let step_x = 2.0 / c.tiles_x as f64;
-        let step_y = 2.0 / c.tiles_y as f64;
         let mean = [0.5 * (f.near.0 + f.far.0), 0.5 * (f.near.1 + f.far.1)];
         let radius = if z1.is_infinite() {
             f64::INFINITY
