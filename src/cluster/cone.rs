@@ -145,14 +145,15 @@ impl ConeSlice<'_> {
         v0.y += row as f64 * self.row_step;
         if x1 - x0 < NARROW_ROW {
             // A few cells: each tested on its own is cheaper than the row's quadratic.
-            let mut kept = None;
+            // Without a branch per cell (which cells pass is what a predictor cannot learn).
+            let (mut first, mut last) = (u32::MAX, 0);
             for x in x0..x1 + 1 {
                 let v = glam::DVec3::new(v0.x + x as f64 * self.sx, v0.y, v0.z);
-                if self.cell_may_touch(v) {
-                    kept = Some((kept.map_or(x, |(first, _)| first), x));
-                }
+                let touches = self.cell_may_touch(v);
+                first = if touches { first.min(x) } else { first };
+                last = if touches { x } else { last };
             }
-            return kept;
+            return (first <= last).then_some((first, last));
         }
         let p = v0.dot(cone.axis);
         let w0 = v0 - cone.axis * p;
@@ -190,10 +191,11 @@ impl ConeSlice<'_> {
         let v1 = v.dot(cone.axis);
         let bound = self.r + v1 * cone.sin;
         let (off_axis, reach) = (cone.cos_sq * (v.length_squared() - v1 * v1), bound * bound);
-        let outside = v1 > self.r + cone.range + self.slack
-            || v1 < -self.r - self.slack
-            || bound < -self.slack
-            || off_axis - reach > 1e-9 * (off_axis.abs() + reach + cone.cos_sq * v1 * v1);
+        // `|`, not `||`: the four tests cost less than the branches between them.
+        let outside = (v1 > self.r + cone.range + self.slack)
+            | (v1 < -self.r - self.slack)
+            | (bound < -self.slack)
+            | (off_axis - reach > 1e-9 * (off_axis.abs() + reach + cone.cos_sq * v1 * v1));
         !outside
     }
 }

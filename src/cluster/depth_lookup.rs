@@ -15,7 +15,7 @@
 //! widening of the depth range absorbs.
 //!
 //! ```text
-//! bits(d) >> 46 ─ base ─► first_slice[bucket] ─► while d ≥ start[g + 1]: g += 1 ─► (k, s)
+//! bits(d) >> 46 ─ base ─► buckets[b]: first slice g ─► while d ≥ start[g + 1]: g += 1 ─► (k, s)
 //! ```
 
 use super::grid::ClusterGrid;
@@ -32,10 +32,10 @@ fn bucket(d: f64) -> i64 {
 /// Slice lookup for the log2 depth mapping (see the module docs).
 #[derive(Clone, Debug, Default)]
 pub(crate) struct SliceLookup {
-    /// Bucket number of `first_slice[0]`.
+    /// Bucket number of `buckets[0]`.
     base: i64,
-    /// Per bucket: the global slice (slices numbered across cascades) its smallest depth is in.
-    first_slice: Vec<u32>,
+    /// Per bucket: the first slice it reaches and where the next one starts.
+    buckets: Vec<Bucket>,
     /// Per global slice: the depth where it starts (0 for the first), then a NaN that no
     /// depth is `≥`, which ends the steps of [`SliceLookup::find`] without a length check.
     start: Vec<f64>,
@@ -70,12 +70,16 @@ impl SliceLookup {
         // Every depth before the second slice's start is in the first slice.
         let base = bucket(start.get(1).copied().unwrap_or(far).min(far));
         let last = bucket(far).max(base);
-        self.first_slice.clear();
-        self.first_slice.extend((base..=last).map(|b| {
+        start.push(f64::NAN);
+        self.buckets.clear();
+        self.buckets.extend((base..=last).map(|b| {
             let d = f64::from_bits((b as u64) << BUCKET_SHIFT);
-            (start.partition_point(|&z| z <= d) - 1) as u32
+            let first = start.partition_point(|&z| z <= d) - 1;
+            Bucket {
+                next_start: start[first + 1],
+                first: first as u32,
+            }
         }));
-        self.start.push(f64::NAN);
         self.base = base;
     }
 
@@ -83,26 +87,35 @@ impl SliceLookup {
     /// needs no table).
     pub(crate) fn clear(&mut self) {
         self.base = 0;
-        self.first_slice.clear();
+        self.buckets.clear();
         self.start.clear();
         self.address.clear();
     }
 
     /// (cascade, slice) of the last slice starting at or before `d` (`d` ≥ 0, not NaN).
-    #[inline]
+    #[inline(always)]
     pub(crate) fn find(&self, d: f64) -> (u32, u32) {
         // Negative patterns (−0 included) clamp to the first bucket, +∞ to the last.
-        let bucket = (bucket(d) - self.base).clamp(0, self.first_slice.len() as i64 - 1);
-        let mut g = self.first_slice[bucket as usize] as usize;
-        // The first step without a branch: on all but the finest grids a bucket holds one
-        // boundary at most, and whether a depth lies past it is a coin toss that a branch
-        // predictor loses (the loop's test was the assignment's hottest line).
-        g += usize::from(d >= self.start[g + 1]);
+        let bucket = (bucket(d) - self.base).clamp(0, self.buckets.len() as i64 - 1);
+        let bucket = self.buckets[bucket as usize];
+        // The first step without a branch and from the bucket's own entry (one load, not two
+        // in a row): on all but the finest grids a bucket holds one boundary at most, and
+        // whether a depth lies past it is a coin toss that a branch predictor loses (the
+        // loop's test was the assignment's hottest line).
+        let mut g = bucket.first as usize + usize::from(d >= bucket.next_start);
         while d >= self.start[g + 1] {
             g += 1;
         }
         self.address[g]
     }
+}
+
+/// One bucket of [`SliceLookup`]: the global slice (slices numbered across cascades) its
+/// smallest depth is in, and the depth where the slice after it starts (NaN after the last).
+#[derive(Clone, Copy, Debug)]
+struct Bucket {
+    next_start: f64,
+    first: u32,
 }
 
 /// Per-cascade constants of the box projection and of the NDC → tile conversion.
