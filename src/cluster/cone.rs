@@ -16,7 +16,8 @@ pub(crate) struct Cone {
     sin: f64,
     /// The light's (padded) radius.
     range: f64,
-    /// `|apex| + range`: the cone's share of every slice's slack (worked out once per light).
+    /// The apex's size (its coordinates' sum, no root) plus `range`: the cone's share of every
+    /// slice's slack.
     slack_terms: f64,
     /// Bounding sphere (centre, radius) of the spherical sector the light reaches.
     pub bound: (glam::DVec3, f64),
@@ -57,7 +58,7 @@ impl Cone {
             cos_sq: cos * cos,
             sin,
             range,
-            slack_terms: apex.length() + range,
+            slack_terms: apex.abs().element_sum() + range,
             bound: (apex + axis * along, radius),
         })
     }
@@ -79,7 +80,7 @@ impl Cone {
             q,
             inv_q: 1.0 / q,
             a: sx * sx * (self.cos_sq - ax * ax),
-            // The origin's size by its coordinates' sum (≥ its length, no root per slice).
+            // Sizes by coordinate sums (≥ lengths, at most √3 times: no roots).
             slack: 1e-12 * (cells.origin.abs().element_sum() + self.slack_terms + r),
             cone: self,
         }
