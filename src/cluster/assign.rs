@@ -46,6 +46,7 @@ use super::grid::ClusterGrid;
 use super::index_list::IndexList;
 use super::overflow::{apply_cap, Overflow};
 use super::pack::GpuLight;
+use super::pack_grid::MAX_TABLE_CELLS;
 
 /// An assignment whose previous frame listed this many indices runs on all cores whatever its
 /// light count: fine grids give each light hundreds of cells, and at about 3 ns an index such
@@ -178,6 +179,11 @@ impl Assigner {
     }
 
     /// Assigns `lights` (view space) to the cells of `grid`. `camera_far` may be infinite.
+    ///
+    /// A grid of [`MAX_TABLE_CELLS`] cells or more (which the renderer refuses by name before
+    /// it gets here) is not assigned: its per-cell arrays alone would take gigabytes. The
+    /// result then has no offsets, counts or indices, [`AssignStats::overflowed_lights`]
+    /// counts every light once, and a warning is logged.
     pub fn assign(
         &mut self,
         grid: &ClusterGrid,
@@ -192,6 +198,23 @@ impl Assigner {
             clusters: grid.total_cells,
             ..AssignStats::default()
         };
+        if grid.total_cells >= MAX_TABLE_CELLS {
+            // Every per-cell array would be 4 bytes a cell (16 GiB for a grid of 2³² cells,
+            // which raised `max_tiles` and a large frame can make): no cells instead.
+            log::warn!(
+                "light assignment: a grid of {} cells is more than the {} the grid textures \
+                 address; it gets no cell lists, and all {} lights count as overflowed \
+                 (a larger grid.footprint_px or lower grid.max_tiles avoid it)",
+                grid.total_cells,
+                MAX_TABLE_CELLS - 1,
+                lights.len()
+            );
+            out.indices.clear();
+            out.offsets.clear();
+            out.counts.clear();
+            out.stats.overflowed_lights = lights.len() as u64;
+            return &self.out;
+        }
         if lights.is_empty() {
             out.indices.clear();
             out.offsets.clear();
