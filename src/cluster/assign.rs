@@ -46,13 +46,19 @@ use super::grid::ClusterGrid;
 use super::index_list::IndexList;
 use super::overflow::{apply_cap, Overflow};
 use super::pack::GpuLight;
-use super::pack_grid::MAX_TABLE_CELLS;
 
 /// An assignment whose previous frame listed this many indices runs on all cores whatever its
 /// light count: fine grids give each light hundreds of cells, and at about 3 ns an index such
 /// a frame's work (a millisecond or more) dwarfs the tens of microseconds of waking rayon's
 /// workers.
 pub const PARALLEL_INDICES: usize = 1 << 17;
+
+/// Most cells an assignment takes: its per-cell arrays (difference counts, counts, offsets,
+/// cursors) hold about 16 bytes a cell, 1 GiB here. Four times what the grid textures address
+/// (2²⁴ cells, which the renderer refuses past by name), so a CPU-only caller has room; a
+/// larger grid (up to 2³², which raised `max_tiles` and a large frame can make) gets no cells
+/// (see [`Assigner::assign`]).
+pub const MAX_ASSIGN_CELLS: u32 = 1 << 26;
 
 /// Limits of one assignment.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -88,7 +94,8 @@ pub struct AssignStats {
     pub avg_lights_per_nonempty: f64,
     /// Most lights any cell touched (before the cap).
     pub max_lights_per_cluster: u32,
-    /// Light references dropped by the overflow policy.
+    /// Light references dropped by the overflow policy; on a grid of more than
+    /// [`MAX_ASSIGN_CELLS`] cells, which gets none, every light once.
     pub overflowed_lights: u64,
     /// Length of the index list.
     pub indices: usize,
@@ -160,6 +167,8 @@ pub struct Assigner {
     out: Assignment,
     /// The overflow policy's buffers.
     overflow: Overflow,
+    /// Whether a grid past [`MAX_ASSIGN_CELLS`] was warned of (once per assigner).
+    warned_oversize: bool,
 }
 
 impl Assigner {
@@ -180,10 +189,10 @@ impl Assigner {
 
     /// Assigns `lights` (view space) to the cells of `grid`. `camera_far` may be infinite.
     ///
-    /// A grid of [`MAX_TABLE_CELLS`] cells or more (which the renderer refuses by name before
-    /// it gets here) is not assigned: its per-cell arrays alone would take gigabytes. The
-    /// result then has no offsets, counts or indices, [`AssignStats::overflowed_lights`]
-    /// counts every light once, and a warning is logged.
+    /// A grid of more than [`MAX_ASSIGN_CELLS`] cells is not assigned: its per-cell arrays
+    /// would take gigabytes. The result then has no offsets, counts or indices,
+    /// [`AssignStats::overflowed_lights`] counts every light once, and the first such call of
+    /// this assigner logs a warning.
     pub fn assign(
         &mut self,
         grid: &ClusterGrid,
@@ -198,17 +207,17 @@ impl Assigner {
             clusters: grid.total_cells,
             ..AssignStats::default()
         };
-        if grid.total_cells >= MAX_TABLE_CELLS {
-            // Every per-cell array would be 4 bytes a cell (16 GiB for a grid of 2³² cells,
-            // which raised `max_tiles` and a large frame can make): no cells instead.
-            log::warn!(
-                "light assignment: a grid of {} cells is more than the {} the grid textures \
-                 address; it gets no cell lists, and all {} lights count as overflowed \
-                 (a larger grid.footprint_px or lower grid.max_tiles avoid it)",
-                grid.total_cells,
-                MAX_TABLE_CELLS - 1,
-                lights.len()
-            );
+        if grid.total_cells > MAX_ASSIGN_CELLS {
+            if !self.warned_oversize {
+                self.warned_oversize = true;
+                log::warn!(
+                    "light assignment: a grid of {} cells is more than the {MAX_ASSIGN_CELLS} an \
+                     assignment takes; it gets no cell lists, and all {} lights count as \
+                     overflowed (a larger grid.footprint_px or a lower grid.max_tiles avoid it)",
+                    grid.total_cells,
+                    lights.len()
+                );
+            }
             out.indices.clear();
             out.offsets.clear();
             out.counts.clear();

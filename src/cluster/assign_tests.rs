@@ -565,9 +565,9 @@ fn small_lights_plain_loops_match_the_general_loop() {
     assert!(small_rects > 500, "only {small_rects} small lights tried");
 }
 
-/// A grid of more cells than the grid textures address (here 2³² − 1, saturated: a large frame
-/// with one-pixel cells and raised limits) is not assigned: no per-cell arrays (four bytes a
-/// cell would be 16 GiB, so allocating them would abort this test), every light counted as
+/// A grid of more cells than an assignment takes (here 2³² − 1, saturated: a large frame with
+/// one-pixel cells and raised limits) is not assigned: no per-cell arrays (four bytes a cell
+/// would be 16 GiB, so allocating them would abort this test), every light counted as
 /// overflowed.
 #[test]
 fn a_grid_past_the_table_gets_no_cell_arrays() {
@@ -583,7 +583,7 @@ fn a_grid_past_the_table_gets_no_cell_arrays() {
             ..GridConfig::fixed(1.0)
         },
     );
-    assert!(grid.total_cells >= crate::cluster::pack_grid::MAX_TABLE_CELLS);
+    assert!(grid.total_cells > super::assign::MAX_ASSIGN_CELLS);
     let light = Light::point(DVec3::new(0.0, 0.0, -5.0), 1.0, Vec3::ONE, 1.0);
     let lights = vec![GpuLight::from_light(&light, &glam::DMat4::IDENTITY); 3];
     let a = assign(&grid, &lights, 60.0, &AssignLimits::default());

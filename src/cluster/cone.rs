@@ -16,8 +16,8 @@ pub(crate) struct Cone {
     sin: f64,
     /// The light's (padded) radius.
     range: f64,
-    /// The apex's size (its coordinates' sum, no root) plus `range`: the cone's share of every
-    /// slice's slack.
+    /// The apex's size (the sum of its coordinates' magnitudes, no root) plus `range`: the
+    /// cone's share of every slice's slack.
     slack_terms: f64,
     /// Bounding sphere (centre, radius) of the spherical sector the light reaches.
     pub bound: (glam::DVec3, f64),
@@ -80,7 +80,7 @@ impl Cone {
             q,
             inv_q: 1.0 / q,
             a: sx * sx * (self.cos_sq - ax * ax),
-            // Sizes by coordinate sums (≥ lengths, at most √3 times: no roots).
+            // Sizes by sums of coordinate magnitudes (≥ lengths, at most √3 times: no roots).
             slack: 1e-12 * (cells.origin.abs().element_sum() + self.slack_terms + r),
             cone: self,
         }
