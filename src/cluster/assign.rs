@@ -54,7 +54,7 @@ use super::pack::GpuLight;
 pub const PARALLEL_INDICES: usize = 1 << 17;
 
 /// Most cells an assignment takes: its per-cell arrays (difference counts, counts, offsets,
-/// cursors) hold about 16 bytes a cell, 1 GiB here. Four times what the grid textures address
+/// cursors; each chunk of lights has its own) hold 16 bytes a cell or more, 1 GiB and up here. Four times what the grid textures address
 /// (2²⁴ cells, which the renderer refuses past by name), so a CPU-only caller has room; a
 /// larger grid (up to 2³², which raised `max_tiles` and a large frame can make) gets no cells
 /// (see [`Assigner::assign`]).
