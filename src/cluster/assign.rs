@@ -54,10 +54,10 @@ use super::pack::GpuLight;
 pub const PARALLEL_INDICES: usize = 1 << 17;
 
 /// Most cells an assignment takes: its per-cell arrays (difference counts, counts, offsets,
-/// cursors; each chunk of lights has its own) hold 16 bytes a cell or more, 1 GiB and up here. Four times what the grid textures address
-/// (2²⁴ cells, which the renderer refuses past by name), so a CPU-only caller has room; a
-/// larger grid (up to 2³², which raised `max_tiles` and a large frame can make) gets no cells
-/// (see [`Assigner::assign`]).
+/// cursors; each chunk of lights has its own) hold 16 bytes a cell or more, 1 GiB and up
+/// here. Four times what the grid textures address (2²⁴ cells, which the renderer refuses past
+/// by name), so a CPU-only caller has room; a larger grid (up to 2³², which raised `max_tiles`
+/// and a large frame can make) gets no cells (see [`Assigner::assign`]).
 pub const MAX_ASSIGN_CELLS: u32 = 1 << 26;
 
 /// Limits of one assignment.

@@ -441,16 +441,20 @@ mod tests {
     /// clearly over gives way to a grid within it even when that one is predicted slower.
     #[test]
     fn a_grid_just_over_the_budget_is_kept() {
-        let candidate = |footprint_px: f64, predicted_ms: f64, assign_ms: f64| Candidate {
-            footprint_px,
-            cells: 1000,
-            indices: 1000,
-            evals_per_pixel: 1.0,
-            bytes: 1000,
-            predicted_ms,
-            assign_ms,
-            over_budget: assign_ms > 0.05 * predicted_ms,
-            overflowed_lights: 0,
+        let candidate = |footprint_px: f64, predicted_ms: f64, assign_ms: f64| {
+            let mut c = Candidate {
+                footprint_px,
+                cells: 1000,
+                indices: 1000,
+                evals_per_pixel: 1.0,
+                bytes: 1000,
+                predicted_ms,
+                assign_ms,
+                over_budget: false,
+                overflowed_lights: 0,
+            };
+            c.over_budget = c.assigns_over(0.05);
+            c
         };
         let choice = |current_assign_ms: f64| GridChoice {
             config: GridConfig {
@@ -556,7 +560,7 @@ mod tests {
         let first_over = c
             .iter()
             .position(|c| c.over_budget)
-            .expect("a grid past 1 %");
+            .expect("a grid past the 5 % budget");
         let least_within = c[..first_over]
             .iter()
             .map(|c| c.overflowed_lights)
