@@ -3,12 +3,15 @@
 #include "deferred_common.glsl"
 
 uniform HIGHP sampler2D u_accum;
+// The geometry pass's depth, written into the target's depth buffer (see deferred.rs).
+uniform HIGHP sampler2D u_gDepth;
 
 void main() {
     ivec2 px = ivec2(gl_FragCoord.xy);
     if (texelFetch(u_gNormalDepth, px, 0).w <= 0.0) {
         discard;
     }
+    gl_FragDepth = texelFetch(u_gDepth, px, 0).r;
 #if COUNT_EVALS
     FRAG_COLOR = encodeCount(texelFetch(u_accum, px, 0).r);
 #else

@@ -99,7 +99,12 @@ impl Caps {
                 ),
             });
         }
-        let mut extensions: BTreeSet<String> = gl.supported_extensions().iter().cloned().collect();
+        let mut extensions: BTreeSet<String> = gl
+            .supported_extensions()
+            .iter()
+            .filter(|e| !e.is_empty())
+            .cloned()
+            .collect();
         if desktop {
             // Float colour buffers and float blending are core in desktop GL 3.0, so drivers do
             // not list the ES extensions; record them so one check serves both.

@@ -1,7 +1,8 @@
 //! Headless GL contexts through EGL.
 //!
-//! libEGL is loaded at run time (`libEGL.so.1`), so the binary starts — and can say clearly
-//! what is missing — on machines without it. Display choice: the `EGL_MESA_platform_surfaceless`
+//! libEGL is loaded at run time (the system's `libEGL.so.1`, or another implementation's:
+//! [`super::gles_lib`]), so the binary starts — and can say clearly what is missing — on
+//! machines without it. Display choice: the `EGL_MESA_platform_surfaceless`
 //! platform when there is no window system (no `DISPLAY` / `WAYLAND_DISPLAY`) and the client
 //! supports it, else the default display; if the first choice fails, the other is tried.
 //! The context is made current without a surface where EGL ≥ 1.5 or
@@ -11,9 +12,8 @@
 
 use khronos_egl as egl;
 
+use super::gles_lib::{self, Egl, GlesLibrary};
 use super::{EsVersion, GlError};
-
-type Egl = egl::DynamicInstance<egl::EGL1_4>;
 
 /// `EGL_PLATFORM_SURFACELESS_MESA`.
 const PLATFORM_SURFACELESS_MESA: egl::Enum = 0x31DD;
@@ -21,7 +21,7 @@ const PLATFORM_SURFACELESS_MESA: egl::Enum = 0x31DD;
 /// An EGL display + context current on the creating thread. Keep it alive as long as anything
 /// uses the GL context it made (the [`crate::Renderer`] built from [`HeadlessContext::load_gl`]).
 pub struct HeadlessContext {
-    egl: Egl,
+    lib: &'static GlesLibrary,
     display: egl::Display,
     context: egl::Context,
     surface: Option<egl::Surface>,
@@ -53,9 +53,8 @@ fn egl_err(call: &'static str) -> impl Fn(egl::Error) -> GlError {
 impl HeadlessContext {
     /// Creates a context for `es` and makes it current on this thread.
     pub fn new(es: EsVersion) -> Result<Self, GlError> {
-        let egl = unsafe { Egl::load_required_from_filename("libEGL.so.1") }
-            .or_else(|_| unsafe { Egl::load_required_from_filename("libEGL.so") })
-            .map_err(|e| GlError::EglLoad(e.to_string()))?;
+        let lib = gles_lib::library()?;
+        let egl = lib.egl();
         let client_ext = egl
             .query_string(None, egl::EXTENSIONS)
             .map(|s| s.to_string_lossy().into_owned())
@@ -72,10 +71,10 @@ impl HeadlessContext {
         };
         let mut last_err = None;
         for platform in order {
-            match Self::with_platform(&egl, platform, es) {
+            match Self::with_platform(egl, platform, es) {
                 Ok((display, context, surface, info)) => {
                     return Ok(HeadlessContext {
-                        egl,
+                        lib,
                         display,
                         context,
                         surface,
@@ -212,13 +211,7 @@ impl HeadlessContext {
 
     /// A glow context for the current EGL context (cheap: it loads function pointers).
     pub fn load_gl(&self) -> glow::Context {
-        unsafe {
-            glow::Context::from_loader_function(|name| {
-                self.egl
-                    .get_proc_address(name)
-                    .map_or(std::ptr::null(), |f| f as *const std::ffi::c_void)
-            })
-        }
+        unsafe { glow::Context::from_loader_function(|name| self.lib.proc_address(name)) }
     }
 
     /// How the context was made.
@@ -231,10 +224,11 @@ impl Drop for HeadlessContext {
     fn drop(&mut self) {
         // The display is shared by every context of the process (EGL returns the same handle),
         // so it is never terminated here: other threads may still be rendering on it.
-        let _ = self.egl.make_current(self.display, None, None, None);
+        let egl = self.lib.egl();
+        let _ = egl.make_current(self.display, None, None, None);
         if let Some(s) = self.surface {
-            let _ = self.egl.destroy_surface(self.display, s);
+            let _ = egl.destroy_surface(self.display, s);
         }
-        let _ = self.egl.destroy_context(self.display, self.context);
+        let _ = egl.destroy_context(self.display, self.context);
     }
 }

@@ -2,33 +2,76 @@
 //! `glRenderbufferStorageMultisampleEXT` (`GL_EXT_multisampled_render_to_texture`), without
 //! which that extension's colour attachment has no multisampled depth to go with it.
 //!
-//! glow takes the caller's GL context already loaded, so these come from
-//! `eglGetProcAddress` of the process's `libEGL`: where an ES 2.0 context comes from on
-//! Android and Linux. A context made otherwise (none here) simply finds none, and MSAA on
-//! ES 2.0 is then unsupported with that reason.
+//! glow takes the caller's GL context already loaded, so these come from the process's EGL
+//! implementation (`eglGetProcAddress`): where an ES 2.0 context comes from on Android and
+//! Linux. A context made otherwise (none here) simply finds none, and MSAA on ES 2.0 is then
+//! unsupported with that reason.
 #![allow(unsafe_code)]
 
 /// `glRenderbufferStorageMultisampleEXT(target, samples, internalformat, width, height)`.
 pub type RenderbufferStorageMultisampleExt =
     unsafe extern "system" fn(target: u32, samples: i32, format: u32, width: i32, height: i32);
 
-/// Loads `glRenderbufferStorageMultisampleEXT` from `libEGL`, if it is there.
+/// Loads `glRenderbufferStorageMultisampleEXT` from the process's GLES implementation
+/// ([`super::gles_lib`]), if it is there.
 pub fn renderbuffer_storage_multisample_ext() -> Option<RenderbufferStorageMultisampleExt> {
-    type Egl = khronos_egl::DynamicInstance<khronos_egl::EGL1_4>;
-    // Kept loaded for the whole process: the pointer it hands out must outlive every Device
-    // (dropping the instance would unload the library it points into, were it the last user).
-    static EGL: std::sync::OnceLock<Option<Egl>> = std::sync::OnceLock::new();
-    let egl = EGL
-        .get_or_init(|| {
-            unsafe { Egl::load_required_from_filename("libEGL.so.1") }
-                .or_else(|_| unsafe { Egl::load_required_from_filename("libEGL.so") })
-                .ok()
-        })
-        .as_ref()?;
-    let f = egl.get_proc_address("glRenderbufferStorageMultisampleEXT")?;
+    let f = super::gles_lib::library()
+        .ok()?
+        .proc_address("glRenderbufferStorageMultisampleEXT");
+    if f.is_null() {
+        return None;
+    }
     // SAFETY: the extension specifies this signature for the entry point of that name, and
-    // the library stays loaded (above).
+    // the library stays loaded for the whole process (gles_lib).
     Some(unsafe {
-        std::mem::transmute::<extern "system" fn(), RenderbufferStorageMultisampleExt>(f)
+        std::mem::transmute::<*const std::ffi::c_void, RenderbufferStorageMultisampleExt>(f)
     })
+}
+
+/// `glGenQueriesEXT(n, ids)`.
+pub type GenQueriesExt = unsafe extern "system" fn(n: i32, ids: *mut u32);
+/// `glDeleteQueriesEXT(n, ids)`.
+pub type DeleteQueriesExt = unsafe extern "system" fn(n: i32, ids: *const u32);
+/// `glBeginQueryEXT(target, id)`.
+pub type BeginQueryExt = unsafe extern "system" fn(target: u32, id: u32);
+/// `glEndQueryEXT(target)`.
+pub type EndQueryExt = unsafe extern "system" fn(target: u32);
+/// `glGetQueryObjectui64vEXT(id, pname, params)`.
+pub type GetQueryObjectUi64vExt = unsafe extern "system" fn(id: u32, pname: u32, params: *mut u64);
+
+/// The entry points of `GL_EXT_disjoint_timer_query` (valid on ES 2.0 and 3.0 contexts).
+#[derive(Clone, Copy)]
+pub struct TimerQueryFns {
+    /// `glGenQueriesEXT`.
+    pub gen_queries: GenQueriesExt,
+    /// `glDeleteQueriesEXT`.
+    pub delete_queries: DeleteQueriesExt,
+    /// `glBeginQueryEXT`.
+    pub begin_query: BeginQueryExt,
+    /// `glEndQueryEXT`.
+    pub end_query: EndQueryExt,
+    /// `glGetQueryObjectui64vEXT`.
+    pub get_query_object_ui64v: GetQueryObjectUi64vExt,
+}
+
+/// Loads `GL_EXT_disjoint_timer_query`'s entry points; `None` when any is missing.
+pub fn timer_query_fns() -> Option<TimerQueryFns> {
+    type Ptr = *const std::ffi::c_void;
+    let lib = super::gles_lib::library().ok()?;
+    let get = |name: &str| Some(lib.proc_address(name)).filter(|f| !f.is_null());
+    // SAFETY: each pointer is the entry point of that name, given the signature the
+    // extension specifies for it; the library stays loaded for the whole process.
+    unsafe {
+        Some(TimerQueryFns {
+            gen_queries: std::mem::transmute::<Ptr, GenQueriesExt>(get("glGenQueriesEXT")?),
+            delete_queries: std::mem::transmute::<Ptr, DeleteQueriesExt>(get(
+                "glDeleteQueriesEXT",
+            )?),
+            begin_query: std::mem::transmute::<Ptr, BeginQueryExt>(get("glBeginQueryEXT")?),
+            end_query: std::mem::transmute::<Ptr, EndQueryExt>(get("glEndQueryEXT")?),
+            get_query_object_ui64v: std::mem::transmute::<Ptr, GetQueryObjectUi64vExt>(get(
+                "glGetQueryObjectui64vEXT",
+            )?),
+        })
+    }
 }

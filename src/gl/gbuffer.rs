@@ -191,6 +191,15 @@ impl GBuffer {
         dev.clear_color_only([0.0; 4]);
     }
 
+    /// Binds the geometry pass's depth texture to `unit`, for the composite pass to write into
+    /// the target's own depth buffer (whatever its format) with `gl_FragDepth`.
+    pub fn bind_depth_texture(&self, dev: &Device, unit: u32) {
+        unsafe {
+            dev.gl.active_texture(glow::TEXTURE0 + unit);
+            dev.gl.bind_texture(glow::TEXTURE_2D, Some(self.depth));
+        }
+    }
+
     /// Binds albedo, normal+depth, specular and accumulation to units `first..first + 4`.
     pub fn bind_textures(&self, dev: &Device, first: u32) {
         for (i, t) in self.color.iter().enumerate() {
@@ -220,18 +229,5 @@ impl Drop for GBuffer {
         if !self.destroyed {
             log::warn!("GBuffer dropped without destroy(): GL objects leaked");
         }
-    }
-}
-
-impl GBuffer {
-    /// Copies the geometry pass's depth into `target` (same size; DEPTH24 on both sides), so
-    /// forward-rendered transparent objects are hidden behind opaque ones.
-    pub fn blit_depth_to(
-        &self,
-        dev: &Device,
-        target: Option<glow::Framebuffer>,
-    ) -> Result<(), GlError> {
-        dev.blit(self.geometry_fbo, target, self.size, glow::DEPTH_BUFFER_BIT);
-        dev.check("G-buffer depth blit")
     }
 }

@@ -1,6 +1,7 @@
 //! The only module that calls glow (and the only one allowed `unsafe`).
 //!
 //! * [`context`] — headless EGL contexts (khronos-egl, `libEGL.so.1` loaded at run time).
+//! * [`gles_lib`] — which GLES implementation (the system's, or a folder's) the process loads.
 //! * [`caps`] — what the context can do, probed once.
 //! * [`device`] — a glow context plus its caps; frame-level calls (viewport, clear, finish).
 //! * [`shader_source`] — GLSL assembly from `glsl/` (GL-free, so it is validated offline too).
@@ -16,6 +17,7 @@ pub mod device;
 pub mod ext_fns;
 pub mod framebuffer;
 pub mod gbuffer;
+pub mod gles_lib;
 pub mod mesh;
 pub mod multisample;
 #[cfg(feature = "osmesa")]

@@ -28,6 +28,9 @@ pub enum DepthTest {
     LessEqual,
     /// `GEQUAL` (a light volume's far side behind or on a surface).
     GreaterEqual,
+    /// `ALWAYS`: every fragment passes and, with depth writes, sets the depth (GL writes depth
+    /// only while the test is enabled).
+    Always,
 }
 
 /// Face culling.
@@ -64,6 +67,13 @@ impl RenderState {
         blend: Blend::Off,
         cull: Cull::None,
         color_write: true,
+    };
+
+    /// A full-screen pass that also sets each pixel's depth from its shader (`gl_FragDepth`).
+    pub const FULL_SCREEN_WITH_DEPTH: RenderState = RenderState {
+        depth_test: DepthTest::Always,
+        depth_write: true,
+        ..Self::FULL_SCREEN
     };
 
     /// Depth prepass: depth test and write, no colour.
@@ -118,6 +128,10 @@ impl RenderState {
                 DepthTest::GreaterEqual => {
                     gl.enable(glow::DEPTH_TEST);
                     gl.depth_func(glow::GEQUAL);
+                }
+                DepthTest::Always => {
+                    gl.enable(glow::DEPTH_TEST);
+                    gl.depth_func(glow::ALWAYS);
                 }
             }
             gl.depth_mask(self.depth_write);

@@ -1,7 +1,14 @@
 //! GPU frame timing with `GL_EXT_disjoint_timer_query` (a `TIME_ELAPSED` query around the
-//! frame's GL work), where the context has it. Without the extension, or when the GPU reports a
-//! disjoint event (a clock change or a context switch invalidates the figure), there is no GPU
-//! time and callers fall back to wall time around `glFinish`.
+//! frame's GL work), where the context has it. The timer is optional: without the extension,
+//! when the GPU reports a disjoint event (a clock change or a context switch invalidates the
+//! figure), or when the driver refuses the query object or a query call, there is no GPU time
+//! (`gpu_ms` absent) and callers fall back to wall time around `glFinish`. A refusal is a
+//! warning, never a failed frame.
+//!
+//! The calls go through the extension's own `…EXT` entry points ([`super::ext_fns`]): on an
+//! ES 2.0 context the core names (`glGenQueries`, ES 3.0 only) exist in some libraries but are
+//! invalid there (ANGLE refuses to create the query), while the `EXT` names are valid on ES 2.0
+//! and 3.0 alike.
 //!
 //! A query is only as good as the driver's: llvmpipe reports the whole frame for plain forward
 //! but a few milliseconds for tiled and clustered frames that take 75 ms by the wall clock
@@ -9,53 +16,110 @@
 //! on llvmpipe the wall-clock `frame_ms` is the figure to quote.
 #![allow(unsafe_code)]
 
+use std::cell::Cell;
+
 use glow::HasContext;
 
-use super::{Device, GlError};
+use super::ext_fns::{timer_query_fns, TimerQueryFns};
+use super::Device;
 
 /// `GL_TIME_ELAPSED_EXT`.
 const TIME_ELAPSED: u32 = 0x88BF;
 /// `GL_GPU_DISJOINT_EXT`.
 const GPU_DISJOINT: u32 = 0x8FBB;
+/// `GL_QUERY_RESULT_EXT`.
+const QUERY_RESULT: u32 = 0x8866;
 
 /// One elapsed-time query, reused frame after frame.
 pub struct GpuTimer {
-    query: glow::Query,
+    fns: TimerQueryFns,
+    query: u32,
+    /// Set when the driver refused a query call: the timer then stays off (warned once).
+    failed: Cell<bool>,
 }
 
 impl GpuTimer {
-    /// A timer, or `None` when the context has no `GL_EXT_disjoint_timer_query`.
-    pub fn new(dev: &Device) -> Result<Option<GpuTimer>, GlError> {
+    /// A timer, or `None` when the context has no `GL_EXT_disjoint_timer_query` or cannot
+    /// make the query object (warned: the frame goes on untimed).
+    pub fn new(dev: &Device) -> Option<GpuTimer> {
         if !dev.caps().timer_query {
-            return Ok(None);
+            return None;
         }
-        let query = unsafe { dev.gl.create_query() }.map_err(GlError::Create)?;
-        Ok(Some(GpuTimer { query }))
+        let Some(fns) = timer_query_fns() else {
+            log::warn!("GL_EXT_disjoint_timer_query is listed but its entry points are missing: no GPU time (gpu_ms absent)");
+            return None;
+        };
+        let mut query = 0u32;
+        // SAFETY: the extension's signature, one name written into `query`.
+        unsafe { (fns.gen_queries)(1, &mut query) };
+        let error = drain_errors(dev);
+        if query == 0 || error != glow::NO_ERROR {
+            log::warn!(
+                "the driver could not create a timer query (GL error {error:#06x}): no GPU time (gpu_ms absent)"
+            );
+            if query != 0 {
+                unsafe { (fns.delete_queries)(1, &query) };
+            }
+            return None;
+        }
+        Some(GpuTimer {
+            fns,
+            query,
+            failed: Cell::new(false),
+        })
     }
 
     /// Starts timing (clears a pending disjoint flag first, so only this frame's counts).
     pub fn begin(&self, dev: &Device) {
+        if self.failed.get() {
+            return;
+        }
         unsafe {
             dev.gl.get_parameter_i32(GPU_DISJOINT);
-            dev.gl.begin_query(TIME_ELAPSED, self.query);
+            (self.fns.begin_query)(TIME_ELAPSED, self.query);
         }
+        self.check(dev, "glBeginQueryEXT");
     }
 
     /// Stops timing and waits for the result: GPU milliseconds, or `None` when the GPU
-    /// reported a disjoint event. Call after the frame's work is submitted (it waits).
+    /// reported a disjoint event or the driver refused the query. Call after the frame's work
+    /// is submitted (it waits).
     pub fn end(&self, dev: &Device) -> Option<f64> {
-        unsafe {
-            dev.gl.end_query(TIME_ELAPSED);
-            let ns = dev
-                .gl
-                .get_query_parameter_u64(self.query, glow::QUERY_RESULT);
-            let disjoint = dev.gl.get_parameter_i32(GPU_DISJOINT) != 0;
-            (!disjoint).then_some(ns as f64 * 1e-6)
+        if self.failed.get() {
+            return None;
         }
+        let mut ns = 0u64;
+        let disjoint = unsafe {
+            (self.fns.end_query)(TIME_ELAPSED);
+            (self.fns.get_query_object_ui64v)(self.query, QUERY_RESULT, &mut ns);
+            dev.gl.get_parameter_i32(GPU_DISJOINT) != 0
+        };
+        (self.check(dev, "the timer query's result") && !disjoint).then_some(ns as f64 * 1e-6)
+    }
+
+    /// False (and the timer off from now on, warned) when the last calls raised a GL error.
+    fn check(&self, dev: &Device, what: &str) -> bool {
+        let error = drain_errors(dev);
+        if error == glow::NO_ERROR {
+            return true;
+        }
+        log::warn!(
+            "the driver refused {what} (GL error {error:#06x}): GPU timing off (gpu_ms absent)"
+        );
+        self.failed.set(true);
+        false
     }
 
     /// Frees the query.
-    pub fn destroy(self, dev: &Device) {
-        unsafe { dev.gl.delete_query(self.query) };
+    pub fn destroy(self, _dev: &Device) {
+        unsafe { (self.fns.delete_queries)(1, &self.query) };
     }
+}
+
+/// The first pending GL error (or `NO_ERROR`), the queue drained, so an optional call's
+/// refusal is not reported as the frame's.
+fn drain_errors(dev: &Device) -> u32 {
+    let first = unsafe { dev.gl.get_error() };
+    while first != glow::NO_ERROR && unsafe { dev.gl.get_error() } != glow::NO_ERROR {}
+    first
 }

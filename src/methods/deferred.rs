@@ -203,7 +203,12 @@ impl Deferred {
         let dev = ctx.dev;
         dev.bind_framebuffer(target);
         dev.viewport(0, 0, ctx.viewport.0 as i32, ctx.viewport.1 as i32);
-        RenderState::FULL_SCREEN.apply(dev);
+        // The composite also gives the target the geometry pass's depth (for the transparent
+        // objects drawn after it, and for whatever the application draws next): written by the
+        // shader, so it works into a target of any depth format, where a depth blit needs both
+        // formats to match exactly (ES 3.0: GL_INVALID_OPERATION otherwise; SwiftShader's
+        // DEPTH_COMPONENT24 texture and renderbuffer differ, and a game's back buffer may too).
+        RenderState::FULL_SCREEN_WITH_DEPTH.apply(dev);
         let features = ctx.features;
         let key = ProgramKey {
             shader: "deferred_composite",
@@ -214,11 +219,11 @@ impl Deferred {
             .programs
             .get_or_build(dev, key, || features.defines(dev.es(), 1))?;
         program.bind(dev);
-        self.gbuffer
-            .as_ref()
-            .expect("allocated")
-            .bind_textures(dev, UNIT_METHOD);
+        let gbuffer = self.gbuffer.as_ref().expect("allocated");
+        gbuffer.bind_textures(dev, UNIT_METHOD);
+        gbuffer.bind_depth_texture(dev, UNIT_METHOD + 4);
         set_gbuffer_uniforms(program, dev, ctx.viewport);
+        program.set_i32(dev, "u_gDepth", UNIT_METHOD as i32 + 4);
         program.set_vec3(dev, "u_ambient", ctx.scene.ambient);
         program.set_f32(dev, "u_exposure", ctx.options.exposure_ev.exp2());
         program.set_f32(dev, "u_alpha", 1.0);
@@ -264,11 +269,7 @@ impl ShadingMethod for Deferred {
         };
         if !ctx.order.transparent.is_empty() && !ctx.features.counting() {
             // Forward fallback for what a G-buffer cannot hold: plain forward over the
-            // transparent objects only.
-            self.gbuffer
-                .as_ref()
-                .expect("allocated")
-                .blit_depth_to(dev, target)?;
+            // transparent objects only, tested against the depth the composite wrote.
             let mut sub = FrameContext {
                 programs: &mut *ctx.programs,
                 order: &mut *ctx.order,

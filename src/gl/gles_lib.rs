@@ -1,0 +1,181 @@
+//! Which OpenGL ES implementation the process renders with: the system's `libEGL.so.1` (Mesa
+//! on a Linux desktop or CI machine, the vendor's driver on a phone), or the `libEGL` and
+//! `libGLESv2` of a folder named by [`select`] or the `MANYLIGHT_GLES_LIB` environment variable
+//! (SwiftShader, ANGLE, a device's own driver; docs/drivers.md).
+//!
+//! The libraries are loaded once per process and stay loaded: EGL displays, contexts and the
+//! GL function pointers handed to glow all point into them. One process uses one
+//! implementation; `manylight matrix` compares several by running one child process each.
+#![allow(unsafe_code)]
+
+use std::path::{Path, PathBuf};
+use std::sync::{Mutex, OnceLock};
+
+use khronos_egl as egl;
+
+use super::GlError;
+
+/// The environment variable naming the folder of the GLES implementation to load.
+pub const GLES_LIB_ENV: &str = "MANYLIGHT_GLES_LIB";
+
+pub(crate) type Egl = egl::DynamicInstance<egl::EGL1_4>;
+
+/// The loaded implementation: its EGL entry points and, for a chosen folder, its GLES library.
+pub struct GlesLibrary {
+    egl: Egl,
+    /// The folder's `libGLESv2`, loaded before its `libEGL` (whose own dependency on
+    /// `libGLESv2.so` it satisfies) and searched for GL entry points EGL does not hand out.
+    gles: Option<libloading::Library>,
+    folder: Option<PathBuf>,
+}
+
+/// The folder chosen by [`select`] before the first load (it wins over the variable).
+static SELECTED: Mutex<Option<PathBuf>> = Mutex::new(None);
+static LOADED: OnceLock<Result<GlesLibrary, String>> = OnceLock::new();
+
+/// Chooses the folder holding `libEGL.so[.1]` and `libGLESv2.so[.2]` for this process, over
+/// `MANYLIGHT_GLES_LIB`. Must come before the first context; choosing another folder after
+/// that is an error (the first stays loaded).
+pub fn select(folder: &Path) -> Result<(), GlError> {
+    let folder = folder.to_path_buf();
+    if let Some(loaded) = LOADED.get() {
+        let current = loaded.as_ref().ok().and_then(|l| l.folder.clone());
+        if current.as_deref() != Some(folder.as_path()) {
+            return Err(GlError::EglLoad(format!(
+                "the GLES implementation is already loaded ({}); {} must be chosen before the first context",
+                current.map_or("the system's".into(), |f| f.display().to_string()),
+                folder.display()
+            )));
+        }
+        return Ok(());
+    }
+    *SELECTED.lock().unwrap_or_else(|e| e.into_inner()) = Some(folder);
+    Ok(())
+}
+
+/// The folder this process loads (or will load) its implementation from, if not the system's.
+pub fn chosen_folder() -> Option<PathBuf> {
+    if let Some(Ok(l)) = LOADED.get() {
+        return l.folder.clone();
+    }
+    SELECTED
+        .lock()
+        .unwrap_or_else(|e| e.into_inner())
+        .clone()
+        .or_else(|| {
+            std::env::var_os(GLES_LIB_ENV)
+                .filter(|v| !v.is_empty())
+                .map(PathBuf::from)
+        })
+}
+
+/// The process's implementation, loaded on first use.
+pub fn library() -> Result<&'static GlesLibrary, GlError> {
+    LOADED
+        .get_or_init(|| GlesLibrary::load(chosen_folder()))
+        .as_ref()
+        .map_err(|e| GlError::EglLoad(e.clone()))
+}
+
+/// The first of `names` that exists in `folder`.
+fn find_in(folder: &Path, names: &[&str]) -> Result<PathBuf, String> {
+    names
+        .iter()
+        .map(|n| folder.join(n))
+        .find(|p| p.is_file())
+        .ok_or_else(|| {
+            format!(
+                "{} (from --gles-lib or {GLES_LIB_ENV}) holds none of {}",
+                folder.display(),
+                names.join(", ")
+            )
+        })
+}
+
+impl GlesLibrary {
+    fn load(folder: Option<PathBuf>) -> Result<GlesLibrary, String> {
+        let Some(folder) = folder else {
+            let egl = unsafe { Egl::load_required_from_filename("libEGL.so.1") }
+                .or_else(|_| unsafe { Egl::load_required_from_filename("libEGL.so") })
+                .map_err(|e| e.to_string())?;
+            return Ok(GlesLibrary {
+                egl,
+                gles: None,
+                folder: None,
+            });
+        };
+        if !folder.is_dir() {
+            return Err(format!(
+                "{} (from --gles-lib or {GLES_LIB_ENV}) is not a folder",
+                folder.display()
+            ));
+        }
+        let gles_path = find_in(&folder, &["libGLESv2.so.2", "libGLESv2.so"])?;
+        let egl_path = find_in(&folder, &["libEGL.so.1", "libEGL.so"])?;
+        // SAFETY: loading a GLES implementation runs its initialisers; that is what the user
+        // asked for by naming the folder.
+        let gles = unsafe { libloading::Library::new(&gles_path) }
+            .map_err(|e| format!("cannot load {}: {e}", gles_path.display()))?;
+        let egl = unsafe { Egl::load_required_from_filename(&egl_path) }
+            .map_err(|e| format!("cannot load {}: {e}", egl_path.display()))?;
+        Ok(GlesLibrary {
+            egl,
+            gles: Some(gles),
+            folder: Some(folder),
+        })
+    }
+
+    pub(crate) fn egl(&self) -> &Egl {
+        &self.egl
+    }
+
+    /// The folder it came from (`None`: the system's libraries).
+    pub fn folder(&self) -> Option<&Path> {
+        self.folder.as_deref()
+    }
+
+    /// A GL or EGL entry point: `eglGetProcAddress`, else (EGL 1.4 need not hand out core
+    /// functions) the folder's `libGLESv2` itself. Null when neither has it.
+    pub fn proc_address(&self, name: &str) -> *const std::ffi::c_void {
+        if let Some(f) = self.egl.get_proc_address(name) {
+            return f as *const std::ffi::c_void;
+        }
+        let Some(gles) = &self.gles else {
+            return std::ptr::null();
+        };
+        let Ok(cname) = std::ffi::CString::new(name) else {
+            return std::ptr::null();
+        };
+        // SAFETY: the symbol is only turned into an address; callers give it the type the
+        // GL specification gives that name.
+        unsafe { gles.get::<*const std::ffi::c_void>(cname.as_bytes_with_nul()) }
+            .map_or(std::ptr::null(), |s| *s)
+    }
+}
+
+/// The EGL and GLES library files this process has mapped (from `/proc/self/maps`), for
+/// `manylight info`: which files the implementation really is, whichever way it was chosen.
+pub fn loaded_files() -> Vec<PathBuf> {
+    let Ok(maps) = std::fs::read_to_string("/proc/self/maps") else {
+        return Vec::new();
+    };
+    let mut files: Vec<PathBuf> = Vec::new();
+    for path in maps.lines().filter_map(|l| l.split_whitespace().nth(5)) {
+        let name = path.rsplit('/').next().unwrap_or("");
+        let gl_lib = [
+            "libEGL",
+            "libGLES",
+            "libGLX",
+            "libGLdispatch",
+            "libgallium",
+            "swrast",
+            "_dri.so",
+        ]
+        .iter()
+        .any(|p| name.contains(p));
+        if gl_lib && !files.iter().any(|f| f == Path::new(path)) {
+            files.push(PathBuf::from(path));
+        }
+    }
+    files
+}
