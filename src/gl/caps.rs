@@ -177,6 +177,28 @@ impl Caps {
         self.extensions.contains(name)
     }
 
+    /// The implementation's family, from `GL_RENDERER` and `GL_VERSION`: "SwiftShader",
+    /// "ANGLE", "Mesa llvmpipe", "Mesa softpipe", "Mesa", "NVIDIA", or else `GL_VENDOR`.
+    pub fn implementation(&self) -> String {
+        let (r, v) = (&self.renderer, &self.gl_version);
+        let name = if r.contains("SwiftShader") {
+            "SwiftShader"
+        } else if r.starts_with("ANGLE") || v.contains("ANGLE") {
+            "ANGLE"
+        } else if r.contains("llvmpipe") {
+            "Mesa llvmpipe"
+        } else if r.contains("softpipe") {
+            "Mesa softpipe"
+        } else if v.contains("Mesa") {
+            "Mesa"
+        } else if self.vendor.contains("NVIDIA") {
+            "NVIDIA"
+        } else {
+            return self.vendor.clone();
+        };
+        name.to_string()
+    }
+
     /// True when fragment shaders have highp floats.
     pub fn fragment_has_highp(&self) -> bool {
         self.fragment_highp.precision > 0

@@ -41,6 +41,11 @@ pub struct EglInfo {
     pub surfaceless_context: bool,
     /// ES version requested from EGL.
     pub requested: EsVersion,
+    /// The folder the implementation was loaded from (`--gles-lib`, `MANYLIGHT_GLES_LIB`);
+    /// `None`: the system's `libEGL.so.1`.
+    pub gles_lib: Option<std::path::PathBuf>,
+    /// The EGL/GLES library files the process has mapped: which files the implementation is.
+    pub files: Vec<std::path::PathBuf>,
 }
 
 fn egl_err(call: &'static str) -> impl Fn(egl::Error) -> GlError {
@@ -205,6 +210,8 @@ impl HeadlessContext {
             egl_vendor,
             surfaceless_context: surface.is_none(),
             requested: es,
+            gles_lib: gles_lib::chosen_folder(),
+            files: gles_lib::loaded_files(),
         };
         Ok((display, context, surface, info))
     }

@@ -85,6 +85,7 @@ pub fn run(args: &InfoArgs) -> Result<(), Box<dyn std::error::Error>> {
     if args.json {
         let value = serde_json::json!({
             "egl": ctx.info(),
+            "implementation": caps.implementation(),
             "caps": caps,
             "mediump_is_fp16": fp16,
             "scene": report,
@@ -139,6 +140,18 @@ fn format_text(
     w!(out, "GLSL               {}", caps.glsl_version);
     w!(out, "GL_RENDERER        {}", caps.renderer);
     w!(out, "GL_VENDOR          {}", caps.vendor);
+    w!(
+        out,
+        "implementation     {} ({})",
+        caps.implementation(),
+        egl.gles_lib.as_ref().map_or_else(
+            || "the system's libEGL.so.1".to_string(),
+            |d| format!("--gles-lib {}", d.display())
+        )
+    );
+    for f in &egl.files {
+        w!(out, "  {}", f.display());
+    }
     w!(
         out,
         "EGL                {} ({}, {} platform, {})",

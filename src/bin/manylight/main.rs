@@ -27,6 +27,12 @@ use manylight::EsVersion;
 struct Cli {
     #[command(subcommand)]
     command: Option<Command>,
+    /// Folder of the OpenGL ES implementation to render with (its libEGL.so[.1] and
+    /// libGLESv2.so[.2]: SwiftShader, ANGLE, a device's driver) instead of the system's; the
+    /// same as MANYLIGHT_GLES_LIB (docs/drivers.md). `matrix` takes it more than once, and
+    /// `system` for the system's libraries.
+    #[arg(long, global = true, value_name = "DIR")]
+    gles_lib: Vec<std::path::PathBuf>,
     /// With no subcommand, `render`'s options apply: `manylight --lights 64` renders.
     #[command(flatten)]
     render: render::RenderArgs,
@@ -98,6 +104,14 @@ fn check_usage(cli: &Cli) {
             )
             .exit();
     }
+    if cli.gles_lib.len() > 1 && !matches!(cli.command, Some(Command::Matrix(_))) {
+        Cli::command()
+            .error(
+                ErrorKind::ArgumentConflict,
+                "--gles-lib names one implementation here; only `matrix` compares several",
+            )
+            .exit();
+    }
     #[cfg(not(feature = "window"))]
     if let Some(Command::View { .. }) = cli.command {
         Cli::command()
@@ -116,13 +130,21 @@ fn main() -> ExitCode {
         .init();
     let cli = Cli::parse();
     check_usage(&cli);
+    if !matches!(cli.command, Some(Command::Matrix(_))) {
+        if let Some(dir) = cli.gles_lib.first() {
+            if let Err(e) = manylight::gl::gles_lib::select(dir) {
+                eprintln!("error: {e}");
+                return ExitCode::FAILURE;
+            }
+        }
+    }
     let result = match cli.command {
         None => render::run(&cli.render),
         Some(Command::Render(args)) => render::run(&args),
         Some(Command::Info(args)) => info::run(&args),
         Some(Command::Bench(args)) => bench::run(&args),
         Some(Command::BenchAssign(args)) => bench_assign::run(&args),
-        Some(Command::Matrix(args)) => matrix::run(&args),
+        Some(Command::Matrix(args)) => matrix::run(&args, &cli.gles_lib),
         Some(Command::MatrixCell(args)) => matrix::run_cell(&args),
         #[cfg(feature = "window")]
         Some(Command::View(args)) => view::run(&args),

@@ -5,6 +5,10 @@
 //! mediump, which llvmpipe runs in fp16). Each child renders every method and compares it
 //! with the reference (plain forward, light model at the best precision the configuration
 //! has) on the same configuration.
+//!
+//! With `--gles-lib DIR` (more than once; `system` for the system's libraries) each
+//! implementation gets a row group: ES 2.0, ES 2.0 without fragment highp (played) and ES 3.x
+//! on it; the Mesa restrictions, softpipe and OSMesa rows belong to the system's group.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -48,6 +52,8 @@ struct Config {
     args: &'static [&'static str],
     /// Image size instead of the matrix's (a slow driver renders a smaller image).
     size: Option<&'static str>,
+    /// A Mesa switch (environment override, second driver): only in the system's group.
+    mesa_only: bool,
 }
 
 const CONFIGS: &[Config] = &[
@@ -57,6 +63,7 @@ const CONFIGS: &[Config] = &[
         es: "2",
         env: &[],
         args: &[],
+        mesa_only: false,
         size: None,
     },
     Config {
@@ -65,6 +72,7 @@ const CONFIGS: &[Config] = &[
         es: "2",
         env: &[],
         args: &["--no-fragment-highp"],
+        mesa_only: false,
         size: None,
     },
     Config {
@@ -76,6 +84,7 @@ const CONFIGS: &[Config] = &[
             "-GL_OES_texture_float -GL_OES_texture_half_float",
         )],
         args: &[],
+        mesa_only: true,
         size: None,
     },
     Config {
@@ -84,6 +93,7 @@ const CONFIGS: &[Config] = &[
         es: "2",
         env: &[("MESA_GLES_VERSION_OVERRIDE", "2.0")],
         args: &[],
+        mesa_only: true,
         size: None,
     },
     Config {
@@ -92,6 +102,7 @@ const CONFIGS: &[Config] = &[
         es: "3",
         env: &[("MESA_GLES_VERSION_OVERRIDE", "3.0")],
         args: &[],
+        mesa_only: true,
         size: None,
     },
     Config {
@@ -100,6 +111,7 @@ const CONFIGS: &[Config] = &[
         es: "3",
         env: &[],
         args: &[],
+        mesa_only: false,
         size: None,
     },
     // A second Mesa rasterizer (mediump at fp32, no LLVM): slow, so a small image. Where it
@@ -110,53 +122,29 @@ const CONFIGS: &[Config] = &[
         es: "3",
         env: &[("GALLIUM_DRIVER", "softpipe")],
         args: &[],
+        mesa_only: true,
         size: Some("96x54"),
     },
 ];
 
-/// Runs the matrix: one child process per configuration.
-pub fn run(args: &MatrixArgs) -> Result<(), Box<dyn std::error::Error>> {
+/// Runs the matrix: one child process per configuration and implementation (`gles_libs`:
+/// folders, `system` for the system's libraries; none: the system's alone).
+pub fn run(args: &MatrixArgs, gles_libs: &[PathBuf]) -> Result<(), Box<dyn std::error::Error>> {
     let exe = std::env::current_exe()?;
     let out = args.out.clone().unwrap_or_else(std::env::temp_dir);
     std::fs::create_dir_all(&out).map_err(|e| format!("cannot create {}: {e}", out.display()))?;
     let size = format!("{}x{}", args.size.0, args.size.1);
+    let system = [PathBuf::from("system")];
+    let groups = if gles_libs.is_empty() {
+        &system[..]
+    } else {
+        gles_libs
+    };
     let mut rows = Vec::new();
-    for config in CONFIGS {
-        let mut cmd = Command::new(&exe);
-        cmd.args([
-            "matrix-cell",
-            "--es",
-            config.es,
-            "--scene",
-            &args.scene,
-            "--size",
-            config.size.unwrap_or(&size),
-        ])
-        .args(["--lights", &args.lights.to_string(), "--tag", config.slug])
-        .args(config.args)
-        .arg("--out")
-        .arg(&out);
-        for (k, v) in config.env {
-            cmd.env(k, v);
-        }
-        let output = cmd.output()?;
-        let mut row = match serde_json::from_slice::<Value>(&output.stdout) {
-            Ok(v) if output.status.success() => v,
-            _ => json!({
-                "error": String::from_utf8_lossy(&output.stderr).trim().replace("error: ", ""),
-                "methods": [],
-            }),
-        };
-        row["config"] = json!(config.name);
-        row["env"] = json!(config
-            .env
-            .iter()
-            .map(|(k, v)| format!("{k}={v}"))
-            .chain(config.args.iter().map(|a| a.to_string()))
-            .collect::<Vec<_>>());
-        rows.push(row);
+    for (g, lib) in groups.iter().enumerate() {
+        let lib = (lib != Path::new("system")).then_some(lib.as_path());
+        rows.extend(group_rows(&exe, args, &size, &out, lib, g)?);
     }
-    rows.push(osmesa_row(&exe, args, &size, &out)?);
     print!("{}", markdown(&rows));
     if let Some(path) = &args.json {
         std::fs::write(path, serde_json::to_string_pretty(&rows)? + "\n")
@@ -171,6 +159,71 @@ pub fn run(args: &MatrixArgs) -> Result<(), Box<dyn std::error::Error>> {
         eprintln!("contact sheet: {}", path.display());
     }
     Ok(())
+}
+
+/// The rows of one implementation (`lib`: its folder; `None`: the system's, with the Mesa
+/// restrictions and OSMesa). `group` numbers the implementation in file names.
+fn group_rows(
+    exe: &Path,
+    args: &MatrixArgs,
+    size: &str,
+    out: &Path,
+    lib: Option<&Path>,
+    group: usize,
+) -> Result<Vec<Value>, Box<dyn std::error::Error>> {
+    let label = lib.map_or_else(|| "system".to_string(), |d| d.display().to_string());
+    let mut rows = Vec::new();
+    for config in CONFIGS.iter().filter(|c| lib.is_none() || !c.mesa_only) {
+        let tag = if group == 0 {
+            config.slug.to_string()
+        } else {
+            format!("lib{group}-{}", config.slug)
+        };
+        let mut cmd = Command::new(exe);
+        cmd.args([
+            "matrix-cell",
+            "--es",
+            config.es,
+            "--scene",
+            &args.scene,
+            "--size",
+            config.size.unwrap_or(size),
+        ])
+        .args(["--lights", &args.lights.to_string(), "--tag", &tag])
+        .args(config.args)
+        .arg("--out")
+        .arg(out);
+        for (k, v) in config.env {
+            cmd.env(k, v);
+        }
+        match lib {
+            Some(dir) => cmd.env(manylight::gl::gles_lib::GLES_LIB_ENV, dir),
+            None => cmd.env_remove(manylight::gl::gles_lib::GLES_LIB_ENV),
+        };
+        let output = cmd.output()?;
+        let mut row = match serde_json::from_slice::<Value>(&output.stdout) {
+            Ok(v) if output.status.success() => v,
+            _ => json!({
+                "error": String::from_utf8_lossy(&output.stderr).trim().replace("error: ", ""),
+                "methods": [],
+            }),
+        };
+        row["config"] = json!(config.name);
+        row["gles_lib"] = json!(label);
+        row["env"] = json!(config
+            .env
+            .iter()
+            .map(|(k, v)| format!("{k}={v}"))
+            .chain(config.args.iter().map(|a| a.to_string()))
+            .collect::<Vec<_>>());
+        rows.push(row);
+    }
+    if lib.is_none() {
+        let mut row = osmesa_row(exe, args, size, out)?;
+        row["gles_lib"] = json!(label);
+        rows.push(row);
+    }
+    Ok(rows)
 }
 
 /// Desktop GL through OSMesa, when built with the `osmesa` feature.
@@ -214,9 +267,15 @@ fn osmesa_row(
 }
 
 fn markdown(rows: &[Value]) -> String {
-    let mut s = String::from("| configuration | context | method | support | max abs vs reference | pixels > 2/255 | frame ms |\n|---|---|---|---|---|---|---|\n");
+    let mut s = String::from("| implementation | configuration | context | method | support | max abs vs reference | pixels > 2/255 | frame ms |\n|---|---|---|---|---|---|---|---|\n");
     for row in rows {
-        let config = row["config"].as_str().unwrap_or("?");
+        let config = &format!(
+            "{} | {}",
+            row["implementation"]
+                .as_str()
+                .unwrap_or(row["gles_lib"].as_str().unwrap_or("?")),
+            row["config"].as_str().unwrap_or("?")
+        );
         if let Some(err) = row["error"].as_str() {
             s += &format!("| {config} | — | — | unavailable: {err} | | | |\n");
             continue;
@@ -255,7 +314,13 @@ fn markdown(rows: &[Value]) -> String {
 fn sheet(rows: &[Value], out: &Path) -> image::RgbaImage {
     let mut cells = Vec::new();
     for row in rows {
-        let config = row["config"].as_str().unwrap_or("?").to_string();
+        let config = format!(
+            "{}: {}",
+            row["implementation"]
+                .as_str()
+                .unwrap_or(row["gles_lib"].as_str().unwrap_or("?")),
+            row["config"].as_str().unwrap_or("?")
+        );
         if row["error"].is_string() {
             cells.push((vec![config, "unavailable".to_string()], None));
             continue;
@@ -381,6 +446,7 @@ pub fn run_cell(args: &MatrixCellArgs) -> Result<(), Box<dyn std::error::Error>>
         "es": caps.es,
         "gl_version": caps.gl_version,
         "renderer": caps.renderer,
+        "implementation": caps.implementation(),
         "float_textures": caps.float_textures,
         "fragment_highp": caps.fragment_has_highp(),
         "max_samples": caps.max_samples,
