@@ -1,8 +1,11 @@
-//! Build script: only decides whether the tests that need the real third-party scenes run.
+//! Build script: only decides whether the tests that need files from outside the repository
+//! run: the real third-party scenes (`MANYLIGHT_ASSETS`, `cfg(manylight_assets)`) and the
+//! other GLES implementations (`MANYLIGHT_GLES_DIR` from `scripts/fetch-gles`,
+//! `cfg(manylight_gles)`).
 //!
-//! With `MANYLIGHT_ASSETS` set at build time, `cfg(manylight_assets)` is on and those tests
-//! run; without it they are compiled as `#[ignore]`d with the reason, so `cargo test` lists
-//! them as ignored instead of passing them silently.
+//! With the variable set at build time the cfg is on and those tests run; without it they are
+//! compiled as `#[ignore]`d with the reason, so `cargo test` lists them as ignored instead of
+//! passing them silently.
 
 fn main() {
     println!("cargo::rustc-check-cfg=cfg(manylight_assets)");
@@ -10,5 +13,10 @@ fn main() {
     println!("cargo::rerun-if-env-changed=MANYLIGHT_ASSETS");
     if std::env::var_os("MANYLIGHT_ASSETS").is_some_and(|v| !v.is_empty()) {
         println!("cargo::rustc-cfg=manylight_assets");
+    }
+    println!("cargo::rustc-check-cfg=cfg(manylight_gles)");
+    println!("cargo::rerun-if-env-changed=MANYLIGHT_GLES_DIR");
+    if std::env::var_os("MANYLIGHT_GLES_DIR").is_some_and(|v| !v.is_empty()) {
+        println!("cargo::rustc-cfg=manylight_gles");
     }
 }

@@ -22,7 +22,7 @@ fn matrix_covers_es2_es2_without_float_and_es3_and_every_supported_cell_matches_
         String::from_utf8_lossy(&out.stderr)
     );
     assert!(
-        stdout.starts_with("| configuration |"),
+        stdout.starts_with("| implementation | configuration |"),
         "a Markdown table on stdout: {stdout}"
     );
     let rows: serde_json::Value =

@@ -1,0 +1,224 @@
+//! Every method against plain forward on the other GLES implementations a phone or browser
+//! ships (docs/drivers.md): SwiftShader and ANGLE, fetched by `scripts/fetch-gles` into the
+//! folder `MANYLIGHT_GLES_DIR` names. Each case runs `manylight matrix-cell` in a child
+//! process with `MANYLIGHT_GLES_LIB` pointing at one implementation (one implementation per
+//! process), ANGLE under `xvfb-run` (it needs an X display). Without the variable at build
+//! time these tests are listed as ignored with the command that fetches the libraries.
+#![cfg_attr(not(manylight_gles), allow(dead_code, unused_imports))]
+
+use std::path::PathBuf;
+use std::process::Command;
+
+use serde_json::Value;
+
+const BIN: &str = env!("CARGO_BIN_EXE_manylight");
+
+/// Defects still open on an implementation (issue 27): (implementation folder, ES version,
+/// method). SwiftShader's ES 2.0 path loses lights at the second pixel of 2×2 quads that
+/// straddle a cell boundary (docs/drivers.md); these cells are reported, not asserted.
+const KNOWN_DEFECTS: &[(&str, &str, &str)] = &[
+    ("swiftshader", "2", "tiled"),
+    ("swiftshader", "2", "clustered"),
+    ("swiftshader", "2", "auto"),
+];
+
+fn gles_dir() -> PathBuf {
+    let dir = std::env::var_os("MANYLIGHT_GLES_DIR")
+        .map(PathBuf::from)
+        .expect("MANYLIGHT_GLES_DIR was set when the tests were built but is not set now");
+    assert!(
+        dir.join("swiftshader").is_dir() && dir.join("angle").is_dir(),
+        "MANYLIGHT_GLES_DIR names {}, which lacks swiftshader/ or angle/ (scripts/fetch-gles makes them)",
+        dir.display()
+    );
+    dir
+}
+
+/// One matrix cell on implementation `name` (a folder of `MANYLIGHT_GLES_DIR`).
+fn cell(name: &str, es: &str, scene: &str, extra: &[&str]) -> Value {
+    let out = tempfile::tempdir().expect("temp dir");
+    let mut cmd = if name == "angle" {
+        let mut c = Command::new("xvfb-run");
+        c.args(["-a", BIN]);
+        c
+    } else {
+        Command::new(BIN)
+    };
+    cmd.env("MANYLIGHT_GLES_LIB", gles_dir().join(name))
+        .args([
+            "matrix-cell",
+            "--es",
+            es,
+            "--scene",
+            scene,
+            "--size",
+            "160x90",
+        ])
+        .args(["--lights", "256", "--tag", "t", "--out"])
+        .arg(out.path())
+        .args(extra);
+    let output = cmd.output().expect("run manylight matrix-cell");
+    assert!(
+        output.status.success(),
+        "{name} ES {es} {scene}: {}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let text = String::from_utf8_lossy(&output.stdout);
+    let line = text.lines().last().unwrap_or_default();
+    serde_json::from_str(line).unwrap_or_else(|e| panic!("{name}: not a JSON row ({e}): {text}"))
+}
+
+/// Every method the implementation supports within 2/255 of forward on at most 0.1 % of the
+/// pixels, on an opaque and a transparent scene, ES 2.0 and 3.0; and the row really came from
+/// that implementation.
+fn methods_equal_forward(name: &str, family: &str) {
+    let mut known = Vec::new();
+    for es in ["2", "3"] {
+        for scene in ["courtyard", "bubbles"] {
+            let row = cell(name, es, scene, &[]);
+            assert_eq!(row["implementation"], family, "{name}: {row}");
+            let mut rendered = 0;
+            for m in row["methods"].as_array().expect("methods") {
+                let method = m["name"].as_str().unwrap();
+                if m["support"]["status"] == "unsupported" {
+                    continue;
+                }
+                rendered += 1;
+                let (max_abs, over) = (
+                    m["max_abs"].as_f64().unwrap(),
+                    m["over_2"].as_f64().unwrap(),
+                );
+                let ok = max_abs <= 2.0 || over <= 0.001;
+                if KNOWN_DEFECTS.contains(&(name, es, method)) {
+                    known.push(format!(
+                        "ES {es} {scene} {method}: max {max_abs}, {:.2} % over 2/255",
+                        over * 100.0
+                    ));
+                    continue;
+                }
+                assert!(ok, "{name} ES {es} {scene} {method}: max {max_abs}/255, {:.3} % of pixels over 2/255", over * 100.0);
+            }
+            assert!(
+                rendered >= 4,
+                "{name} ES {es}: only {rendered} methods rendered: {row}"
+            );
+        }
+    }
+    if !known.is_empty() {
+        eprintln!(
+            "{name}: known open defects (not asserted): {}",
+            known.join("; ")
+        );
+    }
+}
+
+#[test]
+#[cfg_attr(
+    not(manylight_gles),
+    ignore = "needs SwiftShader and ANGLE: scripts/fetch-gles, then set MANYLIGHT_GLES_DIR"
+)]
+fn every_method_equals_forward_on_swiftshader() {
+    methods_equal_forward("swiftshader", "SwiftShader");
+}
+
+#[test]
+#[cfg_attr(
+    not(manylight_gles),
+    ignore = "needs SwiftShader and ANGLE: scripts/fetch-gles, then set MANYLIGHT_GLES_DIR"
+)]
+fn every_method_equals_forward_on_angle() {
+    methods_equal_forward("angle", "ANGLE");
+}
+
+/// `info` names the implementation and the files it loaded from the folder given.
+#[test]
+#[cfg_attr(
+    not(manylight_gles),
+    ignore = "needs SwiftShader and ANGLE: scripts/fetch-gles, then set MANYLIGHT_GLES_DIR"
+)]
+fn info_names_the_chosen_implementation_and_its_files() {
+    let dir = gles_dir().join("swiftshader");
+    let out = Command::new(BIN)
+        .args(["info", "--es", "3", "--gles-lib"])
+        .arg(&dir)
+        .env_remove("MANYLIGHT_GLES_LIB")
+        .output()
+        .expect("run manylight info");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("implementation     SwiftShader (--gles-lib"),
+        "{text}"
+    );
+    assert!(
+        text.contains(&format!("{}/libGLESv2.so", dir.display())),
+        "{text}"
+    );
+}
+
+/// `matrix --gles-lib system --gles-lib DIR` adds a row group for the folder's implementation
+/// (the implementation-neutral configurations), after the system's.
+#[test]
+#[cfg_attr(
+    not(manylight_gles),
+    ignore = "needs SwiftShader and ANGLE: scripts/fetch-gles, then set MANYLIGHT_GLES_DIR"
+)]
+fn matrix_adds_a_row_group_per_implementation() {
+    let dir = tempfile::tempdir().unwrap();
+    let json = dir.path().join("m.json");
+    let swiftshader = gles_dir().join("swiftshader");
+    let out = Command::new(BIN)
+        .args([
+            "matrix",
+            "--size",
+            "64x36",
+            "--lights",
+            "64",
+            "--gles-lib",
+            "system",
+        ])
+        .arg("--gles-lib")
+        .arg(&swiftshader)
+        .arg("--json")
+        .arg(&json)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let rows: Vec<Value> = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let group: Vec<&Value> = rows
+        .iter()
+        .filter(|r| r["gles_lib"] == swiftshader.display().to_string())
+        .collect();
+    let configs: Vec<&str> = group
+        .iter()
+        .map(|r| r["config"].as_str().unwrap())
+        .collect();
+    assert_eq!(
+        configs,
+        [
+            "ES 2.0",
+            "ES 2.0 without fragment highp (played)",
+            "ES 3.x as the driver gives it"
+        ]
+    );
+    assert!(
+        group.iter().all(|r| r["implementation"] == "SwiftShader"),
+        "{group:?}"
+    );
+    assert!(rows
+        .iter()
+        .any(|r| r["gles_lib"] == "system" && r["config"] == "desktop GL (OSMesa)"));
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        stdout.contains("| SwiftShader | ES 3.x as the driver gives it |"),
+        "{stdout}"
+    );
+}
