@@ -7,6 +7,10 @@
 #include "cluster_lookup.glsl"
 
 VARYING HIGHP vec3 v_viewPos;
+#if UNIFORM_LIGHT_LOOP
+// The longest cell list of the frame (the loop bound of the driver workaround).
+uniform HIGHP float u_longestList;
+#endif
 VARYING vec3 v_normal;
 VARYING vec2 v_uv;
 
@@ -27,6 +31,20 @@ void main() {
     HIGHP vec3 color = u_ambient * albedo;
 #if GLSL_ES == 100
     HIGHP vec2 cell = clusterCell(fragXY, viewDepth);
+#if UNIFORM_LIGHT_LOOP
+    // Driver workaround (Caps::needs_uniform_light_loop): every fragment runs to the frame's
+    // longest list and keeps only its own lights, so no fragment of a quad leaves early. Past
+    // its list a fragment reads its last entry again (or any, for an empty cell) and the select
+    // drops the result, NaN included.
+    for (int n = 0; n < CELL_CAP; n++) {
+        if (float(n) >= u_longestList) {
+            break;
+        }
+        HIGHP float pos = cell.x + min(float(n), max(cell.y - 1.0, 0.0));
+        vec3 c = shadeLight(fetchLight(lightIndexAt(pos)), v_viewPos, N, V, albedo, u_specular, u_shininess);
+        color += float(n) < cell.y ? c : vec3(0.0);
+    }
+#else
     // Appendix A: constant bound (the per-cell cap), exit with break.
     for (int n = 0; n < CELL_CAP; n++) {
         if (float(n) >= cell.y) {
@@ -34,6 +52,7 @@ void main() {
         }
         color += shadeLight(fetchLight(lightIndexAt(cell.x + float(n))), v_viewPos, N, V, albedo, u_specular, u_shininess);
     }
+#endif
 #else
     uvec2 cell = clusterCell(fragXY, viewDepth);
     for (uint n = 0u; n < cell.y; n++) {

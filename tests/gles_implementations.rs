@@ -13,15 +13,6 @@ use serde_json::Value;
 
 const BIN: &str = env!("CARGO_BIN_EXE_manylight");
 
-/// Defects still open on an implementation (issue 27): (implementation folder, ES version,
-/// method). SwiftShader's ES 2.0 path loses lights at the second pixel of 2×2 quads that
-/// straddle a cell boundary (docs/drivers.md); these cells are reported, not asserted.
-const KNOWN_DEFECTS: &[(&str, &str, &str)] = &[
-    ("swiftshader", "2", "tiled"),
-    ("swiftshader", "2", "clustered"),
-    ("swiftshader", "2", "auto"),
-];
-
 fn gles_dir() -> PathBuf {
     let dir = std::env::var_os("MANYLIGHT_GLES_DIR")
         .map(PathBuf::from)
@@ -72,7 +63,6 @@ fn cell(name: &str, es: &str, scene: &str, extra: &[&str]) -> Value {
 /// pixels, on an opaque and a transparent scene, ES 2.0 and 3.0; and the row really came from
 /// that implementation.
 fn methods_equal_forward(name: &str, family: &str) {
-    let mut known = Vec::new();
     for es in ["2", "3"] {
         for scene in ["courtyard", "bubbles"] {
             let row = cell(name, es, scene, &[]);
@@ -88,27 +78,13 @@ fn methods_equal_forward(name: &str, family: &str) {
                     m["max_abs"].as_f64().unwrap(),
                     m["over_2"].as_f64().unwrap(),
                 );
-                let ok = max_abs <= 2.0 || over <= 0.001;
-                if KNOWN_DEFECTS.contains(&(name, es, method)) {
-                    known.push(format!(
-                        "ES {es} {scene} {method}: max {max_abs}, {:.2} % over 2/255",
-                        over * 100.0
-                    ));
-                    continue;
-                }
-                assert!(ok, "{name} ES {es} {scene} {method}: max {max_abs}/255, {:.3} % of pixels over 2/255", over * 100.0);
+                assert!(max_abs <= 2.0 || over <= 0.001, "{name} ES {es} {scene} {method}: max {max_abs}/255, {:.3} % of pixels over 2/255", over * 100.0);
             }
             assert!(
                 rendered >= 4,
                 "{name} ES {es}: only {rendered} methods rendered: {row}"
             );
         }
-    }
-    if !known.is_empty() {
-        eprintln!(
-            "{name}: known open defects (not asserted): {}",
-            known.join("; ")
-        );
     }
 }
 

@@ -199,6 +199,15 @@ impl Caps {
         name.to_string()
     }
 
+    /// A driver workaround: SwiftShader 4's GLSL ES 1.00 path loses an active fragment's light
+    /// contributions when another fragment of its 2×2 quad has left the light loop (or skips
+    /// its body), which happens wherever a quad straddles a cell boundary: lights vanish in
+    /// one-pixel strokes along the grid. With every fragment of the draw running the same
+    /// iterations the images equal forward's (docs/drivers.md). Its ES 3.0 path is unaffected.
+    pub fn needs_uniform_light_loop(&self) -> bool {
+        self.es == EsVersion::Es2 && !self.desktop && self.renderer.contains("SwiftShader")
+    }
+
     /// True when fragment shaders have highp floats.
     pub fn fragment_has_highp(&self) -> bool {
         self.fragment_highp.precision > 0

@@ -360,6 +360,7 @@ impl ShadingMethod for CulledForward {
             },
         ];
         let cascades = grid.cascades.len() as f32;
+        let longest_list = assignment.stats.max_lights_per_cluster as f32;
         let ranges = [packed_lights.pos_range, packed_lights.radius_range];
         geometry::draw_objects(ctx, "clustered", RGBA8_CELL_CAP, &mut |program, dev| {
             set.lights.bind(dev, UNIT_METHOD);
@@ -374,6 +375,7 @@ impl ShadingMethod for CulledForward {
             program.set_vec2(dev, "u_viewport", [w as f32, h as f32]);
             program.set_vec3(dev, "u_depthMap", glam::Vec3::from(depth_map));
             program.set_f32(dev, "u_cascadeCount", cascades);
+            program.set_f32(dev, "u_longestList", longest_list);
         })?;
         Ok(MethodStats {
             upload_bytes,

@@ -45,9 +45,14 @@ impl ShaderFeatures {
     pub const TONEMAP_ACES: u64 = 1 << 13;
     /// Khronos PBR Neutral tone map before the encode.
     pub const TONEMAP_NEUTRAL: u64 = 1 << 14;
+    /// Driver workaround (see [`crate::gl::Caps::needs_uniform_light_loop`]): the cell's light
+    /// loop runs the same iterations in every fragment of a draw (to the frame's longest list),
+    /// selecting each fragment's own contributions, so no fragment leaves the loop before its
+    /// neighbours.
+    pub const UNIFORM_LIGHT_LOOP: u64 = 1 << 15;
 
     /// Every flag with its name.
-    pub const NAMED: [(u64, &'static str); 15] = [
+    pub const NAMED: [(u64, &'static str); 16] = [
         (Self::TEXTURE, "texture"),
         (Self::SPOT, "spot"),
         (Self::SPECULAR, "specular"),
@@ -63,6 +68,7 @@ impl ShaderFeatures {
         (Self::TONEMAP_REINHARD, "tonemap_reinhard"),
         (Self::TONEMAP_ACES, "tonemap_aces"),
         (Self::TONEMAP_NEUTRAL, "tonemap_neutral"),
+        (Self::UNIFORM_LIGHT_LOOP, "uniform_light_loop"),
     ];
 
     /// Names of the set flags.
@@ -113,6 +119,7 @@ impl ShaderFeatures {
             ("COUNT_EVALS".into(), flag(Self::COUNT_EVALS)),
             ("COUNT_REACHING".into(), flag(Self::COUNT_REACHING)),
             ("COUNT_HEATMAP".into(), flag(Self::COUNT_HEATMAP)),
+            ("UNIFORM_LIGHT_LOOP".into(), flag(Self::UNIFORM_LIGHT_LOOP)),
             (
                 "TONEMAP".into(),
                 if self.has(Self::TONEMAP_REINHARD) {

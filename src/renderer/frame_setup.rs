@@ -82,6 +82,10 @@ pub(super) fn shader_features(
             ShaderFeatures::LIGHTS_RGBA8,
             options.force_rgba8_lights || !caps.float_textures,
         )
+        .with(
+            ShaderFeatures::UNIFORM_LIGHT_LOOP,
+            caps.needs_uniform_light_loop(),
+        )
 }
 
 /// Farthest view depth of the scene's geometry, clipped to `[near, far]` (never below a little
