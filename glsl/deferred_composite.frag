@@ -8,7 +8,7 @@ uniform HIGHP sampler2D u_gDepth;
 
 void main() {
     ivec2 px = ivec2(gl_FragCoord.xy);
-    if (texelFetch(u_gNormalDepth, px, 0).w <= 0.0) {
+    if (texelFetch(u_gNormalDepth, px, 0).z <= 0.0) {
         discard;
     }
     gl_FragDepth = texelFetch(u_gDepth, px, 0).r;

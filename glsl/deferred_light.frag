@@ -15,14 +15,15 @@ uniform vec4 u_light2;
 void main() {
     ivec2 px = ivec2(gl_FragCoord.xy);
     HIGHP vec4 nd = texelFetch(u_gNormalDepth, px, 0);
-    if (nd.w <= 0.0) {
+    if (nd.z <= 0.0) {
         discard;
     }
 #if COUNT_EVALS
     // One evaluation of this light here, summed by the additive blend.
     FRAG_COLOR = vec4(1.0);
 #else
-    HIGHP vec3 P = viewPosition(gl_FragCoord.xy, nd.w);
+    HIGHP vec4 albedoOffset = texelFetch(u_gAlbedo, px, 0);
+    HIGHP vec3 P = viewPosition(gl_FragCoord.xy + vec2(nd.w, albedoOffset.a), nd.z);
     vec4 spec = texelFetch(u_gSpecular, px, 0);
     Light light;
     light.position = u_light0.xyz;
@@ -33,7 +34,7 @@ void main() {
     light.direction = u_light2.xyz;
     light.spotOffset = u_light2.w;
 #endif
-    MEDP vec3 albedo = texelFetch(u_gAlbedo, px, 0).rgb;
-    FRAG_COLOR = vec4(shadeLight(light, P, nd.xyz, viewDirection(P), albedo, spec.rgb, spec.a), 1.0);
+    MEDP vec3 albedo = albedoOffset.rgb;
+    FRAG_COLOR = vec4(shadeLight(light, P, octDecode(nd.xy), viewDirection(P), albedo, spec.rgb, spec.a), 1.0);
 #endif
 }

@@ -1,6 +1,7 @@
 // Deferred, pass 1 (ES 3.0 multiple render targets): the surface attributes the light pass
 // needs. Layout and bytes per pixel are documented in src/methods/deferred.rs.
 #include "surface.glsl"
+#include "deferred_common.glsl"
 
 VARYING HIGHP vec3 v_viewPos;
 VARYING vec3 v_normal;
@@ -17,9 +18,12 @@ void main() {
     if (dot(N, V) < 0.0) {
         N = -N;
     }
-    o_albedo = vec4(surfaceAlbedo(v_uv), 1.0);
+    // The surface point as its depth and its window offset from the pixel centre (see
+    // windowPosition): the light pass shades the very point forward shades.
+    HIGHP vec2 offset = windowPosition(v_viewPos) - gl_FragCoord.xy;
+    o_albedo = vec4(surfaceAlbedo(v_uv), offset.y);
     // View depth > 0 marks a covered pixel (the buffer is cleared to 0).
-    o_normalDepth = vec4(N, -v_viewPos.z);
+    o_normalDepth = vec4(octEncode(N), -v_viewPos.z, offset.x);
 #if HAS_SPECULAR
     o_specular = vec4(u_specular, u_shininess);
 #else

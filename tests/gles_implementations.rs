@@ -59,9 +59,9 @@ fn cell(name: &str, es: &str, scene: &str, extra: &[&str]) -> Value {
     serde_json::from_str(line).unwrap_or_else(|e| panic!("{name}: not a JSON row ({e}): {text}"))
 }
 
-/// Every method the implementation supports within 2/255 of forward on at most 0.1 % of the
-/// pixels, on an opaque and a transparent scene, ES 2.0 and 3.0; and the row really came from
-/// that implementation.
+/// Every method the implementation supports within 2/255 of forward at every pixel (the bar the
+/// Mesa suites hold them to; the floor is 0.1 % of pixels over it), on an opaque and a
+/// transparent scene, ES 2.0 and 3.0; and the row really came from that implementation.
 fn methods_equal_forward(name: &str, family: &str) {
     for es in ["2", "3"] {
         for scene in ["courtyard", "bubbles"] {
@@ -78,7 +78,11 @@ fn methods_equal_forward(name: &str, family: &str) {
                     m["max_abs"].as_f64().unwrap(),
                     m["over_2"].as_f64().unwrap(),
                 );
-                assert!(max_abs <= 2.0 || over <= 0.001, "{name} ES {es} {scene} {method}: max {max_abs}/255, {:.3} % of pixels over 2/255", over * 100.0);
+                assert!(
+                    max_abs <= 2.0,
+                    "{name} ES {es} {scene} {method}: max {max_abs}/255, {:.3} % of pixels over 2/255",
+                    over * 100.0
+                );
             }
             assert!(
                 rendered >= 4,

@@ -70,8 +70,8 @@ fn validate(conf: Option<&Path>, file: &Path) -> Result<(), String> {
 }
 
 /// Every combination of feature bits a colour variant can have, the count variants
-/// (evaluations, reaching lights, heatmap) with and without spots and RGBA8 light data, and the
-/// tone-mapped variants.
+/// (evaluations, reaching lights, heatmap) with and without spots and RGBA8 light data, the
+/// tone-mapped variants and the uniform-light-loop workaround.
 fn all_features() -> Vec<ShaderFeatures> {
     let mut all = colour_features();
     for count in [
@@ -104,6 +104,16 @@ fn all_features() -> Vec<ShaderFeatures> {
         ] {
             all.push(ShaderFeatures(curve | extra));
         }
+    }
+    // The driver workaround's light loop (SwiftShader, ES 2.0), with the material and light
+    // features and counting.
+    for extra in [
+        0,
+        ShaderFeatures::TEXTURE | ShaderFeatures::SPOT | ShaderFeatures::SPECULAR,
+        ShaderFeatures::LIGHTS_RGBA8 | ShaderFeatures::SPOT,
+        ShaderFeatures::COUNT_EVALS,
+    ] {
+        all.push(ShaderFeatures(ShaderFeatures::UNIFORM_LIGHT_LOOP | extra));
     }
     all
 }

@@ -2,8 +2,10 @@
 //!
 //! ```text
 //! attachment        format     bytes  contents
-//! colour 0 albedo   RGBA16F      8    linear albedo (Kd × decoded texture)
-//! colour 1 normal   RGBA32F     16    view-space normal (two-sided, facing the eye), view depth
+//! colour 0 albedo   RGBA16F      8    linear albedo (Kd × decoded texture); a: the surface
+//!                                     point's window y offset from the pixel centre
+//! colour 1 normal   RGBA32F     16    view-space normal (two-sided, facing the eye) in
+//!                                     octahedral form (xy), view depth (z), window x offset
 //! colour 2 specular RGBA16F      8    Ks, Blinn-Phong exponent
 //! depth             DEPTH24      4    for the geometry pass's depth test
 //! accumulation      RGBA32F     16    Σ light radiance (additive blending; RGBA16F, 8 bytes,
@@ -16,7 +18,11 @@
 //! contributions summed in fp16 drift by several 8-bit steps (measured in the stability tests).
 //!
 //! Float formats everywhere so the G-buffer loses almost nothing against forward: the normal
-//! and depth are exact f32, albedo and specular keep 11 significant bits. Rendering to float
+//! and depth are exact f32, albedo and specular keep 11 significant bits. The surface point is
+//! the one forward shades (its interpolated position, kept as depth and window offset), not the
+//! point on the pixel centre's ray: an implementation that snaps vertices to 1/16 pixel
+//! (SwiftShader) puts them up to a few hundredths of a pixel apart, enough to change a pixel
+//! near a light by 11/255. Rendering to float
 //! textures needs `GL_EXT_color_buffer_float`.
 #![allow(unsafe_code)]
 

@@ -9,11 +9,13 @@
 //!    and adds the light's contribution to a float accumulation buffer. The light model is the
 //!    same GLSL chunk as every other method's.
 //! 3. **Composite** — ambient plus the accumulated light, encoded like the forward methods.
-//! 4. **Transparent objects** — documented forward fallback: the G-buffer's depth is copied into
-//!    the target and transparent objects are drawn back to front with plain forward shading.
+//! 4. **Transparent objects** — documented forward fallback: the composite wrote the G-buffer's
+//!    depth into the target, and transparent objects are drawn back to front with plain
+//!    forward shading.
 //!
 //! The G-buffer keeps float normals, depth and 11-bit albedo/specular, so deferred matches plain
-//! forward within 2/255 (tested); its cost is memory and bandwidth: 44 bytes per pixel.
+//! forward within 2/255 (tested); its cost is memory and bandwidth: 44 or 52 bytes per pixel
+//! (`gl::gbuffer`).
 
 use glam::Vec3;
 
@@ -106,9 +108,16 @@ impl Deferred {
             color_write: true,
         }
         .apply(ctx.dev);
+        // The pass stores each surface point as its depth and window offset (gbuffer.frag),
+        // through the same mapping the light pass reads it back with.
+        let (half, _) = half_extent(ctx);
+        let viewport = [ctx.viewport.0 as f32, ctx.viewport.1 as f32];
         for k in 0..ctx.order.opaque.len() {
             let i = ctx.order.opaque[k];
-            shade_object(ctx, i, "gbuffer", 1, &mut |_, _| {})?;
+            shade_object(ctx, i, "gbuffer", 1, &mut |program, dev| {
+                program.set_vec2(dev, "u_viewport", viewport);
+                program.set_vec2(dev, "u_halfExtent", half);
+            })?;
         }
         Ok(())
     }
@@ -119,13 +128,7 @@ impl Deferred {
         gb.begin_accumulation(dev);
         gb.bind_textures(dev, UNIT_METHOD);
         let features = ctx.features.with(ShaderFeatures::SPECULAR, true);
-        let projection = GridProjection::from_matrix(&ctx.projection.as_dmat4());
-        let (half, ortho) = match projection {
-            GridProjection::Perspective { tan_x, tan_y } => ([tan_x as f32, tan_y as f32], false),
-            GridProjection::Orthographic { half_x, half_y } => {
-                ([half_x as f32, half_y as f32], true)
-            }
-        };
+        let (half, ortho) = half_extent(ctx);
         let far = ctx.far as f32;
         for light in ctx.lights.iter().filter(|l| l.cull_radius > 0.0) {
             // The proxy bounds the light's reach: its culling radius (the radius, or less
@@ -235,6 +238,15 @@ impl Deferred {
         );
         self.fullscreen.as_ref().expect("allocated").draw(dev);
         Ok(())
+    }
+}
+
+/// View-space half extents of the projection (per unit depth when perspective) and whether it
+/// is orthographic: how the G-buffer passes map window positions to view space.
+fn half_extent(ctx: &FrameContext) -> ([f32; 2], bool) {
+    match GridProjection::from_matrix(&ctx.projection.as_dmat4()) {
+        GridProjection::Perspective { tan_x, tan_y } => ([tan_x as f32, tan_y as f32], false),
+        GridProjection::Orthographic { half_x, half_y } => ([half_x as f32, half_y as f32], true),
     }
 }
 
