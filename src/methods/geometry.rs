@@ -15,7 +15,7 @@ pub const UNIT_ALBEDO: u32 = 0;
 pub const UNIT_METHOD: u32 = 1;
 
 fn set_transforms(program: &mut Program, dev: &Device, model_view: &DMat4, projection: &Mat4) {
-    let normal_matrix = DMat3::from_mat4(*model_view).inverse().transpose();
+    let normal_matrix = crate::scene::normal_matrix::normal_matrix(&DMat3::from_mat4(*model_view));
     program.set_mat4(dev, "u_modelView", &model_view.as_mat4());
     program.set_mat3(dev, "u_normalMatrix", &normal_matrix.as_mat3());
     program.set_mat4(dev, "u_projection", projection);

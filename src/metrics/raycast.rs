@@ -81,7 +81,8 @@ impl SceneRaycaster {
         let mut triangles = Vec::new();
         for (object, o) in scene.objects.iter().enumerate() {
             let mesh = &o.mesh;
-            let normal_matrix = DMat3::from_mat4(o.transform).inverse().transpose();
+            let normal_matrix =
+                crate::scene::normal_matrix::normal_matrix(&DMat3::from_mat4(o.transform));
             let pos: Vec<DVec3> = mesh
                 .positions
                 .iter()

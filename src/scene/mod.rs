@@ -17,6 +17,7 @@ pub mod material;
 pub mod mesh;
 pub mod meshbuild;
 pub mod motion;
+pub mod normal_matrix;
 pub mod obj;
 pub mod random;
 pub mod shading;
