@@ -60,14 +60,13 @@ Light fetchLight(int i) {
     vec4 t5 = LIGHT_TEXEL(i, 5);
     vec3 dir = vec3(unpack16(t3.xy), unpack16(t3.zw), unpack16(t4.xy)) * 2.0 - 1.0;
     light.direction = dir / max(length(dir), 1e-6);
-    float outerDeg = unpack16(t5.xy) * 180.0;
-    float innerDeg = unpack16(t5.zw) * 180.0;
-    // 1 − cos α as 2 sin²(α/2), as Light::spot_scale_offset computes it.
-    float sinOuter = sin(radians(outerDeg) * 0.5);
-    float sinInner = sin(radians(innerDeg) * 0.5);
+    // 1 − cos α as 2 sin²(α/2) from the stored sin(α/2), as spot_terms_from_half_sines does:
+    // arithmetic only (GLSL ES leaves sin's precision to the implementation).
+    float sinOuter = unpack16(t5.xy);
+    float sinInner = unpack16(t5.zw);
     float oneMinusCosOuter = 2.0 * sinOuter * sinOuter;
     float scale = 1.0 / max(oneMinusCosOuter - 2.0 * sinInner * sinInner, SPOT_MIN_COS_DELTA);
-    bool omni = innerDeg >= 180.0;
+    bool omni = t4.z > 0.5;
     light.spotScale = omni ? 0.0 : scale;
     light.spotOffset = omni ? 1.0 : oneMinusCosOuter * scale;
 #endif

@@ -20,18 +20,20 @@
 //!   t1: z.hi z.lo r.hi r.lo      radius 16-bit over [0, radius_range]
 //!   t2: R    G    B    E         shared-exponent radiance: c = m/255 · 2^(E−128)
 //!   t3: dx.hi dx.lo dy.hi dy.lo  axis 16-bit snorm
-//!   t4: dz.hi dz.lo  -    -
-//!   t5: outer.hi outer.lo inner.hi inner.lo   half-angles, 16-bit over [0°, 180°]
+//!   t4: dz.hi dz.lo  omni  -     omni: 255 for a point light, 0 for a spot
+//!   t5: so.hi so.lo si.hi si.lo  sin(α/2) of the outer and inner half-angles, 16-bit unorm
 //!   t6, t7: (unused padding)
 //! ```
 //!
 //! The spot terms are `t = clamp(spot_offset − spot_scale·(1 − cos), 0, 1)` (see
-//! [`crate::scene::Light::spot_scale_offset`]); the Rgba8 layout stores angles instead and the
-//! shader rebuilds scale and offset, because `scale` reaches 10⁴ for hard-edged cones.
+//! [`crate::scene::Light::spot_scale_offset`]); the Rgba8 layout stores the half-angles' sines
+//! instead and the shader rebuilds scale and offset with arithmetic alone (`scale` reaches 10⁴
+//! for hard-edged cones; rebuilding it from angles needed `sin`, whose precision GLSL ES leaves
+//! to the implementation: SwiftShader's moved hard cone edges by up to 55/255).
 
 use glam::{DMat4, Vec3};
 
-use crate::scene::light::spot_terms;
+use crate::scene::light::{half_sine, spot_terms_from_half_sines};
 use crate::scene::{Light, LightKind};
 
 /// Width in texels of every data texture (a power of two ≤ 1024: exact under mediump math).
@@ -231,8 +233,12 @@ pub fn pack_lights_into(lights: &[GpuLight], encoding: LightEncoding, packed: &m
                 {
                     rec[12 + k * 2..14 + k * 2].copy_from_slice(&w.to_be_bytes());
                 }
-                rec[20..22].copy_from_slice(&unorm16(l.cone_deg.0 / 180.0).to_be_bytes());
-                rec[22..24].copy_from_slice(&unorm16(l.cone_deg.1 / 180.0).to_be_bytes());
+                let omni = l.cone_deg.1 >= 180.0;
+                rec[18] = if omni { 255 } else { 0 };
+                for (k, deg) in [l.cone_deg.0, l.cone_deg.1].into_iter().enumerate() {
+                    let sine = half_sine(deg as f64) as f32;
+                    rec[20 + 2 * k..22 + 2 * k].copy_from_slice(&unorm16(sine).to_be_bytes());
+                }
             }
         }
     }
@@ -273,13 +279,17 @@ pub fn unpack_light(packed: &PackedLights, i: usize) -> GpuLight {
             let radiance =
                 Vec3::new(rec[8] as f32, rec[9] as f32, rec[10] as f32) / 255.0 * 2f32.powi(e);
             let dir = Vec3::new(snorm(12), snorm(14), snorm(16));
-            let outer = w(20) * 180.0;
-            let inner = w(22) * 180.0;
-            let (scale, offset) = if inner >= 180.0 {
-                (0.0, 1.0)
+            let (sine_outer, sine_inner) = (w(20), w(22));
+            let angle = |sine: f32| 2.0 * (sine as f64).asin().to_degrees() as f32;
+            let ((scale, offset), (outer, inner)) = if rec[18] == 255 {
+                ((0.0, 1.0), (180.0, 180.0))
             } else {
-                let (scale, offset) = spot_terms(outer as f64, inner as f64);
-                (scale as f32, offset as f32)
+                let (scale, offset) =
+                    spot_terms_from_half_sines(sine_outer as f64, sine_inner as f64);
+                (
+                    (scale as f32, offset as f32),
+                    (angle(sine_outer), angle(sine_inner)),
+                )
             };
             GpuLight {
                 position: Vec3::new(pos(0), pos(2), pos(4)),

@@ -184,11 +184,22 @@ impl Light {
 pub const SPOT_MIN_COS_DELTA: f64 = 1e-4;
 
 /// `(scale, offset)` of a cone of half-angles `outer_deg` ≥ `inner_deg` (see
-/// [`Light::spot_scale_offset`]); also what the RGBA8 light decoder rebuilds from angles.
+/// [`Light::spot_scale_offset`]).
 pub fn spot_terms(outer_deg: f64, inner_deg: f64) -> (f64, f64) {
-    // 1 − cos α = 2 sin²(α/2), precise for small angles.
-    let one_minus_cos = |deg: f64| 2.0 * (deg.to_radians() * 0.5).sin().powi(2);
-    let (outer, inner) = (one_minus_cos(outer_deg), one_minus_cos(inner_deg));
+    spot_terms_from_half_sines(half_sine(outer_deg), half_sine(inner_deg))
+}
+
+/// `sin(α/2)` of a cone half-angle `α` in degrees: what the RGBA8 light records store, so the
+/// shader rebuilds the cone with arithmetic alone (no `sin`, whose precision GLSL ES leaves
+/// to the implementation).
+pub fn half_sine(deg: f64) -> f64 {
+    (deg.to_radians() * 0.5).sin()
+}
+
+/// [`spot_terms`] from the cone's [`half_sine`]s: `1 − cos α = 2 sin²(α/2)`, precise for small
+/// angles. The RGBA8 light shader and decoder compute exactly this.
+pub fn spot_terms_from_half_sines(outer: f64, inner: f64) -> (f64, f64) {
+    let (outer, inner) = (2.0 * outer * outer, 2.0 * inner * inner);
     let scale = 1.0 / (outer - inner).max(SPOT_MIN_COS_DELTA);
     (scale, scale * outer)
 }
