@@ -46,6 +46,13 @@ pub struct EglInfo {
     pub gles_lib: Option<std::path::PathBuf>,
     /// The EGL/GLES library files the process has mapped: which files the implementation is.
     pub files: Vec<std::path::PathBuf>,
+    /// A driver workaround: the display is terminated when its last headless context goes
+    /// (and initialised again by the next). ANGLE's GL back end keeps a native context current
+    /// on the thread that initialised the display, and a context made on another thread after
+    /// that one ended crashed it in `eglMakeCurrent` (a test harness runs each test on a new
+    /// thread). Only for ANGLE: elsewhere the display may be shared with an application's own
+    /// contexts.
+    pub terminate_when_unused: bool,
 }
 
 fn egl_err(call: &'static str) -> impl Fn(egl::Error) -> GlError {
@@ -74,17 +81,21 @@ impl HeadlessContext {
         } else {
             &["default"]
         };
+        // Held while the display is initialised and the context made, so a drop on another
+        // thread cannot terminate the display in between (see `LIVE_CONTEXTS`).
+        let mut live = LIVE_CONTEXTS.lock().unwrap_or_else(|e| e.into_inner());
         let mut last_err = None;
         for platform in order {
             match Self::with_platform(egl, platform, es) {
                 Ok((display, context, surface, info)) => {
+                    *live += 1;
                     return Ok(HeadlessContext {
                         lib,
                         display,
                         context,
                         surface,
                         info,
-                    })
+                    });
                 }
                 Err(e @ GlError::VersionUnavailable { .. }) => return Err(e),
                 Err(e) => {
@@ -200,6 +211,10 @@ impl HeadlessContext {
             let _ = egl.destroy_context(display, context);
             return Err(egl_err("eglMakeCurrent")(e));
         }
+        let egl_version_string = egl
+            .query_string(Some(display), egl::VERSION)
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default();
         let egl_vendor = egl
             .query_string(Some(display), egl::VENDOR)
             .map(|s| s.to_string_lossy().into_owned())
@@ -212,6 +227,7 @@ impl HeadlessContext {
             requested: es,
             gles_lib: gles_lib::chosen_folder(),
             files: gles_lib::loaded_files(),
+            terminate_when_unused: egl_version_string.contains("ANGLE"),
         };
         Ok((display, context, surface, info))
     }
@@ -232,10 +248,22 @@ impl Drop for HeadlessContext {
         // The display is shared by every context of the process (EGL returns the same handle),
         // so it is never terminated here: other threads may still be rendering on it.
         let egl = self.lib.egl();
+        // Under the lock `new` holds too: SwiftShader's display keeps its surfaces and contexts
+        // in sets it does not lock, and tore them when two threads created or destroyed at once.
+        let mut live = LIVE_CONTEXTS.lock().unwrap_or_else(|e| e.into_inner());
         let _ = egl.make_current(self.display, None, None, None);
         if let Some(s) = self.surface {
             let _ = egl.destroy_surface(self.display, s);
         }
         let _ = egl.destroy_context(self.display, self.context);
+        *live -= 1;
+        if *live == 0 && self.info.terminate_when_unused {
+            let _ = egl.terminate(self.display);
+        }
     }
 }
+
+/// Headless contexts alive in the process, for the ANGLE workaround of
+/// [`EglInfo::terminate_when_unused`]; its lock also serialises making and destroying
+/// contexts (SwiftShader's EGL display is not thread-safe there).
+static LIVE_CONTEXTS: std::sync::Mutex<usize> = std::sync::Mutex::new(0);
