@@ -39,7 +39,11 @@ fn osmesa_renders_the_default_scene_through_every_method() {
     }
     r.destroy();
     drop(ctx);
-    // The same picture as ES 3.0 on EGL.
+    // The same picture as ES 3.0 on Mesa's EGL (another implementation rasterizes edges its
+    // own way: tests/gles_implementations.rs compares methods within each).
+    if common::other_implementation_than_mesa("OSMesa against Mesa's EGL") {
+        return;
+    }
     let egl = HeadlessContext::new(EsVersion::Es3).unwrap();
     let mut r = Renderer::new(egl.load_gl(), EsVersion::Es3).unwrap();
     r.set_method("forward").unwrap();

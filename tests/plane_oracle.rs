@@ -62,7 +62,7 @@ fn check(es: EsVersion, opts: RenderOptions, tolerance: f64) -> f64 {
     } else {
         Encoding::Srgb
     };
-    let (err, at, covered) = max_oracle_error(&img, &scene, encoding);
+    let (err, at, covered) = max_oracle_error(&img, &scene, encoding, gpu.r().caps());
     eprintln!("{es} {opts:?}: max error {err:.3}/255 at {at:?}");
     // The plane fills the view; only pixels on its diagonal edge are left out.
     assert!(
@@ -134,6 +134,6 @@ fn oracle_detects_a_slightly_moved_light() {
             ..Default::default()
         },
     );
-    let (err, _, _) = max_oracle_error(&img, &reference, Encoding::Linear);
+    let (err, _, _) = max_oracle_error(&img, &reference, Encoding::Linear, gpu.r().caps());
     assert!(err > 2.0, "a moved light went unnoticed (error {err})");
 }

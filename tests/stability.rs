@@ -197,7 +197,7 @@ fn assert_matches_oracle(name: &str, scene: &Scene, w: u32, h: u32) {
             ..Default::default()
         },
     );
-    let (err, at, _) = max_oracle_error(&img, scene, Encoding::Linear);
+    let (err, at, _) = max_oracle_error(&img, scene, Encoding::Linear, gpu.r().caps());
     assert!(
         err <= 2.0,
         "{name}: forward is {err:.2}/255 from the light model at {at:?}"

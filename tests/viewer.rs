@@ -176,6 +176,9 @@ fn check_window_frame(
         .args(render_extra)
         .arg("--out")
         .arg(&reference)
+        // The window renders through the system's libEGL (glutin loads it), whatever
+        // MANYLIGHT_GLES_LIB selects for headless contexts: so does its reference.
+        .env_remove(manylight::gl::gles_lib::GLES_LIB_ENV)
         .envs(env.iter().copied())
         .output()
         .expect("run manylight render");

@@ -66,6 +66,10 @@ pub struct Caps {
     pub depth24: bool,
     /// `GL_EXT_disjoint_timer_query`.
     pub timer_query: bool,
+    /// `GL_SUBPIXEL_BITS`: the rasterizer snaps vertices to 1/2^bits of a pixel (at least 4 by
+    /// the specification: SwiftShader 4, llvmpipe 8), which bounds how far the point a fragment
+    /// is shaded at may lie from its pixel centre's ray.
+    pub subpixel_bits: i32,
     /// The extension set, sorted.
     pub extensions: BTreeSet<String>,
 }
@@ -118,6 +122,7 @@ impl Caps {
         let (mut max_draw_buffers, mut max_color_attachments) = (1, 1);
         let mut max_samples = 0;
         let (fragment_highp, fragment_mediump);
+        let subpixel_bits;
         unsafe {
             gl_version = gl.get_parameter_string(glow::VERSION);
             glsl_version = gl.get_parameter_string(glow::SHADING_LANGUAGE_VERSION);
@@ -126,6 +131,7 @@ impl Caps {
             max_texture_size = gl.get_parameter_i32(glow::MAX_TEXTURE_SIZE);
             max_fragment_uniform_vectors = gl.get_parameter_i32(glow::MAX_FRAGMENT_UNIFORM_VECTORS);
             max_texture_image_units = gl.get_parameter_i32(glow::MAX_TEXTURE_IMAGE_UNITS);
+            subpixel_bits = gl.get_parameter_i32(glow::SUBPIXEL_BITS);
             if es3 || (!desktop && has(MSAA_RENDER_TO_TEXTURE)) {
                 // GL_MAX_SAMPLES_EXT has the value of GL_MAX_SAMPLES.
                 max_samples = gl.get_parameter_i32(glow::MAX_SAMPLES);
@@ -168,6 +174,7 @@ impl Caps {
             float_textures: es3 || has("GL_OES_texture_float"),
             depth24: es3 || has("GL_OES_depth24"),
             timer_query: has("GL_EXT_disjoint_timer_query"),
+            subpixel_bits,
             extensions,
         })
     }

@@ -3,9 +3,10 @@
 //! [`SceneRaycaster`].
 //!
 //! Each sample is an interval per channel: the encoded light model at the pixel centre and at
-//! [`SUBPIXEL`] from it in ±x and ±y. GPUs snap vertices to a sub-pixel grid (1/256 pixel on
-//! common hardware), so the point a fragment is shaded at may be that far from the exact
-//! centre; across a hard spot edge the interval is wide, elsewhere it is a point. Pixels the
+//! [`snapping_reach`] from it in ±x and ±y. GPUs snap vertices to a sub-pixel grid (1/256 pixel
+//! on common hardware and llvmpipe, 1/16 on SwiftShader: `GL_SUBPIXEL_BITS`), so the point a
+//! fragment is shaded at may be that far from the exact centre; across a hard spot edge the
+//! interval is wide, elsewhere it is a point. Pixels the
 //! reference cannot speak for are skipped and counted: triangle edges and silhouettes (the GPU
 //! may shade the neighbour), textured surfaces (filtering is not reproduced), surfaces behind
 //! or on a transparent one (blended), and the background.
@@ -18,9 +19,13 @@ use super::raycast::{pixel_ray, Hit, SceneRaycaster};
 use crate::scene::shading::{self, Surface};
 use crate::scene::{Camera, Projection, Scene};
 
-/// How far from the pixel centre the light model is also evaluated, in pixels: twice the
-/// 1/256-pixel vertex snapping of common rasterizers.
-pub const SUBPIXEL: f64 = 1.0 / 128.0;
+/// How far from the pixel centre the light model is also evaluated, in pixels, for a context
+/// reporting `subpixel_bits` (`Caps::subpixel_bits`): twice its vertex snapping step (8 bits:
+/// 1/128 pixel). Values outside the specification's 4 and a sane 16 are clamped, so a driver
+/// reporting nonsense gets the widest interval the specification allows.
+pub fn snapping_reach(subpixel_bits: i32) -> f64 {
+    2.0 * (-(subpixel_bits.clamp(4, 16) as f64)).exp2()
+}
 
 /// How the image stores linear radiance.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -94,15 +99,17 @@ pub struct CpuError {
 
 /// Chooses `count` pixels (at most) on a stratified grid over the whole image and evaluates
 /// the light model there. Deterministic. The scene must validate.
+/// `subpixel` is [`snapping_reach`] of the context the image comes from.
 pub fn reference_samples(
     scene: &Scene,
     width: u32,
     height: u32,
     count: usize,
     encoding: Encoding,
+    subpixel: f64,
 ) -> ReferenceSet {
     let raycaster = SceneRaycaster::new(scene);
-    reference_samples_with(&raycaster, scene, width, height, count, encoding)
+    reference_samples_with(&raycaster, scene, width, height, count, encoding, subpixel)
 }
 
 /// [`reference_samples`] with a ray caster already built for `scene`'s geometry (to reuse it
@@ -114,10 +121,20 @@ pub fn reference_samples_with(
     height: u32,
     count: usize,
     encoding: Encoding,
+    subpixel: f64,
 ) -> ReferenceSet {
     let outcomes: Vec<Outcome> = sample_pixels(width, height, count)
         .into_par_iter()
-        .map(|(x, y)| evaluate(raycaster, scene, width, height, x, y, encoding))
+        .map(|(x, y)| {
+            evaluate(
+                raycaster,
+                scene,
+                (width, height),
+                (x, y),
+                encoding,
+                subpixel,
+            )
+        })
         .collect();
     let mut set = ReferenceSet {
         width,
@@ -223,13 +240,12 @@ fn sample_pixels(width: u32, height: u32, count: usize) -> Vec<(u32, u32)> {
 fn evaluate(
     raycaster: &SceneRaycaster,
     scene: &Scene,
-    width: u32,
-    height: u32,
-    x: u32,
-    y: u32,
+    (width, height): (u32, u32),
+    (x, y): (u32, u32),
     encoding: Encoding,
+    subpixel: f64,
 ) -> Outcome {
-    let d = SUBPIXEL;
+    let d = subpixel;
     let (cx, cy) = (x as f64 + 0.5, y as f64 + 0.5);
     let is_opaque = |o: usize| !scene.materials[scene.objects[o].material].is_transparent();
     let sees: Vec<RaySees> = [(0.0, 0.0), (d, 0.0), (-d, 0.0), (0.0, d), (0.0, -d)]
@@ -383,7 +399,7 @@ mod tests {
 
     fn check_against_plane(scene: &Scene, encoding: Encoding) {
         let count = 500;
-        let set = reference_samples(scene, W, H, count, encoding);
+        let set = reference_samples(scene, W, H, count, encoding, snapping_reach(8));
         // The quad's diagonal is the only edge; the plane fills the view.
         assert_eq!(
             set.samples.len() + set.skipped_edge + set.skipped_coplanar,
@@ -392,7 +408,7 @@ mod tests {
         assert!(set.samples.len() > count * 9 / 10, "{set:?}");
         for s in &set.samples {
             let (cx, cy) = (s.x as f64 + 0.5, s.y as f64 + 0.5);
-            let d = SUBPIXEL;
+            let d = snapping_reach(8);
             for ch in 0..3 {
                 let values = [(0.0, 0.0), (d, 0.0), (-d, 0.0), (0.0, d), (0.0, -d)]
                     .map(|(dx, dy)| encoding.encode(plane_point(scene, cx + dx, cy + dy)[ch]));
@@ -448,7 +464,7 @@ mod tests {
         assert!((e.rmse - (25.0f64 / 9.0).sqrt()).abs() < 1e-12);
 
         // A rendered-like image from a real set: 8-bit rounding only.
-        let set = reference_samples(&lit_plane(), W, H, 300, Encoding::Srgb);
+        let set = reference_samples(&lit_plane(), W, H, 300, Encoding::Srgb, snapping_reach(8));
         let mut image = image::RgbaImage::new(W, H);
         for s in &set.samples {
             let mid = |c: usize| ((s.lo[c] + s.hi[c]) * 0.5).round() as u8;
@@ -466,7 +482,7 @@ mod tests {
             name: "white".into(),
             image: image::RgbaImage::from_pixel(1, 1, image::Rgba([255; 4])),
         }));
-        let set = reference_samples(&scene, W, H, 200, Encoding::Srgb);
+        let set = reference_samples(&scene, W, H, 200, Encoding::Srgb, snapping_reach(8));
         assert!(set.samples.is_empty());
         assert_eq!(
             set.skipped_texture + set.skipped_edge + set.skipped_coplanar,
@@ -499,7 +515,7 @@ mod tests {
             });
         }
         let count = 400;
-        let set = reference_samples(&scene, W, H, count, Encoding::Srgb);
+        let set = reference_samples(&scene, W, H, count, Encoding::Srgb, snapping_reach(8));
         assert_eq!(
             set.samples.len() + set.skipped_edge + set.skipped_coplanar + set.skipped_transparent,
             count
@@ -527,7 +543,7 @@ mod tests {
             near: 0.1,
             far: 50.0,
         };
-        let set = reference_samples(&scene, W, H, 300, Encoding::Linear);
+        let set = reference_samples(&scene, W, H, 300, Encoding::Linear, snapping_reach(8));
         assert!(set.missed > 150 && !set.samples.is_empty(), "{set:?}");
         assert_eq!(
             set.samples.len() + set.skipped_edge + set.skipped_coplanar + set.missed,
@@ -539,7 +555,7 @@ mod tests {
             near: 0.1,
             far: 4.5,
         };
-        let set = reference_samples(&scene, W, H, 300, Encoding::Linear);
+        let set = reference_samples(&scene, W, H, 300, Encoding::Linear, snapping_reach(8));
         assert_eq!(set.missed, 300);
     }
 

@@ -91,15 +91,17 @@ pub fn asset(relative: &str) -> PathBuf {
 
 /// The image against the light model evaluated on the CPU in f64 at every pixel the
 /// reference can speak for (`manylight::metrics::cpu_reference`: an interval over the
-/// rasterizer's sub-pixel snapping, triangle edges skipped): the largest error in 8-bit steps,
-/// where it is, and how many pixels were compared.
+/// sub-pixel snapping of the rasterizer `caps` describes, triangle edges skipped): the largest
+/// error in 8-bit steps, where it is, and how many pixels were compared.
 pub fn max_oracle_error(
     img: &image::RgbaImage,
     scene: &Scene,
     encoding: Encoding,
+    caps: &manylight::gl::Caps,
 ) -> (f64, (u32, u32), usize) {
     let (w, h) = img.dimensions();
-    let set = cpu_reference::reference_samples(scene, w, h, (w * h) as usize, encoding);
+    let subpixel = cpu_reference::snapping_reach(caps.subpixel_bits);
+    let set = cpu_reference::reference_samples(scene, w, h, (w * h) as usize, encoding, subpixel);
     let e = cpu_reference::compare(img, &set);
     (e.max_abs, e.worst, e.samples)
 }
@@ -112,6 +114,25 @@ pub fn skip(reason: &str) {
         panic!("would skip ({reason}), but MANYLIGHT_REQUIRE_ALL_TESTS is set");
     }
     eprintln!("SKIPPED: {reason}");
+}
+
+/// For a test about a Mesa feature (its `MESA_*` overrides, its second driver, OSMesa against
+/// Mesa's EGL): true, after saying so on stderr, when this run renders with another GLES
+/// implementation (`MANYLIGHT_GLES_LIB`; docs/drivers.md), where the feature does not exist.
+/// Unlike [`skip`] this is not something missing from the environment: the test runs in the
+/// suite's run on the system's Mesa, so `MANYLIGHT_REQUIRE_ALL_TESTS` does not turn it into a
+/// failure.
+pub fn other_implementation_than_mesa(what: &str) -> bool {
+    match manylight::gl::gles_lib::chosen_folder() {
+        Some(dir) => {
+            eprintln!(
+                "NOT APPLICABLE: {what} is a Mesa feature; this run renders with {}",
+                dir.display()
+            );
+            true
+        }
+        None => false,
+    }
 }
 
 /// A white square turned 30° about the view axis on black, lit by ambient light alone: each

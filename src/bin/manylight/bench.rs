@@ -453,8 +453,16 @@ fn baseline(
     let (reference, _) = renderer.render_offscreen(scene, w, h, &reference_opts)?;
     let (bound, _) =
         renderer.render_light_counts(scene, w, h, &reference_opts, CountKind::Reaching)?;
-    let cpu =
-        cpu_reference::reference_samples_with(caster, scene, w, h, cpu_samples, Encoding::Srgb);
+    let subpixel = cpu_reference::snapping_reach(renderer.caps().subpixel_bits);
+    let cpu = cpu_reference::reference_samples_with(
+        caster,
+        scene,
+        w,
+        h,
+        cpu_samples,
+        Encoding::Srgb,
+        subpixel,
+    );
     Ok(Baseline {
         reference,
         bound,
