@@ -89,6 +89,14 @@ pub enum GridEncoding {
 }
 
 impl GridEncoding {
+    /// The encoding a feature level reads: RGBA8 on ES 2.0, integer textures on ES 3.0.
+    pub fn for_es(es: crate::gl::EsVersion) -> GridEncoding {
+        match es {
+            crate::gl::EsVersion::Es2 => GridEncoding::Rgba8,
+            crate::gl::EsVersion::Es3 => GridEncoding::Uint,
+        }
+    }
+
     /// Bytes per cell in the grid texture.
     pub fn cell_bytes(self) -> usize {
         4

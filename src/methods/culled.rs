@@ -21,7 +21,7 @@ use crate::cluster::pack::{
 };
 use crate::cluster::pack_grid::{
     grid_fits_table, grid_texels, pack_grid_into, pack_indices_into, GridEncoding, PackedTexels,
-    MAX_INDEXED_LIGHTS, RGBA8_CELL_CAP, RGBA8_OFFSET_LIMIT,
+    MAX_INDEXED_LIGHTS, RGBA8_CELL_CAP,
 };
 use crate::gl::texture::{DataFormat, DataTexture};
 use crate::gl::{Device, EsVersion};
@@ -202,18 +202,15 @@ impl ShadingMethod for CulledForward {
         let method = self.name();
         let dev = ctx.dev;
         let es = dev.es();
-        let grid_encoding = match es {
-            EsVersion::Es2 => GridEncoding::Rgba8,
-            EsVersion::Es3 => GridEncoding::Uint,
-        };
-        let per_index_texel = grid_encoding.indices_per_texel();
+        let grid_encoding = GridEncoding::for_es(es);
+        let capacity = super::capacity::capacities(dev.caps());
         let max_rows = dev.caps().max_texture_size.max(1) as usize;
-        let mut max_indices = max_rows * DATA_TEXTURE_WIDTH as usize * per_index_texel;
-        let mut cell_cap = ctx.options.cell_cap.unwrap_or(u32::MAX);
-        if es == EsVersion::Es2 {
-            cell_cap = cell_cap.min(RGBA8_CELL_CAP);
-            max_indices = max_indices.min(RGBA8_OFFSET_LIMIT);
-        }
+        let mut max_indices = capacity.index_entries;
+        let cell_cap = ctx
+            .options
+            .cell_cap
+            .unwrap_or(u32::MAX)
+            .min(capacity.cell_lights.unwrap_or(u32::MAX));
         if let Some(m) = ctx.options.max_indices {
             max_indices = max_indices.min(m);
         }

@@ -5,6 +5,7 @@
 //! capability matrix all iterate this one table.
 
 pub mod auto;
+pub mod capacity;
 pub mod clustered;
 pub mod culled;
 pub mod deferred;

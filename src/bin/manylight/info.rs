@@ -87,6 +87,7 @@ pub fn run(args: &InfoArgs) -> Result<(), Box<dyn std::error::Error>> {
             "egl": ctx.info(),
             "implementation": caps.implementation(),
             "caps": caps,
+            "capacities": manylight::methods::capacity::capacities(&caps),
             "mediump_is_fp16": fp16,
             "scene": report,
             "methods": methods.iter().map(|(name, s)| serde_json::json!({"name": name, "support": s})).collect::<Vec<_>>(),
@@ -208,6 +209,17 @@ fn format_text(
     w!(out, "float textures     {}", caps.float_textures);
     w!(out, "depth24            {}", caps.depth24);
     w!(out, "timer queries      {}", caps.timer_query);
+    let cap = manylight::methods::capacity::capacities(caps);
+    w!(
+        out,
+        "capacities         forward {} lights a draw; tiled/clustered {} visible lights, {} list entries, {} a cell, {} grid texels",
+        cap.forward_lights,
+        cap.indexed_lights,
+        cap.index_entries,
+        cap.cell_lights
+            .map_or_else(|| "any number".to_string(), |n| n.to_string()),
+        cap.grid_texels
+    );
     w!(out, "extensions         {}", caps.extensions.len());
     for e in &caps.extensions {
         w!(out, "  {e}");
