@@ -48,12 +48,25 @@ fn check_with(name: &str, scene: &Scene, w: u32, h: u32, opts: &RenderOptions) -
                 .render_offscreen(scene, w, h, &opts)
                 .unwrap_or_else(|e| panic!("{name} {es} {method}: {e}"));
             let d = manylight::metrics::diff(&reference, &img);
-            assert!(
-                d.max_abs <= 2,
-                "{name} {es} {method}: {} / 255 from the reference (rmse {:.3})",
-                d.max_abs,
-                d.rmse
-            );
+            // Deferred sums its lights by blending into its accumulation buffer: fp16 where
+            // the context has no GL_EXT_float_blend (ANGLE 2.1), which drifts like the fp16
+            // device's sums (docs/testing.md), so it is held to that device's bound there.
+            let fp16_sum =
+                method == "deferred" && !gpu.r().caps().has_extension("GL_EXT_float_blend");
+            if fp16_sum {
+                assert!(
+                    d.rmse <= MEDIUMP_ONLY_RMSE,
+                    "{name} {es} {method} (fp16 accumulation): rmse {:.3} from the reference",
+                    d.rmse
+                );
+            } else {
+                assert!(
+                    d.max_abs <= 2,
+                    "{name} {es} {method}: {} / 255 from the reference (rmse {:.3})",
+                    d.max_abs,
+                    d.rmse
+                );
+            }
             assert_eq!(stats.overflowed_lights, 0, "{name} {es} {method}");
             assert_finite_hdr(
                 &mut gpu,
@@ -636,7 +649,9 @@ fn mediump_precision_canary() {
             caps.renderer,
             if fp16 { "fp16" } else { "fp32" }
         );
-        if caps.renderer.contains("llvmpipe") {
+        // Mesa's own llvmpipe (ANGLE's renderer string names the llvmpipe it runs on, but its
+        // shaders reach it as desktop GLSL, without precision).
+        if caps.implementation() == "Mesa llvmpipe" {
             assert!(
                 fp16,
                 "{es}: llvmpipe no longer evaluates mediump as fp16: the suite's fp16 cases lost their teeth"
