@@ -246,7 +246,8 @@ impl HeadlessContext {
 impl Drop for HeadlessContext {
     fn drop(&mut self) {
         // The display is shared by every context of the process (EGL returns the same handle),
-        // so it is never terminated here: other threads may still be rendering on it.
+        // so it is terminated only on ANGLE and only once no headless context is left
+        // (`EglInfo::terminate_when_unused`).
         let egl = self.lib.egl();
         // Under the lock `new` holds too: SwiftShader's display keeps its surfaces and contexts
         // in sets it does not lock, and tore them when two threads created or destroyed at once.
