@@ -329,10 +329,40 @@ fn usage_errors_exit_2_and_name_the_flags() {
         (&["render", "--frames", "many"], "--frames"),
         (&["render", "--size", "0x10"], "empty"),
         (&["render", "--bogus"], "--bogus"),
+        (
+            &["render", "--gles-lib", "a", "--gles-lib", "b"],
+            "only `matrix` compares several",
+        ),
     ];
     for (args, needle) in cases {
         expect_exit(args, &[], dir.path(), 2, needle);
     }
+}
+
+/// A GLES folder that is missing or holds no libraries is one error naming the folder and what
+/// it lacks, from the option and from the variable alike.
+#[test]
+fn a_bad_gles_folder_is_a_clear_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let missing = dir.path().join("nowhere");
+    let missing = missing.to_str().unwrap();
+    let msg = expect_exit(
+        &["info", "--gles-lib", missing],
+        &[],
+        dir.path(),
+        1,
+        "nowhere",
+    );
+    assert!(msg.contains("is not a folder"), "{msg}");
+    let empty = dir.path().to_str().unwrap();
+    let msg = expect_exit(
+        &["render", "--size", "8x8"],
+        &[("MANYLIGHT_GLES_LIB", empty)],
+        dir.path(),
+        1,
+        "holds none of libGLESv2.so.2, libGLESv2.so",
+    );
+    assert!(msg.contains(empty), "{msg}");
 }
 
 #[cfg(not(feature = "window"))]

@@ -104,6 +104,16 @@ fn check_usage(cli: &Cli) {
             )
             .exit();
     }
+    #[cfg(feature = "window")]
+    if !cli.gles_lib.is_empty() && matches!(cli.command, Some(Command::View(_))) {
+        Cli::command()
+            .error(
+                ErrorKind::ArgumentConflict,
+                "--gles-lib does not reach `view`: its window comes from glutin, which loads the \
+                 system's libEGL.so.1 (point LD_LIBRARY_PATH at the folder instead)",
+            )
+            .exit();
+    }
     if cli.gles_lib.len() > 1 && !matches!(cli.command, Some(Command::Matrix(_))) {
         Cli::command()
             .error(
