@@ -187,12 +187,22 @@ fn matrix_adds_a_row_group_per_implementation() {
         [
             "ES 2.0",
             "ES 2.0 without fragment highp (played)",
+            "ES 2.0 with RGBA8 light data (played)",
             "ES 3.x as the driver gives it"
         ]
     );
     assert!(
         group.iter().all(|r| r["implementation"] == "SwiftShader"),
         "{group:?}"
+    );
+    // The played restriction is real: its lights went through the RGBA8 records.
+    let played = group[2]["methods"].as_array().unwrap();
+    assert!(
+        played
+            .iter()
+            .filter(|m| m["support"]["status"] != "unsupported")
+            .all(|m| m["light_encoding"] == "rgba8"),
+        "{played:?}"
     );
     assert!(rows
         .iter()

@@ -7,8 +7,9 @@
 //! has) on the same configuration.
 //!
 //! With `--gles-lib DIR` (more than once; `system` for the system's libraries) each
-//! implementation gets a row group: ES 2.0, ES 2.0 without fragment highp (played) and ES 3.x
-//! on it; the Mesa restrictions, softpipe and OSMesa rows belong to the system's group.
+//! implementation gets a row group: ES 2.0, ES 2.0 without fragment highp and with RGBA8 light
+//! data (both played) and ES 3.x on it; the Mesa restrictions, softpipe and OSMesa rows belong
+//! to the system's group.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -52,8 +53,19 @@ struct Config {
     args: &'static [&'static str],
     /// Image size instead of the matrix's (a slow driver renders a smaller image).
     size: Option<&'static str>,
-    /// A Mesa switch (environment override, second driver): only in the system's group.
-    mesa_only: bool,
+    /// Which row groups have it.
+    groups: Groups,
+}
+
+/// The row groups a configuration belongs to.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Groups {
+    /// Every implementation's.
+    All,
+    /// The system's alone: a Mesa switch (environment override, second driver).
+    System,
+    /// The other implementations': a restriction the renderer plays where no Mesa switch exists.
+    Others,
 }
 
 const CONFIGS: &[Config] = &[
@@ -63,7 +75,7 @@ const CONFIGS: &[Config] = &[
         es: "2",
         env: &[],
         args: &[],
-        mesa_only: false,
+        groups: Groups::All,
         size: None,
     },
     Config {
@@ -72,7 +84,16 @@ const CONFIGS: &[Config] = &[
         es: "2",
         env: &[],
         args: &["--no-fragment-highp"],
-        mesa_only: false,
+        groups: Groups::All,
+        size: None,
+    },
+    Config {
+        name: "ES 2.0 with RGBA8 light data (played)",
+        slug: "es2-rgba8",
+        es: "2",
+        env: &[],
+        args: &["--rgba8-lights"],
+        groups: Groups::Others,
         size: None,
     },
     Config {
@@ -84,7 +105,7 @@ const CONFIGS: &[Config] = &[
             "-GL_OES_texture_float -GL_OES_texture_half_float",
         )],
         args: &[],
-        mesa_only: true,
+        groups: Groups::System,
         size: None,
     },
     Config {
@@ -93,7 +114,7 @@ const CONFIGS: &[Config] = &[
         es: "2",
         env: &[("MESA_GLES_VERSION_OVERRIDE", "2.0")],
         args: &[],
-        mesa_only: true,
+        groups: Groups::System,
         size: None,
     },
     Config {
@@ -102,7 +123,7 @@ const CONFIGS: &[Config] = &[
         es: "3",
         env: &[("MESA_GLES_VERSION_OVERRIDE", "3.0")],
         args: &[],
-        mesa_only: true,
+        groups: Groups::System,
         size: None,
     },
     Config {
@@ -111,7 +132,7 @@ const CONFIGS: &[Config] = &[
         es: "3",
         env: &[],
         args: &[],
-        mesa_only: false,
+        groups: Groups::All,
         size: None,
     },
     // A second Mesa rasterizer (mediump at fp32, no LLVM): slow, so a small image. Where it
@@ -122,7 +143,7 @@ const CONFIGS: &[Config] = &[
         es: "3",
         env: &[("GALLIUM_DRIVER", "softpipe")],
         args: &[],
-        mesa_only: true,
+        groups: Groups::System,
         size: Some("96x54"),
     },
 ];
@@ -173,7 +194,15 @@ fn group_rows(
 ) -> Result<Vec<Value>, Box<dyn std::error::Error>> {
     let label = lib.map_or_else(|| "system".to_string(), |d| d.display().to_string());
     let mut rows = Vec::new();
-    for config in CONFIGS.iter().filter(|c| lib.is_none() || !c.mesa_only) {
+    let wanted = if lib.is_none() {
+        Groups::System
+    } else {
+        Groups::Others
+    };
+    for config in CONFIGS
+        .iter()
+        .filter(|c| c.groups == Groups::All || c.groups == wanted)
+    {
         let tag = if group == 0 {
             config.slug.to_string()
         } else {
@@ -363,6 +392,9 @@ pub struct MatrixCellArgs {
     /// Play a device without fragment highp.
     #[arg(long)]
     no_fragment_highp: bool,
+    /// Play a device without float textures: light records packed in RGBA8.
+    #[arg(long)]
+    rgba8_lights: bool,
 }
 
 /// The context a matrix cell renders with (kept alive for the renderer's life).
@@ -401,6 +433,7 @@ pub fn run_cell(args: &MatrixCellArgs) -> Result<(), Box<dyn std::error::Error>>
     let (w, h) = args.size;
     let opts = RenderOptions {
         timed_frames: 3,
+        force_rgba8_lights: args.rgba8_lights,
         ..RenderOptions::default()
     };
     // The reference comes from an unrestricted renderer of its own (made, used and dropped
@@ -436,6 +469,7 @@ pub fn run_cell(args: &MatrixCellArgs) -> Result<(), Box<dyn std::error::Error>>
             entry["max_abs"] = json!(d.max_abs);
             entry["over_2"] = json!(d.over_2);
             entry["frame_ms"] = json!(stats.frame_ms);
+            entry["light_encoding"] = json!(stats.light_encoding);
             entry["image"] = json!(file);
         }
         methods.push(entry);
