@@ -44,8 +44,6 @@ pub struct EglInfo {
     /// The folder the implementation was loaded from (`--gles-lib`, `MANYLIGHT_GLES_LIB`);
     /// `None`: the system's `libEGL.so.1`.
     pub gles_lib: Option<std::path::PathBuf>,
-    /// The EGL/GLES library files the process has mapped: which files the implementation is.
-    pub files: Vec<std::path::PathBuf>,
     /// A driver workaround: the display is terminated when its last headless context goes
     /// (and initialised again by the next). ANGLE's GL back end keeps a native context current
     /// on the thread that initialised the display, and a context made on another thread after
@@ -226,7 +224,6 @@ impl HeadlessContext {
             surfaceless_context: surface.is_none(),
             requested: es,
             gles_lib: gles_lib::chosen_folder(),
-            files: gles_lib::loaded_files(),
             terminate_when_unused: egl_version_string.contains("ANGLE"),
         };
         Ok((display, context, surface, info))

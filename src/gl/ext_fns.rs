@@ -15,12 +15,7 @@ pub type RenderbufferStorageMultisampleExt =
 /// Loads `glRenderbufferStorageMultisampleEXT` from the process's GLES implementation
 /// ([`super::gles_lib`]), if it is there.
 pub fn renderbuffer_storage_multisample_ext() -> Option<RenderbufferStorageMultisampleExt> {
-    let f = super::gles_lib::library()
-        .ok()?
-        .proc_address("glRenderbufferStorageMultisampleEXT");
-    if f.is_null() {
-        return None;
-    }
+    let f = entry_point("glRenderbufferStorageMultisampleEXT")?;
     // SAFETY: the extension specifies this signature for the entry point of that name, and
     // the library stays loaded for the whole process (gles_lib).
     Some(unsafe {
@@ -57,8 +52,7 @@ pub struct TimerQueryFns {
 /// Loads `GL_EXT_disjoint_timer_query`'s entry points; `None` when any is missing.
 pub fn timer_query_fns() -> Option<TimerQueryFns> {
     type Ptr = *const std::ffi::c_void;
-    let lib = super::gles_lib::library().ok()?;
-    let get = |name: &str| Some(lib.proc_address(name)).filter(|f| !f.is_null());
+    let get = entry_point;
     // SAFETY: each pointer is the entry point of that name, given the signature the
     // extension specifies for it; the library stays loaded for the whole process.
     unsafe {
@@ -74,4 +68,10 @@ pub fn timer_query_fns() -> Option<TimerQueryFns> {
             )?),
         })
     }
+}
+
+/// The process's GLES implementation's entry point of that name, if it has one.
+fn entry_point(name: &str) -> Option<*const std::ffi::c_void> {
+    let f = super::gles_lib::library().ok()?.proc_address(name);
+    (!f.is_null()).then_some(f)
 }

@@ -85,6 +85,7 @@ pub fn run(args: &InfoArgs) -> Result<(), Box<dyn std::error::Error>> {
     if args.json {
         let value = serde_json::json!({
             "egl": ctx.info(),
+            "library_files": manylight::gl::gles_lib::loaded_files(),
             "implementation": caps.implementation(),
             "caps": caps,
             "capacities": manylight::methods::capacity::capacities(&caps),
@@ -150,7 +151,8 @@ fn format_text(
             |d| format!("--gles-lib {}", d.display())
         )
     );
-    for f in &egl.files {
+    // Read here, not at every context's creation: only `info` shows them.
+    for f in &manylight::gl::gles_lib::loaded_files() {
         w!(out, "  {}", f.display());
     }
     w!(
