@@ -41,7 +41,7 @@ pub fn select(folder: &Path) -> Result<(), GlError> {
     if let Some(loaded) = LOADED.get() {
         let current = loaded.as_ref().ok().and_then(|l| l.folder.clone());
         if current.as_deref() != Some(folder.as_path()) {
-            return Err(GlError::EglLoad(format!(
+            return Err(GlError::GlesLibrary(format!(
                 "the GLES implementation is already loaded ({}); {} must be chosen before the first context",
                 current.map_or("the system's".into(), |f| f.display().to_string()),
                 folder.display()
@@ -74,7 +74,10 @@ pub fn library() -> Result<&'static GlesLibrary, GlError> {
     LOADED
         .get_or_init(|| GlesLibrary::load(chosen_folder()))
         .as_ref()
-        .map_err(|e| GlError::EglLoad(e.clone()))
+        .map_err(|e| match chosen_folder() {
+            Some(_) => GlError::GlesLibrary(e.clone()),
+            None => GlError::EglLoad(e.clone()),
+        })
 }
 
 /// The first of `names` that exists in `folder`.

@@ -90,6 +90,10 @@ pub enum GlError {
     /// libEGL could not be loaded or lacks EGL 1.4.
     #[error("cannot load libEGL.so.1 ({0}); install libegl1 and a driver such as libegl-mesa0")]
     EglLoad(String),
+    /// The GLES implementation chosen with `--gles-lib` / `MANYLIGHT_GLES_LIB` could not be
+    /// loaded (the folder, what it lacks, or the loader's reason).
+    #[error("GLES implementation: {0}")]
+    GlesLibrary(String),
     /// An EGL call failed.
     #[error("EGL {call} failed: {error}")]
     Egl {
