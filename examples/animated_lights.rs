@@ -15,11 +15,10 @@
 use std::path::Path;
 
 use glam::{DVec3, Vec3};
-use manylight::gl::HeadlessContext;
-use manylight::metrics::spread::Spread;
-use manylight::scene::motion::{Motion, Orbit, OrbitAbout};
-use manylight::scene::{self, Light, Scene};
-use manylight::{EsVersion, RenderOptions, Renderer};
+use manylight::motion::{Motion, Orbit, OrbitAbout};
+use manylight::{
+    builtin_scene, EsVersion, HeadlessContext, Light, RenderOptions, Renderer, Scene, Spread,
+};
 
 /// Animation time of frame `frame`: 24 frames per second.
 pub fn time_of(frame: u32) -> f64 {
@@ -28,7 +27,7 @@ pub fn time_of(frame: u32) -> f64 {
 
 /// The courtyard with `lights` moving random lights and a spot light circling the fountain.
 pub fn build_scene(lights: usize) -> Result<Scene, Box<dyn std::error::Error>> {
-    let mut scene = scene::builtin::build("courtyard", Some((lights, 7)))?;
+    let mut scene = builtin_scene("courtyard", Some((lights, 7)))?;
     scene.lights.push(Light::spot(
         DVec3::new(4.0, 6.0, 0.0),
         DVec3::new(-0.5, -1.0, 0.0),

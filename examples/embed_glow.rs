@@ -20,8 +20,7 @@
 use std::path::Path;
 
 use glow::HasContext;
-use manylight::gl::HeadlessContext;
-use manylight::{scene, EsVersion, RenderOptions, Renderer};
+use manylight::{builtin_scene, EsVersion, HeadlessContext, RenderOptions, Renderer};
 
 /// The application's render target: a colour texture and depth buffer on an FBO.
 struct AppTarget {
@@ -95,7 +94,7 @@ pub fn run(out: &Path, width: u32, height: u32) -> Result<(), Box<dyn std::error
     let ctx = HeadlessContext::new(EsVersion::Es3)?;
     let app_gl = ctx.load_gl();
     let mut renderer = Renderer::new(ctx.load_gl(), EsVersion::Es3)?;
-    let scene = scene::builtin::build("courtyard", Some((512, 3)))?;
+    let scene = builtin_scene("courtyard", Some((512, 3)))?;
     let (w, h) = (width as i32, height as i32);
     let target = unsafe { AppTarget::new(&app_gl, w, h)? };
     let result = (|| -> Result<image::RgbaImage, Box<dyn std::error::Error>> {

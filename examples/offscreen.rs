@@ -10,10 +10,10 @@
 use std::path::Path;
 
 use glam::{DVec3, Vec3};
-use manylight::gl::HeadlessContext;
-use manylight::scene::meshbuild::MeshBuilder;
-use manylight::scene::{Camera, Light, Material, Object, Scene};
-use manylight::{EsVersion, FrameStats, RenderOptions, Renderer};
+use manylight::{
+    Camera, EsVersion, FrameStats, HeadlessContext, Light, Material, MeshBuilder, Object,
+    RenderOptions, Renderer, Scene,
+};
 
 /// A floor with a row of boxes, lit by a ring of coloured point lights and one white spot.
 pub fn build_scene() -> Scene {

@@ -16,10 +16,10 @@
 //! A minimal headless render:
 //!
 //! ```no_run
-//! use manylight::{gl::HeadlessContext, EsVersion, Renderer, RenderOptions, scene};
+//! use manylight::{builtin_scene, EsVersion, HeadlessContext, Renderer, RenderOptions};
 //! let ctx = HeadlessContext::new(EsVersion::Es3)?;
 //! let mut renderer = Renderer::new(ctx.load_gl(), EsVersion::Es3)?;
-//! let scene = scene::builtin::build("courtyard", Some((256, 7)))?;
+//! let scene = builtin_scene("courtyard", Some((256, 7)))?;
 //! let (image, stats) = renderer.render_offscreen(&scene, 256, 144, &RenderOptions::default())?;
 //! image.save("out.png")?;
 //! println!("{} ms", stats.frame_ms);
@@ -28,22 +28,55 @@
 #![deny(unsafe_code)]
 #![warn(missing_docs)]
 
-pub mod cluster;
-pub mod error;
-pub mod gl;
-pub mod gpu_scene;
-pub mod methods;
-pub mod metrics;
-pub mod options;
-pub mod renderer;
-pub mod scene;
+/// The internal modules: public with the `lab` feature (for manylight-tools, the tests and
+/// benchmarks, no stability promise), private otherwise.
+macro_rules! lab_modules {
+    ($($(#[$attr:meta])* $name:ident),* $(,)?) => {$(
+        $(#[$attr])*
+        #[cfg(feature = "lab")]
+        pub mod $name;
+        $(#[$attr])*
+        #[cfg(not(feature = "lab"))]
+        #[allow(dead_code, unused_imports)]
+        mod $name;
+    )*};
+}
 
+lab_modules!(cluster, error, gl, gpu_scene, methods, metrics, options, renderer, scene);
+
+// The API a game uses: one path each, at the crate root.
+pub use cluster::grid::{Coverage, GridConfig, GridMode};
+pub use cluster::pack::LightEncoding;
 pub use error::Error;
+pub use gl::caps::Precision;
+pub use gl::gles_lib::select as select_gles_library;
+pub use gl::{Caps, EsVersion, GlError, HeadlessContext, Restrictions};
+pub use methods::{method_names, Support, DEFAULT_METHOD};
+pub use metrics::counts::LightCounts;
+pub use metrics::spread::Spread;
+pub use options::{CountKind, RenderOptions, ToneMap, MAX_TIMED_FRAMES};
+pub use renderer::{FrameStats, Renderer};
+pub use scene::features::SceneFeatures;
+pub use scene::meshbuild::MeshBuilder;
+pub use scene::obj::LoadReport;
+pub use scene::{
+    builtin::build as builtin_scene, builtin::DEFAULT as DEFAULT_SCENE,
+    builtin::NAMES as BUILTIN_SCENES, load as load_scene, Aabb, Camera, Light, LightKind, Material,
+    Mesh, Object, Projection, Scene, SceneError, Texture,
+};
+
+/// How lights move over time: a [`Motion`](motion::Motion) per light, set with
+/// [`Scene::animate_light`] and posed by [`Scene::set_time`].
+pub mod motion {
+    pub use crate::scene::motion::{Bob, Flicker, Motion, Orbit, OrbitAbout, Sweep, Wander};
+}
+
+// The crates whose types the API takes and returns, so a game needs no second version of them.
+pub use glam;
+pub use glow;
+pub use image;
 
 /// The README's Rust examples, compiled as doc tests so they stay true.
 #[cfg(doctest)]
 #[doc = include_str!("../README.md")]
 pub struct ReadmeDoctests;
-pub use gl::EsVersion;
-pub use options::{CountKind, RenderOptions, ToneMap, MAX_TIMED_FRAMES};
-pub use renderer::{FrameStats, Renderer};

@@ -99,7 +99,7 @@ impl Default for RenderOptions {
 }
 
 /// The curve that maps exposed linear radiance (0 to ∞) into the displayable [0, 1], applied
-/// per pixel before the sRGB encode; CPU twin: [`crate::scene::shading::tone_map`].
+/// per pixel before the sRGB encode; CPU twin: `scene::shading::tone_map`.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum ToneMap {

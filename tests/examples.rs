@@ -10,8 +10,7 @@ mod animated_lights;
 #[path = "../examples/embed_glow.rs"]
 mod embed_glow;
 
-use manylight::gl::HeadlessContext;
-use manylight::{scene, EsVersion, RenderOptions, Renderer};
+use manylight::{builtin_scene, EsVersion, HeadlessContext, RenderOptions, Renderer};
 
 /// The fraction of pixels brighter than `level` (mean of RGB).
 fn lit_fraction(img: &image::RgbaImage, level: f64) -> f64 {
@@ -72,7 +71,7 @@ fn embedding_draws_into_the_applications_framebuffer_under_its_overlay() {
     // The same view rendered by manylight into its own target.
     let ctx = HeadlessContext::new(EsVersion::Es3).unwrap();
     let mut renderer = Renderer::new(ctx.load_gl(), EsVersion::Es3).unwrap();
-    let scene = scene::builtin::build("courtyard", Some((512, 3))).unwrap();
+    let scene = builtin_scene("courtyard", Some((512, 3))).unwrap();
     let (own, _) = renderer
         .render_offscreen(&scene, 256, 144, &RenderOptions::default())
         .unwrap();

@@ -11,8 +11,7 @@ use glutin::context::{NotCurrentContext, NotCurrentGlContext};
 use glutin::context::{PossiblyCurrentContext, PossiblyCurrentGlContext};
 use glutin::display::{Display, DisplayApiPreference, GlDisplay};
 use glutin::surface::{GlSurface, Surface, SurfaceAttributesBuilder, SwapInterval, WindowSurface};
-use manylight::methods::{DEFAULT_METHOD, METHODS};
-use manylight::scene::{self, Scene};
+use manylight::{builtin_scene, method_names, Scene, DEFAULT_METHOD, DEFAULT_SCENE};
 use manylight::{EsVersion, RenderOptions, Renderer};
 use winit::application::ApplicationHandler;
 use winit::dpi::PhysicalPosition;
@@ -36,7 +35,7 @@ pub fn run(activity: AndroidApp) {
             .with_max_level(log::LevelFilter::Info)
             .with_tag("manylight"),
     );
-    let scene = match scene::builtin::build(scene::builtin::DEFAULT, Some((LIGHTS, 1))) {
+    let scene = match builtin_scene(DEFAULT_SCENE, Some((LIGHTS, 1))) {
         Ok(s) => s,
         Err(e) => return log::error!("cannot build the default scene: {e}"),
     };
@@ -300,7 +299,7 @@ impl Shell {
 /// The default method, else the first of the table this device runs (an ES 2.0 GPU without
 /// fragment `highp` cannot run the culling methods).
 fn pick_method(renderer: &mut Renderer) -> Result<(), String> {
-    let names = std::iter::once(DEFAULT_METHOD).chain(METHODS.iter().map(|m| m.name));
+    let names = std::iter::once(DEFAULT_METHOD).chain(method_names());
     let mut failures = Vec::new();
     for name in names {
         match renderer.set_method(name) {

@@ -2,7 +2,7 @@
 //! a fixed distance. GL- and Android-free, so it is unit-tested on the host.
 
 use glam::DVec3;
-use manylight::scene::Camera;
+use manylight::Camera;
 
 /// Largest angle above or below the horizon, radians (just under 90°, so `up` stays valid).
 const MAX_PITCH: f64 = 1.5;

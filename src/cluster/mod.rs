@@ -20,7 +20,6 @@ mod overflow;
 pub mod pack;
 pub mod pack_grid;
 pub mod tiles;
-pub mod workload;
 
 #[cfg(test)]
 mod assign_paths_tests;

@@ -50,7 +50,7 @@ pub enum LightEncoding {
 }
 
 impl LightEncoding {
-    /// Texels per light record (a power of two dividing [`DATA_TEXTURE_WIDTH`]).
+    /// Texels per light record (a power of two dividing the data textures' width, 1024).
     pub const fn texels_per_light(self) -> u32 {
         match self {
             LightEncoding::Float32 => 4,

@@ -212,7 +212,6 @@ impl Device {
 
 /// Debug builds check `glGetError` after the wrapped step and panic with its decoded name;
 /// release builds compile it out (one check per frame still runs via [`Device::check`]).
-#[macro_export]
 macro_rules! gl_check {
     ($device:expr, $what:expr) => {
         #[cfg(debug_assertions)]
@@ -221,6 +220,7 @@ macro_rules! gl_check {
         }
     };
 }
+pub(crate) use gl_check;
 
 /// Name of a `glGetError` code.
 pub fn error_name(code: u32) -> &'static str {

@@ -290,7 +290,7 @@ impl ShadingMethod for Deferred {
             };
             stats.upload_bytes += self.transparent.render(&mut sub)?.upload_bytes;
         }
-        crate::gl_check!(dev, "deferred frame");
+        crate::gl::device::gl_check!(dev, "deferred frame");
         Ok(stats)
     }
 

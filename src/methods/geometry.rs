@@ -123,7 +123,7 @@ pub fn draw_objects(
             shade_object(ctx, i, shader, max_lights, bind_method)?;
         }
     }
-    crate::gl_check!(ctx.dev, "geometry pass");
+    crate::gl::device::gl_check!(ctx.dev, "geometry pass");
     Ok(())
 }
 

@@ -1,13 +1,8 @@
 //! Image comparison: the numbers every correctness claim is stated in.
 
-pub mod animated;
 pub mod counts;
 pub mod cpu_reference;
-pub mod heatmap;
-pub mod plot;
 pub mod raycast;
-pub mod report;
-pub mod sheet;
 pub mod spread;
 
 use serde::Serialize;

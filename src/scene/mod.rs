@@ -243,7 +243,7 @@ pub fn brings_own_lights(spec: &str) -> bool {
 }
 
 /// Loads what the CLI's `--scene` names: a built-in name, an `.obj` file (camera framed on its
-/// bounds), a `.gltf` or `.glb` file (its own camera and lights; see [`gltf::load`]) or a
+/// bounds), a `.gltf` or `.glb` file (its own camera and lights; see `gltf::load`) or a
 /// `.json` scene file. `lights` = `Some((count, seed))` sets seeded random lights
 /// (for scene files, it replaces their `random_lights` count but keeps explicit lights).
 pub fn load(

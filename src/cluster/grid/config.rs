@@ -14,12 +14,10 @@ pub const DEFAULT_ASSIGN_BUDGET: f64 = 0.05;
 pub struct GridConfig {
     /// Whether the clustered method picks the footprint itself every so often
     /// ([`GridMode::Auto`], the default) or always uses `footprint_px`.
-    /// [`ClusterGrid::new`](super::ClusterGrid::new) always builds `footprint_px`: the choice
-    /// is the method's (see [`super::auto`](crate::cluster::auto)).
+    /// The grid itself is always built at `footprint_px`: the choice is the clustered method's.
     pub mode: GridMode,
-    /// Number of depth cascades (Billeter uses 12), from 1 to [`MAX_CASCADES`] (0 counts as
-    /// 1): the renderer refuses more, naming `grid.cascades`;
-    /// [`ClusterGrid::new`](super::ClusterGrid::new) clamps into that range.
+    /// Number of depth cascades (Billeter uses 12), from 1 to 64 (0 counts as 1): the renderer
+    /// refuses more, naming `grid.cascades`.
     pub cascades: u32,
     /// Target cell footprint in pixels (cells are about this wide, and `slice_depth` times as
     /// deep): the fixed mode's, and where the automatic mode starts.
@@ -66,7 +64,7 @@ pub struct GridConfig {
 #[serde(rename_all = "snake_case")]
 pub enum GridMode {
     /// The clustered method measures candidate footprints against a cost model calibrated on
-    /// the device and switches with hysteresis (see [`super::auto`](crate::cluster::auto)).
+    /// the device and switches with hysteresis (docs/grid.md).
     #[default]
     Auto,
     /// Always `footprint_px` (tests, and users who want one grid).

@@ -1,7 +1,7 @@
 //! Per-pixel counts (lights evaluated per pixel) and image differences as false-colour
 //! pictures, with a colour legend, so a person can see where the work or the error is.
 
-use super::sheet::draw_text;
+use crate::sheet::draw_text;
 use image::{Rgba, RgbaImage};
 
 /// Viridis sampled at nine evenly spaced points (matplotlib / R `viridis(9)`): perceptually
@@ -148,7 +148,7 @@ pub fn heatmap(
 /// images are enlarged as in [`heatmap`]. Below: a colour bar in 8-bit steps (a black swatch
 /// for 0, then 1 to `full_scale`), `what` (say, which method against which reference) and a
 /// caption with the amplification (255 / `full_scale`) and the largest difference found.
-/// Panics if the sizes differ (a caller bug, as in [`crate::metrics::diff`]).
+/// Panics if the sizes differ (a caller bug, as in [`manylight::metrics::diff`]).
 pub fn diff_image(
     reference: &RgbaImage,
     image: &RgbaImage,

@@ -3,10 +3,10 @@
 
 use std::time::Instant;
 
-use super::assign::{AssignLimits, Assigner, Assignment};
-use super::grid::{ClusterGrid, GridConfig, GridProjection};
-use super::pack::GpuLight;
-use crate::scene;
+use manylight::cluster::assign::{AssignLimits, Assigner, Assignment};
+use manylight::cluster::grid::{ClusterGrid, GridConfig, GridProjection};
+use manylight::cluster::pack::GpuLight;
+use manylight::scene;
 
 /// Untimed assignments before [`AssignWorkload::time`] measures: a cold core (clock, caches,
 /// branch predictors) took 0.16 ms for what takes 0.09 ms warm.
@@ -33,7 +33,7 @@ impl AssignWorkload {
     ///
     /// # Panics
     ///
-    /// When `count` is past [`crate::scene::input::MAX_LIGHTS`] (a benchmark helper: the
+    /// When `count` is past [`manylight::scene::input::MAX_LIGHTS`] (a benchmark helper: the
     /// `bench-assign` command refuses such counts first).
     pub fn default_view(count: usize, seed: u64) -> AssignWorkload {
         // The grid this workload has always timed (64-pixel cells, never narrower than 1/64

@@ -1,7 +1,7 @@
 //! `manylight bench-assign`: light assignment alone on the default view, for scripts.
 
 use clap::Parser;
-use manylight::cluster::workload::{AssignWorkload, BENCH_SIZE, MAX_RUNS};
+use manylight_tools::workload::{AssignWorkload, BENCH_SIZE, MAX_RUNS};
 
 /// Options of `manylight bench-assign`.
 #[derive(Parser, Debug)]

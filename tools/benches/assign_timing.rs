@@ -1,5 +1,5 @@
 //! Quick assignment timings for development: `cargo bench --bench assign_timing`.
-use manylight::cluster::workload::AssignWorkload;
+use manylight_tools::workload::AssignWorkload;
 
 fn main() {
     for count in [1usize, 64, 1024, 16_384, 65_536, 1_048_576] {

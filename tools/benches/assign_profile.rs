@@ -2,7 +2,7 @@
 //! `cargo bench --bench assign_profile -- LIGHTS [REPEATS] [--fine]` (or run its binary under
 //! a profiler); `--fine` takes the fine grid of [`AssignWorkload::fine_grid`].
 use manylight::cluster::assign::Assigner;
-use manylight::cluster::workload::AssignWorkload;
+use manylight_tools::workload::AssignWorkload;
 
 fn main() {
     let mut args = std::env::args()

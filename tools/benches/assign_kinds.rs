@@ -1,6 +1,6 @@
 //! Development aid: assignment time of the default workload's point lights alone and spot
 //! lights alone: `cargo bench --bench assign_kinds -- [LIGHTS]`.
-use manylight::cluster::workload::AssignWorkload;
+use manylight_tools::workload::AssignWorkload;
 
 fn main() {
     let count = std::env::args()

@@ -1,6 +1,6 @@
 //! `manylight bench`: error against run time. Sweeps scenes × light counts × ES versions ×
 //! methods, plus the knobs that trade error for time, and writes the report (see
-//! `manylight::metrics::report`).
+//! `manylight_tools::report`).
 //!
 //! For every (scene, light count, ES version) it renders the reference once (plain forward over
 //! all lights, light model at highp), the lower bound of light evaluations (lights that really
@@ -15,13 +15,13 @@ use indicatif::{ProgressBar, ProgressStyle};
 use manylight::cluster::grid::{Coverage, GridConfig};
 use manylight::gl::HeadlessContext;
 use manylight::methods::{Support, METHODS};
-use manylight::metrics::animated::AnimatedRow;
 use manylight::metrics::cpu_reference::{self, Encoding, ReferenceSet};
 use manylight::metrics::raycast::SceneRaycaster;
-use manylight::metrics::report::{self, BenchRow, Pictures, Report};
 use manylight::renderer::{CountKind, LightCounts};
 use manylight::scene::{self, Scene};
 use manylight::{EsVersion, RenderOptions, Renderer};
+use manylight_tools::animated::AnimatedRow;
+use manylight_tools::report::{self, BenchRow, Pictures, Report};
 
 use crate::EsArg;
 
@@ -675,7 +675,7 @@ fn write_pictures(
     base: &Baseline,
     out: &std::path::Path,
 ) -> Result<Pictures, Box<dyn std::error::Error>> {
-    use manylight::metrics::heatmap::{self, Scale};
+    use manylight_tools::heatmap::{self, Scale};
     std::fs::create_dir_all(out)?;
     let (scene, es, lights) = (at.scene, format!("{}.0", at.es.major()), at.lights);
     let maps = std::iter::once(("lower-bound", &base.bound))

@@ -2,7 +2,7 @@
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use manylight::cluster::assign::Assigner;
-use manylight::cluster::workload::AssignWorkload;
+use manylight_tools::workload::AssignWorkload;
 
 fn assignment(c: &mut Criterion) {
     let mut group = c.benchmark_group("assign");

@@ -13,8 +13,8 @@ use std::path::Path;
 
 use serde::Serialize;
 
-use super::plot::{self, Chart, Marker, Series};
-use crate::methods::{auto, METHODS};
+use crate::plot::{self, Chart, Marker, Series};
+use manylight::methods::{auto, METHODS};
 
 /// One configuration's measurements.
 #[derive(Clone, Debug, Serialize)]
@@ -95,7 +95,7 @@ pub struct Report {
     /// The rows.
     pub rows: Vec<BenchRow>,
     /// The animated workload's rows (frame-time spreads over moving frames).
-    pub animated: Vec<super::animated::AnimatedRow>,
+    pub animated: Vec<crate::animated::AnimatedRow>,
     /// The pictures written beside the report, listed in report.md (not in report.json,
     /// whose fields are the rows').
     #[serde(skip)]
@@ -430,7 +430,7 @@ pub fn markdown(report: &Report) -> String {
         }
         s += "\n";
     }
-    s += &super::animated::markdown(&report.animated);
+    s += &crate::animated::markdown(&report.animated);
     s += "## Charts and pictures\n\n\
           Each method has the same colour and marker in every chart; `auto`, which usually \
           picks clustered, is a larger hollow marker (and a dashed line) around clustered's. \

@@ -368,7 +368,7 @@ fn sheet(rows: &[Value], out: &Path) -> image::RgbaImage {
             cells.push((vec![config.clone(), format!("{name}: {detail}")], thumb));
         }
     }
-    manylight::metrics::sheet::contact_sheet(&cells, METHODS.len())
+    manylight_tools::sheet::contact_sheet(&cells, METHODS.len())
 }
 
 /// Options of the hidden per-configuration child.

@@ -6,7 +6,7 @@ use std::fmt::Write as _;
 
 use serde::Serialize;
 
-use super::spread::Spread;
+use manylight::metrics::spread::Spread;
 
 /// One method over the animated frames of one (scene, ES version, light count).
 #[derive(Clone, Debug, Serialize)]
