@@ -85,8 +85,8 @@ pub fn run(
         scene.set_time(time_of(frame));
         let (image, stats) = renderer.render_offscreen(&scene, width, height, &options)?;
         image.save(out_dir.join(format!("frame_{frame:03}.png")))?;
-        frame_ms.push(stats.frame_ms);
-        assign_ms.push(stats.assign_ms);
+        frame_ms.push(stats.time.frame_ms);
+        assign_ms.push(stats.time.assign_ms);
     }
     let frame = Spread::of(frame_ms);
     Ok(Timings {

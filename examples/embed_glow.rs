@@ -110,7 +110,7 @@ pub fn run(out: &Path, width: u32, height: u32) -> Result<(), Box<dyn std::error
         let stats = renderer.render(&scene, width, height, &options)?;
         println!(
             "manylight: {} lights, {} method, {:.2} ms CPU",
-            stats.lights, stats.method, stats.frame_ms
+            stats.lights.total, stats.method, stats.time.frame_ms
         );
         let mut pixels = vec![0u8; (width * height * 4) as usize];
         unsafe {

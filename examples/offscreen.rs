@@ -99,7 +99,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let stats = run(Path::new(&out), 640, 360)?;
     println!(
         "{out}: {} lights, method {}, {:.1} ms (of which light assignment {:.2} ms)",
-        stats.lights, stats.method, stats.frame_ms, stats.assign_ms
+        stats.lights.total, stats.method, stats.time.frame_ms, stats.time.assign_ms
     );
     Ok(())
 }

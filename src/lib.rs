@@ -45,6 +45,7 @@ macro_rules! lab_modules {
 lab_modules!(cluster, error, gl, gpu_scene, methods, metrics, options, renderer, scene);
 
 // The API a game uses: one path each, at the crate root.
+pub use cluster::assign::AssignStats;
 pub use cluster::grid::{Coverage, GridConfig, GridMode};
 pub use cluster::pack::LightEncoding;
 pub use error::Error;
@@ -55,7 +56,9 @@ pub use methods::{method_names, Support, DEFAULT_METHOD};
 pub use metrics::counts::LightCounts;
 pub use metrics::spread::Spread;
 pub use options::{CountKind, RenderOptions, ToneMap, MAX_TIMED_FRAMES};
-pub use renderer::{FrameStats, Renderer};
+pub use renderer::{
+    ContextStats, FrameStats, GridStats, LightStats, MemoryStats, Renderer, TimeStats,
+};
 pub use scene::features::SceneFeatures;
 pub use scene::meshbuild::MeshBuilder;
 pub use scene::obj::LoadReport;

@@ -95,14 +95,19 @@ pub struct AssignStats {
     /// Most lights any cell touched (before the cap).
     pub max_lights_per_cluster: u32,
     /// Light references dropped by the overflow policy; on a grid of more than
-    /// [`MAX_ASSIGN_CELLS`] cells, which gets none, every light once.
+    /// `MAX_ASSIGN_CELLS` (2²⁶) cells, which gets none, every light once. (A frame's total, with
+    /// forward's, is in its `lights` figures.)
+    #[serde(skip)]
     pub overflowed_lights: u64,
     /// Length of the index list.
+    #[serde(skip)]
     pub indices: usize,
-    /// Lights that touch at least one cell.
+    /// Lights that touch at least one cell (a frame reports them with its `lights` figures).
+    #[serde(skip)]
     pub visible_lights: usize,
     /// Runs of consecutive cells the lights were found to touch (before the cap): the
     /// per-run part of the assignment's work, beside the per-index and per-cell parts.
+    #[serde(rename = "assign_runs")]
     pub runs: usize,
 }
 

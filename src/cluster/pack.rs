@@ -40,10 +40,11 @@ use crate::scene::{Light, LightKind};
 pub const DATA_TEXTURE_WIDTH: u32 = 1024;
 
 /// How light records are stored in the light texture.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum LightEncoding {
     /// RGBA32F, exact.
+    #[default]
     Float32,
     /// RGBA8 fixed point and shared exponent, lossy (the error is measured, not hidden).
     Rgba8,

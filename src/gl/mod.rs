@@ -49,13 +49,14 @@ pub struct Restrictions {
 /// The OpenGL ES feature level the renderer targets. With [`EsVersion::Es2`] the renderer uses
 /// ES 2.0 core plus probed extensions and compiles GLSL ES 1.00, even on a driver that returns
 /// a 3.x context.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
 pub enum EsVersion {
     /// OpenGL ES 2.0, GLSL ES 1.00.
     #[serde(rename = "2.0")]
     Es2,
     /// OpenGL ES 3.0, GLSL ES 3.00.
     #[serde(rename = "3.0")]
+    #[default]
     Es3,
 }
 

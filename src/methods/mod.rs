@@ -27,10 +27,11 @@ use crate::Error;
 pub use features::ShaderFeatures;
 
 /// Whether a method can run on a context.
-#[derive(Clone, Debug, PartialEq, Eq, serde::Serialize)]
+#[derive(Clone, Debug, Default, PartialEq, Eq, serde::Serialize)]
 #[serde(tag = "status", content = "reason", rename_all = "snake_case")]
 pub enum Support {
     /// Runs as designed.
+    #[default]
     Supported,
     /// Runs with a documented degradation (the reason says which).
     Fallback(String),

@@ -9,8 +9,8 @@ use glam::DMat4;
 
 use super::frame_setup::{content_far, gather_lights, shader_features};
 use super::stats::{copy_opt_str, copy_str, copy_support};
+use super::stats::{LightStats, MemoryStats, TimeStats};
 use super::{FrameStats, Renderer};
-use crate::cluster::assign::AssignStats;
 use crate::gl::framebuffer::ColorFormat;
 use crate::methods::{self, FrameContext};
 use crate::options::{CountKind, RenderOptions};
@@ -83,7 +83,7 @@ impl Renderer {
             Ok(()) => {
                 msaa.resolve(&self.dev, &mut self.programs, destination)?;
                 stats.samples = samples;
-                stats.msaa_bytes = msaa.gpu_bytes();
+                stats.memory.msaa_bytes = msaa.gpu_bytes();
                 Ok(())
             }
             // A failed frame is not resolved over the caller's picture.
@@ -174,58 +174,57 @@ impl Renderer {
         self.dev.check("frame")?;
         let frame_ms = start.elapsed().as_secs_f64() * 1e3;
         let caps = self.dev.caps();
-        let assign = method_stats.assign.unwrap_or(AssignStats::default());
+        let assignment = method_stats.assign.unwrap_or_default();
         let grid = method_stats.grid.as_ref();
         copy_str(&mut stats.method, method_name);
-        stats.es = caps.es;
-        copy_str(&mut stats.gl_version, &caps.gl_version);
-        copy_str(&mut stats.renderer, &caps.renderer);
+        copy_support(&mut stats.support, &self.support);
+        let auto = method_stats.auto_choice;
+        copy_opt_str(&mut stats.auto_choice, auto.map(|(c, _)| c));
+        copy_opt_str(&mut stats.auto_reason, auto.map(|(_, r)| r));
+        let context = &mut stats.context;
+        context.es = caps.es;
+        copy_str(&mut context.gl_version, &caps.gl_version);
+        copy_str(&mut context.renderer, &caps.renderer);
+        copy_opt_str(&mut context.lp_num_threads, self.lp_num_threads.as_deref());
         stats.width = width;
         stats.height = height;
-        stats.lights = scene.lights.len();
-        stats.active_lights = self.lights.len();
-        stats.frame_ms = frame_ms;
-        stats.gpu_ms = gpu_ms;
-        stats.upload_bytes = method_stats.upload_bytes;
-        stats.assign_ms = method_stats.assign_ms.unwrap_or(0.0);
-        stats.clusters = assign.clusters;
-        stats.nonempty_clusters = assign.nonempty_clusters;
-        stats.avg_lights_per_nonempty = assign.avg_lights_per_nonempty;
-        stats.assign_runs = assign.runs;
-        stats.max_lights_per_cluster = assign.max_lights_per_cluster;
-        stats.overflowed_lights = assign.overflowed_lights + method_stats.dropped_lights;
-        stats.visible_lights = method_stats
-            .assign
-            .map_or(self.lights.len(), |a| a.visible_lights);
-        stats.light_encoding = features.light_encoding();
-        copy_support(&mut stats.support, &self.support);
-        stats.triangles = scene.objects.iter().map(|o| o.mesh.triangle_count()).sum();
-        stats.gbuffer_bytes = method_stats.gbuffer_bytes;
-        copy_opt_str(
-            &mut stats.auto_choice,
-            method_stats.auto_choice.map(|(c, _)| c),
-        );
-        copy_opt_str(
-            &mut stats.auto_reason,
-            method_stats.auto_choice.map(|(_, r)| r),
-        );
-        copy_opt_str(&mut stats.lp_num_threads, self.lp_num_threads.as_deref());
-        stats.scene_features = scene_features;
-        stats.grid_footprint_px = grid.map(|g| g.footprint_px);
-        stats.grid_cells = grid.map_or(0, |g| g.cells);
-        copy_opt_str(&mut stats.grid_reason, grid.map(|g| g.reason));
         stats.samples = 1;
-        stats.msaa_bytes = 0;
-        stats.upload_bytes_spread = None;
-        stats.frame_ms_spread = None;
-        stats.assign_ms_spread = None;
+        stats.triangles = scene.objects.iter().map(|o| o.mesh.triangle_count()).sum();
+        stats.scene_features = scene_features;
+        stats.time = TimeStats {
+            frame_ms,
+            gpu_ms,
+            assign_ms: method_stats.assign_ms.unwrap_or(0.0),
+            frame_ms_spread: None,
+            assign_ms_spread: None,
+        };
+        stats.lights = LightStats {
+            total: scene.lights.len(),
+            active: self.lights.len(),
+            visible: method_stats
+                .assign
+                .map_or(self.lights.len(), |a| a.visible_lights),
+            overflowed: assignment.overflowed_lights + method_stats.dropped_lights,
+            encoding: features.light_encoding(),
+        };
+        stats.assignment = assignment;
+        stats.grid.footprint_px = grid.map(|g| g.footprint_px);
+        stats.grid.cells = grid.map_or(0, |g| g.cells);
+        copy_opt_str(&mut stats.grid.reason, grid.map(|g| g.reason));
+        stats.memory = MemoryStats {
+            upload_bytes: method_stats.upload_bytes,
+            upload_bytes_spread: None,
+            method_gpu_bytes: 0,
+            gbuffer_bytes: method_stats.gbuffer_bytes,
+            msaa_bytes: 0,
+        };
         // Only colour frames that waited for the GPU (or were timed on it) say what shading
         // costs: count passes run other shaders.
         if options.count == CountKind::None {
             let waited = options.wait_for_gpu.then_some(frame_ms);
             self.method.observe_frame(waited, gpu_ms);
         }
-        stats.method_gpu_bytes = self.method.gpu_bytes();
+        stats.memory.method_gpu_bytes = self.method.gpu_bytes();
         Ok(())
     }
 

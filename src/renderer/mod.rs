@@ -20,7 +20,7 @@ use crate::methods::{self, ShadingMethod, Support};
 pub use crate::metrics::counts::LightCounts;
 pub use crate::options::{CountKind, RenderOptions, ToneMap};
 use crate::Error;
-pub use stats::FrameStats;
+pub use stats::{ContextStats, FrameStats, GridStats, LightStats, MemoryStats, TimeStats};
 
 /// Renders scenes with one shading method at a time.
 pub struct Renderer {

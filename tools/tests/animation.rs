@@ -172,7 +172,7 @@ fn culled_methods_match_forward_on_moving_frames() {
                         "{es} frame {k} {method}: max error {} > 2/255 against forward",
                         d.max_abs
                     );
-                    assert_eq!(stats.overflowed_lights, 0);
+                    assert_eq!(stats.lights.overflowed, 0);
                 }
             }
         }

@@ -73,14 +73,14 @@ fn tiled_and_clustered_match_forward_within_2_of_255() {
                     for method in ["tiled", "clustered"] {
                         let (img, stats) = render(&mut gpu, method, &scene, &opts);
                         let d = diff(&reference, &img);
-                        eprintln!("{es} {name} {lights} lights {method} linear={linear}: max {} rmse {:.3}, {} cells, {:.1} lights/cell", d.max_abs, d.rmse, stats.nonempty_clusters, stats.avg_lights_per_nonempty);
+                        eprintln!("{es} {name} {lights} lights {method} linear={linear}: max {} rmse {:.3}, {} cells, {:.1} lights/cell", d.max_abs, d.rmse, stats.assignment.nonempty_clusters, stats.assignment.avg_lights_per_nonempty);
                         assert!(
                             d.max_abs <= 2,
                             "{es} {name} {lights} {method}: max abs error {} > 2/255",
                             d.max_abs
                         );
-                        assert_eq!(stats.overflowed_lights, 0);
-                        assert!(stats.clusters > 0 && stats.visible_lights > 0);
+                        assert_eq!(stats.lights.overflowed, 0);
+                        assert!(stats.assignment.clusters > 0 && stats.lights.visible > 0);
                     }
                 }
             }
@@ -96,11 +96,13 @@ fn clustered_lists_are_short() {
     let (_, tiled) = render(&mut gpu, "tiled", &scene, &RenderOptions::default());
     let (_, clustered) = render(&mut gpu, "clustered", &scene, &RenderOptions::default());
     assert!(
-        clustered.avg_lights_per_nonempty < 1024.0 / 10.0,
+        clustered.assignment.avg_lights_per_nonempty < 1024.0 / 10.0,
         "{}",
-        clustered.avg_lights_per_nonempty
+        clustered.assignment.avg_lights_per_nonempty
     );
-    assert!(clustered.avg_lights_per_nonempty < tiled.avg_lights_per_nonempty);
+    assert!(
+        clustered.assignment.avg_lights_per_nonempty < tiled.assignment.avg_lights_per_nonempty
+    );
 }
 
 /// 300 lights in one cell with a per-cell cap of 255, on ES 2.0 and ES 3.0 (whose grid texture
@@ -139,14 +141,14 @@ fn overflow_policy_holds_in_a_real_render() {
         let (reference, _) = render(&mut gpu, "forward", &scene, &opts);
         let (img, stats) = render(&mut gpu, "clustered", &scene, &opts);
         assert!(
-            stats.max_lights_per_cluster >= 300,
+            stats.assignment.max_lights_per_cluster >= 300,
             "{es}: {}",
-            stats.max_lights_per_cluster
+            stats.assignment.max_lights_per_cluster
         );
         assert!(
-            stats.overflowed_lights >= 45,
+            stats.lights.overflowed >= 45,
             "{es}: overflow not counted: {}",
-            stats.overflowed_lights
+            stats.lights.overflowed
         );
         // Left half (far from the crowd) is exact; the crowded spot degrades but stays bounded.
         let mut left_max = 0u8;
@@ -165,7 +167,7 @@ fn overflow_policy_holds_in_a_real_render() {
         let d = diff(&reference, &img);
         eprintln!(
             "{es} overflow: {} dropped, max error {} / 255, rmse {:.3}",
-            stats.overflowed_lights, d.max_abs, d.rmse
+            stats.lights.overflowed, d.max_abs, d.rmse
         );
 
         // An index budget far below the lists' length: the cap is lowered, nothing breaks.
@@ -174,7 +176,7 @@ fn overflow_policy_holds_in_a_real_render() {
             ..opts.clone()
         };
         let (_, stats) = render(&mut gpu, "clustered", &scene, &tight);
-        assert!(stats.overflowed_lights > 0);
+        assert!(stats.lights.overflowed > 0);
         let said = warnings_containing(warning);
         assert_eq!(
             said.len(),
@@ -218,13 +220,13 @@ fn a_grid_the_texture_cannot_hold_is_a_clear_error() {
         }
         other => panic!(
             "expected a limit error, got {:?}",
-            other.map(|(_, s)| s.grid_cells)
+            other.map(|(_, s)| s.grid.cells)
         ),
     }
     let (_, stats) = gpu
         .r()
         .render_offscreen(&scene, 640, 360, &RenderOptions::default())
         .unwrap();
-    assert!(stats.grid_cells <= manylight::cluster::auto::CELL_BUDGET);
-    assert!(stats.grid_reason.unwrap().starts_with("auto"));
+    assert!(stats.grid.cells <= manylight::cluster::auto::CELL_BUDGET);
+    assert!(stats.grid.reason.unwrap().starts_with("auto"));
 }

@@ -32,7 +32,7 @@ fn deferred_matches_forward_within_2_of_255_on_opaque_scenes() {
                     d.max_abs
                 );
                 let per_pixel = manylight::gl::gbuffer::bytes_per_pixel(gpu.r().caps());
-                assert_eq!(stats.gbuffer_bytes, 256 * 144 * per_pixel);
+                assert_eq!(stats.memory.gbuffer_bytes, 256 * 144 * per_pixel);
             }
         }
     }

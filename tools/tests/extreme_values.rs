@@ -216,5 +216,5 @@ fn a_huge_timed_frame_count_is_refused_naming_the_field() {
         ..RenderOptions::default()
     };
     let (_, stats) = gpu.r().render_offscreen(&s, 16, 16, &options).unwrap();
-    assert_eq!(stats.frame_ms_spread.map(|s| s.frames), Some(3));
+    assert_eq!(stats.time.frame_ms_spread.map(|s| s.frames), Some(3));
 }

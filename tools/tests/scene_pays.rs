@@ -175,7 +175,11 @@ fn a_method_allocates_nothing_before_it_has_lights_to_draw() {
         .render_offscreen(&s, 64, 36, &RenderOptions::default())
         .unwrap();
     assert_eq!(
-        (stats.upload_bytes, stats.assign_ms, stats.method_gpu_bytes),
+        (
+            stats.memory.upload_bytes,
+            stats.time.assign_ms,
+            stats.memory.method_gpu_bytes
+        ),
         (0, 0.0, 0),
         "zero lights did light work"
     );
@@ -184,7 +188,7 @@ fn a_method_allocates_nothing_before_it_has_lights_to_draw() {
         .r()
         .render_offscreen(&s, 64, 36, &RenderOptions::default())
         .unwrap();
-    assert!(stats.upload_bytes > 0 && stats.method_gpu_bytes > 0);
+    assert!(stats.memory.upload_bytes > 0 && stats.memory.method_gpu_bytes > 0);
 }
 
 #[test]

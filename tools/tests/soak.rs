@@ -180,13 +180,13 @@ fn owned_strings(s: &FrameStats) -> usize {
         Support::Supported => None,
         Support::Fallback(r) | Support::Unsupported(r) => Some(r),
     };
-    [&s.method, &s.gl_version, &s.renderer]
+    [&s.method, &s.context.gl_version, &s.context.renderer]
         .into_iter()
         .chain(reason)
         .chain(s.auto_choice.as_ref())
         .chain(s.auto_reason.as_ref())
-        .chain(s.lp_num_threads.as_ref())
-        .chain(s.grid_reason.as_ref())
+        .chain(s.context.lp_num_threads.as_ref())
+        .chain(s.grid.reason.as_ref())
         .filter(|s| !s.is_empty())
         .count()
 }
@@ -424,7 +424,7 @@ fn allocations_per_frame(
             TRACING.store(false, Ordering::Relaxed);
             if cell_cap.is_some() {
                 assert!(
-                    stats.overflowed_lights > 0,
+                    stats.lights.overflowed > 0,
                     "{case}: the cap trimmed no cell"
                 );
             }

@@ -67,7 +67,7 @@ fn check_with(name: &str, scene: &Scene, w: u32, h: u32, opts: &RenderOptions) -
                     d.rmse
                 );
             }
-            assert_eq!(stats.overflowed_lights, 0, "{name} {es} {method}");
+            assert_eq!(stats.lights.overflowed, 0, "{name} {es} {method}");
             assert_finite_hdr(
                 &mut gpu,
                 scene,
@@ -129,7 +129,7 @@ fn check_without_fragment_highp(
             .map(|l| manylight::cluster::pack::GpuLight::from_light(l, &view))
             .collect();
         let kept = manylight::methods::forward_cap::most_important_indices(&gpu_lights, limit);
-        assert_eq!(stats.overflowed_lights as usize, active.len() - kept.len());
+        assert_eq!(stats.lights.overflowed as usize, active.len() - kept.len());
         eprintln!(
             "{name} without fragment highp: forward kept {} of {} lights",
             kept.len(),
@@ -234,7 +234,11 @@ fn zero_lights_is_exactly_ambient_and_does_no_grid_work() {
             .render_offscreen(&s, 64, 36, &RenderOptions::default())
             .unwrap();
         assert_eq!(
-            (stats.upload_bytes, stats.clusters, stats.assign_ms),
+            (
+                stats.memory.upload_bytes,
+                stats.assignment.clusters,
+                stats.time.assign_ms
+            ),
             (0, 0, 0.0),
             "{method} did grid work"
         );
@@ -273,7 +277,7 @@ fn lights_behind_the_camera_and_beyond_far() {
         .render_offscreen(&s, 96, 54, &RenderOptions::default())
         .unwrap();
     assert_eq!(
-        stats.visible_lights, 2,
+        stats.lights.visible, 2,
         "lights behind the camera or beyond far must be counted nowhere"
     );
 }
@@ -383,7 +387,7 @@ fn degenerate_and_huge_radii_and_intensities() {
             .render_offscreen(&s, 32, 18, &RenderOptions::default())
             .unwrap();
         assert_eq!(
-            stats.active_lights, 3,
+            stats.lights.active, 3,
             "{method}: the radius-0 light is inactive"
         );
     }
@@ -446,8 +450,10 @@ fn crowded_cells_and_index_lists_past_16_bits() {
         .r()
         .render_offscreen(&s, 256, 144, &RenderOptions::default())
         .unwrap();
-    assert!(stats.nonempty_clusters > 0);
-    let indices = (stats.avg_lights_per_nonempty * stats.nonempty_clusters as f64).round() as usize;
+    assert!(stats.assignment.nonempty_clusters > 0);
+    let indices = (stats.assignment.avg_lights_per_nonempty
+        * stats.assignment.nonempty_clusters as f64)
+        .round() as usize;
     assert!(
         indices > 65_536,
         "only {indices} indices: the case does not reach past 16 bits"

@@ -206,7 +206,7 @@ pub fn assert_methods_match_forward_with_4_samples(
         gpu.r().set_method(method).unwrap();
         let (img, stats) = gpu.r().render_offscreen(&scene, 128, 72, &msaa(4)).unwrap();
         assert_eq!(stats.samples, 4);
-        assert_eq!(stats.msaa_bytes, 128 * 72 * bytes_per_pixel);
+        assert_eq!(stats.memory.msaa_bytes, 128 * 72 * bytes_per_pixel);
         let d = manylight::metrics::diff(&reference, &img);
         assert!(d.max_abs <= 2, "{method}: {} / 255 from forward", d.max_abs);
     }

@@ -506,9 +506,17 @@ impl Measure<'_> {
         let rendered = match self.frames {
             Frames::Fixed(n) => Ok(n),
             // One untimed frame says how slow the configuration is.
-            Frames::Adaptive => renderer
-                .render_offscreen(self.scene, w, h, &opts)
-                .map(|(_, first)| if first.frame_ms > SLOW_FRAME_MS { 3 } else { 9 }),
+            Frames::Adaptive => {
+                renderer
+                    .render_offscreen(self.scene, w, h, &opts)
+                    .map(|(_, first)| {
+                        if first.time.frame_ms > SLOW_FRAME_MS {
+                            3
+                        } else {
+                            9
+                        }
+                    })
+            }
         }
         .and_then(|frames| {
             opts.timed_frames = frames;
@@ -530,15 +538,15 @@ impl Measure<'_> {
         let row = BenchRow {
             scene: self.name.to_string(),
             method: method.to_string(),
-            es: format!("{}.0", stats.es.major()),
+            es: format!("{}.0", stats.context.es.major()),
             lights: self.scene.lights.len(),
             width: w,
             height: h,
             knob: knob.to_string(),
-            frame_ms: stats.frame_ms,
-            gpu_ms: stats.gpu_ms,
-            assign_ms: stats.assign_ms,
-            upload_bytes: stats.upload_bytes,
+            frame_ms: stats.time.frame_ms,
+            gpu_ms: stats.time.gpu_ms,
+            assign_ms: stats.time.assign_ms,
+            upload_bytes: stats.memory.upload_bytes,
             light_evals: evals.total(),
             evals_per_pixel: evals.mean(),
             max_evals: evals.max(),
@@ -552,12 +560,12 @@ impl Measure<'_> {
             over_2: d.over_2,
             cpu_max_abs_err: (cpu.samples > 0).then_some(cpu.max_abs),
             cpu_samples: cpu.samples,
-            overflowed_lights: stats.overflowed_lights,
-            grid_footprint_px: stats.grid_footprint_px,
-            grid_cells: stats.grid_cells,
-            grid_reason: stats.grid_reason.clone(),
-            renderer: stats.renderer.clone(),
-            lp_num_threads: stats.lp_num_threads.clone(),
+            overflowed_lights: stats.lights.overflowed,
+            grid_footprint_px: stats.grid.footprint_px,
+            grid_cells: stats.grid.cells,
+            grid_reason: stats.grid.reason.clone(),
+            renderer: stats.context.renderer.clone(),
+            lp_num_threads: stats.context.lp_num_threads.clone(),
         };
         Ok(Some(Measured { row, image, evals }))
     }
@@ -630,9 +638,9 @@ impl AnimatedWorkload {
             Some(manylight::metrics::diff(&reference, &rendered.last).max_abs)
         };
         let (Some(frame_ms), Some(assign_ms), Some(upload_bytes)) = (
-            stats.frame_ms_spread,
-            stats.assign_ms_spread,
-            stats.upload_bytes_spread,
+            stats.time.frame_ms_spread,
+            stats.time.assign_ms_spread,
+            stats.memory.upload_bytes_spread,
         ) else {
             return Ok(None);
         };

@@ -42,7 +42,9 @@ fn scene_report(
         let (_, stats) =
             renderer.render_offscreen(&scene, 64, 36, &manylight::RenderOptions::default())?;
         features = Some(stats.scene_features);
-        methods.push(serde_json::json!({"method": m.name, "gpu_bytes": stats.method_gpu_bytes}));
+        methods.push(
+            serde_json::json!({"method": m.name, "gpu_bytes": stats.memory.method_gpu_bytes}),
+        );
     }
     let variants: Vec<_> = renderer
         .program_report()

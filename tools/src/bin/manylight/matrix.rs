@@ -468,8 +468,8 @@ pub fn run_cell(args: &MatrixCellArgs) -> Result<(), Box<dyn std::error::Error>>
             img.save(args.out.join(&file))?;
             entry["max_abs"] = json!(d.max_abs);
             entry["over_2"] = json!(d.over_2);
-            entry["frame_ms"] = json!(stats.frame_ms);
-            entry["light_encoding"] = json!(stats.light_encoding);
+            entry["frame_ms"] = json!(stats.time.frame_ms);
+            entry["light_encoding"] = json!(stats.lights.encoding);
             entry["image"] = json!(file);
         }
         methods.push(entry);

@@ -264,7 +264,7 @@ pub fn run(args: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
             .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
     }
     // The slow frames too, where enough frames were timed for them to mean something.
-    let mut tail = match stats.frame_ms_spread {
+    let mut tail = match stats.time.frame_ms_spread {
         Some(s) if s.frames >= 10 => {
             format!(" (p95 {:.1}, p99 {:.1}, max {:.1})", s.p95, s.p99, s.max)
         }
@@ -286,10 +286,10 @@ pub fn run(args: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
         width,
         height,
         stats.method,
-        stats.lights,
-        stats.es,
-        stats.renderer,
-        stats.frame_ms,
+        stats.lights.total,
+        stats.context.es,
+        stats.context.renderer,
+        stats.time.frame_ms,
         args.out.display()
     );
     Ok(())

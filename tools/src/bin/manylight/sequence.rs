@@ -133,9 +133,9 @@ pub fn render(
         // Dropping the encoder writes the trailer; flush errors surface here.
         drop(encoder);
     }
-    let upload = Spread::of(timed.iter().map(|s| s.upload_bytes as f64));
+    let upload = Spread::of(timed.iter().map(|s| s.memory.upload_bytes as f64));
     let mut stats = FrameStats::summarize(timed).unwrap_or(warm_up);
-    stats.upload_bytes_spread = upload;
+    stats.memory.upload_bytes_spread = upload;
     Ok(Rendered {
         last: last.unwrap_or_else(|| first.clone()),
         first,

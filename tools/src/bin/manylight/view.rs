@@ -466,7 +466,7 @@ impl App<'_> {
 fn summary(stats: &FrameStats, es: EsVersion) -> String {
     format!(
         "manylight · {} · {es} · {} lights",
-        stats.method, stats.lights
+        stats.method, stats.lights.total
     )
 }
 
@@ -475,8 +475,8 @@ fn title(stats: &FrameStats, es: EsVersion, frame_ms: f64) -> String {
     format!(
         "{} · {frame_ms:.1} ms/frame · cpu {:.1} ms · assign {:.2} ms",
         summary(stats, es),
-        stats.frame_ms,
-        stats.assign_ms
+        stats.time.frame_ms,
+        stats.time.assign_ms
     )
 }
 
@@ -485,15 +485,13 @@ fn update_title(t: &mut TitleStats, g: &Gfx, stats: &FrameStats, dt: f64) {
     let since = *t.since.get_or_insert_with(Instant::now);
     t.frames += 1;
     t.wall_s += dt;
-    t.cpu_ms += stats.frame_ms;
-    t.assign_ms += stats.assign_ms;
+    t.cpu_ms += stats.time.frame_ms;
+    t.assign_ms += stats.time.assign_ms;
     if since.elapsed().as_secs_f64() >= TITLE_EVERY_S {
         let n = f64::from(t.frames);
-        let mean = FrameStats {
-            frame_ms: t.cpu_ms / n,
-            assign_ms: t.assign_ms / n,
-            ..stats.clone()
-        };
+        let mut mean = stats.clone();
+        mean.time.frame_ms = t.cpu_ms / n;
+        mean.time.assign_ms = t.assign_ms / n;
         g.window.set_title(&title(&mean, g.es, t.wall_s * 1e3 / n));
         *t = TitleStats::default();
     }
