@@ -55,7 +55,7 @@ pub use gl::{Caps, EsVersion, GlError, HeadlessContext, Restrictions};
 pub use methods::{method_names, Support, DEFAULT_METHOD};
 pub use metrics::counts::LightCounts;
 pub use metrics::spread::Spread;
-pub use options::{CountKind, RenderOptions, ToneMap, MAX_TIMED_FRAMES};
+pub use options::{CountKind, MeasureOptions, RenderOptions, ToneMap, MAX_TIMED_FRAMES};
 pub use renderer::{
     ContextStats, FrameStats, GridStats, LightStats, MemoryStats, Renderer, TimeStats,
 };

@@ -6,7 +6,7 @@ use serde::Serialize;
 use crate::cluster::grid::GridConfig;
 use crate::cluster::tiles::TILE_PX;
 
-/// Most frames one call times ([`RenderOptions::timed_frames`], `render --frames`): each
+/// Most frames one call times ([`MeasureOptions::timed_frames`], `render --frames`): each
 /// timed frame's figures are kept until the percentiles are taken, so a count near 2³² would
 /// grow memory for as long as it ran (65 536 frames are 18 minutes at 60 frames a second).
 pub const MAX_TIMED_FRAMES: u32 = 1 << 16;
@@ -17,24 +17,12 @@ pub struct RenderOptions {
     /// Write linear values (clamped to [0, 1], no sRGB encoding; exposure and tone map still
     /// apply when set, and are off by default) so pixels can be checked against the light model.
     pub linear: bool,
-    /// Pack lights as RGBA8 even where float textures exist (to measure the packing error).
-    pub force_rgba8_lights: bool,
     /// Background colour (linear if `linear`, else as stored).
     pub clear_color: [f32; 4],
-    /// Frames timed after one warm-up frame by [`Renderer::render_offscreen`](crate::Renderer::render_offscreen); the median is
-    /// reported. 0 times the single (cold) frame. At most [`MAX_TIMED_FRAMES`] (the frames'
-    /// figures are kept for the percentiles): more is refused naming `timed_frames`.
-    pub timed_frames: u32,
     /// Cluster grid of the clustered method.
     pub grid: GridConfig,
     /// Tile size in pixels of the tiled method.
     pub tile_px: f64,
-    /// Most lights per cell (tiled/clustered); ES 2.0 never exceeds 255. `None`: no cap
-    /// beyond the encoding's.
-    pub cell_cap: Option<u32>,
-    /// Most indices in a frame's light lists (tiled/clustered); `None`: what the index texture
-    /// holds. Lower values exercise the overflow policy.
-    pub max_indices: Option<usize>,
     /// Wait for the GPU (`glFinish`) at the end of [`Renderer::render`](crate::Renderer::render) so `frame_ms` is the
     /// full frame time. Offscreen rendering and benchmarks want this; a game presenting to a
     /// window sets it to `false` and `frame_ms` is then the CPU submission time only.
@@ -42,10 +30,6 @@ pub struct RenderOptions {
     /// Write linear, unclamped radiance (for float targets; see
     /// [`Renderer::render_offscreen_hdr`](crate::Renderer::render_offscreen_hdr)).
     pub hdr: bool,
-    /// Evaluate the light model's mediump tier at highp as well (the `reference_precision`
-    /// variant): the reference image error is measured against. Off, colour factors run at
-    /// mediump as a mobile build wants (see `glsl/light_model.glsl`).
-    pub reference_precision: bool,
     /// What the frame writes: colour, or per-pixel light counts (see
     /// [`Renderer::render_light_counts`](crate::Renderer::render_light_counts), which sets this).
     pub count: CountKind,
@@ -67,35 +51,55 @@ pub struct RenderOptions {
     /// that was bound (ES 3.0; forward, tiled, clustered and auto; not deferred, not HDR output;
     /// light counts are never multisampled).
     pub samples: u32,
-    /// Compile every variant with spot, specular and texture code even where the scene lacks
-    /// them (a white texture stands in) — to measure what leaving features out saves, and to
-    /// test that it changes nothing in the image.
-    pub full_variants: bool,
+    /// Knobs for measuring and testing the renderer (timed frames, forced encodings, caps that
+    /// exercise the overflow policy); a game leaves them at their defaults.
+    pub measure: MeasureOptions,
 }
 
 impl Default for RenderOptions {
     fn default() -> Self {
         RenderOptions {
             linear: false,
-            force_rgba8_lights: false,
             clear_color: [0.0, 0.0, 0.0, 1.0],
-            timed_frames: 0,
             grid: GridConfig::default(),
             tile_px: TILE_PX,
-            cell_cap: None,
-            max_indices: None,
             wait_for_gpu: true,
             hdr: false,
-            reference_precision: false,
             count: CountKind::None,
             light_cutoff: None,
             heat_scale: 64.0,
-            full_variants: false,
             tone_map: ToneMap::None,
             exposure_ev: 0.0,
             samples: 1,
+            measure: MeasureOptions::default(),
         }
     }
+}
+
+/// What the benchmarks and tests turn to measure the renderer: each default is what a game
+/// wants.
+#[derive(Clone, Debug, Default)]
+pub struct MeasureOptions {
+    /// Frames timed after one warm-up frame by [`Renderer::render_offscreen`](crate::Renderer::render_offscreen); the median is
+    /// reported. 0 times the single (cold) frame. At most [`MAX_TIMED_FRAMES`] (the frames'
+    /// figures are kept for the percentiles): more is refused naming `timed_frames`.
+    pub timed_frames: u32,
+    /// Pack lights as RGBA8 even where float textures exist (to measure the packing error).
+    pub force_rgba8_lights: bool,
+    /// Most lights per cell (tiled/clustered); ES 2.0 never exceeds 255. `None`: no cap
+    /// beyond the encoding's.
+    pub cell_cap: Option<u32>,
+    /// Most indices in a frame's light lists (tiled/clustered); `None`: what the index texture
+    /// holds. Lower values exercise the overflow policy.
+    pub max_indices: Option<usize>,
+    /// Evaluate the light model's mediump tier at highp as well (the `reference_precision`
+    /// variant): the reference image error is measured against. Off, colour factors run at
+    /// mediump as a mobile build wants (see `glsl/light_model.glsl`).
+    pub reference_precision: bool,
+    /// Compile every variant with spot, specular and texture code even where the scene lacks
+    /// them (a white texture stands in) — to measure what leaving features out saves, and to
+    /// test that it changes nothing in the image.
+    pub full_variants: bool,
 }
 
 /// The curve that maps exposed linear radiance (0 to ∞) into the displayable [0, 1], applied

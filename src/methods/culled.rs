@@ -208,10 +208,11 @@ impl ShadingMethod for CulledForward {
         let mut max_indices = capacity.index_entries;
         let cell_cap = ctx
             .options
+            .measure
             .cell_cap
             .unwrap_or(u32::MAX)
             .min(capacity.cell_lights.unwrap_or(u32::MAX));
-        if let Some(m) = ctx.options.max_indices {
+        if let Some(m) = ctx.options.measure.max_indices {
             max_indices = max_indices.min(m);
         }
         let limits = AssignLimits {
@@ -261,7 +262,7 @@ impl ShadingMethod for CulledForward {
                 "{method}: {dropped} light references left out of this frame's cell lists, so \
                  the image lacks those lights where they reach ({cap}, and at most {} \
                  references fit in the index list here: the index texture's capacity on this \
-                 context or RenderOptions::max_indices; each cell keeps the lights that matter \
+                 context or MeasureOptions::max_indices; each cell keeps the lights that matter \
                  most to it, and FrameStats::overflowed_lights counts the dropped ones every \
                  frame): a coarser grid (grid.footprint_px), deeper slices (grid.slice_depth) \
                  or the automatic grid avoid it",

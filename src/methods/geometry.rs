@@ -139,7 +139,7 @@ pub(crate) fn shade_object(
     let dialect = dev.es();
     let object = &ctx.scene.objects[index];
     let material = &ctx.scene.materials[object.material];
-    let full = ctx.options.full_variants;
+    let full = ctx.options.measure.full_variants;
     let texture = ctx
         .gpu_scene
         .texture_for(material)

@@ -114,7 +114,7 @@ impl Renderer {
             return Err(Error::Limit(format!("viewport {width}×{height} is empty")));
         }
         self.gpu_scene
-            .upload(&self.dev, scene, options.full_variants)?;
+            .upload(&self.dev, scene, options.measure.full_variants)?;
         let view: DMat4 = scene.camera.view_matrix();
         let projection = scene
             .camera
@@ -294,13 +294,13 @@ fn check_options(options: &RenderOptions) -> Result<(), Error> {
             );
         }
     }
-    if options.timed_frames > crate::options::MAX_TIMED_FRAMES {
+    if options.measure.timed_frames > crate::options::MAX_TIMED_FRAMES {
         let why = format!(
             "must be at most {}, got {}",
             crate::options::MAX_TIMED_FRAMES,
-            options.timed_frames
+            options.measure.timed_frames
         );
-        return invalid("timed_frames", why);
+        return invalid("measure.timed_frames", why);
     }
     let cascades = options.grid.cascades;
     if cascades > crate::cluster::grid::MAX_CASCADES {

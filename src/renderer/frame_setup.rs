@@ -45,7 +45,7 @@ pub(super) fn shader_features(
     ShaderFeatures::default()
         .with(
             ShaderFeatures::SPOT,
-            scene_features.spot_lights || options.full_variants,
+            scene_features.spot_lights || options.measure.full_variants,
         )
         .with(ShaderFeatures::OUTPUT_LINEAR, options.linear)
         .with(
@@ -63,7 +63,7 @@ pub(super) fn shader_features(
         .with(ShaderFeatures::OUTPUT_HDR, options.hdr)
         .with(
             ShaderFeatures::REFERENCE_PRECISION,
-            options.reference_precision,
+            options.measure.reference_precision,
         )
         .with(ShaderFeatures::FP16_LIGHTS, !caps.fragment_has_highp())
         .with(
@@ -80,7 +80,7 @@ pub(super) fn shader_features(
         )
         .with(
             ShaderFeatures::LIGHTS_RGBA8,
-            options.force_rgba8_lights || !caps.float_textures,
+            options.measure.force_rgba8_lights || !caps.float_textures,
         )
         .with(
             ShaderFeatures::UNIFORM_LIGHT_LOOP,

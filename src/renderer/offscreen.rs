@@ -12,7 +12,7 @@ use crate::Error;
 
 impl Renderer {
     /// Renders into an internal `width × height` target and reads it back (top row first).
-    /// With `options.timed_frames > 0`, renders one warm-up frame and reports the median of
+    /// With `options.measure.timed_frames > 0`, renders one warm-up frame and reports the median of
     /// the timed ones.
     pub fn render_offscreen(
         &mut self,
@@ -75,10 +75,10 @@ impl Renderer {
         }
         self.target.as_ref().expect("created above").bind(&self.dev);
         let mut stats = self.render(scene, width, height, options)?;
-        if options.timed_frames > 0 {
+        if options.measure.timed_frames > 0 {
             // The warm-up frame compiled shaders and uploaded meshes; report the timed ones.
             let mut frames = Vec::new();
-            for _ in 0..options.timed_frames {
+            for _ in 0..options.measure.timed_frames {
                 frames.push(self.render(scene, width, height, options)?);
             }
             stats = FrameStats::summarize(frames).expect("at least one timed frame");
@@ -99,12 +99,12 @@ impl Renderer {
         options: &RenderOptions,
         kind: CountKind,
     ) -> Result<(LightCounts, FrameStats), Error> {
-        let options = RenderOptions {
+        let mut options = RenderOptions {
             count: kind,
             clear_color: [0.0; 4],
-            timed_frames: 0,
             ..options.clone()
         };
+        options.measure.timed_frames = 0;
         let (image, stats) = if kind == CountKind::Reaching {
             // A plain-forward pass whatever the method: swap one in for this frame.
             let forward = (methods::find("forward")?.create)(&self.dev)?;

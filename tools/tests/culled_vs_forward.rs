@@ -133,7 +133,10 @@ fn overflow_policy_holds_in_a_real_render() {
     ));
     let opts = RenderOptions {
         linear: true,
-        cell_cap: Some(255),
+        measure: manylight::MeasureOptions {
+            cell_cap: Some(255),
+            ..Default::default()
+        },
         ..Default::default()
     };
     for (run, es) in [EsVersion::Es2, EsVersion::Es3].into_iter().enumerate() {
@@ -172,7 +175,10 @@ fn overflow_policy_holds_in_a_real_render() {
 
         // An index budget far below the lists' length: the cap is lowered, nothing breaks.
         let tight = RenderOptions {
-            max_indices: Some(64),
+            measure: manylight::MeasureOptions {
+                max_indices: Some(64),
+                ..Default::default()
+            },
             ..opts.clone()
         };
         let (_, stats) = render(&mut gpu, "clustered", &scene, &tight);

@@ -205,14 +205,20 @@ fn a_huge_timed_frame_count_is_refused_naming_the_field() {
     let s = plane(vec![point(3.0)]);
     for frames in [u32::MAX, manylight::MAX_TIMED_FRAMES + 1] {
         let options = RenderOptions {
-            timed_frames: frames,
+            measure: manylight::MeasureOptions {
+                timed_frames: frames,
+                ..Default::default()
+            },
             ..RenderOptions::default()
         };
         let err = refusal(&mut gpu, &s, &options);
         assert!(err.contains("timed_frames"), "{frames}: {err}");
     }
     let options = RenderOptions {
-        timed_frames: 3,
+        measure: manylight::MeasureOptions {
+            timed_frames: 3,
+            ..Default::default()
+        },
         ..RenderOptions::default()
     };
     let (_, stats) = gpu.r().render_offscreen(&s, 16, 16, &options).unwrap();

@@ -111,7 +111,10 @@ fn srgb_output_matches_the_encoded_light_model() {
 fn rgba8_light_packing_stays_within_its_measured_error() {
     let opts = RenderOptions {
         linear: true,
-        force_rgba8_lights: true,
+        measure: manylight::MeasureOptions {
+            force_rgba8_lights: true,
+            ..Default::default()
+        },
         ..Default::default()
     };
     let err = check(EsVersion::Es2, opts, 3.0);

@@ -87,7 +87,10 @@ fn lean_variants_render_exactly_like_the_full_ones() {
                 .unwrap();
             assert!(!stats.scene_features.spot_lights && !stats.scene_features.textures);
             let full_opts = RenderOptions {
-                full_variants: true,
+                measure: manylight::MeasureOptions {
+                    full_variants: true,
+                    ..Default::default()
+                },
                 ..Default::default()
             };
             let (full, _) = gpu.r().render_offscreen(&s, 128, 72, &full_opts).unwrap();

@@ -209,7 +209,7 @@ struct Case {
     samples: u32,
     /// Viewport (and the application's target).
     size: (u32, u32),
-    /// Most lights a cell keeps (`RenderOptions::cell_cap`): the overflow policy's path.
+    /// Most lights a cell keeps (`MeasureOptions::cell_cap`): the overflow policy's path.
     cell_cap: Option<u32>,
     /// Whether the assignment runs on all cores: then one allocation of rayon's injector is
     /// allowed in every [`RAYON_INJECTOR_BLOCK`] frames.
@@ -344,7 +344,10 @@ fn allocations_per_frame(
                 GridConfig::default()
             },
             samples,
-            cell_cap,
+            measure: manylight::MeasureOptions {
+                cell_cap,
+                ..Default::default()
+            },
             ..RenderOptions::default()
         };
         let methods = METHODS

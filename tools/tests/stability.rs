@@ -29,7 +29,10 @@ fn check_with(name: &str, scene: &Scene, w: u32, h: u32, opts: &RenderOptions) -
         let opts = opts.clone();
         gpu.r().set_method("forward").unwrap();
         let reference_opts = RenderOptions {
-            reference_precision: true,
+            measure: manylight::MeasureOptions {
+                reference_precision: true,
+                ..Default::default()
+            },
             ..opts.clone()
         };
         let (reference, _) = gpu

@@ -215,7 +215,7 @@ fn knobs(quick: bool) -> Vec<Knob> {
     add(
         "cell_cap",
         "clustered",
-        |o, v| o.cell_cap = Some(v as u32),
+        |o, v| o.measure.cell_cap = Some(v as u32),
         pick(&[64.0, 16.0], &[16.0]),
     );
     // Fixed grids against the automatic one (the default rows), on every scene.
@@ -275,7 +275,7 @@ fn knobs(quick: bool) -> Vec<Knob> {
     add(
         "rgba8_lights",
         "clustered",
-        |o, _| o.force_rgba8_lights = true,
+        |o, _| o.measure.force_rgba8_lights = true,
         &[1.0],
     );
     k
@@ -447,7 +447,10 @@ fn baseline(
 ) -> Result<Baseline, Box<dyn std::error::Error>> {
     renderer.set_method("forward")?;
     let reference_opts = RenderOptions {
-        reference_precision: true,
+        measure: manylight::MeasureOptions {
+            reference_precision: true,
+            ..Default::default()
+        },
         ..RenderOptions::default()
     };
     let (reference, _) = renderer.render_offscreen(scene, w, h, &reference_opts)?;
@@ -519,7 +522,7 @@ impl Measure<'_> {
             }
         }
         .and_then(|frames| {
-            opts.timed_frames = frames;
+            opts.measure.timed_frames = frames;
             renderer.render_offscreen(self.scene, w, h, &opts)
         });
         let (image, stats) = match rendered {

@@ -432,8 +432,11 @@ pub fn run_cell(args: &MatrixCellArgs) -> Result<(), Box<dyn std::error::Error>>
     let (scene, _) = scene::load(&args.scene, Some((args.lights, 1)))?;
     let (w, h) = args.size;
     let opts = RenderOptions {
-        timed_frames: 3,
-        force_rgba8_lights: args.rgba8_lights,
+        measure: manylight::MeasureOptions {
+            timed_frames: 3,
+            force_rgba8_lights: args.rgba8_lights,
+            ..Default::default()
+        },
         ..RenderOptions::default()
     };
     // The reference comes from an unrestricted renderer of its own (made, used and dropped
@@ -444,7 +447,10 @@ pub fn run_cell(args: &MatrixCellArgs) -> Result<(), Box<dyn std::error::Error>>
         let mut full = Renderer::new(ctx.load_gl(), es)?;
         full.set_method("forward")?;
         let reference_opts = RenderOptions {
-            reference_precision: true,
+            measure: manylight::MeasureOptions {
+                reference_precision: true,
+                ..Default::default()
+            },
             ..RenderOptions::default()
         };
         let result = full.render_offscreen(&scene, w, h, &reference_opts);

@@ -215,7 +215,10 @@ pub fn run(args: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
     }
     let options = RenderOptions {
         linear: args.linear,
-        timed_frames: args.frames,
+        measure: manylight::MeasureOptions {
+            timed_frames: args.frames,
+            ..Default::default()
+        },
         tone_map: args.tonemap.into(),
         samples: args.msaa,
         exposure_ev: args.exposure,

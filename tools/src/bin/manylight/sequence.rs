@@ -107,7 +107,10 @@ pub fn render(
     record: Option<&Path>,
 ) -> Result<Rendered, Box<dyn std::error::Error>> {
     let one_frame = RenderOptions {
-        timed_frames: 0,
+        measure: manylight::MeasureOptions {
+            timed_frames: 0,
+            ..Default::default()
+        },
         ..options.clone()
     };
     let mut recorder = record.map(|p| Recorder::open(p, timeline)).transpose()?;
