@@ -30,6 +30,15 @@ pub enum Error {
         /// The methods this context can run, comma-separated.
         runnable: String,
     },
+    /// Multisampling asked for ([`RenderOptions::samples`](crate::RenderOptions::samples))
+    /// that this context, method or output cannot do.
+    #[error("{samples} samples per pixel (MSAA): {reason}")]
+    Msaa {
+        /// Samples asked for.
+        samples: u32,
+        /// Why not, and what would run.
+        reason: String,
+    },
     /// A request the renderer cannot satisfy (too many lights for a method, bad size, …).
     #[error("{0}")]
     Limit(String),

@@ -78,7 +78,7 @@ impl Default for RenderOptions {
 
 /// What the benchmarks and tests turn to measure the renderer: each default is what a game
 /// wants.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Copy, Debug, Default)]
 pub struct MeasureOptions {
     /// Frames timed after one warm-up frame by [`Renderer::render_offscreen`](crate::Renderer::render_offscreen); the median is
     /// reported. 0 times the single (cold) frame. At most [`MAX_TIMED_FRAMES`] (the frames'

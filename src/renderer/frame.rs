@@ -237,11 +237,7 @@ impl Renderer {
         samples: u32,
         format: ColorFormat,
     ) -> Result<(), Error> {
-        let refuse = |reason: String| {
-            Err(Error::Limit(format!(
-                "RenderOptions::samples = {samples} (MSAA): {reason}"
-            )))
-        };
+        let refuse = |reason: String| Err(Error::Msaa { samples, reason });
         if let Some(reason) = crate::gl::multisample::unsupported_reason(&self.dev, samples) {
             return refuse(reason);
         }

@@ -47,6 +47,12 @@ pub enum SceneError {
         /// serde's message (includes line, column and the unknown or missing field).
         reason: String,
     },
+    /// A file whose type the loader does not read (by its extension).
+    #[error("unsupported scene file type: {path} (a scene is a built-in name, or a .obj, .gltf, .glb or .json file)")]
+    UnsupportedFile {
+        /// The file.
+        path: PathBuf,
+    },
     /// A built-in scene name that does not exist.
     #[error("unknown built-in scene `{0}` (available: {avail})", avail = crate::scene::builtin::NAMES.join(", "))]
     UnknownBuiltin(String),

@@ -273,6 +273,12 @@ pub fn load(
         }
         "gltf" | "glb" => gltf::load(path, lights),
         "json" => file::load(path, lights),
+        // Built-in names have no extension: anything else that looks like a file is one.
+        _ if !ext.is_empty() || path.is_file() || spec.contains(std::path::MAIN_SEPARATOR) => {
+            Err(SceneError::UnsupportedFile {
+                path: path.to_path_buf(),
+            })
+        }
         _ => Ok((builtin::build(spec, lights)?, obj::LoadReport::default())),
     }
 }

@@ -177,7 +177,7 @@ fn overflow_policy_holds_in_a_real_render() {
         let tight = RenderOptions {
             measure: manylight::MeasureOptions {
                 max_indices: Some(64),
-                ..Default::default()
+                ..opts.measure
             },
             ..opts.clone()
         };

@@ -31,7 +31,7 @@ fn check_with(name: &str, scene: &Scene, w: u32, h: u32, opts: &RenderOptions) -
         let reference_opts = RenderOptions {
             measure: manylight::MeasureOptions {
                 reference_precision: true,
-                ..Default::default()
+                ..opts.measure
             },
             ..opts.clone()
         };

@@ -164,7 +164,13 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e}");
+            // The library names its option; the user typed the flag.
+            match e.downcast_ref::<manylight::Error>() {
+                Some(manylight::Error::Msaa { samples, reason }) => {
+                    eprintln!("error: --msaa {samples}: {reason}")
+                }
+                _ => eprintln!("error: {e}"),
+            }
             ExitCode::FAILURE
         }
     }

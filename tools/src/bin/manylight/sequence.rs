@@ -109,7 +109,7 @@ pub fn render(
     let one_frame = RenderOptions {
         measure: manylight::MeasureOptions {
             timed_frames: 0,
-            ..Default::default()
+            ..options.measure
         },
         ..options.clone()
     };
