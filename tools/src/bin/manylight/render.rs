@@ -33,15 +33,16 @@ pub struct RenderArgs {
     /// Image size as WIDTHxHEIGHT.
     #[arg(long, default_value = "1280x720", value_parser = parse_size)]
     pub size: (u32, u32),
-    /// Output PNG.
-    #[arg(long, default_value = "manylight.png")]
-    pub out: PathBuf,
+    /// Output PNG. Default: manylight.png, or none with `--record` (the recording has every
+    /// frame).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
     /// Write frame statistics as JSON to this file.
     #[arg(long)]
     pub stats: Option<PathBuf>,
     /// Write linear values (clamped, no sRGB encoding, no tone map) for checking pixels
-    /// against the light model.
-    #[arg(long)]
+    /// against the light model; `--exposure` still applies.
+    #[arg(long, conflicts_with = "tonemap")]
     pub linear: bool,
     /// Frames timed after a warm-up frame: the median is reported, and from 10 frames also
     /// p95, p99 and the slowest (`--stats` has them from 1). In a scene whose lights move
@@ -178,6 +179,9 @@ pub fn parse_fps(s: &str) -> Result<f64, String> {
     }
 }
 
+/// The picture's file when neither `--out` nor `--record` is given.
+const DEFAULT_OUT: &str = "manylight.png";
+
 /// Random lights for built-ins and OBJ files when `--lights` is not given.
 const DEFAULT_LIGHTS: usize = 1024;
 
@@ -257,11 +261,18 @@ pub fn run(args: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
             .render_offscreen(&scene, width, height, &options)
             .map_err(Into::into)
     };
-    renderer.destroy();
+    drop(renderer);
     let (image, stats) = result?;
-    image
-        .save(&args.out)
-        .map_err(|e| format!("cannot write {}: {e}", args.out.display()))?;
+    let out = match (&args.out, &args.record) {
+        (Some(path), _) => Some(path.as_path()),
+        (None, None) => Some(std::path::Path::new(DEFAULT_OUT)),
+        (None, Some(_)) => None,
+    };
+    if let Some(out) = out {
+        image
+            .save(out)
+            .map_err(|e| format!("cannot write {}: {e}", out.display()))?;
+    }
     if let Some(path) = &args.stats {
         std::fs::write(path, serde_json::to_string_pretty(&stats)? + "\n")
             .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
@@ -274,26 +285,29 @@ pub fn run(args: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
         _ => String::new(),
     };
     if scene.is_animated() {
-        tail += &format!(
-            " · moving lights, t = {:.3} to {:.3} s",
-            args.time,
-            args.time + f64::from(args.frames.saturating_sub(1)) / args.fps
-        );
+        tail += &format!(" · moving lights, picture at t = {:.3} s", args.time);
+        if args.frames > 1 {
+            let last = args.time + f64::from(args.frames - 1) / args.fps;
+            tail += &format!(", timed to t = {last:.3} s");
+        }
     }
     if let Some(path) = &args.record {
         tail += &format!(" · {} frames → {}", args.frames, path.display());
     }
+    let method = match (&stats.auto_choice, &stats.auto_reason) {
+        (Some(choice), Some(reason)) => format!("{} → {choice} ({reason})", stats.method),
+        _ => stats.method.clone(),
+    };
+    let written = out.map_or(String::new(), |p| format!(" → {}", p.display()));
     println!(
-        "{} {}x{} · {} · {} lights · {} on {} · {:.1} ms/frame{tail} → {}",
+        "{} {}x{} · {method} · {} lights · {} on {} · {:.1} ms/frame{tail}{written}",
         args.scene,
         width,
         height,
-        stats.method,
         stats.lights.total,
         stats.context.es,
         stats.context.renderer,
         stats.time.frame_ms,
-        args.out.display()
     );
     Ok(())
 }

@@ -71,8 +71,10 @@ impl Recorder {
                     .map_err(|e| format!("cannot write {}: {e}", path.display()))
             }
             Recorder::Gif(encoder, path) => {
-                // GIF delays are in hundredths of a second: the nearest to 1/fps.
-                let centis = (100.0 / fps).round().clamp(1.0, 65_535.0) as u32;
+                // GIF delays are whole hundredths of a second: each frame ends at the hundredth
+                // nearest its true end, so the rounding never adds up (30 fps: 3, 3, 4, …).
+                let end = |k: u32| (f64::from(k) * 100.0 / fps).round();
+                let centis = (end(k + 1) - end(k)).clamp(1.0, 65_535.0) as u32;
                 let frame =
                     Frame::from_parts(image, 0, 0, Delay::from_numer_denom_ms(centis * 10, 1));
                 encoder

@@ -1,0 +1,124 @@
+//! What the command line writes and says in the cases a newcomer met: files it should not
+//! write, timings that add up, messages that name the flag typed rather than a library field.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+fn manylight(args: &[&str], cwd: &Path) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_manylight"))
+        .args(args)
+        .current_dir(cwd)
+        .output()
+        .expect("run manylight")
+}
+
+fn text(out: &Output) -> String {
+    format!(
+        "{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    )
+}
+
+fn expect(args: &[&str], cwd: &Path, code: i32) -> String {
+    let out = manylight(args, cwd);
+    let msg = text(&out);
+    assert_eq!(out.status.code(), Some(code), "{args:?}: {msg}");
+    assert!(!msg.contains("panicked"), "{args:?}: {msg}");
+    msg
+}
+
+#[test]
+fn a_file_of_another_type_is_called_unsupported_not_an_unknown_built_in() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("notes.md"), "# not a scene\n").unwrap();
+    let msg = expect(&["--scene", "notes.md", "--size", "8x8"], dir.path(), 1);
+    assert!(msg.contains("unsupported scene file type"), "{msg}");
+    assert!(
+        msg.contains("notes.md") && !msg.contains("built-in scene `"),
+        "{msg}"
+    );
+    // A name without an extension is still looked up among the built-ins.
+    let msg = expect(&["--scene", "atlantis", "--size", "8x8"], dir.path(), 1);
+    assert!(msg.contains("unknown built-in scene"), "{msg}");
+}
+
+#[test]
+fn linear_output_and_a_tone_map_are_a_usage_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let msg = expect(&["--linear", "--tonemap", "reinhard"], dir.path(), 2);
+    assert!(
+        msg.contains("--linear") && msg.contains("--tonemap"),
+        "{msg}"
+    );
+}
+
+#[test]
+fn an_msaa_refusal_names_the_flag() {
+    let dir = tempfile::tempdir().unwrap();
+    let args = [
+        "--msaa", "64", "--size", "16x9", "--lights", "4", "--frames", "0",
+    ];
+    let msg = expect(&args, dir.path(), 1);
+    assert!(msg.contains("--msaa 64"), "{msg}");
+    assert!(!msg.contains("RenderOptions"), "{msg}");
+}
+
+#[test]
+fn a_recording_writes_no_default_picture_beside_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let base = ["--size", "16x9", "--lights", "4", "--frames", "2"];
+    expect(&[&base[..], &["--record", "a.gif"]].concat(), dir.path(), 0);
+    assert!(dir.path().join("a.gif").is_file());
+    assert!(
+        !dir.path().join("manylight.png").exists(),
+        "--record wrote ./manylight.png"
+    );
+    // Asked for, the picture is written as well.
+    let args = [&base[..], &["--record", "b.gif", "--out", "x.png"]].concat();
+    expect(&args, dir.path(), 0);
+    assert!(dir.path().join("x.png").is_file());
+}
+
+#[test]
+fn gif_frame_delays_add_up_to_the_animation_time() {
+    use image::AnimationDecoder;
+    let dir = tempfile::tempdir().unwrap();
+    // 9 frames at 30 fps last 0.3 s: whole hundredths that each round 3.33 alone would make 0.27.
+    let args = [
+        "--size", "8x8", "--lights", "4", "--frames", "9", "--fps", "30", "--record", "a.gif",
+    ];
+    expect(&args, dir.path(), 0);
+    let file = std::io::BufReader::new(std::fs::File::open(dir.path().join("a.gif")).unwrap());
+    let frames = image::codecs::gif::GifDecoder::new(file)
+        .unwrap()
+        .into_frames()
+        .collect_frames()
+        .unwrap();
+    assert_eq!(frames.len(), 9);
+    let total_ms: u32 = frames
+        .iter()
+        .map(|f| {
+            let (n, d) = f.delay().numer_denom_ms();
+            n / d
+        })
+        .sum();
+    assert_eq!(total_ms, 300, "frame delays sum to {total_ms} ms");
+}
+
+#[test]
+fn the_summary_line_says_what_auto_picked_and_which_time_the_picture_shows() {
+    let dir = tempfile::tempdir().unwrap();
+    let args = [
+        "--method", "auto", "--size", "16x9", "--lights", "8", "--out", "a.png",
+    ];
+    let msg = expect(&args, dir.path(), 0);
+    assert!(msg.contains("auto → "), "{msg}");
+    let msg = expect(
+        &["--size", "16x9", "--lights", "8", "--out", "b.png"],
+        dir.path(),
+        0,
+    );
+    assert!(msg.contains("picture at t = 0.000 s"), "{msg}");
+    assert!(!msg.contains("t = 0.000 to"), "{msg}");
+}
