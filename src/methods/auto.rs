@@ -18,10 +18,30 @@ pub const DESC: MethodDesc = MethodDesc {
     summary: "forward for few lights, clustered for many (the choice is in the stats)",
     min_es: EsVersion::Es2,
     required_extensions: &[],
-    supported: |_| Support::Supported,
+    supported,
     multisample: true,
     create: |_| Ok(Box::new(Auto::default())),
 };
+
+/// As degraded as what it runs: forward's notes, and clustered's when it can pick clustered
+/// (or that it never can).
+fn supported(caps: &crate::gl::Caps) -> Support {
+    let mut notes = Vec::new();
+    if let Support::Fallback(why) = super::forward::supported(caps) {
+        notes.push(why);
+    }
+    match culled_support(caps) {
+        Support::Supported => {}
+        Support::Fallback(why) if notes.contains(&why) => {}
+        Support::Fallback(why) => notes.push(why),
+        Support::Unsupported(why) => notes.push(format!("always forward: clustered cannot run ({why})")),
+    }
+    if notes.is_empty() {
+        Support::Supported
+    } else {
+        Support::Fallback(notes.join("; "))
+    }
+}
 
 /// Up to this many visible lights, plain forward is chosen.
 pub const FORWARD_UP_TO: usize = 32;

@@ -26,7 +26,7 @@ pub const DESC: MethodDesc = MethodDesc {
     create: |_| Ok(Box::new(Forward::default())),
 };
 
-fn supported(caps: &Caps) -> Support {
+pub(super) fn supported(caps: &Caps) -> Support {
     let mut notes = Vec::new();
     if !caps.float_textures {
         notes.push("lights packed as RGBA8 (lossy) because GL_OES_texture_float is missing");

@@ -66,7 +66,7 @@ pub fn markdown(rows: &[AnimatedRow]) -> String {
          plain forward at the same time.\n",
         first.frames, first.fps, first.width, first.height
     );
-    s += "| scene | ES | method | lights | frame p50 | p95 | p99 | max | p99/p50 | assign p50 | assign p99 | upload KiB p50 | upload KiB max | max err |\n\
+    s += "| scene | ES | method | lights | frame p50 | p95 | p99 | max | p99/p50 | assign p50 | assign p99 | upload KiB p50 | upload KiB max | max err (/255) |\n\
           |---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
     for r in rows {
         let _ = writeln!(

@@ -56,6 +56,11 @@ fn a_small_sweep_writes_the_report_charts_and_heatmaps() {
     ] {
         assert!(dir.path().join(file).is_file(), "{file} missing: {log}");
     }
+    // stderr is a pipe here: progress comes as plain lines, one a step, as the run goes.
+    assert!(log.contains("[1/"), "no progress lines: {log}");
+    // The cell_cap knob drops lights on purpose: no warning that reads like a failure.
+    assert!(log.contains("cell_cap"), "{log}");
+    assert!(!log.contains("light references left out"), "{log}");
     for chart in ["error_vs_time-plane.png", "evals_vs_lights-plane.png"] {
         let img = image::open(dir.path().join(chart)).unwrap();
         assert!(

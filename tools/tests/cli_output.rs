@@ -122,3 +122,36 @@ fn the_summary_line_says_what_auto_picked_and_which_time_the_picture_shows() {
     assert!(msg.contains("picture at t = 0.000 s"), "{msg}");
     assert!(!msg.contains("t = 0.000 to"), "{msg}");
 }
+
+#[test]
+fn info_shows_the_methods_before_any_extension_list() {
+    let dir = tempfile::tempdir().unwrap();
+    let msg = expect(&["info"], dir.path(), 0);
+    let methods = msg.find("\nmethods\n").expect("a methods table");
+    let extensions = msg.find("\nextensions").expect("the extension count");
+    assert!(methods < extensions, "{msg}");
+    assert!(!msg.contains("\n  GL_"), "extensions listed unasked: {msg}");
+    let listed = expect(&["info", "--extensions"], dir.path(), 0);
+    assert!(listed.contains("\n  GL_"), "{listed}");
+}
+
+#[test]
+fn bench_assign_runs_what_runs_asks_and_says_how_many() {
+    let dir = tempfile::tempdir().unwrap();
+    let msg = expect(
+        &[
+            "bench-assign",
+            "--lights",
+            "100001",
+            "--runs",
+            "9",
+            "--json",
+        ],
+        dir.path(),
+        0,
+    );
+    let rows: serde_json::Value = serde_json::from_str(&msg[msg.find('[').unwrap()..]).unwrap();
+    assert_eq!(rows[0]["runs"], 9, "{msg}");
+    let msg = expect(&["bench-assign", "--lights", "8"], dir.path(), 0);
+    assert!(msg.contains("median of 101 runs"), "{msg}");
+}

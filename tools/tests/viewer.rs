@@ -327,3 +327,20 @@ fn view_draws_the_light_evaluation_heatmap() {
     assert!(on_map * 2 > total, "only {on_map} of {total} pixels drawn");
     assert!(colours.len() > 5, "a flat heatmap: {colours:?}");
 }
+
+#[test]
+fn without_a_display_view_says_how_to_get_one() {
+    let out = Command::new(BIN)
+        .env_remove("DISPLAY")
+        .env_remove("WAYLAND_DISPLAY")
+        .args(["view", "--frames", "1"])
+        .output()
+        .expect("run manylight view");
+    let msg = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{msg}");
+    assert!(
+        msg.contains("xvfb-run -a") && msg.contains("--out"),
+        "{msg}"
+    );
+    assert!(!msg.contains(".rs:"), "winit's source path leaked: {msg}");
+}

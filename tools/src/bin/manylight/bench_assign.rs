@@ -15,13 +15,14 @@ pub struct BenchAssignArgs {
     )]
     pub lights: Vec<usize>,
     /// Timed runs per count, after 0.1 s of untimed ones (the median is reported), from 1 to
-    /// 1 048 576.
-    #[arg(long, default_value_t = 101, value_parser = parse_runs)]
-    pub runs: usize,
+    /// 1 048 576. Default: 101, or 7 above 100 000 lights (the median is robust, and the huge
+    /// counts stay quick).
+    #[arg(long, value_parser = parse_runs)]
+    pub runs: Option<usize>,
     /// Seed of the random lights.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// Print JSON (an array of {lights, assign_ms, indices, clusters}) instead of a table.
+    /// Print JSON (an array of {lights, assign_ms, indices, clusters, runs}) instead of a table.
     #[arg(long)]
     pub json: bool,
 }
@@ -50,11 +51,10 @@ pub fn run(args: &BenchAssignArgs) -> Result<(), Box<dyn std::error::Error>> {
     let mut rows = Vec::new();
     for &count in &args.lights {
         let work = AssignWorkload::default_view(count, args.seed);
-        // Fewer runs for the huge counts keep the command quick; the median is robust.
-        let runs = if count > 100_000 {
-            args.runs.min(7)
-        } else {
-            args.runs
+        let runs = match args.runs {
+            Some(runs) => runs,
+            None if count > 100_000 => 7,
+            None => 101,
         };
         let (ms, indices) = work.time(runs);
         rows.push(serde_json::json!({
@@ -62,9 +62,12 @@ pub fn run(args: &BenchAssignArgs) -> Result<(), Box<dyn std::error::Error>> {
             "assign_ms": ms,
             "indices": indices,
             "clusters": work.grid.total_cells,
+            "runs": runs,
         }));
         if !args.json {
-            println!("{count:>9} lights  {ms:>9.3} ms  {indices:>9} indices");
+            println!(
+                "{count:>9} lights  {ms:>9.3} ms  {indices:>9} indices  (median of {runs} runs)"
+            );
         }
     }
     if args.json {

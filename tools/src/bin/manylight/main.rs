@@ -5,6 +5,7 @@ mod bench;
 mod bench_assign;
 mod info;
 mod matrix;
+mod progress;
 mod render;
 mod sequence;
 #[cfg(feature = "window")]

@@ -362,7 +362,7 @@ fn sheet(rows: &[Value], out: &Path) -> image::RgbaImage {
                 .map(|i| i.to_rgba8());
             let detail = match (m["support"]["status"].as_str(), m["max_abs"].as_f64()) {
                 (Some("unsupported"), _) => "unsupported".to_string(),
-                (Some(status), Some(err)) => format!("{status}, max err {err:.0}"),
+                (Some(status), Some(err)) => format!("{status}, max err {err:.0}/255"),
                 (status, _) => status.unwrap_or("?").to_string(),
             };
             cells.push((vec![config.clone(), format!("{name}: {detail}")], thumb));

@@ -6,8 +6,8 @@
 //! got. Every frame renders the scene into the window's default framebuffer without waiting
 //! for the GPU, then swaps buffers (vsync where the driver allows it).
 //!
-//! Controls: WASD move, Q/E down/up, Shift faster, left-drag looks around, 1–9 pick a method
-//! from [`manylight::methods::METHODS`], +/- double/halve the random lights, H toggles the
+//! Controls: WASD move, Q/E down/up, Shift faster, left-drag looks around, 1–5 pick a method
+//! by its place in [`manylight::methods::METHODS`], +/- double/halve the random lights, H toggles the
 //! light-evaluation heatmap (lights each pixel evaluates, viridis from 0 to 64), M toggles 4×
 //! MSAA (resolved into the window), T cycles the tone map (none, Reinhard, ACES, Neutral),
 //! Space pauses and resumes the lights' motion (built-in scenes' lights move; scene files
@@ -47,7 +47,8 @@ pub struct ViewArgs {
     /// A built-in scene (an unknown name lists them), an .obj, .gltf/.glb or .json scene file.
     #[arg(long, default_value = scene::builtin::DEFAULT)]
     pub scene: String,
-    /// Shading method to start with (keys 1–9 switch).
+    /// Shading method to start with (keys 1–5 switch: forward, tiled, clustered, deferred,
+    /// auto, the order of `manylight info`).
     #[arg(long, default_value = manylight::methods::DEFAULT_METHOD)]
     pub method: String,
     /// OpenGL ES version. Default: 3, or 2 where the driver has no ES 3.0.
@@ -102,6 +103,11 @@ fn next_tone_map(current: manylight::ToneMap) -> manylight::ToneMap {
 const TITLE_EVERY_S: f64 = 0.25;
 
 /// Runs the viewer until the window closes, Esc, or `--frames`.
+/// What `view` says where no window can open (winit's own message names its registry path).
+const NO_DISPLAY: &str = "cannot open a window: no X11 or Wayland display (DISPLAY and \
+    WAYLAND_DISPLAY are unset or unreachable); run it under a display server, `xvfb-run -a \
+    manylight view`, or render headless without a window: `manylight --out F.png`";
+
 pub fn run(args: &ViewArgs) -> Result<(), Box<dyn std::error::Error>> {
     let is_file_scene = scene::brings_own_lights(&args.scene);
     let lights = match (args.lights, is_file_scene) {
@@ -115,7 +121,11 @@ pub fn run(args: &ViewArgs) -> Result<(), Box<dyn std::error::Error>> {
     // Validate the method name before opening a window.
     manylight::methods::find(&args.method)?;
     let extent = scene.bounds().map_or(10.0, |b| b.size().length());
-    let event_loop = EventLoop::new().map_err(|e| format!("cannot open a window: {e}"))?;
+    // winit's message starts with its source path: keep only its reason.
+    let event_loop = EventLoop::new().map_err(|e| {
+        let e = e.to_string();
+        format!("{NO_DISPLAY} ({})", e.rsplit(": ").next().unwrap_or(&e))
+    })?;
     event_loop.set_control_flow(ControlFlow::Poll);
     println!(
         "controls: WASD move, Q/E down/up, Shift faster, drag to look, 1-{} method, +/- lights, H heatmap, M MSAA, T tone map, Space pause, Esc quit",
