@@ -230,6 +230,9 @@ pub fn method_style(method: &str) -> ((u8, u8, u8), Marker) {
     plot::style(i.unwrap_or(METHODS.len()))
 }
 
+/// The marker of every ES 2.0 series on the error chart (the method keeps its colour).
+const ES2_MARKER: Marker = Marker::Plus;
+
 /// The series of `method`. `auto` usually picks clustered, so its points lie on clustered's:
 /// it is drawn hollow (a larger outline around clustered's filled marker, its line dashed)
 /// so that both stay visible.
@@ -242,6 +245,7 @@ fn method_series(method: &str, points: Vec<(f64, f64)>, line: bool) -> Series {
         marker,
         line,
         hollow: method == auto::DESC.name,
+        point_labels: Vec::new(),
     }
 }
 
@@ -256,13 +260,43 @@ pub fn error_vs_time(rows: &[BenchRow], scene: &str, lights: usize) -> Chart {
         .filter(|r| r.scene == scene && r.lights == lights)
         .collect();
     let methods = distinct(rows.iter().map(|r| r.method.as_str()));
-    let series = methods
-        .iter()
-        .map(|m| {
-            let these = rows.iter().filter(|r| r.method == *m);
-            method_series(m, these.map(|r| (r.frame_ms, r.rmse)).collect(), false)
-        })
-        .collect();
+    let versions = distinct(rows.iter().map(|r| r.es.as_str()));
+    let mut series = Vec::new();
+    for m in &methods {
+        for es in &versions {
+            let these: Vec<&&BenchRow> = rows
+                .iter()
+                .filter(|r| r.method == *m && r.es == *es)
+                .collect();
+            if these.is_empty() {
+                continue;
+            }
+            let mut s = method_series(
+                m,
+                these.iter().map(|r| (r.frame_ms, r.rmse)).collect(),
+                false,
+            );
+            // ES 2.0 in the method's colour with its own marker: the versions differ in
+            // what they cost and round.
+            if versions.len() > 1 {
+                s.label = format!("{m}, ES {es}");
+                if *es == "2.0" {
+                    s.marker = ES2_MARKER;
+                }
+            }
+            s.point_labels = these
+                .iter()
+                .map(|r| {
+                    if r.knob == "default" {
+                        String::new()
+                    } else {
+                        r.knob.clone()
+                    }
+                })
+                .collect();
+            series.push(s);
+        }
+    }
     let all: Vec<(f64, f64)> = rows.iter().map(|r| (r.frame_ms, r.rmse)).collect();
     let front = plot::pareto_front(&all)
         .into_iter()
@@ -271,7 +305,7 @@ pub fn error_vs_time(rows: &[BenchRow], scene: &str, lights: usize) -> Chart {
     Chart {
         title: format!("Error against frame time: {scene}, {lights} lights"),
         x_label: "frame time (ms, log)".into(),
-        y_label: "RMSE vs reference (log)".into(),
+        y_label: "RMSE vs reference (of 255, log)".into(),
         x_log: true,
         y_log: true,
         series,
@@ -320,6 +354,7 @@ pub fn evals_vs_lights(rows: &[BenchRow], scene: &str) -> Chart {
         marker: Marker::Circle,
         line: true,
         hollow: false,
+        point_labels: Vec::new(),
     });
     Chart {
         title: format!(
@@ -612,6 +647,29 @@ mod tests {
                 diffs: vec![("clustered".into(), diff_file("a", "3.0", "clustered"))],
             }],
         }
+    }
+
+    #[test]
+    fn the_error_chart_tells_es_versions_and_knobs_apart() {
+        let mut rows = rows();
+        let mut es2 = row("a", "clustered", 64, "default", 12.0, 0.4);
+        es2.es = "2.0".into();
+        rows.push(es2);
+        let chart = error_vs_time(&rows, "a", 64);
+        let find = |label: &str| chart.series.iter().find(|s| s.label == label).unwrap();
+        let (es2, es3) = (find("clustered, ES 2.0"), find("clustered, ES 3.0"));
+        assert_eq!(es2.color, es3.color);
+        assert_eq!((es2.marker, es3.marker), (ES2_MARKER, plot::style(2).1));
+        // Each knob point says which knob; default points carry no text.
+        let labelled: Vec<&str> = es3
+            .point_labels
+            .iter()
+            .map(String::as_str)
+            .filter(|l| !l.is_empty())
+            .collect();
+        assert_eq!(labelled, ["cutoff=0.01"]);
+        assert_eq!(es3.point_labels.len(), es3.points.len());
+        assert!(chart.y_label.contains("of 255"), "{}", chart.y_label);
     }
 
     #[test]

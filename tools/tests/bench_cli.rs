@@ -216,3 +216,35 @@ fn every_scene_gets_its_own_charts_heatmaps_and_differences() {
     assert!(md.contains("| — |"), "{md}");
     assert!(md.contains("A \"—\" means"), "{md}");
 }
+
+#[test]
+fn knobs_a_context_cannot_run_are_skipped_not_fatal() {
+    // llvmpipe's ES 2.0 has no multisampling: the msaa knob is skipped with a warning.
+    let dir = tempfile::tempdir().unwrap();
+    let log = bench(
+        &[
+            "--scenes",
+            "plane",
+            "--lights",
+            "16",
+            "--es",
+            "2",
+            "--size",
+            "32x18",
+            "--frames",
+            "0",
+            "--cpu-samples",
+            "16",
+            "--animated-frames",
+            "0",
+        ],
+        dir.path(),
+    );
+    assert!(log.contains("msaa=4: skipped"), "{log}");
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("report.json")).unwrap())
+            .unwrap();
+    let rows = report["rows"].as_array().unwrap();
+    assert!(rows.iter().all(|r| r["knob"] != "msaa=4"), "{rows:?}");
+    assert!(rows.iter().any(|r| r["knob"] == "cell_cap=16"), "{rows:?}");
+}

@@ -53,6 +53,11 @@ fn unsupported_msaa_is_a_clear_error() {
         .render_offscreen(&scene, 16, 16, &msaa(64))
         .unwrap_err();
     assert!(err.to_string().contains("GL_MAX_SAMPLES"), "{err}");
+    // Its own variant, so a caller (the CLI names --msaa) can tell it from other limits.
+    assert!(
+        matches!(err, manylight::Error::Msaa { samples: 64, .. }),
+        "{err:?}"
+    );
     let err = es3
         .r()
         .render_offscreen_hdr(&scene, 16, 16, &msaa(4))

@@ -75,11 +75,15 @@ pub(super) fn draw_grid<DB: DrawingBackend>(
 /// of a line.
 pub(super) const MARKER_WEIGHT: usize = 100;
 
+/// The front's legend text: says what the staircase is, so a steep one (configurations
+/// about as fast, far apart in error) reads as data rather than a drawing fault.
+pub(super) const FRONT_LABEL: &str = "Pareto front (nothing both faster and more exact)";
+
 /// Pixels the legend should not cover, each with the cost of covering it.
 pub(super) type Avoid = Vec<((i32, i32), usize)>;
 
-/// Draws the front, the series lines (solid, then dashed) and the markers (hollow, then
-/// filled), in that order so markers stay on top and a hollow series stays visible around
+/// Draws the front, the series lines (dashed and wider, then solid) and the markers (hollow,
+/// then filled), in that order so markers stay on top and a hollow series stays visible around
 /// the filled markers it shares points with; returns the pixels they cover (lines sampled
 /// every few pixels) with their weights.
 pub(super) fn draw_data<DB: DrawingBackend>(
@@ -116,7 +120,8 @@ pub(super) fn draw_data<DB: DrawingBackend>(
         covered.extend(sample_path(&path));
         root.draw(&PathElement::new(path, FRONT_COLOR.stroke_width(3)))?;
     }
-    for hollow in [false, true] {
+    // Hollow series' lines first, wider: the solid line they coincide with stays on top.
+    for hollow in [true, false] {
         for sr in chart
             .series
             .iter()
@@ -138,18 +143,18 @@ pub(super) fn draw_data<DB: DrawingBackend>(
     Ok(covered)
 }
 
-/// A series line, 2 pixels wide: solid, or `dashed` (8 on, 6 off) so that a solid line it
-/// lies on shows through the gaps.
+/// A series line: solid and 2 pixels wide, or `dashed` (8 on, 6 off) and 5 wide, drawn under
+/// the solid lines so that one lying on it stays visible along its middle.
 pub(super) fn draw_line<DB: DrawingBackend>(
     root: &DrawingArea<DB, plotters::coord::Shift>,
     path: &[(i32, i32)],
     color: RGBColor,
     dashed: bool,
 ) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
-    let style = color.stroke_width(2);
     if !dashed {
-        return root.draw(&PathElement::new(path.to_vec(), style));
+        return root.draw(&PathElement::new(path.to_vec(), color.stroke_width(2)));
     }
+    let style = color.stroke_width(5);
     for dash in dashes(path, 8.0, 6.0) {
         root.draw(&PathElement::new(dash, style))?;
     }
@@ -320,7 +325,7 @@ impl Legend {
             .collect();
         if drawn_front(chart).is_some() {
             entries.push(Entry {
-                label: "Pareto front".to_string(),
+                label: FRONT_LABEL.to_string(),
                 color: FRONT_COLOR,
                 line: true,
                 marker: None,

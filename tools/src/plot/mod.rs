@@ -40,10 +40,12 @@ pub struct Series {
     pub marker: Marker,
     /// Connect the points in x order.
     pub line: bool,
-    /// Draw the markers as larger outlines under the filled ones (and the line dashed over
-    /// the solid ones), for a series whose points often coincide with another's: both stay
-    /// visible, this one around (and through) the other.
+    /// Draw the markers as larger outlines under the filled ones (and the line wider and
+    /// dashed under the solid ones), for a series whose points often coincide with another's:
+    /// both stay visible, this one around the other.
     pub hollow: bool,
+    /// A short text beside each point (empty: none), as many as `points` or none at all.
+    pub point_labels: Vec<String>,
 }
 
 /// The shape of a series' markers.
@@ -96,7 +98,7 @@ pub struct Chart {
     pub y_log: bool,
     /// The data.
     pub series: Vec<Series>,
-    /// Points drawn as a thick dark staircase labelled "Pareto front" (any order); a front of
+    /// Points drawn as a thick dark staircase labelled as the Pareto front (any order); a front of
     /// fewer than two distinct points is no front and is neither drawn nor listed.
     pub front: Option<Vec<(f64, f64)>>,
     /// On a log y axis, where zero and negative y values are drawn; it should lie below the
@@ -302,10 +304,50 @@ fn render_with(chart: &Chart, width: u32, height: u32, face: Face) -> Result<Rgb
     let ydesc_y = (frame.top + frame.h / 2 + ydesc_len / 2).clamp(0, height as i32 - 1);
     let ydesc_at = (PAD as i32, ydesc_y);
     face.draw(&mut img, ydesc_at, &chart.y_label, ydesc_s, TEXT, true);
+    draw_point_labels(&mut img, chart, &frame, (&xa, &ya), s, face);
     if let Some(at) = legend_at {
         legend.draw_text(&mut img, at, s, face);
     }
     Ok(img)
+}
+
+/// Each series' point labels, right of their points in the series' colour, kept inside the
+/// image; a label that would overlap one already drawn is left out (the tables have them all).
+fn draw_point_labels(
+    img: &mut RgbImage,
+    chart: &Chart,
+    frame: &Frame,
+    (xa, ya): (&Axis, &Axis),
+    s: u32,
+    face: Face,
+) {
+    let (width, height) = (img.width() as i32, img.height() as i32);
+    let mut drawn: Vec<(i32, i32, i32, i32)> = Vec::new();
+    for sr in &chart.series {
+        let (r, g, b) = sr.color;
+        for (p, label) in sr.points.iter().zip(&sr.point_labels) {
+            let (Some(x), Some(y)) = (xa.space(p.0), ya.space(p.1)) else {
+                continue;
+            };
+            if label.is_empty() {
+                continue;
+            }
+            let (x, y) = frame.px((x, y), xa, ya);
+            let w = face.width(label, s) as i32;
+            let at_x = (x + 6 + s as i32).clamp(0, (width - w).max(0));
+            let h = face.line(s) as i32;
+            let at_y = (y - h / 2).clamp(0, (height - h).max(0));
+            let rect = (at_x, at_y, at_x + w, at_y + h);
+            let overlaps = |o: &(i32, i32, i32, i32)| {
+                rect.0 < o.2 && o.0 < rect.2 && rect.1 < o.3 && o.1 < rect.3
+            };
+            if drawn.iter().any(overlaps) {
+                continue;
+            }
+            drawn.push(rect);
+            face.draw(img, (at_x, at_y), label, s, Rgb([r, g, b]), false);
+        }
+    }
 }
 
 fn perr<E: std::fmt::Display>(e: E) -> String {

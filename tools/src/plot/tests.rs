@@ -38,6 +38,7 @@ fn series(i: usize, points: Vec<(f64, f64)>, line: bool) -> Series {
         marker,
         line,
         hollow: false,
+        point_labels: Vec::new(),
     }
 }
 

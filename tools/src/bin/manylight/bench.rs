@@ -344,7 +344,7 @@ pub fn run(args: &BenchArgs) -> Result<(), Box<dyn std::error::Error>> {
             for &count in &plan.lights {
                 let (scene, _) = scene::load(spec, Some((count, args.seed)))?;
                 let name = scene_name(spec);
-                progress.set_message(format!("ES {es} {name} {count} lights: reference"));
+                progress.set_message(format!("{es} {name} {count} lights: reference"));
                 // The geometry, and so its ray caster, is the same at every light count.
                 let caster = casters
                     .entry(spec.clone())
@@ -362,7 +362,7 @@ pub fn run(args: &BenchArgs) -> Result<(), Box<dyn std::error::Error>> {
                 let at_knob_lights = count == knob_lights;
                 let mut pictured = Vec::new();
                 for method in &plan.methods {
-                    progress.set_message(format!("ES {es} {name} {count} lights: {method}"));
+                    progress.set_message(format!("{es} {name} {count} lights: {method}"));
                     if let Some(m) = measure.run(&mut renderer, method, "default", |_| {})? {
                         rows.push(m.row.clone());
                         if at_knob_lights {
@@ -374,7 +374,7 @@ pub fn run(args: &BenchArgs) -> Result<(), Box<dyn std::error::Error>> {
                 if at_knob_lights {
                     let here = knob_list.iter().filter(|k| k.every_scene || knob_workload);
                     for knob in here {
-                        progress.set_message(format!("ES {es} {name}: {}", knob.name));
+                        progress.set_message(format!("{es} {name}: {}", knob.name));
                         // A cap per cell drops lights by design: the report counts them, the
                         // renderer's warning about it would read like a failure.
                         let level = log::max_level();
@@ -410,7 +410,7 @@ pub fn run(args: &BenchArgs) -> Result<(), Box<dyn std::error::Error>> {
             };
             for method in &plan.methods {
                 let name = &workload.name;
-                progress.set_message(format!("ES {es} {name} animated: {method}"));
+                progress.set_message(format!("{es} {name} animated: {method}"));
                 animated.extend(workload.run(&mut renderer, method, es)?);
                 progress.inc();
             }
@@ -532,9 +532,10 @@ impl Measure<'_> {
         });
         let (image, stats) = match rendered {
             Ok(r) => r,
-            // A configuration past a method's limits (forward's loop bound, say) is skipped.
-            Err(manylight::Error::Limit(reason)) => {
-                log::warn!("{} {method} {knob}: skipped: {reason}", self.name);
+            // A configuration past a method's limits (forward's loop bound, MSAA where the
+            // context has none) is skipped.
+            Err(e @ (manylight::Error::Limit(_) | manylight::Error::Msaa { .. })) => {
+                log::warn!("{} {method} {knob}: skipped: {e}", self.name);
                 return Ok(None);
             }
             Err(e) => return Err(e.into()),
