@@ -14,10 +14,11 @@
 
 use std::path::Path;
 
-use glam::{DVec3, Vec3};
+use manylight::glam::{DVec3, Vec3};
 use manylight::motion::{Motion, Orbit, OrbitAbout};
 use manylight::{
-    builtin_scene, EsVersion, HeadlessContext, Light, RenderOptions, Renderer, Scene, Spread,
+    builtin_scene, Cone, EsVersion, HeadlessContext, Light, RandomLights, RenderOptions, Renderer,
+    Scene, Spread,
 };
 
 /// Animation time of frame `frame`: 24 frames per second.
@@ -27,15 +28,23 @@ pub fn time_of(frame: u32) -> f64 {
 
 /// The courtyard with `lights` moving random lights and a spot light circling the fountain.
 pub fn build_scene(lights: usize) -> Result<Scene, Box<dyn std::error::Error>> {
-    let mut scene = builtin_scene("courtyard", Some((lights, 7)))?;
+    let mut scene = builtin_scene(
+        "courtyard",
+        Some(RandomLights {
+            count: lights,
+            seed: 7,
+        }),
+    )?;
     scene.lights.push(Light::spot(
         DVec3::new(4.0, 6.0, 0.0),
-        DVec3::new(-0.5, -1.0, 0.0),
-        12.0,
-        25.0,
         14.0,
         Vec3::new(1.0, 0.9, 0.7),
         40.0,
+        Cone {
+            direction: DVec3::new(-0.5, -1.0, 0.0),
+            inner_deg: 12.0,
+            outer_deg: 25.0,
+        },
     ));
     let spot = scene.lights.len() - 1;
     scene.animate_light(

@@ -19,8 +19,8 @@
 
 use std::path::Path;
 
-use glow::HasContext;
-use manylight::{builtin_scene, EsVersion, HeadlessContext, RenderOptions, Renderer};
+use manylight::glow::{self, HasContext};
+use manylight::{builtin_scene, EsVersion, HeadlessContext, RandomLights, RenderOptions, Renderer};
 
 /// The application's render target: a colour texture and depth buffer on an FBO.
 struct AppTarget {
@@ -94,7 +94,13 @@ pub fn run(out: &Path, width: u32, height: u32) -> Result<(), Box<dyn std::error
     let ctx = HeadlessContext::new(EsVersion::Es3)?;
     let app_gl = ctx.load_gl();
     let mut renderer = Renderer::new(ctx.load_gl(), EsVersion::Es3)?;
-    let scene = builtin_scene("courtyard", Some((512, 3)))?;
+    let scene = builtin_scene(
+        "courtyard",
+        Some(RandomLights {
+            count: 512,
+            seed: 3,
+        }),
+    )?;
     let (w, h) = (width as i32, height as i32);
     let target = unsafe { AppTarget::new(&app_gl, w, h)? };
     let result = (|| -> Result<image::RgbaImage, Box<dyn std::error::Error>> {

@@ -9,9 +9,9 @@
 
 use std::path::Path;
 
-use glam::{DVec3, Vec3};
+use manylight::glam::{DMat4, DVec3, Vec3};
 use manylight::{
-    Camera, EsVersion, FrameStats, HeadlessContext, Light, Material, MeshBuilder, Object,
+    Camera, Cone, EsVersion, FrameStats, HeadlessContext, Light, Material, MeshBuilder,
     RenderOptions, Renderer, Scene,
 };
 
@@ -37,13 +37,8 @@ pub fn build_scene() -> Scene {
         let x = i as f32 * 2.5;
         boxes.cuboid(Vec3::new(x - 0.5, 0.0, -0.5), Vec3::new(x + 0.5, 1.5, 0.5));
     }
-    for (mesh, material) in [(floor, stone), (boxes, painted)] {
-        scene.objects.push(Object {
-            mesh: std::sync::Arc::new(mesh.build()),
-            material,
-            transform: glam::DMat4::IDENTITY,
-        });
-    }
+    scene.add_object(floor.build(), stone, DMat4::IDENTITY);
+    scene.add_object(boxes.build(), painted, DMat4::IDENTITY);
     // 200 point lights on a ring just above the floor, hue going round.
     for i in 0..200 {
         let t = i as f64 / 200.0 * std::f64::consts::TAU;
@@ -57,12 +52,14 @@ pub fn build_scene() -> Scene {
     }
     scene.lights.push(Light::spot(
         DVec3::new(0.0, 6.0, 3.0),
-        DVec3::new(0.0, -1.0, -0.4),
-        15.0,
-        25.0,
         12.0,
         Vec3::ONE,
         4.0,
+        Cone {
+            direction: DVec3::new(0.0, -1.0, -0.4),
+            inner_deg: 15.0,
+            outer_deg: 25.0,
+        },
     ));
     scene.camera = Camera::perspective(
         DVec3::new(0.0, 5.0, 12.0),

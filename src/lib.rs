@@ -1,30 +1,37 @@
 //! # manylight
 //!
-//! Thousands of dynamic point and spot lights on OpenGL ES 2.0 and 3.0, mobile first.
+//! Thousands of dynamic point and spot lights on OpenGL ES 2.0 and 3.0, mobile first: lights
+//! are assigned to a cascaded cluster grid on the CPU every frame and uploaded as textures.
 //!
-//! Layers (arrows point down, nothing points up):
+//! ## Start here
 //!
-//! ```text
-//!  renderer ──► methods/ (forward, …)   one file per shading method + the METHODS table
-//!           ├─► options, gpu_scene  what a frame is asked to do; the scene's uploaded meshes
-//!           ├─► cluster/  GL-free CPU light data (texel packing, later the cluster grid)
-//!           ├─► scene/    GL-free scenes: camera, lights, meshes, materials, OBJ, built-ins
-//!           ├─► metrics/  image comparison
-//!           └─► gl/       the only module that calls glow (and the only one with `unsafe`)
-//! ```
+//! - A GL context: your own current one as a [`glow::Context`], or a [`HeadlessContext`] (EGL,
+//!   no window; keep it alive as long as the renderer).
+//! - A [`Renderer`] on it: [`Renderer::render`] into the bound framebuffer (a game's),
+//!   [`Renderer::render_reusing`] the same without allocating per frame,
+//!   [`Renderer::render_offscreen`] into an image; [`Renderer::set_method`] picks forward,
+//!   tiled, clustered (the default), deferred or auto.
+//! - A [`Scene`]: [`builtin_scene`] or [`load_scene`] (OBJ, glTF, JSON scene files), or built
+//!   in code with [`Scene::add_material`], [`MeshBuilder`], [`Scene::add_object`],
+//!   [`Light::point`] and [`Light::spot`]; [`Scene::set_time`] poses moving lights
+//!   ([`motion`]).
+//! - [`RenderOptions`] for the output (tone map, exposure, MSAA, grid) and [`FrameStats`] for
+//!   what a frame did.
 //!
-//! A minimal headless render:
+//! A headless render:
 //!
 //! ```no_run
-//! use manylight::{builtin_scene, EsVersion, HeadlessContext, Renderer, RenderOptions};
+//! use manylight::{builtin_scene, EsVersion, HeadlessContext, RandomLights, Renderer, RenderOptions};
 //! let ctx = HeadlessContext::new(EsVersion::Es3)?;
 //! let mut renderer = Renderer::new(ctx.load_gl(), EsVersion::Es3)?;
-//! let scene = builtin_scene("courtyard", Some((256, 7)))?;
+//! let scene = builtin_scene("courtyard", Some(RandomLights { count: 256, seed: 7 }))?;
 //! let (image, stats) = renderer.render_offscreen(&scene, 256, 144, &RenderOptions::default())?;
 //! image.save("out.png")?;
-//! println!("{} ms", stats.frame_ms);
+//! println!("{} ms", stats.time.frame_ms);
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
+//!
+//! The code's layers and the frame's stages: docs/architecture.md in the repository.
 #![deny(unsafe_code)]
 #![warn(missing_docs)]
 
@@ -63,9 +70,9 @@ pub use scene::features::SceneFeatures;
 pub use scene::meshbuild::MeshBuilder;
 pub use scene::obj::LoadReport;
 pub use scene::{
-    builtin::build as builtin_scene, builtin::DEFAULT as DEFAULT_SCENE,
-    builtin::NAMES as BUILTIN_SCENES, load as load_scene, Aabb, Camera, Light, LightKind, Material,
-    Mesh, Object, Projection, Scene, SceneError, Texture,
+    builtin::DEFAULT as DEFAULT_SCENE, builtin::NAMES as BUILTIN_SCENES, builtin_scene, load_scene,
+    Aabb, Camera, Cone, Light, LightKind, Material, Mesh, Object, Projection, RandomLights, Scene,
+    SceneError, Texture,
 };
 
 /// How lights move over time: a [`Motion`](motion::Motion) per light, set with

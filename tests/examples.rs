@@ -10,7 +10,7 @@ mod animated_lights;
 #[path = "../examples/embed_glow.rs"]
 mod embed_glow;
 
-use manylight::{builtin_scene, EsVersion, HeadlessContext, RenderOptions, Renderer};
+use manylight::{builtin_scene, EsVersion, HeadlessContext, RandomLights, RenderOptions, Renderer};
 
 /// The fraction of pixels brighter than `level` (mean of RGB).
 fn lit_fraction(img: &image::RgbaImage, level: f64) -> f64 {
@@ -71,7 +71,14 @@ fn embedding_draws_into_the_applications_framebuffer_under_its_overlay() {
     // The same view rendered by manylight into its own target.
     let ctx = HeadlessContext::new(EsVersion::Es3).unwrap();
     let mut renderer = Renderer::new(ctx.load_gl(), EsVersion::Es3).unwrap();
-    let scene = builtin_scene("courtyard", Some((512, 3))).unwrap();
+    let scene = builtin_scene(
+        "courtyard",
+        Some(RandomLights {
+            count: 512,
+            seed: 3,
+        }),
+    )
+    .unwrap();
     let (own, _) = renderer
         .render_offscreen(&scene, 256, 144, &RenderOptions::default())
         .unwrap();
@@ -86,4 +93,22 @@ fn embedding_draws_into_the_applications_framebuffer_under_its_overlay() {
             assert!(worst <= 1, "({x}, {y}): embedded {p:?}, offscreen {q:?}");
         }
     }
+}
+
+#[test]
+fn a_renderer_outliving_its_headless_context_says_so() {
+    let ctx = HeadlessContext::new(EsVersion::Es3).expect("headless ES 3.0 context");
+    let mut renderer = Renderer::new(ctx.load_gl(), EsVersion::Es3).unwrap();
+    let scene = builtin_scene("plane", Some(RandomLights { count: 4, seed: 1 })).unwrap();
+    drop(ctx);
+    let err = renderer
+        .render_offscreen(&scene, 16, 9, &RenderOptions::default())
+        .unwrap_err();
+    assert!(
+        matches!(err, manylight::Error::Gl(manylight::GlError::NotCurrent)),
+        "{err}"
+    );
+    assert!(err.to_string().contains("HeadlessContext dropped"), "{err}");
+    // Dropping the renderer afterwards must not crash either.
+    drop(renderer);
 }

@@ -11,7 +11,7 @@ use glutin::context::{NotCurrentContext, NotCurrentGlContext};
 use glutin::context::{PossiblyCurrentContext, PossiblyCurrentGlContext};
 use glutin::display::{Display, DisplayApiPreference, GlDisplay};
 use glutin::surface::{GlSurface, Surface, SurfaceAttributesBuilder, SwapInterval, WindowSurface};
-use manylight::{builtin_scene, method_names, Scene, DEFAULT_METHOD, DEFAULT_SCENE};
+use manylight::{builtin_scene, method_names, RandomLights, Scene, DEFAULT_METHOD, DEFAULT_SCENE};
 use manylight::{EsVersion, RenderOptions, Renderer};
 use winit::application::ApplicationHandler;
 use winit::dpi::PhysicalPosition;
@@ -35,7 +35,11 @@ pub fn run(activity: AndroidApp) {
             .with_max_level(log::LevelFilter::Info)
             .with_tag("manylight"),
     );
-    let scene = match builtin_scene(DEFAULT_SCENE, Some((LIGHTS, 1))) {
+    let lights = RandomLights {
+        count: LIGHTS,
+        seed: 1,
+    };
+    let scene = match builtin_scene(DEFAULT_SCENE, Some(lights)) {
         Ok(s) => s,
         Err(e) => return log::error!("cannot build the default scene: {e}"),
     };

@@ -104,7 +104,7 @@ pub(super) fn random_lights(rng: &mut Pcg64Mcg, n: usize, scale: f64) -> Vec<Gpu
                 );
                 let dir = if dir.length() < 1e-3 { DVec3::Z } else { dir };
                 let outer = rng.random_range(0.5..100.0);
-                Light::spot(p, dir, outer * 0.5, outer, r, Vec3::ONE, 1.0)
+                Light::spot(p, r, Vec3::ONE, 1.0, crate::scene::Cone { direction: dir, inner_deg: outer * 0.5, outer_deg: outer })
             } else {
                 Light::point(p, r, Vec3::ONE, 1.0)
             };

@@ -351,15 +351,7 @@ mod tests {
                 let f = i as f64;
                 let p = DVec3::new((f * 0.37).sin() * 20.0, (f * 0.11).cos() * 5.0, -(f * 0.05));
                 let light = if i % 3 == 0 {
-                    Light::spot(
-                        p,
-                        DVec3::new(0.2, -1.0, 0.1),
-                        10.0 + f % 20.0,
-                        30.0 + f % 40.0,
-                        (2.0 + (f % 7.0)) as f32,
-                        Vec3::new(1.0, 0.5, 0.25),
-                        (1.0 + f) as f32,
-                    )
+                    Light::spot(p, (2.0 + (f % 7.0)) as f32, Vec3::new(1.0, 0.5, 0.25), (1.0 + f) as f32, crate::scene::Cone { direction: DVec3::new(0.2, -1.0, 0.1), inner_deg: 10.0 + f % 20.0, outer_deg: 30.0 + f % 40.0 })
                 } else {
                     Light::point(
                         p,

@@ -36,7 +36,7 @@ pub struct LiveObjects {
 macro_rules! tracked {
     ($create:ident, $delete:ident, $ty:ty, $field:ident) => {
         pub(crate) fn $create(&self) -> Result<$ty, GlError> {
-            let object = unsafe { self.gl.$create() }.map_err(GlError::Create)?;
+            let object = unsafe { self.gl.$create() }.map_err(creation_failed)?;
             self.count(|l| l.$field += 1);
             Ok(object)
         }
@@ -46,6 +46,16 @@ macro_rules! tracked {
             self.count(|l| l.$field -= 1);
         }
     };
+}
+
+/// A creation error, or the usual cause when EGL says no context is current here: the context
+/// (a `HeadlessContext`, say) was dropped, or another made current, while the renderer lived.
+fn creation_failed(reason: String) -> GlError {
+    if super::gles_lib::no_current_context() {
+        GlError::NotCurrent
+    } else {
+        GlError::Create(reason)
+    }
 }
 
 impl Device {

@@ -156,6 +156,15 @@ impl GlesLibrary {
     }
 }
 
+/// True when this process loaded EGL (a headless context did) and EGL says no context is
+/// current on this thread; false when it cannot tell (a context from elsewhere, say WGL).
+pub(crate) fn no_current_context() -> bool {
+    match LOADED.get() {
+        Some(Ok(lib)) => lib.egl().get_current_context().is_none(),
+        _ => false,
+    }
+}
+
 /// The EGL and GLES library files this process has mapped (from `/proc/self/maps`), for
 /// `manylight info`: which files the implementation really is, whichever way it was chosen.
 pub fn loaded_files() -> Vec<PathBuf> {

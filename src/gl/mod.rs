@@ -161,4 +161,7 @@ pub enum GlError {
     /// Object creation failed.
     #[error("GL object creation failed: {0}")]
     Create(String),
+    /// EGL says no context is current on this thread.
+    #[error("no GL context is current on this thread: was the HeadlessContext dropped, or another context made current, while the Renderer lived? Keep the context alive and current as long as the renderer")]
+    NotCurrent,
 }

@@ -53,6 +53,10 @@ impl Renderer {
         options: &RenderOptions,
         stats: &mut FrameStats,
     ) -> Result<(), Error> {
+        // Without a current context every GL call is a silent no-op: say so instead.
+        if crate::gl::gles_lib::no_current_context() {
+            return Err(crate::gl::GlError::NotCurrent.into());
+        }
         // Light counts are exact per pixel: never averaged over samples.
         let samples = if options.count == CountKind::None {
             options.samples.max(1)

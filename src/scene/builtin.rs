@@ -19,7 +19,7 @@ use super::motion::{Flicker, Motion, Orbit, OrbitAbout, Sweep, Wander};
 use super::random::{self, LightSetStyle};
 use super::{Camera, Material, Mesh, Object, Scene, SceneError};
 
-/// Names accepted by [`build`], default first.
+/// Names of the built-in scenes (`builtin_scene` takes them), default first.
 pub const NAMES: &[&str] = &["courtyard", "pillars", "plane", "bubbles"];
 
 /// The default scene's name.
@@ -38,7 +38,8 @@ pub fn build(name: &str, lights: Option<(usize, u64)>) -> Result<Scene, SceneErr
     if let Some((count, seed)) = lights {
         super::input::check_light_count(count, "lights")?;
         scene.lights = random::lights(&volume, count, seed, style);
-        scene.animate_set(0, lively_motion(name, &volume), seed);
+        let all = 0..scene.lights.len();
+        scene.animate_lights(all, lively_motion(name, &volume), seed);
     }
     Ok(scene)
 }

@@ -355,7 +355,7 @@ pub fn parse(
         if let Some(m) = file.random_lights.as_ref().and_then(|r| r.motion.as_ref()) {
             // A set's sweep moves its spots only.
             let motion = m.to_motion("random_lights.motion", true)?;
-            scene.animate_set(first, motion, seed);
+            scene.animate_lights(first..scene.lights.len(), motion, seed);
         }
     }
     scene.validate()?;

@@ -24,6 +24,17 @@ pub enum LightKind {
     },
 }
 
+/// A spot light's cone, for [`Light::spot`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Cone {
+    /// Axis in world space (need not be normalised; must not be zero).
+    pub direction: DVec3,
+    /// Half-angle in degrees of full intensity, 0 ≤ inner ≤ outer.
+    pub inner_deg: f64,
+    /// Half-angle in degrees where the light reaches zero, inner ≤ outer ≤ 180.
+    pub outer_deg: f64,
+}
+
 /// A dynamic light.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Light {
@@ -40,7 +51,9 @@ pub struct Light {
 }
 
 impl Light {
-    /// A point light.
+    /// A point light. The position is `f64` so a scene far from the origin keeps its
+    /// precision (lights are moved into the camera's space in `f64` before they reach the GPU
+    /// as `f32`); radius, colour and intensity are what the GPU gets, so they are `f32`.
     pub fn point(position: DVec3, radius: f32, color: Vec3, intensity: f32) -> Self {
         Light {
             kind: LightKind::Point,
@@ -51,16 +64,14 @@ impl Light {
         }
     }
 
-    /// A spot light.
-    pub fn spot(
-        position: DVec3,
-        direction: DVec3,
-        inner_deg: f64,
-        outer_deg: f64,
-        radius: f32,
-        color: Vec3,
-        intensity: f32,
-    ) -> Self {
+    /// A spot light: a point light's arguments, then its [`Cone`] (named fields, so the two
+    /// angles and the direction cannot be swapped unnoticed).
+    pub fn spot(position: DVec3, radius: f32, color: Vec3, intensity: f32, cone: Cone) -> Self {
+        let Cone {
+            direction,
+            inner_deg,
+            outer_deg,
+        } = cone;
         Light {
             kind: LightKind::Spot {
                 direction,
@@ -251,11 +262,11 @@ mod tests {
                 "lights[0].position",
             ),
             (
-                Light::spot(DVec3::ZERO, DVec3::Z, 30.0, 20.0, 1.0, Vec3::ONE, 1.0),
+                Light::spot(DVec3::ZERO, 1.0, Vec3::ONE, 1.0, Cone { direction: DVec3::Z, inner_deg: 30.0, outer_deg: 20.0 }),
                 "lights[0].outer_deg",
             ),
             (
-                Light::spot(DVec3::ZERO, DVec3::ZERO, 10.0, 20.0, 1.0, Vec3::ONE, 1.0),
+                Light::spot(DVec3::ZERO, 1.0, Vec3::ONE, 1.0, Cone { direction: DVec3::ZERO, inner_deg: 10.0, outer_deg: 20.0 }),
                 "lights[0].direction",
             ),
         ];
@@ -268,7 +279,7 @@ mod tests {
 
     #[test]
     fn spot_scale_offset_is_finite_for_hard_cones() {
-        let l = Light::spot(DVec3::ZERO, DVec3::Z, 10.0, 10.0, 1.0, Vec3::ONE, 1.0);
+        let l = Light::spot(DVec3::ZERO, 1.0, Vec3::ONE, 1.0, Cone { direction: DVec3::Z, inner_deg: 10.0, outer_deg: 10.0 });
         let (s, o) = l.spot_scale_offset();
         assert!(s.is_finite() && o.is_finite());
         let (s, o) = base().spot_scale_offset();

@@ -22,13 +22,14 @@ pub mod obj;
 pub mod random;
 pub mod shading;
 
+use std::ops::Range;
 use std::sync::Arc;
 
 use glam::{DMat4, DVec3, Vec3};
 
 pub use camera::{Camera, Projection};
 pub use error::SceneError;
-pub use light::{Light, LightKind};
+pub use light::{Cone, Light, LightKind};
 pub use material::{Material, Texture};
 pub use mesh::{Aabb, Mesh};
 pub use motion::Motion;
@@ -84,6 +85,23 @@ impl Scene {
             .reduce(|a, b| a.union(&b))
     }
 
+    /// Places `mesh` (a [`Mesh`], or an `Arc` of one to share it between objects) with
+    /// material `material` (an index from [`Scene::add_material`]) at `transform` (object
+    /// space to world space); returns the object's index.
+    pub fn add_object(
+        &mut self,
+        mesh: impl Into<Arc<Mesh>>,
+        material: usize,
+        transform: DMat4,
+    ) -> usize {
+        self.objects.push(Object {
+            mesh: mesh.into(),
+            material,
+            transform,
+        });
+        self.objects.len() - 1
+    }
+
     /// Adds a material and returns its index.
     pub fn add_material(&mut self, material: Material) -> usize {
         self.materials.push(material);
@@ -108,13 +126,14 @@ impl Scene {
         }
     }
 
-    /// Gives the lights from `first` on (to the end) each its own variation of `motion`
-    /// (seeded: phases, periods within ±25 %, wander and flicker seeds; see
-    /// [`motion::Motion::varied`]), starting from their current state.
-    pub fn animate_set(&mut self, first: usize, motion: motion::Motion, seed: u64) {
-        if let (false, Some(rest)) = (motion.is_still(), self.lights.get(first..)) {
+    /// Gives each light of `lights` (indices into [`Scene::lights`], e.g. `0..n`) its own
+    /// variation of `motion` (seeded: phases, periods within ±25 %, wander and flicker seeds),
+    /// starting from its current state. Does nothing for a still motion or a range past the
+    /// lights.
+    pub fn animate_lights(&mut self, lights: Range<usize>, motion: motion::Motion, seed: u64) {
+        if let (false, Some(rest)) = (motion.is_still(), self.lights.get(lights.clone())) {
             self.animation.push(motion::LightTrack {
-                first,
+                first: lights.start,
                 rest: rest.to_vec(),
                 motion,
                 vary: Some(seed),
@@ -233,6 +252,33 @@ impl Scene {
             );
         }
     }
+}
+
+/// Seeded random lights to put in a scene: `count` of them, placed, coloured and moving by the
+/// random generator seeded with `seed` (the same seed gives the same lights).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct RandomLights {
+    /// How many (at most 4 194 304).
+    pub count: usize,
+    /// The generator's seed.
+    pub seed: u64,
+}
+
+/// A built-in scene by name (`BUILTIN_SCENES`): `Some` lights replaces its own with seeded
+/// random ones (which wander, flicker and sweep; [`Scene::set_time`] poses them), `None`
+/// keeps the scene's own.
+pub fn builtin_scene(name: &str, lights: Option<RandomLights>) -> Result<Scene, SceneError> {
+    builtin::build(name, lights.map(|l| (l.count, l.seed)))
+}
+
+/// A scene as `manylight --scene` names it: a built-in name, an `.obj`, `.gltf`/`.glb` or
+/// `.json` scene file, with `lights` random lights added (for a file's own lights, `None`),
+/// and what the loader warned about.
+pub fn load_scene(
+    spec: &str,
+    lights: Option<RandomLights>,
+) -> Result<(Scene, obj::LoadReport), SceneError> {
+    load(spec, lights.map(|l| (l.count, l.seed)))
 }
 
 /// True when `spec` names a file that brings its own lights (a `.json` scene file, a `.gltf`

@@ -49,12 +49,14 @@ fn scene_with_lights_crossing_the_camera() -> Scene {
     // Along the view axis through the eye: from 4 m in front to 4 m behind and back.
     scene.lights.push(Light::spot(
         cam.position + forward * 4.0,
-        DVec3::new(0.2, -1.0, 0.1),
-        20.0,
-        45.0,
         5.0,
         Vec3::new(0.9, 1.0, 0.6),
         3.0,
+        manylight::Cone {
+            direction: DVec3::new(0.2, -1.0, 0.1),
+            inner_deg: 20.0,
+            outer_deg: 45.0,
+        },
     ));
     scene.animate_light(
         scene.lights.len() - 1,

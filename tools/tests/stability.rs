@@ -528,12 +528,14 @@ fn spot_cones_of_zero_half_and_179_degrees() {
         let x = -3.0 + 2.0 * i as f64;
         s.lights.push(Light::spot(
             DVec3::new(x, 0.0, 1.0),
-            DVec3::new(0.0, 0.0, -1.0),
-            outer * 0.5,
-            outer,
             3.0,
             Vec3::ONE,
             2.0,
+            manylight::Cone {
+                direction: DVec3::new(0.0, 0.0, -1.0),
+                inner_deg: outer * 0.5,
+                outer_deg: outer,
+            },
         ));
     }
     // Hard-edged cones (inner = outer) are bright right up to their edge, so a cone-vs-cell
@@ -541,43 +543,51 @@ fn spot_cones_of_zero_half_and_179_degrees() {
     // wide) and a 35° cone from close by.
     s.lights.push(Light::spot(
         DVec3::new(2.5, 2.0, 20.0),
-        DVec3::new(0.0, 0.0, -1.0),
-        0.5,
-        0.5,
         25.0,
         Vec3::ONE,
         1500.0,
+        manylight::Cone {
+            direction: DVec3::new(0.0, 0.0, -1.0),
+            inner_deg: 0.5,
+            outer_deg: 0.5,
+        },
     ));
     s.lights.push(Light::spot(
         DVec3::new(-2.0, 2.0, 0.8),
-        DVec3::new(0.0, 0.0, -1.0),
-        35.0,
-        35.0,
         2.0,
         Vec3::new(0.2, 1.0, 0.4),
         2.0,
+        manylight::Cone {
+            direction: DVec3::new(0.0, 0.0, -1.0),
+            inner_deg: 35.0,
+            outer_deg: 35.0,
+        },
     ));
     // A soft 35° cone (17.5° inner) from 3 m: its bright annulus spans many cells, so a cone
     // test that confuses the inner and the outer angle drops lit cells.
     s.lights.push(Light::spot(
         DVec3::new(1.5, -1.0, 3.0),
-        DVec3::new(0.0, 0.0, -1.0),
-        17.5,
-        35.0,
         5.0,
         Vec3::new(0.5, 0.5, 1.0),
         20.0,
+        manylight::Cone {
+            direction: DVec3::new(0.0, 0.0, -1.0),
+            inner_deg: 17.5,
+            outer_deg: 35.0,
+        },
     ));
     // A spot grazing the plane: its apex 5 cm above it, so the plane is lit from right by
     // the apex outward. A bound of the cone that drops the region near the apex shows here.
     s.lights.push(Light::spot(
         DVec3::new(-4.0, -2.5, 0.05),
-        DVec3::new(0.3, 1.0, -0.08),
-        20.0,
-        20.0,
         4.0,
         Vec3::new(1.0, 0.3, 0.2),
         3.0,
+        manylight::Cone {
+            direction: DVec3::new(0.3, 1.0, -0.08),
+            inner_deg: 20.0,
+            outer_deg: 20.0,
+        },
     ));
     // A fine grid (8-pixel cells, no minimum size), so the cone-vs-cell test decides cells.
     let fine = RenderOptions {

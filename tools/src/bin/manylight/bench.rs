@@ -608,7 +608,7 @@ impl AnimatedWorkload {
         if !scene.is_animated() {
             if let Some(bounds) = scene.bounds() {
                 let motion = scene::builtin::lively_motion(&self.name, &bounds);
-                scene.animate_set(0, motion, 1);
+                scene.animate_lights(0..scene.lights.len(), motion, 1);
             }
         }
         let start = scene.camera;
