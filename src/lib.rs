@@ -59,12 +59,12 @@ pub use error::Error;
 pub use gl::caps::Precision;
 pub use gl::gles_lib::select as select_gles_library;
 pub use gl::{Caps, EsVersion, GlError, HeadlessContext, Restrictions};
-pub use methods::{method_names, Support, DEFAULT_METHOD};
+pub use methods::Support;
 pub use metrics::counts::LightCounts;
 pub use metrics::spread::Spread;
 pub use options::{CountKind, MeasureOptions, RenderOptions, ToneMap, MAX_TIMED_FRAMES};
 pub use renderer::{
-    ContextStats, FrameStats, GridStats, LightStats, MemoryStats, Renderer, TimeStats,
+    ContextStats, FrameStats, GridStats, LightStats, MemoryStats, Method, Renderer, TimeStats,
 };
 pub use scene::features::SceneFeatures;
 pub use scene::meshbuild::MeshBuilder;

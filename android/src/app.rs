@@ -11,7 +11,7 @@ use glutin::context::{NotCurrentContext, NotCurrentGlContext};
 use glutin::context::{PossiblyCurrentContext, PossiblyCurrentGlContext};
 use glutin::display::{Display, DisplayApiPreference, GlDisplay};
 use glutin::surface::{GlSurface, Surface, SurfaceAttributesBuilder, SwapInterval, WindowSurface};
-use manylight::{builtin_scene, method_names, RandomLights, Scene, DEFAULT_METHOD, DEFAULT_SCENE};
+use manylight::{builtin_scene, Method, RandomLights, Scene, DEFAULT_SCENE};
 use manylight::{EsVersion, RenderOptions, Renderer};
 use winit::application::ApplicationHandler;
 use winit::dpi::PhysicalPosition;
@@ -303,10 +303,10 @@ impl Shell {
 /// The default method, else the first of the table this device runs (an ES 2.0 GPU without
 /// fragment `highp` cannot run the culling methods).
 fn pick_method(renderer: &mut Renderer) -> Result<(), String> {
-    let names = std::iter::once(DEFAULT_METHOD).chain(method_names());
+    let methods = std::iter::once(Method::default()).chain(Method::ALL);
     let mut failures = Vec::new();
-    for name in names {
-        match renderer.set_method(name) {
+    for method in methods {
+        match renderer.set_method(method) {
             Ok(_) => return Ok(()),
             Err(e) => failures.push(e.to_string()),
         }

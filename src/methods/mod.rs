@@ -168,12 +168,6 @@ pub static METHODS: &[MethodDesc] = &[
 /// The default method.
 pub const DEFAULT_METHOD: &str = "clustered";
 
-/// The shading methods' names, in the table's order ([`Renderer::set_method`](crate::Renderer::set_method)
-/// takes these and `auto`).
-pub fn method_names() -> impl Iterator<Item = &'static str> {
-    METHODS.iter().map(|m| m.name)
-}
-
 /// Finds a method by name.
 pub fn find(name: &str) -> Result<&'static MethodDesc, Error> {
     METHODS

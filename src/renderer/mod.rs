@@ -8,6 +8,7 @@
 
 mod frame;
 mod frame_setup;
+mod method;
 mod offscreen;
 mod stats;
 
@@ -20,6 +21,7 @@ use crate::methods::{self, ShadingMethod, Support};
 pub use crate::metrics::counts::LightCounts;
 pub use crate::options::{CountKind, RenderOptions, ToneMap};
 use crate::Error;
+pub use method::Method;
 pub use stats::{ContextStats, FrameStats, GridStats, LightStats, MemoryStats, TimeStats};
 
 /// Renders scenes with one shading method at a time.
@@ -129,7 +131,13 @@ impl Renderer {
     /// Switches method. Unsupported methods are an error naming what is missing; a fallback
     /// is returned as `Some(reason)` (also logged as a warning). The previous method's GPU
     /// resources are freed.
-    pub fn set_method(&mut self, name: &str) -> Result<Option<String>, Error> {
+    pub fn set_method(&mut self, method: Method) -> Result<Option<String>, Error> {
+        self.set_method_named(method.name())
+    }
+
+    /// [`Renderer::set_method`] by name, as `--method` or a settings file gives it
+    /// (`"clustered"`, …); an unknown name is [`Error::UnknownMethod`].
+    pub fn set_method_named(&mut self, name: &str) -> Result<Option<String>, Error> {
         // An explicit choice replaces what the default method would have warned about.
         let unannounced = self.pending_warning.take().is_some();
         let desc = methods::find(name)?;

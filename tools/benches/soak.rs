@@ -45,7 +45,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .map(|m| m.name)
         .filter(|m| only.as_deref().is_none_or(|o| o == *m));
     for method in methods {
-        renderer.set_method(method)?;
+        renderer.set_method_named(method)?;
         let mut after_warmup = 0.0;
         let mut samples = Vec::new();
         let (mut timed, mut timed_frames) = (std::time::Duration::ZERO, 0u32);

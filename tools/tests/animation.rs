@@ -90,8 +90,8 @@ fn a_frame_is_the_same_rendered_in_sequence_or_alone() {
     let mut sequence = Gpu::new(EsVersion::Es3);
     let mut alone = Gpu::new(EsVersion::Es3);
     for method in ["forward", "tiled", "clustered"] {
-        sequence.r().set_method(method).unwrap();
-        alone.r().set_method(method).unwrap();
+        sequence.r().set_method_named(method).unwrap();
+        alone.r().set_method_named(method).unwrap();
         let mut scene = scene_with_lights_crossing_the_camera();
         let mut in_sequence = None;
         for frame in 0..=k {
@@ -163,10 +163,10 @@ fn culled_methods_match_forward_on_moving_frames() {
             seen_in_view |= in_view > 0;
             seen_out_of_view |= in_view < 3;
             for opts in [RenderOptions::default(), fixed_grid()] {
-                gpu.r().set_method("forward").unwrap();
+                gpu.r().set_method_named("forward").unwrap();
                 let reference = gpu.render(&scene, W, H, &opts);
                 for method in methods {
-                    gpu.r().set_method(method).unwrap();
+                    gpu.r().set_method_named(method).unwrap();
                     let (image, stats) = gpu.r().render_offscreen(&scene, W, H, &opts).unwrap();
                     let d = diff(&reference, &image);
                     assert!(

@@ -53,7 +53,7 @@ fn render(
     scene: &scene::Scene,
     opts: &RenderOptions,
 ) -> (image::RgbaImage, FrameStats) {
-    gpu.r().set_method(method).unwrap();
+    gpu.r().set_method_named(method).unwrap();
     gpu.r().render_offscreen(scene, W, H, opts).unwrap()
 }
 
@@ -206,7 +206,7 @@ fn a_grid_the_texture_cannot_hold_is_a_clear_error() {
     use manylight::cluster::grid::GridConfig;
     let scene = scene::builtin::build("pillars", Some((64, 1))).unwrap();
     let mut gpu = Gpu::new(EsVersion::Es3);
-    gpu.r().set_method("clustered").unwrap();
+    gpu.r().set_method_named("clustered").unwrap();
     // 640 × 360 one-pixel cells, 64 slices in each of 12 cascades: 177 million cells, more
     // than any texture of 1 024-texel rows holds (32 768 rows would be 33.5 million).
     let options = RenderOptions {

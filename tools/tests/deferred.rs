@@ -17,9 +17,9 @@ fn deferred_matches_forward_within_2_of_255_on_opaque_scenes() {
                     linear,
                     ..Default::default()
                 };
-                gpu.r().set_method("forward").unwrap();
+                gpu.r().set_method_named("forward").unwrap();
                 let (reference, _) = gpu.r().render_offscreen(&s, 256, 144, &opts).unwrap();
-                gpu.r().set_method("deferred").unwrap();
+                gpu.r().set_method_named("deferred").unwrap();
                 let (img, stats) = gpu.r().render_offscreen(&s, 256, 144, &opts).unwrap();
                 let d = manylight::metrics::diff(&reference, &img);
                 eprintln!(
@@ -43,9 +43,9 @@ fn transparent_objects_take_the_forward_fallback() {
     let s = scene::builtin::build("bubbles", Some((128, 2))).unwrap();
     let mut gpu = Gpu::new(EsVersion::Es3);
     let opts = RenderOptions::default();
-    gpu.r().set_method("forward").unwrap();
+    gpu.r().set_method_named("forward").unwrap();
     let (reference, _) = gpu.r().render_offscreen(&s, 192, 108, &opts).unwrap();
-    gpu.r().set_method("deferred").unwrap();
+    gpu.r().set_method_named("deferred").unwrap();
     let (img, _) = gpu.r().render_offscreen(&s, 192, 108, &opts).unwrap();
     let d = manylight::metrics::diff(&reference, &img);
     assert!(
@@ -58,7 +58,11 @@ fn transparent_objects_take_the_forward_fallback() {
 #[test]
 fn deferred_is_unsupported_on_es2_with_a_reason() {
     let mut gpu = Gpu::new(EsVersion::Es2);
-    let err = gpu.r().set_method("deferred").unwrap_err().to_string();
+    let err = gpu
+        .r()
+        .set_method_named("deferred")
+        .unwrap_err()
+        .to_string();
     assert!(err.contains("deferred") && err.contains("ES 3.0"), "{err}");
     // The renderer keeps working with its previous method.
     let s = scene::builtin::build("plane", Some((8, 1))).unwrap();

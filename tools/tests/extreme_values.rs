@@ -47,7 +47,7 @@ fn a_light_whose_radius_dwarfs_the_scene_lights_it_as_a_large_one_does() {
     for es in [EsVersion::Es2, EsVersion::Es3] {
         let mut gpu = Gpu::new(es);
         for method in ["forward", "clustered"] {
-            gpu.r().set_method(method).unwrap();
+            gpu.r().set_method_named(method).unwrap();
             let opts = RenderOptions::default();
             // At 10⁶ the window term is 1 to 10⁻²⁰ across the plane: the same picture as any
             // larger radius, which must not underflow to nothing.

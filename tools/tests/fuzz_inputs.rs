@@ -134,7 +134,7 @@ fn render_finite(scene: &Scene, what: &str) {
         let mut cell = cell.borrow_mut();
         let gpu = cell.get_or_insert_with(|| Gpu::new(EsVersion::Es3));
         for method in ["forward", "clustered"] {
-            gpu.r().set_method(method).unwrap();
+            gpu.r().set_method_named(method).unwrap();
             match gpu
                 .r()
                 .render_offscreen_hdr(scene, 16, 9, &RenderOptions::default())

@@ -649,7 +649,7 @@ fn a_gltf_scene_renders_as_the_same_scene_written_as_json_and_obj() {
     assert_eq!(glass.alpha, 0.5);
     let mut gpu = Gpu::new(EsVersion::Es3);
     for method in ["forward", "clustered"] {
-        gpu.r().set_method(method).unwrap();
+        gpu.r().set_method_named(method).unwrap();
         let a = gpu.render(&from_gltf, 160, 96, &RenderOptions::default());
         let b = gpu.render(&from_json, 160, 96, &RenderOptions::default());
         let d = manylight::metrics::diff(&a, &b);

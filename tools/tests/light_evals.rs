@@ -10,7 +10,7 @@ use manylight::scene::{self, Scene};
 use manylight::{EsVersion, RenderOptions};
 
 fn counts(gpu: &mut Gpu, scene: &Scene, method: &str, kind: CountKind) -> LightCounts {
-    gpu.r().set_method(method).unwrap();
+    gpu.r().set_method_named(method).unwrap();
     gpu.r()
         .render_light_counts(scene, 256, 144, &RenderOptions::default(), kind)
         .unwrap_or_else(|e| panic!("{method} {kind:?}: {e}"))
@@ -218,7 +218,7 @@ fn tight_coverage_never_evaluates_more_than_the_cascade_box() {
     let scene = scene::builtin::build("courtyard", Some((1024, 3))).unwrap();
     let mut gpu = Gpu::new(EsVersion::Es3);
     for (method, footprint) in [("clustered", 64.0), ("clustered", 16.0), ("tiled", 16.0)] {
-        gpu.r().set_method(method).unwrap();
+        gpu.r().set_method_named(method).unwrap();
         let evals = |gpu: &mut Gpu, coverage| {
             let options = RenderOptions {
                 grid: GridConfig {

@@ -33,12 +33,12 @@ fn auto_picks_forward_for_few_lights_and_clustered_for_many_and_says_why() {
     let mut gpu = Gpu::new(EsVersion::Es2);
     for (lights, expected) in [(8, "forward"), (1024, "clustered")] {
         let s = scene::builtin::build("pillars", Some((lights, 3))).unwrap();
-        gpu.r().set_method("forward").unwrap();
+        gpu.r().set_method_named("forward").unwrap();
         let (reference, _) = gpu
             .r()
             .render_offscreen(&s, 128, 72, &RenderOptions::default())
             .unwrap();
-        gpu.r().set_method("auto").unwrap();
+        gpu.r().set_method_named("auto").unwrap();
         let (img, stats) = gpu
             .r()
             .render_offscreen(&s, 128, 72, &RenderOptions::default())

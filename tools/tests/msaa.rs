@@ -15,7 +15,7 @@ fn every_method_with_msaa_matches_forward_with_msaa() {
     // 4 bytes of colour and 4 of depth per sample.
     let reference = common::assert_methods_match_forward_with_4_samples(&mut gpu, 4 * 8);
     let scene = scene::builtin::build("courtyard", Some((64, 2))).unwrap();
-    gpu.r().set_method("forward").unwrap();
+    gpu.r().set_method_named("forward").unwrap();
     let single = gpu.render(&scene, 128, 72, &msaa(1));
     assert_ne!(reference, single, "4 samples changed nothing");
 }
@@ -41,13 +41,13 @@ fn edges_get_the_coverage_fractions_of_their_samples() {
 fn unsupported_msaa_is_a_clear_error() {
     let scene = scene::builtin::build("plane", Some((4, 1))).unwrap();
     let mut es3 = Gpu::new(EsVersion::Es3);
-    es3.r().set_method("deferred").unwrap();
+    es3.r().set_method_named("deferred").unwrap();
     let err = es3
         .r()
         .render_offscreen(&scene, 16, 16, &msaa(4))
         .unwrap_err();
     assert!(err.to_string().contains("deferred"), "{err}");
-    es3.r().set_method("clustered").unwrap();
+    es3.r().set_method_named("clustered").unwrap();
     let err = es3
         .r()
         .render_offscreen(&scene, 16, 16, &msaa(64))

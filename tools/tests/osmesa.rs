@@ -23,10 +23,10 @@ fn osmesa_renders_the_default_scene_through_every_method() {
     let opts = RenderOptions::default();
     let mut r = Renderer::new(ctx.load_gl(), EsVersion::Es3).unwrap();
     assert!(r.caps().desktop, "OSMesa gives desktop GL");
-    r.set_method("forward").unwrap();
+    r.set_method_named("forward").unwrap();
     let (reference, _) = r.render_offscreen(&s, 160, 90, &opts).unwrap();
     for m in METHODS {
-        r.set_method(m.name)
+        r.set_method_named(m.name)
             .unwrap_or_else(|e| panic!("{}: {e}", m.name));
         let (img, _) = r.render_offscreen(&s, 160, 90, &opts).unwrap();
         let d = manylight::metrics::diff(&reference, &img);
@@ -46,7 +46,7 @@ fn osmesa_renders_the_default_scene_through_every_method() {
     }
     let egl = HeadlessContext::new(EsVersion::Es3).unwrap();
     let mut r = Renderer::new(egl.load_gl(), EsVersion::Es3).unwrap();
-    r.set_method("forward").unwrap();
+    r.set_method_named("forward").unwrap();
     let (es3, _) = r.render_offscreen(&s, 160, 90, &opts).unwrap();
     r.destroy();
     let d = manylight::metrics::diff(&reference, &es3);

@@ -80,7 +80,7 @@ fn lean_variants_render_exactly_like_the_full_ones() {
     for es in [EsVersion::Es2, EsVersion::Es3] {
         let mut gpu = Gpu::new(es);
         for method in ["forward", "tiled", "clustered"] {
-            gpu.r().set_method(method).unwrap();
+            gpu.r().set_method_named(method).unwrap();
             let (lean, stats) = gpu
                 .r()
                 .render_offscreen(&s, 128, 72, &RenderOptions::default())
@@ -133,11 +133,11 @@ fn switching_methods_frees_the_previous_methods_resources() {
     let s = point_light_scene();
     let mut gpu = Gpu::new(EsVersion::Es3);
     let opts = RenderOptions::default();
-    gpu.r().set_method("forward").unwrap();
+    gpu.r().set_method_named("forward").unwrap();
     gpu.r().render_offscreen(&s, 64, 36, &opts).unwrap();
     let baseline = gpu.r().live_gl_objects();
     for method in ["clustered", "tiled"] {
-        gpu.r().set_method(method).unwrap();
+        gpu.r().set_method_named(method).unwrap();
         for _ in 0..4 {
             gpu.r().render_offscreen(&s, 64, 36, &opts).unwrap();
         }
@@ -147,7 +147,7 @@ fn switching_methods_frees_the_previous_methods_resources() {
             "{method} allocated no textures?"
         );
     }
-    gpu.r().set_method("forward").unwrap();
+    gpu.r().set_method_named("forward").unwrap();
     gpu.r().render_offscreen(&s, 64, 36, &opts).unwrap();
     let after = gpu.r().live_gl_objects();
     // Programs stay cached; every texture, buffer and framebuffer returns to the baseline.
@@ -172,7 +172,7 @@ fn a_method_allocates_nothing_before_it_has_lights_to_draw() {
     let mut s = point_light_scene();
     let lights = std::mem::take(&mut s.lights);
     let mut gpu = Gpu::new(EsVersion::Es2);
-    gpu.r().set_method("clustered").unwrap();
+    gpu.r().set_method_named("clustered").unwrap();
     let (_, stats) = gpu
         .r()
         .render_offscreen(&s, 64, 36, &RenderOptions::default())
@@ -200,11 +200,11 @@ fn bubbles_match_forward_with_every_forward_method() {
     for es in [EsVersion::Es2, EsVersion::Es3] {
         let mut gpu = Gpu::new(es);
         let opts = RenderOptions::default();
-        gpu.r().set_method("forward").unwrap();
+        gpu.r().set_method_named("forward").unwrap();
         let (reference, stats) = gpu.r().render_offscreen(&s, 192, 108, &opts).unwrap();
         assert!(stats.scene_features.transparency);
         for method in ["tiled", "clustered"] {
-            gpu.r().set_method(method).unwrap();
+            gpu.r().set_method_named(method).unwrap();
             let (img, _) = gpu.r().render_offscreen(&s, 192, 108, &opts).unwrap();
             let d = manylight::metrics::diff(&reference, &img);
             assert!(
@@ -216,7 +216,7 @@ fn bubbles_match_forward_with_every_forward_method() {
         // The bubbles are really there: the same view without them differs.
         let mut opaque = s.clone();
         opaque.objects.retain(|o| !opaque_is_transparent(&s, o));
-        gpu.r().set_method("forward").unwrap();
+        gpu.r().set_method_named("forward").unwrap();
         let (without, _) = gpu.r().render_offscreen(&opaque, 192, 108, &opts).unwrap();
         assert!(
             manylight::metrics::diff(&reference, &without).over_2 > 0.02,

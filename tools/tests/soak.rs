@@ -133,7 +133,7 @@ fn live_heap_and_gl_objects_stay_flat_over_frames_of_moving_lights() {
     let options = RenderOptions::default();
     let (warm_up, measured) = (40, 120);
     for method in METHODS.iter().map(|m| m.name) {
-        gpu.r().set_method(method).unwrap();
+        gpu.r().set_method_named(method).unwrap();
         let mut at_warm_up = None;
         for frame in 0..warm_up + measured {
             move_lights(&mut scene, &start, frame);
@@ -366,7 +366,7 @@ fn allocations_per_frame(
                     ""
                 }
             );
-            if let Err(e) = renderer.set_method(method) {
+            if let Err(e) = renderer.set_method_named(method) {
                 assert!(
                     matches!(
                         (METHODS.iter().find(|m| m.name == method).unwrap().supported)(

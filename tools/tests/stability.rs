@@ -27,7 +27,7 @@ fn check_with(name: &str, scene: &Scene, w: u32, h: u32, opts: &RenderOptions) -
     for es in [EsVersion::Es2, EsVersion::Es3] {
         let mut gpu = Gpu::new(es);
         let opts = opts.clone();
-        gpu.r().set_method("forward").unwrap();
+        gpu.r().set_method_named("forward").unwrap();
         let reference_opts = RenderOptions {
             measure: manylight::MeasureOptions {
                 reference_precision: true,
@@ -45,7 +45,7 @@ fn check_with(name: &str, scene: &Scene, w: u32, h: u32, opts: &RenderOptions) -
             &[]
         };
         for &method in METHODS.iter().chain(deferred) {
-            gpu.r().set_method(method).unwrap();
+            gpu.r().set_method_named(method).unwrap();
             let (img, stats) = gpu
                 .r()
                 .render_offscreen(scene, w, h, &opts)
@@ -231,7 +231,7 @@ fn zero_lights_is_exactly_ambient_and_does_no_grid_work() {
     );
     let mut gpu = Gpu::new(EsVersion::Es3);
     for method in METHODS {
-        gpu.r().set_method(method).unwrap();
+        gpu.r().set_method_named(method).unwrap();
         let (_, stats) = gpu
             .r()
             .render_offscreen(&s, 64, 36, &RenderOptions::default())
@@ -274,7 +274,7 @@ fn lights_behind_the_camera_and_beyond_far() {
     check("behind / beyond", &s, 96, 54);
     assert_matches_oracle("behind / beyond", &s, 96, 54);
     let mut gpu = Gpu::new(EsVersion::Es3);
-    gpu.r().set_method("clustered").unwrap();
+    gpu.r().set_method_named("clustered").unwrap();
     let (_, stats) = gpu
         .r()
         .render_offscreen(&s, 96, 54, &RenderOptions::default())
@@ -384,7 +384,7 @@ fn degenerate_and_huge_radii_and_intensities() {
     // The radius-0 light is never uploaded: it is not active, and no method sees it.
     let mut gpu = Gpu::new(EsVersion::Es3);
     for method in METHODS {
-        gpu.r().set_method(method).unwrap();
+        gpu.r().set_method_named(method).unwrap();
         let (_, stats) = gpu
             .r()
             .render_offscreen(&s, 32, 18, &RenderOptions::default())
@@ -448,7 +448,7 @@ fn crowded_cells_and_index_lists_past_16_bits() {
         })
         .collect();
     let mut gpu = Gpu::new(EsVersion::Es2);
-    gpu.r().set_method("clustered").unwrap();
+    gpu.r().set_method_named("clustered").unwrap();
     let (_, stats) = gpu
         .r()
         .render_offscreen(&s, 256, 144, &RenderOptions::default())
@@ -638,7 +638,7 @@ fn invalid_values_are_rejected_before_upload() {
         s.lights = vec![point([0.0, 0.0, 1.0], 2.0, 1.0)];
         break_it(&mut s);
         for method in METHODS {
-            gpu.r().set_method(method).unwrap();
+            gpu.r().set_method_named(method).unwrap();
             let err = gpu
                 .r()
                 .render_offscreen(&s, 16, 16, &RenderOptions::default())

@@ -36,7 +36,7 @@ fn tone_maps_and_exposure_match_their_formulas() {
     let (w, h) = (96, 54);
     for es in [EsVersion::Es2, EsVersion::Es3] {
         let mut gpu = Gpu::new(es);
-        gpu.r().set_method("forward").unwrap();
+        gpu.r().set_method_named("forward").unwrap();
         let (radiance, _) = gpu
             .r()
             .render_offscreen_hdr(&scene, w, h, &RenderOptions::default())
@@ -152,7 +152,7 @@ fn an_exposure_out_of_range_is_refused_naming_the_field() {
 fn tone_maps_do_not_overflow_without_fragment_highp() {
     let scene = bright_plane();
     let mut full = Gpu::new(EsVersion::Es2);
-    full.r().set_method("forward").unwrap();
+    full.r().set_method_named("forward").unwrap();
     let (radiance, _) = full
         .r()
         .render_offscreen_hdr(&scene, 64, 36, &RenderOptions::default())

@@ -200,10 +200,10 @@ pub fn assert_methods_match_forward_with_4_samples(
     bytes_per_pixel: usize,
 ) -> image::RgbaImage {
     let scene = manylight::scene::builtin::build("courtyard", Some((64, 2))).unwrap();
-    gpu.r().set_method("forward").unwrap();
+    gpu.r().set_method_named("forward").unwrap();
     let reference = gpu.render(&scene, 128, 72, &msaa(4));
     for method in ["tiled", "clustered", "auto"] {
-        gpu.r().set_method(method).unwrap();
+        gpu.r().set_method_named(method).unwrap();
         let (img, stats) = gpu.r().render_offscreen(&scene, 128, 72, &msaa(4)).unwrap();
         assert_eq!(stats.samples, 4);
         assert_eq!(stats.memory.msaa_bytes, 128 * 72 * bytes_per_pixel);

@@ -450,7 +450,7 @@ fn baseline(
     (w, h): (u32, u32),
     cpu_samples: usize,
 ) -> Result<Baseline, Box<dyn std::error::Error>> {
-    renderer.set_method("forward")?;
+    renderer.set_method_named("forward")?;
     let reference_opts = RenderOptions {
         measure: manylight::MeasureOptions {
             reference_precision: true,
@@ -507,7 +507,7 @@ impl Measure<'_> {
         if matches!((desc.supported)(renderer.caps()), Support::Unsupported(_)) {
             return Ok(None);
         }
-        renderer.set_method(method)?;
+        renderer.set_method_named(method)?;
         let mut opts = RenderOptions::default();
         adjust(&mut opts);
         let (w, h) = self.size;
@@ -623,7 +623,7 @@ impl AnimatedWorkload {
             fps: ANIMATED_FPS,
             frames: self.frames,
         };
-        renderer.set_method(method)?;
+        renderer.set_method_named(method)?;
         let options = RenderOptions::default();
         let rendered = match crate::sequence::render(
             renderer, &mut scene, self.size, &options, &timeline, &mut pose, None,
@@ -641,7 +641,7 @@ impl AnimatedWorkload {
         let error = if method == "forward" {
             None
         } else {
-            renderer.set_method("forward")?;
+            renderer.set_method_named("forward")?;
             let (w, h) = self.size;
             let (reference, _) = renderer.render_offscreen(&scene, w, h, &options)?;
             Some(manylight::metrics::diff(&reference, &rendered.last).max_abs)

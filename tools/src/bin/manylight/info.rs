@@ -41,7 +41,7 @@ fn scene_report(
         if matches!((m.supported)(renderer.caps()), Support::Unsupported(_)) {
             continue;
         }
-        renderer.set_method(m.name)?;
+        renderer.set_method_named(m.name)?;
         let (_, stats) =
             renderer.render_offscreen(&scene, 64, 36, &manylight::RenderOptions::default())?;
         features = Some(stats.scene_features);

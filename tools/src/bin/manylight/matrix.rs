@@ -445,7 +445,7 @@ pub fn run_cell(args: &MatrixCellArgs) -> Result<(), Box<dyn std::error::Error>>
     let reference = {
         let ctx = CellContext::new(es, args.osmesa)?;
         let mut full = Renderer::new(ctx.load_gl(), es)?;
-        full.set_method("forward")?;
+        full.set_method_named("forward")?;
         let reference_opts = RenderOptions {
             measure: manylight::MeasureOptions {
                 reference_precision: true,
@@ -467,7 +467,7 @@ pub fn run_cell(args: &MatrixCellArgs) -> Result<(), Box<dyn std::error::Error>>
         let support = (m.supported)(renderer.caps());
         let mut entry = json!({"name": m.name, "support": support});
         if !matches!(support, Support::Unsupported(_)) {
-            renderer.set_method(m.name)?;
+            renderer.set_method_named(m.name)?;
             let (img, stats) = renderer.render_offscreen(&scene, w, h, &opts)?;
             let d = manylight::metrics::diff(&reference, &img);
             let file = format!("{}-{}.png", args.tag, m.name);

@@ -215,7 +215,7 @@ pub fn run(args: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
     let mut renderer = Renderer::restricted(ctx.load_gl(), es, &restrictions)?;
     // A fallback is logged as a warning by the renderer.
     if let Some(method) = &args.method {
-        renderer.set_method(method)?;
+        renderer.set_method_named(method)?;
     }
     let options = RenderOptions {
         linear: args.linear,

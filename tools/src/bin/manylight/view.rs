@@ -203,7 +203,8 @@ impl ApplicationHandler for App<'_> {
         let made = Gfx::create(event_loop, "manylight", self.args.size, es).and_then(|mut g| {
             if let Some(r) = g.renderer.as_mut() {
                 // A fallback is logged as a warning by the renderer.
-                r.set_method(&self.args.method).map_err(|e| e.to_string())?;
+                r.set_method_named(&self.args.method)
+                    .map_err(|e| e.to_string())?;
             }
             Ok(g)
         });
@@ -360,7 +361,7 @@ impl App<'_> {
             eprintln!("no method {}: there are {}", index + 1, METHODS.len());
             return;
         };
-        match r.set_method(desc.name) {
+        match r.set_method_named(desc.name) {
             Ok(None) => eprintln!("method: {}", desc.name),
             Ok(Some(reason)) => eprintln!("warning: {} runs with a fallback: {reason}", desc.name),
             Err(e) => eprintln!("error: {e}"),
@@ -464,7 +465,7 @@ impl App<'_> {
             return Err(error);
         }
         eprintln!("error: {error}; back to {method} with {lights} lights");
-        r.set_method(&method).map_err(|e| e.to_string())?;
+        r.set_method_named(&method).map_err(|e| e.to_string())?;
         if self.light_count != lights {
             self.set_lights(lights);
         }
