@@ -11,7 +11,7 @@ use crate::cluster::auto::{
 };
 use crate::cluster::grid::{ClusterGrid, GridConfig, GridProjection};
 use crate::cluster::pack_grid::GridEncoding;
-use crate::metrics::raycast::SceneRaycaster;
+use crate::scene::raycast::SceneRaycaster;
 
 /// Rays of the surface sample, across and down (1 296 rays).
 const SAMPLE_GRID: (u32, u32) = (48, 27);
