@@ -38,7 +38,7 @@
 
 use super::assign::Assignment;
 use super::grid::ClusterGrid;
-use super::index_list::IndexList;
+use super::assign::index_list::IndexList;
 use super::pack::DATA_TEXTURE_WIDTH;
 
 /// Texels per cascade in the grid texture's table.

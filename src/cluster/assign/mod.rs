@@ -1,14 +1,14 @@
-//! Light assignment: every light → the cells it can touch ([`super::cells`]), then one compact
+//! Light assignment: every light → the cells it can touch ([`cells`]), then one compact
 //! index list by a counting sort.
 //!
 //! The work is shared in one of two ways ([`Assigner::assign`] picks):
 //!
-//! * **Bands of slices** (`assign_bands.rs`; one band on a single thread, and on several
+//! * **Bands of slices** (`bands.rs`; one band on a single thread, and on several
 //!   when the grid has at least as many cells as there are lights): each thread fills a band
 //!   of consecutive slices, balanced by the previous frame's measured times; a band's cells
 //!   are consecutive cell numbers, so each band owns one contiguous part of every output
 //!   array and no thread writes where another does.
-//! * **Chunks of lights** (`assign_chunks.rs`; more lights than cells): each thread
+//! * **Chunks of lights** (`chunks.rs`; more lights than cells): each thread
 //!   finds and sorts its own lights' runs, then blocks of cells gather the chunks' runs.
 //!
 //! ```text
@@ -40,12 +40,23 @@
 //! [`AssignStats::overflowed_lights`], and the image degrades by exactly those lights'
 //! contributions (measurable against plain forward).
 
-use super::assign_bands::Bands;
-use super::assign_chunks::Chunks;
-use super::grid::ClusterGrid;
-use super::index_list::IndexList;
-use super::overflow::{apply_cap, Overflow};
-use super::pack::GpuLight;
+mod bands;
+pub mod cells;
+mod chunks;
+mod cone;
+pub mod index_list;
+mod overflow;
+#[cfg(test)]
+mod paths_tests;
+#[cfg(test)]
+mod tests;
+
+use crate::cluster::grid::ClusterGrid;
+use crate::cluster::pack::GpuLight;
+use bands::Bands;
+use chunks::Chunks;
+use index_list::IndexList;
+use overflow::{apply_cap, Overflow};
 
 /// An assignment whose previous frame listed this many indices runs on all cores whatever its
 /// light count: fine grids give each light hundreds of cells, and at about 3 ns an index such
