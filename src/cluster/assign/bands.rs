@@ -6,7 +6,7 @@ use std::time::Instant;
 
 use super::cells::{for_each_run_in, SliceWindow};
 use super::index_list::{EntriesMut, LightIndex};
-use super::{Assignment, Run, Totals};
+use super::types::{Assignment, Run, Totals};
 use crate::cluster::grid::ClusterGrid;
 use crate::cluster::pack::GpuLight;
 

@@ -6,7 +6,7 @@ use rayon::prelude::*;
 
 use super::cells::for_each_run;
 use super::index_list::{EntriesMut, IndexList, LightIndex};
-use super::{Assignment, Run, Totals};
+use super::types::{Assignment, Run, Totals};
 use crate::cluster::grid::ClusterGrid;
 use crate::cluster::pack::GpuLight;
 

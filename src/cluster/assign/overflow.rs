@@ -4,7 +4,7 @@
 use std::cell::RefCell;
 
 use super::index_list::{EntriesMut, IndexList, LightIndex};
-use super::{AssignLimits, Assignment, PARALLEL_INDICES};
+use super::types::{AssignLimits, Assignment, PARALLEL_INDICES};
 use crate::cluster::grid::{CellCoord, ClusterGrid};
 use crate::cluster::pack::GpuLight;
 
