@@ -1,13 +1,12 @@
 //! GL-free CPU light assignment: the cascaded cluster grid (`grid`) and its hot-path lookups
 //! (`depth_lookup`), 2D screen tiles (`tiles`), per-frame light → cell assignment with a
 //! counting sort (`assign`: which cells one light touches, spot lights' cones, the index list,
-//! the overflow policy), and the texel layouts the shaders read (`pack`). Nothing here touches
-//! GL, so all of it is unit-tested without a context.
+//! the overflow policy), the automatic grid that picks a frame's cell footprint (`auto_grid`),
+//! and the texel layouts the shaders read (`pack`). Nothing here touches GL, so all of it is
+//! unit-tested without a context.
 
 pub mod assign;
-pub mod auto;
-mod auto_costs;
-mod auto_search;
+pub mod auto_grid;
 mod depth_lookup;
 pub mod grid;
 pub mod pack;

@@ -14,7 +14,7 @@ use super::grid_choice::{self, AutoGrid};
 use super::GridReport;
 use super::{FrameContext, MethodStats, ShadingMethod};
 use crate::cluster::assign::{AssignLimits, Assigner};
-use crate::cluster::auto::{assign_work, FrameCost};
+use crate::cluster::auto_grid::{assign_work, FrameCost};
 use crate::cluster::grid::{ClusterGrid, GridConfig, GridMode, GridProjection};
 use crate::cluster::pack::{
     pack_lights_into, GpuLight, LightEncoding, PackedLights, DATA_TEXTURE_WIDTH,

@@ -682,7 +682,7 @@ fn slice_depth_flag_makes_thinner_slices_and_refuses_bad_ratios() {
 }
 
 /// `--assign-budget` reaches the automatic grid (its reason states the budget; what the budget
-/// does to the choice is tested in `cluster::auto`); bad shares are refused.
+/// does to the choice is tested in `cluster::auto_grid`); bad shares are refused.
 #[test]
 fn assign_budget_flag_bounds_the_automatic_grid() {
     let dir = tempfile::tempdir().unwrap();

@@ -32,13 +32,16 @@
 //! budget where the new one does not), so a static scene never flip-flops between two
 //! near-equal grids.
 
-pub use super::auto_costs::{assign_work, FrameCost, GridCosts, CALIBRATION_WINDOW, INDEX_WEIGHT};
-pub use super::auto_search::{choose, ChoiceSearch};
+mod costs;
+mod search;
 
-use super::assign::AssignLimits;
-use super::grid::{ClusterGrid, GridConfig, GridProjection};
-use super::pack::GpuLight;
-use super::pack_grid::GridEncoding;
+pub use costs::{assign_work, FrameCost, GridCosts, CALIBRATION_WINDOW, INDEX_WEIGHT};
+pub use search::{choose, ChoiceSearch};
+
+use crate::cluster::assign::AssignLimits;
+use crate::cluster::grid::{ClusterGrid, GridConfig, GridProjection};
+use crate::cluster::pack::GpuLight;
+use crate::cluster::pack_grid::GridEncoding;
 
 /// A new grid must be predicted this much cheaper (relative) than the current one to replace it.
 pub const HYSTERESIS: f64 = 0.1;
