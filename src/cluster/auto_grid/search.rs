@@ -3,9 +3,9 @@
 //! every candidate in one frame made that frame up to 2.5× its neighbours (seven assignments
 //! instead of one), a spike a game sees as a dropped frame.
 
-use super::costs::assign_work;
-use super::{better, Candidate, ChoiceInputs, GridChoice, GridCosts, SurfaceSamples};
-use super::{first_split, CANDIDATE_FOOTPRINTS, CELL_BUDGET};
+use super::choice::{better, Candidate, ChoiceInputs, GridChoice, SurfaceSamples};
+use super::choice::{first_split, CANDIDATE_FOOTPRINTS, CELL_BUDGET};
+use super::costs::{assign_work, GridCosts};
 use crate::cluster::assign::Assigner;
 use crate::cluster::grid::{ClusterGrid, GridConfig};
 
