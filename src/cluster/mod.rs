@@ -10,5 +10,4 @@ pub mod auto_grid;
 mod depth_lookup;
 pub mod grid;
 pub mod pack;
-pub mod pack_grid;
 pub mod tiles;

@@ -10,7 +10,7 @@ use crate::cluster::auto_grid::{
     self, ChoiceInputs, ChoiceSearch, FrameCost, GridChoice, GridCosts, SurfaceSamples,
 };
 use crate::cluster::grid::{ClusterGrid, GridConfig, GridProjection};
-use crate::cluster::pack_grid::GridEncoding;
+use crate::cluster::pack::GridEncoding;
 use crate::scene::raycast::SceneRaycaster;
 
 /// Rays of the surface sample, across and down (1 296 rays).

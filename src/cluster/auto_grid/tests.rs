@@ -4,7 +4,7 @@ use super::*;
 use crate::cluster::assign::{AssignLimits, Assigner};
 use crate::cluster::grid::{GridConfig, GridProjection};
 use crate::cluster::pack::GpuLight;
-use crate::cluster::pack_grid::GridEncoding;
+use crate::cluster::pack::GridEncoding;
 use crate::scene::Light;
 use glam::{DMat4, DVec3, Vec3};
 use rand::{Rng, SeedableRng};
