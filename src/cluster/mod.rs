@@ -1,5 +1,5 @@
-//! GL-free CPU light assignment: the cascaded cluster grid (`grid`) and its hot-path lookups
-//! (`depth_lookup`), 2D screen tiles (`tiles`), per-frame light → cell assignment with a
+//! GL-free CPU light assignment: the cascaded cluster grid (`grid`, with its hot-path lookup
+//! tables), 2D screen tiles (`tiles`), per-frame light → cell assignment with a
 //! counting sort (`assign`: which cells one light touches, spot lights' cones, the index list,
 //! the overflow policy), the automatic grid that picks a frame's cell footprint (`auto_grid`),
 //! and the texel layouts the shaders read (`pack`). Nothing here touches GL, so all of it is
@@ -7,7 +7,6 @@
 
 pub mod assign;
 pub mod auto_grid;
-mod depth_lookup;
 pub mod grid;
 pub mod pack;
 pub mod tiles;

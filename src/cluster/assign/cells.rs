@@ -26,8 +26,7 @@
 //! neighbouring cell still finds every light that reaches it: the assignment is conservative.
 
 use super::cone::{Cone, ConeSlice};
-use crate::cluster::depth_lookup::CascadeConstants;
-use crate::cluster::grid::{ClusterGrid, Coverage, GridProjection};
+use crate::cluster::grid::{CascadeConstants, ClusterGrid, Coverage, GridProjection};
 use crate::cluster::pack::GpuLight;
 
 /// Relative padding of light radii (see the module docs).
