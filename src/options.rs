@@ -5,6 +5,8 @@ use serde::Serialize;
 
 use crate::cluster::grid::GridConfig;
 use crate::cluster::tiles::TILE_PX;
+// Defined beside its CPU twin in the scene layer, which may not import options.
+pub use crate::scene::shading::ToneMap;
 
 /// Most frames one call times ([`MeasureOptions::timed_frames`], `render --frames`): each
 /// timed frame's figures are kept until the percentiles are taken, so a count near 2³² would
@@ -100,23 +102,6 @@ pub struct MeasureOptions {
     /// them (a white texture stands in) — to measure what leaving features out saves, and to
     /// test that it changes nothing in the image.
     pub full_variants: bool,
-}
-
-/// The curve that maps exposed linear radiance (0 to ∞) into the displayable [0, 1], applied
-/// per pixel before the sRGB encode; CPU twin: `scene::shading::tone_map`.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum ToneMap {
-    /// None: the value is clamped to [0, 1], so bright lights clip to white.
-    #[default]
-    None,
-    /// Reinhard, `c / (1 + c)` per channel: never clips, compresses everything.
-    Reinhard,
-    /// The ACES filmic curve in Narkowicz's fit, per channel: contrast and a soft shoulder.
-    Aces,
-    /// Khronos PBR Neutral: colours below 0.76 unchanged, highlights compressed and desaturated
-    /// towards white, hue kept.
-    Neutral,
 }
 
 /// Per-pixel light counts instead of colour.

@@ -4,9 +4,8 @@
 
 use serde::Serialize;
 
-use crate::cluster::pack::DATA_TEXTURE_WIDTH;
-use crate::cluster::pack_grid::{
-    GridEncoding, MAX_INDEXED_LIGHTS, RGBA8_CELL_CAP, RGBA8_OFFSET_LIMIT,
+use crate::cluster::pack::{
+    GridEncoding, DATA_TEXTURE_WIDTH, MAX_INDEXED_LIGHTS, RGBA8_CELL_CAP, RGBA8_OFFSET_LIMIT,
 };
 use crate::gl::{Caps, EsVersion};
 

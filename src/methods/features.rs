@@ -150,7 +150,7 @@ impl ShaderFeatures {
             ("MAX_LIGHTS".into(), max_lights.to_string()),
             (
                 "CELL_CAP".into(),
-                crate::cluster::pack_grid::RGBA8_CELL_CAP.to_string(),
+                crate::cluster::pack::RGBA8_CELL_CAP.to_string(),
             ),
             (
                 "SPOT_MIN_COS_DELTA".into(),

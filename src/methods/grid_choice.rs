@@ -1,4 +1,4 @@
-//! The clustered method's automatic grid ([`crate::cluster::auto`]) wired to frames: when to
+//! The clustered method's automatic grid ([`crate::cluster::auto_grid`]) wired to frames: when to
 //! choose again, where the surface samples come from (a coarse ray cast of the scene, its
 //! hierarchy built once per geometry), and the calibration fed by every rendered frame.
 
@@ -6,12 +6,12 @@ use glam::{DMat4, DVec3, DVec4};
 
 use super::FrameContext;
 use crate::cluster::assign::{AssignLimits, Assigner};
-use crate::cluster::auto::{
+use crate::cluster::auto_grid::{
     self, ChoiceInputs, ChoiceSearch, FrameCost, GridChoice, GridCosts, SurfaceSamples,
 };
 use crate::cluster::grid::{ClusterGrid, GridConfig, GridProjection};
-use crate::cluster::pack_grid::GridEncoding;
-use crate::metrics::raycast::SceneRaycaster;
+use crate::cluster::pack::GridEncoding;
+use crate::scene::raycast::SceneRaycaster;
 
 /// Rays of the surface sample, across and down (1 296 rays).
 const SAMPLE_GRID: (u32, u32) = (48, 27);
@@ -160,7 +160,7 @@ impl AutoGrid {
             Some(current)
                 if same_layout
                     && !replaces_priors
-                    && !auto::should_switch(&current.config, new) =>
+                    && !auto_grid::should_switch(&current.config, new) =>
             {
                 // The grid stays; the reason says it was measured again.
                 current.reason.clear();
@@ -169,7 +169,7 @@ impl AutoGrid {
                         current.reason,
                         "kept {} px (predicted within {:.0} % of the best): ",
                         current.config.footprint_px,
-                        auto::HYSTERESIS * 100.0,
+                        auto_grid::HYSTERESIS * 100.0,
                     );
                 }
                 current.reason.push_str(&new.reason);

@@ -15,7 +15,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 use serde::Serialize;
 
-use super::raycast::{pixel_ray, Hit, SceneRaycaster};
+use crate::scene::raycast::{pixel_ray, Hit, SceneRaycaster};
 use crate::scene::shading::{self, Surface};
 use crate::scene::{Camera, Projection, Scene};
 
@@ -72,7 +72,7 @@ pub struct ReferenceSet {
     pub samples: Vec<ReferenceSample>,
     /// Skipped: the sub-pixel rays hit different triangles or some missed (edge, silhouette).
     pub skipped_edge: usize,
-    /// Skipped: another opaque surface lies within [`COPLANAR`](super::raycast::COPLANAR) of
+    /// Skipped: another opaque surface lies within [`COPLANAR`](crate::scene::raycast::COPLANAR) of
     /// the one hit (coplanar or doubled faces, a ray exactly on a shared edge: the GPU's depth
     /// test may pick either).
     pub skipped_coplanar: usize,

@@ -2,7 +2,6 @@
 
 pub mod counts;
 pub mod cpu_reference;
-pub mod raycast;
 pub mod spread;
 
 use serde::Serialize;

@@ -1,5 +1,6 @@
 //! GL-free scene description: camera, lights, meshes, materials, OBJ loading, built-in
-//! procedural scenes, seeded random lights and JSON scene files.
+//! procedural scenes, seeded random lights, JSON scene files and a ray caster over the
+//! triangles (`raycast`).
 //!
 //! Positions that can be far from the origin (camera, lights, object transforms) are `f64`;
 //! the renderer subtracts the camera in `f64` before anything reaches the GPU as `f32`, so a
@@ -20,6 +21,7 @@ pub mod motion;
 pub mod normal_matrix;
 pub mod obj;
 pub mod random;
+pub mod raycast;
 pub mod shading;
 
 use std::ops::Range;

@@ -123,10 +123,26 @@ pub fn shade(s: &Surface, v: DVec3, lights: &[Light], ambient: Vec3) -> DVec3 {
     c
 }
 
+/// The curve that maps exposed linear radiance (0 to ∞) into the displayable [0, 1], applied
+/// per pixel before the sRGB encode; CPU twin: `scene::shading::tone_map`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ToneMap {
+    /// None: the value is clamped to [0, 1], so bright lights clip to white.
+    #[default]
+    None,
+    /// Reinhard, `c / (1 + c)` per channel: never clips, compresses everything.
+    Reinhard,
+    /// The ACES filmic curve in Narkowicz's fit, per channel: contrast and a soft shoulder.
+    Aces,
+    /// Khronos PBR Neutral: colours below 0.76 unchanged, highlights compressed and desaturated
+    /// towards white, hue kept.
+    Neutral,
+}
+
 /// The tone map of `glsl/surface.glsl` in f64: exposed linear RGB (the caller multiplies by
 /// 2^EV) → [0, 1]. Inputs are capped at 1 000 as the shader caps them.
-pub fn tone_map(rgb: [f64; 3], curve: crate::options::ToneMap) -> [f64; 3] {
-    use crate::options::ToneMap;
+pub fn tone_map(rgb: [f64; 3], curve: ToneMap) -> [f64; 3] {
     let c = rgb.map(|v| v.clamp(0.0, 1000.0));
     match curve {
         ToneMap::None => c,

@@ -682,7 +682,7 @@ fn slice_depth_flag_makes_thinner_slices_and_refuses_bad_ratios() {
 }
 
 /// `--assign-budget` reaches the automatic grid (its reason states the budget; what the budget
-/// does to the choice is tested in `cluster::auto`); bad shares are refused.
+/// does to the choice is tested in `cluster::auto_grid`); bad shares are refused.
 #[test]
 fn assign_budget_flag_bounds_the_automatic_grid() {
     let dir = tempfile::tempdir().unwrap();
@@ -772,7 +772,16 @@ fn record_writes_the_sequence_and_a_frame_alone_matches_it() {
     let out = manylight(
         &[
             &base[..],
-            &["--frames", "5", "--record", "seq", "--stats", "s.json"],
+            &[
+                "--frames",
+                "5",
+                "--record",
+                "seq",
+                "--stats",
+                "s.json",
+                "--out",
+                "first.png",
+            ],
         ]
         .concat(),
         &[],
@@ -813,8 +822,8 @@ fn record_writes_the_sequence_and_a_frame_alone_matches_it() {
         alone != frame(0),
         "the lights did not move between t = 0 and 1.5 s"
     );
-    // The default --out is the first frame of the sequence.
-    let first = image::open(dir.path().join("manylight.png"))
+    // --out is the first frame of the sequence.
+    let first = image::open(dir.path().join("first.png"))
         .unwrap()
         .to_rgba8();
     assert!(first == frame(0));

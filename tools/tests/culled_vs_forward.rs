@@ -233,6 +233,6 @@ fn a_grid_the_texture_cannot_hold_is_a_clear_error() {
         .r()
         .render_offscreen(&scene, 640, 360, &RenderOptions::default())
         .unwrap();
-    assert!(stats.grid.cells <= manylight::cluster::auto::CELL_BUDGET);
+    assert!(stats.grid.cells <= manylight::cluster::auto_grid::CELL_BUDGET);
     assert!(stats.grid.reason.unwrap().starts_with("auto"));
 }

@@ -95,7 +95,7 @@ fn clustered_evaluates_fewer_lights_than_tiled_and_far_fewer_than_forward() {
 #[test]
 fn counts_equal_the_cpu_cluster_lists_at_sampled_pixels() {
     use manylight::metrics::cpu_reference;
-    use manylight::metrics::raycast::{pixel_ray, SceneRaycaster};
+    use manylight::scene::raycast::{pixel_ray, SceneRaycaster};
     let scene = scene::builtin::build("pillars", Some((512, 3))).unwrap();
     let (w, h) = (256u32, 144u32);
     let caster = SceneRaycaster::new(&scene);

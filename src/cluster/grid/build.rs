@@ -2,10 +2,8 @@
 //! out the cascades, slices and tiles and fill the per-frame lookup tables (slice table, box
 //! projection constants, widened slice slabs).
 
-use super::{
-    Cascade, CascadeConstants, ClusterGrid, DepthMapping, GridConfig, GridProjection, SliceLookup,
-    SLICE_WIDEN,
-};
+use super::tables::{CascadeConstants, SliceLookup};
+use super::{Cascade, ClusterGrid, DepthMapping, GridConfig, GridProjection, SLICE_WIDEN};
 
 impl ClusterGrid {
     /// Builds the grid. `depth_range` is the span of view depths the scene can occupy
@@ -158,13 +156,13 @@ impl ClusterGrid {
         };
         let mut lookup = std::mem::take(&mut self.slice_lookup);
         if mapping == DepthMapping::Log2 {
-            lookup.rebuild(self);
+            lookup.rebuild(self.slice_starts(), self.far);
         } else {
             lookup.clear();
         }
         self.slice_lookup = lookup;
         let mut constants = std::mem::take(&mut self.cascade_constants);
-        CascadeConstants::of_into(self, &mut constants);
+        self.build_cascade_constants(&mut constants);
         self.cascade_constants = constants;
         let mut frusta = std::mem::take(&mut self.slice_frusta);
         self.build_slice_frusta(&mut frusta);
@@ -172,6 +170,42 @@ impl ClusterGrid {
         let mut slabs = std::mem::take(&mut self.slice_slabs);
         self.build_slice_slabs(&mut slabs);
         self.slice_slabs = slabs;
+    }
+
+    /// Every slice's (cascade, slice within the cascade) and the view depth where it starts,
+    /// near to far: what the slice lookup is built from.
+    pub(super) fn slice_starts(&self) -> impl Iterator<Item = ((u32, u32), f64)> + '_ {
+        self.cascades.iter().enumerate().flat_map(move |(k, cascade)| {
+            let k = k as u32;
+            (0..cascade.slices).map(move |s| ((k, s), self.slice_depth_range(k, s).0))
+        })
+    }
+
+    /// The constants of every cascade, into `out` (cleared first).
+    fn build_cascade_constants(&self, out: &mut Vec<CascadeConstants>) {
+        let last = self.cascades.len() - 1;
+        let mut first_slice = 0;
+        out.clear();
+        out.extend(self.cascades.iter().enumerate().map(|(k, c)| {
+            let constants = CascadeConstants {
+                inv_near: if k == 0 {
+                    f64::INFINITY
+                } else {
+                    1.0 / c.z_near
+                },
+                inv_far: if k == last { 0.0 } else { 1.0 / c.z_far },
+                half_tiles: [0.5 * c.tiles_x as f64, 0.5 * c.tiles_y as f64],
+                ndc_step: [2.0 / c.tiles_x as f64, 2.0 / c.tiles_y as f64],
+                tile_step: [
+                    2.0 * (1.0 / self.ndc_scale[0]) / c.tiles_x as f64,
+                    2.0 * (1.0 / self.ndc_scale[1]) / c.tiles_y as f64,
+                ],
+                extent: self.ndc_scale.map(|s| 1.0 / s),
+                first_slice,
+            };
+            first_slice += c.slices;
+            constants
+        }));
     }
 
     /// The slabs of [`ClusterGrid::slice_slabs`] from the slices' exact depths (the frusta,

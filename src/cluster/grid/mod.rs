@@ -28,21 +28,24 @@
 //! coordinates).
 //!
 //! Layout: the grid types here; its settings in `config`, the camera model in `projection`,
-//! building in `build`, depth and pixel lookups in `addressing`, culling volumes in `spheres`.
+//! building in `build`, depth and pixel lookups in `addressing`, culling volumes in `spheres`,
+//! the assignment's hot-path tables in `tables`.
 
 mod addressing;
 mod build;
 mod config;
 mod projection;
 mod spheres;
+mod tables;
 #[cfg(test)]
 mod tests;
 
 pub use config::{Coverage, GridConfig, GridMode, DEFAULT_ASSIGN_BUDGET, MAX_CASCADES};
 pub use projection::{DepthMapping, GridProjection};
 
-use super::depth_lookup::{CascadeConstants, SliceLookup};
-pub(crate) use spheres::{SliceCells, SliceFrustum};
+pub(crate) use spheres::SliceCells;
+pub(crate) use tables::CascadeConstants;
+use tables::{SliceFrustum, SliceLookup};
 
 /// Relative widening of depth ranges against slice boundaries: far more than the CPU table's
 /// rounding at a boundary and than the shader's `f32` evaluation of the mapping (10⁻⁵ in log2

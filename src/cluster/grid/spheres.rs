@@ -1,17 +1,8 @@
 //! Cell bounding volumes for culling: the frustum side-plane test of a light's sphere and the
 //! bounding sphere of a cell (the spot-cone test), from a per-slice table.
 
+use super::tables::SliceFrustum;
 use super::{ClusterGrid, GridProjection};
-
-/// One slice's exact depths and the view half extents at them (see
-/// [`ClusterGrid::row_spheres`]).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub(crate) struct SliceFrustum {
-    /// The slice's view depths (exact: [`ClusterGrid::slice_depth_range`]).
-    pub(super) depths: (f64, f64),
-    near: (f64, f64),
-    far: (f64, f64),
-}
 
 impl ClusterGrid {
     /// True when the view-space sphere (`center`, `radius`) lies wholly outside one of the

@@ -26,9 +26,8 @@
 //! neighbouring cell still finds every light that reaches it: the assignment is conservative.
 
 use super::cone::{Cone, ConeSlice};
-use super::depth_lookup::CascadeConstants;
-use super::grid::{ClusterGrid, Coverage, GridProjection};
-use super::pack::GpuLight;
+use crate::cluster::grid::{CascadeConstants, ClusterGrid, Coverage, GridProjection};
+use crate::cluster::pack::GpuLight;
 
 /// Relative padding of light radii (see the module docs).
 const RADIUS_PAD: f64 = 1e-4;

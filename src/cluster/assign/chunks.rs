@@ -1,14 +1,14 @@
-//! The assignment by **chunks** of lights (see [`super::assign`]): each thread finds and sorts
+//! The assignment by **chunks** of lights (see [`super`]): each thread finds and sorts
 //! the runs of its own lights, then blocks of cells gather the chunks' per-cell runs in chunk
-//! order. Several threads only; one thread takes a single band ([`super::assign_bands`]).
+//! order. Several threads only; one thread takes a single band (`bands.rs`).
 
 use rayon::prelude::*;
 
-use super::assign::{Assignment, Run, Totals};
 use super::cells::for_each_run;
-use super::grid::ClusterGrid;
 use super::index_list::{EntriesMut, IndexList, LightIndex};
-use super::pack::GpuLight;
+use super::types::{Assignment, Run, Totals};
+use crate::cluster::grid::ClusterGrid;
+use crate::cluster::pack::GpuLight;
 
 /// The chunks and their buffers, kept between frames.
 #[derive(Default)]

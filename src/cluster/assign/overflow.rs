@@ -1,12 +1,12 @@
-//! The assignment's overflow policy (see [`super::assign`]'s docs): a cell never lists more
+//! The assignment's overflow policy (see [`super`]'s docs): a cell never lists more
 //! than the cap, keeping its most important lights, and the whole list fits the index texture.
 
 use std::cell::RefCell;
 
-use super::assign::{AssignLimits, Assignment, PARALLEL_INDICES};
-use super::grid::{CellCoord, ClusterGrid};
 use super::index_list::{EntriesMut, IndexList, LightIndex};
-use super::pack::GpuLight;
+use super::types::{AssignLimits, Assignment, PARALLEL_INDICES};
+use crate::cluster::grid::{CellCoord, ClusterGrid};
+use crate::cluster::pack::GpuLight;
 
 /// Buffers of the overflow policy, kept between frames.
 #[derive(Default)]

@@ -1,13 +1,13 @@
-//! The automatic grid's search over candidate footprints ([`super::auto`]), whole in one call
+//! The automatic grid's search over candidate footprints ([`super`]), whole in one call
 //! ([`choose`]) or one candidate per frame ([`ChoiceSearch::step`]): a re-choice that measured
 //! every candidate in one frame made that frame up to 2.5× its neighbours (seven assignments
 //! instead of one), a spike a game sees as a dropped frame.
 
-use super::assign::Assigner;
-use super::auto::{better, Candidate, ChoiceInputs, GridChoice, GridCosts, SurfaceSamples};
-use super::auto::{first_split, CANDIDATE_FOOTPRINTS, CELL_BUDGET};
-use super::auto_costs::assign_work;
-use super::grid::{ClusterGrid, GridConfig};
+use super::choice::{better, Candidate, ChoiceInputs, GridChoice, SurfaceSamples};
+use super::choice::{first_split, CANDIDATE_FOOTPRINTS, CELL_BUDGET};
+use super::costs::{assign_work, GridCosts};
+use crate::cluster::assign::Assigner;
+use crate::cluster::grid::{ClusterGrid, GridConfig};
 
 /// A search over the candidate footprints, coarse to fine, kept between frames (its buffers
 /// and its scratch grid are reused by the next search).
@@ -245,7 +245,7 @@ impl ChoiceSearch {
     }
 }
 
-/// Measures the candidates and picks the cheapest under `costs` (see [`super::auto`]'s docs),
+/// Measures the candidates and picks the cheapest under `costs` (see [`super`]'s docs),
 /// all in this call.
 pub fn choose(
     inputs: &ChoiceInputs,

@@ -1,6 +1,7 @@
-//! The assignment's hot-path view of a [`ClusterGrid`]'s depth mapping: which slice a view
-//! depth lies in without a logarithm, and per-cascade constants that turn divisions into
-//! multiplications.
+//! The tables a grid keeps for the assignment's hot path, filled by `build.rs` from the grid
+//! and holding no reference back to it: which slice a view depth lies in without a logarithm
+//! ([`SliceLookup`]), per-cascade constants that turn divisions into multiplications
+//! ([`CascadeConstants`]), and each slice's exact depths and extents ([`SliceFrustum`]).
 //!
 //! **Slices by table.** Along the log2 mapping, slice boundaries are fixed depths. A depth's
 //! slice is found from the top bits of its `f64` pattern (exponent and 6 mantissa bits: a
@@ -10,15 +11,12 @@
 //! cells on 720 rows, where one comparison decides, 1.013 at 8-pixel half-deep cells on 360,
 //! where a bucket holds two slices at most). The
 //! result is exactly "the last slice whose start is ≤ d"; the boundaries come from
-//! [`ClusterGrid::slice_depth_range`], so it agrees with
-//! [`ClusterGrid::view_z_to_cascade_slice`] up to its rounding at a boundary, which the caller's
-//! widening of the depth range absorbs.
+//! `ClusterGrid::slice_depth_range`, so it agrees with `ClusterGrid::view_z_to_cascade_slice`
+//! up to its rounding at a boundary, which the caller's widening of the depth range absorbs.
 //!
 //! ```text
 //! bits(d) >> 46 ─ base ─► buckets[b]: first slice g ─► while d ≥ start[g + 1]: g += 1 ─► (k, s)
 //! ```
-
-use super::grid::ClusterGrid;
 
 /// Bits below the bucket: 52 mantissa bits − 6 kept.
 const BUCKET_SHIFT: u32 = 46;
@@ -44,29 +42,20 @@ pub(crate) struct SliceLookup {
 }
 
 impl SliceLookup {
-    /// The lookup of `grid`'s slices. Buckets cover the grid's first split to its far end:
-    /// nearer depths all lie in the first slice and farther ones reach the last through
+    /// Makes this the lookup of a grid's slices, reusing its buffers: `slices` gives each
+    /// slice's (cascade, slice within the cascade) and the view depth where it starts, near to
+    /// far, and `far` is the grid's far end. Buckets cover the grid's first split to its far
+    /// end: nearer depths all lie in the first slice and farther ones reach the last through
     /// the steps.
-    #[cfg(test)]
-    pub(crate) fn new(grid: &ClusterGrid) -> SliceLookup {
-        let mut lookup = SliceLookup::default();
-        lookup.rebuild(grid);
-        lookup
-    }
-
-    /// Makes this the lookup of `grid`'s slices, reusing its buffers.
-    pub(crate) fn rebuild(&mut self, grid: &ClusterGrid) {
+    pub(crate) fn rebuild(&mut self, slices: impl Iterator<Item = ((u32, u32), f64)>, far: f64) {
         let (start, address) = (&mut self.start, &mut self.address);
         start.clear();
         address.clear();
-        for (k, cascade) in grid.cascades.iter().enumerate() {
-            for s in 0..cascade.slices {
-                let z0 = grid.slice_depth_range(k as u32, s).0;
-                start.push(if start.is_empty() { 0.0 } else { z0 });
-                address.push((k as u32, s));
-            }
+        for (slice, z0) in slices {
+            start.push(if start.is_empty() { 0.0 } else { z0 });
+            address.push(slice);
         }
-        let far = grid.far.max(f64::MIN_POSITIVE);
+        let far = far.max(f64::MIN_POSITIVE);
         // Every depth before the second slice's start is in the first slice.
         let base = bucket(start.get(1).copied().unwrap_or(far).min(far));
         let last = bucket(far).max(base);
@@ -151,38 +140,29 @@ impl CascadeConstants {
         -self.extent[axis] + i as f64 * self.tile_step[axis]
     }
 
-    /// The constants of every cascade of `grid`, into `out` (cleared first).
-    pub(crate) fn of_into(grid: &ClusterGrid, out: &mut Vec<CascadeConstants>) {
-        let last = grid.cascades.len() - 1;
-        let mut first_slice = 0;
-        out.clear();
-        out.extend(grid.cascades.iter().enumerate().map(|(k, c)| {
-            let constants = CascadeConstants {
-                inv_near: if k == 0 {
-                    f64::INFINITY
-                } else {
-                    1.0 / c.z_near
-                },
-                inv_far: if k == last { 0.0 } else { 1.0 / c.z_far },
-                half_tiles: [0.5 * c.tiles_x as f64, 0.5 * c.tiles_y as f64],
-                ndc_step: [2.0 / c.tiles_x as f64, 2.0 / c.tiles_y as f64],
-                tile_step: [
-                    2.0 * (1.0 / grid.ndc_scale[0]) / c.tiles_x as f64,
-                    2.0 * (1.0 / grid.ndc_scale[1]) / c.tiles_y as f64,
-                ],
-                extent: grid.ndc_scale.map(|s| 1.0 / s),
-                first_slice,
-            };
-            first_slice += c.slices;
-            constants
-        }));
-    }
+}
+
+/// One slice's exact depths and the view half extents at them (see
+/// `ClusterGrid::row_spheres`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct SliceFrustum {
+    /// The slice's view depths (exact: `ClusterGrid::slice_depth_range`).
+    pub(super) depths: (f64, f64),
+    pub(super) near: (f64, f64),
+    pub(super) far: (f64, f64),
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::cluster::grid::{GridConfig, GridProjection};
+    use crate::cluster::grid::{ClusterGrid, GridConfig, GridProjection};
+
+    /// The lookup of `grid`'s slices, as the grid builds it.
+    fn lookup_of(grid: &ClusterGrid) -> SliceLookup {
+        let mut lookup = SliceLookup::default();
+        lookup.rebuild(grid.slice_starts(), grid.far);
+        lookup
+    }
 
     fn grids() -> Vec<ClusterGrid> {
         let t = 30f64.to_radians().tan();
@@ -212,7 +192,7 @@ mod tests {
     #[test]
     fn lookup_matches_a_search_over_slice_starts() {
         for grid in grids() {
-            let lookup = SliceLookup::new(&grid);
+            let lookup = lookup_of(&grid);
             let search =
                 |d: f64| lookup.address[lookup.start.partition_point(|&z| z <= d).max(1) - 1];
             let mut depths = vec![-0.0, 0.0, f64::MIN_POSITIVE, grid.far * 1e3, f64::INFINITY];
@@ -234,7 +214,7 @@ mod tests {
     #[test]
     fn lookup_agrees_with_the_depth_mapping() {
         for grid in grids() {
-            let lookup = SliceLookup::new(&grid);
+            let lookup = lookup_of(&grid);
             let mut d = grid.near.max(1e-6);
             let mut checked = 0;
             while d < grid.far * 2.0 {

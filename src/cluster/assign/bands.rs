@@ -1,14 +1,14 @@
-//! The assignment by **bands** of slices (see [`super::assign`]): each thread fills one band
+//! The assignment by **bands** of slices (see [`super`]): each thread fills one band
 //! of consecutive slices, whose cells are consecutive cell numbers, so it owns one contiguous
 //! part of every output array and no thread writes where another does.
 
 use std::time::Instant;
 
-use super::assign::{Assignment, Run, Totals};
 use super::cells::{for_each_run_in, SliceWindow};
-use super::grid::ClusterGrid;
 use super::index_list::{EntriesMut, LightIndex};
-use super::pack::GpuLight;
+use super::types::{Assignment, Run, Totals};
+use crate::cluster::grid::ClusterGrid;
+use crate::cluster::pack::GpuLight;
 
 /// The bands and their buffers, kept between frames.
 #[derive(Default)]

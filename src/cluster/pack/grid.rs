@@ -36,10 +36,10 @@
 //! Budget at 640×360 with the automatic grid on the courtyard (about 140 000 cells, 1 024
 //! lights, ~660 000 indices): 560 KB grid + 1.3 MB indices per frame on either version.
 
-use super::assign::Assignment;
-use super::grid::ClusterGrid;
-use super::index_list::IndexList;
-use super::pack::DATA_TEXTURE_WIDTH;
+use super::lights::DATA_TEXTURE_WIDTH;
+use crate::cluster::assign::index_list::IndexList;
+use crate::cluster::assign::Assignment;
+use crate::cluster::grid::ClusterGrid;
 
 /// Texels per cascade in the grid texture's table.
 pub const TABLE_TEXELS_PER_CASCADE: u32 = 2;

@@ -5,9 +5,9 @@ use glam::{DVec3, Vec3};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 
-use super::assign::{assign, AssignLimits, Assignment};
-use super::grid::{ClusterGrid, Coverage, GridConfig, GridProjection};
-use super::pack::GpuLight;
+use super::{assign, AssignLimits, Assignment};
+use crate::cluster::grid::{ClusterGrid, Coverage, GridConfig, GridProjection};
+use crate::cluster::pack::GpuLight;
 use crate::scene::Light;
 
 pub(super) struct Case {
@@ -583,7 +583,7 @@ fn a_grid_past_the_table_gets_no_cell_arrays() {
             ..GridConfig::fixed(1.0)
         },
     );
-    assert!(grid.total_cells > super::assign::MAX_ASSIGN_CELLS);
+    assert!(grid.total_cells > super::MAX_ASSIGN_CELLS);
     let light = Light::point(DVec3::new(0.0, 0.0, -5.0), 1.0, Vec3::ONE, 1.0);
     let lights = vec![GpuLight::from_light(&light, &glam::DMat4::IDENTITY); 3];
     let a = assign(&grid, &lights, 60.0, &AssignLimits::default());

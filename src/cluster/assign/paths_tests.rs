@@ -1,16 +1,16 @@
 //! The assignment's paths against each other: one thread, bands of slices and chunks of
 //! lights in pools of several sizes, reused buffers against fresh ones, 16- and 32-bit index
 //! lists, and the figures each reports (the lists themselves are checked against brute force
-//! in `assign_tests.rs`).
+//! in `tests.rs`).
 
 use glam::{DVec3, Vec3};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 
-use super::assign::{assign, AssignLimits, Assignment};
-use super::assign_tests::{cases, cell_lights, random_lights};
-use super::grid::{ClusterGrid, GridConfig, GridProjection};
-use super::pack::GpuLight;
+use super::tests::{cases, cell_lights, random_lights};
+use super::{assign, AssignLimits, Assignment};
+use crate::cluster::grid::{ClusterGrid, GridConfig, GridProjection};
+use crate::cluster::pack::GpuLight;
 use crate::scene::Light;
 
 #[test]
@@ -90,7 +90,7 @@ fn check_stats(a: &Assignment, uncapped_max: Option<u32>) {
 #[test]
 fn reused_buffers_match_fresh_ones() {
     let mut rng = Pcg64Mcg::seed_from_u64(11);
-    let mut assigner = super::assign::Assigner::new();
+    let mut assigner = super::Assigner::new();
     let cases = cases();
     for (frame, case) in cases.iter().cycle().take(12).enumerate() {
         let grid = ClusterGrid::new(320, 180, case.projection, case.near, case.far, &case.config);
@@ -185,7 +185,7 @@ fn any_number_of_bands_gives_what_one_band_gives() {
             .num_threads(threads)
             .build()
             .expect("a thread pool");
-        let mut assigner = super::assign::Assigner::new();
+        let mut assigner = super::Assigner::new();
         for case in cases() {
             let grid = ClusterGrid::new(96, 54, case.projection, case.near, case.far, &case.config);
             // Fewer lights than cells: bands; more: chunks of lights (see `Assigner::assign`).
@@ -241,7 +241,7 @@ fn fewer_chunks_than_threads_keep_nothing_stale() {
         .num_threads(8)
         .build()
         .expect("a thread pool");
-    let mut assigner = super::assign::Assigner::new();
+    let mut assigner = super::Assigner::new();
     for count in [400, 49, 9, 400] {
         let lights = random_lights(&mut rng, count, 5.0);
         let one = assign(&grid, &lights, 10.0, &sequential);
@@ -339,7 +339,7 @@ fn split_cells_never_returns_empty_or_out_of_range_blocks() {
         (vec![0, 100], 200, 8),
         (vec![], 0, 2),
     ] {
-        let blocks = super::assign_chunks::split_cells(&offsets, total, parts);
+        let blocks = super::chunks::split_cells(&offsets, total, parts);
         let mut next = 0;
         for (a, b) in &blocks {
             assert!(a < b && *b <= offsets.len(), "{blocks:?}");

@@ -1,5 +1,6 @@
 //! A ray caster over every triangle of a scene, in world space and `f64`: what the sampled-pixel
-//! reference ([`super::cpu_reference`]) uses to find the surface a pixel sees.
+//! reference (`metrics::cpu_reference`) and the automatic grid's surface samples use to find the
+//! surface a pixel sees.
 //!
 //! The acceleration structure is a bounding volume hierarchy built by median split of the
 //! triangle centroids along the widest axis (about 0.15 s for the 331 179-triangle conference
@@ -8,7 +9,7 @@
 
 use glam::{DMat3, DVec3, DVec4};
 
-use crate::scene::{Camera, Projection, Scene};
+use super::{Camera, Projection, Scene};
 
 /// Most triangles in a leaf.
 const LEAF_SIZE: usize = 4;
@@ -82,7 +83,7 @@ impl SceneRaycaster {
         for (object, o) in scene.objects.iter().enumerate() {
             let mesh = &o.mesh;
             let normal_matrix =
-                crate::scene::normal_matrix::normal_matrix(&DMat3::from_mat4(o.transform));
+                super::normal_matrix::normal_matrix(&DMat3::from_mat4(o.transform));
             let pos: Vec<DVec3> = mesh
                 .positions
                 .iter()

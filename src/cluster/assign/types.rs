@@ -1,0 +1,121 @@
+//! The types the assignment's parts share (its limits, result and figures; the runs and totals
+//! of bands and chunks), below them all so no part imports the module that calls it.
+
+use super::index_list::IndexList;
+
+/// An assignment whose previous frame listed this many indices runs on all cores whatever its
+/// light count: fine grids give each light hundreds of cells, and at about 3 ns an index such
+/// a frame's work (a millisecond or more) dwarfs the tens of microseconds of waking rayon's
+/// workers.
+pub const PARALLEL_INDICES: usize = 1 << 17;
+
+/// Most cells an assignment takes: its per-cell arrays (difference counts, counts, offsets,
+/// cursors; each chunk of lights has its own) hold 16 bytes a cell or more, 1 GiB and up
+/// here. Four times what the grid textures address (2²⁴ cells, which the renderer refuses past
+/// by name), so a CPU-only caller has room; a larger grid (up to 2³², which raised `max_tiles`
+/// and a large frame can make) gets no cells (see
+/// [`Assigner::assign`](super::Assigner::assign)).
+pub const MAX_ASSIGN_CELLS: u32 = 1 << 26;
+
+/// Limits of one assignment.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct AssignLimits {
+    /// Most lights one cell keeps.
+    pub cell_cap: u32,
+    /// Most indices in total.
+    pub max_indices: usize,
+    /// Lights from this count up are assigned on all cores (rayon's pool); so is any
+    /// assignment whose previous one (same [`Assigner`](super::Assigner)) listed
+    /// [`PARALLEL_INDICES`] or more, unless this is `usize::MAX` (never in parallel).
+    pub parallel_threshold: usize,
+}
+
+impl Default for AssignLimits {
+    fn default() -> Self {
+        AssignLimits {
+            cell_cap: 255,
+            max_indices: 1 << 24,
+            parallel_threshold: 4096,
+        }
+    }
+}
+
+/// Figures of one assignment.
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+pub struct AssignStats {
+    /// Cells in the grid.
+    pub clusters: u32,
+    /// Cells with at least one light.
+    pub nonempty_clusters: u32,
+    /// Mean lights per non-empty cell (after the cap).
+    pub avg_lights_per_nonempty: f64,
+    /// Most lights any cell touched (before the cap).
+    pub max_lights_per_cluster: u32,
+    /// Light references dropped by the overflow policy; on a grid of more than
+    /// `MAX_ASSIGN_CELLS` (2²⁶) cells, which gets none, every light once. (A frame's total, with
+    /// forward's, is in its `lights` figures.)
+    #[serde(skip)]
+    pub overflowed_lights: u64,
+    /// Length of the index list.
+    #[serde(skip)]
+    pub indices: usize,
+    /// Lights that touch at least one cell (a frame reports them with its `lights` figures).
+    #[serde(skip)]
+    pub visible_lights: usize,
+    /// Runs of consecutive cells the lights were found to touch (before the cap): the
+    /// per-run part of the assignment's work, beside the per-index and per-cell parts.
+    #[serde(rename = "assign_runs")]
+    pub runs: usize,
+}
+
+/// The result: per-cell offset and count into `indices`, and the visible lights.
+#[derive(Clone, Debug, Default)]
+pub struct Assignment {
+    /// Original indices of the lights that touch at least one cell, ascending.
+    pub visible: Vec<u32>,
+    /// Per cell: first position in `indices`.
+    pub offsets: Vec<u32>,
+    /// Per cell: number of lights (≤ the cap).
+    pub counts: Vec<u32>,
+    /// Positions in `visible`, grouped by cell (16-bit while they fit).
+    pub indices: IndexList,
+    /// Figures.
+    pub stats: AssignStats,
+}
+
+/// Consecutive cells one light touches (numbered from its band's first cell in a band).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Run {
+    pub(super) start: u32,
+    pub(super) len: u32,
+}
+
+/// Figures of the per-cell counts, gathered in the pass that makes the offsets.
+#[derive(Clone, Copy, Debug, Default)]
+pub(super) struct Totals {
+    /// Length of the index list.
+    pub(super) indices: usize,
+    /// Largest count.
+    pub(super) max: u32,
+    /// Cells with a light.
+    pub(super) nonempty: u32,
+    /// Runs of consecutive cells found (before any cap).
+    pub(super) runs: usize,
+}
+
+impl Totals {
+    /// Takes one cell's count in.
+    #[inline(always)]
+    pub(super) fn add(&mut self, n: u32) {
+        self.indices += n as usize;
+        self.max = self.max.max(n);
+        self.nonempty += u32::from(n > 0);
+    }
+
+    /// The figures of `counts` (after the overflow policy changed them).
+    pub(super) fn of(counts: &[u32]) -> Totals {
+        let mut totals = Totals::default();
+        counts.iter().for_each(|&n| totals.add(n));
+        totals
+    }
+}
