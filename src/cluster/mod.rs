@@ -10,3 +10,4 @@ pub mod auto_grid;
 pub mod grid;
 pub mod pack;
 pub mod tiles;
+pub mod view_light;

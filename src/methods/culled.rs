@@ -15,9 +15,10 @@ use super::GridReport;
 use super::{FrameContext, MethodStats, ShadingMethod};
 use crate::cluster::assign::{AssignLimits, Assigner};
 use crate::cluster::auto_grid::{assign_work, FrameCost};
+use crate::cluster::view_light::GpuLight;
 use crate::cluster::grid::{ClusterGrid, GridConfig, GridMode, GridProjection};
 use crate::cluster::pack::{
-    pack_lights_into, GpuLight, LightEncoding, PackedLights, DATA_TEXTURE_WIDTH,
+    pack_lights_into, LightEncoding, PackedLights, DATA_TEXTURE_WIDTH,
 };
 use crate::cluster::pack::{
     grid_fits_table, grid_texels, pack_grid_into, pack_indices_into, GridEncoding, PackedTexels,

@@ -10,7 +10,8 @@
 
 use super::geometry::{self, UNIT_METHOD};
 use super::{FrameContext, MethodDesc, MethodStats, ShadingMethod, Support};
-use crate::cluster::pack::{pack_lights_into, GpuLight, LightEncoding, PackedLights};
+use crate::cluster::pack::{pack_lights_into, LightEncoding, PackedLights};
+use crate::cluster::view_light::GpuLight;
 use crate::gl::texture::{DataFormat, DataTexture};
 use crate::gl::{Caps, Device, EsVersion};
 use crate::Error;

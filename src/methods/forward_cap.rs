@@ -3,7 +3,7 @@
 //! coordinates address no more rows), forward keeps the lights that matter most for this view
 //! and leaves the rest out — the same policy the cluster grid's overflow applies per cell.
 
-use crate::cluster::pack::GpuLight;
+use crate::cluster::view_light::GpuLight;
 
 /// How much a light can matter to this view: its brightest channel over one plus the squared
 /// distance from the eye to its sphere (lights around the eye come first), and nothing for a

@@ -16,7 +16,7 @@ pub mod geometry;
 mod grid_choice;
 pub mod tiled;
 
-use crate::cluster::pack::GpuLight;
+use crate::cluster::view_light::GpuLight;
 use crate::gl::program::ProgramCache;
 use crate::gl::{Caps, Device, EsVersion};
 use crate::gpu_scene::GpuScene;

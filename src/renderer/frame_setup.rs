@@ -4,7 +4,7 @@
 
 use glam::DMat4;
 
-use crate::cluster::pack::GpuLight;
+use crate::cluster::view_light::GpuLight;
 use crate::gl::Caps;
 use crate::methods::ShaderFeatures;
 use crate::options::{CountKind, RenderOptions, ToneMap};

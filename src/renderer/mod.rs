@@ -12,7 +12,7 @@ mod method;
 mod offscreen;
 mod stats;
 
-use crate::cluster::pack::GpuLight;
+use crate::cluster::view_light::GpuLight;
 use crate::gl::framebuffer::OffscreenTarget;
 use crate::gl::program::ProgramCache;
 use crate::gl::{Caps, Device, EsVersion};

@@ -33,7 +33,12 @@ pub fn build(name: &str, lights: Option<(usize, u64)>) -> Result<Scene, SceneErr
         "pillars" => pillars(),
         "plane" => plane(),
         "bubbles" => bubbles(),
-        other => return Err(SceneError::UnknownBuiltin(other.to_string())),
+        other => {
+            return Err(SceneError::UnknownBuiltin {
+                name: other.to_string(),
+                available: NAMES,
+            })
+        }
     };
     if let Some((count, seed)) = lights {
         super::input::check_light_count(count, "lights")?;
@@ -362,7 +367,7 @@ mod tests {
         }
         assert!(matches!(
             build("nope", None),
-            Err(SceneError::UnknownBuiltin(_))
+            Err(SceneError::UnknownBuiltin { .. })
         ));
     }
 

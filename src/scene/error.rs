@@ -54,8 +54,13 @@ pub enum SceneError {
         path: PathBuf,
     },
     /// A built-in scene name that does not exist.
-    #[error("unknown built-in scene `{0}` (available: {avail})", avail = crate::scene::builtin::NAMES.join(", "))]
-    UnknownBuiltin(String),
+    #[error("unknown built-in scene `{name}` (available: {})", available.join(", "))]
+    UnknownBuiltin {
+        /// What was asked for.
+        name: String,
+        /// The built-in scenes' names.
+        available: &'static [&'static str],
+    },
 }
 
 impl SceneError {

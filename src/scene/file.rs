@@ -267,7 +267,10 @@ pub fn parse(
         match (&spec.builtin, &spec.obj, &spec.gltf) {
             (Some(name), None, None) => {
                 let built = builtin::geometry(name)
-                    .ok_or_else(|| SceneError::UnknownBuiltin(name.clone()))?;
+                    .ok_or_else(|| SceneError::UnknownBuiltin {
+                        name: name.clone(),
+                        available: super::builtin::NAMES,
+                    })?;
                 if spec.texture.is_some() {
                     return Err(SceneError::invalid(
                         format!("{field}.texture"),

@@ -5,7 +5,7 @@ use std::time::Instant;
 
 use manylight::cluster::assign::{AssignLimits, Assigner, Assignment};
 use manylight::cluster::grid::{ClusterGrid, GridConfig, GridProjection};
-use manylight::cluster::pack::GpuLight;
+use manylight::cluster::view_light::GpuLight;
 use manylight::scene;
 
 /// Untimed assignments before [`AssignWorkload::time`] measures: a cold core (clock, caches,

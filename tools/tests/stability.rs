@@ -129,7 +129,7 @@ fn check_without_fragment_highp(
         let active: Vec<_> = scene.lights.iter().filter(|l| l.is_active()).collect();
         let gpu_lights: Vec<_> = active
             .iter()
-            .map(|l| manylight::cluster::pack::GpuLight::from_light(l, &view))
+            .map(|l| manylight::cluster::view_light::GpuLight::from_light(l, &view))
             .collect();
         let kept = manylight::methods::forward_cap::most_important_indices(&gpu_lights, limit);
         assert_eq!(stats.lights.overflowed as usize, active.len() - kept.len());

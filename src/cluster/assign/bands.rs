@@ -8,7 +8,7 @@ use super::cells::{for_each_run_in, SliceWindow};
 use super::index_list::{EntriesMut, LightIndex};
 use super::types::{Assignment, Run, Totals};
 use crate::cluster::grid::ClusterGrid;
-use crate::cluster::pack::GpuLight;
+use crate::cluster::view_light::GpuLight;
 
 /// The bands and their buffers, kept between frames.
 #[derive(Default)]

@@ -27,7 +27,7 @@
 
 use super::cone::{Cone, ConeSlice};
 use crate::cluster::grid::{CascadeConstants, ClusterGrid, Coverage, GridProjection};
-use crate::cluster::pack::GpuLight;
+use crate::cluster::view_light::GpuLight;
 
 /// Relative padding of light radii (see the module docs).
 const RADIUS_PAD: f64 = 1e-4;

@@ -8,7 +8,7 @@ use super::cells::for_each_run;
 use super::index_list::{EntriesMut, IndexList, LightIndex};
 use super::types::{Assignment, Run, Totals};
 use crate::cluster::grid::ClusterGrid;
-use crate::cluster::pack::GpuLight;
+use crate::cluster::view_light::GpuLight;
 
 /// The chunks and their buffers, kept between frames.
 #[derive(Default)]

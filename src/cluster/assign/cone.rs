@@ -4,7 +4,7 @@
 //! once (one quadratic) rather than cell by cell.
 
 use crate::cluster::grid::SliceCells;
-use crate::cluster::pack::GpuLight;
+use crate::cluster::view_light::GpuLight;
 
 /// A spot light's cone, for the cone-vs-cell test (Wronski's "cull that cone"), and the
 /// bounding sphere of the part of the light's sphere inside the cone.
@@ -278,7 +278,7 @@ mod tests {
 
     use super::Cone;
     use crate::cluster::grid::{ClusterGrid, GridConfig, GridProjection};
-    use crate::cluster::pack::GpuLight;
+    use crate::cluster::view_light::GpuLight;
     use crate::scene::Light;
 
     /// Random spots in and around the view of `grid`: every size of cone, from a few cells

@@ -55,7 +55,7 @@ mod types;
 pub use types::{AssignLimits, AssignStats, Assignment, MAX_ASSIGN_CELLS, PARALLEL_INDICES};
 
 use crate::cluster::grid::ClusterGrid;
-use crate::cluster::pack::GpuLight;
+use crate::cluster::view_light::GpuLight;
 use bands::Bands;
 use chunks::Chunks;
 use overflow::{apply_cap, Overflow};

@@ -6,7 +6,7 @@ use std::cell::RefCell;
 use super::index_list::{EntriesMut, IndexList, LightIndex};
 use super::types::{AssignLimits, Assignment, PARALLEL_INDICES};
 use crate::cluster::grid::{CellCoord, ClusterGrid};
-use crate::cluster::pack::GpuLight;
+use crate::cluster::view_light::GpuLight;
 
 /// Buffers of the overflow policy, kept between frames.
 #[derive(Default)]

@@ -10,7 +10,7 @@ use rand_pcg::Pcg64Mcg;
 use super::tests::{cases, cell_lights, random_lights};
 use super::{assign, AssignLimits, Assignment};
 use crate::cluster::grid::{ClusterGrid, GridConfig, GridProjection};
-use crate::cluster::pack::GpuLight;
+use crate::cluster::view_light::GpuLight;
 use crate::scene::Light;
 
 #[test]

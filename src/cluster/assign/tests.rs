@@ -7,7 +7,7 @@ use rand_pcg::Pcg64Mcg;
 
 use super::{assign, AssignLimits, Assignment};
 use crate::cluster::grid::{ClusterGrid, Coverage, GridConfig, GridProjection};
-use crate::cluster::pack::GpuLight;
+use crate::cluster::view_light::GpuLight;
 use crate::scene::Light;
 
 pub(super) struct Case {

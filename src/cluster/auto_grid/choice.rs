@@ -3,7 +3,7 @@
 
 use crate::cluster::assign::AssignLimits;
 use crate::cluster::grid::{ClusterGrid, GridConfig, GridProjection};
-use crate::cluster::pack::GpuLight;
+use crate::cluster::view_light::GpuLight;
 use crate::cluster::pack::GridEncoding;
 
 /// A new grid must be predicted this much cheaper (relative) than the current one to replace it.

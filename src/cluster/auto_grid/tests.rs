@@ -3,7 +3,7 @@
 use super::*;
 use crate::cluster::assign::{AssignLimits, Assigner};
 use crate::cluster::grid::{GridConfig, GridProjection};
-use crate::cluster::pack::GpuLight;
+use crate::cluster::view_light::GpuLight;
 use crate::cluster::pack::GridEncoding;
 use crate::scene::Light;
 use glam::{DMat4, DVec3, Vec3};

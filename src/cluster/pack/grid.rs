@@ -295,7 +295,7 @@ mod tests {
     use super::*;
     use crate::cluster::assign::{assign, AssignLimits};
     use crate::cluster::grid::{GridConfig, GridProjection};
-    use crate::cluster::pack::GpuLight;
+    use crate::cluster::view_light::GpuLight;
     use crate::scene::Light;
     use glam::{DVec3, Vec3};
 
