@@ -9,10 +9,13 @@
 use std::fmt::Write as _;
 use std::time::Instant;
 
-use super::geometry::{self, UNIT_METHOD};
+use glam::Vec3;
+
+use super::geometry::{self, GeometryProgram, UNIT_METHOD};
 use super::grid_choice::{self, AutoGrid};
+use super::uniforms::{self, LightData, Surface, Transforms};
 use super::GridReport;
-use super::{FrameContext, MethodStats, ShadingMethod};
+use super::{FrameContext, MethodStats, ShaderFeatures, ShadingMethod};
 use crate::cluster::assign::{AssignLimits, Assigner};
 use crate::cluster::auto::{assign_work, FrameCost};
 use crate::cluster::grid::{ClusterGrid, GridConfig, GridMode, GridProjection};
@@ -23,6 +26,7 @@ use crate::cluster::pack_grid::{
     grid_fits_table, grid_texels, pack_grid_into, pack_indices_into, GridEncoding, PackedTexels,
     MAX_INDEXED_LIGHTS, RGBA8_CELL_CAP,
 };
+use crate::gl::program::{Resolver, Sampler, Uniform, UniformSet};
 use crate::gl::texture::{DataFormat, DataTexture};
 use crate::gl::{Device, EsVersion};
 use crate::Error;
@@ -37,6 +41,63 @@ pub enum Culling {
     Tiled,
     /// The dense cascaded cluster grid.
     Clustered,
+}
+
+/// The `clustered` shader's uniforms (tiled and clustered forward).
+pub struct ClusteredProgram {
+    transforms: Transforms,
+    surface: Surface,
+    lights: LightData,
+    cells: CellLookup,
+    /// The frame's longest cell list (the uniform light loop's bound).
+    longest_list: Uniform<f32>,
+}
+
+/// `cluster_lookup.glsl`: how a fragment finds its cell and reads its list.
+struct CellLookup {
+    viewport: Uniform<[f32; 2]>,
+    depth_map: Uniform<Vec3>,
+    cascade_count: Uniform<f32>,
+    grid: Uniform<Sampler>,
+    indices: Uniform<Sampler>,
+    /// ES 2.0: 1 / the grid's and the index texture's heights.
+    inv_heights: Uniform<[f32; 2]>,
+}
+
+impl UniformSet for ClusteredProgram {
+    fn resolve(r: &mut Resolver<'_>) -> Self {
+        let f = uniforms::features(r);
+        let es2 = r.es() == EsVersion::Es2;
+        // Every variant finds its cell; a count variant does not read its list.
+        let lit = !f.has(ShaderFeatures::COUNT_EVALS);
+        ClusteredProgram {
+            transforms: Transforms::resolve(r, lit),
+            surface: Surface::shaded(r, lit),
+            lights: LightData::resolve(r, lit),
+            cells: CellLookup {
+                viewport: r.required("u_viewport"),
+                depth_map: r.required("u_depthMap"),
+                cascade_count: r.required("u_cascadeCount"),
+                grid: r.required("u_grid"),
+                indices: r.required_when(lit, "u_indices"),
+                inv_heights: r.required_when(es2, "u_gridInvHeight"),
+            },
+            // Only the ES 2.0 loop has a constant bound to stop early.
+            longest_list: r.required_when(
+                lit && es2 && f.has(ShaderFeatures::UNIFORM_LIGHT_LOOP),
+                "u_longestList",
+            ),
+        }
+    }
+}
+
+impl GeometryProgram for ClusteredProgram {
+    fn transforms(&self) -> &Transforms {
+        &self.transforms
+    }
+    fn surface(&self) -> &Surface {
+        &self.surface
+    }
 }
 
 struct TextureSet {
@@ -343,11 +404,12 @@ impl ShadingMethod for CulledForward {
         }
 
         let set = &*set;
-        let inv = |t: &DataTexture| 1.0 / t.size().1.max(1) as f32;
-        let (light_inv, grid_inv, index_inv) =
-            (inv(&set.lights), inv(&set.grid), inv(&set.indices));
+        let inv_heights = [
+            uniforms::inv_height(&set.grid),
+            uniforms::inv_height(&set.indices),
+        ];
         let (w, h) = ctx.viewport;
-        let depth_map = [
+        let depth_map = Vec3::new(
             grid.a as f32,
             grid.b as f32,
             if grid.mapping == crate::cluster::grid::DepthMapping::Log2 {
@@ -355,25 +417,27 @@ impl ShadingMethod for CulledForward {
             } else {
                 0.0
             },
-        ];
+        );
         let cascades = grid.cascades.len() as f32;
         let longest_list = assignment.stats.max_lights_per_cluster as f32;
         let ranges = [packed_lights.pos_range, packed_lights.radius_range];
-        geometry::draw_objects(ctx, "clustered", RGBA8_CELL_CAP, &mut |program, dev| {
-            set.lights.bind(dev, UNIT_METHOD);
-            set.grid.bind(dev, UNIT_METHOD + 1);
-            set.indices.bind(dev, UNIT_METHOD + 2);
-            program.set_i32(dev, "u_lights", UNIT_METHOD as i32);
-            program.set_i32(dev, "u_grid", UNIT_METHOD as i32 + 1);
-            program.set_i32(dev, "u_indices", UNIT_METHOD as i32 + 2);
-            program.set_f32(dev, "u_lightTexInvHeight", light_inv);
-            program.set_vec2(dev, "u_gridInvHeight", [grid_inv, index_inv]);
-            program.set_vec2(dev, "u_lightRanges", ranges);
-            program.set_vec2(dev, "u_viewport", [w as f32, h as f32]);
-            program.set_vec3(dev, "u_depthMap", glam::Vec3::from(depth_map));
-            program.set_f32(dev, "u_cascadeCount", cascades);
-            program.set_f32(dev, "u_longestList", longest_list);
-        })?;
+        geometry::draw_objects(
+            ctx,
+            "clustered",
+            RGBA8_CELL_CAP,
+            &mut |p: &ClusteredProgram, dev| {
+                p.lights.bind(dev, &set.lights, UNIT_METHOD, ranges);
+                set.grid.bind(dev, UNIT_METHOD + 1);
+                set.indices.bind(dev, UNIT_METHOD + 2);
+                p.cells.grid.set(dev, UNIT_METHOD + 1);
+                p.cells.indices.set(dev, UNIT_METHOD + 2);
+                p.cells.inv_heights.set(dev, inv_heights);
+                p.cells.viewport.set(dev, [w as f32, h as f32]);
+                p.cells.depth_map.set(dev, depth_map);
+                p.cells.cascade_count.set(dev, cascades);
+                p.longest_list.set(dev, longest_list);
+            },
+        )?;
         Ok(MethodStats {
             upload_bytes,
             assign_ms: Some(assign_ms),
