@@ -16,7 +16,7 @@ use glow::HasContext;
 
 use super::caps::MSAA_RENDER_TO_TEXTURE;
 use super::mesh::{fullscreen_triangle, GpuMesh};
-use super::program::{ProgramCache, ProgramKey};
+use super::program::{ProgramCache, ProgramKey, Resolver, Sampler, Uniform, UniformSet};
 use super::state::RenderState;
 use super::{Device, EsVersion, GlError};
 
@@ -257,13 +257,12 @@ impl MultisampleTarget {
                     features: 0,
                     dialect: dev.es(),
                 };
-                let program = programs.get_or_build(dev, key, Vec::new)?;
-                program.bind(dev);
+                let uniforms = programs.bind::<ResolveUniforms>(dev, key, Vec::new)?;
                 unsafe {
                     dev.gl.active_texture(glow::TEXTURE0);
                     dev.gl.bind_texture(glow::TEXTURE_2D, Some(*texture));
                 }
-                program.set_i32(dev, "u_resolved", 0);
+                uniforms.resolved.set(dev, 0);
                 triangle.draw(dev);
             }
         }
@@ -283,6 +282,19 @@ impl MultisampleTarget {
             }
             dev.delete_renderbuffer(self.depth);
             self.destroyed = true;
+        }
+    }
+}
+
+/// The ES 2.0 resolve program's texture of averaged samples.
+struct ResolveUniforms {
+    resolved: Uniform<Sampler>,
+}
+
+impl UniformSet for ResolveUniforms {
+    fn resolve(r: &mut Resolver<'_>) -> Self {
+        ResolveUniforms {
+            resolved: r.required("u_resolved"),
         }
     }
 }

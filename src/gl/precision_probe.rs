@@ -6,13 +6,28 @@
 use glow::HasContext;
 
 use super::framebuffer::OffscreenTarget;
-use super::program::Program;
+use super::program::{Program, Resolver, Uniform, UniformSet};
 use super::{Device, GlError};
+
+/// The probe's two operands.
+struct ProbeUniforms {
+    big: Uniform<f32>,
+    one: Uniform<f32>,
+}
+
+impl UniformSet for ProbeUniforms {
+    fn resolve(r: &mut Resolver<'_>) -> Self {
+        ProbeUniforms {
+            big: r.required("u_big"),
+            one: r.required("u_one"),
+        }
+    }
+}
 
 /// True when `mediump` arithmetic in the fragment stage rounds like fp16.
 pub fn mediump_is_fp16(dev: &Device) -> Result<bool, GlError> {
     let mut target = OffscreenTarget::new(dev, 1, 1)?;
-    let mut program = Program::build(dev, "precision_probe", &[])?;
+    let mut program = Program::build::<ProbeUniforms>(dev, "precision_probe", &[], 0)?;
     let gl = &dev.gl;
     // One clip-space triangle covering the pixel.
     let vertices: [f32; 9] = [-1.0, -1.0, 0.0, 3.0, -1.0, 0.0, -1.0, 3.0, 0.0];
@@ -29,8 +44,10 @@ pub fn mediump_is_fp16(dev: &Device) -> Result<bool, GlError> {
         gl.disable(glow::BLEND);
         gl.color_mask(true, true, true, true);
         program.bind(dev);
-        program.set_f32(dev, "u_big", 2048.0);
-        program.set_f32(dev, "u_one", 1.0);
+        if let Some(u) = program.uniforms::<ProbeUniforms>() {
+            u.big.set(dev, 2048.0);
+            u.one.set(dev, 1.0);
+        }
         gl.enable_vertex_attrib_array(0);
         gl.vertex_attrib_pointer_f32(0, 3, glow::FLOAT, false, 12, 0);
         for loc in 1..3 {

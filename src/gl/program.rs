@@ -1,7 +1,17 @@
-//! Programs: compile, link, uniforms, and the cache keyed by (shader, feature bits, dialect).
+//! Programs: compile, link, typed uniforms resolved at link time, and the cache keyed by
+//! (shader, feature bits, dialect).
+//!
+//! Each program is linked together with a [`UniformSet`]: a struct of [`Uniform`] fields,
+//! one per uniform the caller sets, whose locations are looked up once here. At link time
+//! every field's name must be declared by the shader's sources (a misspelt name fails in
+//! every variant), must match the GLSL type it is declared as, and must be active in the
+//! linked program when the set says the variant needs it; otherwise the build fails with
+//! [`GlError::ProgramLink`] naming the uniform.
 #![allow(unsafe_code)]
 
+use std::any::Any;
 use std::collections::HashMap;
+use std::marker::PhantomData;
 
 use glam::{Mat3, Mat4, Vec3, Vec4};
 use glow::HasContext;
@@ -12,13 +22,232 @@ use super::{Device, EsVersion, GlError};
 /// Vertex attribute locations shared by every program (bound before linking).
 pub const ATTRIBUTES: &[(u32, &str)] = &[(0, "a_position"), (1, "a_normal"), (2, "a_uv")];
 
-/// A linked program with a uniform-location cache.
+/// A linked program and the uniform set resolved for it.
 pub struct Program {
     raw: glow::Program,
-    uniforms: HashMap<String, Option<glow::UniformLocation>>,
+    /// The [`UniformSet`] it was linked with.
+    uniforms: Box<dyn Any>,
     /// Total assembled source size in bytes (vertex + fragment), for stats.
     pub source_bytes: usize,
     destroyed: bool,
+}
+
+/// A GLSL uniform type: the GL types it may be declared as, and how a value is set.
+pub trait UniformType {
+    /// What a value is set from.
+    type Value;
+    /// The GLSL type, for errors.
+    const GLSL: &'static str;
+    /// Whether a uniform the driver reports with type `gl_type` takes this.
+    fn accepts(gl_type: u32) -> bool;
+    /// Sets the uniform at `location` of the current program.
+    fn set(dev: &Device, location: &glow::UniformLocation, value: Self::Value);
+}
+
+/// A `sampler2D` or `usampler2D` uniform, set to a texture unit.
+pub struct Sampler;
+
+macro_rules! uniform_type {
+    ($ty:ty, $value:ty, $glsl:literal, [$($gl:path),+], $set:expr) => {
+        impl UniformType for $ty {
+            type Value = $value;
+            const GLSL: &'static str = $glsl;
+            fn accepts(gl_type: u32) -> bool {
+                [$($gl),+].contains(&gl_type)
+            }
+            fn set(dev: &Device, location: &glow::UniformLocation, value: $value) {
+                let set: fn(&glow::Context, &glow::UniformLocation, $value) = $set;
+                set(&dev.gl, location, value);
+            }
+        }
+    };
+}
+
+uniform_type!(f32, f32, "float", [glow::FLOAT], |gl, l, v| unsafe {
+    gl.uniform_1_f32(Some(l), v)
+});
+uniform_type!(i32, i32, "int", [glow::INT], |gl, l, v| unsafe {
+    gl.uniform_1_i32(Some(l), v)
+});
+uniform_type!(
+    Sampler,
+    u32,
+    "sampler2D",
+    [
+        glow::SAMPLER_2D,
+        glow::INT_SAMPLER_2D,
+        glow::UNSIGNED_INT_SAMPLER_2D
+    ],
+    |gl, l, unit| unsafe { gl.uniform_1_i32(Some(l), unit as i32) }
+);
+uniform_type!([f32; 2], [f32; 2], "vec2", [glow::FLOAT_VEC2], |gl, l, v| unsafe {
+    gl.uniform_2_f32(Some(l), v[0], v[1])
+});
+uniform_type!(Vec3, Vec3, "vec3", [glow::FLOAT_VEC3], |gl, l, v| unsafe {
+    gl.uniform_3_f32(Some(l), v.x, v.y, v.z)
+});
+uniform_type!(Vec4, Vec4, "vec4", [glow::FLOAT_VEC4], |gl, l, v| unsafe {
+    gl.uniform_4_f32(Some(l), v.x, v.y, v.z, v.w)
+});
+uniform_type!(Mat3, Mat3, "mat3", [glow::FLOAT_MAT3], |gl, l, m| unsafe {
+    gl.uniform_matrix_3_f32_slice(Some(l), false, &m.to_cols_array())
+});
+uniform_type!(Mat4, Mat4, "mat4", [glow::FLOAT_MAT4], |gl, l, m| unsafe {
+    gl.uniform_matrix_4_f32_slice(Some(l), false, &m.to_cols_array())
+});
+
+/// One uniform of a linked program, its location looked up at link time. Setting one the
+/// variant compiled out (no location) does nothing.
+pub struct Uniform<T: UniformType> {
+    location: Option<glow::UniformLocation>,
+    ty: PhantomData<fn(T)>,
+}
+
+impl<T: UniformType> Uniform<T> {
+    fn inactive() -> Self {
+        Uniform {
+            location: None,
+            ty: PhantomData,
+        }
+    }
+
+    /// Sets the uniform of the current program (which must be the one it was resolved in).
+    pub fn set(&self, dev: &Device, value: T::Value) {
+        if let Some(l) = &self.location {
+            T::set(dev, l, value);
+        }
+    }
+}
+
+/// The typed uniforms of one kind of program: resolved once when a program is linked.
+pub trait UniformSet: Sized + 'static {
+    /// Looks up every uniform of the set in `r`'s program, saying which ones the variant
+    /// ([`Resolver::features`], [`Resolver::es`]) must have.
+    fn resolve(r: &mut Resolver<'_>) -> Self;
+}
+
+/// Looks up a just-linked program's uniforms for a [`UniformSet`], collecting every problem.
+pub struct Resolver<'a> {
+    dev: &'a Device,
+    raw: glow::Program,
+    shader: &'a str,
+    features: u64,
+    /// Every uniform the shader's sources declare, in any variant.
+    declared: Vec<String>,
+    /// The linked program's active uniforms and their GL types.
+    active: Vec<(String, u32)>,
+    problems: Vec<String>,
+}
+
+impl Resolver<'_> {
+    /// The shader name.
+    pub fn shader(&self) -> &str {
+        self.shader
+    }
+
+    /// The variant's feature bits (the program key's).
+    pub fn features(&self) -> u64 {
+        self.features
+    }
+
+    /// The GLSL dialect the program was built for.
+    pub fn es(&self) -> EsVersion {
+        self.dev.es()
+    }
+
+    /// A uniform every variant of the shader must have.
+    pub fn required<T: UniformType>(&mut self, name: &'static str) -> Uniform<T> {
+        self.required_when(true, name)
+    }
+
+    /// A uniform some variants compile or optimise out.
+    pub fn optional<T: UniformType>(&mut self, name: &'static str) -> Uniform<T> {
+        self.required_when(false, name)
+    }
+
+    /// A uniform this variant must have when `required`, else one it may lack.
+    pub fn required_when<T: UniformType>(
+        &mut self,
+        required: bool,
+        name: &'static str,
+    ) -> Uniform<T> {
+        if !self.declared.iter().any(|d| d == name) {
+            self.problems.push(format!(
+                "uniform `{name}` is not declared by shader `{}`",
+                self.shader
+            ));
+            return Uniform::inactive();
+        }
+        match self.active.iter().find(|(n, _)| n == name) {
+            None => {
+                if required {
+                    self.problems.push(format!(
+                        "uniform `{name}` is required but not active in this variant"
+                    ));
+                }
+                Uniform::inactive()
+            }
+            Some(&(_, gl_type)) if !T::accepts(gl_type) => {
+                self.problems.push(format!(
+                    "uniform `{name}` is declared `{}`, set as `{}`",
+                    gl_type_name(gl_type),
+                    T::GLSL
+                ));
+                Uniform::inactive()
+            }
+            Some(_) => Uniform {
+                location: unsafe { self.dev.gl.get_uniform_location(self.raw, name) },
+                ty: PhantomData,
+            },
+        }
+    }
+}
+
+fn gl_type_name(gl_type: u32) -> String {
+    match gl_type {
+        glow::FLOAT => "float".into(),
+        glow::FLOAT_VEC2 => "vec2".into(),
+        glow::FLOAT_VEC3 => "vec3".into(),
+        glow::FLOAT_VEC4 => "vec4".into(),
+        glow::INT => "int".into(),
+        glow::FLOAT_MAT3 => "mat3".into(),
+        glow::FLOAT_MAT4 => "mat4".into(),
+        glow::SAMPLER_2D => "sampler2D".into(),
+        glow::UNSIGNED_INT_SAMPLER_2D => "usampler2D".into(),
+        other => format!("GL type 0x{other:04x}"),
+    }
+}
+
+/// Resolves `U` in the linked program `raw`, or says every problem found, one per line.
+fn resolve<U: UniformSet>(
+    dev: &Device,
+    raw: glow::Program,
+    shader: &str,
+    features: u64,
+) -> Result<U, String> {
+    let gl = &dev.gl;
+    let declared = shader_source::declared_uniforms(shader).map_err(|e| e.to_string())?;
+    let active = unsafe {
+        (0..gl.get_active_uniforms(raw))
+            .filter_map(|i| gl.get_active_uniform(raw, i))
+            .map(|u| (u.name, u.utype))
+            .collect()
+    };
+    let mut r = Resolver {
+        dev,
+        raw,
+        shader,
+        features,
+        declared,
+        active,
+        problems: Vec::new(),
+    };
+    let set = U::resolve(&mut r);
+    if r.problems.is_empty() {
+        Ok(set)
+    } else {
+        Err(r.problems.join("\n"))
+    }
 }
 
 fn compile(
@@ -67,11 +296,13 @@ fn format_defines(defines: &[(String, String)]) -> String {
 }
 
 impl Program {
-    /// Assembles, compiles and links `shader` with `defines`.
-    pub fn build(
+    /// Assembles, compiles and links `shader` with `defines`, then resolves its uniform set
+    /// `U` for the variant `features` (see the module docs for what is checked).
+    pub fn build<U: UniformSet>(
         dev: &Device,
         shader: &str,
         defines: &[(String, String)],
+        features: u64,
     ) -> Result<Program, GlError> {
         let gl = &dev.gl;
         let (vs, vs_len) = compile(dev, shader, Stage::Vertex, defines)?;
@@ -82,8 +313,15 @@ impl Program {
                 return Err(e);
             }
         };
-        unsafe {
-            let raw = dev.create_program()?;
+        let raw = unsafe {
+            let raw = match dev.create_program() {
+                Ok(raw) => raw,
+                Err(e) => {
+                    gl.delete_shader(vs);
+                    gl.delete_shader(fs);
+                    return Err(e);
+                }
+            };
             gl.attach_shader(raw, vs);
             gl.attach_shader(raw, fs);
             for (loc, name) in ATTRIBUTES {
@@ -103,12 +341,23 @@ impl Program {
                     log,
                 });
             }
-            Ok(Program {
+            raw
+        };
+        match resolve::<U>(dev, raw, shader, features) {
+            Ok(uniforms) => Ok(Program {
                 raw,
-                uniforms: HashMap::new(),
+                uniforms: Box::new(uniforms),
                 source_bytes: vs_len + fs_len,
                 destroyed: false,
-            })
+            }),
+            Err(log) => {
+                dev.delete_program(raw);
+                Err(GlError::ProgramLink {
+                    shader: shader.to_string(),
+                    defines: format_defines(defines),
+                    log,
+                })
+            }
         }
     }
 
@@ -117,61 +366,9 @@ impl Program {
         unsafe { dev.gl.use_program(Some(self.raw)) }
     }
 
-    fn location(&mut self, dev: &Device, name: &str) -> Option<glow::UniformLocation> {
-        if let Some(l) = self.uniforms.get(name) {
-            return *l;
-        }
-        let l = unsafe { dev.gl.get_uniform_location(self.raw, name) };
-        self.uniforms.insert(name.to_string(), l);
-        l
-    }
-
-    /// Sets a `float` uniform (ignored when the variant compiled it out).
-    pub fn set_f32(&mut self, dev: &Device, name: &str, v: f32) {
-        let l = self.location(dev, name);
-        unsafe { dev.gl.uniform_1_f32(l.as_ref(), v) }
-    }
-
-    /// Sets an `int` or sampler uniform.
-    pub fn set_i32(&mut self, dev: &Device, name: &str, v: i32) {
-        let l = self.location(dev, name);
-        unsafe { dev.gl.uniform_1_i32(l.as_ref(), v) }
-    }
-
-    /// Sets a `vec2` uniform.
-    pub fn set_vec2(&mut self, dev: &Device, name: &str, v: [f32; 2]) {
-        let l = self.location(dev, name);
-        unsafe { dev.gl.uniform_2_f32(l.as_ref(), v[0], v[1]) }
-    }
-
-    /// Sets a `vec3` uniform.
-    pub fn set_vec3(&mut self, dev: &Device, name: &str, v: Vec3) {
-        let l = self.location(dev, name);
-        unsafe { dev.gl.uniform_3_f32(l.as_ref(), v.x, v.y, v.z) }
-    }
-
-    /// Sets a `vec4` uniform.
-    pub fn set_vec4(&mut self, dev: &Device, name: &str, v: Vec4) {
-        let l = self.location(dev, name);
-        unsafe { dev.gl.uniform_4_f32(l.as_ref(), v.x, v.y, v.z, v.w) }
-    }
-
-    /// Sets a `mat3` uniform.
-    pub fn set_mat3(&mut self, dev: &Device, name: &str, m: &Mat3) {
-        let l = self.location(dev, name);
-        unsafe {
-            dev.gl
-                .uniform_matrix_3_f32_slice(l.as_ref(), false, &m.to_cols_array())
-        }
-    }
-
-    /// Sets a `mat4` uniform.
-    pub fn set_mat4(&mut self, dev: &Device, name: &str, m: &Mat4) {
-        let l = self.location(dev, name);
-        unsafe {
-            dev.gl
-                .uniform_matrix_4_f32_slice(l.as_ref(), false, &m.to_cols_array())
-        }
+    /// The uniform set the program was linked with, when it is a `U`.
+    pub fn uniforms<U: UniformSet>(&self) -> Option<&U> {
+        self.uniforms.downcast_ref()
     }
 
     /// Frees the program.
@@ -228,20 +425,33 @@ impl ProgramCache {
         Self::default()
     }
 
-    /// The program for `key`, building it with `defines()` on first use. `defines` must be a
-    /// function of the key alone.
-    pub fn get_or_build(
+    /// Makes the program for `key` current, building it with `defines()` and the uniform set
+    /// `U` on first use, and returns its uniforms. `defines` must be a function of the key
+    /// alone, and a shader is always used with the same `U`.
+    pub fn bind<U: UniformSet>(
         &mut self,
         dev: &Device,
         key: ProgramKey,
         defines: impl FnOnce() -> Vec<(String, String)>,
-    ) -> Result<&mut Program, GlError> {
-        match self.programs.entry(key) {
-            std::collections::hash_map::Entry::Occupied(e) => Ok(e.into_mut()),
-            std::collections::hash_map::Entry::Vacant(e) => {
-                Ok(e.insert(Program::build(dev, key.shader, &defines())?))
-            }
-        }
+    ) -> Result<&U, GlError> {
+        let program = match self.programs.entry(key) {
+            std::collections::hash_map::Entry::Occupied(e) => e.into_mut(),
+            std::collections::hash_map::Entry::Vacant(e) => e.insert(Program::build::<U>(
+                dev,
+                key.shader,
+                &defines(),
+                key.features,
+            )?),
+        };
+        program.bind(dev);
+        program.uniforms().ok_or_else(|| GlError::ProgramLink {
+            shader: key.shader.to_string(),
+            defines: String::new(),
+            log: format!(
+                "asked for uniform set {}, but built with another",
+                std::any::type_name::<U>()
+            ),
+        })
     }
 
     /// Every cached variant, sorted by shader and features.
@@ -275,5 +485,120 @@ impl ProgramCache {
         for (_, mut p) in self.programs.drain() {
             p.destroy(dev);
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::gl::HeadlessContext;
+
+    /// A headless ES 3.0 device, or `None` (a skip) on a machine without EGL.
+    fn device() -> Option<(Device, HeadlessContext)> {
+        match HeadlessContext::new(EsVersion::Es3) {
+            Ok(ctx) => Some((
+                Device::new(ctx.load_gl(), EsVersion::Es3).expect("device"),
+                ctx,
+            )),
+            Err(e) => {
+                assert!(
+                    std::env::var_os("MANYLIGHT_REQUIRE_ALL_TESTS").is_none(),
+                    "no headless context: {e}"
+                );
+                eprintln!("skipped: no headless context ({e})");
+                None
+            }
+        }
+    }
+
+    /// The link-time problems of `U` on `shader`, or "" when it links.
+    fn problems<U: UniformSet>(dev: &Device, shader: &str) -> String {
+        match Program::build::<U>(dev, shader, &[], 0) {
+            Ok(mut p) => {
+                p.destroy(dev);
+                String::new()
+            }
+            Err(GlError::ProgramLink { log, .. }) => log,
+            Err(e) => panic!("{e}"),
+        }
+    }
+
+    struct Probe {
+        big: Uniform<f32>,
+    }
+    impl UniformSet for Probe {
+        fn resolve(r: &mut Resolver<'_>) -> Self {
+            Probe {
+                big: r.required("u_big"),
+            }
+        }
+    }
+
+    struct Misspelt(#[allow(dead_code)] Uniform<f32>);
+    impl UniformSet for Misspelt {
+        fn resolve(r: &mut Resolver<'_>) -> Self {
+            Misspelt(r.optional("u_bigg"))
+        }
+    }
+
+    struct WrongType(#[allow(dead_code)] Uniform<i32>);
+    impl UniformSet for WrongType {
+        fn resolve(r: &mut Resolver<'_>) -> Self {
+            WrongType(r.required("u_big"))
+        }
+    }
+
+    /// The albedo texture, compiled out of a variant without the texture feature.
+    struct AlbedoTexture<const REQUIRED: bool>(Uniform<Sampler>);
+    impl<const REQUIRED: bool> UniformSet for AlbedoTexture<REQUIRED> {
+        fn resolve(r: &mut Resolver<'_>) -> Self {
+            AlbedoTexture(r.required_when(REQUIRED, "u_albedoTex"))
+        }
+    }
+
+    #[test]
+    fn uniforms_are_checked_when_the_program_links() {
+        let Some((dev, _ctx)) = device() else {
+            return;
+        };
+        assert_eq!(problems::<Probe>(&dev, "precision_probe"), "");
+        assert_eq!(
+            problems::<Misspelt>(&dev, "precision_probe"),
+            "uniform `u_bigg` is not declared by shader `precision_probe`"
+        );
+        assert_eq!(
+            problems::<WrongType>(&dev, "precision_probe"),
+            "uniform `u_big` is declared `float`, set as `int`"
+        );
+        let untextured = crate::methods::ShaderFeatures::default().defines(EsVersion::Es3, 1);
+        match Program::build::<AlbedoTexture<true>>(&dev, "forward", &untextured, 0) {
+            Err(GlError::ProgramLink { log, .. }) => assert_eq!(
+                log,
+                "uniform `u_albedoTex` is required but not active in this variant"
+            ),
+            other => panic!("{:?}", other.map(|_| "linked")),
+        }
+        let mut forward =
+            Program::build::<AlbedoTexture<false>>(&dev, "forward", &untextured, 0).unwrap();
+        assert!(forward.uniforms::<AlbedoTexture<false>>().unwrap().0.location.is_none());
+        forward.destroy(&dev);
+    }
+
+    #[test]
+    fn a_cached_program_is_used_with_the_set_it_was_built_with() {
+        let Some((dev, _ctx)) = device() else {
+            return;
+        };
+        let mut cache = ProgramCache::new();
+        let key = ProgramKey {
+            shader: "precision_probe",
+            features: 0,
+            dialect: EsVersion::Es3,
+        };
+        let probe = cache.bind::<Probe>(&dev, key, Vec::new).unwrap();
+        assert!(probe.big.location.is_some());
+        assert!(cache.bind::<Probe>(&dev, key, Vec::new).is_ok());
+        assert!(cache.bind::<AlbedoTexture<false>>(&dev, key, Vec::new).is_err());
+        cache.destroy(&dev);
     }
 }

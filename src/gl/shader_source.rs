@@ -185,6 +185,29 @@ pub fn shader(name: &str) -> Result<&'static ShaderDesc, GlError> {
         .ok_or_else(|| GlError::ShaderSource(format!("no shader named `{name}`")))
 }
 
+/// The uniforms `shader_name`'s two stages declare, in any variant (feature blocks and dialect
+/// branches included): the names a program's typed uniforms may use.
+pub fn declared_uniforms(shader_name: &str) -> Result<Vec<String>, GlError> {
+    let desc = shader(shader_name)?;
+    let mut text = String::new();
+    for file in [desc.vertex, desc.fragment] {
+        expand(file, &mut text, &mut Vec::new())?;
+    }
+    let mut names: Vec<String> = Vec::new();
+    for line in text.lines() {
+        let Some(declaration) = line.trim().strip_prefix("uniform ") else {
+            continue;
+        };
+        let name = declaration.split(';').next().unwrap_or_default();
+        if let Some(name) = name.split_whitespace().last() {
+            if !names.iter().any(|n| n == name) {
+                names.push(name.to_string());
+            }
+        }
+    }
+    Ok(names)
+}
+
 fn file(name: &str) -> Result<&'static str, GlError> {
     FILES
         .iter()
@@ -503,6 +526,23 @@ mod tests {
         );
         assert!(strip_feature_blocks("#endif\n", &[]).is_err());
         assert!(strip_feature_blocks("#if HAS_X\n", &d("1", "1")).is_err());
+    }
+
+    #[test]
+    fn declared_uniforms_cover_both_stages_and_every_branch() {
+        let names = declared_uniforms("clustered").unwrap();
+        // Vertex stage, an include, a dialect branch and a feature block.
+        for name in ["u_modelView", "u_lights", "u_gridInvHeight", "u_longestList"] {
+            assert!(names.iter().any(|n| n == name), "{name} in {names:?}");
+        }
+        // Declared twice (one per dialect), listed once.
+        assert_eq!(names.iter().filter(|n| *n == "u_grid").count(), 1);
+        assert!(!names.iter().any(|n| n.contains(';') || n == "u_grid;"));
+        assert_eq!(
+            declared_uniforms("precision_probe").unwrap(),
+            ["u_big", "u_one"]
+        );
+        assert!(declared_uniforms("nope").is_err());
     }
 
     #[test]

@@ -17,15 +17,16 @@
 //! forward within 2/255 (tested); its cost is memory and bandwidth: 44 or 52 bytes per pixel
 //! (`gl::gbuffer`).
 
-use glam::Vec3;
+use glam::{Mat4, Vec3, Vec4};
 
 use super::forward::Forward;
-use super::geometry::{shade_object, sort_objects, UNIT_METHOD};
+use super::geometry::{shade_object, sort_objects, GeometryProgram, UNIT_METHOD};
+use super::uniforms::{self, Surface, Transforms};
 use super::{FrameContext, MethodDesc, MethodStats, ShaderFeatures, ShadingMethod, Support};
 use crate::cluster::grid::GridProjection;
 use crate::gl::gbuffer::{self, GBuffer};
 use crate::gl::mesh::GpuMesh;
-use crate::gl::program::{Program, ProgramKey};
+use crate::gl::program::{ProgramKey, Resolver, Sampler, Uniform, UniformSet};
 use crate::gl::state::{Blend, Cull, DepthTest, RenderState};
 use crate::gl::{Caps, Device, EsVersion};
 use crate::scene::meshbuild::MeshBuilder;
@@ -61,6 +62,113 @@ const VOLUME_SCALE: f32 = 1.1;
 /// or it takes the full-screen path (the far side must not be clipped; the margin covers `f32`
 /// rounding of the projection).
 const FAR_MARGIN: f32 = 0.999;
+
+/// Texture units of the G-buffer's textures, in `GBuffer::bind_textures` order, and of its
+/// depth.
+const UNIT_G_ALBEDO: u32 = UNIT_METHOD;
+const UNIT_G_NORMAL_DEPTH: u32 = UNIT_METHOD + 1;
+const UNIT_G_SPECULAR: u32 = UNIT_METHOD + 2;
+const UNIT_ACCUM: u32 = UNIT_METHOD + 3;
+const UNIT_G_DEPTH: u32 = UNIT_METHOD + 4;
+
+/// The geometry pass's program (`gbuffer`): the surface point is stored through the same
+/// window mapping the light pass reads it back with.
+pub struct GBufferProgram {
+    transforms: Transforms,
+    surface: Surface,
+    viewport: Uniform<[f32; 2]>,
+    half_extent: Uniform<[f32; 2]>,
+}
+
+impl UniformSet for GBufferProgram {
+    fn resolve(r: &mut Resolver<'_>) -> Self {
+        GBufferProgram {
+            transforms: Transforms::resolve(r, true),
+            surface: Surface::gbuffer(r),
+            viewport: r.required("u_viewport"),
+            half_extent: r.required("u_halfExtent"),
+        }
+    }
+}
+
+impl GeometryProgram for GBufferProgram {
+    fn transforms(&self) -> &Transforms {
+        &self.transforms
+    }
+    fn surface(&self) -> &Surface {
+        &self.surface
+    }
+}
+
+/// The light pass's program (`deferred_light`, `deferred_light_fullscreen`). A count variant
+/// reads only the G-buffer's coverage.
+pub struct LightProgram {
+    /// The proxy sphere and the projection (`deferred_light` only: the full-screen triangle
+    /// has neither).
+    proxy: Option<(Uniform<Vec4>, Uniform<Mat4>)>,
+    g_albedo: Uniform<Sampler>,
+    g_normal_depth: Uniform<Sampler>,
+    g_specular: Uniform<Sampler>,
+    viewport: Uniform<[f32; 2]>,
+    half_extent: Uniform<[f32; 2]>,
+    orthographic: Uniform<f32>,
+    /// Position and radius; radiance and spot scale; spot axis and offset.
+    light: [Uniform<Vec4>; 3],
+}
+
+impl UniformSet for LightProgram {
+    fn resolve(r: &mut Resolver<'_>) -> Self {
+        let f = uniforms::features(r);
+        let colour = !f.counting();
+        let proxy = r.shader() == "deferred_light";
+        LightProgram {
+            proxy: proxy.then(|| (r.required("u_volume"), r.required("u_projection"))),
+            g_albedo: r.required_when(colour, "u_gAlbedo"),
+            g_normal_depth: r.required("u_gNormalDepth"),
+            g_specular: r.required_when(colour && f.has(ShaderFeatures::SPECULAR), "u_gSpecular"),
+            viewport: r.required_when(colour, "u_viewport"),
+            half_extent: r.required_when(colour, "u_halfExtent"),
+            orthographic: r.required_when(colour, "u_orthographic"),
+            light: [
+                r.required_when(colour, "u_light0"),
+                r.required_when(colour, "u_light1"),
+                r.required_when(colour && f.has(ShaderFeatures::SPOT), "u_light2"),
+            ],
+        }
+    }
+}
+
+/// The composite's program (`deferred_composite`).
+pub struct CompositeProgram {
+    g_albedo: Uniform<Sampler>,
+    g_normal_depth: Uniform<Sampler>,
+    accum: Uniform<Sampler>,
+    g_depth: Uniform<Sampler>,
+    ambient: Uniform<Vec3>,
+    exposure: Uniform<f32>,
+    alpha: Uniform<f32>,
+    heat_scale: Uniform<f32>,
+}
+
+impl UniformSet for CompositeProgram {
+    fn resolve(r: &mut Resolver<'_>) -> Self {
+        let f = uniforms::features(r);
+        let colour = !f.counting();
+        CompositeProgram {
+            g_albedo: r.required_when(colour, "u_gAlbedo"),
+            g_normal_depth: r.required("u_gNormalDepth"),
+            accum: r.required("u_accum"),
+            g_depth: r.required("u_gDepth"),
+            ambient: r.required_when(colour, "u_ambient"),
+            exposure: r.required_when(colour && !f.has(ShaderFeatures::OUTPUT_HDR), "u_exposure"),
+            alpha: r.required_when(colour, "u_alpha"),
+            heat_scale: r.required_when(
+                f.has(ShaderFeatures::COUNT_EVALS) && f.has(ShaderFeatures::COUNT_HEATMAP),
+                "u_heatScale",
+            ),
+        }
+    }
+}
 
 /// Deferred's GPU state.
 #[derive(Default)]
@@ -114,9 +222,9 @@ impl Deferred {
         let viewport = [ctx.viewport.0 as f32, ctx.viewport.1 as f32];
         for k in 0..ctx.order.opaque.len() {
             let i = ctx.order.opaque[k];
-            shade_object(ctx, i, "gbuffer", 1, &mut |program, dev| {
-                program.set_vec2(dev, "u_viewport", viewport);
-                program.set_vec2(dev, "u_halfExtent", half);
+            shade_object(ctx, i, "gbuffer", 1, &mut |p: &GBufferProgram, dev| {
+                p.viewport.set(dev, viewport);
+                p.half_extent.set(dev, half);
             })?;
         }
         Ok(())
@@ -126,9 +234,10 @@ impl Deferred {
         let dev = ctx.dev;
         let gb = self.gbuffer.as_ref().expect("allocated");
         gb.begin_accumulation(dev);
-        gb.bind_textures(dev, UNIT_METHOD);
+        gb.bind_textures(dev, UNIT_G_ALBEDO);
         let features = ctx.features.with(ShaderFeatures::SPECULAR, true);
         let (half, ortho) = half_extent(ctx);
+        let viewport = [ctx.viewport.0 as f32, ctx.viewport.1 as f32];
         let far = ctx.far as f32;
         for light in ctx.lights.iter().filter(|l| l.cull_radius > 0.0) {
             // The proxy bounds the light's reach: its culling radius (the radius, or less
@@ -181,18 +290,23 @@ impl Deferred {
                 features: features.0,
                 dialect: dev.es(),
             };
-            let program = ctx
+            let p = ctx
                 .programs
-                .get_or_build(dev, key, || features.defines(dev.es(), 1))?;
-            program.bind(dev);
-            set_gbuffer_uniforms(program, dev, ctx.viewport);
-            program.set_vec2(dev, "u_halfExtent", half);
-            program.set_f32(dev, "u_orthographic", if ortho { 1.0 } else { 0.0 });
-            program.set_mat4(dev, "u_projection", &ctx.projection);
-            program.set_vec4(dev, "u_volume", light.position.extend(radius));
-            program.set_vec4(dev, "u_light0", light.position.extend(light.radius));
-            program.set_vec4(dev, "u_light1", light.radiance.extend(light.spot_scale));
-            program.set_vec4(dev, "u_light2", light.direction.extend(light.spot_offset));
+                .bind::<LightProgram>(dev, key, || features.defines(dev.es(), 1))?;
+            p.g_albedo.set(dev, UNIT_G_ALBEDO);
+            p.g_normal_depth.set(dev, UNIT_G_NORMAL_DEPTH);
+            p.g_specular.set(dev, UNIT_G_SPECULAR);
+            p.viewport.set(dev, viewport);
+            p.half_extent.set(dev, half);
+            p.orthographic.set(dev, if ortho { 1.0 } else { 0.0 });
+            if let Some((volume, projection)) = &p.proxy {
+                projection.set(dev, ctx.projection);
+                volume.set(dev, light.position.extend(radius));
+            }
+            let [light0, light1, light2] = &p.light;
+            light0.set(dev, light.position.extend(light.radius));
+            light1.set(dev, light.radiance.extend(light.spot_scale));
+            light2.set(dev, light.direction.extend(light.spot_offset));
             mesh.expect("allocated").draw(dev);
         }
         Ok(())
@@ -218,24 +332,20 @@ impl Deferred {
             features: features.0,
             dialect: dev.es(),
         };
-        let program = ctx
+        let p = ctx
             .programs
-            .get_or_build(dev, key, || features.defines(dev.es(), 1))?;
-        program.bind(dev);
+            .bind::<CompositeProgram>(dev, key, || features.defines(dev.es(), 1))?;
         let gbuffer = self.gbuffer.as_ref().expect("allocated");
-        gbuffer.bind_textures(dev, UNIT_METHOD);
-        gbuffer.bind_depth_texture(dev, UNIT_METHOD + 4);
-        set_gbuffer_uniforms(program, dev, ctx.viewport);
-        program.set_i32(dev, "u_gDepth", UNIT_METHOD as i32 + 4);
-        program.set_vec3(dev, "u_ambient", ctx.scene.ambient);
-        program.set_f32(dev, "u_exposure", ctx.options.exposure_ev.exp2());
-        program.set_f32(dev, "u_alpha", 1.0);
-        program.set_f32(dev, "u_heatScale", ctx.options.heat_scale.max(1.0));
-        program.set_f32(
-            dev,
-            "u_orthographic",
-            if ctx.orthographic { 1.0 } else { 0.0 },
-        );
+        gbuffer.bind_textures(dev, UNIT_G_ALBEDO);
+        gbuffer.bind_depth_texture(dev, UNIT_G_DEPTH);
+        p.g_albedo.set(dev, UNIT_G_ALBEDO);
+        p.g_normal_depth.set(dev, UNIT_G_NORMAL_DEPTH);
+        p.accum.set(dev, UNIT_ACCUM);
+        p.g_depth.set(dev, UNIT_G_DEPTH);
+        p.ambient.set(dev, ctx.scene.ambient);
+        p.exposure.set(dev, ctx.options.exposure_ev.exp2());
+        p.alpha.set(dev, 1.0);
+        p.heat_scale.set(dev, ctx.options.heat_scale.max(1.0));
         self.fullscreen.as_ref().expect("allocated").draw(dev);
         Ok(())
     }
@@ -248,18 +358,6 @@ fn half_extent(ctx: &FrameContext) -> ([f32; 2], bool) {
         GridProjection::Perspective { tan_x, tan_y } => ([tan_x as f32, tan_y as f32], false),
         GridProjection::Orthographic { half_x, half_y } => ([half_x as f32, half_y as f32], true),
     }
-}
-
-/// The G-buffer samplers (units from [`UNIT_METHOD`], in `GBuffer::bind_textures` order; the
-/// light pass has no `u_accum`, so setting it there is a no-op) and the viewport size.
-fn set_gbuffer_uniforms(program: &mut Program, dev: &Device, viewport: (u32, u32)) {
-    for (i, name) in ["u_gAlbedo", "u_gNormalDepth", "u_gSpecular", "u_accum"]
-        .iter()
-        .enumerate()
-    {
-        program.set_i32(dev, name, (UNIT_METHOD + i as u32) as i32);
-    }
-    program.set_vec2(dev, "u_viewport", [viewport.0 as f32, viewport.1 as f32]);
 }
 
 impl ShadingMethod for Deferred {

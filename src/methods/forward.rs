@@ -8,10 +8,12 @@
 //! lights than that (only reachable without fragment highp: 1 023) keeps the ones that matter
 //! most to the view ([`super::forward_cap`]), with a warning and the rest counted.
 
-use super::geometry::{self, UNIT_METHOD};
-use super::{FrameContext, MethodDesc, MethodStats, ShadingMethod, Support};
+use super::geometry::{self, GeometryProgram, UNIT_METHOD};
+use super::uniforms::{self, LightData, Surface, Transforms};
+use super::{FrameContext, MethodDesc, MethodStats, ShaderFeatures, ShadingMethod, Support};
 use crate::cluster::pack::{pack_lights_into, LightEncoding, PackedLights};
 use crate::cluster::view_light::GpuLight;
+use crate::gl::program::{Resolver, Uniform, UniformSet};
 use crate::gl::texture::{DataFormat, DataTexture};
 use crate::gl::{Caps, Device, EsVersion};
 use crate::Error;
@@ -56,6 +58,38 @@ pub fn max_lights(caps: &Caps) -> u32 {
     by_texture.min(by_loop)
 }
 
+/// The `forward` shader's uniforms: every light from the light texture, up to the count.
+pub struct ForwardProgram {
+    transforms: Transforms,
+    surface: Surface,
+    lights: LightData,
+    count: Uniform<i32>,
+}
+
+impl UniformSet for ForwardProgram {
+    fn resolve(r: &mut Resolver<'_>) -> Self {
+        let f = uniforms::features(r);
+        let no_lights = f.has(ShaderFeatures::NO_LIGHTS);
+        let lit = !f.counting() && !no_lights;
+        ForwardProgram {
+            transforms: Transforms::resolve(r, lit),
+            surface: Surface::shaded(r, lit),
+            // Evaluation counts are the light count alone; reaching counts read the lights.
+            lights: LightData::resolve(r, !no_lights && !f.has(ShaderFeatures::COUNT_EVALS)),
+            count: r.required_when(!no_lights, "u_lightCount"),
+        }
+    }
+}
+
+impl GeometryProgram for ForwardProgram {
+    fn transforms(&self) -> &Transforms {
+        &self.transforms
+    }
+    fn surface(&self) -> &Surface {
+        &self.surface
+    }
+}
+
 /// Plain forward's GPU state: the light texture, and the buffers a frame fills (kept, so a
 /// frame allocates nothing once they have grown).
 #[derive(Default)]
@@ -97,7 +131,7 @@ impl ShadingMethod for Forward {
                 log::warn!(
                     "forward loops over at most {limit} lights on this context; {} of the \
                      scene's {} active lights, those that matter least to the view, are left \
-                     out (FrameStats::overflowed_lights counts them each frame)",
+                     out (FrameStats::lights.overflowed counts them each frame)",
                     ctx.lights.len() - limit as usize,
                     ctx.lights.len()
                 );
@@ -136,14 +170,10 @@ impl ShadingMethod for Forward {
             stats.upload_bytes = packed.bytes.len();
         }
         let ranges = [packed.pos_range, packed.radius_range];
-        let inv_height = 1.0 / texture.size().1.max(1) as f32;
         let texture = &*texture;
-        geometry::draw_objects(ctx, "forward", limit, &mut |program, dev| {
-            texture.bind(dev, UNIT_METHOD);
-            program.set_i32(dev, "u_lights", UNIT_METHOD as i32);
-            program.set_i32(dev, "u_lightCount", count as i32);
-            program.set_f32(dev, "u_lightTexInvHeight", inv_height);
-            program.set_vec2(dev, "u_lightRanges", ranges);
+        geometry::draw_objects(ctx, "forward", limit, &mut |p: &ForwardProgram, dev| {
+            p.lights.bind(dev, texture, UNIT_METHOD, ranges);
+            p.count.set(dev, count as i32);
         })?;
         Ok(stats)
     }

@@ -1,10 +1,9 @@
 //! The geometry pass shared by the forward-style methods: every object drawn once with its
 //! material's shader variant, the method adding its own uniforms and textures.
 
-use glam::{DMat3, DMat4, Mat4};
-
+use super::uniforms::{Surface, SurfaceFrame, Transforms};
 use super::{FrameContext, ShaderFeatures};
-use crate::gl::program::{Program, ProgramKey};
+use crate::gl::program::{ProgramKey, Resolver, UniformSet};
 use crate::gl::state::RenderState;
 use crate::gl::Device;
 use crate::Error;
@@ -14,11 +13,22 @@ pub const UNIT_ALBEDO: u32 = 0;
 /// First texture unit a method may use for its data textures.
 pub const UNIT_METHOD: u32 = 1;
 
-fn set_transforms(program: &mut Program, dev: &Device, model_view: &DMat4, projection: &Mat4) {
-    let normal_matrix = crate::scene::normal_matrix::normal_matrix(&DMat3::from_mat4(*model_view));
-    program.set_mat4(dev, "u_modelView", &model_view.as_mat4());
-    program.set_mat3(dev, "u_normalMatrix", &normal_matrix.as_mat3());
-    program.set_mat4(dev, "u_projection", projection);
+/// The uniforms of a geometry-pass program: the shared transforms and surface, and the
+/// method's own (set by the method's `bind_method`).
+pub trait GeometryProgram: UniformSet {
+    /// `mesh.vert`'s uniforms.
+    fn transforms(&self) -> &Transforms;
+    /// `surface.glsl`'s uniforms.
+    fn surface(&self) -> &Surface;
+}
+
+/// The depth prepass: transforms only (its fragment stage writes no colour).
+pub(crate) struct DepthProgram(Transforms);
+
+impl UniformSet for DepthProgram {
+    fn resolve(r: &mut Resolver<'_>) -> Self {
+        DepthProgram(Transforms::resolve(r, false))
+    }
 }
 
 /// The objects of a frame in draw order: indices into the scene's objects, in buffers the
@@ -73,16 +83,10 @@ fn depth_prepass(ctx: &mut FrameContext) -> Result<(), Error> {
         features: 0,
         dialect: dev.es(),
     };
-    let program = ctx.programs.get_or_build(dev, key, Vec::new)?;
-    program.bind(dev);
+    let DepthProgram(transforms) = ctx.programs.bind::<DepthProgram>(dev, key, Vec::new)?;
     for &i in &ctx.order.opaque {
         let object = &ctx.scene.objects[i];
-        set_transforms(
-            program,
-            dev,
-            &(ctx.view * object.transform),
-            &ctx.projection,
-        );
+        transforms.set(dev, &(ctx.view * object.transform), &ctx.projection);
         ctx.gpu_scene.mesh(object).draw(dev);
     }
     Ok(())
@@ -94,11 +98,11 @@ fn depth_prepass(ctx: &mut FrameContext) -> Result<(), Error> {
 /// program before a draw so the method can set its uniforms and bind its textures; transparent
 /// surfaces are lit by the same data (the dense grid covers every depth, not just the visible
 /// surface).
-pub fn draw_objects(
+pub fn draw_objects<P: GeometryProgram>(
     ctx: &mut FrameContext,
     shader: &'static str,
     max_lights: u32,
-    bind_method: &mut dyn FnMut(&mut Program, &Device),
+    bind_method: &mut dyn FnMut(&P, &Device),
 ) -> Result<(), Error> {
     sort_objects(ctx);
     depth_prepass(ctx)?;
@@ -128,12 +132,12 @@ pub fn draw_objects(
 }
 
 /// One object with its material's shader variant.
-pub(crate) fn shade_object(
+pub(crate) fn shade_object<P: GeometryProgram>(
     ctx: &mut FrameContext,
     index: usize,
     shader: &'static str,
     max_lights: u32,
-    bind_method: &mut dyn FnMut(&mut Program, &Device),
+    bind_method: &mut dyn FnMut(&P, &Device),
 ) -> Result<(), Error> {
     let dev = ctx.dev;
     let dialect = dev.es();
@@ -153,35 +157,29 @@ pub(crate) fn shade_object(
         features: features.0,
         dialect,
     };
-    let program = ctx
+    let program: &P = ctx
         .programs
-        .get_or_build(dev, key, || features.defines(dialect, max_lights))?;
-    program.bind(dev);
+        .bind(dev, key, || features.defines(dialect, max_lights))?;
     // The camera is subtracted in f64 here, so far-from-origin scenes stay exact in f32.
-    set_transforms(
-        program,
-        dev,
-        &(ctx.view * object.transform),
-        &ctx.projection,
-    );
-    program.set_vec3(dev, "u_albedo", material.diffuse);
-    program.set_vec3(dev, "u_specular", material.specular);
-    program.set_f32(dev, "u_shininess", material.shading_exponent());
-    program.set_f32(dev, "u_alpha", material.alpha);
-    if features.has(ShaderFeatures::COUNT_HEATMAP) {
-        program.set_f32(dev, "u_heatScale", ctx.options.heat_scale.max(1.0));
-    }
-    program.set_vec3(dev, "u_ambient", ctx.scene.ambient);
-    program.set_f32(dev, "u_exposure", ctx.options.exposure_ev.exp2());
-    program.set_f32(
-        dev,
-        "u_orthographic",
-        if ctx.orthographic { 1.0 } else { 0.0 },
-    );
+    program
+        .transforms()
+        .set(dev, &(ctx.view * object.transform), &ctx.projection);
     if let Some(t) = texture {
         t.bind(dev, UNIT_ALBEDO);
-        program.set_i32(dev, "u_albedoTex", UNIT_ALBEDO as i32);
     }
+    let frame = SurfaceFrame {
+        ambient: ctx.scene.ambient,
+        exposure: ctx.options.exposure_ev.exp2(),
+        orthographic: ctx.orthographic,
+        heat_scale: ctx.options.heat_scale.max(1.0),
+    };
+    program.surface().set(
+        dev,
+        material,
+        texture.is_some().then_some(UNIT_ALBEDO),
+        &frame,
+        features.has(ShaderFeatures::COUNT_HEATMAP),
+    );
     bind_method(program, dev);
     ctx.gpu_scene.mesh(object).draw(dev);
     Ok(())
@@ -190,6 +188,6 @@ pub(crate) fn shade_object(
 /// A frame without lights: ambient only, with the light loop compiled out and nothing uploaded.
 pub fn draw_ambient_only(ctx: &mut FrameContext) -> Result<super::MethodStats<'static>, Error> {
     ctx.features = ctx.features.with(ShaderFeatures::NO_LIGHTS, true);
-    draw_objects(ctx, "forward", 1, &mut |_, _| {})?;
+    draw_objects::<super::forward::ForwardProgram>(ctx, "forward", 1, &mut |_, _| {})?;
     Ok(super::MethodStats::default())
 }

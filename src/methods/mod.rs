@@ -15,6 +15,7 @@ pub mod forward_cap;
 pub mod geometry;
 mod grid_choice;
 pub mod tiled;
+pub mod uniforms;
 
 use crate::cluster::view_light::GpuLight;
 use crate::gl::program::ProgramCache;

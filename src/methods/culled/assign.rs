@@ -1,0 +1,70 @@
+//! Stage assign: the frame's lights assigned to the grid's cells on the CPU, timed, with a
+//! warning (once per method) when the overflow policy drops light references.
+
+use std::time::Instant;
+
+use super::limits;
+use crate::cluster::assign::{AssignLimits, Assigner, Assignment};
+use crate::cluster::grid::ClusterGrid;
+use crate::methods::FrameContext;
+use crate::Error;
+
+/// The assignment's buffers, reused frame after frame, and whether overflow was warned about.
+#[derive(Default)]
+pub(super) struct Assign {
+    assigner: Assigner,
+    /// `FrameStats::overflowed_lights` counts every frame's dropped references; the log says
+    /// it once.
+    warned_overflow: bool,
+}
+
+/// A frame's assignment and how long it took.
+pub(super) struct Assigned<'a> {
+    pub assignment: &'a Assignment,
+    pub ms: f64,
+}
+
+impl Assign {
+    /// Assigns `ctx.lights` to `grid`'s cells within `limits`; refuses a frame with more
+    /// visible lights than the index list can number.
+    pub(super) fn run(
+        &mut self,
+        method: &str,
+        grid: &ClusterGrid,
+        ctx: &FrameContext,
+        limits: &AssignLimits,
+    ) -> Result<Assigned<'_>, Error> {
+        let started = Instant::now();
+        let assignment = self.assigner.assign(grid, ctx.lights, ctx.far, limits);
+        let ms = started.elapsed().as_secs_f64() * 1e3;
+        let dropped = assignment.stats.overflowed_lights;
+        if dropped > 0 && !self.warned_overflow {
+            self.warned_overflow = true;
+            warn_overflow(method, dropped, limits);
+        }
+        limits::check_visible(assignment.visible.len())?;
+        Ok(Assigned { assignment, ms })
+    }
+
+    /// The last frame's assignment.
+    pub(super) fn last(&self) -> &Assignment {
+        self.assigner.assignment()
+    }
+}
+
+fn warn_overflow(method: &str, dropped: u64, limits: &AssignLimits) {
+    let cap = match limits.cell_cap {
+        u32::MAX => "no cap per cell".to_string(),
+        cap => format!("a cell keeps at most {cap} lights"),
+    };
+    log::warn!(
+        "{method}: {dropped} light references left out of this frame's cell lists, so \
+         the image lacks those lights where they reach ({cap}, and at most {} \
+         references fit in the index list here: the index texture's capacity on this \
+         context or MeasureOptions::max_indices; each cell keeps the lights that matter \
+         most to it, and FrameStats::lights.overflowed counts the dropped ones every \
+         frame): a coarser grid (grid.footprint_px), deeper slices (grid.slice_depth) \
+         or the automatic grid avoid it",
+        limits.max_indices
+    );
+}

@@ -1,0 +1,70 @@
+//! Stage limits: what one frame may hold on this context (the cell cap, the index list, the
+//! grid and the lights the textures can address), from its capacities and the options.
+
+use crate::cluster::assign::AssignLimits;
+use crate::cluster::grid::ClusterGrid;
+use crate::cluster::pack::DATA_TEXTURE_WIDTH;
+use crate::cluster::pack::{grid_fits_table, grid_texels, MAX_INDEXED_LIGHTS};
+use crate::gl::Device;
+use crate::methods::capacity::capacities;
+use crate::methods::FrameContext;
+use crate::Error;
+
+/// The assignment's limits: the context's cell and index-list capacities, lowered by
+/// `MeasureOptions::cell_cap` and `max_indices`.
+pub(super) fn assign_limits(ctx: &FrameContext) -> AssignLimits {
+    let capacity = capacities(ctx.dev.caps());
+    let cell_cap = ctx
+        .options
+        .measure
+        .cell_cap
+        .unwrap_or(u32::MAX)
+        .min(capacity.cell_lights.unwrap_or(u32::MAX));
+    let mut max_indices = capacity.index_entries;
+    if let Some(m) = ctx.options.measure.max_indices {
+        max_indices = max_indices.min(m);
+    }
+    AssignLimits {
+        cell_cap,
+        max_indices,
+        ..AssignLimits::default()
+    }
+}
+
+/// Refuses, before any assignment, a grid the grid texture cannot hold (it would only fail at
+/// the upload, after allocating its lists) or whose table cannot address its cells.
+pub(super) fn check_grid(dev: &Device, grid: &ClusterGrid, footprint_px: f64) -> Result<(), Error> {
+    let max_rows = dev.caps().max_texture_size.max(1) as usize;
+    let texels = grid_texels(grid);
+    if texels > max_rows * DATA_TEXTURE_WIDTH as usize {
+        return Err(Error::Limit(format!(
+            "a {} px cell footprint (grid.footprint_px) makes {} grid cells; this context's \
+             grid texture holds {}: use a larger footprint, deeper slices (grid.slice_depth) \
+             or the automatic grid",
+            footprint_px,
+            grid.total_cells,
+            max_rows * DATA_TEXTURE_WIDTH as usize - (texels - grid.total_cells as usize)
+        )));
+    }
+    // The table's 24-bit first cells: a limit only where the texture holds more cells
+    // (16 384 rows of 1 024 texels hold 2²⁴ texels, table included).
+    if let Some(what) = grid_fits_table(grid) {
+        return Err(Error::Limit(format!(
+            "a {footprint_px} px cell footprint (grid.footprint_px) with these limits \
+             (grid.max_tiles, grid.max_slices) makes {what}: use a larger footprint or the \
+             automatic grid"
+        )));
+    }
+    Ok(())
+}
+
+/// Refuses more visible lights than the index list can number.
+pub(super) fn check_visible(visible: usize) -> Result<(), Error> {
+    if visible > MAX_INDEXED_LIGHTS {
+        return Err(Error::Limit(format!(
+            "{visible} lights are visible in this frame; tiled and clustered shading index at \
+             most {MAX_INDEXED_LIGHTS}"
+        )));
+    }
+    Ok(())
+}

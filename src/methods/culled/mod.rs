@@ -1,0 +1,155 @@
+//! The shared engine of tiled and clustered forward: assign lights to a grid on the CPU every
+//! frame, upload three data textures (lights, grid, indices), and shade in one geometry pass
+//! where each fragment loops over its cell's lights only.
+//!
+//! A frame runs these stages in order, each in its own file:
+//!
+//! 1. `limits`: what the frame may hold on this context (cell cap, index list), and the grid
+//!    and the visible lights checked against it;
+//! 2. `grid`: the cell grid, rebuilt only when what it depends on changed (and the CPU costs
+//!    the automatic grid calibrates on, recorded after the upload);
+//! 3. `assign`: the lights assigned to the cells, and the overflow warning;
+//! 4. `upload`: the lists packed into texels and uploaded into the texture ring;
+//! 5. `bind`: the textures and uniform values every program of the frame gets;
+//! 6. `draw` (here): the geometry pass, each program bound with them.
+//!
+//! Uploads are ring-buffered over [`RING`] texture sets: a frame writes the set the GPU used
+//! `RING` frames ago, never one an in-flight frame may still read (drivers would otherwise stall
+//! or copy on a rewrite).
+
+mod assign;
+mod bind;
+mod grid;
+mod limits;
+mod upload;
+
+pub use bind::ClusteredProgram;
+
+use super::geometry;
+use super::grid_choice::AutoGrid;
+use super::GridReport;
+use super::{FrameContext, MethodStats, ShadingMethod};
+use crate::cluster::grid::{ClusterGrid, GridMode};
+use crate::cluster::pack::{GridEncoding, RGBA8_CELL_CAP};
+use crate::gl::Device;
+use crate::Error;
+
+/// Texture sets in the upload ring.
+pub const RING: usize = 3;
+
+/// Which grid the method builds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Culling {
+    /// 2D screen tiles, one slice over the whole depth range.
+    Tiled,
+    /// The dense cascaded cluster grid.
+    Clustered,
+}
+
+/// Tiled or clustered forward.
+pub struct CulledForward {
+    culling: Culling,
+    /// The grid and what it was built for.
+    grid: Option<(grid::GridKey, ClusterGrid)>,
+    /// The automatic grid's choice and calibration (clustered, [`GridMode::Auto`]).
+    auto: AutoGrid,
+    /// Why a tiled or fixed grid is what it is (the automatic grid keeps its own reason).
+    reason: String,
+    /// The assignment's buffers and warning state.
+    assign: assign::Assign,
+    /// The packing buffers and the texture ring.
+    upload: upload::Uploads,
+}
+
+impl CulledForward {
+    /// A method with no GPU resources yet (created on first render).
+    pub fn new(culling: Culling) -> Self {
+        CulledForward {
+            culling,
+            grid: None,
+            auto: AutoGrid::default(),
+            reason: String::new(),
+            assign: assign::Assign::default(),
+            upload: upload::Uploads::default(),
+        }
+    }
+
+    /// Whether this frame's grid is the automatic one.
+    fn automatic(&self, ctx: &FrameContext) -> bool {
+        self.culling == Culling::Clustered && ctx.options.grid.mode == GridMode::Auto
+    }
+}
+
+/// The geometry pass with the `clustered` shader, each program bound with the frame's
+/// `bindings`.
+fn draw(ctx: &mut FrameContext, bindings: &bind::Bindings) -> Result<(), Error> {
+    geometry::draw_objects(
+        ctx,
+        "clustered",
+        RGBA8_CELL_CAP,
+        &mut |p: &ClusteredProgram, dev| bindings.bind(p, dev),
+    )
+}
+
+impl ShadingMethod for CulledForward {
+    fn name(&self) -> &'static str {
+        match self.culling {
+            Culling::Tiled => "tiled",
+            Culling::Clustered => "clustered",
+        }
+    }
+
+    /// Renders one frame: the stages of the module docs, in order.
+    fn render(&mut self, ctx: &mut FrameContext) -> Result<MethodStats<'_>, Error> {
+        let method = self.name();
+        let automatic = self.automatic(ctx);
+        let grid_encoding = GridEncoding::for_es(ctx.dev.es());
+
+        let limits = limits::assign_limits(ctx);
+        self.update_grid(ctx, &limits, grid_encoding);
+        self.write_grid_reason(ctx);
+        let (grid_key, grid) = self.grid.as_ref().expect("updated above");
+        limits::check_grid(ctx.dev, grid, grid_key.config.footprint_px)?;
+        let assigned = self.assign.run(method, grid, ctx, &limits)?;
+        let uploaded = self.upload.pack_and_upload(ctx, grid, assigned.assignment)?;
+        if automatic {
+            grid::record_cost(&mut self.auto, grid, &assigned, &uploaded);
+        }
+        let bindings = bind::Bindings::new(&uploaded, grid, assigned.assignment, ctx.viewport);
+        draw(ctx, &bindings)?;
+
+        Ok(MethodStats {
+            upload_bytes: uploaded.bytes,
+            assign_ms: Some(assigned.ms),
+            assign: Some(assigned.assignment.stats),
+            grid: Some(GridReport {
+                footprint_px: grid_key.config.footprint_px,
+                cells: grid.total_cells,
+                reason: if automatic {
+                    self.auto.reason()
+                } else {
+                    &self.reason
+                },
+            }),
+            ..MethodStats::default()
+        })
+    }
+
+    fn observe_frame(&mut self, frame_ms: Option<f64>, gpu_ms: Option<f64>) {
+        self.auto.observe(frame_ms, gpu_ms);
+    }
+
+    fn light_lists(&self) -> Option<super::LightLists<'_>> {
+        Some((&self.grid.as_ref()?.1, self.assign.last()))
+    }
+
+    /// GPU bytes of all ring sets.
+    fn gpu_bytes(&self) -> usize {
+        self.upload.gpu_bytes()
+    }
+
+    /// Frees the ring.
+    fn destroy(&mut self, dev: &Device) {
+        self.upload.destroy(dev);
+    }
+}

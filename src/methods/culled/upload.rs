@@ -1,0 +1,159 @@
+//! Stage pack and upload: the visible lights, the grid's lists and the index list packed into
+//! texels (in buffers kept between frames) and uploaded to the next texture set of the ring.
+
+use std::time::Instant;
+
+use super::RING;
+use crate::cluster::assign::Assignment;
+use crate::cluster::grid::ClusterGrid;
+use crate::cluster::pack::{pack_lights_into, LightEncoding, PackedLights};
+use crate::cluster::view_light::GpuLight;
+use crate::cluster::pack::{pack_grid_into, pack_indices_into, GridEncoding, PackedTexels};
+use crate::gl::texture::{DataFormat, DataTexture};
+use crate::gl::{Device, EsVersion};
+use crate::methods::FrameContext;
+use crate::Error;
+
+/// One frame's textures: light records, the grid (cascade tables and cell list starts) and
+/// the index list.
+pub(super) struct TextureSet {
+    pub lights: DataTexture,
+    light_encoding: LightEncoding,
+    pub grid: DataTexture,
+    pub indices: DataTexture,
+}
+
+impl TextureSet {
+    fn new(dev: &Device, light_encoding: LightEncoding) -> Result<TextureSet, Error> {
+        let light_format = match light_encoding {
+            LightEncoding::Float32 => DataFormat::Rgba32F,
+            LightEncoding::Rgba8 => DataFormat::Rgba8,
+        };
+        let (grid, indices) = match dev.es() {
+            EsVersion::Es2 => (DataFormat::Rgba8, DataFormat::Rgba8),
+            EsVersion::Es3 => (DataFormat::R32Ui, DataFormat::Rgba16Ui),
+        };
+        Ok(TextureSet {
+            lights: DataTexture::new(dev, light_format)?,
+            light_encoding,
+            grid: DataTexture::new(dev, grid)?,
+            indices: DataTexture::new(dev, indices)?,
+        })
+    }
+
+    fn destroy(mut self, dev: &Device) {
+        self.lights.destroy(dev);
+        self.grid.destroy(dev);
+        self.indices.destroy(dev);
+    }
+
+    fn gpu_bytes(&self) -> usize {
+        self.lights.gpu_bytes() + self.grid.gpu_bytes() + self.indices.gpu_bytes()
+    }
+}
+
+/// The texture ring and what a frame packs, kept so a frame allocates nothing once they have
+/// grown.
+pub(super) struct Uploads {
+    ring: Vec<Option<TextureSet>>,
+    frame: usize,
+    /// The visible lights, their texels, the grid's and the index list's texels.
+    visible: Vec<GpuLight>,
+    lights: PackedLights,
+    grid: PackedTexels,
+    indices: PackedTexels,
+}
+
+impl Default for Uploads {
+    fn default() -> Self {
+        Uploads {
+            ring: (0..RING).map(|_| None).collect(),
+            frame: 0,
+            visible: Vec::new(),
+            lights: PackedLights::default(),
+            grid: PackedTexels::default(),
+            indices: PackedTexels::default(),
+        }
+    }
+}
+
+/// What a frame uploaded.
+pub(super) struct Uploaded<'a> {
+    /// The texture set the frame reads.
+    pub set: &'a TextureSet,
+    /// The RGBA8 light encoding's position and radius ranges.
+    pub light_ranges: [f32; 2],
+    /// Bytes uploaded.
+    pub bytes: usize,
+    /// Packing and upload time.
+    pub ms: f64,
+}
+
+impl Uploads {
+    /// Packs the frame's visible lights, cell lists and index list, and uploads them into the
+    /// ring's next set (made anew when the light encoding changed).
+    pub(super) fn pack_and_upload(
+        &mut self,
+        ctx: &FrameContext,
+        grid: &ClusterGrid,
+        assignment: &Assignment,
+    ) -> Result<Uploaded<'_>, Error> {
+        let dev = ctx.dev;
+        let started = Instant::now();
+        self.visible.clear();
+        self.visible
+            .extend(assignment.visible.iter().map(|&i| ctx.lights[i as usize]));
+        let encoding = ctx.features.light_encoding();
+        let grid_encoding = GridEncoding::for_es(dev.es());
+        pack_lights_into(&self.visible, encoding, &mut self.lights);
+        pack_grid_into(grid, assignment, grid_encoding, &mut self.grid);
+        pack_indices_into(&assignment.indices, grid_encoding, &mut self.indices);
+
+        let set = next_set(&mut self.ring, &mut self.frame, dev, encoding)?;
+        let (lights, grid, indices) = (&self.lights, &self.grid, &self.indices);
+        set.lights
+            .upload(dev, lights.width, lights.height, &lights.bytes)?;
+        set.grid.upload(dev, grid.width, grid.height, &grid.bytes)?;
+        set.indices
+            .upload(dev, indices.width, indices.height, &indices.bytes)?;
+        Ok(Uploaded {
+            set,
+            light_ranges: [lights.pos_range, lights.radius_range],
+            bytes: lights.bytes.len() + grid.bytes.len() + indices.bytes.len(),
+            ms: started.elapsed().as_secs_f64() * 1e3,
+        })
+    }
+
+    /// GPU bytes of all ring sets.
+    pub(super) fn gpu_bytes(&self) -> usize {
+        self.ring.iter().flatten().map(TextureSet::gpu_bytes).sum()
+    }
+
+    /// Frees the ring.
+    pub(super) fn destroy(&mut self, dev: &Device) {
+        for set in self.ring.iter_mut().filter_map(Option::take) {
+            set.destroy(dev);
+        }
+    }
+}
+
+/// The ring's set for this frame: the one used `RING` frames ago, made anew when the light
+/// encoding changed.
+fn next_set<'r>(
+    ring: &'r mut [Option<TextureSet>],
+    frame: &mut usize,
+    dev: &Device,
+    encoding: LightEncoding,
+) -> Result<&'r mut TextureSet, Error> {
+    let slot = &mut ring[*frame % RING];
+    *frame += 1;
+    if slot.as_ref().is_some_and(|s| s.light_encoding != encoding) {
+        if let Some(old) = slot.take() {
+            old.destroy(dev);
+        }
+    }
+    if slot.is_none() {
+        *slot = Some(TextureSet::new(dev, encoding)?);
+    }
+    Ok(slot.as_mut().expect("created above"))
+}
