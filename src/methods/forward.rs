@@ -188,3 +188,10 @@ impl ShadingMethod for Forward {
         }
     }
 }
+
+/// A frame without lights: ambient only, with the light loop compiled out and nothing uploaded.
+pub fn draw_ambient_only(ctx: &mut FrameContext) -> Result<MethodStats<'static>, Error> {
+    ctx.features = ctx.features.with(ShaderFeatures::NO_LIGHTS, true);
+    geometry::draw_objects::<ForwardProgram>(ctx, "forward", 1, &mut |_, _| {})?;
+    Ok(MethodStats::default())
+}

@@ -185,9 +185,3 @@ pub(crate) fn shade_object<P: GeometryProgram>(
     Ok(())
 }
 
-/// A frame without lights: ambient only, with the light loop compiled out and nothing uploaded.
-pub fn draw_ambient_only(ctx: &mut FrameContext) -> Result<super::MethodStats<'static>, Error> {
-    ctx.features = ctx.features.with(ShaderFeatures::NO_LIGHTS, true);
-    draw_objects::<super::forward::ForwardProgram>(ctx, "forward", 1, &mut |_, _| {})?;
-    Ok(super::MethodStats::default())
-}

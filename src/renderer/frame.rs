@@ -164,7 +164,7 @@ impl Renderer {
         // No lights: no assignment, no uploads, the light loop compiled out — whatever the
         // method (a scene pays only for what it has).
         let rendered = if self.lights.is_empty() {
-            methods::geometry::draw_ambient_only(&mut ctx)
+            methods::forward::draw_ambient_only(&mut ctx)
         } else {
             self.method.render(&mut ctx)
         };

@@ -13,7 +13,7 @@
 //! 5. `bind`: the textures and uniform values every program of the frame gets;
 //! 6. `draw` (here): the geometry pass, each program bound with them.
 //!
-//! Uploads are ring-buffered over [`RING`] texture sets: a frame writes the set the GPU used
+//! Uploads are ring-buffered over [`upload::RING`] texture sets: a frame writes the set the GPU used
 //! `RING` frames ago, never one an in-flight frame may still read (drivers would otherwise stall
 //! or copy on a rewrite).
 
@@ -33,9 +33,6 @@ use crate::cluster::grid::{ClusterGrid, GridMode};
 use crate::cluster::pack::{GridEncoding, RGBA8_CELL_CAP};
 use crate::gl::Device;
 use crate::Error;
-
-/// Texture sets in the upload ring.
-pub const RING: usize = 3;
 
 /// Which grid the method builds.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

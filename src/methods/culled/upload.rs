@@ -3,7 +3,6 @@
 
 use std::time::Instant;
 
-use super::RING;
 use crate::cluster::assign::Assignment;
 use crate::cluster::grid::ClusterGrid;
 use crate::cluster::pack::{pack_lights_into, LightEncoding, PackedLights};
@@ -13,6 +12,9 @@ use crate::gl::texture::{DataFormat, DataTexture};
 use crate::gl::{Device, EsVersion};
 use crate::methods::FrameContext;
 use crate::Error;
+
+/// Texture sets in the upload ring.
+pub const RING: usize = 3;
 
 /// One frame's textures: light records, the grid (cascade tables and cell list starts) and
 /// the index list.
