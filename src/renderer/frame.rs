@@ -310,7 +310,7 @@ fn check_options(options: &RenderOptions) -> Result<(), Error> {
         );
         return invalid("grid.cascades", why);
     }
-    let budget = options.grid.assign_budget;
+    let budget = options.grid.assign_budget();
     if !(budget.is_finite() && budget >= 0.0) {
         let why = format!("must be a finite share of the frame from 0 up, got {budget}");
         return invalid("grid.assign_budget", why);

@@ -139,7 +139,11 @@ fn grid_settings_that_are_not_finite_are_refused_naming_the_field() {
         let mut options = RenderOptions::default();
         match field {
             "grid.slice_depth" => options.grid.slice_depth = value,
-            "grid.assign_budget" => options.grid.assign_budget = value,
+            "grid.assign_budget" => {
+                options.grid.mode = manylight::GridMode::Auto {
+                    assign_budget: value,
+                }
+            }
             _ => options.grid.footprint_px = value,
         }
         let err = refusal(&mut gpu, &s, &options);

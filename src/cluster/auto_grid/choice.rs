@@ -169,7 +169,7 @@ pub fn should_switch(current: &GridConfig, new: &GridChoice) -> bool {
         (Some(now), Some(best)) => {
             // The current grid must pass the budget clearly too, or a grid whose share sits
             // at the budget would be swapped out whenever a measurement put it a hair over.
-            let clearly_over = now.assigns_over(current.assign_budget * (1.0 + HYSTERESIS));
+            let clearly_over = now.assigns_over(current.assign_budget() * (1.0 + HYSTERESIS));
             best.overflowed_lights < now.overflowed_lights
                 || (best.overflowed_lights == now.overflowed_lights
                     && clearly_over

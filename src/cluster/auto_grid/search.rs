@@ -94,7 +94,7 @@ impl ChoiceSearch {
             overflowed_lights: a.stats.overflowed_lights,
         };
         // A NaN budget (refused by the renderer) keeps every grid in.
-        candidate.over_budget = candidate.assigns_over(inputs.base.assign_budget);
+        candidate.over_budget = candidate.assigns_over(inputs.base.assign_budget());
         // Past here finer grids only assign more than a coarser grid that kept within the CPU
         // budget without overflowing more than this one: they can win only by overflowing
         // less, and then the search goes on.
@@ -188,7 +188,7 @@ impl ChoiceSearch {
         let _ = write!(out.reason, ") over {} samples", samples.points.len());
         // The budget's part: the chosen grid's assignment against it, and the finer grid it
         // turned down (predicted cheaper but over the budget), if any.
-        let budget = inputs.base.assign_budget;
+        let budget = inputs.base.assign_budget();
         let _ = write!(
             out.reason,
             "; assignment {:.2} ms, {:.1} % of the frame (budget {:.1} %)",

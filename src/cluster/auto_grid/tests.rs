@@ -2,7 +2,7 @@
 
 use super::*;
 use crate::cluster::assign::{AssignLimits, Assigner};
-use crate::cluster::grid::{GridConfig, GridProjection};
+use crate::cluster::grid::{GridConfig, GridMode, GridProjection};
 use crate::cluster::view_light::GpuLight;
 use crate::cluster::pack::GridEncoding;
 use crate::scene::Light;
@@ -109,7 +109,7 @@ fn the_choice_is_deterministic_for_given_costs() {
 fn the_choice_follows_the_costs() {
     let (lights, samples) = workload(600);
     let mut unbudgeted = inputs(&lights);
-    unbudgeted.base.assign_budget = 1.0;
+    unbudgeted.base.mode = GridMode::Auto { assign_budget: 1.0 };
     let pick = |shade_ns: f64| {
         let prior = GridCosts::default();
         let costs = GridCosts::new(shade_ns, prior.assign_ns, prior.upload_ns);
@@ -177,7 +177,7 @@ fn switching_needs_a_clear_gain() {
             .iter()
             .find(|b| b.footprint_px == choice.config.footprint_px)
             .unwrap();
-        let budget = choice.config.assign_budget * (1.0 + HYSTERESIS);
+        let budget = choice.config.assign_budget() * (1.0 + HYSTERESIS);
         let clear = best.predicted_ms < c.predicted_ms * (1.0 - HYSTERESIS)
             || (c.assign_ms > budget * c.predicted_ms && !best.over_budget);
         assert_eq!(should_switch(&current, &choice), clear, "{c:?}");
@@ -278,7 +278,7 @@ fn the_cpu_budget_bounds_the_assignment() {
     let prior = GridCosts::default();
     let costs = GridCosts::new(200.0, prior.assign_ns, prior.upload_ns);
     let mut free = inputs(&lights);
-    free.base.assign_budget = 1.0;
+    free.base.mode = GridMode::Auto { assign_budget: 1.0 };
     let unbounded = choose(&free, &samples, &costs, &mut Assigner::new());
     let share = |c: &Candidate| c.assign_ms / c.predicted_ms;
     let chosen = |choice: &GridChoice| {
@@ -296,7 +296,7 @@ fn the_cpu_budget_bounds_the_assignment() {
     assert!(coarsest < share(&free_pick), "{unbounded:?}");
     let budget = 0.5 * (coarsest + share(&free_pick));
     let mut tight = inputs(&lights);
-    tight.base.assign_budget = budget;
+    tight.base.mode = GridMode::Auto { assign_budget: budget };
     let bounded = choose(&tight, &samples, &costs, &mut Assigner::new());
     let pick = chosen(&bounded);
     assert!(!pick.over_budget && share(&pick) <= budget, "{bounded:?}");
@@ -317,13 +317,15 @@ fn the_cpu_budget_bounds_the_assignment() {
     // The grid the free choice would keep is over the budget: the bounded choice replaces
     // it although it is predicted slower; the other way the hysteresis decides.
     let free_config = GridConfig {
-        assign_budget: budget,
+        mode: GridMode::Auto {
+            assign_budget: budget,
+        },
         ..unbounded.config.clone()
     };
     assert!(should_switch(&free_config, &bounded));
     // No candidate within a zero budget: the cheapest prediction, as without one.
     let mut none = inputs(&lights);
-    none.base.assign_budget = 0.0;
+    none.base.mode = GridMode::Auto { assign_budget: 0.0 };
     let zero = choose(&none, &samples, &costs, &mut Assigner::new());
     assert_eq!(zero.config.footprint_px, free_pick.footprint_px);
 }
@@ -336,7 +338,7 @@ fn overflow_outranks_the_cpu_budget() {
     let (lights, samples) = workload(600);
     let mut capped = inputs(&lights);
     capped.limits.cell_cap = 12;
-    capped.base.assign_budget = 0.05;
+    capped.base.mode = GridMode::Auto { assign_budget: 0.05 };
     let choice = choose(
         &capped,
         &samples,

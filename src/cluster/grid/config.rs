@@ -6,7 +6,7 @@
 /// needs (12 cover a 4096:1 range), and a bound on the per-cascade tables.
 pub const MAX_CASCADES: u32 = 64;
 
-/// The automatic grid's default [`GridConfig::assign_budget`]: 5 % of the frame.
+/// The automatic grid's default CPU budget ([`GridMode::Auto`]): 5 % of the frame.
 pub const DEFAULT_ASSIGN_BUDGET: f64 = 0.05;
 
 /// Tunables of the grid.
@@ -46,29 +46,35 @@ pub struct GridConfig {
     /// How tightly a light's cells are found (the default is the tight one; the other is kept
     /// to measure what it saves).
     pub coverage: Coverage,
-    /// Automatic mode: the largest share of the predicted frame time the CPU light assignment
-    /// may take (0.05: 5 %). Among the candidate grids whose predicted assignment stays within
-    /// it, the cheapest predicted frame wins; a finer grid that would save a little frame time
-    /// for much more CPU is not taken (near its optimum the frame time barely changes with the
-    /// footprint, while the assignment's time grows about as the inverse square of it). The CPU
-    /// a game spends here is taken from its own work, and on a phone the GPU's frame does not
-    /// pay it back. 1 (or more) leaves the frame time alone to decide; when no candidate fits,
-    /// the cheapest predicted frame wins. A finite value from 0 up: the renderer refuses a
-    /// NaN, infinite or negative one naming `grid.assign_budget` (in the fixed mode too, which
-    /// otherwise ignores it).
-    pub assign_budget: f64,
 }
 
 /// Who picks the cell footprint.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum GridMode {
     /// The clustered method measures candidate footprints against a cost model calibrated on
     /// the device and switches with hysteresis (docs/grid.md).
-    #[default]
-    Auto,
+    Auto {
+        /// The largest share of the predicted frame time the CPU light assignment may take
+        /// (0.05: 5 %). Among the candidate grids whose predicted assignment stays within it,
+        /// the cheapest predicted frame wins; a finer grid that would save a little frame time
+        /// for much more CPU is not taken (the CPU a game spends here is taken from its own
+        /// work, and on a phone the GPU's frame does not pay it back). 1 (or more) leaves the
+        /// frame time alone to decide; when no candidate fits, the cheapest predicted frame
+        /// wins. A finite value from 0 up: the renderer refuses others naming
+        /// `grid.assign_budget`.
+        assign_budget: f64,
+    },
     /// Always `footprint_px` (tests, and users who want one grid).
     Fixed,
+}
+
+impl Default for GridMode {
+    fn default() -> Self {
+        GridMode::Auto {
+            assign_budget: DEFAULT_ASSIGN_BUDGET,
+        }
+    }
 }
 
 /// How the assignment bounds the cells a light's sphere reaches.
@@ -87,7 +93,7 @@ pub enum Coverage {
 impl Default for GridConfig {
     fn default() -> Self {
         GridConfig {
-            mode: GridMode::Auto,
+            mode: GridMode::default(),
             cascades: 12,
             footprint_px: 64.0,
             slice_depth: 1.0,
@@ -96,12 +102,25 @@ impl Default for GridConfig {
             max_slices: 32,
             max_tiles: 256,
             coverage: Coverage::default(),
-            assign_budget: DEFAULT_ASSIGN_BUDGET,
         }
     }
 }
 
 impl GridConfig {
+    /// The automatic mode's CPU budget ([`GridMode::Auto`]); the default one for a fixed grid,
+    /// which has none.
+    pub fn assign_budget(&self) -> f64 {
+        match self.mode {
+            GridMode::Auto { assign_budget } => assign_budget,
+            GridMode::Fixed => DEFAULT_ASSIGN_BUDGET,
+        }
+    }
+
+    /// Whether the clustered method picks the footprint itself.
+    pub fn is_auto(&self) -> bool {
+        matches!(self.mode, GridMode::Auto { .. })
+    }
+
     /// A fixed grid of `footprint_px` with the other settings at their defaults.
     pub fn fixed(footprint_px: f64) -> Self {
         GridConfig {
@@ -123,7 +142,6 @@ impl GridConfig {
             max_slices: 1,
             max_tiles: 1024,
             coverage: Coverage::default(),
-            assign_budget: DEFAULT_ASSIGN_BUDGET,
         }
     }
 }

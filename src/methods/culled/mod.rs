@@ -29,7 +29,7 @@ use super::geometry;
 use super::grid_choice::AutoGrid;
 use super::GridReport;
 use super::{FrameContext, MethodStats, ShadingMethod};
-use crate::cluster::grid::{ClusterGrid, GridMode};
+use crate::cluster::grid::ClusterGrid;
 use crate::cluster::pack::{GridEncoding, RGBA8_CELL_CAP};
 use crate::gl::Device;
 use crate::Error;
@@ -48,7 +48,7 @@ pub struct CulledForward {
     culling: Culling,
     /// The grid and what it was built for.
     grid: Option<(grid::GridKey, ClusterGrid)>,
-    /// The automatic grid's choice and calibration (clustered, [`GridMode::Auto`]).
+    /// The automatic grid's choice and calibration (clustered, `GridMode::Auto`).
     auto: AutoGrid,
     /// Why a tiled or fixed grid is what it is (the automatic grid keeps its own reason).
     reason: String,
@@ -73,7 +73,7 @@ impl CulledForward {
 
     /// Whether this frame's grid is the automatic one.
     fn automatic(&self, ctx: &FrameContext) -> bool {
-        self.culling == Culling::Clustered && ctx.options.grid.mode == GridMode::Auto
+        self.culling == Culling::Clustered && ctx.options.grid.is_auto()
     }
 }
 

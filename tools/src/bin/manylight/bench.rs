@@ -230,7 +230,7 @@ fn knobs(quick: bool) -> Vec<Knob> {
     add(
         "assign_budget",
         "clustered",
-        |o, v| o.grid.assign_budget = v,
+        |o, v| o.grid.mode = manylight::GridMode::Auto { assign_budget: v },
         pick(&[1.0], &[]),
     );
     // Slices half as deep as a cell is wide: on the automatic grid, and on the finest fixed

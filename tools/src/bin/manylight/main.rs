@@ -105,6 +105,21 @@ fn check_usage(cli: &Cli) {
             )
             .exit();
     }
+    let render = match &cli.command {
+        None => Some(&cli.render),
+        Some(Command::Render(a)) => Some(a),
+        _ => None,
+    };
+    if let Some(a) = render.filter(|a| a.assign_budget.is_some()) {
+        if let render::GridArg::Fixed(_) = a.grid {
+            Cli::command()
+                .error(
+                    ErrorKind::ArgumentConflict,
+                    "--assign-budget is the automatic grid's CPU budget: a fixed --grid has none",
+                )
+                .exit();
+        }
+    }
     #[cfg(feature = "window")]
     if !cli.gles_lib.is_empty() && matches!(cli.command, Some(Command::View(_))) {
         Cli::command()

@@ -85,10 +85,11 @@ pub struct RenderArgs {
     /// seen at a grazing angle, at twice the cells).
     #[arg(long, default_value_t = 1.0, value_parser = parse_slice_depth, allow_hyphen_values = true)]
     pub slice_depth: f64,
-    /// With `--grid auto`: the largest share of the predicted frame time the CPU light
-    /// assignment may take (0.05: 5 %; 1 lets the frame time alone decide).
-    #[arg(long, default_value_t = manylight::cluster::grid::DEFAULT_ASSIGN_BUDGET, value_parser = parse_assign_budget, allow_hyphen_values = true)]
-    pub assign_budget: f64,
+    /// With `--grid auto` (a fixed grid has none): the largest share of the predicted frame
+    /// time the CPU light assignment may take (default 0.05: 5 %; 1 lets the frame time alone
+    /// decide).
+    #[arg(long, value_parser = parse_assign_budget, allow_hyphen_values = true)]
+    pub assign_budget: Option<f64>,
 }
 
 /// `--tonemap`.
@@ -226,12 +227,18 @@ pub fn run(args: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
         tone_map: args.tonemap.into(),
         samples: args.msaa,
         exposure_ev: args.exposure,
-        grid: manylight::cluster::grid::GridConfig {
+        grid: manylight::GridConfig {
             slice_depth: args.slice_depth,
-            assign_budget: args.assign_budget,
             ..match args.grid {
-                GridArg::Auto => manylight::cluster::grid::GridConfig::default(),
-                GridArg::Fixed(px) => manylight::cluster::grid::GridConfig::fixed(px),
+                GridArg::Auto => manylight::GridConfig {
+                    mode: manylight::GridMode::Auto {
+                        assign_budget: args
+                            .assign_budget
+                            .unwrap_or(manylight::cluster::grid::DEFAULT_ASSIGN_BUDGET),
+                    },
+                    ..manylight::GridConfig::default()
+                },
+                GridArg::Fixed(px) => manylight::GridConfig::fixed(px),
             }
         },
         ..RenderOptions::default()
