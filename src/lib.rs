@@ -53,7 +53,7 @@ lab_modules!(cluster, error, gl, gpu_scene, methods, metrics, options, renderer,
 
 // The API a game uses: one path each, at the crate root.
 pub use cluster::assign::AssignStats;
-pub use cluster::grid::{Coverage, GridConfig, GridMode};
+pub use cluster::grid::{Coverage, GridConfig, GridMeasure, GridMode};
 pub use cluster::pack::LightEncoding;
 pub use error::Error;
 pub use gl::caps::Precision;

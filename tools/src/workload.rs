@@ -4,7 +4,7 @@
 use std::time::Instant;
 
 use manylight::cluster::assign::{AssignLimits, Assigner, Assignment};
-use manylight::cluster::grid::{ClusterGrid, GridConfig, GridProjection};
+use manylight::cluster::grid::{ClusterGrid, GridConfig, GridMeasure, GridProjection};
 use manylight::cluster::view_light::GpuLight;
 use manylight::scene;
 
@@ -39,7 +39,10 @@ impl AssignWorkload {
         // The grid this workload has always timed (64-pixel cells, never narrower than 1/64
         // of the depth range), so figures compare across versions.
         Self::view_with(count, seed, BENCH_SIZE, |near, far| GridConfig {
-            min_cell_size: Some((far - near) / 64.0),
+            measure: GridMeasure {
+                min_cell_size: Some((far - near) / 64.0),
+                ..GridMeasure::default()
+            },
             ..GridConfig::fixed(64.0)
         })
     }

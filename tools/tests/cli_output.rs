@@ -160,5 +160,8 @@ fn bench_assign_runs_what_runs_asks_and_says_how_many() {
 fn a_budget_for_a_fixed_grid_is_a_usage_error() {
     let dir = tempfile::tempdir().unwrap();
     let msg = expect(&["--grid", "16", "--assign-budget", "0.1"], dir.path(), 2);
-    assert!(msg.contains("--assign-budget") && msg.contains("fixed"), "{msg}");
+    assert!(
+        msg.contains("--assign-budget") && msg.contains("fixed"),
+        "{msg}"
+    );
 }

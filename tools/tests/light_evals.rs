@@ -222,7 +222,10 @@ fn tight_coverage_never_evaluates_more_than_the_cascade_box() {
         let evals = |gpu: &mut Gpu, coverage| {
             let options = RenderOptions {
                 grid: GridConfig {
-                    coverage,
+                    measure: manylight::GridMeasure {
+                        coverage,
+                        ..Default::default()
+                    },
                     ..GridConfig::fixed(footprint)
                 },
                 tile_px: footprint,

@@ -364,7 +364,6 @@ fn lights_on_cell_boundaries_and_one_ulp_either_side() {
 fn fine_grid() -> manylight::cluster::grid::GridConfig {
     manylight::cluster::grid::GridConfig {
         footprint_px: 8.0,
-        min_cell_size: Some(0.0),
         ..Default::default()
     }
 }
@@ -593,7 +592,6 @@ fn spot_cones_of_zero_half_and_179_degrees() {
     let fine = RenderOptions {
         grid: manylight::cluster::grid::GridConfig {
             footprint_px: 8.0,
-            min_cell_size: Some(0.0),
             ..Default::default()
         },
         tile_px: 8.0,

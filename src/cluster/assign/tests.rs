@@ -79,7 +79,6 @@ pub(super) fn cases() -> Vec<Case> {
             far: 30.0,
             config: GridConfig {
                 footprint_px: 8.0,
-                min_cell_size: Some(0.0),
                 ..GridConfig::default()
             },
         },
@@ -373,10 +372,8 @@ fn never_misses_where_a_light_barely_reaches() {
     let mut rng = Pcg64Mcg::seed_from_u64(99);
     for case in cases() {
         for coverage in [Coverage::SliceRows, Coverage::CascadeBox] {
-            let config = GridConfig {
-                coverage,
-                ..case.config.clone()
-            };
+            let mut config = case.config.clone();
+            config.measure.coverage = coverage;
             let grid = ClusterGrid::new(320, 180, case.projection, case.near, case.far, &config);
             let lights = lights_in_view(&mut rng, &grid, 300);
             let limits = AssignLimits {
@@ -425,10 +422,8 @@ fn slice_rows_are_a_subset_of_the_cascade_box() {
             ..Default::default()
         };
         let build = |coverage| {
-            let config = GridConfig {
-                coverage,
-                ..case.config.clone()
-            };
+            let mut config = case.config.clone();
+            config.measure.coverage = coverage;
             let grid = ClusterGrid::new(320, 180, case.projection, case.near, case.far, &config);
             assign(&grid, &lights, case.far, &limits)
         };

@@ -28,7 +28,7 @@ impl ClusterGrid {
             b: 0.0,
             cascades: Vec::new(),
             total_cells: 0,
-            coverage: config.coverage,
+            coverage: config.measure.coverage,
             ndc_scale: [0.0; 2],
             slice_frusta: Vec::new(),
             side_plane_norm: [0.0; 2],
@@ -61,7 +61,7 @@ impl ClusterGrid {
             near + 1.0
         };
         let c = config.cascades.clamp(1, super::MAX_CASCADES);
-        let min_cell = config.min_cell_size.unwrap_or(0.0).max(0.0);
+        let min_cell = config.measure.min_cell_size.unwrap_or(0.0).max(0.0);
         let split = config.first_split.filter(|d| d.is_finite());
         let slice_depth = if config.slice_depth.is_finite() {
             config.slice_depth.clamp(1.0 / 16.0, 16.0)
@@ -143,7 +143,7 @@ impl ClusterGrid {
         self.b = b;
         self.cascades = cascades;
         self.total_cells = first_cell;
-        self.coverage = config.coverage;
+        self.coverage = config.measure.coverage;
         self.ndc_scale = match projection {
             GridProjection::Perspective { tan_x, tan_y } => [1.0 / tan_x, 1.0 / tan_y],
             GridProjection::Orthographic { half_x, half_y } => [1.0 / half_x, 1.0 / half_y],

@@ -34,18 +34,27 @@ pub struct GridConfig {
     /// automatic mode sets it a little before the nearest surface, so no slice is spent on the
     /// empty space in front of the camera.
     pub first_split: Option<f64>,
-    /// Minimum cell width in world units at a cascade's near end; `None`: no minimum, every
-    /// cascade has cells of `footprint_px` (the grid starts at the first geometry, see
-    /// [`GridConfig::first_split`], so near cascades are not wasted on empty space).
-    pub min_cell_size: Option<f64>,
     /// Upper bound on slices per cascade (never above 255, what the ES 2.0 grid texture's byte
     /// holds).
     pub max_slices: u32,
     /// Upper bound on columns or rows of a cascade.
     pub max_tiles: u32,
+    /// Knobs kept to measure the grid against earlier designs; a game leaves them at their
+    /// defaults.
+    pub measure: GridMeasure,
+}
+
+/// The grid's measuring knobs ([`GridConfig::measure`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+pub struct GridMeasure {
     /// How tightly a light's cells are found (the default is the tight one; the other is kept
     /// to measure what it saves).
     pub coverage: Coverage,
+    /// Minimum cell width in world units at a cascade's near end; `None`: no minimum, every
+    /// cascade has cells of `footprint_px` (the grid starts at the first geometry, see
+    /// [`GridConfig::first_split`], so near cascades are not wasted on empty space). The
+    /// benchmarks' historical workload keeps its grid with it.
+    pub min_cell_size: Option<f64>,
 }
 
 /// Who picks the cell footprint.
@@ -98,10 +107,9 @@ impl Default for GridConfig {
             footprint_px: 64.0,
             slice_depth: 1.0,
             first_split: None,
-            min_cell_size: None,
             max_slices: 32,
             max_tiles: 256,
-            coverage: Coverage::default(),
+            measure: GridMeasure::default(),
         }
     }
 }
@@ -138,10 +146,9 @@ impl GridConfig {
             footprint_px: tile_px,
             slice_depth: 1.0,
             first_split: None,
-            min_cell_size: Some(0.0),
             max_slices: 1,
             max_tiles: 1024,
-            coverage: Coverage::default(),
+            measure: GridMeasure::default(),
         }
     }
 }

@@ -40,7 +40,9 @@ mod tables;
 #[cfg(test)]
 mod tests;
 
-pub use config::{Coverage, GridConfig, GridMode, DEFAULT_ASSIGN_BUDGET, MAX_CASCADES};
+pub use config::{
+    Coverage, GridConfig, GridMeasure, GridMode, DEFAULT_ASSIGN_BUDGET, MAX_CASCADES,
+};
 pub use projection::{DepthMapping, GridProjection};
 
 pub(crate) use spheres::SliceCells;

@@ -161,7 +161,10 @@ fn cells_are_roughly_cubical_or_clamped_to_the_minimum() {
         0.1,
         80.0,
         &GridConfig {
-            min_cell_size: Some(80.0 / 64.0),
+            measure: GridMeasure {
+                min_cell_size: Some(80.0 / 64.0),
+                ..GridMeasure::default()
+            },
             ..GridConfig::default()
         },
     );

@@ -42,7 +42,7 @@ impl CulledForward {
             Culling::Clustered => ctx.options.grid.clone(),
             // Tiled shares the clustered grid's coverage setting (to measure it).
             Culling::Tiled => GridConfig {
-                coverage: ctx.options.grid.coverage,
+                measure: ctx.options.grid.measure,
                 ..GridConfig::tiles(ctx.options.tile_px)
             },
         };

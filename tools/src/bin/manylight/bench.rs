@@ -256,7 +256,7 @@ fn knobs(quick: bool) -> Vec<Knob> {
     add(
         "coverage",
         "clustered",
-        |o, _| o.grid.coverage = Coverage::CascadeBox,
+        |o, _| o.grid.measure.coverage = Coverage::CascadeBox,
         pick(&[1.0], &[]),
     );
     // 4× MSAA against none: cost against edge error (ES 3.0; skipped where unsupported).
