@@ -287,11 +287,11 @@ impl Shell {
             log::info!(
                 "{} · {} lights · {}x{} · {:.1} ms/frame · assign {:.2} ms",
                 stats.method,
-                stats.lights,
+                stats.lights.total,
                 size.width,
                 size.height,
                 elapsed * 1e3 / f64::from(self.frames),
-                stats.assign_ms
+                stats.time.assign_ms
             );
             self.frames = 0;
             self.since = Instant::now();
