@@ -22,8 +22,7 @@
 //! the one forward shades (its interpolated position, kept as depth and window offset), not the
 //! point on the pixel centre's ray: an implementation that snaps vertices to 1/16 pixel
 //! (SwiftShader) puts them up to a few hundredths of a pixel apart, enough to change a pixel
-//! near a light by 11/255. Rendering to float
-//! textures needs `GL_EXT_color_buffer_float`.
+//! near a light by 11/255. Rendering to float textures needs `GL_EXT_color_buffer_float`.
 #![allow(unsafe_code)]
 
 use glow::HasContext;

@@ -1,5 +1,5 @@
-//! Measures how the fragment stage really evaluates `mediump`: phones (and llvmpipe on this
-//! Mesa) use fp16, desktop drivers fp32. The stability tests use it as a canary, so they keep
+//! Measures how the fragment stage really evaluates `mediump`: phones (and llvmpipe) use fp16,
+//! desktop drivers fp32. The stability tests use it as a canary, so they keep
 //! testing fp16 behaviour rather than silently passing on an fp32 driver.
 #![allow(unsafe_code)]
 

@@ -11,9 +11,9 @@
 //! and 3.0 alike.
 //!
 //! A query is only as good as the driver's: llvmpipe reports the whole frame for plain forward
-//! but a few milliseconds for tiled and clustered frames that take 75 ms by the wall clock
-//! (their per-frame texture uploads split llvmpipe's work, and the query sees only part), so
-//! on llvmpipe the wall-clock `frame_ms` is the figure to quote.
+//! but only part of a tiled or clustered frame (their per-frame texture uploads split
+//! llvmpipe's work, and the query sees only part), so on llvmpipe the wall-clock `frame_ms` is
+//! the figure to quote.
 #![allow(unsafe_code)]
 
 use std::cell::Cell;

@@ -14,8 +14,8 @@
 //!    forward shading.
 //!
 //! The G-buffer keeps float normals, depth and 11-bit albedo/specular, so deferred matches plain
-//! forward within 2/255 (tested); its cost is memory and bandwidth: 44 or 52 bytes per pixel
-//! (`gl::gbuffer`).
+//! forward within 2/255 (tested); its cost is memory and bandwidth: 52 bytes per pixel, 44
+//! without `GL_EXT_float_blend` (`gl::gbuffer`).
 
 use glam::{Mat4, Vec3, Vec4};
 
@@ -250,10 +250,9 @@ impl Deferred {
             // - reaching the near plane (the eye inside or beside it), whose near side would be
             //   clipped: the far side, GEQUAL — surfaces behind the whole sphere are skipped;
             // - that far side reaching the far plane too: a full-screen triangle.
-            // Each is one-sided (no stencil). The far side everywhere would skip more on the
-            // courtyard (13 evaluations per pixel against 35 at 1 024 lights) but more than
-            // doubles them in the conference room (43 against 24); this rule is never worse
-            // than the near side with full-screen passes it replaced (courtyard 131).
+            // Each is one-sided (no stencil). The far side everywhere would skip more in open
+            // scenes but evaluate far more in enclosed ones (the conference room); the near
+            // side first avoids that worst case.
             let depth = -light.position.z;
             let (shader, mesh, cull, depth_test) = if depth - radius >= 2.0 * ctx.near as f32 {
                 (

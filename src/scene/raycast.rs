@@ -3,9 +3,10 @@
 //! surface a pixel sees.
 //!
 //! The acceleration structure is a bounding volume hierarchy built by median split of the
-//! triangle centroids along the widest axis (about 0.15 s for the 331 179-triangle conference
-//! room; trace quality matters little for the few thousand rays a reference casts). Traversal is iterative, nearer child first, and the ray test is Möller–Trumbore
-//! with both faces accepted (the renderer draws surfaces two-sided).
+//! triangle centroids along the widest axis (quick to build; trace quality matters little for
+//! the few thousand rays a reference casts). Traversal is iterative, nearer child first, and
+//! the ray test is Möller–Trumbore with both faces accepted (the renderer draws surfaces
+//! two-sided).
 
 use glam::{DMat3, DVec3, DVec4};
 

@@ -9,7 +9,7 @@ use manylight::cluster::view_light::GpuLight;
 use manylight::scene;
 
 /// Untimed assignments before [`AssignWorkload::time`] measures: a cold core (clock, caches,
-/// branch predictors) took 0.16 ms for what takes 0.09 ms warm.
+/// branch predictors) is markedly slower than a warm one.
 pub const WARM_UP: std::time::Duration = std::time::Duration::from_millis(100);
 
 /// Viewport of the benchmark view.

@@ -24,8 +24,8 @@ impl Bands {
     /// The work is what the last assignment measured when it was to a grid of as many cells
     /// and slices in as many bands: each band's time spread evenly over its cells. So the
     /// bands follow the work from frame to frame whatever it is made of (per-light setup for
-    /// many small lights, per-index scatter for a fine grid), which a fixed measure does not:
-    /// split by indices, 65 536 small lights ran at half the speed-up of a split by lights.
+    /// many small lights, per-index scatter for a fine grid), which a fixed measure does not
+    /// (a split by indices misjudges many small lights, a split by lights a fine grid).
     /// Failing that, the last assignment's indices, else cells. Only the speed depends on
     /// where the bands are cut, never the lists.
     fn split(&mut self, grid: &ClusterGrid, threads: usize, out: &Assignment) {

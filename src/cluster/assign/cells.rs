@@ -193,8 +193,8 @@ pub(crate) fn for_each_run_in(
         let small = columns.1 - columns.0 < 2 && rows.1 - rows.0 < 2;
         if small && small_path_enabled() {
             // The common case of many small lights, kept to the plain loops: with the
-            // refinement's code in the same loop the compiler spilled and called per row,
-            // which cost a small light about 7 ns more (a fifth).
+            // refinement's code in the same loop the compiler spills registers and calls per
+            // row.
             let width = columns.1 - columns.0 + 1;
             let mut run = slice_start + rows.0 * cascade.tiles_x + columns.0;
             let two_rows = rows.1 > rows.0;

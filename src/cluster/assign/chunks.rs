@@ -157,9 +157,9 @@ impl Chunk {
     /// goes). Light order is kept, so every cell's list is ascending.
     ///
     /// `self.cursor` has one entry past the cells, pointing at a spare last entry of `out`:
-    /// a run of one or two cells (nine in ten with many small lights) writes two entries,
+    /// a run of one or two cells (most runs with many small lights) writes two entries,
     /// the second into the spare one when the run has one cell, instead of looping — how
-    /// many cells a run has is what a branch predictor cannot learn (16 % off the scatter).
+    /// many cells a run has is what a branch predictor cannot learn.
     fn scatter<T: LightIndex>(&mut self, first_id: u32, out: &mut [T]) {
         let spare = self.cursor.len() - 1;
         let mut id = first_id;

@@ -21,24 +21,22 @@
 //! ```
 //!
 //! Why two: a fine grid gives each light hundreds of cells, and merging chunks cell by cell
-//! (with a second copy of the list) was a third of its time, which bands do not pay; with
+//! (with a second copy of the list) is a large share of the work, which bands do not pay; with
 //! many small lights each light's setup dominates, every band would look at every light, and
-//! chunks of lights share that work evenly (measured on the benchmark workloads: bands took
-//! the fine grid's 1 024 lights from 3.4 to 2.0 ms on two cores, chunks stay 1.2× faster at
-//! 65 536 lights on 5 172 cells).
+//! chunks of lights share that work evenly.
 //!
 //! An [`Assigner`] keeps its buffers between frames: after the first frame an assignment
-//! reuses every large buffer (the page faults of fresh buffers were a tenth of the time).
+//! reuses every large buffer, so it pays no page faults of fresh buffers.
 //!
 //! **Overflow policy** (`overflow.rs`). A cell never holds more than `cell_cap` lights
-//! (the shader's loop bound on ES 2.0 and the count field of the grid texel): it keeps the
-//! `cell_cap` lights with the largest `max(radiance) / (1 + distance²)` to the cell centre (of
-//! equal ones, the earlier) and drops the rest, in one selection and one pass (no sort per
-//! cell). If the whole list would exceed `max_indices` (what the index texture holds), the
-//! per-cell cap is lowered to the largest that fits (a binary search over the counts). Nothing
-//! wraps and nothing reads out of range; every dropped light is counted in
-//! [`AssignStats::overflowed_lights`], and the image degrades by exactly those lights'
-//! contributions (measurable against plain forward).
+//! (in the renderer, the ES 2.0 shader's constant loop bound; on ES 3.0 only the index list
+//! bounds a cell): it keeps the `cell_cap` lights with the largest
+//! `max(radiance) / (1 + distance²)` to the cell centre (of equal ones, the earlier) and drops
+//! the rest, in one selection and one pass (no sort per cell). If the whole list would exceed
+//! `max_indices` (what the index texture holds), the per-cell cap is lowered to the largest
+//! that fits (a binary search over the counts). Nothing wraps and nothing reads out of range;
+//! every dropped light is counted in [`AssignStats::overflowed_lights`], and the image degrades
+//! by exactly those lights' contributions (measurable against plain forward).
 
 mod bands;
 pub mod cells;

@@ -83,9 +83,10 @@ thread_local! {
 }
 
 /// Moves the `cap` most important lights of every cell holding more to the front of its list,
-/// in ascending order (of equally important ones, the earlier). Each light's importance is computed once (the comparisons of a
-/// selection would otherwise recompute it, through two random reads, several times per
-/// entry: 4 M lights took 2 s), and cells are trimmed in parallel: their lists are disjoint.
+/// in ascending order (of equally important ones, the earlier). Each light's importance is
+/// computed once (the comparisons of a selection would otherwise recompute it, through two
+/// random reads, several times per entry), and cells are trimmed in parallel: their lists are
+/// disjoint.
 fn trim_overfull_cells(
     out: &mut Assignment,
     grid: &ClusterGrid,

@@ -4,9 +4,8 @@
 use super::index_list::IndexList;
 
 /// An assignment whose previous frame listed this many indices runs on all cores whatever its
-/// light count: fine grids give each light hundreds of cells, and at about 3 ns an index such
-/// a frame's work (a millisecond or more) dwarfs the tens of microseconds of waking rayon's
-/// workers.
+/// light count: fine grids give each light hundreds of cells, and scattering that many indices
+/// outweighs the cost of waking rayon's workers.
 pub const PARALLEL_INDICES: usize = 1 << 17;
 
 /// Most cells an assignment takes: its per-cell arrays (difference counts, counts, offsets,

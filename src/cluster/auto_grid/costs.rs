@@ -3,10 +3,9 @@
 //!
 //! Each figure is the median of the last [`CALIBRATION_WINDOW`] frames' nanoseconds per unit.
 //! A median, not a running mean: a frame's assignment swings with the pool threads' wake-up
-//! and the caches the frame before left (on the 2-core llvmpipe host its 95th percentile was
-//! 1.7× its median), and the first frames after a grid change pay page faults of buffers
-//! that grow; a mean of the few frames before the first calibrated choice took those for the
-//! typical frame and predicted the assignment 1.5× slower than its median.
+//! and the caches the frame before left, and the first frames after a grid change pay page
+//! faults of buffers that grow; a mean of the few frames before the first calibrated choice
+//! takes those for the typical frame and overpredicts the assignment.
 
 /// Frames whose per-unit costs make a figure (the median of the last this many).
 pub const CALIBRATION_WINDOW: usize = 9;
@@ -18,13 +17,9 @@ pub const INDEX_WEIGHT: f64 = 1.0 / 64.0;
 /// (a row of a slice: its chord, its columns, the cone's test, the run and its two
 /// difference counts), plus [`INDEX_WEIGHT`] for each index scattered and each cell counted.
 ///
-/// Fitted to the renderer's assignments on the courtyard (1 024 lights, 640×360, footprints
-/// 64 to 8 px, 30-frame medians, llvmpipe's 2-core host): the time follows the runs (about
-/// 25 ns each, two threads), within 15 % from 23 to 8 px, while indices and cells, 3 to 23 a
-/// run there, add little; the indices-plus-cells measure the model used before was off by
-/// −85 % to +42 % over the same grids, so its calibration at one grid mispredicted the others
-/// (the assignment per unit of a coarse grid is dearer). The small weight keeps grids of very
-/// long runs (huge lights) from looking free.
+/// Fitted to the renderer's assignments on the courtyard over footprints 64 to 8 px: the time
+/// follows the runs, while indices and cells add little, so a calibration at one grid predicts
+/// the others. The small weight keeps grids of very long runs (huge lights) from looking free.
 pub fn assign_work(runs: usize, indices: usize, cells: u32) -> f64 {
     runs as f64 + INDEX_WEIGHT * (indices as f64 + f64::from(cells))
 }

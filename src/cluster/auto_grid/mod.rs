@@ -2,9 +2,9 @@
 //! measured candidates.
 //!
 //! A finer grid makes every fragment loop over fewer lights but costs more assignment (more
-//! runs of cells to find, more indices and cells to count) and more bytes to upload; the best footprint depends on
-//! the resolution, the lights, the view and the device. So the choice is made by measuring, not
-//! by a constant:
+//! runs of cells to find, more indices and cells to count) and more bytes to upload; the best
+//! footprint depends on the resolution, the lights, the view and the device. So the choice is
+//! made by measuring, not by a constant:
 //!
 //! ```text
 //! predicted frame cost(f) = shade · E(f) · P  +  assign · work(f)  +  upload · bytes(f)

@@ -1,7 +1,7 @@
 //! The automatic grid's search over candidate footprints ([`super`]), whole in one call
-//! ([`choose`]) or one candidate per frame ([`ChoiceSearch::step`]): a re-choice that measured
-//! every candidate in one frame made that frame up to 2.5× its neighbours (seven assignments
-//! instead of one), a spike a game sees as a dropped frame.
+//! ([`choose`]) or one candidate per frame ([`ChoiceSearch::step`]): a re-choice that measures
+//! every candidate in one frame runs several assignments in it instead of one, a spike a game
+//! sees as a dropped frame.
 
 use super::choice::{better, Candidate, ChoiceInputs, GridChoice, SurfaceSamples};
 use super::choice::{first_split, CANDIDATE_FOOTPRINTS, CELL_BUDGET};

@@ -119,7 +119,7 @@ impl ClusterGrid {
                 }
                 DepthMapping::Linear => ((z_far - z_near) / slice.max(1e-300)).ceil(),
             };
-            // At most 255: the ES 2.0 grid texture stores a cascade's slice count in a byte.
+            // At most 255: the grid texture's cascade table stores a slice count in a byte.
             let slices = if slices.is_finite() { slices as u32 } else { 1 }
                 .clamp(1, config.max_slices.clamp(1, 255));
             let cascade = Cascade {

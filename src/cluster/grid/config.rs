@@ -39,7 +39,7 @@ pub struct GridConfig {
     pub max_slices: u32,
     /// Upper bound on columns or rows of a cascade.
     pub max_tiles: u32,
-    /// Knobs kept to measure the grid against earlier designs; a game leaves them at their
+    /// Knobs the benchmarks and tests measure the grid with; a game leaves them at their
     /// defaults.
     pub measure: GridMeasure,
 }
@@ -94,7 +94,7 @@ pub enum Coverage {
     /// columns that cross-section reaches inside the row.
     #[default]
     SliceRows,
-    /// One screen rectangle per cascade, every slice and row of it (earlier versions): kept
+    /// One screen rectangle per cascade, every slice and row of it: the looser bound, kept
     /// as a yardstick for the bench and the tests.
     CascadeBox,
 }

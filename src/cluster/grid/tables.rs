@@ -89,8 +89,8 @@ impl SliceLookup {
         let bucket = self.buckets[bucket as usize];
         // The first step without a branch and from the bucket's own entry (one load, not two
         // in a row): on all but the finest grids a bucket holds one boundary at most, and
-        // whether a depth lies past it is a coin toss that a branch predictor loses (the
-        // loop's test was the assignment's hottest line).
+        // whether a depth lies past it is a coin toss that a branch predictor loses, on the
+        // assignment's hot path.
         let mut g = bucket.first as usize + usize::from(d >= bucket.next_start);
         while d >= self.start[g + 1] {
             g += 1;

@@ -92,10 +92,8 @@ enum Frames {
     /// What `--frames` (or `--quick`) says.
     Fixed(u32),
     /// Nine, or three for a configuration whose first (untimed) frame took over
-    /// [`SLOW_FRAME_MS`]: the median of three let one slow pool wake-up decide a fast row's
-    /// assignment time about one row in five, while nine frames of every slow row made the
-    /// full sweep much longer (dev VM: 20 minutes with this split at 400 ms, 18 at 100 ms,
-    /// 16 with three frames everywhere).
+    /// [`SLOW_FRAME_MS`]: the median of three lets one slow pool wake-up decide a fast row's
+    /// assignment time, while nine frames of every slow row make the full sweep much longer.
     Adaptive,
 }
 
@@ -252,7 +250,7 @@ fn knobs(quick: bool) -> Vec<Knob> {
         },
         pick(&[0.5], &[]),
     );
-    // The per-cascade rectangle of earlier versions (1 = cascade box), automatic grid.
+    // The per-cascade rectangle (1 = cascade box), automatic grid: what the tight bound saves.
     add(
         "coverage",
         "clustered",
