@@ -13,7 +13,7 @@
 //! 5. `bind`: the textures and uniform values every program of the frame gets;
 //! 6. `draw` (here): the geometry pass, each program bound with them.
 //!
-//! Uploads are ring-buffered over [`upload::RING`] texture sets: a frame writes the set the GPU used
+//! Uploads are ring-buffered over `upload::RING` texture sets: a frame writes the set the GPU used
 //! `RING` frames ago, never one an in-flight frame may still read (drivers would otherwise stall
 //! or copy on a rewrite).
 
