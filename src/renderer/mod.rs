@@ -113,12 +113,15 @@ impl Renderer {
         Ok(crate::gl::precision_probe::mediump_is_fp16(&self.dev)?)
     }
 
-    /// GL objects the renderer holds now.
+    /// GL objects the renderer holds now (`lab`: the soak tests count them).
+    #[cfg(feature = "lab")]
     pub fn live_gl_objects(&self) -> crate::gl::device::LiveObjects {
         self.dev.live_objects()
     }
 
-    /// Every shader variant built so far: shader, feature bits and assembled source size.
+    /// Every shader variant built so far: shader, feature bits and assembled source size
+    /// (`lab`: `manylight info --scene`).
+    #[cfg(feature = "lab")]
     pub fn program_report(&self) -> Vec<crate::gl::program::ProgramInfo> {
         self.programs.report()
     }
@@ -175,7 +178,8 @@ impl Renderer {
     }
 
     /// The cell grid and light lists of the last tiled or clustered frame (for tests and
-    /// tools that check what the shader read); `None` for other methods.
+    /// tools that check what the shader read); `None` for other methods (`lab`).
+    #[cfg(feature = "lab")]
     pub fn last_light_lists(&self) -> Option<methods::LightLists<'_>> {
         self.method.light_lists()
     }
