@@ -7,7 +7,14 @@ fn dependencies() -> Vec<String> {
     let mut in_dependencies = false;
     let mut names = Vec::new();
     for line in manifest.lines().map(str::trim) {
-        if line.starts_with('[') {
+        if let Some(name) = line
+            .strip_prefix("[dependencies.")
+            .and_then(|rest| rest.strip_suffix(']'))
+        {
+            // The table form a published manifest uses.
+            names.push(name.trim_matches('"').to_string());
+            in_dependencies = false;
+        } else if line.starts_with('[') {
             in_dependencies = line == "[dependencies]";
         } else if in_dependencies && !line.is_empty() && !line.starts_with('#') {
             if let Some((name, _)) = line.split_once('=') {
