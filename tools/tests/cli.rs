@@ -4,38 +4,9 @@
 mod common;
 
 use std::path::Path;
-use std::process::{Command, Output};
+use std::process::Command;
 
-fn manylight(args: &[&str], env: &[(&str, &str)], cwd: &Path) -> Output {
-    let mut cmd = Command::new(env!("CARGO_BIN_EXE_manylight"));
-    cmd.args(args).current_dir(cwd);
-    for (k, v) in env {
-        cmd.env(k, v);
-    }
-    cmd.output().expect("run manylight")
-}
-
-fn text(out: &Output) -> String {
-    format!(
-        "{}{}",
-        String::from_utf8_lossy(&out.stdout),
-        String::from_utf8_lossy(&out.stderr)
-    )
-}
-
-/// Runs `manylight ARGS`, asserting its exit status, that its output names `needle`, and that
-/// nothing panicked; returns the output.
-fn expect_exit(args: &[&str], env: &[(&str, &str)], cwd: &Path, code: i32, needle: &str) -> String {
-    let out = manylight(args, env, cwd);
-    let msg = text(&out);
-    assert_eq!(out.status.code(), Some(code), "{args:?}: {msg}");
-    assert!(
-        msg.contains(needle),
-        "{args:?}: expected `{needle}` in: {msg}"
-    );
-    assert!(!msg.contains("panicked"), "{args:?} panicked: {msg}");
-    msg
-}
+use common::cli::{expect_exit, manylight, text};
 
 fn stats(path: &Path) -> serde_json::Value {
     serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()

@@ -1,31 +1,13 @@
 //! What the command line writes and says in the cases a newcomer met: files it should not
 //! write, timings that add up, messages that name the flag typed rather than a library field.
 
-use std::path::Path;
-use std::process::{Command, Output};
+mod common;
 
-fn manylight(args: &[&str], cwd: &Path) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_manylight"))
-        .args(args)
-        .current_dir(cwd)
-        .output()
-        .expect("run manylight")
-}
+use common::cli::expect_status;
 
-fn text(out: &Output) -> String {
-    format!(
-        "{}{}",
-        String::from_utf8_lossy(&out.stdout),
-        String::from_utf8_lossy(&out.stderr)
-    )
-}
-
-fn expect(args: &[&str], cwd: &Path, code: i32) -> String {
-    let out = manylight(args, cwd);
-    let msg = text(&out);
-    assert_eq!(out.status.code(), Some(code), "{args:?}: {msg}");
-    assert!(!msg.contains("panicked"), "{args:?}: {msg}");
-    msg
+/// [`expect_status`] without extra environment.
+fn expect(args: &[&str], cwd: &std::path::Path, code: i32) -> String {
+    expect_status(args, &[], cwd, code)
 }
 
 #[test]
