@@ -90,11 +90,14 @@ impl From<EsArg> for EsVersion {
 /// Usage errors clap's attributes cannot express, reported the way clap reports its own
 /// (exit status 2).
 fn check_usage(cli: &Cli) {
-    let no_highp_es = match &cli.command {
-        None => Some((cli.render.no_fragment_highp, cli.render.es)),
-        Some(Command::Render(a)) => Some((a.no_fragment_highp, a.es)),
-        Some(Command::Info(a)) => Some((a.no_fragment_highp, a.es)),
+    let render = match &cli.command {
+        None => Some(&cli.render),
+        Some(Command::Render(a)) => Some(a),
         _ => None,
+    };
+    let no_highp_es = match &cli.command {
+        Some(Command::Info(a)) => Some((a.no_fragment_highp, a.es)),
+        _ => render.map(|a| (a.no_fragment_highp, a.es)),
     };
     if let Some((true, EsArg::Three)) = no_highp_es {
         Cli::command()
@@ -105,11 +108,6 @@ fn check_usage(cli: &Cli) {
             )
             .exit();
     }
-    let render = match &cli.command {
-        None => Some(&cli.render),
-        Some(Command::Render(a)) => Some(a),
-        _ => None,
-    };
     if let Some(a) = render.filter(|a| a.assign_budget.is_some()) {
         if let render::GridArg::Fixed(_) = a.grid {
             Cli::command()
