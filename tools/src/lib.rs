@@ -8,6 +8,7 @@
 
 pub mod animated;
 pub mod heatmap;
+pub mod output;
 pub mod plot;
 pub mod report;
 pub mod sheet;

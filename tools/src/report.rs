@@ -13,6 +13,7 @@ use std::path::Path;
 
 use serde::Serialize;
 
+use crate::output;
 use crate::plot::{self, Chart, Marker, Series};
 use manylight::methods::{auto, METHODS};
 
@@ -179,8 +180,9 @@ pub fn write(report: &Report, dir: &Path) -> Result<(), String> {
     let io = |what: &str, e: &dyn std::fmt::Display| format!("cannot write {what}: {e}");
     std::fs::create_dir_all(dir).map_err(|e| io(&dir.display().to_string(), &e))?;
     let json = serde_json::to_string_pretty(report).map_err(|e| e.to_string())? + "\n";
-    std::fs::write(dir.join("report.json"), json).map_err(|e| io("report.json", &e))?;
-    std::fs::write(dir.join("report.md"), markdown(report)).map_err(|e| io("report.md", &e))?;
+    output::write_bytes(&dir.join("report.json"), json.as_bytes()).map_err(|e| e.to_string())?;
+    output::write_bytes(&dir.join("report.md"), markdown(report).as_bytes())
+        .map_err(|e| e.to_string())?;
     for scene in distinct(report.rows.iter().map(|r| r.scene.as_str())) {
         let lights = workload_lights(report, scene);
         let charts = [
@@ -189,9 +191,8 @@ pub fn write(report: &Report, dir: &Path) -> Result<(), String> {
         ];
         for (base, chart) in CHARTS.iter().zip(charts) {
             let name = chart_file(base, scene);
-            plot::render(&chart, 960, 640)?
-                .save(dir.join(&name))
-                .map_err(|e| io(&name, &e))?;
+            let picture = plot::render(&chart, 960, 640)?;
+            output::save_png(&dir.join(&name), &picture).map_err(|e| e.to_string())?;
         }
     }
     Ok(())

@@ -693,6 +693,7 @@ fn write_pictures(
     out: &std::path::Path,
 ) -> Result<Pictures, Box<dyn std::error::Error>> {
     use manylight_tools::heatmap::{self, Scale};
+    use manylight_tools::output::save_png;
     std::fs::create_dir_all(out)?;
     let (scene, es, lights) = (at.scene, format!("{}.0", at.es.major()), at.lights);
     let maps = std::iter::once(("lower-bound", &base.bound))
@@ -720,8 +721,8 @@ fn write_pictures(
             scale.max()
         );
         let file = report::heatmap_file(scene, &es, name);
-        heatmap::heatmap(&c.counts, &c.covered, c.width, c.height, scale, &title)
-            .save(out.join(&file))?;
+        let map = heatmap::heatmap(&c.counts, &c.covered, c.width, c.height, scale, &title);
+        save_png(&out.join(&file), &map)?;
         pictures.heatmaps.push((name.to_string(), file));
     }
     for (name, m) in measured {
@@ -729,10 +730,10 @@ fn write_pictures(
             "{name} vs reference (forward, all lights, highp): {scene}, ES {es}, {lights} lights."
         );
         let file = report::diff_file(scene, &es, name);
-        heatmap::diff_image(&base.reference, &m.image, DIFF_FULL_SCALE, &what)
-            .save(out.join(&file))?;
+        let diff = heatmap::diff_image(&base.reference, &m.image, DIFF_FULL_SCALE, &what);
+        save_png(&out.join(&file), &diff)?;
         pictures.diffs.push((name.clone(), file));
     }
-    base.reference.save(out.join(&pictures.reference))?;
+    save_png(&out.join(&pictures.reference), &base.reference)?;
     Ok(pictures)
 }

@@ -1,6 +1,7 @@
 //! `manylight bench-assign`: light assignment alone on the default view, for scripts.
 
 use clap::Parser;
+use manylight_tools::output::print_stdout;
 use manylight_tools::workload::{AssignWorkload, BENCH_SIZE, MAX_RUNS};
 
 /// Options of `manylight bench-assign`.
@@ -65,19 +66,19 @@ pub fn run(args: &BenchAssignArgs) -> Result<(), Box<dyn std::error::Error>> {
             "runs": runs,
         }));
         if !args.json {
-            println!(
-                "{count:>9} lights  {ms:>9.3} ms  {indices:>9} indices  (median of {runs} runs)"
-            );
+            print_stdout(&format!(
+                "{count:>9} lights  {ms:>9.3} ms  {indices:>9} indices  (median of {runs} runs)\n"
+            ))?;
         }
     }
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&rows)?);
+        print_stdout(&(serde_json::to_string_pretty(&rows)? + "\n"))?;
     } else {
         let (w, h) = BENCH_SIZE;
-        println!(
-            "default view ({w}x{h}), {} threads available, LP_NUM_THREADS does not apply (CPU only)",
+        print_stdout(&format!(
+            "default view ({w}x{h}), {} threads available, LP_NUM_THREADS does not apply (CPU only)\n",
             std::thread::available_parallelism().map_or(1, |n| n.get())
-        );
+        ))?;
     }
     Ok(())
 }

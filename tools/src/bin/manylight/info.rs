@@ -4,6 +4,7 @@ use clap::Parser;
 use manylight::gl::{Caps, HeadlessContext};
 use manylight::methods::{ShaderFeatures, Support, METHODS};
 use manylight::Renderer;
+use manylight_tools::output::print_stdout;
 
 use crate::EsArg;
 
@@ -98,7 +99,7 @@ pub fn run(args: &InfoArgs) -> Result<(), Box<dyn std::error::Error>> {
             "scene": report,
             "methods": methods.iter().map(|(name, s)| serde_json::json!({"name": name, "support": s})).collect::<Vec<_>>(),
         });
-        print_stdout(&(serde_json::to_string_pretty(&value)? + "\n"));
+        print_stdout(&(serde_json::to_string_pretty(&value)? + "\n"))?;
     } else {
         let mut text = format_text(&caps, ctx.info(), &methods, args.extensions);
         text.push_str(&format!(
@@ -112,15 +113,9 @@ pub fn run(args: &InfoArgs) -> Result<(), Box<dyn std::error::Error>> {
         if let Some(r) = &report {
             text.push_str(&format_scene_report(r));
         }
-        print_stdout(&text);
+        print_stdout(&text)?;
     }
     Ok(())
-}
-
-/// Writes to stdout, treating a closed pipe (`manylight info | head`) as the end, not a panic.
-fn print_stdout(text: &str) {
-    use std::io::Write;
-    let _ = std::io::stdout().lock().write_all(text.as_bytes());
 }
 
 /// `writeln!` into a String (cannot fail).

@@ -18,6 +18,7 @@ use clap::Parser;
 use manylight::gl::HeadlessContext;
 use manylight::methods::{Support, METHODS};
 use manylight::{scene, EsVersion, RenderOptions, Renderer};
+use manylight_tools::output::{self, print_stdout, OutputFile};
 use serde_json::{json, Value};
 
 use crate::EsArg;
@@ -154,6 +155,12 @@ pub fn run(args: &MatrixArgs, gles_libs: &[PathBuf]) -> Result<(), Box<dyn std::
     let exe = std::env::current_exe()?;
     let out = args.out.clone().unwrap_or_else(std::env::temp_dir);
     std::fs::create_dir_all(&out).map_err(|e| format!("cannot create {}: {e}", out.display()))?;
+    let json_file = args.json.as_deref().map(OutputFile::create).transpose()?;
+    let sheet_file = args
+        .out
+        .is_some()
+        .then(|| OutputFile::create(&out.join("matrix.png")))
+        .transpose()?;
     let size = format!("{}x{}", args.size.0, args.size.1);
     let system = [PathBuf::from("system")];
     let groups = if gles_libs.is_empty() {
@@ -166,18 +173,14 @@ pub fn run(args: &MatrixArgs, gles_libs: &[PathBuf]) -> Result<(), Box<dyn std::
         let lib = (lib != Path::new("system")).then_some(lib.as_path());
         rows.extend(group_rows(&exe, args, &size, &out, lib, g)?);
     }
-    print!("{}", markdown(&rows));
-    if let Some(path) = &args.json {
-        std::fs::write(path, serde_json::to_string_pretty(&rows)? + "\n")
-            .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+    print_stdout(&markdown(&rows))?;
+    if let Some(file) = json_file {
+        file.commit_bytes((serde_json::to_string_pretty(&rows)? + "\n").as_bytes())?;
     }
-    if args.out.is_some() {
-        let sheet = sheet(&rows, &out);
-        let path = out.join("matrix.png");
-        sheet
-            .save(&path)
-            .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
-        eprintln!("contact sheet: {}", path.display());
+    if let Some(file) = sheet_file {
+        let path = file.path().display().to_string();
+        file.commit_png(&sheet(&rows, &out))?;
+        eprintln!("contact sheet: {path}");
     }
     Ok(())
 }
@@ -471,7 +474,7 @@ pub fn run_cell(args: &MatrixCellArgs) -> Result<(), Box<dyn std::error::Error>>
             let (img, stats) = renderer.render_offscreen(&scene, w, h, &opts)?;
             let d = manylight::metrics::diff(&reference, &img);
             let file = format!("{}-{}.png", args.tag, m.name);
-            img.save(args.out.join(&file))?;
+            output::save_png(&args.out.join(&file), &img)?;
             entry["max_abs"] = json!(d.max_abs);
             entry["over_2"] = json!(d.over_2);
             entry["frame_ms"] = json!(stats.time.frame_ms);
@@ -492,6 +495,6 @@ pub fn run_cell(args: &MatrixCellArgs) -> Result<(), Box<dyn std::error::Error>>
         "max_samples": caps.max_samples,
         "methods": methods,
     });
-    println!("{row}");
+    print_stdout(&format!("{row}\n"))?;
     Ok(())
 }

@@ -5,6 +5,7 @@ use std::path::PathBuf;
 use clap::Parser;
 use manylight::gl::HeadlessContext;
 use manylight::{scene, RenderOptions, Renderer};
+use manylight_tools::output::{print_stdout, OutputFile};
 
 use crate::EsArg;
 
@@ -208,6 +209,14 @@ pub fn run(args: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
     };
     // The loader logs each warning (at `warn`, shown by default): not printed again here.
     let (mut scene, _logged_warnings) = scene::load(&args.scene, lights)?;
+    let out = match (&args.out, &args.record) {
+        (Some(path), _) => Some(path.as_path()),
+        (None, None) => Some(std::path::Path::new(DEFAULT_OUT)),
+        (None, Some(_)) => None,
+    };
+    // Opened before rendering: a path that cannot be written fails now, not after the frames.
+    let out_file = out.map(OutputFile::create).transpose()?;
+    let stats_file = args.stats.as_deref().map(OutputFile::create).transpose()?;
     let es = args.es.into();
     let ctx = HeadlessContext::new(es)?;
     let restrictions = manylight::gl::Restrictions {
@@ -270,19 +279,11 @@ pub fn run(args: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
     };
     drop(renderer);
     let (image, stats) = result?;
-    let out = match (&args.out, &args.record) {
-        (Some(path), _) => Some(path.as_path()),
-        (None, None) => Some(std::path::Path::new(DEFAULT_OUT)),
-        (None, Some(_)) => None,
-    };
-    if let Some(out) = out {
-        image
-            .save(out)
-            .map_err(|e| format!("cannot write {}: {e}", out.display()))?;
+    if let Some(file) = out_file {
+        file.commit_png(&image)?;
     }
-    if let Some(path) = &args.stats {
-        std::fs::write(path, serde_json::to_string_pretty(&stats)? + "\n")
-            .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+    if let Some(file) = stats_file {
+        file.commit_bytes((serde_json::to_string_pretty(&stats)? + "\n").as_bytes())?;
     }
     // The slow frames too, where enough frames were timed for them to mean something.
     let mut tail = match stats.time.frame_ms_spread {
@@ -306,8 +307,8 @@ pub fn run(args: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
         _ => stats.method.clone(),
     };
     let written = out.map_or(String::new(), |p| format!(" → {}", p.display()));
-    println!(
-        "{} {}x{} · {method} · {} lights · {} on {} · {:.1} ms/frame{tail}{written}",
+    print_stdout(&format!(
+        "{} {}x{} · {method} · {} lights · {} on {} · {:.1} ms/frame{tail}{written}\n",
         args.scene,
         width,
         height,
@@ -315,6 +316,6 @@ pub fn run(args: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
         stats.context.es,
         stats.context.renderer,
         stats.time.frame_ms,
-    );
+    ))?;
     Ok(())
 }

@@ -2,9 +2,10 @@
 //! (p50/p95/p99/max of frame time, assignment time and upload bytes) and optionally recorded
 //! as a numbered PNG sequence or an animated GIF.
 
-use std::fs::File;
-use std::io::BufWriter;
+use std::cell::RefCell;
+use std::io::Write;
 use std::path::{Path, PathBuf};
+use std::rc::Rc;
 
 use image::codecs::gif::{GifEncoder, Repeat};
 use image::{Delay, Frame, RgbaImage};
@@ -12,6 +13,7 @@ use manylight::metrics::spread::Spread;
 use manylight::renderer::FrameStats;
 use manylight::scene::Scene;
 use manylight::{RenderOptions, Renderer};
+use manylight_tools::output::{self, OutputFile};
 
 /// When and how many frames.
 pub struct Timeline {
@@ -35,7 +37,22 @@ enum Recorder {
     /// `DIR/frame_00000.png` …
     Pngs { dir: PathBuf, digits: usize },
     /// One animated GIF.
-    Gif(Box<GifEncoder<BufWriter<File>>>, PathBuf),
+    Gif(Box<GifEncoder<SharedFile>>, SharedFile),
+}
+
+/// The GIF's file, shared with its encoder, which cannot hand its writer back: once the
+/// encoder is dropped (writing the trailer), the file is committed through the other handle.
+#[derive(Clone)]
+struct SharedFile(Rc<RefCell<OutputFile>>);
+
+impl Write for SharedFile {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        self.0.borrow_mut().write(buf)
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        self.0.borrow_mut().flush()
+    }
 }
 
 impl Recorder {
@@ -45,13 +62,13 @@ impl Recorder {
             .extension()
             .is_some_and(|e| e.eq_ignore_ascii_case("gif"));
         if is_gif {
-            let file = File::create(path)
-                .map_err(|e| format!("--record: cannot create {}: {e}", path.display()))?;
-            let mut encoder = GifEncoder::new_with_speed(BufWriter::new(file), 10);
+            let file = OutputFile::create(path).map_err(|e| format!("--record: {e}"))?;
+            let file = SharedFile(Rc::new(RefCell::new(file)));
+            let mut encoder = GifEncoder::new_with_speed(file.clone(), 10);
             encoder
                 .set_repeat(Repeat::Infinite)
                 .map_err(|e| format!("--record {}: {e}", path.display()))?;
-            return Ok(Recorder::Gif(Box::new(encoder), path.to_path_buf()));
+            return Ok(Recorder::Gif(Box::new(encoder), file));
         }
         std::fs::create_dir_all(path)
             .map_err(|e| format!("--record: cannot create {}: {e}", path.display()))?;
@@ -66,22 +83,33 @@ impl Recorder {
         match self {
             Recorder::Pngs { dir, digits } => {
                 let path = dir.join(format!("frame_{k:0width$}.png", width = *digits));
-                image
-                    .save(&path)
-                    .map_err(|e| format!("cannot write {}: {e}", path.display()))
+                output::save_png(&path, &image).map_err(|e| e.to_string())
             }
-            Recorder::Gif(encoder, path) => {
+            Recorder::Gif(encoder, file) => {
                 // GIF delays are whole hundredths of a second: each frame ends at the hundredth
                 // nearest its true end, so the rounding never adds up (30 fps: 3, 3, 4, …).
                 let end = |k: u32| (f64::from(k) * 100.0 / fps).round();
                 let centis = (end(k + 1) - end(k)).clamp(1.0, 65_535.0) as u32;
                 let frame =
                     Frame::from_parts(image, 0, 0, Delay::from_numer_denom_ms(centis * 10, 1));
-                encoder
-                    .encode_frame(frame)
-                    .map_err(|e| format!("cannot write {}: {e}", path.display()))
+                encoder.encode_frame(frame).map_err(|e| {
+                    let path = file.0.borrow().path().display().to_string();
+                    format!("cannot write {path}: {e}")
+                })
             }
         }
+    }
+
+    /// Completes the recording: the GIF's trailer written, its file flushed and put in place.
+    fn finish(self) -> Result<(), String> {
+        if let Recorder::Gif(encoder, file) = self {
+            drop(encoder);
+            let file = Rc::try_unwrap(file.0)
+                .ok()
+                .expect("the encoder held the only other handle");
+            file.into_inner().commit().map_err(|e| e.to_string())?;
+        }
+        Ok(())
     }
 }
 
@@ -134,9 +162,8 @@ pub fn render(
         }
         timed.push(s);
     }
-    if let Some(Recorder::Gif(encoder, _)) = recorder {
-        // Dropping the encoder writes the trailer; flush errors surface here.
-        drop(encoder);
+    if let Some(recorder) = recorder {
+        recorder.finish()?;
     }
     let upload = Spread::of(timed.iter().map(|s| s.memory.upload_bytes as f64));
     let mut stats = FrameStats::summarize(timed).unwrap_or(warm_up);

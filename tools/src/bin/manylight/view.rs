@@ -127,10 +127,10 @@ pub fn run(args: &ViewArgs) -> Result<(), Box<dyn std::error::Error>> {
         format!("{NO_DISPLAY} ({})", e.rsplit(": ").next().unwrap_or(&e))
     })?;
     event_loop.set_control_flow(ControlFlow::Poll);
-    println!(
-        "controls: WASD move, Q/E down/up, Shift faster, drag to look, 1-{} method, +/- lights, H heatmap, M MSAA, T tone map, Space pause, Esc quit",
+    manylight_tools::output::print_stdout(&format!(
+        "controls: WASD move, Q/E down/up, Shift faster, drag to look, 1-{} method, +/- lights, H heatmap, M MSAA, T tone map, Space pause, Esc quit\n",
         METHODS.len()
-    );
+    ))?;
     let mut app = App {
         args,
         light_count: lights.unwrap_or(scene.lights.len()),
@@ -440,12 +440,10 @@ impl App<'_> {
             );
             if let Some(path) = &self.args.screenshot {
                 let image = g.read_back(size)?;
-                image
-                    .save(path)
-                    .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+                manylight_tools::output::save_png(path, &image).map_err(|e| e.to_string())?;
                 line += &format!(" → {}", path.display());
             }
-            println!("{line}");
+            manylight_tools::output::print_stdout(&format!("{line}\n"))?;
             self.done = true;
             event_loop.exit();
         }

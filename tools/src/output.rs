@@ -1,0 +1,373 @@
+//! Writing the command line's files so that no failure is lost: every byte goes through a
+//! buffer that is flushed and synced, the first write error is kept even where an encoder
+//! swallows it (the GIF trailer), and every error names the file.
+//!
+//! A regular file is written to a hidden temporary file beside it (`.NAME.PID.N.tmp`) that is
+//! renamed over it once complete: a failure half-way (a full disk) leaves the old file, or
+//! none, never a truncated one that looks valid. A device, FIFO or socket, and any path under
+//! `/dev` or `/proc` (`/dev/stdout`, whatever it points at), is written in place.
+
+use std::ffi::OsString;
+use std::fs::{File, OpenOptions, Permissions};
+use std::io::{self, BufWriter, Write};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU32, Ordering};
+
+/// A file that could not be written, and why (the OS error).
+#[derive(Debug)]
+pub struct WriteError {
+    /// The file as the user named it.
+    pub path: PathBuf,
+    /// What the system said.
+    pub source: io::Error,
+}
+
+impl std::fmt::Display for WriteError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "cannot write {}: {}", self.path.display(), self.source)
+    }
+}
+
+impl std::error::Error for WriteError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        Some(&self.source)
+    }
+}
+
+/// An image in memory (RGBA or RGB, 8 bits a channel: what the command line writes).
+pub type Picture<P> = image::ImageBuffer<P, Vec<<P as image::Pixel>::Subpixel>>;
+
+/// Where the bytes go until [`OutputFile::commit`].
+enum Target {
+    /// A temporary file renamed over `dest` when complete (with `permissions`, those of the
+    /// file it replaces).
+    Replace {
+        temp: PathBuf,
+        dest: PathBuf,
+        permissions: Option<Permissions>,
+    },
+    /// A device, FIFO or socket, written in place.
+    InPlace,
+}
+
+/// An output file being written: [`Write`] into it, then [`OutputFile::commit`]. Dropped
+/// without a commit, it leaves the destination as it was.
+pub struct OutputFile {
+    path: PathBuf,
+    target: Target,
+    writer: Option<BufWriter<File>>,
+    /// The first write error, kept for [`OutputFile::commit`] even if the writer's caller
+    /// ignored it.
+    failed: Option<io::Error>,
+}
+
+/// Numbers the temporary files of one process.
+static TEMP_COUNTER: AtomicU32 = AtomicU32::new(0);
+
+impl OutputFile {
+    /// Opens `path` for writing: fails now, naming it, where it cannot be written (a folder, a
+    /// missing folder, a read-only file or folder).
+    pub fn create(path: &Path) -> Result<OutputFile, WriteError> {
+        let fail = |source| WriteError {
+            path: path.to_path_buf(),
+            source,
+        };
+        // An existing file is opened for writing (not truncated) to learn whether it may be
+        // written at all and what it is; a symbolic link is followed, and its target replaced.
+        let (target, file) = match OpenOptions::new().write(true).open(path) {
+            Ok(existing) => {
+                let meta = existing.metadata().map_err(fail)?;
+                if meta.is_file() && is_system_path(path) {
+                    // `/dev/stdout` redirected to a file: that file, truncated, as before.
+                    existing.set_len(0).map_err(fail)?;
+                    (Target::InPlace, existing)
+                } else if meta.is_file() {
+                    let dest = std::fs::canonicalize(path).map_err(fail)?;
+                    let (temp, file) = create_temp(&dest).map_err(fail)?;
+                    let permissions = Some(meta.permissions());
+                    (
+                        Target::Replace {
+                            temp,
+                            dest,
+                            permissions,
+                        },
+                        file,
+                    )
+                } else {
+                    (Target::InPlace, existing)
+                }
+            }
+            Err(e) if e.kind() == io::ErrorKind::NotFound => {
+                // A dangling link: its target is created, as `File::create` would.
+                let dest = follow_links(path);
+                let (temp, file) = create_temp(&dest).map_err(fail)?;
+                (
+                    Target::Replace {
+                        temp,
+                        dest,
+                        permissions: None,
+                    },
+                    file,
+                )
+            }
+            Err(e) => return Err(fail(e)),
+        };
+        Ok(OutputFile {
+            path: path.to_path_buf(),
+            target,
+            writer: Some(BufWriter::new(file)),
+            failed: None,
+        })
+    }
+
+    /// The file as the user named it.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// Flushes, syncs and puts the file in place; the first error met on the way, naming the
+    /// file.
+    pub fn commit(mut self) -> Result<(), WriteError> {
+        let result = self.finish();
+        result.map_err(|source| self.error(source))
+    }
+
+    fn finish(&mut self) -> io::Result<()> {
+        if let Some(e) = self.failed.take() {
+            return Err(e);
+        }
+        let writer = self.writer.take().expect("an output file commits once");
+        let file = writer.into_inner().map_err(|e| e.into_error())?;
+        if let Target::Replace {
+            temp,
+            dest,
+            permissions,
+        } = &mut self.target
+        {
+            // Synced before the rename, so the new name never points at unwritten data; a
+            // device or pipe has nothing to sync.
+            file.sync_all()?;
+            if let Some(p) = permissions.take() {
+                std::fs::set_permissions(&*temp, p)?;
+            }
+            std::fs::rename(&*temp, &*dest)?;
+            self.target = Target::InPlace;
+        }
+        Ok(())
+    }
+}
+
+impl Write for OutputFile {
+    fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
+        let writer = self.writer.as_mut().ok_or(io::ErrorKind::BrokenPipe)?;
+        writer.write(buf).inspect_err(|e| self.keep(e))
+    }
+
+    fn flush(&mut self) -> io::Result<()> {
+        let writer = self.writer.as_mut().ok_or(io::ErrorKind::BrokenPipe)?;
+        writer.flush().inspect_err(|e| self.keep(e))
+    }
+}
+
+impl OutputFile {
+    /// Keeps the first error (a copy: the caller gets the original).
+    fn keep(&mut self, e: &io::Error) {
+        if self.failed.is_none() {
+            self.failed = Some(match e.raw_os_error() {
+                Some(code) => io::Error::from_raw_os_error(code),
+                None => io::Error::new(e.kind(), e.to_string()),
+            });
+        }
+    }
+}
+
+impl Drop for OutputFile {
+    fn drop(&mut self) {
+        if let Target::Replace { temp, .. } = &self.target {
+            drop(self.writer.take());
+            let _ = std::fs::remove_file(temp);
+        }
+    }
+}
+
+/// Whether `path` is one of the system's names for a stream (`/dev/stdout`, `/proc/self/fd/1`):
+/// written in place, whatever it points at.
+fn is_system_path(path: &Path) -> bool {
+    path.starts_with("/dev") || path.starts_with("/proc")
+}
+
+/// `path` with symbolic links followed to the last one's target, which need not exist (at most
+/// 40 links, the system's own limit; past it, the last path reached).
+fn follow_links(path: &Path) -> PathBuf {
+    let mut path = path.to_path_buf();
+    for _ in 0..40 {
+        match std::fs::read_link(&path) {
+            Ok(target) => {
+                path = match path.parent() {
+                    Some(folder) => folder.join(target),
+                    None => target,
+                }
+            }
+            Err(_) => break,
+        }
+    }
+    path
+}
+
+/// Creates `.NAME.PID.N.tmp` beside `dest`, new (never an existing file).
+fn create_temp(dest: &Path) -> io::Result<(PathBuf, File)> {
+    let name = dest
+        .file_name()
+        .ok_or_else(|| io::Error::new(io::ErrorKind::InvalidInput, "the path names no file"))?;
+    let mut temp_name = OsString::from(".");
+    temp_name.push(name);
+    let n = TEMP_COUNTER.fetch_add(1, Ordering::Relaxed);
+    temp_name.push(format!(".{}.{n}.tmp", std::process::id()));
+    let temp = dest.with_file_name(temp_name);
+    let file = OpenOptions::new()
+        .write(true)
+        .create_new(true)
+        .open(&temp)?;
+    Ok((temp, file))
+}
+
+impl OutputFile {
+    /// Writes `bytes` and commits.
+    pub fn commit_bytes(mut self, bytes: &[u8]) -> Result<(), WriteError> {
+        match self.write_all(bytes) {
+            Ok(()) => self.commit(),
+            Err(source) => Err(self.error(source)),
+        }
+    }
+
+    /// Writes `image` as a PNG and commits.
+    pub fn commit_png<P>(mut self, image: &Picture<P>) -> Result<(), WriteError>
+    where
+        P: image::PixelWithColorType,
+        [P::Subpixel]: image::EncodableLayout,
+    {
+        let encoder = image::codecs::png::PngEncoder::new(&mut self);
+        match image.write_with_encoder(encoder) {
+            Ok(()) => self.commit(),
+            Err(e) => Err(self.error(image_to_io(e))),
+        }
+    }
+
+    fn error(&self, source: io::Error) -> WriteError {
+        WriteError {
+            path: self.path.clone(),
+            source,
+        }
+    }
+}
+
+/// Writes `bytes` to `path` (see the module's notes).
+pub fn write_bytes(path: &Path, bytes: &[u8]) -> Result<(), WriteError> {
+    OutputFile::create(path)?.commit_bytes(bytes)
+}
+
+/// Writes `image` to `path` as a PNG (see the module's notes).
+pub fn save_png<P>(path: &Path, image: &Picture<P>) -> Result<(), WriteError>
+where
+    P: image::PixelWithColorType,
+    [P::Subpixel]: image::EncodableLayout,
+{
+    OutputFile::create(path)?.commit_png(image)
+}
+
+/// The I/O error inside an image error, or the image error as one.
+fn image_to_io(e: image::ImageError) -> io::Error {
+    match e {
+        image::ImageError::IoError(e) => e,
+        other => io::Error::other(other.to_string()),
+    }
+}
+
+/// Writes `text` to standard output and flushes it. A closed pipe (`manylight info | head`)
+/// ends the output quietly; any other error (a full disk) is returned.
+pub fn print_stdout(text: &str) -> Result<(), String> {
+    let mut out = io::stdout().lock();
+    match out.write_all(text.as_bytes()).and_then(|()| out.flush()) {
+        Err(e) if e.kind() != io::ErrorKind::BrokenPipe => {
+            Err(format!("cannot write to standard output: {e}"))
+        }
+        _ => Ok(()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_complete_file_replaces_the_old_one_and_keeps_its_permissions() {
+        use std::os::unix::fs::PermissionsExt;
+        let tmp = tempfile::tempdir().unwrap();
+        let dir = tmp.path();
+        let path = dir.join("a.json");
+        std::fs::write(&path, "old").unwrap();
+        std::fs::set_permissions(&path, Permissions::from_mode(0o640)).unwrap();
+        write_bytes(&path, b"new").unwrap();
+        assert_eq!(std::fs::read(&path).unwrap(), b"new");
+        let mode = std::fs::metadata(&path).unwrap().permissions().mode();
+        assert_eq!(mode & 0o777, 0o640);
+        assert_eq!(
+            std::fs::read_dir(dir).unwrap().count(),
+            1,
+            "a temporary file is left"
+        );
+    }
+
+    #[test]
+    fn an_uncommitted_file_leaves_the_old_one_and_no_temporary_file() {
+        let tmp = tempfile::tempdir().unwrap();
+        let dir = tmp.path();
+        let path = dir.join("a.png");
+        std::fs::write(&path, "old").unwrap();
+        let mut file = OutputFile::create(&path).unwrap();
+        file.write_all(b"half").unwrap();
+        drop(file);
+        assert_eq!(std::fs::read(&path).unwrap(), b"old");
+        assert_eq!(std::fs::read_dir(dir).unwrap().count(), 1);
+    }
+
+    #[test]
+    fn a_symbolic_link_keeps_pointing_at_the_file_it_named() {
+        let tmp = tempfile::tempdir().unwrap();
+        let dir = tmp.path();
+        std::fs::write(dir.join("real.json"), "old").unwrap();
+        std::os::unix::fs::symlink("real.json", dir.join("link.json")).unwrap();
+        write_bytes(&dir.join("link.json"), b"new").unwrap();
+        assert!(std::fs::symlink_metadata(dir.join("link.json"))
+            .unwrap()
+            .file_type()
+            .is_symlink());
+        assert_eq!(std::fs::read(dir.join("real.json")).unwrap(), b"new");
+    }
+
+    #[test]
+    fn a_full_device_is_an_error_naming_it() {
+        let e = write_bytes(Path::new("/dev/full"), b"{}").unwrap_err();
+        assert_eq!(e.path, Path::new("/dev/full"));
+        assert_eq!(e.source.raw_os_error(), Some(28), "{e}");
+        // A caller that ignores a write error (the GIF encoder's trailer) still gets one.
+        let mut file = OutputFile::create(Path::new("/dev/full")).unwrap();
+        let _ = file.write_all(&[0; 64 * 1024]);
+        let _ = file.write_all(b"more");
+        let e = file.commit().unwrap_err();
+        assert!(e.to_string().contains("/dev/full"), "{e}");
+    }
+
+    #[test]
+    fn a_dangling_link_writes_its_target() {
+        let tmp = tempfile::tempdir().unwrap();
+        let dir = tmp.path();
+        std::os::unix::fs::symlink("new.json", dir.join("link.json")).unwrap();
+        write_bytes(&dir.join("link.json"), b"new").unwrap();
+        assert_eq!(std::fs::read(dir.join("new.json")).unwrap(), b"new");
+        assert!(std::fs::symlink_metadata(dir.join("link.json"))
+            .unwrap()
+            .file_type()
+            .is_symlink());
+    }
+}

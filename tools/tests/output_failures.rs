@@ -1,0 +1,200 @@
+//! Outputs that cannot be written: every file the command line writes (`--out`, `--stats`,
+//! `--record` frames and GIF, `matrix`'s JSON and contact sheet, `bench`'s report, charts and
+//! pictures, standard output) onto a full disk (`/dev/full`: ENOSPC on every write) or half
+//! written (a file-size limit). Each must end in a non-zero exit and a message naming the
+//! file, never a success line.
+
+mod common;
+
+use std::path::Path;
+use std::process::{Command, Stdio};
+
+use common::cli::{expect_exit, expect_status, text};
+
+/// A small, quick render: a few lights, one untimed frame.
+const TINY: [&str; 6] = ["--size", "16x9", "--lights", "4", "--frames", "0"];
+
+/// `args` after [`TINY`].
+fn tiny(args: &[&str]) -> Vec<String> {
+    TINY.iter().chain(args).map(|s| s.to_string()).collect()
+}
+
+fn strs(v: &[String]) -> Vec<&str> {
+    v.iter().map(String::as_str).collect()
+}
+
+/// `manylight ARGS` fails with exit 1, names `file` and prints no success line.
+fn fails_naming(args: &[&str], cwd: &Path, file: &str) -> String {
+    let msg = expect_exit(args, &[], cwd, 1, file);
+    assert!(!msg.contains("ms/frame"), "{args:?} claimed success: {msg}");
+    msg
+}
+
+#[test]
+fn every_render_output_onto_a_full_disk_fails_naming_the_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let cwd = dir.path();
+    std::os::unix::fs::symlink("/dev/full", cwd.join("full.gif")).unwrap();
+    std::fs::create_dir(cwd.join("frames")).unwrap();
+    std::os::unix::fs::symlink("/dev/full", cwd.join("frames/frame_00000.png")).unwrap();
+    // A picture far smaller than any write buffer: only a flush finds the full disk.
+    let msg = fails_naming(&strs(&tiny(&["--out", "/dev/full"])), cwd, "/dev/full");
+    assert!(msg.contains("No space left on device"), "{msg}");
+    let args = tiny(&["--out", "a.png", "--stats", "/dev/full"]);
+    fails_naming(&strs(&args), cwd, "/dev/full");
+    let args = [&TINY[..4], &["--frames", "2", "--record", "full.gif"]].concat();
+    fails_naming(&args, cwd, "full.gif");
+    let args = [&TINY[..4], &["--frames", "2", "--record", "frames"]].concat();
+    fails_naming(&args, cwd, "frame_00000.png");
+}
+
+#[test]
+fn every_bench_and_matrix_output_onto_a_full_disk_fails_naming_the_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let cwd = dir.path();
+    let bench = [
+        "bench",
+        "--scenes",
+        "plane",
+        "--lights",
+        "0",
+        "--methods",
+        "forward",
+        "--es",
+        "3",
+        "--size",
+        "16x9",
+        "--frames",
+        "1",
+        "--cpu-samples",
+        "1",
+        "--no-knobs",
+        "--animated-frames",
+        "0",
+        "--out",
+        "b",
+    ];
+    for file in [
+        "report.json",
+        "report.md",
+        "error_vs_time-plane.png",
+        "heatmap-plane-es3-forward.png",
+        "diff-plane-es3-forward.png",
+        "reference-plane-es3.png",
+    ] {
+        let _ = std::fs::remove_dir_all(cwd.join("b"));
+        std::fs::create_dir(cwd.join("b")).unwrap();
+        std::os::unix::fs::symlink("/dev/full", cwd.join("b").join(file)).unwrap();
+        fails_naming(&bench, cwd, file);
+    }
+    let matrix = ["matrix", "--size", "16x9", "--lights", "4"];
+    fails_naming(
+        &[&matrix[..], &["--json", "/dev/full"]].concat(),
+        cwd,
+        "/dev/full",
+    );
+    std::fs::create_dir(cwd.join("m")).unwrap();
+    std::os::unix::fs::symlink("/dev/full", cwd.join("m/matrix.png")).unwrap();
+    fails_naming(&[&matrix[..], &["--out", "m"]].concat(), cwd, "matrix.png");
+}
+
+#[test]
+fn standard_output_onto_a_full_disk_fails_but_a_closed_pipe_does_not() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = |args: &[&str], stdout: Stdio| {
+        Command::new(env!("CARGO_BIN_EXE_manylight"))
+            .args(args)
+            .current_dir(dir.path())
+            .stdout(stdout)
+            .output()
+            .unwrap()
+    };
+    let full = || Stdio::from(std::fs::File::create("/dev/full").unwrap());
+    let cases: [&[&str]; 4] = [
+        &["--size", "16x9", "--lights", "4", "--frames", "0"],
+        &["info", "--json"],
+        &["info"],
+        &["bench-assign", "--lights", "1", "--runs", "1"],
+    ];
+    for args in cases {
+        let out = run(args, full());
+        let msg = text(&out);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {msg}");
+        assert!(
+            msg.contains("cannot write to standard output"),
+            "{args:?}: {msg}"
+        );
+        assert!(!msg.contains("panicked"), "{args:?}: {msg}");
+    }
+    // `--stats /dev/stdout | jq`: the statistics, then the success line, into the pipe.
+    let args = [
+        "--size",
+        "16x9",
+        "--lights",
+        "4",
+        "--frames",
+        "0",
+        "--stats",
+        "/dev/stdout",
+    ];
+    let out = run(&args, Stdio::piped());
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{}", text(&out));
+    assert!(
+        stdout.starts_with('{') && stdout.contains("\"method\"") && stdout.contains("ms/frame")
+    );
+    // `manylight info | head -c 1`: the reader leaving ends the output, not in an error.
+    let mut child = Command::new(env!("CARGO_BIN_EXE_manylight"))
+        .args(["info"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    let out = child.wait_with_output().unwrap();
+    assert!(!String::from_utf8_lossy(&out.stderr).contains("panicked"));
+}
+
+/// Runs `manylight ARGS` with its file size limited to `kib` KiB (writes past it fail with
+/// EFBIG instead of killing the process).
+fn with_file_size_limit(args: &[&str], cwd: &Path, kib: u32) -> std::process::Output {
+    let script = format!("trap '' XFSZ; ulimit -f {}; exec \"$0\" \"$@\"", kib * 2);
+    Command::new("sh")
+        .arg("-c")
+        .arg(script)
+        .arg(env!("CARGO_BIN_EXE_manylight"))
+        .args(args)
+        .current_dir(cwd)
+        .output()
+        .unwrap()
+}
+
+#[test]
+fn an_output_failing_half_way_leaves_the_old_file_whole_and_no_partial_one() {
+    let dir = tempfile::tempdir().unwrap();
+    let cwd = dir.path();
+    std::fs::write(cwd.join("a.png"), "the old picture").unwrap();
+    // `ulimit -f` counts 512-byte blocks in sh: 1 KiB, less than the picture.
+    let args: Vec<String> = ["--size", "256x144", "--lights", "64", "--frames", "0"]
+        .iter()
+        .chain(&["--out", "a.png"])
+        .map(|s| s.to_string())
+        .collect();
+    let out = with_file_size_limit(&strs(&args), cwd, 1);
+    let msg = text(&out);
+    assert_eq!(out.status.code(), Some(1), "{msg}");
+    assert!(msg.contains("cannot write a.png"), "{msg}");
+    assert!(msg.contains("File too large"), "{msg}");
+    assert_eq!(
+        std::fs::read(cwd.join("a.png")).unwrap(),
+        b"the old picture"
+    );
+    let left: Vec<_> = std::fs::read_dir(cwd)
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(left, ["a.png"], "a temporary file was left");
+    // Without the limit the same command replaces it with a whole picture.
+    expect_status(&strs(&args), &[], cwd, 0);
+    image::open(cwd.join("a.png")).expect("a whole PNG");
+}
