@@ -295,6 +295,23 @@ pub fn print_stdout(text: &str) -> Result<(), String> {
     }
 }
 
+/// The file `path` names, spelled one way: symbolic links resolved, `.` and `..` gone, made
+/// absolute; for a file that does not exist yet, its folder resolved. Two outputs with the same
+/// identity would overwrite each other.
+pub fn identity(path: &Path) -> PathBuf {
+    if let Ok(p) = std::fs::canonicalize(path) {
+        return p;
+    }
+    let path = follow_links(path);
+    let absolute = std::path::absolute(&path).unwrap_or(path);
+    match (absolute.parent(), absolute.file_name()) {
+        (Some(parent), Some(name)) => std::fs::canonicalize(parent)
+            .unwrap_or_else(|_| parent.to_path_buf())
+            .join(name),
+        _ => absolute,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -343,6 +360,10 @@ mod tests {
             .file_type()
             .is_symlink());
         assert_eq!(std::fs::read(dir.join("real.json")).unwrap(), b"new");
+        assert_eq!(
+            identity(&dir.join("link.json")),
+            identity(&dir.join("real.json"))
+        );
     }
 
     #[test]
@@ -363,11 +384,29 @@ mod tests {
         let tmp = tempfile::tempdir().unwrap();
         let dir = tmp.path();
         std::os::unix::fs::symlink("new.json", dir.join("link.json")).unwrap();
+        assert_eq!(
+            identity(&dir.join("link.json")),
+            identity(&dir.join("new.json"))
+        );
         write_bytes(&dir.join("link.json"), b"new").unwrap();
         assert_eq!(std::fs::read(dir.join("new.json")).unwrap(), b"new");
         assert!(std::fs::symlink_metadata(dir.join("link.json"))
             .unwrap()
             .file_type()
             .is_symlink());
+    }
+
+    #[test]
+    fn spellings_of_one_file_have_one_identity() {
+        let tmp = tempfile::tempdir().unwrap();
+        let dir = tmp.path();
+        let a = identity(&dir.join("x.png"));
+        let b = identity(&dir.join(".").join("x.png"));
+        let sub = dir.join("sub");
+        std::fs::create_dir(&sub).unwrap();
+        let c = identity(&sub.join("..").join("x.png"));
+        assert_eq!(a, b);
+        assert_eq!(a, c);
+        assert_ne!(a, identity(&dir.join("y.png")));
     }
 }

@@ -1,8 +1,8 @@
 //! Outputs that cannot be written: every file the command line writes (`--out`, `--stats`,
 //! `--record` frames and GIF, `matrix`'s JSON and contact sheet, `bench`'s report, charts and
-//! pictures, standard output) onto a full disk (`/dev/full`: ENOSPC on every write) or half
-//! written (a file-size limit). Each must end in a non-zero exit and a message naming the
-//! file, never a success line.
+//! pictures, standard output) onto a full disk (`/dev/full`: ENOSPC on every write), half
+//! written (a file-size limit), or named twice. Each must end in a non-zero exit and a message
+//! naming the file (or both options), never a success line.
 
 mod common;
 
@@ -197,4 +197,69 @@ fn an_output_failing_half_way_leaves_the_old_file_whole_and_no_partial_one() {
     // Without the limit the same command replaces it with a whole picture.
     expect_status(&strs(&args), &[], cwd, 0);
     image::open(cwd.join("a.png")).expect("a whole PNG");
+}
+
+#[test]
+fn two_options_naming_one_file_are_a_usage_error_naming_both() {
+    let dir = tempfile::tempdir().unwrap();
+    let cwd = dir.path();
+    std::fs::create_dir(cwd.join("sub")).unwrap();
+    std::os::unix::fs::symlink("a.png", cwd.join("link.png")).unwrap();
+    let cases: [(&[&str], &str, &str); 6] = [
+        (
+            &["--out", "a.png", "--stats", "./a.png"],
+            "--out",
+            "--stats",
+        ),
+        (
+            &["--out", "a.png", "--stats", "sub/../a.png"],
+            "--out",
+            "--stats",
+        ),
+        (
+            &["--out", "a.png", "--stats", "link.png"],
+            "--out",
+            "--stats",
+        ),
+        (
+            &["--stats", "manylight.png"],
+            "the default --out",
+            "--stats",
+        ),
+        (
+            &["--out", "r.gif", "--record", "./r.gif"],
+            "--out",
+            "--record",
+        ),
+        (
+            &["--stats", "s.json", "--record", "s.json"],
+            "--stats",
+            "--record",
+        ),
+    ];
+    for (args, a, b) in cases {
+        let args = tiny(args);
+        let msg = expect_exit(&strs(&args), &[], cwd, 2, a);
+        assert!(
+            msg.contains(b) && msg.contains("same file"),
+            "{args:?}: {msg}"
+        );
+    }
+    let absolute = cwd.join("a.png");
+    let args = tiny(&["--out", absolute.to_str().unwrap(), "--stats", "a.png"]);
+    expect_exit(&strs(&args), &[], cwd, 2, "same file");
+    let args = ["matrix", "--json", "m", "--out", "./m"];
+    expect_exit(&args, &[], cwd, 2, "same file");
+    let args = ["matrix", "--json", "m/matrix.png", "--out", "m"];
+    expect_exit(&args, &[], cwd, 2, "same file");
+    assert!(!cwd.join("a.png").exists() && !cwd.join("m").exists());
+    // A device takes any number of outputs; different files are fine.
+    let args = tiny(&["--out", "/dev/null", "--stats", "/dev/null"]);
+    expect_status(&strs(&args), &[], cwd, 0);
+    expect_status(
+        &strs(&tiny(&["--out", "a.png", "--stats", "a.json"])),
+        &[],
+        cwd,
+        0,
+    );
 }

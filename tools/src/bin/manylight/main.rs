@@ -11,11 +11,13 @@ mod sequence;
 #[cfg(feature = "window")]
 mod view;
 
+use std::path::Path;
 use std::process::ExitCode;
 
 use clap::error::ErrorKind;
 use clap::{CommandFactory, Parser, Subcommand, ValueEnum};
 use manylight::EsVersion;
+use manylight_tools::output;
 
 /// Thousands of dynamic lights on OpenGL ES 2.0 / 3.0, rendered headless through EGL.
 #[derive(Parser)]
@@ -118,6 +120,22 @@ fn check_usage(cli: &Cli) {
                 .exit();
         }
     }
+    if let Some(a) = render {
+        let out = match (&a.out, &a.record) {
+            (Some(out), _) => Some(("--out", out.as_path())),
+            (None, None) => Some(("the default --out", Path::new(render::DEFAULT_OUT))),
+            (None, Some(_)) => None,
+        };
+        let stats = a.stats.as_deref().map(|p| ("--stats", p));
+        let record = a.record.as_deref().map(|p| ("--record", p));
+        check_distinct_outputs(&[out, stats, record]);
+    }
+    if let Some(Command::Matrix(a)) = &cli.command {
+        let json = a.json.as_deref().map(|p| ("--json", p));
+        let sheet = a.out.as_ref().map(|p| p.join("matrix.png"));
+        check_distinct_outputs(&[json, a.out.as_deref().map(|p| ("--out", p))]);
+        check_distinct_outputs(&[json, sheet.as_deref().map(|p| ("--out", p))]);
+    }
     #[cfg(feature = "window")]
     if !cli.gles_lib.is_empty() && matches!(cli.command, Some(Command::View(_))) {
         Cli::command()
@@ -145,6 +163,32 @@ fn check_usage(cli: &Cli) {
                  cargo run --release --features window -- view",
             )
             .exit();
+    }
+}
+
+/// Two options naming one file (through any spelling or symbolic link) would overwrite each
+/// other's output: a usage error naming both. A device or FIFO (`/dev/null`) may take both.
+fn check_distinct_outputs(outputs: &[Option<(&str, &Path)>]) {
+    let is_stream = |p: &Path| std::fs::metadata(p).is_ok_and(|m| !m.is_file() && !m.is_dir());
+    let named: Vec<_> = outputs
+        .iter()
+        .flatten()
+        .filter(|(_, path)| !is_stream(path))
+        .map(|&(option, path)| (option, path, output::identity(path)))
+        .collect();
+    for (i, (a, a_path, a_id)) in named.iter().enumerate() {
+        if let Some((b, b_path, _)) = named[i + 1..].iter().find(|(_, _, id)| id == a_id) {
+            Cli::command()
+                .error(
+                    ErrorKind::ArgumentConflict,
+                    format!(
+                        "{a} {} and {b} {} name the same file: one would overwrite the other",
+                        a_path.display(),
+                        b_path.display()
+                    ),
+                )
+                .exit();
+        }
     }
 }
 

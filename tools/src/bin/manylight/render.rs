@@ -182,7 +182,7 @@ pub fn parse_fps(s: &str) -> Result<f64, String> {
 }
 
 /// The picture's file when neither `--out` nor `--record` is given.
-const DEFAULT_OUT: &str = "manylight.png";
+pub const DEFAULT_OUT: &str = "manylight.png";
 
 /// Random lights for built-ins and OBJ files when `--lights` is not given.
 const DEFAULT_LIGHTS: usize = 1024;
