@@ -2,7 +2,8 @@
 //! `--record` frames and GIF, `matrix`'s JSON and contact sheet, `bench`'s report, charts and
 //! pictures, standard output) onto a full disk (`/dev/full`: ENOSPC on every write), half
 //! written (a file-size limit), or named twice. Each must end in a non-zero exit and a message
-//! naming the file (or both options), never a success line.
+//! naming the file (or both options), never a success line. Also: options that take a signed
+//! value take a negative number as a separate word (`--time -1.5`).
 
 mod common;
 
@@ -262,4 +263,40 @@ fn two_options_naming_one_file_are_a_usage_error_naming_both() {
         cwd,
         0,
     );
+}
+
+#[test]
+fn signed_options_take_a_negative_number_as_a_separate_word() {
+    let dir = tempfile::tempdir().unwrap();
+    let cwd = dir.path();
+    // The built-in scene's lights move: a picture at t = -1.5 s differs from one at 0.
+    for (i, time) in [["--time", "-1.5"], ["--time=-1.5", ""], ["--time", "0"]]
+        .iter()
+        .enumerate()
+    {
+        let out = format!("{i}.png");
+        let mut args = tiny(&["--out", &out, time[0]]);
+        if !time[1].is_empty() {
+            args.push(time[1].to_string());
+        }
+        expect_status(&strs(&args), &[], cwd, 0);
+    }
+    let read = |i: usize| {
+        image::open(cwd.join(format!("{i}.png")))
+            .unwrap()
+            .to_rgba8()
+    };
+    assert_eq!(read(0), read(1), "`--time -1.5` and `--time=-1.5` differ");
+    assert_ne!(read(0), read(2), "`--time -1.5` rendered time 0");
+    for (args, needle) in [
+        (&["--exposure", "-1"][..], ""),
+        (&["--fps", "-3"], "not a frame rate"),
+        (&["--slice-depth", "-1"], "not a slice depth"),
+        (&["--time", "-inf"], "not a time"),
+        (&["--time", "-2e9"], "not a time"),
+    ] {
+        let args = tiny(args);
+        let code = if needle.is_empty() { 0 } else { 2 };
+        expect_exit(&strs(&args), &[], cwd, code, needle);
+    }
 }

@@ -52,10 +52,10 @@ pub struct RenderArgs {
     pub frames: u32,
     /// Animation time of the picture written to `--out` and of the first timed frame, in
     /// seconds (0: the scene as built).
-    #[arg(long, default_value_t = 0.0, value_parser = parse_time)]
+    #[arg(long, default_value_t = 0.0, value_parser = parse_time, allow_hyphen_values = true)]
     pub time: f64,
     /// Frames per second of animation time between timed frames.
-    #[arg(long, default_value_t = 30.0, value_parser = parse_fps)]
+    #[arg(long, default_value_t = 30.0, value_parser = parse_fps, allow_hyphen_values = true)]
     pub fps: f64,
     /// Write every timed frame: into a directory as `frame_00000.png` …, or, for a path
     /// ending in `.gif`, as one animated GIF.

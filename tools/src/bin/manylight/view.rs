@@ -73,7 +73,7 @@ pub struct ViewArgs {
     #[arg(long)]
     pub heatmap: bool,
     /// Animation time to start at, in seconds (0: the scene as built).
-    #[arg(long, default_value_t = 0.0, value_parser = crate::render::parse_time)]
+    #[arg(long, default_value_t = 0.0, value_parser = crate::render::parse_time, allow_hyphen_values = true)]
     pub time: f64,
     /// Start with the lights' motion paused (Space resumes it); with `--frames` and
     /// `--screenshot`, the picture is then the frame at `--time`, as `render --time` draws it.
