@@ -1,16 +1,17 @@
 //! Outputs that cannot be written: every file the command line writes (`--out`, `--stats`,
 //! `--record` frames and GIF, `matrix`'s JSON and contact sheet, `bench`'s report, charts and
 //! pictures, standard output) onto a full disk (`/dev/full`: ENOSPC on every write), half
-//! written (a file-size limit), or named twice. Each must end in a non-zero exit and a message
-//! naming the file (or both options), never a success line. Also: options that take a signed
-//! value take a negative number as a separate word (`--time -1.5`).
+//! written (a file-size limit), or named twice; and every subcommand that cannot do its job.
+//! Each must end in a non-zero exit and a message naming the file (or both options), never a
+//! success line. Also: options that take a signed value take a negative number as a separate
+//! word (`--time -1.5`).
 
 mod common;
 
 use std::path::Path;
 use std::process::{Command, Stdio};
 
-use common::cli::{expect_exit, expect_status, text};
+use common::cli::{expect_exit, expect_status, manylight, text};
 
 /// A small, quick render: a few lights, one untimed frame.
 const TINY: [&str; 6] = ["--size", "16x9", "--lights", "4", "--frames", "0"];
@@ -298,5 +299,65 @@ fn signed_options_take_a_negative_number_as_a_separate_word() {
         let args = tiny(args);
         let code = if needle.is_empty() { 0 } else { 2 };
         expect_exit(&strs(&args), &[], cwd, code, needle);
+    }
+}
+
+#[test]
+fn every_subcommand_that_cannot_do_its_job_exits_non_zero_naming_why() {
+    let dir = tempfile::tempdir().unwrap();
+    let cwd = dir.path();
+    std::fs::write(cwd.join("file"), "").unwrap();
+    let cases: [&[&str]; 10] = [
+        &["--scene", "missing.obj", "--size", "16x9"],
+        &["render", "--scene", "missing.obj", "--size", "16x9"],
+        &["info", "--scene", "missing.obj"],
+        &["matrix", "--scene", "missing.obj", "--size", "16x9"],
+        &[
+            "bench",
+            "--scenes",
+            "missing.obj",
+            "--size",
+            "16x9",
+            "--out",
+            "b",
+        ],
+        &[
+            "--method",
+            "no-such-method",
+            "--size",
+            "16x9",
+            "--lights",
+            "4",
+        ],
+        &["bench", "--methods", "no-such-method", "--out", "b"],
+        &["bench", "--out", "file/b"],
+        &["matrix", "--out", "file/m", "--size", "16x9"],
+        &["matrix", "--gles-lib", "/nonexistent", "--size", "16x9"],
+    ];
+    let needles = [
+        "missing.obj",
+        "missing.obj",
+        "missing.obj",
+        "missing.obj",
+        "missing.obj",
+        "no-such-method",
+        "no-such-method",
+        "file/b",
+        "file/m",
+        "no configuration of the matrix could run",
+    ];
+    for (args, needle) in cases.iter().zip(needles) {
+        let out = manylight(args, &[], cwd);
+        let msg = text(&out);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {msg}");
+        assert!(
+            msg.contains(needle),
+            "{args:?}: expected `{needle}` in {msg}"
+        );
+        assert!(!msg.contains("panicked"), "{args:?}: {msg}");
+        // A scene no cell could read is found before any cell runs.
+        if args[0] == "matrix" && needle == "missing.obj" {
+            assert!(!msg.contains("unavailable"), "{msg}");
+        }
     }
 }

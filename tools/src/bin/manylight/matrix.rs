@@ -153,6 +153,9 @@ const CONFIGS: &[Config] = &[
 /// folders, `system` for the system's libraries; none: the system's alone).
 pub fn run(args: &MatrixArgs, gles_libs: &[PathBuf]) -> Result<(), Box<dyn std::error::Error>> {
     let exe = std::env::current_exe()?;
+    // What every cell would fail on is an error of the matrix, not a row of failures: a scene
+    // that cannot be read, outputs that cannot be written.
+    scene::load(&args.scene, Some((args.lights, 1)))?;
     let out = args.out.clone().unwrap_or_else(std::env::temp_dir);
     std::fs::create_dir_all(&out).map_err(|e| format!("cannot create {}: {e}", out.display()))?;
     let json_file = args.json.as_deref().map(OutputFile::create).transpose()?;
@@ -181,6 +184,14 @@ pub fn run(args: &MatrixArgs, gles_libs: &[PathBuf]) -> Result<(), Box<dyn std::
         let path = file.path().display().to_string();
         file.commit_png(&sheet(&rows, &out))?;
         eprintln!("contact sheet: {path}");
+    }
+    if let Some(error) = rows
+        .iter()
+        .map(|r| r["error"].as_str())
+        .collect::<Option<Vec<_>>>()
+        .and_then(|errors| errors.first().copied())
+    {
+        return Err(format!("no configuration of the matrix could run: {error}").into());
     }
     Ok(())
 }
