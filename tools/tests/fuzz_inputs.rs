@@ -7,6 +7,8 @@
 //! thousand cases in all, well under a minute).
 
 mod common;
+#[path = "fuzz/outputs.rs"]
+mod outputs;
 
 use std::cell::RefCell;
 use std::panic::{catch_unwind, AssertUnwindSafe};
