@@ -48,6 +48,16 @@ fn every_render_output_onto_a_full_disk_fails_naming_the_file() {
     fails_naming(&args, cwd, "full.gif");
     let args = [&TINY[..4], &["--frames", "2", "--record", "frames"]].concat();
     fails_naming(&args, cwd, "frame_00000.png");
+    // No frame to record is no recording, not an empty GIF.
+    let msg = expect_exit(
+        &strs(&tiny(&["--record", "z.gif"])),
+        &[],
+        cwd,
+        2,
+        "--frames 0",
+    );
+    assert!(msg.contains("--record z.gif"), "{msg}");
+    assert!(!cwd.join("z.gif").exists());
 }
 
 #[test]
@@ -240,8 +250,9 @@ fn two_options_naming_one_file_are_a_usage_error_naming_both() {
         ),
     ];
     for (args, a, b) in cases {
-        let args = tiny(args);
-        let msg = expect_exit(&strs(&args), &[], cwd, 2, a);
+        // One timed frame, so that a recording has something to record.
+        let args = [&TINY[..4], &["--frames", "1"], args].concat();
+        let msg = expect_exit(&args, &[], cwd, 2, a);
         assert!(
             msg.contains(b) && msg.contains("same file"),
             "{args:?}: {msg}"

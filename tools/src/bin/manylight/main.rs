@@ -120,6 +120,15 @@ fn check_usage(cli: &Cli) {
                 .exit();
         }
     }
+    if let Some(a) = render.filter(|a| a.record.is_some() && a.frames == 0) {
+        let record = a.record.as_deref().unwrap_or(Path::new("")).display();
+        Cli::command()
+            .error(
+                ErrorKind::ArgumentConflict,
+                format!("--record {record} writes the timed frames, and --frames 0 times none"),
+            )
+            .exit();
+    }
     if let Some(a) = render {
         let out = match (&a.out, &a.record) {
             (Some(out), _) => Some(("--out", out.as_path())),
