@@ -120,12 +120,14 @@ fn check_usage(cli: &Cli) {
                 .exit();
         }
     }
-    if let Some(a) = render.filter(|a| a.record.is_some() && a.frames == 0) {
-        let record = a.record.as_deref().unwrap_or(Path::new("")).display();
+    if let Some(record) = render.and_then(|a| a.record.as_deref().filter(|_| a.frames == 0)) {
         Cli::command()
             .error(
                 ErrorKind::ArgumentConflict,
-                format!("--record {record} writes the timed frames, and --frames 0 times none"),
+                format!(
+                    "--record {} writes the timed frames, and --frames 0 times none",
+                    record.display()
+                ),
             )
             .exit();
     }
