@@ -1420,6 +1420,10 @@ fn a_scene_files_transform_that_places_a_model_out_of_range_is_blamed_on_the_sce
     // Lights and a camera only, no mesh: placed far by the transform all the same.
     doc["nodes"][0].as_object_mut().unwrap().remove("mesh");
     write(dir.path(), "lights.gltf", b.gltf(doc));
+    // A mesh only.
+    let mut t = Builder::default();
+    let tri = triangle(&mut t);
+    write(dir.path(), "tri.gltf", t.gltf(tri));
     write(dir.path(), "q.obj", quad_obj(&floor(), "q"));
     write(dir.path(), "q.mtl", "newmtl q\nKd 1 1 1\n");
     for (model, transform) in [
@@ -1429,6 +1433,7 @@ fn a_scene_files_transform_that_places_a_model_out_of_range_is_blamed_on_the_sce
             r#""gltf": "lights.gltf""#,
             r#"{"translate": [0, -2e12, 0]}"#,
         ),
+        (r#""gltf": "tri.gltf""#, r#"{"translate": [0, 0, 5e12]}"#),
         (r#""obj": "q.obj""#, r#"{"translate": [0, 0, 5e12]}"#),
         (r#""builtin": "plane""#, r#"{"scale": [1e200, 1, 1]}"#),
     ] {
@@ -1443,4 +1448,30 @@ fn a_scene_files_transform_that_places_a_model_out_of_range_is_blamed_on_the_sce
             "{err}"
         );
     }
+}
+
+#[test]
+fn the_cli_refuses_an_outside_buffer_unless_allow_outside_files_is_given() {
+    let mut b = Builder::default();
+    let doc = triangle(&mut b);
+    let out = Outside::new(&b.bin);
+    let gltf = b.document(doc, Some("../b.bin".into())).to_string();
+    write(&out.model(), "m.gltf", gltf);
+    let args = [
+        "render",
+        "--scene",
+        "model/m.gltf",
+        "--size",
+        "64x36",
+        "--lights",
+        "4",
+        "--out",
+        "o.png",
+    ];
+    let refused = common::cli::expect_exit(&args, &[], out.root.path(), 1, "buffers[0].uri");
+    assert!(refused.contains("--allow-outside-files"), "{refused}");
+    assert!(!out.root.path().join("o.png").exists());
+    let allowed = [&args[..], &["--allow-outside-files"]].concat();
+    common::cli::expect_status(&allowed, &[], out.root.path(), 0);
+    assert!(out.root.path().join("o.png").is_file());
 }
