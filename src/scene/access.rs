@@ -55,6 +55,12 @@ pub(crate) fn resolve(dir: &Path, path: &Path, allow_outside: bool) -> Result<Pa
     if allow_outside {
         return Ok(real);
     }
+    // A file named without a folder (`m.gltf`) has the empty path as its parent.
+    let dir = if dir.as_os_str().is_empty() {
+        Path::new(".")
+    } else {
+        dir
+    };
     let real_dir = dir.canonicalize().map_err(|e| {
         format!("the model's folder {} cannot be resolved ({e})", dir.display())
     })?;
@@ -114,5 +120,14 @@ mod tests {
         assert_eq!(std::fs::read(real).unwrap(), b"I");
         let missing = model.join("missing.bin");
         assert_eq!(resolve(&model, &missing, false).unwrap(), missing);
+    }
+
+    #[test]
+    fn a_model_in_the_working_folder_has_the_empty_path_as_its_folder() {
+        // `Path::new("m.gltf").parent()` is `""`: the working folder (the package's, in tests).
+        let dir = Path::new("m.gltf").parent().unwrap();
+        let path = join(dir, "Cargo.toml", false).unwrap();
+        let real = resolve(dir, &path, false).unwrap();
+        assert_eq!(real, Path::new("Cargo.toml").canonicalize().unwrap());
     }
 }
