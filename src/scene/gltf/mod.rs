@@ -306,11 +306,11 @@ fn import(
                 light.index()
             );
             match lights::convert(&light, &p.world, &lfield)? {
+                // Checked in the file's space; now placed.
                 lights::Converted::Light(_) => {
-                    if let lights::Converted::Light(l) =
-                        lights::convert(&light, &world, &lfield).map_err(placing)?
-                    {
-                        out.lights.push(l);
+                    match lights::convert(&light, &world, &lfield).map_err(placing)? {
+                        lights::Converted::Light(l) => out.lights.push(l),
+                        lights::Converted::Skipped(why) => warnings.push(why),
                     }
                 }
                 lights::Converted::Skipped(why) => warnings.push(why),
