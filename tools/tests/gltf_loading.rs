@@ -1448,6 +1448,21 @@ fn a_scene_files_transform_that_places_a_model_out_of_range_is_blamed_on_the_sce
             "{err}"
         );
     }
+    // Within range, but too large for a camera framing it to stay within range: the missing
+    // `camera` is named, and giving one loads.
+    let big = r#"{"builtin": "plane", "transform": {"scale": 1e11}}"#;
+    // Two objects: framed rather than the built-in's own camera.
+    let objects = format!(r#""objects": [{big}, {{"builtin": "plane"}}]"#);
+    let path = write(dir.path(), "big.json", &format!("{{{objects}}}"));
+    let err = load(&path).unwrap_err().to_string();
+    assert!(
+        err.contains("`camera`") && err.contains("give `camera`"),
+        "{err}"
+    );
+    let camera = r#""camera": {"position": [0, 1, 9e11], "target": [0, 0, 0]}"#;
+    let text = format!("{{{objects}, {camera}}}");
+    let path = write(dir.path(), "big.json", &text);
+    load(&path).unwrap();
 }
 
 #[test]
