@@ -1453,7 +1453,7 @@ fn a_scene_files_transform_that_places_a_model_out_of_range_is_blamed_on_the_sce
     let big = r#"{"builtin": "plane", "transform": {"scale": 1e11}}"#;
     // Two objects: framed rather than the built-in's own camera.
     let objects = format!(r#""objects": [{big}, {{"builtin": "plane"}}]"#);
-    let path = write(dir.path(), "big.json", &format!("{{{objects}}}"));
+    let path = write(dir.path(), "big.json", format!("{{{objects}}}"));
     let err = load(&path).unwrap_err().to_string();
     assert!(
         err.contains("`camera`") && err.contains("give `camera`"),
