@@ -11,7 +11,8 @@
 //!   [`Renderer::render_reusing`] the same without allocating per frame,
 //!   [`Renderer::render_offscreen`] into an image; [`Renderer::set_method`] picks forward,
 //!   tiled, clustered (the default), deferred or auto.
-//! - A [`Scene`]: [`builtin_scene`] or [`load_scene`] (OBJ, glTF, JSON scene files), or built
+//! - A [`Scene`]: [`builtin_scene`] or [`load_scene`] (OBJ, glTF, JSON scene files;
+//!   [`load_scene_with`] and [`LoadOptions`] let a trusted glTF read outside its folder), or built
 //!   in code with [`Scene::add_material`], [`MeshBuilder`], [`Scene::add_object`],
 //!   [`Light::point`] and [`Light::spot`]; [`Scene::set_time`] poses moving lights
 //!   ([`motion`]).
@@ -71,8 +72,8 @@ pub use scene::meshbuild::MeshBuilder;
 pub use scene::obj::LoadReport;
 pub use scene::{
     builtin::DEFAULT as DEFAULT_SCENE, builtin::NAMES as BUILTIN_SCENES, builtin_scene, load_scene,
-    Aabb, Camera, Cone, Light, LightKind, Material, Mesh, Object, Projection, RandomLights, Scene,
-    SceneError, Texture,
+    load_scene_with, Aabb, Camera, Cone, Light, LightKind, LoadOptions, Material, Mesh, Object,
+    Projection, RandomLights, Scene, SceneError, Texture,
 };
 
 /// How lights move over time: a [`Motion`](motion::Motion) per light, set with

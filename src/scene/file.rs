@@ -35,7 +35,8 @@ use std::path::{Path, PathBuf};
 use glam::{DMat4, DVec3, Vec3};
 use serde::Deserialize;
 
-use super::camera::Projection;
+use super::access::LoadOptions;
+use super::camera::{Projection, MAX_CAMERA_COORD};
 use super::motion::{Bob, Flicker, Motion, Orbit, OrbitAbout, Sweep, Wander};
 use super::obj::{self, LoadReport};
 use super::random::{self, LightSetStyle};
@@ -228,6 +229,7 @@ fn deserialize(text: &str) -> Result<SceneFile, String> {
 pub fn load(
     path: &Path,
     random_override: Option<(usize, u64)>,
+    options: &LoadOptions,
 ) -> Result<(Scene, LoadReport), SceneError> {
     let bytes = super::input::read_bounded(path, super::input::FileKind::SceneFile)?;
     let text = String::from_utf8(bytes).map_err(|e| SceneError::SceneFile {
@@ -239,16 +241,19 @@ pub fn load(
         path.parent().unwrap_or(Path::new(".")),
         path,
         random_override,
+        options,
     )
 }
 
 /// Parses scene-file text; relative paths are resolved against `base_dir`, `origin` names the
-/// source in errors.
+/// source in errors. The models it names may lie anywhere (`../models/a.glb`): a scene file is
+/// the user's own, like a command line; what a glTF file itself names follows `options`.
 pub fn parse(
     text: &str,
     base_dir: &Path,
     origin: &Path,
     random_override: Option<(usize, u64)>,
+    options: &LoadOptions,
 ) -> Result<(Scene, LoadReport), SceneError> {
     let file: SceneFile = deserialize(text).map_err(|reason| SceneError::SceneFile {
         path: origin.to_path_buf(),
@@ -264,6 +269,7 @@ pub fn parse(
             .as_ref()
             .map_or(Ok(DMat4::IDENTITY), |t| t.matrix(&field))?;
         let first_material = scene.materials.len();
+        let first_object = scene.objects.len();
         match (&spec.builtin, &spec.obj, &spec.gltf) {
             (Some(name), None, None) => {
                 let built = builtin::geometry(name)
@@ -302,8 +308,13 @@ pub fn parse(
                         "only OBJ objects take a texture",
                     ));
                 }
-                let loaded =
-                    super::gltf::load_into(&mut scene, &base_dir.join(gltf_path), transform)?;
+                let loaded = super::gltf::load_into(
+                    &mut scene,
+                    &base_dir.join(gltf_path),
+                    transform,
+                    &format!("{field}.transform"),
+                    options,
+                )?;
                 if let Some(camera) = loaded.camera {
                     builtin_camera.get_or_insert(camera);
                 }
@@ -316,6 +327,7 @@ pub fn parse(
                 ))
             }
         }
+        check_placed(&scene, first_object, &field)?;
         if let Some(c) = spec.color {
             // Recolour this object's materials only (they were appended for it).
             for m in &mut scene.materials[first_material..] {
@@ -338,7 +350,19 @@ pub fn parse(
     match (&file.camera, builtin_camera) {
         (Some(c), _) => scene.camera = c.to_camera(),
         (None, Some(c)) if file.objects.len() == 1 => scene.camera = c,
-        _ => scene.frame_camera(),
+        _ => {
+            scene.frame_camera();
+            // Objects near the limit leave no room for a camera that sees them all.
+            if scene.camera.validate().is_err() {
+                return Err(SceneError::invalid(
+                    "camera",
+                    format!(
+                        "the file gives none, and one framing all its objects would lie past \
+                         ±{MAX_CAMERA_COORD:e}: give `camera`"
+                    ),
+                ));
+            }
+        }
     }
     let random = match (random_override, &file.random_lights) {
         (Some(r), _) => Some((r, "lights")),
@@ -363,6 +387,27 @@ pub fn parse(
     }
     scene.validate()?;
     Ok((scene, report))
+}
+
+/// The objects from `first` on, placed by `field`'s transform: their world bounds must be
+/// finite and within the camera's coordinate limit, or the transform is at fault.
+fn check_placed(scene: &Scene, first: usize, field: &str) -> Result<(), SceneError> {
+    for o in &scene.objects[first..] {
+        let Some(b) = o.mesh.bounds().map(|b| b.transformed(&o.transform)) else {
+            continue;
+        };
+        let reach = b.min.abs().max(b.max.abs()).max_element();
+        if !reach.is_finite() || reach > MAX_CAMERA_COORD {
+            return Err(SceneError::invalid(
+                format!("{field}.transform"),
+                format!(
+                    "places the object's bounds {reach:e} from the origin, past \
+                     ±{MAX_CAMERA_COORD:e} (the camera's limit)"
+                ),
+            ));
+        }
+    }
+    Ok(())
 }
 
 impl TransformSpec {
@@ -511,7 +556,14 @@ mod tests {
     use super::*;
 
     fn parse_str(s: &str) -> Result<Scene, SceneError> {
-        parse(s, Path::new("."), Path::new("test.json"), None).map(|(s, _)| s)
+        parse(
+            s,
+            Path::new("."),
+            Path::new("test.json"),
+            None,
+            &LoadOptions::default(),
+        )
+        .map(|(s, _)| s)
     }
 
     #[test]

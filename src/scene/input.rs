@@ -1,4 +1,4 @@
-//! Bounded reads of the files a scene names (scene JSON, OBJ, MTL, textures) and the limits
+//! Bounded reads of the files a scene names (scene JSON, OBJ, MTL, glTF, textures) and the limits
 //! that keep hostile input from hanging the loader or exhausting memory.
 //!
 //! Only regular files are read: a FIFO would block `open` forever and `/dev/zero` never ends,
@@ -24,6 +24,10 @@ pub enum FileKind {
     SceneFile,
     /// An OBJ model (1 GiB: the largest real scene tried, the conference room, is 27 MB).
     Model,
+    /// A `.gltf` or `.glb` file (the OBJ model's limit).
+    Gltf,
+    /// A file a glTF buffer's URI names (the OBJ model's limit).
+    GltfBuffer,
     /// An MTL material library (16 MiB).
     Materials,
     /// A texture image file (256 MiB; its decoded size is limited separately).
@@ -38,7 +42,7 @@ impl FileKind {
     pub fn default_limit(self) -> u64 {
         match self {
             FileKind::SceneFile | FileKind::Materials => 16 << 20,
-            FileKind::Model => 1 << 30,
+            FileKind::Model | FileKind::Gltf | FileKind::GltfBuffer => 1 << 30,
             FileKind::Texture => 256 << 20,
         }
     }
@@ -55,6 +59,8 @@ impl FileKind {
         match self {
             FileKind::SceneFile => "scene file",
             FileKind::Model => "OBJ file",
+            FileKind::Gltf => "glTF file",
+            FileKind::GltfBuffer => "glTF buffer",
             FileKind::Materials => "MTL file",
             FileKind::Texture => "texture",
         }

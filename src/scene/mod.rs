@@ -6,6 +6,7 @@
 //! the renderer subtracts the camera in `f64` before anything reaches the GPU as `f32`, so a
 //! scene 10 km from the origin loses no precision on the device.
 
+pub mod access;
 pub mod builtin;
 pub mod camera;
 pub mod error;
@@ -29,6 +30,7 @@ use std::sync::Arc;
 
 use glam::{DMat4, DVec3, Vec3};
 
+pub use access::LoadOptions;
 pub use camera::{Camera, Projection};
 pub use error::SceneError;
 pub use light::{Cone, Light, LightKind};
@@ -283,6 +285,16 @@ pub fn load_scene(
     load(spec, lights.map(|l| (l.count, l.seed)))
 }
 
+/// [`load_scene`] with `options` (e.g. letting a trusted glTF file read files outside its
+/// folder, which [`load_scene`] refuses).
+pub fn load_scene_with(
+    spec: &str,
+    lights: Option<RandomLights>,
+    options: &LoadOptions,
+) -> Result<(Scene, obj::LoadReport), SceneError> {
+    load_with(spec, lights.map(|l| (l.count, l.seed)), options)
+}
+
 /// True when `spec` names a file that brings its own lights (a `.json` scene file, a `.gltf`
 /// or `.glb` file): the CLI then adds random lights only when asked to.
 pub fn brings_own_lights(spec: &str) -> bool {
@@ -297,6 +309,15 @@ pub fn brings_own_lights(spec: &str) -> bool {
 pub fn load(
     spec: &str,
     lights: Option<(usize, u64)>,
+) -> Result<(Scene, obj::LoadReport), SceneError> {
+    load_with(spec, lights, &LoadOptions::default())
+}
+
+/// [`load`] with `options`.
+pub fn load_with(
+    spec: &str,
+    lights: Option<(usize, u64)>,
+    options: &LoadOptions,
 ) -> Result<(Scene, obj::LoadReport), SceneError> {
     let path = std::path::Path::new(spec);
     let ext = path
@@ -319,8 +340,8 @@ pub fn load(
             scene.validate()?;
             Ok((scene, report))
         }
-        "gltf" | "glb" => gltf::load(path, lights),
-        "json" => file::load(path, lights),
+        "gltf" | "glb" => gltf::load(path, lights, options),
+        "json" => file::load(path, lights, options),
         // Built-in names have no extension: anything else that looks like a file is one.
         _ if !ext.is_empty() || path.is_file() || spec.contains(std::path::MAIN_SEPARATOR) => {
             Err(SceneError::UnsupportedFile {

@@ -35,7 +35,13 @@ pub fn load_into(
     texture_override: Option<&Path>,
 ) -> Result<LoadReport, SceneError> {
     let mut report = LoadReport::default();
-    let (models, materials) = parse_obj(path)?;
+    let (models, materials, not_utf8) = parse_obj(path)?;
+    if not_utf8 {
+        report.warn(format!(
+            "{}: not UTF-8 text; bytes that are not (in names) were replaced by U+FFFD",
+            path.display()
+        ));
+    }
     if models.is_empty() || models.iter().all(|m| m.mesh.indices.is_empty()) {
         return Err(SceneError::Obj {
             path: path.to_path_buf(),
@@ -131,15 +137,31 @@ pub fn load_into(
 
 /// Parses an OBJ read within its size limit, its MTL libraries read the same way and checked
 /// first for what tobj would panic on. tobj runs under `catch_unwind` as a last guard: a panic
-/// inside it becomes an error naming the file, never an abort of the caller.
+/// inside it becomes an error naming the file, never an abort of the caller. The last value
+/// is true when the OBJ was not UTF-8 (read lossily, see [`text_of`]).
 type Parsed = (
     Vec<tobj::Model>,
     Result<Vec<tobj::Material>, tobj::LoadError>,
+    bool,
 );
 
+/// OBJ or MTL bytes as the text tobj reads: bytes that are not UTF-8 (a Latin-1 name)
+/// replaced by U+FFFD rather than failing the whole read, and a lone CR (old Mac line ends)
+/// taken as a line end, as CRLF is. Also says whether any byte was not UTF-8.
+fn text_of(bytes: &[u8]) -> (String, bool) {
+    let text = String::from_utf8_lossy(bytes);
+    let not_utf8 = matches!(text, std::borrow::Cow::Owned(_));
+    let text = if text.contains('\r') {
+        text.replace("\r\n", "\n").replace('\r', "\n")
+    } else {
+        text.into_owned()
+    };
+    (text, not_utf8)
+}
+
 fn parse_obj(path: &Path) -> Result<Parsed, SceneError> {
-    let bytes = read_bounded(path, FileKind::Model)?;
-    check_face_indices(&bytes).map_err(|reason| SceneError::Obj {
+    let (text, not_utf8) = text_of(&read_bounded(path, FileKind::Model)?);
+    check_face_indices(&text).map_err(|reason| SceneError::Obj {
         path: path.to_path_buf(),
         reason,
     })?;
@@ -162,21 +184,30 @@ fn parse_obj(path: &Path) -> Result<Parsed, SceneError> {
             log::warn!("{e}");
             tobj::LoadError::OpenFileFailed
         })?;
-        if let Err(line) = check_mtl(&bytes) {
+        let (text, not_utf8) = text_of(&bytes);
+        if not_utf8 {
+            log::warn!(
+                "{}: not UTF-8 text; bytes that are not (in names) were replaced by U+FFFD",
+                mtl_path.display()
+            );
+        }
+        if let Err(line) = check_mtl(&text) {
             log::warn!("{}: {line}", mtl_path.display());
             return Err(tobj::LoadError::MaterialParseError);
         }
-        tobj::load_mtl_buf(&mut std::io::BufReader::new(&bytes[..]))
+        tobj::load_mtl_buf(&mut std::io::BufReader::new(text.as_bytes()))
     };
     let parsed = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        tobj::load_obj_buf(&mut std::io::BufReader::new(&bytes[..]), &options, load_mtl)
+        tobj::load_obj_buf(&mut std::io::BufReader::new(text.as_bytes()), &options, load_mtl)
     }));
     let obj_error = |reason: String| SceneError::Obj {
         path: path.to_path_buf(),
         reason,
     };
     match parsed {
-        Ok(result) => result.map_err(|e| obj_error(e.to_string())),
+        Ok(result) => result
+            .map(|(models, materials)| (models, materials, not_utf8))
+            .map_err(|e| obj_error(e.to_string())),
         Err(_) => Err(obj_error(
             "the OBJ parser (tobj) failed on this file; it is malformed".into(),
         )),
@@ -186,9 +217,9 @@ fn parse_obj(path: &Path) -> Result<Parsed, SceneError> {
 /// Every index of every face and line refers to a vertex, texture coordinate or normal the file
 /// defines (negative indices count back from the last one defined before the line): what tobj
 /// assumes — an index beyond them overflowed its arithmetic (a panic in debug builds, a read of
-/// the wrong element in release ones). Errors name the line.
-fn check_face_indices(bytes: &[u8]) -> Result<(), String> {
-    let text = String::from_utf8_lossy(bytes);
+/// the wrong element in release ones). Errors name the line and the word, never the file's
+/// text.
+fn check_face_indices(text: &str) -> Result<(), String> {
     let kind_of = |key: Option<&str>| match key {
         Some("v") => Some(0),
         Some("vt") => Some(1),
@@ -214,19 +245,16 @@ fn check_face_indices(bytes: &[u8]) -> Result<(), String> {
             _ => 0,
         };
         // The numbers first, so a bad one is named rather than the face that uses it.
-        if needs > 0
-            && words
-                .clone()
-                .take(needs)
-                .filter(|w| w.parse::<f32>().is_ok())
-                .count()
-                < needs
-        {
+        let numbers = words
+            .clone()
+            .take(needs)
+            .filter(|w| w.parse::<f32>().is_ok())
+            .count();
+        if numbers < needs {
             return Err(format!(
-                "line {}: `{}` needs {needs} numbers, got `{}`",
+                "line {}: `{}` needs {needs} numbers, found {numbers}",
                 number + 1,
-                key.unwrap_or_default(),
-                line.trim()
+                key.unwrap_or_default()
             ));
         }
         if let Some(kind) = kind_of(key) {
@@ -236,7 +264,7 @@ fn check_face_indices(bytes: &[u8]) -> Result<(), String> {
         let Some(key @ ("f" | "l")) = key else {
             continue;
         };
-        for word in words {
+        for (at, word) in words.enumerate() {
             for (kind, part) in word.split('/').enumerate().take(3) {
                 if kind > 0 && (part.is_empty() || totals[kind] == 0) {
                     continue;
@@ -249,9 +277,10 @@ fn check_face_indices(bytes: &[u8]) -> Result<(), String> {
                 if !resolves {
                     let what = ["vertex", "texture coordinate", "normal"][kind];
                     return Err(format!(
-                        "line {}: `{key}` refers to {what} `{part}`, but the file defines {} \
-                         ({} before this line)",
+                        "line {}: `{key}` corner {}: its {what} index is not one of the {} the \
+                         file defines ({} before this line)",
                         number + 1,
+                        at + 1,
                         totals[kind],
                         defined[kind]
                     ));
@@ -263,9 +292,8 @@ fn check_face_indices(bytes: &[u8]) -> Result<(), String> {
 }
 
 /// The first MTL line tobj would panic on or misread (a colour with fewer than three numbers,
-/// as a truncated file has), as a message naming the line.
-fn check_mtl(bytes: &[u8]) -> Result<(), String> {
-    let text = String::from_utf8_lossy(bytes);
+/// as a truncated file has), as a message naming the line (not showing it).
+fn check_mtl(text: &str) -> Result<(), String> {
     for (number, line) in text.lines().enumerate() {
         let mut words = line.split_whitespace();
         let Some(key @ ("Ka" | "Kd" | "Ks" | "Ke")) = words.next() else {
@@ -274,9 +302,8 @@ fn check_mtl(bytes: &[u8]) -> Result<(), String> {
         let numbers = words.take(3).filter(|w| w.parse::<f32>().is_ok()).count();
         if numbers < 3 {
             return Err(format!(
-                "line {}: `{key}` needs three numbers, got `{}`",
-                number + 1,
-                line.trim()
+                "line {}: `{key}` needs three numbers, found {numbers}",
+                number + 1
             ));
         }
     }

@@ -625,6 +625,10 @@ proptest! {
     }
 }
 
+// Hostile glTF structure: URIs leaving the folder, extras, matrices, modes, accessor fields.
+#[path = "fuzz/gltf_hostile.rs"]
+mod gltf_hostile;
+
 #[test]
 fn the_valid_gltf_the_fuzzer_mutates_loads_and_renders() {
     let (doc, bin) = gltf_valid();

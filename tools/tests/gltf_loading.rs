@@ -773,7 +773,7 @@ fn malformed_files_are_errors_naming_the_file_and_what_is_wrong() {
             b.gltf(doc).into_bytes(),
             vec![
                 "meshes[0].primitives[0].indices",
-                "is 9, out of range for 3 vertices",
+                "element 2 is out of range for 3 vertices",
             ],
         ));
     }
@@ -1081,7 +1081,412 @@ fn an_external_buffer_file_and_a_sparse_accessor_are_read() {
     );
     let err = load(&path).unwrap_err().to_string();
     assert!(
-        err.contains("accessors[0].sparse.indices") && err.contains("is 7, out of range"),
+        err.contains("accessors[0].sparse.indices") && err.contains("element 0 is out of range"),
         "{err}"
     );
+    assert!(
+        !err.contains("is 7"),
+        "the index's value is not shown: {err}"
+    );
+}
+
+/// What a test model may not read: files beside its folder, with bytes a message must never
+/// show. `b.bin` is a valid buffer for the model (so a load that reads it succeeds).
+struct Outside {
+    root: tempfile::TempDir,
+}
+
+const SENTINEL: &str = "SENTINEL-83-do-not-show";
+
+impl Outside {
+    fn new(bin: &[u8]) -> Outside {
+        let root = tempfile::tempdir().unwrap();
+        std::fs::create_dir(root.path().join("model")).unwrap();
+        std::fs::write(root.path().join("b.bin"), bin).unwrap();
+        std::fs::write(root.path().join("secret.txt"), SENTINEL.repeat(4)).unwrap();
+        std::fs::write(root.path().join("secret.png"), checker_png()).unwrap();
+        Outside { root }
+    }
+
+    fn model(&self) -> PathBuf {
+        self.root.path().join("model")
+    }
+}
+
+fn load_with(
+    path: &Path,
+    allow: bool,
+) -> Result<(Scene, manylight::scene::obj::LoadReport), scene::SceneError> {
+    let mut options = manylight::LoadOptions::default();
+    options.allow_outside_files = allow;
+    scene::load_with(path.to_str().unwrap(), Some((0, 1)), &options)
+}
+
+#[test]
+fn buffer_uris_outside_the_models_folder_are_refused_unless_allowed() {
+    let mut b = Builder::default();
+    let doc = triangle(&mut b);
+    let out = Outside::new(&b.bin);
+    std::fs::create_dir(out.model().join("sub")).unwrap();
+    let abs = out.root.path().join("b.bin");
+    #[cfg(unix)]
+    std::os::unix::fs::symlink(&abs, out.model().join("link.bin")).unwrap();
+    let mut uris = vec![
+        "../b.bin".to_string(),
+        "%2e%2e/b.bin".into(),
+        "%2E%2E%2Fb.bin".into(),
+        "sub/../../b.bin".into(),
+        abs.to_str().unwrap().into(),
+        abs.to_str().unwrap().replace('.', "%2e"),
+    ];
+    if cfg!(unix) {
+        uris.push("link.bin".into());
+    }
+    for uri in &uris {
+        let path = write(
+            &out.model(),
+            "m.gltf",
+            b.document(doc.clone(), Some(uri.clone())).to_string(),
+        );
+        let err = load(&path).unwrap_err().to_string();
+        assert!(
+            err.contains("buffers[0].uri") && err.contains("outside the model's folder"),
+            "{uri}: {err}"
+        );
+        assert!(err.contains("--allow-outside-files"), "{err}");
+        let (scene, _) = load_with(&path, true).unwrap_or_else(|e| panic!("{uri}: {e}"));
+        assert_eq!(scene.objects.len(), 1, "{uri}");
+    }
+    // Other systems' absolute forms are refused before anything is looked up.
+    for uri in [
+        "C:/b.bin",
+        "c:%5Cb.bin",
+        "%5C%5Cserver%5Cshare%5Cb.bin",
+        "\\\\server\\b.bin",
+    ] {
+        let path = write(
+            &out.model(),
+            "m.gltf",
+            b.document(doc.clone(), Some(uri.into())).to_string(),
+        );
+        let err = load(&path).unwrap_err().to_string();
+        assert!(err.contains("outside the model's folder"), "{uri}: {err}");
+    }
+    // A file inside the folder is read as before.
+    std::fs::write(out.model().join("in.bin"), &b.bin).unwrap();
+    let path = write(
+        &out.model(),
+        "m.gltf",
+        b.document(doc, Some("./in.bin".into())).to_string(),
+    );
+    assert_eq!(load(&path).unwrap().0.objects.len(), 1);
+}
+
+#[test]
+fn an_index_accessor_over_an_outside_text_file_shows_none_of_its_bytes() {
+    let mut b = Builder::default();
+    let doc = triangle(&mut b);
+    let out = Outside::new(&b.bin);
+    // The text file as a second buffer, read as the indices.
+    let data = format!("data:application/octet-stream;base64,{}", base64(&b.bin));
+    let mut doc = b.document(doc, Some(data));
+    let text = SENTINEL.repeat(4);
+    doc["buffers"]
+        .as_array_mut()
+        .unwrap()
+        .push(json!({"uri": "../secret.txt", "byteLength": text.len()}));
+    doc["bufferViews"][1] = json!({"buffer": 1, "byteOffset": 0, "byteLength": 6});
+    let path = write(&out.model(), "m.gltf", doc.to_string());
+    let refused = load(&path).unwrap_err().to_string();
+    assert!(refused.contains("buffers[1].uri"), "{refused}");
+    // Allowed: read, and the index error says where, not what the bytes were.
+    let err = load_with(&path, true).unwrap_err().to_string();
+    let shown_value = u16::from_le_bytes([text.as_bytes()[0], text.as_bytes()[1]]);
+    assert!(
+        err.contains("element 0 is out of range for 3 vertices"),
+        "{err}"
+    );
+    for secret in [SENTINEL.to_string(), shown_value.to_string()] {
+        assert!(!err.contains(&secret), "{err}");
+    }
+}
+
+#[test]
+fn image_uris_outside_the_models_folder_are_refused_unless_allowed() {
+    let mut b = Builder::default();
+    let prim = b.primitive(&floor(), Some(0));
+    let out = Outside::new(&b.bin);
+    #[cfg(unix)]
+    std::os::unix::fs::symlink(
+        out.root.path().join("secret.png"),
+        out.model().join("link.png"),
+    )
+    .unwrap();
+    let mut uris = vec!["../secret.png", "%2e%2e/secret.png", "..\\secret.png"];
+    if cfg!(unix) {
+        uris.push("link.png");
+    }
+    for uri in uris {
+        let doc = json!({
+            "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+            "meshes": [{"primitives": [prim]}],
+            "materials": [{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}],
+            "textures": [{"source": 0}], "images": [{"uri": uri}],
+        });
+        let path = write(&out.model(), "m.gltf", b.gltf(doc));
+        let err = load(&path).unwrap_err().to_string();
+        assert!(
+            err.contains("images[0].uri") && err.contains("outside the model's folder"),
+            "{uri}: {err}"
+        );
+        if uri.contains('\\') {
+            continue; // a backslash is no separator here: allowed, the file is just absent
+        }
+        let (scene, report) = load_with(&path, true).unwrap();
+        assert!(report.warnings.is_empty(), "{uri}: {:?}", report.warnings);
+        assert!(scene.materials[0].diffuse_texture.is_some(), "{uri}");
+    }
+}
+
+#[test]
+fn a_scene_file_may_name_models_anywhere_but_their_own_uris_stay_confined() {
+    let mut b = Builder::default();
+    let doc = triangle(&mut b);
+    let out = Outside::new(&b.bin);
+    std::fs::write(out.model().join("in.bin"), &b.bin).unwrap();
+    write(
+        &out.model(),
+        "in.gltf",
+        b.document(doc.clone(), Some("in.bin".into())).to_string(),
+    );
+    write(
+        &out.model(),
+        "out.gltf",
+        b.document(doc, Some("../b.bin".into())).to_string(),
+    );
+    let scenes = out.root.path().join("scenes");
+    std::fs::create_dir(&scenes).unwrap();
+    let ok = write(
+        &scenes,
+        "ok.json",
+        r#"{"objects": [{"gltf": "../model/in.gltf"}]}"#,
+    );
+    assert_eq!(load(&ok).unwrap().0.objects.len(), 1);
+    let bad = write(
+        &scenes,
+        "bad.json",
+        r#"{"objects": [{"gltf": "../model/out.gltf"}]}"#,
+    );
+    let err = load(&bad).unwrap_err().to_string();
+    assert!(
+        err.contains("out.gltf") && err.contains("buffers[0].uri"),
+        "{err}"
+    );
+    assert_eq!(load_with(&bad, true).unwrap().0.objects.len(), 1);
+}
+
+#[test]
+fn extras_of_any_json_type_and_custom_attributes_are_valid_and_ignored() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut b = Builder::default();
+    let base = triangle(&mut b);
+    for extras in [
+        json!(5),
+        json!("x"),
+        json!([1, {"a": null}]),
+        json!(null),
+        json!(true),
+        json!({}),
+    ] {
+        let mut doc = base.clone();
+        doc["extras"] = extras.clone();
+        doc["nodes"][0]["extras"] = extras.clone();
+        doc["scenes"][0]["extras"] = extras.clone();
+        doc["meshes"][0]["extras"] = extras.clone();
+        doc["meshes"][0]["primitives"][0]["extras"] = extras.clone();
+        let mut doc = b.document(doc, None);
+        doc["asset"]["extras"] = extras.clone();
+        doc["accessors"][0]["extras"] = extras.clone();
+        doc["buffers"][0]["uri"] = json!(format!(
+            "data:application/octet-stream;base64,{}",
+            base64(&b.bin)
+        ));
+        doc["buffers"][0]["extras"] = extras.clone();
+        // An application-specific attribute (a leading underscore) is valid glTF too.
+        doc["meshes"][0]["primitives"][0]["attributes"]["_TEMPERATURE"] = json!(0);
+        let path = write(dir.path(), "extras.gltf", doc.to_string());
+        let (scene, _) = load(&path).unwrap_or_else(|e| panic!("extras {extras}: {e}"));
+        assert_eq!(scene.objects.len(), 1);
+    }
+}
+
+#[test]
+fn gltf_files_and_buffers_are_named_as_such_in_limit_errors() {
+    let out = Outside::new(&[]);
+    let folder = out.model().join("folder.gltf");
+    std::fs::create_dir(&folder).unwrap();
+    let err = load(&folder).unwrap_err().to_string();
+    assert!(err.contains("the glTF file must be a file"), "{err}");
+    assert!(!err.contains("OBJ"), "{err}");
+    #[cfg(unix)]
+    {
+        let mut b = Builder::default();
+        let doc = triangle(&mut b);
+        let path = write(
+            &out.model(),
+            "zero.gltf",
+            b.document(doc, Some("/dev/zero".into())).to_string(),
+        );
+        assert!(load(&path).unwrap_err().to_string().contains("outside"));
+        let err = load_with(&path, true).unwrap_err().to_string();
+        assert!(
+            err.contains("buffers[0]") && err.contains("the glTF buffer must be a file"),
+            "{err}"
+        );
+    }
+}
+
+#[test]
+fn structural_values_that_wrap_or_cannot_be_drawn_are_refused_by_field() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut b = Builder::default();
+    let base = triangle(&mut b);
+    // 2³² + 4 would wrap to TRIANGLES, 2³² to POINTS (and be skipped): both refused.
+    let mode = "/meshes/0/primitives/0/mode";
+    let cases = [
+        (
+            "mode",
+            mode,
+            json!(4294967300u64),
+            "meshes[0].primitives[0].mode: a number past",
+        ),
+        (
+            "mode0",
+            mode,
+            json!(4294967296u64),
+            "meshes[0].primitives[0].mode",
+        ),
+        (
+            "mesh",
+            "/nodes/0/mesh",
+            json!(4294967296u64),
+            "nodes[0].mesh",
+        ),
+        (
+            "projective",
+            "/nodes/0/matrix",
+            json!([1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, -1, 0, 0, 0, 1]),
+            "nodes[0].matrix: not an affine transform (last row 0 0 -1 1",
+        ),
+        (
+            "zero_row",
+            "/nodes/0/matrix",
+            json!([1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 0]),
+            "nodes[0].matrix: not an affine transform (last row 0 0 0 0",
+        ),
+    ];
+    for (name, pointer, value, want) in cases {
+        let mut doc = base.clone();
+        let (parent, key) = pointer.rsplit_once('/').unwrap();
+        doc.pointer_mut(parent).unwrap()[key] = value;
+        let path = write(dir.path(), &format!("{name}.gltf"), b.gltf(doc));
+        let err = load(&path).unwrap_err().to_string();
+        assert!(err.contains(want), "{name}: {err}");
+    }
+    // A flat (singular) matrix is a flat object, not an error.
+    let mut doc = base.clone();
+    doc["nodes"][0]["matrix"] = json!([1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1]);
+    let path = write(dir.path(), "flat.gltf", b.gltf(doc));
+    assert_eq!(load(&path).unwrap().0.objects.len(), 1);
+    // A GLB whose first chunk is neither JSON nor BIN says what it is.
+    let mut bytes = b.glb(base);
+    bytes[16..20].copy_from_slice(b"ABCD");
+    let path = write(dir.path(), "chunk.glb", &bytes);
+    let err = load(&path).unwrap_err().to_string();
+    assert!(
+        err.contains("first chunk has type 0x44434241 `ABCD`"),
+        "{err}"
+    );
+}
+
+#[test]
+fn a_scene_files_transform_that_places_a_model_out_of_range_is_blamed_on_the_scene_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut b = Builder::default();
+    let mut doc = lights_document(&mut b);
+    doc["cameras"] = json!([{"type": "perspective", "perspective": {"yfov": 0.8, "znear": 0.1}}]);
+    doc["nodes"][4]["camera"] = json!(0);
+    write(dir.path(), "lamps.gltf", b.gltf(doc.clone()));
+    // Lights and a camera only, no mesh: placed far by the transform all the same.
+    doc["nodes"][0].as_object_mut().unwrap().remove("mesh");
+    write(dir.path(), "lights.gltf", b.gltf(doc));
+    // A mesh only.
+    let mut t = Builder::default();
+    let tri = triangle(&mut t);
+    write(dir.path(), "tri.gltf", t.gltf(tri));
+    write(dir.path(), "q.obj", quad_obj(&floor(), "q"));
+    write(dir.path(), "q.mtl", "newmtl q\nKd 1 1 1\n");
+    for (model, transform) in [
+        (r#""gltf": "lamps.gltf""#, r#"{"translate": [1e13, 0, 0]}"#),
+        (r#""gltf": "lamps.gltf""#, r#"{"scale": 1e300}"#),
+        (
+            r#""gltf": "lights.gltf""#,
+            r#"{"translate": [0, -2e12, 0]}"#,
+        ),
+        (r#""gltf": "tri.gltf""#, r#"{"translate": [0, 0, 5e12]}"#),
+        (r#""obj": "q.obj""#, r#"{"translate": [0, 0, 5e12]}"#),
+        (r#""builtin": "plane""#, r#"{"scale": [1e200, 1, 1]}"#),
+    ] {
+        let text = format!(
+            r#"{{"objects": [{{"builtin": "plane"}}, {{{model}, "transform": {transform}}}]}}"#
+        );
+        let path = write(dir.path(), "far.json", &text);
+        let err = load(&path).unwrap_err().to_string();
+        assert!(err.contains("`objects[1].transform`"), "{text}: {err}");
+        assert!(
+            !err.contains("malformed glTF") && !err.contains("camera.position"),
+            "{err}"
+        );
+    }
+    // Within range, but too large for a camera framing it to stay within range: the missing
+    // `camera` is named, and giving one loads.
+    let big = r#"{"builtin": "plane", "transform": {"scale": 1e11}}"#;
+    // Two objects: framed rather than the built-in's own camera.
+    let objects = format!(r#""objects": [{big}, {{"builtin": "plane"}}]"#);
+    let path = write(dir.path(), "big.json", format!("{{{objects}}}"));
+    let err = load(&path).unwrap_err().to_string();
+    assert!(
+        err.contains("`camera`") && err.contains("give `camera`"),
+        "{err}"
+    );
+    let camera = r#""camera": {"position": [0, 1, 9e11], "target": [0, 0, 0]}"#;
+    let text = format!("{{{objects}, {camera}}}");
+    let path = write(dir.path(), "big.json", &text);
+    load(&path).unwrap();
+}
+
+#[test]
+fn the_cli_refuses_an_outside_buffer_unless_allow_outside_files_is_given() {
+    let mut b = Builder::default();
+    let doc = triangle(&mut b);
+    let out = Outside::new(&b.bin);
+    let gltf = b.document(doc, Some("../b.bin".into())).to_string();
+    write(&out.model(), "m.gltf", gltf);
+    let args = [
+        "render",
+        "--scene",
+        "model/m.gltf",
+        "--size",
+        "64x36",
+        "--lights",
+        "4",
+        "--out",
+        "o.png",
+    ];
+    let refused = common::cli::expect_exit(&args, &[], out.root.path(), 1, "buffers[0].uri");
+    assert!(refused.contains("--allow-outside-files"), "{refused}");
+    assert!(!out.root.path().join("o.png").exists());
+    let allowed = [&args[..], &["--allow-outside-files"]].concat();
+    common::cli::expect_status(&allowed, &[], out.root.path(), 0);
+    assert!(out.root.path().join("o.png").is_file());
 }

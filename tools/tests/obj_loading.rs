@@ -224,12 +224,12 @@ fn malformed_obj_files_are_clear_errors() {
         (
             "oob.obj",
             "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n",
-            "line 4: `f` refers to vertex `9`",
+            "line 4: `f` corner 3: its vertex index is not one of the 3",
         ),
         (
             "vt.obj",
             "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1/1 2/-3 3/1\n",
-            "texture coordinate `-3`",
+            "corner 2: its texture coordinate index",
         ),
         (
             "nan.obj",
@@ -432,4 +432,59 @@ fn files_tobj_accepts_are_not_refused_by_the_checks() {
         scene.materials.iter().any(|m| m.diffuse_texture.is_some()),
         "grass.tga bound"
     );
+}
+
+#[test]
+fn a_latin1_name_loads_with_a_warning_and_cr_only_lines_load_as_lf_ones() {
+    let dir = tempfile::tempdir().unwrap();
+    let lf = "mtllib m.mtl\no quad\nusemtl red\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n";
+    std::fs::write(dir.path().join("m.mtl"), "newmtl red\nKd 1 0 0\n").unwrap();
+    let (want, report) = load_obj(&write(dir.path(), "lf.obj", lf)).unwrap();
+    assert!(report.warnings.is_empty(), "{:?}", report.warnings);
+    // Old Mac line ends: a lone CR ends a line, in the OBJ and in its MTL.
+    std::fs::write(dir.path().join("cr.mtl"), "newmtl red\rKd 1 0 0\r").unwrap();
+    let cr = lf.replace("m.mtl", "cr.mtl").replace('\n', "\r");
+    let (got, report) = load_obj(&write(dir.path(), "cr.obj", &cr)).unwrap();
+    assert!(report.warnings.is_empty(), "{:?}", report.warnings);
+    assert_eq!(got.objects.len(), want.objects.len());
+    assert_eq!(
+        got.objects[0].mesh.positions,
+        want.objects[0].mesh.positions
+    );
+    assert_eq!(got.objects[0].mesh.indices, want.objects[0].mesh.indices);
+    assert_eq!(got.materials[0].diffuse, want.materials[0].diffuse);
+    // A Latin-1 object name (`é` as the single byte 0xE9): loaded, with a warning.
+    let mut latin1 = lf.replace("o quad", "o caf\u{1}").into_bytes();
+    let at = latin1.iter().position(|&b| b == 1).unwrap();
+    latin1[at] = 0xE9;
+    let path = dir.path().join("latin1.obj");
+    std::fs::write(&path, &latin1).unwrap();
+    let (got, report) = load_obj(&path).unwrap();
+    assert_eq!(
+        got.objects[0].mesh.positions,
+        want.objects[0].mesh.positions
+    );
+    assert!(
+        report.warnings.iter().any(|w| w.contains("not UTF-8")),
+        "{:?}",
+        report.warnings
+    );
+}
+
+#[test]
+fn obj_and_mtl_errors_do_not_show_the_files_text() {
+    let dir = tempfile::tempdir().unwrap();
+    let secret = "hunter2-secret";
+    for (name, text) in [
+        ("word.obj", format!("v 1 2 {secret}\nf 1 1 1\n")),
+        (
+            "face.obj",
+            format!("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 {secret}\n"),
+        ),
+    ] {
+        let err = load_obj(&write(dir.path(), name, &text))
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("line ") && !err.contains(secret), "{err}");
+    }
 }

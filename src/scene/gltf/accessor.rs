@@ -206,7 +206,7 @@ fn read<T: Copy + Default>(
             let target = component_u32(&ibytes[at..at + isize], itype) as usize;
             if target >= count {
                 return Err(format!(
-                    "{field}.indices: element {k} is {target}, out of range for {count} elements"
+                    "{field}.indices: element {k} is out of range for {count} elements"
                 ));
             }
             for c in 0..d {

@@ -1,14 +1,16 @@
 //! The bytes of a glTF file's buffers: the GLB's BIN chunk, `data:` URIs and files next to the
 //! `.gltf`, each read once, when first used, within the model size limit.
 //!
-//! Files are read through [`read_bounded`] (regular files only, [`FileKind::Model`]'s limit),
-//! and all buffers together may hold at most that same limit: a file cannot name the same
-//! 1 GiB file a thousand times.
+//! Files are read through [`read_bounded`] (regular files only, [`FileKind::GltfBuffer`]'s
+//! limit), and all buffers together may hold at most that same limit: a file cannot name the
+//! same 1 GiB file a thousand times. A file URI may name only a file inside the glTF file's
+//! folder unless the load allows outside files ([`crate::scene::access`]).
 
 use std::borrow::Cow;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use super::uri::{self, Uri};
+use crate::scene::access;
 use crate::scene::input::{read_bounded, FileKind};
 
 /// Lazily loaded buffer contents of one glTF document.
@@ -16,6 +18,7 @@ pub(super) struct Buffers<'a> {
     document: &'a gltf::Document,
     bin: Option<&'a [u8]>,
     base_dir: &'a Path,
+    allow_outside: bool,
     loaded: Vec<Option<Cow<'a, [u8]>>>,
     /// Bytes still allowed to be read or decoded into buffers.
     budget: u64,
@@ -23,15 +26,35 @@ pub(super) struct Buffers<'a> {
 
 impl<'a> Buffers<'a> {
     /// Buffers of `document`; `bin` is the GLB's BIN chunk, `base_dir` the folder relative
-    /// file URIs start from.
-    pub fn new(document: &'a gltf::Document, bin: Option<&'a [u8]>, base_dir: &'a Path) -> Self {
+    /// file URIs start from; `allow_outside` lets URIs name files outside it.
+    pub fn new(
+        document: &'a gltf::Document,
+        bin: Option<&'a [u8]>,
+        base_dir: &'a Path,
+        allow_outside: bool,
+    ) -> Self {
         Buffers {
             document,
             bin,
             base_dir,
+            allow_outside,
             loaded: vec![None; document.buffers().len()],
-            budget: FileKind::Model.limit(),
+            budget: FileKind::GltfBuffer.limit(),
         }
+    }
+
+    /// The file a URI of this document names (`name`, percent-decoded), refused when it lies
+    /// outside the glTF file's folder and the load does not allow that. `field` names the URI.
+    pub fn file(&self, field: &str, name: &str) -> Result<PathBuf, String> {
+        let path = access::join(self.base_dir, name, self.allow_outside)
+            .and_then(|p| access::resolve(self.base_dir, &p, self.allow_outside))
+            .map_err(|e| format!("{field}: {e}"))?;
+        Ok(path)
+    }
+
+    /// The folder relative file URIs start from, and whether names may leave it.
+    pub fn base_dir(&self) -> (&'a Path, bool) {
+        (self.base_dir, self.allow_outside)
     }
 
     /// The document the buffers belong to.
@@ -97,7 +120,7 @@ impl<'a> Buffers<'a> {
                         "{field}: byteLength {length} exceeds the {} bytes left of the {}-byte \
                          limit on a model's buffers (set {} to raise it)",
                         self.budget,
-                        FileKind::Model.limit(),
+                        FileKind::GltfBuffer.limit(),
                         crate::scene::input::LIMIT_VARIABLE
                     ));
                 }
@@ -109,8 +132,8 @@ impl<'a> Buffers<'a> {
                         Cow::Owned(bytes)
                     }
                     Uri::File(name) => {
-                        let path = self.base_dir.join(&name);
-                        let bytes = read_bounded(&path, FileKind::Model)
+                        let path = self.file(&format!("{field}.uri"), &name)?;
+                        let bytes = read_bounded(&path, FileKind::GltfBuffer)
                             .map_err(|e| format!("{field}: {e}"))?;
                         if bytes.len() < length {
                             return Err(too_short(path.display().to_string(), bytes.len()));

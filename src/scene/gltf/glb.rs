@@ -21,6 +21,22 @@ fn u32_at(bytes: &[u8], at: usize) -> Option<u32> {
     Some(u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
 }
 
+/// A chunk type for messages: its number, and its four bytes when they are printable ASCII
+/// (`0x004E4942 \`BIN\``).
+fn chunk_type(kind: u32) -> String {
+    let bytes = kind.to_le_bytes();
+    let printable = bytes.iter().all(|b| b.is_ascii_graphic() || *b == 0 || *b == b' ');
+    let text: String = bytes
+        .iter()
+        .map(|&b| if b == 0 { "\\0".to_string() } else { (b as char).to_string() })
+        .collect();
+    if printable {
+        format!("0x{kind:08X} `{text}`")
+    } else {
+        format!("0x{kind:08X}")
+    }
+}
+
 /// Splits a GLB file into its chunks; errors say what is truncated or wrong.
 pub(super) fn split(bytes: &[u8]) -> Result<Glb<'_>, String> {
     if bytes.len() < 12 {
@@ -69,11 +85,14 @@ pub(super) fn split(bytes: &[u8]) -> Result<Glb<'_>, String> {
             })?;
         let data = &body[start..end];
         match kind {
-            CHUNK_JSON if json.is_none() && at == 12 => json = Some(data),
-            CHUNK_JSON => return Err(format!("GLB has a second JSON chunk at byte {at}")),
-            CHUNK_BIN if json.is_none() => {
-                return Err("GLB's first chunk is BIN; it must be JSON".into())
+            CHUNK_JSON if json.is_none() => json = Some(data),
+            _ if json.is_none() => {
+                return Err(format!(
+                    "GLB's first chunk has type {}; it must be JSON (0x{CHUNK_JSON:08X} `JSON`)",
+                    chunk_type(kind)
+                ))
             }
+            CHUNK_JSON => return Err(format!("GLB has a second JSON chunk at byte {at}")),
             CHUNK_BIN if bin.is_none() => bin = Some(data),
             // Further BIN chunks and chunks of unknown types are ignored (the format says so).
             _ => {}
@@ -142,5 +161,20 @@ mod tests {
         let mut long = file.clone();
         long[12..16].copy_from_slice(&u32::MAX.to_le_bytes());
         assert!(split(&long).unwrap_err().contains("chunk at byte 12"));
+    }
+
+    #[test]
+    fn a_first_chunk_that_is_not_json_is_named_by_its_type() {
+        let file = glb(br#"{"asset":{"version":"2.0"}}"#, Some(&[1, 2, 3, 4]));
+        for (kind, want) in [
+            (*b"BIN\0", "0x004E4942 `BIN\\0`"),
+            (*b"XYZW", "0x575A5958 `XYZW`"),
+            ([1, 2, 3, 200], "type 0xC8030201;"),
+        ] {
+            let mut bad = file.clone();
+            bad[16..20].copy_from_slice(&kind);
+            let err = split(&bad).unwrap_err();
+            assert!(err.contains("first chunk has type") && err.contains(want), "{err}");
+        }
     }
 }

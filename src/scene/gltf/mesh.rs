@@ -1,7 +1,8 @@
 //! Mesh primitives → [`Mesh`]: positions, normals (flat ones computed when the primitive has
 //! none, as glTF asks), `TEXCOORD_0`, indices (u8, u16, u32 or none), triangle strips and fans
 //! unrolled into lists. Every index is checked against the vertex count and every position
-//! against [`MAX_VERTEX_COORD`], with the glTF path in the message.
+//! against [`MAX_VERTEX_COORD`], with the glTF path and the element's position in the message
+//! (never its value: buffer bytes are not shown).
 
 use glam::{Vec2, Vec3};
 use gltf::accessor::DataType;
@@ -81,13 +82,13 @@ pub(super) fn build(
     for (i, v) in positions.iter().enumerate() {
         if !v.is_finite() {
             return Err(format!(
-                "{pos_field}: element {i} is {v:?}; positions must be finite"
+                "{pos_field}: element {i} is not finite; positions must be"
             ));
         }
         if v.abs().max_element() > MAX_VERTEX_COORD {
             return Err(format!(
-                "{pos_field}: element {i} is {v:?}, past ±{MAX_VERTEX_COORD:e} (object space \
-                 is f32; place far objects with their node's transform)"
+                "{pos_field}: element {i} lies past ±{MAX_VERTEX_COORD:e} (object space is \
+                 f32; place far objects with their node's transform)"
             ));
         }
     }
@@ -131,9 +132,8 @@ pub(super) fn build(
             uvs = raw.chunks_exact(2).map(Vec2::from_slice).collect();
             if let Some(i) = uvs.iter().position(|t| !t.is_finite()) {
                 return Err(format!(
-                    "{}: element {i} is {:?}; texture coordinates must be finite",
-                    attr("TEXCOORD_0", &a),
-                    uvs[i]
+                    "{}: element {i} is not finite; texture coordinates must be",
+                    attr("TEXCOORD_0", &a)
                 ));
             }
         } else {
@@ -159,8 +159,7 @@ pub(super) fn build(
                 accessor::read_u32(&a, buffers, a.count()).map_err(|e| format!("{ifield}: {e}"))?;
             if let Some(k) = indices.iter().position(|&i| i as usize >= n) {
                 return Err(format!(
-                    "{ifield}: element {k} is {}, out of range for {n} vertices",
-                    indices[k]
+                    "{ifield}: element {k} is out of range for {n} vertices"
                 ));
             }
             indices

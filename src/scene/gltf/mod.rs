@@ -14,14 +14,18 @@
 //! - `KHR_lights_punctual` point and spot lights ([`lights`]).
 //!
 //! Malformed files are [`SceneError::Gltf`] errors naming the file and the glTF path
-//! (`meshes[2].primitives[0].indices (accessors[5]): element 7 is 9, out of range for 4
-//! vertices`). The crate runs under `catch_unwind` as a last guard: a panic inside it becomes
-//! such an error, never an abort of the caller.
+//! (`meshes[2].primitives[0].indices (accessors[5]): element 7 is out of range for 4
+//! vertices`); no message shows the bytes of a buffer. A transform that places the file
+//! badly is blamed on the caller's field (`objects[2].transform` of a scene file). Buffer and
+//! image URIs may name only files inside the glTF file's folder unless [`LoadOptions`] allows
+//! more. The crate runs under `catch_unwind` as a last guard: a panic inside it becomes such
+//! an error, never an abort of the caller.
 
 mod accessor;
 mod buffers;
 pub mod camera;
 mod glb;
+mod integers;
 pub mod lights;
 pub mod material;
 pub mod mesh;
@@ -39,6 +43,7 @@ use glam::DMat4;
 pub use lights::{unbounded_radius, CANDELA_TO_INTENSITY, UNBOUNDED_CUTOFF};
 pub use material::{shininess, DIELECTRIC_SPECULAR};
 
+use super::access::LoadOptions;
 use super::camera::MAX_CAMERA_COORD;
 use super::input::{self, read_bounded, FileKind};
 use super::obj::LoadReport;
@@ -70,12 +75,16 @@ pub struct GltfLoad {
 /// Loads what `--scene file.gltf|file.glb` names: the file's objects, materials and lights,
 /// its camera (or one framing its bounds, as for OBJ), and `lights` = `Some((count, seed))`
 /// seeded random lights added to the file's own (`count` 0: the file's lights only).
-pub fn load(path: &Path, lights: Option<(usize, u64)>) -> Result<(Scene, LoadReport), SceneError> {
+pub fn load(
+    path: &Path,
+    lights: Option<(usize, u64)>,
+    options: &LoadOptions,
+) -> Result<(Scene, LoadReport), SceneError> {
     if let Some((count, _)) = lights {
         input::check_light_count(count, "lights")?;
     }
     let mut scene = Scene::empty();
-    let loaded = load_into(&mut scene, path, DMat4::IDENTITY)?;
+    let loaded = load_into(&mut scene, path, DMat4::IDENTITY, "transform", options)?;
     match loaded.camera {
         Some(camera) => scene.camera = camera,
         None => scene.frame_camera(),
@@ -98,21 +107,36 @@ pub fn load(path: &Path, lights: Option<(usize, u64)>) -> Result<(Scene, LoadRep
 /// Loads a glTF file into `scene`, placing it with `transform`: objects and materials are
 /// appended, lights appended in world space (moved and turned by `transform`; their radius is
 /// not scaled). The scene's camera is left alone: the file's own comes back in the result.
-/// On error `scene` is unchanged.
-pub fn load_into(scene: &mut Scene, path: &Path, transform: DMat4) -> Result<GltfLoad, SceneError> {
-    let bytes = read_bounded(path, FileKind::Model)?;
+/// A transform that puts what the file holds out of range is an [`SceneError::Invalid`] of
+/// `transform_field` (what the caller calls it, e.g. `objects[2].transform`). On error
+/// `scene` is unchanged.
+pub fn load_into(
+    scene: &mut Scene,
+    path: &Path,
+    transform: DMat4,
+    transform_field: &str,
+    options: &LoadOptions,
+) -> Result<GltfLoad, SceneError> {
+    if !transform.is_finite() {
+        return Err(SceneError::invalid(transform_field, "must be finite"));
+    }
+    let bytes = read_bounded(path, FileKind::Gltf)?;
     let error = |reason: String| SceneError::Gltf {
         path: path.to_path_buf(),
         reason,
     };
-    if !transform.is_finite() {
-        return Err(error("the placing transform is not finite".into()));
-    }
     let imported = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        import(&bytes, path, transform)
+        import(&bytes, path, transform, options)
     }));
     let imported = match imported {
-        Ok(result) => result.map_err(error)?,
+        Ok(Ok(imported)) => imported,
+        Ok(Err(Fault::File(reason))) => return Err(error(reason)),
+        Ok(Err(Fault::Placing(reason))) => {
+            return Err(SceneError::invalid(
+                transform_field,
+                format!("{reason} (in {})", path.display()),
+            ))
+        }
         Err(_) => {
             return Err(error(
                 "the glTF parser (gltf crate) failed on this file; it is malformed".into(),
@@ -142,6 +166,18 @@ pub fn load_into(scene: &mut Scene, path: &Path, transform: DMat4) -> Result<Glt
     })
 }
 
+/// Why an import failed: the file itself, or the caller's transform placing what is in it.
+enum Fault {
+    File(String),
+    Placing(String),
+}
+
+impl From<String> for Fault {
+    fn from(reason: String) -> Self {
+        Fault::File(reason)
+    }
+}
+
 /// A built primitive and its object-space bounds.
 type BuiltMesh = (Arc<Mesh>, Option<Aabb>);
 
@@ -154,7 +190,14 @@ struct Imported {
     warnings: Vec<String>,
 }
 
-fn import(bytes: &[u8], path: &Path, transform: DMat4) -> Result<Imported, String> {
+/// Everything is converted and checked in the file's own space first (faults are the file's),
+/// then placed by `transform` and checked again (faults are the transform's).
+fn import(
+    bytes: &[u8],
+    path: &Path,
+    transform: DMat4,
+    options: &LoadOptions,
+) -> Result<Imported, Fault> {
     let (json, bin) = if bytes.starts_with(glb::MAGIC) {
         let g = glb::split(bytes)?;
         (g.json, g.bin)
@@ -162,6 +205,7 @@ fn import(bytes: &[u8], path: &Path, transform: DMat4) -> Result<Imported, Strin
         (bytes, None)
     };
     let root = gltf::json::deserialize::from_slice(json).map_err(|e| format!("JSON: {e}"))?;
+    integers::check(json)?;
     validate(&root)?;
     let document = gltf::Document::from_json_without_validation(root);
     let locals = nodes::local_transforms(json)?;
@@ -170,7 +214,8 @@ fn import(bytes: &[u8], path: &Path, transform: DMat4) -> Result<Imported, Strin
             "nodes: {} read in f64 but {} parsed",
             locals.len(),
             document.nodes().len()
-        ));
+        )
+        .into());
     }
     let mut warnings = Vec::new();
     let unsupported: Vec<&str> = document
@@ -184,9 +229,10 @@ fn import(bytes: &[u8], path: &Path, transform: DMat4) -> Result<Imported, Strin
         ));
     }
     let base_dir = path.parent().unwrap_or(Path::new("."));
-    let mut buffers = buffers::Buffers::new(&document, bin, base_dir);
+    let mut buffers =
+        buffers::Buffers::new(&document, bin, base_dir, options.allow_outside_files);
     let (roots, from) = nodes::roots(&document);
-    let placed = nodes::walk(&document, &roots, &locals, transform)?;
+    let placed = nodes::walk(&document, &roots, &locals, DMat4::IDENTITY)?;
 
     let mut budget = mesh::Budget {
         vertices: MAX_VERTICES,
@@ -208,6 +254,8 @@ fn import(bytes: &[u8], path: &Path, transform: DMat4) -> Result<Imported, Strin
             continue;
         };
         let field = format!("nodes[{}]", p.node);
+        let world = transform * p.world;
+        let placing = |e: String| Fault::Placing(format!("placing {field}: {e}"));
         skinned |= node.skin().is_some();
         if let Some(m) = node.mesh() {
             morphed |= m.primitives().any(|pr| pr.morph_targets().next().is_some());
@@ -236,17 +284,19 @@ fn import(bytes: &[u8], path: &Path, transform: DMat4) -> Result<Imported, Strin
                 };
                 check_placement(bounds, &p.world)
                     .map_err(|e| format!("{field} placing {pfield}: {e}"))?;
+                check_placement(bounds, &world).map_err(|e| placing(format!("{pfield}: {e}")))?;
                 let material =
                     materials.get(&prim.material(), &mut buffers, path, &mut warnings)?;
                 if out.objects.len() >= MAX_OBJECTS {
                     return Err(format!(
                         "{field}: more than {MAX_OBJECTS} placed primitives (the limit per file)"
-                    ));
+                    )
+                    .into());
                 }
                 out.objects.push(Object {
                     mesh,
                     material,
-                    transform: p.world,
+                    transform: world,
                 });
             }
         }
@@ -256,13 +306,20 @@ fn import(bytes: &[u8], path: &Path, transform: DMat4) -> Result<Imported, Strin
                 light.index()
             );
             match lights::convert(&light, &p.world, &lfield)? {
-                lights::Converted::Light(l) => out.lights.push(l),
+                // Checked in the file's space; now placed.
+                lights::Converted::Light(_) => {
+                    match lights::convert(&light, &world, &lfield).map_err(placing)? {
+                        lights::Converted::Light(l) => out.lights.push(l),
+                        lights::Converted::Skipped(why) => warnings.push(why),
+                    }
+                }
                 lights::Converted::Skipped(why) => warnings.push(why),
             }
         }
         if let (Some(cam), None) = (node.camera(), &out.camera) {
             let cfield = format!("{field} (cameras[{}])", cam.index());
-            out.camera = Some(camera::convert(&document, &cam, &p.world, &cfield)?);
+            camera::convert(&document, &cam, &p.world, &cfield)?;
+            out.camera = Some(camera::convert(&document, &cam, &world, &cfield).map_err(placing)?);
         }
     }
     if skinned || morphed {
@@ -271,7 +328,8 @@ fn import(bytes: &[u8], path: &Path, transform: DMat4) -> Result<Imported, Strin
     if out.objects.is_empty() && out.lights.is_empty() {
         return Err(format!(
             "nothing to show: {from} place no triangle mesh and no light"
-        ));
+        )
+        .into());
     }
     out.materials = materials.list;
     out.warnings = warnings;

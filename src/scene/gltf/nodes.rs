@@ -30,11 +30,7 @@ pub(super) fn local_transforms(json: &[u8]) -> Result<Vec<DMat4>, String> {
         .map(|(i, n)| {
             let field = format!("nodes[{i}]");
             if let Some(m) = n.matrix {
-                let m = DMat4::from_cols_array(&m);
-                if !m.is_finite() {
-                    return Err(format!("{field}.matrix: must be finite"));
-                }
-                return Ok(m);
+                return matrix(&m).map_err(|e| format!("{field}.matrix: {e}"));
             }
             let t = DVec3::from(n.translation.unwrap_or([0.0; 3]));
             let s = DVec3::from(n.scale.unwrap_or([1.0; 3]));
@@ -58,6 +54,31 @@ pub(super) fn local_transforms(json: &[u8]) -> Result<Vec<DMat4>, String> {
             Ok(DMat4::from_scale_rotation_translation(s, q, t))
         })
         .collect()
+}
+
+/// Most a `matrix`'s last row may differ from `0 0 0 1` (exporters round) before it is refused.
+const AFFINE_TOLERANCE: f64 = 1e-6;
+
+/// A node's `matrix` (column-major): finite and affine (glTF asks for a TRS matrix; a
+/// projective one would put every vertex at w ≠ 1, a last row of zeros at infinity). A
+/// singular one is kept: it flattens its node, as a zero scale does.
+fn matrix(m: &[f64; 16]) -> Result<DMat4, String> {
+    let mut m = DMat4::from_cols_array(m);
+    if !m.is_finite() {
+        return Err("must be finite".into());
+    }
+    let last = m.row(3);
+    if (last - glam::DVec4::W).abs().max_element() > AFFINE_TOLERANCE {
+        return Err(format!(
+            "not an affine transform (last row {} {} {} {}, must be 0 0 0 1)",
+            last.x, last.y, last.z, last.w
+        ));
+    }
+    for col in [&mut m.x_axis, &mut m.y_axis, &mut m.z_axis] {
+        col.w = 0.0;
+    }
+    m.w_axis.w = 1.0;
+    Ok(m)
 }
 
 /// A node reached from the scene's roots, with its world transform.
@@ -188,6 +209,30 @@ mod tests {
             DVec3::new(1.0, 2.0, 3.0)
         );
         assert!(local_transforms(b"{}").unwrap().is_empty());
+    }
+
+    #[test]
+    fn a_matrix_must_be_affine_and_finite_and_may_be_singular() {
+        let node = |m: &str| format!(r#"{{"nodes": [{{}}, {{"matrix": [{m}]}}]}}"#);
+        for (m, want) in [
+            ("1,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,0,0", "last row 0 0 0 0"),
+            ("1,0,0,0.5, 0,1,0,0, 0,0,1,0, 0,0,0,1", "last row 0.5 0 0 1"),
+            ("1,0,0,0, 0,1,0,0, 0,0,1,-1, 0,0,0,1", "last row 0 0 -1 1"),
+            ("1,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,0,2", "last row 0 0 0 2"),
+        ] {
+            let err = local_transforms(node(m).as_bytes()).unwrap_err();
+            assert!(err.starts_with("nodes[1].matrix: not an affine"), "{err}");
+            assert!(err.contains(want), "{err}");
+        }
+        // JSON cannot hold infinity; a number past f64 is refused as it is read.
+        assert!(local_transforms(node("1e999,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,0,1").as_bytes()).is_err());
+        // Flat (singular) and nearly affine (rounded by an exporter) matrices are kept; the
+        // rounding is snapped away.
+        let flat = local_transforms(node("1,0,0,0, 0,0,0,0, 0,0,1,0, 0,0,0,1").as_bytes());
+        assert_eq!(flat.unwrap()[1].y_axis, glam::DVec4::ZERO);
+        let rounded =
+            local_transforms(node("1,0,0,1e-9, 0,1,0,0, 0,0,1,0, 0,0,0,0.9999999").as_bytes());
+        assert_eq!(rounded.unwrap()[1], DMat4::IDENTITY);
     }
 
     #[test]

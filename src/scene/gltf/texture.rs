@@ -2,7 +2,8 @@
 //! to the `.gltf`. Decoded with the limits the OBJ loader's textures have (at most
 //! [`MAX_TEXTURE_SIDE`](crate::scene::obj::MAX_TEXTURE_SIDE) pixels a side, files within [`FileKind::Texture`]'s limit); an image
 //! that is missing or does not decode is a warning and its material keeps its flat colour,
-//! never an abort — as with OBJ.
+//! never an abort — as with OBJ. A file outside the glTF file's folder is refused unless the
+//! load allows it ([`crate::scene::access`]).
 
 use std::collections::HashMap;
 use std::path::Path;
@@ -10,6 +11,7 @@ use std::sync::Arc;
 
 use super::buffers::Buffers;
 use super::uri::{self, Uri};
+use crate::scene::access;
 use crate::scene::input::{read_bounded, FileKind, LIMIT_VARIABLE};
 use crate::scene::obj::{decode_texture_bytes, resolve_texture};
 use crate::scene::Texture;
@@ -127,14 +129,24 @@ fn encoded(
             }))
         }
         Ok(Uri::File(name)) => {
-            let base_dir = gltf_path.parent().unwrap_or(Path::new("."));
-            let as_written = base_dir.join(&name);
+            let (base_dir, allow_outside) = buffers.base_dir();
+            let uri_field = format!("{field}.uri");
+            let as_written = access::join(base_dir, &name, allow_outside)
+                .map_err(|e| format!("{uri_field}: {e}"))?;
             // As written first (names may hold spaces); then in other letter case or
-            // flattened folders, as OBJ textures are found.
+            // flattened folders, as OBJ textures are found. Wherever found, it must lie
+            // inside the folder (a link may lead out).
             let path = if as_written.is_file() {
                 Some(as_written)
             } else {
                 resolve_texture(base_dir, &name)
+            };
+            let path = match path {
+                Some(p) => Some(
+                    access::resolve(base_dir, &p, allow_outside)
+                        .map_err(|e| format!("{uri_field}: {e}"))?,
+                ),
+                None => None,
             };
             let Some(path) = path else {
                 return Ok(Err(format!(

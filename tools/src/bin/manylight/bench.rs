@@ -344,7 +344,8 @@ pub fn run(args: &BenchArgs) -> Result<(), Box<dyn std::error::Error>> {
         let mut renderer = Renderer::new(ctx.load_gl(), es)?;
         for spec in &plan.scenes {
             for &count in &plan.lights {
-                let (scene, _) = scene::load(spec, Some((count, args.seed)))?;
+                let (scene, _) =
+                    scene::load_with(spec, Some((count, args.seed)), &crate::load_options())?;
                 let name = scene_name(spec);
                 progress.set_message(format!("{es} {name} {count} lights: reference"));
                 // The geometry, and so its ray caster, is the same at every light count.
@@ -401,7 +402,11 @@ pub fn run(args: &BenchArgs) -> Result<(), Box<dyn std::error::Error>> {
             }
         }
         if plan.animated_frames > 0 && !knob_scene.is_empty() {
-            let (scene, _) = scene::load(&knob_scene, Some((knob_lights, args.seed)))?;
+            let (scene, _) = scene::load_with(
+                &knob_scene,
+                Some((knob_lights, args.seed)),
+                &crate::load_options(),
+            )?;
             let workload = AnimatedWorkload {
                 scene,
                 name: scene_name(&knob_scene),

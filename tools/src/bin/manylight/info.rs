@@ -35,7 +35,7 @@ fn scene_report(
     renderer: &mut Renderer,
     spec: &str,
 ) -> Result<serde_json::Value, Box<dyn std::error::Error>> {
-    let (scene, _) = manylight::scene::load(spec, Some((256, 1)))?;
+    let (scene, _) = manylight::scene::load_with(spec, Some((256, 1)), &crate::load_options())?;
     let mut methods = Vec::new();
     let mut features = None;
     for m in METHODS {

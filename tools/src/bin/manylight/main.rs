@@ -16,8 +16,16 @@ use std::process::ExitCode;
 
 use clap::error::ErrorKind;
 use clap::{CommandFactory, Parser, Subcommand, ValueEnum};
-use manylight::EsVersion;
+use manylight::{EsVersion, LoadOptions};
 use manylight_tools::output;
+
+/// How every subcommand loads its scene (set once from the command line).
+static LOAD_OPTIONS: std::sync::OnceLock<LoadOptions> = std::sync::OnceLock::new();
+
+/// The scene-loading options the command line asked for.
+pub fn load_options() -> LoadOptions {
+    LOAD_OPTIONS.get().copied().unwrap_or_default()
+}
 
 /// Thousands of dynamic lights on OpenGL ES 2.0 / 3.0, rendered headless through EGL.
 #[derive(Parser)]
@@ -36,6 +44,11 @@ struct Cli {
     /// `system` for the system's libraries.
     #[arg(long, global = true, value_name = "DIR")]
     gles_lib: Vec<std::path::PathBuf>,
+    /// Let a glTF model's buffer and image URIs name files outside the model's folder
+    /// (`../x`, absolute paths, links leading out). Refused by default: an untrusted model must
+    /// not read your files. Only for models you trust.
+    #[arg(long, global = true)]
+    allow_outside_files: bool,
     /// With no subcommand, `render`'s options apply: `manylight --lights 64` renders.
     #[command(flatten)]
     render: render::RenderArgs,
@@ -209,6 +222,9 @@ fn main() -> ExitCode {
         .init();
     let cli = Cli::parse();
     check_usage(&cli);
+    let mut options = LoadOptions::default();
+    options.allow_outside_files = cli.allow_outside_files;
+    let _ = LOAD_OPTIONS.set(options);
     if !matches!(cli.command, Some(Command::Matrix(_))) {
         if let Some(dir) = cli.gles_lib.first() {
             if let Err(e) = manylight::gl::gles_lib::select(dir) {

@@ -149,13 +149,20 @@ const CONFIGS: &[Config] = &[
     },
 ];
 
+/// `--allow-outside-files` for a cell when the matrix was given it.
+fn outside_files_flag() -> Option<&'static str> {
+    crate::load_options()
+        .allow_outside_files
+        .then_some("--allow-outside-files")
+}
+
 /// Runs the matrix: one child process per configuration and implementation (`gles_libs`:
 /// folders, `system` for the system's libraries; none: the system's alone).
 pub fn run(args: &MatrixArgs, gles_libs: &[PathBuf]) -> Result<(), Box<dyn std::error::Error>> {
     let exe = std::env::current_exe()?;
     // What every cell would fail on is an error of the matrix, not a row of failures: a scene
     // that cannot be read, outputs that cannot be written.
-    scene::load(&args.scene, Some((args.lights, 1)))?;
+    scene::load_with(&args.scene, Some((args.lights, 1)), &crate::load_options())?;
     let out = args.out.clone().unwrap_or_else(std::env::temp_dir);
     std::fs::create_dir_all(&out).map_err(|e| format!("cannot create {}: {e}", out.display()))?;
     let json_file = args.json.as_deref().map(OutputFile::create).transpose()?;
@@ -234,6 +241,7 @@ fn group_rows(
         ])
         .args(["--lights", &args.lights.to_string(), "--tag", &tag])
         .args(config.args)
+        .args(outside_files_flag())
         .arg("--out")
         .arg(out);
         for (k, v) in config.env {
@@ -295,6 +303,7 @@ fn osmesa_row(
             size,
         ])
         .args(["--lights", &args.lights.to_string(), "--tag", "osmesa"])
+        .args(outside_files_flag())
         .arg("--out")
         .arg(out)
         .output()?;
@@ -443,7 +452,7 @@ impl CellContext {
 /// Renders every method in this (restricted) process and prints one JSON row.
 pub fn run_cell(args: &MatrixCellArgs) -> Result<(), Box<dyn std::error::Error>> {
     let es: EsVersion = args.es.into();
-    let (scene, _) = scene::load(&args.scene, Some((args.lights, 1)))?;
+    let (scene, _) = scene::load_with(&args.scene, Some((args.lights, 1)), &crate::load_options())?;
     let (w, h) = args.size;
     let opts = RenderOptions {
         measure: manylight::MeasureOptions {

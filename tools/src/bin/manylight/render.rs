@@ -208,7 +208,8 @@ pub fn run(args: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
         (None, false) => Some((DEFAULT_LIGHTS, args.seed)),
     };
     // The loader logs each warning (at `warn`, shown by default): not printed again here.
-    let (mut scene, _logged_warnings) = scene::load(&args.scene, lights)?;
+    let (mut scene, _logged_warnings) =
+        scene::load_with(&args.scene, lights, &crate::load_options())?;
     let out = match (&args.out, &args.record) {
         (Some(path), _) => Some(path.as_path()),
         (None, None) => Some(std::path::Path::new(DEFAULT_OUT)),

@@ -116,7 +116,11 @@ pub fn run(args: &ViewArgs) -> Result<(), Box<dyn std::error::Error>> {
         (None, false) => Some(DEFAULT_LIGHTS),
     };
     // The loader logs each warning (at `warn`, shown by default): not printed again here.
-    let (mut scene, _logged_warnings) = scene::load(&args.scene, lights.map(|n| (n, args.seed)))?;
+    let (mut scene, _logged_warnings) = scene::load_with(
+        &args.scene,
+        lights.map(|n| (n, args.seed)),
+        &crate::load_options(),
+    )?;
     scene.set_time(args.time);
     // Validate the method name before opening a window.
     manylight::methods::find(&args.method)?;
@@ -370,7 +374,11 @@ impl App<'_> {
 
     /// Regenerates the random lights with a new count (same seed); problems go to stderr.
     fn set_lights(&mut self, count: usize) {
-        match scene::load(&self.args.scene, Some((count, self.args.seed))) {
+        match scene::load_with(
+            &self.args.scene,
+            Some((count, self.args.seed)),
+            &crate::load_options(),
+        ) {
             // Keep geometry (already uploaded) and camera; only the lights change.
             Ok((new, _)) => {
                 self.scene.lights = new.lights;

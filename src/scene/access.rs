@@ -1,0 +1,133 @@
+//! Which files a model may read besides itself. A glTF file names its buffers and images by
+//! URI; an untrusted model must not read the user's other files through them, so by default
+//! a URI may name only a file inside the glTF file's own folder: no `..`, no absolute path
+//! (`/x`, `C:/x`, `\\server\x`), no link that leads out of the folder. [`LoadOptions`] lifts
+//! this for trusted local content. Scene files and command lines name models anywhere: they
+//! are the user's own.
+
+use std::path::{Path, PathBuf};
+
+/// How [`load_scene_with`](crate::load_scene_with) reads the files a scene names.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[non_exhaustive]
+pub struct LoadOptions {
+    /// Let a glTF file's buffer and image URIs name files outside the glTF file's folder
+    /// (`../x`, absolute paths, links leading out). Off by default: a downloaded model must
+    /// not read the user's files. Turn it on only for trusted local content.
+    pub allow_outside_files: bool,
+}
+
+/// What the refusal says after the reason: how to lift it for trusted content.
+const HOW_TO_ALLOW: &str = "a model may read only files in its own folder (for trusted \
+                            models: --allow-outside-files, or LoadOptions::allow_outside_files)";
+
+/// The path `name` (a percent-decoded URI) names relative to `dir`. Unless `allow_outside`,
+/// a name that leaves `dir` as written — absolute, or with a `..` part (`/` and `\` both
+/// separate) — is refused before anything on disk is looked at.
+pub(crate) fn join(dir: &Path, name: &str, allow_outside: bool) -> Result<PathBuf, String> {
+    if !allow_outside {
+        let bytes = name.as_bytes();
+        let drive = bytes.len() >= 2 && bytes[0].is_ascii_alphabetic() && bytes[1] == b':';
+        let why = if name.starts_with(['/', '\\']) || drive || Path::new(name).is_absolute() {
+            Some("an absolute path")
+        } else if name.split(['/', '\\']).any(|part| part == "..") {
+            Some("`..` leads out of it")
+        } else {
+            None
+        };
+        if let Some(why) = why {
+            return Err(format!(
+                "`{name}` is outside the model's folder ({why}); refused: {HOW_TO_ALLOW}"
+            ));
+        }
+    }
+    Ok(dir.join(name))
+}
+
+/// `path` (found from `dir` through [`join`]) with its links resolved. Unless
+/// `allow_outside`, a path whose real location is not inside `dir`'s is refused: a link in
+/// the model's folder may not lead out of it. A path that does not exist comes back as it is
+/// (reading it says so).
+pub(crate) fn resolve(dir: &Path, path: &Path, allow_outside: bool) -> Result<PathBuf, String> {
+    let Ok(real) = path.canonicalize() else {
+        return Ok(path.to_path_buf());
+    };
+    if allow_outside {
+        return Ok(real);
+    }
+    // A file named without a folder (`m.gltf`) has the empty path as its parent.
+    let dir = if dir.as_os_str().is_empty() {
+        Path::new(".")
+    } else {
+        dir
+    };
+    let real_dir = dir.canonicalize().map_err(|e| {
+        format!("the model's folder {} cannot be resolved ({e})", dir.display())
+    })?;
+    if real.starts_with(&real_dir) {
+        Ok(real)
+    } else {
+        let shown = path.strip_prefix(dir).unwrap_or(path);
+        Err(format!(
+            "`{}` is outside the model's folder (a link leads out of it); refused: \
+             {HOW_TO_ALLOW}",
+            shown.display()
+        ))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_that_leave_the_folder_as_written_are_refused() {
+        let dir = Path::new("models");
+        for name in [
+            "../x.bin",
+            "a/../../x.bin",
+            "a/..",
+            "..\\x.bin",
+            "/etc/passwd",
+            "\\\\server\\share\\x.bin",
+            "C:/x.bin",
+            "c:x.bin",
+        ] {
+            let err = join(dir, name, false).unwrap_err();
+            assert!(err.contains("outside the model's folder"), "{name}: {err}");
+            assert!(err.contains("--allow-outside-files"), "{err}");
+            assert_eq!(join(dir, name, true).unwrap(), dir.join(name));
+        }
+        for name in ["x.bin", "tex/a b.png", "a..b.bin", "./x.bin", "..x/y"] {
+            assert_eq!(join(dir, name, false).unwrap(), dir.join(name), "{name}");
+        }
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn a_link_leading_out_of_the_folder_is_refused() {
+        let root = tempfile::tempdir().unwrap();
+        let model = root.path().join("model");
+        std::fs::create_dir(&model).unwrap();
+        std::fs::write(root.path().join("secret.txt"), b"S").unwrap();
+        std::fs::write(model.join("inside.bin"), b"I").unwrap();
+        std::os::unix::fs::symlink(root.path().join("secret.txt"), model.join("out.bin")).unwrap();
+        std::os::unix::fs::symlink(model.join("inside.bin"), model.join("in.bin")).unwrap();
+        let err = resolve(&model, &model.join("out.bin"), false).unwrap_err();
+        assert!(err.contains("`out.bin` is outside"), "{err}");
+        assert!(resolve(&model, &model.join("out.bin"), true).is_ok());
+        let real = resolve(&model, &model.join("in.bin"), false).unwrap();
+        assert_eq!(std::fs::read(real).unwrap(), b"I");
+        let missing = model.join("missing.bin");
+        assert_eq!(resolve(&model, &missing, false).unwrap(), missing);
+    }
+
+    #[test]
+    fn a_model_in_the_working_folder_has_the_empty_path_as_its_folder() {
+        // `Path::new("m.gltf").parent()` is `""`: the working folder (the package's, in tests).
+        let dir = Path::new("m.gltf").parent().unwrap();
+        let path = join(dir, "Cargo.toml", false).unwrap();
+        let real = resolve(dir, &path, false).unwrap();
+        assert_eq!(real, Path::new("Cargo.toml").canonicalize().unwrap());
+    }
+}

@@ -1,0 +1,169 @@
+//! Integers past `u32`: the `gltf` crate reads indices (`"mesh": 4294967296`) and enum codes
+//! (`mode`, `componentType`, `target`, sampler filters and wraps) as `value as u32`, so 2³²
+//! would wrap to 0 (mesh 0, mode POINTS). Refused here first, naming the field. Only
+//! `byteOffset`, `byteLength` and `count` may be larger; `extras` and unsupported extensions
+//! are not looked into (any JSON is valid there). Walks the JSON without building it.
+
+use std::fmt;
+
+use serde::de::{self, DeserializeSeed, IgnoredAny, MapAccess, SeqAccess, Visitor};
+
+/// The first integer past `u32::MAX` where glTF allows none, as an error naming its field.
+pub(super) fn check(json: &[u8]) -> Result<(), String> {
+    let mut path = Vec::new();
+    let mut found = None;
+    let mut reader = serde_json::Deserializer::from_slice(json);
+    let walk = Walk {
+        path: &mut path,
+        look: true,
+        found: &mut found,
+    };
+    // The JSON was parsed once already: an error here can only repeat that parse's.
+    let _ = walk.deserialize(&mut reader);
+    match found {
+        Some(field) => Err(format!(
+            "{field}: a number past the largest glTF allows here ({})",
+            u32::MAX
+        )),
+        None => Ok(()),
+    }
+}
+
+/// Fields whose values may pass `u32` (the crate reads them as `u64`).
+const WIDE: &[&str] = &["byteOffset", "byteLength", "count"];
+
+/// Extensions whose contents the loader reads (others are skipped).
+const READ_EXTENSIONS: &[&str] = &["KHR_lights_punctual"];
+
+struct Walk<'a> {
+    /// `meshes`, `[0]`, `primitives`, … down to the value being read.
+    path: &'a mut Vec<String>,
+    /// False inside `extras` and unsupported extensions.
+    look: bool,
+    found: &'a mut Option<String>,
+}
+
+impl Walk<'_> {
+    fn field(&self) -> String {
+        let mut out = String::new();
+        for part in self.path.iter() {
+            if !part.starts_with('[') && !out.is_empty() {
+                out.push('.');
+            }
+            out.push_str(part);
+        }
+        out
+    }
+
+    fn child(&mut self, part: String, look: bool) -> Walk<'_> {
+        self.path.push(part);
+        Walk {
+            path: &mut *self.path,
+            look,
+            found: &mut *self.found,
+        }
+    }
+}
+
+impl<'de> DeserializeSeed<'de> for Walk<'_> {
+    type Value = ();
+
+    fn deserialize<D: de::Deserializer<'de>>(self, d: D) -> Result<(), D::Error> {
+        if self.look && self.found.is_none() {
+            d.deserialize_any(self)
+        } else {
+            d.deserialize_ignored_any(IgnoredAny).map(|_| ())
+        }
+    }
+}
+
+impl<'de> Visitor<'de> for Walk<'_> {
+    type Value = ();
+
+    fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+        f.write_str("any JSON value")
+    }
+
+    fn visit_u64<E>(self, v: u64) -> Result<(), E> {
+        let wide = self.path.last().is_some_and(|k| WIDE.contains(&k.as_str()));
+        if v > u64::from(u32::MAX) && !wide {
+            *self.found = Some(self.field());
+        }
+        Ok(())
+    }
+
+    fn visit_i64<E>(self, _: i64) -> Result<(), E> {
+        Ok(())
+    }
+
+    fn visit_f64<E>(self, _: f64) -> Result<(), E> {
+        Ok(())
+    }
+
+    fn visit_bool<E>(self, _: bool) -> Result<(), E> {
+        Ok(())
+    }
+
+    fn visit_str<E>(self, _: &str) -> Result<(), E> {
+        Ok(())
+    }
+
+    fn visit_unit<E>(self) -> Result<(), E> {
+        Ok(())
+    }
+
+    fn visit_seq<A: SeqAccess<'de>>(mut self, mut seq: A) -> Result<(), A::Error> {
+        let mut i = 0usize;
+        loop {
+            let look = self.look;
+            let element = self.child(format!("[{i}]"), look);
+            let more = seq.next_element_seed(element)?.is_some();
+            self.path.pop();
+            if !more {
+                return Ok(());
+            }
+            i += 1;
+        }
+    }
+
+    fn visit_map<A: MapAccess<'de>>(mut self, mut map: A) -> Result<(), A::Error> {
+        let in_extensions = self.path.last().is_some_and(|k| k == "extensions");
+        while let Some(key) = map.next_key::<String>()? {
+            let look = self.look
+                && key != "extras"
+                && (!in_extensions || READ_EXTENSIONS.contains(&key.as_str()));
+            let value = self.child(key, look);
+            map.next_value_seed(value)?;
+            self.path.pop();
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn integers_past_u32_are_refused_by_field() {
+        let err = check(br#"{"meshes":[{"primitives":[{"mode":4294967296}]}]}"#).unwrap_err();
+        assert!(err.starts_with("meshes[0].primitives[0].mode:"), "{err}");
+        let err = check(br#"{"nodes":[{"children":[1, 4294967297]}]}"#).unwrap_err();
+        assert!(err.starts_with("nodes[0].children[1]:"), "{err}");
+        let err = check(
+            br#"{"nodes":[{"extensions":{"KHR_lights_punctual":{"light":4294967296}}}]}"#,
+        )
+        .unwrap_err();
+        assert!(err.contains("KHR_lights_punctual.light"), "{err}");
+        assert!(check(br#"{"nodes":[{"mesh":4294967295}]}"#).is_ok());
+    }
+
+    #[test]
+    fn wide_fields_extras_and_other_extensions_may_hold_any_number() {
+        let json = br#"{"buffers":[{"byteLength":8589934592}],
+            "accessors":[{"count":8589934592,"byteOffset":8589934592}],
+            "extras":{"mesh":8589934592},
+            "nodes":[{"extras":[8589934592],"extensions":{"EXT_other":{"n":8589934592}}}]}"#;
+        assert!(check(json).is_ok());
+    }
+}
