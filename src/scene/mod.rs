@@ -8,6 +8,7 @@
 
 pub mod builtin;
 pub mod camera;
+pub mod direction;
 pub mod error;
 pub mod features;
 pub mod file;
