@@ -4,6 +4,8 @@
 use std::collections::HashMap;
 use std::sync::Arc;
 
+use glam::{DMat4, DVec3};
+
 use crate::gl::mesh::GpuMesh;
 use crate::gl::texture::ImageTexture;
 use crate::gl::Device;
@@ -14,8 +16,10 @@ use crate::Error;
 /// an `Arc` of each source, so a key can never be reused by another allocation.
 #[derive(Default)]
 pub struct GpuScene {
-    /// Uploaded meshes with their object-space bounds (computed once, not every frame).
-    meshes: HashMap<usize, (Arc<Mesh>, GpuMesh, Option<Aabb>)>,
+    /// Uploaded meshes with their object-space bounds and longest triangle edge (computed
+    /// once, not every frame). Each is uploaded about its bounds' centre (see
+    /// [`GpuScene::model`]).
+    meshes: HashMap<usize, (Arc<Mesh>, GpuMesh, Option<Aabb>, f64)>,
     textures: HashMap<usize, (Arc<Texture>, ImageTexture)>,
     /// 1×1 white texture for full variants on untextured materials (made on first use).
     white: Option<ImageTexture>,
@@ -35,7 +39,11 @@ impl GpuScene {
         for o in &scene.objects {
             let key = Arc::as_ptr(&o.mesh) as usize;
             if let std::collections::hash_map::Entry::Vacant(e) = self.meshes.entry(key) {
-                e.insert((o.mesh.clone(), GpuMesh::new(dev, &o.mesh)?, o.mesh.bounds()));
+                let bounds = o.mesh.bounds();
+                let origin = bounds.map_or(DVec3::ZERO, |b| b.center());
+                let gpu = GpuMesh::new_about(dev, &o.mesh, origin)?;
+                let longest = crate::renderer::triangle_reach::longest_edge(&o.mesh);
+                e.insert((o.mesh.clone(), gpu, bounds, longest));
             }
         }
         for m in &scene.materials {
@@ -54,11 +62,27 @@ impl GpuScene {
         &self.meshes[&(Arc::as_ptr(&object.mesh) as usize)].1
     }
 
+    /// The object's model matrix for its uploaded mesh: the object's transform after a move
+    /// to the mesh's centre. Vertices far from their mesh's own origin (an OBJ modelled at
+    /// 10⁷) are stored in `f32` relative to that centre, and the offset joins the `f64`
+    /// transform, from which the camera is subtracted before anything becomes `f32`.
+    pub fn model(&self, object: &crate::scene::Object) -> DMat4 {
+        let (_, _, bounds, _) = &self.meshes[&(Arc::as_ptr(&object.mesh) as usize)];
+        let origin = bounds.map_or(DVec3::ZERO, |b| b.center());
+        object.transform * DMat4::from_translation(origin)
+    }
+
     /// World-space bounds of an object, from its mesh's cached bounds (the scene must have
     /// been uploaded).
     pub fn world_bounds(&self, object: &crate::scene::Object) -> Option<Aabb> {
-        let (_, _, bounds) = &self.meshes[&(Arc::as_ptr(&object.mesh) as usize)];
+        let (_, _, bounds, _) = &self.meshes[&(Arc::as_ptr(&object.mesh) as usize)];
         bounds.map(|b| b.transformed(&object.transform))
+    }
+
+    /// The longest triangle edge of an object's mesh, in object space (the scene must have
+    /// been uploaded).
+    pub fn longest_edge(&self, object: &crate::scene::Object) -> f64 {
+        self.meshes[&(Arc::as_ptr(&object.mesh) as usize)].3
     }
 
     /// World-space bounds of the whole scene ([`Scene::bounds`] without walking every vertex).
@@ -84,7 +108,7 @@ impl GpuScene {
     }
 
     pub(crate) fn destroy(&mut self, dev: &Device) {
-        for (_, (_, mut m, _)) in self.meshes.drain() {
+        for (_, (_, mut m, _, _)) in self.meshes.drain() {
             m.destroy(dev);
         }
         for (_, (_, mut t)) in self.textures.drain() {

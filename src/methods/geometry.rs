@@ -86,7 +86,7 @@ fn depth_prepass(ctx: &mut FrameContext) -> Result<(), Error> {
     let DepthProgram(transforms) = ctx.programs.bind::<DepthProgram>(dev, key, Vec::new)?;
     for &i in &ctx.order.opaque {
         let object = &ctx.scene.objects[i];
-        transforms.set(dev, &(ctx.view * object.transform), &ctx.projection);
+        transforms.set(dev, &(ctx.view * ctx.gpu_scene.model(object)), &ctx.projection);
         ctx.gpu_scene.mesh(object).draw(dev);
     }
     Ok(())
@@ -163,7 +163,7 @@ pub(crate) fn shade_object<P: GeometryProgram>(
     // The camera is subtracted in f64 here, so far-from-origin scenes stay exact in f32.
     program
         .transforms()
-        .set(dev, &(ctx.view * object.transform), &ctx.projection);
+        .set(dev, &(ctx.view * ctx.gpu_scene.model(object)), &ctx.projection);
     if let Some(t) = texture {
         t.bind(dev, UNIT_ALBEDO);
     }

@@ -11,6 +11,7 @@ mod frame_setup;
 mod method;
 mod offscreen;
 mod stats;
+pub(crate) mod triangle_reach;
 
 use crate::cluster::view_light::GpuLight;
 use crate::gl::framebuffer::OffscreenTarget;
