@@ -23,6 +23,10 @@ pub struct GpuScene {
     textures: HashMap<usize, (Arc<Texture>, ImageTexture)>,
     /// 1×1 white texture for full variants on untextured materials (made on first use).
     white: Option<ImageTexture>,
+    /// This frame's stand-ins for objects with triangles too long for their distance from the
+    /// eye: object index → the split mesh and its model matrix (see
+    /// `renderer::triangle_reach`).
+    splits: HashMap<usize, (GpuMesh, DMat4)>,
 }
 
 impl GpuScene {
@@ -55,6 +59,28 @@ impl GpuScene {
             }
         }
         Ok(())
+    }
+
+    /// Replaces last frame's split meshes with this frame's: objects of `scene` with triangles
+    /// too long for their distance from its camera are drawn from a copy split near the eye.
+    pub(crate) fn split_for_frame(&mut self, dev: &Device, scene: &Scene) -> Result<(), Error> {
+        for (_, (mut m, _)) in self.splits.drain() {
+            m.destroy(dev);
+        }
+        let model = DMat4::from_translation(scene.camera.position);
+        for (i, mesh) in crate::renderer::triangle_reach::split_objects(scene, self) {
+            self.splits.insert(i, (GpuMesh::new(dev, &mesh)?, model));
+        }
+        Ok(())
+    }
+
+    /// The mesh object `index` is drawn with this frame, and its model matrix: its uploaded
+    /// mesh and [`GpuScene::model`], or the frame's split copy.
+    pub(crate) fn drawn(&self, index: usize, object: &crate::scene::Object) -> (&GpuMesh, DMat4) {
+        match self.splits.get(&index) {
+            Some((mesh, model)) => (mesh, *model),
+            None => (self.mesh(object), self.model(object)),
+        }
     }
 
     /// The uploaded mesh of an object (the scene must have been uploaded).
@@ -113,6 +139,9 @@ impl GpuScene {
         }
         for (_, (_, mut t)) in self.textures.drain() {
             t.destroy(dev);
+        }
+        for (_, (mut m, _)) in self.splits.drain() {
+            m.destroy(dev);
         }
         if let Some(mut w) = self.white.take() {
             w.destroy(dev);

@@ -119,7 +119,7 @@ impl Renderer {
         }
         self.gpu_scene
             .upload(&self.dev, scene, options.measure.full_variants)?;
-        super::triangle_reach::check(scene, &self.gpu_scene)?;
+        self.gpu_scene.split_for_frame(&self.dev, scene)?;
         let view: DMat4 = scene.camera.view_matrix();
         let projection = scene
             .camera

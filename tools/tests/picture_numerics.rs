@@ -84,9 +84,11 @@ fn assert_draws_as(s: &Scene, oracle: &Scene, what: &str) {
     });
 }
 
+/// Scaled to 0 or 10⁻²⁰ along its normal (the scene-file and glTF forms), or by 10⁹ (the
+/// normal matrix then shrinks the normal to 10⁻⁹, which fp16 varyings flushed to zero: NaN).
 #[test]
-fn a_plane_scaled_to_nothing_along_its_normal_is_lit_as_the_plane() {
-    for z in [1e-20, 0.0] {
+fn a_plane_scaled_to_nothing_or_vastly_along_its_normal_is_lit_as_the_plane() {
+    for z in [1e-20, 0.0, 1e9] {
         let mut flat = lit_plane();
         for o in &mut flat.objects {
             o.transform = DMat4::from_scale(DVec3::new(1.0, 1.0, z)) * o.transform;
@@ -211,7 +213,7 @@ fn a_scene_scaled_up_renders_as_the_f64_model_says_or_is_refused_without_highp()
 }
 
 #[test]
-fn a_triangle_huge_beside_the_camera_is_refused_naming_its_object() {
+fn a_triangle_huge_beside_the_camera_renders_as_the_f64_model_says() {
     let wide = |k: f64| {
         let mut s = lit_plane();
         s.objects[0].transform = DMat4::from_scale(DVec3::new(k, k, 1.0));
@@ -219,27 +221,23 @@ fn a_triangle_huge_beside_the_camera_is_refused_naming_its_object() {
     };
     each_device(|device, gpu| {
         let caps = gpu.r().caps().clone();
-        // A thousand times the plane: still what the f64 model says.
-        let s = wide(1e3);
-        let img = render(gpu, "forward", &s);
-        let (e, at, _) = max_oracle_error(&img, &s, Encoding::Srgb, &caps);
-        let bound = if device.contains("without") {
-            24.0
-        } else {
-            2.0
-        };
-        assert!(
-            e <= bound,
-            "{device}: {e:.1} / 255 off the f64 model at {at:?}"
-        );
-        // 10⁶ put the light off centre (29/255), 10⁸ left half the frame black.
-        for k in [1e6, 1e8] {
-            let err = gpu
-                .r()
-                .render_offscreen(&wide(k), W, H, &RenderOptions::default())
-                .unwrap_err()
-                .to_string();
-            assert!(err.contains("objects[0]"), "{device} ×{k:e}: {err}");
+        // 10⁶ put the light off centre (29/255), 10⁸ left half the frame black: the plane is
+        // split near the eye for the frame.
+        for k in [1e3, 1e6, 1e8, 1e11] {
+            let s = wide(k);
+            for method in methods(gpu) {
+                let img = render(gpu, method, &s);
+                let (e, at, _) = max_oracle_error(&img, &s, Encoding::Srgb, &caps);
+                let bound = if device.contains("without") {
+                    24.0
+                } else {
+                    2.0
+                };
+                assert!(
+                    e <= bound,
+                    "{device} {method} ×{k:e}: {e:.1} / 255 off the f64 model at {at:?}"
+                );
+            }
         }
     });
 }
