@@ -43,16 +43,17 @@ pub fn placement() -> impl Strategy<Value = f64> {
     ]
 }
 
-/// A vertex normal: a unit one, or one of no use.
+/// A vertex normal along the plane's own (of any length), or one of no use. (A tilted one
+/// under a huge scale along the normal turns edge-on to the view, where whether it is lit is
+/// the sign of a rounding error.)
 pub fn normal() -> impl Strategy<Value = Vec3> {
     prop::sample::select(vec![
         Vec3::Z,
-        Vec3::new(0.0, 0.3, 1.0),
+        Vec3::new(0.0, 0.0, 3e30),
+        Vec3::new(0.0, 0.0, 1e-30),
         Vec3::ZERO,
         Vec3::NAN,
         Vec3::new(0.0, 0.0, f32::INFINITY),
-        Vec3::new(1e30, 0.0, 3e30),
-        Vec3::new(0.0, 1e-30, 1e-30),
     ])
 }
 
