@@ -7,7 +7,7 @@ use std::time::Instant;
 
 use glam::DMat4;
 
-use super::frame_setup::{check_fp16_depth, content_far, gather_lights, shader_features};
+use super::frame_setup::{content_far, gather_lights, shader_features};
 use super::stats::{copy_opt_str, copy_str, copy_support};
 use super::stats::{LightStats, MemoryStats, TimeStats};
 use super::{FrameStats, Renderer};
@@ -130,7 +130,8 @@ impl Renderer {
         let features = shader_features(&scene_features, options, self.dev.caps());
         let (near, far) = scene.camera.near_far();
         let content_far = content_far(self.gpu_scene.scene_bounds(scene), &view, near, far);
-        check_fp16_depth(content_far, self.dev.caps())?;
+        let reach = super::fp16_range::view_reach(scene, width as f64 / height as f64, content_far);
+        super::fp16_range::check(self.dev.caps(), scene, &mut self.lights, reach)?;
         self.dev.viewport(0, 0, width as i32, height as i32);
         self.dev.clear(options.clear_color);
         let mut ctx = FrameContext {

@@ -102,21 +102,3 @@ pub(super) fn content_far(bounds: Option<Aabb>, view: &DMat4, near: f64, far: f6
         floor.max(1.0)
     }
 }
-
-/// Deepest view depth a device without fragment `highp` is drawn to: its view-space positions
-/// are fp16 (largest 65 504, and a view's corners lie farther out than its depth).
-pub const MAX_FP16_VIEW_DEPTH: f64 = 32768.0;
-
-/// Without fragment `highp`, refuses a frame whose geometry reaches past
-/// [`MAX_FP16_VIEW_DEPTH`] (`content_far` is already clipped to the far plane): positions
-/// there are infinite in fp16, and what they light is black.
-pub(super) fn check_fp16_depth(content_far: f64, caps: &Caps) -> Result<(), crate::Error> {
-    if caps.fragment_has_highp() || content_far <= MAX_FP16_VIEW_DEPTH {
-        return Ok(());
-    }
-    Err(crate::Error::Limit(format!(
-        "camera.far: without fragment highp view-space positions are fp16, but the scene \
-         reaches {content_far:.3e} from the camera; set camera.far to at most \
-         {MAX_FP16_VIEW_DEPTH} (or scale the scene down)"
-    )))
-}

@@ -8,6 +8,7 @@
 
 mod frame;
 mod frame_setup;
+mod fp16_range;
 mod method;
 mod offscreen;
 mod stats;

@@ -354,3 +354,50 @@ fn an_object_placed_with_translation_only_keeps_its_own_picture() {
     }];
     assert_draws_as(&moved, &s, "vertices 3e6 from their origin");
 }
+
+#[test]
+fn without_highp_a_light_too_far_to_place_is_refused_by_name_or_left_out_when_it_reaches_nothing() {
+    let with = |light: Light| {
+        let mut s = lit_plane();
+        s.lights.push(light);
+        s
+    };
+    // A sun 70 km away whose sphere takes in the plane; a lamp as far whose sphere does not.
+    let sun = Light::point(DVec3::new(0.0, 0.0, 7e4), 1e5, Vec3::ONE, 2e9);
+    let far_lamp = Light::point(DVec3::new(0.0, 0.0, 7e4), 100.0, Vec3::ONE, 2.0);
+    each_device(|device, gpu| {
+        let caps = gpu.r().caps().clone();
+        let alone = render(gpu, "forward", &lit_plane());
+        let lamp = render(gpu, "forward", &with(far_lamp));
+        assert_eq!(
+            manylight::metrics::diff(&alone, &lamp).max_abs,
+            0,
+            "{device}"
+        );
+        let s = with(sun);
+        match gpu
+            .r()
+            .render_offscreen(&s, W, H, &RenderOptions::default())
+        {
+            Ok((img, _)) => {
+                assert!(
+                    !device.contains("without"),
+                    "{device}: the sun cannot be placed"
+                );
+                let (e, at, _) = max_oracle_error(&img, &s, Encoding::Srgb, &caps);
+                assert!(
+                    e <= 2.0,
+                    "{device}: {e:.1} / 255 off the f64 model at {at:?}"
+                );
+                assert!(
+                    mean(&img) > mean(&alone) + 5.0,
+                    "{device}: the sun lights nothing"
+                );
+            }
+            Err(e) => {
+                assert!(device.contains("without"), "{device}: {e}");
+                assert!(e.to_string().contains("lights[1]"), "{e}");
+            }
+        }
+    });
+}
