@@ -9,30 +9,42 @@
 // llvmpipe, so the tests see it), or highp in the reference variant.
 //
 // Devices without fragment highp turn HIGHP into mediump too; the falloff is written so it
-// survives that: the distance is r·|u| with u = (Lp − P)/r (|u| < 1 wherever the light
-// reaches), and 1/(d² + 1) is (1/d)²/(1 + (1/d)²) past d = 1, so no intermediate exceeds the
-// light's radius (d² would overflow fp16 past 256 m).
+// survives that: nothing is squared before it is scaled to at most 1. The vector to the light
+// is divided by its largest component m (s = (Lp − P)/m, 1 ≤ |s|² ≤ 3), the distance is
+// d = m·|s|, and the window takes the ratio q = d/r before squaring it; 1/(d² + 1) is
+// (1/d)²/(1 + (1/d)²) past d = 1. So neither d² (past 256 m) nor |Lp − P|² overflows fp16, and
+// (d/r)² of a light with a large radius (d/r = 10⁻⁴ at r = 6 000) may underflow to 0 but no
+// longer takes the direction to the light with it.
 vec3 shadeLight(Light light, HIGHP vec3 P, vec3 N, vec3 V, MEDP vec3 albedo, MEDP vec3 Ks, HIGHP float Ns) {
-    HIGHP vec3 u = (light.position - P) / light.radius;
-    HIGHP float u2 = dot(u, u);
-    if (u2 >= 1.0) {
+    HIGHP vec3 toLight = light.position - P;
+    HIGHP float m = max(max(abs(toLight.x), abs(toLight.y)), abs(toLight.z));
+    // Beyond the radius (|Lp − P| ≥ m), or exactly at the light (no direction: no contribution).
+    if (m >= light.radius || m <= 0.0) {
+        return vec3(0.0);
+    }
+    HIGHP vec3 s = toLight / m;
+    HIGHP float invLen = inversesqrt(dot(s, s));
+    HIGHP float q = m / light.radius / invLen;
+    if (q >= 1.0) {
         return vec3(0.0);
     }
     // Windowed inverse square: w² / (d² + 1) with w = 1 − (d/r)⁴, exactly zero at the radius.
-    HIGHP float w = 1.0 - u2 * u2;
-    HIGHP float d = light.radius * sqrt(u2);
-    HIGHP float inv = 1.0 / max(d, 1.0);
+    HIGHP float q2 = q * q;
+    HIGHP float w = 1.0 - q2 * q2;
+    // 1 / max(d, 1), without forming d where it is large (1/m is small there).
+    HIGHP float inv = min(invLen / m, 1.0);
+    // Read only where d ≤ 1.
+    HIGHP float d = m / invLen;
 #if FP16_LIGHTS
     // Radiance came divided by k² (light_struct.glsl): k² goes into the falloff as (k/d)², and
     // the product is capped where only a saturated pixel could come out (no Inf, no Inf·0).
     HIGHP float k = light.radianceRoot;
     HIGHP float kInv = k * inv;
-    HIGHP float falloff = min(w * w * (d > 1.0 ? kInv * kInv / (1.0 + inv * inv) : k * k / (d * d + 1.0)), 60000.0);
+    HIGHP float falloff = min(w * w * (inv < 1.0 ? kInv * kInv / (1.0 + inv * inv) : k * k / (d * d + 1.0)), 60000.0);
 #else
-    HIGHP float falloff = w * w * (d > 1.0 ? inv * inv / (1.0 + inv * inv) : 1.0 / (d * d + 1.0));
+    HIGHP float falloff = w * w * (inv < 1.0 ? inv * inv / (1.0 + inv * inv) : 1.0 / (d * d + 1.0));
 #endif
-    // Unit direction to the light (zero for a fragment exactly at the light: no contribution).
-    HIGHP vec3 L = u2 > 0.0 ? u * inversesqrt(u2) : vec3(0.0);
+    HIGHP vec3 L = s * invLen;
     MEDP float nDotL = dot(N, L);
     if (falloff <= 0.0 || nDotL <= 0.0) {
         return vec3(0.0);
@@ -61,13 +73,18 @@ vec3 shadeLight(Light light, HIGHP vec3 P, vec3 N, vec3 V, MEDP vec3 albedo, MED
 // Whether the light can contribute at P at all, whatever the surface's orientation: P inside
 // its sphere and (spots) inside its cone. What a perfect per-pixel culler would keep.
 bool lightReaches(Light light, HIGHP vec3 P) {
-    HIGHP vec3 u = (light.position - P) / light.radius;
-    HIGHP float u2 = dot(u, u);
-    if (u2 >= 1.0) {
+    // As shadeLight: scaled by the largest component before anything is squared.
+    HIGHP vec3 toLight = light.position - P;
+    HIGHP float m = max(max(abs(toLight.x), abs(toLight.y)), abs(toLight.z));
+    if (m >= light.radius) {
+        return false;
+    }
+    HIGHP vec3 s = m > 0.0 ? toLight / m : vec3(0.0);
+    if (m / light.radius * length(s) >= 1.0) {
         return false;
     }
 #if HAS_SPOT
-    HIGHP vec3 L = u2 > 0.0 ? u * inversesqrt(u2) : vec3(0.0);
+    HIGHP vec3 L = m > 0.0 ? normalize(s) : vec3(0.0);
     HIGHP vec3 chord = L + light.direction;
     return light.spotOffset - 0.5 * light.spotScale * dot(chord, chord) > 0.0;
 #else

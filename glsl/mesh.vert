@@ -20,7 +20,12 @@ VARYING vec2 v_uv;
 void main() {
     vec4 viewPos = u_modelView * vec4(a_position, 1.0);
     v_viewPos = viewPos.xyz;
-    v_normal = u_normalMatrix * a_normal;
+    // Unit length here, in the vertex stage's highp, divided by its largest component first:
+    // a normal the normal matrix squashes (an object scaled 10⁹ along its normal, or to 10⁻⁹
+    // across it) is 10⁻⁹ long, which a mediump varying (fp16) flushes to zero.
+    vec3 n = u_normalMatrix * a_normal;
+    float largest = max(max(abs(n.x), abs(n.y)), abs(n.z));
+    v_normal = largest > 0.0 ? normalize(n / largest) : vec3(0.0);
     v_uv = a_uv;
     gl_Position = u_projection * viewPos;
 }

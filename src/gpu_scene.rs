@@ -4,6 +4,8 @@
 use std::collections::HashMap;
 use std::sync::Arc;
 
+use glam::{DMat4, DVec3};
+
 use crate::gl::mesh::GpuMesh;
 use crate::gl::texture::ImageTexture;
 use crate::gl::Device;
@@ -14,11 +16,17 @@ use crate::Error;
 /// an `Arc` of each source, so a key can never be reused by another allocation.
 #[derive(Default)]
 pub struct GpuScene {
-    /// Uploaded meshes with their object-space bounds (computed once, not every frame).
-    meshes: HashMap<usize, (Arc<Mesh>, GpuMesh, Option<Aabb>)>,
+    /// Uploaded meshes with their object-space bounds and longest triangle edge (computed
+    /// once, not every frame). Each is uploaded about its bounds' centre (see
+    /// [`GpuScene::model`]).
+    meshes: HashMap<usize, (Arc<Mesh>, GpuMesh, Option<Aabb>, f64)>,
     textures: HashMap<usize, (Arc<Texture>, ImageTexture)>,
     /// 1×1 white texture for full variants on untextured materials (made on first use).
     white: Option<ImageTexture>,
+    /// This frame's stand-ins for objects with triangles too long for their distance from the
+    /// eye: object index → the split mesh and its model matrix (see
+    /// `renderer::triangle_reach`).
+    splits: HashMap<usize, (GpuMesh, DMat4)>,
 }
 
 impl GpuScene {
@@ -35,7 +43,11 @@ impl GpuScene {
         for o in &scene.objects {
             let key = Arc::as_ptr(&o.mesh) as usize;
             if let std::collections::hash_map::Entry::Vacant(e) = self.meshes.entry(key) {
-                e.insert((o.mesh.clone(), GpuMesh::new(dev, &o.mesh)?, o.mesh.bounds()));
+                let bounds = o.mesh.bounds();
+                let origin = bounds.map_or(DVec3::ZERO, |b| b.center());
+                let gpu = GpuMesh::new_about(dev, &o.mesh, origin)?;
+                let longest = crate::renderer::triangle_reach::longest_edge(&o.mesh);
+                e.insert((o.mesh.clone(), gpu, bounds, longest));
             }
         }
         for m in &scene.materials {
@@ -49,16 +61,54 @@ impl GpuScene {
         Ok(())
     }
 
+    /// Replaces last frame's split meshes with this frame's: objects of `scene` with triangles
+    /// too long for their distance from its camera are drawn from a copy split near the eye.
+    pub(crate) fn split_for_frame(&mut self, dev: &Device, scene: &Scene) -> Result<(), Error> {
+        for (_, (mut m, _)) in self.splits.drain() {
+            m.destroy(dev);
+        }
+        let model = DMat4::from_translation(scene.camera.position);
+        for (i, mesh) in crate::renderer::triangle_reach::split_objects(scene, self) {
+            self.splits.insert(i, (GpuMesh::new(dev, &mesh)?, model));
+        }
+        Ok(())
+    }
+
+    /// The mesh object `index` is drawn with this frame, and its model matrix: its uploaded
+    /// mesh and [`GpuScene::model`], or the frame's split copy.
+    pub(crate) fn drawn(&self, index: usize, object: &crate::scene::Object) -> (&GpuMesh, DMat4) {
+        match self.splits.get(&index) {
+            Some((mesh, model)) => (mesh, *model),
+            None => (self.mesh(object), self.model(object)),
+        }
+    }
+
     /// The uploaded mesh of an object (the scene must have been uploaded).
     pub fn mesh(&self, object: &crate::scene::Object) -> &GpuMesh {
         &self.meshes[&(Arc::as_ptr(&object.mesh) as usize)].1
     }
 
+    /// The object's model matrix for its uploaded mesh: the object's transform after a move
+    /// to the mesh's centre. Vertices far from their mesh's own origin (an OBJ modelled at
+    /// 10⁷) are stored in `f32` relative to that centre, and the offset joins the `f64`
+    /// transform, from which the camera is subtracted before anything becomes `f32`.
+    pub fn model(&self, object: &crate::scene::Object) -> DMat4 {
+        let (_, _, bounds, _) = &self.meshes[&(Arc::as_ptr(&object.mesh) as usize)];
+        let origin = bounds.map_or(DVec3::ZERO, |b| b.center());
+        object.transform * DMat4::from_translation(origin)
+    }
+
     /// World-space bounds of an object, from its mesh's cached bounds (the scene must have
     /// been uploaded).
     pub fn world_bounds(&self, object: &crate::scene::Object) -> Option<Aabb> {
-        let (_, _, bounds) = &self.meshes[&(Arc::as_ptr(&object.mesh) as usize)];
+        let (_, _, bounds, _) = &self.meshes[&(Arc::as_ptr(&object.mesh) as usize)];
         bounds.map(|b| b.transformed(&object.transform))
+    }
+
+    /// The longest triangle edge of an object's mesh, in object space (the scene must have
+    /// been uploaded).
+    pub fn longest_edge(&self, object: &crate::scene::Object) -> f64 {
+        self.meshes[&(Arc::as_ptr(&object.mesh) as usize)].3
     }
 
     /// World-space bounds of the whole scene ([`Scene::bounds`] without walking every vertex).
@@ -84,11 +134,14 @@ impl GpuScene {
     }
 
     pub(crate) fn destroy(&mut self, dev: &Device) {
-        for (_, (_, mut m, _)) in self.meshes.drain() {
+        for (_, (_, mut m, _, _)) in self.meshes.drain() {
             m.destroy(dev);
         }
         for (_, (_, mut t)) in self.textures.drain() {
             t.destroy(dev);
+        }
+        for (_, (mut m, _)) in self.splits.drain() {
+            m.destroy(dev);
         }
         if let Some(mut w) = self.white.take() {
             w.destroy(dev);

@@ -1,8 +1,9 @@
 //! [`GpuLight`]: a light as the assignment and the shaders see it, in view space. Below both
 //! the assignment and the texture packing, which take it as input.
 
-use glam::{DMat4, Vec3};
+use glam::{DMat4, DVec3, Vec3};
 
+use crate::scene::direction::unit;
 use crate::scene::{Light, LightKind};
 
 /// Largest radius a light is given on the GPU. The shader divides by the radius, and past
@@ -46,7 +47,12 @@ impl GpuLight {
                 inner_deg,
                 outer_deg,
             } => (
-                view.transform_vector3(direction).normalize().as_vec3(),
+                // Unit before and after the turn, so no length overflows (a validated light's
+                // axis has a direction; zero stands for one that has not).
+                unit(direction)
+                    .and_then(|d| unit(view.transform_vector3(d)))
+                    .unwrap_or(DVec3::ZERO)
+                    .as_vec3(),
                 (outer_deg as f32, inner_deg as f32),
             ),
         };

@@ -5,6 +5,7 @@
 
 use std::collections::HashMap;
 
+use glam::DVec3;
 use glow::HasContext;
 
 use super::{Device, GlError};
@@ -24,6 +25,12 @@ pub struct Chunk {
 
 /// Splits a mesh into chunks whose vertices fit 16-bit indices; triangles stay whole.
 pub fn split_u16(mesh: &Mesh) -> Vec<Chunk> {
+    split_u16_about(mesh, DVec3::ZERO)
+}
+
+/// [`split_u16`] with `origin` subtracted from every position (in `f64`, before the vertex
+/// becomes `f32`).
+pub fn split_u16_about(mesh: &Mesh, origin: DVec3) -> Vec<Chunk> {
     const LIMIT: usize = u16::MAX as usize + 1;
     let mut chunks = Vec::new();
     let mut remap: HashMap<u32, u16> = HashMap::new();
@@ -46,7 +53,7 @@ pub fn split_u16(mesh: &Mesh) -> Vec<Chunk> {
         for &i in tri {
             let local = *remap.entry(i).or_insert_with(|| {
                 let v = i as usize;
-                let p = mesh.positions[v];
+                let p = (mesh.positions[v].as_dvec3() - origin).as_vec3();
                 let n = mesh.normals[v];
                 let uv = mesh.uvs.get(v).copied().unwrap_or_default();
                 cur.vertices
@@ -78,13 +85,19 @@ pub struct GpuMesh {
 impl GpuMesh {
     /// Uploads a mesh.
     pub fn new(dev: &Device, mesh: &Mesh) -> Result<GpuMesh, GlError> {
+        GpuMesh::new_about(dev, mesh, DVec3::ZERO)
+    }
+
+    /// Uploads a mesh with its positions relative to `origin` (drawn with the model matrix
+    /// translated by `origin`).
+    pub fn new_about(dev: &Device, mesh: &Mesh, origin: DVec3) -> Result<GpuMesh, GlError> {
         let gl = &dev.gl;
         let mut out = GpuMesh {
             chunks: Vec::new(),
             bytes: 0,
             destroyed: false,
         };
-        for chunk in split_u16(mesh) {
+        for chunk in split_u16_about(mesh, origin) {
             unsafe {
                 let vbo = dev.create_buffer()?;
                 gl.bind_buffer(glow::ARRAY_BUFFER, Some(vbo));

@@ -85,9 +85,9 @@ fn depth_prepass(ctx: &mut FrameContext) -> Result<(), Error> {
     };
     let DepthProgram(transforms) = ctx.programs.bind::<DepthProgram>(dev, key, Vec::new)?;
     for &i in &ctx.order.opaque {
-        let object = &ctx.scene.objects[i];
-        transforms.set(dev, &(ctx.view * object.transform), &ctx.projection);
-        ctx.gpu_scene.mesh(object).draw(dev);
+        let (mesh, model) = ctx.gpu_scene.drawn(i, &ctx.scene.objects[i]);
+        transforms.set(dev, &(ctx.view * model), &ctx.projection);
+        mesh.draw(dev);
     }
     Ok(())
 }
@@ -161,9 +161,10 @@ pub(crate) fn shade_object<P: GeometryProgram>(
         .programs
         .bind(dev, key, || features.defines(dialect, max_lights))?;
     // The camera is subtracted in f64 here, so far-from-origin scenes stay exact in f32.
+    let (mesh, model) = ctx.gpu_scene.drawn(index, object);
     program
         .transforms()
-        .set(dev, &(ctx.view * object.transform), &ctx.projection);
+        .set(dev, &(ctx.view * model), &ctx.projection);
     if let Some(t) = texture {
         t.bind(dev, UNIT_ALBEDO);
     }
@@ -181,7 +182,7 @@ pub(crate) fn shade_object<P: GeometryProgram>(
         features.has(ShaderFeatures::COUNT_HEATMAP),
     );
     bind_method(program, dev);
-    ctx.gpu_scene.mesh(object).draw(dev);
+    mesh.draw(dev);
     Ok(())
 }
 

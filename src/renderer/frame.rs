@@ -119,6 +119,7 @@ impl Renderer {
         }
         self.gpu_scene
             .upload(&self.dev, scene, options.measure.full_variants)?;
+        self.gpu_scene.split_for_frame(&self.dev, scene)?;
         let view: DMat4 = scene.camera.view_matrix();
         let projection = scene
             .camera
@@ -129,6 +130,8 @@ impl Renderer {
         let features = shader_features(&scene_features, options, self.dev.caps());
         let (near, far) = scene.camera.near_far();
         let content_far = content_far(self.gpu_scene.scene_bounds(scene), &view, near, far);
+        let reach = super::fp16_range::view_reach(scene, width as f64 / height as f64, content_far);
+        super::fp16_range::check(self.dev.caps(), scene, &mut self.lights, reach)?;
         self.dev.viewport(0, 0, width as i32, height as i32);
         self.dev.clear(options.clear_color);
         let mut ctx = FrameContext {

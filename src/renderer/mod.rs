@@ -8,9 +8,11 @@
 
 mod frame;
 mod frame_setup;
+mod fp16_range;
 mod method;
 mod offscreen;
 mod stats;
+pub(crate) mod triangle_reach;
 
 use crate::cluster::view_light::GpuLight;
 use crate::gl::framebuffer::OffscreenTarget;

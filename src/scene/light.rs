@@ -161,7 +161,8 @@ impl Light {
             outer_deg,
         } = self.kind
         {
-            if !direction.is_finite() || direction.length_squared() == 0.0 {
+            // A length whose square leaves f64 (10¹⁵⁵, 10⁻²⁰⁰) is still a direction.
+            if super::direction::unit(direction).is_none() {
                 return Err(SceneError::invalid(
                     format!("{field}.direction"),
                     format!("must be finite and non-zero, got {direction:?}"),

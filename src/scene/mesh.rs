@@ -147,11 +147,8 @@ impl Mesh {
                 format!("must be finite, got {:?}", uvs[i]),
             ));
         }
-        let normals = if normals.len() == n && normals.iter().all(|v| v.is_finite()) {
-            normals
-                .into_iter()
-                .map(|v| v.try_normalize().unwrap_or(Vec3::Y))
-                .collect()
+        let normals = if normals.len() == n {
+            repair_normals(normals, &positions, &indices)
         } else {
             compute_normals(&positions, &indices)
         };
@@ -174,20 +171,37 @@ impl Mesh {
     }
 }
 
+/// Given normals made unit; those with no direction (zero, NaN or infinite) replaced by the
+/// area-weighted normal of the faces around their vertex, as a mesh without normals gets.
+fn repair_normals(normals: Vec<Vec3>, positions: &[Vec3], indices: &[u32]) -> Vec<Vec3> {
+    let mut faces: Option<Vec<Vec3>> = None;
+    normals
+        .into_iter()
+        .enumerate()
+        .map(|(i, v)| {
+            super::direction::unit_f32(v).unwrap_or_else(|| {
+                faces.get_or_insert_with(|| compute_normals(positions, indices))[i]
+            })
+        })
+        .collect()
+}
+
 /// Area-weighted vertex normals from the faces; vertices on no face (or only degenerate ones)
-/// get +Y.
+/// get +Y. Summed in `f64`, so faces too small or too large for an `f32` cross product keep
+/// their direction.
 pub fn compute_normals(positions: &[Vec3], indices: &[u32]) -> Vec<Vec3> {
-    let mut acc = vec![Vec3::ZERO; positions.len()];
+    let mut acc = vec![DVec3::ZERO; positions.len()];
     for tri in indices.chunks_exact(3) {
         let [a, b, c] = [tri[0], tri[1], tri[2]].map(|i| i as usize);
+        let [pa, pb, pc] = [a, b, c].map(|i| positions[i].as_dvec3());
         // The cross product's length is twice the area: larger faces weigh more.
-        let n = (positions[b] - positions[a]).cross(positions[c] - positions[a]);
+        let n = (pb - pa).cross(pc - pa);
         acc[a] += n;
         acc[b] += n;
         acc[c] += n;
     }
     acc.into_iter()
-        .map(|n| n.try_normalize().unwrap_or(Vec3::Y))
+        .map(|n| super::direction::unit(n).map_or(Vec3::Y, |n| n.as_vec3()))
         .collect()
 }
 
@@ -206,6 +220,27 @@ mod tests {
         .unwrap();
         for n in &m.normals {
             assert!((*n - Vec3::Z).length() < 1e-6);
+        }
+    }
+
+    #[test]
+    fn unusable_normals_are_recomputed_from_the_faces_and_huge_ones_kept() {
+        let positions = vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::new(1.0, 1.0, 0.0)];
+        let huge = Vec3::new(3e30, 0.0, 4e30);
+        let normals = vec![Vec3::ZERO, Vec3::NAN, Vec3::new(f32::INFINITY, 0.0, 0.0), huge];
+        let m = Mesh::new(positions, normals, vec![], vec![0, 1, 2, 1, 3, 2]).unwrap();
+        for n in &m.normals[..3] {
+            assert!((*n - Vec3::Z).length() < 1e-6, "{n}");
+        }
+        assert!((m.normals[3] - Vec3::new(0.6, 0.0, 0.8)).length() < 1e-6);
+    }
+
+    #[test]
+    fn face_normals_of_tiny_and_huge_triangles_keep_their_direction() {
+        for scale in [1e-25f32, 1e-15, 1.0, 1e9] {
+            let positions = vec![Vec3::ZERO, Vec3::X * scale, Vec3::Y * scale];
+            let normals = compute_normals(&positions, &[0, 1, 2]);
+            assert!(normals.iter().all(|n| (*n - Vec3::Z).length() < 1e-6), "{scale:e}");
         }
     }
 

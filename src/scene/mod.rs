@@ -9,6 +9,7 @@
 pub mod access;
 pub mod builtin;
 pub mod camera;
+pub mod direction;
 pub mod error;
 pub mod features;
 pub mod file;

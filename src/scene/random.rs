@@ -26,6 +26,7 @@ const TARGET_OVERLAP: f64 = 6.0;
 /// visible.
 pub fn lights(volume: &Aabb, count: usize, seed: u64, style: LightSetStyle) -> Vec<Light> {
     let mut rng = Pcg64Mcg::seed_from_u64(seed);
+    let volume = &thickened(volume);
     let size = volume.size();
     let diag = size.length();
     let vol = size.x.max(1e-6) * size.y.max(1e-6) * size.z.max(1e-6);
@@ -60,6 +61,22 @@ pub fn lights(volume: &Aabb, count: usize, seed: u64, style: LightSetStyle) -> V
         .collect()
 }
 
+/// Least thickness of a light volume along any axis, as a fraction of its largest edge.
+const MIN_THICKNESS: f64 = 0.05;
+
+/// `volume` grown about its centre to at least [`MIN_THICKNESS`] of its largest edge along
+/// every axis: the bounds of a flat scene (a plane, or an object scaled to 0 along its normal)
+/// have no thickness, and lights placed in the plane itself light nothing (N·L = 0).
+fn thickened(volume: &Aabb) -> Aabb {
+    let size = volume.size();
+    let least = size.max_element() * MIN_THICKNESS;
+    let pad = (DVec3::splat(least) - size).max(DVec3::ZERO) * 0.5;
+    Aabb {
+        min: volume.min - pad,
+        max: volume.max + pad,
+    }
+}
+
 /// A saturated but not garish colour from a hue in [0, 1).
 fn hue(h: f32) -> Vec3 {
     let k = |n: f32| {
@@ -73,6 +90,18 @@ fn hue(h: f32) -> Vec3 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn lights_of_a_flat_volume_leave_its_plane() {
+        let flat = Aabb {
+            min: DVec3::new(-8.0, -8.0, 0.0),
+            max: DVec3::new(8.0, 8.0, 1e-20),
+        };
+        let ls = lights(&flat, 64, 5, LightSetStyle::PointsOnly);
+        let off = ls.iter().filter(|l| l.position.z.abs() > 0.05).count();
+        assert!(off > 48, "only {off} of 64 lights off the plane");
+        assert!(ls.iter().all(|l| l.position.z.abs() <= 0.4 + 1e-9));
+    }
 
     #[test]
     fn lights_stay_inside_the_volume_and_validate() {

@@ -52,9 +52,8 @@ pub const COPLANAR: f64 = 1e-3;
 #[derive(Clone, Copy, Debug)]
 struct Triangle {
     v: [DVec3; 3],
-    /// Vertex normals times the normal matrix, not renormalised: the GPU interpolates exactly
-    /// these (`v_normal = u_normalMatrix * a_normal`) and normalises per fragment, which differs
-    /// from interpolating unit normals under non-uniform scale.
+    /// Vertex normals times the normal matrix, made unit (zero where the matrix takes them to
+    /// nothing): the GPU interpolates exactly these (`mesh.vert`) and normalises per fragment.
     n: [DVec3; 3],
     object: u32,
     triangle: u32,
@@ -96,7 +95,10 @@ impl SceneRaycaster {
                 let [a, b, c] = [idx[0], idx[1], idx[2]].map(|i| i as usize);
                 let v = [pos[a], pos[b], pos[c]];
                 let n = if has_normals {
-                    [a, b, c].map(|i| normal_matrix * mesh.normals[i].as_dvec3())
+                    [a, b, c].map(|i| {
+                        super::direction::unit(normal_matrix * mesh.normals[i].as_dvec3())
+                            .unwrap_or(DVec3::ZERO)
+                    })
                 } else {
                     [(v[1] - v[0]).cross(v[2] - v[0]); 3]
                 };

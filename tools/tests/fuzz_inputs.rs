@@ -7,6 +7,8 @@
 //! thousand cases in all, well under a minute).
 
 mod common;
+#[path = "fuzz/numerics.rs"]
+mod numerics;
 #[path = "fuzz/outputs.rs"]
 mod outputs;
 
@@ -639,4 +641,29 @@ fn the_valid_gltf_the_fuzzer_mutates_loads_and_renders() {
     assert!(report.warnings.is_empty(), "{:?}", report.warnings);
     assert_eq!((scene.objects.len(), scene.lights.len()), (4, 2));
     render_finite(&scene, "the valid glTF");
+}
+
+proptest! {
+    #![proptest_config(config(48))]
+
+    /// Transforms near 0 and 10¹², unusable normals, long and short spot axes and large
+    /// ranges, on ES 3.0, ES 2.0 and without fragment highp (`fuzz/numerics.rs`).
+    #[test]
+    fn extreme_numbers_light_what_they_should_or_are_refused_by_name(case in numerics::case()) {
+        numerics::check(&case);
+    }
+
+    /// glTF node scales of 0 or tiny along an axis, or huge, load and render finite frames.
+    #[test]
+    fn gltf_node_scales_near_zero_and_huge_load_and_render(
+        scale in (numerics::scale_factor(), numerics::scale_factor(), numerics::scale_factor()),
+        node in 0usize..2,
+    ) {
+        let (mut doc, bin) = gltf_valid();
+        doc["nodes"][node]["scale"] = serde_json::json!([scale.0, scale.1, scale.2]);
+        let dir = workspace();
+        let file = dir.path().join("m.glb");
+        std::fs::write(&file, gltf_glb(doc.to_string().as_bytes(), &bin)).unwrap();
+        gltf_check(&file, true, &format!("node {node} scale {scale:?}"));
+    }
 }

@@ -34,8 +34,8 @@ pub(super) fn convert(
         }
     }
     let position = world.transform_point3(DVec3::ZERO);
-    let forward = world.transform_vector3(DVec3::NEG_Z).try_normalize();
-    let up = world.transform_vector3(DVec3::Y).try_normalize();
+    let forward = crate::scene::direction::unit(world.transform_vector3(DVec3::NEG_Z));
+    let up = crate::scene::direction::unit(world.transform_vector3(DVec3::Y));
     let (Some(forward), Some(up)) = (forward, up) else {
         return Err(format!(
             "{field}: the node's transform has no direction (zero scale)"

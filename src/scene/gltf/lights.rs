@@ -84,7 +84,7 @@ pub(super) fn convert(
             outer_cone_angle,
         } => {
             let direction = world.transform_vector3(DVec3::NEG_Z);
-            let Some(direction) = direction.try_normalize() else {
+            let Some(direction) = crate::scene::direction::unit(direction) else {
                 return Ok(Converted::Skipped(format!(
                     "{field}: the node's transform has no direction (zero scale); skipped"
                 )));

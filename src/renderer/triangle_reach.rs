@@ -1,0 +1,258 @@
+//! Triangles too large for `f32` interpolation near the camera are split on the CPU in `f64`.
+//!
+//! A fragment's view position is interpolated from its triangle's vertices in `f32` (clipping
+//! too), so it is off by about 2⁻²⁴ of the vertices' distance from the eye. Near a triangle
+//! much larger than its distance from the eye that error is a visible part of the distance
+//! itself: a plane scaled 10⁸ seen from 5 m was half black, at 10⁶ its light sat off centre.
+//! Such an object is drawn, for the frame, from a copy of its mesh in camera-relative world
+//! space whose triangles near the eye are split until none is longer than
+//! [`MAX_TRIANGLE_REACH`] times its distance (a few hundred triangles: only those near the
+//! eye split, and each level halves them).
+
+use glam::{DMat3, DMat4, DVec2, DVec3, Vec2};
+
+use crate::gpu_scene::GpuScene;
+use crate::scene::normal_matrix::normal_matrix;
+use crate::scene::{Camera, Mesh, Projection, Scene};
+
+/// Largest ratio of a triangle's longest edge to its distance from the eye (at least the near
+/// plane's) that is drawn as it is: positions are then within about 10⁻³ of their distance.
+pub const MAX_TRIANGLE_REACH: f64 = 16384.0;
+
+/// Most halvings of one triangle: 2⁻⁶⁰ of the largest edge f64 holds is below any near plane
+/// that edge could need.
+const MAX_SPLITS: u32 = 60;
+
+/// The longest triangle edge of a mesh in object space (0 without triangles).
+pub fn longest_edge(mesh: &Mesh) -> f64 {
+    mesh.indices
+        .chunks_exact(3)
+        .map(|t| {
+            let [a, b, c] = [t[0], t[1], t[2]].map(|i| mesh.positions[i as usize].as_dvec3());
+            a.distance(b).max(b.distance(c)).max(c.distance(a))
+        })
+        .fold(0.0, f64::max)
+}
+
+/// The objects of `scene` that need splitting this frame, each with its split mesh in
+/// camera-relative world space (drawn with the model matrix `translation(eye)`). Objects
+/// whose longest edge and bounds clear the limit cost one test.
+pub fn split_objects(scene: &Scene, gpu_scene: &GpuScene) -> Vec<(usize, Mesh)> {
+    let camera = &scene.camera;
+    let floor = closest_fragment(camera);
+    let eye = camera.position;
+    let mut out = Vec::new();
+    for (i, object) in scene.objects.iter().enumerate() {
+        let scale = largest_scale(&object.transform);
+        let longest = gpu_scene.longest_edge(object) * scale;
+        let distance = gpu_scene.world_bounds(object).map_or(f64::INFINITY, |b| {
+            (b.min - eye).max(eye - b.max).max(DVec3::ZERO).length()
+        });
+        if longest <= MAX_TRIANGLE_REACH * distance.max(floor) {
+            continue;
+        }
+        if let Some(mesh) = split_mesh(&object.mesh, &object.transform, eye, floor) {
+            out.push((i, mesh));
+        }
+    }
+    out
+}
+
+/// How close to the eye a fragment can be: the near plane, or an orthographic view's height.
+fn closest_fragment(camera: &Camera) -> f64 {
+    match camera.projection {
+        Projection::Perspective { near, .. } => near,
+        Projection::Orthographic { height, near, .. } => height.max(near),
+    }
+}
+
+/// An upper bound of how much `m` lengthens a vector (3 × its largest entry bounds the
+/// Frobenius norm, which bounds the stretch).
+fn largest_scale(m: &DMat4) -> f64 {
+    let cols = [m.x_axis, m.y_axis, m.z_axis].map(|c| c.truncate().abs().max_element());
+    cols.into_iter().fold(0.0, f64::max) * 3.0
+}
+
+/// A vertex being split: camera-relative world position, world normal, texture coordinate.
+#[derive(Clone, Copy)]
+struct Vertex {
+    p: DVec3,
+    n: DVec3,
+    uv: DVec2,
+}
+
+impl Vertex {
+    fn mid(a: &Vertex, b: &Vertex) -> Vertex {
+        Vertex {
+            p: (a.p + b.p) * 0.5,
+            n: (a.n + b.n) * 0.5,
+            uv: (a.uv + b.uv) * 0.5,
+        }
+    }
+}
+
+/// Whether triangle `abc` (relative to the eye) is longer than the limit allows at its
+/// distance, measured in units of its largest coordinate so no square leaves f64.
+fn too_long(a: DVec3, b: DVec3, c: DVec3, floor: f64) -> bool {
+    let unit = [a, b, c]
+        .iter()
+        .map(|v| v.abs().max_element())
+        .fold(0.0, f64::max);
+    if !(unit > 0.0 && unit.is_finite()) {
+        return false;
+    }
+    let [a, b, c] = [a, b, c].map(|v| v / unit);
+    let edge = a.distance(b).max(b.distance(c)).max(c.distance(a));
+    let distance = closest_point(a, b, c).length();
+    let distance = if distance.is_finite() {
+        distance
+    } else {
+        a.length().min(b.length()).min(c.length())
+    };
+    edge > MAX_TRIANGLE_REACH * distance.max(floor / unit)
+}
+
+/// `mesh` placed by `transform`, relative to `eye`, with the triangles too long for their
+/// distance split in four until they are not; `None` when no triangle needs it (or the
+/// placed mesh is not finite, which no split can mend).
+fn split_mesh(mesh: &Mesh, transform: &DMat4, eye: DVec3, floor: f64) -> Option<Mesh> {
+    let normals = normal_matrix(&DMat3::from_mat4(*transform));
+    let vertex = |i: u32| {
+        let i = i as usize;
+        Vertex {
+            p: transform.transform_point3(mesh.positions[i].as_dvec3()) - eye,
+            n: normals * mesh.normals[i].as_dvec3(),
+            uv: mesh.uvs.get(i).map_or(DVec2::ZERO, |t| t.as_dvec2()),
+        }
+    };
+    let placed: Vec<[Vertex; 3]> = mesh
+        .indices
+        .chunks_exact(3)
+        .map(|t| [vertex(t[0]), vertex(t[1]), vertex(t[2])])
+        .collect();
+    if placed.iter().flatten().any(|v| !v.p.is_finite()) {
+        return None;
+    }
+    if !placed.iter().any(|[a, b, c]| too_long(a.p, b.p, c.p, floor)) {
+        return None;
+    }
+    let mut out = Mesh::default();
+    let mut stack: Vec<([Vertex; 3], u32)> = placed.into_iter().map(|t| (t, 0)).collect();
+    while let Some(([a, b, c], depth)) = stack.pop() {
+        if depth < MAX_SPLITS && too_long(a.p, b.p, c.p, floor) {
+            let (ab, bc, ca) = (Vertex::mid(&a, &b), Vertex::mid(&b, &c), Vertex::mid(&c, &a));
+            for t in [[a, ab, ca], [ab, b, bc], [ca, bc, c], [ab, bc, ca]] {
+                stack.push((t, depth + 1));
+            }
+            continue;
+        }
+        for v in [a, b, c] {
+            out.indices.push(out.positions.len() as u32);
+            out.positions.push(v.p.as_vec3());
+            out.normals.push(v.n.as_vec3());
+            out.uvs.push(Vec2::new(v.uv.x as f32, v.uv.y as f32));
+        }
+    }
+    if mesh.uvs.is_empty() {
+        out.uvs.clear();
+    }
+    Some(out)
+}
+
+/// The point of triangle `abc` closest to the origin (Ericson, Real-Time Collision Detection,
+/// 5.1.5).
+fn closest_point(a: DVec3, b: DVec3, c: DVec3) -> DVec3 {
+    let (ab, ac, ap) = (b - a, c - a, -a);
+    let (d1, d2) = (ab.dot(ap), ac.dot(ap));
+    if d1 <= 0.0 && d2 <= 0.0 {
+        return a;
+    }
+    let bp = -b;
+    let (d3, d4) = (ab.dot(bp), ac.dot(bp));
+    if d3 >= 0.0 && d4 <= d3 {
+        return b;
+    }
+    let vc = d1 * d4 - d3 * d2;
+    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+        return a + ab * (d1 / (d1 - d3));
+    }
+    let cp = -c;
+    let (d5, d6) = (ab.dot(cp), ac.dot(cp));
+    if d6 >= 0.0 && d5 <= d6 {
+        return c;
+    }
+    let vb = d5 * d2 - d1 * d6;
+    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+        return a + ac * (d2 / (d2 - d6));
+    }
+    let va = d3 * d6 - d5 * d4;
+    if va <= 0.0 && d4 - d3 >= 0.0 && d5 - d6 >= 0.0 {
+        return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
+    }
+    let denom = 1.0 / (va + vb + vc);
+    a + ab * (vb * denom) + ac * (vc * denom)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn closest_point_finds_the_face_the_edge_and_the_corner() {
+        let (a, b, c) = (
+            DVec3::new(-1.0, -1.0, 2.0),
+            DVec3::new(3.0, -1.0, 2.0),
+            DVec3::new(-1.0, 3.0, 2.0),
+        );
+        assert_eq!(closest_point(a, b, c), DVec3::new(0.0, 0.0, 2.0));
+        let shifted = DVec3::new(5.0, 5.0, 0.0);
+        let edge = closest_point(a - shifted, b - shifted, c - shifted) + shifted;
+        assert!((edge - DVec3::new(1.0, 1.0, 2.0)).length() < 1e-12, "{edge}");
+        let far = DVec3::new(-9.0, -9.0, 0.0);
+        assert_eq!(closest_point(a - far, b - far, c - far) + far, a);
+    }
+
+    fn quad() -> Mesh {
+        let mut b = crate::MeshBuilder::new();
+        b.quad(
+            glam::Vec3::new(-1.0, -1.0, 0.0),
+            glam::Vec3::new(1.0, -1.0, 0.0),
+            glam::Vec3::new(1.0, 1.0, 0.0),
+            glam::Vec3::new(-1.0, 1.0, 0.0),
+        );
+        b.build()
+    }
+
+    #[test]
+    fn only_triangles_too_long_for_their_distance_are_split() {
+        let eye = DVec3::new(0.0, 0.0, 5.0);
+        let scaled = |s: f64| DMat4::from_scale(DVec3::new(s, s, 1.0));
+        assert!(split_mesh(&quad(), &scaled(1e4), eye, 0.1).is_none());
+        let split = split_mesh(&quad(), &scaled(1e8), eye, 0.1).unwrap();
+        let n = split.triangle_count();
+        assert!(n > 2 && n < 2000, "{n} triangles");
+        // Every triangle now within the limit, all together the same area, normals kept.
+        let mut area = 0.0;
+        for t in split.indices.chunks_exact(3) {
+            let [a, b, c] = [t[0], t[1], t[2]].map(|i| split.positions[i as usize].as_dvec3());
+            assert!(!too_long(a, b, c, 0.1));
+            area += (b - a).cross(c - a).length() * 0.5;
+        }
+        assert!((area / 4e16 - 1.0).abs() < 1e-4, "area {area:e}");
+        assert!(split.normals.iter().all(|n| n.normalize() == glam::Vec3::Z));
+        // Seen from within its own plane, the near plane bounds how close a fragment can be.
+        assert!(split_mesh(&quad(), &scaled(1e2), DVec3::ZERO, 0.1).is_none());
+        assert!(split_mesh(&quad(), &scaled(1e4), DVec3::ZERO, 0.1).is_some());
+    }
+
+    #[test]
+    fn coordinates_whose_squares_overflow_still_measure() {
+        let [a, b, c] = [
+            DVec3::new(-1e200, -1e200, -5e190),
+            DVec3::new(1e200, -1e200, -5e190),
+            DVec3::new(0.0, 1e200, -5e190),
+        ];
+        assert!(too_long(a, b, c, 1.0));
+        assert!(!too_long(a * 1e-20, b * 1e-20, c * 1e-20, 1e180));
+    }
+}
