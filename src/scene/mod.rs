@@ -23,6 +23,7 @@ pub mod obj;
 pub mod random;
 pub mod raycast;
 pub mod shading;
+pub mod texture_budget;
 
 use std::ops::Range;
 use std::sync::Arc;
