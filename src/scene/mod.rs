@@ -8,6 +8,7 @@
 
 pub mod builtin;
 pub mod camera;
+mod duplicates;
 pub mod error;
 pub mod features;
 pub mod file;

@@ -120,6 +120,13 @@ pub fn load_into(
             Some(id) if id < mtl.len() => first + id,
             _ => fallback,
         };
+        let (mesh, dropped) =
+            super::duplicates::drop_from_opaque(mesh, &scene.materials[material], || {
+                format!("{}: object `{}`", path.display(), model.name)
+            });
+        if let Some(warning) = dropped {
+            report.warn(warning);
+        }
         scene.objects.push(Object {
             mesh: Arc::new(mesh),
             material,
