@@ -37,9 +37,10 @@ use serde::Deserialize;
 
 use super::camera::Projection;
 use super::motion::{Bob, Flicker, Motion, Orbit, OrbitAbout, Sweep, Wander};
-use super::obj::{self, LoadReport};
+use super::model_cache::{self, ModelCache};
+use super::obj::LoadReport;
 use super::random::{self, LightSetStyle};
-use super::{builtin, Camera, Light, LightKind, Scene, SceneError};
+use super::{Camera, Light, LightKind, Scene, SceneError};
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -257,6 +258,7 @@ pub fn parse(
     let mut scene = Scene::empty();
     let mut report = LoadReport::default();
     let mut builtin_camera = None;
+    let mut models = ModelCache::default();
     for (i, spec) in file.objects.iter().enumerate() {
         let field = format!("objects[{i}]");
         let transform = spec
@@ -266,7 +268,8 @@ pub fn parse(
         let first_material = scene.materials.len();
         match (&spec.builtin, &spec.obj, &spec.gltf) {
             (Some(name), None, None) => {
-                let built = builtin::geometry(name)
+                let built = models
+                    .builtin(name)
                     .ok_or_else(|| SceneError::UnknownBuiltin {
                         name: name.clone(),
                         available: super::builtin::NAMES,
@@ -287,11 +290,12 @@ pub fn parse(
             }
             (None, Some(obj_path), None) => {
                 let tex = spec.texture.as_ref().map(|t| base_dir.join(t));
-                let r = obj::load_into(
+                let r = models.place_obj(
                     &mut scene,
                     &base_dir.join(obj_path),
                     transform,
                     tex.as_deref(),
+                    spec.color.is_some(),
                 )?;
                 report.warnings.extend(r.warnings);
             }
@@ -303,7 +307,7 @@ pub fn parse(
                     ));
                 }
                 let loaded =
-                    super::gltf::load_into(&mut scene, &base_dir.join(gltf_path), transform)?;
+                    models.place_gltf(&mut scene, &base_dir.join(gltf_path), transform)?;
                 if let Some(camera) = loaded.camera {
                     builtin_camera.get_or_insert(camera);
                 }
@@ -322,6 +326,7 @@ pub fn parse(
                 m.diffuse = Vec3::from(c);
             }
         }
+        model_cache::check_budget(&scene, &format!("objects[{i}]"))?;
     }
     if let Some(a) = file.ambient {
         scene.ambient = Vec3::from(a);

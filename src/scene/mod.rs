@@ -18,6 +18,7 @@ pub mod light;
 pub mod material;
 pub mod mesh;
 pub mod meshbuild;
+mod model_cache;
 pub mod motion;
 pub mod normal_matrix;
 pub mod obj;
