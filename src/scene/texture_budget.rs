@@ -49,7 +49,9 @@ pub fn to_rgba8(image: DynamicImage, name: &str) -> (image::RgbaImage, Option<St
     if (sw, sh) == (w, h) {
         return (image.into_rgba8(), None);
     }
-    let scaled = image.resize_exact(sw, sh, image::imageops::FilterType::Triangle);
+    // Area averaging straight into the small image: `resize_exact` would first build a
+    // full-width f32 RGBA copy (786 MB for 12 000 × 4 096).
+    let scaled = image.thumbnail_exact(sw, sh);
     let warning = format!(
         "texture {name} is {w}×{h}; scaled down to {sw}×{sh} (textures are kept within \
          {MAX_STORED_TEXTURE_SIDE} pixels a side)"
