@@ -7,6 +7,8 @@
 //! thousand cases in all, well under a minute).
 
 mod common;
+#[path = "fuzz/repeats.rs"]
+mod repeats;
 
 use std::cell::RefCell;
 use std::panic::{catch_unwind, AssertUnwindSafe};
