@@ -1,8 +1,7 @@
 //! Exact duplicate triangles: the same three corners (position, normal and texture coordinate
 //! alike) as an earlier triangle of the mesh, in any rotation or winding. On an opaque surface
-//! drawn two-sided they add nothing to the picture, only overdraw: a 16 MB OBJ repeating one
-//! triangle 2 M times took 80–95 s a 16×16 frame. Transparent surfaces keep them (each copy
-//! blends once more).
+//! drawn two-sided they add nothing to the picture, only overdraw (a 16 MB OBJ can repeat one
+//! triangle 2 M times). Transparent surfaces keep them (each copy blends once more).
 
 use super::{Material, Mesh};
 

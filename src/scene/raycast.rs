@@ -5,8 +5,7 @@
 //! It is instance-aware: one bounding volume hierarchy per distinct mesh (objects that place
 //! the same `Arc<Mesh>` share it), in mesh space, and a top-level hierarchy over the placed
 //! objects' world bounds. A ray enters each object through the inverse of its transform, so
-//! a placement costs a few hundred bytes whatever its mesh (a model placed 1 000 times took
-//! one copy of every triangle per placement before, gigabytes). A transform without a usable
+//! a placement costs a few hundred bytes whatever its mesh. A transform without a usable
 //! inverse (flattened to a plane) is traced in world space instead, its triangles carried
 //! through the transform as they are tested. The ray test is Möller–Trumbore with both faces
 //! accepted (the renderer draws surfaces two-sided); `t` is the world ray's parameter in

@@ -2,7 +2,7 @@
 //! the decoder's allocation), and a decoded image larger than [`MAX_STORED_TEXTURE_SIDE`] on a
 //! side is scaled down in its own pixel format before it becomes RGBA8, the decoded copy
 //! dropped then: a 12 000² RGB PNG peaks near 0.55 GB (0.43 decoded, 0.05 scaled, 0.06 RGBA)
-//! instead of 1.9 GB, and is kept as 64 MiB.
+//! and is kept as 64 MiB.
 
 use image::DynamicImage;
 
