@@ -307,7 +307,12 @@ pub fn parse(
                     ));
                 }
                 let loaded =
-                    models.place_gltf(&mut scene, &base_dir.join(gltf_path), transform)?;
+                    models.place_gltf(
+                        &mut scene,
+                        &base_dir.join(gltf_path),
+                        transform,
+                        spec.color.is_some(),
+                    )?;
                 if let Some(camera) = loaded.camera {
                     builtin_camera.get_or_insert(camera);
                 }

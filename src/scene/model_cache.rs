@@ -1,11 +1,11 @@
 //! Models a scene file names more than once, kept once. A built-in scene is built once; an
-//! OBJ file (with the same texture override) is loaded on its first reference only, later
-//! ones place the same `Arc<Mesh>`es and reuse its materials (copied when the reference
-//! recolours them). A glTF file is read again for each reference (its lights, camera and
-//! checks depend on the placing transform), an OBJ again for another texture override, but
-//! their meshes are swapped for those of the file's first load when equal, and every texture
-//! for an equal one of the same name loaded before, so memory holds one copy. Repeats add no
-//! warnings: the first load said them.
+//! OBJ file (with the same texture override) and a glTF file without lights or cameras are
+//! read on their first reference only, later ones place the same `Arc<Mesh>`es and reuse the
+//! materials (copied when the reference recolours them). A glTF file with lights or cameras is
+//! read again for each reference (they depend on the placing transform), an OBJ again for
+//! another texture override, but their meshes are swapped for those of the file's first read
+//! when equal, and every texture for an equal one of the same name loaded before, so memory
+//! holds one copy. Repeats add no warnings: the first load said them.
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -14,7 +14,8 @@ use std::sync::Arc;
 use glam::DMat4;
 
 use super::obj::{self, LoadReport};
-use super::{Material, Mesh, Object, Scene, SceneError, Texture};
+use super::camera::MAX_CAMERA_COORD;
+use super::{Aabb, Material, Mesh, Object, Scene, SceneError, Texture};
 
 /// Most objects a scene file may place (all its references together), the per-file limit of
 /// glTF too: each costs about 0.6 KB of CPU state besides its mesh (placement, draw order,
@@ -24,20 +25,96 @@ pub const MAX_SCENE_OBJECTS: usize = super::gltf::MAX_OBJECTS;
 /// Most materials a scene file may make (references that recolour a model copy its materials).
 pub const MAX_SCENE_MATERIALS: usize = 1 << 20;
 
-/// An OBJ load as it came from the file.
-struct LoadedObj {
-    /// Each object's mesh and material index relative to the file's first material.
-    objects: Vec<(Arc<Mesh>, usize)>,
-    /// The file's materials before any recolouring.
+/// A model as loaded, to be placed again without reading it.
+struct Loaded {
+    /// Each object's mesh, material index relative to the model's first material, transform
+    /// relative to the placing one, and object-space bounds when placements must be checked.
+    objects: Vec<(Arc<Mesh>, usize, DMat4, Option<Aabb>)>,
+    /// The model's materials before any recolouring.
     materials: Vec<Material>,
     /// Where an unrecoloured copy of `materials` starts in the scene, once there is one.
     uncoloured_at: Option<usize>,
 }
 
+impl Loaded {
+    /// What `scene` holds from `first_object` and `first_material` on; `relative` gives an
+    /// object's transform relative to the placing one and `checked` whether to keep bounds.
+    fn record(
+        scene: &Scene,
+        (first_object, first_material): (usize, usize),
+        relative: impl Fn(&Object) -> DMat4,
+        checked: bool,
+    ) -> Loaded {
+        let objects = scene.objects[first_object..]
+            .iter()
+            .map(|o| {
+                let bounds = if checked { o.mesh.bounds() } else { None };
+                (o.mesh.clone(), o.material - first_material, relative(o), bounds)
+            })
+            .collect();
+        Loaded {
+            objects,
+            materials: scene.materials[first_material..].to_vec(),
+            uncoloured_at: None,
+        }
+    }
+
+    /// Places the model again with `transform`, reusing an unrecoloured copy of its materials
+    /// unless the caller will `recolour` them. Errors (from `path`) when a placed object's
+    /// bounds pass the camera's coordinate limit, as the glTF loader's own check does.
+    fn place(
+        &mut self,
+        scene: &mut Scene,
+        path: &Path,
+        transform: DMat4,
+        recolour: bool,
+    ) -> Result<(), SceneError> {
+        for (_, _, relative, bounds) in &self.objects {
+            let world = transform * *relative;
+            let reach = bounds.map_or(0.0, |b| {
+                let b = b.transformed(&world);
+                b.min.abs().max(b.max.abs()).max_element()
+            });
+            if !world.is_finite() || !reach.is_finite() || reach > MAX_CAMERA_COORD {
+                return Err(SceneError::Gltf {
+                    path: path.to_path_buf(),
+                    reason: format!(
+                        "placed by this reference, an object's world-space bounds reach \
+                         {reach:e}, past ±{MAX_CAMERA_COORD:e}"
+                    ),
+                });
+            }
+        }
+        let base = match self.uncoloured_at {
+            Some(base) if !recolour => base,
+            _ => {
+                let base = scene.materials.len();
+                scene.materials.extend(self.materials.iter().cloned());
+                if !recolour {
+                    self.uncoloured_at = Some(base);
+                }
+                base
+            }
+        };
+        scene.objects.extend(
+            self.objects
+                .iter()
+                .map(|(mesh, material, relative, _)| Object {
+                    mesh: mesh.clone(),
+                    material: base + material,
+                    transform: transform * *relative,
+                }),
+        );
+        Ok(())
+    }
+}
+
 /// The models one scene file has loaded, by canonical path (and texture override for OBJ).
 #[derive(Default)]
 pub(super) struct ModelCache {
-    obj: HashMap<(PathBuf, Option<PathBuf>), LoadedObj>,
+    obj: HashMap<(PathBuf, Option<PathBuf>), Loaded>,
+    /// glTF files without lights or cameras, read at the identity; `None`: read per reference.
+    gltf: HashMap<PathBuf, Option<Loaded>>,
     /// The distinct meshes of each model file's first load, in first-use order.
     meshes: HashMap<PathBuf, Vec<Arc<Mesh>>>,
     /// Every texture loaded so far, by name (its path).
@@ -69,56 +146,60 @@ impl ModelCache {
             (p, texture)
         });
         if let Some(loaded) = key.as_ref().and_then(|k| self.obj.get_mut(k)) {
-            let base = match loaded.uncoloured_at {
-                Some(base) if !recolour => base,
-                _ => {
-                    let base = scene.materials.len();
-                    scene.materials.extend(loaded.materials.iter().cloned());
-                    if !recolour {
-                        loaded.uncoloured_at = Some(base);
-                    }
-                    base
-                }
-            };
-            scene
-                .objects
-                .extend(loaded.objects.iter().map(|(mesh, material)| Object {
-                    mesh: mesh.clone(),
-                    material: base + material,
-                    transform,
-                }));
+            loaded.place(scene, path, transform, recolour)?;
             return Ok(LoadReport::default());
         }
-        let (first_object, first_material) = (scene.objects.len(), scene.materials.len());
+        let first = (scene.objects.len(), scene.materials.len());
         let report = obj::load_into(scene, path, transform, texture)?;
-        self.share(scene, first_object, first_material, key.as_ref().map(|k| &k.0));
+        self.share(scene, first.0, first.1, key.as_ref().map(|k| &k.0));
         if let Some(key) = key {
-            let objects = scene.objects[first_object..]
-                .iter()
-                .map(|o| (o.mesh.clone(), o.material - first_material))
-                .collect();
-            self.obj.insert(
-                key,
-                LoadedObj {
-                    objects,
-                    materials: scene.materials[first_material..].to_vec(),
-                    uncoloured_at: (!recolour).then_some(first_material),
-                },
-            );
+            // The loader places every object with `transform` itself.
+            let mut loaded = Loaded::record(scene, first, |_| DMat4::IDENTITY, false);
+            loaded.uncoloured_at = (!recolour).then_some(first.1);
+            self.obj.insert(key, loaded);
         }
         Ok(report)
     }
 
-    /// Places a glTF file with `transform`, sharing the meshes and textures of earlier loads.
+    /// Places a glTF file with `transform`. A file without lights or cameras is read once, at
+    /// the identity, and placed from that; one with them is read for each reference (they
+    /// depend on the transform), sharing the meshes and textures of earlier reads.
     pub fn place_gltf(
         &mut self,
         scene: &mut Scene,
         path: &Path,
         transform: DMat4,
+        recolour: bool,
     ) -> Result<super::gltf::GltfLoad, SceneError> {
+        let key = std::fs::canonicalize(path).ok();
+        if let Some(k) = &key {
+            if !self.gltf.contains_key(k) {
+                let mut alone = Scene::empty();
+                let read = super::gltf::load_into(&mut alone, path, DMat4::IDENTITY);
+                let entry = match read {
+                    Ok(read) if alone.lights.is_empty() && read.camera.is_none() => {
+                        self.share(&mut alone, 0, 0, Some(k));
+                        let loaded = Loaded::record(&alone, (0, 0), |o| o.transform, true);
+                        Some((loaded, read.report))
+                    }
+                    _ => None,
+                };
+                let (loaded, report) = entry.unzip();
+                self.gltf.insert(k.clone(), loaded);
+                if let Some(Some(loaded)) = self.gltf.get_mut(k) {
+                    loaded.place(scene, path, transform, recolour)?;
+                    return Ok(super::gltf::GltfLoad {
+                        report: report.unwrap_or_default(),
+                        camera: None,
+                    });
+                }
+            } else if let Some(Some(loaded)) = self.gltf.get_mut(k) {
+                loaded.place(scene, path, transform, recolour)?;
+                return Ok(super::gltf::GltfLoad::default());
+            }
+        }
         let (first_object, first_material) = (scene.objects.len(), scene.materials.len());
         let mut loaded = super::gltf::load_into(scene, path, transform)?;
-        let key = std::fs::canonicalize(path).ok();
         if self.share(scene, first_object, first_material, key.as_ref()) {
             loaded.report.warnings.clear();
         }

@@ -134,6 +134,43 @@ fn a_gltf_named_many_times_shares_its_meshes_and_textures() {
         .filter_map(|m| m.diffuse_texture.as_ref().map(Arc::as_ptr))
         .collect();
     assert_eq!(textures.len(), 1);
+    assert_eq!(
+        scene.materials.len(),
+        1,
+        "uncoloured references share the material"
+    );
+    // A placement past the coordinate limit is refused as the loader's own check refuses it.
+    for far in [
+        [[0.0, 0.0, 0.0], [1e13, 0.0, 0.0]],
+        [[1e13, 0.0, 0.0], [0.0, 0.0, 0.0]],
+    ] {
+        let objects: Vec<serde_json::Value> = far
+            .iter()
+            .map(|t| serde_json::json!({"gltf": "q.gltf", "transform": {"translate": t}}))
+            .collect();
+        std::fs::write(&file, serde_json::json!({"objects": objects}).to_string()).unwrap();
+        let err = scene::load(file.to_str().unwrap(), None)
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("q.gltf") && err.contains("past"), "{err}");
+    }
+
+    // With a light, the file is read per reference (the light moves with it): three lights,
+    // one mesh.
+    let mut lit = doc.clone();
+    lit["extensionsUsed"] = serde_json::json!(["KHR_lights_punctual"]);
+    lit["extensions"] = serde_json::json!({"KHR_lights_punctual": {"lights": [
+        {"type": "point", "intensity": 2, "range": 3}]}});
+    lit["nodes"][0]["extensions"] = serde_json::json!({"KHR_lights_punctual": {"light": 0}});
+    std::fs::write(dir.path().join("lit.gltf"), lit.to_string()).unwrap();
+    let objects: Vec<serde_json::Value> = (0..3)
+        .map(|i| serde_json::json!({"gltf": "lit.gltf", "transform": {"translate": [i, 0, 0]}}))
+        .collect();
+    std::fs::write(&file, serde_json::json!({"objects": objects}).to_string()).unwrap();
+    let (scene, _) = scene::load(file.to_str().unwrap(), None).unwrap();
+    assert_eq!((scene.objects.len(), distinct_meshes(&scene)), (3, 1));
+    let xs: Vec<f64> = scene.lights.iter().map(|l| l.position.x).collect();
+    assert_eq!(xs, [0.0, 1.0, 2.0]);
 }
 
 /// An OBJ repeating a quad thousands of times (in every rotation and winding) loads as the

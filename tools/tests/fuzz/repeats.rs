@@ -1,6 +1,6 @@
 //! Generators for models placed many times: scene files naming the same OBJ and glTF files
 //! again and again (under other spellings of the path, with other transforms and colours),
-//! and glTF nodes placing one mesh many times. What loads must hold each distinct mesh once —
+//! and glTF nodes placing one mesh many times, with and without lights and cameras. What loads must hold each distinct mesh once —
 //! in the scene and in the ray caster, whose memory a placement adds to stays a constant.
 
 use std::collections::HashSet;
@@ -89,12 +89,25 @@ proptest! {
         placements in 0usize..40,
         refs in prop::collection::vec(reference(), 1..200),
         render in prop::bool::weighted(0.2),
+        lit in any::<bool>(),
     ) {
         let dir = workspace();
         std::fs::write(dir.path().join("m.obj"), obj_with_groups(groups)).unwrap();
         std::fs::write(dir.path().join("m.mtl"), MTL).unwrap();
         // The glTF places its mesh (two primitives) `placements` more times through nodes.
         let (mut doc, bin) = gltf_valid();
+        if !lit {
+            // Without lights and cameras the file is read once; with them, per reference.
+            let root = doc.as_object_mut().unwrap();
+            root.remove("extensions");
+            root.remove("extensionsUsed");
+            root.remove("cameras");
+            for node in doc["nodes"].as_array_mut().unwrap() {
+                let node = node.as_object_mut().unwrap();
+                node.remove("camera");
+                node.remove("extensions");
+            }
+        }
         for i in 0..placements {
             let n = doc["nodes"].as_array().unwrap().len();
             doc["nodes"].as_array_mut().unwrap().push(
