@@ -45,11 +45,15 @@ impl Loaded {
         relative: impl Fn(&Object) -> DMat4,
         checked: bool,
     ) -> Loaded {
+        // Bounds once a mesh: a file may place one large mesh many times.
+        let mut bounds = HashMap::new();
         let objects = scene.objects[first_object..]
             .iter()
             .map(|o| {
-                let bounds = if checked { o.mesh.bounds() } else { None };
-                (o.mesh.clone(), o.material - first_material, relative(o), bounds)
+                let b = checked
+                    .then(|| *bounds.entry(Arc::as_ptr(&o.mesh)).or_insert_with(|| o.mesh.bounds()))
+                    .flatten();
+                (o.mesh.clone(), o.material - first_material, relative(o), b)
             })
             .collect();
         Loaded {
