@@ -82,11 +82,18 @@ impl Scene {
         }
     }
 
-    /// World-space bounds of all objects (`None` for a scene without geometry).
+    /// World-space bounds of all objects (`None` for a scene without geometry). Each distinct
+    /// mesh's vertices are walked once, however many objects place it.
     pub fn bounds(&self) -> Option<Aabb> {
+        let mut meshes = std::collections::HashMap::new();
         self.objects
             .iter()
-            .filter_map(|o| o.mesh.bounds().map(|b| b.transformed(&o.transform)))
+            .filter_map(|o| {
+                let b = meshes
+                    .entry(Arc::as_ptr(&o.mesh))
+                    .or_insert_with(|| o.mesh.bounds());
+                b.map(|b| b.transformed(&o.transform))
+            })
             .reduce(|a, b| a.union(&b))
     }
 

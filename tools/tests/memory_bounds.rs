@@ -246,3 +246,40 @@ fn an_oversized_texture_is_kept_scaled_down_with_a_warning() {
         "{warning}"
     );
 }
+
+/// A mesh placed 100 000 times: the scene's bounds are those of its placements (each distinct
+/// mesh's vertices are walked once, not once a placement).
+#[test]
+fn bounds_of_a_mesh_placed_many_times() {
+    use glam::{DMat4, DVec3, Vec3};
+    let mesh = Arc::new(
+        manylight::Mesh::new(
+            vec![
+                Vec3::new(-1.0, 0.0, 0.0),
+                Vec3::new(1.0, 2.0, 0.5),
+                Vec3::ZERO,
+            ],
+            vec![],
+            vec![],
+            vec![0, 1, 2],
+        )
+        .unwrap(),
+    );
+    let mut scene = Scene::empty();
+    let material = scene.add_material(manylight::Material::default());
+    for i in 0..100_000 {
+        let at = DVec3::new((i % 500) as f64 * 4.0, 0.0, (i / 500) as f64 * -3.0);
+        let turn = if i == 77 {
+            DMat4::from_rotation_z(std::f64::consts::PI)
+        } else {
+            DMat4::IDENTITY
+        };
+        scene.add_object(mesh.clone(), material, DMat4::from_translation(at) * turn);
+    }
+    let b = scene.bounds().unwrap();
+    // Placement 77 (at x = 308) is turned half round z: its y runs down to -2.
+    let want_min = DVec3::new(-1.0, -2.0, -597.0);
+    let want_max = DVec3::new(1997.0, 2.0, 0.5);
+    assert!((b.min - want_min).length() < 1e-9, "{:?}", b.min);
+    assert!((b.max - want_max).length() < 1e-9, "{:?}", b.max);
+}
