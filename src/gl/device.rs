@@ -212,6 +212,11 @@ impl Device {
             return Ok(());
         }
         unsafe { while self.gl.get_error() != glow::NO_ERROR {} }
+        if code == glow::OUT_OF_MEMORY {
+            return Err(GlError::OutOfMemory(format!(
+                "the driver reported GL_OUT_OF_MEMORY after {what}"
+            )));
+        }
         Err(GlError::Driver {
             what: what.to_string(),
             name: error_name(code),

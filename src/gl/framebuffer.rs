@@ -109,6 +109,13 @@ impl OffscreenTarget {
                 width as i32,
                 height as i32,
             );
+            // Out of memory here is an error naming the size, not an incomplete framebuffer.
+            if let Err(e) = dev.check(&format!("allocating a {width}×{height} {format:?} target"))
+            {
+                dev.delete_texture(color);
+                dev.delete_renderbuffer(depth);
+                return Err(e);
+            }
             let fbo = dev.create_framebuffer()?;
             gl.bind_framebuffer(glow::FRAMEBUFFER, Some(fbo));
             gl.framebuffer_texture_2d(
@@ -167,8 +174,8 @@ impl OffscreenTarget {
     /// Reads a float colour buffer as f32 RGBA, top row first.
     pub fn read_rgba_f32(&self, dev: &Device) -> Result<Vec<[f32; 4]>, GlError> {
         let (w, h) = (self.width as usize, self.height as usize);
-        // f32 storage so the byte view is aligned for the cast back.
-        let mut floats = vec![0f32; w * h * 4];
+        let mut texels: Vec<[f32; 4]> =
+            super::alloc::zeroed(self.width, self.height, 1, "float read-back")?;
         unsafe {
             dev.gl.bind_framebuffer(glow::FRAMEBUFFER, Some(self.fbo));
             dev.gl.pixel_store_i32(glow::PACK_ALIGNMENT, 4);
@@ -179,18 +186,18 @@ impl OffscreenTarget {
                 h as i32,
                 glow::RGBA,
                 glow::FLOAT,
-                glow::PixelPackData::Slice(Some(bytemuck::cast_slice_mut(&mut floats))),
+                glow::PixelPackData::Slice(Some(bytemuck::cast_slice_mut(&mut texels))),
             );
         }
         dev.check("glReadPixels (float)")?;
-        let texels: &[[f32; 4]] = bytemuck::cast_slice(&floats);
-        Ok(texels.chunks_exact(w).rev().flatten().copied().collect())
+        super::alloc::flip_rows(&mut texels, w);
+        Ok(texels)
     }
 
     /// Reads the colour buffer, top row first (as image files store it).
     pub fn read_rgba8(&self, dev: &Device) -> Result<image::RgbaImage, GlError> {
         let (w, h) = (self.width as usize, self.height as usize);
-        let mut pixels = vec![0u8; w * h * 4];
+        let mut pixels: Vec<u8> = super::alloc::zeroed(self.width, self.height, 4, "read-back")?;
         unsafe {
             dev.gl.bind_framebuffer(glow::FRAMEBUFFER, Some(self.fbo));
             dev.gl.pixel_store_i32(glow::PACK_ALIGNMENT, 1);
@@ -205,12 +212,8 @@ impl OffscreenTarget {
             );
         }
         dev.check("glReadPixels")?;
-        // GL's row 0 is the bottom row.
-        let mut flipped = Vec::with_capacity(pixels.len());
-        for row in pixels.chunks_exact(w * 4).rev() {
-            flipped.extend_from_slice(row);
-        }
-        Ok(image::RgbaImage::from_raw(self.width, self.height, flipped).expect("size matches"))
+        super::alloc::flip_rows(&mut pixels, w * 4);
+        Ok(image::RgbaImage::from_raw(self.width, self.height, pixels).expect("size matches"))
     }
 
     /// Frees the framebuffer and its attachments.

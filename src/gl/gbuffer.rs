@@ -110,6 +110,12 @@ impl GBuffer {
             bytes_per_pixel: bytes_per_pixel(dev.caps()),
             destroyed: false,
         };
+        // Out of memory is an error naming the size, not an incomplete framebuffer.
+        if let Err(e) = dev.check(&format!("allocating a {w}×{h} G-buffer")) {
+            let mut gb = gb;
+            gb.destroy(dev);
+            return Err(e);
+        }
         let gl = &dev.gl;
         unsafe {
             gl.bind_framebuffer(glow::FRAMEBUFFER, Some(geometry_fbo));
@@ -160,7 +166,11 @@ impl GBuffer {
                 }
             }
         }
-        dev.check("G-buffer creation")?;
+        if let Err(e) = dev.check("G-buffer creation") {
+            let mut gb = gb;
+            gb.destroy(dev);
+            return Err(e);
+        }
         Ok(gb)
     }
 

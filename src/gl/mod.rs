@@ -11,6 +11,7 @@
 //! Every GL object has an explicit `destroy(&Device)`; `Drop` only warns when it was never
 //! called, because GL objects cannot be freed without the context at hand.
 
+pub mod alloc;
 pub mod caps;
 pub mod context;
 pub mod device;
@@ -161,6 +162,10 @@ pub enum GlError {
     /// Object creation failed.
     #[error("GL object creation failed: {0}")]
     Create(String),
+    /// Memory for an image, read-back or GL object could not be had: what it was for, and its
+    /// size.
+    #[error("out of memory: {0}")]
+    OutOfMemory(String),
     /// EGL says no context is current on this thread.
     #[error("no GL context is current on this thread: was the HeadlessContext dropped, or another context made current, while the Renderer lived? Keep the context alive and current as long as the renderer")]
     NotCurrent,

@@ -197,6 +197,12 @@ impl MultisampleTarget {
                 glow::RENDERBUFFER,
                 Some(depth),
             );
+            // Out of memory is an error naming the size, not an incomplete framebuffer.
+            let what = format!("allocating a {width}×{height} target with {samples} samples");
+            if let Err(e) = dev.check(&what) {
+                target.destroy(dev);
+                return Err(e);
+            }
             let status = gl.check_framebuffer_status(glow::FRAMEBUFFER);
             if status != glow::FRAMEBUFFER_COMPLETE {
                 target.destroy(dev);

@@ -231,7 +231,9 @@ impl ImageTexture {
         let (pw, ph) = upload_size((w, h), max, dev.es() == EsVersion::Es2);
         let resized;
         let img = if (pw, ph) != (w, h) {
-            resized = image::imageops::resize(image, pw, ph, image::imageops::FilterType::Triangle);
+            // Area averaging (upload sizes only ever shrink) without `resize`'s full-width f32
+            // copy.
+            resized = image::imageops::thumbnail(image, pw, ph);
             &resized
         } else {
             image
@@ -255,7 +257,7 @@ impl ImageTexture {
             gl.generate_mipmap(glow::TEXTURE_2D);
         }
         set_sampling(gl, glow::LINEAR, glow::REPEAT, glow::LINEAR_MIPMAP_LINEAR);
-        dev.check("image texture upload")?;
+        dev.check(&format!("uploading a {pw}×{ph} image texture"))?;
         Ok(ImageTexture {
             raw,
             destroyed: false,

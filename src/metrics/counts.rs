@@ -32,6 +32,25 @@ impl LightCounts {
         }
     }
 
+    /// [`LightCounts::decode`] into buffers allocated fallibly: a frame whose counts the
+    /// machine cannot hold is an error naming its size.
+    pub(crate) fn try_decode(image: &image::RgbaImage) -> Result<LightCounts, crate::GlError> {
+        use crate::gl::alloc::zeroed;
+        let (width, height) = image.dimensions();
+        let mut counts: Vec<u32> = zeroed(width, height, 1, "light counts")?;
+        let mut covered: Vec<bool> = zeroed(width, height, 1, "light coverage")?;
+        for ((count, cover), p) in counts.iter_mut().zip(&mut covered).zip(image.pixels()) {
+            *count = p[0] as u32 | (p[1] as u32) << 8 | (p[2] as u32) << 16;
+            *cover = p[3] > 127;
+        }
+        Ok(LightCounts {
+            width,
+            height,
+            counts,
+            covered,
+        })
+    }
+
     /// Sum over covered pixels.
     pub fn total(&self) -> u64 {
         self.counts.iter().map(|&n| n as u64).sum()
@@ -82,5 +101,6 @@ mod tests {
         );
         assert_eq!(c.mean(), 0x01_1234 as f64 / 2.0);
         assert_eq!(c.at(0, 0), 0x01_1234);
+        assert_eq!(LightCounts::try_decode(&img).unwrap(), c);
     }
 }

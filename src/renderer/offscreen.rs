@@ -116,6 +116,6 @@ impl Renderer {
         } else {
             self.render_offscreen(scene, width, height, &options)?
         };
-        Ok((LightCounts::decode(&image), stats))
+        Ok((LightCounts::try_decode(&image)?, stats))
     }
 }

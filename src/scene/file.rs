@@ -38,9 +38,10 @@ use serde::Deserialize;
 use super::access::LoadOptions;
 use super::camera::{Projection, MAX_CAMERA_COORD};
 use super::motion::{Bob, Flicker, Motion, Orbit, OrbitAbout, Sweep, Wander};
-use super::obj::{self, LoadReport};
+use super::model_cache::{self, ModelCache};
+use super::obj::LoadReport;
 use super::random::{self, LightSetStyle};
-use super::{builtin, Camera, Light, LightKind, Scene, SceneError};
+use super::{Camera, Light, LightKind, Scene, SceneError};
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -262,6 +263,7 @@ pub fn parse(
     let mut scene = Scene::empty();
     let mut report = LoadReport::default();
     let mut builtin_camera = None;
+    let mut models = ModelCache::default();
     for (i, spec) in file.objects.iter().enumerate() {
         let field = format!("objects[{i}]");
         let transform = spec
@@ -272,7 +274,8 @@ pub fn parse(
         let first_object = scene.objects.len();
         match (&spec.builtin, &spec.obj, &spec.gltf) {
             (Some(name), None, None) => {
-                let built = builtin::geometry(name)
+                let built = models
+                    .builtin(name)
                     .ok_or_else(|| SceneError::UnknownBuiltin {
                         name: name.clone(),
                         available: super::builtin::NAMES,
@@ -293,11 +296,13 @@ pub fn parse(
             }
             (None, Some(obj_path), None) => {
                 let tex = spec.texture.as_ref().map(|t| base_dir.join(t));
-                let r = obj::load_into(
+                let r = models.place_obj(
                     &mut scene,
                     &base_dir.join(obj_path),
                     transform,
                     tex.as_deref(),
+                    spec.color.is_some(),
+                    &format!("{field}.transform"),
                 )?;
                 report.warnings.extend(r.warnings);
             }
@@ -308,10 +313,11 @@ pub fn parse(
                         "only OBJ objects take a texture",
                     ));
                 }
-                let loaded = super::gltf::load_into(
+                let loaded = models.place_gltf(
                     &mut scene,
                     &base_dir.join(gltf_path),
                     transform,
+                    spec.color.is_some(),
                     &format!("{field}.transform"),
                     options,
                 )?;
@@ -334,6 +340,7 @@ pub fn parse(
                 m.diffuse = Vec3::from(c);
             }
         }
+        model_cache::check_budget(&scene, &format!("objects[{i}]"))?;
     }
     if let Some(a) = file.ambient {
         scene.ambient = Vec3::from(a);
@@ -392,8 +399,13 @@ pub fn parse(
 /// The objects from `first` on, placed by `field`'s transform: their world bounds must be
 /// finite and within the camera's coordinate limit, or the transform is at fault.
 fn check_placed(scene: &Scene, first: usize, field: &str) -> Result<(), SceneError> {
+    // A model placing one mesh many times has its vertices walked once.
+    let mut mesh_bounds = std::collections::HashMap::new();
     for o in &scene.objects[first..] {
-        let Some(b) = o.mesh.bounds().map(|b| b.transformed(&o.transform)) else {
+        let bounds = *mesh_bounds
+            .entry(std::sync::Arc::as_ptr(&o.mesh))
+            .or_insert_with(|| o.mesh.bounds());
+        let Some(b) = bounds.map(|b| b.transformed(&o.transform)) else {
             continue;
         };
         let reach = b.min.abs().max(b.max.abs()).max_element();

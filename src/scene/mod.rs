@@ -10,6 +10,7 @@ pub mod access;
 pub mod builtin;
 pub mod camera;
 pub mod direction;
+mod duplicates;
 pub mod error;
 pub mod features;
 pub mod file;
@@ -19,12 +20,14 @@ pub mod light;
 pub mod material;
 pub mod mesh;
 pub mod meshbuild;
+mod model_cache;
 pub mod motion;
 pub mod normal_matrix;
 pub mod obj;
 pub mod random;
 pub mod raycast;
 pub mod shading;
+pub mod texture_budget;
 
 use std::ops::Range;
 use std::sync::Arc;
@@ -82,11 +85,18 @@ impl Scene {
         }
     }
 
-    /// World-space bounds of all objects (`None` for a scene without geometry).
+    /// World-space bounds of all objects (`None` for a scene without geometry). Each distinct
+    /// mesh's vertices are walked once, however many objects place it.
     pub fn bounds(&self) -> Option<Aabb> {
+        let mut meshes = std::collections::HashMap::new();
         self.objects
             .iter()
-            .filter_map(|o| o.mesh.bounds().map(|b| b.transformed(&o.transform)))
+            .filter_map(|o| {
+                let b = meshes
+                    .entry(Arc::as_ptr(&o.mesh))
+                    .or_insert_with(|| o.mesh.bounds());
+                b.map(|b| b.transformed(&o.transform))
+            })
             .reduce(|a, b| a.union(&b))
     }
 

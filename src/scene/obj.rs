@@ -126,6 +126,13 @@ pub fn load_into(
             Some(id) if id < mtl.len() => first + id,
             _ => fallback,
         };
+        let (mesh, dropped) =
+            super::duplicates::drop_from_opaque(mesh, &scene.materials[material], || {
+                format!("{}: object `{}`", path.display(), model.name)
+            });
+        if let Some(warning) = dropped {
+            report.warn(warning);
+        }
         scene.objects.push(Object {
             mesh: Arc::new(mesh),
             material,
@@ -319,8 +326,9 @@ fn decode_texture(path: &Path) -> Result<image::DynamicImage, String> {
 }
 
 /// Decodes an encoded texture (OBJ and glTF alike): the stated format first, the contents
-/// decide otherwise; at most [`MAX_TEXTURE_SIDE`] pixels a side and that many squared RGBA
-/// bytes, so a header claiming a giant image fails before any allocation.
+/// decide otherwise; at most [`MAX_TEXTURE_SIDE`] pixels a side and
+/// [`MAX_DECODE_BYTES`](super::texture_budget::MAX_DECODE_BYTES) decoded, so a header claiming
+/// a giant image fails before any allocation.
 pub(crate) fn decode_texture_bytes(
     bytes: impl AsRef<[u8]>,
     format: Option<image::ImageFormat>,
@@ -330,17 +338,13 @@ pub(crate) fn decode_texture_bytes(
         reader.set_format(format);
     }
     let mut reader = reader.with_guessed_format().map_err(|e| e.to_string())?;
-    let mut limits = image::Limits::default();
-    limits.max_image_width = Some(MAX_TEXTURE_SIDE);
-    limits.max_image_height = Some(MAX_TEXTURE_SIDE);
-    limits.max_alloc = Some(u64::from(MAX_TEXTURE_SIDE).pow(2) * 4);
-    reader.limits(limits);
+    reader.limits(super::texture_budget::limits());
     reader.decode().map_err(|e| e.to_string())
 }
 
 /// Largest texture side decoded, in pixels (the largest `GL_MAX_TEXTURE_SIZE` common on phones;
-/// the renderer downscales further to what its context supports).
-pub const MAX_TEXTURE_SIDE: u32 = 16_384;
+/// the image is then kept within [`super::texture_budget::MAX_STORED_TEXTURE_SIDE`]).
+pub const MAX_TEXTURE_SIDE: u32 = super::texture_budget::MAX_DECODED_SIDE;
 
 impl LoadReport {
     fn warn(&mut self, msg: String) {
@@ -360,10 +364,14 @@ impl TextureCache {
             return t.clone();
         }
         let tex = match decode_texture(path) {
-            Ok(img) => Some(Arc::new(Texture {
-                name: path.display().to_string(),
-                image: img.to_rgba8(),
-            })),
+            Ok(img) => {
+                let name = path.display().to_string();
+                let (image, scaled) = super::texture_budget::to_rgba8(img, &name);
+                if let Some(w) = scaled {
+                    report.warn(w);
+                }
+                Some(Arc::new(Texture { name, image }))
+            }
             Err(e) => {
                 report.warn(format!(
                     "texture {} could not be decoded ({e}); using the flat colour",

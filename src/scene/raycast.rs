@@ -1,19 +1,25 @@
-//! A ray caster over every triangle of a scene, in world space and `f64`: what the sampled-pixel
-//! reference (`metrics::cpu_reference`) and the automatic grid's surface samples use to find the
-//! surface a pixel sees.
+//! A ray caster over every triangle of a scene, in `f64`: what the sampled-pixel reference
+//! (`metrics::cpu_reference`) and the automatic grid's surface samples use to find the surface
+//! a pixel sees.
 //!
-//! The acceleration structure is a bounding volume hierarchy built by median split of the
-//! triangle centroids along the widest axis (quick to build; trace quality matters little for
-//! the few thousand rays a reference casts). Traversal is iterative, nearer child first, and
-//! the ray test is Möller–Trumbore with both faces accepted (the renderer draws surfaces
-//! two-sided).
+//! It is instance-aware: one bounding volume hierarchy per distinct mesh (objects that place
+//! the same `Arc<Mesh>` share it), in mesh space, and a top-level hierarchy over the placed
+//! objects' world bounds. A ray enters each object through the inverse of its transform, so
+//! a placement costs a few hundred bytes whatever its mesh. A transform without a usable
+//! inverse (flattened to a plane) is traced in world space instead, its triangles carried
+//! through the transform as they are tested. The ray test is Möller–Trumbore with both faces
+//! accepted (the renderer draws surfaces two-sided); `t` is the world ray's parameter in
+//! either space, since an affine map keeps it.
 
-use glam::{DMat3, DVec3, DVec4};
+mod bvh;
 
-use super::{Camera, Projection, Scene};
+use std::collections::HashMap;
+use std::sync::Arc;
 
-/// Most triangles in a leaf.
-const LEAF_SIZE: usize = 4;
+use glam::{DMat3, DMat4, DVec3, DVec4};
+
+use super::{Camera, Mesh, Projection, Scene};
+use bvh::Node;
 
 /// The nearest surface along a ray.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -48,76 +54,139 @@ pub struct FirstOpaque {
 /// the distance; ten times that, for coplanar decals and doubled faces in real models.
 pub const COPLANAR: f64 = 1e-3;
 
-/// One triangle in world space with what is needed to rebuild a hit on it.
+/// The hierarchy of one distinct mesh, in mesh space: leaves refer to triangles through
+/// `order` (triangle indices), vertices are read from the shared mesh as they are tested.
+#[derive(Debug)]
+struct MeshBvh {
+    mesh: Arc<Mesh>,
+    nodes: Vec<Node>,
+    order: Vec<u32>,
+}
+
+/// One placed object.
 #[derive(Clone, Copy, Debug)]
-struct Triangle {
-    v: [DVec3; 3],
-    /// Vertex normals times the normal matrix, made unit (zero where the matrix takes them to
-    /// nothing): the GPU interpolates exactly these (`mesh.vert`) and normalises per fragment.
-    n: [DVec3; 3],
+struct Instance {
+    /// Object space → world space.
+    to_world: DMat4,
+    /// World space → object space, `None` when the transform has no usable inverse.
+    to_object: Option<DMat4>,
+    mesh: u32,
     object: u32,
-    triangle: u32,
 }
 
-/// A BVH node: a leaf holds `count > 0` triangles from `first`; an inner node (`count == 0`)
-/// has its two children at `first` and `first + 1`.
-#[derive(Clone, Copy, Debug)]
-struct Node {
-    min: DVec3,
-    max: DVec3,
-    first: u32,
-    count: u32,
+/// Per-thread traversal stacks (top level, mesh level): the automatic grid casts rays during
+/// a frame, and a frame in steady state allocates nothing.
+type Stacks = (Vec<u32>, Vec<u32>);
+
+thread_local! {
+    static STACKS: std::cell::RefCell<Stacks> = const {
+        std::cell::RefCell::new((Vec::new(), Vec::new()))
+    };
 }
 
-/// A BVH over every triangle of a scene, world space, `f64`.
+/// A two-level BVH over the placed meshes of a scene, `f64`.
 #[derive(Debug)]
 pub struct SceneRaycaster {
-    triangles: Vec<Triangle>,
+    meshes: Vec<MeshBvh>,
+    /// Placed objects in the top level's leaf order.
+    instances: Vec<Instance>,
     nodes: Vec<Node>,
 }
 
-impl SceneRaycaster {
-    /// Transforms every triangle of every object to world space and builds the hierarchy.
-    pub fn new(scene: &Scene) -> Self {
-        let mut triangles = Vec::new();
-        for (object, o) in scene.objects.iter().enumerate() {
-            let mesh = &o.mesh;
-            let normal_matrix =
-                super::normal_matrix::normal_matrix(&DMat3::from_mat4(o.transform));
-            let pos: Vec<DVec3> = mesh
-                .positions
-                .iter()
-                .map(|p| o.transform.transform_point3(p.as_dvec3()))
-                .collect();
-            // `Mesh::new` always fills normals; a hand-built mesh without them shades flat.
-            let has_normals = mesh.normals.len() == mesh.positions.len();
-            for (triangle, idx) in mesh.indices.chunks_exact(3).enumerate() {
-                let [a, b, c] = [idx[0], idx[1], idx[2]].map(|i| i as usize);
-                let v = [pos[a], pos[b], pos[c]];
-                let n = if has_normals {
-                    [a, b, c].map(|i| {
-                        super::direction::unit(normal_matrix * mesh.normals[i].as_dvec3())
-                            .unwrap_or(DVec3::ZERO)
-                    })
-                } else {
-                    [(v[1] - v[0]).cross(v[2] - v[0]); 3]
-                };
-                triangles.push(Triangle {
-                    v,
-                    n,
-                    object: object as u32,
-                    triangle: triangle as u32,
-                });
-            }
+/// The best hits of one search.
+struct Search {
+    /// (t, u, v, instance slot, triangle) of the nearest opaque hit.
+    best: Option<(f64, f64, f64, usize, u32)>,
+    best_t: f64,
+    runner_up: f64,
+    transparent_t: f64,
+}
+
+impl Search {
+    /// Boxes and hits are accepted a little beyond the best hit, so a near runner-up is found.
+    fn reach(&self) -> f64 {
+        if self.best_t.is_finite() {
+            self.best_t * (1.0 + COPLANAR)
+        } else {
+            self.best_t
         }
-        let (nodes, order) = build(&triangles);
-        let triangles = order.iter().map(|&i| triangles[i as usize]).collect();
-        SceneRaycaster { triangles, nodes }
+    }
+}
+
+/// The ray as one object sees it.
+enum Frame<'a> {
+    /// In object space (the world ray through the inverse transform).
+    Object { origin: DVec3, dir: DVec3 },
+    /// In world space, triangles carried through `to_world` as they are tested.
+    World {
+        to_world: &'a DMat4,
+        origin: DVec3,
+        dir: DVec3,
+    },
+}
+
+impl SceneRaycaster {
+    /// Builds one hierarchy per distinct mesh and one over the placed objects.
+    pub fn new(scene: &Scene) -> Self {
+        let mut meshes: Vec<MeshBvh> = Vec::new();
+        let mut mesh_index: HashMap<*const Mesh, u32> = HashMap::new();
+        let mut instances = Vec::new();
+        let mut boxes = Vec::new();
+        for (object, o) in scene.objects.iter().enumerate() {
+            let mesh = *mesh_index.entry(Arc::as_ptr(&o.mesh)).or_insert_with(|| {
+                meshes.push(MeshBvh::new(&o.mesh));
+                (meshes.len() - 1) as u32
+            });
+            let Some(root) = meshes[mesh as usize].nodes.first() else {
+                continue; // no triangles
+            };
+            let world = bvh::transformed_box(root.min, root.max, &o.transform);
+            if !(world.0.is_finite() && world.1.is_finite()) {
+                continue; // a scene that validates has finite transforms
+            }
+            boxes.push(world);
+            instances.push(Instance {
+                to_world: o.transform,
+                to_object: usable_inverse(&o.transform),
+                mesh,
+                object: object as u32,
+            });
+        }
+        let (nodes, order) = bvh::build(&boxes);
+        drop(boxes);
+        let instances = order.iter().map(|&i| instances[i as usize]).collect();
+        SceneRaycaster {
+            meshes,
+            instances,
+            nodes,
+        }
     }
 
-    /// Number of triangles in the hierarchy.
+    /// Number of triangles placed (each object's mesh counted once per placement).
     pub fn triangle_count(&self) -> usize {
-        self.triangles.len()
+        self.instances
+            .iter()
+            .map(|i| self.meshes[i.mesh as usize].order.len())
+            .sum()
+    }
+
+    /// Number of distinct meshes, each with one hierarchy.
+    pub fn mesh_count(&self) -> usize {
+        self.meshes.len()
+    }
+
+    /// Heap bytes the caster holds besides the meshes themselves (shared with the scene).
+    pub fn heap_bytes(&self) -> usize {
+        use std::mem::size_of;
+        let per_mesh: usize = self
+            .meshes
+            .iter()
+            .map(|m| m.nodes.capacity() * size_of::<Node>() + m.order.capacity() * 4)
+            .sum();
+        per_mesh
+            + self.meshes.capacity() * size_of::<MeshBvh>()
+            + self.instances.capacity() * size_of::<Instance>()
+            + self.nodes.capacity() * size_of::<Node>()
     }
 
     /// Nearest surface along `origin + t·dir` with `t > 0`, either face.
@@ -136,174 +205,190 @@ impl SceneRaycaster {
         t_max: f64,
         is_opaque: impl Fn(usize) -> bool,
     ) -> FirstOpaque {
-        let mut best: Option<(f64, f64, f64, usize)> = None; // (t, u, v, triangle slot)
-        let mut best_t = t_max;
-        let mut runner_up = f64::INFINITY;
-        // Boxes are pruned a little beyond the best hit, so a near runner-up is still found.
-        let reach = |t: f64| {
-            if t.is_finite() {
-                t * (1.0 + COPLANAR)
-            } else {
-                t
-            }
+        let mut search = Search {
+            best: None,
+            best_t: t_max,
+            runner_up: f64::INFINITY,
+            transparent_t: f64::INFINITY,
         };
-        let mut transparent_t = f64::INFINITY;
         let inv = dir.recip();
-        // The traversal stack is kept per thread: the automatic grid casts rays during a frame,
-        // and a frame in steady state allocates nothing.
-        thread_local! {
-            static STACK: std::cell::RefCell<Vec<u32>> = const { std::cell::RefCell::new(Vec::new()) };
-        }
-        let mut stack = STACK.with(|s| std::mem::take(&mut *s.borrow_mut()));
-        stack.clear();
-        if !self.nodes.is_empty() && slab(&self.nodes[0], origin, inv, reach(best_t)).is_some() {
-            stack.push(0);
-        }
-        while let Some(ni) = stack.pop() {
-            let node = &self.nodes[ni as usize];
-            // The box was entered when pushed; a nearer opaque hit found since may rule it out.
-            if slab(node, origin, inv, reach(best_t)).is_none() {
-                continue;
-            }
-            if node.count > 0 {
-                let range = node.first as usize..(node.first + node.count) as usize;
+        let (mut top, mut inner) = STACKS.with(|s| std::mem::take(&mut *s.borrow_mut()));
+        bvh::traverse(
+            &self.nodes,
+            &mut top,
+            &mut search,
+            |node, s| node.slab(origin, inv, s.reach()),
+            |s, range| {
                 for slot in range {
-                    let tri = &self.triangles[slot];
-                    let Some((t, u, v)) = intersect(tri, origin, dir) else {
-                        continue;
+                    let instance = &self.instances[slot];
+                    let opaque = is_opaque(instance.object as usize);
+                    let frame = match &instance.to_object {
+                        Some(m) => Frame::Object {
+                            origin: m.transform_point3(origin),
+                            dir: m.transform_vector3(dir),
+                        },
+                        None => Frame::World {
+                            to_world: &instance.to_world,
+                            origin,
+                            dir,
+                        },
                     };
-                    if t > reach(best_t) {
-                        continue;
-                    }
-                    if !is_opaque(tri.object as usize) {
-                        if t <= best_t {
-                            transparent_t = transparent_t.min(t);
+                    let mesh = &self.meshes[instance.mesh as usize];
+                    mesh.search(&frame, &mut inner, s, |s, t, u, v, triangle| {
+                        if !opaque {
+                            if t <= s.best_t {
+                                s.transparent_t = s.transparent_t.min(t);
+                            }
+                        } else if t < s.best_t {
+                            s.runner_up = s.best_t;
+                            s.best_t = t;
+                            s.best = Some((t, u, v, slot, triangle));
+                        } else {
+                            s.runner_up = s.runner_up.min(t);
                         }
-                    } else if t < best_t {
-                        runner_up = best_t;
-                        best_t = t;
-                        best = Some((t, u, v, slot));
-                    } else {
-                        runner_up = runner_up.min(t);
-                    }
+                    });
                 }
-                continue;
-            }
-            let (a, b) = (node.first, node.first + 1);
-            let ta = slab(&self.nodes[a as usize], origin, inv, reach(best_t));
-            let tb = slab(&self.nodes[b as usize], origin, inv, reach(best_t));
-            // Push the farther child first so the nearer one is traversed first.
-            match (ta, tb) {
-                (Some(ta), Some(tb)) if ta <= tb => stack.extend([b, a]),
-                (Some(_), Some(_)) => stack.extend([a, b]),
-                (Some(_), None) => stack.push(a),
-                (None, Some(_)) => stack.push(b),
-                (None, None) => {}
-            }
-        }
-        STACK.with(|s| *s.borrow_mut() = stack);
-        let hit = best.map(|(t, u, v, slot)| self.make_hit(slot, origin, dir, t, u, v));
+            },
+        );
+        STACKS.with(|s| *s.borrow_mut() = (top, inner));
+        let hit = search
+            .best
+            .map(|(t, u, v, slot, triangle)| self.make_hit((slot, triangle), (t, u, v), origin, dir));
         // Ties count as in front: a transparent surface coplanar with an opaque one is blended.
         let limit = hit.map_or(t_max, |h| h.t);
         FirstOpaque {
             hit,
-            transparent_t: (transparent_t <= limit).then_some(transparent_t),
-            runner_up_t: hit.filter(|h| runner_up <= reach(h.t)).map(|_| runner_up),
+            transparent_t: (search.transparent_t <= limit).then_some(search.transparent_t),
+            runner_up_t: hit
+                .filter(|_| search.runner_up <= search.reach())
+                .map(|_| search.runner_up),
         }
     }
 
-    fn make_hit(&self, slot: usize, origin: DVec3, dir: DVec3, t: f64, u: f64, v: f64) -> Hit {
-        let tri = &self.triangles[slot];
-        let n = tri.n[0] * (1.0 - u - v) + tri.n[1] * u + tri.n[2] * v;
-        let geometric = || (tri.v[1] - tri.v[0]).cross(tri.v[2] - tri.v[0]).normalize();
-        let normal = n.try_normalize().unwrap_or_else(geometric);
+    /// The hit at `(t, u, v)` on `triangle` of the object in `slot`.
+    fn make_hit(
+        &self,
+        (slot, triangle): (usize, u32),
+        (t, u, v): (f64, f64, f64),
+        origin: DVec3,
+        dir: DVec3,
+    ) -> Hit {
+        let instance = &self.instances[slot];
+        let mesh = &self.meshes[instance.mesh as usize].mesh;
+        let corners = corners(mesh, triangle);
+        let world = corners.map(|i| {
+            instance
+                .to_world
+                .transform_point3(mesh.positions[i].as_dvec3())
+        });
+        let geometric = (world[1] - world[0]).cross(world[2] - world[0]);
+        // Vertex normals times the normal matrix, made unit (zero where the matrix takes them
+        // to nothing), interpolated and normalised again: what `mesh.vert` and the fragment
+        // shader do. `Mesh::new` always fills normals; a hand-built mesh without them shades
+        // flat.
+        let n = if mesh.normals.len() == mesh.positions.len() {
+            let normal_matrix =
+                super::normal_matrix::normal_matrix(&DMat3::from_mat4(instance.to_world));
+            let n = corners.map(|i| {
+                super::direction::unit(normal_matrix * mesh.normals[i].as_dvec3())
+                    .unwrap_or(DVec3::ZERO)
+            });
+            n[0] * (1.0 - u - v) + n[1] * u + n[2] * v
+        } else {
+            geometric
+        };
         Hit {
             t,
             position: origin + dir * t,
-            normal,
-            object: tri.object as usize,
-            triangle: tri.triangle as usize,
+            normal: n
+                .try_normalize()
+                .unwrap_or_else(|| geometric.normalize()),
+            object: instance.object as usize,
+            triangle: triangle as usize,
         }
     }
 }
 
-/// Builds the hierarchy; returns the nodes and the triangle order the leaves refer to.
-fn build(triangles: &[Triangle]) -> (Vec<Node>, Vec<u32>) {
-    let n = triangles.len();
-    if n == 0 {
-        return (Vec::new(), Vec::new());
+impl MeshBvh {
+    fn new(mesh: &Arc<Mesh>) -> MeshBvh {
+        let boxes: Vec<(DVec3, DVec3)> = (0..mesh.triangle_count() as u32)
+            .map(|t| {
+                let [a, b, c] = corners(mesh, t).map(|i| mesh.positions[i].as_dvec3());
+                (a.min(b).min(c), a.max(b).max(c))
+            })
+            .collect();
+        let (nodes, order) = bvh::build(&boxes);
+        MeshBvh {
+            mesh: mesh.clone(),
+            nodes,
+            order,
+        }
     }
-    let boxes: Vec<(DVec3, DVec3)> = triangles
-        .iter()
-        .map(|t| {
-            let [a, b, c] = t.v;
-            (a.min(b).min(c), a.max(b).max(c))
-        })
-        .collect();
-    let centroids: Vec<DVec3> = boxes.iter().map(|(lo, hi)| (*lo + *hi) * 0.5).collect();
-    let mut order: Vec<u32> = (0..n as u32).collect();
-    let empty = Node {
-        min: DVec3::ZERO,
-        max: DVec3::ZERO,
-        first: 0,
-        count: 0,
-    };
-    let mut nodes = vec![empty];
-    let mut work = vec![(0usize, 0usize, n)];
-    while let Some((ni, start, end)) = work.pop() {
-        let items = &mut order[start..end];
-        let (mut lo, mut hi) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
-        let (mut clo, mut chi) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
-        for &i in items.iter() {
-            let (bl, bh) = boxes[i as usize];
-            (lo, hi) = (lo.min(bl), hi.max(bh));
-            let c = centroids[i as usize];
-            (clo, chi) = (clo.min(c), chi.max(c));
-        }
-        nodes[ni].min = lo;
-        nodes[ni].max = hi;
-        if items.len() <= LEAF_SIZE {
-            nodes[ni].first = start as u32;
-            nodes[ni].count = items.len() as u32;
-            continue;
-        }
-        let extent = chi - clo;
-        let axis = if extent.x >= extent.y && extent.x >= extent.z {
-            0
-        } else if extent.y >= extent.z {
-            1
-        } else {
-            2
+
+    /// Tests the ray against every triangle whose boxes it reaches, calling `found` with
+    /// `(t, u, v, triangle)` for each hit within the search's reach.
+    fn search(
+        &self,
+        frame: &Frame,
+        stack: &mut Vec<u32>,
+        s: &mut Search,
+        mut found: impl FnMut(&mut Search, f64, f64, f64, u32),
+    ) {
+        let positions = &self.mesh.positions;
+        let (origin, dir) = match *frame {
+            Frame::Object { origin, dir } | Frame::World { origin, dir, .. } => (origin, dir),
         };
-        // Median split: always halves the set, so the depth stays log₂(n) even when many
-        // centroids coincide.
-        let mid = items.len() / 2;
-        items.select_nth_unstable_by(mid, |&a, &b| {
-            centroids[a as usize][axis].total_cmp(&centroids[b as usize][axis])
-        });
-        let left = nodes.len();
-        nodes.extend([empty, empty]);
-        nodes[ni].first = left as u32;
-        work.push((left, start, start + mid));
-        work.push((left + 1, start + mid, end));
+        let inv = dir.recip();
+        let vertices = |triangle: u32| {
+            let v = corners(&self.mesh, triangle).map(|i| positions[i].as_dvec3());
+            match frame {
+                Frame::Object { .. } => v,
+                Frame::World { to_world, .. } => v.map(|p| to_world.transform_point3(p)),
+            }
+        };
+        bvh::traverse(
+            &self.nodes,
+            stack,
+            s,
+            |node, s| match frame {
+                Frame::Object { .. } => node.slab(origin, inv, s.reach()),
+                Frame::World { to_world, .. } => {
+                    node.slab_transformed(to_world, origin, inv, s.reach())
+                }
+            },
+            |s, range| {
+                for &triangle in &self.order[range] {
+                    if let Some((t, u, v)) = intersect(vertices(triangle), origin, dir) {
+                        if t <= s.reach() {
+                            found(s, t, u, v, triangle);
+                        }
+                    }
+                }
+            },
+        );
     }
-    (nodes, order)
 }
 
-/// Entry parameter of the ray into the node's box within `[0, t_max]`, if it enters at all.
-fn slab(node: &Node, origin: DVec3, inv_dir: DVec3, t_max: f64) -> Option<f64> {
-    let t0 = (node.min - origin) * inv_dir;
-    let t1 = (node.max - origin) * inv_dir;
-    // A zero direction component gives ±∞ (or NaN on the slab's plane, which min/max ignore).
-    let enter = t0.min(t1).max_element().max(0.0);
-    let exit = t0.max(t1).min_element().min(t_max);
-    (enter <= exit).then_some(enter)
+/// Vertex indices of a triangle.
+fn corners(mesh: &Mesh, triangle: u32) -> [usize; 3] {
+    let i = 3 * triangle as usize;
+    [0, 1, 2].map(|k| mesh.indices[i + k] as usize)
+}
+
+/// The inverse of an affine transform when it is well enough conditioned to carry rays into
+/// object space: its volume not below 10⁻⁹ of its columns' (a flat or nearly flat object is
+/// traced in world space instead).
+fn usable_inverse(m: &DMat4) -> Option<DMat4> {
+    let m3 = DMat3::from_mat4(*m);
+    let columns = m3.x_axis.length() * m3.y_axis.length() * m3.z_axis.length();
+    let det = m3.determinant();
+    let inverse = m.inverse();
+    (det.abs() > 1e-9 * columns && columns.is_finite() && inverse.is_finite()).then_some(inverse)
 }
 
 /// Möller–Trumbore, both faces: `(t, u, v)` with `t > 0`, the hit at
 /// `(1 − u − v)·v0 + u·v1 + v·v2`.
-fn intersect(tri: &Triangle, origin: DVec3, dir: DVec3) -> Option<(f64, f64, f64)> {
-    let [v0, v1, v2] = tri.v;
+fn intersect([v0, v1, v2]: [DVec3; 3], origin: DVec3, dir: DVec3) -> Option<(f64, f64, f64)> {
     let (e1, e2) = (v1 - v0, v2 - v0);
     let p = dir.cross(e2);
     let det = e1.dot(p);
@@ -352,7 +437,7 @@ pub fn pixel_ray(camera: &Camera, width: u32, height: u32, px: f64, py: f64) -> 
 mod tests {
     use std::sync::Arc;
 
-    use glam::{DMat4, Vec3};
+    use glam::Vec3;
     use rand::{Rng, SeedableRng};
 
     use super::*;
@@ -475,78 +560,214 @@ mod tests {
         assert_eq!((r.hit.unwrap().object, r.runner_up_t), (0, None));
     }
 
+    /// The nearest hits found the simple way: every triangle of every object carried to world
+    /// space and tested (what the caster did before it was instance-aware), with the normal
+    /// interpolated from world-space barycentrics.
     fn brute_force(
-        rc: &SceneRaycaster,
+        scene: &Scene,
         origin: DVec3,
         dir: DVec3,
         opaque: impl Fn(usize) -> bool,
-    ) -> (Option<(f64, usize, usize)>, Option<f64>) {
-        let (mut best, mut transparent) = (None::<(f64, usize, usize)>, f64::INFINITY);
-        for tri in &rc.triangles {
-            if let Some((t, _, _)) = intersect(tri, origin, dir) {
-                if !opaque(tri.object as usize) {
+    ) -> (Option<Hit>, Option<f64>) {
+        let (mut best, mut transparent) = (None::<Hit>, f64::INFINITY);
+        for (object, o) in scene.objects.iter().enumerate() {
+            let m = &o.mesh;
+            let nm = crate::scene::normal_matrix::normal_matrix(&DMat3::from_mat4(o.transform));
+            for triangle in 0..m.triangle_count() {
+                let c = corners(m, triangle as u32);
+                let v = c.map(|i| o.transform.transform_point3(m.positions[i].as_dvec3()));
+                let Some((t, u, w)) = intersect(v, origin, dir) else {
+                    continue;
+                };
+                if !opaque(object) {
                     transparent = transparent.min(t);
-                } else if best.is_none_or(|b| t < b.0) {
-                    best = Some((t, tri.object as usize, tri.triangle as usize));
+                } else if best.is_none_or(|b| t < b.t) {
+                    let n = c.map(|i| {
+                        crate::scene::direction::unit(nm * m.normals[i].as_dvec3())
+                            .unwrap_or(DVec3::ZERO)
+                    });
+                    best = Some(Hit {
+                        t,
+                        position: origin + dir * t,
+                        normal: (n[0] * (1.0 - u - w) + n[1] * u + n[2] * w).normalize(),
+                        object,
+                        triangle,
+                    });
                 }
             }
         }
-        let limit = best.map_or(f64::INFINITY, |b| b.0);
+        let limit = best.map_or(f64::INFINITY, |b| b.t);
         (best, (transparent <= limit).then_some(transparent))
+    }
+
+    fn close(a: f64, b: f64) -> bool {
+        a == b || (a - b).abs() <= 1e-9 * a.abs().max(1.0)
+    }
+
+    /// Casts `rays` random rays at `scene` and checks every hit against [`brute_force`]: the
+    /// same object and triangle, `t` and normal to rounding, the same transparent surface.
+    /// Returns (hits, rays with a transparent surface in front).
+    fn agrees_with_brute_force(
+        scene: &Scene,
+        rng: &mut rand_pcg::Pcg64,
+        rays: usize,
+        spread: f32,
+        opaque: impl Fn(usize) -> bool + Copy,
+    ) -> (usize, usize) {
+        let rc = SceneRaycaster::new(scene);
+        let (mut hits, mut transparent) = (0, 0);
+        for _ in 0..rays {
+            let origin = rand_point(rng, 2.0 * spread).as_dvec3();
+            let dir = (rand_point(rng, 0.8 * spread).as_dvec3() - origin).normalize();
+            for (opaque, name) in [(&(|_| true) as &dyn Fn(usize) -> bool, "all"), (&opaque, "some")]
+            {
+                let (want, want_t) = brute_force(scene, origin, dir, opaque);
+                let got = rc.first_opaque_hit(origin, dir, f64::INFINITY, opaque);
+                let same = match (got.hit, want) {
+                    (Some(g), Some(w)) => {
+                        (g.object, g.triangle) == (w.object, w.triangle)
+                            && close(g.t, w.t)
+                            && (g.position - w.position).length() <= 1e-9 * w.t.max(1.0)
+                            && (g.normal - w.normal).length() < 1e-6
+                    }
+                    (g, w) => g.is_none() && w.is_none(),
+                };
+                assert!(same, "{name}: {:?} vs {want:?} ({origin}, {dir})", got.hit);
+                match (got.transparent_t, want_t) {
+                    (Some(g), Some(w)) => assert!(close(g, w), "{g} vs {w}"),
+                    (g, w) => assert_eq!(g, w),
+                }
+                hits += got.hit.is_some() as usize;
+                transparent += got.transparent_t.is_some() as usize;
+            }
+        }
+        (hits, transparent)
+    }
+
+    fn rand_point(rng: &mut rand_pcg::Pcg64, s: f32) -> Vec3 {
+        Vec3::new(
+            rng.random_range(-s..s),
+            rng.random_range(-s..s),
+            rng.random_range(-s..s),
+        )
+    }
+
+    /// `triangles` random small triangles within ±`size`, with random vertex normals.
+    fn random_mesh(rng: &mut rand_pcg::Pcg64, triangles: usize, size: f32) -> Mesh {
+        let mut positions = Vec::new();
+        for _ in 0..triangles {
+            let c = rand_point(rng, size);
+            for _ in 0..3 {
+                positions.push(c + rand_point(rng, 0.08 * size));
+            }
+        }
+        let normals = (0..positions.len())
+            .map(|_| rand_point(rng, 1.0) + Vec3::Z * 1.5)
+            .collect();
+        let indices = (0..positions.len() as u32).collect();
+        Mesh::new(positions, normals, vec![], indices).unwrap()
     }
 
     #[test]
     fn bvh_agrees_with_brute_force() {
         let mut rng = rand_pcg::Pcg64::seed_from_u64(11);
-        let rand_point = |rng: &mut rand_pcg::Pcg64, s: f32| {
-            Vec3::new(
-                rng.random_range(-s..s),
-                rng.random_range(-s..s),
-                rng.random_range(-s..s),
-            )
-        };
         // Several objects with transforms, so object and triangle indices are checked too.
         let mut meshes = Vec::new();
         for o in 0..4 {
-            let mut positions = Vec::new();
-            for _ in 0..600 {
-                let c = rand_point(&mut rng, 10.0);
-                for _ in 0..3 {
-                    positions.push(c + rand_point(&mut rng, 0.8));
-                }
-            }
-            let indices = (0..positions.len() as u32).collect();
-            let mesh = Mesh::new(positions, vec![], vec![], indices).unwrap();
+            let mesh = random_mesh(&mut rng, 600, 10.0);
             let transform = DMat4::from_translation(DVec3::new(o as f64, 0.0, 0.0))
                 * DMat4::from_rotation_y(o as f64 * 0.3);
             meshes.push((mesh, transform));
         }
-        let rc = SceneRaycaster::new(&scene_of(meshes));
-        let opaque = |o: usize| o.is_multiple_of(2);
-        let (mut hits, mut transparent) = (0, 0);
-        for _ in 0..2000 {
-            let origin = rand_point(&mut rng, 20.0).as_dvec3();
-            let dir = (rand_point(&mut rng, 8.0).as_dvec3() - origin).normalize();
-            let expected = brute_force(&rc, origin, dir, |_| true).0;
+        let scene = scene_of(meshes);
+        let (hits, transparent) =
+            agrees_with_brute_force(&scene, &mut rng, 1000, 10.0, |o| o.is_multiple_of(2));
+        assert!(hits > 1000 && transparent > 250, "{hits} hits, {transparent}");
+    }
+
+    /// One mesh placed many times — moved, rotated, mirrored, scaled unevenly, far from the
+    /// origin, flattened to a plane (no inverse: traced in world space) — is one hierarchy,
+    /// and every placement is hit where the world-space triangles are.
+    #[test]
+    fn repeated_placements_share_one_hierarchy_and_agree_with_brute_force() {
+        let mut rng = rand_pcg::Pcg64::seed_from_u64(5);
+        let mesh = Arc::new(random_mesh(&mut rng, 300, 3.0));
+        let mut scene = Scene::empty();
+        let material = scene.add_material(Material::default());
+        let transforms = [
+            DMat4::IDENTITY,
+            DMat4::from_translation(DVec3::new(4.0, 1.0, -2.0)) * DMat4::from_rotation_x(1.1),
+            DMat4::from_translation(DVec3::new(-3.0, 2.0, 1.0))
+                * DMat4::from_scale(DVec3::new(-1.0, 1.0, 1.0)),
+            DMat4::from_translation(DVec3::new(0.0, -4.0, 3.0))
+                * DMat4::from_rotation_z(0.4)
+                * DMat4::from_scale(DVec3::new(2.5, 0.3, 1.0)),
+            DMat4::from_translation(DVec3::new(2.0, 3.0, 4.0))
+                * DMat4::from_scale(DVec3::new(1.0, 1.0, 0.0)),
+            DMat4::from_translation(DVec3::new(-4.0, -2.0, -3.0))
+                * DMat4::from_scale(DVec3::new(0.5, 1e-12, 0.5)),
+            DMat4::from_rotation_y(2.0) * DMat4::from_scale(DVec3::splat(-0.7)),
+        ];
+        for transform in transforms {
+            scene.add_object(mesh.clone(), material, transform);
+        }
+        let rc = SceneRaycaster::new(&scene);
+        assert_eq!(rc.mesh_count(), 1);
+        assert_eq!(rc.triangle_count(), 300 * transforms.len());
+        let flat = rc.instances.iter().filter(|i| i.to_object.is_none());
+        // Squashed to 10⁻¹² still has an inverse that works; flattened to 0 has none.
+        assert_eq!(flat.count(), 1, "the flattened placement is traced in world space");
+        let (hits, transparent) =
+            agrees_with_brute_force(&scene, &mut rng, 1500, 5.0, |o| o % 3 != 1);
+        assert!(hits > 500 && transparent > 100, "{hits} hits, {transparent}");
+
+        // Far from the origin: the same, relative to the distance.
+        let far = DMat4::from_translation(DVec3::new(3e6, -1e6, 2e6));
+        for o in &mut scene.objects {
+            o.transform = far * o.transform;
+        }
+        let rc = SceneRaycaster::new(&scene);
+        let mut found = 0;
+        for _ in 0..300 {
+            let target = far.transform_point3(rand_point(&mut rng, 4.0).as_dvec3());
+            let origin = target + rand_point(&mut rng, 20.0).as_dvec3();
+            let dir = (target - origin).normalize();
+            let (want, _) = brute_force(&scene, origin, dir, |_| true);
             let got = rc.hit(origin, dir);
             assert_eq!(
                 got.map(|h| (h.object, h.triangle)),
-                expected.map(|e| (e.1, e.2))
+                want.map(|w| (w.object, w.triangle))
             );
-            if let (Some(g), Some(e)) = (got, expected) {
-                assert_eq!(g.t, e.0);
-                hits += 1;
+            if let (Some(g), Some(w)) = (got, want) {
+                assert!((g.t - w.t).abs() < 1e-6, "{} vs {}", g.t, w.t);
+                found += 1;
             }
-            let (eo, et) = brute_force(&rc, origin, dir, opaque);
-            let r = rc.first_opaque_hit(origin, dir, f64::INFINITY, opaque);
-            assert_eq!(r.hit.map(|h| (h.t, h.object, h.triangle)), eo);
-            assert_eq!(r.transparent_t, et);
-            transparent += et.is_some() as usize;
         }
-        assert!(
-            hits > 1000 && transparent > 500,
-            "{hits} hits, {transparent}"
-        );
+        assert!(found > 50, "{found}");
+    }
+
+    /// The memory a placement costs does not depend on its mesh: 100 000 placements of a
+    /// 2 000-triangle mesh hold one mesh hierarchy and a fixed few hundred bytes each.
+    #[test]
+    fn memory_per_placement_is_constant() {
+        let mut rng = rand_pcg::Pcg64::seed_from_u64(3);
+        let mesh = Arc::new(random_mesh(&mut rng, 2000, 1.0));
+        let placed = |n: usize| {
+            let mut scene = Scene::empty();
+            let material = scene.add_material(Material::default());
+            for i in 0..n {
+                let at = DVec3::new((i % 400) as f64 * 3.0, (i / 400) as f64 * 3.0, 0.0);
+                scene.add_object(mesh.clone(), material, DMat4::from_translation(at));
+            }
+            SceneRaycaster::new(&scene)
+        };
+        let (one, many) = (placed(1), placed(100_000));
+        assert_eq!((one.mesh_count(), many.mesh_count()), (1, 1));
+        assert_eq!(many.triangle_count(), 2000 * 100_000);
+        let per_placement = (many.heap_bytes() - one.heap_bytes()) / 100_000;
+        assert!(per_placement <= 400, "{per_placement} bytes a placement");
+        // One mesh's hierarchy: about one node per two triangles and an index per triangle.
+        assert!(one.heap_bytes() < 2000 * 64, "{} bytes", one.heap_bytes());
     }
 
     #[test]

@@ -11,6 +11,8 @@ mod common;
 mod numerics;
 #[path = "fuzz/outputs.rs"]
 mod outputs;
+#[path = "fuzz/repeats.rs"]
+mod repeats;
 
 use std::cell::RefCell;
 use std::panic::{catch_unwind, AssertUnwindSafe};

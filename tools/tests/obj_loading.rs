@@ -422,7 +422,7 @@ fn files_tobj_accepts_are_not_refused_by_the_checks() {
     let path = write(
         dir.path(),
         "lenient.obj",
-        "mtllib m.mtl\nmtllib m.mtl\nusemtl m\np 1\nf 1/1/1 2/2/2 3/3/3\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf -3 -2 -1\n",
+        "mtllib m.mtl\nmtllib m.mtl\nusemtl m\np 1\nf 1/1/1 2/2/2 3/3/3\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf -3 -2 -1\n",
     );
     let (scene, report) = load_obj(&path).unwrap();
     assert!(report.warnings.is_empty(), "{:?}", report.warnings);

@@ -14,7 +14,7 @@ use super::uri::{self, Uri};
 use crate::scene::access;
 use crate::scene::input::{read_bounded, FileKind, LIMIT_VARIABLE};
 use crate::scene::obj::{decode_texture_bytes, resolve_texture};
-use crate::scene::Texture;
+use crate::scene::{texture_budget, Texture};
 
 /// Decoded images of one glTF file, by image index (`None`: failed, warned once).
 #[derive(Default)]
@@ -45,10 +45,15 @@ impl Textures {
         let field = format!("images[{}]", image.index());
         let texture = match encoded(image, buffers, gltf_path, &field)? {
             Ok(enc) => match decode(&enc.bytes, enc.format) {
-                Ok(img) => Some(Arc::new(Texture {
-                    name: enc.name,
-                    image: img.to_rgba8(),
-                })),
+                Ok(img) => {
+                    drop(enc.bytes);
+                    let (image, scaled) = texture_budget::to_rgba8(img, &enc.name);
+                    warnings.extend(scaled);
+                    Some(Arc::new(Texture {
+                        name: enc.name,
+                        image,
+                    }))
+                }
                 Err(e) => {
                     warnings.push(format!(
                         "texture {} could not be decoded ({e}); using the flat colour",

@@ -1,0 +1,315 @@
+//! Models a scene file names more than once, kept once. A built-in scene is built once; an
+//! OBJ file (with the same texture override) and a glTF file without lights or cameras are
+//! read on their first reference only, later ones place the same `Arc<Mesh>`es and reuse the
+//! materials (copied when the reference recolours them). A glTF file with lights or cameras is
+//! read again for each reference (they depend on the placing transform), an OBJ again for
+//! another texture override, but their meshes are swapped for those of the file's first read
+//! when equal, and every texture for an equal one of the same name loaded before, so memory
+//! holds one copy. Repeats add no warnings: the first load said them.
+
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use glam::DMat4;
+
+use super::access::LoadOptions;
+use super::obj::{self, LoadReport};
+use super::camera::MAX_CAMERA_COORD;
+use super::{Aabb, Material, Mesh, Object, Scene, SceneError, Texture};
+
+/// Most objects a scene file may place (all its references together), the per-file limit of
+/// glTF too: each costs about 0.6 KB of CPU state besides its mesh (placement, draw order,
+/// the automatic grid's ray caster), so the limit holds that near 600 MB.
+pub const MAX_SCENE_OBJECTS: usize = super::gltf::MAX_OBJECTS;
+
+/// Most materials a scene file may make (references that recolour a model copy its materials).
+pub const MAX_SCENE_MATERIALS: usize = 1 << 20;
+
+/// A model as loaded, to be placed again without reading it.
+struct Loaded {
+    /// Each object's mesh, material index relative to the model's first material, transform
+    /// relative to the placing one, and object-space bounds when placements must be checked.
+    objects: Vec<(Arc<Mesh>, usize, DMat4, Option<Aabb>)>,
+    /// The model's materials before any recolouring.
+    materials: Vec<Material>,
+    /// Where an unrecoloured copy of `materials` starts in the scene, once there is one.
+    uncoloured_at: Option<usize>,
+}
+
+impl Loaded {
+    /// What `scene` holds from `first_object` and `first_material` on; `relative` gives an
+    /// object's transform relative to the placing one and `checked` whether to keep bounds.
+    fn record(
+        scene: &Scene,
+        (first_object, first_material): (usize, usize),
+        relative: impl Fn(&Object) -> DMat4,
+        checked: bool,
+    ) -> Loaded {
+        // Bounds once a mesh: a file may place one large mesh many times.
+        let mut bounds = HashMap::new();
+        let objects = scene.objects[first_object..]
+            .iter()
+            .map(|o| {
+                let b = checked
+                    .then(|| *bounds.entry(Arc::as_ptr(&o.mesh)).or_insert_with(|| o.mesh.bounds()))
+                    .flatten();
+                (o.mesh.clone(), o.material - first_material, relative(o), b)
+            })
+            .collect();
+        Loaded {
+            objects,
+            materials: scene.materials[first_material..].to_vec(),
+            uncoloured_at: None,
+        }
+    }
+
+    /// Places the model again with `transform`, reusing an unrecoloured copy of its materials
+    /// unless the caller will `recolour` them. Errors (from `path`) when a placed object's
+    /// bounds pass the camera's coordinate limit, as the glTF loader's own check does.
+    fn place(
+        &mut self,
+        scene: &mut Scene,
+        transform: DMat4,
+        recolour: bool,
+        transform_field: &str,
+    ) -> Result<(), SceneError> {
+        for (_, _, relative, bounds) in &self.objects {
+            let world = transform * *relative;
+            let reach = bounds.map_or(0.0, |b| {
+                let b = b.transformed(&world);
+                b.min.abs().max(b.max.abs()).max_element()
+            });
+            if !world.is_finite() || !reach.is_finite() || reach > MAX_CAMERA_COORD {
+                return Err(SceneError::invalid(
+                    transform_field,
+                    format!(
+                        "places the object's bounds {reach:e} from the origin, past \
+                         ±{MAX_CAMERA_COORD:e} (the camera's limit)"
+                    ),
+                ));
+            }
+        }
+        let base = match self.uncoloured_at {
+            Some(base) if !recolour => base,
+            _ => {
+                let base = scene.materials.len();
+                scene.materials.extend(self.materials.iter().cloned());
+                if !recolour {
+                    self.uncoloured_at = Some(base);
+                }
+                base
+            }
+        };
+        scene.objects.extend(
+            self.objects
+                .iter()
+                .map(|(mesh, material, relative, _)| Object {
+                    mesh: mesh.clone(),
+                    material: base + material,
+                    transform: transform * *relative,
+                }),
+        );
+        Ok(())
+    }
+}
+
+/// The models one scene file has loaded, by canonical path (and texture override for OBJ).
+#[derive(Default)]
+pub(super) struct ModelCache {
+    obj: HashMap<(PathBuf, Option<PathBuf>), Loaded>,
+    /// glTF files without lights or cameras, read at the identity; `None`: read per reference.
+    gltf: HashMap<PathBuf, Option<Loaded>>,
+    /// The distinct meshes of each model file's first load, in first-use order.
+    meshes: HashMap<PathBuf, Vec<Arc<Mesh>>>,
+    /// Every texture loaded so far, by name (its path).
+    textures: HashMap<String, Arc<Texture>>,
+    builtin: HashMap<String, Option<Scene>>,
+}
+
+impl ModelCache {
+    /// A built-in scene's geometry, built on first use (later ones share its meshes).
+    pub fn builtin(&mut self, name: &str) -> Option<Scene> {
+        self.builtin
+            .entry(name.to_string())
+            .or_insert_with(|| super::builtin::geometry(name))
+            .clone()
+    }
+
+    /// Places an OBJ file with `transform`, loading it on first use. `recolour`: the caller
+    /// will recolour the materials appended from `scene.materials.len()` on.
+    pub fn place_obj(
+        &mut self,
+        scene: &mut Scene,
+        path: &Path,
+        transform: DMat4,
+        texture: Option<&Path>,
+        recolour: bool,
+        transform_field: &str,
+    ) -> Result<LoadReport, SceneError> {
+        let key = std::fs::canonicalize(path).ok().map(|p| {
+            let texture = texture.map(|t| std::fs::canonicalize(t).unwrap_or(t.to_path_buf()));
+            (p, texture)
+        });
+        if let Some(loaded) = key.as_ref().and_then(|k| self.obj.get_mut(k)) {
+            loaded.place(scene, transform, recolour, transform_field)?;
+            return Ok(LoadReport::default());
+        }
+        let first = (scene.objects.len(), scene.materials.len());
+        let report = obj::load_into(scene, path, transform, texture)?;
+        self.share(scene, first.0, first.1, key.as_ref().map(|k| &k.0));
+        if let Some(key) = key {
+            // The loader places every object with `transform` itself.
+            let mut loaded = Loaded::record(scene, first, |_| DMat4::IDENTITY, false);
+            loaded.uncoloured_at = (!recolour).then_some(first.1);
+            self.obj.insert(key, loaded);
+        }
+        Ok(report)
+    }
+
+    /// Places a glTF file with `transform`. A file without lights or cameras is read once, at
+    /// the identity, and placed from that; one with them is read for each reference (they
+    /// depend on the transform), sharing the meshes and textures of earlier reads.
+    pub fn place_gltf(
+        &mut self,
+        scene: &mut Scene,
+        path: &Path,
+        transform: DMat4,
+        recolour: bool,
+        transform_field: &str,
+        options: &LoadOptions,
+    ) -> Result<super::gltf::GltfLoad, SceneError> {
+        let key = std::fs::canonicalize(path).ok();
+        if let Some(k) = &key {
+            if !self.gltf.contains_key(k) {
+                let mut alone = Scene::empty();
+                let read = super::gltf::load_into(
+                    &mut alone,
+                    path,
+                    DMat4::IDENTITY,
+                    transform_field,
+                    options,
+                );
+                let entry = match read {
+                    Ok(read) if alone.lights.is_empty() && read.camera.is_none() => {
+                        self.share(&mut alone, 0, 0, Some(k));
+                        let loaded = Loaded::record(&alone, (0, 0), |o| o.transform, true);
+                        Some((loaded, read.report))
+                    }
+                    _ => None,
+                };
+                let (loaded, report) = entry.unzip();
+                self.gltf.insert(k.clone(), loaded);
+                if let Some(Some(loaded)) = self.gltf.get_mut(k) {
+                    loaded.place(scene, transform, recolour, transform_field)?;
+                    return Ok(super::gltf::GltfLoad {
+                        report: report.unwrap_or_default(),
+                        camera: None,
+                    });
+                }
+            } else if let Some(Some(loaded)) = self.gltf.get_mut(k) {
+                loaded.place(scene, transform, recolour, transform_field)?;
+                return Ok(super::gltf::GltfLoad::default());
+            }
+        }
+        let (first_object, first_material) = (scene.objects.len(), scene.materials.len());
+        let mut loaded = super::gltf::load_into(scene, path, transform, transform_field, options)?;
+        if self.share(scene, first_object, first_material, key.as_ref()) {
+            loaded.report.warnings.clear();
+        }
+        Ok(loaded)
+    }
+
+    /// Swaps the meshes of the objects from `first_object` on for those of an earlier load of
+    /// the same file (`path`, canonical) when they are equal — the file may have changed
+    /// between reads — and the textures of the materials from `first_material` on for equal
+    /// ones loaded before. Returns whether the file was loaded before with the same meshes.
+    fn share(
+        &mut self,
+        scene: &mut Scene,
+        first_object: usize,
+        first_material: usize,
+        path: Option<&PathBuf>,
+    ) -> bool {
+        for t in scene.materials[first_material..]
+            .iter_mut()
+            .filter_map(|m| m.diffuse_texture.as_mut())
+        {
+            match self.textures.get(&t.name) {
+                Some(known) if known.image == t.image => *t = known.clone(),
+                Some(_) => {}
+                None => {
+                    self.textures.insert(t.name.clone(), t.clone());
+                }
+            }
+        }
+        let Some(path) = path else {
+            return false;
+        };
+        let objects = &mut scene.objects[first_object..];
+        let meshes = distinct(objects.iter().map(|o| &o.mesh));
+        let Some(earlier) = self.meshes.get(path) else {
+            self.meshes.insert(path.clone(), meshes);
+            return false;
+        };
+        let same = earlier.len() == meshes.len()
+            && earlier.iter().zip(&meshes).all(|(a, b)| same_mesh(a, b));
+        if same {
+            for o in objects.iter_mut() {
+                let i = meshes.iter().position(|m| Arc::ptr_eq(m, &o.mesh));
+                o.mesh = earlier[i.expect("listed above")].clone();
+            }
+        }
+        same
+    }
+}
+
+/// The distinct `Arc`s of a list, in first-use order.
+fn distinct<'a, T: 'a>(items: impl Iterator<Item = &'a Arc<T>>) -> Vec<Arc<T>> {
+    let mut seen = std::collections::HashSet::new();
+    items
+        .filter(|a| seen.insert(Arc::as_ptr(a)))
+        .cloned()
+        .collect()
+}
+
+fn same_mesh(a: &Mesh, b: &Mesh) -> bool {
+    a.positions == b.positions && a.normals == b.normals && a.uvs == b.uvs && a.indices == b.indices
+}
+
+/// Checks the scene's objects and materials against the scene-file limits after object
+/// `field` was placed.
+pub(super) fn check_budget(scene: &Scene, field: &str) -> Result<(), SceneError> {
+    check_counts(scene.objects.len(), scene.materials.len(), field)
+}
+
+fn check_counts(objects: usize, materials: usize, field: &str) -> Result<(), SceneError> {
+    let over = |count: usize, what: &str, limit: usize, verb: &str| {
+        SceneError::invalid(
+            field,
+            format!("the scene would hold {count} {what}, more than the {limit} a scene file may {verb}"),
+        )
+    };
+    if objects > MAX_SCENE_OBJECTS {
+        return Err(over(objects, "objects", MAX_SCENE_OBJECTS, "place"));
+    }
+    if materials > MAX_SCENE_MATERIALS {
+        return Err(over(materials, "materials", MAX_SCENE_MATERIALS, "make"));
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn counts_past_the_budget_are_errors_naming_the_object() {
+        assert!(check_counts(MAX_SCENE_OBJECTS, MAX_SCENE_MATERIALS, "objects[3]").is_ok());
+        let err = check_counts(MAX_SCENE_OBJECTS + 1, 1, "objects[3]").unwrap_err();
+        let text = err.to_string();
+        assert!(text.contains("objects[3]") && text.contains("1048577 objects"), "{text}");
+        let err = check_counts(1, MAX_SCENE_MATERIALS + 1, "objects[9]").unwrap_err();
+        assert!(err.to_string().contains("materials"), "{err}");
+    }
+}

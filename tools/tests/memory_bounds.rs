@@ -1,0 +1,288 @@
+//! Memory bounds of repeated and oversized input: a scene file naming one model many times
+//! holds and uploads it once, duplicate triangles are dropped without changing the picture,
+//! and oversized textures are kept scaled down, each with the warning the loader promises.
+
+mod common;
+
+use std::collections::HashSet;
+use std::path::Path;
+use std::sync::Arc;
+
+use common::Gpu;
+use manylight::scene::{self, Scene};
+use manylight::{EsVersion, RenderOptions};
+
+fn distinct_meshes(scene: &Scene) -> usize {
+    let set: HashSet<*const manylight::Mesh> =
+        scene.objects.iter().map(|o| Arc::as_ptr(&o.mesh)).collect();
+    set.len()
+}
+
+/// Two objects (a red quad, a green triangle behind it) and their MTL.
+fn write_model(dir: &Path) {
+    std::fs::write(
+        dir.join("m.obj"),
+        "mtllib m.mtl\no quad\nusemtl red\nv -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\n\
+         f 1 2 3\nf 1 3 4\no tri\nusemtl green\nv -1 -1 -1\nv 1 -1 -1\nv 0 1 -1\nf 5 6 7\n",
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("m.mtl"),
+        "newmtl red\nKd 0.9 0.1 0.1\nnewmtl green\nKd 0.1 0.9 0.1\n",
+    )
+    .unwrap();
+}
+
+/// A scene file placing `m.obj` `n` times in a row along x (every tenth reference recoloured,
+/// every third spelled another way), with a camera and a light seeing the first few.
+fn scene_file(dir: &Path, n: usize) -> std::path::PathBuf {
+    std::fs::create_dir_all(dir.join("sub")).unwrap();
+    let objects: Vec<serde_json::Value> = (0..n)
+        .map(|i| {
+            let path = ["m.obj", "./m.obj", "sub/../m.obj"][i % 3];
+            let mut o = serde_json::json!({"obj": path,
+                "transform": {"translate": [i as f64 * 2.5, 0, 0]}});
+            if i % 10 == 9 {
+                o["color"] = serde_json::json!([0.2, 0.2, 0.9]);
+            }
+            o
+        })
+        .collect();
+    let text = serde_json::json!({
+        "camera": {"position": [2.5, 0, 9], "target": [2.5, 0, 0]},
+        "objects": objects,
+        "lights": [{"kind": "point", "position": [2.5, 0, 4], "radius": 30, "color": [1, 1, 1],
+                    "intensity": 3}]
+    });
+    let file = dir.join(format!("s{n}.json"));
+    std::fs::write(&file, text.to_string()).unwrap();
+    file
+}
+
+#[test]
+fn a_scene_file_naming_one_obj_1000_times_holds_and_uploads_it_once() {
+    let dir = tempfile::tempdir().unwrap();
+    write_model(dir.path());
+    let load = |n| scene::load(scene_file(dir.path(), n).to_str().unwrap(), None).unwrap();
+    let (one, _) = load(1);
+    let (many, report) = load(1000);
+    assert!(report.warnings.is_empty(), "{:?}", report.warnings);
+    assert_eq!(many.objects.len(), 2000);
+    assert_eq!(distinct_meshes(&many), 2, "one mesh per object of the OBJ");
+    // Uncoloured references share the file's materials; each recoloured one has its own.
+    assert_eq!(many.materials.len(), 3 + 100 * 3);
+
+    // On the GPU: the same buffers for 1 000 placements as for one.
+    let options = RenderOptions::default();
+    let buffers = |scene: &Scene| {
+        let mut gpu = Gpu::new(EsVersion::Es3);
+        gpu.r().set_method_named("forward").unwrap();
+        let image = gpu.render(scene, 64, 36, &options);
+        (gpu.r().live_gl_objects().buffers, image)
+    };
+    let (one_buffers, _) = buffers(&one);
+    let (many_buffers, image) = buffers(&many);
+    assert_eq!(many_buffers, one_buffers);
+    // The shared placements still draw: the first (red) quad fills the middle of the view.
+    let centre = image.get_pixel(32, 18);
+    assert!(centre[0] > 2 * centre[1].max(8), "{centre:?}");
+}
+
+#[test]
+fn a_gltf_named_many_times_shares_its_meshes_and_textures() {
+    let dir = tempfile::tempdir().unwrap();
+    // A textured quad (glTF with an embedded PNG in a data URI).
+    let mut png = Vec::new();
+    image::RgbaImage::from_pixel(4, 4, image::Rgba([200, 100, 50, 255]))
+        .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+        .unwrap();
+    let f = |v: &[f32]| v.iter().flat_map(|x| x.to_le_bytes()).collect::<Vec<u8>>();
+    let mut bin = f(&[-1.0, -1.0, 0.0, 1.0, -1.0, 0.0, 1.0, 1.0, 0.0]);
+    bin.extend(f(&[0.0, 0.0, 1.0, 0.0, 0.0, 1.0]));
+    use base64::Engine;
+    let b64 = |b: &[u8]| base64::engine::general_purpose::STANDARD.encode(b);
+    let doc = serde_json::json!({
+        "asset": {"version": "2.0"},
+        "scenes": [{"nodes": [0]}],
+        "nodes": [{"mesh": 0}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "TEXCOORD_0": 1},
+                                     "material": 0}]}],
+        "materials": [{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}],
+        "textures": [{"source": 0}],
+        "images": [{"uri": format!("data:image/png;base64,{}", b64(&png))}],
+        "buffers": [{"byteLength": bin.len(),
+                     "uri": format!("data:application/octet-stream;base64,{}", b64(&bin))}],
+        "bufferViews": [{"buffer": 0, "byteLength": 36}, {"buffer": 0, "byteOffset": 36,
+                                                          "byteLength": 24}],
+        "accessors": [
+            {"bufferView": 0, "componentType": 5126, "type": "VEC3", "count": 3,
+             "min": [-1, -1, 0], "max": [1, 1, 0]},
+            {"bufferView": 1, "componentType": 5126, "type": "VEC2", "count": 3}
+        ]
+    });
+    std::fs::write(dir.path().join("q.gltf"), doc.to_string()).unwrap();
+    let objects: Vec<serde_json::Value> = (0..200)
+        .map(|i| serde_json::json!({"gltf": "q.gltf", "transform": {"translate": [i, 0, 0]}}))
+        .collect();
+    let file = dir.path().join("s.json");
+    std::fs::write(&file, serde_json::json!({"objects": objects}).to_string()).unwrap();
+    let (scene, _) = scene::load(file.to_str().unwrap(), None).unwrap();
+    assert_eq!((scene.objects.len(), distinct_meshes(&scene)), (200, 1));
+    let textures: HashSet<*const manylight::Texture> = scene
+        .materials
+        .iter()
+        .filter_map(|m| m.diffuse_texture.as_ref().map(Arc::as_ptr))
+        .collect();
+    assert_eq!(textures.len(), 1);
+    assert_eq!(
+        scene.materials.len(),
+        1,
+        "uncoloured references share the material"
+    );
+    // A placement past the coordinate limit is refused, naming the scene file's transform, on
+    // the first reference and on a later one.
+    for far in [
+        [[0.0, 0.0, 0.0], [1e13, 0.0, 0.0]],
+        [[1e13, 0.0, 0.0], [0.0, 0.0, 0.0]],
+    ] {
+        let objects: Vec<serde_json::Value> = far
+            .iter()
+            .map(|t| serde_json::json!({"gltf": "q.gltf", "transform": {"translate": t}}))
+            .collect();
+        std::fs::write(&file, serde_json::json!({"objects": objects}).to_string()).unwrap();
+        let err = scene::load(file.to_str().unwrap(), None)
+            .unwrap_err()
+            .to_string();
+        let far_one = far.iter().position(|t| t[0] != 0.0).unwrap();
+        let field = format!("objects[{far_one}].transform");
+        assert!(err.contains(&field) && err.contains("past"), "{err}");
+    }
+
+    // With a light, the file is read per reference (the light moves with it): three lights,
+    // one mesh.
+    let mut lit = doc.clone();
+    lit["extensionsUsed"] = serde_json::json!(["KHR_lights_punctual"]);
+    lit["extensions"] = serde_json::json!({"KHR_lights_punctual": {"lights": [
+        {"type": "point", "intensity": 2, "range": 3}]}});
+    lit["nodes"][0]["extensions"] = serde_json::json!({"KHR_lights_punctual": {"light": 0}});
+    std::fs::write(dir.path().join("lit.gltf"), lit.to_string()).unwrap();
+    let objects: Vec<serde_json::Value> = (0..3)
+        .map(|i| serde_json::json!({"gltf": "lit.gltf", "transform": {"translate": [i, 0, 0]}}))
+        .collect();
+    std::fs::write(&file, serde_json::json!({"objects": objects}).to_string()).unwrap();
+    let (scene, _) = scene::load(file.to_str().unwrap(), None).unwrap();
+    assert_eq!((scene.objects.len(), distinct_meshes(&scene)), (3, 1));
+    let xs: Vec<f64> = scene.lights.iter().map(|l| l.position.x).collect();
+    assert_eq!(xs, [0.0, 1.0, 2.0]);
+}
+
+/// An OBJ repeating a quad thousands of times (in every rotation and winding) loads as the
+/// quad, with one warning giving the count, and renders exactly as the quad written once; a
+/// transparent object keeps its copies (each blends once more).
+#[test]
+fn duplicate_triangles_are_dropped_with_a_count_and_the_picture_kept() {
+    let dir = tempfile::tempdir().unwrap();
+    // Normals given: computed ones would weigh the copies (and did before they were dropped).
+    let header = "mtllib m.mtl\nv -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nv -1 -1 0\nv 0 -1 -1\n\
+                  vn 0 0 1\nvn 0 -1 0\nusemtl solid\n";
+    let faces = "f 1//1 2//1 3//1\nf 1//1 3//1 4//1\nf 1//2 2//2 6//2\n";
+    let mut repeated = format!("{header}{faces}");
+    for _ in 0..2500 {
+        // Rotated, reversed, and through vertex 5 (vertex 1's position again).
+        repeated += "f 2//1 3//1 1//1\nf 4//1 3//1 1//1\nf 5//1 3//1 4//1\nf 3//1 1//1 2//1\n";
+    }
+    let once = format!("{header}{faces}");
+    let mtl = "newmtl solid\nKd 0.8 0.6 0.2\nnewmtl glass\nKd 0.2 0.6 0.8\nd 0.5\n";
+    std::fs::write(dir.path().join("m.mtl"), mtl).unwrap();
+    let load = |name: &str, text: &str| {
+        let file = dir.path().join(name);
+        std::fs::write(&file, text).unwrap();
+        scene::load(file.to_str().unwrap(), Some((8, 3))).unwrap()
+    };
+    let (deduped, report) = load("repeated.obj", &repeated);
+    let (written_once, clean) = load("once.obj", &once);
+    assert!(clean.warnings.is_empty(), "{:?}", clean.warnings);
+    assert_eq!(deduped.objects[0].mesh.triangle_count(), 3);
+    assert_eq!(report.warnings.len(), 1, "{:?}", report.warnings);
+    assert!(
+        report.warnings[0].contains("10000 duplicate triangles dropped"),
+        "{}",
+        report.warnings[0]
+    );
+    let mut gpu = Gpu::new(EsVersion::Es3);
+    let options = RenderOptions::default();
+    let a = gpu.render(&deduped, 64, 36, &options);
+    let b = gpu.render(&written_once, 64, 36, &options);
+    assert!(a.pixels().any(|p| p[0] > 20), "the quad is lit");
+    assert!(a == b, "the picture changed");
+
+    let glass = repeated.replace("usemtl solid", "usemtl glass");
+    let (kept, report) = load("glass.obj", &glass);
+    assert_eq!(kept.objects[0].mesh.triangle_count(), 3 + 10_000);
+    assert!(report.warnings.is_empty(), "{:?}", report.warnings);
+}
+
+/// A texture wider than the kept budget is scaled down, aspect kept, with a warning naming it.
+#[test]
+fn an_oversized_texture_is_kept_scaled_down_with_a_warning() {
+    let dir = tempfile::tempdir().unwrap();
+    let wide = image::RgbImage::from_pixel(6000, 3, image::Rgb([30, 160, 90]));
+    wide.save(dir.path().join("Wide.png")).unwrap();
+    std::fs::write(
+        dir.path().join("m.mtl"),
+        "newmtl t\nKd 1 1 1\nmap_Kd Wide.png\n",
+    )
+    .unwrap();
+    let obj = "mtllib m.mtl\nusemtl t\nv -1 -1 0\nv 1 -1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\n\
+               f 1/1 2/2 3/3\n";
+    let file = dir.path().join("m.obj");
+    std::fs::write(&file, obj).unwrap();
+    let (scene, report) = scene::load(file.to_str().unwrap(), Some((4, 1))).unwrap();
+    let texture = scene.materials[0].diffuse_texture.as_ref().unwrap();
+    let kept = scene::texture_budget::MAX_STORED_TEXTURE_SIDE;
+    assert_eq!(texture.image.dimensions(), (kept, 2));
+    assert_eq!(texture.image.get_pixel(10, 1).0, [30, 160, 90, 255]);
+    assert_eq!(report.warnings.len(), 1, "{:?}", report.warnings);
+    let warning = &report.warnings[0];
+    assert!(
+        warning.contains("Wide.png") && warning.contains("6000×3"),
+        "{warning}"
+    );
+}
+
+/// A mesh placed 100 000 times: the scene's bounds are those of its placements (each distinct
+/// mesh's vertices are walked once, not once a placement).
+#[test]
+fn bounds_of_a_mesh_placed_many_times() {
+    use glam::{DMat4, DVec3, Vec3};
+    let mesh = Arc::new(
+        manylight::Mesh::new(
+            vec![
+                Vec3::new(-1.0, 0.0, 0.0),
+                Vec3::new(1.0, 2.0, 0.5),
+                Vec3::ZERO,
+            ],
+            vec![],
+            vec![],
+            vec![0, 1, 2],
+        )
+        .unwrap(),
+    );
+    let mut scene = Scene::empty();
+    let material = scene.add_material(manylight::Material::default());
+    for i in 0..100_000 {
+        let at = DVec3::new((i % 500) as f64 * 4.0, 0.0, (i / 500) as f64 * -3.0);
+        let turn = if i == 77 {
+            DMat4::from_rotation_z(std::f64::consts::PI)
+        } else {
+            DMat4::IDENTITY
+        };
+        scene.add_object(mesh.clone(), material, DMat4::from_translation(at) * turn);
+    }
+    let b = scene.bounds().unwrap();
+    // Placement 77 (at x = 308) is turned half round z: its y runs down to -2.
+    let want_min = DVec3::new(-1.0, -2.0, -597.0);
+    let want_max = DVec3::new(1997.0, 2.0, 0.5);
+    assert!((b.min - want_min).length() < 1e-9, "{:?}", b.min);
+    assert!((b.max - want_max).length() < 1e-9, "{:?}", b.max);
+}
