@@ -25,7 +25,7 @@ pub struct GpuScene {
     white: Option<ImageTexture>,
     /// This frame's stand-ins for objects with triangles too long for their distance from the
     /// eye: object index → the split mesh and its model matrix (see
-    /// `renderer::triangle_reach`).
+    /// `scene::triangle_reach`).
     splits: HashMap<usize, (GpuMesh, DMat4)>,
 }
 
@@ -46,7 +46,7 @@ impl GpuScene {
                 let bounds = o.mesh.bounds();
                 let origin = bounds.map_or(DVec3::ZERO, |b| b.center());
                 let gpu = GpuMesh::new_about(dev, &o.mesh, origin)?;
-                let longest = crate::renderer::triangle_reach::longest_edge(&o.mesh);
+                let longest = crate::scene::triangle_reach::longest_edge(&o.mesh);
                 e.insert((o.mesh.clone(), gpu, bounds, longest));
             }
         }
@@ -68,7 +68,9 @@ impl GpuScene {
             m.destroy(dev);
         }
         let model = DMat4::from_translation(scene.camera.position);
-        for (i, mesh) in crate::renderer::triangle_reach::split_objects(scene, self) {
+        for (i, mesh) in crate::scene::triangle_reach::split_objects(scene, |o| {
+            (self.longest_edge(o), self.world_bounds(o))
+        }) {
             self.splits.insert(i, (GpuMesh::new(dev, &mesh)?, model));
         }
         Ok(())

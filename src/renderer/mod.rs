@@ -12,7 +12,6 @@ mod fp16_range;
 mod method;
 mod offscreen;
 mod stats;
-pub(crate) mod triangle_reach;
 
 use crate::cluster::view_light::GpuLight;
 use crate::gl::framebuffer::OffscreenTarget;

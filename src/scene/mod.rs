@@ -28,6 +28,7 @@ pub mod random;
 pub mod raycast;
 pub mod shading;
 pub mod texture_budget;
+pub(crate) mod triangle_reach;
 
 use std::ops::Range;
 use std::sync::Arc;

@@ -11,9 +11,8 @@
 
 use glam::{DMat3, DMat4, DVec2, DVec3, Vec2};
 
-use crate::gpu_scene::GpuScene;
-use crate::scene::normal_matrix::normal_matrix;
-use crate::scene::{Camera, Mesh, Projection, Scene};
+use super::normal_matrix::normal_matrix;
+use super::{Aabb, Camera, Mesh, Object, Projection, Scene};
 
 /// Largest ratio of a triangle's longest edge to its distance from the eye (at least the near
 /// plane's) that is drawn as it is: positions are then within about 10⁻³ of their distance.
@@ -35,17 +34,22 @@ pub fn longest_edge(mesh: &Mesh) -> f64 {
 }
 
 /// The objects of `scene` that need splitting this frame, each with its split mesh in
-/// camera-relative world space (drawn with the model matrix `translation(eye)`). Objects
-/// whose longest edge and bounds clear the limit cost one test.
-pub fn split_objects(scene: &Scene, gpu_scene: &GpuScene) -> Vec<(usize, Mesh)> {
+/// camera-relative world space (drawn with the model matrix `translation(eye)`). `measure`
+/// gives an object's longest edge in object space and its world bounds (kept by the caller
+/// per mesh); objects whose longest edge and bounds clear the limit cost one test.
+pub fn split_objects(
+    scene: &Scene,
+    measure: impl Fn(&Object) -> (f64, Option<Aabb>),
+) -> Vec<(usize, Mesh)> {
     let camera = &scene.camera;
     let floor = closest_fragment(camera);
     let eye = camera.position;
     let mut out = Vec::new();
     for (i, object) in scene.objects.iter().enumerate() {
         let scale = largest_scale(&object.transform);
-        let longest = gpu_scene.longest_edge(object) * scale;
-        let distance = gpu_scene.world_bounds(object).map_or(f64::INFINITY, |b| {
+        let (longest, bounds) = measure(object);
+        let longest = longest * scale;
+        let distance = bounds.map_or(f64::INFINITY, |b| {
             (b.min - eye).max(eye - b.max).max(DVec3::ZERO).length()
         });
         if longest <= MAX_TRIANGLE_REACH * distance.max(floor) {
