@@ -14,7 +14,7 @@ pub fn unit(v: DVec3) -> Option<DVec3> {
     (v / largest).try_normalize()
 }
 
-/// [`unit`] in `f32`.
+/// [`unit()`] in `f32`.
 pub fn unit_f32(v: Vec3) -> Option<Vec3> {
     let largest = v.abs().max_element();
     if !(largest > 0.0 && largest.is_finite()) {
