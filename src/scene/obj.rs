@@ -154,8 +154,11 @@ type Parsed = (
 
 /// OBJ or MTL bytes as the text tobj reads: bytes that are not UTF-8 (a Latin-1 name)
 /// replaced by U+FFFD rather than failing the whole read, and a lone CR (old Mac line ends)
-/// taken as a line end, as CRLF is. Also says whether any byte was not UTF-8.
+/// taken as a line end, as CRLF is; a UTF-8 byte-order mark (Windows editors write one) is
+/// dropped, else tobj would not know the first line's keyword. Also says whether any byte was
+/// not UTF-8.
 fn text_of(bytes: &[u8]) -> (String, bool) {
+    let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
     let text = String::from_utf8_lossy(bytes);
     let not_utf8 = matches!(text, std::borrow::Cow::Owned(_));
     let text = if text.contains('\r') {

@@ -1490,3 +1490,37 @@ fn the_cli_refuses_an_outside_buffer_unless_allow_outside_files_is_given() {
     common::cli::expect_status(&allowed, &[], out.root.path(), 0);
     assert!(out.root.path().join("o.png").is_file());
 }
+
+#[test]
+fn a_json_file_that_is_not_gltf_shows_none_of_its_strings() {
+    // A scene file may name any file as its glTF: serde's own message would quote the value.
+    let dir = tempfile::tempdir().unwrap();
+    write(
+        dir.path(),
+        "config.json",
+        format!(r#"{{"asset": "{SENTINEL}", "token": 1}}"#),
+    );
+    let scene_file = write(
+        dir.path(),
+        "s.json",
+        r#"{"objects": [{"gltf": "config.json"}]}"#,
+    );
+    let mut paths = vec![scene_file];
+    for (name, text) in [
+        (
+            "enum.gltf",
+            format!(r#"{{"asset": {{"version": "2.0"}}, "scene": "{SENTINEL}"}}"#),
+        ),
+        ("syntax.gltf", format!(r#"{{"asset": {SENTINEL}}}"#)),
+    ] {
+        paths.push(write(dir.path(), name, text));
+    }
+    for path in paths {
+        let err = load(&path).unwrap_err().to_string();
+        assert!(err.contains("line 1"), "{err}");
+        assert!(!err.contains(SENTINEL), "{err}");
+    }
+    let path = write(dir.path(), "none.gltf", "{}");
+    let err = load(&path).unwrap_err().to_string();
+    assert!(err.contains("missing field `asset`"), "{err}");
+}

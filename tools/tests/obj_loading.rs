@@ -453,6 +453,12 @@ fn a_latin1_name_loads_with_a_warning_and_cr_only_lines_load_as_lf_ones() {
     );
     assert_eq!(got.objects[0].mesh.indices, want.objects[0].mesh.indices);
     assert_eq!(got.materials[0].diffuse, want.materials[0].diffuse);
+    // A UTF-8 byte-order mark before `mtllib` and before `newmtl`: the material still loads.
+    std::fs::write(dir.path().join("bom.mtl"), "\u{feff}newmtl red\nKd 1 0 0\n").unwrap();
+    let bom = format!("\u{feff}{}", lf.replace("m.mtl", "bom.mtl"));
+    let (got, report) = load_obj(&write(dir.path(), "bom.obj", &bom)).unwrap();
+    assert!(report.warnings.is_empty(), "{:?}", report.warnings);
+    assert_eq!(got.materials[0].diffuse, want.materials[0].diffuse);
     // A Latin-1 object name (`é` as the single byte 0xE9): loaded, with a warning.
     let mut latin1 = lf.replace("o quad", "o caf\u{1}").into_bytes();
     let at = latin1.iter().position(|&b| b == 1).unwrap();

@@ -258,6 +258,15 @@ fn two_options_naming_one_file_are_a_usage_error_naming_both() {
             "{args:?}: {msg}"
         );
     }
+    // A file in the folder --record fills with frames could be a frame.
+    for args in [
+        ["--stats", "d/frame_00001.png", "--record", "d"],
+        ["--out", "d/frame_00002.png", "--record", "./d/"],
+    ] {
+        let args = [&TINY[..4], &["--frames", "3"], &args[..]].concat();
+        let msg = expect_exit(&args, &[], cwd, 2, args[7]);
+        assert!(msg.contains("--record") && msg.contains("frames"), "{msg}");
+    }
     let absolute = cwd.join("a.png");
     let args = tiny(&["--out", absolute.to_str().unwrap(), "--stats", "a.png"]);
     expect_exit(&strs(&args), &[], cwd, 2, "same file");

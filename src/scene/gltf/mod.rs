@@ -166,6 +166,28 @@ pub fn load_into(
     })
 }
 
+/// A JSON error said by its kind and place: serde's own text quotes the offending value,
+/// which may be any file's bytes (a scene file can name any file as its glTF).
+fn json_error(e: &serde_json::Error) -> String {
+    use serde_json::error::Category;
+    let what = match e.classify() {
+        Category::Io => "could not be read".to_string(),
+        Category::Syntax => "is not valid JSON".to_string(),
+        Category::Eof => "ends early".to_string(),
+        Category::Data => {
+            let message = e.to_string();
+            match message.split_once(" at line") {
+                // A missing field is named by the glTF schema, not by the file.
+                Some((missing, _)) if missing.starts_with("missing field") => {
+                    format!("is not glTF ({missing})")
+                }
+                _ => "is not glTF (a value of the wrong type or form)".to_string(),
+            }
+        }
+    };
+    format!("JSON {what} at line {}, column {}", e.line(), e.column())
+}
+
 /// Why an import failed: the file itself, or the caller's transform placing what is in it.
 enum Fault {
     File(String),
@@ -204,7 +226,7 @@ fn import(
     } else {
         (bytes, None)
     };
-    let root = gltf::json::deserialize::from_slice(json).map_err(|e| format!("JSON: {e}"))?;
+    let root = gltf::json::deserialize::from_slice(json).map_err(|e| json_error(&e))?;
     integers::check(json)?;
     validate(&root)?;
     let document = gltf::Document::from_json_without_validation(root);

@@ -153,6 +153,9 @@ fn check_usage(cli: &Cli) {
         let stats = a.stats.as_deref().map(|p| ("--stats", p));
         let record = a.record.as_deref().map(|p| ("--record", p));
         check_distinct_outputs(&[out, stats, record]);
+        if let Some(folder) = a.record.as_deref().filter(|p| !is_gif(p)) {
+            check_outside_folder(&[out, stats], ("--record", folder));
+        }
     }
     if let Some(Command::Matrix(a)) = &cli.command {
         let json = a.json.as_deref().map(|p| ("--json", p));
@@ -209,6 +212,33 @@ fn check_distinct_outputs(outputs: &[Option<(&str, &Path)>]) {
                         "{a} {} and {b} {} name the same file: one would overwrite the other",
                         a_path.display(),
                         b_path.display()
+                    ),
+                )
+                .exit();
+        }
+    }
+}
+
+/// Whether `--record` names an animated GIF (else a folder of PNG frames).
+fn is_gif(path: &Path) -> bool {
+    path.extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("gif"))
+}
+
+/// A file inside the folder `--record` fills with frames could be one of them: a usage error
+/// naming both options.
+fn check_outside_folder(outputs: &[Option<(&str, &Path)>], (folder_option, folder): (&str, &Path)) {
+    let folder_id = output::identity(folder);
+    for &(option, path) in outputs.iter().flatten() {
+        if output::identity(path).parent() == Some(folder_id.as_path()) {
+            Cli::command()
+                .error(
+                    ErrorKind::ArgumentConflict,
+                    format!(
+                        "{option} {} lies in the folder {folder_option} {} fills with frames: \
+                         a frame could overwrite it",
+                        path.display(),
+                        folder.display()
                     ),
                 )
                 .exit();
