@@ -156,13 +156,17 @@ impl ModelCache {
             return Ok(LoadReport::default());
         }
         let first = (scene.objects.len(), scene.materials.len());
-        let report = obj::load_into(scene, path, transform, texture)?;
+        // Loaded at the identity: each object's transform is then its own (its mesh is stored
+        // about its centre), recorded once and placed below.
+        let report = obj::load_into(scene, path, DMat4::IDENTITY, texture)?;
         self.share(scene, first.0, first.1, key.as_ref().map(|k| &k.0));
         if let Some(key) = key {
-            // The loader places every object with `transform` itself.
-            let mut loaded = Loaded::record(scene, first, |_| DMat4::IDENTITY, false);
+            let mut loaded = Loaded::record(scene, first, |o| o.transform, false);
             loaded.uncoloured_at = (!recolour).then_some(first.1);
             self.obj.insert(key, loaded);
+        }
+        for o in &mut scene.objects[first.0..] {
+            o.transform = transform * o.transform;
         }
         Ok(report)
     }

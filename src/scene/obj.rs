@@ -12,11 +12,11 @@ use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use glam::{DMat4, Vec2, Vec3};
+use glam::{DMat4, DVec3, Vec2, Vec3};
 
 use super::input::{read_bounded, FileKind};
 use super::material::MAX_COLOR_FACTOR;
-use super::{Material, Mesh, Object, Scene, SceneError, Texture};
+use super::{Aabb, Material, Mesh, Object, Scene, SceneError, Texture};
 
 /// What an OBJ load produced besides the objects: non-fatal problems, for the caller to show.
 #[derive(Debug, Default)]
@@ -77,8 +77,8 @@ pub fn load_into(
             },
             _ => None,
         };
-        let mut factor = |key: &str, value: Option<[f32; 3]>, default: f32| {
-            let v = Vec3::from(value.unwrap_or([default; 3]));
+        let mut factor = |key: &str, value: Option<[f64; 3]>, default: f32| {
+            let v = value.map_or(Vec3::splat(default), |v| DVec3::from(v).as_vec3());
             // NaN becomes 0: f32::clamp keeps NaN, max/min do not.
             let clamped = v.max(Vec3::ZERO).min(Vec3::splat(MAX_COLOR_FACTOR));
             if clamped != v {
@@ -97,8 +97,8 @@ pub fn load_into(
             diffuse,
             diffuse_texture: override_tex.clone().or(texture),
             specular,
-            shininess: m.shininess.unwrap_or(1.0),
-            alpha: m.dissolve.unwrap_or(1.0).clamp(0.0, 1.0),
+            shininess: m.shininess.map_or(1.0, |s| s as f32),
+            alpha: m.dissolve.map_or(1.0, |d| d as f32).clamp(0.0, 1.0),
         });
     }
     let fallback = scene.add_material(Material {
@@ -110,13 +110,26 @@ pub fn load_into(
         if m.indices.is_empty() {
             continue;
         }
-        let positions: Vec<Vec3> = m.positions.chunks_exact(3).map(Vec3::from_slice).collect();
-        let normals: Vec<Vec3> = m.normals.chunks_exact(3).map(Vec3::from_slice).collect();
+        // Read in f64 and stored about the object's own centre, which joins its transform: a
+        // model far from its origin keeps detail that f32 coordinates there would round away.
+        let positions: Vec<DVec3> = m.positions.chunks_exact(3).map(DVec3::from_slice).collect();
+        // Past the object-space limit (or not finite) they stay where they are, and
+        // `Mesh::new` refuses them by index.
+        let limit = f64::from(super::mesh::MAX_VERTEX_COORD);
+        let centre = Aabb::from_points(positions.iter().copied())
+            .filter(|b| b.min.abs().max(b.max.abs()).max_element() <= limit)
+            .map_or(DVec3::ZERO, |b| b.center());
+        let positions: Vec<Vec3> = positions.iter().map(|p| (*p - centre).as_vec3()).collect();
+        let normals: Vec<Vec3> = m
+            .normals
+            .chunks_exact(3)
+            .map(|n| DVec3::from_slice(n).as_vec3())
+            .collect();
         // OBJ's v axis points up; images store row 0 at the top: flip once here.
         let uvs: Vec<Vec2> = m
             .texcoords
             .chunks_exact(2)
-            .map(|t| Vec2::new(t[0], 1.0 - t[1]))
+            .map(|t| Vec2::new(t[0] as f32, 1.0 - t[1] as f32))
             .collect();
         let mesh = Mesh::new(positions, normals, uvs, m.indices).map_err(|e| SceneError::Obj {
             path: path.to_path_buf(),
@@ -136,7 +149,7 @@ pub fn load_into(
         scene.objects.push(Object {
             mesh: Arc::new(mesh),
             material,
-            transform,
+            transform: transform * DMat4::from_translation(centre),
         });
     }
     Ok(report)

@@ -242,12 +242,19 @@ fn a_triangle_huge_beside_the_camera_renders_as_the_f64_model_says() {
     });
 }
 
-/// An OBJ quad with its corners `offset` from the origin (integers, exact in f32), with its
-/// camera framed and 32 random lights as the CLI loads it.
-fn obj_quad(dir: &std::path::Path, offset: f64) -> Scene {
-    let path = dir.join(format!("quad{offset}.obj"));
+/// An OBJ quad of half-size `half` with its corners `offset` from the origin, with its camera
+/// framed and 32 random lights as the CLI loads it.
+fn obj_quad(dir: &std::path::Path, offset: f64, half: f64) -> Scene {
+    let path = dir.join(format!("quad{offset}-{half}.obj"));
     let v = |x: f64, y: f64| format!("v {} {} {}\n", offset + x, offset + y, offset);
-    let text = [v(-4.0, -4.0), v(4.0, -4.0), v(4.0, 4.0), v(-4.0, 4.0)].concat() + "f 1 2 3 4\n";
+    let text = [
+        v(-half, -half),
+        v(half, -half),
+        v(half, half),
+        v(-half, half),
+    ]
+    .concat()
+        + "f 1 2 3 4\n";
     std::fs::write(&path, text).unwrap();
     let (mut s, _) = scene::load(path.to_str().unwrap(), Some((32, 5))).unwrap();
     s.ambient = Vec3::ZERO;
@@ -257,12 +264,22 @@ fn obj_quad(dir: &std::path::Path, offset: f64) -> Scene {
 #[test]
 fn an_obj_modelled_far_from_its_origin_renders_as_at_the_origin() {
     let dir = tempfile::tempdir().unwrap();
-    let at_origin = obj_quad(dir.path(), 0.0);
+    let at_origin = obj_quad(dir.path(), 0.0, 4.0);
     for offset in [1e5, 1e7] {
         assert_draws_as(
-            &obj_quad(dir.path(), offset),
+            &obj_quad(dir.path(), offset, 4.0),
             &at_origin,
             &format!("quad at {offset:e}"),
+        );
+    }
+    // Corners 0.1 apart 1e7 and 1e8 from the origin: f32 there rounds to 1 and 8, but the
+    // file is read in f64 and the mesh stored about its centre.
+    let fine = obj_quad(dir.path(), 0.0, 0.05);
+    for offset in [1e7, 1e8] {
+        assert_draws_as(
+            &obj_quad(dir.path(), offset, 0.05),
+            &fine,
+            &format!("fine quad at {offset:e}"),
         );
     }
     // The same through an object transform (f64 all the way).
