@@ -68,5 +68,77 @@ pub(super) fn check(
         }
     }
     lights.retain(placeable);
+    warn_of_capped_radii(lights, reach);
     Ok(())
+}
+
+/// Largest value fp16 holds: a larger radius reads as this in a mediump shader.
+const FP16_MAX: f64 = 65504.0;
+
+/// Whether a light's radius was found past [`FP16_MAX`] where it changes the picture (said once
+/// a process: a warning per frame would flood a game's log).
+static WARNED_CAPPED_RADIUS: std::sync::atomic::AtomicBool =
+    std::sync::atomic::AtomicBool::new(false);
+
+/// How far from a light the visible geometry may lie: its distance from the eye plus the reach.
+fn farthest_lit(l: &GpuLight, reach: f64) -> f64 {
+    (l.position.length() as f64 + reach).min(l.radius as f64)
+}
+
+/// How much darker the window of a light of radius `r` is `d` away when fp16 holds the radius
+/// as [`FP16_MAX`] (0 for radii it holds).
+fn capped_radius_error(r: f64, d: f64) -> f64 {
+    if r <= FP16_MAX {
+        0.0
+    } else {
+        window(d, r) - window(d, FP16_MAX)
+    }
+}
+
+/// The light model's window `(1 − (d/r)⁴)²` (0 past the radius).
+fn window(d: f64, r: f64) -> f64 {
+    let q = d / r;
+    if q >= 1.0 {
+        0.0
+    } else {
+        (1.0 - q.powi(4)).powi(2)
+    }
+}
+
+/// Warns (once) of a light whose radius fp16 caps at [`FP16_MAX`] while it reaches geometry
+/// far enough that the capped window differs from the true one by more than 1/255.
+fn warn_of_capped_radii(lights: &[GpuLight], reach: f64) {
+    use std::sync::atomic::Ordering;
+    if WARNED_CAPPED_RADIUS.load(Ordering::Relaxed) {
+        return;
+    }
+    for l in lights {
+        let (r, d) = (l.radius as f64, farthest_lit(l, reach));
+        let error = capped_radius_error(r, d);
+        if error > 1.0 / 255.0 {
+            WARNED_CAPPED_RADIUS.store(true, Ordering::Relaxed);
+            log::warn!(
+                "without fragment highp a light radius is held in fp16: radius {r:.3e} acts as \
+                 {FP16_MAX}, and this light's falloff {d:.0} away is {:.0}% too dark (keep \
+                 radii under {FP16_MAX} or lights within a few thousand of what they light)",
+                100.0 * error / window(d, r).max(f64::MIN_POSITIVE)
+            );
+            return;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_capped_radius_matters_only_far_from_the_light() {
+        // The red-team case: 59 000 from the plane, radius 10⁵: far too dark.
+        assert!(capped_radius_error(1e5, 59000.0) > 0.5);
+        // A lamp with a huge radius lighting a room a few hundred units across: exact enough.
+        assert!(capped_radius_error(1e6, 500.0) < 1e-6);
+        assert!(capped_radius_error(1e12, 3000.0) < 1.0 / 255.0);
+        assert_eq!(capped_radius_error(6e4, 59000.0), 0.0);
+    }
 }
