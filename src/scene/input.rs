@@ -48,11 +48,24 @@ impl FileKind {
     }
 
     /// The limit in force: `MANYLIGHT_MAX_FILE_MB` if set to a number, else the default.
+    /// A value that is not a whole number of MiB is warned of (once) and the default kept.
     pub fn limit(self) -> u64 {
-        std::env::var(LIMIT_VARIABLE)
-            .ok()
-            .and_then(|v| v.trim().parse::<u64>().ok())
-            .map_or(self.default_limit(), |mb| mb.saturating_mul(1 << 20))
+        let Ok(value) = std::env::var(LIMIT_VARIABLE) else {
+            return self.default_limit();
+        };
+        match value.trim().parse::<u64>() {
+            Ok(mb) => mb.saturating_mul(1 << 20),
+            Err(e) => {
+                static WARNED: std::sync::Once = std::sync::Once::new();
+                WARNED.call_once(|| {
+                    log::warn!(
+                        "{LIMIT_VARIABLE} is not a whole number of MiB ({e}); the default \
+                         limits apply"
+                    )
+                });
+                self.default_limit()
+            }
+        }
     }
 
     fn name(self) -> &'static str {

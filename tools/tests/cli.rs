@@ -550,6 +550,13 @@ fn hostile_files_and_counts_are_refused_quickly_and_clearly() {
             "MANYLIGHT_MAX_FILE_MB",
             1,
         ),
+        // Not a number: warned of, the default limits kept (the file loads).
+        (
+            vec!["render", "--scene", "plain.obj", "--lights", "2"],
+            &[("MANYLIGHT_MAX_FILE_MB", "abc")],
+            "MANYLIGHT_MAX_FILE_MB is not a whole number",
+            0,
+        ),
     ];
     if made.is_ok_and(|s| s.success()) {
         cases.push((
