@@ -255,7 +255,7 @@ fn group_rows(
         let mut row = match serde_json::from_slice::<Value>(&output.stdout) {
             Ok(v) if output.status.success() => v,
             _ => json!({
-                "error": String::from_utf8_lossy(&output.stderr).trim().replace("error: ", ""),
+                "error": cell_error(&output.stderr),
                 "methods": [],
             }),
         };
@@ -275,6 +275,27 @@ fn group_rows(
         rows.push(row);
     }
     Ok(rows)
+}
+
+/// Why a cell failed, on one line for its table cell: the child's `error:` lines, without the
+/// warnings logged before them (or its last line when it printed no `error:`).
+fn cell_error(stderr: &[u8]) -> String {
+    let text = String::from_utf8_lossy(stderr);
+    let errors: Vec<&str> = text
+        .lines()
+        .filter_map(|l| l.strip_prefix("error: "))
+        .map(str::trim)
+        .collect();
+    if errors.is_empty() {
+        text.lines()
+            .rev()
+            .find(|l| !l.trim().is_empty())
+            .unwrap_or("")
+            .trim()
+            .to_string()
+    } else {
+        errors.join("; ")
+    }
 }
 
 /// Desktop GL through OSMesa, when built with the `osmesa` feature.
@@ -310,7 +331,7 @@ fn osmesa_row(
     let mut row = match serde_json::from_slice::<Value>(&output.stdout) {
         Ok(v) if output.status.success() => v,
         _ => json!({
-            "error": String::from_utf8_lossy(&output.stderr).trim().replace("error: ", ""),
+            "error": cell_error(&output.stderr),
             "methods": [],
         }),
     };
@@ -517,4 +538,16 @@ pub fn run_cell(args: &MatrixCellArgs) -> Result<(), Box<dyn std::error::Error>>
     });
     print_stdout(&format!("{row}\n"))?;
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::cell_error;
+
+    #[test]
+    fn a_cell_error_is_one_line_without_the_warnings_before_it() {
+        let stderr = b"[WARN  manylight::renderer] fragment mediump\nerror: lights[0]: too far\n";
+        assert_eq!(cell_error(stderr), "lights[0]: too far");
+        assert_eq!(cell_error(b"thread panicked\nboom\n\n"), "boom");
+    }
 }
