@@ -67,8 +67,14 @@ pub fn load_into(
             Some(name) if !name.trim().is_empty() => match resolve_texture(base_dir, name) {
                 Some(p) => textures.load(&p, &mut report),
                 None => {
+                    // Something there that is not a file (`/dev/zero`, a folder) is named so.
+                    let what = if base_dir.join(name.trim()).exists() {
+                        "is not a regular file"
+                    } else {
+                        "not found"
+                    };
                     report.warn(format!(
-                        "material `{}`: texture `{name}` not found next to {}; using its flat colour",
+                        "material `{}`: texture `{name}` {what} next to {}; using its flat colour",
                         m.name,
                         path.display()
                     ));

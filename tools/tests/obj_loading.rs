@@ -494,3 +494,25 @@ fn obj_and_mtl_errors_do_not_show_the_files_text() {
         assert!(err.contains("line ") && !err.contains(secret), "{err}");
     }
 }
+
+#[cfg(unix)]
+#[test]
+fn a_texture_that_is_a_device_is_named_so_and_the_flat_colour_kept() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(
+        dir.path().join("m.mtl"),
+        "newmtl red\nKd 1 0 0\nmap_Kd /dev/zero\n",
+    )
+    .unwrap();
+    let obj = "mtllib m.mtl\nusemtl red\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+    let (scene, report) = load_obj(&write(dir.path(), "d.obj", obj)).unwrap();
+    assert!(
+        report
+            .warnings
+            .iter()
+            .any(|w| w.contains("/dev/zero") && w.contains("not a regular file")),
+        "{:?}",
+        report.warnings
+    );
+    assert!(scene.materials[0].diffuse_texture.is_none());
+}

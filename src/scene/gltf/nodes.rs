@@ -42,12 +42,15 @@ pub(super) fn local_transforms(json: &[u8]) -> Result<Vec<DMat4>, String> {
             if !s.is_finite() {
                 return Err(format!("{field}.scale: must be finite, got {s:?}"));
             }
-            // Exporters round: a quaternion of nearly unit length is normalised; one of no
-            // length has no rotation to give.
+            // Exporters round: a quaternion is normalised (divided by its largest component
+            // first, so no length overflows); one of no length has no rotation to give.
+            let largest = glam::DVec4::from(q).abs().max_element();
+            let q = q / largest;
             let length = q.length();
-            if !(length.is_finite() && length > 1e-12) {
+            if !(largest.is_finite() && largest > 0.0 && length.is_finite()) {
                 return Err(format!(
-                    "{field}.rotation: must be a finite non-zero quaternion, got {q:?}"
+                    "{field}.rotation: must be a finite non-zero quaternion, got {:?}",
+                    [x, y, z, w]
                 ));
             }
             let q = q / length;
@@ -209,6 +212,12 @@ mod tests {
             DVec3::new(1.0, 2.0, 3.0)
         );
         assert!(local_transforms(b"{}").unwrap().is_empty());
+        // A quaternion of any finite non-zero length is the rotation it says.
+        let json = br#"{"nodes": [{"rotation": [0, 1e200, 0, 1e200]}, {"rotation": [0, 1e-300, 0, 1e-300]}]}"#;
+        let quarter = DMat4::from_rotation_y(std::f64::consts::FRAC_PI_2);
+        for m in local_transforms(json).unwrap() {
+            assert!((m.transform_vector3(DVec3::X) - quarter.transform_vector3(DVec3::X)).length() < 1e-12);
+        }
     }
 
     #[test]
