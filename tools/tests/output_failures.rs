@@ -138,6 +138,12 @@ fn standard_output_onto_a_full_disk_fails_but_a_closed_pipe_does_not() {
         );
         assert!(!msg.contains("panicked"), "{args:?}: {msg}");
     }
+    // Help and the version are output too.
+    for args in [["--help"], ["--version"]] {
+        let out = run(&args, full());
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {}", text(&out));
+        assert_eq!(run(&args, Stdio::null()).status.code(), Some(0), "{args:?}");
+    }
     // `--stats /dev/stdout | jq`: the statistics, then the success line, into the pipe.
     let args = [
         "--size",

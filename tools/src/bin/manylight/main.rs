@@ -250,7 +250,19 @@ fn main() -> ExitCode {
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn"))
         .format_timestamp(None)
         .init();
-    let cli = Cli::parse();
+    let cli = Cli::try_parse().unwrap_or_else(|e| {
+        // As clap's own `exit`, but help or a version that cannot be written is a failure too.
+        let code = if e
+            .print()
+            .and_then(|()| std::io::Write::flush(&mut std::io::stdout()))
+            .is_err()
+        {
+            1
+        } else {
+            e.exit_code()
+        };
+        std::process::exit(code)
+    });
     check_usage(&cli);
     let mut options = LoadOptions::default();
     options.allow_outside_files = cli.allow_outside_files;
