@@ -138,6 +138,14 @@ fn standard_output_onto_a_full_disk_fails_but_a_closed_pipe_does_not() {
         );
         assert!(!msg.contains("panicked"), "{args:?}: {msg}");
     }
+    // Standard error onto a full disk: nothing can be said, but the exit status still tells.
+    let out = Command::new(env!("CARGO_BIN_EXE_manylight"))
+        .args(["--scene", "missing.obj"])
+        .current_dir(dir.path())
+        .stderr(full())
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1), "{}", text(&out));
     // Help and the version are output too.
     for args in [["--help"], ["--version"]] {
         let out = run(&args, full());

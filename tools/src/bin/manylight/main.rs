@@ -1,6 +1,16 @@
 //! The `manylight` command line: `render` (the default), `info`, `bench`, `bench-assign`,
 //! `matrix`, `view`.
 
+/// `std::eprintln!` for this binary and its modules, except that a standard error that cannot
+/// be written (`2>/dev/full`) is ignored instead of panicking: there is nowhere left to say so,
+/// and the exit status still tells.
+macro_rules! eprintln {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stderr(), $($arg)*);
+    }};
+}
+
 mod bench;
 mod bench_assign;
 mod info;
