@@ -37,7 +37,13 @@ const NEEDS_ASSETS: &str = "needs the real scenes: set MANYLIGHT_ASSETS (scripts
 fn cornell_box_loads_and_renders_lit_on_es2_and_es3() {
     let path = asset("cornell-box/CornellBox-Original.obj");
     let (scene, report) = scene::load(path.to_str().unwrap(), Some((64, 3))).unwrap();
-    assert!(report.warnings.is_empty(), "{:?}", report.warnings);
+    // The file itself doubles two faces of `leftWall` and of `shortBox`: dropped, and said.
+    let (duplicates, others): (Vec<_>, Vec<_>) = report
+        .warnings
+        .iter()
+        .partition(|w| w.contains("duplicate triangles dropped"));
+    assert!(others.is_empty(), "{others:?}");
+    assert_eq!(duplicates.len(), 2, "{duplicates:?}");
     assert!(
         scene
             .materials
