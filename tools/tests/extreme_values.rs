@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::Gpu;
+use common::{mean, Gpu};
 use glam::{DVec3, Vec3};
 use manylight::scene::{self, Camera, Light, Projection, Scene};
 use manylight::{EsVersion, RenderOptions};
@@ -32,14 +32,6 @@ fn refusal(gpu: &mut Gpu, s: &Scene, options: &RenderOptions) -> String {
         .render_offscreen(s, 16, 16, options)
         .unwrap_err()
         .to_string()
-}
-
-fn mean(img: &image::RgbaImage) -> f64 {
-    let sum: u64 = img
-        .pixels()
-        .map(|p| p[0] as u64 + p[1] as u64 + p[2] as u64)
-        .sum();
-    sum as f64 / (3 * img.width() * img.height()) as f64
 }
 
 #[test]

@@ -156,31 +156,44 @@ fn render_finite(scene: &Scene, what: &str) {
     });
 }
 
+/// Loads `spec` under `catch_unwind`: a panic fails the test, a refusal must carry a message
+/// other than the loader's last guard against a parser's panic (`guard`: the checks before the
+/// parser must have refused the file instead), and a loaded scene must validate. `what`
+/// describes the input for a failure.
+fn load_guarded(
+    spec: &str,
+    lights: Option<(usize, u64)>,
+    guard: &str,
+    what: impl Fn() -> String,
+) -> Result<Scene, String> {
+    match catch_unwind(AssertUnwindSafe(|| scene::load(spec, lights))) {
+        Err(_) => panic!("loading {spec} panicked:\n{}", what()),
+        Ok(Err(e)) => {
+            let message = e.to_string();
+            assert!(!message.is_empty());
+            assert!(
+                !message.contains(guard),
+                "the parser panicked on {spec} ({guard}): {message}\n{}",
+                what()
+            );
+            Err(message)
+        }
+        Ok(Ok((scene, _))) => {
+            scene.validate().expect("a loaded scene validates");
+            Ok(scene)
+        }
+    }
+}
+
 /// Loads `file` as a user would (with a few random lights), asserting no panic and a message
 /// on refusal; renders what is accepted when `render` is set.
 fn load_and_check(file: &Path, render: bool) {
     let spec = file.to_str().unwrap();
     // Scene files keep their own lights (and random_lights count); OBJ files get a few.
     let lights = (!spec.ends_with(".json")).then_some((4, 1));
-    let loaded = catch_unwind(AssertUnwindSafe(|| scene::load(spec, lights)));
-    match loaded {
-        Err(_) => panic!("loading {spec} panicked:\n{}", describe(file)),
-        Ok(Err(e)) => {
-            let message = e.to_string();
-            assert!(!message.is_empty());
-            // The loader's last guard turned a panic inside tobj into this error: the checks
-            // before tobj must have refused the file instead.
-            assert!(
-                !message.contains("(tobj) failed"),
-                "tobj panicked on {spec}:\n{}",
-                describe(file)
-            );
-        }
-        Ok(Ok((scene, _))) => {
-            scene.validate().expect("a loaded scene validates");
-            if render {
-                render_finite(&scene, &describe(file));
-            }
+    if let Ok(scene) = load_guarded(spec, lights, "(tobj) failed", || describe(file)) {
+        if render {
+            render_finite(&scene, &describe(file));
         }
     }
 }
@@ -545,21 +558,9 @@ fn gltf_replacement() -> impl Strategy<Value = serde_json::Value> {
 /// when `render` is set).
 fn gltf_check(file: &Path, render: bool, what: &str) {
     let spec = file.to_str().unwrap();
-    match catch_unwind(AssertUnwindSafe(|| scene::load(spec, Some((2, 1))))) {
-        Err(_) => panic!("loading panicked: {what}"),
-        Ok(Err(e)) => {
-            let message = e.to_string();
-            assert!(!message.is_empty());
-            assert!(
-                !message.contains("(gltf crate) failed"),
-                "the gltf crate panicked: {message}\n{what}"
-            );
-        }
-        Ok(Ok((scene, _))) => {
-            scene.validate().expect("a loaded scene validates");
-            if render {
-                render_finite(&scene, what);
-            }
+    if let Ok(scene) = load_guarded(spec, Some((2, 1)), "(gltf crate) failed", || what.into()) {
+        if render {
+            render_finite(&scene, what);
         }
     }
 }

@@ -108,6 +108,15 @@ pub fn max_oracle_error(
     (e.max_abs, e.worst, e.samples)
 }
 
+/// The mean of a picture's red, green and blue values, in 8-bit steps.
+pub fn mean(img: &image::RgbaImage) -> f64 {
+    let sum: u64 = img
+        .pixels()
+        .map(|p| p[0] as u64 + p[1] as u64 + p[2] as u64)
+        .sum();
+    sum as f64 / (3 * img.width() * img.height()) as f64
+}
+
 /// A test that cannot run in this environment (no Xvfb, no libOSMesa, a driver without Mesa's
 /// overrides) says so on stderr and returns. With `MANYLIGHT_REQUIRE_ALL_TESTS` set (CI sets
 /// it, where everything is installed) a skip is a failure instead, so nothing passes unrun.
