@@ -163,7 +163,7 @@ fn check_usage(cli: &Cli) {
         let stats = a.stats.as_deref().map(|p| ("--stats", p));
         let record = a.record.as_deref().map(|p| ("--record", p));
         check_distinct_outputs(&[out, stats, record]);
-        if let Some(folder) = a.record.as_deref().filter(|p| !is_gif(p)) {
+        if let Some(folder) = a.record.as_deref().filter(|p| !sequence::records_gif(p)) {
             check_outside_folder(&[out, stats], ("--record", folder));
         }
     }
@@ -227,12 +227,6 @@ fn check_distinct_outputs(outputs: &[Option<(&str, &Path)>]) {
                 .exit();
         }
     }
-}
-
-/// Whether `--record` names an animated GIF (else a folder of PNG frames).
-fn is_gif(path: &Path) -> bool {
-    path.extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("gif"))
 }
 
 /// A file inside the folder `--record` fills with frames could be one of them: a usage error

@@ -55,13 +55,16 @@ impl Write for SharedFile {
     }
 }
 
+/// Whether `--record PATH` records an animated GIF (else a folder of PNG frames).
+pub fn records_gif(path: &Path) -> bool {
+    path.extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("gif"))
+}
+
 impl Recorder {
     /// A `.gif` path records an animated GIF, anything else is a directory for PNGs.
     fn open(path: &Path, timeline: &Timeline) -> Result<Recorder, String> {
-        let is_gif = path
-            .extension()
-            .is_some_and(|e| e.eq_ignore_ascii_case("gif"));
-        if is_gif {
+        if records_gif(path) {
             let file = OutputFile::create(path).map_err(|e| format!("--record: {e}"))?;
             let file = SharedFile(Rc::new(RefCell::new(file)));
             let mut encoder = GifEncoder::new_with_speed(file.clone(), 10);
