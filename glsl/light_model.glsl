@@ -15,11 +15,16 @@
 // (1/d)²/(1 + (1/d)²) past d = 1. So neither d² (past 256 m) nor |Lp − P|² overflows fp16, and
 // (d/r)² of a light with a large radius (d/r = 10⁻⁴ at r = 6 000) may underflow to 0 but no
 // longer takes the direction to the light with it.
+// Closer than this (largest component of the vector to the light) a light has no direction
+// and contributes nothing, as exactly at it. 2^-13: above fp16's smallest normal (2^-14), where
+// drivers that flush subnormals (NVIDIA's) turned the division by it into NaN.
+#define LIGHT_MIN_DISTANCE 1.220703125e-4
+
 vec3 shadeLight(Light light, HIGHP vec3 P, vec3 N, vec3 V, MEDP vec3 albedo, MEDP vec3 Ks, HIGHP float Ns) {
     HIGHP vec3 toLight = light.position - P;
     HIGHP float m = max(max(abs(toLight.x), abs(toLight.y)), abs(toLight.z));
-    // Beyond the radius (|Lp − P| ≥ m), or exactly at the light (no direction: no contribution).
-    if (m >= light.radius || m <= 0.0) {
+    // Beyond the radius (|Lp − P| ≥ m), or at the light (no direction: no contribution).
+    if (m >= light.radius || m <= LIGHT_MIN_DISTANCE) {
         return vec3(0.0);
     }
     HIGHP vec3 s = toLight / m;
@@ -79,12 +84,12 @@ bool lightReaches(Light light, HIGHP vec3 P) {
     if (m >= light.radius) {
         return false;
     }
-    HIGHP vec3 s = m > 0.0 ? toLight / m : vec3(0.0);
+    HIGHP vec3 s = m > LIGHT_MIN_DISTANCE ? toLight / m : vec3(0.0);
     if (m / light.radius * length(s) >= 1.0) {
         return false;
     }
 #if HAS_SPOT
-    HIGHP vec3 L = m > 0.0 ? normalize(s) : vec3(0.0);
+    HIGHP vec3 L = m > LIGHT_MIN_DISTANCE ? normalize(s) : vec3(0.0);
     HIGHP vec3 chord = L + light.direction;
     return light.spotOffset - 0.5 * light.spotScale * dot(chord, chord) > 0.0;
 #else

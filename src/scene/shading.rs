@@ -88,10 +88,18 @@ pub fn spot_factor(light: &Light, to_surface: DVec3) -> f64 {
     }
 }
 
+/// Closer to a light than this (in the largest component of the vector to it) a surface gets
+/// nothing from it: there is no direction to the light. 2⁻¹³, above fp16's smallest normal, so
+/// no driver divides by a subnormal it flushes to zero (glsl/light_model.glsl).
+pub const LIGHT_MIN_DISTANCE: f64 = 1.0 / 8192.0;
+
 /// Radiance one light reflects along `v`, the unit direction from the surface to the eye
 /// (no ambient). The normal is used as given (see [`shade`] for two-sided surfaces).
 pub fn light_contribution(light: &Light, s: &Surface, v: DVec3) -> DVec3 {
     let to_light = light.position - s.position;
+    if to_light.abs().max_element() <= LIGHT_MIN_DISTANCE {
+        return DVec3::ZERO;
+    }
     let d = to_light.length();
     let f = falloff(d, light.radius as f64);
     if f == 0.0 {
@@ -209,6 +217,22 @@ mod tests {
         assert_eq!(cutoff_distance(c, r, 0.0), r);
         assert_eq!(cutoff_distance(c, r, 3.0), 0.0, "peak below the cut-off");
         assert!(cutoff_distance(c, r, 1e-3) > cutoff_distance(c, r, 1e-2));
+    }
+
+    #[test]
+    fn a_surface_at_a_light_gets_nothing_from_it() {
+        let light = Light::point(DVec3::ZERO, 2.0, Vec3::ONE, 1.0);
+        let at = |x: f64| Surface {
+            position: DVec3::new(x, 0.0, 0.0),
+            normal: DVec3::NEG_X,
+            albedo: DVec3::ONE,
+            specular: DVec3::ZERO,
+            exponent: 1.0,
+        };
+        let v = DVec3::NEG_X;
+        assert_eq!(light_contribution(&light, &at(1e-5), v), DVec3::ZERO);
+        assert_eq!(light_contribution(&light, &at(0.0), v), DVec3::ZERO);
+        assert!(light_contribution(&light, &at(1e-3), v).x > 0.0);
     }
 
     #[test]

@@ -10,6 +10,18 @@ use manylight::gl::shader_source::{assemble, assemble_without_fragment_highp, St
 use manylight::methods::ShaderFeatures;
 use manylight::EsVersion;
 
+mod common;
+
+/// Whether glslangValidator runs here; if not the test is skipped (a failure where
+/// `MANYLIGHT_REQUIRE_ALL_TESTS` is set, as in CI, which installs it).
+fn validator_installed() -> bool {
+    let found = Command::new("glslangValidator").arg("-v").output().is_ok();
+    if !found {
+        common::skip("glslangValidator not found: install the Debian package glslang-tools");
+    }
+    found
+}
+
 /// glslangValidator's default resource file with Appendix A switched on and the ES 2.0
 /// minimum limits (GLSL ES 1.00 spec §7.4).
 fn appendix_a_config(dir: &Path) -> std::path::PathBuf {
@@ -164,6 +176,9 @@ fn strip_unused_defines(src: &str) -> String {
 
 #[test]
 fn every_shader_variant_passes_the_strict_validator() {
+    if !validator_installed() {
+        return;
+    }
     let dir = tempfile::tempdir().unwrap();
     let conf = appendix_a_config(dir.path());
     let mut failures = Vec::new();
@@ -248,6 +263,9 @@ fn every_shader_variant_passes_the_strict_validator() {
 /// The configuration has teeth: a loop bounded by a uniform, accepted by Mesa, is rejected.
 #[test]
 fn the_appendix_a_configuration_rejects_a_uniform_loop_bound() {
+    if !validator_installed() {
+        return;
+    }
     let dir = tempfile::tempdir().unwrap();
     let conf = appendix_a_config(dir.path());
     let file = dir.path().join("bad.frag");
