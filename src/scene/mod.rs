@@ -255,8 +255,8 @@ impl Scene {
     }
 
     /// Points the camera at the scene bounds from a three-quarter view that keeps all of them
-    /// in the picture at any aspect of at least [`framing::FRAMED_MIN_ASPECT`] (see
-    /// [`framing`]); a scene without geometry keeps its camera.
+    /// in the picture, with a margin, at any aspect (width / height) of at least 1: square
+    /// and landscape pictures. A scene without geometry keeps its camera.
     pub fn frame_camera(&mut self) {
         if let Some(b) = self.bounds() {
             self.camera = framing::framing(&b);

@@ -33,13 +33,18 @@ impl Builder {
         self.views
             .push(json!({"buffer": 0, "byteOffset": self.bin.len(), "byteLength": bytes.len()}));
         self.bin.extend(bytes);
-        self.accessors.push(json!({"bufferView": self.views.len() - 1,
+        self.accessors
+            .push(json!({"bufferView": self.views.len() - 1,
             "componentType": component, "type": ty, "count": count}));
         self.accessors.len() - 1
     }
 
     fn vec3s(&mut self, values: &[[f32; 3]]) -> usize {
-        let bytes = values.iter().flatten().flat_map(|v| v.to_le_bytes()).collect();
+        let bytes = values
+            .iter()
+            .flatten()
+            .flat_map(|v| v.to_le_bytes())
+            .collect();
         self.accessor(bytes, FLOAT, "VEC3", values.len())
     }
 
@@ -57,7 +62,13 @@ impl Builder {
     fn cuboid(&mut self, min: [f32; 3], max: [f32; 3]) -> Value {
         let corners: Vec<[f32; 3]> = (0..8)
             .map(|i| {
-                let pick = |bit: usize, axis: usize| if i & (1 << bit) != 0 { max[axis] } else { min[axis] };
+                let pick = |bit: usize, axis: usize| {
+                    if i & (1 << bit) != 0 {
+                        max[axis]
+                    } else {
+                        min[axis]
+                    }
+                };
                 [pick(0, 0), pick(1, 1), pick(2, 2)]
             })
             .collect();
@@ -150,7 +161,10 @@ fn the_automatic_camera_keeps_the_whole_model_inside_the_frame() {
                 .chain((0..h).flat_map(|y| [(0, y), (w - 1, y)]))
                 .filter(|&(x, y)| lit(x, y))
                 .count();
-            assert_eq!(on_edge, 0, "{name} at {w}x{h}: the model touches the frame's edge");
+            assert_eq!(
+                on_edge, 0,
+                "{name} at {w}x{h}: the model touches the frame's edge"
+            );
             let covered = (0..w)
                 .flat_map(|x| (0..h).map(move |y| (x, y)))
                 .filter(|&(x, y)| lit(x, y))
@@ -189,10 +203,17 @@ fn random_lights_light_a_flat_model_as_the_f64_model_says() {
         .filter(|(_, m)| m[0] > 128)
         .map(|(p, _)| u32::from(p[0].max(p[1]).max(p[2])))
         .collect();
-    assert!(floor.len() > 96 * 54 / 20, "the floor covers {} pixels", floor.len());
+    assert!(
+        floor.len() > 96 * 54 / 20,
+        "the floor covers {} pixels",
+        floor.len()
+    );
     let floor_mean = f64::from(floor.iter().sum::<u32>()) / floor.len() as f64;
     eprintln!("floor mean {floor_mean:.1}, picture mean {:.1}", mean(&img));
-    assert!(floor_mean > 40.0, "the floor is nearly black: mean {floor_mean:.1}");
+    assert!(
+        floor_mean > 40.0,
+        "the floor is nearly black: mean {floor_mean:.1}"
+    );
     let (e, at, _) = max_oracle_error(&img, &s, Encoding::Srgb, gpu.r().caps());
     assert!(e <= 2.0, "{e:.1} / 255 off the f64 model at {at:?}");
 }
@@ -246,7 +267,11 @@ fn required_extensions_are_refused_by_name_unless_supported() {
     let dir = tempfile::tempdir().unwrap();
     let mut b = Builder::default();
     let doc = meshes(vec![b.cuboid([0.0; 3], [1.0; 3])]);
-    for ext in ["KHR_draco_mesh_compression", "EXT_meshopt_compression", "KHR_unknown_thing"] {
+    for ext in [
+        "KHR_draco_mesh_compression",
+        "EXT_meshopt_compression",
+        "KHR_unknown_thing",
+    ] {
         let mut doc = doc.clone();
         doc["extensionsUsed"] = json!([ext]);
         doc["extensionsRequired"] = json!([ext]);
@@ -254,7 +279,10 @@ fn required_extensions_are_refused_by_name_unless_supported() {
         let err = load(&path, 1).unwrap_err().to_string();
         let said = format!("extensionsRequired lists {ext}, which manylight does not support");
         assert!(err.contains(&said), "{err}");
-        assert!(err.contains("needs.gltf") && !err.contains("malformed"), "{err}");
+        assert!(
+            err.contains("needs.gltf") && !err.contains("malformed"),
+            "{err}"
+        );
     }
     // Every extension the loader lists as supported may be required.
     for ext in manylight::scene::gltf::SUPPORTED_EXTENSIONS {
@@ -320,6 +348,9 @@ fn ignored_features_are_warned_once_each_by_name() {
         let n = w.iter().filter(|l| l.contains(needle)).count();
         assert_eq!(n, 1, "`{needle}` said {n} times in {w:#?}");
     }
-    assert!(w.iter().all(|l| l.starts_with(&path.display().to_string())), "{w:#?}");
+    assert!(
+        w.iter().all(|l| l.starts_with(&path.display().to_string())),
+        "{w:#?}"
+    );
     assert_eq!(w.len(), 8, "{w:#?}");
 }
