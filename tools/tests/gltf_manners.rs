@@ -260,6 +260,20 @@ fn a_file_with_nothing_to_draw_is_an_error_naming_it() {
         );
         assert!(!err.contains("malformed"), "{name}: {err}");
     }
+    // In a scene file beside something to draw, such a file is a light rig, said once.
+    let rig = r#"{"objects": [{"gltf": "lights.gltf"}, {"builtin": "plane"}]}"#;
+    let path = write(dir.path(), "rig.json", rig);
+    let (s, report) = scene::load(path.to_str().unwrap(), None).unwrap();
+    assert_eq!(s.lights.len(), 1);
+    let said: Vec<_> = report
+        .warnings
+        .iter()
+        .filter(|w| w.contains("nothing to draw"))
+        .collect();
+    assert_eq!(
+        said,
+        ["objects[0]: lights.gltf has nothing to draw: only its lights are used"]
+    );
 }
 
 #[test]
