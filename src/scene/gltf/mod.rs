@@ -13,6 +13,10 @@
 //! - the first camera a node instances (depth first, in order) ([`camera`]);
 //! - `KHR_lights_punctual` point and spot lights ([`lights`]).
 //!
+//! A required extension the loader lacks, or a file with nothing to draw, is a
+//! [`SceneError::GltfUnsupported`] naming it; features that change the picture but are not
+//! drawn are warned once per file each (`ignored.rs`, which lists [`SUPPORTED_EXTENSIONS`]).
+//!
 //! Malformed files are [`SceneError::Gltf`] errors naming the file and the glTF path
 //! (`meshes[2].primitives[0].indices (accessors[5]): element 7 is out of range for 4
 //! vertices`); no message shows the bytes of a buffer. A transform that places the file
