@@ -39,6 +39,15 @@ pub enum SceneError {
         /// What is wrong, starting with the glTF path of the object at fault.
         reason: String,
     },
+    /// A glTF file asks for what the renderer cannot do (an extension it requires, or
+    /// nothing to draw); `reason` names it.
+    #[error("unsupported glTF {path}: {reason}")]
+    GltfUnsupported {
+        /// The `.gltf` or `.glb` file.
+        path: PathBuf,
+        /// What it asks for, e.g. `extensionsRequired lists KHR_draco_mesh_compression, …`.
+        reason: String,
+    },
     /// A scene file is not valid JSON for the scene schema.
     #[error("scene file {path}: {reason}")]
     SceneFile {

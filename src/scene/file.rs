@@ -325,6 +325,15 @@ pub fn parse(
                     builtin_camera.get_or_insert(camera);
                 }
                 report.warnings.extend(loaded.report.warnings);
+                if scene.objects.len() == first_object {
+                    // A light rig is fine here (on its own, `--scene` refuses it).
+                    let msg = format!(
+                        "{field}: {} has nothing to draw: only its lights are used",
+                        gltf_path.display()
+                    );
+                    log::warn!("{msg}");
+                    report.warnings.push(msg);
+                }
             }
             _ => {
                 return Err(SceneError::invalid(

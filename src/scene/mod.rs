@@ -14,6 +14,7 @@ mod duplicates;
 pub mod error;
 pub mod features;
 pub mod file;
+pub mod framing;
 pub mod gltf;
 pub mod input;
 pub mod light;
@@ -33,7 +34,7 @@ pub(crate) mod triangle_reach;
 use std::ops::Range;
 use std::sync::Arc;
 
-use glam::{DMat4, DVec3, Vec3};
+use glam::{DMat4, Vec3};
 
 pub use access::LoadOptions;
 pub use camera::{Camera, Projection};
@@ -253,19 +254,12 @@ impl Scene {
         Ok(())
     }
 
-    /// Points the camera at the scene bounds from a pleasant three-quarter view.
+    /// Points the camera at the scene bounds from a three-quarter view that keeps all of them
+    /// in the picture, with a margin, at any aspect (width / height) of at least 1: square
+    /// and landscape pictures. A scene without geometry keeps its camera.
     pub fn frame_camera(&mut self) {
         if let Some(b) = self.bounds() {
-            let c = b.center();
-            let extent = b.size().length().max(1e-3);
-            let dir = DVec3::new(0.55, 0.45, 1.0).normalize();
-            self.camera = Camera::perspective(
-                c + dir * extent * 0.95,
-                c,
-                55.0,
-                extent * 1e-3,
-                extent * 4.0,
-            );
+            self.camera = framing::framing(&b);
         }
     }
 }
@@ -345,8 +339,7 @@ pub fn load_with(
             let report = obj::load_into(&mut scene, path, DMat4::IDENTITY, None)?;
             scene.frame_camera();
             if let (Some((count, seed)), Some(bounds)) = (lights, scene.bounds()) {
-                // Around the model as well as inside it: lights inside a closed model light nothing.
-                let volume = bounds.expanded(0.25);
+                let volume = random::model_light_volume(&bounds);
                 scene.lights = random::lights(&volume, count, seed, random::LightSetStyle::Mixed);
             }
             scene.validate()?;

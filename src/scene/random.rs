@@ -61,6 +61,22 @@ pub fn lights(volume: &Aabb, count: usize, seed: u64, style: LightSetStyle) -> V
         .collect()
 }
 
+/// Share of a model's bounds diagonal that `--lights N` pads its light volume by on every
+/// side ([`model_light_volume`]).
+pub const MODEL_LIGHT_PAD: f64 = 0.15;
+
+/// Where `--lights N` places random lights around a model (OBJ and glTF files): its bounds
+/// padded on every side by [`MODEL_LIGHT_PAD`] of their diagonal. Around the model as well as
+/// inside it (lights inside a closed model light nothing), and as far above and below a flat
+/// model (a plane, a terrain tile) as beside it, so that lights leave its plane.
+pub fn model_light_volume(bounds: &Aabb) -> Aabb {
+    let pad = DVec3::splat(bounds.size().length() * MODEL_LIGHT_PAD);
+    Aabb {
+        min: bounds.min - pad,
+        max: bounds.max + pad,
+    }
+}
+
 /// Least thickness of a light volume along any axis, as a fraction of its largest edge.
 const MIN_THICKNESS: f64 = 0.05;
 
@@ -101,6 +117,18 @@ mod tests {
         let off = ls.iter().filter(|l| l.position.z.abs() > 0.05).count();
         assert!(off > 48, "only {off} of 64 lights off the plane");
         assert!(ls.iter().all(|l| l.position.z.abs() <= 0.4 + 1e-9));
+    }
+
+    #[test]
+    fn a_flat_models_light_volume_is_padded_by_a_share_of_its_diagonal() {
+        let plane = Aabb {
+            min: DVec3::new(-3.0, 0.0, -4.0),
+            max: DVec3::new(3.0, 0.0, 4.0),
+        };
+        let v = model_light_volume(&plane);
+        // Diagonal 10: 1.5 on every side, the flat axis included.
+        assert_eq!(v.min, DVec3::new(-4.5, -1.5, -5.5));
+        assert_eq!(v.max, DVec3::new(4.5, 1.5, 5.5));
     }
 
     #[test]

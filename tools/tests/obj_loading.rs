@@ -92,8 +92,10 @@ fn assert_lit_on_es2_and_es3(scene: &Scene, what: &str) {
         let mut gpu = Gpu::new(es);
         let img = gpu.render(scene, 128, 128, &RenderOptions::default());
         let (mean, lit) = brightness(&img);
+        // The automatic camera shows the whole model with a margin: a box seen from three
+        // quarters covers about 40 % of a square frame, all of it lit.
         assert!(
-            mean > 20.0 && lit > 0.5,
+            mean > 20.0 && lit > 0.3,
             "{es}: {what} too dark (mean {mean:.1}, lit {lit:.2})"
         );
     }

@@ -13,6 +13,10 @@
 //! - the first camera a node instances (depth first, in order) ([`camera`]);
 //! - `KHR_lights_punctual` point and spot lights ([`lights`]).
 //!
+//! A required extension the loader lacks, or a file with nothing to draw, is a
+//! [`SceneError::GltfUnsupported`] naming it; features that change the picture but are not
+//! drawn are warned once per file each (`ignored.rs`, which lists [`SUPPORTED_EXTENSIONS`]).
+//!
 //! Malformed files are [`SceneError::Gltf`] errors naming the file and the glTF path
 //! (`meshes[2].primitives[0].indices (accessors[5]): element 7 is out of range for 4
 //! vertices`); no message shows the bytes of a buffer. A transform that places the file
@@ -25,6 +29,7 @@ mod accessor;
 mod buffers;
 pub mod camera;
 mod glb;
+mod ignored;
 mod integers;
 pub mod lights;
 pub mod material;
@@ -59,9 +64,7 @@ pub const MAX_INDICES: usize = 3 << 25;
 /// Most objects (placed primitives) one glTF file may make.
 pub const MAX_OBJECTS: usize = 1 << 20;
 
-/// Extensions the loader implements; a file *requiring* another is refused (by the `gltf`
-/// crate's validation), one merely *using* another gets a warning that it is ignored.
-pub const SUPPORTED_EXTENSIONS: &[&str] = &["KHR_lights_punctual"];
+pub use ignored::SUPPORTED_EXTENSIONS;
 
 /// What a glTF load produced besides what went into the scene.
 #[derive(Debug, Default)]
@@ -74,7 +77,8 @@ pub struct GltfLoad {
 
 /// Loads what `--scene file.gltf|file.glb` names: the file's objects, materials and lights,
 /// its camera (or one framing its bounds, as for OBJ), and `lights` = `Some((count, seed))`
-/// seeded random lights added to the file's own (`count` 0: the file's lights only).
+/// seeded random lights added to the file's own (`count` 0: the file's lights only). A file
+/// with nothing to draw is an error; one that leaves the scene without lights gets a hint.
 pub fn load(
     path: &Path,
     lights: Option<(usize, u64)>,
@@ -84,21 +88,37 @@ pub fn load(
         input::check_light_count(count, "lights")?;
     }
     let mut scene = Scene::empty();
-    let loaded = load_into(&mut scene, path, DMat4::IDENTITY, "transform", options)?;
+    let mut loaded = load_into(&mut scene, path, DMat4::IDENTITY, "transform", options)?;
+    if scene.objects.is_empty() {
+        // Its lights alone would render a black frame.
+        return Err(SceneError::GltfUnsupported {
+            path: path.to_path_buf(),
+            reason: "nothing to draw: no node of the scene places a triangle mesh (only \
+                     lights)"
+                .into(),
+        });
+    }
     match loaded.camera {
         Some(camera) => scene.camera = camera,
         None => scene.frame_camera(),
     }
     if let (Some((count, seed)), Some(bounds)) = (lights, scene.bounds()) {
         input::check_light_count(count.saturating_add(scene.lights.len()), "lights")?;
-        // Around the model as well as inside it, as for OBJ.
-        let volume = bounds.expanded(0.25);
+        let volume = random::model_light_volume(&bounds);
         scene.lights.extend(random::lights(
             &volume,
             count,
             seed,
             random::LightSetStyle::Mixed,
         ));
+    }
+    if scene.lights.is_empty() {
+        let hint = format!(
+            "no lights in {}: ambient only; add --lights N",
+            path.display()
+        );
+        log::warn!("{hint}");
+        loaded.report.warnings.push(hint);
     }
     scene.validate()?;
     Ok((scene, loaded.report))
@@ -131,6 +151,12 @@ pub fn load_into(
     let imported = match imported {
         Ok(Ok(imported)) => imported,
         Ok(Err(Fault::File(reason))) => return Err(error(reason)),
+        Ok(Err(Fault::Unsupported(reason))) => {
+            return Err(SceneError::GltfUnsupported {
+                path: path.to_path_buf(),
+                reason,
+            })
+        }
         Ok(Err(Fault::Placing(reason))) => {
             return Err(SceneError::invalid(
                 transform_field,
@@ -188,9 +214,11 @@ fn json_error(e: &serde_json::Error) -> String {
     format!("JSON {what} at line {}, column {}", e.line(), e.column())
 }
 
-/// Why an import failed: the file itself, or the caller's transform placing what is in it.
+/// Why an import failed: the file itself, what it asks for that the loader cannot do, or the
+/// caller's transform placing what is in it.
 enum Fault {
     File(String),
+    Unsupported(String),
     Placing(String),
 }
 
@@ -228,6 +256,9 @@ fn import(
     };
     let root = gltf::json::deserialize::from_slice(json).map_err(|e| json_error(&e))?;
     integers::check(json)?;
+    if let Some(reason) = ignored::unsupported_required(&root) {
+        return Err(Fault::Unsupported(reason));
+    }
     validate(&root)?;
     let document = gltf::Document::from_json_without_validation(root);
     let locals = nodes::local_transforms(json)?;
@@ -240,16 +271,6 @@ fn import(
         .into());
     }
     let mut warnings = Vec::new();
-    let unsupported: Vec<&str> = document
-        .extensions_used()
-        .filter(|e| !SUPPORTED_EXTENSIONS.contains(e))
-        .collect();
-    if !unsupported.is_empty() {
-        warnings.push(format!(
-            "extensions used but not supported, ignored: {}",
-            unsupported.join(", ")
-        ));
-    }
     let base_dir = path.parent().unwrap_or(Path::new("."));
     let mut buffers =
         buffers::Buffers::new(&document, bin, base_dir, options.allow_outside_files);
@@ -270,7 +291,7 @@ fn import(
         camera: None,
         warnings: Vec::new(),
     };
-    let (mut skinned, mut morphed) = (false, false);
+    let mut camera_nodes = 0;
     for p in &placed {
         let Some(node) = document.nodes().nth(p.node) else {
             continue;
@@ -278,9 +299,7 @@ fn import(
         let field = format!("nodes[{}]", p.node);
         let world = transform * p.world;
         let placing = |e: String| Fault::Placing(format!("placing {field}: {e}"));
-        skinned |= node.skin().is_some();
         if let Some(m) = node.mesh() {
-            morphed |= m.primitives().any(|pr| pr.morph_targets().next().is_some());
             for prim in m.primitives() {
                 let key = (m.index(), prim.index());
                 let pfield = format!("meshes[{}].primitives[{}]", key.0, key.1);
@@ -338,28 +357,27 @@ fn import(
                 lights::Converted::Skipped(why) => warnings.push(why),
             }
         }
+        camera_nodes += usize::from(node.camera().is_some());
         if let (Some(cam), None) = (node.camera(), &out.camera) {
             let cfield = format!("{field} (cameras[{}])", cam.index());
             camera::convert(&document, &cam, &p.world, &cfield)?;
             out.camera = Some(camera::convert(&document, &cam, &world, &cfield).map_err(placing)?);
         }
     }
-    if skinned || morphed {
-        warnings.push("skins and morph targets are not applied: meshes are drawn as bound".into());
-    }
     if out.objects.is_empty() && out.lights.is_empty() {
-        return Err(format!(
+        return Err(Fault::Unsupported(format!(
             "nothing to show: {from} place no triangle mesh and no light"
-        )
-        .into());
+        )));
     }
     out.materials = materials.list;
-    out.warnings = warnings;
+    // Features first, then what the parts said, each once.
+    out.warnings = ignored::unused_features(&document, camera_nodes);
+    out.warnings.extend(ignored::once_per_feature(warnings));
     Ok(out)
 }
 
-/// The `gltf` crate's validation (every index in range, every enum value known, required
-/// extensions supported), except that accessors may lack `min` and `max` or have malformed
+/// The `gltf` crate's validation (every index in range, every enum value known), except
+/// required extensions (checked before, by [`ignored::unsupported_required`]), and that accessors may lack `min` and `max` or have malformed
 /// ones: the spec asks exporters for them on positions, many omit them, and the loader does
 /// not use them.
 fn validate(root: &gltf::json::Root) -> Result<(), String> {
@@ -385,7 +403,10 @@ fn validate(root: &gltf::json::Root) -> Result<(), String> {
     root.validate(root, gltf::json::Path::new, &mut |path, error| {
         let path = path().to_string();
         let bounds = path.ends_with(".min") || path.ends_with(".max");
-        if !(bounds && matches!(error, Error::Missing | Error::Invalid)) {
+        let ignored_bounds = bounds && matches!(error, Error::Missing | Error::Invalid);
+        // Required extensions are checked against the loader's own list, not the crate's.
+        let required = path.starts_with("extensionsRequired");
+        if !(required || ignored_bounds) {
             errors.push(format!("{path}: {error}"));
         }
     });
