@@ -292,3 +292,30 @@ fn metal_spheres_match_the_twin_and_every_method_equals_forward() {
         }
     }
 }
+
+/// Pay for use: a Blinn-Phong variant carries none of the metallic-roughness code or
+/// uniforms; the metallic-roughness variant (and deferred's light pass with it) does.
+#[test]
+fn only_the_metallic_roughness_variant_carries_its_code() {
+    use manylight::gl::shader_source::{assemble, Stage};
+    use manylight::methods::ShaderFeatures;
+    for es in [EsVersion::Es2, EsVersion::Es3] {
+        let shaders: &[&str] = match es {
+            EsVersion::Es2 => &["forward", "clustered"],
+            EsVersion::Es3 => &["forward", "clustered", "gbuffer", "deferred_light"],
+        };
+        for &shader in shaders {
+            let base = ShaderFeatures::default().with(ShaderFeatures::SPECULAR, true);
+            let mr = base.with(ShaderFeatures::METALLIC_ROUGHNESS, true);
+            let lean = assemble(shader, Stage::Fragment, es, &base.defines(es, 1024)).unwrap();
+            let full = assemble(shader, Stage::Fragment, es, &mr.defines(es, 1024)).unwrap();
+            for needle in ["u_metallic", "u_roughness", "surfaceMetallicRoughness("] {
+                assert!(
+                    !lean.contains(needle),
+                    "{shader} {es}: `{needle}` in Blinn-Phong"
+                );
+                assert!(full.contains(needle), "{shader} {es}: `{needle}` missing");
+            }
+        }
+    }
+}
