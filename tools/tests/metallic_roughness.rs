@@ -270,7 +270,9 @@ fn metal_spheres_match_the_twin_and_every_method_equals_forward() {
         let (forward, _) = gpu.r().render_offscreen(&s, w, h, &opts).unwrap();
         let (err, at, n) = max_oracle_error(&forward, &s, Encoding::Srgb, gpu.r().caps());
         eprintln!("{es} forward: {err:.1} / 255 from the twin at {at:?} over {n} pixels");
-        assert!(n > 1000, "{es}: only {n} pixels compared");
+        // Fewer where a rasterizer snaps coarser (SwiftShader: ~700), as the reference skips
+        // pixels whose snapping reach crosses a triangle edge.
+        assert!(n > 500, "{es}: only {n} pixels compared");
         assert!(
             err <= 3.0,
             "{es} forward: {err:.1} / 255 from the twin at {at:?}"
