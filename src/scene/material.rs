@@ -16,7 +16,7 @@ pub struct Texture {
 }
 
 /// Which reflectance model a material is shaded with (one light model, two BRDFs; see
-/// `glsl/light_model.glsl` and its CPU twin [`crate::scene::shading`]).
+/// `glsl/light_model.glsl` and its CPU twin `scene::shading`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum MaterialModel {
     /// Lambert diffuse plus a Blinn-Phong highlight (`diffuse`, `specular`, `shininess`):
@@ -52,7 +52,7 @@ pub struct Material {
     /// Metalness in [0, 1] (glTF `metallicFactor`).
     pub metallic: f32,
     /// Perceptual roughness in [0, 1] (glTF `roughnessFactor`; α = roughness²). Shaded with
-    /// at least [`crate::scene::brdf::MIN_ROUGHNESS`] (docs/precision.md).
+    /// at least 0.089 (`MIN_ROUGHNESS`: fp16 safety, docs/precision.md).
     pub roughness: f32,
 }
 
