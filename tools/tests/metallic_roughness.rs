@@ -30,6 +30,9 @@ enum LightCase {
     Beside,
     /// Exactly at the sphere's top pole, a vertex of its mesh.
     OnSurface,
+    /// Behind the sphere: the highlights sit on the rim, grazing for both the eye and the
+    /// light (where the lobe reaches its cap).
+    Behind,
 }
 
 /// A 5 × 4 grid of spheres: roughness along x, (metallic, base colour) ∈ {0, 1}² along y,
@@ -58,6 +61,7 @@ fn sweep(case: LightCase, intensity: f32) -> Scene {
                 let at = match case {
                     LightCase::Beside => centre + DVec3::new(0.35, 0.3, 0.9),
                     LightCase::OnSurface => centre + DVec3::new(0.0, 0.42, 0.0),
+                    LightCase::Behind => centre + DVec3::new(0.1, 0.15, -0.8),
                 };
                 s.lights
                     .push(Light::point(at, 1.2, Vec3::new(1.0, 0.9, 0.8), intensity));
@@ -158,6 +162,7 @@ fn stiff_cases_match_the_f64_twin_on_every_tier_and_stay_finite() {
     let cases = [
         ("beside", LightCase::Beside, 1.0, 0.0),
         ("on the surface", LightCase::OnSurface, 1.0, 0.0),
+        ("behind (grazing)", LightCase::Behind, 1.0, 0.0),
         ("very bright", LightCase::Beside, 32768.0, -ev),
         ("very dim", LightCase::Beside, 1.0 / 32768.0, ev),
     ];
@@ -210,6 +215,7 @@ fn every_method_stays_finite_on_the_stiff_cases() {
             gpu.r().set_method_named(method).unwrap();
             for (case, intensity) in [
                 (LightCase::OnSurface, 1.0),
+                (LightCase::Behind, 1.0),
                 (LightCase::Beside, 1e6),
                 (LightCase::Beside, 1e-6),
             ] {
