@@ -28,6 +28,7 @@ void main() {
         N = -N;
     }
     MEDP vec3 albedo = surfaceAlbedo(v_uv);
+    SurfaceParams surface = materialSurface(albedo, v_uv);
     HIGHP vec3 color = u_ambient * albedo;
 #if GLSL_ES == 100
     HIGHP vec2 cell = clusterCell(fragXY, viewDepth);
@@ -41,7 +42,7 @@ void main() {
             break;
         }
         HIGHP float pos = cell.x + min(float(n), max(cell.y - 1.0, 0.0));
-        vec3 c = shadeLight(fetchLight(lightIndexAt(pos)), v_viewPos, N, V, albedo, u_specular, u_shininess);
+        vec3 c = shadeLight(fetchLight(lightIndexAt(pos)), v_viewPos, N, V, surface);
         color += float(n) < cell.y ? c : vec3(0.0);
     }
 #else
@@ -50,13 +51,13 @@ void main() {
         if (float(n) >= cell.y) {
             break;
         }
-        color += shadeLight(fetchLight(lightIndexAt(cell.x + float(n))), v_viewPos, N, V, albedo, u_specular, u_shininess);
+        color += shadeLight(fetchLight(lightIndexAt(cell.x + float(n))), v_viewPos, N, V, surface);
     }
 #endif
 #else
     uvec2 cell = clusterCell(fragXY, viewDepth);
     for (uint n = 0u; n < cell.y; n++) {
-        color += shadeLight(fetchLight(lightIndexAt(cell.x + n)), v_viewPos, N, V, albedo, u_specular, u_shininess);
+        color += shadeLight(fetchLight(lightIndexAt(cell.x + n)), v_viewPos, N, V, surface);
     }
 #endif
     FRAG_COLOR = encodeOutput(color);

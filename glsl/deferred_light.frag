@@ -1,5 +1,7 @@
 // Deferred, pass 2: one light, drawn as a proxy volume (or a full-screen triangle when the eye
 // is inside it), added to the accumulation buffer.
+// Materials of both models share the G-buffer: the BRDF is chosen per pixel.
+#define PER_PIXEL_MODEL 1
 #include "surface.glsl"
 #include "light_struct.glsl"
 #include "light_model.glsl"
@@ -34,7 +36,12 @@ void main() {
     light.direction = u_light2.xyz;
     light.spotOffset = u_light2.w;
 #endif
-    MEDP vec3 albedo = albedoOffset.rgb;
-    FRAG_COLOR = vec4(shadeLight(light, P, octDecode(nd.xy), viewDirection(P), albedo, spec.rgb, spec.a), 1.0);
+    SurfaceParams surface;
+    surface.albedo = albedoOffset.rgb;
+    surface.Ks = spec.rgb;
+    surface.Ns = spec.a;
+    surface.metallic = spec.r;
+    surface.roughness = spec.g;
+    FRAG_COLOR = vec4(shadeLight(light, P, octDecode(nd.xy), viewDirection(P), surface), 1.0);
 #endif
 }

@@ -42,6 +42,7 @@ void main() {
         N = -N;
     }
     MEDP vec3 albedo = surfaceAlbedo(v_uv);
+    SurfaceParams surface = materialSurface(albedo, v_uv);
     HIGHP vec3 color = u_ambient * albedo;
 #if !NO_LIGHTS
 #if GLSL_ES == 100
@@ -50,11 +51,11 @@ void main() {
         if (i >= u_lightCount) {
             break;
         }
-        color += shadeLight(fetchLight(i), v_viewPos, N, V, albedo, u_specular, u_shininess);
+        color += shadeLight(fetchLight(i), v_viewPos, N, V, surface);
     }
 #else
     for (int i = 0; i < u_lightCount; i++) {
-        color += shadeLight(fetchLight(i), v_viewPos, N, V, albedo, u_specular, u_shininess);
+        color += shadeLight(fetchLight(i), v_viewPos, N, V, surface);
     }
 #endif
 #endif

@@ -24,7 +24,10 @@ void main() {
     o_albedo = vec4(surfaceAlbedo(v_uv), offset.y);
     // View depth > 0 marks a covered pixel (the buffer is cleared to 0).
     o_normalDepth = vec4(octEncode(N), -v_viewPos.z, offset.x);
-#if HAS_SPECULAR
+#if METALLIC_ROUGHNESS
+    // Metallic-roughness: (metallic, roughness, 0, −1); the negative exponent marks the model.
+    o_specular = vec4(surfaceMetallicRoughness(v_uv), 0.0, -1.0);
+#elif HAS_SPECULAR
     o_specular = vec4(u_specular, u_shininess);
 #else
     o_specular = vec4(0.0, 0.0, 0.0, 1.0);

@@ -1,6 +1,8 @@
 // The light model, shared by every method (CPU twin: src/scene/shading.rs).
 // P, N, V in view space; N and V unit; the light's radius is > 0 (inactive lights are never
-// uploaded). Ks and Ns are parameters so deferred shading can pass them from its G-buffer.
+// uploaded). The surface's parameters come as a SurfaceParams so deferred shading can pass them
+// from its G-buffer. Two BRDFs (src/scene/material.rs MaterialModel): Blinn-Phong, and with
+// METALLIC_ROUGHNESS the glTF 2.0 metallic-roughness BRDF (CPU twin: src/scene/brdf.rs).
 //
 // Precision, mobile first. What fp16 cannot hold stays HIGHP: positions and light vectors
 // (a light 300 m away), the spot term,
@@ -20,7 +22,97 @@
 // drivers that flush subnormals (NVIDIA's) turned the division by it into NaN.
 #define LIGHT_MIN_DISTANCE 1.220703125e-4
 
-vec3 shadeLight(Light light, HIGHP vec3 P, vec3 N, vec3 V, MEDP vec3 albedo, MEDP vec3 Ks, HIGHP float Ns) {
+// What the BRDF reads. Blinn-Phong: albedo, Ks, Ns. Metallic-roughness: albedo (base colour),
+// metallic, roughness (perceptual); in the deferred light pass a negative Ns marks it.
+struct SurfaceParams {
+    MEDP vec3 albedo;
+    MEDP vec3 Ks;
+    HIGHP float Ns;
+    MEDP float metallic;
+    MEDP float roughness;
+};
+
+// The material's parameters at uv (forward and clustered; deferred reads its G-buffer).
+SurfaceParams materialSurface(MEDP vec3 albedo, vec2 uv) {
+    SurfaceParams s;
+    s.albedo = albedo;
+    s.Ks = u_specular;
+    s.Ns = u_shininess;
+#if METALLIC_ROUGHNESS
+    vec2 mr = surfaceMetallicRoughness(uv);
+    s.metallic = mr.x;
+    s.roughness = mr.y;
+#else
+    s.metallic = 0.0;
+    s.roughness = 1.0;
+#endif
+    return s;
+}
+
+// Lambert + Blinn-Phong times N·L (the colour factors at MEDP; N·H at HIGHP before the power).
+MEDP vec3 blinnPhong(HIGHP vec3 L, vec3 N, vec3 V, MEDP float nDotL, SurfaceParams s) {
+#if HAS_SPECULAR
+    HIGHP vec3 halfSum = L + V;
+    HIGHP vec3 H = halfSum / max(length(halfSum), 1e-6);
+    MEDP vec3 spec = s.Ks * pow(max(dot(N, H), 0.0), s.Ns);
+#else
+    MEDP vec3 spec = vec3(0.0);
+#endif
+    return s.albedo * nDotL + spec;
+}
+
+#if METALLIC_ROUGHNESS
+// glTF 2.0 Appendix B (GGX, height-correlated Smith, Schlick, the spec's dielectric/metal mix)
+// times π·N·L; every step written to survive fp16 (docs/precision.md, "Metallic-roughness"):
+// - perceptual roughness ≥ 0.089: α² ≥ 6.3e-5, a normal fp16 number, and the peak 1/α fits;
+// - (N·H)²(α² − 1) + 1 as α²(N·H)² + |N×H|²: 1 − (N·H)² cancels to 0 in fp16 near N = H;
+// - π·D as k², k = α / that (≤ 1/α), never squaring the small denominator;
+// - Vis·N·L in one quotient (Vis alone grows without bound at grazing angles), N·V ≥ 1e-4;
+// - the lobe capped at 16384 as min(k·Vis·N·L, 16384/k)·k, so no product overflows.
+// The lobe runs at HIGHP (fp16 only where the device has no fragment highp), colours at MEDP.
+MEDP vec3 metallicRoughness(HIGHP vec3 L, vec3 N, vec3 V, MEDP float nDotL, SurfaceParams s) {
+    HIGHP vec3 halfSum = L + V;
+    HIGHP vec3 H = halfSum / max(length(halfSum), 1e-6);
+    HIGHP float nDotV = max(dot(N, V), 1e-4);
+    HIGHP float nDotH = clamp(dot(N, H), 0.0, 1.0);
+    MEDP float vDotH = clamp(dot(V, H), 0.0, 1.0);
+    HIGHP float r = clamp(s.roughness, 0.089, 1.0);
+    HIGHP float a = r * r;
+    HIGHP float a2 = a * a;
+    HIGHP vec3 NxH = cross(N, H);
+    HIGHP float k = a / max(a2 * nDotH * nDotH + dot(NxH, NxH), a2);
+    HIGHP float lambdaV = sqrt(nDotV * nDotV * (1.0 - a2) + a2);
+    HIGHP float lambdaL = sqrt(nDotL * nDotL * (1.0 - a2) + a2);
+    HIGHP float visCos = 0.5 / (lambdaV + nDotV * lambdaL / nDotL);
+    HIGHP float lobe = min(k * visCos, 16384.0 / k) * k;
+    MEDP float x = 1.0 - vDotH;
+    MEDP float x2 = x * x;
+    MEDP float x5 = x2 * x2 * x;
+    MEDP vec3 f0 = mix(vec3(0.04), s.albedo, s.metallic);
+    MEDP vec3 fresnel = f0 + (1.0 - f0) * x5;
+    MEDP float dielectric = 0.04 + 0.96 * x5;
+    MEDP vec3 diffuse = s.albedo * ((1.0 - s.metallic) * (1.0 - dielectric) * nDotL);
+    return diffuse + fresnel * lobe;
+}
+#endif
+
+// The BRDF times N·L for unit L (to the light), N, V (to the eye) where N·L > 0: what the
+// light's radiance × falloff × spot is multiplied by. Shared by every light type.
+MEDP vec3 surfaceReflectance(HIGHP vec3 L, vec3 N, vec3 V, SurfaceParams s) {
+    MEDP float nDotL = dot(N, L);
+#if METALLIC_ROUGHNESS && defined(PER_PIXEL_MODEL)
+    if (s.Ns < 0.0) {
+        return metallicRoughness(L, N, V, nDotL, s);
+    }
+    return blinnPhong(L, N, V, nDotL, s);
+#elif METALLIC_ROUGHNESS
+    return metallicRoughness(L, N, V, nDotL, s);
+#else
+    return blinnPhong(L, N, V, nDotL, s);
+#endif
+}
+
+vec3 shadeLight(Light light, HIGHP vec3 P, vec3 N, vec3 V, SurfaceParams surface) {
     HIGHP vec3 toLight = light.position - P;
     HIGHP float m = max(max(abs(toLight.x), abs(toLight.y)), abs(toLight.z));
     // Beyond the radius (|Lp − P| ≥ m), or at the light (no direction: no contribution).
@@ -63,15 +155,14 @@ vec3 shadeLight(Light light, HIGHP vec3 P, vec3 N, vec3 V, MEDP vec3 albedo, MED
 #else
     HIGHP float spot = 1.0;
 #endif
-#if HAS_SPECULAR
-    HIGHP vec3 halfSum = L + V;
-    HIGHP vec3 H = halfSum / max(length(halfSum), 1e-6);
-    MEDP vec3 spec = Ks * pow(max(dot(N, H), 0.0), Ns);
+    MEDP vec3 reflectance = surfaceReflectance(L, N, V, surface);
+#if FP16_LIGHTS
+    // fp16 everywhere: falloff (≤ 60000) × reflectance (≤ 16385) is capped before it could
+    // overflow; radiance is ≤ 1 here, so only a pixel far past saturation is changed.
+    return light.radiance * (min(vec3(falloff * spot), 60000.0 / max(reflectance, vec3(1.0))) * reflectance);
 #else
-    MEDP vec3 spec = vec3(0.0);
-#endif
-    MEDP vec3 reflectance = albedo * nDotL + spec;
     return light.radiance * (falloff * spot) * reflectance;
+#endif
 }
 
 #if COUNT_REACHING

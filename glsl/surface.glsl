@@ -2,6 +2,11 @@
 uniform vec3 u_albedo;
 uniform vec3 u_specular;
 uniform float u_shininess;
+#if METALLIC_ROUGHNESS
+// glTF metallicFactor and roughnessFactor (perceptual roughness).
+uniform float u_metallic;
+uniform float u_roughness;
+#endif
 // Material opacity (1 for opaque objects; blended when below 1).
 uniform float u_alpha;
 uniform vec3 u_ambient;
@@ -30,6 +35,13 @@ vec3 surfaceAlbedo(vec2 uv) {
 #endif
     return albedo;
 }
+
+#if METALLIC_ROUGHNESS
+// (metallic, perceptual roughness) at uv: the material's factors (texture maps multiply in here).
+vec2 surfaceMetallicRoughness(vec2 uv) {
+    return vec2(u_metallic, u_roughness);
+}
+#endif
 
 #if !OUTPUT_HDR
 // 2^exposure (stops), applied before the tone map (1 by default).

@@ -235,7 +235,15 @@ impl Deferred {
         let gb = self.gbuffer.as_ref().expect("allocated");
         gb.begin_accumulation(dev);
         gb.bind_textures(dev, UNIT_G_ALBEDO);
-        let features = ctx.features.with(ShaderFeatures::SPECULAR, true);
+        // Metallic-roughness compiled in only where a material uses it (the BRDF is then
+        // chosen per pixel from the G-buffer).
+        let features = ctx
+            .features
+            .with(ShaderFeatures::SPECULAR, true)
+            .with(
+                ShaderFeatures::METALLIC_ROUGHNESS,
+                ctx.scene.materials.iter().any(|m| m.is_metallic_roughness()),
+            );
         let (half, ortho) = half_extent(ctx);
         let viewport = [ctx.viewport.0 as f32, ctx.viewport.1 as f32];
         let far = ctx.far as f32;

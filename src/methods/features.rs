@@ -50,9 +50,13 @@ impl ShaderFeatures {
     /// selecting each fragment's own contributions, so no fragment leaves the loop before its
     /// neighbours.
     pub const UNIFORM_LIGHT_LOOP: u64 = 1 << 15;
+    /// The glTF metallic-roughness BRDF instead of Blinn-Phong: set for the variants of
+    /// materials that use it, and for the deferred light pass of a scene that has any (which
+    /// then picks the BRDF per pixel from its G-buffer).
+    pub const METALLIC_ROUGHNESS: u64 = 1 << 16;
 
     /// Every flag with its name.
-    pub const NAMED: [(u64, &'static str); 16] = [
+    pub const NAMED: [(u64, &'static str); 17] = [
         (Self::TEXTURE, "texture"),
         (Self::SPOT, "spot"),
         (Self::SPECULAR, "specular"),
@@ -69,6 +73,7 @@ impl ShaderFeatures {
         (Self::TONEMAP_ACES, "tonemap_aces"),
         (Self::TONEMAP_NEUTRAL, "tonemap_neutral"),
         (Self::UNIFORM_LIGHT_LOOP, "uniform_light_loop"),
+        (Self::METALLIC_ROUGHNESS, "metallic_roughness"),
     ];
 
     /// Names of the set flags.
@@ -120,6 +125,7 @@ impl ShaderFeatures {
             ("COUNT_REACHING".into(), flag(Self::COUNT_REACHING)),
             ("COUNT_HEATMAP".into(), flag(Self::COUNT_HEATMAP)),
             ("UNIFORM_LIGHT_LOOP".into(), flag(Self::UNIFORM_LIGHT_LOOP)),
+            ("METALLIC_ROUGHNESS".into(), flag(Self::METALLIC_ROUGHNESS)),
             (
                 "TONEMAP".into(),
                 if self.has(Self::TONEMAP_REINHARD) {

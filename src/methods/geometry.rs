@@ -151,7 +151,14 @@ pub(crate) fn shade_object<P: GeometryProgram>(
     let features = ctx
         .features
         .with(ShaderFeatures::TEXTURE, texture.is_some())
-        .with(ShaderFeatures::SPECULAR, material.has_specular() || full);
+        .with(
+            ShaderFeatures::SPECULAR,
+            !material.is_metallic_roughness() && (material.has_specular() || full),
+        )
+        .with(
+            ShaderFeatures::METALLIC_ROUGHNESS,
+            material.is_metallic_roughness(),
+        );
     let key = ProgramKey {
         shader,
         features: features.0,

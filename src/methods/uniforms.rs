@@ -51,6 +51,8 @@ pub struct Surface {
     albedo: Uniform<Vec3>,
     specular: Uniform<Vec3>,
     shininess: Uniform<f32>,
+    metallic: Uniform<f32>,
+    roughness: Uniform<f32>,
     alpha: Uniform<f32>,
     ambient: Uniform<Vec3>,
     exposure: Uniform<f32>,
@@ -77,10 +79,13 @@ impl Surface {
     pub(crate) fn shaded(r: &mut Resolver<'_>, lit: bool) -> Self {
         let f = features(r);
         let colour = !f.counting();
+        let mr = colour && f.has(ShaderFeatures::METALLIC_ROUGHNESS);
         Surface {
             albedo: r.required_when(colour, "u_albedo"),
             specular: r.required_when(lit && f.has(ShaderFeatures::SPECULAR), "u_specular"),
             shininess: r.required_when(lit && f.has(ShaderFeatures::SPECULAR), "u_shininess"),
+            metallic: r.required_when(lit && mr, "u_metallic"),
+            roughness: r.required_when(lit && mr, "u_roughness"),
             alpha: r.required_when(colour, "u_alpha"),
             ambient: r.required_when(colour, "u_ambient"),
             exposure: r.required_when(colour && !f.has(ShaderFeatures::OUTPUT_HDR), "u_exposure"),
@@ -103,6 +108,8 @@ impl Surface {
             albedo: r.required("u_albedo"),
             specular: r.required_when(f.has(ShaderFeatures::SPECULAR), "u_specular"),
             shininess: r.required_when(f.has(ShaderFeatures::SPECULAR), "u_shininess"),
+            metallic: r.required_when(f.has(ShaderFeatures::METALLIC_ROUGHNESS), "u_metallic"),
+            roughness: r.required_when(f.has(ShaderFeatures::METALLIC_ROUGHNESS), "u_roughness"),
             alpha: r.optional("u_alpha"),
             ambient: r.optional("u_ambient"),
             exposure: r.optional("u_exposure"),
@@ -125,6 +132,8 @@ impl Surface {
         self.albedo.set(dev, material.diffuse);
         self.specular.set(dev, material.specular);
         self.shininess.set(dev, material.shading_exponent());
+        self.metallic.set(dev, material.metallic);
+        self.roughness.set(dev, material.roughness);
         self.alpha.set(dev, material.alpha);
         if heatmap {
             self.heat_scale.set(dev, frame.heat_scale);
@@ -201,6 +210,9 @@ mod tests {
         F::COUNT_EVALS | F::COUNT_HEATMAP | F::TEXTURE,
         F::COUNT_REACHING | F::LIGHTS_RGBA8 | F::SPOT,
         F::UNIFORM_LIGHT_LOOP | F::SPECULAR,
+        F::METALLIC_ROUGHNESS,
+        F::METALLIC_ROUGHNESS | F::SPOT | F::TEXTURE | F::REFERENCE_PRECISION,
+        F::METALLIC_ROUGHNESS | F::LIGHTS_RGBA8 | F::FP16_LIGHTS,
         F::NO_LIGHTS,
         F::NO_LIGHTS | F::TEXTURE | F::SPECULAR,
         F::NO_LIGHTS | F::COUNT_EVALS | F::COUNT_HEATMAP,

@@ -288,13 +288,7 @@ fn evaluate(
     }
     let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
     for h in &hits {
-        let surface = Surface {
-            position: h.position,
-            normal: h.normal,
-            albedo: material.diffuse.as_dvec3(),
-            specular: material.specular.as_dvec3(),
-            exponent: material.shading_exponent() as f64,
-        };
+        let surface = Surface::of(material, h.position, h.normal, material.diffuse.as_dvec3());
         let v = view_direction(&scene.camera, h.position);
         let c = shading::shade(&surface, v, &scene.lights, scene.ambient);
         for ch in 0..3 {
@@ -374,13 +368,7 @@ mod tests {
         let (a, b) = (unproject(-1.0), unproject(1.0));
         let p = a + (b - a) * (-a.z / (b - a).z);
         let m = &scene.materials[0];
-        let surface = Surface {
-            position: p,
-            normal: DVec3::Z,
-            albedo: m.diffuse.as_dvec3(),
-            specular: m.specular.as_dvec3(),
-            exponent: m.shading_exponent() as f64,
-        };
+        let surface = Surface::of(m, p, DVec3::Z, m.diffuse.as_dvec3());
         shading::shade(
             &surface,
             view_direction(cam, p),

@@ -8,6 +8,7 @@
 //!     {"builtin": "plane"},
 //!     {"obj": "models/teapot.obj", "transform": {"translate": [0, 0, -2], "rotate_y_deg": 30, "scale": 0.5},
 //!      "color": [0.8, 0.2, 0.2]},
+//!     {"builtin": "plane", "metallic": 1, "roughness": 0.3},
 //!     {"gltf": "models/lamp.glb", "transform": {"translate": [2, 0, 0]}}
 //!   ],
 //!   "lights": [
@@ -41,7 +42,7 @@ use super::motion::{Bob, Flicker, Motion, Orbit, OrbitAbout, Sweep, Wander};
 use super::model_cache::{self, ModelCache};
 use super::obj::LoadReport;
 use super::random::{self, LightSetStyle};
-use super::{Camera, Light, LightKind, Scene, SceneError};
+use super::{Camera, Light, LightKind, MaterialModel, Scene, SceneError};
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -88,6 +89,9 @@ struct ObjectSpec {
     texture: Option<PathBuf>,
     transform: Option<TransformSpec>,
     color: Option<[f32; 3]>,
+    /// With `roughness`: the object's materials become metallic-roughness (glTF BRDF).
+    metallic: Option<f32>,
+    roughness: Option<f32>,
 }
 
 #[derive(Deserialize)]
@@ -347,6 +351,25 @@ pub fn parse(
             // Recolour this object's materials only (they were appended for it).
             for m in &mut scene.materials[first_material..] {
                 m.diffuse = Vec3::from(c);
+            }
+        }
+        if spec.metallic.is_some() || spec.roughness.is_some() {
+            let unit = |name: &str, v: Option<f32>| match v {
+                Some(v) if v.is_finite() && (0.0..=1.0).contains(&v) => Ok(v),
+                Some(v) => Err(SceneError::invalid(
+                    format!("{field}.{name}"),
+                    format!("must be in [0, 1], got {v}"),
+                )),
+                None => Err(SceneError::invalid(
+                    format!("{field}.{name}"),
+                    "is needed with `metallic` and `roughness` (both or neither)",
+                )),
+            };
+            let (metallic, roughness) =
+                (unit("metallic", spec.metallic)?, unit("roughness", spec.roughness)?);
+            for m in &mut scene.materials[first_material..] {
+                m.model = MaterialModel::MetallicRoughness;
+                (m.metallic, m.roughness) = (metallic, roughness);
             }
         }
         model_cache::check_budget(&scene, &format!("objects[{i}]"))?;
@@ -621,6 +644,26 @@ mod tests {
         assert_eq!(s.lights.len(), 7);
         assert_eq!(s.materials[0].diffuse, Vec3::new(1.0, 0.0, 0.0));
         assert_eq!(s.ambient, Vec3::splat(0.1));
+    }
+
+    #[test]
+    fn metallic_and_roughness_make_an_objects_materials_metallic_roughness() {
+        let s = parse_str(
+            r#"{"objects": [{"builtin": "plane", "metallic": 1, "roughness": 0.25}]}"#,
+        )
+        .unwrap();
+        let m = &s.materials[0];
+        assert_eq!(m.model, MaterialModel::MetallicRoughness);
+        assert_eq!((m.metallic, m.roughness), (1.0, 0.25));
+        for (json, field) in [
+            (r#"{"builtin": "plane", "metallic": 1}"#, "objects[0].roughness"),
+            (r#"{"builtin": "plane", "metallic": 2, "roughness": 0}"#, "objects[0].metallic"),
+        ] {
+            let err = parse_str(&format!(r#"{{"objects": [{json}]}}"#))
+                .unwrap_err()
+                .to_string();
+            assert!(err.contains(field), "{err}");
+        }
     }
 
     #[test]

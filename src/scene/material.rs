@@ -15,12 +15,27 @@ pub struct Texture {
     pub image: image::RgbaImage,
 }
 
-/// A Lambert + Blinn-Phong material in linear RGB.
+/// Which reflectance model a material is shaded with (one light model, two BRDFs; see
+/// `glsl/light_model.glsl` and its CPU twin `scene::shading`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum MaterialModel {
+    /// Lambert diffuse plus a Blinn-Phong highlight (`diffuse`, `specular`, `shininess`):
+    /// OBJ/MTL and the built-in scenes.
+    #[default]
+    BlinnPhong,
+    /// The glTF 2.0 metallic-roughness BRDF (`diffuse` as base colour, `metallic`,
+    /// `roughness`): glTF materials.
+    MetallicRoughness,
+}
+
+/// A material in linear RGB: Lambert + Blinn-Phong, or glTF metallic-roughness (see
+/// [`MaterialModel`]).
 #[derive(Clone, Debug)]
 pub struct Material {
     /// Name from the MTL file or the built-in scene.
     pub name: String,
-    /// Diffuse albedo (`Kd`), multiplied by the texture when there is one.
+    /// Diffuse albedo (`Kd`), multiplied by the texture when there is one. For
+    /// [`MaterialModel::MetallicRoughness`] the base colour (`baseColorFactor`).
     pub diffuse: Vec3,
     /// Diffuse texture (`map_Kd`), sRGB encoded.
     pub diffuse_texture: Option<Arc<Texture>>,
@@ -31,6 +46,14 @@ pub struct Material {
     /// Opacity (`d` in MTL): 1 is opaque; below 1 the object is drawn after the opaque ones,
     /// back to front, alpha-blended.
     pub alpha: f32,
+    /// The reflectance model; `specular`/`shininess` are read by Blinn-Phong only,
+    /// `metallic`/`roughness` by metallic-roughness only.
+    pub model: MaterialModel,
+    /// Metalness in [0, 1] (glTF `metallicFactor`).
+    pub metallic: f32,
+    /// Perceptual roughness in [0, 1] (glTF `roughnessFactor`; α = roughness²). Shaded with
+    /// at least 0.089 (`MIN_ROUGHNESS`: fp16 safety, docs/precision.md).
+    pub roughness: f32,
 }
 
 impl Default for Material {
@@ -55,7 +78,26 @@ impl Material {
             specular: Vec3::splat(0.04),
             shininess: 32.0,
             alpha: 1.0,
+            model: MaterialModel::BlinnPhong,
+            metallic: 0.0,
+            roughness: 1.0,
         }
+    }
+
+    /// A glTF metallic-roughness material.
+    pub fn metallic_roughness(name: &str, base_color: Vec3, metallic: f32, roughness: f32) -> Self {
+        Material {
+            model: MaterialModel::MetallicRoughness,
+            metallic,
+            roughness,
+            specular: Vec3::ZERO,
+            ..Material::flat(name, base_color)
+        }
+    }
+
+    /// True when the material is shaded with the metallic-roughness BRDF.
+    pub fn is_metallic_roughness(&self) -> bool {
+        self.model == MaterialModel::MetallicRoughness
     }
 
     /// A material with a specular colour and exponent.
@@ -78,9 +120,10 @@ impl Material {
         self.alpha < 1.0
     }
 
-    /// True when the material has a non-zero specular term.
+    /// True when the material has a non-zero Blinn-Phong specular term (never for
+    /// metallic-roughness, whose specular lobe is always there).
     pub fn has_specular(&self) -> bool {
-        self.specular.max_element() > 0.0
+        !self.is_metallic_roughness() && self.specular.max_element() > 0.0
     }
 
     /// Checks colours and exponent; `field` names the material in errors.
@@ -101,6 +144,14 @@ impl Material {
                 format!("{field}.alpha"),
                 format!("must be in [0, 1], got {}", self.alpha),
             ));
+        }
+        for (name, v) in [("metallic", self.metallic), ("roughness", self.roughness)] {
+            if !(v.is_finite() && (0.0..=1.0).contains(&v)) {
+                return Err(SceneError::invalid(
+                    format!("{field}.{name}"),
+                    format!("must be in [0, 1], got {v}"),
+                ));
+            }
         }
         if !(self.shininess.is_finite() && self.shininess >= 0.0) {
             return Err(SceneError::invalid(
@@ -125,5 +176,18 @@ mod tests {
         assert!(err.contains("materials[0].specular"), "{err}");
         m.specular = Vec3::splat(MAX_COLOR_FACTOR);
         assert!(m.validate("materials[0]").is_ok());
+    }
+
+    #[test]
+    fn metallic_and_roughness_outside_0_1_are_refused_naming_the_field() {
+        let mut m = Material::metallic_roughness("m", Vec3::ONE, 1.0, 0.0);
+        assert!(m.validate("materials[1]").is_ok());
+        m.roughness = f32::NAN;
+        let err = m.validate("materials[1]").unwrap_err().to_string();
+        assert!(err.contains("materials[1].roughness"), "{err}");
+        m.roughness = 0.5;
+        m.metallic = 1.5;
+        let err = m.validate("materials[1]").unwrap_err().to_string();
+        assert!(err.contains("materials[1].metallic"), "{err}");
     }
 }

@@ -7,6 +7,7 @@
 //! scene 10 km from the origin loses no precision on the device.
 
 pub mod access;
+pub mod brdf;
 pub mod builtin;
 pub mod camera;
 pub mod direction;
@@ -40,7 +41,7 @@ pub use access::LoadOptions;
 pub use camera::{Camera, Projection};
 pub use error::SceneError;
 pub use light::{Cone, Light, LightKind};
-pub use material::{Material, Texture};
+pub use material::{Material, MaterialModel, Texture};
 pub use mesh::{Aabb, Mesh};
 pub use motion::Motion;
 

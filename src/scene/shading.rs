@@ -13,6 +13,9 @@
 //! out      = ambient · albedo + Σ c · falloff · spot · (diffuse + specular)
 //! ```
 //!
+//! That is the Blinn-Phong model; a metallic-roughness material replaces `diffuse + specular`
+//! with the glTF BRDF times π·N·L ([`super::brdf::reflectance`]); `albedo` is its base colour.
+//!
 //! Surfaces are two-sided (`N` flipped towards the eye). In view space, `V` is
 //! `normalize(−P)` for perspective cameras and `+Z` for orthographic ones.
 //!
@@ -23,6 +26,7 @@
 use glam::{DVec3, Vec3};
 
 use super::light::{Light, LightKind};
+use super::material::{Material, MaterialModel};
 
 /// Surface attributes at one shading point, in linear RGB.
 #[derive(Clone, Copy, Debug)]
@@ -37,6 +41,29 @@ pub struct Surface {
     pub specular: DVec3,
     /// Blinn-Phong exponent, already clamped (see `Material::shading_exponent`).
     pub exponent: f64,
+    /// Which BRDF shades it.
+    pub model: MaterialModel,
+    /// Metalness (metallic-roughness only).
+    pub metallic: f64,
+    /// Perceptual roughness (metallic-roughness only; clamped by the BRDF).
+    pub roughness: f64,
+}
+
+impl Surface {
+    /// The surface of `material` at `position` with unit `normal`; `albedo` is the material's
+    /// diffuse (base) colour times its decoded texture, where it has one.
+    pub fn of(material: &Material, position: DVec3, normal: DVec3, albedo: DVec3) -> Surface {
+        Surface {
+            position,
+            normal,
+            albedo,
+            specular: material.specular.as_dvec3(),
+            exponent: material.shading_exponent() as f64,
+            model: material.model,
+            metallic: material.metallic as f64,
+            roughness: material.roughness as f64,
+        }
+    }
 }
 
 /// `clamp(1 − (d/r)⁴, 0, 1)² / (d² + 1)`; zero for `r <= 0`.
@@ -110,11 +137,23 @@ pub fn light_contribution(light: &Light, s: &Surface, v: DVec3) -> DVec3 {
     if n_dot_l <= 0.0 {
         return DVec3::ZERO;
     }
-    let h = (l + v).normalize_or_zero();
-    let n_dot_h = s.normal.dot(h).max(0.0);
-    let spec = s.specular * n_dot_h.powf(s.exponent);
     let spot = spot_factor(light, -l);
-    light.radiance().as_dvec3() * (f * spot) * (s.albedo * n_dot_l + spec)
+    light.radiance().as_dvec3() * (f * spot) * reflectance(l, s, v)
+}
+
+/// What the light's radiance × falloff × spot is multiplied by for unit `l` (to the light)
+/// with N·L > 0: the BRDF times N·L (times π for metallic-roughness; see [`super::brdf`]).
+pub fn reflectance(l: DVec3, s: &Surface, v: DVec3) -> DVec3 {
+    match s.model {
+        MaterialModel::BlinnPhong => {
+            let h = (l + v).normalize_or_zero();
+            let n_dot_h = s.normal.dot(h).max(0.0);
+            s.albedo * s.normal.dot(l) + s.specular * n_dot_h.powf(s.exponent)
+        }
+        MaterialModel::MetallicRoughness => {
+            super::brdf::reflectance(l, s.normal, v, s.albedo, s.metallic, s.roughness)
+        }
+    }
 }
 
 /// Total linear radiance along `v` (unit, surface → eye): ambient plus every light. Surfaces
@@ -228,6 +267,9 @@ mod tests {
             albedo: DVec3::ONE,
             specular: DVec3::ZERO,
             exponent: 1.0,
+            model: MaterialModel::BlinnPhong,
+            metallic: 0.0,
+            roughness: 1.0,
         };
         let v = DVec3::NEG_X;
         assert_eq!(light_contribution(&light, &at(1e-5), v), DVec3::ZERO);
@@ -247,11 +289,9 @@ mod tests {
     fn light_at_the_surface_gives_no_nan() {
         let l = Light::point(DVec3::ZERO, 1.0, Vec3::ONE, 1.0);
         let s = Surface {
-            position: DVec3::ZERO,
-            normal: DVec3::Z,
-            albedo: DVec3::ONE,
             specular: DVec3::ONE,
             exponent: 16.0,
+            ..Surface::of(&Material::default(), DVec3::ZERO, DVec3::Z, DVec3::ONE)
         };
         let c = shade(&s, DVec3::Z, &[l], Vec3::ZERO);
         assert!(c.is_finite());

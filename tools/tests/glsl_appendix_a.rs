@@ -127,6 +127,19 @@ fn all_features() -> Vec<ShaderFeatures> {
     ] {
         all.push(ShaderFeatures(ShaderFeatures::UNIFORM_LIGHT_LOOP | extra));
     }
+    // The metallic-roughness BRDF with the material, light, precision and output features
+    // (the deferred light pass's per-pixel choice among them).
+    for extra in [
+        0,
+        ShaderFeatures::TEXTURE | ShaderFeatures::SPOT,
+        ShaderFeatures::SPECULAR | ShaderFeatures::SPOT,
+        ShaderFeatures::LIGHTS_RGBA8 | ShaderFeatures::REFERENCE_PRECISION,
+        ShaderFeatures::OUTPUT_HDR | ShaderFeatures::TONEMAP_ACES,
+        ShaderFeatures::UNIFORM_LIGHT_LOOP | ShaderFeatures::SPOT,
+        ShaderFeatures::COUNT_EVALS,
+    ] {
+        all.push(ShaderFeatures(ShaderFeatures::METALLIC_ROUGHNESS | extra));
+    }
     all
 }
 

@@ -657,6 +657,20 @@ fn a_gltf_scene_renders_as_the_same_scene_written_as_json_and_obj() {
         .find(|m| m.is_transparent())
         .expect("the BLEND material is transparent");
     assert_eq!(glass.alpha, 0.5);
+    // glTF materials are metallic-roughness (the factors' defaults: metallic 1, roughness 1);
+    // OBJ's are Blinn-Phong. The comparison is of geometry, textures, lights and camera, so
+    // the glTF materials are shaded with the Blinn-Phong parameters the loader also fills.
+    let mut from_gltf = from_gltf;
+    for m in &mut from_gltf.materials {
+        assert_eq!(
+            m.model,
+            manylight::scene::MaterialModel::MetallicRoughness,
+            "{}",
+            m.name
+        );
+        assert_eq!((m.metallic, m.roughness), (1.0, 1.0), "{}", m.name);
+        m.model = manylight::scene::MaterialModel::BlinnPhong;
+    }
     let mut gpu = Gpu::new(EsVersion::Es3);
     for method in ["forward", "clustered"] {
         gpu.r().set_method_named(method).unwrap();

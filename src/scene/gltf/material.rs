@@ -1,12 +1,13 @@
-//! glTF materials (metallic-roughness) → the renderer's Lambert + Blinn-Phong [`Material`].
+//! glTF materials → the renderer's metallic-roughness [`Material`] (the glTF 2.0 BRDF).
 //!
 //! - `baseColorFactor.rgb` → `diffuse`, `baseColorTexture` → `diffuse_texture` (sRGB, as the
 //!   renderer decodes it); factors clamped to [0, [`MAX_COLOR_FACTOR`]] with a warning, as
 //!   OBJ's are.
-//! - `specular` is the dielectric 0.04 grey; `shininess` comes from `roughnessFactor` through
-//!   the Blinn-Phong ↔ Beckmann match `Ns = 2/α² − 2` with `α = roughness²` ([`shininess`]).
-//!   `metallicFactor` and the metallic-roughness, normal, occlusion and emissive textures are
-//!   not used (the renderer has no reflections for metals to show).
+//! - `metallicFactor` → `metallic`, `roughnessFactor` → `roughness` (clamped to [0, 1]), shaded
+//!   by the glTF BRDF ([`crate::scene::brdf`]). `specular`/`shininess` (the dielectric 0.04
+//!   grey and the Blinn-Phong ↔ Beckmann match `Ns = 2/α² − 2`, [`shininess`]) are kept for
+//!   callers that switch the material to Blinn-Phong. The metallic-roughness, normal,
+//!   occlusion and emissive textures are not used.
 //! - `alphaMode`: `OPAQUE` ignores alpha; `BLEND` takes `baseColorFactor.a` as the material's
 //!   opacity (below 1: the renderer's transparent path, back to front, alpha-blended);
 //!   `MASK` cuts the whole material — invisible (opacity 0) when `baseColorFactor.a` is below
@@ -42,6 +43,15 @@ pub fn shininess(roughness: f32) -> f32 {
         return 4096.0;
     }
     (2.0 / alpha2 - 2.0).clamp(0.0, 4096.0)
+}
+
+/// A glTF factor in [0, 1] (the spec's range; NaN, which JSON cannot carry, as 1).
+fn unit_factor(f: f32) -> f32 {
+    if f.is_nan() {
+        1.0
+    } else {
+        f.clamp(0.0, 1.0)
+    }
 }
 
 /// The materials of one glTF file, converted when a primitive first uses them.
@@ -149,12 +159,16 @@ impl Materials {
             ));
         }
         Ok(Material {
-            name,
-            diffuse,
             diffuse_texture,
             specular: Vec3::splat(DIELECTRIC_SPECULAR),
             shininess: shininess(pbr.roughness_factor()),
             alpha,
+            ..Material::metallic_roughness(
+                &name,
+                diffuse,
+                unit_factor(pbr.metallic_factor()),
+                unit_factor(pbr.roughness_factor()),
+            )
         })
     }
 }

@@ -72,6 +72,49 @@ pub struct BenchArgs {
     /// with --quick.
     #[arg(long, value_parser = crate::render::frame_count())]
     pub animated_frames: Option<u32>,
+    /// The scenes' materials: as loaded (OBJ and the built-ins Blinn-Phong, glTF
+    /// metallic-roughness), or all metallic-roughness (each Blinn-Phong material a dielectric
+    /// of its colour, its roughness matching its exponent): two runs give the new model's cost
+    /// against the old on the same scenes.
+    #[arg(long, value_enum, default_value = "as-loaded")]
+    pub material_model: MaterialModelArg,
+}
+
+/// `--material-model`.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MaterialModelArg {
+    /// Each material's own model.
+    AsLoaded,
+    /// Every material converted to metallic-roughness.
+    MetallicRoughness,
+}
+
+/// Every Blinn-Phong material as a dielectric metallic-roughness one of the same colour, its
+/// roughness the glTF loader's exponent match inverted (`Ns = 2/α² − 2`, `α = roughness²`).
+fn to_metallic_roughness(scene: &mut Scene) {
+    for m in &mut scene.materials {
+        if !m.is_metallic_roughness() {
+            let roughness = (2.0 / (m.shading_exponent() + 2.0)).powf(0.25);
+            *m = scene::Material {
+                diffuse_texture: m.diffuse_texture.clone(),
+                alpha: m.alpha,
+                ..scene::Material::metallic_roughness(&m.name, m.diffuse, 0.0, roughness)
+            };
+        }
+    }
+}
+
+/// A benchmark scene with the materials `--material-model` asks for.
+fn load_bench_scene(
+    spec: &str,
+    lights: usize,
+    args: &BenchArgs,
+) -> Result<Scene, Box<dyn std::error::Error>> {
+    let (mut scene, _) = scene::load_with(spec, Some((lights, args.seed)), &crate::load_options())?;
+    if args.material_model == MaterialModelArg::MetallicRoughness {
+        to_metallic_roughness(&mut scene);
+    }
+    Ok(scene)
 }
 
 /// The sweep, with the `--quick` or full defaults filled in.
@@ -344,8 +387,7 @@ pub fn run(args: &BenchArgs) -> Result<(), Box<dyn std::error::Error>> {
         let mut renderer = Renderer::new(ctx.load_gl(), es)?;
         for spec in &plan.scenes {
             for &count in &plan.lights {
-                let (scene, _) =
-                    scene::load_with(spec, Some((count, args.seed)), &crate::load_options())?;
+                let scene = load_bench_scene(spec, count, args)?;
                 let name = scene_name(spec);
                 progress.set_message(format!("{es} {name} {count} lights: reference"));
                 // The geometry, and so its ray caster, is the same at every light count.
@@ -402,11 +444,7 @@ pub fn run(args: &BenchArgs) -> Result<(), Box<dyn std::error::Error>> {
             }
         }
         if plan.animated_frames > 0 && !knob_scene.is_empty() {
-            let (scene, _) = scene::load_with(
-                &knob_scene,
-                Some((knob_lights, args.seed)),
-                &crate::load_options(),
-            )?;
+            let scene = load_bench_scene(&knob_scene, knob_lights, args)?;
             let workload = AnimatedWorkload {
                 scene,
                 name: scene_name(&knob_scene),
