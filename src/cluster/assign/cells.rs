@@ -26,6 +26,7 @@
 //! neighbouring cell still finds every light that reaches it: the assignment is conservative.
 
 use super::cone::{Cone, ConeSlice};
+use super::rows::{RowChords, ROW_LANES};
 use crate::cluster::grid::{CascadeConstants, ClusterGrid, Coverage, GridProjection};
 use crate::cluster::view_light::GpuLight;
 
@@ -353,35 +354,36 @@ impl ScreenExtent {
             }
             return;
         }
-        for row in y0..y1 + 1 {
-            let t0 = constants.tile_edge(1, row);
-            let t1 = t0 + constants.tile_step[1];
-            // The band's nearest approach to the centre over the slab (a lower bound).
-            let gap = if self.perspective {
-                let below = (t0 * za).min(t0 * zb) - cy;
-                let above = cy - (t1 * za).max(t1 * zb);
-                below.max(above)
-            } else {
-                (t0 - cy).max(cy - t1)
-            };
-            if gap.is_nan() || gap <= 0.0 {
-                // The row's band holds the centre (or the gap is NaN): its chord is the whole
-                // cross-section, whose columns are `columns` (the same arithmetic, done once
-                // per slice).
-                emit(row, columns.0, columns.1);
-                continue;
-            }
-            let half_sq = rho_sq - gap * gap;
-            if half_sq < 0.0 {
-                continue;
-            }
-            let half = half_sq.sqrt();
-            if let Some((x0, x1)) = self.tiles_of(tiles, 0, cx - half, cx + half, inv_a, inv_b) {
-                let (x0, x1) = (x0.max(columns.0), x1.min(columns.1));
+        // Four rows at a time (`rows.rs`), each emitted in order.
+        let chords = RowChords {
+            perspective: self.perspective,
+            za,
+            zb,
+            inv_a,
+            inv_b,
+            cx,
+            cy,
+            rho_sq,
+            extent_y: constants.extent[1],
+            step_y: constants.tile_step[1],
+            scale_x: tiles.grid.ndc_scale[0],
+            half_tiles_x: constants.half_tiles[0],
+            last_column: tiles.tiles_x - 1,
+            columns,
+        };
+        let mut row = y0;
+        loop {
+            let spans = chords.columns(row);
+            let lanes = ((y1 - row) as usize + 1).min(ROW_LANES);
+            for (i, &(x0, x1)) in spans[..lanes].iter().enumerate() {
                 if x0 <= x1 {
-                    emit(row, x0, x1);
+                    emit(row + i as u32, x0, x1);
                 }
             }
+            if lanes < ROW_LANES || row + ROW_LANES as u32 > y1 {
+                break;
+            }
+            row += ROW_LANES as u32;
         }
     }
 

@@ -38,12 +38,13 @@
 //! every dropped light is counted in [`AssignStats::overflowed_lights`], and the image degrades
 //! by exactly those lights' contributions (measurable against plain forward).
 
-mod bands;
+pub(super) mod bands;
 pub mod cells;
 mod chunks;
 mod cone;
 pub mod index_list;
 mod overflow;
+mod rows;
 #[cfg(test)]
 mod paths_tests;
 #[cfg(test)]
