@@ -354,7 +354,8 @@ impl ScreenExtent {
             }
             return;
         }
-        // Four rows at a time (`rows.rs`), each emitted in order.
+        // Four rows at a time (`rows.rs`), the last fewer than four one at a time (the lanes
+        // of a slice of few rows would cost more than they save), each emitted in order.
         let chords = RowChords {
             perspective: self.perspective,
             za,
@@ -372,18 +373,22 @@ impl ScreenExtent {
             columns,
         };
         let mut row = y0;
-        loop {
-            let spans = chords.columns(row);
-            let lanes = ((y1 - row) as usize + 1).min(ROW_LANES);
-            for (i, &(x0, x1)) in spans[..lanes].iter().enumerate() {
+        while y1 - row + 1 >= ROW_LANES as u32 {
+            for (i, &(x0, x1)) in chords.columns(row).iter().enumerate() {
                 if x0 <= x1 {
                     emit(row + i as u32, x0, x1);
                 }
             }
-            if lanes < ROW_LANES || row + ROW_LANES as u32 > y1 {
-                break;
-            }
             row += ROW_LANES as u32;
+            if row > y1 {
+                return;
+            }
+        }
+        for row in row..y1 + 1 {
+            let (x0, x1) = chords.one(row);
+            if x0 <= x1 {
+                emit(row, x0, x1);
+            }
         }
     }
 
