@@ -12,7 +12,8 @@
 //!    rectangle, per slice, the sphere is cut to its largest cross-section over the slice's
 //!    depths (radius `ρ`), and per row of cells to that cross-section's chord where the row's
 //!    band comes nearest (half-width `√(ρ² − δ²)`): each row gets the columns that chord can
-//!    reach ([`Coverage::SliceRows`]). The rectangle alone is [`Coverage::CascadeBox`].
+//!    reach ([`Coverage::SliceRows`]), four rows at a time (`rows.rs`). The rectangle alone is
+//!    [`Coverage::CascadeBox`].
 //! 4. Spot lights start from the bounding sphere of their cone's reach instead of their whole
 //!    sphere, and each row's columns are then cut to those whose cells' bounding spheres the
 //!    cone may touch, solved per row in closed form (`cone.rs`); a rectangle of at most 2 × 2
