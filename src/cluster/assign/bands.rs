@@ -4,6 +4,9 @@
 
 use std::time::Instant;
 
+#[cfg(test)]
+mod balance_tests;
+
 use super::cells::{for_each_run_in, SliceWindow};
 use super::index_list::{EntriesMut, LightIndex};
 use super::types::{Assignment, Run, Totals};
