@@ -4,6 +4,9 @@
 
 use std::time::Instant;
 
+#[cfg(test)]
+mod balance_tests;
+
 use super::cells::{for_each_run_in, SliceWindow};
 use super::index_list::{EntriesMut, LightIndex};
 use super::types::{Assignment, Run, Totals};
@@ -169,6 +172,8 @@ struct Band {
     lights: Vec<(u32, u32)>,
     /// Per entry of `lights`: the light's visible number (phase 2).
     ids: Vec<u32>,
+    /// Per entry of `lights`: its first run not yet scattered (phase 3 by blocks of cells).
+    cursors: Vec<u32>,
     /// The band's [`Totals`] (phase 2).
     totals: Totals,
     /// Seconds its phases 1 and 3 took (the next split's balance).
@@ -239,19 +244,48 @@ impl Band {
     /// the runs are taken in reverse, each write one place before the last, so every cell's
     /// list comes out ascending in light order and each offset ends where its list starts
     /// (no cursor array: a fine grid's assignment runs cache-cold in a renderer).
+    ///
+    /// A band whose offsets and list outgrow a core's cache is scattered by blocks of cells
+    /// ([`scatter_blocks`]), each block's runs over all its lights before the next block's:
+    /// a cell's lists are still written in reverse light order, so the lists are the same,
+    /// but each block's part of the offsets and the list stays in cache while it is written.
     fn scatter<T: LightIndex>(&mut self, offsets: &mut [u32], list: &mut [T]) {
         let started = Instant::now();
-        let mut end = self.runs.len();
-        for (&(_, start), &id) in self.lights.iter().rev().zip(self.ids.iter().rev()) {
-            let start = start as usize;
-            for run in &self.runs[start..end] {
-                let a = run.start as usize;
-                for at in &mut offsets[a..a + run.len as usize] {
-                    *at -= 1;
-                    list[*at as usize] = T::from_u32(id);
+        let cells = offsets.len();
+        let blocks = scatter_blocks(cells, list.len(), std::mem::size_of::<T>(), self.lights.len());
+        #[cfg(test)]
+        let blocks = FORCED_SCATTER_BLOCKS.with(|b| b.get()).map_or(blocks, |b| b.clamp(1, cells));
+        self.cursors.clear();
+        self.cursors
+            .extend(self.lights.iter().map(|&(_, start)| start));
+        for block in 0..blocks {
+            // In u64: cells × blocks may pass a 32-bit usize.
+            let cut = |b: usize| (cells as u64 * b as u64 / blocks as u64) as u32;
+            let (first, end_cell) = (cut(block), cut(block + 1));
+            let mut end = self.runs.len();
+            let lights = self.lights.iter().zip(&self.ids).zip(&mut self.cursors);
+            for ((&(_, start), &id), cursor) in lights.rev() {
+                let entry = T::from_u32(id);
+                let mut k = *cursor as usize;
+                for run in &self.runs[k..end] {
+                    if run.start >= end_cell {
+                        break;
+                    }
+                    let run_end = run.start + run.len;
+                    let (a, b) = (run.start.max(first), run_end.min(end_cell));
+                    for at in &mut offsets[a as usize..b as usize] {
+                        *at -= 1;
+                        list[*at as usize] = entry;
+                    }
+                    if run_end > end_cell {
+                        // The rest of the run is the next block's.
+                        break;
+                    }
+                    k += 1;
                 }
+                *cursor = k as u32;
+                end = start as usize;
             }
-            end = start;
         }
         if self.first_cell != 0 {
             let base = self.base as u32;
@@ -259,6 +293,32 @@ impl Band {
         }
         self.seconds += started.elapsed().as_secs_f64();
     }
+}
+
+#[cfg(test)]
+thread_local! {
+    /// Set by the tests that check that any number of scatter blocks gives the same lists.
+    pub(super) static FORCED_SCATTER_BLOCKS: std::cell::Cell<Option<usize>> =
+        const { std::cell::Cell::new(None) };
+}
+
+/// Bytes of a band's offsets and list that one block of [`Band::scatter`] writes at most:
+/// about what a core's own (L2) cache holds beside the runs it reads.
+const SCATTER_BLOCK_BYTES: usize = 256 << 10;
+
+/// Fewest indices a block should give each light on average: a block costs every light a
+/// look at its next run.
+const SCATTER_BLOCK_MIN_PER_LIGHT: usize = 16;
+
+/// Blocks of cells [`Band::scatter`] takes a band of `cells` cells and `entries` list
+/// entries of `entry_bytes` each, with `lights` lights: enough to keep each block's offsets
+/// and list within [`SCATTER_BLOCK_BYTES`], few enough that each light has about
+/// [`SCATTER_BLOCK_MIN_PER_LIGHT`] indices in a block; at least one.
+fn scatter_blocks(cells: usize, entries: usize, entry_bytes: usize, lights: usize) -> usize {
+    let bytes = cells * std::mem::size_of::<u32>() + entries * entry_bytes;
+    let by_cache = bytes.div_ceil(SCATTER_BLOCK_BYTES);
+    let by_lights = entries / (lights * SCATTER_BLOCK_MIN_PER_LIGHT).max(1);
+    by_cache.min(by_lights).clamp(1, cells.max(1))
 }
 
 /// The first cell of slice `g` (numbered across cascades), or the grid's cell count past the

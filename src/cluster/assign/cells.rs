@@ -12,7 +12,8 @@
 //!    rectangle, per slice, the sphere is cut to its largest cross-section over the slice's
 //!    depths (radius `ρ`), and per row of cells to that cross-section's chord where the row's
 //!    band comes nearest (half-width `√(ρ² − δ²)`): each row gets the columns that chord can
-//!    reach ([`Coverage::SliceRows`]). The rectangle alone is [`Coverage::CascadeBox`].
+//!    reach ([`Coverage::SliceRows`]), four rows at a time (`rows.rs`). The rectangle alone is
+//!    [`Coverage::CascadeBox`].
 //! 4. Spot lights start from the bounding sphere of their cone's reach instead of their whole
 //!    sphere, and each row's columns are then cut to those whose cells' bounding spheres the
 //!    cone may touch, solved per row in closed form (`cone.rs`); a rectangle of at most 2 × 2
@@ -26,6 +27,7 @@
 //! neighbouring cell still finds every light that reaches it: the assignment is conservative.
 
 use super::cone::{Cone, ConeSlice};
+use super::rows::{RowChords, ROW_LANES};
 use crate::cluster::grid::{CascadeConstants, ClusterGrid, Coverage, GridProjection};
 use crate::cluster::view_light::GpuLight;
 
@@ -353,34 +355,40 @@ impl ScreenExtent {
             }
             return;
         }
-        for row in y0..y1 + 1 {
-            let t0 = constants.tile_edge(1, row);
-            let t1 = t0 + constants.tile_step[1];
-            // The band's nearest approach to the centre over the slab (a lower bound).
-            let gap = if self.perspective {
-                let below = (t0 * za).min(t0 * zb) - cy;
-                let above = cy - (t1 * za).max(t1 * zb);
-                below.max(above)
-            } else {
-                (t0 - cy).max(cy - t1)
-            };
-            if gap.is_nan() || gap <= 0.0 {
-                // The row's band holds the centre (or the gap is NaN): its chord is the whole
-                // cross-section, whose columns are `columns` (the same arithmetic, done once
-                // per slice).
-                emit(row, columns.0, columns.1);
-                continue;
-            }
-            let half_sq = rho_sq - gap * gap;
-            if half_sq < 0.0 {
-                continue;
-            }
-            let half = half_sq.sqrt();
-            if let Some((x0, x1)) = self.tiles_of(tiles, 0, cx - half, cx + half, inv_a, inv_b) {
-                let (x0, x1) = (x0.max(columns.0), x1.min(columns.1));
+        // Four rows at a time (`rows.rs`), the last fewer than four one at a time (the lanes
+        // of a slice of few rows would cost more than they save), each emitted in order.
+        let chords = RowChords {
+            perspective: self.perspective,
+            za,
+            zb,
+            inv_a,
+            inv_b,
+            cx,
+            cy,
+            rho_sq,
+            extent_y: constants.extent[1],
+            step_y: constants.tile_step[1],
+            scale_x: tiles.grid.ndc_scale[0],
+            half_tiles_x: constants.half_tiles[0],
+            last_column: tiles.tiles_x - 1,
+            columns,
+        };
+        let mut row = y0;
+        while y1 - row + 1 >= ROW_LANES as u32 {
+            for (i, &(x0, x1)) in chords.columns(row).iter().enumerate() {
                 if x0 <= x1 {
-                    emit(row, x0, x1);
+                    emit(row + i as u32, x0, x1);
                 }
+            }
+            row += ROW_LANES as u32;
+            if row > y1 {
+                return;
+            }
+        }
+        for row in row..y1 + 1 {
+            let (x0, x1) = chords.one(row);
+            if x0 <= x1 {
+                emit(row, x0, x1);
             }
         }
     }

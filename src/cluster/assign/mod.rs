@@ -16,8 +16,9 @@
 //!          per-cell counts kept as a difference array (two additions per run)
 //! phase 2  the visible lights (a light is visible if any band listed it), numbered in light
 //!          order; counts → offsets
-//! phase 3  runs scattered into the list: bands straight into their own parts of it; chunks
-//!          into their own lists, then merged cell by cell
+//! phase 3  runs scattered into the list: bands straight into their own parts of it (a band
+//!          larger than a core's cache by blocks of cells, each block's runs of all lights
+//!          before the next); chunks into their own lists, then merged cell by cell
 //! ```
 //!
 //! Why two: a fine grid gives each light hundreds of cells, and merging chunks cell by cell
@@ -38,12 +39,13 @@
 //! every dropped light is counted in [`AssignStats::overflowed_lights`], and the image degrades
 //! by exactly those lights' contributions (measurable against plain forward).
 
-mod bands;
+pub(super) mod bands;
 pub mod cells;
 mod chunks;
 mod cone;
 pub mod index_list;
 mod overflow;
+mod rows;
 #[cfg(test)]
 mod paths_tests;
 #[cfg(test)]

@@ -349,3 +349,29 @@ fn split_cells_never_returns_empty_or_out_of_range_blocks() {
         assert_eq!(next, offsets.len());
     }
 }
+
+#[test]
+fn scatter_blocks_of_any_number_give_the_same_lists() {
+    use super::bands::FORCED_SCATTER_BLOCKS;
+    let mut rng = Pcg64Mcg::seed_from_u64(31);
+    let limits = AssignLimits {
+        cell_cap: u32::MAX,
+        parallel_threshold: usize::MAX,
+        ..Default::default()
+    };
+    for case in cases() {
+        let grid = ClusterGrid::new(320, 180, case.projection, case.near, case.far, &case.config);
+        let lights = random_lights(&mut rng, 600, case.far.min(200.0) * 0.5);
+        FORCED_SCATTER_BLOCKS.with(|b| b.set(Some(1)));
+        let whole = assign(&grid, &lights, case.far, &limits);
+        assert!(whole.indices.len() > 1000, "{}: too few indices to cut", case.name);
+        // Block edges cut runs in two (7, 64), or nearly every run (a block a cell).
+        for blocks in [2, 7, 64, grid.total_cells as usize] {
+            FORCED_SCATTER_BLOCKS.with(|b| b.set(Some(blocks)));
+            let cut = assign(&grid, &lights, case.far, &limits);
+            assert_eq!(cut.offsets, whole.offsets, "{}, {blocks} blocks", case.name);
+            assert_eq!(cut.indices.to_vec(), whole.indices.to_vec(), "{}, {blocks}", case.name);
+        }
+        FORCED_SCATTER_BLOCKS.with(|b| b.set(None));
+    }
+}

@@ -1,0 +1,50 @@
+//! The bands' split with one slow worker: a band whose thread is slower (a phone's little
+//! core) gets fewer cells in the next frames, until both bands take about as long.
+
+use super::Bands;
+use crate::cluster::assign::types::Assignment;
+use crate::cluster::grid::{ClusterGrid, GridConfig, GridProjection};
+
+/// Per-cell time of the band each thread runs: the first thread is three times slower.
+const SPEED: [f64; 2] = [3e-9, 1e-9];
+
+#[test]
+fn a_slow_worker_gets_less_work_until_both_take_about_as_long() {
+    let grid = ClusterGrid::new(
+        640,
+        360,
+        GridProjection::test_view(),
+        0.1,
+        80.0,
+        &GridConfig::fixed(16.0),
+    );
+    let cells = grid.total_cells as usize;
+    // The previous frame's lists (the split reads only their length and offsets).
+    let previous = Assignment {
+        offsets: (0..cells as u32).collect(),
+        ..Assignment::default()
+    };
+    let mut bands = Bands::default();
+    bands.split(&grid, 2, &previous);
+    let even = bands.bands[0].end_cell;
+    let mut spread = f64::INFINITY;
+    for _frame in 0..6 {
+        // Each band's time as a thread of its speed would measure it.
+        for (band, speed) in bands.bands.iter_mut().zip(SPEED) {
+            band.seconds = (band.end_cell - band.first_cell) as f64 * speed;
+        }
+        let times: Vec<f64> = bands.bands.iter().map(|b| b.seconds).collect();
+        spread = times[0].max(times[1]) / times[0].min(times[1]);
+        bands.split(&grid, 2, &previous);
+    }
+    let slow = bands.bands[0].end_cell - bands.bands[0].first_cell;
+    assert!(slow < even, "the slow band kept {slow} cells of an even {even}");
+    // Bands are cut between slices: within one slice of the balance (a slice is about 4 %
+    // of this grid's cells).
+    let slice = (cells / grid.slice_slabs.len()) as f64;
+    let tolerance = 1.0 + 2.0 * slice * SPEED[0] / (cells as f64 * 0.25 * SPEED[0]);
+    assert!(
+        spread <= tolerance,
+        "after six frames the bands' times differ by {spread:.2}x (more than {tolerance:.2}x)"
+    );
+}

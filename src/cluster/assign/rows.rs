@@ -1,0 +1,235 @@
+//! The per-row chord of the slice refinement (`cells.rs`), four rows at a time: the same
+//! arithmetic as one row at a time, lane by lane, written without branches so that the
+//! compiler keeps the four rows in SIMD registers (two `f64` lanes on x86-64's baseline SSE2
+//! and on aarch64's NEON, four with AVX). Every lane does exactly the scalar operations in the
+//! scalar order, so the columns, and the lists, are the same bit for bit.
+
+/// Rows whose chords one call of [`RowChords::columns`] works out.
+pub(super) const ROW_LANES: usize = 4;
+
+/// What every row of one slice shares (see `ScreenExtent::for_each_row_run`).
+pub(super) struct RowChords {
+    /// Perspective (rows are bands of slopes) or orthographic (bands of offsets).
+    pub perspective: bool,
+    /// The slab's clipped depths `za ≤ zb` and their reciprocals `inv_a ≥ inv_b`.
+    pub za: f64,
+    pub zb: f64,
+    pub inv_a: f64,
+    pub inv_b: f64,
+    /// The sphere's centre (view x, y) and its cross-section's squared radius `ρ²`.
+    pub cx: f64,
+    pub cy: f64,
+    pub rho_sq: f64,
+    /// Row `i` starts at `−extent_y + i · step_y` (`CascadeConstants::tile_edge`).
+    pub extent_y: f64,
+    pub step_y: f64,
+    /// NDC scale of x, half the columns, and the last column.
+    pub scale_x: f64,
+    pub half_tiles_x: f64,
+    pub last_column: u32,
+    /// The cross-section's columns: every chord's bound, and a row holding the centre's.
+    pub columns: (u32, u32),
+}
+
+impl RowChords {
+    /// Columns `(x0, x1)` of rows `row .. row + ROW_LANES`; `x0 > x1` where a row gets none.
+    #[inline(always)]
+    pub(super) fn columns(&self, row: u32) -> [(u32, u32); ROW_LANES] {
+        let t0 = lanes(|i| -self.extent_y + (row + i as u32) as f64 * self.step_y);
+        let t1 = lanes(|i| t0[i] + self.step_y);
+        let (za, zb, cy) = (self.za, self.zb, self.cy);
+        // The band's nearest approach to the centre over the slab (a lower bound).
+        let gap = if self.perspective {
+            lanes(|i| {
+                let below = (t0[i] * za).min(t0[i] * zb) - cy;
+                let above = cy - (t1[i] * za).max(t1[i] * zb);
+                below.max(above)
+            })
+        } else {
+            lanes(|i| (t0[i] - cy).max(cy - t1[i]))
+        };
+        let half_sq = lanes(|i| self.rho_sq - gap[i] * gap[i]);
+        // A negative `half_sq` gives NaN here, and its lane no columns below.
+        let half = lanes(|i| half_sq[i].sqrt());
+        let (low, high) = (
+            lanes(|i| self.cx - half[i]),
+            lanes(|i| self.cx + half[i]),
+        );
+        let (lo, hi) = if self.perspective {
+            (
+                lanes(|i| (low[i] * self.inv_a).min(low[i] * self.inv_b)),
+                lanes(|i| (high[i] * self.inv_a).max(high[i] * self.inv_b)),
+            )
+        } else {
+            (low, high)
+        };
+        let (lo, hi) = (
+            lanes(|i| lo[i] * self.scale_x),
+            lanes(|i| hi[i] * self.scale_x),
+        );
+        // `ndc_to_tiles`: `as u32` saturates (NaN and negatives to 0) and the last column
+        // caps it; clamping in f64 first gives the same tile and converts as a vector.
+        let last = self.last_column as f64;
+        let tile = |ndc: f64| ((ndc + 1.0) * self.half_tiles_x).max(0.0).min(last) as u32;
+        let (c0, c1) = self.columns;
+        std::array::from_fn(|i| {
+            let (g, lo, hi) = (gap[i], lo[i], hi[i]);
+            // The band holds the centre (or the gap is NaN): the whole
+            // cross-section's columns.
+            let whole = g.is_nan() || g <= 0.0;
+            let hits = (half_sq[i] >= 0.0) & (lo <= hi) & (hi >= -1.0) & (lo <= 1.0);
+            let (x0, x1) = (tile(lo).max(c0), tile(hi).min(c1));
+            if whole {
+                (c0, c1)
+            } else if hits {
+                (x0, x1)
+            } else {
+                (1, 0)
+            }
+        })
+    }
+}
+
+impl RowChords {
+    /// Columns `(x0, x1)` of one row, `x0 > x1` where it gets none: lane 0 of
+    /// [`RowChords::columns`] without the other three (a slice's last rows).
+    #[inline(always)]
+    pub(super) fn one(&self, row: u32) -> (u32, u32) {
+        let t0 = -self.extent_y + row as f64 * self.step_y;
+        let t1 = t0 + self.step_y;
+        let gap = if self.perspective {
+            let below = (t0 * self.za).min(t0 * self.zb) - self.cy;
+            let above = self.cy - (t1 * self.za).max(t1 * self.zb);
+            below.max(above)
+        } else {
+            (t0 - self.cy).max(self.cy - t1)
+        };
+        if gap.is_nan() || gap <= 0.0 {
+            return self.columns;
+        }
+        let half_sq = self.rho_sq - gap * gap;
+        if half_sq < 0.0 {
+            return (1, 0);
+        }
+        let half = half_sq.sqrt();
+        let (low, high) = (self.cx - half, self.cx + half);
+        let (lo, hi) = if self.perspective {
+            (
+                (low * self.inv_a).min(low * self.inv_b),
+                (high * self.inv_a).max(high * self.inv_b),
+            )
+        } else {
+            (low, high)
+        };
+        let (lo, hi) = (lo * self.scale_x, hi * self.scale_x);
+        if !((lo <= hi) & (hi >= -1.0) & (lo <= 1.0)) {
+            return (1, 0);
+        }
+        let tile = |ndc: f64| (((ndc + 1.0) * self.half_tiles_x) as u32).min(self.last_column);
+        (tile(lo).max(self.columns.0), tile(hi).min(self.columns.1))
+    }
+}
+
+/// The lanes `f(0), f(1), …`.
+#[inline(always)]
+fn lanes(f: impl Fn(usize) -> f64) -> [f64; ROW_LANES] {
+    std::array::from_fn(f)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{Rng, SeedableRng};
+    use rand_pcg::Pcg64Mcg;
+
+    /// One row at a time, as the refinement did before the lanes (the oracle of both):
+    /// `None` for no columns.
+    fn one_row(c: &RowChords, row: u32) -> Option<(u32, u32)> {
+        let t0 = -c.extent_y + row as f64 * c.step_y;
+        let t1 = t0 + c.step_y;
+        let gap = if c.perspective {
+            let below = (t0 * c.za).min(t0 * c.zb) - c.cy;
+            let above = c.cy - (t1 * c.za).max(t1 * c.zb);
+            below.max(above)
+        } else {
+            (t0 - c.cy).max(c.cy - t1)
+        };
+        if gap.is_nan() || gap <= 0.0 {
+            return Some(c.columns);
+        }
+        let half_sq = c.rho_sq - gap * gap;
+        if half_sq < 0.0 {
+            return None;
+        }
+        let half = half_sq.sqrt();
+        let (low, high) = (c.cx - half, c.cx + half);
+        let (lo, hi) = if c.perspective {
+            (
+                (low * c.inv_a).min(low * c.inv_b),
+                (high * c.inv_a).max(high * c.inv_b),
+            )
+        } else {
+            (low, high)
+        };
+        let (lo, hi) = (lo * c.scale_x, hi * c.scale_x);
+        if !((lo <= hi) & (hi >= -1.0) & (lo <= 1.0)) {
+            return None;
+        }
+        let to_tile = |ndc: f64| (((ndc + 1.0) * c.half_tiles_x) as u32).min(c.last_column);
+        let (x0, x1) = (to_tile(lo).max(c.columns.0), to_tile(hi).min(c.columns.1));
+        (x0 <= x1).then_some((x0, x1))
+    }
+
+    /// A value from a wide range, now and then an extreme one.
+    fn value(rng: &mut Pcg64Mcg, scale: f64) -> f64 {
+        match rng.random_range(0..40) {
+            0 => f64::NAN,
+            1 => f64::INFINITY,
+            2 => f64::NEG_INFINITY,
+            3 => 0.0,
+            4 => 1e300,
+            _ => rng.random_range(-scale..scale),
+        }
+    }
+
+    #[test]
+    fn four_lanes_and_one_give_the_columns_of_one_row_at_a_time() {
+        let mut rng = Pcg64Mcg::seed_from_u64(31);
+        let mut differ = 0;
+        for case in 0..20_000 {
+            let tiles_x: u32 = rng.random_range(1..300);
+            let tiles_y: u32 = rng.random_range(1..200);
+            let c0 = rng.random_range(0..tiles_x);
+            let c1 = rng.random_range(c0..tiles_x);
+            let extent_y = rng.random_range(0.1..3.0);
+            let za = rng.random_range(0.01..100.0);
+            let inv_a = 1.0 / za;
+            let zb = za + rng.random_range(0.0..10.0);
+            let chords = RowChords {
+                perspective: case % 4 != 0,
+                za,
+                zb,
+                inv_a,
+                inv_b: (1.0 / zb).min(inv_a),
+                cx: value(&mut rng, 50.0),
+                cy: value(&mut rng, 50.0),
+                rho_sq: value(&mut rng, 400.0).abs(),
+                extent_y,
+                step_y: 2.0 * extent_y / tiles_y as f64,
+                scale_x: rng.random_range(0.1..3.0),
+                half_tiles_x: tiles_x as f64 / 2.0,
+                last_column: tiles_x - 1,
+                columns: (c0, c1),
+            };
+            let row = rng.random_range(0..tiles_y);
+            for (i, &(x0, x1)) in chords.columns(row).iter().enumerate() {
+                let expected = one_row(&chords, row + i as u32);
+                let lanes = (x0 <= x1).then_some((x0, x1));
+                let (x0, x1) = chords.one(row + i as u32);
+                let one = (x0 <= x1).then_some((x0, x1));
+                differ += usize::from(lanes != expected) + usize::from(one != expected);
+            }
+        }
+        assert_eq!(differ, 0, "rows whose lanes and scalar columns differ");
+    }
+}
