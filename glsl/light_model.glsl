@@ -15,6 +15,25 @@
 // (1/d)²/(1 + (1/d)²) past d = 1. So neither d² (past 256 m) nor |Lp − P|² overflows fp16, and
 // (d/r)² of a light with a large radius (d/r = 10⁻⁴ at r = 6 000) may underflow to 0 but no
 // longer takes the direction to the light with it.
+// What the surface reflects towards V of unit irradiance from the unit direction L (surface to
+// light): albedo·N·L plus the specular lobe, zero where N·L ≤ 0. Every kind of light scales
+// this (point and spot lights below, directional lights in directional.glsl); CPU twin:
+// scene::shading::reflected.
+MEDP vec3 reflected(HIGHP vec3 L, vec3 N, vec3 V, MEDP vec3 albedo, MEDP vec3 Ks, HIGHP float Ns) {
+    MEDP float nDotL = dot(N, L);
+    if (nDotL <= 0.0) {
+        return vec3(0.0);
+    }
+#if HAS_SPECULAR
+    HIGHP vec3 halfSum = L + V;
+    HIGHP vec3 H = halfSum / max(length(halfSum), 1e-6);
+    MEDP vec3 spec = Ks * pow(max(dot(N, H), 0.0), Ns);
+#else
+    MEDP vec3 spec = vec3(0.0);
+#endif
+    return albedo * nDotL + spec;
+}
+
 vec3 shadeLight(Light light, HIGHP vec3 P, vec3 N, vec3 V, MEDP vec3 albedo, MEDP vec3 Ks, HIGHP float Ns) {
     HIGHP vec3 toLight = light.position - P;
     HIGHP float m = max(max(abs(toLight.x), abs(toLight.y)), abs(toLight.z));
@@ -45,8 +64,7 @@ vec3 shadeLight(Light light, HIGHP vec3 P, vec3 N, vec3 V, MEDP vec3 albedo, MED
     HIGHP float falloff = w * w * (inv < 1.0 ? inv * inv / (1.0 + inv * inv) : 1.0 / (d * d + 1.0));
 #endif
     HIGHP vec3 L = s * invLen;
-    MEDP float nDotL = dot(N, L);
-    if (falloff <= 0.0 || nDotL <= 0.0) {
+    if (falloff <= 0.0 || dot(N, L) <= 0.0) {
         return vec3(0.0);
     }
 #if HAS_SPOT
@@ -58,15 +76,7 @@ vec3 shadeLight(Light light, HIGHP vec3 P, vec3 N, vec3 V, MEDP vec3 albedo, MED
 #else
     HIGHP float spot = 1.0;
 #endif
-#if HAS_SPECULAR
-    HIGHP vec3 halfSum = L + V;
-    HIGHP vec3 H = halfSum / max(length(halfSum), 1e-6);
-    MEDP vec3 spec = Ks * pow(max(dot(N, H), 0.0), Ns);
-#else
-    MEDP vec3 spec = vec3(0.0);
-#endif
-    MEDP vec3 reflectance = albedo * nDotL + spec;
-    return light.radiance * (falloff * spot) * reflectance;
+    return light.radiance * (falloff * spot) * reflected(L, N, V, albedo, Ks, Ns);
 }
 
 #if COUNT_REACHING

@@ -50,9 +50,12 @@ impl ShaderFeatures {
     /// selecting each fragment's own contributions, so no fragment leaves the loop before its
     /// neighbours.
     pub const UNIFORM_LIGHT_LOOP: u64 = 1 << 15;
+    /// The scene has directional lights: up to four, evaluated for every pixel from uniforms,
+    /// outside the light lists (`glsl/directional.glsl`).
+    pub const DIRECTIONAL: u64 = 1 << 16;
 
     /// Every flag with its name.
-    pub const NAMED: [(u64, &'static str); 16] = [
+    pub const NAMED: [(u64, &'static str); 17] = [
         (Self::TEXTURE, "texture"),
         (Self::SPOT, "spot"),
         (Self::SPECULAR, "specular"),
@@ -69,6 +72,7 @@ impl ShaderFeatures {
         (Self::TONEMAP_ACES, "tonemap_aces"),
         (Self::TONEMAP_NEUTRAL, "tonemap_neutral"),
         (Self::UNIFORM_LIGHT_LOOP, "uniform_light_loop"),
+        (Self::DIRECTIONAL, "directional"),
     ];
 
     /// Names of the set flags.
@@ -120,6 +124,15 @@ impl ShaderFeatures {
             ("COUNT_REACHING".into(), flag(Self::COUNT_REACHING)),
             ("COUNT_HEATMAP".into(), flag(Self::COUNT_HEATMAP)),
             ("UNIFORM_LIGHT_LOOP".into(), flag(Self::UNIFORM_LIGHT_LOOP)),
+            ("HAS_DIRECTIONAL".into(), flag(Self::DIRECTIONAL)),
+            (
+                "DIRECTIONAL_FP16_CAP".into(),
+                format!("{:.1}", super::directional::DIRECTIONAL_FP16_CAP),
+            ),
+            (
+                "MAX_DIRECTIONAL".into(),
+                crate::scene::MAX_DIRECTIONAL_LIGHTS.to_string(),
+            ),
             (
                 "TONEMAP".into(),
                 if self.has(Self::TONEMAP_REINHARD) {

@@ -296,7 +296,8 @@ fn evaluate(
             exponent: material.shading_exponent() as f64,
         };
         let v = view_direction(&scene.camera, h.position);
-        let c = shading::shade(&surface, v, &scene.lights, scene.ambient);
+        let c = shading::shade(&surface, v, &scene.lights, scene.ambient)
+            + shading::shade_directional(&surface, v, &scene.directional_lights);
         for ch in 0..3 {
             let e = encoding.encode(c[ch]);
             (lo[ch], hi[ch]) = (lo[ch].min(e), hi[ch].max(e));
@@ -381,12 +382,9 @@ mod tests {
             specular: m.specular.as_dvec3(),
             exponent: m.shading_exponent() as f64,
         };
-        shading::shade(
-            &surface,
-            view_direction(cam, p),
-            &scene.lights,
-            scene.ambient,
-        )
+        let v = view_direction(cam, p);
+        shading::shade(&surface, v, &scene.lights, scene.ambient)
+            + shading::shade_directional(&surface, v, &scene.directional_lights)
     }
 
     fn check_against_plane(scene: &Scene, encoding: Encoding) {

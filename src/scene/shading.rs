@@ -11,6 +11,7 @@
 //! diffuse  = albedo · max(N·L, 0)
 //! specular = Ks · max(N·H, 0)^Ns   with H = normalize(L + V), only where N·L > 0
 //! out      = ambient · albedo + Σ c · falloff · spot · (diffuse + specular)
+//!                             + Σ suns c · (diffuse + specular)  with L = −direction
 //! ```
 //!
 //! Surfaces are two-sided (`N` flipped towards the eye). In view space, `V` is
@@ -22,6 +23,7 @@
 
 use glam::{DVec3, Vec3};
 
+use super::directional::{shown_directional_lights, DirectionalLight};
 use super::light::{Light, LightKind};
 
 /// Surface attributes at one shading point, in linear RGB.
@@ -98,6 +100,18 @@ pub fn light_contribution(light: &Light, s: &Surface, v: DVec3) -> DVec3 {
         return DVec3::ZERO;
     }
     let l = to_light / d.max(1e-6);
+    let reflected = reflected(l, s, v);
+    if reflected == DVec3::ZERO {
+        return DVec3::ZERO;
+    }
+    let spot = spot_factor(light, -l);
+    light.radiance().as_dvec3() * (f * spot) * reflected
+}
+
+/// What the surface reflects along `v` of unit irradiance arriving from the unit direction `l`
+/// (surface → light): `albedo · N·L + specular`, zero where `N·L ≤ 0`. Every kind of light
+/// scales this (`reflected` in `glsl/light_model.glsl`).
+pub fn reflected(l: DVec3, s: &Surface, v: DVec3) -> DVec3 {
     let n_dot_l = s.normal.dot(l);
     if n_dot_l <= 0.0 {
         return DVec3::ZERO;
@@ -105,8 +119,28 @@ pub fn light_contribution(light: &Light, s: &Surface, v: DVec3) -> DVec3 {
     let h = (l + v).normalize_or_zero();
     let n_dot_h = s.normal.dot(h).max(0.0);
     let spec = s.specular * n_dot_h.powf(s.exponent);
-    let spot = spot_factor(light, -l);
-    light.radiance().as_dvec3() * (f * spot) * (s.albedo * n_dot_l + spec)
+    s.albedo * n_dot_l + spec
+}
+
+/// Radiance one directional light reflects along `v` (no falloff: it is the same everywhere).
+pub fn directional_contribution(light: &DirectionalLight, s: &Surface, v: DVec3) -> DVec3 {
+    light.radiance().as_dvec3() * reflected(light.to_light(), s, v)
+}
+
+/// What the directional lights a frame shows ([`shown_directional_lights`]: the brightest
+/// [`MAX_DIRECTIONAL_LIGHTS`](super::MAX_DIRECTIONAL_LIGHTS)) add along `v`, two-sided as
+/// [`shade`]. The total a pixel shows is `shade(..) + shade_directional(..)`.
+pub fn shade_directional(s: &Surface, v: DVec3, lights: &[DirectionalLight]) -> DVec3 {
+    let mut s = *s;
+    if s.normal.dot(v) < 0.0 {
+        s.normal = -s.normal;
+    }
+    let mut shown = Vec::new();
+    shown_directional_lights(lights, &mut shown);
+    shown
+        .iter()
+        .map(|&i| directional_contribution(&lights[i], &s, v))
+        .sum()
 }
 
 /// Total linear radiance along `v` (unit, surface → eye): ambient plus every light. Surfaces
