@@ -11,12 +11,6 @@ use crate::gl::Device;
 use crate::scene::directional::shown_directional_lights;
 use crate::scene::{Scene, MAX_DIRECTIONAL_LIGHTS};
 
-/// Without fragment highp, the most one directional light adds to a pixel (in the fp16-range
-/// form): four of them stay below fp16's 65 504. Only a contribution at least a quarter of
-/// this (radiance / k² > 1/4) is ever capped, so the picture is unchanged at exposures of
-/// −11 EV and up (−2 EV and up through a tone map, whose input is capped at 1 000).
-pub const DIRECTIONAL_FP16_CAP: f32 = 16000.0;
-
 /// Without fragment highp, radiance above this is uploaded as this (its `k` then fits fp16).
 const FP16_MAX_RADIANCE: f32 = (1u32 << 30) as f32;
 

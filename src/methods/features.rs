@@ -5,6 +5,12 @@ use crate::cluster::pack::{LightEncoding, DATA_TEXTURE_WIDTH};
 use crate::gl::EsVersion;
 use crate::scene::light::SPOT_MIN_COS_DELTA;
 
+/// Without fragment highp, the most one directional light adds to a pixel (in the fp16-range
+/// form): four of them stay below fp16's 65 504. Only a contribution at least a quarter of
+/// this (radiance / k² > 1/4) is ever capped, so the picture is unchanged at exposures of
+/// −11 EV and up (−2 EV and up through a tone map, whose input is capped at 1 000).
+pub const DIRECTIONAL_FP16_CAP: f32 = 16000.0;
+
 /// Feature bitset of a shader variant.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub struct ShaderFeatures(pub u64);
@@ -127,7 +133,7 @@ impl ShaderFeatures {
             ("HAS_DIRECTIONAL".into(), flag(Self::DIRECTIONAL)),
             (
                 "DIRECTIONAL_FP16_CAP".into(),
-                format!("{:.1}", super::directional::DIRECTIONAL_FP16_CAP),
+                format!("{DIRECTIONAL_FP16_CAP:.1}"),
             ),
             (
                 "MAX_DIRECTIONAL".into(),

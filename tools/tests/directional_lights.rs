@@ -130,7 +130,7 @@ fn a_bright_sun_without_fragment_highp_stays_finite_and_right() {
         };
         let img = gpu.render(&scene, W, H, &opts);
         let mut scaled = scene.clone();
-        let s = (ev as f32).exp2();
+        let s = ev.exp2();
         scaled.ambient *= s;
         for l in &mut scaled.directional_lights {
             l.intensity *= s;
