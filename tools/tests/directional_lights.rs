@@ -15,11 +15,13 @@ use manylight::{EsVersion, RenderOptions};
 const W: u32 = 96;
 const H: u32 = 54;
 
-/// A warm sun from the upper left, and a dim blue one from the right.
+/// A warm sun from the upper left, and a dim blue one low from the right (its direction's
+/// length far from 1; not in the plane of the courtyard's floor, where N·L = 0 would make the
+/// specular lobe hang on the last bit of the normal).
 fn suns() -> Vec<DirectionalLight> {
     vec![
         DirectionalLight::new(DVec3::new(1.0, -2.0, -1.5), Vec3::new(1.0, 0.9, 0.7), 0.6),
-        DirectionalLight::new(DVec3::new(-3e5, 0.0, -1e5), Vec3::new(0.2, 0.3, 1.0), 0.4),
+        DirectionalLight::new(DVec3::new(-3e5, -1e5, -1e5), Vec3::new(0.2, 0.3, 1.0), 0.4),
     ]
 }
 
