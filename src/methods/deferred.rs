@@ -236,14 +236,22 @@ impl Deferred {
         // through the same mapping the light pass reads it back with.
         let (half, _) = half_extent(ctx);
         let viewport = [ctx.viewport.0 as f32, ctx.viewport.1 as f32];
+        // Directional lights are the composite's: the G-buffer variant is the same without.
+        let features = ctx.features;
+        ctx.features = features.with(ShaderFeatures::DIRECTIONAL, false);
+        let mut drawn = Ok(());
         for k in 0..ctx.order.opaque.len() {
             let i = ctx.order.opaque[k];
-            shade_object(ctx, i, "gbuffer", 1, &mut |p: &GBufferProgram, dev| {
+            drawn = shade_object(ctx, i, "gbuffer", 1, &mut |p: &GBufferProgram, dev| {
                 p.viewport.set(dev, viewport);
                 p.half_extent.set(dev, half);
-            })?;
+            });
+            if drawn.is_err() {
+                break;
+            }
         }
-        Ok(())
+        ctx.features = features;
+        drawn
     }
 
     fn light_pass(&self, ctx: &mut FrameContext) -> Result<(), Error> {
@@ -251,7 +259,10 @@ impl Deferred {
         let gb = self.gbuffer.as_ref().expect("allocated");
         gb.begin_accumulation(dev);
         gb.bind_textures(dev, UNIT_G_ALBEDO);
-        let features = ctx.features.with(ShaderFeatures::SPECULAR, true);
+        let features = ctx
+            .features
+            .with(ShaderFeatures::SPECULAR, true)
+            .with(ShaderFeatures::DIRECTIONAL, false);
         let (half, ortho) = half_extent(ctx);
         let viewport = [ctx.viewport.0 as f32, ctx.viewport.1 as f32];
         let far = ctx.far as f32;

@@ -205,3 +205,32 @@ fn more_than_four_suns_keep_the_brightest_with_one_warning() {
     assert_eq!(warned.len(), 1, "one warning for two frames: {warned:?}");
     assert!(warned[0].contains("2 of the scene's 6"), "{warned:?}");
 }
+
+#[test]
+fn only_a_scene_with_an_active_sun_builds_the_sun_code() {
+    use manylight::methods::ShaderFeatures;
+    let has_sun_code = |gpu: &mut Gpu| {
+        let report = gpu.r().program_report();
+        report
+            .iter()
+            .filter(|p| ShaderFeatures(p.features).has(ShaderFeatures::DIRECTIONAL))
+            .map(|p| p.shader.to_string())
+            .collect::<Vec<_>>()
+    };
+    let mut gpu = Gpu::new(EsVersion::Es3);
+    let mut dark = scene::builtin::build("courtyard", Some((16, 2))).unwrap();
+    dark.directional_lights = vec![DirectionalLight::new(DVec3::NEG_Y, Vec3::ONE, 0.0)];
+    gpu.r().set_method_named("deferred").unwrap();
+    gpu.render(&dark, W, H, &RenderOptions::default());
+    assert!(
+        has_sun_code(&mut gpu).is_empty(),
+        "a dark sun costs nothing"
+    );
+    let mut lit = dark.clone();
+    lit.directional_lights[0].intensity = 1.0;
+    gpu.render(&lit, W, H, &RenderOptions::default());
+    let mut with_sun = has_sun_code(&mut gpu);
+    with_sun.sort();
+    // The composite shades the suns; the G-buffer and light passes are the same without.
+    assert_eq!(with_sun, ["deferred_composite"], "{with_sun:?}");
+}
