@@ -15,6 +15,7 @@
 // (1/d)²/(1 + (1/d)²) past d = 1. So neither d² (past 256 m) nor |Lp − P|² overflows fp16, and
 // (d/r)² of a light with a large radius (d/r = 10⁻⁴ at r = 6 000) may underflow to 0 but no
 // longer takes the direction to the light with it.
+
 // What the surface reflects towards V of unit irradiance from the unit direction L (surface to
 // light): albedo·N·L plus the specular lobe, zero where N·L ≤ 0. Every kind of light scales
 // this (point and spot lights below, directional lights in directional.glsl); CPU twin:
@@ -34,6 +35,7 @@ MEDP vec3 reflected(HIGHP vec3 L, vec3 N, vec3 V, MEDP vec3 albedo, MEDP vec3 Ks
     return albedo * nDotL + spec;
 }
 
+// A point or spot light: the falloff described above, the spot cone, then reflected().
 vec3 shadeLight(Light light, HIGHP vec3 P, vec3 N, vec3 V, MEDP vec3 albedo, MEDP vec3 Ks, HIGHP float Ns) {
     HIGHP vec3 toLight = light.position - P;
     HIGHP float m = max(max(abs(toLight.x), abs(toLight.y)), abs(toLight.z));
