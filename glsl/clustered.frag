@@ -4,6 +4,7 @@
 #include "data_texture.glsl"
 #include "light_data.glsl"
 #include "light_model.glsl"
+#include "directional.glsl"
 #include "cluster_lookup.glsl"
 
 VARYING HIGHP vec3 v_viewPos;
@@ -30,6 +31,10 @@ void main() {
     MEDP vec3 albedo = surfaceAlbedo(v_uv);
     SurfaceParams surface = materialSurface(albedo, v_uv);
     HIGHP vec3 color = u_ambient * albedo;
+#if HAS_DIRECTIONAL
+    // Directional lights reach every cell: evaluated here, outside the cell's list.
+    color += shadeDirectional(N, V, surface);
+#endif
 #if GLSL_ES == 100
     HIGHP vec2 cell = clusterCell(fragXY, viewDepth);
 #if UNIFORM_LIGHT_LOOP

@@ -1,5 +1,10 @@
 // Deferred, pass 3: ambient plus the accumulated lights, encoded like every other method.
+// Directional lights are shaded here, with the BRDF chosen per pixel as in the light pass.
+#define PER_PIXEL_MODEL 1
 #include "surface.glsl"
+#include "light_struct.glsl"
+#include "light_model.glsl"
+#include "directional.glsl"
 #include "deferred_common.glsl"
 
 uniform HIGHP sampler2D u_accum;
@@ -15,8 +20,23 @@ void main() {
 #if COUNT_EVALS
     FRAG_COLOR = encodeCount(texelFetch(u_accum, px, 0).r);
 #else
-    vec3 albedo = texelFetch(u_gAlbedo, px, 0).rgb;
-    vec3 color = u_ambient * albedo + texelFetch(u_accum, px, 0).rgb;
+    HIGHP vec4 albedoOffset = texelFetch(u_gAlbedo, px, 0);
+    MEDP vec3 albedo = albedoOffset.rgb;
+    HIGHP vec3 color = u_ambient * albedo + texelFetch(u_accum, px, 0).rgb;
+#if HAS_DIRECTIONAL
+    // Directional lights light every pixel: here, once, rather than as a light volume. The
+    // surface point comes back from the G-buffer as in the light pass.
+    HIGHP vec4 nd = texelFetch(u_gNormalDepth, px, 0);
+    HIGHP vec3 P = viewPosition(gl_FragCoord.xy + vec2(nd.w, albedoOffset.a), nd.z);
+    vec4 spec = texelFetch(u_gSpecular, px, 0);
+    SurfaceParams surface;
+    surface.albedo = albedo;
+    surface.Ks = spec.rgb;
+    surface.Ns = spec.a;
+    surface.metallic = spec.r;
+    surface.roughness = spec.g;
+    color += shadeDirectional(octDecode(nd.xy), viewDirection(P), surface);
+#endif
     FRAG_COLOR = encodeOutput(color);
 #endif
 }

@@ -5,6 +5,7 @@
 #include "data_texture.glsl"
 #include "light_data.glsl"
 #include "light_model.glsl"
+#include "directional.glsl"
 
 VARYING HIGHP vec3 v_viewPos;
 VARYING vec3 v_normal;
@@ -44,6 +45,9 @@ void main() {
     MEDP vec3 albedo = surfaceAlbedo(v_uv);
     SurfaceParams surface = materialSurface(albedo, v_uv);
     HIGHP vec3 color = u_ambient * albedo;
+#if HAS_DIRECTIONAL
+    color += shadeDirectional(N, V, surface);
+#endif
 #if !NO_LIGHTS
 #if GLSL_ES == 100
     // GLSL ES 1.00 Appendix A: constant loop bound, exit with break.

@@ -142,8 +142,7 @@ vec3 shadeLight(Light light, HIGHP vec3 P, vec3 N, vec3 V, SurfaceParams surface
     HIGHP float falloff = w * w * (inv < 1.0 ? inv * inv / (1.0 + inv * inv) : 1.0 / (d * d + 1.0));
 #endif
     HIGHP vec3 L = s * invLen;
-    MEDP float nDotL = dot(N, L);
-    if (falloff <= 0.0 || nDotL <= 0.0) {
+    if (falloff <= 0.0 || dot(N, L) <= 0.0) {
         return vec3(0.0);
     }
 #if HAS_SPOT

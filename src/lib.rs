@@ -72,8 +72,9 @@ pub use scene::meshbuild::MeshBuilder;
 pub use scene::obj::LoadReport;
 pub use scene::{
     builtin::DEFAULT as DEFAULT_SCENE, builtin::NAMES as BUILTIN_SCENES, builtin_scene, load_scene,
-    load_scene_with, Aabb, Camera, Cone, Light, LightKind, LoadOptions, Material, MaterialModel,
-    Mesh, Object, Projection, RandomLights, Scene, SceneError, Texture,
+    load_scene_with, Aabb, Camera, Cone, DirectionalLight, Light, LightKind, LoadOptions, Material,
+    MaterialModel, Mesh, Object, Projection, RandomLights, Scene, SceneError, Texture,
+    MAX_DIRECTIONAL_LIGHTS,
 };
 
 /// How lights move over time: a [`Motion`](motion::Motion) per light, set with

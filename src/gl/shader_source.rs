@@ -138,6 +138,10 @@ pub const FILES: &[(&str, &str)] = &[
     ),
     ("surface.glsl", include_str!("../../glsl/surface.glsl")),
     (
+        "directional.glsl",
+        include_str!("../../glsl/directional.glsl"),
+    ),
+    (
         "light_struct.glsl",
         include_str!("../../glsl/light_struct.glsl"),
     ),

@@ -19,6 +19,7 @@
 
 use glam::{Mat4, Vec3, Vec4};
 
+use super::directional::DirectionalUniforms;
 use super::forward::Forward;
 use super::geometry::{shade_object, sort_objects, GeometryProgram, UNIT_METHOD};
 use super::uniforms::{self, Surface, Transforms};
@@ -148,12 +149,22 @@ pub struct CompositeProgram {
     exposure: Uniform<f32>,
     alpha: Uniform<f32>,
     heat_scale: Uniform<f32>,
+    /// Directional lights: the G-buffer's specular and the surface point's reconstruction.
+    g_specular: Uniform<Sampler>,
+    viewport: Uniform<[f32; 2]>,
+    half_extent: Uniform<[f32; 2]>,
+    orthographic: Uniform<f32>,
+    directional: DirectionalUniforms,
 }
 
 impl UniformSet for CompositeProgram {
     fn resolve(r: &mut Resolver<'_>) -> Self {
         let f = uniforms::features(r);
         let colour = !f.counting();
+        // The eye's direction (from the surface point) is read only by the specular term.
+        let directional = colour
+            && f.has(ShaderFeatures::DIRECTIONAL)
+            && f.has(ShaderFeatures::SPECULAR);
         CompositeProgram {
             g_albedo: r.required_when(colour, "u_gAlbedo"),
             g_normal_depth: r.required("u_gNormalDepth"),
@@ -166,6 +177,11 @@ impl UniformSet for CompositeProgram {
                 f.has(ShaderFeatures::COUNT_EVALS) && f.has(ShaderFeatures::COUNT_HEATMAP),
                 "u_heatScale",
             ),
+            g_specular: r.required_when(directional, "u_gSpecular"),
+            viewport: r.required_when(directional, "u_viewport"),
+            half_extent: r.required_when(directional, "u_halfExtent"),
+            orthographic: r.required_when(directional, "u_orthographic"),
+            directional: DirectionalUniforms::resolve(r, colour),
         }
     }
 }
@@ -220,14 +236,22 @@ impl Deferred {
         // through the same mapping the light pass reads it back with.
         let (half, _) = half_extent(ctx);
         let viewport = [ctx.viewport.0 as f32, ctx.viewport.1 as f32];
+        // Directional lights are the composite's: the G-buffer variant is the same without.
+        let features = ctx.features;
+        ctx.features = features.with(ShaderFeatures::DIRECTIONAL, false);
+        let mut drawn = Ok(());
         for k in 0..ctx.order.opaque.len() {
             let i = ctx.order.opaque[k];
-            shade_object(ctx, i, "gbuffer", 1, &mut |p: &GBufferProgram, dev| {
+            drawn = shade_object(ctx, i, "gbuffer", 1, &mut |p: &GBufferProgram, dev| {
                 p.viewport.set(dev, viewport);
                 p.half_extent.set(dev, half);
-            })?;
+            });
+            if drawn.is_err() {
+                break;
+            }
         }
-        Ok(())
+        ctx.features = features;
+        drawn
     }
 
     fn light_pass(&self, ctx: &mut FrameContext) -> Result<(), Error> {
@@ -236,14 +260,15 @@ impl Deferred {
         gb.begin_accumulation(dev);
         gb.bind_textures(dev, UNIT_G_ALBEDO);
         // Metallic-roughness compiled in only where a material uses it (the BRDF is then
-        // chosen per pixel from the G-buffer).
+        // chosen per pixel from the G-buffer); directional lights are the composite's.
         let features = ctx
             .features
             .with(ShaderFeatures::SPECULAR, true)
             .with(
                 ShaderFeatures::METALLIC_ROUGHNESS,
                 ctx.scene.materials.iter().any(|m| m.is_metallic_roughness()),
-            );
+            )
+            .with(ShaderFeatures::DIRECTIONAL, false);
         let (half, ortho) = half_extent(ctx);
         let viewport = [ctx.viewport.0 as f32, ctx.viewport.1 as f32];
         let far = ctx.far as f32;
@@ -333,7 +358,13 @@ impl Deferred {
         // formats to match exactly (ES 3.0: GL_INVALID_OPERATION otherwise; SwiftShader's
         // DEPTH_COMPONENT24 texture and renderbuffer differ, and a game's back buffer may too).
         RenderState::FULL_SCREEN_WITH_DEPTH.apply(dev);
-        let features = ctx.features;
+        let (half, ortho) = half_extent(ctx);
+        // Directional lights are shaded here, with the light pass's full material.
+        let sun = ctx.features.has(ShaderFeatures::DIRECTIONAL);
+        let features = ctx.features.with(ShaderFeatures::SPECULAR, sun).with(
+            ShaderFeatures::METALLIC_ROUGHNESS,
+            sun && ctx.scene.materials.iter().any(|m| m.is_metallic_roughness()),
+        );
         let key = ProgramKey {
             shader: "deferred_composite",
             features: features.0,
@@ -353,6 +384,12 @@ impl Deferred {
         p.exposure.set(dev, ctx.options.exposure_ev.exp2());
         p.alpha.set(dev, 1.0);
         p.heat_scale.set(dev, ctx.options.heat_scale.max(1.0));
+        p.g_specular.set(dev, UNIT_G_SPECULAR);
+        p.viewport
+            .set(dev, [ctx.viewport.0 as f32, ctx.viewport.1 as f32]);
+        p.half_extent.set(dev, half);
+        p.orthographic.set(dev, if ortho { 1.0 } else { 0.0 });
+        p.directional.set(dev, &ctx.directional);
         self.fullscreen.as_ref().expect("allocated").draw(dev);
         Ok(())
     }

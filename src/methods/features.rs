@@ -5,6 +5,12 @@ use crate::cluster::pack::{LightEncoding, DATA_TEXTURE_WIDTH};
 use crate::gl::EsVersion;
 use crate::scene::light::SPOT_MIN_COS_DELTA;
 
+/// Without fragment highp, the most one directional light adds to a pixel (in the fp16-range
+/// form): four of them stay below fp16's 65 504. Only a contribution at least a quarter of
+/// this (radiance / k² > 1/4) is ever capped, so the picture is unchanged at exposures of
+/// −11 EV and up (−2 EV and up through a tone map, whose input is capped at 1 000).
+pub const DIRECTIONAL_FP16_CAP: f32 = 16000.0;
+
 /// Feature bitset of a shader variant.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub struct ShaderFeatures(pub u64);
@@ -54,9 +60,12 @@ impl ShaderFeatures {
     /// materials that use it, and for the deferred light pass of a scene that has any (which
     /// then picks the BRDF per pixel from its G-buffer).
     pub const METALLIC_ROUGHNESS: u64 = 1 << 16;
+    /// The scene has directional lights: up to four, evaluated for every pixel from uniforms,
+    /// outside the light lists (`glsl/directional.glsl`).
+    pub const DIRECTIONAL: u64 = 1 << 17;
 
     /// Every flag with its name.
-    pub const NAMED: [(u64, &'static str); 17] = [
+    pub const NAMED: [(u64, &'static str); 18] = [
         (Self::TEXTURE, "texture"),
         (Self::SPOT, "spot"),
         (Self::SPECULAR, "specular"),
@@ -74,6 +83,7 @@ impl ShaderFeatures {
         (Self::TONEMAP_NEUTRAL, "tonemap_neutral"),
         (Self::UNIFORM_LIGHT_LOOP, "uniform_light_loop"),
         (Self::METALLIC_ROUGHNESS, "metallic_roughness"),
+        (Self::DIRECTIONAL, "directional"),
     ];
 
     /// Names of the set flags.
@@ -126,6 +136,15 @@ impl ShaderFeatures {
             ("COUNT_HEATMAP".into(), flag(Self::COUNT_HEATMAP)),
             ("UNIFORM_LIGHT_LOOP".into(), flag(Self::UNIFORM_LIGHT_LOOP)),
             ("METALLIC_ROUGHNESS".into(), flag(Self::METALLIC_ROUGHNESS)),
+            ("HAS_DIRECTIONAL".into(), flag(Self::DIRECTIONAL)),
+            (
+                "DIRECTIONAL_FP16_CAP".into(),
+                format!("{DIRECTIONAL_FP16_CAP:.1}"),
+            ),
+            (
+                "MAX_DIRECTIONAL".into(),
+                crate::scene::MAX_DIRECTIONAL_LIGHTS.to_string(),
+            ),
             (
                 "TONEMAP".into(),
                 if self.has(Self::TONEMAP_REINHARD) {

@@ -8,6 +8,7 @@
 //! lights than that (only reachable without fragment highp: 1 023) keeps the ones that matter
 //! most to the view ([`super::forward_cap`]), with a warning and the rest counted.
 
+use super::directional::DirectionalUniforms;
 use super::geometry::{self, GeometryProgram, UNIT_METHOD};
 use super::uniforms::{self, LightData, Surface, Transforms};
 use super::{FrameContext, MethodDesc, MethodStats, ShaderFeatures, ShadingMethod, Support};
@@ -64,6 +65,7 @@ pub struct ForwardProgram {
     surface: Surface,
     lights: LightData,
     count: Uniform<i32>,
+    directional: DirectionalUniforms,
 }
 
 impl UniformSet for ForwardProgram {
@@ -77,6 +79,7 @@ impl UniformSet for ForwardProgram {
             // Evaluation counts are the light count alone; reaching counts read the lights.
             lights: LightData::resolve(r, !no_lights && !f.has(ShaderFeatures::COUNT_EVALS)),
             count: r.required_when(!no_lights, "u_lightCount"),
+            directional: DirectionalUniforms::resolve(r, !f.counting()),
         }
     }
 }
@@ -87,6 +90,9 @@ impl GeometryProgram for ForwardProgram {
     }
     fn surface(&self) -> &Surface {
         &self.surface
+    }
+    fn directional(&self) -> Option<&DirectionalUniforms> {
+        Some(&self.directional)
     }
 }
 

@@ -1,6 +1,7 @@
 //! The geometry pass shared by the forward-style methods: every object drawn once with its
 //! material's shader variant, the method adding its own uniforms and textures.
 
+use super::directional::DirectionalUniforms;
 use super::uniforms::{Surface, SurfaceFrame, Transforms};
 use super::{FrameContext, ShaderFeatures};
 use crate::gl::program::{ProgramKey, Resolver, UniformSet};
@@ -20,6 +21,10 @@ pub trait GeometryProgram: UniformSet {
     fn transforms(&self) -> &Transforms;
     /// `surface.glsl`'s uniforms.
     fn surface(&self) -> &Surface;
+    /// `directional.glsl`'s uniforms, for programs that shade directional lights.
+    fn directional(&self) -> Option<&DirectionalUniforms> {
+        None
+    }
 }
 
 /// The depth prepass: transforms only (its fragment stage writes no colour).
@@ -188,6 +193,9 @@ pub(crate) fn shade_object<P: GeometryProgram>(
         &frame,
         features.has(ShaderFeatures::COUNT_HEATMAP),
     );
+    if let Some(directional) = program.directional() {
+        directional.set(dev, &ctx.directional);
+    }
     bind_method(program, dev);
     mesh.draw(dev);
     Ok(())

@@ -9,6 +9,7 @@ pub mod capacity;
 pub mod clustered;
 pub mod culled;
 pub mod deferred;
+pub mod directional;
 pub mod features;
 pub mod forward;
 pub mod forward_cap;
@@ -58,6 +59,8 @@ pub struct FrameContext<'a> {
     pub orthographic: bool,
     /// Active lights in view space (radius and radiance > 0).
     pub lights: &'a [GpuLight],
+    /// The frame's directional lights (shaded outside the light lists).
+    pub directional: directional::DirectionalFrame,
     /// Scene-level shader features (spots present, output encoding, light encoding).
     pub features: ShaderFeatures,
     /// Viewport size in pixels.

@@ -216,6 +216,12 @@ mod tests {
         F::NO_LIGHTS,
         F::NO_LIGHTS | F::TEXTURE | F::SPECULAR,
         F::NO_LIGHTS | F::COUNT_EVALS | F::COUNT_HEATMAP,
+        F::DIRECTIONAL,
+        F::DIRECTIONAL | F::SPECULAR | F::SPOT,
+        F::DIRECTIONAL | F::LIGHTS_RGBA8 | F::FP16_LIGHTS,
+        F::DIRECTIONAL | F::NO_LIGHTS | F::TEXTURE,
+        F::DIRECTIONAL | F::COUNT_EVALS,
+        F::DIRECTIONAL | F::UNIFORM_LIGHT_LOOP,
     ];
 
     fn build<U: UniformSet>(

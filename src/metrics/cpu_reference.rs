@@ -290,7 +290,8 @@ fn evaluate(
     for h in &hits {
         let surface = Surface::of(material, h.position, h.normal, material.diffuse.as_dvec3());
         let v = view_direction(&scene.camera, h.position);
-        let c = shading::shade(&surface, v, &scene.lights, scene.ambient);
+        let c = shading::shade(&surface, v, &scene.lights, scene.ambient)
+            + shading::shade_directional(&surface, v, &scene.directional_lights);
         for ch in 0..3 {
             let e = encoding.encode(c[ch]);
             (lo[ch], hi[ch]) = (lo[ch].min(e), hi[ch].max(e));
@@ -369,12 +370,9 @@ mod tests {
         let p = a + (b - a) * (-a.z / (b - a).z);
         let m = &scene.materials[0];
         let surface = Surface::of(m, p, DVec3::Z, m.diffuse.as_dvec3());
-        shading::shade(
-            &surface,
-            view_direction(cam, p),
-            &scene.lights,
-            scene.ambient,
-        )
+        let v = view_direction(cam, p);
+        shading::shade(&surface, v, &scene.lights, scene.ambient)
+            + shading::shade_directional(&surface, v, &scene.directional_lights)
     }
 
     fn check_against_plane(scene: &Scene, encoding: Encoding) {

@@ -7,7 +7,7 @@ use std::time::Instant;
 
 use glam::DMat4;
 
-use super::frame_setup::{content_far, gather_lights, shader_features};
+use super::frame_setup::{content_far, gather_directional, gather_lights, shader_features};
 use super::stats::{copy_opt_str, copy_str, copy_support};
 use super::stats::{LightStats, MemoryStats, TimeStats};
 use super::{FrameStats, Renderer};
@@ -128,6 +128,13 @@ impl Renderer {
         gather_lights(&mut self.lights, scene, &view, options);
         let scene_features = SceneFeatures::of(scene);
         let features = shader_features(&scene_features, options, self.dev.caps());
+        let directional = gather_directional(
+            scene,
+            &view,
+            features,
+            &mut self.shown_directional,
+            &mut self.warned_directional,
+        );
         let (near, far) = scene.camera.near_far();
         let content_far = content_far(self.gpu_scene.scene_bounds(scene), &view, near, far);
         let reach = super::fp16_range::view_reach(scene, width as f64 / height as f64, content_far);
@@ -143,6 +150,7 @@ impl Renderer {
             projection,
             orthographic: matches!(scene.camera.projection, Projection::Orthographic { .. }),
             lights: &self.lights,
+            directional,
             features,
             viewport: (width, height),
             near,

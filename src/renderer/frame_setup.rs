@@ -6,6 +6,7 @@ use glam::DMat4;
 
 use crate::cluster::view_light::GpuLight;
 use crate::gl::Caps;
+use crate::methods::directional::DirectionalFrame;
 use crate::methods::ShaderFeatures;
 use crate::options::{CountKind, RenderOptions, ToneMap};
 use crate::scene::features::SceneFeatures;
@@ -34,6 +35,30 @@ pub(super) fn gather_lights(
     }));
 }
 
+/// The frame's directional lights in view space (the brightest
+/// [`MAX_DIRECTIONAL_LIGHTS`](crate::scene::MAX_DIRECTIONAL_LIGHTS); `shown` keeps which),
+/// warning once (`warned`) when a scene has more.
+pub(super) fn gather_directional(
+    scene: &Scene,
+    view: &DMat4,
+    features: ShaderFeatures,
+    shown: &mut Vec<usize>,
+    warned: &mut bool,
+) -> DirectionalFrame {
+    let fp16 = features.has(ShaderFeatures::FP16_LIGHTS);
+    let (frame, dropped) = DirectionalFrame::gather(scene, view, fp16, shown);
+    if dropped > 0 && !*warned {
+        *warned = true;
+        log::warn!(
+            "a frame shows at most {} directional lights; {dropped} of the scene's {} active \
+             ones (the dimmest) are left out",
+            crate::scene::MAX_DIRECTIONAL_LIGHTS,
+            dropped + frame.count as usize
+        );
+    }
+    frame
+}
+
 /// The shader features a frame is drawn with: the scene's (spot lights), the options' (output,
 /// tone map, counts, precision) and the device's (fp16 lights without fragment highp, RGBA8
 /// light texels without float textures).
@@ -46,6 +71,10 @@ pub(super) fn shader_features(
         .with(
             ShaderFeatures::SPOT,
             scene_features.spot_lights || options.measure.full_variants,
+        )
+        .with(
+            ShaderFeatures::DIRECTIONAL,
+            scene_features.directional_lights,
         )
         .with(ShaderFeatures::OUTPUT_LINEAR, options.linear)
         .with(

@@ -45,6 +45,10 @@ pub struct Renderer {
     freed: bool,
     /// The frame's active lights in view space (kept: a frame fills it without allocating).
     lights: Vec<GpuLight>,
+    /// Which directional lights the frame shows (kept likewise).
+    shown_directional: Vec<usize>,
+    /// More directional lights than are shown was announced (once per renderer).
+    warned_directional: bool,
     /// The frame's objects in draw order (kept likewise).
     draw_order: methods::geometry::DrawOrder,
     /// `LP_NUM_THREADS` when the renderer was made (llvmpipe reads it when the context is
@@ -99,6 +103,8 @@ impl Renderer {
             pending_warning,
             freed: false,
             lights: Vec::new(),
+            shown_directional: Vec::new(),
+            warned_directional: false,
             draw_order: methods::geometry::DrawOrder::default(),
             lp_num_threads: std::env::var("LP_NUM_THREADS").ok(),
         })

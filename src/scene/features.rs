@@ -12,13 +12,15 @@ pub struct SceneFeatures {
     pub point_lights: bool,
     /// At least one active spot light (cone code compiled in).
     pub spot_lights: bool,
+    /// At least one active directional light (a sun), evaluated outside the light lists.
+    pub directional_lights: bool,
     /// At least one material with a diffuse texture.
     pub textures: bool,
     /// At least one material with a specular term.
     pub specular: bool,
     /// At least one transparent material (alpha below 1).
     pub transparency: bool,
-    /// Any active light at all.
+    /// Any active point or spot light at all.
     pub lights: bool,
 }
 
@@ -29,6 +31,7 @@ impl SceneFeatures {
         SceneFeatures {
             point_lights: active().any(|l| matches!(l.kind, LightKind::Point)),
             spot_lights: active().any(|l| matches!(l.kind, LightKind::Spot { .. })),
+            directional_lights: scene.directional_lights.iter().any(|l| l.is_active()),
             textures: scene.materials.iter().any(|m| m.diffuse_texture.is_some()),
             specular: scene.materials.iter().any(|m| m.has_specular()),
             transparency: scene.materials.iter().any(|m| m.is_transparent()),
@@ -51,5 +54,12 @@ mod tests {
         let f = SceneFeatures::of(&court);
         assert!(f.lights && f.point_lights && f.spot_lights && !f.transparency);
         assert!(SceneFeatures::of(&builtin::build("bubbles", None).unwrap()).transparency);
+        let mut sunny = builtin::build("plane", None).unwrap();
+        assert!(!SceneFeatures::of(&sunny).directional_lights);
+        let sun = crate::scene::DirectionalLight::new(glam::DVec3::NEG_Y, glam::Vec3::ONE, 0.0);
+        sunny.directional_lights.push(sun);
+        assert!(!SceneFeatures::of(&sunny).directional_lights, "a dark sun is not active");
+        sunny.directional_lights[0].intensity = 2.0;
+        assert!(SceneFeatures::of(&sunny).directional_lights);
     }
 }

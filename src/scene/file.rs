@@ -19,6 +19,7 @@
 //!      "direction": [0, -1, 0], "inner_deg": 15, "outer_deg": 30,
 //!      "motion": {"sweep": {"axis": [1, 0, 0], "angle_deg": 25, "period_s": 4}}}
 //!   ],
+//!   "directional_lights": [{"direction": [-1, -2, -1], "color": [1, 0.95, 0.9], "intensity": 3}],
 //!   "random_lights": {"count": 256, "seed": 7,
 //!                     "motion": {"wander": {"radius": 1.5, "period_s": 6}}}
 //! }
@@ -42,7 +43,7 @@ use super::motion::{Bob, Flicker, Motion, Orbit, OrbitAbout, Sweep, Wander};
 use super::model_cache::{self, ModelCache};
 use super::obj::LoadReport;
 use super::random::{self, LightSetStyle};
-use super::{Camera, Light, LightKind, MaterialModel, Scene, SceneError};
+use super::{Camera, DirectionalLight, Light, LightKind, MaterialModel, Scene, SceneError};
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -53,6 +54,8 @@ struct SceneFile {
     ambient: Option<[f32; 3]>,
     #[serde(default)]
     lights: Vec<LightSpec>,
+    #[serde(default)]
+    directional_lights: Vec<DirectionalSpec>,
     random_lights: Option<RandomLightsSpec>,
 }
 
@@ -124,6 +127,16 @@ struct LightSpec {
     inner_deg: Option<f64>,
     outer_deg: Option<f64>,
     motion: Option<MotionSpec>,
+}
+
+/// A sun: `direction` is the way the light travels (from it towards the scene).
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct DirectionalSpec {
+    direction: [f64; 3],
+    color: [f32; 3],
+    #[serde(default = "one")]
+    intensity: f32,
 }
 
 fn one() -> f32 {
@@ -386,6 +399,11 @@ pub fn parse(
             scene.animate_light(scene.lights.len() - 1, motion);
         }
     }
+    for (i, d) in file.directional_lights.iter().enumerate() {
+        let light = DirectionalLight::new(DVec3::from(d.direction), Vec3::from(d.color), d.intensity);
+        light.validate(&format!("directional_lights[{i}]"))?;
+        scene.directional_lights.push(light);
+    }
     match (&file.camera, builtin_camera) {
         (Some(c), _) => scene.camera = c.to_camera(),
         (None, Some(c)) if file.objects.len() == 1 => scene.camera = c,
@@ -627,6 +645,31 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(err.contains("ambient"), "{err}");
+    }
+
+    #[test]
+    fn directional_lights_parse_and_errors_name_the_field() {
+        let s = parse_str(
+            r#"{"objects": [{"builtin": "plane"}],
+                "directional_lights": [{"direction": [0, -3, 0], "color": [1, 0.5, 0.25]},
+                                       {"direction": [1, -1, 0], "color": [1, 1, 1], "intensity": 2.5}]}"#,
+        )
+        .unwrap();
+        assert_eq!(s.directional_lights.len(), 2);
+        assert_eq!(s.directional_lights[0].intensity, 1.0, "intensity defaults to 1");
+        assert_eq!(s.directional_lights[0].to_light(), DVec3::Y);
+        assert_eq!(s.directional_lights[1].radiance(), Vec3::splat(2.5));
+        for (bad, field) in [
+            (r#"{"direction": [0, 0, 0], "color": [1, 1, 1]}"#, "directional_lights[0].direction"),
+            (r#"{"direction": [0, -1, 0], "color": [1, -1, 1]}"#, "directional_lights[0].color"),
+            (r#"{"direction": [0, -1, 0], "color": [1, 1, 1], "intensity": -2}"#, "directional_lights[0].intensity"),
+            (r#"{"direction": [0, -1, 0], "color": [1, 1, 1], "radius": 2}"#, "directional_lights[0]"),
+            (r#"{"color": [1, 1, 1]}"#, "directional_lights[0]"),
+        ] {
+            let text = format!(r#"{{"objects": [{{"builtin": "plane"}}], "directional_lights": [{bad}]}}"#);
+            let err = parse_str(&text).unwrap_err().to_string();
+            assert!(err.contains(field), "{bad}: {err}");
+        }
     }
 
     #[test]

@@ -11,6 +11,7 @@ pub mod brdf;
 pub mod builtin;
 pub mod camera;
 pub mod direction;
+pub mod directional;
 mod duplicates;
 pub mod error;
 pub mod features;
@@ -39,6 +40,7 @@ use glam::{DMat4, Vec3};
 
 pub use access::LoadOptions;
 pub use camera::{Camera, Projection};
+pub use directional::{DirectionalLight, MAX_DIRECTIONAL_LIGHTS};
 pub use error::SceneError;
 pub use light::{Cone, Light, LightKind};
 pub use material::{Material, MaterialModel, Texture};
@@ -66,6 +68,9 @@ pub struct Scene {
     pub materials: Vec<Material>,
     /// Point and spot lights (validated with [`Scene::validate`] before rendering).
     pub lights: Vec<Light>,
+    /// Lights from infinitely far away (a sun), evaluated for every pixel outside the light
+    /// lists; at most [`MAX_DIRECTIONAL_LIGHTS`] are shown (the brightest, with a warning).
+    pub directional_lights: Vec<DirectionalLight>,
     /// Ambient radiance in linear RGB, multiplied by the albedo.
     pub ambient: Vec3,
     /// The viewpoint.
@@ -82,6 +87,7 @@ impl Scene {
             objects: Vec::new(),
             materials: Vec::new(),
             lights: Vec::new(),
+            directional_lights: Vec::new(),
             ambient: Vec3::splat(0.02),
             camera: Camera::default(),
             animation: Vec::new(),
@@ -204,6 +210,11 @@ impl Scene {
         for (i, light) in self.lights.iter().enumerate() {
             if light.validate("").is_err() {
                 light.validate(&format!("lights[{i}]"))?;
+            }
+        }
+        for (i, light) in self.directional_lights.iter().enumerate() {
+            if light.validate("").is_err() {
+                light.validate(&format!("directional_lights[{i}]"))?;
             }
         }
         for track in &self.animation {

@@ -11,6 +11,7 @@
 //! diffuse  = albedo · max(N·L, 0)
 //! specular = Ks · max(N·H, 0)^Ns   with H = normalize(L + V), only where N·L > 0
 //! out      = ambient · albedo + Σ c · falloff · spot · (diffuse + specular)
+//!                             + Σ suns c · (diffuse + specular)  with L = −direction
 //! ```
 //!
 //! That is the Blinn-Phong model; a metallic-roughness material replaces `diffuse + specular`
@@ -25,6 +26,7 @@
 
 use glam::{DVec3, Vec3};
 
+use super::directional::{shown_directional_lights, DirectionalLight};
 use super::light::{Light, LightKind};
 use super::material::{Material, MaterialModel};
 
@@ -133,12 +135,23 @@ pub fn light_contribution(light: &Light, s: &Surface, v: DVec3) -> DVec3 {
         return DVec3::ZERO;
     }
     let l = to_light / d.max(1e-6);
+    let reflected = reflected(l, s, v);
+    if reflected == DVec3::ZERO {
+        return DVec3::ZERO;
+    }
+    let spot = spot_factor(light, -l);
+    light.radiance().as_dvec3() * (f * spot) * reflected
+}
+
+/// What the surface reflects along `v` of unit irradiance arriving from the unit direction `l`
+/// (surface → light): [`reflectance`], zero where `N·L ≤ 0`. Every kind of light scales this
+/// (`surfaceReflectance` in `glsl/light_model.glsl`).
+pub fn reflected(l: DVec3, s: &Surface, v: DVec3) -> DVec3 {
     let n_dot_l = s.normal.dot(l);
     if n_dot_l <= 0.0 {
         return DVec3::ZERO;
     }
-    let spot = spot_factor(light, -l);
-    light.radiance().as_dvec3() * (f * spot) * reflectance(l, s, v)
+    reflectance(l, s, v)
 }
 
 /// What the light's radiance × falloff × spot is multiplied by for unit `l` (to the light)
@@ -154,6 +167,27 @@ pub fn reflectance(l: DVec3, s: &Surface, v: DVec3) -> DVec3 {
             super::brdf::reflectance(l, s.normal, v, s.albedo, s.metallic, s.roughness)
         }
     }
+}
+
+/// Radiance one directional light reflects along `v` (no falloff: it is the same everywhere).
+pub fn directional_contribution(light: &DirectionalLight, s: &Surface, v: DVec3) -> DVec3 {
+    light.radiance().as_dvec3() * reflected(light.to_light(), s, v)
+}
+
+/// What the directional lights a frame shows ([`shown_directional_lights`]: the brightest
+/// [`MAX_DIRECTIONAL_LIGHTS`](super::MAX_DIRECTIONAL_LIGHTS)) add along `v`, two-sided as
+/// [`shade`]. The total a pixel shows is `shade(..) + shade_directional(..)`.
+pub fn shade_directional(s: &Surface, v: DVec3, lights: &[DirectionalLight]) -> DVec3 {
+    let mut s = *s;
+    if s.normal.dot(v) < 0.0 {
+        s.normal = -s.normal;
+    }
+    let mut shown = Vec::new();
+    shown_directional_lights(lights, &mut shown);
+    shown
+        .iter()
+        .map(|&i| directional_contribution(&lights[i], &s, v))
+        .sum()
 }
 
 /// Total linear radiance along `v` (unit, surface → eye): ambient plus every light. Surfaces

@@ -83,7 +83,7 @@ fn validate(conf: Option<&Path>, file: &Path) -> Result<(), String> {
 
 /// Every combination of feature bits a colour variant can have, the count variants
 /// (evaluations, reaching lights, heatmap) with and without spots and RGBA8 light data, the
-/// tone-mapped variants and the uniform-light-loop workaround.
+/// tone-mapped variants, the uniform-light-loop workaround and directional lights.
 fn all_features() -> Vec<ShaderFeatures> {
     let mut all = colour_features();
     for count in [
@@ -139,6 +139,22 @@ fn all_features() -> Vec<ShaderFeatures> {
         ShaderFeatures::COUNT_EVALS,
     ] {
         all.push(ShaderFeatures(ShaderFeatures::METALLIC_ROUGHNESS | extra));
+    }
+    // Directional lights (their own loop over uniforms), with the material and light features,
+    // without point lights, the workaround's loop, the precisions, HDR output and counting.
+    for extra in [
+        0,
+        ShaderFeatures::SPECULAR,
+        ShaderFeatures::TEXTURE | ShaderFeatures::SPOT | ShaderFeatures::SPECULAR,
+        ShaderFeatures::LIGHTS_RGBA8 | ShaderFeatures::SPOT | ShaderFeatures::SPECULAR,
+        ShaderFeatures::NO_LIGHTS | ShaderFeatures::SPECULAR,
+        ShaderFeatures::UNIFORM_LIGHT_LOOP | ShaderFeatures::SPECULAR,
+        ShaderFeatures::REFERENCE_PRECISION | ShaderFeatures::SPECULAR,
+        ShaderFeatures::OUTPUT_HDR | ShaderFeatures::TONEMAP_ACES,
+        ShaderFeatures::COUNT_EVALS,
+        ShaderFeatures::METALLIC_ROUGHNESS | ShaderFeatures::SPOT,
+    ] {
+        all.push(ShaderFeatures(ShaderFeatures::DIRECTIONAL | extra));
     }
     all
 }

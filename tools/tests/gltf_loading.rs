@@ -367,7 +367,7 @@ fn lights_document(b: &mut Builder) -> Value {
         "extensionsUsed": ["KHR_lights_punctual"],
         "extensions": {"KHR_lights_punctual": {"lights": [
             {"type": "point", "color": [1, 0.5, 0.25], "intensity": 3, "range": 7},
-            {"type": "point", "intensity": 1},
+            {"type": "point", "intensity": 2048},
             {"type": "spot", "intensity": 5, "range": 9,
              "spot": {"innerConeAngle": 0.25, "outerConeAngle": 0.5}},
             {"type": "directional", "intensity": 100}
@@ -394,21 +394,28 @@ fn point_and_spot_lights_come_with_positions_directions_radii_and_cones() {
     let doc = lights_document(&mut b);
     let path = write(dir.path(), "lights.gltf", b.gltf(doc));
     let (scene, report) = load(&path).unwrap();
-    assert_eq!(scene.lights.len(), 3, "the directional light is skipped");
-    assert!(
-        report
-            .warnings
-            .iter()
-            .any(|w| w.contains("directional") && w.contains("lights[3]")),
-        "{:?}",
-        report.warnings
+    assert_eq!(scene.lights.len(), 3);
+    assert!(report.warnings.is_empty(), "{:?}", report.warnings);
+    // The directional light: the node's −Z, lux on the candela's scale.
+    assert_eq!(scene.directional_lights.len(), 1);
+    let sun = &scene.directional_lights[0];
+    assert_eq!(sun.direction, DVec3::NEG_Z);
+    assert_eq!(sun.color, Vec3::ONE);
+    assert_eq!(
+        f64::from(sun.intensity),
+        100.0 * scene::gltf::LUX_TO_INTENSITY
     );
     let point = &scene.lights[0];
     assert_eq!(point.kind, LightKind::Point);
     assert_eq!(point.position, DVec3::new(1.0, 2.0, 3.0));
     assert_eq!(point.radius, 7.0);
     assert_eq!(point.color, Vec3::new(1.0, 0.5, 0.25));
-    assert_eq!(point.intensity, 3.0);
+    assert_eq!(
+        f64::from(point.intensity),
+        3.0 * scene::gltf::CANDELA_TO_INTENSITY
+    );
+    // One photometric scale: 2 048 cd is intensity 1.
+    assert_eq!(scene.lights[1].intensity, 1.0);
     // No range: where 1 / (d² + 1) falls to the cut-off; scale does not change it.
     let unbounded = &scene.lights[1];
     let want = (1.0 / scene::gltf::UNBOUNDED_CUTOFF - 1.0).sqrt();
@@ -465,6 +472,9 @@ fn a_gltf_object_in_a_json_scene_brings_its_lights_and_camera_placed_by_its_tran
     assert!((scene.lights[0].position - want).length() < 1e-9);
     assert!((scene.lights[0].position - DVec3::new(13.0, 2.0, -1.0)).length() < 1e-9);
     assert_eq!(scene.lights[0].radius, 7.0, "radius not scaled");
+    // The sun turned with the object: the quarter turn about +Y takes −Z to −X.
+    let sun = scene.directional_lights[0].direction;
+    assert!((sun - DVec3::NEG_X).length() < 1e-9, "{sun}");
     // The camera: the only object's own, placed too, looking down the turned −Z (−X).
     let cam = scene.camera;
     assert!((cam.position - place.transform_point3(DVec3::new(0.0, 0.0, 5.0))).length() < 1e-9);
@@ -571,8 +581,9 @@ fn comparison(dir: &Path) -> Comparison {
     let gltf = json!({
         "extensionsUsed": ["KHR_lights_punctual"],
         "extensions": {"KHR_lights_punctual": {"lights": [
-            {"type": "point", "color": [1, 0.9, 0.8], "intensity": 8, "range": 6},
-            {"type": "spot", "intensity": 12, "range": 8,
+            // 8 and 12 in the JSON scene: candela × 2⁻¹¹ (docs/gltf.md).
+            {"type": "point", "color": [1, 0.9, 0.8], "intensity": 8 * 2048, "range": 6},
+            {"type": "spot", "intensity": 12 * 2048, "range": 8,
              "spot": {"innerConeAngle": 0.3, "outerConeAngle": 0.6}}
         ]}},
         "scene": 0,
@@ -1551,4 +1562,56 @@ fn a_json_file_that_is_not_gltf_shows_none_of_its_strings() {
     let path = write(dir.path(), "none.gltf", "{}");
     let err = load(&path).unwrap_err().to_string();
     assert!(err.contains("missing field `asset`"), "{err}");
+}
+
+#[test]
+fn a_file_lit_only_by_a_sun_is_lit_as_the_model_says() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut b = Builder::default();
+    let floor_prim = b.primitive(&floor(), Some(0));
+    // The sun's node aimed down and forward: −Z turned 50° about +X.
+    let sun_turn = DQuat::from_rotation_x(-50f64.to_radians());
+    let cam_turn = DQuat::from_rotation_x(-20f64.to_radians());
+    let gltf = json!({
+        "extensionsUsed": ["KHR_lights_punctual"],
+        // 2 048 lux: intensity 1 on the photometric scale (docs/gltf.md).
+        "extensions": {"KHR_lights_punctual": {"lights": [
+            {"type": "directional", "color": [1, 0.9, 0.8], "intensity": 2048}
+        ]}},
+        "scenes": [{"nodes": [0, 1, 2]}],
+        "nodes": [
+            {"mesh": 0},
+            {"translation": [0, 5, 0], "rotation": quat(sun_turn),
+             "extensions": {"KHR_lights_punctual": {"light": 0}}},
+            {"camera": 0, "translation": [0, 2, 5], "rotation": quat(cam_turn)}
+        ],
+        "cameras": [{"type": "perspective", "perspective": {"yfov": 0.9, "znear": 0.05, "zfar": 50}}],
+        "meshes": [{"primitives": [floor_prim]}],
+        "materials": [{"pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.8, 0.8, 1]}}],
+    });
+    let path = write(dir.path(), "sunny.gltf", b.gltf(gltf));
+    let (scene, report) = load(&path).unwrap();
+    assert!(report.warnings.is_empty(), "{:?}", report.warnings);
+    assert!(scene.lights.is_empty());
+    let sun = scene.directional_lights[0];
+    assert!((sun.direction - sun_turn * DVec3::NEG_Z).length() < 1e-9);
+    assert_eq!(sun.intensity, 1.0);
+    let mut gpu = Gpu::new(EsVersion::Es3);
+    let img = gpu.render(&scene, 96, 54, &RenderOptions::default());
+    let caps = gpu.r().caps().clone();
+    let encoding = manylight::metrics::cpu_reference::Encoding::Srgb;
+    let (err, at, n) = common::max_oracle_error(&img, &scene, encoding, &caps);
+    assert!(
+        n > 96 * 54 / 8 && err <= 2.0,
+        "{err:.2}/255 at {at:?} over {n}"
+    );
+    // Neither black nor white: the floor at 0.8 × cos 40° of the sun (sRGB 207).
+    let lit: Vec<u8> = img
+        .pixels()
+        .map(|p| p[0].max(p[1]).max(p[2]))
+        .filter(|&v| v > 40)
+        .collect();
+    assert!(lit.len() > 96 * 54 / 8, "only {} lit pixels", lit.len());
+    let peak = lit.iter().max().copied().unwrap_or(0);
+    assert!((150..=240).contains(&peak), "brightest {peak}/255");
 }

@@ -9,6 +9,7 @@ use crate::cluster::grid::{ClusterGrid, DepthMapping};
 use crate::gl::program::{Resolver, Sampler, Uniform, UniformSet};
 use crate::gl::texture::DataTexture;
 use crate::gl::{Device, EsVersion};
+use crate::methods::directional::DirectionalUniforms;
 use crate::methods::geometry::{GeometryProgram, UNIT_METHOD};
 use crate::methods::uniforms::{self, inv_height, LightData, Surface, Transforms};
 use crate::methods::ShaderFeatures;
@@ -26,6 +27,7 @@ pub struct ClusteredProgram {
     cells: CellLookup,
     /// The frame's longest cell list (the uniform light loop's bound).
     longest_list: Uniform<f32>,
+    directional: DirectionalUniforms,
 }
 
 /// `cluster_lookup.glsl`: how a fragment finds its cell and reads its list.
@@ -62,6 +64,7 @@ impl UniformSet for ClusteredProgram {
                 lit && es2 && f.has(ShaderFeatures::UNIFORM_LIGHT_LOOP),
                 "u_longestList",
             ),
+            directional: DirectionalUniforms::resolve(r, lit),
         }
     }
 }
@@ -72,6 +75,9 @@ impl GeometryProgram for ClusteredProgram {
     }
     fn surface(&self) -> &Surface {
         &self.surface
+    }
+    fn directional(&self) -> Option<&DirectionalUniforms> {
+        Some(&self.directional)
     }
 }
 

@@ -1,13 +1,19 @@
 //! `KHR_lights_punctual` → the renderer's [`Light`]s.
 //!
-//! - Position: the node's world origin; a spot's direction: the node's world −Z.
-//! - Units: glTF gives point and spot intensities in candela. The renderer's `intensity` is
-//!   taken as candela × [`CANDELA_TO_INTENSITY`] (= 1): a surface 1 unit from a 1 cd light
-//!   receives 1 lux, which the renderer shows as radiance 1 × albedo. The renderer's
+//! - Position: the node's world origin; a spot's or a directional light's direction: the
+//!   node's world −Z.
+//! - Units: glTF is photometric: point and spot intensities in candela, directional ones in
+//!   lux. Both come in on one scale, [`PHOTOMETRIC_SCALE`] = 2⁻¹¹: renderer intensity =
+//!   cd × 2⁻¹¹ ([`CANDELA_TO_INTENSITY`]) = lux × 2⁻¹¹ ([`LUX_TO_INTENSITY`]), so a surface
+//!   square to a sun of 2 048 lux shows radiance 1 × albedo (and one facing a lamp of I cd,
+//!   d away, I × 2⁻¹¹ / (d² + 1) × albedo).
+//!   This is the default exposure of glTF scenes, −11 EV against the raw numbers: a lamp of a
+//!   few hundred cd lights a room a few metres across, and a sun of a few thousand lux an
+//!   outdoor scene, without going black or white (the real sun's 100 000 lux needs
+//!   `--exposure -5` or a tone map); `--exposure` works on top. The renderer's
 //!   falloff is `w(d)² / (d² + 1)` (see [`crate::scene::shading::falloff`]), not glTF's
 //!   `w(d) / d²`: within about 1 unit of a light it is dimmer than glTF's, and never
-//!   infinite. Physically based exports (Blender writes W × 683 / 4π cd) come out bright:
-//!   `--exposure` brings them down.
+//!   infinite.
 //! - Radius: `range` when given (both reach exactly zero there). Without a range glTF's light
 //!   reaches to infinity; the renderer's must stop, so the radius is where the inverse-square
 //!   term `I / (d² + 1)` of the light's brightest channel falls to [`UNBOUNDED_CUTOFF`]
@@ -16,17 +22,23 @@
 //! - Cones: glTF's half-angles in radians → `inner_deg` / `outer_deg`. glTF fades linearly
 //!   in the cosine and squares; the renderer fades with a smoothstep between the same angles.
 //! - Node scale moves lights but changes neither their radius nor their intensity (as glTF
-//!   says). Directional lights cannot be shown (every light needs a finite radius): each is
-//!   skipped with a warning.
+//!   says). Directional lights become [`DirectionalLight`]s (a frame shows the brightest four).
 
 use glam::{DMat4, DVec3, Vec3};
 use gltf::khr_lights_punctual::Kind;
 
 use crate::scene::camera::MAX_CAMERA_COORD;
-use crate::scene::{Light, LightKind};
+use crate::scene::{DirectionalLight, Light, LightKind};
+
+/// The one scale of glTF's photometric units (candela, lux) to the renderer's intensity: in
+/// effect a default exposure of −11 EV for glTF files (see the module's notes).
+pub const PHOTOMETRIC_SCALE: f64 = 1.0 / 2048.0;
 
 /// Renderer `intensity` per candela of a glTF point or spot light.
-pub const CANDELA_TO_INTENSITY: f64 = 1.0;
+pub const CANDELA_TO_INTENSITY: f64 = PHOTOMETRIC_SCALE;
+
+/// Renderer `intensity` per lux of a glTF directional light.
+pub const LUX_TO_INTENSITY: f64 = PHOTOMETRIC_SCALE;
 
 /// Radiance (linear, before the surface's albedo) at which a light without a `range` is cut
 /// off: 1/1024, about one 8-bit step of the sRGB output over the default ambient.
@@ -47,6 +59,8 @@ pub fn unbounded_radius(peak: f64) -> f64 {
 pub(super) enum Converted {
     /// A light the renderer shows.
     Light(Light),
+    /// A directional light (a sun).
+    Directional(DirectionalLight),
     /// Not shown; the warning says why.
     Skipped(String),
 }
@@ -70,13 +84,18 @@ pub(super) fn convert(
             "{field}: color must be finite and >= 0, got {color:?}"
         ));
     }
-    let intensity = (f64::from(raw) * CANDELA_TO_INTENSITY) as f32;
     let kind = match light.kind() {
         Kind::Directional => {
-            return Ok(Converted::Skipped(format!(
-                "{field}: directional lights are not supported by the renderer (every light \
-                 needs a finite radius); skipped"
-            )))
+            let direction = world.transform_vector3(DVec3::NEG_Z);
+            if crate::scene::direction::unit(direction).is_none() {
+                return Ok(Converted::Skipped(format!(
+                    "{field}: the node's transform has no direction (zero scale); skipped"
+                )));
+            }
+            let intensity = (f64::from(raw) * LUX_TO_INTENSITY) as f32;
+            let sun = DirectionalLight::new(direction, color, intensity);
+            sun.validate(field).map_err(|e| e.to_string())?;
+            return Ok(Converted::Directional(sun));
         }
         Kind::Point => LightKind::Point,
         Kind::Spot {
@@ -96,6 +115,7 @@ pub(super) fn convert(
             }
         }
     };
+    let intensity = (f64::from(raw) * CANDELA_TO_INTENSITY) as f32;
     let position = world.transform_point3(DVec3::ZERO);
     let reach = position.abs().max_element();
     if !reach.is_finite() || reach > MAX_CAMERA_COORD {

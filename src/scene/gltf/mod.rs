@@ -11,7 +11,8 @@
 //!   every other node that places it ([`mesh`]); points and lines are skipped with a warning;
 //! - materials → Lambert + Blinn-Phong ([`material`]), base colour textures ([`texture`]);
 //! - the first camera a node instances (depth first, in order) ([`camera`]);
-//! - `KHR_lights_punctual` point and spot lights ([`lights`]).
+//! - `KHR_lights_punctual` point, spot and directional lights, on one photometric scale
+//!   ([`lights`]).
 //!
 //! A required extension the loader lacks, or a file with nothing to draw, is a
 //! [`SceneError::GltfUnsupported`] naming it; features that change the picture but are not
@@ -45,14 +46,18 @@ use std::sync::Arc;
 
 use glam::DMat4;
 
-pub use lights::{unbounded_radius, CANDELA_TO_INTENSITY, UNBOUNDED_CUTOFF};
+pub use lights::{
+    unbounded_radius, CANDELA_TO_INTENSITY, LUX_TO_INTENSITY, PHOTOMETRIC_SCALE, UNBOUNDED_CUTOFF,
+};
 pub use material::{shininess, DIELECTRIC_SPECULAR};
 
 use super::access::LoadOptions;
 use super::camera::MAX_CAMERA_COORD;
 use super::input::{self, read_bounded, FileKind};
 use super::obj::LoadReport;
-use super::{random, Aabb, Camera, Light, Material, Mesh, Object, Scene, SceneError};
+use super::{
+    random, Aabb, Camera, DirectionalLight, Light, Material, Mesh, Object, Scene, SceneError,
+};
 
 /// Most vertices one glTF file may decode into (33.5 M, about 1 GiB of vertex data: what
 /// the largest OBJ file allowed holds). Checked before each accessor is allocated.
@@ -180,6 +185,7 @@ pub fn load_into(
             o
         }));
     scene.lights.extend(imported.lights);
+    scene.directional_lights.extend(imported.directional_lights);
     let mut report = LoadReport::default();
     for w in imported.warnings {
         let msg = format!("{}: {w}", path.display());
@@ -236,6 +242,7 @@ struct Imported {
     objects: Vec<Object>,
     materials: Vec<Material>,
     lights: Vec<Light>,
+    directional_lights: Vec<DirectionalLight>,
     camera: Option<Camera>,
     warnings: Vec<String>,
 }
@@ -288,6 +295,7 @@ fn import(
         objects: Vec::new(),
         materials: Vec::new(),
         lights: Vec::new(),
+        directional_lights: Vec::new(),
         camera: None,
         warnings: Vec::new(),
     };
@@ -348,9 +356,10 @@ fn import(
             );
             match lights::convert(&light, &p.world, &lfield)? {
                 // Checked in the file's space; now placed.
-                lights::Converted::Light(_) => {
+                lights::Converted::Light(_) | lights::Converted::Directional(_) => {
                     match lights::convert(&light, &world, &lfield).map_err(placing)? {
                         lights::Converted::Light(l) => out.lights.push(l),
+                        lights::Converted::Directional(l) => out.directional_lights.push(l),
                         lights::Converted::Skipped(why) => warnings.push(why),
                     }
                 }
@@ -364,7 +373,7 @@ fn import(
             out.camera = Some(camera::convert(&document, &cam, &world, &cfield).map_err(placing)?);
         }
     }
-    if out.objects.is_empty() && out.lights.is_empty() {
+    if out.objects.is_empty() && out.lights.is_empty() && out.directional_lights.is_empty() {
         return Err(Fault::Unsupported(format!(
             "nothing to show: {from} place no triangle mesh and no light"
         )));
