@@ -231,7 +231,7 @@ fn every_method_stays_finite_on_the_stiff_cases() {
 /// deferred G-buffer holds both models): the picture is the f64 twin's, and every method
 /// equals forward on ES 2.0 and 3.0.
 #[test]
-fn metal_spheres_match_the_twin_and_every_method_equals_forward() {
+fn metal_spheres_under_a_sun_match_the_twin_and_every_method_equals_forward() {
     let mut s = Scene::empty();
     let materials = [
         Material::metallic_roughness("rough gold", Vec3::new(1.0, 0.77, 0.34), 1.0, 0.6),
@@ -265,6 +265,12 @@ fn metal_spheres_match_the_twin_and_every_method_equals_forward() {
         ][i];
         s.lights.push(Light::point(DVec3::from(p), 6.0, c, 3.0));
     }
+    // A sun too: deferred shades it in its composite, with the BRDF chosen per pixel there.
+    s.directional_lights.push(manylight::DirectionalLight::new(
+        DVec3::new(-0.4, -1.0, -0.6),
+        Vec3::new(1.0, 0.95, 0.9),
+        0.4,
+    ));
     s.ambient = Vec3::splat(0.03);
     s.camera = Camera::perspective(DVec3::new(0.0, 0.5, 6.0), DVec3::ZERO, 50.0, 0.5, 30.0);
     s.validate().unwrap();
