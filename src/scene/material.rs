@@ -4,6 +4,7 @@ use std::sync::Arc;
 
 use glam::Vec3;
 
+use super::surface_maps::SurfaceMaps;
 use super::SceneError;
 
 /// An 8-bit sRGB RGBA image used as a diffuse texture (decoded to linear in the shader).
@@ -31,6 +32,9 @@ pub struct Material {
     /// Opacity (`d` in MTL): 1 is opaque; below 1 the object is drawn after the opaque ones,
     /// back to front, alpha-blended.
     pub alpha: f32,
+    /// Normal, emissive, occlusion and metallic-roughness inputs and texture transforms
+    /// (glTF; defaults for OBJ and built-in materials).
+    pub maps: SurfaceMaps,
 }
 
 impl Default for Material {
@@ -55,6 +59,7 @@ impl Material {
             specular: Vec3::splat(0.04),
             shininess: 32.0,
             alpha: 1.0,
+            maps: SurfaceMaps::default(),
         }
     }
 
@@ -100,6 +105,13 @@ impl Material {
             return Err(SceneError::invalid(
                 format!("{field}.alpha"),
                 format!("must be in [0, 1], got {}", self.alpha),
+            ));
+        }
+        let e = self.maps.emissive;
+        if !e.is_finite() || e.min_element() < 0.0 || e.max_element() > MAX_COLOR_FACTOR {
+            return Err(SceneError::invalid(
+                format!("{field}.emissive"),
+                format!("must be in [0, {MAX_COLOR_FACTOR}], got {e:?}"),
             ));
         }
         if !(self.shininess.is_finite() && self.shininess >= 0.0) {

@@ -105,6 +105,7 @@ pub fn load_into(
             specular,
             shininess: m.shininess.map_or(1.0, |s| s as f32),
             alpha: m.dissolve.map_or(1.0, |d| d as f32).clamp(0.0, 1.0),
+            maps: Default::default(),
         });
     }
     let fallback = scene.add_material(Material {

@@ -9,7 +9,8 @@
 //!   hierarchy composed in `f64` ([`nodes`]);
 //! - each triangle primitive of each placed mesh → one [`Object`] sharing its [`Mesh`] with
 //!   every other node that places it ([`mesh`]); points and lines are skipped with a warning;
-//! - materials → Lambert + Blinn-Phong ([`material`]), base colour textures ([`texture`]);
+//! - materials → Lambert + Blinn-Phong ([`material`]), their textures ([`texture`]) and
+//!   surface maps (normal, emissive, occlusion, metallic-roughness, texture transforms);
 //! - the first camera a node instances (depth first, in order) ([`camera`]);
 //! - `KHR_lights_punctual` point and spot lights ([`lights`]).
 //!
@@ -27,6 +28,7 @@ pub mod camera;
 mod glb;
 mod integers;
 pub mod lights;
+mod maps;
 pub mod material;
 pub mod mesh;
 pub mod nodes;
@@ -61,7 +63,11 @@ pub const MAX_OBJECTS: usize = 1 << 20;
 
 /// Extensions the loader implements; a file *requiring* another is refused (by the `gltf`
 /// crate's validation), one merely *using* another gets a warning that it is ignored.
-pub const SUPPORTED_EXTENSIONS: &[&str] = &["KHR_lights_punctual"];
+pub const SUPPORTED_EXTENSIONS: &[&str] = &[
+    "KHR_lights_punctual",
+    "KHR_texture_transform",
+    "KHR_materials_emissive_strength",
+];
 
 /// What a glTF load produced besides what went into the scene.
 #[derive(Debug, Default)]
@@ -262,7 +268,7 @@ fn import(
     };
     // Each primitive is built once, with its object-space bounds, however many nodes place it.
     let mut meshes: HashMap<(usize, usize), Option<BuiltMesh>> = HashMap::new();
-    let mut materials = material::Materials::default();
+    let mut materials = material::Materials::new(json);
     let mut out = Imported {
         objects: Vec::new(),
         materials: Vec::new(),
