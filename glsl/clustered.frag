@@ -27,8 +27,11 @@ void main() {
     if (dot(N, V) < 0.0) {
         N = -N;
     }
+#if HAS_NORMAL_MAP
+    N = surfaceNormal(N, v_uv);
+#endif
     MEDP vec3 albedo = surfaceAlbedo(v_uv);
-    HIGHP vec3 color = u_ambient * albedo;
+    HIGHP vec3 color = surfaceAmbient(albedo, v_uv);
 #if GLSL_ES == 100
     HIGHP vec2 cell = clusterCell(fragXY, viewDepth);
 #if UNIFORM_LIGHT_LOOP
@@ -58,6 +61,9 @@ void main() {
     for (uint n = 0u; n < cell.y; n++) {
         color += shadeLight(fetchLight(lightIndexAt(cell.x + n)), v_viewPos, N, V, albedo, u_specular, u_shininess);
     }
+#endif
+#if HAS_EMISSIVE
+    color += surfaceEmission(v_uv);
 #endif
     FRAG_COLOR = encodeOutput(color);
 #endif

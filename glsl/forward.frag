@@ -41,8 +41,11 @@ void main() {
     if (dot(N, V) < 0.0) {
         N = -N;
     }
+#if HAS_NORMAL_MAP
+    N = surfaceNormal(N, v_uv);
+#endif
     MEDP vec3 albedo = surfaceAlbedo(v_uv);
-    HIGHP vec3 color = u_ambient * albedo;
+    HIGHP vec3 color = surfaceAmbient(albedo, v_uv);
 #if !NO_LIGHTS
 #if GLSL_ES == 100
     // GLSL ES 1.00 Appendix A: constant loop bound, exit with break.
@@ -57,6 +60,9 @@ void main() {
         color += shadeLight(fetchLight(i), v_viewPos, N, V, albedo, u_specular, u_shininess);
     }
 #endif
+#endif
+#if HAS_EMISSIVE
+    color += surfaceEmission(v_uv);
 #endif
     FRAG_COLOR = encodeOutput(color);
 #endif

@@ -9,7 +9,9 @@ uniform vec3 u_ambient;
 uniform float u_orthographic;
 #if HAS_TEXTURE
 uniform sampler2D u_albedoTex;
+#endif
 
+#if HAS_TEXTURE || HAS_EMISSIVE_MAP
 vec3 srgbToLinear(vec3 c) {
     vec3 lo = c / 12.92;
     vec3 hi = pow((c + 0.055) / 1.055, vec3(2.4));
@@ -23,10 +25,15 @@ vec3 linearToSrgb(vec3 c) {
     return mix(lo, hi, step(vec3(0.0031308), c));
 }
 
+#include "surface_maps.glsl"
+
 vec3 surfaceAlbedo(vec2 uv) {
     vec3 albedo = u_albedo;
 #if HAS_TEXTURE
-    albedo *= srgbToLinear(TEXTURE2D(u_albedoTex, uv).rgb);
+    albedo *= srgbToLinear(TEXTURE2D(u_albedoTex, UV_ALBEDO(uv)).rgb);
+#endif
+#if HAS_VERTEX_COLOR
+    albedo *= v_color;
 #endif
     return albedo;
 }

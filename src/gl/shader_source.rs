@@ -138,6 +138,10 @@ pub const FILES: &[(&str, &str)] = &[
     ),
     ("surface.glsl", include_str!("../../glsl/surface.glsl")),
     (
+        "surface_maps.glsl",
+        include_str!("../../glsl/surface_maps.glsl"),
+    ),
+    (
         "light_struct.glsl",
         include_str!("../../glsl/light_struct.glsl"),
     ),

@@ -50,9 +50,33 @@ impl ShaderFeatures {
     /// selecting each fragment's own contributions, so no fragment leaves the loop before its
     /// neighbours.
     pub const UNIFORM_LIGHT_LOOP: u64 = 1 << 15;
+    /// The mesh has vertex colours (glTF `COLOR_0`): they multiply the base colour.
+    pub const VERTEX_COLOR: u64 = 1 << 16;
+    /// The material has a normal map (and the mesh tangents).
+    pub const NORMAL_MAP: u64 = 1 << 17;
+    /// The material emits light (added after the light sum).
+    pub const EMISSIVE: u64 = 1 << 18;
+    /// With [`Self::EMISSIVE`]: an emissive texture multiplies the emission.
+    pub const EMISSIVE_MAP: u64 = 1 << 19;
+    /// The material has an ambient occlusion texture (scales the ambient term).
+    pub const OCCLUSION: u64 = 1 << 20;
+    /// The material has a glTF metallic-roughness texture.
+    pub const MR_TEXTURE: u64 = 1 << 21;
+    /// Some texture the material samples has a `KHR_texture_transform`.
+    pub const TEXTURE_TRANSFORM: u64 = 1 << 22;
+
+    /// The flags a material's (and its mesh's) surface inputs set, as opposed to the scene's,
+    /// the frame's and the device's.
+    pub const SURFACE_INPUTS: u64 = Self::VERTEX_COLOR
+        | Self::NORMAL_MAP
+        | Self::EMISSIVE
+        | Self::EMISSIVE_MAP
+        | Self::OCCLUSION
+        | Self::MR_TEXTURE
+        | Self::TEXTURE_TRANSFORM;
 
     /// Every flag with its name.
-    pub const NAMED: [(u64, &'static str); 16] = [
+    pub const NAMED: [(u64, &'static str); 23] = [
         (Self::TEXTURE, "texture"),
         (Self::SPOT, "spot"),
         (Self::SPECULAR, "specular"),
@@ -69,6 +93,13 @@ impl ShaderFeatures {
         (Self::TONEMAP_ACES, "tonemap_aces"),
         (Self::TONEMAP_NEUTRAL, "tonemap_neutral"),
         (Self::UNIFORM_LIGHT_LOOP, "uniform_light_loop"),
+        (Self::VERTEX_COLOR, "vertex_color"),
+        (Self::NORMAL_MAP, "normal_map"),
+        (Self::EMISSIVE, "emissive"),
+        (Self::EMISSIVE_MAP, "emissive_map"),
+        (Self::OCCLUSION, "occlusion"),
+        (Self::MR_TEXTURE, "mr_texture"),
+        (Self::TEXTURE_TRANSFORM, "texture_transform"),
     ];
 
     /// Names of the set flags.
@@ -120,6 +151,13 @@ impl ShaderFeatures {
             ("COUNT_REACHING".into(), flag(Self::COUNT_REACHING)),
             ("COUNT_HEATMAP".into(), flag(Self::COUNT_HEATMAP)),
             ("UNIFORM_LIGHT_LOOP".into(), flag(Self::UNIFORM_LIGHT_LOOP)),
+            ("HAS_VERTEX_COLOR".into(), flag(Self::VERTEX_COLOR)),
+            ("HAS_NORMAL_MAP".into(), flag(Self::NORMAL_MAP)),
+            ("HAS_EMISSIVE".into(), flag(Self::EMISSIVE)),
+            ("HAS_EMISSIVE_MAP".into(), flag(Self::EMISSIVE_MAP)),
+            ("HAS_OCCLUSION".into(), flag(Self::OCCLUSION)),
+            ("HAS_MR_TEXTURE".into(), flag(Self::MR_TEXTURE)),
+            ("HAS_TEXTURE_TRANSFORM".into(), flag(Self::TEXTURE_TRANSFORM)),
             (
                 "TONEMAP".into(),
                 if self.has(Self::TONEMAP_REINHARD) {

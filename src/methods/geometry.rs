@@ -148,8 +148,14 @@ pub(crate) fn shade_object<P: GeometryProgram>(
         .gpu_scene
         .texture_for(material)
         .or_else(|| full.then(|| ctx.gpu_scene.white()).flatten());
-    let features = ctx
-        .features
+    // Surface inputs only where a colour is computed (counts read none).
+    let inputs = if ctx.features.counting() {
+        ShaderFeatures::default()
+    } else {
+        let units = dev.caps().max_texture_image_units;
+        super::maps::features(material, &object.mesh, units)
+    };
+    let features = ShaderFeatures(ctx.features.0 | inputs.0)
         .with(ShaderFeatures::TEXTURE, texture.is_some())
         .with(ShaderFeatures::SPECULAR, material.has_specular() || full);
     let key = ProgramKey {
@@ -181,6 +187,10 @@ pub(crate) fn shade_object<P: GeometryProgram>(
         &frame,
         features.has(ShaderFeatures::COUNT_HEATMAP),
     );
+    program
+        .surface()
+        .maps()
+        .set(dev, material, features, ctx.gpu_scene);
     bind_method(program, dev);
     mesh.draw(dev);
     Ok(())

@@ -7,6 +7,7 @@
 
 use glam::{DMat3, DMat4, Mat3, Mat4, Vec3};
 
+use super::maps::MapUniforms;
 use super::ShaderFeatures;
 use crate::gl::program::{Resolver, Sampler, Uniform};
 use crate::gl::texture::DataTexture;
@@ -57,6 +58,7 @@ pub struct Surface {
     orthographic: Uniform<f32>,
     heat_scale: Uniform<f32>,
     albedo_tex: Uniform<Sampler>,
+    maps: MapUniforms,
 }
 
 /// What a frame sets on every object's [`Surface`] besides its material.
@@ -93,6 +95,7 @@ impl Surface {
                 "u_heatScale",
             ),
             albedo_tex: r.required_when(colour && f.has(ShaderFeatures::TEXTURE), "u_albedoTex"),
+            maps: MapUniforms::resolve(r, colour),
         }
     }
 
@@ -109,6 +112,7 @@ impl Surface {
             orthographic: r.required("u_orthographic"),
             heat_scale: r.optional("u_heatScale"),
             albedo_tex: r.required_when(f.has(ShaderFeatures::TEXTURE), "u_albedoTex"),
+            maps: MapUniforms::resolve(r, true),
         }
     }
 
@@ -136,6 +140,11 @@ impl Surface {
         if let Some(unit) = texture_unit {
             self.albedo_tex.set(dev, unit);
         }
+    }
+
+    /// `surface_maps.glsl`'s uniforms and textures (see [`MapUniforms::set`]).
+    pub(crate) fn maps(&self) -> &MapUniforms {
+        &self.maps
     }
 }
 
@@ -204,6 +213,10 @@ mod tests {
         F::NO_LIGHTS,
         F::NO_LIGHTS | F::TEXTURE | F::SPECULAR,
         F::NO_LIGHTS | F::COUNT_EVALS | F::COUNT_HEATMAP,
+        F::SURFACE_INPUTS | F::TEXTURE | F::SPECULAR | F::SPOT,
+        F::NORMAL_MAP | F::TEXTURE_TRANSFORM,
+        F::EMISSIVE | F::OCCLUSION | F::VERTEX_COLOR | F::LIGHTS_RGBA8,
+        F::NO_LIGHTS | F::EMISSIVE | F::EMISSIVE_MAP | F::TEXTURE | F::TEXTURE_TRANSFORM,
     ];
 
     fn build<U: UniformSet>(
@@ -257,10 +270,12 @@ mod tests {
                 build::<ClusteredProgram>(&mut programs, &dev, "clustered", f);
                 if es == EsVersion::Es3 && !f.has(F::LIGHTS_RGBA8) {
                     build::<GBufferProgram>(&mut programs, &dev, "gbuffer", f);
-                    let lights = f.with(F::SPECULAR, true);
+                    // The full-screen passes never see a material's surface inputs.
+                    let frame = ShaderFeatures(f.0 & !F::SURFACE_INPUTS);
+                    let lights = frame.with(F::SPECULAR, true);
                     build::<LightProgram>(&mut programs, &dev, "deferred_light", lights);
                     build::<LightProgram>(&mut programs, &dev, "deferred_light_fullscreen", lights);
-                    build::<CompositeProgram>(&mut programs, &dev, "deferred_composite", f);
+                    build::<CompositeProgram>(&mut programs, &dev, "deferred_composite", frame);
                 }
             }
             programs.destroy(&dev);
