@@ -1,6 +1,16 @@
 // Shared vertex stage of every geometry pass: view-space position and normal.
 // u_modelView is computed on the CPU in f64 with the camera subtracted, so objects far from
 // the origin keep full precision here.
+// The depth prepass compiles this stage without the surface-input switches.
+#ifndef HAS_VERTEX_COLOR
+#define HAS_VERTEX_COLOR 0
+#endif
+#ifndef HAS_NORMAL_MAP
+#define HAS_NORMAL_MAP 0
+#endif
+#ifndef HAS_TEXTURE_TRANSFORM
+#define HAS_TEXTURE_TRANSFORM 0
+#endif
 ATTRIBUTE vec3 a_position;
 ATTRIBUTE vec3 a_normal;
 ATTRIBUTE vec2 a_uv;
