@@ -11,7 +11,15 @@ uniform float u_orthographic;
 uniform sampler2D u_albedoTex;
 #endif
 
-#if HAS_TEXTURE || HAS_EMISSIVE_MAP
+// sRGB-encoded textures (base colour, emission) are decoded here. Two branches with one body:
+// the variant stripper (shader_source::strip_feature_blocks) reads single-flag conditions.
+#if HAS_TEXTURE
+vec3 srgbToLinear(vec3 c) {
+    vec3 lo = c / 12.92;
+    vec3 hi = pow((c + 0.055) / 1.055, vec3(2.4));
+    return mix(lo, hi, step(vec3(0.04045), c));
+}
+#elif HAS_EMISSIVE_MAP
 vec3 srgbToLinear(vec3 c) {
     vec3 lo = c / 12.92;
     vec3 hi = pow((c + 0.055) / 1.055, vec3(2.4));

@@ -586,3 +586,41 @@ fn other_texture_sets_malformed_transforms_and_every_colour_format_are_handled()
         "{warnings:?}"
     );
 }
+
+/// Pay for use: a variant without the surface inputs has none of their code, attributes or
+/// varyings; each input's variant has its own.
+#[test]
+fn variants_without_surface_inputs_contain_none_of_their_code() {
+    use manylight::gl::shader_source::{assemble, Stage};
+    use manylight::methods::ShaderFeatures as F;
+    let needles = [
+        (F::VERTEX_COLOR, "a_color", Stage::Vertex),
+        (F::VERTEX_COLOR, "v_color", Stage::Fragment),
+        (F::NORMAL_MAP, "a_tangent", Stage::Vertex),
+        (F::NORMAL_MAP, "u_normalTex", Stage::Fragment),
+        (F::EMISSIVE, "u_emissive", Stage::Fragment),
+        (
+            F::EMISSIVE | F::EMISSIVE_MAP,
+            "u_emissiveTex",
+            Stage::Fragment,
+        ),
+        (F::OCCLUSION, "u_occlusionTex", Stage::Fragment),
+        (F::MR_TEXTURE, "u_metallicRoughnessTex", Stage::Fragment),
+        (F::TEXTURE_TRANSFORM, "u_albedoUvTransform", Stage::Vertex),
+        (F::TEXTURE_TRANSFORM, "v_uvAlbedoNormal", Stage::Fragment),
+    ];
+    for es in [EsVersion::Es2, EsVersion::Es3] {
+        for shader in ["forward", "clustered"] {
+            let source = |f: F, stage| assemble(shader, stage, es, &f.defines(es, 64)).unwrap();
+            for (bits, needle, stage) in needles {
+                let lean = source(F(F::TEXTURE), stage);
+                assert!(
+                    !lean.contains(needle),
+                    "{shader} {es}: `{needle}` without its feature"
+                );
+                let with = source(F(bits | F::TEXTURE), stage);
+                assert!(with.contains(needle), "{shader} {es}: `{needle}` missing");
+            }
+        }
+    }
+}
