@@ -13,6 +13,9 @@ pub const UNIT_ALBEDO: u32 = 0;
 /// First texture unit a method may use for its data textures.
 pub const UNIT_METHOD: u32 = 1;
 
+// The material's maps follow the three units clustered's geometry pass uses.
+const _: () = assert!(super::maps::UNIT_MAPS == UNIT_METHOD + 3);
+
 /// The uniforms of a geometry-pass program: the shared transforms and surface, and the
 /// method's own (set by the method's `bind_method`).
 pub trait GeometryProgram: UniformSet {

@@ -10,7 +10,6 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 use glam::{Mat3, Vec3};
 
-use super::geometry::UNIT_METHOD;
 use super::ShaderFeatures as F;
 use crate::gl::program::{Resolver, Sampler, Uniform};
 use crate::gl::Device;
@@ -18,8 +17,9 @@ use crate::gpu_scene::GpuScene;
 use crate::scene::surface_maps::{MapTexture, TextureTransform};
 use crate::scene::{Material, Mesh};
 
-/// First texture unit of the maps: after the most any geometry program's method uses.
-pub const UNIT_MAPS: u32 = UNIT_METHOD + 3;
+/// First texture unit of the maps: after the most any geometry program's method uses
+/// (checked against `geometry::UNIT_METHOD` there).
+pub const UNIT_MAPS: u32 = 4;
 
 /// The map slots: feature bit, texture unit, name for warnings.
 const SLOTS: [(u64, u32, &str); 4] = [
@@ -82,6 +82,9 @@ pub fn features(material: &Material, mesh: &Mesh, units: i32) -> F {
     bits.with(F::TEXTURE_TRANSFORM, transformed)
 }
 
+/// One map as [`MapUniforms::set`] binds it: feature bit, texture, sampler, UV transform.
+type MapSlot<'a> = (u64, &'a Option<MapTexture>, &'a Uniform<Sampler>, &'a Uniform<Mat3>);
+
 /// The uniforms of `surface_maps.glsl`.
 pub struct MapUniforms {
     albedo_uv: Uniform<Mat3>,
@@ -127,7 +130,7 @@ impl MapUniforms {
         if features.has(F::TEXTURE_TRANSFORM) {
             self.albedo_uv.set(dev, uv_matrix(&maps.base_transform));
         }
-        let slots: [(u64, &Option<MapTexture>, &Uniform<Sampler>, &Uniform<Mat3>); 4] = [
+        let slots: [MapSlot<'_>; 4] = [
             (F::NORMAL_MAP, &maps.normal, &self.normal_tex, &self.normal_uv),
             (
                 F::EMISSIVE_MAP,

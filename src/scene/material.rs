@@ -5,16 +5,8 @@ use std::sync::Arc;
 use glam::Vec3;
 
 use super::surface_maps::SurfaceMaps;
+pub use super::texture::Texture;
 use super::SceneError;
-
-/// An 8-bit sRGB RGBA image used as a diffuse texture (decoded to linear in the shader).
-#[derive(Debug)]
-pub struct Texture {
-    /// Where it came from (file path or a built-in name), for messages.
-    pub name: String,
-    /// Pixels, row 0 at the top as image files store them.
-    pub image: image::RgbaImage,
-}
 
 /// A Lambert + Blinn-Phong material in linear RGB.
 #[derive(Clone, Debug)]

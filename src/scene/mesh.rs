@@ -189,16 +189,25 @@ impl Mesh {
     /// the generated ones ([`super::tangents::generate`]).
     pub fn with_tangents(mut self, tangents: Vec<Vec4>) -> Result<Mesh, SceneError> {
         check_per_vertex("mesh.tangents", tangents.len(), self.positions.len())?;
-        self.tangents = super::tangents::repair(&self, tangents);
+        self.tangents = super::tangents::repair(self.geometry(), tangents);
         Ok(self)
     }
 
     /// The mesh with generated tangents when it has texture coordinates and none yet.
     pub fn with_generated_tangents(mut self) -> Mesh {
         if self.tangents.is_empty() && !self.uvs.is_empty() {
-            self.tangents = super::tangents::generate(&self);
+            self.tangents = super::tangents::generate(self.geometry());
         }
         self
+    }
+
+    fn geometry(&self) -> super::tangents::Geometry<'_> {
+        super::tangents::Geometry {
+            positions: &self.positions,
+            normals: &self.normals,
+            uvs: &self.uvs,
+            indices: &self.indices,
+        }
     }
 
     /// Object-space bounds (`None` for an empty mesh).

@@ -29,6 +29,7 @@ pub mod raycast;
 pub mod shading;
 pub mod surface_maps;
 pub mod tangents;
+pub mod texture;
 pub mod texture_budget;
 pub(crate) mod triangle_reach;
 

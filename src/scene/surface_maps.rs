@@ -9,7 +9,7 @@ use std::sync::Arc;
 
 use glam::{DVec2, DVec3, Vec2, Vec3};
 
-use super::Texture;
+use super::texture::Texture;
 
 /// Where a texture is sampled: `KHR_texture_transform`'s `uv' = T·R·S·uv` (offset, rotation
 /// counter-clockwise in radians, scale), in the glTF convention (`u' = c·sx·u + s·sy·v + ox`,
@@ -118,9 +118,9 @@ impl Default for SurfaceMaps {
     }
 }
 
-/// Largest emitted radiance per channel: the colour tier is fp16 (see
-/// [`super::material::MAX_COLOR_FACTOR`]).
-pub const MAX_EMISSIVE: f32 = super::material::MAX_COLOR_FACTOR;
+/// Largest emitted radiance per channel: the colour tier is fp16 (the same cap as
+/// `material::MAX_COLOR_FACTOR`).
+pub const MAX_EMISSIVE: f32 = 1024.0;
 
 impl SurfaceMaps {
     /// True when the material emits light.

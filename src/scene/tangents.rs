@@ -4,13 +4,23 @@
 //! are an affine map of its positions (every planar, unstretched mapping) the two agree, and
 //! they differ only in how sharp UV seams share a vertex (see `docs/gltf.md`).
 
-use glam::{DVec2, DVec3, Vec3, Vec4};
+use glam::{DVec2, DVec3, Vec2, Vec3, Vec4};
 
-use super::Mesh;
+/// The vertex data tangents are made from (a mesh's, borrowed).
+#[derive(Clone, Copy)]
+pub struct Geometry<'a> {
+    /// Vertex positions.
+    pub positions: &'a [Vec3],
+    /// Unit vertex normals, one per position.
+    pub normals: &'a [Vec3],
+    /// Texture coordinates, one per position (or empty: every tangent is a fallback one).
+    pub uvs: &'a [Vec2],
+    /// Triangle list.
+    pub indices: &'a [u32],
+}
 
-/// One tangent per vertex of `mesh` (which must have texture coordinates; without, every
-/// tangent is a fallback one).
-pub fn generate(mesh: &Mesh) -> Vec<Vec4> {
+/// One tangent per vertex.
+pub fn generate(mesh: Geometry<'_>) -> Vec<Vec4> {
     let n = mesh.positions.len();
     let (mut tan, mut bit) = (vec![DVec3::ZERO; n], vec![DVec3::ZERO; n]);
     for tri in mesh.indices.chunks_exact(3) {
@@ -40,7 +50,7 @@ pub fn generate(mesh: &Mesh) -> Vec<Vec4> {
 
 /// Given tangents made unit and orthogonal to their normals; unusable ones (zero, parallel
 /// to the normal, not finite) replaced by generated ones, and `w` made ±1.
-pub fn repair(mesh: &Mesh, given: Vec<Vec4>) -> Vec<Vec4> {
+pub fn repair(mesh: Geometry<'_>, given: Vec<Vec4>) -> Vec<Vec4> {
     let mut generated: Option<Vec<Vec4>> = None;
     given
         .into_iter()
@@ -72,7 +82,7 @@ fn orthogonal(normal: DVec3, t: DVec3, b: DVec3) -> Vec4 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use glam::Vec2;
+    use crate::scene::Mesh;
 
     #[test]
     fn a_plane_mapped_along_its_axes_gets_the_u_direction_and_its_handedness() {
@@ -85,11 +95,17 @@ mod tests {
             Vec2::new(0.0, 0.0),
         ];
         let m = Mesh::new(positions, vec![], uvs, vec![0, 1, 2, 0, 2, 3]).unwrap();
-        for t in generate(&m) {
+        let m = Geometry {
+            positions: &m.positions,
+            normals: &m.normals,
+            uvs: &m.uvs,
+            indices: &m.indices,
+        };
+        for t in generate(m) {
             assert!((t.truncate() - Vec3::X).length() < 1e-6, "{t}");
             assert_eq!(t.w, -1.0);
         }
-        let repaired = repair(&m, vec![Vec4::new(2.0, 0.0, 5.0, 3.0), Vec4::ZERO, Vec4::NAN, Vec4::X]);
+        let repaired = repair(m, vec![Vec4::new(2.0, 0.0, 5.0, 3.0), Vec4::ZERO, Vec4::NAN, Vec4::X]);
         assert_eq!(repaired[0], Vec4::new(1.0, 0.0, 0.0, 1.0));
         assert_eq!(repaired[1], Vec4::new(1.0, 0.0, 0.0, -1.0));
         assert_eq!(repaired[2], Vec4::new(1.0, 0.0, 0.0, -1.0));
