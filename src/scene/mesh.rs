@@ -186,7 +186,7 @@ impl Mesh {
 
     /// The mesh with tangents (one per position). Each is made orthogonal to its vertex's
     /// normal and unit; one with no usable direction, and the `w` sign, are repaired from
-    /// the generated ones ([`super::tangents::generate`]).
+    /// the generated ones (per-vertex sums of the UV gradients, see `docs/gltf.md`).
     pub fn with_tangents(mut self, tangents: Vec<Vec4>) -> Result<Mesh, SceneError> {
         check_per_vertex("mesh.tangents", tangents.len(), self.positions.len())?;
         self.tangents = super::tangents::repair(self.geometry(), tangents);
