@@ -32,6 +32,8 @@ VARYING vec3 v_color;
 #endif
 #if HAS_NORMAL_MAP
 ATTRIBUTE vec4 a_tangent;
+// −1 when the model-view matrix mirrors (flips the bitangent's handedness), else 1.
+uniform float u_tangentSign;
 VARYING vec4 v_tangent;
 #endif
 #if HAS_TEXTURE_TRANSFORM
@@ -71,7 +73,7 @@ void main() {
     // its inverse transpose), made unit here in highp as the normal is.
     vec3 t = (u_modelView * vec4(a_tangent.xyz, 0.0)).xyz;
     float tl = max(max(abs(t.x), abs(t.y)), abs(t.z));
-    v_tangent = vec4(tl > 0.0 ? normalize(t / tl) : vec3(0.0), a_tangent.w);
+    v_tangent = vec4(tl > 0.0 ? normalize(t / tl) : vec3(0.0), a_tangent.w * u_tangentSign);
 #endif
     gl_Position = u_projection * viewPos;
 }

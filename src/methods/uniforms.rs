@@ -24,6 +24,7 @@ pub struct Transforms {
     model_view: Uniform<Mat4>,
     normal_matrix: Uniform<Mat3>,
     projection: Uniform<Mat4>,
+    tangent_sign: Uniform<f32>,
 }
 
 impl Transforms {
@@ -33,6 +34,8 @@ impl Transforms {
             model_view: r.required("u_modelView"),
             normal_matrix: r.required_when(normals, "u_normalMatrix"),
             projection: r.required("u_projection"),
+            // Normal-mapped variants only.
+            tangent_sign: r.optional("u_tangentSign"),
         }
     }
 
@@ -44,6 +47,10 @@ impl Transforms {
         self.model_view.set(dev, model_view.as_mat4());
         self.normal_matrix.set(dev, normal_matrix.as_mat3());
         self.projection.set(dev, *projection);
+        // A mirroring transform flips the bitangent (N × T turns the other way).
+        let det = DMat3::from_mat4(*model_view).determinant();
+        self.tangent_sign
+            .set(dev, if det < 0.0 { -1.0 } else { 1.0 });
     }
 }
 

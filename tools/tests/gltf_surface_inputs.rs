@@ -294,7 +294,7 @@ fn grazing_light() -> Vec<Light> {
 fn a_normal_map_tilts_the_shading_normal_with_file_and_generated_tangents() {
     let dir = tempfile::tempdir().unwrap();
     // Tilted towards −x (the light) and +v; scale 0.8 on x and y.
-    let texel = [60u8, 150, 210, 255];
+    let texel = [60u8, 215, 200, 255];
     let material = json!({
         "pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.7, 0.6, 1.0], "roughnessFactor": 1.0,
                                  "metallicFactor": 0.0},
@@ -319,8 +319,8 @@ fn a_normal_map_tilts_the_shading_normal_with_file_and_generated_tangents() {
         (surface(p, n, albedo), DVec3::ZERO, 1.0)
     };
     let flat = |p: DVec3, _: DVec2, _: [f64; 4]| (surface(p, DVec3::Z, albedo), DVec3::ZERO, 1.0);
-    for path in [generated, from_file] {
-        let (s, warnings) = scene_of(&path, grazing_light(), 0.02);
+    for path in [&generated, &from_file] {
+        let (s, warnings) = scene_of(path, grazing_light(), 0.02);
         assert!(warnings.is_empty(), "{warnings:?}");
         assert_eq!(s.materials[0].maps.normal_scale, 0.8);
         let want = oracle(&s, &mapped);
@@ -331,6 +331,23 @@ fn a_normal_map_tilts_the_shading_normal_with_file_and_generated_tangents() {
         );
         check_every_method("normal map", &s, &want, 3.0);
     }
+    // Mirrored along x: the tangent turns to −x and the bitangent keeps pointing down the
+    // image, so the handedness flips with the transform's determinant.
+    let (mut s, _) = scene_of(&from_file, grazing_light(), 0.02);
+    s.objects[0].transform = glam::DMat4::from_scale(DVec3::new(-1.0, 1.0, 1.0));
+    let mirrored = |w: f64| {
+        move |p: DVec3, _: DVec2, _: [f64; 4]| {
+            let n = perturbed_normal(DVec3::Z, -DVec3::X, w, rgb, 0.8);
+            (surface(p, n, albedo), DVec3::ZERO, 1.0)
+        }
+    };
+    let want = oracle(&s, &mirrored(1.0));
+    let gap = oracle_gap(&want, &oracle(&s, &mirrored(-1.0)));
+    assert!(
+        gap > 10.0,
+        "the handedness changes the picture by only {gap:.1}/255"
+    );
+    check_every_method("mirrored normal map", &s, &want, 3.0);
 }
 
 #[test]
