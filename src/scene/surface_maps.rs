@@ -140,6 +140,18 @@ impl SurfaceMaps {
         .filter_map(|(n, t)| t.as_ref().map(|t| (n, t)))
     }
 
+    /// Every texture of the maps, to share equal ones between loads.
+    pub fn textures_mut(&mut self) -> impl Iterator<Item = &mut Arc<Texture>> {
+        [
+            &mut self.normal,
+            &mut self.emissive_texture,
+            &mut self.occlusion,
+            &mut self.metallic_roughness,
+        ]
+        .into_iter()
+        .filter_map(|t| t.as_mut().map(|t| &mut t.texture))
+    }
+
     /// True when some texture (the base colour's included) is sampled through a transform.
     pub fn has_transform(&self) -> bool {
         !self.base_transform.is_identity() || self.textures().any(|(_, t)| !t.transform.is_identity())
