@@ -28,9 +28,12 @@ void main() {
     if (dot(N, V) < 0.0) {
         N = -N;
     }
+#if HAS_NORMAL_MAP
+    N = surfaceNormal(N, v_uv);
+#endif
     MEDP vec3 albedo = surfaceAlbedo(v_uv);
     SurfaceParams surface = materialSurface(albedo, v_uv);
-    HIGHP vec3 color = u_ambient * albedo;
+    HIGHP vec3 color = surfaceAmbient(albedo, v_uv);
 #if HAS_DIRECTIONAL
     // Directional lights reach every cell: evaluated here, outside the cell's list.
     color += shadeDirectional(N, V, surface);
@@ -64,6 +67,9 @@ void main() {
     for (uint n = 0u; n < cell.y; n++) {
         color += shadeLight(fetchLight(lightIndexAt(cell.x + n)), v_viewPos, N, V, surface);
     }
+#endif
+#if HAS_EMISSIVE
+    color += surfaceEmission(v_uv);
 #endif
     FRAG_COLOR = encodeOutput(color);
 #endif

@@ -42,9 +42,12 @@ void main() {
     if (dot(N, V) < 0.0) {
         N = -N;
     }
+#if HAS_NORMAL_MAP
+    N = surfaceNormal(N, v_uv);
+#endif
     MEDP vec3 albedo = surfaceAlbedo(v_uv);
     SurfaceParams surface = materialSurface(albedo, v_uv);
-    HIGHP vec3 color = u_ambient * albedo;
+    HIGHP vec3 color = surfaceAmbient(albedo, v_uv);
 #if HAS_DIRECTIONAL
     color += shadeDirectional(N, V, surface);
 #endif
@@ -62,6 +65,9 @@ void main() {
         color += shadeLight(fetchLight(i), v_viewPos, N, V, surface);
     }
 #endif
+#endif
+#if HAS_EMISSIVE
+    color += surfaceEmission(v_uv);
 #endif
     FRAG_COLOR = encodeOutput(color);
 #endif

@@ -10,6 +10,9 @@ VARYING vec2 v_uv;
 layout(location = 0) out vec4 o_albedo;
 layout(location = 1) out HIGHP vec4 o_normalDepth;
 layout(location = 2) out vec4 o_specular;
+// The accumulation buffer's start: what the surface adds besides ambient × albedo and the
+// lights (emission, the ambient term's occlusion), so the composite's sum equals forward's.
+layout(location = 3) out vec4 o_extra;
 
 void main() {
     vec3 N = normalize(v_normal);
@@ -18,10 +21,19 @@ void main() {
     if (dot(N, V) < 0.0) {
         N = -N;
     }
+#if HAS_NORMAL_MAP
+    N = surfaceNormal(N, v_uv);
+#endif
     // The surface point as its depth and its window offset from the pixel centre (see
     // windowPosition): the light pass shades the very point forward shades.
     HIGHP vec2 offset = windowPosition(v_viewPos) - gl_FragCoord.xy;
-    o_albedo = vec4(surfaceAlbedo(v_uv), offset.y);
+    vec3 albedo = surfaceAlbedo(v_uv);
+    o_albedo = vec4(albedo, offset.y);
+    vec3 extra = surfaceAmbient(albedo, v_uv) - u_ambient * albedo;
+#if HAS_EMISSIVE
+    extra += surfaceEmission(v_uv);
+#endif
+    o_extra = vec4(extra, 0.0);
     // View depth > 0 marks a covered pixel (the buffer is cleared to 0).
     o_normalDepth = vec4(octEncode(N), -v_viewPos.z, offset.x);
 #if METALLIC_ROUGHNESS

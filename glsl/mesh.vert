@@ -1,6 +1,16 @@
 // Shared vertex stage of every geometry pass: view-space position and normal.
 // u_modelView is computed on the CPU in f64 with the camera subtracted, so objects far from
 // the origin keep full precision here.
+// The depth prepass compiles this stage without the surface-input switches.
+#ifndef HAS_VERTEX_COLOR
+#define HAS_VERTEX_COLOR 0
+#endif
+#ifndef HAS_NORMAL_MAP
+#define HAS_NORMAL_MAP 0
+#endif
+#ifndef HAS_TEXTURE_TRANSFORM
+#define HAS_TEXTURE_TRANSFORM 0
+#endif
 ATTRIBUTE vec3 a_position;
 ATTRIBUTE vec3 a_normal;
 ATTRIBUTE vec2 a_uv;
@@ -16,6 +26,27 @@ invariant gl_Position;
 
 VARYING vec3 v_normal;
 VARYING vec2 v_uv;
+#if HAS_VERTEX_COLOR
+ATTRIBUTE vec4 a_color;
+VARYING vec3 v_color;
+#endif
+#if HAS_NORMAL_MAP
+ATTRIBUTE vec4 a_tangent;
+// −1 when the model-view matrix mirrors (flips the bitangent's handedness), else 1.
+uniform float u_tangentSign;
+VARYING vec4 v_tangent;
+#endif
+#if HAS_TEXTURE_TRANSFORM
+// Each texture's KHR_texture_transform: uv' = (M · (uv, 1)).xy (see surface_maps.glsl).
+uniform mat3 u_albedoUvTransform;
+uniform mat3 u_normalUvTransform;
+uniform mat3 u_emissiveUvTransform;
+uniform mat3 u_occlusionUvTransform;
+uniform mat3 u_metallicRoughnessUvTransform;
+VARYING vec4 v_uvAlbedoNormal;
+VARYING vec4 v_uvEmissiveOcclusion;
+VARYING vec2 v_uvMetallicRoughness;
+#endif
 
 void main() {
     vec4 viewPos = u_modelView * vec4(a_position, 1.0);
@@ -27,5 +58,22 @@ void main() {
     float largest = max(max(abs(n.x), abs(n.y)), abs(n.z));
     v_normal = largest > 0.0 ? normalize(n / largest) : vec3(0.0);
     v_uv = a_uv;
+#if HAS_TEXTURE_TRANSFORM
+    vec3 uv1 = vec3(a_uv, 1.0);
+    v_uvAlbedoNormal = vec4((u_albedoUvTransform * uv1).xy, (u_normalUvTransform * uv1).xy);
+    v_uvEmissiveOcclusion =
+        vec4((u_emissiveUvTransform * uv1).xy, (u_occlusionUvTransform * uv1).xy);
+    v_uvMetallicRoughness = (u_metallicRoughnessUvTransform * uv1).xy;
+#endif
+#if HAS_VERTEX_COLOR
+    v_color = a_color.rgb;
+#endif
+#if HAS_NORMAL_MAP
+    // Tangents lie in the surface: they turn with the model-view matrix itself (normals with
+    // its inverse transpose), made unit here in highp as the normal is.
+    vec3 t = (u_modelView * vec4(a_tangent.xyz, 0.0)).xyz;
+    float tl = max(max(abs(t.x), abs(t.y)), abs(t.z));
+    v_tangent = vec4(tl > 0.0 ? normalize(t / tl) : vec3(0.0), a_tangent.w * u_tangentSign);
+#endif
     gl_Position = u_projection * viewPos;
 }

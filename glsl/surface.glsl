@@ -2,11 +2,6 @@
 uniform vec3 u_albedo;
 uniform vec3 u_specular;
 uniform float u_shininess;
-#if METALLIC_ROUGHNESS
-// glTF metallicFactor and roughnessFactor (perceptual roughness).
-uniform float u_metallic;
-uniform float u_roughness;
-#endif
 // Material opacity (1 for opaque objects; blended when below 1).
 uniform float u_alpha;
 uniform vec3 u_ambient;
@@ -14,7 +9,17 @@ uniform vec3 u_ambient;
 uniform float u_orthographic;
 #if HAS_TEXTURE
 uniform sampler2D u_albedoTex;
+#endif
 
+// sRGB-encoded textures (base colour, emission) are decoded here. Two branches with one body:
+// the variant stripper (shader_source::strip_feature_blocks) reads single-flag conditions.
+#if HAS_TEXTURE
+vec3 srgbToLinear(vec3 c) {
+    vec3 lo = c / 12.92;
+    vec3 hi = pow((c + 0.055) / 1.055, vec3(2.4));
+    return mix(lo, hi, step(vec3(0.04045), c));
+}
+#elif HAS_EMISSIVE_MAP
 vec3 srgbToLinear(vec3 c) {
     vec3 lo = c / 12.92;
     vec3 hi = pow((c + 0.055) / 1.055, vec3(2.4));
@@ -28,20 +33,18 @@ vec3 linearToSrgb(vec3 c) {
     return mix(lo, hi, step(vec3(0.0031308), c));
 }
 
+#include "surface_maps.glsl"
+
 vec3 surfaceAlbedo(vec2 uv) {
     vec3 albedo = u_albedo;
 #if HAS_TEXTURE
-    albedo *= srgbToLinear(TEXTURE2D(u_albedoTex, uv).rgb);
+    albedo *= srgbToLinear(TEXTURE2D(u_albedoTex, UV_ALBEDO(uv)).rgb);
+#endif
+#if HAS_VERTEX_COLOR
+    albedo *= v_color;
 #endif
     return albedo;
 }
-
-#if METALLIC_ROUGHNESS
-// (metallic, perceptual roughness) at uv: the material's factors (texture maps multiply in here).
-vec2 surfaceMetallicRoughness(vec2 uv) {
-    return vec2(u_metallic, u_roughness);
-}
-#endif
 
 #if !OUTPUT_HDR
 // 2^exposure (stops), applied before the tone map (1 by default).

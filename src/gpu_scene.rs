@@ -51,7 +51,8 @@ impl GpuScene {
             }
         }
         for m in &scene.materials {
-            if let Some(t) = &m.diffuse_texture {
+            let maps = m.maps.textures().map(|(_, t)| &t.texture);
+            for t in m.diffuse_texture.iter().chain(maps) {
                 let key = Arc::as_ptr(t) as usize;
                 if let std::collections::hash_map::Entry::Vacant(e) = self.textures.entry(key) {
                     e.insert((t.clone(), ImageTexture::new(dev, &t.image)?));
@@ -124,9 +125,13 @@ impl GpuScene {
 
     /// The uploaded diffuse texture of a material, if it has one.
     pub fn texture_for(&self, material: &Material) -> Option<&ImageTexture> {
-        let t = material.diffuse_texture.as_ref()?;
+        self.texture_of(material.diffuse_texture.as_ref()?)
+    }
+
+    /// The upload of one of the scene's textures (any slot).
+    pub fn texture_of(&self, texture: &Arc<Texture>) -> Option<&ImageTexture> {
         self.textures
-            .get(&(Arc::as_ptr(t) as usize))
+            .get(&(Arc::as_ptr(texture) as usize))
             .map(|(_, g)| g)
     }
 

@@ -9,7 +9,9 @@
 //! colour 2 specular RGBA16F      8    Ks, Blinn-Phong exponent
 //! depth             DEPTH24      4    for the geometry pass's depth test
 //! accumulation      RGBA32F     16    Σ light radiance (additive blending; RGBA16F, 8 bytes,
-//!                                     where GL_EXT_float_blend is missing)
+//!                                     where GL_EXT_float_blend is missing), started by the
+//!                                     geometry pass (colour 3) with the surface's emission
+//!                                     and the ambient term's occlusion
 //!                              ----
 //!                               52 bytes per pixel (1280×720: 47.9 MB), 44 with RGBA16F
 //! ```
@@ -50,9 +52,9 @@ pub fn unsupported_reason(dev_caps: &super::Caps) -> Option<String> {
     if !dev_caps.has_extension("GL_EXT_color_buffer_float") {
         return Some("needs GL_EXT_color_buffer_float to render the float G-buffer".into());
     }
-    if dev_caps.max_draw_buffers < 3 || dev_caps.max_color_attachments < 3 {
+    if dev_caps.max_draw_buffers < 4 || dev_caps.max_color_attachments < 4 {
         return Some(format!(
-            "needs 3 draw buffers, the context has {}",
+            "needs 4 draw buffers, the context has {}",
             dev_caps.max_draw_buffers
         ));
     }
@@ -119,7 +121,8 @@ impl GBuffer {
         let gl = &dev.gl;
         unsafe {
             gl.bind_framebuffer(glow::FRAMEBUFFER, Some(geometry_fbo));
-            for (i, t) in gb.color[..3].iter().enumerate() {
+            // The accumulation buffer too: the geometry pass starts it (emission, occlusion).
+            for (i, t) in gb.color.iter().enumerate() {
                 gl.framebuffer_texture_2d(
                     glow::FRAMEBUFFER,
                     glow::COLOR_ATTACHMENT0 + i as u32,
@@ -139,6 +142,7 @@ impl GBuffer {
                 glow::COLOR_ATTACHMENT0,
                 glow::COLOR_ATTACHMENT1,
                 glow::COLOR_ATTACHMENT2,
+                glow::COLOR_ATTACHMENT3,
             ]);
             let status = gl.check_framebuffer_status(glow::FRAMEBUFFER);
             gl.bind_framebuffer(glow::FRAMEBUFFER, Some(accum_fbo));
@@ -195,15 +199,15 @@ impl GBuffer {
         dev.clear([0.0; 4]);
     }
 
-    /// Binds the accumulation buffer, cleared to black, with the geometry pass's depth
-    /// attached (kept) for the light volumes' depth test.
+    /// Binds the accumulation buffer as the geometry pass left it (each surface's emission
+    /// and occlusion; 0 elsewhere), with the geometry pass's depth attached (kept) for the
+    /// light volumes' depth test.
     pub fn begin_accumulation(&self, dev: &Device) {
         unsafe {
             dev.gl
                 .bind_framebuffer(glow::FRAMEBUFFER, Some(self.accum_fbo));
         }
         dev.viewport(0, 0, self.size.0 as i32, self.size.1 as i32);
-        dev.clear_color_only([0.0; 4]);
     }
 
     /// Binds the geometry pass's depth texture to `unit`, for the composite pass to write into

@@ -11,16 +11,61 @@ use glow::HasContext;
 use super::{Device, GlError};
 use crate::scene::Mesh;
 
-/// Floats per interleaved vertex: position (3), normal (3), uv (2).
+/// Floats per interleaved vertex every mesh has: position (3), normal (3), uv (2).
 pub const VERTEX_FLOATS: usize = 8;
+
+/// Which optional attributes a mesh's vertices carry after the [`VERTEX_FLOATS`]: each is
+/// uploaded only when the mesh has it (colour: 4 floats, then tangent: 4 floats).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct VertexLayout {
+    /// `a_color` (location 3).
+    pub colors: bool,
+    /// `a_tangent` (location 4).
+    pub tangents: bool,
+}
+
+impl VertexLayout {
+    /// The layout of `mesh`'s vertices.
+    pub fn of(mesh: &Mesh) -> VertexLayout {
+        VertexLayout {
+            colors: !mesh.colors.is_empty(),
+            tangents: !mesh.tangents.is_empty(),
+        }
+    }
+
+    /// Floats per vertex.
+    pub fn floats(self) -> usize {
+        VERTEX_FLOATS + 4 * usize::from(self.colors) + 4 * usize::from(self.tangents)
+    }
+
+    /// (location, components, byte offset) of every attribute present.
+    fn attributes(self) -> impl Iterator<Item = (u32, i32, i32)> {
+        let colour_at = (VERTEX_FLOATS * 4) as i32;
+        let tangent_at = colour_at + if self.colors { 16 } else { 0 };
+        [
+            Some((0, 3, 0)),
+            Some((1, 3, 12)),
+            Some((2, 2, 24)),
+            self.colors.then_some((3, 4, colour_at)),
+            self.tangents.then_some((4, 4, tangent_at)),
+        ]
+        .into_iter()
+        .flatten()
+    }
+}
+
+/// Values a shader reads for an optional attribute the mesh lacks (white, +X tangent).
+const ABSENT: [(u32, [f32; 4]); 2] = [(3, [1.0; 4]), (4, [1.0, 0.0, 0.0, 1.0])];
 
 /// One chunk of a mesh, CPU side: interleaved vertices and 16-bit indices.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Chunk {
-    /// `VERTEX_FLOATS` floats per vertex.
+    /// `layout.floats()` floats per vertex.
     pub vertices: Vec<f32>,
     /// Triangle list.
     pub indices: Vec<u16>,
+    /// Which optional attributes follow the first [`VERTEX_FLOATS`].
+    pub layout: VertexLayout,
 }
 
 /// Splits a mesh into chunks whose vertices fit 16-bit indices; triangles stay whole.
@@ -32,11 +77,14 @@ pub fn split_u16(mesh: &Mesh) -> Vec<Chunk> {
 /// becomes `f32`).
 pub fn split_u16_about(mesh: &Mesh, origin: DVec3) -> Vec<Chunk> {
     const LIMIT: usize = u16::MAX as usize + 1;
+    let layout = VertexLayout::of(mesh);
+    let floats = layout.floats();
     let mut chunks = Vec::new();
     let mut remap: HashMap<u32, u16> = HashMap::new();
     let mut cur = Chunk {
         vertices: Vec::new(),
         indices: Vec::new(),
+        layout,
     };
     for tri in mesh.indices.chunks_exact(3) {
         let new_vertices = tri.iter().filter(|i| !remap.contains_key(i)).count();
@@ -46,6 +94,7 @@ pub fn split_u16_about(mesh: &Mesh, origin: DVec3) -> Vec<Chunk> {
                 Chunk {
                     vertices: Vec::new(),
                     indices: Vec::new(),
+                    layout,
                 },
             ));
             remap.clear();
@@ -58,7 +107,13 @@ pub fn split_u16_about(mesh: &Mesh, origin: DVec3) -> Vec<Chunk> {
                 let uv = mesh.uvs.get(v).copied().unwrap_or_default();
                 cur.vertices
                     .extend_from_slice(&[p.x, p.y, p.z, n.x, n.y, n.z, uv.x, uv.y]);
-                (cur.vertices.len() / VERTEX_FLOATS - 1) as u16
+                if layout.colors {
+                    cur.vertices.extend_from_slice(&mesh.colors[v].to_array());
+                }
+                if layout.tangents {
+                    cur.vertices.extend_from_slice(&mesh.tangents[v].to_array());
+                }
+                (cur.vertices.len() / floats - 1) as u16
             });
             cur.indices.push(local);
         }
@@ -73,6 +128,7 @@ struct GpuChunk {
     vbo: glow::Buffer,
     ibo: glow::Buffer,
     index_count: i32,
+    layout: VertexLayout,
 }
 
 /// A mesh uploaded as static vertex and index buffers.
@@ -118,6 +174,7 @@ impl GpuMesh {
                     vbo,
                     ibo,
                     index_count: chunk.indices.len() as i32,
+                    layout: chunk.layout,
                 });
             }
         }
@@ -128,12 +185,17 @@ impl GpuMesh {
     /// Draws all chunks with the bound program (attributes at [`super::program::ATTRIBUTES`]).
     pub fn draw(&self, dev: &Device) {
         let gl = &dev.gl;
-        let stride = (VERTEX_FLOATS * 4) as i32;
         unsafe {
             for c in &self.chunks {
+                let stride = (c.layout.floats() * 4) as i32;
                 gl.bind_buffer(glow::ARRAY_BUFFER, Some(c.vbo));
                 gl.bind_buffer(glow::ELEMENT_ARRAY_BUFFER, Some(c.ibo));
-                for (loc, size, offset) in [(0u32, 3, 0), (1, 3, 12), (2, 2, 24)] {
+                // Optional attributes the mesh lacks read a constant instead of a stale array.
+                for (loc, value) in ABSENT {
+                    gl.disable_vertex_attrib_array(loc);
+                    gl.vertex_attrib_4_f32(loc, value[0], value[1], value[2], value[3]);
+                }
+                for (loc, size, offset) in c.layout.attributes() {
                     gl.enable_vertex_attrib_array(loc);
                     gl.vertex_attrib_pointer_f32(loc, size, glow::FLOAT, false, stride, offset);
                 }

@@ -20,7 +20,13 @@ use super::shader_source::{self, numbered, Stage};
 use super::{Device, EsVersion, GlError};
 
 /// Vertex attribute locations shared by every program (bound before linking).
-pub const ATTRIBUTES: &[(u32, &str)] = &[(0, "a_position"), (1, "a_normal"), (2, "a_uv")];
+pub const ATTRIBUTES: &[(u32, &str)] = &[
+    (0, "a_position"),
+    (1, "a_normal"),
+    (2, "a_uv"),
+    (3, "a_color"),
+    (4, "a_tangent"),
+];
 
 /// A linked program and the uniform set resolved for it.
 pub struct Program {

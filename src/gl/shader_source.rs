@@ -142,6 +142,10 @@ pub const FILES: &[(&str, &str)] = &[
         include_str!("../../glsl/directional.glsl"),
     ),
     (
+        "surface_maps.glsl",
+        include_str!("../../glsl/surface_maps.glsl"),
+    ),
+    (
         "light_struct.glsl",
         include_str!("../../glsl/light_struct.glsl"),
     ),

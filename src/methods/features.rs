@@ -64,8 +64,33 @@ impl ShaderFeatures {
     /// outside the light lists (`glsl/directional.glsl`).
     pub const DIRECTIONAL: u64 = 1 << 17;
 
+    /// The mesh has vertex colours (glTF `COLOR_0`): they multiply the base colour.
+    pub const VERTEX_COLOR: u64 = 1 << 18;
+    /// The material has a normal map (and the mesh tangents).
+    pub const NORMAL_MAP: u64 = 1 << 19;
+    /// The material emits light (added after the light sum).
+    pub const EMISSIVE: u64 = 1 << 20;
+    /// With [`Self::EMISSIVE`]: an emissive texture multiplies the emission.
+    pub const EMISSIVE_MAP: u64 = 1 << 21;
+    /// The material has an ambient occlusion texture (scales the ambient term).
+    pub const OCCLUSION: u64 = 1 << 22;
+    /// The material has a glTF metallic-roughness texture.
+    pub const MR_TEXTURE: u64 = 1 << 23;
+    /// Some texture the material samples has a `KHR_texture_transform`.
+    pub const TEXTURE_TRANSFORM: u64 = 1 << 24;
+
+    /// The flags a material's (and its mesh's) surface inputs set, as opposed to the scene's,
+    /// the frame's and the device's.
+    pub const SURFACE_INPUTS: u64 = Self::VERTEX_COLOR
+        | Self::NORMAL_MAP
+        | Self::EMISSIVE
+        | Self::EMISSIVE_MAP
+        | Self::OCCLUSION
+        | Self::MR_TEXTURE
+        | Self::TEXTURE_TRANSFORM;
+
     /// Every flag with its name.
-    pub const NAMED: [(u64, &'static str); 18] = [
+    pub const NAMED: [(u64, &'static str); 25] = [
         (Self::TEXTURE, "texture"),
         (Self::SPOT, "spot"),
         (Self::SPECULAR, "specular"),
@@ -84,6 +109,13 @@ impl ShaderFeatures {
         (Self::UNIFORM_LIGHT_LOOP, "uniform_light_loop"),
         (Self::METALLIC_ROUGHNESS, "metallic_roughness"),
         (Self::DIRECTIONAL, "directional"),
+        (Self::VERTEX_COLOR, "vertex_color"),
+        (Self::NORMAL_MAP, "normal_map"),
+        (Self::EMISSIVE, "emissive"),
+        (Self::EMISSIVE_MAP, "emissive_map"),
+        (Self::OCCLUSION, "occlusion"),
+        (Self::MR_TEXTURE, "mr_texture"),
+        (Self::TEXTURE_TRANSFORM, "texture_transform"),
     ];
 
     /// Names of the set flags.
@@ -145,6 +177,13 @@ impl ShaderFeatures {
                 "MAX_DIRECTIONAL".into(),
                 crate::scene::MAX_DIRECTIONAL_LIGHTS.to_string(),
             ),
+            ("HAS_VERTEX_COLOR".into(), flag(Self::VERTEX_COLOR)),
+            ("HAS_NORMAL_MAP".into(), flag(Self::NORMAL_MAP)),
+            ("HAS_EMISSIVE".into(), flag(Self::EMISSIVE)),
+            ("HAS_EMISSIVE_MAP".into(), flag(Self::EMISSIVE_MAP)),
+            ("HAS_OCCLUSION".into(), flag(Self::OCCLUSION)),
+            ("HAS_MR_TEXTURE".into(), flag(Self::MR_TEXTURE)),
+            ("HAS_TEXTURE_TRANSFORM".into(), flag(Self::TEXTURE_TRANSFORM)),
             (
                 "TONEMAP".into(),
                 if self.has(Self::TONEMAP_REINHARD) {

@@ -14,6 +14,9 @@ pub const UNIT_ALBEDO: u32 = 0;
 /// First texture unit a method may use for its data textures.
 pub const UNIT_METHOD: u32 = 1;
 
+// The material's maps follow the three units clustered's geometry pass uses.
+const _: () = assert!(super::maps::UNIT_MAPS == UNIT_METHOD + 3);
+
 /// The uniforms of a geometry-pass program: the shared transforms and surface, and the
 /// method's own (set by the method's `bind_method`).
 pub trait GeometryProgram: UniformSet {
@@ -153,8 +156,14 @@ pub(crate) fn shade_object<P: GeometryProgram>(
         .gpu_scene
         .texture_for(material)
         .or_else(|| full.then(|| ctx.gpu_scene.white()).flatten());
-    let features = ctx
-        .features
+    // Surface inputs only where a colour is computed (counts read none).
+    let inputs = if ctx.features.counting() {
+        ShaderFeatures::default()
+    } else {
+        let units = dev.caps().max_texture_image_units;
+        super::maps::features(material, &object.mesh, units)
+    };
+    let features = ShaderFeatures(ctx.features.0 | inputs.0)
         .with(ShaderFeatures::TEXTURE, texture.is_some())
         .with(
             ShaderFeatures::SPECULAR,
@@ -196,6 +205,10 @@ pub(crate) fn shade_object<P: GeometryProgram>(
     if let Some(directional) = program.directional() {
         directional.set(dev, &ctx.directional);
     }
+    program
+        .surface()
+        .maps()
+        .set(dev, material, features, ctx.gpu_scene);
     bind_method(program, dev);
     mesh.draw(dev);
     Ok(())

@@ -15,6 +15,7 @@ pub mod forward;
 pub mod forward_cap;
 pub mod geometry;
 mod grid_choice;
+pub mod maps;
 pub mod tiled;
 pub mod uniforms;
 

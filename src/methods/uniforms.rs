@@ -7,6 +7,7 @@
 
 use glam::{DMat3, DMat4, Mat3, Mat4, Vec3};
 
+use super::maps::MapUniforms;
 use super::ShaderFeatures;
 use crate::gl::program::{Resolver, Sampler, Uniform};
 use crate::gl::texture::DataTexture;
@@ -23,6 +24,7 @@ pub struct Transforms {
     model_view: Uniform<Mat4>,
     normal_matrix: Uniform<Mat3>,
     projection: Uniform<Mat4>,
+    tangent_sign: Uniform<f32>,
 }
 
 impl Transforms {
@@ -32,6 +34,8 @@ impl Transforms {
             model_view: r.required("u_modelView"),
             normal_matrix: r.required_when(normals, "u_normalMatrix"),
             projection: r.required("u_projection"),
+            // Normal-mapped variants only.
+            tangent_sign: r.optional("u_tangentSign"),
         }
     }
 
@@ -43,6 +47,10 @@ impl Transforms {
         self.model_view.set(dev, model_view.as_mat4());
         self.normal_matrix.set(dev, normal_matrix.as_mat3());
         self.projection.set(dev, *projection);
+        // A mirroring transform flips the bitangent (N × T turns the other way).
+        let det = DMat3::from_mat4(*model_view).determinant();
+        self.tangent_sign
+            .set(dev, if det < 0.0 { -1.0 } else { 1.0 });
     }
 }
 
@@ -59,6 +67,7 @@ pub struct Surface {
     orthographic: Uniform<f32>,
     heat_scale: Uniform<f32>,
     albedo_tex: Uniform<Sampler>,
+    maps: MapUniforms,
 }
 
 /// What a frame sets on every object's [`Surface`] besides its material.
@@ -98,6 +107,7 @@ impl Surface {
                 "u_heatScale",
             ),
             albedo_tex: r.required_when(colour && f.has(ShaderFeatures::TEXTURE), "u_albedoTex"),
+            maps: MapUniforms::resolve(r, colour),
         }
     }
 
@@ -116,6 +126,7 @@ impl Surface {
             orthographic: r.required("u_orthographic"),
             heat_scale: r.optional("u_heatScale"),
             albedo_tex: r.required_when(f.has(ShaderFeatures::TEXTURE), "u_albedoTex"),
+            maps: MapUniforms::resolve(r, true),
         }
     }
 
@@ -145,6 +156,11 @@ impl Surface {
         if let Some(unit) = texture_unit {
             self.albedo_tex.set(dev, unit);
         }
+    }
+
+    /// `surface_maps.glsl`'s uniforms and textures (see [`MapUniforms::set`]).
+    pub(crate) fn maps(&self) -> &MapUniforms {
+        &self.maps
     }
 }
 
@@ -222,6 +238,10 @@ mod tests {
         F::DIRECTIONAL | F::NO_LIGHTS | F::TEXTURE,
         F::DIRECTIONAL | F::COUNT_EVALS,
         F::DIRECTIONAL | F::UNIFORM_LIGHT_LOOP,
+        F::SURFACE_INPUTS | F::TEXTURE | F::SPECULAR | F::SPOT,
+        F::NORMAL_MAP | F::TEXTURE_TRANSFORM,
+        F::EMISSIVE | F::OCCLUSION | F::VERTEX_COLOR | F::LIGHTS_RGBA8,
+        F::NO_LIGHTS | F::EMISSIVE | F::EMISSIVE_MAP | F::TEXTURE | F::TEXTURE_TRANSFORM,
     ];
 
     fn build<U: UniformSet>(
@@ -275,10 +295,12 @@ mod tests {
                 build::<ClusteredProgram>(&mut programs, &dev, "clustered", f);
                 if es == EsVersion::Es3 && !f.has(F::LIGHTS_RGBA8) {
                     build::<GBufferProgram>(&mut programs, &dev, "gbuffer", f);
-                    let lights = f.with(F::SPECULAR, true);
+                    // The full-screen passes never see a material's surface inputs.
+                    let frame = ShaderFeatures(f.0 & !F::SURFACE_INPUTS);
+                    let lights = frame.with(F::SPECULAR, true);
                     build::<LightProgram>(&mut programs, &dev, "deferred_light", lights);
                     build::<LightProgram>(&mut programs, &dev, "deferred_light_fullscreen", lights);
-                    build::<CompositeProgram>(&mut programs, &dev, "deferred_composite", f);
+                    build::<CompositeProgram>(&mut programs, &dev, "deferred_composite", frame);
                 }
             }
             programs.destroy(&dev);

@@ -76,7 +76,8 @@ pub struct ReferenceSet {
     /// the one hit (coplanar or doubled faces, a ray exactly on a shared edge: the GPU's depth
     /// test may pick either).
     pub skipped_coplanar: usize,
-    /// Skipped: the surface has a diffuse texture.
+    /// Skipped: the surface has a diffuse texture, vertex colours or glTF surface maps
+    /// (normal, occlusion, emission).
     pub skipped_texture: usize,
     /// Skipped: a transparent surface lies in front of (or instead of) the opaque one.
     pub skipped_transparent: usize,
@@ -283,7 +284,16 @@ fn evaluate(
         return Outcome::Edge;
     }
     let material = &scene.materials[scene.objects[hits[0].object].material];
-    if material.diffuse_texture.is_some() {
+    // Textures, vertex colours and the glTF surface inputs vary across a triangle or add
+    // terms this light-model reference does not evaluate: skipped like textures.
+    let object = &scene.objects[hits[0].object];
+    let maps = &material.maps;
+    if material.diffuse_texture.is_some()
+        || !object.mesh.colors.is_empty()
+        || maps.emits()
+        || maps.normal.is_some()
+        || maps.occlusion.is_some()
+    {
         return Outcome::Texture;
     }
     let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);

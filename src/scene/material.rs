@@ -4,16 +4,9 @@ use std::sync::Arc;
 
 use glam::Vec3;
 
+use super::surface_maps::SurfaceMaps;
+pub use super::texture::Texture;
 use super::SceneError;
-
-/// An 8-bit sRGB RGBA image used as a diffuse texture (decoded to linear in the shader).
-#[derive(Debug)]
-pub struct Texture {
-    /// Where it came from (file path or a built-in name), for messages.
-    pub name: String,
-    /// Pixels, row 0 at the top as image files store them.
-    pub image: image::RgbaImage,
-}
 
 /// Which reflectance model a material is shaded with (one light model, two BRDFs; see
 /// `glsl/light_model.glsl` and its CPU twin `scene::shading`).
@@ -54,6 +47,9 @@ pub struct Material {
     /// Perceptual roughness in [0, 1] (glTF `roughnessFactor`; α = roughness²). Shaded with
     /// at least 0.089 (`MIN_ROUGHNESS`: fp16 safety, docs/precision.md).
     pub roughness: f32,
+    /// Normal, emissive, occlusion and metallic-roughness inputs and texture transforms
+    /// (glTF; defaults for OBJ and built-in materials).
+    pub maps: SurfaceMaps,
 }
 
 impl Default for Material {
@@ -81,6 +77,7 @@ impl Material {
             model: MaterialModel::BlinnPhong,
             metallic: 0.0,
             roughness: 1.0,
+            maps: SurfaceMaps::default(),
         }
     }
 
@@ -152,6 +149,13 @@ impl Material {
                     format!("must be in [0, 1], got {v}"),
                 ));
             }
+        }
+        let e = self.maps.emissive;
+        if !e.is_finite() || e.min_element() < 0.0 || e.max_element() > MAX_COLOR_FACTOR {
+            return Err(SceneError::invalid(
+                format!("{field}.emissive"),
+                format!("must be in [0, {MAX_COLOR_FACTOR}], got {e:?}"),
+            ));
         }
         if !(self.shininess.is_finite() && self.shininess >= 0.0) {
             return Err(SceneError::invalid(

@@ -1,6 +1,6 @@
 //! Triangle meshes in object space and axis-aligned bounds.
 
-use glam::{DMat4, DVec3, Vec2, Vec3};
+use glam::{DMat4, DVec3, Vec2, Vec3, Vec4};
 
 use super::SceneError;
 
@@ -89,6 +89,12 @@ pub struct Mesh {
     pub uvs: Vec<Vec2>,
     /// Triangle list, three indices per triangle.
     pub indices: Vec<u32>,
+    /// Linear RGBA vertex colours (glTF `COLOR_0`), one per position, or empty. Their RGB
+    /// multiplies the base colour; alpha is not used (opacity is per material).
+    pub colors: Vec<Vec4>,
+    /// Unit tangents with the bitangent sign in `w` (glTF `TANGENT`, or generated for a
+    /// normal-mapped material), one per position, or empty.
+    pub tangents: Vec<Vec4>,
 }
 
 impl Mesh {
@@ -157,7 +163,51 @@ impl Mesh {
             normals,
             uvs,
             indices,
+            colors: Vec::new(),
+            tangents: Vec::new(),
         })
+    }
+
+    /// The mesh with vertex colours (one per position, finite; values are clamped to [0, 1]).
+    pub fn with_colors(mut self, colors: Vec<Vec4>) -> Result<Mesh, SceneError> {
+        check_per_vertex("mesh.colors", colors.len(), self.positions.len())?;
+        if let Some(i) = colors.iter().position(|c| !c.is_finite()) {
+            return Err(SceneError::invalid(
+                format!("mesh.colors[{i}]"),
+                "must be finite",
+            ));
+        }
+        self.colors = colors
+            .into_iter()
+            .map(|c| c.clamp(Vec4::ZERO, Vec4::ONE))
+            .collect();
+        Ok(self)
+    }
+
+    /// The mesh with tangents (one per position). Each is made orthogonal to its vertex's
+    /// normal and unit; one with no usable direction, and the `w` sign, are repaired from
+    /// the generated ones (per-vertex sums of the UV gradients, see `docs/gltf.md`).
+    pub fn with_tangents(mut self, tangents: Vec<Vec4>) -> Result<Mesh, SceneError> {
+        check_per_vertex("mesh.tangents", tangents.len(), self.positions.len())?;
+        self.tangents = super::tangents::repair(self.geometry(), tangents);
+        Ok(self)
+    }
+
+    /// The mesh with generated tangents when it has texture coordinates and none yet.
+    pub fn with_generated_tangents(mut self) -> Mesh {
+        if self.tangents.is_empty() && !self.uvs.is_empty() {
+            self.tangents = super::tangents::generate(self.geometry());
+        }
+        self
+    }
+
+    fn geometry(&self) -> super::tangents::Geometry<'_> {
+        super::tangents::Geometry {
+            positions: &self.positions,
+            normals: &self.normals,
+            uvs: &self.uvs,
+            indices: &self.indices,
+        }
     }
 
     /// Object-space bounds (`None` for an empty mesh).
@@ -169,6 +219,16 @@ impl Mesh {
     pub fn triangle_count(&self) -> usize {
         self.indices.len() / 3
     }
+}
+
+fn check_per_vertex(field: &str, got: usize, n: usize) -> Result<(), SceneError> {
+    if got != n {
+        return Err(SceneError::invalid(
+            field,
+            format!("{got} values for {n} vertices"),
+        ));
+    }
+    Ok(())
 }
 
 /// Given normals made unit; those with no direction (zero, NaN or infinite) replaced by the

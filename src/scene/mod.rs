@@ -30,6 +30,9 @@ pub mod obj;
 pub mod random;
 pub mod raycast;
 pub mod shading;
+pub mod surface_maps;
+pub mod tangents;
+pub mod texture;
 pub mod texture_budget;
 pub(crate) mod triangle_reach;
 

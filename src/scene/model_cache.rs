@@ -235,9 +235,10 @@ impl ModelCache {
         first_material: usize,
         path: Option<&PathBuf>,
     ) -> bool {
+        // Every texture slot: a model named many times holds each image once.
         for t in scene.materials[first_material..]
             .iter_mut()
-            .filter_map(|m| m.diffuse_texture.as_mut())
+            .flat_map(|m| m.diffuse_texture.iter_mut().chain(m.maps.textures_mut()))
         {
             match self.textures.get(&t.name) {
                 Some(known) if known.image == t.image => *t = known.clone(),
@@ -278,7 +279,12 @@ fn distinct<'a, T: 'a>(items: impl Iterator<Item = &'a Arc<T>>) -> Vec<Arc<T>> {
 }
 
 fn same_mesh(a: &Mesh, b: &Mesh) -> bool {
-    a.positions == b.positions && a.normals == b.normals && a.uvs == b.uvs && a.indices == b.indices
+    a.positions == b.positions
+        && a.normals == b.normals
+        && a.uvs == b.uvs
+        && a.indices == b.indices
+        && a.colors == b.colors
+        && a.tangents == b.tangents
 }
 
 /// Checks the scene's objects and materials against the scene-file limits after object

@@ -9,7 +9,7 @@
 //! [`MAX_TRIANGLE_REACH`] times its distance (a few hundred triangles: only those near the
 //! eye split, and each level halves them).
 
-use glam::{DMat3, DMat4, DVec2, DVec3, Vec2};
+use glam::{DMat3, DMat4, DVec2, DVec3, DVec4, Vec2};
 
 use super::normal_matrix::normal_matrix;
 use super::{Aabb, Camera, Mesh, Object, Projection, Scene};
@@ -83,6 +83,9 @@ struct Vertex {
     p: DVec3,
     n: DVec3,
     uv: DVec2,
+    /// Vertex colour and tangent (bitangent sign in `w`), kept when the mesh has them.
+    color: DVec4,
+    tangent: DVec4,
 }
 
 impl Vertex {
@@ -91,6 +94,8 @@ impl Vertex {
             p: (a.p + b.p) * 0.5,
             n: (a.n + b.n) * 0.5,
             uv: (a.uv + b.uv) * 0.5,
+            color: (a.color + b.color) * 0.5,
+            tangent: ((a.tangent + b.tangent) * 0.5).with_w(a.tangent.w),
         }
     }
 }
@@ -120,13 +125,22 @@ fn too_long(a: DVec3, b: DVec3, c: DVec3, floor: f64) -> bool {
 /// distance split in four until they are not; `None` when no triangle needs it (or the
 /// placed mesh is not finite, which no split can mend).
 fn split_mesh(mesh: &Mesh, transform: &DMat4, eye: DVec3, floor: f64) -> Option<Mesh> {
-    let normals = normal_matrix(&DMat3::from_mat4(*transform));
+    let linear = DMat3::from_mat4(*transform);
+    let normals = normal_matrix(&linear);
+    // A mirroring transform flips the bitangent's handedness; the split copy is drawn
+    // unmirrored, so the flip is baked into `w`.
+    let handedness = linear.determinant().signum();
     let vertex = |i: u32| {
         let i = i as usize;
         Vertex {
             p: transform.transform_point3(mesh.positions[i].as_dvec3()) - eye,
             n: normals * mesh.normals[i].as_dvec3(),
             uv: mesh.uvs.get(i).map_or(DVec2::ZERO, |t| t.as_dvec2()),
+            color: mesh.colors.get(i).map_or(DVec4::ONE, |c| c.as_dvec4()),
+            tangent: mesh.tangents.get(i).map_or(DVec4::X, |t| {
+                let t = t.as_dvec4();
+                transform.transform_vector3(t.truncate()).extend(t.w * handedness)
+            }),
         }
     };
     let placed: Vec<[Vertex; 3]> = mesh
@@ -155,10 +169,18 @@ fn split_mesh(mesh: &Mesh, transform: &DMat4, eye: DVec3, floor: f64) -> Option<
             out.positions.push(v.p.as_vec3());
             out.normals.push(v.n.as_vec3());
             out.uvs.push(Vec2::new(v.uv.x as f32, v.uv.y as f32));
+            out.colors.push(v.color.as_vec4());
+            out.tangents.push(v.tangent.as_vec4());
         }
     }
     if mesh.uvs.is_empty() {
         out.uvs.clear();
+    }
+    if mesh.colors.is_empty() {
+        out.colors.clear();
+    }
+    if mesh.tangents.is_empty() {
+        out.tangents.clear();
     }
     Some(out)
 }

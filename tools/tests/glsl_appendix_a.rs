@@ -156,6 +156,28 @@ fn all_features() -> Vec<ShaderFeatures> {
     ] {
         all.push(ShaderFeatures(ShaderFeatures::DIRECTIONAL | extra));
     }
+    // The glTF surface inputs, alone and together, with the material and light features, the
+    // texture transform, RGBA8 light data and no lights.
+    type F = ShaderFeatures;
+    for input in [
+        F::VERTEX_COLOR,
+        F::NORMAL_MAP,
+        F::EMISSIVE,
+        F::EMISSIVE | F::EMISSIVE_MAP,
+        F::OCCLUSION,
+        F::MR_TEXTURE | F::METALLIC_ROUGHNESS,
+        F::SURFACE_INPUTS | F::METALLIC_ROUGHNESS | F::DIRECTIONAL,
+    ] {
+        for extra in [
+            0,
+            F::TEXTURE | F::SPOT | F::SPECULAR | F::TEXTURE_TRANSFORM,
+            F::LIGHTS_RGBA8 | F::OUTPUT_LINEAR,
+            F::NO_LIGHTS | F::TEXTURE,
+            F::UNIFORM_LIGHT_LOOP | F::TEXTURE_TRANSFORM,
+        ] {
+            all.push(ShaderFeatures(input | extra));
+        }
+    }
     all
 }
 

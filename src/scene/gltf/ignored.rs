@@ -5,7 +5,11 @@
 
 /// Extensions the loader implements. A file *requiring* another is refused, naming it; one
 /// merely *using* another gets one warning per extension that it is ignored.
-pub const SUPPORTED_EXTENSIONS: &[&str] = &["KHR_lights_punctual"];
+pub const SUPPORTED_EXTENSIONS: &[&str] = &[
+    "KHR_lights_punctual",
+    "KHR_texture_transform",
+    "KHR_materials_emissive_strength",
+];
 
 /// The file's `extensionsRequired` that the loader does not support, as the reason it is
 /// refused (`None`: all supported).

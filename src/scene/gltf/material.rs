@@ -6,8 +6,9 @@
 //! - `metallicFactor` → `metallic`, `roughnessFactor` → `roughness` (clamped to [0, 1]), shaded
 //!   by the glTF BRDF ([`crate::scene::brdf`]). `specular`/`shininess` (the dielectric 0.04
 //!   grey and the Blinn-Phong ↔ Beckmann match `Ns = 2/α² − 2`, [`shininess`]) are kept for
-//!   callers that switch the material to Blinn-Phong. The metallic-roughness, normal,
-//!   occlusion and emissive textures are not used.
+//!   callers that switch the material to Blinn-Phong.
+//! - normal, occlusion, emissive and metallic-roughness textures, emission and every
+//!   texture's `KHR_texture_transform` → [`Material::maps`] ([`super::maps`]).
 //! - `alphaMode`: `OPAQUE` ignores alpha; `BLEND` takes `baseColorFactor.a` as the material's
 //!   opacity (below 1: the renderer's transparent path, back to front, alpha-blended);
 //!   `MASK` cuts the whole material — invisible (opacity 0) when `baseColorFactor.a` is below
@@ -23,6 +24,7 @@ use glam::Vec3;
 use gltf::material::AlphaMode;
 
 use super::buffers::Buffers;
+use super::maps::{self, RawMaterials, Sources};
 use super::texture::Textures;
 use crate::scene::material::MAX_COLOR_FACTOR;
 use crate::scene::Material;
@@ -55,16 +57,26 @@ fn unit_factor(f: f32) -> f32 {
 }
 
 /// The materials of one glTF file, converted when a primitive first uses them.
-#[derive(Default)]
 pub(super) struct Materials {
     /// Converted materials, in the order first used.
     pub list: Vec<Material>,
     /// glTF material index (`None`: the default material) → index in `list`.
     by_index: HashMap<Option<usize>, usize>,
     textures: Textures,
+    raw: RawMaterials,
 }
 
 impl Materials {
+    /// For the file whose JSON chunk is `json`.
+    pub fn new(json: &[u8]) -> Materials {
+        Materials {
+            list: Vec::new(),
+            by_index: HashMap::new(),
+            textures: Textures::default(),
+            raw: RawMaterials::parse(json),
+        }
+    }
+
     /// Index in [`Materials::list`] of `m`, converting it on first use.
     pub fn get(
         &mut self,
@@ -111,12 +123,22 @@ impl Materials {
         }
         let factor_alpha = if a.is_nan() { 1.0 } else { a.clamp(0.0, 1.0) };
         let mut diffuse_texture = None;
+        let mut base_transform = Default::default();
         if let Some(info) = pbr.base_color_texture() {
-            if info.tex_coord() != 0 {
+            let path = ["pbrMetallicRoughness", "baseColorTexture"];
+            let (transform, tex_coord) = maps::transform_of(
+                &self.raw,
+                m.index(),
+                &path,
+                info.tex_coord(),
+                &format!("{field}.{}", path.join(".")),
+                warnings,
+            );
+            base_transform = transform;
+            if tex_coord != 0 {
                 warnings.push(format!(
-                    "{field} (`{name}`): baseColorTexture uses TEXCOORD_{}; only TEXCOORD_0 is \
-                     read, so it is not bound (flat colour)",
-                    info.tex_coord()
+                    "{field} (`{name}`): baseColorTexture uses TEXCOORD_{tex_coord}; only \
+                     TEXCOORD_0 is read, so it is not bound (flat colour)"
                 ));
             } else {
                 let image = info.texture().source();
@@ -152,17 +174,20 @@ impl Materials {
                 }
             }
         };
-        let emissive = m.emissive_factor();
-        if emissive.iter().any(|&e| e > 0.0) || m.emissive_texture().is_some() {
-            warnings.push(format!(
-                "{field} (`{name}`): emission is not rendered (no emissive term)"
-            ));
-        }
+        let mut sources = Sources {
+            raw: &self.raw,
+            textures: &mut self.textures,
+            buffers,
+            gltf_path,
+        };
+        let mut maps = maps::convert(m, &field, &mut sources, warnings)?;
+        maps.base_transform = base_transform;
         Ok(Material {
             diffuse_texture,
             specular: Vec3::splat(DIELECTRIC_SPECULAR),
             shininess: shininess(pbr.roughness_factor()),
             alpha,
+            maps,
             ..Material::metallic_roughness(
                 &name,
                 diffuse,

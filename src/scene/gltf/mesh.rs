@@ -4,7 +4,7 @@
 //! against [`MAX_VERTEX_COORD`], with the glTF path and the element's position in the message
 //! (never its value: buffer bytes are not shown).
 
-use glam::{Vec2, Vec3};
+use glam::{Vec2, Vec3, Vec4};
 use gltf::accessor::DataType;
 use gltf::mesh::Mode;
 
@@ -144,6 +144,22 @@ pub(super) fn build(
             ));
         }
     }
+    let colors = read_colors(p, n, buffers, warnings, &attr)?;
+    let mut tangents = Vec::new();
+    if let Some(a) = p.get(&gltf::Semantic::Tangents) {
+        same_count(&a, "TANGENT")?;
+        if a.dimensions() == gltf::accessor::Dimensions::Vec4 && a.data_type() == DataType::F32 {
+            let raw = accessor::read_f32(&a, buffers, n)
+                .map_err(|e| format!("{}: {e}", attr("TANGENT", &a)))?;
+            tangents = raw.chunks_exact(4).map(Vec4::from_slice).collect();
+        } else {
+            warnings.push(format!(
+                "{}: is {}, not VEC4 of FLOAT; tangents generated instead",
+                attr("TANGENT", &a),
+                describe(&a)
+            ));
+        }
+    }
     let listed: Vec<u32> = match p.indices() {
         Some(a) => {
             let ifield = format!("{field}.indices (accessors[{}])", a.index());
@@ -178,9 +194,17 @@ pub(super) fn build(
     if indices.is_empty() {
         return Ok(Built::Skipped(format!("{field}: has no triangles")));
     }
-    let (positions, uvs, indices) = if normals.is_empty() {
-        // glTF asks for flat normals when a primitive has none: each triangle gets its own
-        // three vertices, and the mesh's area-weighted normals are then the face normals.
+    let flat = normals.is_empty();
+    // glTF asks for flat normals when a primitive has none: each triangle gets its own
+    // three vertices, and the mesh's area-weighted normals are then the face normals.
+    let unshare = |v: Vec<Vec4>| -> Vec<Vec4> {
+        if !flat || v.is_empty() {
+            return v;
+        }
+        indices.iter().map(|&i| v[i as usize]).collect()
+    };
+    let (colors, tangents) = (unshare(colors), unshare(tangents));
+    let (positions, uvs, indices) = if flat {
         budget.take("vertices", indices.len(), field)?;
         let pick = |i: &u32| positions[*i as usize];
         let flat_uvs = if uvs.is_empty() {
@@ -196,9 +220,68 @@ pub(super) fn build(
     } else {
         (positions, uvs, indices)
     };
-    Mesh::new(positions, normals, uvs, indices)
-        .map(Built::Mesh)
-        .map_err(|e| format!("{field}: {e}"))
+    let mut mesh = Mesh::new(positions, normals, uvs, indices).map_err(|e| format!("{field}: {e}"))?;
+    if !colors.is_empty() {
+        mesh = mesh.with_colors(colors).map_err(|e| format!("{field}: {e}"))?;
+    }
+    // Tangents only where a normal map will use them (they cost a vertex attribute).
+    if p.material().normal_texture().is_some() {
+        if !tangents.is_empty() {
+            mesh = mesh.with_tangents(tangents).map_err(|e| format!("{field}: {e}"))?;
+        } else if mesh.uvs.is_empty() {
+            warnings.push(format!(
+                "{field}: its material has a normal map but the primitive has no TEXCOORD_0; \
+                 the map is not applied"
+            ));
+        } else {
+            mesh = mesh.with_generated_tangents();
+        }
+    }
+    Ok(Built::Mesh(mesh))
+}
+
+/// `COLOR_0` as linear RGBA (VEC3 or VEC4 of FLOAT or normalized UNSIGNED_BYTE/SHORT), or
+/// empty; another type is a warning and ignored.
+fn read_colors(
+    p: &gltf::Primitive,
+    n: usize,
+    buffers: &mut Buffers,
+    warnings: &mut Vec<String>,
+    attr: &dyn Fn(&str, &gltf::Accessor) -> String,
+) -> Result<Vec<Vec4>, String> {
+    let Some(a) = p.get(&gltf::Semantic::Colors(0)) else {
+        return Ok(Vec::new());
+    };
+    let field = attr("COLOR_0", &a);
+    if a.count() != n {
+        return Err(format!("{field}: {} elements but POSITION has {n}", a.count()));
+    }
+    let ok_type = match a.data_type() {
+        DataType::F32 => true,
+        DataType::U8 | DataType::U16 => a.normalized(),
+        _ => false,
+    };
+    let dims = match a.dimensions() {
+        gltf::accessor::Dimensions::Vec3 => 3,
+        gltf::accessor::Dimensions::Vec4 => 4,
+        _ => 0,
+    };
+    if !ok_type || dims == 0 {
+        warnings.push(format!(
+            "{field}: is {}, not VEC3/VEC4 of FLOAT or normalized UNSIGNED_BYTE/SHORT; ignored",
+            describe(&a)
+        ));
+        return Ok(Vec::new());
+    }
+    let raw = accessor::read_f32(&a, buffers, n).map_err(|e| format!("{field}: {e}"))?;
+    let colors: Vec<Vec4> = raw
+        .chunks_exact(dims)
+        .map(|c| Vec4::new(c[0], c[1], c[2], if dims == 4 { c[3] } else { 1.0 }))
+        .collect();
+    if let Some(i) = colors.iter().position(|c| !c.is_finite()) {
+        return Err(format!("{field}: element {i} is not finite; colours must be"));
+    }
+    Ok(colors)
 }
 
 /// A triangle list from the primitive's mode and its (checked) vertex sequence.

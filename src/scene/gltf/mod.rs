@@ -9,7 +9,8 @@
 //!   hierarchy composed in `f64` ([`nodes`]);
 //! - each triangle primitive of each placed mesh → one [`Object`] sharing its [`Mesh`] with
 //!   every other node that places it ([`mesh`]); points and lines are skipped with a warning;
-//! - materials → Lambert + Blinn-Phong ([`material`]), base colour textures ([`texture`]);
+//! - materials → Lambert + Blinn-Phong ([`material`]), their textures ([`texture`]) and
+//!   surface maps (normal, emissive, occlusion, metallic-roughness, texture transforms);
 //! - the first camera a node instances (depth first, in order) ([`camera`]);
 //! - `KHR_lights_punctual` point, spot and directional lights, on one photometric scale
 //!   ([`lights`]).
@@ -33,6 +34,7 @@ mod glb;
 mod ignored;
 mod integers;
 pub mod lights;
+mod maps;
 pub mod material;
 pub mod mesh;
 pub mod nodes;
@@ -290,7 +292,7 @@ fn import(
     };
     // Each primitive is built once, with its object-space bounds, however many nodes place it.
     let mut meshes: HashMap<(usize, usize), Option<BuiltMesh>> = HashMap::new();
-    let mut materials = material::Materials::default();
+    let mut materials = material::Materials::new(json);
     let mut out = Imported {
         objects: Vec::new(),
         materials: Vec::new(),

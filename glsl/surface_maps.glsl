@@ -1,0 +1,101 @@
+// glTF surface inputs beyond the base colour, each compiled in only when the material uses
+// it (CPU twin: src/scene/surface_maps.rs): texture transforms, vertex colours, normal maps,
+// emission, ambient occlusion, the metallic-roughness texture.
+
+#if HAS_TEXTURE_TRANSFORM
+// KHR_texture_transform, applied per vertex in mesh.vert (the map is affine, so this is exact
+// and costs no fragment uniforms): each texture's own coordinates, two per varying.
+VARYING vec4 v_uvAlbedoNormal;
+VARYING vec4 v_uvEmissiveOcclusion;
+VARYING vec2 v_uvMetallicRoughness;
+#define UV_ALBEDO(uv) v_uvAlbedoNormal.xy
+#define UV_NORMAL(uv) v_uvAlbedoNormal.zw
+#define UV_EMISSIVE(uv) v_uvEmissiveOcclusion.xy
+#define UV_OCCLUSION(uv) v_uvEmissiveOcclusion.zw
+#define UV_METALLIC_ROUGHNESS(uv) v_uvMetallicRoughness
+#else
+#define UV_ALBEDO(uv) (uv)
+#define UV_NORMAL(uv) (uv)
+#define UV_EMISSIVE(uv) (uv)
+#define UV_OCCLUSION(uv) (uv)
+#define UV_METALLIC_ROUGHNESS(uv) (uv)
+#endif
+
+#if HAS_VERTEX_COLOR
+// COLOR_0's linear RGB (multiplies the base colour).
+VARYING vec3 v_color;
+#endif
+
+#if HAS_NORMAL_MAP
+uniform sampler2D u_normalTex;
+uniform float u_normalScale;
+// View-space tangent, bitangent sign in w.
+VARYING vec4 v_tangent;
+
+// The normal-mapped shading normal; N is the interpolated unit normal, turned to the eye.
+vec3 surfaceNormal(vec3 N, vec2 uv) {
+    vec3 t = v_tangent.xyz - N * dot(N, v_tangent.xyz);
+    float len = length(t);
+    if (len <= 0.0) {
+        return N;
+    }
+    t /= len;
+    vec3 b = cross(N, t) * (v_tangent.w < 0.0 ? -1.0 : 1.0);
+    vec3 m = TEXTURE2D(u_normalTex, UV_NORMAL(uv)).rgb * 2.0 - 1.0;
+    m.xy *= u_normalScale;
+    vec3 n = t * m.x + b * m.y + N * m.z;
+    float l = length(n);
+    return l > 0.0 ? n / l : N;
+}
+#endif
+
+#if HAS_EMISSIVE
+// Emitted radiance, added after the light sum.
+uniform vec3 u_emissive;
+#if HAS_EMISSIVE_MAP
+uniform sampler2D u_emissiveTex;
+#endif
+
+vec3 surfaceEmission(vec2 uv) {
+    vec3 e = u_emissive;
+#if HAS_EMISSIVE_MAP
+    e *= srgbToLinear(TEXTURE2D(u_emissiveTex, UV_EMISSIVE(uv)).rgb);
+#endif
+    return e;
+}
+#endif
+
+#if HAS_OCCLUSION
+// Ambient occlusion (red channel) scales the ambient term only: glTF applies it to indirect
+// light, which the ambient term stands for here.
+uniform sampler2D u_occlusionTex;
+uniform float u_occlusionStrength;
+#endif
+
+// The ambient term of a surface of this albedo.
+vec3 surfaceAmbient(vec3 albedo, vec2 uv) {
+    vec3 a = u_ambient * albedo;
+#if HAS_OCCLUSION
+    float ao = TEXTURE2D(u_occlusionTex, UV_OCCLUSION(uv)).r;
+    a *= 1.0 + u_occlusionStrength * (ao - 1.0);
+#endif
+    return a;
+}
+
+#if METALLIC_ROUGHNESS
+// (metallic, perceptual roughness) at uv: the glTF factors, times the metallic-roughness
+// texture's B and G where the material has one (linear data).
+uniform float u_metallic;
+uniform float u_roughness;
+#if HAS_MR_TEXTURE
+uniform sampler2D u_metallicRoughnessTex;
+#endif
+
+vec2 surfaceMetallicRoughness(vec2 uv) {
+    vec2 mr = vec2(u_metallic, u_roughness);
+#if HAS_MR_TEXTURE
+    mr *= TEXTURE2D(u_metallicRoughnessTex, UV_METALLIC_ROUGHNESS(uv)).bg;
+#endif
+    return mr;
+}
+#endif

@@ -1,0 +1,176 @@
+//! The material's surface inputs beyond the base colour (`glsl/surface_maps.glsl`): which
+//! shader features an object needs, its textures' units and its uniforms.
+//!
+//! Texture units: the base colour has unit 0 and the methods' geometry programs use units 1
+//! to 3 (clustered's lights, grid and index list), so the four maps take units 4 to 7 — within
+//! the 8 fragment units ES 2.0 guarantees. A context with fewer leaves out the maps that do
+//! not fit, with a warning naming them (once per process).
+
+use std::sync::atomic::{AtomicBool, Ordering};
+
+use glam::{Mat3, Vec3};
+
+use super::ShaderFeatures as F;
+use crate::gl::program::{Resolver, Sampler, Uniform};
+use crate::gl::Device;
+use crate::gpu_scene::GpuScene;
+use crate::scene::surface_maps::{MapTexture, TextureTransform};
+use crate::scene::{Material, Mesh};
+
+/// First texture unit of the maps: after the most any geometry program's method uses
+/// (checked against `geometry::UNIT_METHOD` there).
+pub const UNIT_MAPS: u32 = 4;
+
+/// The map slots: feature bit, texture unit, name for warnings.
+const SLOTS: [(u64, u32, &str); 4] = [
+    (F::NORMAL_MAP, UNIT_MAPS, "normal map"),
+    (F::EMISSIVE_MAP, UNIT_MAPS + 1, "emissive texture"),
+    (F::OCCLUSION, UNIT_MAPS + 2, "occlusion texture"),
+    (F::MR_TEXTURE, UNIT_MAPS + 3, "metallic-roughness texture"),
+];
+
+/// Whether each slot's missing-unit warning was given.
+static WARNED: [AtomicBool; 4] = [
+    AtomicBool::new(false),
+    AtomicBool::new(false),
+    AtomicBool::new(false),
+    AtomicBool::new(false),
+];
+
+/// The surface-input features of `material` on `mesh`, on a context with `units` fragment
+/// texture units: each only where the material (or mesh) has it.
+pub fn features(material: &Material, mesh: &Mesh, units: i32) -> F {
+    let maps = &material.maps;
+    let emits = maps.emits();
+    let mut bits = [
+        (F::VERTEX_COLOR, !mesh.colors.is_empty()),
+        (
+            F::NORMAL_MAP,
+            maps.normal.is_some() && !mesh.tangents.is_empty() && maps.normal_scale != 0.0,
+        ),
+        (F::EMISSIVE, emits),
+        (F::EMISSIVE_MAP, emits && maps.emissive_texture.is_some()),
+        (
+            F::OCCLUSION,
+            maps.occlusion.is_some() && maps.occlusion_strength > 0.0,
+        ),
+        (F::MR_TEXTURE, maps.metallic_roughness.is_some()),
+    ]
+    .into_iter()
+    .fold(F::default(), |f, (bit, on)| f.with(bit, on));
+    for (k, (bit, unit, name)) in SLOTS.iter().enumerate() {
+        if bits.has(*bit) && *unit as i32 >= units {
+            bits = bits.with(*bit, false);
+            if !WARNED[k].swap(true, Ordering::Relaxed) {
+                log::warn!(
+                    "the {name} of material `{}` is not applied: it needs texture unit {unit} \
+                     and this context has {units} fragment texture units",
+                    material.name
+                );
+            }
+        }
+    }
+    let transformed = (material.diffuse_texture.is_some() && !maps.base_transform.is_identity())
+        || [
+            (F::NORMAL_MAP, &maps.normal),
+            (F::EMISSIVE_MAP, &maps.emissive_texture),
+            (F::OCCLUSION, &maps.occlusion),
+            (F::MR_TEXTURE, &maps.metallic_roughness),
+        ]
+        .iter()
+        .any(|(bit, t)| bits.has(*bit) && t.as_ref().is_some_and(|t| !t.transform.is_identity()));
+    bits.with(F::TEXTURE_TRANSFORM, transformed)
+}
+
+/// One map as [`MapUniforms::set`] binds it: feature bit, texture, sampler, UV transform.
+type MapSlot<'a> = (u64, &'a Option<MapTexture>, &'a Uniform<Sampler>, &'a Uniform<Mat3>);
+
+/// The uniforms of `surface_maps.glsl`.
+pub struct MapUniforms {
+    albedo_uv: Uniform<Mat3>,
+    normal_uv: Uniform<Mat3>,
+    emissive_uv: Uniform<Mat3>,
+    occlusion_uv: Uniform<Mat3>,
+    mr_uv: Uniform<Mat3>,
+    normal_tex: Uniform<Sampler>,
+    normal_scale: Uniform<f32>,
+    emissive: Uniform<Vec3>,
+    emissive_tex: Uniform<Sampler>,
+    occlusion_tex: Uniform<Sampler>,
+    occlusion_strength: Uniform<f32>,
+    mr_tex: Uniform<Sampler>,
+}
+
+impl MapUniforms {
+    /// `colour`: whether the variant computes a colour (not a count) and so reads the maps.
+    /// The metallic-roughness texture is optional: its reader is the light model's.
+    pub(crate) fn resolve(r: &mut Resolver<'_>, colour: bool) -> Self {
+        let f = F(r.features());
+        let on = |bit| colour && f.has(bit);
+        // The transforms are mesh.vert's; a slot the variant does not sample may be dropped.
+        MapUniforms {
+            albedo_uv: r.optional("u_albedoUvTransform"),
+            normal_uv: r.optional("u_normalUvTransform"),
+            emissive_uv: r.optional("u_emissiveUvTransform"),
+            occlusion_uv: r.optional("u_occlusionUvTransform"),
+            mr_uv: r.optional("u_metallicRoughnessUvTransform"),
+            normal_tex: r.required_when(on(F::NORMAL_MAP), "u_normalTex"),
+            normal_scale: r.required_when(on(F::NORMAL_MAP), "u_normalScale"),
+            emissive: r.required_when(on(F::EMISSIVE), "u_emissive"),
+            emissive_tex: r.required_when(on(F::EMISSIVE_MAP), "u_emissiveTex"),
+            occlusion_tex: r.required_when(on(F::OCCLUSION), "u_occlusionTex"),
+            occlusion_strength: r.required_when(on(F::OCCLUSION), "u_occlusionStrength"),
+            mr_tex: r.optional("u_metallicRoughnessTex"),
+        }
+    }
+
+    /// Binds the maps `features` selected and sets their uniforms.
+    pub(crate) fn set(&self, dev: &Device, material: &Material, features: F, scene: &GpuScene) {
+        let maps = &material.maps;
+        if features.has(F::TEXTURE_TRANSFORM) {
+            self.albedo_uv.set(dev, uv_matrix(&maps.base_transform));
+        }
+        let slots: [MapSlot<'_>; 4] = [
+            (F::NORMAL_MAP, &maps.normal, &self.normal_tex, &self.normal_uv),
+            (
+                F::EMISSIVE_MAP,
+                &maps.emissive_texture,
+                &self.emissive_tex,
+                &self.emissive_uv,
+            ),
+            (F::OCCLUSION, &maps.occlusion, &self.occlusion_tex, &self.occlusion_uv),
+            (F::MR_TEXTURE, &maps.metallic_roughness, &self.mr_tex, &self.mr_uv),
+        ];
+        for ((bit, map, sampler, uv), (_, unit, _)) in slots.into_iter().zip(SLOTS) {
+            let Some(map) = map.as_ref().filter(|_| features.has(bit)) else {
+                continue;
+            };
+            if let Some(t) = scene.texture_of(&map.texture) {
+                t.bind(dev, unit);
+            }
+            sampler.set(dev, unit);
+            if features.has(F::TEXTURE_TRANSFORM) {
+                uv.set(dev, uv_matrix(&map.transform));
+            }
+        }
+        if features.has(F::NORMAL_MAP) {
+            self.normal_scale.set(dev, maps.normal_scale);
+        }
+        if features.has(F::EMISSIVE) {
+            self.emissive.set(dev, maps.emissive);
+        }
+        if features.has(F::OCCLUSION) {
+            self.occlusion_strength.set(dev, maps.occlusion_strength);
+        }
+    }
+}
+
+/// The transform as the shader's `mat3` (columns; `uv' = (M · (uv, 1)).xy`).
+fn uv_matrix(t: &TextureTransform) -> Mat3 {
+    let [r0, r1] = t.rows();
+    Mat3::from_cols(
+        Vec3::new(r0.x, r1.x, 0.0),
+        Vec3::new(r0.y, r1.y, 0.0),
+        Vec3::new(r0.z, r1.z, 1.0),
+    )
+}

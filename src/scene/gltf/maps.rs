@@ -1,0 +1,207 @@
+//! A glTF material's textures besides the base colour → [`SurfaceMaps`]: normal (with
+//! `scale`), occlusion (with `strength`), emissive (`emissiveFactor` ×
+//! `KHR_materials_emissive_strength`, × texture), metallic-roughness; and every texture's
+//! `KHR_texture_transform`, read from the file's JSON (the `gltf` crate exposes it on only
+//! some texture infos).
+//!
+//! Only `TEXCOORD_0` is read: a texture on another set (after the transform's `texCoord`
+//! override) is a warning and not bound, as the base colour's always was.
+
+use std::path::Path;
+
+use glam::{Vec2, Vec3};
+use serde_json::Value;
+
+use super::buffers::Buffers;
+use super::texture::Textures;
+use crate::scene::surface_maps::{MapTexture, SurfaceMaps, TextureTransform, MAX_EMISSIVE};
+
+/// The file's `materials` array as plain JSON, for the transforms.
+pub(super) struct RawMaterials(Vec<Value>);
+
+impl RawMaterials {
+    /// From the file's JSON chunk (already parsed once by the `gltf` crate, so valid).
+    pub fn parse(json: &[u8]) -> RawMaterials {
+        let root: Value = serde_json::from_slice(json).unwrap_or(Value::Null);
+        match root.get("materials") {
+            Some(Value::Array(list)) => RawMaterials(list.clone()),
+            _ => RawMaterials(Vec::new()),
+        }
+    }
+
+    /// The texture info at `path` (keys from the material object) of material `index`.
+    fn info(&self, index: Option<usize>, path: &[&str]) -> Option<&Value> {
+        let mut v = self.0.get(index?)?;
+        for key in path {
+            v = v.get(key)?;
+        }
+        Some(v)
+    }
+}
+
+/// One texture slot of a material: where it is in the JSON, its glTF name for messages.
+pub(super) struct Slot<'a> {
+    pub name: &'a str,
+    pub path: &'a [&'a str],
+    pub image: gltf::Image<'a>,
+    pub tex_coord: u32,
+}
+
+/// What the maps converter needs from the file.
+pub(super) struct Sources<'a, 'b> {
+    pub raw: &'b RawMaterials,
+    pub textures: &'b mut Textures,
+    pub buffers: &'b mut Buffers<'a>,
+    pub gltf_path: &'b Path,
+}
+
+/// `KHR_texture_transform` of the texture info at `path` and the set it reads; a malformed
+/// one is ignored with a warning.
+pub(super) fn transform_of(
+    raw: &RawMaterials,
+    index: Option<usize>,
+    path: &[&str],
+    tex_coord: u32,
+    field: &str,
+    warnings: &mut Vec<String>,
+) -> (TextureTransform, u32) {
+    let Some(ext) = raw
+        .info(index, path)
+        .and_then(|i| i.get("extensions"))
+        .and_then(|e| e.get("KHR_texture_transform"))
+    else {
+        return (TextureTransform::IDENTITY, tex_coord);
+    };
+    let pair = |key: &str, default: Vec2| -> Option<Vec2> {
+        match ext.get(key) {
+            None => Some(default),
+            Some(Value::Array(a)) if a.len() == 2 => {
+                Some(Vec2::new(a[0].as_f64()? as f32, a[1].as_f64()? as f32))
+            }
+            Some(_) => None,
+        }
+    };
+    let rotation = match ext.get("rotation") {
+        None => Some(0.0),
+        Some(v) => v.as_f64().map(|r| r as f32),
+    };
+    let parsed = match (pair("offset", Vec2::ZERO), rotation, pair("scale", Vec2::ONE)) {
+        (Some(offset), Some(rotation), Some(scale)) => Some(TextureTransform {
+            offset,
+            rotation,
+            scale,
+        }),
+        _ => None,
+    };
+    let t = match parsed.filter(|t| t.is_finite() && t.rows().iter().all(|r| r.is_finite())) {
+        Some(t) => t,
+        None => {
+            warnings.push(format!(
+                "{field}.extensions.KHR_texture_transform: malformed (offset and scale are \
+                 two numbers, rotation one, all finite); ignored"
+            ));
+            TextureTransform::IDENTITY
+        }
+    };
+    let tex_coord = ext
+        .get("texCoord")
+        .and_then(Value::as_u64)
+        .map_or(tex_coord, |t| u32::try_from(t).unwrap_or(u32::MAX));
+    (t, tex_coord)
+}
+
+/// Loads one slot's texture with its transform (`None`: absent, on another texture
+/// coordinate set, or not decodable — each warned).
+pub(super) fn load_slot(
+    slot: Slot<'_>,
+    index: Option<usize>,
+    field: &str,
+    src: &mut Sources<'_, '_>,
+    warnings: &mut Vec<String>,
+) -> Result<Option<MapTexture>, String> {
+    let tfield = format!("{field}.{}", slot.path.join("."));
+    let (transform, tex_coord) =
+        transform_of(src.raw, index, slot.path, slot.tex_coord, &tfield, warnings);
+    if tex_coord != 0 {
+        warnings.push(format!(
+            "{tfield}: uses TEXCOORD_{tex_coord}; only TEXCOORD_0 is read, so the {} texture \
+             is not bound",
+            slot.name
+        ));
+        return Ok(None);
+    }
+    let texture = src
+        .textures
+        .load(&slot.image, src.buffers, src.gltf_path, warnings)
+        .map_err(|e| format!("{tfield}: {e}"))?;
+    Ok(texture.map(|texture| MapTexture { texture, transform }))
+}
+
+/// The maps of material `m` (the base colour's transform is the caller's).
+pub(super) fn convert(
+    m: &gltf::Material,
+    field: &str,
+    src: &mut Sources<'_, '_>,
+    warnings: &mut Vec<String>,
+) -> Result<SurfaceMaps, String> {
+    let index = m.index();
+    let mut maps = SurfaceMaps::default();
+    if let Some(n) = m.normal_texture() {
+        let slot = Slot {
+            name: "normal",
+            path: &["normalTexture"],
+            image: n.texture().source(),
+            tex_coord: n.tex_coord(),
+        };
+        maps.normal = load_slot(slot, index, field, src, warnings)?;
+        let scale = n.scale();
+        maps.normal_scale = if scale.is_finite() { scale.clamp(-16.0, 16.0) } else { 1.0 };
+    }
+    if let Some(o) = m.occlusion_texture() {
+        let slot = Slot {
+            name: "occlusion",
+            path: &["occlusionTexture"],
+            image: o.texture().source(),
+            tex_coord: o.tex_coord(),
+        };
+        maps.occlusion = load_slot(slot, index, field, src, warnings)?;
+        let strength = o.strength();
+        maps.occlusion_strength = if strength.is_finite() {
+            strength.clamp(0.0, 1.0)
+        } else {
+            1.0
+        };
+    }
+    if let Some(info) = m.pbr_metallic_roughness().metallic_roughness_texture() {
+        let slot = Slot {
+            name: "metallic-roughness",
+            path: &["pbrMetallicRoughness", "metallicRoughnessTexture"],
+            image: info.texture().source(),
+            tex_coord: info.tex_coord(),
+        };
+        maps.metallic_roughness = load_slot(slot, index, field, src, warnings)?;
+    }
+    let strength = m.emissive_strength().unwrap_or(1.0);
+    let e = Vec3::from(m.emissive_factor()) * if strength.is_finite() { strength } else { 1.0 };
+    // NaN becomes 0 (max/min drop it).
+    let emissive = e.max(Vec3::ZERO).min(Vec3::splat(MAX_EMISSIVE));
+    if emissive != e {
+        warnings.push(format!(
+            "{field}: emissiveFactor × KHR_materials_emissive_strength {e} clamped to \
+             {emissive} (the fp16 colour tier's range)"
+        ));
+    }
+    maps.emissive = emissive;
+    if let Some(info) = m.emissive_texture() {
+        let slot = Slot {
+            name: "emissive",
+            path: &["emissiveTexture"],
+            image: info.texture().source(),
+            tex_coord: info.tex_coord(),
+        };
+        if emissive.max_element() > 0.0 {
+            maps.emissive_texture = load_slot(slot, index, field, src, warnings)?;
+        }
+    }
+    Ok(maps)
+}

@@ -1,0 +1,475 @@
+//! glTF surface inputs as artists export them, on files the tests write: a normal-mapped plane
+//! under a grazing light (tangents from the file and generated), emission with its strength
+//! and texture plus ambient occlusion, `COLOR_0` vertex colours, and a base colour texture
+//! through `KHR_texture_transform` (a required extension). Each picture is checked pixel by
+//! pixel against the f64 twin (`manylight::scene::shading` + `surface_maps`), each oracle is
+//! checked to differ from the one without its feature (so the test can fail), and tiled,
+//! clustered and deferred must equal forward on ES 2.0 and 3.0.
+
+mod common;
+#[path = "gltf_surface_inputs/support.rs"]
+mod support;
+
+use std::path::Path;
+
+use common::Gpu;
+use glam::{DVec2, DVec3, Vec2, Vec3};
+use manylight::scene::shading::srgb_to_linear;
+use manylight::scene::surface_maps::{occlusion_factor, perturbed_normal, TextureTransform};
+use manylight::scene::{self, Camera, Light, Scene};
+use manylight::{EsVersion, RenderOptions};
+use serde_json::json;
+use support::*;
+
+/// Loads a written file with the view, lights and ambient every test uses.
+fn scene_of(path: &Path, lights: Vec<Light>, ambient: f32) -> (Scene, Vec<String>) {
+    let (mut s, report) = scene::load(path.to_str().unwrap(), Some((0, 1))).expect("loads");
+    s.camera = Camera::perspective(DVec3::new(0.0, -0.4, 1.6), DVec3::ZERO, 60.0, 0.1, 20.0);
+    s.lights = lights;
+    s.ambient = Vec3::splat(ambient);
+    s.validate().unwrap();
+    // The files carry no lights (the test adds them): less gltf_manners.rs's hint.
+    let warnings = report.warnings.into_iter();
+    (
+        s,
+        warnings
+            .filter(|w| !w.starts_with("no lights in "))
+            .collect(),
+    )
+}
+
+/// Renders `scene` with every method on ES 2.0 (also as a device without fragment highp) and
+/// 3.0: forward against the twin within `tolerance`, every other method against forward
+/// within 2/255 (and the twin).
+fn check_every_method(what: &str, scene: &Scene, want: &[Option<[f64; 3]>], tolerance: f64) {
+    // ES 2.0, ES 2.0 on a device without fragment highp (every float fp16 here), ES 3.0.
+    for (es, no_fragment_highp) in [
+        (EsVersion::Es2, false),
+        (EsVersion::Es2, true),
+        (EsVersion::Es3, false),
+    ] {
+        let restrictions = manylight::gl::Restrictions { no_fragment_highp };
+        let mut gpu = Gpu::restricted(es, &restrictions);
+        let es = format!("{es}{}", if no_fragment_highp { " mediump" } else { "" });
+        let opts = RenderOptions::default();
+        gpu.r().set_method_named("forward").unwrap();
+        let forward = gpu.render(scene, W, H, &opts);
+        let (err, at, n) = error(&forward, want);
+        eprintln!("{what} {es} forward: {err:.2}/255 at {at:?} over {n} pixels");
+        assert!(n > (W * H / 3) as usize, "{what}: only {n} pixels compared");
+        assert!(
+            err <= tolerance,
+            "{what} {es} forward: {err:.2}/255 from the f64 twin at {at:?}"
+        );
+        // Without fragment highp only forward runs (the culled methods need exact cells).
+        let mut methods = if no_fragment_highp {
+            vec![]
+        } else {
+            vec!["tiled", "clustered"]
+        };
+        if es == "ES 3.0" {
+            methods.push("deferred");
+        }
+        for method in methods {
+            gpu.r().set_method_named(method).unwrap();
+            let img = gpu.render(scene, W, H, &opts);
+            let d = img
+                .pixels()
+                .zip(forward.pixels())
+                .flat_map(|(a, b)| (0..3).map(move |k| (a[k] as i32 - b[k] as i32).abs()))
+                .max()
+                .unwrap_or(0);
+            assert!(
+                d <= 2,
+                "{what} {es} {method}: differs from forward by {d}/255"
+            );
+            let (err, at, _) = error(&img, want);
+            assert!(
+                err <= tolerance,
+                "{what} {es} {method}: {err:.2}/255 from the f64 twin at {at:?}"
+            );
+        }
+    }
+}
+
+/// A light low over the plane's −x edge, so a normal tilted towards it shows.
+fn grazing_light() -> Vec<Light> {
+    vec![Light::point(
+        DVec3::new(-2.5, 0.2, 0.35),
+        8.0,
+        Vec3::new(1.0, 0.95, 0.9),
+        9.0,
+    )]
+}
+
+#[test]
+fn a_normal_map_tilts_the_shading_normal_with_file_and_generated_tangents() {
+    let dir = tempfile::tempdir().unwrap();
+    // Tilted towards −x (the light) and +v; scale 0.8 on x and y.
+    let texel = [60u8, 215, 200, 255];
+    let material = json!({
+        "pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.7, 0.6, 1.0], "roughnessFactor": 1.0,
+                                 "metallicFactor": 0.0},
+        "normalTexture": {"index": 0, "scale": 0.8},
+    });
+    let mut plane = Plane::new(material);
+    plane.images.push(png(1, 1, &[texel]));
+    let generated = plane.write(dir.path(), "generated.gltf");
+    // The same tangent frame written out: +x, bitangent down the image (w = −1).
+    let tangents: Vec<u8> = [1.0f32, 0.0, 0.0, -1.0]
+        .repeat(4)
+        .iter()
+        .flat_map(|v| v.to_le_bytes())
+        .collect();
+    plane.extra.push(("TANGENT", FLOAT, "VEC4", tangents));
+    let from_file = plane.write(dir.path(), "tangents.gltf");
+
+    let rgb = DVec3::new(texel[0] as f64, texel[1] as f64, texel[2] as f64) / 255.0;
+    let albedo = DVec3::new(0.8, 0.7, 0.6);
+    let mapped = |p: DVec3, _: DVec2, _: [f64; 4]| {
+        let n = perturbed_normal(DVec3::Z, DVec3::X, -1.0, rgb, 0.8);
+        (surface(p, n, albedo), DVec3::ZERO, 1.0)
+    };
+    let flat = |p: DVec3, _: DVec2, _: [f64; 4]| (surface(p, DVec3::Z, albedo), DVec3::ZERO, 1.0);
+    for path in [&generated, &from_file] {
+        let (s, warnings) = scene_of(path, grazing_light(), 0.02);
+        assert!(warnings.is_empty(), "{warnings:?}");
+        assert_eq!(s.materials[0].maps.normal_scale, 0.8);
+        let want = oracle(&s, &mapped);
+        let gap = oracle_gap(&want, &oracle(&s, &flat));
+        assert!(
+            gap > 30.0,
+            "the normal map changes the picture by only {gap:.1}/255"
+        );
+        check_every_method("normal map", &s, &want, 3.0);
+    }
+    // Mirrored along x: the tangent turns to −x and the bitangent keeps pointing down the
+    // image, so the handedness flips with the transform's determinant.
+    let (mut s, _) = scene_of(&from_file, grazing_light(), 0.02);
+    s.objects[0].transform = glam::DMat4::from_scale(DVec3::new(-1.0, 1.0, 1.0));
+    let mirrored = |w: f64| {
+        move |p: DVec3, _: DVec2, _: [f64; 4]| {
+            let n = perturbed_normal(DVec3::Z, -DVec3::X, w, rgb, 0.8);
+            (surface(p, n, albedo), DVec3::ZERO, 1.0)
+        }
+    };
+    let want = oracle(&s, &mirrored(1.0));
+    let gap = oracle_gap(&want, &oracle(&s, &mirrored(-1.0)));
+    assert!(
+        gap > 10.0,
+        "the handedness changes the picture by only {gap:.1}/255"
+    );
+    check_every_method("mirrored normal map", &s, &want, 3.0);
+}
+
+#[test]
+fn the_metallic_roughness_texture_multiplies_the_factors_by_its_blue_and_green() {
+    let dir = tempfile::tempdir().unwrap();
+    // B: metallic 1, G: roughness 77/255 (linear data, not sRGB).
+    let texel = [0u8, 77, 255, 255];
+    let material = json!({
+        "pbrMetallicRoughness": {
+            "baseColorFactor": [0.9, 0.6, 0.3, 1.0],
+            "metallicFactor": 1.0,
+            "roughnessFactor": 1.0,
+            "metallicRoughnessTexture": {"index": 0},
+        },
+    });
+    let mut plane = Plane::new(material);
+    plane.images.push(png(1, 1, &[texel]));
+    let path = plane.write(dir.path(), "mr.gltf");
+    let light = Light::point(DVec3::new(0.0, 0.35, 0.5), 3.0, Vec3::ONE, 2.0);
+    let (s, warnings) = scene_of(&path, vec![light], 0.02);
+    assert!(warnings.is_empty(), "{warnings:?}");
+    let albedo = DVec3::new(0.9, 0.6, 0.3);
+    let model = |metallic: f64, roughness: f64| {
+        move |p: DVec3, _: DVec2, _: [f64; 4]| {
+            let mut surface = surface(p, DVec3::Z, albedo);
+            (surface.metallic, surface.roughness) = (metallic, roughness);
+            (surface, DVec3::ZERO, 1.0)
+        }
+    };
+    let want = oracle(&s, &model(1.0, 77.0 / 255.0));
+    let gap = oracle_gap(&want, &oracle(&s, &model(1.0, 1.0)));
+    assert!(
+        gap > 20.0,
+        "the texture changes the picture by only {gap:.1}/255"
+    );
+    check_every_method("metallic-roughness texture", &s, &want, 3.0);
+}
+
+#[test]
+fn emission_with_its_strength_and_texture_adds_light_and_occlusion_darkens_the_ambient() {
+    let dir = tempfile::tempdir().unwrap();
+    let emissive_texel = [200u8, 90, 250, 255];
+    let occlusion_texel = [90u8, 255, 0, 255];
+    let material = json!({
+        "pbrMetallicRoughness": {"baseColorFactor": [0.7, 0.7, 0.7, 1.0], "roughnessFactor": 1.0,
+                                 "metallicFactor": 0.0},
+        "emissiveFactor": [0.2, 0.15, 0.05],
+        "emissiveTexture": {"index": 0},
+        "occlusionTexture": {"index": 1, "strength": 0.75},
+        "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 2.0}},
+    });
+    let mut plane = Plane::new(material);
+    plane.images.push(png(1, 1, &[emissive_texel]));
+    plane.images.push(png(1, 1, &[occlusion_texel]));
+    plane.extensions.push("KHR_materials_emissive_strength");
+    let path = plane.write(dir.path(), "emissive.gltf");
+    let (s, warnings) = scene_of(&path, grazing_light(), 0.4);
+    assert!(warnings.is_empty(), "{warnings:?}");
+    let m = &s.materials[0].maps;
+    assert_eq!(m.emissive, Vec3::new(0.4, 0.3, 0.1));
+    assert!(m.emissive_texture.is_some() && m.occlusion.is_some());
+
+    let emitted = DVec3::new(0.4, 0.3, 0.1)
+        * DVec3::from_array(
+            emissive_texel.map(|c| srgb_to_linear(c as f64 / 255.0))[..3]
+                .try_into()
+                .unwrap(),
+        );
+    let ao = occlusion_factor(occlusion_texel[0] as f64 / 255.0, 0.75);
+    let albedo = DVec3::splat(0.7);
+    let model = |emits: bool, occludes: bool| {
+        move |p: DVec3, _: DVec2, _: [f64; 4]| {
+            (
+                surface(p, DVec3::Z, albedo),
+                if emits { emitted } else { DVec3::ZERO },
+                if occludes { ao } else { 1.0 },
+            )
+        }
+    };
+    let want = oracle(&s, &model(true, true));
+    for (what, without) in [
+        ("emission", oracle(&s, &model(false, true))),
+        ("occlusion", oracle(&s, &model(true, false))),
+    ] {
+        let gap = oracle_gap(&want, &without);
+        assert!(
+            gap > 20.0,
+            "{what} changes the picture by only {gap:.1}/255"
+        );
+    }
+    check_every_method("emission and occlusion", &s, &want, 3.0);
+}
+
+#[test]
+fn vertex_colours_multiply_the_base_colour() {
+    let dir = tempfile::tempdir().unwrap();
+    let colours: [[u8; 4]; 4] = [
+        [255, 40, 40, 255],
+        [40, 255, 60, 255],
+        [50, 60, 255, 255],
+        [255, 255, 255, 128],
+    ];
+    let material = json!({
+        "pbrMetallicRoughness": {"baseColorFactor": [0.9, 0.8, 0.7, 1.0], "roughnessFactor": 1.0,
+                                 "metallicFactor": 0.0},
+    });
+    let mut plane = Plane::new(material);
+    plane.extra.push((
+        "COLOR_0",
+        UNSIGNED_BYTE,
+        "VEC4",
+        colours.as_flattened().to_vec(),
+    ));
+    let path = plane.write(dir.path(), "colours.gltf");
+    let lights = vec![Light::point(DVec3::new(0.3, 0.2, 1.2), 5.0, Vec3::ONE, 3.0)];
+    let (s, warnings) = scene_of(&path, lights, 0.1);
+    assert!(warnings.is_empty(), "{warnings:?}");
+    let base = DVec3::new(0.9, 0.8, 0.7);
+    let corner = |k: usize| {
+        DVec3::new(
+            colours[k][0] as f64,
+            colours[k][1] as f64,
+            colours[k][2] as f64,
+        ) / 255.0
+    };
+    let coloured = |p: DVec3, _: DVec2, w: [f64; 4]| {
+        let c: DVec3 = (0..4).map(|k| corner(k) * w[k]).sum();
+        (surface(p, DVec3::Z, base * c), DVec3::ZERO, 1.0)
+    };
+    let plain = |p: DVec3, _: DVec2, _: [f64; 4]| (surface(p, DVec3::Z, base), DVec3::ZERO, 1.0);
+    let want = oracle(&s, &coloured);
+    let gap = oracle_gap(&want, &oracle(&s, &plain));
+    assert!(
+        gap > 40.0,
+        "vertex colours change the picture by only {gap:.1}/255"
+    );
+    check_every_method("vertex colours", &s, &want, 3.0);
+}
+
+#[test]
+fn a_required_texture_transform_offsets_rotates_and_scales_the_base_colour() {
+    let dir = tempfile::tempdir().unwrap();
+    let texels = [
+        [230u8, 40, 40, 255],
+        [40, 220, 60, 255],
+        [40, 60, 230, 255],
+        [230, 230, 60, 255],
+    ];
+    let transform = TextureTransform {
+        offset: Vec2::new(0.3, 0.1),
+        rotation: 0.5,
+        scale: Vec2::new(0.7, 1.3),
+    };
+    let material = json!({
+        "pbrMetallicRoughness": {
+            "baseColorTexture": {"index": 0, "extensions": {"KHR_texture_transform": {
+                "offset": [0.3, 0.1], "rotation": 0.5, "scale": [0.7, 1.3]}}},
+            "roughnessFactor": 1.0,
+            "metallicFactor": 0.0,
+        },
+    });
+    let mut plane = Plane::new(material);
+    plane.images.push(png(2, 2, &texels));
+    plane.extensions.push("KHR_texture_transform");
+    plane.required = true;
+    let path = plane.write(dir.path(), "transform.gltf");
+    let lights = vec![Light::point(
+        DVec3::new(-0.2, 0.3, 1.5),
+        6.0,
+        Vec3::ONE,
+        3.0,
+    )];
+    let (s, warnings) = scene_of(&path, lights, 0.15);
+    assert!(warnings.is_empty(), "{warnings:?}");
+    assert_eq!(s.materials[0].maps.base_transform, transform);
+    let model = |t: TextureTransform| {
+        move |p: DVec3, uv: DVec2, _: [f64; 4]| {
+            let albedo = bilinear_srgb(&texels, 2, 2, t.apply(uv));
+            (surface(p, DVec3::Z, albedo), DVec3::ZERO, 1.0)
+        }
+    };
+    let want = oracle(&s, &model(transform));
+    let gap = oracle_gap(&want, &oracle(&s, &model(TextureTransform::IDENTITY)));
+    assert!(
+        gap > 40.0,
+        "the transform changes the picture by only {gap:.1}/255"
+    );
+    check_every_method("texture transform", &s, &want, 3.0);
+}
+
+#[test]
+fn other_texture_sets_malformed_transforms_and_every_colour_format_are_handled() {
+    let dir = tempfile::tempdir().unwrap();
+    let material = json!({
+        "pbrMetallicRoughness": {
+            "baseColorTexture": {"index": 0},
+            "metallicRoughnessTexture": {"index": 0},
+        },
+        "normalTexture": {"index": 0, "extensions": {"KHR_texture_transform": {
+            "offset": [0.5], "rotation": 0.5}}},
+        "emissiveFactor": [1.0, 1.0, 1.0],
+        "emissiveTexture": {"index": 0, "extensions": {"KHR_texture_transform": {"texCoord": 1}}},
+        "occlusionTexture": {"index": 0, "texCoord": 1},
+    });
+    let mut plane = Plane::new(material);
+    plane.images.push(png(1, 1, &[[10, 20, 30, 255]]));
+    plane.extensions.push("KHR_texture_transform");
+    let colours: Vec<u8> = [0.5f32, 0.25, 2.0]
+        .repeat(4)
+        .iter()
+        .flat_map(|v| v.to_le_bytes())
+        .collect();
+    plane.extra.push(("COLOR_0", FLOAT, "VEC3", colours));
+    let path = plane.write(dir.path(), "sets.gltf");
+    let (s, warnings) = scene_of(&path, grazing_light(), 0.1);
+    let all = warnings.join("\n");
+    assert!(
+        all.contains("normalTexture.extensions.KHR_texture_transform: malformed"),
+        "{all}"
+    );
+    assert!(all.contains("emissiveTexture: uses TEXCOORD_1"), "{all}");
+    assert!(all.contains("occlusionTexture: uses TEXCOORD_1"), "{all}");
+    assert_eq!(warnings.len(), 3, "{all}");
+    let m = &s.materials[0];
+    assert!(m.diffuse_texture.is_some() && m.maps.base_transform.is_identity());
+    let normal = m.maps.normal.as_ref().expect("normal map bound");
+    assert!(normal.transform.is_identity());
+    assert!(m.maps.metallic_roughness.is_some());
+    assert!(m.maps.emissive_texture.is_none() && m.maps.occlusion.is_none());
+    let mesh = &s.objects[0].mesh;
+    // Float colours are clamped to [0, 1]; VEC3 gets alpha 1.
+    assert!(mesh
+        .colors
+        .iter()
+        .all(|c| *c == glam::Vec4::new(0.5, 0.25, 1.0, 1.0)));
+    assert_eq!(mesh.tangents.len(), 4, "generated for the normal map");
+
+    // 16-bit normalized colours read too; a SCALAR one is ignored with a warning.
+    let mut plane = Plane::new(json!({}));
+    let colours: Vec<u8> = [65535u16, 0, 32768, 65535]
+        .repeat(4)
+        .iter()
+        .flat_map(|v| v.to_le_bytes())
+        .collect();
+    plane
+        .extra
+        .push(("COLOR_0", UNSIGNED_SHORT, "VEC4", colours));
+    let (s, _) = scene_of(&plane.write(dir.path(), "u16.gltf"), vec![], 0.1);
+    let c = s.objects[0].mesh.colors[0];
+    assert!(
+        s.objects[0].mesh.tangents.is_empty(),
+        "tangents only for normal maps"
+    );
+    assert!(
+        (c - glam::Vec4::new(1.0, 0.0, 0.5, 1.0))
+            .abs()
+            .max_element()
+            < 1e-4,
+        "{c}"
+    );
+    let mut plane = Plane::new(json!({}));
+    plane.extra.push(("COLOR_0", FLOAT, "SCALAR", vec![0; 16]));
+    let (s, warnings) = scene_of(&plane.write(dir.path(), "scalar.gltf"), vec![], 0.1);
+    assert!(s.objects[0].mesh.colors.is_empty());
+    assert!(
+        warnings
+            .iter()
+            .any(|w| w.contains("COLOR_0") && w.contains("ignored")),
+        "{warnings:?}"
+    );
+}
+
+/// Pay for use: a variant without the surface inputs has none of their code, attributes or
+/// varyings; each input's variant has its own.
+#[test]
+fn variants_without_surface_inputs_contain_none_of_their_code() {
+    use manylight::gl::shader_source::{assemble, Stage};
+    use manylight::methods::ShaderFeatures as F;
+    let needles = [
+        (F::VERTEX_COLOR, "a_color", Stage::Vertex),
+        (F::VERTEX_COLOR, "v_color", Stage::Fragment),
+        (F::NORMAL_MAP, "a_tangent", Stage::Vertex),
+        (F::NORMAL_MAP, "u_normalTex", Stage::Fragment),
+        (F::EMISSIVE, "u_emissive", Stage::Fragment),
+        (
+            F::EMISSIVE | F::EMISSIVE_MAP,
+            "u_emissiveTex",
+            Stage::Fragment,
+        ),
+        (F::OCCLUSION, "u_occlusionTex", Stage::Fragment),
+        (
+            F::MR_TEXTURE | F::METALLIC_ROUGHNESS,
+            "u_metallicRoughnessTex",
+            Stage::Fragment,
+        ),
+        (F::TEXTURE_TRANSFORM, "u_albedoUvTransform", Stage::Vertex),
+        (F::TEXTURE_TRANSFORM, "v_uvAlbedoNormal", Stage::Fragment),
+    ];
+    for es in [EsVersion::Es2, EsVersion::Es3] {
+        for shader in ["forward", "clustered"] {
+            let source = |f: F, stage| assemble(shader, stage, es, &f.defines(es, 64)).unwrap();
+            for (bits, needle, stage) in needles {
+                let lean = source(F(F::TEXTURE), stage);
+                assert!(
+                    !lean.contains(needle),
+                    "{shader} {es}: `{needle}` without its feature"
+                );
+                let with = source(F(bits | F::TEXTURE), stage);
+                assert!(with.contains(needle), "{shader} {es}: `{needle}` missing");
+            }
+        }
+    }
+}
