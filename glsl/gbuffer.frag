@@ -29,7 +29,12 @@ void main() {
     HIGHP vec2 offset = windowPosition(v_viewPos) - gl_FragCoord.xy;
     vec3 albedo = surfaceAlbedo(v_uv);
     o_albedo = vec4(albedo, offset.y);
-    vec3 extra = surfaceAmbient(albedo, v_uv) - u_ambient * albedo;
+    // Only what a material adds: the count variants' accumulation must start at 0 exactly
+    // (their albedo is no colour: NVIDIA's count frames read billions from a − a there).
+    vec3 extra = vec3(0.0);
+#if HAS_OCCLUSION
+    extra = surfaceAmbient(albedo, v_uv) - u_ambient * albedo;
+#endif
 #if HAS_EMISSIVE
     extra += surfaceEmission(v_uv);
 #endif

@@ -9,6 +9,7 @@ mod balance_tests;
 
 use super::cells::{for_each_run_in, SliceWindow};
 use super::index_list::{EntriesMut, LightIndex};
+use super::headroom::{clear_with_headroom, room_for};
 use super::types::{Assignment, Run, Totals};
 use crate::cluster::grid::ClusterGrid;
 use crate::cluster::view_light::GpuLight;
@@ -115,6 +116,8 @@ impl Bands {
         let bands = &mut self.bands[..];
         // Phase 1, its difference counts straight into the counts' array (phase 2 sums them
         // in place: one cold array less than a separate one).
+        room_for(&mut out.counts, cells);
+        room_for(&mut out.offsets, cells);
         out.counts.resize(cells, 0);
         out.offsets.resize(cells, 0);
         let (counts, offsets) = (&mut out.counts[..], &mut out.offsets[..]);
@@ -199,8 +202,8 @@ impl Band {
         let first = self.first_cell as u32;
         deltas.fill(0);
         let cells = deltas.len() as u32;
-        self.runs.clear();
-        self.lights.clear();
+        clear_with_headroom(&mut self.runs);
+        clear_with_headroom(&mut self.lights);
         let runs = &mut self.runs;
         for (i, light) in lights.iter().enumerate() {
             let before = runs.len();

@@ -6,6 +6,7 @@ use rayon::prelude::*;
 
 use super::cells::for_each_run;
 use super::index_list::{EntriesMut, IndexList, LightIndex};
+use super::headroom::{clear_with_headroom, room_for};
 use super::types::{Assignment, Run, Totals};
 use crate::cluster::grid::ClusterGrid;
 use crate::cluster::view_light::GpuLight;
@@ -116,11 +117,12 @@ struct Chunk {
 impl Chunk {
     /// Phase 1: the runs of `lights` and their per-cell difference counts.
     fn find(&mut self, grid: &ClusterGrid, lights: &[GpuLight], camera_far: f64) {
+        room_for(&mut self.deltas, grid.total_cells as usize + 1);
         self.deltas.clear();
         self.deltas.resize(grid.total_cells as usize + 1, 0);
-        self.runs.clear();
+        clear_with_headroom(&mut self.runs);
         self.ends.clear();
-        self.visible.clear();
+        clear_with_headroom(&mut self.visible);
         let (deltas, runs) = (&mut self.deltas, &mut self.runs);
         for (i, light) in lights.iter().enumerate() {
             let before = runs.len();
@@ -138,6 +140,7 @@ impl Chunk {
 
     /// Phase 2: per-cell offsets into the chunk's own sorted list.
     fn prefix(&mut self) {
+        room_for(&mut self.offsets, self.deltas.len());
         self.offsets.clear();
         let (mut running, mut total) = (0i32, 0u32);
         for delta in &self.deltas {
@@ -198,6 +201,7 @@ impl Chunk {
     fn sort_locally(&mut self, first_id: u32, cells: usize, visible: usize) {
         let mut sorted = std::mem::take(&mut self.sorted);
         let len = self.offsets[cells];
+        room_for(&mut self.cursor, cells + 1);
         self.cursor.clear();
         self.cursor.extend_from_slice(&self.offsets[..cells]);
         self.cursor.push(len);

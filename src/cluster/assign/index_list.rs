@@ -7,6 +7,8 @@
 //! renderer refuses but the CPU-only uses (`bench-assign` at a million lights) reach. Both
 //! buffers are kept, so a list that changes width allocates nothing once both have grown.
 
+use super::headroom::room_for;
+
 /// Every cell's lights, cell after cell: positions in
 /// [`Assignment::visible`](crate::cluster::assign::Assignment::visible), 16-bit when there are at most 65 536 visible
 /// lights ([`IndexList::as_u16`]), else 32-bit ([`IndexList::as_u32`]).
@@ -81,10 +83,12 @@ impl IndexList {
         self.is_wide = visible > NARROW_LIGHTS;
         if self.is_wide {
             self.narrow.clear();
+            room_for(&mut self.wide, len);
             self.wide.resize(len, 0);
             EntriesMut::Wide(&mut self.wide)
         } else {
             self.wide.clear();
+            room_for(&mut self.narrow, len);
             self.narrow.resize(len, 0);
             EntriesMut::Narrow(&mut self.narrow)
         }

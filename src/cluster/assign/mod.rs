@@ -42,6 +42,7 @@
 pub(super) mod bands;
 pub mod cells;
 mod chunks;
+mod headroom;
 mod cone;
 pub mod index_list;
 mod overflow;
