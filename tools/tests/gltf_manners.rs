@@ -232,6 +232,20 @@ fn a_file_without_lights_gets_one_hint_and_one_with_lights_none() {
     assert_eq!(report.warnings, [hint], "{:?}", report.warnings);
     let (_, report) = load(&path, 4).unwrap();
     assert!(report.warnings.is_empty(), "{:?}", report.warnings);
+    // A sun alone lights the file: no hint.
+    let mut doc = meshes(vec![b.cuboid([0.0; 3], [1.0; 3])]);
+    doc["extensionsUsed"] = json!(["KHR_lights_punctual"]);
+    doc["extensions"] = json!({"KHR_lights_punctual":
+        {"lights": [{"type": "directional", "intensity": 2048}]}});
+    doc["nodes"]
+        .as_array_mut()
+        .unwrap()
+        .push(json!({"extensions": {"KHR_lights_punctual": {"light": 0}}}));
+    doc["scenes"][0]["nodes"] = json!([0, 1]);
+    let path = write(dir.path(), "sunlit.gltf", &b.gltf(doc));
+    let (scene, report) = load(&path, 0).unwrap();
+    assert_eq!(scene.directional_lights.len(), 1);
+    assert!(report.warnings.is_empty(), "{:?}", report.warnings);
 }
 
 #[test]
@@ -321,7 +335,8 @@ fn ignored_features_are_warned_once_each_by_name() {
     let moves = b.vec3s(&[[0.0; 3], [0.0, 1.0, 0.0]]);
     let camera = json!({"type": "perspective", "perspective": {"yfov": 0.8, "znear": 0.1}});
     let doc = json!({
-        "extensionsUsed": ["KHR_materials_clearcoat", "KHR_materials_sheen"],
+        // Listed twice (against the schema's uniqueItems): still one warning.
+        "extensionsUsed": ["KHR_materials_clearcoat", "KHR_materials_sheen", "KHR_materials_clearcoat"],
         "scene": 0,
         "scenes": [{"nodes": [0, 1, 2, 3, 4, 5]}, {"nodes": [0]}],
         "nodes": [

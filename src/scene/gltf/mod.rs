@@ -117,7 +117,8 @@ pub fn load(
             random::LightSetStyle::Mixed,
         ));
     }
-    if scene.lights.is_empty() {
+    // A sun lights the scene too: only a file with neither gets the hint.
+    if scene.lights.is_empty() && scene.directional_lights.is_empty() {
         let hint = format!(
             "no lights in {}: ambient only; add --lights N",
             path.display()
