@@ -383,3 +383,26 @@ fn ignored_features_are_warned_once_each_by_name() {
     );
     assert_eq!(w.len(), 8, "{w:#?}");
 }
+
+#[test]
+fn out_of_range_metallic_and_roughness_are_clamped_with_a_warning_naming_them() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut b = Builder::default();
+    let mut cube = b.cuboid([0.0; 3], [1.0; 3]);
+    cube["material"] = json!(0);
+    let mut doc = meshes(vec![cube]);
+    doc["materials"] =
+        json!([{"pbrMetallicRoughness": {"metallicFactor": 5, "roughnessFactor": -2}}]);
+    let path = write(dir.path(), "factors.gltf", &b.gltf(doc));
+    let (scene, report) = load(&path, 1).unwrap();
+    let m = &scene.materials[0];
+    assert_eq!((m.metallic, m.roughness), (1.0, 0.0), "{m:?}");
+    let w = &report.warnings;
+    for needle in [
+        "materials[0] (`gltf-material-0`): metallicFactor 5 clamped to 1",
+        "materials[0] (`gltf-material-0`): roughnessFactor -2 clamped to 0",
+    ] {
+        let n = w.iter().filter(|l| l.contains(needle)).count();
+        assert_eq!(n, 1, "`{needle}` said {n} times in {w:#?}");
+    }
+}

@@ -3,7 +3,7 @@
 //! - `baseColorFactor.rgb` → `diffuse`, `baseColorTexture` → `diffuse_texture` (sRGB, as the
 //!   renderer decodes it); factors clamped to [0, [`MAX_COLOR_FACTOR`]] with a warning, as
 //!   OBJ's are.
-//! - `metallicFactor` → `metallic`, `roughnessFactor` → `roughness` (clamped to [0, 1]), shaded
+//! - `metallicFactor` → `metallic`, `roughnessFactor` → `roughness` (clamped to [0, 1], warned), shaded
 //!   by the glTF BRDF ([`crate::scene::brdf`]). `specular`/`shininess` (the dielectric 0.04
 //!   grey and the Blinn-Phong ↔ Beckmann match `Ns = 2/α² − 2`, [`shininess`]) are kept for
 //!   callers that switch the material to Blinn-Phong. The metallic-roughness, normal,
@@ -152,6 +152,17 @@ impl Materials {
                 }
             }
         };
+        for (what, f) in [
+            ("metallicFactor", pbr.metallic_factor()),
+            ("roughnessFactor", pbr.roughness_factor()),
+        ] {
+            if unit_factor(f) != f {
+                warnings.push(format!(
+                    "{field} (`{name}`): {what} {f} clamped to {} (glTF's range is [0, 1])",
+                    unit_factor(f)
+                ));
+            }
+        }
         let emissive = m.emissive_factor();
         if emissive.iter().any(|&e| e > 0.0) || m.emissive_texture().is_some() {
             warnings.push(format!(
