@@ -6,8 +6,8 @@
 //! - `metallicFactor` → `metallic`, `roughnessFactor` → `roughness` (clamped to [0, 1] with
 //!   a warning), shaded by the glTF BRDF ([`crate::scene::brdf`]). `specular`/`shininess`
 //!   (the dielectric 0.04 grey and the Blinn-Phong ↔ Beckmann match `Ns = 2/α² − 2`,
-//!   [`shininess`]) are kept for callers that switch the material to Blinn-Phong. The metallic-roughness, normal,
-//!   occlusion and emissive textures are not used.
+//!   [`shininess`]) are kept for callers that switch the material to Blinn-Phong. The
+//!   metallic-roughness, normal, occlusion and emissive textures are not used.
 //! - `alphaMode`: `OPAQUE` ignores alpha; `BLEND` takes `baseColorFactor.a` as the material's
 //!   opacity (below 1: the renderer's transparent path, back to front, alpha-blended);
 //!   `MASK` cuts the whole material — invisible (opacity 0) when `baseColorFactor.a` is below
