@@ -923,7 +923,12 @@ fn malformed_files_are_errors_naming_the_file_and_what_is_wrong() {
         cases.push((
             "cone.gltf",
             b.gltf(doc.clone()).into_bytes(),
-            vec!["lights[0]", "outer_deg"],
+            // In the file's own terms, not the converted `outer_deg`.
+            vec![
+                "lights[0]",
+                "spot.innerConeAngle (0.7)",
+                "spot.outerConeAngle (0.2)",
+            ],
         ));
         doc.as_object_mut().unwrap().remove("extensions");
         doc["nodes"][0] = json!({"mesh": 0});
