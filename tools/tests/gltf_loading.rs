@@ -930,6 +930,13 @@ fn malformed_files_are_errors_naming_the_file_and_what_is_wrong() {
                 "spot.outerConeAngle (0.2)",
             ],
         ));
+        doc["nodes"][0] = json!({"mesh": 0, "extensions": {"KHR_lights_punctual": {"light": 3}}});
+        cases.push((
+            "light_index.gltf",
+            b.gltf(doc.clone()).into_bytes(),
+            // The file's spelling of the extension, not the crate's `khrLightsPunctual`.
+            vec!["nodes[0].extensions.KHR_lights_punctual.light"],
+        ));
         doc.as_object_mut().unwrap().remove("extensions");
         doc["nodes"][0] = json!({"mesh": 0});
         doc["extensionsRequired"] = json!(["KHR_draco_mesh_compression"]);

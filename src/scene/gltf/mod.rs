@@ -411,7 +411,10 @@ fn validate(root: &gltf::json::Root) -> Result<(), String> {
     }
     let mut errors = Vec::new();
     root.validate(root, gltf::json::Path::new, &mut |path, error| {
-        let path = path().to_string();
+        // The crate spells the extension's key in camelCase; name it as the file does.
+        let path = path()
+            .to_string()
+            .replace("khrLightsPunctual", "KHR_lights_punctual");
         let bounds = path.ends_with(".min") || path.ends_with(".max");
         let ignored_bounds = bounds && matches!(error, Error::Missing | Error::Invalid);
         // Required extensions are checked against the loader's own list, not the crate's.
