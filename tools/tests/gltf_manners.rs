@@ -288,6 +288,23 @@ fn a_file_with_nothing_to_draw_is_an_error_naming_it() {
         said,
         ["objects[0]: lights.gltf has nothing to draw: only its lights are used"]
     );
+    // A scene file with nothing else to draw is refused like the glTF file alone.
+    for (name, text) in [
+        (
+            "rig_alone.json",
+            r#"{"objects": [{"gltf": "lights.gltf"}]}"#,
+        ),
+        ("empty.json", r#"{"objects": []}"#),
+    ] {
+        let path = write(dir.path(), name, text);
+        let err = scene::load(path.to_str().unwrap(), None)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("objects") && err.contains("nothing to draw"),
+            "{name}: {err}"
+        );
+    }
 }
 
 #[test]
