@@ -407,17 +407,23 @@ fn out_of_range_metallic_and_roughness_are_clamped_with_a_warning_naming_them() 
     let mut b = Builder::default();
     let mut cube = b.cuboid([0.0; 3], [1.0; 3]);
     cube["material"] = json!(0);
-    let mut doc = meshes(vec![cube]);
-    doc["materials"] =
-        json!([{"pbrMetallicRoughness": {"metallicFactor": 5, "roughnessFactor": -2}}]);
+    let mut cube2 = b.cuboid([2.0; 3], [3.0; 3]);
+    cube2["material"] = json!(1);
+    let mut doc = meshes(vec![cube, cube2]);
+    doc["materials"] = json!([
+        {"pbrMetallicRoughness": {"metallicFactor": 5, "roughnessFactor": -2}},
+        {"pbrMetallicRoughness": {"metallicFactor": -1, "roughnessFactor": 0.5}}
+    ]);
     let path = write(dir.path(), "factors.gltf", &b.gltf(doc));
     let (scene, report) = load(&path, 1).unwrap();
     let m = &scene.materials[0];
     assert_eq!((m.metallic, m.roughness), (1.0, 0.0), "{m:?}");
     let w = &report.warnings;
+    // Both materials' metallicFactor in one line.
     for needle in [
-        "materials[0] (`gltf-material-0`): metallicFactor 5 clamped to 1",
-        "materials[0] (`gltf-material-0`): roughnessFactor -2 clamped to 0",
+        "materials[0] (`gltf-material-0`): metallicFactor outside [0, 1] (glTF's range): \
+         clamped (and 1 more like it)",
+        "materials[0] (`gltf-material-0`): roughnessFactor outside [0, 1]",
     ] {
         let n = w.iter().filter(|l| l.contains(needle)).count();
         assert_eq!(n, 1, "`{needle}` said {n} times in {w:#?}");

@@ -157,9 +157,9 @@ impl Materials {
             ("roughnessFactor", pbr.roughness_factor()),
         ] {
             if unit_factor(f) != f {
+                // No value in the words, so many such materials make one line.
                 warnings.push(format!(
-                    "{field} (`{name}`): {what} {f} clamped to {} (glTF's range is [0, 1])",
-                    unit_factor(f)
+                    "{field} (`{name}`): {what} outside [0, 1] (glTF's range): clamped"
                 ));
             }
         }
