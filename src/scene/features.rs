@@ -20,6 +20,8 @@ pub struct SceneFeatures {
     pub specular: bool,
     /// At least one transparent material (alpha below 1).
     pub transparency: bool,
+    /// At least one metallic-roughness material (glTF BRDF code compiled in for it).
+    pub metallic_roughness: bool,
     /// Any active point or spot light at all.
     pub lights: bool,
 }
@@ -35,6 +37,7 @@ impl SceneFeatures {
             textures: scene.materials.iter().any(|m| m.diffuse_texture.is_some()),
             specular: scene.materials.iter().any(|m| m.has_specular()),
             transparency: scene.materials.iter().any(|m| m.is_transparent()),
+            metallic_roughness: scene.materials.iter().any(|m| m.is_metallic_roughness()),
             lights: active().next().is_some(),
         }
     }
@@ -61,5 +64,9 @@ mod tests {
         assert!(!SceneFeatures::of(&sunny).directional_lights, "a dark sun is not active");
         sunny.directional_lights[0].intensity = 2.0;
         assert!(SceneFeatures::of(&sunny).directional_lights);
+        assert!(!SceneFeatures::of(&sunny).metallic_roughness);
+        let mr = crate::scene::Material::metallic_roughness("m", glam::Vec3::ONE, 1.0, 0.5);
+        sunny.materials.push(mr);
+        assert!(SceneFeatures::of(&sunny).metallic_roughness);
     }
 }

@@ -443,6 +443,13 @@ pub fn parse(
         }
     }
     scene.validate()?;
+    // As for a glTF file alone: a picture of the background only is refused, not drawn black.
+    if scene.objects.is_empty() {
+        return Err(SceneError::invalid(
+            "objects",
+            "nothing to draw: no object places a triangle mesh",
+        ));
+    }
     Ok((scene, report))
 }
 

@@ -839,3 +839,23 @@ fn bad_animation_flags_are_usage_errors() {
     ];
     expect_exit(&args, &[], dir.path(), 1, "--record");
 }
+
+#[test]
+fn info_scene_reports_the_scenes_own_features_and_variants() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = r#"{"objects": [{"builtin": "plane"}],
+        "directional_lights": [{"direction": [0, 0, -1], "color": [1, 1, 1]}]}"#;
+    std::fs::write(dir.path().join("sun.json"), scene).unwrap();
+    let out = manylight(&["info", "--json", "--scene", "sun.json"], &[], dir.path());
+    assert!(out.status.success(), "{}", text(&out));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let f = &v["scene"]["features"];
+    // A sun and no point or spot light: no light-list code, no cone code.
+    assert_eq!(f["directional_lights"], true, "{f}");
+    assert_eq!(f["point_lights"], false, "{f}");
+    assert_eq!(f["spot_lights"], false, "{f}");
+    for variant in v["scene"]["variants"].as_array().unwrap() {
+        let names = variant["features"].to_string();
+        assert!(!names.contains("\"spot\""), "{variant}");
+    }
+}

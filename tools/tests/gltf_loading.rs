@@ -923,7 +923,19 @@ fn malformed_files_are_errors_naming_the_file_and_what_is_wrong() {
         cases.push((
             "cone.gltf",
             b.gltf(doc.clone()).into_bytes(),
-            vec!["lights[0]", "outer_deg"],
+            // In the file's own terms, not the converted `outer_deg`.
+            vec![
+                "lights[0]",
+                "spot.innerConeAngle (0.7)",
+                "spot.outerConeAngle (0.2)",
+            ],
+        ));
+        doc["nodes"][0] = json!({"mesh": 0, "extensions": {"KHR_lights_punctual": {"light": 3}}});
+        cases.push((
+            "light_index.gltf",
+            b.gltf(doc.clone()).into_bytes(),
+            // The file's spelling of the extension, not the crate's `khrLightsPunctual`.
+            vec!["nodes[0].extensions.KHR_lights_punctual.light"],
         ));
         doc.as_object_mut().unwrap().remove("extensions");
         doc["nodes"][0] = json!({"mesh": 0});

@@ -232,6 +232,20 @@ fn a_file_without_lights_gets_one_hint_and_one_with_lights_none() {
     assert_eq!(report.warnings, [hint], "{:?}", report.warnings);
     let (_, report) = load(&path, 4).unwrap();
     assert!(report.warnings.is_empty(), "{:?}", report.warnings);
+    // A sun alone lights the file: no hint.
+    let mut doc = meshes(vec![b.cuboid([0.0; 3], [1.0; 3])]);
+    doc["extensionsUsed"] = json!(["KHR_lights_punctual"]);
+    doc["extensions"] = json!({"KHR_lights_punctual":
+        {"lights": [{"type": "directional", "intensity": 2048}]}});
+    doc["nodes"]
+        .as_array_mut()
+        .unwrap()
+        .push(json!({"extensions": {"KHR_lights_punctual": {"light": 0}}}));
+    doc["scenes"][0]["nodes"] = json!([0, 1]);
+    let path = write(dir.path(), "sunlit.gltf", &b.gltf(doc));
+    let (scene, report) = load(&path, 0).unwrap();
+    assert_eq!(scene.directional_lights.len(), 1);
+    assert!(report.warnings.is_empty(), "{:?}", report.warnings);
 }
 
 #[test]
@@ -274,6 +288,23 @@ fn a_file_with_nothing_to_draw_is_an_error_naming_it() {
         said,
         ["objects[0]: lights.gltf has nothing to draw: only its lights are used"]
     );
+    // A scene file with nothing else to draw is refused like the glTF file alone.
+    for (name, text) in [
+        (
+            "rig_alone.json",
+            r#"{"objects": [{"gltf": "lights.gltf"}]}"#,
+        ),
+        ("empty.json", r#"{"objects": []}"#),
+    ] {
+        let path = write(dir.path(), name, text);
+        let err = scene::load(path.to_str().unwrap(), None)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("objects") && err.contains("nothing to draw"),
+            "{name}: {err}"
+        );
+    }
 }
 
 #[test]
@@ -321,7 +352,8 @@ fn ignored_features_are_warned_once_each_by_name() {
     let moves = b.vec3s(&[[0.0; 3], [0.0, 1.0, 0.0]]);
     let camera = json!({"type": "perspective", "perspective": {"yfov": 0.8, "znear": 0.1}});
     let doc = json!({
-        "extensionsUsed": ["KHR_materials_clearcoat", "KHR_materials_sheen"],
+        // Listed twice (against the schema's uniqueItems): still one warning.
+        "extensionsUsed": ["KHR_materials_clearcoat", "KHR_materials_sheen", "KHR_materials_clearcoat"],
         "scene": 0,
         "scenes": [{"nodes": [0, 1, 2, 3, 4, 5]}, {"nodes": [0]}],
         "nodes": [
@@ -367,4 +399,33 @@ fn ignored_features_are_warned_once_each_by_name() {
         "{w:#?}"
     );
     assert_eq!(w.len(), 8, "{w:#?}");
+}
+
+#[test]
+fn out_of_range_metallic_and_roughness_are_clamped_with_a_warning_naming_them() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut b = Builder::default();
+    let mut cube = b.cuboid([0.0; 3], [1.0; 3]);
+    cube["material"] = json!(0);
+    let mut cube2 = b.cuboid([2.0; 3], [3.0; 3]);
+    cube2["material"] = json!(1);
+    let mut doc = meshes(vec![cube, cube2]);
+    doc["materials"] = json!([
+        {"pbrMetallicRoughness": {"metallicFactor": 5, "roughnessFactor": -2}},
+        {"pbrMetallicRoughness": {"metallicFactor": -1, "roughnessFactor": 0.5}}
+    ]);
+    let path = write(dir.path(), "factors.gltf", &b.gltf(doc));
+    let (scene, report) = load(&path, 1).unwrap();
+    let m = &scene.materials[0];
+    assert_eq!((m.metallic, m.roughness), (1.0, 0.0), "{m:?}");
+    let w = &report.warnings;
+    // Both materials' metallicFactor in one line.
+    for needle in [
+        "materials[0] (`gltf-material-0`): metallicFactor outside [0, 1] (glTF's range): \
+         clamped (and 1 more like it)",
+        "materials[0] (`gltf-material-0`): roughnessFactor outside [0, 1]",
+    ] {
+        let n = w.iter().filter(|l| l.contains(needle)).count();
+        assert_eq!(n, 1, "`{needle}` said {n} times in {w:#?}");
+    }
 }

@@ -34,9 +34,15 @@ pub(super) fn unsupported_required(root: &gltf::json::Root) -> Option<String> {
 /// unsupported extensions it uses, skins, morph targets, animations, further scenes and
 /// cameras. `camera_nodes` counts the drawn scene's nodes that place a camera.
 pub(super) fn unused_features(document: &gltf::Document, camera_nodes: usize) -> Vec<String> {
-    let mut out: Vec<String> = document
+    // extensionsUsed should list each name once; a file that repeats one gets one warning.
+    let mut unsupported: Vec<&str> = document
         .extensions_used()
         .filter(|e| !SUPPORTED_EXTENSIONS.contains(e))
+        .collect();
+    unsupported.sort_unstable();
+    unsupported.dedup();
+    let mut out: Vec<String> = unsupported
+        .into_iter()
         .map(|e| format!("extension {e} is not supported: ignored ({})", effect_of(e)))
         .collect();
     let skins = document.skins().len();

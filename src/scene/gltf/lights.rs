@@ -102,6 +102,13 @@ pub(super) fn convert(
             inner_cone_angle,
             outer_cone_angle,
         } => {
+            // Named in the file's terms (radians), not as the converted `outer_deg`.
+            if inner_cone_angle > outer_cone_angle {
+                return Err(format!(
+                    "{field}: spot.innerConeAngle ({inner_cone_angle}) must not exceed \
+                     spot.outerConeAngle ({outer_cone_angle})"
+                ));
+            }
             let direction = world.transform_vector3(DVec3::NEG_Z);
             let Some(direction) = crate::scene::direction::unit(direction) else {
                 return Ok(Converted::Skipped(format!(

@@ -3,7 +3,8 @@
 //! - `baseColorFactor.rgb` → `diffuse`, `baseColorTexture` → `diffuse_texture` (sRGB, as the
 //!   renderer decodes it); factors clamped to [0, [`MAX_COLOR_FACTOR`]] with a warning, as
 //!   OBJ's are.
-//! - `metallicFactor` → `metallic`, `roughnessFactor` → `roughness` (clamped to [0, 1]), shaded
+//! - `metallicFactor` → `metallic`, `roughnessFactor` → `roughness` (clamped to [0, 1] with a
+//!   warning), shaded
 //!   by the glTF BRDF ([`crate::scene::brdf`]). `specular`/`shininess` (the dielectric 0.04
 //!   grey and the Blinn-Phong ↔ Beckmann match `Ns = 2/α² − 2`, [`shininess`]) are kept for
 //!   callers that switch the material to Blinn-Phong.
@@ -174,6 +175,17 @@ impl Materials {
                 }
             }
         };
+        for (what, f) in [
+            ("metallicFactor", pbr.metallic_factor()),
+            ("roughnessFactor", pbr.roughness_factor()),
+        ] {
+            if unit_factor(f) != f {
+                // No value in the words, so many such materials make one line.
+                warnings.push(format!(
+                    "{field} (`{name}`): {what} outside [0, 1] (glTF's range): clamped"
+                ));
+            }
+        }
         let mut sources = Sources {
             raw: &self.raw,
             textures: &mut self.textures,

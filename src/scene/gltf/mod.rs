@@ -119,7 +119,8 @@ pub fn load(
             random::LightSetStyle::Mixed,
         ));
     }
-    if scene.lights.is_empty() {
+    // A sun lights the scene too: only a file with neither gets the hint.
+    if scene.lights.is_empty() && scene.directional_lights.is_empty() {
         let hint = format!(
             "no lights in {}: ambient only; add --lights N",
             path.display()
@@ -412,7 +413,10 @@ fn validate(root: &gltf::json::Root) -> Result<(), String> {
     }
     let mut errors = Vec::new();
     root.validate(root, gltf::json::Path::new, &mut |path, error| {
-        let path = path().to_string();
+        // The crate spells the extension's key in camelCase; name it as the file does.
+        let path = path()
+            .to_string()
+            .replace("khrLightsPunctual", "KHR_lights_punctual");
         let bounds = path.ends_with(".min") || path.ends_with(".max");
         let ignored_bounds = bounds && matches!(error, Error::Missing | Error::Invalid);
         // Required extensions are checked against the loader's own list, not the crate's.
