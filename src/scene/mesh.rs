@@ -1,5 +1,7 @@
 //! Triangle meshes in object space and axis-aligned bounds.
 
+use std::collections::HashMap;
+
 use glam::{DMat4, DVec3, Vec2, Vec3, Vec4};
 
 use super::SceneError;
@@ -185,20 +187,48 @@ impl Mesh {
     }
 
     /// The mesh with tangents (one per position). Each is made orthogonal to its vertex's
-    /// normal and unit; one with no usable direction, and the `w` sign, are repaired from
-    /// the generated ones (per-vertex sums of the UV gradients, see `docs/gltf.md`).
+    /// normal and unit, `w` made ±1; one with no usable direction is replaced by the
+    /// generated one (MikkTSpace, see `docs/gltf.md`).
     pub fn with_tangents(mut self, tangents: Vec<Vec4>) -> Result<Mesh, SceneError> {
         check_per_vertex("mesh.tangents", tangents.len(), self.positions.len())?;
         self.tangents = super::tangents::repair(self.geometry(), tangents);
         Ok(self)
     }
 
-    /// The mesh with generated tangents when it has texture coordinates and none yet.
-    pub fn with_generated_tangents(mut self) -> Mesh {
-        if self.tangents.is_empty() && !self.uvs.is_empty() {
-            self.tangents = super::tangents::generate(self.geometry());
+    /// The mesh with MikkTSpace tangents when it has texture coordinates and none yet, and how
+    /// many triangle corners got the fallback tangent (see `docs/gltf.md`). MikkTSpace works
+    /// per corner: a vertex whose corners get different tangents (a mirrored UV seam through
+    /// shared vertices) is split, one copy per tangent, so adds at most one vertex per index.
+    pub fn with_generated_tangents(mut self) -> (Mesh, usize) {
+        if !self.tangents.is_empty() || self.uvs.is_empty() {
+            return (self, 0);
         }
-        self
+        let corners = super::tangents::generate_corners(self.geometry());
+        // Vertices no triangle uses keep the fallback tangent.
+        let mut tangents = super::tangents::per_vertex_fallback(self.geometry());
+        let mut taken = vec![false; tangents.len()];
+        let mut copies: HashMap<(u32, [u32; 4]), u32> = HashMap::new();
+        for (k, &t) in corners.tangents.iter().enumerate() {
+            let v = self.indices[k] as usize;
+            if !taken[v] {
+                (tangents[v], taken[v]) = (t, true);
+            } else if tangents[v] != t {
+                let key = (v as u32, t.to_array().map(f32::to_bits));
+                let copy = *copies.entry(key).or_insert_with(|| {
+                    self.positions.push(self.positions[v]);
+                    self.normals.push(self.normals[v]);
+                    self.uvs.push(self.uvs[v]);
+                    if !self.colors.is_empty() {
+                        self.colors.push(self.colors[v]);
+                    }
+                    tangents.push(t);
+                    (tangents.len() - 1) as u32
+                });
+                self.indices[k] = copy;
+            }
+        }
+        self.tangents = tangents;
+        (self, corners.fallbacks)
     }
 
     fn geometry(&self) -> super::tangents::Geometry<'_> {

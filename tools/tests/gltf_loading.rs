@@ -1627,3 +1627,49 @@ fn a_file_lit_only_by_a_sun_is_lit_as_the_model_says() {
     let peak = lit.iter().max().copied().unwrap_or(0);
     assert!((150..=240).contains(&peak), "brightest {peak}/255");
 }
+
+#[test]
+fn a_normal_mapped_fan_beyond_the_mikktspace_bound_gets_fallback_tangents_and_a_warning() {
+    let dir = tempfile::tempdir().unwrap();
+    write(dir.path(), "checker.png", checker_png());
+    // 300 triangles around one vertex (over the 256 corners MikkTSpace gets at one position),
+    // mapped upright: u along +x, v down the image (−y).
+    let rim = 300u16;
+    let mut positions = vec![0.0f32; 3];
+    for k in 0..=rim {
+        let a = k as f32 / rim as f32 * 6.0;
+        positions.extend([a.cos(), a.sin(), 0.0]);
+    }
+    let normals = [0.0f32, 0.0, 1.0].repeat(rim as usize + 2);
+    let uvs: Vec<f32> = positions.chunks(3).flat_map(|p| [p[0], -p[1]]).collect();
+    let indices: Vec<u16> = (1..=rim).flat_map(|k| [0, k, k + 1]).collect();
+    let mut b = Builder::default();
+    let (p, n, t) = (
+        b.floats(&positions, "VEC3"),
+        b.floats(&normals, "VEC3"),
+        b.floats(&uvs, "VEC2"),
+    );
+    let i = b.u16s(&indices);
+    let rest = json!({
+        "scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": p, "NORMAL": n, "TEXCOORD_0": t},
+                                    "indices": i, "material": 0}]}],
+        "materials": [{"normalTexture": {"index": 0}}],
+        "textures": [{"source": 0}], "images": [{"uri": "checker.png"}],
+    });
+    let (scene, report) = load(&write(dir.path(), "fan.gltf", b.gltf(rest))).unwrap();
+    let warned: Vec<_> = report
+        .warnings
+        .iter()
+        .filter(|w| w.contains("900 of 900 triangle corners have no MikkTSpace tangent"))
+        .collect();
+    assert_eq!(warned.len(), 1, "{:?}", report.warnings);
+    let mesh = &scene.objects[0].mesh;
+    assert_eq!(mesh.tangents.len(), mesh.positions.len());
+    for t in &mesh.tangents {
+        assert!(
+            (*t - glam::Vec4::new(1.0, 0.0, 0.0, 1.0)).length() < 1e-5,
+            "{t}"
+        );
+    }
+}

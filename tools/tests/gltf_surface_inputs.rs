@@ -105,17 +105,21 @@ fn grazing_light() -> Vec<Light> {
 #[test]
 fn a_normal_map_tilts_the_shading_normal_with_file_and_generated_tangents() {
     let dir = tempfile::tempdir().unwrap();
-    // Tilted towards −x (the light) and +v; scale 0.8 on x and y.
-    let texel = [60u8, 215, 200, 255];
+    // The plane's mapping is upright, so MikkTSpace gives +x with the bitangent up the image
+    // (w = +1, glTF's convention); the file's tangents say the other hand (w = −1). Each file's
+    // texel tilts the normal towards −x (the light) and −y (the eye), scale 0.8 on x and y: a
+    // normal tilted away from the eye is turned back whole by the twin, not by the shaders.
+    let down = [60u8, 215, 200, 255];
+    let up = [60u8, 40, 200, 255];
     let material = json!({
         "pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.7, 0.6, 1.0], "roughnessFactor": 1.0,
                                  "metallicFactor": 0.0},
         "normalTexture": {"index": 0, "scale": 0.8},
     });
     let mut plane = Plane::new(material);
-    plane.images.push(png(1, 1, &[texel]));
+    plane.images.push(png(1, 1, &[up]));
     let generated = plane.write(dir.path(), "generated.gltf");
-    // The same tangent frame written out: +x, bitangent down the image (w = −1).
+    plane.images[0] = png(1, 1, &[down]);
     let tangents: Vec<u8> = [1.0f32, 0.0, 0.0, -1.0]
         .repeat(4)
         .iter()
@@ -124,22 +128,30 @@ fn a_normal_map_tilts_the_shading_normal_with_file_and_generated_tangents() {
     plane.extra.push(("TANGENT", FLOAT, "VEC4", tangents));
     let from_file = plane.write(dir.path(), "tangents.gltf");
 
-    let rgb = DVec3::new(texel[0] as f64, texel[1] as f64, texel[2] as f64) / 255.0;
+    let rgb = |t: [u8; 4]| DVec3::new(t[0] as f64, t[1] as f64, t[2] as f64) / 255.0;
     let albedo = DVec3::new(0.8, 0.7, 0.6);
-    let mapped = |p: DVec3, _: DVec2, _: [f64; 4]| {
-        let n = perturbed_normal(DVec3::Z, DVec3::X, -1.0, rgb, 0.8);
-        (surface(p, n, albedo), DVec3::ZERO, 1.0)
+    let mapped = |texel: [u8; 4], w: f64| {
+        move |p: DVec3, _: DVec2, _: [f64; 4]| {
+            let n = perturbed_normal(DVec3::Z, DVec3::X, w, rgb(texel), 0.8);
+            (surface(p, n, albedo), DVec3::ZERO, 1.0)
+        }
     };
     let flat = |p: DVec3, _: DVec2, _: [f64; 4]| (surface(p, DVec3::Z, albedo), DVec3::ZERO, 1.0);
-    for path in [&generated, &from_file] {
+    for (path, texel, w) in [(&generated, up, 1.0), (&from_file, down, -1.0)] {
         let (s, warnings) = scene_of(path, grazing_light(), 0.02);
         assert!(warnings.is_empty(), "{warnings:?}");
         assert_eq!(s.materials[0].maps.normal_scale, 0.8);
-        let want = oracle(&s, &mapped);
+        let want = oracle(&s, &mapped(texel, w));
         let gap = oracle_gap(&want, &oracle(&s, &flat));
         assert!(
             gap > 30.0,
             "the normal map changes the picture by only {gap:.1}/255"
+        );
+        // The other hand (green read the other way) must show too.
+        let hand = oracle_gap(&want, &oracle(&s, &mapped(texel, -w)));
+        assert!(
+            hand > 10.0,
+            "the handedness changes the picture by only {hand:.1}/255"
         );
         check_every_method("normal map", &s, &want, 3.0);
     }
@@ -149,7 +161,7 @@ fn a_normal_map_tilts_the_shading_normal_with_file_and_generated_tangents() {
     s.objects[0].transform = glam::DMat4::from_scale(DVec3::new(-1.0, 1.0, 1.0));
     let mirrored = |w: f64| {
         move |p: DVec3, _: DVec2, _: [f64; 4]| {
-            let n = perturbed_normal(DVec3::Z, -DVec3::X, w, rgb, 0.8);
+            let n = perturbed_normal(DVec3::Z, -DVec3::X, w, rgb(down), 0.8);
             (surface(p, n, albedo), DVec3::ZERO, 1.0)
         }
     };

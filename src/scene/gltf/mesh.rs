@@ -234,7 +234,18 @@ pub(super) fn build(
                  the map is not applied"
             ));
         } else {
-            mesh = mesh.with_generated_tangents();
+            let (with, fallbacks) = mesh.with_generated_tangents();
+            mesh = with;
+            if fallbacks > 0 {
+                warnings.push(format!(
+                    "{field}: {fallbacks} of {} triangle corners have no MikkTSpace tangent \
+                     (degenerate or non-finite data, over {} triangles, or over {} corners at \
+                     one position); they get the fallback tangent",
+                    mesh.indices.len(),
+                    crate::scene::tangents::MAX_TRIANGLES,
+                    crate::scene::tangents::MAX_CORNERS_AT_A_POSITION,
+                ));
+            }
         }
     }
     Ok(Built::Mesh(mesh))
