@@ -9,7 +9,7 @@
 //!   grey and the Blinn-Phong ↔ Beckmann match `Ns = 2/α² − 2`, [`shininess`]) are kept for
 //!   callers that switch the material to Blinn-Phong.
 //! - normal, occlusion, emissive and metallic-roughness textures, emission and every
-//!   texture's `KHR_texture_transform` → [`Material::maps`] ([`super::maps`]).
+//!   texture's `KHR_texture_transform` → [`Material::maps`] (`maps.rs`).
 //! - `alphaMode`: `OPAQUE` ignores alpha; `BLEND` takes `baseColorFactor.a` as the material's
 //!   opacity (below 1: the renderer's transparent path, back to front, alpha-blended);
 //!   `MASK` cuts the whole material — invisible (opacity 0) when `baseColorFactor.a` is below
