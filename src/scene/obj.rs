@@ -108,6 +108,7 @@ pub fn load_into(
             ..Material::default()
         });
     }
+    warn_unapplied_mtl(&mtl, path, &mut report);
     let fallback = scene.add_material(Material {
         diffuse_texture: override_tex.clone(),
         ..Material::flat("obj-default", Vec3::splat(0.8))
@@ -242,6 +243,48 @@ fn parse_obj(path: &Path) -> Result<Parsed, SceneError> {
             "the OBJ parser (tobj) failed on this file; it is malformed".into(),
         )),
     }
+}
+
+/// MTL statements the Blinn-Phong OBJ material does not read (normal maps, the PBR extension's
+/// `Pr`/`Pm`, emission): one warning per file naming them and how many materials use each, so
+/// a model that relies on them is not silently drawn flat.
+fn warn_unapplied_mtl(mtl: &[tobj::Material], path: &Path, report: &mut LoadReport) {
+    const UNAPPLIED: [&str; 9] = [
+        "norm", "Pr", "Pm", "map_Pr", "map_Pm", "map_Ke", "Ps", "Pc", "aniso",
+    ];
+    let mut used: Vec<(&str, usize)> = Vec::new();
+    let mut count = |name: &'static str| match used.iter_mut().find(|(n, _)| *n == name) {
+        Some((_, k)) => *k += 1,
+        None => used.push((name, 1)),
+    };
+    for m in mtl {
+        if m.normal_texture.is_some() {
+            count("bump/map_Bump");
+        }
+        if m.emissive.is_some_and(|e| e.iter().any(|&c| c != 0.0)) {
+            count("Ke");
+        }
+        for key in UNAPPLIED {
+            // `Ke 0 0 0` and the like change nothing (exporters write them for every material).
+            let zero = |v: &str| v.split_whitespace().all(|x| x.parse() == Ok(0.0f64));
+            if m.unknown_param.get(key).is_some_and(|v| !zero(v)) {
+                count(key);
+            }
+        }
+    }
+    if used.is_empty() {
+        return;
+    }
+    let list: Vec<String> = used
+        .iter()
+        .map(|(n, k)| format!("{n} ({k} material{})", if *k == 1 { "" } else { "s" }))
+        .collect();
+    report.warn(format!(
+        "{}: MTL statements not applied: {} (OBJ materials are Lambert + Blinn-Phong from Kd, \
+         map_Kd, Ks, Ns and d; normal maps and metallic-roughness are read from glTF)",
+        path.display(),
+        list.join(", ")
+    ));
 }
 
 /// Every index of every face and line refers to a vertex, texture coordinate or normal the file

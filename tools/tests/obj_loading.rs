@@ -42,7 +42,13 @@ fn cornell_box_loads_and_renders_lit_on_es2_and_es3() {
         .warnings
         .iter()
         .partition(|w| w.contains("duplicate triangles dropped"));
-    assert!(others.is_empty(), "{others:?}");
+    // Its lamp's `Ke 17 12 4` is emission, which OBJ materials do not draw: said once (the
+    // other materials' `Ke 0 0 0` are not).
+    assert_eq!(others.len(), 1, "{others:?}");
+    assert!(
+        others[0].contains("MTL statements not applied: Ke (1 material)"),
+        "{others:?}"
+    );
     assert_eq!(duplicates.len(), 2, "{duplicates:?}");
     assert!(
         scene
@@ -523,4 +529,48 @@ fn a_texture_that_is_a_device_is_named_so_and_the_flat_colour_kept() {
         report.warnings
     );
     assert!(scene.materials[0].diffuse_texture.is_none());
+}
+
+#[test]
+fn mtl_statements_the_blinn_phong_material_cannot_apply_are_named_once() {
+    let dir = tempfile::tempdir().unwrap();
+    write(
+        dir.path(),
+        "pbr.mtl",
+        "newmtl a\nKd 0.5 0.5 0.5\nmap_Bump n.png\nPr 0.4\nPm 1\nKe 0 0 0\nnewmtl b\nKd 1 0 0\nPr 0.2\nKe 2 1 0\n",
+    );
+    let obj = write(
+        dir.path(),
+        "pbr.obj",
+        "mtllib pbr.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl a\nf 1 2 3\nusemtl b\nf 1 3 2\n",
+    );
+    let (_, report) = load_obj(&obj).unwrap();
+    let notes: Vec<_> = report
+        .warnings
+        .iter()
+        .filter(|w| w.contains("MTL statements not applied"))
+        .collect();
+    assert_eq!(notes.len(), 1, "{:?}", report.warnings);
+    for part in [
+        "bump/map_Bump (1 material)",
+        "Pr (2 materials)",
+        "Pm (1 material)",
+    ] {
+        assert!(notes[0].contains(part), "{part}: {}", notes[0]);
+    }
+    // Material a's `Ke 0 0 0` changes nothing; b's emission is counted.
+    assert!(notes[0].contains("Ke (1 material)"), "{}", notes[0]);
+    // A plain Blinn-Phong MTL says nothing of the kind.
+    write(
+        dir.path(),
+        "plain.mtl",
+        "newmtl a\nKd 0.5 0.5 0.5\nKs 0.2 0.2 0.2\nNs 20\n",
+    );
+    let plain = write(
+        dir.path(),
+        "plain.obj",
+        "mtllib plain.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl a\nf 1 2 3\n",
+    );
+    let (_, report) = load_obj(&plain).unwrap();
+    assert!(report.warnings.is_empty(), "{:?}", report.warnings);
 }
