@@ -1673,3 +1673,29 @@ fn a_normal_mapped_fan_beyond_the_mikktspace_bound_gets_fallback_tangents_and_a_
         );
     }
 }
+
+#[test]
+fn a_spot_cone_wider_than_the_spec_allows_is_drawn_as_given_with_a_warning() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut b = Builder::default();
+    let mut doc = triangle(&mut b);
+    doc["nodes"] = json!([
+        {"mesh": 0},
+        {"translation": [0, 0, 1], "extensions": {"KHR_lights_punctual": {"light": 0}}}
+    ]);
+    doc["scenes"] = json!([{"nodes": [0, 1]}]);
+    doc["extensionsUsed"] = json!(["KHR_lights_punctual"]);
+    doc["extensions"] = json!({"KHR_lights_punctual": {"lights": [
+        {"type": "spot", "intensity": 100, "spot": {"outerConeAngle": 2.0}}]}});
+    let path = write(dir.path(), "wide.gltf", b.gltf(doc));
+    let (scene, report) = load(&path).unwrap();
+    assert_eq!(scene.lights.len(), 1, "drawn");
+    assert!(
+        report
+            .warnings
+            .iter()
+            .any(|w| w.contains("lights[0]") && w.contains("spot.outerConeAngle (2) is past π/2")),
+        "{:?}",
+        report.warnings
+    );
+}

@@ -357,6 +357,17 @@ fn import(
                 "{field} (extensions.KHR_lights_punctual.lights[{}])",
                 light.index()
             );
+            if let gltf::khr_lights_punctual::Kind::Spot {
+                outer_cone_angle, ..
+            } = light.kind()
+            {
+                if outer_cone_angle > std::f32::consts::FRAC_PI_2 {
+                    warnings.push(format!(
+                        "{lfield}: spot.outerConeAngle ({outer_cone_angle}) is past π/2, glTF's \
+                         maximum: drawn as given"
+                    ));
+                }
+            }
             match lights::convert(&light, &p.world, &lfield)? {
                 // Checked in the file's space; now placed.
                 lights::Converted::Light(_) | lights::Converted::Directional(_) => {
