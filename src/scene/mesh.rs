@@ -240,6 +240,14 @@ impl Mesh {
         }
     }
 
+    /// Whether any triangle has a non-zero area (all points or lines: nothing to draw).
+    pub fn has_area(&self) -> bool {
+        self.indices.chunks_exact(3).any(|t| {
+            let p = |k: usize| self.positions.get(t[k] as usize).copied().unwrap_or_default();
+            (p(1) - p(0)).cross(p(2) - p(0)) != Vec3::ZERO
+        })
+    }
+
     /// Object-space bounds (`None` for an empty mesh).
     pub fn bounds(&self) -> Option<Aabb> {
         Aabb::from_points(self.positions.iter().map(|p| p.as_dvec3()))

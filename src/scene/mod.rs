@@ -112,6 +112,16 @@ impl Scene {
             .reduce(|a, b| a.union(&b))
     }
 
+    /// Whether any object has a triangle of non-zero area in its own space (each distinct
+    /// mesh looked at once); a transform that flattens a mesh is not considered.
+    pub fn has_visible_area(&self) -> bool {
+        let mut seen = std::collections::HashSet::new();
+        self.objects
+            .iter()
+            .filter(|o| seen.insert(Arc::as_ptr(&o.mesh)))
+            .any(|o| o.mesh.has_area())
+    }
+
     /// Places `mesh` (a [`Mesh`], or an `Arc` of one to share it between objects) with
     /// material `material` (an index from [`Scene::add_material`]) at `transform` (object
     /// space to world space); returns the object's index.
@@ -345,7 +355,7 @@ pub fn load_with(
         .extension()
         .map(|e| e.to_string_lossy().to_lowercase())
         .unwrap_or_default();
-    match ext.as_str() {
+    let loaded = match ext.as_str() {
         "obj" => {
             if let Some((count, _)) = lights {
                 input::check_light_count(count, "lights")?;
@@ -368,6 +378,23 @@ pub fn load_with(
                 path: path.to_path_buf(),
             })
         }
-        _ => Ok((builtin::build(spec, lights)?, obj::LoadReport::default())),
+        _ => return Ok((builtin::build(spec, lights)?, obj::LoadReport::default())),
+    }?;
+    // Triangles that are all points or lines draw nothing: refused as an empty file is, not
+    // rendered as a black frame.
+    if !loaded.0.objects.is_empty() && !loaded.0.has_visible_area() {
+        let reason = "nothing to draw: every triangle has zero area".to_string();
+        return Err(match ext.as_str() {
+            "obj" => SceneError::Obj {
+                path: path.to_path_buf(),
+                reason,
+            },
+            "json" => SceneError::invalid("objects", reason),
+            _ => SceneError::GltfUnsupported {
+                path: path.to_path_buf(),
+                reason,
+            },
+        });
     }
+    Ok(loaded)
 }

@@ -429,3 +429,29 @@ fn out_of_range_metallic_and_roughness_are_clamped_with_a_warning_naming_them() 
         assert_eq!(n, 1, "`{needle}` said {n} times in {w:#?}");
     }
 }
+
+#[test]
+fn a_file_whose_triangles_all_have_zero_area_is_refused_not_drawn_black() {
+    let dir = tempfile::tempdir().unwrap();
+    // One triangle whose three corners are one point, and one along a line.
+    let obj = dir.path().join("points.obj");
+    std::fs::write(
+        &obj,
+        "v 1 2 3\nv 1 2 3\nv 1 2 3\nv 0 0 0\nv 1 1 1\nv 2 2 2\nf 1 2 3\nf 4 5 6\n",
+    )
+    .unwrap();
+    let err = manylight::scene::load(obj.to_str().unwrap(), Some((4, 1))).unwrap_err();
+    let text = err.to_string();
+    assert!(
+        text.contains("nothing to draw") && text.contains("zero area"),
+        "{text}"
+    );
+    assert!(text.contains("points.obj"), "{text}");
+    // One real triangle among them draws.
+    std::fs::write(
+        &obj,
+        "v 1 2 3\nv 1 2 3\nv 1 2 3\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 4 5 6\n",
+    )
+    .unwrap();
+    assert!(manylight::scene::load(obj.to_str().unwrap(), Some((4, 1))).is_ok());
+}

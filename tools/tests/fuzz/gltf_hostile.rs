@@ -25,11 +25,13 @@ fn folders(bin: &[u8]) -> (tempfile::TempDir, std::path::PathBuf) {
     image::RgbaImage::from_pixel(2, 2, image::Rgba([200, 100, 50, 255]))
         .save(model.join("in.png"))
         .unwrap();
-    // The same buffer with its positions moved to x = 777 and its indices turned: loads if
-    // read. (Views: 48 bytes of positions, 48 of normals, 32 of uvs, then the indices.)
+    // The same buffer with its positions moved by 777 along x (beyond any of the model's own;
+    // moved, not flattened, so it still draws) and its indices turned: loads if read. (Views:
+    // 48 bytes of positions, 48 of normals, 32 of uvs, then the indices.)
     let mut outside = bin.to_vec();
     for v in outside[..48].chunks_exact_mut(12) {
-        v[..4].copy_from_slice(&777f32.to_le_bytes());
+        let x = f32::from_le_bytes(v[..4].try_into().unwrap()) + 777.0;
+        v[..4].copy_from_slice(&x.to_le_bytes());
     }
     let indices: Vec<u8> = OUTSIDE_INDICES
         .iter()
@@ -261,10 +263,11 @@ fn the_hostile_harness_sees_an_outside_read_when_one_is_allowed() {
     let mut options = manylight::LoadOptions::default();
     options.allow_outside_files = true;
     let (scene, _) = scene::load_with(file.to_str().unwrap(), Some((0, 1)), &options).unwrap();
+    // The model's own vertices lie within x ∈ [−1, 1]; the outside buffer's, 777 along.
     assert!(scene
         .objects
         .iter()
-        .any(|o| o.mesh.positions.iter().any(|p| p.x == 777.0)));
+        .any(|o| o.mesh.positions.iter().all(|p| p.x > 700.0)));
     assert!(scene
         .objects
         .iter()
