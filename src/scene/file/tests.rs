@@ -1,0 +1,220 @@
+//! Scene-file parsing and validation: each field's errors and what a valid file builds.
+
+use super::*;
+
+fn parse_str(s: &str) -> Result<Scene, SceneError> {
+    parse(
+        s,
+        Path::new("."),
+        Path::new("test.json"),
+        None,
+        &LoadOptions::default(),
+    )
+    .map(|(s, _)| s)
+}
+
+#[test]
+fn json_errors_name_the_field_and_too_many_values_say_so() {
+    let err = parse_str(
+        r#"{"objects": [{"builtin": "plane"}],
+            "lights": [{"kind": "spot", "position": [0, 0, 1], "radius": 2,
+                        "color": [1, 1, 1], "direction": [0, 0, -1, 0, 0]}]}"#,
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        err.contains("lights[0].direction: too many values"),
+        "{err}"
+    );
+    let err = parse_str(r#"{"objects": [{"builtin": "plane"}], "ambient": [1, "x", 0]}"#)
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("ambient"), "{err}");
+}
+
+#[test]
+fn directional_lights_parse_and_errors_name_the_field() {
+    let s = parse_str(
+        r#"{"objects": [{"builtin": "plane"}],
+            "directional_lights": [{"direction": [0, -3, 0], "color": [1, 0.5, 0.25]},
+                                   {"direction": [1, -1, 0], "color": [1, 1, 1], "intensity": 2.5}]}"#,
+    )
+    .unwrap();
+    assert_eq!(s.directional_lights.len(), 2);
+    assert_eq!(s.directional_lights[0].intensity, 1.0, "intensity defaults to 1");
+    assert_eq!(s.directional_lights[0].to_light(), DVec3::Y);
+    assert_eq!(s.directional_lights[1].radiance(), Vec3::splat(2.5));
+    for (bad, field) in [
+        (r#"{"direction": [0, 0, 0], "color": [1, 1, 1]}"#, "directional_lights[0].direction"),
+        (r#"{"direction": [0, -1, 0], "color": [1, -1, 1]}"#, "directional_lights[0].color"),
+        (r#"{"direction": [0, -1, 0], "color": [1, 1, 1], "intensity": -2}"#, "directional_lights[0].intensity"),
+        (r#"{"direction": [0, -1, 0], "color": [1, 1, 1], "radius": 2}"#, "directional_lights[0]"),
+        (r#"{"color": [1, 1, 1]}"#, "directional_lights[0]"),
+    ] {
+        let text = format!(r#"{{"objects": [{{"builtin": "plane"}}], "directional_lights": [{bad}]}}"#);
+        let err = parse_str(&text).unwrap_err().to_string();
+        assert!(err.contains(field), "{bad}: {err}");
+    }
+}
+
+#[test]
+fn parses_a_full_scene() {
+    let s = parse_str(
+        r#"{"camera": {"position": [0,0,5], "target": [0,0,0]},
+            "objects": [{"builtin": "plane", "transform": {"translate": [0,1,0], "scale": 2}, "color": [1,0,0]}],
+            "ambient": [0.1, 0.1, 0.1],
+            "lights": [{"kind":"point","position":[0,0,1],"radius":3,"color":[1,1,1],"intensity":2},
+                       {"kind":"spot","position":[0,0,2],"radius":3,"color":[1,1,1],
+                        "direction":[0,0,-1],"inner_deg":10,"outer_deg":20}],
+            "random_lights": {"count": 5, "seed": 3}}"#,
+    )
+    .unwrap();
+    assert_eq!(s.lights.len(), 7);
+    assert_eq!(s.materials[0].diffuse, Vec3::new(1.0, 0.0, 0.0));
+    assert_eq!(s.ambient, Vec3::splat(0.1));
+}
+
+#[test]
+fn metallic_and_roughness_make_an_objects_materials_metallic_roughness() {
+    let s = parse_str(
+        r#"{"objects": [{"builtin": "plane", "metallic": 1, "roughness": 0.25}]}"#,
+    )
+    .unwrap();
+    let m = &s.materials[0];
+    assert_eq!(m.model, MaterialModel::MetallicRoughness);
+    assert_eq!((m.metallic, m.roughness), (1.0, 0.25));
+    for (json, field) in [
+        (r#"{"builtin": "plane", "metallic": 1}"#, "objects[0].roughness"),
+        (r#"{"builtin": "plane", "metallic": 2, "roughness": 0}"#, "objects[0].metallic"),
+    ] {
+        let err = parse_str(&format!(r#"{{"objects": [{json}]}}"#))
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains(field), "{err}");
+    }
+}
+
+#[test]
+fn motions_parse_animate_and_start_at_the_written_state() {
+    let mut s = parse_str(
+        r#"{"objects": [{"builtin": "plane"}],
+            "lights": [{"kind":"point","position":[0,0,1],"radius":3,"color":[1,1,1],
+                        "motion": {"orbit": {"center": [0,0,0], "period_s": 4},
+                                   "flicker": {"amount": 0.5, "rate_hz": 2}}},
+                       {"kind":"spot","position":[0,0,2],"radius":3,"color":[1,1,1],
+                        "direction":[0,0,-1],"inner_deg":10,"outer_deg":20,
+                        "motion": {"sweep": {"axis": [1,0,0], "angle_deg": 30, "period_s": 2}}},
+                       {"kind":"point","position":[1,1,1],"radius":3,"color":[1,1,1]}],
+            "random_lights": {"count": 8, "seed": 3,
+                              "motion": {"wander": {"radius": 0.5, "period_s": 3},
+                                         "sweep": {"axis": [1,0,0], "angle_deg": 10, "period_s": 2}}}}"#,
+    )
+    .unwrap();
+    assert_eq!(s.lights.len(), 11);
+    // Two single-light tracks and one for the random set; the third light stands still.
+    assert_eq!(s.animation.len(), 2 + 1);
+    let written = s.lights.clone();
+    s.set_time(0.0);
+    for (a, b) in s.lights.iter().zip(&written) {
+        assert!((a.position - b.position).length() < 1e-12);
+    }
+    s.set_time(1.0);
+    // A quarter turn round the origin about +Y: (0, 0, 1) → (1, 0, 0).
+    assert!(
+        (s.lights[0].position - DVec3::X).length() < 1e-9,
+        "{:?}",
+        s.lights[0].position
+    );
+    assert_ne!(s.lights[1].kind, written[1].kind, "the spot swept");
+    assert_eq!(s.lights[2], written[2], "a light without motion stays");
+    assert!(s.lights[3..]
+        .iter()
+        .zip(&written[3..])
+        .all(|(a, b)| a.position != b.position));
+    s.validate().unwrap();
+}
+
+#[test]
+fn motion_errors_name_the_field() {
+    let light = |motion: &str| {
+        format!(
+            r#"{{"objects": [{{"builtin": "plane"}}],
+                 "lights": [{{"kind":"point","position":[0,0,1],"radius":3,"color":[1,1,1],
+                              "motion": {motion}}}]}}"#
+        )
+    };
+    let cases = [
+        (
+            light(r#"{"orbit": {"period_s": 2}}"#),
+            "lights[0].motion.orbit",
+        ),
+        (
+            light(r#"{"orbit": {"center": [0,0,0], "radius": 1, "period_s": 2}}"#),
+            "lights[0].motion.orbit",
+        ),
+        (
+            light(r#"{"bob": {"amplitude": [0,1,0], "period_s": -1}}"#),
+            "lights[0].motion.bob.period_s",
+        ),
+        (
+            light(r#"{"sweep": {"axis": [1,0,0], "angle_deg": 5, "period_s": 1}}"#),
+            "lights[0].motion.sweep",
+        ),
+        (
+            light(r#"{"flicker": {"amount": 2, "rate_hz": 1}}"#),
+            "lights[0].motion.flicker.amount",
+        ),
+        (light(r#"{"spin": {}}"#), "lights[0].motion"),
+        (
+            r#"{"objects": [{"builtin": "plane"}], "random_lights": {"count": 2,
+                "motion": {"wander": {"radius": 1e300, "period_s": 1}}}}"#
+                .to_string(),
+            "random_lights.motion.wander.radius",
+        ),
+    ];
+    for (text, needle) in cases {
+        let err = parse_str(&text).unwrap_err().to_string();
+        assert!(err.contains(needle), "expected `{needle}` in: {err}");
+    }
+}
+
+#[test]
+fn errors_name_the_field() {
+    let cases = [
+        (r#"{"objects": [], "lihgts": []}"#, "lihgts"),
+        (
+            r#"{"lights": [{"kind":"point","position":[0,0,0],"radius":-1,"color":[1,1,1]}]}"#,
+            "lights[0].radius",
+        ),
+        (
+            r#"{"lights": [{"kind":"spot","position":[0,0,0],"radius":1,"color":[1,1,1],
+               "direction":[0,-1,0],"inner_deg":40,"outer_deg":20}]}"#,
+            "lights[0].outer_deg",
+        ),
+        (
+            r#"{"lights": [{"kind":"spot","position":[0,0,0],"radius":1,"color":[1,1,1]}]}"#,
+            "lights[0].direction",
+        ),
+        (
+            r#"{"lights": [{"kind":"point","position":[0,0,0],"radius":1,"color":[1,1,1],"inner_deg":3}]}"#,
+            "lights[0].inner_deg",
+        ),
+        (
+            r#"{"objects": [{"builtin": "plane", "obj": "x.obj"}]}"#,
+            "objects[0]",
+        ),
+        (r#"{"objects": [{"builtin": "nope"}]}"#, "nope"),
+        (
+            r#"{"camera": {"position": [0,0,0], "target": [0,0,0]}}"#,
+            "camera.target",
+        ),
+        (
+            r#"{"lights": [{"kind":"point","position":[0,0,0],"radius":1,"color":[1,1,1],"intensity":-2}]}"#,
+            "lights[0].intensity",
+        ),
+    ];
+    for (text, needle) in cases {
+        let err = parse_str(text).unwrap_err().to_string();
+        assert!(err.contains(needle), "expected `{needle}` in: {err}");
+    }
+}
