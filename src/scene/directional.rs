@@ -60,24 +60,7 @@ impl DirectionalLight {
                 format!("must be finite and non-zero, got {:?}", self.direction),
             ));
         }
-        if !self.color.is_finite() || self.color.min_element() < 0.0 {
-            return Err(SceneError::invalid(
-                format!("{field}.color"),
-                format!("must be finite and >= 0, got {:?}", self.color),
-            ));
-        }
-        if !(self.intensity.is_finite() && self.intensity >= 0.0) {
-            return Err(SceneError::invalid(
-                format!("{field}.intensity"),
-                format!("must be finite and >= 0, got {}", self.intensity),
-            ));
-        }
-        if !self.radiance().is_finite() {
-            return Err(SceneError::invalid(
-                format!("{field}.intensity"),
-                "color × intensity overflows f32",
-            ));
-        }
+        super::light::validate_emission(self.color, self.intensity, field)?;
         Ok(())
     }
 }

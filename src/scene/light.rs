@@ -137,24 +137,7 @@ impl Light {
                 format!("must be finite and >= 0, got {}", self.radius),
             ));
         }
-        if !self.color.is_finite() || self.color.min_element() < 0.0 {
-            return Err(SceneError::invalid(
-                format!("{field}.color"),
-                format!("must be finite and >= 0, got {:?}", self.color),
-            ));
-        }
-        if !(self.intensity.is_finite() && self.intensity >= 0.0) {
-            return Err(SceneError::invalid(
-                format!("{field}.intensity"),
-                format!("must be finite and >= 0, got {}", self.intensity),
-            ));
-        }
-        if !self.radiance().is_finite() {
-            return Err(SceneError::invalid(
-                format!("{field}.intensity"),
-                "color × intensity overflows f32",
-            ));
-        }
+        validate_emission(self.color, self.intensity, field)?;
         if let LightKind::Spot {
             direction,
             inner_deg,
@@ -214,6 +197,30 @@ pub fn spot_terms_from_half_sines(outer: f64, inner: f64) -> (f64, f64) {
     let (outer, inner) = (2.0 * outer * outer, 2.0 * inner * inner);
     let scale = 1.0 / (outer - inner).max(SPOT_MIN_COS_DELTA);
     (scale, scale * outer)
+}
+
+/// A light's `color` and `intensity` (point, spot or directional): finite, non-negative, and
+/// their product finite; errors name `field.color` or `field.intensity`.
+pub(super) fn validate_emission(color: Vec3, intensity: f32, field: &str) -> Result<(), SceneError> {
+    if !color.is_finite() || color.min_element() < 0.0 {
+        return Err(SceneError::invalid(
+            format!("{field}.color"),
+            format!("must be finite and >= 0, got {color:?}"),
+        ));
+    }
+    if !(intensity.is_finite() && intensity >= 0.0) {
+        return Err(SceneError::invalid(
+            format!("{field}.intensity"),
+            format!("must be finite and >= 0, got {intensity}"),
+        ));
+    }
+    if !(color * intensity).is_finite() {
+        return Err(SceneError::invalid(
+            format!("{field}.intensity"),
+            "color × intensity overflows f32",
+        ));
+    }
+    Ok(())
 }
 
 #[cfg(test)]

@@ -3,6 +3,7 @@
 
 mod common;
 
+use common::warnings::warnings_containing;
 use common::Gpu;
 use glam::{DVec3, Vec3};
 use manylight::metrics::diff;
@@ -11,41 +12,6 @@ use manylight::{EsVersion, FrameStats, RenderOptions};
 
 const W: u32 = 256;
 const H: u32 = 144;
-
-/// The warnings this test binary's renderers log (a logger of its own: the library logs
-/// through `log`, and a warning is what a user is told).
-struct Warnings(std::sync::Mutex<Vec<String>>);
-
-impl log::Log for Warnings {
-    fn enabled(&self, metadata: &log::Metadata) -> bool {
-        metadata.level() <= log::Level::Warn
-    }
-
-    fn log(&self, record: &log::Record) {
-        if self.enabled(record.metadata()) {
-            self.0.lock().unwrap().push(record.args().to_string());
-        }
-    }
-
-    fn flush(&self) {}
-}
-
-static WARNINGS: Warnings = Warnings(std::sync::Mutex::new(Vec::new()));
-
-/// The warnings logged so far that contain `text` (installs the logger on first use).
-fn warnings_containing(text: &str) -> Vec<String> {
-    static INSTALL: std::sync::Once = std::sync::Once::new();
-    INSTALL.call_once(|| {
-        log::set_logger(&WARNINGS).expect("no other logger in this test binary");
-        log::set_max_level(log::LevelFilter::Warn);
-    });
-    let logged = WARNINGS.0.lock().unwrap();
-    logged
-        .iter()
-        .filter(|w| w.contains(text))
-        .cloned()
-        .collect()
-}
 
 fn render(
     gpu: &mut Gpu,

@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::{max_oracle_error, mean, Gpu};
+use common::{max_oracle_error, mean, warnings, Gpu};
 use glam::{DVec3, Vec3};
 use manylight::metrics::cpu_reference::Encoding;
 use manylight::metrics::diff;
@@ -147,29 +147,9 @@ fn a_bright_sun_without_fragment_highp_stays_finite_and_right() {
     }
 }
 
-/// The warnings this test binary's renderers log.
-struct Warnings(std::sync::Mutex<Vec<String>>);
-
-impl log::Log for Warnings {
-    fn enabled(&self, metadata: &log::Metadata) -> bool {
-        metadata.level() <= log::Level::Warn
-    }
-
-    fn log(&self, record: &log::Record) {
-        if self.enabled(record.metadata()) {
-            self.0.lock().unwrap().push(record.args().to_string());
-        }
-    }
-
-    fn flush(&self) {}
-}
-
-static WARNINGS: Warnings = Warnings(std::sync::Mutex::new(Vec::new()));
-
 #[test]
 fn more_than_four_suns_keep_the_brightest_with_one_warning() {
-    log::set_logger(&WARNINGS).expect("no other logger in this test binary");
-    log::set_max_level(log::LevelFilter::Warn);
+    warnings::install();
     let sun = |x: f64, i: f32| DirectionalLight::new(DVec3::new(x, -1.0, -1.0), Vec3::ONE, i);
     // Six: the two dimmest (but not dark) are left out.
     let scene = sunlit_plane(vec![
@@ -194,14 +174,7 @@ fn more_than_four_suns_keep_the_brightest_with_one_warning() {
     assert_eq!(four.directional_lights.len(), 4);
     let d = diff(&img, &gpu.render(&four, W, H, &RenderOptions::default()));
     assert_eq!(d.max_abs, 0, "not the brightest four: {d:?}");
-    let warned: Vec<_> = WARNINGS
-        .0
-        .lock()
-        .unwrap()
-        .iter()
-        .filter(|w| w.contains("directional"))
-        .cloned()
-        .collect();
+    let warned = warnings::warnings_containing("directional");
     assert_eq!(warned.len(), 1, "one warning for two frames: {warned:?}");
     assert!(warned[0].contains("2 of the scene's 6"), "{warned:?}");
 }
