@@ -8,129 +8,26 @@ mod common;
 
 use std::path::{Path, PathBuf};
 
+use common::gltf::{base64, Builder, FLOAT, UNSIGNED_SHORT};
 use common::Gpu;
 use glam::{DMat4, DQuat, DVec3, Vec3};
 use manylight::scene::{self, LightKind, Scene};
 use manylight::{EsVersion, RenderOptions};
 use serde_json::{json, Value};
 
-const FLOAT: u32 = 5126;
-const UNSIGNED_SHORT: u32 = 5123;
 const UNSIGNED_INT: u32 = 5125;
 
-fn base64(bytes: &[u8]) -> String {
-    use base64::Engine;
-    base64::engine::general_purpose::STANDARD.encode(bytes)
-}
-
-/// Accumulates one binary buffer with its views and accessors, then writes a `.gltf` (the
-/// buffer as a data URI) or a `.glb` (the buffer as its BIN chunk).
-#[derive(Default)]
-struct Builder {
-    bin: Vec<u8>,
-    views: Vec<Value>,
-    accessors: Vec<Value>,
-}
-
-impl Builder {
-    fn view(&mut self, bytes: &[u8]) -> usize {
-        while !self.bin.len().is_multiple_of(4) {
-            self.bin.push(0);
-        }
-        self.views
-            .push(json!({"buffer": 0, "byteOffset": self.bin.len(), "byteLength": bytes.len()}));
-        self.bin.extend_from_slice(bytes);
-        self.views.len() - 1
+/// A primitive (positions, normals, uvs, u16 indices) as glTF JSON.
+fn primitive(b: &mut Builder, quad: &Quad, material: Option<usize>) -> Value {
+    let p = b.floats(&quad.positions, "VEC3");
+    let n = b.floats(&quad.normals, "VEC3");
+    let t = b.floats(&quad.uvs, "VEC2");
+    let i = b.u16s(&[0, 1, 2, 0, 2, 3]);
+    let mut v = json!({"attributes": {"POSITION": p, "NORMAL": n, "TEXCOORD_0": t}, "indices": i});
+    if let Some(m) = material {
+        v["material"] = json!(m);
     }
-
-    fn accessor(&mut self, bytes: &[u8], component: u32, ty: &str, count: usize) -> usize {
-        let view = self.view(bytes);
-        self.accessors.push(
-            json!({"bufferView": view, "componentType": component, "type": ty, "count": count}),
-        );
-        self.accessors.len() - 1
-    }
-
-    fn floats(&mut self, values: &[f32], ty: &str) -> usize {
-        let per = match ty {
-            "VEC2" => 2,
-            "VEC3" => 3,
-            _ => 1,
-        };
-        let bytes: Vec<u8> = values.iter().flat_map(|v| v.to_le_bytes()).collect();
-        self.accessor(&bytes, FLOAT, ty, values.len() / per)
-    }
-
-    fn u16s(&mut self, values: &[u16]) -> usize {
-        let bytes: Vec<u8> = values.iter().flat_map(|v| v.to_le_bytes()).collect();
-        self.accessor(&bytes, UNSIGNED_SHORT, "SCALAR", values.len())
-    }
-
-    /// A primitive (positions, normals, uvs, u16 indices) as glTF JSON.
-    fn primitive(&mut self, quad: &Quad, material: Option<usize>) -> Value {
-        let p = self.floats(&quad.positions, "VEC3");
-        let n = self.floats(&quad.normals, "VEC3");
-        let t = self.floats(&quad.uvs, "VEC2");
-        let i = self.u16s(&[0, 1, 2, 0, 2, 3]);
-        let mut v =
-            json!({"attributes": {"POSITION": p, "NORMAL": n, "TEXCOORD_0": t}, "indices": i});
-        if let Some(m) = material {
-            v["material"] = json!(m);
-        }
-        v
-    }
-
-    fn document(&self, mut rest: Value, buffer_uri: Option<String>) -> Value {
-        let mut buffer = json!({"byteLength": self.bin.len()});
-        if let Some(uri) = buffer_uri {
-            buffer["uri"] = json!(uri);
-        }
-        rest["asset"] = json!({"version": "2.0"});
-        if !self.bin.is_empty() {
-            rest["buffers"] = json!([buffer]);
-            rest["bufferViews"] = json!(self.views);
-            rest["accessors"] = json!(self.accessors);
-        }
-        rest
-    }
-
-    fn gltf(&self, rest: Value) -> String {
-        let uri = format!("data:application/octet-stream;base64,{}", base64(&self.bin));
-        self.document(rest, Some(uri)).to_string()
-    }
-
-    fn glb(&self, rest: Value) -> Vec<u8> {
-        glb(
-            self.document(rest, None).to_string().as_bytes(),
-            Some(&self.bin),
-        )
-    }
-}
-
-fn glb(json: &[u8], bin: Option<&[u8]>) -> Vec<u8> {
-    let padded = |v: &[u8], with: u8| {
-        let mut v = v.to_vec();
-        while !v.len().is_multiple_of(4) {
-            v.push(with);
-        }
-        v
-    };
-    let mut body = Vec::new();
-    let json = padded(json, b' ');
-    body.extend((json.len() as u32).to_le_bytes());
-    body.extend(b"JSON");
-    body.extend(&json);
-    if let Some(bin) = bin {
-        let bin = padded(bin, 0);
-        body.extend((bin.len() as u32).to_le_bytes());
-        body.extend(b"BIN\0");
-        body.extend(&bin);
-    }
-    let mut out = b"glTF".to_vec();
-    out.extend(2u32.to_le_bytes());
-    out.extend(((body.len() + 12) as u32).to_le_bytes());
-    out.extend(body);
-    out
+    v
 }
 
 /// A unit quad's vertex data: four corners, their normals and texture coordinates (glTF's:
@@ -237,7 +134,7 @@ fn a_textured_mesh_loads_from_gltf_with_a_side_file_and_from_glb() {
     let png = checker_png();
     write(dir.path(), "checker.png", &png);
     let mut b = Builder::default();
-    let prim = b.primitive(&floor(), Some(0));
+    let prim = primitive(&mut b, &floor(), Some(0));
     let material = json!([{"name": "checker", "pbrMetallicRoughness":
         {"baseColorFactor": [0.5, 1, 1, 1], "baseColorTexture": {"index": 0}, "roughnessFactor": 0.5}}]);
     let rest = json!({
@@ -571,9 +468,9 @@ fn comparison(dir: &Path) -> Comparison {
     let png = checker_png();
     write(dir, "checker.png", &png);
     let mut b = Builder::default();
-    let floor_prim = b.primitive(&floor(), Some(0));
-    let wall_prim = b.primitive(&pane(2.0, 1.5), Some(1));
-    let glass_prim = b.primitive(&pane(1.0, 1.0), Some(2));
+    let floor_prim = primitive(&mut b, &floor(), Some(0));
+    let wall_prim = primitive(&mut b, &pane(2.0, 1.5), Some(1));
+    let glass_prim = primitive(&mut b, &pane(1.0, 1.0), Some(2));
     let image_view = b.view(&png);
     let wall_turn = DQuat::from_rotation_y(30f64.to_radians());
     let spot_turn = DQuat::from_rotation_x(-std::f64::consts::FRAC_PI_2);
@@ -748,8 +645,8 @@ fn a_blend_material_is_drawn_through_the_transparent_path() {
 fn a_mask_material_below_its_cutoff_is_invisible_and_above_is_opaque() {
     let dir = tempfile::tempdir().unwrap();
     let mut b = Builder::default();
-    let prim = b.primitive(&floor(), Some(0));
-    let prim2 = b.primitive(&floor(), Some(1));
+    let prim = primitive(&mut b, &floor(), Some(0));
+    let prim2 = primitive(&mut b, &floor(), Some(1));
     let doc = json!({
         "scenes": [{"nodes": [0, 1]}], "nodes": [{"mesh": 0}, {"mesh": 1}],
         "meshes": [{"primitives": [prim]}, {"primitives": [prim2]}],
@@ -994,7 +891,7 @@ fn malformed_files_are_errors_naming_the_file_and_what_is_wrong() {
 fn a_missing_texture_is_a_warning_and_the_flat_colour() {
     let dir = tempfile::tempdir().unwrap();
     let mut b = Builder::default();
-    let prim = b.primitive(&floor(), Some(0));
+    let prim = primitive(&mut b, &floor(), Some(0));
     let doc = json!({
         "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
         "meshes": [{"primitives": [prim]}],
@@ -1265,7 +1162,7 @@ fn an_index_accessor_over_an_outside_text_file_shows_none_of_its_bytes() {
 #[test]
 fn image_uris_outside_the_models_folder_are_refused_unless_allowed() {
     let mut b = Builder::default();
-    let prim = b.primitive(&floor(), Some(0));
+    let prim = primitive(&mut b, &floor(), Some(0));
     let out = Outside::new(&b.bin);
     #[cfg(unix)]
     std::os::unix::fs::symlink(
@@ -1580,7 +1477,7 @@ fn a_json_file_that_is_not_gltf_shows_none_of_its_strings() {
 fn a_file_lit_only_by_a_sun_is_lit_as_the_model_says() {
     let dir = tempfile::tempdir().unwrap();
     let mut b = Builder::default();
-    let floor_prim = b.primitive(&floor(), Some(0));
+    let floor_prim = primitive(&mut b, &floor(), Some(0));
     // The sun's node aimed down and forward: −Z turned 50° about +X.
     let sun_turn = DQuat::from_rotation_x(-50f64.to_radians());
     let cam_turn = DQuat::from_rotation_x(-20f64.to_radians());

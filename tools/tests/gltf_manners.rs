@@ -7,6 +7,7 @@ mod common;
 
 use std::path::{Path, PathBuf};
 
+use common::gltf::Builder;
 use common::{max_oracle_error, mean, Gpu};
 use glam::Vec3;
 use manylight::metrics::cpu_reference::Encoding;
@@ -14,103 +15,50 @@ use manylight::scene::{self, obj::LoadReport, Scene, SceneError};
 use manylight::{EsVersion, RenderOptions};
 use serde_json::{json, Value};
 
-const FLOAT: u32 = 5126;
-const UNSIGNED_SHORT: u32 = 5123;
-
-/// One buffer (written as a base64 data URI) with its views and accessors.
-#[derive(Default)]
-struct Builder {
-    bin: Vec<u8>,
-    views: Vec<Value>,
-    accessors: Vec<Value>,
+/// A VEC3 float accessor of `values`.
+fn vec3s(b: &mut Builder, values: &[[f32; 3]]) -> usize {
+    b.floats(values.as_flattened(), "VEC3")
 }
 
-impl Builder {
-    fn accessor(&mut self, bytes: Vec<u8>, component: u32, ty: &str, count: usize) -> usize {
-        while !self.bin.len().is_multiple_of(4) {
-            self.bin.push(0);
-        }
-        self.views
-            .push(json!({"buffer": 0, "byteOffset": self.bin.len(), "byteLength": bytes.len()}));
-        self.bin.extend(bytes);
-        self.accessors
-            .push(json!({"bufferView": self.views.len() - 1,
-            "componentType": component, "type": ty, "count": count}));
-        self.accessors.len() - 1
-    }
+/// An axis-aligned box from `min` to `max` (flat normals: none given) as a primitive.
+fn cuboid(b: &mut Builder, min: [f32; 3], max: [f32; 3]) -> Value {
+    let corners: Vec<[f32; 3]> = (0..8)
+        .map(|i| {
+            let pick = |bit: usize, axis: usize| {
+                if i & (1 << bit) != 0 {
+                    max[axis]
+                } else {
+                    min[axis]
+                }
+            };
+            [pick(0, 0), pick(1, 1), pick(2, 2)]
+        })
+        .collect();
+    let p = vec3s(b, &corners);
+    // Two triangles per face, every face.
+    let faces: [[u16; 4]; 6] = [
+        [0, 2, 6, 4],
+        [1, 5, 7, 3],
+        [0, 4, 5, 1],
+        [2, 3, 7, 6],
+        [0, 1, 3, 2],
+        [4, 6, 7, 5],
+    ];
+    let idx: Vec<u16> = faces
+        .iter()
+        .flat_map(|f| [f[0], f[1], f[2], f[0], f[2], f[3]])
+        .collect();
+    let i = b.u16s(&idx);
+    json!({"attributes": {"POSITION": p}, "indices": i})
+}
 
-    fn vec3s(&mut self, values: &[[f32; 3]]) -> usize {
-        let bytes = values
-            .iter()
-            .flatten()
-            .flat_map(|v| v.to_le_bytes())
-            .collect();
-        self.accessor(bytes, FLOAT, "VEC3", values.len())
-    }
-
-    fn scalars(&mut self, values: &[f32]) -> usize {
-        let bytes = values.iter().flat_map(|v| v.to_le_bytes()).collect();
-        self.accessor(bytes, FLOAT, "SCALAR", values.len())
-    }
-
-    fn indices(&mut self, values: &[u16]) -> usize {
-        let bytes = values.iter().flat_map(|v| v.to_le_bytes()).collect();
-        self.accessor(bytes, UNSIGNED_SHORT, "SCALAR", values.len())
-    }
-
-    /// An axis-aligned box from `min` to `max` (flat normals: none given) as a primitive.
-    fn cuboid(&mut self, min: [f32; 3], max: [f32; 3]) -> Value {
-        let corners: Vec<[f32; 3]> = (0..8)
-            .map(|i| {
-                let pick = |bit: usize, axis: usize| {
-                    if i & (1 << bit) != 0 {
-                        max[axis]
-                    } else {
-                        min[axis]
-                    }
-                };
-                [pick(0, 0), pick(1, 1), pick(2, 2)]
-            })
-            .collect();
-        let p = self.vec3s(&corners);
-        // Two triangles per face, every face.
-        let faces: [[u16; 4]; 6] = [
-            [0, 2, 6, 4],
-            [1, 5, 7, 3],
-            [0, 4, 5, 1],
-            [2, 3, 7, 6],
-            [0, 1, 3, 2],
-            [4, 6, 7, 5],
-        ];
-        let idx: Vec<u16> = faces
-            .iter()
-            .flat_map(|f| [f[0], f[1], f[2], f[0], f[2], f[3]])
-            .collect();
-        let i = self.indices(&idx);
-        json!({"attributes": {"POSITION": p}, "indices": i})
-    }
-
-    /// A `size` × `size` square in XZ at y = 0, facing +Y.
-    fn floor(&mut self, size: f32) -> Value {
-        let h = size / 2.0;
-        let p = self.vec3s(&[[-h, 0.0, h], [h, 0.0, h], [h, 0.0, -h], [-h, 0.0, -h]]);
-        let n = self.vec3s(&[[0.0, 1.0, 0.0]; 4]);
-        let i = self.indices(&[0, 1, 2, 0, 2, 3]);
-        json!({"attributes": {"POSITION": p, "NORMAL": n}, "indices": i})
-    }
-
-    fn gltf(&self, mut doc: Value) -> String {
-        use base64::Engine;
-        let data = base64::engine::general_purpose::STANDARD.encode(&self.bin);
-        doc["asset"] = json!({"version": "2.0"});
-        if !self.bin.is_empty() {
-            doc["buffers"] = json!([{"byteLength": self.bin.len(),
-                "uri": format!("data:application/octet-stream;base64,{data}")}]);
-            doc["bufferViews"] = json!(self.views);
-            doc["accessors"] = json!(self.accessors);
-        }
-        doc.to_string()
-    }
+/// A `size` × `size` square in XZ at y = 0, facing +Y.
+fn floor(b: &mut Builder, size: f32) -> Value {
+    let h = size / 2.0;
+    let p = vec3s(b, &[[-h, 0.0, h], [h, 0.0, h], [h, 0.0, -h], [-h, 0.0, -h]]);
+    let n = vec3s(b, &[[0.0, 1.0, 0.0]; 4]);
+    let i = b.u16s(&[0, 1, 2, 0, 2, 3]);
+    json!({"attributes": {"POSITION": p, "NORMAL": n}, "indices": i})
 }
 
 /// A document placing each primitive as its own mesh on its own node, white materials.
@@ -148,7 +96,7 @@ fn the_automatic_camera_keeps_the_whole_model_inside_the_frame() {
     let mut gpu = Gpu::new(EsVersion::Es3);
     for (name, min, max) in shapes {
         let mut b = Builder::default();
-        let doc = meshes(vec![b.cuboid(min, max)]);
+        let doc = meshes(vec![cuboid(&mut b, min, max)]);
         let path = write(dir.path(), &format!("{name}.gltf"), &b.gltf(doc));
         let (mut s, _) = load(&path, 0).unwrap();
         // Lit by ambient alone: the model white, the background black.
@@ -182,7 +130,7 @@ fn the_automatic_camera_keeps_the_whole_model_inside_the_frame() {
 fn random_lights_light_a_flat_model_as_the_f64_model_says() {
     let dir = tempfile::tempdir().unwrap();
     let mut b = Builder::default();
-    let doc = meshes(vec![b.floor(8.0)]);
+    let doc = meshes(vec![floor(&mut b, 8.0)]);
     let path = write(dir.path(), "floor.gltf", &b.gltf(doc));
     let (mut s, report) = load(&path, 16).unwrap();
     assert!(report.warnings.is_empty(), "{:?}", report.warnings);
@@ -222,7 +170,7 @@ fn random_lights_light_a_flat_model_as_the_f64_model_says() {
 fn a_file_without_lights_gets_one_hint_and_one_with_lights_none() {
     let dir = tempfile::tempdir().unwrap();
     let mut b = Builder::default();
-    let doc = meshes(vec![b.cuboid([0.0; 3], [1.0; 3])]);
+    let doc = meshes(vec![cuboid(&mut b, [0.0; 3], [1.0; 3])]);
     let path = write(dir.path(), "dark.gltf", &b.gltf(doc));
     let (_, report) = load(&path, 0).unwrap();
     let hint = format!(
@@ -233,7 +181,7 @@ fn a_file_without_lights_gets_one_hint_and_one_with_lights_none() {
     let (_, report) = load(&path, 4).unwrap();
     assert!(report.warnings.is_empty(), "{:?}", report.warnings);
     // A sun alone lights the file: no hint.
-    let mut doc = meshes(vec![b.cuboid([0.0; 3], [1.0; 3])]);
+    let mut doc = meshes(vec![cuboid(&mut b, [0.0; 3], [1.0; 3])]);
     doc["extensionsUsed"] = json!(["KHR_lights_punctual"]);
     doc["extensions"] = json!({"KHR_lights_punctual":
         {"lights": [{"type": "directional", "intensity": 2048}]}});
@@ -258,7 +206,7 @@ fn a_file_with_nothing_to_draw_is_an_error_naming_it() {
         "scenes": [{"nodes": [0]}], "nodes": [light_node]});
     // A light and points, which are not drawn.
     let mut b = Builder::default();
-    let p = b.vec3s(&[[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]);
+    let p = vec3s(&mut b, &[[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]);
     let points = json!({"extensionsUsed": ["KHR_lights_punctual"], "extensions": lights,
         "scenes": [{"nodes": [0, 1]}], "nodes": [light_node, {"mesh": 0}],
         "meshes": [{"primitives": [{"attributes": {"POSITION": p}, "mode": 0}]}]});
@@ -311,7 +259,7 @@ fn a_file_with_nothing_to_draw_is_an_error_naming_it() {
 fn required_extensions_are_refused_by_name_unless_supported() {
     let dir = tempfile::tempdir().unwrap();
     let mut b = Builder::default();
-    let doc = meshes(vec![b.cuboid([0.0; 3], [1.0; 3])]);
+    let doc = meshes(vec![cuboid(&mut b, [0.0; 3], [1.0; 3])]);
     for ext in [
         "KHR_draco_mesh_compression",
         "EXT_meshopt_compression",
@@ -343,13 +291,13 @@ fn required_extensions_are_refused_by_name_unless_supported() {
 fn ignored_features_are_warned_once_each_by_name() {
     let dir = tempfile::tempdir().unwrap();
     let mut b = Builder::default();
-    let cube = b.cuboid([0.0; 3], [1.0; 3]);
-    let morph = b.vec3s(&[[0.0, 0.1, 0.0]; 8]);
+    let cube = cuboid(&mut b, [0.0; 3], [1.0; 3]);
+    let morph = vec3s(&mut b, &[[0.0, 0.1, 0.0]; 8]);
     let mut morphed = cube.clone();
     morphed["targets"] = json!([{"POSITION": morph}]);
-    let p = b.vec3s(&[[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]);
-    let times = b.scalars(&[0.0, 1.0]);
-    let moves = b.vec3s(&[[0.0; 3], [0.0, 1.0, 0.0]]);
+    let p = vec3s(&mut b, &[[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]);
+    let times = b.floats(&[0.0, 1.0], "SCALAR");
+    let moves = vec3s(&mut b, &[[0.0; 3], [0.0, 1.0, 0.0]]);
     let camera = json!({"type": "perspective", "perspective": {"yfov": 0.8, "znear": 0.1}});
     let doc = json!({
         // Listed twice (against the schema's uniqueItems): still one warning.
@@ -405,9 +353,9 @@ fn ignored_features_are_warned_once_each_by_name() {
 fn out_of_range_metallic_and_roughness_are_clamped_with_a_warning_naming_them() {
     let dir = tempfile::tempdir().unwrap();
     let mut b = Builder::default();
-    let mut cube = b.cuboid([0.0; 3], [1.0; 3]);
+    let mut cube = cuboid(&mut b, [0.0; 3], [1.0; 3]);
     cube["material"] = json!(0);
-    let mut cube2 = b.cuboid([2.0; 3], [3.0; 3]);
+    let mut cube2 = cuboid(&mut b, [2.0; 3], [3.0; 3]);
     cube2["material"] = json!(1);
     let mut doc = meshes(vec![cube, cube2]);
     doc["materials"] = json!([

@@ -2,6 +2,7 @@
 #![allow(dead_code)]
 
 pub mod cli;
+pub mod gltf;
 pub mod warnings;
 
 use std::path::PathBuf;
