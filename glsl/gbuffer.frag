@@ -29,8 +29,8 @@ void main() {
     HIGHP vec2 offset = windowPosition(v_viewPos) - gl_FragCoord.xy;
     vec3 albedo = surfaceAlbedo(v_uv);
     o_albedo = vec4(albedo, offset.y);
-    // Only what a material adds: the count variants' accumulation must start at 0 exactly
-    // (their albedo is no colour: NVIDIA's count frames read billions from a − a there).
+    // Only what a material adds: the count variants' accumulation must start at exactly 0,
+    // and their albedo is not a colour (a − a of it need not be 0).
     vec3 extra = vec3(0.0);
 #if HAS_OCCLUSION
     extra = surfaceAmbient(albedo, v_uv) - u_ambient * albedo;

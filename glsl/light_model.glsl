@@ -18,8 +18,8 @@
 // (d/r)² of a light with a large radius (d/r = 10⁻⁴ at r = 6 000) may underflow to 0 but no
 // longer takes the direction to the light with it.
 // Closer than this (largest component of the vector to the light) a light has no direction
-// and contributes nothing, as exactly at it. 2^-13: above fp16's smallest normal (2^-14), where
-// drivers that flush subnormals (NVIDIA's) turned the division by it into NaN.
+// and contributes nothing, as exactly at it. 2^-13: above fp16's smallest normal (2^-14), so a
+// driver that flushes subnormals never divides by one it treats as zero.
 #define LIGHT_MIN_DISTANCE 1.220703125e-4
 
 // What the BRDF reads. Blinn-Phong: albedo, Ks, Ns. Metallic-roughness: albedo (base colour),
