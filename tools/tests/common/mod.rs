@@ -148,6 +148,24 @@ pub fn other_implementation_than_mesa(what: &str) -> bool {
     }
 }
 
+/// For a test that never touches GL (offline shader validation): true, after saying so on
+/// stderr, when this run renders with another GLES implementation (`MANYLIGHT_GLES_LIB`).
+/// Its result is the same on every implementation, so it runs once, in the suite's run on the
+/// system's GL, and `MANYLIGHT_REQUIRE_ALL_TESTS` does not turn this into a failure.
+pub fn independent_of_the_implementation(what: &str) -> bool {
+    match manylight::gl::gles_lib::chosen_folder() {
+        Some(dir) => {
+            eprintln!(
+                "NOT APPLICABLE: {what} does not use GL; it runs without MANYLIGHT_GLES_LIB, not \
+                 again with {}",
+                dir.display()
+            );
+            true
+        }
+        None => false,
+    }
+}
+
 /// A white square turned 30° about the view axis on black, lit by ambient light alone: each
 /// pixel's value is its coverage.
 pub fn turned_square() -> Scene {
