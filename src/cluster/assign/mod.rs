@@ -53,7 +53,10 @@ mod paths_tests;
 mod tests;
 mod types;
 
-pub use types::{AssignLimits, AssignStats, Assignment, MAX_ASSIGN_CELLS, PARALLEL_INDICES};
+pub use types::{
+    AssignLimits, AssignStats, Assignment, MAX_ASSIGN_CELLS, PARALLEL_INDICES,
+    PARALLEL_MIN_LIGHTS, PARALLEL_SECONDS,
+};
 
 use crate::cluster::grid::ClusterGrid;
 use crate::cluster::view_light::GpuLight;
@@ -73,6 +76,8 @@ pub struct Assigner {
     overflow: Overflow,
     /// Whether a grid past [`MAX_ASSIGN_CELLS`] was warned of (once per assigner).
     warned_oversize: bool,
+    /// CPU seconds the last assignment took: its wall time times its threads.
+    last_cpu_seconds: f64,
 }
 
 impl Assigner {
@@ -109,8 +114,11 @@ impl Assigner {
         out.visible.clear();
         out.stats = AssignStats {
             clusters: grid.total_cells,
+            threads: 1,
             ..AssignStats::default()
         };
+        // Zero until this assignment's is known (the early returns below leave it so).
+        let last_cpu_seconds = std::mem::take(&mut self.last_cpu_seconds);
         if grid.total_cells > MAX_ASSIGN_CELLS {
             if !self.warned_oversize {
                 self.warned_oversize = true;
@@ -136,15 +144,14 @@ impl Assigner {
             out.counts.resize(cells, 0);
             return &self.out;
         }
-        // Waking rayon's workers costs tens of microseconds on some machines: small light
-        // counts stay on the calling thread.
-        let heavy =
-            out.indices.len() >= PARALLEL_INDICES && limits.parallel_threshold != usize::MAX;
-        let threads = if lights.len() >= limits.parallel_threshold || heavy {
-            rayon::current_num_threads().clamp(1, 8)
-        } else {
-            1
-        };
+        let started = std::time::Instant::now();
+        let threads = threads_for(
+            lights.len(),
+            out.indices.len(),
+            last_cpu_seconds,
+            limits,
+            rayon::current_num_threads(),
+        );
         let totals = if threads == 1 {
             self.bands.assign(grid, lights, camera_far, out, 1)
         } else {
@@ -176,7 +183,31 @@ impl Assigner {
         } else {
             0.0
         };
+        out.stats.threads = threads;
+        self.last_cpu_seconds = started.elapsed().as_secs_f64() * threads as f64;
         &self.out
+    }
+}
+
+/// Threads an assignment of `lights` takes from a pool of `pool` (at most 8), given its
+/// previous one's index count and CPU seconds: one unless the lights reach
+/// `limits.parallel_threshold`, or the previous assignment was heavy (see
+/// [`AssignLimits::parallel_threshold`]). Waking rayon's workers costs tens of microseconds
+/// on some machines, so light work stays on the calling thread.
+fn threads_for(
+    lights: usize,
+    last_indices: usize,
+    last_cpu_seconds: f64,
+    limits: &AssignLimits,
+    pool: usize,
+) -> usize {
+    let heavy = limits.parallel_threshold != usize::MAX
+        && (last_indices >= PARALLEL_INDICES
+            || (lights >= PARALLEL_MIN_LIGHTS && last_cpu_seconds >= PARALLEL_SECONDS));
+    if lights >= limits.parallel_threshold || heavy {
+        pool.clamp(1, 8)
+    } else {
+        1
     }
 }
 

@@ -8,7 +8,10 @@ use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 
 use super::tests::{cases, cell_lights, random_lights};
-use super::{assign, AssignLimits, Assignment};
+use super::{
+    assign, threads_for, AssignLimits, AssignStats, Assignment, PARALLEL_INDICES,
+    PARALLEL_MIN_LIGHTS, PARALLEL_SECONDS,
+};
 use crate::cluster::grid::{ClusterGrid, GridConfig, GridProjection};
 use crate::cluster::view_light::GpuLight;
 use crate::scene::Light;
@@ -47,7 +50,14 @@ fn parallel_and_sequential_assignment_agree() {
     assert_eq!(seq.offsets, par.offsets);
     assert_eq!(seq.counts, par.counts);
     assert_eq!(seq.indices, par.indices);
-    assert_eq!(seq.stats, par.stats);
+    // The same figures, but the threads they ran on.
+    assert_eq!(seq.stats, AssignStats { threads: 1, ..par.stats });
+    assert_eq!(seq.stats.threads, 1);
+    assert_eq!(
+        par.stats.threads,
+        rayon::current_num_threads().clamp(1, 8),
+        "the parallel path reports its threads"
+    );
     check_stats(&seq, None);
     // Capped, on both paths: the figures describe the lists after the cap, the largest count
     // the lists before it.
@@ -108,6 +118,76 @@ fn reused_buffers_match_fresh_ones() {
         assert_eq!(fresh.counts, reused.counts, "{}", case.name);
         assert_eq!(fresh.indices, reused.indices, "{}", case.name);
         assert_eq!(fresh.stats, reused.stats, "{}", case.name);
+    }
+}
+
+/// Which assignments take the pool: many lights, or a previous assignment of the same
+/// assigner that listed many indices or took long (counted in CPU time, so a parallel one that
+/// became fast stays parallel); never with `parallel_threshold: usize::MAX`, at most 8 threads.
+#[test]
+fn heavy_assignments_take_the_pool_and_light_ones_stay_on_the_calling_thread() {
+    let limits = AssignLimits::default();
+    let lights = limits.parallel_threshold;
+    assert_eq!(threads_for(lights, 0, 0.0, &limits, 4), 4);
+    assert_eq!(threads_for(lights - 1, 0, 0.0, &limits, 4), 1);
+    assert_eq!(threads_for(10, PARALLEL_INDICES, 0.0, &limits, 4), 4);
+    assert_eq!(threads_for(10, PARALLEL_INDICES - 1, 0.0, &limits, 4), 1);
+    // By the previous assignment's CPU time: a 1 ms assignment on one thread, and the same
+    // work split over four (280 µs of CPU time in 70 µs).
+    assert_eq!(threads_for(1024, 0, 1e-3, &limits, 4), 4);
+    assert_eq!(threads_for(1024, 0, 4.0 * 70e-6, &limits, 4), 4);
+    assert_eq!(threads_for(1024, 0, PARALLEL_SECONDS * 0.9, &limits, 4), 1);
+    // Few lights that took long did so on a slow core, not for their work.
+    assert_eq!(threads_for(PARALLEL_MIN_LIGHTS - 1, 0, 1.0, &limits, 4), 1);
+    assert_eq!(threads_for(PARALLEL_MIN_LIGHTS, 0, 1.0, &limits, 4), 4);
+    let never = AssignLimits {
+        parallel_threshold: usize::MAX,
+        ..limits
+    };
+    assert_eq!(threads_for(1 << 20, PARALLEL_INDICES, 1.0, &never, 4), 1);
+    assert_eq!(threads_for(1 << 20, 0, 0.0, &limits, 64), 8);
+    assert_eq!(threads_for(1 << 20, 0, 0.0, &limits, 1), 1);
+}
+
+/// An assigner measures each assignment's CPU time and takes the pool on the next frame when
+/// it passed [`PARALLEL_SECONDS`] (below the light and index thresholds), reporting it in its
+/// figures; the lists stay the same.
+#[test]
+fn a_slow_assignment_takes_the_pool_on_the_next_frame() {
+    let mut rng = Pcg64Mcg::seed_from_u64(5);
+    let grid = ClusterGrid::new(
+        640,
+        360,
+        GridProjection::test_view(),
+        0.1,
+        80.0,
+        &GridConfig::default(),
+    );
+    let lights = random_lights(&mut rng, 1024, 30.0);
+    let limits = AssignLimits::default();
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(2)
+        .build()
+        .expect("a thread pool");
+    let mut assigner = super::Assigner::new();
+    let frame = |assigner: &mut super::Assigner| {
+        pool.install(|| assigner.assign(&grid, &lights, 80.0, &limits).clone())
+    };
+    let first = frame(&mut assigner);
+    assert!(first.indices.len() < PARALLEL_INDICES && lights.len() < limits.parallel_threshold);
+    assert_eq!(first.stats.threads, 1, "the first frame has no measure yet");
+    assert!(assigner.last_cpu_seconds > 0.0, "the assignment was timed");
+    // The measure decides, whatever this machine's speed: set, as a slow frame would leave it.
+    assigner.last_cpu_seconds = PARALLEL_SECONDS;
+    let slow_before = frame(&mut assigner);
+    assert_eq!(slow_before.stats.threads, 2);
+    assigner.last_cpu_seconds = PARALLEL_SECONDS * 0.5;
+    let fast_before = frame(&mut assigner);
+    assert_eq!(fast_before.stats.threads, 1);
+    for other in [&slow_before, &fast_before] {
+        assert_eq!(first.indices, other.indices);
+        assert_eq!(first.offsets, other.offsets);
+        assert_eq!(first.visible, other.visible);
     }
 }
 
@@ -202,7 +282,8 @@ fn any_number_of_bands_gives_what_one_band_gives() {
                 assert_eq!(one.offsets, bands.offsets, "{what}");
                 assert_eq!(one.counts, bands.counts, "{what}");
                 assert_eq!(one.indices, bands.indices, "{what}");
-                assert_eq!(one.stats, bands.stats, "{what}");
+                assert_eq!(one.stats, AssignStats { threads: 1, ..bands.stats }, "{what}");
+                assert_eq!(bands.stats.threads, threads, "{what}");
                 listed += one.stats.indices;
             }
             assert!(listed > 0, "{}", case.name);

@@ -8,6 +8,17 @@ use super::index_list::IndexList;
 /// outweighs the cost of waking rayon's workers.
 pub const PARALLEL_INDICES: usize = 1 << 17;
 
+/// An assignment whose previous one (same [`Assigner`](super::Assigner)) took this much CPU
+/// time (its wall time times its threads) or more runs on all cores, from
+/// [`PARALLEL_MIN_LIGHTS`] lights up: waking the pool's workers costs tens of microseconds,
+/// which a millisecond's work repays on the second core. Counting the threads' time, not the
+/// wall time, keeps a parallel assignment parallel when it becomes fast.
+pub const PARALLEL_SECONDS: f64 = 250e-6;
+
+/// Fewest lights the [`PARALLEL_SECONDS`] rule takes to all cores: below, an assignment that
+/// took long did so on a slow or busy core, not for its work.
+pub const PARALLEL_MIN_LIGHTS: usize = 256;
+
 /// Most cells an assignment takes: its per-cell arrays (difference counts, counts, offsets,
 /// cursors; each chunk of lights has its own) hold 16 bytes a cell or more, 1 GiB and up
 /// here. Four times what the grid textures address (2²⁴ cells, which the renderer refuses past
@@ -25,7 +36,8 @@ pub struct AssignLimits {
     pub max_indices: usize,
     /// Lights from this count up are assigned on all cores (rayon's pool); so is any
     /// assignment whose previous one (same [`Assigner`](super::Assigner)) listed
-    /// [`PARALLEL_INDICES`] or more, unless this is `usize::MAX` (never in parallel).
+    /// [`PARALLEL_INDICES`] or more, or took [`PARALLEL_SECONDS`] of CPU time or more (from
+    /// [`PARALLEL_MIN_LIGHTS`] lights), unless this is `usize::MAX` (never in parallel).
     pub parallel_threshold: usize,
 }
 
@@ -65,6 +77,9 @@ pub struct AssignStats {
     /// per-run part of the assignment's work, beside the per-index and per-cell parts.
     #[serde(rename = "assign_runs")]
     pub runs: usize,
+    /// Threads the assignment ran on (1 unless it took rayon's pool).
+    #[serde(rename = "assign_threads")]
+    pub threads: usize,
 }
 
 /// The result: per-cell offset and count into `indices`, and the visible lights.
