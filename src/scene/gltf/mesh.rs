@@ -5,7 +5,7 @@
 //! (never its value: buffer bytes are not shown).
 
 use glam::{Vec2, Vec3, Vec4};
-use gltf::accessor::DataType;
+use gltf::accessor::{DataType, Dimensions};
 use gltf::mesh::Mode;
 
 use super::accessor::{self, describe};
@@ -67,7 +67,7 @@ pub(super) fn build(
         format!("{field}.attributes.{name} (accessors[{}])", a.index())
     };
     let pos_field = attr("POSITION", &position);
-    if position.dimensions() != gltf::accessor::Dimensions::Vec3
+    if position.dimensions() != Dimensions::Vec3
         || position.data_type() != DataType::F32
     {
         return Err(format!(
@@ -92,40 +92,19 @@ pub(super) fn build(
             ));
         }
     }
-    let same_count = |a: &gltf::Accessor, name: &str| -> Result<(), String> {
-        if a.count() != n {
-            return Err(format!(
-                "{}: {} elements but POSITION has {n}",
-                attr(name, a),
-                a.count()
-            ));
-        }
-        Ok(())
-    };
-    let mut normals = Vec::new();
-    if let Some(a) = p.get(&gltf::Semantic::Normals) {
-        same_count(&a, "NORMAL")?;
-        if a.dimensions() == gltf::accessor::Dimensions::Vec3 && a.data_type() == DataType::F32 {
-            let raw = accessor::read_f32(&a, buffers, n)
-                .map_err(|e| format!("{}: {e}", attr("NORMAL", &a)))?;
-            normals = raw.chunks_exact(3).map(Vec3::from_slice).collect();
-        } else {
-            warnings.push(format!(
-                "{}: is {}, not VEC3 of FLOAT; normals computed instead",
-                attr("NORMAL", &a),
-                describe(&a)
-            ));
-        }
-    }
+    let normals: Vec<Vec3> = read_vectors(p, &NORMAL, n, buffers, warnings, &attr)?
+        .chunks_exact(3)
+        .map(Vec3::from_slice)
+        .collect();
     let mut uvs = Vec::new();
     if let Some(a) = p.get(&gltf::Semantic::TexCoords(0)) {
-        same_count(&a, "TEXCOORD_0")?;
+        same_count(&attr("TEXCOORD_0", &a), &a, n)?;
         let ok_type = match a.data_type() {
             DataType::F32 => true,
             DataType::U8 | DataType::U16 => a.normalized(),
             _ => false,
         };
-        if a.dimensions() == gltf::accessor::Dimensions::Vec2 && ok_type {
+        if a.dimensions() == Dimensions::Vec2 && ok_type {
             let raw = accessor::read_f32(&a, buffers, n)
                 .map_err(|e| format!("{}: {e}", attr("TEXCOORD_0", &a)))?;
             // glTF's (0, 0) is the image's top-left corner, as the renderer's is: no flip.
@@ -145,26 +124,15 @@ pub(super) fn build(
         }
     }
     let colors = read_colors(p, n, buffers, warnings, &attr)?;
-    let mut tangents = Vec::new();
-    if let Some(a) = p.get(&gltf::Semantic::Tangents) {
-        same_count(&a, "TANGENT")?;
-        if a.dimensions() == gltf::accessor::Dimensions::Vec4 && a.data_type() == DataType::F32 {
-            let raw = accessor::read_f32(&a, buffers, n)
-                .map_err(|e| format!("{}: {e}", attr("TANGENT", &a)))?;
-            tangents = raw.chunks_exact(4).map(Vec4::from_slice).collect();
-        } else {
-            warnings.push(format!(
-                "{}: is {}, not VEC4 of FLOAT; tangents generated instead",
-                attr("TANGENT", &a),
-                describe(&a)
-            ));
-        }
-    }
+    let tangents: Vec<Vec4> = read_vectors(p, &TANGENT, n, buffers, warnings, &attr)?
+        .chunks_exact(4)
+        .map(Vec4::from_slice)
+        .collect();
     let listed: Vec<u32> = match p.indices() {
         Some(a) => {
             let ifield = format!("{field}.indices (accessors[{}])", a.index());
             let integer = matches!(a.data_type(), DataType::U8 | DataType::U16 | DataType::U32);
-            if a.dimensions() != gltf::accessor::Dimensions::Scalar || !integer {
+            if a.dimensions() != Dimensions::Scalar || !integer {
                 return Err(format!(
                     "{ifield}: is {}; indices must be SCALAR of UNSIGNED_BYTE, SHORT or INT",
                     describe(&a)
@@ -251,6 +219,65 @@ pub(super) fn build(
     Ok(Built::Mesh(mesh))
 }
 
+/// A FLOAT vector attribute that the loader replaces when it has another type.
+struct VectorAttribute {
+    semantic: gltf::Semantic,
+    /// Its name in the file (`NORMAL`).
+    name: &'static str,
+    dimensions: Dimensions,
+    /// What the loader does instead, for the warning.
+    fallback: &'static str,
+}
+
+const NORMAL: VectorAttribute = VectorAttribute {
+    semantic: gltf::Semantic::Normals,
+    name: "NORMAL",
+    dimensions: Dimensions::Vec3,
+    fallback: "normals computed instead",
+};
+
+const TANGENT: VectorAttribute = VectorAttribute {
+    semantic: gltf::Semantic::Tangents,
+    name: "TANGENT",
+    dimensions: Dimensions::Vec4,
+    fallback: "tangents generated instead",
+};
+
+/// The attribute `what` of `p` as its floats, or empty when absent; another type is a
+/// warning and empty.
+fn read_vectors(
+    p: &gltf::Primitive,
+    what: &VectorAttribute,
+    n: usize,
+    buffers: &mut Buffers,
+    warnings: &mut Vec<String>,
+    attr: &dyn Fn(&str, &gltf::Accessor) -> String,
+) -> Result<Vec<f32>, String> {
+    let Some(a) = p.get(&what.semantic) else {
+        return Ok(Vec::new());
+    };
+    let field = attr(what.name, &a);
+    same_count(&field, &a, n)?;
+    if a.dimensions() != what.dimensions || a.data_type() != DataType::F32 {
+        warnings.push(format!(
+            "{field}: is {}, not VEC{} of FLOAT; {}",
+            describe(&a),
+            what.dimensions.multiplicity(),
+            what.fallback
+        ));
+        return Ok(Vec::new());
+    }
+    accessor::read_f32(&a, buffers, n).map_err(|e| format!("{field}: {e}"))
+}
+
+/// An attribute (`field`, its glTF path) must have one element per position (`n`).
+fn same_count(field: &str, a: &gltf::Accessor, n: usize) -> Result<(), String> {
+    if a.count() != n {
+        return Err(format!("{field}: {} elements but POSITION has {n}", a.count()));
+    }
+    Ok(())
+}
+
 /// `COLOR_0` as linear RGBA (VEC3 or VEC4 of FLOAT or normalized UNSIGNED_BYTE/SHORT), or
 /// empty; another type is a warning and ignored.
 fn read_colors(
@@ -264,17 +291,15 @@ fn read_colors(
         return Ok(Vec::new());
     };
     let field = attr("COLOR_0", &a);
-    if a.count() != n {
-        return Err(format!("{field}: {} elements but POSITION has {n}", a.count()));
-    }
+    same_count(&field, &a, n)?;
     let ok_type = match a.data_type() {
         DataType::F32 => true,
         DataType::U8 | DataType::U16 => a.normalized(),
         _ => false,
     };
     let dims = match a.dimensions() {
-        gltf::accessor::Dimensions::Vec3 => 3,
-        gltf::accessor::Dimensions::Vec4 => 4,
+        Dimensions::Vec3 => 3,
+        Dimensions::Vec4 => 4,
         _ => 0,
     };
     if !ok_type || dims == 0 {

@@ -2,7 +2,9 @@
 #![allow(dead_code)]
 
 pub mod cli;
+pub mod files;
 pub mod gltf;
+pub mod gltf_models;
 pub mod warnings;
 
 use std::path::PathBuf;

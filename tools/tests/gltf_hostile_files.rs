@@ -1,0 +1,286 @@
+//! Hostile glTF files, on files the tests write: buffer and image URIs leaving the model's
+//! folder (`..`, `%2e%2e`, absolute paths, links) are refused unless outside files are allowed
+//! (in the library and on the command line); a scene file may name models anywhere but their
+//! own URIs stay confined; a folder or a device is named as not a file; and no error shows a
+//! byte of an outside file or a string of a JSON file that is not glTF.
+
+mod common;
+
+use std::path::PathBuf;
+
+use common::files::{load, load_with, write};
+use common::gltf::{base64, Builder};
+use common::gltf_models::{checker_png, floor, primitive, triangle};
+use serde_json::json;
+
+/// What a test model may not read: files beside its folder, with bytes a message must never
+/// show. `b.bin` is a valid buffer for the model (so a load that reads it succeeds).
+struct Outside {
+    root: tempfile::TempDir,
+}
+
+const SENTINEL: &str = "SENTINEL-83-do-not-show";
+
+impl Outside {
+    fn new(bin: &[u8]) -> Outside {
+        let root = tempfile::tempdir().unwrap();
+        std::fs::create_dir(root.path().join("model")).unwrap();
+        std::fs::write(root.path().join("b.bin"), bin).unwrap();
+        std::fs::write(root.path().join("secret.txt"), SENTINEL.repeat(4)).unwrap();
+        std::fs::write(root.path().join("secret.png"), checker_png()).unwrap();
+        Outside { root }
+    }
+
+    fn model(&self) -> PathBuf {
+        self.root.path().join("model")
+    }
+}
+
+#[test]
+fn buffer_uris_outside_the_models_folder_are_refused_unless_allowed() {
+    let mut b = Builder::default();
+    let doc = triangle(&mut b);
+    let out = Outside::new(&b.bin);
+    std::fs::create_dir(out.model().join("sub")).unwrap();
+    let abs = out.root.path().join("b.bin");
+    #[cfg(unix)]
+    std::os::unix::fs::symlink(&abs, out.model().join("link.bin")).unwrap();
+    let mut uris = vec![
+        "../b.bin".to_string(),
+        "%2e%2e/b.bin".into(),
+        "%2E%2E%2Fb.bin".into(),
+        "sub/../../b.bin".into(),
+        abs.to_str().unwrap().into(),
+        abs.to_str().unwrap().replace('.', "%2e"),
+    ];
+    if cfg!(unix) {
+        uris.push("link.bin".into());
+    }
+    for uri in &uris {
+        let path = write(
+            &out.model(),
+            "m.gltf",
+            b.document(doc.clone(), Some(uri.clone())).to_string(),
+        );
+        let err = load(&path).unwrap_err().to_string();
+        assert!(
+            err.contains("buffers[0].uri") && err.contains("outside the model's folder"),
+            "{uri}: {err}"
+        );
+        assert!(err.contains("--allow-outside-files"), "{err}");
+        let (scene, _) = load_with(&path, true).unwrap_or_else(|e| panic!("{uri}: {e}"));
+        assert_eq!(scene.objects.len(), 1, "{uri}");
+    }
+    // Other systems' absolute forms are refused before anything is looked up.
+    for uri in [
+        "C:/b.bin",
+        "c:%5Cb.bin",
+        "%5C%5Cserver%5Cshare%5Cb.bin",
+        "\\\\server\\b.bin",
+    ] {
+        let path = write(
+            &out.model(),
+            "m.gltf",
+            b.document(doc.clone(), Some(uri.into())).to_string(),
+        );
+        let err = load(&path).unwrap_err().to_string();
+        assert!(err.contains("outside the model's folder"), "{uri}: {err}");
+    }
+    // A file inside the folder is read as before.
+    std::fs::write(out.model().join("in.bin"), &b.bin).unwrap();
+    let path = write(
+        &out.model(),
+        "m.gltf",
+        b.document(doc, Some("./in.bin".into())).to_string(),
+    );
+    assert_eq!(load(&path).unwrap().0.objects.len(), 1);
+}
+
+#[test]
+fn an_index_accessor_over_an_outside_text_file_shows_none_of_its_bytes() {
+    let mut b = Builder::default();
+    let doc = triangle(&mut b);
+    let out = Outside::new(&b.bin);
+    // The text file as a second buffer, read as the indices.
+    let data = format!("data:application/octet-stream;base64,{}", base64(&b.bin));
+    let mut doc = b.document(doc, Some(data));
+    let text = SENTINEL.repeat(4);
+    doc["buffers"]
+        .as_array_mut()
+        .unwrap()
+        .push(json!({"uri": "../secret.txt", "byteLength": text.len()}));
+    doc["bufferViews"][1] = json!({"buffer": 1, "byteOffset": 0, "byteLength": 6});
+    let path = write(&out.model(), "m.gltf", doc.to_string());
+    let refused = load(&path).unwrap_err().to_string();
+    assert!(refused.contains("buffers[1].uri"), "{refused}");
+    // Allowed: read, and the index error says where, not what the bytes were.
+    let err = load_with(&path, true).unwrap_err().to_string();
+    let shown_value = u16::from_le_bytes([text.as_bytes()[0], text.as_bytes()[1]]);
+    assert!(
+        err.contains("element 0 is out of range for 3 vertices"),
+        "{err}"
+    );
+    for secret in [SENTINEL.to_string(), shown_value.to_string()] {
+        assert!(!err.contains(&secret), "{err}");
+    }
+}
+
+#[test]
+fn image_uris_outside_the_models_folder_are_refused_unless_allowed() {
+    let mut b = Builder::default();
+    let prim = primitive(&mut b, &floor(), Some(0));
+    let out = Outside::new(&b.bin);
+    #[cfg(unix)]
+    std::os::unix::fs::symlink(
+        out.root.path().join("secret.png"),
+        out.model().join("link.png"),
+    )
+    .unwrap();
+    let mut uris = vec!["../secret.png", "%2e%2e/secret.png", "..\\secret.png"];
+    if cfg!(unix) {
+        uris.push("link.png");
+    }
+    for uri in uris {
+        let doc = json!({
+            "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+            "meshes": [{"primitives": [prim]}],
+            "materials": [{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}],
+            "textures": [{"source": 0}], "images": [{"uri": uri}],
+        });
+        let path = write(&out.model(), "m.gltf", b.gltf(doc));
+        let err = load(&path).unwrap_err().to_string();
+        assert!(
+            err.contains("images[0].uri") && err.contains("outside the model's folder"),
+            "{uri}: {err}"
+        );
+        if uri.contains('\\') {
+            continue; // a backslash is no separator here: allowed, the file is just absent
+        }
+        let (scene, report) = load_with(&path, true).unwrap();
+        assert!(report.warnings.is_empty(), "{uri}: {:?}", report.warnings);
+        assert!(scene.materials[0].diffuse_texture.is_some(), "{uri}");
+    }
+}
+
+#[test]
+fn a_scene_file_may_name_models_anywhere_but_their_own_uris_stay_confined() {
+    let mut b = Builder::default();
+    let doc = triangle(&mut b);
+    let out = Outside::new(&b.bin);
+    std::fs::write(out.model().join("in.bin"), &b.bin).unwrap();
+    write(
+        &out.model(),
+        "in.gltf",
+        b.document(doc.clone(), Some("in.bin".into())).to_string(),
+    );
+    write(
+        &out.model(),
+        "out.gltf",
+        b.document(doc, Some("../b.bin".into())).to_string(),
+    );
+    let scenes = out.root.path().join("scenes");
+    std::fs::create_dir(&scenes).unwrap();
+    let ok = write(
+        &scenes,
+        "ok.json",
+        r#"{"objects": [{"gltf": "../model/in.gltf"}]}"#,
+    );
+    assert_eq!(load(&ok).unwrap().0.objects.len(), 1);
+    let bad = write(
+        &scenes,
+        "bad.json",
+        r#"{"objects": [{"gltf": "../model/out.gltf"}]}"#,
+    );
+    let err = load(&bad).unwrap_err().to_string();
+    assert!(
+        err.contains("out.gltf") && err.contains("buffers[0].uri"),
+        "{err}"
+    );
+    assert_eq!(load_with(&bad, true).unwrap().0.objects.len(), 1);
+}
+
+#[test]
+fn gltf_files_and_buffers_are_named_as_such_in_limit_errors() {
+    let out = Outside::new(&[]);
+    let folder = out.model().join("folder.gltf");
+    std::fs::create_dir(&folder).unwrap();
+    let err = load(&folder).unwrap_err().to_string();
+    assert!(err.contains("the glTF file must be a file"), "{err}");
+    assert!(!err.contains("OBJ"), "{err}");
+    #[cfg(unix)]
+    {
+        let mut b = Builder::default();
+        let doc = triangle(&mut b);
+        let path = write(
+            &out.model(),
+            "zero.gltf",
+            b.document(doc, Some("/dev/zero".into())).to_string(),
+        );
+        assert!(load(&path).unwrap_err().to_string().contains("outside"));
+        let err = load_with(&path, true).unwrap_err().to_string();
+        assert!(
+            err.contains("buffers[0]") && err.contains("the glTF buffer must be a file"),
+            "{err}"
+        );
+    }
+}
+
+#[test]
+fn the_cli_refuses_an_outside_buffer_unless_allow_outside_files_is_given() {
+    let mut b = Builder::default();
+    let doc = triangle(&mut b);
+    let out = Outside::new(&b.bin);
+    let gltf = b.document(doc, Some("../b.bin".into())).to_string();
+    write(&out.model(), "m.gltf", gltf);
+    let args = [
+        "render",
+        "--scene",
+        "model/m.gltf",
+        "--size",
+        "64x36",
+        "--lights",
+        "4",
+        "--out",
+        "o.png",
+    ];
+    let refused = common::cli::expect_exit(&args, &[], out.root.path(), 1, "buffers[0].uri");
+    assert!(refused.contains("--allow-outside-files"), "{refused}");
+    assert!(!out.root.path().join("o.png").exists());
+    let allowed = [&args[..], &["--allow-outside-files"]].concat();
+    common::cli::expect_status(&allowed, &[], out.root.path(), 0);
+    assert!(out.root.path().join("o.png").is_file());
+}
+
+#[test]
+fn a_json_file_that_is_not_gltf_shows_none_of_its_strings() {
+    // A scene file may name any file as its glTF: serde's own message would quote the value.
+    let dir = tempfile::tempdir().unwrap();
+    write(
+        dir.path(),
+        "config.json",
+        format!(r#"{{"asset": "{SENTINEL}", "token": 1}}"#),
+    );
+    let scene_file = write(
+        dir.path(),
+        "s.json",
+        r#"{"objects": [{"gltf": "config.json"}]}"#,
+    );
+    let mut paths = vec![scene_file];
+    for (name, text) in [
+        (
+            "enum.gltf",
+            format!(r#"{{"asset": {{"version": "2.0"}}, "scene": "{SENTINEL}"}}"#),
+        ),
+        ("syntax.gltf", format!(r#"{{"asset": {SENTINEL}}}"#)),
+    ] {
+        paths.push(write(dir.path(), name, text));
+    }
+    for path in paths {
+        let err = load(&path).unwrap_err().to_string();
+        assert!(err.contains("line 1"), "{err}");
+        assert!(!err.contains(SENTINEL), "{err}");
+    }
+    let path = write(dir.path(), "none.gltf", "{}");
+    let err = load(&path).unwrap_err().to_string();
+    assert!(err.contains("missing field `asset`"), "{err}");
+}
