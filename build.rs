@@ -9,7 +9,15 @@
 
 fn main() {
     println!("cargo::rustc-check-cfg=cfg(manylight_assets)");
-    println!("cargo::rerun-if-changed=build.rs");
+    // This script serves both packages (tools/ names it `../build.rs`); the path is taken
+    // from the package's folder, where the script runs. A path that names no file would make
+    // every cargo command run it again and rebuild the package.
+    let script = if std::path::Path::new("build.rs").exists() {
+        "build.rs"
+    } else {
+        "../build.rs"
+    };
+    println!("cargo::rerun-if-changed={script}");
     println!("cargo::rerun-if-env-changed=MANYLIGHT_ASSETS");
     if std::env::var_os("MANYLIGHT_ASSETS").is_some_and(|v| !v.is_empty()) {
         println!("cargo::rustc-cfg=manylight_assets");
