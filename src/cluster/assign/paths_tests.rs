@@ -7,7 +7,7 @@ use glam::{DVec3, Vec3};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 
-use super::tests::{cases, cell_lights, random_lights};
+use super::tests::{cases, cell_lights, random_lights, view_grid};
 use super::{
     assign, threads_for, AssignLimits, AssignStats, Assignment, PARALLEL_INDICES,
     PARALLEL_MIN_LIGHTS, PARALLEL_SECONDS,
@@ -19,14 +19,7 @@ use crate::scene::Light;
 #[test]
 fn parallel_and_sequential_assignment_agree() {
     let mut rng = Pcg64Mcg::seed_from_u64(3);
-    let grid = ClusterGrid::new(
-        640,
-        360,
-        GridProjection::test_view(),
-        0.1,
-        80.0,
-        &GridConfig::default(),
-    );
+    let grid = view_grid(&GridConfig::default());
     let lights = random_lights(&mut rng, 5000, 40.0);
     let seq = assign(
         &grid,
@@ -155,14 +148,7 @@ fn heavy_assignments_take_the_pool_and_light_ones_stay_on_the_calling_thread() {
 #[test]
 fn a_slow_assignment_takes_the_pool_on_the_next_frame() {
     let mut rng = Pcg64Mcg::seed_from_u64(5);
-    let grid = ClusterGrid::new(
-        640,
-        360,
-        GridProjection::test_view(),
-        0.1,
-        80.0,
-        &GridConfig::default(),
-    );
+    let grid = view_grid(&GridConfig::default());
     let lights = random_lights(&mut rng, 1024, 30.0);
     let limits = AssignLimits::default();
     let pool = rayon::ThreadPoolBuilder::new()

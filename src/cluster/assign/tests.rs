@@ -85,6 +85,11 @@ pub(super) fn cases() -> Vec<Case> {
     ]
 }
 
+/// The test view at 640×360, near 0.1 and far 80, with the grid `config` makes.
+pub(super) fn view_grid(config: &GridConfig) -> ClusterGrid {
+    ClusterGrid::new(640, 360, GridProjection::test_view(), 0.1, 80.0, config)
+}
+
 /// Random lights around, behind and beyond the camera, point and spot, many sizes.
 pub(super) fn random_lights(rng: &mut Pcg64Mcg, n: usize, scale: f64) -> Vec<GpuLight> {
     (0..n)

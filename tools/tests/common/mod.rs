@@ -138,16 +138,9 @@ pub fn skip(reason: &str) {
 /// suite's run on the system's Mesa, so `MANYLIGHT_REQUIRE_ALL_TESTS` does not turn it into a
 /// failure.
 pub fn other_implementation_than_mesa(what: &str) -> bool {
-    match manylight::gl::gles_lib::chosen_folder() {
-        Some(dir) => {
-            eprintln!(
-                "NOT APPLICABLE: {what} is a Mesa feature; this run renders with {}",
-                dir.display()
-            );
-            true
-        }
-        None => false,
-    }
+    not_applicable_on_another_implementation(|dir| {
+        format!("{what} is a Mesa feature; this run renders with {dir}")
+    })
 }
 
 /// For a test that never touches GL (offline shader validation): true, after saying so on
@@ -155,13 +148,17 @@ pub fn other_implementation_than_mesa(what: &str) -> bool {
 /// Its result is the same on every implementation, so it runs once, in the suite's run on the
 /// system's GL, and `MANYLIGHT_REQUIRE_ALL_TESTS` does not turn this into a failure.
 pub fn independent_of_the_implementation(what: &str) -> bool {
+    not_applicable_on_another_implementation(|dir| {
+        format!("{what} does not use GL; it runs without MANYLIGHT_GLES_LIB, not again with {dir}")
+    })
+}
+
+/// True, after printing `NOT APPLICABLE:` and `why` (given the implementation's folder) on
+/// stderr, when this run renders with another GLES implementation (`MANYLIGHT_GLES_LIB`).
+fn not_applicable_on_another_implementation(why: impl FnOnce(&str) -> String) -> bool {
     match manylight::gl::gles_lib::chosen_folder() {
         Some(dir) => {
-            eprintln!(
-                "NOT APPLICABLE: {what} does not use GL; it runs without MANYLIGHT_GLES_LIB, not \
-                 again with {}",
-                dir.display()
-            );
+            eprintln!("NOT APPLICABLE: {}", why(&dir.display().to_string()));
             true
         }
         None => false,

@@ -3,21 +3,15 @@
 
 use super::Bands;
 use crate::cluster::assign::types::Assignment;
-use crate::cluster::grid::{ClusterGrid, GridConfig, GridProjection};
+use crate::cluster::assign::tests::view_grid;
+use crate::cluster::grid::GridConfig;
 
 /// Per-cell time of the band each thread runs: the first thread is three times slower.
 const SPEED: [f64; 2] = [3e-9, 1e-9];
 
 #[test]
 fn a_slow_worker_gets_less_work_until_both_take_about_as_long() {
-    let grid = ClusterGrid::new(
-        640,
-        360,
-        GridProjection::test_view(),
-        0.1,
-        80.0,
-        &GridConfig::fixed(16.0),
-    );
+    let grid = view_grid(&GridConfig::fixed(16.0));
     let cells = grid.total_cells as usize;
     // The previous frame's lists (the split reads only their length and offsets).
     let previous = Assignment {
