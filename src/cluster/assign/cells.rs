@@ -29,6 +29,7 @@
 use super::cone::{Cone, ConeSlice};
 use super::rows::{RowChords, ROW_LANES};
 use crate::cluster::grid::{CascadeConstants, ClusterGrid, Coverage, GridProjection};
+use crate::cluster::min_max::MinMax;
 use crate::cluster::view_light::GpuLight;
 
 /// Relative padding of light radii (see the module docs).
@@ -179,16 +180,6 @@ pub(crate) fn for_each_run_in(
             rows,
         };
         let mut slice_start = cascade.first_cell + sa * slice_cells;
-        let mut emit_row = |cone: &Option<ConeSlice>, slice_start: u32, row: u32, x0, x1| {
-            let (x0, x1) = match cone {
-                None => (x0, x1),
-                Some(cone) => match cone.columns(row, x0, x1) {
-                    Some(span) => span,
-                    None => return,
-                },
-            };
-            emit(slice_start + row * cascade.tiles_x + x0, x1 - x0 + 1)
-        };
         // A rectangle of at most 2 × 2 cells per slice has little to trim (a corner cell at
         // most) and the per-row arithmetic, or a spot's cone test, would cost more than the
         // cells it saves (a spot's bounding sphere already fits its cone).
@@ -228,19 +219,51 @@ pub(crate) fn for_each_run_in(
             match coverage {
                 Coverage::SliceRows => {
                     let slab = grid.slice_slabs[(constants.first_slice + s) as usize];
-                    extent.for_each_row_run(&tiles, slab, &mut |row, x0, x1| {
-                        emit_row(&cone, slice_start, row, x0, x1)
-                    });
+                    let row_start = |row: u32| slice_start + row * cascade.tiles_x;
+                    // Two callers, so that a point light's rows take the plain emission
+                    // inlined: with the cone's test in the same closure, the compiler kept
+                    // it out of line, a call per row.
+                    match &cone {
+                        None => extent.for_each_row_run(&tiles, slab, &mut |row, x0, x1| {
+                            emit(row_start(row) + x0, x1 - x0 + 1)
+                        }),
+                        Some(_) => extent.for_each_row_run(&tiles, slab, &mut |row, x0, x1| {
+                            emit_row(emit, &cone, row_start(row), row, x0, x1)
+                        }),
+                    }
                 }
                 Coverage::CascadeBox => {
                     for row in rows.0..rows.1 + 1 {
-                        emit_row(&cone, slice_start, row, columns.0, columns.1);
+                        let row_start = slice_start + row * cascade.tiles_x;
+                        emit_row(emit, &cone, row_start, row, columns.0, columns.1);
                     }
                 }
             }
             slice_start += slice_cells;
         }
     }
+}
+
+/// Emits the run of columns `x0..=x1` of the row starting at cell `row_start`, cut to a spot's
+/// cone when there is one. A function, not a closure: the compiler left the closure out of
+/// line, a call per row.
+#[inline(always)]
+fn emit_row(
+    emit: &mut impl FnMut(u32, u32),
+    cone: &Option<ConeSlice>,
+    row_start: u32,
+    row: u32,
+    x0: u32,
+    x1: u32,
+) {
+    let (x0, x1) = match cone {
+        None => (x0, x1),
+        Some(cone) => match cone.columns(row, x0, x1) {
+            Some(span) => span,
+            None => return,
+        },
+    };
+    emit(row_start + x0, x1 - x0 + 1)
 }
 
 #[cfg(test)]
@@ -284,6 +307,17 @@ fn box_slopes(low: f64, high: f64, inv_a: f64, inv_b: f64) -> (f64, f64) {
     )
 }
 
+/// [`box_slopes`] for finite `inv_a ≥ inv_b ≥ 0` (a slice's slab, see
+/// `ScreenExtent::for_each_row_run`), by comparison and select: a product with `inv_a` is NaN
+/// only when the one with `inv_b` is too (a NaN extent, or an infinite one and both zero).
+#[inline(always)]
+fn slab_slopes(low: f64, high: f64, inv_a: f64, inv_b: f64) -> (f64, f64) {
+    (
+        (low * inv_a).at_most(low * inv_b),
+        (high * inv_a).at_least(high * inv_b),
+    )
+}
+
 /// Tile range `[t0, t1]` of `count` tiles (`half` = count / 2) covering the NDC range
 /// `[lo, hi]`, or `None` when it misses the screen (or is NaN).
 #[inline(always)]
@@ -320,15 +354,19 @@ impl ScreenExtent {
         emit: &mut impl FnMut(u32, u32, u32),
     ) {
         let (dmin, dmax) = self.depth;
-        let za = z0.max(dmin);
+        // The slab's bounds and reciprocals are never NaN, so they go first (`MinMax`); the
+        // light's may be (a hostile spot's axis) and go second.
+        let za = z0.at_least(dmin);
         // Never below `za`: the slice came from the widened depth range, so the slab meets it
         // up to rounding.
-        let zb = z1.min(dmax).max(za);
+        let zb = z1.at_most(dmax).at_least(za);
         // Their reciprocals without a division: `1/max(a, b) = min(1/a, 1/b)`.
-        let inv_a = inv_z0.min(self.inv_depth.0).min(MAX_INV_DEPTH);
-        let inv_b = inv_z1.max(self.inv_depth.1).min(inv_a);
-        let nearest = self.d.clamp(za, zb) - self.d;
-        let rho_sq = (self.r * self.r - nearest * nearest).max(0.0);
+        let inv_a = inv_z0.at_most(self.inv_depth.0).at_most(MAX_INV_DEPTH);
+        let inv_b = inv_z1.at_least(self.inv_depth.1).at_most(inv_a);
+        // The centre's depth clamped into the slab (NaN stays NaN, as with `f64::clamp`).
+        let nearest = self.d.at_least(za).at_most(zb) - self.d;
+        // 0 first: a NaN difference gives 0, as `f64::max` did.
+        let rho_sq = 0.0_f64.at_least(self.r * self.r - nearest * nearest);
         let rho = rho_sq.sqrt();
         let constants = tiles.constants;
         let [cx, cy] = self.center;
@@ -407,7 +445,7 @@ impl ScreenExtent {
     ) -> Option<(u32, u32)> {
         let scale = tiles.grid.ndc_scale[axis];
         let (lo, hi) = if self.perspective {
-            box_slopes(low, high, inv_a, inv_b)
+            slab_slopes(low, high, inv_a, inv_b)
         } else {
             (low, high)
         };

@@ -3,6 +3,7 @@
 //! test that trims each row of cells to those the cone may touch, solved for the whole row at
 //! once (one quadratic) rather than cell by cell.
 
+use crate::cluster::min_max::MinMax;
 use crate::cluster::grid::SliceCells;
 use crate::cluster::view_light::GpuLight;
 
@@ -206,13 +207,15 @@ impl ConeSlice<'_> {
 const NARROW_ROW: u32 = 3;
 
 /// The part of `span` (`lo ≤ hi`) where `a + b·t ≥ 0`, or `None` when there is none;
-/// `inv_b` is `1 / b` (a row's reciprocal is worked out once per slice).
+/// `inv_b` is `1 / b` (a row's reciprocal is worked out once per slice). A span's ends are
+/// never NaN (column numbers, or a span cut by these two functions), so they go first in its
+/// bounds ([`MinMax`]): a NaN bound leaves them.
 #[inline(always)]
 fn keep_nonnegative((lo, hi): (f64, f64), a: f64, b: f64, inv_b: f64) -> Option<(f64, f64)> {
     let (lo, hi) = if b > 0.0 {
-        (lo.max(-a * inv_b), hi)
+        (lo.at_least(-a * inv_b), hi)
     } else if b < 0.0 {
-        (lo, hi.min(-a * inv_b))
+        (lo, hi.at_most(-a * inv_b))
     } else if a >= 0.0 || a.is_nan() {
         // Also for NaN (an overflowed coefficient): keep the span.
         (lo, hi)
@@ -234,7 +237,7 @@ fn quadratic_nonpositive(
     c_terms: f64,
     (lo, hi): (f64, f64),
 ) -> Option<(f64, f64)> {
-    let t = lo.abs().max(hi.abs()).max(1.0);
+    let t = lo.abs().at_least(hi.abs()).at_least(1.0);
     let c = c - 1e-9 * (c_terms.abs() + b.abs() * t + a.abs() * t * t);
     if a == 0.0 {
         // b·t + c ≤ 0.
@@ -258,12 +261,12 @@ fn quadratic_nonpositive(
         (x.min(y), x.max(y))
     };
     if a > 0.0 {
-        let (lo, hi) = (lo.max(r1), hi.min(r2));
+        let (lo, hi) = (lo.at_least(r1), hi.at_most(r2));
         return (lo <= hi).then_some((lo, hi));
     }
     // Non-positive outside the roots: the hull of what is left of the span on either side.
-    let left = (lo <= r1).then_some((lo, hi.min(r1)));
-    let right = (hi >= r2).then_some((lo.max(r2), hi));
+    let left = (lo <= r1).then_some((lo, hi.at_most(r1)));
+    let right = (hi >= r2).then_some((lo.at_least(r2), hi));
     match (left, right) {
         (Some((l, _)), Some((_, h))) => Some((l, h)),
         (one, other) => one.or(other),

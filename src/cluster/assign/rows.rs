@@ -3,6 +3,15 @@
 //! compiler keeps the four rows in SIMD registers (two `f64` lanes on x86-64's baseline SSE2
 //! and on aarch64's NEON, four with AVX). Every lane does exactly the scalar operations in the
 //! scalar order, so the columns, and the lists, are the same bit for bit.
+//!
+//! Bounds are taken by comparison and select ([`MinMax`]), the operand first that is NaN only
+//! when the other is too: `t · za` (the slab's near end is finite, so its product is NaN only
+//! when the far end's is), `low · inv_a` (`inv_a ≥ inv_b ≥ 0`, both finite). A gap that comes
+//! out NaN where `f64::max` gave a number gives the same columns: either is "the whole
+//! cross-section" (where `f64::max` gave a number, it was ≤ 0; the tests check the lanes
+//! against `f64`'s bounds, slabs reaching infinity included).
+
+use crate::cluster::min_max::MinMax;
 
 /// Rows whose chords one call of [`RowChords::columns`] works out.
 pub(super) const ROW_LANES: usize = 4;
@@ -41,12 +50,12 @@ impl RowChords {
         // The band's nearest approach to the centre over the slab (a lower bound).
         let gap = if self.perspective {
             lanes(|i| {
-                let below = (t0[i] * za).min(t0[i] * zb) - cy;
-                let above = cy - (t1[i] * za).max(t1[i] * zb);
-                below.max(above)
+                let below = (t0[i] * za).at_most(t0[i] * zb) - cy;
+                let above = cy - (t1[i] * za).at_least(t1[i] * zb);
+                below.at_least(above)
             })
         } else {
-            lanes(|i| (t0[i] - cy).max(cy - t1[i]))
+            lanes(|i| (t0[i] - cy).at_least(cy - t1[i]))
         };
         let half_sq = lanes(|i| self.rho_sq - gap[i] * gap[i]);
         // A negative `half_sq` gives NaN here, and its lane no columns below.
@@ -57,8 +66,8 @@ impl RowChords {
         );
         let (lo, hi) = if self.perspective {
             (
-                lanes(|i| (low[i] * self.inv_a).min(low[i] * self.inv_b)),
-                lanes(|i| (high[i] * self.inv_a).max(high[i] * self.inv_b)),
+                lanes(|i| (low[i] * self.inv_a).at_most(low[i] * self.inv_b)),
+                lanes(|i| (high[i] * self.inv_a).at_least(high[i] * self.inv_b)),
             )
         } else {
             (low, high)
@@ -68,9 +77,9 @@ impl RowChords {
             lanes(|i| hi[i] * self.scale_x),
         );
         // `ndc_to_tiles`: `as u32` saturates (NaN and negatives to 0) and the last column
-        // caps it; clamping in f64 first gives the same tile and converts as a vector.
+        // caps it; clamping in f64 first (0 first: NaN gives 0) gives the same tile.
         let last = self.last_column as f64;
-        let tile = |ndc: f64| ((ndc + 1.0) * self.half_tiles_x).max(0.0).min(last) as u32;
+        let tile = |ndc: f64| 0.0_f64.at_least((ndc + 1.0) * self.half_tiles_x).at_most(last) as u32;
         let (c0, c1) = self.columns;
         std::array::from_fn(|i| {
             let (g, lo, hi) = (gap[i], lo[i], hi[i]);
@@ -98,11 +107,11 @@ impl RowChords {
         let t0 = -self.extent_y + row as f64 * self.step_y;
         let t1 = t0 + self.step_y;
         let gap = if self.perspective {
-            let below = (t0 * self.za).min(t0 * self.zb) - self.cy;
-            let above = self.cy - (t1 * self.za).max(t1 * self.zb);
-            below.max(above)
+            let below = (t0 * self.za).at_most(t0 * self.zb) - self.cy;
+            let above = self.cy - (t1 * self.za).at_least(t1 * self.zb);
+            below.at_least(above)
         } else {
-            (t0 - self.cy).max(self.cy - t1)
+            (t0 - self.cy).at_least(self.cy - t1)
         };
         if gap.is_nan() || gap <= 0.0 {
             return self.columns;
@@ -115,8 +124,8 @@ impl RowChords {
         let (low, high) = (self.cx - half, self.cx + half);
         let (lo, hi) = if self.perspective {
             (
-                (low * self.inv_a).min(low * self.inv_b),
-                (high * self.inv_a).max(high * self.inv_b),
+                (low * self.inv_a).at_most(low * self.inv_b),
+                (high * self.inv_a).at_least(high * self.inv_b),
             )
         } else {
             (low, high)
@@ -202,9 +211,17 @@ mod tests {
             let c0 = rng.random_range(0..tiles_x);
             let c1 = rng.random_range(c0..tiles_x);
             let extent_y = rng.random_range(0.1..3.0);
-            let za = rng.random_range(0.01..100.0);
+            // Now and then a slab reaching infinity (the last slice), or wholly there (a
+            // light past an infinite far plane): products of zero and infinity are NaN.
+            let za = match case % 97 {
+                0 => f64::INFINITY,
+                _ => rng.random_range(0.01..100.0),
+            };
             let inv_a = 1.0 / za;
-            let zb = za + rng.random_range(0.0..10.0);
+            let zb = match case % 7 {
+                0 => f64::INFINITY,
+                _ => za + rng.random_range(0.0..10.0),
+            };
             let chords = RowChords {
                 perspective: case % 4 != 0,
                 za,

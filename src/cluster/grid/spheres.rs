@@ -3,6 +3,7 @@
 
 use super::tables::SliceFrustum;
 use super::{ClusterGrid, GridProjection};
+use crate::cluster::min_max::MinMax;
 
 impl ClusterGrid {
     /// True when the view-space sphere (`center`, `radius`) lies wholly outside one of the
@@ -40,7 +41,7 @@ impl ClusterGrid {
         // The farthest corner, per depth end: the farther of the two NDC bounds in x and in y
         // (the squared distance separates into the three axes).
         let y_and_z = |hy: f64| {
-            (ny0 * hy - cy).powi(2).max((ny1 * hy - cy).powi(2)) + half_depth * half_depth
+            (ny0 * hy - cy).powi(2).at_least((ny1 * hy - cy).powi(2)) + half_depth * half_depth
         };
         RowSpheres {
             #[cfg(test)]
@@ -109,15 +110,27 @@ impl RowSpheres {
     }
 
     /// The view x of the centre of the row's cell in column `x`, and its squared radius.
-    #[inline(always)]
+    #[cfg(test)]
     fn centre_x_and_radius_sq(&self, x: u32) -> (f64, f64) {
+        let (cx, x_terms) = self.column_terms(x);
+        (cx, self.radius_sq(x_terms))
+    }
+
+    /// The view x of the centre of the cells in column `x` and, per depth end, the farthest
+    /// corner's squared distance in x: the same in every row of the slice.
+    #[inline(always)]
+    fn column_terms(&self, x: u32) -> (f64, [f64; 2]) {
         let nx0 = -1.0 + x as f64 * self.step_x;
         let nx1 = -1.0 + (x + 1) as f64 * self.step_x;
         let cx = 0.5 * (nx0 + nx1) * self.mean_x;
-        let farthest_x = |hx: f64| (nx0 * hx - cx).powi(2).max((nx1 * hx - cx).powi(2));
-        let near = farthest_x(self.near_x) + self.near_rest;
-        let far = farthest_x(self.far_x) + self.far_rest;
-        (cx, near.max(far))
+        let farthest_x = |hx: f64| (nx0 * hx - cx).powi(2).at_least((nx1 * hx - cx).powi(2));
+        (cx, [farthest_x(self.near_x), farthest_x(self.far_x)])
+    }
+
+    /// The squared radius of this row's cell in the column with `column_terms` `[near, far]`.
+    #[inline(always)]
+    fn radius_sq(&self, [near, far]: [f64; 2]) -> f64 {
+        (near + self.near_rest).at_least(far + self.far_rest)
     }
 }
 
@@ -152,11 +165,16 @@ impl ClusterGrid {
             // A cell's squared radius is a sum of per-axis terms, each a maximum of squares of
             // functions affine in the column or row (see `RowSpheres::cell`): convex over the
             // rectangle, so largest at one of its corners.
+            // The columns' terms are the rows' too: worked out once (the sizes are finite
+            // here, so no bound is NaN).
+            let first_row = self.row_spheres(cascade, slice, rows.0);
+            let last_row = self.row_spheres(cascade, slice, rows.1);
+            let (_, left) = first_row.column_terms(columns.0);
+            let (_, right) = first_row.column_terms(columns.1);
             let mut largest: f64 = 0.0;
-            for y in [rows.0, rows.1] {
-                let spheres = self.row_spheres(cascade, slice, y);
-                for x in [columns.0, columns.1] {
-                    largest = largest.max(spheres.centre_x_and_radius_sq(x).1);
+            for spheres in [&first_row, &last_row] {
+                for x_terms in [left, right] {
+                    largest = largest.at_least(spheres.radius_sq(x_terms));
                 }
             }
             largest.sqrt()
