@@ -190,10 +190,12 @@ impl Assigner {
 }
 
 /// Threads an assignment of `lights` takes from a pool of `pool` (at most 8), given its
-/// previous one's index count and CPU seconds: one unless the lights reach
-/// `limits.parallel_threshold`, or the previous assignment was heavy (see
-/// [`AssignLimits::parallel_threshold`]). Waking rayon's workers costs tens of microseconds
-/// on some machines, so light work stays on the calling thread.
+/// previous one's index count and CPU seconds: the pool's when the lights reach
+/// `limits.parallel_threshold` or the previous assignment listed [`PARALLEL_INDICES`]; from
+/// [`PARALLEL_MIN_LIGHTS`] lights, one more than the whole [`PARALLEL_SECONDS`] in the
+/// previous one's CPU time (so two from one up), each worker getting enough work to repay its
+/// waking (tens of microseconds on some machines); else one, on the calling thread. Never more
+/// than one with `limits.parallel_threshold` at `usize::MAX`.
 fn threads_for(
     lights: usize,
     last_indices: usize,
@@ -201,11 +203,16 @@ fn threads_for(
     limits: &AssignLimits,
     pool: usize,
 ) -> usize {
-    let heavy = limits.parallel_threshold != usize::MAX
-        && (last_indices >= PARALLEL_INDICES
-            || (lights >= PARALLEL_MIN_LIGHTS && last_cpu_seconds >= PARALLEL_SECONDS));
-    if lights >= limits.parallel_threshold || heavy {
-        pool.clamp(1, 8)
+    let most = pool.clamp(1, 8);
+    if limits.parallel_threshold == usize::MAX {
+        1
+    } else if lights >= limits.parallel_threshold || last_indices >= PARALLEL_INDICES {
+        most
+    } else if lights >= PARALLEL_MIN_LIGHTS && last_cpu_seconds >= PARALLEL_SECONDS {
+        // `as` saturates: any time past 2⁶⁴ shares is the whole pool.
+        ((last_cpu_seconds / PARALLEL_SECONDS) as usize)
+            .saturating_add(1)
+            .min(most)
     } else {
         1
     }

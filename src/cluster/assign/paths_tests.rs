@@ -116,7 +116,8 @@ fn reused_buffers_match_fresh_ones() {
 
 /// Which assignments take the pool: many lights, or a previous assignment of the same
 /// assigner that listed many indices or took long (counted in CPU time, so a parallel one that
-/// became fast stays parallel); never with `parallel_threshold: usize::MAX`, at most 8 threads.
+/// became fast stays parallel; a thread more per `PARALLEL_SECONDS` of it); never with
+/// `parallel_threshold: usize::MAX`, at most 8 threads.
 #[test]
 fn heavy_assignments_take_the_pool_and_light_ones_stay_on_the_calling_thread() {
     let limits = AssignLimits::default();
@@ -125,11 +126,20 @@ fn heavy_assignments_take_the_pool_and_light_ones_stay_on_the_calling_thread() {
     assert_eq!(threads_for(lights - 1, 0, 0.0, &limits, 4), 1);
     assert_eq!(threads_for(10, PARALLEL_INDICES, 0.0, &limits, 4), 4);
     assert_eq!(threads_for(10, PARALLEL_INDICES - 1, 0.0, &limits, 4), 1);
-    // By the previous assignment's CPU time: a 1 ms assignment on one thread, and the same
-    // work split over four (280 µs of CPU time in 70 µs).
+    // By the previous assignment's CPU time: a 1 ms assignment on one thread takes the pool,
+    // the same work split over four (280 µs of CPU time in 70 µs) stays on three or four.
+    let seconds = PARALLEL_SECONDS;
     assert_eq!(threads_for(1024, 0, 1e-3, &limits, 4), 4);
-    assert_eq!(threads_for(1024, 0, 4.0 * 70e-6, &limits, 4), 4);
-    assert_eq!(threads_for(1024, 0, PARALLEL_SECONDS * 0.9, &limits, 4), 1);
+    assert_eq!(threads_for(1024, 0, 100.0 * seconds, &limits, 64), 8);
+    assert!(threads_for(1024, 0, 4.0 * 70e-6, &limits, 4) >= 3);
+    // Two threads from one such time, a third from two; under one, the calling thread.
+    assert_eq!(threads_for(1024, 0, seconds, &limits, 4), 2);
+    assert_eq!(threads_for(1024, 0, 1.9 * seconds, &limits, 4), 2);
+    assert_eq!(threads_for(1024, 0, 2.0 * seconds, &limits, 4), 3);
+    assert_eq!(threads_for(1024, 0, 2.0 * seconds, &limits, 2), 2);
+    assert_eq!(threads_for(1024, 0, 2.0 * seconds, &limits, 1), 1);
+    assert_eq!(threads_for(1024, 0, seconds * 0.9, &limits, 4), 1);
+    assert_eq!(threads_for(1024, 0, f64::INFINITY, &limits, 4), 4);
     // Few lights that took long did so on a slow core, not for their work.
     assert_eq!(threads_for(PARALLEL_MIN_LIGHTS - 1, 0, 1.0, &limits, 4), 1);
     assert_eq!(threads_for(PARALLEL_MIN_LIGHTS, 0, 1.0, &limits, 4), 4);

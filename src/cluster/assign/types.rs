@@ -9,11 +9,12 @@ use super::index_list::IndexList;
 pub const PARALLEL_INDICES: usize = 1 << 17;
 
 /// An assignment whose previous one (same [`Assigner`](super::Assigner)) took this much CPU
-/// time (its wall time times its threads) or more runs on all cores, from
-/// [`PARALLEL_MIN_LIGHTS`] lights up: waking the pool's workers costs tens of microseconds,
-/// which a millisecond's work repays on the second core. Counting the threads' time, not the
-/// wall time, keeps a parallel assignment parallel when it becomes fast.
-pub const PARALLEL_SECONDS: f64 = 250e-6;
+/// time (its wall time times its threads) or more runs on two threads, and on one more for
+/// every further `PARALLEL_SECONDS` (up to the pool, at most 8), from [`PARALLEL_MIN_LIGHTS`]
+/// lights up: waking a pool's worker costs tens of microseconds, which half of this repays.
+/// Counting the threads' time, not the wall time, keeps a parallel assignment parallel when
+/// it becomes fast.
+pub const PARALLEL_SECONDS: f64 = 100e-6;
 
 /// Fewest lights the [`PARALLEL_SECONDS`] rule takes to all cores: below, an assignment that
 /// took long did so on a slow or busy core, not for its work.
@@ -34,10 +35,11 @@ pub struct AssignLimits {
     pub cell_cap: u32,
     /// Most indices in total.
     pub max_indices: usize,
-    /// Lights from this count up are assigned on all cores (rayon's pool); so is any
-    /// assignment whose previous one (same [`Assigner`](super::Assigner)) listed
-    /// [`PARALLEL_INDICES`] or more, or took [`PARALLEL_SECONDS`] of CPU time or more (from
-    /// [`PARALLEL_MIN_LIGHTS`] lights), unless this is `usize::MAX` (never in parallel).
+    /// Lights from this count up are assigned on all cores (rayon's pool, at most 8); so is
+    /// any assignment whose previous one (same [`Assigner`](super::Assigner)) listed
+    /// [`PARALLEL_INDICES`] or more, and one that took [`PARALLEL_SECONDS`] of CPU time or
+    /// more (from [`PARALLEL_MIN_LIGHTS`] lights) on a thread per such time and one, unless
+    /// this is `usize::MAX` (never in parallel).
     pub parallel_threshold: usize,
 }
 
