@@ -3,8 +3,8 @@
 //! test that trims each row of cells to those the cone may touch, solved for the whole row at
 //! once (one quadratic) rather than cell by cell.
 
-use crate::cluster::min_max::MinMax;
 use crate::cluster::grid::SliceCells;
+use crate::cluster::min_max::MinMax;
 use crate::cluster::view_light::GpuLight;
 
 /// A spot light's cone, for the cone-vs-cell test (Wronski's "cull that cone"), and the

@@ -5,8 +5,8 @@
 //! scalar order, so the columns, and the lists, are the same bit for bit.
 //!
 //! Bounds are taken by comparison and select ([`MinMax`]), the operand first that is NaN only
-//! when the other is too: `t · za` (the slab's near end is finite, so its product is NaN only
-//! when the far end's is), `low · inv_a` (`inv_a ≥ inv_b ≥ 0`, both finite). A gap that comes
+//! when the other is too: `t · za` (NaN only for `t = 0` and an infinite `za`, and then
+//! `zb ≥ za` is infinite too), `low · inv_a` (`inv_a ≥ inv_b ≥ 0`, both finite). A gap that comes
 //! out NaN where `f64::max` gave a number gives the same columns: either is "the whole
 //! cross-section" (where `f64::max` gave a number, it was ≤ 0; the tests check the lanes
 //! against `f64`'s bounds, slabs reaching infinity included).
