@@ -16,7 +16,7 @@ pub const PARALLEL_INDICES: usize = 1 << 17;
 /// it becomes fast.
 pub const PARALLEL_SECONDS: f64 = 100e-6;
 
-/// Fewest lights the [`PARALLEL_SECONDS`] rule takes to all cores: below, an assignment that
+/// Fewest lights the [`PARALLEL_SECONDS`] rule takes to the pool: below, an assignment that
 /// took long did so on a slow or busy core, not for its work.
 pub const PARALLEL_MIN_LIGHTS: usize = 256;
 
