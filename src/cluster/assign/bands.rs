@@ -258,6 +258,33 @@ impl Band {
         let blocks = scatter_blocks(cells, list.len(), std::mem::size_of::<T>(), self.lights.len());
         #[cfg(test)]
         let blocks = FORCED_SCATTER_BLOCKS.with(|b| b.get()).map_or(blocks, |b| b.clamp(1, cells));
+        if blocks == 1 {
+            // One block, every run whole: no cursors into the runs, no run cut at a block's
+            // end (a run's bookkeeping was most of the scatter's work on runs of one or two
+            // cells).
+            let mut end = self.runs.len();
+            for (&(_, start), &id) in self.lights.iter().zip(&self.ids).rev() {
+                let entry = T::from_u32(id);
+                for run in &self.runs[start as usize..end] {
+                    let a = run.start as usize;
+                    write_entries(&mut offsets[a..a + run.len as usize], list, entry);
+                }
+                end = start as usize;
+            }
+        } else {
+            self.scatter_by_blocks(blocks, offsets, list);
+        }
+        if self.first_cell != 0 {
+            let base = self.base as u32;
+            offsets.iter_mut().for_each(|offset| *offset += base);
+        }
+        self.seconds += started.elapsed().as_secs_f64();
+    }
+
+    /// [`Band::scatter`]'s writes by `blocks` blocks of cells (more than one), each block's
+    /// runs of all the band's lights before the next block's.
+    fn scatter_by_blocks<T: LightIndex>(&mut self, blocks: usize, offsets: &mut [u32], list: &mut [T]) {
+        let cells = offsets.len();
         self.cursors.clear();
         self.cursors
             .extend(self.lights.iter().map(|&(_, start)| start));
@@ -276,20 +303,7 @@ impl Band {
                     }
                     let run_end = run.start + run.len;
                     let (a, b) = (run.start.max(first), run_end.min(end_cell));
-                    // Four cursors moved at once (a vector subtraction), then their entries.
-                    let cursors = &mut offsets[a as usize..b as usize];
-                    let mut quads = cursors.chunks_exact_mut(4);
-                    for quad in &mut quads {
-                        let q: &mut [u32; 4] = quad.try_into().expect("four cursors");
-                        *q = q.map(|at| at - 1);
-                        for &at in q.iter() {
-                            list[at as usize] = entry;
-                        }
-                    }
-                    for at in quads.into_remainder() {
-                        *at -= 1;
-                        list[*at as usize] = entry;
-                    }
+                    write_entries(&mut offsets[a as usize..b as usize], list, entry);
                     if run_end > end_cell {
                         // The rest of the run is the next block's.
                         break;
@@ -300,11 +314,25 @@ impl Band {
                 end = start as usize;
             }
         }
-        if self.first_cell != 0 {
-            let base = self.base as u32;
-            offsets.iter_mut().for_each(|offset| *offset += base);
+    }
+}
+
+/// Writes `entry` into `list` once for each of `cursors` (the offsets of a run's cells), each
+/// cursor moved one place back first: four cursors at once (a vector subtraction), then their
+/// entries.
+#[inline(always)]
+fn write_entries<T: LightIndex>(cursors: &mut [u32], list: &mut [T], entry: T) {
+    let mut quads = cursors.chunks_exact_mut(4);
+    for quad in &mut quads {
+        let q: &mut [u32; 4] = quad.try_into().expect("four cursors");
+        *q = q.map(|at| at - 1);
+        for &at in q.iter() {
+            list[at as usize] = entry;
         }
-        self.seconds += started.elapsed().as_secs_f64();
+    }
+    for at in quads.into_remainder() {
+        *at -= 1;
+        list[*at as usize] = entry;
     }
 }
 
