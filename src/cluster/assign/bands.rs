@@ -267,7 +267,20 @@ impl Band {
                 let entry = T::from_u32(id);
                 for run in &self.runs[start as usize..end] {
                     let a = run.start as usize;
-                    write_entries(&mut offsets[a..a + run.len as usize], list, entry);
+                    if run.len <= 2 {
+                        // Most runs of small lights: the first cell, then the last, without a
+                        // branch on which (a run of one cell writes its entry twice, the second
+                        // time where the first went).
+                        let at = offsets[a] - 1;
+                        offsets[a] = at;
+                        list[at as usize] = entry;
+                        let (last, step) = (a + run.len as usize - 1, run.len - 1);
+                        let at = offsets[last] - step;
+                        offsets[last] = at;
+                        list[at as usize] = entry;
+                    } else {
+                        write_entries(&mut offsets[a..a + run.len as usize], list, entry);
+                    }
                 }
                 end = start as usize;
             }
