@@ -12,63 +12,58 @@ use manylight::cluster::assign::{AssignLimits, Assigner};
 use manylight::cluster::grid::{ClusterGrid, Coverage, GridConfig, GridProjection};
 use manylight::cluster::view_light::GpuLight;
 use manylight_tools::workload::AssignWorkload;
+use rand::{Rng, SeedableRng};
+use rand_pcg::Pcg64Mcg;
 
-/// A small deterministic generator (xorshift64*), so the battery needs no crate.
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        self.0.wrapping_mul(0x2545_f491_4f6c_dd1d)
-    }
-    /// Uniform in `[lo, hi)`.
-    fn range(&mut self, lo: f32, hi: f32) -> f32 {
-        lo + (hi - lo) * ((self.next() >> 40) as f32 / (1u64 << 24) as f32)
-    }
-    /// Now and then an extreme value, else uniform in `[-scale, scale)`.
-    fn value(&mut self, scale: f32) -> f32 {
-        match self.next() % 50 {
-            0 => f32::NAN,
-            1 => f32::INFINITY,
-            2 => f32::NEG_INFINITY,
-            3 => 0.0,
-            4 => 1e30,
-            5 => -1e30,
-            6 => 1e7,
-            _ => self.range(-scale, scale),
-        }
+/// Now and then an extreme value, else uniform in `[-scale, scale)`.
+fn value(rng: &mut Pcg64Mcg, scale: f32) -> f32 {
+    match rng.random_range(0..50) {
+        0 => f32::NAN,
+        1 => f32::INFINITY,
+        2 => f32::NEG_INFINITY,
+        3 => 0.0,
+        4 => 1e30,
+        5 => -1e30,
+        6 => 1e7,
+        _ => rng.random_range(-scale..scale),
     }
 }
 
 /// Lights anywhere around the eye (`scale` m), some hostile.
 fn hostile_lights(seed: u64, n: usize, scale: f32) -> Vec<GpuLight> {
-    let mut rng = Rng(seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) | 1);
+    let mut rng = Pcg64Mcg::seed_from_u64(seed);
     (0..n)
         .map(|_| {
-            let position = Vec3::new(rng.value(scale), rng.value(scale), rng.value(scale));
-            let radius = match rng.next() % 12 {
-                0 => rng.value(scale).abs(),
+            let position = Vec3::new(
+                value(&mut rng, scale),
+                value(&mut rng, scale),
+                value(&mut rng, scale),
+            );
+            let radius = match rng.random_range(0..12) {
+                0 => value(&mut rng, scale).abs(),
                 1 => 1e12,
-                2 => rng.range(1e-6, 1e-3),
-                3..=5 => rng.range(0.01, scale * 0.3),
-                _ => rng.range(0.01, scale * 0.03),
+                2 => rng.random_range(1e-6..1e-3),
+                3..=5 => rng.random_range(0.01..scale * 0.3),
+                _ => rng.random_range(0.01..scale * 0.03),
             };
-            let spot = rng.next().is_multiple_of(3);
+            let spot = rng.random_range(0..3) == 0;
             let (spot_scale, spot_offset, direction) = if spot {
-                let cos_outer = rng.range(-0.2, 1.0);
-                let scale = match rng.next() % 20 {
-                    0 => rng.value(10.0),
-                    _ => 1.0 / rng.range(0.01, 0.5),
+                let cos_outer = rng.random_range(-0.2..1.0);
+                let scale = match rng.random_range(0..20) {
+                    0 => value(&mut rng, 10.0),
+                    _ => 1.0 / rng.random_range(0.01..0.5),
                 };
-                let direction = match rng.next() % 15 {
+                let direction = match rng.random_range(0..15) {
                     0 => Vec3::ZERO,
-                    1 => Vec3::new(rng.value(1.0), rng.value(1.0), rng.value(1.0)),
+                    1 => Vec3::new(
+                        value(&mut rng, 1.0),
+                        value(&mut rng, 1.0),
+                        value(&mut rng, 1.0),
+                    ),
                     _ => Vec3::new(
-                        rng.range(-1.0, 1.0),
-                        rng.range(-1.0, 1.0),
-                        rng.range(-1.0, 1.0),
+                        rng.random_range(-1.0..1.0),
+                        rng.random_range(-1.0..1.0),
+                        rng.random_range(-1.0..1.0),
                     )
                     .normalize_or_zero(),
                 };
@@ -80,7 +75,7 @@ fn hostile_lights(seed: u64, n: usize, scale: f32) -> Vec<GpuLight> {
                 position,
                 radius,
                 cull_radius: radius,
-                radiance: Vec3::new(rng.range(0.0, 5.0), rng.range(0.0, 5.0), 1.0),
+                radiance: Vec3::new(rng.random_range(0.0..5.0), rng.random_range(0.0..5.0), 1.0),
                 spot_scale,
                 direction,
                 spot_offset,
