@@ -25,13 +25,15 @@ pub(crate) struct Cone {
 }
 
 impl Cone {
-    /// The cone of a spot light of (padded) radius `range`; `None` for point lights and cones
-    /// too wide to be worth testing.
+    /// The cone of a spot light of (padded) radius `range`; `None` for point lights, cones
+    /// too wide to be worth testing, and axes without a direction (zero, or a non-finite
+    /// component): those are bounded by the light's whole sphere.
     #[inline(always)]
     pub fn of(light: &GpuLight, range: f64) -> Option<Cone> {
         // 1 − cos(outer) = offset / scale (see `Light::spot_scale_offset`): no trigonometry
         // per light. Cones of 89° and wider are not worth testing.
-        if light.spot_scale == 0.0 || light.direction.length_squared() == 0.0 {
+        let axis = light.direction.as_dvec3().normalize_or_zero();
+        if light.spot_scale == 0.0 || axis == glam::DVec3::ZERO {
             return None;
         }
         let cos_outer = 1.0 - light.spot_offset as f64 / light.spot_scale as f64;
@@ -42,7 +44,6 @@ impl Cone {
         }
         let sin = (1.0 - cos * cos).max(0.0).sqrt();
         let apex = light.position.as_dvec3();
-        let axis = light.direction.as_dvec3().normalize();
         // The sector {apex + t·u : u·axis ≥ cos, 0 ≤ t ≤ range}. Up to 45°, the sphere through
         // the apex and the rim circle (centre range / (2 cos) along the axis) holds it; wider,
         // the sphere on the rim circle (centre range·cos along the axis, radius range·sin)

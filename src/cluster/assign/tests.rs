@@ -565,6 +565,61 @@ fn small_lights_plain_loops_match_the_general_loop() {
     assert!(small_rects > 500, "only {small_rects} small lights tried");
 }
 
+/// A spot whose axis has no direction (zero, or an infinite or NaN component: only a caller
+/// building `GpuLight`s itself can give one) is bounded by its whole sphere, as the point
+/// light of the same sphere is, and every band of slices lists it where the whole grid does:
+/// an axis normalised to NaN made the whole grid list such a spot everywhere while a band
+/// rejected it by its apex's depth, so the lists depended on where the bands were cut.
+#[test]
+fn a_spot_without_an_axis_direction_is_its_sphere_in_every_band() {
+    use super::cells::{for_each_run_in, SliceWindow};
+    for case in cases() {
+        let grid = ClusterGrid::new(320, 180, case.projection, case.near, case.far, &case.config);
+        let slices = grid.slice_slabs.len() as u32;
+        let cells = |light: &GpuLight, window: &SliceWindow| {
+            let mut cells = Vec::new();
+            for_each_run_in(&grid, window, light, case.far, &mut |start, len| {
+                cells.extend(start..start + len)
+            });
+            cells
+        };
+        // Behind the eye (reaches nothing) and in front of it (reaches cells).
+        for (position, radius) in [(Vec3::new(-6.8, -3.1, 12.7), 0.48), (Vec3::new(0.5, 0.2, -6.0), 1.5)] {
+            let point = GpuLight {
+                position,
+                radius,
+                cull_radius: radius,
+                radiance: Vec3::ONE,
+                spot_scale: 0.0,
+                direction: Vec3::ZERO,
+                spot_offset: 1.0,
+                cone_deg: (180.0, 180.0),
+            };
+            let sphere = cells(&point, &SliceWindow::ALL);
+            for direction in [
+                Vec3::ZERO,
+                Vec3::new(-0.24, 0.0, f32::NEG_INFINITY),
+                Vec3::new(f32::NAN, 0.3, -1.0),
+            ] {
+                let spot = GpuLight {
+                    spot_scale: 3.3,
+                    spot_offset: 1.5,
+                    direction,
+                    cone_deg: (60.0, 30.0),
+                    ..point
+                };
+                let what = format!("{}: axis {direction}, at {position}", case.name);
+                assert_eq!(cells(&spot, &SliceWindow::ALL), sphere, "{what}");
+                for split in 1..slices {
+                    let mut bands = cells(&spot, &SliceWindow::of(&grid, 0, split));
+                    bands.extend(cells(&spot, &SliceWindow::of(&grid, split, slices)));
+                    assert_eq!(bands, sphere, "{what}, bands split at slice {split}");
+                }
+            }
+        }
+    }
+}
+
 /// A grid of more cells than an assignment takes (here 2³² − 1, saturated: a large frame with
 /// one-pixel cells and raised limits) is not assigned: no per-cell arrays (four bytes a cell
 /// would be 16 GiB, so allocating them would abort this test), every light counted as
