@@ -179,7 +179,7 @@ pub(crate) fn for_each_run_in(
             columns,
             rows,
         };
-        let mut slice_start = cascade.first_cell + sa * slice_cells;
+        let slice_start = cascade.first_cell + sa * slice_cells;
         // A rectangle of at most 2 × 2 cells per slice has little to trim (a corner cell at
         // most) and the per-row arithmetic, or a spot's cone test, would cost more than the
         // cells it saves (a spot's bounding sphere already fits its cone).
@@ -200,47 +200,72 @@ pub(crate) fn for_each_run_in(
             }
             continue;
         }
-        // A small rectangle reaches this loop only in the tests that check the plain loops
-        // above against it (the whole rectangle, no cone): outside tests `small` is false here.
-        let coverage = if small {
-            Coverage::CascadeBox
-        } else {
-            grid.coverage
+        refine_slices(&extent, &tiles, &cone, k, sa..sb + 1, slice_start, small, emit);
+    }
+}
+
+/// The cells of slices `slices` of cascade `k` (the first starting at cell `slice_start`)
+/// for a light wider than 2 × 2 cells there (or, in the tests, a small one with `small`):
+/// the per-slice refinement of [`Coverage::SliceRows`], or the cascade's rectangle.
+///
+/// Kept out of line: inlined, its state crowded the small lights' path (the common case of
+/// many lights) out of the registers, and every light paid for the spills.
+#[inline(never)]
+#[allow(clippy::too_many_arguments)]
+fn refine_slices(
+    extent: &ScreenExtent,
+    tiles: &CascadeTiles,
+    cone: &Option<Cone>,
+    k: u32,
+    slices: std::ops::Range<u32>,
+    mut slice_start: u32,
+    small: bool,
+    emit: &mut impl FnMut(u32, u32),
+) {
+    let grid = tiles.grid;
+    let constants = tiles.constants;
+    let (columns, rows) = (tiles.columns, tiles.rows);
+    let slice_cells = tiles.tiles_x * tiles.tiles_y;
+    // A small rectangle reaches this loop only in the tests that check the plain loops
+    // above against it (the whole rectangle, no cone): outside tests `small` is false here.
+    let coverage = if small {
+        Coverage::CascadeBox
+    } else {
+        grid.coverage
+    };
+    for s in slices {
+        // A spot's cone against the slice's cells, worked out once per slice.
+        let cone = match cone {
+            Some(cone) if !small => {
+                let g = constants.first_slice + s;
+                Some(cone.slice(&grid.slice_cells(k, g, columns, rows)))
+            }
+            _ => None,
         };
-        for s in sa..sb + 1 {
-            // A spot's cone against the slice's cells, worked out once per slice.
-            let cone = match &cone {
-                Some(cone) if !small => {
-                    let g = constants.first_slice + s;
-                    Some(cone.slice(&grid.slice_cells(k, g, columns, rows)))
-                }
-                _ => None,
-            };
-            match coverage {
-                Coverage::SliceRows => {
-                    let slab = grid.slice_slabs[(constants.first_slice + s) as usize];
-                    let row_start = |row: u32| slice_start + row * cascade.tiles_x;
-                    // Two callers, so that a point light's rows take the plain emission
-                    // inlined: with the cone's test in the same closure, the compiler kept
-                    // it out of line, a call per row.
-                    match &cone {
-                        None => extent.for_each_row_run(&tiles, slab, &mut |row, x0, x1| {
-                            emit(row_start(row) + x0, x1 - x0 + 1)
-                        }),
-                        Some(_) => extent.for_each_row_run(&tiles, slab, &mut |row, x0, x1| {
-                            emit_row(emit, &cone, row_start(row), row, x0, x1)
-                        }),
-                    }
-                }
-                Coverage::CascadeBox => {
-                    for row in rows.0..rows.1 + 1 {
-                        let row_start = slice_start + row * cascade.tiles_x;
-                        emit_row(emit, &cone, row_start, row, columns.0, columns.1);
-                    }
+        match coverage {
+            Coverage::SliceRows => {
+                let slab = grid.slice_slabs[(constants.first_slice + s) as usize];
+                let row_start = |row: u32| slice_start + row * tiles.tiles_x;
+                // Two callers, so that a point light's rows take the plain emission
+                // inlined: with the cone's test in the same closure, the compiler kept
+                // it out of line, a call per row.
+                match &cone {
+                    None => extent.for_each_row_run(tiles, slab, &mut |row, x0, x1| {
+                        emit(row_start(row) + x0, x1 - x0 + 1)
+                    }),
+                    Some(_) => extent.for_each_row_run(tiles, slab, &mut |row, x0, x1| {
+                        emit_row(emit, &cone, row_start(row), row, x0, x1)
+                    }),
                 }
             }
-            slice_start += slice_cells;
+            Coverage::CascadeBox => {
+                for row in rows.0..rows.1 + 1 {
+                    let row_start = slice_start + row * tiles.tiles_x;
+                    emit_row(emit, &cone, row_start, row, columns.0, columns.1);
+                }
+            }
         }
+        slice_start += slice_cells;
     }
 }
 

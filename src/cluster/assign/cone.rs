@@ -32,8 +32,13 @@ impl Cone {
     pub fn of(light: &GpuLight, range: f64) -> Option<Cone> {
         // 1 − cos(outer) = offset / scale (see `Light::spot_scale_offset`): no trigonometry
         // per light. Cones of 89° and wider are not worth testing.
+        if light.spot_scale == 0.0 {
+            return None;
+        }
+        // After the test above: taken before it, the compiler worked the root and the
+        // division out for every point light too.
         let axis = light.direction.as_dvec3().normalize_or_zero();
-        if light.spot_scale == 0.0 || axis == glam::DVec3::ZERO {
+        if axis == glam::DVec3::ZERO {
             return None;
         }
         let cos_outer = 1.0 - light.spot_offset as f64 / light.spot_scale as f64;
