@@ -5,8 +5,9 @@
 
 mod common;
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
+use common::files::write;
 use common::gltf::Builder;
 use common::{max_oracle_error, mean, Gpu};
 use glam::Vec3;
@@ -72,12 +73,6 @@ fn meshes(primitives: Vec<Value>) -> Value {
     })
 }
 
-fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
-    let p = dir.join(name);
-    std::fs::write(&p, text).unwrap();
-    p
-}
-
 /// `--scene FILE --lights N` (`lights` 0: the file's own lights only).
 fn load(path: &Path, lights: usize) -> Result<(Scene, LoadReport), SceneError> {
     scene::load(path.to_str().unwrap(), Some((lights, 3)))
@@ -97,7 +92,7 @@ fn the_automatic_camera_keeps_the_whole_model_inside_the_frame() {
     for (name, min, max) in shapes {
         let mut b = Builder::default();
         let doc = meshes(vec![cuboid(&mut b, min, max)]);
-        let path = write(dir.path(), &format!("{name}.gltf"), &b.gltf(doc));
+        let path = write(dir.path(), &format!("{name}.gltf"), b.gltf(doc));
         let (mut s, _) = load(&path, 0).unwrap();
         // Lit by ambient alone: the model white, the background black.
         s.ambient = Vec3::ONE;
@@ -131,7 +126,7 @@ fn random_lights_light_a_flat_model_as_the_f64_model_says() {
     let dir = tempfile::tempdir().unwrap();
     let mut b = Builder::default();
     let doc = meshes(vec![floor(&mut b, 8.0)]);
-    let path = write(dir.path(), "floor.gltf", &b.gltf(doc));
+    let path = write(dir.path(), "floor.gltf", b.gltf(doc));
     let (mut s, report) = load(&path, 16).unwrap();
     assert!(report.warnings.is_empty(), "{:?}", report.warnings);
     s.ambient = Vec3::ZERO;
@@ -171,7 +166,7 @@ fn a_file_without_lights_gets_one_hint_and_one_with_lights_none() {
     let dir = tempfile::tempdir().unwrap();
     let mut b = Builder::default();
     let doc = meshes(vec![cuboid(&mut b, [0.0; 3], [1.0; 3])]);
-    let path = write(dir.path(), "dark.gltf", &b.gltf(doc));
+    let path = write(dir.path(), "dark.gltf", b.gltf(doc));
     let (_, report) = load(&path, 0).unwrap();
     let hint = format!(
         "no lights in {}: ambient only; add --lights N",
@@ -190,7 +185,7 @@ fn a_file_without_lights_gets_one_hint_and_one_with_lights_none() {
         .unwrap()
         .push(json!({"extensions": {"KHR_lights_punctual": {"light": 0}}}));
     doc["scenes"][0]["nodes"] = json!([0, 1]);
-    let path = write(dir.path(), "sunlit.gltf", &b.gltf(doc));
+    let path = write(dir.path(), "sunlit.gltf", b.gltf(doc));
     let (scene, report) = load(&path, 0).unwrap();
     assert_eq!(scene.directional_lights.len(), 1);
     assert!(report.warnings.is_empty(), "{:?}", report.warnings);
@@ -268,7 +263,7 @@ fn required_extensions_are_refused_by_name_unless_supported() {
         let mut doc = doc.clone();
         doc["extensionsUsed"] = json!([ext]);
         doc["extensionsRequired"] = json!([ext]);
-        let path = write(dir.path(), "needs.gltf", &b.gltf(doc));
+        let path = write(dir.path(), "needs.gltf", b.gltf(doc));
         let err = load(&path, 1).unwrap_err().to_string();
         let said = format!("extensionsRequired lists {ext}, which manylight does not support");
         assert!(err.contains(&said), "{err}");
@@ -282,7 +277,7 @@ fn required_extensions_are_refused_by_name_unless_supported() {
         let mut doc = doc.clone();
         doc["extensionsUsed"] = json!([ext]);
         doc["extensionsRequired"] = json!([ext]);
-        let path = write(dir.path(), "supported.gltf", &b.gltf(doc));
+        let path = write(dir.path(), "supported.gltf", b.gltf(doc));
         load(&path, 1).unwrap_or_else(|e| panic!("{ext}: {e}"));
     }
 }
@@ -325,7 +320,7 @@ fn ignored_features_are_warned_once_each_by_name() {
                         "samplers": [{"input": times, "output": moves}]}],
         "cameras": [camera],
     });
-    let path = write(dir.path(), "features.gltf", &b.gltf(doc));
+    let path = write(dir.path(), "features.gltf", b.gltf(doc));
     let (_, report) = load(&path, 1).unwrap();
     let w = &report.warnings;
     for needle in [
@@ -362,7 +357,7 @@ fn out_of_range_metallic_and_roughness_are_clamped_with_a_warning_naming_them() 
         {"pbrMetallicRoughness": {"metallicFactor": 5, "roughnessFactor": -2}},
         {"pbrMetallicRoughness": {"metallicFactor": -1, "roughnessFactor": 0.5}}
     ]);
-    let path = write(dir.path(), "factors.gltf", &b.gltf(doc));
+    let path = write(dir.path(), "factors.gltf", b.gltf(doc));
     let (scene, report) = load(&path, 1).unwrap();
     let m = &scene.materials[0];
     assert_eq!((m.metallic, m.roughness), (1.0, 0.0), "{m:?}");

@@ -6,6 +6,7 @@ mod common;
 
 use std::path::Path;
 
+use common::files::write;
 use common::{asset, Gpu};
 use glam::DMat4;
 use manylight::scene::{self, obj, Scene, SceneError};
@@ -212,12 +213,6 @@ fn a_textured_model_without_normals_gets_its_texture_and_outward_normals() {
             "channel {channel}: expected {expected:.1} from the texture, got {p:?}"
         );
     }
-}
-
-fn write(dir: &Path, name: &str, text: &str) -> std::path::PathBuf {
-    let p = dir.join(name);
-    std::fs::write(&p, text).unwrap();
-    p
 }
 
 fn load_obj(path: &Path) -> Result<(Scene, obj::LoadReport), SceneError> {
