@@ -7,12 +7,10 @@
 mod common;
 
 use common::files::{load, write};
-use common::gltf::{base64, Builder, FLOAT, UNSIGNED_SHORT};
+use common::gltf::{base64, Builder, FLOAT, UNSIGNED_BYTE, UNSIGNED_INT, UNSIGNED_SHORT};
 use common::gltf_models::{checker_png, triangle};
 use glam::{DVec3, Vec3};
 use serde_json::json;
-
-const UNSIGNED_INT: u32 = 5125;
 
 #[test]
 fn missing_normals_become_flat_ones_and_strips_unroll() {
@@ -107,7 +105,7 @@ fn indices_of_every_width_and_none_give_the_same_mesh() {
                 .iter()
                 .flat_map(|&i| i.to_le_bytes()[..width].to_vec())
                 .collect();
-            let component = [0, 5121, UNSIGNED_SHORT, 0, UNSIGNED_INT][width];
+            let component = [0, UNSIGNED_BYTE, UNSIGNED_SHORT, 0, UNSIGNED_INT][width];
             prim["indices"] = json!(b.accessor(&bytes, component, "SCALAR", list.len()));
         } else {
             // No indices: the vertices in order, two triangles' worth.

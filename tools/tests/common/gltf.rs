@@ -3,8 +3,11 @@
 
 use serde_json::{json, Value};
 
-pub const FLOAT: u32 = 5126;
+/// glTF accessor component types (`componentType`, the GL enums).
+pub const UNSIGNED_BYTE: u32 = 5121;
 pub const UNSIGNED_SHORT: u32 = 5123;
+pub const UNSIGNED_INT: u32 = 5125;
+pub const FLOAT: u32 = 5126;
 
 pub fn base64(bytes: &[u8]) -> String {
     use base64::Engine;

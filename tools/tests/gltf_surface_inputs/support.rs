@@ -9,11 +9,11 @@ use manylight::scene::shading::{self, linear_to_srgb, srgb_to_linear, Surface};
 use manylight::scene::Scene;
 use serde_json::{json, Value};
 
+use crate::common::gltf::base64;
+
 pub const W: u32 = 96;
 pub const H: u32 = 54;
-pub const FLOAT: u32 = 5126;
-pub const UNSIGNED_BYTE: u32 = 5121;
-pub const UNSIGNED_SHORT: u32 = 5123;
+pub use crate::common::gltf::{FLOAT, UNSIGNED_BYTE, UNSIGNED_SHORT};
 
 /// The plane: z = 0, x and y in [−1, 1], facing +Z; u along +x, v down the image (−y).
 const CORNERS: [[f32; 3]; 4] = [
@@ -24,11 +24,6 @@ const CORNERS: [[f32; 3]; 4] = [
 ];
 const UVS: [[f32; 2]; 4] = [[0.0, 1.0], [1.0, 1.0], [1.0, 0.0], [0.0, 0.0]];
 const TRIANGLES: [u16; 6] = [0, 1, 2, 0, 2, 3];
-
-fn b64(bytes: &[u8]) -> String {
-    use base64::Engine;
-    base64::engine::general_purpose::STANDARD.encode(bytes)
-}
 
 pub fn png(w: u32, h: u32, texels: &[[u8; 4]]) -> Vec<u8> {
     let img = image::RgbaImage::from_fn(w, h, |x, y| image::Rgba(texels[(y * w + x) as usize]));
@@ -90,7 +85,7 @@ impl Plane {
         let images: Vec<Value> = self
             .images
             .iter()
-            .map(|png| json!({"uri": format!("data:image/png;base64,{}", b64(png))}))
+            .map(|png| json!({"uri": format!("data:image/png;base64,{}", base64(png))}))
             .collect();
         let textures: Vec<Value> = (0..images.len()).map(|i| json!({"source": i})).collect();
         let mut doc = json!({
@@ -101,7 +96,7 @@ impl Plane {
             "meshes": [{"primitives": [{"attributes": attributes, "indices": i, "material": 0}]}],
             "materials": [self.material],
             "buffers": [{"byteLength": bin.len(),
-                         "uri": format!("data:application/octet-stream;base64,{}", b64(&bin))}],
+                         "uri": format!("data:application/octet-stream;base64,{}", base64(&bin))}],
             "bufferViews": views,
             "accessors": accessors,
         });
