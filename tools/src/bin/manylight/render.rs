@@ -70,9 +70,10 @@ pub struct RenderArgs {
     /// values, clipped at 1), `reinhard`, `aces` or `neutral` (Khronos PBR Neutral).
     #[arg(long, value_enum, default_value_t = ToneMapArg::None)]
     pub tonemap: ToneMapArg,
-    /// Samples per pixel (MSAA) of the offscreen image: 1 (none), 2, 4 or 8; ES 3.0, or ES 2.0
-    /// with GL_EXT_multisampled_render_to_texture; not with deferred.
-    #[arg(long, default_value_t = 1)]
+    /// Samples per pixel (MSAA) of the offscreen image: 1 (none), 2, 4, 8, or another power of
+    /// two up to the context's GL_MAX_SAMPLES; ES 3.0, or ES 2.0 with
+    /// GL_EXT_multisampled_render_to_texture; not with deferred.
+    #[arg(long, default_value_t = 1, value_parser = parse_samples)]
     pub msaa: u32,
     /// Exposure in stops (radiance × 2^EV before the tone map), within ±15.
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
@@ -161,6 +162,17 @@ pub fn parse_assign_budget(s: &str) -> Result<f64, String> {
         Ok(b) if (0.0..=1.0).contains(&b) => Ok(b),
         _ => Err(format!(
             "`{s}` is not a share of the frame from 0 to 1 (0.05: 5 %)"
+        )),
+    }
+}
+
+/// Parses `--msaa`: a power of two. GL would round any other count up to one it supports, and
+/// the stats would then name a count the picture was not drawn with.
+pub fn parse_samples(s: &str) -> Result<u32, String> {
+    match s.parse::<u32>() {
+        Ok(n) if n.is_power_of_two() => Ok(n),
+        _ => Err(format!(
+            "`{s}` is not a sample count: 1 (no MSAA) or a power of two (2, 4, 8, ...)"
         )),
     }
 }

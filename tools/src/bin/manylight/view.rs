@@ -80,7 +80,7 @@ pub struct ViewArgs {
     #[arg(long)]
     pub paused: bool,
     /// Samples per pixel to start with (M toggles between 1 and 4): ES 3.0, not deferred.
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, value_parser = crate::render::parse_samples)]
     pub msaa: u32,
 }
 
