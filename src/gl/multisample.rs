@@ -26,7 +26,10 @@ pub struct MultisampleTarget {
     color: Color,
     depth: glow::Renderbuffer,
     size: (u32, u32),
+    /// The samples asked for.
     samples: u32,
+    /// The samples the implementation gave: GL rounds a count it lacks up to one it has.
+    samples_drawn: u32,
     /// Bytes of one depth sample.
     depth_bytes: usize,
     destroyed: bool,
@@ -114,6 +117,7 @@ impl MultisampleTarget {
             depth,
             size: (width, height),
             samples,
+            samples_drawn: samples,
             depth_bytes: if dev.es() == EsVersion::Es3 || dev.caps().depth24 {
                 4
             } else {
@@ -208,6 +212,9 @@ impl MultisampleTarget {
                 target.destroy(dev);
                 return Err(GlError::FramebufferIncomplete(status));
             }
+            // At least the count asked for (a driver saying less is not believed).
+            let drawn = gl.get_parameter_i32(glow::SAMPLES);
+            target.samples_drawn = u32::try_from(drawn).unwrap_or(0).max(samples);
         }
         if let Err(e) = dev.check("multisampled target creation") {
             target.destroy(dev);
@@ -216,9 +223,14 @@ impl MultisampleTarget {
         Ok(target)
     }
 
-    /// Size in pixels and samples per pixel.
+    /// Size in pixels and samples per pixel asked for.
     pub fn shape(&self) -> ((u32, u32), u32) {
         (self.size, self.samples)
+    }
+
+    /// Samples per pixel the implementation gave (at least those asked for).
+    pub fn samples_drawn(&self) -> u32 {
+        self.samples_drawn
     }
 
     /// GPU memory of its buffers: 4 bytes of colour and 4 of depth per sample (2 of depth on
@@ -228,8 +240,8 @@ impl MultisampleTarget {
         let pixels = self.size.0 as usize * self.size.1 as usize;
         let per_sample = 4 + self.depth_bytes;
         match self.color {
-            Color::Renderbuffer(_) => pixels * self.samples as usize * per_sample,
-            Color::Texture { .. } => pixels * (self.samples as usize * per_sample + 4),
+            Color::Renderbuffer(_) => pixels * self.samples_drawn as usize * per_sample,
+            Color::Texture { .. } => pixels * (self.samples_drawn as usize * per_sample + 4),
         }
     }
 

@@ -86,7 +86,7 @@ impl Renderer {
         match rendered {
             Ok(()) => {
                 msaa.resolve(&self.dev, &mut self.programs, destination)?;
-                stats.samples = samples;
+                stats.samples = msaa.samples_drawn();
                 stats.memory.msaa_bytes = msaa.gpu_bytes();
                 Ok(())
             }

@@ -29,7 +29,8 @@ pub struct FrameStats {
     pub width: u32,
     /// Viewport height.
     pub height: u32,
-    /// Samples per pixel of the offscreen target (1: no MSAA).
+    /// Samples per pixel the frame was drawn with (1: no MSAA): what the implementation gave
+    /// for `RenderOptions::samples`, which GL rounds up to a count it has.
     pub samples: u32,
     /// Triangles drawn.
     pub triangles: usize,

@@ -83,3 +83,39 @@ fn unsupported_msaa_is_a_clear_error() {
         "{err}"
     );
 }
+
+/// GL rounds a sample count it lacks up to one it has: the stats name the count the frame was
+/// drawn with, which is what GL itself says a renderbuffer of that many samples gets.
+#[test]
+fn stats_name_the_samples_gl_gave() {
+    use manylight::glow::{self, HasContext};
+    let es = EsVersion::Es3;
+    let ctx = manylight::HeadlessContext::new(es).expect("headless ES 3.0 context");
+    let gl = ctx.load_gl();
+    let mut renderer = manylight::Renderer::new(ctx.load_gl(), es).expect("renderer");
+    let scene = scene::builtin::build("courtyard", Some((4, 1))).unwrap();
+    let max = renderer.caps().max_samples.max(0) as u32;
+    for asked in 2..=max {
+        // SAFETY: a renderbuffer of the test's own, on the current context, deleted at once.
+        let given = unsafe {
+            let rb = gl.create_renderbuffer().expect("renderbuffer");
+            gl.bind_renderbuffer(glow::RENDERBUFFER, Some(rb));
+            gl.renderbuffer_storage_multisample(
+                glow::RENDERBUFFER,
+                asked as i32,
+                glow::RGBA8,
+                4,
+                4,
+            );
+            let n =
+                gl.get_renderbuffer_parameter_i32(glow::RENDERBUFFER, glow::RENDERBUFFER_SAMPLES);
+            gl.delete_renderbuffer(rb);
+            n as u32
+        };
+        let (_, stats) = renderer
+            .render_offscreen(&scene, 16, 9, &msaa(asked))
+            .unwrap_or_else(|e| panic!("{asked} samples: {e}"));
+        assert_eq!(stats.samples, given, "{asked} samples asked");
+    }
+    renderer.destroy();
+}

@@ -166,8 +166,8 @@ pub fn parse_assign_budget(s: &str) -> Result<f64, String> {
     }
 }
 
-/// Parses `--msaa`: a power of two. GL would round any other count up to one it supports, and
-/// the stats would then name a count the picture was not drawn with.
+/// Parses `--msaa`: a power of two, the counts implementations have (GL rounds another count
+/// up to one it has).
 pub fn parse_samples(s: &str) -> Result<u32, String> {
     match s.parse::<u32>() {
         Ok(n) if n.is_power_of_two() => Ok(n),
