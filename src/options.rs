@@ -48,11 +48,11 @@ pub struct RenderOptions {
     /// Exposure in stops: radiance is multiplied by 2^`exposure_ev` before the tone map.
     /// Within ±15 (2^15 is what fp16 holds, on devices without fragment highp).
     pub exposure_ev: f32,
-    /// Samples per pixel: 1 (the default) for none, up to `GL_MAX_SAMPLES` for MSAA (a count the
-    /// implementation lacks is rounded up by GL: `FrameStats::samples` says what it drew). The frame
-    /// is drawn into the renderer's multisampled target and resolved into the framebuffer
-    /// that was bound (ES 3.0; forward, tiled, clustered and auto; not deferred, not HDR output;
-    /// light counts are never multisampled).
+    /// Samples per pixel: 1 (the default) or 0 for none, up to `GL_MAX_SAMPLES` for MSAA (GL
+    /// rounds a count the implementation lacks up: `FrameStats::samples` says what it drew).
+    /// The frame is drawn into the renderer's multisampled target and resolved into the
+    /// framebuffer that was bound (ES 3.0; forward, tiled, clustered and auto; not deferred, not
+    /// HDR output; light counts are never multisampled).
     pub samples: u32,
     /// Knobs for measuring and testing the renderer (timed frames, forced encodings, caps that
     /// exercise the overflow policy); a game leaves them at their defaults.
