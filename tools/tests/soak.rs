@@ -249,8 +249,8 @@ const CASE: Case = Case {
 
 /// Jobs rayon's global job queue (crossbeam's `Injector`) holds per block: every this many
 /// entries into the pool from outside it, it allocates a block. Whether an assignment enters
-/// the pool depends on the host (its time on the previous frame: a slow or busy CPU sends even
-/// 16 lights there), so every case allows these blocks, at most one per this many entries.
+/// the pool depends on the host (its time on the previous frame, which a slow or busy CPU makes
+/// long with few lights), so every case allows these blocks, at most one per this many entries.
 const RAYON_INJECTOR_BLOCK: usize = 63;
 
 /// Entries into rayon's pool a frame can make: its assignment, and a candidate grid's of the
