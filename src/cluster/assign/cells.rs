@@ -200,25 +200,23 @@ pub(crate) fn for_each_run_in(
             }
             continue;
         }
-        refine_slices(&extent, &tiles, &cone, k, sa..sb + 1, slice_start, small, emit);
+        refine_slices(&extent, &tiles, &cone, k, sa..sb + 1, small, emit);
     }
 }
 
-/// The cells of slices `slices` of cascade `k` (the first starting at cell `slice_start`)
-/// for a light wider than 2 × 2 cells there (or, in the tests, a small one with `small`):
+/// The cells of slices `slices` of cascade `k` (numbered within it) for a light wider than
+/// 2 × 2 cells there (or, in the tests, a small one with `small`):
 /// the per-slice refinement of [`Coverage::SliceRows`], or the cascade's rectangle.
 ///
 /// Kept out of line: inlined, its state crowded the small lights' path (the common case of
 /// many lights) out of the registers, and every light paid for the spills.
 #[inline(never)]
-#[allow(clippy::too_many_arguments)]
 fn refine_slices(
     extent: &ScreenExtent,
     tiles: &CascadeTiles,
     cone: &Option<Cone>,
     k: u32,
     slices: std::ops::Range<u32>,
-    mut slice_start: u32,
     small: bool,
     emit: &mut impl FnMut(u32, u32),
 ) {
@@ -226,6 +224,7 @@ fn refine_slices(
     let constants = tiles.constants;
     let (columns, rows) = (tiles.columns, tiles.rows);
     let slice_cells = tiles.tiles_x * tiles.tiles_y;
+    let mut slice_start = grid.cascades[k as usize].first_cell + slices.start * slice_cells;
     // A small rectangle reaches this loop only in the tests that check the plain loops
     // above against it (the whole rectangle, no cone): outside tests `small` is false here.
     let coverage = if small {

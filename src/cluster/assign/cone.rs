@@ -35,8 +35,8 @@ impl Cone {
         if light.spot_scale == 0.0 {
             return None;
         }
-        // After the test above: taken before it, the compiler worked the root and the
-        // division out for every point light too.
+        // Normalised only once the light is known to be a spot: point lights skip the root
+        // and the division.
         let axis = light.direction.as_dvec3().normalize_or_zero();
         if axis == glam::DVec3::ZERO {
             return None;
