@@ -8,6 +8,7 @@
 pub mod assign;
 pub mod auto_grid;
 pub mod grid;
+pub(crate) mod headroom;
 pub(crate) mod min_max;
 pub mod pack;
 pub mod tiles;

@@ -9,20 +9,28 @@ mod balance_tests;
 
 use super::cells::{for_each_run_in, SliceWindow};
 use super::index_list::{EntriesMut, LightIndex};
-use super::headroom::{clear_with_headroom, room_for};
-use super::types::{Assignment, Run, Totals};
+use crate::cluster::headroom::{clear_with_room_for, room_for, share_of};
+use super::types::{Assignment, Run, Totals, PARALLEL_SECONDS};
 use crate::cluster::grid::ClusterGrid;
 use crate::cluster::view_light::GpuLight;
 
 /// The bands and their buffers, kept between frames.
 #[derive(Default)]
 pub(super) struct Bands {
+    /// Every band made so far; the first `active` are the last split's. A band left out of a
+    /// split keeps its buffers for when it is needed again.
     bands: Vec<Band>,
+    active: usize,
     /// Per light: its visible number (phase 2, several bands).
     numbers: Vec<u32>,
 }
 
 impl Bands {
+    /// The last split's bands.
+    fn active(&self) -> &[Band] {
+        &self.bands[..self.active]
+    }
+
     /// Cuts the grid's slices into at most `threads` non-empty bands of about equal work.
     ///
     /// The work is what the last assignment measured when it was to a grid of as many cells
@@ -37,14 +45,18 @@ impl Bands {
         let slices = grid.slice_slabs.len() as u32;
         let threads = threads.clamp(1, slices.max(1) as usize);
         let previous = out;
-        let timed = self.bands.len() == threads
+        let last = &self.bands[..self.active];
+        let timed = last.len() == threads
             && threads > 1
             && previous.offsets.len() == cells
-            && self.bands.last().and_then(|b| b.window).map(|w| w.end) == Some(slices)
-            && self.bands.iter().all(|b| b.seconds > 0.0);
+            && last.last().and_then(|b| b.window).map(|w| w.end) == Some(slices)
+            && last.iter().all(|b| b.seconds > 0.0)
+            // Below this, timer noise and a worker's waking outweigh the work: a split by
+            // such times would jump from frame to frame (and the bands' buffers with it).
+            && last.iter().map(|b| b.seconds).sum::<f64>() >= PARALLEL_SECONDS;
         let by_indices = previous.offsets.len() == cells && !previous.indices.is_empty();
         // Seconds per cell of each band's cells, from the last split.
-        let density: [(usize, usize, f64); 8] = std::array::from_fn(|b| match self.bands.get(b) {
+        let density: [(usize, usize, f64); 8] = std::array::from_fn(|b| match last.get(b) {
             Some(band) if timed => (
                 band.first_cell,
                 band.end_cell,
@@ -72,7 +84,9 @@ impl Bands {
             }
         };
         let total = work_before(cells);
-        self.bands.resize_with(threads, Band::default);
+        if self.bands.len() < threads {
+            self.bands.resize_with(threads, Band::default);
+        }
         let (mut first, mut used) = (0u32, 0usize);
         for t in 0..threads {
             if first >= slices {
@@ -97,7 +111,7 @@ impl Bands {
             used += 1;
             first = end;
         }
-        self.bands.truncate(used);
+        self.active = used;
     }
 
     /// Phases 1 to 3 over at most `threads` bands (in parallel when more than one: called
@@ -110,10 +124,22 @@ impl Bands {
         out: &mut Assignment,
         threads: usize,
     ) -> Totals {
+        // The last assignment's runs and listed lights over all bands, before the split
+        // moves the bands' borders.
+        let last_runs: usize = self.active().iter().map(|b| b.runs.len()).sum();
+        let last_lights: usize = self.active().iter().map(|b| b.lights.len()).sum();
         self.split(grid, threads, out);
-        let parallel = self.bands.len() > 1;
+        let parallel = self.active > 1;
+        // Each band keeps room for its share of them (`share_of`, of the threads asked for:
+        // how many bands a split makes varies), so a border that moves with the work does not
+        // make a band grow frame after frame; the bands this split leaves out too, so a band
+        // taken again later does not grow either.
+        let (runs_share, lights_share) = (share_of(last_runs, threads), share_of(last_lights, threads));
+        for band in &mut self.bands {
+            band.clear_with_room(runs_share, lights_share);
+        }
         let cells = grid.total_cells as usize;
-        let bands = &mut self.bands[..];
+        let bands = &mut self.bands[..self.active];
         // Phase 1, its difference counts straight into the counts' array (phase 2 sums them
         // in place: one cold array less than a separate one).
         room_for(&mut out.counts, cells);
@@ -186,6 +212,15 @@ struct Band {
 }
 
 impl Band {
+    /// Empties the band's runs and lights for a new assignment, with room for at least
+    /// `runs` and `lights` of them (and the per-light arrays for as many lights).
+    fn clear_with_room(&mut self, runs: usize, lights: usize) {
+        clear_with_room_for(&mut self.runs, runs);
+        clear_with_room_for(&mut self.lights, lights);
+        room_for(&mut self.ids, self.lights.capacity());
+        room_for(&mut self.cursors, self.lights.capacity());
+    }
+
     /// Phase 1: the band's runs of every light, and into `deltas` (the band's cells' part of
     /// the counts) their difference counts: `+1` where a run starts and `−1` (wrapping) where
     /// it ends, so a run costs two additions whatever its length and the running sum over
@@ -202,8 +237,6 @@ impl Band {
         let first = self.first_cell as u32;
         deltas.fill(0);
         let cells = deltas.len() as u32;
-        clear_with_headroom(&mut self.runs);
-        clear_with_headroom(&mut self.lights);
         let runs = &mut self.runs;
         for (i, light) in lights.iter().enumerate() {
             let before = runs.len();

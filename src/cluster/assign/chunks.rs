@@ -6,7 +6,7 @@ use rayon::prelude::*;
 
 use super::cells::for_each_run;
 use super::index_list::{EntriesMut, IndexList, LightIndex};
-use super::headroom::{clear_with_headroom, room_for};
+use crate::cluster::headroom::{clear_with_room_for, room_for, share_of};
 use super::types::{Assignment, Run, Totals};
 use crate::cluster::grid::ClusterGrid;
 use crate::cluster::view_light::GpuLight;
@@ -38,13 +38,20 @@ impl Chunks {
         // Fewer chunks than threads when lights are few (49 lights in chunks of 7 make 7, not
         // 8): a chunk past the last would keep an earlier frame's runs.
         let chunks = lights.len().div_ceil(chunk_len);
+        // Each chunk keeps room for its share (`share_of`) of the last assignment's runs and
+        // visible lights: which chunk's lights are in view changes with the camera, and a
+        // chunk would otherwise grow at each new peak of its own.
+        let last_runs: usize = self.chunks.iter().map(|k| k.runs.len()).sum();
+        let last_visible: usize = self.chunks.iter().map(|k| k.visible.len()).sum();
+        let share = |total: usize| share_of(total, chunks);
+        let shares = (share(last_runs), share(last_visible));
         self.chunks.resize_with(chunks, Chunk::default);
         self.chunks.truncate(chunks);
         self.chunks
             .par_iter_mut()
             .zip(lights.par_chunks(chunk_len))
             .for_each(|(chunk, part)| {
-                chunk.find(grid, part, camera_far);
+                chunk.find(grid, part, camera_far, shares);
                 chunk.prefix();
             });
         // Phase 2: the visible lights (numbered chunk after chunk: each chunk listed its own
@@ -115,14 +122,21 @@ struct Chunk {
 }
 
 impl Chunk {
-    /// Phase 1: the runs of `lights` and their per-cell difference counts.
-    fn find(&mut self, grid: &ClusterGrid, lights: &[GpuLight], camera_far: f64) {
+    /// Phase 1: the runs of `lights` and their per-cell difference counts. `shares`: the
+    /// runs and visible lights the chunk keeps room for at least.
+    fn find(
+        &mut self,
+        grid: &ClusterGrid,
+        lights: &[GpuLight],
+        camera_far: f64,
+        (runs_share, visible_share): (usize, usize),
+    ) {
         room_for(&mut self.deltas, grid.total_cells as usize + 1);
         self.deltas.clear();
         self.deltas.resize(grid.total_cells as usize + 1, 0);
-        clear_with_headroom(&mut self.runs);
+        clear_with_room_for(&mut self.runs, runs_share);
         self.ends.clear();
-        clear_with_headroom(&mut self.visible);
+        clear_with_room_for(&mut self.visible, visible_share);
         let (deltas, runs) = (&mut self.deltas, &mut self.runs);
         for (i, light) in lights.iter().enumerate() {
             let before = runs.len();

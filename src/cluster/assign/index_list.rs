@@ -7,7 +7,7 @@
 //! renderer refuses but the CPU-only uses (`bench-assign` at a million lights) reach. Both
 //! buffers are kept, so a list that changes width allocates nothing once both have grown.
 
-use super::headroom::room_for;
+use crate::cluster::headroom::room_for;
 
 /// Every cell's lights, cell after cell: positions in
 /// [`Assignment::visible`](crate::cluster::assign::Assignment::visible), 16-bit when there are at most 65 536 visible

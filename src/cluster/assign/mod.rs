@@ -42,7 +42,6 @@
 pub(super) mod bands;
 pub mod cells;
 mod chunks;
-mod headroom;
 mod cone;
 pub mod index_list;
 mod overflow;

@@ -1,0 +1,73 @@
+//! Buffers that keep room to spare, so that frames stop allocating once each buffer has seen
+//! its peak (soak test: no allocation per frame in steady state, on any number of cores): the
+//! assignment's and the packed textures' bytes.
+
+/// The least room one of `parts` bands or chunks keeps for the runs or lights of the last
+/// assignment's `total`: four even shares, and all of them with up to four parts or while they
+/// are few (4 096 runs are 32 KiB). A band's borders follow the measured work, which a busy or
+/// slow core moves from frame to frame (a phone's little core takes fewer cells), and which
+/// lights are in view moves a chunk's share; with room for a quarter more than this, a part
+/// grows only when the whole assignment outgrows its last peak.
+pub(crate) fn share_of(total: usize, parts: usize) -> usize {
+    (4 * total / parts.max(1)).max(4096).min(total)
+}
+
+/// Empties `buffer` for a new frame, keeping room for a quarter more than it held or than
+/// `share` (a band's or chunk's share of the whole assignment, which moves between them from
+/// frame to frame), whichever is more: a buffer whose size wanders with moving lights then
+/// stops allocating once it has seen its peak, also on many cores where each worker's buffer
+/// has a peak of its own.
+pub(crate) fn clear_with_room_for<T>(buffer: &mut Vec<T>, share: usize) {
+    let len = buffer.len().max(share);
+    buffer.clear();
+    // Grown by half again when it grows, so the peaks of a wandering size stop allocating.
+    room_for(buffer, len + len / 4);
+}
+
+/// Makes room in `buffer` for `len` elements, by half again when it must grow, so a grid a
+/// little finer than any before (the automatic grid's next choice) does not allocate again.
+pub(crate) fn room_for<T>(buffer: &mut Vec<T>, len: usize) {
+    if buffer.capacity() < len {
+        buffer.reserve((len + len / 2).saturating_sub(buffer.len()));
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_frame_up_to_a_quarter_larger_than_the_last_or_its_share_does_not_allocate() {
+        let mut runs: Vec<u32> = (0..1000).collect();
+        clear_with_room_for(&mut runs, 0);
+        let capacity = runs.capacity();
+        assert!(capacity >= 1250, "{capacity}");
+        runs.extend(0..1250);
+        assert_eq!(runs.capacity(), capacity, "grew within its headroom");
+        // A band that held little keeps room for its share of the whole.
+        let mut band: Vec<u32> = (0..10).collect();
+        clear_with_room_for(&mut band, 1000);
+        assert!(band.capacity() >= 1250, "{}", band.capacity());
+    }
+
+    #[test]
+    fn a_share_is_all_with_few_parts_or_runs_else_four_even_shares() {
+        assert_eq!(share_of(100_000, 2), 100_000);
+        assert_eq!(share_of(100_000, 4), 100_000);
+        assert_eq!(share_of(100_000, 8), 50_000);
+        assert_eq!(share_of(3000, 8), 3000);
+        assert_eq!(share_of(20_000, 8), 10_000);
+        assert_eq!(share_of(0, 0), 0);
+    }
+
+    #[test]
+    fn a_grid_up_to_half_again_as_fine_does_not_allocate() {
+        let mut cells: Vec<u32> = Vec::new();
+        room_for(&mut cells, 1000);
+        let capacity = cells.capacity();
+        assert!(capacity >= 1500, "{capacity}");
+        room_for(&mut cells, 1400);
+        cells.resize(1400, 0);
+        assert_eq!(cells.capacity(), capacity);
+    }
+}

@@ -1,0 +1,162 @@
+//! An assigner's buffers stop growing after a warm-up on any number of workers: frames of
+//! moving lights reuse every buffer however the work is split (bands of slices, chunks of
+//! lights) and however the split moves from frame to frame. The soak test checks the same
+//! rule for whole frames, but the 2-core CI host's renderer keeps small scenes on one thread;
+//! here every assignment runs on a pool of 2, 4 or 8 workers (as many of those as the host
+//! has cores for).
+
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+
+use manylight::cluster::assign::{AssignLimits, Assigner};
+use manylight::cluster::grid::GridConfig;
+use manylight::cluster::view_light::GpuLight;
+use manylight_tools::workload::AssignWorkload;
+
+/// The system allocator, counting the calls that allocate while [`COUNTING`] is set (on every
+/// thread: this binary runs one test, and its pool's workers are the assignment's).
+struct Counting;
+
+static COUNTING: AtomicBool = AtomicBool::new(false);
+static CALLS: AtomicUsize = AtomicUsize::new(0);
+
+thread_local! {
+    /// This thread is printing a backtrace: what that allocates is not counted.
+    static IN_TRACE: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+}
+/// With `MANYLIGHT_ALLOC_TRACE` set (any value), every counted call prints its backtrace.
+static TRACE: AtomicBool = AtomicBool::new(false);
+
+fn count() {
+    if COUNTING.load(Ordering::Relaxed) && !IN_TRACE.try_with(|t| t.get()).unwrap_or(true) {
+        CALLS.fetch_add(1, Ordering::Relaxed);
+        if TRACE.load(Ordering::Relaxed) {
+            IN_TRACE.with(|t| t.set(true));
+            eprintln!("ALLOC {}", std::backtrace::Backtrace::force_capture());
+            IN_TRACE.with(|t| t.set(false));
+        }
+    }
+}
+
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        count();
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
+        count();
+        unsafe { System.alloc_zeroed(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        unsafe { System.dealloc(ptr, layout) }
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        count();
+        unsafe { System.realloc(ptr, layout, new_size) }
+    }
+}
+
+#[global_allocator]
+static ALLOCATOR: Counting = Counting;
+
+/// Frames before counting (as the soak test's warm-up), and frames counted.
+const WARM_UP: usize = 40;
+const MEASURED: usize = 100;
+
+/// Moves every light of `start` for `frame`: each on its own orbit in view x and depth, so
+/// the lights' work moves between slices (the bands' borders follow it) and in and out of view
+/// (a chunk's share of the runs changes). Every orbit repeats within the warm-up: the whole
+/// assignment's peak is in it, and only where the work is split differs afterwards.
+fn move_lights(lights: &mut [GpuLight], start: &[GpuLight], frame: usize) {
+    for (i, (light, from)) in lights.iter_mut().zip(start).enumerate() {
+        let turns = (1 + i % 3) as f32 * frame as f32 / WARM_UP as f32;
+        let phase = std::f32::consts::TAU * turns + i as f32;
+        let depth = -from.position.z;
+        light.position.x = from.position.x + 0.3 * depth * phase.sin();
+        light.position.z = -depth * (1.0 + 0.6 * phase.cos());
+    }
+}
+
+/// Allocations in the counted frames of moving lights assigned by one assigner on `pool`,
+/// every assignment on the pool.
+fn allocations(workload: &AssignWorkload, pool: &rayon::ThreadPool) -> usize {
+    let limits = AssignLimits {
+        cell_cap: u32::MAX,
+        parallel_threshold: 0,
+        ..AssignLimits::default()
+    };
+    // Inside the pool: an entry from outside would queue a job in rayon's global queue,
+    // which allocates a block now and then (the soak test tells those apart).
+    pool.install(|| {
+        let mut assigner = Assigner::new();
+        let mut lights = workload.lights.clone();
+        let mut before = 0;
+        for frame in 0..WARM_UP + MEASURED {
+            move_lights(&mut lights, &workload.lights, frame);
+            if frame == WARM_UP {
+                before = CALLS.load(Ordering::Relaxed);
+                COUNTING.store(true, Ordering::Relaxed);
+            }
+            let a = assigner.assign(&workload.grid, &lights, workload.far, &limits);
+            assert!(a.stats.threads > 1, "frame {frame} ran on one thread");
+        }
+        COUNTING.store(false, Ordering::Relaxed);
+        CALLS.load(Ordering::Relaxed) - before
+    })
+}
+
+#[test]
+fn moving_lights_on_two_to_eight_workers_allocate_nothing_after_a_warm_up() {
+    let fixed = |px: f64| move |_: f64, _: f64| GridConfig::fixed(px);
+    let workloads = [
+        // More cells than lights: bands of slices.
+        (
+            "bands, 128 lights",
+            AssignWorkload::view_with(128, 3, (256, 144), fixed(16.0)),
+        ),
+        (
+            "bands, 2 048 lights",
+            AssignWorkload::view_with(2048, 3, (640, 360), fixed(16.0)),
+        ),
+        // More lights than cells: chunks of lights.
+        (
+            "chunks, 512 lights",
+            AssignWorkload::view_with(512, 3, (48, 27), fixed(32.0)),
+        ),
+    ];
+    // Made once and kept to the end: a worker starting or ending (a dropped pool's) allocates
+    // on its own thread, whenever the system runs it.
+    // No more workers than cores (but two): on fewer cores the workers preempt one another, so
+    // each band's measured time, and the split that follows it, is noise, which no device
+    // running a pool of its own size sees.
+    let cores = std::thread::available_parallelism().map_or(2, |n| n.get());
+    let pools: Vec<rayon::ThreadPool> = [2, 4, 8]
+        .into_iter()
+        .filter(|&threads| threads <= cores.max(2))
+        .map(|threads| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .expect("a thread pool");
+            // Every worker started before any counting.
+            pool.broadcast(|_| ());
+            pool
+        })
+        .collect();
+    let mut failures = Vec::new();
+    TRACE.store(
+        std::env::var_os("MANYLIGHT_ALLOC_TRACE").is_some(),
+        Ordering::Relaxed,
+    );
+    for (name, workload) in &workloads {
+        for pool in &pools {
+            let threads = pool.current_num_threads();
+            let n = allocations(workload, pool);
+            eprintln!("{name}, {threads} workers: {n} allocations in {MEASURED} frames");
+            if n > 0 {
+                failures.push(format!("{name}, {threads} workers: {n} allocations"));
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
