@@ -54,8 +54,6 @@ pub(crate) struct AutoGrid {
     /// Ray caster of the scene's geometry, with the identity of the meshes and transforms it
     /// was built from.
     caster: Option<(GeometryKey, SceneRaycaster)>,
-    /// Spare buffers for the candidates' assignments.
-    assigner: Assigner,
     /// The frame rendered and not yet observed.
     pending: Option<FrameCost>,
     /// The current frame measured a candidate: its time holds the candidate's assignment (and
@@ -81,12 +79,18 @@ impl AutoGrid {
     /// or the lights moved, the period passed, the costs got calibrated) only refine a grid
     /// that works: they measure one candidate per frame, so no frame pays for many
     /// assignments, and switch when the last is measured.
+    ///
+    /// The candidates are assigned with `assigner`, the frame's own: its buffers then
+    /// already fit whichever candidate is adopted, so a switch to a finer grid does not grow
+    /// them (and no second set of buffers is kept). Its last assignment is a candidate's until
+    /// the frame assigns.
     pub(crate) fn config(
         &mut self,
         ctx: &FrameContext,
         projection: GridProjection,
         limits: &AssignLimits,
         encoding: GridEncoding,
+        assigner: &mut Assigner,
     ) -> &GridChoice {
         let layout = Layout {
             size: ctx.viewport,
@@ -112,7 +116,7 @@ impl AutoGrid {
             self.search.start(&inputs, &self.samples);
             while !self
                 .search
-                .step(&inputs, &self.samples, &self.costs, &mut self.assigner)
+                .step(&inputs, &self.samples, &self.costs, assigner)
             {}
             self.conclude(&inputs, layout, ctx);
             self.chose_this_frame = true;
@@ -137,7 +141,7 @@ impl AutoGrid {
         if self.chose_this_frame
             && self
                 .search
-                .step(&inputs, &self.samples, &self.costs, &mut self.assigner)
+                .step(&inputs, &self.samples, &self.costs, assigner)
         {
             self.conclude(&inputs, layout, ctx);
         }
@@ -177,7 +181,13 @@ impl AutoGrid {
                 current.candidates.extend_from_slice(&new.candidates);
             }
             Some(current) => std::mem::swap(current, new),
-            None => self.choice = Some(new.clone()),
+            None => {
+                // With the scratch's room, so that swapping the two later allocates nothing.
+                let mut first = new.clone();
+                first.reason.reserve(auto_grid::REASON_CAPACITY - first.reason.len().min(auto_grid::REASON_CAPACITY));
+                first.candidates.reserve(new.candidates.capacity() - first.candidates.len());
+                self.choice = Some(first);
+            }
         }
         if self.layout.as_ref() != Some(&layout) {
             self.layout = Some(layout);

@@ -9,6 +9,10 @@ use super::costs::{assign_work, GridCosts};
 use crate::cluster::assign::Assigner;
 use crate::cluster::grid::{ClusterGrid, GridConfig};
 
+/// Bytes a choice's reason keeps room for: more than its longest (about 400 with realistic
+/// numbers), with a prefix when the current grid is kept.
+pub(crate) const REASON_CAPACITY: usize = 1024;
+
 /// A search over the candidate footprints, coarse to fine, kept between frames (its buffers
 /// and its scratch grid are reused by the next search).
 #[derive(Default)]
@@ -50,6 +54,7 @@ impl ChoiceSearch {
         {
             self.footprints.insert(0, self.footprints[0] * 2.0);
         }
+        self.candidates.reserve(self.footprints.len());
     }
 
     /// Whether a started search has candidates left to measure.
@@ -167,6 +172,8 @@ impl ChoiceSearch {
             },
         };
         out.reason.clear();
+        // Room for any reason (its numbers' widths vary), so a re-choice allocates nothing.
+        out.reason.reserve(REASON_CAPACITY);
         let _ = write!(
             out.reason,
             "auto: {} px predicted {:.2} ms ({:.1} evaluations per pixel, {} cells, {} indices) \
@@ -216,6 +223,7 @@ impl ChoiceSearch {
             ..inputs.base.clone()
         };
         out.candidates.clear();
+        out.candidates.reserve(self.footprints.len());
         out.candidates.extend_from_slice(&self.candidates);
     }
 

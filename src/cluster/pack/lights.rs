@@ -35,6 +35,7 @@ use glam::Vec3;
 
 use crate::scene::light::{half_sine, spot_terms_from_half_sines};
 use crate::cluster::view_light::GpuLight;
+use crate::cluster::headroom::room_for;
 
 /// Width in texels of every data texture (a power of two ≤ 1024: exact under mediump math).
 pub const DATA_TEXTURE_WIDTH: u32 = 1024;
@@ -123,8 +124,11 @@ pub fn pack_lights_into(lights: &[GpuLight], encoding: LightEncoding, packed: &m
     let width = DATA_TEXTURE_WIDTH as usize;
     let height = (lights.len() * tpl).div_ceil(width).max(1);
     let bytes = &mut packed.bytes;
+    let len = width * height * encoding.bytes_per_texel();
     bytes.clear();
-    bytes.resize(width * height * encoding.bytes_per_texel(), 0);
+    // The visible lights wander with the view: half again when it grows.
+    room_for(bytes, len);
+    bytes.resize(len, 0);
     let pos_range = lights
         .iter()
         .map(|l| l.position.abs().max_element())

@@ -16,6 +16,8 @@ pub(super) struct Assign {
     /// `FrameStats::overflowed_lights` counts every frame's dropped references; the log says
     /// it once.
     warned_overflow: bool,
+    /// The assigner's last assignment is an automatic grid candidate's, not a frame's.
+    holds_candidate: bool,
 }
 
 /// A frame's assignment and how long it took.
@@ -35,6 +37,7 @@ impl Assign {
         limits: &AssignLimits,
     ) -> Result<Assigned<'_>, Error> {
         let started = Instant::now();
+        self.holds_candidate = false;
         let assignment = self.assigner.assign(grid, ctx.lights, ctx.far, limits);
         let ms = started.elapsed().as_secs_f64() * 1e3;
         let dropped = assignment.stats.overflowed_lights;
@@ -46,9 +49,16 @@ impl Assign {
         Ok(Assigned { assignment, ms })
     }
 
-    /// The last frame's assignment.
-    pub(super) fn last(&self) -> &Assignment {
-        self.assigner.assignment()
+    /// The last frame's assignment; `None` when an automatic grid's candidate was assigned
+    /// since (a frame that failed before its own assignment).
+    pub(super) fn last(&self) -> Option<&Assignment> {
+        (!self.holds_candidate).then(|| self.assigner.assignment())
+    }
+
+    /// The assigner, for the automatic grid's candidates: they share the frame's buffers.
+    pub(super) fn assigner_mut(&mut self) -> &mut Assigner {
+        self.holds_candidate = true;
+        &mut self.assigner
     }
 }
 

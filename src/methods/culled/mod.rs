@@ -137,7 +137,7 @@ impl ShadingMethod for CulledForward {
     }
 
     fn light_lists(&self) -> Option<super::LightLists<'_>> {
-        Some((&self.grid.as_ref()?.1, self.assign.last()))
+        Some((&self.grid.as_ref()?.1, self.assign.last()?))
     }
 
     /// GPU bytes of all ring sets.

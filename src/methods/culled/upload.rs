@@ -5,6 +5,7 @@ use std::time::Instant;
 
 use crate::cluster::assign::Assignment;
 use crate::cluster::grid::ClusterGrid;
+use crate::cluster::headroom::room_for;
 use crate::cluster::pack::{pack_lights_into, LightEncoding, PackedLights};
 use crate::cluster::view_light::GpuLight;
 use crate::cluster::pack::{pack_grid_into, pack_indices_into, GridEncoding, PackedTexels};
@@ -103,6 +104,7 @@ impl Uploads {
         let dev = ctx.dev;
         let started = Instant::now();
         self.visible.clear();
+        room_for(&mut self.visible, assignment.visible.len());
         self.visible
             .extend(assignment.visible.iter().map(|&i| ctx.lights[i as usize]));
         let encoding = ctx.features.light_encoding();
