@@ -9,8 +9,11 @@
 /// lights are in view moves a chunk's share; with room for a quarter more than this, a part
 /// grows only when the whole assignment outgrows its last peak.
 pub(crate) fn share_of(total: usize, parts: usize) -> usize {
-    (4 * total / parts.max(1)).max(4096).min(total)
+    (4 * total / parts.max(1)).max(WHOLE_UP_TO).min(total)
 }
+
+/// Entries a part keeps room for all of, whatever its share: 32 KiB of runs.
+pub(crate) const WHOLE_UP_TO: usize = 4096;
 
 /// Empties `buffer` for a new frame, keeping room for a quarter more than it held or than
 /// `share` (a band's or chunk's share of the whole assignment, which moves between them from

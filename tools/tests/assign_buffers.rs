@@ -27,12 +27,15 @@ thread_local! {
 /// With `MANYLIGHT_ALLOC_TRACE` set (any value), every counted call prints its backtrace.
 static TRACE: AtomicBool = AtomicBool::new(false);
 
-fn count() {
+fn count(bytes: usize) {
     if COUNTING.load(Ordering::Relaxed) && !IN_TRACE.try_with(|t| t.get()).unwrap_or(true) {
         CALLS.fetch_add(1, Ordering::Relaxed);
         if TRACE.load(Ordering::Relaxed) {
             IN_TRACE.with(|t| t.set(true));
-            eprintln!("ALLOC {}", std::backtrace::Backtrace::force_capture());
+            eprintln!(
+                "allocation of {bytes} bytes:\n{}",
+                std::backtrace::Backtrace::force_capture()
+            );
             IN_TRACE.with(|t| t.set(false));
         }
     }
@@ -40,18 +43,18 @@ fn count() {
 
 unsafe impl GlobalAlloc for Counting {
     unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        count();
+        count(layout.size());
         unsafe { System.alloc(layout) }
     }
     unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
-        count();
+        count(layout.size());
         unsafe { System.alloc_zeroed(layout) }
     }
     unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
         unsafe { System.dealloc(ptr, layout) }
     }
     unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        count();
+        count(new_size);
         unsafe { System.realloc(ptr, layout, new_size) }
     }
 }

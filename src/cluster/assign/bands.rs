@@ -9,7 +9,7 @@ mod balance_tests;
 
 use super::cells::{for_each_run_in, SliceWindow};
 use super::index_list::{EntriesMut, LightIndex};
-use crate::cluster::headroom::{clear_with_room_for, room_for, share_of};
+use crate::cluster::headroom::{clear_with_room_for, room_for, share_of, WHOLE_UP_TO};
 use super::types::{Assignment, Run, Totals, PARALLEL_SECONDS};
 use crate::cluster::grid::ClusterGrid;
 use crate::cluster::view_light::GpuLight;
@@ -134,7 +134,11 @@ impl Bands {
         // how many bands a split makes varies), so a border that moves with the work does not
         // make a band grow frame after frame; the bands this split leaves out too, so a band
         // taken again later does not grow either.
-        let (runs_share, lights_share) = (share_of(last_runs, threads), share_of(last_lights, threads));
+        // A band lists a light once at most, but the bands together list a light once per
+        // band it reaches, which depends on where the borders are: while the lights are few,
+        // room for every one of them in each band.
+        let runs_share = share_of(last_runs, threads);
+        let lights_share = share_of(last_lights, threads).max(lights.len().min(WHOLE_UP_TO));
         for band in &mut self.bands {
             band.clear_with_room(runs_share, lights_share);
         }

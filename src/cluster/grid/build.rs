@@ -4,6 +4,7 @@
 
 use super::tables::{CascadeConstants, SliceLookup};
 use super::{Cascade, ClusterGrid, DepthMapping, GridConfig, GridProjection, SLICE_WIDEN};
+use crate::cluster::headroom::room_for;
 
 impl ClusterGrid {
     /// Builds the grid. `depth_range` is the span of view depths the scene can occupy
@@ -154,9 +155,13 @@ impl ClusterGrid {
             }
             GridProjection::Orthographic { .. } => [1.0; 2],
         };
+        // Per-slice arrays with room for the most slices these settings allow (a few
+        // kilobytes): the automatic grid rebuilds a grid for finer and coarser footprints,
+        // and a finer one than any before would otherwise grow them in a later frame.
+        let most_slices = (c * config.max_slices.clamp(1, 255)) as usize;
         let mut lookup = std::mem::take(&mut self.slice_lookup);
         if mapping == DepthMapping::Log2 {
-            lookup.rebuild(self.slice_starts(), self.far);
+            lookup.rebuild(self.slice_starts(), most_slices, self.near, self.far);
         } else {
             lookup.clear();
         }
@@ -165,9 +170,11 @@ impl ClusterGrid {
         self.build_cascade_constants(&mut constants);
         self.cascade_constants = constants;
         let mut frusta = std::mem::take(&mut self.slice_frusta);
+        room_for(&mut frusta, most_slices);
         self.build_slice_frusta(&mut frusta);
         self.slice_frusta = frusta;
         let mut slabs = std::mem::take(&mut self.slice_slabs);
+        room_for(&mut slabs, most_slices);
         self.build_slice_slabs(&mut slabs);
         self.slice_slabs = slabs;
     }

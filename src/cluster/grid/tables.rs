@@ -18,6 +18,8 @@
 //! bits(d) >> 46 ─ base ─► buckets[b]: first slice g ─► while d ≥ start[g + 1]: g += 1 ─► (k, s)
 //! ```
 
+use crate::cluster::headroom::room_for;
+
 /// Bits below the bucket: 52 mantissa bits − 6 kept.
 const BUCKET_SHIFT: u32 = 46;
 
@@ -44,13 +46,22 @@ pub(crate) struct SliceLookup {
 impl SliceLookup {
     /// Makes this the lookup of a grid's slices, reusing its buffers: `slices` gives each
     /// slice's (cascade, slice within the cascade) and the view depth where it starts, near to
-    /// far, and `far` is the grid's far end. Buckets cover the grid's first split to its far
-    /// end: nearer depths all lie in the first slice and farther ones reach the last through
-    /// the steps.
-    pub(crate) fn rebuild(&mut self, slices: impl Iterator<Item = ((u32, u32), f64)>, far: f64) {
+    /// far, and `near` and `far` are the grid's ends. Buckets cover the grid's first split to
+    /// its far end: nearer depths all lie in the first slice and farther ones reach the last
+    /// through the steps. The buffers keep room for `most_slices` and for buckets from `near`
+    /// (the nearest a split can be), so a grid rebuilt finer allocates nothing.
+    pub(crate) fn rebuild(
+        &mut self,
+        slices: impl Iterator<Item = ((u32, u32), f64)>,
+        most_slices: usize,
+        near: f64,
+        far: f64,
+    ) {
         let (start, address) = (&mut self.start, &mut self.address);
         start.clear();
         address.clear();
+        room_for(start, most_slices + 1);
+        room_for(address, most_slices);
         for (slice, z0) in slices {
             start.push(if start.is_empty() { 0.0 } else { z0 });
             address.push(slice);
@@ -61,6 +72,9 @@ impl SliceLookup {
         let last = bucket(far).max(base);
         start.push(f64::NAN);
         self.buckets.clear();
+        // Capped: a near plane of 10⁻³⁰⁰ would ask for a bucket per 1/64 octave down to it.
+        let most_buckets = last - bucket(near.max(f64::MIN_POSITIVE)).min(last) + 1;
+        room_for(&mut self.buckets, (most_buckets as usize).min(1 << 14));
         self.buckets.extend((base..=last).map(|b| {
             let d = f64::from_bits((b as u64) << BUCKET_SHIFT);
             let first = start.partition_point(|&z| z <= d) - 1;
@@ -70,6 +84,16 @@ impl SliceLookup {
             }
         }));
         self.base = base;
+    }
+
+    /// Its buffers' capacities (a test that a rebuild did not grow them).
+    #[cfg(test)]
+    pub(crate) fn capacities(&self) -> [usize; 3] {
+        [
+            self.buckets.capacity(),
+            self.start.capacity(),
+            self.address.capacity(),
+        ]
     }
 
     /// Empty, as [`SliceLookup::default`], keeping the buffers (for the linear mapping, which
@@ -160,7 +184,7 @@ mod tests {
     /// The lookup of `grid`'s slices, as the grid builds it.
     fn lookup_of(grid: &ClusterGrid) -> SliceLookup {
         let mut lookup = SliceLookup::default();
-        lookup.rebuild(grid.slice_starts(), grid.far);
+        lookup.rebuild(grid.slice_starts(), 0, grid.near, grid.far);
         lookup
     }
 

@@ -273,3 +273,28 @@ fn cell_spheres_hold_their_cells() {
         }
     }
 }
+
+#[test]
+fn a_grid_rebuilt_finer_keeps_its_buffers() {
+    // Coarse to fine, first splits near and far, as the automatic grid's candidates come.
+    let mut grid = persp_with(0.1, 80.0, &GridConfig::fixed(64.0));
+    let buffers = |g: &ClusterGrid| {
+        (
+            g.slice_slabs.capacity(),
+            g.slice_frusta.capacity(),
+            g.cascade_constants.capacity(),
+            g.slice_lookup.capacities(),
+        )
+    };
+    let before = buffers(&grid);
+    let slices = grid.slice_slabs.len();
+    for (px, split) in [(32.0, None), (16.0, Some(4.0)), (8.0, Some(0.2)), (4.0, Some(0.1))] {
+        let config = GridConfig {
+            first_split: split,
+            ..GridConfig::fixed(px)
+        };
+        grid.rebuild(1280, 720, GridProjection::test_view(), 0.1, 80.0, &config);
+        assert_eq!(buffers(&grid), before, "{px} px, first split {split:?}");
+    }
+    assert!(grid.slice_slabs.len() > 2 * slices, "the finest grid has more slices");
+}
