@@ -133,10 +133,9 @@ impl Bands {
         // Each band keeps room for its share of them (`share_of`, of the threads asked for:
         // how many bands a split makes varies), so a border that moves with the work does not
         // make a band grow frame after frame; the bands this split leaves out too, so a band
-        // taken again later does not grow either.
-        // A band lists a light once at most, but the bands together list a light once per
-        // band it reaches, which depends on where the borders are: while the lights are few,
-        // room for every one of them in each band.
+        // taken again later does not grow either. The bands together list a light once per
+        // band it reaches, a sum that moves with the borders: while the lights are few, each
+        // band keeps room for all of them (it lists each once at most).
         let runs_share = share_of(last_runs, threads);
         let lights_share = share_of(last_lights, threads).max(lights.len().min(WHOLE_UP_TO));
         for band in &mut self.bands {
