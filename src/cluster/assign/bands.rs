@@ -31,6 +31,34 @@ impl Bands {
         &self.bands[..self.active]
     }
 
+    /// Where the last split cut the bands and what each took: what the next split follows.
+    pub(super) fn split_record(&self) -> SplitRecord {
+        SplitRecord {
+            active: self.active,
+            bands: std::array::from_fn(|b| {
+                self.bands.get(b).map(|band| BandCut {
+                    window: band.window,
+                    first_cell: band.first_cell,
+                    end_cell: band.end_cell,
+                    seconds: band.seconds,
+                })
+            }),
+        }
+    }
+
+    /// Puts back a [`SplitRecord`] (after an assignment that was not a frame's).
+    pub(super) fn restore_split(&mut self, record: &SplitRecord) {
+        self.active = record.active;
+        for (band, kept) in self.bands.iter_mut().zip(&record.bands) {
+            if let Some(cut) = *kept {
+                band.window = cut.window;
+                band.first_cell = cut.first_cell;
+                band.end_cell = cut.end_cell;
+                band.seconds = cut.seconds;
+            }
+        }
+    }
+
     /// Cuts the grid's slices into at most `threads` non-empty bands of about equal work.
     ///
     /// The work is what the last assignment measured when it was to a grid of as many cells
@@ -46,9 +74,11 @@ impl Bands {
         let threads = threads.clamp(1, slices.max(1) as usize);
         let previous = out;
         let last = &self.bands[..self.active];
+        // The bands' own record of the grid they were cut for (not the last lists, which may
+        // be an automatic grid candidate's since: see `Assigner::assign_candidate`).
         let timed = last.len() == threads
             && threads > 1
-            && previous.offsets.len() == cells
+            && last.last().map(|b| b.end_cell) == Some(cells)
             && last.last().and_then(|b| b.window).map(|w| w.end) == Some(slices)
             && last.iter().all(|b| b.seconds > 0.0)
             // Below this, timer noise and a worker's waking outweigh the work: a split by
@@ -185,6 +215,22 @@ impl Bands {
         }
         totals
     }
+}
+
+/// The bands' split as [`Bands::split_record`] keeps it (at most 8 bands).
+#[derive(Debug, PartialEq)]
+pub(super) struct SplitRecord {
+    active: usize,
+    bands: [Option<BandCut>; 8],
+}
+
+/// One band's part of a [`SplitRecord`]: its slices and cells, and the seconds it took.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct BandCut {
+    window: Option<SliceWindow>,
+    first_cell: usize,
+    end_cell: usize,
+    seconds: f64,
 }
 
 /// One band of slices and its buffers. Aligned to two cache lines: the bands sit side by side

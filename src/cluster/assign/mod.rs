@@ -77,6 +77,16 @@ pub struct Assigner {
     warned_oversize: bool,
     /// CPU seconds the last assignment took: its wall time times its threads.
     last_cpu_seconds: f64,
+    /// Indices the last assignment listed (the lists may be a candidate's since).
+    frame_indices: usize,
+}
+
+/// What the next frame's assignment follows from the last frame's (its threads and the bands'
+/// split), kept aside while an automatic grid candidate is assigned in between.
+struct FrameRecord {
+    cpu_seconds: f64,
+    indices: usize,
+    split: bands::SplitRecord,
 }
 
 impl Assigner {
@@ -87,6 +97,29 @@ impl Assigner {
 
     /// The last result.
     pub fn assignment(&self) -> &Assignment {
+        &self.out
+    }
+
+    /// [`Assigner::assign`] for a grid that is not the frame's (the automatic grid's
+    /// candidates, measured with the frame's assigner so that the grid it adopts already fits
+    /// its buffers): the next frame still takes its threads and its bands' split from the
+    /// last frame's assignment, not from this one.
+    pub fn assign_candidate(
+        &mut self,
+        grid: &ClusterGrid,
+        lights: &[GpuLight],
+        camera_far: f64,
+        limits: &AssignLimits,
+    ) -> &Assignment {
+        let frame = FrameRecord {
+            cpu_seconds: self.last_cpu_seconds,
+            indices: self.frame_indices,
+            split: self.bands.split_record(),
+        };
+        self.assign(grid, lights, camera_far, limits);
+        self.last_cpu_seconds = frame.cpu_seconds;
+        self.frame_indices = frame.indices;
+        self.bands.restore_split(&frame.split);
         &self.out
     }
 
@@ -118,6 +151,7 @@ impl Assigner {
         };
         // Zero until this assignment's is known (the early returns below leave it so).
         let last_cpu_seconds = std::mem::take(&mut self.last_cpu_seconds);
+        let last_indices = std::mem::take(&mut self.frame_indices);
         if grid.total_cells > MAX_ASSIGN_CELLS {
             if !self.warned_oversize {
                 self.warned_oversize = true;
@@ -146,7 +180,7 @@ impl Assigner {
         let started = std::time::Instant::now();
         let threads = threads_for(
             lights.len(),
-            out.indices.len(),
+            last_indices,
             last_cpu_seconds,
             limits,
             rayon::current_num_threads(),
@@ -183,6 +217,7 @@ impl Assigner {
             0.0
         };
         out.stats.threads = threads;
+        self.frame_indices = out.indices.len();
         self.last_cpu_seconds = started.elapsed().as_secs_f64() * threads as f64;
         &self.out
     }

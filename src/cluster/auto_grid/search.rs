@@ -81,7 +81,7 @@ impl ChoiceSearch {
             self.done = true;
             return true;
         }
-        let a = assigner.assign(grid, inputs.lights, inputs.camera_far, &inputs.limits);
+        let a = assigner.assign_candidate(grid, inputs.lights, inputs.camera_far, &inputs.limits);
         let evals_per_pixel = samples.evals_per_pixel(grid, &a.counts);
         let bytes = grid.total_cells as usize * inputs.encoding.cell_bytes()
             + a.indices.len() * inputs.encoding.index_bytes();

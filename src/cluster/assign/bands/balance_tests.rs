@@ -42,3 +42,32 @@ fn a_slow_worker_gets_less_work_until_both_take_about_as_long() {
         "after six frames the bands' times differ by {spread:.2}x (more than {tolerance:.2}x)"
     );
 }
+
+#[test]
+fn a_candidate_assigned_in_between_leaves_the_frames_split_and_threads() {
+    use crate::cluster::assign::tests::random_lights;
+    use crate::cluster::assign::{AssignLimits, Assigner};
+    use rand::SeedableRng;
+
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
+    let frame_grid = view_grid(&GridConfig::fixed(16.0));
+    let candidate_grid = view_grid(&GridConfig::fixed(45.0));
+    let lights = random_lights(&mut rand_pcg::Pcg64Mcg::seed_from_u64(5), 300, 20.0);
+    let limits = AssignLimits {
+        parallel_threshold: 0,
+        ..AssignLimits::default()
+    };
+    pool.install(|| {
+        let mut assigner = Assigner::new();
+        for _ in 0..3 {
+            assigner.assign(&frame_grid, &lights, 80.0, &limits);
+        }
+        let split = assigner.bands.split_record();
+        let (seconds, indices) = (assigner.last_cpu_seconds, assigner.frame_indices);
+        assert!(indices > 0);
+        let candidate = assigner.assign_candidate(&candidate_grid, &lights, 80.0, &limits);
+        assert_ne!(candidate.indices.len(), indices, "the candidate's lists differ");
+        assert_eq!(assigner.bands.split_record(), split);
+        assert_eq!((assigner.last_cpu_seconds, assigner.frame_indices), (seconds, indices));
+    });
+}
