@@ -184,8 +184,7 @@ impl AutoGrid {
             None => {
                 // With the scratch's room, so that swapping the two later allocates nothing.
                 let mut first = new.clone();
-                first.reason.reserve(auto_grid::REASON_CAPACITY - first.reason.len().min(auto_grid::REASON_CAPACITY));
-                first.candidates.reserve(new.candidates.capacity() - first.candidates.len());
+                first.keep_room(new.candidates.capacity());
                 self.choice = Some(first);
             }
         }

@@ -112,6 +112,21 @@ pub struct GridChoice {
     pub candidates: Vec<Candidate>,
 }
 
+/// Bytes a choice's reason keeps room for: more than its longest (about 400 with realistic
+/// numbers), with a prefix when the current grid is kept.
+const REASON_CAPACITY: usize = 1024;
+
+impl GridChoice {
+    /// Gives the reason room for any reason (its numbers' widths vary) and the candidates room
+    /// for `candidates`, so that a re-choice written into this choice allocates nothing.
+    pub(crate) fn keep_room(&mut self, candidates: usize) {
+        self.reason
+            .reserve(REASON_CAPACITY.saturating_sub(self.reason.len()));
+        self.candidates
+            .reserve(candidates.saturating_sub(self.candidates.len()));
+    }
+}
+
 /// What a candidate grid is built and assigned with.
 pub struct ChoiceInputs<'a> {
     /// Viewport.

@@ -43,4 +43,3 @@ pub use choice::{first_split, should_switch, Candidate, ChoiceInputs, GridChoice
 pub use choice::{CANDIDATE_FOOTPRINTS, CELL_BUDGET, HYSTERESIS};
 pub use costs::{assign_work, FrameCost, GridCosts, CALIBRATION_WINDOW, INDEX_WEIGHT};
 pub use search::{choose, ChoiceSearch};
-pub(crate) use search::REASON_CAPACITY;

@@ -9,10 +9,6 @@ use super::costs::{assign_work, GridCosts};
 use crate::cluster::assign::Assigner;
 use crate::cluster::grid::{ClusterGrid, GridConfig};
 
-/// Bytes a choice's reason keeps room for: more than its longest (about 400 with realistic
-/// numbers), with a prefix when the current grid is kept.
-pub(crate) const REASON_CAPACITY: usize = 1024;
-
 /// A search over the candidate footprints, coarse to fine, kept between frames (its buffers
 /// and its scratch grid are reused by the next search).
 #[derive(Default)]
@@ -172,8 +168,8 @@ impl ChoiceSearch {
             },
         };
         out.reason.clear();
-        // Room for any reason (its numbers' widths vary), so a re-choice allocates nothing.
-        out.reason.reserve(REASON_CAPACITY);
+        out.candidates.clear();
+        out.keep_room(self.footprints.len());
         let _ = write!(
             out.reason,
             "auto: {} px predicted {:.2} ms ({:.1} evaluations per pixel, {} cells, {} indices) \
@@ -222,8 +218,6 @@ impl ChoiceSearch {
             first_split: self.split,
             ..inputs.base.clone()
         };
-        out.candidates.clear();
-        out.candidates.reserve(self.footprints.len());
         out.candidates.extend_from_slice(&self.candidates);
     }
 
