@@ -2,12 +2,9 @@
 //! its peak (soak test: no allocation per frame in steady state, on any number of cores): the
 //! assignment's and the packed textures' bytes.
 
-/// The least room one of `parts` bands or chunks keeps for the runs or lights of the last
-/// assignment's `total`: four even shares, and all of them with up to four parts or while they
-/// are few (4 096 runs are 32 KiB). A band's borders follow the measured work, which a busy or
-/// slow core moves from frame to frame (a phone's little core takes fewer cells), and which
-/// lights are in view moves a chunk's share; with room for a quarter more than this, a part
-/// grows only when the whole assignment outgrows its last peak.
+/// The least room one of `parts` bands or chunks keeps for its part of `total` (the last
+/// assignment's runs or lights): all of it with up to four parts or up to [`WHOLE_UP_TO`],
+/// else four even shares, since each part's share moves with the split and the view.
 pub(crate) fn share_of(total: usize, parts: usize) -> usize {
     (4 * total / parts.max(1)).max(WHOLE_UP_TO).min(total)
 }
@@ -16,10 +13,7 @@ pub(crate) fn share_of(total: usize, parts: usize) -> usize {
 pub(crate) const WHOLE_UP_TO: usize = 4096;
 
 /// Empties `buffer` for a new frame, keeping room for a quarter more than it held or than
-/// `share` (a band's or chunk's share of the whole assignment, which moves between them from
-/// frame to frame), whichever is more: a buffer whose size wanders with moving lights then
-/// stops allocating once it has seen its peak, also on many cores where each worker's buffer
-/// has a peak of its own.
+/// `share`, whichever is more, so a size that wanders stops allocating at its peak.
 pub(crate) fn clear_with_room_for<T>(buffer: &mut Vec<T>, share: usize) {
     let len = buffer.len().max(share);
     buffer.clear();

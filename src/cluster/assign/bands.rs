@@ -160,12 +160,9 @@ impl Bands {
         let last_lights: usize = self.active().iter().map(|b| b.lights.len()).sum();
         self.split(grid, threads, out);
         let parallel = self.active > 1;
-        // Each band keeps room for its share of them (`share_of`, of the threads asked for:
-        // how many bands a split makes varies), so a border that moves with the work does not
-        // make a band grow frame after frame; the bands this split leaves out too, so a band
-        // taken again later does not grow either. The bands together list a light once per
-        // band it reaches, a sum that moves with the borders: while the lights are few, each
-        // band keeps room for all of them (it lists each once at most).
+        // Every band, also those this split leaves out, keeps room for its share of the runs
+        // (the borders move with the work), and for every light while they are few (the sum
+        // of the bands' lights depends on where the borders are).
         let runs_share = share_of(last_runs, threads);
         let lights_share = share_of(last_lights, threads).max(lights.len().min(WHOLE_UP_TO));
         for band in &mut self.bands {
