@@ -21,7 +21,7 @@ pub(super) struct Bands {
     /// split keeps its buffers for when it is needed again.
     bands: Vec<Band>,
     active: usize,
-    /// Per light: its visible number (phase 2, several bands).
+    /// Per light: its visible number (phase 2, several bands; empty with one).
     numbers: Vec<u32>,
 }
 
@@ -170,32 +170,20 @@ impl Bands {
         }
         let cells = grid.total_cells as usize;
         let bands = &mut self.bands[..self.active];
-        // Phase 1, its difference counts straight into the counts' array (phase 2 sums them
-        // in place: one cold array less than a separate one).
+        // Phase 1, its difference counts straight into the counts' array, and each band's
+        // counts and offsets as soon as its runs are found (phase 2 sums them in place: one
+        // cold array less than a separate one, and no wait for the other bands in between).
         room_for(&mut out.counts, cells);
         room_for(&mut out.offsets, cells);
         out.counts.resize(cells, 0);
         out.offsets.resize(cells, 0);
         let (counts, offsets) = (&mut out.counts[..], &mut out.offsets[..]);
-        for_band_cells(bands, counts, offsets, parallel, &|band, counts, _| {
-            band.find(grid, lights, camera_far, counts)
+        for_band_cells(bands, counts, offsets, parallel, &|band, counts, offsets| {
+            band.find_and_count(grid, lights, camera_far, counts, offsets)
         });
-        // Phase 2: the visible lights and their numbers, then counts, offsets and totals.
-        number_visible(
-            bands,
-            lights.len(),
-            &mut out.visible,
-            &mut self.numbers,
-            parallel,
-        );
-        let (counts, offsets) = (&mut out.counts[..], &mut out.offsets[..]);
-        for_band_cells(
-            bands,
-            counts,
-            offsets,
-            parallel,
-            &|band, counts, offsets| band.count(counts, offsets),
-        );
+        // Phase 2: the visible lights and their numbers (each band looks its lights' numbers
+        // up in phase 3's job), then the totals.
+        number_visible(bands, lights.len(), &mut out.visible, &mut self.numbers);
         let mut totals = Totals::default();
         for band in bands.iter_mut() {
             band.base = totals.indices;
@@ -206,9 +194,12 @@ impl Bands {
         }
         // Phase 3. Every entry is written, so the list is not cleared first: only growth is
         // zero-filled.
+        let numbers = &self.numbers[..];
         match out.indices.prepare(totals.indices, out.visible.len()) {
-            EntriesMut::Narrow(list) => scatter_bands(bands, &mut out.offsets, list, parallel),
-            EntriesMut::Wide(list) => scatter_bands(bands, &mut out.offsets, list, parallel),
+            EntriesMut::Narrow(list) => {
+                scatter_bands(bands, numbers, &mut out.offsets, list, parallel)
+            }
+            EntriesMut::Wide(list) => scatter_bands(bands, numbers, &mut out.offsets, list, parallel),
         }
         totals
     }
@@ -245,13 +236,14 @@ struct Band {
     runs: Vec<Run>,
     /// Every light with a run in the band, ascending: (light, start of its runs in `runs`).
     lights: Vec<(u32, u32)>,
-    /// Per entry of `lights`: the light's visible number (phase 2).
+    /// Per entry of `lights`: the light's visible number (phase 2 with one band, else the
+    /// start of phase 3).
     ids: Vec<u32>,
     /// Per entry of `lights`: its first run not yet scattered (phase 3 by blocks of cells).
     cursors: Vec<u32>,
     /// The band's [`Totals`] (phase 2).
     totals: Totals,
-    /// Seconds its phases 1 and 3 took (the next split's balance).
+    /// Seconds its phases 1 to 3 took (the next split's balance).
     seconds: f64,
     /// Where the band's part of the list starts (phase 2).
     base: usize,
@@ -278,7 +270,6 @@ impl Band {
         camera_far: f64,
         deltas: &mut [u32],
     ) {
-        let started = Instant::now();
         let window = self.window.expect("a band has a window");
         let first = self.first_cell as u32;
         deltas.fill(0);
@@ -300,6 +291,21 @@ impl Band {
                 self.lights.push((i as u32, before as u32));
             }
         }
+    }
+
+    /// Phases 1 and 2 of the band ([`Band::find`], then [`Band::count`] on the same cells),
+    /// timed for the next split.
+    fn find_and_count(
+        &mut self,
+        grid: &ClusterGrid,
+        lights: &[GpuLight],
+        camera_far: f64,
+        counts: &mut [u32],
+        offsets: &mut [u32],
+    ) {
+        let started = Instant::now();
+        self.find(grid, lights, camera_far, counts);
+        self.count(counts, offsets);
         self.seconds = started.elapsed().as_secs_f64();
     }
 
@@ -319,8 +325,9 @@ impl Band {
         self.totals = totals;
     }
 
-    /// Phase 3: the band's lights' visible numbers written into `list` (the band's part of the
-    /// index list) grouped by cell, then the band's final offsets (its own plus `base`).
+    /// Phase 3: the band's lights' visible numbers (looked up in `numbers` first, unless it is
+    /// empty: one band numbered its own) written into `list` (the band's part of the index
+    /// list) grouped by cell, then the band's final offsets (its own plus `base`).
     ///
     /// The offsets serve as the write cursors: they start where each cell's list ends and
     /// the runs are taken in reverse, each write one place before the last, so every cell's
@@ -331,8 +338,13 @@ impl Band {
     /// ([`scatter_blocks`]), each block's runs over all its lights before the next block's:
     /// a cell's lists are still written in reverse light order, so the lists are the same,
     /// but each block's part of the offsets and the list stays in cache while it is written.
-    fn scatter<T: LightIndex>(&mut self, offsets: &mut [u32], list: &mut [T]) {
+    fn scatter<T: LightIndex>(&mut self, numbers: &[u32], offsets: &mut [u32], list: &mut [T]) {
         let started = Instant::now();
+        if !numbers.is_empty() {
+            self.ids.clear();
+            self.ids
+                .extend(self.lights.iter().map(|&(light, _)| numbers[light as usize]));
+        }
         let cells = offsets.len();
         let blocks = scatter_blocks(cells, list.len(), std::mem::size_of::<T>(), self.lights.len());
         #[cfg(test)]
@@ -467,24 +479,13 @@ fn slice_first_cell(grid: &ClusterGrid, g: u32) -> usize {
     grid.total_cells as usize
 }
 
-/// Runs `f` on every band: the two halves at once with `parallel` (`rayon::join` keeps its
-/// jobs on the stack, so no list of jobs is allocated).
-fn for_bands(bands: &mut [Band], parallel: bool, f: &(dyn Fn(&mut Band) + Sync)) {
-    if !parallel || bands.len() < 2 {
-        bands.iter_mut().for_each(f);
-        return;
-    }
-    let (left, right) = bands.split_at_mut(bands.len() / 2);
-    rayon::join(|| for_bands(left, true, f), || for_bands(right, true, f));
-}
-
 /// What [`for_band_cells`] runs on a band: the band, then its cells' parts of the counts and
 /// the offsets.
 type BandCellsFn<'a> = dyn Fn(&mut Band, &mut [u32], &mut [u32]) + Sync + 'a;
 
 /// Runs `f` on every band with its cells' parts of `counts` and `offsets` (the grid's): phase
-/// 1 ([`Band::find`]) and phase 2's counts ([`Band::count`]); the halves of the bands at once
-/// with `parallel`.
+/// 1 and 2's counts ([`Band::find_and_count`]); the halves of the bands at once with
+/// `parallel`.
 fn for_band_cells(
     bands: &mut [Band],
     counts: &mut [u32],
@@ -512,25 +513,20 @@ fn for_band_cells(
     }
 }
 
-/// Phase 2's numbering: the lights listed by any band, ascending, into `visible`, and each
-/// band's lights' positions there into its `ids`. `numbers` (one entry per light) is scratch.
-fn number_visible(
-    bands: &mut [Band],
-    lights: usize,
-    visible: &mut Vec<u32>,
-    numbers: &mut Vec<u32>,
-    parallel: bool,
-) {
+/// Phase 2's numbering: the lights listed by any band, ascending, into `visible`. One band
+/// numbers its own lights (its `ids`); several leave each light's number in `numbers` (one
+/// entry per light, else empty), which phase 3 looks their lights up in.
+fn number_visible(bands: &mut [Band], lights: usize, visible: &mut Vec<u32>, numbers: &mut Vec<u32>) {
     visible.clear();
+    numbers.clear();
     if let [band] = bands {
         visible.extend(band.lights.iter().map(|&(light, _)| light));
         band.ids.clear();
         band.ids.extend(0..band.lights.len() as u32);
         return;
     }
-    // Mark the listed lights, number the marks in light order, and look the numbers up (a
-    // merge of the bands' lists cost more: a comparison per band per light).
-    numbers.clear();
+    // Mark the listed lights and number the marks in light order (a merge of the bands' lists
+    // cost more: a comparison per band per light).
     numbers.resize(lights, u32::MAX);
     for band in bands.iter() {
         for &(light, _) in &band.lights {
@@ -543,27 +539,19 @@ fn number_visible(
             visible.push(light as u32);
         }
     }
-    let numbers = &numbers[..];
-    for_bands(bands, parallel, &|band| {
-        band.ids.clear();
-        band.ids.extend(
-            band.lights
-                .iter()
-                .map(|&(light, _)| numbers[light as usize]),
-        );
-    });
 }
 
 /// Phase 3 ([`Band::scatter`]) over `offsets` and the index list `list` (from the first band's
 /// cell and entry on), the halves of the bands at once with `parallel`.
 fn scatter_bands<T: LightIndex>(
     bands: &mut [Band],
+    numbers: &[u32],
     offsets: &mut [u32],
     list: &mut [T],
     parallel: bool,
 ) {
     if let [band] = bands {
-        band.scatter(offsets, list);
+        band.scatter(numbers, offsets, list);
         return;
     }
     let (left, right) = bands.split_at_mut(bands.len() / 2);
@@ -573,11 +561,11 @@ fn scatter_bands<T: LightIndex>(
     let (list_left, list_right) = list.split_at_mut(entries);
     if parallel {
         rayon::join(
-            || scatter_bands(left, offsets_left, list_left, true),
-            || scatter_bands(right, offsets_right, list_right, true),
+            || scatter_bands(left, numbers, offsets_left, list_left, true),
+            || scatter_bands(right, numbers, offsets_right, list_right, true),
         );
     } else {
-        scatter_bands(left, offsets_left, list_left, false);
-        scatter_bands(right, offsets_right, list_right, false);
+        scatter_bands(left, numbers, offsets_left, list_left, false);
+        scatter_bands(right, numbers, offsets_right, list_right, false);
     }
 }

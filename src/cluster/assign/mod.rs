@@ -15,7 +15,8 @@
 //! phase 1  per band (or chunk of lights): every light's runs of consecutive cells, and
 //!          per-cell counts kept as a difference array (two additions per run)
 //! phase 2  the visible lights (a light is visible if any band listed it), numbered in light
-//!          order; counts → offsets
+//!          order; counts → offsets (a band's in the same job as its phase 1, so two
+//!          threads meet twice a frame, not four times)
 //! phase 3  runs scattered into the list: bands straight into their own parts of it (a band
 //!          larger than a core's cache by blocks of cells, each block's runs of all lights
 //!          before the next); chunks into their own lists, then merged cell by cell
