@@ -110,6 +110,12 @@ impl AssignWorkload {
     /// the nearest), after [`WARM_UP`] of untimed ones (at least one, which sizes the reused
     /// buffers as a renderer's first frame does), and the number of indices produced.
     pub fn time(&self, runs: usize) -> (f64, usize) {
+        let timing = self.timing(runs);
+        (timing.median_ms, timing.indices)
+    }
+
+    /// [`AssignWorkload::time`], with the threads the median run took.
+    pub fn timing(&self, runs: usize) -> AssignTiming {
         let runs = runs.clamp(1, MAX_RUNS);
         let mut assigner = Assigner::new();
         let indices = self.assign_with(&mut assigner).indices.len();
@@ -117,14 +123,32 @@ impl AssignWorkload {
         while start.elapsed() < WARM_UP {
             std::hint::black_box(self.assign_with(&mut assigner));
         }
-        let mut times: Vec<f64> = (0..runs)
+        let mut times: Vec<(f64, usize)> = (0..runs)
             .map(|_| {
                 let t = Instant::now();
-                std::hint::black_box(self.assign_with(&mut assigner));
-                t.elapsed().as_secs_f64() * 1e3
+                let threads = std::hint::black_box(self.assign_with(&mut assigner))
+                    .stats
+                    .threads;
+                (t.elapsed().as_secs_f64() * 1e3, threads)
             })
             .collect();
-        times.sort_by(f64::total_cmp);
-        (times[times.len() / 2], indices)
+        times.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let (median_ms, threads) = times[times.len() / 2];
+        AssignTiming {
+            median_ms,
+            indices,
+            threads,
+        }
     }
+}
+
+/// What [`AssignWorkload::timing`] measured.
+#[derive(Clone, Copy, Debug)]
+pub struct AssignTiming {
+    /// Median wall time of the timed runs, in milliseconds.
+    pub median_ms: f64,
+    /// Indices listed.
+    pub indices: usize,
+    /// Threads the median run took (the assignment picks them from the previous run's time).
+    pub threads: usize,
 }

@@ -468,6 +468,28 @@ fn bench_assign_prints_json_for_scripts() {
     for r in rows {
         assert!(r["assign_ms"].as_f64().unwrap() > 0.0);
         assert!(r["indices"].as_u64().unwrap() > 0);
+        // An assignment takes at most eight threads, and no more than its pool has.
+        let threads = r["threads"].as_u64().unwrap();
+        let cores = std::thread::available_parallelism().map_or(1, |n| n.get()) as u64;
+        assert!((1..=cores.min(8)).contains(&threads), "{r}");
+    }
+    // A pool of one: every row says one thread.
+    let out = manylight(
+        &[
+            "bench-assign",
+            "--lights",
+            "16,65536",
+            "--runs",
+            "3",
+            "--json",
+        ],
+        &[("RAYON_NUM_THREADS", "1")],
+        dir.path(),
+    );
+    assert!(out.status.success(), "{}", text(&out));
+    let rows: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    for r in rows.as_array().unwrap() {
+        assert_eq!(r["threads"], 1, "{r}");
     }
 }
 

@@ -23,7 +23,9 @@ pub struct BenchAssignArgs {
     /// Seed of the random lights.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// Print JSON (an array of {lights, assign_ms, indices, clusters, runs}) instead of a table.
+    /// Print JSON (an array of {lights, assign_ms, indices, clusters, runs, threads}) instead of
+    /// a table. `threads`: what the median run took (the assignment picks one or more from the
+    /// previous run's time).
     #[arg(long)]
     pub json: bool,
 }
@@ -57,17 +59,21 @@ pub fn run(args: &BenchAssignArgs) -> Result<(), Box<dyn std::error::Error>> {
             None if count > 100_000 => 7,
             None => 101,
         };
-        let (ms, indices) = work.time(runs);
+        let timing = work.timing(runs);
+        let (ms, indices, threads) = (timing.median_ms, timing.indices, timing.threads);
         rows.push(serde_json::json!({
             "lights": count,
             "assign_ms": ms,
             "indices": indices,
             "clusters": work.grid.total_cells,
             "runs": runs,
+            "threads": threads,
         }));
         if !args.json {
             print_stdout(&format!(
-                "{count:>9} lights  {ms:>9.3} ms  {indices:>9} indices  (median of {runs} runs)\n"
+                "{count:>9} lights  {ms:>9.3} ms  {indices:>9} indices  (median of {runs} runs, \
+                 on {threads} thread{})\n",
+                if threads == 1 { "" } else { "s" }
             ))?;
         }
     }
