@@ -29,6 +29,14 @@ pub(crate) fn room_for<T>(buffer: &mut Vec<T>, len: usize) {
     }
 }
 
+/// Makes `buffer` `len` default values (zeros), with [`room_for`]'s room to grow: for
+/// per-frame buffers filled afresh, whose length wanders with the view and the lights.
+pub(crate) fn zeroed_with_room<T: Clone + Default>(buffer: &mut Vec<T>, len: usize) {
+    buffer.clear();
+    room_for(buffer, len);
+    buffer.resize(len, T::default());
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -66,5 +74,13 @@ mod tests {
         room_for(&mut cells, 1400);
         cells.resize(1400, 0);
         assert_eq!(cells.capacity(), capacity);
+        // Zeroed afresh, with the same room.
+        let mut bytes: Vec<u8> = vec![7; 10];
+        zeroed_with_room(&mut bytes, 1000);
+        assert!(bytes.len() == 1000 && bytes.iter().all(|&b| b == 0));
+        let capacity = bytes.capacity();
+        assert!(capacity >= 1500, "{capacity}");
+        zeroed_with_room(&mut bytes, 1400);
+        assert_eq!(bytes.capacity(), capacity);
     }
 }

@@ -6,7 +6,7 @@ use rayon::prelude::*;
 
 use super::cells::for_each_run;
 use super::index_list::{EntriesMut, IndexList, LightIndex};
-use crate::cluster::headroom::{clear_with_room_for, room_for, share_of};
+use crate::cluster::headroom::{clear_with_room_for, room_for, share_of, zeroed_with_room};
 use super::types::{Assignment, Run, Totals};
 use crate::cluster::grid::ClusterGrid;
 use crate::cluster::view_light::GpuLight;
@@ -131,9 +131,7 @@ impl Chunk {
         camera_far: f64,
         (runs_share, visible_share): (usize, usize),
     ) {
-        room_for(&mut self.deltas, grid.total_cells as usize + 1);
-        self.deltas.clear();
-        self.deltas.resize(grid.total_cells as usize + 1, 0);
+        zeroed_with_room(&mut self.deltas, grid.total_cells as usize + 1);
         clear_with_room_for(&mut self.runs, runs_share);
         self.ends.clear();
         clear_with_room_for(&mut self.visible, visible_share);

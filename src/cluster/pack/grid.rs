@@ -40,7 +40,7 @@ use super::lights::DATA_TEXTURE_WIDTH;
 use crate::cluster::assign::index_list::IndexList;
 use crate::cluster::assign::Assignment;
 use crate::cluster::grid::ClusterGrid;
-use crate::cluster::headroom::room_for;
+use crate::cluster::headroom::zeroed_with_room;
 
 /// Texels per cascade in the grid texture's table.
 pub const TABLE_TEXELS_PER_CASCADE: u32 = 2;
@@ -179,10 +179,7 @@ pub fn pack_grid_into(
     let table = grid.cascades.len() * TABLE_TEXELS_PER_CASCADE as usize;
     let height = rows_for(grid_texels(grid));
     let bytes = &mut packed.bytes;
-    let len = DATA_TEXTURE_WIDTH as usize * height as usize * 4;
-    bytes.clear();
-    room_for(bytes, len);
-    bytes.resize(len, 0);
+    zeroed_with_room(bytes, DATA_TEXTURE_WIDTH as usize * height as usize * 4);
     let mut put =
         |texel: usize, value: [u8; 4]| bytes[texel * 4..texel * 4 + 4].copy_from_slice(&value);
     match encoding {
@@ -237,11 +234,7 @@ pub fn pack_indices_into(indices: &IndexList, encoding: GridEncoding, packed: &m
     let height = rows_for(indices.len().div_ceil(per_texel));
     let texel_bytes = per_texel * encoding.index_bytes();
     let bytes = &mut packed.bytes;
-    let len = DATA_TEXTURE_WIDTH as usize * height as usize * texel_bytes;
-    bytes.clear();
-    // The list's length wanders with moving lights: half again when it grows.
-    room_for(bytes, len);
-    bytes.resize(len, 0);
+    zeroed_with_room(bytes, DATA_TEXTURE_WIDTH as usize * height as usize * texel_bytes);
     match (indices.as_u16(), indices.as_u32()) {
         (Some(list), _) => put_indices(bytes, list.iter().copied(), encoding),
         (_, Some(list)) => put_indices(bytes, list.iter().map(|&v| v as u16), encoding),

@@ -35,7 +35,7 @@ use glam::Vec3;
 
 use crate::scene::light::{half_sine, spot_terms_from_half_sines};
 use crate::cluster::view_light::GpuLight;
-use crate::cluster::headroom::room_for;
+use crate::cluster::headroom::zeroed_with_room;
 
 /// Width in texels of every data texture (a power of two ≤ 1024: exact under mediump math).
 pub const DATA_TEXTURE_WIDTH: u32 = 1024;
@@ -124,11 +124,7 @@ pub fn pack_lights_into(lights: &[GpuLight], encoding: LightEncoding, packed: &m
     let width = DATA_TEXTURE_WIDTH as usize;
     let height = (lights.len() * tpl).div_ceil(width).max(1);
     let bytes = &mut packed.bytes;
-    let len = width * height * encoding.bytes_per_texel();
-    bytes.clear();
-    // The visible lights wander with the view: half again when it grows.
-    room_for(bytes, len);
-    bytes.resize(len, 0);
+    zeroed_with_room(bytes, width * height * encoding.bytes_per_texel());
     let pos_range = lights
         .iter()
         .map(|l| l.position.abs().max_element())
