@@ -21,7 +21,7 @@ pub(super) struct Bands {
     /// split keeps its buffers for when it is needed again.
     bands: Vec<Band>,
     active: usize,
-    /// Per light: its visible number (phase 2, several bands; empty with one).
+    /// Per light: its visible number (phase 2, several bands).
     numbers: Vec<u32>,
 }
 
@@ -194,7 +194,8 @@ impl Bands {
         }
         // Phase 3. Every entry is written, so the list is not cleared first: only growth is
         // zero-filled.
-        let numbers = &self.numbers[..];
+        // One band numbered its own lights in phase 2; several look theirs up.
+        let numbers = (bands.len() > 1).then_some(&self.numbers[..]);
         match out.indices.prepare(totals.indices, out.visible.len()) {
             EntriesMut::Narrow(list) => {
                 scatter_bands(bands, numbers, &mut out.offsets, list, parallel)
@@ -325,9 +326,9 @@ impl Band {
         self.totals = totals;
     }
 
-    /// Phase 3: the band's lights' visible numbers (looked up in `numbers` first, unless it is
-    /// empty: one band numbered its own) written into `list` (the band's part of the index
-    /// list) grouped by cell, then the band's final offsets (its own plus `base`).
+    /// Phase 3: the band's lights' visible numbers (looked up in `numbers` first, when given)
+    /// written into `list` (the band's part of the index list) grouped by cell, then the
+    /// band's final offsets (its own plus `base`).
     ///
     /// The offsets serve as the write cursors: they start where each cell's list ends and
     /// the runs are taken in reverse, each write one place before the last, so every cell's
@@ -338,9 +339,14 @@ impl Band {
     /// ([`scatter_blocks`]), each block's runs over all its lights before the next block's:
     /// a cell's lists are still written in reverse light order, so the lists are the same,
     /// but each block's part of the offsets and the list stays in cache while it is written.
-    fn scatter<T: LightIndex>(&mut self, numbers: &[u32], offsets: &mut [u32], list: &mut [T]) {
+    fn scatter<T: LightIndex>(
+        &mut self,
+        numbers: Option<&[u32]>,
+        offsets: &mut [u32],
+        list: &mut [T],
+    ) {
         let started = Instant::now();
-        if !numbers.is_empty() {
+        if let Some(numbers) = numbers {
             self.ids.clear();
             self.ids
                 .extend(self.lights.iter().map(|&(light, _)| numbers[light as usize]));
@@ -515,10 +521,9 @@ fn for_band_cells(
 
 /// Phase 2's numbering: the lights listed by any band, ascending, into `visible`. One band
 /// numbers its own lights (its `ids`); several leave each light's number in `numbers` (one
-/// entry per light, else empty), which phase 3 looks their lights up in.
+/// entry per light), which phase 3 looks their lights up in.
 fn number_visible(bands: &mut [Band], lights: usize, visible: &mut Vec<u32>, numbers: &mut Vec<u32>) {
     visible.clear();
-    numbers.clear();
     if let [band] = bands {
         visible.extend(band.lights.iter().map(|&(light, _)| light));
         band.ids.clear();
@@ -527,6 +532,7 @@ fn number_visible(bands: &mut [Band], lights: usize, visible: &mut Vec<u32>, num
     }
     // Mark the listed lights and number the marks in light order (a merge of the bands' lists
     // cost more: a comparison per band per light).
+    numbers.clear();
     numbers.resize(lights, u32::MAX);
     for band in bands.iter() {
         for &(light, _) in &band.lights {
@@ -545,7 +551,7 @@ fn number_visible(bands: &mut [Band], lights: usize, visible: &mut Vec<u32>, num
 /// cell and entry on), the halves of the bands at once with `parallel`.
 fn scatter_bands<T: LightIndex>(
     bands: &mut [Band],
-    numbers: &[u32],
+    numbers: Option<&[u32]>,
     offsets: &mut [u32],
     list: &mut [T],
     parallel: bool,
