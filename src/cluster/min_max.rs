@@ -3,21 +3,39 @@
 //!
 //! `f64::min` and `f64::max` return the other operand when one is NaN, which costs x86-64
 //! five instructions more than a comparison and a select (`minsd`, `maxsd`): before these,
-//! the NaN checks were an eighth of the instructions of finding a light's cells. The
-//! difference is only in NaN: `a.at_most(b)` is `a.min(b)` whenever `a` is not NaN (a NaN `b`
-//! gives `a`, as `f64::min` does), but a NaN `a` stays NaN. So every caller puts first an
-//! operand that is never NaN, or one that is NaN only when the other is too, and says why.
-//! (Of two equal operands both give the first, the one of `±0` x86-64's `f64::min` gives.)
+//! the NaN checks were an eighth of the instructions of finding a light's cells. So on
+//! x86-64 these are a comparison and a select, and they differ from `f64::min` only in NaN:
+//! `a.at_most(b)` is `a.min(b)` whenever `a` is not NaN (a NaN `b` gives `a`, as `f64::min`
+//! does), but a NaN `a` stays NaN. aarch64 has `f64::min` and `max` in one instruction each
+//! (`fminnm`, `fmaxnm`; a comparison and a select take two), so there they are `f64::min` and
+//! `max`, and a NaN `a` gives `b`. Every caller puts first an operand that is never NaN, or
+//! one that is NaN only when the other is too, and says why: then both give the same.
+//! (Of two zeros x86-64 gives the first, aarch64 orders −0 below +0; no list depends on it:
+//! `scripts/check-aarch64` compares the lists made on both.)
 
-/// `f64` bounds by comparison and select (see the module docs).
+/// `f64` bounds in one instruction each (see the module docs).
 pub(crate) trait MinMax {
-    /// `b` where it is less than `self`, else `self` (`self.min(b)` for a `self` not NaN).
+    /// The lesser of `self` and `b`: `self.min(b)` for a `self` not NaN (a NaN `self`: see
+    /// the module docs).
     fn at_most(self, b: f64) -> f64;
-    /// `b` where it is greater than `self`, else `self` (`self.max(b)` for a `self` not NaN).
+    /// The greater of `self` and `b`: `self.max(b)` for a `self` not NaN.
     fn at_least(self, b: f64) -> f64;
 }
 
 impl MinMax for f64 {
+    #[cfg(target_arch = "aarch64")]
+    #[inline(always)]
+    fn at_most(self, b: f64) -> f64 {
+        self.min(b)
+    }
+
+    #[cfg(target_arch = "aarch64")]
+    #[inline(always)]
+    fn at_least(self, b: f64) -> f64 {
+        self.max(b)
+    }
+
+    #[cfg(not(target_arch = "aarch64"))]
     #[inline(always)]
     fn at_most(self, b: f64) -> f64 {
         if b < self {
@@ -27,6 +45,7 @@ impl MinMax for f64 {
         }
     }
 
+    #[cfg(not(target_arch = "aarch64"))]
     #[inline(always)]
     fn at_least(self, b: f64) -> f64 {
         if b > self {
@@ -42,7 +61,8 @@ mod tests {
     use super::MinMax;
 
     /// Equal to `f64::min` and `f64::max` wherever the first operand is not NaN, bit for bit
-    /// apart from the sign of an equal zero; a NaN first operand stays NaN.
+    /// apart from the sign of an equal zero; a NaN first operand stays NaN on x86-64 (and
+    /// gives the other operand on aarch64, as `f64::min` does).
     #[test]
     fn agrees_with_f64_min_and_max_for_a_first_operand_not_nan() {
         let values = [
@@ -52,8 +72,11 @@ mod tests {
         let same = |a: f64, b: f64| a.to_bits() == b.to_bits() || (a == 0.0 && b == 0.0);
         for &a in &values {
             for &b in &values {
-                if a.is_nan() {
+                if a.is_nan() && cfg!(not(target_arch = "aarch64")) {
                     assert!(a.at_most(b).is_nan() && a.at_least(b).is_nan());
+                } else if a.is_nan() {
+                    assert!(same(a.at_most(b), b) || b.is_nan(), "NaN at most {b}");
+                    assert!(same(a.at_least(b), b) || b.is_nan(), "NaN at least {b}");
                 } else {
                     assert!(same(a.at_most(b), a.min(b)), "{a} at most {b}");
                     assert!(same(a.at_least(b), a.max(b)), "{a} at least {b}");
