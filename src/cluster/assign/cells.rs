@@ -135,8 +135,9 @@ pub(crate) fn for_each_run_in(
         return;
     }
     let d = -c.z;
-    let dmin = (d - r).max(grid.near);
-    let dmax = (d + r).min(camera_far);
+    // The planes first (`MinMax`): never NaN, where a hostile spot's bound may be.
+    let dmin = grid.near.at_least(d - r);
+    let dmax = camera_far.at_most(d + r);
     if dmin > dmax {
         return;
     }
@@ -387,7 +388,8 @@ impl ScreenExtent {
         // Their reciprocals without a division: `1/max(a, b) = min(1/a, 1/b)`.
         let inv_a = inv_z0.at_most(self.inv_depth.0).at_most(MAX_INV_DEPTH);
         let inv_b = inv_z1.at_least(self.inv_depth.1).at_most(inv_a);
-        // The centre's depth clamped into the slab (NaN stays NaN, as with `f64::clamp`).
+        // The centre's depth clamped into the slab, less the depth: NaN for a NaN depth on
+        // either architecture's `MinMax` (as with `f64::clamp`).
         let nearest = self.d.at_least(za).at_most(zb) - self.d;
         // 0 first: a NaN difference gives 0, as `f64::max` did.
         let rho_sq = 0.0_f64.at_least(self.r * self.r - nearest * nearest);

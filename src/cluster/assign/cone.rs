@@ -263,8 +263,10 @@ fn quadratic_nonpositive(
     let (r1, r2) = if k == 0.0 {
         (0.0, 0.0)
     } else {
+        // Never NaN: `a`, `c` and `k` are finite (else the discriminant is not), `a` and `k`
+        // not zero.
         let (x, y) = (k / a, c / k);
-        (x.min(y), x.max(y))
+        (x.at_most(y), x.at_least(y))
     };
     if a > 0.0 {
         let (lo, hi) = (lo.at_least(r1), hi.at_most(r2));
