@@ -4,9 +4,9 @@
 //! `f64::min` and `f64::max` return the other operand when one is NaN, which costs x86-64
 //! five instructions more than a comparison and a select (`minsd`, `maxsd`): before these,
 //! the NaN checks were an eighth of the instructions of finding a light's cells. So on
-//! x86-64 these are a comparison and a select, and they differ from `f64::min` only in NaN:
-//! `a.at_most(b)` is `a.min(b)` whenever `a` is not NaN (a NaN `b` gives `a`, as `f64::min`
-//! does), but a NaN `a` stays NaN. aarch64 has `f64::min` and `max` in one instruction each
+//! x86-64 (and on every target but aarch64) these are a comparison and a select, and they
+//! differ from `f64::min` only in NaN: `a.at_most(b)` is `a.min(b)` whenever `a` is not NaN
+//! (a NaN `b` gives `a`, as `f64::min` does), but a NaN `a` stays NaN. aarch64 has `f64::min` and `max` in one instruction each
 //! (`fminnm`, `fmaxnm`; a comparison and a select take two), so there they are `f64::min` and
 //! `max`, and a NaN `a` gives `b`. Every caller puts first an operand that is never NaN, or
 //! one that is NaN only when the other is too, and says why: then both give the same.
@@ -61,8 +61,8 @@ mod tests {
     use super::MinMax;
 
     /// Equal to `f64::min` and `f64::max` wherever the first operand is not NaN, bit for bit
-    /// apart from the sign of an equal zero; a NaN first operand stays NaN on x86-64 (and
-    /// gives the other operand on aarch64, as `f64::min` does).
+    /// apart from the sign of an equal zero; a NaN first operand stays NaN (on aarch64 it
+    /// gives the other operand, as `f64::min` does).
     #[test]
     fn agrees_with_f64_min_and_max_for_a_first_operand_not_nan() {
         let values = [
