@@ -447,26 +447,20 @@ fn clustered_without_float_textures_stays_within_the_packing_error() {
 #[test]
 fn bench_assign_prints_json_for_scripts() {
     let dir = tempfile::tempdir().unwrap();
-    let out = manylight(
-        &[
-            "bench-assign",
-            "--lights",
-            "16,256",
-            "--runs",
-            "3",
-            "--json",
-        ],
-        // A pool of two whatever the host and the caller's environment say.
-        &[("RAYON_NUM_THREADS", "2")],
-        dir.path(),
-    );
-    assert!(out.status.success(), "{}", text(&out));
-    let rows: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-    let rows = rows.as_array().unwrap();
+    // `bench-assign --json` at `lights` on a rayon pool of `pool` threads, whatever the host
+    // and the caller's environment say: its rows.
+    let rows_on = |lights: &str, pool: &str| -> Vec<serde_json::Value> {
+        let args = ["bench-assign", "--lights", lights, "--runs", "3", "--json"];
+        let out = manylight(&args, &[("RAYON_NUM_THREADS", pool)], dir.path());
+        assert!(out.status.success(), "{}", text(&out));
+        let rows: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        rows.as_array().unwrap().clone()
+    };
+    let rows = rows_on("16,256", "2");
     assert_eq!(rows.len(), 2);
     assert_eq!(rows[0]["lights"], 16);
     assert_eq!(rows[1]["lights"], 256);
-    for r in rows {
+    for r in &rows {
         assert!(r["assign_ms"].as_f64().unwrap() > 0.0);
         assert!(r["indices"].as_u64().unwrap() > 0);
         // An assignment takes no more threads than its pool has.
@@ -474,21 +468,7 @@ fn bench_assign_prints_json_for_scripts() {
         assert!((1..=2).contains(&threads), "{r}");
     }
     // A pool of one: every row says one thread.
-    let out = manylight(
-        &[
-            "bench-assign",
-            "--lights",
-            "16,65536",
-            "--runs",
-            "3",
-            "--json",
-        ],
-        &[("RAYON_NUM_THREADS", "1")],
-        dir.path(),
-    );
-    assert!(out.status.success(), "{}", text(&out));
-    let rows: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-    for r in rows.as_array().unwrap() {
+    for r in rows_on("16,65536", "1") {
         assert_eq!(r["threads"], 1, "{r}");
     }
 }
