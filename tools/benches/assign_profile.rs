@@ -1,6 +1,7 @@
 //! Development aid: one workload assigned repeatedly with reused buffers (for profilers):
-//! `cargo bench --bench assign_profile -- LIGHTS [REPEATS] [--fine]` (or run its binary under
-//! a profiler); `--fine` takes the fine grid of [`AssignWorkload::fine_grid`].
+//! `cargo bench --bench assign_profile -- LIGHTS [REPEATS] [--fine | --hd]` (or run its binary under
+//! a profiler); `--fine` takes the fine grid of [`AssignWorkload::fine_grid`], `--hd` the
+//! renderer's 1280×720 grid pinned to 16-px cells ([`AssignWorkload::renderer_grid`]).
 use manylight::cluster::assign::Assigner;
 use manylight_tools::workload::AssignWorkload;
 
@@ -11,8 +12,11 @@ fn main() {
         .map(|a| a.parse::<usize>().ok());
     let count = args.next().flatten().unwrap_or(65_536);
     let repeats = args.next().flatten().unwrap_or(20);
-    let w = if std::env::args().any(|a| a == "--fine") {
+    let flag = |name: &str| std::env::args().any(|a| a == name);
+    let w = if flag("--fine") {
         AssignWorkload::fine_grid(count, 1)
+    } else if flag("--hd") {
+        AssignWorkload::renderer_grid(count, 1, (1280, 720), 16.0)
     } else {
         AssignWorkload::default_view(count, 1)
     };

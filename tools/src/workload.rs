@@ -57,6 +57,12 @@ impl AssignWorkload {
         })
     }
 
+    /// The grid the renderer's `--grid PX` pins at `size` (fixed `px`-pixel cells, no first
+    /// split): the renderer's own assignment, in a loop.
+    pub fn renderer_grid(count: usize, seed: u64, size: (u32, u32), px: f64) -> AssignWorkload {
+        Self::view_with(count, seed, size, |_, _| GridConfig::fixed(px))
+    }
+
     /// The default scene's camera with `count` random lights at `size` with the grid that
     /// `config` makes of the camera's near and far planes.
     pub fn view_with(

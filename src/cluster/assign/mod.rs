@@ -12,14 +12,15 @@
 //!   finds and sorts its own lights' runs, then blocks of cells gather the chunks' runs.
 //!
 //! ```text
-//! phase 1  per band (or chunk of lights): every light's runs of consecutive cells, and
-//!          per-cell counts kept as a difference array (two additions per run)
+//! phase 1  per band (or chunk of lights): every light's runs of consecutive cells
+//!          (chunks: and per-cell counts kept as a difference array, two additions per run)
 //! phase 2  the visible lights (a light is visible if any band listed it), numbered in light
-//!          order; counts → offsets (a band's in the same job as its phase 1, so two
-//!          threads meet twice a frame, not four times)
-//! phase 3  runs scattered into the list: bands straight into their own parts of it (a band
-//!          larger than a core's cache by blocks of cells, each block's runs of all lights
-//!          before the next); chunks into their own lists, then merged cell by cell
+//!          order; where each band's part of the list starts (chunks: counts → offsets)
+//! phase 3  bands, block by block of cells: a block's counts from the difference counts of
+//!          its parts of the runs, its offsets, and its runs scattered into the list while
+//!          the block is in cache (so two threads meet twice a frame, and each per-cell array
+//!          is written once); chunks: runs scattered into their own lists, then merged cell
+//!          by cell
 //! ```
 //!
 //! Why two: a fine grid gives each light hundreds of cells, and merging chunks cell by cell

@@ -447,7 +447,29 @@ fn scatter_blocks_of_any_number_give_the_same_lists() {
             FORCED_SCATTER_BLOCKS.with(|b| b.set(Some(blocks)));
             let cut = assign(&grid, &lights, case.far, &limits);
             assert_eq!(cut.offsets, whole.offsets, "{}, {blocks} blocks", case.name);
+            assert_eq!(cut.counts, whole.counts, "{}, {blocks} blocks", case.name);
             assert_eq!(cut.indices.to_vec(), whole.indices.to_vec(), "{}, {blocks}", case.name);
+            // The totals each block adds up (the block count changes how they are summed).
+            let stats = |a: &Assignment| {
+                let s = &a.stats;
+                (s.nonempty_clusters, s.max_lights_per_cluster, s.indices, s.runs)
+            };
+            assert_eq!(stats(&cut), stats(&whole), "{}, {blocks} blocks", case.name);
+            // Two bands, each cut into blocks: the second band's offsets take its base.
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(2)
+                .start_handler(move |_| FORCED_SCATTER_BLOCKS.with(|b| b.set(Some(blocks))))
+                .build()
+                .expect("a pool of two");
+            let parallel = AssignLimits {
+                parallel_threshold: 0,
+                ..limits
+            };
+            let banded = pool.install(|| assign(&grid, &lights, case.far, &parallel));
+            assert_eq!(banded.stats.threads, 2, "{}", case.name);
+            assert_eq!(banded.offsets, whole.offsets, "{}, two bands of {blocks}", case.name);
+            assert_eq!(banded.counts, whole.counts, "{}, two bands of {blocks}", case.name);
+            assert_eq!(banded.indices.to_vec(), whole.indices.to_vec(), "{}, {blocks}", case.name);
         }
         FORCED_SCATTER_BLOCKS.with(|b| b.set(None));
     }
