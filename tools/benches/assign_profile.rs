@@ -1,6 +1,6 @@
-//! Development aid: one workload assigned repeatedly with reused buffers (for profilers):
-//! `cargo bench --bench assign_profile -- LIGHTS [REPEATS] [--fine | --hd]` (or run its binary under
-//! a profiler); `--fine` takes the fine grid of [`AssignWorkload::fine_grid`], `--hd` the
+//! Development aid: one workload assigned repeatedly with reused buffers (for profilers): `cargo
+//! bench --bench assign_profile -- LIGHTS [REPEATS] [--fine | --hd]` (or run its binary under a
+//! profiler); `--fine` takes the fine grid of [`AssignWorkload::fine_grid`], `--hd` the
 //! renderer's 1280×720 grid pinned to 16-px cells ([`AssignWorkload::renderer_grid`]).
 use manylight::cluster::assign::Assigner;
 use manylight_tools::workload::AssignWorkload;
