@@ -1,7 +1,8 @@
 //! Development aid: one workload assigned repeatedly with reused buffers (for profilers): `cargo
 //! bench --bench assign_profile -- LIGHTS [REPEATS] [--fine | --hd]` (or run its binary under a
 //! profiler); `--fine` takes the fine grid of [`AssignWorkload::fine_grid`], `--hd` the
-//! renderer's 1280×720 grid pinned to 16-px cells ([`AssignWorkload::renderer_grid`]).
+//! default view at 1280×720 on a fixed grid of 16-px cells ([`AssignWorkload::renderer_grid`],
+//! near the renderer's `--size 1280x720 --grid 16`).
 use manylight::cluster::assign::Assigner;
 use manylight_tools::workload::AssignWorkload;
 

@@ -57,8 +57,10 @@ impl AssignWorkload {
         })
     }
 
-    /// The grid the renderer's `--grid PX` pins at `size` (fixed `px`-pixel cells, no first
-    /// split): the renderer's own assignment, in a loop.
+    /// A fixed grid of `px`-pixel cells (no first split) at `size`, as the renderer's `--grid
+    /// PX` makes, over the camera's near and far planes: near the renderer's own assignment
+    /// (whose depth range may give it fewer slices: 820 800 cells against this grid's 950 400
+    /// at 1280×720 on 16-px cells), in a loop.
     pub fn renderer_grid(count: usize, seed: u64, size: (u32, u32), px: f64) -> AssignWorkload {
         Self::view_with(count, seed, size, |_, _| GridConfig::fixed(px))
     }
