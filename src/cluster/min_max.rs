@@ -8,8 +8,9 @@
 //! differ from `f64::min` only in NaN: `a.at_most(b)` is `a.min(b)` whenever `a` is not NaN
 //! (a NaN `b` gives `a`, as `f64::min` does), but a NaN `a` stays NaN. aarch64 has
 //! `f64::min` and `max` in one instruction each (`fminnm`, `fmaxnm`; a comparison and a
-//! select take two), so there they are `f64::min` and `max`, and a NaN `a` gives `b`. Every caller puts first an operand that is never NaN, or
-//! one that is NaN only when the other is too, and says why: then both give the same.
+//! select take two), so there they are `f64::min` and `max`, and a NaN `a` gives `b`. Every
+//! caller puts first an operand that is never NaN, or one that is NaN only when the other is
+//! too, and says why: then both give the same.
 //! (Of two zeros x86-64 gives the first, aarch64 orders −0 below +0; no list depends on it:
 //! `scripts/check-aarch64` compares the lists made on both.)
 

@@ -183,8 +183,8 @@ impl Bands {
             band.base = indices;
             indices += band.indices;
         }
-        // Phase 3. Every count, offset and entry is written, so none is cleared first: only
-        // growth is zero-filled.
+        // Phase 3. Every offset and entry is written and the counts are cleared block by
+        // block there, so the resizing only zero-fills growth.
         room_for(&mut out.counts, cells);
         room_for(&mut out.offsets, cells);
         out.counts.resize(cells, 0);

@@ -21,9 +21,7 @@ impl Band {
     /// cursor array). Last, the block's offsets get the band's base.
     ///
     /// One block while the band's offsets and list fit a core's cache; more for a larger
-    /// band ([`scatter_blocks`]): then the cells' arrays are each touched in one pass, while
-    /// in cache, instead of a per-cell array of differences written at random over the whole
-    /// band, then summed, then scattered into, each pass cold.
+    /// band ([`scatter_blocks`]), so that each per-cell array is written once, in cache.
     pub(super) fn count_and_scatter<T: LightIndex>(
         &mut self,
         numbers: Option<&[u32]>,
