@@ -1,8 +1,9 @@
 //! Development aid: one workload assigned repeatedly with reused buffers (for profilers): `cargo
-//! bench --bench assign_profile -- LIGHTS [REPEATS] [--fine | --hd]` (or run its binary under a
-//! profiler); `--fine` takes the fine grid of [`AssignWorkload::fine_grid`], `--hd` the
-//! default view at 1280×720 on a fixed grid of 16-px cells ([`AssignWorkload::renderer_grid`],
-//! near the renderer's `--size 1280x720 --grid 16`).
+//! bench --bench assign_profile -- LIGHTS [REPEATS] [--fine | --hd | --size=WxH --grid=PX]` (or
+//! run its binary under a profiler); `--fine` takes the fine grid of
+//! [`AssignWorkload::fine_grid`], `--hd` the default view at 1280×720 on a fixed grid of 16-px
+//! cells ([`AssignWorkload::renderer_grid`], near the renderer's `--size 1280x720 --grid 16`),
+//! `--size` and `--grid` any such fixed grid (1280x720 and 16 px unless given).
 use manylight::cluster::assign::Assigner;
 use manylight_tools::workload::AssignWorkload;
 
@@ -14,10 +15,20 @@ fn main() {
     let count = args.next().flatten().unwrap_or(65_536);
     let repeats = args.next().flatten().unwrap_or(20);
     let flag = |name: &str| std::env::args().any(|a| a == name);
+    let value = |name: &str| {
+        let prefix = format!("--{name}=");
+        std::env::args().find_map(|a| a.strip_prefix(&prefix).map(str::to_string))
+    };
+    let size = value("size").map(|s| {
+        let (w, h) = s.split_once('x').expect("--size=WIDTHxHEIGHT");
+        (w.parse().expect("a width"), h.parse().expect("a height"))
+    });
+    let grid = value("grid").map(|px| px.parse::<f64>().expect("--grid=PX"));
     let w = if flag("--fine") {
         AssignWorkload::fine_grid(count, 1)
-    } else if flag("--hd") {
-        AssignWorkload::renderer_grid(count, 1, (1280, 720), 16.0)
+    } else if flag("--hd") || size.is_some() || grid.is_some() {
+        let size = size.unwrap_or((1280, 720));
+        AssignWorkload::renderer_grid(count, 1, size, grid.unwrap_or(16.0))
     } else {
         AssignWorkload::default_view(count, 1)
     };
