@@ -248,7 +248,6 @@ impl Assigner {
         }
         &self.out
     }
-
 }
 
 /// Keeps the bands' split of the pool aside while one thread runs (`last` threads ran the
