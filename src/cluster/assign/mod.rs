@@ -248,6 +248,7 @@ impl Assigner {
         }
         &self.out
     }
+
 }
 
 /// Keeps the bands' split of the pool aside while one thread runs (`last` threads ran the
