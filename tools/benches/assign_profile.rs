@@ -19,11 +19,21 @@ fn main() {
         let prefix = format!("--{name}=");
         std::env::args().find_map(|a| a.strip_prefix(&prefix).map(str::to_string))
     };
+    let fail = |what: &str| -> ! {
+        eprintln!("assign_profile: {what}");
+        std::process::exit(2)
+    };
     let size = value("size").map(|s| {
-        let (w, h) = s.split_once('x').expect("--size=WIDTHxHEIGHT");
-        (w.parse().expect("a width"), h.parse().expect("a height"))
+        let parsed = s.split_once('x').map(|(w, h)| (w.parse(), h.parse()));
+        match parsed {
+            Some((Ok(w), Ok(h))) if w > 0 && h > 0 => (w, h),
+            _ => fail("--size wants WIDTHxHEIGHT, both above 0"),
+        }
     });
-    let grid = value("grid").map(|px| px.parse::<f64>().expect("--grid=PX"));
+    let grid = value("grid").map(|px| match px.parse::<f64>() {
+        Ok(px) if px.is_finite() && px >= 1.0 => px,
+        _ => fail("--grid wants a cell footprint of 1 pixel or more"),
+    });
     let w = if flag("--fine") {
         AssignWorkload::fine_grid(count, 1)
     } else if flag("--hd") || size.is_some() || grid.is_some() {
