@@ -34,6 +34,12 @@ impl Bands {
         &self.bands[..self.active]
     }
 
+    /// Seconds the last split's bands spent in their phases 1 and 3, all together: the
+    /// threads' work, without their waiting.
+    pub(super) fn busy_seconds(&self) -> f64 {
+        self.active().iter().map(|band| band.seconds).sum()
+    }
+
     /// Where the last split cut the bands and what each took: what the next split follows.
     pub(super) fn split_record(&self) -> SplitRecord {
         SplitRecord {

@@ -52,11 +52,12 @@ mod rows;
 mod paths_tests;
 #[cfg(test)]
 mod tests;
+mod thread_choice;
 mod types;
 
 pub use types::{
-    AssignLimits, AssignStats, Assignment, MAX_ASSIGN_CELLS, PARALLEL_INDICES,
-    PARALLEL_MIN_LIGHTS, PARALLEL_SECONDS,
+    assign_work, AssignLimits, AssignStats, Assignment, INDEX_WEIGHT, MAX_ASSIGN_CELLS,
+    PARALLEL_INDICES, PARALLEL_MIN_LIGHTS, PARALLEL_SECONDS,
 };
 
 use crate::cluster::grid::ClusterGrid;
@@ -64,6 +65,7 @@ use crate::cluster::view_light::GpuLight;
 use bands::Bands;
 use chunks::Chunks;
 use overflow::{apply_cap, Overflow};
+use thread_choice::ThreadChoice;
 use types::Totals;
 
 /// Light assignment with buffers kept from frame to frame. One per renderer (or per thread).
@@ -81,6 +83,12 @@ pub struct Assigner {
     last_cpu_seconds: f64,
     /// Indices the last assignment listed (the lists may be a candidate's since).
     frame_indices: usize,
+    /// One thread or the pool, by measure, where the rules would take the pool.
+    choice: ThreadChoice,
+    /// Threads the last assignment took.
+    last_threads: usize,
+    /// The bands' split of the last assignment on the pool, kept while one thread runs.
+    pool_split: Option<bands::SplitRecord>,
 }
 
 /// What the next frame's assignment follows from the last frame's (its threads and the bands'
@@ -89,6 +97,8 @@ struct FrameRecord {
     cpu_seconds: f64,
     indices: usize,
     split: bands::SplitRecord,
+    choice: ThreadChoice,
+    threads: usize,
 }
 
 impl Assigner {
@@ -117,11 +127,15 @@ impl Assigner {
             cpu_seconds: self.last_cpu_seconds,
             indices: self.frame_indices,
             split: self.bands.split_record(),
+            choice: self.choice,
+            threads: self.last_threads,
         };
         self.assign(grid, lights, camera_far, limits);
         self.last_cpu_seconds = frame.cpu_seconds;
         self.frame_indices = frame.indices;
         self.bands.restore_split(&frame.split);
+        self.choice = frame.choice;
+        self.last_threads = frame.threads;
         &self.out
     }
 
@@ -180,13 +194,20 @@ impl Assigner {
             return &self.out;
         }
         let started = std::time::Instant::now();
-        let threads = threads_for(
+        let rule = threads_for(
             lights.len(),
             last_indices,
             last_cpu_seconds,
             limits,
             rayon::current_num_threads(),
         );
+        // Lights past the caller's threshold take the pool; the rules' other reasons are
+        // weighed against one thread by measure.
+        let chosen = rule > 1 && lights.len() < limits.parallel_threshold;
+        let threads = if chosen { self.choice.threads(rule) } else { rule };
+        keep_pool_split(&mut self.bands, &mut self.pool_split, self.last_threads, threads);
+        self.last_threads = threads;
+        let by_bands = threads == 1 || cells >= lights.len();
         let totals = if threads == 1 {
             self.bands.assign(grid, lights, camera_far, out, 1)
         } else {
@@ -195,7 +216,7 @@ impl Assigner {
             // every 63 jobs (so a parallel frame allocates once in 63 frames, not 3 times).
             let (bands, chunks) = (&mut self.bands, &mut self.chunks);
             rayon::scope(|_| {
-                if cells >= lights.len() {
+                if by_bands {
                     bands.assign(grid, lights, camera_far, out, threads)
                 } else {
                     chunks.assign(grid, lights, camera_far, out, threads)
@@ -220,8 +241,33 @@ impl Assigner {
         };
         out.stats.threads = threads;
         self.frame_indices = out.indices.len();
-        self.last_cpu_seconds = started.elapsed().as_secs_f64() * threads as f64;
+        let seconds = started.elapsed().as_secs_f64();
+        self.last_cpu_seconds = seconds * threads as f64;
+        if chosen {
+            let work = assign_work(out.stats.runs, out.indices.len(), grid.total_cells);
+            // The bands time their own work; the chunks of lights do not.
+            let busy = by_bands.then(|| self.bands.busy_seconds());
+            self.choice.measured(threads, seconds, work, busy);
+        }
         &self.out
+    }
+}
+
+/// Keeps the bands' split of the pool aside while one thread runs (`last` threads ran the
+/// last assignment, `threads` run this one), and puts it back for the pool's next assignment,
+/// so that a try of one thread costs the pool no balance.
+fn keep_pool_split(
+    bands: &mut Bands,
+    pool_split: &mut Option<bands::SplitRecord>,
+    last: usize,
+    threads: usize,
+) {
+    if threads == 1 && last > 1 {
+        *pool_split = Some(bands.split_record());
+    } else if threads > 1 && last == 1 {
+        if let Some(split) = pool_split.take() {
+            bands.restore_split(&split);
+        }
     }
 }
 
@@ -231,7 +277,9 @@ impl Assigner {
 /// [`PARALLEL_MIN_LIGHTS`] lights, one more than the whole [`PARALLEL_SECONDS`] in the
 /// previous one's CPU time (so two from one up), each worker getting enough work to repay its
 /// waking (tens of microseconds on some machines); else one, on the calling thread. Never more
-/// than one with `limits.parallel_threshold` at `usize::MAX`.
+/// than one with `limits.parallel_threshold` at `usize::MAX`. Where the pool comes from the
+/// previous assignment (its indices or its time), [`Assigner::assign`] then keeps the work on
+/// one thread where one thread measures at most 0.9× the pool's time ([`ThreadChoice`]).
 fn threads_for(
     lights: usize,
     last_indices: usize,

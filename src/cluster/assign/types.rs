@@ -28,6 +28,22 @@ pub const PARALLEL_MIN_LIGHTS: usize = 256;
 /// [`Assigner::assign`](super::Assigner::assign)).
 pub const MAX_ASSIGN_CELLS: u32 = 1 << 26;
 
+/// What an index or a cell weighs against a run in [`assign_work`].
+pub const INDEX_WEIGHT: f64 = 1.0 / 64.0;
+
+/// An assignment's work in units of one run: each run of consecutive cells a light touches
+/// (a row of a slice: its chord, its columns, the cone's test, the run and its two
+/// difference counts), plus [`INDEX_WEIGHT`] for each index scattered and each cell counted.
+///
+/// The automatic grid predicts an assignment's time from it, and an
+/// [`Assigner`](super::Assigner) compares one thread with the pool by it. Fitted to the
+/// renderer's assignments on the courtyard over footprints 64 to 8 px: the time follows the
+/// runs, while indices and cells add little, so a calibration at one grid predicts the others.
+/// The small weight keeps grids of very long runs (huge lights) from looking free.
+pub fn assign_work(runs: usize, indices: usize, cells: u32) -> f64 {
+    runs as f64 + INDEX_WEIGHT * (indices as f64 + f64::from(cells))
+}
+
 /// Limits of one assignment.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct AssignLimits {
@@ -39,7 +55,11 @@ pub struct AssignLimits {
     /// any assignment whose previous one (same [`Assigner`](super::Assigner)) listed
     /// [`PARALLEL_INDICES`] or more, and one that took [`PARALLEL_SECONDS`] of CPU time or
     /// more (from [`PARALLEL_MIN_LIGHTS`] lights) on a thread per such time and one, unless
-    /// this is `usize::MAX` (never in parallel).
+    /// this is `usize::MAX` (never in parallel). Those two by the previous assignment only
+    /// while the pool measures as fast: an [`Assigner`](super::Assigner) keeps one thread
+    /// where one thread takes at most 0.9× the pool's time per unit of work (the pool's own
+    /// estimate of it: what its workers spent working; tries of the other mode now and then).
+    /// From this count of lights up the pool always runs.
     pub parallel_threshold: usize,
 }
 

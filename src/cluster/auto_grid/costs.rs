@@ -10,19 +10,7 @@
 /// Frames whose per-unit costs make a figure (the median of the last this many).
 pub const CALIBRATION_WINDOW: usize = 9;
 
-/// What an index or a cell weighs against a run in [`assign_work`].
-pub const INDEX_WEIGHT: f64 = 1.0 / 64.0;
-
-/// An assignment's work in units of one run: each run of consecutive cells a light touches
-/// (a row of a slice: its chord, its columns, the cone's test, the run and its two
-/// difference counts), plus [`INDEX_WEIGHT`] for each index scattered and each cell counted.
-///
-/// Fitted to the renderer's assignments on the courtyard over footprints 64 to 8 px: the time
-/// follows the runs, while indices and cells add little, so a calibration at one grid predicts
-/// the others. The small weight keeps grids of very long runs (huge lights) from looking free.
-pub fn assign_work(runs: usize, indices: usize, cells: u32) -> f64 {
-    runs as f64 + INDEX_WEIGHT * (indices as f64 + f64::from(cells))
-}
+pub use crate::cluster::assign::{assign_work, INDEX_WEIGHT};
 
 /// Cost per unit in nanoseconds: what the model multiplies its counts by.
 ///

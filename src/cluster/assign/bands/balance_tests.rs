@@ -71,3 +71,35 @@ fn a_candidate_assigned_in_between_leaves_the_frames_split_and_threads() {
         assert_eq!((assigner.last_cpu_seconds, assigner.frame_indices), (seconds, indices));
     });
 }
+
+#[test]
+fn a_try_of_one_thread_leaves_the_pools_split_for_its_next_assignment() {
+    use crate::cluster::assign::keep_pool_split;
+    use crate::cluster::assign::tests::random_lights;
+    use crate::cluster::assign::{AssignLimits, Assigner};
+    use rand::SeedableRng;
+
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
+    let grid = view_grid(&GridConfig::fixed(16.0));
+    let lights = random_lights(&mut rand_pcg::Pcg64Mcg::seed_from_u64(7), 300, 20.0);
+    let on_pool = AssignLimits {
+        parallel_threshold: 0,
+        ..AssignLimits::default()
+    };
+    pool.install(|| {
+        let mut assigner = Assigner::new();
+        for _ in 0..3 {
+            assigner.assign(&grid, &lights, 80.0, &on_pool);
+        }
+        let split = assigner.bands.split_record();
+        assert_eq!(split.active, 2);
+        let (bands, kept) = (&mut assigner.bands, &mut assigner.pool_split);
+        keep_pool_split(bands, kept, 2, 1);
+        let mut out = Assignment::default();
+        bands.assign(&grid, &lights, 80.0, &mut out, 1);
+        assert_eq!(bands.active, 1, "one thread, one band");
+        keep_pool_split(bands, kept, 1, 2);
+        assert_eq!(bands.split_record(), split, "the pool's split is back");
+        assert!(kept.is_none());
+    });
+}
