@@ -58,6 +58,17 @@ impl Default for ThreadChoice {
 }
 
 impl ThreadChoice {
+    /// A choice that keeps one thread (`one`) or the pool and tries nothing (for the tests
+    /// that set each assignment's mode).
+    #[cfg(test)]
+    pub(super) fn kept(one: bool) -> ThreadChoice {
+        ThreadChoice {
+            one,
+            interval: u32::MAX,
+            ..ThreadChoice::default()
+        }
+    }
+
     /// Threads for an assignment that the rules would give the pool's `pool` (two or more):
     /// the kept mode's, or, when a try is due and the kept mode has been measured, the other's
     /// (never one thread while the pool's own assignments estimate it).
@@ -112,7 +123,7 @@ impl ThreadChoice {
             }
         } else if one != self.one {
             // A try that lost: the next one later.
-            self.interval = (self.interval * 2).min(LAST_TRY);
+            self.interval = self.interval.saturating_mul(2).min(LAST_TRY);
         }
     }
 }

@@ -103,3 +103,37 @@ fn a_try_of_one_thread_leaves_the_pools_split_for_its_next_assignment() {
         assert!(kept.is_none());
     });
 }
+
+#[test]
+fn one_thread_and_the_pool_by_turns_give_every_frame_its_own_lists() {
+    use crate::cluster::assign::tests::random_lights;
+    use crate::cluster::assign::thread_choice::ThreadChoice;
+    use crate::cluster::assign::{assign, AssignLimits, Assigner, PARALLEL_INDICES};
+    use rand::SeedableRng;
+
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
+    // Fine enough that every frame lists more than PARALLEL_INDICES, so the rules ask for the
+    // pool (the case the choice decides) whatever the assignments' times.
+    let grid = view_grid(&GridConfig::fixed(8.0));
+    let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(11);
+    let limits = AssignLimits::default();
+    // One thread on frames 3, 4, 7 (a switch, a stay, a single try), else the pool.
+    let one = [false, false, false, true, true, false, false, true, false, false];
+    pool.install(|| {
+        let mut assigner = Assigner::new();
+        for (frame, &one) in one.iter().enumerate() {
+            let lights = random_lights(&mut rng, 400, 20.0);
+            assigner.choice = ThreadChoice::kept(one);
+            let got = assigner.assign(&grid, &lights, 80.0, &limits);
+            let fresh = assign(&grid, &lights, 80.0, &limits);
+            if frame > 0 {
+                assert!(fresh.indices.len() >= PARALLEL_INDICES, "a frame the rules give the pool");
+                assert_eq!(got.stats.threads, if one { 1 } else { 2 }, "frame {frame}");
+            }
+            assert_eq!(got.visible, fresh.visible, "frame {frame}");
+            assert_eq!(got.offsets, fresh.offsets, "frame {frame}");
+            assert_eq!(got.counts, fresh.counts, "frame {frame}");
+            assert!(got.indices == fresh.indices, "frame {frame}: other indices");
+        }
+    });
+}
