@@ -137,3 +137,42 @@ fn one_thread_and_the_pool_by_turns_give_every_frame_its_own_lists() {
         }
     });
 }
+
+#[test]
+fn switching_between_one_thread_and_the_pool_grows_no_buffer_after_each_has_run() {
+    use crate::cluster::assign::tests::random_lights;
+    use crate::cluster::assign::thread_choice::ThreadChoice;
+    use crate::cluster::assign::{AssignLimits, Assigner};
+    use rand::SeedableRng;
+
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
+    let grid = view_grid(&GridConfig::fixed(8.0));
+    let lights = random_lights(&mut rand_pcg::Pcg64Mcg::seed_from_u64(13), 400, 20.0);
+    let limits = AssignLimits::default();
+    // Every buffer's capacity: the bands' (those a split leaves out too), the numbers, the
+    // output's per-cell arrays and visible lights (the index list's length is the same in
+    // either mode).
+    let capacities = |a: &Assigner| -> Vec<usize> {
+        let bands = a.bands.bands.iter().flat_map(|b| {
+            [b.runs.capacity(), b.lights.capacity(), b.ids.capacity(), b.cursors.capacity()]
+        });
+        let out = &a.out;
+        bands
+            .chain([a.bands.numbers.capacity(), out.visible.capacity()])
+            .chain([out.offsets.capacity(), out.counts.capacity()])
+            .collect()
+    };
+    pool.install(|| {
+        let mut assigner = Assigner::new();
+        let mut run = |modes: &[bool]| {
+            for &one in modes {
+                assigner.choice = ThreadChoice::kept(one);
+                assigner.assign(&grid, &lights, 80.0, &limits);
+            }
+            capacities(&assigner)
+        };
+        let warm = run(&[false, false, true, true, false]);
+        let after = run(&[true, false, false, true, false, true, true, false, true, false]);
+        assert_eq!(warm, after, "a buffer grew after the warm-up");
+    });
+}
