@@ -7,9 +7,11 @@
 //! The choice keeps one mode and now and then tries the other on one assignment. Each mode is
 //! judged by the fastest of its last [`WINDOW`] times per unit of work: other work on the
 //! cores only ever slows a mode down, so a slow start (a driver compiling shaders on the same
-//! cores in a renderer's first frames) or a slow patch is soon forgotten. Tries come at
-//! growing intervals while they lose ([`FIRST_TRY`] to [`LAST_TRY`] assignments apart), and
-//! soon again after a switch.
+//! cores in a renderer's first frames) or a slow patch is soon forgotten. While the pool is
+//! kept, its workers' busy time stands for one thread's, so it is not interrupted by tries
+//! (the bands report it; the chunks of lights do not, and are tried). Tries come at growing
+//! intervals while they lose ([`FIRST_TRY`] to [`LAST_TRY`] assignments apart), and soon
+//! again after a switch.
 
 /// Assignments between the first try of the other mode and the previous one, and after a
 /// switch.
@@ -90,9 +92,9 @@ impl ThreadChoice {
 
     /// Takes in an assignment on `threads` threads that took `seconds` for `work` units, and
     /// keeps the mode whose best recent time is best (with [`ONE_THREAD_GAIN`]'s margin).
-    /// `busy` is what the pool's workers spent working, where it is known: one thread's time
-    /// less the little that only one thread does (numbering the visible lights, the overflow
-    /// policy), which stands for one thread's time while the pool is kept.
+    /// `busy` is what the pool's workers spent working, where it is known (the bands' phases
+    /// 1 and 3): about one thread's time (more where each band sets up the same lights, less
+    /// by what runs outside the bands), which stands for it while the pool is kept.
     pub(super) fn measured(&mut self, threads: usize, seconds: f64, work: f64, busy: Option<f64>) {
         if !(work > 0.0 && seconds.is_finite() && seconds > 0.0) {
             return;
