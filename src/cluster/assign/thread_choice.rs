@@ -194,7 +194,7 @@ mod tests {
         let threads = run(&mut choice, 200, |_| 2e-3, |_| 1e-3);
         assert_eq!(threads[0], 4);
         assert_eq!(threads[1], 1, "one thread is tried early");
-        // Tries 2, 4, 8, 16, 32, 32, ... apart: 8 in 200, none twice in a row.
+        // Tries 2, 4, 8, 16, 32, 32, ... apart: 9 in 200, none twice in a row.
         assert!((6..=9).contains(&ones(&threads)), "{threads:?}");
         assert!(threads.windows(2).all(|w| w != [1, 1]), "{threads:?}");
         assert_eq!(ones(&threads[100..164]), 2, "one try in 32 once settled");
