@@ -143,6 +143,17 @@ pub fn other_implementation_than_mesa(what: &str) -> bool {
     })
 }
 
+/// For a test whose child processes each pick their own GLES implementation (the tests of
+/// every implementation against forward): true, after saying so on stderr, when this run
+/// renders with another implementation (`MANYLIGHT_GLES_LIB`). Its children do the same work
+/// whatever this run's implementation is, so it runs once, in the suite's run on the system's
+/// GL, and `MANYLIGHT_REQUIRE_ALL_TESTS` does not turn this into a failure.
+pub fn picks_its_own_implementations(what: &str) -> bool {
+    not_applicable_on_another_implementation(|dir| {
+        format!("{what} picks its implementations itself; it runs without MANYLIGHT_GLES_LIB, not again with {dir}")
+    })
+}
+
 /// For a test that never touches GL (offline shader validation): true, after saying so on
 /// stderr, when this run renders with another GLES implementation (`MANYLIGHT_GLES_LIB`).
 /// Its result is the same on every implementation, so it runs once, in the suite's run on the
