@@ -29,6 +29,12 @@ fn gles_dir() -> PathBuf {
     dir
 }
 
+/// Whether this is the suite's run on another implementation, where these tests do nothing
+/// (see the top).
+fn in_another_implementations_run() -> bool {
+    common::picks_its_own_implementations("tools/tests/gles_implementations.rs")
+}
+
 /// One matrix cell on implementation `name` (a folder of `MANYLIGHT_GLES_DIR`).
 fn cell(name: &str, es: &str, scene: &str, extra: &[&str]) -> Value {
     let out = tempfile::tempdir().expect("temp dir");
@@ -103,7 +109,7 @@ fn methods_equal_forward(name: &str, family: &str) {
     ignore = "needs SwiftShader and ANGLE: scripts/fetch-gles, then set MANYLIGHT_GLES_DIR"
 )]
 fn every_method_equals_forward_on_swiftshader() {
-    if common::picks_its_own_implementations("every method equals forward on swiftshader") {
+    if in_another_implementations_run() {
         return;
     }
     methods_equal_forward("swiftshader", "SwiftShader");
@@ -115,7 +121,7 @@ fn every_method_equals_forward_on_swiftshader() {
     ignore = "needs SwiftShader and ANGLE: scripts/fetch-gles, then set MANYLIGHT_GLES_DIR"
 )]
 fn every_method_equals_forward_on_angle() {
-    if common::picks_its_own_implementations("every method equals forward on angle") {
+    if in_another_implementations_run() {
         return;
     }
     methods_equal_forward("angle", "ANGLE");
@@ -128,7 +134,7 @@ fn every_method_equals_forward_on_angle() {
     ignore = "needs SwiftShader and ANGLE: scripts/fetch-gles, then set MANYLIGHT_GLES_DIR"
 )]
 fn info_names_the_chosen_implementation_and_its_files() {
-    if common::picks_its_own_implementations("info names the chosen implementation and its files") {
+    if in_another_implementations_run() {
         return;
     }
     let dir = gles_dir().join("swiftshader");
@@ -162,7 +168,7 @@ fn info_names_the_chosen_implementation_and_its_files() {
     ignore = "needs SwiftShader and ANGLE: scripts/fetch-gles, then set MANYLIGHT_GLES_DIR"
 )]
 fn matrix_adds_a_row_group_per_implementation() {
-    if common::picks_its_own_implementations("matrix adds a row group per implementation") {
+    if in_another_implementations_run() {
         return;
     }
     let dir = tempfile::tempdir().unwrap();

@@ -430,8 +430,8 @@ fn crowded_cells_and_index_lists_past_16_bits() {
             .collect();
         check(&format!("{n} lights in one cell"), &s, 64, 36);
     }
-    // Enough big lights that the index list passes 65 536 entries (246 209 at 64×36 on the
-    // default grid: past 16 bits without the shading cost of a larger frame).
+    // Enough big lights that the index list passes 65 536 entries, in a small frame: the
+    // assertion below checks that it still does.
     let mut s = plane();
     s.lights = (0..3000)
         .map(|i| {
