@@ -15,18 +15,30 @@ use khronos_egl as egl;
 use super::gles_lib::{self, Egl, GlesLibrary};
 use super::{EsVersion, GlError};
 
+#[cfg(test)]
+mod thread_tests;
+
 /// `EGL_PLATFORM_SURFACELESS_MESA`.
 const PLATFORM_SURFACELESS_MESA: egl::Enum = 0x31DD;
 
-/// An EGL display + context current on the creating thread. Keep it alive as long as anything
-/// uses the GL context it made (the [`crate::Renderer`] built from [`HeadlessContext::load_gl`]).
+/// An EGL display + context, current on the creating thread until
+/// [`HeadlessContext::release_current`]. Keep it alive as long as anything uses the GL context
+/// it made (the [`crate::Renderer`] built from [`HeadlessContext::load_gl`]).
 pub struct HeadlessContext {
     lib: &'static GlesLibrary,
     display: egl::Display,
     context: egl::Context,
     surface: Option<egl::Surface>,
     info: EglInfo,
+    /// The thread that made it, the only one it may be current on where it cannot move
+    /// ([`HeadlessContext::can_move_between_threads`]).
+    made_on: std::thread::ThreadId,
 }
+
+// SAFETY: the EGL handles are process-wide and EGL may be called from any thread; a context
+// is current on at most one thread, which EGL itself enforces (EGL_BAD_ACCESS), and dropping
+// it where it is not current only releases the dropping thread's own context.
+unsafe impl Send for HeadlessContext {}
 
 /// How the context was made, for `manylight info`.
 #[derive(Clone, Debug, serde::Serialize)]
@@ -93,6 +105,7 @@ impl HeadlessContext {
                         context,
                         surface,
                         info,
+                        made_on: std::thread::current().id(),
                     });
                 }
                 Err(e @ GlError::VersionUnavailable { .. }) => return Err(e),
@@ -234,6 +247,44 @@ impl HeadlessContext {
         unsafe { glow::Context::from_loader_function(|name| self.lib.proc_address(name)) }
     }
 
+    /// Whether the context may be made current on a thread other than the one that made it.
+    /// Not on ANGLE: its GL back end keeps a native context current on the thread that
+    /// initialised the display (see [`EglInfo::terminate_when_unused`]), and crashed in
+    /// `eglMakeCurrent` when a context was made current on another.
+    pub fn can_move_between_threads(&self) -> bool {
+        !self.info.terminate_when_unused
+    }
+
+    /// Makes the context current on the calling thread, as [`HeadlessContext::new`] did on
+    /// the creating one: how a context moves to another thread (a test harness's pool, say),
+    /// after [`HeadlessContext::release_current`] on the thread that used it last. An error
+    /// on another thread than the creating one where the context cannot move
+    /// ([`HeadlessContext::can_move_between_threads`]).
+    pub fn make_current(&self) -> Result<(), GlError> {
+        if !self.can_move_between_threads() && std::thread::current().id() != self.made_on {
+            return Err(GlError::Unsupported(format!(
+                "this {} context cannot be made current on another thread than the one that \
+                 made it",
+                self.info.egl_vendor
+            )));
+        }
+        let _lock = LIVE_CONTEXTS.lock().unwrap_or_else(|e| e.into_inner());
+        self.lib
+            .egl()
+            .make_current(self.display, self.surface, self.surface, Some(self.context))
+            .map_err(egl_err("eglMakeCurrent"))
+    }
+
+    /// Makes no context current on the calling thread, so that another thread may make this
+    /// one current. Nothing may draw with it here until [`HeadlessContext::make_current`].
+    pub fn release_current(&self) -> Result<(), GlError> {
+        let _lock = LIVE_CONTEXTS.lock().unwrap_or_else(|e| e.into_inner());
+        self.lib
+            .egl()
+            .make_current(self.display, None, None, None)
+            .map_err(egl_err("eglMakeCurrent"))
+    }
+
     /// How the context was made.
     pub fn info(&self) -> &EglInfo {
         &self.info
@@ -262,6 +313,6 @@ impl Drop for HeadlessContext {
 }
 
 /// Headless contexts alive in the process, for the ANGLE workaround of
-/// [`EglInfo::terminate_when_unused`]; its lock also serialises making and destroying
+/// [`EglInfo::terminate_when_unused`]; its lock also serialises making, moving and destroying
 /// contexts (SwiftShader's EGL display is not thread-safe there).
 static LIVE_CONTEXTS: std::sync::Mutex<usize> = std::sync::Mutex::new(0);

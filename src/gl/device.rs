@@ -107,6 +107,12 @@ impl Device {
         self.live.get()
     }
 
+    /// Counts `n` programs built by another device on this context as this one's (a negative
+    /// `n`: handed to another), for [`crate::Renderer::adopt_programs`].
+    pub(crate) fn count_handed_programs(&self, n: i64) {
+        self.count(|l| l.programs += n);
+    }
+
     fn count(&self, f: impl FnOnce(&mut LiveObjects)) {
         let mut l = self.live.get();
         f(&mut l);

@@ -32,7 +32,7 @@ pub const ATTRIBUTES: &[(u32, &str)] = &[
 pub struct Program {
     raw: glow::Program,
     /// The [`UniformSet`] it was linked with.
-    uniforms: Box<dyn Any>,
+    uniforms: Box<dyn Any + Send>,
     /// Total assembled source size in bytes (vertex + fragment), for stats.
     pub source_bytes: usize,
     destroyed: bool,
@@ -126,7 +126,7 @@ impl<T: UniformType> Uniform<T> {
 }
 
 /// The typed uniforms of one kind of program: resolved once when a program is linked.
-pub trait UniformSet: Sized + 'static {
+pub trait UniformSet: Sized + Send + 'static {
     /// Looks up every uniform of the set in `r`'s program, saying which ones the variant
     /// ([`Resolver::features`], [`Resolver::es`]) must have.
     fn resolve(r: &mut Resolver<'_>) -> Self;

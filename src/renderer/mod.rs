@@ -110,6 +110,27 @@ impl Renderer {
         })
     }
 
+    /// Frees the renderer's GL objects except its built programs, which it hands over for
+    /// [`Renderer::adopt_programs`] (`lab`: the tests keep them per context, since SwiftShader
+    /// compiles each program's code again for every new one).
+    #[cfg(feature = "lab")]
+    pub fn destroy_keeping_programs(mut self) -> ProgramCache {
+        let programs = std::mem::take(&mut self.programs);
+        self.dev.count_handed_programs(-(programs.len() as i64));
+        self.free_gl();
+        programs
+    }
+
+    /// Uses `programs`, built by an earlier renderer on this same context (from
+    /// [`Renderer::destroy_keeping_programs`]), instead of building them again. (A program
+    /// keeps the uniform values last set in it; each draw sets the ones it reads.)
+    #[cfg(feature = "lab")]
+    pub fn adopt_programs(&mut self, programs: ProgramCache) {
+        self.dev.count_handed_programs(programs.len() as i64);
+        let mut own = std::mem::replace(&mut self.programs, programs);
+        own.destroy(&self.dev);
+    }
+
     /// The probed capabilities.
     pub fn caps(&self) -> &Caps {
         self.dev.caps()

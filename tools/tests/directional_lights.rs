@@ -190,7 +190,8 @@ fn only_a_scene_with_an_active_sun_builds_the_sun_code() {
             .map(|p| p.shader.to_string())
             .collect::<Vec<_>>()
     };
-    let mut gpu = Gpu::new(EsVersion::Es3);
+    // Fresh: the report is of the variants this renderer built.
+    let mut gpu = Gpu::fresh(EsVersion::Es3);
     let mut dark = scene::builtin::build("courtyard", Some((16, 2))).unwrap();
     dark.directional_lights = vec![DirectionalLight::new(DVec3::NEG_Y, Vec3::ONE, 0.0)];
     gpu.r().set_method_named("deferred").unwrap();

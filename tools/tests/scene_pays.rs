@@ -1,6 +1,7 @@
 //! A scene pays only for what it uses: variants leave out absent features (checked on the
 //! assembled source) without changing the image, methods free their resources when switched
-//! away, zero lights cost nothing, and transparency is lit like everything else.
+//! away, a renderer given an earlier one's programs builds none, zero lights cost nothing,
+//! and transparency is lit like everything else.
 
 mod common;
 
@@ -9,7 +10,7 @@ use glam::{DVec3, Vec3};
 use manylight::gl::shader_source::{assemble, Stage};
 use manylight::methods::ShaderFeatures;
 use manylight::scene::{self, Light};
-use manylight::{EsVersion, RenderOptions};
+use manylight::{EsVersion, HeadlessContext, RenderOptions, Renderer};
 
 #[test]
 fn variants_without_spots_or_textures_contain_no_such_code() {
@@ -78,7 +79,8 @@ fn point_light_scene() -> scene::Scene {
 fn lean_variants_render_exactly_like_the_full_ones() {
     let s = point_light_scene();
     for es in [EsVersion::Es2, EsVersion::Es3] {
-        let mut gpu = Gpu::new(es);
+        // Fresh: the report below is of the variants this renderer built.
+        let mut gpu = Gpu::fresh(es);
         for method in ["forward", "tiled", "clustered"] {
             gpu.r().set_method_named(method).unwrap();
             let (lean, stats) = gpu
@@ -126,6 +128,31 @@ fn lean_variants_render_exactly_like_the_full_ones() {
         };
         assert!(size(false) < size(true), "the lean variant is smaller");
     }
+}
+
+/// What the test harness's pool relies on (`common::Gpu`): a renderer given the programs an
+/// earlier one built on the same context builds none of its own, counts them as its own, and
+/// draws the same picture.
+#[test]
+fn a_renderer_given_an_earlier_ones_programs_builds_none_and_draws_the_same() {
+    let s = point_light_scene();
+    let opts = RenderOptions::default();
+    let ctx = HeadlessContext::new(EsVersion::Es3).expect("a headless ES 3.0 context");
+    let mut first = Renderer::new(ctx.load_gl(), EsVersion::Es3).unwrap();
+    first.set_method_named("clustered").unwrap();
+    let (before, _) = first.render_offscreen(&s, 64, 36, &opts).unwrap();
+    let built = first.program_report();
+    assert!(!built.is_empty());
+    let programs = first.destroy_keeping_programs();
+    let mut second = Renderer::new(ctx.load_gl(), EsVersion::Es3).unwrap();
+    second.adopt_programs(programs);
+    assert_eq!(second.live_gl_objects().programs, built.len() as i64);
+    second.set_method_named("clustered").unwrap();
+    let (after, _) = second.render_offscreen(&s, 64, 36, &opts).unwrap();
+    assert_eq!(second.program_report(), built, "programs built again");
+    assert_eq!(second.live_gl_objects().programs, built.len() as i64);
+    assert!(before == after, "another picture with the same programs");
+    second.destroy();
 }
 
 #[test]

@@ -9,35 +9,74 @@ pub mod warnings;
 
 use std::path::PathBuf;
 
-use manylight::gl::HeadlessContext;
+use manylight::gl::program::ProgramCache;
+use manylight::gl::{HeadlessContext, Restrictions};
 use manylight::metrics::cpu_reference::{self, Encoding};
-use std::sync::Arc;
+use std::sync::{Arc, Mutex};
 
 use glam::{DMat4, DVec3, Vec3};
 use manylight::scene::meshbuild::MeshBuilder;
 use manylight::scene::{Camera, Material, Object, Scene};
 use manylight::{EsVersion, RenderOptions, Renderer};
 
-/// A headless context and a renderer on it (the context must outlive the renderer).
+/// A headless context and a new renderer on it. The context, and the programs the renderers
+/// on it built, come from an earlier test of the same program where one has finished (see
+/// [`POOL`]); [`Gpu::fresh`] builds every program anew.
 pub struct Gpu {
     pub renderer: Option<Renderer>,
-    _ctx: HeadlessContext,
+    ctx: Option<HeadlessContext>,
+    kind: ContextKind,
 }
+
+/// What a context's renderers are made for: their ES level and restrictions.
+type ContextKind = (EsVersion, Restrictions);
+
+/// Contexts whose tests have finished, each with the programs built on it. SwiftShader compiles
+/// a program's code again in every new context (about a second a shader variant): made anew in
+/// every test, the same variants took three quarters of its run (docs/testing.md).
+static POOL: Mutex<Vec<(ContextKind, HeadlessContext, ProgramCache)>> = Mutex::new(Vec::new());
 
 impl Gpu {
     pub fn new(es: EsVersion) -> Gpu {
-        Gpu::restricted(es, &manylight::gl::Restrictions::default())
+        Gpu::restricted(es, &Restrictions::default())
     }
 
     /// A renderer playing a weaker device (see `manylight::gl::Restrictions`).
-    pub fn restricted(es: EsVersion, restrictions: &manylight::gl::Restrictions) -> Gpu {
+    pub fn restricted(es: EsVersion, restrictions: &Restrictions) -> Gpu {
+        let kind = (es, *restrictions);
+        let pooled = {
+            let mut pool = POOL.lock().unwrap_or_else(|e| e.into_inner());
+            let found = pool.iter().position(|(k, _, _)| *k == kind);
+            found.map(|i| pool.swap_remove(i))
+        };
+        let Some((_, ctx, programs)) = pooled else {
+            return Gpu::fresh_restricted(es, restrictions);
+        };
+        ctx.make_current().expect("a pooled context made current");
+        let mut renderer = Renderer::restricted(ctx.load_gl(), es, restrictions).expect("renderer");
+        renderer.adopt_programs(programs);
+        Gpu {
+            renderer: Some(renderer),
+            ctx: Some(ctx),
+            kind,
+        }
+    }
+
+    /// A new context and renderer, which builds every program it draws with: for tests of
+    /// what a renderer builds or holds.
+    pub fn fresh(es: EsVersion) -> Gpu {
+        Gpu::fresh_restricted(es, &Restrictions::default())
+    }
+
+    fn fresh_restricted(es: EsVersion, restrictions: &Restrictions) -> Gpu {
         let ctx = HeadlessContext::new(es).unwrap_or_else(|e| {
             panic!("no headless {es} context ({e}); install libegl1 libegl-mesa0 libgles2 libgl1-mesa-dri")
         });
         let renderer = Renderer::restricted(ctx.load_gl(), es, restrictions).expect("renderer");
         Gpu {
             renderer: Some(renderer),
-            _ctx: ctx,
+            ctx: Some(ctx),
+            kind: (es, *restrictions),
         }
     }
 
@@ -60,10 +99,27 @@ impl Gpu {
 }
 
 impl Drop for Gpu {
+    /// Frees the renderer and pools the context with its programs, released so that the next
+    /// test's thread can make it current; after a failure (a panic) nothing is pooled, so that
+    /// one test's broken state cannot fail the next, nor where contexts cannot move between
+    /// threads (ANGLE).
     fn drop(&mut self) {
-        if let Some(r) = self.renderer.take() {
-            r.destroy();
+        let (Some(renderer), Some(ctx)) = (self.renderer.take(), self.ctx.take()) else {
+            return;
+        };
+        if std::thread::panicking() {
+            renderer.destroy();
+            return;
         }
+        if !ctx.can_move_between_threads() {
+            // ANGLE: the next test's thread could not use it.
+            renderer.destroy();
+            return;
+        }
+        let programs = renderer.destroy_keeping_programs();
+        ctx.release_current().expect("the context released");
+        let mut pool = POOL.lock().unwrap_or_else(|e| e.into_inner());
+        pool.push((self.kind, ctx, programs));
     }
 }
 
