@@ -249,8 +249,8 @@ impl HeadlessContext {
 
     /// Whether the context may be made current on a thread other than the one that made it.
     /// Not on ANGLE: its GL back end keeps a native context current on the thread that
-    /// initialised the display (see [`EglInfo::terminate_when_unused`]), and crashed in
-    /// `eglMakeCurrent` when a context was made current on another.
+    /// initialised the display, and crashed in `eglMakeCurrent` when a context was made
+    /// current on another (docs/drivers.md).
     pub fn can_move_between_threads(&self) -> bool {
         !self.info.terminate_when_unused
     }
