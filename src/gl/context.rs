@@ -18,6 +18,23 @@ use super::{EsVersion, GlError};
 #[cfg(test)]
 mod thread_tests;
 
+/// A headless context for a unit test, or `None` where the machine has no EGL (the test then
+/// skips); with `MANYLIGHT_REQUIRE_ALL_TESTS` set, no context fails the test instead.
+#[cfg(test)]
+pub(crate) fn context_or_skip(es: EsVersion) -> Option<HeadlessContext> {
+    match HeadlessContext::new(es) {
+        Ok(ctx) => Some(ctx),
+        Err(e) => {
+            assert!(
+                std::env::var_os("MANYLIGHT_REQUIRE_ALL_TESTS").is_none(),
+                "no headless context: {e}"
+            );
+            eprintln!("skipped: no headless {es} context ({e})");
+            None
+        }
+    }
+}
+
 /// `EGL_PLATFORM_SURFACELESS_MESA`.
 const PLATFORM_SURFACELESS_MESA: egl::Enum = 0x31DD;
 

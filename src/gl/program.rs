@@ -497,24 +497,16 @@ impl ProgramCache {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::gl::context::context_or_skip;
     use crate::gl::HeadlessContext;
 
     /// A headless ES 3.0 device, or `None` (a skip) on a machine without EGL.
     fn device() -> Option<(Device, HeadlessContext)> {
-        match HeadlessContext::new(EsVersion::Es3) {
-            Ok(ctx) => Some((
-                Device::new(ctx.load_gl(), EsVersion::Es3).expect("device"),
-                ctx,
-            )),
-            Err(e) => {
-                assert!(
-                    std::env::var_os("MANYLIGHT_REQUIRE_ALL_TESTS").is_none(),
-                    "no headless context: {e}"
-                );
-                eprintln!("skipped: no headless context ({e})");
-                None
-            }
-        }
+        let ctx = context_or_skip(EsVersion::Es3)?;
+        Some((
+            Device::new(ctx.load_gl(), EsVersion::Es3).expect("device"),
+            ctx,
+        ))
     }
 
     /// The link-time problems of `U` on `shader`, or "" when it links.

@@ -204,7 +204,7 @@ pub(crate) fn inv_height(texture: &DataTexture) -> f32 {
 mod tests {
     use super::*;
     use crate::gl::program::{ProgramCache, ProgramKey, UniformSet};
-    use crate::gl::HeadlessContext;
+    use crate::gl::context::context_or_skip;
     use crate::methods::culled::ClusteredProgram;
     use crate::methods::deferred::{CompositeProgram, GBufferProgram, LightProgram};
     use crate::methods::forward::ForwardProgram;
@@ -270,16 +270,8 @@ mod tests {
             (EsVersion::Es2, true),
             (EsVersion::Es3, false),
         ] {
-            let ctx = match HeadlessContext::new(es) {
-                Ok(ctx) => ctx,
-                Err(e) => {
-                    assert!(
-                        std::env::var_os("MANYLIGHT_REQUIRE_ALL_TESTS").is_none(),
-                        "no headless context: {e}"
-                    );
-                    eprintln!("skipped: no headless {es} context ({e})");
-                    return;
-                }
+            let Some(ctx) = context_or_skip(es) else {
+                return;
             };
             let restrictions = crate::gl::Restrictions { no_fragment_highp };
             let dev = Device::restricted(ctx.load_gl(), es, &restrictions).expect("device");

@@ -21,16 +21,8 @@ fn render_plane(ctx: &HeadlessContext) -> image::RgbaImage {
 /// error, not a crash. Either way it is current again on its own thread afterwards.
 #[test]
 fn a_released_context_draws_on_another_thread_or_is_refused_there() {
-    let ctx = match HeadlessContext::new(EsVersion::Es3) {
-        Ok(ctx) => ctx,
-        Err(e) => {
-            assert!(
-                std::env::var_os("MANYLIGHT_REQUIRE_ALL_TESTS").is_none(),
-                "no headless context: {e}"
-            );
-            eprintln!("skipped: no headless context ({e})");
-            return;
-        }
+    let Some(ctx) = super::context_or_skip(EsVersion::Es3) else {
+        return;
     };
     let here = render_plane(&ctx);
     assert!(

@@ -107,12 +107,7 @@ impl Drop for Gpu {
         let (Some(renderer), Some(ctx)) = (self.renderer.take(), self.ctx.take()) else {
             return;
         };
-        if std::thread::panicking() {
-            renderer.destroy();
-            return;
-        }
-        if !ctx.can_move_between_threads() {
-            // ANGLE: the next test's thread could not use it.
+        if std::thread::panicking() || !ctx.can_move_between_threads() {
             renderer.destroy();
             return;
         }
