@@ -575,7 +575,8 @@ fn hostile_files_and_counts_are_refused_quickly_and_clearly() {
 }
 
 /// Errors found before or during a bench name what is at fault and print nothing else: no
-/// "GL … leaked" warnings from the error path.
+/// "GL … leaked" warnings from the error path. A scene that does not load is found before the
+/// first row (the scenes before it are not measured first: their pictures would be written).
 #[test]
 fn bench_errors_name_the_fault_without_leak_warnings() {
     let dir = tempfile::tempdir().unwrap();
@@ -595,14 +596,41 @@ fn bench_errors_name_the_fault_without_leak_warnings() {
                 "3",
                 "--scenes",
                 "plane,nowhere.obj",
+                "--out",
+                "scenes",
             ],
             "nowhere.obj",
+        ),
+        // During the sweep: the renderer exists when its first target is refused.
+        (
+            &[
+                "bench",
+                "--quick",
+                "--no-knobs",
+                "--es",
+                "3",
+                "--lights",
+                "0",
+                "--size",
+                "65536x16",
+                "--out",
+                "size",
+            ],
+            "65536",
         ),
     ];
     for (args, needle) in cases {
         let msg = expect_exit(args, &[], dir.path(), 1, needle);
         assert!(!msg.contains("leaked"), "{args:?}: {msg}");
     }
+    let written: Vec<_> = std::fs::read_dir(dir.path().join("scenes"))
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert!(
+        written.is_empty(),
+        "a bench whose second scene does not load measured the first: {written:?}"
+    );
 }
 
 #[test]

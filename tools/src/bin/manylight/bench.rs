@@ -351,6 +351,12 @@ pub fn run(args: &BenchArgs) -> Result<(), Box<dyn std::error::Error>> {
     std::fs::write(&probe, b"")
         .and_then(|()| std::fs::remove_file(&probe))
         .map_err(|e| format!("cannot write into {}: {e}", args.out.display()))?;
+    // Every scene loads once here, so a bad one fails the sweep before its first row, not
+    // after the scenes before it were measured.
+    let first_count = plan.lights.first().copied().unwrap_or(0);
+    for spec in &plan.scenes {
+        load_bench_scene(spec, first_count, args)?;
+    }
     let knob_list = if plan.knobs {
         knobs(args.quick)
     } else {
