@@ -73,17 +73,27 @@ fn appendix_a_config(dir: &Path) -> std::path::PathBuf {
 }
 
 fn validate(conf: Option<&Path>, file: &Path) -> Result<(), String> {
+    validate_all(conf, std::slice::from_ref(&file))
+}
+
+/// [`validate`] for many files in one run of the validator (a run per file spent most of this
+/// test's minute starting processes).
+fn validate_all(conf: Option<&Path>, files: &[&Path]) -> Result<(), String> {
     let mut cmd = Command::new("glslangValidator");
     if let Some(c) = conf {
         cmd.arg(c);
     }
-    let out = cmd.arg(file).output().expect("run glslangValidator");
+    let out = cmd.args(files).output().expect("run glslangValidator");
     if out.status.success() {
         Ok(())
     } else {
         Err(String::from_utf8_lossy(&out.stdout).into_owned())
     }
 }
+
+/// Files validated together; a group that fails is validated file by file, so that each
+/// failure names its own variant.
+const BATCH: usize = 200;
 
 /// Every combination of feature bits a colour variant can have, the count variants
 /// (evaluations, reaching lights, heatmap) with and without spots and RGBA8 light data, the
@@ -209,22 +219,29 @@ fn colour_features() -> Vec<ShaderFeatures> {
         .collect()
 }
 
-/// The source without `#define` lines of macros the body never mentions: two variants that
-/// differ only there compile to the same program.
+/// The name a `#define` line defines.
+fn defined_name(line: &str) -> Option<&str> {
+    line.strip_prefix("#define ")
+        .map(|rest| rest.split([' ', '(']).next().unwrap_or(""))
+}
+
+/// The source without `#define` lines of macros nothing mentions (as a token, in the body or
+/// in another macro's value): two variants that differ only there compile to the same program.
 fn strip_unused_defines(src: &str) -> String {
-    let body: String = src
-        .lines()
-        .filter(|l| !l.starts_with("#define "))
-        .collect::<Vec<_>>()
-        .join("\n");
+    let mut used = std::collections::HashSet::new();
+    for line in src.lines() {
+        // A `#define` line uses what its value names, not its own name.
+        let uses = match defined_name(line) {
+            Some(name) => &line["#define ".len() + name.len()..],
+            None => line,
+        };
+        used.extend(
+            uses.split(|c: char| !(c.is_ascii_alphanumeric() || c == '_'))
+                .filter(|t| !t.is_empty()),
+        );
+    }
     src.lines()
-        .filter(|l| match l.strip_prefix("#define ") {
-            Some(rest) => {
-                let name = rest.split([' ', '(']).next().unwrap_or("");
-                body.contains(name)
-            }
-            None => true,
-        })
+        .filter(|l| defined_name(l).is_none_or(|name| used.contains(name)))
         .collect::<Vec<_>>()
         .join("\n")
 }
@@ -238,6 +255,8 @@ fn every_shader_variant_passes_the_strict_validator() {
     let conf = appendix_a_config(dir.path());
     let mut failures = Vec::new();
     let mut checked = 0;
+    // Distinct sources to validate (file, variant), ES 3.0's and ES 2.0's (Appendix A).
+    let mut pending: [Vec<(std::path::PathBuf, String)>; 2] = Default::default();
     // Variants whose assembled text is identical (a define the shader does not use) are
     // validated once.
     let mut seen = std::collections::HashSet::new();
@@ -281,19 +300,32 @@ fn every_shader_variant_passes_the_strict_validator() {
                         if mediump_only { "_mediump" } else { "" }
                     ));
                     std::fs::write(&file, &src).unwrap();
-                    let conf = (es == EsVersion::Es2).then_some(conf.as_path());
-                    if let Err(log) = validate(conf, &file) {
-                        failures.push(format!(
-                            "{} {es}{} {stage:?} features {:#x}:\n{log}",
-                            shader.name,
-                            if mediump_only {
-                                " (no fragment highp)"
-                            } else {
-                                ""
-                            },
-                            features.0
-                        ));
-                    }
+                    let name = format!(
+                        "{} {es}{} {stage:?} features {:#x}",
+                        shader.name,
+                        if mediump_only {
+                            " (no fragment highp)"
+                        } else {
+                            ""
+                        },
+                        features.0
+                    );
+                    pending[usize::from(es == EsVersion::Es2)].push((file, name));
+                }
+            }
+        }
+    }
+    eprintln!("{checked} variants, {} distinct sources", seen.len());
+    for (es2, group) in pending.iter().enumerate() {
+        let conf = (es2 == 1).then_some(conf.as_path());
+        for batch in group.chunks(BATCH) {
+            let files: Vec<&Path> = batch.iter().map(|(f, _)| f.as_path()).collect();
+            if validate_all(conf, &files).is_ok() {
+                continue;
+            }
+            for (file, name) in batch {
+                if let Err(log) = validate(conf, file) {
+                    failures.push(format!("{name}:\n{log}"));
                 }
             }
         }
@@ -330,6 +362,17 @@ fn the_appendix_a_configuration_rejects_a_uniform_loop_bound() {
     )
     .unwrap();
     let err = validate(Some(&conf), &file).expect_err("a uniform loop bound must be rejected");
+    assert!(err.contains("inductive"), "{err}");
+    // Among valid files in one run of the validator too (how the variants are validated).
+    let good = dir.path().join("good.frag");
+    std::fs::write(
+        &good,
+        "#version 100\nprecision mediump float;\nvoid main() { gl_FragColor = vec4(1.0); }\n",
+    )
+    .unwrap();
+    assert!(validate_all(Some(&conf), &[&good, &good]).is_ok());
+    let err = validate_all(Some(&conf), &[&good, &file, &good])
+        .expect_err("a batch with a uniform loop bound must be rejected");
     assert!(err.contains("inductive"), "{err}");
     // And the same file passes without the limits, so it is the configuration that bites.
     assert!(validate(None, &file).is_ok());
