@@ -162,21 +162,25 @@ fn culled_methods_match_forward_on_moving_frames() {
             seen_behind |= behind;
             seen_in_view |= in_view > 0;
             seen_out_of_view |= in_view < 3;
-            // Forward has no grid: one reference serves both grids.
             gpu.r().set_method_named("forward").unwrap();
             let reference = gpu.render(&scene, W, H, &RenderOptions::default());
-            for opts in [RenderOptions::default(), fixed_grid()] {
-                for method in methods {
-                    gpu.r().set_method_named(method).unwrap();
-                    let (image, stats) = gpu.r().render_offscreen(&scene, W, H, &opts).unwrap();
-                    let d = diff(&reference, &image);
-                    assert!(
-                        d.max_abs <= 2,
-                        "{es} frame {k} {method}: max error {} > 2/255 against forward",
-                        d.max_abs
-                    );
-                    assert_eq!(stats.lights.overflowed, 0);
-                }
+            // The automatic grid and a fixed one take turns, five poses each: every culled
+            // render takes a software GPU up to a second (docs/testing.md).
+            let opts = if k % 2 == 0 {
+                RenderOptions::default()
+            } else {
+                fixed_grid()
+            };
+            for method in methods {
+                gpu.r().set_method_named(method).unwrap();
+                let (image, stats) = gpu.r().render_offscreen(&scene, W, H, &opts).unwrap();
+                let d = diff(&reference, &image);
+                assert!(
+                    d.max_abs <= 2,
+                    "{es} frame {k} {method}: max error {} > 2/255 against forward",
+                    d.max_abs
+                );
+                assert_eq!(stats.lights.overflowed, 0);
             }
         }
         // The test covers what it says: lights went behind the eye, into view and out of it.

@@ -30,7 +30,15 @@ fn tiled_and_clustered_match_forward_within_2_of_255() {
         for name in ["courtyard", "pillars"] {
             for lights in [64, 1024] {
                 let scene = scene::builtin::build(name, Some((lights, 11))).unwrap();
-                for linear in [false, true] {
+                // Linear output changes only the last step, the encoding, whatever the lights:
+                // the smaller count checks it (forward over 1 024 lights is the slow part on a
+                // software GPU, docs/testing.md).
+                let encodings: &[bool] = if lights == 64 {
+                    &[false, true]
+                } else {
+                    &[false]
+                };
+                for &linear in encodings {
                     let opts = RenderOptions {
                         linear,
                         ..Default::default()
