@@ -164,8 +164,8 @@ fn culled_methods_match_forward_on_moving_frames() {
             seen_out_of_view |= in_view < 3;
             gpu.r().set_method_named("forward").unwrap();
             let reference = gpu.render(&scene, W, H, &RenderOptions::default());
-            // The automatic grid and a fixed one take turns, five poses each: every culled
-            // render takes a software GPU up to a second (docs/testing.md).
+            // The automatic grid and a fixed one take turns, five poses each: half the culled
+            // renders, a software GPU's slow part.
             let opts = if k % 2 == 0 {
                 RenderOptions::default()
             } else {

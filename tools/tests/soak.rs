@@ -240,8 +240,7 @@ struct Case {
 }
 
 /// A case with still camera, waiting for the GPU, every method, nothing allowed. 64 lights:
-/// enough that `auto` picks clustered (62 in view), few enough that a software GPU's frame is
-/// short (its time grows with the lights a pixel evaluates, docs/testing.md).
+/// enough that `auto` picks clustered, few enough to keep a software GPU's frames short.
 const CASE: Case = Case {
     scene: "courtyard",
     lights: 64,
@@ -298,9 +297,8 @@ fn common_cases() -> Vec<Case> {
         // The automatic grid with a moving camera: a re-choice every 30 frames, each
         // measuring one candidate per frame, three of them in the counted frames.
         //
-        // 128 lights: with 64, its search reached a grid finer than any its 40 warm-up frames
-        // saw, and measuring it grew the per-cell arrays (a buffer reaching a new peak, not a
-        // frame's own allocation; docs/performance.md, "Allocations per frame").
+        // 128 lights: with 64 the search can measure a grid finer than any of the warm-up,
+        // whose per-cell arrays then grow (docs/performance.md, "Allocations per frame").
         Case {
             lights: 128,
             camera_moves: true,
