@@ -16,8 +16,8 @@
 //!    [`Coverage::CascadeBox`].
 //! 4. Spot lights start from the bounding sphere of their cone's reach instead of their whole
 //!    sphere, and each row's columns are then cut to those whose cells' bounding spheres the
-//!    cone may touch, solved per row in closed form (`cone.rs`); a rectangle of at most 2 × 2
-//!    cells per slice is kept whole.
+//!    cone may touch, solved per row in closed form (`cone.rs`; four rows at a time,
+//!    `cone/lanes.rs`); a rectangle of at most 2 × 2 cells per slice is kept whole.
 //!
 //! The cells come out as **runs**: a run is consecutive columns of one row of one slice, which
 //! are consecutive cell numbers. Emitting runs instead of single cells lets the counting sort
@@ -246,16 +246,11 @@ fn refine_slices(
             Coverage::SliceRows => {
                 let slab = grid.slice_slabs[(constants.first_slice + s) as usize];
                 let row_start = |row: u32| slice_start + row * tiles.tiles_x;
-                // Two callers, so that a point light's rows take the plain emission
-                // inlined: with the cone's test in the same closure, the compiler kept
-                // it out of line, a call per row.
+                // Two callers, so that a point light's rows take no cone's test.
+                let emit_row = &mut |row, x0, x1| emit(row_start(row) + x0, x1 - x0 + 1);
                 match &cone {
-                    None => extent.for_each_row_run(tiles, slab, &mut |row, x0, x1| {
-                        emit(row_start(row) + x0, x1 - x0 + 1)
-                    }),
-                    Some(_) => extent.for_each_row_run(tiles, slab, &mut |row, x0, x1| {
-                        emit_row(emit, &cone, row_start(row), row, x0, x1)
-                    }),
+                    None => extent.for_each_row_run(tiles, slab, &WholeRows, emit_row),
+                    Some(cone) => extent.for_each_row_run(tiles, slab, cone, emit_row),
                 }
             }
             Coverage::CascadeBox => {
@@ -289,6 +284,42 @@ fn emit_row(
         },
     };
     emit(row_start + x0, x1 - x0 + 1)
+}
+
+/// What a slice's rows are cut to past their chords: nothing more (a point light's,
+/// [`WholeRows`]) or a spot's cone ([`ConeSlice`]).
+trait RowTrim {
+    /// Row `row`'s columns within `x0..=x1`, or `None`.
+    fn one(&self, row: u32, x0: u32, x1: u32) -> Option<(u32, u32)>;
+    /// Rows `row .. row + ROW_LANES`, each within its span, `x0 > x1` for none.
+    fn rows(&self, row: u32, spans: [(u32, u32); ROW_LANES]) -> [(u32, u32); ROW_LANES];
+}
+
+/// A point light's rows: their chords' columns.
+struct WholeRows;
+
+impl RowTrim for WholeRows {
+    #[inline(always)]
+    fn one(&self, _: u32, x0: u32, x1: u32) -> Option<(u32, u32)> {
+        Some((x0, x1))
+    }
+
+    #[inline(always)]
+    fn rows(&self, _: u32, spans: [(u32, u32); ROW_LANES]) -> [(u32, u32); ROW_LANES] {
+        spans
+    }
+}
+
+impl RowTrim for ConeSlice<'_> {
+    #[inline(always)]
+    fn one(&self, row: u32, x0: u32, x1: u32) -> Option<(u32, u32)> {
+        self.columns(row, x0, x1)
+    }
+
+    #[inline(always)]
+    fn rows(&self, row: u32, spans: [(u32, u32); ROW_LANES]) -> [(u32, u32); ROW_LANES] {
+        self.columns_of_rows(row, spans)
+    }
 }
 
 #[cfg(test)]
@@ -362,7 +393,8 @@ fn ndc_to_tiles(lo: f64, hi: f64, half: f64, count: u32) -> Option<(u32, u32)> {
 /// point.
 impl ScreenExtent {
     /// Calls `emit(row, first_column, last_column)` for every row of the cascade whose cells
-    /// in the depth slab `[z0, z1]` the sphere may reach, with the columns it may reach there.
+    /// in the depth slab `[z0, z1]` the sphere may reach, with the columns it may reach there
+    /// and `trim` keeps (a spot's cone).
     ///
     /// In the slab (clipped to the sphere's depth range, `za ≤ z ≤ zb`) the sphere's points
     /// lie within `ρ` of its axis, `ρ` the radius of its cross-section at the depth of the
@@ -376,6 +408,7 @@ impl ScreenExtent {
         &self,
         tiles: &CascadeTiles,
         [z0, z1, inv_z0, inv_z1]: [f64; 4],
+        trim: &impl RowTrim,
         emit: &mut impl FnMut(u32, u32, u32),
     ) {
         let (dmin, dmax) = self.depth;
@@ -415,7 +448,9 @@ impl ScreenExtent {
             // Too narrow for a chord to trim more than a corner cell: the per-row arithmetic
             // would cost more than the cells it saves.
             for row in y0..y1 + 1 {
-                emit(row, columns.0, columns.1);
+                if let Some((x0, x1)) = trim.one(row, columns.0, columns.1) {
+                    emit(row, x0, x1);
+                }
             }
             return;
         }
@@ -439,7 +474,7 @@ impl ScreenExtent {
         };
         let mut row = y0;
         while y1 - row + 1 >= ROW_LANES as u32 {
-            for (i, &(x0, x1)) in chords.columns(row).iter().enumerate() {
+            for (i, &(x0, x1)) in trim.rows(row, chords.columns(row)).iter().enumerate() {
                 if x0 <= x1 {
                     emit(row + i as u32, x0, x1);
                 }
@@ -451,7 +486,10 @@ impl ScreenExtent {
         }
         for row in row..y1 + 1 {
             let (x0, x1) = chords.one(row);
-            if x0 <= x1 {
+            if x0 > x1 {
+                continue;
+            }
+            if let Some((x0, x1)) = trim.one(row, x0, x1) {
                 emit(row, x0, x1);
             }
         }

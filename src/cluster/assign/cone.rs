@@ -3,6 +3,8 @@
 //! test that trims each row of cells to those the cone may touch, solved for the whole row at
 //! once (one quadratic) rather than cell by cell.
 
+mod lanes;
+
 use crate::cluster::grid::SliceCells;
 use crate::cluster::min_max::MinMax;
 use crate::cluster::view_light::GpuLight;
@@ -152,16 +154,9 @@ impl ConeSlice<'_> {
         let mut v0 = self.origin;
         v0.y += row as f64 * self.row_step;
         if x1 - x0 < NARROW_ROW {
-            // A few cells: each tested on its own is cheaper than the row's quadratic.
-            // Without a branch per cell (which cells pass is what a predictor cannot learn).
-            let (mut first, mut last) = (u32::MAX, 0);
-            for x in x0..x1 + 1 {
-                let v = glam::DVec3::new(v0.x + x as f64 * self.sx, v0.y, v0.z);
-                let touches = self.cell_may_touch(v);
-                first = if touches { first.min(x) } else { first };
-                last = if touches { x } else { last };
-            }
-            return (first <= last).then_some((first, last));
+            // A few cells: each tested on its own is cheaper than the row's quadratic, all in
+            // one set of lanes.
+            return self.narrow_columns(v0, x0, x1);
         }
         let p = v0.dot(cone.axis);
         let w0 = v0 - cone.axis * p;
@@ -192,8 +187,9 @@ impl ConeSlice<'_> {
     /// False only when the sphere of radius `r` (every cell's bound) at `v` from the apex is
     /// certainly outside the cone: the conditions [`ConeSlice::columns`] solves for a row,
     /// loosened as it loosens them (the linear ones by the slack, the quadratic one by a
-    /// billionth of its terms). NaN keeps the cell.
-    #[inline(always)]
+    /// billionth of its terms). NaN keeps the cell. What a narrow row's lanes
+    /// (`ConeSlice::narrow_columns`) do cell by cell, kept as their yardstick in the tests.
+    #[cfg(test)]
     fn cell_may_touch(&self, v: glam::DVec3) -> bool {
         let cone = self.cone;
         let v1 = v.dot(cone.axis);
@@ -209,7 +205,7 @@ impl ConeSlice<'_> {
 }
 
 /// Rows of fewer than this many columns plus one test their cells one by one
-/// ([`ConeSlice::cell_may_touch`]) instead of solving the row's quadratic.
+/// (`ConeSlice::narrow_columns`) instead of solving the row's quadratic.
 const NARROW_ROW: u32 = 3;
 
 /// The part of `span` (`lo ≤ hi`) where `a + b·t ≥ 0`, or `None` when there is none;
@@ -294,7 +290,7 @@ mod tests {
 
     /// Random spots in and around the view of `grid`: every size of cone, from a few cells
     /// to most of the view, pointing every way (some at or away from the eye).
-    fn spots(rng: &mut Pcg64Mcg, grid: &ClusterGrid, n: usize) -> Vec<GpuLight> {
+    pub(super) fn spots(rng: &mut Pcg64Mcg, grid: &ClusterGrid, n: usize) -> Vec<GpuLight> {
         (0..n)
             .map(|_| {
                 let d = rng

@@ -48,6 +48,7 @@ mod cone;
 pub mod index_list;
 mod overflow;
 mod rows;
+mod simd;
 #[cfg(test)]
 mod paths_tests;
 #[cfg(test)]

@@ -1,8 +1,8 @@
 //! The per-row chord of the slice refinement (`cells.rs`), four rows at a time: the same
-//! arithmetic as one row at a time, lane by lane, written without branches so that the
-//! compiler keeps the four rows in SIMD registers (two `f64` lanes on x86-64's baseline SSE2
-//! and on aarch64's NEON, four with AVX). Every lane does exactly the scalar operations in the
-//! scalar order, so the columns, and the lists, are the same bit for bit.
+//! arithmetic as one row at a time, lane by lane, in `wide`'s four `f64` lanes (`simd.rs`: two
+//! SSE2 registers on x86-64's baseline, two NEON registers on aarch64), without branches
+//! between the lanes. Every lane does exactly the scalar operations in the scalar order, so
+//! the columns, and the lists, are the same bit for bit.
 //!
 //! Bounds are taken by comparison and select ([`MinMax`]), the operand first that is NaN only
 //! when the other is too: `t · za` (NaN only for `t = 0` and an infinite `za`, and then
@@ -11,6 +11,7 @@
 //! cross-section" (where `f64::max` gave a number, it was ≤ 0; the tests check the lanes
 //! against `f64`'s bounds, slabs reaching infinity included).
 
+use super::simd::{at_least, at_most, splat, F64x4};
 use crate::cluster::min_max::MinMax;
 
 /// Rows whose chords one call of [`RowChords::columns`] works out.
@@ -44,54 +45,53 @@ impl RowChords {
     /// Columns `(x0, x1)` of rows `row .. row + ROW_LANES`; `x0 > x1` where a row gets none.
     #[inline(always)]
     pub(super) fn columns(&self, row: u32) -> [(u32, u32); ROW_LANES] {
-        let t0 = lanes(|i| -self.extent_y + (row + i as u32) as f64 * self.step_y);
-        let t1 = lanes(|i| t0[i] + self.step_y);
-        let (za, zb, cy) = (self.za, self.zb, self.cy);
+        let rows = F64x4::from(std::array::from_fn(|i| (row + i as u32) as f64));
+        let t0 = splat(-self.extent_y) + rows * splat(self.step_y);
+        let t1 = t0 + splat(self.step_y);
+        let (za, zb, cy) = (splat(self.za), splat(self.zb), splat(self.cy));
         // The band's nearest approach to the centre over the slab (a lower bound).
         let gap = if self.perspective {
-            lanes(|i| {
-                let below = (t0[i] * za).at_most(t0[i] * zb) - cy;
-                let above = cy - (t1[i] * za).at_least(t1[i] * zb);
-                below.at_least(above)
-            })
+            let below = at_most(t0 * za, t0 * zb) - cy;
+            let above = cy - at_least(t1 * za, t1 * zb);
+            at_least(below, above)
         } else {
-            lanes(|i| (t0[i] - cy).at_least(cy - t1[i]))
+            at_least(t0 - cy, cy - t1)
         };
-        let half_sq = lanes(|i| self.rho_sq - gap[i] * gap[i]);
+        let half_sq = splat(self.rho_sq) - gap * gap;
         // A negative `half_sq` gives NaN here, and its lane no columns below.
-        let half = lanes(|i| half_sq[i].sqrt());
-        let (low, high) = (
-            lanes(|i| self.cx - half[i]),
-            lanes(|i| self.cx + half[i]),
-        );
+        let half = half_sq.sqrt();
+        let (low, high) = (splat(self.cx) - half, splat(self.cx) + half);
         let (lo, hi) = if self.perspective {
+            let (inv_a, inv_b) = (splat(self.inv_a), splat(self.inv_b));
             (
-                lanes(|i| (low[i] * self.inv_a).at_most(low[i] * self.inv_b)),
-                lanes(|i| (high[i] * self.inv_a).at_least(high[i] * self.inv_b)),
+                at_most(low * inv_a, low * inv_b),
+                at_least(high * inv_a, high * inv_b),
             )
         } else {
             (low, high)
         };
-        let (lo, hi) = (
-            lanes(|i| lo[i] * self.scale_x),
-            lanes(|i| hi[i] * self.scale_x),
-        );
+        let (lo, hi) = (lo * splat(self.scale_x), hi * splat(self.scale_x));
         // `ndc_to_tiles`: `as u32` saturates (NaN and negatives to 0) and the last column
         // caps it; clamping in f64 first (0 first: NaN gives 0) gives the same tile.
-        let last = self.last_column as f64;
-        let tile = |ndc: f64| 0.0_f64.at_least((ndc + 1.0) * self.half_tiles_x).at_most(last) as u32;
+        let last = splat(self.last_column as f64);
+        let tile = |ndc: F64x4| {
+            at_most(at_least(splat(0.0), (ndc + splat(1.0)) * splat(self.half_tiles_x)), last)
+                .to_array()
+        };
+        let (x0, x1) = (tile(lo), tile(hi));
+        // The band holds the centre (or the gap is NaN): the whole cross-section's columns.
+        let whole = (gap.is_nan() | gap.simd_le(splat(0.0))).to_bitmask();
+        let hits = (half_sq.simd_ge(splat(0.0))
+            & lo.simd_le(hi)
+            & hi.simd_ge(splat(-1.0))
+            & lo.simd_le(splat(1.0)))
+        .to_bitmask();
         let (c0, c1) = self.columns;
         std::array::from_fn(|i| {
-            let (g, lo, hi) = (gap[i], lo[i], hi[i]);
-            // The band holds the centre (or the gap is NaN): the whole
-            // cross-section's columns.
-            let whole = g.is_nan() || g <= 0.0;
-            let hits = (half_sq[i] >= 0.0) & (lo <= hi) & (hi >= -1.0) & (lo <= 1.0);
-            let (x0, x1) = (tile(lo).max(c0), tile(hi).min(c1));
-            if whole {
+            if whole & (1 << i) != 0 {
                 (c0, c1)
-            } else if hits {
-                (x0, x1)
+            } else if hits & (1 << i) != 0 {
+                ((x0[i] as u32).max(c0), (x1[i] as u32).min(c1))
             } else {
                 (1, 0)
             }
@@ -137,12 +137,6 @@ impl RowChords {
         let tile = |ndc: f64| (((ndc + 1.0) * self.half_tiles_x) as u32).min(self.last_column);
         (tile(lo).max(self.columns.0), tile(hi).min(self.columns.1))
     }
-}
-
-/// The lanes `f(0), f(1), …`.
-#[inline(always)]
-fn lanes(f: impl Fn(usize) -> f64) -> [f64; ROW_LANES] {
-    std::array::from_fn(f)
 }
 
 #[cfg(test)]

@@ -29,8 +29,10 @@ impl ClusterGrid {
     /// units), far more than the table's rounding at a boundary and than the shader's `f32`
     /// evaluation of the mapping; so the result never misses a slice that
     /// [`view_z_to_cascade_slice`](Self::view_z_to_cascade_slice) gives a depth inside the
-    /// range, and at worst includes one neighbour slice more.
-    #[inline]
+    /// range, and at worst includes one neighbour slice more. Inlined always: the
+    /// assignment's per-light path calls it once a light, and left to the compiler it went
+    /// out of line there as that path's code grew.
+    #[inline(always)]
     pub fn depth_range_to_slices(&self, dmin: f64, dmax: f64) -> ((u32, u32), (u32, u32)) {
         match self.mapping {
             DepthMapping::Linear => (
