@@ -36,21 +36,54 @@
 #![deny(unsafe_code)]
 #![warn(missing_docs)]
 
-/// The internal modules: public with the `lab` feature (for manylight-tools, the tests and
-/// benchmarks, no stability promise), private otherwise.
-macro_rules! lab_modules {
-    ($($(#[$attr:meta])* $name:ident),* $(,)?) => {$(
-        $(#[$attr])*
-        #[cfg(feature = "lab")]
-        pub mod $name;
-        $(#[$attr])*
-        #[cfg(not(feature = "lab"))]
-        #[allow(dead_code, unused_imports)]
-        mod $name;
-    )*};
-}
-
-lab_modules!(cluster, error, gl, gpu_scene, methods, metrics, options, renderer, scene);
+// The internal modules: public with the `lab` feature (for manylight-tools, the tests and
+// benchmarks, no stability promise), private otherwise. Each declared twice rather than by a
+// macro: rustfmt does not follow modules declared inside a macro, and left them unformatted.
+#[cfg(feature = "lab")]
+pub mod cluster;
+#[cfg(not(feature = "lab"))]
+#[allow(dead_code, unused_imports)]
+mod cluster;
+#[cfg(feature = "lab")]
+pub mod error;
+#[cfg(not(feature = "lab"))]
+#[allow(dead_code, unused_imports)]
+mod error;
+#[cfg(feature = "lab")]
+pub mod gl;
+#[cfg(not(feature = "lab"))]
+#[allow(dead_code, unused_imports)]
+mod gl;
+#[cfg(feature = "lab")]
+pub mod gpu_scene;
+#[cfg(not(feature = "lab"))]
+#[allow(dead_code, unused_imports)]
+mod gpu_scene;
+#[cfg(feature = "lab")]
+pub mod methods;
+#[cfg(not(feature = "lab"))]
+#[allow(dead_code, unused_imports)]
+mod methods;
+#[cfg(feature = "lab")]
+pub mod metrics;
+#[cfg(not(feature = "lab"))]
+#[allow(dead_code, unused_imports)]
+mod metrics;
+#[cfg(feature = "lab")]
+pub mod options;
+#[cfg(not(feature = "lab"))]
+#[allow(dead_code, unused_imports)]
+mod options;
+#[cfg(feature = "lab")]
+pub mod renderer;
+#[cfg(not(feature = "lab"))]
+#[allow(dead_code, unused_imports)]
+mod renderer;
+#[cfg(feature = "lab")]
+pub mod scene;
+#[cfg(not(feature = "lab"))]
+#[allow(dead_code, unused_imports)]
+mod scene;
 
 // The API a game uses: one path each, at the crate root.
 pub use cluster::assign::AssignStats;

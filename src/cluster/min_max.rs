@@ -67,8 +67,19 @@ mod tests {
     #[test]
     fn agrees_with_f64_min_and_max_for_a_first_operand_not_nan() {
         let values = [
-            f64::NEG_INFINITY, -1e300, -2.5, -1.0, -f64::MIN_POSITIVE, -0.0, 0.0,
-            f64::MIN_POSITIVE, 1.0, 2.5, 1e300, f64::INFINITY, f64::NAN,
+            f64::NEG_INFINITY,
+            -1e300,
+            -2.5,
+            -1.0,
+            -f64::MIN_POSITIVE,
+            -0.0,
+            0.0,
+            f64::MIN_POSITIVE,
+            1.0,
+            2.5,
+            1e300,
+            f64::INFINITY,
+            f64::NAN,
         ];
         let same = |a: f64, b: f64| a.to_bits() == b.to_bits() || (a == 0.0 && b == 0.0);
         for &a in &values {

@@ -54,7 +54,10 @@ mod tests {
         let err = zeroed::<[f32; 4]>(u32::MAX, u32::MAX, 1, "read-back").unwrap_err();
         assert!(matches!(err, GlError::OutOfMemory(_)), "{err}");
         let text = err.to_string();
-        assert!(text.contains("read-back") && text.contains("4294967295×4294967295"), "{text}");
+        assert!(
+            text.contains("read-back") && text.contains("4294967295×4294967295"),
+            "{text}"
+        );
         // 2⁵² bytes fit isize but no 64-bit address space (2⁴⁸): the allocator refuses.
         let err = zeroed::<[f32; 4]>(1 << 24, 1 << 24, 1, "HDR read-back").unwrap_err();
         assert!(err.to_string().contains("4503599627370496 bytes"), "{err}");

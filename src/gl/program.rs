@@ -86,9 +86,13 @@ uniform_type!(
     ],
     |gl, l, unit| unsafe { gl.uniform_1_i32(Some(l), unit as i32) }
 );
-uniform_type!([f32; 2], [f32; 2], "vec2", [glow::FLOAT_VEC2], |gl, l, v| unsafe {
-    gl.uniform_2_f32(Some(l), v[0], v[1])
-});
+uniform_type!(
+    [f32; 2],
+    [f32; 2],
+    "vec2",
+    [glow::FLOAT_VEC2],
+    |gl, l, v| unsafe { gl.uniform_2_f32(Some(l), v[0], v[1]) }
+);
 uniform_type!(Vec3, Vec3, "vec3", [glow::FLOAT_VEC3], |gl, l, v| unsafe {
     gl.uniform_3_f32(Some(l), v.x, v.y, v.z)
 });
@@ -578,7 +582,12 @@ mod tests {
         }
         let mut forward =
             Program::build::<AlbedoTexture<false>>(&dev, "forward", &untextured, 0).unwrap();
-        assert!(forward.uniforms::<AlbedoTexture<false>>().unwrap().0.location.is_none());
+        assert!(forward
+            .uniforms::<AlbedoTexture<false>>()
+            .unwrap()
+            .0
+            .location
+            .is_none());
         forward.destroy(&dev);
     }
 
@@ -596,7 +605,9 @@ mod tests {
         let probe = cache.bind::<Probe>(&dev, key, Vec::new).unwrap();
         assert!(probe.big.location.is_some());
         assert!(cache.bind::<Probe>(&dev, key, Vec::new).is_ok());
-        assert!(cache.bind::<AlbedoTexture<false>>(&dev, key, Vec::new).is_err());
+        assert!(cache
+            .bind::<AlbedoTexture<false>>(&dev, key, Vec::new)
+            .is_err());
         cache.destroy(&dev);
     }
 }

@@ -540,7 +540,12 @@ mod tests {
     fn declared_uniforms_cover_both_stages_and_every_branch() {
         let names = declared_uniforms("clustered").unwrap();
         // Vertex stage, an include, a dialect branch and a feature block.
-        for name in ["u_modelView", "u_lights", "u_gridInvHeight", "u_longestList"] {
+        for name in [
+            "u_modelView",
+            "u_lights",
+            "u_gridInvHeight",
+            "u_longestList",
+        ] {
             assert!(names.iter().any(|n| n == name), "{name} in {names:?}");
         }
         // Declared twice (one per dialect), listed once.

@@ -34,7 +34,9 @@ fn supported(caps: &crate::gl::Caps) -> Support {
         Support::Supported => {}
         Support::Fallback(why) if notes.contains(&why) => {}
         Support::Fallback(why) => notes.push(why),
-        Support::Unsupported(why) => notes.push(format!("always forward: clustered cannot run ({why})")),
+        Support::Unsupported(why) => {
+            notes.push(format!("always forward: clustered cannot run ({why})"))
+        }
     }
     if notes.is_empty() {
         Support::Supported

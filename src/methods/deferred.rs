@@ -162,9 +162,8 @@ impl UniformSet for CompositeProgram {
         let f = uniforms::features(r);
         let colour = !f.counting();
         // The eye's direction (from the surface point) is read only by the specular term.
-        let directional = colour
-            && f.has(ShaderFeatures::DIRECTIONAL)
-            && f.has(ShaderFeatures::SPECULAR);
+        let directional =
+            colour && f.has(ShaderFeatures::DIRECTIONAL) && f.has(ShaderFeatures::SPECULAR);
         CompositeProgram {
             g_albedo: r.required_when(colour, "u_gAlbedo"),
             g_normal_depth: r.required("u_gNormalDepth"),
@@ -266,7 +265,10 @@ impl Deferred {
             .with(ShaderFeatures::SPECULAR, true)
             .with(
                 ShaderFeatures::METALLIC_ROUGHNESS,
-                ctx.scene.materials.iter().any(|m| m.is_metallic_roughness()),
+                ctx.scene
+                    .materials
+                    .iter()
+                    .any(|m| m.is_metallic_roughness()),
             )
             .with(ShaderFeatures::DIRECTIONAL, false);
         let (half, ortho) = half_extent(ctx);
@@ -363,7 +365,11 @@ impl Deferred {
         let sun = ctx.features.has(ShaderFeatures::DIRECTIONAL);
         let features = ctx.features.with(ShaderFeatures::SPECULAR, sun).with(
             ShaderFeatures::METALLIC_ROUGHNESS,
-            sun && ctx.scene.materials.iter().any(|m| m.is_metallic_roughness()),
+            sun && ctx
+                .scene
+                .materials
+                .iter()
+                .any(|m| m.is_metallic_roughness()),
         );
         let key = ProgramKey {
             shader: "deferred_composite",

@@ -29,7 +29,12 @@ impl DirectionalFrame {
     /// The scene's shown directional lights ([`shown_directional_lights`], indices kept in
     /// `shown`) in view space; `fp16`: in the fp16-range form. Returns the frame and how many
     /// active lights past [`MAX_DIRECTIONAL_LIGHTS`] were left out.
-    pub fn gather(scene: &Scene, view: &DMat4, fp16: bool, shown: &mut Vec<usize>) -> (Self, usize) {
+    pub fn gather(
+        scene: &Scene,
+        view: &DMat4,
+        fp16: bool,
+        shown: &mut Vec<usize>,
+    ) -> (Self, usize) {
         let dropped = shown_directional_lights(&scene.directional_lights, shown);
         let mut frame = DirectionalFrame::default();
         for (column, &i) in shown.iter().enumerate().take(MAX_DIRECTIONAL_LIGHTS) {

@@ -183,7 +183,10 @@ impl ShaderFeatures {
             ("HAS_EMISSIVE_MAP".into(), flag(Self::EMISSIVE_MAP)),
             ("HAS_OCCLUSION".into(), flag(Self::OCCLUSION)),
             ("HAS_MR_TEXTURE".into(), flag(Self::MR_TEXTURE)),
-            ("HAS_TEXTURE_TRANSFORM".into(), flag(Self::TEXTURE_TRANSFORM)),
+            (
+                "HAS_TEXTURE_TRANSFORM".into(),
+                flag(Self::TEXTURE_TRANSFORM),
+            ),
             (
                 "TONEMAP".into(),
                 if self.has(Self::TONEMAP_REINHARD) {

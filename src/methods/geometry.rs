@@ -213,4 +213,3 @@ pub(crate) fn shade_object<P: GeometryProgram>(
     mesh.draw(dev);
     Ok(())
 }
-

@@ -83,7 +83,12 @@ pub fn features(material: &Material, mesh: &Mesh, units: i32) -> F {
 }
 
 /// One map as [`MapUniforms::set`] binds it: feature bit, texture, sampler, UV transform.
-type MapSlot<'a> = (u64, &'a Option<MapTexture>, &'a Uniform<Sampler>, &'a Uniform<Mat3>);
+type MapSlot<'a> = (
+    u64,
+    &'a Option<MapTexture>,
+    &'a Uniform<Sampler>,
+    &'a Uniform<Mat3>,
+);
 
 /// The uniforms of `surface_maps.glsl`.
 pub struct MapUniforms {
@@ -131,15 +136,30 @@ impl MapUniforms {
             self.albedo_uv.set(dev, uv_matrix(&maps.base_transform));
         }
         let slots: [MapSlot<'_>; 4] = [
-            (F::NORMAL_MAP, &maps.normal, &self.normal_tex, &self.normal_uv),
+            (
+                F::NORMAL_MAP,
+                &maps.normal,
+                &self.normal_tex,
+                &self.normal_uv,
+            ),
             (
                 F::EMISSIVE_MAP,
                 &maps.emissive_texture,
                 &self.emissive_tex,
                 &self.emissive_uv,
             ),
-            (F::OCCLUSION, &maps.occlusion, &self.occlusion_tex, &self.occlusion_uv),
-            (F::MR_TEXTURE, &maps.metallic_roughness, &self.mr_tex, &self.mr_uv),
+            (
+                F::OCCLUSION,
+                &maps.occlusion,
+                &self.occlusion_tex,
+                &self.occlusion_uv,
+            ),
+            (
+                F::MR_TEXTURE,
+                &maps.metallic_roughness,
+                &self.mr_tex,
+                &self.mr_uv,
+            ),
         ];
         for ((bit, map, sampler, uv), (_, unit, _)) in slots.into_iter().zip(SLOTS) {
             let Some(map) = map.as_ref().filter(|_| features.has(bit)) else {

@@ -203,8 +203,8 @@ pub(crate) fn inv_height(texture: &DataTexture) -> f32 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::gl::program::{ProgramCache, ProgramKey, UniformSet};
     use crate::gl::context::context_or_skip;
+    use crate::gl::program::{ProgramCache, ProgramKey, UniformSet};
     use crate::methods::culled::ClusteredProgram;
     use crate::methods::deferred::{CompositeProgram, GBufferProgram, LightProgram};
     use crate::methods::forward::ForwardProgram;

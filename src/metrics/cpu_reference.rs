@@ -360,7 +360,17 @@ mod tests {
                 Vec3::new(0.3, 0.6, 1.0),
                 3.0,
             ),
-            Light::spot(DVec3::new(0.5, 0.5, 2.0), 6.0, Vec3::ONE, 1.5, crate::scene::Cone { direction: DVec3::new(0.0, -0.2, -1.0), inner_deg: 12.0, outer_deg: 12.0 }),
+            Light::spot(
+                DVec3::new(0.5, 0.5, 2.0),
+                6.0,
+                Vec3::ONE,
+                1.5,
+                crate::scene::Cone {
+                    direction: DVec3::new(0.0, -0.2, -1.0),
+                    inner_deg: 12.0,
+                    outer_deg: 12.0,
+                },
+            ),
         ];
         scene.validate().unwrap();
         scene

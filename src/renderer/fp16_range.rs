@@ -55,7 +55,11 @@ pub(super) fn check(
         return Ok(());
     }
     // The gathered lights are the scene's active ones in order: name the scene's index.
-    let active = scene.lights.iter().enumerate().filter(|(_, l)| l.is_active());
+    let active = scene
+        .lights
+        .iter()
+        .enumerate()
+        .filter(|(_, l)| l.is_active());
     for ((i, _), l) in active.zip(lights.iter()) {
         let distance = l.position.length() as f64;
         if distance > farthest && distance - (l.radius as f64) < reach {

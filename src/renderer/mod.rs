@@ -6,9 +6,9 @@
 //! its light gathering, shader features and grid depth in `frame_setup`; offscreen renders
 //! read back to the CPU (colour, HDR, light counts) in `offscreen`.
 
+mod fp16_range;
 mod frame;
 mod frame_setup;
-mod fp16_range;
 mod method;
 mod offscreen;
 mod stats;

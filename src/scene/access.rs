@@ -62,7 +62,10 @@ pub(crate) fn resolve(dir: &Path, path: &Path, allow_outside: bool) -> Result<Pa
         dir
     };
     let real_dir = dir.canonicalize().map_err(|e| {
-        format!("the model's folder {} cannot be resolved ({e})", dir.display())
+        format!(
+            "the model's folder {} cannot be resolved ({e})",
+            dir.display()
+        )
     })?;
     if real.starts_with(&real_dir) {
         Ok(real)

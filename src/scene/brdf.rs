@@ -36,7 +36,14 @@ pub const DIELECTRIC_F0: f64 = 0.04;
 
 /// `π·f·(N·L)` for unit `l` (to the light), `n`, `v` (to the eye) with `N·L > 0`: what the
 /// light's radiance × falloff × spot is multiplied by.
-pub fn reflectance(l: DVec3, n: DVec3, v: DVec3, base: DVec3, metallic: f64, roughness: f64) -> DVec3 {
+pub fn reflectance(
+    l: DVec3,
+    n: DVec3,
+    v: DVec3,
+    base: DVec3,
+    metallic: f64,
+    roughness: f64,
+) -> DVec3 {
     let n_dot_l = n.dot(l);
     if n_dot_l <= 0.0 {
         return DVec3::ZERO;

@@ -43,10 +43,18 @@ mod tests {
 
     #[test]
     fn zero_and_non_finite_vectors_have_no_direction() {
-        for v in [DVec3::ZERO, DVec3::new(f64::NAN, 1.0, 0.0), DVec3::new(f64::INFINITY, 0.0, 0.0)] {
+        for v in [
+            DVec3::ZERO,
+            DVec3::new(f64::NAN, 1.0, 0.0),
+            DVec3::new(f64::INFINITY, 0.0, 0.0),
+        ] {
             assert_eq!(unit(v), None, "{v}");
         }
-        for v in [Vec3::ZERO, Vec3::new(0.0, f32::NAN, 0.0), Vec3::new(0.0, 0.0, f32::NEG_INFINITY)] {
+        for v in [
+            Vec3::ZERO,
+            Vec3::new(0.0, f32::NAN, 0.0),
+            Vec3::new(0.0, 0.0, f32::NEG_INFINITY),
+        ] {
             assert_eq!(unit_f32(v), None, "{v}");
         }
     }

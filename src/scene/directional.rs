@@ -86,7 +86,11 @@ pub fn shown_directional_lights(lights: &[DirectionalLight], shown: &mut Vec<usi
         let (slot, dimmest) = shown
             .iter()
             .enumerate()
-            .min_by(|a, b| brightness(*a.1).total_cmp(&brightness(*b.1)).then(b.0.cmp(&a.0)))
+            .min_by(|a, b| {
+                brightness(*a.1)
+                    .total_cmp(&brightness(*b.1))
+                    .then(b.0.cmp(&a.0))
+            })
             .map(|(slot, &j)| (slot, brightness(j)))
             .expect("full");
         if light.radiance().max_element() > dimmest {
@@ -118,14 +122,27 @@ mod tests {
     #[test]
     fn validation_names_the_field() {
         let bad = DirectionalLight::new(DVec3::ZERO, Vec3::ONE, 1.0);
-        let e = bad.validate("directional_lights[2]").unwrap_err().to_string();
+        let e = bad
+            .validate("directional_lights[2]")
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("directional_lights[2].direction"), "{e}");
         let bad = DirectionalLight::new(DVec3::X, Vec3::new(1.0, -1.0, 0.0), 1.0);
-        assert!(bad.validate("d").unwrap_err().to_string().contains("d.color"));
+        assert!(bad
+            .validate("d")
+            .unwrap_err()
+            .to_string()
+            .contains("d.color"));
         let bad = DirectionalLight::new(DVec3::X, Vec3::ONE, f32::NAN);
-        assert!(bad.validate("d").unwrap_err().to_string().contains("d.intensity"));
+        assert!(bad
+            .validate("d")
+            .unwrap_err()
+            .to_string()
+            .contains("d.intensity"));
         // Any finite non-zero length is a direction.
-        assert!(DirectionalLight::new(DVec3::X * 1e300, Vec3::ONE, 1.0).validate("d").is_ok());
+        assert!(DirectionalLight::new(DVec3::X * 1e300, Vec3::ONE, 1.0)
+            .validate("d")
+            .is_ok());
         assert_eq!(sun(1.0).to_light(), DVec3::Y);
     }
 }

@@ -132,7 +132,12 @@ mod tests {
         let normals = vec![Vec3::Z, Vec3::Z, Vec3::Z, Vec3::X];
         let mut mesh = Mesh::new(p, normals, vec![], vec![0, 1, 2, 3, 1, 2]).unwrap();
         assert_eq!(drop_duplicate_triangles(&mut mesh), 0);
-        let uvs = vec![glam::Vec2::ZERO, glam::Vec2::X, glam::Vec2::Y, glam::Vec2::ONE];
+        let uvs = vec![
+            glam::Vec2::ZERO,
+            glam::Vec2::X,
+            glam::Vec2::Y,
+            glam::Vec2::ONE,
+        ];
         let p = vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::ZERO];
         let mut mesh = Mesh::new(p, vec![Vec3::Z; 4], uvs, vec![0, 1, 2, 3, 1, 2]).unwrap();
         assert_eq!(drop_duplicate_triangles(&mut mesh), 0);

@@ -61,7 +61,10 @@ mod tests {
         assert!(!SceneFeatures::of(&sunny).directional_lights);
         let sun = crate::scene::DirectionalLight::new(glam::DVec3::NEG_Y, glam::Vec3::ONE, 0.0);
         sunny.directional_lights.push(sun);
-        assert!(!SceneFeatures::of(&sunny).directional_lights, "a dark sun is not active");
+        assert!(
+            !SceneFeatures::of(&sunny).directional_lights,
+            "a dark sun is not active"
+        );
         sunny.directional_lights[0].intensity = 2.0;
         assert!(SceneFeatures::of(&sunny).directional_lights);
         assert!(!SceneFeatures::of(&sunny).metallic_roughness);

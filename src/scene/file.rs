@@ -39,8 +39,8 @@ use serde::Deserialize;
 
 use super::access::LoadOptions;
 use super::camera::{Projection, MAX_CAMERA_COORD};
-use super::motion::{Bob, Flicker, Motion, Orbit, OrbitAbout, Sweep, Wander};
 use super::model_cache::{self, ModelCache};
+use super::motion::{Bob, Flicker, Motion, Orbit, OrbitAbout, Sweep, Wander};
 use super::obj::LoadReport;
 use super::random::{self, LightSetStyle};
 use super::{Camera, DirectionalLight, Light, LightKind, MaterialModel, Scene, SceneError};
@@ -378,8 +378,10 @@ pub fn parse(
                     "is needed with `metallic` and `roughness` (both or neither)",
                 )),
             };
-            let (metallic, roughness) =
-                (unit("metallic", spec.metallic)?, unit("roughness", spec.roughness)?);
+            let (metallic, roughness) = (
+                unit("metallic", spec.metallic)?,
+                unit("roughness", spec.roughness)?,
+            );
             for m in &mut scene.materials[first_material..] {
                 m.model = MaterialModel::MetallicRoughness;
                 (m.metallic, m.roughness) = (metallic, roughness);
@@ -400,7 +402,8 @@ pub fn parse(
         }
     }
     for (i, d) in file.directional_lights.iter().enumerate() {
-        let light = DirectionalLight::new(DVec3::from(d.direction), Vec3::from(d.color), d.intensity);
+        let light =
+            DirectionalLight::new(DVec3::from(d.direction), Vec3::from(d.color), d.intensity);
         light.validate(&format!("directional_lights[{i}]"))?;
         scene.directional_lights.push(light);
     }

@@ -53,7 +53,11 @@ pub fn framing(bounds: &Aabb) -> Camera {
     // stays at least 5 % of the extent in front of the eye.
     let distance = corners
         .iter()
-        .map(|c| c.z + (c.x.abs() / tan_x).max(c.y.abs() / tan_y).max(0.05 * extent))
+        .map(|c| {
+            c.z + (c.x.abs() / tan_x)
+                .max(c.y.abs() / tan_y)
+                .max(0.05 * extent)
+        })
         .fold(0.0, f64::max);
     let depths = corners.iter().map(|c| distance - c.z);
     let nearest = depths.clone().fold(f64::INFINITY, f64::min);
@@ -83,13 +87,19 @@ mod tests {
     fn every_corner_of_every_shape_projects_inside_the_frame_and_depth_range() {
         let shapes = [
             ("cube", aabb([-1.0; 3], [1.0; 3])),
-            ("box at y 0 (Khronos Box)", aabb([-0.5, 0.0, -0.5], [0.5, 1.0, 0.5])),
+            (
+                "box at y 0 (Khronos Box)",
+                aabb([-0.5, 0.0, -0.5], [0.5, 1.0, 0.5]),
+            ),
             ("tall", aabb([-0.1, 0.0, -0.1], [0.1, 30.0, 0.1])),
             ("wide", aabb([-40.0, 0.0, -0.2], [40.0, 1.0, 0.2])),
             ("deep", aabb([-0.5, 0.0, -50.0], [0.5, 1.0, 50.0])),
             ("flat XZ plane", aabb([-8.0, 0.0, -8.0], [8.0, 0.0, 8.0])),
             ("flat XY plane", aabb([-8.0, -8.0, 0.0], [8.0, 8.0, 0.0])),
-            ("far from origin", aabb([1e6, 2e6, -3e6], [1e6 + 2.0, 2e6 + 1.0, -3e6 + 3.0])),
+            (
+                "far from origin",
+                aabb([1e6, 2e6, -3e6], [1e6 + 2.0, 2e6 + 1.0, -3e6 + 3.0]),
+            ),
             ("tiny", aabb([1e-7, 0.0, 0.0], [3e-7, 1e-7, 2e-7])),
             ("huge", aabb([-1e9, -2e8, -5e8], [1e9, 2e8, 5e8])),
             ("point", aabb([2.0, 3.0, 4.0], [2.0, 3.0, 4.0])),
@@ -100,7 +110,8 @@ mod tests {
             for aspect in [FRAMED_MIN_ASPECT, 16.0 / 9.0, 4.0] {
                 let m = cam.projection_matrix(aspect) * cam.view_matrix();
                 for i in 0..8 {
-                    let pick = |bit: u32, lo: f64, hi: f64| if i & (1 << bit) != 0 { hi } else { lo };
+                    let pick =
+                        |bit: u32, lo: f64, hi: f64| if i & (1 << bit) != 0 { hi } else { lo };
                     let p = DVec3::new(
                         pick(0, b.min.x, b.max.x),
                         pick(1, b.min.y, b.max.y),
@@ -115,7 +126,10 @@ mod tests {
                         ndc.x.abs() <= limit && ndc.y.abs() <= limit,
                         "{name} at aspect {aspect}: corner {i} at {ndc:?}"
                     );
-                    assert!(ndc.z > -1.0 && ndc.z < 1.0, "{name}: corner {i} clipped, {ndc:?}");
+                    assert!(
+                        ndc.z > -1.0 && ndc.z < 1.0,
+                        "{name}: corner {i} clipped, {ndc:?}"
+                    );
                 }
             }
         }

@@ -201,7 +201,11 @@ pub fn spot_terms_from_half_sines(outer: f64, inner: f64) -> (f64, f64) {
 
 /// A light's `color` and `intensity` (point, spot or directional): finite, non-negative, and
 /// their product finite; errors name `field.color` or `field.intensity`.
-pub(super) fn validate_emission(color: Vec3, intensity: f32, field: &str) -> Result<(), SceneError> {
+pub(super) fn validate_emission(
+    color: Vec3,
+    intensity: f32,
+    field: &str,
+) -> Result<(), SceneError> {
     if !color.is_finite() || color.min_element() < 0.0 {
         return Err(SceneError::invalid(
             format!("{field}.color"),
@@ -270,11 +274,31 @@ mod tests {
                 "lights[0].position",
             ),
             (
-                Light::spot(DVec3::ZERO, 1.0, Vec3::ONE, 1.0, Cone { direction: DVec3::Z, inner_deg: 30.0, outer_deg: 20.0 }),
+                Light::spot(
+                    DVec3::ZERO,
+                    1.0,
+                    Vec3::ONE,
+                    1.0,
+                    Cone {
+                        direction: DVec3::Z,
+                        inner_deg: 30.0,
+                        outer_deg: 20.0,
+                    },
+                ),
                 "lights[0].outer_deg",
             ),
             (
-                Light::spot(DVec3::ZERO, 1.0, Vec3::ONE, 1.0, Cone { direction: DVec3::ZERO, inner_deg: 10.0, outer_deg: 20.0 }),
+                Light::spot(
+                    DVec3::ZERO,
+                    1.0,
+                    Vec3::ONE,
+                    1.0,
+                    Cone {
+                        direction: DVec3::ZERO,
+                        inner_deg: 10.0,
+                        outer_deg: 20.0,
+                    },
+                ),
                 "lights[0].direction",
             ),
         ];
@@ -287,7 +311,17 @@ mod tests {
 
     #[test]
     fn spot_scale_offset_is_finite_for_hard_cones() {
-        let l = Light::spot(DVec3::ZERO, 1.0, Vec3::ONE, 1.0, Cone { direction: DVec3::Z, inner_deg: 10.0, outer_deg: 10.0 });
+        let l = Light::spot(
+            DVec3::ZERO,
+            1.0,
+            Vec3::ONE,
+            1.0,
+            Cone {
+                direction: DVec3::Z,
+                inner_deg: 10.0,
+                outer_deg: 10.0,
+            },
+        );
         let (s, o) = l.spot_scale_offset();
         assert!(s.is_finite() && o.is_finite());
         let (s, o) = base().spot_scale_offset();

@@ -243,7 +243,12 @@ impl Mesh {
     /// Whether any triangle has a non-zero area (all points or lines: nothing to draw).
     pub fn has_area(&self) -> bool {
         self.indices.chunks_exact(3).any(|t| {
-            let p = |k: usize| self.positions.get(t[k] as usize).copied().unwrap_or_default();
+            let p = |k: usize| {
+                self.positions
+                    .get(t[k] as usize)
+                    .copied()
+                    .unwrap_or_default()
+            };
             (p(1) - p(0)).cross(p(2) - p(0)) != Vec3::ZERO
         })
     }
@@ -325,7 +330,12 @@ mod tests {
     fn unusable_normals_are_recomputed_from_the_faces_and_huge_ones_kept() {
         let positions = vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::new(1.0, 1.0, 0.0)];
         let huge = Vec3::new(3e30, 0.0, 4e30);
-        let normals = vec![Vec3::ZERO, Vec3::NAN, Vec3::new(f32::INFINITY, 0.0, 0.0), huge];
+        let normals = vec![
+            Vec3::ZERO,
+            Vec3::NAN,
+            Vec3::new(f32::INFINITY, 0.0, 0.0),
+            huge,
+        ];
         let m = Mesh::new(positions, normals, vec![], vec![0, 1, 2, 1, 3, 2]).unwrap();
         for n in &m.normals[..3] {
             assert!((*n - Vec3::Z).length() < 1e-6, "{n}");
@@ -338,7 +348,10 @@ mod tests {
         for scale in [1e-25f32, 1e-15, 1.0, 1e9] {
             let positions = vec![Vec3::ZERO, Vec3::X * scale, Vec3::Y * scale];
             let normals = compute_normals(&positions, &[0, 1, 2]);
-            assert!(normals.iter().all(|n| (*n - Vec3::Z).length() < 1e-6), "{scale:e}");
+            assert!(
+                normals.iter().all(|n| (*n - Vec3::Z).length() < 1e-6),
+                "{scale:e}"
+            );
         }
     }
 

@@ -14,8 +14,8 @@ use std::sync::Arc;
 use glam::DMat4;
 
 use super::access::LoadOptions;
-use super::obj::{self, LoadReport};
 use super::camera::MAX_CAMERA_COORD;
+use super::obj::{self, LoadReport};
 use super::{Aabb, Material, Mesh, Object, Scene, SceneError, Texture};
 
 /// Most objects a scene file may place (all its references together), the per-file limit of
@@ -52,7 +52,11 @@ impl Loaded {
             .iter()
             .map(|o| {
                 let b = checked
-                    .then(|| *bounds.entry(Arc::as_ptr(&o.mesh)).or_insert_with(|| o.mesh.bounds()))
+                    .then(|| {
+                        *bounds
+                            .entry(Arc::as_ptr(&o.mesh))
+                            .or_insert_with(|| o.mesh.bounds())
+                    })
                     .flatten();
                 (o.mesh.clone(), o.material - first_material, relative(o), b)
             })
@@ -318,7 +322,10 @@ mod tests {
         assert!(check_counts(MAX_SCENE_OBJECTS, MAX_SCENE_MATERIALS, "objects[3]").is_ok());
         let err = check_counts(MAX_SCENE_OBJECTS + 1, 1, "objects[3]").unwrap_err();
         let text = err.to_string();
-        assert!(text.contains("objects[3]") && text.contains("1048577 objects"), "{text}");
+        assert!(
+            text.contains("objects[3]") && text.contains("1048577 objects"),
+            "{text}"
+        );
         let err = check_counts(1, MAX_SCENE_MATERIALS + 1, "objects[9]").unwrap_err();
         assert!(err.to_string().contains("materials"), "{err}");
     }

@@ -229,7 +229,11 @@ fn parse_obj(path: &Path) -> Result<Parsed, SceneError> {
         tobj::load_mtl_buf(&mut std::io::BufReader::new(text.as_bytes()))
     };
     let parsed = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        tobj::load_obj_buf(&mut std::io::BufReader::new(text.as_bytes()), &options, load_mtl)
+        tobj::load_obj_buf(
+            &mut std::io::BufReader::new(text.as_bytes()),
+            &options,
+            load_mtl,
+        )
     }));
     let obj_error = |reason: String| SceneError::Obj {
         path: path.to_path_buf(),

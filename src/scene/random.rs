@@ -53,7 +53,17 @@ pub fn lights(volume: &Aabb, count: usize, seed: u64, style: LightSetStyle) -> V
                 );
                 let outer = rng.random_range(20.0..60.0);
                 let inner = outer * rng.random_range(0.3..0.9);
-                Light::spot(position, r * 1.5, color, intensity * 2.0, crate::scene::Cone { direction: dir, inner_deg: inner, outer_deg: outer })
+                Light::spot(
+                    position,
+                    r * 1.5,
+                    color,
+                    intensity * 2.0,
+                    crate::scene::Cone {
+                        direction: dir,
+                        inner_deg: inner,
+                        outer_deg: outer,
+                    },
+                )
             } else {
                 Light::point(position, r, color, intensity)
             }

@@ -251,9 +251,9 @@ impl SceneRaycaster {
             },
         );
         STACKS.with(|s| *s.borrow_mut() = (top, inner));
-        let hit = search
-            .best
-            .map(|(t, u, v, slot, triangle)| self.make_hit((slot, triangle), (t, u, v), origin, dir));
+        let hit = search.best.map(|(t, u, v, slot, triangle)| {
+            self.make_hit((slot, triangle), (t, u, v), origin, dir)
+        });
         // Ties count as in front: a transparent surface coplanar with an opaque one is blended.
         let limit = hit.map_or(t_max, |h| h.t);
         FirstOpaque {
@@ -300,9 +300,7 @@ impl SceneRaycaster {
         Hit {
             t,
             position: origin + dir * t,
-            normal: n
-                .try_normalize()
-                .unwrap_or_else(|| geometric.normalize()),
+            normal: n.try_normalize().unwrap_or_else(|| geometric.normalize()),
             object: instance.object as usize,
             triangle: triangle as usize,
         }

@@ -110,7 +110,8 @@ pub fn spot_factor(light: &Light, to_surface: DVec3) -> f64 {
         LightKind::Point => 1.0,
         LightKind::Spot { direction, .. } => {
             let (scale, offset) = light.spot_scale_offset();
-            let one_minus_cos = 1.0 - to_surface.dot(super::direction::unit(direction).unwrap_or(DVec3::ZERO));
+            let one_minus_cos =
+                1.0 - to_surface.dot(super::direction::unit(direction).unwrap_or(DVec3::ZERO));
             let t = (offset as f64 - scale as f64 * one_minus_cos).clamp(0.0, 1.0);
             t * t * (3.0 - 2.0 * t)
         }

@@ -154,7 +154,8 @@ impl SurfaceMaps {
 
     /// True when some texture (the base colour's included) is sampled through a transform.
     pub fn has_transform(&self) -> bool {
-        !self.base_transform.is_identity() || self.textures().any(|(_, t)| !t.transform.is_identity())
+        !self.base_transform.is_identity()
+            || self.textures().any(|(_, t)| !t.transform.is_identity())
     }
 }
 
@@ -192,7 +193,10 @@ mod tests {
             ((1.0, 1.0), (0.5, 0.5)),
         ] {
             let got = t.apply(DVec2::new(uv.0, uv.1));
-            assert!((got - DVec2::new(want.0, want.1)).length() < 1e-6, "{uv:?} → {got}");
+            assert!(
+                (got - DVec2::new(want.0, want.1)).length() < 1e-6,
+                "{uv:?} → {got}"
+            );
             let r = t.rows();
             let p = Vec3::new(uv.0 as f32, uv.1 as f32, 1.0);
             assert!((r[0].dot(p) as f64 - got.x).abs() < 1e-6);

@@ -63,11 +63,17 @@ pub fn generate_corners(mesh: Geometry<'_>) -> CornerTangents {
             t.unwrap_or_else(|| {
                 fallbacks += 1;
                 let per_vertex = fallback.get_or_insert_with(|| per_vertex_fallback(mesh));
-                per_vertex.get(i as usize).copied().unwrap_or(Vec4::new(1.0, 0.0, 0.0, 1.0))
+                per_vertex
+                    .get(i as usize)
+                    .copied()
+                    .unwrap_or(Vec4::new(1.0, 0.0, 0.0, 1.0))
             })
         })
         .collect();
-    CornerTangents { tangents, fallbacks }
+    CornerTangents {
+        tangents,
+        fallbacks,
+    }
 }
 
 /// One tangent per vertex: the MikkTSpace tangent of the vertex's first corner (a vertex used
@@ -116,7 +122,11 @@ pub fn per_vertex_fallback(mesh: Geometry<'_>) -> Vec<Vec4> {
         if a.max(b).max(c) >= n {
             continue;
         }
-        let uv = |i: usize| mesh.uvs.get(i).map_or(DVec2::ZERO, |&t| mikk_uv(t).as_dvec2());
+        let uv = |i: usize| {
+            mesh.uvs
+                .get(i)
+                .map_or(DVec2::ZERO, |&t| mikk_uv(t).as_dvec2())
+        };
         let p = |i: usize| mesh.positions[i].as_dvec3();
         let (e1, e2) = (p(b) - p(a), p(c) - p(a));
         let (d1, d2) = (uv(b) - uv(a), uv(c) - uv(a));
@@ -153,12 +163,22 @@ fn mikk_uv(uv: Vec2) -> Vec2 {
 /// unusable).
 fn orthogonal(normal: DVec3, t: DVec3, b: DVec3) -> Vec4 {
     let normal = normal.try_normalize().unwrap_or(DVec3::Z);
-    let v = (t - normal * normal.dot(t)).try_normalize().unwrap_or_else(|| {
-        // Any axis not parallel to the normal.
-        let axis = if normal.x.abs() < 0.9 { DVec3::X } else { DVec3::Y };
-        (axis - normal * normal.dot(axis)).normalize()
-    });
-    let w = if normal.cross(v).dot(b) < 0.0 { -1.0 } else { 1.0 };
+    let v = (t - normal * normal.dot(t))
+        .try_normalize()
+        .unwrap_or_else(|| {
+            // Any axis not parallel to the normal.
+            let axis = if normal.x.abs() < 0.9 {
+                DVec3::X
+            } else {
+                DVec3::Y
+            };
+            (axis - normal * normal.dot(axis)).normalize()
+        });
+    let w = if normal.cross(v).dot(b) < 0.0 {
+        -1.0
+    } else {
+        1.0
+    };
     v.as_vec3().extend(w)
 }
 
@@ -190,7 +210,11 @@ fn served_triangles(mesh: Geometry<'_>) -> Vec<u32> {
         .filter(|&t| corners(t).iter().all(|&i| usable(i)))
         .collect();
     // Positions compared as MikkTSpace welds them (−0 and +0 alike: adding +0 makes −0 +0).
-    let key = |i: u32| (mesh.positions[i as usize] + Vec3::ZERO).to_array().map(f32::to_bits);
+    let key = |i: u32| {
+        (mesh.positions[i as usize] + Vec3::ZERO)
+            .to_array()
+            .map(f32::to_bits)
+    };
     let mut at_position: HashMap<[u32; 3], usize> = HashMap::new();
     for &t in &faces {
         for &i in corners(t) {
@@ -246,11 +270,17 @@ impl bevy_mikktspace::Geometry for Mikk<'_> {
         face: usize,
         vert: usize,
     ) {
-        let normal = self.mesh.normals[self.vertex(face, vert)].as_dvec3().normalize();
+        let normal = self.mesh.normals[self.vertex(face, vert)]
+            .as_dvec3()
+            .normalize();
         // Made exactly orthogonal in f64; a zero or non-finite one is left to the fallback.
         let tangent = space.and_then(|s| {
             let t = Vec3::from_array(s.tangent()).as_dvec3();
-            let w = if s.is_orientation_preserving() { 1.0 } else { -1.0 };
+            let w = if s.is_orientation_preserving() {
+                1.0
+            } else {
+                -1.0
+            };
             let t = (t - normal * normal.dot(t)).try_normalize()?;
             Some(t.as_vec3().extend(w))
         });

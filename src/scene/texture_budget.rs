@@ -75,7 +75,10 @@ mod tests {
         assert_eq!(img.dimensions(), (4096, 4));
         assert_eq!(img.get_pixel(100, 2).0, [200, 100, 50, 255]);
         let warning = warning.unwrap();
-        assert!(warning.contains("wall.png") && warning.contains("5000×6"), "{warning}");
+        assert!(
+            warning.contains("wall.png") && warning.contains("5000×6"),
+            "{warning}"
+        );
         let small = image::RgbaImage::from_pixel(3, 2, image::Rgba([1, 2, 3, 4]));
         let (img, warning) = to_rgba8(DynamicImage::ImageRgba8(small.clone()), "s.png");
         assert_eq!((img, warning), (small, None));

@@ -139,7 +139,9 @@ fn split_mesh(mesh: &Mesh, transform: &DMat4, eye: DVec3, floor: f64) -> Option<
             color: mesh.colors.get(i).map_or(DVec4::ONE, |c| c.as_dvec4()),
             tangent: mesh.tangents.get(i).map_or(DVec4::X, |t| {
                 let t = t.as_dvec4();
-                transform.transform_vector3(t.truncate()).extend(t.w * handedness)
+                transform
+                    .transform_vector3(t.truncate())
+                    .extend(t.w * handedness)
             }),
         }
     };
@@ -151,14 +153,21 @@ fn split_mesh(mesh: &Mesh, transform: &DMat4, eye: DVec3, floor: f64) -> Option<
     if placed.iter().flatten().any(|v| !v.p.is_finite()) {
         return None;
     }
-    if !placed.iter().any(|[a, b, c]| too_long(a.p, b.p, c.p, floor)) {
+    if !placed
+        .iter()
+        .any(|[a, b, c]| too_long(a.p, b.p, c.p, floor))
+    {
         return None;
     }
     let mut out = Mesh::default();
     let mut stack: Vec<([Vertex; 3], u32)> = placed.into_iter().map(|t| (t, 0)).collect();
     while let Some(([a, b, c], depth)) = stack.pop() {
         if depth < MAX_SPLITS && too_long(a.p, b.p, c.p, floor) {
-            let (ab, bc, ca) = (Vertex::mid(&a, &b), Vertex::mid(&b, &c), Vertex::mid(&c, &a));
+            let (ab, bc, ca) = (
+                Vertex::mid(&a, &b),
+                Vertex::mid(&b, &c),
+                Vertex::mid(&c, &a),
+            );
             for t in [[a, ab, ca], [ab, b, bc], [ca, bc, c], [ab, bc, ca]] {
                 stack.push((t, depth + 1));
             }
@@ -233,7 +242,10 @@ mod tests {
         assert_eq!(closest_point(a, b, c), DVec3::new(0.0, 0.0, 2.0));
         let shifted = DVec3::new(5.0, 5.0, 0.0);
         let edge = closest_point(a - shifted, b - shifted, c - shifted) + shifted;
-        assert!((edge - DVec3::new(1.0, 1.0, 2.0)).length() < 1e-12, "{edge}");
+        assert!(
+            (edge - DVec3::new(1.0, 1.0, 2.0)).length() < 1e-12,
+            "{edge}"
+        );
         let far = DVec3::new(-9.0, -9.0, 0.0);
         assert_eq!(closest_point(a - far, b - far, c - far) + far, a);
     }

@@ -12,9 +12,9 @@ pub(super) use scatter::FORCED_SCATTER_BLOCKS;
 
 use super::cells::{for_each_run_in, SliceWindow};
 use super::index_list::{EntriesMut, LightIndex};
-use crate::cluster::headroom::{clear_with_room_for, room_for, share_of, WHOLE_UP_TO};
 use super::types::{Assignment, Run, Totals, PARALLEL_SECONDS};
 use crate::cluster::grid::ClusterGrid;
+use crate::cluster::headroom::{clear_with_room_for, room_for, share_of, WHOLE_UP_TO};
 use crate::cluster::view_light::GpuLight;
 
 /// The bands and their buffers, kept between frames.
@@ -333,7 +333,12 @@ fn for_each_band(bands: &mut [Band], parallel: bool, f: &(dyn Fn(&mut Band) + Sy
 /// Phase 2's numbering: the lights listed by any band, ascending, into `visible`. One band
 /// numbers its own lights (its `ids`); several leave each light's number in `numbers` (one
 /// entry per light), which phase 3 looks their lights up in.
-fn number_visible(bands: &mut [Band], lights: usize, visible: &mut Vec<u32>, numbers: &mut Vec<u32>) {
+fn number_visible(
+    bands: &mut [Band],
+    lights: usize,
+    visible: &mut Vec<u32>,
+    numbers: &mut Vec<u32>,
+) {
     visible.clear();
     if let [band] = bands {
         visible.extend(band.lights.iter().map(|&(light, _)| light));
@@ -393,7 +398,12 @@ fn scatter_bands<T: LightIndex>(
 ) {
     if let [band] = bands {
         let n = band.end_cell - band.first_cell;
-        band.count_and_scatter(numbers, &mut cells.counts[..n], &mut cells.offsets[..n], list);
+        band.count_and_scatter(
+            numbers,
+            &mut cells.counts[..n],
+            &mut cells.offsets[..n],
+            list,
+        );
         return;
     }
     let (left, right) = bands.split_at_mut(bands.len() / 2);

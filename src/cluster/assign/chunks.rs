@@ -6,9 +6,9 @@ use rayon::prelude::*;
 
 use super::cells::for_each_run;
 use super::index_list::{EntriesMut, IndexList, LightIndex};
-use crate::cluster::headroom::{clear_with_room_for, room_for, share_of, zeroed_with_room};
 use super::types::{Assignment, Run, Totals};
 use crate::cluster::grid::ClusterGrid;
+use crate::cluster::headroom::{clear_with_room_for, room_for, share_of, zeroed_with_room};
 use crate::cluster::view_light::GpuLight;
 
 /// The chunks and their buffers, kept between frames.

@@ -310,7 +310,17 @@ mod tests {
                 let dir = if dir.length() < 1e-3 { DVec3::Z } else { dir };
                 let outer = rng.random_range(1.0..120.0);
                 let r = hy * rng.random_range(0.05..1.5);
-                let light = Light::spot(p, r as f32, Vec3::ONE, 1.0, crate::scene::Cone { direction: dir, inner_deg: outer * 0.5, outer_deg: outer });
+                let light = Light::spot(
+                    p,
+                    r as f32,
+                    Vec3::ONE,
+                    1.0,
+                    crate::scene::Cone {
+                        direction: dir,
+                        inner_deg: outer * 0.5,
+                        outer_deg: outer,
+                    },
+                );
                 GpuLight::from_light(&light, &glam::DMat4::IDENTITY)
             })
             .collect()

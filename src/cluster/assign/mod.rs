@@ -47,10 +47,10 @@ mod chunks;
 mod cone;
 pub mod index_list;
 mod overflow;
-mod rows;
-mod simd;
 #[cfg(test)]
 mod paths_tests;
+mod rows;
+mod simd;
 #[cfg(test)]
 mod tests;
 mod thread_choice;
@@ -205,8 +205,17 @@ impl Assigner {
         // Lights past the caller's threshold take the pool; the rules' other reasons are
         // weighed against one thread by measure.
         let chosen = rule > 1 && lights.len() < limits.parallel_threshold;
-        let threads = if chosen { self.choice.threads(rule) } else { rule };
-        keep_pool_split(&mut self.bands, &mut self.pool_split, self.last_threads, threads);
+        let threads = if chosen {
+            self.choice.threads(rule)
+        } else {
+            rule
+        };
+        keep_pool_split(
+            &mut self.bands,
+            &mut self.pool_split,
+            self.last_threads,
+            threads,
+        );
         self.last_threads = threads;
         let by_bands = threads == 1 || cells >= lights.len();
         let totals = if threads == 1 {

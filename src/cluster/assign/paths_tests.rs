@@ -44,7 +44,13 @@ fn parallel_and_sequential_assignment_agree() {
     assert_eq!(seq.counts, par.counts);
     assert_eq!(seq.indices, par.indices);
     // The same figures, but the threads they ran on.
-    assert_eq!(seq.stats, AssignStats { threads: 1, ..par.stats });
+    assert_eq!(
+        seq.stats,
+        AssignStats {
+            threads: 1,
+            ..par.stats
+        }
+    );
     assert_eq!(seq.stats.threads, 1);
     assert_eq!(
         par.stats.threads,
@@ -278,7 +284,14 @@ fn any_number_of_bands_gives_what_one_band_gives() {
                 assert_eq!(one.offsets, bands.offsets, "{what}");
                 assert_eq!(one.counts, bands.counts, "{what}");
                 assert_eq!(one.indices, bands.indices, "{what}");
-                assert_eq!(one.stats, AssignStats { threads: 1, ..bands.stats }, "{what}");
+                assert_eq!(
+                    one.stats,
+                    AssignStats {
+                        threads: 1,
+                        ..bands.stats
+                    },
+                    "{what}"
+                );
                 assert_eq!(bands.stats.threads, threads, "{what}");
                 listed += one.stats.indices;
             }
@@ -441,18 +454,32 @@ fn scatter_blocks_of_any_number_give_the_same_lists() {
         let lights = random_lights(&mut rng, 600, case.far.min(200.0) * 0.5);
         FORCED_SCATTER_BLOCKS.with(|b| b.set(Some(1)));
         let whole = assign(&grid, &lights, case.far, &limits);
-        assert!(whole.indices.len() > 1000, "{}: too few indices to cut", case.name);
+        assert!(
+            whole.indices.len() > 1000,
+            "{}: too few indices to cut",
+            case.name
+        );
         // Block edges cut runs in two (7, 64), or nearly every run (a block a cell).
         for blocks in [2, 7, 64, grid.total_cells as usize] {
             FORCED_SCATTER_BLOCKS.with(|b| b.set(Some(blocks)));
             let cut = assign(&grid, &lights, case.far, &limits);
             assert_eq!(cut.offsets, whole.offsets, "{}, {blocks} blocks", case.name);
             assert_eq!(cut.counts, whole.counts, "{}, {blocks} blocks", case.name);
-            assert_eq!(cut.indices.to_vec(), whole.indices.to_vec(), "{}, {blocks}", case.name);
+            assert_eq!(
+                cut.indices.to_vec(),
+                whole.indices.to_vec(),
+                "{}, {blocks}",
+                case.name
+            );
             // The totals each block adds up (the block count changes how they are summed).
             let stats = |a: &Assignment| {
                 let s = &a.stats;
-                (s.nonempty_clusters, s.max_lights_per_cluster, s.indices, s.runs)
+                (
+                    s.nonempty_clusters,
+                    s.max_lights_per_cluster,
+                    s.indices,
+                    s.runs,
+                )
             };
             assert_eq!(stats(&cut), stats(&whole), "{}, {blocks} blocks", case.name);
             // Two bands, each cut into blocks: the second band's offsets take its base.
@@ -467,9 +494,22 @@ fn scatter_blocks_of_any_number_give_the_same_lists() {
             };
             let banded = pool.install(|| assign(&grid, &lights, case.far, &parallel));
             assert_eq!(banded.stats.threads, 2, "{}", case.name);
-            assert_eq!(banded.offsets, whole.offsets, "{}, two bands of {blocks}", case.name);
-            assert_eq!(banded.counts, whole.counts, "{}, two bands of {blocks}", case.name);
-            assert_eq!(banded.indices.to_vec(), whole.indices.to_vec(), "{}, {blocks}", case.name);
+            assert_eq!(
+                banded.offsets, whole.offsets,
+                "{}, two bands of {blocks}",
+                case.name
+            );
+            assert_eq!(
+                banded.counts, whole.counts,
+                "{}, two bands of {blocks}",
+                case.name
+            );
+            assert_eq!(
+                banded.indices.to_vec(),
+                whole.indices.to_vec(),
+                "{}, {blocks}",
+                case.name
+            );
         }
         FORCED_SCATTER_BLOCKS.with(|b| b.set(None));
     }

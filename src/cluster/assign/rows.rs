@@ -75,8 +75,11 @@ impl RowChords {
         // caps it; clamping in f64 first (0 first: NaN gives 0) gives the same tile.
         let last = splat(self.last_column as f64);
         let tile = |ndc: F64x4| {
-            at_most(at_least(splat(0.0), (ndc + splat(1.0)) * splat(self.half_tiles_x)), last)
-                .to_array()
+            at_most(
+                at_least(splat(0.0), (ndc + splat(1.0)) * splat(self.half_tiles_x)),
+                last,
+            )
+            .to_array()
         };
         let (x0, x1) = (tile(lo), tile(hi));
         // The band holds the centre (or the gap is NaN): the whole cross-section's columns.

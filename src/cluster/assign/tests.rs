@@ -108,7 +108,17 @@ pub(super) fn random_lights(rng: &mut Pcg64Mcg, n: usize, scale: f64) -> Vec<Gpu
                 );
                 let dir = if dir.length() < 1e-3 { DVec3::Z } else { dir };
                 let outer = rng.random_range(0.5..100.0);
-                Light::spot(p, r, Vec3::ONE, 1.0, crate::scene::Cone { direction: dir, inner_deg: outer * 0.5, outer_deg: outer })
+                Light::spot(
+                    p,
+                    r,
+                    Vec3::ONE,
+                    1.0,
+                    crate::scene::Cone {
+                        direction: dir,
+                        inner_deg: outer * 0.5,
+                        outer_deg: outer,
+                    },
+                )
             } else {
                 Light::point(p, r, Vec3::ONE, 1.0)
             };
@@ -584,7 +594,10 @@ fn a_spot_without_an_axis_direction_is_its_sphere_in_every_band() {
             cells
         };
         // Behind the eye (reaches nothing) and in front of it (reaches cells).
-        for (position, radius) in [(Vec3::new(-6.8, -3.1, 12.7), 0.48), (Vec3::new(0.5, 0.2, -6.0), 1.5)] {
+        for (position, radius) in [
+            (Vec3::new(-6.8, -3.1, 12.7), 0.48),
+            (Vec3::new(0.5, 0.2, -6.0), 1.5),
+        ] {
             let point = GpuLight {
                 position,
                 radius,

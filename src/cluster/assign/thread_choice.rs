@@ -77,9 +77,8 @@ impl ThreadChoice {
     pub(super) fn threads(&mut self, pool: usize) -> usize {
         self.since_try = self.since_try.saturating_add(1);
         let kept_measured = self.seconds_per_unit[usize::from(!self.one)].len > 0;
-        let try_other = self.since_try >= self.interval
-            && kept_measured
-            && (self.one || !self.estimated);
+        let try_other =
+            self.since_try >= self.interval && kept_measured && (self.one || !self.estimated);
         if try_other {
             self.since_try = 0;
         }
@@ -177,7 +176,11 @@ mod tests {
         (0..frames)
             .map(|i| {
                 let threads = choice.threads(4);
-                let (seconds, busy) = if threads == 1 { (one(i), None) } else { pool(i) };
+                let (seconds, busy) = if threads == 1 {
+                    (one(i), None)
+                } else {
+                    pool(i)
+                };
                 choice.measured(threads, seconds, 1.0, busy);
                 threads
             })
@@ -221,10 +224,22 @@ mod tests {
         // As in a renderer's first frames on a 2-core host, where the driver's threads compile
         // shaders on the same cores: the pool is slow at first, then twice as fast.
         let mut choice = ThreadChoice::default();
-        let threads = run(&mut choice, 20, |_| 2e-3, |i| if i < 4 { 5e-3 } else { 1e-3 });
-        assert_eq!(threads[1..3], [1, 1], "one thread wins its first try: {threads:?}");
+        let threads = run(
+            &mut choice,
+            20,
+            |_| 2e-3,
+            |i| if i < 4 { 5e-3 } else { 1e-3 },
+        );
+        assert_eq!(
+            threads[1..3],
+            [1, 1],
+            "one thread wins its first try: {threads:?}"
+        );
         assert!(ones(&threads) <= 7, "{threads:?}");
-        assert!(threads[8..].iter().filter(|&&t| t > 1).count() >= 10, "{threads:?}");
+        assert!(
+            threads[8..].iter().filter(|&&t| t > 1).count() >= 10,
+            "{threads:?}"
+        );
     }
 
     #[test]

@@ -3,8 +3,8 @@
 
 use crate::cluster::assign::AssignLimits;
 use crate::cluster::grid::{ClusterGrid, GridConfig, GridProjection};
-use crate::cluster::view_light::GpuLight;
 use crate::cluster::pack::GridEncoding;
+use crate::cluster::view_light::GpuLight;
 
 /// A new grid must be predicted this much cheaper (relative) than the current one to replace it.
 pub const HYSTERESIS: f64 = 0.1;

@@ -3,8 +3,8 @@
 use super::*;
 use crate::cluster::assign::{AssignLimits, Assigner};
 use crate::cluster::grid::{GridConfig, GridMode, GridProjection};
-use crate::cluster::view_light::GpuLight;
 use crate::cluster::pack::GridEncoding;
+use crate::cluster::view_light::GpuLight;
 use crate::scene::Light;
 use glam::{DMat4, DVec3, Vec3};
 use rand::{Rng, SeedableRng};
@@ -296,7 +296,9 @@ fn the_cpu_budget_bounds_the_assignment() {
     assert!(coarsest < share(&free_pick), "{unbounded:?}");
     let budget = 0.5 * (coarsest + share(&free_pick));
     let mut tight = inputs(&lights);
-    tight.base.mode = GridMode::Auto { assign_budget: budget };
+    tight.base.mode = GridMode::Auto {
+        assign_budget: budget,
+    };
     let bounded = choose(&tight, &samples, &costs, &mut Assigner::new());
     let pick = chosen(&bounded);
     assert!(!pick.over_budget && share(&pick) <= budget, "{bounded:?}");
@@ -338,7 +340,9 @@ fn overflow_outranks_the_cpu_budget() {
     let (lights, samples) = workload(600);
     let mut capped = inputs(&lights);
     capped.limits.cell_cap = 12;
-    capped.base.mode = GridMode::Auto { assign_budget: 0.05 };
+    capped.base.mode = GridMode::Auto {
+        assign_budget: 0.05,
+    };
     let choice = choose(
         &capped,
         &samples,

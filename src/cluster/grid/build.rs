@@ -182,10 +182,13 @@ impl ClusterGrid {
     /// Every slice's (cascade, slice within the cascade) and the view depth where it starts,
     /// near to far: what the slice lookup is built from.
     pub(super) fn slice_starts(&self) -> impl Iterator<Item = ((u32, u32), f64)> + '_ {
-        self.cascades.iter().enumerate().flat_map(move |(k, cascade)| {
-            let k = k as u32;
-            (0..cascade.slices).map(move |s| ((k, s), self.slice_depth_range(k, s).0))
-        })
+        self.cascades
+            .iter()
+            .enumerate()
+            .flat_map(move |(k, cascade)| {
+                let k = k as u32;
+                (0..cascade.slices).map(move |s| ((k, s), self.slice_depth_range(k, s).0))
+            })
     }
 
     /// The constants of every cascade, into `out` (cleared first).

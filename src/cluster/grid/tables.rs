@@ -163,7 +163,6 @@ impl CascadeConstants {
     pub(crate) fn tile_edge(&self, axis: usize, i: u32) -> f64 {
         -self.extent[axis] + i as f64 * self.tile_step[axis]
     }
-
 }
 
 /// One slice's exact depths and the view half extents at them (see

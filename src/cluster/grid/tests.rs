@@ -288,7 +288,12 @@ fn a_grid_rebuilt_finer_keeps_its_buffers() {
     };
     let before = buffers(&grid);
     let slices = grid.slice_slabs.len();
-    for (px, split) in [(32.0, None), (16.0, Some(4.0)), (8.0, Some(0.2)), (4.0, Some(0.1))] {
+    for (px, split) in [
+        (32.0, None),
+        (16.0, Some(4.0)),
+        (8.0, Some(0.2)),
+        (4.0, Some(0.1)),
+    ] {
         let config = GridConfig {
             first_split: split,
             ..GridConfig::fixed(px)
@@ -296,5 +301,8 @@ fn a_grid_rebuilt_finer_keeps_its_buffers() {
         grid.rebuild(1280, 720, GridProjection::test_view(), 0.1, 80.0, &config);
         assert_eq!(buffers(&grid), before, "{px} px, first split {split:?}");
     }
-    assert!(grid.slice_slabs.len() > 2 * slices, "the finest grid has more slices");
+    assert!(
+        grid.slice_slabs.len() > 2 * slices,
+        "the finest grid has more slices"
+    );
 }

@@ -234,7 +234,10 @@ pub fn pack_indices_into(indices: &IndexList, encoding: GridEncoding, packed: &m
     let height = rows_for(indices.len().div_ceil(per_texel));
     let texel_bytes = per_texel * encoding.index_bytes();
     let bytes = &mut packed.bytes;
-    zeroed_with_room(bytes, DATA_TEXTURE_WIDTH as usize * height as usize * texel_bytes);
+    zeroed_with_room(
+        bytes,
+        DATA_TEXTURE_WIDTH as usize * height as usize * texel_bytes,
+    );
     match (indices.as_u16(), indices.as_u32()) {
         (Some(list), _) => put_indices(bytes, list.iter().copied(), encoding),
         (_, Some(list)) => put_indices(bytes, list.iter().map(|&v| v as u16), encoding),

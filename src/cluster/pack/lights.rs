@@ -33,9 +33,9 @@
 
 use glam::Vec3;
 
-use crate::scene::light::{half_sine, spot_terms_from_half_sines};
-use crate::cluster::view_light::GpuLight;
 use crate::cluster::headroom::zeroed_with_room;
+use crate::cluster::view_light::GpuLight;
+use crate::scene::light::{half_sine, spot_terms_from_half_sines};
 
 /// Width in texels of every data texture (a power of two ≤ 1024: exact under mediump math).
 pub const DATA_TEXTURE_WIDTH: u32 = 1024;
@@ -294,7 +294,17 @@ mod tests {
                 let f = i as f64;
                 let p = DVec3::new((f * 0.37).sin() * 20.0, (f * 0.11).cos() * 5.0, -(f * 0.05));
                 let light = if i % 3 == 0 {
-                    Light::spot(p, (2.0 + (f % 7.0)) as f32, Vec3::new(1.0, 0.5, 0.25), (1.0 + f) as f32, crate::scene::Cone { direction: DVec3::new(0.2, -1.0, 0.1), inner_deg: 10.0 + f % 20.0, outer_deg: 30.0 + f % 40.0 })
+                    Light::spot(
+                        p,
+                        (2.0 + (f % 7.0)) as f32,
+                        Vec3::new(1.0, 0.5, 0.25),
+                        (1.0 + f) as f32,
+                        crate::scene::Cone {
+                            direction: DVec3::new(0.2, -1.0, 0.1),
+                            inner_deg: 10.0 + f % 20.0,
+                            outer_deg: 30.0 + f % 40.0,
+                        },
+                    )
                 } else {
                     Light::point(
                         p,

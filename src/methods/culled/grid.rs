@@ -36,7 +36,13 @@ impl CulledForward {
         let projection = GridProjection::from_matrix(&ctx.projection.as_dmat4());
         let config = match self.culling {
             Culling::Clustered if self.automatic(ctx) => {
-                let choice = self.auto.config(ctx, projection, limits, encoding, self.assign.assigner_mut());
+                let choice = self.auto.config(
+                    ctx,
+                    projection,
+                    limits,
+                    encoding,
+                    self.assign.assigner_mut(),
+                );
                 choice.config.clone()
             }
             Culling::Clustered => ctx.options.grid.clone(),

@@ -108,7 +108,9 @@ impl ShadingMethod for CulledForward {
         let (grid_key, grid) = self.grid.as_ref().expect("updated above");
         limits::check_grid(ctx.dev, grid, grid_key.config.footprint_px)?;
         let assigned = self.assign.run(method, grid, ctx, &limits)?;
-        let uploaded = self.upload.pack_and_upload(ctx, grid, assigned.assignment)?;
+        let uploaded = self
+            .upload
+            .pack_and_upload(ctx, grid, assigned.assignment)?;
         if automatic {
             grid::record_cost(&mut self.auto, grid, &assigned, &uploaded);
         }

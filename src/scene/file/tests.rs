@@ -41,17 +41,33 @@ fn directional_lights_parse_and_errors_name_the_field() {
     )
     .unwrap();
     assert_eq!(s.directional_lights.len(), 2);
-    assert_eq!(s.directional_lights[0].intensity, 1.0, "intensity defaults to 1");
+    assert_eq!(
+        s.directional_lights[0].intensity, 1.0,
+        "intensity defaults to 1"
+    );
     assert_eq!(s.directional_lights[0].to_light(), DVec3::Y);
     assert_eq!(s.directional_lights[1].radiance(), Vec3::splat(2.5));
     for (bad, field) in [
-        (r#"{"direction": [0, 0, 0], "color": [1, 1, 1]}"#, "directional_lights[0].direction"),
-        (r#"{"direction": [0, -1, 0], "color": [1, -1, 1]}"#, "directional_lights[0].color"),
-        (r#"{"direction": [0, -1, 0], "color": [1, 1, 1], "intensity": -2}"#, "directional_lights[0].intensity"),
-        (r#"{"direction": [0, -1, 0], "color": [1, 1, 1], "radius": 2}"#, "directional_lights[0]"),
+        (
+            r#"{"direction": [0, 0, 0], "color": [1, 1, 1]}"#,
+            "directional_lights[0].direction",
+        ),
+        (
+            r#"{"direction": [0, -1, 0], "color": [1, -1, 1]}"#,
+            "directional_lights[0].color",
+        ),
+        (
+            r#"{"direction": [0, -1, 0], "color": [1, 1, 1], "intensity": -2}"#,
+            "directional_lights[0].intensity",
+        ),
+        (
+            r#"{"direction": [0, -1, 0], "color": [1, 1, 1], "radius": 2}"#,
+            "directional_lights[0]",
+        ),
         (r#"{"color": [1, 1, 1]}"#, "directional_lights[0]"),
     ] {
-        let text = format!(r#"{{"objects": [{{"builtin": "plane"}}], "directional_lights": [{bad}]}}"#);
+        let text =
+            format!(r#"{{"objects": [{{"builtin": "plane"}}], "directional_lights": [{bad}]}}"#);
         let err = parse_str(&text).unwrap_err().to_string();
         assert!(err.contains(field), "{bad}: {err}");
     }
@@ -76,16 +92,20 @@ fn parses_a_full_scene() {
 
 #[test]
 fn metallic_and_roughness_make_an_objects_materials_metallic_roughness() {
-    let s = parse_str(
-        r#"{"objects": [{"builtin": "plane", "metallic": 1, "roughness": 0.25}]}"#,
-    )
-    .unwrap();
+    let s = parse_str(r#"{"objects": [{"builtin": "plane", "metallic": 1, "roughness": 0.25}]}"#)
+        .unwrap();
     let m = &s.materials[0];
     assert_eq!(m.model, MaterialModel::MetallicRoughness);
     assert_eq!((m.metallic, m.roughness), (1.0, 0.25));
     for (json, field) in [
-        (r#"{"builtin": "plane", "metallic": 1}"#, "objects[0].roughness"),
-        (r#"{"builtin": "plane", "metallic": 2, "roughness": 0}"#, "objects[0].metallic"),
+        (
+            r#"{"builtin": "plane", "metallic": 1}"#,
+            "objects[0].roughness",
+        ),
+        (
+            r#"{"builtin": "plane", "metallic": 2, "roughness": 0}"#,
+            "objects[0].metallic",
+        ),
     ] {
         let err = parse_str(&format!(r#"{{"objects": [{json}]}}"#))
             .unwrap_err()

@@ -25,10 +25,18 @@ fn u32_at(bytes: &[u8], at: usize) -> Option<u32> {
 /// (`0x004E4942 \`BIN\``).
 fn chunk_type(kind: u32) -> String {
     let bytes = kind.to_le_bytes();
-    let printable = bytes.iter().all(|b| b.is_ascii_graphic() || *b == 0 || *b == b' ');
+    let printable = bytes
+        .iter()
+        .all(|b| b.is_ascii_graphic() || *b == 0 || *b == b' ');
     let text: String = bytes
         .iter()
-        .map(|&b| if b == 0 { "\\0".to_string() } else { (b as char).to_string() })
+        .map(|&b| {
+            if b == 0 {
+                "\\0".to_string()
+            } else {
+                (b as char).to_string()
+            }
+        })
         .collect();
     if printable {
         format!("0x{kind:08X} `{text}`")
@@ -174,7 +182,10 @@ mod tests {
             let mut bad = file.clone();
             bad[16..20].copy_from_slice(&kind);
             let err = split(&bad).unwrap_err();
-            assert!(err.contains("first chunk has type") && err.contains(want), "{err}");
+            assert!(
+                err.contains("first chunk has type") && err.contains(want),
+                "{err}"
+            );
         }
     }
 }

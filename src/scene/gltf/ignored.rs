@@ -101,7 +101,10 @@ pub(super) fn once_per_feature(warnings: Vec<String>) -> Vec<String> {
     let mut merged: Vec<(String, usize)> = Vec::new();
     let mut index: std::collections::HashMap<String, usize> = std::collections::HashMap::new();
     for w in warnings {
-        let saying = w.split_once(": ").map_or(w.as_str(), |(_, s)| s).to_string();
+        let saying = w
+            .split_once(": ")
+            .map_or(w.as_str(), |(_, s)| s)
+            .to_string();
         match index.get(&saying) {
             Some(&i) => merged[i].1 += 1,
             None => {

@@ -150,10 +150,9 @@ mod tests {
         assert!(err.starts_with("meshes[0].primitives[0].mode:"), "{err}");
         let err = check(br#"{"nodes":[{"children":[1, 4294967297]}]}"#).unwrap_err();
         assert!(err.starts_with("nodes[0].children[1]:"), "{err}");
-        let err = check(
-            br#"{"nodes":[{"extensions":{"KHR_lights_punctual":{"light":4294967296}}}]}"#,
-        )
-        .unwrap_err();
+        let err =
+            check(br#"{"nodes":[{"extensions":{"KHR_lights_punctual":{"light":4294967296}}}]}"#)
+                .unwrap_err();
         assert!(err.contains("KHR_lights_punctual.light"), "{err}");
         assert!(check(br#"{"nodes":[{"mesh":4294967295}]}"#).is_ok());
     }

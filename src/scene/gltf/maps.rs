@@ -85,7 +85,11 @@ pub(super) fn transform_of(
         None => Some(0.0),
         Some(v) => v.as_f64().map(|r| r as f32),
     };
-    let parsed = match (pair("offset", Vec2::ZERO), rotation, pair("scale", Vec2::ONE)) {
+    let parsed = match (
+        pair("offset", Vec2::ZERO),
+        rotation,
+        pair("scale", Vec2::ONE),
+    ) {
         (Some(offset), Some(rotation), Some(scale)) => Some(TextureTransform {
             offset,
             rotation,
@@ -155,7 +159,11 @@ pub(super) fn convert(
         };
         maps.normal = load_slot(slot, index, field, src, warnings)?;
         let scale = n.scale();
-        maps.normal_scale = if scale.is_finite() { scale.clamp(-16.0, 16.0) } else { 1.0 };
+        maps.normal_scale = if scale.is_finite() {
+            scale.clamp(-16.0, 16.0)
+        } else {
+            1.0
+        };
     }
     if let Some(o) = m.occlusion_texture() {
         let slot = Slot {

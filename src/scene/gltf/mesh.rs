@@ -67,9 +67,7 @@ pub(super) fn build(
         format!("{field}.attributes.{name} (accessors[{}])", a.index())
     };
     let pos_field = attr("POSITION", &position);
-    if position.dimensions() != Dimensions::Vec3
-        || position.data_type() != DataType::F32
-    {
+    if position.dimensions() != Dimensions::Vec3 || position.data_type() != DataType::F32 {
         return Err(format!(
             "{pos_field}: is {}; positions must be VEC3 of FLOAT",
             describe(&position)
@@ -188,14 +186,19 @@ pub(super) fn build(
     } else {
         (positions, uvs, indices)
     };
-    let mut mesh = Mesh::new(positions, normals, uvs, indices).map_err(|e| format!("{field}: {e}"))?;
+    let mut mesh =
+        Mesh::new(positions, normals, uvs, indices).map_err(|e| format!("{field}: {e}"))?;
     if !colors.is_empty() {
-        mesh = mesh.with_colors(colors).map_err(|e| format!("{field}: {e}"))?;
+        mesh = mesh
+            .with_colors(colors)
+            .map_err(|e| format!("{field}: {e}"))?;
     }
     // Tangents only where a normal map will use them (they cost a vertex attribute).
     if p.material().normal_texture().is_some() {
         if !tangents.is_empty() {
-            mesh = mesh.with_tangents(tangents).map_err(|e| format!("{field}: {e}"))?;
+            mesh = mesh
+                .with_tangents(tangents)
+                .map_err(|e| format!("{field}: {e}"))?;
         } else if mesh.uvs.is_empty() {
             warnings.push(format!(
                 "{field}: its material has a normal map but the primitive has no TEXCOORD_0; \
@@ -273,7 +276,10 @@ fn read_vectors(
 /// An attribute (`field`, its glTF path) must have one element per position (`n`).
 fn same_count(field: &str, a: &gltf::Accessor, n: usize) -> Result<(), String> {
     if a.count() != n {
-        return Err(format!("{field}: {} elements but POSITION has {n}", a.count()));
+        return Err(format!(
+            "{field}: {} elements but POSITION has {n}",
+            a.count()
+        ));
     }
     Ok(())
 }
@@ -315,7 +321,9 @@ fn read_colors(
         .map(|c| Vec4::new(c[0], c[1], c[2], if dims == 4 { c[3] } else { 1.0 }))
         .collect();
     if let Some(i) = colors.iter().position(|c| !c.is_finite()) {
-        return Err(format!("{field}: element {i} is not finite; colours must be"));
+        return Err(format!(
+            "{field}: element {i} is not finite; colours must be"
+        ));
     }
     Ok(colors)
 }

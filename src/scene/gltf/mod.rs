@@ -282,8 +282,7 @@ fn import(
     }
     let mut warnings = Vec::new();
     let base_dir = path.parent().unwrap_or(Path::new("."));
-    let mut buffers =
-        buffers::Buffers::new(&document, bin, base_dir, options.allow_outside_files);
+    let mut buffers = buffers::Buffers::new(&document, bin, base_dir, options.allow_outside_files);
     let (roots, from) = nodes::roots(&document);
     let placed = nodes::walk(&document, &roots, &locals, DMat4::IDENTITY)?;
 

@@ -216,7 +216,10 @@ mod tests {
         let json = br#"{"nodes": [{"rotation": [0, 1e200, 0, 1e200]}, {"rotation": [0, 1e-300, 0, 1e-300]}]}"#;
         let quarter = DMat4::from_rotation_y(std::f64::consts::FRAC_PI_2);
         for m in local_transforms(json).unwrap() {
-            assert!((m.transform_vector3(DVec3::X) - quarter.transform_vector3(DVec3::X)).length() < 1e-12);
+            assert!(
+                (m.transform_vector3(DVec3::X) - quarter.transform_vector3(DVec3::X)).length()
+                    < 1e-12
+            );
         }
     }
 
@@ -234,7 +237,9 @@ mod tests {
             assert!(err.contains(want), "{err}");
         }
         // JSON cannot hold infinity; a number past f64 is refused as it is read.
-        assert!(local_transforms(node("1e999,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,0,1").as_bytes()).is_err());
+        assert!(
+            local_transforms(node("1e999,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,0,1").as_bytes()).is_err()
+        );
         // Flat (singular) and nearly affine (rounded by an exporter) matrices are kept; the
         // rounding is snapped away.
         let flat = local_transforms(node("1,0,0,0, 0,0,0,0, 0,0,1,0, 0,0,0,1").as_bytes());

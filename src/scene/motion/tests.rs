@@ -7,7 +7,17 @@ fn point() -> Light {
 }
 
 fn spot() -> Light {
-    Light::spot(DVec3::new(0.0, 5.0, 0.0), 8.0, Vec3::ONE, 2.0, crate::scene::Cone { direction: DVec3::NEG_Y, inner_deg: 10.0, outer_deg: 25.0 })
+    Light::spot(
+        DVec3::new(0.0, 5.0, 0.0),
+        8.0,
+        Vec3::ONE,
+        2.0,
+        crate::scene::Cone {
+            direction: DVec3::NEG_Y,
+            inner_deg: 10.0,
+            outer_deg: 25.0,
+        },
+    )
 }
 
 fn every_motion() -> Motion {

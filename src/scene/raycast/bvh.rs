@@ -128,7 +128,10 @@ pub(super) fn traverse<S>(
     mut leaf: impl FnMut(&mut S, Range<usize>),
 ) {
     stack.clear();
-    if nodes.first().is_some_and(|root| enter(root, state).is_some()) {
+    if nodes
+        .first()
+        .is_some_and(|root| enter(root, state).is_some())
+    {
         stack.push(0);
     }
     while let Some(ni) = stack.pop() {
@@ -137,7 +140,10 @@ pub(super) fn traverse<S>(
             continue;
         }
         if node.count > 0 {
-            leaf(state, node.first as usize..(node.first + node.count) as usize);
+            leaf(
+                state,
+                node.first as usize..(node.first + node.count) as usize,
+            );
             continue;
         }
         let (a, b) = (node.first, node.first + 1);
@@ -172,7 +178,10 @@ mod tests {
                 pick(1, lo.y, hi.y),
                 pick(2, lo.z, hi.z),
             ));
-            assert!(corner.cmpge(wlo).all() && corner.cmple(whi).all(), "{corner}");
+            assert!(
+                corner.cmpge(wlo).all() && corner.cmple(whi).all(),
+                "{corner}"
+            );
         }
     }
 }

@@ -109,10 +109,9 @@ fn a_nearly_coplanar_second_surface_is_reported() {
         (triangle_at(0.0), DMat4::IDENTITY),
         (triangle_at(-0.0001), DMat4::IDENTITY),
     ]));
-    let r =
-        doubled.first_opaque_hit(DVec3::new(0.0, 0.0, 5.0), -DVec3::Z, f64::INFINITY, |_| {
-            true
-        });
+    let r = doubled.first_opaque_hit(DVec3::new(0.0, 0.0, 5.0), -DVec3::Z, f64::INFINITY, |_| {
+        true
+    });
     assert_eq!(r.hit.unwrap().object, 0);
     assert!((r.runner_up_t.unwrap() - 5.0001).abs() < 1e-9);
     let apart = SceneRaycaster::new(&scene_of(vec![
@@ -184,8 +183,10 @@ fn agrees_with_brute_force(
     for _ in 0..rays {
         let origin = rand_point(rng, 2.0 * spread).as_dvec3();
         let dir = (rand_point(rng, 0.8 * spread).as_dvec3() - origin).normalize();
-        for (opaque, name) in [(&(|_| true) as &dyn Fn(usize) -> bool, "all"), (&opaque, "some")]
-        {
+        for (opaque, name) in [
+            (&(|_| true) as &dyn Fn(usize) -> bool, "all"),
+            (&opaque, "some"),
+        ] {
             let (want, want_t) = brute_force(scene, origin, dir, opaque);
             let got = rc.first_opaque_hit(origin, dir, f64::INFINITY, opaque);
             let same = match (got.hit, want) {
@@ -247,7 +248,10 @@ fn bvh_agrees_with_brute_force() {
     let scene = scene_of(meshes);
     let (hits, transparent) =
         agrees_with_brute_force(&scene, &mut rng, 1000, 10.0, |o| o.is_multiple_of(2));
-    assert!(hits > 1000 && transparent > 250, "{hits} hits, {transparent}");
+    assert!(
+        hits > 1000 && transparent > 250,
+        "{hits} hits, {transparent}"
+    );
 }
 
 /// One mesh placed many times — moved, rotated, mirrored, scaled unevenly, far from the
@@ -281,10 +285,16 @@ fn repeated_placements_share_one_hierarchy_and_agree_with_brute_force() {
     assert_eq!(rc.triangle_count(), 300 * transforms.len());
     let flat = rc.instances.iter().filter(|i| i.to_object.is_none());
     // Squashed to 10⁻¹² still has an inverse that works; flattened to 0 has none.
-    assert_eq!(flat.count(), 1, "the flattened placement is traced in world space");
-    let (hits, transparent) =
-        agrees_with_brute_force(&scene, &mut rng, 1500, 5.0, |o| o % 3 != 1);
-    assert!(hits > 500 && transparent > 100, "{hits} hits, {transparent}");
+    assert_eq!(
+        flat.count(),
+        1,
+        "the flattened placement is traced in world space"
+    );
+    let (hits, transparent) = agrees_with_brute_force(&scene, &mut rng, 1500, 5.0, |o| o % 3 != 1);
+    assert!(
+        hits > 500 && transparent > 100,
+        "{hits} hits, {transparent}"
+    );
 
     // Far from the origin: the same, relative to the distance.
     let far = DMat4::from_translation(DVec3::new(3e6, -1e6, 2e6));

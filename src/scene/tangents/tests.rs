@@ -39,14 +39,21 @@ fn a_plane_gets_the_u_direction_and_gltf_handedness_mirrors_flip_w() {
     let u_mirrored = generate_corners(geometry(&square(|x, y| Vec2::new(1.0 - x, 1.0 - y))));
     assert_all(&u_mirrored.tangents, Vec4::new(-1.0, 0.0, 0.0, -1.0));
     // Stretched and shifted, still upright: the direction and hand do not change.
-    let stretched = generate_corners(geometry(&square(|x, y| Vec2::new(3.0 * x + 7.0, 0.5 - 2.0 * y))));
+    let stretched = generate_corners(geometry(&square(|x, y| {
+        Vec2::new(3.0 * x + 7.0, 0.5 - 2.0 * y)
+    })));
     assert_all(&stretched.tangents, Vec4::new(1.0, 0.0, 0.0, 1.0));
 }
 
 #[test]
 fn given_tangents_are_repaired_and_unusable_ones_generated() {
     let m = square(|x, y| Vec2::new(x, 1.0 - y));
-    let given = vec![Vec4::new(2.0, 0.0, 5.0, 3.0), Vec4::ZERO, Vec4::NAN, Vec4::Z];
+    let given = vec![
+        Vec4::new(2.0, 0.0, 5.0, 3.0),
+        Vec4::ZERO,
+        Vec4::NAN,
+        Vec4::Z,
+    ];
     let repaired = repair(geometry(&m), given);
     assert_eq!(repaired[0], Vec4::new(1.0, 0.0, 0.0, 1.0));
     assert_eq!(repaired[1], Vec4::new(1.0, 0.0, 0.0, 1.0));
@@ -63,7 +70,11 @@ fn uv_sphere(segments: usize, rings: usize) -> Mesh {
         for j in 0..=segments {
             let (u, v) = (j as f64 / segments as f64, i as f64 / rings as f64);
             let (theta, phi) = (PI * v, 2.0 * PI * u);
-            let p = DVec3::new(theta.sin() * phi.cos(), theta.sin() * phi.sin(), theta.cos());
+            let p = DVec3::new(
+                theta.sin() * phi.cos(),
+                theta.sin() * phi.sin(),
+                theta.cos(),
+            );
             positions.push(p.as_vec3());
             uvs.push(Vec2::new(u as f32, v as f32));
         }
@@ -88,7 +99,10 @@ fn a_uv_sphere_gets_unit_orthogonal_tangents_along_the_longitude() {
     // its own faces, half a segment away).
     let (mut inner, mut seam): (f64, f64) = (1.0, 1.0);
     for (&i, t) in m.indices.iter().zip(&got.tangents) {
-        let (p, n) = (m.positions[i as usize].as_dvec3(), m.normals[i as usize].as_dvec3());
+        let (p, n) = (
+            m.positions[i as usize].as_dvec3(),
+            m.normals[i as usize].as_dvec3(),
+        );
         let v = t.truncate().as_dvec3();
         assert!((v.length() - 1.0).abs() < 1e-5, "{t} is not unit");
         assert!(v.dot(n).abs() < 1e-5, "{t} is not orthogonal to {n}");
@@ -99,13 +113,23 @@ fn a_uv_sphere_gets_unit_orthogonal_tangents_along_the_longitude() {
         // dP/du ∝ (−sin φ, cos φ, 0); unmirrored, so w = +1.
         let want = DVec3::new(-p.y, p.x, 0.0).normalize();
         let u = m.uvs[i as usize].x;
-        let worst = if u == 0.0 || u == 1.0 { &mut seam } else { &mut inner };
+        let worst = if u == 0.0 || u == 1.0 {
+            &mut seam
+        } else {
+            &mut inner
+        };
         *worst = worst.min(v.dot(want));
         assert_eq!(t.w, 1.0, "at {p}");
     }
     // A 32 × 16 sphere's faces span 11.25° of longitude.
-    assert!(inner > 1f64.to_radians().cos(), "worst cosine {inner} off the seam");
-    assert!(seam > 5.625f64.to_radians().cos(), "worst cosine {seam} on the seam");
+    assert!(
+        inner > 1f64.to_radians().cos(),
+        "worst cosine {inner} off the seam"
+    );
+    assert!(
+        seam > 5.625f64.to_radians().cos(),
+        "worst cosine {seam} on the seam"
+    );
 }
 
 /// True when `t` is finite, unit, `w` ±1 and orthogonal to `normal` (when that is unit).
@@ -214,10 +238,20 @@ fn hostile_counts_get_the_fallback_within_bounds() {
 fn a_mirrored_seam_through_shared_vertices_splits_them() {
     // Two unit squares side by side, u = |x| (mirrored at x = 0), v down the image; the two
     // vertices on x = 0 are shared by both halves.
-    let positions = [(-1.0, 0.0), (0.0, 0.0), (1.0, 0.0), (-1.0, 1.0), (0.0, 1.0), (1.0, 1.0)]
-        .map(|(x, y)| Vec3::new(x, y, 0.0))
-        .to_vec();
-    let uvs = positions.iter().map(|p| Vec2::new(p.x.abs(), 1.0 - p.y)).collect();
+    let positions = [
+        (-1.0, 0.0),
+        (0.0, 0.0),
+        (1.0, 0.0),
+        (-1.0, 1.0),
+        (0.0, 1.0),
+        (1.0, 1.0),
+    ]
+    .map(|(x, y)| Vec3::new(x, y, 0.0))
+    .to_vec();
+    let uvs = positions
+        .iter()
+        .map(|p| Vec2::new(p.x.abs(), 1.0 - p.y))
+        .collect();
     let indices = vec![0, 1, 4, 0, 4, 3, 1, 2, 5, 1, 5, 4];
     let m = Mesh::new(positions, vec![], uvs, indices).unwrap();
     let (m, fallbacks) = m.with_generated_tangents();

@@ -2,8 +2,8 @@
 //! core) gets fewer cells in the next frames, until both bands take about as long.
 
 use super::Bands;
-use crate::cluster::assign::types::Assignment;
 use crate::cluster::assign::tests::view_grid;
+use crate::cluster::assign::types::Assignment;
 use crate::cluster::grid::GridConfig;
 
 /// Per-cell time of the band each thread runs: the first thread is three times slower.
@@ -32,7 +32,10 @@ fn a_slow_worker_gets_less_work_until_both_take_about_as_long() {
         bands.split(&grid, 2, &previous);
     }
     let slow = bands.bands[0].end_cell - bands.bands[0].first_cell;
-    assert!(slow < even, "the slow band kept {slow} cells of an even {even}");
+    assert!(
+        slow < even,
+        "the slow band kept {slow} cells of an even {even}"
+    );
     // Bands are cut between slices: within one slice of the balance (a slice is about 4 %
     // of this grid's cells).
     let slice = (cells / grid.slice_slabs.len()) as f64;
@@ -49,7 +52,10 @@ fn a_candidate_assigned_in_between_leaves_the_frames_split_and_threads() {
     use crate::cluster::assign::{AssignLimits, Assigner};
     use rand::SeedableRng;
 
-    let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(2)
+        .build()
+        .unwrap();
     let frame_grid = view_grid(&GridConfig::fixed(16.0));
     let candidate_grid = view_grid(&GridConfig::fixed(45.0));
     let lights = random_lights(&mut rand_pcg::Pcg64Mcg::seed_from_u64(5), 300, 20.0);
@@ -66,9 +72,16 @@ fn a_candidate_assigned_in_between_leaves_the_frames_split_and_threads() {
         let (seconds, indices) = (assigner.last_cpu_seconds, assigner.frame_indices);
         assert!(indices > 0);
         let candidate = assigner.assign_candidate(&candidate_grid, &lights, 80.0, &limits);
-        assert_ne!(candidate.indices.len(), indices, "the candidate's lists differ");
+        assert_ne!(
+            candidate.indices.len(),
+            indices,
+            "the candidate's lists differ"
+        );
         assert_eq!(assigner.bands.split_record(), split);
-        assert_eq!((assigner.last_cpu_seconds, assigner.frame_indices), (seconds, indices));
+        assert_eq!(
+            (assigner.last_cpu_seconds, assigner.frame_indices),
+            (seconds, indices)
+        );
     });
 }
 
@@ -79,7 +92,10 @@ fn a_try_of_one_thread_leaves_the_pools_split_for_its_next_assignment() {
     use crate::cluster::assign::{AssignLimits, Assigner};
     use rand::SeedableRng;
 
-    let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(2)
+        .build()
+        .unwrap();
     let grid = view_grid(&GridConfig::fixed(16.0));
     let lights = random_lights(&mut rand_pcg::Pcg64Mcg::seed_from_u64(7), 300, 20.0);
     let on_pool = AssignLimits {
@@ -111,14 +127,19 @@ fn one_thread_and_the_pool_by_turns_give_every_frame_its_own_lists() {
     use crate::cluster::assign::{assign, AssignLimits, Assigner, PARALLEL_INDICES};
     use rand::SeedableRng;
 
-    let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(2)
+        .build()
+        .unwrap();
     // Fine enough that every frame lists more than PARALLEL_INDICES, so the rules ask for the
     // pool (the case the choice decides) whatever the assignments' times.
     let grid = view_grid(&GridConfig::fixed(8.0));
     let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(11);
     let limits = AssignLimits::default();
     // One thread on frames 3, 4, 7 (a switch, a stay, a single try), else the pool.
-    let one = [false, false, false, true, true, false, false, true, false, false];
+    let one = [
+        false, false, false, true, true, false, false, true, false, false,
+    ];
     pool.install(|| {
         let mut assigner = Assigner::new();
         for (frame, &one) in one.iter().enumerate() {
@@ -127,7 +148,10 @@ fn one_thread_and_the_pool_by_turns_give_every_frame_its_own_lists() {
             let got = assigner.assign(&grid, &lights, 80.0, &limits);
             let fresh = assign(&grid, &lights, 80.0, &limits);
             if frame > 0 {
-                assert!(fresh.indices.len() >= PARALLEL_INDICES, "a frame the rules give the pool");
+                assert!(
+                    fresh.indices.len() >= PARALLEL_INDICES,
+                    "a frame the rules give the pool"
+                );
                 assert_eq!(got.stats.threads, if one { 1 } else { 2 }, "frame {frame}");
             }
             assert_eq!(got.visible, fresh.visible, "frame {frame}");
@@ -145,7 +169,10 @@ fn switching_between_one_thread_and_the_pool_grows_no_buffer_after_each_has_run(
     use crate::cluster::assign::{AssignLimits, Assigner};
     use rand::SeedableRng;
 
-    let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(2)
+        .build()
+        .unwrap();
     let grid = view_grid(&GridConfig::fixed(8.0));
     let lights = random_lights(&mut rand_pcg::Pcg64Mcg::seed_from_u64(13), 400, 20.0);
     let limits = AssignLimits::default();
@@ -154,7 +181,12 @@ fn switching_between_one_thread_and_the_pool_grows_no_buffer_after_each_has_run(
     // either mode).
     let capacities = |a: &Assigner| -> Vec<usize> {
         let bands = a.bands.bands.iter().flat_map(|b| {
-            [b.runs.capacity(), b.lights.capacity(), b.ids.capacity(), b.cursors.capacity()]
+            [
+                b.runs.capacity(),
+                b.lights.capacity(),
+                b.ids.capacity(),
+                b.cursors.capacity(),
+            ]
         });
         let out = &a.out;
         bands
@@ -172,7 +204,9 @@ fn switching_between_one_thread_and_the_pool_grows_no_buffer_after_each_has_run(
             capacities(&assigner)
         };
         let warm = run(&[false, false, true, true, false]);
-        let after = run(&[true, false, false, true, false, true, true, false, true, false]);
+        let after = run(&[
+            true, false, false, true, false, true, true, false, true, false,
+        ]);
         assert_eq!(warm, after, "a buffer grew after the warm-up");
     });
 }

@@ -32,13 +32,23 @@ impl Band {
         let started = Instant::now();
         if let Some(numbers) = numbers {
             self.ids.clear();
-            self.ids
-                .extend(self.lights.iter().map(|&(light, _)| numbers[light as usize]));
+            self.ids.extend(
+                self.lights
+                    .iter()
+                    .map(|&(light, _)| numbers[light as usize]),
+            );
         }
         let cells = offsets.len();
-        let blocks = scatter_blocks(cells, list.len(), std::mem::size_of::<T>(), self.lights.len());
+        let blocks = scatter_blocks(
+            cells,
+            list.len(),
+            std::mem::size_of::<T>(),
+            self.lights.len(),
+        );
         #[cfg(test)]
-        let blocks = FORCED_SCATTER_BLOCKS.with(|b| b.get()).map_or(blocks, |b| b.clamp(1, cells));
+        let blocks = FORCED_SCATTER_BLOCKS
+            .with(|b| b.get())
+            .map_or(blocks, |b| b.clamp(1, cells));
         let mut totals = Totals::default();
         if blocks == 1 {
             self.count_and_scatter_whole(counts, offsets, list, &mut totals);
