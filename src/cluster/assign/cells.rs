@@ -247,10 +247,10 @@ fn refine_slices(
                 let slab = grid.slice_slabs[(constants.first_slice + s) as usize];
                 let row_start = |row: u32| slice_start + row * tiles.tiles_x;
                 // Two callers, so that a point light's rows take no cone's test.
-                let emit_row = &mut |row, x0, x1| emit(row_start(row) + x0, x1 - x0 + 1);
+                let emit_run = &mut |row, x0, x1| emit(row_start(row) + x0, x1 - x0 + 1);
                 match &cone {
-                    None => extent.for_each_row_run(tiles, slab, &WholeRows, emit_row),
-                    Some(cone) => extent.for_each_row_run(tiles, slab, cone, emit_row),
+                    None => extent.for_each_row_run(tiles, slab, &WholeRows, emit_run),
+                    Some(cone) => extent.for_each_row_run(tiles, slab, cone, emit_run),
                 }
             }
             Coverage::CascadeBox => {
