@@ -172,16 +172,7 @@ impl ConeSlice<'_> {
         // Widened, then the whole cells inside (by conversions: `ceil` and `floor` are library
         // calls on a baseline x86-64 target).
         let margin = |t: f64| 1e-6 * (1.0 + t.abs());
-        let (lo, hi) = (lo - margin(lo), hi + margin(hi));
-        if !(hi >= x0 as f64 && lo <= x1 as f64) {
-            // Also for NaN, which keeps the whole span.
-            return (lo.is_nan() || hi.is_nan()).then_some((x0, x1));
-        }
-        // `as u32` truncates, and saturates below 0; `hi ≥ x0 ≥ 0` here.
-        let truncated = lo as u32;
-        let first = (truncated + u32::from((truncated as f64) < lo)).max(x0);
-        let last = (hi as u32).min(x1);
-        (first <= last).then_some((first, last))
+        whole_cells(lo - margin(lo), hi + margin(hi), x0, x1)
     }
 
     /// False only when the sphere of radius `r` (every cell's bound) at `v` from the apex is
@@ -202,6 +193,21 @@ impl ConeSlice<'_> {
             | (off_axis - reach > 1e-9 * (off_axis.abs() + reach + cone.cos_sq * v1 * v1));
         !outside
     }
+}
+
+/// The columns of `x0..=x1` wholly or partly inside the (widened) interval `[lo, hi]` of
+/// column coordinates, or `None`; a NaN end keeps them all.
+#[inline(always)]
+fn whole_cells(lo: f64, hi: f64, x0: u32, x1: u32) -> Option<(u32, u32)> {
+    if !(hi >= x0 as f64 && lo <= x1 as f64) {
+        // Also for NaN, which keeps the whole span.
+        return (lo.is_nan() || hi.is_nan()).then_some((x0, x1));
+    }
+    // `as u32` truncates, and saturates below 0; `hi ≥ x0 ≥ 0` here.
+    let truncated = lo as u32;
+    let first = (truncated + u32::from((truncated as f64) < lo)).max(x0);
+    let last = (hi as u32).min(x1);
+    (first <= last).then_some((first, last))
 }
 
 /// Rows of fewer than this many columns plus one test their cells one by one

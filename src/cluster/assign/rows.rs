@@ -143,7 +143,7 @@ impl RowChords {
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
     use rand::{Rng, SeedableRng};
     use rand_pcg::Pcg64Mcg;
@@ -186,15 +186,18 @@ mod tests {
         (x0 <= x1).then_some((x0, x1))
     }
 
-    /// A value from a wide range, now and then an extreme one.
-    fn value(rng: &mut Pcg64Mcg, scale: f64) -> f64 {
+    /// A value from `range`, now and then an extreme one (also the spot cone lanes' test's).
+    pub(in crate::cluster::assign) fn value(
+        rng: &mut Pcg64Mcg,
+        range: std::ops::Range<f64>,
+    ) -> f64 {
         match rng.random_range(0..40) {
             0 => f64::NAN,
             1 => f64::INFINITY,
             2 => f64::NEG_INFINITY,
             3 => 0.0,
             4 => 1e300,
-            _ => rng.random_range(-scale..scale),
+            _ => rng.random_range(range),
         }
     }
 
@@ -225,9 +228,9 @@ mod tests {
                 zb,
                 inv_a,
                 inv_b: (1.0 / zb).min(inv_a),
-                cx: value(&mut rng, 50.0),
-                cy: value(&mut rng, 50.0),
-                rho_sq: value(&mut rng, 400.0).abs(),
+                cx: value(&mut rng, -50.0..50.0),
+                cy: value(&mut rng, -50.0..50.0),
+                rho_sq: value(&mut rng, -400.0..400.0).abs(),
                 extent_y,
                 step_y: 2.0 * extent_y / tiles_y as f64,
                 scale_x: rng.random_range(0.1..3.0),

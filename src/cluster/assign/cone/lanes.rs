@@ -5,7 +5,7 @@
 //! lists, are the same bit for bit; what the lanes do not cover (narrow rows, a slice whose
 //! quadratic has no `t²` term) goes to the scalar code.
 
-use super::{ConeSlice, NARROW_ROW};
+use super::{whole_cells, ConeSlice, NARROW_ROW};
 use crate::cluster::assign::rows::ROW_LANES;
 use crate::cluster::assign::simd::{at_least, at_most, splat, F64x4 as F};
 
@@ -69,9 +69,9 @@ impl ConeSlice<'_> {
         );
         let v1 = vx * splat(axis.x) + vy * splat(axis.y) + vz * splat(axis.z);
         let bound = splat(self.r) + v1 * splat(cone.sin);
-        let off_axis = splat(cone.cos_sq) * (vx * vx + vy * vy + vz * vz - v1 * v1);
-        let reach = bound * bound;
         let cos_sq = splat(cone.cos_sq);
+        let off_axis = cos_sq * (vx * vx + vy * vy + vz * vz - v1 * v1);
+        let reach = bound * bound;
         let outside = v1.simd_gt(splat(self.r + cone.range + self.slack))
             | v1.simd_lt(splat(-self.r - self.slack))
             | bound.simd_lt(splat(-self.slack))
@@ -129,20 +129,8 @@ impl ConeSlice<'_> {
         let hi = (hi + splat(1e-6) * (splat(1.0) + hi.abs())).to_array();
         std::array::from_fn(|i| {
             let (x0, x1) = spans[i];
-            let (lo, hi) = (lo[i], hi[i]);
-            if ok & (1 << i) == 0 {
-                return (1, 0);
-            }
-            if !(hi >= x0 as f64 && lo <= x1 as f64) {
-                return if lo.is_nan() || hi.is_nan() {
-                    (x0, x1)
-                } else {
-                    (1, 0)
-                };
-            }
-            let truncated = lo as u32;
-            let first = (truncated + u32::from((truncated as f64) < lo)).max(x0);
-            (first, (hi as u32).min(x1))
+            let cells = (ok & (1 << i) != 0).then(|| whole_cells(lo[i], hi[i], x0, x1));
+            cells.flatten().unwrap_or((1, 0))
         })
     }
 }
@@ -209,23 +197,11 @@ mod tests {
     use super::super::tests::spots;
     use super::super::{Cone, ConeSlice};
     use super::{NARROW_ROW, ROW_LANES};
+    use crate::cluster::assign::rows::tests::value;
     use crate::cluster::grid::{ClusterGrid, GridConfig, GridProjection, SliceCells};
     use glam::DVec3;
     use rand::{Rng, SeedableRng};
     use rand_pcg::Pcg64Mcg;
-
-    /// A value from `range`, now and then an extreme one.
-    fn value(rng: &mut Pcg64Mcg, range: std::ops::Range<f64>) -> f64 {
-        match rng.random_range(0..60) {
-            0 => f64::NAN,
-            1 => f64::INFINITY,
-            2 => f64::NEG_INFINITY,
-            3 => 0.0,
-            4 => 1e300,
-            5 => -1e-300,
-            _ => rng.random_range(range),
-        }
-    }
 
     /// A spot's cone as `Cone::of` makes it, from random parts (the bound is not used here).
     fn cone(rng: &mut Pcg64Mcg) -> Cone {
