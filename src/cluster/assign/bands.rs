@@ -1,17 +1,19 @@
-//! The assignment by **bands** of slices (see [`super`]): each thread fills one band
-//! of consecutive slices, whose cells are consecutive cell numbers, so it owns one contiguous
-//! part of every output array and no thread writes where another does.
+//! The assignment by **bands** of slices (see [`super`]): each band is consecutive slices,
+//! whose cells are consecutive cell numbers, so it owns one contiguous part of every output
+//! array and no thread writes where another does. On several threads there are two bands a
+//! worker, each taken by the next worker free (`shared.rs`).
 
 use std::time::Instant;
 
 #[cfg(test)]
 mod balance_tests;
 mod scatter;
+mod shared;
 #[cfg(test)]
 pub(super) use scatter::FORCED_SCATTER_BLOCKS;
 
 use super::cells::{for_each_run_in, SliceWindow};
-use super::index_list::{EntriesMut, LightIndex};
+use super::index_list::EntriesMut;
 use super::types::{Assignment, Run, Totals, PARALLEL_SECONDS};
 use crate::cluster::grid::ClusterGrid;
 use crate::cluster::headroom::{clear_with_room_for, room_for, share_of, WHOLE_UP_TO};
@@ -68,7 +70,7 @@ impl Bands {
         }
     }
 
-    /// Cuts the grid's slices into at most `threads` non-empty bands of about equal work.
+    /// Cuts the grid's slices into at most `count` non-empty bands of about equal work.
     ///
     /// The work is what the last assignment measured when it was to a grid of as many cells
     /// and slices in as many bands: each band's time spread evenly over its cells. So the
@@ -77,16 +79,16 @@ impl Bands {
     /// (a split by indices misjudges many small lights, a split by lights a fine grid).
     /// Failing that, the last assignment's indices, else cells. Only the speed depends on
     /// where the bands are cut, never the lists.
-    fn split(&mut self, grid: &ClusterGrid, threads: usize, out: &Assignment) {
+    fn split(&mut self, grid: &ClusterGrid, count: usize, out: &Assignment) {
         let cells = grid.total_cells as usize;
         let slices = grid.slice_slabs.len() as u32;
-        let threads = threads.clamp(1, slices.max(1) as usize);
+        let count = count.clamp(1, slices.max(1) as usize);
         let previous = out;
         let last = &self.bands[..self.active];
         // The bands' own record of the grid they were cut for (not the last lists, which may
         // be an automatic grid candidate's since: see `Assigner::assign_candidate`).
-        let timed = last.len() == threads
-            && threads > 1
+        let timed = last.len() == count
+            && count > 1
             && last.last().map(|b| b.end_cell) == Some(cells)
             && last.last().and_then(|b| b.window).map(|w| w.end) == Some(slices)
             && last.iter().all(|b| b.seconds > 0.0)
@@ -123,19 +125,19 @@ impl Bands {
             }
         };
         let total = work_before(cells);
-        if self.bands.len() < threads {
-            self.bands.resize_with(threads, Band::default);
+        if self.bands.len() < count {
+            self.bands.resize_with(count, Band::default);
         }
         let (mut first, mut used) = (0u32, 0usize);
-        for t in 0..threads {
+        for t in 0..count {
             if first >= slices {
                 break;
             }
             // At least one slice per band; the last band takes the rest.
-            let end = if t + 1 == threads {
+            let end = if t + 1 == count {
                 slices
             } else {
-                let target = total * (t + 1) as f64 / threads as f64;
+                let target = total * (t + 1) as f64 / count as f64;
                 let mut end = first + 1;
                 while end < slices && work_before(slice_first_cell(grid, end)) < target {
                     end += 1;
@@ -153,8 +155,9 @@ impl Bands {
         self.active = used;
     }
 
-    /// Phases 1 to 3 over at most `threads` bands (in parallel when more than one: called
-    /// inside rayon's pool then), into `out`; the list's totals before any cap.
+    /// Phases 1 to 3 over [`bands_for`] `threads` bands (shared among `threads` workers when
+    /// more than one: called inside rayon's pool then), into `out`; the list's totals before
+    /// any cap.
     pub(super) fn assign(
         &mut self,
         grid: &ClusterGrid,
@@ -167,46 +170,25 @@ impl Bands {
         // moves the bands' borders.
         let last_runs: usize = self.active().iter().map(|b| b.runs.len()).sum();
         let last_lights: usize = self.active().iter().map(|b| b.lights.len()).sum();
-        self.split(grid, threads, out);
-        let parallel = self.active > 1;
+        let wanted = bands_for(threads);
+        self.split(grid, wanted, out);
         // Every band, also those this split leaves out, keeps room for its share of the runs
         // (the borders move with the work), and for every light while they are few (the sum
         // of the bands' lights depends on where the borders are).
-        let runs_share = share_of(last_runs, threads);
-        let lights_share = share_of(last_lights, threads).max(lights.len().min(WHOLE_UP_TO));
+        let runs_share = share_of(last_runs, wanted);
+        let lights_share = share_of(last_lights, wanted).max(lights.len().min(WHOLE_UP_TO));
         for band in &mut self.bands {
             band.clear_with_room(runs_share, lights_share);
         }
-        let cells = grid.total_cells as usize;
         let bands = &mut self.bands[..self.active];
-        // Phase 1.
-        for_each_band(bands, parallel, &|band| band.find(grid, lights, camera_far));
-        // Phase 2: the visible lights and their numbers (each band looks its lights' numbers
-        // up in phase 3's job), and where each band's part of the list starts.
-        number_visible(bands, lights.len(), &mut out.visible, &mut self.numbers);
-        let mut indices = 0;
-        for band in bands.iter_mut() {
-            band.base = indices;
-            indices += band.indices;
-        }
-        // Phase 3. Every offset and entry is written and the counts are cleared block by
-        // block there, so the resizing only zero-fills growth.
-        room_for(&mut out.counts, cells);
-        room_for(&mut out.offsets, cells);
-        out.counts.resize(cells, 0);
-        out.offsets.resize(cells, 0);
-        // One band numbered its own lights in phase 2; several look theirs up.
-        let numbers = (bands.len() > 1).then_some(&self.numbers[..]);
-        let cells_out = CellsOut {
-            counts: &mut out.counts,
-            offsets: &mut out.offsets,
-        };
-        match out.indices.prepare(indices, out.visible.len()) {
-            EntriesMut::Narrow(list) => scatter_bands(bands, numbers, cells_out, list, parallel),
-            EntriesMut::Wide(list) => scatter_bands(bands, numbers, cells_out, list, parallel),
+        if let [band] = bands {
+            band.assign_alone(grid, lights, camera_far, out);
+        } else {
+            let numbers = &mut self.numbers;
+            shared::assign_shared(bands, threads, grid, lights, camera_far, out, numbers);
         }
         let mut totals = Totals::default();
-        for band in bands.iter() {
+        for band in self.active() {
             totals.indices += band.totals.indices;
             totals.max = totals.max.max(band.totals.max);
             totals.nonempty += band.totals.nonempty;
@@ -216,11 +198,24 @@ impl Bands {
     }
 }
 
-/// The bands' split as [`Bands::split_record`] keeps it (at most 8 bands).
+/// Most bands a split makes (and a [`SplitRecord`] keeps).
+const MAX_BANDS: usize = 8;
+
+/// Bands a split for `threads` workers makes: two a worker (so a worker that wakes late still
+/// finds a band to take, see [`shared::assign_shared`]), at most [`MAX_BANDS`]; one for one.
+fn bands_for(threads: usize) -> usize {
+    if threads > 1 {
+        (2 * threads).min(MAX_BANDS)
+    } else {
+        1
+    }
+}
+
+/// The bands' split as [`Bands::split_record`] keeps it.
 #[derive(Debug, PartialEq)]
 pub(super) struct SplitRecord {
     active: usize,
-    bands: [Option<BandCut>; 8],
+    bands: [Option<BandCut>; MAX_BANDS],
 }
 
 /// One band's part of a [`SplitRecord`]: its slices and cells, and the seconds it took.
@@ -297,6 +292,36 @@ impl Band {
         self.indices = indices;
         self.seconds = started.elapsed().as_secs_f64();
     }
+
+    /// Phases 1 to 3 of the only band (the whole grid, one thread) into `out`: it numbers its
+    /// own lights in phase 2 (its `ids`).
+    fn assign_alone(
+        &mut self,
+        grid: &ClusterGrid,
+        lights: &[GpuLight],
+        camera_far: f64,
+        out: &mut Assignment,
+    ) {
+        self.find(grid, lights, camera_far);
+        out.visible.clear();
+        out.visible
+            .extend(self.lights.iter().map(|&(light, _)| light));
+        self.ids.clear();
+        self.ids.extend(0..self.lights.len() as u32);
+        self.base = 0;
+        // Every offset and entry is written and the counts are cleared block by block in
+        // phase 3, so the resizing only zero-fills growth.
+        let cells = self.end_cell - self.first_cell;
+        room_for(&mut out.counts, cells);
+        room_for(&mut out.offsets, cells);
+        out.counts.resize(cells, 0);
+        out.offsets.resize(cells, 0);
+        let (counts, offsets) = (&mut out.counts[..], &mut out.offsets[..]);
+        match out.indices.prepare(self.indices, out.visible.len()) {
+            EntriesMut::Narrow(list) => self.count_and_scatter(None, counts, offsets, list),
+            EntriesMut::Wide(list) => self.count_and_scatter(None, counts, offsets, list),
+        }
+    }
 }
 
 /// The first cell of slice `g` (numbered across cascades), or the grid's cell count past the
@@ -312,45 +337,21 @@ fn slice_first_cell(grid: &ClusterGrid, g: u32) -> usize {
     grid.total_cells as usize
 }
 
-/// Runs `f` on every band (phase 1), the halves of the bands at once with `parallel`.
-fn for_each_band(bands: &mut [Band], parallel: bool, f: &(dyn Fn(&mut Band) + Sync)) {
-    if let [band] = bands {
-        f(band);
-        return;
-    }
-    let (left, right) = bands.split_at_mut(bands.len() / 2);
-    if parallel {
-        rayon::join(
-            || for_each_band(left, true, f),
-            || for_each_band(right, true, f),
-        );
-    } else {
-        for_each_band(left, false, f);
-        for_each_band(right, false, f);
-    }
-}
-
-/// Phase 2's numbering: the lights listed by any band, ascending, into `visible`. One band
-/// numbers its own lights (its `ids`); several leave each light's number in `numbers` (one
-/// entry per light), which phase 3 looks their lights up in.
-fn number_visible(
-    bands: &mut [Band],
+/// Phase 2's numbering with several bands: the lights listed by any of `bands`, ascending,
+/// into `visible`, and each light's number in `numbers` (one entry per light), which phase 3
+/// looks the bands' lights up in.
+fn number_listed<'a>(
+    bands: impl Iterator<Item = &'a Band>,
     lights: usize,
     visible: &mut Vec<u32>,
     numbers: &mut Vec<u32>,
 ) {
     visible.clear();
-    if let [band] = bands {
-        visible.extend(band.lights.iter().map(|&(light, _)| light));
-        band.ids.clear();
-        band.ids.extend(0..band.lights.len() as u32);
-        return;
-    }
     // Mark the listed lights and number the marks in light order (a merge of the bands' lists
     // cost more: a comparison per band per light).
     numbers.clear();
     numbers.resize(lights, u32::MAX);
-    for band in bands.iter() {
+    for band in bands {
         for &(light, _) in &band.lights {
             numbers[light as usize] = 0;
         }
@@ -384,38 +385,5 @@ impl<'a> CellsOut<'a> {
                 offsets: offsets_right,
             },
         )
-    }
-}
-
-/// Phase 3 ([`Band::count_and_scatter`]) into `cells` and the index list `list` (from the
-/// first band's cell and entry on), the halves of the bands at once with `parallel`.
-fn scatter_bands<T: LightIndex>(
-    bands: &mut [Band],
-    numbers: Option<&[u32]>,
-    cells: CellsOut,
-    list: &mut [T],
-    parallel: bool,
-) {
-    if let [band] = bands {
-        let n = band.end_cell - band.first_cell;
-        band.count_and_scatter(
-            numbers,
-            &mut cells.counts[..n],
-            &mut cells.offsets[..n],
-            list,
-        );
-        return;
-    }
-    let (left, right) = bands.split_at_mut(bands.len() / 2);
-    let (cells_left, cells_right) = cells.split_at(right[0].first_cell - left[0].first_cell);
-    let (list_left, list_right) = list.split_at_mut(right[0].base - left[0].base);
-    if parallel {
-        rayon::join(
-            || scatter_bands(left, numbers, cells_left, list_left, true),
-            || scatter_bands(right, numbers, cells_right, list_right, true),
-        );
-    } else {
-        scatter_bands(left, numbers, cells_left, list_left, false);
-        scatter_bands(right, numbers, cells_right, list_right, false);
     }
 }

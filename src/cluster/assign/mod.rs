@@ -4,10 +4,10 @@
 //! The work is shared in one of two ways ([`Assigner::assign`] picks):
 //!
 //! * **Bands of slices** (`bands.rs`; one band on a single thread, and on several
-//!   when the grid has at least as many cells as there are lights): each thread fills a band
-//!   of consecutive slices, balanced by the previous frame's measured times; a band's cells
-//!   are consecutive cell numbers, so each band owns one contiguous part of every output
-//!   array and no thread writes where another does.
+//!   when the grid has at least as many cells as there are lights): two bands of consecutive
+//!   slices a thread, balanced by the previous frame's measured times, each taken by the next
+//!   thread free; a band's cells are consecutive cell numbers, so each band owns one
+//!   contiguous part of every output array and no thread writes where another does.
 //! * **Chunks of lights** (`chunks.rs`; more lights than cells): each thread
 //!   finds and sorts its own lights' runs, then blocks of cells gather the chunks' runs.
 //!

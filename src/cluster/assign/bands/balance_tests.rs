@@ -108,7 +108,7 @@ fn a_try_of_one_thread_leaves_the_pools_split_for_its_next_assignment() {
             assigner.assign(&grid, &lights, 80.0, &on_pool);
         }
         let split = assigner.bands.split_record();
-        assert_eq!(split.active, 2);
+        assert_eq!(split.active, super::bands_for(2));
         let (bands, kept) = (&mut assigner.bands, &mut assigner.pool_split);
         keep_pool_split(bands, kept, 2, 1);
         let mut out = Assignment::default();

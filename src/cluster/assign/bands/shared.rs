@@ -1,0 +1,274 @@
+//! Phases 1 to 3 of several bands on the pool's workers, each band of a phase taken by the
+//! next worker that is free (see [`assign_shared`]).
+
+use super::{number_listed, Band, CellsOut, MAX_BANDS};
+use crate::cluster::assign::index_list::{EntriesMut, LightIndex};
+use crate::cluster::assign::types::Assignment;
+use crate::cluster::grid::ClusterGrid;
+use crate::cluster::headroom::room_for;
+use crate::cluster::view_light::GpuLight;
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::{Mutex, MutexGuard};
+
+/// Phases 1 to 3 of `bands` (two or more, at most [`MAX_BANDS`]) into `out`, on up to
+/// `workers` threads of the current rayon pool.
+///
+/// Each worker takes the next band of phase 1 that no one has taken, until none is left;
+/// whoever finishes the last one does phase 2; then each takes the next band of phase 3. So a
+/// worker that wakes late (an idle core can take milliseconds to wake: a phone's sleeping
+/// little core, or a virtual machine's) still takes whatever bands are left, and a worker
+/// that waits for phase 2 (at most one band's time) spins instead of falling asleep, so it
+/// is awake for phase 3. With one band per worker taken by halves (`rayon::join`), a worker
+/// that woke after its partner had started on the second half did nothing, and one that fell
+/// asleep between the phases missed phase 3 as well. Which worker takes which band changes
+/// nothing in the lists: each band writes its own part of every array.
+pub(super) fn assign_shared(
+    bands: &mut [Band],
+    workers: usize,
+    grid: &ClusterGrid,
+    lights: &[GpuLight],
+    camera_far: f64,
+    out: &mut Assignment,
+    numbers: &mut Vec<u32>,
+) {
+    let n = bands.len();
+    assert!((2..=MAX_BANDS).contains(&n), "{n} bands");
+    let mut each = bands.iter_mut();
+    let found: [Mutex<Option<&mut Band>>; MAX_BANDS] =
+        std::array::from_fn(|_| Mutex::new(each.next()));
+    let scatters: [Mutex<Option<Scatter>>; MAX_BANDS] = std::array::from_fn(|_| Mutex::new(None));
+    let between = Mutex::new(Some((out, numbers)));
+    let (find_next, find_done) = (AtomicUsize::new(0), AtomicUsize::new(0));
+    let (scatter_open, scatter_next) = (AtomicBool::new(false), AtomicUsize::new(0));
+    let work = || {
+        while let Some(i) = claim(&find_next, n) {
+            let mut band = lock(&found[i]);
+            band.as_mut()
+                .expect("phase 1's band")
+                .find(grid, lights, camera_far);
+            drop(band);
+            if find_done.fetch_add(1, Ordering::AcqRel) + 1 == n {
+                let (out, numbers) = lock(&between).take().expect("phase 2 runs once");
+                let taken = found.each_ref().map(|band| lock(band).take());
+                between_phases(taken, lights.len(), out, numbers, &scatters);
+                scatter_open.store(true, Ordering::Release);
+            }
+        }
+        wait_until(&scatter_open);
+        while let Some(i) = claim(&scatter_next, n) {
+            lock(&scatters[i]).take().expect("phase 3's band").run();
+        }
+    };
+    on_workers(workers.min(n), &work);
+}
+
+/// Runs `work` once on each of up to `count` workers of the pool: this thread's first, the
+/// others' as the pool's idle workers steal them (a worker that comes too late finds nothing
+/// left to take; a copy no one stole runs here last and finds the same). By `rayon::join`,
+/// whose jobs live on the stack: a scope's spawned jobs are allocated, one per frame.
+fn on_workers(count: usize, work: &(dyn Fn() + Sync)) {
+    if count <= 1 {
+        work();
+    } else {
+        let others = count / 2;
+        rayon::join(
+            || on_workers(count - others, work),
+            || on_workers(others, work),
+        );
+    }
+}
+
+/// Phase 2 (the visible lights, numbered; where each band's part of the list starts) and
+/// phase 3's jobs: each band's parts of the per-cell arrays and of the list, in `scatters`.
+fn between_phases<'a>(
+    mut taken: [Option<&'a mut Band>; MAX_BANDS],
+    lights: usize,
+    out: &'a mut Assignment,
+    numbers: &'a mut Vec<u32>,
+    scatters: &[Mutex<Option<Scatter<'a>>>; MAX_BANDS],
+) {
+    let listed = taken.iter().flatten().map(|band| &**band);
+    number_listed(listed, lights, &mut out.visible, numbers);
+    let mut indices = 0;
+    for band in taken.iter_mut().flatten() {
+        band.base = indices;
+        indices += band.indices;
+    }
+    let first = taken[0].as_ref().map_or(0, |band| band.first_cell);
+    let cells = taken
+        .iter()
+        .flatten()
+        .last()
+        .map_or(0, |band| band.end_cell);
+    // Every offset and entry is written and the counts are cleared block by block in phase
+    // 3, so the resizing only zero-fills growth.
+    room_for(&mut out.counts, cells);
+    room_for(&mut out.offsets, cells);
+    out.counts.resize(cells, 0);
+    out.offsets.resize(cells, 0);
+    let mut rest = CellsOut {
+        counts: &mut out.counts[first..],
+        offsets: &mut out.offsets[first..],
+    };
+    let numbers = shared(numbers);
+    let mut list = match out.indices.prepare(indices, out.visible.len()) {
+        EntriesMut::Narrow(list) => ListPart::Narrow(list),
+        EntriesMut::Wide(list) => ListPart::Wide(list),
+    };
+    for (band, slot) in taken.into_iter().flatten().zip(scatters) {
+        let (cells, after) = rest.split_at(band.end_cell - band.first_cell);
+        let (part, tail) = list.split_at(band.indices);
+        *lock(slot) = Some(Scatter {
+            band,
+            cells,
+            list: part,
+            numbers,
+        });
+        (rest, list) = (after, tail);
+    }
+}
+
+/// One band's phase 3 and where it writes.
+struct Scatter<'a> {
+    band: &'a mut Band,
+    cells: CellsOut<'a>,
+    list: ListPart<'a>,
+    numbers: &'a [u32],
+}
+
+impl Scatter<'_> {
+    fn run(self) {
+        let Scatter {
+            band,
+            cells,
+            list,
+            numbers,
+        } = self;
+        match list {
+            ListPart::Narrow(list) => scatter(band, cells, list, numbers),
+            ListPart::Wide(list) => scatter(band, cells, list, numbers),
+        }
+    }
+}
+
+fn scatter<T: LightIndex>(band: &mut Band, cells: CellsOut, list: &mut [T], numbers: &[u32]) {
+    band.count_and_scatter(Some(numbers), cells.counts, cells.offsets, list);
+}
+
+/// A part of the index list, at its width.
+enum ListPart<'a> {
+    Narrow(&'a mut [u16]),
+    Wide(&'a mut [u32]),
+}
+
+impl<'a> ListPart<'a> {
+    /// The first `len` entries, and the rest.
+    fn split_at(self, len: usize) -> (ListPart<'a>, ListPart<'a>) {
+        match self {
+            ListPart::Narrow(list) => {
+                let (a, b) = list.split_at_mut(len);
+                (ListPart::Narrow(a), ListPart::Narrow(b))
+            }
+            ListPart::Wide(list) => {
+                let (a, b) = list.split_at_mut(len);
+                (ListPart::Wide(a), ListPart::Wide(b))
+            }
+        }
+    }
+}
+
+/// The next of `n` jobs no one has taken, if any.
+fn claim(next: &AtomicUsize, n: usize) -> Option<usize> {
+    let i = next.fetch_add(1, Ordering::AcqRel);
+    (i < n).then_some(i)
+}
+
+/// Waits for `flag`: spinning a while (the wait is at most one band's phase 1), then giving
+/// the core to others in turn (on a busy core the band's worker may need it).
+fn wait_until(flag: &AtomicBool) {
+    let mut spins = 0u32;
+    while !flag.load(Ordering::Acquire) {
+        if spins < 1 << 10 {
+            spins += 1;
+            std::hint::spin_loop();
+        } else {
+            std::thread::yield_now();
+        }
+    }
+}
+
+/// `mutex` locked; a lock a panicking worker left poisoned is taken as it is (the panic
+/// reaches the caller through rayon's scope).
+fn lock<T>(mutex: &Mutex<T>) -> MutexGuard<'_, T> {
+    mutex
+        .lock()
+        .unwrap_or_else(|poisoned| poisoned.into_inner())
+}
+
+/// `v`'s elements, shared for as long as `v` was lent.
+fn shared<T>(v: &mut Vec<T>) -> &[T] {
+    v
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::cluster::assign::tests::{random_lights, view_grid};
+    use crate::cluster::assign::{AssignLimits, Assigner};
+    use crate::cluster::grid::GridConfig;
+    use rand::SeedableRng;
+    use std::sync::mpsc;
+    use std::time::Duration;
+
+    /// With the second of two workers held elsewhere and let go at some moment of the
+    /// assignment (before it, during it, after it), each frame lists what one thread lists:
+    /// the first worker takes every band the second has not, and a copy of the work no one
+    /// stole finds nothing left.
+    #[test]
+    fn a_worker_that_comes_at_any_moment_takes_what_is_left_and_the_lists_stay() {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(2)
+            .build()
+            .unwrap();
+        let grid = view_grid(&GridConfig::fixed(8.0));
+        let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(17);
+        let on_pool = AssignLimits {
+            parallel_threshold: 0,
+            ..AssignLimits::default()
+        };
+        let one_thread = AssignLimits {
+            parallel_threshold: usize::MAX,
+            ..AssignLimits::default()
+        };
+        let mut assigner = Assigner::new();
+        let mut alone = Assigner::new();
+        for (frame, late_us) in [0, 200, 500, 1000, 2000, 5000, 100_000]
+            .into_iter()
+            .enumerate()
+        {
+            let lights = random_lights(&mut rng, 400, 20.0);
+            let expected = alone.assign(&grid, &lights, 80.0, &one_thread).clone();
+            // Holds one worker until the timer lets it go; the other runs the assignment.
+            let (go, wait) = mpsc::channel::<()>();
+            let (held, is_held) = mpsc::channel::<()>();
+            pool.spawn(move || {
+                held.send(()).unwrap();
+                wait.recv().unwrap();
+            });
+            is_held.recv().unwrap();
+            let timer = std::thread::spawn(move || {
+                std::thread::sleep(Duration::from_micros(late_us));
+                let _ = go.send(());
+            });
+            let got = pool.install(|| assigner.assign(&grid, &lights, 80.0, &on_pool).clone());
+            timer.join().unwrap();
+            assert_eq!(got.stats.threads, 2, "frame {frame}: the pool's assignment");
+            assert_eq!(got.visible, expected.visible, "frame {frame}");
+            assert_eq!(got.offsets, expected.offsets, "frame {frame}");
+            assert_eq!(got.counts, expected.counts, "frame {frame}");
+            assert!(
+                got.indices == expected.indices,
+                "frame {frame}: other indices"
+            );
+        }
+    }
+}
