@@ -40,8 +40,15 @@ pub(super) fn assign_shared(
     let between = Mutex::new(Some((out, numbers)));
     let (find_next, find_done) = (AtomicUsize::new(0), AtomicUsize::new(0));
     let (scatter_open, scatter_next) = (AtomicBool::new(false), AtomicUsize::new(0));
+    let abandoned = AtomicBool::new(false);
     let work = || {
+        // A worker that panics lets the others stop waiting (the panic then reaches the
+        // caller through `rayon::join`), rather than leave them spinning for a phase that
+        // never opens.
+        let _panicking = AbandonOnPanic(&abandoned);
         while let Some(i) = claim(&find_next, n) {
+            #[cfg(test)]
+            tests::panic_if_asked(lights);
             let mut band = lock(&found[i]);
             band.as_mut()
                 .expect("phase 1's band")
@@ -54,7 +61,9 @@ pub(super) fn assign_shared(
                 scatter_open.store(true, Ordering::Release);
             }
         }
-        wait_until(&scatter_open);
+        if !wait_until(&scatter_open, &abandoned) {
+            return;
+        }
         while let Some(i) = claim(&scatter_next, n) {
             lock(&scatters[i]).take().expect("phase 3's band").run();
         }
@@ -183,16 +192,32 @@ fn claim(next: &AtomicUsize, n: usize) -> Option<usize> {
     (i < n).then_some(i)
 }
 
-/// Waits for `flag`: spinning a while (the wait is at most one band's phase 1), then giving
-/// the core to others in turn (on a busy core the band's worker may need it).
-fn wait_until(flag: &AtomicBool) {
+/// Waits for `flag` (true) or `abandoned` (false): spinning a while (the wait is at most one
+/// band's phase 1), then giving the core to others in turn (on a busy core the band's worker
+/// may need it).
+fn wait_until(flag: &AtomicBool, abandoned: &AtomicBool) -> bool {
     let mut spins = 0u32;
     while !flag.load(Ordering::Acquire) {
+        if abandoned.load(Ordering::Acquire) {
+            return false;
+        }
         if spins < 1 << 10 {
             spins += 1;
             std::hint::spin_loop();
         } else {
             std::thread::yield_now();
+        }
+    }
+    true
+}
+
+/// Sets its flag when dropped by a panic.
+struct AbandonOnPanic<'a>(&'a AtomicBool);
+
+impl Drop for AbandonOnPanic<'_> {
+    fn drop(&mut self) {
+        if std::thread::panicking() {
+            self.0.store(true, Ordering::Release);
         }
     }
 }
@@ -215,9 +240,68 @@ mod tests {
     use crate::cluster::assign::tests::{random_lights, view_grid};
     use crate::cluster::assign::{AssignLimits, Assigner};
     use crate::cluster::grid::GridConfig;
+    use crate::cluster::view_light::GpuLight;
     use rand::SeedableRng;
+    use std::sync::atomic::{AtomicUsize, Ordering};
     use std::sync::mpsc;
     use std::time::Duration;
+
+    /// The address of the lights whose phase 1 panics (one test's own, so the tests that run
+    /// beside it are not touched).
+    static PANIC_ON: AtomicUsize = AtomicUsize::new(0);
+
+    /// Panics when asked to for `lights`: the first band claimed is never found, so the
+    /// other workers find theirs and wait for phase 3.
+    pub(super) fn panic_if_asked(lights: &[GpuLight]) {
+        let asked = PANIC_ON.load(Ordering::Acquire);
+        if asked != 0 && asked == lights.as_ptr() as usize {
+            PANIC_ON.store(0, Ordering::Release);
+            panic!("asked to panic in phase 1");
+        }
+    }
+
+    /// A worker that panics in phase 1 makes the assignment panic, not hang: the others stop
+    /// waiting for phase 3.
+    #[test]
+    fn a_worker_that_panics_in_phase_1_leaves_no_one_waiting() {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(4)
+            .build()
+            .unwrap();
+        let grid = view_grid(&GridConfig::fixed(8.0));
+        let lights = random_lights(&mut rand_pcg::Pcg64Mcg::seed_from_u64(19), 400, 20.0);
+        let on_pool = AssignLimits {
+            parallel_threshold: 0,
+            ..AssignLimits::default()
+        };
+        let (done, result) = mpsc::channel();
+        // On its own thread, so that a hang fails the test instead of stalling the suite.
+        std::thread::spawn(move || {
+            let mut assigner = Assigner::new();
+            let threads = pool.install(|| {
+                assigner
+                    .assign(&grid, &lights, 80.0, &on_pool)
+                    .stats
+                    .threads
+            });
+            assert!(threads > 1, "the pool's assignment");
+            PANIC_ON.store(lights.as_ptr() as usize, Ordering::Release);
+            let panicked = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+                pool.install(|| {
+                    assigner
+                        .assign(&grid, &lights, 80.0, &on_pool)
+                        .stats
+                        .threads
+                })
+            }))
+            .is_err();
+            let _ = done.send(panicked);
+        });
+        let panicked = result
+            .recv_timeout(Duration::from_secs(60))
+            .expect("the assignment returns (no worker left waiting)");
+        assert!(panicked, "the panic reaches the caller");
+    }
 
     /// With the second of two workers held elsewhere and let go at some moment of the
     /// assignment (before it, during it, after it), each frame lists what one thread lists:
