@@ -146,6 +146,7 @@ struct Scatter<'a> {
 }
 
 impl Scatter<'_> {
+    /// The band's phase 3, at the list's width.
     fn run(self) {
         let Scatter {
             band,
@@ -160,6 +161,7 @@ impl Scatter<'_> {
     }
 }
 
+/// [`Band::count_and_scatter`] with the lights' numbers from phase 2.
 fn scatter<T: LightIndex>(band: &mut Band, cells: CellsOut, list: &mut [T], numbers: &[u32]) {
     band.count_and_scatter(Some(numbers), cells.counts, cells.offsets, list);
 }
