@@ -108,7 +108,7 @@ impl Device {
     }
 
     /// Counts `n` programs built by another device on this context as this one's (a negative
-    /// `n`: handed to another), for [`crate::Renderer::adopt_programs`].
+    /// `n`: handed to another), for `Renderer::adopt_programs` (with `lab`).
     pub(crate) fn count_handed_programs(&self, n: i64) {
         self.count(|l| l.programs += n);
     }

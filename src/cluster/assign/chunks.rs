@@ -280,7 +280,7 @@ pub(super) fn split_cells(offsets: &[u32], total: usize, parts: usize) -> Vec<(u
     blocks
 }
 
-/// [`split_cells`] into `blocks` (cleared first).
+/// `split_cells` (the tests' version) into `blocks` (cleared first).
 fn split_cells_into(offsets: &[u32], total: usize, parts: usize, blocks: &mut Vec<(usize, usize)>) {
     let cells = offsets.len();
     blocks.clear();

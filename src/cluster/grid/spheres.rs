@@ -77,7 +77,7 @@ impl ClusterGrid {
 
 /// The bounding spheres of one row of cells (see [`ClusterGrid::row_spheres`]). The
 /// assignment reads only their radii ([`ClusterGrid::slice_cells`]); the centres are for the
-/// tests ([`RowSpheres::cell`]).
+/// tests (`RowSpheres::cell`).
 pub(crate) struct RowSpheres {
     #[cfg(test)]
     infinite: bool,
