@@ -309,14 +309,8 @@ impl Band {
         self.ids.clear();
         self.ids.extend(0..self.lights.len() as u32);
         self.base = 0;
-        // Every offset and entry is written and the counts are cleared block by block in
-        // phase 3, so the resizing only zero-fills growth.
-        let cells = self.end_cell - self.first_cell;
-        room_for(&mut out.counts, cells);
-        room_for(&mut out.offsets, cells);
-        out.counts.resize(cells, 0);
-        out.offsets.resize(cells, 0);
-        let (counts, offsets) = (&mut out.counts[..], &mut out.offsets[..]);
+        let cells = CellsOut::sized(&mut out.counts, &mut out.offsets, self.end_cell);
+        let (counts, offsets) = (cells.counts, cells.offsets);
         match out.indices.prepare(self.indices, out.visible.len()) {
             EntriesMut::Narrow(list) => self.count_and_scatter(None, counts, offsets, list),
             EntriesMut::Wide(list) => self.count_and_scatter(None, counts, offsets, list),
@@ -371,6 +365,16 @@ struct CellsOut<'a> {
 }
 
 impl<'a> CellsOut<'a> {
+    /// `counts` and `offsets` sized to the grid's `cells` cells. Phase 3 writes every offset
+    /// and clears the counts block by block, so the resizing only zero-fills growth.
+    fn sized(counts: &'a mut Vec<u32>, offsets: &'a mut Vec<u32>, cells: usize) -> Self {
+        room_for(counts, cells);
+        room_for(offsets, cells);
+        counts.resize(cells, 0);
+        offsets.resize(cells, 0);
+        CellsOut { counts, offsets }
+    }
+
     /// The first `cells` cells, and the rest.
     fn split_at(self, cells: usize) -> (CellsOut<'a>, CellsOut<'a>) {
         let (counts_left, counts_right) = self.counts.split_at_mut(cells);

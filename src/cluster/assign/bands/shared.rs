@@ -5,7 +5,6 @@ use super::{number_listed, Band, CellsOut, MAX_BANDS};
 use crate::cluster::assign::index_list::{EntriesMut, LightIndex};
 use crate::cluster::assign::types::Assignment;
 use crate::cluster::grid::ClusterGrid;
-use crate::cluster::headroom::room_for;
 use crate::cluster::view_light::GpuLight;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::{Mutex, MutexGuard};
@@ -103,23 +102,14 @@ fn between_phases<'a>(
         band.base = indices;
         indices += band.indices;
     }
-    let first = taken[0].as_ref().map_or(0, |band| band.first_cell);
+    // The bands cover the grid, from cell 0 to the last band's end.
     let cells = taken
         .iter()
         .flatten()
         .last()
         .map_or(0, |band| band.end_cell);
-    // Every offset and entry is written and the counts are cleared block by block in phase
-    // 3, so the resizing only zero-fills growth.
-    room_for(&mut out.counts, cells);
-    room_for(&mut out.offsets, cells);
-    out.counts.resize(cells, 0);
-    out.offsets.resize(cells, 0);
-    let mut rest = CellsOut {
-        counts: &mut out.counts[first..],
-        offsets: &mut out.offsets[first..],
-    };
-    let numbers = shared(numbers);
+    let mut rest = CellsOut::sized(&mut out.counts, &mut out.offsets, cells);
+    let numbers: &[u32] = numbers;
     let mut list = match out.indices.prepare(indices, out.visible.len()) {
         EntriesMut::Narrow(list) => ListPart::Narrow(list),
         EntriesMut::Wide(list) => ListPart::Wide(list),
@@ -230,11 +220,6 @@ fn lock<T>(mutex: &Mutex<T>) -> MutexGuard<'_, T> {
     mutex
         .lock()
         .unwrap_or_else(|poisoned| poisoned.into_inner())
-}
-
-/// `v`'s elements, shared for as long as `v` was lent.
-fn shared<T>(v: &mut Vec<T>) -> &[T] {
-    v
 }
 
 #[cfg(test)]
