@@ -17,10 +17,8 @@ use std::sync::{Mutex, MutexGuard};
 /// worker that wakes late (an idle core can take milliseconds to wake: a phone's sleeping
 /// little core, or a virtual machine's) still takes whatever bands are left, and a worker
 /// that waits for phase 2 (at most one band's time) spins instead of falling asleep, so it
-/// is awake for phase 3. With one band per worker taken by halves (`rayon::join`), a worker
-/// that woke after its partner had started on the second half did nothing, and one that fell
-/// asleep between the phases missed phase 3 as well. Which worker takes which band changes
-/// nothing in the lists: each band writes its own part of every array.
+/// is awake for phase 3. Which worker takes which band changes nothing in the lists: each
+/// band writes its own part of every array.
 pub(super) fn assign_shared(
     bands: &mut [Band],
     workers: usize,
