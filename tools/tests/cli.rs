@@ -473,6 +473,26 @@ fn bench_assign_prints_json_for_scripts() {
     }
 }
 
+/// The command line's thread (which renders, and so assigns the lights) is one of rayon's pool,
+/// so a parallel assignment starts on it at once; the pool still has the threads asked for.
+#[test]
+fn the_command_lines_thread_is_one_of_the_assignment_pool() {
+    let dir = tempfile::tempdir().unwrap();
+    for pool in [1, 3] {
+        let threads = pool.to_string();
+        let env = [("RAYON_NUM_THREADS", threads.as_str())];
+        let out = manylight(&["info", "--json"], &env, dir.path());
+        assert!(out.status.success(), "{}", text(&out));
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        assert_eq!(v["assign_pool"]["threads"], pool, "{}", v["assign_pool"]);
+        assert_eq!(
+            v["assign_pool"]["caller_in_pool"], true,
+            "{}",
+            v["assign_pool"]
+        );
+    }
+}
+
 #[test]
 fn a_missing_texture_is_warned_once() {
     let dir = tempfile::tempdir().unwrap();

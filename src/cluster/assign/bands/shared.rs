@@ -288,6 +288,51 @@ mod tests {
         assert!(panicked, "the panic reaches the caller");
     }
 
+    /// A caller that is one of the pool's threads (`use_current_thread`, as the command line
+    /// builds rayon's global pool) starts the assignment itself: with the pool's other worker
+    /// held until the assignment has returned, it still returns, with one thread's lists.
+    /// (From outside the pool the work would wait in rayon's queue for a worker to take it.)
+    #[test]
+    fn a_caller_in_the_pool_works_without_waiting_for_another_worker() {
+        let (done, result) = mpsc::channel();
+        // On its own thread (it becomes one of the pool's), so a hang fails the test.
+        std::thread::spawn(move || {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(2)
+                .use_current_thread()
+                .build()
+                .unwrap();
+            let grid = view_grid(&GridConfig::fixed(8.0));
+            let lights = random_lights(&mut rand_pcg::Pcg64Mcg::seed_from_u64(23), 400, 20.0);
+            let limits = |parallel_threshold| AssignLimits {
+                parallel_threshold,
+                ..AssignLimits::default()
+            };
+            let expected = Assigner::new()
+                .assign(&grid, &lights, 80.0, &limits(usize::MAX))
+                .clone();
+            let (go, wait) = mpsc::channel::<()>();
+            let (held, is_held) = mpsc::channel::<()>();
+            pool.spawn(move || {
+                held.send(()).unwrap();
+                wait.recv().unwrap();
+            });
+            is_held.recv().unwrap();
+            let mut assigner = Assigner::new();
+            let got = pool.install(|| assigner.assign(&grid, &lights, 80.0, &limits(0)).clone());
+            go.send(()).unwrap();
+            let _ = done.send((got, expected));
+        });
+        let (got, expected) = result
+            .recv_timeout(Duration::from_secs(60))
+            .expect("the assignment returns while the other worker is held");
+        assert_eq!(got.stats.threads, 2, "the pool's assignment");
+        assert_eq!(got.visible, expected.visible);
+        assert_eq!(got.offsets, expected.offsets);
+        assert_eq!(got.counts, expected.counts);
+        assert!(got.indices == expected.indices, "other indices");
+    }
+
     /// With the second of two workers held elsewhere and let go at some moment of the
     /// assignment (before it, during it, after it), each frame lists what one thread lists:
     /// the first worker takes every band the second has not, and a copy of the work no one

@@ -98,6 +98,10 @@ pub fn run(args: &InfoArgs) -> Result<(), Box<dyn std::error::Error>> {
             "caps": caps,
             "capacities": manylight::methods::capacity::capacities(&caps),
             "mediump_is_fp16": fp16,
+            "assign_pool": {
+                "threads": rayon::current_num_threads(),
+                "caller_in_pool": caller_in_pool(),
+            },
             "scene": report,
             "methods": methods.iter().map(|(name, s)| serde_json::json!({"name": name, "support": s})).collect::<Vec<_>>(),
         });
@@ -112,12 +116,27 @@ pub fn run(args: &InfoArgs) -> Result<(), Box<dyn std::error::Error>> {
                 "fp32 (measured)"
             }
         ));
+        text.push_str(&format!(
+            "light assignment     up to {} CPU threads (rayon's pool{})\n",
+            rayon::current_num_threads(),
+            if caller_in_pool() {
+                ", this thread one of them"
+            } else {
+                "; this thread waits for them"
+            }
+        ));
         if let Some(r) = &report {
             text.push_str(&format_scene_report(r));
         }
         print_stdout(&text)?;
     }
     Ok(())
+}
+
+/// Whether this thread, which renders and so assigns the lights, is one of rayon's pool: then a
+/// parallel assignment starts on it at once (`main`'s `join_rayon_pool`).
+fn caller_in_pool() -> bool {
+    rayon::current_thread_index().is_some()
 }
 
 /// `writeln!` into a String (cannot fail).

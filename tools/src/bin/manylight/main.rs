@@ -250,6 +250,17 @@ fn check_outside_folder(outputs: &[Option<(&str, &Path)>], (folder_option, folde
     }
 }
 
+/// Makes this thread (the one that renders and assigns lights) one of rayon's global pool, so
+/// a parallel light assignment starts on it at once. From outside the pool the caller would
+/// queue the work, wait idle until a pool thread woke to take it (milliseconds for a core that
+/// slept: docs/performance.md, `pool_wake`), and leave one core to the pool.
+fn join_rayon_pool() {
+    let pool = rayon::ThreadPoolBuilder::new().use_current_thread();
+    if let Err(e) = pool.build_global() {
+        log::debug!("rayon's global pool left as it was: {e}");
+    }
+}
+
 fn main() -> ExitCode {
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn"))
         .format_timestamp(None)
@@ -271,6 +282,7 @@ fn main() -> ExitCode {
     let mut options = LoadOptions::default();
     options.allow_outside_files = cli.allow_outside_files;
     let _ = LOAD_OPTIONS.set(options);
+    join_rayon_pool();
     if !matches!(cli.command, Some(Command::Matrix(_))) {
         if let Some(dir) = cli.gles_lib.first() {
             if let Err(e) = manylight::gl::gles_lib::select(dir) {
