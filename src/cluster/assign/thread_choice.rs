@@ -1,8 +1,9 @@
 //! One thread or the pool, by measure: where the rules of `threads_for` would wake the pool
 //! for an assignment, an [`Assigner`](super::Assigner) keeps it on the calling thread when
 //! that is as fast. Waking a worker costs from microseconds to milliseconds with the machine
-//! and with what else runs on its cores (a game's own threads, the GL driver's), and the
-//! caller waits for it; a worker woken for no gain is a core taken from the caller's work.
+//! and with what else runs on its cores (a game's own threads, the GL driver's), and a caller
+//! outside rayon's pool waits for it (one in the pool starts at once); a worker woken for no
+//! gain is a core taken from the caller's work.
 //!
 //! The choice keeps one mode and now and then tries the other on one assignment. Each mode is
 //! judged by the fastest of its last [`WINDOW`] times per unit of work: other work on the
