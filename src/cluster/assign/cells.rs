@@ -143,43 +143,81 @@ pub(crate) fn for_each_run_in(
     }
     let ((k0, s0), (k1, s1)) = grid.depth_range_to_slices(dmin, dmax);
     let extent = ScreenExtent::new(grid, c, r, dmin, dmax);
+    let light = LightBounds {
+        grid,
+        window,
+        extent: &extent,
+        cone: &cone,
+    };
+    if k0 == k1 {
+        // The common case, apart from the loop: nothing is needed after the cascade's runs,
+        // so the compiler keeps the light's bounds in registers rather than on the stack
+        // across the refinement's call.
+        light.cascade_runs(k0, s0, s1, false, emit);
+        return;
+    }
     // Exclusive ranges in the loops below: inclusive ones cost a flag check per step.
     for k in k0..k1 + 1 {
+        let sa = if k == k0 { s0 } else { 0 };
+        let sb = if k == k1 {
+            s1
+        } else {
+            grid.cascades[k as usize].slices - 1
+        };
+        if !light.cascade_runs(k, sa, sb, true, emit) {
+            // The window ends before this cascade (and every later one).
+            break;
+        }
+    }
+}
+
+/// What a light's cells in each cascade are cut from: its screen extent and cone, the grid and
+/// the window's slices.
+struct LightBounds<'a> {
+    grid: &'a ClusterGrid,
+    window: &'a SliceWindow,
+    extent: &'a ScreenExtent,
+    cone: &'a Option<Cone>,
+}
+
+impl LightBounds<'_> {
+    /// Emits the light's runs in slices `sa..=sb` of cascade `k` (numbered within it), cut to
+    /// the window's; with `slab`, the light's depth range spans several cascades and this
+    /// cascade's slab tightens the tangent bounds. False when the window ends before the
+    /// cascade.
+    #[inline(always)]
+    fn cascade_runs(
+        &self,
+        k: u32,
+        sa: u32,
+        sb: u32,
+        slab: bool,
+        emit: &mut impl FnMut(u32, u32),
+    ) -> bool {
+        let (grid, window, extent) = (self.grid, self.window, self.extent);
         let cascade = &grid.cascades[k as usize];
         let constants = &grid.cascade_constants[k as usize];
         // The light's slices of this cascade, cut to the window's (numbered within the
         // cascade, inclusive).
-        let sa = if k == k0 { s0 } else { 0 };
-        let sb = if k == k1 { s1 } else { cascade.slices - 1 };
         let sa = sa.max(window.first.saturating_sub(constants.first_slice));
         let Some(last) = window.end.checked_sub(constants.first_slice + 1) else {
-            // The window ends before this cascade (and every later one).
-            break;
+            return false;
         };
         let sb = sb.min(last);
         if sa > sb {
-            continue;
+            return true;
         }
         // The whole sphere's tangent bounds are exact on their own when the depth range
         // lies in one cascade (the common case); otherwise each cascade's slab tightens them.
         // Every slice and row below stays inside these ranges, so the refinement can only
         // remove cells.
-        let slab = k0 != k1;
         let Some(columns) = extent.tile_range(constants, slab, 0, cascade.tiles_x) else {
-            continue;
+            return true;
         };
         let Some(rows) = extent.tile_range(constants, slab, 1, cascade.tiles_y) else {
-            continue;
+            return true;
         };
         let slice_cells = cascade.tiles_x * cascade.tiles_y;
-        let tiles = CascadeTiles {
-            grid,
-            constants,
-            tiles_x: cascade.tiles_x,
-            tiles_y: cascade.tiles_y,
-            columns,
-            rows,
-        };
         let slice_start = cascade.first_cell + sa * slice_cells;
         // A rectangle of at most 2 × 2 cells per slice has little to trim (a corner cell at
         // most) and the per-row arithmetic, or a spot's cone test, would cost more than the
@@ -199,9 +237,18 @@ pub(crate) fn for_each_run_in(
                 }
                 run += slice_cells;
             }
-            continue;
+            return true;
         }
-        refine_slices(&extent, &tiles, &cone, k, sa..sb + 1, small, emit);
+        let tiles = CascadeTiles {
+            grid,
+            constants,
+            tiles_x: cascade.tiles_x,
+            tiles_y: cascade.tiles_y,
+            columns,
+            rows,
+        };
+        refine_slices(extent, &tiles, self.cone, k, sa..sb + 1, small, emit);
+        true
     }
 }
 
