@@ -135,14 +135,18 @@ impl Chunk {
         clear_with_room_for(&mut self.runs, runs_share);
         self.ends.clear();
         clear_with_room_for(&mut self.visible, visible_share);
-        let (deltas, runs) = (&mut self.deltas, &mut self.runs);
+        let (deltas, runs) = (&mut self.deltas[..], &mut self.runs);
         for (i, light) in lights.iter().enumerate() {
             let before = runs.len();
-            for_each_run(grid, light, camera_far, &mut |start, len| {
+            // The callback lives on the stack (the refinement takes it out of line): it holds
+            // the difference counts as a slice, not through their `Vec`, one load less a run.
+            let (deltas, to) = (&mut *deltas, &mut *runs);
+            let mut emit = move |start: u32, len: u32| {
                 deltas[start as usize] += 1;
                 deltas[(start + len) as usize] -= 1;
-                runs.push(Run { start, len });
-            });
+                to.push(Run { start, len });
+            };
+            for_each_run(grid, light, camera_far, &mut emit);
             if runs.len() > before {
                 self.visible.push(i as u32);
             }
