@@ -245,6 +245,19 @@ mod tests {
         }
     }
 
+    /// Keeps one of `pool`'s workers busy until the returned sender sends (or is dropped);
+    /// returns once that worker is held.
+    fn hold_one_worker(pool: &rayon::ThreadPool) -> mpsc::Sender<()> {
+        let (go, wait) = mpsc::channel::<()>();
+        let (held, is_held) = mpsc::channel::<()>();
+        pool.spawn(move || {
+            held.send(()).unwrap();
+            let _ = wait.recv();
+        });
+        is_held.recv().unwrap();
+        go
+    }
+
     /// A worker that panics in phase 1 makes the assignment panic, not hang: the others stop
     /// waiting for phase 3.
     #[test]
@@ -311,13 +324,7 @@ mod tests {
             let expected = Assigner::new()
                 .assign(&grid, &lights, 80.0, &limits(usize::MAX))
                 .clone();
-            let (go, wait) = mpsc::channel::<()>();
-            let (held, is_held) = mpsc::channel::<()>();
-            pool.spawn(move || {
-                held.send(()).unwrap();
-                wait.recv().unwrap();
-            });
-            is_held.recv().unwrap();
+            let go = hold_one_worker(&pool);
             let mut assigner = Assigner::new();
             let got = pool.install(|| assigner.assign(&grid, &lights, 80.0, &limits(0)).clone());
             go.send(()).unwrap();
@@ -362,13 +369,7 @@ mod tests {
             let lights = random_lights(&mut rng, 400, 20.0);
             let expected = alone.assign(&grid, &lights, 80.0, &one_thread).clone();
             // Holds one worker until the timer lets it go; the other runs the assignment.
-            let (go, wait) = mpsc::channel::<()>();
-            let (held, is_held) = mpsc::channel::<()>();
-            pool.spawn(move || {
-                held.send(()).unwrap();
-                wait.recv().unwrap();
-            });
-            is_held.recv().unwrap();
+            let go = hold_one_worker(&pool);
             let timer = std::thread::spawn(move || {
                 std::thread::sleep(Duration::from_micros(late_us));
                 let _ = go.send(());

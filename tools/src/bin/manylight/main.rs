@@ -252,8 +252,8 @@ fn check_outside_folder(outputs: &[Option<(&str, &Path)>], (folder_option, folde
 
 /// Makes this thread (the one that renders and assigns lights) one of rayon's global pool, so
 /// a parallel light assignment starts on it at once. From outside the pool the caller would
-/// queue the work, wait idle until a pool thread woke to take it (milliseconds for a core that
-/// slept: docs/performance.md, `pool_wake`), and leave one core to the pool.
+/// queue the work and wait, its own core idle, until a pool thread woke to take it
+/// (milliseconds for a core that slept: docs/performance.md, `pool_wake`).
 fn join_rayon_pool() {
     let pool = rayon::ThreadPoolBuilder::new().use_current_thread();
     if let Err(e) = pool.build_global() {
