@@ -160,6 +160,15 @@ pub fn run(out: &Path, width: u32, height: u32) -> Result<(), Box<dyn std::error
 
 #[allow(dead_code)] // `tests/examples.rs` includes this file and calls `run` itself.
 fn main() -> Result<(), Box<dyn std::error::Error>> {
+    // The thread that renders joins rayon's global pool before anything uses rayon, so the CPU
+    // light assignment starts on it at once instead of waiting for a pool thread to wake
+    // (README, "Embedding").
+    if let Err(e) = rayon::ThreadPoolBuilder::new()
+        .use_current_thread()
+        .build_global()
+    {
+        eprintln!("rayon's pool left as it was: {e}");
+    }
     let out = std::env::args()
         .nth(1)
         .unwrap_or_else(|| "embedded.png".into());
