@@ -39,10 +39,9 @@ impl ClusterGrid {
                 self.view_z_to_cascade_slice(dmin),
                 self.view_z_to_cascade_slice(dmax),
             ),
-            DepthMapping::Log2 => (
-                self.slice_lookup.find(dmin * (1.0 - SLICE_WIDEN)),
-                self.slice_lookup.find(dmax * (1.0 + SLICE_WIDEN)),
-            ),
+            DepthMapping::Log2 => self
+                .slice_lookup
+                .find_range(dmin * (1.0 - SLICE_WIDEN), dmax * (1.0 + SLICE_WIDEN)),
         }
     }
 

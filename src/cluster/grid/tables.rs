@@ -105,9 +105,30 @@ impl SliceLookup {
         self.address.clear();
     }
 
-    /// (cascade, slice) of the last slice starting at or before `d` (`d` ≥ 0, not NaN).
-    #[inline(always)]
+    /// (cascade, slice) of the last slice starting at or before `d` (`d` ≥ 0, not NaN). The
+    /// assignment takes ranges ([`SliceLookup::find_range`]).
+    #[cfg(test)]
     pub(crate) fn find(&self, d: f64) -> (u32, u32) {
+        self.address[self.index(d)]
+    }
+
+    /// [`SliceLookup::find`] of `d0` and of `d1 ≥ d0`, the second without a look-up of its
+    /// own when `d1` lies in the first's slice (a small light's whole depth range, most often).
+    #[inline(always)]
+    pub(crate) fn find_range(&self, d0: f64, d1: f64) -> ((u32, u32), (u32, u32)) {
+        let g0 = self.index(d0);
+        // The slices start in ascending order, and the last entry is NaN (no such start).
+        let g1 = if d1 < self.start[g0 + 1] {
+            g0
+        } else {
+            self.index(d1)
+        };
+        (self.address[g0], self.address[g1])
+    }
+
+    /// The number of the last slice starting at or before `d` (`d` ≥ 0, not NaN).
+    #[inline(always)]
+    fn index(&self, d: f64) -> usize {
         // Negative patterns (−0 included) clamp to the first bucket, +∞ to the last.
         let bucket = (bucket(d) - self.base).clamp(0, self.buckets.len() as i64 - 1);
         let bucket = self.buckets[bucket as usize];
@@ -119,7 +140,7 @@ impl SliceLookup {
         while d >= self.start[g + 1] {
             g += 1;
         }
-        self.address[g]
+        g
     }
 }
 
@@ -227,8 +248,16 @@ mod tests {
                 depths.push(d);
                 d *= 1.001;
             }
-            for d in depths {
+            for &d in &depths {
                 assert_eq!(lookup.find(d), search(d), "depth {d}");
+            }
+            // A range's ends as two look-ups give, whether or not they share a slice.
+            depths.sort_by(f64::total_cmp);
+            for (i, &d0) in depths.iter().enumerate() {
+                for &d1 in depths[i..].iter().take(12) {
+                    let ends = (search(d0), search(d1));
+                    assert_eq!(lookup.find_range(d0, d1), ends, "depths {d0}..{d1}");
+                }
             }
         }
     }
