@@ -7,7 +7,7 @@ use glam::{DVec3, Vec3};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 
-use super::tests::{cases, cell_lights, random_lights, view_grid};
+use super::tests::{assert_same_lists, cases, cell_lights, random_lights, view_grid};
 use super::{
     assign, threads_for, AssignLimits, AssignStats, Assignment, PARALLEL_INDICES,
     PARALLEL_MIN_LIGHTS, PARALLEL_SECONDS,
@@ -39,10 +39,7 @@ fn parallel_and_sequential_assignment_agree() {
             ..Default::default()
         },
     );
-    assert_eq!(seq.visible, par.visible);
-    assert_eq!(seq.offsets, par.offsets);
-    assert_eq!(seq.counts, par.counts);
-    assert_eq!(seq.indices, par.indices);
+    assert_same_lists(&par, &seq, "parallel against sequential");
     // The same figures, but the threads they ran on.
     assert_eq!(
         seq.stats,
@@ -112,10 +109,7 @@ fn reused_buffers_match_fresh_ones() {
         };
         let fresh = assign(&grid, &lights, case.far, &limits);
         let reused = assigner.assign(&grid, &lights, case.far, &limits);
-        assert_eq!(fresh.visible, reused.visible, "{}", case.name);
-        assert_eq!(fresh.offsets, reused.offsets, "{}", case.name);
-        assert_eq!(fresh.counts, reused.counts, "{}", case.name);
-        assert_eq!(fresh.indices, reused.indices, "{}", case.name);
+        assert_same_lists(reused, &fresh, case.name);
         assert_eq!(fresh.stats, reused.stats, "{}", case.name);
     }
 }
@@ -280,10 +274,7 @@ fn any_number_of_bands_gives_what_one_band_gives() {
                 let bands =
                     pool.install(|| assigner.assign(&grid, &lights, case.far, &parallel).clone());
                 let what = format!("{threads} threads, {}, {count} lights", case.name);
-                assert_eq!(one.visible, bands.visible, "{what}");
-                assert_eq!(one.offsets, bands.offsets, "{what}");
-                assert_eq!(one.counts, bands.counts, "{what}");
-                assert_eq!(one.indices, bands.indices, "{what}");
+                assert_same_lists(&bands, &one, &what);
                 assert_eq!(
                     one.stats,
                     AssignStats {

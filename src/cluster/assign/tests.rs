@@ -85,6 +85,15 @@ pub(super) fn cases() -> Vec<Case> {
     ]
 }
 
+/// `got` lists what `expected` lists: the same visible lights, per-cell offsets and counts and
+/// index list (compared without printing it on failure: it is long). `what` names the case.
+pub(super) fn assert_same_lists(got: &Assignment, expected: &Assignment, what: &str) {
+    assert_eq!(got.visible, expected.visible, "{what}");
+    assert_eq!(got.offsets, expected.offsets, "{what}");
+    assert_eq!(got.counts, expected.counts, "{what}");
+    assert!(got.indices == expected.indices, "{what}: other indices");
+}
+
 /// The test view at 640×360, near 0.1 and far 80, with the grid `config` makes.
 pub(super) fn view_grid(config: &GridConfig) -> ClusterGrid {
     ClusterGrid::new(640, 360, GridProjection::test_view(), 0.1, 80.0, config)

@@ -122,7 +122,7 @@ fn a_try_of_one_thread_leaves_the_pools_split_for_its_next_assignment() {
 
 #[test]
 fn one_thread_and_the_pool_by_turns_give_every_frame_its_own_lists() {
-    use crate::cluster::assign::tests::random_lights;
+    use crate::cluster::assign::tests::{assert_same_lists, random_lights};
     use crate::cluster::assign::thread_choice::ThreadChoice;
     use crate::cluster::assign::{assign, AssignLimits, Assigner, PARALLEL_INDICES};
     use rand::SeedableRng;
@@ -154,10 +154,7 @@ fn one_thread_and_the_pool_by_turns_give_every_frame_its_own_lists() {
                 );
                 assert_eq!(got.stats.threads, if one { 1 } else { 2 }, "frame {frame}");
             }
-            assert_eq!(got.visible, fresh.visible, "frame {frame}");
-            assert_eq!(got.offsets, fresh.offsets, "frame {frame}");
-            assert_eq!(got.counts, fresh.counts, "frame {frame}");
-            assert!(got.indices == fresh.indices, "frame {frame}: other indices");
+            assert_same_lists(got, &fresh, &format!("frame {frame}"));
         }
     });
 }

@@ -222,7 +222,7 @@ fn lock<T>(mutex: &Mutex<T>) -> MutexGuard<'_, T> {
 
 #[cfg(test)]
 mod tests {
-    use crate::cluster::assign::tests::{random_lights, view_grid};
+    use crate::cluster::assign::tests::{assert_same_lists, random_lights, view_grid};
     use crate::cluster::assign::{AssignLimits, Assigner};
     use crate::cluster::grid::GridConfig;
     use crate::cluster::view_light::GpuLight;
@@ -334,10 +334,7 @@ mod tests {
             .recv_timeout(Duration::from_secs(60))
             .expect("the assignment returns while the other worker is held");
         assert_eq!(got.stats.threads, 2, "the pool's assignment");
-        assert_eq!(got.visible, expected.visible);
-        assert_eq!(got.offsets, expected.offsets);
-        assert_eq!(got.counts, expected.counts);
-        assert!(got.indices == expected.indices, "other indices");
+        assert_same_lists(&got, &expected, "a caller in the pool");
     }
 
     /// With the second of two workers held elsewhere and let go at some moment of the
@@ -377,13 +374,7 @@ mod tests {
             let got = pool.install(|| assigner.assign(&grid, &lights, 80.0, &on_pool).clone());
             timer.join().unwrap();
             assert_eq!(got.stats.threads, 2, "frame {frame}: the pool's assignment");
-            assert_eq!(got.visible, expected.visible, "frame {frame}");
-            assert_eq!(got.offsets, expected.offsets, "frame {frame}");
-            assert_eq!(got.counts, expected.counts, "frame {frame}");
-            assert!(
-                got.indices == expected.indices,
-                "frame {frame}: other indices"
-            );
+            assert_same_lists(&got, &expected, &format!("frame {frame}"));
         }
     }
 }
