@@ -104,10 +104,26 @@ impl IndexList {
     }
 }
 
-/// The list's entries, to be written, at their width.
+/// The list's entries (or a part of them), to be written, at their width.
 pub(super) enum EntriesMut<'a> {
-    Narrow(&'a mut Vec<u16>),
-    Wide(&'a mut Vec<u32>),
+    Narrow(&'a mut [u16]),
+    Wide(&'a mut [u32]),
+}
+
+impl<'a> EntriesMut<'a> {
+    /// The first `len` entries, and the rest.
+    pub(super) fn split_at(self, len: usize) -> (EntriesMut<'a>, EntriesMut<'a>) {
+        match self {
+            EntriesMut::Narrow(list) => {
+                let (a, b) = list.split_at_mut(len);
+                (EntriesMut::Narrow(a), EntriesMut::Narrow(b))
+            }
+            EntriesMut::Wide(list) => {
+                let (a, b) = list.split_at_mut(len);
+                (EntriesMut::Wide(a), EntriesMut::Wide(b))
+            }
+        }
+    }
 }
 
 /// An entry type of the index list: what the scatter, merge and trim code is generic over.

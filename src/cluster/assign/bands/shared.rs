@@ -108,10 +108,7 @@ fn between_phases<'a>(
         .map_or(0, |band| band.end_cell);
     let mut rest = CellsOut::sized(&mut out.counts, &mut out.offsets, cells);
     let numbers: &[u32] = numbers;
-    let mut list = match out.indices.prepare(indices, out.visible.len()) {
-        EntriesMut::Narrow(list) => ListPart::Narrow(list),
-        EntriesMut::Wide(list) => ListPart::Wide(list),
-    };
+    let mut list = out.indices.prepare(indices, out.visible.len());
     for (band, slot) in taken.into_iter().flatten().zip(scatters) {
         let (cells, after) = rest.split_at(band.end_cell - band.first_cell);
         let (part, tail) = list.split_at(band.indices);
@@ -129,7 +126,7 @@ fn between_phases<'a>(
 struct Scatter<'a> {
     band: &'a mut Band,
     cells: CellsOut<'a>,
-    list: ListPart<'a>,
+    list: EntriesMut<'a>,
     numbers: &'a [u32],
 }
 
@@ -143,8 +140,8 @@ impl Scatter<'_> {
             numbers,
         } = self;
         match list {
-            ListPart::Narrow(list) => scatter(band, cells, list, numbers),
-            ListPart::Wide(list) => scatter(band, cells, list, numbers),
+            EntriesMut::Narrow(list) => scatter(band, cells, list, numbers),
+            EntriesMut::Wide(list) => scatter(band, cells, list, numbers),
         }
     }
 }
@@ -152,28 +149,6 @@ impl Scatter<'_> {
 /// [`Band::count_and_scatter`] with the lights' numbers from phase 2.
 fn scatter<T: LightIndex>(band: &mut Band, cells: CellsOut, list: &mut [T], numbers: &[u32]) {
     band.count_and_scatter(Some(numbers), cells.counts, cells.offsets, list);
-}
-
-/// A part of the index list, at its width.
-enum ListPart<'a> {
-    Narrow(&'a mut [u16]),
-    Wide(&'a mut [u32]),
-}
-
-impl<'a> ListPart<'a> {
-    /// The first `len` entries, and the rest.
-    fn split_at(self, len: usize) -> (ListPart<'a>, ListPart<'a>) {
-        match self {
-            ListPart::Narrow(list) => {
-                let (a, b) = list.split_at_mut(len);
-                (ListPart::Narrow(a), ListPart::Narrow(b))
-            }
-            ListPart::Wide(list) => {
-                let (a, b) = list.split_at_mut(len);
-                (ListPart::Wide(a), ListPart::Wide(b))
-            }
-        }
-    }
 }
 
 /// The next of `n` jobs no one has taken, if any.
