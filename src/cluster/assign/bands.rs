@@ -13,7 +13,6 @@ mod shared;
 pub(super) use scatter::FORCED_SCATTER_BLOCKS;
 
 use super::cells::{for_each_run_in, SliceWindow};
-use super::index_list::EntriesMut;
 use super::types::{Assignment, Run, Totals, PARALLEL_SECONDS};
 use crate::cluster::grid::ClusterGrid;
 use crate::cluster::headroom::{clear_with_room_for, room_for, share_of, WHOLE_UP_TO};
@@ -313,11 +312,8 @@ impl Band {
         self.ids.extend(0..self.lights.len() as u32);
         self.base = 0;
         let cells = CellsOut::sized(&mut out.counts, &mut out.offsets, self.end_cell);
-        let (counts, offsets) = (cells.counts, cells.offsets);
-        match out.indices.prepare(self.indices, out.visible.len()) {
-            EntriesMut::Narrow(list) => self.count_and_scatter(None, counts, offsets, list),
-            EntriesMut::Wide(list) => self.count_and_scatter(None, counts, offsets, list),
-        }
+        let list = out.indices.prepare(self.indices, out.visible.len());
+        self.count_and_scatter(None, cells, list);
     }
 }
 

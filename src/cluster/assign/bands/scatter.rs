@@ -2,15 +2,15 @@
 //! its part of the index list, block by block of cells, each block's counts, offsets and list
 //! written while they are in cache.
 
-use super::Band;
-use crate::cluster::assign::index_list::LightIndex;
+use super::{Band, CellsOut};
+use crate::cluster::assign::index_list::{EntriesMut, LightIndex};
 use crate::cluster::assign::types::{Run, Totals};
 use std::time::Instant;
 
 impl Band {
-    /// Phase 3: the band's `counts`, `offsets` and `list` (its cells' parts, and its part of
-    /// the list) from its runs (phase 1), with its lights' visible numbers (looked up in
-    /// `numbers` first, when given); the band's [`Totals`] into `self.totals`.
+    /// Phase 3: the band's `cells` (its counts and offsets) and `list` (its part of the list)
+    /// from its runs (phase 1), with its lights' visible numbers (looked up in `numbers` first,
+    /// when given); the band's [`Totals`] into `self.totals`.
     ///
     /// Per block of cells: the block's parts of the runs add their difference counts into its
     /// counts (`+1` where a part starts, `−1` (wrapping) where it ends, two additions whatever
@@ -22,12 +22,11 @@ impl Band {
     ///
     /// One block while the band's offsets and list fit a core's cache; more for a larger
     /// band ([`scatter_blocks`]), so that each per-cell array is written once, in cache.
-    pub(super) fn count_and_scatter<T: LightIndex>(
+    pub(super) fn count_and_scatter(
         &mut self,
         numbers: Option<&[u32]>,
-        counts: &mut [u32],
-        offsets: &mut [u32],
-        list: &mut [T],
+        cells: CellsOut,
+        list: EntriesMut,
     ) {
         let started = Instant::now();
         if let Some(numbers) = numbers {
@@ -38,6 +37,21 @@ impl Band {
                     .map(|&(light, _)| numbers[light as usize]),
             );
         }
+        let (counts, offsets) = (cells.counts, cells.offsets);
+        self.totals = match list {
+            EntriesMut::Narrow(list) => self.count_and_scatter_at(counts, offsets, list),
+            EntriesMut::Wide(list) => self.count_and_scatter_at(counts, offsets, list),
+        };
+        self.seconds += started.elapsed().as_secs_f64();
+    }
+
+    /// [`Band::count_and_scatter`] at the list's width: in one block or several; the totals.
+    fn count_and_scatter_at<T: LightIndex>(
+        &mut self,
+        counts: &mut [u32],
+        offsets: &mut [u32],
+        list: &mut [T],
+    ) -> Totals {
         let cells = offsets.len();
         let blocks = scatter_blocks(
             cells,
@@ -55,8 +69,7 @@ impl Band {
         } else {
             self.count_and_scatter_blocks(blocks, counts, offsets, list, &mut totals);
         }
-        self.totals = totals;
-        self.seconds += started.elapsed().as_secs_f64();
+        totals
     }
 
     /// [`Band::count_and_scatter`] in one block: every run whole, so no cursors into the runs

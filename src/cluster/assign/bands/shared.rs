@@ -2,7 +2,7 @@
 //! next worker that is free (see [`assign_shared`]).
 
 use super::{number_listed, Band, CellsOut, MAX_BANDS};
-use crate::cluster::assign::index_list::{EntriesMut, LightIndex};
+use crate::cluster::assign::index_list::EntriesMut;
 use crate::cluster::assign::types::Assignment;
 use crate::cluster::grid::ClusterGrid;
 use crate::cluster::view_light::GpuLight;
@@ -131,24 +131,11 @@ struct Scatter<'a> {
 }
 
 impl Scatter<'_> {
-    /// The band's phase 3, at the list's width.
+    /// The band's phase 3, with the lights' numbers from phase 2.
     fn run(self) {
-        let Scatter {
-            band,
-            cells,
-            list,
-            numbers,
-        } = self;
-        match list {
-            EntriesMut::Narrow(list) => scatter(band, cells, list, numbers),
-            EntriesMut::Wide(list) => scatter(band, cells, list, numbers),
-        }
+        let numbers = Some(self.numbers);
+        self.band.count_and_scatter(numbers, self.cells, self.list);
     }
-}
-
-/// [`Band::count_and_scatter`] with the lights' numbers from phase 2.
-fn scatter<T: LightIndex>(band: &mut Band, cells: CellsOut, list: &mut [T], numbers: &[u32]) {
-    band.count_and_scatter(Some(numbers), cells.counts, cells.offsets, list);
 }
 
 /// The next of `n` jobs no one has taken, if any.
