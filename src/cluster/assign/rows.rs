@@ -11,7 +11,7 @@
 //! cross-section" (where `f64::max` gave a number, it was ≤ 0; the tests check the lanes
 //! against `f64`'s bounds, slabs reaching infinity included).
 
-use super::simd::{at_least, at_most, splat, F64x4};
+use super::simd::{at_least, at_most, counting_from, splat, F64x4};
 use crate::cluster::min_max::MinMax;
 
 /// Rows whose chords one call of [`RowChords::columns`] works out.
@@ -45,7 +45,7 @@ impl RowChords {
     /// Columns `(x0, x1)` of rows `row .. row + ROW_LANES`; `x0 > x1` where a row gets none.
     #[inline(always)]
     pub(super) fn columns(&self, row: u32) -> [(u32, u32); ROW_LANES] {
-        let rows = F64x4::from(std::array::from_fn(|i| (row + i as u32) as f64));
+        let rows = counting_from(row);
         let t0 = splat(-self.extent_y) + rows * splat(self.step_y);
         let t1 = t0 + splat(self.step_y);
         let (za, zb, cy) = (splat(self.za), splat(self.zb), splat(self.cy));

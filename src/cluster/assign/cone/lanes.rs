@@ -7,7 +7,7 @@
 
 use super::{whole_cells, ConeSlice, NARROW_ROW};
 use crate::cluster::assign::rows::ROW_LANES;
-use crate::cluster::assign::simd::{at_least, at_most, splat, F64x4 as F};
+use crate::cluster::assign::simd::{at_least, at_most, counting_from, splat, F64x4 as F};
 
 // A narrow row's cells fit the lanes.
 const _: () = assert!(NARROW_ROW as usize <= ROW_LANES);
@@ -61,7 +61,7 @@ impl ConeSlice<'_> {
     pub(super) fn narrow_columns(&self, v0: glam::DVec3, x0: u32, x1: u32) -> Option<(u32, u32)> {
         let cone = self.cone;
         let axis = cone.axis;
-        let columns = F::from(std::array::from_fn(|i| (x0 + i as u32) as f64));
+        let columns = counting_from(x0);
         let (vx, vy, vz) = (
             splat(v0.x) + columns * splat(self.sx),
             splat(v0.y),
@@ -92,7 +92,7 @@ impl ConeSlice<'_> {
         let cone = self.cone;
         let axis = cone.axis;
         let (ox, oz) = (splat(self.origin.x), splat(self.origin.z));
-        let rows = F::from(std::array::from_fn(|i| (row + i as u32) as f64));
+        let rows = counting_from(row);
         let vy = splat(self.origin.y) + rows * splat(self.row_step);
         // `v₀ · axis`, `v₀ − axis · p` and `r + sin · p`, as `DVec3` computes them.
         let p = ox * splat(axis.x) + vy * splat(axis.y) + oz * splat(axis.z);
