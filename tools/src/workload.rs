@@ -131,22 +131,83 @@ impl AssignWorkload {
         while start.elapsed() < WARM_UP {
             std::hint::black_box(self.assign_with(&mut assigner));
         }
-        let mut times: Vec<(f64, usize)> = (0..runs)
-            .map(|_| {
-                let t = Instant::now();
-                let threads = std::hint::black_box(self.assign_with(&mut assigner))
-                    .stats
-                    .threads;
-                (t.elapsed().as_secs_f64() * 1e3, threads)
-            })
-            .collect();
-        times.sort_by(|a, b| a.0.total_cmp(&b.0));
-        let (median_ms, threads) = times[times.len() / 2];
-        AssignTiming {
-            median_ms,
-            indices,
-            threads,
+        let mut times: Vec<(f64, usize)> =
+            (0..runs).map(|_| self.timed_run(&mut assigner)).collect();
+        median_of(&mut times, indices)
+    }
+}
+
+/// Rounds in which [`AssignWorkload::timing_on_pools`] alternates its pools.
+pub const POOL_ROUNDS: usize = 5;
+
+impl AssignWorkload {
+    /// [`AssignWorkload::timing`] on each of `pools` (rayon pools: one of one thread and one
+    /// of two, say), alternating: in each of [`POOL_ROUNDS`] rounds every pool in turn warms
+    /// up (a fifth of [`WARM_UP`], at least one assignment) and times its share of the `runs`,
+    /// each run timed on one of the pool's threads. So a host whose speed drifts (a shared VM,
+    /// a phone's clocks) drifts under every pool alike, and their ratio is one run's. Each pool
+    /// keeps its own [`Assigner`] (buffers, thread choice, bands' split).
+    ///
+    /// The pools are driven from a thread of no pool: a worker of another pool (the command
+    /// line's thread is one of the global pool) waits for `install` by looking for work in
+    /// its own pool, spinning a core away from the pool being timed.
+    pub fn timing_on_pools(&self, pools: &[rayon::ThreadPool], runs: usize) -> Vec<AssignTiming> {
+        std::thread::scope(|scope| {
+            scope
+                .spawn(|| self.alternate_pools(pools, runs))
+                .join()
+                .unwrap_or_else(|panic| std::panic::resume_unwind(panic))
+        })
+    }
+
+    /// [`AssignWorkload::timing_on_pools`] on the calling thread.
+    fn alternate_pools(&self, pools: &[rayon::ThreadPool], runs: usize) -> Vec<AssignTiming> {
+        let runs = runs.clamp(1, MAX_RUNS);
+        let rounds = POOL_ROUNDS.min(runs);
+        let mut assigners: Vec<Assigner> = pools.iter().map(|_| Assigner::new()).collect();
+        let mut indices = vec![0; pools.len()];
+        let mut times: Vec<Vec<(f64, usize)>> = vec![Vec::with_capacity(runs); pools.len()];
+        for round in 0..rounds {
+            let share = runs * (round + 1) / rounds - runs * round / rounds;
+            for (p, pool) in pools.iter().enumerate() {
+                let assigner = &mut assigners[p];
+                let samples = &mut times[p];
+                indices[p] = pool.install(|| {
+                    let indices = self.assign_with(assigner).indices.len();
+                    let start = Instant::now();
+                    while start.elapsed() < WARM_UP / POOL_ROUNDS as u32 {
+                        std::hint::black_box(self.assign_with(assigner));
+                    }
+                    samples.extend((0..share).map(|_| self.timed_run(assigner)));
+                    indices
+                });
+            }
         }
+        times
+            .iter_mut()
+            .zip(indices)
+            .map(|(samples, indices)| median_of(samples, indices))
+            .collect()
+    }
+
+    /// One assignment's wall time in milliseconds, and the threads it took.
+    fn timed_run(&self, assigner: &mut Assigner) -> (f64, usize) {
+        let t = Instant::now();
+        let threads = std::hint::black_box(self.assign_with(assigner))
+            .stats
+            .threads;
+        (t.elapsed().as_secs_f64() * 1e3, threads)
+    }
+}
+
+/// The median of `times` (wall time in milliseconds, threads), with `indices`.
+fn median_of(times: &mut [(f64, usize)], indices: usize) -> AssignTiming {
+    times.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let (median_ms, threads) = times[times.len() / 2];
+    AssignTiming {
+        median_ms,
+        indices,
+        threads,
     }
 }
 

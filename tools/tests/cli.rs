@@ -473,6 +473,64 @@ fn bench_assign_prints_json_for_scripts() {
     }
 }
 
+/// `bench-assign --threads 1,2` times each count on a pool of one thread and on one of two,
+/// taking turns: a row per pool, each on no more threads than its pool has, with the same
+/// lists; a pool of no threads is refused.
+#[test]
+fn bench_assign_times_pools_side_by_side() {
+    let dir = tempfile::tempdir().unwrap();
+    let args = [
+        "bench-assign",
+        "--lights",
+        "16,256",
+        "--runs",
+        "3",
+        "--threads",
+        "1,2",
+        "--json",
+    ];
+    // The global pool's size must not matter: the rows say their own pools.
+    let out = manylight(&args, &[("RAYON_NUM_THREADS", "1")], dir.path());
+    assert!(out.status.success(), "{}", text(&out));
+    let rows: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let rows = rows.as_array().unwrap();
+    let got: Vec<_> = rows
+        .iter()
+        .map(|r| (r["lights"].as_u64(), r["pool"].as_u64()))
+        .collect();
+    let expected = [(16, 1), (16, 2), (256, 1), (256, 2)].map(|(l, p)| (Some(l), Some(p)));
+    assert_eq!(got, expected);
+    for pair in rows.chunks(2) {
+        assert_eq!(pair[0]["threads"], 1, "{}", pair[0]);
+        let threads = pair[1]["threads"].as_u64().unwrap();
+        assert!((1..=2).contains(&threads), "{}", pair[1]);
+        assert_eq!(pair[0]["indices"], pair[1]["indices"]);
+        assert!(pair[0]["indices"].as_u64().unwrap() > 0);
+    }
+    let text_out = manylight(
+        &[
+            "bench-assign",
+            "--lights",
+            "64",
+            "--runs",
+            "2",
+            "--threads",
+            "1,2",
+        ],
+        &[],
+        dir.path(),
+    );
+    assert!(text_out.status.success(), "{}", text(&text_out));
+    assert!(
+        text(&text_out).contains("x the pool of 1"),
+        "{}",
+        text(&text_out)
+    );
+    let refused = manylight(&["bench-assign", "--threads", "0"], &[], dir.path());
+    assert!(!refused.status.success());
+    assert!(text(&refused).contains("--threads"), "{}", text(&refused));
+}
+
 /// The command line's thread (which renders, and so assigns the lights) is one of rayon's pool,
 /// so a parallel assignment starts on it at once; the pool still has the threads asked for.
 #[test]

@@ -23,11 +23,30 @@ pub struct BenchAssignArgs {
     /// Seed of the random lights.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// Print JSON (an array of {lights, assign_ms, indices, clusters, runs, threads}) instead of
-    /// a table. `threads`: what the median run took (the assignment picks one or more from the
-    /// previous run's time).
+    /// Time each count on rayon pools of these sizes instead of the global pool (comma
+    /// separated, each 1 to 256; `1,2` for one worker against two): the pools take turns in
+    /// five rounds, so a host whose speed drifts drifts under each alike, and each row after
+    /// the first of a count gives its time as a ratio to the first pool's.
+    #[arg(long, value_delimiter = ',', value_parser = parse_pool_size)]
+    pub threads: Vec<usize>,
+    /// Print JSON (an array of {lights, assign_ms, indices, clusters, runs, threads}, and
+    /// `pool` with `--threads`) instead of a table. `threads`: what the median run took (the
+    /// assignment picks one or more from the previous run's time).
     #[arg(long)]
     pub json: bool,
+}
+
+/// Most threads a `--threads` pool may have.
+const MAX_POOL: usize = 256;
+
+/// Parses a pool size of `--threads`: from 1 to [`MAX_POOL`].
+fn parse_pool_size(s: &str) -> Result<usize, String> {
+    match s.parse::<usize>() {
+        Ok(n) if (1..=MAX_POOL).contains(&n) => Ok(n),
+        _ => Err(format!(
+            "`{s}` is not a number of threads from 1 to {MAX_POOL}"
+        )),
+    }
 }
 
 /// Parses a light count of `--lights`: at most what a scene may hold.
@@ -51,6 +70,11 @@ fn parse_runs(s: &str) -> Result<usize, String> {
 
 /// Runs the command.
 pub fn run(args: &BenchAssignArgs) -> Result<(), Box<dyn std::error::Error>> {
+    let pools = args
+        .threads
+        .iter()
+        .map(|&n| rayon::ThreadPoolBuilder::new().num_threads(n).build())
+        .collect::<Result<Vec<_>, _>>()?;
     let mut rows = Vec::new();
     for &count in &args.lights {
         let work = AssignWorkload::default_view(count, args.seed);
@@ -59,22 +83,42 @@ pub fn run(args: &BenchAssignArgs) -> Result<(), Box<dyn std::error::Error>> {
             None if count > 100_000 => 7,
             None => 101,
         };
-        let timing = work.timing(runs);
-        let (ms, indices, threads) = (timing.median_ms, timing.indices, timing.threads);
-        rows.push(serde_json::json!({
-            "lights": count,
-            "assign_ms": ms,
-            "indices": indices,
-            "clusters": work.grid.total_cells,
-            "runs": runs,
-            "threads": threads,
-        }));
-        if !args.json {
-            print_stdout(&format!(
-                "{count:>9} lights  {ms:>9.3} ms  {indices:>9} indices  (median of {runs} runs, \
-                 on {threads} thread{})\n",
-                if threads == 1 { "" } else { "s" }
-            ))?;
+        let timings = if pools.is_empty() {
+            vec![work.timing(runs)]
+        } else {
+            work.timing_on_pools(&pools, runs)
+        };
+        let first_ms = timings[0].median_ms;
+        for (i, timing) in timings.iter().enumerate() {
+            let (ms, indices, threads) = (timing.median_ms, timing.indices, timing.threads);
+            let mut row = serde_json::json!({
+                "lights": count,
+                "assign_ms": ms,
+                "indices": indices,
+                "clusters": work.grid.total_cells,
+                "runs": runs,
+                "threads": threads,
+            });
+            let pool = args.threads.get(i).copied();
+            if let Some(pool) = pool {
+                row["pool"] = pool.into();
+            }
+            rows.push(row);
+            if !args.json {
+                let on = match pool {
+                    Some(pool) => format!("pool of {pool}, on {threads}"),
+                    None => format!("on {threads}"),
+                };
+                let ratio = match i {
+                    0 => String::new(),
+                    _ => format!("  {:.2}x the pool of {}", ms / first_ms, args.threads[0]),
+                };
+                print_stdout(&format!(
+                    "{count:>9} lights  {ms:>9.3} ms  {indices:>9} indices  (median of {runs} runs, \
+                     {on} thread{}){ratio}\n",
+                    if threads == 1 { "" } else { "s" }
+                ))?;
+            }
         }
     }
     if args.json {
