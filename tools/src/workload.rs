@@ -12,6 +12,9 @@ use manylight::scene;
 /// branch predictors) is markedly slower than a warm one.
 pub const WARM_UP: std::time::Duration = std::time::Duration::from_millis(100);
 
+/// Rounds in which [`AssignWorkload::timing_on_pools`] alternates its pools.
+pub const POOL_ROUNDS: usize = 5;
+
 /// Viewport of the benchmark view.
 pub const BENCH_SIZE: (u32, u32) = (1280, 720);
 
@@ -135,12 +138,7 @@ impl AssignWorkload {
             (0..runs).map(|_| self.timed_run(&mut assigner)).collect();
         median_of(&mut times, indices)
     }
-}
 
-/// Rounds in which [`AssignWorkload::timing_on_pools`] alternates its pools.
-pub const POOL_ROUNDS: usize = 5;
-
-impl AssignWorkload {
     /// [`AssignWorkload::timing`] on each of `pools` (rayon pools: one of one thread and one
     /// of two, say), alternating: in each of [`POOL_ROUNDS`] rounds every pool in turn warms
     /// up (a fifth of [`WARM_UP`], at least one assignment) and times its share of the `runs`,
