@@ -128,14 +128,8 @@ impl AssignWorkload {
     /// [`AssignWorkload::time`], with the threads the median run took.
     pub fn timing(&self, runs: usize) -> AssignTiming {
         let runs = runs.clamp(1, MAX_RUNS);
-        let mut assigner = Assigner::new();
-        let indices = self.assign_with(&mut assigner).indices.len();
-        let start = Instant::now();
-        while start.elapsed() < WARM_UP {
-            std::hint::black_box(self.assign_with(&mut assigner));
-        }
-        let mut times: Vec<(f64, usize)> =
-            (0..runs).map(|_| self.timed_run(&mut assigner)).collect();
+        let mut times = Vec::with_capacity(runs);
+        let indices = self.warm_and_time(&mut Assigner::new(), WARM_UP, runs, &mut times);
         median_of(&mut times, indices)
     }
 
@@ -165,20 +159,12 @@ impl AssignWorkload {
         let mut assigners: Vec<Assigner> = pools.iter().map(|_| Assigner::new()).collect();
         let mut indices = vec![0; pools.len()];
         let mut times: Vec<Vec<(f64, usize)>> = vec![Vec::with_capacity(runs); pools.len()];
+        let warm_up = WARM_UP / POOL_ROUNDS as u32;
         for round in 0..rounds {
             let share = runs * (round + 1) / rounds - runs * round / rounds;
             for (p, pool) in pools.iter().enumerate() {
-                let assigner = &mut assigners[p];
-                let samples = &mut times[p];
-                indices[p] = pool.install(|| {
-                    let indices = self.assign_with(assigner).indices.len();
-                    let start = Instant::now();
-                    while start.elapsed() < WARM_UP / POOL_ROUNDS as u32 {
-                        std::hint::black_box(self.assign_with(assigner));
-                    }
-                    samples.extend((0..share).map(|_| self.timed_run(assigner)));
-                    indices
-                });
+                let (assigner, samples) = (&mut assigners[p], &mut times[p]);
+                indices[p] = pool.install(|| self.warm_and_time(assigner, warm_up, share, samples));
             }
         }
         times
@@ -186,6 +172,24 @@ impl AssignWorkload {
             .zip(indices)
             .map(|(samples, indices)| median_of(samples, indices))
             .collect()
+    }
+
+    /// One assignment, then more untimed ones for `warm_up`, then `runs` timed ones into
+    /// `samples` (wall time in milliseconds, threads taken); the first one's indices.
+    fn warm_and_time(
+        &self,
+        assigner: &mut Assigner,
+        warm_up: std::time::Duration,
+        runs: usize,
+        samples: &mut Vec<(f64, usize)>,
+    ) -> usize {
+        let indices = self.assign_with(assigner).indices.len();
+        let start = Instant::now();
+        while start.elapsed() < warm_up {
+            std::hint::black_box(self.assign_with(assigner));
+        }
+        samples.extend((0..runs).map(|_| self.timed_run(assigner)));
+        indices
     }
 
     /// One assignment's wall time in milliseconds, and the threads it took.
