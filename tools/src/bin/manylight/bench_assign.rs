@@ -41,30 +41,25 @@ const MAX_POOL: usize = 256;
 
 /// Parses a pool size of `--threads`: from 1 to [`MAX_POOL`].
 fn parse_pool_size(s: &str) -> Result<usize, String> {
-    match s.parse::<usize>() {
-        Ok(n) if (1..=MAX_POOL).contains(&n) => Ok(n),
-        _ => Err(format!(
-            "`{s}` is not a number of threads from 1 to {MAX_POOL}"
-        )),
-    }
+    count_within(s, 1, MAX_POOL, "a number of threads")
 }
 
 /// Parses a light count of `--lights`: at most what a scene may hold.
 fn parse_light_count(s: &str) -> Result<usize, String> {
-    let max = manylight::scene::input::MAX_LIGHTS;
-    match s.parse::<usize>() {
-        Ok(n) if n <= max => Ok(n),
-        _ => Err(format!("`{s}` is not a light count from 0 to {max}")),
-    }
+    count_within(s, 0, manylight::scene::input::MAX_LIGHTS, "a light count")
 }
 
 /// Parses `--runs`: from 1 to [`MAX_RUNS`] timed runs.
 fn parse_runs(s: &str) -> Result<usize, String> {
+    count_within(s, 1, MAX_RUNS, "a number of runs")
+}
+
+/// `s` as a whole number from `min` to `max`, or an error saying it is not `what` in that
+/// range.
+fn count_within(s: &str, min: usize, max: usize, what: &str) -> Result<usize, String> {
     match s.parse::<usize>() {
-        Ok(n) if (1..=MAX_RUNS).contains(&n) => Ok(n),
-        _ => Err(format!(
-            "`{s}` is not a number of runs from 1 to {MAX_RUNS}"
-        )),
+        Ok(n) if (min..=max).contains(&n) => Ok(n),
+        _ => Err(format!("`{s}` is not {what} from {min} to {max}")),
     }
 }
 
