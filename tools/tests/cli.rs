@@ -526,9 +526,13 @@ fn bench_assign_times_pools_side_by_side() {
         "{}",
         text(&text_out)
     );
-    let refused = manylight(&["bench-assign", "--threads", "0"], &[], dir.path());
-    assert!(!refused.status.success());
-    assert!(text(&refused).contains("--threads"), "{}", text(&refused));
+    // No pool of no threads, and not more pools than the command keeps at once.
+    let nine = ["1"; 9].join(",");
+    for threads in ["0", nine.as_str()] {
+        let refused = manylight(&["bench-assign", "--threads", threads], &[], dir.path());
+        assert!(!refused.status.success(), "{}", text(&refused));
+        assert!(text(&refused).contains("--threads"), "{}", text(&refused));
+    }
 }
 
 /// The command line's thread (which renders, and so assigns the lights) is one of rayon's pool,

@@ -24,9 +24,10 @@ pub struct BenchAssignArgs {
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
     /// Time each count on rayon pools of these sizes instead of the global pool (comma
-    /// separated, each 1 to 256; `1,2` for one worker against two): the pools take turns in
-    /// five rounds, so a host whose speed drifts drifts under each alike, and each row after
-    /// the first of a count gives its time as a ratio to the first pool's.
+    /// separated, at most 8 pools of 1 to 256 threads each; `1,2` for one worker against
+    /// two): the pools take turns in five rounds, so a host whose speed drifts drifts under
+    /// each alike, and each row after the first of a count gives its time as a ratio to the
+    /// first pool's.
     #[arg(long, value_delimiter = ',', value_parser = parse_pool_size)]
     pub threads: Vec<usize>,
     /// Print JSON (an array of {lights, assign_ms, indices, clusters, runs, threads}, and
@@ -38,6 +39,9 @@ pub struct BenchAssignArgs {
 
 /// Most threads a `--threads` pool may have.
 const MAX_POOL: usize = 256;
+
+/// Most pools `--threads` may list (they all exist at once).
+const MAX_POOLS: usize = 8;
 
 /// Parses a pool size of `--threads`: from 1 to [`MAX_POOL`].
 fn parse_pool_size(s: &str) -> Result<usize, String> {
@@ -65,6 +69,13 @@ fn count_within(s: &str, min: usize, max: usize, what: &str) -> Result<usize, St
 
 /// Runs the command.
 pub fn run(args: &BenchAssignArgs) -> Result<(), Box<dyn std::error::Error>> {
+    if args.threads.len() > MAX_POOLS {
+        return Err(format!(
+            "--threads lists {} pools; at most {MAX_POOLS}",
+            args.threads.len()
+        )
+        .into());
+    }
     let pools = args
         .threads
         .iter()
