@@ -475,7 +475,7 @@ fn bench_assign_prints_json_for_scripts() {
 
 /// `bench-assign --threads 1,2` times each count on a pool of one thread and on one of two,
 /// taking turns: a row per pool, each on no more threads than its pool has, with the same
-/// lists; a pool of no threads is refused.
+/// lists; a pool of no threads, or a ninth pool, is refused.
 #[test]
 fn bench_assign_times_pools_side_by_side() {
     let dir = tempfile::tempdir().unwrap();
