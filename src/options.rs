@@ -13,6 +13,10 @@ pub use crate::scene::shading::ToneMap;
 /// grow memory for as long as it ran (65 536 frames are 18 minutes at 60 frames a second).
 pub const MAX_TIMED_FRAMES: u32 = 1 << 16;
 
+/// Largest [`RenderOptions::exposure_ev`] either way, in stops: 2¹⁵ is what fp16 holds, on
+/// devices without fragment highp.
+pub const MAX_EXPOSURE_EV: f32 = 15.0;
+
 /// Per-call rendering options.
 #[derive(Clone, Debug)]
 pub struct RenderOptions {
@@ -46,7 +50,7 @@ pub struct RenderOptions {
     /// HDR output). [`ToneMap::None`], the default, keeps images the light model's own.
     pub tone_map: ToneMap,
     /// Exposure in stops: radiance is multiplied by 2^`exposure_ev` before the tone map.
-    /// Within ±15 (2^15 is what fp16 holds, on devices without fragment highp).
+    /// Within ±[`MAX_EXPOSURE_EV`].
     pub exposure_ev: f32,
     /// Samples per pixel: 1 (the default) or 0 for none, up to `GL_MAX_SAMPLES` for MSAA (GL
     /// rounds a count the implementation lacks up: `FrameStats::samples` says what it drew).

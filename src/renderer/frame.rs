@@ -13,7 +13,7 @@ use super::stats::{LightStats, MemoryStats, TimeStats};
 use super::{FrameStats, Renderer};
 use crate::gl::framebuffer::ColorFormat;
 use crate::methods::{self, FrameContext};
-use crate::options::{CountKind, RenderOptions};
+use crate::options::{CountKind, RenderOptions, MAX_EXPOSURE_EV};
 use crate::scene::features::SceneFeatures;
 use crate::scene::{Projection, Scene};
 use crate::Error;
@@ -287,9 +287,11 @@ impl Renderer {
 /// Refuses render options the frame cannot be made from, naming the field.
 fn check_options(options: &RenderOptions) -> Result<(), Error> {
     let invalid = |field, why| Err(Error::Scene(crate::scene::SceneError::invalid(field, why)));
-    // 2^15 stays finite in fp16, where a device without fragment highp holds it.
-    if !(options.exposure_ev.is_finite() && options.exposure_ev.abs() <= 15.0) {
-        let why = format!("must be within ±15 stops, got {}", options.exposure_ev);
+    if !(options.exposure_ev.is_finite() && options.exposure_ev.abs() <= MAX_EXPOSURE_EV) {
+        let why = format!(
+            "must be within ±{MAX_EXPOSURE_EV} stops, got {}",
+            options.exposure_ev
+        );
         return invalid("exposure_ev", why);
     }
     // Non-finite grid settings: a NaN never equals itself, so the grid would be rebuilt and

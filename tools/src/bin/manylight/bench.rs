@@ -35,8 +35,8 @@ pub struct BenchArgs {
     /// Folder for report.json, report.md, the charts, heatmaps and diff images.
     #[arg(long, default_value = "bench-report")]
     pub out: PathBuf,
-    /// Scenes (built-in names, .obj or .json files), comma separated. Default: the built-ins,
-    /// and the conference room when $MANYLIGHT_ASSETS has it.
+    /// Scenes (built-in names, .obj, .gltf/.glb or .json files), comma separated. Default: the
+    /// built-ins, and the conference room when $MANYLIGHT_ASSETS has it.
     #[arg(long, value_delimiter = ',')]
     pub scenes: Vec<String>,
     /// Light counts, comma separated (default 0,8,64,256,1024,4096).

@@ -40,8 +40,8 @@ pub struct BenchAssignArgs {
 /// Most threads a `--threads` pool may have.
 const MAX_POOL: usize = 256;
 
-/// Most pools `--threads` may list (they all exist at once).
-const MAX_POOLS: usize = 8;
+/// Most pools `--threads` may list (they all exist at once; more is a usage error).
+pub const MAX_POOLS: usize = 8;
 
 /// Parses a pool size of `--threads`: from 1 to [`MAX_POOL`].
 fn parse_pool_size(s: &str) -> Result<usize, String> {
@@ -69,13 +69,6 @@ fn count_within(s: &str, min: usize, max: usize, what: &str) -> Result<usize, St
 
 /// Runs the command.
 pub fn run(args: &BenchAssignArgs) -> Result<(), Box<dyn std::error::Error>> {
-    if args.threads.len() > MAX_POOLS {
-        return Err(format!(
-            "--threads lists {} pools; at most {MAX_POOLS}",
-            args.threads.len()
-        )
-        .into());
-    }
     let pools = args
         .threads
         .iter()

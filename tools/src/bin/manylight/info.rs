@@ -17,8 +17,9 @@ pub struct InfoArgs {
     /// Print JSON instead of text.
     #[arg(long)]
     pub json: bool,
-    /// Also render this scene (built-in, .obj or .json) once with every supported method and
-    /// report the shader variants built (features, source size) and each method's GPU memory.
+    /// Also render this scene (built-in, .obj, .gltf/.glb or .json) once with every supported
+    /// method and report the shader variants built (features, source size) and each method's
+    /// GPU memory.
     #[arg(long)]
     pub scene: Option<String>,
     /// Play a device whose fragment stage has no highp (needs `--es 2`; see `render`).

@@ -167,6 +167,20 @@ fn check_usage(cli: &Cli) {
             check_outside_folder(&[out, stats], ("--record", folder));
         }
     }
+    if let Some(Command::BenchAssign(a)) = &cli.command {
+        if a.threads.len() > bench_assign::MAX_POOLS {
+            Cli::command()
+                .error(
+                    ErrorKind::ValueValidation,
+                    format!(
+                        "--threads lists {} pools; at most {} (each pool's threads exist at once)",
+                        a.threads.len(),
+                        bench_assign::MAX_POOLS
+                    ),
+                )
+                .exit();
+        }
+    }
     if let Some(Command::Matrix(a)) = &cli.command {
         let json = a.json.as_deref().map(|p| ("--json", p));
         let sheet = a.out.as_ref().map(|p| p.join("matrix.png"));

@@ -76,7 +76,7 @@ pub struct RenderArgs {
     #[arg(long, default_value_t = 1, value_parser = parse_samples)]
     pub msaa: u32,
     /// Exposure in stops (radiance × 2^EV before the tone map), within ±15.
-    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true, value_parser = parse_exposure)]
     pub exposure: f32,
     /// Cell footprint of the clustered grid in pixels, or `auto` (chosen per frame from a
     /// cost model calibrated on this device; `--stats` says which and why).
@@ -182,6 +182,17 @@ pub fn parse_time(s: &str) -> Result<f64, String> {
     match s.parse::<f64>() {
         Ok(t) if t.is_finite() && t.abs() <= 1e9 => Ok(t),
         _ => Err(format!("`{s}` is not a time in seconds within ±1e9")),
+    }
+}
+
+/// Parses `--exposure`: finite stops within what the renderer takes.
+pub fn parse_exposure(s: &str) -> Result<f32, String> {
+    match s.parse::<f32>() {
+        Ok(ev) if ev.is_finite() && ev.abs() <= manylight::MAX_EXPOSURE_EV => Ok(ev),
+        _ => Err(format!(
+            "`{s}` is not an exposure in stops within ±{}",
+            manylight::MAX_EXPOSURE_EV
+        )),
     }
 }
 
