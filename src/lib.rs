@@ -12,7 +12,7 @@
 //!   [`Renderer::render_offscreen`] into an image; [`Renderer::set_method`] picks forward,
 //!   tiled, clustered (the default), deferred or auto.
 //! - A [`Scene`]: [`builtin_scene`] or [`load_scene`] (OBJ, glTF, JSON scene files;
-//!   [`load_scene_with`] and [`LoadOptions`] let a trusted glTF read outside its folder), or built
+//!   [`load_scene_with`] and [`LoadOptions`] let a trusted model read outside its folder), or built
 //!   in code with [`Scene::add_material`], [`MeshBuilder`], [`Scene::add_object`],
 //!   [`Light::point`] and [`Light::spot`]; [`Scene::set_time`] poses moving lights
 //!   ([`motion`]).

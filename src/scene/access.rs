@@ -1,8 +1,9 @@
 //! Which files a model may read besides itself. A glTF file names its buffers and images by
-//! URI; an untrusted model must not read the user's other files through them, so by default
-//! a URI may name only a file inside the glTF file's own folder: no `..`, no absolute path
-//! (`/x`, `C:/x`, `\\server\x`), no link that leads out of the folder. [`LoadOptions`] lifts
-//! this for trusted local content. Scene files and command lines name models anywhere: they
+//! URI, an OBJ file its material libraries and their textures by path; an untrusted model must
+//! not read the user's other files through them, so by default such a name may name only a
+//! file inside the model file's own folder: no `..`, no absolute path (`/x`, `C:/x`,
+//! `\\server\x`), no link that leads out of the folder. [`LoadOptions`] lifts this for trusted
+//! local content. Scene files and command lines name models anywhere: they
 //! are the user's own.
 
 use std::path::{Path, PathBuf};
@@ -11,8 +12,9 @@ use std::path::{Path, PathBuf};
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 #[non_exhaustive]
 pub struct LoadOptions {
-    /// Let a glTF file's buffer and image URIs name files outside the glTF file's folder
-    /// (`../x`, absolute paths, links leading out). Off by default: a downloaded model must
+    /// Let a model's own references (a glTF file's buffer and image URIs, an OBJ file's
+    /// `mtllib` and texture paths) name files outside the model's folder (`../x`, absolute
+    /// paths, links leading out). Off by default: a downloaded model must
     /// not read the user's files. Turn it on only for trusted local content.
     pub allow_outside_files: bool,
 }

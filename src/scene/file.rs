@@ -265,7 +265,7 @@ pub fn load(
 
 /// Parses scene-file text; relative paths are resolved against `base_dir`, `origin` names the
 /// source in errors. The models it names may lie anywhere (`../models/a.glb`): a scene file is
-/// the user's own, like a command line; what a glTF file itself names follows `options`.
+/// the user's own, like a command line; what a model file itself names follows `options`.
 pub fn parse(
     text: &str,
     base_dir: &Path,
@@ -280,7 +280,7 @@ pub fn parse(
     let mut scene = Scene::empty();
     let mut report = LoadReport::default();
     let mut builtin_camera = None;
-    let mut models = ModelCache::default();
+    let mut models = ModelCache::new(*options);
     for (i, spec) in file.objects.iter().enumerate() {
         let field = format!("objects[{i}]");
         let transform = spec
@@ -336,7 +336,6 @@ pub fn parse(
                     transform,
                     spec.color.is_some(),
                     &format!("{field}.transform"),
-                    options,
                 )?;
                 if let Some(camera) = loaded.camera {
                     builtin_camera.get_or_insert(camera);

@@ -121,6 +121,8 @@ impl Loaded {
 /// The models one scene file has loaded, by canonical path (and texture override for OBJ).
 #[derive(Default)]
 pub(super) struct ModelCache {
+    /// How the models' own references are read.
+    options: LoadOptions,
     obj: HashMap<(PathBuf, Option<PathBuf>), Loaded>,
     /// glTF files without lights or cameras, read at the identity; `None`: read per reference.
     gltf: HashMap<PathBuf, Option<Loaded>>,
@@ -132,6 +134,14 @@ pub(super) struct ModelCache {
 }
 
 impl ModelCache {
+    /// An empty cache whose models read their references by `options`.
+    pub fn new(options: LoadOptions) -> ModelCache {
+        ModelCache {
+            options,
+            ..ModelCache::default()
+        }
+    }
+
     /// A built-in scene's geometry, built on first use (later ones share its meshes).
     pub fn builtin(&mut self, name: &str) -> Option<Scene> {
         self.builtin
@@ -162,7 +172,7 @@ impl ModelCache {
         let first = (scene.objects.len(), scene.materials.len());
         // Loaded at the identity: each object's transform is then its own (its mesh is stored
         // about its centre), recorded once and placed below.
-        let report = obj::load_into(scene, path, DMat4::IDENTITY, texture)?;
+        let report = obj::load_into(scene, path, DMat4::IDENTITY, texture, &self.options)?;
         self.share(scene, first.0, first.1, key.as_ref().map(|k| &k.0));
         if let Some(key) = key {
             let mut loaded = Loaded::record(scene, first, |o| o.transform, false);
@@ -185,7 +195,6 @@ impl ModelCache {
         transform: DMat4,
         recolour: bool,
         transform_field: &str,
-        options: &LoadOptions,
     ) -> Result<super::gltf::GltfLoad, SceneError> {
         let key = std::fs::canonicalize(path).ok();
         if let Some(k) = &key {
@@ -196,7 +205,7 @@ impl ModelCache {
                     path,
                     DMat4::IDENTITY,
                     transform_field,
-                    options,
+                    &self.options,
                 );
                 let entry = match read {
                     Ok(read) if alone.lights.is_empty() && read.camera.is_none() => {
@@ -221,7 +230,8 @@ impl ModelCache {
             }
         }
         let (first_object, first_material) = (scene.objects.len(), scene.materials.len());
-        let mut loaded = super::gltf::load_into(scene, path, transform, transform_field, options)?;
+        let mut loaded =
+            super::gltf::load_into(scene, path, transform, transform_field, &self.options)?;
         if self.share(scene, first_object, first_material, key.as_ref()) {
             loaded.report.warnings.clear();
         }

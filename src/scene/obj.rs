@@ -7,6 +7,11 @@
 //! name, case-insensitively, in the MTL's folder. A texture that is still not found, or that
 //! does not decode, is a warning and the material falls back to its flat `Kd` colour — the load
 //! never aborts for a texture.
+//!
+//! A model reads only files in its own folder (the OBJ's), as a glTF does (`access.rs`):
+//! an `mtllib` or texture named by `..` or an absolute path, or a link leading out, is refused
+//! with a warning unless [`LoadOptions::allow_outside_files`]. A texture named outside (an
+//! exporter's `C:\Users\…\wood.png`) is still looked for by its bare file name in the folder.
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -14,6 +19,7 @@ use std::sync::Arc;
 
 use glam::{DMat4, DVec3, Vec2, Vec3};
 
+use super::access::{self, LoadOptions};
 use super::input::{read_bounded, FileKind};
 use super::material::MAX_COLOR_FACTOR;
 use super::{Aabb, Material, Mesh, Object, Scene, SceneError, Texture};
@@ -27,15 +33,17 @@ pub struct LoadReport {
 
 /// Loads an OBJ file (and its MTL) into `scene`, placing it with `transform`. Returns the
 /// warnings. `texture_override` binds a diffuse texture to every material (for models that
-/// ship a texture but no MTL).
+/// ship a texture but no MTL; the caller's own file, so not confined to the model's folder).
 pub fn load_into(
     scene: &mut Scene,
     path: &Path,
     transform: DMat4,
     texture_override: Option<&Path>,
+    options: &LoadOptions,
 ) -> Result<LoadReport, SceneError> {
     let mut report = LoadReport::default();
-    let (models, materials, not_utf8) = parse_obj(path)?;
+    let allow_outside = options.allow_outside_files;
+    let (models, materials, not_utf8) = parse_obj(path, allow_outside)?;
     if not_utf8 {
         report.warn(format!(
             "{}: not UTF-8 text; bytes that are not (in names) were replaced by U+FFFD",
@@ -64,23 +72,33 @@ pub fn load_into(
     let first = scene.materials.len();
     for m in &mtl {
         let texture = match &m.diffuse_texture {
-            Some(name) if !name.trim().is_empty() => match resolve_texture(base_dir, name) {
-                Some(p) => textures.load(&p, &mut report),
-                None => {
-                    // Something there that is not a file (`/dev/zero`, a folder) is named so.
-                    let what = if base_dir.join(name.trim()).exists() {
-                        "is not a regular file"
-                    } else {
-                        "not found"
-                    };
-                    report.warn(format!(
-                        "material `{}`: texture `{name}` {what} next to {}; using its flat colour",
-                        m.name,
-                        path.display()
-                    ));
-                    None
+            Some(name) if !name.trim().is_empty() => {
+                match find_texture(base_dir, name, allow_outside) {
+                    Ok(Some(p)) => textures.load(&p, &mut report),
+                    Ok(None) => {
+                        // Something there that is not a file (`/dev/zero`, a folder) is named so.
+                        let what = if base_dir.join(name.trim()).exists() {
+                            "is not a regular file"
+                        } else {
+                            "not found"
+                        };
+                        report.warn(format!(
+                            "material `{}`: texture `{name}` {what} next to {}; using its flat \
+                             colour",
+                            m.name,
+                            path.display()
+                        ));
+                        None
+                    }
+                    Err(refusal) => {
+                        report.warn(format!(
+                            "material `{}`: texture {refusal}; using its flat colour",
+                            m.name
+                        ));
+                        None
+                    }
                 }
-            },
+            }
             _ => None,
         };
         let mut factor = |key: &str, value: Option<[f64; 3]>, default: f32| {
@@ -190,7 +208,7 @@ fn text_of(bytes: &[u8]) -> (String, bool) {
     (text, not_utf8)
 }
 
-fn parse_obj(path: &Path) -> Result<Parsed, SceneError> {
+fn parse_obj(path: &Path, allow_outside: bool) -> Result<Parsed, SceneError> {
     let (text, not_utf8) = text_of(&read_bounded(path, FileKind::Model)?);
     check_face_indices(&text).map_err(|reason| SceneError::Obj {
         path: path.to_path_buf(),
@@ -207,7 +225,12 @@ fn parse_obj(path: &Path) -> Result<Parsed, SceneError> {
     // a file repeating the line millions of times would exhaust memory.
     let seen = std::cell::RefCell::new(std::collections::HashSet::new());
     let load_mtl = |name: &Path| -> tobj::MTLLoadResult {
-        let mtl_path = base_dir.join(name);
+        let mtl_path = access::join(&base_dir, &name.to_string_lossy(), allow_outside)
+            .and_then(|p| access::resolve(&base_dir, &p, allow_outside).map(|_| p))
+            .map_err(|refusal| {
+                log::warn!("{}: mtllib {refusal}", path.display());
+                tobj::LoadError::OpenFileFailed
+            })?;
         if !seen.borrow_mut().insert(mtl_path.clone()) {
             return Ok(Default::default());
         }
@@ -455,6 +478,40 @@ impl TextureCache {
     }
 }
 
+/// The file an MTL texture reference names, inside `base_dir` (links resolved) unless
+/// `allow_outside`: `Ok(None)` when none is found, `Err` with the refusal when the name leads
+/// out of the folder and its bare file name is not in it either.
+fn find_texture(
+    base_dir: &Path,
+    name: &str,
+    allow_outside: bool,
+) -> Result<Option<PathBuf>, String> {
+    let Some(written) = name.split_whitespace().last() else {
+        return Ok(None);
+    };
+    let written = written.replace('\\', "/");
+    let found = match access::join(base_dir, &written, allow_outside) {
+        Ok(_) => resolve_texture(base_dir, name),
+        Err(refusal) => match bare_file_in(base_dir, &written) {
+            Some(p) => Some(p),
+            None => return Err(refusal),
+        },
+    };
+    // Checked with its links resolved, kept as found (its name in messages stays the model's).
+    found
+        .map(|p| access::resolve(base_dir, &p, allow_outside).map(|_| p))
+        .transpose()
+}
+
+/// The file `name`'s last component names in `dir` (in any letter case), if it is one.
+fn bare_file_in(dir: &Path, name: &str) -> Option<PathBuf> {
+    let file_name = name
+        .rsplit('/')
+        .next()
+        .filter(|n| !n.is_empty() && *n != "..")?;
+    find_case_insensitive(dir, file_name).filter(|p| p.is_file())
+}
+
 /// Finds the file an MTL texture reference means (see the module docs for the order).
 pub fn resolve_texture(base_dir: &Path, name: &str) -> Option<PathBuf> {
     // MTL options such as `-bm 0.5 file.png` put the file name last.
@@ -516,6 +573,75 @@ mod tests {
             Some(want)
         );
         assert_eq!(resolve_texture(dir.path(), "missing.png"), None);
+    }
+
+    /// A model folder inside a temporary root holding `secret.png` and `secret.mtl`.
+    fn model_beside_secrets() -> (tempfile::TempDir, PathBuf) {
+        let root = tempfile::tempdir().unwrap();
+        let model = root.path().join("model");
+        std::fs::create_dir(&model).unwrap();
+        image::RgbaImage::from_pixel(2, 2, image::Rgba([255, 0, 0, 255]))
+            .save(root.path().join("secret.png"))
+            .unwrap();
+        std::fs::write(root.path().join("secret.mtl"), "newmtl red\nKd 1 0 0\n").unwrap();
+        (root, model)
+    }
+
+    #[test]
+    fn textures_outside_the_models_folder_are_refused_unless_allowed() {
+        let (root, model) = model_beside_secrets();
+        let secret = root.path().join("secret.png");
+        let absolute = secret.to_str().unwrap().to_string();
+        for name in ["../secret.png", "./../secret.png", absolute.as_str()] {
+            let refusal = find_texture(&model, name, false).unwrap_err();
+            assert!(
+                refusal.contains("outside the model's folder"),
+                "{name}: {refusal}"
+            );
+            assert!(
+                find_texture(&model, name, true).unwrap().is_some(),
+                "{name}"
+            );
+        }
+        #[cfg(unix)]
+        {
+            std::os::unix::fs::symlink(&secret, model.join("link.png")).unwrap();
+            let refusal = find_texture(&model, "link.png", false).unwrap_err();
+            assert!(refusal.contains("a link leads out"), "{refusal}");
+            assert!(find_texture(&model, "link.png", true).unwrap().is_some());
+        }
+        // An exporter's absolute path is still found by its file name in the folder.
+        std::fs::write(model.join("wood.png"), b"x").unwrap();
+        let found = find_texture(&model, "C:\\Users\\bob\\Wood.PNG", false).unwrap();
+        assert_eq!(found, Some(model.join("wood.png")));
+        let found = find_texture(&model, "/home/bob/maps/wood.png", false).unwrap();
+        assert_eq!(found, Some(model.join("wood.png")));
+        assert_eq!(find_texture(&model, "missing.png", false).unwrap(), None);
+    }
+
+    #[test]
+    fn a_material_library_outside_the_models_folder_is_refused_unless_allowed() {
+        let (_root, model) = model_beside_secrets();
+        let obj = model.join("m.obj");
+        let faces = "v 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl red\nf 1 2 3\n";
+        std::fs::write(&obj, format!("mtllib ../secret.mtl\n{faces}")).unwrap();
+        let diffuse = |allow_outside_files| {
+            let mut scene = Scene::empty();
+            let options = LoadOptions {
+                allow_outside_files,
+            };
+            let report = load_into(&mut scene, &obj, DMat4::IDENTITY, None, &options).unwrap();
+            let material = scene.objects[0].material;
+            (scene.materials[material].diffuse, report.warnings)
+        };
+        let (refused, warnings) = diffuse(false);
+        assert_eq!(refused, Vec3::splat(0.8), "the default grey");
+        assert!(
+            warnings.iter().any(|w| w.contains("materials not loaded")),
+            "{warnings:?}"
+        );
+        let (allowed, _) = diffuse(true);
+        assert_eq!(allowed, Vec3::new(1.0, 0.0, 0.0));
     }
 
     #[test]

@@ -600,9 +600,23 @@ fn hostile_files_and_counts_are_refused_quickly_and_clearly() {
     // (arguments, environment, text the output must contain, exit status)
     type Case<'a> = (Vec<&'a str>, &'a [(&'a str, &'a str)], &'a str, i32);
     let mut cases: Vec<Case> = vec![
-        // A material library that never ends: a warning, the flat default, a rendered frame.
+        // A material library outside the model's folder: refused with a warning naming it.
         (
             vec!["render", "--scene", "zero.obj", "--lights", "2"],
+            &[],
+            "`/dev/zero` is outside the model's folder",
+            0,
+        ),
+        // Allowed, it never ends: a warning, the flat default, a rendered frame.
+        (
+            vec![
+                "render",
+                "--scene",
+                "zero.obj",
+                "--lights",
+                "2",
+                "--allow-outside-files",
+            ],
             &[],
             "/dev/zero",
             0,

@@ -54,9 +54,10 @@ struct Cli {
     /// `system` for the system's libraries.
     #[arg(long, global = true, value_name = "DIR")]
     gles_lib: Vec<std::path::PathBuf>,
-    /// Let a glTF model's buffer and image URIs name files outside the model's folder
-    /// (`../x`, absolute paths, links leading out). Refused by default: an untrusted model must
-    /// not read your files. Only for models you trust.
+    /// Let a model's references (glTF buffer and image URIs, OBJ mtllib and texture paths)
+    /// name files outside the model's folder (`../x`, absolute paths, links leading out).
+    /// Refused by default: an untrusted model must not read your files. Only for models you
+    /// trust.
     #[arg(long, global = true)]
     allow_outside_files: bool,
     /// With no subcommand, `render`'s options apply: `manylight --lights 64` renders.
