@@ -361,7 +361,15 @@ pub fn load_with(
                 input::check_light_count(count, "lights")?;
             }
             let mut scene = Scene::empty();
-            let report = obj::load_into(&mut scene, path, DMat4::IDENTITY, None, options)?;
+            let mut textures = texture_budget::TextureBudget::default();
+            let report = obj::load_into(
+                &mut scene,
+                path,
+                DMat4::IDENTITY,
+                None,
+                options,
+                &mut textures,
+            )?;
             scene.frame_camera();
             if let (Some((count, seed)), Some(bounds)) = (lights, scene.bounds()) {
                 let volume = random::model_light_volume(&bounds);

@@ -16,6 +16,7 @@ use glam::DMat4;
 use super::access::LoadOptions;
 use super::camera::MAX_CAMERA_COORD;
 use super::obj::{self, LoadReport};
+use super::texture_budget::TextureBudget;
 use super::{Aabb, Material, Mesh, Object, Scene, SceneError, Texture};
 
 /// Most objects a scene file may place (all its references together), the per-file limit of
@@ -123,6 +124,8 @@ impl Loaded {
 pub(super) struct ModelCache {
     /// How the models' own references are read.
     options: LoadOptions,
+    /// What is left of the scene's texture memory.
+    texture_budget: TextureBudget,
     obj: HashMap<(PathBuf, Option<PathBuf>), Loaded>,
     /// glTF files without lights or cameras, read at the identity; `None`: read per reference.
     gltf: HashMap<PathBuf, Option<Loaded>>,
@@ -172,7 +175,14 @@ impl ModelCache {
         let first = (scene.objects.len(), scene.materials.len());
         // Loaded at the identity: each object's transform is then its own (its mesh is stored
         // about its centre), recorded once and placed below.
-        let report = obj::load_into(scene, path, DMat4::IDENTITY, texture, &self.options)?;
+        let report = obj::load_into(
+            scene,
+            path,
+            DMat4::IDENTITY,
+            texture,
+            &self.options,
+            &mut self.texture_budget,
+        )?;
         self.share(scene, first.0, first.1, key.as_ref().map(|k| &k.0));
         if let Some(key) = key {
             let mut loaded = Loaded::record(scene, first, |o| o.transform, false);
@@ -200,12 +210,14 @@ impl ModelCache {
         if let Some(k) = &key {
             if !self.gltf.contains_key(k) {
                 let mut alone = Scene::empty();
+                let budget_before = self.texture_budget;
                 let read = super::gltf::load_into(
                     &mut alone,
                     path,
                     DMat4::IDENTITY,
                     transform_field,
                     &self.options,
+                    &mut self.texture_budget,
                 );
                 let entry = match read {
                     Ok(read) if alone.lights.is_empty() && read.camera.is_none() => {
@@ -213,7 +225,11 @@ impl ModelCache {
                         let loaded = Loaded::record(&alone, (0, 0), |o| o.transform, true);
                         Some((loaded, read.report))
                     }
-                    _ => None,
+                    // Read again per reference below: this read's textures are dropped.
+                    _ => {
+                        self.texture_budget = budget_before;
+                        None
+                    }
                 };
                 let (loaded, report) = entry.unzip();
                 self.gltf.insert(k.clone(), loaded);
@@ -230,8 +246,14 @@ impl ModelCache {
             }
         }
         let (first_object, first_material) = (scene.objects.len(), scene.materials.len());
-        let mut loaded =
-            super::gltf::load_into(scene, path, transform, transform_field, &self.options)?;
+        let mut loaded = super::gltf::load_into(
+            scene,
+            path,
+            transform,
+            transform_field,
+            &self.options,
+            &mut self.texture_budget,
+        )?;
         if self.share(scene, first_object, first_material, key.as_ref()) {
             loaded.report.warnings.clear();
         }
@@ -249,13 +271,21 @@ impl ModelCache {
         first_material: usize,
         path: Option<&PathBuf>,
     ) -> bool {
-        // Every texture slot: a model named many times holds each image once.
+        // Every texture slot: a model named many times holds each image once, and a copy
+        // dropped for the one held gives its memory back to the budget (once per copy).
+        let mut dropped = std::collections::HashSet::new();
         for t in scene.materials[first_material..]
             .iter_mut()
             .flat_map(|m| m.diffuse_texture.iter_mut().chain(m.maps.textures_mut()))
         {
             match self.textures.get(&t.name) {
-                Some(known) if known.image == t.image => *t = known.clone(),
+                Some(known) if Arc::ptr_eq(known, t) => {}
+                Some(known) if known.image == t.image => {
+                    if dropped.insert(Arc::as_ptr(t)) {
+                        self.texture_budget.give_back(t.image.as_raw().len() as u64);
+                    }
+                    *t = known.clone();
+                }
                 Some(_) => {}
                 None => {
                     self.textures.insert(t.name.clone(), t.clone());

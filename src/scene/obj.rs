@@ -22,6 +22,7 @@ use glam::{DMat4, DVec3, Vec2, Vec3};
 use super::access::{self, LoadOptions};
 use super::input::{read_bounded, FileKind};
 use super::material::MAX_COLOR_FACTOR;
+use super::texture_budget::TextureBudget;
 use super::{Aabb, Material, Mesh, Object, Scene, SceneError, Texture};
 
 /// What an OBJ load produced besides the objects: non-fatal problems, for the caller to show.
@@ -34,12 +35,14 @@ pub struct LoadReport {
 /// Loads an OBJ file (and its MTL) into `scene`, placing it with `transform`. Returns the
 /// warnings. `texture_override` binds a diffuse texture to every material (for models that
 /// ship a texture but no MTL; the caller's own file, so not confined to the model's folder).
+/// The textures kept take their part of `budget` (the whole scene's).
 pub fn load_into(
     scene: &mut Scene,
     path: &Path,
     transform: DMat4,
     texture_override: Option<&Path>,
     options: &LoadOptions,
+    budget: &mut TextureBudget,
 ) -> Result<LoadReport, SceneError> {
     let mut report = LoadReport::default();
     let allow_outside = options.allow_outside_files;
@@ -58,7 +61,7 @@ pub fn load_into(
     }
     let base_dir = path.parent().unwrap_or(Path::new("."));
     let mut textures = TextureCache::default();
-    let override_tex = texture_override.and_then(|p| textures.load(p, &mut report));
+    let override_tex = texture_override.and_then(|p| textures.load(p, &mut report, budget));
     let mtl = match materials {
         Ok(m) => m,
         Err(e) => {
@@ -74,7 +77,7 @@ pub fn load_into(
         let texture = match &m.diffuse_texture {
             Some(name) if !name.trim().is_empty() => {
                 match find_texture(base_dir, name, allow_outside) {
-                    Ok(Some(p)) => textures.load(&p, &mut report),
+                    Ok(Some(p)) => textures.load(&p, &mut report, budget),
                     Ok(None) => {
                         // Something there that is not a file (`/dev/zero`, a folder) is named so.
                         let what = if base_dir.join(name.trim()).exists() {
@@ -411,28 +414,44 @@ fn check_mtl(text: &str) -> Result<(), String> {
 }
 
 /// Decodes a texture file read within its size limit, refusing images whose decoded size
-/// would pass [`MAX_TEXTURE_SIDE`] on a side (a small PNG can claim 100 000² pixels).
-fn decode_texture(path: &Path) -> Result<image::DynamicImage, String> {
-    let bytes = read_bounded(path, FileKind::Texture).map_err(|e| e.to_string())?;
+/// would pass [`MAX_TEXTURE_SIDE`] on a side (a small PNG can claim 100 000² pixels), and
+/// images past what is left of `budget`. The error completes "texture NAME …".
+fn decode_texture(path: &Path, budget: &mut TextureBudget) -> Result<image::DynamicImage, String> {
+    let bytes =
+        read_bounded(path, FileKind::Texture).map_err(|e| format!("could not be decoded ({e})"))?;
     // The extension first: TGA has no magic bytes to guess from.
-    decode_texture_bytes(bytes, image::ImageFormat::from_path(path).ok())
+    decode_texture_bytes(&bytes, image::ImageFormat::from_path(path).ok(), budget)
 }
 
 /// Decodes an encoded texture (OBJ and glTF alike): the stated format first, the contents
 /// decide otherwise; at most [`MAX_TEXTURE_SIDE`] pixels a side and
 /// [`MAX_DECODE_BYTES`](super::texture_budget::MAX_DECODE_BYTES) decoded, so a header claiming
-/// a giant image fails before any allocation.
+/// a giant image fails before any allocation; and only where what it is kept as fits what is
+/// left of `budget` (its header says, before anything is decoded). The error completes
+/// "texture NAME …".
 pub(crate) fn decode_texture_bytes(
-    bytes: impl AsRef<[u8]>,
+    bytes: &[u8],
     format: Option<image::ImageFormat>,
+    budget: &mut TextureBudget,
 ) -> Result<image::DynamicImage, String> {
-    let mut reader = image::ImageReader::new(std::io::Cursor::new(bytes));
-    if let Some(format) = format {
-        reader.set_format(format);
-    }
-    let mut reader = reader.with_guessed_format().map_err(|e| e.to_string())?;
-    reader.limits(super::texture_budget::limits());
-    reader.decode().map_err(|e| e.to_string())
+    let undecodable = |e: image::ImageError| format!("could not be decoded ({e})");
+    let reader = || {
+        let mut reader = image::ImageReader::new(std::io::Cursor::new(bytes));
+        if let Some(format) = format {
+            reader.set_format(format);
+        }
+        let mut reader = reader
+            .with_guessed_format()
+            .map_err(|e| format!("could not be decoded ({e})"))?;
+        reader.limits(super::texture_budget::limits());
+        Ok::<_, String>(reader)
+    };
+    let (w, h) = reader()?.into_dimensions().map_err(undecodable)?;
+    let taken = budget.take(w, h)?;
+    reader()?.decode().map_err(|e| {
+        budget.give_back(taken);
+        undecodable(e)
+    })
 }
 
 /// Largest texture side decoded, in pixels (the largest `GL_MAX_TEXTURE_SIZE` common on phones;
@@ -452,11 +471,16 @@ struct TextureCache {
 }
 
 impl TextureCache {
-    fn load(&mut self, path: &Path, report: &mut LoadReport) -> Option<Arc<Texture>> {
+    fn load(
+        &mut self,
+        path: &Path,
+        report: &mut LoadReport,
+        budget: &mut TextureBudget,
+    ) -> Option<Arc<Texture>> {
         if let Some(t) = self.loaded.get(path) {
             return t.clone();
         }
-        let tex = match decode_texture(path) {
+        let tex = match decode_texture(path, budget) {
             Ok(img) => {
                 let name = path.display().to_string();
                 let (image, scaled) = super::texture_budget::to_rgba8(img, &name);
@@ -465,9 +489,9 @@ impl TextureCache {
                 }
                 Some(Arc::new(Texture { name, image }))
             }
-            Err(e) => {
+            Err(why) => {
                 report.warn(format!(
-                    "texture {} could not be decoded ({e}); using the flat colour",
+                    "texture {} {why}; using the flat colour",
                     path.display()
                 ));
                 None
@@ -630,7 +654,16 @@ mod tests {
             let options = LoadOptions {
                 allow_outside_files,
             };
-            let report = load_into(&mut scene, &obj, DMat4::IDENTITY, None, &options).unwrap();
+            let mut budget = TextureBudget::default();
+            let report = load_into(
+                &mut scene,
+                &obj,
+                DMat4::IDENTITY,
+                None,
+                &options,
+                &mut budget,
+            )
+            .unwrap();
             let material = scene.objects[0].material;
             (scene.materials[material].diffuse, report.warnings)
         };
@@ -642,6 +675,48 @@ mod tests {
         );
         let (allowed, _) = diffuse(true);
         assert_eq!(allowed, Vec3::new(1.0, 0.0, 0.0));
+    }
+
+    #[test]
+    fn textures_past_the_scenes_budget_are_left_out_with_a_warning() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut mtl = String::new();
+        let mut obj = String::from("mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\n");
+        for i in 0..3 {
+            image::RgbaImage::from_pixel(2, 2, image::Rgba([i * 100, 0, 0, 255]))
+                .save(dir.path().join(format!("t{i}.png")))
+                .unwrap();
+            mtl += &format!("newmtl m{i}\nKd 1 1 1\nmap_Kd t{i}.png\n");
+            obj += &format!("usemtl m{i}\nf 1 2 3\n");
+        }
+        std::fs::write(dir.path().join("m.mtl"), mtl).unwrap();
+        std::fs::write(dir.path().join("m.obj"), obj).unwrap();
+        let mut scene = Scene::empty();
+        // Room for two 2 × 2 RGBA8 textures, not three.
+        let mut budget = TextureBudget::with_left(2 * 16 + 15);
+        let options = LoadOptions::default();
+        let path = dir.path().join("m.obj");
+        let report = load_into(
+            &mut scene,
+            &path,
+            DMat4::IDENTITY,
+            None,
+            &options,
+            &mut budget,
+        )
+        .unwrap();
+        let textured: Vec<bool> = scene.materials[..3]
+            .iter()
+            .map(|m| m.diffuse_texture.is_some())
+            .collect();
+        assert_eq!(textured, [true, true, false]);
+        assert_eq!(budget, TextureBudget::with_left(15));
+        let left_out: Vec<_> = report
+            .warnings
+            .iter()
+            .filter(|w| w.contains("t2.png is left out"))
+            .collect();
+        assert_eq!(left_out.len(), 1, "{:?}", report.warnings);
     }
 
     #[test]

@@ -59,6 +59,65 @@ pub fn to_rgba8(image: DynamicImage, name: &str) -> (image::RgbaImage, Option<St
     (scaled.into_rgba8(), Some(warning))
 }
 
+/// Most bytes the textures of one scene load keep (RGBA8, each within
+/// [`MAX_STORED_TEXTURE_SIDE`]): 16 images of 4096², 256 of 1024². More than a phone's GPU
+/// holds; without a total, a few megabytes of PNGs (each one colour, so each compresses to
+/// kilobytes) named by distinct materials took 15 GB. A texture past it is left out with a
+/// warning and its material keeps its flat colour.
+pub const MAX_SCENE_TEXTURE_BYTES: u64 = 1 << 30;
+
+/// What is left of one scene load's [`MAX_SCENE_TEXTURE_BYTES`]: every texture a load keeps
+/// takes its part before it is decoded.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct TextureBudget {
+    left: u64,
+}
+
+impl Default for TextureBudget {
+    fn default() -> Self {
+        TextureBudget {
+            left: MAX_SCENE_TEXTURE_BYTES,
+        }
+    }
+}
+
+impl TextureBudget {
+    /// Nothing left: what a loader holds while its budget is lent out (an interrupted load
+    /// never hands back a fresh one).
+    pub(crate) fn spent() -> TextureBudget {
+        TextureBudget { left: 0 }
+    }
+
+    /// Takes what a `w × h` image is kept as ([`stored_size`], RGBA8) and returns it, or says
+    /// why the image is left out.
+    pub fn take(&mut self, w: u32, h: u32) -> Result<u64, String> {
+        let (sw, sh) = stored_size(w, h);
+        let bytes = u64::from(sw) * u64::from(sh) * 4;
+        if bytes > self.left {
+            let mib = |b: u64| b.div_ceil(1 << 20);
+            return Err(format!(
+                "is left out: its {} MiB would take the scene's textures past the {} MiB they \
+                 may keep",
+                mib(bytes),
+                mib(MAX_SCENE_TEXTURE_BYTES)
+            ));
+        }
+        self.left -= bytes;
+        Ok(bytes)
+    }
+
+    /// A budget of `left` bytes (tests of what is left out).
+    #[cfg(test)]
+    pub(crate) fn with_left(left: u64) -> TextureBudget {
+        TextureBudget { left }
+    }
+
+    /// Returns `bytes` taken for a texture that is not kept after all.
+    pub fn give_back(&mut self, bytes: u64) {
+        self.left = self.left.saturating_add(bytes).min(MAX_SCENE_TEXTURE_BYTES);
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -82,5 +141,22 @@ mod tests {
         let small = image::RgbaImage::from_pixel(3, 2, image::Rgba([1, 2, 3, 4]));
         let (img, warning) = to_rgba8(DynamicImage::ImageRgba8(small.clone()), "s.png");
         assert_eq!((img, warning), (small, None));
+    }
+
+    #[test]
+    fn the_budget_takes_what_textures_are_kept_as_and_refuses_past_it() {
+        let mut budget = TextureBudget::default();
+        // Kept as 4096² RGBA8, whatever was decoded: 64 MiB each, 16 fit.
+        for _ in 0..16 {
+            assert_eq!(budget.take(12_000, 12_000), Ok(64 << 20));
+        }
+        assert_eq!(budget, TextureBudget::spent());
+        let refusal = budget.take(1, 1).unwrap_err();
+        assert!(refusal.contains("1024 MiB"), "{refusal}");
+        budget.give_back(64 << 20);
+        assert_eq!(budget.take(4096, 4096), Ok(64 << 20));
+        // Never more than the whole, however much is given back.
+        budget.give_back(u64::MAX);
+        assert_eq!(budget, TextureBudget::default());
     }
 }

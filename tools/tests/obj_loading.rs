@@ -217,7 +217,16 @@ fn a_textured_model_without_normals_gets_its_texture_and_outward_normals() {
 
 fn load_obj(path: &Path) -> Result<(Scene, obj::LoadReport), SceneError> {
     let mut scene = Scene::empty();
-    let report = obj::load_into(&mut scene, path, DMat4::IDENTITY, None)?;
+    let options = manylight::LoadOptions::default();
+    let mut textures = manylight::scene::texture_budget::TextureBudget::default();
+    let report = obj::load_into(
+        &mut scene,
+        path,
+        DMat4::IDENTITY,
+        None,
+        &options,
+        &mut textures,
+    )?;
     Ok((scene, report))
 }
 

@@ -28,6 +28,7 @@ use super::buffers::Buffers;
 use super::maps::{self, RawMaterials, Sources};
 use super::texture::Textures;
 use crate::scene::material::MAX_COLOR_FACTOR;
+use crate::scene::texture_budget::TextureBudget;
 use crate::scene::Material;
 
 /// Specular reflectance of dielectrics (4 %), the `specular` every glTF material gets.
@@ -68,14 +69,19 @@ pub(super) struct Materials {
 }
 
 impl Materials {
-    /// For the file whose JSON chunk is `json`.
-    pub fn new(json: &[u8]) -> Materials {
+    /// For the file whose JSON chunk is `json`, its textures taking their part of `budget`.
+    pub fn new(json: &[u8], budget: TextureBudget) -> Materials {
         Materials {
             list: Vec::new(),
             by_index: HashMap::new(),
-            textures: Textures::default(),
+            textures: Textures::new(budget),
             raw: RawMaterials::parse(json),
         }
+    }
+
+    /// The converted materials, and what is left of the texture budget.
+    pub fn finish(self) -> (Vec<Material>, TextureBudget) {
+        (self.list, self.textures.budget)
     }
 
     /// Index in [`Materials::list`] of `m`, converting it on first use.

@@ -57,6 +57,7 @@ use super::access::LoadOptions;
 use super::camera::MAX_CAMERA_COORD;
 use super::input::{self, read_bounded, FileKind};
 use super::obj::LoadReport;
+use super::texture_budget::TextureBudget;
 use super::{
     random, Aabb, Camera, DirectionalLight, Light, Material, Mesh, Object, Scene, SceneError,
 };
@@ -95,7 +96,15 @@ pub fn load(
         input::check_light_count(count, "lights")?;
     }
     let mut scene = Scene::empty();
-    let mut loaded = load_into(&mut scene, path, DMat4::IDENTITY, "transform", options)?;
+    let mut textures = TextureBudget::default();
+    let mut loaded = load_into(
+        &mut scene,
+        path,
+        DMat4::IDENTITY,
+        "transform",
+        options,
+        &mut textures,
+    )?;
     if scene.objects.is_empty() {
         // Its lights alone would render a black frame.
         return Err(SceneError::GltfUnsupported {
@@ -137,13 +146,15 @@ pub fn load(
 /// not scaled). The scene's camera is left alone: the file's own comes back in the result.
 /// A transform that puts what the file holds out of range is an [`SceneError::Invalid`] of
 /// `transform_field` (what the caller calls it, e.g. `objects[2].transform`). On error
-/// `scene` is unchanged.
+/// `scene` is unchanged. The textures kept take their part of `textures` (the whole scene's
+/// budget; an error leaves none of it).
 pub fn load_into(
     scene: &mut Scene,
     path: &Path,
     transform: DMat4,
     transform_field: &str,
     options: &LoadOptions,
+    textures: &mut TextureBudget,
 ) -> Result<GltfLoad, SceneError> {
     if !transform.is_finite() {
         return Err(SceneError::invalid(transform_field, "must be finite"));
@@ -154,7 +165,7 @@ pub fn load_into(
         reason,
     };
     let imported = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        import(&bytes, path, transform, options)
+        import(&bytes, path, transform, options, textures)
     }));
     let imported = match imported {
         Ok(Ok(imported)) => imported,
@@ -257,6 +268,7 @@ fn import(
     path: &Path,
     transform: DMat4,
     options: &LoadOptions,
+    textures: &mut TextureBudget,
 ) -> Result<Imported, Fault> {
     let (json, bin) = if bytes.starts_with(glb::MAGIC) {
         let g = glb::split(bytes)?;
@@ -292,7 +304,9 @@ fn import(
     };
     // Each primitive is built once, with its object-space bounds, however many nodes place it.
     let mut meshes: HashMap<(usize, usize), Option<BuiltMesh>> = HashMap::new();
-    let mut materials = material::Materials::new(json);
+    // Lent to the materials' textures, handed back at the end (an error keeps none of it).
+    let lent = std::mem::replace(textures, TextureBudget::spent());
+    let mut materials = material::Materials::new(json, lent);
     let mut out = Imported {
         objects: Vec::new(),
         materials: Vec::new(),
@@ -391,7 +405,7 @@ fn import(
             "nothing to show: {from} place no triangle mesh and no light"
         )));
     }
-    out.materials = materials.list;
+    (out.materials, *textures) = materials.finish();
     // Features first, then what the parts said, each once.
     out.warnings = ignored::unused_features(&document, camera_nodes);
     out.warnings.extend(ignored::once_per_feature(warnings));

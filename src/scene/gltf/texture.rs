@@ -14,12 +14,14 @@ use super::uri::{self, Uri};
 use crate::scene::access;
 use crate::scene::input::{read_bounded, FileKind, LIMIT_VARIABLE};
 use crate::scene::obj::{decode_texture_bytes, resolve_texture};
-use crate::scene::{texture_budget, Texture};
+use crate::scene::texture_budget::{self, TextureBudget};
+use crate::scene::Texture;
 
-/// Decoded images of one glTF file, by image index (`None`: failed, warned once).
-#[derive(Default)]
+/// Decoded images of one glTF file, by image index (`None`: failed, warned once), and what is
+/// left of the scene's texture budget.
 pub(super) struct Textures {
     loaded: HashMap<usize, Option<Arc<Texture>>>,
+    pub budget: TextureBudget,
 }
 
 /// Where an image's encoded bytes came from, for names and messages.
@@ -30,6 +32,14 @@ struct Encoded {
 }
 
 impl Textures {
+    /// None decoded yet, `budget` left for those that will be.
+    pub fn new(budget: TextureBudget) -> Textures {
+        Textures {
+            loaded: HashMap::new(),
+            budget,
+        }
+    }
+
     /// The texture of `image`, decoded once. Problems with the image data itself are warnings
     /// (`None`); a buffer view past its buffer is an error, as anywhere else in the file.
     pub fn load(
@@ -44,7 +54,7 @@ impl Textures {
         }
         let field = format!("images[{}]", image.index());
         let texture = match encoded(image, buffers, gltf_path, &field)? {
-            Ok(enc) => match decode(&enc.bytes, enc.format) {
+            Ok(enc) => match decode_texture_bytes(&enc.bytes, enc.format, &mut self.budget) {
                 Ok(img) => {
                     drop(enc.bytes);
                     let (image, scaled) = texture_budget::to_rgba8(img, &enc.name);
@@ -54,11 +64,8 @@ impl Textures {
                         image,
                     }))
                 }
-                Err(e) => {
-                    warnings.push(format!(
-                        "texture {} could not be decoded ({e}); using the flat colour",
-                        enc.name
-                    ));
+                Err(why) => {
+                    warnings.push(format!("texture {} {why}; using the flat colour", enc.name));
                     None
                 }
             },
@@ -178,9 +185,10 @@ fn encoded(
     }
 }
 
-/// Decodes with the OBJ loader's limits ([`decode_texture_bytes`]).
+/// Decodes with the OBJ loader's limits ([`decode_texture_bytes`]) and a whole budget.
+#[cfg(test)]
 fn decode(bytes: &[u8], format: Option<image::ImageFormat>) -> Result<image::DynamicImage, String> {
-    decode_texture_bytes(bytes, format)
+    decode_texture_bytes(bytes, format, &mut TextureBudget::default())
 }
 
 #[cfg(test)]
