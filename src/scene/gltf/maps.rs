@@ -22,9 +22,17 @@ pub(super) struct RawMaterials(Vec<Value>);
 impl RawMaterials {
     /// From the file's JSON chunk (already parsed once by the `gltf` crate, so valid).
     pub fn parse(json: &[u8]) -> RawMaterials {
-        let root: Value = serde_json::from_slice(json).unwrap_or(Value::Null);
-        match root.get("materials") {
-            Some(Value::Array(list)) => RawMaterials(list.clone()),
+        // Only `materials` is built: the rest of the document is skipped, not parsed into
+        // values (which took some 50 bytes a number).
+        #[derive(serde::Deserialize)]
+        struct Root {
+            #[serde(default)]
+            materials: Option<Value>,
+        }
+        match serde_json::from_slice::<Root>(json) {
+            Ok(Root {
+                materials: Some(Value::Array(list)),
+            }) => RawMaterials(list),
             _ => RawMaterials(Vec::new()),
         }
     }

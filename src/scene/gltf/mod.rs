@@ -33,6 +33,7 @@ pub mod camera;
 mod glb;
 mod ignored;
 mod integers;
+mod json_size;
 pub mod lights;
 mod maps;
 pub mod material;
@@ -276,6 +277,7 @@ fn import(
     } else {
         (bytes, None)
     };
+    json_size::check(json)?;
     let root = gltf::json::deserialize::from_slice(json).map_err(|e| json_error(&e))?;
     integers::check(json)?;
     if let Some(reason) = ignored::unsupported_required(&root) {
