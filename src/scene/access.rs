@@ -39,7 +39,8 @@ pub(crate) fn join(dir: &Path, name: &str, allow_outside: bool) -> Result<PathBu
         };
         if let Some(why) = why {
             return Err(format!(
-                "`{name}` is outside the model's folder ({why}); refused: {HOW_TO_ALLOW}"
+                "`{}` is outside the model's folder ({why}); refused: {HOW_TO_ALLOW}",
+                super::shown::name(name)
             ));
         }
     }
@@ -76,7 +77,7 @@ pub(crate) fn resolve(dir: &Path, path: &Path, allow_outside: bool) -> Result<Pa
         Err(format!(
             "`{}` is outside the model's folder (a link leads out of it); refused: \
              {HOW_TO_ALLOW}",
-            shown.display()
+            super::shown::name(&shown.to_string_lossy())
         ))
     }
 }

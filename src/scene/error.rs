@@ -1,13 +1,22 @@
 //! Errors of the scene layer: file I/O, parsing and validation. Every validation error names
-//! the field it is about (`lights[3].radius`, `materials[2] (stone).shininess`, …).
+//! the field it is about (`lights[3].radius`, `materials[2] (stone).shininess`, …). What an
+//! error quotes from a file (a path, a name, a key) has its control characters escaped
+//! ([`shown`]).
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
+
+use super::shown;
+
+/// A path as an error shows it ([`shown::text`]).
+fn shown_path(path: &Path) -> String {
+    shown::text(&path.to_string_lossy()).into_owned()
+}
 
 /// What went wrong while building, loading or validating a scene.
 #[derive(Debug, thiserror::Error)]
 pub enum SceneError {
     /// A value is out of its valid range (NaN, negative radius, outer < inner, …).
-    #[error("invalid value for `{field}`: {reason}")]
+    #[error("invalid value for `{}`: {}", shown::text(field), shown::text(reason))]
     Invalid {
         /// Path of the offending field, e.g. `lights[3].radius`.
         field: String,
@@ -15,7 +24,7 @@ pub enum SceneError {
         reason: String,
     },
     /// A file could not be read.
-    #[error("cannot read {path}: {source}")]
+    #[error("cannot read {}: {source}", shown_path(path))]
     Io {
         /// The file.
         path: PathBuf,
@@ -23,7 +32,7 @@ pub enum SceneError {
         source: std::io::Error,
     },
     /// An OBJ file could not be parsed.
-    #[error("malformed OBJ {path}: {reason}")]
+    #[error("malformed OBJ {}: {}", shown_path(path), shown::text(reason))]
     Obj {
         /// The file.
         path: PathBuf,
@@ -32,7 +41,7 @@ pub enum SceneError {
     },
     /// A glTF file (`.gltf` or `.glb`) is malformed or cannot be shown; `reason` names the
     /// part of the file at fault, e.g. `meshes[2].primitives[0]: index 9 out of range …`.
-    #[error("malformed glTF {path}: {reason}")]
+    #[error("malformed glTF {}: {}", shown_path(path), shown::text(reason))]
     Gltf {
         /// The `.gltf` or `.glb` file.
         path: PathBuf,
@@ -41,7 +50,7 @@ pub enum SceneError {
     },
     /// A glTF file asks for what the renderer cannot do (an extension it requires, or
     /// nothing to draw); `reason` names it.
-    #[error("unsupported glTF {path}: {reason}")]
+    #[error("unsupported glTF {}: {}", shown_path(path), shown::text(reason))]
     GltfUnsupported {
         /// The `.gltf` or `.glb` file.
         path: PathBuf,
@@ -49,7 +58,7 @@ pub enum SceneError {
         reason: String,
     },
     /// A scene file is not valid JSON for the scene schema.
-    #[error("scene file {path}: {reason}")]
+    #[error("scene file {}: {}", shown_path(path), shown::text(reason))]
     SceneFile {
         /// The file.
         path: PathBuf,
@@ -57,13 +66,13 @@ pub enum SceneError {
         reason: String,
     },
     /// A file whose type the loader does not read (by its extension).
-    #[error("unsupported scene file type: {path} (a scene is a built-in name, or a .obj, .gltf, .glb or .json file)")]
+    #[error("unsupported scene file type: {} (a scene is a built-in name, or a .obj, .gltf, .glb or .json file)", shown_path(path))]
     UnsupportedFile {
         /// The file.
         path: PathBuf,
     },
     /// A built-in scene name that does not exist.
-    #[error("unknown built-in scene `{name}` (available: {})", available.join(", "))]
+    #[error("unknown built-in scene `{}` (available: {})", shown::name(name), available.join(", "))]
     UnknownBuiltin {
         /// What was asked for.
         name: String,

@@ -224,10 +224,11 @@ struct RandomLightsSpec {
 }
 
 /// Parses the JSON, naming the field at fault: serde's own messages lack the path, and for an
-/// array with too many values say only "trailing characters".
+/// array with too many values say only "trailing characters". Anything after the scene's
+/// object but white space is an error too.
 fn deserialize(text: &str) -> Result<SceneFile, String> {
     let mut json = serde_json::Deserializer::from_str(text);
-    serde_path_to_error::deserialize(&mut json).map_err(|e| {
+    let file = serde_path_to_error::deserialize(&mut json).map_err(|e| {
         let path = e.path().to_string();
         let inner = e.inner().to_string();
         let inner = match inner.strip_prefix("trailing characters") {
@@ -239,7 +240,10 @@ fn deserialize(text: &str) -> Result<SceneFile, String> {
         } else {
             format!("{path}: {inner}")
         }
-    })
+    })?;
+    json.end()
+        .map_err(|e| format!("something follows the scene's JSON object: {e}"))?;
+    Ok(file)
 }
 
 /// Loads a scene file. Returns the scene (validated) and the warnings of any OBJ loads.

@@ -30,6 +30,7 @@ pub mod obj;
 pub mod random;
 pub mod raycast;
 pub mod shading;
+pub mod shown;
 pub mod surface_maps;
 pub mod tangents;
 pub mod texture;

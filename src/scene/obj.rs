@@ -23,7 +23,7 @@ use super::access::{self, LoadOptions};
 use super::input::{read_bounded, FileKind};
 use super::material::MAX_COLOR_FACTOR;
 use super::texture_budget::TextureBudget;
-use super::{Aabb, Material, Mesh, Object, Scene, SceneError, Texture};
+use super::{shown, Aabb, Material, Mesh, Object, Scene, SceneError, Texture};
 
 /// What an OBJ load produced besides the objects: non-fatal problems, for the caller to show.
 #[derive(Debug, Default)]
@@ -74,6 +74,8 @@ pub fn load_into(
     };
     let first = scene.materials.len();
     for m in &mtl {
+        // The name as messages (and the renderer's stats) show it.
+        let material_name = shown::name(&m.name);
         let texture = match &m.diffuse_texture {
             Some(name) if !name.trim().is_empty() => {
                 match find_texture(base_dir, name, allow_outside) {
@@ -86,17 +88,16 @@ pub fn load_into(
                             "not found"
                         };
                         report.warn(format!(
-                            "material `{}`: texture `{name}` {what} next to {}; using its flat \
-                             colour",
-                            m.name,
+                            "material `{material_name}`: texture `{}` {what} next to {}; using \
+                             its flat colour",
+                            shown::name(name),
                             path.display()
                         ));
                         None
                     }
                     Err(refusal) => {
                         report.warn(format!(
-                            "material `{}`: texture {refusal}; using its flat colour",
-                            m.name
+                            "material `{material_name}`: texture {refusal}; using its flat colour"
                         ));
                         None
                     }
@@ -110,9 +111,8 @@ pub fn load_into(
             let clamped = v.max(Vec3::ZERO).min(Vec3::splat(MAX_COLOR_FACTOR));
             if clamped != v {
                 report.warn(format!(
-                    "material `{}`: {key} {v} clamped to {clamped} (factors are limited to \
-                     [0, {MAX_COLOR_FACTOR}], the range the fp16 colour tier holds)",
-                    m.name
+                    "material `{material_name}`: {key} {v} clamped to {clamped} (factors are \
+                     limited to [0, {MAX_COLOR_FACTOR}], the range the fp16 colour tier holds)"
                 ));
             }
             clamped
@@ -120,7 +120,7 @@ pub fn load_into(
         let diffuse = factor("Kd", m.diffuse, 0.8);
         let specular = factor("Ks", m.specular, 0.0);
         scene.materials.push(Material {
-            name: m.name.clone(),
+            name: material_name,
             diffuse,
             diffuse_texture: override_tex.clone().or(texture),
             specular,
@@ -162,7 +162,7 @@ pub fn load_into(
             .collect();
         let mesh = Mesh::new(positions, normals, uvs, m.indices).map_err(|e| SceneError::Obj {
             path: path.to_path_buf(),
-            reason: format!("object `{}`: {e}", model.name),
+            reason: format!("object `{}`: {e}", shown::name(&model.name)),
         })?;
         let material = match m.material_id {
             Some(id) if id < mtl.len() => first + id,
@@ -170,7 +170,7 @@ pub fn load_into(
         };
         let (mesh, dropped) =
             super::duplicates::drop_from_opaque(mesh, &scene.materials[material], || {
-                format!("{}: object `{}`", path.display(), model.name)
+                format!("{}: object `{}`", path.display(), shown::name(&model.name))
             });
         if let Some(warning) = dropped {
             report.warn(warning);
@@ -231,7 +231,10 @@ fn parse_obj(path: &Path, allow_outside: bool) -> Result<Parsed, SceneError> {
         let mtl_path = access::join(&base_dir, &name.to_string_lossy(), allow_outside)
             .and_then(|p| access::resolve(&base_dir, &p, allow_outside).map(|_| p))
             .map_err(|refusal| {
-                log::warn!("{}: mtllib {refusal}", path.display());
+                log::warn!(
+                    "{}",
+                    shown::text(&format!("{}: mtllib {refusal}", path.display()))
+                );
                 tobj::LoadError::OpenFileFailed
             })?;
         if !seen.borrow_mut().insert(mtl_path.clone()) {
@@ -459,7 +462,9 @@ pub(crate) fn decode_texture_bytes(
 pub const MAX_TEXTURE_SIDE: u32 = super::texture_budget::MAX_DECODED_SIDE;
 
 impl LoadReport {
+    /// Logs and keeps `msg`, its control characters escaped ([`shown::text`]).
     fn warn(&mut self, msg: String) {
+        let msg = shown::text(&msg).into_owned();
         log::warn!("{msg}");
         self.warnings.push(msg);
     }

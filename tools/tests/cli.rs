@@ -992,3 +992,44 @@ fn info_scene_reports_the_scenes_own_features_and_variants() {
         assert!(!names.contains("\"spot\""), "{variant}");
     }
 }
+
+/// No message carries a file's bytes as they are: a name with a terminal's escape sequence is
+/// shown escaped, and a name of 100 000 characters is cut (an error and a warning alike).
+#[test]
+fn messages_show_names_from_files_escaped_and_cut() {
+    let dir = tempfile::tempdir().unwrap();
+    let long = "n".repeat(100_000);
+    let bad_vertex = format!("o \u{1b}]0;PWN\u{7}{long}\nv nan 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+    std::fs::write(dir.path().join("bad.obj"), bad_vertex).unwrap();
+    let obj = "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl \u{1b}[31mred\nf 1 2 3\n";
+    std::fs::write(dir.path().join("hot.obj"), obj).unwrap();
+    std::fs::write(
+        dir.path().join("m.mtl"),
+        "newmtl \u{1b}[31mred\nKd 5000 1 1\n",
+    )
+    .unwrap();
+    let small = ["--size", "16x9", "--lights", "2", "--frames", "0"];
+    let error = expect_exit(
+        &[&["render", "--scene", "bad.obj"], &small[..]].concat(),
+        &[],
+        dir.path(),
+        1,
+        "\\u{1b}]0;PWN\\u{7}",
+    );
+    assert!(error.len() < 1_000, "{} bytes", error.len());
+    assert!(error.contains("characters more"), "{error}");
+    let out = manylight(
+        &[&["render", "--scene", "hot.obj"], &small[..]].concat(),
+        &[],
+        dir.path(),
+    );
+    let warned = text(&out);
+    assert!(out.status.success(), "{warned}");
+    assert!(warned.contains("\\u{1b}[31mred"), "{warned}");
+    for said in [&error, &warned] {
+        assert!(
+            !said.chars().any(|c| c.is_control() && c != '\n'),
+            "{said:?}"
+        );
+    }
+}

@@ -513,26 +513,40 @@ fn obj_and_mtl_errors_do_not_show_the_files_text() {
     }
 }
 
+/// A texture that is a folder in the model's folder is named as not a file; a device
+/// (`/dev/zero`) lies outside it and is refused as such. Both keep the flat colour.
 #[cfg(unix)]
 #[test]
-fn a_texture_that_is_a_device_is_named_so_and_the_flat_colour_kept() {
+fn a_texture_that_is_a_folder_or_a_device_is_named_so_and_the_flat_colour_kept() {
     let dir = tempfile::tempdir().unwrap();
+    std::fs::create_dir(dir.path().join("maps")).unwrap();
     std::fs::write(
         dir.path().join("m.mtl"),
-        "newmtl red\nKd 1 0 0\nmap_Kd /dev/zero\n",
+        "newmtl red\nKd 1 0 0\nmap_Kd maps\nnewmtl zero\nKd 1 0 0\nmap_Kd /dev/zero\n",
     )
     .unwrap();
-    let obj = "mtllib m.mtl\nusemtl red\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+    let obj =
+        "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl red\nf 1 2 3\nusemtl zero\nf 1 3 2\n";
     let (scene, report) = load_obj(&write(dir.path(), "d.obj", obj)).unwrap();
-    assert!(
+    let warned = |needles: &[&str]| {
         report
             .warnings
             .iter()
-            .any(|w| w.contains("/dev/zero") && w.contains("not a regular file")),
+            .any(|w| needles.iter().all(|n| w.contains(n)))
+    };
+    assert!(
+        warned(&["`maps`", "not a regular file"]),
         "{:?}",
         report.warnings
     );
-    assert!(scene.materials[0].diffuse_texture.is_none());
+    assert!(
+        warned(&["/dev/zero", "outside the model's folder"]),
+        "{:?}",
+        report.warnings
+    );
+    assert!(scene.materials[..2]
+        .iter()
+        .all(|m| m.diffuse_texture.is_none()));
 }
 
 #[test]

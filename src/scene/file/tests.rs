@@ -33,6 +33,27 @@ fn json_errors_name_the_field_and_too_many_values_say_so() {
 }
 
 #[test]
+fn anything_after_the_scenes_object_is_an_error_and_keys_are_shown_escaped() {
+    let scene = r#"{"objects": [{"builtin": "plane"}]}"#;
+    assert!(parse_str(&format!("{scene} \n\t ")).is_ok());
+    for tail in [" xx", "\0", " {}"] {
+        let err = parse_str(&format!("{scene}{tail}"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("something follows the scene's JSON object"),
+            "{err}"
+        );
+    }
+    // A key with a terminal's escape sequence: named, its control characters escaped.
+    let err = parse_str(r#"{"\u001b]0;PWN\u0007": 1}"#)
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("\\u{1b}]0;PWN\\u{7}"), "{err}");
+    assert!(!err.chars().any(char::is_control), "{err:?}");
+}
+
+#[test]
 fn directional_lights_parse_and_errors_name_the_field() {
     let s = parse_str(
         r#"{"objects": [{"builtin": "plane"}],

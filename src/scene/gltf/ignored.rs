@@ -3,6 +3,8 @@
 //! warning per file and feature, by name). The supported extensions are listed once, in
 //! [`SUPPORTED_EXTENSIONS`].
 
+use crate::scene::shown;
+
 /// Extensions the loader implements. A file *requiring* another is refused, naming it; one
 /// merely *using* another gets one warning per extension that it is ignored.
 pub const SUPPORTED_EXTENSIONS: &[&str] = &[
@@ -25,9 +27,20 @@ pub(super) fn unsupported_required(root: &gltf::json::Root) -> Option<String> {
     }
     Some(format!(
         "extensionsRequired lists {}, which manylight does not support (supported: {})",
-        missing.join(", "),
+        listed(&missing),
         SUPPORTED_EXTENSIONS.join(", ")
     ))
+}
+
+/// Names from the file as a message lists them: the first eight, each as [`shown::name`]
+/// shows it, then how many more.
+fn listed(names: &[&str]) -> String {
+    const SHOWN: usize = 8;
+    let mut list: Vec<String> = names.iter().take(SHOWN).map(|n| shown::name(n)).collect();
+    if names.len() > SHOWN {
+        list.push(format!("and {} more", names.len() - SHOWN));
+    }
+    list.join(", ")
 }
 
 /// One warning per feature the file uses that changes its picture but is not drawn:
@@ -41,10 +54,24 @@ pub(super) fn unused_features(document: &gltf::Document, camera_nodes: usize) ->
         .collect();
     unsupported.sort_unstable();
     unsupported.dedup();
+    // One warning each for the first eight (a hostile file may list millions).
     let mut out: Vec<String> = unsupported
-        .into_iter()
-        .map(|e| format!("extension {e} is not supported: ignored ({})", effect_of(e)))
+        .iter()
+        .take(8)
+        .map(|e| {
+            let name = shown::name(e);
+            format!(
+                "extension {name} is not supported: ignored ({})",
+                effect_of(e)
+            )
+        })
         .collect();
+    if unsupported.len() > 8 {
+        out.push(format!(
+            "{} more extensions are not supported: ignored",
+            unsupported.len() - 8
+        ));
+    }
     let skins = document.skins().len();
     if skins > 0 {
         out.push(format!(

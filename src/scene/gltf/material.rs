@@ -28,6 +28,7 @@ use super::buffers::Buffers;
 use super::maps::{self, RawMaterials, Sources};
 use super::texture::Textures;
 use crate::scene::material::MAX_COLOR_FACTOR;
+use crate::scene::shown;
 use crate::scene::texture_budget::TextureBudget;
 use crate::scene::Material;
 
@@ -113,7 +114,7 @@ impl Materials {
             None => "the default material".to_string(),
         };
         let name = match (m.index(), m.name()) {
-            (_, Some(n)) => n.to_string(),
+            (_, Some(n)) => shown::name(n),
             (Some(i), None) => format!("gltf-material-{i}"),
             (None, None) => "gltf-default".to_string(),
         };

@@ -60,7 +60,7 @@ use super::input::{self, read_bounded, FileKind};
 use super::obj::LoadReport;
 use super::texture_budget::TextureBudget;
 use super::{
-    random, Aabb, Camera, DirectionalLight, Light, Material, Mesh, Object, Scene, SceneError,
+    random, shown, Aabb, Camera, DirectionalLight, Light, Material, Mesh, Object, Scene, SceneError,
 };
 
 /// Most vertices one glTF file may decode into (33.5 M, about 1 GiB of vertex data: what
@@ -203,7 +203,7 @@ pub fn load_into(
     scene.directional_lights.extend(imported.directional_lights);
     let mut report = LoadReport::default();
     for w in imported.warnings {
-        let msg = format!("{}: {w}", path.display());
+        let msg = shown::text(&format!("{}: {w}", path.display())).into_owned();
         log::warn!("{msg}");
         report.warnings.push(msg);
     }

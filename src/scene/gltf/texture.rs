@@ -11,11 +11,11 @@ use std::sync::Arc;
 
 use super::buffers::Buffers;
 use super::uri::{self, Uri};
-use crate::scene::access;
 use crate::scene::input::{read_bounded, FileKind, LIMIT_VARIABLE};
 use crate::scene::obj::{decode_texture_bytes, resolve_texture};
 use crate::scene::texture_budget::{self, TextureBudget};
 use crate::scene::Texture;
+use crate::scene::{access, shown};
 
 /// Decoded images of one glTF file, by image index (`None`: failed, warned once), and what is
 /// left of the scene's texture budget.
@@ -162,7 +162,8 @@ fn encoded(
             };
             let Some(path) = path else {
                 return Ok(Err(format!(
-                    "{field}: texture `{name}` not found next to {}; using its flat colour",
+                    "{field}: texture `{}` not found next to {}; using its flat colour",
+                    shown::name(&name),
                     gltf_path.display()
                 )));
             };

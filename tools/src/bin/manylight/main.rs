@@ -26,6 +26,7 @@ use std::process::ExitCode;
 
 use clap::error::ErrorKind;
 use clap::{CommandFactory, Parser, Subcommand, ValueEnum};
+use manylight::scene::shown;
 use manylight::{EsVersion, LoadOptions};
 use manylight_tools::output;
 
@@ -277,8 +278,20 @@ fn join_rayon_pool() {
 }
 
 fn main() -> ExitCode {
+    // env_logger's own layout, each message on one line with its control characters escaped
+    // (a model's names reach warnings, and a terminal acts on escape sequences).
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn"))
-        .format_timestamp(None)
+        .format(|buf, record| {
+            use std::io::Write as _;
+            let message = record.args().to_string();
+            writeln!(
+                buf,
+                "[{:<5} {}] {}",
+                record.level(),
+                record.target(),
+                shown::text(&message)
+            )
+        })
         .init();
     let cli = Cli::try_parse().unwrap_or_else(|e| {
         // As clap's own `exit`, but help or a version that cannot be written is a failure too.
@@ -327,7 +340,7 @@ fn main() -> ExitCode {
                 Some(manylight::Error::Msaa { samples, reason }) => {
                     eprintln!("error: --msaa {samples}: {reason}")
                 }
-                _ => eprintln!("error: {e}"),
+                _ => eprintln!("error: {}", shown::text(&e.to_string())),
             }
             ExitCode::FAILURE
         }
