@@ -38,6 +38,11 @@ pub const MAX_CAMERA_COORD: f64 = 1e12;
 /// coordinates resolve (10⁻⁹ rendered half the frame black).
 pub const MIN_ORTHO_HEIGHT: f64 = 1e-6;
 
+/// Narrowest perspective field of view, in degrees: a narrower one puts a scene's triangles
+/// millions of NDC units wide, past what rasterizers clip exactly (llvmpipe drew the right
+/// half of the frame black from 2·10⁻⁵° down, all of it at 10⁻³⁰⁰°).
+pub const MIN_FOV_Y_DEG: f64 = 1e-3;
+
 /// A perspective far plane this many near planes away or more is treated as infinite.
 pub const FAR_AS_INFINITE: f64 = 1e20;
 
@@ -177,10 +182,10 @@ impl Camera {
         let (near, far) = self.near_far();
         match self.projection {
             Projection::Perspective { fov_y_deg, .. } => {
-                if !(fov_y_deg > 0.0 && fov_y_deg < 180.0) {
+                if !(MIN_FOV_Y_DEG..180.0).contains(&fov_y_deg) {
                     return Err(SceneError::invalid(
                         "camera.fov_y_deg",
-                        format!("must be in (0, 180), got {fov_y_deg}"),
+                        format!("must be in [{MIN_FOV_Y_DEG:e}, 180), got {fov_y_deg}"),
                     ));
                 }
                 if !(near > 0.0 && near.is_finite()) {
@@ -286,6 +291,19 @@ mod tests {
         };
         let err = cam.validate().unwrap_err().to_string();
         assert!(err.contains("camera.near"), "{err}");
+        for (fov, ok) in [
+            (MIN_FOV_Y_DEG, true),
+            (2e-5, false),
+            (1e-300, false),
+            (180.0, false),
+        ] {
+            let cam = Camera::perspective(DVec3::ZERO, -DVec3::Z, fov, 0.1, 10.0);
+            let result = cam.validate();
+            assert_eq!(result.is_ok(), ok, "{fov}: {result:?}");
+            if let Err(e) = result {
+                assert!(e.to_string().contains("camera.fov_y_deg"), "{e}");
+            }
+        }
         cam.position = DVec3::new(f64::NAN, 0.0, 0.0);
         assert!(cam
             .validate()

@@ -242,14 +242,41 @@ impl Mesh {
 
     /// Whether any triangle has a non-zero area (all points or lines: nothing to draw).
     pub fn has_area(&self) -> bool {
-        self.indices.chunks_exact(3).any(|t| {
+        self.triangle_normals().any(|n| n != Vec3::ZERO)
+    }
+
+    /// Unit vectors spanning the directions of the triangles' normals (none: no triangle has
+    /// an area; one: the mesh is flat). A linear map `A` gives a triangle of normal `n` the
+    /// normal `cof(A)·n`, so the mesh keeps an area under `A` exactly when `cof(A)` keeps one
+    /// of these. Stops reading the triangles once it has three.
+    pub fn normal_span(&self) -> Vec<glam::DVec3> {
+        let mut basis: Vec<glam::DVec3> = Vec::new();
+        for n in self.triangle_normals() {
+            let mut n = n.as_dvec3().normalize_or_zero();
+            for b in &basis {
+                n -= *b * n.dot(*b);
+            }
+            // What is left of a unit normal once the span's part is taken away.
+            if n.length() > 1e-6 {
+                basis.push(n.normalize());
+                if basis.len() == 3 {
+                    break;
+                }
+            }
+        }
+        basis
+    }
+
+    /// The triangles' (unnormalised) normals, out-of-range corners at the origin.
+    fn triangle_normals(&self) -> impl Iterator<Item = Vec3> + '_ {
+        self.indices.chunks_exact(3).map(|t| {
             let p = |k: usize| {
                 self.positions
                     .get(t[k] as usize)
                     .copied()
                     .unwrap_or_default()
             };
-            (p(1) - p(0)).cross(p(2) - p(0)) != Vec3::ZERO
+            (p(1) - p(0)).cross(p(2) - p(0))
         })
     }
 

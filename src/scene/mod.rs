@@ -113,14 +113,17 @@ impl Scene {
             .reduce(|a, b| a.union(&b))
     }
 
-    /// Whether any object has a triangle of non-zero area in its own space (each distinct
-    /// mesh looked at once); a transform that flattens a mesh is not considered.
+    /// Whether any object has a triangle of non-zero area as its transform places it (each
+    /// distinct mesh read once): a node scaled by zero on an axis, or by 10⁻³⁰⁰, flattens its
+    /// mesh into lines, which draw nothing.
     pub fn has_visible_area(&self) -> bool {
-        let mut seen = std::collections::HashSet::new();
-        self.objects
-            .iter()
-            .filter(|o| seen.insert(Arc::as_ptr(&o.mesh)))
-            .any(|o| o.mesh.has_area())
+        let mut spans = std::collections::HashMap::new();
+        self.objects.iter().any(|o| {
+            let span = spans
+                .entry(Arc::as_ptr(&o.mesh))
+                .or_insert_with(|| o.mesh.normal_span());
+            keeps_an_area(&o.transform, span)
+        })
     }
 
     /// Places `mesh` (a [`Mesh`], or an `Arc` of one to share it between objects) with
@@ -406,4 +409,67 @@ pub fn load_with(
         });
     }
     Ok(loaded)
+}
+
+/// Whether `transform` leaves a triangle whose normal lies in `span` ([`Mesh::normal_span`])
+/// an area: `cof(A)·n` not negligible next to the cofactors' largest (a scale of 10⁻³⁰⁰ on
+/// one axis of a flat mesh is no area in f32, whatever f64 makes of it).
+fn keeps_an_area(transform: &DMat4, span: &[glam::DVec3]) -> bool {
+    let a = glam::DMat3::from_mat4(*transform);
+    // cof(A) = det(A)·A⁻ᵀ, written without the inverse (A may be singular).
+    let (c0, c1, c2) = (a.x_axis, a.y_axis, a.z_axis);
+    let cofactor = glam::DMat3::from_cols(c1.cross(c2), c2.cross(c0), c0.cross(c1));
+    let largest = cofactor
+        .to_cols_array()
+        .iter()
+        .fold(0.0_f64, |m, v| m.max(v.abs()));
+    largest.is_finite()
+        && largest > 0.0
+        && span
+            .iter()
+            .any(|n| (cofactor * *n).length() > 1e-12 * largest)
+}
+
+#[cfg(test)]
+mod area_tests {
+    use super::*;
+    use glam::{DVec3, DVec4};
+
+    #[test]
+    fn a_transform_that_flattens_every_triangle_leaves_nothing_to_draw() {
+        let mut quad = meshbuild::MeshBuilder::default();
+        quad.quad(
+            Vec3::new(-1.0, -1.0, 0.0),
+            Vec3::new(1.0, -1.0, 0.0),
+            Vec3::new(1.0, 1.0, 0.0),
+            Vec3::new(-1.0, 1.0, 0.0),
+        );
+        let mut cube = meshbuild::MeshBuilder::default();
+        cube.cuboid(Vec3::splat(-1.0), Vec3::splat(1.0));
+        let (quad, cube) = (quad.build(), cube.build());
+        assert_eq!(quad.normal_span().len(), 1);
+        assert_eq!(cube.normal_span().len(), 3);
+        let scale = |x, y, z| DMat4::from_scale(DVec3::new(x, y, z));
+        // y onto x: the quad's plane becomes a line.
+        let shear = DMat4::from_cols(DVec4::X, DVec4::X, DVec4::Z, DVec4::W);
+        let turned = DMat4::from_rotation_x(0.7) * DMat4::from_translation(DVec3::splat(5.0));
+        for (mesh, transform, visible) in [
+            (&quad, DMat4::IDENTITY, true),
+            (&quad, turned, true),
+            (&quad, scale(1.0, 1.0, 0.0), true),
+            (&quad, scale(1.0, 0.0, 1.0), false),
+            (&quad, scale(0.0, 0.0, 0.0), false),
+            (&quad, scale(1e-300, 1.0, 1.0), false),
+            (&quad, scale(1e-6, 1.0, 1.0), true),
+            (&quad, shear, false),
+            (&cube, scale(1.0, 0.0, 1.0), true),
+            (&cube, scale(1.0, 0.0, 0.0), false),
+            (&quad, scale(f64::NAN, 1.0, 1.0), false),
+        ] {
+            let mut scene = Scene::empty();
+            let material = scene.add_material(Material::flat("m", Vec3::ONE));
+            scene.add_object(mesh.clone(), material, transform);
+            assert_eq!(scene.has_visible_area(), visible, "{transform}");
+        }
+    }
 }
