@@ -8,6 +8,9 @@ use super::surface_maps::SurfaceMaps;
 pub use super::texture::Texture;
 use super::SceneError;
 
+/// Largest Blinn-Phong exponent the light model uses (a larger `shininess` shades as this).
+pub const MAX_SHININESS: f32 = 4096.0;
+
 /// Which reflectance model a material is shaded with (one light model, two BRDFs; see
 /// `glsl/light_model.glsl` and its CPU twin `scene::shading`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -106,10 +109,11 @@ impl Material {
         }
     }
 
-    /// The exponent the light model uses: `Ns` clamped to [1, 4096]. `pow(0, 0)` is undefined
-    /// in GLSL, and MTL files commonly say `Ns 0` for "no highlight" together with `Ks 0`.
+    /// The exponent the light model uses: `Ns` clamped to [1, [`MAX_SHININESS`]]. `pow(0, 0)`
+    /// is undefined in GLSL, and MTL files commonly say `Ns 0` for "no highlight" together
+    /// with `Ks 0`.
     pub fn shading_exponent(&self) -> f32 {
-        self.shininess.clamp(1.0, 4096.0)
+        self.shininess.clamp(1.0, MAX_SHININESS)
     }
 
     /// True when the material is see-through (alpha below 1).

@@ -21,7 +21,7 @@ use glam::{DMat4, DVec3, Vec2, Vec3};
 
 use super::access::{self, LoadOptions};
 use super::input::{read_bounded, FileKind};
-use super::material::MAX_COLOR_FACTOR;
+use super::material::{MAX_COLOR_FACTOR, MAX_SHININESS};
 use super::texture_budget::TextureBudget;
 use super::{shown, Aabb, Material, Mesh, Object, Scene, SceneError, Texture};
 
@@ -119,13 +119,38 @@ pub fn load_into(
         };
         let diffuse = factor("Kd", m.diffuse, 0.8);
         let specular = factor("Ks", m.specular, 0.0);
+        // NaN takes the default, the rest their range (an exponent past f32 its largest
+        // used); a warning names the MTL statement, not the library's field.
+        let mut number = |key: &str, value: Option<f32>, default: f32, range: (f32, f32)| {
+            let v = value.unwrap_or(default);
+            let kept = if v.is_nan() {
+                default
+            } else {
+                v.clamp(range.0, range.1)
+            };
+            if kept != v {
+                report.warn(format!(
+                    "material `{material_name}`: {key} {v} taken as {kept} (its range is [{}, \
+                     {}])",
+                    range.0, range.1
+                ));
+            }
+            kept
+        };
+        let shininess = number(
+            "Ns",
+            m.shininess.map(|s| s as f32),
+            1.0,
+            (0.0, MAX_SHININESS),
+        );
+        let alpha = number("d", m.dissolve.map(|d| d as f32), 1.0, (0.0, 1.0));
         scene.materials.push(Material {
             name: material_name,
             diffuse,
             diffuse_texture: override_tex.clone().or(texture),
             specular,
-            shininess: m.shininess.map_or(1.0, |s| s as f32),
-            alpha: m.dissolve.map_or(1.0, |d| d as f32).clamp(0.0, 1.0),
+            shininess,
+            alpha,
             ..Material::default()
         });
     }
@@ -722,6 +747,47 @@ mod tests {
             .filter(|w| w.contains("t2.png is left out"))
             .collect();
         assert_eq!(left_out.len(), 1, "{:?}", report.warnings);
+    }
+
+    #[test]
+    fn out_of_range_mtl_numbers_are_warnings_naming_the_statement() {
+        let dir = tempfile::tempdir().unwrap();
+        let mtl = "newmtl a\nNs nan\nd -5\nnewmtl b\nNs 1e308\nd nan\nnewmtl c\nNs -1\nd 0.5\n";
+        std::fs::write(dir.path().join("m.mtl"), mtl).unwrap();
+        let mut obj = String::from("mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\n");
+        for name in ["a", "b", "c"] {
+            obj += &format!("usemtl {name}\nf 1 2 3\n");
+        }
+        std::fs::write(dir.path().join("m.obj"), obj).unwrap();
+        let mut scene = Scene::empty();
+        let report = load_into(
+            &mut scene,
+            &dir.path().join("m.obj"),
+            DMat4::IDENTITY,
+            None,
+            &LoadOptions::default(),
+            &mut TextureBudget::default(),
+        )
+        .unwrap();
+        let kept: Vec<(f32, f32)> = scene.materials[..3]
+            .iter()
+            .map(|m| (m.shininess, m.alpha))
+            .collect();
+        assert_eq!(kept, [(1.0, 0.0), (MAX_SHININESS, 1.0), (0.0, 0.5)]);
+        assert!(scene.validate().is_ok());
+        for said in [
+            "`a`: Ns NaN",
+            "`a`: d -5",
+            "`b`: Ns inf",
+            "`b`: d NaN",
+            "`c`: Ns -1",
+        ] {
+            assert!(
+                report.warnings.iter().any(|w| w.contains(said)),
+                "{said}: {:?}",
+                report.warnings
+            );
+        }
     }
 
     #[test]
