@@ -119,6 +119,11 @@ impl Loaded {
     }
 }
 
+/// Most bytes of glTF files with lights or a camera a scene file's load reads again (such a
+/// file is read for each reference): a 1 MB file named by 100 000 objects kept a load busy for
+/// minutes.
+pub const MAX_REREAD_BYTES: u64 = 1 << 30;
+
 /// The models one scene file has loaded, by canonical path (and texture override for OBJ).
 #[derive(Default)]
 pub(super) struct ModelCache {
@@ -126,6 +131,9 @@ pub(super) struct ModelCache {
     options: LoadOptions,
     /// What is left of the scene's texture memory.
     texture_budget: TextureBudget,
+    /// Bytes of glTF files read again for references after their first (files with lights
+    /// or a camera).
+    reread_bytes: u64,
     obj: HashMap<(PathBuf, Option<PathBuf>), Loaded>,
     /// glTF files without lights or cameras, read at the identity; `None`: read per reference.
     gltf: HashMap<PathBuf, Option<Loaded>>,
@@ -244,6 +252,22 @@ impl ModelCache {
                 loaded.place(scene, transform, recolour, transform_field)?;
                 return Ok(super::gltf::GltfLoad::default());
             }
+        }
+        // Read again for this reference: bounded in total, so a scene file of many references
+        // to a large file with lights cannot keep the load busy for hours.
+        let size = std::fs::metadata(path).map_or(0, |m| m.len());
+        self.reread_bytes = self.reread_bytes.saturating_add(size);
+        if self.reread_bytes > MAX_REREAD_BYTES {
+            return Err(SceneError::GltfUnsupported {
+                path: path.to_path_buf(),
+                reason: format!(
+                    "a glTF file with lights or a camera is read again for each reference, and \
+                     {transform_field}'s read would take this scene file's re-reads past \
+                     {} MiB (fewer references, or a file without its lights: place lights in \
+                     the scene file)",
+                    MAX_REREAD_BYTES >> 20
+                ),
+            });
         }
         let (first_object, first_material) = (scene.objects.len(), scene.materials.len());
         let mut loaded = super::gltf::load_into(

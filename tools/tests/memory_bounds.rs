@@ -174,6 +174,21 @@ fn a_gltf_named_many_times_shares_its_meshes_and_textures() {
     assert_eq!((scene.objects.len(), distinct_meshes(&scene)), (3, 1));
     let xs: Vec<f64> = scene.lights.iter().map(|l| l.position.x).collect();
     assert_eq!(xs, [0.0, 1.0, 2.0]);
+    // Read per reference, a 4 MiB file named 300 times would be read 1.2 GB over: refused
+    // once the re-reads pass their 1 GiB, naming the reference.
+    lit["extras"] = serde_json::json!({"pad": "x".repeat(4 << 20)});
+    std::fs::write(dir.path().join("lit.gltf"), lit.to_string()).unwrap();
+    let objects: Vec<serde_json::Value> = (0..300)
+        .map(|i| serde_json::json!({"gltf": "lit.gltf", "transform": {"translate": [i, 0, 0]}}))
+        .collect();
+    std::fs::write(&file, serde_json::json!({"objects": objects}).to_string()).unwrap();
+    let err = scene::load(file.to_str().unwrap(), None)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("objects[255].transform's read") && err.contains("past 1024 MiB"),
+        "{err}"
+    );
 }
 
 /// An OBJ repeating a quad thousands of times (in every rotation and winding) loads as the
