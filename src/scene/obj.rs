@@ -397,10 +397,15 @@ fn check_face_indices(text: &str) -> Result<(), String> {
         };
         for (at, word) in words.enumerate() {
             for (kind, part) in word.split('/').enumerate().take(3) {
-                if kind > 0 && (part.is_empty() || totals[kind] == 0) {
+                if kind > 0 && part.is_empty() {
                     continue;
                 }
-                let resolves = part.parse::<i64>().is_ok_and(|i| match i {
+                let index = part.parse::<i64>();
+                // tobj ignores them where the file has none, but parses them all the same.
+                if kind > 0 && totals[kind] == 0 && index.is_ok() {
+                    continue;
+                }
+                let resolves = index.is_ok_and(|i| match i {
                     0 => false,
                     i if i > 0 => i <= totals[kind],
                     i => i.unsigned_abs() <= defined[kind].unsigned_abs(),

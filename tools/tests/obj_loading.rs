@@ -254,6 +254,13 @@ fn malformed_obj_files_are_clear_errors() {
             "v nan 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
             "positions",
         ),
+        // A normal index past i64 in a file with no normals: tobj's "face parse error"
+        // named no line.
+        (
+            "wide.obj",
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1//99999999999999999999 2 3\n",
+            "line 4: `f` corner 1: its normal index",
+        ),
         ("empty.obj", "# nothing here\n", "no faces"),
     ];
     for (name, text, needle) in cases {
