@@ -109,9 +109,8 @@ impl Material {
         }
     }
 
-    /// The exponent the light model uses: `Ns` clamped to [1, [`MAX_SHININESS`]]. `pow(0, 0)`
-    /// is undefined in GLSL, and MTL files commonly say `Ns 0` for "no highlight" together
-    /// with `Ks 0`.
+    /// The exponent the light model uses: `Ns` clamped to [1, 4096]. `pow(0, 0)` is undefined
+    /// in GLSL, and MTL files commonly say `Ns 0` for "no highlight" together with `Ks 0`.
     pub fn shading_exponent(&self) -> f32 {
         self.shininess.clamp(1.0, MAX_SHININESS)
     }
