@@ -1,20 +1,12 @@
-//! OBJ + MTL loading (tobj) with textures (image).
-//!
-//! Real MTL files name textures with other letter case than the file on disk, with Windows
-//! backslashes, or with folders that were flattened when the model was shared. Resolution
-//! tries, in order: the path as written (backslashes turned into `/`) relative to the MTL's
-//! folder; the same path matched case-insensitively component by component; the bare file
-//! name, case-insensitively, in the MTL's folder. A texture that is still not found, or that
-//! does not decode, is a warning and the material falls back to its flat `Kd` colour — the load
-//! never aborts for a texture.
+//! OBJ + MTL loading (tobj) with textures (image; found and decoded in `obj/textures.rs`).
 //!
 //! A model reads only files in its own folder (the OBJ's), as a glTF does (`access.rs`):
 //! an `mtllib` or texture named by `..` or an absolute path, or a link leading out, is refused
-//! with a warning unless [`LoadOptions::allow_outside_files`]. A texture named outside (an
-//! exporter's `C:\Users\…\wood.png`) is still looked for by its bare file name in the folder.
+//! with a warning unless [`LoadOptions::allow_outside_files`]. A texture that is missing,
+//! refused or does not decode is a warning and the material keeps its flat `Kd` colour — the
+//! load never aborts for a texture.
 
-use std::collections::HashMap;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::Arc;
 
 use glam::{DMat4, DVec3, Vec2, Vec3};
@@ -23,7 +15,12 @@ use super::access::{self, LoadOptions};
 use super::input::{read_bounded, FileKind};
 use super::material::{MAX_COLOR_FACTOR, MAX_SHININESS};
 use super::texture_budget::TextureBudget;
-use super::{shown, Aabb, Material, Mesh, Object, Scene, SceneError, Texture};
+use super::{shown, Aabb, Material, Mesh, Object, Scene, SceneError};
+
+mod textures;
+
+pub use textures::resolve_texture;
+use textures::{find_texture, TextureCache};
 
 /// What an OBJ load produced besides the objects: non-fatal problems, for the caller to show.
 #[derive(Debug, Default)]
@@ -61,7 +58,8 @@ pub fn load_into(
     }
     let base_dir = path.parent().unwrap_or(Path::new("."));
     let mut textures = TextureCache::default();
-    let override_tex = texture_override.and_then(|p| textures.load(p, &mut report, budget));
+    let override_tex =
+        texture_override.and_then(|p| textures.load(p, budget, &mut |w| report.warn(w)));
     let mtl = match materials {
         Ok(m) => m,
         Err(e) => {
@@ -79,7 +77,7 @@ pub fn load_into(
         let texture = match &m.diffuse_texture {
             Some(name) if !name.trim().is_empty() => {
                 match find_texture(base_dir, name, allow_outside) {
-                    Ok(Some(p)) => textures.load(&p, &mut report, budget),
+                    Ok(Some(p)) => textures.load(&p, budget, &mut |w| report.warn(w)),
                     Ok(None) => {
                         // Something there that is not a file (`/dev/zero`, a folder) is named so.
                         let what = if base_dir.join(name.trim()).exists() {
@@ -446,47 +444,6 @@ fn check_mtl(text: &str) -> Result<(), String> {
     Ok(())
 }
 
-/// Decodes a texture file read within its size limit, refusing images whose decoded size
-/// would pass [`MAX_TEXTURE_SIDE`] on a side (a small PNG can claim 100 000² pixels), and
-/// images past what is left of `budget`. The error completes "texture NAME …".
-fn decode_texture(path: &Path, budget: &mut TextureBudget) -> Result<image::DynamicImage, String> {
-    let bytes =
-        read_bounded(path, FileKind::Texture).map_err(|e| format!("could not be decoded ({e})"))?;
-    // The extension first: TGA has no magic bytes to guess from.
-    decode_texture_bytes(&bytes, image::ImageFormat::from_path(path).ok(), budget)
-}
-
-/// Decodes an encoded texture (OBJ and glTF alike): the stated format first, the contents
-/// decide otherwise; at most [`MAX_TEXTURE_SIDE`] pixels a side and
-/// [`MAX_DECODE_BYTES`](super::texture_budget::MAX_DECODE_BYTES) decoded, so a header claiming
-/// a giant image fails before any allocation; and only where what it is kept as fits what is
-/// left of `budget` (its header says, before anything is decoded). The error completes
-/// "texture NAME …".
-pub(crate) fn decode_texture_bytes(
-    bytes: &[u8],
-    format: Option<image::ImageFormat>,
-    budget: &mut TextureBudget,
-) -> Result<image::DynamicImage, String> {
-    let undecodable = |e: image::ImageError| format!("could not be decoded ({e})");
-    let reader = || {
-        let mut reader = image::ImageReader::new(std::io::Cursor::new(bytes));
-        if let Some(format) = format {
-            reader.set_format(format);
-        }
-        let mut reader = reader
-            .with_guessed_format()
-            .map_err(|e| format!("could not be decoded ({e})"))?;
-        reader.limits(super::texture_budget::limits());
-        Ok::<_, String>(reader)
-    };
-    let (w, h) = reader()?.into_dimensions().map_err(undecodable)?;
-    let taken = budget.take(w, h)?;
-    reader()?.decode().map_err(|e| {
-        budget.give_back(taken);
-        undecodable(e)
-    })
-}
-
 /// Largest texture side decoded, in pixels (the largest `GL_MAX_TEXTURE_SIZE` common on phones;
 /// the image is then kept within [`super::texture_budget::MAX_STORED_TEXTURE_SIDE`]).
 pub const MAX_TEXTURE_SIDE: u32 = super::texture_budget::MAX_DECODED_SIDE;
@@ -500,187 +457,22 @@ impl LoadReport {
     }
 }
 
-#[derive(Default)]
-struct TextureCache {
-    loaded: HashMap<PathBuf, Option<Arc<Texture>>>,
-}
-
-impl TextureCache {
-    fn load(
-        &mut self,
-        path: &Path,
-        report: &mut LoadReport,
-        budget: &mut TextureBudget,
-    ) -> Option<Arc<Texture>> {
-        if let Some(t) = self.loaded.get(path) {
-            return t.clone();
-        }
-        let tex = match decode_texture(path, budget) {
-            Ok(img) => {
-                let name = path.display().to_string();
-                let (image, scaled) = super::texture_budget::to_rgba8(img, &name);
-                if let Some(w) = scaled {
-                    report.warn(w);
-                }
-                Some(Arc::new(Texture { name, image }))
-            }
-            Err(why) => {
-                report.warn(format!(
-                    "texture {} {why}; using the flat colour",
-                    path.display()
-                ));
-                None
-            }
-        };
-        self.loaded.insert(path.to_path_buf(), tex.clone());
-        tex
-    }
-}
-
-/// The file an MTL texture reference names, inside `base_dir` (links resolved) unless
-/// `allow_outside`: `Ok(None)` when none is found, `Err` with the refusal when the name leads
-/// out of the folder and its bare file name is not in it either.
-fn find_texture(
-    base_dir: &Path,
-    name: &str,
-    allow_outside: bool,
-) -> Result<Option<PathBuf>, String> {
-    let Some(written) = name.split_whitespace().last() else {
-        return Ok(None);
-    };
-    let written = written.replace('\\', "/");
-    let found = match access::join(base_dir, &written, allow_outside) {
-        Ok(_) => resolve_texture(base_dir, name),
-        Err(refusal) => match bare_file_in(base_dir, &written) {
-            Some(p) => Some(p),
-            None => return Err(refusal),
-        },
-    };
-    // Checked with its links resolved, kept as found (its name in messages stays the model's).
-    found
-        .map(|p| access::resolve(base_dir, &p, allow_outside).map(|_| p))
-        .transpose()
-}
-
-/// The file `name`'s last component names in `dir` (in any letter case), if it is one.
-fn bare_file_in(dir: &Path, name: &str) -> Option<PathBuf> {
-    let file_name = name
-        .rsplit('/')
-        .next()
-        .filter(|n| !n.is_empty() && *n != "..")?;
-    find_case_insensitive(dir, file_name).filter(|p| p.is_file())
-}
-
-/// Finds the file an MTL texture reference means (see the module docs for the order).
-pub fn resolve_texture(base_dir: &Path, name: &str) -> Option<PathBuf> {
-    // MTL options such as `-bm 0.5 file.png` put the file name last.
-    let name = name.split_whitespace().last()?.replace('\\', "/");
-    let as_written = base_dir.join(&name);
-    if as_written.is_file() {
-        return Some(as_written);
-    }
-    let mut dir = base_dir.to_path_buf();
-    let mut matched = true;
-    for part in name.split('/').filter(|p| !p.is_empty() && *p != ".") {
-        match find_case_insensitive(&dir, part) {
-            Some(p) => dir = p,
-            None => {
-                matched = false;
-                break;
-            }
-        }
-    }
-    if matched && dir.is_file() {
-        return Some(dir);
-    }
-    let file_name = name.rsplit('/').next()?;
-    find_case_insensitive(base_dir, file_name).filter(|p| p.is_file())
-}
-
-fn find_case_insensitive(dir: &Path, name: &str) -> Option<PathBuf> {
-    if name == ".." {
-        return Some(dir.join(".."));
-    }
-    let lower = name.to_lowercase();
-    std::fs::read_dir(dir)
-        .ok()?
-        .filter_map(Result::ok)
-        .find(|e| e.file_name().to_string_lossy().to_lowercase() == lower)
-        .map(|e| e.path())
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    #[test]
-    fn resolves_case_and_backslashes() {
-        let dir = tempfile::tempdir().unwrap();
-        std::fs::create_dir(dir.path().join("Textures")).unwrap();
-        std::fs::write(dir.path().join("Textures").join("Brick.PNG"), b"x").unwrap();
-        let want = dir.path().join("Textures").join("Brick.PNG");
-        assert_eq!(
-            resolve_texture(dir.path(), "textures\\brick.png"),
-            Some(want.clone())
-        );
-        assert_eq!(
-            resolve_texture(dir.path(), "TEXTURES/BRICK.png"),
-            Some(want.clone())
-        );
-        assert_eq!(
-            resolve_texture(dir.path(), "-bm 1 Textures/Brick.PNG"),
-            Some(want)
-        );
-        assert_eq!(resolve_texture(dir.path(), "missing.png"), None);
-    }
-
-    /// A model folder inside a temporary root holding `secret.png` and `secret.mtl`.
-    fn model_beside_secrets() -> (tempfile::TempDir, PathBuf) {
+    /// A model folder inside a temporary root holding `secret.mtl`.
+    fn model_beside_a_secret_library() -> (tempfile::TempDir, std::path::PathBuf) {
         let root = tempfile::tempdir().unwrap();
         let model = root.path().join("model");
         std::fs::create_dir(&model).unwrap();
-        image::RgbaImage::from_pixel(2, 2, image::Rgba([255, 0, 0, 255]))
-            .save(root.path().join("secret.png"))
-            .unwrap();
         std::fs::write(root.path().join("secret.mtl"), "newmtl red\nKd 1 0 0\n").unwrap();
         (root, model)
     }
 
     #[test]
-    fn textures_outside_the_models_folder_are_refused_unless_allowed() {
-        let (root, model) = model_beside_secrets();
-        let secret = root.path().join("secret.png");
-        let absolute = secret.to_str().unwrap().to_string();
-        for name in ["../secret.png", "./../secret.png", absolute.as_str()] {
-            let refusal = find_texture(&model, name, false).unwrap_err();
-            assert!(
-                refusal.contains("outside the model's folder"),
-                "{name}: {refusal}"
-            );
-            assert!(
-                find_texture(&model, name, true).unwrap().is_some(),
-                "{name}"
-            );
-        }
-        #[cfg(unix)]
-        {
-            std::os::unix::fs::symlink(&secret, model.join("link.png")).unwrap();
-            let refusal = find_texture(&model, "link.png", false).unwrap_err();
-            assert!(refusal.contains("a link leads out"), "{refusal}");
-            assert!(find_texture(&model, "link.png", true).unwrap().is_some());
-        }
-        // An exporter's absolute path is still found by its file name in the folder.
-        std::fs::write(model.join("wood.png"), b"x").unwrap();
-        let found = find_texture(&model, "C:\\Users\\bob\\Wood.PNG", false).unwrap();
-        assert_eq!(found, Some(model.join("wood.png")));
-        let found = find_texture(&model, "/home/bob/maps/wood.png", false).unwrap();
-        assert_eq!(found, Some(model.join("wood.png")));
-        assert_eq!(find_texture(&model, "missing.png", false).unwrap(), None);
-    }
-
-    #[test]
     fn a_material_library_outside_the_models_folder_is_refused_unless_allowed() {
-        let (_root, model) = model_beside_secrets();
+        let (_root, model) = model_beside_a_secret_library();
         let obj = model.join("m.obj");
         let faces = "v 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl red\nf 1 2 3\n";
         std::fs::write(&obj, format!("mtllib ../secret.mtl\n{faces}")).unwrap();
@@ -793,15 +585,5 @@ mod tests {
                 report.warnings
             );
         }
-    }
-
-    #[test]
-    fn flattened_folders_fall_back_to_the_file_name() {
-        let dir = tempfile::tempdir().unwrap();
-        std::fs::write(dir.path().join("wood.jpg"), b"x").unwrap();
-        assert_eq!(
-            resolve_texture(dir.path(), "C:\\models\\maps\\Wood.JPG"),
-            Some(dir.path().join("wood.jpg"))
-        );
     }
 }

@@ -59,6 +59,37 @@ pub fn to_rgba8(image: DynamicImage, name: &str) -> (image::RgbaImage, Option<St
     (scaled.into_rgba8(), Some(warning))
 }
 
+/// Decodes an encoded texture (OBJ and glTF alike): the stated format first, the contents
+/// decide otherwise; at most [`MAX_DECODED_SIDE`] pixels a side and
+/// [`MAX_DECODE_BYTES`] decoded, so a header claiming
+/// a giant image fails before any allocation; and only where what it is kept as fits what is
+/// left of `budget` (its header says, before anything is decoded). The error completes
+/// "texture NAME …".
+pub(crate) fn decode_texture_bytes(
+    bytes: &[u8],
+    format: Option<image::ImageFormat>,
+    budget: &mut TextureBudget,
+) -> Result<image::DynamicImage, String> {
+    let undecodable = |e: image::ImageError| format!("could not be decoded ({e})");
+    let reader = || {
+        let mut reader = image::ImageReader::new(std::io::Cursor::new(bytes));
+        if let Some(format) = format {
+            reader.set_format(format);
+        }
+        let mut reader = reader
+            .with_guessed_format()
+            .map_err(|e| format!("could not be decoded ({e})"))?;
+        reader.limits(limits());
+        Ok::<_, String>(reader)
+    };
+    let (w, h) = reader()?.into_dimensions().map_err(undecodable)?;
+    let taken = budget.take(w, h)?;
+    reader()?.decode().map_err(|e| {
+        budget.give_back(taken);
+        undecodable(e)
+    })
+}
+
 /// Most bytes the textures of one scene load keep (RGBA8, each within
 /// [`MAX_STORED_TEXTURE_SIDE`]): 16 images of 4096², 256 of 1024². More than a phone's GPU
 /// holds; without a total, a few megabytes of PNGs (each one colour, so each compresses to

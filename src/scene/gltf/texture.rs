@@ -12,8 +12,8 @@ use std::sync::Arc;
 use super::buffers::Buffers;
 use super::uri::{self, Uri};
 use crate::scene::input::{read_bounded, FileKind, LIMIT_VARIABLE};
-use crate::scene::obj::{decode_texture_bytes, resolve_texture};
-use crate::scene::texture_budget::{self, TextureBudget};
+use crate::scene::obj::resolve_texture;
+use crate::scene::texture_budget::{self, decode_texture_bytes, TextureBudget};
 use crate::scene::Texture;
 use crate::scene::{access, shown};
 

@@ -1,0 +1,219 @@
+//! An MTL file's textures: found, confined to the model's folder, decoded once each.
+//!
+//! Real MTL files name textures with other letter case than the file on disk, with Windows
+//! backslashes, or with folders that were flattened when the model was shared. Resolution
+//! tries, in order: the path as written (backslashes turned into `/`) relative to the MTL's
+//! folder; the same path matched case-insensitively component by component; the bare file
+//! name, case-insensitively, in the MTL's folder. A name leading out of the model's folder is
+//! refused unless allowed, but its bare file name is still looked for in the folder (an
+//! exporter's `C:\Users\…\wood.png`).
+
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use crate::scene::access;
+use crate::scene::input::{read_bounded, FileKind};
+use crate::scene::texture_budget::{self, decode_texture_bytes, TextureBudget};
+use crate::scene::Texture;
+
+/// The textures one OBJ load decoded, by path (`None`: failed, warned once).
+#[derive(Default)]
+pub(super) struct TextureCache {
+    loaded: HashMap<PathBuf, Option<Arc<Texture>>>,
+}
+
+impl TextureCache {
+    /// The texture at `path`, decoded on first use within `budget`; `warn` hears of a texture
+    /// scaled down or left out.
+    pub(super) fn load(
+        &mut self,
+        path: &Path,
+        budget: &mut TextureBudget,
+        warn: &mut dyn FnMut(String),
+    ) -> Option<Arc<Texture>> {
+        if let Some(t) = self.loaded.get(path) {
+            return t.clone();
+        }
+        let tex = match decode_texture(path, budget) {
+            Ok(img) => {
+                let name = path.display().to_string();
+                let (image, scaled) = texture_budget::to_rgba8(img, &name);
+                if let Some(w) = scaled {
+                    warn(w);
+                }
+                Some(Arc::new(Texture { name, image }))
+            }
+            Err(why) => {
+                warn(format!(
+                    "texture {} {why}; using the flat colour",
+                    path.display()
+                ));
+                None
+            }
+        };
+        self.loaded.insert(path.to_path_buf(), tex.clone());
+        tex
+    }
+}
+
+/// Decodes a texture file read within its size limit, refusing images whose decoded size
+/// would pass [`MAX_TEXTURE_SIDE`](super::MAX_TEXTURE_SIDE) on a side (a small PNG can claim 100 000² pixels), and
+/// images past what is left of `budget`. The error completes "texture NAME …".
+fn decode_texture(path: &Path, budget: &mut TextureBudget) -> Result<image::DynamicImage, String> {
+    let bytes =
+        read_bounded(path, FileKind::Texture).map_err(|e| format!("could not be decoded ({e})"))?;
+    // The extension first: TGA has no magic bytes to guess from.
+    decode_texture_bytes(&bytes, image::ImageFormat::from_path(path).ok(), budget)
+}
+
+/// The file an MTL texture reference names, inside `base_dir` (links resolved) unless
+/// `allow_outside`: `Ok(None)` when none is found, `Err` with the refusal when the name leads
+/// out of the folder and its bare file name is not in it either.
+pub(super) fn find_texture(
+    base_dir: &Path,
+    name: &str,
+    allow_outside: bool,
+) -> Result<Option<PathBuf>, String> {
+    let Some(written) = name.split_whitespace().last() else {
+        return Ok(None);
+    };
+    let written = written.replace('\\', "/");
+    let found = match access::join(base_dir, &written, allow_outside) {
+        Ok(_) => resolve_texture(base_dir, name),
+        Err(refusal) => match bare_file_in(base_dir, &written) {
+            Some(p) => Some(p),
+            None => return Err(refusal),
+        },
+    };
+    // Checked with its links resolved, kept as found (its name in messages stays the model's).
+    found
+        .map(|p| access::resolve(base_dir, &p, allow_outside).map(|_| p))
+        .transpose()
+}
+
+/// The file `name`'s last component names in `dir` (in any letter case), if it is one.
+fn bare_file_in(dir: &Path, name: &str) -> Option<PathBuf> {
+    let file_name = name
+        .rsplit('/')
+        .next()
+        .filter(|n| !n.is_empty() && *n != "..")?;
+    find_case_insensitive(dir, file_name).filter(|p| p.is_file())
+}
+
+/// Finds the file an MTL texture reference means (see the module docs for the order).
+pub fn resolve_texture(base_dir: &Path, name: &str) -> Option<PathBuf> {
+    // MTL options such as `-bm 0.5 file.png` put the file name last.
+    let name = name.split_whitespace().last()?.replace('\\', "/");
+    let as_written = base_dir.join(&name);
+    if as_written.is_file() {
+        return Some(as_written);
+    }
+    let mut dir = base_dir.to_path_buf();
+    let mut matched = true;
+    for part in name.split('/').filter(|p| !p.is_empty() && *p != ".") {
+        match find_case_insensitive(&dir, part) {
+            Some(p) => dir = p,
+            None => {
+                matched = false;
+                break;
+            }
+        }
+    }
+    if matched && dir.is_file() {
+        return Some(dir);
+    }
+    let file_name = name.rsplit('/').next()?;
+    find_case_insensitive(base_dir, file_name).filter(|p| p.is_file())
+}
+
+fn find_case_insensitive(dir: &Path, name: &str) -> Option<PathBuf> {
+    if name == ".." {
+        return Some(dir.join(".."));
+    }
+    let lower = name.to_lowercase();
+    std::fs::read_dir(dir)
+        .ok()?
+        .filter_map(Result::ok)
+        .find(|e| e.file_name().to_string_lossy().to_lowercase() == lower)
+        .map(|e| e.path())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn resolves_case_and_backslashes() {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::create_dir(dir.path().join("Textures")).unwrap();
+        std::fs::write(dir.path().join("Textures").join("Brick.PNG"), b"x").unwrap();
+        let want = dir.path().join("Textures").join("Brick.PNG");
+        assert_eq!(
+            resolve_texture(dir.path(), "textures\\brick.png"),
+            Some(want.clone())
+        );
+        assert_eq!(
+            resolve_texture(dir.path(), "TEXTURES/BRICK.png"),
+            Some(want.clone())
+        );
+        assert_eq!(
+            resolve_texture(dir.path(), "-bm 1 Textures/Brick.PNG"),
+            Some(want)
+        );
+        assert_eq!(resolve_texture(dir.path(), "missing.png"), None);
+    }
+
+    /// A model folder inside a temporary root holding `secret.png`.
+    fn model_beside_a_secret_image() -> (tempfile::TempDir, PathBuf) {
+        let root = tempfile::tempdir().unwrap();
+        let model = root.path().join("model");
+        std::fs::create_dir(&model).unwrap();
+        image::RgbaImage::from_pixel(2, 2, image::Rgba([255, 0, 0, 255]))
+            .save(root.path().join("secret.png"))
+            .unwrap();
+        (root, model)
+    }
+
+    #[test]
+    fn textures_outside_the_models_folder_are_refused_unless_allowed() {
+        let (root, model) = model_beside_a_secret_image();
+        let secret = root.path().join("secret.png");
+        let absolute = secret.to_str().unwrap().to_string();
+        for name in ["../secret.png", "./../secret.png", absolute.as_str()] {
+            let refusal = find_texture(&model, name, false).unwrap_err();
+            assert!(
+                refusal.contains("outside the model's folder"),
+                "{name}: {refusal}"
+            );
+            assert!(
+                find_texture(&model, name, true).unwrap().is_some(),
+                "{name}"
+            );
+        }
+        #[cfg(unix)]
+        {
+            std::os::unix::fs::symlink(&secret, model.join("link.png")).unwrap();
+            let refusal = find_texture(&model, "link.png", false).unwrap_err();
+            assert!(refusal.contains("a link leads out"), "{refusal}");
+            assert!(find_texture(&model, "link.png", true).unwrap().is_some());
+        }
+        // An exporter's absolute path is still found by its file name in the folder.
+        std::fs::write(model.join("wood.png"), b"x").unwrap();
+        let found = find_texture(&model, "C:\\Users\\bob\\Wood.PNG", false).unwrap();
+        assert_eq!(found, Some(model.join("wood.png")));
+        let found = find_texture(&model, "/home/bob/maps/wood.png", false).unwrap();
+        assert_eq!(found, Some(model.join("wood.png")));
+        assert_eq!(find_texture(&model, "missing.png", false).unwrap(), None);
+    }
+
+    #[test]
+    fn flattened_folders_fall_back_to_the_file_name() {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join("wood.jpg"), b"x").unwrap();
+        assert_eq!(
+            resolve_texture(dir.path(), "C:\\models\\maps\\Wood.JPG"),
+            Some(dir.path().join("wood.jpg"))
+        );
+    }
+}
