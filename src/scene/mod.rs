@@ -408,7 +408,24 @@ pub fn load_with(
             },
         });
     }
-    Ok(loaded)
+    let (scene, mut report) = loaded;
+    // Drawn, but a frame of background only: said, not left silent.
+    let invisible = |o: &Object| {
+        scene
+            .materials
+            .get(o.material)
+            .is_some_and(|m| m.alpha <= 0.0)
+    };
+    if !scene.objects.is_empty() && scene.objects.iter().all(invisible) {
+        let warning = format!(
+            "{}: every object's material is fully transparent (alpha 0: MTL `d 0`, a glTF base \
+             colour alpha of 0): the frame shows the background only",
+            shown::text(&path.display().to_string())
+        );
+        log::warn!("{warning}");
+        report.warnings.push(warning);
+    }
+    Ok((scene, report))
 }
 
 /// Whether `transform` leaves a triangle whose normal lies in `span` ([`Mesh::normal_span`])

@@ -599,3 +599,29 @@ fn mtl_statements_the_blinn_phong_material_cannot_apply_are_named_once() {
     let (_, report) = load_obj(&plain).unwrap();
     assert!(report.warnings.is_empty(), "{:?}", report.warnings);
 }
+
+/// A model whose every material is fully transparent would render the background alone: the
+/// load says so rather than leaving a blank frame unexplained. One visible object is enough.
+#[test]
+fn a_model_drawn_fully_transparent_is_warned_of() {
+    let dir = tempfile::tempdir().unwrap();
+    let mtl = "newmtl glass\nKd 1 1 1\nd 0\nnewmtl stone\nKd 1 1 1\n";
+    write(dir.path(), "m.mtl", mtl);
+    let faces = |names: &[&str]| {
+        let mut obj = String::from("mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\n");
+        for name in names {
+            obj += &format!("usemtl {name}\nf 1 2 3\n");
+        }
+        obj
+    };
+    let warned = |obj: String| {
+        let path = write(dir.path(), "m.obj", &obj);
+        let (_, report) = scene::load(path.to_str().unwrap(), None).unwrap();
+        report
+            .warnings
+            .iter()
+            .any(|w| w.contains("fully transparent"))
+    };
+    assert!(warned(faces(&["glass"])));
+    assert!(!warned(faces(&["glass", "stone"])));
+}
