@@ -160,6 +160,35 @@ fn image_uris_outside_the_models_folder_are_refused_unless_allowed() {
         assert!(report.warnings.is_empty(), "{uri}: {:?}", report.warnings);
         assert!(scene.materials[0].diffuse_texture.is_some(), "{uri}");
     }
+    // A folder in the model's folder is named as not a file (it was "not found"); a link to a
+    // device outside is refused as leading out.
+    std::fs::create_dir(out.model().join("maps")).unwrap();
+    #[cfg(unix)]
+    std::os::unix::fs::symlink("/dev/zero", out.model().join("zero.png")).unwrap();
+    let image_doc = |uri: &str| {
+        json!({
+            "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+            "meshes": [{"primitives": [prim]}],
+            "materials": [{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}],
+            "textures": [{"source": 0}], "images": [{"uri": uri}],
+        })
+    };
+    let path = write(&out.model(), "m.gltf", b.gltf(image_doc("maps")));
+    let (scene, report) = load(&path).unwrap();
+    assert!(
+        report
+            .warnings
+            .iter()
+            .any(|w| w.contains("`maps` is not a regular file")),
+        "{:?}",
+        report.warnings
+    );
+    assert!(scene.materials[0].diffuse_texture.is_none());
+    if cfg!(unix) {
+        let path = write(&out.model(), "m.gltf", b.gltf(image_doc("zero.png")));
+        let err = load(&path).unwrap_err().to_string();
+        assert!(err.contains("a link leads out"), "{err}");
+    }
 }
 
 #[test]

@@ -150,6 +150,16 @@ fn encoded(
             // inside the folder (a link may lead out).
             let path = if as_written.is_file() {
                 Some(as_written)
+            } else if as_written.exists() {
+                // A FIFO, device or folder (or a link to one): named so, once it is known to
+                // lie inside the folder.
+                access::resolve(base_dir, &as_written, allow_outside)
+                    .map_err(|e| format!("{uri_field}: {e}"))?;
+                return Ok(Err(format!(
+                    "{field}: texture `{}` is not a regular file (a folder, device or FIFO); \
+                     using its flat colour",
+                    shown::name(&name)
+                )));
             } else {
                 resolve_texture(base_dir, &name)
             };
