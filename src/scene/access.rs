@@ -50,10 +50,22 @@ pub(crate) fn join(dir: &Path, name: &str, allow_outside: bool) -> Result<PathBu
 /// `path` (found from `dir` through [`join`]) with its links resolved. Unless
 /// `allow_outside`, a path whose real location is not inside `dir`'s is refused: a link in
 /// the model's folder may not lead out of it. A path that does not exist comes back as it is
-/// (reading it says so).
+/// (reading it says so); one whose links cannot be resolved otherwise (a chain of them too
+/// long to spell out, which opening it would still follow) is refused.
 pub(crate) fn resolve(dir: &Path, path: &Path, allow_outside: bool) -> Result<PathBuf, String> {
-    let Ok(real) = path.canonicalize() else {
-        return Ok(path.to_path_buf());
+    let real = match path.canonicalize() {
+        Ok(real) => real,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound || allow_outside => {
+            return Ok(path.to_path_buf())
+        }
+        Err(e) => {
+            let shown = path.strip_prefix(dir).unwrap_or(path);
+            return Err(format!(
+                "`{}` cannot be resolved to check it lies in the model's folder ({e}); \
+                 refused: {HOW_TO_ALLOW}",
+                super::shown::name(&shown.to_string_lossy())
+            ));
+        }
     };
     if allow_outside {
         return Ok(real);
@@ -126,6 +138,39 @@ mod tests {
         assert_eq!(std::fs::read(real).unwrap(), b"I");
         let missing = model.join("missing.bin");
         assert_eq!(resolve(&model, &missing, false).unwrap(), missing);
+    }
+
+    /// Links whose spelled-out target passes `PATH_MAX` (so resolving them fails with "file
+    /// name too long") still lead where opening follows them: out of the folder here.
+    #[cfg(unix)]
+    #[test]
+    fn links_too_long_to_resolve_are_refused() {
+        use std::os::unix::fs::symlink;
+        let root = tempfile::tempdir().unwrap();
+        let model = root.path().join("model");
+        std::fs::write(root.path().join("secret.txt"), b"S").unwrap();
+        let names: Vec<String> = (0..20)
+            .map(|i| format!("{i:02}{}", "d".repeat(248)))
+            .collect();
+        // Made in two halves through a short link (the whole is past what a path may spell).
+        let middle = names[..10].iter().fold(model.clone(), |p, n| p.join(n));
+        std::fs::create_dir_all(&middle).unwrap();
+        symlink(names[..10].join("/"), model.join("m")).unwrap();
+        let middle = model.join("m");
+        let deepest = names[10..].iter().fold(middle.clone(), |p, n| p.join(n));
+        std::fs::create_dir_all(&deepest).unwrap();
+        symlink(names[..10].join("/"), model.join("a")).unwrap();
+        symlink(names[10..].join("/"), middle.join("b")).unwrap();
+        symlink(format!("{}secret.txt", "../".repeat(21)), deepest.join("c")).unwrap();
+        let path = model.join("a/b/c");
+        assert_eq!(
+            std::fs::read(&path).unwrap(),
+            b"S",
+            "the kernel follows the chain"
+        );
+        let err = resolve(&model, &path, false).unwrap_err();
+        assert!(err.contains("cannot be resolved"), "{err}");
+        assert_eq!(resolve(&model, &path, true).unwrap(), path);
     }
 
     #[test]

@@ -20,7 +20,7 @@ use super::{shown, Aabb, Material, Mesh, Object, Scene, SceneError};
 mod textures;
 
 pub use textures::resolve_texture;
-use textures::{find_texture, TextureCache};
+use textures::{bare_file_in, find_texture, TextureCache};
 
 /// What an OBJ load produced besides the objects: non-fatal problems, for the caller to show.
 #[derive(Debug, Default)]
@@ -43,7 +43,10 @@ pub fn load_into(
 ) -> Result<LoadReport, SceneError> {
     let mut report = LoadReport::default();
     let allow_outside = options.allow_outside_files;
-    let (models, materials, not_utf8) = parse_obj(path, allow_outside)?;
+    let (models, materials, not_utf8, mtl_warnings) = parse_obj(path, allow_outside)?;
+    for warning in mtl_warnings {
+        report.warn(warning);
+    }
     if not_utf8 {
         report.warn(format!(
             "{}: not UTF-8 text; bytes that are not (in names) were replaced by U+FFFD",
@@ -74,7 +77,10 @@ pub fn load_into(
     for m in &mtl {
         // The name as messages (and the renderer's stats) show it.
         let material_name = shown::name(&m.name);
+        // The caller's texture replaces the MTL's, which is then not even decoded (it would
+        // take its part of the budget for nothing).
         let texture = match &m.diffuse_texture {
+            _ if override_tex.is_some() => None,
             Some(name) if !name.trim().is_empty() => {
                 match find_texture(base_dir, name, allow_outside) {
                     Ok(Some(p)) => textures.load(&p, budget, &mut |w| report.warn(w)),
@@ -211,10 +217,12 @@ pub fn load_into(
 /// first for what tobj would panic on. tobj runs under `catch_unwind` as a last guard: a panic
 /// inside it becomes an error naming the file, never an abort of the caller. The last value
 /// is true when the OBJ was not UTF-8 (read lossily, see [`text_of`]).
+/// The warnings are the material libraries' (each refused, unreadable or malformed one).
 type Parsed = (
     Vec<tobj::Model>,
     Result<Vec<tobj::Material>, tobj::LoadError>,
     bool,
+    Vec<String>,
 );
 
 /// OBJ or MTL bytes as the text tobj reads: bytes that are not UTF-8 (a Latin-1 name)
@@ -250,32 +258,37 @@ fn parse_obj(path: &Path, allow_outside: bool) -> Result<Parsed, SceneError> {
     // Each library is read once: tobj reads and merges one again for every `mtllib` line, so
     // a file repeating the line millions of times would exhaust memory.
     let seen = std::cell::RefCell::new(std::collections::HashSet::new());
+    let warnings = std::cell::RefCell::new(Vec::new());
+    let warn = |w: String| warnings.borrow_mut().push(w);
     let load_mtl = |name: &Path| -> tobj::MTLLoadResult {
-        let mtl_path = access::join(&base_dir, &name.to_string_lossy(), allow_outside)
+        let name = name.to_string_lossy().replace('\\', "/");
+        // Named outside the folder (an exporter's absolute path): its file name in the folder.
+        let found = match access::join(&base_dir, &name, allow_outside) {
+            Ok(p) => Ok(p),
+            Err(refusal) => bare_file_in(&base_dir, &name).ok_or(refusal),
+        };
+        let mtl_path = found
             .and_then(|p| access::resolve(&base_dir, &p, allow_outside).map(|_| p))
             .map_err(|refusal| {
-                log::warn!(
-                    "{}",
-                    shown::text(&format!("{}: mtllib {refusal}", path.display()))
-                );
+                warn(format!("{}: mtllib {refusal}", path.display()));
                 tobj::LoadError::OpenFileFailed
             })?;
         if !seen.borrow_mut().insert(mtl_path.clone()) {
             return Ok(Default::default());
         }
         let bytes = read_bounded(&mtl_path, FileKind::Materials).map_err(|e| {
-            log::warn!("{e}");
+            warn(e.to_string());
             tobj::LoadError::OpenFileFailed
         })?;
         let (text, not_utf8) = text_of(&bytes);
         if not_utf8 {
-            log::warn!(
+            warn(format!(
                 "{}: not UTF-8 text; bytes that are not (in names) were replaced by U+FFFD",
                 mtl_path.display()
-            );
+            ));
         }
         if let Err(line) = check_mtl(&text) {
-            log::warn!("{}: {line}", mtl_path.display());
+            warn(format!("{}: {line}", mtl_path.display()));
             return Err(tobj::LoadError::MaterialParseError);
         }
         tobj::load_mtl_buf(&mut std::io::BufReader::new(text.as_bytes()))
@@ -291,9 +304,10 @@ fn parse_obj(path: &Path, allow_outside: bool) -> Result<Parsed, SceneError> {
         path: path.to_path_buf(),
         reason,
     };
+    let warnings = warnings.into_inner();
     match parsed {
         Ok(result) => result
-            .map(|(models, materials)| (models, materials, not_utf8))
+            .map(|(models, materials)| (models, materials, not_utf8, warnings))
             .map_err(|e| obj_error(e.to_string())),
         Err(_) => Err(obj_error(
             "the OBJ parser (tobj) failed on this file; it is malformed".into(),
@@ -475,7 +489,8 @@ mod tests {
         let (_root, model) = model_beside_a_secret_library();
         let obj = model.join("m.obj");
         let faces = "v 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl red\nf 1 2 3\n";
-        std::fs::write(&obj, format!("mtllib ../secret.mtl\n{faces}")).unwrap();
+        let write = |mtllib: &str| std::fs::write(&obj, format!("mtllib {mtllib}\n{faces}"));
+        write("../secret.mtl").unwrap();
         let diffuse = |allow_outside_files| {
             let mut scene = Scene::empty();
             let options = LoadOptions {
@@ -496,12 +511,54 @@ mod tests {
         };
         let (refused, warnings) = diffuse(false);
         assert_eq!(refused, Vec3::splat(0.8), "the default grey");
-        assert!(
-            warnings.iter().any(|w| w.contains("materials not loaded")),
-            "{warnings:?}"
-        );
+        for said in [
+            "mtllib `../secret.mtl` is outside the model's folder",
+            "materials not loaded",
+        ] {
+            assert!(warnings.iter().any(|w| w.contains(said)), "{warnings:?}");
+        }
         let (allowed, _) = diffuse(true);
         assert_eq!(allowed, Vec3::new(1.0, 0.0, 0.0));
+        // Named by an absolute path (an exporter's), a library in the folder is found by
+        // its file name.
+        std::fs::write(model.join("own.mtl"), "newmtl red\nKd 0 0 1\n").unwrap();
+        write("C:\\Users\\bob\\Own.MTL").unwrap();
+        assert_eq!(diffuse(false).0, Vec3::new(0.0, 0.0, 1.0));
+    }
+
+    #[test]
+    fn a_texture_override_leaves_the_mtls_texture_undecoded() {
+        let dir = tempfile::tempdir().unwrap();
+        for (name, side) in [("big.png", 64), ("small.png", 2)] {
+            image::RgbaImage::from_pixel(side, side, image::Rgba([9, 9, 9, 255]))
+                .save(dir.path().join(name))
+                .unwrap();
+        }
+        std::fs::write(dir.path().join("m.mtl"), "newmtl t\nmap_Kd big.png\n").unwrap();
+        let obj = dir.path().join("m.obj");
+        std::fs::write(
+            &obj,
+            "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl t\nf 1 2 3\n",
+        )
+        .unwrap();
+        let mut scene = Scene::empty();
+        let mut budget = TextureBudget::default();
+        let small = dir.path().join("small.png");
+        let options = LoadOptions::default();
+        load_into(
+            &mut scene,
+            &obj,
+            DMat4::IDENTITY,
+            Some(&small),
+            &options,
+            &mut budget,
+        )
+        .unwrap();
+        let mut expected = TextureBudget::default();
+        expected.take(2, 2).unwrap();
+        assert_eq!(budget, expected, "only the override's 2 × 2 taken");
+        let texture = scene.materials[0].diffuse_texture.as_ref().unwrap();
+        assert_eq!(texture.image.dimensions(), (2, 2));
     }
 
     #[test]

@@ -93,7 +93,7 @@ pub(super) fn find_texture(
 }
 
 /// The file `name`'s last component names in `dir` (in any letter case), if it is one.
-fn bare_file_in(dir: &Path, name: &str) -> Option<PathBuf> {
+pub(super) fn bare_file_in(dir: &Path, name: &str) -> Option<PathBuf> {
     let file_name = name
         .rsplit('/')
         .next()
@@ -127,12 +127,19 @@ pub fn resolve_texture(base_dir: &Path, name: &str) -> Option<PathBuf> {
     find_case_insensitive(base_dir, file_name).filter(|p| p.is_file())
 }
 
+/// The entry of `dir` named `name` in any letter case (`dir` empty: the working folder, which
+/// a model named without a folder lies in).
 fn find_case_insensitive(dir: &Path, name: &str) -> Option<PathBuf> {
     if name == ".." {
         return Some(dir.join(".."));
     }
     let lower = name.to_lowercase();
-    std::fs::read_dir(dir)
+    let listed = if dir.as_os_str().is_empty() {
+        Path::new(".")
+    } else {
+        dir
+    };
+    std::fs::read_dir(listed)
         .ok()?
         .filter_map(Result::ok)
         .find(|e| e.file_name().to_string_lossy().to_lowercase() == lower)
@@ -205,6 +212,13 @@ mod tests {
         let found = find_texture(&model, "/home/bob/maps/wood.png", false).unwrap();
         assert_eq!(found, Some(model.join("wood.png")));
         assert_eq!(find_texture(&model, "missing.png", false).unwrap(), None);
+    }
+
+    #[test]
+    fn a_model_in_the_working_folder_finds_a_bare_file_name_there() {
+        // The tests run in the package's folder, beside its Cargo.toml.
+        let found = bare_file_in(Path::new(""), "C:/Users/bob/CARGO.toml");
+        assert_eq!(found, Some(Path::new(".").join("Cargo.toml")));
     }
 
     #[test]
