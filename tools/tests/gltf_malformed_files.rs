@@ -285,11 +285,16 @@ fn structural_values_that_wrap_or_cannot_be_drawn_are_refused_by_field() {
         let err = load(&path).unwrap_err().to_string();
         assert!(err.contains(want), "{name}: {err}");
     }
-    // A flat (singular) matrix is a flat object, not an error.
+    // A flat (singular) matrix is a flat object, not an error: drawn where the triangle (in
+    // the XY plane) keeps its area, nothing to draw where it becomes a line.
     let mut doc = base.clone();
-    doc["nodes"][0]["matrix"] = json!([1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1]);
-    let path = write(dir.path(), "flat.gltf", b.gltf(doc));
+    doc["nodes"][0]["matrix"] = json!([1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 1]);
+    let path = write(dir.path(), "flat.gltf", b.gltf(doc.clone()));
     assert_eq!(load(&path).unwrap().0.objects.len(), 1);
+    doc["nodes"][0]["matrix"] = json!([1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1]);
+    let path = write(dir.path(), "line.gltf", b.gltf(doc));
+    let err = load(&path).unwrap_err().to_string();
+    assert!(err.contains("nothing to draw"), "{err}");
     // A GLB whose first chunk is neither JSON nor BIN says what it is.
     let mut bytes = b.glb(base);
     bytes[16..20].copy_from_slice(b"ABCD");
