@@ -1,22 +1,26 @@
 //! Errors of the scene layer: file I/O, parsing and validation. Every validation error names
 //! the field it is about (`lights[3].radius`, `materials[2] (stone).shininess`, …). What an
-//! error quotes from a file (a path, a name, a key) has its control characters escaped
-//! ([`shown`]).
+//! error quotes from a file (a path, a name, a key) has its control characters escaped and is
+//! cut at a length ([`shown`]).
 
 use std::path::{Path, PathBuf};
 
 use super::shown;
 
-/// A path as an error shows it ([`shown::text`]).
+/// A path as an error shows it ([`shown::reason`]).
 fn shown_path(path: &Path) -> String {
-    shown::text(&path.to_string_lossy()).into_owned()
+    shown::reason(&path.to_string_lossy())
 }
 
 /// What went wrong while building, loading or validating a scene.
 #[derive(Debug, thiserror::Error)]
 pub enum SceneError {
     /// A value is out of its valid range (NaN, negative radius, outer < inner, …).
-    #[error("invalid value for `{}`: {}", shown::text(field), shown::text(reason))]
+    #[error(
+        "invalid value for `{}`: {}",
+        shown::reason(field),
+        shown::reason(reason)
+    )]
     Invalid {
         /// Path of the offending field, e.g. `lights[3].radius`.
         field: String,
@@ -32,7 +36,7 @@ pub enum SceneError {
         source: std::io::Error,
     },
     /// An OBJ file could not be parsed.
-    #[error("malformed OBJ {}: {}", shown_path(path), shown::text(reason))]
+    #[error("malformed OBJ {}: {}", shown_path(path), shown::reason(reason))]
     Obj {
         /// The file.
         path: PathBuf,
@@ -41,7 +45,7 @@ pub enum SceneError {
     },
     /// A glTF file (`.gltf` or `.glb`) is malformed or cannot be shown; `reason` names the
     /// part of the file at fault, e.g. `meshes[2].primitives[0]: index 9 out of range …`.
-    #[error("malformed glTF {}: {}", shown_path(path), shown::text(reason))]
+    #[error("malformed glTF {}: {}", shown_path(path), shown::reason(reason))]
     Gltf {
         /// The `.gltf` or `.glb` file.
         path: PathBuf,
@@ -50,7 +54,7 @@ pub enum SceneError {
     },
     /// A glTF file asks for what the renderer cannot do (an extension it requires, or
     /// nothing to draw); `reason` names it.
-    #[error("unsupported glTF {}: {}", shown_path(path), shown::text(reason))]
+    #[error("unsupported glTF {}: {}", shown_path(path), shown::reason(reason))]
     GltfUnsupported {
         /// The `.gltf` or `.glb` file.
         path: PathBuf,
@@ -58,7 +62,7 @@ pub enum SceneError {
         reason: String,
     },
     /// A scene file is not valid JSON for the scene schema.
-    #[error("scene file {}: {}", shown_path(path), shown::text(reason))]
+    #[error("scene file {}: {}", shown_path(path), shown::reason(reason))]
     SceneFile {
         /// The file.
         path: PathBuf,

@@ -419,7 +419,8 @@ pub fn load_with(
     if !scene.objects.is_empty() && scene.objects.iter().all(invisible) {
         let warning = format!(
             "{}: every object's material is fully transparent (alpha 0: MTL `d 0`, a glTF base \
-             colour alpha of 0): the frame shows the background only",
+             colour alpha of 0, or a glTF MASK material cut out everywhere): the frame shows the \
+             background only",
             shown::text(&path.display().to_string())
         );
         log::warn!("{warning}");

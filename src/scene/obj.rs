@@ -125,29 +125,24 @@ pub fn load_into(
         let specular = factor("Ks", m.specular, 0.0);
         // NaN takes the default, the rest their range (an exponent past f32 its largest
         // used); a warning names the MTL statement, not the library's field.
-        let mut number = |key: &str, value: Option<f32>, default: f32, range: (f32, f32)| {
-            let v = value.unwrap_or(default);
-            let kept = if v.is_nan() {
+        let mut number = |key: &str, value: Option<f64>, default: f32, range: (f32, f32)| {
+            let written = value.unwrap_or(f64::from(default));
+            let kept = if written.is_nan() {
                 default
             } else {
-                v.clamp(range.0, range.1)
+                written.clamp(range.0.into(), range.1.into()) as f32
             };
-            if kept != v {
+            if f64::from(kept) != written {
                 report.warn(format!(
-                    "material `{material_name}`: {key} {v} taken as {kept} (its range is [{}, \
-                     {}])",
+                    "material `{material_name}`: {key} {written:?} taken as {kept} (its range is \
+                     [{}, {}])",
                     range.0, range.1
                 ));
             }
             kept
         };
-        let shininess = number(
-            "Ns",
-            m.shininess.map(|s| s as f32),
-            1.0,
-            (0.0, MAX_SHININESS),
-        );
-        let alpha = number("d", m.dissolve.map(|d| d as f32), 1.0, (0.0, 1.0));
+        let shininess = number("Ns", m.shininess, 1.0, (0.0, MAX_SHININESS));
+        let alpha = number("d", m.dissolve, 1.0, (0.0, 1.0));
         scene.materials.push(Material {
             name: material_name,
             diffuse,
@@ -465,7 +460,7 @@ pub const MAX_TEXTURE_SIDE: u32 = super::texture_budget::MAX_DECODED_SIDE;
 impl LoadReport {
     /// Logs and keeps `msg`, its control characters escaped ([`shown::text`]).
     fn warn(&mut self, msg: String) {
-        let msg = shown::text(&msg).into_owned();
+        let msg = shown::reason(&msg);
         log::warn!("{msg}");
         self.warnings.push(msg);
     }
@@ -632,7 +627,7 @@ mod tests {
         for said in [
             "`a`: Ns NaN",
             "`a`: d -5",
-            "`b`: Ns inf",
+            "`b`: Ns 1e308",
             "`b`: d NaN",
             "`c`: Ns -1",
         ] {

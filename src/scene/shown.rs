@@ -7,14 +7,36 @@ use std::borrow::Cow;
 /// Most characters of a name a message quotes; longer ones are cut, with the count left out.
 pub const MAX_SHOWN_NAME: usize = 64;
 
-/// `text` with every control character escaped (`\u{1b}`), the rest as it is.
+/// Most characters of a message's reason built from a file (a parser's message quoting a key
+/// or a URI); longer ones are cut, with the count left out.
+pub const MAX_SHOWN_REASON: usize = 1000;
+
+/// Whether `c` is escaped: a control character, or one that reorders the text around it
+/// (bidirectional marks, embeddings, overrides and isolates: a name could make a message
+/// read other than it is).
+fn escaped(c: char) -> bool {
+    c.is_control()
+        || matches!(c, '\u{61c}' | '\u{200e}' | '\u{200f}' | '\u{202a}'..='\u{202e}' | '\u{2066}'..='\u{2069}')
+}
+
+/// `text` with every control and reordering character escaped (`\u{1b}`), the rest as it is.
 pub fn text(text: &str) -> Cow<'_, str> {
-    if !text.chars().any(char::is_control) {
+    escape(text, |_| false)
+}
+
+/// [`text`], keeping line ends and tabs: for messages written over several lines on purpose
+/// (a shader's compile log), where the rest must still reach a terminal inert.
+pub fn lines(text: &str) -> Cow<'_, str> {
+    escape(text, |c| c == '\n' || c == '\t')
+}
+
+fn escape(text: &str, keep: impl Fn(char) -> bool) -> Cow<'_, str> {
+    if !text.chars().any(|c| escaped(c) && !keep(c)) {
         return Cow::Borrowed(text);
     }
     let mut out = String::with_capacity(text.len() + 8);
     for c in text.chars() {
-        if c.is_control() {
+        if escaped(c) && !keep(c) {
             out.extend(c.escape_unicode());
         } else {
             out.push(c);
@@ -23,18 +45,25 @@ pub fn text(text: &str) -> Cow<'_, str> {
     Cow::Owned(out)
 }
 
+/// A reason built from a file as an error or warning gives it: [`text`], at most
+/// [`MAX_SHOWN_REASON`] characters.
+pub fn reason(reason: &str) -> String {
+    cut(reason, MAX_SHOWN_REASON)
+}
+
 /// A name from a file as a message quotes it: [`text`], at most [`MAX_SHOWN_NAME`] characters.
 pub fn name(name: &str) -> String {
-    let count = name.chars().count();
-    if count <= MAX_SHOWN_NAME {
-        return text(name).into_owned();
+    cut(name, MAX_SHOWN_NAME)
+}
+
+/// [`text`] of at most `most` characters of `s`, then how many more there were.
+fn cut(s: &str, most: usize) -> String {
+    let count = s.chars().count();
+    if count <= most {
+        return text(s).into_owned();
     }
-    let kept: String = name.chars().take(MAX_SHOWN_NAME).collect();
-    format!(
-        "{}… ({} characters more)",
-        text(&kept),
-        count - MAX_SHOWN_NAME
-    )
+    let kept: String = s.chars().take(most).collect();
+    format!("{}… ({} characters more)", text(&kept), count - most)
 }
 
 #[cfg(test)]
@@ -52,5 +81,11 @@ mod tests {
         assert!(shown.len() < 100, "{}", shown.len());
         assert!(shown.ends_with("… (9999936 characters more)"), "{shown}");
         assert!(!name(&format!("{long}\u{1b}")).contains('\u{1b}'));
+        assert_eq!(text("a\u{202e}b\u{2066}"), "a\\u{202e}b\\u{2066}");
+        assert_eq!(lines("log:\n\tline\u{1b}"), "log:\n\tline\\u{1b}");
+        assert_eq!(
+            reason(&long).chars().count(),
+            1000 + "… (9999000 characters more)".chars().count()
+        );
     }
 }

@@ -4,10 +4,11 @@
 //! empty node `{}` of 3 bytes took about 600 bytes parsed, so 30 MB of `{},` took 6 GB. The
 //! objects and arrays are counted first, in one pass over the bytes, before anything is built.
 
-/// Most JSON objects and arrays a glTF file's JSON may hold: far more than a real scene's
-/// (every node, mesh, primitive, accessor and material is one or two), and about 0.6 GB at
-/// the worst once parsed.
-pub const MAX_JSON_CONTAINERS: usize = 1 << 20;
+/// Most JSON objects and arrays a glTF file's JSON may hold: four for each of the 2²⁰
+/// primitives a file may place (a node with a translation, a rotation, a scale and children
+/// is five; a primitive, its attributes and its accessors' bounds a few more), and about
+/// 2.5 GB at the worst once parsed.
+pub const MAX_JSON_CONTAINERS: usize = 1 << 22;
 
 /// Refuses JSON holding more than [`MAX_JSON_CONTAINERS`] objects and arrays. Brackets inside
 /// strings do not count; what is not valid JSON is left for the parser to name.

@@ -203,7 +203,7 @@ pub fn load_into(
     scene.directional_lights.extend(imported.directional_lights);
     let mut report = LoadReport::default();
     for w in imported.warnings {
-        let msg = shown::text(&format!("{}: {w}", path.display())).into_owned();
+        let msg = shown::reason(&format!("{}: {w}", path.display()));
         log::warn!("{msg}");
         report.warnings.push(msg);
     }

@@ -278,8 +278,8 @@ fn join_rayon_pool() {
 }
 
 fn main() -> ExitCode {
-    // env_logger's own layout, each message on one line with its control characters escaped
-    // (a model's names reach warnings, and a terminal acts on escape sequences).
+    // env_logger's own layout, each message with its control characters escaped but its line
+    // ends (a model's names reach warnings, and a terminal acts on escape sequences).
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn"))
         .format(|buf, record| {
             use std::io::Write as _;
@@ -289,7 +289,7 @@ fn main() -> ExitCode {
                 "[{:<5} {}] {}",
                 record.level(),
                 record.target(),
-                shown::text(&message)
+                shown::lines(&message)
             )
         })
         .init();
@@ -340,7 +340,8 @@ fn main() -> ExitCode {
                 Some(manylight::Error::Msaa { samples, reason }) => {
                     eprintln!("error: --msaa {samples}: {reason}")
                 }
-                _ => eprintln!("error: {}", shown::text(&e.to_string())),
+                // Line ends kept: a shader's compile error lists its source.
+                _ => eprintln!("error: {}", shown::lines(&e.to_string())),
             }
             ExitCode::FAILURE
         }
