@@ -87,6 +87,17 @@ fn refuse(path: &Path, kind: std::io::ErrorKind, reason: String) -> SceneError {
     }
 }
 
+thread_local! {
+    /// Bytes [`read_bounded`] has read on this thread: what a caller measures a load by.
+    static BYTES_READ: std::cell::Cell<u64> = const { std::cell::Cell::new(0) };
+}
+
+/// Bytes [`read_bounded`] has read on this thread so far (a running count: a caller takes
+/// the difference over what it measures).
+pub fn bytes_read() -> u64 {
+    BYTES_READ.with(std::cell::Cell::get)
+}
+
 /// Reads a whole file of `kind`, refusing anything but a regular file within the limit.
 pub fn read_bounded(path: &Path, kind: FileKind) -> Result<Vec<u8>, SceneError> {
     let io = |source| SceneError::Io {
@@ -125,6 +136,7 @@ pub fn read_bounded(path: &Path, kind: FileKind) -> Result<Vec<u8>, SceneError> 
     file.take(limit.saturating_add(1))
         .read_to_end(&mut bytes)
         .map_err(io)?;
+    BYTES_READ.with(|read| read.set(read.get().saturating_add(bytes.len() as u64)));
     if bytes.len() as u64 > limit {
         return Err(too_big(bytes.len() as u64));
     }

@@ -119,9 +119,9 @@ impl Loaded {
     }
 }
 
-/// Most bytes of glTF files with lights or a camera a scene file's load reads again (such a
-/// file is read for each reference): a 1 MB file named by 100 000 objects kept a load busy for
-/// minutes.
+/// Most bytes a scene file's load reads again for glTF files with lights or a camera (such a
+/// file is read for each reference; its buffers and images count): a 1 MB file named by
+/// 100 000 objects kept a load busy for minutes.
 pub const MAX_REREAD_BYTES: u64 = 1 << 30;
 
 /// The models one scene file has loaded, by canonical path (and texture override for OBJ).
@@ -253,32 +253,40 @@ impl ModelCache {
                 return Ok(super::gltf::GltfLoad::default());
             }
         }
-        // Read again for this reference: bounded in total, so a scene file of many references
-        // to a large file with lights cannot keep the load busy for hours.
-        let size = std::fs::metadata(path).map_or(0, |m| m.len());
-        self.reread_bytes = self.reread_bytes.saturating_add(size);
+        // Read again for this reference: bounded in total (the file, its buffers and images),
+        // so a scene file of many references to a large file with lights cannot keep the load
+        // busy for hours.
         if self.reread_bytes > MAX_REREAD_BYTES {
             return Err(SceneError::GltfUnsupported {
                 path: path.to_path_buf(),
                 reason: format!(
                     "a glTF file with lights or a camera is read again for each reference, and \
-                     {transform_field}'s read would take this scene file's re-reads past \
-                     {} MiB (fewer references, or a file without its lights: place lights in \
-                     the scene file)",
+                     this scene file's re-reads (the files, their buffers and images) passed \
+                     {} MiB before {transform_field}'s (fewer references, or a file without \
+                     its lights: place lights in the scene file)",
                     MAX_REREAD_BYTES >> 20
                 ),
             });
         }
         let (first_object, first_material) = (scene.objects.len(), scene.materials.len());
-        let mut loaded = super::gltf::load_into(
+        let read_before = super::input::bytes_read();
+        // Its textures are the first read's: decoded again within a budget of their own, then
+        // swapped for those held, and only one the cache did not hold takes its part of the
+        // scene's (else a scene near its budget lost them on every later reference).
+        let mut lent = TextureBudget::default();
+        let read = super::gltf::load_into(
             scene,
             path,
             transform,
             transform_field,
             &self.options,
-            &mut self.texture_budget,
-        )?;
-        if self.share(scene, first_object, first_material, key.as_ref()) {
+            &mut lent,
+        );
+        self.reread_bytes = self
+            .reread_bytes
+            .saturating_add(super::input::bytes_read().wrapping_sub(read_before));
+        let mut loaded = read?;
+        if self.share_charging(scene, first_object, first_material, key.as_ref(), false) {
             loaded.report.warnings.clear();
         }
         Ok(loaded)
@@ -288,12 +296,27 @@ impl ModelCache {
     /// the same file (`path`, canonical) when they are equal — the file may have changed
     /// between reads — and the textures of the materials from `first_material` on for equal
     /// ones loaded before. Returns whether the file was loaded before with the same meshes.
+    /// The load's textures took their part of the scene's budget as they were decoded.
     fn share(
         &mut self,
         scene: &mut Scene,
         first_object: usize,
         first_material: usize,
         path: Option<&PathBuf>,
+    ) -> bool {
+        self.share_charging(scene, first_object, first_material, path, true)
+    }
+
+    /// [`ModelCache::share`]; with `charged` false the load's textures were decoded within a
+    /// budget of their own: a copy dropped gives nothing back, and one the cache did not hold
+    /// takes its part of the scene's budget now.
+    fn share_charging(
+        &mut self,
+        scene: &mut Scene,
+        first_object: usize,
+        first_material: usize,
+        path: Option<&PathBuf>,
+        charged: bool,
     ) -> bool {
         // Every texture slot: a model named many times holds each image once, and a copy
         // dropped for the one held gives its memory back to the budget (once per copy).
@@ -305,13 +328,19 @@ impl ModelCache {
             match self.textures.get(&t.name) {
                 Some(known) if Arc::ptr_eq(known, t) => {}
                 Some(known) if known.image == t.image => {
-                    if dropped.insert(Arc::as_ptr(t)) {
+                    if charged && dropped.insert(Arc::as_ptr(t)) {
                         self.texture_budget.give_back(t.image.as_raw().len() as u64);
                     }
                     *t = known.clone();
                 }
                 Some(_) => {}
                 None => {
+                    if !charged {
+                        // Only where the file changed between reads; kept either way (its
+                        // read was bounded by the budget it was lent).
+                        let (w, h) = t.image.dimensions();
+                        let _ = self.texture_budget.take(w, h);
+                    }
                     self.textures.insert(t.name.clone(), t.clone());
                 }
             }
@@ -392,5 +421,70 @@ mod tests {
         );
         let err = check_counts(1, MAX_SCENE_MATERIALS + 1, "objects[9]").unwrap_err();
         assert!(err.to_string().contains("materials"), "{err}");
+    }
+
+    /// A glTF with a light (read for each reference) and one texture, in a data URI.
+    fn lit_textured_gltf(dir: &Path) -> PathBuf {
+        use base64::Engine;
+        let b64 = |b: &[u8]| base64::engine::general_purpose::STANDARD.encode(b);
+        let mut png = Vec::new();
+        image::RgbaImage::from_pixel(4, 4, image::Rgba([200, 100, 50, 255]))
+            .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+            .unwrap();
+        let floats = [
+            -1.0f32, -1.0, 0.0, 1.0, -1.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0,
+        ];
+        let bin: Vec<u8> = floats.iter().flat_map(|x| x.to_le_bytes()).collect();
+        let doc = serde_json::json!({
+            "asset": {"version": "2.0"},
+            "extensionsUsed": ["KHR_lights_punctual"],
+            "extensions": {"KHR_lights_punctual": {"lights": [
+                {"type": "point", "intensity": 2, "range": 3}]}},
+            "scenes": [{"nodes": [0]}],
+            "nodes": [{"mesh": 0, "extensions": {"KHR_lights_punctual": {"light": 0}}}],
+            "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "TEXCOORD_0": 1},
+                                         "material": 0}]}],
+            "materials": [{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}],
+            "textures": [{"source": 0}],
+            "images": [{"uri": format!("data:image/png;base64,{}", b64(&png))}],
+            "buffers": [{"byteLength": bin.len(),
+                         "uri": format!("data:application/octet-stream;base64,{}", b64(&bin))}],
+            "bufferViews": [{"buffer": 0, "byteLength": 36},
+                            {"buffer": 0, "byteOffset": 36, "byteLength": 24}],
+            "accessors": [
+                {"bufferView": 0, "componentType": 5126, "type": "VEC3", "count": 3,
+                 "min": [-1, -1, 0], "max": [1, 1, 0]},
+                {"bufferView": 1, "componentType": 5126, "type": "VEC2", "count": 3}
+            ]
+        });
+        let path = dir.join("lit.gltf");
+        std::fs::write(&path, doc.to_string()).unwrap();
+        path
+    }
+
+    #[test]
+    fn a_file_read_per_reference_keeps_its_textures_with_room_for_one_copy() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = lit_textured_gltf(dir.path());
+        let mut cache = ModelCache::new(LoadOptions::default());
+        // Room for the 4 × 4 texture once, not twice.
+        cache.texture_budget = TextureBudget::with_left(64 + 63);
+        let mut scene = Scene::empty();
+        for x in 0..3 {
+            let transform = DMat4::from_translation(glam::DVec3::new(x as f64, 0.0, 0.0));
+            let loaded = cache
+                .place_gltf(&mut scene, &path, transform, false, "objects[0].transform")
+                .unwrap();
+            assert!(loaded.report.warnings.is_empty(), "{:?}", loaded.report);
+        }
+        assert_eq!(scene.lights.len(), 3, "read per reference");
+        let textures: std::collections::HashSet<_> = scene
+            .materials
+            .iter()
+            .map(|m| m.diffuse_texture.as_ref().map(Arc::as_ptr))
+            .collect();
+        assert_eq!(textures.len(), 1, "one texture, held once: {textures:?}");
+        assert!(!textures.contains(&None));
+        assert_eq!(cache.texture_budget, TextureBudget::with_left(63));
     }
 }
