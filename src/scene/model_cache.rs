@@ -134,6 +134,8 @@ pub(super) struct ModelCache {
     /// Bytes of glTF files read again for references after their first (files with lights
     /// or a camera).
     reread_bytes: u64,
+    /// Texture bytes the first read of each such file kept.
+    reread_textures: HashMap<PathBuf, u64>,
     obj: HashMap<(PathBuf, Option<PathBuf>), Loaded>,
     /// glTF files without lights or cameras, read at the identity; `None`: read per reference.
     gltf: HashMap<PathBuf, Option<Loaded>>,
@@ -270,23 +272,38 @@ impl ModelCache {
         }
         let (first_object, first_material) = (scene.objects.len(), scene.materials.len());
         let read_before = super::input::bytes_read();
-        // Its textures are the first read's: decoded again within a budget of their own, then
-        // swapped for those held, and only one the cache did not hold takes its part of the
-        // scene's (else a scene near its budget lost them on every later reference).
-        let mut lent = TextureBudget::default();
+        // The file's first read takes its textures' part of the scene's budget. A later one's
+        // are the first read's: decoded again within what is left and what the first read
+        // kept, then swapped for those held (charged again, a scene near its budget lost them
+        // on every later reference), so what the first read left out stays out.
+        let kept_earlier = key
+            .as_ref()
+            .and_then(|k| self.reread_textures.get(k).copied());
+        let mut lent = self.texture_budget.and(kept_earlier.unwrap_or(0));
+        let left_before = self.texture_budget.left();
+        let budget = if kept_earlier.is_some() {
+            &mut lent
+        } else {
+            &mut self.texture_budget
+        };
         let read = super::gltf::load_into(
             scene,
             path,
             transform,
             transform_field,
             &self.options,
-            &mut lent,
+            budget,
         );
         self.reread_bytes = self
             .reread_bytes
             .saturating_add(super::input::bytes_read().wrapping_sub(read_before));
         let mut loaded = read?;
-        if self.share_charging(scene, first_object, first_material, key.as_ref(), false) {
+        let charged = kept_earlier.is_none();
+        if let (true, Some(k)) = (charged, &key) {
+            let kept = left_before.saturating_sub(self.texture_budget.left());
+            self.reread_textures.insert(k.clone(), kept);
+        }
+        if self.share_charging(scene, first_object, first_material, key.as_ref(), charged) {
             loaded.report.warnings.clear();
         }
         Ok(loaded)
@@ -336,8 +353,8 @@ impl ModelCache {
                 Some(_) => {}
                 None => {
                     if !charged {
-                        // Only where the file changed between reads; kept either way (its
-                        // read was bounded by the budget it was lent).
+                        // Only where the file changed since its first read; kept either way
+                        // (its read was bounded by what was left and the first read's part).
                         let (w, h) = t.image.dimensions();
                         let _ = self.texture_budget.take(w, h);
                     }
@@ -423,8 +440,8 @@ mod tests {
         assert!(err.to_string().contains("materials"), "{err}");
     }
 
-    /// A glTF with a light (read for each reference) and one texture, in a data URI.
-    fn lit_textured_gltf(dir: &Path) -> PathBuf {
+    /// A glTF `name` with a light (read for each reference) and one texture, in a data URI.
+    fn lit_textured_gltf(dir: &Path, name: &str) -> PathBuf {
         use base64::Engine;
         let b64 = |b: &[u8]| base64::engine::general_purpose::STANDARD.encode(b);
         let mut png = Vec::new();
@@ -457,7 +474,7 @@ mod tests {
                 {"bufferView": 1, "componentType": 5126, "type": "VEC2", "count": 3}
             ]
         });
-        let path = dir.join("lit.gltf");
+        let path = dir.join(name);
         std::fs::write(&path, doc.to_string()).unwrap();
         path
     }
@@ -465,7 +482,7 @@ mod tests {
     #[test]
     fn a_file_read_per_reference_keeps_its_textures_with_room_for_one_copy() {
         let dir = tempfile::tempdir().unwrap();
-        let path = lit_textured_gltf(dir.path());
+        let path = lit_textured_gltf(dir.path(), "lit.gltf");
         let mut cache = ModelCache::new(LoadOptions::default());
         // Room for the 4 × 4 texture once, not twice.
         cache.texture_budget = TextureBudget::with_left(64 + 63);
@@ -485,6 +502,20 @@ mod tests {
             .collect();
         assert_eq!(textures.len(), 1, "one texture, held once: {textures:?}");
         assert!(!textures.contains(&None));
+        assert_eq!(cache.texture_budget, TextureBudget::with_left(63));
+        // Another such file's texture does not fit: left out (said once) on every reference.
+        let other = lit_textured_gltf(dir.path(), "other.gltf");
+        for reference in 0..2 {
+            let field = "objects[3].transform";
+            let loaded = cache
+                .place_gltf(&mut scene, &other, DMat4::IDENTITY, false, field)
+                .unwrap();
+            let material = scene.objects.last().unwrap().material;
+            assert!(scene.materials[material].diffuse_texture.is_none());
+            let warnings = &loaded.report.warnings;
+            let said = warnings.iter().any(|w| w.contains("left out"));
+            assert_eq!(said, reference == 0, "{warnings:?}");
+        }
         assert_eq!(cache.texture_budget, TextureBudget::with_left(63));
     }
 }
