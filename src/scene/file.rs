@@ -51,7 +51,7 @@ struct SceneFile {
     camera: Option<CameraSpec>,
     #[serde(default)]
     objects: Vec<ObjectSpec>,
-    ambient: Option<[f32; 3]>,
+    ambient: Option<[f64; 3]>,
     #[serde(default)]
     lights: Vec<LightSpec>,
     #[serde(default)]
@@ -91,10 +91,10 @@ struct ObjectSpec {
     gltf: Option<PathBuf>,
     texture: Option<PathBuf>,
     transform: Option<TransformSpec>,
-    color: Option<[f32; 3]>,
+    color: Option<[f64; 3]>,
     /// With `roughness`: the object's materials become metallic-roughness (glTF BRDF).
-    metallic: Option<f32>,
-    roughness: Option<f32>,
+    metallic: Option<f64>,
+    roughness: Option<f64>,
 }
 
 #[derive(Deserialize)]
@@ -119,10 +119,10 @@ enum ScaleSpec {
 struct LightSpec {
     kind: LightKindSpec,
     position: [f64; 3],
-    radius: f32,
-    color: [f32; 3],
+    radius: f64,
+    color: [f64; 3],
     #[serde(default = "one")]
-    intensity: f32,
+    intensity: f64,
     direction: Option<[f64; 3]>,
     inner_deg: Option<f64>,
     outer_deg: Option<f64>,
@@ -134,12 +134,12 @@ struct LightSpec {
 #[serde(deny_unknown_fields)]
 struct DirectionalSpec {
     direction: [f64; 3],
-    color: [f32; 3],
+    color: [f64; 3],
     #[serde(default = "one")]
-    intensity: f32,
+    intensity: f64,
 }
 
-fn one() -> f32 {
+fn one() -> f64 {
     1.0
 }
 
@@ -191,7 +191,7 @@ struct WanderSpec {
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct FlickerSpec {
-    amount: f32,
+    amount: f64,
     rate_hz: f64,
     #[serde(default)]
     seed: u64,
@@ -221,6 +221,31 @@ struct RandomLightsSpec {
     #[serde(default)]
     seed: u64,
     motion: Option<MotionSpec>,
+}
+
+/// `v` as the `f32` a scene keeps it in, or an error naming `field` where it is finite but
+/// past `f32`'s range (read straight into an `f32`, 1e308 became infinite, and the error said
+/// `got inf` of a number the file wrote finite).
+fn narrow(field: &str, v: f64) -> Result<f32, SceneError> {
+    if v.is_finite() && v.abs() > f64::from(f32::MAX) {
+        return Err(SceneError::invalid(
+            field,
+            format!(
+                "{v:e} is past the largest number a scene keeps ({:e})",
+                f32::MAX
+            ),
+        ));
+    }
+    Ok(v as f32)
+}
+
+/// [`narrow`] of each of three values (`field[i]` names the one at fault).
+fn narrow3(field: &str, v: [f64; 3]) -> Result<Vec3, SceneError> {
+    let mut out = [0.0; 3];
+    for (i, (o, v)) in out.iter_mut().zip(v).enumerate() {
+        *o = narrow(&format!("{field}[{i}]"), v)?;
+    }
+    Ok(Vec3::from(out))
 }
 
 /// Parses the JSON, naming the field at fault: serde's own messages lack the path, and for an
@@ -364,14 +389,15 @@ pub fn parse(
         }
         check_placed(&scene, first_object, &field)?;
         if let Some(c) = spec.color {
+            let c = narrow3(&format!("{field}.color"), c)?;
             // Recolour this object's materials only (they were appended for it).
             for m in &mut scene.materials[first_material..] {
-                m.diffuse = Vec3::from(c);
+                m.diffuse = c;
             }
         }
         if spec.metallic.is_some() || spec.roughness.is_some() {
-            let unit = |name: &str, v: Option<f32>| match v {
-                Some(v) if v.is_finite() && (0.0..=1.0).contains(&v) => Ok(v),
+            let unit = |name: &str, v: Option<f64>| match v {
+                Some(v) if v.is_finite() && (0.0..=1.0).contains(&v) => Ok(v as f32),
                 Some(v) => Err(SceneError::invalid(
                     format!("{field}.{name}"),
                     format!("must be in [0, 1], got {v}"),
@@ -393,7 +419,7 @@ pub fn parse(
         model_cache::check_budget(&scene, &format!("objects[{i}]"))?;
     }
     if let Some(a) = file.ambient {
-        scene.ambient = Vec3::from(a);
+        scene.ambient = narrow3("ambient", a)?;
     }
     for (i, l) in file.lights.iter().enumerate() {
         let field = format!("lights[{i}]");
@@ -405,9 +431,11 @@ pub fn parse(
         }
     }
     for (i, d) in file.directional_lights.iter().enumerate() {
-        let light =
-            DirectionalLight::new(DVec3::from(d.direction), Vec3::from(d.color), d.intensity);
-        light.validate(&format!("directional_lights[{i}]"))?;
+        let field = format!("directional_lights[{i}]");
+        let color = narrow3(&format!("{field}.color"), d.color)?;
+        let intensity = narrow(&format!("{field}.intensity"), d.intensity)?;
+        let light = DirectionalLight::new(DVec3::from(d.direction), color, intensity);
+        light.validate(&field)?;
         scene.directional_lights.push(light);
     }
     match (&file.camera, builtin_camera) {
@@ -537,11 +565,17 @@ impl MotionSpec {
                 period_s: w.period_s,
                 seed: w.seed,
             }),
-            flicker: self.flicker.as_ref().map(|f| Flicker {
-                amount: f.amount,
-                rate_hz: f.rate_hz,
-                seed: f.seed,
-            }),
+            flicker: self
+                .flicker
+                .as_ref()
+                .map(|f| {
+                    Ok::<_, SceneError>(Flicker {
+                        amount: narrow(&format!("{field}.flicker.amount"), f.amount)?,
+                        rate_hz: f.rate_hz,
+                        seed: f.seed,
+                    })
+                })
+                .transpose()?,
             sweep: self.sweep.as_ref().map(|s| Sweep {
                 axis: DVec3::from(s.axis),
                 angle_deg: s.angle_deg,
@@ -617,9 +651,9 @@ impl LightSpec {
         let light = Light {
             kind,
             position: DVec3::from(self.position),
-            radius: self.radius,
-            color: Vec3::from(self.color),
-            intensity: self.intensity,
+            radius: narrow(&format!("{field}.radius"), self.radius)?,
+            color: narrow3(&format!("{field}.color"), self.color)?,
+            intensity: narrow(&format!("{field}.intensity"), self.intensity)?,
         };
         light.validate(field)?;
         Ok(light)

@@ -33,6 +33,40 @@ fn json_errors_name_the_field_and_too_many_values_say_so() {
 }
 
 #[test]
+fn finite_numbers_past_f32_are_named_as_written_not_as_infinite() {
+    let light = |field: &str, value: &str| {
+        let mut l = serde_json::json!({"kind": "point", "position": [0, 0, 1], "radius": 2,
+                                       "color": [1, 1, 1]});
+        l[field] = serde_json::from_str(value).unwrap();
+        format!(r#"{{"objects": [{{"builtin": "plane"}}], "lights": [{l}]}}"#)
+    };
+    for (text, field) in [
+        (
+            r#"{"objects": [{"builtin": "plane"}], "ambient": [1e308, 0, 0]}"#.to_string(),
+            "`ambient[0]`",
+        ),
+        (light("radius", "1e308"), "`lights[0].radius`"),
+        (light("color", "[1, -1e39, 1]"), "`lights[0].color[1]`"),
+        (light("intensity", "1e300"), "`lights[0].intensity`"),
+        (
+            r#"{"objects": [{"builtin": "plane", "color": [1, 1, 5e38]}]}"#.to_string(),
+            "`objects[0].color[2]`",
+        ),
+        (
+            r#"{"objects": [{"builtin": "plane"}], "directional_lights":
+                [{"direction": [0, -1, 0], "color": [1, 1, 1], "intensity": 1e39}]}"#
+                .to_string(),
+            "`directional_lights[0].intensity`",
+        ),
+    ] {
+        let err = parse_str(&text).unwrap_err().to_string();
+        assert!(err.contains(field) && err.contains("e3"), "{field}: {err}");
+        assert!(err.contains("past the largest number"), "{err}");
+        assert!(!err.contains("inf"), "{err}");
+    }
+}
+
+#[test]
 fn anything_after_the_scenes_object_is_an_error_and_keys_are_shown_escaped() {
     let scene = r#"{"objects": [{"builtin": "plane"}]}"#;
     assert!(parse_str(&format!("{scene} \n\t ")).is_ok());
