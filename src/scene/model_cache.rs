@@ -193,7 +193,7 @@ impl ModelCache {
             &self.options,
             &mut self.texture_budget,
         )?;
-        self.share(scene, first.0, first.1, key.as_ref().map(|k| &k.0));
+        self.share(scene, first.0, first.1, key.as_ref().map(|k| &k.0), true);
         if let Some(key) = key {
             let mut loaded = Loaded::record(scene, first, |o| o.transform, false);
             loaded.uncoloured_at = (!recolour).then_some(first.1);
@@ -231,7 +231,7 @@ impl ModelCache {
                 );
                 let entry = match read {
                     Ok(read) if alone.lights.is_empty() && read.camera.is_none() => {
-                        self.share(&mut alone, 0, 0, Some(k));
+                        self.share(&mut alone, 0, 0, Some(k), true);
                         let loaded = Loaded::record(&alone, (0, 0), |o| o.transform, true);
                         Some((loaded, read.report))
                     }
@@ -279,7 +279,8 @@ impl ModelCache {
         let kept_earlier = key
             .as_ref()
             .and_then(|k| self.reread_textures.get(k).copied());
-        let mut lent = self.texture_budget.and(kept_earlier.unwrap_or(0));
+        let mut lent = self.texture_budget;
+        lent.give_back(kept_earlier.unwrap_or(0));
         let left_before = self.texture_budget.left();
         let budget = if kept_earlier.is_some() {
             &mut lent
@@ -303,7 +304,7 @@ impl ModelCache {
             let kept = left_before.saturating_sub(self.texture_budget.left());
             self.reread_textures.insert(k.clone(), kept);
         }
-        if self.share_charging(scene, first_object, first_material, key.as_ref(), charged) {
+        if self.share(scene, first_object, first_material, key.as_ref(), charged) {
             loaded.report.warnings.clear();
         }
         Ok(loaded)
@@ -313,21 +314,10 @@ impl ModelCache {
     /// the same file (`path`, canonical) when they are equal — the file may have changed
     /// between reads — and the textures of the materials from `first_material` on for equal
     /// ones loaded before. Returns whether the file was loaded before with the same meshes.
-    /// The load's textures took their part of the scene's budget as they were decoded.
+    /// With `charged`, the load's textures took their part of the scene's budget as they were
+    /// decoded; else they were decoded within a budget of their own: a copy dropped gives
+    /// nothing back, and one the cache did not hold takes its part of the scene's budget now.
     fn share(
-        &mut self,
-        scene: &mut Scene,
-        first_object: usize,
-        first_material: usize,
-        path: Option<&PathBuf>,
-    ) -> bool {
-        self.share_charging(scene, first_object, first_material, path, true)
-    }
-
-    /// [`ModelCache::share`]; with `charged` false the load's textures were decoded within a
-    /// budget of their own: a copy dropped gives nothing back, and one the cache did not hold
-    /// takes its part of the scene's budget now.
-    fn share_charging(
         &mut self,
         scene: &mut Scene,
         first_object: usize,

@@ -11,7 +11,7 @@ use std::sync::Arc;
 
 use glam::{DMat4, DVec3, Vec2, Vec3};
 
-use super::access::{self, LoadOptions};
+use super::access::LoadOptions;
 use super::input::{read_bounded, FileKind};
 use super::material::{MAX_COLOR_FACTOR, MAX_SHININESS};
 use super::texture_budget::TextureBudget;
@@ -20,7 +20,7 @@ use super::{shown, Aabb, Material, Mesh, Object, Scene, SceneError};
 mod textures;
 
 pub use textures::resolve_texture;
-use textures::{bare_file_in, find_texture, TextureCache};
+use textures::{find_texture, within_folder, TextureCache};
 
 /// What an OBJ load produced besides the objects: non-fatal problems, for the caller to show.
 #[derive(Debug, Default)]
@@ -257,13 +257,10 @@ fn parse_obj(path: &Path, allow_outside: bool) -> Result<Parsed, SceneError> {
     let warn = |w: String| warnings.borrow_mut().push(w);
     let load_mtl = |name: &Path| -> tobj::MTLLoadResult {
         let name = name.to_string_lossy().replace('\\', "/");
-        // Named outside the folder (an exporter's absolute path): its file name in the folder.
-        let found = match access::join(&base_dir, &name, allow_outside) {
-            Ok(p) => Ok(p),
-            Err(refusal) => bare_file_in(&base_dir, &name).ok_or(refusal),
-        };
-        let mtl_path = found
-            .and_then(|p| access::resolve(&base_dir, &p, allow_outside).map(|_| p))
+        // `find` is `Some`: the library is read as joined (reading it says if it is
+        // missing), or as its bare file name was found; there is always a path.
+        let mtl_path = within_folder(&base_dir, &name, allow_outside, Some)
+            .map(|found| found.unwrap_or_default())
             .map_err(|refusal| {
                 warn(format!("{}: mtllib {refusal}", path.display()));
                 tobj::LoadError::OpenFileFailed

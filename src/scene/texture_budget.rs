@@ -148,14 +148,6 @@ impl TextureBudget {
         self.left
     }
 
-    /// A budget of what is left here and `bytes` more (within the whole): what a model read
-    /// again may decode, its earlier read's textures (which it then shares) included.
-    pub(crate) fn and(&self, bytes: u64) -> TextureBudget {
-        TextureBudget {
-            left: self.left.saturating_add(bytes).min(MAX_SCENE_TEXTURE_BYTES),
-        }
-    }
-
     /// Returns `bytes` taken for a texture that is not kept after all.
     pub fn give_back(&mut self, bytes: u64) {
         self.left = self.left.saturating_add(bytes).min(MAX_SCENE_TEXTURE_BYTES);

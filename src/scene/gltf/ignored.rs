@@ -5,6 +5,9 @@
 
 use crate::scene::shown;
 
+/// Most names from the file a message lists one by one (a hostile file may list millions).
+const LISTED: usize = 8;
+
 /// Extensions the loader implements. A file *requiring* another is refused, naming it; one
 /// merely *using* another gets one warning per extension that it is ignored.
 pub const SUPPORTED_EXTENSIONS: &[&str] = &[
@@ -32,13 +35,12 @@ pub(super) fn unsupported_required(root: &gltf::json::Root) -> Option<String> {
     ))
 }
 
-/// Names from the file as a message lists them: the first eight, each as [`shown::name`]
+/// Names from the file as a message lists them: the first [`LISTED`], each as [`shown::name`]
 /// shows it, then how many more.
 fn listed(names: &[&str]) -> String {
-    const SHOWN: usize = 8;
-    let mut list: Vec<String> = names.iter().take(SHOWN).map(|n| shown::name(n)).collect();
-    if names.len() > SHOWN {
-        list.push(format!("and {} more", names.len() - SHOWN));
+    let mut list: Vec<String> = names.iter().take(LISTED).map(|n| shown::name(n)).collect();
+    if names.len() > LISTED {
+        list.push(format!("and {} more", names.len() - LISTED));
     }
     list.join(", ")
 }
@@ -54,10 +56,10 @@ pub(super) fn unused_features(document: &gltf::Document, camera_nodes: usize) ->
         .collect();
     unsupported.sort_unstable();
     unsupported.dedup();
-    // One warning each for the first eight (a hostile file may list millions).
+    // One warning each for the first few.
     let mut out: Vec<String> = unsupported
         .iter()
-        .take(8)
+        .take(LISTED)
         .map(|e| {
             let name = shown::name(e);
             format!(
@@ -66,10 +68,10 @@ pub(super) fn unused_features(document: &gltf::Document, camera_nodes: usize) ->
             )
         })
         .collect();
-    if unsupported.len() > 8 {
+    if unsupported.len() > LISTED {
         out.push(format!(
             "{} more extensions are not supported: ignored",
-            unsupported.len() - 8
+            unsupported.len() - LISTED
         ));
     }
     let skins = document.skins().len();

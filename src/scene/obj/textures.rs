@@ -79,21 +79,33 @@ pub(super) fn find_texture(
         return Ok(None);
     };
     let written = written.replace('\\', "/");
-    let found = match access::join(base_dir, &written, allow_outside) {
-        Ok(_) => resolve_texture(base_dir, name),
-        Err(refusal) => match bare_file_in(base_dir, &written) {
-            Some(p) => Some(p),
-            None => return Err(refusal),
-        },
+    within_folder(base_dir, &written, allow_outside, |_| {
+        resolve_texture(base_dir, name)
+    })
+}
+
+/// What `find` finds of `written` (`/` separating) from `base_dir`, given the path as joined,
+/// where the name stays in the folder; else, unless `allow_outside`, its bare file name in
+/// the folder, or the refusal when it is not there (an exporter's absolute path). What is found
+/// is checked with its links resolved and kept as found (its name in messages stays the
+/// model's).
+pub(super) fn within_folder(
+    base_dir: &Path,
+    written: &str,
+    allow_outside: bool,
+    find: impl FnOnce(PathBuf) -> Option<PathBuf>,
+) -> Result<Option<PathBuf>, String> {
+    let found = match access::join(base_dir, written, allow_outside) {
+        Ok(joined) => find(joined),
+        Err(refusal) => Some(bare_file_in(base_dir, written).ok_or(refusal)?),
     };
-    // Checked with its links resolved, kept as found (its name in messages stays the model's).
     found
         .map(|p| access::resolve(base_dir, &p, allow_outside).map(|_| p))
         .transpose()
 }
 
 /// The file `name`'s last component names in `dir` (in any letter case), if it is one.
-pub(super) fn bare_file_in(dir: &Path, name: &str) -> Option<PathBuf> {
+fn bare_file_in(dir: &Path, name: &str) -> Option<PathBuf> {
     let file_name = name
         .rsplit('/')
         .next()
@@ -123,8 +135,7 @@ pub fn resolve_texture(base_dir: &Path, name: &str) -> Option<PathBuf> {
     if matched && dir.is_file() {
         return Some(dir);
     }
-    let file_name = name.rsplit('/').next()?;
-    find_case_insensitive(base_dir, file_name).filter(|p| p.is_file())
+    bare_file_in(base_dir, &name)
 }
 
 /// The entry of `dir` named `name` in any letter case (`dir` empty: the working folder, which
