@@ -39,8 +39,8 @@ pub const MAX_CAMERA_COORD: f64 = 1e12;
 pub const MIN_ORTHO_HEIGHT: f64 = 1e-6;
 
 /// Narrowest perspective field of view, in degrees: a narrower one puts a scene's triangles
-/// millions of NDC units wide, past what rasterizers clip exactly (llvmpipe drew the right
-/// half of the frame black from 2·10⁻⁵° down, all of it at 10⁻³⁰⁰°).
+/// millions of NDC units wide, past what rasterizers clip exactly (llvmpipe drew half the
+/// frame black).
 pub const MIN_FOV_Y_DEG: f64 = 1e-3;
 
 /// A perspective far plane this many near planes away or more is treated as infinite.

@@ -224,8 +224,8 @@ struct RandomLightsSpec {
 }
 
 /// `v` as the `f32` a scene keeps it in, or an error naming `field` where it is finite but
-/// past `f32`'s range (read straight into an `f32`, 1e308 became infinite, and the error said
-/// `got inf` of a number the file wrote finite).
+/// past `f32`'s range (read straight into an `f32` it would become infinite, and an error
+/// would say `inf` of a number the file wrote finite).
 fn narrow(field: &str, v: f64) -> Result<f32, SceneError> {
     if v.is_finite() && v.abs() > f64::from(f32::MAX) {
         return Err(SceneError::invalid(

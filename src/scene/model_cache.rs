@@ -120,8 +120,8 @@ impl Loaded {
 }
 
 /// Most bytes a scene file's load reads again for glTF files with lights or a camera (such a
-/// file is read for each reference; its buffers and images count): a 1 MB file named by
-/// 100 000 objects kept a load busy for minutes.
+/// file is read for each reference; its buffers and images count): many references to a
+/// large file would keep a load busy without end.
 pub const MAX_REREAD_BYTES: u64 = 1 << 30;
 
 /// The models one scene file has loaded, by canonical path (and texture override for OBJ).

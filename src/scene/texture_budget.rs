@@ -92,9 +92,9 @@ pub(crate) fn decode_texture_bytes(
 
 /// Most bytes the textures of one scene load keep (RGBA8, each within
 /// [`MAX_STORED_TEXTURE_SIDE`]): 16 images of 4096², 256 of 1024². More than a phone's GPU
-/// holds; without a total, a few megabytes of PNGs (each one colour, so each compresses to
-/// kilobytes) named by distinct materials took 15 GB. A texture past it is left out with a
-/// warning and its material keeps its flat colour.
+/// holds; each image is bounded on its own, and without a total, PNGs of one colour (a few
+/// kilobytes each) named by many materials would take gigabytes. A texture past it is left out
+/// with a warning and its material keeps its flat colour.
 pub const MAX_SCENE_TEXTURE_BYTES: u64 = 1 << 30;
 
 /// What is left of one scene load's [`MAX_SCENE_TEXTURE_BYTES`]: every texture a load keeps

@@ -23,7 +23,7 @@ impl RawMaterials {
     /// From the file's JSON chunk (already parsed once by the `gltf` crate, so valid).
     pub fn parse(json: &[u8]) -> RawMaterials {
         // Only `materials` is built: the rest of the document is skipped, not parsed into
-        // values (which took some 50 bytes a number).
+        // values (tens of bytes each).
         #[derive(serde::Deserialize)]
         struct Root {
             #[serde(default)]
