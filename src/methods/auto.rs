@@ -1,14 +1,16 @@
 //! `auto`: picks a method per frame from the context and the scene, and says which and why in
 //! the frame's stats. Few lights → plain forward (one short loop beats assigning and uploading
-//! a grid); many → clustered; clustered unsupported → forward. The method not in use holds no
-//! GPU resources.
+//! a grid); many → clustered; clustered unsupported, or more lights visible than it can index
+//! → forward. The method not in use holds no GPU resources, except clustered's while a frame
+//! has too many visible lights for it (it tries again every frame).
 
 use std::fmt::Write as _;
 
 use super::clustered::culled_support;
-use super::culled::{CulledForward, Culling};
+use super::culled::{CulledForward, CulledFrame, Culling};
 use super::forward::Forward;
 use super::{FrameContext, MethodDesc, MethodStats, ShadingMethod, Support};
+use crate::cluster::pack::MAX_INDEXED_LIGHTS;
 use crate::gl::{Device, EsVersion};
 use crate::Error;
 
@@ -57,6 +59,8 @@ pub struct Auto {
     reason: String,
     /// Whether clustered runs on this context (asked once: the context does not change).
     clustered_support: Option<Support>,
+    /// Whether the log has said that a frame had more visible lights than clustered indexes.
+    warned_too_many: bool,
 }
 
 impl Auto {
@@ -98,17 +102,39 @@ impl ShadingMethod for Auto {
 
     fn render(&mut self, ctx: &mut FrameContext) -> Result<MethodStats<'_>, Error> {
         let choice = self.choose(ctx);
-        let mut stats = if choice == "clustered" {
-            self.forward.destroy(ctx.dev);
-            self.clustered
-                .get_or_insert_with(|| CulledForward::new(Culling::Clustered))
-                .render(ctx)?
-        } else {
-            if let Some(mut c) = self.clustered.take() {
-                c.destroy(ctx.dev);
+        if choice == "clustered" {
+            let clustered = self
+                .clustered
+                .get_or_insert_with(|| CulledForward::new(Culling::Clustered));
+            match clustered.render_unless_too_many(ctx)? {
+                CulledFrame::Rendered(mut stats) => {
+                    self.forward.destroy(ctx.dev);
+                    stats.auto_choice = Some((choice, &self.reason));
+                    return Ok(stats);
+                }
+                // Forward this frame; clustered keeps its resources and tries again next frame
+                // (the visible lights change as they and the camera move).
+                CulledFrame::TooManyVisible(visible) => {
+                    self.reason.clear();
+                    let _ = write!(
+                        self.reason,
+                        "{visible} lights visible > {MAX_INDEXED_LIGHTS}, more than clustered \
+                         can index: forward loops over them all"
+                    );
+                    if !self.warned_too_many {
+                        self.warned_too_many = true;
+                        log::warn!("auto: {}", self.reason);
+                    }
+                    let mut stats = self.forward.render(ctx)?;
+                    stats.auto_choice = Some(("forward", &self.reason));
+                    return Ok(stats);
+                }
             }
-            self.forward.render(ctx)?
-        };
+        }
+        if let Some(mut c) = self.clustered.take() {
+            c.destroy(ctx.dev);
+        }
+        let mut stats = self.forward.render(ctx)?;
         stats.auto_choice = Some((choice, &self.reason));
         Ok(stats)
     }

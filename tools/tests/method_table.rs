@@ -56,3 +56,54 @@ fn auto_picks_forward_for_few_lights_and_clustered_for_many_and_says_why() {
         assert!(manylight::metrics::diff(&reference, &img).max_abs <= 2);
     }
 }
+
+/// More lights visible than tiled and clustered can index: clustered refuses the frame with an
+/// error naming the limit, and `auto` renders it with forward, says why, and equals forward.
+#[test]
+fn auto_renders_with_forward_when_more_lights_are_visible_than_clustered_indexes() {
+    use manylight::cluster::pack::MAX_INDEXED_LIGHTS;
+    use manylight::scene::Light;
+    let mut s = scene::builtin::build("plane", None).unwrap();
+    // A 320 × 208 lattice just above the plane, all of it in view.
+    let side = 320;
+    s.lights = (0..MAX_INDEXED_LIGHTS + 1_000)
+        .map(|i| {
+            let (x, y) = ((i % side) as f64, (i / side) as f64);
+            let at = glam::DVec3::new(x / side as f64 * 4.0 - 2.0, y / 208.0 * 2.4 - 1.2, 0.2);
+            Light::point(at, 0.3, glam::Vec3::ONE, 1e-3)
+        })
+        .collect();
+    let (w, h) = (32, 18);
+    let mut gpu = Gpu::new(EsVersion::Es3);
+    gpu.r().set_method_named("clustered").unwrap();
+    let err = gpu
+        .r()
+        .render_offscreen(&s, w, h, &RenderOptions::default())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("visible") && err.contains(&MAX_INDEXED_LIGHTS.to_string()),
+        "{err}"
+    );
+    gpu.r().set_method_named("forward").unwrap();
+    let (reference, _) = gpu
+        .r()
+        .render_offscreen(&s, w, h, &RenderOptions::default())
+        .unwrap();
+    gpu.r().set_method_named("auto").unwrap();
+    let (img, stats) = gpu
+        .r()
+        .render_offscreen(&s, w, h, &RenderOptions::default())
+        .unwrap();
+    assert_eq!(stats.auto_choice.as_deref(), Some("forward"));
+    let reason = stats.auto_reason.unwrap_or_default();
+    assert!(reason.contains("more than clustered can index"), "{reason}");
+    assert!(manylight::metrics::diff(&reference, &img).max_abs <= 2);
+    // With few of them in view again, the same method goes back to clustered.
+    s.lights.truncate(2_000);
+    let (_, stats) = gpu
+        .r()
+        .render_offscreen(&s, w, h, &RenderOptions::default())
+        .unwrap();
+    assert_eq!(stats.auto_choice.as_deref(), Some("clustered"));
+}

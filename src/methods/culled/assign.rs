@@ -3,11 +3,9 @@
 
 use std::time::Instant;
 
-use super::limits;
 use crate::cluster::assign::{AssignLimits, Assigner, Assignment};
 use crate::cluster::grid::ClusterGrid;
 use crate::methods::FrameContext;
-use crate::Error;
 
 /// The assignment's buffers, reused frame after frame, and whether overflow was warned about.
 #[derive(Default)]
@@ -27,15 +25,14 @@ pub(super) struct Assigned<'a> {
 }
 
 impl Assign {
-    /// Assigns `ctx.lights` to `grid`'s cells within `limits`; refuses a frame with more
-    /// visible lights than the index list can number.
+    /// Assigns `ctx.lights` to `grid`'s cells within `limits`.
     pub(super) fn run(
         &mut self,
         method: &str,
         grid: &ClusterGrid,
         ctx: &FrameContext,
         limits: &AssignLimits,
-    ) -> Result<Assigned<'_>, Error> {
+    ) -> Assigned<'_> {
         let started = Instant::now();
         self.holds_candidate = false;
         let assignment = self.assigner.assign(grid, ctx.lights, ctx.far, limits);
@@ -45,8 +42,7 @@ impl Assign {
             self.warned_overflow = true;
             warn_overflow(method, dropped, limits);
         }
-        limits::check_visible(assignment.visible.len())?;
-        Ok(Assigned { assignment, ms })
+        Assigned { assignment, ms }
     }
 
     /// The last frame's assignment; `None` when an automatic grid's candidate was assigned

@@ -58,13 +58,10 @@ pub(super) fn check_grid(dev: &Device, grid: &ClusterGrid, footprint_px: f64) ->
     Ok(())
 }
 
-/// Refuses more visible lights than the index list can number.
-pub(super) fn check_visible(visible: usize) -> Result<(), Error> {
-    if visible > MAX_INDEXED_LIGHTS {
-        return Err(Error::Limit(format!(
-            "{visible} lights are visible in this frame; tiled and clustered shading index at \
-             most {MAX_INDEXED_LIGHTS}"
-        )));
-    }
-    Ok(())
+/// The error of a frame with more visible lights than the index list can number.
+pub(super) fn too_many_visible(visible: usize) -> Error {
+    Error::Limit(format!(
+        "{visible} lights are visible in this frame; tiled and clustered shading index at most \
+         {MAX_INDEXED_LIGHTS}"
+    ))
 }

@@ -30,7 +30,7 @@ use super::grid_choice::AutoGrid;
 use super::GridReport;
 use super::{FrameContext, MethodStats, ShadingMethod};
 use crate::cluster::grid::ClusterGrid;
-use crate::cluster::pack::{GridEncoding, RGBA8_CELL_CAP};
+use crate::cluster::pack::{GridEncoding, MAX_INDEXED_LIGHTS, RGBA8_CELL_CAP};
 use crate::gl::Device;
 use crate::Error;
 
@@ -41,6 +41,14 @@ pub enum Culling {
     Tiled,
     /// The dense cascaded cluster grid.
     Clustered,
+}
+
+/// A frame of [`CulledForward::render_unless_too_many`].
+pub(crate) enum CulledFrame<'a> {
+    /// Rendered, with its stats.
+    Rendered(MethodStats<'a>),
+    /// Not rendered: this many lights were visible, more than the index list can number.
+    TooManyVisible(usize),
 }
 
 /// Tiled or clustered forward.
@@ -71,6 +79,53 @@ impl CulledForward {
         }
     }
 
+    /// Renders one frame (the stages of the module docs, in order), or stops after the
+    /// assignment, before any GL work, when more lights are visible than the index list can
+    /// number: `auto` then renders the frame with forward.
+    pub(crate) fn render_unless_too_many(
+        &mut self,
+        ctx: &mut FrameContext,
+    ) -> Result<CulledFrame<'_>, Error> {
+        let method = self.name();
+        let automatic = self.automatic(ctx);
+        let grid_encoding = GridEncoding::for_es(ctx.dev.es());
+
+        let limits = limits::assign_limits(ctx);
+        self.update_grid(ctx, &limits, grid_encoding);
+        self.write_grid_reason(ctx);
+        let (grid_key, grid) = self.grid.as_ref().expect("updated above");
+        limits::check_grid(ctx.dev, grid, grid_key.config.footprint_px)?;
+        let assigned = self.assign.run(method, grid, ctx, &limits);
+        let visible = assigned.assignment.visible.len();
+        if visible > MAX_INDEXED_LIGHTS {
+            return Ok(CulledFrame::TooManyVisible(visible));
+        }
+        let uploaded = self
+            .upload
+            .pack_and_upload(ctx, grid, assigned.assignment)?;
+        if automatic {
+            grid::record_cost(&mut self.auto, grid, &assigned, &uploaded);
+        }
+        let bindings = bind::Bindings::new(&uploaded, grid, assigned.assignment, ctx.viewport);
+        draw(ctx, &bindings)?;
+
+        Ok(CulledFrame::Rendered(MethodStats {
+            upload_bytes: uploaded.bytes,
+            assign_ms: Some(assigned.ms),
+            assign: Some(assigned.assignment.stats),
+            grid: Some(GridReport {
+                footprint_px: grid_key.config.footprint_px,
+                cells: grid.total_cells,
+                reason: if automatic {
+                    self.auto.reason()
+                } else {
+                    &self.reason
+                },
+            }),
+            ..MethodStats::default()
+        }))
+    }
+
     /// Whether this frame's grid is the automatic one.
     fn automatic(&self, ctx: &FrameContext) -> bool {
         self.culling == Culling::Clustered && ctx.options.grid.is_auto()
@@ -96,42 +151,12 @@ impl ShadingMethod for CulledForward {
         }
     }
 
-    /// Renders one frame: the stages of the module docs, in order.
+    /// Renders one frame; more visible lights than the index list can number is an error.
     fn render(&mut self, ctx: &mut FrameContext) -> Result<MethodStats<'_>, Error> {
-        let method = self.name();
-        let automatic = self.automatic(ctx);
-        let grid_encoding = GridEncoding::for_es(ctx.dev.es());
-
-        let limits = limits::assign_limits(ctx);
-        self.update_grid(ctx, &limits, grid_encoding);
-        self.write_grid_reason(ctx);
-        let (grid_key, grid) = self.grid.as_ref().expect("updated above");
-        limits::check_grid(ctx.dev, grid, grid_key.config.footprint_px)?;
-        let assigned = self.assign.run(method, grid, ctx, &limits)?;
-        let uploaded = self
-            .upload
-            .pack_and_upload(ctx, grid, assigned.assignment)?;
-        if automatic {
-            grid::record_cost(&mut self.auto, grid, &assigned, &uploaded);
+        match self.render_unless_too_many(ctx)? {
+            CulledFrame::Rendered(stats) => Ok(stats),
+            CulledFrame::TooManyVisible(visible) => Err(limits::too_many_visible(visible)),
         }
-        let bindings = bind::Bindings::new(&uploaded, grid, assigned.assignment, ctx.viewport);
-        draw(ctx, &bindings)?;
-
-        Ok(MethodStats {
-            upload_bytes: uploaded.bytes,
-            assign_ms: Some(assigned.ms),
-            assign: Some(assigned.assignment.stats),
-            grid: Some(GridReport {
-                footprint_px: grid_key.config.footprint_px,
-                cells: grid.total_cells,
-                reason: if automatic {
-                    self.auto.reason()
-                } else {
-                    &self.reason
-                },
-            }),
-            ..MethodStats::default()
-        })
     }
 
     fn observe_frame(&mut self, frame_ms: Option<f64>, gpu_ms: Option<f64>) {
