@@ -17,6 +17,7 @@ use super::material::{MAX_COLOR_FACTOR, MAX_SHININESS};
 use super::texture_budget::TextureBudget;
 use super::{shown, Aabb, Material, Mesh, Object, Scene, SceneError};
 
+mod lines;
 mod textures;
 
 pub use textures::resolve_texture;
@@ -239,7 +240,7 @@ fn text_of(bytes: &[u8]) -> (String, bool) {
 
 fn parse_obj(path: &Path, allow_outside: bool) -> Result<Parsed, SceneError> {
     let (text, not_utf8) = text_of(&read_bounded(path, FileKind::Model)?);
-    check_face_indices(&text).map_err(|reason| SceneError::Obj {
+    lines::check_obj(&text).map_err(|reason| SceneError::Obj {
         path: path.to_path_buf(),
         reason,
     })?;
@@ -279,7 +280,7 @@ fn parse_obj(path: &Path, allow_outside: bool) -> Result<Parsed, SceneError> {
                 mtl_path.display()
             ));
         }
-        if let Err(line) = check_mtl(&text) {
+        if let Err(line) = lines::check_mtl(&text) {
             warn(format!("{}: {line}", mtl_path.display()));
             return Err(tobj::LoadError::MaterialParseError);
         }
@@ -347,107 +348,6 @@ fn warn_unapplied_mtl(mtl: &[tobj::Material], path: &Path, report: &mut LoadRepo
         path.display(),
         list.join(", ")
     ));
-}
-
-/// Every index of every face and line refers to a vertex, texture coordinate or normal the file
-/// defines (negative indices count back from the last one defined before the line): what tobj
-/// assumes — an index beyond them overflowed its arithmetic (a panic in debug builds, a read of
-/// the wrong element in release ones). Errors name the line and the word, never the file's
-/// text.
-fn check_face_indices(text: &str) -> Result<(), String> {
-    let kind_of = |key: Option<&str>| match key {
-        Some("v") => Some(0),
-        Some("vt") => Some(1),
-        Some("vn") => Some(2),
-        _ => None,
-    };
-    // tobj resolves positive indices once the whole object is read (a face may come before
-    // its vertices) and negative ones against what is defined so far; it ignores texture and
-    // normal indices when the file has none of them, and `p` lines altogether.
-    let mut totals = [0i64; 3];
-    for line in text.lines() {
-        if let Some(kind) = kind_of(line.split_whitespace().next()) {
-            totals[kind] += 1;
-        }
-    }
-    let mut defined = [0i64; 3];
-    for (number, line) in text.lines().enumerate() {
-        let mut words = line.split_whitespace();
-        let key = words.next();
-        let needs = match key {
-            Some("v") | Some("vn") => 3,
-            Some("vt") => 2,
-            _ => 0,
-        };
-        // The numbers first, so a bad one is named rather than the face that uses it.
-        let numbers = words
-            .clone()
-            .take(needs)
-            .filter(|w| w.parse::<f32>().is_ok())
-            .count();
-        if numbers < needs {
-            return Err(format!(
-                "line {}: `{}` needs {needs} numbers, found {numbers}",
-                number + 1,
-                key.unwrap_or_default()
-            ));
-        }
-        if let Some(kind) = kind_of(key) {
-            defined[kind] += 1;
-            continue;
-        }
-        let Some(key @ ("f" | "l")) = key else {
-            continue;
-        };
-        for (at, word) in words.enumerate() {
-            for (kind, part) in word.split('/').enumerate().take(3) {
-                if kind > 0 && part.is_empty() {
-                    continue;
-                }
-                let index = part.parse::<i64>();
-                // tobj ignores them where the file has none, but parses them all the same.
-                if kind > 0 && totals[kind] == 0 && index.is_ok() {
-                    continue;
-                }
-                let resolves = index.is_ok_and(|i| match i {
-                    0 => false,
-                    i if i > 0 => i <= totals[kind],
-                    i => i.unsigned_abs() <= defined[kind].unsigned_abs(),
-                });
-                if !resolves {
-                    let what = ["vertex", "texture coordinate", "normal"][kind];
-                    return Err(format!(
-                        "line {}: `{key}` corner {}: its {what} index is not one of the {} the \
-                         file defines ({} before this line)",
-                        number + 1,
-                        at + 1,
-                        totals[kind],
-                        defined[kind]
-                    ));
-                }
-            }
-        }
-    }
-    Ok(())
-}
-
-/// The first MTL line tobj would panic on or misread (a colour with fewer than three numbers,
-/// as a truncated file has), as a message naming the line (not showing it).
-fn check_mtl(text: &str) -> Result<(), String> {
-    for (number, line) in text.lines().enumerate() {
-        let mut words = line.split_whitespace();
-        let Some(key @ ("Ka" | "Kd" | "Ks" | "Ke")) = words.next() else {
-            continue;
-        };
-        let numbers = words.take(3).filter(|w| w.parse::<f32>().is_ok()).count();
-        if numbers < 3 {
-            return Err(format!(
-                "line {}: `{key}` needs three numbers, found {numbers}",
-                number + 1
-            ));
-        }
-    }
-    Ok(())
 }
 
 /// Largest texture side decoded, in pixels (the largest `GL_MAX_TEXTURE_SIZE` common on phones;

@@ -252,7 +252,20 @@ fn malformed_obj_files_are_clear_errors() {
         (
             "nan.obj",
             "v nan 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
-            "positions",
+            "line 1: `v` number 1: not a finite number",
+        ),
+        // Finite as written, infinite as tobj's f32: named by line, not as `inf` later.
+        (
+            "huge.obj",
+            "v 0 0 0\nv 1 0 0\nv 0 1e39 0\nf 1 2 3\n",
+            "line 3: `v` number 2: not a finite number within f32's range",
+        ),
+        // A trailing backslash (no line continuation in tobj): its "position parse error"
+        // named no line.
+        (
+            "continued.obj",
+            "v 0 0 0\nv 1 0 0 \\\nv 0 1 0\nf 1 2 3\n",
+            "line 2: `v` w (the 4th value) is not a number",
         ),
         // A normal index past i64 in a file with no normals: tobj's "face parse error"
         // named no line.

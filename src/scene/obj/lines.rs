@@ -1,0 +1,174 @@
+//! The OBJ and MTL lines tobj would misread, panic on or reject without saying where, checked
+//! before it parses: each error names the line and the statement, never the file's text.
+
+/// The file's vertex data and faces as tobj reads them:
+/// - `v`, `vt` and `vn` start with 3, 2 and 3 numbers within f32's range (tobj reads each
+///   into an `f32`, where `1e39` becomes infinite);
+/// - a `v` may then have a `w` (a number the position is divided by: not zero, and the
+///   quotient within range) or three colour values, nothing else (tobj rejects anything else
+///   as an unplaced "position parse error");
+/// - every index of every face and line refers to a vertex, texture coordinate or normal the
+///   file defines (negative indices count back from the last one defined before the line):
+///   an index beyond them overflowed tobj's arithmetic (a panic in debug builds, a read of the
+///   wrong element in release ones).
+pub(super) fn check_obj(text: &str) -> Result<(), String> {
+    let kind_of = |key: Option<&str>| match key {
+        Some("v") => Some(0),
+        Some("vt") => Some(1),
+        Some("vn") => Some(2),
+        _ => None,
+    };
+    // tobj resolves positive indices once the whole object is read (a face may come before
+    // its vertices) and negative ones against what is defined so far; it ignores texture and
+    // normal indices when the file has none of them, and `p` lines altogether.
+    let mut totals = [0i64; 3];
+    for line in text.lines() {
+        if let Some(kind) = kind_of(line.split_whitespace().next()) {
+            totals[kind] += 1;
+        }
+    }
+    let mut defined = [0i64; 3];
+    for (number, line) in text.lines().enumerate() {
+        let at_line = |what: String| format!("line {}: {what}", number + 1);
+        let mut words = line.split_whitespace();
+        let key = words.next();
+        if let Some(kind) = kind_of(key) {
+            check_vertex_data(key.unwrap_or_default(), words).map_err(at_line)?;
+            defined[kind] += 1;
+            continue;
+        }
+        let Some(key @ ("f" | "l")) = key else {
+            continue;
+        };
+        for (at, word) in words.enumerate() {
+            for (kind, part) in word.split('/').enumerate().take(3) {
+                if kind > 0 && part.is_empty() {
+                    continue;
+                }
+                let index = part.parse::<i64>();
+                // tobj ignores them where the file has none, but parses them all the same.
+                if kind > 0 && totals[kind] == 0 && index.is_ok() {
+                    continue;
+                }
+                let resolves = index.is_ok_and(|i| match i {
+                    0 => false,
+                    i if i > 0 => i <= totals[kind],
+                    i => i.unsigned_abs() <= defined[kind].unsigned_abs(),
+                });
+                if !resolves {
+                    let what = ["vertex", "texture coordinate", "normal"][kind];
+                    return Err(at_line(format!(
+                        "`{key}` corner {}: its {what} index is not one of the {} the file \
+                         defines ({} before this line)",
+                        at + 1,
+                        totals[kind],
+                        defined[kind]
+                    )));
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// A `v`, `vt` or `vn` statement's words after its key, as [`check_obj`] says.
+fn check_vertex_data<'a>(
+    key: &str,
+    mut words: impl Iterator<Item = &'a str>,
+) -> Result<(), String> {
+    let needs = if key == "vt" { 2 } else { 3 };
+    let mut values = [0f32; 3];
+    for (i, value) in values.iter_mut().enumerate().take(needs) {
+        // The numbers first, so a bad one is named rather than the face that uses it.
+        match words.next().map(str::parse::<f32>) {
+            Some(Ok(v)) if v.is_finite() => *value = v,
+            Some(Ok(_)) => {
+                return Err(format!(
+                    "`{key}` number {}: not a finite number within f32's range (±{:.1e})",
+                    i + 1,
+                    f32::MAX
+                ))
+            }
+            _ => return Err(format!("`{key}` needs {needs} numbers, found {i}")),
+        }
+    }
+    if key != "v" {
+        return Ok(()); // tobj ignores what follows a texture coordinate or a normal
+    }
+    let rest: Vec<&str> = words.take(4).collect();
+    match rest[..] {
+        [] => Ok(()),
+        [w] => match w.parse::<f32>() {
+            Ok(w) if w != 0.0 && values.iter().all(|x| (x / w).is_finite()) => Ok(()),
+            Ok(_) => Err(format!(
+                "`v` w: the position divided by it must be finite (w not zero, within \
+                 f32's range ±{:.1e})",
+                f32::MAX
+            )),
+            Err(_) => Err("`v` w (the 4th value) is not a number".into()),
+        },
+        [_, _, _] => Ok(()), // a vertex colour, which tobj reads and manylight does not use
+        _ => Err(format!(
+            "`v` takes 3 numbers, then a w or an RGB colour (1 or 3 values); found {} more",
+            if rest.len() > 3 { "4 or" } else { "2" }
+        )),
+    }
+}
+
+/// The first MTL line tobj would panic on or misread (a colour with fewer than three numbers,
+/// as a truncated file has), as a message naming the line (not showing it).
+pub(super) fn check_mtl(text: &str) -> Result<(), String> {
+    for (number, line) in text.lines().enumerate() {
+        let mut words = line.split_whitespace();
+        let Some(key @ ("Ka" | "Kd" | "Ks" | "Ke")) = words.next() else {
+            continue;
+        };
+        let numbers = words.take(3).filter(|w| w.parse::<f32>().is_ok()).count();
+        if numbers < 3 {
+            return Err(format!(
+                "line {}: `{key}` needs three numbers, found {numbers}",
+                number + 1
+            ));
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::check_obj;
+
+    #[test]
+    fn vertex_lines_tobj_rejects_or_overflows_are_named_by_line() {
+        let triangle = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+        assert_eq!(check_obj(triangle), Ok(()));
+        let cases = [
+            ("v 0 0 0\nv 1 0 0 \\\n", "line 2: `v` w (the 4th value) is not a number"),
+            ("v 0 1e39 0\n", "line 1: `v` number 2: not a finite number"),
+            ("v 0 0 0\nvn 0 -1e39 0\n", "line 2: `vn` number 2: not a finite number"),
+            ("vt inf 0\n", "line 1: `vt` number 1: not a finite number"),
+            ("v 1 2 3 0\n", "line 1: `v` w: the position divided by it must be finite"),
+            ("v 1 2 3 1e-39\n", "line 1: `v` w: the position divided by it must be finite"),
+            ("v 1 2 3 0.5 0.5\n", "line 1: `v` takes 3 numbers, then a w or an RGB colour (1 or 3 values); found 2 more"),
+            ("v 1 2 3 1 1 1 1\n", "found 4 or more"),
+            ("v 1 2\n", "line 1: `v` needs 3 numbers, found 2"),
+            ("vt 0.5\n", "line 1: `vt` needs 2 numbers, found 1"),
+        ];
+        for (text, expected) in cases {
+            let err = check_obj(text).expect_err(text);
+            assert!(
+                err.starts_with(expected) || err.contains(expected),
+                "{text:?}: {err}"
+            );
+        }
+        // What tobj accepts stays accepted: a w, a colour, words after a normal.
+        for text in [
+            "v 2 4 6 2\n",
+            "v 0 0 0 1 0.5 0\n",
+            "vn 0 0 1 extra\n",
+            "vt 0 1 0\n",
+        ] {
+            assert_eq!(check_obj(text), Ok(()), "{text:?}");
+        }
+    }
+}
