@@ -264,3 +264,44 @@ fn a_spot_cone_wider_than_the_spec_allows_is_drawn_as_given_with_a_warning() {
         report.warnings
     );
 }
+
+#[test]
+fn light_values_past_f32_are_errors_naming_the_field_and_the_range() {
+    let dir = tempfile::tempdir().unwrap();
+    let cases = [
+        (
+            json!({"type": "point", "intensity": 1e39}),
+            "intensity",
+            true,
+        ),
+        (
+            json!({"type": "point", "color": [1, 1e39, 1]}),
+            "color",
+            true,
+        ),
+        (json!({"type": "point", "range": 1e39}), "range", true),
+        (
+            json!({"type": "point", "intensity": -1}),
+            "intensity",
+            false,
+        ),
+    ];
+    for (i, (light, field, past_f32)) in cases.into_iter().enumerate() {
+        let mut b = Builder::default();
+        let mut doc = triangle(&mut b);
+        doc["nodes"] = json!([
+            {"mesh": 0},
+            {"translation": [0, 0, 1], "extensions": {"KHR_lights_punctual": {"light": 0}}}
+        ]);
+        doc["scenes"] = json!([{"nodes": [0, 1]}]);
+        doc["extensionsUsed"] = json!(["KHR_lights_punctual"]);
+        doc["extensions"] = json!({"KHR_lights_punctual": {"lights": [light]}});
+        let path = write(dir.path(), &format!("light{i}.gltf"), b.gltf(doc));
+        let err = load(&path).unwrap_err().to_string();
+        assert!(
+            err.contains(&format!("lights[0]): {field} must be")),
+            "{field}: {err}"
+        );
+        assert_eq!(err.contains("past f32's range"), past_f32, "{err}");
+    }
+}

@@ -65,6 +65,19 @@ pub(super) enum Converted {
     Skipped(String),
 }
 
+/// What an infinite value in these messages was in the file: the glTF crate reads the light's
+/// numbers as `f32`, so a finite JSON number past its range (`1e39`) arrives infinite.
+fn past_f32(infinite: bool) -> String {
+    if infinite {
+        format!(
+            " (a number past f32's range, ±{:.1e}, reads as infinite)",
+            f32::MAX
+        )
+    } else {
+        String::new()
+    }
+}
+
 /// Converts `light` on a node with world transform `world`; `field` names it
 /// (`nodes[3] (extensions.KHR_lights_punctual.lights[1])`).
 pub(super) fn convert(
@@ -76,12 +89,14 @@ pub(super) fn convert(
     let raw = light.intensity();
     if !raw.is_finite() || raw < 0.0 {
         return Err(format!(
-            "{field}: intensity must be finite and >= 0, got {raw}"
+            "{field}: intensity must be finite and >= 0, got {raw}{}",
+            past_f32(raw.is_infinite())
         ));
     }
     if !color.is_finite() || color.min_element() < 0.0 {
         return Err(format!(
-            "{field}: color must be finite and >= 0, got {color:?}"
+            "{field}: color must be finite and >= 0, got {color:?}{}",
+            past_f32(color.to_array().iter().any(|c| c.is_infinite()))
         ));
     }
     let kind = match light.kind() {
@@ -134,7 +149,8 @@ pub(super) fn convert(
         Some(range) if range.is_finite() && range > 0.0 => range,
         Some(range) => {
             return Err(format!(
-                "{field}: range must be finite and > 0, got {range}"
+                "{field}: range must be finite and > 0, got {range}{}",
+                past_f32(range.is_infinite())
             ))
         }
         None => {
