@@ -242,17 +242,8 @@ fn a_file_lit_only_by_a_sun_is_lit_as_the_model_says() {
 #[test]
 fn a_spot_cone_wider_than_the_spec_allows_is_drawn_as_given_with_a_warning() {
     let dir = tempfile::tempdir().unwrap();
-    let mut b = Builder::default();
-    let mut doc = triangle(&mut b);
-    doc["nodes"] = json!([
-        {"mesh": 0},
-        {"translation": [0, 0, 1], "extensions": {"KHR_lights_punctual": {"light": 0}}}
-    ]);
-    doc["scenes"] = json!([{"nodes": [0, 1]}]);
-    doc["extensionsUsed"] = json!(["KHR_lights_punctual"]);
-    doc["extensions"] = json!({"KHR_lights_punctual": {"lights": [
-        {"type": "spot", "intensity": 100, "spot": {"outerConeAngle": 2.0}}]}});
-    let path = write(dir.path(), "wide.gltf", b.gltf(doc));
+    let spot = json!({"type": "spot", "intensity": 100, "spot": {"outerConeAngle": 2.0}});
+    let path = write(dir.path(), "wide.gltf", triangle_lit_by(spot));
     let (scene, report) = load(&path).unwrap();
     assert_eq!(scene.lights.len(), 1, "drawn");
     assert!(
@@ -287,16 +278,11 @@ fn light_values_past_f32_are_errors_naming_the_field_and_the_range() {
         ),
     ];
     for (i, (light, field, past_f32)) in cases.into_iter().enumerate() {
-        let mut b = Builder::default();
-        let mut doc = triangle(&mut b);
-        doc["nodes"] = json!([
-            {"mesh": 0},
-            {"translation": [0, 0, 1], "extensions": {"KHR_lights_punctual": {"light": 0}}}
-        ]);
-        doc["scenes"] = json!([{"nodes": [0, 1]}]);
-        doc["extensionsUsed"] = json!(["KHR_lights_punctual"]);
-        doc["extensions"] = json!({"KHR_lights_punctual": {"lights": [light]}});
-        let path = write(dir.path(), &format!("light{i}.gltf"), b.gltf(doc));
+        let path = write(
+            dir.path(),
+            &format!("light{i}.gltf"),
+            triangle_lit_by(light),
+        );
         let err = load(&path).unwrap_err().to_string();
         assert!(
             err.contains(&format!("lights[0]): {field} must be")),
@@ -304,4 +290,19 @@ fn light_values_past_f32_are_errors_naming_the_field_and_the_range() {
         );
         assert_eq!(err.contains("past f32's range"), past_f32, "{err}");
     }
+}
+
+/// A glTF file: a triangle and `light` (a `KHR_lights_punctual` light) on a node one
+/// unit above it.
+fn triangle_lit_by(light: Value) -> String {
+    let mut b = Builder::default();
+    let mut doc = triangle(&mut b);
+    doc["nodes"] = json!([
+        {"mesh": 0},
+        {"translation": [0, 0, 1], "extensions": {"KHR_lights_punctual": {"light": 0}}}
+    ]);
+    doc["scenes"] = json!([{"nodes": [0, 1]}]);
+    doc["extensionsUsed"] = json!(["KHR_lights_punctual"]);
+    doc["extensions"] = json!({"KHR_lights_punctual": {"lights": [light]}});
+    b.gltf(doc)
 }
