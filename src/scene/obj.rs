@@ -17,6 +17,7 @@ use super::material::{MAX_COLOR_FACTOR, MAX_SHININESS};
 use super::texture_budget::TextureBudget;
 use super::{shown, Aabb, Material, Mesh, Object, Scene, SceneError};
 
+mod corners;
 mod lines;
 mod textures;
 
@@ -244,6 +245,9 @@ fn parse_obj(path: &Path, allow_outside: bool) -> Result<Parsed, SceneError> {
         path: path.to_path_buf(),
         reason,
     })?;
+    let filled = corners::fill_missing(&text);
+    let filled_corners = filled.is_some();
+    let text = filled.unwrap_or(text);
     let base_dir = path.parent().unwrap_or(Path::new(".")).to_path_buf();
     let options = tobj::LoadOptions {
         triangulate: true,
@@ -255,6 +259,13 @@ fn parse_obj(path: &Path, allow_outside: bool) -> Result<Parsed, SceneError> {
     // a file repeating the line millions of times would exhaust memory.
     let seen = std::cell::RefCell::new(std::collections::HashSet::new());
     let warnings = std::cell::RefCell::new(Vec::new());
+    if filled_corners {
+        warnings.borrow_mut().push(format!(
+            "{}: some face corners name a texture coordinate or normal and others do not; \
+             those without take texture coordinate (0, 0) and their faces' normal",
+            path.display()
+        ));
+    }
     let warn = |w: String| warnings.borrow_mut().push(w);
     let load_mtl = |name: &Path| -> tobj::MTLLoadResult {
         let name = name.to_string_lossy().replace('\\', "/");

@@ -7,6 +7,8 @@
 /// - a `v` may then have a `w` (a number the position is divided by: not zero, and the
 ///   quotient within range) or three colour values, nothing else (tobj rejects anything else
 ///   as an unplaced "position parse error");
+/// - a face or line names at least one vertex (tobj fails an empty one as an unplaced
+///   "invalid polygon");
 /// - every index of every face and line refers to a vertex, texture coordinate or normal the
 ///   file defines (negative indices count back from the last one defined before the line):
 ///   an index beyond them overflowed tobj's arithmetic (a panic in debug builds, a read of the
@@ -40,6 +42,10 @@ pub(super) fn check_obj(text: &str) -> Result<(), String> {
         let Some(key @ ("f" | "l")) = key else {
             continue;
         };
+        // tobj's "invalid polygon", without a line.
+        if words.clone().next().is_none() {
+            return Err(at_line(format!("`{key}` names no vertices")));
+        }
         for (at, word) in words.enumerate() {
             for (kind, part) in word.split('/').enumerate().take(3) {
                 if kind > 0 && part.is_empty() {
@@ -153,6 +159,8 @@ mod tests {
             ("v 1 2 3 1 1 1 1\n", "found 4 or more"),
             ("v 1 2\n", "line 1: `v` needs 3 numbers, found 2"),
             ("vt 0.5\n", "line 1: `vt` needs 2 numbers, found 1"),
+            ("v 0 0 0\nf\n", "line 2: `f` names no vertices"),
+            ("v 0 0 0\nl \n", "line 2: `l` names no vertices"),
         ];
         for (text, expected) in cases {
             let err = check_obj(text).expect_err(text);
