@@ -64,7 +64,10 @@ fn matrix_covers_es2_es2_without_float_and_es3_and_every_supported_cell_matches_
         }
     }
     // A device without fragment highp: only the methods that need no highp run, forward
-    // (and auto choosing it) within the measured fp16 bounds of tests/stability.rs.
+    // (and auto choosing it) within the fp16 guarantee of docs/precision.md: an RMSE of 2/255
+    // from the highp reference. Single pixels go further (a light a few centimetres from a
+    // surface lands off by fp16's position step: 21/255 measured there), hence the loose
+    // bound on the largest.
     let mediump = row("ES 2.0 without fragment highp (played)");
     assert!(mediump["error"].is_null(), "{}", mediump["error"]);
     assert_eq!(mediump["fragment_highp"], false);
@@ -74,6 +77,8 @@ fn matrix_covers_es2_es2_without_float_and_es3_and_every_supported_cell_matches_
             "forward" | "auto" => {
                 assert_ne!(status, "unsupported", "{}", m["name"]);
                 assert!(m["max_abs"].as_u64().unwrap() <= 32, "{}", m["name"]);
+                let rmse = m["rmse"].as_f64().unwrap();
+                assert!(rmse <= 2.0, "{}: RMSE {rmse:.2} / 255", m["name"]);
             }
             other => assert_eq!(status, "unsupported", "{other} needs fragment highp"),
         }

@@ -8,6 +8,7 @@ use std::cell::RefCell;
 use std::sync::Arc;
 
 use glam::{DMat4, DVec3, Vec3};
+use manylight::metrics::cpu_reference::Encoding;
 use manylight::scene::{self, Camera, Light, Mesh, Scene};
 use manylight::{EsVersion, RenderOptions};
 use proptest::prelude::*;
@@ -151,7 +152,8 @@ thread_local! {
 }
 
 /// Renders the case's scene (16 × 9, half float) with forward: a finite frame whose centre the
-/// light reaches, or an error naming the object, camera or light.
+/// light reaches, and whose pixels the f64 light model gives, or an error naming the object,
+/// camera or light.
 pub fn check(case: &Case) {
     let s = scene_of(case);
     if let Err(e) = s.validate() {
@@ -190,6 +192,24 @@ pub fn check(case: &Case) {
                 assert!(
                     centre[0] > 0.0,
                     "the light does not reach the centre: {case:?}"
+                );
+                // And what it lights is what the f64 light model says, within the documented
+                // bounds (docs/precision.md): 2/255 with fragment highp; without it, fp16
+                // positions put a light off by up to 21/255 on a few pixels.
+                let linear = RenderOptions {
+                    linear: true,
+                    ..RenderOptions::default()
+                };
+                let (img, _) = gpu.r().render_offscreen(&s, 16, 9, &linear).unwrap();
+                let (err, at, samples) =
+                    crate::common::max_oracle_error(&img, &s, Encoding::Linear, gpu.r().caps());
+                let bound = match case.device {
+                    Device::NoFragmentHighp => 21.0,
+                    Device::Es3 | Device::Es2 => 2.0,
+                };
+                assert!(
+                    samples > 0 && err <= bound,
+                    "{err:.1}/255 from the light model at {at:?} ({samples} samples): {case:?}"
                 );
             }
             Err(manylight::Error::Limit(reason)) => assert!(

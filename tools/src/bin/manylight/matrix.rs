@@ -517,6 +517,7 @@ pub fn run_cell(args: &MatrixCellArgs) -> Result<(), Box<dyn std::error::Error>>
             let file = format!("{}-{}.png", args.tag, m.name);
             output::save_png(&args.out.join(&file), &img)?;
             entry["max_abs"] = json!(d.max_abs);
+            entry["rmse"] = json!(d.rmse);
             entry["over_2"] = json!(d.over_2);
             entry["frame_ms"] = json!(stats.time.frame_ms);
             entry["light_encoding"] = json!(stats.lights.encoding);
