@@ -999,7 +999,8 @@ fn info_scene_reports_the_scenes_own_features_and_variants() {
 fn messages_show_names_from_files_escaped_and_cut() {
     let dir = tempfile::tempdir().unwrap();
     let long = "n".repeat(100_000);
-    let bad_vertex = format!("o \u{1b}]0;PWN\u{7}{long}\nv nan 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+    // A vertex past the object-space limit: an error naming the object.
+    let bad_vertex = format!("o \u{1b}]0;PWN\u{7}{long}\nv 2e9 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
     std::fs::write(dir.path().join("bad.obj"), bad_vertex).unwrap();
     let obj = "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl \u{1b}[31mred\nf 1 2 3\n";
     std::fs::write(dir.path().join("hot.obj"), obj).unwrap();
