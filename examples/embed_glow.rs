@@ -13,8 +13,9 @@
 //! 2. bind the target (here an FBO with a texture; in a game, often the default framebuffer)
 //!    and call [`Renderer::render`], which draws into whatever is bound, with the viewport it
 //!    is given;
-//! 3. carry on: the application sets the GL state its next pass needs (manylight leaves the
-//!    framebuffer binding as it found it, but not blending, depth or program state).
+//! 3. carry on: manylight gives back the GL state it found (framebuffer, vertex array on ES 3.0,
+//!    program, textures, blend, depth, viewport, …; the README's "Sharing the context with a
+//!    game" lists it), so the application's next pass starts where it left off.
 #![allow(unsafe_code)] // raw glow calls: the application's side of the example
 
 use std::path::Path;

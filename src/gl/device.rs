@@ -15,6 +15,13 @@ pub struct Device {
     /// `GL_EXT_multisampled_render_to_texture` (see [`super::ext_fns`]).
     pub(crate) renderbuffer_storage_multisample_ext:
         Option<super::ext_fns::RenderbufferStorageMultisampleExt>,
+    /// The renderer's own vertex array object (ES 3.0 and desktop), bound only during its
+    /// calls, so a game's bound one keeps its buffers and attributes.
+    vertex_array: Option<glow::VertexArray>,
+    /// Nesting depth of [`Device::enter_host`] (the outermost call saves the state).
+    host_depth: std::cell::Cell<u32>,
+    /// The EGL context current when the device was made (as an address), where EGL can say.
+    context: Option<usize>,
 }
 
 /// GL objects currently alive, as counted by the renderer's own create/delete calls: what
@@ -72,13 +79,13 @@ impl Device {
     ) -> Result<Device, GlError> {
         let mut caps = Caps::probe(&gl, es)?;
         caps.restrict(restrictions)?;
-        if caps.desktop {
-            // A core profile draws nothing without a bound vertex array object; ES needs none.
-            unsafe {
-                let vao = gl.create_vertex_array().map_err(GlError::Create)?;
-                gl.bind_vertex_array(Some(vao));
-            }
-        }
+        // A core profile draws nothing without a bound vertex array object; on ES 3.0 one of
+        // the renderer's own leaves a game's untouched.
+        let vertex_array = if caps.desktop || es == EsVersion::Es3 {
+            Some(unsafe { gl.create_vertex_array() }.map_err(GlError::Create)?)
+        } else {
+            None
+        };
         let renderbuffer_storage_multisample_ext = if caps.msaa_render_to_texture {
             let f = super::ext_fns::renderbuffer_storage_multisample_ext();
             if f.is_none() {
@@ -99,7 +106,44 @@ impl Device {
             caps,
             live: std::cell::Cell::new(LiveObjects::default()),
             renderbuffer_storage_multisample_ext,
+            vertex_array,
+            host_depth: std::cell::Cell::new(0),
+            context: super::gles_lib::current_context().flatten(),
         })
+    }
+
+    /// Whether this device's context is current on this thread: an error when EGL says no
+    /// context is, or another one (its GL names would be that context's objects).
+    pub(crate) fn check_current(&self) -> Result<(), GlError> {
+        match (super::gles_lib::current_context(), self.context) {
+            (Some(None), _) => Err(GlError::NotCurrent),
+            (Some(Some(now)), Some(own)) if now != own => Err(GlError::OtherContext),
+            _ => Ok(()),
+        }
+    }
+
+    /// Starts a call of the renderer: saves the application's GL state and sets what the
+    /// renderer assumes ([`super::host_state`]); `None` inside a call already started.
+    pub(crate) fn enter_host(&self) -> Option<super::host_state::HostState> {
+        let depth = self.host_depth.get();
+        self.host_depth.set(depth + 1);
+        (depth == 0)
+            .then(|| super::host_state::HostState::enter(&self.gl, self.caps.es, self.vertex_array))
+    }
+
+    /// Ends a call started by [`Device::enter_host`], giving the application its state back.
+    pub(crate) fn leave_host(&self, saved: Option<super::host_state::HostState>) {
+        self.host_depth.set(self.host_depth.get().saturating_sub(1));
+        if let Some(saved) = saved {
+            saved.leave(&self.gl, self.vertex_array);
+        }
+    }
+
+    /// Deletes the renderer's vertex array object (with the renderer's other objects).
+    pub(crate) fn delete_vertex_array(&mut self) {
+        if let Some(vao) = self.vertex_array.take() {
+            unsafe { self.gl.delete_vertex_array(vao) };
+        }
     }
 
     /// GL objects alive now (created and not yet deleted by this crate).

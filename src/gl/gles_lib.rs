@@ -165,6 +165,15 @@ pub(crate) fn no_current_context() -> bool {
     }
 }
 
+/// The EGL context current on this thread, as an address (`Some(None)`: none), when this
+/// process loaded EGL; `None` when it cannot tell (a context from elsewhere, say WGL).
+pub(crate) fn current_context() -> Option<Option<usize>> {
+    match LOADED.get() {
+        Some(Ok(lib)) => Some(lib.egl().get_current_context().map(|c| c.as_ptr() as usize)),
+        _ => None,
+    }
+}
+
 /// The EGL and GLES library files this process has mapped (from `/proc/self/maps`), for
 /// `manylight info`: which files the implementation really is, whichever way it was chosen.
 pub fn loaded_files() -> Vec<PathBuf> {

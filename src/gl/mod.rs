@@ -19,6 +19,7 @@ pub mod ext_fns;
 pub mod framebuffer;
 pub mod gbuffer;
 pub mod gles_lib;
+pub(crate) mod host_state;
 pub mod mesh;
 pub mod multisample;
 #[cfg(feature = "osmesa")]
@@ -169,4 +170,7 @@ pub enum GlError {
     /// EGL says no context is current on this thread.
     #[error("no GL context is current on this thread: was the HeadlessContext dropped, or another context made current, while the Renderer lived? Keep the context alive and current as long as the renderer")]
     NotCurrent,
+    /// EGL says another context than the renderer's is current on this thread.
+    #[error("another GL context than the renderer's is current on this thread: make the renderer's context current again before using it (its objects are that context's)")]
+    OtherContext,
 }

@@ -53,10 +53,18 @@ impl Renderer {
         options: &RenderOptions,
         stats: &mut FrameStats,
     ) -> Result<(), Error> {
-        // Without a current context every GL call is a silent no-op: say so instead.
-        if crate::gl::gles_lib::no_current_context() {
-            return Err(crate::gl::GlError::NotCurrent.into());
-        }
+        self.hosted(|r| r.render_hosted(scene, width, height, options, stats))
+    }
+
+    /// [`Renderer::render_reusing`] between the application's GL state saved and given back.
+    fn render_hosted(
+        &mut self,
+        scene: &Scene,
+        width: u32,
+        height: u32,
+        options: &RenderOptions,
+        stats: &mut FrameStats,
+    ) -> Result<(), Error> {
         // Light counts are exact per pixel: never averaged over samples.
         let samples = if options.count == CountKind::None {
             options.samples.max(1)

@@ -90,7 +90,10 @@ impl Renderer {
                 None => note,
             });
         }
-        let method = (desc.create)(&dev)?;
+        let host = dev.enter_host();
+        let method = (desc.create)(&dev);
+        dev.leave_host(host);
+        let method = method?;
         Ok(Renderer {
             dev,
             programs: ProgramCache::new(),
@@ -138,7 +141,21 @@ impl Renderer {
 
     /// Whether the fragment stage evaluates `mediump` as fp16 (measured with a tiny render).
     pub fn mediump_is_fp16(&self) -> Result<bool, Error> {
-        Ok(crate::gl::precision_probe::mediump_is_fp16(&self.dev)?)
+        self.dev.check_current()?;
+        let host = self.dev.enter_host();
+        let fp16 = crate::gl::precision_probe::mediump_is_fp16(&self.dev);
+        self.dev.leave_host(host);
+        Ok(fp16?)
+    }
+
+    /// Runs `f` between the application's GL state saved and given back (see
+    /// `gl::host_state`), after checking that the renderer's context is current.
+    fn hosted<T>(&mut self, f: impl FnOnce(&mut Self) -> Result<T, Error>) -> Result<T, Error> {
+        self.dev.check_current()?;
+        let host = self.dev.enter_host();
+        let result = f(self);
+        self.dev.leave_host(host);
+        result
     }
 
     /// GL objects the renderer holds now (`lab`: the soak tests count them).
@@ -169,6 +186,11 @@ impl Renderer {
     /// [`Renderer::set_method`] by name, as `--method` or a settings file gives it
     /// (`"clustered"`, …); an unknown name is [`Error::UnknownMethod`].
     pub fn set_method_named(&mut self, name: &str) -> Result<Option<String>, Error> {
+        self.hosted(|r| r.switch_method(name))
+    }
+
+    /// [`Renderer::set_method_named`] with the application's GL state saved.
+    fn switch_method(&mut self, name: &str) -> Result<Option<String>, Error> {
         // An explicit choice replaces what the default method would have warned about.
         let unannounced = self.pending_warning.take().is_some();
         let desc = methods::find(name)?;
@@ -219,11 +241,24 @@ impl Renderer {
         self.free_gl();
     }
 
+    /// Forgets the renderer's GL objects without a GL call: for a context that is gone (an
+    /// Android app's EGL context lost while it was paused), whose names must not be deleted
+    /// in whatever context is current now. A new renderer then starts on the new context.
+    pub fn abandon(mut self) {
+        self.freed = true;
+    }
+
     fn free_gl(&mut self) {
         if self.freed {
             return;
         }
         self.freed = true;
+        // Its objects' names would be another context's: leave them (a leak) rather than
+        // delete those.
+        if let Err(e) = self.dev.check_current() {
+            log::warn!("the renderer's GL objects are not freed: {e}");
+            return;
+        }
         if let Some(Some(t)) = self.timer.take() {
             t.destroy(&self.dev);
         }
@@ -236,6 +271,7 @@ impl Renderer {
         if let Some(mut t) = self.msaa.take() {
             t.destroy(&self.dev);
         }
+        self.dev.delete_vertex_array();
     }
 }
 

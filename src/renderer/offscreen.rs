@@ -11,8 +11,8 @@ use crate::scene::Scene;
 use crate::Error;
 
 impl Renderer {
-    /// Renders into an internal `width × height` target and reads it back (top row first).
-    /// With `options.measure.timed_frames > 0`, renders one warm-up frame and reports the median of
+    /// Renders into an internal `width × height` target and reads it back (top row first);
+    /// the application's framebuffer binding and other GL state are as they were. With `options.measure.timed_frames > 0`, renders one warm-up frame and reports the median of
     /// the timed ones.
     pub fn render_offscreen(
         &mut self,
@@ -21,14 +21,11 @@ impl Renderer {
         height: u32,
         options: &RenderOptions,
     ) -> Result<(image::RgbaImage, FrameStats), Error> {
-        let stats = self.render_into_target(scene, width, height, options, ColorFormat::Rgba8)?;
-        let image = self
-            .target
-            .as_ref()
-            .expect("rendered")
-            .read_rgba8(&self.dev)?;
-        self.dev.bind_default_framebuffer();
-        Ok((image, stats))
+        self.hosted(|r| {
+            let stats = r.render_into_target(scene, width, height, options, ColorFormat::Rgba8)?;
+            let image = r.target.as_ref().expect("rendered").read_rgba8(&r.dev)?;
+            Ok((image, stats))
+        })
     }
 
     /// Renders linear, unclamped radiance into an RGBA16F target and reads it back as f32,
@@ -45,15 +42,12 @@ impl Renderer {
             hdr: true,
             ..options.clone()
         };
-        let stats =
-            self.render_into_target(scene, width, height, &options, ColorFormat::Rgba16F)?;
-        let pixels = self
-            .target
-            .as_ref()
-            .expect("rendered")
-            .read_rgba_f32(&self.dev)?;
-        self.dev.bind_default_framebuffer();
-        Ok((pixels, stats))
+        self.hosted(|r| {
+            let stats =
+                r.render_into_target(scene, width, height, &options, ColorFormat::Rgba16F)?;
+            let pixels = r.target.as_ref().expect("rendered").read_rgba_f32(&r.dev)?;
+            Ok((pixels, stats))
+        })
     }
 
     fn render_into_target(
@@ -105,17 +99,18 @@ impl Renderer {
             ..options.clone()
         };
         options.measure.timed_frames = 0;
-        let (image, stats) = if kind == CountKind::Reaching {
+        let (image, stats) = self.hosted(|r| {
+            if kind != CountKind::Reaching {
+                return r.render_offscreen(scene, width, height, &options);
+            }
             // A plain-forward pass whatever the method: swap one in for this frame.
-            let forward = (methods::find("forward")?.create)(&self.dev)?;
-            let current = std::mem::replace(&mut self.method, forward);
-            let result = self.render_offscreen(scene, width, height, &options);
-            let mut forward = std::mem::replace(&mut self.method, current);
-            forward.destroy(&self.dev);
-            result?
-        } else {
-            self.render_offscreen(scene, width, height, &options)?
-        };
+            let forward = (methods::find("forward")?.create)(&r.dev)?;
+            let current = std::mem::replace(&mut r.method, forward);
+            let result = r.render_offscreen(scene, width, height, &options);
+            let mut forward = std::mem::replace(&mut r.method, current);
+            forward.destroy(&r.dev);
+            result
+        })?;
         Ok((LightCounts::try_decode(&image)?, stats))
     }
 }

@@ -80,7 +80,12 @@ impl Gpu {
         }
     }
 
+    /// The renderer, its context made current first: a test may hold several contexts (the
+    /// renderer refuses to draw while another is current).
     pub fn r(&mut self) -> &mut Renderer {
+        if let Some(ctx) = &self.ctx {
+            ctx.make_current().expect("the test's context made current");
+        }
         self.renderer.as_mut().unwrap()
     }
 
@@ -107,6 +112,8 @@ impl Drop for Gpu {
         let (Some(renderer), Some(ctx)) = (self.renderer.take(), self.ctx.take()) else {
             return;
         };
+        // The renderer frees its objects only in its own context.
+        let _ = ctx.make_current();
         if std::thread::panicking() || !ctx.can_move_between_threads() {
             renderer.destroy();
             return;

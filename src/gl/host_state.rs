@@ -1,0 +1,253 @@
+//! The application's GL state around the renderer's calls. A game draws with the same context:
+//! each entry into the renderer saves the state the renderer changes or depends on, sets the
+//! part it depends on to what it assumes, and gives everything back on the way out, so the
+//! game's vertex array, buffers, program, textures, samplers, framebuffers, viewport, blend,
+//! depth, culling and pixel-store settings are as it left them (the way Dear ImGui's GL
+//! back-end embeds). ES 2.0 has no vertex array objects: there the vertex attribute arrays
+//! are the renderer's after a call, and a game specifies its own before it draws.
+#![allow(unsafe_code)]
+
+use glow::HasContext;
+
+use super::EsVersion;
+
+/// Texture units the renderer binds: 0 to 7 (`methods::maps::UNIT_MAPS` + 3), within the
+/// 8 fragment units every ES 2.0 context has.
+const UNITS: usize = 8;
+
+/// Capabilities the renderer enables and disables as each pass needs (saved and given back).
+const TOGGLED: [u32; 3] = [glow::BLEND, glow::CULL_FACE, glow::DEPTH_TEST];
+
+/// Capabilities that change what the renderer draws and that it never uses: off during its
+/// calls (a game's scissor box or stencil test would cut its frame), given back after.
+const OFF_INSIDE: [u32; 5] = [
+    glow::SCISSOR_TEST,
+    glow::STENCIL_TEST,
+    glow::POLYGON_OFFSET_FILL,
+    glow::SAMPLE_ALPHA_TO_COVERAGE,
+    glow::SAMPLE_COVERAGE,
+];
+
+/// ES 3.0 pixel-store settings that move where uploads and read-backs start: 0 inside.
+const STORE_ES3: [u32; 6] = [
+    glow::UNPACK_ROW_LENGTH,
+    glow::UNPACK_SKIP_ROWS,
+    glow::UNPACK_SKIP_PIXELS,
+    glow::PACK_ROW_LENGTH,
+    glow::PACK_SKIP_ROWS,
+    glow::PACK_SKIP_PIXELS,
+];
+
+/// The application's state on entry; [`HostState::leave`] sets it back.
+pub(crate) struct HostState {
+    es3: bool,
+    vertex_array: Option<glow::VertexArray>,
+    array_buffer: Option<glow::Buffer>,
+    element_buffer: Option<glow::Buffer>,
+    pixel_buffers: [Option<glow::Buffer>; 2],
+    program: Option<glow::Program>,
+    active_texture: i32,
+    textures: [Option<glow::Texture>; UNITS],
+    samplers: [Option<glow::Sampler>; UNITS],
+    units: usize,
+    framebuffers: [Option<glow::Framebuffer>; 2],
+    renderbuffer: Option<glow::Renderbuffer>,
+    viewport: [i32; 4],
+    toggled: [bool; TOGGLED.len()],
+    off_inside: [bool; OFF_INSIDE.len()],
+    rasterizer_discard: bool,
+    blend_func: [i32; 4],
+    blend_equation: [i32; 2],
+    depth_func: i32,
+    depth_mask: bool,
+    depth_range: [f32; 2],
+    color_mask: [bool; 4],
+    cull_face: i32,
+    front_face: i32,
+    clear_color: [f32; 4],
+    clear_depth: f32,
+    alignment: [i32; 2],
+    store_es3: [i32; STORE_ES3.len()],
+}
+
+impl HostState {
+    /// Saves the application's state and sets what the renderer assumes: its own vertex
+    /// array (`vao`, ES 3.0 and desktop), no pixel buffer, no sampler objects on its units,
+    /// the capabilities of `OFF_INSIDE` off, additive blend equations, counter-clockwise
+    /// front faces, the full depth range, a clear depth of 1 and pixel rows that start where
+    /// the data does.
+    pub(crate) fn enter(gl: &glow::Context, es: EsVersion, vao: Option<glow::VertexArray>) -> Self {
+        let es3 = es == EsVersion::Es3;
+        unsafe {
+            let int = |p| gl.get_parameter_i32(p);
+            let units = (int(glow::MAX_COMBINED_TEXTURE_IMAGE_UNITS).max(0) as usize).min(UNITS);
+            let active_texture = int(glow::ACTIVE_TEXTURE);
+            let mut textures = [None; UNITS];
+            let mut samplers = [None; UNITS];
+            for unit in 0..units {
+                gl.active_texture(glow::TEXTURE0 + unit as u32);
+                textures[unit] = gl.get_parameter_texture(glow::TEXTURE_BINDING_2D);
+                if es3 {
+                    samplers[unit] = gl.get_parameter_sampler(glow::SAMPLER_BINDING);
+                    gl.bind_sampler(unit as u32, None);
+                }
+            }
+            gl.active_texture(active_texture as u32);
+            let mut viewport = [0i32; 4];
+            gl.get_parameter_i32_slice(glow::VIEWPORT, &mut viewport);
+            let mut clear_color = [0f32; 4];
+            gl.get_parameter_f32_slice(glow::COLOR_CLEAR_VALUE, &mut clear_color);
+            let mut depth_range = [0f32; 2];
+            gl.get_parameter_f32_slice(glow::DEPTH_RANGE, &mut depth_range);
+            let blend_func = [
+                int(glow::BLEND_SRC_RGB),
+                int(glow::BLEND_DST_RGB),
+                int(glow::BLEND_SRC_ALPHA),
+                int(glow::BLEND_DST_ALPHA),
+            ];
+            let saved = HostState {
+                es3,
+                vertex_array: vao
+                    .and_then(|_| gl.get_parameter_vertex_array(glow::VERTEX_ARRAY_BINDING)),
+                array_buffer: gl.get_parameter_buffer(glow::ARRAY_BUFFER_BINDING),
+                element_buffer: gl.get_parameter_buffer(glow::ELEMENT_ARRAY_BUFFER_BINDING),
+                pixel_buffers: if es3 {
+                    [
+                        gl.get_parameter_buffer(glow::PIXEL_PACK_BUFFER_BINDING),
+                        gl.get_parameter_buffer(glow::PIXEL_UNPACK_BUFFER_BINDING),
+                    ]
+                } else {
+                    [None; 2]
+                },
+                program: gl.get_parameter_program(glow::CURRENT_PROGRAM),
+                active_texture,
+                textures,
+                samplers,
+                units,
+                framebuffers: if es3 {
+                    [
+                        gl.get_parameter_framebuffer(glow::DRAW_FRAMEBUFFER_BINDING),
+                        gl.get_parameter_framebuffer(glow::READ_FRAMEBUFFER_BINDING),
+                    ]
+                } else {
+                    [
+                        gl.get_parameter_framebuffer(glow::FRAMEBUFFER_BINDING),
+                        None,
+                    ]
+                },
+                renderbuffer: gl.get_parameter_renderbuffer(glow::RENDERBUFFER_BINDING),
+                viewport,
+                toggled: TOGGLED.map(|c| gl.is_enabled(c)),
+                off_inside: OFF_INSIDE.map(|c| gl.is_enabled(c)),
+                rasterizer_discard: es3 && gl.is_enabled(glow::RASTERIZER_DISCARD),
+                blend_func,
+                blend_equation: [
+                    int(glow::BLEND_EQUATION_RGB),
+                    int(glow::BLEND_EQUATION_ALPHA),
+                ],
+                depth_func: int(glow::DEPTH_FUNC),
+                depth_mask: gl.get_parameter_bool(glow::DEPTH_WRITEMASK),
+                depth_range,
+                color_mask: gl.get_parameter_bool_array::<4>(glow::COLOR_WRITEMASK),
+                cull_face: int(glow::CULL_FACE_MODE),
+                front_face: int(glow::FRONT_FACE),
+                clear_color,
+                clear_depth: gl.get_parameter_f32(glow::DEPTH_CLEAR_VALUE),
+                alignment: [int(glow::PACK_ALIGNMENT), int(glow::UNPACK_ALIGNMENT)],
+                store_es3: if es3 {
+                    STORE_ES3.map(int)
+                } else {
+                    [0; STORE_ES3.len()]
+                },
+            };
+            if let Some(vao) = vao {
+                gl.bind_vertex_array(Some(vao));
+            }
+            if es3 {
+                gl.bind_buffer(glow::PIXEL_PACK_BUFFER, None);
+                gl.bind_buffer(glow::PIXEL_UNPACK_BUFFER, None);
+                gl.disable(glow::RASTERIZER_DISCARD);
+                for p in STORE_ES3 {
+                    gl.pixel_store_i32(p, 0);
+                }
+            }
+            for c in OFF_INSIDE {
+                gl.disable(c);
+            }
+            gl.blend_equation(glow::FUNC_ADD);
+            gl.front_face(glow::CCW);
+            gl.depth_range(0.0, 1.0);
+            gl.clear_depth(1.0);
+            gl.color_mask(true, true, true, true);
+            saved
+        }
+    }
+
+    /// Gives the application its state back.
+    pub(crate) fn leave(self, gl: &glow::Context, vao: Option<glow::VertexArray>) {
+        let enable = |c, on| unsafe {
+            if on {
+                gl.enable(c)
+            } else {
+                gl.disable(c)
+            }
+        };
+        unsafe {
+            // The vertex array first: on ES 3.0 the element buffer is its state.
+            if vao.is_some() {
+                gl.bind_vertex_array(self.vertex_array);
+            } else {
+                gl.bind_buffer(glow::ELEMENT_ARRAY_BUFFER, self.element_buffer);
+            }
+            gl.bind_buffer(glow::ARRAY_BUFFER, self.array_buffer);
+            gl.use_program(self.program);
+            for unit in 0..self.units {
+                gl.active_texture(glow::TEXTURE0 + unit as u32);
+                gl.bind_texture(glow::TEXTURE_2D, self.textures[unit]);
+                if self.es3 {
+                    gl.bind_sampler(unit as u32, self.samplers[unit]);
+                }
+            }
+            gl.active_texture(self.active_texture as u32);
+            if self.es3 {
+                gl.bind_framebuffer(glow::DRAW_FRAMEBUFFER, self.framebuffers[0]);
+                gl.bind_framebuffer(glow::READ_FRAMEBUFFER, self.framebuffers[1]);
+                gl.bind_buffer(glow::PIXEL_PACK_BUFFER, self.pixel_buffers[0]);
+                gl.bind_buffer(glow::PIXEL_UNPACK_BUFFER, self.pixel_buffers[1]);
+                for (p, v) in STORE_ES3.into_iter().zip(self.store_es3) {
+                    gl.pixel_store_i32(p, v);
+                }
+            } else {
+                gl.bind_framebuffer(glow::FRAMEBUFFER, self.framebuffers[0]);
+            }
+            gl.bind_renderbuffer(glow::RENDERBUFFER, self.renderbuffer);
+            let [x, y, w, h] = self.viewport;
+            gl.viewport(x, y, w, h);
+            for (c, on) in TOGGLED.into_iter().zip(self.toggled) {
+                enable(c, on);
+            }
+            for (c, on) in OFF_INSIDE.into_iter().zip(self.off_inside) {
+                enable(c, on);
+            }
+            if self.es3 {
+                enable(glow::RASTERIZER_DISCARD, self.rasterizer_discard);
+            }
+            let [sr, dr, sa, da] = self.blend_func.map(|v| v as u32);
+            gl.blend_func_separate(sr, dr, sa, da);
+            let [er, ea] = self.blend_equation.map(|v| v as u32);
+            gl.blend_equation_separate(er, ea);
+            gl.depth_func(self.depth_func as u32);
+            gl.depth_mask(self.depth_mask);
+            gl.depth_range(self.depth_range[0].into(), self.depth_range[1].into());
+            let [r, g, b, a] = self.color_mask;
+            gl.color_mask(r, g, b, a);
+            gl.cull_face(self.cull_face as u32);
+            gl.front_face(self.front_face as u32);
+            let [r, g, b, a] = self.clear_color;
+            gl.clear_color(r, g, b, a);
+            gl.clear_depth(self.clear_depth.into());
+            gl.pixel_store_i32(glow::PACK_ALIGNMENT, self.alignment[0]);
+            gl.pixel_store_i32(glow::UNPACK_ALIGNMENT, self.alignment[1]);
+        }
+    }
+}

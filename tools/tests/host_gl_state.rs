@@ -1,0 +1,376 @@
+//! A game draws with the same GL context as the renderer: every renderer call gives the game's
+//! GL state back as it found it, and the game's state (a scissor box, a stencil test, blend
+//! equations, a bound pixel buffer, its vertex array…) does not change what the renderer draws.
+//! And a renderer used while another context is current refuses instead of drawing into, or
+//! freeing, that context's objects.
+#![allow(unsafe_code)] // the game's side: raw glow calls
+
+mod common;
+
+use common::Gpu;
+use manylight::gl::GlError;
+use manylight::glow::{self, HasContext};
+use manylight::scene;
+use manylight::{EsVersion, HeadlessContext, RenderOptions, Renderer};
+
+/// Everything the game set, read back the same way after each renderer call.
+#[derive(Debug, PartialEq)]
+struct Snapshot {
+    ints: Vec<(u32, i32)>,
+    floats: Vec<(u32, Vec<f32>)>,
+    enabled: Vec<(u32, bool)>,
+    units: Vec<(u32, i32, i32)>,
+    attribute_0: Option<(i32, i32)>,
+}
+
+fn snapshot(gl: &glow::Context, es3: bool) -> Snapshot {
+    let mut ints = vec![
+        glow::ARRAY_BUFFER_BINDING,
+        glow::ELEMENT_ARRAY_BUFFER_BINDING,
+        glow::CURRENT_PROGRAM,
+        glow::ACTIVE_TEXTURE,
+        glow::FRAMEBUFFER_BINDING,
+        glow::RENDERBUFFER_BINDING,
+        glow::BLEND_SRC_RGB,
+        glow::BLEND_DST_RGB,
+        glow::BLEND_SRC_ALPHA,
+        glow::BLEND_DST_ALPHA,
+        glow::BLEND_EQUATION_RGB,
+        glow::BLEND_EQUATION_ALPHA,
+        glow::DEPTH_FUNC,
+        glow::DEPTH_WRITEMASK,
+        glow::CULL_FACE_MODE,
+        glow::FRONT_FACE,
+        glow::PACK_ALIGNMENT,
+        glow::UNPACK_ALIGNMENT,
+    ];
+    let mut enabled = vec![
+        glow::BLEND,
+        glow::CULL_FACE,
+        glow::DEPTH_TEST,
+        glow::SCISSOR_TEST,
+        glow::STENCIL_TEST,
+        glow::POLYGON_OFFSET_FILL,
+        glow::SAMPLE_ALPHA_TO_COVERAGE,
+    ];
+    if es3 {
+        ints.extend([
+            glow::VERTEX_ARRAY_BINDING,
+            glow::READ_FRAMEBUFFER_BINDING,
+            glow::PIXEL_UNPACK_BUFFER_BINDING,
+            glow::UNPACK_ROW_LENGTH,
+            glow::PACK_ROW_LENGTH,
+        ]);
+        enabled.push(glow::RASTERIZER_DISCARD);
+    }
+    unsafe {
+        let floats = [
+            (glow::VIEWPORT, 4),
+            (glow::COLOR_CLEAR_VALUE, 4),
+            (glow::DEPTH_CLEAR_VALUE, 1),
+            (glow::DEPTH_RANGE, 2),
+            (glow::COLOR_WRITEMASK, 4),
+        ]
+        .into_iter()
+        .map(|(p, n)| {
+            let mut v = vec![0f32; n];
+            gl.get_parameter_f32_slice(p, &mut v);
+            (p, v)
+        })
+        .collect();
+        let active = gl.get_parameter_i32(glow::ACTIVE_TEXTURE);
+        let units = (0..8)
+            .map(|u| {
+                gl.active_texture(glow::TEXTURE0 + u);
+                let texture = gl.get_parameter_i32(glow::TEXTURE_BINDING_2D);
+                let sampler = if es3 {
+                    gl.get_parameter_i32(glow::SAMPLER_BINDING)
+                } else {
+                    0
+                };
+                (u, texture, sampler)
+            })
+            .collect();
+        gl.active_texture(active as u32);
+        // In the game's vertex array (ES 3.0): attribute 0's buffer and whether it is on.
+        let attribute_0 = es3.then(|| {
+            let read = |pname| {
+                let mut v = [0f32; 4];
+                gl.get_vertex_attrib_parameter_f32_slice(0, pname, &mut v);
+                v[0] as i32
+            };
+            (
+                read(glow::VERTEX_ATTRIB_ARRAY_BUFFER_BINDING),
+                read(glow::VERTEX_ATTRIB_ARRAY_ENABLED),
+            )
+        });
+        Snapshot {
+            ints: ints
+                .into_iter()
+                .map(|p| (p, gl.get_parameter_i32(p)))
+                .collect(),
+            floats,
+            enabled: enabled.into_iter().map(|c| (c, gl.is_enabled(c))).collect(),
+            units,
+            attribute_0,
+        }
+    }
+}
+
+/// Sets state a game might leave on (every value unlike the GL default), with its own objects
+/// bound: a vertex array (ES 3.0), buffers, a program, textures on eight units, a sampler, a
+/// framebuffer with a texture. Returns the game's framebuffer.
+unsafe fn set_game_state(gl: &glow::Context, es3: bool, size: (i32, i32)) -> glow::Framebuffer {
+    if es3 {
+        let vao = gl.create_vertex_array().unwrap();
+        gl.bind_vertex_array(Some(vao));
+    }
+    let vbo = gl.create_buffer().unwrap();
+    gl.bind_buffer(glow::ARRAY_BUFFER, Some(vbo));
+    gl.buffer_data_size(glow::ARRAY_BUFFER, 64, glow::STATIC_DRAW);
+    gl.vertex_attrib_pointer_f32(0, 2, glow::FLOAT, false, 8, 0);
+    gl.enable_vertex_attrib_array(0);
+    let ibo = gl.create_buffer().unwrap();
+    gl.bind_buffer(glow::ELEMENT_ARRAY_BUFFER, Some(ibo));
+    gl.buffer_data_size(glow::ELEMENT_ARRAY_BUFFER, 12, glow::STATIC_DRAW);
+    let other = gl.create_buffer().unwrap();
+    gl.bind_buffer(glow::ARRAY_BUFFER, Some(other));
+    let program = gl.create_program().unwrap();
+    let shaders = [
+        (
+            glow::VERTEX_SHADER,
+            "attribute vec2 p; void main() { gl_Position = vec4(p, 0.0, 1.0); }",
+        ),
+        (
+            glow::FRAGMENT_SHADER,
+            "void main() { gl_FragColor = vec4(1.0); }",
+        ),
+    ];
+    for (kind, source) in shaders {
+        let shader = gl.create_shader(kind).unwrap();
+        gl.shader_source(shader, source);
+        gl.compile_shader(shader);
+        gl.attach_shader(program, shader);
+    }
+    gl.link_program(program);
+    assert!(gl.get_program_link_status(program));
+    gl.use_program(Some(program));
+    for unit in 0..8 {
+        gl.active_texture(glow::TEXTURE0 + unit);
+        let t = gl.create_texture().unwrap();
+        gl.bind_texture(glow::TEXTURE_2D, Some(t));
+    }
+    gl.active_texture(glow::TEXTURE3);
+    let colour = gl.create_texture().unwrap();
+    gl.active_texture(glow::TEXTURE5);
+    gl.bind_texture(glow::TEXTURE_2D, Some(colour));
+    let (w, h) = size;
+    gl.tex_image_2d(
+        glow::TEXTURE_2D,
+        0,
+        glow::RGBA as i32,
+        w,
+        h,
+        0,
+        glow::RGBA,
+        glow::UNSIGNED_BYTE,
+        glow::PixelUnpackData::Slice(None),
+    );
+    let fbo = gl.create_framebuffer().unwrap();
+    gl.bind_framebuffer(glow::FRAMEBUFFER, Some(fbo));
+    gl.framebuffer_texture_2d(
+        glow::FRAMEBUFFER,
+        glow::COLOR_ATTACHMENT0,
+        glow::TEXTURE_2D,
+        Some(colour),
+        0,
+    );
+    let depth = gl.create_renderbuffer().unwrap();
+    gl.bind_renderbuffer(glow::RENDERBUFFER, Some(depth));
+    gl.renderbuffer_storage(glow::RENDERBUFFER, glow::DEPTH_COMPONENT16, w, h);
+    gl.framebuffer_renderbuffer(
+        glow::FRAMEBUFFER,
+        glow::DEPTH_ATTACHMENT,
+        glow::RENDERBUFFER,
+        Some(depth),
+    );
+    if es3 {
+        let sampler = gl.create_sampler().unwrap();
+        gl.sampler_parameter_i32(sampler, glow::TEXTURE_MIN_FILTER, glow::NEAREST as i32);
+        gl.bind_sampler(1, Some(sampler));
+        let unpack = gl.create_buffer().unwrap();
+        gl.bind_buffer(glow::PIXEL_UNPACK_BUFFER, Some(unpack));
+        gl.buffer_data_size(glow::PIXEL_UNPACK_BUFFER, 16, glow::STATIC_DRAW);
+        gl.pixel_store_i32(glow::UNPACK_ROW_LENGTH, 7);
+        gl.pixel_store_i32(glow::PACK_ROW_LENGTH, 5);
+        gl.blend_equation_separate(glow::MAX, glow::MIN);
+        gl.enable(glow::RASTERIZER_DISCARD);
+    } else {
+        gl.blend_equation_separate(glow::FUNC_SUBTRACT, glow::FUNC_REVERSE_SUBTRACT);
+    }
+    gl.viewport(3, 4, 50, 60);
+    gl.clear_color(0.25, 0.5, 0.75, 1.0);
+    gl.clear_depth_f32(0.5);
+    gl.depth_range_f32(0.25, 0.75);
+    gl.pixel_store_i32(glow::PACK_ALIGNMENT, 8);
+    gl.pixel_store_i32(glow::UNPACK_ALIGNMENT, 8);
+    for c in [
+        glow::SCISSOR_TEST,
+        glow::STENCIL_TEST,
+        glow::BLEND,
+        glow::CULL_FACE,
+        glow::DEPTH_TEST,
+        glow::POLYGON_OFFSET_FILL,
+        glow::SAMPLE_ALPHA_TO_COVERAGE,
+    ] {
+        gl.enable(c);
+    }
+    gl.scissor(0, 0, 2, 2);
+    gl.stencil_func(glow::EQUAL, 1, 0xff);
+    gl.polygon_offset(50.0, 50.0);
+    gl.blend_func_separate(
+        glow::SRC_ALPHA,
+        glow::ONE_MINUS_SRC_ALPHA,
+        glow::DST_COLOR,
+        glow::ZERO,
+    );
+    gl.depth_func(glow::GREATER);
+    gl.depth_mask(false);
+    gl.color_mask(true, false, true, false);
+    gl.cull_face(glow::FRONT);
+    gl.front_face(glow::CW);
+    fbo
+}
+
+#[test]
+fn every_call_gives_the_games_gl_state_back_and_draws_as_from_a_clean_one() {
+    let scene = scene::builtin::build("pillars", Some((300, 4))).unwrap();
+    let (w, h) = (96, 54);
+    for es in [EsVersion::Es2, EsVersion::Es3] {
+        let es3 = es == EsVersion::Es3;
+        // MSAA: ES 3.0's renderbuffers (llvmpipe's ES 2.0 has no multisampled extension).
+        let sample_counts: &[u32] = if es3 { &[1, 4] } else { &[1] };
+        let methods: &[&str] = if es3 {
+            &["forward", "clustered", "deferred", "auto"]
+        } else {
+            &["forward", "tiled", "clustered"]
+        };
+        // What each method draws from the default state, on a renderer of its own.
+        let mut clean = Gpu::fresh(es);
+        let mut expected = Vec::new();
+        for m in methods {
+            clean.r().set_method_named(m).unwrap();
+            // Deferred has no MSAA.
+            for &samples in sample_counts
+                .iter()
+                .filter(|&&n| n == 1 || *m != "deferred")
+            {
+                let opts = RenderOptions {
+                    samples,
+                    ..Default::default()
+                };
+                expected.push(clean.r().render_offscreen(&scene, w, h, &opts).unwrap().0);
+            }
+        }
+        drop(clean);
+        let ctx = HeadlessContext::new(es).unwrap();
+        let gl = ctx.load_gl();
+        let mut renderer = Renderer::new(ctx.load_gl(), es).unwrap();
+        let fbo = unsafe { set_game_state(&gl, es3, (w as i32, h as i32)) };
+        let before = snapshot(&gl, es3);
+        let mut expected = expected.into_iter();
+        for m in methods {
+            renderer.set_method_named(m).unwrap();
+            assert_eq!(
+                snapshot(&gl, es3),
+                before,
+                "{es}: set_method({m}) changed the game's state"
+            );
+            // Deferred has no MSAA.
+            for &samples in sample_counts
+                .iter()
+                .filter(|&&n| n == 1 || *m != "deferred")
+            {
+                let opts = RenderOptions {
+                    samples,
+                    ..Default::default()
+                };
+                let (img, _) = renderer.render_offscreen(&scene, w, h, &opts).unwrap();
+                let d = manylight::metrics::diff(&expected.next().unwrap(), &img);
+                assert_eq!(
+                    d.max_abs, 0,
+                    "{es} {m} ×{samples}: the game's state changed the picture"
+                );
+                assert_eq!(
+                    snapshot(&gl, es3),
+                    before,
+                    "{es} {m} ×{samples}: render_offscreen changed the game's state"
+                );
+                // Into the game's own framebuffer, as a game draws.
+                renderer.render(&scene, w, h, &opts).unwrap();
+                assert_eq!(
+                    snapshot(&gl, es3),
+                    before,
+                    "{es} {m} ×{samples}: render changed the game's state"
+                );
+            }
+        }
+        renderer.mediump_is_fp16().unwrap();
+        assert_eq!(
+            snapshot(&gl, es3),
+            before,
+            "{es}: the precision probe changed the game's state"
+        );
+        let _ = fbo;
+        drop(renderer);
+        drop(ctx);
+    }
+}
+
+#[test]
+fn a_renderer_refuses_another_current_context_and_leaves_its_objects() {
+    let scene = scene::builtin::build("plane", Some((8, 1))).unwrap();
+    let a = HeadlessContext::new(EsVersion::Es3).unwrap();
+    let mut on_a = Renderer::new(a.load_gl(), EsVersion::Es3).unwrap();
+    on_a.render_offscreen(&scene, 32, 18, &RenderOptions::default())
+        .unwrap();
+    let b = HeadlessContext::new(EsVersion::Es3).unwrap(); // now current
+    let mut on_b = Renderer::new(b.load_gl(), EsVersion::Es3).unwrap();
+    let (reference, _) = on_b
+        .render_offscreen(&scene, 32, 18, &RenderOptions::default())
+        .unwrap();
+    let err = on_a
+        .render_offscreen(&scene, 32, 18, &RenderOptions::default())
+        .unwrap_err();
+    assert!(
+        matches!(err, manylight::Error::Gl(GlError::OtherContext)),
+        "{err}"
+    );
+    assert!(err.to_string().contains("another GL context"), "{err}");
+    assert!(matches!(
+        on_a.set_method_named("forward"),
+        Err(manylight::Error::Gl(GlError::OtherContext))
+    ));
+    // Dropped while b is current: a's names are not b's to delete.
+    drop(on_a);
+    let (after, _) = on_b
+        .render_offscreen(&scene, 32, 18, &RenderOptions::default())
+        .unwrap();
+    assert_eq!(manylight::metrics::diff(&reference, &after).max_abs, 0);
+    // Back on a, a new renderer works; one whose context is lost is abandoned without a GL
+    // call, whatever is current.
+    a.make_current().unwrap();
+    let mut again = Renderer::new(a.load_gl(), EsVersion::Es3).unwrap();
+    again
+        .render_offscreen(&scene, 32, 18, &RenderOptions::default())
+        .unwrap();
+    b.make_current().unwrap();
+    again.abandon();
+    let (after_abandon, _) = on_b
+        .render_offscreen(&scene, 32, 18, &RenderOptions::default())
+        .unwrap();
+    assert_eq!(
+        manylight::metrics::diff(&reference, &after_abandon).max_abs,
+        0
+    );
+}
