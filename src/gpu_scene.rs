@@ -13,7 +13,8 @@ use crate::scene::{Aabb, Material, Mesh, Scene, Texture};
 use crate::Error;
 
 /// Meshes and textures of scenes, uploaded once and found again by identity. The cache holds
-/// an `Arc` of each source, so a key can never be reused by another allocation.
+/// an `Arc` of each source, so a key can never be reused by another allocation, and frees an
+/// upload once it holds the last one.
 #[derive(Default)]
 pub struct GpuScene {
     /// Uploaded meshes with their object-space bounds and longest triangle edge (computed
@@ -36,13 +37,15 @@ impl GpuScene {
         scene: &Scene,
         full_variants: bool,
     ) -> Result<(), Error> {
+        self.forget_unreferenced(dev);
         if full_variants && self.white.is_none() {
             let white = image::RgbaImage::from_pixel(1, 1, image::Rgba([255, 255, 255, 255]));
             self.white = Some(ImageTexture::new(dev, &white)?);
         }
-        for o in &scene.objects {
+        for (i, o) in scene.objects.iter().enumerate() {
             let key = Arc::as_ptr(&o.mesh) as usize;
             if let std::collections::hash_map::Entry::Vacant(e) = self.meshes.entry(key) {
+                o.mesh.check_shape(&format!("objects[{i}].mesh"))?;
                 let bounds = o.mesh.bounds();
                 let origin = bounds.map_or(DVec3::ZERO, |b| b.center());
                 let gpu = GpuMesh::new_about(dev, &o.mesh, origin)?;
@@ -60,6 +63,26 @@ impl GpuScene {
             }
         }
         Ok(())
+    }
+
+    /// Frees the uploads of meshes and textures the application no longer holds: the cache's
+    /// `Arc` is the last one, so no scene can draw them again (a game that rebuilds a mesh, or
+    /// changes one through `Arc::make_mut`, makes a new one each time).
+    fn forget_unreferenced(&mut self, dev: &Device) {
+        self.meshes.retain(|_, (source, gpu, _, _)| {
+            let held = Arc::strong_count(source) > 1;
+            if !held {
+                gpu.destroy(dev);
+            }
+            held
+        });
+        self.textures.retain(|_, (source, gpu)| {
+            let held = Arc::strong_count(source) > 1;
+            if !held {
+                gpu.destroy(dev);
+            }
+            held
+        });
     }
 
     /// Replaces last frame's split meshes with this frame's: objects of `scene` with triangles

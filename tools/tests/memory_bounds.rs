@@ -301,3 +301,34 @@ fn bounds_of_a_mesh_placed_many_times() {
     assert!((b.min - want_min).length() < 1e-9, "{:?}", b.min);
     assert!((b.max - want_max).length() < 1e-9, "{:?}", b.max);
 }
+
+/// A game that rebuilds a mesh every frame (or edits one through `Arc::make_mut`, which copies
+/// it while the renderer holds the old one) keeps the renderer's buffers and textures bounded:
+/// an upload is freed once the application no longer holds its mesh or texture.
+#[test]
+fn meshes_and_textures_the_game_dropped_are_freed() {
+    let mut s = scene::builtin::build("plane", Some((16, 1))).unwrap();
+    let image = image::RgbaImage::from_pixel(2, 2, image::Rgba([200, 100, 50, 255]));
+    let mut gpu = Gpu::new(EsVersion::Es3);
+    gpu.r().set_method_named("forward").unwrap(); // no texture ring of its own
+    let options = RenderOptions::default();
+    gpu.render(&s, 32, 18, &options);
+    let baseline = gpu.r().live_gl_objects();
+    for frame in 0..20 {
+        // A new mesh and a new texture each frame, the old ones dropped.
+        let mesh = (*s.objects[0].mesh).clone();
+        s.objects[0].mesh = Arc::new(mesh);
+        let fresh = manylight::scene::Texture {
+            name: format!("frame {frame}"),
+            image: image.clone(),
+        };
+        s.materials[0].diffuse_texture = Some(Arc::new(fresh));
+        gpu.render(&s, 32, 18, &options);
+        let live = gpu.r().live_gl_objects();
+        assert_eq!(
+            (live.buffers, live.textures),
+            (baseline.buffers, baseline.textures + 1),
+            "frame {frame}: one mesh's buffers and one texture, not every frame's"
+        );
+    }
+}
