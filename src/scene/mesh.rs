@@ -291,6 +291,45 @@ impl Mesh {
     }
 }
 
+impl Mesh {
+    /// Whether the mesh's arrays fit together as [`Mesh::new`] and the `with_*` methods make
+    /// them: whole triangles of indices in range, one normal per position, and texture
+    /// coordinates, colours and tangents either none or one per position. The fields are
+    /// public, so a mesh edited in code is checked again before it is uploaded; errors name
+    /// the field under `field` (`objects[3].mesh`).
+    pub(crate) fn check_shape(&self, field: &str) -> Result<(), SceneError> {
+        let n = self.positions.len();
+        let at = |what: &str| format!("{field}.{what}");
+        if !self.indices.len().is_multiple_of(3) {
+            return Err(SceneError::invalid(
+                at("indices"),
+                format!(
+                    "{} indices is not a whole number of triangles",
+                    self.indices.len()
+                ),
+            ));
+        }
+        if let Some(bad) = self.indices.iter().find(|&&i| i as usize >= n) {
+            return Err(SceneError::invalid(
+                at("indices"),
+                format!("index {bad} out of range for {n} vertices"),
+            ));
+        }
+        check_per_vertex(&at("normals"), self.normals.len(), n)?;
+        let optional = [
+            ("uvs", self.uvs.len()),
+            ("colors", self.colors.len()),
+            ("tangents", self.tangents.len()),
+        ];
+        for (name, len) in optional {
+            if len != 0 {
+                check_per_vertex(&at(name), len, n)?;
+            }
+        }
+        Ok(())
+    }
+}
+
 fn check_per_vertex(field: &str, got: usize, n: usize) -> Result<(), SceneError> {
     if got != n {
         return Err(SceneError::invalid(

@@ -637,6 +637,24 @@ fn invalid_values_are_rejected_before_upload() {
             Box::new(|s: &mut Scene| s.materials[0].shininess = -1.0),
             "shininess",
         ),
+        // A mesh edited through its public fields: checked before it is uploaded (an index
+        // past its vertices, or normals dropped, panicked in the upload).
+        (
+            Box::new(|s: &mut Scene| {
+                let mut mesh = (*s.objects[0].mesh).clone();
+                mesh.indices.extend([100_000, 0, 1]);
+                s.objects[0].mesh = std::sync::Arc::new(mesh);
+            }),
+            "objects[0].mesh.indices",
+        ),
+        (
+            Box::new(|s: &mut Scene| {
+                let mut mesh = (*s.objects[0].mesh).clone();
+                mesh.normals.clear();
+                s.objects[0].mesh = std::sync::Arc::new(mesh);
+            }),
+            "objects[0].mesh.normals",
+        ),
     ];
     for (break_it, field) in cases {
         let mut s = plane();
