@@ -92,6 +92,7 @@ pub use cluster::pack::LightEncoding;
 pub use error::Error;
 pub use gl::caps::Precision;
 pub use gl::gles_lib::select as select_gles_library;
+pub use gl::context::EglInfo;
 pub use gl::{Caps, EsVersion, GlError, HeadlessContext, Restrictions};
 pub use methods::Support;
 pub use metrics::counts::LightCounts;
@@ -104,6 +105,7 @@ pub use renderer::{
 };
 pub use scene::features::SceneFeatures;
 pub use scene::meshbuild::MeshBuilder;
+pub use scene::surface_maps::{MapTexture, SurfaceMaps, TextureTransform};
 pub use scene::obj::LoadReport;
 pub use scene::{
     builtin::DEFAULT as DEFAULT_SCENE, builtin::NAMES as BUILTIN_SCENES, builtin_scene, load_scene,
@@ -115,7 +117,9 @@ pub use scene::{
 /// How lights move over time: a [`Motion`](motion::Motion) per light, set with
 /// [`Scene::animate_light`] and posed by [`Scene::set_time`].
 pub mod motion {
-    pub use crate::scene::motion::{Bob, Flicker, Motion, Orbit, OrbitAbout, Sweep, Wander};
+    pub use crate::scene::motion::{
+        Bob, Flicker, LightTrack, Motion, Orbit, OrbitAbout, Sweep, Wander,
+    };
 }
 
 // The crates whose types the API takes and returns, so a game needs no second version of them.
