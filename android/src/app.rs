@@ -168,7 +168,10 @@ impl Shell {
         let (parked, kept) = match self.parked.take() {
             Some(c) => (c, true),
             None => {
-                self.renderer = None; // its objects went with the old context
+                // Its objects went with the old context: let it go without a GL call.
+                if let Some(old) = self.renderer.take() {
+                    old.abandon();
+                }
                 (create_context(egl)?, false)
             }
         };
@@ -194,7 +197,9 @@ impl Shell {
             Err(e) if kept => {
                 // Context loss while suspended: start over with a new context and renderer.
                 log::warn!("the kept context is gone ({e}); rebuilding it");
-                self.renderer = None;
+                if let Some(old) = self.renderer.take() {
+                    old.abandon();
+                }
                 create_context(egl)?
                     .make_current(&surface)
                     .map_err(|e| format!("cannot make the context current: {e}"))?
