@@ -91,8 +91,8 @@ pub use cluster::grid::{Coverage, GridConfig, GridMeasure, GridMode};
 pub use cluster::pack::LightEncoding;
 pub use error::Error;
 pub use gl::caps::Precision;
-pub use gl::gles_lib::select as select_gles_library;
 pub use gl::context::EglInfo;
+pub use gl::gles_lib::select as select_gles_library;
 pub use gl::{Caps, EsVersion, GlError, HeadlessContext, Restrictions};
 pub use methods::Support;
 pub use metrics::counts::LightCounts;
@@ -105,8 +105,8 @@ pub use renderer::{
 };
 pub use scene::features::SceneFeatures;
 pub use scene::meshbuild::MeshBuilder;
-pub use scene::surface_maps::{MapTexture, SurfaceMaps, TextureTransform};
 pub use scene::obj::LoadReport;
+pub use scene::surface_maps::{MapTexture, SurfaceMaps, TextureTransform};
 pub use scene::{
     builtin::DEFAULT as DEFAULT_SCENE, builtin::NAMES as BUILTIN_SCENES, builtin_scene, load_scene,
     load_scene_with, Aabb, Camera, Cone, DirectionalLight, Light, LightKind, LoadOptions, Material,

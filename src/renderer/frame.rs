@@ -22,7 +22,11 @@ impl Renderer {
     /// Renders `scene` into the currently bound framebuffer with a `width × height` viewport
     /// (for embedding: a game binds its own target or the default framebuffer first). With
     /// `options.samples` > 1 the frame is drawn into the renderer's own multisampled target
-    /// and resolved into the bound framebuffer, which must then be RGBA8 of that size.
+    /// and resolved into the bound framebuffer, which must then be RGBA8 of that size. The
+    /// application's GL state (bindings, viewport, blend, depth, …) is given back as it was,
+    /// and its scissor, stencil or blend equations do not change the frame (the README's
+    /// "Sharing the context with a game"); another EGL context current is
+    /// [`GlError::OtherContext`](crate::GlError::OtherContext).
     ///
     /// The returned stats own their texts (method, GL strings, reasons): in steady state they
     /// are all the renderer allocates for a frame. A game's per-frame loop calls

@@ -12,7 +12,8 @@ use crate::Error;
 
 impl Renderer {
     /// Renders into an internal `width × height` target and reads it back (top row first);
-    /// the application's framebuffer binding and other GL state are as they were. With `options.measure.timed_frames > 0`, renders one warm-up frame and reports the median of
+    /// the application's framebuffer binding and other GL state are as they were. With
+    /// `options.measure.timed_frames > 0`, renders one warm-up frame and reports the median of
     /// the timed ones.
     pub fn render_offscreen(
         &mut self,
