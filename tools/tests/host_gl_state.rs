@@ -119,8 +119,8 @@ fn snapshot(gl: &glow::Context, es3: bool) -> Snapshot {
 
 /// Sets state a game might leave on (every value unlike the GL default), with its own objects
 /// bound: a vertex array (ES 3.0), buffers, a program, textures on eight units, a sampler, a
-/// framebuffer with a texture. Returns the game's framebuffer.
-unsafe fn set_game_state(gl: &glow::Context, es3: bool, size: (i32, i32)) -> glow::Framebuffer {
+/// framebuffer with a texture, bound.
+unsafe fn set_game_state(gl: &glow::Context, es3: bool, size: (i32, i32)) {
     if es3 {
         let vao = gl.create_vertex_array().unwrap();
         gl.bind_vertex_array(Some(vao));
@@ -239,7 +239,6 @@ unsafe fn set_game_state(gl: &glow::Context, es3: bool, size: (i32, i32)) -> glo
     gl.color_mask(true, false, true, false);
     gl.cull_face(glow::FRONT);
     gl.front_face(glow::CW);
-    fbo
 }
 
 #[test]
@@ -255,65 +254,60 @@ fn every_call_gives_the_games_gl_state_back_and_draws_as_from_a_clean_one() {
         } else {
             &["forward", "tiled", "clustered"]
         };
-        // What each method draws from the default state, on a renderer of its own.
+        // Every method, with MSAA where it runs (deferred has none).
+        let cases: Vec<(&str, RenderOptions)> = methods
+            .iter()
+            .flat_map(|&m| {
+                let counts = sample_counts
+                    .iter()
+                    .filter(move |&&n| n == 1 || m != "deferred");
+                counts.map(move |&samples| {
+                    let opts = RenderOptions {
+                        samples,
+                        ..Default::default()
+                    };
+                    (m, opts)
+                })
+            })
+            .collect();
+        // What each draws from the default state, on a renderer of its own.
         let mut clean = Gpu::fresh(es);
-        let mut expected = Vec::new();
-        for m in methods {
-            clean.r().set_method_named(m).unwrap();
-            // Deferred has no MSAA.
-            for &samples in sample_counts
-                .iter()
-                .filter(|&&n| n == 1 || *m != "deferred")
-            {
-                let opts = RenderOptions {
-                    samples,
-                    ..Default::default()
-                };
-                expected.push(clean.r().render_offscreen(&scene, w, h, &opts).unwrap().0);
-            }
-        }
+        let expected: Vec<_> = cases
+            .iter()
+            .map(|(m, opts)| {
+                clean.r().set_method_named(m).unwrap();
+                clean.r().render_offscreen(&scene, w, h, opts).unwrap().0
+            })
+            .collect();
         drop(clean);
         let ctx = HeadlessContext::new(es).unwrap();
         let gl = ctx.load_gl();
         let mut renderer = Renderer::new(ctx.load_gl(), es).unwrap();
-        let fbo = unsafe { set_game_state(&gl, es3, (w as i32, h as i32)) };
+        unsafe { set_game_state(&gl, es3, (w as i32, h as i32)) };
         let before = snapshot(&gl, es3);
-        let mut expected = expected.into_iter();
-        for m in methods {
+        for ((m, opts), expected) in cases.iter().zip(&expected) {
+            let what = format!("{es} {m} ×{}", opts.samples);
             renderer.set_method_named(m).unwrap();
             assert_eq!(
                 snapshot(&gl, es3),
                 before,
-                "{es}: set_method({m}) changed the game's state"
+                "{what}: set_method changed the game's state"
             );
-            // Deferred has no MSAA.
-            for &samples in sample_counts
-                .iter()
-                .filter(|&&n| n == 1 || *m != "deferred")
-            {
-                let opts = RenderOptions {
-                    samples,
-                    ..Default::default()
-                };
-                let (img, _) = renderer.render_offscreen(&scene, w, h, &opts).unwrap();
-                let d = manylight::metrics::diff(&expected.next().unwrap(), &img);
-                assert_eq!(
-                    d.max_abs, 0,
-                    "{es} {m} ×{samples}: the game's state changed the picture"
-                );
-                assert_eq!(
-                    snapshot(&gl, es3),
-                    before,
-                    "{es} {m} ×{samples}: render_offscreen changed the game's state"
-                );
-                // Into the game's own framebuffer, as a game draws.
-                renderer.render(&scene, w, h, &opts).unwrap();
-                assert_eq!(
-                    snapshot(&gl, es3),
-                    before,
-                    "{es} {m} ×{samples}: render changed the game's state"
-                );
-            }
+            let (img, _) = renderer.render_offscreen(&scene, w, h, opts).unwrap();
+            let d = manylight::metrics::diff(expected, &img);
+            assert_eq!(d.max_abs, 0, "{what}: the game's state changed the picture");
+            assert_eq!(
+                snapshot(&gl, es3),
+                before,
+                "{what}: render_offscreen changed the game's state"
+            );
+            // Into the game's own framebuffer, as a game draws.
+            renderer.render(&scene, w, h, opts).unwrap();
+            assert_eq!(
+                snapshot(&gl, es3),
+                before,
+                "{what}: render changed the game's state"
+            );
         }
         renderer.mediump_is_fp16().unwrap();
         assert_eq!(
@@ -321,7 +315,6 @@ fn every_call_gives_the_games_gl_state_back_and_draws_as_from_a_clean_one() {
             before,
             "{es}: the precision probe changed the game's state"
         );
-        let _ = fbo;
         drop(renderer);
         drop(ctx);
     }
