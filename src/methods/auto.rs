@@ -119,7 +119,7 @@ impl ShadingMethod for Auto {
                     let _ = write!(
                         self.reason,
                         "{visible} lights visible > {MAX_INDEXED_LIGHTS}, more than clustered \
-                         can index: forward loops over them all"
+                         can index: forward renders this frame"
                     );
                     if !self.warned_too_many {
                         self.warned_too_many = true;

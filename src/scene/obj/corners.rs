@@ -16,10 +16,7 @@ pub(super) fn fill_missing(text: &str) -> Option<String> {
             .any(|l| l.split_whitespace().next() == Some(key))
     };
     let (has_uvs, has_normals) = (has("vt"), has("vn"));
-    let lacks = |at: usize, has: bool| {
-        has && face_corners(text).any(|corner| corner.split('/').nth(at).is_none_or(str::is_empty))
-    };
-    let (fill_uvs, fill_normals) = (lacks(1, has_uvs), lacks(2, has_normals));
+    let (fill_uvs, fill_normals) = (has_uvs && mixed(text, 1), has_normals && mixed(text, 2));
     if !fill_uvs && !fill_normals {
         return None;
     }
@@ -61,13 +58,31 @@ pub(super) fn fill_missing(text: &str) -> Option<String> {
     Some(out)
 }
 
-/// Every corner of every `f` line.
-fn face_corners(text: &str) -> impl Iterator<Item = &str> {
-    text.lines().flat_map(|l| {
-        let mut words = l.split_whitespace();
-        let face = words.next() == Some("f");
-        words.filter(move |_| face)
-    })
+/// Whether some object's faces name index `at` (1: texture coordinate, 2: normal) in some
+/// corners and not in others. An object runs to the next `o` or `g` line; tobj also starts a
+/// new mesh at a `usemtl` that changes the material, so this may see a mix tobj would not
+/// (then the rewrite only costs a warning), never the other way round.
+fn mixed(text: &str, at: usize) -> bool {
+    let (mut with, mut without) = (false, false);
+    for line in text.lines() {
+        let mut words = line.split_whitespace();
+        match words.next() {
+            Some("o" | "g") => (with, without) = (false, false),
+            Some("f") => {
+                for corner in words {
+                    match corner.split('/').nth(at) {
+                        Some(index) if !index.is_empty() => with = true,
+                        _ => without = true,
+                    }
+                }
+                if with && without {
+                    return true;
+                }
+            }
+            _ => {}
+        }
+    }
+    false
 }
 
 /// A corner's texture coordinate or normal index once the file is rewritten: as written
@@ -105,8 +120,10 @@ mod tests {
             fill_missing(mixed).as_deref(),
             Some("vt 0 0\nvn 0 0 0\nv 0 0 0\nvt 0 0\nvn 0 0 1\nf 1/2/2 1/-1/1 1/1/-1\n")
         );
-        // Files whose corners all name them, or that have none, are left alone.
+        // Files whose corners all name them, or that have none, or whose objects each do or
+        // do not (tobj makes each object its own mesh), are left alone.
         for text in [
+            "v 0 0 0\nvt 0 0\no a\nf 1/1 1/1 1/1\no b\nf 1 1 1\n",
             "v 0 0 0\nvt 0 0\nf 1/1 1/1 1/1\n",
             "v 0 0 0\nf 1 1 1\n",
             "v 0 0 0\nvn 0 0 1\nf 1//1 1//1 1//1\n",
