@@ -58,7 +58,7 @@ macro_rules! tracked {
 /// A creation error, or the usual cause when EGL says no context is current here: the context
 /// (a `HeadlessContext`, say) was dropped, or another made current, while the renderer lived.
 fn creation_failed(reason: String) -> GlError {
-    if super::gles_lib::no_current_context() {
+    if super::gles_lib::current_context() == Some(None) {
         GlError::NotCurrent
     } else {
         GlError::Create(reason)

@@ -156,15 +156,6 @@ impl GlesLibrary {
     }
 }
 
-/// True when this process loaded EGL (a headless context did) and EGL says no context is
-/// current on this thread; false when it cannot tell (a context from elsewhere, say WGL).
-pub(crate) fn no_current_context() -> bool {
-    match LOADED.get() {
-        Some(Ok(lib)) => lib.egl().get_current_context().is_none(),
-        _ => false,
-    }
-}
-
 /// The EGL context current on this thread, as an address (`Some(None)`: none), when this
 /// process loaded EGL; `None` when it cannot tell (a context from elsewhere, say WGL).
 pub(crate) fn current_context() -> Option<Option<usize>> {
