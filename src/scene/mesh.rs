@@ -109,21 +109,7 @@ impl Mesh {
         indices: Vec<u32>,
     ) -> Result<Mesh, SceneError> {
         let n = positions.len();
-        if !indices.len().is_multiple_of(3) {
-            return Err(SceneError::invalid(
-                "mesh.indices",
-                format!(
-                    "{} indices is not a whole number of triangles",
-                    indices.len()
-                ),
-            ));
-        }
-        if let Some(bad) = indices.iter().find(|&&i| i as usize >= n) {
-            return Err(SceneError::invalid(
-                "mesh.indices",
-                format!("index {bad} out of range for {n} vertices"),
-            ));
-        }
+        check_indices(&indices, n, "mesh.indices")?;
         if let Some(i) = positions.iter().position(|p| !p.is_finite()) {
             return Err(SceneError::invalid(
                 format!("mesh.positions[{i}]"),
@@ -300,21 +286,7 @@ impl Mesh {
     pub(crate) fn check_shape(&self, field: &str) -> Result<(), SceneError> {
         let n = self.positions.len();
         let at = |what: &str| format!("{field}.{what}");
-        if !self.indices.len().is_multiple_of(3) {
-            return Err(SceneError::invalid(
-                at("indices"),
-                format!(
-                    "{} indices is not a whole number of triangles",
-                    self.indices.len()
-                ),
-            ));
-        }
-        if let Some(bad) = self.indices.iter().find(|&&i| i as usize >= n) {
-            return Err(SceneError::invalid(
-                at("indices"),
-                format!("index {bad} out of range for {n} vertices"),
-            ));
-        }
+        check_indices(&self.indices, n, &at("indices"))?;
         check_per_vertex(&at("normals"), self.normals.len(), n)?;
         let optional = [
             ("uvs", self.uvs.len()),
@@ -328,6 +300,26 @@ impl Mesh {
         }
         Ok(())
     }
+}
+
+/// Whole triangles of indices, each below `n` (the vertex count); errors name `field`.
+fn check_indices(indices: &[u32], n: usize, field: &str) -> Result<(), SceneError> {
+    if !indices.len().is_multiple_of(3) {
+        return Err(SceneError::invalid(
+            field,
+            format!(
+                "{} indices is not a whole number of triangles",
+                indices.len()
+            ),
+        ));
+    }
+    if let Some(bad) = indices.iter().find(|&&i| i as usize >= n) {
+        return Err(SceneError::invalid(
+            field,
+            format!("index {bad} out of range for {n} vertices"),
+        ));
+    }
+    Ok(())
 }
 
 fn check_per_vertex(field: &str, got: usize, n: usize) -> Result<(), SceneError> {
