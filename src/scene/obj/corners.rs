@@ -11,12 +11,7 @@
 /// The text with every face corner naming a texture coordinate where the file has any, and a
 /// normal where it has any; `None` when every corner already does (the common file).
 pub(super) fn fill_missing(text: &str) -> Option<String> {
-    let has = |key: &str| {
-        text.lines()
-            .any(|l| l.split_whitespace().next() == Some(key))
-    };
-    let (has_uvs, has_normals) = (has("vt"), has("vn"));
-    let (fill_uvs, fill_normals) = (has_uvs && mixed(text, 1), has_normals && mixed(text, 2));
+    let [fill_uvs, fill_normals] = mixed(text);
     if !fill_uvs && !fill_normals {
         return None;
     }
@@ -58,31 +53,38 @@ pub(super) fn fill_missing(text: &str) -> Option<String> {
     Some(out)
 }
 
-/// Whether some object's faces name index `at` (1: texture coordinate, 2: normal) in some
-/// corners and not in others. An object runs to the next `o` or `g` line; tobj also starts a
-/// new mesh at a `usemtl` that changes the material, so this may see a mix tobj would not
-/// (then the rewrite only costs a warning), never the other way round.
-fn mixed(text: &str, at: usize) -> bool {
-    let (mut with, mut without) = (false, false);
+/// Whether the file has texture coordinates (`[0]`) and normals (`[1]`) and some object's
+/// faces name them in some corners and not in others, in one pass. An object runs to the
+/// next `o` or `g` line; tobj also starts a new mesh at a `usemtl` that changes the material,
+/// so this may see a mix tobj would not (then the rewrite only costs a warning), never the
+/// other way round.
+fn mixed(text: &str) -> [bool; 2] {
+    let (mut has, mut mixed) = ([false; 2], [false; 2]);
+    let (mut with, mut without) = ([false; 2], [false; 2]);
     for line in text.lines() {
         let mut words = line.split_whitespace();
         match words.next() {
-            Some("o" | "g") => (with, without) = (false, false),
+            Some("vt") => has[0] = true,
+            Some("vn") => has[1] = true,
+            Some("o" | "g") => (with, without) = ([false; 2], [false; 2]),
             Some("f") => {
                 for corner in words {
-                    match corner.split('/').nth(at) {
-                        Some(index) if !index.is_empty() => with = true,
-                        _ => without = true,
+                    let mut indices = corner.split('/').skip(1);
+                    for k in 0..2 {
+                        match indices.next() {
+                            Some(index) if !index.is_empty() => with[k] = true,
+                            _ => without[k] = true,
+                        }
                     }
                 }
-                if with && without {
-                    return true;
+                for k in 0..2 {
+                    mixed[k] |= with[k] && without[k];
                 }
             }
             _ => {}
         }
     }
-    false
+    [has[0] && mixed[0], has[1] && mixed[1]]
 }
 
 /// A corner's texture coordinate or normal index once the file is rewritten: as written
