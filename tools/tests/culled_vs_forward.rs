@@ -141,7 +141,7 @@ fn overflow_policy_holds_in_a_real_render() {
         // In the crowd, dropping lights only darkens, and the kept lights (at least 255 of the
         // 300 in every cell, the most important to it) still give most of the crowd's light:
         // their share, summed over the image, is at least 3/4 (the 85 % they are of the lights,
-        // less room for the brighter ones' overlap; 0.89 here). An overfull cell that lost all
+        // less room for the brighter ones' overlap). An overfull cell that lost all
         // its lights gives none.
         let (mut crowd, mut kept) = (0i64, 0i64);
         for ((r, f), c) in reference.pixels().zip(floor.pixels()).zip(img.pixels()) {

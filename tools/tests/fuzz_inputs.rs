@@ -276,8 +276,8 @@ fn most_generated_obj_files_load() {
             std::fs::write(&file, &obj).unwrap();
             loaded += usize::from(load_and_check(&file, false).is_ok());
         }
-        // The generators are hostile by design (about one number or index in twenty is bad,
-        // and one bad one refuses the file): 38 % and more load here.
+        // The generators are hostile by design: some numbers and indices are bad, and one bad
+        // one refuses the file.
         assert!(
             loaded >= 50,
             "only {loaded} of 200 generated OBJ files loaded"

@@ -66,7 +66,7 @@ fn matrix_covers_es2_es2_without_float_and_es3_and_every_supported_cell_matches_
     // A device without fragment highp: only the methods that need no highp run, forward
     // (and auto choosing it) within the fp16 guarantee of docs/precision.md: an RMSE of 2/255
     // from the highp reference. Single pixels go further (a light a few centimetres from a
-    // surface lands off by fp16's position step: 21/255 measured there), hence the loose
+    // surface lands off by fp16's position step, docs/precision.md), hence the loose
     // bound on the largest.
     let mediump = row("ES 2.0 without fragment highp (played)");
     assert!(mediump["error"].is_null(), "{}", mediump["error"]);

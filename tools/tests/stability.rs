@@ -316,7 +316,8 @@ fn extreme_near_and_far_planes_and_orthographic() {
     };
     check("orthographic near 0", &ortho, 128, 72);
     // SwiftShader (a 4-bit sub-pixel grid) shades two pixels where the floor's far edge meets
-    // the background 18/255 off the light model; its methods still equal its forward (above).
+    // the background off the light model (docs/testing.md); its methods still equal its forward
+    // (above).
     let renderer = Gpu::new(EsVersion::Es3).r().caps().renderer.clone();
     if renderer.contains("SwiftShader") {
         eprintln!("NOT CHECKED against the light model on {renderer}: orthographic near 0");
