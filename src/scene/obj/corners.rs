@@ -2,7 +2,7 @@
 //!
 //! OBJ allows it (`f 1/1 2/2 3/3` then `f 2 4 3`), but tobj then pushes a texture coordinate
 //! only for the corners that have one, so a mesh's coordinates no longer line up with its
-//! vertices (the load failed with "3 texture coordinates for 6 vertices"). Such a file is
+//! vertices. Such a file is
 //! rewritten before tobj reads it: one texture coordinate `(0, 0)` and one zero normal are
 //! put first, each corner without one names them, and every positive index is moved past
 //! them (negative ones count back from the corner and still find the same line). A zero
