@@ -2,6 +2,8 @@
 // (grid: src/cluster/grid.rs; texels: src/cluster/pack_grid.rs). Needs data_texture.glsl.
 // Tiled forward uses the same code with a one-cascade, one-slice grid.
 uniform HIGHP vec2 u_viewport;
+// The viewport's lower-left corner in the framebuffer: the frame's pixel (0, 0).
+uniform HIGHP vec2 u_frameOrigin;
 // t = (f(d) - x) * y, with f = log2 when z > 0.5 (perspective) and f(d) = d otherwise.
 uniform HIGHP vec3 u_depthMap;
 uniform HIGHP float u_cascadeCount;

@@ -17,7 +17,7 @@ VARYING vec2 v_uv;
 
 void main() {
     // A highp copy: gl_FragCoord may be mediump on ES 2.0, too coarse past 2048 pixels.
-    HIGHP vec2 fragXY = gl_FragCoord.xy;
+    HIGHP vec2 fragXY = gl_FragCoord.xy - u_frameOrigin;
     HIGHP float viewDepth = -v_viewPos.z;
 #if COUNT_EVALS
     // The loop below runs over the cell's list: its length is the evaluation count.

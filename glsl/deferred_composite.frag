@@ -10,9 +10,12 @@
 uniform HIGHP sampler2D u_accum;
 // The geometry pass's depth, written into the target's depth buffer (see deferred.rs).
 uniform HIGHP sampler2D u_gDepth;
+// The viewport's lower-left corner in the target: the G-buffer's pixel (0, 0).
+uniform HIGHP vec2 u_frameOrigin;
 
 void main() {
-    ivec2 px = ivec2(gl_FragCoord.xy);
+    HIGHP vec2 frameXY = gl_FragCoord.xy - u_frameOrigin;
+    ivec2 px = ivec2(frameXY);
     if (texelFetch(u_gNormalDepth, px, 0).z <= 0.0) {
         discard;
     }
@@ -27,7 +30,7 @@ void main() {
     // Directional lights light every pixel: here, once, rather than as a light volume. The
     // surface point comes back from the G-buffer as in the light pass.
     HIGHP vec4 nd = texelFetch(u_gNormalDepth, px, 0);
-    HIGHP vec3 P = viewPosition(gl_FragCoord.xy + vec2(nd.w, albedoOffset.a), nd.z);
+    HIGHP vec3 P = viewPosition(frameXY + vec2(nd.w, albedoOffset.a), nd.z);
     vec4 spec = texelFetch(u_gSpecular, px, 0);
     SurfaceParams surface;
     surface.albedo = albedo;

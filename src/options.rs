@@ -58,6 +58,12 @@ pub struct RenderOptions {
     /// framebuffer that was bound (ES 3.0; forward, tiled, clustered and auto; not deferred, not
     /// HDR output; light counts are never multisampled).
     pub samples: u32,
+    /// Where the frame's lower-left corner lies in the bound framebuffer, in pixels:
+    /// [`Renderer::render`](crate::Renderer::render) draws into the `width × height` rectangle
+    /// from there and leaves the rest of the framebuffer as it was (split screen, a view beside
+    /// an editor's panel). `[0, 0]` by default. The offscreen renders ignore it: their image is
+    /// the frame.
+    pub origin: [u32; 2],
     /// Knobs for measuring and testing the renderer (timed frames, forced encodings, caps that
     /// exercise the overflow policy); a game leaves them at their defaults.
     pub measure: MeasureOptions,
@@ -78,6 +84,7 @@ impl Default for RenderOptions {
             tone_map: ToneMap::None,
             exposure_ev: 0.0,
             samples: 1,
+            origin: [0, 0],
             measure: MeasureOptions::default(),
         }
     }

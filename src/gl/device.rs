@@ -194,6 +194,17 @@ impl Device {
         unsafe { self.gl.viewport(x, y, width, height) }
     }
 
+    /// Clears colour and depth within `[x, y, width, height]` of the bound framebuffer only
+    /// (a scissored clear; the scissor test is off again after it).
+    pub fn clear_rect(&self, [x, y, width, height]: [i32; 4], color: [f32; 4]) {
+        unsafe {
+            self.gl.enable(glow::SCISSOR_TEST);
+            self.gl.scissor(x, y, width, height);
+        }
+        self.clear(color);
+        unsafe { self.gl.disable(glow::SCISSOR_TEST) };
+    }
+
     /// Clears colour and depth of the bound framebuffer.
     pub fn clear(&self, color: [f32; 4]) {
         unsafe {
@@ -231,21 +242,24 @@ impl Device {
     }
 
     /// Copies the buffers of `mask` (`glow::COLOR_BUFFER_BIT`, `DEPTH_BUFFER_BIT`) of the
-    /// framebuffer `from` into `into` (`None`: the default one), both `size` pixels, nearest
-    /// (ES 3.0: a multisampled source is resolved); leaves `into` bound.
+    /// `size` pixels at the corner of framebuffer `from` into `into` (`None`: the default
+    /// one) at `to`, nearest (ES 3.0: a multisampled source is resolved, and only onto the
+    /// corner); leaves `into` bound.
     pub fn blit(
         &self,
         from: glow::Framebuffer,
         into: Option<glow::Framebuffer>,
         (width, height): (u32, u32),
+        to: [u32; 2],
         mask: u32,
     ) {
         let (w, h) = (width as i32, height as i32);
+        let (x, y) = (to[0] as i32, to[1] as i32);
         unsafe {
             self.gl.bind_framebuffer(glow::READ_FRAMEBUFFER, Some(from));
             self.gl.bind_framebuffer(glow::DRAW_FRAMEBUFFER, into);
             self.gl
-                .blit_framebuffer(0, 0, w, h, 0, 0, w, h, mask, glow::NEAREST);
+                .blit_framebuffer(0, 0, w, h, x, y, x + w, y + h, mask, glow::NEAREST);
         }
         self.bind_framebuffer(into);
     }

@@ -53,6 +53,8 @@ pub(crate) struct HostState {
     framebuffers: [Option<glow::Framebuffer>; 2],
     renderbuffer: Option<glow::Renderbuffer>,
     viewport: [i32; 4],
+    /// The scissor box (the renderer's scissored clear sets it).
+    scissor: [i32; 4],
     toggled: [bool; TOGGLED.len()],
     off_inside: [bool; OFF_INSIDE.len()],
     rasterizer_discard: bool,
@@ -95,6 +97,8 @@ impl HostState {
             gl.active_texture(active_texture as u32);
             let mut viewport = [0i32; 4];
             gl.get_parameter_i32_slice(glow::VIEWPORT, &mut viewport);
+            let mut scissor = [0i32; 4];
+            gl.get_parameter_i32_slice(glow::SCISSOR_BOX, &mut scissor);
             let mut clear_color = [0f32; 4];
             gl.get_parameter_f32_slice(glow::COLOR_CLEAR_VALUE, &mut clear_color);
             let mut depth_range = [0f32; 2];
@@ -137,6 +141,7 @@ impl HostState {
                 },
                 renderbuffer: gl.get_parameter_renderbuffer(glow::RENDERBUFFER_BINDING),
                 viewport,
+                scissor,
                 toggled: TOGGLED.map(|c| gl.is_enabled(c)),
                 off_inside: OFF_INSIDE.map(|c| gl.is_enabled(c)),
                 rasterizer_discard: es3 && gl.is_enabled(glow::RASTERIZER_DISCARD),
@@ -223,6 +228,8 @@ impl HostState {
             gl.bind_renderbuffer(glow::RENDERBUFFER, self.renderbuffer);
             let [x, y, w, h] = self.viewport;
             gl.viewport(x, y, w, h);
+            let [x, y, w, h] = self.scissor;
+            gl.scissor(x, y, w, h);
             for (c, on) in TOGGLED.into_iter().zip(self.toggled) {
                 enable(c, on);
             }

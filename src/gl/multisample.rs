@@ -32,6 +32,10 @@ pub struct MultisampleTarget {
     samples_drawn: u32,
     /// Bytes of one depth sample.
     depth_bytes: usize,
+    /// ES 3.0, resolving to an origin other than (0, 0): a single-sampled copy the samples are
+    /// resolved into first, made when first needed (GL blits a multisampled source only onto
+    /// the same rectangle).
+    resolved_copy: Option<(glow::Framebuffer, glow::Renderbuffer)>,
     destroyed: bool,
 }
 
@@ -123,6 +127,7 @@ impl MultisampleTarget {
             } else {
                 2
             },
+            resolved_copy: None,
             destroyed: false,
         };
         unsafe {
@@ -239,8 +244,9 @@ impl MultisampleTarget {
     pub fn gpu_bytes(&self) -> usize {
         let pixels = self.size.0 as usize * self.size.1 as usize;
         let per_sample = 4 + self.depth_bytes;
+        let copy = if self.resolved_copy.is_some() { 4 } else { 0 };
         match self.color {
-            Color::Renderbuffer(_) => pixels * self.samples_drawn as usize * per_sample,
+            Color::Renderbuffer(_) => pixels * (self.samples_drawn as usize * per_sample + copy),
             Color::Texture { .. } => pixels * (self.samples_drawn as usize * per_sample + 4),
         }
     }
@@ -251,24 +257,34 @@ impl MultisampleTarget {
         dev.viewport(0, 0, self.size.0 as i32, self.size.1 as i32);
     }
 
-    /// Resolves the samples into the framebuffer `into` (`None`: the default one) of the same
-    /// size: each pixel the average of its samples. Leaves `into` bound. ES 3.0 blits, so the
-    /// destination's colour format must be RGBA8 (its multisample resolve needs identical
-    /// formats); ES 2.0 draws the averaged texture over it with a program from `programs`.
+    /// Resolves the samples into the target-sized rectangle at `origin` of the framebuffer
+    /// `into` (`None`: the default one): each pixel the average of its samples. Leaves `into`
+    /// bound. ES 3.0 blits, so the destination's colour format must be RGBA8 (its multisample
+    /// resolve needs identical formats); ES 2.0 draws the averaged texture over it with a
+    /// program from `programs`.
     pub fn resolve(
-        &self,
+        &mut self,
         dev: &Device,
         programs: &mut ProgramCache,
         into: Option<glow::Framebuffer>,
+        origin: [u32; 2],
     ) -> Result<(), GlError> {
         let (w, h) = (self.size.0 as i32, self.size.1 as i32);
+        let colour = glow::COLOR_BUFFER_BIT;
         match &self.color {
-            Color::Renderbuffer(_) => dev.blit(self.fbo, into, self.size, glow::COLOR_BUFFER_BIT),
+            Color::Renderbuffer(_) if origin == [0, 0] => {
+                dev.blit(self.fbo, into, self.size, [0, 0], colour)
+            }
+            Color::Renderbuffer(_) => {
+                let copy = self.resolved_copy(dev)?;
+                dev.blit(self.fbo, Some(copy), self.size, [0, 0], colour);
+                dev.blit(copy, into, self.size, origin, colour);
+            }
             Color::Texture { texture, triangle } => {
                 // Unbinding the framebuffer is what makes the driver average the samples into
                 // the texture.
                 dev.bind_framebuffer(into);
-                dev.viewport(0, 0, w, h);
+                dev.viewport(origin[0] as i32, origin[1] as i32, w, h);
                 RenderState::FULL_SCREEN.apply(dev);
                 let key = ProgramKey {
                     shader: "msaa_resolve",
@@ -284,7 +300,42 @@ impl MultisampleTarget {
                 triangle.draw(dev);
             }
         }
-        dev.check("MSAA resolve (ES 3.0: the destination must be RGBA8 and the same size)")
+        dev.check("MSAA resolve (ES 3.0: the destination must be RGBA8 and hold the frame)")
+    }
+
+    /// The single-sampled copy (made now if it is not yet): its framebuffer.
+    fn resolved_copy(&mut self, dev: &Device) -> Result<glow::Framebuffer, GlError> {
+        if let Some((fbo, _)) = self.resolved_copy {
+            return Ok(fbo);
+        }
+        let colour = dev.create_renderbuffer()?;
+        let fbo = match dev.create_framebuffer() {
+            Ok(fbo) => fbo,
+            Err(e) => {
+                dev.delete_renderbuffer(colour);
+                return Err(e);
+            }
+        };
+        self.resolved_copy = Some((fbo, colour));
+        let (w, h) = (self.size.0 as i32, self.size.1 as i32);
+        unsafe {
+            dev.gl.bind_renderbuffer(glow::RENDERBUFFER, Some(colour));
+            dev.gl
+                .renderbuffer_storage(glow::RENDERBUFFER, glow::RGBA8, w, h);
+            dev.gl.bind_framebuffer(glow::FRAMEBUFFER, Some(fbo));
+            dev.gl.framebuffer_renderbuffer(
+                glow::FRAMEBUFFER,
+                glow::COLOR_ATTACHMENT0,
+                glow::RENDERBUFFER,
+                Some(colour),
+            );
+        }
+        dev.check("allocating the MSAA resolve's copy")?;
+        let status = unsafe { dev.gl.check_framebuffer_status(glow::FRAMEBUFFER) };
+        if status != glow::FRAMEBUFFER_COMPLETE {
+            return Err(GlError::FramebufferIncomplete(status));
+        }
+        Ok(fbo)
     }
 
     /// Frees the framebuffer and its buffers.
@@ -299,6 +350,10 @@ impl MultisampleTarget {
                 }
             }
             dev.delete_renderbuffer(self.depth);
+            if let Some((fbo, colour)) = self.resolved_copy.take() {
+                dev.delete_framebuffer(fbo);
+                dev.delete_renderbuffer(colour);
+            }
             self.destroyed = true;
         }
     }

@@ -145,6 +145,7 @@ pub struct CompositeProgram {
     g_normal_depth: Uniform<Sampler>,
     accum: Uniform<Sampler>,
     g_depth: Uniform<Sampler>,
+    frame_origin: Uniform<[f32; 2]>,
     ambient: Uniform<Vec3>,
     exposure: Uniform<f32>,
     alpha: Uniform<f32>,
@@ -169,6 +170,7 @@ impl UniformSet for CompositeProgram {
             g_normal_depth: r.required("u_gNormalDepth"),
             accum: r.required("u_accum"),
             g_depth: r.required("u_gDepth"),
+            frame_origin: r.required("u_frameOrigin"),
             ambient: r.required_when(colour, "u_ambient"),
             exposure: r.required_when(colour && !f.has(ShaderFeatures::OUTPUT_HDR), "u_exposure"),
             alpha: r.required_when(colour, "u_alpha"),
@@ -353,7 +355,8 @@ impl Deferred {
     ) -> Result<(), Error> {
         let dev = ctx.dev;
         dev.bind_framebuffer(target);
-        dev.viewport(0, 0, ctx.viewport.0 as i32, ctx.viewport.1 as i32);
+        let [x, y] = ctx.origin.map(|v| v as i32);
+        dev.viewport(x, y, ctx.viewport.0 as i32, ctx.viewport.1 as i32);
         // The composite also gives the target the geometry pass's depth (for the transparent
         // objects drawn after it, and for whatever the application draws next): written by the
         // shader, so it works into a target of any depth format, where a depth blit needs both
@@ -386,6 +389,7 @@ impl Deferred {
         p.g_normal_depth.set(dev, UNIT_G_NORMAL_DEPTH);
         p.accum.set(dev, UNIT_ACCUM);
         p.g_depth.set(dev, UNIT_G_DEPTH);
+        p.frame_origin.set(dev, ctx.origin.map(|v| v as f32));
         p.ambient.set(dev, ctx.scene.ambient);
         p.exposure.set(dev, ctx.options.exposure_ev.exp2());
         p.alpha.set(dev, 1.0);

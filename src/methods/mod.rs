@@ -66,6 +66,8 @@ pub struct FrameContext<'a> {
     pub features: ShaderFeatures,
     /// Viewport size in pixels.
     pub viewport: (u32, u32),
+    /// The viewport's lower-left corner in the bound framebuffer (the frame's pixel (0, 0)).
+    pub origin: [u32; 2],
     /// Near plane distance.
     pub near: f64,
     /// Far plane distance (may be infinite).

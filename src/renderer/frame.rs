@@ -20,9 +20,10 @@ use crate::Error;
 
 impl Renderer {
     /// Renders `scene` into the currently bound framebuffer with a `width × height` viewport
-    /// (for embedding: a game binds its own target or the default framebuffer first). With
+    /// whose lower-left corner is `options.origin` (for embedding: a game binds its own target
+    /// or the default framebuffer first); only that rectangle is cleared and drawn. With
     /// `options.samples` > 1 the frame is drawn into the renderer's own multisampled target
-    /// and resolved into the bound framebuffer, which must then be RGBA8 of that size. The
+    /// and resolved into that rectangle, and the bound framebuffer must then be RGBA8. The
     /// application's GL state (bindings, viewport, blend, depth, …) is given back as it was,
     /// and its scissor, stencil or blend equations do not change the frame (the README's
     /// "Sharing the context with a game"); another EGL context current is
@@ -57,18 +58,32 @@ impl Renderer {
         options: &RenderOptions,
         stats: &mut FrameStats,
     ) -> Result<(), Error> {
-        self.hosted(|r| r.render_hosted(scene, width, height, options, stats))
+        self.render_at(scene, (width, height), options, options.origin, stats)
     }
 
-    /// [`Renderer::render_reusing`] between the application's GL state saved and given back.
+    /// [`Renderer::render_reusing`] with the frame's lower-left corner at `origin` in the bound
+    /// framebuffer (the offscreen renders pass `[0, 0]`).
+    pub(super) fn render_at(
+        &mut self,
+        scene: &Scene,
+        (width, height): (u32, u32),
+        options: &RenderOptions,
+        origin: [u32; 2],
+        stats: &mut FrameStats,
+    ) -> Result<(), Error> {
+        self.hosted(|r| r.render_hosted(scene, (width, height), options, origin, stats))
+    }
+
+    /// [`Renderer::render_at`] between the application's GL state saved and given back.
     fn render_hosted(
         &mut self,
         scene: &Scene,
-        width: u32,
-        height: u32,
+        (width, height): (u32, u32),
         options: &RenderOptions,
+        origin: [u32; 2],
         stats: &mut FrameStats,
     ) -> Result<(), Error> {
+        check_origin(origin, width, height)?;
         // Light counts are exact per pixel: never averaged over samples.
         let samples = if options.count == CountKind::None {
             options.samples.max(1)
@@ -76,7 +91,7 @@ impl Renderer {
             1
         };
         if samples <= 1 {
-            return self.render_frame(scene, width, height, options, stats);
+            return self.render_frame(scene, (width, height), options, origin, stats);
         }
         if width == 0 || height == 0 {
             return Err(Error::Limit(format!("viewport {width}×{height} is empty")));
@@ -93,11 +108,12 @@ impl Renderer {
         prepared?;
         let msaa = self.msaa.as_ref().expect("created by prepare_msaa");
         msaa.bind(&self.dev);
-        let rendered = self.render_frame(scene, width, height, options, stats);
-        let msaa = self.msaa.as_ref().expect("created by prepare_msaa");
+        // Drawn at the target's corner, resolved to the origin.
+        let rendered = self.render_frame(scene, (width, height), options, [0, 0], stats);
+        let msaa = self.msaa.as_mut().expect("created by prepare_msaa");
         match rendered {
             Ok(()) => {
-                msaa.resolve(&self.dev, &mut self.programs, destination)?;
+                msaa.resolve(&self.dev, &mut self.programs, destination, origin)?;
                 stats.samples = msaa.samples_drawn();
                 stats.memory.msaa_bytes = msaa.gpu_bytes();
                 Ok(())
@@ -114,9 +130,9 @@ impl Renderer {
     fn render_frame(
         &mut self,
         scene: &Scene,
-        width: u32,
-        height: u32,
+        (width, height): (u32, u32),
         options: &RenderOptions,
+        origin: [u32; 2],
         stats: &mut FrameStats,
     ) -> Result<(), Error> {
         let start = Instant::now();
@@ -151,8 +167,10 @@ impl Renderer {
         let content_far = content_far(self.gpu_scene.scene_bounds(scene), &view, near, far);
         let reach = super::fp16_range::view_reach(scene, width as f64 / height as f64, content_far);
         super::fp16_range::check(self.dev.caps(), scene, &mut self.lights, reach)?;
-        self.dev.viewport(0, 0, width as i32, height as i32);
-        self.dev.clear(options.clear_color);
+        let frame_rect = [origin[0], origin[1], width, height].map(|v| v as i32);
+        self.dev
+            .viewport(frame_rect[0], frame_rect[1], frame_rect[2], frame_rect[3]);
+        self.dev.clear_rect(frame_rect, options.clear_color);
         let mut ctx = FrameContext {
             dev: &self.dev,
             programs: &mut self.programs,
@@ -165,6 +183,7 @@ impl Renderer {
             directional,
             features,
             viewport: (width, height),
+            origin,
             near,
             far,
             content_far,
@@ -294,6 +313,23 @@ impl Renderer {
         }
         Ok(())
     }
+}
+
+/// Refuses a frame rectangle past GL's `i32` window coordinates, naming the field.
+fn check_origin(origin: [u32; 2], width: u32, height: u32) -> Result<(), Error> {
+    for (axis, start, size) in [("x", origin[0], width), ("y", origin[1], height)] {
+        if u64::from(start) + u64::from(size) > i32::MAX as u64 {
+            let why = format!(
+                "{axis} {start} plus the frame's {size} pixels passes GL's largest window \
+                 coordinate, {}",
+                i32::MAX
+            );
+            return Err(Error::Scene(crate::scene::SceneError::invalid(
+                "origin", why,
+            )));
+        }
+    }
+    Ok(())
 }
 
 /// Refuses render options the frame cannot be made from, naming the field.

@@ -69,12 +69,17 @@ impl Renderer {
             )?);
         }
         self.target.as_ref().expect("created above").bind(&self.dev);
-        let mut stats = self.render(scene, width, height, options)?;
+        let frame = |r: &mut Renderer| {
+            let mut stats = FrameStats::default();
+            r.render_at(scene, (width, height), options, [0, 0], &mut stats)
+                .map(|()| stats)
+        };
+        let mut stats = frame(self)?;
         if options.measure.timed_frames > 0 {
             // The warm-up frame compiled shaders and uploaded meshes; report the timed ones.
             let mut frames = Vec::new();
             for _ in 0..options.measure.timed_frames {
-                frames.push(self.render(scene, width, height, options)?);
+                frames.push(frame(self)?);
             }
             stats = FrameStats::summarize(frames).expect("at least one timed frame");
         }

@@ -66,6 +66,7 @@ fn snapshot(gl: &glow::Context, es3: bool) -> Snapshot {
     unsafe {
         let floats = [
             (glow::VIEWPORT, 4),
+            (glow::SCISSOR_BOX, 4),
             (glow::COLOR_CLEAR_VALUE, 4),
             (glow::DEPTH_CLEAR_VALUE, 1),
             (glow::DEPTH_RANGE, 2),

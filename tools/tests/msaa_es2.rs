@@ -9,6 +9,7 @@
 
 mod common;
 
+use common::game_target::render_at_origin;
 use common::{msaa, Gpu};
 use manylight::scene;
 use manylight::{EsVersion, RenderOptions};
@@ -89,5 +90,37 @@ fn edges_resolve_to_sample_coverage_and_the_copy_is_exact_on_es2() {
         }
         // The square crosses the target: both colours are there.
         assert!(smooth.pixels().any(|p| p[0] == 255) && smooth.pixels().any(|p| p[0] == 0));
+    }
+}
+
+/// Into part of a game's framebuffer (`RenderOptions::origin`): the copy pass puts the frame at
+/// the origin, and every method through it equals forward through it there.
+#[test]
+fn msaa_at_an_origin_copies_the_frame_there_on_es2() {
+    let Some(mut gpu) = es2_with_the_extension() else {
+        return;
+    };
+    let scene = scene::builtin::build("courtyard", Some((64, 2))).unwrap();
+    let size = (80, 45);
+    let options = RenderOptions {
+        origin: [13, 9],
+        ..msaa(4)
+    };
+    let whole = (size.0 + 30, size.1 + 20);
+    gpu.r().set_method_named("forward").unwrap();
+    let corner = gpu.render(&scene, size.0, size.1, &msaa(4));
+    let reference = render_at_origin(&mut gpu, &scene, &options, size, whole, "forward");
+    // Edge pixels a rasterizer rounds the other way once moved (viewport_origin.rs).
+    let d = manylight::metrics::diff(&corner, &reference);
+    assert!(
+        d.over_2 <= 0.01,
+        "{:.1} % of pixels moved",
+        d.over_2 * 100.0
+    );
+    for method in ["tiled", "clustered", "auto"] {
+        gpu.r().set_method_named(method).unwrap();
+        let img = render_at_origin(&mut gpu, &scene, &options, size, whole, method);
+        let d = manylight::metrics::diff(&reference, &img);
+        assert!(d.max_abs <= 2, "{method}: {}/255 from forward", d.max_abs);
     }
 }

@@ -33,6 +33,7 @@ pub struct ClusteredProgram {
 /// `cluster_lookup.glsl`: how a fragment finds its cell and reads its list.
 struct CellLookup {
     viewport: Uniform<[f32; 2]>,
+    frame_origin: Uniform<[f32; 2]>,
     depth_map: Uniform<Vec3>,
     cascade_count: Uniform<f32>,
     grid: Uniform<Sampler>,
@@ -53,6 +54,7 @@ impl UniformSet for ClusteredProgram {
             lights: LightData::resolve(r, lit),
             cells: CellLookup {
                 viewport: r.required("u_viewport"),
+                frame_origin: r.required("u_frameOrigin"),
                 depth_map: r.required("u_depthMap"),
                 cascade_count: r.required("u_cascadeCount"),
                 grid: r.required("u_grid"),
@@ -86,6 +88,7 @@ pub(super) struct Bindings<'a> {
     set: &'a TextureSet,
     light_ranges: [f32; 2],
     viewport: [f32; 2],
+    frame_origin: [f32; 2],
     /// The depth → cascade mapping: `a`, `b`, and 1 for log2 (see `cluster_lookup.glsl`).
     depth_map: Vec3,
     cascades: f32,
@@ -100,6 +103,7 @@ impl<'a> Bindings<'a> {
         grid: &ClusterGrid,
         assignment: &Assignment,
         (w, h): (u32, u32),
+        origin: [u32; 2],
     ) -> Self {
         let set = uploaded.set;
         let log2 = if grid.mapping == DepthMapping::Log2 {
@@ -111,6 +115,7 @@ impl<'a> Bindings<'a> {
             set,
             light_ranges: uploaded.light_ranges,
             viewport: [w as f32, h as f32],
+            frame_origin: origin.map(|v| v as f32),
             depth_map: Vec3::new(grid.a as f32, grid.b as f32, log2),
             cascades: grid.cascades.len() as f32,
             inv_heights: [inv_height(&set.grid), inv_height(&set.indices)],
@@ -127,6 +132,7 @@ impl<'a> Bindings<'a> {
         bind_texture(dev, &self.set.indices, UNIT_INDICES, &cells.indices);
         cells.inv_heights.set(dev, self.inv_heights);
         cells.viewport.set(dev, self.viewport);
+        cells.frame_origin.set(dev, self.frame_origin);
         cells.depth_map.set(dev, self.depth_map);
         cells.cascade_count.set(dev, self.cascades);
         p.longest_list.set(dev, self.longest_list);

@@ -106,7 +106,13 @@ impl CulledForward {
         if automatic {
             grid::record_cost(&mut self.auto, grid, &assigned, &uploaded);
         }
-        let bindings = bind::Bindings::new(&uploaded, grid, assigned.assignment, ctx.viewport);
+        let bindings = bind::Bindings::new(
+            &uploaded,
+            grid,
+            assigned.assignment,
+            ctx.viewport,
+            ctx.origin,
+        );
         draw(ctx, &bindings)?;
 
         Ok(CulledFrame::Rendered(MethodStats {

@@ -3,6 +3,7 @@
 
 pub mod cli;
 pub mod files;
+pub mod game_target;
 pub mod gltf;
 pub mod gltf_models;
 pub mod warnings;
@@ -87,6 +88,14 @@ impl Gpu {
             ctx.make_current().expect("the test's context made current");
         }
         self.renderer.as_mut().unwrap()
+    }
+
+    /// The context's GL functions, for a test playing the game's side; the context made
+    /// current first.
+    pub fn gl(&mut self) -> manylight::glow::Context {
+        let ctx = self.ctx.as_ref().expect("a context");
+        ctx.make_current().expect("the test's context made current");
+        ctx.load_gl()
     }
 
     pub fn render(
