@@ -95,11 +95,7 @@ impl Caps {
                 requested: es,
                 reason: format!(
                     "the driver returned OpenGL ES {context_version}{}",
-                    if std::env::var_os("MESA_GLES_VERSION_OVERRIDE").is_some() {
-                        " (MESA_GLES_VERSION_OVERRIDE is set)"
-                    } else {
-                        ""
-                    }
+                    mesa_switches_note()
                 ),
             });
         }
@@ -239,5 +235,29 @@ impl Caps {
             self.fragment_highp = Precision::default();
         }
         Ok(())
+    }
+}
+
+/// The Mesa switches set in this process that lower the ES version a context offers, as a
+/// parenthesis for a version error ("" when none is).
+pub(crate) fn mesa_switches_note() -> String {
+    let notes: Vec<&str> = [
+        (
+            "MESA_GLES_VERSION_OVERRIDE",
+            "MESA_GLES_VERSION_OVERRIDE is set and caps the version",
+        ),
+        (
+            "MESA_EXTENSION_OVERRIDE",
+            "MESA_EXTENSION_OVERRIDE is set: Mesa offers ES 3.0 only with the extensions it needs",
+        ),
+    ]
+    .into_iter()
+    .filter(|(var, _)| std::env::var_os(var).is_some())
+    .map(|(_, note)| note)
+    .collect();
+    if notes.is_empty() {
+        String::new()
+    } else {
+        format!(" ({})", notes.join("; "))
     }
 }

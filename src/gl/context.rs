@@ -85,8 +85,35 @@ pub struct EglInfo {
 fn egl_err(call: &'static str) -> impl Fn(egl::Error) -> GlError {
     move |e| GlError::Egl {
         call,
-        error: e.to_string(),
+        error: egl_error_text(e),
     }
+}
+
+/// EGL's error by its name and what it means (khronos-egl's text, whose parenthesis it leaves
+/// open for two of them, closed).
+fn egl_error_text(e: egl::Error) -> String {
+    use egl::Error::*;
+    let name = match e {
+        NotInitialized => "EGL_NOT_INITIALIZED",
+        BadAccess => "EGL_BAD_ACCESS",
+        BadAlloc => "EGL_BAD_ALLOC",
+        BadAttribute => "EGL_BAD_ATTRIBUTE",
+        BadContext => "EGL_BAD_CONTEXT",
+        BadConfig => "EGL_BAD_CONFIG",
+        BadCurrentSurface => "EGL_BAD_CURRENT_SURFACE",
+        BadDisplay => "EGL_BAD_DISPLAY",
+        BadSurface => "EGL_BAD_SURFACE",
+        BadMatch => "EGL_BAD_MATCH",
+        BadParameter => "EGL_BAD_PARAMETER",
+        BadNativePixmap => "EGL_BAD_NATIVE_PIXMAP",
+        BadNativeWindow => "EGL_BAD_NATIVE_WINDOW",
+        ContextLost => "EGL_CONTEXT_LOST",
+    };
+    let mut text = e.to_string().trim_end_matches('.').to_string();
+    if text.matches('(').count() > text.matches(')').count() {
+        text.push(')');
+    }
+    format!("{name}: {text}")
 }
 
 impl HeadlessContext {
@@ -206,12 +233,9 @@ impl HeadlessContext {
             .map_err(|e| GlError::VersionUnavailable {
                 requested: es,
                 reason: format!(
-                    "eglCreateContext: {e}{}",
-                    if std::env::var_os("MESA_GLES_VERSION_OVERRIDE").is_some() {
-                        " (MESA_GLES_VERSION_OVERRIDE is set and caps the version)"
-                    } else {
-                        ""
-                    }
+                    "eglCreateContext: {}{}",
+                    egl_error_text(e),
+                    super::caps::mesa_switches_note()
                 ),
             })?;
         let display_ext = egl

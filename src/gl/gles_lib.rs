@@ -80,6 +80,24 @@ pub fn library() -> Result<&'static GlesLibrary, GlError> {
         })
 }
 
+/// The `libGLESv2` and `libEGL` files of `folder`, loaded by nothing yet: an error naming
+/// the folder when it is not one or lacks either.
+pub fn files_in(folder: &Path) -> Result<(PathBuf, PathBuf), GlError> {
+    library_files(folder).map_err(GlError::GlesLibrary)
+}
+
+fn library_files(folder: &Path) -> Result<(PathBuf, PathBuf), String> {
+    if !folder.is_dir() {
+        return Err(format!(
+            "{} (from --gles-lib or {GLES_LIB_ENV}) is not a folder",
+            folder.display()
+        ));
+    }
+    let gles_path = find_in(folder, &["libGLESv2.so.2", "libGLESv2.so"])?;
+    let egl_path = find_in(folder, &["libEGL.so.1", "libEGL.so"])?;
+    Ok((gles_path, egl_path))
+}
+
 /// The first of `names` that exists in `folder`.
 fn find_in(folder: &Path, names: &[&str]) -> Result<PathBuf, String> {
     names
@@ -107,14 +125,7 @@ impl GlesLibrary {
                 folder: None,
             });
         };
-        if !folder.is_dir() {
-            return Err(format!(
-                "{} (from --gles-lib or {GLES_LIB_ENV}) is not a folder",
-                folder.display()
-            ));
-        }
-        let gles_path = find_in(&folder, &["libGLESv2.so.2", "libGLESv2.so"])?;
-        let egl_path = find_in(&folder, &["libEGL.so.1", "libEGL.so"])?;
+        let (gles_path, egl_path) = library_files(&folder)?;
         // SAFETY: loading a GLES implementation runs its initialisers; that is what the user
         // asked for by naming the folder.
         let gles = unsafe { libloading::Library::new(&gles_path) }

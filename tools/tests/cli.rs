@@ -175,6 +175,35 @@ fn capped_driver_says_clearly_that_es3_is_unavailable() {
         "{msg}"
     );
     assert!(!msg.contains("panicked"), "{msg}");
+    // The switch is named, and EGL's reason reads as a sentence (its parenthesis closed).
+    assert!(msg.contains("MESA_GLES_VERSION_OVERRIDE is set"), "{msg}");
+    assert_eq!(msg.matches('(').count(), msg.matches(')').count(), "{msg}");
+    // A sweep over both versions stops before its first row, not after the ES 2.0 ones.
+    let sweep = [
+        "bench",
+        "--quick",
+        "--es",
+        "2,3",
+        "--scenes",
+        "plane",
+        "--lights",
+        "8",
+        "--methods",
+        "forward",
+        "--size",
+        "32x18",
+        "--no-knobs",
+        "--animated-frames",
+        "0",
+        "--out",
+        "b",
+    ];
+    let msg = expect_exit(&sweep, &env, dir.path(), 1, "ES 3.0");
+    assert!(!msg.contains("ES 2.0 plane"), "rows ran first: {msg}");
+    // Removing an extension ES 3.0 needs lowers the version too: that switch is named.
+    let removed = [("MESA_EXTENSION_OVERRIDE", "-GL_OES_texture_float")];
+    let msg = expect_exit(&["info", "--es", "3"], &removed, dir.path(), 1, "ES 3.0");
+    assert!(msg.contains("MESA_EXTENSION_OVERRIDE is set"), "{msg}");
     // ES 2.0 still works on the capped driver, and the context really is 2.0.
     let out = manylight(&["info", "--es", "2", "--json"], &env, dir.path());
     assert!(out.status.success(), "{}", text(&out));
@@ -991,6 +1020,27 @@ fn info_scene_reports_the_scenes_own_features_and_variants() {
         let names = variant["features"].to_string();
         assert!(!names.contains("\"spot\""), "{variant}");
     }
+}
+
+/// A built-in scene is reported with the lights `render` gives it by default (it had none:
+/// every method then held no light data and only the no-lights variant was built).
+#[test]
+fn info_scene_of_a_built_in_has_renders_default_lights() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = manylight(&["info", "--json", "--scene", "plane"], &[], dir.path());
+    assert!(out.status.success(), "{}", text(&out));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let scene = &v["scene"];
+    assert_eq!(scene["features"]["point_lights"], true, "{scene}");
+    let clustered = scene["methods"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|m| m["method"] == "clustered")
+        .unwrap_or_else(|| panic!("no clustered entry: {scene}"));
+    assert!(clustered["gpu_bytes"].as_u64().unwrap() > 0, "{clustered}");
+    let variants = scene["variants"].to_string();
+    assert!(variants.contains("clustered"), "{variants}");
 }
 
 /// No message carries a file's bytes as they are: a name with a terminal's escape sequence is

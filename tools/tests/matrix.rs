@@ -141,3 +141,70 @@ fn matrix_covers_es2_es2_without_float_and_es3_and_every_supported_cell_matches_
         "contact sheet too small"
     );
 }
+
+/// As a CI script runs it: `--json -` prints only JSON on stdout (the table goes to stderr);
+/// the caller's own Mesa switches do not reach the cells, whose rows are then what their
+/// labels say (a capped caller turned the ES 3 rows into failures); and without `--out` no
+/// image is written anywhere.
+#[test]
+fn matrix_json_on_stdout_ignores_the_callers_driver_switches_and_writes_no_images() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_manylight"))
+        .args(["matrix", "--size", "32x18", "--lights", "8", "--json", "-"])
+        .env("MESA_GLES_VERSION_OVERRIDE", "2.0")
+        .env("TMPDIR", dir.path())
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    let rows: serde_json::Value = serde_json::from_slice(&out.stdout)
+        .unwrap_or_else(|e| panic!("stdout is not JSON alone ({e}): {stderr}"));
+    assert!(
+        stderr.contains("| implementation | configuration |"),
+        "the table on stderr: {stderr}"
+    );
+    assert!(
+        stderr.contains("MESA_GLES_VERSION_OVERRIDE=2.0 is not passed"),
+        "{stderr}"
+    );
+    let rows = rows.as_array().unwrap();
+    let es3 = rows
+        .iter()
+        .find(|r| r["config"] == "ES 3.x as the driver gives it")
+        .unwrap();
+    assert!(es3["error"].is_null(), "{es3}");
+    assert_eq!(es3["es"], "3.0", "{es3}");
+    for row in rows {
+        assert!(row["implementation"].is_string(), "{row}");
+        assert!(row["env"].is_array(), "{row}");
+        for m in row["methods"].as_array().unwrap() {
+            assert!(m["image"].is_null(), "an image without --out: {m}");
+        }
+    }
+    let written: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();
+    assert!(written.is_empty(), "files written: {written:?}");
+}
+
+/// A `--gles-lib` folder that cannot serve is an error of the matrix, before any cell runs.
+#[test]
+fn matrix_refuses_a_gles_lib_that_is_not_a_folder_before_any_cell() {
+    let dir = tempfile::tempdir().unwrap();
+    let missing = dir.path().join("nowhere");
+    let out = Command::new(env!("CARGO_BIN_EXE_manylight"))
+        .args(["matrix", "--gles-lib", "system", "--gles-lib"])
+        .arg(&missing)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.contains("nowhere") && stderr.contains("not a folder"),
+        "{stderr}"
+    );
+    assert!(
+        out.stdout.is_empty(),
+        "no table: {}",
+        String::from_utf8_lossy(&out.stdout)
+    );
+}

@@ -357,6 +357,11 @@ pub fn run(args: &BenchArgs) -> Result<(), Box<dyn std::error::Error>> {
     for spec in &plan.scenes {
         load_bench_scene(spec, first_count, args)?;
     }
+    // And each ES version's context once: a driver capped at ES 2.0 refuses the sweep here,
+    // not after its ES 2.0 rows.
+    for &es in &plan.es {
+        drop(HeadlessContext::new(es)?);
+    }
     let knob_list = if plan.knobs {
         knobs(args.quick)
     } else {

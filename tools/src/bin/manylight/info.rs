@@ -36,9 +36,9 @@ fn scene_report(
     renderer: &mut Renderer,
     spec: &str,
 ) -> Result<serde_json::Value, Box<dyn std::error::Error>> {
-    // The scene's own lights (built-ins and OBJ files their default set): added random
-    // lights would report, and build, features the scene does not have (spots, points).
-    let (scene, _) = manylight::scene::load_with(spec, None, &crate::load_options())?;
+    // The lights `render` gives it by default (seed 1): a glTF or scene file its own.
+    let lights = crate::render::lights_for(spec, None, 1);
+    let (scene, _) = manylight::scene::load_with(spec, lights, &crate::load_options())?;
     let mut methods = Vec::new();
     let mut features = None;
     for m in METHODS {

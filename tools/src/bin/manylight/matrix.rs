@@ -12,7 +12,7 @@
 //! to the system's group.
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
+use std::process::{Command, ExitStatus, Output};
 
 use clap::Parser;
 use manylight::gl::HeadlessContext;
@@ -35,13 +35,23 @@ pub struct MatrixArgs {
     /// Thumbnail size as WIDTHxHEIGHT.
     #[arg(long, default_value = "192x108", value_parser = crate::render::parse_size)]
     pub size: (u32, u32),
-    /// Write the results as JSON to this file.
+    /// Write the results as JSON to this file (`-`: to stdout, and the Markdown table to
+    /// stderr).
     #[arg(long)]
     pub json: Option<PathBuf>,
-    /// Write each cell's image and a labelled contact sheet (`matrix.png`) into this folder.
+    /// Write each cell's image and a labelled contact sheet (`matrix.png`) into this folder
+    /// (without it, no image is written).
     #[arg(long)]
     pub out: Option<PathBuf>,
 }
+
+/// The driver switches the configurations set: cleared in every cell first, so a row is
+/// the restriction its label names and no other the caller's environment carried.
+const DRIVER_ENV: [&str; 3] = [
+    "MESA_GLES_VERSION_OVERRIDE",
+    "MESA_EXTENSION_OVERRIDE",
+    "GALLIUM_DRIVER",
+];
 
 /// One configuration: a name, the ES version asked for, and the environment that restricts
 /// the driver.
@@ -163,14 +173,30 @@ pub fn run(args: &MatrixArgs, gles_libs: &[PathBuf]) -> Result<(), Box<dyn std::
     // What every cell would fail on is an error of the matrix, not a row of failures: a scene
     // that cannot be read, outputs that cannot be written.
     scene::load_with(&args.scene, Some((args.lights, 1)), &crate::load_options())?;
-    let out = args.out.clone().unwrap_or_else(std::env::temp_dir);
-    std::fs::create_dir_all(&out).map_err(|e| format!("cannot create {}: {e}", out.display()))?;
-    let json_file = args.json.as_deref().map(OutputFile::create).transpose()?;
-    let sheet_file = args
-        .out
-        .is_some()
-        .then(|| OutputFile::create(&out.join("matrix.png")))
+    for lib in gles_libs.iter().filter(|l| *l != Path::new("system")) {
+        manylight::gl::gles_lib::files_in(lib)?;
+    }
+    let out = args.out.as_deref();
+    if let Some(out) = out {
+        std::fs::create_dir_all(out)
+            .map_err(|e| format!("cannot create {}: {e}", out.display()))?;
+    }
+    let json_to_stdout = args.json.as_deref() == Some(Path::new("-"));
+    let json_file = match &args.json {
+        Some(path) if !json_to_stdout => Some(OutputFile::create(path)?),
+        _ => None,
+    };
+    let sheet_file = out
+        .map(|out| OutputFile::create(&out.join("matrix.png")))
         .transpose()?;
+    for var in DRIVER_ENV {
+        if let Some(value) = std::env::var_os(var) {
+            log::warn!(
+                "{var}={} is not passed to the matrix's cells: each row sets its own restriction",
+                value.to_string_lossy()
+            );
+        }
+    }
     let size = format!("{}x{}", args.size.0, args.size.1);
     let system = [PathBuf::from("system")];
     let groups = if gles_libs.is_empty() {
@@ -181,15 +207,21 @@ pub fn run(args: &MatrixArgs, gles_libs: &[PathBuf]) -> Result<(), Box<dyn std::
     let mut rows = Vec::new();
     for (g, lib) in groups.iter().enumerate() {
         let lib = (lib != Path::new("system")).then_some(lib.as_path());
-        rows.extend(group_rows(&exe, args, &size, &out, lib, g)?);
+        rows.extend(group_rows(&exe, args, &size, out, lib, g)?);
     }
-    print_stdout(&markdown(&rows))?;
+    let json = serde_json::to_string_pretty(&rows)? + "\n";
+    if json_to_stdout {
+        eprint!("{}", markdown(&rows));
+        print_stdout(&json)?;
+    } else {
+        print_stdout(&markdown(&rows))?;
+    }
     if let Some(file) = json_file {
-        file.commit_bytes((serde_json::to_string_pretty(&rows)? + "\n").as_bytes())?;
+        file.commit_bytes(json.as_bytes())?;
     }
-    if let Some(file) = sheet_file {
+    if let (Some(file), Some(out)) = (sheet_file, out) {
         let path = file.path().display().to_string();
-        file.commit_png(&sheet(&rows, &out))?;
+        file.commit_png(&sheet(&rows, out))?;
         eprintln!("contact sheet: {path}");
     }
     if let Some(error) = rows
@@ -209,7 +241,7 @@ fn group_rows(
     exe: &Path,
     args: &MatrixArgs,
     size: &str,
-    out: &Path,
+    out: Option<&Path>,
     lib: Option<&Path>,
     group: usize,
 ) -> Result<Vec<Value>, Box<dyn std::error::Error>> {
@@ -241,9 +273,8 @@ fn group_rows(
         ])
         .args(["--lights", &args.lights.to_string(), "--tag", &tag])
         .args(config.args)
-        .args(outside_files_flag())
-        .arg("--out")
-        .arg(out);
+        .args(outside_files_flag());
+        cell_environment(&mut cmd, out);
         for (k, v) in config.env {
             cmd.env(k, v);
         }
@@ -251,14 +282,7 @@ fn group_rows(
             Some(dir) => cmd.env(manylight::gl::gles_lib::GLES_LIB_ENV, dir),
             None => cmd.env_remove(manylight::gl::gles_lib::GLES_LIB_ENV),
         };
-        let output = cmd.output()?;
-        let mut row = match serde_json::from_slice::<Value>(&output.stdout) {
-            Ok(v) if output.status.success() => v,
-            _ => json!({
-                "error": cell_error(&output.stderr),
-                "methods": [],
-            }),
-        };
+        let mut row = cell_row(&cmd.output()?);
         row["config"] = json!(config.name);
         row["gles_lib"] = json!(label);
         row["env"] = json!(config
@@ -274,27 +298,67 @@ fn group_rows(
         row["gles_lib"] = json!(label);
         rows.push(row);
     }
+    // A row whose context could not be made names the implementation its group's others do.
+    let implementation = rows
+        .iter()
+        .find_map(|r| r["implementation"].as_str().map(String::from));
+    for row in &mut rows {
+        if row["implementation"].is_null() {
+            row["implementation"] = json!(implementation.as_deref().unwrap_or(&label));
+        }
+    }
     Ok(rows)
 }
 
+/// What every cell's child gets: no driver switch from the caller ([`DRIVER_ENV`]), and the
+/// folder for its images, if any.
+fn cell_environment(cmd: &mut Command, out: Option<&Path>) {
+    for var in DRIVER_ENV {
+        cmd.env_remove(var);
+    }
+    if let Some(out) = out {
+        cmd.arg("--out").arg(out);
+    }
+}
+
+/// A cell's row: the last line of its output that is a JSON object (a driver may print lines
+/// of its own there, as Mesa's "extension … cannot be disabled"), else why it has none.
+fn cell_row(output: &Output) -> Value {
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    let row = stdout.lines().rev().find_map(|l| {
+        serde_json::from_str::<Value>(l)
+            .ok()
+            .filter(Value::is_object)
+    });
+    match row {
+        Some(row) if output.status.success() => row,
+        _ => json!({
+            "error": cell_error(&output.stderr, output.status),
+            "methods": [],
+        }),
+    }
+}
+
 /// Why a cell failed, on one line for its table cell: the child's `error:` lines, without the
-/// warnings logged before them (or its last line when it printed no `error:`).
-fn cell_error(stderr: &[u8]) -> String {
+/// warnings logged before them; else how it ended, with its last line.
+fn cell_error(stderr: &[u8], status: ExitStatus) -> String {
     let text = String::from_utf8_lossy(stderr);
     let errors: Vec<&str> = text
         .lines()
         .filter_map(|l| l.strip_prefix("error: "))
         .map(str::trim)
         .collect();
-    if errors.is_empty() {
-        text.lines()
-            .rev()
-            .find(|l| !l.trim().is_empty())
-            .unwrap_or("")
-            .trim()
-            .to_string()
+    if !errors.is_empty() {
+        return errors.join("; ");
+    }
+    let ended = if status.success() {
+        "the cell printed no result".to_string()
     } else {
-        errors.join("; ")
+        format!("the cell stopped ({status})")
+    };
+    match text.lines().rev().map(str::trim).find(|l| !l.is_empty()) {
+        Some(last) => format!("{ended}; its last line: {last}"),
+        None => ended,
     }
 }
 
@@ -303,39 +367,33 @@ fn osmesa_row(
     exe: &Path,
     args: &MatrixArgs,
     size: &str,
-    out: &Path,
+    out: Option<&Path>,
 ) -> Result<Value, Box<dyn std::error::Error>> {
     if !cfg!(feature = "osmesa") {
         return Ok(json!({
             "config": "desktop GL (OSMesa)",
             "error": "not built: rebuild with `--features osmesa`",
+            "env": [],
             "methods": [],
         }));
     }
-    let output = Command::new(exe)
-        .args([
-            "matrix-cell",
-            "--es",
-            "3",
-            "--osmesa",
-            "--scene",
-            &args.scene,
-            "--size",
-            size,
-        ])
-        .args(["--lights", &args.lights.to_string(), "--tag", "osmesa"])
-        .args(outside_files_flag())
-        .arg("--out")
-        .arg(out)
-        .output()?;
-    let mut row = match serde_json::from_slice::<Value>(&output.stdout) {
-        Ok(v) if output.status.success() => v,
-        _ => json!({
-            "error": cell_error(&output.stderr),
-            "methods": [],
-        }),
-    };
+    let mut cmd = Command::new(exe);
+    cmd.args([
+        "matrix-cell",
+        "--es",
+        "3",
+        "--osmesa",
+        "--scene",
+        &args.scene,
+        "--size",
+        size,
+    ])
+    .args(["--lights", &args.lights.to_string(), "--tag", "osmesa"])
+    .args(outside_files_flag());
+    cell_environment(&mut cmd, out);
+    let mut row = cell_row(&cmd.output()?);
     row["config"] = json!("desktop GL (OSMesa)");
+    row["env"] = json!([]);
     Ok(row)
 }
 
@@ -362,9 +420,10 @@ fn markdown(rows: &[Value]) -> String {
         };
         for m in row["methods"].as_array().into_iter().flatten() {
             let status = m["support"]["status"].as_str().unwrap_or("?");
-            let support = match m["support"]["reason"].as_str() {
-                Some(r) => format!("{status}: {r}"),
-                None => status.to_string(),
+            let support = match (m["error"].as_str(), m["support"]["reason"].as_str()) {
+                (Some(e), _) => format!("error: {e}"),
+                (None, Some(r)) => format!("{status}: {r}"),
+                (None, None) => status.to_string(),
             };
             let num = |k: &str, digits: usize| {
                 m[k].as_f64()
@@ -405,6 +464,7 @@ fn sheet(rows: &[Value], out: &Path) -> image::RgbaImage {
                 .and_then(|f| image::open(out.join(f)).ok())
                 .map(|i| i.to_rgba8());
             let detail = match (m["support"]["status"].as_str(), m["max_abs"].as_f64()) {
+                _ if m["error"].is_string() => "error".to_string(),
                 (Some("unsupported"), _) => "unsupported".to_string(),
                 (Some(status), Some(err)) => format!("{status}, max err {err:.0}/255"),
                 (status, _) => status.unwrap_or("?").to_string(),
@@ -428,8 +488,9 @@ pub struct MatrixCellArgs {
     lights: usize,
     #[arg(long)]
     tag: String,
+    /// The folder for the cell's images (none written without it).
     #[arg(long)]
-    out: PathBuf,
+    out: Option<PathBuf>,
     /// Desktop GL through OSMesa instead of EGL (needs the `osmesa` feature).
     #[arg(long)]
     osmesa: bool,
@@ -510,18 +571,29 @@ pub fn run_cell(args: &MatrixCellArgs) -> Result<(), Box<dyn std::error::Error>>
     for m in METHODS {
         let support = (m.supported)(renderer.caps());
         let mut entry = json!({"name": m.name, "support": support});
-        if !matches!(support, Support::Unsupported(_)) {
-            renderer.set_method_named(m.name)?;
-            let (img, stats) = renderer.render_offscreen(&scene, w, h, &opts)?;
-            let d = manylight::metrics::diff(&reference, &img);
-            let file = format!("{}-{}.png", args.tag, m.name);
-            output::save_png(&args.out.join(&file), &img)?;
-            entry["max_abs"] = json!(d.max_abs);
-            entry["rmse"] = json!(d.rmse);
-            entry["over_2"] = json!(d.over_2);
-            entry["frame_ms"] = json!(stats.time.frame_ms);
-            entry["light_encoding"] = json!(stats.lights.encoding);
-            entry["image"] = json!(file);
+        if matches!(support, Support::Unsupported(_)) {
+            methods.push(entry);
+            continue;
+        }
+        // One method failing is its entry's error; the others are still measured.
+        let rendered = renderer
+            .set_method_named(m.name)
+            .and_then(|_| renderer.render_offscreen(&scene, w, h, &opts));
+        match rendered {
+            Ok((img, stats)) => {
+                let d = manylight::metrics::diff(&reference, &img);
+                entry["max_abs"] = json!(d.max_abs);
+                entry["rmse"] = json!(d.rmse);
+                entry["over_2"] = json!(d.over_2);
+                entry["frame_ms"] = json!(stats.time.frame_ms);
+                entry["light_encoding"] = json!(stats.lights.encoding);
+                if let Some(out) = &args.out {
+                    let file = format!("{}-{}.png", args.tag, m.name);
+                    output::save_png(&out.join(&file), &img)?;
+                    entry["image"] = json!(file);
+                }
+            }
+            Err(e) => entry["error"] = json!(e.to_string()),
         }
         methods.push(entry);
     }
@@ -543,12 +615,42 @@ pub fn run_cell(args: &MatrixCellArgs) -> Result<(), Box<dyn std::error::Error>>
 
 #[cfg(test)]
 mod tests {
-    use super::cell_error;
+    use super::{cell_error, cell_row};
+    use std::os::unix::process::ExitStatusExt;
+    use std::process::{ExitStatus, Output};
 
     #[test]
     fn a_cell_error_is_one_line_without_the_warnings_before_it() {
         let stderr = b"[WARN  manylight::renderer] fragment mediump\nerror: lights[0]: too far\n";
-        assert_eq!(cell_error(stderr), "lights[0]: too far");
-        assert_eq!(cell_error(b"thread panicked\nboom\n\n"), "boom");
+        let failed = ExitStatus::from_raw(1 << 8);
+        assert_eq!(cell_error(stderr, failed), "lights[0]: too far");
+        assert_eq!(
+            cell_error(b"[WARN  x] slow\nthread panicked\nboom\n\n", failed),
+            "the cell stopped (exit status: 1); its last line: boom"
+        );
+        assert_eq!(
+            cell_error(b"", ExitStatus::from_raw(0)),
+            "the cell printed no result"
+        );
+    }
+
+    /// A driver's own line on stdout (Mesa's, under `MESA_EXTENSION_OVERRIDE`) does not hide
+    /// the row printed before it.
+    #[test]
+    fn a_cells_row_is_its_last_json_line_whatever_follows() {
+        let output = Output {
+            status: ExitStatus::from_raw(0),
+            stdout: b"{\"es\":\"2\",\"methods\":[]}\nWarning: extension 'X' cannot be disabled\n"
+                .to_vec(),
+            stderr: Vec::new(),
+        };
+        let row = cell_row(&output);
+        assert_eq!(row["es"], "2", "{row}");
+        assert!(row["error"].is_null(), "{row}");
+        let failed = Output {
+            status: ExitStatus::from_raw(1 << 8),
+            ..output
+        };
+        assert!(cell_row(&failed)["error"].is_string());
     }
 }
