@@ -85,7 +85,7 @@ pub fn run(
 ) -> Result<Timings, Box<dyn std::error::Error>> {
     std::fs::create_dir_all(out_dir)?;
     let ctx = HeadlessContext::new(EsVersion::Es3)?;
-    let mut renderer = Renderer::new(ctx.load_gl(), EsVersion::Es3)?;
+    let mut renderer = Renderer::new(ctx.load_gl()?, EsVersion::Es3)?;
     let mut scene = build_scene(lights)?;
     let options = RenderOptions::default();
     let mut frame_ms = Vec::new();

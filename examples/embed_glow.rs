@@ -93,8 +93,8 @@ impl AppTarget {
 /// scissored bar along the bottom) after it, reads the result back and writes it to `out`.
 pub fn run(out: &Path, width: u32, height: u32) -> Result<(), Box<dyn std::error::Error>> {
     let ctx = HeadlessContext::new(EsVersion::Es3)?;
-    let app_gl = ctx.load_gl();
-    let mut renderer = Renderer::new(ctx.load_gl(), EsVersion::Es3)?;
+    let app_gl = ctx.load_gl()?;
+    let mut renderer = Renderer::new(ctx.load_gl()?, EsVersion::Es3)?;
     let scene = builtin_scene(
         "courtyard",
         Some(RandomLights {

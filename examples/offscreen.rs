@@ -78,7 +78,7 @@ pub fn run(out: &Path, width: u32, height: u32) -> Result<FrameStats, Box<dyn st
         Ok(ctx) => (ctx, EsVersion::Es3),
         Err(_) => (HeadlessContext::new(EsVersion::Es2)?, EsVersion::Es2),
     };
-    let mut renderer = Renderer::new(ctx.load_gl(), es)?;
+    let mut renderer = Renderer::new(ctx.load_gl()?, es)?;
     let scene = build_scene();
     let result = renderer.render_offscreen(&scene, width, height, &RenderOptions::default());
     // Free the GL objects before the context goes, whatever happened.

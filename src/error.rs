@@ -39,6 +39,14 @@ pub enum Error {
         /// Why not, and what would run.
         reason: String,
     },
+    /// A [`RenderOptions`](crate::RenderOptions) field the frame cannot be made from.
+    #[error("render option `{field}` {reason}")]
+    InvalidOption {
+        /// The field, as written in code (`exposure_ev`, `grid.footprint_px`, …).
+        field: &'static str,
+        /// What it must be, and what it was.
+        reason: String,
+    },
     /// A request the renderer cannot satisfy (too many lights for a method, bad size, …).
     #[error("{0}")]
     Limit(String),

@@ -24,7 +24,7 @@
 //! ```no_run
 //! use manylight::{builtin_scene, EsVersion, HeadlessContext, RandomLights, Renderer, RenderOptions};
 //! let ctx = HeadlessContext::new(EsVersion::Es3)?;
-//! let mut renderer = Renderer::new(ctx.load_gl(), EsVersion::Es3)?;
+//! let mut renderer = Renderer::new(ctx.load_gl()?, EsVersion::Es3)?;
 //! let scene = builtin_scene("courtyard", Some(RandomLights { count: 256, seed: 7 }))?;
 //! let (image, stats) = renderer.render_offscreen(&scene, 256, 144, &RenderOptions::default())?;
 //! image.save("out.png")?;

@@ -50,7 +50,7 @@ pub struct RenderOptions {
     /// HDR output). [`ToneMap::None`], the default, keeps images the light model's own.
     pub tone_map: ToneMap,
     /// Exposure in stops: radiance is multiplied by 2^`exposure_ev` before the tone map.
-    /// Within ±[`MAX_EXPOSURE_EV`].
+    /// Within ±[`MAX_EXPOSURE_EV`]. Not in HDR output, which is the light model's radiance.
     pub exposure_ev: f32,
     /// Samples per pixel: 1 (the default) or 0 for none, up to `GL_MAX_SAMPLES` for MSAA (GL
     /// rounds a count the implementation lacks up: `FrameStats::samples` says what it drew).

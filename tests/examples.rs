@@ -52,7 +52,7 @@ fn animated_lights_move_every_frame_and_each_frame_depends_on_its_time_only() {
     // Frame 2 rendered on its own, from its time alone, is the sequence's frame 2: the motion
     // is a function of time, and assignment keeps nothing of the frames before.
     let ctx = HeadlessContext::new(EsVersion::Es3).unwrap();
-    let mut renderer = Renderer::new(ctx.load_gl(), EsVersion::Es3).unwrap();
+    let mut renderer = Renderer::new(ctx.load_gl().unwrap(), EsVersion::Es3).unwrap();
     let mut scene = animated_lights::build_scene(128).unwrap();
     scene.set_time(animated_lights::time_of(2));
     let (alone, _) = renderer
@@ -70,7 +70,7 @@ fn embedding_draws_into_the_applications_framebuffer_under_its_overlay() {
     let embedded = image::open(&out).unwrap().to_rgba8();
     // The same view rendered by manylight into its own target.
     let ctx = HeadlessContext::new(EsVersion::Es3).unwrap();
-    let mut renderer = Renderer::new(ctx.load_gl(), EsVersion::Es3).unwrap();
+    let mut renderer = Renderer::new(ctx.load_gl().unwrap(), EsVersion::Es3).unwrap();
     let scene = builtin_scene(
         "courtyard",
         Some(RandomLights {
@@ -102,7 +102,7 @@ fn embedding_draws_into_the_applications_framebuffer_under_its_overlay() {
 #[test]
 fn a_renderer_outliving_its_headless_context_says_so() {
     let ctx = HeadlessContext::new(EsVersion::Es3).expect("headless ES 3.0 context");
-    let mut renderer = Renderer::new(ctx.load_gl(), EsVersion::Es3).unwrap();
+    let mut renderer = Renderer::new(ctx.load_gl().unwrap(), EsVersion::Es3).unwrap();
     let scene = builtin_scene("plane", Some(RandomLights { count: 4, seed: 1 })).unwrap();
     drop(ctx);
     let err = renderer

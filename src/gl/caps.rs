@@ -211,6 +211,23 @@ impl Caps {
         self.es == EsVersion::Es2 && !self.desktop && self.renderer.contains("SwiftShader")
     }
 
+    /// Whether the context renders to half-float (RGBA16F) targets: what
+    /// [`Renderer::render_offscreen_hdr`](crate::Renderer::render_offscreen_hdr) and HDR output
+    /// need (ES 3.0: `GL_EXT_color_buffer_float` or `_half_float`; ES 2.0: `OES_texture_half_float`
+    /// and `GL_EXT_color_buffer_half_float`).
+    pub fn hdr_output(&self) -> bool {
+        match self.es {
+            EsVersion::Es3 => {
+                self.has_extension("GL_EXT_color_buffer_float")
+                    || self.has_extension("GL_EXT_color_buffer_half_float")
+            }
+            EsVersion::Es2 => {
+                self.has_extension("GL_OES_texture_half_float")
+                    && self.has_extension("GL_EXT_color_buffer_half_float")
+            }
+        }
+    }
+
     /// True when fragment shaders have highp floats.
     pub fn fragment_has_highp(&self) -> bool {
         self.fragment_highp.precision > 0

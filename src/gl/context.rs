@@ -283,9 +283,14 @@ impl HeadlessContext {
         Ok((display, context, surface, info))
     }
 
-    /// A glow context for the current EGL context (cheap: it loads function pointers).
-    pub fn load_gl(&self) -> glow::Context {
-        unsafe { glow::Context::from_loader_function(|name| self.lib.proc_address(name)) }
+    /// A glow context for this context, which must be current on the calling thread (as
+    /// [`HeadlessContext::new`] leaves it); cheap: it loads function pointers. Elsewhere
+    /// [`GlError::ContextNotCurrent`].
+    pub fn load_gl(&self) -> Result<glow::Context, GlError> {
+        if self.lib.egl().get_current_context() != Some(self.context) {
+            return Err(GlError::ContextNotCurrent);
+        }
+        Ok(unsafe { glow::Context::from_loader_function(|name| self.lib.proc_address(name)) })
     }
 
     /// Whether the context may be made current on a thread other than the one that made it.
@@ -313,7 +318,18 @@ impl HeadlessContext {
         self.lib
             .egl()
             .make_current(self.display, self.surface, self.surface, Some(self.context))
-            .map_err(egl_err("eglMakeCurrent"))
+            .map_err(|e| GlError::Egl {
+                call: "eglMakeCurrent",
+                error: if matches!(e, egl::Error::BadAccess) {
+                    format!(
+                        "{}: it is current on another thread, which must release_current it \
+                         first (a thread that ended without doing so keeps it)",
+                        egl_error_text(e)
+                    )
+                } else {
+                    egl_error_text(e)
+                },
+            })
     }
 
     /// Makes no context current on the calling thread, so that another thread may make this
@@ -341,7 +357,11 @@ impl Drop for HeadlessContext {
         // Under the lock `new` holds too: SwiftShader's display keeps its surfaces and contexts
         // in sets it does not lock, and tore them when two threads created or destroyed at once.
         let mut live = LIVE_CONTEXTS.lock().unwrap_or_else(|e| e.into_inner());
-        let _ = egl.make_current(self.display, None, None, None);
+        // Released only where it is current: another context current on this thread (a test
+        // holding an ES 2.0 and an ES 3.0 context) stays current.
+        if egl.get_current_context() == Some(self.context) {
+            let _ = egl.make_current(self.display, None, None, None);
+        }
         if let Some(s) = self.surface {
             let _ = egl.destroy_surface(self.display, s);
         }

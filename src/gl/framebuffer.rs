@@ -31,19 +31,9 @@ pub enum ColorFormat {
 impl ColorFormat {
     /// Whether the context can render to this format.
     pub fn supported(self, dev: &Device) -> bool {
-        let caps = dev.caps();
         match self {
             ColorFormat::Rgba8 => true,
-            ColorFormat::Rgba16F => match dev.es() {
-                EsVersion::Es3 => {
-                    caps.has_extension("GL_EXT_color_buffer_float")
-                        || caps.has_extension("GL_EXT_color_buffer_half_float")
-                }
-                EsVersion::Es2 => {
-                    caps.has_extension("GL_OES_texture_half_float")
-                        && caps.has_extension("GL_EXT_color_buffer_half_float")
-                }
-            },
+            ColorFormat::Rgba16F => dev.caps().hdr_output(),
         }
     }
 }

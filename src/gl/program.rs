@@ -508,7 +508,7 @@ mod tests {
     fn device() -> Option<(Device, HeadlessContext)> {
         let ctx = context_or_skip(EsVersion::Es3)?;
         Some((
-            Device::new(ctx.load_gl(), EsVersion::Es3).expect("device"),
+            Device::new(ctx.load_gl().expect("gl"), EsVersion::Es3).expect("device"),
             ctx,
         ))
     }

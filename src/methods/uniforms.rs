@@ -274,7 +274,8 @@ mod tests {
                 return;
             };
             let restrictions = crate::gl::Restrictions { no_fragment_highp };
-            let dev = Device::restricted(ctx.load_gl(), es, &restrictions).expect("device");
+            let dev =
+                Device::restricted(ctx.load_gl().expect("gl"), es, &restrictions).expect("device");
             let mut programs = ProgramCache::new();
             build::<DepthProgram>(&mut programs, &dev, "depth", F::default());
             for &bits in VARIANTS {

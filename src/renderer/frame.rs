@@ -319,14 +319,15 @@ impl Renderer {
 fn check_origin(origin: [u32; 2], width: u32, height: u32) -> Result<(), Error> {
     for (axis, start, size) in [("x", origin[0], width), ("y", origin[1], height)] {
         if u64::from(start) + u64::from(size) > i32::MAX as u64 {
-            let why = format!(
+            let reason = format!(
                 "{axis} {start} plus the frame's {size} pixels passes GL's largest window \
                  coordinate, {}",
                 i32::MAX
             );
-            return Err(Error::Scene(crate::scene::SceneError::invalid(
-                "origin", why,
-            )));
+            return Err(Error::InvalidOption {
+                field: "origin",
+                reason,
+            });
         }
     }
     Ok(())
@@ -334,7 +335,31 @@ fn check_origin(origin: [u32; 2], width: u32, height: u32) -> Result<(), Error> 
 
 /// Refuses render options the frame cannot be made from, naming the field.
 fn check_options(options: &RenderOptions) -> Result<(), Error> {
-    let invalid = |field, why| Err(Error::Scene(crate::scene::SceneError::invalid(field, why)));
+    let invalid = |field, reason| Err(Error::InvalidOption { field, reason });
+    let positive = |v: f64| v.is_finite() && v > 0.0;
+    if let Some(cutoff) = options.light_cutoff {
+        if !(cutoff.is_finite() && cutoff >= 0.0) {
+            let why = format!("must be a finite radiance from 0 up, got {cutoff}");
+            return invalid("light_cutoff", why);
+        }
+    }
+    if !options.clear_color.iter().all(|c| c.is_finite()) {
+        let why = format!("must be finite, got {:?}", options.clear_color);
+        return invalid("clear_color", why);
+    }
+    // A NaN tile size, like a NaN grid setting, never equals itself: the tiles would be
+    // rebuilt every frame.
+    for (field, value) in [
+        ("tile_px", options.tile_px),
+        ("heat_scale", f64::from(options.heat_scale)),
+    ] {
+        if !positive(value) {
+            return invalid(
+                field,
+                format!("must be a finite number above 0, got {value}"),
+            );
+        }
+    }
     if !(options.exposure_ev.is_finite() && options.exposure_ev.abs() <= MAX_EXPOSURE_EV) {
         let why = format!(
             "must be within ±{MAX_EXPOSURE_EV} stops, got {}",
@@ -348,7 +373,7 @@ fn check_options(options: &RenderOptions) -> Result<(), Error> {
         ("grid.footprint_px", options.grid.footprint_px),
         ("grid.slice_depth", options.grid.slice_depth),
     ] {
-        if !(value.is_finite() && value > 0.0) {
+        if !positive(value) {
             return invalid(
                 field,
                 format!("must be a finite number above 0, got {value}"),

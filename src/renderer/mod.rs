@@ -26,6 +26,12 @@ pub use method::Method;
 pub use stats::{ContextStats, FrameStats, GridStats, LightStats, MemoryStats, TimeStats};
 
 /// Renders scenes with one shading method at a time.
+///
+/// A renderer stays on the thread that made it (it is not `Send`): its GL objects belong to a
+/// context current there. Tests that render in parallel make a [`HeadlessContext`](crate::HeadlessContext)
+/// and a renderer each, which is cheap; a context moves between threads only after
+/// [`HeadlessContext::release_current`](crate::HeadlessContext::release_current) on the one
+/// it leaves.
 pub struct Renderer {
     dev: Device,
     programs: ProgramCache,

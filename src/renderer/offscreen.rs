@@ -11,7 +11,9 @@ use crate::scene::Scene;
 use crate::Error;
 
 impl Renderer {
-    /// Renders into an internal `width × height` target and reads it back (top row first);
+    /// Renders into an internal `width × height` target and reads it back (top row first):
+    /// 8-bit sRGB-encoded colour (linear with `options.linear`), alpha 1 on opaque surfaces and
+    /// the clear colour's where nothing was drawn;
     /// the application's framebuffer binding and other GL state are as they were. With
     /// `options.measure.timed_frames > 0`, renders one warm-up frame and reports the median of
     /// the timed ones.
@@ -30,8 +32,10 @@ impl Renderer {
     }
 
     /// Renders linear, unclamped radiance into an RGBA16F target and reads it back as f32,
-    /// top row first: NaN and Inf stay visible (an 8-bit target shows them as black or white).
-    /// Errors when the context cannot render to half floats.
+    /// top row first (`width × height` pixels, row by row): NaN and Inf stay visible (an 8-bit
+    /// target shows them as black or white). Exposure and tone map are not applied: the values
+    /// are the light model's radiance. Errors when the context cannot render to half floats
+    /// ([`Caps::hdr_output`](crate::Caps::hdr_output) says so beforehand).
     pub fn render_offscreen_hdr(
         &mut self,
         scene: &Scene,
@@ -59,6 +63,10 @@ impl Renderer {
         options: &RenderOptions,
         format: ColorFormat,
     ) -> Result<FrameStats, Error> {
+        // As `render` says it, before the target is made.
+        if width == 0 || height == 0 {
+            return Err(Error::Limit(format!("viewport {width}×{height} is empty")));
+        }
         let current = self.target.as_ref().map(|t| (t.size(), t.format()));
         if current != Some(((width, height), format)) {
             if let Some(mut t) = self.target.take() {
@@ -90,7 +98,8 @@ impl Renderer {
     /// lights the current method evaluates at each pixel (its loop length, or for deferred its
     /// proxy volumes covering the pixel), or `Reaching`, the lights whose sphere (and cone)
     /// contains the pixel's surface point, the lower bound of any culling (always evaluated
-    /// by a plain-forward pass). Counts are exact (24 bits in an RGBA8 target).
+    /// by a plain-forward pass). Counts are exact (24 bits in an RGBA8 target). `None` and
+    /// `Heatmap` are colour, not counts: [`Error::InvalidOption`] naming `kind`.
     pub fn render_light_counts(
         &mut self,
         scene: &Scene,
@@ -99,6 +108,12 @@ impl Renderer {
         options: &RenderOptions,
         kind: CountKind,
     ) -> Result<(LightCounts, FrameStats), Error> {
+        if !matches!(kind, CountKind::Evals | CountKind::Reaching) {
+            return Err(Error::InvalidOption {
+                field: "kind",
+                reason: format!("must be Evals or Reaching (counts), got {kind:?}"),
+            });
+        }
         let mut options = RenderOptions {
             count: kind,
             clear_color: [0.0; 4],

@@ -80,7 +80,9 @@ impl Aabb {
 }
 
 /// An indexed triangle mesh in object space. Normals are always present (computed from the
-/// faces when the source had none); texture coordinates are optional.
+/// faces when the source had none); texture coordinates are optional. Drawn double-sided: no
+/// back face is culled, and a face seen from behind is shaded with its normal turned to the
+/// eye.
 #[derive(Clone, Debug, Default)]
 pub struct Mesh {
     /// Vertex positions.

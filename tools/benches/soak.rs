@@ -33,7 +33,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let lights: usize = args.get(2).and_then(|a| a.parse().ok()).unwrap_or(256);
     let only = args.get(3).cloned();
     let ctx = HeadlessContext::new(EsVersion::Es3)?;
-    let mut renderer = Renderer::new(ctx.load_gl(), EsVersion::Es3)?;
+    let mut renderer = Renderer::new(ctx.load_gl()?, EsVersion::Es3)?;
     let mut scene = scene::builtin::build("courtyard", Some((lights, 7)))?;
     let start: Vec<DVec3> = scene.lights.iter().map(|l| l.position).collect();
     let options = RenderOptions::default();

@@ -169,7 +169,7 @@ fn a_file_without_lights_gets_one_hint_and_one_with_lights_none() {
     let path = write(dir.path(), "dark.gltf", b.gltf(doc));
     let (_, report) = load(&path, 0).unwrap();
     let hint = format!(
-        "no lights in {}: ambient only; add --lights N",
+        "no lights in {}: ambient only; add lights (`Scene::lights`; `--lights N` on the command line)",
         path.display()
     );
     assert_eq!(report.warnings, [hint], "{:?}", report.warnings);

@@ -282,8 +282,8 @@ fn every_call_gives_the_games_gl_state_back_and_draws_as_from_a_clean_one() {
             .collect();
         drop(clean);
         let ctx = HeadlessContext::new(es).unwrap();
-        let gl = ctx.load_gl();
-        let mut renderer = Renderer::new(ctx.load_gl(), es).unwrap();
+        let gl = ctx.load_gl().unwrap();
+        let mut renderer = Renderer::new(ctx.load_gl().unwrap(), es).unwrap();
         unsafe { set_game_state(&gl, es3, (w as i32, h as i32)) };
         let before = snapshot(&gl, es3);
         for ((m, opts), expected) in cases.iter().zip(&expected) {
@@ -325,11 +325,11 @@ fn every_call_gives_the_games_gl_state_back_and_draws_as_from_a_clean_one() {
 fn a_renderer_refuses_another_current_context_and_leaves_its_objects() {
     let scene = scene::builtin::build("plane", Some((8, 1))).unwrap();
     let a = HeadlessContext::new(EsVersion::Es3).unwrap();
-    let mut on_a = Renderer::new(a.load_gl(), EsVersion::Es3).unwrap();
+    let mut on_a = Renderer::new(a.load_gl().unwrap(), EsVersion::Es3).unwrap();
     on_a.render_offscreen(&scene, 32, 18, &RenderOptions::default())
         .unwrap();
     let b = HeadlessContext::new(EsVersion::Es3).unwrap(); // now current
-    let mut on_b = Renderer::new(b.load_gl(), EsVersion::Es3).unwrap();
+    let mut on_b = Renderer::new(b.load_gl().unwrap(), EsVersion::Es3).unwrap();
     let (reference, _) = on_b
         .render_offscreen(&scene, 32, 18, &RenderOptions::default())
         .unwrap();
@@ -354,7 +354,7 @@ fn a_renderer_refuses_another_current_context_and_leaves_its_objects() {
     // Back on a, a new renderer works; one whose context is lost is abandoned without a GL
     // call, whatever is current.
     a.make_current().unwrap();
-    let mut again = Renderer::new(a.load_gl(), EsVersion::Es3).unwrap();
+    let mut again = Renderer::new(a.load_gl().unwrap(), EsVersion::Es3).unwrap();
     again
         .render_offscreen(&scene, 32, 18, &RenderOptions::default())
         .unwrap();

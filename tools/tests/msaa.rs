@@ -91,8 +91,8 @@ fn stats_name_the_samples_gl_gave() {
     use manylight::glow::{self, HasContext};
     let es = EsVersion::Es3;
     let ctx = manylight::HeadlessContext::new(es).expect("headless ES 3.0 context");
-    let gl = ctx.load_gl();
-    let mut renderer = manylight::Renderer::new(ctx.load_gl(), es).expect("renderer");
+    let gl = ctx.load_gl().unwrap();
+    let mut renderer = manylight::Renderer::new(ctx.load_gl().unwrap(), es).expect("renderer");
     let scene = scene::builtin::build("courtyard", Some((4, 1))).unwrap();
     let max = renderer.caps().max_samples.max(0) as u32;
     // ES 3.0 requires GL_MAX_SAMPLES of at least 4: the loop below is never empty.

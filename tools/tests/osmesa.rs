@@ -45,7 +45,7 @@ fn osmesa_renders_the_default_scene_through_every_method() {
         return;
     }
     let egl = HeadlessContext::new(EsVersion::Es3).unwrap();
-    let mut r = Renderer::new(egl.load_gl(), EsVersion::Es3).unwrap();
+    let mut r = Renderer::new(egl.load_gl().unwrap(), EsVersion::Es3).unwrap();
     r.set_method_named("forward").unwrap();
     let (es3, _) = r.render_offscreen(&s, 160, 90, &opts).unwrap();
     r.destroy();

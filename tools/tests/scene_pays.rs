@@ -138,13 +138,13 @@ fn a_renderer_given_an_earlier_ones_programs_builds_none_and_draws_the_same() {
     let s = point_light_scene();
     let opts = RenderOptions::default();
     let ctx = HeadlessContext::new(EsVersion::Es3).expect("a headless ES 3.0 context");
-    let mut first = Renderer::new(ctx.load_gl(), EsVersion::Es3).unwrap();
+    let mut first = Renderer::new(ctx.load_gl().unwrap(), EsVersion::Es3).unwrap();
     first.set_method_named("clustered").unwrap();
     let (before, _) = first.render_offscreen(&s, 64, 36, &opts).unwrap();
     let built = first.program_report();
     assert!(!built.is_empty());
     let programs = first.destroy_keeping_programs();
-    let mut second = Renderer::new(ctx.load_gl(), EsVersion::Es3).unwrap();
+    let mut second = Renderer::new(ctx.load_gl().unwrap(), EsVersion::Es3).unwrap();
     second.adopt_programs(programs);
     assert_eq!(second.live_gl_objects().programs, built.len() as i64);
     second.set_method_named("clustered").unwrap();

@@ -343,8 +343,9 @@ fn allocations_per_frame(
         )
     });
     // The application's own GL objects, made with its own glow context on the same GL context.
-    let app = Device::new(ctx.load_gl(), es).expect("application device");
-    let mut renderer = Renderer::restricted(ctx.load_gl(), es, restrictions).expect("renderer");
+    let app = Device::new(ctx.load_gl().unwrap(), es).expect("application device");
+    let mut renderer =
+        Renderer::restricted(ctx.load_gl().unwrap(), es, restrictions).expect("renderer");
     let trace_cases = std::env::var("MANYLIGHT_ALLOC_TRACE").ok();
     let mut failures = Vec::new();
     for c in cases {

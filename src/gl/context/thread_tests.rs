@@ -7,7 +7,7 @@ use crate::{RenderOptions, Renderer};
 
 /// Renders the lit built-in plane with a new renderer on the current context.
 fn render_plane(ctx: &HeadlessContext) -> image::RgbaImage {
-    let mut renderer = Renderer::new(ctx.load_gl(), EsVersion::Es3).expect("renderer");
+    let mut renderer = Renderer::new(ctx.load_gl().expect("gl"), EsVersion::Es3).expect("renderer");
     let scene = builtin::build("plane", Some((16, 1))).unwrap();
     let (img, _) = renderer
         .render_offscreen(&scene, 32, 18, &RenderOptions::default())
@@ -53,4 +53,52 @@ fn a_released_context_draws_on_another_thread_or_is_refused_there() {
     }
     ctx.make_current().unwrap();
     assert!(render_plane(&ctx) == here, "another picture back home");
+}
+
+/// Two contexts on one thread (an ES 2.0 and an ES 3.0 one in a test): dropping the one that is
+/// not current leaves the other current, and a glow context is refused for the one that is not
+/// current instead of panicking inside glow.
+#[test]
+fn dropping_a_context_not_current_leaves_the_current_one() {
+    let Some(first) = super::context_or_skip(EsVersion::Es3) else {
+        return;
+    };
+    let second = HeadlessContext::new(EsVersion::Es3).expect("a second context");
+    assert!(matches!(
+        first.load_gl(),
+        Err(crate::gl::GlError::ContextNotCurrent)
+    ));
+    first.make_current().unwrap();
+    drop(second);
+    let img = render_plane(&first);
+    assert!(
+        img.pixels().any(|p| p[0] > 16),
+        "the plane's lights drew nothing"
+    );
+}
+
+/// A context left current by a thread that ended cannot be made current elsewhere on Mesa: the
+/// error says why and what to do. (SwiftShader releases it when the thread ends.)
+#[test]
+fn a_context_kept_by_an_ended_thread_says_so() {
+    let Some(ctx) = super::context_or_skip(EsVersion::Es3) else {
+        return;
+    };
+    if !ctx.can_move_between_threads() {
+        return;
+    }
+    ctx.release_current().unwrap();
+    let ctx = std::thread::spawn(move || {
+        ctx.make_current().unwrap();
+        ctx
+    })
+    .join()
+    .unwrap();
+    if let Err(e) = ctx.make_current() {
+        let err = e.to_string();
+        assert!(err.contains("release_current"), "{err}");
+        assert!(err.contains("EGL_BAD_ACCESS"), "{err}");
+    } else {
+        assert!(ctx.info().egl_vendor.contains("Google"), "{:?}", ctx.info());
+    }
 }

@@ -132,7 +132,7 @@ pub fn load(
     // A sun lights the scene too: only a file with neither gets the hint.
     if scene.lights.is_empty() && scene.directional_lights.is_empty() {
         let hint = format!(
-            "no lights in {}: ambient only; add --lights N",
+            "no lights in {}: ambient only; add lights (`Scene::lights`; `--lights N` on the command line)",
             path.display()
         );
         log::warn!("{hint}");

@@ -54,7 +54,8 @@ impl Gpu {
             return Gpu::fresh_restricted(es, restrictions);
         };
         ctx.make_current().expect("a pooled context made current");
-        let mut renderer = Renderer::restricted(ctx.load_gl(), es, restrictions).expect("renderer");
+        let mut renderer =
+            Renderer::restricted(ctx.load_gl().unwrap(), es, restrictions).expect("renderer");
         renderer.adopt_programs(programs);
         Gpu {
             renderer: Some(renderer),
@@ -73,7 +74,8 @@ impl Gpu {
         let ctx = HeadlessContext::new(es).unwrap_or_else(|e| {
             panic!("no headless {es} context ({e}); install libegl1 libegl-mesa0 libgles2 libgl1-mesa-dri")
         });
-        let renderer = Renderer::restricted(ctx.load_gl(), es, restrictions).expect("renderer");
+        let renderer =
+            Renderer::restricted(ctx.load_gl().unwrap(), es, restrictions).expect("renderer");
         Gpu {
             renderer: Some(renderer),
             ctx: Some(ctx),
@@ -95,7 +97,7 @@ impl Gpu {
     pub fn gl(&mut self) -> manylight::glow::Context {
         let ctx = self.ctx.as_ref().expect("a context");
         ctx.make_current().expect("the test's context made current");
-        ctx.load_gl()
+        ctx.load_gl().unwrap()
     }
 
     pub fn render(

@@ -395,7 +395,7 @@ pub fn run(args: &BenchArgs) -> Result<(), Box<dyn std::error::Error>> {
     for &es in &plan.es {
         // One context per ES version, made current for its renderer's whole life.
         let ctx = HeadlessContext::new(es)?;
-        let mut renderer = Renderer::new(ctx.load_gl(), es)?;
+        let mut renderer = Renderer::new(ctx.load_gl()?, es)?;
         for spec in &plan.scenes {
             for &count in &plan.lights {
                 let scene = load_bench_scene(spec, count, args)?;

@@ -76,7 +76,7 @@ pub fn run(args: &InfoArgs) -> Result<(), Box<dyn std::error::Error>> {
     let restrictions = manylight::gl::Restrictions {
         no_fragment_highp: args.no_fragment_highp,
     };
-    let mut renderer = Renderer::restricted(ctx.load_gl(), es, &restrictions)?;
+    let mut renderer = Renderer::restricted(ctx.load_gl()?, es, &restrictions)?;
     let report = args
         .scene
         .as_deref()

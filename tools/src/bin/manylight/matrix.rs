@@ -522,11 +522,11 @@ impl CellContext {
         Ok(CellContext::Egl(Box::new(HeadlessContext::new(es)?)))
     }
 
-    fn load_gl(&self) -> glow::Context {
+    fn load_gl(&self) -> Result<glow::Context, manylight::GlError> {
         match self {
             CellContext::Egl(c) => c.load_gl(),
             #[cfg(feature = "osmesa")]
-            CellContext::OsMesa(c) => c.load_gl(),
+            CellContext::OsMesa(c) => Ok(c.load_gl()),
         }
     }
 }
@@ -549,7 +549,7 @@ pub fn run_cell(args: &MatrixCellArgs) -> Result<(), Box<dyn std::error::Error>>
     // restriction the driver underneath is unrestricted, so the row shows what it costs.
     let reference = {
         let ctx = CellContext::new(es, args.osmesa)?;
-        let mut full = Renderer::new(ctx.load_gl(), es)?;
+        let mut full = Renderer::new(ctx.load_gl()?, es)?;
         full.set_method_named("forward")?;
         let reference_opts = RenderOptions {
             measure: manylight::MeasureOptions {
@@ -566,7 +566,7 @@ pub fn run_cell(args: &MatrixCellArgs) -> Result<(), Box<dyn std::error::Error>>
     let restrictions = manylight::gl::Restrictions {
         no_fragment_highp: args.no_fragment_highp,
     };
-    let mut renderer = Renderer::restricted(ctx.load_gl(), es, &restrictions)?;
+    let mut renderer = Renderer::restricted(ctx.load_gl()?, es, &restrictions)?;
     let mut methods = Vec::new();
     for m in METHODS {
         let support = (m.supported)(renderer.caps());

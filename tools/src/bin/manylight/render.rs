@@ -251,7 +251,7 @@ pub fn run(args: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
     let restrictions = manylight::gl::Restrictions {
         no_fragment_highp: args.no_fragment_highp,
     };
-    let mut renderer = Renderer::restricted(ctx.load_gl(), es, &restrictions)?;
+    let mut renderer = Renderer::restricted(ctx.load_gl()?, es, &restrictions)?;
     // A fallback is logged as a warning by the renderer.
     if let Some(method) = &args.method {
         renderer.set_method_named(method)?;
