@@ -170,7 +170,7 @@ pub enum GlError {
     /// EGL says no context is current on this thread.
     #[error("no GL context is current on this thread: was the HeadlessContext dropped, or another context made current, while the Renderer lived? Keep the context alive and current as long as the renderer")]
     NotCurrent,
-    /// A [`HeadlessContext`](crate::HeadlessContext) used on a thread where it is not current.
+    /// A [`HeadlessContext`] used on a thread where it is not current.
     #[error("this context is not current on the calling thread: call make_current here first (after release_current on the thread where it is current)")]
     ContextNotCurrent,
     /// EGL says another context than the renderer's is current on this thread.
