@@ -39,10 +39,12 @@ pub enum Error {
         /// Why not, and what would run.
         reason: String,
     },
-    /// A [`RenderOptions`](crate::RenderOptions) field the frame cannot be made from.
-    #[error("render option `{field}` {reason}")]
+    /// A [`RenderOptions`](crate::RenderOptions) field, or another argument of a render call
+    /// (`render_light_counts`'s `kind`), the frame cannot be made from.
+    #[error("invalid `{field}`: {reason}")]
     InvalidOption {
-        /// The field, as written in code (`exposure_ev`, `grid.footprint_px`, …).
+        /// The field or argument, as written in code (`exposure_ev`, `grid.footprint_px`,
+        /// `kind`, …).
         field: &'static str,
         /// What it must be, and what it was.
         reason: String,

@@ -44,7 +44,7 @@ pub struct RenderOptions {
     /// radius, trading error for time (tiled, clustered, deferred; forward loops over every
     /// light regardless). `None`: cull at the radius, exactly.
     pub light_cutoff: Option<f32>,
-    /// Lights at which [`CountKind::Heatmap`]'s colour map tops out.
+    /// Lights at which [`CountKind::Heatmap`]'s colour map tops out (1 or more).
     pub heat_scale: f32,
     /// The tone map applied to the exposed radiance before it is clamped and encoded (not in
     /// HDR output). [`ToneMap::None`], the default, keeps images the light model's own.

@@ -239,7 +239,8 @@ impl MultisampleTarget {
     }
 
     /// GPU memory of its buffers: 4 bytes of colour and 4 of depth per sample (2 of depth on
-    /// ES 2.0 without `OES_depth24`), and on ES 2.0 the 4-byte resolved texel — what an
+    /// ES 2.0 without `OES_depth24`), and on ES 2.0 the 4-byte resolved texel (on ES 3.0 the
+    /// 4-byte copy, once a frame was resolved to an origin other than (0, 0)) — what an
     /// immediate-mode GPU allocates; a tile-based one keeps the samples on chip.
     pub fn gpu_bytes(&self) -> usize {
         let pixels = self.size.0 as usize * self.size.1 as usize;
@@ -316,7 +317,6 @@ impl MultisampleTarget {
                 return Err(e);
             }
         };
-        self.resolved_copy = Some((fbo, colour));
         let (w, h) = (self.size.0 as i32, self.size.1 as i32);
         unsafe {
             dev.gl.bind_renderbuffer(glow::RENDERBUFFER, Some(colour));
@@ -330,11 +330,23 @@ impl MultisampleTarget {
                 Some(colour),
             );
         }
-        dev.check("allocating the MSAA resolve's copy")?;
+        // Kept only once complete: a failed one (out of memory) is freed, and the next frame
+        // tries again.
         let status = unsafe { dev.gl.check_framebuffer_status(glow::FRAMEBUFFER) };
-        if status != glow::FRAMEBUFFER_COMPLETE {
-            return Err(GlError::FramebufferIncomplete(status));
+        let complete = if status == glow::FRAMEBUFFER_COMPLETE {
+            Ok(())
+        } else {
+            Err(GlError::FramebufferIncomplete(status))
+        };
+        let made = dev
+            .check("allocating the MSAA resolve's copy")
+            .and(complete);
+        if let Err(e) = made {
+            dev.delete_framebuffer(fbo);
+            dev.delete_renderbuffer(colour);
+            return Err(e);
         }
+        self.resolved_copy = Some((fbo, colour));
         Ok(fbo)
     }
 

@@ -23,9 +23,10 @@ impl Renderer {
     /// whose lower-left corner is `options.origin` (for embedding: a game binds its own target
     /// or the default framebuffer first); only that rectangle is cleared and drawn. With
     /// `options.samples` > 1 the frame is drawn into the renderer's own multisampled target
-    /// and resolved into that rectangle, and the bound framebuffer must then be RGBA8. The
-    /// application's GL state (bindings, viewport, blend, depth, …) is given back as it was,
-    /// and its scissor, stencil or blend equations do not change the frame (the README's
+    /// and resolved into that rectangle, and on ES 3.0 the bound framebuffer must then be
+    /// RGBA8 (GL resolves between identical formats only). The application's GL state
+    /// (bindings, viewport, blend, depth, …) is given back as it was, and its scissor,
+    /// stencil or blend equations do not change the frame (the README's
     /// "Sharing the context with a game"); another EGL context current is
     /// [`GlError::OtherContext`](crate::GlError::OtherContext).
     ///
@@ -84,6 +85,8 @@ impl Renderer {
         stats: &mut FrameStats,
     ) -> Result<(), Error> {
         check_origin(origin, width, height)?;
+        // Before MSAA's target is made: its refusal would hide the option's error.
+        check_options(options)?;
         // Light counts are exact per pixel: never averaged over samples.
         let samples = if options.count == CountKind::None {
             options.samples.max(1)
@@ -141,7 +144,6 @@ impl Renderer {
             log::warn!("{warning}");
         }
         scene.validate()?;
-        check_options(options)?;
         if width == 0 || height == 0 {
             return Err(Error::Limit(format!("viewport {width}×{height} is empty")));
         }
@@ -349,16 +351,16 @@ fn check_options(options: &RenderOptions) -> Result<(), Error> {
     }
     // A NaN tile size, like a NaN grid setting, never equals itself: the tiles would be
     // rebuilt every frame.
-    for (field, value) in [
-        ("tile_px", options.tile_px),
-        ("heat_scale", f64::from(options.heat_scale)),
-    ] {
-        if !positive(value) {
-            return invalid(
-                field,
-                format!("must be a finite number above 0, got {value}"),
-            );
-        }
+    if !positive(options.tile_px) {
+        let why = format!("must be a finite number above 0, got {}", options.tile_px);
+        return invalid("tile_px", why);
+    }
+    let heat = options.heat_scale;
+    if !(heat.is_finite() && heat >= 1.0) {
+        return invalid(
+            "heat_scale",
+            format!("must be a finite count from 1 up, got {heat}"),
+        );
     }
     if !(options.exposure_ev.is_finite() && options.exposure_ev.abs() <= MAX_EXPOSURE_EV) {
         let why = format!(

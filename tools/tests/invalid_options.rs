@@ -77,6 +77,14 @@ fn every_unusable_option_is_refused_naming_its_field() {
             },
         ),
         (
+            "clustered",
+            "heat_scale",
+            RenderOptions {
+                heat_scale: 0.5,
+                ..Default::default()
+            },
+        ),
+        (
             "forward",
             "exposure_ev",
             RenderOptions {
@@ -85,6 +93,17 @@ fn every_unusable_option_is_refused_naming_its_field() {
             },
         ),
     ];
+    // MSAA asked for on a method without it: the option's error still comes first.
+    let mut cases = cases;
+    cases.push((
+        "deferred",
+        "exposure_ev",
+        RenderOptions {
+            exposure_ev: f32::INFINITY,
+            samples: 4,
+            ..Default::default()
+        },
+    ));
     for (method, field, options) in cases {
         gpu.r().set_method_named(method).unwrap();
         let err = gpu

@@ -78,7 +78,7 @@ fn dropping_a_context_not_current_leaves_the_current_one() {
 }
 
 /// A context left current by a thread that ended cannot be made current elsewhere on Mesa: the
-/// error says why and what to do. (SwiftShader releases it when the thread ends.)
+/// error says why and what to do. (SwiftShader releases it when the thread ends, as EGL allows.)
 #[test]
 fn a_context_kept_by_an_ended_thread_says_so() {
     let Some(ctx) = super::context_or_skip(EsVersion::Es3) else {
@@ -98,7 +98,5 @@ fn a_context_kept_by_an_ended_thread_says_so() {
         let err = e.to_string();
         assert!(err.contains("release_current"), "{err}");
         assert!(err.contains("EGL_BAD_ACCESS"), "{err}");
-    } else {
-        assert!(ctx.info().egl_vendor.contains("Google"), "{:?}", ctx.info());
     }
 }

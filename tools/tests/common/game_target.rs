@@ -10,9 +10,17 @@ use super::Gpu;
 /// The game's colour outside the frame, unlike anything the scene draws.
 pub const MARKER: [u8; 4] = [51, 230, 102, 255];
 
-/// Makes and binds a `size` RGBA8 framebuffer with depth, cleared to [`MARKER`] and to a depth
-/// that would hide the whole scene if the renderer drew against it.
-unsafe fn game_framebuffer(gl: &glow::Context, es3: bool, (w, h): (i32, i32)) {
+/// The game's framebuffer and its attachments.
+struct GameTarget {
+    fbo: glow::Framebuffer,
+    colour: glow::Texture,
+    depth: glow::Renderbuffer,
+}
+
+/// Makes and binds a `size` RGBA8 framebuffer with depth (24 bits where the context has them,
+/// as the README asks of a game's), cleared to [`MARKER`] and to a depth that would hide the
+/// whole scene if the renderer drew against it.
+unsafe fn game_framebuffer(gl: &glow::Context, depth24: bool, (w, h): (i32, i32)) -> GameTarget {
     let colour = gl.create_texture().unwrap();
     gl.bind_texture(glow::TEXTURE_2D, Some(colour));
     gl.tex_image_2d(
@@ -37,7 +45,7 @@ unsafe fn game_framebuffer(gl: &glow::Context, es3: bool, (w, h): (i32, i32)) {
     );
     let depth = gl.create_renderbuffer().unwrap();
     gl.bind_renderbuffer(glow::RENDERBUFFER, Some(depth));
-    let format = if es3 {
+    let format = if depth24 {
         glow::DEPTH_COMPONENT24
     } else {
         glow::DEPTH_COMPONENT16
@@ -57,6 +65,18 @@ unsafe fn game_framebuffer(gl: &glow::Context, es3: bool, (w, h): (i32, i32)) {
     gl.clear_color(m[0], m[1], m[2], m[3]);
     gl.clear_depth_f32(0.0);
     gl.clear(glow::COLOR_BUFFER_BIT | glow::DEPTH_BUFFER_BIT);
+    GameTarget { fbo, colour, depth }
+}
+
+/// Frees the game's framebuffer and puts back the defaults it changed, so the pooled context
+/// reaches the next test clean.
+unsafe fn free_game_framebuffer(gl: &glow::Context, target: GameTarget) {
+    gl.bind_framebuffer(glow::FRAMEBUFFER, None);
+    gl.clear_color(0.0, 0.0, 0.0, 0.0);
+    gl.clear_depth_f32(1.0);
+    gl.delete_framebuffer(target.fbo);
+    gl.delete_texture(target.colour);
+    gl.delete_renderbuffer(target.depth);
 }
 
 /// The bound framebuffer's pixels, top row first (as the offscreen renders give them).
@@ -86,10 +106,13 @@ pub fn render_at_origin(
     what: &str,
 ) -> image::RgbaImage {
     let gl = gpu.gl();
-    let es3 = gpu.r().caps().es == EsVersion::Es3;
-    unsafe { game_framebuffer(&gl, es3, (whole.0 as i32, whole.1 as i32)) };
-    gpu.r().render(scene, w, h, options).unwrap();
+    let caps = gpu.r().caps();
+    let depth24 = caps.es == EsVersion::Es3 || caps.depth24;
+    let target = unsafe { game_framebuffer(&gl, depth24, (whole.0 as i32, whole.1 as i32)) };
+    let rendered = gpu.r().render(scene, w, h, options);
     let got = unsafe { read_back(&gl, whole) };
+    unsafe { free_game_framebuffer(&gl, target) };
+    rendered.unwrap_or_else(|e| panic!("{what}: {e}"));
     // The frame's top row is `origin.y + h` rows up from the bottom.
     let [x0, y0] = options.origin;
     let top = whole.1 - y0 - h;

@@ -357,10 +357,11 @@ pub fn run(args: &BenchArgs) -> Result<(), Box<dyn std::error::Error>> {
     for spec in &plan.scenes {
         load_bench_scene(spec, first_count, args)?;
     }
-    // And each ES version's context once: a driver capped at ES 2.0 refuses the sweep here,
-    // not after its ES 2.0 rows.
+    // And each ES version's context and renderer once (a driver capped at ES 2.0 refuses an
+    // ES 3.0 context, or gives a 2.0 one the renderer refuses): here, not after the ES 2.0 rows.
     for &es in &plan.es {
-        drop(HeadlessContext::new(es)?);
+        let ctx = HeadlessContext::new(es)?;
+        Renderer::new(ctx.load_gl()?, es)?.destroy();
     }
     let knob_list = if plan.knobs {
         knobs(args.quick)

@@ -184,7 +184,12 @@ fn check_usage(cli: &Cli) {
         }
     }
     if let Some(Command::Matrix(a)) = &cli.command {
-        let json = a.json.as_deref().map(|p| ("--json", p));
+        // `--json -` is stdout, no file.
+        let json = a
+            .json
+            .as_deref()
+            .filter(|p| *p != Path::new("-"))
+            .map(|p| ("--json", p));
         let sheet = a.out.as_ref().map(|p| p.join("matrix.png"));
         check_distinct_outputs(&[json, a.out.as_deref().map(|p| ("--out", p))]);
         check_distinct_outputs(&[json, sheet.as_deref().map(|p| ("--out", p))]);
