@@ -18,6 +18,9 @@ pub struct Device {
     /// The renderer's own vertex array object (ES 3.0 and desktop), bound only during its
     /// calls, so a game's bound one keeps its buffers and attributes.
     vertex_array: Option<glow::VertexArray>,
+    /// Without a vertex array of its own (ES 2.0): what saves the application's attribute
+    /// arrays around each call.
+    attrib_pointer_fns: Option<super::ext_fns::AttribPointerFns>,
     /// Nesting depth of [`Device::enter_host`] (the outermost call saves the state).
     host_depth: std::cell::Cell<u32>,
     /// The EGL context current when the device was made (as an address), where EGL can say.
@@ -106,6 +109,10 @@ impl Device {
             caps,
             live: std::cell::Cell::new(LiveObjects::default()),
             renderbuffer_storage_multisample_ext,
+            attrib_pointer_fns: vertex_array
+                .is_none()
+                .then(super::ext_fns::attrib_pointer_fns)
+                .flatten(),
             vertex_array,
             host_depth: std::cell::Cell::new(0),
             context: super::gles_lib::current_context().flatten(),
@@ -127,8 +134,14 @@ impl Device {
     pub(crate) fn enter_host(&self) -> Option<super::host_state::HostState> {
         let depth = self.host_depth.get();
         self.host_depth.set(depth + 1);
-        (depth == 0)
-            .then(|| super::host_state::HostState::enter(&self.gl, self.caps.es, self.vertex_array))
+        (depth == 0).then(|| {
+            super::host_state::HostState::enter(
+                &self.gl,
+                self.caps.es,
+                self.vertex_array,
+                self.attrib_pointer_fns,
+            )
+        })
     }
 
     /// Ends a call started by [`Device::enter_host`], giving the application its state back.

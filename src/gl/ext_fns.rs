@@ -23,6 +23,47 @@ pub fn renderbuffer_storage_multisample_ext() -> Option<RenderbufferStorageMulti
     })
 }
 
+/// `glGetVertexAttribPointerv(index, pname, pointer)`.
+pub type GetVertexAttribPointerv =
+    unsafe extern "system" fn(index: u32, pname: u32, pointer: *mut *mut std::ffi::c_void);
+/// `glVertexAttribPointer(index, size, type, normalized, stride, pointer)`.
+pub type VertexAttribPointer = unsafe extern "system" fn(
+    index: u32,
+    size: i32,
+    data_type: u32,
+    normalized: u8,
+    stride: i32,
+    pointer: *const std::ffi::c_void,
+);
+
+/// The two core entry points that read and set an attribute array's pointer as a pointer:
+/// glow offers the setter with a buffer offset only and no getter, and an ES 2.0 game's array
+/// may be a client-side pointer.
+#[derive(Clone, Copy)]
+pub struct AttribPointerFns {
+    /// `glGetVertexAttribPointerv`.
+    pub get: GetVertexAttribPointerv,
+    /// `glVertexAttribPointer`.
+    pub set: VertexAttribPointer,
+}
+
+/// Loads [`AttribPointerFns`]; `None` when either is missing.
+pub fn attrib_pointer_fns() -> Option<AttribPointerFns> {
+    type Ptr = *const std::ffi::c_void;
+    // SAFETY: each pointer is the core ES 2.0 entry point of that name, given the signature
+    // the specification gives it; the library stays loaded for the whole process.
+    unsafe {
+        Some(AttribPointerFns {
+            get: std::mem::transmute::<Ptr, GetVertexAttribPointerv>(entry_point(
+                "glGetVertexAttribPointerv",
+            )?),
+            set: std::mem::transmute::<Ptr, VertexAttribPointer>(entry_point(
+                "glVertexAttribPointer",
+            )?),
+        })
+    }
+}
+
 /// `glGenQueriesEXT(n, ids)`.
 pub type GenQueriesExt = unsafe extern "system" fn(n: i32, ids: *mut u32);
 /// `glDeleteQueriesEXT(n, ids)`.

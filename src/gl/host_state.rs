@@ -3,12 +3,15 @@
 //! part it depends on to what it assumes, and gives everything back on the way out, so the
 //! game's vertex array, buffers, program, textures, samplers, framebuffers, viewport, blend,
 //! depth, culling and pixel-store settings are as it left them (the way Dear ImGui's GL
-//! back-end embeds). ES 2.0 has no vertex array objects: there the vertex attribute arrays
-//! are the renderer's after a call, and a game specifies its own before it draws.
+//! back-end embeds). The attributes' constant values at the renderer's locations, and on ES
+//! 2.0 (no vertex array objects) their arrays, are saved and given back one by one
+//! (`host_attributes.rs`).
 #![allow(unsafe_code)]
 
 use glow::HasContext;
 
+use super::ext_fns::AttribPointerFns;
+use super::host_attributes::HostAttributes;
 use super::EsVersion;
 
 /// Texture units the renderer binds: 0 to 7 (`methods::maps::UNIT_MAPS` + 3), within the
@@ -70,6 +73,9 @@ pub(crate) struct HostState {
     clear_depth: f32,
     alignment: [i32; 2],
     store_es3: [i32; STORE_ES3.len()],
+    /// The attributes' constant values, and on ES 2.0 their arrays (no vertex array object
+    /// keeps them apart).
+    attributes: HostAttributes,
 }
 
 impl HostState {
@@ -78,7 +84,12 @@ impl HostState {
     /// the capabilities of `OFF_INSIDE` off, additive blend equations, counter-clockwise
     /// front faces, the full depth range, a clear depth of 1 and pixel rows that start where
     /// the data does.
-    pub(crate) fn enter(gl: &glow::Context, es: EsVersion, vao: Option<glow::VertexArray>) -> Self {
+    pub(crate) fn enter(
+        gl: &glow::Context,
+        es: EsVersion,
+        vao: Option<glow::VertexArray>,
+        attrib_fns: Option<AttribPointerFns>,
+    ) -> Self {
         let es3 = es == EsVersion::Es3;
         unsafe {
             let int = |p| gl.get_parameter_i32(p);
@@ -164,6 +175,7 @@ impl HostState {
                 } else {
                     [0; STORE_ES3.len()]
                 },
+                attributes: HostAttributes::save(gl, vao.is_none().then_some(attrib_fns).flatten()),
             };
             if let Some(vao) = vao {
                 gl.bind_vertex_array(Some(vao));
@@ -204,6 +216,7 @@ impl HostState {
             } else {
                 gl.bind_buffer(glow::ELEMENT_ARRAY_BUFFER, self.element_buffer);
             }
+            self.attributes.restore(gl);
             gl.bind_buffer(glow::ARRAY_BUFFER, self.array_buffer);
             gl.use_program(self.program);
             for unit in 0..self.units {

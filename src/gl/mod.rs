@@ -19,6 +19,7 @@ pub mod ext_fns;
 pub mod framebuffer;
 pub mod gbuffer;
 pub mod gles_lib;
+pub(crate) mod host_attributes;
 pub(crate) mod host_state;
 pub mod mesh;
 pub mod multisample;

@@ -504,6 +504,17 @@ mod tests {
     use crate::gl::context::context_or_skip;
     use crate::gl::HeadlessContext;
 
+    /// Every attribute location is one whose state a call saves and gives back.
+    #[test]
+    fn attribute_locations_are_those_the_host_state_keeps() {
+        for (location, name) in ATTRIBUTES {
+            assert!(
+                (*location as usize) < crate::gl::host_attributes::LOCATIONS,
+                "{name} at {location}"
+            );
+        }
+    }
+
     /// A headless ES 3.0 device, or `None` (a skip) on a machine without EGL.
     fn device() -> Option<(Device, HeadlessContext)> {
         let ctx = context_or_skip(EsVersion::Es3)?;

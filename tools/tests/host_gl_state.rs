@@ -20,7 +20,9 @@ struct Snapshot {
     floats: Vec<(u32, Vec<f32>)>,
     enabled: Vec<(u32, bool)>,
     units: Vec<(u32, i32, i32)>,
-    attribute_0: Option<(i32, i32)>,
+    /// Locations 0 to 4 (the renderer's): enabled, size, type, normalized, stride, buffer,
+    /// pointer and current value.
+    attributes: Vec<([i32; 6], usize, [f32; 4])>,
 }
 
 fn snapshot(gl: &glow::Context, es3: bool) -> Snapshot {
@@ -93,18 +95,29 @@ fn snapshot(gl: &glow::Context, es3: bool) -> Snapshot {
             })
             .collect();
         gl.active_texture(active as u32);
-        // In the game's vertex array (ES 3.0): attribute 0's buffer and whether it is on.
-        let attribute_0 = es3.then(|| {
-            let read = |pname| {
-                let mut v = [0f32; 4];
-                gl.get_vertex_attrib_parameter_f32_slice(0, pname, &mut v);
-                v[0] as i32
-            };
-            (
-                read(glow::VERTEX_ATTRIB_ARRAY_BUFFER_BINDING),
-                read(glow::VERTEX_ATTRIB_ARRAY_ENABLED),
-            )
-        });
+        // The game's arrays (on ES 3.0 in its vertex array; on ES 2.0 the context's own).
+        let pointers = manylight::gl::ext_fns::attrib_pointer_fns().expect("core entry points");
+        let attributes = (0..5)
+            .map(|index| {
+                let read = |pname| {
+                    let mut v = [0f32; 4];
+                    gl.get_vertex_attrib_parameter_f32_slice(index, pname, &mut v);
+                    v
+                };
+                let array = [
+                    glow::VERTEX_ATTRIB_ARRAY_ENABLED,
+                    glow::VERTEX_ATTRIB_ARRAY_SIZE,
+                    glow::VERTEX_ATTRIB_ARRAY_TYPE,
+                    glow::VERTEX_ATTRIB_ARRAY_NORMALIZED,
+                    glow::VERTEX_ATTRIB_ARRAY_STRIDE,
+                    glow::VERTEX_ATTRIB_ARRAY_BUFFER_BINDING,
+                ]
+                .map(|p| read(p)[0] as i32);
+                let mut pointer = std::ptr::null_mut();
+                (pointers.get)(index, glow::VERTEX_ATTRIB_ARRAY_POINTER, &mut pointer);
+                (array, pointer as usize, read(glow::CURRENT_VERTEX_ATTRIB))
+            })
+            .collect();
         Snapshot {
             ints: ints
                 .into_iter()
@@ -113,7 +126,7 @@ fn snapshot(gl: &glow::Context, es3: bool) -> Snapshot {
             floats,
             enabled: enabled.into_iter().map(|c| (c, gl.is_enabled(c))).collect(),
             units,
-            attribute_0,
+            attributes,
         }
     }
 }
@@ -131,6 +144,13 @@ unsafe fn set_game_state(gl: &glow::Context, es3: bool, size: (i32, i32)) {
     gl.buffer_data_size(glow::ARRAY_BUFFER, 64, glow::STATIC_DRAW);
     gl.vertex_attrib_pointer_f32(0, 2, glow::FLOAT, false, 8, 0);
     gl.enable_vertex_attrib_array(0);
+    // Unlike anything the renderer sets: a normalized byte array at an offset, one left off
+    // with its own array, and constant values where the renderer sets its own.
+    gl.vertex_attrib_pointer_f32(1, 4, glow::UNSIGNED_BYTE, true, 12, 4);
+    gl.enable_vertex_attrib_array(1);
+    gl.vertex_attrib_pointer_f32(2, 3, glow::SHORT, false, 16, 6);
+    gl.vertex_attrib_4_f32(3, 0.25, 0.5, 0.75, 2.0);
+    gl.vertex_attrib_4_f32(4, -1.0, 3.0, 0.0, 0.5);
     let ibo = gl.create_buffer().unwrap();
     gl.bind_buffer(glow::ELEMENT_ARRAY_BUFFER, Some(ibo));
     gl.buffer_data_size(glow::ELEMENT_ARRAY_BUFFER, 12, glow::STATIC_DRAW);

@@ -1,0 +1,91 @@
+//! The application's vertex attributes at the renderer's locations. Their current (constant)
+//! values are context state on every version, and the renderer sets them where a mesh lacks an
+//! attribute. ES 2.0 has no vertex array objects, so there the arrays themselves are the
+//! application's too. Each call saves both and gives them back: an engine that caches which
+//! arrays it enabled, or a constant colour it set, draws wrong when they change behind it.
+#![allow(unsafe_code)]
+
+use glow::HasContext;
+
+use super::ext_fns::AttribPointerFns;
+
+/// Locations 0 to 4: where `program::ATTRIBUTES` binds the renderer's attributes (its tests
+/// check that they all fall below this), the precision probe's 0 among them.
+pub(crate) const LOCATIONS: usize = 5;
+
+/// One location's array (ES 2.0).
+#[derive(Clone, Copy)]
+struct Array {
+    enabled: bool,
+    size: i32,
+    data_type: u32,
+    normalized: bool,
+    stride: i32,
+    buffer: Option<glow::Buffer>,
+    pointer: *mut std::ffi::c_void,
+}
+
+/// The application's attributes at the renderer's locations.
+pub(crate) struct HostAttributes {
+    current: [[f32; 4]; LOCATIONS],
+    /// Without a vertex array object of the renderer's own: the arrays, and what sets their
+    /// pointers back (`None` where those entry points could not be loaded).
+    arrays: Option<([Array; LOCATIONS], AttribPointerFns)>,
+}
+
+/// One attribute parameter of location `index` (up to four values).
+fn read(gl: &glow::Context, index: u32, pname: u32) -> [f32; 4] {
+    let mut v = [0f32; 4];
+    unsafe { gl.get_vertex_attrib_parameter_f32_slice(index, pname, &mut v) };
+    v
+}
+
+impl HostAttributes {
+    /// Reads them: the arrays too where `fns` is given (the renderer has no vertex array).
+    pub(crate) fn save(gl: &glow::Context, fns: Option<AttribPointerFns>) -> Self {
+        let current = std::array::from_fn(|i| read(gl, i as u32, glow::CURRENT_VERTEX_ATTRIB));
+        let arrays = fns.map(|fns| (std::array::from_fn(|i| save_array(gl, fns, i as u32)), fns));
+        HostAttributes { current, arrays }
+    }
+
+    /// Gives them back; leaves `GL_ARRAY_BUFFER` bound to whatever an array needed last (the
+    /// caller restores it next).
+    pub(crate) fn restore(&self, gl: &glow::Context) {
+        if let Some((arrays, fns)) = &self.arrays {
+            for (index, a) in arrays.iter().enumerate() {
+                let index = index as u32;
+                unsafe {
+                    gl.bind_buffer(glow::ARRAY_BUFFER, a.buffer);
+                    let normalized = u8::from(a.normalized);
+                    (fns.set)(index, a.size, a.data_type, normalized, a.stride, a.pointer);
+                    if a.enabled {
+                        gl.enable_vertex_attrib_array(index);
+                    } else {
+                        gl.disable_vertex_attrib_array(index);
+                    }
+                }
+            }
+        }
+        for (index, [x, y, z, w]) in self.current.iter().copied().enumerate() {
+            unsafe { gl.vertex_attrib_4_f32(index as u32, x, y, z, w) };
+        }
+    }
+}
+
+fn save_array(gl: &glow::Context, fns: AttribPointerFns, index: u32) -> Array {
+    let number = |pname| read(gl, index, pname)[0] as i64;
+    let mut pointer = std::ptr::null_mut();
+    unsafe { (fns.get)(index, glow::VERTEX_ATTRIB_ARRAY_POINTER, &mut pointer) };
+    Array {
+        enabled: number(glow::VERTEX_ATTRIB_ARRAY_ENABLED) != 0,
+        size: number(glow::VERTEX_ATTRIB_ARRAY_SIZE) as i32,
+        data_type: number(glow::VERTEX_ATTRIB_ARRAY_TYPE) as u32,
+        normalized: number(glow::VERTEX_ATTRIB_ARRAY_NORMALIZED) != 0,
+        stride: number(glow::VERTEX_ATTRIB_ARRAY_STRIDE) as i32,
+        buffer: u32::try_from(number(glow::VERTEX_ATTRIB_ARRAY_BUFFER_BINDING))
+            .ok()
+            .and_then(std::num::NonZeroU32::new)
+            .map(glow::NativeBuffer),
+        pointer,
+    }
+}
