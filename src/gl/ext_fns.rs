@@ -54,14 +54,44 @@ pub fn attrib_pointer_fns() -> Option<AttribPointerFns> {
     // the specification gives it; the library stays loaded for the whole process.
     unsafe {
         Some(AttribPointerFns {
-            get: std::mem::transmute::<Ptr, GetVertexAttribPointerv>(entry_point(
+            get: std::mem::transmute::<Ptr, GetVertexAttribPointerv>(core_entry_point(
                 "glGetVertexAttribPointerv",
             )?),
-            set: std::mem::transmute::<Ptr, VertexAttribPointer>(entry_point(
+            set: std::mem::transmute::<Ptr, VertexAttribPointer>(core_entry_point(
                 "glVertexAttribPointer",
             )?),
         })
     }
+}
+
+/// A core ES 2.0 entry point: from the implementation manylight loaded where it did (a
+/// `HeadlessContext`'s), else from the system's `libGLESv2`, the one a window toolkit's context
+/// (glutin's, Android's) draws through. Loading manylight's own EGL here instead would tie the
+/// renderer's context checks to an EGL the application's context may not come from (under
+/// `MANYLIGHT_GLES_LIB`, another implementation than the toolkit's).
+fn core_entry_point(name: &str) -> Option<*const std::ffi::c_void> {
+    if let Some(lib) = super::gles_lib::loaded() {
+        let f = lib.proc_address(name);
+        return (!f.is_null()).then_some(f);
+    }
+    static SYSTEM: std::sync::OnceLock<Option<libloading::Library>> = std::sync::OnceLock::new();
+    let system = SYSTEM.get_or_init(|| {
+        // SAFETY: the system's GLES library, which the application's context already uses;
+        // loading it again maps nothing new.
+        ["libGLESv2.so.2", "libGLESv2.so"]
+            .iter()
+            .find_map(|file| unsafe { libloading::Library::new(file) }.ok())
+    });
+    let symbol = format!("{name}\0");
+    // SAFETY: only the symbol's address is read; the caller gives it its signature.
+    let f = unsafe {
+        system
+            .as_ref()?
+            .get::<*const std::ffi::c_void>(symbol.as_bytes())
+    }
+    .ok()?;
+    let f = *f;
+    (!f.is_null()).then_some(f)
 }
 
 /// `glGenQueriesEXT(n, ids)`.

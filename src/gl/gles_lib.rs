@@ -167,6 +167,11 @@ impl GlesLibrary {
     }
 }
 
+/// The implementation this process loaded, if it has loaded one (without loading it).
+pub(crate) fn loaded() -> Option<&'static GlesLibrary> {
+    LOADED.get().and_then(|l| l.as_ref().ok())
+}
+
 /// The EGL context current on this thread, as an address (`Some(None)`: none), when this
 /// process loaded EGL; `None` when it cannot tell (a context from elsewhere, say WGL).
 pub(crate) fn current_context() -> Option<Option<usize>> {
