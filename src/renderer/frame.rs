@@ -59,24 +59,14 @@ impl Renderer {
         options: &RenderOptions,
         stats: &mut FrameStats,
     ) -> Result<(), Error> {
-        self.render_at(scene, (width, height), options, options.origin, stats)
-    }
-
-    /// [`Renderer::render_reusing`] with the frame's lower-left corner at `origin` in the bound
-    /// framebuffer (the offscreen renders pass `[0, 0]`).
-    pub(super) fn render_at(
-        &mut self,
-        scene: &Scene,
-        (width, height): (u32, u32),
-        options: &RenderOptions,
-        origin: [u32; 2],
-        stats: &mut FrameStats,
-    ) -> Result<(), Error> {
+        let origin = options.origin;
         self.hosted(|r| r.render_hosted(scene, (width, height), options, origin, stats))
     }
 
-    /// [`Renderer::render_at`] between the application's GL state saved and given back.
-    fn render_hosted(
+    /// [`Renderer::render_reusing`] with the frame's lower-left corner at `origin` in the bound
+    /// framebuffer (the offscreen renders pass `[0, 0]`), inside a call that saved the
+    /// application's GL state ([`Renderer::hosted`]).
+    pub(super) fn render_hosted(
         &mut self,
         scene: &Scene,
         (width, height): (u32, u32),
@@ -96,9 +86,7 @@ impl Renderer {
         if samples <= 1 {
             return self.render_frame(scene, (width, height), options, origin, stats);
         }
-        if width == 0 || height == 0 {
-            return Err(Error::Limit(format!("viewport {width}×{height} is empty")));
-        }
+        check_viewport(width, height)?;
         let destination = self.dev.bound_framebuffer();
         let format = if options.hdr {
             ColorFormat::Rgba16F
@@ -144,9 +132,7 @@ impl Renderer {
             log::warn!("{warning}");
         }
         scene.validate()?;
-        if width == 0 || height == 0 {
-            return Err(Error::Limit(format!("viewport {width}×{height} is empty")));
-        }
+        check_viewport(width, height)?;
         self.gpu_scene
             .upload(&self.dev, scene, options.measure.full_variants)?;
         self.gpu_scene.split_for_frame(&self.dev, scene)?;
@@ -315,6 +301,14 @@ impl Renderer {
         }
         Ok(())
     }
+}
+
+/// Refuses an empty frame (the same error whichever call was given it).
+pub(super) fn check_viewport(width: u32, height: u32) -> Result<(), Error> {
+    if width == 0 || height == 0 {
+        return Err(Error::Limit(format!("viewport {width}×{height} is empty")));
+    }
+    Ok(())
 }
 
 /// Refuses a frame rectangle past GL's `i32` window coordinates, naming the field.

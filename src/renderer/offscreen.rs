@@ -64,9 +64,7 @@ impl Renderer {
         format: ColorFormat,
     ) -> Result<FrameStats, Error> {
         // As `render` says it, before the target is made.
-        if width == 0 || height == 0 {
-            return Err(Error::Limit(format!("viewport {width}×{height} is empty")));
-        }
+        super::frame::check_viewport(width, height)?;
         let current = self.target.as_ref().map(|t| (t.size(), t.format()));
         if current != Some(((width, height), format)) {
             if let Some(mut t) = self.target.take() {
@@ -77,9 +75,10 @@ impl Renderer {
             )?);
         }
         self.target.as_ref().expect("created above").bind(&self.dev);
+        // Inside the caller's `hosted`: the application's state is saved already.
         let frame = |r: &mut Renderer| {
             let mut stats = FrameStats::default();
-            r.render_at(scene, (width, height), options, [0, 0], &mut stats)
+            r.render_hosted(scene, (width, height), options, [0, 0], &mut stats)
                 .map(|()| stats)
         };
         let mut stats = frame(self)?;

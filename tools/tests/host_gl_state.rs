@@ -7,6 +7,7 @@
 
 mod common;
 
+use common::game_target::game_framebuffer;
 use common::Gpu;
 use manylight::gl::GlError;
 use manylight::glow::{self, HasContext};
@@ -181,40 +182,9 @@ unsafe fn set_game_state(gl: &glow::Context, es3: bool, size: (i32, i32)) {
         let t = gl.create_texture().unwrap();
         gl.bind_texture(glow::TEXTURE_2D, Some(t));
     }
-    gl.active_texture(glow::TEXTURE3);
-    let colour = gl.create_texture().unwrap();
+    // The game's framebuffer, its colour texture bound on unit 5.
     gl.active_texture(glow::TEXTURE5);
-    gl.bind_texture(glow::TEXTURE_2D, Some(colour));
-    let (w, h) = size;
-    gl.tex_image_2d(
-        glow::TEXTURE_2D,
-        0,
-        glow::RGBA as i32,
-        w,
-        h,
-        0,
-        glow::RGBA,
-        glow::UNSIGNED_BYTE,
-        glow::PixelUnpackData::Slice(None),
-    );
-    let fbo = gl.create_framebuffer().unwrap();
-    gl.bind_framebuffer(glow::FRAMEBUFFER, Some(fbo));
-    gl.framebuffer_texture_2d(
-        glow::FRAMEBUFFER,
-        glow::COLOR_ATTACHMENT0,
-        glow::TEXTURE_2D,
-        Some(colour),
-        0,
-    );
-    let depth = gl.create_renderbuffer().unwrap();
-    gl.bind_renderbuffer(glow::RENDERBUFFER, Some(depth));
-    gl.renderbuffer_storage(glow::RENDERBUFFER, glow::DEPTH_COMPONENT16, w, h);
-    gl.framebuffer_renderbuffer(
-        glow::FRAMEBUFFER,
-        glow::DEPTH_ATTACHMENT,
-        glow::RENDERBUFFER,
-        Some(depth),
-    );
+    game_framebuffer(gl, false, size);
     if es3 {
         let sampler = gl.create_sampler().unwrap();
         gl.sampler_parameter_i32(sampler, glow::TEXTURE_MIN_FILTER, glow::NEAREST as i32);

@@ -11,7 +11,7 @@ use super::Gpu;
 pub const MARKER: [u8; 4] = [51, 230, 102, 255];
 
 /// The game's framebuffer and its attachments.
-struct GameTarget {
+pub struct GameTarget {
     fbo: glow::Framebuffer,
     colour: glow::Texture,
     depth: glow::Renderbuffer,
@@ -20,7 +20,11 @@ struct GameTarget {
 /// Makes and binds a `size` RGBA8 framebuffer with depth (24 bits where the context has them,
 /// as the README asks of a game's), cleared to [`MARKER`] and to a depth that would hide the
 /// whole scene if the renderer drew against it.
-unsafe fn game_framebuffer(gl: &glow::Context, depth24: bool, (w, h): (i32, i32)) -> GameTarget {
+pub unsafe fn game_framebuffer(
+    gl: &glow::Context,
+    depth24: bool,
+    (w, h): (i32, i32),
+) -> GameTarget {
     let colour = gl.create_texture().unwrap();
     gl.bind_texture(glow::TEXTURE_2D, Some(colour));
     gl.tex_image_2d(
