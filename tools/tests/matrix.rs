@@ -2,6 +2,7 @@
 
 mod common;
 
+use std::path::Path;
 use std::process::Command;
 
 #[test]
@@ -9,7 +10,16 @@ fn matrix_covers_es2_es2_without_float_and_es3_and_every_supported_cell_matches_
     let dir = tempfile::tempdir().unwrap();
     let json = dir.path().join("m.json");
     let out = Command::new(env!("CARGO_BIN_EXE_manylight"))
-        .args(["matrix", "--size", "64x36", "--lights", "64", "--json"])
+        .args([
+            "matrix",
+            "--size",
+            "64x36",
+            "--lights",
+            "64",
+            "--max-error",
+            "2",
+        ])
+        .arg("--json")
         .arg(&json)
         .arg("--out")
         .arg(dir.path())
@@ -135,11 +145,37 @@ fn matrix_covers_es2_es2_without_float_and_es3_and_every_supported_cell_matches_
             }
         }
     }
+    vs_forward_is_each_image_against_its_cells_forward(&rows, dir.path());
     let sheet = image::open(dir.path().join("matrix.png")).unwrap();
     assert!(
         sheet.width() > 64 * 5 && sheet.height() > 36 * 5,
         "contact sheet too small"
     );
+}
+
+/// `max_abs_vs_forward` is each method's image against its own cell's forward image, as this
+/// test computes it from the images written; under `--max-error 2` every rendered method passes.
+fn vs_forward_is_each_image_against_its_cells_forward(rows: &serde_json::Value, out: &Path) {
+    let mut compared = 0;
+    for row in rows.as_array().unwrap() {
+        let methods = row["methods"].as_array().unwrap();
+        let image = |m: &serde_json::Value| {
+            image::open(out.join(m["image"].as_str().unwrap()))
+                .unwrap()
+                .to_rgba8()
+        };
+        let Some(forward) = methods.iter().find(|m| m["name"] == "forward") else {
+            continue;
+        };
+        let forward = image(forward);
+        for m in methods.iter().filter(|m| m["image"].is_string()) {
+            let expected = manylight::metrics::diff(&forward, &image(m)).max_abs;
+            assert_eq!(m["max_abs_vs_forward"], expected, "{} {m}", row["config"]);
+            assert_eq!(m["pass"], expected <= 2, "{} {m}", row["config"]);
+            compared += 1;
+        }
+    }
+    assert!(compared >= 20, "only {compared} renders compared");
 }
 
 /// As a CI script runs it: `--json -` prints only JSON on stdout (the table goes to stderr);
@@ -151,15 +187,36 @@ fn matrix_json_on_stdout_ignores_the_callers_driver_switches_and_writes_no_image
     let dir = tempfile::tempdir().unwrap();
     let out = Command::new(env!("CARGO_BIN_EXE_manylight"))
         .args(["matrix", "--size", "32x18", "--lights", "8", "--json", "-"])
+        .args(["--max-error", "0"])
         .env("MESA_GLES_VERSION_OVERRIDE", "2.0")
         .env("TMPDIR", dir.path())
         .current_dir(dir.path())
         .output()
         .unwrap();
     let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(out.status.success(), "{stderr}");
     let rows: serde_json::Value = serde_json::from_slice(&out.stdout)
         .unwrap_or_else(|e| panic!("stdout is not JSON alone ({e}): {stderr}"));
+    // `--max-error 0`: the exit status says whether any render differs from its cell's
+    // forward at all, and stderr names each that does.
+    let mut over = 0;
+    for row in rows.as_array().unwrap() {
+        for m in row["methods"].as_array().unwrap() {
+            match m["max_abs_vs_forward"].as_u64() {
+                Some(d) if d > 0 => {
+                    over += 1;
+                    let line = format!(
+                        "{} / {}: {d}/255 from forward",
+                        row["config"].as_str().unwrap(),
+                        m["name"].as_str().unwrap()
+                    );
+                    assert!(stderr.contains(&line), "{line} not in {stderr}");
+                }
+                Some(_) => assert_eq!(m["pass"], true, "{m}"),
+                None => assert!(m["pass"].is_null(), "{m}"),
+            }
+        }
+    }
+    assert_eq!(out.status.success(), over == 0, "{over} over: {stderr}");
     assert!(
         stderr.contains("| implementation | configuration |"),
         "the table on stderr: {stderr}"

@@ -11,6 +11,8 @@
 //! data (both played) and ES 3.x on it; the Mesa restrictions, softpipe and OSMesa rows belong
 //! to the system's group.
 
+mod verdict;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, ExitStatus, Output};
 
@@ -43,6 +45,11 @@ pub struct MatrixArgs {
     /// (without it, no image is written).
     #[arg(long)]
     pub out: Option<PathBuf>,
+    /// Exit with status 1 when a method differs from forward on the same configuration by
+    /// more than N/255 at any pixel, fails to render, or its cell crashes. Unsupported methods
+    /// and configurations the driver cannot give do not count.
+    #[arg(long, value_name = "N")]
+    pub max_error: Option<u8>,
 }
 
 /// The driver switches the configurations set: cleared in every cell first, so a row is
@@ -209,6 +216,10 @@ pub fn run(args: &MatrixArgs, gles_libs: &[PathBuf]) -> Result<(), Box<dyn std::
         let lib = (lib != Path::new("system")).then_some(lib.as_path());
         rows.extend(group_rows(&exe, args, &size, out, lib, g)?);
     }
+    let failures = args
+        .max_error
+        .map(|n| verdict::mark(&mut rows, n))
+        .unwrap_or_default();
     let json = serde_json::to_string_pretty(&rows)? + "\n";
     if json_to_stdout {
         eprint!("{}", markdown(&rows));
@@ -231,6 +242,16 @@ pub fn run(args: &MatrixArgs, gles_libs: &[PathBuf]) -> Result<(), Box<dyn std::
         .and_then(|errors| errors.first().copied())
     {
         return Err(format!("no configuration of the matrix could run: {error}").into());
+    }
+    if let (Some(n), false) = (args.max_error, failures.is_empty()) {
+        for failure in &failures {
+            eprintln!("over --max-error {n}: {failure}");
+        }
+        return Err(format!(
+            "{} of the matrix's renders fail --max-error {n} (listed above)",
+            failures.len()
+        )
+        .into());
     }
     Ok(())
 }
@@ -334,9 +355,18 @@ fn cell_row(output: &Output) -> Value {
         Some(row) if output.status.success() => row,
         _ => json!({
             "error": cell_error(&output.stderr, output.status),
+            "crashed": !has_error_line(&output.stderr),
             "methods": [],
         }),
     }
+}
+
+/// Whether the child said why it failed (`error: …`), as opposed to panicking, being killed
+/// or printing no row.
+fn has_error_line(stderr: &[u8]) -> bool {
+    String::from_utf8_lossy(stderr)
+        .lines()
+        .any(|l| l.starts_with("error: "))
 }
 
 /// Why a cell failed, on one line for its table cell: the child's `error:` lines, without the
@@ -398,7 +428,7 @@ fn osmesa_row(
 }
 
 fn markdown(rows: &[Value]) -> String {
-    let mut s = String::from("| implementation | configuration | context | method | support | max abs vs reference | pixels > 2/255 | frame ms |\n|---|---|---|---|---|---|---|---|\n");
+    let mut s = String::from("| implementation | configuration | context | method | support | max abs vs forward | max abs vs reference | pixels > 2/255 | frame ms |\n|---|---|---|---|---|---|---|---|---|\n");
     for row in rows {
         let config = &format!(
             "{} | {}",
@@ -408,7 +438,7 @@ fn markdown(rows: &[Value]) -> String {
             row["config"].as_str().unwrap_or("?")
         );
         if let Some(err) = row["error"].as_str() {
-            s += &format!("| {config} | — | — | unavailable: {err} | | | |\n");
+            s += &format!("| {config} | — | — | unavailable: {err} | | | | |\n");
             continue;
         }
         let context = match row["max_samples"].as_i64() {
@@ -430,8 +460,9 @@ fn markdown(rows: &[Value]) -> String {
                     .map_or(String::new(), |v| format!("{v:.digits$}"))
             };
             s += &format!(
-                "| {config} | {context} | {} | {support} | {} | {} | {} |\n",
+                "| {config} | {context} | {} | {support} | {} | {} | {} | {} |\n",
                 m["name"].as_str().unwrap_or("?"),
+                num("max_abs_vs_forward", 0),
                 num("max_abs", 0),
                 m["over_2"]
                     .as_f64()
@@ -568,6 +599,7 @@ pub fn run_cell(args: &MatrixCellArgs) -> Result<(), Box<dyn std::error::Error>>
     };
     let mut renderer = Renderer::restricted(ctx.load_gl()?, es, &restrictions)?;
     let mut methods = Vec::new();
+    let mut images = Vec::new();
     for m in METHODS {
         let support = (m.supported)(renderer.caps());
         let mut entry = json!({"name": m.name, "support": support});
@@ -592,10 +624,21 @@ pub fn run_cell(args: &MatrixCellArgs) -> Result<(), Box<dyn std::error::Error>>
                     output::save_png(&out.join(&file), &img)?;
                     entry["image"] = json!(file);
                 }
+                images.push((methods.len(), img));
             }
             Err(e) => entry["error"] = json!(e.to_string()),
         }
         methods.push(entry);
+    }
+    // Each method against forward on this very configuration: what a method must equal.
+    if let Some((_, forward)) = images
+        .iter()
+        .find(|(i, _)| methods[*i]["name"] == "forward")
+    {
+        for (i, img) in &images {
+            methods[*i]["max_abs_vs_forward"] =
+                json!(manylight::metrics::diff(forward, img).max_abs);
+        }
     }
     let caps = renderer.caps().clone();
     renderer.destroy();
