@@ -2,17 +2,18 @@
 //! `glRenderbufferStorageMultisampleEXT` (`GL_EXT_multisampled_render_to_texture`), without
 //! which that extension's colour attachment has no multisampled depth to go with it.
 //!
-//! glow takes the caller's GL context already loaded, so these come from the process's EGL
-//! implementation (`eglGetProcAddress`): where an ES 2.0 context comes from on Android and
-//! Linux. A context made otherwise (none here) simply finds none, and MSAA on ES 2.0 is then
-//! unsupported with that reason.
+//! glow takes the caller's GL context already loaded, so these come from the implementation
+//! the context does: the one manylight loaded for its own contexts, else the system's (a
+//! window toolkit's, Android's), through `eglGetProcAddress` for an extension's. A context made
+//! otherwise (none here) simply finds none, and what needs the entry point is then unsupported
+//! with that reason.
 #![allow(unsafe_code)]
 
 /// `glRenderbufferStorageMultisampleEXT(target, samples, internalformat, width, height)`.
 pub type RenderbufferStorageMultisampleExt =
     unsafe extern "system" fn(target: u32, samples: i32, format: u32, width: i32, height: i32);
 
-/// Loads `glRenderbufferStorageMultisampleEXT` from the process's GLES implementation
+/// Loads `glRenderbufferStorageMultisampleEXT` from the current context's implementation
 /// ([`super::gles_lib`]), if it is there.
 pub fn renderbuffer_storage_multisample_ext() -> Option<RenderbufferStorageMultisampleExt> {
     let f = entry_point("glRenderbufferStorageMultisampleEXT")?;
@@ -71,26 +72,55 @@ pub fn attrib_pointer_fns() -> Option<AttribPointerFns> {
 /// `MANYLIGHT_GLES_LIB`, another implementation than the toolkit's).
 fn core_entry_point(name: &str) -> Option<*const std::ffi::c_void> {
     if let Some(lib) = super::gles_lib::loaded() {
-        let f = lib.proc_address(name);
-        return (!f.is_null()).then_some(f);
+        return non_null(lib.proc_address(name));
     }
     static SYSTEM: std::sync::OnceLock<Option<libloading::Library>> = std::sync::OnceLock::new();
-    let system = SYSTEM.get_or_init(|| {
-        // SAFETY: the system's GLES library, which the application's context already uses;
-        // loading it again maps nothing new.
-        ["libGLESv2.so.2", "libGLESv2.so"]
-            .iter()
-            .find_map(|file| unsafe { libloading::Library::new(file) }.ok())
-    });
-    let symbol = format!("{name}\0");
-    // SAFETY: only the symbol's address is read; the caller gives it its signature.
-    let f = unsafe {
-        system
-            .as_ref()?
-            .get::<*const std::ffi::c_void>(symbol.as_bytes())
+    let gles = SYSTEM.get_or_init(|| system_library(&["libGLESv2.so.2", "libGLESv2.so"]));
+    symbol(gles.as_ref()?, name)
+}
+
+/// An extension's entry point, from the implementation as [`core_entry_point`] picks it, but
+/// through `eglGetProcAddress`: an extension's functions need not be exported by `libGLESv2`.
+fn entry_point(name: &str) -> Option<*const std::ffi::c_void> {
+    if let Some(lib) = super::gles_lib::loaded() {
+        return non_null(lib.proc_address(name));
     }
-    .ok()?;
-    let f = *f;
+    type GetProcAddress =
+        unsafe extern "system" fn(*const std::ffi::c_char) -> *const std::ffi::c_void;
+    static SYSTEM: std::sync::OnceLock<Option<(libloading::Library, GetProcAddress)>> =
+        std::sync::OnceLock::new();
+    let (_egl, get_proc_address) = SYSTEM
+        .get_or_init(|| {
+            let egl = system_library(&["libEGL.so.1", "libEGL.so"])?;
+            let f = symbol(&egl, "eglGetProcAddress")?;
+            // SAFETY: EGL 1.4 specifies this signature for `eglGetProcAddress`.
+            let f = unsafe { std::mem::transmute::<*const std::ffi::c_void, GetProcAddress>(f) };
+            Some((egl, f))
+        })
+        .as_ref()?;
+    let cname = std::ffi::CString::new(name).ok()?;
+    // SAFETY: a NUL-terminated name, and the library stays loaded (kept beside the pointer).
+    non_null(unsafe { get_proc_address(cname.as_ptr()) })
+}
+
+/// The first of the system's `files` that loads.
+fn system_library(files: &[&str]) -> Option<libloading::Library> {
+    // SAFETY: the system's GL library, which the application's context already uses; loading
+    // it again maps nothing new.
+    files
+        .iter()
+        .find_map(|file| unsafe { libloading::Library::new(file) }.ok())
+}
+
+/// The address of `library`'s symbol `name`, if it has one.
+fn symbol(library: &libloading::Library, name: &str) -> Option<*const std::ffi::c_void> {
+    let cname = std::ffi::CString::new(name).ok()?;
+    // SAFETY: only the symbol's address is read; the caller gives it its signature.
+    let f = unsafe { library.get::<*const std::ffi::c_void>(cname.as_bytes_with_nul()) }.ok()?;
+    non_null(*f)
+}
+
+fn non_null(f: *const std::ffi::c_void) -> Option<*const std::ffi::c_void> {
     (!f.is_null()).then_some(f)
 }
 
@@ -139,10 +169,4 @@ pub fn timer_query_fns() -> Option<TimerQueryFns> {
             )?),
         })
     }
-}
-
-/// The process's GLES implementation's entry point of that name, if it has one.
-fn entry_point(name: &str) -> Option<*const std::ffi::c_void> {
-    let f = super::gles_lib::library().ok()?.proc_address(name);
-    (!f.is_null()).then_some(f)
 }

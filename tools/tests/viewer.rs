@@ -224,6 +224,26 @@ fn view_resolves_msaa_into_the_window() {
     }
 }
 
+/// ES 2.0's MSAA (`GL_EXT_multisampled_render_to_texture`, added by Mesa's override) in the
+/// window: its entry point comes from the implementation the window's context uses, also in a
+/// run where `MANYLIGHT_GLES_LIB` names another one for headless contexts (loading that one's
+/// EGL made the viewer fail with "no GL context is current").
+#[test]
+fn view_resolves_es2_msaa_through_the_extension() {
+    let es2_msaa = ["--es", "2", "--msaa", "4"];
+    let extension = [(
+        "MESA_EXTENSION_OVERRIDE",
+        "+GL_EXT_multisampled_render_to_texture",
+    )];
+    if let Some((stdout, stderr)) = check_window_frame(&es2_msaa, &es2_msaa, &extension) {
+        assert!(stdout.contains("ES 2.0"), "{stdout}");
+        assert!(
+            !stderr.contains("MSAA off") && !stderr.contains("could not be loaded"),
+            "{stderr}"
+        );
+    }
+}
+
 /// The window posed at `--time` (paused) is `render --time`'s frame: the moving lights are
 /// where the same function of time puts them.
 #[test]
