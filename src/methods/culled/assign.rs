@@ -5,6 +5,7 @@ use std::time::Instant;
 
 use crate::cluster::assign::{AssignLimits, Assigner, Assignment};
 use crate::cluster::grid::ClusterGrid;
+use crate::cluster::pack::MAX_INDEXED_LIGHTS;
 use crate::methods::FrameContext;
 
 /// The assignment's buffers, reused frame after frame, and whether overflow was warned about.
@@ -38,7 +39,10 @@ impl Assign {
         let assignment = self.assigner.assign(grid, ctx.lights, ctx.far, limits);
         let ms = started.elapsed().as_secs_f64() * 1e3;
         let dropped = assignment.stats.overflowed_lights;
-        if dropped > 0 && !self.warned_overflow {
+        // A frame refused for too many visible lights drops nothing: the warning (once a
+        // renderer) is kept for one that draws.
+        let drawn = assignment.visible.len() <= MAX_INDEXED_LIGHTS;
+        if dropped > 0 && drawn && !self.warned_overflow {
             self.warned_overflow = true;
             warn_overflow(method, dropped, limits);
         }
