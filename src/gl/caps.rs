@@ -40,6 +40,8 @@ pub struct Caps {
     pub vendor: String,
     /// `GL_MAX_TEXTURE_SIZE`.
     pub max_texture_size: i32,
+    /// `GL_MAX_VIEWPORT_DIMS`: the widest and tallest frame into a framebuffer a game binds.
+    pub max_viewport_dims: [i32; 2],
     /// `GL_MAX_FRAGMENT_UNIFORM_VECTORS`.
     pub max_fragment_uniform_vectors: i32,
     /// `GL_MAX_TEXTURE_IMAGE_UNITS`.
@@ -94,7 +96,7 @@ impl Caps {
             return Err(GlError::VersionUnavailable {
                 requested: es,
                 reason: format!(
-                    "the driver returned OpenGL ES {context_version}{}",
+                    "the current context is OpenGL ES {context_version}{}",
                     mesa_switches_note()
                 ),
             });
@@ -119,6 +121,7 @@ impl Caps {
         let mut max_samples = 0;
         let (fragment_highp, fragment_mediump);
         let subpixel_bits;
+        let mut max_viewport_dims = [0; 2];
         unsafe {
             gl_version = gl.get_parameter_string(glow::VERSION);
             glsl_version = gl.get_parameter_string(glow::SHADING_LANGUAGE_VERSION);
@@ -128,6 +131,7 @@ impl Caps {
             max_fragment_uniform_vectors = gl.get_parameter_i32(glow::MAX_FRAGMENT_UNIFORM_VECTORS);
             max_texture_image_units = gl.get_parameter_i32(glow::MAX_TEXTURE_IMAGE_UNITS);
             subpixel_bits = gl.get_parameter_i32(glow::SUBPIXEL_BITS);
+            gl.get_parameter_i32_slice(glow::MAX_VIEWPORT_DIMS, &mut max_viewport_dims);
             if es3 || (!desktop && has(MSAA_RENDER_TO_TEXTURE)) {
                 // GL_MAX_SAMPLES_EXT has the value of GL_MAX_SAMPLES.
                 max_samples = gl.get_parameter_i32(glow::MAX_SAMPLES);
@@ -159,6 +163,7 @@ impl Caps {
             renderer,
             vendor,
             max_texture_size,
+            max_viewport_dims,
             max_fragment_uniform_vectors,
             max_texture_image_units,
             max_draw_buffers,

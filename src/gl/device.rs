@@ -23,6 +23,8 @@ pub struct Device {
     attrib_pointer_fns: Option<super::ext_fns::AttribPointerFns>,
     /// Nesting depth of [`Device::enter_host`] (the outermost call saves the state).
     host_depth: std::cell::Cell<u32>,
+    /// Whether a GL error the application left pending has been reported (once a device).
+    warned_pending_error: std::cell::Cell<bool>,
     /// The EGL context current when the device was made (as an address), where EGL can say.
     context: Option<usize>,
 }
@@ -115,6 +117,7 @@ impl Device {
                 .flatten(),
             vertex_array,
             host_depth: std::cell::Cell::new(0),
+            warned_pending_error: std::cell::Cell::new(false),
             context: super::gles_lib::current_context().flatten(),
         })
     }
@@ -129,12 +132,25 @@ impl Device {
         }
     }
 
-    /// Starts a call of the renderer: saves the application's GL state and sets what the
-    /// renderer assumes ([`super::host_state`]); `None` inside a call already started.
+    /// Runs `f` as one call of the renderer ([`Device::enter_host`] to
+    /// [`Device::leave_host`]), giving the application its state back also when `f` panics
+    /// (the panic then goes on): a caller that catches it keeps a working renderer.
+    pub(crate) fn host_call<T>(&self, f: impl FnOnce() -> T) -> T {
+        let saved = self.enter_host();
+        let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(f));
+        self.leave_host(saved);
+        result.unwrap_or_else(|panic| std::panic::resume_unwind(panic))
+    }
+
+    /// Starts a call of the renderer: clears GL errors the application left pending (they are
+    /// not the renderer's), saves the application's GL state and sets what the renderer
+    /// assumes ([`super::host_state`]); `None` inside a call already started. Pair it with
+    /// [`Device::leave_host`] in a way a panic cannot skip ([`Device::host_call`]).
     pub(crate) fn enter_host(&self) -> Option<super::host_state::HostState> {
         let depth = self.host_depth.get();
         self.host_depth.set(depth + 1);
         (depth == 0).then(|| {
+            self.clear_pending_errors();
             super::host_state::HostState::enter(
                 &self.gl,
                 self.caps.es,
@@ -149,6 +165,30 @@ impl Device {
         self.host_depth.set(self.host_depth.get().saturating_sub(1));
         if let Some(saved) = saved {
             saved.leave(&self.gl, self.vertex_array);
+        }
+    }
+
+    /// Drains the GL errors pending when a call starts, saying so once: otherwise the first
+    /// check of the call would report the application's error as the renderer's.
+    fn clear_pending_errors(&self) {
+        let first = unsafe { self.gl.get_error() };
+        if first == glow::NO_ERROR {
+            return;
+        }
+        for _ in 0..16 {
+            if unsafe { self.gl.get_error() } == glow::NO_ERROR {
+                break;
+            }
+        }
+        let message = format!(
+            "{} (0x{first:04x}) was pending when the renderer was called: the application's, \
+             cleared so that it is not taken for the renderer's",
+            error_name(first)
+        );
+        if self.warned_pending_error.replace(true) {
+            log::debug!("{message}");
+        } else {
+            log::warn!("{message} (said once; later ones are logged at debug level)");
         }
     }
 
@@ -249,6 +289,42 @@ impl Device {
         unsafe { self.gl.get_parameter_framebuffer(glow::FRAMEBUFFER_BINDING) }
     }
 
+    /// `glCheckFramebufferStatus` of the bound framebuffer.
+    pub(crate) fn bound_framebuffer_status(&self) -> u32 {
+        unsafe { self.gl.check_framebuffer_status(glow::FRAMEBUFFER) }
+    }
+
+    /// The depth bits of the bound framebuffer (0: no depth buffer); `None` where the driver
+    /// would not say. ES 2.0 asks `GL_DEPTH_BITS`; ES 3.0 and desktop core (which dropped that
+    /// query) ask the depth attachment.
+    pub(crate) fn bound_depth_bits(&self) -> Option<i32> {
+        let gl = &self.gl;
+        let bits = unsafe {
+            if self.caps.es == EsVersion::Es2 && !self.caps.desktop {
+                gl.get_parameter_i32(glow::DEPTH_BITS)
+            } else {
+                let attachment = if self.bound_framebuffer().is_some() {
+                    glow::DEPTH_ATTACHMENT
+                } else {
+                    glow::DEPTH
+                };
+                let param = |p| {
+                    gl.get_framebuffer_attachment_parameter_i32(glow::FRAMEBUFFER, attachment, p)
+                };
+                if param(glow::FRAMEBUFFER_ATTACHMENT_OBJECT_TYPE) == glow::NONE as i32 {
+                    0
+                } else {
+                    param(glow::FRAMEBUFFER_ATTACHMENT_DEPTH_SIZE)
+                }
+            }
+        };
+        let refused = unsafe { gl.get_error() } != glow::NO_ERROR;
+        if refused {
+            unsafe { while gl.get_error() != glow::NO_ERROR {} }
+        }
+        (!refused).then_some(bits)
+    }
+
     /// Binds `fbo` (`None`: the default framebuffer).
     pub fn bind_framebuffer(&self, fbo: Option<glow::Framebuffer>) {
         unsafe { self.gl.bind_framebuffer(glow::FRAMEBUFFER, fbo) }
@@ -302,14 +378,13 @@ impl Device {
     }
 }
 
-/// Debug builds check `glGetError` after the wrapped step and panic with its decoded name;
-/// release builds compile it out (one check per frame still runs via [`Device::check`]).
+/// Debug builds check `glGetError` after the wrapped step and return its error from the
+/// enclosing function; release builds compile it out (one check per frame still runs via
+/// [`Device::check`]).
 macro_rules! gl_check {
     ($device:expr, $what:expr) => {
         #[cfg(debug_assertions)]
-        if let Err(e) = $device.check($what) {
-            panic!("{e}");
-        }
+        $device.check($what)?;
     };
 }
 pub(crate) use gl_check;

@@ -245,7 +245,7 @@ impl GBuffer {
 
 impl Drop for GBuffer {
     fn drop(&mut self) {
-        if !self.destroyed {
+        if !self.destroyed && !super::left_objects::left_on_purpose() {
             log::warn!("GBuffer dropped without destroy(): GL objects leaked");
         }
     }

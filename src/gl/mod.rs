@@ -21,6 +21,7 @@ pub mod gbuffer;
 pub mod gles_lib;
 pub(crate) mod host_attributes;
 pub(crate) mod host_state;
+pub(crate) mod left_objects;
 pub mod mesh;
 pub mod multisample;
 #[cfg(feature = "osmesa")]
@@ -106,8 +107,9 @@ pub enum GlError {
         /// EGL's error.
         error: String,
     },
-    /// The driver cannot give the requested ES version.
-    #[error("the driver cannot create an OpenGL {requested} context: {reason}")]
+    /// The requested ES version cannot be had: the driver made no such context, or the
+    /// context the renderer was given is an older version.
+    #[error("OpenGL {requested} is not available: {reason}")]
     VersionUnavailable {
         /// What was asked for.
         requested: EsVersion,
@@ -151,6 +153,10 @@ pub enum GlError {
     /// A framebuffer is incomplete.
     #[error("framebuffer incomplete: status 0x{0:04x}")]
     FramebufferIncomplete(u32),
+    /// The framebuffer the application bound cannot take the frame: incomplete, or without a
+    /// depth buffer (every method draws with the depth test).
+    #[error("the bound framebuffer cannot take the frame: {0}")]
+    BoundFramebuffer(String),
     /// The driver reported an error.
     #[error("GL error {name} (0x{code:04x}) after {what}")]
     Driver {
@@ -169,7 +175,7 @@ pub enum GlError {
     #[error("out of memory: {0}")]
     OutOfMemory(String),
     /// EGL says no context is current on this thread.
-    #[error("no GL context is current on this thread: was the HeadlessContext dropped, or another context made current, while the Renderer lived? Keep the context alive and current as long as the renderer")]
+    #[error("no GL context is current on this thread: was the renderer's context (its HeadlessContext, or the application's own) dropped or released while the Renderer lived? Keep it alive and current on this thread as long as the renderer")]
     NotCurrent,
     /// A [`HeadlessContext`] used on a thread where it is not current.
     #[error("this context is not current on the calling thread: call make_current here first (after release_current on the thread where it is current)")]

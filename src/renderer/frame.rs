@@ -60,7 +60,15 @@ impl Renderer {
         stats: &mut FrameStats,
     ) -> Result<(), Error> {
         let origin = options.origin;
-        self.hosted(|r| r.render_hosted(scene, (width, height), options, origin, stats))
+        let own_msaa = options.count == CountKind::None && options.samples > 1;
+        self.hosted(|r| {
+            // The frame's own errors first: they do not depend on what is bound.
+            check_viewport(width, height)?;
+            check_origin(origin, width, height)?;
+            check_options(options)?;
+            r.check_bound_target(width, height, !own_msaa)?;
+            r.render_hosted(scene, (width, height), options, origin, stats)
+        })
     }
 
     /// [`Renderer::render_reusing`] with the frame's lower-left corner at `origin` in the bound

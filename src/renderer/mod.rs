@@ -6,15 +6,19 @@
 //! its light gathering, shader features and grid depth in `frame_setup`; offscreen renders
 //! read back to the CPU (colour, HDR, light counts) in `offscreen`.
 
+mod bound_target;
 mod fp16_range;
 mod frame;
 mod frame_setup;
+#[cfg(test)]
+mod hosted_tests;
 mod method;
 mod offscreen;
 mod stats;
 
 use crate::cluster::view_light::GpuLight;
 use crate::gl::framebuffer::OffscreenTarget;
+use crate::gl::left_objects::LeftObjects;
 use crate::gl::program::ProgramCache;
 use crate::gl::{Caps, Device, EsVersion};
 pub use crate::gpu_scene::GpuScene;
@@ -55,11 +59,17 @@ pub struct Renderer {
     shown_directional: Vec<usize>,
     /// More directional lights than are shown was announced (once per renderer).
     warned_directional: bool,
+    /// A bound framebuffer's shallow depth buffer was announced (once per renderer).
+    warned_depth_bits: bool,
     /// The frame's objects in draw order (kept likewise).
     draw_order: methods::geometry::DrawOrder,
     /// `LP_NUM_THREADS` when the renderer was made (llvmpipe reads it when the context is
     /// made; reading it every frame would allocate).
     lp_num_threads: Option<String>,
+    /// Marks the GL objects left when the context is gone ([`Renderer::abandon`], or no
+    /// context current at drop), so that they drop without a warning each. Last: fields drop
+    /// in declaration order, and the mark must outlive the others.
+    left: LeftObjects,
 }
 
 impl Renderer {
@@ -96,10 +106,7 @@ impl Renderer {
                 None => note,
             });
         }
-        let host = dev.enter_host();
-        let method = (desc.create)(&dev);
-        dev.leave_host(host);
-        let method = method?;
+        let method = dev.host_call(|| (desc.create)(&dev))?;
         Ok(Renderer {
             dev,
             programs: ProgramCache::new(),
@@ -114,8 +121,10 @@ impl Renderer {
             lights: Vec::new(),
             shown_directional: Vec::new(),
             warned_directional: false,
+            warned_depth_bits: false,
             draw_order: methods::geometry::DrawOrder::default(),
             lp_num_threads: std::env::var("LP_NUM_THREADS").ok(),
+            left: LeftObjects::default(),
         })
     }
 
@@ -148,20 +157,21 @@ impl Renderer {
     /// Whether the fragment stage evaluates `mediump` as fp16 (measured with a tiny render).
     pub fn mediump_is_fp16(&self) -> Result<bool, Error> {
         self.dev.check_current()?;
-        let host = self.dev.enter_host();
-        let fp16 = crate::gl::precision_probe::mediump_is_fp16(&self.dev);
-        self.dev.leave_host(host);
-        Ok(fp16?)
+        Ok(self
+            .dev
+            .host_call(|| crate::gl::precision_probe::mediump_is_fp16(&self.dev))?)
     }
 
     /// Runs `f` between the application's GL state saved and given back (see
-    /// `gl::host_state`), after checking that the renderer's context is current.
+    /// `gl::host_state`), after checking that the renderer's context is current. As
+    /// [`Device::host_call`], but `f` gets the renderer: the state comes back also when `f`
+    /// panics.
     fn hosted<T>(&mut self, f: impl FnOnce(&mut Self) -> Result<T, Error>) -> Result<T, Error> {
         self.dev.check_current()?;
         let host = self.dev.enter_host();
-        let result = f(self);
+        let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| f(self)));
         self.dev.leave_host(host);
-        result
+        result.unwrap_or_else(|panic| std::panic::resume_unwind(panic))
     }
 
     /// GL objects the renderer holds now (`lab`: the soak tests count them).
@@ -252,6 +262,7 @@ impl Renderer {
     /// in whatever context is current now. A new renderer then starts on the new context.
     pub fn abandon(mut self) {
         self.freed = true;
+        self.left.leave();
     }
 
     fn free_gl(&mut self) {
@@ -263,6 +274,7 @@ impl Renderer {
         // delete those.
         if let Err(e) = self.dev.check_current() {
             log::warn!("the renderer's GL objects are not freed: {e}");
+            self.left.leave();
             return;
         }
         if let Some(Some(t)) = self.timer.take() {

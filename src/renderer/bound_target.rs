@@ -1,0 +1,78 @@
+//! What a frame needs of the framebuffer the application bound ([`Renderer::render`]): complete,
+//! no larger than the driver's viewport, and with a depth buffer when the frame is drawn in it
+//! (every method draws with the depth test; an MSAA frame brings its own and only resolves
+//! there). Without these checks such a frame returned `Ok` with a wrong picture, or a GL error
+//! that named a later step.
+
+use super::Renderer;
+use crate::gl::GlError;
+use crate::Error;
+
+/// Depth bits below which surfaces close in depth show through (the README's 24).
+const FULL_DEPTH_BITS: i32 = 24;
+
+impl Renderer {
+    /// Refuses a bound framebuffer that cannot take a `width × height` frame; warns once of a
+    /// shallow depth buffer. `drawn_here`: the frame is drawn in it (no MSAA of the renderer's).
+    pub(super) fn check_bound_target(
+        &mut self,
+        width: u32,
+        height: u32,
+        drawn_here: bool,
+    ) -> Result<(), Error> {
+        let [max_w, max_h] = self.dev.caps().max_viewport_dims;
+        if (max_w > 0 && width > max_w as u32) || (max_h > 0 && height > max_h as u32) {
+            return Err(Error::Limit(format!(
+                "a {width}×{height} frame is larger than the driver's largest viewport, \
+                 {max_w}×{max_h} (GL_MAX_VIEWPORT_DIMS)"
+            )));
+        }
+        let status = self.dev.bound_framebuffer_status();
+        if status != glow::FRAMEBUFFER_COMPLETE {
+            return Err(GlError::BoundFramebuffer(format!(
+                "it is incomplete ({}; on a surfaceless context, framebuffer 0 has no surface: \
+                 bind a framebuffer object of your own)",
+                status_name(status)
+            ))
+            .into());
+        }
+        if !drawn_here {
+            return Ok(());
+        }
+        match self.dev.bound_depth_bits() {
+            Some(0) => Err(GlError::BoundFramebuffer(
+                "it has no depth buffer, and every method draws with the depth test: attach \
+                 one (24-bit; 16-bit loses precision), or render with MSAA, whose target has \
+                 its own"
+                    .to_string(),
+            )
+            .into()),
+            Some(bits) if bits < FULL_DEPTH_BITS && !self.warned_depth_bits => {
+                self.warned_depth_bits = true;
+                log::warn!(
+                    "the bound framebuffer's depth buffer has {bits} bits: surfaces close \
+                     together in depth may show the one behind (a 24-bit one does not)"
+                );
+                Ok(())
+            }
+            _ => Ok(()),
+        }
+    }
+}
+
+/// `glCheckFramebufferStatus`'s answer by name.
+fn status_name(status: u32) -> String {
+    let name = match status {
+        glow::FRAMEBUFFER_UNDEFINED => "GL_FRAMEBUFFER_UNDEFINED",
+        glow::FRAMEBUFFER_INCOMPLETE_ATTACHMENT => "GL_FRAMEBUFFER_INCOMPLETE_ATTACHMENT",
+        glow::FRAMEBUFFER_INCOMPLETE_MISSING_ATTACHMENT => {
+            "GL_FRAMEBUFFER_INCOMPLETE_MISSING_ATTACHMENT"
+        }
+        // GL_FRAMEBUFFER_INCOMPLETE_DIMENSIONS (ES 2.0), not in glow's core list.
+        0x8CD9 => "GL_FRAMEBUFFER_INCOMPLETE_DIMENSIONS",
+        glow::FRAMEBUFFER_UNSUPPORTED => "GL_FRAMEBUFFER_UNSUPPORTED",
+        glow::FRAMEBUFFER_INCOMPLETE_MULTISAMPLE => "GL_FRAMEBUFFER_INCOMPLETE_MULTISAMPLE",
+        _ => return format!("status 0x{status:04x}"),
+    };
+    format!("{name}, 0x{status:04x}")
+}

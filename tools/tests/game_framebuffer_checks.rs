@@ -1,0 +1,194 @@
+//! What `Renderer::render` needs of the framebuffer a game binds, and what a game's own GL
+//! mistakes do to a call: a framebuffer that cannot take the frame is an error naming why (it
+//! returned `Ok` with a wrong picture, or panicked in debug builds); a GL error the game left
+//! pending is neither the renderer's error nor the end of its GPU timing; a renderer left
+//! behind with its context says so once, not once for each of its objects.
+#![allow(unsafe_code)] // the game's side: raw glow calls
+
+mod common;
+
+use common::warnings::warnings_containing;
+use manylight::glow::{self, HasContext};
+use manylight::scene;
+use manylight::{EsVersion, GlError, HeadlessContext, RenderOptions, Renderer};
+
+const SIZE: (i32, i32) = (64, 36);
+
+/// A game's RGBA8 framebuffer of [`SIZE`] with the depth renderbuffer `depth` (`None`:
+/// none), bound.
+unsafe fn game_fbo(gl: &glow::Context, depth: Option<u32>) -> glow::Framebuffer {
+    let (w, h) = SIZE;
+    let colour = gl.create_renderbuffer().unwrap();
+    gl.bind_renderbuffer(glow::RENDERBUFFER, Some(colour));
+    gl.renderbuffer_storage(glow::RENDERBUFFER, glow::RGBA8, w, h);
+    let fbo = gl.create_framebuffer().unwrap();
+    gl.bind_framebuffer(glow::FRAMEBUFFER, Some(fbo));
+    gl.framebuffer_renderbuffer(
+        glow::FRAMEBUFFER,
+        glow::COLOR_ATTACHMENT0,
+        glow::RENDERBUFFER,
+        Some(colour),
+    );
+    if let Some(format) = depth {
+        let rb = gl.create_renderbuffer().unwrap();
+        gl.bind_renderbuffer(glow::RENDERBUFFER, Some(rb));
+        gl.renderbuffer_storage(glow::RENDERBUFFER, format, w, h);
+        gl.framebuffer_renderbuffer(
+            glow::FRAMEBUFFER,
+            glow::DEPTH_ATTACHMENT,
+            glow::RENDERBUFFER,
+            Some(rb),
+        );
+    }
+    assert_eq!(
+        gl.check_framebuffer_status(glow::FRAMEBUFFER),
+        glow::FRAMEBUFFER_COMPLETE
+    );
+    fbo
+}
+
+fn plane() -> manylight::Scene {
+    scene::builtin::build("plane", Some((8, 1))).unwrap()
+}
+
+fn render(
+    r: &mut Renderer,
+    options: &RenderOptions,
+) -> Result<manylight::FrameStats, manylight::Error> {
+    r.render(&plane(), SIZE.0 as u32, SIZE.1 as u32, options)
+}
+
+/// Without a depth buffer every method drew a wrong picture (17 003 of 36 864 pixels moved,
+/// returning `Ok`); now it is refused, unless the renderer's own MSAA target brings the
+/// depth. A 16-bit one draws, and is warned of once.
+#[test]
+fn a_framebuffer_without_depth_is_refused_and_a_shallow_one_warned_of() {
+    common::warnings::install();
+    for es in [EsVersion::Es3, EsVersion::Es2] {
+        let ctx = HeadlessContext::new(es).unwrap();
+        let gl = ctx.load_gl().unwrap();
+        let mut r = Renderer::new(ctx.load_gl().unwrap(), es).unwrap();
+        unsafe { game_fbo(&gl, None) };
+        let err = render(&mut r, &RenderOptions::default()).unwrap_err();
+        assert!(
+            matches!(err, manylight::Error::Gl(GlError::BoundFramebuffer(_))),
+            "{es}: {err}"
+        );
+        assert!(err.to_string().contains("no depth buffer"), "{es}: {err}");
+        if es == EsVersion::Es3 {
+            let msaa = RenderOptions {
+                samples: 4,
+                ..Default::default()
+            };
+            render(&mut r, &msaa).expect("MSAA brings its own depth");
+        }
+        let before = warnings_containing("depth buffer has 16 bits").len();
+        unsafe { game_fbo(&gl, Some(glow::DEPTH_COMPONENT16)) };
+        render(&mut r, &RenderOptions::default()).unwrap();
+        render(&mut r, &RenderOptions::default()).unwrap();
+        assert_eq!(
+            warnings_containing("depth buffer has 16 bits").len(),
+            before + 1,
+            "{es}: warned once"
+        );
+        if r.caps().depth24 {
+            unsafe { game_fbo(&gl, Some(glow::DEPTH_COMPONENT24)) };
+            render(&mut r, &RenderOptions::default()).unwrap();
+        }
+    }
+}
+
+/// An incomplete framebuffer (here one with no attachment) is refused by its status, where a
+/// debug build panicked on the GL error of the geometry pass.
+#[test]
+fn an_incomplete_framebuffer_is_refused_naming_its_status() {
+    let ctx = HeadlessContext::new(EsVersion::Es3).unwrap();
+    let gl = ctx.load_gl().unwrap();
+    let mut r = Renderer::new(ctx.load_gl().unwrap(), EsVersion::Es3).unwrap();
+    unsafe {
+        let fbo = gl.create_framebuffer().unwrap();
+        gl.bind_framebuffer(glow::FRAMEBUFFER, Some(fbo));
+    }
+    let err = render(&mut r, &RenderOptions::default()).unwrap_err();
+    let text = err.to_string();
+    assert!(
+        text.contains("incomplete")
+            && text.contains("GL_FRAMEBUFFER_INCOMPLETE_MISSING_ATTACHMENT"),
+        "{text}"
+    );
+    // The same renderer draws once the game binds a framebuffer that can take the frame.
+    unsafe { game_fbo(&gl, Some(glow::DEPTH_COMPONENT24)) };
+    render(&mut r, &RenderOptions::default()).unwrap();
+}
+
+/// A frame wider than `GL_MAX_VIEWPORT_DIMS` is refused naming the limit (GL clamped the
+/// viewport and the call returned `Ok`).
+#[test]
+fn a_frame_past_the_viewport_limit_is_refused() {
+    let ctx = HeadlessContext::new(EsVersion::Es3).unwrap();
+    let gl = ctx.load_gl().unwrap();
+    let mut r = Renderer::new(ctx.load_gl().unwrap(), EsVersion::Es3).unwrap();
+    let [max_w, _] = r.caps().max_viewport_dims;
+    assert!(max_w > 0, "GL_MAX_VIEWPORT_DIMS was not read");
+    unsafe { game_fbo(&gl, Some(glow::DEPTH_COMPONENT24)) };
+    let err = r
+        .render(&plane(), max_w as u32 + 1, 8, &RenderOptions::default())
+        .unwrap_err();
+    assert!(
+        matches!(err, manylight::Error::Limit(_))
+            && err.to_string().contains("GL_MAX_VIEWPORT_DIMS"),
+        "{err}"
+    );
+}
+
+/// A GL error the game left pending was the first check's error (`render_offscreen`: "after
+/// allocating a target"), and turned GPU timing off for good; it is now cleared at the call,
+/// with a warning.
+#[test]
+fn a_gl_error_the_game_left_pending_is_not_the_renderers() {
+    common::warnings::install();
+    let ctx = HeadlessContext::new(EsVersion::Es3).unwrap();
+    let gl = ctx.load_gl().unwrap();
+    let mut r = Renderer::new(ctx.load_gl().unwrap(), EsVersion::Es3).unwrap();
+    let game_bug = || unsafe { gl.enable(0x1234) };
+    game_bug();
+    r.render_offscreen(&plane(), 32, 18, &RenderOptions::default())
+        .expect("offscreen, with the game's error pending");
+    unsafe { game_fbo(&gl, Some(glow::DEPTH_COMPONENT24)) };
+    for _ in 0..2 {
+        game_bug();
+        let stats = render(&mut r, &RenderOptions::default()).expect("into the game's framebuffer");
+        if r.caps().timer_query {
+            assert!(stats.time.gpu_ms.is_some(), "GPU timing turned off");
+        }
+        assert_eq!(unsafe { gl.get_error() }, glow::NO_ERROR);
+    }
+    assert!(
+        !warnings_containing("was pending when the renderer was called").is_empty(),
+        "the cleared error is said"
+    );
+    assert!(warnings_containing("GPU timing off").is_empty());
+}
+
+/// `abandon` (the context is lost) and a drop with no context current leave the renderer's
+/// objects with one warning at most, where each object used to add its own "leaked".
+#[test]
+fn a_renderer_left_behind_says_so_once() {
+    common::warnings::install();
+    let ctx = HeadlessContext::new(EsVersion::Es3).unwrap();
+    let mut r = Renderer::new(ctx.load_gl().unwrap(), EsVersion::Es3).unwrap();
+    r.render_offscreen(&plane(), 32, 18, &RenderOptions::default())
+        .unwrap();
+    r.abandon();
+    let mut r = Renderer::new(ctx.load_gl().unwrap(), EsVersion::Es3).unwrap();
+    r.render_offscreen(&plane(), 32, 18, &RenderOptions::default())
+        .unwrap();
+    ctx.release_current().unwrap();
+    drop(r);
+    assert_eq!(
+        warnings_containing("the renderer's GL objects are not freed").len(),
+        1
+    );
+    let leaked = warnings_containing("dropped without destroy()");
+    assert!(leaked.is_empty(), "{leaked:?}");
+}
