@@ -100,6 +100,21 @@ pub fn bytes_read() -> u64 {
 
 /// Reads a whole file of `kind`, refusing anything but a regular file within the limit.
 pub fn read_bounded(path: &Path, kind: FileKind) -> Result<Vec<u8>, SceneError> {
+    read_limited(path, kind, None)
+}
+
+/// Reads at most the first `wanted` bytes of a file of `kind` (a glTF buffer: its
+/// `byteLength`, however large the file is), refusing anything but a regular file; `wanted`
+/// above the kind's limit is refused.
+pub fn read_bounded_prefix(
+    path: &Path,
+    kind: FileKind,
+    wanted: u64,
+) -> Result<Vec<u8>, SceneError> {
+    read_limited(path, kind, Some(wanted))
+}
+
+fn read_limited(path: &Path, kind: FileKind, prefix: Option<u64>) -> Result<Vec<u8>, SceneError> {
     let io = |source| SceneError::Io {
         path: path.to_path_buf(),
         source,
@@ -128,14 +143,15 @@ pub fn read_bounded(path: &Path, kind: FileKind) -> Result<Vec<u8>, SceneError> 
             ),
         )
     };
-    if meta.len() > limit {
-        return Err(too_big(meta.len()));
+    // The whole file, or the part wanted of it, is what must be within the limit.
+    let size = prefix.map_or(meta.len(), |p| p.min(meta.len()));
+    if size > limit {
+        return Err(too_big(size));
     }
     let file = std::fs::File::open(path).map_err(io)?;
-    let mut bytes = Vec::with_capacity(meta.len() as usize);
-    file.take(limit.saturating_add(1))
-        .read_to_end(&mut bytes)
-        .map_err(io)?;
+    let mut bytes = Vec::with_capacity(size as usize);
+    let most = prefix.map_or(limit.saturating_add(1), |p| p.min(limit.saturating_add(1)));
+    file.take(most).read_to_end(&mut bytes).map_err(io)?;
     BYTES_READ.with(|read| read.set(read.get().saturating_add(bytes.len() as u64)));
     if bytes.len() as u64 > limit {
         return Err(too_big(bytes.len() as u64));

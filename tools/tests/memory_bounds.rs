@@ -332,3 +332,202 @@ fn meshes_and_textures_the_game_dropped_are_freed() {
         );
     }
 }
+
+/// A sparse file of `len` bytes starting with `head` (no disk space for the rest).
+fn sparse_file(path: &Path, head: &[u8], len: u64) {
+    std::fs::write(path, head).unwrap();
+    std::fs::OpenOptions::new()
+        .write(true)
+        .open(path)
+        .unwrap()
+        .set_len(len)
+        .unwrap();
+}
+
+const MIB: u64 = 1 << 20;
+
+/// 20 buffers naming one 64 MiB file, each for its first few bytes: each read its whole file
+/// (20 × 64 MiB, where the budget was charged 20 × 110 bytes; 3.15 GB of memory with a 256 MiB
+/// file). A buffer now reads its own `byteLength` bytes.
+#[test]
+fn gltf_buffers_naming_one_large_file_read_only_their_own_bytes() {
+    use common::gltf::Builder;
+    let dir = tempfile::tempdir().unwrap();
+    let mut b = Builder::default();
+    let triangle = common::gltf_models::triangle(&mut b);
+    sparse_file(&dir.path().join("big.bin"), &b.bin, 64 * MIB);
+    let n = 20;
+    let mut doc = b.document(triangle, Some("big.bin".into()));
+    let buffer = doc["buffers"][0].clone();
+    let (views, accessors) = (doc["bufferViews"].clone(), doc["accessors"].clone());
+    let (mut all_views, mut all_accessors, mut meshes, mut nodes) =
+        (vec![], vec![], vec![], vec![]);
+    for i in 0..n {
+        let first_view = all_views.len();
+        for v in views.as_array().unwrap() {
+            let mut v = v.clone();
+            v["buffer"] = serde_json::json!(i);
+            all_views.push(v);
+        }
+        let first_accessor = all_accessors.len();
+        for a in accessors.as_array().unwrap() {
+            let mut a = a.clone();
+            a["bufferView"] =
+                serde_json::json!(first_view + a["bufferView"].as_u64().unwrap() as usize);
+            all_accessors.push(a);
+        }
+        let mut mesh = doc["meshes"][0].clone();
+        let prim = &mut mesh["primitives"][0];
+        prim["attributes"]["POSITION"] = serde_json::json!(first_accessor);
+        prim["indices"] = serde_json::json!(first_accessor + 1);
+        meshes.push(mesh);
+        nodes.push(serde_json::json!({"mesh": i}));
+    }
+    doc["buffers"] = serde_json::json!(vec![buffer; n]);
+    doc["bufferViews"] = serde_json::json!(all_views);
+    doc["accessors"] = serde_json::json!(all_accessors);
+    doc["meshes"] = serde_json::json!(meshes);
+    doc["nodes"] = serde_json::json!(nodes);
+    doc["scenes"] = serde_json::json!([{"nodes": (0..n).collect::<Vec<_>>()}]);
+    let path = common::files::write(dir.path(), "m.gltf", doc.to_string());
+    let before = scene::input::bytes_read();
+    let (loaded, _) = common::files::load(&path).unwrap();
+    let read = scene::input::bytes_read() - before;
+    assert_eq!(loaded.objects.len(), n);
+    let own = (n * b.bin.len()) as u64 + doc.to_string().len() as u64;
+    assert!(
+        read <= own,
+        "read {read} bytes for {own} bytes of buffers and JSON"
+    );
+}
+
+/// 30 images naming one file of 16 MiB (a PNG followed by zeros) were each read and decoded
+/// (400 such took over a minute): the file is now read once and its texture shared.
+#[test]
+fn gltf_images_naming_one_file_read_and_decode_it_once() {
+    use common::gltf::Builder;
+    let dir = tempfile::tempdir().unwrap();
+    sparse_file(
+        &dir.path().join("big.png"),
+        &common::gltf_models::checker_png(),
+        16 * MIB,
+    );
+    let n = 30;
+    let mut b = Builder::default();
+    let quad = common::gltf_models::floor();
+    let meshes: Vec<_> = (0..n)
+        .map(|i| serde_json::json!({"primitives": [common::gltf_models::primitive(&mut b, &quad, Some(i))]}))
+        .collect();
+    let doc = serde_json::json!({
+        "scenes": [{"nodes": (0..n).collect::<Vec<_>>()}],
+        "nodes": (0..n).map(|i| serde_json::json!({"mesh": i})).collect::<Vec<_>>(),
+        "meshes": meshes,
+        "materials": (0..n).map(|i| serde_json::json!(
+            {"pbrMetallicRoughness": {"baseColorTexture": {"index": i}}})).collect::<Vec<_>>(),
+        "textures": (0..n).map(|i| serde_json::json!({"source": i})).collect::<Vec<_>>(),
+        "images": vec![serde_json::json!({"uri": "big.png"}); n],
+    });
+    let path = common::files::write(dir.path(), "m.gltf", b.gltf(doc));
+    let before = scene::input::bytes_read();
+    let (loaded, report) = common::files::load(&path).unwrap();
+    let read = scene::input::bytes_read() - before;
+    assert!(read < 2 * 16 * MIB, "read {} MiB", read / MIB);
+    let textures: HashSet<*const manylight::scene::Texture> = loaded
+        .materials
+        .iter()
+        .map(|m| Arc::as_ptr(m.diffuse_texture.as_ref().expect("textured")))
+        .collect();
+    assert_eq!(textures.len(), 1, "{:?}", report.warnings);
+}
+
+/// Images in distinct files share one budget for what they read: five files of 250 MiB (each
+/// within the texture limit) pass a model's 1 GiB, and the last gets its flat colour with a
+/// warning instead of being read.
+#[test]
+fn gltf_images_together_read_at_most_a_models_limit() {
+    use common::gltf::Builder;
+    let dir = tempfile::tempdir().unwrap();
+    let n = 5;
+    for i in 0..n {
+        sparse_file(
+            &dir.path().join(format!("big{i}.png")),
+            &common::gltf_models::checker_png(),
+            250 * MIB,
+        );
+    }
+    let mut b = Builder::default();
+    let quad = common::gltf_models::floor();
+    let meshes: Vec<_> = (0..n)
+        .map(|i| serde_json::json!({"primitives": [common::gltf_models::primitive(&mut b, &quad, Some(i))]}))
+        .collect();
+    let doc = serde_json::json!({
+        "scenes": [{"nodes": (0..n).collect::<Vec<_>>()}],
+        "nodes": (0..n).map(|i| serde_json::json!({"mesh": i})).collect::<Vec<_>>(),
+        "meshes": meshes,
+        "materials": (0..n).map(|i| serde_json::json!(
+            {"pbrMetallicRoughness": {"baseColorTexture": {"index": i}}})).collect::<Vec<_>>(),
+        "textures": (0..n).map(|i| serde_json::json!({"source": i})).collect::<Vec<_>>(),
+        "images": (0..n).map(|i| serde_json::json!({"uri": format!("big{i}.png")})).collect::<Vec<_>>(),
+    });
+    let path = common::files::write(dir.path(), "m.gltf", b.gltf(doc));
+    let before = scene::input::bytes_read();
+    let (loaded, report) = common::files::load(&path).unwrap();
+    let read = scene::input::bytes_read() - before;
+    assert!(read <= 1024 * MIB, "read {} MiB", read / MIB);
+    let textured = loaded
+        .materials
+        .iter()
+        .filter(|m| m.diffuse_texture.is_some())
+        .count();
+    assert_eq!(textured, 4);
+    assert!(
+        report
+            .warnings
+            .iter()
+            .any(|w| w.contains("big4.png") && w.contains("images together")),
+        "{:?}",
+        report.warnings
+    );
+}
+
+/// A scene's root list naming one node 4 million times (an 8 MB file) was stacked whole, 144
+/// bytes an entry, before the repeat was found: gigabytes from megabytes (8.1 GB at 100 MB).
+/// Under a 384 MiB address-space limit (the old walk needed 576 MiB here) the load must
+/// still end in its error, not an abort.
+#[test]
+fn a_root_list_repeating_one_node_is_refused_within_bounded_memory() {
+    let Ok(prlimit) = which_prlimit() else {
+        common::skip("no prlimit (util-linux) to bound the child's memory");
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let mut b = common::gltf::Builder::default();
+    let mut doc = common::gltf_models::triangle(&mut b);
+    let repeats = 4_000_000;
+    doc["scenes"] = serde_json::json!([{"nodes": vec![0; repeats]}]);
+    let path = common::files::write(dir.path(), "m.gltf", b.gltf(doc));
+    let out = std::process::Command::new(prlimit)
+        .arg("--as=402653184")
+        .arg(env!("CARGO_BIN_EXE_manylight"))
+        // What the address space holds besides the load, the same on any machine: one
+        // worker thread, one malloc arena.
+        .env("RAYON_NUM_THREADS", "1")
+        .env("MALLOC_ARENA_MAX", "1")
+        .args(["render", "--size", "8x8", "--scene"])
+        .arg(&path)
+        .arg("--out")
+        .arg(dir.path().join("x.png"))
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("nodes[0] is reached from both"), "{stderr}");
+}
+
+fn which_prlimit() -> Result<std::path::PathBuf, ()> {
+    ["/usr/bin/prlimit", "/bin/prlimit"]
+        .iter()
+        .map(std::path::PathBuf::from)
+        .find(|p| p.is_file())
+        .ok_or(())
+}

@@ -1,9 +1,10 @@
 //! The bytes of a glTF file's buffers: the GLB's BIN chunk, `data:` URIs and files next to the
 //! `.gltf`, each read once, when first used, within the model size limit.
 //!
-//! Files are read through [`read_bounded`] (regular files only, [`FileKind::GltfBuffer`]'s
-//! limit), and all buffers together may hold at most that same limit: a file cannot name the
-//! same 1 GiB file a thousand times. A file URI may name only a file inside the glTF file's
+//! Files are read through [`read_bounded_prefix`] (regular files only, the buffer's own
+//! `byteLength` bytes, [`FileKind::GltfBuffer`]'s limit), and all buffers together may hold
+//! at most that same limit: a file cannot name the same 1 GiB file a thousand times, nor a
+//! few bytes of it a thousand times over. A file URI may name only a file inside the glTF file's
 //! folder unless the load allows outside files ([`crate::scene::access`]).
 
 use std::borrow::Cow;
@@ -11,7 +12,7 @@ use std::path::{Path, PathBuf};
 
 use super::uri::{self, Uri};
 use crate::scene::access;
-use crate::scene::input::{read_bounded, FileKind};
+use crate::scene::input::{read_bounded_prefix, FileKind};
 
 /// Lazily loaded buffer contents of one glTF document.
 pub(super) struct Buffers<'a> {
@@ -133,7 +134,9 @@ impl<'a> Buffers<'a> {
                     }
                     Uri::File(name) => {
                         let path = self.file(&format!("{field}.uri"), &name)?;
-                        let bytes = read_bounded(&path, FileKind::GltfBuffer)
+                        // Only the buffer's own bytes: a file named by many buffers is
+                        // read as often, each time no more than the budget was charged.
+                        let bytes = read_bounded_prefix(&path, FileKind::GltfBuffer, length as u64)
                             .map_err(|e| format!("{field}: {e}"))?;
                         if bytes.len() < length {
                             return Err(too_short(path.display().to_string(), bytes.len()));

@@ -129,29 +129,34 @@ pub(super) fn walk(
 ) -> Result<Vec<Placed>, String> {
     let count = locals.len();
     // Who reached each node first (`usize::MAX`: a root), to tell a cycle from two parents.
+    // Set when a node is put on the stack, so the stack holds each node once: a list naming
+    // one node millions of times is refused at its second mention, not stacked whole.
     let mut parent: Vec<Option<usize>> = vec![None; count];
-    let mut placed = Vec::new();
-    let mut stack: Vec<(usize, usize, DMat4)> = Vec::new();
-    for &r in roots.iter().rev() {
-        stack.push((r, usize::MAX, root));
-    }
-    while let Some((node, from, parent_world)) = stack.pop() {
-        let local = locals
-            .get(node)
-            .ok_or_else(|| format!("nodes[{node}] does not exist ({count} nodes)"))?;
-        if let Some(first) = parent[node] {
-            return Err(reached_twice(node, first, from, &parent));
+    let reach = |node: usize, from: usize, parent: &mut Vec<Option<usize>>| match parent.get(node) {
+        None => Err(format!("nodes[{node}] does not exist ({count} nodes)")),
+        Some(Some(first)) => Err(reached_twice(node, *first, from, parent)),
+        Some(None) => {
+            parent[node] = Some(from);
+            Ok(())
         }
-        parent[node] = Some(from);
-        let world = parent_world * *local;
+    };
+    let mut placed = Vec::new();
+    let mut stack: Vec<(usize, DMat4)> = Vec::new();
+    for &r in roots.iter() {
+        reach(r, usize::MAX, &mut parent)?;
+    }
+    stack.extend(roots.iter().rev().map(|&r| (r, root)));
+    while let Some((node, parent_world)) = stack.pop() {
+        let world = parent_world * locals[node];
         placed.push(Placed { node, world });
         let Some(n) = document.nodes().nth(node) else {
             continue;
         };
         let children: Vec<usize> = n.children().map(|c| c.index()).collect();
-        for &c in children.iter().rev() {
-            stack.push((c, node, world));
+        for &c in &children {
+            reach(c, node, &mut parent)?;
         }
+        stack.extend(children.iter().rev().map(|&c| (c, world)));
     }
     Ok(placed)
 }

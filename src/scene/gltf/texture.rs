@@ -6,7 +6,7 @@
 //! load allows it ([`crate::scene::access`]).
 
 use std::collections::HashMap;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use super::buffers::Buffers;
@@ -17,18 +17,25 @@ use crate::scene::texture_budget::{self, decode_texture_bytes, TextureBudget};
 use crate::scene::Texture;
 use crate::scene::{access, shown};
 
-/// Decoded images of one glTF file, by image index (`None`: failed, warned once), and what is
-/// left of the scene's texture budget.
+/// Decoded images of one glTF file, by image index and by where their bytes lie (`None`:
+/// failed, warned once), and what is left of the scene's texture budget and of the bytes
+/// the images may read.
 pub(super) struct Textures {
     loaded: HashMap<usize, Option<Arc<Texture>>>,
+    by_source: HashMap<Source, Option<Arc<Texture>>>,
+    /// Encoded bytes the model's images may still read from files or decode from buffer
+    /// views, all together: the limit on a model's buffers. Without it, 400 images naming one
+    /// 256 MiB file (or 400 views of one large buffer) took minutes.
+    encoded_left: u64,
     pub budget: TextureBudget,
 }
 
-/// Where an image's encoded bytes came from, for names and messages.
-struct Encoded {
-    bytes: Vec<u8>,
-    name: String,
-    format: Option<image::ImageFormat>,
+/// Where an image's encoded bytes lie, when images can share them: a file or a buffer view
+/// named by many images is read and decoded once.
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
+enum Source {
+    View(usize),
+    File(PathBuf),
 }
 
 impl Textures {
@@ -36,6 +43,8 @@ impl Textures {
     pub fn new(budget: TextureBudget) -> Textures {
         Textures {
             loaded: HashMap::new(),
+            by_source: HashMap::new(),
+            encoded_left: FileKind::GltfBuffer.limit(),
             budget,
         }
     }
@@ -53,29 +62,126 @@ impl Textures {
             return Ok(t.clone());
         }
         let field = format!("images[{}]", image.index());
-        let texture = match encoded(image, buffers, gltf_path, &field)? {
-            Ok(enc) => match decode_texture_bytes(&enc.bytes, enc.format, &mut self.budget) {
-                Ok(img) => {
-                    drop(enc.bytes);
-                    let (image, scaled) = texture_budget::to_rgba8(img, &enc.name);
-                    warnings.extend(scaled);
-                    Some(Arc::new(Texture {
-                        name: enc.name,
-                        image,
-                    }))
-                }
-                Err(why) => {
-                    warnings.push(format!("texture {} {why}; using the flat colour", enc.name));
-                    None
-                }
-            },
+        let texture = match locate(image, buffers, gltf_path, &field)? {
             Err(warning) => {
                 warnings.push(warning);
                 None
             }
+            Ok(located) => {
+                let source = located.source();
+                match source.as_ref().and_then(|s| self.by_source.get(s)) {
+                    Some(shared) => shared.clone(),
+                    None => {
+                        let texture = self.decode(located, buffers, &field, warnings)?;
+                        if let Some(source) = source {
+                            self.by_source.insert(source, texture.clone());
+                        }
+                        texture
+                    }
+                }
+            }
         };
         self.loaded.insert(image.index(), texture.clone());
         Ok(texture)
+    }
+
+    /// Reads and decodes a located image within the limits; a problem is a warning (`None`).
+    fn decode(
+        &mut self,
+        located: Located,
+        buffers: &mut Buffers,
+        field: &str,
+        warnings: &mut Vec<String>,
+    ) -> Result<Option<Arc<Texture>>, String> {
+        let limit = FileKind::Texture.limit();
+        let size = match &located.bytes {
+            Bytes::View(view) => view.length() as u64,
+            Bytes::Data(bytes) => bytes.len() as u64,
+            // Refused unread when the file alone would pass the limits.
+            Bytes::File(path) => std::fs::metadata(path).map_or(0, |m| m.len()),
+        };
+        let refusal = if size > limit {
+            Some(format!(
+                "texture {} of {size} bytes exceeds the limit of {limit} bytes (set \
+                 {LIMIT_VARIABLE} to raise it); using the flat colour",
+                located.name
+            ))
+        } else if size > self.encoded_left {
+            Some(format!(
+                "texture {}: the model's images together pass the limit of {} bytes on what \
+                 they may read (set {LIMIT_VARIABLE} to raise it); using the flat colour",
+                located.name,
+                FileKind::GltfBuffer.limit()
+            ))
+        } else {
+            None
+        };
+        if let Some(refusal) = refusal {
+            warnings.push(refusal);
+            return Ok(None);
+        }
+        let file_bytes;
+        let bytes: &[u8] = match &located.bytes {
+            Bytes::View(view) => buffers.view(view).map_err(|e| format!("{field}: {e}"))?,
+            Bytes::Data(bytes) => bytes,
+            Bytes::File(path) => match read_bounded(path, FileKind::Texture) {
+                Ok(bytes) => {
+                    file_bytes = bytes;
+                    &file_bytes
+                }
+                Err(e) => {
+                    warnings.push(format!(
+                        "texture {} could not be decoded ({e}); using the flat colour",
+                        path.display()
+                    ));
+                    return Ok(None);
+                }
+            },
+        };
+        self.encoded_left = self.encoded_left.saturating_sub(bytes.len() as u64);
+        Ok(
+            match decode_texture_bytes(bytes, located.format, &mut self.budget) {
+                Ok(img) => {
+                    let (image, scaled) = texture_budget::to_rgba8(img, &located.name);
+                    warnings.extend(scaled);
+                    Some(Arc::new(Texture {
+                        name: located.name,
+                        image,
+                    }))
+                }
+                Err(why) => {
+                    warnings.push(format!(
+                        "texture {} {why}; using the flat colour",
+                        located.name
+                    ));
+                    None
+                }
+            },
+        )
+    }
+}
+
+/// Where an image's encoded bytes are, not yet read: its name for messages and its format.
+struct Located<'d> {
+    bytes: Bytes<'d>,
+    name: String,
+    format: Option<image::ImageFormat>,
+}
+
+enum Bytes<'d> {
+    View(gltf::buffer::View<'d>),
+    Data(Vec<u8>),
+    File(PathBuf),
+}
+
+impl Located<'_> {
+    /// What other images may share (a `data:` URI belongs to its image alone).
+    fn source(&self) -> Option<Source> {
+        match &self.bytes {
+            Bytes::View(view) => Some(Source::View(view.index())),
+            Bytes::Data(_) => None,
+            Bytes::File(path) => Some(Source::File(path.clone())),
+        }
     }
 }
 
@@ -83,21 +189,15 @@ fn format_of(media_type: &str) -> Option<image::ImageFormat> {
     image::ImageFormat::from_mime_type(media_type)
 }
 
-/// The image's encoded bytes (outer `Err`: a malformed file; inner `Err`: a warning).
-fn encoded(
+/// Where the image's encoded bytes are (outer `Err`: a malformed file; inner `Err`: a
+/// warning).
+fn locate<'d>(
     image: &gltf::Image,
-    buffers: &mut Buffers,
+    buffers: &Buffers<'d>,
     gltf_path: &Path,
     field: &str,
-) -> Result<Result<Encoded, String>, String> {
-    let limit = FileKind::Texture.limit();
+) -> Result<Result<Located<'d>, String>, String> {
     let embedded_name = format!("{}#{field}", gltf_path.display());
-    let too_big = |n: usize| {
-        format!(
-            "texture {embedded_name} of {n} bytes exceeds the limit of {limit} bytes (set \
-             {LIMIT_VARIABLE} to raise it); using the flat colour"
-        )
-    };
     // From the JSON rather than `image.source()`, which assumes a `uri` where there is no
     // `bufferView` and a `mimeType` where there is one.
     let Some(json) = buffers.document().as_json().images.get(image.index()) else {
@@ -113,12 +213,8 @@ fn encoded(
                 view_index.value()
             ));
         };
-        let bytes = buffers.view(&view).map_err(|e| format!("{field}: {e}"))?;
-        if bytes.len() as u64 > limit {
-            return Ok(Err(too_big(bytes.len())));
-        }
-        return Ok(Ok(Encoded {
-            bytes: bytes.to_vec(),
+        return Ok(Ok(Located {
+            bytes: Bytes::View(view),
             name: embedded_name,
             format: mime_type.as_deref().and_then(format_of),
         }));
@@ -130,16 +226,11 @@ fn encoded(
     };
     match uri::parse(text) {
         Err(e) => Ok(Err(format!("{field}.uri: {e}; using the flat colour"))),
-        Ok(Uri::Data { media_type, bytes }) => {
-            if bytes.len() as u64 > limit {
-                return Ok(Err(too_big(bytes.len())));
-            }
-            Ok(Ok(Encoded {
-                bytes,
-                name: embedded_name,
-                format: format_of(mime_type.as_deref().unwrap_or(&media_type)),
-            }))
-        }
+        Ok(Uri::Data { media_type, bytes }) => Ok(Ok(Located {
+            bytes: Bytes::Data(bytes),
+            name: embedded_name,
+            format: format_of(mime_type.as_deref().unwrap_or(&media_type)),
+        })),
         Ok(Uri::File(name)) => {
             let (base_dir, allow_outside) = buffers.base_dir();
             let uri_field = format!("{field}.uri");
@@ -181,17 +272,11 @@ fn encoded(
                 .as_deref()
                 .and_then(format_of)
                 .or_else(|| image::ImageFormat::from_path(&path).ok());
-            match read_bounded(&path, FileKind::Texture) {
-                Ok(bytes) => Ok(Ok(Encoded {
-                    bytes,
-                    name: path.display().to_string(),
-                    format,
-                })),
-                Err(e) => Ok(Err(format!(
-                    "texture {} could not be decoded ({e}); using the flat colour",
-                    path.display()
-                ))),
-            }
+            Ok(Ok(Located {
+                name: path.display().to_string(),
+                bytes: Bytes::File(path),
+                format,
+            }))
         }
     }
 }
