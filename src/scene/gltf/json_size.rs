@@ -1,29 +1,45 @@
 //! A bound on what parsing a glTF file's JSON builds. The loader parses it several times (the
 //! crate's typed document, the node transforms in `f64`, the integers' widths, the materials'
 //! texture slots), and each object or array becomes a struct or a collection of its own,
-//! hundreds of bytes for the few an empty node `{}` takes in the file. The objects and arrays
-//! are counted first, in one pass over the bytes, before anything is built.
+//! hundreds of bytes for the few an empty node `{}` takes in the file; and each element of an
+//! array the crate keeps as JSON (an accessor's `min`, `extensionsUsed`) some 35 bytes for the
+//! two of `0,`. The objects and arrays, and the elements and members, are counted first, in
+//! one pass over the bytes, before anything is built.
 
 /// Most JSON objects and arrays a glTF file's JSON may hold: four for each of the 2²⁰
 /// primitives a file may place (a node with a translation, a rotation, a scale and children
 /// is five; a primitive, its attributes and its accessors' bounds a few more).
 pub const MAX_JSON_CONTAINERS: usize = 1 << 22;
 
-/// Refuses JSON holding more than [`MAX_JSON_CONTAINERS`] objects and arrays. Brackets inside
-/// strings do not count; what is not valid JSON is left for the parser to name.
+/// Most array elements and object members a glTF file's JSON may hold (counted by the commas
+/// between them): a node with a matrix is some 20, so 2²⁰ such nodes and their accessors fit,
+/// while a 100 MB accessor `min` of 50 million zeros (1.75 GB parsed) does not.
+pub const MAX_JSON_ELEMENTS: usize = 1 << 25;
+
+/// Refuses JSON holding more than [`MAX_JSON_CONTAINERS`] objects and arrays or more than
+/// [`MAX_JSON_ELEMENTS`] elements and members. Brackets and commas inside strings do not
+/// count; what is not valid JSON is left for the parser to name.
 pub(super) fn check(json: &[u8]) -> Result<(), String> {
-    let containers = count_containers(json);
+    let (containers, separators) = count_containers(json);
     if containers > MAX_JSON_CONTAINERS {
         return Err(format!(
             "its JSON holds {containers} objects and arrays, more than the \
              {MAX_JSON_CONTAINERS} a glTF file may (refused before parsing)"
         ));
     }
+    let elements = separators.saturating_add(containers);
+    if elements > MAX_JSON_ELEMENTS {
+        return Err(format!(
+            "its JSON holds about {elements} array elements and object members, more than \
+             the {MAX_JSON_ELEMENTS} a glTF file may (refused before parsing)"
+        ));
+    }
     Ok(())
 }
 
-/// The `{` and `[` outside strings.
-fn count_containers(json: &[u8]) -> usize {
+/// The `{` and `[`, and the `,`, outside strings.
+fn count_containers(json: &[u8]) -> (usize, usize) {
+    let mut commas = 0;
     let (mut count, mut in_string, mut escaped) = (0, false, false);
     for &b in json {
         if in_string {
@@ -38,9 +54,11 @@ fn count_containers(json: &[u8]) -> usize {
             in_string = true;
         } else if b == b'{' || b == b'[' {
             count += 1;
+        } else if b == b',' {
+            commas += 1;
         }
     }
-    count
+    (count, commas)
 }
 
 #[cfg(test)]
@@ -49,10 +67,19 @@ mod tests {
 
     #[test]
     fn objects_and_arrays_are_counted_outside_strings() {
-        assert_eq!(count_containers(br#"{"a": [1, {"b": []}]}"#), 4);
-        // Brackets in strings, escaped quotes and escaped backslashes.
-        assert_eq!(count_containers(br#"{"n": "{[\"[{\\", "m": [}"#), 2);
-        assert_eq!(count_containers(b""), 0);
+        assert_eq!(count_containers(br#"{"a": [1, {"b": []}]}"#), (4, 1));
+        // Brackets and commas in strings, escaped quotes and escaped backslashes.
+        assert_eq!(count_containers(br#"{"n": "{[\",[{\\", "m": [}"#), (2, 1));
+        assert_eq!(count_containers(b""), (0, 0));
+    }
+
+    #[test]
+    fn a_long_flat_array_is_refused_before_parsing() {
+        let at_limit = format!("[{}]", vec!["0"; MAX_JSON_ELEMENTS - 1].join(","));
+        assert_eq!(check(at_limit.as_bytes()), Ok(()));
+        let past = format!("[{}]", vec!["0"; MAX_JSON_ELEMENTS + 1].join(","));
+        let refusal = check(past.as_bytes()).unwrap_err();
+        assert!(refusal.contains("array elements"), "{refusal}");
     }
 
     #[test]
