@@ -58,6 +58,28 @@ fn a_light_whose_radius_dwarfs_the_scene_lights_it_as_a_large_one_does() {
     }
 }
 
+/// Radiance past 2¹²⁶ on a device without fragment highp: its fp16 form divided by k² = 2¹²⁸,
+/// which is past `f32`, and the light uploaded as black (an ambient-only frame, no warning).
+/// A light that bright saturates the plane under it, as it does with highp.
+#[test]
+fn a_light_brighter_than_2_to_the_126_still_lights_without_fragment_highp() {
+    let restrictions = manylight::gl::Restrictions {
+        no_fragment_highp: true,
+    };
+    let mut gpu = Gpu::restricted(EsVersion::Es2, &restrictions);
+    let opts = RenderOptions::default();
+    let ambient = mean(&gpu.render(&plane(vec![]), 64, 36, &opts));
+    for intensity in [5e37f32, 1e38, 3e38] {
+        let mut light = point(10.0);
+        light.intensity = intensity;
+        let lit = mean(&gpu.render(&plane(vec![light]), 64, 36, &opts));
+        assert!(
+            lit > ambient + 100.0,
+            "intensity {intensity:e}: mean {lit:.1}, ambient alone {ambient:.1}"
+        );
+    }
+}
+
 #[test]
 fn a_far_plane_near_the_top_of_f64_renders_as_an_infinite_one() {
     let mut gpu = Gpu::new(EsVersion::Es3);

@@ -260,7 +260,8 @@ pub fn fp16_radiance(c: Vec3) -> (Vec3, f32) {
         0
     };
     let k = 2f32.powi(e);
-    (c / (k * k), k)
+    // Divided twice: k² itself is past f32 above 2¹²⁶ (k = 2⁶⁴), and c / ∞ was a black light.
+    (c / k / k, k)
 }
 
 fn unorm16(x: f32) -> u16 {
@@ -354,6 +355,9 @@ mod tests {
             (1.01, 2.0),
             (4.0, 2.0),
             (1e6, 1024.0),
+            // k² is past f32 here: the radiance must still come out, not as 0.
+            (1e38, 2f32.powi(64)),
+            (f32::MAX, 2f32.powi(64)),
         ] {
             let (scaled, root) = fp16_radiance(Vec3::splat(c));
             assert_eq!(root, k, "radiance {c}");
