@@ -39,6 +39,10 @@ pub(super) fn check_obj(text: &str) -> Result<(), String> {
             defined[kind] += 1;
             continue;
         }
+        // tobj's "material parse error", without a line (and not about an MTL file).
+        if key == Some("usemtl") && words.clone().next().is_none() {
+            return Err(at_line("`usemtl` names no material".to_string()));
+        }
         let Some(key @ ("f" | "l")) = key else {
             continue;
         };
@@ -47,7 +51,16 @@ pub(super) fn check_obj(text: &str) -> Result<(), String> {
             return Err(at_line(format!("`{key}` names no vertices")));
         }
         for (at, word) in words.enumerate() {
-            for (kind, part) in word.split('/').enumerate().take(3) {
+            // tobj's "face parse error", without a line (it reads `1/2/3/` as `1/2/3`).
+            let parts = word.split('/').count();
+            if word.split('/').skip(3).any(|p| !p.is_empty()) {
+                return Err(at_line(format!(
+                    "`{key}` corner {} has {parts} indices; a corner is v, v/vt, v//vn or \
+                     v/vt/vn",
+                    at + 1
+                )));
+            }
+            for (kind, part) in word.split('/').enumerate() {
                 if kind > 0 && part.is_empty() {
                     continue;
                 }
@@ -161,6 +174,11 @@ mod tests {
             ("vt 0.5\n", "line 1: `vt` needs 2 numbers, found 1"),
             ("v 0 0 0\nf\n", "line 2: `f` names no vertices"),
             ("v 0 0 0\nl \n", "line 2: `l` names no vertices"),
+            ("v 0 0 0\nusemtl\nf 1 1 1\n", "line 2: `usemtl` names no material"),
+            (
+                "v 0 0 0\nvt 0 0\nvn 0 0 1\nf 1/1/1/1 1 1\n",
+                "line 4: `f` corner 1 has 4 indices",
+            ),
         ];
         for (text, expected) in cases {
             let err = check_obj(text).expect_err(text);
@@ -175,6 +193,7 @@ mod tests {
             "v 0 0 0 1 0.5 0\n",
             "vn 0 0 1 extra\n",
             "vt 0 1 0\n",
+            "v 0 0 0\nvt 0 0\nvn 0 0 1\nf 1/1/1/ 1 1\n",
         ] {
             assert_eq!(check_obj(text), Ok(()), "{text:?}");
         }
