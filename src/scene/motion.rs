@@ -376,7 +376,7 @@ fn check_axis(axis: DVec3, field: &str, name: &str) -> Result<(), SceneError> {
     } else {
         Err(SceneError::invalid(
             format!("{field}.{name}"),
-            format!("must be finite and non-zero, got {axis:?}"),
+            format!("must be finite and longer than 1e-12 (a direction), got {axis:?}"),
         ))
     }
 }
