@@ -180,6 +180,18 @@ impl Caps {
         })
     }
 
+    /// Whether the context itself is ES 3.0 or later (or desktop core), whatever feature level
+    /// the renderer restricts itself to: its state (samplers, pixel buffers, separate read and
+    /// draw framebuffers, ES 3.0 pixel-store settings) exists, a game may have set it, and an
+    /// ES 2.0-level renderer's calls must neither depend on it nor change it.
+    pub fn context_has_es3_state(&self) -> bool {
+        let major = self.context_version.split('.').next();
+        self.desktop
+            || major
+                .and_then(|m| m.parse::<u32>().ok())
+                .is_some_and(|m| m >= 3)
+    }
+
     /// True when the extension is present.
     pub fn has_extension(&self, name: &str) -> bool {
         self.extensions.contains(name)

@@ -153,7 +153,7 @@ impl Device {
             self.clear_pending_errors();
             super::host_state::HostState::enter(
                 &self.gl,
-                self.caps.es,
+                self.caps.context_has_es3_state(),
                 self.vertex_array,
                 self.attrib_pointer_fns,
             )
@@ -171,14 +171,9 @@ impl Device {
     /// Drains the GL errors pending when a call starts, saying so once: otherwise the first
     /// check of the call would report the application's error as the renderer's.
     fn clear_pending_errors(&self) {
-        let first = unsafe { self.gl.get_error() };
+        let first = self.drain_errors();
         if first == glow::NO_ERROR {
             return;
-        }
-        for _ in 0..16 {
-            if unsafe { self.gl.get_error() } == glow::NO_ERROR {
-                break;
-            }
         }
         let message = format!(
             "{} (0x{first:04x}) was pending when the renderer was called: the application's, \
@@ -318,11 +313,27 @@ impl Device {
                 }
             }
         };
-        let refused = unsafe { gl.get_error() } != glow::NO_ERROR;
-        if refused {
-            unsafe { while gl.get_error() != glow::NO_ERROR {} }
+        (self.drain_errors() == glow::NO_ERROR).then_some(bits)
+    }
+
+    /// Drops the pending GL errors of a call that failed (its error already returned).
+    pub(crate) fn discard_errors(&self) {
+        self.drain_errors();
+    }
+
+    /// The first pending GL error (or `NO_ERROR`), with the queue drained: at most one flag
+    /// per error kind is pending, so a few reads empty it (bounded all the same, for a driver
+    /// that keeps reporting a lost context).
+    fn drain_errors(&self) -> u32 {
+        let first = unsafe { self.gl.get_error() };
+        if first != glow::NO_ERROR {
+            for _ in 0..16 {
+                if unsafe { self.gl.get_error() } == glow::NO_ERROR {
+                    break;
+                }
+            }
         }
-        (!refused).then_some(bits)
+        first
     }
 
     /// Binds `fbo` (`None`: the default framebuffer).
@@ -360,11 +371,10 @@ impl Device {
 
     /// Returns the first pending GL error as [`GlError::Driver`], draining the queue.
     pub fn check(&self, what: &str) -> Result<(), GlError> {
-        let code = unsafe { self.gl.get_error() };
+        let code = self.drain_errors();
         if code == glow::NO_ERROR {
             return Ok(());
         }
-        unsafe { while self.gl.get_error() != glow::NO_ERROR {} }
         if code == glow::OUT_OF_MEMORY {
             return Err(GlError::OutOfMemory(format!(
                 "the driver reported GL_OUT_OF_MEMORY after {what}"

@@ -12,7 +12,6 @@ use glow::HasContext;
 
 use super::ext_fns::AttribPointerFns;
 use super::host_attributes::HostAttributes;
-use super::EsVersion;
 
 /// Texture units the renderer binds: 0 to 7 (`methods::maps::UNIT_MAPS` + 3), within the
 /// 8 fragment units every ES 2.0 context has.
@@ -86,11 +85,10 @@ impl HostState {
     /// the data does.
     pub(crate) fn enter(
         gl: &glow::Context,
-        es: EsVersion,
+        es3: bool,
         vao: Option<glow::VertexArray>,
         attrib_fns: Option<AttribPointerFns>,
     ) -> Self {
-        let es3 = es == EsVersion::Es3;
         unsafe {
             let int = |p| gl.get_parameter_i32(p);
             let units = (int(glow::MAX_COMBINED_TEXTURE_IMAGE_UNITS).max(0) as usize).min(UNITS);

@@ -154,7 +154,7 @@ pub enum GlError {
     #[error("framebuffer incomplete: status 0x{0:04x}")]
     FramebufferIncomplete(u32),
     /// The framebuffer the application bound cannot take the frame: incomplete, or without a
-    /// depth buffer (every method draws with the depth test).
+    /// depth buffer (the frame is drawn against one, unless with MSAA).
     #[error("the bound framebuffer cannot take the frame: {0}")]
     BoundFramebuffer(String),
     /// The driver reported an error.

@@ -36,6 +36,8 @@ pub struct GpuTimer {
     query: u32,
     /// Set when the driver refused a query call: the timer then stays off (warned once).
     failed: Cell<bool>,
+    /// Between `begin` and `end`: a frame that panicked in between left the query running.
+    active: Cell<bool>,
 }
 
 impl GpuTimer {
@@ -66,6 +68,7 @@ impl GpuTimer {
             fns,
             query,
             failed: Cell::new(false),
+            active: Cell::new(false),
         })
     }
 
@@ -74,11 +77,17 @@ impl GpuTimer {
         if self.failed.get() {
             return;
         }
+        if self.active.replace(false) {
+            // Left running by a frame that panicked (and was caught): ended unread, or this
+            // begin would be refused and the timer turned off.
+            unsafe { (self.fns.end_query)(TIME_ELAPSED) };
+            drain_errors(dev);
+        }
         unsafe {
             dev.gl.get_parameter_i32(GPU_DISJOINT);
             (self.fns.begin_query)(TIME_ELAPSED, self.query);
         }
-        self.check(dev, "glBeginQueryEXT");
+        self.active.set(self.check(dev, "glBeginQueryEXT"));
     }
 
     /// Stops timing and waits for the result: GPU milliseconds, or `None` when the GPU
@@ -88,6 +97,7 @@ impl GpuTimer {
         if self.failed.get() {
             return None;
         }
+        self.active.set(false);
         let mut ns = 0u64;
         let disjoint = unsafe {
             (self.fns.end_query)(TIME_ELAPSED);
@@ -98,6 +108,7 @@ impl GpuTimer {
     }
 
     /// False (and the timer off from now on, warned) when the last calls raised a GL error.
+    /// The caller takes the frame's own errors before the query's calls (they drain the queue).
     fn check(&self, dev: &Device, what: &str) -> bool {
         let error = drain_errors(dev);
         if error == glow::NO_ERROR {

@@ -1,8 +1,10 @@
 //! What a frame needs of the framebuffer the application bound ([`Renderer::render`]): complete,
 //! no larger than the driver's viewport, and with a depth buffer when the frame is drawn in it
-//! (every method draws with the depth test; an MSAA frame brings its own and only resolves
-//! there). Without these checks such a frame returned `Ok` with a wrong picture, or a GL error
-//! that named a later step.
+//! (an MSAA frame brings its own and only resolves there). Forward, tiled and clustered draw
+//! with the depth test there, and so does deferred for transparent objects and for a frame
+//! without lights; deferred's opaque composite alone does not, but one rule for every method
+//! and frame is what the README asks of a game. Without these checks such a frame returned
+//! `Ok` with a wrong picture, or a GL error that named a later step.
 
 use super::Renderer;
 use crate::gl::GlError;
@@ -41,10 +43,10 @@ impl Renderer {
         }
         match self.dev.bound_depth_bits() {
             Some(0) => Err(GlError::BoundFramebuffer(
-                "it has no depth buffer, and every method draws with the depth test: attach \
-                 one (24-bit; 16-bit loses precision), or render with MSAA, whose target has \
-                 its own"
-                    .to_string(),
+                "it has no depth buffer, which the frame is drawn against: attach one \
+                 (24-bit; 16-bit loses precision), or render with MSAA, whose target has its \
+                 own"
+                .to_string(),
             )
             .into()),
             Some(bits) if bits < FULL_DEPTH_BITS && !self.warned_depth_bits => {

@@ -197,6 +197,8 @@ impl Renderer {
             None
         };
         if let Some(t) = timer {
+            // The frame's errors so far are its own: the query's calls would drain them as theirs.
+            self.dev.check("the frame's uploads")?;
             t.begin(&self.dev);
         }
         // No lights: no assignment, no uploads, the light loop compiled out — whatever the
@@ -206,8 +208,12 @@ impl Renderer {
         } else {
             self.method.render(&mut ctx)
         };
-        // The query ends on the error path too: one left active makes the next frame's
-        // `glBeginQuery` fail.
+        // Likewise the draws' errors, before the query ends (on the error path too: one left
+        // active makes the next frame's `glBeginQuery` fail).
+        let rendered = match (rendered, timer) {
+            (Ok(stats), Some(_)) => self.dev.check("frame").map(|()| stats).map_err(Error::from),
+            (other, _) => other,
+        };
         let gpu_ms = timer.and_then(|t| t.end(&self.dev));
         let method_stats = rendered?;
         if options.wait_for_gpu {

@@ -58,3 +58,33 @@ fn a_panicking_call_gives_the_state_back_and_the_next_calls_still_do() {
     renderer.hosted(|_| Ok(())).unwrap();
     renderer.destroy();
 }
+
+/// A frame that panicked between the GPU timer's begin and end left its query running, and
+/// the next timed frame's begin was refused: GPU timing off for good.
+#[test]
+fn a_frame_that_panicked_mid_query_leaves_gpu_timing_on() {
+    let Some(ctx) = context_or_skip(EsVersion::Es3) else {
+        return;
+    };
+    let mut renderer = Renderer::new(ctx.load_gl().unwrap(), EsVersion::Es3).unwrap();
+    if !renderer.caps().timer_query {
+        eprintln!("skipped: no GL_EXT_disjoint_timer_query here");
+        return;
+    }
+    let scene = crate::scene::builtin::build("plane", Some((4, 1))).unwrap();
+    let options = crate::RenderOptions::default();
+    let (_, stats) = renderer.render_offscreen(&scene, 16, 9, &options).unwrap();
+    assert!(stats.time.gpu_ms.is_some(), "no GPU time to begin with");
+    let caught = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        let _ = renderer.hosted(|r| -> Result<(), crate::Error> {
+            if let Some(Some(timer)) = &r.timer {
+                timer.begin(&r.dev);
+            }
+            panic!("a bug between the query's begin and end");
+        });
+    }));
+    assert!(caught.is_err());
+    let (_, stats) = renderer.render_offscreen(&scene, 16, 9, &options).unwrap();
+    assert!(stats.time.gpu_ms.is_some(), "GPU timing turned off");
+    renderer.destroy();
+}

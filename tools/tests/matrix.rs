@@ -265,3 +265,40 @@ fn matrix_refuses_a_gles_lib_that_is_not_a_folder_before_any_cell() {
         String::from_utf8_lossy(&out.stdout)
     );
 }
+
+/// A configuration the driver cannot give is a row marked `refused`, which `--max-error` does
+/// not count; any other failure of a cell is not marked, and fails the gate (the verdict's
+/// unit tests). Here a driver capped at ES 2.0 asked for ES 3.0.
+#[test]
+fn a_cell_the_driver_cannot_give_is_marked_refused() {
+    if common::other_implementation_than_mesa("MESA_GLES_VERSION_OVERRIDE") {
+        return;
+    }
+    let out = Command::new(env!("CARGO_BIN_EXE_manylight"))
+        .args([
+            "matrix-cell",
+            "--es",
+            "3",
+            "--scene",
+            "plane",
+            "--size",
+            "16x9",
+        ])
+        .args(["--lights", "4", "--tag", "t"])
+        .env("MESA_GLES_VERSION_OVERRIDE", "2.0")
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let row: serde_json::Value = serde_json::from_str(stdout.lines().last().unwrap_or_default())
+        .unwrap_or_else(|e| panic!("no JSON row ({e}): {stdout}"));
+    assert_eq!(row["refused"], true, "{row}");
+    assert!(
+        row["error"]
+            .as_str()
+            .unwrap()
+            .contains("OpenGL ES 3.0 is not available"),
+        "{row}"
+    );
+}

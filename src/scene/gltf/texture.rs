@@ -30,12 +30,12 @@ pub(super) struct Textures {
     pub budget: TextureBudget,
 }
 
-/// Where an image's encoded bytes lie, when images can share them: a file or a buffer view
-/// named by many images is read and decoded once.
+/// Where an image's encoded bytes lie, and the format they are decoded as, when images can
+/// share them: a file or a buffer view named by many images is read and decoded once.
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
 enum Source {
-    View(usize),
-    File(PathBuf),
+    View(usize, Option<image::ImageFormat>),
+    File(PathBuf, Option<image::ImageFormat>),
 }
 
 impl Textures {
@@ -95,7 +95,11 @@ impl Textures {
     ) -> Result<Option<Arc<Texture>>, String> {
         let limit = FileKind::Texture.limit();
         let size = match &located.bytes {
-            Bytes::View(view) => view.length() as u64,
+            // Checked to lie within its buffer first, as everywhere else in the file.
+            Bytes::View(view) => buffers
+                .view(view)
+                .map_err(|e| format!("{field}: {e}"))?
+                .len() as u64,
             Bytes::Data(bytes) => bytes.len() as u64,
             // Refused unread when the file alone would pass the limits.
             Bytes::File(path) => std::fs::metadata(path).map_or(0, |m| m.len()),
@@ -178,9 +182,10 @@ impl Located<'_> {
     /// What other images may share (a `data:` URI belongs to its image alone).
     fn source(&self) -> Option<Source> {
         match &self.bytes {
-            Bytes::View(view) => Some(Source::View(view.index())),
+            // With the format it is decoded as: a `mimeType` names it for an image.
+            Bytes::View(view) => Some(Source::View(view.index(), self.format)),
             Bytes::Data(_) => None,
-            Bytes::File(path) => Some(Source::File(path.clone())),
+            Bytes::File(path) => Some(Source::File(path.clone(), self.format)),
         }
     }
 }

@@ -52,8 +52,9 @@ pub(super) fn check_obj(text: &str) -> Result<(), String> {
         }
         for (at, word) in words.enumerate() {
             // tobj's "face parse error", without a line (it reads `1/2/3/` as `1/2/3`).
-            let parts = word.split('/').count();
-            if word.split('/').skip(3).any(|p| !p.is_empty()) {
+            // Up to the last one written: `1/1/1/1/` has four.
+            let parts = word.trim_end_matches('/').split('/').count();
+            if parts > 3 {
                 return Err(at_line(format!(
                     "`{key}` corner {} has {parts} indices; a corner is v, v/vt, v//vn or \
                      v/vt/vn",

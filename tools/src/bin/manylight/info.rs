@@ -191,6 +191,8 @@ fn format_text(
         }
     );
     w!(out, "max texture size   {}", caps.max_texture_size);
+    let [vw, vh] = caps.max_viewport_dims;
+    w!(out, "max viewport       {vw}×{vh}");
     w!(
         out,
         "frag uniform vecs  {}",

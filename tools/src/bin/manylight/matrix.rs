@@ -17,7 +17,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, ExitStatus, Output};
 
 use clap::Parser;
-use manylight::gl::HeadlessContext;
+use manylight::gl::{GlError, HeadlessContext};
 use manylight::methods::{Support, METHODS};
 use manylight::{scene, EsVersion, RenderOptions, Renderer};
 use manylight_tools::output::{self, print_stdout, OutputFile};
@@ -355,18 +355,9 @@ fn cell_row(output: &Output) -> Value {
         Some(row) if output.status.success() => row,
         _ => json!({
             "error": cell_error(&output.stderr, output.status),
-            "crashed": !has_error_line(&output.stderr),
             "methods": [],
         }),
     }
-}
-
-/// Whether the child said why it failed (`error: …`), as opposed to panicking, being killed
-/// or printing no row.
-fn has_error_line(stderr: &[u8]) -> bool {
-    String::from_utf8_lossy(stderr)
-        .lines()
-        .any(|l| l.starts_with("error: "))
 }
 
 /// Why a cell failed, on one line for its table cell: the child's `error:` lines, without the
@@ -403,6 +394,7 @@ fn osmesa_row(
         return Ok(json!({
             "config": "desktop GL (OSMesa)",
             "error": "not built: rebuild with `--features osmesa`",
+            "refused": true,
             "env": [],
             "methods": [],
         }));
@@ -438,7 +430,12 @@ fn markdown(rows: &[Value]) -> String {
             row["config"].as_str().unwrap_or("?")
         );
         if let Some(err) = row["error"].as_str() {
-            s += &format!("| {config} | — | — | unavailable: {err} | | | | |\n");
+            let what = if row["refused"] == true {
+                "unavailable"
+            } else {
+                "failed"
+            };
+            s += &format!("| {config} | — | — | {what}: {err} | | | | |\n");
             continue;
         }
         let context = match row["max_samples"].as_i64() {
@@ -485,7 +482,12 @@ fn sheet(rows: &[Value], out: &Path) -> image::RgbaImage {
             row["config"].as_str().unwrap_or("?")
         );
         if row["error"].is_string() {
-            cells.push((vec![config, "unavailable".to_string()], None));
+            let what = if row["refused"] == true {
+                "unavailable"
+            } else {
+                "failed"
+            };
+            cells.push((vec![config, what.to_string()], None));
             continue;
         }
         for m in row["methods"].as_array().into_iter().flatten() {
@@ -562,6 +564,21 @@ impl CellContext {
     }
 }
 
+/// Whether `e` says this configuration cannot be had here (the driver gives no context of
+/// that version), as opposed to a failure of the renderer on a configuration that exists.
+fn refuses_the_configuration(e: &manylight::Error) -> bool {
+    matches!(e, manylight::Error::Gl(GlError::VersionUnavailable { .. }))
+}
+
+/// The row of a configuration this machine cannot give (its context could not be made, or
+/// is another version): printed as the cell's result, marked `refused`, so the matrix lists
+/// it without counting it as a failure.
+fn print_refusal(e: &dyn std::error::Error) -> Result<(), Box<dyn std::error::Error>> {
+    let row = json!({"error": e.to_string(), "refused": true, "methods": []});
+    print_stdout(&format!("{row}\n"))?;
+    Ok(())
+}
+
 /// Renders every method in this (restricted) process and prints one JSON row.
 pub fn run_cell(args: &MatrixCellArgs) -> Result<(), Box<dyn std::error::Error>> {
     let es: EsVersion = args.es.into();
@@ -579,8 +596,14 @@ pub fn run_cell(args: &MatrixCellArgs) -> Result<(), Box<dyn std::error::Error>>
     // before the cell's context, since creating a context makes it current): under a played
     // restriction the driver underneath is unrestricted, so the row shows what it costs.
     let reference = {
-        let ctx = CellContext::new(es, args.osmesa)?;
-        let mut full = Renderer::new(ctx.load_gl()?, es)?;
+        let ctx = match CellContext::new(es, args.osmesa) {
+            Ok(ctx) => ctx,
+            Err(e) => return print_refusal(&*e),
+        };
+        let mut full = match Renderer::new(ctx.load_gl()?, es) {
+            Err(e) if refuses_the_configuration(&e) => return print_refusal(&e),
+            made => made?,
+        };
         full.set_method_named("forward")?;
         let reference_opts = RenderOptions {
             measure: manylight::MeasureOptions {
@@ -597,7 +620,10 @@ pub fn run_cell(args: &MatrixCellArgs) -> Result<(), Box<dyn std::error::Error>>
     let restrictions = manylight::gl::Restrictions {
         no_fragment_highp: args.no_fragment_highp,
     };
-    let mut renderer = Renderer::restricted(ctx.load_gl()?, es, &restrictions)?;
+    let mut renderer = match Renderer::restricted(ctx.load_gl()?, es, &restrictions) {
+        Err(e) if refuses_the_configuration(&e) => return print_refusal(&e),
+        made => made?,
+    };
     let mut methods = Vec::new();
     let mut images = Vec::new();
     for m in METHODS {
