@@ -170,10 +170,7 @@ fn capped_driver_says_clearly_that_es3_is_unavailable() {
     );
     assert!(!out.status.success());
     let msg = text(&out);
-    assert!(
-        msg.contains("OpenGL ES 3.0 is not available: the current context is OpenGL ES 2.0"),
-        "{msg}"
-    );
+    assert!(msg.contains("OpenGL ES 3.0 is not available"), "{msg}");
     assert!(!msg.contains("panicked"), "{msg}");
     // The switch is named, and EGL's reason reads as a sentence (its parenthesis closed).
     assert!(msg.contains("MESA_GLES_VERSION_OVERRIDE is set"), "{msg}");
