@@ -401,19 +401,10 @@ fn gltf_buffers_naming_one_large_file_read_only_their_own_bytes() {
     );
 }
 
-/// 30 images naming one file of 16 MiB (a PNG followed by zeros) were each read and decoded
-/// (400 such took over a minute): the file is now read once and its texture shared.
-#[test]
-fn gltf_images_naming_one_file_read_and_decode_it_once() {
-    use common::gltf::Builder;
-    let dir = tempfile::tempdir().unwrap();
-    sparse_file(
-        &dir.path().join("big.png"),
-        &common::gltf_models::checker_png(),
-        16 * MIB,
-    );
-    let n = 30;
-    let mut b = Builder::default();
+/// `dir/m.gltf`: `n` quads, each with a material of its own whose base colour is image `i`,
+/// which names the file `uri(i)`.
+fn textured_quads(dir: &Path, n: usize, uri: impl Fn(usize) -> String) -> std::path::PathBuf {
+    let mut b = common::gltf::Builder::default();
     let quad = common::gltf_models::floor();
     let meshes: Vec<_> = (0..n)
         .map(|i| serde_json::json!({"primitives": [common::gltf_models::primitive(&mut b, &quad, Some(i))]}))
@@ -425,9 +416,23 @@ fn gltf_images_naming_one_file_read_and_decode_it_once() {
         "materials": (0..n).map(|i| serde_json::json!(
             {"pbrMetallicRoughness": {"baseColorTexture": {"index": i}}})).collect::<Vec<_>>(),
         "textures": (0..n).map(|i| serde_json::json!({"source": i})).collect::<Vec<_>>(),
-        "images": vec![serde_json::json!({"uri": "big.png"}); n],
+        "images": (0..n).map(|i| serde_json::json!({"uri": uri(i)})).collect::<Vec<_>>(),
     });
-    let path = common::files::write(dir.path(), "m.gltf", b.gltf(doc));
+    common::files::write(dir, "m.gltf", b.gltf(doc))
+}
+
+/// 30 images naming one file of 16 MiB (a PNG followed by zeros) were each read and decoded
+/// (400 such took over a minute): the file is now read once and its texture shared.
+#[test]
+fn gltf_images_naming_one_file_read_and_decode_it_once() {
+    let dir = tempfile::tempdir().unwrap();
+    sparse_file(
+        &dir.path().join("big.png"),
+        &common::gltf_models::checker_png(),
+        16 * MIB,
+    );
+    let n = 30;
+    let path = textured_quads(dir.path(), n, |_| "big.png".to_string());
     let before = scene::input::bytes_read();
     let (loaded, report) = common::files::load(&path).unwrap();
     let read = scene::input::bytes_read() - before;
@@ -445,7 +450,6 @@ fn gltf_images_naming_one_file_read_and_decode_it_once() {
 /// warning instead of being read.
 #[test]
 fn gltf_images_together_read_at_most_a_models_limit() {
-    use common::gltf::Builder;
     let dir = tempfile::tempdir().unwrap();
     let n = 5;
     for i in 0..n {
@@ -455,21 +459,7 @@ fn gltf_images_together_read_at_most_a_models_limit() {
             250 * MIB,
         );
     }
-    let mut b = Builder::default();
-    let quad = common::gltf_models::floor();
-    let meshes: Vec<_> = (0..n)
-        .map(|i| serde_json::json!({"primitives": [common::gltf_models::primitive(&mut b, &quad, Some(i))]}))
-        .collect();
-    let doc = serde_json::json!({
-        "scenes": [{"nodes": (0..n).collect::<Vec<_>>()}],
-        "nodes": (0..n).map(|i| serde_json::json!({"mesh": i})).collect::<Vec<_>>(),
-        "meshes": meshes,
-        "materials": (0..n).map(|i| serde_json::json!(
-            {"pbrMetallicRoughness": {"baseColorTexture": {"index": i}}})).collect::<Vec<_>>(),
-        "textures": (0..n).map(|i| serde_json::json!({"source": i})).collect::<Vec<_>>(),
-        "images": (0..n).map(|i| serde_json::json!({"uri": format!("big{i}.png")})).collect::<Vec<_>>(),
-    });
-    let path = common::files::write(dir.path(), "m.gltf", b.gltf(doc));
+    let path = textured_quads(dir.path(), n, |i| format!("big{i}.png"));
     let before = scene::input::bytes_read();
     let (loaded, report) = common::files::load(&path).unwrap();
     let read = scene::input::bytes_read() - before;

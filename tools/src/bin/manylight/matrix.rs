@@ -419,22 +419,31 @@ fn osmesa_row(
     Ok(row)
 }
 
+/// A row's implementation (its folder where the context could not say) and configuration.
+fn row_label(row: &Value) -> (&str, &str) {
+    let implementation = row["implementation"]
+        .as_str()
+        .or(row["gles_lib"].as_str())
+        .unwrap_or("?");
+    (implementation, row["config"].as_str().unwrap_or("?"))
+}
+
+/// What a row with an `error` is: a configuration this machine cannot give, or a failure.
+fn row_failure(row: &Value) -> &'static str {
+    if row["refused"] == true {
+        "unavailable"
+    } else {
+        "failed"
+    }
+}
+
 fn markdown(rows: &[Value]) -> String {
     let mut s = String::from("| implementation | configuration | context | method | support | max abs vs forward | max abs vs reference | pixels > 2/255 | frame ms |\n|---|---|---|---|---|---|---|---|---|\n");
     for row in rows {
-        let config = &format!(
-            "{} | {}",
-            row["implementation"]
-                .as_str()
-                .unwrap_or(row["gles_lib"].as_str().unwrap_or("?")),
-            row["config"].as_str().unwrap_or("?")
-        );
+        let (implementation, config) = row_label(row);
+        let config = &format!("{implementation} | {config}");
         if let Some(err) = row["error"].as_str() {
-            let what = if row["refused"] == true {
-                "unavailable"
-            } else {
-                "failed"
-            };
+            let what = row_failure(row);
             s += &format!("| {config} | — | — | {what}: {err} | | | | |\n");
             continue;
         }
@@ -474,20 +483,10 @@ fn markdown(rows: &[Value]) -> String {
 fn sheet(rows: &[Value], out: &Path) -> image::RgbaImage {
     let mut cells = Vec::new();
     for row in rows {
-        let config = format!(
-            "{}: {}",
-            row["implementation"]
-                .as_str()
-                .unwrap_or(row["gles_lib"].as_str().unwrap_or("?")),
-            row["config"].as_str().unwrap_or("?")
-        );
+        let (implementation, config) = row_label(row);
+        let config = format!("{implementation}: {config}");
         if row["error"].is_string() {
-            let what = if row["refused"] == true {
-                "unavailable"
-            } else {
-                "failed"
-            };
-            cells.push((vec![config, what.to_string()], None));
+            cells.push((vec![config, row_failure(row).to_string()], None));
             continue;
         }
         for m in row["methods"].as_array().into_iter().flatten() {

@@ -11,14 +11,8 @@ use serde_json::{json, Value};
 pub fn mark(rows: &mut [Value], max_error: u8) -> Vec<String> {
     let mut failures = Vec::new();
     for row in rows {
-        let place = format!(
-            "{} / {}",
-            row["implementation"]
-                .as_str()
-                .or(row["gles_lib"].as_str())
-                .unwrap_or("?"),
-            row["config"].as_str().unwrap_or("?")
-        );
+        let (implementation, config) = super::row_label(row);
+        let place = format!("{implementation} / {config}");
         if let Some(error) = row["error"].as_str() {
             if row["refused"] != true {
                 failures.push(format!("{place}: the cell failed: {error}"));
