@@ -286,33 +286,39 @@ impl Deferred {
             //   skipped;
             // - reaching the near plane (the eye inside or beside it), whose near side would be
             //   clipped: the far side, GEQUAL — surfaces behind the whole sphere are skipped;
-            // - that far side reaching the far plane too: a full-screen triangle.
+            // - that far side reaching the far plane too, or depth too coarse there for either
+            //   side's test: a full-screen triangle.
             // Each is one-sided (no stencil). The far side everywhere would skip more in open
             // scenes but evaluate far more in enclosed ones (the conference room); the near
             // side first avoids that worst case.
             let depth = -light.position.z;
-            let (shader, mesh, cull, depth_test) = if depth - radius >= 2.0 * ctx.near as f32 {
-                (
-                    "deferred_light",
-                    self.sphere.as_ref(),
-                    Cull::Back,
-                    DepthTest::LessEqual,
-                )
-            } else if depth + radius < FAR_MARGIN * far {
-                (
-                    "deferred_light",
-                    self.sphere.as_ref(),
-                    Cull::Front,
-                    DepthTest::GreaterEqual,
-                )
-            } else {
-                (
-                    "deferred_light_fullscreen",
-                    self.fullscreen.as_ref(),
-                    Cull::None,
-                    DepthTest::Off,
-                )
-            };
+            // A proxy's one-sided depth test needs depth steps well inside the light's reach
+            // where it ends (a near plane of 10⁻⁵ made them wider: 167/255 from forward).
+            let coarse = ctx.scene.camera.depth_step_at(f64::from(depth + radius))
+                > 0.1 * f64::from(light.cull_radius);
+            let (shader, mesh, cull, depth_test) =
+                if !coarse && depth - radius >= 2.0 * ctx.near as f32 {
+                    (
+                        "deferred_light",
+                        self.sphere.as_ref(),
+                        Cull::Back,
+                        DepthTest::LessEqual,
+                    )
+                } else if !coarse && depth + radius < FAR_MARGIN * far {
+                    (
+                        "deferred_light",
+                        self.sphere.as_ref(),
+                        Cull::Front,
+                        DepthTest::GreaterEqual,
+                    )
+                } else {
+                    (
+                        "deferred_light_fullscreen",
+                        self.fullscreen.as_ref(),
+                        Cull::None,
+                        DepthTest::Off,
+                    )
+                };
             RenderState {
                 depth_test,
                 depth_write: false,

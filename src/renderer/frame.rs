@@ -161,6 +161,11 @@ impl Renderer {
         );
         let (near, far) = scene.camera.near_far();
         let content_far = content_far(self.gpu_scene.scene_bounds(scene), &view, near, far);
+        super::depth_warning::warn_of_coarse_depth(
+            &scene.camera,
+            content_far,
+            &mut self.warned_depth_step,
+        );
         let reach = super::fp16_range::view_reach(scene, width as f64 / height as f64, content_far);
         super::fp16_range::check(self.dev.caps(), scene, &mut self.lights, reach)?;
         let frame_rect = [origin[0], origin[1], width, height].map(|v| v as i32);

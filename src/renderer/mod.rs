@@ -7,6 +7,7 @@
 //! read back to the CPU (colour, HDR, light counts) in `offscreen`.
 
 mod bound_target;
+mod depth_warning;
 mod fp16_range;
 mod frame;
 mod frame_setup;
@@ -61,6 +62,8 @@ pub struct Renderer {
     warned_directional: bool,
     /// A bound framebuffer's shallow depth buffer was announced (once per renderer).
     warned_depth_bits: bool,
+    /// A camera too coarse in depth for the scene was announced (once per renderer).
+    warned_depth_step: bool,
     /// The frame's objects in draw order (kept likewise).
     draw_order: methods::geometry::DrawOrder,
     /// `LP_NUM_THREADS` when the renderer was made (llvmpipe reads it when the context is
@@ -122,6 +125,7 @@ impl Renderer {
             shown_directional: Vec::new(),
             warned_directional: false,
             warned_depth_bits: false,
+            warned_depth_step: false,
             draw_order: methods::geometry::DrawOrder::default(),
             lp_num_threads: std::env::var("LP_NUM_THREADS").ok(),
             left: LeftObjects::default(),

@@ -80,6 +80,32 @@ fn a_light_brighter_than_2_to_the_126_still_lights_without_fragment_highp() {
     }
 }
 
+/// A near plane of 10⁻⁵ before the 40 m courtyard: depth steps wider than a light's reach at
+/// its far end made deferred's proxy volumes skip lit pixels (184/255 from forward); they
+/// now fall back to its full-screen pass there. Every method draws the one coarse picture, so
+/// the camera itself is warned of, once, naming `camera.near`; a usual near plane is not.
+#[test]
+fn a_tiny_near_plane_is_warned_of_and_deferred_still_equals_forward() {
+    common::warnings::install();
+    let mut s = scene::builtin::build("courtyard", Some((256, 7))).unwrap();
+    let warned = || common::warnings::warnings_containing("camera.near 1e-5").len();
+    let mut gpu = Gpu::new(EsVersion::Es3);
+    let opts = RenderOptions::default();
+    gpu.render(&s, 128, 72, &opts);
+    let any = common::warnings::warnings_containing("camera.near");
+    assert!(any.is_empty(), "the built-in camera is warned of: {any:?}");
+    if let Projection::Perspective { near, .. } = &mut s.camera.projection {
+        *near = 1e-5;
+    }
+    gpu.r().set_method_named("forward").unwrap();
+    let forward = gpu.render(&s, 128, 72, &opts);
+    gpu.r().set_method_named("deferred").unwrap();
+    let deferred = gpu.render(&s, 128, 72, &opts);
+    let d = manylight::metrics::diff(&forward, &deferred);
+    assert!(d.max_abs <= 2, "deferred {} / 255 from forward", d.max_abs);
+    assert_eq!(warned(), 1, "warned once a renderer");
+}
+
 #[test]
 fn a_far_plane_near_the_top_of_f64_renders_as_an_infinite_one() {
     let mut gpu = Gpu::new(EsVersion::Es3);
