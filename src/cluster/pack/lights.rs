@@ -86,6 +86,12 @@ pub struct PackedLights {
     pub pos_range: f32,
     /// Rgba8 only: radii are fixed point over `[0, radius_range]`.
     pub radius_range: f32,
+    /// Rgba8 only: lights whose position or radius step at this frame's ranges passes a tenth
+    /// of their radius (one far or huge light widens the ranges for all): they light the wrong
+    /// place, or nothing.
+    pub coarse: usize,
+    /// The coarse lights were warned of (once for these records, frame after frame).
+    warned_coarse: bool,
 }
 
 impl Default for PackedLights {
@@ -106,6 +112,8 @@ impl PackedLights {
             bytes: Vec::new(),
             pos_range: 0.0,
             radius_range: 0.0,
+            coarse: 0,
+            warned_coarse: false,
         }
     }
 }
@@ -130,6 +138,9 @@ pub fn pack_lights_into(lights: &[GpuLight], encoding: LightEncoding, packed: &m
         .map(|l| l.position.abs().max_element())
         .fold(1e-6f32, f32::max);
     let radius_range = lights.iter().map(|l| l.radius).fold(1e-6f32, f32::max);
+    // Fixed-point steps: positions over 2·pos_range, radii over radius_range, in 65 535 steps.
+    let step = (2.0 * pos_range).max(radius_range) / 65535.0;
+    let mut coarse = 0;
     for (i, l) in lights.iter().enumerate() {
         match encoding {
             LightEncoding::Float32 => {
@@ -156,6 +167,7 @@ pub fn pack_lights_into(lights: &[GpuLight], encoding: LightEncoding, packed: &m
                 bytes[start..start + 64].copy_from_slice(bytemuck::cast_slice(&rec));
             }
             LightEncoding::Rgba8 => {
+                coarse += usize::from(step > 0.1 * l.radius);
                 let p = |v: f32| unorm16(v / pos_range * 0.5 + 0.5);
                 let s = |v: f32| unorm16(v * 0.5 + 0.5);
                 let words = [
@@ -191,6 +203,18 @@ pub fn pack_lights_into(lights: &[GpuLight], encoding: LightEncoding, packed: &m
     packed.height = height as u32;
     packed.pos_range = pos_range;
     packed.radius_range = radius_range;
+    packed.coarse = coarse;
+    if coarse > 0 && !packed.warned_coarse {
+        packed.warned_coarse = true;
+        log::warn!(
+            "RGBA8 light data (no float textures): {coarse} of {} lights are smaller than ten \
+             steps of this frame's fixed point (positions within ±{pos_range:.3e}, radii up to \
+             {radius_range:.3e}, set by the farthest and the largest light) and light the wrong \
+             place or nothing; keep lights of one scale near the camera, or use a context with \
+             float textures (said once)",
+            lights.len()
+        );
+    }
 }
 
 /// Decodes light `i` exactly as the shader does (used to test round trips and to measure the
@@ -366,6 +390,21 @@ mod tests {
                 "radiance {c}"
             );
         }
+    }
+
+    /// One huge light widens the radius range for all: the others' radii round to nothing,
+    /// and the records say how many (the renderer warns of them).
+    #[test]
+    fn rgba8_counts_the_lights_its_ranges_cannot_hold() {
+        let lights = sample_lights();
+        assert_eq!(pack_lights(&lights, LightEncoding::Rgba8).coarse, 0);
+        assert_eq!(pack_lights(&lights, LightEncoding::Float32).coarse, 0);
+        let mut with_huge = lights.clone();
+        with_huge[0].radius = 1e6;
+        let packed = pack_lights(&with_huge, LightEncoding::Rgba8);
+        assert_eq!(packed.coarse, lights.len() - 1);
+        let small = unpack_light(&packed, 1);
+        assert!(small.radius < 0.5 * lights[1].radius, "{}", small.radius);
     }
 
     #[test]
