@@ -194,6 +194,9 @@ impl Renderer {
         };
         // GPU time only where the frame waits anyway: reading the query result stalls.
         let timer = if options.wait_for_gpu {
+            // The frame's errors so far are its own: the timer's calls (creating the query
+            // too) would drain them as theirs.
+            self.dev.check("the frame's uploads")?;
             if self.timer.is_none() {
                 self.timer = Some(crate::gl::timer::GpuTimer::new(&self.dev));
             }
@@ -202,8 +205,6 @@ impl Renderer {
             None
         };
         if let Some(t) = timer {
-            // The frame's errors so far are its own: the query's calls would drain them as theirs.
-            self.dev.check("the frame's uploads")?;
             t.begin(&self.dev);
         }
         // No lights: no assignment, no uploads, the light loop compiled out — whatever the
