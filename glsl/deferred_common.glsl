@@ -7,6 +7,12 @@ uniform HIGHP vec2 u_viewport;
 // View-space half extents per unit depth (perspective) or absolute (orthographic).
 uniform HIGHP vec2 u_halfExtent;
 
+// The normal buffer's depth where no surface was drawn (src/gl/gbuffer.rs clears it so): a
+// surface may lie at or behind the eye plane (an orthographic camera with near 0).
+bool noSurface(HIGHP float depth) {
+    return depth < -1.0e29;
+}
+
 // The view-space point at window position windowXY (pixels) and view depth.
 HIGHP vec3 viewPosition(HIGHP vec2 windowXY, HIGHP float depth) {
     HIGHP vec2 ndc = windowXY / u_viewport * 2.0 - 1.0;

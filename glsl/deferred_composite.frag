@@ -16,7 +16,7 @@ uniform HIGHP vec2 u_frameOrigin;
 void main() {
     HIGHP vec2 frameXY = gl_FragCoord.xy - u_frameOrigin;
     ivec2 px = ivec2(frameXY);
-    if (texelFetch(u_gNormalDepth, px, 0).z <= 0.0) {
+    if (noSurface(texelFetch(u_gNormalDepth, px, 0).z)) {
         discard;
     }
     gl_FragDepth = texelFetch(u_gDepth, px, 0).r;

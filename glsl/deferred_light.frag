@@ -17,7 +17,7 @@ uniform vec4 u_light2;
 void main() {
     ivec2 px = ivec2(gl_FragCoord.xy);
     HIGHP vec4 nd = texelFetch(u_gNormalDepth, px, 0);
-    if (nd.z <= 0.0) {
+    if (noSurface(nd.z)) {
         discard;
     }
 #if COUNT_EVALS

@@ -39,7 +39,7 @@ void main() {
     extra += surfaceEmission(v_uv);
 #endif
     o_extra = vec4(extra, 0.0);
-    // View depth > 0 marks a covered pixel (the buffer is cleared to 0).
+    // Any view depth marks a covered pixel (the buffer is cleared to −10³⁰: noSurface).
     o_normalDepth = vec4(octEncode(N), -v_viewPos.z, offset.x);
 #if METALLIC_ROUGHNESS
     // Metallic-roughness: (metallic, roughness, 0, −1); the negative exponent marks the model.

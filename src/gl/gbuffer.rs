@@ -27,6 +27,8 @@
 //! near a light by 11/255. Rendering to float textures needs `GL_EXT_color_buffer_float`.
 #![allow(unsafe_code)]
 
+/// The normal buffer's view depth where no surface was drawn (below `noSurface`'s −10²⁹).
+const NO_SURFACE_DEPTH: f32 = -1.0e30;
 use glow::HasContext;
 
 use super::{Device, EsVersion, GlError};
@@ -188,8 +190,10 @@ impl GBuffer {
         self.size.0 as usize * self.size.1 as usize * self.bytes_per_pixel
     }
 
-    /// Binds the G-buffer for the geometry pass and clears it (depth 0 in the normal buffer's
-    /// `w` marks uncovered pixels).
+    /// Binds the G-buffer for the geometry pass and clears it: a view depth of −10³⁰ in the
+    /// normal buffer marks uncovered pixels (`noSurface` in `deferred_common.glsl`). Not 0: an
+    /// orthographic camera with near 0 draws surfaces at and just behind the eye plane, which
+    /// were read as background (26 black pixels at a far of 10⁷).
     pub fn begin_geometry(&self, dev: &Device) {
         let gl = &dev.gl;
         unsafe {
@@ -197,6 +201,7 @@ impl GBuffer {
         }
         dev.viewport(0, 0, self.size.0 as i32, self.size.1 as i32);
         dev.clear([0.0; 4]);
+        unsafe { gl.clear_buffer_f32_slice(glow::COLOR, 1, &[0.0, 0.0, NO_SURFACE_DEPTH, 0.0]) };
     }
 
     /// Binds the accumulation buffer as the geometry pass left it (each surface's emission

@@ -106,6 +106,29 @@ fn a_tiny_near_plane_is_warned_of_and_deferred_still_equals_forward() {
     assert_eq!(warned(), 1, "warned once a renderer");
 }
 
+/// An orthographic camera with near 0 and far 10⁷: `f32` depth cannot place surfaces within
+/// some 0.6 m of the eye plane, so some at or behind it survive clipping. Forward shades them;
+/// deferred read their view depth ≤ 0 as "no surface" and left black pixels (109/255).
+#[test]
+fn deferred_keeps_surfaces_at_an_orthographic_eye_plane() {
+    let mut s = scene::builtin::build("courtyard", Some((256, 7))).unwrap();
+    s.camera.position = DVec3::new(-18.5, 3.0, 1.5);
+    s.camera.target = DVec3::new(6.0, 3.6, -1.0);
+    s.camera.projection = Projection::Orthographic {
+        height: 20.0,
+        near: 0.0,
+        far: 1e7,
+    };
+    let mut gpu = Gpu::new(EsVersion::Es3);
+    let opts = RenderOptions::default();
+    gpu.r().set_method_named("forward").unwrap();
+    let forward = gpu.render(&s, 128, 72, &opts);
+    gpu.r().set_method_named("deferred").unwrap();
+    let deferred = gpu.render(&s, 128, 72, &opts);
+    let d = manylight::metrics::diff(&forward, &deferred);
+    assert!(d.max_abs <= 2, "deferred {} / 255 from forward", d.max_abs);
+}
+
 #[test]
 fn a_far_plane_near_the_top_of_f64_renders_as_an_infinite_one() {
     let mut gpu = Gpu::new(EsVersion::Es3);
