@@ -316,15 +316,10 @@ impl Device {
         (self.drain_errors() == glow::NO_ERROR).then_some(bits)
     }
 
-    /// Drops the pending GL errors of a call that failed (its error already returned).
-    pub(crate) fn discard_errors(&self) {
-        self.drain_errors();
-    }
-
     /// The first pending GL error (or `NO_ERROR`), with the queue drained: at most one flag
     /// per error kind is pending, so a few reads empty it (bounded all the same, for a driver
     /// that keeps reporting a lost context).
-    fn drain_errors(&self) -> u32 {
+    pub(crate) fn drain_errors(&self) -> u32 {
         let first = unsafe { self.gl.get_error() };
         if first != glow::NO_ERROR {
             for _ in 0..16 {

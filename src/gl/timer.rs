@@ -54,7 +54,7 @@ impl GpuTimer {
         let mut query = 0u32;
         // SAFETY: the extension's signature, one name written into `query`.
         unsafe { (fns.gen_queries)(1, &mut query) };
-        let error = drain_errors(dev);
+        let error = dev.drain_errors();
         if query == 0 || error != glow::NO_ERROR {
             log::warn!(
                 "the driver could not create a timer query (GL error {error:#06x}): no GPU time (gpu_ms absent)"
@@ -81,7 +81,7 @@ impl GpuTimer {
             // Left running by a frame that panicked (and was caught): ended unread, or this
             // begin would be refused and the timer turned off.
             unsafe { (self.fns.end_query)(TIME_ELAPSED) };
-            drain_errors(dev);
+            dev.drain_errors();
         }
         unsafe {
             dev.gl.get_parameter_i32(GPU_DISJOINT);
@@ -110,7 +110,7 @@ impl GpuTimer {
     /// False (and the timer off from now on, warned) when the last calls raised a GL error.
     /// The caller takes the frame's own errors before the query's calls (they drain the queue).
     fn check(&self, dev: &Device, what: &str) -> bool {
-        let error = drain_errors(dev);
+        let error = dev.drain_errors();
         if error == glow::NO_ERROR {
             return true;
         }
@@ -125,12 +125,4 @@ impl GpuTimer {
     pub fn destroy(self, _dev: &Device) {
         unsafe { (self.fns.delete_queries)(1, &self.query) };
     }
-}
-
-/// The first pending GL error (or `NO_ERROR`), the queue drained, so an optional call's
-/// refusal is not reported as the frame's.
-fn drain_errors(dev: &Device) -> u32 {
-    let first = unsafe { dev.gl.get_error() };
-    while first != glow::NO_ERROR && unsafe { dev.gl.get_error() } != glow::NO_ERROR {}
-    first
 }

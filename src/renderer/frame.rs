@@ -60,20 +60,14 @@ impl Renderer {
         stats: &mut FrameStats,
     ) -> Result<(), Error> {
         let origin = options.origin;
-        let own_msaa = options.count == CountKind::None && options.samples > 1;
-        self.hosted(|r| {
-            // The frame's own errors first: they do not depend on what is bound.
-            check_viewport(width, height)?;
-            check_origin(origin, width, height)?;
-            check_options(options)?;
-            r.check_bound_target(width, height, !own_msaa)?;
-            r.render_hosted(scene, (width, height), options, origin, stats)
-        })
+        self.hosted(|r| r.render_hosted(scene, (width, height), options, origin, stats, true))
     }
 
     /// [`Renderer::render_reusing`] with the frame's lower-left corner at `origin` in the bound
     /// framebuffer (the offscreen renders pass `[0, 0]`), inside a call that saved the
-    /// application's GL state ([`Renderer::hosted`]).
+    /// application's GL state ([`Renderer::hosted`]). `applications`: the framebuffer is the
+    /// application's, checked for what the frame needs of it (the offscreen renders bind their
+    /// own).
     pub(super) fn render_hosted(
         &mut self,
         scene: &Scene,
@@ -81,7 +75,10 @@ impl Renderer {
         options: &RenderOptions,
         origin: [u32; 2],
         stats: &mut FrameStats,
+        applications: bool,
     ) -> Result<(), Error> {
+        // The frame's own errors first: they do not depend on what is bound.
+        check_viewport(width, height)?;
         check_origin(origin, width, height)?;
         // Before MSAA's target is made: its refusal would hide the option's error.
         check_options(options)?;
@@ -91,10 +88,12 @@ impl Renderer {
         } else {
             1
         };
+        if applications {
+            self.check_bound_target(width, height, samples <= 1)?;
+        }
         if samples <= 1 {
             return self.render_frame(scene, (width, height), options, origin, stats);
         }
-        check_viewport(width, height)?;
         let destination = self.dev.bound_framebuffer();
         let format = if options.hdr {
             ColorFormat::Rgba16F
@@ -140,7 +139,6 @@ impl Renderer {
             log::warn!("{warning}");
         }
         scene.validate()?;
-        check_viewport(width, height)?;
         self.gpu_scene
             .upload(&self.dev, scene, options.measure.full_variants)?;
         self.gpu_scene.split_for_frame(&self.dev, scene)?;

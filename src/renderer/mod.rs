@@ -176,7 +176,7 @@ impl Renderer {
         let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| f(self)));
         if !matches!(result, Ok(Ok(_))) {
             // A failed call's own GL errors, not to be reported as the game's next time.
-            self.dev.discard_errors();
+            self.dev.drain_errors();
         }
         self.dev.leave_host(host);
         result.unwrap_or_else(|panic| std::panic::resume_unwind(panic))

@@ -78,7 +78,7 @@ impl Renderer {
         // Inside the caller's `hosted`: the application's state is saved already.
         let frame = |r: &mut Renderer| {
             let mut stats = FrameStats::default();
-            r.render_hosted(scene, (width, height), options, [0, 0], &mut stats)
+            r.render_hosted(scene, (width, height), options, [0, 0], &mut stats, false)
                 .map(|()| stats)
         };
         let mut stats = frame(self)?;

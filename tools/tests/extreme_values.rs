@@ -80,6 +80,16 @@ fn a_light_brighter_than_2_to_the_126_still_lights_without_fragment_highp() {
     }
 }
 
+/// How far deferred's 128 × 72 frame of `s` lies from forward's, per channel (0–255).
+fn deferred_from_forward(gpu: &mut Gpu, s: &Scene) -> u8 {
+    let opts = RenderOptions::default();
+    gpu.r().set_method_named("forward").unwrap();
+    let forward = gpu.render(s, 128, 72, &opts);
+    gpu.r().set_method_named("deferred").unwrap();
+    let deferred = gpu.render(s, 128, 72, &opts);
+    manylight::metrics::diff(&forward, &deferred).max_abs
+}
+
 /// A near plane of 10⁻⁵ before the 40 m courtyard: depth steps wider than a light's reach at
 /// its far end made deferred's proxy volumes skip lit pixels (184/255 from forward); they
 /// now fall back to its full-screen pass there. Every method draws the one coarse picture, so
@@ -97,12 +107,8 @@ fn a_tiny_near_plane_is_warned_of_and_deferred_still_equals_forward() {
     if let Projection::Perspective { near, .. } = &mut s.camera.projection {
         *near = 1e-5;
     }
-    gpu.r().set_method_named("forward").unwrap();
-    let forward = gpu.render(&s, 128, 72, &opts);
-    gpu.r().set_method_named("deferred").unwrap();
-    let deferred = gpu.render(&s, 128, 72, &opts);
-    let d = manylight::metrics::diff(&forward, &deferred);
-    assert!(d.max_abs <= 2, "deferred {} / 255 from forward", d.max_abs);
+    let off = deferred_from_forward(&mut gpu, &s);
+    assert!(off <= 2, "deferred {off} / 255 from forward");
     assert_eq!(warned(), 1, "warned once a renderer");
 }
 
@@ -120,13 +126,8 @@ fn deferred_keeps_surfaces_at_an_orthographic_eye_plane() {
         far: 1e7,
     };
     let mut gpu = Gpu::new(EsVersion::Es3);
-    let opts = RenderOptions::default();
-    gpu.r().set_method_named("forward").unwrap();
-    let forward = gpu.render(&s, 128, 72, &opts);
-    gpu.r().set_method_named("deferred").unwrap();
-    let deferred = gpu.render(&s, 128, 72, &opts);
-    let d = manylight::metrics::diff(&forward, &deferred);
-    assert!(d.max_abs <= 2, "deferred {} / 255 from forward", d.max_abs);
+    let off = deferred_from_forward(&mut gpu, &s);
+    assert!(off <= 2, "deferred {off} / 255 from forward");
 }
 
 #[test]

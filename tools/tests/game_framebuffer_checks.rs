@@ -47,6 +47,15 @@ unsafe fn game_fbo(gl: &glow::Context, depth: Option<u32>) -> glow::Framebuffer 
     fbo
 }
 
+/// A game's context (current), its GL functions and a renderer on it. Bound in this order,
+/// they drop in the reverse one: the renderer while its context is still current.
+fn game(es: EsVersion) -> (HeadlessContext, glow::Context, Renderer) {
+    let ctx = HeadlessContext::new(es).unwrap();
+    let gl = ctx.load_gl().unwrap();
+    let renderer = Renderer::new(ctx.load_gl().unwrap(), es).unwrap();
+    (ctx, gl, renderer)
+}
+
 fn plane() -> manylight::Scene {
     scene::builtin::build("plane", Some((8, 1))).unwrap()
 }
@@ -65,9 +74,7 @@ fn render(
 fn a_framebuffer_without_depth_is_refused_and_a_shallow_one_warned_of() {
     common::warnings::install();
     for es in [EsVersion::Es3, EsVersion::Es2] {
-        let ctx = HeadlessContext::new(es).unwrap();
-        let gl = ctx.load_gl().unwrap();
-        let mut r = Renderer::new(ctx.load_gl().unwrap(), es).unwrap();
+        let (_ctx, gl, mut r) = game(es);
         unsafe { game_fbo(&gl, None) };
         let err = render(&mut r, &RenderOptions::default()).unwrap_err();
         assert!(
@@ -102,9 +109,7 @@ fn a_framebuffer_without_depth_is_refused_and_a_shallow_one_warned_of() {
 /// debug build panicked on the GL error of the geometry pass.
 #[test]
 fn an_incomplete_framebuffer_is_refused_naming_its_status() {
-    let ctx = HeadlessContext::new(EsVersion::Es3).unwrap();
-    let gl = ctx.load_gl().unwrap();
-    let mut r = Renderer::new(ctx.load_gl().unwrap(), EsVersion::Es3).unwrap();
+    let (_ctx, gl, mut r) = game(EsVersion::Es3);
     unsafe {
         let fbo = gl.create_framebuffer().unwrap();
         gl.bind_framebuffer(glow::FRAMEBUFFER, Some(fbo));
@@ -125,9 +130,7 @@ fn an_incomplete_framebuffer_is_refused_naming_its_status() {
 /// viewport and the call returned `Ok`).
 #[test]
 fn a_frame_past_the_viewport_limit_is_refused() {
-    let ctx = HeadlessContext::new(EsVersion::Es3).unwrap();
-    let gl = ctx.load_gl().unwrap();
-    let mut r = Renderer::new(ctx.load_gl().unwrap(), EsVersion::Es3).unwrap();
+    let (_ctx, gl, mut r) = game(EsVersion::Es3);
     let [max_w, _] = r.caps().max_viewport_dims;
     assert!(max_w > 0, "GL_MAX_VIEWPORT_DIMS was not read");
     unsafe { game_fbo(&gl, Some(glow::DEPTH_COMPONENT24)) };
@@ -147,9 +150,7 @@ fn a_frame_past_the_viewport_limit_is_refused() {
 #[test]
 fn a_gl_error_the_game_left_pending_is_not_the_renderers() {
     common::warnings::install();
-    let ctx = HeadlessContext::new(EsVersion::Es3).unwrap();
-    let gl = ctx.load_gl().unwrap();
-    let mut r = Renderer::new(ctx.load_gl().unwrap(), EsVersion::Es3).unwrap();
+    let (_ctx, gl, mut r) = game(EsVersion::Es3);
     let game_bug = || unsafe { gl.enable(0x1234) };
     game_bug();
     r.render_offscreen(&plane(), 32, 18, &RenderOptions::default())
