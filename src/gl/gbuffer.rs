@@ -193,7 +193,7 @@ impl GBuffer {
     /// Binds the G-buffer for the geometry pass and clears it: a view depth of −10³⁰ in the
     /// normal buffer marks uncovered pixels (`noSurface` in `deferred_common.glsl`). Not 0: an
     /// orthographic camera with near 0 draws surfaces at and just behind the eye plane, which
-    /// were read as background (26 black pixels at a far of 10⁷).
+    /// must not read as background.
     pub fn begin_geometry(&self, dev: &Device) {
         let gl = &dev.gl;
         unsafe {

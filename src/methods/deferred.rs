@@ -293,7 +293,7 @@ impl Deferred {
             // side first avoids that worst case.
             let depth = -light.position.z;
             // A proxy's one-sided depth test needs depth steps well inside the light's reach
-            // where it ends (a near plane of 10⁻⁵ made them wider: 167/255 from forward).
+            // where it ends (a tiny near plane makes them wider; docs/precision.md).
             let coarse = ctx.scene.camera.depth_step_at(f64::from(depth + radius))
                 > 0.1 * f64::from(light.cull_radius);
             let (shader, mesh, cull, depth_test) =

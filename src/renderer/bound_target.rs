@@ -3,8 +3,7 @@
 //! (an MSAA frame brings its own and only resolves there). Forward, tiled and clustered draw
 //! with the depth test there, and so does deferred for transparent objects and for a frame
 //! without lights; deferred's opaque composite alone does not, but one rule for every method
-//! and frame is what the README asks of a game. Without these checks such a frame returned
-//! `Ok` with a wrong picture, or a GL error that named a later step.
+//! and frame is what the README asks of a game.
 
 use super::Renderer;
 use crate::gl::GlError;

@@ -1,12 +1,11 @@
 //! A warning, once a renderer, when the camera leaves the depth buffer too coarse at the
 //! scene's far content: surfaces closer together in depth than its step show the one behind on
-//! some pixels, in every method alike (so comparing methods with forward cannot see it). A
-//! near plane of 10⁻⁵ before a 40 m scene moved 23 % of the pixels, with no word.
+//! some pixels, in every method alike (so comparing methods with forward cannot see it;
+//! docs/precision.md).
 
 use crate::scene::{Camera, Projection};
 
-/// The largest depth step, as a share of the far content's distance, left unsaid (a near
-/// plane of 0.1 before 40 m of content is 0.002 %; 10⁻⁴ is 2.4 %).
+/// The largest depth step, as a share of the far content's distance, left unsaid.
 const QUIET_SHARE: f64 = 0.01;
 
 /// Warns (once: `warned`) when the depth step at `content_far` passes [`QUIET_SHARE`] of it.

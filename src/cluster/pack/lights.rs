@@ -284,7 +284,7 @@ pub fn fp16_radiance(c: Vec3) -> (Vec3, f32) {
         0
     };
     let k = 2f32.powi(e);
-    // Divided twice: k² itself is past f32 above 2¹²⁶ (k = 2⁶⁴), and c / ∞ was a black light.
+    // Divided twice: k² itself is past f32 above 2¹²⁶ (k = 2⁶⁴), and c / ∞ would be 0.
     (c / k / k, k)
 }
 

@@ -13,7 +13,7 @@ pub const MAX_JSON_CONTAINERS: usize = 1 << 22;
 
 /// Most array elements and object members a glTF file's JSON may hold (counted by the commas
 /// between them): a node with a matrix is some 20, so 2²⁰ such nodes and their accessors fit,
-/// while a 100 MB accessor `min` of 50 million zeros (1.75 GB parsed) does not.
+/// while a flat array of 50 million numbers (an accessor `min`, say) does not.
 pub const MAX_JSON_ELEMENTS: usize = 1 << 25;
 
 /// Refuses JSON holding more than [`MAX_JSON_CONTAINERS`] objects and arrays or more than

@@ -24,8 +24,8 @@ pub(super) struct Textures {
     loaded: HashMap<usize, Option<Arc<Texture>>>,
     by_source: HashMap<Source, Option<Arc<Texture>>>,
     /// Encoded bytes the model's images may still read from files or decode from buffer
-    /// views, all together: the limit on a model's buffers. Without it, 400 images naming one
-    /// 256 MiB file (or 400 views of one large buffer) took minutes.
+    /// views, all together: the limit on a model's buffers, so many images of large distinct
+    /// files or views cannot read and decode without end.
     encoded_left: u64,
     pub budget: TextureBudget,
 }
