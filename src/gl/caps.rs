@@ -40,6 +40,8 @@ pub struct Caps {
     pub vendor: String,
     /// `GL_MAX_TEXTURE_SIZE`.
     pub max_texture_size: i32,
+    /// `GL_MAX_RENDERBUFFER_SIZE`.
+    pub max_renderbuffer_size: i32,
     /// `GL_MAX_VIEWPORT_DIMS`: the widest and tallest frame into a framebuffer a game binds.
     pub max_viewport_dims: [i32; 2],
     /// `GL_MAX_FRAGMENT_UNIFORM_VECTORS`.
@@ -116,7 +118,8 @@ impl Caps {
         let has = |e: &str| extensions.contains(e);
         let es3 = es == EsVersion::Es3;
         let (gl_version, glsl_version, renderer, vendor);
-        let (max_texture_size, max_fragment_uniform_vectors, max_texture_image_units);
+        let (max_texture_size, max_renderbuffer_size);
+        let (max_fragment_uniform_vectors, max_texture_image_units);
         let (mut max_draw_buffers, mut max_color_attachments) = (1, 1);
         let mut max_samples = 0;
         let (fragment_highp, fragment_mediump);
@@ -128,6 +131,7 @@ impl Caps {
             renderer = gl.get_parameter_string(glow::RENDERER);
             vendor = gl.get_parameter_string(glow::VENDOR);
             max_texture_size = gl.get_parameter_i32(glow::MAX_TEXTURE_SIZE);
+            max_renderbuffer_size = gl.get_parameter_i32(glow::MAX_RENDERBUFFER_SIZE);
             max_fragment_uniform_vectors = gl.get_parameter_i32(glow::MAX_FRAGMENT_UNIFORM_VECTORS);
             max_texture_image_units = gl.get_parameter_i32(glow::MAX_TEXTURE_IMAGE_UNITS);
             subpixel_bits = gl.get_parameter_i32(glow::SUBPIXEL_BITS);
@@ -163,6 +167,7 @@ impl Caps {
             renderer,
             vendor,
             max_texture_size,
+            max_renderbuffer_size,
             max_viewport_dims,
             max_fragment_uniform_vectors,
             max_texture_image_units,

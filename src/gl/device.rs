@@ -232,6 +232,12 @@ impl Device {
         &self.caps
     }
 
+    /// The capabilities, to play a device with other limits in a test.
+    #[cfg(test)]
+    pub(crate) fn caps_mut(&mut self) -> &mut Caps {
+        &mut self.caps
+    }
+
     /// The feature level in use.
     pub fn es(&self) -> EsVersion {
         self.caps.es

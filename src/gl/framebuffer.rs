@@ -5,6 +5,7 @@
 
 use glow::HasContext;
 
+use super::target_size::{self, TargetStorage};
 use super::{Device, EsVersion, GlError};
 
 /// An offscreen framebuffer of a fixed size.
@@ -56,12 +57,11 @@ impl OffscreenTarget {
                 "{format:?} render targets are not supported on this context"
             )));
         }
-        let max = dev.caps().max_texture_size as u32;
-        if width == 0 || height == 0 || width > max || height > max {
-            return Err(GlError::Unsupported(format!(
-                "render target {width}×{height} is outside 1..={max} (GL_MAX_TEXTURE_SIZE)"
-            )));
-        }
+        let storage = TargetStorage {
+            textures: true,
+            renderbuffers: true,
+        };
+        target_size::check(dev.caps(), "a render target", (width, height), storage)?;
         let gl = &dev.gl;
         unsafe {
             let color = dev.create_texture()?;

@@ -31,6 +31,7 @@
 const NO_SURFACE_DEPTH: f32 = -1.0e30;
 use glow::HasContext;
 
+use super::target_size::{self, TargetStorage};
 use super::{Device, EsVersion, GlError};
 
 /// Bytes of GPU memory per pixel on this context (see the module docs).
@@ -93,6 +94,11 @@ impl GBuffer {
             return Err(GlError::Unsupported(reason));
         }
         let (w, h) = (width, height);
+        let storage = TargetStorage {
+            textures: true,
+            renderbuffers: false,
+        };
+        target_size::check(dev.caps(), "a deferred G-buffer", (w, h), storage)?;
         let albedo = texture(dev, w, h, glow::RGBA16F)?;
         let normal = texture(dev, w, h, glow::RGBA32F)?;
         let specular = texture(dev, w, h, glow::RGBA16F)?;

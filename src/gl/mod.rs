@@ -30,6 +30,7 @@ pub mod precision_probe;
 pub mod program;
 pub mod shader_source;
 pub mod state;
+pub(crate) mod target_size;
 pub mod texture;
 pub mod timer;
 

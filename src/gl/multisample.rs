@@ -18,6 +18,7 @@ use super::caps::MSAA_RENDER_TO_TEXTURE;
 use super::mesh::{fullscreen_triangle, GpuMesh};
 use super::program::{ProgramCache, ProgramKey, Resolver, Sampler, Uniform, UniformSet};
 use super::state::RenderState;
+use super::target_size::{self, TargetStorage};
 use super::{Device, EsVersion, GlError};
 
 /// A framebuffer whose colour and depth have several samples per pixel.
@@ -96,6 +97,11 @@ impl MultisampleTarget {
         if let Some(reason) = unsupported_reason(dev, samples) {
             return Err(GlError::Unsupported(reason));
         }
+        let storage = TargetStorage {
+            textures: dev.es() != EsVersion::Es3,
+            renderbuffers: true,
+        };
+        target_size::check(dev.caps(), "an MSAA target", (width, height), storage)?;
         let gl = &dev.gl;
         let (w, h) = (width as i32, height as i32);
         // Created one by one; whatever was made is freed if a later one fails.

@@ -191,6 +191,7 @@ fn format_text(
         }
     );
     w!(out, "max texture size   {}", caps.max_texture_size);
+    w!(out, "max renderbuffer   {}", caps.max_renderbuffer_size);
     let [vw, vh] = caps.max_viewport_dims;
     w!(out, "max viewport       {vw}×{vh}");
     w!(
