@@ -49,7 +49,10 @@ SurfaceParams materialSurface(MEDP vec3 albedo, vec2 uv) {
     return s;
 }
 
-// Lambert + Blinn-Phong times N·L (the colour factors at MEDP; N·H at HIGHP before the power).
+// Lambert + Blinn-Phong, both times N·L (the colour factors at MEDP; N·H at HIGHP before the
+// power). The specular lobe fades with N·L, as irradiance does: a light at grazing incidence (one
+// lying on the surface) adds nothing rather than a full highlight gated by the sign of N·L,
+// which rounding flips from pixel to pixel.
 MEDP vec3 blinnPhong(HIGHP vec3 L, vec3 N, vec3 V, MEDP float nDotL, SurfaceParams s) {
 #if HAS_SPECULAR
     HIGHP vec3 halfSum = L + V;
@@ -58,7 +61,7 @@ MEDP vec3 blinnPhong(HIGHP vec3 L, vec3 N, vec3 V, MEDP float nDotL, SurfacePara
 #else
     MEDP vec3 spec = vec3(0.0);
 #endif
-    return s.albedo * nDotL + spec;
+    return (s.albedo + spec) * nDotL;
 }
 
 #if METALLIC_ROUGHNESS

@@ -9,7 +9,7 @@
 //! falloff  = clamp(1 − (d/r)⁴, 0, 1)² / (d² + 1)          exactly 0 for d ≥ r
 //! spot     = smoothstep over t = clamp(offset − scale·(1 − dot(−L, dir)), 0, 1)   (1 for points)
 //! diffuse  = albedo · max(N·L, 0)
-//! specular = Ks · max(N·H, 0)^Ns   with H = normalize(L + V), only where N·L > 0
+//! specular = Ks · max(N·H, 0)^Ns · max(N·L, 0)   with H = normalize(L + V)
 //! out      = ambient · albedo + Σ c · falloff · spot · (diffuse + specular)
 //!                             + Σ suns c · (diffuse + specular)  with L = −direction
 //! ```
@@ -162,7 +162,7 @@ pub fn reflectance(l: DVec3, s: &Surface, v: DVec3) -> DVec3 {
         MaterialModel::BlinnPhong => {
             let h = (l + v).normalize_or_zero();
             let n_dot_h = s.normal.dot(h).max(0.0);
-            s.albedo * s.normal.dot(l) + s.specular * n_dot_h.powf(s.exponent)
+            (s.albedo + s.specular * n_dot_h.powf(s.exponent)) * s.normal.dot(l)
         }
         MaterialModel::MetallicRoughness => {
             super::brdf::reflectance(l, s.normal, v, s.albedo, s.metallic, s.roughness)

@@ -144,3 +144,72 @@ fn oracle_detects_a_slightly_moved_light() {
     let (err, _, _) = max_oracle_error(&img, &reference, Encoding::Linear, gpu.r().caps());
     assert!(err > 2.0, "a moved light went unnoticed (error {err})");
 }
+
+/// Lights lying on the plane and a hair above it: the plane lit at grazing incidence, its
+/// material a broad highlight (`Ns` 2, as many MTL files have), which the grazing lights reach.
+fn lights_on_the_plane() -> Scene {
+    let mut s = scene::builtin::build("plane", None).unwrap();
+    s.ambient = Vec3::splat(0.03);
+    for m in &mut s.materials {
+        m.specular = Vec3::ONE;
+        m.shininess = 2.0;
+    }
+    // Oblique, so that view space rounds the plane's points off it (head-on, every point of
+    // the plane and the lights on it share one view depth exactly).
+    s.camera = manylight::Camera::perspective(
+        DVec3::new(0.7, -4.0, 2.5),
+        DVec3::new(0.0, 0.0, 0.0),
+        60.0,
+        0.1,
+        50.0,
+    );
+    s.lights = [(-1.0, 0.0), (1.0, 1e-3), (0.0, 1e-5)]
+        .map(|(x, z)| Light::point(DVec3::new(x, -0.3, z), 3.0, Vec3::ONE, 6.0))
+        .to_vec();
+    s
+}
+
+/// A light on a surface sends it no irradiance, whatever the BRDF: its specular term fades with
+/// N·L as the diffuse one does. Gated instead by the sign of N·L, a highlight of the light on
+/// the plane showed in broken dashes wherever rounding made N·L positive, and the light just
+/// above it lost dashes of its highlight where rounding made N·L negative.
+#[test]
+fn lights_lying_on_a_surface_light_it_as_the_light_model_says() {
+    let linear = RenderOptions {
+        linear: true,
+        ..Default::default()
+    };
+    for es in [EsVersion::Es3, EsVersion::Es2] {
+        let mut gpu = Gpu::new(es);
+        let mut dark = lights_on_the_plane();
+        dark.lights.truncate(1);
+        let ambient_only = Scene {
+            lights: vec![],
+            ..dark.clone()
+        };
+        for method in ["forward", "clustered"] {
+            gpu.r().set_method_named(method).unwrap();
+            let unlit = gpu.render(&ambient_only, W, H, &linear);
+            let img = gpu.render(&dark, W, H, &linear);
+            let brighter = img
+                .pixels()
+                .zip(unlit.pixels())
+                .filter(|(a, b)| (0..3).any(|c| a[c] > b[c].saturating_add(1)))
+                .count();
+            assert_eq!(
+                brighter, 0,
+                "{es} {method}: a light lying on the plane lit {brighter} pixels"
+            );
+            let scene = lights_on_the_plane();
+            let img = gpu.render(&scene, W, H, &linear);
+            let (err, at, covered) =
+                max_oracle_error(&img, &scene, Encoding::Linear, gpu.r().caps());
+            // The plane fills the picture below its far edge.
+            assert!(covered > (W * H) as usize * 3 / 4, "{covered} compared");
+            assert!(
+                err <= 2.0,
+                "{es} {method}: max error {err:.2}/255 at {at:?} against the light model"
+            );
+        }
+    }
+}
