@@ -25,8 +25,35 @@ pub struct Device {
     host_depth: std::cell::Cell<u32>,
     /// Whether a GL error the application left pending has been reported (once a device).
     warned_pending_error: std::cell::Cell<bool>,
-    /// The EGL context current when the device was made (as an address), where EGL can say.
-    context: Option<usize>,
+    /// How the device tells whether its context is current.
+    context: ContextWatch,
+}
+
+/// Which EGL says what context is current, and the device's own context there.
+#[derive(Clone, Copy, Debug)]
+enum ContextWatch {
+    /// The EGL manylight loaded (a `HeadlessContext`'s): the context current at creation,
+    /// where there was one.
+    Loaded(Option<usize>),
+    /// The system's EGL, which reported this context current at creation: the application's
+    /// context came from it (glutin's, Android's).
+    System(usize),
+    /// Neither can tell (GLX, WGL, another EGL): never checked.
+    Unknown,
+}
+
+impl ContextWatch {
+    /// The watch for the context current now.
+    fn of_current() -> ContextWatch {
+        if let Some(current) = super::gles_lib::current_context() {
+            return ContextWatch::Loaded(current);
+        }
+        match super::ext_fns::system_current_context() {
+            Some(Some(context)) => ContextWatch::System(context),
+            // No EGL context current while a context works: it is not the system EGL's.
+            _ => ContextWatch::Unknown,
+        }
+    }
 }
 
 /// GL objects currently alive, as counted by the renderer's own create/delete calls: what
@@ -118,14 +145,19 @@ impl Device {
             vertex_array,
             host_depth: std::cell::Cell::new(0),
             warned_pending_error: std::cell::Cell::new(false),
-            context: super::gles_lib::current_context().flatten(),
+            context: ContextWatch::of_current(),
         })
     }
 
     /// Whether this device's context is current on this thread: an error when EGL says no
     /// context is, or another one (its GL names would be that context's objects).
     pub(crate) fn check_current(&self) -> Result<(), GlError> {
-        match (super::gles_lib::current_context(), self.context) {
+        let (now, own) = match self.context {
+            ContextWatch::Loaded(own) => (super::gles_lib::current_context(), own),
+            ContextWatch::System(own) => (super::ext_fns::system_current_context(), Some(own)),
+            ContextWatch::Unknown => return Ok(()),
+        };
+        match (now, own) {
             (Some(None), _) => Err(GlError::NotCurrent),
             (Some(Some(now)), Some(own)) if now != own => Err(GlError::OtherContext),
             _ => Ok(()),

@@ -103,6 +103,28 @@ fn entry_point(name: &str) -> Option<*const std::ffi::c_void> {
     non_null(unsafe { get_proc_address(cname.as_ptr()) })
 }
 
+/// The EGL context current on this thread according to the system's `libEGL` (`Some(None)`:
+/// none), or `None` when that library or its `eglGetCurrentContext` cannot be loaded. Only
+/// meaningful for a context made through the system's EGL (a window toolkit's, Android's): a
+/// context made through GLX, WGL or another EGL is not one it knows.
+pub(crate) fn system_current_context() -> Option<Option<usize>> {
+    type GetCurrentContext = unsafe extern "system" fn() -> *mut std::ffi::c_void;
+    static SYSTEM: std::sync::OnceLock<Option<(libloading::Library, GetCurrentContext)>> =
+        std::sync::OnceLock::new();
+    let (_egl, get_current_context) = SYSTEM
+        .get_or_init(|| {
+            let egl = system_library(&["libEGL.so.1", "libEGL.so"])?;
+            let f = symbol(&egl, "eglGetCurrentContext")?;
+            // SAFETY: EGL 1.4 specifies this signature for `eglGetCurrentContext`.
+            let f = unsafe { std::mem::transmute::<*const std::ffi::c_void, GetCurrentContext>(f) };
+            Some((egl, f))
+        })
+        .as_ref()?;
+    // SAFETY: no arguments; the library stays loaded (kept beside the pointer).
+    let context = unsafe { get_current_context() };
+    Some((!context.is_null()).then_some(context as usize))
+}
+
 /// The first of the system's `files` that loads.
 fn system_library(files: &[&str]) -> Option<libloading::Library> {
     // SAFETY: the system's GL library, which the application's context already uses; loading
