@@ -186,6 +186,7 @@ impl Device {
             super::host_state::HostState::enter(
                 &self.gl,
                 self.caps.context_has_es3_state(),
+                self.caps.desktop,
                 self.vertex_array,
                 self.attrib_pointer_fns,
             )

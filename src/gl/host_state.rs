@@ -75,17 +75,28 @@ pub(crate) struct HostState {
     /// The attributes' constant values, and on ES 2.0 their arrays (no vertex array object
     /// keeps them apart).
     attributes: HostAttributes,
+    /// Desktop GL's own state that changes the picture: its polygon mode (a wireframe debug
+    /// view) and whether sRGB framebuffers encode (the shaders encode already).
+    desktop: Option<DesktopState>,
+}
+
+/// See [`HostState::desktop`].
+struct DesktopState {
+    polygon_mode: i32,
+    framebuffer_srgb: bool,
 }
 
 impl HostState {
     /// Saves the application's state and sets what the renderer assumes: its own vertex
     /// array (`vao`, ES 3.0 and desktop), no pixel buffer, no sampler objects on its units,
     /// the capabilities of `OFF_INSIDE` off, additive blend equations, counter-clockwise
-    /// front faces, the full depth range, a clear depth of 1 and pixel rows that start where
-    /// the data does.
+    /// front faces, the full depth range, a clear depth of 1, pixel rows that start where
+    /// the data does and texture unit 0 active (a game's active unit past the saved ones
+    /// keeps its texture); on `desktop` GL, filled polygons and no sRGB encoding.
     pub(crate) fn enter(
         gl: &glow::Context,
         es3: bool,
+        desktop: bool,
         vao: Option<glow::VertexArray>,
         attrib_fns: Option<AttribPointerFns>,
     ) -> Self {
@@ -103,7 +114,7 @@ impl HostState {
                     gl.bind_sampler(unit as u32, None);
                 }
             }
-            gl.active_texture(active_texture as u32);
+            gl.active_texture(glow::TEXTURE0);
             let mut viewport = [0i32; 4];
             gl.get_parameter_i32_slice(glow::VIEWPORT, &mut viewport);
             let mut scissor = [0i32; 4];
@@ -174,7 +185,19 @@ impl HostState {
                     [0; STORE_ES3.len()]
                 },
                 attributes: HostAttributes::save(gl, vao.is_none().then_some(attrib_fns).flatten()),
+                desktop: desktop.then(|| {
+                    let mut polygon_mode = [glow::FILL as i32; 2];
+                    gl.get_parameter_i32_slice(glow::POLYGON_MODE, &mut polygon_mode);
+                    DesktopState {
+                        polygon_mode: polygon_mode[0],
+                        framebuffer_srgb: gl.is_enabled(glow::FRAMEBUFFER_SRGB),
+                    }
+                }),
             };
+            if desktop {
+                gl.polygon_mode(glow::FRONT_AND_BACK, glow::FILL);
+                gl.disable(glow::FRAMEBUFFER_SRGB);
+            }
             if let Some(vao) = vao {
                 gl.bind_vertex_array(Some(vao));
             }
@@ -266,6 +289,10 @@ impl HostState {
             gl.clear_depth(self.clear_depth.into());
             gl.pixel_store_i32(glow::PACK_ALIGNMENT, self.alignment[0]);
             gl.pixel_store_i32(glow::UNPACK_ALIGNMENT, self.alignment[1]);
+            if let Some(desktop) = &self.desktop {
+                gl.polygon_mode(glow::FRONT_AND_BACK, desktop.polygon_mode as u32);
+                enable(glow::FRAMEBUFFER_SRGB, desktop.framebuffer_srgb);
+            }
         }
     }
 }

@@ -14,6 +14,10 @@ use manylight::glow::{self, HasContext};
 use manylight::scene;
 use manylight::{EsVersion, HeadlessContext, RenderOptions, Renderer};
 
+/// Texture units the game binds: past the renderer's eight (every context here has at least
+/// 16 combined units).
+const GAME_UNITS: u32 = 12;
+
 /// Everything the game set, read back the same way after each renderer call.
 #[derive(Debug, PartialEq)]
 struct Snapshot {
@@ -83,7 +87,7 @@ fn snapshot(gl: &glow::Context, es3: bool) -> Snapshot {
         })
         .collect();
         let active = gl.get_parameter_i32(glow::ACTIVE_TEXTURE);
-        let units = (0..8)
+        let units = (0..GAME_UNITS)
             .map(|u| {
                 gl.active_texture(glow::TEXTURE0 + u);
                 let texture = gl.get_parameter_i32(glow::TEXTURE_BINDING_2D);
@@ -185,6 +189,11 @@ unsafe fn set_game_state(gl: &glow::Context, es3: bool, vao: bool, size: (i32, i
     // The game's framebuffer, its colour texture bound on unit 5.
     gl.active_texture(glow::TEXTURE5);
     game_framebuffer(gl, false, size);
+    // Left active: a unit past those the renderer binds (a game's shadow map, say), whose
+    // texture an upload bound on the active unit would replace.
+    gl.active_texture(glow::TEXTURE0 + GAME_UNITS - 1);
+    let t = gl.create_texture().unwrap();
+    gl.bind_texture(glow::TEXTURE_2D, Some(t));
     if es3 {
         let sampler = gl.create_sampler().unwrap();
         gl.sampler_parameter_i32(sampler, glow::TEXTURE_MIN_FILTER, glow::NEAREST as i32);

@@ -52,3 +52,44 @@ fn osmesa_renders_the_default_scene_through_every_method() {
     let d = manylight::metrics::diff(&reference, &es3);
     assert!(d.max_abs <= 2, "OSMesa vs EGL ES 3.0: {} / 255", d.max_abs);
 }
+
+/// Desktop GL's own state a game may leave on: a wireframe polygon mode (a debug view) and
+/// sRGB encoding of framebuffers. Neither changes the frame, and both come back.
+#[test]
+#[allow(unsafe_code)] // the game's side: raw glow calls
+fn a_desktop_games_polygon_mode_and_srgb_switch_neither_change_the_frame_nor_stay_changed() {
+    use manylight::glow::{self, HasContext};
+    let ctx = match OsMesaContext::new() {
+        Ok(c) => c,
+        Err(e) => {
+            common::skip(&e.to_string());
+            return;
+        }
+    };
+    let s = scene::builtin::build(scene::builtin::DEFAULT, Some((64, 5))).unwrap();
+    let opts = RenderOptions::default();
+    let mut r = Renderer::new(ctx.load_gl(), EsVersion::Es3).unwrap();
+    let (clean, _) = r.render_offscreen(&s, 96, 54, &opts).unwrap();
+    let gl = ctx.load_gl();
+    unsafe {
+        gl.polygon_mode(glow::FRONT_AND_BACK, glow::LINE);
+        gl.enable(glow::FRAMEBUFFER_SRGB);
+    }
+    let (img, _) = r.render_offscreen(&s, 96, 54, &opts).unwrap();
+    let d = manylight::metrics::diff(&clean, &img);
+    assert_eq!(d.max_abs, 0, "the game's desktop state changed the frame");
+    unsafe {
+        let mut mode = [0; 2];
+        gl.get_parameter_i32_slice(glow::POLYGON_MODE, &mut mode);
+        assert_eq!(
+            mode[0],
+            glow::LINE as i32,
+            "the polygon mode was not given back"
+        );
+        assert!(
+            gl.is_enabled(glow::FRAMEBUFFER_SRGB),
+            "sRGB encoding left off"
+        );
+    }
+    r.destroy();
+}
