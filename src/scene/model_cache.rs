@@ -205,9 +205,9 @@ impl ModelCache {
         Ok(report)
     }
 
-    /// Places a glTF file with `transform`. A file without lights or cameras is read once, at
-    /// the identity, and placed from that; one with them is read for each reference (they
-    /// depend on the transform), sharing the meshes and textures of earlier reads.
+    /// Places a glTF file with `transform`. A file without lights (suns included) or cameras
+    /// is read once, at the identity, and placed from that; one with them is read for each
+    /// reference (they depend on the transform), sharing the meshes and textures of earlier reads.
     pub fn place_gltf(
         &mut self,
         scene: &mut Scene,
@@ -230,7 +230,12 @@ impl ModelCache {
                     &mut self.texture_budget,
                 );
                 let entry = match read {
-                    Ok(read) if alone.lights.is_empty() && read.camera.is_none() => {
+                    // A sun's direction turns with the placement as a lamp's position moves.
+                    Ok(read)
+                        if alone.lights.is_empty()
+                            && alone.directional_lights.is_empty()
+                            && read.camera.is_none() =>
+                    {
                         self.share(&mut alone, 0, 0, Some(k), true);
                         let loaded = Loaded::record(&alone, (0, 0), |o| o.transform, true);
                         Some((loaded, read.report))

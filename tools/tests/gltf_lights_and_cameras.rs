@@ -306,3 +306,42 @@ fn triangle_lit_by(light: Value) -> String {
     doc["extensions"] = json!({"KHR_lights_punctual": {"lights": [light]}});
     b.gltf(doc)
 }
+
+/// A file whose only lights are suns, with no camera, placed from a scene file twice: each
+/// placement brings its sun, turned with it (such a file was once cached as a light-free
+/// model, and the scene came out black without a warning).
+#[test]
+fn a_sun_only_gltf_placed_from_a_scene_file_brings_its_sun_each_time() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut b = Builder::default();
+    let floor_prim = primitive(&mut b, &floor(), Some(0));
+    let gltf = json!({
+        "extensionsUsed": ["KHR_lights_punctual"],
+        "extensions": {"KHR_lights_punctual": {"lights": [
+            {"type": "directional", "color": [1, 1, 1], "intensity": 2048}
+        ]}},
+        "scenes": [{"nodes": [0, 1]}],
+        "nodes": [
+            {"mesh": 0},
+            {"extensions": {"KHR_lights_punctual": {"light": 0}}}
+        ],
+        "meshes": [{"primitives": [floor_prim]}],
+        "materials": [{"pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.8, 0.8, 1]}}],
+    });
+    write(dir.path(), "sun.gltf", b.gltf(gltf));
+    let json_path = write(
+        dir.path(),
+        "scene.json",
+        r#"{"objects": [{"gltf": "sun.gltf"},
+                        {"gltf": "sun.gltf", "transform": {"rotate_y_deg": 90}}]}"#,
+    );
+    let (scene, _) = scene::load(json_path.to_str().unwrap(), None).unwrap();
+    let suns: Vec<DVec3> = scene
+        .directional_lights
+        .iter()
+        .map(|s| s.direction)
+        .collect();
+    assert_eq!(suns.len(), 2, "one sun a placement: {suns:?}");
+    assert!((suns[0] - DVec3::NEG_Z).length() < 1e-9, "{suns:?}");
+    assert!((suns[1] - DVec3::NEG_X).length() < 1e-9, "{suns:?}");
+}
