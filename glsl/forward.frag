@@ -38,13 +38,8 @@ void main() {
 #else
     vec3 N = normalize(v_normal);
     vec3 V = viewDirection(v_viewPos);
-    // Two-sided surfaces: light the side the eye sees.
-    if (dot(N, V) < 0.0) {
-        N = -N;
-    }
-#if HAS_NORMAL_MAP
-    N = surfaceNormal(N, v_uv);
-#endif
+    // Two-sided: the side the eye sees.
+    N = shadingNormal(N, V, v_uv);
     MEDP vec3 albedo = surfaceAlbedo(v_uv);
     SurfaceParams surface = materialSurface(albedo, v_uv);
     HIGHP vec3 color = surfaceAmbient(albedo, v_uv);

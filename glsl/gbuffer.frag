@@ -17,13 +17,8 @@ layout(location = 3) out vec4 o_extra;
 void main() {
     vec3 N = normalize(v_normal);
     vec3 V = viewDirection(v_viewPos);
-    // Two-sided, as in the forward shaders: store the side the eye sees.
-    if (dot(N, V) < 0.0) {
-        N = -N;
-    }
-#if HAS_NORMAL_MAP
-    N = surfaceNormal(N, v_uv);
-#endif
+    // Two-sided: the side the eye sees.
+    N = shadingNormal(N, V, v_uv);
     // The surface point as its depth and its window offset from the pixel centre (see
     // windowPosition): the light pass shades the very point forward shades.
     HIGHP vec2 offset = windowPosition(v_viewPos) - gl_FragCoord.xy;

@@ -35,6 +35,18 @@ vec3 linearToSrgb(vec3 c) {
 
 #include "surface_maps.glsl"
 
+// The shading normal of the side the eye sees (surfaces are two-sided): the interpolated unit
+// normal N, normal-mapped in its own tangent frame, then reversed whole where N faces away
+// (glTF 2.0 §3.9.5: a back face's normals are reversed). Mapping after the flip instead would
+// mirror the map along the tangent, lighting a back face from the wrong side.
+vec3 shadingNormal(vec3 N, vec3 V, vec2 uv) {
+    float side = dot(N, V) < 0.0 ? -1.0 : 1.0;
+#if HAS_NORMAL_MAP
+    N = surfaceNormal(N, uv);
+#endif
+    return N * side;
+}
+
 vec3 surfaceAlbedo(vec2 uv) {
     vec3 albedo = u_albedo;
 #if HAS_TEXTURE

@@ -32,7 +32,7 @@ uniform float u_normalScale;
 // View-space tangent, bitangent sign in w.
 VARYING vec4 v_tangent;
 
-// The normal-mapped shading normal; N is the interpolated unit normal, turned to the eye.
+// The normal-mapped normal; N is the interpolated unit normal (of the front face).
 vec3 surfaceNormal(vec3 N, vec2 uv) {
     vec3 t = v_tangent.xyz - N * dot(N, v_tangent.xyz);
     float len = length(t);

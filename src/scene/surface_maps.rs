@@ -162,7 +162,8 @@ impl SurfaceMaps {
 /// The shading normal from a normal-map texel (`rgb` in [0, 1], linear), CPU twin of
 /// `surfaceNormal` in `glsl/surface.glsl`: `n = normalize(T·x + B·y + N·z)` with
 /// `(x, y, z) = (2·rgb − 1)·(scale, scale, 1)` and `B = w·(N × T)`. `normal` and `tangent`
-/// are the interpolated unit vectors of the surface; a degenerate result keeps `normal`.
+/// are the interpolated unit vectors of the surface (its front face's); a degenerate result
+/// keeps `normal`. A back face's shading normal is this reversed whole (`shadingNormal`).
 pub fn perturbed_normal(normal: DVec3, tangent: DVec3, w: f64, rgb: DVec3, scale: f64) -> DVec3 {
     let t = (tangent - normal * normal.dot(tangent)).normalize_or_zero();
     let b = normal.cross(t) * w.signum();

@@ -102,13 +102,25 @@ fn grazing_light() -> Vec<Light> {
     )]
 }
 
+/// `lights` mirrored through the plane (z to −z), for a view from behind it.
+fn behind(lights: Vec<Light>) -> Vec<Light> {
+    lights
+        .into_iter()
+        .map(|mut l| {
+            l.position.z = -l.position.z;
+            l
+        })
+        .collect()
+}
+
 #[test]
 fn a_normal_map_tilts_the_shading_normal_with_file_and_generated_tangents() {
     let dir = tempfile::tempdir().unwrap();
     // The plane's mapping is upright, so MikkTSpace gives +x with the bitangent up the image
     // (w = +1, glTF's convention); the file's tangents say the other hand (w = −1). Each file's
-    // texel tilts the normal towards −x (the light) and −y (the eye), scale 0.8 on x and y: a
-    // normal tilted away from the eye is turned back whole by the twin, not by the shaders.
+    // texel tilts the normal towards −x (the light) and −y (the eye), scale 0.8 on x and y
+    // (the shaders light a mapped normal as it is, also one tilted away from the eye, and so
+    // does the twin here).
     let down = [60u8, 215, 200, 255];
     let up = [60u8, 40, 200, 255];
     let material = json!({
@@ -155,6 +167,27 @@ fn a_normal_map_tilts_the_shading_normal_with_file_and_generated_tangents() {
         );
         check_every_method("normal map", &s, &want, 3.0);
     }
+    // Seen from behind, with the light on the eye's side: the back face's shading normal is
+    // the front's reversed whole (glTF 2.0 §3.9.5); mapped in a frame flipped with the
+    // normal, the tilt along the tangent would be mirrored.
+    let (mut s, _) = scene_of(&from_file, behind(grazing_light()), 0.02);
+    s.camera = Camera::perspective(DVec3::new(0.0, -0.4, -1.6), DVec3::ZERO, 60.0, 0.1, 20.0);
+    let back = |p: DVec3, _: DVec2, _: [f64; 4]| {
+        let n = perturbed_normal(DVec3::Z, DVec3::X, -1.0, rgb(down), 0.8);
+        (surface(p, -n, albedo), DVec3::ZERO, 1.0)
+    };
+    let want = oracle(&s, &back);
+    let mirrored_back = |p: DVec3, _: DVec2, _: [f64; 4]| {
+        let n = perturbed_normal(DVec3::Z, DVec3::X, -1.0, rgb(down), 0.8);
+        let n = DVec3::new(n.x, -n.y, -n.z);
+        (surface(p, n, albedo), DVec3::ZERO, 1.0)
+    };
+    let gap = oracle_gap(&want, &oracle(&s, &mirrored_back));
+    assert!(
+        gap > 10.0,
+        "a mirrored back face differs by only {gap:.1}/255"
+    );
+    check_every_method("normal map seen from behind", &s, &want, 3.0);
     // Mirrored along x: the tangent turns to −x and the bitangent keeps pointing down the
     // image, so the handedness flips with the transform's determinant.
     let (mut s, _) = scene_of(&from_file, grazing_light(), 0.02);

@@ -3,7 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
-use glam::{DVec2, DVec3, Vec3};
+use glam::{DVec2, DVec3};
 use manylight::scene::raycast::pixel_ray;
 use manylight::scene::shading::{self, linear_to_srgb, srgb_to_linear, Surface};
 use manylight::scene::Scene;
@@ -136,7 +136,13 @@ pub fn oracle(scene: &Scene, model: &Model) -> Vec<Option<[f64; 3]>> {
             let uv = DVec2::new((p.x + 1.0) / 2.0, (1.0 - p.y) / 2.0);
             let (surface, emitted, ao) = model(p, uv, corner_weights(p));
             let v = (scene.camera.position - p).normalize();
-            let mut c = shading::shade(&surface, v, &scene.lights, Vec3::ZERO);
+            // Lit with the model's normal as given, as the shaders light a mapped normal
+            // (`shading::shade` would turn one facing away from the eye back).
+            let mut c: DVec3 = scene
+                .lights
+                .iter()
+                .map(|l| shading::light_contribution(l, &surface, v))
+                .sum();
             c += scene.ambient.as_dvec3() * surface.albedo * ao + emitted;
             out.push(Some([0, 1, 2].map(|k| linear_to_srgb(c[k]) * 255.0)));
         }
