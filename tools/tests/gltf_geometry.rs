@@ -273,3 +273,36 @@ fn a_normal_mapped_fan_beyond_the_mikktspace_bound_gets_fallback_tangents_and_a_
         );
     }
 }
+
+/// A primitive without normals ignores its tangents (glTF 2.0 §3.7.2.1): a normal map gets
+/// generated ones, here +x for a quad mapped upright, not the file's +y.
+#[test]
+fn a_primitive_without_normals_ignores_its_tangents() {
+    let dir = tempfile::tempdir().unwrap();
+    write(dir.path(), "checker.png", checker_png());
+    let mut b = Builder::default();
+    let p = b.floats(
+        &[0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 1.0, 0.0],
+        "VEC3",
+    );
+    let t = b.floats(&[0.0, 1.0, 1.0, 1.0, 1.0, 0.0, 0.0, 0.0], "VEC2");
+    let tangent = b.floats(&[0.0, 1.0, 0.0, 1.0].repeat(4), "VEC4");
+    let i = b.u16s(&[0, 1, 2, 0, 2, 3]);
+    let rest = json!({
+        "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": p, "TEXCOORD_0": t,
+                                                   "TANGENT": tangent},
+                                    "indices": i, "material": 0}]}],
+        "materials": [{"normalTexture": {"index": 0}}],
+        "textures": [{"source": 0}], "images": [{"uri": "checker.png"}],
+    });
+    let (scene, _) = load(&write(dir.path(), "quad.gltf", b.gltf(rest))).unwrap();
+    let mesh = &scene.objects[0].mesh;
+    assert_eq!(mesh.tangents.len(), mesh.positions.len());
+    for t in &mesh.tangents {
+        assert!(
+            (t.truncate() - Vec3::X).length() < 1e-5,
+            "not the generated tangent: {t}"
+        );
+    }
+}

@@ -169,6 +169,9 @@ pub(super) fn build(
         }
         indices.iter().map(|&i| v[i as usize]).collect()
     };
+    // Without normals the file's tangents are ignored (glTF 2.0 §3.7.2.1): they were made for
+    // normals the file does not give, so a normal map takes generated ones.
+    let tangents = if flat { Vec::new() } else { tangents };
     let (colors, tangents) = (unshare(colors), unshare(tangents));
     let (positions, uvs, indices) = if flat {
         budget.take("vertices", indices.len(), field)?;

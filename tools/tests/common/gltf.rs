@@ -46,6 +46,7 @@ impl Builder {
         let per = match ty {
             "VEC2" => 2,
             "VEC3" => 3,
+            "VEC4" => 4,
             _ => 1,
         };
         let bytes: Vec<u8> = values.iter().flat_map(|v| v.to_le_bytes()).collect();
