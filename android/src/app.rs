@@ -142,10 +142,15 @@ impl ApplicationHandler for Shell {
     }
 
     fn exiting(&mut self, _: &ActiveEventLoop) {
-        // GL objects can only be freed with the context current, i.e. while shown.
-        if self.live.is_some() {
-            if let Some(r) = self.renderer.take() {
+        // GL objects can only be freed with the context current, i.e. while shown. Android
+        // suspends before it exits, so usually the context is parked: the renderer then goes
+        // without a GL call (the context and its objects go with the process), before the
+        // parked context is dropped.
+        if let Some(r) = self.renderer.take() {
+            if self.live.is_some() {
                 r.destroy();
+            } else {
+                r.abandon();
             }
         }
     }
