@@ -328,6 +328,30 @@ impl Device {
         unsafe { self.gl.check_framebuffer_status(glow::FRAMEBUFFER) }
     }
 
+    /// Whether the bound framebuffer's colour buffer encodes sRGB on write
+    /// (`GL_FRAMEBUFFER_ATTACHMENT_COLOR_ENCODING`: an `SRGB8_ALPHA8` attachment, or a window
+    /// surface made with an sRGB colour space). ES 3.0, and ES 2.0 with `GL_EXT_sRGB`; never
+    /// on desktop GL, whose encoding the renderer's calls switch off (`GL_FRAMEBUFFER_SRGB`).
+    pub(crate) fn bound_color_is_srgb(&self) -> bool {
+        let caps = &self.caps;
+        if caps.desktop || !(caps.context_has_es3_state() || caps.has_extension("GL_EXT_sRGB")) {
+            return false;
+        }
+        let gl = &self.gl;
+        let attachment = if self.bound_framebuffer().is_some() {
+            glow::COLOR_ATTACHMENT0
+        } else {
+            glow::BACK
+        };
+        let param = |p| unsafe {
+            gl.get_framebuffer_attachment_parameter_i32(glow::FRAMEBUFFER, attachment, p)
+        };
+        let srgb = param(glow::FRAMEBUFFER_ATTACHMENT_OBJECT_TYPE) != glow::NONE as i32
+            && param(glow::FRAMEBUFFER_ATTACHMENT_COLOR_ENCODING) == glow::SRGB as i32;
+        // A driver that cannot say (a surfaceless default framebuffer) leaves an error.
+        self.drain_errors() == glow::NO_ERROR && srgb
+    }
+
     /// The depth bits of the bound framebuffer (0: no depth buffer); `None` where the driver
     /// would not say. ES 2.0 asks `GL_DEPTH_BITS`; ES 3.0 and desktop core (which dropped that
     /// query) ask the depth attachment.

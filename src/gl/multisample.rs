@@ -31,6 +31,9 @@ pub struct MultisampleTarget {
     samples: u32,
     /// The samples the implementation gave: GL rounds a count it lacks up to one it has.
     samples_drawn: u32,
+    /// ES 3.0: the colour renderbuffers' format, `SRGB8_ALPHA8` for a destination that
+    /// encodes sRGB (a multisampled blit needs identical formats), else `RGBA8`.
+    color_format: u32,
     /// Bytes of one depth sample.
     depth_bytes: usize,
     /// ES 3.0, resolving to an origin other than (0, 0): a single-sampled copy the samples are
@@ -94,6 +97,18 @@ pub fn unsupported_reason(dev: &Device, samples: u32) -> Option<String> {
 impl MultisampleTarget {
     /// A `width × height` target with `samples` samples per pixel (at least 2).
     pub fn new(dev: &Device, width: u32, height: u32, samples: u32) -> Result<Self, GlError> {
+        Self::with_encoding(dev, width, height, samples, false)
+    }
+
+    /// [`MultisampleTarget::new`], its colour encoded as sRGB on ES 3.0 with `srgb` (to be
+    /// resolved into an sRGB destination; the frame is then drawn with linear output).
+    pub fn with_encoding(
+        dev: &Device,
+        width: u32,
+        height: u32,
+        samples: u32,
+        srgb: bool,
+    ) -> Result<Self, GlError> {
         if let Some(reason) = unsupported_reason(dev, samples) {
             return Err(GlError::Unsupported(reason));
         }
@@ -128,6 +143,11 @@ impl MultisampleTarget {
             size: (width, height),
             samples,
             samples_drawn: samples,
+            color_format: if srgb && dev.es() == EsVersion::Es3 {
+                glow::SRGB8_ALPHA8
+            } else {
+                glow::RGBA8
+            },
             depth_bytes: if dev.es() == EsVersion::Es3 || dev.caps().depth24 {
                 4
             } else {
@@ -144,7 +164,7 @@ impl MultisampleTarget {
                     gl.renderbuffer_storage_multisample(
                         glow::RENDERBUFFER,
                         samples as i32,
-                        glow::RGBA8,
+                        target.color_format,
                         w,
                         h,
                     );
@@ -239,6 +259,11 @@ impl MultisampleTarget {
         (self.size, self.samples)
     }
 
+    /// Whether the colour samples are stored sRGB-encoded (see [`Self::with_encoding`]).
+    pub fn is_srgb(&self) -> bool {
+        self.color_format == glow::SRGB8_ALPHA8
+    }
+
     /// Samples per pixel the implementation gave (at least those asked for).
     pub fn samples_drawn(&self) -> u32 {
         self.samples_drawn
@@ -266,8 +291,8 @@ impl MultisampleTarget {
 
     /// Resolves the samples into the target-sized rectangle at `origin` of the framebuffer
     /// `into` (`None`: the default one): each pixel the average of its samples. Leaves `into`
-    /// bound. ES 3.0 blits, so the destination's colour format must be RGBA8 (its multisample
-    /// resolve needs identical formats); ES 2.0 draws the averaged texture over it with a
+    /// bound. ES 3.0 blits, so the destination's colour format must be RGBA8, or SRGB8_ALPHA8
+    /// for a target made sRGB (a multisample resolve needs identical formats); ES 2.0 draws the averaged texture over it with a
     /// program from `programs`.
     pub fn resolve(
         &mut self,
@@ -307,7 +332,10 @@ impl MultisampleTarget {
                 triangle.draw(dev);
             }
         }
-        dev.check("MSAA resolve (ES 3.0: the destination must be RGBA8 and hold the frame)")
+        dev.check(
+            "MSAA resolve (ES 3.0: the destination must be RGBA8 or SRGB8_ALPHA8 and hold the \
+             frame)",
+        )
     }
 
     /// The single-sampled copy (made now if it is not yet): its framebuffer.
@@ -327,7 +355,7 @@ impl MultisampleTarget {
         unsafe {
             dev.gl.bind_renderbuffer(glow::RENDERBUFFER, Some(colour));
             dev.gl
-                .renderbuffer_storage(glow::RENDERBUFFER, glow::RGBA8, w, h);
+                .renderbuffer_storage(glow::RENDERBUFFER, self.color_format, w, h);
             dev.gl.bind_framebuffer(glow::FRAMEBUFFER, Some(fbo));
             dev.gl.framebuffer_renderbuffer(
                 glow::FRAMEBUFFER,

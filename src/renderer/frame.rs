@@ -91,6 +91,8 @@ impl Renderer {
         if applications {
             self.check_bound_target(width, height, samples <= 1)?;
         }
+        // A framebuffer that encodes sRGB itself is given linear values, not encoded twice.
+        self.srgb_destination = applications && self.dev.bound_color_is_srgb();
         if samples <= 1 {
             return self.render_frame(scene, (width, height), options, origin, stats);
         }
@@ -100,7 +102,8 @@ impl Renderer {
         } else {
             ColorFormat::Rgba8
         };
-        let prepared = self.prepare_msaa(width, height, samples, format);
+        let srgb = self.srgb_destination;
+        let prepared = self.prepare_msaa(width, height, samples, format, srgb);
         // Creating the target binds (then leaves) framebuffers: the caller's comes back.
         self.dev.bind_framebuffer(destination);
         prepared?;
@@ -149,7 +152,10 @@ impl Renderer {
             .as_mat4();
         gather_lights(&mut self.lights, scene, &view, options);
         let scene_features = SceneFeatures::of(scene);
-        let features = shader_features(&scene_features, options, self.dev.caps());
+        let features = shader_features(&scene_features, options, self.dev.caps()).with(
+            methods::ShaderFeatures::OUTPUT_LINEAR,
+            options.linear || self.srgb_destination,
+        );
         let directional = gather_directional(
             scene,
             &view,
@@ -288,6 +294,7 @@ impl Renderer {
         height: u32,
         samples: u32,
         format: ColorFormat,
+        srgb: bool,
     ) -> Result<(), Error> {
         let refuse = |reason: String| Err(Error::Msaa { samples, reason });
         if let Some(reason) = crate::gl::multisample::unsupported_reason(&self.dev, samples) {
@@ -309,12 +316,15 @@ impl Renderer {
             return refuse("only 8-bit output is multisampled, not HDR".into());
         }
         let shape = ((width, height), samples);
-        if self.msaa.as_ref().map(|m| m.shape()) != Some(shape) {
+        let kept = self.msaa.as_ref().map(|m| (m.shape(), m.is_srgb()));
+        // ES 2.0's target has no sRGB form: it keeps the frame's linear values in RGBA8.
+        let srgb = srgb && self.dev.es() == crate::gl::EsVersion::Es3;
+        if kept != Some((shape, srgb)) {
             if let Some(mut m) = self.msaa.take() {
                 m.destroy(&self.dev);
             }
-            self.msaa = Some(crate::gl::multisample::MultisampleTarget::new(
-                &self.dev, width, height, samples,
+            self.msaa = Some(crate::gl::multisample::MultisampleTarget::with_encoding(
+                &self.dev, width, height, samples, srgb,
             )?);
         }
         Ok(())

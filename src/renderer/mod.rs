@@ -62,6 +62,9 @@ pub struct Renderer {
     warned_directional: bool,
     /// A bound framebuffer's shallow depth buffer was announced (once per renderer).
     warned_depth_bits: bool,
+    /// The frame being drawn goes to a framebuffer that encodes sRGB itself: drawn with linear
+    /// output (and, with MSAA on ES 3.0, an sRGB multisampled target).
+    srgb_destination: bool,
     /// A camera too coarse in depth for the scene was announced (once per renderer).
     warned_depth_step: bool,
     /// The frame's objects in draw order (kept likewise).
@@ -125,6 +128,7 @@ impl Renderer {
             shown_directional: Vec::new(),
             warned_directional: false,
             warned_depth_bits: false,
+            srgb_destination: false,
             warned_depth_step: false,
             draw_order: methods::geometry::DrawOrder::default(),
             lp_num_threads: std::env::var("LP_NUM_THREADS").ok(),

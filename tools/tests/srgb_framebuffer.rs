@@ -1,0 +1,121 @@
+//! A game's framebuffer that encodes sRGB itself (an `SRGB8_ALPHA8` attachment; a window
+//! surface made with an sRGB colour space is the same to GL): the renderer gives it linear
+//! values, so what it stores is the picture an RGBA8 framebuffer gets, not one encoded twice,
+//! with every method and with MSAA.
+#![allow(unsafe_code)] // the game's side: raw glow calls
+
+mod common;
+
+use common::Gpu;
+use manylight::glow::{self, HasContext};
+use manylight::{scene, EsVersion, RenderOptions};
+
+const W: u32 = 128;
+const H: u32 = 72;
+
+/// Draws `scene` with `options` into a fresh game framebuffer whose colour texture has the
+/// sized format `colour` (with a 24-bit depth buffer) and reads back the bytes it stores.
+fn stored(gpu: &mut Gpu, colour: u32, scene: &scene::Scene, options: &RenderOptions) -> Vec<u8> {
+    let gl = gpu.gl();
+    let (w, h) = (W as i32, H as i32);
+    let (texture, depth, fbo) = unsafe {
+        let texture = gl.create_texture().unwrap();
+        gl.bind_texture(glow::TEXTURE_2D, Some(texture));
+        gl.tex_storage_2d(glow::TEXTURE_2D, 1, colour, w, h);
+        let depth = gl.create_renderbuffer().unwrap();
+        gl.bind_renderbuffer(glow::RENDERBUFFER, Some(depth));
+        gl.renderbuffer_storage(glow::RENDERBUFFER, glow::DEPTH_COMPONENT24, w, h);
+        let fbo = gl.create_framebuffer().unwrap();
+        gl.bind_framebuffer(glow::FRAMEBUFFER, Some(fbo));
+        gl.framebuffer_texture_2d(
+            glow::FRAMEBUFFER,
+            glow::COLOR_ATTACHMENT0,
+            glow::TEXTURE_2D,
+            Some(texture),
+            0,
+        );
+        gl.framebuffer_renderbuffer(
+            glow::FRAMEBUFFER,
+            glow::DEPTH_ATTACHMENT,
+            glow::RENDERBUFFER,
+            Some(depth),
+        );
+        (texture, depth, fbo)
+    };
+    gpu.r().render(scene, W, H, options).unwrap();
+    let mut pixels = vec![0u8; (W * H * 4) as usize];
+    unsafe {
+        gl.read_pixels(
+            0,
+            0,
+            w,
+            h,
+            glow::RGBA,
+            glow::UNSIGNED_BYTE,
+            glow::PixelPackData::Slice(Some(&mut pixels)),
+        );
+        gl.bind_framebuffer(glow::FRAMEBUFFER, None);
+        gl.delete_framebuffer(fbo);
+        gl.delete_texture(texture);
+        gl.delete_renderbuffer(depth);
+    }
+    pixels
+}
+
+#[test]
+fn an_srgb_framebuffer_stores_what_an_rgba8_one_does_with_every_method_and_msaa() {
+    let s = scene::builtin::build(scene::builtin::DEFAULT, Some((128, 3))).unwrap();
+    let mut gpu = Gpu::new(EsVersion::Es3);
+    for (method, samples) in [
+        ("forward", 1),
+        ("tiled", 1),
+        ("clustered", 1),
+        ("deferred", 1),
+        ("clustered", 4),
+    ] {
+        gpu.r().set_method_named(method).unwrap();
+        let options = RenderOptions {
+            samples,
+            ..Default::default()
+        };
+        let plain = stored(&mut gpu, glow::RGBA8, &s, &options);
+        let srgb = stored(&mut gpu, glow::SRGB8_ALPHA8, &s, &options);
+        let lit = plain.chunks(4).filter(|p| p[0] > 20).count();
+        assert!(
+            lit > (W * H / 4) as usize,
+            "{method}: only {lit} lit pixels"
+        );
+        // The shader's encode and the hardware's round apart by a step at most. With MSAA,
+        // an sRGB resolve averages an edge pixel's samples as linear values (as it should),
+        // the RGBA8 one as encoded ones: only pixels whose samples all agree (the RGBA8
+        // frame's pixel equals its single-sampled one) are compared there.
+        let single = if samples > 1 {
+            let one = RenderOptions {
+                samples: 1,
+                ..options
+            };
+            Some(stored(&mut gpu, glow::RGBA8, &s, &one))
+        } else {
+            None
+        };
+        let mut compared = 0;
+        for (i, (a, b)) in plain.chunks(4).zip(srgb.chunks(4)).enumerate() {
+            if let Some(single) = &single {
+                if single[i * 4..i * 4 + 3] != a[..3] {
+                    continue;
+                }
+            }
+            compared += 1;
+            let d = (0..3).map(|c| a[c].abs_diff(b[c])).max().unwrap_or(0);
+            assert!(
+                d <= 2,
+                "{method} ×{samples}: pixel {i} of the sRGB framebuffer is {d}/255 from the \
+                 RGBA8 one's ({b:?} against {a:?})"
+            );
+        }
+        assert!(
+            compared > (W * H / 2) as usize,
+            "{method}: {compared} compared"
+        );
+    }
+}
