@@ -16,6 +16,11 @@ VARYING vec3 v_normal;
 VARYING vec2 v_uv;
 
 void main() {
+#if HAS_ALPHA_MASK
+    if (surfaceCut(v_uv)) {
+        discard;
+    }
+#endif
     // A highp copy: gl_FragCoord may be mediump on ES 2.0, too coarse past 2048 pixels.
     HIGHP vec2 fragXY = gl_FragCoord.xy - u_frameOrigin;
     HIGHP float viewDepth = -v_viewPos.z;

@@ -12,6 +12,11 @@ VARYING vec3 v_normal;
 VARYING vec2 v_uv;
 
 void main() {
+#if HAS_ALPHA_MASK
+    if (surfaceCut(v_uv)) {
+        discard;
+    }
+#endif
 #if COUNT_REACHING
     // The lower bound of culling: lights whose sphere (and cone) contains this point.
     HIGHP float reaching = 0.0;

@@ -15,6 +15,11 @@ layout(location = 2) out vec4 o_specular;
 layout(location = 3) out vec4 o_extra;
 
 void main() {
+#if HAS_ALPHA_MASK
+    if (surfaceCut(v_uv)) {
+        discard;
+    }
+#endif
     vec3 N = normalize(v_normal);
     vec3 V = viewDirection(v_viewPos);
     // Two-sided: the side the eye sees.

@@ -47,6 +47,19 @@ vec3 shadingNormal(vec3 N, vec3 V, vec2 uv) {
     return N * side;
 }
 
+#if HAS_ALPHA_MASK
+uniform float u_alphaCutoff;
+// glTF MASK: the fragment is cut where the base colour texture's alpha is below the cutoff
+// (the factor's alpha folded into it). Set only with a base colour texture.
+bool surfaceCut(vec2 uv) {
+#if HAS_TEXTURE
+    return TEXTURE2D(u_albedoTex, UV_ALBEDO(uv)).a < u_alphaCutoff;
+#else
+    return false;
+#endif
+}
+#endif
+
 vec3 surfaceAlbedo(vec2 uv) {
     vec3 albedo = u_albedo;
 #if HAS_TEXTURE

@@ -95,6 +95,14 @@ impl RenderState {
         color_write: true,
     };
 
+    /// Opaque surfaces cut out by a texture's alpha, after the others: tested and written
+    /// against their depth (the prepass left them out), the last drawn winning ties as after
+    /// the prepass.
+    pub const CUT_OUT: RenderState = RenderState {
+        depth_write: true,
+        ..Self::OPAQUE_AFTER_PREPASS
+    };
+
     /// Transparent objects, first pass: their far side, blended over what is behind, tested
     /// against (but not writing) the opaque depth.
     pub const TRANSPARENT_BACK_FACES: RenderState = RenderState {

@@ -78,6 +78,8 @@ impl ShaderFeatures {
     pub const MR_TEXTURE: u64 = 1 << 23;
     /// Some texture the material samples has a `KHR_texture_transform`.
     pub const TEXTURE_TRANSFORM: u64 = 1 << 24;
+    /// The material cuts fragments by its base colour texture's alpha (glTF `MASK`).
+    pub const ALPHA_MASK: u64 = 1 << 25;
 
     /// The flags a material's (and its mesh's) surface inputs set, as opposed to the scene's,
     /// the frame's and the device's.
@@ -87,10 +89,11 @@ impl ShaderFeatures {
         | Self::EMISSIVE_MAP
         | Self::OCCLUSION
         | Self::MR_TEXTURE
-        | Self::TEXTURE_TRANSFORM;
+        | Self::TEXTURE_TRANSFORM
+        | Self::ALPHA_MASK;
 
     /// Every flag with its name.
-    pub const NAMED: [(u64, &'static str); 25] = [
+    pub const NAMED: [(u64, &'static str); 26] = [
         (Self::TEXTURE, "texture"),
         (Self::SPOT, "spot"),
         (Self::SPECULAR, "specular"),
@@ -116,6 +119,7 @@ impl ShaderFeatures {
         (Self::OCCLUSION, "occlusion"),
         (Self::MR_TEXTURE, "mr_texture"),
         (Self::TEXTURE_TRANSFORM, "texture_transform"),
+        (Self::ALPHA_MASK, "alpha_mask"),
     ];
 
     /// Names of the set flags.
@@ -187,6 +191,7 @@ impl ShaderFeatures {
                 "HAS_TEXTURE_TRANSFORM".into(),
                 flag(Self::TEXTURE_TRANSFORM),
             ),
+            ("HAS_ALPHA_MASK".into(), flag(Self::ALPHA_MASK)),
             (
                 "TONEMAP".into(),
                 if self.has(Self::TONEMAP_REINHARD) {

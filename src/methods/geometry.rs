@@ -44,8 +44,12 @@ impl UniformSet for DepthProgram {
 /// grown to the scene's object count).
 #[derive(Debug, Default)]
 pub struct DrawOrder {
-    /// Opaque objects, in scene order.
+    /// Opaque objects, in scene order, those cut out by a texture's alpha (glTF `MASK`) last,
+    /// from [`DrawOrder::cut_out_from`] on.
     pub opaque: Vec<usize>,
+    /// Where the cut-out objects start in `opaque`: they take no depth prepass (the prepass
+    /// does not sample textures), and are drawn after the others with their own depth writes.
+    pub cut_out_from: usize,
     /// Transparent objects, back to front.
     pub transparent: Vec<usize>,
     /// (view depth, object) of the transparent objects, to sort them.
@@ -60,6 +64,7 @@ pub(crate) fn sort_objects(ctx: &mut FrameContext) {
     let order = &mut *ctx.order;
     order.opaque.clear();
     order.depths.clear();
+    let cut_out = |o: &crate::scene::Object| scene.materials[o.material].alpha_cutoff.is_some();
     for (i, o) in scene.objects.iter().enumerate() {
         if scene.materials[o.material].is_transparent() {
             let centre = ctx
@@ -67,9 +72,17 @@ pub(crate) fn sort_objects(ctx: &mut FrameContext) {
                 .world_bounds(o)
                 .map_or(glam::DVec3::ZERO, |b| b.center());
             order.depths.push((-ctx.view.transform_point3(centre).z, i));
-        } else if !ctx.transparent_only {
+        } else if !ctx.transparent_only && !cut_out(o) {
             order.opaque.push(i);
         }
+    }
+    order.cut_out_from = order.opaque.len();
+    if !ctx.transparent_only {
+        let cut = scene.objects.iter().enumerate();
+        order.opaque.extend(
+            cut.filter(|(_, o)| !scene.materials[o.material].is_transparent() && cut_out(o))
+                .map(|(i, _)| i),
+        );
     }
     // Farthest first; the index makes the order that of a stable sort without its buffer.
     order
@@ -92,7 +105,7 @@ fn depth_prepass(ctx: &mut FrameContext) -> Result<(), Error> {
         dialect: dev.es(),
     };
     let DepthProgram(transforms) = ctx.programs.bind::<DepthProgram>(dev, key, Vec::new)?;
-    for &i in &ctx.order.opaque {
+    for &i in &ctx.order.opaque[..ctx.order.cut_out_from] {
         let (mesh, model) = ctx.gpu_scene.drawn(i, &ctx.scene.objects[i]);
         transforms.set(dev, &(ctx.view * model), &ctx.projection);
         mesh.draw(dev);
@@ -114,8 +127,15 @@ pub fn draw_objects<P: GeometryProgram>(
 ) -> Result<(), Error> {
     sort_objects(ctx);
     depth_prepass(ctx)?;
-    RenderState::OPAQUE_AFTER_PREPASS.apply(ctx.dev);
     for k in 0..ctx.order.opaque.len() {
+        if k == 0 || k == ctx.order.cut_out_from {
+            let state = if k < ctx.order.cut_out_from {
+                RenderState::OPAQUE_AFTER_PREPASS
+            } else {
+                RenderState::CUT_OUT
+            };
+            state.apply(ctx.dev);
+        }
         let i = ctx.order.opaque[k];
         shade_object(ctx, i, shader, max_lights, bind_method)?;
     }
@@ -165,6 +185,10 @@ pub(crate) fn shade_object<P: GeometryProgram>(
     };
     let features = ShaderFeatures(ctx.features.0 | inputs.0)
         .with(ShaderFeatures::TEXTURE, texture.is_some())
+        .with(
+            ShaderFeatures::ALPHA_MASK,
+            texture.is_some() && material.alpha_cutoff.is_some() && !ctx.features.counting(),
+        )
         .with(
             ShaderFeatures::SPECULAR,
             !material.is_metallic_roughness() && (material.has_specular() || full),

@@ -62,6 +62,7 @@ pub struct Surface {
     metallic: Uniform<f32>,
     roughness: Uniform<f32>,
     alpha: Uniform<f32>,
+    alpha_cutoff: Uniform<f32>,
     ambient: Uniform<Vec3>,
     exposure: Uniform<f32>,
     orthographic: Uniform<f32>,
@@ -82,6 +83,11 @@ pub(crate) struct SurfaceFrame {
     pub heat_scale: f32,
 }
 
+/// Whether a variant cuts fragments by its texture's alpha (`surfaceCut`: only with one).
+fn cuts(f: ShaderFeatures) -> bool {
+    f.has(ShaderFeatures::ALPHA_MASK) && f.has(ShaderFeatures::TEXTURE)
+}
+
 impl Surface {
     /// For a shader that lights and encodes a colour (forward, clustered): `lit` is whether
     /// the variant runs the light model.
@@ -96,6 +102,7 @@ impl Surface {
             metallic: r.required_when(lit && mr, "u_metallic"),
             roughness: r.required_when(lit && mr, "u_roughness"),
             alpha: r.required_when(colour, "u_alpha"),
+            alpha_cutoff: r.required_when(colour && cuts(f), "u_alphaCutoff"),
             ambient: r.required_when(colour, "u_ambient"),
             exposure: r.required_when(colour && !f.has(ShaderFeatures::OUTPUT_HDR), "u_exposure"),
             orthographic: r.required_when(lit, "u_orthographic"),
@@ -121,6 +128,7 @@ impl Surface {
             metallic: r.required_when(f.has(ShaderFeatures::METALLIC_ROUGHNESS), "u_metallic"),
             roughness: r.required_when(f.has(ShaderFeatures::METALLIC_ROUGHNESS), "u_roughness"),
             alpha: r.optional("u_alpha"),
+            alpha_cutoff: r.required_when(cuts(f), "u_alphaCutoff"),
             ambient: r.optional("u_ambient"),
             exposure: r.optional("u_exposure"),
             orthographic: r.required("u_orthographic"),
@@ -146,6 +154,8 @@ impl Surface {
         self.metallic.set(dev, material.metallic);
         self.roughness.set(dev, material.roughness);
         self.alpha.set(dev, material.alpha);
+        self.alpha_cutoff
+            .set(dev, material.alpha_cutoff.unwrap_or(0.0));
         if heatmap {
             self.heat_scale.set(dev, frame.heat_scale);
         }

@@ -42,6 +42,9 @@ pub struct Material {
     /// Opacity (`d` in MTL): 1 is opaque; below 1 the object is drawn after the opaque ones,
     /// back to front, alpha-blended.
     pub alpha: f32,
+    /// A cut-out (glTF `alphaMode: MASK`): fragments where the diffuse texture's alpha is below
+    /// this are not drawn (the factor's alpha already folded in). `None`: nothing is cut.
+    pub alpha_cutoff: Option<f32>,
     /// The reflectance model; `specular`/`shininess` are read by Blinn-Phong only,
     /// `metallic`/`roughness` by metallic-roughness only.
     pub model: MaterialModel,
@@ -77,6 +80,7 @@ impl Material {
             specular: Vec3::splat(0.04),
             shininess: 32.0,
             alpha: 1.0,
+            alpha_cutoff: None,
             model: MaterialModel::BlinnPhong,
             metallic: 0.0,
             roughness: 1.0,
@@ -144,6 +148,14 @@ impl Material {
                 format!("{field}.alpha"),
                 format!("must be in [0, 1], got {}", self.alpha),
             ));
+        }
+        if let Some(c) = self.alpha_cutoff {
+            if !(c.is_finite() && (0.0..=1.0).contains(&c)) {
+                return Err(SceneError::invalid(
+                    format!("{field}.alpha_cutoff"),
+                    format!("must be in [0, 1], got {c}"),
+                ));
+            }
         }
         for (name, v) in [("metallic", self.metallic), ("roughness", self.roughness)] {
             if !(v.is_finite() && (0.0..=1.0).contains(&v)) {

@@ -13,8 +13,10 @@
 //! - `alphaMode`: `OPAQUE` ignores alpha; `BLEND` takes `baseColorFactor.a` as the material's
 //!   opacity (below 1: the renderer's transparent path, back to front, alpha-blended);
 //!   `MASK` cuts the whole material — invisible (opacity 0) when `baseColorFactor.a` is below
-//!   `alphaCutoff`, else opaque. Per-texel alpha is not used by the renderer: a texture's
-//!   alpha neither blends nor cuts (a warning says so where it would matter).
+//!   `alphaCutoff` — and else, with a base colour texture, each fragment whose texture alpha
+//!   times that factor is below it ([`Material::alpha_cutoff`]: leaves, fences). A texture's
+//!   alpha does not blend (`BLEND` uses the factor alone; a warning says so where it would
+//!   matter).
 //! - `doubleSided`: the renderer draws every surface from both sides (no culling, the normal
 //!   turned towards the eye), so `doubleSided: false` surfaces are visible from behind too.
 
@@ -156,6 +158,7 @@ impl Materials {
                     .map_err(|e| format!("{field}.pbrMetallicRoughness.baseColorTexture: {e}"))?;
             }
         }
+        let mut alpha_cutoff = None;
         let alpha = match m.alpha_mode() {
             AlphaMode::Opaque => 1.0,
             AlphaMode::Blend => {
@@ -168,12 +171,14 @@ impl Materials {
                 factor_alpha
             }
             AlphaMode::Mask => {
-                let cutoff = m.alpha_cutoff().unwrap_or(0.5);
-                if diffuse_texture.is_some() && factor_alpha >= cutoff {
-                    warnings.push(format!(
-                        "{field} (`{name}`): alphaMode MASK cut out by the texture's alpha is \
-                         not supported; drawn opaque"
-                    ));
+                // NaN or out of range: the spec's default; at 0 nothing is ever cut.
+                let cutoff = m
+                    .alpha_cutoff()
+                    .filter(|c| (0.0..=1.0).contains(c))
+                    .unwrap_or(0.5);
+                if diffuse_texture.is_some() && factor_alpha >= cutoff && cutoff > 0.0 {
+                    // Texel alpha × factor alpha < cutoff, as texel alpha < cutoff / factor.
+                    alpha_cutoff = Some(cutoff / factor_alpha);
                 }
                 if factor_alpha < cutoff {
                     0.0
@@ -206,6 +211,7 @@ impl Materials {
             specular: Vec3::splat(DIELECTRIC_SPECULAR),
             shininess: shininess(pbr.roughness_factor()),
             alpha,
+            alpha_cutoff,
             maps,
             ..Material::metallic_roughness(
                 &name,

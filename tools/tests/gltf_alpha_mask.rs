@@ -1,0 +1,121 @@
+//! glTF `alphaMode: MASK` cut out by the base colour texture's alpha (leaves, fences): a pane
+//! whose texture is transparent on its left half and opaque on its right stands in front of a
+//! lit wall and a red box. Every pixel is either the picture without the pane (where it is
+//! cut) or the picture with the pane opaque (where it is not), and both occur, with every
+//! method on ES 2.0 and 3.0: the cut holds in the depth prepass's place, in the G-buffer and
+//! in the depth test of what lies behind.
+
+mod common;
+
+use std::path::Path;
+
+use common::files::{load, write};
+use common::gltf::{base64, Builder};
+use common::gltf_models::{floor, pane, primitive, quat};
+use common::Gpu;
+use glam::{DQuat, DVec3, Vec3};
+use manylight::scene::{Light, Scene};
+use manylight::{EsVersion, RenderOptions};
+use serde_json::json;
+
+const W: u32 = 128;
+const H: u32 = 72;
+
+/// A 2 × 1 texture: a transparent green texel left, an opaque yellow one right.
+fn half_cut_png() -> Vec<u8> {
+    let texels = [[40u8, 200, 60, 0], [230, 210, 40, 255]];
+    let img = image::RgbaImage::from_fn(2, 1, |x, _| image::Rgba(texels[x as usize]));
+    let mut png = Vec::new();
+    img.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+        .unwrap();
+    png
+}
+
+/// The scene with the pane's material in `alpha_mode` (`None`: no pane at all).
+fn scene_with_pane(dir: &Path, alpha_mode: Option<&str>) -> Scene {
+    let mut b = Builder::default();
+    let floor_prim = primitive(&mut b, &floor(), Some(0));
+    let wall_prim = primitive(&mut b, &pane(3.0, 2.0), Some(1));
+    let pane_prim = primitive(&mut b, &pane(1.6, 1.2), Some(2));
+    let mut nodes = vec![
+        json!({"mesh": 0}),
+        json!({"mesh": 1, "translation": [0, 0, -1.5]}),
+        json!({"camera": 0, "translation": [0, 1, 3],
+               "rotation": quat(DQuat::from_rotation_x(-0.15))}),
+    ];
+    if alpha_mode.is_some() {
+        nodes.push(json!({"mesh": 2, "translation": [0, 0.3, 0.5]}));
+    }
+    let scene_nodes: Vec<usize> = (0..nodes.len()).collect();
+    let gltf = json!({
+        "scenes": [{"nodes": scene_nodes}],
+        "nodes": nodes,
+        "cameras": [{"type": "perspective", "perspective": {"yfov": 0.9, "znear": 0.05, "zfar": 50}}],
+        "meshes": [{"primitives": [floor_prim]}, {"primitives": [wall_prim]},
+                   {"primitives": [pane_prim]}],
+        "materials": [
+            {"pbrMetallicRoughness": {"baseColorFactor": [0.7, 0.7, 0.7, 1], "metallicFactor": 0}},
+            {"pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.1, 0.1, 1], "metallicFactor": 0}},
+            {"alphaMode": alpha_mode.unwrap_or("OPAQUE"), "alphaCutoff": 0.5,
+             "pbrMetallicRoughness": {"baseColorTexture": {"index": 0}, "metallicFactor": 0}}
+        ],
+        "samplers": [{"magFilter": 9728, "minFilter": 9728}],
+        "textures": [{"source": 0, "sampler": 0}],
+        "images": [{"uri": format!("data:image/png;base64,{}", base64(&half_cut_png()))}],
+    });
+    let name = format!("pane_{}.gltf", alpha_mode.unwrap_or("none"));
+    let (mut scene, _) = load(&write(dir, &name, b.gltf(gltf))).unwrap();
+    scene.lights = vec![Light::point(DVec3::new(0.5, 1.5, 1.5), 8.0, Vec3::ONE, 6.0)];
+    scene.ambient = Vec3::splat(0.05);
+    scene
+}
+
+#[test]
+fn a_masked_texture_cuts_the_pane_where_its_alpha_is_below_the_cutoff() {
+    let dir = tempfile::tempdir().unwrap();
+    let masked = scene_with_pane(dir.path(), Some("MASK"));
+    let opaque = scene_with_pane(dir.path(), Some("OPAQUE"));
+    let without = scene_with_pane(dir.path(), None);
+    let pane_material = masked
+        .materials
+        .iter()
+        .find(|m| m.alpha_cutoff.is_some())
+        .expect("the MASK material cuts by its texture");
+    assert_eq!(pane_material.alpha_cutoff, Some(0.5));
+    let opts = RenderOptions::default();
+    for es in [EsVersion::Es2, EsVersion::Es3] {
+        let mut gpu = Gpu::new(es);
+        let methods: &[&str] = if es == EsVersion::Es3 {
+            &["forward", "tiled", "clustered", "deferred"]
+        } else {
+            &["forward", "tiled", "clustered"]
+        };
+        for method in methods {
+            gpu.r().set_method_named(method).unwrap();
+            let cut = gpu.render(&masked, W, H, &opts);
+            let solid = gpu.render(&opaque, W, H, &opts);
+            let behind = gpu.render(&without, W, H, &opts);
+            let (mut as_behind, mut as_solid) = (0, 0);
+            for ((c, s), b) in cut.pixels().zip(solid.pixels()).zip(behind.pixels()) {
+                let near = |x: &image::Rgba<u8>| (0..3).all(|k| c[k].abs_diff(x[k]) <= 1);
+                let (is_behind, is_solid) = (near(b), near(s));
+                assert!(
+                    is_behind || is_solid,
+                    "{es} {method}: a pixel {c:?} is neither the scene without the pane {b:?} \
+                     nor with it opaque {s:?}"
+                );
+                // Where the pane makes a difference, which side won.
+                if is_behind && !is_solid {
+                    as_behind += 1;
+                } else if is_solid && !is_behind {
+                    as_solid += 1;
+                }
+            }
+            let enough = (W * H / 20) as usize;
+            assert!(
+                as_behind > enough && as_solid > enough,
+                "{es} {method}: {as_behind} pixels cut and {as_solid} drawn"
+            );
+        }
+    }
+}
