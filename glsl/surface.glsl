@@ -11,20 +11,27 @@ uniform float u_orthographic;
 uniform sampler2D u_albedoTex;
 #endif
 
-// sRGB-encoded textures (base colour, emission) are decoded here. Two branches with one body:
-// the variant stripper (shader_source::strip_feature_blocks) reads single-flag conditions.
-#if HAS_TEXTURE
+// A colour texel (base colour, emission) in linear RGB: LINEAR_TEXEL. Where colour textures
+// are sRGB ones (SRGB_TEXTURES, the ES 3.0 level) the sampler decodes each texel before
+// filtering, as glTF asks; else (ES 2.0) the filtered value is decoded here. Branches with one
+// body: the variant stripper (shader_source::strip_feature_blocks) reads single-flag
+// conditions.
+#if SRGB_TEXTURES
+#define LINEAR_TEXEL(c) (c)
+#elif HAS_TEXTURE
 vec3 srgbToLinear(vec3 c) {
     vec3 lo = c / 12.92;
     vec3 hi = pow((c + 0.055) / 1.055, vec3(2.4));
     return mix(lo, hi, step(vec3(0.04045), c));
 }
+#define LINEAR_TEXEL(c) srgbToLinear(c)
 #elif HAS_EMISSIVE_MAP
 vec3 srgbToLinear(vec3 c) {
     vec3 lo = c / 12.92;
     vec3 hi = pow((c + 0.055) / 1.055, vec3(2.4));
     return mix(lo, hi, step(vec3(0.04045), c));
 }
+#define LINEAR_TEXEL(c) srgbToLinear(c)
 #endif
 
 vec3 linearToSrgb(vec3 c) {
@@ -63,7 +70,7 @@ bool surfaceCut(vec2 uv) {
 vec3 surfaceAlbedo(vec2 uv) {
     vec3 albedo = u_albedo;
 #if HAS_TEXTURE
-    albedo *= srgbToLinear(TEXTURE2D(u_albedoTex, UV_ALBEDO(uv)).rgb);
+    albedo *= LINEAR_TEXEL(TEXTURE2D(u_albedoTex, UV_ALBEDO(uv)).rgb);
 #endif
 #if HAS_VERTEX_COLOR
     albedo *= v_color;

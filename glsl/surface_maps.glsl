@@ -59,7 +59,7 @@ uniform sampler2D u_emissiveTex;
 vec3 surfaceEmission(vec2 uv) {
     vec3 e = u_emissive;
 #if HAS_EMISSIVE_MAP
-    e *= srgbToLinear(TEXTURE2D(u_emissiveTex, UV_EMISSIVE(uv)).rgb);
+    e *= LINEAR_TEXEL(TEXTURE2D(u_emissiveTex, UV_EMISSIVE(uv)).rgb);
 #endif
     return e;
 }

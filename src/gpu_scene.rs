@@ -21,7 +21,9 @@ pub struct GpuScene {
     /// once, not every frame). Each is uploaded about its bounds' centre (see
     /// [`GpuScene::model`]).
     meshes: HashMap<usize, (Arc<Mesh>, GpuMesh, Option<Aabb>, f64)>,
-    textures: HashMap<usize, (Arc<Texture>, ImageTexture)>,
+    /// Per texture: its upload as linear data and as sRGB colour (each made when a material
+    /// first samples it so: a base colour or emission is colour, a normal map data).
+    textures: HashMap<usize, (Arc<Texture>, [Option<ImageTexture>; 2])>,
     /// 1×1 white texture for full variants on untextured materials (made on first use).
     white: Option<ImageTexture>,
     /// This frame's stand-ins for objects with triangles too long for their distance from the
@@ -40,7 +42,7 @@ impl GpuScene {
         self.forget_unreferenced(dev);
         if full_variants && self.white.is_none() {
             let white = image::RgbaImage::from_pixel(1, 1, image::Rgba([255, 255, 255, 255]));
-            self.white = Some(ImageTexture::new(dev, &white)?);
+            self.white = Some(ImageTexture::new(dev, &white, false)?);
         }
         for (i, o) in scene.objects.iter().enumerate() {
             let key = Arc::as_ptr(&o.mesh) as usize;
@@ -54,11 +56,18 @@ impl GpuScene {
             }
         }
         for m in &scene.materials {
-            let maps = m.maps.textures().map(|(_, t)| &t.texture);
-            for t in m.diffuse_texture.iter().chain(maps) {
+            let maps = m
+                .maps
+                .textures()
+                .map(|(slot, t)| (&t.texture, slot == "emissive"));
+            for (t, srgb) in m.diffuse_texture.iter().map(|t| (t, true)).chain(maps) {
                 let key = Arc::as_ptr(t) as usize;
-                if let std::collections::hash_map::Entry::Vacant(e) = self.textures.entry(key) {
-                    e.insert((t.clone(), ImageTexture::new(dev, &t.image)?));
+                let (_, uploads) = self
+                    .textures
+                    .entry(key)
+                    .or_insert_with(|| (t.clone(), [None, None]));
+                if uploads[srgb as usize].is_none() {
+                    uploads[srgb as usize] = Some(ImageTexture::new(dev, &t.image, srgb)?);
                 }
             }
         }
@@ -76,10 +85,13 @@ impl GpuScene {
             }
             held
         });
-        self.textures.retain(|_, (source, gpu)| {
+        self.textures.retain(|_, (source, uploads)| {
             let held = Arc::strong_count(source) > 1;
             if !held {
-                gpu.destroy(dev);
+                uploads
+                    .iter_mut()
+                    .flatten()
+                    .for_each(|gpu| gpu.destroy(dev));
             }
             held
         });
@@ -148,14 +160,14 @@ impl GpuScene {
 
     /// The uploaded diffuse texture of a material, if it has one.
     pub fn texture_for(&self, material: &Material) -> Option<&ImageTexture> {
-        self.texture_of(material.diffuse_texture.as_ref()?)
+        self.texture_of(material.diffuse_texture.as_ref()?, true)
     }
 
-    /// The upload of one of the scene's textures (any slot).
-    pub fn texture_of(&self, texture: &Arc<Texture>) -> Option<&ImageTexture> {
+    /// The upload of one of the scene's textures, as sRGB colour (`srgb`) or linear data.
+    pub fn texture_of(&self, texture: &Arc<Texture>, srgb: bool) -> Option<&ImageTexture> {
         self.textures
             .get(&(Arc::as_ptr(texture) as usize))
-            .map(|(_, g)| g)
+            .and_then(|(_, uploads)| uploads[srgb as usize].as_ref())
     }
 
     /// The white stand-in texture (only after an upload with full variants).
@@ -167,8 +179,11 @@ impl GpuScene {
         for (_, (_, mut m, _, _)) in self.meshes.drain() {
             m.destroy(dev);
         }
-        for (_, (_, mut t)) in self.textures.drain() {
-            t.destroy(dev);
+        for (_, (_, uploads)) in self.textures.drain() {
+            uploads
+                .into_iter()
+                .flatten()
+                .for_each(|mut t| t.destroy(dev));
         }
         for (_, (mut m, _)) in self.splits.drain() {
             m.destroy(dev);

@@ -198,6 +198,12 @@ impl Drop for DataTexture {
     }
 }
 
+/// Whether colour textures are sRGB textures, decoded by the sampler (the ES 3.0 level and
+/// desktop GL), rather than by the shader after filtering (ES 2.0).
+pub fn hardware_srgb(dev: &Device) -> bool {
+    dev.es() == EsVersion::Es3
+}
+
 /// The size an image of `size` is uploaded at: each side within `max` (the context's
 /// `GL_MAX_TEXTURE_SIZE`), and with `power_of_two` (ES 2.0, which allows neither mipmaps nor
 /// `REPEAT` on other sizes, and OBJ texture coordinates tile) the largest power of two not above
@@ -215,8 +221,11 @@ pub fn upload_size((w, h): (u32, u32), max: u32, power_of_two: bool) -> (u32, u3
     (fit(w), fit(h))
 }
 
-/// A mipmapped, repeating RGBA8 image texture (sRGB-encoded; decoded in the shader because
-/// ES 2.0 has no sRGB textures in core).
+/// A mipmapped, repeating RGBA8 image texture. A colour one (sRGB-encoded) is an
+/// `SRGB8_ALPHA8` texture at the ES 3.0 level, so texels are decoded before they are filtered
+/// (glTF 2.0 §3.9.2; filtering encoded values darkens fine high-contrast detail); ES 2.0 has
+/// no sRGB textures in core (`GL_EXT_sRGB` cannot make their mipmaps), so there the shader
+/// decodes the filtered value (`SRGB_TEXTURES` off).
 pub struct ImageTexture {
     raw: glow::Texture,
     destroyed: bool,
@@ -224,8 +233,12 @@ pub struct ImageTexture {
 
 impl ImageTexture {
     /// Uploads an image, downscaled where it is larger than the context's texture limit and,
-    /// on ES 2.0, to a power of two (see [`upload_size`]).
-    pub fn new(dev: &Device, image: &image::RgbaImage) -> Result<ImageTexture, GlError> {
+    /// on ES 2.0, to a power of two (see [`upload_size`]); `srgb` for colour (see above).
+    pub fn new(
+        dev: &Device,
+        image: &image::RgbaImage,
+        srgb: bool,
+    ) -> Result<ImageTexture, GlError> {
         let max = dev.caps().max_texture_size.max(1) as u32;
         let (w, h) = image.dimensions();
         let (pw, ph) = upload_size((w, h), max, dev.es() == EsVersion::Es2);
@@ -243,10 +256,15 @@ impl ImageTexture {
         unsafe {
             gl.bind_texture(glow::TEXTURE_2D, Some(raw));
             gl.pixel_store_i32(glow::UNPACK_ALIGNMENT, 1);
+            let internal = if srgb && hardware_srgb(dev) {
+                glow::SRGB8_ALPHA8
+            } else {
+                glow::RGBA
+            };
             gl.tex_image_2d(
                 glow::TEXTURE_2D,
                 0,
-                glow::RGBA as i32,
+                internal as i32,
                 pw as i32,
                 ph as i32,
                 0,

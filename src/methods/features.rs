@@ -80,6 +80,9 @@ impl ShaderFeatures {
     pub const TEXTURE_TRANSFORM: u64 = 1 << 24;
     /// The material cuts fragments by its base colour texture's alpha (glTF `MASK`).
     pub const ALPHA_MASK: u64 = 1 << 25;
+    /// Colour textures are sRGB textures the sampler decodes before filtering (ES 3.0 level);
+    /// without, the shader decodes the filtered texel (ES 2.0).
+    pub const SRGB_TEXTURES: u64 = 1 << 26;
 
     /// The flags a material's (and its mesh's) surface inputs set, as opposed to the scene's,
     /// the frame's and the device's.
@@ -93,7 +96,7 @@ impl ShaderFeatures {
         | Self::ALPHA_MASK;
 
     /// Every flag with its name.
-    pub const NAMED: [(u64, &'static str); 26] = [
+    pub const NAMED: [(u64, &'static str); 27] = [
         (Self::TEXTURE, "texture"),
         (Self::SPOT, "spot"),
         (Self::SPECULAR, "specular"),
@@ -120,6 +123,7 @@ impl ShaderFeatures {
         (Self::MR_TEXTURE, "mr_texture"),
         (Self::TEXTURE_TRANSFORM, "texture_transform"),
         (Self::ALPHA_MASK, "alpha_mask"),
+        (Self::SRGB_TEXTURES, "srgb_textures"),
     ];
 
     /// Names of the set flags.
@@ -192,6 +196,7 @@ impl ShaderFeatures {
                 flag(Self::TEXTURE_TRANSFORM),
             ),
             ("HAS_ALPHA_MASK".into(), flag(Self::ALPHA_MASK)),
+            ("SRGB_TEXTURES".into(), flag(Self::SRGB_TEXTURES)),
             (
                 "TONEMAP".into(),
                 if self.has(Self::TONEMAP_REINHARD) {

@@ -165,7 +165,7 @@ impl MapUniforms {
             let Some(map) = map.as_ref().filter(|_| features.has(bit)) else {
                 continue;
             };
-            if let Some(t) = scene.texture_of(&map.texture) {
+            if let Some(t) = scene.texture_of(&map.texture, bit == F::EMISSIVE_MAP) {
                 t.bind(dev, unit);
             }
             sampler.set(dev, unit);

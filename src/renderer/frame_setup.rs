@@ -115,6 +115,10 @@ pub(super) fn shader_features(
             ShaderFeatures::UNIFORM_LIGHT_LOOP,
             caps.needs_uniform_light_loop(),
         )
+        .with(
+            ShaderFeatures::SRGB_TEXTURES,
+            caps.es == crate::gl::EsVersion::Es3,
+        )
 }
 
 /// Farthest view depth of the scene's geometry, clipped to `[near, far]` (never below a little

@@ -211,8 +211,23 @@ pub fn oracle_gap(a: &[Option<[f64; 3]>], b: &[Option<[f64; 3]>]) -> f64 {
         .fold(0.0, f64::max)
 }
 
-/// Bilinear sample with REPEAT of an sRGB texture at `uv`, decoded (as the shader does).
-pub fn bilinear_srgb(texels: &[[u8; 4]], w: usize, h: usize, uv: DVec2) -> DVec3 {
+/// Bilinear sample with REPEAT of an sRGB texture at `uv` in linear RGB: its texels decoded
+/// first with `decoded_first` (an sRGB texture's sampler, ES 3.0), else the filtered value
+/// decoded (the shader, ES 2.0).
+pub fn bilinear_colour(
+    texels: &[[u8; 4]],
+    w: usize,
+    h: usize,
+    uv: DVec2,
+    decoded_first: bool,
+) -> DVec3 {
+    let decode = |c: DVec3| {
+        DVec3::new(
+            srgb_to_linear(c.x),
+            srgb_to_linear(c.y),
+            srgb_to_linear(c.z),
+        )
+    };
     let (x, y) = (uv.x * w as f64 - 0.5, uv.y * h as f64 - 0.5);
     let (x0, y0) = (x.floor(), y.floor());
     let (fx, fy) = (x - x0, y - y0);
@@ -222,14 +237,19 @@ pub fn bilinear_srgb(texels: &[[u8; 4]], w: usize, h: usize, uv: DVec2) -> DVec3
             (j as i64).rem_euclid(h as i64) as usize,
         );
         let t = texels[j * w + i];
-        DVec3::new(t[0] as f64, t[1] as f64, t[2] as f64) / 255.0
+        let c = DVec3::new(t[0] as f64, t[1] as f64, t[2] as f64) / 255.0;
+        if decoded_first {
+            decode(c)
+        } else {
+            c
+        }
     };
     let top = at(x0, y0) * (1.0 - fx) + at(x0 + 1.0, y0) * fx;
     let bottom = at(x0, y0 + 1.0) * (1.0 - fx) + at(x0 + 1.0, y0 + 1.0) * fx;
     let c = top * (1.0 - fy) + bottom * fy;
-    DVec3::new(
-        srgb_to_linear(c.x),
-        srgb_to_linear(c.y),
-        srgb_to_linear(c.z),
-    )
+    if decoded_first {
+        c
+    } else {
+        decode(c)
+    }
 }
