@@ -150,6 +150,11 @@ vec4 encodeCount(HIGHP float n) {
     c = mix(c, vec3(0.128, 0.567, 0.551), clamp(t - 1.0, 0.0, 1.0));
     c = mix(c, vec3(0.369, 0.789, 0.383), clamp(t - 2.0, 0.0, 1.0));
     c = mix(c, vec3(0.993, 0.906, 0.144), clamp(t - 3.0, 0.0, 1.0));
+#if OUTPUT_LINEAR
+    // The map's colours are sRGB values: a target that encodes (or a linear read-back) is
+    // given them decoded.
+    c = mix(c / 12.92, pow((c + 0.055) / 1.055, vec3(2.4)), step(vec3(0.04045), c));
+#endif
     return vec4(c, 1.0);
 #else
     HIGHP float high = floor(n / 65536.0);

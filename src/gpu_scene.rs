@@ -60,7 +60,9 @@ impl GpuScene {
                 .maps
                 .textures()
                 .map(|(slot, t)| (&t.texture, slot == "emissive"));
-            for (t, srgb) in m.diffuse_texture.iter().map(|t| (t, true)).chain(maps) {
+            for (t, colour) in m.diffuse_texture.iter().map(|t| (t, true)).chain(maps) {
+                // One upload serves both where colour textures are plain ones (ES 2.0).
+                let srgb = colour && crate::gl::texture::hardware_srgb(dev);
                 let key = Arc::as_ptr(t) as usize;
                 let (_, uploads) = self
                     .textures
@@ -163,11 +165,12 @@ impl GpuScene {
         self.texture_of(material.diffuse_texture.as_ref()?, true)
     }
 
-    /// The upload of one of the scene's textures, as sRGB colour (`srgb`) or linear data.
-    pub fn texture_of(&self, texture: &Arc<Texture>, srgb: bool) -> Option<&ImageTexture> {
-        self.textures
-            .get(&(Arc::as_ptr(texture) as usize))
-            .and_then(|(_, uploads)| uploads[srgb as usize].as_ref())
+    /// The upload of one of the scene's textures, as colour (`colour`: an sRGB texture where
+    /// the context has them) or as data.
+    pub fn texture_of(&self, texture: &Arc<Texture>, colour: bool) -> Option<&ImageTexture> {
+        let (_, uploads) = self.textures.get(&(Arc::as_ptr(texture) as usize))?;
+        // Whichever was made: on ES 2.0 colour and data share the plain upload.
+        uploads[colour as usize].as_ref().or(uploads[0].as_ref())
     }
 
     /// The white stand-in texture (only after an upload with full variants).

@@ -45,13 +45,19 @@ enum ContextWatch {
 impl ContextWatch {
     /// The watch for the context current now.
     fn of_current() -> ContextWatch {
-        if let Some(current) = super::gles_lib::current_context() {
-            return ContextWatch::Loaded(current);
+        let loaded = super::gles_lib::current_context();
+        if let Some(Some(context)) = loaded {
+            return ContextWatch::Loaded(Some(context));
         }
+        // The EGL manylight loaded has none current (or none was loaded): the context may be a
+        // toolkit's, from the system's EGL (a process that also made a `HeadlessContext`).
         match super::ext_fns::system_current_context() {
             Some(Some(context)) => ContextWatch::System(context),
-            // No EGL context current while a context works: it is not the system EGL's.
-            _ => ContextWatch::Unknown,
+            _ => match loaded {
+                Some(current) => ContextWatch::Loaded(current),
+                // No EGL context current while a context works: it is not the system EGL's.
+                None => ContextWatch::Unknown,
+            },
         }
     }
 }

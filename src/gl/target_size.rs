@@ -69,10 +69,10 @@ mod tests {
         Some((ctx, dev))
     }
 
-    /// The error names the limit, and the refused target left no object and no GL error.
-    fn refused(dev: &Device, result: Result<(), GlError>, limit: &str) {
+    /// `make`'s error names the limit, and the refused target left no object and no GL error.
+    fn refused(dev: &Device, make: impl FnOnce() -> Result<(), GlError>, limit: &str) {
         let live = dev.live_objects();
-        match result {
+        match make() {
             Err(GlError::Unsupported(msg)) => assert!(msg.contains(limit), "{msg}"),
             other => panic!("expected an error naming {limit}, got {other:?}"),
         }
@@ -86,16 +86,14 @@ mod tests {
             return;
         };
         let before = dev.live_objects();
-        let gbuffer = GBuffer::new(&dev, 65, 10).map(|mut g| g.destroy(&dev));
-        refused(&dev, gbuffer, "GL_MAX_TEXTURE_SIZE");
-        let offscreen = OffscreenTarget::new(&dev, 10, 65).map(|mut t| t.destroy(&dev));
-        refused(&dev, offscreen, "GL_MAX_TEXTURE_SIZE");
-        let offscreen = OffscreenTarget::new(&dev, 49, 10).map(|mut t| t.destroy(&dev));
-        refused(&dev, offscreen, "GL_MAX_RENDERBUFFER_SIZE");
-        let msaa = MultisampleTarget::new(&dev, 10, 49, 4).map(|mut t| t.destroy(&dev));
-        refused(&dev, msaa, "GL_MAX_RENDERBUFFER_SIZE");
-        let empty = GBuffer::new(&dev, 0, 10).map(|mut g| g.destroy(&dev));
-        refused(&dev, empty, "at least 1");
+        let gbuffer = |w, h| GBuffer::new(&dev, w, h).map(|mut g| g.destroy(&dev));
+        let offscreen = |w, h| OffscreenTarget::new(&dev, w, h).map(|mut t| t.destroy(&dev));
+        let msaa = |w, h| MultisampleTarget::new(&dev, w, h, 4).map(|mut t| t.destroy(&dev));
+        refused(&dev, || gbuffer(65, 10), "GL_MAX_TEXTURE_SIZE");
+        refused(&dev, || offscreen(10, 65), "GL_MAX_TEXTURE_SIZE");
+        refused(&dev, || offscreen(49, 10), "GL_MAX_RENDERBUFFER_SIZE");
+        refused(&dev, || msaa(10, 49), "GL_MAX_RENDERBUFFER_SIZE");
+        refused(&dev, || gbuffer(0, 10), "at least 1");
         // At the limits every one is made.
         GBuffer::new(&dev, 64, 64).unwrap().destroy(&dev);
         OffscreenTarget::new(&dev, 48, 48).unwrap().destroy(&dev);

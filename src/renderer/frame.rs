@@ -93,6 +93,15 @@ impl Renderer {
         }
         // A framebuffer that encodes sRGB itself is given linear values, not encoded twice.
         self.srgb_destination = applications && self.dev.bound_color_is_srgb();
+        if self.srgb_destination && matches!(options.count, CountKind::Evals | CountKind::Reaching)
+        {
+            return Err(Error::InvalidOption {
+                field: "count",
+                reason: "exact light counts are bytes, which a framebuffer that encodes sRGB \
+                         would change: draw them into an RGBA8 one (or use the heatmap)"
+                    .into(),
+            });
+        }
         if samples <= 1 {
             return self.render_frame(scene, (width, height), options, origin, stats);
         }
@@ -125,6 +134,23 @@ impl Renderer {
                 Err(e)
             }
         }
+    }
+
+    /// What `clear_color` is cleared with: an sRGB destination encodes the clear value as it
+    /// does a fragment's, so one given as stored (not `linear`) is decoded first.
+    fn clear_value(&self, options: &RenderOptions) -> [f32; 4] {
+        let color = options.clear_color;
+        if !self.srgb_destination || options.linear {
+            return color;
+        }
+        let decode =
+            |c: f32| crate::scene::shading::srgb_to_linear(c.clamp(0.0, 1.0) as f64) as f32;
+        [
+            decode(color[0]),
+            decode(color[1]),
+            decode(color[2]),
+            color[3],
+        ]
     }
 
     /// One frame into the bound framebuffer (see [`Renderer::render_reusing`]).
@@ -175,7 +201,7 @@ impl Renderer {
         let frame_rect = [origin[0], origin[1], width, height].map(|v| v as i32);
         self.dev
             .viewport(frame_rect[0], frame_rect[1], frame_rect[2], frame_rect[3]);
-        self.dev.clear_rect(frame_rect, options.clear_color);
+        self.dev.clear_rect(frame_rect, self.clear_value(options));
         let mut ctx = FrameContext {
             dev: &self.dev,
             programs: &mut self.programs,

@@ -16,6 +16,16 @@ const H: u32 = 72;
 /// Draws `scene` with `options` into a fresh game framebuffer whose colour texture has the
 /// sized format `colour` (with a 24-bit depth buffer) and reads back the bytes it stores.
 fn stored(gpu: &mut Gpu, colour: u32, scene: &scene::Scene, options: &RenderOptions) -> Vec<u8> {
+    try_stored(gpu, colour, scene, options).unwrap()
+}
+
+/// [`stored`], or the render's error (the framebuffer freed either way).
+fn try_stored(
+    gpu: &mut Gpu,
+    colour: u32,
+    scene: &scene::Scene,
+    options: &RenderOptions,
+) -> Result<Vec<u8>, manylight::Error> {
     let gl = gpu.gl();
     let (w, h) = (W as i32, H as i32);
     let (texture, depth, fbo) = unsafe {
@@ -42,7 +52,7 @@ fn stored(gpu: &mut Gpu, colour: u32, scene: &scene::Scene, options: &RenderOpti
         );
         (texture, depth, fbo)
     };
-    gpu.r().render(scene, W, H, options).unwrap();
+    let rendered = gpu.r().render(scene, W, H, options);
     let mut pixels = vec![0u8; (W * H * 4) as usize];
     unsafe {
         gl.read_pixels(
@@ -59,7 +69,7 @@ fn stored(gpu: &mut Gpu, colour: u32, scene: &scene::Scene, options: &RenderOpti
         gl.delete_texture(texture);
         gl.delete_renderbuffer(depth);
     }
-    pixels
+    rendered.map(|_| pixels)
 }
 
 #[test]
@@ -118,4 +128,79 @@ fn an_srgb_framebuffer_stores_what_an_rgba8_one_does_with_every_method_and_msaa(
             "{method}: {compared} compared"
         );
     }
+}
+
+/// The background and the light-count heatmap, given as stored values, are stored so in an
+/// sRGB framebuffer too; exact counts, which an encode would change, are refused there.
+#[test]
+fn the_clear_colour_and_the_heatmap_are_stored_as_given_and_exact_counts_are_refused() {
+    let mut plane = scene::builtin::build("plane", Some((64, 2))).unwrap();
+    // Far enough that the background shows around the plane.
+    plane.camera = manylight::Camera::perspective(
+        glam::DVec3::new(0.0, 0.0, 30.0),
+        glam::DVec3::ZERO,
+        60.0,
+        0.1,
+        100.0,
+    );
+    let mut gpu = Gpu::new(EsVersion::Es3);
+    gpu.r().set_method_named("clustered").unwrap();
+    let cases = [
+        RenderOptions {
+            clear_color: [0.5, 0.25, 0.75, 1.0],
+            ..Default::default()
+        },
+        RenderOptions {
+            clear_color: [0.5, 0.25, 0.75, 1.0],
+            samples: 4,
+            ..Default::default()
+        },
+        RenderOptions {
+            count: manylight::CountKind::Heatmap,
+            ..Default::default()
+        },
+    ];
+    for options in &cases {
+        let plain = stored(&mut gpu, glow::RGBA8, &plane, options);
+        let srgb = stored(&mut gpu, glow::SRGB8_ALPHA8, &plane, options);
+        let background = plain.chunks(4).filter(|p| p[..3] == [128, 64, 191]).count();
+        if options.count == manylight::CountKind::None {
+            assert!(
+                background > (W * H / 4) as usize,
+                "{background} background pixels"
+            );
+        }
+        // With MSAA, edge pixels are averaged in linear space in the sRGB one (see above).
+        let one = RenderOptions {
+            samples: 1,
+            ..options.clone()
+        };
+        let single = stored(&mut gpu, glow::RGBA8, &plane, &one);
+        let worst = (0..plain.len() / 4)
+            .filter(|i| single[i * 4..i * 4 + 3] == plain[i * 4..i * 4 + 3])
+            .flat_map(|i| (0..3).map(move |c| i * 4 + c))
+            .map(|k| plain[k].abs_diff(srgb[k]))
+            .max()
+            .unwrap_or(0);
+        assert!(
+            worst <= 2,
+            "{} samples, {:?}: the sRGB framebuffer stores values {worst}/255 from the RGBA8 \
+             one's",
+            options.samples,
+            options.count
+        );
+    }
+    let exact = RenderOptions {
+        count: manylight::CountKind::Evals,
+        ..Default::default()
+    };
+    match try_stored(&mut gpu, glow::SRGB8_ALPHA8, &plane, &exact) {
+        Err(manylight::Error::InvalidOption { field: "count", .. }) => {}
+        other => panic!(
+            "exact counts into an sRGB framebuffer: {:?}",
+            other.map(|_| ())
+        ),
+    }
+    // Into an RGBA8 one they are drawn.
+    try_stored(&mut gpu, glow::RGBA8, &plane, &exact).unwrap();
 }
