@@ -171,11 +171,9 @@ impl Materials {
                 factor_alpha
             }
             AlphaMode::Mask => {
-                // NaN or out of range: the spec's default; at 0 nothing is ever cut.
-                let cutoff = m
-                    .alpha_cutoff()
-                    .filter(|c| (0.0..=1.0).contains(c))
-                    .unwrap_or(0.5);
+                // NaN: the spec's default. Past 1 everything is cut (below), at 0 or less
+                // nothing is.
+                let cutoff = m.alpha_cutoff().filter(|c| !c.is_nan()).unwrap_or(0.5);
                 if diffuse_texture.is_some() && factor_alpha >= cutoff && cutoff > 0.0 {
                     // Texel alpha × factor alpha < cutoff, as texel alpha < cutoff / factor.
                     alpha_cutoff = Some(cutoff / factor_alpha);
