@@ -94,33 +94,10 @@ fn a_desktop_games_polygon_mode_and_srgb_switch_neither_change_the_frame_nor_sta
     // Drawn into a game's sRGB framebuffer with the switch on: the frame is stored as an
     // RGBA8 one stores it (encoded once, by the shader), not encoded again.
     let mut into = |colour: u32| -> Vec<u8> {
-        unsafe {
-            let texture = gl.create_texture().unwrap();
-            gl.bind_texture(glow::TEXTURE_2D, Some(texture));
-            gl.tex_storage_2d(glow::TEXTURE_2D, 1, colour, 96, 54);
-            let depth = gl.create_renderbuffer().unwrap();
-            gl.bind_renderbuffer(glow::RENDERBUFFER, Some(depth));
-            gl.renderbuffer_storage(glow::RENDERBUFFER, glow::DEPTH_COMPONENT24, 96, 54);
-            let fbo = gl.create_framebuffer().unwrap();
-            gl.bind_framebuffer(glow::FRAMEBUFFER, Some(fbo));
-            let (color, depth_at) = (glow::COLOR_ATTACHMENT0, glow::DEPTH_ATTACHMENT);
-            gl.framebuffer_texture_2d(glow::FRAMEBUFFER, color, glow::TEXTURE_2D, Some(texture), 0);
-            gl.framebuffer_renderbuffer(
-                glow::FRAMEBUFFER,
-                depth_at,
-                glow::RENDERBUFFER,
-                Some(depth),
-            );
-            r.render(&s, 96, 54, &opts).unwrap();
-            let mut pixels = vec![0u8; 96 * 54 * 4];
-            let pack = glow::PixelPackData::Slice(Some(&mut pixels));
-            gl.read_pixels(0, 0, 96, 54, glow::RGBA, glow::UNSIGNED_BYTE, pack);
-            gl.bind_framebuffer(glow::FRAMEBUFFER, None);
-            gl.delete_framebuffer(fbo);
-            gl.delete_texture(texture);
-            gl.delete_renderbuffer(depth);
-            pixels
-        }
+        use common::game_target::{sized_framebuffer, stored_then_free};
+        let target = unsafe { sized_framebuffer(&gl, colour, (96, 54)) };
+        r.render(&s, 96, 54, &opts).unwrap();
+        unsafe { stored_then_free(&gl, target, (96, 54)) }
     };
     unsafe { gl.polygon_mode(glow::FRONT_AND_BACK, glow::FILL) };
     let (plain, srgb) = (into(glow::RGBA8), into(glow::SRGB8_ALPHA8));

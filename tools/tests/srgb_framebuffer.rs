@@ -6,8 +6,9 @@
 
 mod common;
 
+use common::game_target::{sized_framebuffer, stored_then_free};
 use common::Gpu;
-use manylight::glow::{self, HasContext};
+use manylight::glow;
 use manylight::{scene, EsVersion, RenderOptions};
 
 const W: u32 = 128;
@@ -27,48 +28,9 @@ fn try_stored(
     options: &RenderOptions,
 ) -> Result<Vec<u8>, manylight::Error> {
     let gl = gpu.gl();
-    let (w, h) = (W as i32, H as i32);
-    let (texture, depth, fbo) = unsafe {
-        let texture = gl.create_texture().unwrap();
-        gl.bind_texture(glow::TEXTURE_2D, Some(texture));
-        gl.tex_storage_2d(glow::TEXTURE_2D, 1, colour, w, h);
-        let depth = gl.create_renderbuffer().unwrap();
-        gl.bind_renderbuffer(glow::RENDERBUFFER, Some(depth));
-        gl.renderbuffer_storage(glow::RENDERBUFFER, glow::DEPTH_COMPONENT24, w, h);
-        let fbo = gl.create_framebuffer().unwrap();
-        gl.bind_framebuffer(glow::FRAMEBUFFER, Some(fbo));
-        gl.framebuffer_texture_2d(
-            glow::FRAMEBUFFER,
-            glow::COLOR_ATTACHMENT0,
-            glow::TEXTURE_2D,
-            Some(texture),
-            0,
-        );
-        gl.framebuffer_renderbuffer(
-            glow::FRAMEBUFFER,
-            glow::DEPTH_ATTACHMENT,
-            glow::RENDERBUFFER,
-            Some(depth),
-        );
-        (texture, depth, fbo)
-    };
+    let target = unsafe { sized_framebuffer(&gl, colour, (W as i32, H as i32)) };
     let rendered = gpu.r().render(scene, W, H, options);
-    let mut pixels = vec![0u8; (W * H * 4) as usize];
-    unsafe {
-        gl.read_pixels(
-            0,
-            0,
-            w,
-            h,
-            glow::RGBA,
-            glow::UNSIGNED_BYTE,
-            glow::PixelPackData::Slice(Some(&mut pixels)),
-        );
-        gl.bind_framebuffer(glow::FRAMEBUFFER, None);
-        gl.delete_framebuffer(fbo);
-        gl.delete_texture(texture);
-        gl.delete_renderbuffer(depth);
-    }
+    let pixels = unsafe { stored_then_free(&gl, target, (W, H)) };
     rendered.map(|_| pixels)
 }
 

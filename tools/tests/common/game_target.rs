@@ -72,6 +72,54 @@ pub unsafe fn game_framebuffer(
     GameTarget { fbo, colour, depth }
 }
 
+/// Makes and binds a `size` framebuffer whose colour is a texture of the sized format
+/// `colour` (`RGBA8`, `SRGB8_ALPHA8`), with a 24-bit depth buffer, uncleared.
+pub unsafe fn sized_framebuffer(gl: &glow::Context, colour: u32, (w, h): (i32, i32)) -> GameTarget {
+    let texture = gl.create_texture().unwrap();
+    gl.bind_texture(glow::TEXTURE_2D, Some(texture));
+    gl.tex_storage_2d(glow::TEXTURE_2D, 1, colour, w, h);
+    let depth = gl.create_renderbuffer().unwrap();
+    gl.bind_renderbuffer(glow::RENDERBUFFER, Some(depth));
+    gl.renderbuffer_storage(glow::RENDERBUFFER, glow::DEPTH_COMPONENT24, w, h);
+    let fbo = gl.create_framebuffer().unwrap();
+    gl.bind_framebuffer(glow::FRAMEBUFFER, Some(fbo));
+    let attach = (glow::COLOR_ATTACHMENT0, glow::DEPTH_ATTACHMENT);
+    gl.framebuffer_texture_2d(
+        glow::FRAMEBUFFER,
+        attach.0,
+        glow::TEXTURE_2D,
+        Some(texture),
+        0,
+    );
+    gl.framebuffer_renderbuffer(glow::FRAMEBUFFER, attach.1, glow::RENDERBUFFER, Some(depth));
+    GameTarget {
+        fbo,
+        colour: texture,
+        depth,
+    }
+}
+
+/// The bytes the bound framebuffer stores, bottom row first, and the framebuffer freed.
+pub unsafe fn stored_then_free(
+    gl: &glow::Context,
+    target: GameTarget,
+    (w, h): (u32, u32),
+) -> Vec<u8> {
+    let mut pixels = vec![0u8; (w * h * 4) as usize];
+    let pack = glow::PixelPackData::Slice(Some(&mut pixels));
+    gl.read_pixels(
+        0,
+        0,
+        w as i32,
+        h as i32,
+        glow::RGBA,
+        glow::UNSIGNED_BYTE,
+        pack,
+    );
+    free_game_framebuffer(gl, target);
+    pixels
+}
+
 /// Frees the game's framebuffer and puts back the defaults it changed, so the pooled context
 /// reaches the next test clean.
 unsafe fn free_game_framebuffer(gl: &glow::Context, target: GameTarget) {
