@@ -87,19 +87,17 @@ fn entry_point(name: &str) -> Option<*const std::ffi::c_void> {
     }
     type GetProcAddress =
         unsafe extern "system" fn(*const std::ffi::c_char) -> *const std::ffi::c_void;
-    static SYSTEM: std::sync::OnceLock<Option<(libloading::Library, GetProcAddress)>> =
+    static GET_PROC_ADDRESS: std::sync::OnceLock<Option<GetProcAddress>> =
         std::sync::OnceLock::new();
-    let (_egl, get_proc_address) = SYSTEM
+    let get_proc_address = GET_PROC_ADDRESS
         .get_or_init(|| {
-            let egl = system_library(&["libEGL.so.1", "libEGL.so"])?;
-            let f = symbol(&egl, "eglGetProcAddress")?;
+            let f = symbol(system_egl()?, "eglGetProcAddress")?;
             // SAFETY: EGL 1.4 specifies this signature for `eglGetProcAddress`.
-            let f = unsafe { std::mem::transmute::<*const std::ffi::c_void, GetProcAddress>(f) };
-            Some((egl, f))
+            Some(unsafe { std::mem::transmute::<*const std::ffi::c_void, GetProcAddress>(f) })
         })
         .as_ref()?;
     let cname = std::ffi::CString::new(name).ok()?;
-    // SAFETY: a NUL-terminated name, and the library stays loaded (kept beside the pointer).
+    // SAFETY: a NUL-terminated name, and the library stays loaded for the whole process.
     non_null(unsafe { get_proc_address(cname.as_ptr()) })
 }
 
@@ -109,20 +107,26 @@ fn entry_point(name: &str) -> Option<*const std::ffi::c_void> {
 /// context made through GLX, WGL or another EGL is not one it knows.
 pub(crate) fn system_current_context() -> Option<Option<usize>> {
     type GetCurrentContext = unsafe extern "system" fn() -> *mut std::ffi::c_void;
-    static SYSTEM: std::sync::OnceLock<Option<(libloading::Library, GetCurrentContext)>> =
+    static GET_CURRENT_CONTEXT: std::sync::OnceLock<Option<GetCurrentContext>> =
         std::sync::OnceLock::new();
-    let (_egl, get_current_context) = SYSTEM
+    let get_current_context = GET_CURRENT_CONTEXT
         .get_or_init(|| {
-            let egl = system_library(&["libEGL.so.1", "libEGL.so"])?;
-            let f = symbol(&egl, "eglGetCurrentContext")?;
+            let f = symbol(system_egl()?, "eglGetCurrentContext")?;
             // SAFETY: EGL 1.4 specifies this signature for `eglGetCurrentContext`.
-            let f = unsafe { std::mem::transmute::<*const std::ffi::c_void, GetCurrentContext>(f) };
-            Some((egl, f))
+            Some(unsafe { std::mem::transmute::<*const std::ffi::c_void, GetCurrentContext>(f) })
         })
         .as_ref()?;
-    // SAFETY: no arguments; the library stays loaded (kept beside the pointer).
+    // SAFETY: no arguments; the library stays loaded for the whole process.
     let context = unsafe { get_current_context() };
     Some((!context.is_null()).then_some(context as usize))
+}
+
+/// The system's `libEGL`, loaded once and kept for the whole process (the entry points taken
+/// from it stay valid).
+fn system_egl() -> Option<&'static libloading::Library> {
+    static EGL: std::sync::OnceLock<Option<libloading::Library>> = std::sync::OnceLock::new();
+    EGL.get_or_init(|| system_library(&["libEGL.so.1", "libEGL.so"]))
+        .as_ref()
 }
 
 /// The first of the system's `files` that loads.
