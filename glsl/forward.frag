@@ -70,5 +70,8 @@ void main() {
     color += surfaceEmission(v_uv);
 #endif
     FRAG_COLOR = encodeOutput(color);
+#if HAS_TEXTURE_ALPHA
+    FRAG_COLOR.a *= surfaceTextureAlpha(v_uv);
+#endif
 #endif
 }

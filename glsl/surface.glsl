@@ -67,6 +67,17 @@ bool surfaceCut(vec2 uv) {
 }
 #endif
 
+#if HAS_TEXTURE_ALPHA
+// glTF BLEND: the base colour texture's alpha multiplies the material's opacity.
+float surfaceTextureAlpha(vec2 uv) {
+#if HAS_TEXTURE
+    return TEXTURE2D(u_albedoTex, UV_ALBEDO(uv)).a;
+#else
+    return 1.0;
+#endif
+}
+#endif
+
 vec3 surfaceAlbedo(vec2 uv) {
     vec3 albedo = u_albedo;
 #if HAS_TEXTURE

@@ -83,6 +83,8 @@ impl ShaderFeatures {
     /// Colour textures are sRGB textures the sampler decodes before filtering (ES 3.0 level);
     /// without, the shader decodes the filtered texel (ES 2.0).
     pub const SRGB_TEXTURES: u64 = 1 << 26;
+    /// The material's opacity is multiplied by its base colour texture's alpha (glTF `BLEND`).
+    pub const TEXTURE_ALPHA: u64 = 1 << 27;
 
     /// The flags a material's (and its mesh's) surface inputs set, as opposed to the scene's,
     /// the frame's and the device's.
@@ -93,10 +95,11 @@ impl ShaderFeatures {
         | Self::OCCLUSION
         | Self::MR_TEXTURE
         | Self::TEXTURE_TRANSFORM
-        | Self::ALPHA_MASK;
+        | Self::ALPHA_MASK
+        | Self::TEXTURE_ALPHA;
 
     /// Every flag with its name.
-    pub const NAMED: [(u64, &'static str); 27] = [
+    pub const NAMED: [(u64, &'static str); 28] = [
         (Self::TEXTURE, "texture"),
         (Self::SPOT, "spot"),
         (Self::SPECULAR, "specular"),
@@ -124,6 +127,7 @@ impl ShaderFeatures {
         (Self::TEXTURE_TRANSFORM, "texture_transform"),
         (Self::ALPHA_MASK, "alpha_mask"),
         (Self::SRGB_TEXTURES, "srgb_textures"),
+        (Self::TEXTURE_ALPHA, "texture_alpha"),
     ];
 
     /// Names of the set flags.
@@ -197,6 +201,7 @@ impl ShaderFeatures {
             ),
             ("HAS_ALPHA_MASK".into(), flag(Self::ALPHA_MASK)),
             ("SRGB_TEXTURES".into(), flag(Self::SRGB_TEXTURES)),
+            ("HAS_TEXTURE_ALPHA".into(), flag(Self::TEXTURE_ALPHA)),
             (
                 "TONEMAP".into(),
                 if self.has(Self::TONEMAP_REINHARD) {

@@ -190,6 +190,10 @@ pub(crate) fn shade_object<P: GeometryProgram>(
             texture.is_some() && material.alpha_cutoff.is_some() && !ctx.features.counting(),
         )
         .with(
+            ShaderFeatures::TEXTURE_ALPHA,
+            texture.is_some() && material.alpha_texture && !ctx.features.counting(),
+        )
+        .with(
             ShaderFeatures::SPECULAR,
             !material.is_metallic_roughness() && (material.has_specular() || full),
         )

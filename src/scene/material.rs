@@ -45,6 +45,9 @@ pub struct Material {
     /// A cut-out (glTF `alphaMode: MASK`): fragments where the diffuse texture's alpha is below
     /// this are not drawn (the factor's alpha already folded in). `None`: nothing is cut.
     pub alpha_cutoff: Option<f32>,
+    /// The diffuse texture's alpha multiplies `alpha` (glTF `BLEND` with a texture some of
+    /// whose texels are not opaque): the object is transparent.
+    pub alpha_texture: bool,
     /// The reflectance model; `specular`/`shininess` are read by Blinn-Phong only,
     /// `metallic`/`roughness` by metallic-roughness only.
     pub model: MaterialModel,
@@ -81,6 +84,7 @@ impl Material {
             shininess: 32.0,
             alpha: 1.0,
             alpha_cutoff: None,
+            alpha_texture: false,
             model: MaterialModel::BlinnPhong,
             metallic: 0.0,
             roughness: 1.0,
@@ -121,7 +125,7 @@ impl Material {
 
     /// True when the material is see-through (alpha below 1).
     pub fn is_transparent(&self) -> bool {
-        self.alpha < 1.0
+        self.alpha < 1.0 || (self.alpha_texture && self.diffuse_texture.is_some())
     }
 
     /// True when the material has a non-zero Blinn-Phong specular term (never for

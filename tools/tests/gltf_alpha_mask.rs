@@ -1,9 +1,10 @@
-//! glTF `alphaMode: MASK` cut out by the base colour texture's alpha (leaves, fences): a pane
-//! whose texture is transparent on its left half and opaque on its right stands in front of a
-//! lit wall and a red box. Every pixel is either the picture without the pane (where it is
-//! cut) or the picture with the pane opaque (where it is not), and both occur, with every
-//! method on ES 2.0 and 3.0: the cut holds in the depth prepass's place, in the G-buffer and
-//! in the depth test of what lies behind.
+//! glTF `alphaMode: MASK` cut out by the base colour texture's alpha (leaves, fences), and
+//! `BLEND` blended by it: a pane whose texture is transparent on its left half and opaque on
+//! its right stands in front of a lit wall. With `MASK` every pixel is either the picture
+//! without the pane (where it is cut) or the picture with the pane opaque (where it is not),
+//! and both occur, with every method on ES 2.0 and 3.0: the cut holds in the depth prepass's
+//! place, in the G-buffer and in the depth test of what lies behind. With `BLEND` every pixel
+//! lies between the two (filtering blends the texels' alphas where they meet).
 
 mod common;
 
@@ -21,18 +22,25 @@ use serde_json::json;
 const W: u32 = 128;
 const H: u32 = 72;
 
-/// A 2 × 1 texture: a transparent green texel left, an opaque yellow one right.
+/// A 16 × 1 texture: transparent green texels on the left half, opaque yellow ones on the
+/// right (wide enough that filtering mixes them only near the middle and the edges).
 fn half_cut_png() -> Vec<u8> {
     let texels = [[40u8, 200, 60, 0], [230, 210, 40, 255]];
-    let img = image::RgbaImage::from_fn(2, 1, |x, _| image::Rgba(texels[x as usize]));
+    let img = image::RgbaImage::from_fn(16, 1, |x, _| image::Rgba(texels[(x / 8) as usize]));
     let mut png = Vec::new();
     img.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
         .unwrap();
     png
 }
 
-/// The scene with the pane's material in `alpha_mode` (`None`: no pane at all).
+/// The scene with the pane's material in `alpha_mode` (`None`: no pane at all), its texture
+/// [`half_cut_png`].
 fn scene_with_pane(dir: &Path, alpha_mode: Option<&str>) -> Scene {
+    scene_with_pane_of(dir, alpha_mode, &half_cut_png())
+}
+
+/// [`scene_with_pane`] with the pane's texture `png`.
+fn scene_with_pane_of(dir: &Path, alpha_mode: Option<&str>, png: &[u8]) -> Scene {
     let mut b = Builder::default();
     let floor_prim = primitive(&mut b, &floor(), Some(0));
     let wall_prim = primitive(&mut b, &pane(3.0, 2.0), Some(1));
@@ -61,7 +69,7 @@ fn scene_with_pane(dir: &Path, alpha_mode: Option<&str>) -> Scene {
         ],
         "samplers": [{"magFilter": 9728, "minFilter": 9728}],
         "textures": [{"source": 0, "sampler": 0}],
-        "images": [{"uri": format!("data:image/png;base64,{}", base64(&half_cut_png()))}],
+        "images": [{"uri": format!("data:image/png;base64,{}", base64(png))}],
     });
     let name = format!("pane_{}.gltf", alpha_mode.unwrap_or("none"));
     let (mut scene, _) = load(&write(dir, &name, b.gltf(gltf))).unwrap();
@@ -115,6 +123,63 @@ fn a_masked_texture_cuts_the_pane_where_its_alpha_is_below_the_cutoff() {
             assert!(
                 as_behind > enough && as_solid > enough,
                 "{es} {method}: {as_behind} pixels cut and {as_solid} drawn"
+            );
+        }
+    }
+}
+
+#[test]
+fn a_blended_texture_blends_the_pane_by_its_alpha_and_an_opaque_one_keeps_it_opaque() {
+    let dir = tempfile::tempdir().unwrap();
+    let blended = scene_with_pane(dir.path(), Some("BLEND"));
+    let opaque = scene_with_pane(dir.path(), Some("OPAQUE"));
+    let without = scene_with_pane(dir.path(), None);
+    assert!(
+        blended
+            .materials
+            .iter()
+            .any(|m| m.alpha_texture && m.is_transparent()),
+        "the BLEND material takes its texture's alpha"
+    );
+    // A BLEND material whose texture is opaque everywhere stays an opaque object.
+    let solid_png = common::gltf_models::checker_png();
+    let solid_blend = scene_with_pane_of(dir.path(), Some("BLEND"), &solid_png);
+    assert!(solid_blend.materials.iter().all(|m| !m.is_transparent()));
+    let opts = RenderOptions::default();
+    for es in [EsVersion::Es2, EsVersion::Es3] {
+        let mut gpu = Gpu::new(es);
+        let methods: &[&str] = if es == EsVersion::Es3 {
+            &["forward", "clustered", "deferred"]
+        } else {
+            &["forward", "clustered"]
+        };
+        for method in methods {
+            gpu.r().set_method_named(method).unwrap();
+            let mixed = gpu.render(&blended, W, H, &opts);
+            let solid = gpu.render(&opaque, W, H, &opts);
+            let behind = gpu.render(&without, W, H, &opts);
+            let (mut as_behind, mut as_solid) = (0, 0);
+            for ((m, s), b) in mixed.pixels().zip(solid.pixels()).zip(behind.pixels()) {
+                let between = (0..3).all(|k| {
+                    let (lo, hi) = (s[k].min(b[k]), s[k].max(b[k]));
+                    (lo.saturating_sub(1)..=hi.saturating_add(1)).contains(&m[k])
+                });
+                assert!(
+                    between,
+                    "{es} {method}: a pixel {m:?} is not between the scene without the pane \
+                     {b:?} and with it opaque {s:?}"
+                );
+                let near = |x: &image::Rgba<u8>| (0..3).all(|k| m[k].abs_diff(x[k]) <= 1);
+                if near(b) && !near(s) {
+                    as_behind += 1;
+                } else if near(s) && !near(b) {
+                    as_solid += 1;
+                }
+            }
+            let enough = (W * H / 20) as usize;
+            assert!(
+                as_behind > enough && as_solid > enough,
+                "{es} {method}: {as_behind} pixels see through and {as_solid} do not"
             );
         }
     }

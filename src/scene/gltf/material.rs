@@ -11,12 +11,12 @@
 //! - normal, occlusion, emissive and metallic-roughness textures, emission and every
 //!   texture's `KHR_texture_transform` → [`Material::maps`] (`maps.rs`).
 //! - `alphaMode`: `OPAQUE` ignores alpha; `BLEND` takes `baseColorFactor.a` as the material's
-//!   opacity (below 1: the renderer's transparent path, back to front, alpha-blended);
-//!   `MASK` cuts the whole material — invisible (opacity 0) when `baseColorFactor.a` is below
-//!   `alphaCutoff` — and else, with a base colour texture, each fragment whose texture alpha
-//!   times that factor is below it ([`Material::alpha_cutoff`]: leaves, fences). A texture's
-//!   alpha does not blend (`BLEND` uses the factor alone; a warning says so where it would
-//!   matter).
+//!   opacity, times the base colour texture's alpha where some texel is not opaque
+//!   ([`Material::alpha_texture`]); below 1, or with such a texture, the renderer's transparent
+//!   path (back to front, alpha-blended); `MASK` cuts the whole material — invisible (opacity
+//!   0) when `baseColorFactor.a` is below `alphaCutoff` — and else, with a base colour
+//!   texture, each fragment whose texture alpha times that factor is below it
+//!   ([`Material::alpha_cutoff`]: leaves, fences).
 //! - `doubleSided`: the renderer draws every surface from both sides (no culling, the normal
 //!   turned towards the eye), so `doubleSided: false` surfaces are visible from behind too.
 
@@ -69,6 +69,8 @@ pub(super) struct Materials {
     by_index: HashMap<Option<usize>, usize>,
     textures: Textures,
     raw: RawMaterials,
+    /// Per texture (by address): whether some texel is not opaque, looked at once.
+    translucent: HashMap<usize, bool>,
 }
 
 impl Materials {
@@ -79,6 +81,7 @@ impl Materials {
             by_index: HashMap::new(),
             textures: Textures::new(budget),
             raw: RawMaterials::parse(json),
+            translucent: HashMap::new(),
         }
     }
 
@@ -158,15 +161,18 @@ impl Materials {
                     .map_err(|e| format!("{field}.pbrMetallicRoughness.baseColorTexture: {e}"))?;
             }
         }
-        let mut alpha_cutoff = None;
+        let (mut alpha_cutoff, mut alpha_texture) = (None, false);
         let alpha = match m.alpha_mode() {
             AlphaMode::Opaque => 1.0,
             AlphaMode::Blend => {
-                if factor_alpha >= 1.0 && diffuse_texture.is_some() {
-                    warnings.push(format!(
-                        "{field} (`{name}`): alphaMode BLEND with its opacity only in the \
-                         texture; drawn opaque (the renderer blends by one opacity per material)"
-                    ));
+                // The texture's alpha multiplies the factor's where some texel is not opaque
+                // (exporters often say BLEND of opaque textures: those stay opaque objects).
+                if let Some(t) = &diffuse_texture {
+                    let key = std::sync::Arc::as_ptr(t) as usize;
+                    alpha_texture = *self
+                        .translucent
+                        .entry(key)
+                        .or_insert_with(|| t.image.pixels().any(|p| p[3] < 255));
                 }
                 factor_alpha
             }
@@ -210,6 +216,7 @@ impl Materials {
             shininess: shininess(pbr.roughness_factor()),
             alpha,
             alpha_cutoff,
+            alpha_texture,
             maps,
             ..Material::metallic_roughness(
                 &name,
