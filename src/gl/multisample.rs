@@ -40,6 +40,8 @@ pub struct MultisampleTarget {
     /// resolved into first, made when first needed (GL blits a multisampled source only onto
     /// the same rectangle).
     resolved_copy: Option<(glow::Framebuffer, glow::Renderbuffer)>,
+    /// A full-screen triangle for [`MultisampleTarget::fill`], made when first needed.
+    fill_triangle: Option<GpuMesh>,
     destroyed: bool,
 }
 
@@ -154,6 +156,7 @@ impl MultisampleTarget {
                 2
             },
             resolved_copy: None,
+            fill_triangle: None,
             destroyed: false,
         };
         unsafe {
@@ -338,6 +341,35 @@ impl MultisampleTarget {
         )
     }
 
+    /// Draws `color` (linear: the target encodes it) over every sample of the bound target,
+    /// where a sRGB one's `glClear` may not reach them all (SwiftShader 4.0 fills one sample);
+    /// a no-op for a target that is not sRGB. The caller's clear follows as usual. Leaves the
+    /// full-screen state and the solid program bound.
+    pub fn fill(
+        &mut self,
+        dev: &Device,
+        programs: &mut ProgramCache,
+        color: [f32; 4],
+    ) -> Result<(), GlError> {
+        if !self.is_srgb() {
+            return Ok(());
+        }
+        if self.fill_triangle.is_none() {
+            self.fill_triangle = Some(GpuMesh::new(dev, &fullscreen_triangle())?);
+        }
+        dev.viewport(0, 0, self.size.0 as i32, self.size.1 as i32);
+        RenderState::FULL_SCREEN.apply(dev);
+        let key = ProgramKey {
+            shader: "solid",
+            features: 0,
+            dialect: dev.es(),
+        };
+        let uniforms = programs.bind::<SolidUniforms>(dev, key, Vec::new)?;
+        uniforms.color.set(dev, glam::Vec4::from_array(color));
+        self.fill_triangle.as_ref().expect("made above").draw(dev);
+        dev.check("filling an sRGB MSAA target")
+    }
+
     /// The single-sampled copy (made now if it is not yet): its framebuffer.
     fn resolved_copy(&mut self, dev: &Device) -> Result<glow::Framebuffer, GlError> {
         if let Some((fbo, _)) = self.resolved_copy {
@@ -400,7 +432,23 @@ impl MultisampleTarget {
                 dev.delete_framebuffer(fbo);
                 dev.delete_renderbuffer(colour);
             }
+            if let Some(mut triangle) = self.fill_triangle.take() {
+                triangle.destroy(dev);
+            }
             self.destroyed = true;
+        }
+    }
+}
+
+/// The solid program's colour ([`MultisampleTarget::fill`]).
+struct SolidUniforms {
+    color: Uniform<glam::Vec4>,
+}
+
+impl UniformSet for SolidUniforms {
+    fn resolve(r: &mut Resolver<'_>) -> Self {
+        SolidUniforms {
+            color: r.required("u_color"),
         }
     }
 }

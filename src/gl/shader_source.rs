@@ -86,6 +86,13 @@ pub const SHADERS: &[ShaderDesc] = &[
         mrt: false,
     },
     ShaderDesc {
+        name: "solid",
+        vertex: "fullscreen.vert",
+        fragment: "solid.frag",
+        es3_only: false,
+        mrt: false,
+    },
+    ShaderDesc {
         name: "gbuffer",
         vertex: "mesh.vert",
         fragment: "gbuffer.frag",
@@ -128,6 +135,7 @@ pub const FILES: &[(&str, &str)] = &[
         include_str!("../../glsl/msaa_resolve.frag"),
     ),
     ("forward.frag", include_str!("../../glsl/forward.frag")),
+    ("solid.frag", include_str!("../../glsl/solid.frag")),
     (
         "light_model.glsl",
         include_str!("../../glsl/light_model.glsl"),

@@ -116,8 +116,10 @@ impl Renderer {
         // Creating the target binds (then leaves) framebuffers: the caller's comes back.
         self.dev.bind_framebuffer(destination);
         prepared?;
-        let msaa = self.msaa.as_ref().expect("created by prepare_msaa");
+        let background = self.clear_value(options);
+        let msaa = self.msaa.as_mut().expect("created by prepare_msaa");
         msaa.bind(&self.dev);
+        msaa.fill(&self.dev, &mut self.programs, background)?;
         // Drawn at the target's corner, resolved to the origin.
         let rendered = self.render_frame(scene, (width, height), options, [0, 0], stats);
         let msaa = self.msaa.as_mut().expect("created by prepare_msaa");
