@@ -2,7 +2,8 @@
 uniform vec3 u_albedo;
 uniform vec3 u_specular;
 uniform float u_shininess;
-// Material opacity (1 for opaque objects; blended when below 1).
+// Material opacity (1 for opaque objects; blended when below 1, and by the texture's alpha
+// too with HAS_TEXTURE_ALPHA).
 uniform float u_alpha;
 uniform vec3 u_ambient;
 // 1.0 for orthographic cameras (view direction +Z), 0.0 for perspective.

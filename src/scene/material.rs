@@ -123,7 +123,8 @@ impl Material {
         self.shininess.clamp(1.0, MAX_SHININESS)
     }
 
-    /// True when the material is see-through (alpha below 1).
+    /// True when the material is see-through: alpha below 1, or a diffuse texture whose alpha
+    /// it blends by ([`Material::alpha_texture`]).
     pub fn is_transparent(&self) -> bool {
         self.alpha < 1.0 || (self.alpha_texture && self.diffuse_texture.is_some())
     }

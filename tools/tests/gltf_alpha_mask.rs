@@ -41,6 +41,16 @@ fn scene_with_pane(dir: &Path, alpha_mode: Option<&str>) -> Scene {
 
 /// [`scene_with_pane`] with the pane's texture `png`.
 fn scene_with_pane_of(dir: &Path, alpha_mode: Option<&str>, png: &[u8]) -> Scene {
+    scene_with_pane_of_factor(dir, alpha_mode, png, 1.0)
+}
+
+/// [`scene_with_pane_of`] with the pane's `baseColorFactor` alpha `factor_alpha`.
+fn scene_with_pane_of_factor(
+    dir: &Path,
+    alpha_mode: Option<&str>,
+    png: &[u8],
+    factor_alpha: f32,
+) -> Scene {
     let mut b = Builder::default();
     let floor_prim = primitive(&mut b, &floor(), Some(0));
     let wall_prim = primitive(&mut b, &pane(3.0, 2.0), Some(1));
@@ -65,13 +75,14 @@ fn scene_with_pane_of(dir: &Path, alpha_mode: Option<&str>, png: &[u8]) -> Scene
             {"pbrMetallicRoughness": {"baseColorFactor": [0.7, 0.7, 0.7, 1], "metallicFactor": 0}},
             {"pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.1, 0.1, 1], "metallicFactor": 0}},
             {"alphaMode": alpha_mode.unwrap_or("OPAQUE"), "alphaCutoff": 0.5,
-             "pbrMetallicRoughness": {"baseColorTexture": {"index": 0}, "metallicFactor": 0}}
+             "pbrMetallicRoughness": {"baseColorTexture": {"index": 0}, "metallicFactor": 0,
+                                      "baseColorFactor": [1, 1, 1, factor_alpha]}}
         ],
         "samplers": [{"magFilter": 9728, "minFilter": 9728}],
         "textures": [{"source": 0, "sampler": 0}],
         "images": [{"uri": format!("data:image/png;base64,{}", base64(png))}],
     });
-    let name = format!("pane_{}.gltf", alpha_mode.unwrap_or("none"));
+    let name = format!("pane_{}_{factor_alpha}.gltf", alpha_mode.unwrap_or("none"));
     let (mut scene, _) = load(&write(dir, &name, b.gltf(gltf))).unwrap();
     scene.lights = vec![Light::point(DVec3::new(0.5, 1.5, 1.5), 8.0, Vec3::ONE, 6.0)];
     scene.ambient = Vec3::splat(0.05);
@@ -128,11 +139,26 @@ fn a_masked_texture_cuts_the_pane_where_its_alpha_is_below_the_cutoff() {
     }
 }
 
+/// A 16 × 1 texture: half-transparent texels (alpha 128) on the left half, opaque ones on the
+/// right, all yellow.
+fn half_translucent_png() -> Vec<u8> {
+    let alphas = [128u8, 255];
+    let img = image::RgbaImage::from_fn(16, 1, |x, _| {
+        image::Rgba([230, 210, 40, alphas[(x / 8) as usize]])
+    });
+    let mut png = Vec::new();
+    img.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+        .unwrap();
+    png
+}
+
 #[test]
-fn a_blended_texture_blends_the_pane_by_its_alpha_and_an_opaque_one_keeps_it_opaque() {
+fn a_blended_texture_blends_the_pane_by_its_alpha_times_the_factor() {
     let dir = tempfile::tempdir().unwrap();
-    let blended = scene_with_pane(dir.path(), Some("BLEND"));
-    let opaque = scene_with_pane(dir.path(), Some("OPAQUE"));
+    let png = half_translucent_png();
+    // Opacity 0.5 × 128/255 on the left half, 0.5 × 1 on the right.
+    let blended = scene_with_pane_of_factor(dir.path(), Some("BLEND"), &png, 0.5);
+    let opaque = scene_with_pane_of_factor(dir.path(), Some("OPAQUE"), &png, 1.0);
     let without = scene_with_pane(dir.path(), None);
     assert!(
         blended
@@ -145,41 +171,47 @@ fn a_blended_texture_blends_the_pane_by_its_alpha_and_an_opaque_one_keeps_it_opa
     let solid_png = common::gltf_models::checker_png();
     let solid_blend = scene_with_pane_of(dir.path(), Some("BLEND"), &solid_png);
     assert!(solid_blend.materials.iter().all(|m| !m.is_transparent()));
+    let opacities = [0.5 * 128.0 / 255.0, 0.5];
     let opts = RenderOptions::default();
     for es in [EsVersion::Es2, EsVersion::Es3] {
         let mut gpu = Gpu::new(es);
         let methods: &[&str] = if es == EsVersion::Es3 {
-            &["forward", "clustered", "deferred"]
+            &["forward", "tiled", "clustered", "deferred"]
         } else {
-            &["forward", "clustered"]
+            &["forward", "tiled", "clustered"]
         };
         for method in methods {
             gpu.r().set_method_named(method).unwrap();
             let mixed = gpu.render(&blended, W, H, &opts);
             let solid = gpu.render(&opaque, W, H, &opts);
             let behind = gpu.render(&without, W, H, &opts);
-            let (mut as_behind, mut as_solid) = (0, 0);
+            // The blend of an 8-bit target: opacity × pane + (1 − opacity) × what is behind,
+            // in stored values. Where the pane shows, each pixel is one of the two mixes
+            // (or between them where filtering meets the halves).
+            let mut at = [0usize; 2];
             for ((m, s), b) in mixed.pixels().zip(solid.pixels()).zip(behind.pixels()) {
+                if (0..3).all(|k| s[k].abs_diff(b[k]) < 24) {
+                    continue; // no pane here, or the pane as bright as what it covers
+                }
+                let mix = |a: f64, k: usize| a * s[k] as f64 + (1.0 - a) * b[k] as f64;
+                let near = |a: f64| (0..3).all(|k| (m[k] as f64 - mix(a, k)).abs() <= 3.0);
                 let between = (0..3).all(|k| {
-                    let (lo, hi) = (s[k].min(b[k]), s[k].max(b[k]));
-                    (lo.saturating_sub(1)..=hi.saturating_add(1)).contains(&m[k])
+                    let (lo, hi) = (mix(opacities[0], k), mix(opacities[1], k));
+                    (lo.min(hi) - 3.0..=lo.max(hi) + 3.0).contains(&(m[k] as f64))
                 });
                 assert!(
                     between,
-                    "{es} {method}: a pixel {m:?} is not between the scene without the pane \
-                     {b:?} and with it opaque {s:?}"
+                    "{es} {method}: a pixel {m:?} is not a mix of the pane {s:?} over {b:?} \
+                     at opacity {opacities:?}"
                 );
-                let near = |x: &image::Rgba<u8>| (0..3).all(|k| m[k].abs_diff(x[k]) <= 1);
-                if near(b) && !near(s) {
-                    as_behind += 1;
-                } else if near(s) && !near(b) {
-                    as_solid += 1;
+                for (n, &a) in opacities.iter().enumerate() {
+                    at[n] += usize::from(near(a));
                 }
             }
-            let enough = (W * H / 20) as usize;
+            let enough = (W * H / 40) as usize;
             assert!(
-                as_behind > enough && as_solid > enough,
-                "{es} {method}: {as_behind} pixels see through and {as_solid} do not"
+                at.iter().all(|&n| n > enough),
+                "{es} {method}: {at:?} pixels at opacities {opacities:?}"
             );
         }
     }
