@@ -101,19 +101,9 @@ fn a_masked_texture_cuts_the_pane_where_its_alpha_is_below_the_cutoff() {
         .find(|m| m.alpha_cutoff.is_some())
         .expect("the MASK material cuts by its texture");
     assert_eq!(pane_material.alpha_cutoff, Some(0.5));
-    let opts = RenderOptions::default();
-    for es in [EsVersion::Es2, EsVersion::Es3] {
-        let mut gpu = Gpu::new(es);
-        let methods: &[&str] = if es == EsVersion::Es3 {
-            &["forward", "tiled", "clustered", "deferred"]
-        } else {
-            &["forward", "tiled", "clustered"]
-        };
-        for method in methods {
-            gpu.r().set_method_named(method).unwrap();
-            let cut = gpu.render(&masked, W, H, &opts);
-            let solid = gpu.render(&opaque, W, H, &opts);
-            let behind = gpu.render(&without, W, H, &opts);
+    for_every_method(
+        &[&masked, &opaque, &without],
+        |es, method, [cut, solid, behind]| {
             let (mut as_behind, mut as_solid) = (0, 0);
             for ((c, s), b) in cut.pixels().zip(solid.pixels()).zip(behind.pixels()) {
                 let near = |x: &image::Rgba<u8>| (0..3).all(|k| c[k].abs_diff(x[k]) <= 1);
@@ -135,8 +125,8 @@ fn a_masked_texture_cuts_the_pane_where_its_alpha_is_below_the_cutoff() {
                 as_behind > enough && as_solid > enough,
                 "{es} {method}: {as_behind} pixels cut and {as_solid} drawn"
             );
-        }
-    }
+        },
+    );
 }
 
 /// A 16 × 1 texture: half-transparent texels (alpha 128) on the left half, opaque ones on the
@@ -172,19 +162,9 @@ fn a_blended_texture_blends_the_pane_by_its_alpha_times_the_factor() {
     let solid_blend = scene_with_pane_of(dir.path(), Some("BLEND"), &solid_png);
     assert!(solid_blend.materials.iter().all(|m| !m.is_transparent()));
     let opacities = [0.5 * 128.0 / 255.0, 0.5];
-    let opts = RenderOptions::default();
-    for es in [EsVersion::Es2, EsVersion::Es3] {
-        let mut gpu = Gpu::new(es);
-        let methods: &[&str] = if es == EsVersion::Es3 {
-            &["forward", "tiled", "clustered", "deferred"]
-        } else {
-            &["forward", "tiled", "clustered"]
-        };
-        for method in methods {
-            gpu.r().set_method_named(method).unwrap();
-            let mixed = gpu.render(&blended, W, H, &opts);
-            let solid = gpu.render(&opaque, W, H, &opts);
-            let behind = gpu.render(&without, W, H, &opts);
+    for_every_method(
+        &[&blended, &opaque, &without],
+        |es, method, [mixed, solid, behind]| {
             // The blend of an 8-bit target: opacity × pane + (1 − opacity) × what is behind,
             // in stored values. Where the pane shows, each pixel is one of the two mixes
             // (or between them where filtering meets the halves).
@@ -212,6 +192,31 @@ fn a_blended_texture_blends_the_pane_by_its_alpha_times_the_factor() {
             assert!(
                 at.iter().all(|&n| n > enough),
                 "{es} {method}: {at:?} pixels at opacities {opacities:?}"
+            );
+        },
+    );
+}
+
+/// Renders each of `scenes` with every method on ES 2.0 and 3.0 (deferred on 3.0 only) and
+/// hands `check` the pictures.
+fn for_every_method(
+    scenes: &[&Scene; 3],
+    mut check: impl FnMut(EsVersion, &str, [image::RgbaImage; 3]),
+) {
+    let opts = RenderOptions::default();
+    for es in [EsVersion::Es2, EsVersion::Es3] {
+        let mut gpu = Gpu::new(es);
+        let methods: &[&str] = if es == EsVersion::Es3 {
+            &["forward", "tiled", "clustered", "deferred"]
+        } else {
+            &["forward", "tiled", "clustered"]
+        };
+        for method in methods {
+            gpu.r().set_method_named(method).unwrap();
+            check(
+                es,
+                method,
+                scenes.map(|scene| gpu.render(scene, W, H, &opts)),
             );
         }
     }
