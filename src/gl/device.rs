@@ -343,46 +343,45 @@ impl Device {
         if caps.desktop || !(caps.context_has_es3_state() || caps.has_extension("GL_EXT_sRGB")) {
             return false;
         }
-        let gl = &self.gl;
-        let attachment = if self.bound_framebuffer().is_some() {
-            glow::COLOR_ATTACHMENT0
-        } else {
-            glow::BACK
-        };
-        let param = |p| unsafe {
-            gl.get_framebuffer_attachment_parameter_i32(glow::FRAMEBUFFER, attachment, p)
-        };
-        let srgb = param(glow::FRAMEBUFFER_ATTACHMENT_OBJECT_TYPE) != glow::NONE as i32
-            && param(glow::FRAMEBUFFER_ATTACHMENT_COLOR_ENCODING) == glow::SRGB as i32;
-        // A driver that cannot say (a surfaceless default framebuffer) leaves an error.
-        self.drain_errors() == glow::NO_ERROR && srgb
+        let colour = [glow::COLOR_ATTACHMENT0, glow::BACK];
+        let encoding = self.bound_attachment(colour, glow::FRAMEBUFFER_ATTACHMENT_COLOR_ENCODING);
+        encoding == Some(Some(glow::SRGB as i32))
     }
 
     /// The depth bits of the bound framebuffer (0: no depth buffer); `None` where the driver
     /// would not say. ES 2.0 asks `GL_DEPTH_BITS`; ES 3.0 and desktop core (which dropped that
     /// query) ask the depth attachment.
     pub(crate) fn bound_depth_bits(&self) -> Option<i32> {
-        let gl = &self.gl;
-        let bits = unsafe {
-            if self.caps.es == EsVersion::Es2 && !self.caps.desktop {
-                gl.get_parameter_i32(glow::DEPTH_BITS)
-            } else {
-                let attachment = if self.bound_framebuffer().is_some() {
-                    glow::DEPTH_ATTACHMENT
-                } else {
-                    glow::DEPTH
-                };
-                let param = |p| {
-                    gl.get_framebuffer_attachment_parameter_i32(glow::FRAMEBUFFER, attachment, p)
-                };
-                if param(glow::FRAMEBUFFER_ATTACHMENT_OBJECT_TYPE) == glow::NONE as i32 {
-                    0
-                } else {
-                    param(glow::FRAMEBUFFER_ATTACHMENT_DEPTH_SIZE)
-                }
-            }
+        if self.caps.es == EsVersion::Es2 && !self.caps.desktop {
+            let bits = unsafe { self.gl.get_parameter_i32(glow::DEPTH_BITS) };
+            return (self.drain_errors() == glow::NO_ERROR).then_some(bits);
+        }
+        let depth = [glow::DEPTH_ATTACHMENT, glow::DEPTH];
+        self.bound_attachment(depth, glow::FRAMEBUFFER_ATTACHMENT_DEPTH_SIZE)
+            .map(|bits| bits.unwrap_or(0))
+    }
+
+    /// `pname` of the bound framebuffer's attachment (the first of `[in_object, in_default]`
+    /// for a framebuffer object, the second for the default one): `Some(None)` where nothing
+    /// is attached, `None` where the driver would not say (a surfaceless default framebuffer,
+    /// ES 2.0's default one), its error drained.
+    fn bound_attachment(
+        &self,
+        [in_object, in_default]: [u32; 2],
+        pname: u32,
+    ) -> Option<Option<i32>> {
+        let attachment = if self.bound_framebuffer().is_some() {
+            in_object
+        } else {
+            in_default
         };
-        (self.drain_errors() == glow::NO_ERROR).then_some(bits)
+        let param = |p| unsafe {
+            self.gl
+                .get_framebuffer_attachment_parameter_i32(glow::FRAMEBUFFER, attachment, p)
+        };
+        let attached = param(glow::FRAMEBUFFER_ATTACHMENT_OBJECT_TYPE) != glow::NONE as i32;
+        let value = attached.then(|| param(pname));
+        (self.drain_errors() == glow::NO_ERROR).then_some(value)
     }
 
     /// The first pending GL error (or `NO_ERROR`), with the queue drained: at most one flag
