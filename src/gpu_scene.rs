@@ -26,6 +26,9 @@ pub struct GpuScene {
     textures: HashMap<usize, (Arc<Texture>, [Option<ImageTexture>; 2])>,
     /// 1×1 white texture for full variants on untextured materials (made on first use).
     white: Option<ImageTexture>,
+    /// Colour textures are uploaded as sRGB textures, in their own slot of `textures`
+    /// (`texture::hardware_srgb`; set by each upload).
+    srgb_textures: bool,
     /// This frame's stand-ins for objects with triangles too long for their distance from the
     /// eye: object index → the split mesh and its model matrix (see
     /// `scene::triangle_reach`).
@@ -40,6 +43,7 @@ impl GpuScene {
         full_variants: bool,
     ) -> Result<(), Error> {
         self.forget_unreferenced(dev);
+        self.srgb_textures = crate::gl::texture::hardware_srgb(dev.caps());
         if full_variants && self.white.is_none() {
             let white = image::RgbaImage::from_pixel(1, 1, image::Rgba([255, 255, 255, 255]));
             self.white = Some(ImageTexture::new(dev, &white, false)?);
@@ -61,8 +65,7 @@ impl GpuScene {
                 .textures()
                 .map(|(slot, t)| (&t.texture, slot == "emissive"));
             for (t, colour) in m.diffuse_texture.iter().map(|t| (t, true)).chain(maps) {
-                // One upload serves both where colour textures are plain ones (ES 2.0).
-                let srgb = colour && crate::gl::texture::hardware_srgb(dev);
+                let srgb = self.upload_slot(colour);
                 let key = Arc::as_ptr(t) as usize;
                 let (_, uploads) = self
                     .textures
@@ -169,8 +172,13 @@ impl GpuScene {
     /// the context has them) or as data.
     pub fn texture_of(&self, texture: &Arc<Texture>, colour: bool) -> Option<&ImageTexture> {
         let (_, uploads) = self.textures.get(&(Arc::as_ptr(texture) as usize))?;
-        // Whichever was made: on ES 2.0 colour and data share the plain upload.
-        uploads[colour as usize].as_ref().or(uploads[0].as_ref())
+        uploads[self.upload_slot(colour) as usize].as_ref()
+    }
+
+    /// Whether a texture sampled as colour (`colour`) or data takes the sRGB upload: one
+    /// upload serves both where colour textures are plain ones (ES 2.0).
+    fn upload_slot(&self, colour: bool) -> bool {
+        colour && self.srgb_textures
     }
 
     /// The white stand-in texture (only after an upload with full variants).

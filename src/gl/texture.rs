@@ -199,9 +199,10 @@ impl Drop for DataTexture {
 }
 
 /// Whether colour textures are sRGB textures, decoded by the sampler (the ES 3.0 level and
-/// desktop GL), rather than by the shader after filtering (ES 2.0).
-pub fn hardware_srgb(dev: &Device) -> bool {
-    dev.es() == EsVersion::Es3
+/// desktop GL), rather than by the shader after filtering (ES 2.0): what the uploads and the
+/// shaders' `SRGB_TEXTURES` both follow.
+pub fn hardware_srgb(caps: &super::Caps) -> bool {
+    caps.es == EsVersion::Es3
 }
 
 /// The size an image of `size` is uploaded at: each side within `max` (the context's
@@ -256,7 +257,7 @@ impl ImageTexture {
         unsafe {
             gl.bind_texture(glow::TEXTURE_2D, Some(raw));
             gl.pixel_store_i32(glow::UNPACK_ALIGNMENT, 1);
-            let internal = if srgb && hardware_srgb(dev) {
+            let internal = if srgb && hardware_srgb(dev.caps()) {
                 glow::SRGB8_ALPHA8
             } else {
                 glow::RGBA

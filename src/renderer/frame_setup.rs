@@ -117,7 +117,7 @@ pub(super) fn shader_features(
         )
         .with(
             ShaderFeatures::SRGB_TEXTURES,
-            caps.es == crate::gl::EsVersion::Es3,
+            crate::gl::texture::hardware_srgb(caps),
         )
 }
 
