@@ -27,12 +27,13 @@
 //! near a light by 11/255. Rendering to float textures needs `GL_EXT_color_buffer_float`.
 #![allow(unsafe_code)]
 
-/// The normal buffer's view depth where no surface was drawn (below `noSurface`'s −10²⁹).
-const NO_SURFACE_DEPTH: f32 = -1.0e30;
 use glow::HasContext;
 
 use super::target_size::{self, TargetStorage};
 use super::{Device, EsVersion, GlError};
+
+/// The normal buffer's view depth where no surface was drawn (below `noSurface`'s −10²⁹).
+const NO_SURFACE_DEPTH: f32 = -1.0e30;
 
 /// Bytes of GPU memory per pixel on this context (see the module docs).
 pub fn bytes_per_pixel(caps: &super::Caps) -> usize {
