@@ -7,6 +7,8 @@
 
 mod common;
 
+use common::game_target::sized_framebuffer;
+
 use khronos_egl as egl;
 use manylight::glow::{self, HasContext};
 use manylight::{EsVersion, RenderOptions, Renderer};
@@ -88,24 +90,6 @@ fn game_egl_or_skip() -> Option<GameEgl> {
     game
 }
 
-/// A game's texture and framebuffer on the current context.
-unsafe fn game_objects(gl: &glow::Context) -> (glow::Texture, glow::Framebuffer) {
-    let texture = gl.create_texture().unwrap();
-    gl.bind_texture(glow::TEXTURE_2D, Some(texture));
-    gl.tex_storage_2d(glow::TEXTURE_2D, 1, glow::RGBA8, 16, 16);
-    let fbo = gl.create_framebuffer().unwrap();
-    gl.bind_framebuffer(glow::FRAMEBUFFER, Some(fbo));
-    gl.framebuffer_texture_2d(
-        glow::FRAMEBUFFER,
-        glow::COLOR_ATTACHMENT0,
-        glow::TEXTURE_2D,
-        Some(texture),
-        0,
-    );
-    gl.bind_framebuffer(glow::FRAMEBUFFER, None);
-    (texture, fbo)
-}
-
 #[test]
 fn replacing_a_renderer_on_a_new_context_leaves_that_contexts_objects_alone() {
     let Some(game) = game_egl_or_skip() else {
@@ -125,13 +109,21 @@ fn replacing_a_renderer_on_a_new_context_leaves_that_contexts_objects_alone() {
     let second = game.context();
     game.make_current(Some(second));
     let gl = game.glow();
-    let (texture, fbo) = unsafe { game_objects(&gl) };
+    // The game's objects, its framebuffer left unbound.
+    let target = unsafe { sized_framebuffer(&gl, glow::RGBA8, (16, 16)) };
+    unsafe { gl.bind_framebuffer(glow::FRAMEBUFFER, None) };
     let mut new = Renderer::new(game.glow(), EsVersion::Es3).unwrap();
     let before = common::warnings::warnings_containing("not freed").len();
     drop(old);
     unsafe {
-        assert!(gl.is_texture(texture), "the game's texture was deleted");
-        assert!(gl.is_framebuffer(fbo), "the game's framebuffer was deleted");
+        assert!(
+            gl.is_texture(target.colour()),
+            "the game's texture was deleted"
+        );
+        assert!(
+            gl.is_framebuffer(target.fbo()),
+            "the game's framebuffer was deleted"
+        );
     }
     assert_eq!(
         common::warnings::warnings_containing("not freed").len(),

@@ -17,6 +17,18 @@ pub struct GameTarget {
     depth: glow::Renderbuffer,
 }
 
+impl GameTarget {
+    /// The framebuffer object.
+    pub fn fbo(&self) -> glow::Framebuffer {
+        self.fbo
+    }
+
+    /// Its colour texture.
+    pub fn colour(&self) -> glow::Texture {
+        self.colour
+    }
+}
+
 /// Makes and binds a `size` RGBA8 framebuffer with depth (24 bits where the context has them,
 /// as the README asks of a game's), cleared to [`MARKER`] and to a depth that would hide the
 /// whole scene if the renderer drew against it.
