@@ -10,14 +10,18 @@ use manylight::gl::HeadlessContext;
 use manylight::methods::METHODS;
 use manylight::{scene, EsVersion, RenderOptions, Renderer};
 
+/// A desktop GL context through OSMesa, or `None` (the test skips, saying why) without
+/// libOSMesa.
+fn osmesa_or_skip() -> Option<OsMesaContext> {
+    OsMesaContext::new()
+        .map_err(|e| common::skip(&e.to_string()))
+        .ok()
+}
+
 #[test]
 fn osmesa_renders_the_default_scene_through_every_method() {
-    let ctx = match OsMesaContext::new() {
-        Ok(c) => c,
-        Err(e) => {
-            common::skip(&e.to_string());
-            return;
-        }
+    let Some(ctx) = osmesa_or_skip() else {
+        return;
     };
     let s = scene::builtin::build(scene::builtin::DEFAULT, Some((256, 5))).unwrap();
     let opts = RenderOptions::default();
@@ -59,12 +63,8 @@ fn osmesa_renders_the_default_scene_through_every_method() {
 #[allow(unsafe_code)] // the game's side: raw glow calls
 fn a_desktop_games_polygon_mode_and_srgb_switch_neither_change_the_frame_nor_stay_changed() {
     use manylight::glow::{self, HasContext};
-    let ctx = match OsMesaContext::new() {
-        Ok(c) => c,
-        Err(e) => {
-            common::skip(&e.to_string());
-            return;
-        }
+    let Some(ctx) = osmesa_or_skip() else {
+        return;
     };
     let s = scene::builtin::build(scene::builtin::DEFAULT, Some((64, 5))).unwrap();
     let opts = RenderOptions::default();
