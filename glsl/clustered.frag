@@ -30,7 +30,7 @@ void main() {
 #else
     vec3 N = normalize(v_normal);
     vec3 V = viewDirection(v_viewPos);
-    N = shadingNormal(N, V, v_uv);
+    N = shadingNormal(N, v_uv);
     MEDP vec3 albedo = surfaceAlbedo(v_uv);
     SurfaceParams surface = materialSurface(albedo, v_uv);
     HIGHP vec3 color = surfaceAmbient(albedo, v_uv);

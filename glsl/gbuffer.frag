@@ -21,9 +21,8 @@ void main() {
     }
 #endif
     vec3 N = normalize(v_normal);
-    vec3 V = viewDirection(v_viewPos);
     // Two-sided: the side the eye sees.
-    N = shadingNormal(N, V, v_uv);
+    N = shadingNormal(N, v_uv);
     // The surface point as its depth and its window offset from the pixel centre (see
     // windowPosition): the light pass shades the very point forward shades.
     HIGHP vec2 offset = windowPosition(v_viewPos) - gl_FragCoord.xy;

@@ -43,12 +43,17 @@ vec3 linearToSrgb(vec3 c) {
 
 #include "surface_maps.glsl"
 
+// −1 for an object placed by a mirroring transform, which turns its winding round on screen.
+// A uniform rather than glFrontFace: SwiftShader's gl_FrontFacing ignores glFrontFace.
+uniform float u_frontSign;
+
 // The shading normal of the side the eye sees (surfaces are two-sided): the interpolated unit
-// normal N, normal-mapped in its own tangent frame, then reversed whole where N faces away
-// (glTF 2.0 §3.9.5: a back face's normals are reversed). Mapping after the flip instead would
-// mirror the map along the tangent, lighting a back face from the wrong side.
-vec3 shadingNormal(vec3 N, vec3 V, vec2 uv) {
-    float side = dot(N, V) < 0.0 ? -1.0 : 1.0;
+// normal N, normal-mapped in its own tangent frame, then reversed whole on a back face (glTF
+// 2.0 §3.9.5). The side is the winding's (meshes are wound towards their normals): turned by
+// N · V instead, a front face's normal leaning away near a silhouette lit it from behind.
+// Mapping after the flip would mirror the map along the tangent.
+vec3 shadingNormal(vec3 N, vec2 uv) {
+    float side = gl_FrontFacing ? u_frontSign : -u_frontSign;
 #if HAS_NORMAL_MAP
     N = surfaceNormal(N, uv);
 #endif

@@ -4,7 +4,7 @@
 //! attachment        format     bytes  contents
 //! colour 0 albedo   RGBA16F      8    linear albedo (Kd × decoded texture); a: the surface
 //!                                     point's window y offset from the pixel centre
-//! colour 1 normal   RGBA32F     16    view-space normal (two-sided, facing the eye) in
+//! colour 1 normal   RGBA32F     16    view-space normal (of the side seen) in
 //!                                     octahedral form (xy), view depth (z), window x offset
 //! colour 2 specular RGBA16F      8    Ks, Blinn-Phong exponent
 //! depth             DEPTH24      4    for the geometry pass's depth test

@@ -36,7 +36,7 @@ pub enum DepthTest {
 /// Face culling.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Cull {
-    /// Draw both sides (OBJ files often have inconsistent winding).
+    /// Draw both sides (every surface is two-sided).
     None,
     /// Cull back faces.
     Back,
@@ -103,8 +103,9 @@ impl RenderState {
         ..Self::OPAQUE_AFTER_PREPASS
     };
 
-    /// Transparent objects, first pass: their far side, blended over what is behind, tested
-    /// against (but not writing) the opaque depth.
+    /// Transparent objects, first pass: their far side (GL's back faces; the front ones of a
+    /// mirrored object, which takes the passes the other way round), blended over what is
+    /// behind, tested against (but not writing) the opaque depth.
     pub const TRANSPARENT_BACK_FACES: RenderState = RenderState {
         depth_test: DepthTest::Less,
         depth_write: false,

@@ -2,7 +2,7 @@
 //! material's shader variant, the method adding its own uniforms and textures.
 
 use super::directional::DirectionalUniforms;
-use super::uniforms::{Surface, SurfaceFrame, Transforms};
+use super::uniforms::{is_mirroring, Surface, SurfaceFrame, Transforms};
 use super::{FrameContext, ShaderFeatures};
 use crate::gl::program::{ProgramKey, Resolver, UniformSet};
 use crate::gl::state::RenderState;
@@ -147,10 +147,17 @@ pub fn draw_objects<P: GeometryProgram>(
     };
     for k in 0..transparent {
         let i = ctx.order.transparent[k];
-        for state in [
+        // The far side first: GL's back faces (clockwise on screen), which are the front ones
+        // of an object a mirroring transform places.
+        let (_, model) = ctx.gpu_scene.drawn(i, &ctx.scene.objects[i]);
+        let mut passes = [
             RenderState::TRANSPARENT_BACK_FACES,
             RenderState::TRANSPARENT_FRONT_FACES,
-        ] {
+        ];
+        if is_mirroring(&(ctx.view * model)) {
+            passes.reverse();
+        }
+        for state in passes {
             state.apply(ctx.dev);
             shade_object(ctx, i, shader, max_lights, bind_method)?;
         }
@@ -230,6 +237,9 @@ pub(crate) fn shade_object<P: GeometryProgram>(
         &frame,
         features.has(ShaderFeatures::COUNT_HEATMAP),
     );
+    program
+        .surface()
+        .set_mirrored(dev, is_mirroring(&(ctx.view * model)));
     if let Some(directional) = program.directional() {
         directional.set(dev, &ctx.directional);
     }

@@ -48,10 +48,14 @@ impl Transforms {
         self.normal_matrix.set(dev, normal_matrix.as_mat3());
         self.projection.set(dev, *projection);
         // A mirroring transform flips the bitangent (N × T turns the other way).
-        let det = DMat3::from_mat4(*model_view).determinant();
-        self.tangent_sign
-            .set(dev, if det < 0.0 { -1.0 } else { 1.0 });
+        let sign = if is_mirroring(model_view) { -1.0 } else { 1.0 };
+        self.tangent_sign.set(dev, sign);
     }
+}
+
+/// Whether `model_view` mirrors what it places: its front faces are then clockwise on screen.
+pub(crate) fn is_mirroring(model_view: &DMat4) -> bool {
+    DMat3::from_mat4(*model_view).determinant() < 0.0
 }
 
 /// `surface.glsl`: the material, the ambient light and the output encoding.
@@ -68,6 +72,7 @@ pub struct Surface {
     orthographic: Uniform<f32>,
     heat_scale: Uniform<f32>,
     albedo_tex: Uniform<Sampler>,
+    front_sign: Uniform<f32>,
     maps: MapUniforms,
 }
 
@@ -105,7 +110,11 @@ impl Surface {
             alpha_cutoff: r.required_when(colour && cuts(f), "u_alphaCutoff"),
             ambient: r.required_when(colour, "u_ambient"),
             exposure: r.required_when(colour && !f.has(ShaderFeatures::OUTPUT_HDR), "u_exposure"),
-            orthographic: r.required_when(lit, "u_orthographic"),
+            // The view direction: the highlights' (both sides' normals come from the winding).
+            orthographic: r.required_when(
+                lit && (mr || f.has(ShaderFeatures::SPECULAR)),
+                "u_orthographic",
+            ),
             // A light-less count is a constant a compiler may fold through the colour map.
             heat_scale: r.required_when(
                 f.counting()
@@ -114,6 +123,8 @@ impl Surface {
                 "u_heatScale",
             ),
             albedo_tex: r.required_when(colour && f.has(ShaderFeatures::TEXTURE), "u_albedoTex"),
+            // Which side is seen: read with the normal.
+            front_sign: r.required_when(lit, "u_frontSign"),
             maps: MapUniforms::resolve(r, colour),
         }
     }
@@ -134,6 +145,7 @@ impl Surface {
             orthographic: r.required("u_orthographic"),
             heat_scale: r.optional("u_heatScale"),
             albedo_tex: r.required_when(f.has(ShaderFeatures::TEXTURE), "u_albedoTex"),
+            front_sign: r.required("u_frontSign"),
             maps: MapUniforms::resolve(r, true),
         }
     }
@@ -166,6 +178,12 @@ impl Surface {
         if let Some(unit) = texture_unit {
             self.albedo_tex.set(dev, unit);
         }
+    }
+
+    /// Whether the object drawn is placed by a mirroring transform ([`is_mirroring`]), which
+    /// turns round the winding that tells which side is seen.
+    pub(crate) fn set_mirrored(&self, dev: &Device, mirrored: bool) {
+        self.front_sign.set(dev, if mirrored { -1.0 } else { 1.0 });
     }
 
     /// `surface_maps.glsl`'s uniforms and textures (see [`MapUniforms::set`]).

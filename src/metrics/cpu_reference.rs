@@ -298,8 +298,9 @@ fn evaluate(
     }
     let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
     for h in &hits {
-        let surface = Surface::of(material, h.position, h.normal, material.diffuse.as_dvec3());
         let v = view_direction(&scene.camera, h.position);
+        let normal = shading::seen_side(h.normal, h.face, v);
+        let surface = Surface::of(material, h.position, normal, material.diffuse.as_dvec3());
         let c = shading::shade(&surface, v, &scene.lights, scene.ambient)
             + shading::shade_directional(&surface, v, &scene.directional_lights);
         for ch in 0..3 {

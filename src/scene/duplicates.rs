@@ -120,7 +120,13 @@ mod tests {
             0, 1, 3, // the third one reversed: dropped
             3, 2, 1, // kept
         ];
-        let mut mesh = Mesh::new(p, normals, vec![], indices).unwrap();
+        // Built as a struct: `Mesh::new` would wind each triangle towards its normals.
+        let mut mesh = Mesh {
+            positions: p,
+            normals,
+            indices,
+            ..Mesh::default()
+        };
         assert_eq!(drop_duplicate_triangles(&mut mesh), 4);
         assert_eq!(mesh.indices, [0, 1, 2, 0, 3, 1, 3, 2, 1]);
         assert_eq!(drop_duplicate_triangles(&mut mesh), 0);

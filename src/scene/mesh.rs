@@ -81,8 +81,8 @@ impl Aabb {
 
 /// An indexed triangle mesh in object space. Normals are always present (computed from the
 /// faces when the source had none); texture coordinates are optional. Drawn double-sided: no
-/// back face is culled, and a face seen from behind is shaded with its normal turned to the
-/// eye.
+/// back face is culled, and a back face (clockwise on screen; [`Mesh::new`] winds each
+/// triangle towards its normals) is shaded with its normals reversed.
 #[derive(Clone, Debug, Default)]
 pub struct Mesh {
     /// Vertex positions.
@@ -103,13 +103,16 @@ pub struct Mesh {
 
 impl Mesh {
     /// Builds a mesh and checks it: indices in range, a multiple of three, finite values.
-    /// Missing normals (`normals` empty) are computed as area-weighted face normals.
+    /// Missing normals (`normals` empty) are computed as area-weighted face normals; given
+    /// ones turn each triangle whose winding faces away from them round (its front face is
+    /// the side its normals point to).
     pub fn new(
         positions: Vec<Vec3>,
         normals: Vec<Vec3>,
         uvs: Vec<Vec2>,
         indices: Vec<u32>,
     ) -> Result<Mesh, SceneError> {
+        let mut indices = indices;
         let n = positions.len();
         check_indices(&indices, n, "mesh.indices")?;
         if let Some(i) = positions.iter().position(|p| !p.is_finite()) {
@@ -144,7 +147,9 @@ impl Mesh {
             ));
         }
         let normals = if normals.len() == n {
-            repair_normals(normals, &positions, &indices)
+            let normals = repair_normals(normals, &positions, &indices);
+            wind_to_normals(&positions, &normals, &mut indices);
+            normals
         } else {
             compute_normals(&positions, &indices)
         };
@@ -349,6 +354,25 @@ fn repair_normals(normals: Vec<Vec3>, positions: &[Vec3], indices: &[u32]) -> Ve
         .collect()
 }
 
+/// Reverses each triangle whose winding points away from its vertex normals (their sum), so
+/// that its front face (counter-clockwise on screen) is the side they point to: the shaders
+/// tell the side seen by the winding (`gl_FrontFacing`), and OBJ files follow no winding rule.
+/// Returns how many were reversed.
+fn wind_to_normals(positions: &[Vec3], normals: &[Vec3], indices: &mut [u32]) -> usize {
+    let mut reversed = 0;
+    for tri in indices.chunks_exact_mut(3) {
+        let [a, b, c] = [tri[0], tri[1], tri[2]].map(|i| i as usize);
+        let [pa, pb, pc] = [a, b, c].map(|i| positions[i].as_dvec3());
+        let winding = (pb - pa).cross(pc - pa);
+        let normal = normals[a].as_dvec3() + normals[b].as_dvec3() + normals[c].as_dvec3();
+        if winding.dot(normal) < 0.0 {
+            tri.swap(1, 2);
+            reversed += 1;
+        }
+    }
+    reversed
+}
+
 /// Area-weighted vertex normals from the faces; vertices on no face (or only degenerate ones)
 /// get +Y. Summed in `f64`, so faces too small or too large for an `f32` cross product keep
 /// their direction.
@@ -412,6 +436,53 @@ mod tests {
                 normals.iter().all(|n| (*n - Vec3::Z).length() < 1e-6),
                 "{scale:e}"
             );
+        }
+    }
+
+    /// Every triangle's winding normal, in f64.
+    fn windings(m: &Mesh) -> Vec<DVec3> {
+        m.indices
+            .chunks_exact(3)
+            .map(|t| {
+                let [a, b, c] = [t[0], t[1], t[2]].map(|i| m.positions[i as usize].as_dvec3());
+                (b - a).cross(c - a)
+            })
+            .collect()
+    }
+
+    #[test]
+    fn triangles_are_wound_towards_their_normals() {
+        // Two triangles of the plane z = 0, the first counter-clockwise seen from +Z, the
+        // second clockwise; every normal is +Z.
+        let positions = vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::new(1.0, 1.0, 0.0)];
+        let m = Mesh::new(
+            positions.clone(),
+            vec![Vec3::Z; 4],
+            vec![],
+            vec![0, 1, 2, 1, 2, 3],
+        )
+        .unwrap();
+        assert_eq!(
+            &m.indices[..3],
+            &[0, 1, 2],
+            "a triangle already wound stays"
+        );
+        for w in windings(&m) {
+            assert!(w.z > 0.0, "{w}");
+        }
+        // Normals tilted far from the face still pick its side by their sum.
+        let tilted = vec![
+            Vec3::new(-0.9, 0.0, -0.2).normalize(),
+            Vec3::new(0.9, 0.0, 0.5).normalize(),
+            Vec3::Z,
+            Vec3::Z,
+        ];
+        let m = Mesh::new(positions.clone(), tilted, vec![], vec![0, 2, 1]).unwrap();
+        assert!(windings(&m)[0].z > 0.0);
+        // Normals facing -Z turn the first triangle round instead.
+        let m = Mesh::new(positions, vec![-Vec3::Z; 4], vec![], vec![0, 1, 2, 1, 2, 3]).unwrap();
+        for w in windings(&m) {
+            assert!(w.z < 0.0, "{w}");
         }
     }
 

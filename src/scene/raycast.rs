@@ -8,7 +8,7 @@
 //! a placement costs a few hundred bytes whatever its mesh. A transform without a usable
 //! inverse (flattened to a plane) is traced in world space instead, its triangles carried
 //! through the transform as they are tested. The ray test is Möller–Trumbore with both faces
-//! accepted (the renderer draws surfaces two-sided); `t` is the world ray's parameter in
+//! accepted (the renderer draws surfaces two-sided, [`Hit::face`] tells which); `t` is the world ray's parameter in
 //! either space, since an affine map keeps it.
 
 mod bvh;
@@ -30,6 +30,9 @@ pub struct Hit {
     pub position: DVec3,
     /// Interpolated vertex normal, world space, unit length (not flipped towards the ray).
     pub normal: DVec3,
+    /// The triangle's unit normal on its front side (the one its winding faces, turned back
+    /// for a mirroring transform): the side `Mesh::new` winds towards its vertex normals.
+    pub face: DVec3,
     /// Index into [`Scene::objects`].
     pub object: usize,
     /// Triangle index within that object's mesh (`indices[3 * triangle..]`).
@@ -281,14 +284,21 @@ impl SceneRaycaster {
                 .to_world
                 .transform_point3(mesh.positions[i].as_dvec3())
         });
+        let linear = DMat3::from_mat4(instance.to_world);
         let geometric = (world[1] - world[0]).cross(world[2] - world[0]);
+        // A mirroring transform turns the placed winding round; the GPU draws such an object
+        // with the opposite front face.
+        let face = if linear.determinant() < 0.0 {
+            -geometric
+        } else {
+            geometric
+        };
         // Vertex normals times the normal matrix, made unit (zero where the matrix takes them
         // to nothing), interpolated and normalised again: what `mesh.vert` and the fragment
         // shader do. `Mesh::new` always fills normals; a hand-built mesh without them shades
         // flat.
         let n = if mesh.normals.len() == mesh.positions.len() {
-            let normal_matrix =
-                super::normal_matrix::normal_matrix(&DMat3::from_mat4(instance.to_world));
+            let normal_matrix = super::normal_matrix::normal_matrix(&linear);
             let n = corners.map(|i| {
                 super::direction::unit(normal_matrix * mesh.normals[i].as_dvec3())
                     .unwrap_or(DVec3::ZERO)
@@ -300,7 +310,8 @@ impl SceneRaycaster {
         Hit {
             t,
             position: origin + dir * t,
-            normal: n.try_normalize().unwrap_or_else(|| geometric.normalize()),
+            normal: n.try_normalize().unwrap_or_else(|| face.normalize()),
+            face: face.normalize(),
             object: instance.object as usize,
             triangle: triangle as usize,
         }

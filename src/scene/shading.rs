@@ -17,7 +17,8 @@
 //! That is the Blinn-Phong model; a metallic-roughness material replaces `diffuse + specular`
 //! with the glTF BRDF times π·N·L ([`super::brdf::reflectance`]); `albedo` is its base colour.
 //!
-//! Surfaces are two-sided (`N` flipped towards the eye). In view space, `V` is
+//! Surfaces are two-sided: a back face is shaded with its normals reversed ([`seen_side`]),
+//! a front face with them as they are, even where one leans away from the eye. In view space, `V` is
 //! `normalize(−P)` for perspective cameras and `+Z` for orthographic ones.
 //!
 //! The shaders compute the same quantities in forms that survive fp16 (the distance as
@@ -124,7 +125,7 @@ pub fn spot_factor(light: &Light, to_surface: DVec3) -> f64 {
 pub const LIGHT_MIN_DISTANCE: f64 = 1.0 / 8192.0;
 
 /// Radiance one light reflects along `v`, the unit direction from the surface to the eye
-/// (no ambient). The normal is used as given (see [`shade`] for two-sided surfaces).
+/// (no ambient). The normal is used as given (see [`seen_side`] for two-sided surfaces).
 pub fn light_contribution(light: &Light, s: &Surface, v: DVec3) -> DVec3 {
     let to_light = light.position - s.position;
     if to_light.abs().max_element() <= LIGHT_MIN_DISTANCE {
@@ -176,31 +177,36 @@ pub fn directional_contribution(light: &DirectionalLight, s: &Surface, v: DVec3)
 }
 
 /// What the directional lights a frame shows ([`shown_directional_lights`]: the brightest
-/// [`MAX_DIRECTIONAL_LIGHTS`](super::MAX_DIRECTIONAL_LIGHTS)) add along `v`, two-sided as
-/// [`shade`]. The total a pixel shows is `shade(..) + shade_directional(..)`.
+/// [`MAX_DIRECTIONAL_LIGHTS`](super::MAX_DIRECTIONAL_LIGHTS)) add along `v`, with the
+/// normal as given. The total a pixel shows is `shade(..) + shade_directional(..)`.
 pub fn shade_directional(s: &Surface, v: DVec3, lights: &[DirectionalLight]) -> DVec3 {
-    let mut s = *s;
-    if s.normal.dot(v) < 0.0 {
-        s.normal = -s.normal;
-    }
     let mut shown = Vec::new();
     shown_directional_lights(lights, &mut shown);
     shown
         .iter()
-        .map(|&i| directional_contribution(&lights[i], &s, v))
+        .map(|&i| directional_contribution(&lights[i], s, v))
         .sum()
 }
 
-/// Total linear radiance along `v` (unit, surface → eye): ambient plus every light. Surfaces
-/// are two-sided: a normal facing away from the eye is flipped, as the shaders do.
-pub fn shade(s: &Surface, v: DVec3, lights: &[Light], ambient: Vec3) -> DVec3 {
-    let mut s = *s;
-    if s.normal.dot(v) < 0.0 {
-        s.normal = -s.normal;
+/// The shading normal of the side the eye sees, as `shadingNormal` in `glsl/surface.glsl`:
+/// `normal` on a front face (`face`, the triangle's normal on its front side, towards `v`),
+/// reversed on a back face. By the face, not by `normal`: an interpolated normal leans away
+/// from the eye near a smooth surface's silhouette, and turning it there lit notches of the
+/// silhouette from the wrong side.
+pub fn seen_side(normal: DVec3, face: DVec3, v: DVec3) -> DVec3 {
+    if face.dot(v) < 0.0 {
+        -normal
+    } else {
+        normal
     }
+}
+
+/// Total linear radiance along `v` (unit, surface → eye): ambient plus every light, with the
+/// normal as given (two-sided surfaces turn it first, [`seen_side`]).
+pub fn shade(s: &Surface, v: DVec3, lights: &[Light], ambient: Vec3) -> DVec3 {
     let mut c = ambient.as_dvec3() * s.albedo;
     for light in lights {
-        c += light_contribution(light, &s, v);
+        c += light_contribution(light, s, v);
     }
     c
 }

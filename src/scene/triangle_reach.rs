@@ -145,10 +145,13 @@ fn split_mesh(mesh: &Mesh, transform: &DMat4, eye: DVec3, floor: f64) -> Option<
             }),
         }
     };
+    // The copy is drawn unmirrored, so a mirroring transform's triangles are wound the other
+    // way to keep their front faces on their normals' side.
+    let (second, third) = if handedness < 0.0 { (2, 1) } else { (1, 2) };
     let placed: Vec<[Vertex; 3]> = mesh
         .indices
         .chunks_exact(3)
-        .map(|t| [vertex(t[0]), vertex(t[1]), vertex(t[2])])
+        .map(|t| [vertex(t[0]), vertex(t[second]), vertex(t[third])])
         .collect();
     if placed.iter().flatten().any(|v| !v.p.is_finite()) {
         return None;
@@ -281,6 +284,22 @@ mod tests {
         // Seen from within its own plane, the near plane bounds how close a fragment can be.
         assert!(split_mesh(&quad(), &scaled(1e2), DVec3::ZERO, 0.1).is_none());
         assert!(split_mesh(&quad(), &scaled(1e4), DVec3::ZERO, 0.1).is_some());
+    }
+
+    #[test]
+    fn a_mirrored_copy_keeps_its_front_faces_on_its_normals_side() {
+        let eye = DVec3::new(0.0, 0.0, 5.0);
+        for mirror in [1.0, -1.0] {
+            let transform = DMat4::from_scale(DVec3::new(1e8 * mirror, 1e8, 1.0));
+            let split = split_mesh(&quad(), &transform, eye, 0.1).unwrap();
+            // Drawn unmirrored: each winding must face the way its normals do.
+            for t in split.indices.chunks_exact(3) {
+                let [a, b, c] = [t[0], t[1], t[2]].map(|i| split.positions[i as usize]);
+                let winding = (b - a).cross(c - a).as_dvec3();
+                let normal = split.normals[t[0] as usize].as_dvec3();
+                assert!(winding.dot(normal) > 0.0, "mirror {mirror}: {winding}");
+            }
+        }
     }
 
     #[test]

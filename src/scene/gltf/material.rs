@@ -17,8 +17,8 @@
 //!   0) when `baseColorFactor.a` is below `alphaCutoff` — and else, with a base colour
 //!   texture, each fragment whose texture alpha times that factor is below it
 //!   ([`Material::alpha_cutoff`]: leaves, fences).
-//! - `doubleSided`: the renderer draws every surface from both sides (no culling, the normal
-//!   turned towards the eye), so `doubleSided: false` surfaces are visible from behind too.
+//! - `doubleSided`: the renderer draws every surface from both sides (no culling, a back face
+//!   with its normals reversed), so `doubleSided: false` surfaces are visible from behind too.
 
 use std::collections::HashMap;
 use std::path::Path;

@@ -64,10 +64,12 @@ fn quad_hit_point_and_interpolated_normal() {
     let other = rc.hit(DVec3::new(-1.0, 0.3, 5.0), -DVec3::Z).unwrap();
     assert_eq!(other.triangle, 1);
 
-    // Back face: hit too, the same unflipped normal.
+    assert!((h.face - DVec3::Z).length() < 1e-12, "{}", h.face);
+    // Back face: hit too, the same unflipped normal and face.
     let back = rc.hit(DVec3::new(1.0, 0.3, -10.0), DVec3::Z).unwrap();
     assert!((back.t - 7.0).abs() < 1e-12);
     assert!((back.normal - expected).length() < 1e-6);
+    assert!((back.face - DVec3::Z).length() < 1e-12);
     // Behind the origin or beside the quad: no hit.
     assert!(rc.hit(DVec3::new(1.0, 0.3, -10.0), -DVec3::Z).is_none());
     assert!(rc.hit(DVec3::new(2.5, 0.0, 5.0), -DVec3::Z).is_none());
@@ -150,10 +152,15 @@ fn brute_force(
                     crate::scene::direction::unit(nm * m.normals[i].as_dvec3())
                         .unwrap_or(DVec3::ZERO)
                 });
+                // The object-space winding's normal carried as a normal is, by definition,
+                // the front side's.
+                let p = c.map(|i| m.positions[i].as_dvec3());
+                let face = (nm * (p[1] - p[0]).cross(p[2] - p[0])).normalize();
                 best = Some(Hit {
                     t,
                     position: origin + dir * t,
                     normal: (n[0] * (1.0 - u - w) + n[1] * u + n[2] * w).normalize(),
+                    face,
                     object,
                     triangle,
                 });
@@ -195,6 +202,7 @@ fn agrees_with_brute_force(
                         && close(g.t, w.t)
                         && (g.position - w.position).length() <= 1e-9 * w.t.max(1.0)
                         && (g.normal - w.normal).length() < 1e-6
+                        && (g.face - w.face).length() < 1e-6
                 }
                 (g, w) => g.is_none() && w.is_none(),
             };

@@ -3,8 +3,8 @@
 //! schemes, links leading out), odd `extras`, node matrices, primitive modes and accessor
 //! counts and offsets. Every case loads or is refused with a message, never panics, and never
 //! reads a file outside the folder: the files beside it are a valid buffer whose vertices lie
-//! at x = 777 and whose indices turn the other way, a magenta image and a text sentinel, and
-//! nothing loaded nor any message may come from them.
+//! at x = 777 and whose triangles start at other corners, a magenta image and a text
+//! sentinel, and nothing loaded nor any message may come from them.
 
 use super::*;
 
@@ -12,8 +12,10 @@ use super::*;
 const SENTINEL: &str = "SENTINEL-TEXT-do-not-show";
 /// The colour of the image beside the folder; no loaded texture may contain it.
 const MAGENTA: [u8; 4] = [255, 0, 255, 255];
-/// The indices of the buffer beside the folder (the valid file's, wound the other way).
-const OUTSIDE_INDICES: [u16; 6] = [2, 1, 0, 3, 2, 0];
+/// The indices of the buffer beside the folder: the valid file's triangles, each started at
+/// another corner (wound as before: the loader turns a triangle wound against its normals
+/// round, which would make any list of these triangles read the same).
+const OUTSIDE_INDICES: [u16; 6] = [1, 2, 0, 2, 3, 0];
 
 /// A root folder holding `model/` (the glTF, `in.bin`, `in.png`, `sub/`, links to the outside)
 /// and, beside it, what the model must not read: `s.bin`, `s.png`, `s.txt`.
