@@ -302,3 +302,55 @@ fn a_cell_the_driver_cannot_give_is_marked_refused() {
         "{row}"
     );
 }
+
+/// Libraries that cannot load are not a configuration this machine cannot give: every cell of
+/// their group fails, unmarked, and `--max-error` fails on them (it passed a broken machine
+/// when any failure to make a context read as a refusal). `MANYLIGHT_GLES_LIB` names the
+/// group when no `--gles-lib` does, as for every other command.
+#[test]
+fn libraries_that_cannot_load_fail_the_gate_whether_named_by_flag_or_variable() {
+    let dir = tempfile::tempdir().unwrap();
+    for name in ["libEGL.so.1", "libGLESv2.so.2"] {
+        std::fs::write(dir.path().join(name), b"not a library").unwrap();
+    }
+    let folder = dir.path().to_str().unwrap();
+    let small = [
+        "--size",
+        "16x9",
+        "--lights",
+        "4",
+        "--json",
+        "-",
+        "--max-error",
+        "2",
+    ];
+    let by_flag = Command::new(env!("CARGO_BIN_EXE_manylight"))
+        .args(["matrix", "--gles-lib", folder])
+        .args(small)
+        .env_remove("MANYLIGHT_GLES_LIB")
+        .output()
+        .unwrap();
+    let by_variable = Command::new(env!("CARGO_BIN_EXE_manylight"))
+        .arg("matrix")
+        .args(small)
+        .env("MANYLIGHT_GLES_LIB", folder)
+        .output()
+        .unwrap();
+    for (how, out) in [("--gles-lib", by_flag), ("MANYLIGHT_GLES_LIB", by_variable)] {
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{how}: {stderr}");
+        let rows: Vec<serde_json::Value> = serde_json::from_slice(&out.stdout)
+            .unwrap_or_else(|e| panic!("{how}: no JSON ({e}): {stderr}"));
+        assert!(!rows.is_empty(), "{how}");
+        for row in &rows {
+            assert_eq!(row["gles_lib"], folder, "{how}: {row}");
+            assert!(row["refused"] != true, "{how}: a refusal: {row}");
+            assert!(
+                row["error"]
+                    .as_str()
+                    .is_some_and(|e| e.contains("cannot load")),
+                "{how}: {row}"
+            );
+        }
+    }
+}

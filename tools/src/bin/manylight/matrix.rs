@@ -166,6 +166,23 @@ const CONFIGS: &[Config] = &[
     },
 ];
 
+/// `MANYLIGHT_GLES_LIB` as the matrix's one implementation when no `--gles-lib` names any, as
+/// for every other command; a warning when `--gles-lib` overrides it.
+fn gles_lib_from_env(gles_libs: &[PathBuf]) -> Vec<PathBuf> {
+    let env = manylight::gl::gles_lib::GLES_LIB_ENV;
+    let Some(folder) = std::env::var_os(env).filter(|v| !v.is_empty()) else {
+        return Vec::new();
+    };
+    if !gles_libs.is_empty() {
+        log::warn!(
+            "{env}={} is not used: --gles-lib names the matrix's implementations",
+            folder.to_string_lossy()
+        );
+        return Vec::new();
+    }
+    vec![PathBuf::from(folder)]
+}
+
 /// `--allow-outside-files` for a cell when the matrix was given it.
 fn outside_files_flag() -> Option<&'static str> {
     crate::load_options()
@@ -177,6 +194,12 @@ fn outside_files_flag() -> Option<&'static str> {
 /// folders, `system` for the system's libraries; none: the system's alone).
 pub fn run(args: &MatrixArgs, gles_libs: &[PathBuf]) -> Result<(), Box<dyn std::error::Error>> {
     let exe = std::env::current_exe()?;
+    let from_env = gles_lib_from_env(gles_libs);
+    let gles_libs = if gles_libs.is_empty() {
+        &from_env[..]
+    } else {
+        gles_libs
+    };
     // What every cell would fail on is an error of the matrix, not a row of failures: a scene
     // that cannot be read, outputs that cannot be written.
     scene::load_with(&args.scene, Some((args.lights, 1)), &crate::load_options())?;
@@ -314,12 +337,8 @@ fn group_rows(
             .collect::<Vec<_>>());
         rows.push(row);
     }
-    if lib.is_none() {
-        let mut row = osmesa_row(exe, args, size, out)?;
-        row["gles_lib"] = json!(label);
-        rows.push(row);
-    }
-    // A row whose context could not be made names the implementation its group's others do.
+    // A row whose context could not be made names the implementation its group's other EGL
+    // rows do (not OSMesa's, another library), else the group's label.
     let implementation = rows
         .iter()
         .find_map(|r| r["implementation"].as_str().map(String::from));
@@ -327,6 +346,14 @@ fn group_rows(
         if row["implementation"].is_null() {
             row["implementation"] = json!(implementation.as_deref().unwrap_or(&label));
         }
+    }
+    if lib.is_none() {
+        let mut row = osmesa_row(exe, args, size, out)?;
+        row["gles_lib"] = json!(label);
+        if row["implementation"].is_null() {
+            row["implementation"] = json!("OSMesa");
+        }
+        rows.push(row);
     }
     Ok(rows)
 }
@@ -569,6 +596,15 @@ fn refuses_the_configuration(e: &manylight::Error) -> bool {
     matches!(e, manylight::Error::Gl(GlError::VersionUnavailable { .. }))
 }
 
+/// Whether making a context failed because the driver gives no context of that version (not
+/// because it could not start at all).
+fn cannot_give_the_version(e: &(dyn std::error::Error + 'static)) -> bool {
+    matches!(
+        e.downcast_ref::<GlError>(),
+        Some(GlError::VersionUnavailable { .. })
+    )
+}
+
 /// The row of a configuration this machine cannot give (its context could not be made, or
 /// is another version): printed as the cell's result, marked `refused`, so the matrix lists
 /// it without counting it as a failure.
@@ -597,7 +633,9 @@ pub fn run_cell(args: &MatrixCellArgs) -> Result<(), Box<dyn std::error::Error>>
     let reference = {
         let ctx = match CellContext::new(es, args.osmesa) {
             Ok(ctx) => ctx,
-            Err(e) => return print_refusal(&*e),
+            Err(e) if args.osmesa || cannot_give_the_version(&*e) => return print_refusal(&*e),
+            // A driver that cannot start, a library that cannot load: the cell fails.
+            Err(e) => return Err(e),
         };
         let mut full = match Renderer::new(ctx.load_gl()?, es) {
             Err(e) if refuses_the_configuration(&e) => return print_refusal(&e),
