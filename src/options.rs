@@ -23,7 +23,10 @@ pub struct RenderOptions {
     /// Write linear values (clamped to [0, 1], no sRGB encoding; exposure and tone map still
     /// apply when set, and are off by default) so pixels can be checked against the light model.
     pub linear: bool,
-    /// Background colour (linear if `linear`, else as stored).
+    /// Background colour (linear if `linear`, else as stored). Its alpha is what pixels that
+    /// show nothing get; a transparent surface in front adds its opacity (`a + a_bg·(1 − a)`)
+    /// and blends its colour over the background's, so over a transparent black background
+    /// the image's colour is premultiplied by its alpha.
     pub clear_color: [f32; 4],
     /// Cluster grid of the clustered method.
     pub grid: GridConfig,

@@ -154,12 +154,13 @@ impl RenderState {
                 }
                 Blend::Alpha => {
                     gl.enable(glow::BLEND);
-                    // The framebuffer's alpha stays opaque: images are read back as they show.
+                    // Alpha composes as coverage, `a + a_dst·(1 − a)`: 1 over an opaque
+                    // background, the surface's own opacity over a transparent one.
                     gl.blend_func_separate(
                         glow::SRC_ALPHA,
                         glow::ONE_MINUS_SRC_ALPHA,
-                        glow::ZERO,
                         glow::ONE,
+                        glow::ONE_MINUS_SRC_ALPHA,
                     );
                 }
             }
