@@ -172,7 +172,11 @@ impl Scene {
     /// starting from its current state. Does nothing for a still motion or a range past the
     /// lights.
     pub fn animate_lights(&mut self, lights: Range<usize>, motion: motion::Motion, seed: u64) {
-        if let (false, Some(rest)) = (motion.is_still(), self.lights.get(lights.clone())) {
+        let rest = self
+            .lights
+            .get(lights.clone())
+            .filter(|rest| !rest.is_empty());
+        if let (false, Some(rest)) = (motion.is_still(), rest) {
             self.animation.push(motion::LightTrack {
                 first: lights.start,
                 rest: rest.to_vec(),

@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::cli::expect_status;
+use common::cli::{expect_status, manylight, text};
 
 /// [`expect_status`] without extra environment.
 fn expect(args: &[&str], cwd: &std::path::Path, code: i32) -> String {
@@ -145,5 +145,28 @@ fn a_budget_for_a_fixed_grid_is_a_usage_error() {
     assert!(
         msg.contains("--assign-budget") && msg.contains("fixed"),
         "{msg}"
+    );
+}
+
+/// `--stats -` puts the statistics alone on standard output, for a pipe into a JSON reader,
+/// and the summary line on standard error; it wrote a file named `-`. Without lights, the
+/// summary says nothing of moving lights.
+#[test]
+fn stats_to_standard_output_are_json_alone() {
+    let dir = tempfile::tempdir().unwrap();
+    let args = [
+        "--size", "16x9", "--lights", "0", "--out", "a.png", "--stats", "-",
+    ];
+    let out = manylight(&args, &[], dir.path());
+    assert!(out.status.success(), "{}", text(&out));
+    let stats: serde_json::Value = serde_json::from_slice(&out.stdout)
+        .unwrap_or_else(|e| panic!("standard output is not JSON ({e}): {}", text(&out)));
+    assert_eq!(stats["lights"], 0, "{stats}");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("0 lights"), "{stderr}");
+    assert!(!stderr.contains("moving lights"), "{stderr}");
+    assert!(
+        !dir.path().join("-").exists(),
+        "a file named `-` was written"
     );
 }

@@ -38,7 +38,8 @@ pub struct RenderArgs {
     /// frame).
     #[arg(long)]
     pub out: Option<PathBuf>,
-    /// Write frame statistics as JSON to this file.
+    /// Write frame statistics as JSON to this file (`-`: to standard output, and the summary
+    /// line to standard error).
     #[arg(long)]
     pub stats: Option<PathBuf>,
     /// Write linear values (clamped, no sRGB encoding, no tone map) for checking pixels
@@ -245,7 +246,11 @@ pub fn run(args: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
     };
     // Opened before rendering: a path that cannot be written fails now, not after the frames.
     let out_file = out.map(OutputFile::create).transpose()?;
-    let stats_file = args.stats.as_deref().map(OutputFile::create).transpose()?;
+    let stats_to_stdout = args.stats.as_deref() == Some(std::path::Path::new("-"));
+    let stats_file = match &args.stats {
+        Some(path) if !stats_to_stdout => Some(OutputFile::create(path)?),
+        _ => None,
+    };
     let es = args.es.into();
     let ctx = HeadlessContext::new(es)?;
     let restrictions = manylight::gl::Restrictions {
@@ -311,8 +316,12 @@ pub fn run(args: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
     if let Some(file) = out_file {
         file.commit_png(&image)?;
     }
+    let stats_json = serde_json::to_string_pretty(&stats)? + "\n";
     if let Some(file) = stats_file {
-        file.commit_bytes((serde_json::to_string_pretty(&stats)? + "\n").as_bytes())?;
+        file.commit_bytes(stats_json.as_bytes())?;
+    }
+    if stats_to_stdout {
+        print_stdout(&stats_json)?;
     }
     // The slow frames too, where enough frames were timed for them to mean something.
     let mut tail = match stats.time.frame_ms_spread {
@@ -336,7 +345,7 @@ pub fn run(args: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
         _ => stats.method.clone(),
     };
     let written = out.map_or(String::new(), |p| format!(" → {}", p.display()));
-    print_stdout(&format!(
+    let summary = format!(
         "{} {}x{} · {method} · {} lights · {} on {} · {:.1} ms/frame{tail}{written}\n",
         args.scene,
         width,
@@ -345,6 +354,12 @@ pub fn run(args: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
         stats.context.es,
         stats.context.renderer,
         stats.time.frame_ms,
-    ))?;
+    );
+    // Standard output holds the statistics alone when they go there.
+    if stats_to_stdout {
+        eprint!("{summary}");
+    } else {
+        print_stdout(&summary)?;
+    }
     Ok(())
 }
