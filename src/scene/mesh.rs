@@ -91,7 +91,9 @@ pub struct Mesh {
     pub normals: Vec<Vec3>,
     /// Texture coordinates, one per position, or empty.
     pub uvs: Vec<Vec2>,
-    /// Triangle list, three indices per triangle.
+    /// Triangle list, three indices per triangle. Its front face, the side `normals` point to,
+    /// is counter-clockwise: [`Mesh::new`] turns a triangle listed the other way round; a mesh
+    /// built or edited through these fields is drawn as listed.
     pub indices: Vec<u32>,
     /// Linear RGBA vertex colours (glTF `COLOR_0`), one per position, or empty. Their RGB
     /// multiplies the base colour; alpha is not used (opacity is per material).
@@ -151,6 +153,10 @@ impl Mesh {
             wind_to_normals(&positions, &normals, &mut indices);
             normals
         } else {
+            // A triangle listed against its neighbours (an OBJ without `vn`) is turned round
+            // first: its face would have been shaded as a back face, and weighed against
+            // theirs in their normals.
+            super::orientation::orient_consistently(&positions, &mut indices);
             compute_normals(&positions, &indices)
         };
         Ok(Mesh {
@@ -483,6 +489,28 @@ mod tests {
         let m = Mesh::new(positions, vec![-Vec3::Z; 4], vec![], vec![0, 1, 2, 1, 2, 3]).unwrap();
         for w in windings(&m) {
             assert!(w.z < 0.0, "{w}");
+        }
+    }
+
+    #[test]
+    fn a_triangle_listed_against_its_neighbours_is_turned_round_without_normals_too() {
+        // An octahedron (its faces counter-clockwise seen from outside) with one face listed
+        // the other way, and no normals (an OBJ without `vn`).
+        let positions = vec![Vec3::X, -Vec3::X, Vec3::Y, -Vec3::Y, Vec3::Z, -Vec3::Z];
+        #[rustfmt::skip]
+        let mut indices = vec![
+            0, 2, 4, 2, 1, 4, 1, 3, 4, 3, 0, 4,
+            2, 0, 5, 1, 2, 5, 3, 1, 5, 0, 3, 5,
+        ];
+        indices.swap(1, 2);
+        let m = Mesh::new(positions, vec![], vec![], indices).unwrap();
+        for (t, w) in m.indices.chunks_exact(3).zip(windings(&m)) {
+            let centre: DVec3 = t.iter().map(|&i| m.positions[i as usize].as_dvec3()).sum();
+            assert!(w.dot(centre) > 0.0, "triangle {t:?} faces inwards");
+        }
+        // The normals, recomputed, have no reversed face in them: each points outwards.
+        for (p, n) in m.positions.iter().zip(&m.normals) {
+            assert!(p.dot(*n) > 0.99, "{p}: {n}");
         }
     }
 

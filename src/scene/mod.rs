@@ -27,6 +27,7 @@ mod model_cache;
 pub mod motion;
 pub mod normal_matrix;
 pub mod obj;
+mod orientation;
 pub mod random;
 pub mod raycast;
 pub mod shading;

@@ -293,6 +293,8 @@ impl SceneRaycaster {
         } else {
             geometric
         };
+        // Made unit without squaring: the cross product of huge edges overflows a square.
+        let face = super::direction::unit(face).unwrap_or(DVec3::ZERO);
         // Vertex normals times the normal matrix, made unit (zero where the matrix takes them
         // to nothing), interpolated and normalised again: what `mesh.vert` and the fragment
         // shader do. `Mesh::new` always fills normals; a hand-built mesh without them shades
@@ -310,8 +312,8 @@ impl SceneRaycaster {
         Hit {
             t,
             position: origin + dir * t,
-            normal: n.try_normalize().unwrap_or_else(|| face.normalize()),
-            face: face.normalize(),
+            normal: n.try_normalize().unwrap_or(face),
+            face,
             object: instance.object as usize,
             triangle: triangle as usize,
         }

@@ -129,7 +129,9 @@ fn split_mesh(mesh: &Mesh, transform: &DMat4, eye: DVec3, floor: f64) -> Option<
     let normals = normal_matrix(&linear);
     // A mirroring transform flips the bitangent's handedness; the split copy is drawn
     // unmirrored, so the flip is baked into `w`.
-    let handedness = linear.determinant().signum();
+    // `< 0`, as the normal matrix and the GPU's front side take it (a −0 determinant is not).
+    let mirrored = linear.determinant() < 0.0;
+    let handedness = if mirrored { -1.0 } else { 1.0 };
     let vertex = |i: u32| {
         let i = i as usize;
         Vertex {
@@ -147,7 +149,7 @@ fn split_mesh(mesh: &Mesh, transform: &DMat4, eye: DVec3, floor: f64) -> Option<
     };
     // The copy is drawn unmirrored, so a mirroring transform's triangles are wound the other
     // way to keep their front faces on their normals' side.
-    let (second, third) = if handedness < 0.0 { (2, 1) } else { (1, 2) };
+    let (second, third) = if mirrored { (2, 1) } else { (1, 2) };
     let placed: Vec<[Vertex; 3]> = mesh
         .indices
         .chunks_exact(3)

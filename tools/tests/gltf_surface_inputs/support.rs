@@ -136,8 +136,8 @@ pub fn oracle(scene: &Scene, model: &Model) -> Vec<Option<[f64; 3]>> {
             let uv = DVec2::new((p.x + 1.0) / 2.0, (1.0 - p.y) / 2.0);
             let (surface, emitted, ao) = model(p, uv, corner_weights(p));
             let v = (scene.camera.position - p).normalize();
-            // Lit with the model's normal as given, as the shaders light a mapped normal
-            // (`shading::shade` would turn one facing away from the eye back).
+            // Lit with the model's normal as given, as the shaders light a mapped normal on a
+            // front face, also where it leans away from the eye.
             let mut c: DVec3 = scene
                 .lights
                 .iter()
