@@ -282,6 +282,21 @@ fn join_rayon_pool() {
     }
 }
 
+/// The exit status of a request this context cannot do (docs/cli.md, "Exit codes"), so that a
+/// capability script tells what a device cannot do from a failure without reading stderr.
+const CANNOT_ON_THIS_CONTEXT: u8 = 3;
+
+/// Whether `e` says the context cannot do what was asked: its ES version, the method, MSAA.
+fn cannot_on_this_context(e: &(dyn std::error::Error + 'static)) -> bool {
+    let version =
+        |e: &manylight::GlError| matches!(e, manylight::GlError::VersionUnavailable { .. });
+    match e.downcast_ref::<manylight::Error>() {
+        Some(manylight::Error::UnsupportedMethod { .. } | manylight::Error::Msaa { .. }) => true,
+        Some(manylight::Error::Gl(gl)) => version(gl),
+        _ => e.downcast_ref::<manylight::GlError>().is_some_and(version),
+    }
+}
+
 fn main() -> ExitCode {
     // env_logger's own layout, each message with its control characters escaped but its line
     // ends (a model's names reach warnings, and a terminal acts on escape sequences).
@@ -348,7 +363,11 @@ fn main() -> ExitCode {
                 // Line ends kept: a shader's compile error lists its source.
                 _ => eprintln!("error: {}", shown::lines(&e.to_string())),
             }
-            ExitCode::FAILURE
+            if cannot_on_this_context(&*e) {
+                ExitCode::from(CANNOT_ON_THIS_CONTEXT)
+            } else {
+                ExitCode::FAILURE
+            }
         }
     }
 }
