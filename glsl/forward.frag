@@ -70,8 +70,8 @@ void main() {
     color += surfaceEmission(v_uv);
 #endif
     FRAG_COLOR = encodeOutput(color);
-#if HAS_TEXTURE_ALPHA
-    FRAG_COLOR.a *= surfaceTextureAlpha(v_uv);
+#if HAS_SURFACE_OPACITY
+    FRAG_COLOR.a *= surfaceOpacity(v_uv);
 #endif
 #endif
 }

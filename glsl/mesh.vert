@@ -28,7 +28,7 @@ VARYING vec3 v_normal;
 VARYING vec2 v_uv;
 #if HAS_VERTEX_COLOR
 ATTRIBUTE vec4 a_color;
-VARYING vec3 v_color;
+VARYING vec4 v_color;
 #endif
 #if HAS_NORMAL_MAP
 ATTRIBUTE vec4 a_tangent;
@@ -66,7 +66,7 @@ void main() {
     v_uvMetallicRoughness = (u_metallicRoughnessUvTransform * uv1).xy;
 #endif
 #if HAS_VERTEX_COLOR
-    v_color = a_color.rgb;
+    v_color = a_color;
 #endif
 #if HAS_NORMAL_MAP
     // Tangents lie in the surface: they turn with the model-view matrix itself (normals with

@@ -60,28 +60,36 @@ vec3 shadingNormal(vec3 N, vec2 uv) {
     return N * side;
 }
 
+// The alpha the base colour texture (under HAS_TEXTURE_ALPHA or HAS_ALPHA_MASK) and COLOR_0
+// (under HAS_VERTEX_ALPHA) give on top of the material's factor.
+#if (HAS_TEXTURE_ALPHA || HAS_ALPHA_MASK) && HAS_TEXTURE
+#define TEXEL_ALPHA(uv) TEXTURE2D(u_albedoTex, UV_ALBEDO(uv)).a
+#else
+#define TEXEL_ALPHA(uv) 1.0
+#endif
+#if HAS_VERTEX_ALPHA
+#define VERTEX_ALPHA v_color.a
+#else
+#define VERTEX_ALPHA 1.0
+#endif
+
 #if HAS_ALPHA_MASK
 uniform float u_alphaCutoff;
-// glTF MASK: the fragment is cut where the base colour texture's alpha is below the cutoff
-// (the factor's alpha folded into it). Set only with a base colour texture.
+// glTF MASK: the fragment is cut where the base colour texture's alpha times COLOR_0's is
+// below the cutoff (the factor's alpha folded into it).
 bool surfaceCut(vec2 uv) {
-#if HAS_TEXTURE
-    return TEXTURE2D(u_albedoTex, UV_ALBEDO(uv)).a < u_alphaCutoff;
-#else
-    return false;
-#endif
+    return TEXEL_ALPHA(uv) * VERTEX_ALPHA < u_alphaCutoff;
 }
 #endif
 
-#if HAS_TEXTURE_ALPHA
-// glTF BLEND: the base colour texture's alpha multiplies the material's opacity.
-float surfaceTextureAlpha(vec2 uv) {
-#if HAS_TEXTURE
-    return TEXTURE2D(u_albedoTex, UV_ALBEDO(uv)).a;
-#else
-    return 1.0;
-#endif
+#if (HAS_TEXTURE_ALPHA || HAS_VERTEX_ALPHA) && !HAS_ALPHA_MASK
+#define HAS_SURFACE_OPACITY 1
+// glTF BLEND: the base colour texture's alpha and COLOR_0's multiply the material's opacity.
+float surfaceOpacity(vec2 uv) {
+    return TEXEL_ALPHA(uv) * VERTEX_ALPHA;
 }
+#else
+#define HAS_SURFACE_OPACITY 0
 #endif
 
 vec3 surfaceAlbedo(vec2 uv) {
@@ -90,7 +98,7 @@ vec3 surfaceAlbedo(vec2 uv) {
     albedo *= LINEAR_TEXEL(TEXTURE2D(u_albedoTex, UV_ALBEDO(uv)).rgb);
 #endif
 #if HAS_VERTEX_COLOR
-    albedo *= v_color;
+    albedo *= v_color.rgb;
 #endif
     return albedo;
 }

@@ -22,8 +22,8 @@ VARYING vec2 v_uvMetallicRoughness;
 #endif
 
 #if HAS_VERTEX_COLOR
-// COLOR_0's linear RGB (multiplies the base colour).
-VARYING vec3 v_color;
+// COLOR_0: its linear RGB multiplies the base colour, its alpha (HAS_VERTEX_ALPHA) the opacity.
+VARYING vec4 v_color;
 #endif
 
 #if HAS_NORMAL_MAP

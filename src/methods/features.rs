@@ -78,13 +78,17 @@ impl ShaderFeatures {
     pub const MR_TEXTURE: u64 = 1 << 23;
     /// Some texture the material samples has a `KHR_texture_transform`.
     pub const TEXTURE_TRANSFORM: u64 = 1 << 24;
-    /// The material cuts fragments by its base colour texture's alpha (glTF `MASK`).
+    /// The material cuts fragments by its base colour texture's alpha, or `COLOR_0`'s with
+    /// [`Self::VERTEX_ALPHA`] (glTF `MASK`).
     pub const ALPHA_MASK: u64 = 1 << 25;
     /// Colour textures are sRGB textures the sampler decodes before filtering (ES 3.0 level);
     /// without, the shader decodes the filtered texel (ES 2.0).
     pub const SRGB_TEXTURES: u64 = 1 << 26;
     /// The material's opacity is multiplied by its base colour texture's alpha (glTF `BLEND`).
     pub const TEXTURE_ALPHA: u64 = 1 << 27;
+    /// With [`Self::VERTEX_COLOR`]: `COLOR_0`'s alpha multiplies the opacity (glTF `BLEND`) or
+    /// takes part in the cut (glTF `MASK`).
+    pub const VERTEX_ALPHA: u64 = 1 << 28;
 
     /// The flags a material's (and its mesh's) surface inputs set, as opposed to the scene's,
     /// the frame's and the device's.
@@ -96,10 +100,11 @@ impl ShaderFeatures {
         | Self::MR_TEXTURE
         | Self::TEXTURE_TRANSFORM
         | Self::ALPHA_MASK
-        | Self::TEXTURE_ALPHA;
+        | Self::TEXTURE_ALPHA
+        | Self::VERTEX_ALPHA;
 
     /// Every flag with its name.
-    pub const NAMED: [(u64, &'static str); 28] = [
+    pub const NAMED: [(u64, &'static str); 29] = [
         (Self::TEXTURE, "texture"),
         (Self::SPOT, "spot"),
         (Self::SPECULAR, "specular"),
@@ -128,6 +133,7 @@ impl ShaderFeatures {
         (Self::ALPHA_MASK, "alpha_mask"),
         (Self::SRGB_TEXTURES, "srgb_textures"),
         (Self::TEXTURE_ALPHA, "texture_alpha"),
+        (Self::VERTEX_ALPHA, "vertex_alpha"),
     ];
 
     /// Names of the set flags.
@@ -202,6 +208,7 @@ impl ShaderFeatures {
             ("HAS_ALPHA_MASK".into(), flag(Self::ALPHA_MASK)),
             ("SRGB_TEXTURES".into(), flag(Self::SRGB_TEXTURES)),
             ("HAS_TEXTURE_ALPHA".into(), flag(Self::TEXTURE_ALPHA)),
+            ("HAS_VERTEX_ALPHA".into(), flag(Self::VERTEX_ALPHA)),
             (
                 "TONEMAP".into(),
                 if self.has(Self::TONEMAP_REINHARD) {

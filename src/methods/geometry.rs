@@ -194,7 +194,9 @@ pub(crate) fn shade_object<P: GeometryProgram>(
         .with(ShaderFeatures::TEXTURE, texture.is_some())
         .with(
             ShaderFeatures::ALPHA_MASK,
-            texture.is_some() && material.alpha_cutoff.is_some() && !ctx.features.counting(),
+            (texture.is_some() || inputs.has(ShaderFeatures::VERTEX_ALPHA))
+                && material.alpha_cutoff.is_some()
+                && !ctx.features.counting(),
         )
         .with(
             ShaderFeatures::TEXTURE_ALPHA,

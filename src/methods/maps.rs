@@ -45,6 +45,10 @@ pub fn features(material: &Material, mesh: &Mesh, units: i32) -> F {
     let mut bits = [
         (F::VERTEX_COLOR, !mesh.colors.is_empty()),
         (
+            F::VERTEX_ALPHA,
+            material.alpha_vertex && !mesh.colors.is_empty(),
+        ),
+        (
             F::NORMAL_MAP,
             maps.normal.is_some() && !mesh.tangents.is_empty() && maps.normal_scale != 0.0,
         ),

@@ -90,7 +90,8 @@ pub(crate) struct SurfaceFrame {
 
 /// Whether a variant cuts fragments by its texture's alpha (`surfaceCut`: only with one).
 fn cuts(f: ShaderFeatures) -> bool {
-    f.has(ShaderFeatures::ALPHA_MASK) && f.has(ShaderFeatures::TEXTURE)
+    f.has(ShaderFeatures::ALPHA_MASK)
+        && (f.has(ShaderFeatures::TEXTURE) || f.has(ShaderFeatures::VERTEX_ALPHA))
 }
 
 impl Surface {
@@ -269,6 +270,9 @@ mod tests {
         F::SURFACE_INPUTS | F::TEXTURE | F::SPECULAR | F::SPOT,
         F::NORMAL_MAP | F::TEXTURE_TRANSFORM,
         F::EMISSIVE | F::OCCLUSION | F::VERTEX_COLOR | F::LIGHTS_RGBA8,
+        F::VERTEX_COLOR | F::VERTEX_ALPHA | F::ALPHA_MASK,
+        F::VERTEX_COLOR | F::VERTEX_ALPHA | F::TEXTURE | F::TEXTURE_ALPHA,
+        F::VERTEX_COLOR | F::VERTEX_ALPHA,
         F::NO_LIGHTS | F::EMISSIVE | F::EMISSIVE_MAP | F::TEXTURE | F::TEXTURE_TRANSFORM,
     ];
 

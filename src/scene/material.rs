@@ -48,6 +48,10 @@ pub struct Material {
     /// The diffuse texture's alpha multiplies `alpha` (glTF `BLEND` with a texture some of
     /// whose texels are not opaque): the object is transparent.
     pub alpha_texture: bool,
+    /// The mesh's vertex colours' alpha (glTF `COLOR_0`, where not all opaque) multiplies the
+    /// opacity: blended (glTF `BLEND`: the object is transparent) or, with `alpha_cutoff`,
+    /// cut (`MASK`).
+    pub alpha_vertex: bool,
     /// The reflectance model; `specular`/`shininess` are read by Blinn-Phong only,
     /// `metallic`/`roughness` by metallic-roughness only.
     pub model: MaterialModel,
@@ -85,6 +89,7 @@ impl Material {
             alpha: 1.0,
             alpha_cutoff: None,
             alpha_texture: false,
+            alpha_vertex: false,
             model: MaterialModel::BlinnPhong,
             metallic: 0.0,
             roughness: 1.0,
@@ -126,7 +131,9 @@ impl Material {
     /// True when the material is see-through: alpha below 1, or a diffuse texture whose alpha
     /// it blends by ([`Material::alpha_texture`]).
     pub fn is_transparent(&self) -> bool {
-        self.alpha < 1.0 || (self.alpha_texture && self.diffuse_texture.is_some())
+        self.alpha < 1.0
+            || (self.alpha_texture && self.diffuse_texture.is_some())
+            || (self.alpha_vertex && self.alpha_cutoff.is_none())
     }
 
     /// True when the material has a non-zero Blinn-Phong specular term (never for

@@ -96,7 +96,8 @@ pub struct Mesh {
     /// built or edited through these fields is drawn as listed.
     pub indices: Vec<u32>,
     /// Linear RGBA vertex colours (glTF `COLOR_0`), one per position, or empty. Their RGB
-    /// multiplies the base colour; alpha is not used (opacity is per material).
+    /// multiplies the base colour; alpha takes part in the opacity only where the material
+    /// says so ([`Material::alpha_vertex`](super::Material::alpha_vertex)).
     pub colors: Vec<Vec4>,
     /// Unit tangents with the bitangent sign in `w` (glTF `TANGENT`, or generated for a
     /// normal-mapped material), one per position, or empty.

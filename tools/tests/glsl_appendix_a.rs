@@ -175,6 +175,8 @@ fn all_features() -> Vec<ShaderFeatures> {
     type F = ShaderFeatures;
     for input in [
         F::VERTEX_COLOR,
+        F::VERTEX_COLOR | F::VERTEX_ALPHA,
+        F::VERTEX_COLOR | F::VERTEX_ALPHA | F::ALPHA_MASK,
         F::NORMAL_MAP,
         F::EMISSIVE,
         F::EMISSIVE | F::EMISSIVE_MAP,

@@ -197,6 +197,110 @@ fn a_blended_texture_blends_the_pane_by_its_alpha_times_the_factor() {
     );
 }
 
+/// The scene with an untextured pane whose `COLOR_0` alphas are `alphas` (corners: bottom
+/// left, bottom right, top right, top left), its material in `alpha_mode` (`None`: no pane).
+fn scene_with_coloured_pane(dir: &Path, alpha_mode: Option<&str>, alphas: [f32; 4]) -> Scene {
+    let mut b = Builder::default();
+    let floor_prim = primitive(&mut b, &floor(), Some(0));
+    let wall_prim = primitive(&mut b, &pane(3.0, 2.0), Some(1));
+    let mut pane_prim = primitive(&mut b, &pane(1.6, 1.2), Some(2));
+    let colours: Vec<f32> = alphas.iter().flat_map(|&a| [1.0, 1.0, 1.0, a]).collect();
+    pane_prim["attributes"]["COLOR_0"] = json!(b.floats(&colours, "VEC4"));
+    let mut nodes = vec![
+        json!({"mesh": 0}),
+        json!({"mesh": 1, "translation": [0, 0, -1.5]}),
+        json!({"camera": 0, "translation": [0, 1, 3],
+               "rotation": quat(DQuat::from_rotation_x(-0.15))}),
+    ];
+    if alpha_mode.is_some() {
+        nodes.push(json!({"mesh": 2, "translation": [0, 0.3, 0.5]}));
+    }
+    let scene_nodes: Vec<usize> = (0..nodes.len()).collect();
+    let gltf = json!({
+        "scenes": [{"nodes": scene_nodes}],
+        "nodes": nodes,
+        "cameras": [{"type": "perspective", "perspective": {"yfov": 0.9, "znear": 0.05, "zfar": 50}}],
+        "meshes": [{"primitives": [floor_prim]}, {"primitives": [wall_prim]},
+                   {"primitives": [pane_prim]}],
+        "materials": [
+            {"pbrMetallicRoughness": {"baseColorFactor": [0.7, 0.7, 0.7, 1], "metallicFactor": 0}},
+            {"pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.1, 0.1, 1], "metallicFactor": 0}},
+            {"alphaMode": alpha_mode.unwrap_or("OPAQUE"), "alphaCutoff": 0.5,
+             "pbrMetallicRoughness": {"metallicFactor": 0,
+                                      "baseColorFactor": [0.9, 0.8, 0.2, 1]}}
+        ],
+    });
+    let name = format!("coloured_pane_{}.gltf", alpha_mode.unwrap_or("none"));
+    let (mut scene, _) = load(&write(dir, &name, b.gltf(gltf))).unwrap();
+    scene.lights = vec![Light::point(DVec3::new(0.5, 1.5, 1.5), 8.0, Vec3::ONE, 6.0)];
+    scene.ambient = Vec3::splat(0.05);
+    scene
+}
+
+/// glTF's base colour alpha is the factor's × the texture's × `COLOR_0`'s: vertex alpha 0.5
+/// blends a `BLEND` pane at 0.5 everywhere, and alphas 0 on the left and 1 on the right cut a
+/// `MASK` pane (cutoff 0.5) down the middle. Both showed the pane opaque when vertex alpha was
+/// ignored.
+#[test]
+fn vertex_alpha_blends_and_cuts_as_the_base_colour_alpha() {
+    let dir = tempfile::tempdir().unwrap();
+    let half = [0.5; 4];
+    let blended = scene_with_coloured_pane(dir.path(), Some("BLEND"), half);
+    let opaque = scene_with_coloured_pane(dir.path(), Some("OPAQUE"), half);
+    let without = scene_with_coloured_pane(dir.path(), None, half);
+    assert!(blended.materials.iter().any(|m| m.is_transparent()));
+    assert!(opaque.materials.iter().all(|m| !m.is_transparent()));
+    for_every_method(
+        &[&blended, &opaque, &without],
+        |es, method, [mixed, solid, behind]| {
+            let mut panes = 0;
+            for ((m, s), b) in mixed.pixels().zip(solid.pixels()).zip(behind.pixels()) {
+                if (0..3).all(|k| s[k].abs_diff(b[k]) < 24) {
+                    continue;
+                }
+                let mix = |k: usize| 0.5 * s[k] as f64 + 0.5 * b[k] as f64;
+                assert!(
+                    (0..3).all(|k| (m[k] as f64 - mix(k)).abs() <= 3.0),
+                    "{es} {method}: a pixel {m:?} is not half the pane {s:?} over {b:?}"
+                );
+                panes += 1;
+            }
+            assert!(
+                panes > (W * H / 20) as usize,
+                "{es} {method}: {panes} pane pixels"
+            );
+        },
+    );
+    let ramp = [0.0, 1.0, 1.0, 0.0];
+    let masked = scene_with_coloured_pane(dir.path(), Some("MASK"), ramp);
+    let opaque = scene_with_coloured_pane(dir.path(), Some("OPAQUE"), ramp);
+    for_every_method(
+        &[&masked, &opaque, &without],
+        |es, method, [cut, solid, behind]| {
+            let (mut as_behind, mut as_solid) = (0, 0);
+            for ((c, s), b) in cut.pixels().zip(solid.pixels()).zip(behind.pixels()) {
+                let near = |x: &image::Rgba<u8>| (0..3).all(|k| c[k].abs_diff(x[k]) <= 1);
+                let (is_behind, is_solid) = (near(b), near(s));
+                assert!(
+                    is_behind || is_solid,
+                    "{es} {method}: a pixel {c:?} is neither the scene without the pane {b:?} \
+                     nor with it opaque {s:?}"
+                );
+                if is_behind && !is_solid {
+                    as_behind += 1;
+                } else if is_solid && !is_behind {
+                    as_solid += 1;
+                }
+            }
+            let enough = (W * H / 40) as usize;
+            assert!(
+                as_behind > enough && as_solid > enough,
+                "{es} {method}: {as_behind} pixels cut and {as_solid} drawn"
+            );
+        },
+    );
+}
+
 /// Renders each of `scenes` with every method on ES 2.0 and 3.0 (deferred on 3.0 only) and
 /// hands `check` the pictures.
 fn for_every_method(

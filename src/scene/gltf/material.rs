@@ -12,11 +12,13 @@
 //!   texture's `KHR_texture_transform` → [`Material::maps`] (`maps.rs`).
 //! - `alphaMode`: `OPAQUE` ignores alpha; `BLEND` takes `baseColorFactor.a` as the material's
 //!   opacity, times the base colour texture's alpha where some texel is not opaque
-//!   ([`Material::alpha_texture`]); below 1, or with such a texture, the renderer's transparent
-//!   path (back to front, alpha-blended); `MASK` cuts the whole material — invisible (opacity
-//!   0) when `baseColorFactor.a` is below `alphaCutoff` — and else, with a base colour
-//!   texture, each fragment whose texture alpha times that factor is below it
-//!   ([`Material::alpha_cutoff`]: leaves, fences).
+//!   ([`Material::alpha_texture`]) and `COLOR_0`'s where some vertex is not
+//!   ([`Material::alpha_vertex`], a variant for those primitives); below 1, or with such a
+//!   texture or vertex colours, the renderer's transparent path (back to front,
+//!   alpha-blended); `MASK` cuts the whole material — invisible (opacity 0) when
+//!   `baseColorFactor.a` is below `alphaCutoff` — and else, with a base colour texture or
+//!   such vertex colours, each fragment whose texture alpha times vertex alpha times that
+//!   factor is below it ([`Material::alpha_cutoff`]: leaves, fences).
 //! - `doubleSided`: the renderer draws every surface from both sides (no culling, a back face
 //!   with its normals reversed), so `doubleSided: false` surfaces are visible from behind too.
 
@@ -61,12 +63,31 @@ fn unit_factor(f: f32) -> f32 {
     }
 }
 
+/// A `MASK` material's `alphaCutoff` (NaN: the spec's default, 0.5).
+fn gltf_cutoff(m: &gltf::Material) -> f32 {
+    m.alpha_cutoff().filter(|c| !c.is_nan()).unwrap_or(0.5)
+}
+
+/// What a `MASK` material's per-fragment alpha (texel alpha × vertex alpha) is cut below, the
+/// factor's alpha folded in (`a · factor < cutoff` as `a < cutoff / factor`); `None` where
+/// the factor decides alone: below the cutoff everything is cut (the material's opacity is
+/// 0), at a cutoff of 0 or less nothing is.
+fn mask_cutoff(m: &gltf::Material) -> Option<f32> {
+    let a = m.pbr_metallic_roughness().base_color_factor()[3];
+    let factor_alpha = if a.is_nan() { 1.0 } else { a.clamp(0.0, 1.0) };
+    let cutoff = gltf_cutoff(m);
+    (factor_alpha >= cutoff && cutoff > 0.0).then(|| cutoff / factor_alpha)
+}
+
 /// The materials of one glTF file, converted when a primitive first uses them.
 pub(super) struct Materials {
     /// Converted materials, in the order first used.
     pub list: Vec<Material>,
     /// glTF material index (`None`: the default material) → index in `list`.
     by_index: HashMap<Option<usize>, usize>,
+    /// The same for the variants whose vertex colours' alpha takes part
+    /// ([`Materials::get_with_vertex_alpha`]).
+    with_vertex_alpha: HashMap<Option<usize>, usize>,
     textures: Textures,
     raw: RawMaterials,
     /// Per texture (by address): whether some texel is not opaque, looked at once.
@@ -79,6 +100,7 @@ impl Materials {
         Materials {
             list: Vec::new(),
             by_index: HashMap::new(),
+            with_vertex_alpha: HashMap::new(),
             textures: Textures::new(budget),
             raw: RawMaterials::parse(json),
             translucent: HashMap::new(),
@@ -104,6 +126,39 @@ impl Materials {
         let material = self.convert(m, buffers, gltf_path, warnings)?;
         self.list.push(material);
         self.by_index.insert(m.index(), self.list.len() - 1);
+        Ok(self.list.len() - 1)
+    }
+
+    /// [`Materials::get`] for a primitive whose `COLOR_0` is not opaque everywhere: a variant
+    /// of `m` in which that alpha multiplies the opacity (`BLEND`) or takes part in the cut
+    /// (`MASK`); `m` itself where it ignores alpha (`OPAQUE`, or a `MASK` that cuts all or
+    /// nothing).
+    pub fn get_with_vertex_alpha(
+        &mut self,
+        m: &gltf::Material,
+        buffers: &mut Buffers,
+        gltf_path: &Path,
+        warnings: &mut Vec<String>,
+    ) -> Result<usize, String> {
+        let base = self.get(m, buffers, gltf_path, warnings)?;
+        if let Some(&i) = self.with_vertex_alpha.get(&m.index()) {
+            return Ok(i);
+        }
+        let mut variant = self.list[base].clone();
+        match m.alpha_mode() {
+            AlphaMode::Opaque => return Ok(base),
+            AlphaMode::Blend => variant.alpha_vertex = true,
+            AlphaMode::Mask => match mask_cutoff(m) {
+                Some(cutoff) => {
+                    variant.alpha_cutoff = Some(cutoff);
+                    variant.alpha_vertex = true;
+                }
+                None => return Ok(base),
+            },
+        }
+        self.list.push(variant);
+        self.with_vertex_alpha
+            .insert(m.index(), self.list.len() - 1);
         Ok(self.list.len() - 1)
     }
 
@@ -177,14 +232,10 @@ impl Materials {
                 factor_alpha
             }
             AlphaMode::Mask => {
-                // NaN: the spec's default. Past 1 everything is cut (below), at 0 or less
-                // nothing is.
-                let cutoff = m.alpha_cutoff().filter(|c| !c.is_nan()).unwrap_or(0.5);
-                if diffuse_texture.is_some() && factor_alpha >= cutoff && cutoff > 0.0 {
-                    // Texel alpha × factor alpha < cutoff, as texel alpha < cutoff / factor.
-                    alpha_cutoff = Some(cutoff / factor_alpha);
+                if diffuse_texture.is_some() {
+                    alpha_cutoff = mask_cutoff(m);
                 }
-                if factor_alpha < cutoff {
+                if factor_alpha < gltf_cutoff(m) {
                     0.0
                 } else {
                     1.0

@@ -249,8 +249,8 @@ impl From<String> for Fault {
     }
 }
 
-/// A built primitive and its object-space bounds.
-type BuiltMesh = (Arc<Mesh>, Option<Aabb>);
+/// A built primitive, its object-space bounds, and whether some vertex colour is not opaque.
+type BuiltMesh = (Arc<Mesh>, Option<Aabb>, bool);
 
 /// A file's contents, converted; material indices start at 0.
 struct Imported {
@@ -337,7 +337,8 @@ fn import(
                         e.insert(match built {
                             mesh::Built::Mesh(mesh) => {
                                 let bounds = mesh.bounds();
-                                Some((Arc::new(mesh), bounds))
+                                let vertex_alpha = mesh.colors.iter().any(|c| c.w < 1.0);
+                                Some((Arc::new(mesh), bounds, vertex_alpha))
                             }
                             mesh::Built::Skipped(why) => {
                                 warnings.push(format!("{why}; skipped"));
@@ -346,14 +347,22 @@ fn import(
                         })
                     }
                 };
-                let Some((mesh, bounds)) = cached.clone() else {
+                let Some((mesh, bounds, vertex_alpha)) = cached.clone() else {
                     continue;
                 };
                 check_placement(bounds, &p.world)
                     .map_err(|e| format!("{field} placing {pfield}: {e}"))?;
                 check_placement(bounds, &world).map_err(|e| placing(format!("{pfield}: {e}")))?;
-                let material =
-                    materials.get(&prim.material(), &mut buffers, path, &mut warnings)?;
+                let material = if vertex_alpha {
+                    materials.get_with_vertex_alpha(
+                        &prim.material(),
+                        &mut buffers,
+                        path,
+                        &mut warnings,
+                    )?
+                } else {
+                    materials.get(&prim.material(), &mut buffers, path, &mut warnings)?
+                };
                 if out.objects.len() >= MAX_OBJECTS {
                     return Err(format!(
                         "{field}: more than {MAX_OBJECTS} placed primitives (the limit per file)"
