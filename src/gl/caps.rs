@@ -76,7 +76,19 @@ pub struct Caps {
     pub subpixel_bits: i32,
     /// The extension set, sorted.
     pub extensions: BTreeSet<String>,
+    /// Most iterations a fragment shader's loops may run together before the driver ends
+    /// them early and silently (`None`: no such limit is known). llvmpipe stops every loop of
+    /// a shader once they have run 65 535 iterations between them.
+    pub max_loop_iterations: Option<u32>,
 }
+
+/// llvmpipe's loop limiter (`LP_MAX_TGSI_LOOP_ITERATIONS` in Mesa's gallivm): one count for
+/// all the loops of a shader invocation.
+const LLVMPIPE_LOOP_ITERATIONS: u32 = 65_535;
+
+/// Iterations kept back from [`Caps::max_loop_iterations`] for a shader's other loops (the
+/// directional lights', at most four) when a light loop is bounded by it.
+const LOOP_RESERVE: u32 = 64;
 
 /// The ES 2.0 extension MSAA renders through.
 pub const MSAA_RENDER_TO_TEXTURE: &str = "GL_EXT_multisampled_render_to_texture";
@@ -164,7 +176,6 @@ impl Caps {
             desktop,
             gl_version,
             glsl_version,
-            renderer,
             vendor,
             max_texture_size,
             max_renderbuffer_size,
@@ -181,6 +192,10 @@ impl Caps {
             depth24: es3 || has("GL_OES_depth24"),
             timer_query: has("GL_EXT_disjoint_timer_query"),
             subpixel_bits,
+            max_loop_iterations: renderer
+                .contains("llvmpipe")
+                .then_some(LLVMPIPE_LOOP_ITERATIONS),
+            renderer,
             extensions,
         })
     }
@@ -195,6 +210,13 @@ impl Caps {
             || major
                 .and_then(|m| m.parse::<u32>().ok())
                 .is_some_and(|m| m >= 3)
+    }
+
+    /// Most lights one fragment's light loop may visit here: no limit but where the driver
+    /// ends long loops early ([`Caps::max_loop_iterations`], less the other loops' share).
+    pub fn light_loop_budget(&self) -> u32 {
+        self.max_loop_iterations
+            .map_or(u32::MAX, |n| n.saturating_sub(LOOP_RESERVE))
     }
 
     /// True when the extension is present.

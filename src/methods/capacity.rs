@@ -38,7 +38,12 @@ pub fn capacities(caps: &Caps) -> Capacities {
         } else {
             index_entries
         },
-        cell_lights: es2.then_some(RGBA8_CELL_CAP),
+        // A cell's lights are one loop of the shader, which some drivers end early.
+        cell_lights: match (es2, caps.light_loop_budget()) {
+            (true, budget) => Some(RGBA8_CELL_CAP.min(budget)),
+            (false, u32::MAX) => None,
+            (false, budget) => Some(budget),
+        },
         grid_texels: texels,
     }
 }

@@ -46,7 +46,8 @@ pub(super) fn supported(caps: &Caps) -> Support {
 }
 
 /// Largest light count one forward draw can loop over on this context. ES 2.0 needs a constant
-/// loop bound that fits the fragment `int` precision: highp ints reach ±2¹⁶, mediump only ±2¹⁰.
+/// loop bound that fits the fragment `int` precision: highp ints reach ±2¹⁶, mediump only ±2¹⁰;
+/// and a driver that ends long loops early bounds any loop ([`Caps::light_loop_budget`]).
 pub fn max_lights(caps: &Caps) -> u32 {
     let texture_rows = caps.max_texture_size.max(1) as u32;
     let by_texture = texture_rows
@@ -56,7 +57,7 @@ pub fn max_lights(caps: &Caps) -> u32 {
         (EsVersion::Es2, true) => 65_535,
         (EsVersion::Es2, false) => 1_023,
     };
-    by_texture.min(by_loop)
+    by_texture.min(by_loop).min(caps.light_loop_budget())
 }
 
 /// The `forward` shader's uniforms: every light from the light texture, up to the count.
