@@ -170,6 +170,13 @@ impl Mesh {
         })
     }
 
+    /// Normals computed again from the faces, after a consistent winding (as [`Mesh::new`]
+    /// gives a mesh without normals): for a mesh whose triangles changed since.
+    pub(crate) fn recompute_normals(&mut self) {
+        super::orientation::orient_consistently(&self.positions, &mut self.indices);
+        self.normals = compute_normals(&self.positions, &self.indices);
+    }
+
     /// The mesh with vertex colours (one per position, finite; values are clamped to [0, 1]).
     pub fn with_colors(mut self, colors: Vec<Vec4>) -> Result<Mesh, SceneError> {
         check_per_vertex("mesh.colors", colors.len(), self.positions.len())?;

@@ -186,6 +186,7 @@ pub fn load_into(
             .chunks_exact(2)
             .map(|t| Vec2::new(t[0] as f32, 1.0 - t[1] as f32))
             .collect();
+        let computed_normals = normals.is_empty();
         let mesh = Mesh::new(positions, normals, uvs, m.indices).map_err(|e| SceneError::Obj {
             path: path.to_path_buf(),
             reason: format!("object `{}`: {e}", shown::name(&model.name)),
@@ -194,12 +195,17 @@ pub fn load_into(
             Some(id) if id < mtl.len() => first + id,
             _ => fallback,
         };
-        let (mesh, dropped) =
+        let (mut mesh, dropped) =
             super::duplicates::drop_from_opaque(mesh, &scene.materials[material], || {
                 format!("{}: object `{}`", path.display(), shown::name(&model.name))
             });
         if let Some(warning) = dropped {
             report.warn(warning);
+            // Normals the faces gave, copies included: a sheet listed in both windings
+            // cancelled to nothing.
+            if computed_normals {
+                mesh.recompute_normals();
+            }
         }
         scene.objects.push(Object {
             mesh: Arc::new(mesh),

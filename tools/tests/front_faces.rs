@@ -275,3 +275,35 @@ fn an_obj_without_normals_listed_both_ways_looks_as_one_listed_one_way() {
         .count();
     assert_eq!(differ, 0, "{differ} pixels differ");
 }
+
+/// A sheet listed in both windings without normals (a common way to model a two-sided sheet):
+/// the copy is dropped as a duplicate, and the normals are those of the sheet listed once.
+/// Computed with the copy, they cancelled and the sheet was lit as if it faced up (+Y).
+#[test]
+fn a_sheet_listed_both_ways_without_normals_looks_as_the_sheet_listed_once() {
+    let dir = tempfile::tempdir().unwrap();
+    let opts = RenderOptions {
+        linear: true,
+        ..Default::default()
+    };
+    let mut gpu = Gpu::new(EsVersion::Es3);
+    let mut render = |name: &str, faces: &str| {
+        let path = dir.path().join(name);
+        let obj = format!("v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\n{faces}");
+        std::fs::write(&path, obj).unwrap();
+        let (mut s, _) = manylight::scene::load(path.to_str().unwrap(), None).unwrap();
+        s.camera = Camera::perspective(DVec3::new(0.0, 0.0, 4.0), DVec3::ZERO, 50.0, 0.1, 20.0);
+        s.lights = vec![Light::point(DVec3::new(0.0, 0.0, 1.0), 3.0, Vec3::ONE, 2.0)];
+        gpu.render(&s, W, H, &opts)
+    };
+    let once = render("once.obj", "f 1 2 3\nf 1 3 4\n");
+    let both = render("both.obj", "f 1 2 3\nf 1 3 4\nf 1 3 2\nf 1 4 3\n");
+    let centre = once.get_pixel(W / 2, H / 2);
+    assert!(centre[0] > 60, "the sheet is lit: {centre:?}");
+    let differ = once
+        .pixels()
+        .zip(both.pixels())
+        .filter(|(a, b)| (0..3).any(|c| a[c].abs_diff(b[c]) > 1))
+        .count();
+    assert_eq!(differ, 0, "{differ} pixels differ");
+}
