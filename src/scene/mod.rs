@@ -431,6 +431,24 @@ pub fn load_with(
         log::warn!("{warning}");
         report.warnings.push(warning);
     }
+    // A model so small that its lights' spheres fit inside the distance the shaders leave out
+    // around a light: said, not drawn dark.
+    let near = shading::LIGHT_MIN_DISTANCE;
+    let unlit = (scene.lights.iter())
+        .filter(|l| l.radius > 0.0 && f64::from(l.radius) <= near)
+        .count();
+    if unlit > 0 {
+        let warning = format!(
+            "{}: {unlit} of {} lights have a radius of at most 2⁻¹³ ({near:.3e}) and light \
+             nothing: the shaders leave out what lies that near a light (above fp16's smallest \
+             normal, docs/precision.md); scale the model up (its transform, or the units it \
+             was exported in)",
+            shown::text(&path.display().to_string()),
+            scene.lights.len()
+        );
+        log::warn!("{warning}");
+        report.warnings.push(warning);
+    }
     Ok((scene, report))
 }
 

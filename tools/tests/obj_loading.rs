@@ -680,3 +680,35 @@ fn faces_with_and_without_texture_coordinates_in_one_object_load() {
         }
     }
 }
+
+/// A model so small (a box of 2·10⁻⁵) that the random lights fitted to it have radii below the
+/// distance the shaders leave out around a light (2⁻¹³): they light nothing, and the loader
+/// says so rather than leaving a dark frame unexplained. At 1 unit, no such warning.
+#[test]
+fn lights_too_small_to_light_anything_are_named_at_load() {
+    let dir = tempfile::tempdir().unwrap();
+    let scaled = |s: f64| {
+        let line = |l: &str| {
+            let mut words = l.split_whitespace();
+            if words.next() != Some("v") {
+                return format!("{l}\n");
+            }
+            let v: Vec<String> = words
+                .map(|x| (x.parse::<f64>().unwrap() * s).to_string())
+                .collect();
+            format!("v {}\n", v.join(" "))
+        };
+        BOX_OBJ.lines().map(line).collect::<String>()
+    };
+    write(dir.path(), "box.mtl", BOX_MTL);
+    for (scale, warned) in [(1.0, false), (1e-5, true)] {
+        let path = write(dir.path(), "box.obj", &scaled(scale));
+        let (scene, report) = scene::load(path.to_str().unwrap(), Some((64, 3))).unwrap();
+        let radius = scene.lights.iter().map(|l| l.radius).fold(0.0, f32::max);
+        let said = report.warnings.iter().any(|w| w.contains("light nothing"));
+        assert_eq!(
+            said, warned,
+            "scale {scale:e}, radii up to {radius:e}: {report:?}"
+        );
+    }
+}
