@@ -170,14 +170,34 @@ impl Camera {
             }
         }
         let forward = self.target - self.position;
-        if forward.length_squared() == 0.0 {
+        if forward == DVec3::ZERO {
             return Err(SceneError::invalid(
                 "camera.target",
                 "equals camera.position",
             ));
         }
-        if self.up.length_squared() == 0.0 {
+        // Lengths whose squares underflow give no direction to the view maths.
+        if forward.length_squared() == 0.0 {
+            return Err(SceneError::invalid(
+                "camera.target",
+                format!(
+                    "lies only {:?} from camera.position along an axis: too near to give a \
+                     view direction",
+                    forward.abs().max_element()
+                ),
+            ));
+        }
+        if self.up == DVec3::ZERO {
             return Err(SceneError::invalid("camera.up", "must be non-zero"));
+        }
+        if self.up.length_squared() == 0.0 {
+            return Err(SceneError::invalid(
+                "camera.up",
+                format!(
+                    "is too short to give a direction ({:?}): a unit vector is the usual",
+                    self.up
+                ),
+            ));
         }
         // Unit vectors first: the squared lengths of raw ones can overflow or underflow.
         if forward

@@ -252,6 +252,8 @@ fn narrow3(field: &str, v: [f64; 3]) -> Result<Vec3, SceneError> {
 /// array with too many values say only "trailing characters". Anything after the scene's
 /// object but white space is an error too.
 fn deserialize(text: &str) -> Result<SceneFile, String> {
+    // A UTF-8 byte order mark, as some Windows editors write: skipped, as for OBJ and MTL.
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let mut json = serde_json::Deserializer::from_str(text);
     let file = serde_path_to_error::deserialize(&mut json).map_err(|e| {
         let path = e.path().to_string();

@@ -134,7 +134,7 @@ impl Light {
         if !(self.radius.is_finite() && self.radius >= 0.0) {
             return Err(SceneError::invalid(
                 format!("{field}.radius"),
-                format!("must be finite and >= 0, got {}", self.radius),
+                format!("must be finite and >= 0, got {:?}", self.radius),
             ));
         }
         validate_emission(self.color, self.intensity, field)?;
@@ -154,19 +154,19 @@ impl Light {
             if !(inner_deg.is_finite() && (0.0..=180.0).contains(&inner_deg)) {
                 return Err(SceneError::invalid(
                     format!("{field}.inner_deg"),
-                    format!("must be in [0, 180], got {inner_deg}"),
+                    format!("must be in [0, 180], got {inner_deg:?}"),
                 ));
             }
             if !(outer_deg.is_finite() && (0.0..=180.0).contains(&outer_deg)) {
                 return Err(SceneError::invalid(
                     format!("{field}.outer_deg"),
-                    format!("must be in [0, 180], got {outer_deg}"),
+                    format!("must be in [0, 180], got {outer_deg:?}"),
                 ));
             }
             if outer_deg < inner_deg {
                 return Err(SceneError::invalid(
                     format!("{field}.outer_deg"),
-                    format!("must be >= inner_deg ({inner_deg}), got {outer_deg}"),
+                    format!("must be >= inner_deg ({inner_deg:?}), got {outer_deg:?}"),
                 ));
             }
         }
@@ -215,7 +215,7 @@ pub(super) fn validate_emission(
     if !(intensity.is_finite() && intensity >= 0.0) {
         return Err(SceneError::invalid(
             format!("{field}.intensity"),
-            format!("must be finite and >= 0, got {intensity}"),
+            format!("must be finite and >= 0, got {intensity:?}"),
         ));
     }
     if !(color * intensity).is_finite() {

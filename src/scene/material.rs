@@ -158,14 +158,14 @@ impl Material {
         if !(self.alpha.is_finite() && (0.0..=1.0).contains(&self.alpha)) {
             return Err(SceneError::invalid(
                 format!("{field}.alpha"),
-                format!("must be in [0, 1], got {}", self.alpha),
+                format!("must be in [0, 1], got {:?}", self.alpha),
             ));
         }
         if let Some(c) = self.alpha_cutoff {
             if !(c.is_finite() && (0.0..=1.0).contains(&c)) {
                 return Err(SceneError::invalid(
                     format!("{field}.alpha_cutoff"),
-                    format!("must be in [0, 1], got {c}"),
+                    format!("must be in [0, 1], got {c:?}"),
                 ));
             }
         }
@@ -173,7 +173,7 @@ impl Material {
             if !(v.is_finite() && (0.0..=1.0).contains(&v)) {
                 return Err(SceneError::invalid(
                     format!("{field}.{name}"),
-                    format!("must be in [0, 1], got {v}"),
+                    format!("must be in [0, 1], got {v:?}"),
                 ));
             }
         }
@@ -187,7 +187,7 @@ impl Material {
         if !(self.shininess.is_finite() && self.shininess >= 0.0) {
             return Err(SceneError::invalid(
                 format!("{field}.shininess"),
-                format!("must be finite and >= 0, got {}", self.shininess),
+                format!("must be finite and >= 0, got {:?}", self.shininess),
             ));
         }
         Ok(())

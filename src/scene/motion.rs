@@ -275,7 +275,7 @@ impl Motion {
             if !(f.amount.is_finite() && (0.0..=1.0).contains(&f.amount)) {
                 return Err(SceneError::invalid(
                     format!("{field}.flicker.amount"),
-                    format!("must be in [0, 1], got {}", f.amount),
+                    format!("must be in [0, 1], got {:?}", f.amount),
                 ));
             }
             let (slowest, fastest) = (1.0 / MAX_PERIOD_S, 1.0 / MIN_PERIOD_S);
@@ -283,7 +283,7 @@ impl Motion {
                 return Err(SceneError::invalid(
                     format!("{field}.flicker.rate_hz"),
                     format!(
-                        "must be within [{slowest:e}, {fastest:e}] Hz, got {}",
+                        "must be within [{slowest:e}, {fastest:e}] Hz, got {:?}",
                         f.rate_hz
                     ),
                 ));
@@ -302,7 +302,7 @@ impl Motion {
             if !(s.angle_deg.is_finite() && (0.0..=180.0).contains(&s.angle_deg)) {
                 return Err(SceneError::invalid(
                     format!("{field}.sweep.angle_deg"),
-                    format!("must be in [0, 180], got {}", s.angle_deg),
+                    format!("must be in [0, 180], got {:?}", s.angle_deg),
                 ));
             }
         }
@@ -365,7 +365,7 @@ fn check_period(value: f64, field: &str, name: &str) -> Result<(), SceneError> {
     } else {
         Err(SceneError::invalid(
             format!("{field}.{name}"),
-            format!("must be within [{MIN_PERIOD_S:e}, {MAX_PERIOD_S:e}] seconds, got {value}"),
+            format!("must be within [{MIN_PERIOD_S:e}, {MAX_PERIOD_S:e}] seconds, got {value:?}"),
         ))
     }
 }
@@ -387,7 +387,7 @@ fn check_length(value: f64, field: &str, name: &str) -> Result<(), SceneError> {
     } else {
         Err(SceneError::invalid(
             format!("{field}.{name}"),
-            format!("must be within [0, {MAX_DISPLACEMENT:e}], got {value}"),
+            format!("must be within [0, {MAX_DISPLACEMENT:e}], got {value:?}"),
         ))
     }
 }
@@ -398,7 +398,7 @@ fn check_finite(value: f64, field: &str, name: &str) -> Result<(), SceneError> {
     } else {
         Err(SceneError::invalid(
             format!("{field}.{name}"),
-            format!("must be finite, got {value}"),
+            format!("must be finite, got {value:?}"),
         ))
     }
 }

@@ -254,6 +254,14 @@ fn a_spot_cone_wider_than_the_spec_allows_is_drawn_as_given_with_a_warning() {
         "{:?}",
         report.warnings
     );
+    // Past π it is no cone: refused in the file's terms, not as the converted degrees.
+    let spot = json!({"type": "spot", "intensity": 100, "spot": {"outerConeAngle": 10.0}});
+    let path = write(dir.path(), "past_pi.gltf", triangle_lit_by(spot));
+    let err = load(&path).unwrap_err().to_string();
+    assert!(
+        err.contains("spot.outerConeAngle (10.0) must be within [0, π] radians"),
+        "{err}"
+    );
 }
 
 #[test]

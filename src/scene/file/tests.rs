@@ -293,3 +293,39 @@ fn errors_name_the_field() {
         assert!(err.contains(needle), "expected `{needle}` in: {err}");
     }
 }
+
+#[test]
+fn a_byte_order_mark_is_skipped_and_huge_values_are_shown_short() {
+    let plain = r#"{"objects": [{"builtin": "plane"}]}"#;
+    assert!(parse_str(&format!("\u{feff}{plain}")).is_ok());
+    let err = parse_str(
+        r#"{"objects": [{"builtin": "plane"}],
+            "lights": [{"kind": "point", "position": [0, 0, 1], "radius": 2,
+                        "color": [1, 1, 1],
+                        "motion": {"wander": {"radius": 1e300, "period_s": 4}}}]}"#,
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(err.contains("wander.radius") && err.contains("1e300"), "{err}");
+    assert!(err.len() < 300, "{err}");
+}
+
+#[test]
+fn a_camera_too_near_its_target_or_with_a_tiny_up_says_so() {
+    let camera = |target: &str, up: &str| {
+        parse_str(&format!(
+            r#"{{"objects": [{{"builtin": "plane"}}],
+                "camera": {{"position": [0, 0, 4], "target": {target}, "up": {up}}}}}"#
+        ))
+        .unwrap_err()
+        .to_string()
+    };
+    let err = camera("[0, 0, 3.9999999999999999]", "[0, 1, 0]");
+    assert!(err.contains("equals camera.position"), "{err}");
+    let err = camera("[1e-170, 0, 4]", "[0, 1, 0]");
+    assert!(err.contains("too near"), "{err}");
+    let err = camera("[0, 0, 0]", "[0, 1e-200, 0]");
+    assert!(err.contains("camera.up") && err.contains("too short"), "{err}");
+    let err = camera("[0, 0, 0]", "[0, 0, 0]");
+    assert!(err.contains("must be non-zero"), "{err}");
+}

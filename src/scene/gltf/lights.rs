@@ -118,6 +118,16 @@ pub(super) fn convert(
             outer_cone_angle,
         } => {
             // Named in the file's terms (radians), not as the converted `outer_deg`.
+            for (name, angle) in [
+                ("innerConeAngle", inner_cone_angle),
+                ("outerConeAngle", outer_cone_angle),
+            ] {
+                if !(0.0..=std::f32::consts::PI).contains(&angle) {
+                    return Err(format!(
+                        "{field}: spot.{name} ({angle:?}) must be within [0, π] radians"
+                    ));
+                }
+            }
             if inner_cone_angle > outer_cone_angle {
                 return Err(format!(
                     "{field}: spot.innerConeAngle ({inner_cone_angle}) must not exceed \
