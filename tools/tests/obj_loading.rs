@@ -702,7 +702,7 @@ fn lights_too_small_to_light_anything_are_named_at_load() {
     };
     write(dir.path(), "box.mtl", BOX_MTL);
     for (scale, warned) in [(1.0, false), (1e-5, true)] {
-        let path = write(dir.path(), "box.obj", &scaled(scale));
+        let path = write(dir.path(), "box.obj", scaled(scale));
         let (scene, report) = scene::load(path.to_str().unwrap(), Some((64, 3))).unwrap();
         let radius = scene.lights.iter().map(|l| l.radius).fold(0.0, f32::max);
         let said = report.warnings.iter().any(|w| w.contains("light nothing"));

@@ -306,7 +306,10 @@ fn a_byte_order_mark_is_skipped_and_huge_values_are_shown_short() {
     )
     .unwrap_err()
     .to_string();
-    assert!(err.contains("wander.radius") && err.contains("1e300"), "{err}");
+    assert!(
+        err.contains("wander.radius") && err.contains("1e300"),
+        "{err}"
+    );
     assert!(err.len() < 300, "{err}");
 }
 
@@ -325,7 +328,10 @@ fn a_camera_too_near_its_target_or_with_a_tiny_up_says_so() {
     let err = camera("[1e-170, 0, 4]", "[0, 1, 0]");
     assert!(err.contains("too near"), "{err}");
     let err = camera("[0, 0, 0]", "[0, 1e-200, 0]");
-    assert!(err.contains("camera.up") && err.contains("too short"), "{err}");
+    assert!(
+        err.contains("camera.up") && err.contains("too short"),
+        "{err}"
+    );
     let err = camera("[0, 0, 0]", "[0, 0, 0]");
     assert!(err.contains("must be non-zero"), "{err}");
 }
