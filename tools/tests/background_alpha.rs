@@ -67,12 +67,7 @@ fn alpha_over_a_transparent_background_is_coverage() {
     let s = scene();
     for es in [EsVersion::Es2, EsVersion::Es3] {
         let mut gpu = Gpu::new(es);
-        let methods: &[&str] = if es == EsVersion::Es3 {
-            &["forward", "tiled", "clustered", "deferred"]
-        } else {
-            &["forward", "tiled", "clustered"]
-        };
-        for method in methods {
+        for method in common::methods_on(es) {
             gpu.r().set_method_named(method).unwrap();
             let img = gpu.render(&s, W, H, &opts);
             let alpha = |x: u32| img.get_pixel(x, H / 2)[3];

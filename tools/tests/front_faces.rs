@@ -122,12 +122,7 @@ fn the_side_seen_is_the_windings_with_every_method() {
     let mirror = DMat4::from_scale(DVec3::new(-1.0, 1.0, 1.0));
     for es in [EsVersion::Es2, EsVersion::Es3] {
         let mut gpu = Gpu::new(es);
-        let methods: &[&str] = if es == EsVersion::Es3 {
-            &["forward", "tiled", "clustered", "deferred"]
-        } else {
-            &["forward", "tiled", "clustered"]
-        };
-        for method in methods {
+        for method in common::methods_on(es) {
             gpu.r().set_method_named(method).unwrap();
             for (i, (what, s)) in scenes().iter().enumerate() {
                 let img = gpu.render(s, W, H, &opts);
@@ -244,36 +239,41 @@ fn octahedron_obj(reversed: &[usize]) -> String {
 
 #[test]
 fn an_obj_without_normals_listed_both_ways_looks_as_one_listed_one_way() {
+    let (eye, light) = (DVec3::new(2.0, 1.5, 3.0), DVec3::new(2.5, 2.0, 2.0));
+    let consistent = render_obj(&octahedron_obj(&[]), eye, (light, 10.0, 12.0));
+    // The faces towards the eye and the light among them.
+    let mixed = render_obj(&octahedron_obj(&[0, 5]), eye, (light, 10.0, 12.0));
+    let lit = consistent.pixels().filter(|p| p[0] > 60).count();
+    assert!(lit > 500, "{lit} lit pixels");
+    assert_eq!(differing_pixels(&consistent, &mixed), 0);
+}
+
+/// `obj` loaded as a file and rendered (linear, forward on ES 3.0) from `eye` towards the
+/// origin, lit by one white light (position, radius, intensity).
+fn render_obj(
+    obj: &str,
+    eye: DVec3,
+    (at, radius, intensity): (DVec3, f32, f32),
+) -> image::RgbaImage {
     let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("model.obj");
+    std::fs::write(&path, obj).unwrap();
+    let (mut s, _) = manylight::scene::load(path.to_str().unwrap(), None).unwrap();
+    s.camera = Camera::perspective(eye, DVec3::ZERO, 50.0, 0.1, 20.0);
+    s.lights = vec![Light::point(at, radius, Vec3::ONE, intensity)];
     let opts = RenderOptions {
         linear: true,
         ..Default::default()
     };
-    let mut gpu = Gpu::new(EsVersion::Es3);
-    let mut render = |name: &str, reversed: &[usize]| {
-        let path = dir.path().join(name);
-        std::fs::write(&path, octahedron_obj(reversed)).unwrap();
-        let (mut s, _) = manylight::scene::load(path.to_str().unwrap(), None).unwrap();
-        s.camera = Camera::perspective(DVec3::new(2.0, 1.5, 3.0), DVec3::ZERO, 50.0, 0.1, 20.0);
-        s.lights = vec![Light::point(
-            DVec3::new(2.5, 2.0, 2.0),
-            10.0,
-            Vec3::ONE,
-            12.0,
-        )];
-        gpu.render(&s, W, H, &opts)
-    };
-    let consistent = render("one_way.obj", &[]);
-    // The faces towards the eye and the light among them.
-    let mixed = render("both_ways.obj", &[0, 5]);
-    let lit = consistent.pixels().filter(|p| p[0] > 60).count();
-    assert!(lit > 500, "{lit} lit pixels");
-    let differ = consistent
-        .pixels()
-        .zip(mixed.pixels())
+    Gpu::new(EsVersion::Es3).render(&s, W, H, &opts)
+}
+
+/// Pixels of `a` and `b` more than 1/255 apart in some channel.
+fn differing_pixels(a: &image::RgbaImage, b: &image::RgbaImage) -> usize {
+    a.pixels()
+        .zip(b.pixels())
         .filter(|(a, b)| (0..3).any(|c| a[c].abs_diff(b[c]) > 1))
-        .count();
-    assert_eq!(differ, 0, "{differ} pixels differ");
+        .count()
 }
 
 /// A sheet listed in both windings without normals (a common way to model a two-sided sheet):
@@ -281,29 +281,14 @@ fn an_obj_without_normals_listed_both_ways_looks_as_one_listed_one_way() {
 /// Computed with the copy, they cancelled and the sheet was lit as if it faced up (+Y).
 #[test]
 fn a_sheet_listed_both_ways_without_normals_looks_as_the_sheet_listed_once() {
-    let dir = tempfile::tempdir().unwrap();
-    let opts = RenderOptions {
-        linear: true,
-        ..Default::default()
-    };
-    let mut gpu = Gpu::new(EsVersion::Es3);
-    let mut render = |name: &str, faces: &str| {
-        let path = dir.path().join(name);
+    let sheet = |faces: &str| {
         let obj = format!("v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\n{faces}");
-        std::fs::write(&path, obj).unwrap();
-        let (mut s, _) = manylight::scene::load(path.to_str().unwrap(), None).unwrap();
-        s.camera = Camera::perspective(DVec3::new(0.0, 0.0, 4.0), DVec3::ZERO, 50.0, 0.1, 20.0);
-        s.lights = vec![Light::point(DVec3::new(0.0, 0.0, 1.0), 3.0, Vec3::ONE, 2.0)];
-        gpu.render(&s, W, H, &opts)
+        let light = (DVec3::new(0.0, 0.0, 1.0), 3.0, 2.0);
+        render_obj(&obj, DVec3::new(0.0, 0.0, 4.0), light)
     };
-    let once = render("once.obj", "f 1 2 3\nf 1 3 4\n");
-    let both = render("both.obj", "f 1 2 3\nf 1 3 4\nf 1 3 2\nf 1 4 3\n");
+    let once = sheet("f 1 2 3\nf 1 3 4\n");
+    let both = sheet("f 1 2 3\nf 1 3 4\nf 1 3 2\nf 1 4 3\n");
     let centre = once.get_pixel(W / 2, H / 2);
     assert!(centre[0] > 60, "the sheet is lit: {centre:?}");
-    let differ = once
-        .pixels()
-        .zip(both.pixels())
-        .filter(|(a, b)| (0..3).any(|c| a[c].abs_diff(b[c]) > 1))
-        .count();
-    assert_eq!(differ, 0, "{differ} pixels differ");
+    assert_eq!(differing_pixels(&once, &both), 0);
 }

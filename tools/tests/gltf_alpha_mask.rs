@@ -17,7 +17,7 @@ use common::Gpu;
 use glam::{DQuat, DVec3, Vec3};
 use manylight::scene::{Light, Scene};
 use manylight::{EsVersion, RenderOptions};
-use serde_json::json;
+use serde_json::{json, Value};
 
 const W: u32 = 128;
 const H: u32 = 72;
@@ -52,38 +52,63 @@ fn scene_with_pane_of_factor(
     factor_alpha: f32,
 ) -> Scene {
     let mut b = Builder::default();
+    let pane_prim = primitive(&mut b, &pane(1.6, 1.2), Some(2));
+    let material = json!({"alphaMode": alpha_mode.unwrap_or("OPAQUE"), "alphaCutoff": 0.5,
+        "pbrMetallicRoughness": {"baseColorTexture": {"index": 0}, "metallicFactor": 0,
+                                 "baseColorFactor": [1, 1, 1, factor_alpha]}});
+    let texture = json!({
+        "samplers": [{"magFilter": 9728, "minFilter": 9728}],
+        "textures": [{"source": 0, "sampler": 0}],
+        "images": [{"uri": format!("data:image/png;base64,{}", base64(png))}],
+    });
+    let name = format!("pane_{}_{factor_alpha}.gltf", alpha_mode.unwrap_or("none"));
+    let front = alpha_mode.map(|_| (pane_prim, material));
+    scene_around(dir, &name, b, front, texture)
+}
+
+/// A floor, a red wall behind and, with `front`, a pane (its primitive, whose material is
+/// number 2, and that material) in front, seen by the file's camera and lit by one light;
+/// `extra` adds top-level glTF members (the pane's texture).
+fn scene_around(
+    dir: &Path,
+    name: &str,
+    mut b: Builder,
+    front: Option<(Value, Value)>,
+    extra: Value,
+) -> Scene {
     let floor_prim = primitive(&mut b, &floor(), Some(0));
     let wall_prim = primitive(&mut b, &pane(3.0, 2.0), Some(1));
-    let pane_prim = primitive(&mut b, &pane(1.6, 1.2), Some(2));
     let mut nodes = vec![
         json!({"mesh": 0}),
         json!({"mesh": 1, "translation": [0, 0, -1.5]}),
         json!({"camera": 0, "translation": [0, 1, 3],
                "rotation": quat(DQuat::from_rotation_x(-0.15))}),
     ];
-    if alpha_mode.is_some() {
+    let mut meshes = vec![
+        json!({"primitives": [floor_prim]}),
+        json!({"primitives": [wall_prim]}),
+    ];
+    let mut materials = vec![
+        json!({"pbrMetallicRoughness": {"baseColorFactor": [0.7, 0.7, 0.7, 1], "metallicFactor": 0}}),
+        json!({"pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.1, 0.1, 1], "metallicFactor": 0}}),
+    ];
+    if let Some((prim, material)) = front {
         nodes.push(json!({"mesh": 2, "translation": [0, 0.3, 0.5]}));
+        meshes.push(json!({"primitives": [prim]}));
+        materials.push(material);
     }
     let scene_nodes: Vec<usize> = (0..nodes.len()).collect();
-    let gltf = json!({
+    let mut gltf = json!({
         "scenes": [{"nodes": scene_nodes}],
         "nodes": nodes,
         "cameras": [{"type": "perspective", "perspective": {"yfov": 0.9, "znear": 0.05, "zfar": 50}}],
-        "meshes": [{"primitives": [floor_prim]}, {"primitives": [wall_prim]},
-                   {"primitives": [pane_prim]}],
-        "materials": [
-            {"pbrMetallicRoughness": {"baseColorFactor": [0.7, 0.7, 0.7, 1], "metallicFactor": 0}},
-            {"pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.1, 0.1, 1], "metallicFactor": 0}},
-            {"alphaMode": alpha_mode.unwrap_or("OPAQUE"), "alphaCutoff": 0.5,
-             "pbrMetallicRoughness": {"baseColorTexture": {"index": 0}, "metallicFactor": 0,
-                                      "baseColorFactor": [1, 1, 1, factor_alpha]}}
-        ],
-        "samplers": [{"magFilter": 9728, "minFilter": 9728}],
-        "textures": [{"source": 0, "sampler": 0}],
-        "images": [{"uri": format!("data:image/png;base64,{}", base64(png))}],
+        "meshes": meshes,
+        "materials": materials,
     });
-    let name = format!("pane_{}_{factor_alpha}.gltf", alpha_mode.unwrap_or("none"));
-    let (mut scene, _) = load(&write(dir, &name, b.gltf(gltf))).unwrap();
+    if let (Some(gltf), Some(extra)) = (gltf.as_object_mut(), extra.as_object()) {
+        gltf.extend(extra.clone());
+    }
+    let (mut scene, _) = load(&write(dir, name, b.gltf(gltf))).unwrap();
     scene.lights = vec![Light::point(DVec3::new(0.5, 1.5, 1.5), 8.0, Vec3::ONE, 6.0)];
     scene.ambient = Vec3::splat(0.05);
     scene
@@ -104,27 +129,7 @@ fn a_masked_texture_cuts_the_pane_where_its_alpha_is_below_the_cutoff() {
     for_every_method(
         &[&masked, &opaque, &without],
         |es, method, [cut, solid, behind]| {
-            let (mut as_behind, mut as_solid) = (0, 0);
-            for ((c, s), b) in cut.pixels().zip(solid.pixels()).zip(behind.pixels()) {
-                let near = |x: &image::Rgba<u8>| (0..3).all(|k| c[k].abs_diff(x[k]) <= 1);
-                let (is_behind, is_solid) = (near(b), near(s));
-                assert!(
-                    is_behind || is_solid,
-                    "{es} {method}: a pixel {c:?} is neither the scene without the pane {b:?} \
-                     nor with it opaque {s:?}"
-                );
-                // Where the pane makes a difference, which side won.
-                if is_behind && !is_solid {
-                    as_behind += 1;
-                } else if is_solid && !is_behind {
-                    as_solid += 1;
-                }
-            }
-            let enough = (W * H / 20) as usize;
-            assert!(
-                as_behind > enough && as_solid > enough,
-                "{es} {method}: {as_behind} pixels cut and {as_solid} drawn"
-            );
+            assert_cut_or_whole(&format!("{es} {method}"), [cut, solid, behind], W * H / 20);
         },
     );
 }
@@ -201,40 +206,14 @@ fn a_blended_texture_blends_the_pane_by_its_alpha_times_the_factor() {
 /// left, bottom right, top right, top left), its material in `alpha_mode` (`None`: no pane).
 fn scene_with_coloured_pane(dir: &Path, alpha_mode: Option<&str>, alphas: [f32; 4]) -> Scene {
     let mut b = Builder::default();
-    let floor_prim = primitive(&mut b, &floor(), Some(0));
-    let wall_prim = primitive(&mut b, &pane(3.0, 2.0), Some(1));
     let mut pane_prim = primitive(&mut b, &pane(1.6, 1.2), Some(2));
     let colours: Vec<f32> = alphas.iter().flat_map(|&a| [1.0, 1.0, 1.0, a]).collect();
     pane_prim["attributes"]["COLOR_0"] = json!(b.floats(&colours, "VEC4"));
-    let mut nodes = vec![
-        json!({"mesh": 0}),
-        json!({"mesh": 1, "translation": [0, 0, -1.5]}),
-        json!({"camera": 0, "translation": [0, 1, 3],
-               "rotation": quat(DQuat::from_rotation_x(-0.15))}),
-    ];
-    if alpha_mode.is_some() {
-        nodes.push(json!({"mesh": 2, "translation": [0, 0.3, 0.5]}));
-    }
-    let scene_nodes: Vec<usize> = (0..nodes.len()).collect();
-    let gltf = json!({
-        "scenes": [{"nodes": scene_nodes}],
-        "nodes": nodes,
-        "cameras": [{"type": "perspective", "perspective": {"yfov": 0.9, "znear": 0.05, "zfar": 50}}],
-        "meshes": [{"primitives": [floor_prim]}, {"primitives": [wall_prim]},
-                   {"primitives": [pane_prim]}],
-        "materials": [
-            {"pbrMetallicRoughness": {"baseColorFactor": [0.7, 0.7, 0.7, 1], "metallicFactor": 0}},
-            {"pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.1, 0.1, 1], "metallicFactor": 0}},
-            {"alphaMode": alpha_mode.unwrap_or("OPAQUE"), "alphaCutoff": 0.5,
-             "pbrMetallicRoughness": {"metallicFactor": 0,
-                                      "baseColorFactor": [0.9, 0.8, 0.2, 1]}}
-        ],
-    });
+    let material = json!({"alphaMode": alpha_mode.unwrap_or("OPAQUE"), "alphaCutoff": 0.5,
+        "pbrMetallicRoughness": {"metallicFactor": 0, "baseColorFactor": [0.9, 0.8, 0.2, 1]}});
     let name = format!("coloured_pane_{}.gltf", alpha_mode.unwrap_or("none"));
-    let (mut scene, _) = load(&write(dir, &name, b.gltf(gltf))).unwrap();
-    scene.lights = vec![Light::point(DVec3::new(0.5, 1.5, 1.5), 8.0, Vec3::ONE, 6.0)];
-    scene.ambient = Vec3::splat(0.05);
-    scene
+    let front = alpha_mode.map(|_| (pane_prim, material));
+    scene_around(dir, &name, b, front, json!({}))
 }
 
 /// glTF's base colour alpha is the factor's × the texture's × `COLOR_0`'s: vertex alpha 0.5
@@ -277,27 +256,33 @@ fn vertex_alpha_blends_and_cuts_as_the_base_colour_alpha() {
     for_every_method(
         &[&masked, &opaque, &without],
         |es, method, [cut, solid, behind]| {
-            let (mut as_behind, mut as_solid) = (0, 0);
-            for ((c, s), b) in cut.pixels().zip(solid.pixels()).zip(behind.pixels()) {
-                let near = |x: &image::Rgba<u8>| (0..3).all(|k| c[k].abs_diff(x[k]) <= 1);
-                let (is_behind, is_solid) = (near(b), near(s));
-                assert!(
-                    is_behind || is_solid,
-                    "{es} {method}: a pixel {c:?} is neither the scene without the pane {b:?} \
-                     nor with it opaque {s:?}"
-                );
-                if is_behind && !is_solid {
-                    as_behind += 1;
-                } else if is_solid && !is_behind {
-                    as_solid += 1;
-                }
-            }
-            let enough = (W * H / 40) as usize;
-            assert!(
-                as_behind > enough && as_solid > enough,
-                "{es} {method}: {as_behind} pixels cut and {as_solid} drawn"
-            );
+            assert_cut_or_whole(&format!("{es} {method}"), [cut, solid, behind], W * H / 40);
         },
+    );
+}
+
+/// Asserts that every pixel of `cut` is the scene without the pane (`behind`) or with it
+/// opaque (`solid`), and that more than `enough` pixels are each.
+fn assert_cut_or_whole(what: &str, [cut, solid, behind]: [image::RgbaImage; 3], enough: u32) {
+    let (mut as_behind, mut as_solid) = (0, 0);
+    for ((c, s), b) in cut.pixels().zip(solid.pixels()).zip(behind.pixels()) {
+        let near = |x: &image::Rgba<u8>| (0..3).all(|k| c[k].abs_diff(x[k]) <= 1);
+        let (is_behind, is_solid) = (near(b), near(s));
+        assert!(
+            is_behind || is_solid,
+            "{what}: a pixel {c:?} is neither the scene without the pane {b:?} nor with it \
+             opaque {s:?}"
+        );
+        // Where the pane makes a difference, which side won.
+        if is_behind && !is_solid {
+            as_behind += 1;
+        } else if is_solid && !is_behind {
+            as_solid += 1;
+        }
+    }
+    assert!(
+        as_behind > enough && as_solid > enough,
+        "{what}: {as_behind} pixels cut and {as_solid} drawn"
     );
 }
 
@@ -310,12 +295,7 @@ fn for_every_method(
     let opts = RenderOptions::default();
     for es in [EsVersion::Es2, EsVersion::Es3] {
         let mut gpu = Gpu::new(es);
-        let methods: &[&str] = if es == EsVersion::Es3 {
-            &["forward", "tiled", "clustered", "deferred"]
-        } else {
-            &["forward", "tiled", "clustered"]
-        };
-        for method in methods {
+        for method in common::methods_on(es) {
             gpu.r().set_method_named(method).unwrap();
             check(
                 es,

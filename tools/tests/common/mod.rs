@@ -181,6 +181,14 @@ pub fn max_oracle_error(
     (e.max_abs, e.worst, e.samples)
 }
 
+/// The methods a context of `es` runs: deferred needs ES 3.0.
+pub fn methods_on(es: EsVersion) -> &'static [&'static str] {
+    match es {
+        EsVersion::Es2 => &["forward", "tiled", "clustered"],
+        EsVersion::Es3 => &["forward", "tiled", "clustered", "deferred"],
+    }
+}
+
 /// The mean of a picture's red, green and blue values, in 8-bit steps.
 pub fn mean(img: &image::RgbaImage) -> f64 {
     let sum: u64 = img
