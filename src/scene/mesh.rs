@@ -249,7 +249,7 @@ impl Mesh {
 
     /// Whether any triangle has a non-zero area (all points or lines: nothing to draw).
     pub fn has_area(&self) -> bool {
-        self.triangle_normals().any(|n| n != Vec3::ZERO)
+        self.triangle_normals().any(|n| n != DVec3::ZERO)
     }
 
     /// Unit vectors spanning the directions of the triangles' normals (none: no triangle has
@@ -259,7 +259,7 @@ impl Mesh {
     pub fn normal_span(&self) -> Vec<glam::DVec3> {
         let mut basis: Vec<glam::DVec3> = Vec::new();
         for n in self.triangle_normals() {
-            let mut n = n.as_dvec3().normalize_or_zero();
+            let mut n = n.normalize_or_zero();
             for b in &basis {
                 n -= *b * n.dot(*b);
             }
@@ -274,14 +274,14 @@ impl Mesh {
         basis
     }
 
-    /// The triangles' (unnormalised) normals, out-of-range corners at the origin.
-    fn triangle_normals(&self) -> impl Iterator<Item = Vec3> + '_ {
+    /// The triangles' (unnormalised) normals, out-of-range corners at the origin. In f64: an
+    /// f32 cross product of edges near 10⁻²³ underflows to zero, a real triangle to none.
+    fn triangle_normals(&self) -> impl Iterator<Item = DVec3> + '_ {
         self.indices.chunks_exact(3).map(|t| {
             let p = |k: usize| {
                 self.positions
                     .get(t[k] as usize)
-                    .copied()
-                    .unwrap_or_default()
+                    .map_or(DVec3::ZERO, |p| p.as_dvec3())
             };
             (p(1) - p(0)).cross(p(2) - p(0))
         })
@@ -520,6 +520,24 @@ mod tests {
         for (p, n) in m.positions.iter().zip(&m.normals) {
             assert!(p.dot(*n) > 0.99, "{p}: {n}");
         }
+    }
+
+    #[test]
+    fn a_tiny_triangle_has_an_area() {
+        let tiny = |s: f32| {
+            let m = Mesh::new(
+                vec![Vec3::ZERO, Vec3::X * s, Vec3::Y * s],
+                vec![],
+                vec![],
+                vec![0, 1, 2],
+            );
+            m.unwrap().has_area()
+        };
+        assert!(
+            tiny(1e-23),
+            "its f32 cross product underflows, its area does not"
+        );
+        assert!(!tiny(0.0));
     }
 
     #[test]
