@@ -61,11 +61,17 @@ vec3 shadingNormal(vec3 N, vec2 uv) {
 }
 
 // The alpha the base colour texture (under HAS_TEXTURE_ALPHA or HAS_ALPHA_MASK) and COLOR_0
-// (under HAS_VERTEX_ALPHA) give on top of the material's factor.
-#if (HAS_TEXTURE_ALPHA || HAS_ALPHA_MASK) && HAS_TEXTURE
-#define TEXEL_ALPHA(uv) TEXTURE2D(u_albedoTex, UV_ALBEDO(uv)).a
-#else
+// (under HAS_VERTEX_ALPHA) give on top of the material's factor. Single-flag conditions, so
+// that a variant without a texture holds no texture code (`strip_feature_blocks`).
 #define TEXEL_ALPHA(uv) 1.0
+#if HAS_TEXTURE
+#if HAS_TEXTURE_ALPHA
+#undef TEXEL_ALPHA
+#define TEXEL_ALPHA(uv) TEXTURE2D(u_albedoTex, UV_ALBEDO(uv)).a
+#elif HAS_ALPHA_MASK
+#undef TEXEL_ALPHA
+#define TEXEL_ALPHA(uv) TEXTURE2D(u_albedoTex, UV_ALBEDO(uv)).a
+#endif
 #endif
 #if HAS_VERTEX_ALPHA
 #define VERTEX_ALPHA v_color.a
