@@ -40,8 +40,9 @@ pub struct MultisampleTarget {
     /// resolved into first, made when first needed (GL blits a multisampled source only onto
     /// the same rectangle).
     resolved_copy: Option<(glow::Framebuffer, glow::Renderbuffer)>,
-    /// A full-screen triangle for [`MultisampleTarget::fill`], made when first needed.
-    fill_triangle: Option<GpuMesh>,
+    /// A full-screen triangle: ES 2.0's resolve draws with it (made with the target), and
+    /// [`MultisampleTarget::fill`] (made when first needed).
+    triangle: Option<GpuMesh>,
     destroyed: bool,
 }
 
@@ -51,26 +52,17 @@ enum Color {
     Renderbuffer(glow::Renderbuffer),
     /// ES 2.0 with `GL_EXT_multisampled_render_to_texture`: a single-sampled texture the driver
     /// averages the samples into when the framebuffer is flushed, then copied to the
-    /// destination by a full-screen triangle (ES 2.0 has no blit).
-    Texture {
-        texture: glow::Texture,
-        triangle: GpuMesh,
-    },
+    /// destination by the target's full-screen triangle (ES 2.0 has no blit).
+    Texture(glow::Texture),
 }
 
 impl Color {
     /// The colour storage this context uses (its storage is allocated by the caller).
     fn new(dev: &Device) -> Result<Color, GlError> {
         if dev.es() == EsVersion::Es3 {
-            return Ok(Color::Renderbuffer(dev.create_renderbuffer()?));
-        }
-        let mut triangle = GpuMesh::new(dev, &fullscreen_triangle())?;
-        match dev.create_texture() {
-            Ok(texture) => Ok(Color::Texture { texture, triangle }),
-            Err(e) => {
-                triangle.destroy(dev);
-                Err(e)
-            }
+            Ok(Color::Renderbuffer(dev.create_renderbuffer()?))
+        } else {
+            Ok(Color::Texture(dev.create_texture()?))
         }
     }
 }
@@ -156,9 +148,18 @@ impl MultisampleTarget {
                 2
             },
             resolved_copy: None,
-            fill_triangle: None,
+            triangle: None,
             destroyed: false,
         };
+        if let Color::Texture(_) = target.color {
+            match GpuMesh::new(dev, &fullscreen_triangle()) {
+                Ok(triangle) => target.triangle = Some(triangle),
+                Err(e) => {
+                    target.destroy(dev);
+                    return Err(e);
+                }
+            }
+        }
         unsafe {
             gl.bind_framebuffer(glow::FRAMEBUFFER, Some(fbo));
             match &target.color {
@@ -186,7 +187,7 @@ impl MultisampleTarget {
                         h,
                     );
                 }
-                Color::Texture { texture, .. } => {
+                Color::Texture(texture) => {
                     gl.bind_texture(glow::TEXTURE_2D, Some(*texture));
                     gl.tex_image_2d(
                         glow::TEXTURE_2D,
@@ -282,7 +283,7 @@ impl MultisampleTarget {
         let copy = if self.resolved_copy.is_some() { 4 } else { 0 };
         match self.color {
             Color::Renderbuffer(_) => pixels * (self.samples_drawn as usize * per_sample + copy),
-            Color::Texture { .. } => pixels * (self.samples_drawn as usize * per_sample + 4),
+            Color::Texture(_) => pixels * (self.samples_drawn as usize * per_sample + 4),
         }
     }
 
@@ -315,24 +316,19 @@ impl MultisampleTarget {
                 dev.blit(self.fbo, Some(copy), self.size, [0, 0], colour);
                 dev.blit(copy, into, self.size, origin, colour);
             }
-            Color::Texture { texture, triangle } => {
+            Color::Texture(texture) => {
                 // Unbinding the framebuffer is what makes the driver average the samples into
                 // the texture.
                 dev.bind_framebuffer(into);
                 dev.viewport(origin[0] as i32, origin[1] as i32, w, h);
-                RenderState::FULL_SCREEN.apply(dev);
-                let key = ProgramKey {
-                    shader: "msaa_resolve",
-                    features: 0,
-                    dialect: dev.es(),
-                };
-                let uniforms = programs.bind::<ResolveUniforms>(dev, key, Vec::new)?;
+                let uniforms: &ResolveUniforms = full_screen(dev, programs, "msaa_resolve")?;
                 unsafe {
                     dev.gl.active_texture(glow::TEXTURE0);
                     dev.gl.bind_texture(glow::TEXTURE_2D, Some(*texture));
                 }
                 uniforms.resolved.set(dev, 0);
-                triangle.draw(dev);
+                let triangle = self.triangle.as_ref();
+                triangle.expect("made with the ES 2.0 target").draw(dev);
             }
         }
         dev.check(
@@ -354,19 +350,13 @@ impl MultisampleTarget {
         if !self.is_srgb() {
             return Ok(());
         }
-        if self.fill_triangle.is_none() {
-            self.fill_triangle = Some(GpuMesh::new(dev, &fullscreen_triangle())?);
+        if self.triangle.is_none() {
+            self.triangle = Some(GpuMesh::new(dev, &fullscreen_triangle())?);
         }
         dev.viewport(0, 0, self.size.0 as i32, self.size.1 as i32);
-        RenderState::FULL_SCREEN.apply(dev);
-        let key = ProgramKey {
-            shader: "solid",
-            features: 0,
-            dialect: dev.es(),
-        };
-        let uniforms = programs.bind::<SolidUniforms>(dev, key, Vec::new)?;
+        let uniforms: &SolidUniforms = full_screen(dev, programs, "solid")?;
         uniforms.color.set(dev, glam::Vec4::from_array(color));
-        self.fill_triangle.as_ref().expect("made above").draw(dev);
+        self.triangle.as_ref().expect("made above").draw(dev);
         dev.check("filling an sRGB MSAA target")
     }
 
@@ -422,22 +412,34 @@ impl MultisampleTarget {
             dev.delete_framebuffer(self.fbo);
             match &mut self.color {
                 Color::Renderbuffer(color) => dev.delete_renderbuffer(*color),
-                Color::Texture { texture, triangle } => {
-                    dev.delete_texture(*texture);
-                    triangle.destroy(dev);
-                }
+                Color::Texture(texture) => dev.delete_texture(*texture),
             }
             dev.delete_renderbuffer(self.depth);
             if let Some((fbo, colour)) = self.resolved_copy.take() {
                 dev.delete_framebuffer(fbo);
                 dev.delete_renderbuffer(colour);
             }
-            if let Some(mut triangle) = self.fill_triangle.take() {
+            if let Some(mut triangle) = self.triangle.take() {
                 triangle.destroy(dev);
             }
             self.destroyed = true;
         }
     }
+}
+
+/// Sets the full-screen state and binds `shader`'s one variant from `programs`.
+fn full_screen<'p, U: UniformSet>(
+    dev: &Device,
+    programs: &'p mut ProgramCache,
+    shader: &'static str,
+) -> Result<&'p U, GlError> {
+    RenderState::FULL_SCREEN.apply(dev);
+    let key = ProgramKey {
+        shader,
+        features: 0,
+        dialect: dev.es(),
+    };
+    programs.bind::<U>(dev, key, Vec::new)
 }
 
 /// The solid program's colour ([`MultisampleTarget::fill`]).
