@@ -124,9 +124,15 @@ impl Materials {
             return Ok(i);
         }
         let material = self.convert(m, buffers, gltf_path, warnings)?;
+        let i = self.add(material);
+        self.by_index.insert(m.index(), i);
+        Ok(i)
+    }
+
+    /// Appends `material` to [`Materials::list`]; its index.
+    fn add(&mut self, material: Material) -> usize {
         self.list.push(material);
-        self.by_index.insert(m.index(), self.list.len() - 1);
-        Ok(self.list.len() - 1)
+        self.list.len() - 1
     }
 
     /// [`Materials::get`] for a primitive whose `COLOR_0` is not opaque everywhere: a variant
@@ -156,10 +162,9 @@ impl Materials {
                 None => return Ok(base),
             },
         }
-        self.list.push(variant);
-        self.with_vertex_alpha
-            .insert(m.index(), self.list.len() - 1);
-        Ok(self.list.len() - 1)
+        let i = self.add(variant);
+        self.with_vertex_alpha.insert(m.index(), i);
+        Ok(i)
     }
 
     fn convert(
