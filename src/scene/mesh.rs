@@ -154,11 +154,7 @@ impl Mesh {
             wind_to_normals(&positions, &normals, &mut indices);
             normals
         } else {
-            // A triangle listed against its neighbours (an OBJ without `vn`) is turned round
-            // first: its face would have been shaded as a back face, and weighed against
-            // theirs in their normals.
-            super::orientation::orient_consistently(&positions, &mut indices);
-            compute_normals(&positions, &indices)
+            consistent_face_normals(&positions, &mut indices)
         };
         Ok(Mesh {
             positions,
@@ -173,8 +169,7 @@ impl Mesh {
     /// Normals computed again from the faces, after a consistent winding (as [`Mesh::new`]
     /// gives a mesh without normals): for a mesh whose triangles changed since.
     pub(crate) fn recompute_normals(&mut self) {
-        super::orientation::orient_consistently(&self.positions, &mut self.indices);
-        self.normals = compute_normals(&self.positions, &self.indices);
+        self.normals = consistent_face_normals(&self.positions, &mut self.indices);
     }
 
     /// The mesh with vertex colours (one per position, finite; values are clamped to [0, 1]).
@@ -385,6 +380,14 @@ fn wind_to_normals(positions: &[Vec3], normals: &[Vec3], indices: &mut [u32]) ->
         }
     }
     reversed
+}
+
+/// The normals of a mesh that has none: a triangle listed against its neighbours (an OBJ
+/// without `vn`) is turned round first, since it would be shaded as a back face and weigh
+/// against theirs in their normals; then [`compute_normals`].
+fn consistent_face_normals(positions: &[Vec3], indices: &mut [u32]) -> Vec<Vec3> {
+    super::orientation::orient_consistently(positions, indices);
+    compute_normals(positions, indices)
 }
 
 /// Area-weighted vertex normals from the faces; vertices on no face (or only degenerate ones)
