@@ -283,6 +283,41 @@ fn image_to_io(e: image::ImageError) -> io::Error {
     }
 }
 
+/// Where a JSON output goes: a file, or standard output for `-` (whose caller then sends its
+/// summary lines to standard error, so that standard output is the JSON alone).
+pub enum JsonOut {
+    /// A file, written beside itself and renamed over it (see the module's notes).
+    File(OutputFile),
+    /// Standard output.
+    Stdout,
+}
+
+impl JsonOut {
+    /// `path`'s destination, a file opened now: one that cannot be written fails before the
+    /// work, not after.
+    pub fn create(path: &Path) -> Result<JsonOut, WriteError> {
+        if path == Path::new("-") {
+            Ok(JsonOut::Stdout)
+        } else {
+            Ok(JsonOut::File(OutputFile::create(path)?))
+        }
+    }
+
+    /// Whether it is standard output.
+    pub fn is_stdout(&self) -> bool {
+        matches!(self, JsonOut::Stdout)
+    }
+
+    /// Writes `json` and commits the file.
+    pub fn commit(self, json: &str) -> Result<(), Box<dyn std::error::Error>> {
+        match self {
+            JsonOut::File(file) => file.commit_bytes(json.as_bytes())?,
+            JsonOut::Stdout => print_stdout(json)?,
+        }
+        Ok(())
+    }
+}
+
 /// Writes `text` to standard output and flushes it. A closed pipe (`manylight info | head`)
 /// ends the output quietly; any other error (a full disk) is returned.
 pub fn print_stdout(text: &str) -> Result<(), String> {

@@ -20,7 +20,7 @@ use clap::Parser;
 use manylight::gl::{GlError, HeadlessContext};
 use manylight::methods::{Support, METHODS};
 use manylight::{scene, EsVersion, RenderOptions, Renderer};
-use manylight_tools::output::{self, print_stdout, OutputFile};
+use manylight_tools::output::{self, print_stdout, JsonOut, OutputFile};
 use serde_json::{json, Value};
 
 use crate::EsArg;
@@ -211,11 +211,8 @@ pub fn run(args: &MatrixArgs, gles_libs: &[PathBuf]) -> Result<(), Box<dyn std::
         std::fs::create_dir_all(out)
             .map_err(|e| format!("cannot create {}: {e}", out.display()))?;
     }
-    let json_to_stdout = args.json.as_deref() == Some(Path::new("-"));
-    let json_file = match &args.json {
-        Some(path) if !json_to_stdout => Some(OutputFile::create(path)?),
-        _ => None,
-    };
+    let json_out = args.json.as_deref().map(JsonOut::create).transpose()?;
+    let json_to_stdout = json_out.as_ref().is_some_and(JsonOut::is_stdout);
     let sheet_file = out
         .map(|out| OutputFile::create(&out.join("matrix.png")))
         .transpose()?;
@@ -246,12 +243,11 @@ pub fn run(args: &MatrixArgs, gles_libs: &[PathBuf]) -> Result<(), Box<dyn std::
     let json = serde_json::to_string_pretty(&rows)? + "\n";
     if json_to_stdout {
         eprint!("{}", markdown(&rows));
-        print_stdout(&json)?;
     } else {
         print_stdout(&markdown(&rows))?;
     }
-    if let Some(file) = json_file {
-        file.commit_bytes(json.as_bytes())?;
+    if let Some(out) = json_out {
+        out.commit(&json)?;
     }
     if let (Some(file), Some(out)) = (sheet_file, out) {
         let path = file.path().display().to_string();

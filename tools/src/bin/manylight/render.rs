@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use clap::Parser;
 use manylight::gl::HeadlessContext;
 use manylight::{scene, RenderOptions, Renderer};
-use manylight_tools::output::{print_stdout, OutputFile};
+use manylight_tools::output::{print_stdout, JsonOut, OutputFile};
 
 use crate::EsArg;
 
@@ -246,11 +246,8 @@ pub fn run(args: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
     };
     // Opened before rendering: a path that cannot be written fails now, not after the frames.
     let out_file = out.map(OutputFile::create).transpose()?;
-    let stats_to_stdout = args.stats.as_deref() == Some(std::path::Path::new("-"));
-    let stats_file = match &args.stats {
-        Some(path) if !stats_to_stdout => Some(OutputFile::create(path)?),
-        _ => None,
-    };
+    let stats_out = args.stats.as_deref().map(JsonOut::create).transpose()?;
+    let stats_to_stdout = stats_out.as_ref().is_some_and(JsonOut::is_stdout);
     let es = args.es.into();
     let ctx = HeadlessContext::new(es)?;
     let restrictions = manylight::gl::Restrictions {
@@ -316,12 +313,8 @@ pub fn run(args: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
     if let Some(file) = out_file {
         file.commit_png(&image)?;
     }
-    let stats_json = serde_json::to_string_pretty(&stats)? + "\n";
-    if let Some(file) = stats_file {
-        file.commit_bytes(stats_json.as_bytes())?;
-    }
-    if stats_to_stdout {
-        print_stdout(&stats_json)?;
+    if let Some(out) = stats_out {
+        out.commit(&(serde_json::to_string_pretty(&stats)? + "\n"))?;
     }
     // The slow frames too, where enough frames were timed for them to mean something.
     let mut tail = match stats.time.frame_ms_spread {
