@@ -288,13 +288,20 @@ const CANNOT_ON_THIS_CONTEXT: u8 = 3;
 
 /// Whether `e` says the context cannot do what was asked: its ES version, the method, MSAA.
 fn cannot_on_this_context(e: &(dyn std::error::Error + 'static)) -> bool {
-    let version =
-        |e: &manylight::GlError| matches!(e, manylight::GlError::VersionUnavailable { .. });
-    match e.downcast_ref::<manylight::Error>() {
-        Some(manylight::Error::UnsupportedMethod { .. } | manylight::Error::Msaa { .. }) => true,
-        Some(manylight::Error::Gl(gl)) => version(gl),
-        _ => e.downcast_ref::<manylight::GlError>().is_some_and(version),
-    }
+    matches!(
+        e.downcast_ref::<manylight::Error>(),
+        Some(manylight::Error::UnsupportedMethod { .. } | manylight::Error::Msaa { .. })
+    ) || version_unavailable(e)
+}
+
+/// Whether `e` (a library or GL error) says the driver gives no context of the version asked,
+/// as opposed to one that could not start at all.
+pub(crate) fn version_unavailable(e: &(dyn std::error::Error + 'static)) -> bool {
+    let gl = match e.downcast_ref::<manylight::Error>() {
+        Some(manylight::Error::Gl(gl)) => Some(gl),
+        _ => e.downcast_ref::<manylight::GlError>(),
+    };
+    matches!(gl, Some(manylight::GlError::VersionUnavailable { .. }))
 }
 
 fn main() -> ExitCode {

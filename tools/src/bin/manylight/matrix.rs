@@ -17,7 +17,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, ExitStatus, Output};
 
 use clap::Parser;
-use manylight::gl::{GlError, HeadlessContext};
+use manylight::gl::HeadlessContext;
 use manylight::methods::{Support, METHODS};
 use manylight::{scene, EsVersion, RenderOptions, Renderer};
 use manylight_tools::output::{self, print_stdout, JsonOut, OutputFile};
@@ -586,21 +586,6 @@ impl CellContext {
     }
 }
 
-/// Whether `e` says this configuration cannot be had here (the driver gives no context of
-/// that version), as opposed to a failure of the renderer on a configuration that exists.
-fn refuses_the_configuration(e: &manylight::Error) -> bool {
-    matches!(e, manylight::Error::Gl(GlError::VersionUnavailable { .. }))
-}
-
-/// Whether making a context failed because the driver gives no context of that version (not
-/// because it could not start at all).
-fn cannot_give_the_version(e: &(dyn std::error::Error + 'static)) -> bool {
-    matches!(
-        e.downcast_ref::<GlError>(),
-        Some(GlError::VersionUnavailable { .. })
-    )
-}
-
 /// The row of a configuration this machine cannot give (its context could not be made, or
 /// is another version): printed as the cell's result, marked `refused`, so the matrix lists
 /// it without counting it as a failure.
@@ -629,12 +614,12 @@ pub fn run_cell(args: &MatrixCellArgs) -> Result<(), Box<dyn std::error::Error>>
     let reference = {
         let ctx = match CellContext::new(es, args.osmesa) {
             Ok(ctx) => ctx,
-            Err(e) if args.osmesa || cannot_give_the_version(&*e) => return print_refusal(&*e),
+            Err(e) if args.osmesa || crate::version_unavailable(&*e) => return print_refusal(&*e),
             // A driver that cannot start, a library that cannot load: the cell fails.
             Err(e) => return Err(e),
         };
         let mut full = match Renderer::new(ctx.load_gl()?, es) {
-            Err(e) if refuses_the_configuration(&e) => return print_refusal(&e),
+            Err(e) if crate::version_unavailable(&e) => return print_refusal(&e),
             made => made?,
         };
         full.set_method_named("forward")?;
@@ -654,7 +639,7 @@ pub fn run_cell(args: &MatrixCellArgs) -> Result<(), Box<dyn std::error::Error>>
         no_fragment_highp: args.no_fragment_highp,
     };
     let mut renderer = match Renderer::restricted(ctx.load_gl()?, es, &restrictions) {
-        Err(e) if refuses_the_configuration(&e) => return print_refusal(&e),
+        Err(e) if crate::version_unavailable(&e) => return print_refusal(&e),
         made => made?,
     };
     let mut methods = Vec::new();
