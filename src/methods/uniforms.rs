@@ -55,7 +55,7 @@ impl Transforms {
 
 /// Whether `model_view` mirrors what it places: its front faces are then clockwise on screen.
 pub(crate) fn is_mirroring(model_view: &DMat4) -> bool {
-    DMat3::from_mat4(*model_view).determinant() < 0.0
+    crate::scene::normal_matrix::mirrors(&DMat3::from_mat4(*model_view))
 }
 
 /// `surface.glsl`: the material, the ambient light and the output encoding.

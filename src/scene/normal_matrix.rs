@@ -16,7 +16,7 @@ pub fn normal_matrix(m: &DMat3) -> DMat3 {
         m.x_axis.cross(m.y_axis),
     );
     // A mirroring transform keeps its normals' orientation as the inverse transpose does.
-    let sign = if m.determinant() < 0.0 { -1.0 } else { 1.0 };
+    let sign = if mirrors(m) { -1.0 } else { 1.0 };
     let largest = cofactor
         .abs()
         .to_cols_array()
@@ -27,6 +27,13 @@ pub fn normal_matrix(m: &DMat3) -> DMat3 {
     } else {
         DMat3::IDENTITY
     }
+}
+
+/// Whether `m` mirrors what it places (a negative determinant; −0 does not), turning its
+/// triangles' winding round: the one test the normals, the GPU's front side and the CPU twin
+/// share.
+pub fn mirrors(m: &DMat3) -> bool {
+    m.determinant() < 0.0
 }
 
 #[cfg(test)]

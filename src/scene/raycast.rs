@@ -288,7 +288,7 @@ impl SceneRaycaster {
         let geometric = (world[1] - world[0]).cross(world[2] - world[0]);
         // A mirroring transform turns the placed winding round; the GPU draws such an object
         // with the opposite front face.
-        let face = if linear.determinant() < 0.0 {
+        let face = if super::normal_matrix::mirrors(&linear) {
             -geometric
         } else {
             geometric

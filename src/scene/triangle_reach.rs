@@ -129,8 +129,7 @@ fn split_mesh(mesh: &Mesh, transform: &DMat4, eye: DVec3, floor: f64) -> Option<
     let normals = normal_matrix(&linear);
     // A mirroring transform flips the bitangent's handedness; the split copy is drawn
     // unmirrored, so the flip is baked into `w`.
-    // `< 0`, as the normal matrix and the GPU's front side take it (a −0 determinant is not).
-    let mirrored = linear.determinant() < 0.0;
+    let mirrored = super::normal_matrix::mirrors(&linear);
     let handedness = if mirrored { -1.0 } else { 1.0 };
     let vertex = |i: u32| {
         let i = i as usize;
