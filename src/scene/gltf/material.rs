@@ -63,6 +63,16 @@ fn unit_factor(f: f32) -> f32 {
     }
 }
 
+/// `baseColorFactor`'s alpha in [0, 1] (NaN: 1).
+fn factor_alpha(m: &gltf::Material) -> f32 {
+    let a = m.pbr_metallic_roughness().base_color_factor()[3];
+    if a.is_nan() {
+        1.0
+    } else {
+        a.clamp(0.0, 1.0)
+    }
+}
+
 /// A `MASK` material's `alphaCutoff` (NaN: the spec's default, 0.5).
 fn gltf_cutoff(m: &gltf::Material) -> f32 {
     m.alpha_cutoff().filter(|c| !c.is_nan()).unwrap_or(0.5)
@@ -73,8 +83,7 @@ fn gltf_cutoff(m: &gltf::Material) -> f32 {
 /// the factor decides alone: below the cutoff everything is cut (the material's opacity is
 /// 0), at a cutoff of 0 or less nothing is.
 fn mask_cutoff(m: &gltf::Material) -> Option<f32> {
-    let a = m.pbr_metallic_roughness().base_color_factor()[3];
-    let factor_alpha = if a.is_nan() { 1.0 } else { a.clamp(0.0, 1.0) };
+    let factor_alpha = factor_alpha(m);
     let cutoff = gltf_cutoff(m);
     (factor_alpha >= cutoff && cutoff > 0.0).then(|| cutoff / factor_alpha)
 }
@@ -184,7 +193,7 @@ impl Materials {
             (None, None) => "gltf-default".to_string(),
         };
         let pbr = m.pbr_metallic_roughness();
-        let [r, g, b, a] = pbr.base_color_factor();
+        let [r, g, b, _] = pbr.base_color_factor();
         let base = Vec3::new(r, g, b);
         // NaN becomes 0: f32::clamp keeps NaN, max/min do not.
         let diffuse = base.max(Vec3::ZERO).min(Vec3::splat(MAX_COLOR_FACTOR));
@@ -194,7 +203,7 @@ impl Materials {
                  limited to [0, {MAX_COLOR_FACTOR}], the range the fp16 colour tier holds)"
             ));
         }
-        let factor_alpha = if a.is_nan() { 1.0 } else { a.clamp(0.0, 1.0) };
+        let factor_alpha = factor_alpha(m);
         let mut diffuse_texture = None;
         let mut base_transform = Default::default();
         if let Some(info) = pbr.base_color_texture() {
