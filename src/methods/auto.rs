@@ -1,23 +1,27 @@
 //! `auto`: picks a method per frame from the context and the scene, and says which and why in
 //! the frame's stats. Few lights → plain forward (one short loop beats assigning and uploading
-//! a grid); many → clustered; clustered unsupported, or more lights visible than it can index
-//! → forward. The method not in use holds no GPU resources, except clustered's while a frame
-//! has too many visible lights for it (it tries again every frame).
+//! a grid); many → clustered; clustered unsupported → forward. A frame with more lights visible
+//! than clustered can index → deferred where it runs (ES 3.0 G-buffer, single-sampled frame):
+//! one proxy per light has no index limit, where forward's loop is capped by the driver and
+//! leaves lights out. The method not in use holds no GPU resources, except clustered's while
+//! a frame has too many visible lights for it (it tries again every frame).
 
 use std::fmt::Write as _;
 
 use super::clustered::culled_support;
 use super::culled::{CulledForward, CulledFrame, Culling};
+use super::deferred::Deferred;
 use super::forward::Forward;
 use super::{FrameContext, MethodDesc, MethodStats, ShadingMethod, Support};
 use crate::cluster::pack::MAX_INDEXED_LIGHTS;
-use crate::gl::{Device, EsVersion};
+use crate::gl::{gbuffer, Device, EsVersion};
+use crate::options::CountKind;
 use crate::Error;
 
 /// The table row.
 pub const DESC: MethodDesc = MethodDesc {
     name: "auto",
-    summary: "forward for few lights, clustered for many (the choice is in the stats)",
+    summary: "forward for few lights, clustered for many, deferred past clustered's index limit (the choice is in the stats)",
     min_es: EsVersion::Es2,
     required_extensions: &[],
     supported,
@@ -55,6 +59,8 @@ pub const FORWARD_UP_TO: usize = 32;
 pub struct Auto {
     forward: Forward,
     clustered: Option<CulledForward>,
+    /// For frames with more visible lights than clustered indexes, where deferred runs.
+    deferred: Option<Deferred>,
     /// Why this frame's method was chosen (rewritten every frame, its buffer kept).
     reason: String,
     /// Whether clustered runs on this context (asked once: the context does not change).
@@ -95,6 +101,25 @@ impl Auto {
     }
 }
 
+impl Auto {
+    fn destroy_deferred(&mut self, dev: &Device) {
+        if let Some(mut d) = self.deferred.take() {
+            d.destroy(dev);
+        }
+    }
+}
+
+/// Why deferred cannot render this frame, if it cannot: no G-buffer on this context, or the
+/// frame is drawn into the renderer's multisampled target, which deferred does not support.
+fn deferred_refusal(ctx: &FrameContext) -> Option<String> {
+    if let Some(why) = gbuffer::unsupported_reason(ctx.dev.caps()) {
+        return Some(why);
+    }
+    // As `Renderer::render_hosted` decides: light counts are never multisampled.
+    (ctx.options.samples > 1 && ctx.options.count == CountKind::None)
+        .then(|| format!("{} MSAA samples, one G-buffer sample", ctx.options.samples))
+}
+
 impl ShadingMethod for Auto {
     fn name(&self) -> &'static str {
         DESC.name
@@ -109,24 +134,46 @@ impl ShadingMethod for Auto {
             match clustered.render_unless_too_many(ctx)? {
                 CulledFrame::Rendered(mut stats) => {
                     self.forward.destroy(ctx.dev);
+                    if let Some(mut d) = self.deferred.take() {
+                        d.destroy(ctx.dev);
+                    }
                     stats.auto_choice = Some((choice, &self.reason));
                     return Ok(stats);
                 }
                 // Forward this frame; clustered keeps its resources and tries again next frame
                 // (the visible lights change as they and the camera move).
                 CulledFrame::TooManyVisible(visible) => {
+                    let refusal = deferred_refusal(ctx);
+                    let instead = if refusal.is_none() {
+                        "deferred"
+                    } else {
+                        "forward"
+                    };
                     self.reason.clear();
                     let _ = write!(
                         self.reason,
                         "{visible} lights visible > {MAX_INDEXED_LIGHTS}, more than clustered \
-                         can index: forward renders this frame"
+                         can index: {instead} renders this frame"
                     );
+                    if let Some(why) = refusal {
+                        let _ = write!(self.reason, " (deferred cannot: {why})");
+                    }
                     if !self.warned_too_many {
                         self.warned_too_many = true;
                         log::warn!("auto: {}", self.reason);
                     }
-                    let mut stats = self.forward.render(ctx)?;
-                    stats.auto_choice = Some(("forward", &self.reason));
+                    let mut stats = if instead == "deferred" {
+                        self.forward.destroy(ctx.dev);
+                        self.deferred
+                            .get_or_insert_with(Deferred::default)
+                            .render(ctx)?
+                    } else {
+                        if let Some(mut d) = self.deferred.take() {
+                            d.destroy(ctx.dev);
+                        }
+                        self.forward.render(ctx)?
+                    };
+                    stats.auto_choice = Some((instead, &self.reason));
                     return Ok(stats);
                 }
             }
@@ -134,6 +181,7 @@ impl ShadingMethod for Auto {
         if let Some(mut c) = self.clustered.take() {
             c.destroy(ctx.dev);
         }
+        self.destroy_deferred(ctx.dev);
         let mut stats = self.forward.render(ctx)?;
         stats.auto_choice = Some((choice, &self.reason));
         Ok(stats)
@@ -146,7 +194,9 @@ impl ShadingMethod for Auto {
     }
 
     fn gpu_bytes(&self) -> usize {
-        self.forward.gpu_bytes() + self.clustered.as_ref().map_or(0, CulledForward::gpu_bytes)
+        self.forward.gpu_bytes()
+            + self.clustered.as_ref().map_or(0, CulledForward::gpu_bytes)
+            + self.deferred.as_ref().map_or(0, Deferred::gpu_bytes)
     }
 
     fn destroy(&mut self, dev: &Device) {
@@ -154,5 +204,6 @@ impl ShadingMethod for Auto {
         if let Some(mut c) = self.clustered.take() {
             c.destroy(dev);
         }
+        self.destroy_deferred(dev);
     }
 }

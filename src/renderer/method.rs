@@ -18,7 +18,8 @@ pub enum Method {
     Clustered,
     /// A G-buffer, then the lights as screen-space volumes (ES 3.0).
     Deferred,
-    /// Forward for few lights, clustered for many, chosen per frame.
+    /// Forward for few lights, clustered for many, chosen per frame; deferred (else forward)
+    /// for a frame with more visible lights than clustered indexes.
     Auto,
 }
 

@@ -58,9 +58,10 @@ fn auto_picks_forward_for_few_lights_and_clustered_for_many_and_says_why() {
 }
 
 /// More lights visible than tiled and clustered can index: clustered refuses the frame with an
-/// error naming the limit, and `auto` renders it with forward, says why, and equals forward.
+/// error naming the limit, and `auto` renders it with deferred where a single-sampled ES 3.0
+/// frame allows (no index limit, no light left out), else with forward, and says why.
 #[test]
-fn auto_renders_with_forward_when_more_lights_are_visible_than_clustered_indexes() {
+fn auto_renders_with_deferred_or_forward_when_more_lights_are_visible_than_clustered_indexes() {
     use manylight::cluster::pack::MAX_INDEXED_LIGHTS;
     use manylight::scene::Light;
     let mut s = scene::builtin::build("plane", None).unwrap();
@@ -75,35 +76,82 @@ fn auto_renders_with_forward_when_more_lights_are_visible_than_clustered_indexes
         .collect();
     let (w, h) = (32, 18);
     let mut gpu = Gpu::new(EsVersion::Es3);
-    gpu.r().set_method_named("clustered").unwrap();
-    let err = gpu
-        .r()
-        .render_offscreen(&s, w, h, &RenderOptions::default())
-        .unwrap_err()
-        .to_string();
+    let mut render = |method: &str, options: &RenderOptions| {
+        gpu.r().set_method_named(method).unwrap();
+        gpu.r().render_offscreen(&s, w, h, options)
+    };
+    let single = RenderOptions::default();
+    let err = render("clustered", &single).unwrap_err().to_string();
     assert!(
         err.contains("visible") && err.contains(&MAX_INDEXED_LIGHTS.to_string()),
         "{err}"
     );
+    let (reference, _) = render("deferred", &single).unwrap();
+    let (img, stats) = render("auto", &single).unwrap();
+    assert_eq!(stats.auto_choice.as_deref(), Some("deferred"));
+    let reason = stats.auto_reason.unwrap_or_default();
+    assert!(
+        reason.contains("more than clustered can index: deferred renders"),
+        "{reason}"
+    );
+    assert_eq!(manylight::metrics::diff(&reference, &img).max_abs, 0);
+    assert!(stats.memory.gbuffer_bytes > 0);
+
+    // Deferred has no multisampled G-buffer: with 4 samples auto renders with forward.
+    let msaa = RenderOptions {
+        samples: 4,
+        ..RenderOptions::default()
+    };
+    let (reference, _) = render("forward", &msaa).unwrap();
+    let (img, stats) = render("auto", &msaa).unwrap();
+    assert_eq!(stats.auto_choice.as_deref(), Some("forward"));
+    let reason = stats.auto_reason.unwrap_or_default();
+    assert!(
+        reason.contains("forward renders this frame (deferred cannot: 4 MSAA samples"),
+        "{reason}"
+    );
+    assert!(manylight::metrics::diff(&reference, &img).max_abs <= 2);
+
+    // With few of them in view again, the same method goes back to clustered.
+    s.lights.truncate(2_000);
+    gpu.r().set_method_named("auto").unwrap();
+    let (_, stats) = gpu.r().render_offscreen(&s, w, h, &single).unwrap();
+    assert_eq!(stats.auto_choice.as_deref(), Some("clustered"));
+    assert_eq!(
+        stats.memory.gbuffer_bytes, 0,
+        "deferred's G-buffer is freed"
+    );
+}
+
+/// ES 2.0 has no G-buffer: past clustered's index limit `auto` renders with forward.
+#[test]
+fn auto_renders_with_forward_past_the_index_limit_on_es2() {
+    use manylight::cluster::pack::MAX_INDEXED_LIGHTS;
+    use manylight::scene::Light;
+    let mut s = scene::builtin::build("plane", None).unwrap();
+    s.lights = (0..MAX_INDEXED_LIGHTS + 1)
+        .map(|i| {
+            let x = (i % 256) as f64 / 64.0 - 2.0;
+            let y = (i / 256) as f64 / 107.0 - 1.2;
+            Light::point(glam::DVec3::new(x, y, 0.2), 0.3, glam::Vec3::ONE, 1e-3)
+        })
+        .collect();
+    let mut gpu = Gpu::new(EsVersion::Es2);
     gpu.r().set_method_named("forward").unwrap();
     let (reference, _) = gpu
         .r()
-        .render_offscreen(&s, w, h, &RenderOptions::default())
+        .render_offscreen(&s, 16, 9, &RenderOptions::default())
         .unwrap();
     gpu.r().set_method_named("auto").unwrap();
     let (img, stats) = gpu
         .r()
-        .render_offscreen(&s, w, h, &RenderOptions::default())
+        .render_offscreen(&s, 16, 9, &RenderOptions::default())
         .unwrap();
     assert_eq!(stats.auto_choice.as_deref(), Some("forward"));
     let reason = stats.auto_reason.unwrap_or_default();
-    assert!(reason.contains("more than clustered can index"), "{reason}");
+    assert!(
+        reason.contains("deferred cannot: needs OpenGL ES 3.0"),
+        "{reason}"
+    );
     assert!(manylight::metrics::diff(&reference, &img).max_abs <= 2);
-    // With few of them in view again, the same method goes back to clustered.
-    s.lights.truncate(2_000);
-    let (_, stats) = gpu
-        .r()
-        .render_offscreen(&s, w, h, &RenderOptions::default())
-        .unwrap();
-    assert_eq!(stats.auto_choice.as_deref(), Some("clustered"));
 }
