@@ -4,7 +4,9 @@
 //! than clustered can index → deferred where it runs (ES 3.0 G-buffer, single-sampled frame):
 //! one proxy per light has no index limit, where forward's loop is capped by the driver and
 //! leaves lights out. The method not in use holds no GPU resources, except clustered's while
-//! a frame has too many visible lights for it (it tries again every frame).
+//! a frame has too many visible lights for it (it tries again every frame), and deferred's for
+//! [`DEFERRED_KEPT_FRAMES`] after its last frame (a count hovering round the limit would
+//! otherwise allocate a G-buffer every other frame).
 
 use std::fmt::Write as _;
 
@@ -54,6 +56,10 @@ fn supported(caps: &crate::gl::Caps) -> Support {
 /// Up to this many visible lights, plain forward is chosen.
 pub const FORWARD_UP_TO: usize = 32;
 
+/// Frames deferred's resources are kept after the last frame it rendered (two seconds at
+/// 60 frames a second).
+pub const DEFERRED_KEPT_FRAMES: u32 = 120;
+
 /// The adaptive method.
 #[derive(Default)]
 pub struct Auto {
@@ -61,6 +67,10 @@ pub struct Auto {
     clustered: Option<CulledForward>,
     /// For frames with more visible lights than clustered indexes, where deferred runs.
     deferred: Option<Deferred>,
+    /// Frames since deferred last rendered one: its G-buffer is freed after
+    /// [`DEFERRED_KEPT_FRAMES`], not at once, so a visible count that hovers round the limit
+    /// does not allocate a full-screen G-buffer every other frame.
+    deferred_idle: u32,
     /// Why this frame's method was chosen (rewritten every frame, its buffer kept).
     reason: String,
     /// Whether clustered runs on this context (asked once: the context does not change).
@@ -109,6 +119,20 @@ impl Auto {
     }
 }
 
+/// Counts a frame deferred did not render; frees its resources once it has been idle for
+/// [`DEFERRED_KEPT_FRAMES`].
+fn retire_deferred(deferred: &mut Option<Deferred>, idle: &mut u32, dev: &Device) {
+    if deferred.is_none() {
+        return;
+    }
+    *idle += 1;
+    if *idle > DEFERRED_KEPT_FRAMES {
+        if let Some(mut d) = deferred.take() {
+            d.destroy(dev);
+        }
+    }
+}
+
 /// Why deferred cannot render this frame, if it cannot: no G-buffer on this context, or the
 /// frame is drawn into the renderer's multisampled target, which deferred does not support.
 fn deferred_refusal(ctx: &FrameContext) -> Option<String> {
@@ -134,9 +158,7 @@ impl ShadingMethod for Auto {
             match clustered.render_unless_too_many(ctx)? {
                 CulledFrame::Rendered(mut stats) => {
                     self.forward.destroy(ctx.dev);
-                    if let Some(mut d) = self.deferred.take() {
-                        d.destroy(ctx.dev);
-                    }
+                    retire_deferred(&mut self.deferred, &mut self.deferred_idle, ctx.dev);
                     stats.auto_choice = Some((choice, &self.reason));
                     return Ok(stats);
                 }
@@ -164,13 +186,12 @@ impl ShadingMethod for Auto {
                     }
                     let mut stats = if instead == "deferred" {
                         self.forward.destroy(ctx.dev);
+                        self.deferred_idle = 0;
                         self.deferred
                             .get_or_insert_with(Deferred::default)
                             .render(ctx)?
                     } else {
-                        if let Some(mut d) = self.deferred.take() {
-                            d.destroy(ctx.dev);
-                        }
+                        retire_deferred(&mut self.deferred, &mut self.deferred_idle, ctx.dev);
                         self.forward.render(ctx)?
                     };
                     stats.auto_choice = Some((instead, &self.reason));
@@ -181,7 +202,7 @@ impl ShadingMethod for Auto {
         if let Some(mut c) = self.clustered.take() {
             c.destroy(ctx.dev);
         }
-        self.destroy_deferred(ctx.dev);
+        retire_deferred(&mut self.deferred, &mut self.deferred_idle, ctx.dev);
         let mut stats = self.forward.render(ctx)?;
         stats.auto_choice = Some((choice, &self.reason));
         Ok(stats)
