@@ -204,6 +204,19 @@ impl Renderer {
         self.method.name()
     }
 
+    /// Whether `method` runs on this renderer's context, without switching to it: supported,
+    /// with a fallback (the reason names the degradation), or not (the reason names what is
+    /// missing). `Method::ALL` filtered by it lists what a device can run.
+    pub fn support(&self, method: Method) -> Support {
+        methods::METHODS
+            .iter()
+            .find(|m| m.name == method.name())
+            .map_or_else(
+                || Support::Unsupported(format!("no method `{}`", method.name())),
+                |m| (m.supported)(self.dev.caps()),
+            )
+    }
+
     /// Switches method. Unsupported methods are an error naming what is missing; a fallback
     /// is returned as `Some(reason)` (also logged as a warning). The previous method's GPU
     /// resources are freed.
@@ -219,8 +232,6 @@ impl Renderer {
 
     /// [`Renderer::set_method_named`] with the application's GL state saved.
     fn switch_method(&mut self, name: &str) -> Result<Option<String>, Error> {
-        // An explicit choice replaces what the default method would have warned about.
-        let unannounced = self.pending_warning.take().is_some();
         let desc = methods::find(name)?;
         let support = (desc.supported)(self.dev.caps());
         if let Support::Unsupported(reason) = &support {
@@ -236,6 +247,9 @@ impl Renderer {
                 runnable: runnable.join(", "),
             });
         }
+        // An explicit choice replaces what the default method would have warned about (a
+        // refused one above does not: the default method stays).
+        let unannounced = self.pending_warning.take().is_some();
         let switching = desc.name != self.method.name();
         if switching {
             let new = (desc.create)(&self.dev)?;

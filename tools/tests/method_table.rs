@@ -167,3 +167,44 @@ fn auto_renders_with_forward_past_the_index_limit_on_es2() {
     );
     assert!(manylight::metrics::diff(&reference, &img).max_abs <= 2);
 }
+
+/// `Renderer::support` answers for every method without switching, as the table does; a
+/// refused `set_method` leaves the default method, and the warning about its fallback still
+/// reaches the log at the first frame.
+#[test]
+fn support_answers_without_switching_and_a_refusal_keeps_the_default_methods_warning() {
+    use common::warnings::warnings_containing;
+    use manylight::Method;
+    let restrictions = manylight::Restrictions {
+        no_fragment_highp: true,
+        ..Default::default()
+    };
+    let mut gpu = Gpu::restricted(EsVersion::Es2, &restrictions);
+    let caps = gpu.r().caps().clone();
+    for m in Method::ALL {
+        let row = METHODS.iter().find(|d| d.name == m.name()).unwrap();
+        assert_eq!(gpu.r().support(m), (row.supported)(&caps), "{m:?}");
+    }
+    assert!(matches!(
+        gpu.r().support(Method::Deferred),
+        Support::Unsupported(_)
+    ));
+    assert!(matches!(
+        gpu.r().support(Method::Forward),
+        Support::Supported | Support::Fallback(_)
+    ));
+    let default = gpu.r().method();
+    let warning = format!("method `{default}` runs with a fallback");
+    assert!(gpu.r().set_method(Method::Deferred).is_err());
+    assert_eq!(
+        gpu.r().method(),
+        default,
+        "a refused method switches nothing"
+    );
+    let before = warnings_containing(&warning).len();
+    let s = scene::builtin::build("plane", Some((4, 1))).unwrap();
+    gpu.r()
+        .render_offscreen(&s, 32, 18, &RenderOptions::default())
+        .unwrap();
+    assert_eq!(warnings_containing(&warning).len(), before + 1, "{warning}");
+}
