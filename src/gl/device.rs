@@ -348,6 +348,40 @@ impl Device {
         encoding == Some(Some(glow::SRGB as i32))
     }
 
+    /// Samples per pixel of the bound framebuffer (`GL_SAMPLES`: 0 for a single-sampled
+    /// one, and where the driver would not say).
+    pub(crate) fn bound_samples(&self) -> i32 {
+        let samples = unsafe { self.gl.get_parameter_i32(glow::SAMPLES) };
+        if self.drain_errors() == glow::NO_ERROR {
+            samples
+        } else {
+            0
+        }
+    }
+
+    /// Whether the bound framebuffer's colour is 8-bit normalized RGBA (`RGBA8` or
+    /// `SRGB8_ALPHA8`): what an ES 3.0 multisample resolve may blit into, which needs identical
+    /// formats. False where it is not (`RGB8`, `RGB565`: a window surface without alpha) and
+    /// where the driver would not say.
+    pub(crate) fn bound_color_is_rgba8(&self) -> bool {
+        if self.caps.desktop || !self.caps.context_has_es3_state() {
+            return false;
+        }
+        let colour = [glow::COLOR_ATTACHMENT0, glow::BACK];
+        let sizes = [
+            glow::FRAMEBUFFER_ATTACHMENT_RED_SIZE,
+            glow::FRAMEBUFFER_ATTACHMENT_GREEN_SIZE,
+            glow::FRAMEBUFFER_ATTACHMENT_BLUE_SIZE,
+            glow::FRAMEBUFFER_ATTACHMENT_ALPHA_SIZE,
+        ];
+        let normalized = self.bound_attachment(colour, glow::FRAMEBUFFER_ATTACHMENT_COMPONENT_TYPE)
+            == Some(Some(glow::UNSIGNED_NORMALIZED as i32));
+        normalized
+            && sizes
+                .iter()
+                .all(|&size| self.bound_attachment(colour, size) == Some(Some(8)))
+    }
+
     /// The depth bits of the bound framebuffer (0: no depth buffer); `None` where the driver
     /// would not say. ES 2.0 asks `GL_DEPTH_BITS`; ES 3.0 and desktop core (which dropped that
     /// query) ask the depth attachment.

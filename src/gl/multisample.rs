@@ -36,9 +36,9 @@ pub struct MultisampleTarget {
     color_format: u32,
     /// Bytes of one depth sample.
     depth_bytes: usize,
-    /// ES 3.0, resolving to an origin other than (0, 0): a single-sampled copy the samples are
-    /// resolved into first, made when first needed (GL blits a multisampled source only onto
-    /// the same rectangle).
+    /// ES 3.0, resolving to an origin other than (0, 0) or into another colour format: a
+    /// single-sampled copy the samples are resolved into first, made when first needed (GL
+    /// blits a multisampled source only onto the same rectangle of the same format).
     resolved_copy: Option<(glow::Framebuffer, glow::Renderbuffer)>,
     /// A full-screen triangle: ES 2.0's resolve draws with it (made with the target), and
     /// [`MultisampleTarget::fill`] (made when first needed).
@@ -295,8 +295,10 @@ impl MultisampleTarget {
 
     /// Resolves the samples into the target-sized rectangle at `origin` of the framebuffer
     /// `into` (`None`: the default one): each pixel the average of its samples. Leaves `into`
-    /// bound. ES 3.0 blits, so the destination's colour format must be RGBA8, or SRGB8_ALPHA8
-    /// for a target made sRGB (a multisample resolve needs identical formats); ES 2.0 draws the averaged texture over it with a
+    /// bound. ES 3.0 blits: straight into `into` where `same_format` (its colour is RGBA8, or
+    /// SRGB8_ALPHA8 for a target made sRGB: a multisample resolve needs identical formats) and
+    /// `origin` is (0, 0), else through a single-sampled copy, whose blit converts to any
+    /// normalized format (`RGB8`, `RGB565`); ES 2.0 draws the averaged texture over it with a
     /// program from `programs`.
     pub fn resolve(
         &mut self,
@@ -304,11 +306,12 @@ impl MultisampleTarget {
         programs: &mut ProgramCache,
         into: Option<glow::Framebuffer>,
         origin: [u32; 2],
+        same_format: bool,
     ) -> Result<(), GlError> {
         let (w, h) = (self.size.0 as i32, self.size.1 as i32);
         let colour = glow::COLOR_BUFFER_BIT;
         match &self.color {
-            Color::Renderbuffer(_) if origin == [0, 0] => {
+            Color::Renderbuffer(_) if origin == [0, 0] && same_format => {
                 dev.blit(self.fbo, into, self.size, [0, 0], colour)
             }
             Color::Renderbuffer(_) => {
@@ -331,10 +334,7 @@ impl MultisampleTarget {
                 triangle.expect("made with the ES 2.0 target").draw(dev);
             }
         }
-        dev.check(
-            "MSAA resolve (ES 3.0: the destination must be RGBA8 or SRGB8_ALPHA8 and hold the \
-             frame)",
-        )
+        dev.check("MSAA resolve (the destination must be single-sampled and hold the frame)")
     }
 
     /// Draws `color` (linear: the target encodes it) over every sample of the bound target,

@@ -83,11 +83,21 @@ impl Renderer {
         // Before MSAA's target is made: its refusal would hide the option's error.
         check_options(options)?;
         // Light counts are exact per pixel: never averaged over samples.
-        let samples = if options.count == CountKind::None {
+        let mut samples = if options.count == CountKind::None {
             options.samples.max(1)
         } else {
             1
         };
+        // A game's multisampled framebuffer (a window surface with EGL_SAMPLES) samples the
+        // frame itself; a resolve could not blit into it.
+        let destination_samples = if applications {
+            self.dev.bound_samples()
+        } else {
+            0
+        };
+        if destination_samples > 0 {
+            samples = 1;
+        }
         if applications {
             self.check_bound_target(width, height, samples <= 1)?;
         }
@@ -103,9 +113,12 @@ impl Renderer {
             });
         }
         if samples <= 1 {
-            return self.render_frame(scene, (width, height), options, origin, stats);
+            self.render_frame(scene, (width, height), options, origin, stats)?;
+            stats.samples = stats.samples.max(destination_samples as u32);
+            return Ok(());
         }
         let destination = self.dev.bound_framebuffer();
+        let same_format = self.dev.bound_color_is_rgba8();
         let format = if options.hdr {
             ColorFormat::Rgba16F
         } else {
@@ -125,7 +138,13 @@ impl Renderer {
         let msaa = self.msaa.as_mut().expect("created by prepare_msaa");
         match rendered {
             Ok(()) => {
-                msaa.resolve(&self.dev, &mut self.programs, destination, origin)?;
+                msaa.resolve(
+                    &self.dev,
+                    &mut self.programs,
+                    destination,
+                    origin,
+                    same_format,
+                )?;
                 stats.samples = msaa.samples_drawn();
                 stats.memory.msaa_bytes = msaa.gpu_bytes();
                 Ok(())
