@@ -58,8 +58,10 @@ pub struct RenderOptions {
     /// Samples per pixel: 1 (the default) or 0 for none, up to `GL_MAX_SAMPLES` for MSAA (GL
     /// rounds a count the implementation lacks up: `FrameStats::samples` says what it drew).
     /// The frame is drawn into the renderer's multisampled target and resolved into the
-    /// framebuffer that was bound (ES 3.0; forward, tiled, clustered and auto; not deferred, not
-    /// HDR output; light counts are never multisampled).
+    /// framebuffer that was bound, whose depth buffer it leaves as it was (ES 3.0, and ES 2.0
+    /// with `GL_EXT_multisampled_render_to_texture`; forward, tiled, clustered and auto; not
+    /// deferred, not HDR output; light counts are never multisampled). A bound framebuffer
+    /// that is multisampled itself is drawn into directly.
     pub samples: u32,
     /// Where the frame's lower-left corner lies in the bound framebuffer, in pixels:
     /// [`Renderer::render`](crate::Renderer::render) draws into the `width × height` rectangle
