@@ -250,7 +250,9 @@ impl AutoGrid {
         });
         if !same_geometry {
             let key: GeometryKey = scene.objects.iter().map(identity).collect();
-            self.caster = Some((key, SceneRaycaster::new(scene)));
+            // Moved objects keep their meshes' hierarchies: only the top level is rebuilt.
+            let previous = self.caster.take().map(|(_, caster)| caster);
+            self.caster = Some((key, SceneRaycaster::rebuilt(previous, scene)));
         }
         let caster = &self.caster.as_ref().expect("built above").1;
         let (w, h) = ctx.viewport;

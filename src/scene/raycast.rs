@@ -94,6 +94,8 @@ pub struct SceneRaycaster {
     /// Placed objects in the top level's leaf order.
     instances: Vec<Instance>,
     nodes: Vec<Node>,
+    /// Mesh hierarchies built by its construction, not kept from a previous caster.
+    meshes_built: usize,
 }
 
 /// The best hits of one search.
@@ -131,13 +133,32 @@ enum Frame<'a> {
 impl SceneRaycaster {
     /// Builds one hierarchy per distinct mesh and one over the placed objects.
     pub fn new(scene: &Scene) -> Self {
+        Self::rebuilt(None, scene)
+    }
+
+    /// [`SceneRaycaster::new`], keeping `previous`'s hierarchy of every mesh the scene still
+    /// places: objects that move rebuild only the level over the placed objects. (A kept
+    /// hierarchy holds its mesh's `Arc`, so the mesh it is found by cannot have been freed and
+    /// its address reused.)
+    pub fn rebuilt(previous: Option<SceneRaycaster>, scene: &Scene) -> Self {
+        let mut kept: HashMap<*const Mesh, MeshBvh> = previous
+            .map(|p| p.meshes)
+            .unwrap_or_default()
+            .into_iter()
+            .map(|m| (Arc::as_ptr(&m.mesh), m))
+            .collect();
         let mut meshes: Vec<MeshBvh> = Vec::new();
         let mut mesh_index: HashMap<*const Mesh, u32> = HashMap::new();
+        let mut meshes_built = 0;
         let mut instances = Vec::new();
         let mut boxes = Vec::new();
         for (object, o) in scene.objects.iter().enumerate() {
-            let mesh = *mesh_index.entry(Arc::as_ptr(&o.mesh)).or_insert_with(|| {
-                meshes.push(MeshBvh::new(&o.mesh));
+            let key = Arc::as_ptr(&o.mesh);
+            let mesh = *mesh_index.entry(key).or_insert_with(|| {
+                meshes.push(kept.remove(&key).unwrap_or_else(|| {
+                    meshes_built += 1;
+                    MeshBvh::new(&o.mesh)
+                }));
                 (meshes.len() - 1) as u32
             });
             let Some(root) = meshes[mesh as usize].nodes.first() else {
@@ -162,7 +183,13 @@ impl SceneRaycaster {
             meshes,
             instances,
             nodes,
+            meshes_built,
         }
+    }
+
+    /// How many mesh hierarchies its construction built (the rest were kept).
+    pub fn meshes_built(&self) -> usize {
+        self.meshes_built
     }
 
     /// Number of triangles placed (each object's mesh counted once per placement).

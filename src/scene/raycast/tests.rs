@@ -395,3 +395,41 @@ fn pixel_ray_through_the_centre_points_at_the_target() {
         assert!((o_left - o).dot(forward.cross(DVec3::Y)) < 0.0); // column 0 is the left
     }
 }
+
+/// Rebuilding after objects moved keeps every mesh's hierarchy (one built for a new mesh
+/// only) and casts what a caster built from scratch casts.
+#[test]
+fn a_rebuild_keeps_the_hierarchies_of_the_meshes_still_placed() {
+    let shared = Arc::new(triangle_at(0.0));
+    let mut scene = scene_of(vec![(triangle_at(-1.0), DMat4::IDENTITY)]);
+    for x in [-2.0, 2.0] {
+        scene.objects.push(Object {
+            mesh: shared.clone(),
+            material: 0,
+            transform: DMat4::from_translation(DVec3::new(x, 0.0, -4.0)),
+        });
+    }
+    let first = SceneRaycaster::new(&scene);
+    assert_eq!(first.meshes_built(), 2, "two distinct meshes");
+    scene.objects[1].transform = DMat4::from_translation(DVec3::new(-2.0, 1.0, -6.0));
+    let moved = SceneRaycaster::rebuilt(Some(first), &scene);
+    assert_eq!(moved.meshes_built(), 0);
+    let fresh = SceneRaycaster::new(&scene);
+    let mut rng = rand::rngs::StdRng::seed_from_u64(5);
+    for _ in 0..200 {
+        let dir = DVec3::new(
+            rng.random_range(-0.6..0.6),
+            rng.random_range(-0.6..0.6),
+            -1.0,
+        );
+        let (a, b) = (
+            moved.hit(DVec3::Z * 3.0, dir),
+            fresh.hit(DVec3::Z * 3.0, dir),
+        );
+        assert_eq!(a.map(|h| h.position), b.map(|h| h.position), "{dir}");
+    }
+    // A mesh replaced by a new one is built; the one no object places any more is dropped.
+    scene.objects[0].mesh = Arc::new(triangle_at(-2.0));
+    let replaced = SceneRaycaster::rebuilt(Some(moved), &scene);
+    assert_eq!((replaced.meshes_built(), replaced.mesh_count()), (1, 2));
+}
