@@ -1,5 +1,6 @@
 //! GPU frame timing with `GL_EXT_disjoint_timer_query` (a `TIME_ELAPSED` query around the
-//! frame's GL work), where the context has it. The timer is optional: without the extension,
+//! frame's GL work), where the context has it: read at once by a frame that waits for the GPU
+//! anyway, and a few frames later, when finished, by one that does not (a game's). The timer is optional: without the extension,
 //! when the GPU reports a disjoint event (a clock change or a context switch invalidates the
 //! figure), or when the driver refuses the query object or a query call, there is no GPU time
 //! (`gpu_ms` absent) and callers fall back to wall time around `glFinish`. A refusal is a
@@ -30,19 +31,30 @@ const GPU_DISJOINT: u32 = 0x8FBB;
 /// `GL_QUERY_RESULT_EXT`.
 const QUERY_RESULT: u32 = 0x8866;
 
-/// One elapsed-time query, reused frame after frame.
+/// Queries in the ring: a frame that does not wait reads its result up to this many frames
+/// later (a GPU runs two or three frames behind the CPU at most).
+pub const RING: usize = 4;
+
+/// `GL_QUERY_RESULT_AVAILABLE_EXT`.
+const QUERY_RESULT_AVAILABLE: u32 = 0x8867;
+
+/// A ring of elapsed-time queries, reused frame after frame. A frame that waits for the GPU
+/// reads its own query at once; one that does not leaves it in flight and reads the finished
+/// ones later, without stalling ([`GpuTimer::poll`]).
 pub struct GpuTimer {
     fns: TimerQueryFns,
-    query: u32,
+    queries: [u32; RING],
+    /// The frame each query times, while its result is unread (`None`: free).
+    in_flight: [Cell<Option<u64>>; RING],
+    /// The query between `begin` and `end`: a frame that panicked in between left it running.
+    running: Cell<Option<usize>>,
     /// Set when the driver refused a query call: the timer then stays off (warned once).
     failed: Cell<bool>,
-    /// Between `begin` and `end`: a frame that panicked in between left the query running.
-    active: Cell<bool>,
 }
 
 impl GpuTimer {
     /// A timer, or `None` when the context has no `GL_EXT_disjoint_timer_query` or cannot
-    /// make the query object (warned: the frame goes on untimed).
+    /// make the query objects (warned: the frame goes on untimed).
     pub fn new(dev: &Device) -> Option<GpuTimer> {
         if !dev.caps().timer_query {
             return None;
@@ -51,60 +63,116 @@ impl GpuTimer {
             log::warn!("GL_EXT_disjoint_timer_query is listed but its entry points are missing: no GPU time (gpu_ms absent)");
             return None;
         };
-        let mut query = 0u32;
-        // SAFETY: the extension's signature, one name written into `query`.
-        unsafe { (fns.gen_queries)(1, &mut query) };
+        let mut queries = [0u32; RING];
+        // SAFETY: the extension's signature, RING names written into `queries`.
+        unsafe { (fns.gen_queries)(RING as i32, queries.as_mut_ptr()) };
         let error = dev.drain_errors();
-        if query == 0 || error != glow::NO_ERROR {
+        if queries.contains(&0) || error != glow::NO_ERROR {
             log::warn!(
-                "the driver could not create a timer query (GL error {error:#06x}): no GPU time (gpu_ms absent)"
+                "the driver could not create timer queries (GL error {error:#06x}): no GPU time (gpu_ms absent)"
             );
-            if query != 0 {
-                unsafe { (fns.delete_queries)(1, &query) };
+            for query in queries.iter().filter(|&&q| q != 0) {
+                unsafe { (fns.delete_queries)(1, query) };
             }
             return None;
         }
         Some(GpuTimer {
             fns,
-            query,
+            queries,
+            in_flight: Default::default(),
+            running: Cell::new(None),
             failed: Cell::new(false),
-            active: Cell::new(false),
         })
     }
 
-    /// Starts timing (clears a pending disjoint flag first, so only this frame's counts).
-    pub fn begin(&self, dev: &Device) {
+    /// Starts timing frame `serial` on a free query; a frame finds none when every query is
+    /// still in flight, and goes untimed.
+    pub fn begin(&self, dev: &Device, serial: u64) {
         if self.failed.get() {
             return;
         }
-        if self.active.replace(false) {
+        if let Some(slot) = self.running.take() {
             // Left running by a frame that panicked (and was caught): ended unread, or this
             // begin would be refused and the timer turned off.
             unsafe { (self.fns.end_query)(TIME_ELAPSED) };
             dev.drain_errors();
+            self.in_flight[slot].set(None);
         }
-        unsafe {
-            dev.gl.get_parameter_i32(GPU_DISJOINT);
-            (self.fns.begin_query)(TIME_ELAPSED, self.query);
+        self.take_disjoint(dev);
+        let Some(slot) = self.in_flight.iter().position(|f| f.get().is_none()) else {
+            return;
+        };
+        unsafe { (self.fns.begin_query)(TIME_ELAPSED, self.queries[slot]) };
+        if self.check(dev, "glBeginQueryEXT") {
+            self.running.set(Some(slot));
+            self.in_flight[slot].set(Some(serial));
         }
-        self.active.set(self.check(dev, "glBeginQueryEXT"));
     }
 
-    /// Stops timing and waits for the result: GPU milliseconds, or `None` when the GPU
-    /// reported a disjoint event or the driver refused the query. Call after the frame's work
-    /// is submitted (it waits).
-    pub fn end(&self, dev: &Device) -> Option<f64> {
+    /// Stops timing. `wait`: reads the result now, waiting for it (call after the frame's
+    /// work is submitted): GPU milliseconds, or `None` when the GPU reported a disjoint event
+    /// or the driver refused the query. Otherwise the query stays in flight for
+    /// [`GpuTimer::poll`], and this returns `None`.
+    pub fn end(&self, dev: &Device, wait: bool) -> Option<f64> {
+        let slot = self.running.take()?;
         if self.failed.get() {
             return None;
         }
-        self.active.set(false);
-        let mut ns = 0u64;
-        let disjoint = unsafe {
-            (self.fns.end_query)(TIME_ELAPSED);
-            (self.fns.get_query_object_ui64v)(self.query, QUERY_RESULT, &mut ns);
-            dev.gl.get_parameter_i32(GPU_DISJOINT) != 0
-        };
-        (self.check(dev, "the timer query's result") && !disjoint).then_some(ns as f64 * 1e-6)
+        unsafe { (self.fns.end_query)(TIME_ELAPSED) };
+        if !wait {
+            self.check(dev, "glEndQueryEXT");
+            return None;
+        }
+        self.in_flight[slot].set(None);
+        let ns = self.result(slot, QUERY_RESULT);
+        let valid = self.check(dev, "the timer query's result") && !self.take_disjoint(dev);
+        valid.then_some(ns as f64 * 1e-6)
+    }
+
+    /// The newest finished frame whose query was left in flight: its serial and GPU
+    /// milliseconds, read without waiting; `None` while none has finished, and when the GPU
+    /// reported a disjoint event (every result in flight is then dropped).
+    pub fn poll(&self, dev: &Device) -> Option<(u64, f64)> {
+        if self.failed.get() {
+            return None;
+        }
+        let mut newest: Option<(u64, f64)> = None;
+        for (slot, flight) in self.in_flight.iter().enumerate() {
+            let Some(serial) = flight.get() else { continue };
+            if self.running.get() == Some(slot) || self.result(slot, QUERY_RESULT_AVAILABLE) == 0 {
+                continue;
+            }
+            flight.set(None);
+            let ms = self.result(slot, QUERY_RESULT) as f64 * 1e-6;
+            if newest.is_none_or(|(s, _)| serial > s) {
+                newest = Some((serial, ms));
+            }
+        }
+        if !self.check(dev, "the timer query's result") || self.take_disjoint(dev) {
+            return None;
+        }
+        newest
+    }
+
+    /// `pname` of query `slot`.
+    fn result(&self, slot: usize, pname: u32) -> u64 {
+        let mut value = 0u64;
+        unsafe { (self.fns.get_query_object_ui64v)(self.queries[slot], pname, &mut value) };
+        value
+    }
+
+    /// Reads (and so clears) the disjoint flag; when it was set, every result in flight is
+    /// unreliable and dropped, except the running query's (begun after the flag was read).
+    fn take_disjoint(&self, dev: &Device) -> bool {
+        let disjoint = unsafe { dev.gl.get_parameter_i32(GPU_DISJOINT) } != 0;
+        if disjoint {
+            for (slot, flight) in self.in_flight.iter().enumerate() {
+                if self.running.get() != Some(slot) {
+                    flight.set(None);
+                }
+            }
+        }
+        disjoint
     }
 
     /// False (and the timer off from now on, warned) when the last calls raised a GL error.
@@ -121,8 +189,8 @@ impl GpuTimer {
         false
     }
 
-    /// Frees the query.
+    /// Frees the queries.
     pub fn destroy(self, _dev: &Device) {
-        unsafe { (self.fns.delete_queries)(1, &self.query) };
+        unsafe { (self.fns.delete_queries)(RING as i32, self.queries.as_ptr()) };
     }
 }

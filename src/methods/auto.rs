@@ -208,9 +208,9 @@ impl ShadingMethod for Auto {
         Ok(stats)
     }
 
-    fn observe_frame(&mut self, frame_ms: Option<f64>, gpu_ms: Option<f64>) {
+    fn observe_frame(&mut self, timing: super::FrameTiming) {
         if let Some(c) = &mut self.clustered {
-            c.observe_frame(frame_ms, gpu_ms);
+            c.observe_frame(timing);
         }
     }
 

@@ -4,13 +4,14 @@
 
 use glam::{DMat4, DVec3, DVec4};
 
-use super::FrameContext;
+use super::{FrameContext, FrameTiming};
 use crate::cluster::assign::{AssignLimits, Assigner};
 use crate::cluster::auto_grid::{
     self, ChoiceInputs, ChoiceSearch, FrameCost, GridChoice, GridCosts, SurfaceSamples,
 };
 use crate::cluster::grid::{ClusterGrid, GridConfig, GridProjection};
 use crate::cluster::pack::GridEncoding;
+use crate::gl::timer::RING as TIMER_RING;
 use crate::scene::raycast::SceneRaycaster;
 
 /// Rays of the surface sample, across and down (1 296 rays).
@@ -40,6 +41,11 @@ struct Layout {
     base: GridConfig,
 }
 
+/// A frame's slot in [`AutoGrid`]'s ring of recent evaluations.
+fn ring_slot(serial: u64) -> usize {
+    (serial % TIMER_RING as u64) as usize
+}
+
 /// The automatic grid's state across frames.
 #[derive(Default)]
 pub(crate) struct AutoGrid {
@@ -56,6 +62,9 @@ pub(crate) struct AutoGrid {
     caster: Option<(GeometryKey, SceneRaycaster)>,
     /// The frame rendered and not yet observed.
     pending: Option<FrameCost>,
+    /// The last observed frames' numbers and light evaluations, by number modulo the ring:
+    /// what a GPU time read a few frames later is set against.
+    recent_evals: [Option<(u64, f64)>; TIMER_RING],
     /// The current frame measured a candidate: its time holds the candidate's assignment (and
     /// on the first frame shader compiles), so it calibrates nothing.
     chose_this_frame: bool,
@@ -213,20 +222,36 @@ impl AutoGrid {
     }
 
     /// Takes the frame's time in and calibrates the costs: the wall time less the CPU work
-    /// when the frame waited for the GPU (`frame_ms`), else the GPU timer's. The wall time
-    /// wins where both exist: it bounds the GPU's work from above, while some timers
+    /// when the frame waited for the GPU, else the GPU timer's, which for a frame that did
+    /// not wait arrives a few frames later and is set against that frame's evaluations. The
+    /// wall time wins where both exist: it bounds the GPU's work from above, while some timers
     /// (llvmpipe's) undercount a frame that samples textures in the fragment loop.
-    pub(crate) fn observe(&mut self, frame_ms: Option<f64>, gpu_ms: Option<f64>) {
-        let Some(mut cost) = self.pending.take() else {
+    pub(crate) fn observe(&mut self, timing: FrameTiming) {
+        let serial = timing.serial;
+        if let Some(mut cost) = self.pending.take() {
+            let own_gpu = timing.gpu.filter(|&(s, _)| s == serial).map(|(_, ms)| ms);
+            // Without either (a frame that did not wait, its GPU time not read yet or never,
+            // on a device without timer queries) the shading is not measured, but the CPU's
+            // assignment and uploads are.
+            cost.shade_ms = timing
+                .waited_ms
+                .map(|ms| ms - cost.assign_ms - cost.upload_ms)
+                .or(own_gpu)
+                .unwrap_or(f64::NAN);
+            self.costs.observe(&cost);
+            self.recent_evals[ring_slot(serial)] = Some((serial, cost.evals));
+        }
+        if timing.waited_ms.is_some() {
+            return;
+        }
+        let Some((earlier, ms)) = timing.gpu.filter(|&(s, _)| s != serial) else {
             return;
         };
-        // Without either (a frame that did not wait for the GPU on a device without timer
-        // queries) the shading is not measured, but the CPU's assignment and uploads are.
-        cost.shade_ms = frame_ms
-            .map(|ms| ms - cost.assign_ms - cost.upload_ms)
-            .or(gpu_ms)
-            .unwrap_or(f64::NAN);
-        self.costs.observe(&cost);
+        if let Some((s, evals)) = self.recent_evals[ring_slot(earlier)] {
+            if s == earlier {
+                self.costs.observe_shading(ms, evals);
+            }
+        }
     }
 
     /// Casts the frame's sample rays into `self.samples` (its buffer reused): the surface
@@ -316,7 +341,51 @@ pub(crate) fn write_fixed_reason(out: &mut String, config: &GridConfig) {
 
 #[cfg(test)]
 mod tests {
-    use super::first_calibrated;
+    use super::{first_calibrated, AutoGrid, FrameCost, FrameTiming};
+
+    fn rendered(auto: &mut AutoGrid, evals: f64) {
+        auto.pending = Some(FrameCost {
+            evals,
+            assign_ms: 0.5,
+            assign_work: 1e4,
+            ..FrameCost::default()
+        });
+    }
+
+    /// A frame that does not wait calibrates the shading from its GPU time read frames later,
+    /// set against that frame's evaluations, not the current one's.
+    #[test]
+    fn a_gpu_time_read_later_calibrates_against_its_own_frame() {
+        let mut auto = AutoGrid::default();
+        let prior = auto.costs.shade_ns;
+        let timing = |serial, gpu| FrameTiming {
+            serial,
+            waited_ms: None,
+            gpu,
+        };
+        // Frames 1 and 2: no GPU time yet; only the assignment is measured.
+        rendered(&mut auto, 2e6);
+        auto.observe(timing(1, None));
+        rendered(&mut auto, 4e6);
+        auto.observe(timing(2, None));
+        assert_eq!(auto.costs.shade_ns, prior);
+        assert_eq!(auto.costs.assign_ns, 50.0);
+        // Frame 3 reads frame 1's: 10 ms over 2e6 evaluations is 5 ns each.
+        rendered(&mut auto, 8e6);
+        auto.observe(timing(3, Some((1, 10.0))));
+        assert_eq!(auto.costs.shade_ns, 5.0);
+        // A time of a frame the ring no longer holds (or never observed) is dropped.
+        rendered(&mut auto, 8e6);
+        auto.observe(timing(9, Some((5, 80.0))));
+        assert_eq!(auto.costs.shade_ns, 5.0);
+        // A frame's own GPU time counts for that frame.
+        rendered(&mut auto, 1e6);
+        auto.observe(timing(10, Some((10, 7.0))));
+        assert!(
+            (auto.costs.shade_ns - 6.0).abs() < 1e-9,
+            "median of 5 and 7"
+        );
+    }
 
     /// The hysteresis is skipped once, for the first calibrated choice after the priors' one,
     /// and never while no frame calibrates (a game that does not wait for the GPU on a device

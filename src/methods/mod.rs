@@ -42,6 +42,18 @@ pub enum Support {
     Unsupported(String),
 }
 
+/// What a frame's timing says, for a method's cost model ([`ShadingMethod::observe_frame`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct FrameTiming {
+    /// The frame's number, counted by the renderer.
+    pub serial: u64,
+    /// Wall time of a frame that waited for the GPU (`None` when it did not).
+    pub waited_ms: Option<f64>,
+    /// GPU time of this frame, or of an earlier one read when it finished: that frame's
+    /// number and milliseconds.
+    pub gpu: Option<(u64, f64)>,
+}
+
 /// Everything a method needs for one frame.
 pub struct FrameContext<'a> {
     /// The GL device.
@@ -137,10 +149,10 @@ pub trait ShadingMethod {
     fn light_lists(&self) -> Option<LightLists<'_>> {
         None
     }
-    /// The whole frame's time after it finished (`frame_ms`: wall time including the GPU's
-    /// work, only when the frame waited for it; `gpu_ms` from a timer query): methods that
-    /// calibrate a cost model take it in.
-    fn observe_frame(&mut self, _frame_ms: Option<f64>, _gpu_ms: Option<f64>) {}
+    /// The frame's time after it was submitted (wall time including the GPU's work when the
+    /// frame waited for it; GPU time from a timer query, this frame's or an earlier one's):
+    /// methods that calibrate a cost model take it in.
+    fn observe_frame(&mut self, _timing: FrameTiming) {}
     /// Frees the method's GPU resources.
     fn destroy(&mut self, dev: &Device);
 }

@@ -243,20 +243,17 @@ impl Renderer {
             order: &mut self.draw_order,
             transparent_only: false,
         };
-        // GPU time only where the frame waits anyway: reading the query result stalls.
-        let timer = if options.wait_for_gpu {
-            // The frame's errors so far are its own: the timer's calls (creating the query
-            // too) would drain them as theirs.
-            self.dev.check("the frame's uploads")?;
-            if self.timer.is_none() {
-                self.timer = Some(crate::gl::timer::GpuTimer::new(&self.dev));
-            }
-            self.timer.as_ref().and_then(Option::as_ref)
-        } else {
-            None
-        };
+        // The frame's errors so far are its own: the timer's calls (creating the queries too)
+        // would drain them as theirs.
+        self.dev.check("the frame's uploads")?;
+        if self.timer.is_none() {
+            self.timer = Some(crate::gl::timer::GpuTimer::new(&self.dev));
+        }
+        let timer = self.timer.as_ref().and_then(Option::as_ref);
+        self.frame_serial += 1;
+        let serial = self.frame_serial;
         if let Some(t) = timer {
-            t.begin(&self.dev);
+            t.begin(&self.dev, serial);
         }
         // No lights: no assignment, no uploads, the light loop compiled out — whatever the
         // method (a scene pays only for what it has).
@@ -271,7 +268,22 @@ impl Renderer {
             (Ok(stats), Some(_)) => self.dev.check("frame").map(|()| stats).map_err(Error::from),
             (other, _) => other,
         };
-        let gpu_ms = timer.and_then(|t| t.end(&self.dev));
+        // A frame that waits reads its own query; one that does not reads the newest that has
+        // finished, without stalling.
+        let wait = options.wait_for_gpu;
+        let gpu = match timer {
+            Some(t) if wait => {
+                let own = t.end(&self.dev, true);
+                t.poll(&self.dev); // frees queries earlier frames left in flight
+                own.map(|ms| (serial, ms))
+            }
+            Some(t) => {
+                t.end(&self.dev, false);
+                t.poll(&self.dev)
+            }
+            None => None,
+        };
+        let gpu_ms = gpu.map(|(_, ms)| ms);
         let method_stats = rendered?;
         if options.wait_for_gpu {
             self.dev.finish();
@@ -326,8 +338,11 @@ impl Renderer {
         // Only colour frames that waited for the GPU (or were timed on it) say what shading
         // costs: count passes run other shaders.
         if options.count == CountKind::None {
-            let waited = options.wait_for_gpu.then_some(frame_ms);
-            self.method.observe_frame(waited, gpu_ms);
+            self.method.observe_frame(methods::FrameTiming {
+                serial,
+                waited_ms: options.wait_for_gpu.then_some(frame_ms),
+                gpu,
+            });
         }
         stats.memory.method_gpu_bytes = self.method.gpu_bytes();
         Ok(())

@@ -78,7 +78,7 @@ fn a_frame_that_panicked_mid_query_leaves_gpu_timing_on() {
     let caught = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
         let _ = renderer.hosted(|r| -> Result<(), crate::Error> {
             if let Some(Some(timer)) = &r.timer {
-                timer.begin(&r.dev);
+                timer.begin(&r.dev, 0);
             }
             panic!("a bug between the query's begin and end");
         });
@@ -86,5 +86,37 @@ fn a_frame_that_panicked_mid_query_leaves_gpu_timing_on() {
     assert!(caught.is_err());
     let (_, stats) = renderer.render_offscreen(&scene, 16, 9, &options).unwrap();
     assert!(stats.time.gpu_ms.is_some(), "GPU timing turned off");
+    renderer.destroy();
+}
+
+/// A frame that does not wait for the GPU still gets GPU time: an earlier frame's, read once
+/// it finished, without stalling (a game's frames).
+#[test]
+fn frames_that_do_not_wait_report_the_gpu_time_of_a_finished_frame() {
+    let Some(ctx) = context_or_skip(EsVersion::Es3) else {
+        return;
+    };
+    let mut renderer = Renderer::new(ctx.load_gl().unwrap(), EsVersion::Es3).unwrap();
+    if !renderer.caps().timer_query {
+        eprintln!("skipped: no GL_EXT_disjoint_timer_query here");
+        return;
+    }
+    let scene = crate::scene::builtin::build("plane", Some((64, 1))).unwrap();
+    let options = crate::RenderOptions {
+        wait_for_gpu: false,
+        ..Default::default()
+    };
+    let timed: Vec<Option<f64>> = (0..12)
+        .map(|_| {
+            let (_, stats) = renderer.render_offscreen(&scene, 64, 36, &options).unwrap();
+            stats.time.gpu_ms
+        })
+        .collect();
+    let read = timed.iter().flatten().count();
+    assert!(read >= 6, "GPU times read: {timed:?}");
+    assert!(
+        timed.iter().flatten().all(|ms| ms.is_finite() && *ms > 0.0),
+        "{timed:?}"
+    );
     renderer.destroy();
 }

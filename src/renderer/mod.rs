@@ -49,6 +49,8 @@ pub struct Renderer {
     /// The GPU timer: `None` until first needed, then `Some(None)` where the context has no
     /// timer queries.
     timer: Option<Option<crate::gl::timer::GpuTimer>>,
+    /// Frames rendered: the number the GPU timer's results are matched to their frames by.
+    frame_serial: u64,
     /// What the default method's support would warn about: said at the first frame, unless
     /// the caller picks a method first (whose own support is then what is said).
     pending_warning: Option<String>,
@@ -122,6 +124,7 @@ impl Renderer {
             target: None,
             msaa: None,
             timer: None,
+            frame_serial: 0,
             pending_warning,
             freed: false,
             lights: Vec::new(),

@@ -72,8 +72,10 @@ pub struct TimeStats {
     /// Frame time in milliseconds: CPU work plus `glFinish` (median of the timed frames).
     pub frame_ms: f64,
     /// GPU time of the frame's GL work from a `GL_EXT_disjoint_timer_query` elapsed-time query
-    /// (median of the timed frames); `None` without the extension, when the GPU reported a
-    /// disjoint event, or when the frame does not wait for the GPU.
+    /// (median of the timed frames). A frame that does not wait for the GPU (a game's) reports
+    /// the newest earlier frame whose query has finished, read without stalling (a GPU runs a
+    /// frame or two behind). `None` without the extension, when the GPU reported a disjoint
+    /// event, and while no query has finished.
     pub gpu_ms: Option<f64>,
     /// CPU light-assignment time in milliseconds (0 for forward).
     pub assign_ms: f64,

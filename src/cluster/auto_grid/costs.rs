@@ -81,6 +81,16 @@ impl GridCosts {
         self.frames = self.frames.saturating_add(1);
     }
 
+    /// Takes in a shading time that arrived after its frame was observed (a GPU timer read
+    /// a few frames later): `shade_ms` for `evals` light evaluations, as
+    /// [`GridCosts::observe`] takes them. Counts no frame.
+    pub fn observe_shading(&mut self, shade_ms: f64, evals: f64) {
+        let ns = shade_ms * 1e6 / evals;
+        if evals > 0.0 && shade_ms > 0.0 && ns.is_finite() {
+            self.shade_ns = self.windows[0].push(ns);
+        }
+    }
+
     /// Predicted cost in milliseconds of `evals` light evaluations, `work` assignment units
     /// and `bytes` uploaded.
     pub fn predict_ms(&self, evals: f64, work: f64, bytes: f64) -> f64 {

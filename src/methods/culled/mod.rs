@@ -165,8 +165,8 @@ impl ShadingMethod for CulledForward {
         }
     }
 
-    fn observe_frame(&mut self, frame_ms: Option<f64>, gpu_ms: Option<f64>) {
-        self.auto.observe(frame_ms, gpu_ms);
+    fn observe_frame(&mut self, timing: super::FrameTiming) {
+        self.auto.observe(timing);
     }
 
     fn light_lists(&self) -> Option<super::LightLists<'_>> {
