@@ -177,7 +177,6 @@ fn support_answers_without_switching_and_a_refusal_keeps_the_default_methods_war
     use manylight::Method;
     let restrictions = manylight::Restrictions {
         no_fragment_highp: true,
-        ..Default::default()
     };
     let mut gpu = Gpu::restricted(EsVersion::Es2, &restrictions);
     let caps = gpu.r().caps().clone();
