@@ -312,6 +312,7 @@ pub fn parse(
     let mut report = LoadReport::default();
     let mut builtin_camera = None;
     let mut models = ModelCache::new(*options);
+    let mut meshes = model_cache::MeshCount::default();
     for (i, spec) in file.objects.iter().enumerate() {
         let field = format!("objects[{i}]");
         let transform = spec
@@ -418,7 +419,7 @@ pub fn parse(
                 (m.metallic, m.roughness) = (metallic, roughness);
             }
         }
-        model_cache::check_budget(&scene, &format!("objects[{i}]"))?;
+        model_cache::check_budget(&scene, &mut meshes, &format!("objects[{i}]"))?;
     }
     if let Some(a) = file.ambient {
         scene.ambient = narrow3("ambient", a)?;

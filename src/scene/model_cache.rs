@@ -24,6 +24,12 @@ use super::{Aabb, Material, Mesh, Object, Scene, SceneError, Texture};
 /// the automatic grid's ray caster), so the limit holds that near 600 MB.
 pub const MAX_SCENE_OBJECTS: usize = super::gltf::MAX_OBJECTS;
 
+/// Most distinct meshes a model file, or a scene file with all its references, may make: each
+/// has a fixed cost besides its data (its buffers and their GL objects, the automatic grid's
+/// ray-caster hierarchy; about 4.4 KB measured with llvmpipe), so the limit holds that near
+/// 300 MB. Objects placing one mesh many times cost far less ([`MAX_SCENE_OBJECTS`]).
+pub const MAX_SCENE_MESHES: usize = 1 << 16;
+
 /// Most materials a scene file may make (references that recolour a model copy its materials).
 pub const MAX_SCENE_MATERIALS: usize = 1 << 20;
 
@@ -396,10 +402,38 @@ fn same_mesh(a: &Mesh, b: &Mesh) -> bool {
         && a.tangents == b.tangents
 }
 
-/// Checks the scene's objects and materials against the scene-file limits after object
-/// `field` was placed.
-pub(super) fn check_budget(scene: &Scene, field: &str) -> Result<(), SceneError> {
-    check_counts(scene.objects.len(), scene.materials.len(), field)
+/// The distinct meshes a scene file's objects have made so far, counted as they are placed.
+#[derive(Default)]
+pub(super) struct MeshCount {
+    seen: std::collections::HashSet<*const Mesh>,
+    counted_objects: usize,
+}
+
+/// Checks the scene's objects, meshes and materials against the scene-file limits after
+/// object `field` was placed (`meshes` counts the objects placed since the last check).
+pub(super) fn check_budget(
+    scene: &Scene,
+    meshes: &mut MeshCount,
+    field: &str,
+) -> Result<(), SceneError> {
+    check_counts(scene.objects.len(), scene.materials.len(), field)?;
+    let new = scene
+        .objects
+        .get(meshes.counted_objects..)
+        .unwrap_or_default();
+    meshes.seen.extend(new.iter().map(|o| Arc::as_ptr(&o.mesh)));
+    meshes.counted_objects = scene.objects.len();
+    if meshes.seen.len() > MAX_SCENE_MESHES {
+        return Err(SceneError::invalid(
+            field,
+            format!(
+                "the scene would hold {} distinct meshes, more than the {MAX_SCENE_MESHES} a \
+                 scene file may make",
+                meshes.seen.len()
+            ),
+        ));
+    }
+    Ok(())
 }
 
 fn check_counts(objects: usize, materials: usize, field: &str) -> Result<(), SceneError> {
@@ -433,6 +467,45 @@ mod tests {
         );
         let err = check_counts(1, MAX_SCENE_MATERIALS + 1, "objects[9]").unwrap_err();
         assert!(err.to_string().contains("materials"), "{err}");
+    }
+
+    /// Distinct meshes are counted across the checks (each check sees only the objects placed
+    /// since the last), shared ones once; one past the limit is an error naming the object.
+    #[test]
+    fn distinct_meshes_past_the_budget_are_an_error_naming_the_object() {
+        let triangle = || {
+            let p = vec![glam::Vec3::ZERO, glam::Vec3::X, glam::Vec3::Y];
+            Arc::new(Mesh::new(p, vec![], vec![], vec![0, 1, 2]).unwrap())
+        };
+        let mut scene = Scene::empty();
+        let material = scene.add_material(Material::default());
+        let place = |scene: &mut Scene, mesh: Arc<Mesh>| {
+            scene.objects.push(Object {
+                mesh,
+                material,
+                transform: DMat4::IDENTITY,
+            })
+        };
+        let mut count = MeshCount::default();
+        let shared = triangle();
+        for _ in 0..3 {
+            place(&mut scene, shared.clone());
+        }
+        check_budget(&scene, &mut count, "objects[0]").unwrap();
+        for _ in 1..MAX_SCENE_MESHES {
+            place(&mut scene, triangle());
+        }
+        check_budget(&scene, &mut count, "objects[1]").unwrap();
+        place(&mut scene, shared.clone());
+        check_budget(&scene, &mut count, "objects[2]").unwrap();
+        place(&mut scene, triangle());
+        let err = check_budget(&scene, &mut count, "objects[3]").unwrap_err();
+        let text = err.to_string();
+        let over = format!("{} distinct meshes", MAX_SCENE_MESHES + 1);
+        assert!(
+            text.contains("objects[3]") && text.contains(&over),
+            "{text}"
+        );
     }
 
     /// A glTF `name` with a light (read for each reference) and one texture, in a data URI.

@@ -313,3 +313,34 @@ fn a_json_file_that_is_not_gltf_shows_none_of_its_strings() {
     let err = load(&path).unwrap_err().to_string();
     assert!(err.contains("missing field `asset`"), "{err}");
 }
+
+/// Distinct meshes each cost a fixed few KB besides their data: a small file listing more than
+/// `MAX_SCENE_MESHES` of them (one triangle's accessor shared by all) is refused naming the
+/// first one past the limit, before memory runs out; as many placements of one mesh load.
+#[test]
+fn more_distinct_meshes_than_the_limit_are_refused_naming_the_first_past_it() {
+    use manylight::scene::MAX_SCENE_MESHES;
+    let mut b = Builder::default();
+    let p = b.floats(&[0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0], "VEC3");
+    let n = MAX_SCENE_MESHES + 1;
+    let dir = tempfile::tempdir().unwrap();
+    let model = |meshes: usize| {
+        let mesh = json!({"primitives": [{"attributes": {"POSITION": p}}]});
+        b.gltf(json!({
+            "scene": 0,
+            "scenes": [{"nodes": (0..n).collect::<Vec<_>>()}],
+            "nodes": (0..n).map(|i| json!({"mesh": i % meshes})).collect::<Vec<_>>(),
+            "meshes": vec![mesh; meshes],
+        }))
+    };
+    let err = load(&write(dir.path(), "many.gltf", model(n)))
+        .unwrap_err()
+        .to_string();
+    let past = format!("meshes[{MAX_SCENE_MESHES}].primitives[0]");
+    assert!(
+        err.contains(&past) && err.contains(&MAX_SCENE_MESHES.to_string()),
+        "{err}"
+    );
+    let (scene, _) = load(&write(dir.path(), "shared.gltf", model(1))).unwrap();
+    assert_eq!(scene.objects.len(), n);
+}

@@ -712,3 +712,32 @@ fn lights_too_small_to_light_anything_are_named_at_load() {
         );
     }
 }
+
+/// Each OBJ object with faces (after `o`, `g` or a change of material) is a mesh of its own:
+/// more than `MAX_SCENE_MESHES` of them is refused before parsing, naming the line where the
+/// first one past the limit begins. Repeating the current material splits nothing.
+#[test]
+fn more_objects_than_the_mesh_limit_are_refused_naming_the_line() {
+    use manylight::scene::MAX_SCENE_MESHES;
+    let dir = tempfile::tempdir().unwrap();
+    let n = MAX_SCENE_MESHES + 1;
+    let mut text = String::from("v 0 0 0\nv 1 0 0\nv 0 1 0\n");
+    for i in 0..n {
+        text += &format!("o part{i}\nf 1 2 3\n");
+    }
+    let err = load_obj(&write(dir.path(), "groups.obj", &text))
+        .unwrap_err()
+        .to_string();
+    // Three vertex lines, then two lines per object: the last object's face.
+    let line = 3 + 2 * n;
+    assert!(
+        err.contains(&format!("line {line}:")) && err.contains(&MAX_SCENE_MESHES.to_string()),
+        "{err}"
+    );
+    let mut same = String::from("v 0 0 0\nv 1 0 0\nv 0 1 0\no one\n");
+    for _ in 0..n {
+        same += "usemtl m\nf 1 2 3\n";
+    }
+    let (scene, _) = load_obj(&write(dir.path(), "one.obj", &same)).unwrap();
+    assert_eq!(scene.objects.len(), 1);
+}

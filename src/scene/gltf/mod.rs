@@ -57,6 +57,7 @@ pub use material::{shininess, DIELECTRIC_SPECULAR};
 use super::access::LoadOptions;
 use super::camera::MAX_CAMERA_COORD;
 use super::input::{self, read_bounded, FileKind};
+use super::model_cache::MAX_SCENE_MESHES;
 use super::obj::LoadReport;
 use super::texture_budget::TextureBudget;
 use super::{
@@ -318,6 +319,7 @@ fn import(
         warnings: Vec::new(),
     };
     let mut camera_nodes = 0;
+    let mut mesh_count = 0;
     for p in &placed {
         let Some(node) = document.nodes().nth(p.node) else {
             continue;
@@ -332,6 +334,14 @@ fn import(
                 let cached = match meshes.entry(key) {
                     Entry::Occupied(e) => e.into_mut(),
                     Entry::Vacant(e) => {
+                        if mesh_count >= MAX_SCENE_MESHES {
+                            return Err(format!(
+                                "{pfield}: more than {MAX_SCENE_MESHES} distinct meshes \
+                                 (primitives), the limit per file"
+                            )
+                            .into());
+                        }
+                        mesh_count += 1;
                         let built =
                             mesh::build(&prim, &pfield, &mut buffers, &mut budget, &mut warnings)?;
                         e.insert(match built {

@@ -1,6 +1,8 @@
 //! The OBJ and MTL lines tobj would misread, panic on or reject without saying where, checked
 //! before it parses: each error names the line and the statement, never the file's text.
 
+use crate::scene::model_cache::MAX_SCENE_MESHES;
+
 /// The file's vertex data and faces as tobj reads them:
 /// - `v`, `vt` and `vn` start with 3, 2 and 3 numbers within f32's range (tobj reads each
 ///   into an `f32`, where `1e39` becomes infinite);
@@ -12,7 +14,10 @@
 /// - every index of every face and line refers to a vertex, texture coordinate or normal the
 ///   file defines (negative indices count back from the last one defined before the line):
 ///   an index beyond them overflowed tobj's arithmetic (a panic in debug builds, a read of the
-///   wrong element in release ones).
+///   wrong element in release ones);
+/// - at most [`MAX_SCENE_MESHES`] objects have faces (tobj makes one at each `o`, `g` or change
+///   of `usemtl` after faces): each is a mesh of its own, whose fixed cost (buffers, GL
+///   objects, the ray caster's hierarchy) would otherwise grow past memory before a frame.
 pub(super) fn check_obj(text: &str) -> Result<(), String> {
     let kind_of = |key: Option<&str>| match key {
         Some("v") => Some(0),
@@ -30,10 +35,12 @@ pub(super) fn check_obj(text: &str) -> Result<(), String> {
         }
     }
     let mut defined = [0i64; 3];
+    let mut objects = Objects::default();
     for (number, line) in text.lines().enumerate() {
         let at_line = |what: String| format!("line {}: {what}", number + 1);
         let mut words = line.split_whitespace();
         let key = words.next();
+        objects.read(key, words.clone()).map_err(at_line)?;
         if let Some(kind) = kind_of(key) {
             check_vertex_data(key.unwrap_or_default(), words).map_err(at_line)?;
             defined[kind] += 1;
@@ -89,6 +96,48 @@ pub(super) fn check_obj(text: &str) -> Result<(), String> {
         }
     }
     Ok(())
+}
+
+/// The objects tobj makes of a file, counted as [`check_obj`] reads it: one where faces
+/// follow an `o`, a `g` or a `usemtl` naming another material.
+#[derive(Default)]
+struct Objects<'a> {
+    with_faces: usize,
+    current_has_faces: bool,
+    material: Option<&'a str>,
+}
+
+impl<'a> Objects<'a> {
+    fn read(
+        &mut self,
+        key: Option<&str>,
+        mut words: impl Iterator<Item = &'a str>,
+    ) -> Result<(), String> {
+        match key {
+            Some("o" | "g") => self.current_has_faces = false,
+            Some("usemtl") => {
+                let name = words.next();
+                if name != self.material {
+                    self.current_has_faces = false;
+                    self.material = name;
+                }
+            }
+            Some("f") if !self.current_has_faces => {
+                self.current_has_faces = true;
+                self.with_faces += 1;
+                if self.with_faces > MAX_SCENE_MESHES {
+                    return Err(format!(
+                        "a face of object {}: more than {MAX_SCENE_MESHES} objects with faces \
+                         (`o`, `g` and material changes), the limit per file; merge objects \
+                         that share a material in the exporter",
+                        self.with_faces
+                    ));
+                }
+            }
+            _ => {}
+        }
+        Ok(())
+    }
 }
 
 /// A `v`, `vt` or `vn` statement's words after its key, as [`check_obj`] says.
