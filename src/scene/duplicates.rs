@@ -5,8 +5,9 @@
 
 use super::{Material, Mesh};
 
-/// One corner as bits: position, normal, texture coordinate (zero without them).
-type Corner = [u32; 8];
+/// One corner as bits: position, normal, texture coordinate, colour, tangent (zero without
+/// them).
+type Corner = [u32; 16];
 
 /// `mesh` without its duplicate triangles when `material` is opaque, and a warning giving
 /// their count when there were any (`what` names the object).
@@ -79,7 +80,12 @@ fn canonical(mesh: &Mesh, triangle: u32) -> [Corner; 3] {
         let p = mesh.positions[v];
         let n = mesh.normals.get(v).copied().unwrap_or_default();
         let uv = mesh.uvs.get(v).copied().unwrap_or_default();
-        [p.x, p.y, p.z, n.x, n.y, n.z, uv.x, uv.y].map(f32::to_bits)
+        let c = mesh.colors.get(v).copied().unwrap_or_default();
+        let t = mesh.tangents.get(v).copied().unwrap_or_default();
+        [
+            p.x, p.y, p.z, n.x, n.y, n.z, uv.x, uv.y, c.x, c.y, c.z, c.w, t.x, t.y, t.z, t.w,
+        ]
+        .map(f32::to_bits)
     };
     let [a, b, c] = [corner(0), corner(1), corner(2)];
     [

@@ -306,3 +306,40 @@ fn a_primitive_without_normals_ignores_its_tangents() {
         );
     }
 }
+
+/// A primitive listing one triangle over and over (through its indices, in either winding)
+/// keeps one copy with a warning counting the rest; a copy whose colour differs stays, and a
+/// blended surface keeps every copy (they blend).
+#[test]
+fn duplicate_triangles_are_dropped_from_opaque_primitives_only() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut b = Builder::default();
+    let p = b.floats(
+        &[0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0],
+        "VEC3",
+    );
+    let n = b.floats(&[0.0, 0.0, 1.0].repeat(4), "VEC3");
+    let c = b.floats(
+        &[[1.0, 1.0, 1.0, 1.0].repeat(3), vec![1.0, 0.0, 0.0, 1.0]].concat(),
+        "VEC4",
+    );
+    // 1 000 copies of (0 1 2), half of them reversed, then one through vertex 3 (another colour).
+    let mut indices: Vec<u16> = (0..1000)
+        .flat_map(|k| if k % 2 == 0 { [0, 1, 2] } else { [2, 1, 0] })
+        .collect();
+    indices.extend([3, 1, 2]);
+    let i = b.u16s(&indices);
+    for (mode, kept) in [("OPAQUE", 2), ("BLEND", 1001)] {
+        let rest = json!({"scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+            "materials": [{"alphaMode": mode}],
+            "meshes": [{"primitives": [{"attributes": {"POSITION": p, "NORMAL": n, "COLOR_0": c},
+                "indices": i, "material": 0}]}]});
+        let (scene, report) = load(&write(dir.path(), "dup.gltf", b.gltf(rest))).unwrap();
+        assert_eq!(scene.objects[0].mesh.triangle_count(), kept, "{mode}");
+        let warned = report
+            .warnings
+            .iter()
+            .any(|w| w.contains("999 duplicate triangles"));
+        assert_eq!(warned, mode == "OPAQUE", "{mode}: {:?}", report.warnings);
+    }
+}

@@ -222,6 +222,17 @@ pub(super) fn build(
             }
         }
     }
+    // Exact copies of a triangle add only overdraw (a file listing one a million times took
+    // seconds a frame); a blended surface keeps them, as its copies do blend.
+    if p.material().alpha_mode() != gltf::material::AlphaMode::Blend {
+        let dropped = crate::scene::duplicates::drop_duplicate_triangles(&mut mesh);
+        if dropped > 0 {
+            warnings.push(format!(
+                "{field}: {dropped} duplicate triangles dropped (the same corners as an earlier \
+                 one; they add nothing to the picture)"
+            ));
+        }
+    }
     Ok(Built::Mesh(mesh))
 }
 
