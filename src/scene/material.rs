@@ -184,6 +184,15 @@ impl Material {
                 format!("must be in [0, {MAX_COLOR_FACTOR}], got {e:?}"),
             ));
         }
+        if let Some(t) = self.maps.unusable_transform() {
+            return Err(SceneError::invalid(
+                format!("{field}.maps.{t}"),
+                format!(
+                    "offset and scale must be within ±{:e} and every number finite",
+                    super::mesh::MAX_TEXCOORD
+                ),
+            ));
+        }
         if !(self.shininess.is_finite() && self.shininess >= 0.0) {
             return Err(SceneError::invalid(
                 format!("{field}.shininess"),

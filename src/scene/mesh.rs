@@ -12,6 +12,12 @@ use super::SceneError;
 /// and were reported as a bad light intensity.
 pub const MAX_VERTEX_COORD: f32 = 1e9;
 
+/// Largest texture coordinate, and texture-transform offset or scale: far past any tiling (an
+/// f32 there has no fraction left), and small enough that a transformed coordinate and its
+/// differences across a triangle stay finite (past ±1.7e38 they overflowed, the texture
+/// lookup gave NaN and the whole surface drew black).
+pub const MAX_TEXCOORD: f32 = 1e9;
+
 /// Axis-aligned bounding box in `f64`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Aabb {
@@ -143,10 +149,16 @@ impl Mesh {
                 format!("{} texture coordinates for {n} vertices", uvs.len()),
             ));
         }
-        if let Some(i) = uvs.iter().position(|t| !t.is_finite()) {
+        if let Some(i) = uvs
+            .iter()
+            .position(|t| !(t.is_finite() && t.abs().max_element() <= MAX_TEXCOORD))
+        {
             return Err(SceneError::invalid(
                 format!("mesh.uvs[{i}]"),
-                format!("must be finite, got {:?}", uvs[i]),
+                format!(
+                    "must be finite and within ±{MAX_TEXCOORD:e}, got {:?}",
+                    uvs[i]
+                ),
             ));
         }
         let normals = if normals.len() == n {

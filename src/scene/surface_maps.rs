@@ -152,6 +152,24 @@ impl SurfaceMaps {
         .filter_map(|t| t.as_mut().map(|t| &mut t.texture))
     }
 
+    /// The first transform whose numbers are not finite or whose offset or scale passes
+    /// ±[`MAX_TEXCOORD`](super::mesh::MAX_TEXCOORD) (a transformed coordinate would overflow
+    /// and the surface draw black): its field, relative to the maps.
+    pub fn unusable_transform(&self) -> Option<String> {
+        let limit = super::mesh::MAX_TEXCOORD;
+        let usable = |t: &TextureTransform| {
+            t.is_finite()
+                && t.offset.abs().max_element() <= limit
+                && t.scale.abs().max_element() <= limit
+        };
+        if !usable(&self.base_transform) {
+            return Some("base_transform".into());
+        }
+        self.textures()
+            .find(|(_, t)| !usable(&t.transform))
+            .map(|(name, _)| format!("{name}.transform"))
+    }
+
     /// True when some texture (the base colour's included) is sampled through a transform.
     pub fn has_transform(&self) -> bool {
         !self.base_transform.is_identity()

@@ -14,6 +14,7 @@ use serde_json::Value;
 
 use super::buffers::Buffers;
 use super::texture::Textures;
+use crate::scene::mesh::MAX_TEXCOORD;
 use crate::scene::surface_maps::{MapTexture, SurfaceMaps, TextureTransform, MAX_EMISSIVE};
 
 /// The file's `materials` array as plain JSON, for the transforms.
@@ -105,12 +106,19 @@ pub(super) fn transform_of(
         }),
         _ => None,
     };
-    let t = match parsed.filter(|t| t.is_finite() && t.rows().iter().all(|r| r.is_finite())) {
+    let within = |v: Vec2| v.abs().max_element() <= MAX_TEXCOORD;
+    let usable = |t: &TextureTransform| {
+        t.is_finite()
+            && within(t.offset)
+            && within(t.scale)
+            && t.rows().iter().all(|r| r.is_finite())
+    };
+    let t = match parsed.filter(usable) {
         Some(t) => t,
         None => {
             warnings.push(format!(
                 "{field}.extensions.KHR_texture_transform: malformed (offset and scale are \
-                 two numbers, rotation one, all finite); ignored"
+                 two numbers within ±{MAX_TEXCOORD:e}, rotation one, all finite); ignored"
             ));
             TextureTransform::IDENTITY
         }

@@ -1,6 +1,7 @@
 //! The OBJ and MTL lines tobj would misread, panic on or reject without saying where, checked
 //! before it parses: each error names the line and the statement, never the file's text.
 
+use crate::scene::mesh::MAX_TEXCOORD;
 use crate::scene::model_cache::MAX_SCENE_MESHES;
 
 /// The file's vertex data and faces as tobj reads them:
@@ -150,6 +151,12 @@ fn check_vertex_data<'a>(
     for (i, value) in values.iter_mut().enumerate().take(needs) {
         // The numbers first, so a bad one is named rather than the face that uses it.
         match words.next().map(str::parse::<f32>) {
+            Some(Ok(v)) if key == "vt" && v.abs() > MAX_TEXCOORD => {
+                return Err(format!(
+                    "`vt` number {}: a texture coordinate must be within ±{MAX_TEXCOORD:e}",
+                    i + 1
+                ))
+            }
             Some(Ok(v)) if v.is_finite() => *value = v,
             Some(Ok(_)) => {
                 return Err(format!(
