@@ -70,7 +70,7 @@ pub(crate) fn decode_texture_bytes(
     format: Option<image::ImageFormat>,
     budget: &mut TextureBudget,
 ) -> Result<image::DynamicImage, String> {
-    let undecodable = |e: image::ImageError| format!("could not be decoded ({e})");
+    let undecodable = |e: image::ImageError| undecodable(&e);
     let reader = || {
         let mut reader = image::ImageReader::new(std::io::Cursor::new(bytes));
         if let Some(format) = format {
@@ -78,7 +78,7 @@ pub(crate) fn decode_texture_bytes(
         }
         let mut reader = reader
             .with_guessed_format()
-            .map_err(|e| format!("could not be decoded ({e})"))?;
+            .map_err(|e| format!("could not be read ({})", e.kind()))?;
         reader.limits(limits());
         Ok::<_, String>(reader)
     };
@@ -88,6 +88,33 @@ pub(crate) fn decode_texture_bytes(
         budget.give_back(taken);
         undecodable(e)
     })
+}
+
+/// Why an image did not decode, by the kind of failure only: the decoders' own messages
+/// quote the file (a PNG chunk's type, a BMP header's bytes read as a number), and no message
+/// may show a file's bytes.
+fn undecodable(e: &image::ImageError) -> String {
+    use image::error::{ImageError, ImageFormatHint};
+    let format = |hint: ImageFormatHint| match hint {
+        ImageFormatHint::Exact(format) => format!("{format:?}"),
+        _ => "image".to_string(),
+    };
+    match e {
+        ImageError::Decoding(d) => format!(
+            "could not be decoded (not valid {} data)",
+            format(d.format_hint())
+        ),
+        ImageError::Limits(_) => format!(
+            "could not be decoded (past the decoder's limits: {MAX_DECODED_SIDE} pixels a side, \
+             {MAX_DECODE_BYTES} bytes decoded)"
+        ),
+        ImageError::Unsupported(u) => format!(
+            "could not be decoded ({} data with a format or feature the decoder does not support)",
+            format(u.format_hint())
+        ),
+        ImageError::IoError(io) => format!("could not be decoded (read failed: {})", io.kind()),
+        ImageError::Parameter(_) | ImageError::Encoding(_) => "could not be decoded".to_string(),
+    }
 }
 
 /// Most bytes the textures of one scene load keep (RGBA8, each within

@@ -344,3 +344,42 @@ fn more_distinct_meshes_than_the_limit_are_refused_naming_the_first_past_it() {
     let (scene, _) = load(&write(dir.path(), "shared.gltf", model(1))).unwrap();
     assert_eq!(scene.objects.len(), n);
 }
+
+/// Images that do not decode are named with the kind of failure only: the decoders' own
+/// messages quote the file (a PNG chunk's type, a BMP header read as a number, a TGA's image
+/// type), and no message may show a file's bytes.
+#[test]
+fn an_image_that_does_not_decode_is_warned_of_without_its_bytes() {
+    let secret = b"SECRETPASSWORD".repeat(4);
+    let png = |chunk: &[u8]| [b"\x89PNG\r\n\x1a\n".as_slice(), chunk].concat();
+    let ihdr = b"\0\0\0\x0dIHDR\0\0\0\x04\0\0\0\x04\x08\x02\0\0\0\x26\x93\x09\x29";
+    let images: [(&str, Vec<u8>); 4] = [
+        ("chunk.png", png(b"\0\0\0\x06SECRETDATA\x1e\xd0\x1d\xfa")),
+        (
+            "second.png",
+            png(&[ihdr.as_slice(), b"\0\0\0\x04PASSword\xc5\x647-"].concat()),
+        ),
+        ("header.bmp", [b"BM".as_slice(), &secret].concat()),
+        ("kind.tga", [b"\0\0\x02".as_slice(), &secret].concat()),
+    ];
+    let dir = tempfile::tempdir().unwrap();
+    for (name, bytes) in &images {
+        write(dir.path(), name, bytes);
+        let mut b = Builder::default();
+        let mut doc = triangle(&mut b);
+        doc["materials"] = json!([{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}]);
+        doc["textures"] = json!([{"source": 0}]);
+        doc["images"] = json!([{"uri": name}]);
+        doc["meshes"][0]["primitives"][0]["material"] = json!(0);
+        let path = write(dir.path(), "model.gltf", b.gltf(doc));
+        let (_, report) = load(&path).unwrap();
+        let warning = report
+            .warnings
+            .iter()
+            .find(|w| w.contains("could not be decoded"))
+            .unwrap_or_else(|| panic!("{name}: {:?}", report.warnings));
+        for quoted in ["SECR", "PASS", "1163084882", "Unknown("] {
+            assert!(!warning.contains(quoted), "{name}: {warning}");
+        }
+    }
+}
