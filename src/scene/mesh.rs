@@ -12,6 +12,12 @@ use super::SceneError;
 /// and were reported as a bad light intensity.
 pub const MAX_VERTEX_COORD: f32 = 1e9;
 
+/// Most distinct meshes a model file, or a scene file with all its references, may make: each
+/// has a fixed cost besides its data (its buffers and their GL objects, the automatic grid's
+/// ray-caster hierarchy; about 4.4 KB measured with llvmpipe), so the limit holds that near
+/// 300 MB. Objects placing one mesh many times cost far less ([`MAX_SCENE_OBJECTS`](super::MAX_SCENE_OBJECTS)).
+pub const MAX_SCENE_MESHES: usize = 1 << 16;
+
 /// Largest texture coordinate, and texture-transform offset or scale: far past any tiling (an
 /// f32 there has no fraction left), and small enough that a transformed coordinate and its
 /// differences across a triangle stay finite (past ±1.7e38 they overflowed, the texture

@@ -49,8 +49,9 @@ pub use directional::{DirectionalLight, MAX_DIRECTIONAL_LIGHTS};
 pub use error::SceneError;
 pub use light::{Cone, Light, LightKind};
 pub use material::{Material, MaterialModel, Texture};
+pub use mesh::MAX_SCENE_MESHES;
 pub use mesh::{Aabb, Mesh};
-pub use model_cache::{MAX_SCENE_MATERIALS, MAX_SCENE_MESHES, MAX_SCENE_OBJECTS};
+pub use model_cache::{MAX_SCENE_MATERIALS, MAX_SCENE_OBJECTS};
 pub use motion::Motion;
 
 /// One placed mesh: shared geometry, its material and a model transform (`f64`, so objects

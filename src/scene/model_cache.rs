@@ -15,6 +15,7 @@ use glam::DMat4;
 
 use super::access::LoadOptions;
 use super::camera::MAX_CAMERA_COORD;
+use super::mesh::MAX_SCENE_MESHES;
 use super::obj::{self, LoadReport};
 use super::texture_budget::TextureBudget;
 use super::{Aabb, Material, Mesh, Object, Scene, SceneError, Texture};
@@ -23,12 +24,6 @@ use super::{Aabb, Material, Mesh, Object, Scene, SceneError, Texture};
 /// glTF too: each costs about 0.6 KB of CPU state besides its mesh (placement, draw order,
 /// the automatic grid's ray caster), so the limit holds that near 600 MB.
 pub const MAX_SCENE_OBJECTS: usize = super::gltf::MAX_OBJECTS;
-
-/// Most distinct meshes a model file, or a scene file with all its references, may make: each
-/// has a fixed cost besides its data (its buffers and their GL objects, the automatic grid's
-/// ray-caster hierarchy; about 4.4 KB measured with llvmpipe), so the limit holds that near
-/// 300 MB. Objects placing one mesh many times cost far less ([`MAX_SCENE_OBJECTS`]).
-pub const MAX_SCENE_MESHES: usize = 1 << 16;
 
 /// Most materials a scene file may make (references that recolour a model copy its materials).
 pub const MAX_SCENE_MATERIALS: usize = 1 << 20;

@@ -153,7 +153,7 @@ impl SurfaceMaps {
     }
 
     /// The first transform whose numbers are not finite or whose offset or scale passes
-    /// ±[`MAX_TEXCOORD`](super::mesh::MAX_TEXCOORD) (a transformed coordinate would overflow
+    /// ±1e9 (`MAX_TEXCOORD`; a transformed coordinate would overflow
     /// and the surface draw black): its field, relative to the maps.
     pub fn unusable_transform(&self) -> Option<String> {
         let limit = super::mesh::MAX_TEXCOORD;

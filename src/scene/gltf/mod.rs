@@ -57,7 +57,7 @@ pub use material::{shininess, DIELECTRIC_SPECULAR};
 use super::access::LoadOptions;
 use super::camera::MAX_CAMERA_COORD;
 use super::input::{self, read_bounded, FileKind};
-use super::model_cache::MAX_SCENE_MESHES;
+use super::mesh::MAX_SCENE_MESHES;
 use super::obj::LoadReport;
 use super::texture_budget::TextureBudget;
 use super::{

@@ -1,8 +1,7 @@
 //! The OBJ and MTL lines tobj would misread, panic on or reject without saying where, checked
 //! before it parses: each error names the line and the statement, never the file's text.
 
-use crate::scene::mesh::MAX_TEXCOORD;
-use crate::scene::model_cache::MAX_SCENE_MESHES;
+use crate::scene::mesh::{MAX_SCENE_MESHES, MAX_TEXCOORD};
 
 /// The file's vertex data and faces as tobj reads them:
 /// - `v`, `vt` and `vn` start with 3, 2 and 3 numbers within f32's range (tobj reads each
