@@ -418,16 +418,17 @@ pub fn load_with(
     let (scene, mut report) = loaded;
     // Drawn, but a frame of background only: said, not left silent.
     let invisible = |o: &Object| {
-        scene
-            .materials
-            .get(o.material)
-            .is_some_and(|m| m.alpha <= 0.0)
+        scene.materials.get(o.material).is_some_and(|m| {
+            let colors = &o.mesh.colors;
+            m.alpha <= 0.0
+                || (m.alpha_vertex && !colors.is_empty() && colors.iter().all(|c| c.w <= 0.0))
+        })
     };
     if !scene.objects.is_empty() && scene.objects.iter().all(invisible) {
         let warning = format!(
-            "{}: every object's material is fully transparent (alpha 0: MTL `d 0`, a glTF base \
-             colour alpha of 0, or a glTF MASK material cut out everywhere): the frame shows the \
-             background only",
+            "{}: every object is fully transparent (alpha 0: MTL `d 0`, a glTF base colour or \
+             COLOR_0 alpha of 0, or a glTF MASK material cut out everywhere): the frame shows \
+             the background only",
             shown::text(&path.display().to_string())
         );
         log::warn!("{warning}");

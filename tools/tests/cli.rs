@@ -1083,3 +1083,34 @@ fn messages_show_names_from_files_escaped_and_cut() {
         );
     }
 }
+
+/// A picture that comes out black is warned of with what can cause it (here a camera turned
+/// away from the geometry, then a scene nothing lights); a lit one is not.
+#[test]
+fn a_black_picture_is_warned_of_with_its_likely_causes() {
+    let dir = tempfile::tempdir().unwrap();
+    let away = r#"{"camera": {"position": [0, 1, 5], "target": [0, 1, 10]},
+        "objects": [{"builtin": "plane"}], "random_lights": {"count": 8}}"#;
+    let unlit = r#"{"objects": [{"builtin": "plane"}], "ambient": [0, 0, 0]}"#;
+    std::fs::write(dir.path().join("away.json"), away).unwrap();
+    std::fs::write(dir.path().join("unlit.json"), unlit).unwrap();
+    let run = |scene: &str| {
+        let out = manylight(
+            &["--scene", scene, "--size", "32x18", "--out", "o.png"],
+            &[],
+            dir.path(),
+        );
+        let msg = text(&out);
+        assert!(out.status.success(), "{msg}");
+        msg
+    };
+    let msg = run("away.json");
+    assert!(
+        msg.contains("the picture is black") && msg.contains("sees none of the geometry"),
+        "{msg}"
+    );
+    let msg = run("unlit.json");
+    assert!(msg.contains("nothing lights it"), "{msg}");
+    let msg = run("plane");
+    assert!(!msg.contains("the picture is black"), "{msg}");
+}

@@ -305,3 +305,30 @@ fn for_every_method(
         }
     }
 }
+
+/// A blended primitive whose `COLOR_0` alpha is 0 at every vertex draws nothing: said at
+/// load, as a material alpha of 0 is; one vertex above 0 draws something, and is not.
+#[test]
+fn vertex_alpha_of_zero_everywhere_is_warned_of_as_fully_transparent() {
+    let dir = tempfile::tempdir().unwrap();
+    for (last_alpha, warned) in [(0.0, true), (0.5, false)] {
+        let mut b = Builder::default();
+        let p = b.floats(&[0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0], "VEC3");
+        let c = b.floats(
+            &[
+                1.0, 1.0, 1.0, 0.0, 1.0, 1.0, 1.0, 0.0, 1.0, 1.0, 1.0, last_alpha,
+            ],
+            "VEC4",
+        );
+        let rest = json!({"scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+            "materials": [{"alphaMode": "BLEND"}],
+            "meshes": [{"primitives": [{"attributes": {"POSITION": p, "COLOR_0": c},
+                "material": 0}]}]});
+        let (_, report) = load(&write(dir.path(), "a.gltf", b.gltf(rest))).unwrap();
+        let said = report
+            .warnings
+            .iter()
+            .any(|w| w.contains("fully transparent"));
+        assert_eq!(said, warned, "{last_alpha}: {:?}", report.warnings);
+    }
+}

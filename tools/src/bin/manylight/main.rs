@@ -13,6 +13,7 @@ macro_rules! eprintln {
 
 mod bench;
 mod bench_assign;
+mod black_frame;
 mod info;
 mod matrix;
 mod progress;

@@ -310,6 +310,9 @@ pub fn run(args: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
     };
     drop(renderer);
     let (image, stats) = result?;
+    if let Some(warning) = crate::black_frame::warning(&image, &scene) {
+        log::warn!("{warning}");
+    }
     if let Some(file) = out_file {
         file.commit_png(&image)?;
     }
