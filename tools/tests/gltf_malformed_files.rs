@@ -362,3 +362,46 @@ fn a_scene_files_transform_that_places_a_model_out_of_range_is_blamed_on_the_sce
     let path = write(dir.path(), "big.json", &text);
     load(&path).unwrap();
 }
+
+/// A document that is valid JSON but not glTF names the field that does not fit (an array too
+/// long, a field given twice, an index past u32), never "not valid JSON", and never a name the
+/// file made up.
+#[test]
+fn a_value_that_does_not_fit_the_schema_is_named_by_its_field() {
+    let dir = tempfile::tempdir().unwrap();
+    let asset = r#""asset": {"version": "2.0"}"#;
+    let cases = [
+        (
+            format!(r#"{{{asset}, "nodes": [{{"rotation": [0, 0, 0, 1, 0]}}]}}"#),
+            "nodes[0].rotation: the wrong type or form",
+        ),
+        (
+            format!(r#"{{{asset}, "scene": 0, "scene": 0, "scenes": [{{}}]}}"#),
+            "`scene` given twice",
+        ),
+        (
+            format!(
+                r#"{{{asset}, "materials": [{{"pbrMetallicRoughness":
+                    {{"baseColorTexture": {{"index": 0, "texCoord": 4294967296}}}}}}]}}"#
+            ),
+            "materials[0].pbrMetallicRoughness.baseColorTexture.texCoord",
+        ),
+        (
+            format!(
+                r#"{{{asset}, "meshes": [{{"primitives": [{{"attributes":
+                    {{"SECRET_KEY": true}}}}]}}]}}"#
+            ),
+            "meshes[0].primitives[0].attributes",
+        ),
+    ];
+    for (json, expected) in &cases {
+        let err = load(&write(dir.path(), "m.gltf", json))
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains(expected), "{expected}: {err}");
+        assert!(
+            !err.contains("not valid JSON") && !err.contains("SECRET"),
+            "{err}"
+        );
+    }
+}

@@ -39,6 +39,7 @@ mod maps;
 pub mod material;
 pub mod mesh;
 pub mod nodes;
+mod schema_path;
 pub mod texture;
 mod uri;
 
@@ -216,20 +217,32 @@ pub fn load_into(
 
 /// A JSON error said by its kind and place: serde's own text quotes the offending value,
 /// which may be any file's bytes (a scene file can name any file as its glTF).
-fn json_error(e: &serde_json::Error) -> String {
+fn json_error(e: &serde_json::Error, json: &[u8]) -> String {
     use serde_json::error::Category;
+    let valid_json = || serde_json::from_slice::<serde::de::IgnoredAny>(json).is_ok();
     let what = match e.classify() {
         Category::Io => "could not be read".to_string(),
-        Category::Syntax => "is not valid JSON".to_string(),
         Category::Eof => "ends early".to_string(),
-        Category::Data => {
+        // The crate reports some misfits (an array too long) as syntax.
+        Category::Syntax if !valid_json() => "is not valid JSON".to_string(),
+        Category::Syntax | Category::Data => {
             let message = e.to_string();
+            let at = schema_path::misfit(json).unwrap_or_else(|| "a value".into());
             match message.split_once(" at line") {
                 // A missing field is named by the glTF schema, not by the file.
                 Some((missing, _)) if missing.starts_with("missing field") => {
-                    format!("is not glTF ({missing})")
+                    format!("is not glTF ({at}: {missing})")
                 }
-                _ => "is not glTF (a value of the wrong type or form)".to_string(),
+                // serde names the field by the schema's name (from the type, not the file).
+                _ if message.starts_with("duplicate field") => {
+                    let name = message
+                        .split('`')
+                        .nth(1)
+                        .filter(|n| schema_path::is_schema_name(n));
+                    let name = name.map_or("a field".to_string(), |n| format!("`{n}`"));
+                    format!("is not glTF ({at}: {name} given twice)")
+                }
+                _ => format!("is not glTF ({at}: the wrong type or form)"),
             }
         }
     };
@@ -279,7 +292,12 @@ fn import(
         (bytes, None)
     };
     json_size::check(json)?;
-    let root = gltf::json::deserialize::from_slice(json).map_err(|e| json_error(&e))?;
+    let root = gltf::json::deserialize::from_slice(json).map_err(|e| {
+        // An integer past u32 fails the crate's parse as a wrong type: named as what it is.
+        integers::check(json)
+            .err()
+            .unwrap_or_else(|| json_error(&e, json))
+    })?;
     integers::check(json)?;
     if let Some(reason) = ignored::unsupported_required(&root) {
         return Err(Fault::Unsupported(reason));
