@@ -314,10 +314,19 @@ fn parse_obj(path: &Path, allow_outside: bool) -> Result<Parsed, SceneError> {
         path: path.to_path_buf(),
         reason,
     };
-    let warnings = warnings.into_inner();
+    let mut warnings = warnings.into_inner();
     match parsed {
         Ok(result) => result
-            .map(|(models, materials)| (models, materials, not_utf8, warnings))
+            .map(|(models, materials)| {
+                // A library that failed was warned of already.
+                if let Ok(materials) = &materials {
+                    let defined: Vec<&str> = materials.iter().map(|m| m.name.as_str()).collect();
+                    if let Some(w) = lines::undefined_materials(&text, &defined) {
+                        warnings.push(format!("{}: {w}", path.display()));
+                    }
+                }
+                (models, materials, not_utf8, warnings)
+            })
             .map_err(|e| obj_error(e.to_string())),
         Err(_) => Err(obj_error(
             "the OBJ parser (tobj) failed on this file; it is malformed".into(),

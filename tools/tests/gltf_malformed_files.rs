@@ -405,3 +405,40 @@ fn a_value_that_does_not_fit_the_schema_is_named_by_its_field() {
         );
     }
 }
+
+/// A glTF version this loader does not read (a major version past 2, a minVersion past 2.0)
+/// is refused naming the field, without the file's string; 2.x and minVersion 2.0 load.
+#[test]
+fn versions_past_2_0_are_refused_naming_the_field() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut b = Builder::default();
+    let base = triangle(&mut b);
+    let with = |asset: serde_json::Value| {
+        let mut doc = serde_json::from_str::<serde_json::Value>(&b.gltf(base.clone())).unwrap();
+        doc["asset"] = asset;
+        doc.to_string()
+    };
+    for (asset, refused) in [
+        (json!({"version": "3.0"}), Some("asset.version")),
+        (
+            json!({"version": "2.0", "minVersion": "2.5"}),
+            Some("asset.minVersion"),
+        ),
+        (json!({"version": "2.1", "minVersion": "2.0"}), None),
+        (json!({"version": "2.0"}), None),
+    ] {
+        let loaded = load(&write(dir.path(), "v.gltf", with(asset.clone())));
+        match refused {
+            Some(field) => {
+                let err = loaded.unwrap_err().to_string();
+                assert!(
+                    err.contains(field) && !err.contains("2.5") && !err.contains("3.0"),
+                    "{err}"
+                );
+            }
+            None => {
+                loaded.unwrap_or_else(|e| panic!("{asset}: {e}"));
+            }
+        }
+    }
+}

@@ -741,3 +741,34 @@ fn more_objects_than_the_mesh_limit_are_refused_naming_the_line() {
     let (scene, _) = load_obj(&write(dir.path(), "one.obj", &same)).unwrap();
     assert_eq!(scene.objects.len(), 1);
 }
+
+/// `usemtl` naming a material no library defines draws its faces in the default grey: said,
+/// with how many names and the first line, not the names (the file's text).
+#[test]
+fn usemtl_naming_an_undefined_material_is_warned_of() {
+    let dir = tempfile::tempdir().unwrap();
+    write(dir.path(), "m.mtl", "newmtl red\nKd 0.9 0.1 0.1\n");
+    let obj = "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl red\nf 1 2 3\n\
+               usemtl nosuch\nf 1 3 2\nusemtl other\nf 3 2 1\nusemtl nosuch\nf 2 1 3\n";
+    let (_, report) = load_obj(&write(dir.path(), "u.obj", obj)).unwrap();
+    let warning = report
+        .warnings
+        .iter()
+        .find(|w| w.contains("defined by no material library"))
+        .unwrap_or_else(|| panic!("{:?}", report.warnings));
+    assert!(
+        warning.contains("2 material names") && warning.contains("line 7"),
+        "{warning}"
+    );
+    assert!(!warning.contains("nosuch"), "{warning}");
+    let defined = "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl red\nf 1 2 3\n";
+    let (_, report) = load_obj(&write(dir.path(), "d.obj", defined)).unwrap();
+    assert!(
+        !report
+            .warnings
+            .iter()
+            .any(|w| w.contains("no material library")),
+        "{:?}",
+        report.warnings
+    );
+}

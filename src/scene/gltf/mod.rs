@@ -457,6 +457,23 @@ fn import(
 /// not use them.
 fn validate(root: &gltf::json::Root) -> Result<(), String> {
     use gltf::json::validation::{Checked, Error, Validate};
+    // A major version past 2 (or a minimum past 2.0) may mean anything: refused, as the
+    // specification asks (§3.2), without showing the file's string.
+    let major = |v: &str| v.split('.').next().map(str::trim).map(str::to_owned);
+    if major(&root.asset.version).as_deref() != Some("2") {
+        return Err("asset.version: not a glTF 2.x version; this loader reads glTF 2.0".into());
+    }
+    if let Some(min) = &root.asset.min_version {
+        let mut parts = min.trim().split('.').map(|p| p.parse::<u32>().ok());
+        let (major, minor) = (parts.next().flatten(), parts.next().flatten());
+        let at_most_2_0 =
+            matches!((major, minor), (Some(m), _) if m < 2) || (major, minor) == (Some(2), Some(0));
+        if !at_most_2_0 {
+            return Err(
+                "asset.minVersion: asks for more than glTF 2.0, which this loader reads".into(),
+            );
+        }
+    }
     // The crate's own check of `min`/`max` indexes the accessors with POSITION's index
     // before it checks that index: checked here first.
     for (m, mesh) in root.meshes.iter().enumerate() {

@@ -150,7 +150,7 @@ fn check_vertex_data<'a>(
     for (i, value) in values.iter_mut().enumerate().take(needs) {
         // The numbers first, so a bad one is named rather than the face that uses it.
         match words.next().map(str::parse::<f32>) {
-            Some(Ok(v)) if key == "vt" && v.abs() > MAX_TEXCOORD => {
+            Some(Ok(v)) if key == "vt" && v.is_finite() && v.abs() > MAX_TEXCOORD => {
                 return Err(format!(
                     "`vt` number {}: a texture coordinate must be within ±{MAX_TEXCOORD:e}",
                     i + 1
@@ -190,20 +190,70 @@ fn check_vertex_data<'a>(
     }
 }
 
-/// The first MTL line tobj would panic on or misread (a colour with fewer than three numbers,
-/// as a truncated file has), as a message naming the line (not showing it).
+/// What `usemtl` lines name that no material library defined (tobj gives those faces no
+/// material, and they are drawn in the default grey), said without the names (the file's
+/// text): how many, and the line of the first.
+pub(super) fn undefined_materials(text: &str, defined: &[&str]) -> Option<String> {
+    let mut missing = std::collections::HashSet::new();
+    let mut first = None;
+    for (number, line) in text.lines().enumerate() {
+        let mut words = line.split_whitespace();
+        if words.next() != Some("usemtl") {
+            continue;
+        }
+        // tobj takes the rest of the line, trimmed, as the name.
+        let name = line
+            .trim()
+            .split_once(char::is_whitespace)
+            .map(|(_, n)| n.trim());
+        let Some(name) = name.filter(|n| !defined.contains(n)) else {
+            continue;
+        };
+        if missing.insert(name) && first.is_none() {
+            first = Some(number + 1);
+        }
+    }
+    first.map(|line| {
+        format!(
+            "{} material names given to `usemtl` are defined by no material library (the \
+             first at line {line}); their faces are drawn in the default grey",
+            missing.len()
+        )
+    })
+}
+
+/// The first MTL line tobj would panic on, misread or reject without saying where (a colour
+/// with fewer than three numbers, as a truncated file has; `d`, `Ns`, `Ni` or `illum` without
+/// its number; a texture statement or `newmtl` naming nothing), as a message naming the line
+/// (not showing it).
 pub(super) fn check_mtl(text: &str) -> Result<(), String> {
     for (number, line) in text.lines().enumerate() {
         let mut words = line.split_whitespace();
-        let Some(key @ ("Ka" | "Kd" | "Ks" | "Ke")) = words.next() else {
+        let Some(key) = words.next() else {
             continue;
         };
-        let numbers = words.take(3).filter(|w| w.parse::<f32>().is_ok()).count();
-        if numbers < 3 {
-            return Err(format!(
-                "line {}: `{key}` needs three numbers, found {numbers}",
-                number + 1
-            ));
+        let fault = match key {
+            "Ka" | "Kd" | "Ks" | "Ke" => {
+                let numbers = words.take(3).filter(|w| w.parse::<f32>().is_ok()).count();
+                (numbers < 3).then(|| format!("`{key}` needs three numbers, found {numbers}"))
+            }
+            "Ns" | "Ni" | "d" => words
+                .next()
+                .is_none_or(|w| w.parse::<f32>().is_err())
+                .then(|| format!("`{key}` needs a number")),
+            "illum" => words
+                .next()
+                .is_none_or(|w| w.parse::<u8>().is_err())
+                .then(|| "`illum` needs an illumination model number (0 to 255)".to_string()),
+            "newmtl" | "map_Ka" | "map_Kd" | "map_Ks" | "map_Bump" | "map_bump" | "map_Ns"
+            | "map_ns" | "map_NS" | "bump" | "map_d" => words
+                .next()
+                .is_none()
+                .then(|| format!("`{key}` names nothing")),
+            _ => None,
+        };
+        if let Some(fault) = fault {
+            return Err(format!("line {}: {fault}", number + 1));
         }
     }
     Ok(())
@@ -211,7 +261,28 @@ pub(super) fn check_mtl(text: &str) -> Result<(), String> {
 
 #[cfg(test)]
 mod tests {
-    use super::check_obj;
+    use super::{check_mtl, check_obj};
+
+    #[test]
+    fn mtl_statements_without_their_values_are_named_by_line() {
+        let cases = [
+            (
+                "newmtl m\nKd 1 1\n",
+                "line 2: `Kd` needs three numbers, found 2",
+            ),
+            ("newmtl m\nd\n", "line 2: `d` needs a number"),
+            ("newmtl m\nNs x\n", "line 2: `Ns` needs a number"),
+            ("newmtl m\nillum 300\n", "line 2: `illum` needs"),
+            ("newmtl m\nmap_Kd   \n", "line 2: `map_Kd` names nothing"),
+            ("newmtl\n", "line 1: `newmtl` names nothing"),
+        ];
+        for (text, expected) in cases {
+            let err = check_mtl(text).expect_err(text);
+            assert!(err.starts_with(expected), "{text:?}: {err}");
+        }
+        let fine = "newmtl m\nKd 1 1 1\nd 0.5\nNs 10\nillum 2\nmap_Kd a b.png\n";
+        assert_eq!(check_mtl(fine), Ok(()));
+    }
 
     #[test]
     fn vertex_lines_tobj_rejects_or_overflows_are_named_by_line() {
