@@ -166,6 +166,7 @@ impl Scene {
                 rest: vec![*rest],
                 motion,
                 vary: None,
+                variation_start: 0,
             });
         }
     }
@@ -185,8 +186,40 @@ impl Scene {
                 rest: rest.to_vec(),
                 motion,
                 vary: Some(seed),
+                variation_start: 0,
             });
         }
+    }
+
+    /// Removes light `index` and its place in the track that moves it, the other lights
+    /// keeping their motions (later indices shift with the lights): what a game does when a
+    /// light goes out for good. Removing it from `lights` alone would leave its track to pose
+    /// the next light in its place. `None` past the end.
+    pub fn remove_light(&mut self, index: usize) -> Option<Light> {
+        if index >= self.lights.len() {
+            return None;
+        }
+        let mut tracks = Vec::with_capacity(self.animation.len() + 1);
+        for mut track in std::mem::take(&mut self.animation) {
+            if index < track.first {
+                track.first -= 1;
+            } else if index - track.first < track.rest.len() {
+                // Split round the removed light: the part after it keeps its variations.
+                let k = index - track.first;
+                let after = motion::LightTrack {
+                    first: index,
+                    rest: track.rest.split_off(k + 1),
+                    variation_start: track.variation_start + k + 1,
+                    ..track
+                };
+                track.rest.truncate(k);
+                tracks.extend([track, after].into_iter().filter(|t| !t.rest.is_empty()));
+                continue;
+            }
+            tracks.push(track);
+        }
+        self.animation = tracks;
+        Some(self.lights.remove(index))
     }
 
     /// Poses every animated light at time `t` (seconds; 0 is the scene as built). A pure
@@ -241,19 +274,10 @@ impl Scene {
                 light.validate(&format!("directional_lights[{i}]"))?;
             }
         }
+        // A track reaching past the lights (a game popped some) poses those that are there,
+        // as `set_time` does.
         for track in &self.animation {
             let field = || format!("lights[{}].motion", track.first);
-            if track.first.saturating_add(track.rest.len()) > self.lights.len() {
-                return Err(SceneError::invalid(
-                    field(),
-                    format!(
-                        "moves lights {}..{} but the scene has {}",
-                        track.first,
-                        track.first.saturating_add(track.rest.len()),
-                        self.lights.len()
-                    ),
-                ));
-            }
             // A set's sweep applies to its spots only; a single light's must have a cone.
             let is_spot = track.vary.is_some()
                 || track

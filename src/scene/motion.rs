@@ -129,6 +129,9 @@ pub struct LightTrack {
     /// `Some(seed)`: each light moves by its own variation of `motion` ([`Motion::varied`]),
     /// so a set does not move in lockstep; `None`: all exactly as `motion`.
     pub vary: Option<u64>,
+    /// The variation number of its first light (0, unless [`super::Scene::remove_light`]
+    /// split the track: the lights after a removed one keep their own variations).
+    pub variation_start: usize,
 }
 
 impl LightTrack {
@@ -136,8 +139,8 @@ impl LightTrack {
     pub fn motion_of(&self, k: usize) -> Motion {
         match (self.vary, self.rest.get(k)) {
             (Some(seed), Some(rest)) => {
-                self.motion
-                    .varied(seed, k, matches!(rest.kind, LightKind::Spot { .. }))
+                let is_spot = matches!(rest.kind, LightKind::Spot { .. });
+                self.motion.varied(seed, self.variation_start + k, is_spot)
             }
             _ => self.motion,
         }

@@ -212,3 +212,33 @@ fn built_in_scenes_move_and_start_where_they_were_built() {
         posed.validate().unwrap();
     }
 }
+
+/// A game removing a light with `Scene::remove_light` keeps every other light's motion (a
+/// varied set included); popping lights off the end leaves a scene that validates and poses
+/// what remains.
+#[test]
+fn removing_a_light_keeps_the_others_moving_as_before() {
+    let lights = manylight::RandomLights { count: 16, seed: 3 };
+    let original = manylight::builtin_scene("courtyard", Some(lights)).unwrap();
+    assert!(original.is_animated());
+    let mut scene = original.clone();
+    assert!(scene.remove_light(5).is_some());
+    assert_eq!(scene.lights.len(), 15);
+    scene.validate().unwrap();
+    let mut reference = original.clone();
+    for t in [0.0, 1.3, 7.9] {
+        scene.set_time(t);
+        reference.set_time(t);
+        let others: Vec<_> = (reference.lights.iter().enumerate())
+            .filter(|&(i, _)| i != 5)
+            .map(|(_, l)| *l)
+            .collect();
+        assert_eq!(scene.lights, others, "t = {t}");
+    }
+    assert!(scene.remove_light(15).is_none());
+    scene.lights.truncate(10);
+    scene
+        .validate()
+        .expect("tracks past the lights pose what is there");
+    scene.set_time(2.0);
+}
