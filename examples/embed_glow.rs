@@ -16,6 +16,10 @@
 //! 3. carry on: manylight gives back the GL state it found (framebuffer, vertex array on ES 3.0,
 //!    program, textures, blend, depth, viewport, …; the README's "Sharing the context with a
 //!    game" lists it), so the application's next pass starts where it left off.
+//!
+//! `image` is manylight's re-export (`manylight::image`, the type its offscreen renders
+//! return); `rayon`, for joining its pool, is a crate of its own that a game copying this adds
+//! to its `Cargo.toml` (manylight uses rayon's global pool, and does not re-export it).
 #![allow(unsafe_code)] // raw glow calls: the application's side of the example
 
 use std::path::Path;
@@ -104,7 +108,7 @@ pub fn run(out: &Path, width: u32, height: u32) -> Result<(), Box<dyn std::error
     )?;
     let (w, h) = (width as i32, height as i32);
     let target = unsafe { AppTarget::new(&app_gl, w, h)? };
-    let result = (|| -> Result<image::RgbaImage, Box<dyn std::error::Error>> {
+    let result = (|| -> Result<manylight::image::RgbaImage, Box<dyn std::error::Error>> {
         unsafe {
             app_gl.bind_framebuffer(glow::FRAMEBUFFER, Some(target.fbo));
             app_gl.viewport(0, 0, w, h);
@@ -148,7 +152,7 @@ pub fn run(out: &Path, width: u32, height: u32) -> Result<(), Box<dyn std::error
             .flatten()
             .copied()
             .collect();
-        Ok(image::RgbaImage::from_raw(width, height, rows).ok_or("readback size")?)
+        Ok(manylight::image::RgbaImage::from_raw(width, height, rows).ok_or("readback size")?)
     })();
     renderer.destroy();
     unsafe {

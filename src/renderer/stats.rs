@@ -96,8 +96,8 @@ pub struct LightStats {
     /// Lights uploaded (radius and radiance > 0).
     #[serde(rename = "active_lights")]
     pub active: usize,
-    /// Lights that reached the screen (touched at least one cell); all active lights for
-    /// forward.
+    /// Lights that reached the screen (touched at least one cell) with tiled and clustered;
+    /// all active lights with forward and deferred, which do not cull by cell.
     #[serde(rename = "visible_lights")]
     pub visible: usize,
     /// Light references dropped by the overflow policy (docs/grid.md), or lights forward left
