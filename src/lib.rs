@@ -98,7 +98,7 @@ pub use methods::Support;
 pub use metrics::counts::LightCounts;
 pub use metrics::spread::Spread;
 pub use options::{
-    CountKind, MeasureOptions, RenderOptions, ToneMap, MAX_EXPOSURE_EV, MAX_TIMED_FRAMES,
+    Clear, CountKind, MeasureOptions, RenderOptions, ToneMap, MAX_EXPOSURE_EV, MAX_TIMED_FRAMES,
 };
 pub use renderer::{
     ContextStats, FrameStats, GridStats, LightStats, MemoryStats, Method, Renderer, TimeStats,

@@ -17,6 +17,20 @@ pub const MAX_TIMED_FRAMES: u32 = 1 << 16;
 /// devices without fragment highp.
 pub const MAX_EXPOSURE_EV: f32 = 15.0;
 
+/// What a frame clears of its rectangle before drawing ([`RenderOptions::clear`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+pub enum Clear {
+    /// Colour (to [`RenderOptions::clear_color`]) and depth: the frame alone.
+    #[default]
+    All,
+    /// Depth only: the frame draws over the colour already there (a sky drawn first), which
+    /// shows wherever no object is.
+    Depth,
+    /// Nothing: the frame draws over the colour and is depth-tested against the depth already
+    /// there (the application's own opaque geometry, drawn first, hides what is behind it).
+    Nothing,
+}
+
 /// Per-call rendering options.
 #[derive(Clone, Debug)]
 pub struct RenderOptions {
@@ -63,6 +77,13 @@ pub struct RenderOptions {
     /// deferred, not HDR output; light counts are never multisampled). A bound framebuffer
     /// that is multisampled itself is drawn into directly.
     pub samples: u32,
+    /// What [`Renderer::render`](crate::Renderer::render) clears of its rectangle before it
+    /// draws: everything (the default), or only depth, or nothing, so the frame draws over
+    /// what the application drew first (a sky; its own opaque geometry, which then hides what
+    /// lies behind it). Only for a single-sampled frame in the application's framebuffer (or
+    /// one multisampled itself): an offscreen render and the renderer's own MSAA target have
+    /// nothing to keep, and refuse it.
+    pub clear: Clear,
     /// Where the frame's lower-left corner lies in the bound framebuffer, in pixels:
     /// [`Renderer::render`](crate::Renderer::render) draws into the `width × height` rectangle
     /// from there and leaves the rest of the framebuffer as it was (split screen, a view beside
@@ -89,6 +110,7 @@ impl Default for RenderOptions {
             tone_map: ToneMap::None,
             exposure_ev: 0.0,
             samples: 1,
+            clear: Clear::All,
             origin: [0, 0],
             measure: MeasureOptions::default(),
         }

@@ -289,13 +289,37 @@ impl Device {
 
     /// Clears colour and depth within `[x, y, width, height]` of the bound framebuffer only
     /// (a scissored clear; the scissor test is off again after it).
-    pub fn clear_rect(&self, [x, y, width, height]: [i32; 4], color: [f32; 4]) {
+    pub fn clear_rect(&self, rect: [i32; 4], color: [f32; 4]) {
+        self.clear_rect_of(rect, Some(color), true);
+    }
+
+    /// Clears the colour (where `color` is given) and the depth (where `depth`) of a rectangle
+    /// of the bound framebuffer.
+    pub fn clear_rect_of(
+        &self,
+        [x, y, width, height]: [i32; 4],
+        color: Option<[f32; 4]>,
+        depth: bool,
+    ) {
+        let mut bits = 0;
         unsafe {
             self.gl.enable(glow::SCISSOR_TEST);
             self.gl.scissor(x, y, width, height);
+            if let Some(c) = color {
+                self.gl.color_mask(true, true, true, true);
+                self.gl.clear_color(c[0], c[1], c[2], c[3]);
+                bits |= glow::COLOR_BUFFER_BIT;
+            }
+            if depth {
+                self.gl.depth_mask(true);
+                self.gl.clear_depth_f32(1.0);
+                bits |= glow::DEPTH_BUFFER_BIT;
+            }
+            if bits != 0 {
+                self.gl.clear(bits);
+            }
+            self.gl.disable(glow::SCISSOR_TEST);
         }
-        self.clear(color);
-        unsafe { self.gl.disable(glow::SCISSOR_TEST) };
     }
 
     /// Clears colour and depth of the bound framebuffer.

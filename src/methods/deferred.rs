@@ -368,7 +368,13 @@ impl Deferred {
         // shader, so it works into a target of any depth format, where a depth blit needs both
         // formats to match exactly (ES 3.0: GL_INVALID_OPERATION otherwise; SwiftShader's
         // DEPTH_COMPONENT24 texture and renderbuffer differ, and a game's back buffer may too).
-        RenderState::FULL_SCREEN_WITH_DEPTH.apply(dev);
+        // Against the application's depth where the frame keeps it (its geometry hides what
+        // lies behind); over a cleared depth the test passes wherever there is a surface.
+        let mut state = RenderState::FULL_SCREEN_WITH_DEPTH;
+        if ctx.options.clear == crate::options::Clear::Nothing {
+            state.depth_test = crate::gl::state::DepthTest::LessEqual;
+        }
+        state.apply(dev);
         let (half, ortho) = half_extent(ctx);
         // Directional lights are shaded here, with the light pass's full material.
         let sun = ctx.features.has(ShaderFeatures::DIRECTIONAL);

@@ -13,7 +13,7 @@ use super::stats::{LightStats, MemoryStats, TimeStats};
 use super::{FrameStats, Renderer};
 use crate::gl::framebuffer::ColorFormat;
 use crate::methods::{self, FrameContext};
-use crate::options::{CountKind, RenderOptions, MAX_EXPOSURE_EV};
+use crate::options::{Clear, CountKind, RenderOptions, MAX_EXPOSURE_EV};
 use crate::scene::features::SceneFeatures;
 use crate::scene::{Projection, Scene};
 use crate::Error;
@@ -97,6 +97,24 @@ impl Renderer {
         };
         if destination_samples > 0 {
             samples = 1;
+        }
+        if options.clear != Clear::All {
+            let keep = |why: &str| Error::InvalidOption {
+                field: "clear",
+                reason: format!("nothing to keep: {why}; use Clear::All"),
+            };
+            if !applications {
+                return Err(keep(
+                    "an offscreen render draws into the renderer's own target",
+                ));
+            }
+            if samples > 1 {
+                return Err(keep(
+                    "MSAA draws into the renderer's own multisampled target, which has none of \
+                     the framebuffer's colour or depth (draw with samples 1, or into a \
+                     framebuffer multisampled itself)",
+                ));
+            }
         }
         if applications {
             self.check_bound_target(width, height, samples <= 1)?;
@@ -222,7 +240,10 @@ impl Renderer {
         let frame_rect = [origin[0], origin[1], width, height].map(|v| v as i32);
         self.dev
             .viewport(frame_rect[0], frame_rect[1], frame_rect[2], frame_rect[3]);
-        self.dev.clear_rect(frame_rect, self.clear_value(options));
+        let keep_colour = options.clear != Clear::All;
+        let colour = (!keep_colour).then(|| self.clear_value(options));
+        self.dev
+            .clear_rect_of(frame_rect, colour, options.clear != Clear::Nothing);
         let mut ctx = FrameContext {
             dev: &self.dev,
             programs: &mut self.programs,
