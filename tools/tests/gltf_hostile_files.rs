@@ -343,6 +343,19 @@ fn more_distinct_meshes_than_the_limit_are_refused_naming_the_first_past_it() {
     );
     let (scene, _) = load(&write(dir.path(), "shared.gltf", model(1))).unwrap();
     assert_eq!(scene.objects.len(), n);
+    // Primitives skipped as points hold nothing and do not count.
+    let points = json!({"primitives": [{"attributes": {"POSITION": p}, "mode": 0}]});
+    let triangle = json!({"primitives": [{"attributes": {"POSITION": p}}]});
+    let mut meshes = vec![points; n];
+    meshes.push(triangle);
+    let skipped = b.gltf(json!({
+        "scene": 0,
+        "scenes": [{"nodes": (0..=n).collect::<Vec<_>>()}],
+        "nodes": (0..=n).map(|i| json!({"mesh": i})).collect::<Vec<_>>(),
+        "meshes": meshes,
+    }));
+    let (scene, _) = load(&write(dir.path(), "points.gltf", skipped)).unwrap();
+    assert_eq!(scene.objects.len(), 1);
 }
 
 /// Images that do not decode are named with the kind of failure only: the decoders' own

@@ -352,18 +352,20 @@ fn import(
                 let cached = match meshes.entry(key) {
                     Entry::Occupied(e) => e.into_mut(),
                     Entry::Vacant(e) => {
-                        if mesh_count >= MAX_SCENE_MESHES {
-                            return Err(format!(
-                                "{pfield}: more than {MAX_SCENE_MESHES} distinct meshes \
-                                 (primitives), the limit per file"
-                            )
-                            .into());
-                        }
-                        mesh_count += 1;
                         let built =
                             mesh::build(&prim, &pfield, &mut buffers, &mut budget, &mut warnings)?;
                         e.insert(match built {
                             mesh::Built::Mesh(mesh) => {
+                                // Counted once made: a skipped primitive (points, lines) holds
+                                // nothing.
+                                mesh_count += 1;
+                                if mesh_count > MAX_SCENE_MESHES {
+                                    return Err(format!(
+                                        "{pfield}: more than {MAX_SCENE_MESHES} distinct meshes \
+                                         (primitives), the limit per file"
+                                    )
+                                    .into());
+                                }
                                 let bounds = mesh.bounds();
                                 let vertex_alpha = mesh.colors.iter().any(|c| c.w < 1.0);
                                 Some((Arc::new(mesh), bounds, vertex_alpha))

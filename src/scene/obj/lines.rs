@@ -40,14 +40,14 @@ pub(super) fn check_obj(text: &str) -> Result<(), String> {
         let at_line = |what: String| format!("line {}: {what}", number + 1);
         let mut words = line.split_whitespace();
         let key = words.next();
-        objects.read(key, words.clone()).map_err(at_line)?;
+        objects.read(key, line).map_err(at_line)?;
         if let Some(kind) = kind_of(key) {
             check_vertex_data(key.unwrap_or_default(), words).map_err(at_line)?;
             defined[kind] += 1;
             continue;
         }
         // tobj's "material parse error", without a line (and not about an MTL file).
-        if key == Some("usemtl") && words.clone().next().is_none() {
+        if key == Some("usemtl") && usemtl_name(line).is_empty() {
             return Err(at_line("`usemtl` names no material".to_string()));
         }
         let Some(key @ ("f" | "l")) = key else {
@@ -108,15 +108,13 @@ struct Objects<'a> {
 }
 
 impl<'a> Objects<'a> {
-    fn read(
-        &mut self,
-        key: Option<&str>,
-        mut words: impl Iterator<Item = &'a str>,
-    ) -> Result<(), String> {
+    fn read(&mut self, key: Option<&str>, line: &'a str) -> Result<(), String> {
         match key {
             Some("o" | "g") => self.current_has_faces = false,
             Some("usemtl") => {
-                let name = words.next();
+                // Two names no library defines are one object to tobj (both no material) and
+                // two here: a count a little high, never too low.
+                let name = Some(usemtl_name(line));
                 if name != self.material {
                     self.current_has_faces = false;
                     self.material = name;
@@ -190,10 +188,17 @@ fn check_vertex_data<'a>(
     }
 }
 
+/// The material name of a `usemtl` line as tobj reads it: everything after the line's first
+/// space, trimmed (so a tab after the key, or spaces before it, change what it names).
+fn usemtl_name(line: &str) -> &str {
+    line.split_once(' ').map_or("", |(_, name)| name.trim())
+}
+
 /// What `usemtl` lines name that no material library defined (tobj gives those faces no
 /// material, and they are drawn in the default grey), said without the names (the file's
 /// text): how many, and the line of the first.
 pub(super) fn undefined_materials(text: &str, defined: &[&str]) -> Option<String> {
+    let defined: std::collections::HashSet<&str> = defined.iter().copied().collect();
     let mut missing = std::collections::HashSet::new();
     let mut first = None;
     for (number, line) in text.lines().enumerate() {
@@ -201,14 +206,10 @@ pub(super) fn undefined_materials(text: &str, defined: &[&str]) -> Option<String
         if words.next() != Some("usemtl") {
             continue;
         }
-        // tobj takes the rest of the line, trimmed, as the name.
-        let name = line
-            .trim()
-            .split_once(char::is_whitespace)
-            .map(|(_, n)| n.trim());
-        let Some(name) = name.filter(|n| !defined.contains(n)) else {
+        let name = usemtl_name(line);
+        if defined.contains(name) {
             continue;
-        };
+        }
         if missing.insert(name) && first.is_none() {
             first = Some(number + 1);
         }
@@ -261,7 +262,31 @@ pub(super) fn check_mtl(text: &str) -> Result<(), String> {
 
 #[cfg(test)]
 mod tests {
-    use super::{check_mtl, check_obj};
+    use super::{check_mtl, check_obj, undefined_materials, Objects};
+
+    /// Objects are counted as tobj splits them: a `usemtl` naming the whole rest of its line.
+    #[test]
+    fn objects_split_at_o_g_and_a_change_of_the_whole_material_name() {
+        let text = "f 1 1 1\nusemtl red paint\nf 1 1 1\nusemtl red brick\nf 1 1 1\n\
+                    usemtl red brick\nf 1 1 1\ng a\ng b\nf 1 1 1\n";
+        let mut objects = Objects::default();
+        for line in text.lines() {
+            objects.read(line.split_whitespace().next(), line).unwrap();
+        }
+        assert_eq!(objects.with_faces, 4);
+    }
+
+    #[test]
+    fn undefined_material_names_are_counted_as_tobj_reads_them() {
+        let text = "usemtl red\nusemtl blue\n  usemtl red\nusemtl blue\n";
+        // The indented line names `usemtl red` to tobj, which no library defines either.
+        let warning = undefined_materials(text, &["red"]).unwrap();
+        assert!(
+            warning.starts_with("2 material names") && warning.contains("line 2"),
+            "{warning}"
+        );
+        assert_eq!(undefined_materials("usemtl red\n", &["red"]), None);
+    }
 
     #[test]
     fn mtl_statements_without_their_values_are_named_by_line() {
@@ -302,6 +327,7 @@ mod tests {
             ("v 0 0 0\nf\n", "line 2: `f` names no vertices"),
             ("v 0 0 0\nl \n", "line 2: `l` names no vertices"),
             ("v 0 0 0\nusemtl\nf 1 1 1\n", "line 2: `usemtl` names no material"),
+            ("v 0 0 0\nusemtl\tred\nf 1 1 1\n", "line 2: `usemtl` names no material"),
             (
                 "v 0 0 0\nvt 0 0\nvn 0 0 1\nf 1/1/1/1 1 1\n",
                 "line 4: `f` corner 1 has 4 indices",
