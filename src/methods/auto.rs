@@ -17,7 +17,6 @@ use super::forward::Forward;
 use super::{FrameContext, MethodDesc, MethodStats, ShadingMethod, Support};
 use crate::cluster::pack::MAX_INDEXED_LIGHTS;
 use crate::gl::{gbuffer, Device, EsVersion};
-use crate::options::CountKind;
 use crate::Error;
 
 /// The table row.
@@ -139,8 +138,7 @@ fn deferred_refusal(ctx: &FrameContext) -> Option<String> {
     if let Some(why) = gbuffer::unsupported_reason(ctx.dev.caps()) {
         return Some(why);
     }
-    // As `Renderer::render_hosted` decides: light counts are never multisampled.
-    (ctx.options.samples > 1 && ctx.options.count == CountKind::None)
+    ctx.own_msaa
         .then(|| format!("{} MSAA samples, one G-buffer sample", ctx.options.samples))
 }
 

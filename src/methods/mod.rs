@@ -94,6 +94,9 @@ pub struct FrameContext<'a> {
     pub order: &'a mut geometry::DrawOrder,
     /// Draw only the transparent objects (deferred's forward fallback for them).
     pub transparent_only: bool,
+    /// The frame is drawn into the renderer's own multisampled target (`RenderOptions::samples`
+    /// above 1, not drawn straight into a framebuffer multisampled itself).
+    pub own_msaa: bool,
 }
 
 /// Which grid a tiled or clustered frame used, and why.

@@ -130,6 +130,7 @@ impl Renderer {
                     .into(),
             });
         }
+        self.own_msaa_frame = samples > 1;
         if samples <= 1 {
             self.render_frame(scene, (width, height), options, origin, stats)?;
             stats.samples = stats.samples.max(destination_samples as u32);
@@ -263,6 +264,7 @@ impl Renderer {
             options,
             order: &mut self.draw_order,
             transparent_only: false,
+            own_msaa: self.own_msaa_frame,
         };
         // The frame's errors so far are its own: the timer's calls (creating the queries too)
         // would drain them as theirs.

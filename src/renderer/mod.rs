@@ -51,6 +51,8 @@ pub struct Renderer {
     timer: Option<Option<crate::gl::timer::GpuTimer>>,
     /// Frames rendered: the number the GPU timer's results are matched to their frames by.
     frame_serial: u64,
+    /// The frame being drawn goes into the renderer's own MSAA target.
+    own_msaa_frame: bool,
     /// What the default method's support would warn about: said at the first frame, unless
     /// the caller picks a method first (whose own support is then what is said).
     pending_warning: Option<String>,
@@ -125,6 +127,7 @@ impl Renderer {
             msaa: None,
             timer: None,
             frame_serial: 0,
+            own_msaa_frame: false,
             pending_warning,
             freed: false,
             lights: Vec::new(),

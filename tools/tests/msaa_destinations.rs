@@ -63,6 +63,66 @@ fn msaa_resolves_into_framebuffers_of_other_colour_formats() {
     }
 }
 
+/// Makes and binds a 4-sample RGBA8 framebuffer with 24-bit depth (a window surface made with
+/// `EGL_SAMPLES`): the framebuffer and its colour and depth renderbuffers.
+unsafe fn multisampled_framebuffer(
+    gl: &glow::Context,
+    (w, h): (i32, i32),
+) -> (glow::Framebuffer, [glow::Renderbuffer; 2]) {
+    let buffers = [
+        gl.create_renderbuffer().unwrap(),
+        gl.create_renderbuffer().unwrap(),
+    ];
+    let fbo = gl.create_framebuffer().unwrap();
+    gl.bind_framebuffer(glow::FRAMEBUFFER, Some(fbo));
+    for (rb, format, attachment) in [
+        (buffers[0], glow::RGBA8, glow::COLOR_ATTACHMENT0),
+        (buffers[1], glow::DEPTH_COMPONENT24, glow::DEPTH_ATTACHMENT),
+    ] {
+        gl.bind_renderbuffer(glow::RENDERBUFFER, Some(rb));
+        gl.renderbuffer_storage_multisample(glow::RENDERBUFFER, 4, format, w, h);
+        gl.framebuffer_renderbuffer(glow::FRAMEBUFFER, attachment, glow::RENDERBUFFER, Some(rb));
+    }
+    assert_eq!(
+        gl.check_framebuffer_status(glow::FRAMEBUFFER),
+        glow::FRAMEBUFFER_COMPLETE
+    );
+    (fbo, buffers)
+}
+
+/// Into a framebuffer multisampled itself, `auto` past clustered's index limit can still take
+/// deferred (its G-buffer is single-sampled, the framebuffer samples the composite): the
+/// renderer's own MSAA is what rules deferred out, not `samples` as asked.
+#[test]
+fn auto_takes_deferred_into_a_multisampled_game_framebuffer() {
+    use manylight::cluster::pack::MAX_INDEXED_LIGHTS;
+    let mut s = scene::builtin::build("plane", None).unwrap();
+    s.lights = (0..MAX_INDEXED_LIGHTS + 1)
+        .map(|i| {
+            let x = (i % 256) as f64 / 64.0 - 2.0;
+            let y = (i / 256) as f64 / 107.0 - 1.2;
+            scene::Light::point(glam::DVec3::new(x, y, 0.2), 0.3, glam::Vec3::ONE, 1e-3)
+        })
+        .collect();
+    let mut gpu = Gpu::new(EsVersion::Es3);
+    gpu.r().set_method_named("auto").unwrap();
+    let gl = gpu.gl();
+    let (fbo, buffers) = unsafe { multisampled_framebuffer(&gl, (32, 18)) };
+    let stats = gpu.r().render(&s, 32, 18, &msaa());
+    unsafe {
+        gl.bind_framebuffer(glow::FRAMEBUFFER, None);
+        gl.delete_framebuffer(fbo);
+        buffers.iter().for_each(|&rb| gl.delete_renderbuffer(rb));
+    }
+    let stats = stats.unwrap();
+    assert_eq!(
+        stats.auto_choice.as_deref(),
+        Some("deferred"),
+        "{:?}",
+        stats.auto_reason
+    );
+}
+
 #[test]
 fn a_multisampled_game_framebuffer_samples_the_frame_itself() {
     let s = scene::builtin::build(scene::builtin::DEFAULT, Some((128, 3))).unwrap();
@@ -70,32 +130,7 @@ fn a_multisampled_game_framebuffer_samples_the_frame_itself() {
     let reference = stored(&mut gpu, glow::RGBA8, &s);
     let gl = gpu.gl();
     let (w, h) = (W as i32, H as i32);
-    let (fbo, buffers) = unsafe {
-        let buffers = [
-            gl.create_renderbuffer().unwrap(),
-            gl.create_renderbuffer().unwrap(),
-        ];
-        let fbo = gl.create_framebuffer().unwrap();
-        gl.bind_framebuffer(glow::FRAMEBUFFER, Some(fbo));
-        for (rb, format, attachment) in [
-            (buffers[0], glow::RGBA8, glow::COLOR_ATTACHMENT0),
-            (buffers[1], glow::DEPTH_COMPONENT24, glow::DEPTH_ATTACHMENT),
-        ] {
-            gl.bind_renderbuffer(glow::RENDERBUFFER, Some(rb));
-            gl.renderbuffer_storage_multisample(glow::RENDERBUFFER, 4, format, w, h);
-            gl.framebuffer_renderbuffer(
-                glow::FRAMEBUFFER,
-                attachment,
-                glow::RENDERBUFFER,
-                Some(rb),
-            );
-        }
-        assert_eq!(
-            gl.check_framebuffer_status(glow::FRAMEBUFFER),
-            glow::FRAMEBUFFER_COMPLETE
-        );
-        (fbo, buffers)
-    };
+    let (fbo, buffers) = unsafe { multisampled_framebuffer(&gl, (w, h)) };
     let stats = gpu.r().render(&s, W, H, &msaa());
     // The game resolves its own framebuffer, into a single-sampled one to read.
     let single = unsafe { sized_framebuffer(&gl, glow::RGBA8, (w, h)) };
