@@ -274,10 +274,22 @@ impl Scene {
                 light.validate(&format!("directional_lights[{i}]"))?;
             }
         }
-        // A track reaching past the lights (a game popped some) poses those that are there,
-        // as `set_time` does.
         for track in &self.animation {
             let field = || format!("lights[{}].motion", track.first);
+            // Lights removed without their tracks: a track would pose whatever lights take
+            // their places (lights pushed later included).
+            if track.first.saturating_add(track.rest.len()) > self.lights.len() {
+                return Err(SceneError::invalid(
+                    field(),
+                    format!(
+                        "moves lights {}..{} but the scene has {}: remove lights with \
+                         Scene::remove_light, which removes them from their motions too",
+                        track.first,
+                        track.first.saturating_add(track.rest.len()),
+                        self.lights.len()
+                    ),
+                ));
+            }
             // A set's sweep applies to its spots only; a single light's must have a cone.
             let is_spot = track.vary.is_some()
                 || track
