@@ -50,6 +50,12 @@ pub struct RenderOptions {
     /// full frame time. Offscreen rendering and benchmarks want this; a game presenting to a
     /// window sets it to `false` and `frame_ms` is then the CPU submission time only.
     pub wait_for_gpu: bool,
+    /// Time the frame's GL work on the GPU with `GL_EXT_disjoint_timer_query` where the
+    /// context has it (`FrameStats::time::gpu_ms`; the automatic grid's shading cost when the
+    /// frame does not wait). Reading the extension's disjoint flag clears it: an application
+    /// that times its own work with the extension sets this to `false`, or it may miss a
+    /// disjoint event. A frame inside the application's own elapsed-time query goes untimed.
+    pub gpu_timer: bool,
     /// Write linear, unclamped radiance (for float targets; see
     /// [`Renderer::render_offscreen_hdr`](crate::Renderer::render_offscreen_hdr)).
     pub hdr: bool,
@@ -103,6 +109,7 @@ impl Default for RenderOptions {
             grid: GridConfig::default(),
             tile_px: TILE_PX,
             wait_for_gpu: true,
+            gpu_timer: true,
             hdr: false,
             count: CountKind::None,
             light_cutoff: None,

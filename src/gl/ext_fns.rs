@@ -158,6 +158,8 @@ pub type DeleteQueriesExt = unsafe extern "system" fn(n: i32, ids: *const u32);
 pub type BeginQueryExt = unsafe extern "system" fn(target: u32, id: u32);
 /// `glEndQueryEXT(target)`.
 pub type EndQueryExt = unsafe extern "system" fn(target: u32);
+/// `glGetQueryivEXT(target, pname, params)`.
+pub type GetQueryivExt = unsafe extern "system" fn(target: u32, pname: u32, params: *mut i32);
 /// `glGetQueryObjectui64vEXT(id, pname, params)`.
 pub type GetQueryObjectUi64vExt = unsafe extern "system" fn(id: u32, pname: u32, params: *mut u64);
 
@@ -174,6 +176,8 @@ pub struct TimerQueryFns {
     pub end_query: EndQueryExt,
     /// `glGetQueryObjectui64vEXT`.
     pub get_query_object_ui64v: GetQueryObjectUi64vExt,
+    /// `glGetQueryivEXT`.
+    pub get_queryiv: GetQueryivExt,
 }
 
 /// Loads `GL_EXT_disjoint_timer_query`'s entry points; `None` when any is missing.
@@ -193,6 +197,7 @@ pub fn timer_query_fns() -> Option<TimerQueryFns> {
             get_query_object_ui64v: std::mem::transmute::<Ptr, GetQueryObjectUi64vExt>(get(
                 "glGetQueryObjectui64vEXT",
             )?),
+            get_queryiv: std::mem::transmute::<Ptr, GetQueryivExt>(get("glGetQueryivEXT")?),
         })
     }
 }

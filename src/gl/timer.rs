@@ -38,6 +38,9 @@ pub const RING: usize = 4;
 /// `GL_QUERY_RESULT_AVAILABLE_EXT`.
 const QUERY_RESULT_AVAILABLE: u32 = 0x8867;
 
+/// `GL_CURRENT_QUERY_EXT`.
+const CURRENT_QUERY: u32 = 0x8865;
+
 /// A ring of elapsed-time queries, reused frame after frame. A frame that waits for the GPU
 /// reads its own query at once; one that does not leaves it in flight and reads the finished
 /// ones later, without stalling ([`GpuTimer::poll`]).
@@ -97,6 +100,13 @@ impl GpuTimer {
             unsafe { (self.fns.end_query)(TIME_ELAPSED) };
             dev.drain_errors();
             self.in_flight[slot].set(None);
+        }
+        // An application timing its own work around the frame has a query running: one
+        // elapsed-time query at a time, so this frame goes untimed (beginning ours would fail).
+        let mut current = 0;
+        unsafe { (self.fns.get_queryiv)(TIME_ELAPSED, CURRENT_QUERY, &mut current) };
+        if !self.check(dev, "glGetQueryivEXT") || current != 0 {
+            return;
         }
         self.take_disjoint(dev);
         let Some(slot) = self.in_flight.iter().position(|f| f.get().is_none()) else {

@@ -269,13 +269,18 @@ impl Renderer {
         // The frame's errors so far are its own: the timer's calls (creating the queries too)
         // would drain them as theirs.
         self.dev.check("the frame's uploads")?;
-        if self.timer.is_none() {
+        if options.gpu_timer && self.timer.is_none() {
             self.timer = Some(crate::gl::timer::GpuTimer::new(&self.dev));
         }
-        let timer = self.timer.as_ref().and_then(Option::as_ref);
+        let timer = (self.timer.as_ref().and_then(Option::as_ref)).filter(|_| options.gpu_timer);
         self.frame_serial += 1;
         let serial = self.frame_serial;
         if let Some(t) = timer {
+            // A frame that waits reads its own query: earlier frames' left in flight are
+            // taken first, so one is free for it.
+            if options.wait_for_gpu {
+                t.poll(&self.dev);
+            }
             t.begin(&self.dev, serial);
         }
         // No lights: no assignment, no uploads, the light loop compiled out — whatever the

@@ -120,3 +120,44 @@ fn frames_that_do_not_wait_report_the_gpu_time_of_a_finished_frame() {
     );
     renderer.destroy();
 }
+
+/// An application timing its own work around a frame has an elapsed-time query running: the
+/// frame goes untimed (beginning a second one would fail and turn timing off for good), and
+/// the next frame is timed again. With `gpu_timer: false` no query is made at all.
+#[test]
+fn a_frame_inside_the_applications_own_query_goes_untimed() {
+    let Some(ctx) = context_or_skip(EsVersion::Es3) else {
+        return;
+    };
+    let mut renderer = Renderer::new(ctx.load_gl().unwrap(), EsVersion::Es3).unwrap();
+    if !renderer.caps().timer_query {
+        eprintln!("skipped: no GL_EXT_disjoint_timer_query here");
+        return;
+    }
+    let scene = crate::scene::builtin::build("plane", Some((4, 1))).unwrap();
+    let options = crate::RenderOptions::default();
+    let fns = crate::gl::ext_fns::timer_query_fns().unwrap();
+    let mut query = 0;
+    let (_, inside) = unsafe {
+        (fns.gen_queries)(1, &mut query);
+        (fns.begin_query)(0x88BF, query);
+        let inside = renderer.render_offscreen(&scene, 16, 9, &options).unwrap();
+        (fns.end_query)(0x88BF);
+        (fns.delete_queries)(1, &query);
+        inside
+    };
+    assert_eq!(inside.time.gpu_ms, None);
+    let (_, after) = renderer.render_offscreen(&scene, 16, 9, &options).unwrap();
+    assert!(after.time.gpu_ms.is_some(), "GPU timing turned off");
+
+    let mut untimed = Renderer::new(ctx.load_gl().unwrap(), EsVersion::Es3).unwrap();
+    let off = crate::RenderOptions {
+        gpu_timer: false,
+        ..Default::default()
+    };
+    let (_, stats) = untimed.render_offscreen(&scene, 16, 9, &off).unwrap();
+    assert_eq!(stats.time.gpu_ms, None);
+    assert!(untimed.timer.is_none(), "no query made");
+    untimed.destroy();
+    renderer.destroy();
+}
