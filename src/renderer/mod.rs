@@ -16,6 +16,8 @@ mod hosted_tests;
 mod method;
 mod offscreen;
 mod stats;
+#[cfg(test)]
+mod timer_tests;
 
 use crate::cluster::view_light::GpuLight;
 use crate::gl::framebuffer::OffscreenTarget;

@@ -138,16 +138,7 @@ fn auto_renders_with_deferred_or_forward_when_more_lights_are_visible_than_clust
 /// ES 2.0 has no G-buffer: past clustered's index limit `auto` renders with forward.
 #[test]
 fn auto_renders_with_forward_past_the_index_limit_on_es2() {
-    use manylight::cluster::pack::MAX_INDEXED_LIGHTS;
-    use manylight::scene::Light;
-    let mut s = scene::builtin::build("plane", None).unwrap();
-    s.lights = (0..MAX_INDEXED_LIGHTS + 1)
-        .map(|i| {
-            let x = (i % 256) as f64 / 64.0 - 2.0;
-            let y = (i / 256) as f64 / 107.0 - 1.2;
-            Light::point(glam::DVec3::new(x, y, 0.2), 0.3, glam::Vec3::ONE, 1e-3)
-        })
-        .collect();
+    let s = common::light_lattice::plane_past_the_index_limit();
     let mut gpu = Gpu::new(EsVersion::Es2);
     gpu.r().set_method_named("forward").unwrap();
     let (reference, _) = gpu

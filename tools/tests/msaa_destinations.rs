@@ -95,15 +95,7 @@ unsafe fn multisampled_framebuffer(
 /// renderer's own MSAA is what rules deferred out, not `samples` as asked.
 #[test]
 fn auto_takes_deferred_into_a_multisampled_game_framebuffer() {
-    use manylight::cluster::pack::MAX_INDEXED_LIGHTS;
-    let mut s = scene::builtin::build("plane", None).unwrap();
-    s.lights = (0..MAX_INDEXED_LIGHTS + 1)
-        .map(|i| {
-            let x = (i % 256) as f64 / 64.0 - 2.0;
-            let y = (i / 256) as f64 / 107.0 - 1.2;
-            scene::Light::point(glam::DVec3::new(x, y, 0.2), 0.3, glam::Vec3::ONE, 1e-3)
-        })
-        .collect();
+    let s = common::light_lattice::plane_past_the_index_limit();
     let mut gpu = Gpu::new(EsVersion::Es3);
     gpu.r().set_method_named("auto").unwrap();
     let gl = gpu.gl();

@@ -6,6 +6,7 @@ pub mod files;
 pub mod game_target;
 pub mod gltf;
 pub mod gltf_models;
+pub mod light_lattice;
 pub mod warnings;
 
 use std::path::PathBuf;

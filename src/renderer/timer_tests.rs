@@ -1,0 +1,107 @@
+//! The GPU timer as a frame uses it: results read at once or frames later, a query left
+//! running by a panicked frame, an application's own query around a frame.
+#![allow(unsafe_code)] // the application's own query: the extension's entry points
+
+use crate::gl::context::context_or_skip;
+use crate::gl::EsVersion;
+use crate::{HeadlessContext, Renderer};
+
+/// An ES 3.0 context and a renderer on it, where the context has timer queries (the
+/// renderer, bound second, is dropped first).
+fn timed_renderer() -> Option<(HeadlessContext, Renderer)> {
+    let ctx = context_or_skip(EsVersion::Es3)?;
+    let renderer = Renderer::new(ctx.load_gl().unwrap(), EsVersion::Es3).unwrap();
+    if !renderer.caps().timer_query {
+        eprintln!("skipped: no GL_EXT_disjoint_timer_query here");
+        return None;
+    }
+    Some((ctx, renderer))
+}
+
+/// A frame that panicked between the GPU timer's begin and end left its query running, and
+/// the next timed frame's begin was refused: GPU timing off for good.
+#[test]
+fn a_frame_that_panicked_mid_query_leaves_gpu_timing_on() {
+    let Some((_ctx, mut renderer)) = timed_renderer() else {
+        return;
+    };
+    let scene = crate::scene::builtin::build("plane", Some((4, 1))).unwrap();
+    let options = crate::RenderOptions::default();
+    let (_, stats) = renderer.render_offscreen(&scene, 16, 9, &options).unwrap();
+    assert!(stats.time.gpu_ms.is_some(), "no GPU time to begin with");
+    let caught = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        let _ = renderer.hosted(|r| -> Result<(), crate::Error> {
+            if let Some(Some(timer)) = &r.timer {
+                timer.begin(&r.dev, 0);
+            }
+            panic!("a bug between the query's begin and end");
+        });
+    }));
+    assert!(caught.is_err());
+    let (_, stats) = renderer.render_offscreen(&scene, 16, 9, &options).unwrap();
+    assert!(stats.time.gpu_ms.is_some(), "GPU timing turned off");
+    renderer.destroy();
+}
+
+/// A frame that does not wait for the GPU still gets GPU time: an earlier frame's, read once
+/// it finished, without stalling (a game's frames).
+#[test]
+fn frames_that_do_not_wait_report_the_gpu_time_of_a_finished_frame() {
+    let Some((_ctx, mut renderer)) = timed_renderer() else {
+        return;
+    };
+    let scene = crate::scene::builtin::build("plane", Some((64, 1))).unwrap();
+    let options = crate::RenderOptions {
+        wait_for_gpu: false,
+        ..Default::default()
+    };
+    let timed: Vec<Option<f64>> = (0..12)
+        .map(|_| {
+            let (_, stats) = renderer.render_offscreen(&scene, 64, 36, &options).unwrap();
+            stats.time.gpu_ms
+        })
+        .collect();
+    let read = timed.iter().flatten().count();
+    assert!(read >= 6, "GPU times read: {timed:?}");
+    assert!(
+        timed.iter().flatten().all(|ms| ms.is_finite() && *ms > 0.0),
+        "{timed:?}"
+    );
+    renderer.destroy();
+}
+
+/// An application timing its own work around a frame has an elapsed-time query running: the
+/// frame goes untimed (beginning a second one would fail and turn timing off for good), and
+/// the next frame is timed again. With `gpu_timer: false` no query is made at all.
+#[test]
+fn a_frame_inside_the_applications_own_query_goes_untimed() {
+    let Some((ctx, mut renderer)) = timed_renderer() else {
+        return;
+    };
+    let scene = crate::scene::builtin::build("plane", Some((4, 1))).unwrap();
+    let options = crate::RenderOptions::default();
+    let fns = crate::gl::ext_fns::timer_query_fns().unwrap();
+    let mut query = 0;
+    let (_, inside) = unsafe {
+        (fns.gen_queries)(1, &mut query);
+        (fns.begin_query)(0x88BF, query);
+        let inside = renderer.render_offscreen(&scene, 16, 9, &options).unwrap();
+        (fns.end_query)(0x88BF);
+        (fns.delete_queries)(1, &query);
+        inside
+    };
+    assert_eq!(inside.time.gpu_ms, None);
+    let (_, after) = renderer.render_offscreen(&scene, 16, 9, &options).unwrap();
+    assert!(after.time.gpu_ms.is_some(), "GPU timing turned off");
+
+    let mut untimed = Renderer::new(ctx.load_gl().unwrap(), EsVersion::Es3).unwrap();
+    let off = crate::RenderOptions {
+        gpu_timer: false,
+        ..Default::default()
+    };
+    let (_, stats) = untimed.render_offscreen(&scene, 16, 9, &off).unwrap();
+    assert_eq!(stats.time.gpu_ms, None);
+    assert!(untimed.timer.is_none(), "no query made");
+    untimed.destroy();
+    renderer.destroy();
+}
