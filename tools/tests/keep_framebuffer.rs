@@ -1,7 +1,7 @@
 //! `RenderOptions::clear`: a frame drawn over what the game drew first. Keeping the colour,
 //! the game's picture shows wherever the scene has no surface and the rest equals a frame of
 //! its own; keeping the depth too, the game's nearer depth hides the scene where it lies
-//! (here: the left half at depth 0). Forward, clustered and deferred alike; an offscreen
+//! (here: the left half at depth 0). Every method alike; an offscreen
 //! render and the renderer's own MSAA target refuse it.
 #![allow(unsafe_code)] // the game's side: raw glow calls
 
@@ -53,8 +53,11 @@ fn pixel(bytes: &[u8], x: u32, y: u32) -> [u8; 4] {
 fn a_frame_keeps_the_games_colour_and_depth_when_asked() {
     let s = scene::builtin::build("pillars", Some((64, 5))).unwrap();
     let cases: [(EsVersion, &[&str]); 2] = [
-        (EsVersion::Es2, &["forward", "clustered"]),
-        (EsVersion::Es3, &["forward", "clustered", "deferred"]),
+        (EsVersion::Es2, &["forward", "tiled", "clustered", "auto"]),
+        (
+            EsVersion::Es3,
+            &["forward", "tiled", "clustered", "deferred", "auto"],
+        ),
     ];
     for (es, methods) in cases {
         let mut gpu = Gpu::new(es);
