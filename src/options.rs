@@ -86,9 +86,10 @@ pub struct RenderOptions {
     /// What [`Renderer::render`](crate::Renderer::render) clears of its rectangle before it
     /// draws: everything (the default), or only depth, or nothing, so the frame draws over
     /// what the application drew first (a sky; its own opaque geometry, which then hides what
-    /// lies behind it). Only for a single-sampled frame in the application's framebuffer (or
-    /// one multisampled itself): an offscreen render and the renderer's own MSAA target have
-    /// nothing to keep, and refuse it.
+    /// lies behind it); its colour and alpha then stay wherever no surface is drawn, in place
+    /// of `clear_color`. For a single-sampled frame in the application's framebuffer (or one
+    /// multisampled itself): the renderer's own MSAA target has nothing to keep and refuses
+    /// it, and an offscreen render ignores it, as it ignores `origin`.
     pub clear: Clear,
     /// Where the frame's lower-left corner lies in the bound framebuffer, in pixels:
     /// [`Renderer::render`](crate::Renderer::render) draws into the `width × height` rectangle

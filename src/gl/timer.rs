@@ -94,13 +94,7 @@ impl GpuTimer {
         if self.failed.get() {
             return;
         }
-        if let Some(slot) = self.running.take() {
-            // Left running by a frame that panicked (and was caught): ended unread, or this
-            // begin would be refused and the timer turned off.
-            unsafe { (self.fns.end_query)(TIME_ELAPSED) };
-            dev.drain_errors();
-            self.in_flight[slot].set(None);
-        }
+        self.end_running(dev);
         // An application timing its own work around the frame has a query running: one
         // elapsed-time query at a time, so this frame goes untimed (beginning ours would fail).
         let mut current = 0;
@@ -116,6 +110,16 @@ impl GpuTimer {
         if self.check(dev, "glBeginQueryEXT") {
             self.running.set(Some(slot));
             self.in_flight[slot].set(Some(serial));
+        }
+    }
+
+    /// Ends, unread, a query left running by a frame that panicked between `begin` and `end`
+    /// (else this timer's next begin, and the application's own queries, would be refused).
+    pub fn end_running(&self, dev: &Device) {
+        if let Some(slot) = self.running.take() {
+            unsafe { (self.fns.end_query)(TIME_ELAPSED) };
+            dev.drain_errors();
+            self.in_flight[slot].set(None);
         }
     }
 

@@ -16,6 +16,7 @@ use super::deferred::Deferred;
 use super::forward::Forward;
 use super::{FrameContext, MethodDesc, MethodStats, ShadingMethod, Support};
 use crate::cluster::pack::MAX_INDEXED_LIGHTS;
+use crate::gl::target_size::{self, TargetStorage};
 use crate::gl::{gbuffer, Device, EsVersion};
 use crate::Error;
 
@@ -135,8 +136,18 @@ fn retire_deferred(deferred: &mut Option<Deferred>, idle: &mut u32, dev: &Device
 /// Why deferred cannot render this frame, if it cannot: no G-buffer on this context, or the
 /// frame is drawn into the renderer's multisampled target, which deferred does not support.
 fn deferred_refusal(ctx: &FrameContext) -> Option<String> {
-    if let Some(why) = gbuffer::unsupported_reason(ctx.dev.caps()) {
+    let caps = ctx.dev.caps();
+    if let Some(why) = gbuffer::unsupported_reason(caps) {
         return Some(why);
+    }
+    // A frame within the viewport limit may still pass the G-buffer's texture size: forward
+    // draws it then, rather than every such frame failing.
+    let textures = TargetStorage {
+        textures: true,
+        renderbuffers: false,
+    };
+    if let Err(e) = target_size::check(caps, "a deferred G-buffer", ctx.viewport, textures) {
+        return Some(e.to_string());
     }
     ctx.own_msaa
         .then(|| format!("{} MSAA samples, one G-buffer sample", ctx.options.samples))

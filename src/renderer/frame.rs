@@ -98,16 +98,18 @@ impl Renderer {
         if destination_samples > 0 {
             samples = 1;
         }
-        if options.clear != Clear::All {
+        // An offscreen render has nothing to keep (its target is the renderer's own): it
+        // ignores `clear`, as it ignores `origin`.
+        self.frame_clear = if applications {
+            options.clear
+        } else {
+            Clear::All
+        };
+        if self.frame_clear != Clear::All {
             let keep = |why: &str| Error::InvalidOption {
                 field: "clear",
                 reason: format!("nothing to keep: {why}; use Clear::All"),
             };
-            if !applications {
-                return Err(keep(
-                    "an offscreen render draws into the renderer's own target",
-                ));
-            }
             if samples > 1 {
                 return Err(keep(
                     "MSAA draws into the renderer's own multisampled target, which has none of \
@@ -241,10 +243,10 @@ impl Renderer {
         let frame_rect = [origin[0], origin[1], width, height].map(|v| v as i32);
         self.dev
             .viewport(frame_rect[0], frame_rect[1], frame_rect[2], frame_rect[3]);
-        let keep_colour = options.clear != Clear::All;
-        let colour = (!keep_colour).then(|| self.clear_value(options));
+        let clear = self.frame_clear;
+        let colour = (clear == Clear::All).then(|| self.clear_value(options));
         self.dev
-            .clear_rect_of(frame_rect, colour, options.clear != Clear::Nothing);
+            .clear_rect_of(frame_rect, colour, clear != Clear::Nothing);
         let mut ctx = FrameContext {
             dev: &self.dev,
             programs: &mut self.programs,
@@ -294,7 +296,12 @@ impl Renderer {
         // active makes the next frame's `glBeginQuery` fail).
         let rendered = match (rendered, timer) {
             (Ok(stats), Some(_)) => self.dev.check("frame").map(|()| stats).map_err(Error::from),
-            (other, _) => other,
+            // A failed frame's pending errors are its own, not the query's.
+            (Err(e), Some(_)) => {
+                self.dev.drain_errors();
+                Err(e)
+            }
+            (other, None) => other,
         };
         // A frame that waits reads its own query; one that does not reads the newest that has
         // finished, without stalling.

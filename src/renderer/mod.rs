@@ -55,6 +55,8 @@ pub struct Renderer {
     frame_serial: u64,
     /// The frame being drawn goes into the renderer's own MSAA target.
     own_msaa_frame: bool,
+    /// What the frame being drawn clears (`RenderOptions::clear`, or everything offscreen).
+    frame_clear: crate::options::Clear,
     /// What the default method's support would warn about: said at the first frame, unless
     /// the caller picks a method first (whose own support is then what is said).
     pending_warning: Option<String>,
@@ -130,6 +132,7 @@ impl Renderer {
             timer: None,
             frame_serial: 0,
             own_msaa_frame: false,
+            frame_clear: crate::options::Clear::All,
             pending_warning,
             freed: false,
             lights: Vec::new(),
@@ -186,6 +189,13 @@ impl Renderer {
         self.dev.check_current()?;
         let host = self.dev.enter_host();
         let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| f(self)));
+        if result.is_err() {
+            // A frame that panicked between the GPU timer's begin and end left its query
+            // running: ended, or the application's own queries would be refused.
+            if let Some(Some(t)) = &self.timer {
+                t.end_running(&self.dev);
+            }
+        }
         if !matches!(result, Ok(Ok(_))) {
             // A failed call's own GL errors, not to be reported as the game's next time.
             self.dev.drain_errors();
@@ -312,6 +322,7 @@ impl Renderer {
             return;
         }
         if let Some(Some(t)) = self.timer.take() {
+            t.end_running(&self.dev);
             t.destroy(&self.dev);
         }
         self.method.destroy(&self.dev);

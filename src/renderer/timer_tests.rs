@@ -2,6 +2,8 @@
 //! running by a panicked frame, an application's own query around a frame.
 #![allow(unsafe_code)] // the application's own query: the extension's entry points
 
+use glow::HasContext;
+
 use crate::gl::context::context_or_skip;
 use crate::gl::EsVersion;
 use crate::{HeadlessContext, Renderer};
@@ -22,7 +24,7 @@ fn timed_renderer() -> Option<(HeadlessContext, Renderer)> {
 /// the next timed frame's begin was refused: GPU timing off for good.
 #[test]
 fn a_frame_that_panicked_mid_query_leaves_gpu_timing_on() {
-    let Some((_ctx, mut renderer)) = timed_renderer() else {
+    let Some((ctx, mut renderer)) = timed_renderer() else {
         return;
     };
     let scene = crate::scene::builtin::build("plane", Some((4, 1))).unwrap();
@@ -38,6 +40,21 @@ fn a_frame_that_panicked_mid_query_leaves_gpu_timing_on() {
         });
     }));
     assert!(caught.is_err());
+    // The panicked frame's query was ended: the application's own begins.
+    let gl = ctx.load_gl().unwrap();
+    let fns = crate::gl::ext_fns::timer_query_fns().unwrap();
+    unsafe {
+        let mut query = 0;
+        (fns.gen_queries)(1, &mut query);
+        (fns.begin_query)(0x88BF, query);
+        assert_eq!(
+            gl.get_error(),
+            glow::NO_ERROR,
+            "the application's query refused"
+        );
+        (fns.end_query)(0x88BF);
+        (fns.delete_queries)(1, &query);
+    }
     let (_, stats) = renderer.render_offscreen(&scene, 16, 9, &options).unwrap();
     assert!(stats.time.gpu_ms.is_some(), "GPU timing turned off");
     renderer.destroy();
