@@ -217,6 +217,10 @@ impl ShadingMethod for Auto {
         Ok(stats)
     }
 
+    fn skip_frame(&mut self, dev: &Device) {
+        retire_deferred(&mut self.deferred, &mut self.deferred_idle, dev);
+    }
+
     fn observe_frame(&mut self, timing: super::FrameTiming) {
         if let Some(c) = &mut self.clustered {
             c.observe_frame(timing);

@@ -156,6 +156,9 @@ pub trait ShadingMethod {
     /// frame waited for it; GPU time from a timer query, this frame's or an earlier one's):
     /// methods that calibrate a cost model take it in.
     fn observe_frame(&mut self, _timing: FrameTiming) {}
+    /// A frame with no lights, drawn without the method (ambient only): a method that keeps
+    /// resources for a number of frames counts it.
+    fn skip_frame(&mut self, _dev: &Device) {}
     /// Frees the method's GPU resources.
     fn destroy(&mut self, dev: &Device);
 }

@@ -288,6 +288,7 @@ impl Renderer {
         // No lights: no assignment, no uploads, the light loop compiled out — whatever the
         // method (a scene pays only for what it has).
         let rendered = if self.lights.is_empty() {
+            self.method.skip_frame(&self.dev);
             methods::forward::draw_ambient_only(&mut ctx)
         } else {
             self.method.render(&mut ctx)

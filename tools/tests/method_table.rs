@@ -133,6 +133,20 @@ fn auto_renders_with_deferred_or_forward_when_more_lights_are_visible_than_clust
         drops[..last].iter().all(|&d| d < gbuffer),
         "kept before: {held:?}"
     );
+    // Frames with no lights at all (ambient only, drawn without the method) count too.
+    let all = common::light_lattice::plane_past_the_index_limit();
+    let (_, stats) = gpu.r().render_offscreen(&all, w, h, &single).unwrap();
+    assert_eq!(stats.auto_choice.as_deref(), Some("deferred"));
+    let with_gbuffer = gpu.r().render_offscreen(&all, w, h, &single).unwrap().1;
+    s.lights.clear();
+    let unlit: Vec<usize> = (0..=manylight::methods::auto::DEFERRED_KEPT_FRAMES)
+        .map(|_| {
+            let (_, stats) = gpu.r().render_offscreen(&s, w, h, &single).unwrap();
+            stats.memory.method_gpu_bytes
+        })
+        .collect();
+    let freed = with_gbuffer.memory.method_gpu_bytes - unlit[unlit.len() - 1];
+    assert!(freed >= gbuffer, "{unlit:?}");
 }
 
 /// ES 2.0 has no G-buffer: past clustered's index limit `auto` renders with forward.
