@@ -1,10 +1,10 @@
 //! GPU frame timing with `GL_EXT_disjoint_timer_query` (a `TIME_ELAPSED` query around the
 //! frame's GL work), where the context has it: read at once by a frame that waits for the GPU
-//! anyway, and a few frames later, when finished, by one that does not (a game's). The timer is optional: without the extension,
-//! when the GPU reports a disjoint event (a clock change or a context switch invalidates the
-//! figure), or when the driver refuses the query object or a query call, there is no GPU time
-//! (`gpu_ms` absent) and callers fall back to wall time around `glFinish`. A refusal is a
-//! warning, never a failed frame.
+//! anyway, and a few frames later, when finished, by one that does not (a game's). The timer
+//! is optional: without the extension, when the GPU reports a disjoint event (a clock change
+//! or a context switch invalidates the figure), or when the driver refuses the query object or
+//! a query call, there is no GPU time (`gpu_ms` absent) and callers fall back to wall time
+//! around `glFinish`. A refusal is a warning, never a failed frame.
 //!
 //! The calls go through the extension's own `…EXT` entry points ([`super::ext_fns`]): on an
 //! ES 2.0 context the core names (`glGenQueries`, ES 3.0 only) exist in some libraries but are

@@ -1,12 +1,12 @@
 //! `auto`: picks a method per frame from the context and the scene, and says which and why in
 //! the frame's stats. Few lights → plain forward (one short loop beats assigning and uploading
 //! a grid); many → clustered; clustered unsupported → forward. A frame with more lights visible
-//! than clustered can index → deferred where it runs (ES 3.0 G-buffer, single-sampled frame):
-//! one proxy per light has no index limit, where forward's loop is capped by the driver and
-//! leaves lights out. The method not in use holds no GPU resources, except clustered's while
-//! a frame has too many visible lights for it (it tries again every frame), and deferred's for
-//! [`DEFERRED_KEPT_FRAMES`] after its last frame (a count hovering round the limit would
-//! otherwise allocate a G-buffer every other frame).
+//! than clustered can index → deferred where it runs (ES 3.0 G-buffer, not the renderer's own
+//! MSAA target): one proxy per light has no index limit, where forward's loop is capped by the
+//! driver and leaves lights out. The method not in use holds no GPU resources, except
+//! clustered's while a frame has too many visible lights for it (it tries again every frame),
+//! and deferred's for [`DEFERRED_KEPT_FRAMES`] after its last frame (a count hovering round the
+//! limit would otherwise allocate a G-buffer every other frame).
 
 use std::fmt::Write as _;
 
@@ -107,14 +107,6 @@ impl Auto {
                 );
                 "clustered"
             }
-        }
-    }
-}
-
-impl Auto {
-    fn destroy_deferred(&mut self, dev: &Device) {
-        if let Some(mut d) = self.deferred.take() {
-            d.destroy(dev);
         }
     }
 }
@@ -238,6 +230,8 @@ impl ShadingMethod for Auto {
         if let Some(mut c) = self.clustered.take() {
             c.destroy(dev);
         }
-        self.destroy_deferred(dev);
+        if let Some(mut d) = self.deferred.take() {
+            d.destroy(dev);
+        }
     }
 }

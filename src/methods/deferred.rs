@@ -371,7 +371,7 @@ impl Deferred {
         // Against the application's depth where the frame keeps it (its geometry hides what
         // lies behind); over a cleared depth the test passes wherever there is a surface.
         let mut state = RenderState::FULL_SCREEN_WITH_DEPTH;
-        if ctx.options.clear == crate::options::Clear::Nothing {
+        if ctx.clear == crate::options::Clear::Nothing {
             state.depth_test = crate::gl::state::DepthTest::LessEqual;
         }
         state.apply(dev);

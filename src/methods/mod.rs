@@ -97,6 +97,9 @@ pub struct FrameContext<'a> {
     /// The frame is drawn into the renderer's own multisampled target (`RenderOptions::samples`
     /// above 1, not drawn straight into a framebuffer multisampled itself).
     pub own_msaa: bool,
+    /// What the frame cleared before it was drawn (`RenderOptions::clear`; everything in an
+    /// offscreen render, which ignores it).
+    pub clear: crate::options::Clear,
 }
 
 /// Which grid a tiled or clustered frame used, and why.

@@ -267,6 +267,7 @@ impl Renderer {
             order: &mut self.draw_order,
             transparent_only: false,
             own_msaa: self.own_msaa_frame,
+            clear,
         };
         // The frame's errors so far are its own: the timer's calls (creating the queries too)
         // would drain them as theirs.

@@ -226,13 +226,10 @@ impl Renderer {
     /// with a fallback (the reason names the degradation), or not (the reason names what is
     /// missing). `Method::ALL` filtered by it lists what a device can run.
     pub fn support(&self, method: Method) -> Support {
-        methods::METHODS
-            .iter()
-            .find(|m| m.name == method.name())
-            .map_or_else(
-                || Support::Unsupported(format!("no method `{}`", method.name())),
-                |m| (m.supported)(self.dev.caps()),
-            )
+        methods::find(method.name()).map_or_else(
+            |e| Support::Unsupported(e.to_string()),
+            |m| (m.supported)(self.dev.caps()),
+        )
     }
 
     /// Switches method. Unsupported methods are an error naming what is missing; a fallback

@@ -320,7 +320,7 @@ fn parse_obj(path: &Path, allow_outside: bool) -> Result<Parsed, SceneError> {
             .map(|(models, materials)| {
                 // A library that failed was warned of already.
                 if let Ok(materials) = &materials {
-                    let defined: Vec<&str> = materials.iter().map(|m| m.name.as_str()).collect();
+                    let defined = materials.iter().map(|m| m.name.as_str()).collect();
                     if let Some(w) = lines::undefined_materials(&text, &defined) {
                         warnings.push(format!("{}: {w}", path.display()));
                     }

@@ -67,6 +67,13 @@ impl TextureTransform {
     pub fn is_finite(&self) -> bool {
         self.offset.is_finite() && self.rotation.is_finite() && self.scale.is_finite()
     }
+
+    /// Finite, with offset and scale within ±`MAX_TEXCOORD` (past it a transformed coordinate
+    /// overflows and the surface draws black).
+    pub fn is_usable(&self) -> bool {
+        let within = |v: Vec2| v.abs().max_element() <= super::mesh::MAX_TEXCOORD;
+        self.is_finite() && within(self.offset) && within(self.scale)
+    }
 }
 
 /// A texture and where it is sampled.
@@ -156,17 +163,11 @@ impl SurfaceMaps {
     /// ±1e9 (`MAX_TEXCOORD`; a transformed coordinate would overflow
     /// and the surface draw black): its field, relative to the maps.
     pub fn unusable_transform(&self) -> Option<String> {
-        let limit = super::mesh::MAX_TEXCOORD;
-        let usable = |t: &TextureTransform| {
-            t.is_finite()
-                && t.offset.abs().max_element() <= limit
-                && t.scale.abs().max_element() <= limit
-        };
-        if !usable(&self.base_transform) {
+        if !self.base_transform.is_usable() {
             return Some("base_transform".into());
         }
         self.textures()
-            .find(|(_, t)| !usable(&t.transform))
+            .find(|(_, t)| !t.transform.is_usable())
             .map(|(name, _)| format!("{name}.transform"))
     }
 

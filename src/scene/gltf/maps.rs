@@ -106,13 +106,7 @@ pub(super) fn transform_of(
         }),
         _ => None,
     };
-    let within = |v: Vec2| v.abs().max_element() <= MAX_TEXCOORD;
-    let usable = |t: &TextureTransform| {
-        t.is_finite()
-            && within(t.offset)
-            && within(t.scale)
-            && t.rows().iter().all(|r| r.is_finite())
-    };
+    let usable = |t: &TextureTransform| t.is_usable() && t.rows().iter().all(|r| r.is_finite());
     let t = match parsed.filter(usable) {
         Some(t) => t,
         None => {

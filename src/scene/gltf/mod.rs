@@ -461,8 +461,7 @@ fn validate(root: &gltf::json::Root) -> Result<(), String> {
     use gltf::json::validation::{Checked, Error, Validate};
     // A major version past 2 (or a minimum past 2.0) may mean anything: refused, as the
     // specification asks (§3.2), without showing the file's string.
-    let major = |v: &str| v.split('.').next().map(str::trim).map(str::to_owned);
-    if major(&root.asset.version).as_deref() != Some("2") {
+    if root.asset.version.split('.').next().map(str::trim) != Some("2") {
         return Err("asset.version: not a glTF 2.x version; this loader reads glTF 2.0".into());
     }
     if let Some(min) = &root.asset.min_version {

@@ -1,6 +1,8 @@
 //! The OBJ and MTL lines tobj would misread, panic on or reject without saying where, checked
 //! before it parses: each error names the line and the statement, never the file's text.
 
+use std::collections::HashSet;
+
 use crate::scene::mesh::{MAX_SCENE_MESHES, MAX_TEXCOORD};
 
 /// The file's vertex data and faces as tobj reads them:
@@ -197,9 +199,8 @@ fn usemtl_name(line: &str) -> &str {
 /// What `usemtl` lines name that no material library defined (tobj gives those faces no
 /// material, and they are drawn in the default grey), said without the names (the file's
 /// text): how many, and the line of the first.
-pub(super) fn undefined_materials(text: &str, defined: &[&str]) -> Option<String> {
-    let defined: std::collections::HashSet<&str> = defined.iter().copied().collect();
-    let mut missing = std::collections::HashSet::new();
+pub(super) fn undefined_materials(text: &str, defined: &HashSet<&str>) -> Option<String> {
+    let mut missing = HashSet::new();
     let mut first = None;
     for (number, line) in text.lines().enumerate() {
         let mut words = line.split_whitespace();
@@ -262,7 +263,7 @@ pub(super) fn check_mtl(text: &str) -> Result<(), String> {
 
 #[cfg(test)]
 mod tests {
-    use super::{check_mtl, check_obj, undefined_materials, Objects};
+    use super::{check_mtl, check_obj, undefined_materials, HashSet, Objects};
 
     /// Objects are counted as tobj splits them: a `usemtl` naming the whole rest of its line.
     #[test]
@@ -280,12 +281,13 @@ mod tests {
     fn undefined_material_names_are_counted_as_tobj_reads_them() {
         let text = "usemtl red\nusemtl blue\n  usemtl red\nusemtl blue\n";
         // The indented line names `usemtl red` to tobj, which no library defines either.
-        let warning = undefined_materials(text, &["red"]).unwrap();
+        let defined = HashSet::from(["red"]);
+        let warning = undefined_materials(text, &defined).unwrap();
         assert!(
             warning.starts_with("2 material names") && warning.contains("line 2"),
             "{warning}"
         );
-        assert_eq!(undefined_materials("usemtl red\n", &["red"]), None);
+        assert_eq!(undefined_materials("usemtl red\n", &defined), None);
     }
 
     #[test]
