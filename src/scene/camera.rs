@@ -43,6 +43,10 @@ pub const MIN_ORTHO_HEIGHT: f64 = 1e-6;
 /// frame black).
 pub const MIN_FOV_Y_DEG: f64 = 1e-3;
 
+/// How far from orthonormal the rotation of [`Camera::from_view_matrix`]'s matrix may be
+/// (largest entry of `RᵀR − I`): `f32` matrices a game builds are off by about 10⁻⁷.
+pub const VIEW_RIGID_TOLERANCE: f64 = 1e-4;
+
 /// A perspective far plane this many near planes away or more is treated as infinite.
 pub const FAR_AS_INFINITE: f64 = 1e20;
 
@@ -84,6 +88,51 @@ impl Camera {
                 far,
             },
         }
+    }
+
+    /// The camera a game's own view matrix (world → view, right-handed, looking down −Z, as
+    /// [`Camera::view_matrix`] gives) describes, with `projection`: an engine keeps its camera
+    /// as a transform, not as a look-at. The matrix must be rigid (a rotation and a
+    /// translation, to within `f32` rounding): one that scales, shears, mirrors or projects is
+    /// refused, naming `camera.view`, since the light assignment works in its view space.
+    pub fn from_view_matrix(view: DMat4, projection: Projection) -> Result<Camera, SceneError> {
+        let invalid = |reason: String| SceneError::invalid("camera.view", reason);
+        if !view.is_finite() {
+            return Err(invalid("must be finite".into()));
+        }
+        let bottom = view.row(3);
+        if bottom != glam::DVec4::W {
+            return Err(invalid(format!(
+                "must be rigid: its last row is {bottom:?}, not (0, 0, 0, 1) (a projection \
+                 goes in the camera's projection)"
+            )));
+        }
+        let rotation = glam::DMat3::from_mat4(view);
+        // f32 rounding of a game's matrix leaves errors near 1e-7; a scale or shear leaves more.
+        let gram = rotation.transpose() * rotation;
+        let off = (gram - glam::DMat3::IDENTITY).to_cols_array();
+        let worst = off.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+        if worst > VIEW_RIGID_TOLERANCE {
+            return Err(invalid(format!(
+                "must be rigid (a rotation and a translation): its 3 × 3 part is off \
+                 orthonormal by {worst:.2e}, past {VIEW_RIGID_TOLERANCE:e} (a scale or a shear)"
+            )));
+        }
+        if rotation.determinant() < 0.0 {
+            return Err(invalid(
+                "mirrors (its determinant is negative): the view space is right-handed".into(),
+            ));
+        }
+        let world_from_view = view.inverse();
+        let position = world_from_view.w_axis.truncate();
+        let camera = Camera {
+            position,
+            target: position - world_from_view.z_axis.truncate(),
+            up: world_from_view.y_axis.truncate(),
+            projection,
+        };
+        camera.validate()?;
+        Ok(camera)
     }
 
     /// World → view transform (right-handed, looking down −Z).
@@ -309,6 +358,69 @@ mod tests {
         let far = p * DVec4::new(0.0, 0.0, -1e12, 1.0);
         assert!((near.z / near.w + 1.0).abs() < 1e-9);
         assert!(far.z / far.w < 1.0 && far.z / far.w > 0.99);
+    }
+
+    #[test]
+    fn a_rigid_view_matrix_gives_the_camera_that_makes_it() {
+        let projection = Camera::default().projection;
+        let poses = [
+            (glam::DQuat::IDENTITY, DVec3::ZERO),
+            (
+                glam::DQuat::from_rotation_x(-1.5707963),
+                DVec3::new(3.0, 40.0, -2.0),
+            ),
+            (
+                glam::DQuat::from_euler(glam::EulerRot::YXZ, 2.5, -0.7, 0.4),
+                DVec3::new(-1e6, 2.0, 5e5),
+            ),
+            (
+                glam::DQuat::from_rotation_z(3.1),
+                DVec3::new(0.5, -0.25, 8.0),
+            ),
+        ];
+        for (rotation, position) in poses {
+            let view = DMat4::from_rotation_translation(rotation, position).inverse();
+            let camera = Camera::from_view_matrix(view, projection).unwrap();
+            let back = camera.view_matrix();
+            let scale = 1.0 + position.abs().max_element();
+            for (a, b) in back.to_cols_array().iter().zip(view.to_cols_array()) {
+                assert!((a - b).abs() <= 1e-9 * scale, "{back:?} against {view:?}");
+            }
+            // A game's f32 matrix is rigid to its rounding, and accepted.
+            let rounded = DMat4::from_cols_array(&view.to_cols_array().map(|v| v as f32 as f64));
+            assert!(Camera::from_view_matrix(rounded, projection).is_ok());
+        }
+    }
+
+    #[test]
+    fn a_view_matrix_that_is_not_rigid_is_refused_naming_it() {
+        let projection = Camera::default().projection;
+        let view = DMat4::from_rotation_y(0.3) * DMat4::from_translation(DVec3::new(1.0, 2.0, 3.0));
+        let mut nan = view;
+        nan.w_axis.x = f64::NAN;
+        let refused = [
+            (view * DMat4::from_scale(DVec3::splat(1.01)), "rigid"),
+            (
+                DMat4::from_scale(DVec3::new(1.0, 1.0, -1.0)) * view,
+                "mirrors",
+            ),
+            (Camera::default().projection_matrix(1.5) * view, "last row"),
+            (nan, "finite"),
+        ];
+        for (matrix, why) in refused {
+            let err = Camera::from_view_matrix(matrix, projection)
+                .unwrap_err()
+                .to_string();
+            assert!(err.contains("camera.view") && err.contains(why), "{err}");
+        }
+        // The projection is still checked.
+        let bad = Projection::Perspective {
+            fov_y_deg: 60.0,
+            near: 0.0,
+            far: 1.0,
+        };
+        let err = Camera::from_view_matrix(view, bad).unwrap_err().to_string();
+        assert!(err.contains("camera.near"), "{err}");
     }
 
     #[test]
