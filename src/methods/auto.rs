@@ -35,8 +35,11 @@ pub const DESC: MethodDesc = MethodDesc {
 /// (or that it never can).
 fn supported(caps: &crate::gl::Caps) -> Support {
     let mut notes = Vec::new();
-    if let Support::Fallback(why) = super::forward::supported(caps) {
-        notes.push(why);
+    match super::forward::supported(caps) {
+        Support::Supported => {}
+        Support::Fallback(why) => notes.push(why),
+        // What auto would run for a few lights cannot run.
+        Support::Unsupported(why) => return Support::Unsupported(why),
     }
     match culled_support(caps) {
         Support::Supported => {}

@@ -24,8 +24,31 @@ pub struct Capacities {
     pub grid_texels: usize,
 }
 
+/// Why the light, grid and index data textures ([`DATA_TEXTURE_WIDTH`] texels wide) cannot be
+/// made on `caps`' context, if they cannot: every method but deferred reads them. ES 2.0 only
+/// requires `GL_MAX_TEXTURE_SIZE` 64, ES 3.0 2048.
+pub fn data_textures_unfit(caps: &Caps) -> Option<String> {
+    (caps.max_texture_size < DATA_TEXTURE_WIDTH as i32).then(|| {
+        format!(
+            "its data textures are {DATA_TEXTURE_WIDTH} texels wide, past this context's \
+             GL_MAX_TEXTURE_SIZE {}",
+            caps.max_texture_size
+        )
+    })
+}
+
 /// The capacities of `caps`' context.
 pub fn capacities(caps: &Caps) -> Capacities {
+    if data_textures_unfit(caps).is_some() {
+        // No method that reads the data textures runs: nothing fits.
+        return Capacities {
+            forward_lights: 0,
+            indexed_lights: 0,
+            index_entries: 0,
+            cell_lights: Some(0),
+            grid_texels: 0,
+        };
+    }
     let rows = caps.max_texture_size.max(1) as usize;
     let texels = rows * DATA_TEXTURE_WIDTH as usize;
     let es2 = caps.es == EsVersion::Es2;
@@ -45,5 +68,42 @@ pub fn capacities(caps: &Caps) -> Capacities {
             (false, budget) => Some(budget),
         },
         grid_texels: texels,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::gl::context::context_or_skip;
+    use crate::gl::Device;
+    use crate::methods::{Support, METHODS};
+
+    /// A context whose `GL_MAX_TEXTURE_SIZE` is below the data textures' width (ES 2.0 allows
+    /// 64) runs deferred only; every other method says why not, naming the limit.
+    #[test]
+    fn data_textures_past_the_texture_limit_leave_only_deferred() {
+        let Some(ctx) = context_or_skip(EsVersion::Es3) else {
+            return;
+        };
+        let mut dev = Device::new(ctx.load_gl().unwrap(), EsVersion::Es3).unwrap();
+        for (limit, fits) in [
+            (DATA_TEXTURE_WIDTH as i32 - 1, false),
+            (64, false),
+            (1024, true),
+        ] {
+            dev.caps_mut().max_texture_size = limit;
+            for m in METHODS {
+                let support = (m.supported)(dev.caps());
+                match support {
+                    Support::Unsupported(why) if !fits && m.name != "deferred" => {
+                        assert!(why.contains("GL_MAX_TEXTURE_SIZE"), "{}: {why}", m.name)
+                    }
+                    Support::Unsupported(why) => panic!("{} at {limit}: {why}", m.name),
+                    _ => assert!(fits || m.name == "deferred", "{} runs at {limit}", m.name),
+                }
+            }
+            let forward_lights = capacities(dev.caps()).forward_lights;
+            assert_eq!(forward_lights > 0, fits, "{limit}");
+        }
     }
 }

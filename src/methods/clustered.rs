@@ -19,6 +19,9 @@ pub const DESC: MethodDesc = MethodDesc {
 /// Support of both culled methods: ES 2.0 needs highp fragments (cell lookup and texel
 /// addressing), and without float textures lights are RGBA8-packed.
 pub fn culled_support(caps: &Caps) -> Support {
+    if let Some(why) = super::capacity::data_textures_unfit(caps) {
+        return Support::Unsupported(why);
+    }
     if caps.es == EsVersion::Es2 && !caps.fragment_has_highp() {
         return Support::Unsupported(
             "the fragment stage has no highp floats, needed to find cells and address data textures exactly".into(),

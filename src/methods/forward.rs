@@ -31,6 +31,9 @@ pub const DESC: MethodDesc = MethodDesc {
 };
 
 pub(super) fn supported(caps: &Caps) -> Support {
+    if let Some(why) = super::capacity::data_textures_unfit(caps) {
+        return Support::Unsupported(why);
+    }
     let mut notes = Vec::new();
     if !caps.float_textures {
         notes.push("lights packed as RGBA8 (lossy) because GL_OES_texture_float is missing");
