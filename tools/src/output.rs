@@ -12,6 +12,7 @@ use std::fs::{File, OpenOptions, Permissions};
 use std::io::{self, BufWriter, Write};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU32, Ordering};
+use std::sync::OnceLock;
 
 /// A file that could not be written, and why (the OS error).
 #[derive(Debug)]
@@ -74,7 +75,11 @@ impl OutputFile {
         };
         // An existing file is opened for writing (not truncated) to learn whether it may be
         // written at all and what it is; a symbolic link is followed, and its target replaced.
-        let (target, file) = match OpenOptions::new().write(true).open(path) {
+        let opened = match own_stdout_named(path) {
+            Some(own) => own.try_clone(),
+            None => OpenOptions::new().write(true).open(path),
+        };
+        let (target, file) = match opened {
             Ok(existing) => {
                 let meta = existing.metadata().map_err(fail)?;
                 if meta.is_file() && is_system_path(path) {
@@ -318,11 +323,49 @@ impl JsonOut {
     }
 }
 
+/// Standard output as the process was given it, once [`keep_stdout_for_own_output`] has
+/// pointed descriptor 1 at standard error.
+static OWN_STDOUT: OnceLock<File> = OnceLock::new();
+
+/// Keeps standard output for the command line's own output and sends what the libraries loaded
+/// in this process print there to standard error: a driver's `printf` (Mesa's "extension …
+/// cannot be disabled" under `MESA_EXTENSION_OVERRIDE`, flushed at exit) would otherwise
+/// follow `info --json` or `--stats -` and break whatever parses them. Call once, before any
+/// GL library is loaded; [`print_stdout`] and `/dev/stdout` as an output then reach the
+/// original. Unix only; where either stream is closed nothing changes.
+pub fn keep_stdout_for_own_output() {
+    #[cfg(unix)]
+    {
+        use std::os::fd::AsFd;
+        let Ok(saved) = io::stdout().as_fd().try_clone_to_owned() else {
+            return;
+        };
+        if rustix::stdio::dup2_stdout(io::stderr().as_fd()).is_ok() {
+            let _ = OWN_STDOUT.set(File::from(saved));
+        }
+    }
+}
+
+/// The original standard output, for a path that names it (`/dev/stdout`, `/dev/fd/1`,
+/// `/proc/self/fd/1`), once descriptor 1 no longer does.
+fn own_stdout_named(path: &Path) -> Option<&'static File> {
+    let names = ["/dev/stdout", "/dev/fd/1", "/proc/self/fd/1"];
+    OWN_STDOUT
+        .get()
+        .filter(|_| names.iter().any(|name| path == Path::new(name)))
+}
+
 /// Writes `text` to standard output and flushes it. A closed pipe (`manylight info | head`)
 /// ends the output quietly; any other error (a full disk) is returned.
 pub fn print_stdout(text: &str) -> Result<(), String> {
-    let mut out = io::stdout().lock();
-    match out.write_all(text.as_bytes()).and_then(|()| out.flush()) {
+    let written = match OWN_STDOUT.get() {
+        Some(mut own) => own.write_all(text.as_bytes()).and_then(|()| own.flush()),
+        None => {
+            let mut out = io::stdout().lock();
+            out.write_all(text.as_bytes()).and_then(|()| out.flush())
+        }
+    };
+    match written {
         Err(e) if e.kind() != io::ErrorKind::BrokenPipe => {
             Err(format!("cannot write to standard output: {e}"))
         }
@@ -334,6 +377,14 @@ pub fn print_stdout(text: &str) -> Result<(), String> {
 /// absolute; for a file that does not exist yet, its folder resolved. Two outputs with the same
 /// identity would overwrite each other.
 pub fn identity(path: &Path) -> PathBuf {
+    #[cfg(unix)]
+    if let Some(own) = own_stdout_named(path) {
+        use std::os::fd::AsRawFd;
+        let fd = Path::new("/proc/self/fd").join(own.as_raw_fd().to_string());
+        if let Ok(p) = std::fs::canonicalize(fd) {
+            return p;
+        }
+    }
     if let Ok(p) = std::fs::canonicalize(path) {
         return p;
     }

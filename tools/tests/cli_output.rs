@@ -171,3 +171,30 @@ fn stats_to_standard_output_are_json_alone() {
         "a file named `-` was written"
     );
 }
+
+/// A driver's own `printf` on standard output (Mesa's "extension … cannot be disabled" under
+/// `MESA_EXTENSION_OVERRIDE`, flushed at exit) goes to standard error: `info --json` and
+/// `--stats -` stay the JSON alone, as a CI script parses them.
+#[test]
+fn a_drivers_own_line_on_stdout_leaves_the_json_alone() {
+    let dir = tempfile::tempdir().unwrap();
+    let env = [(
+        "MESA_EXTENSION_OVERRIDE",
+        "-GL_OES_texture_float -GL_EXT_color_buffer_float",
+    )];
+    let info: &[&str] = &["info", "--es", "2", "--json"];
+    let render: &[&str] = &[
+        "--es", "2", "--size", "16x9", "--lights", "4", "--stats", "-", "--out", "p.png",
+    ];
+    let mut chatter = false;
+    for args in [info, render] {
+        let out = manylight(args, &env, dir.path());
+        assert_eq!(out.status.code(), Some(0), "{args:?}: {}", text(&out));
+        let parsed = serde_json::from_slice::<serde_json::Value>(&out.stdout);
+        assert!(parsed.is_ok(), "{args:?}: {parsed:?} in {}", text(&out));
+        chatter |= String::from_utf8_lossy(&out.stderr).contains("cannot be disabled");
+    }
+    if !chatter {
+        eprintln!("this Mesa printed nothing for the override: the JSON was checked alone");
+    }
+}

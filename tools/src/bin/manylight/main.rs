@@ -335,6 +335,7 @@ fn main() -> ExitCode {
         std::process::exit(code)
     });
     check_usage(&cli);
+    output::keep_stdout_for_own_output();
     let mut options = LoadOptions::default();
     options.allow_outside_files = cli.allow_outside_files;
     let _ = LOAD_OPTIONS.set(options);
