@@ -68,6 +68,10 @@ pub struct Caps {
     pub float_textures: bool,
     /// 24-bit depth renderbuffers (ES 3.0, or `GL_OES_depth24`).
     pub depth24: bool,
+    /// Packed depth and stencil renderbuffers, 24 bits of depth (ES 3.0, or
+    /// `GL_OES_packed_depth_stencil`): the renderer's own targets' depth where `depth24` is
+    /// missing.
+    pub packed_depth_stencil: bool,
     /// `GL_EXT_disjoint_timer_query`.
     pub timer_query: bool,
     /// `GL_SUBPIXEL_BITS`: the rasterizer snaps vertices to 1/2^bits of a pixel (at least 4 by
@@ -190,6 +194,7 @@ impl Caps {
             fragment_mediump,
             float_textures: es3 || has("GL_OES_texture_float"),
             depth24: es3 || has("GL_OES_depth24"),
+            packed_depth_stencil: es3 || has("GL_OES_packed_depth_stencil"),
             timer_query: has("GL_EXT_disjoint_timer_query"),
             subpixel_bits,
             max_loop_iterations: renderer
@@ -269,6 +274,18 @@ impl Caps {
                 self.has_extension("GL_OES_texture_half_float")
                     && self.has_extension("GL_EXT_color_buffer_half_float")
             }
+        }
+    }
+
+    /// The depth format of the renderer's own targets and its bits: 24-bit depth, else the
+    /// 24 bits of a packed depth and stencil format, else ES 2.0's one required format, 16-bit.
+    pub fn own_depth_format(&self) -> (u32, u32) {
+        if self.depth24 {
+            (glow::DEPTH_COMPONENT24, 24)
+        } else if self.packed_depth_stencil {
+            (glow::DEPTH24_STENCIL8, 24)
+        } else {
+            (glow::DEPTH_COMPONENT16, 16)
         }
     }
 

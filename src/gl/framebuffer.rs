@@ -88,11 +88,7 @@ impl OffscreenTarget {
             super::texture::set_nearest_clamp(gl);
             let depth = dev.create_renderbuffer()?;
             gl.bind_renderbuffer(glow::RENDERBUFFER, Some(depth));
-            let depth_format = if dev.caps().depth24 {
-                glow::DEPTH_COMPONENT24
-            } else {
-                glow::DEPTH_COMPONENT16
-            };
+            let (depth_format, _) = dev.caps().own_depth_format();
             gl.renderbuffer_storage(
                 glow::RENDERBUFFER,
                 depth_format,
@@ -221,6 +217,37 @@ impl Drop for OffscreenTarget {
     fn drop(&mut self) {
         if !self.destroyed && !super::left_objects::left_on_purpose() {
             log::warn!("OffscreenTarget dropped without destroy(): GL objects leaked");
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::OffscreenTarget;
+    use crate::gl::context::context_or_skip;
+    use crate::gl::{Device, EsVersion};
+
+    /// Without `GL_OES_depth24` the renderer's own target takes the 24 depth bits of a packed
+    /// depth and stencil format where the context has one, and 16 only where it has neither.
+    #[test]
+    fn the_own_target_keeps_24_depth_bits_through_packed_depth_stencil() {
+        let Some(ctx) = context_or_skip(EsVersion::Es2) else {
+            return;
+        };
+        let mut dev = Device::new(ctx.load_gl().unwrap(), EsVersion::Es2).unwrap();
+        for (depth24, packed, bits) in [(false, true, 24), (false, false, 16), (true, false, 24)] {
+            dev.caps_mut().depth24 = depth24;
+            dev.caps_mut().packed_depth_stencil = packed;
+            assert_eq!(dev.caps().own_depth_format().1, bits);
+            let mut target = OffscreenTarget::new(&dev, 8, 8).unwrap();
+            target.bind(&dev);
+            assert_eq!(
+                dev.bound_depth_bits(),
+                Some(bits as i32),
+                "depth24 {depth24}, packed {packed}"
+            );
+            dev.check("the target").unwrap();
+            target.destroy(&dev);
         }
     }
 }

@@ -142,7 +142,7 @@ impl MultisampleTarget {
             } else {
                 glow::RGBA8
             },
-            depth_bytes: if dev.es() == EsVersion::Es3 || dev.caps().depth24 {
+            depth_bytes: if dev.caps().own_depth_format().1 > 16 {
                 4
             } else {
                 2
@@ -220,13 +220,9 @@ impl MultisampleTarget {
                         .renderbuffer_storage_multisample_ext
                         .expect("loaded with the extension (see unsupported_reason)");
                     gl.bind_renderbuffer(glow::RENDERBUFFER, Some(depth));
-                    // 24-bit depth where OES_depth24 is (as the single-sampled target), else
-                    // ES 2.0's one required format: the same precision with MSAA as without.
-                    let format = if dev.caps().depth24 {
-                        glow::DEPTH_COMPONENT24
-                    } else {
-                        glow::DEPTH_COMPONENT16
-                    };
+                    // The single-sampled target's depth: the same precision with MSAA as
+                    // without.
+                    let (format, _) = dev.caps().own_depth_format();
                     storage(glow::RENDERBUFFER, samples as i32, format, w, h);
                 }
             }

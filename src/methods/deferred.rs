@@ -294,7 +294,10 @@ impl Deferred {
             let depth = -light.position.z;
             // A proxy's one-sided depth test needs depth steps well inside the light's reach
             // where it ends (a tiny near plane makes them wider; docs/precision.md).
-            let coarse = ctx.scene.camera.depth_step_at(f64::from(depth + radius))
+            let coarse = ctx
+                .scene
+                .camera
+                .depth_step_at(f64::from(depth + radius), 24)
                 > 0.1 * f64::from(light.cull_radius);
             let (shader, mesh, cull, depth_test) =
                 if !coarse && depth - radius >= 2.0 * ctx.near as f32 {

@@ -61,6 +61,31 @@ impl Renderer {
     }
 }
 
+impl Renderer {
+    /// Depth bits of the frame's depth buffer: the bound framebuffer's where the frame is
+    /// drawn in it (24 where the driver would not say), else the renderer's own target's, a
+    /// 16-bit one warned of once.
+    pub(super) fn depth_bits_of_frame(&mut self, drawn_in_games: bool) -> u32 {
+        if drawn_in_games {
+            return self
+                .dev
+                .bound_depth_bits()
+                .map_or(FULL_DEPTH_BITS as u32, |bits| bits.max(0) as u32);
+        }
+        let (_, bits) = self.dev.caps().own_depth_format();
+        if bits < FULL_DEPTH_BITS as u32 && !self.warned_own_depth_bits {
+            self.warned_own_depth_bits = true;
+            log::warn!(
+                "the renderer's own depth buffer has {bits} bits on this context (it has \
+                 neither GL_OES_depth24 nor GL_OES_packed_depth_stencil): surfaces close \
+                 together in depth may show the one behind, whatever the method; a near plane \
+                 as far out as the scene allows narrows it (docs/precision.md)"
+            );
+        }
+        bits
+    }
+}
+
 /// `glCheckFramebufferStatus`'s answer by name.
 fn status_name(status: u32) -> String {
     let name = match status {

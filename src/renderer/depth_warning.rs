@@ -8,12 +8,18 @@ use crate::scene::{Camera, Projection};
 /// The largest depth step, as a share of the far content's distance, left unsaid.
 const QUIET_SHARE: f64 = 0.01;
 
-/// Warns (once: `warned`) when the depth step at `content_far` passes [`QUIET_SHARE`] of it.
-pub(super) fn warn_of_coarse_depth(camera: &Camera, content_far: f64, warned: &mut bool) {
+/// Warns (once: `warned`) when the depth step of a `bits`-bit depth buffer at `content_far`
+/// passes [`QUIET_SHARE`] of it.
+pub(super) fn warn_of_coarse_depth(
+    camera: &Camera,
+    content_far: f64,
+    bits: u32,
+    warned: &mut bool,
+) {
     if *warned {
         return;
     }
-    let step = camera.depth_step_at(content_far);
+    let step = camera.depth_step_at(content_far, bits);
     if step.is_nan() || step <= QUIET_SHARE * content_far {
         return;
     }
@@ -26,7 +32,7 @@ pub(super) fn warn_of_coarse_depth(camera: &Camera, content_far: f64, warned: &m
         }
     };
     log::warn!(
-        "{what} leaves the depth buffer a step of {step:.3e} at the scene's farthest content \
+        "{what} leaves the {bits}-bit depth buffer a step of {step:.3e} at the scene's farthest content \
          ({content_far:.3e} away): surfaces closer together in depth than that may show the \
          one behind, whatever the method; a near plane as far out (or, orthographic, a depth \
          range as tight) as the scene allows fixes it (docs/precision.md)"

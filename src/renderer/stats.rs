@@ -32,6 +32,10 @@ pub struct FrameStats {
     /// Samples per pixel the frame was drawn with (1: no MSAA): what the implementation gave
     /// for `RenderOptions::samples`, which GL rounds up to a count it has.
     pub samples: u32,
+    /// Bits of the depth buffer the frame was drawn against: the game's framebuffer's, or the
+    /// renderer's own target's (16 on an ES 2.0 context with neither `GL_OES_depth24` nor
+    /// `GL_OES_packed_depth_stencil`, where surfaces close in depth may show through).
+    pub depth_bits: u32,
     /// Triangles drawn.
     pub triangles: usize,
     /// What the scene uses (and so what the shader variants were built with).
@@ -153,6 +157,7 @@ impl Default for FrameStats {
             width: 0,
             height: 0,
             samples: 1,
+            depth_bits: 24,
             triangles: 0,
             scene_features: SceneFeatures::default(),
             time: TimeStats::default(),

@@ -178,14 +178,14 @@ impl Camera {
     }
 
     /// How far apart in depth two surfaces `distance` from the eye must be for the depth
-    /// test to tell them apart: one step of a 24-bit depth buffer (and of `f32` window depth,
-    /// which has as many bits), `distance² / (near · 2²⁴)` in perspective (any far plane), the
-    /// depth range over 2²⁴ in orthographic. `docs/precision.md` gives figures.
-    pub(crate) fn depth_step_at(&self, distance: f64) -> f64 {
-        const STEPS: f64 = (1u32 << 24) as f64;
+    /// test of a `bits`-bit depth buffer to tell them apart: one step, `distance² / (near ·
+    /// 2^bits)` in perspective (any far plane), the depth range over `2^bits` in orthographic
+    /// (24 bits: as `f32` window depth, which has as many). `docs/precision.md` gives figures.
+    pub(crate) fn depth_step_at(&self, distance: f64, bits: u32) -> f64 {
+        let steps = 2f64.powi(bits.min(32) as i32);
         match self.projection {
-            Projection::Perspective { near, .. } => distance * distance / (near * STEPS),
-            Projection::Orthographic { near, far, .. } => (far - near) / STEPS,
+            Projection::Perspective { near, .. } => distance * distance / (near * steps),
+            Projection::Orthographic { near, far, .. } => (far - near) / steps,
         }
     }
 

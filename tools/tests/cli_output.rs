@@ -198,3 +198,26 @@ fn a_drivers_own_line_on_stdout_leaves_the_json_alone() {
         eprintln!("this Mesa printed nothing for the override: the JSON was checked alone");
     }
 }
+
+/// An ES 2.0 context without 24-bit depth (`GL_OES_depth24` removed; Mesa then offers no
+/// `GL_OES_packed_depth_stencil` either): the renderer's own target has 16 bits, which the
+/// stats say and a warning names; with it, 24 and no warning.
+#[test]
+fn a_sixteen_bit_own_depth_buffer_is_said() {
+    let dir = tempfile::tempdir().unwrap();
+    let args = [
+        "--es", "2", "--size", "16x9", "--lights", "4", "--stats", "s.json", "--out", "p.png",
+    ];
+    for (env, bits) in [
+        (&[("MESA_EXTENSION_OVERRIDE", "-GL_OES_depth24")][..], 16),
+        (&[], 24),
+    ] {
+        let out = manylight(&args, env, dir.path());
+        assert_eq!(out.status.code(), Some(0), "{env:?}: {}", text(&out));
+        let stats: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(dir.path().join("s.json")).unwrap()).unwrap();
+        assert_eq!(stats["depth_bits"], bits, "{env:?}");
+        let warned = text(&out).contains("own depth buffer has 16 bits");
+        assert_eq!(warned, bits == 16, "{env:?}: {}", text(&out));
+    }
+}
