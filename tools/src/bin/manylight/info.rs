@@ -235,7 +235,12 @@ fn format_text(
     );
     w!(out, "fragment mediump   {}", p(&caps.fragment_mediump));
     w!(out, "float textures     {}", caps.float_textures);
-    w!(out, "depth24            {}", caps.depth24);
+    w!(
+        out,
+        "depth24            {} (own targets' depth: {} bits)",
+        caps.depth24,
+        caps.own_depth_format().1
+    );
     w!(out, "timer queries      {}", caps.timer_query);
     let cap = manylight::methods::capacity::capacities(caps);
     w!(
