@@ -3,6 +3,7 @@
 use clap::Parser;
 use manylight::gl::{Caps, HeadlessContext};
 use manylight::methods::{ShaderFeatures, Support, METHODS};
+use manylight::EsVersion;
 use manylight::Renderer;
 use manylight_tools::output::print_stdout;
 
@@ -210,6 +211,13 @@ fn format_text(
         w!(
             out,
             "MSAA               up to {}× (--msaa)",
+            caps.max_samples
+        );
+    } else if caps.es == EsVersion::Es3 || caps.msaa_render_to_texture {
+        // The way to multisample is there, but not the samples (softpipe).
+        w!(
+            out,
+            "MSAA               unsupported here (GL_MAX_SAMPLES is {})",
             caps.max_samples
         );
     } else {
