@@ -74,6 +74,17 @@ fn matrix_covers_es2_es2_without_float_and_es3_and_every_supported_cell_matches_
                 m["max_abs"]
             );
             assert!(dir.path().join(m["image"].as_str().unwrap()).is_file());
+            // What auto ran, as `--stats` says it; the others say nothing of it.
+            let choice = m["auto_choice"].as_str();
+            if m["name"] == "auto" {
+                let choice = choice.unwrap_or_else(|| panic!("{name}: auto says no choice"));
+                assert!(
+                    ["forward", "clustered", "deferred"].contains(&choice),
+                    "{choice}"
+                );
+            } else {
+                assert!(choice.is_none(), "{name} {}", m["name"]);
+            }
         }
     }
     // A device without fragment highp: only the methods that need no highp run, forward

@@ -443,12 +443,31 @@ fn osmesa_row(
 }
 
 /// A row's implementation (its folder where the context could not say) and configuration.
-fn row_label(row: &Value) -> (&str, &str) {
-    let implementation = row["implementation"]
-        .as_str()
-        .or(row["gles_lib"].as_str())
-        .unwrap_or("?");
-    (implementation, row["config"].as_str().unwrap_or("?"))
+/// Each row's implementation as the table and sheet show it, and its configuration: the
+/// implementation's family, with the `--gles-lib` it came from where another row's
+/// implementation of the same family came from elsewhere (two Mesa builds).
+fn row_labels(rows: &[Value]) -> Vec<(String, &str)> {
+    let family = |row: &Value| {
+        row["implementation"]
+            .as_str()
+            .or(row["gles_lib"].as_str())
+            .unwrap_or("?")
+            .to_string()
+    };
+    let lib = |row: &Value| row["gles_lib"].as_str().unwrap_or("?").to_string();
+    rows.iter()
+        .map(|row| {
+            let shared = rows
+                .iter()
+                .any(|other| family(other) == family(row) && lib(other) != lib(row));
+            let implementation = if shared {
+                format!("{} ({})", family(row), lib(row))
+            } else {
+                family(row)
+            };
+            (implementation, row["config"].as_str().unwrap_or("?"))
+        })
+        .collect()
 }
 
 /// What a row with an `error` is: a configuration this machine cannot give, or a failure.
@@ -462,8 +481,7 @@ fn row_failure(row: &Value) -> &'static str {
 
 fn markdown(rows: &[Value]) -> String {
     let mut s = String::from("| implementation | configuration | context | method | support | max abs vs forward | max abs vs reference | pixels > 2/255 | frame ms |\n|---|---|---|---|---|---|---|---|---|\n");
-    for row in rows {
-        let (implementation, config) = row_label(row);
+    for (row, (implementation, config)) in rows.iter().zip(row_labels(rows)) {
         let config = &format!("{implementation} | {config}");
         if let Some(err) = row["error"].as_str() {
             let what = row_failure(row);
@@ -488,9 +506,13 @@ fn markdown(rows: &[Value]) -> String {
                 m[k].as_f64()
                     .map_or(String::new(), |v| format!("{v:.digits$}"))
             };
+            let name = m["name"].as_str().unwrap_or("?");
+            let method = match m["auto_choice"].as_str() {
+                Some(choice) => format!("{name} → {choice}"),
+                None => name.to_string(),
+            };
             s += &format!(
-                "| {config} | {context} | {} | {support} | {} | {} | {} | {} |\n",
-                m["name"].as_str().unwrap_or("?"),
+                "| {config} | {context} | {method} | {support} | {} | {} | {} | {} |\n",
                 num("max_abs_vs_forward", 0),
                 num("max_abs", 0),
                 m["over_2"]
@@ -505,8 +527,7 @@ fn markdown(rows: &[Value]) -> String {
 
 fn sheet(rows: &[Value], out: &Path) -> image::RgbaImage {
     let mut cells = Vec::new();
-    for row in rows {
-        let (implementation, config) = row_label(row);
+    for (row, (implementation, config)) in rows.iter().zip(row_labels(rows)) {
         let config = format!("{implementation}: {config}");
         if row["error"].is_string() {
             cells.push((vec![config, row_failure(row).to_string()], None));
@@ -663,6 +684,10 @@ pub fn run_cell(args: &MatrixCellArgs) -> Result<(), Box<dyn std::error::Error>>
                 entry["over_2"] = json!(d.over_2);
                 entry["frame_ms"] = json!(stats.time.frame_ms);
                 entry["light_encoding"] = json!(stats.lights.encoding);
+                if stats.auto_choice.is_some() {
+                    entry["auto_choice"] = json!(stats.auto_choice);
+                    entry["auto_reason"] = json!(stats.auto_reason);
+                }
                 if let Some(out) = &args.out {
                     let file = format!("{}-{}.png", args.tag, m.name);
                     output::save_png(&out.join(&file), &img)?;
@@ -702,7 +727,26 @@ pub fn run_cell(args: &MatrixCellArgs) -> Result<(), Box<dyn std::error::Error>>
 
 #[cfg(test)]
 mod tests {
-    use super::{cell_error, cell_row};
+    use super::{cell_error, cell_row, markdown};
+    use serde_json::json;
+
+    /// Two implementations of one family (two Mesa builds) are told apart by their folders;
+    /// auto's row says what it ran.
+    #[test]
+    fn the_table_tells_same_family_implementations_apart_and_says_what_auto_ran() {
+        let row = |lib: &str| {
+            json!({"implementation": "Mesa llvmpipe", "gles_lib": lib, "config": "ES 3.0",
+                "gl_version": "3.2", "max_samples": 4,
+                "methods": [{"name": "auto", "support": {"status": "supported"},
+                    "auto_choice": "forward", "max_abs_vs_forward": 0}]})
+        };
+        let table = markdown(&[row("system"), row("/opt/mesa")]);
+        assert!(table.contains("| Mesa llvmpipe (system) |"), "{table}");
+        assert!(table.contains("| Mesa llvmpipe (/opt/mesa) |"), "{table}");
+        assert!(table.contains("| auto → forward |"), "{table}");
+        let alone = markdown(&[row("system")]);
+        assert!(alone.contains("| Mesa llvmpipe | ES 3.0 |"), "{alone}");
+    }
     use std::os::unix::process::ExitStatusExt;
     use std::process::{ExitStatus, Output};
 

@@ -10,9 +10,11 @@ use serde_json::{json, Value};
 /// returns one line per failure, naming its implementation, configuration and method.
 pub fn mark(rows: &mut [Value], max_error: u8) -> Vec<String> {
     let mut failures = Vec::new();
-    for row in rows {
-        let (implementation, config) = super::row_label(row);
-        let place = format!("{implementation} / {config}");
+    let places: Vec<String> = super::row_labels(rows)
+        .into_iter()
+        .map(|(implementation, config)| format!("{implementation} / {config}"))
+        .collect();
+    for (row, place) in rows.iter_mut().zip(places) {
         if let Some(error) = row["error"].as_str() {
             if row["refused"] != true {
                 failures.push(format!("{place}: the cell failed: {error}"));
