@@ -324,7 +324,7 @@ fn usage_errors_exit_2_and_name_the_flags() {
             &["render", "--no-fragment-highp", "--size", "8x8"],
             "--es 2",
         ),
-        (&["info", "--no-fragment-highp"], "--es 2"),
+        (&["info", "--no-fragment-highp", "--es", "3"], "--es 2"),
         (&["render", "--frames", "many"], "--frames"),
         (&["render", "--size", "0x10"], "empty"),
         (&["render", "--bogus"], "--bogus"),

@@ -236,3 +236,31 @@ fn info_gives_the_real_reason_msaa_is_missing() {
     }
     assert!(msaa.contains("GL_MAX_SAMPLES is 1"), "{msaa}");
 }
+
+/// `info` without `--es` reports what the device has: ES 2.0, with a warning, where the driver
+/// gives no ES 3.0; `--es 3` still insists (status 3).
+#[test]
+fn info_probes_es_2_where_es_3_is_missing() {
+    let dir = tempfile::tempdir().unwrap();
+    let capped = [("MESA_GLES_VERSION_OVERRIDE", "2.0")];
+    let out = manylight(&["info", "--json"], &capped, dir.path());
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out));
+    let info: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(info["caps"]["es"], "2.0");
+    assert!(
+        String::from_utf8_lossy(&out.stderr).contains("probing OpenGL ES 2.0"),
+        "{}",
+        text(&out)
+    );
+    let out = manylight(&["info", "--es", "3"], &capped, dir.path());
+    assert_eq!(out.status.code(), Some(3), "{}", text(&out));
+    // Uncapped, the default is ES 3.0, said without a warning.
+    let out = manylight(&["info", "--json"], &[], dir.path());
+    let info: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(info["caps"]["es"], "3.0");
+    assert!(!text(&out).contains("probing"), "{}", text(&out));
+    // A device without fragment highp is an ES 2.0 one: probed as such.
+    let out = manylight(&["info", "--json", "--no-fragment-highp"], &[], dir.path());
+    let info: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(info["caps"]["es"], "2.0");
+}

@@ -12,9 +12,10 @@ use crate::EsArg;
 /// Options of `manylight info`.
 #[derive(Parser, Debug)]
 pub struct InfoArgs {
-    /// OpenGL ES version of the context to probe.
-    #[arg(long, value_enum, default_value = "3")]
-    pub es: EsArg,
+    /// OpenGL ES version of the context to probe (default: 3 where the driver gives it, else 2
+    /// with a warning; 2 with `--no-fragment-highp`).
+    #[arg(long, value_enum)]
+    pub es: Option<EsArg>,
     /// Print JSON instead of text.
     #[arg(long)]
     pub json: bool,
@@ -72,12 +73,26 @@ fn scene_report(
 
 /// Runs the command.
 pub fn run(args: &InfoArgs) -> Result<(), Box<dyn std::error::Error>> {
-    let es = args.es.into();
-    let ctx = HeadlessContext::new(es)?;
     let restrictions = manylight::gl::Restrictions {
         no_fragment_highp: args.no_fragment_highp,
     };
-    let mut renderer = Renderer::restricted(ctx.load_gl()?, es, &restrictions)?;
+    let probe = |es: EsVersion| -> Result<_, Box<dyn std::error::Error>> {
+        let ctx = HeadlessContext::new(es)?;
+        let renderer = Renderer::restricted(ctx.load_gl()?, es, &restrictions)?;
+        Ok((ctx, renderer))
+    };
+    let (ctx, mut renderer) = match args.es {
+        Some(es) => probe(es.into())?,
+        None if args.no_fragment_highp => probe(EsVersion::Es2)?,
+        // A capability probe reports what the device has: ES 2.0 where ES 3.0 is missing.
+        None => match probe(EsVersion::Es3) {
+            Err(e) if crate::version_unavailable(e.as_ref()) => {
+                log::warn!("{e}: probing OpenGL ES 2.0 (`--es 3` insists on 3.0)");
+                probe(EsVersion::Es2)?
+            }
+            probed => probed?,
+        },
+    };
     let report = args
         .scene
         .as_deref()

@@ -124,7 +124,7 @@ fn check_usage(cli: &Cli) {
         _ => None,
     };
     let no_highp_es = match &cli.command {
-        Some(Command::Info(a)) => Some((a.no_fragment_highp, a.es)),
+        Some(Command::Info(a)) => a.es.map(|es| (a.no_fragment_highp, es)),
         _ => render.map(|a| (a.no_fragment_highp, a.es)),
     };
     if let Some((true, EsArg::Three)) = no_highp_es {
