@@ -24,22 +24,9 @@ pub struct Capacities {
     pub grid_texels: usize,
 }
 
-/// Why the light, grid and index data textures ([`DATA_TEXTURE_WIDTH`] texels wide) cannot be
-/// made on `caps`' context, if they cannot: every method but deferred reads them. ES 2.0 only
-/// requires `GL_MAX_TEXTURE_SIZE` 64, ES 3.0 2048.
-pub fn data_textures_unfit(caps: &Caps) -> Option<String> {
-    (caps.max_texture_size < DATA_TEXTURE_WIDTH as i32).then(|| {
-        format!(
-            "its data textures are {DATA_TEXTURE_WIDTH} texels wide, past this context's \
-             GL_MAX_TEXTURE_SIZE {}",
-            caps.max_texture_size
-        )
-    })
-}
-
 /// The capacities of `caps`' context.
 pub fn capacities(caps: &Caps) -> Capacities {
-    if data_textures_unfit(caps).is_some() {
+    if super::forward::data_textures_unfit(caps).is_some() {
         // No method that reads the data textures runs: nothing fits.
         return Capacities {
             forward_lights: 0,

@@ -19,7 +19,7 @@ pub const DESC: MethodDesc = MethodDesc {
 /// Support of both culled methods: ES 2.0 needs highp fragments (cell lookup and texel
 /// addressing), and without float textures lights are RGBA8-packed.
 pub fn culled_support(caps: &Caps) -> Support {
-    if let Some(why) = super::capacity::data_textures_unfit(caps) {
+    if let Some(why) = super::forward::data_textures_unfit(caps) {
         return Support::Unsupported(why);
     }
     if caps.es == EsVersion::Es2 && !caps.fragment_has_highp() {

@@ -12,7 +12,7 @@ use super::directional::DirectionalUniforms;
 use super::geometry::{self, GeometryProgram, UNIT_METHOD};
 use super::uniforms::{self, LightData, Surface, Transforms};
 use super::{FrameContext, MethodDesc, MethodStats, ShaderFeatures, ShadingMethod, Support};
-use crate::cluster::pack::{pack_lights_into, LightEncoding, PackedLights};
+use crate::cluster::pack::{pack_lights_into, LightEncoding, PackedLights, DATA_TEXTURE_WIDTH};
 use crate::cluster::view_light::GpuLight;
 use crate::gl::program::{Resolver, Uniform, UniformSet};
 use crate::gl::texture::{DataFormat, DataTexture};
@@ -31,7 +31,7 @@ pub const DESC: MethodDesc = MethodDesc {
 };
 
 pub(super) fn supported(caps: &Caps) -> Support {
-    if let Some(why) = super::capacity::data_textures_unfit(caps) {
+    if let Some(why) = data_textures_unfit(caps) {
         return Support::Unsupported(why);
     }
     let mut notes = Vec::new();
@@ -48,13 +48,25 @@ pub(super) fn supported(caps: &Caps) -> Support {
     }
 }
 
+/// Why the light, grid and index data textures (`DATA_TEXTURE_WIDTH` texels wide) cannot be
+/// made on `caps`' context, if they cannot: every method but deferred reads them. ES 2.0 only
+/// requires `GL_MAX_TEXTURE_SIZE` 64, ES 3.0 2048.
+pub(crate) fn data_textures_unfit(caps: &Caps) -> Option<String> {
+    (caps.max_texture_size < DATA_TEXTURE_WIDTH as i32).then(|| {
+        format!(
+            "its data textures are {DATA_TEXTURE_WIDTH} texels wide, past this context's \
+             GL_MAX_TEXTURE_SIZE {}",
+            caps.max_texture_size
+        )
+    })
+}
+
 /// Largest light count one forward draw can loop over on this context. ES 2.0 needs a constant
 /// loop bound that fits the fragment `int` precision: highp ints reach ±2¹⁶, mediump only ±2¹⁰;
 /// and a driver that ends long loops early bounds any loop ([`Caps::light_loop_budget`]).
 pub fn max_lights(caps: &Caps) -> u32 {
     let texture_rows = caps.max_texture_size.max(1) as u32;
-    let by_texture = texture_rows
-        * (crate::cluster::pack::DATA_TEXTURE_WIDTH / LightEncoding::Rgba8.texels_per_light());
+    let by_texture = texture_rows * (DATA_TEXTURE_WIDTH / LightEncoding::Rgba8.texels_per_light());
     let by_loop = match (caps.es, caps.fragment_has_highp()) {
         (EsVersion::Es3, _) => u32::MAX,
         (EsVersion::Es2, true) => 65_535,

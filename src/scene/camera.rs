@@ -366,7 +366,7 @@ mod tests {
         let poses = [
             (glam::DQuat::IDENTITY, DVec3::ZERO),
             (
-                glam::DQuat::from_rotation_x(-1.5707963),
+                glam::DQuat::from_rotation_x(-1.57),
                 DVec3::new(3.0, 40.0, -2.0),
             ),
             (
