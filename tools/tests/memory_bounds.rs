@@ -521,3 +521,46 @@ fn which_prlimit() -> Result<std::path::PathBuf, ()> {
         .find(|p| p.is_file())
         .ok_or(())
 }
+
+/// A sparse POSITION without a buffer view claims its count for free: 703 bytes of glTF with
+/// 2²⁵ such vertices took 2.4 GB. Past `MAX_UNBACKED_ELEMENTS` it is refused naming the
+/// accessor; a small one (zeros but for its sparse values) still loads.
+#[test]
+fn gltf_accessors_without_a_buffer_view_are_bounded() {
+    use common::gltf::Builder;
+    use manylight::scene::gltf::MAX_UNBACKED_ELEMENTS;
+    let dir = tempfile::tempdir().unwrap();
+    let document = |count: usize| {
+        let mut b = Builder::default();
+        let index_bytes: Vec<u8> = [0u16, 1, 2].iter().flat_map(|v| v.to_le_bytes()).collect();
+        let sparse_indices = b.view(&index_bytes);
+        let values: Vec<u8> = [0f32, 0., 0., 1., 0., 0., 0., 1., 0.]
+            .iter()
+            .flat_map(|v| v.to_le_bytes())
+            .collect();
+        let sparse_values = b.view(&values);
+        b.accessors.push(serde_json::json!({
+            "componentType": 5126, "type": "VEC3", "count": count,
+            "min": [0, 0, 0], "max": [1, 1, 0],
+            "sparse": {"count": 3,
+                "indices": {"bufferView": sparse_indices, "componentType": 5123},
+                "values": {"bufferView": sparse_values}}
+        }));
+        let position = b.accessors.len() - 1;
+        let indices = b.u16s(&[0, 1, 2]);
+        b.gltf(serde_json::json!({
+            "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+            "meshes": [{"primitives": [{"attributes": {"POSITION": position},
+                "indices": indices}]}]
+        }))
+    };
+    let path = common::files::write(dir.path(), "small.gltf", document(3));
+    let (scene, _) = common::files::load(&path).unwrap();
+    assert_eq!(scene.objects.len(), 1);
+    let path = common::files::write(dir.path(), "big.gltf", document(MAX_UNBACKED_ELEMENTS + 1));
+    let err = common::files::load(&path).unwrap_err().to_string();
+    assert!(
+        err.contains("accessors[0]") && err.contains("without a bufferView"),
+        "{err}"
+    );
+}

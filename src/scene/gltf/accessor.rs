@@ -165,7 +165,10 @@ fn read<T: Copy + Default>(
             }
         }
         // No view: every element is zero until sparse substitution.
-        None => out.resize(count * d, T::default()),
+        None => {
+            buffers.take_unbacked(count, &field)?;
+            out.resize(count * d, T::default())
+        }
     }
     if let Some(sparse) = a.sparse() {
         let field = format!("{field}.sparse");

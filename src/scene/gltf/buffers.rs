@@ -15,6 +15,11 @@ use crate::scene::access;
 use crate::scene::input::{read_bounded_prefix, FileKind};
 
 /// Lazily loaded buffer contents of one glTF document.
+/// Most elements one glTF file's accessors without a buffer view may hold together (16 MiB
+/// of `VEC4` floats): their count is free to claim, so without a bound a file of a few hundred
+/// bytes took gigabytes.
+pub const MAX_UNBACKED_ELEMENTS: usize = 1 << 20;
+
 pub(super) struct Buffers<'a> {
     document: &'a gltf::Document,
     bin: Option<&'a [u8]>,
@@ -23,6 +28,8 @@ pub(super) struct Buffers<'a> {
     loaded: Vec<Option<Cow<'a, [u8]>>>,
     /// Bytes still allowed to be read or decoded into buffers.
     budget: u64,
+    /// Elements still allowed in accessors without a buffer view.
+    unbacked: usize,
 }
 
 impl<'a> Buffers<'a> {
@@ -41,7 +48,21 @@ impl<'a> Buffers<'a> {
             allow_outside,
             loaded: vec![None; document.buffers().len()],
             budget: FileKind::GltfBuffer.limit(),
+            unbacked: MAX_UNBACKED_ELEMENTS,
         }
+    }
+
+    /// Takes `count` elements of an accessor without a buffer view (zeros but for its sparse
+    /// values) from the file's [`MAX_UNBACKED_ELEMENTS`]; `field` names the accessor.
+    pub fn take_unbacked(&mut self, count: usize, field: &str) -> Result<(), String> {
+        self.unbacked = self.unbacked.checked_sub(count).ok_or_else(|| {
+            format!(
+                "{field}: {count} elements without a bufferView (zeros but for its sparse \
+                 values) pass the limit of {MAX_UNBACKED_ELEMENTS} such elements per file: no \
+                 bytes of the file back them"
+            )
+        })?;
+        Ok(())
     }
 
     /// The file a URI of this document names (`name`, percent-decoded), refused when it lies

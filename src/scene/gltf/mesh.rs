@@ -28,10 +28,19 @@ impl Budget {
             "vertices" => (&mut self.vertices, super::MAX_VERTICES),
             _ => (&mut self.indices, super::MAX_INDICES),
         };
+        let taken = limit - *left;
         *left = left.checked_sub(n).ok_or_else(|| {
-            format!("{field}: {n} {what} would pass the limit of {limit} {what} per file")
+            format!(
+                "{field}: {n} {what} more than the file's {taken} before would pass the limit \
+                 of {limit} {what} per file"
+            )
         })?;
         Ok(())
+    }
+
+    /// Gives back `n` vertices a primitive no longer keeps.
+    fn give_back_vertices(&mut self, n: usize) {
+        self.vertices = (self.vertices + n).min(super::MAX_VERTICES);
     }
 }
 
@@ -174,6 +183,8 @@ pub(super) fn build(
     let tangents = if flat { Vec::new() } else { tangents };
     let (colors, tangents) = (unshare(colors), unshare(tangents));
     let (positions, uvs, indices) = if flat {
+        // The unshared vertices replace the file's.
+        budget.give_back_vertices(n);
         budget.take("vertices", indices.len(), field)?;
         let pick = |i: &u32| positions[*i as usize];
         let flat_uvs = if uvs.is_empty() {
@@ -390,6 +401,45 @@ mod tests {
         assert!(triangles(Mode::Triangles, &[0, 1, 2, 3])
             .unwrap_err()
             .contains("4 indices"));
+    }
+
+    /// A non-indexed primitive without normals unshares nothing more than its own vertices:
+    /// they replace the file's in the budget instead of counting twice.
+    #[test]
+    fn flat_normals_count_their_vertices_once() {
+        let floats: Vec<u8> = [0f32, 0., 0., 1., 0., 0., 0., 1., 0.]
+            .iter()
+            .flat_map(|v| v.to_le_bytes())
+            .collect();
+        let uri = format!(
+            "data:application/octet-stream;base64,{}",
+            base64::Engine::encode(&base64::engine::general_purpose::STANDARD, &floats)
+        );
+        let json = serde_json::json!({
+            "asset": {"version": "2.0"},
+            "buffers": [{"byteLength": 36, "uri": uri}],
+            "bufferViews": [{"buffer": 0, "byteLength": 36}],
+            "accessors": [{"bufferView": 0, "componentType": 5126, "type": "VEC3", "count": 3}],
+            "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}]
+        });
+        let root: gltf::json::Root = serde_json::from_value(json).unwrap();
+        let document = gltf::Document::from_json_without_validation(root);
+        let dir = std::env::temp_dir();
+        let mut buffers = Buffers::new(&document, None, &dir, false);
+        let primitive = document
+            .meshes()
+            .next()
+            .unwrap()
+            .primitives()
+            .next()
+            .unwrap();
+        let mut budget = Budget {
+            vertices: 5,
+            indices: 10,
+        };
+        let built = build(&primitive, "m", &mut buffers, &mut budget, &mut Vec::new());
+        assert!(matches!(built, Ok(Built::Mesh(_))), "{:?}", built.err());
+        assert_eq!(budget.vertices, 2);
     }
 
     #[test]

@@ -69,6 +69,8 @@ use super::{
 /// the largest OBJ file allowed holds). Checked before each accessor is allocated.
 pub const MAX_VERTICES: usize = 1 << 25;
 
+pub use buffers::MAX_UNBACKED_ELEMENTS;
+
 /// Most indices one glTF file may decode into (three per vertex of [`MAX_VERTICES`]).
 pub const MAX_INDICES: usize = 3 << 25;
 
