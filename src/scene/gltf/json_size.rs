@@ -6,15 +6,17 @@
 //! two of `0,`. The objects and arrays, and the elements and members, are counted first, in
 //! one pass over the bytes, before anything is built.
 
-/// Most JSON objects and arrays a glTF file's JSON may hold: four for each of the 2²⁰
-/// primitives a file may place (a node with a translation, a rotation, a scale and children
-/// is five; a primitive, its attributes and its accessors' bounds a few more).
-pub const MAX_JSON_CONTAINERS: usize = 1 << 22;
+/// Most JSON objects and arrays a glTF file's JSON may hold: about 600 MB parsed at some 600
+/// bytes an empty node, where 2²² let 16 MB of `{},` take 2.5 GB. A node placing a mesh is one
+/// (with a translation, a rotation, a scale and children, five): far more than the largest
+/// real scenes' tens of thousands of nodes.
+pub const MAX_JSON_CONTAINERS: usize = 1 << 20;
 
 /// Most array elements and object members a glTF file's JSON may hold (counted by the commas
-/// between them): a node with a matrix is some 20, so 2²⁰ such nodes and their accessors fit,
-/// while a flat array of 50 million numbers (an accessor `min`, say) does not.
-pub const MAX_JSON_ELEMENTS: usize = 1 << 25;
+/// between them): a node with a matrix is some 20, so 400 000 such nodes and their accessors
+/// fit, while a flat array of 10 million numbers (an accessor `min`, say, some 35 bytes each
+/// parsed: 2²⁵ of them took 2.2 GB) does not.
+pub const MAX_JSON_ELEMENTS: usize = 1 << 23;
 
 /// Refuses JSON holding more than [`MAX_JSON_CONTAINERS`] objects and arrays or more than
 /// [`MAX_JSON_ELEMENTS`] elements and members. Brackets and commas inside strings do not
@@ -93,5 +95,16 @@ mod tests {
             refusal.contains(&format!("{} objects and arrays", MAX_JSON_CONTAINERS + 1)),
             "{refusal}"
         );
+    }
+
+    /// What the limits are for: the cheapest files that parse into a gigabyte or more, a
+    /// few megabytes each, are refused (16 MB of empty nodes took 2.5 GB, 67 MB of an
+    /// accessor's `min` 2.2 GB).
+    #[test]
+    fn files_that_parse_into_a_gigabyte_are_refused() {
+        let nodes = format!("[{}]", vec!["{}"; 1_700_000].join(","));
+        assert!(check(nodes.as_bytes()).is_err(), "1.7 M empty nodes");
+        let zeros = format!("[{}0]", "0,".repeat(30_000_000));
+        assert!(check(zeros.as_bytes()).is_err(), "30 M zeros");
     }
 }
