@@ -21,6 +21,7 @@ mod corners;
 mod lines;
 mod textures;
 
+pub use lines::MAX_OBJ_MATERIALS;
 pub use textures::resolve_texture;
 use textures::{find_texture, within_folder, TextureCache};
 
@@ -75,8 +76,19 @@ pub fn load_into(
             Vec::new()
         }
     };
-    let first = scene.materials.len();
-    for m in &mtl {
+    // A library's materials no face uses are not kept, nor their textures decoded: a shared
+    // library may define hundreds, and every material kept costs each frame.
+    let mut used = vec![false; mtl.len()];
+    for id in models.iter().filter_map(|m| m.mesh.material_id) {
+        if let Some(u) = used.get_mut(id) {
+            *u = true;
+        }
+    }
+    let mut material_of = vec![None; mtl.len()];
+    for (id, m) in mtl.iter().enumerate() {
+        if !used[id] {
+            continue;
+        }
         // The name as messages (and the renderer's stats) show it.
         let material_name = shown::name(&m.name);
         // The caller's texture replaces the MTL's, which is then not even decoded (it would
@@ -145,6 +157,7 @@ pub fn load_into(
         };
         let shininess = number("Ns", m.shininess, 1.0, (0.0, MAX_SHININESS));
         let alpha = number("d", m.dissolve, 1.0, (0.0, 1.0));
+        material_of[id] = Some(scene.materials.len());
         scene.materials.push(Material {
             name: material_name,
             diffuse,
@@ -191,10 +204,10 @@ pub fn load_into(
             path: path.to_path_buf(),
             reason: format!("object `{}`: {e}", shown::name(&model.name)),
         })?;
-        let material = match m.material_id {
-            Some(id) if id < mtl.len() => first + id,
-            _ => fallback,
-        };
+        let material = m
+            .material_id
+            .and_then(|id| material_of.get(id).copied().flatten())
+            .unwrap_or(fallback);
         let (mut mesh, dropped) =
             super::duplicates::drop_from_opaque(mesh, &scene.materials[material], || {
                 format!("{}: object `{}`", path.display(), shown::name(&model.name))
@@ -264,6 +277,8 @@ fn parse_obj(path: &Path, allow_outside: bool) -> Result<Parsed, SceneError> {
     // Each library is read once: tobj reads and merges one again for every `mtllib` line, so
     // a file repeating the line millions of times would exhaust memory.
     let seen = std::cell::RefCell::new(std::collections::HashSet::new());
+    // Materials the libraries read so far define (within `lines::MAX_OBJ_MATERIALS`).
+    let defined = std::cell::Cell::new(0);
     let warnings = std::cell::RefCell::new(Vec::new());
     if filled_corners {
         warnings.borrow_mut().push(format!(
@@ -297,9 +312,12 @@ fn parse_obj(path: &Path, allow_outside: bool) -> Result<Parsed, SceneError> {
                 mtl_path.display()
             ));
         }
-        if let Err(line) = lines::check_mtl(&text) {
-            warn(format!("{}: {line}", mtl_path.display()));
-            return Err(tobj::LoadError::MaterialParseError);
+        match lines::check_mtl(&text, defined.get()) {
+            Ok(materials) => defined.set(defined.get() + materials),
+            Err(line) => {
+                warn(format!("{}: {line}", mtl_path.display()));
+                return Err(tobj::LoadError::MaterialParseError);
+            }
         }
         tobj::load_mtl_buf(&mut std::io::BufReader::new(text.as_bytes()))
     };

@@ -772,3 +772,59 @@ fn usemtl_naming_an_undefined_material_is_warned_of() {
         report.warnings
     );
 }
+
+/// A library's materials no face uses are not kept, and their textures are not even looked
+/// for (a missing one is not warned of); the face's material is the one it names.
+#[test]
+fn only_the_materials_faces_use_are_kept() {
+    let dir = tempfile::tempdir().unwrap();
+    write(
+        dir.path(),
+        "m.mtl",
+        "newmtl unused\nKd 0 1 0\nmap_Kd gone.png\nnewmtl red\nKd 0.9 0.1 0.1\n\
+         newmtl also_unused\nKd 0 0 1\n",
+    );
+    let path = write(
+        dir.path(),
+        "tri.obj",
+        "mtllib m.mtl\nv -1 -1 0\nv 1 -1 0\nv 0 1 0\nusemtl red\nf 1 2 3\n",
+    );
+    let (scene, report) = load_obj(&path).unwrap();
+    assert!(report.warnings.is_empty(), "{:?}", report.warnings);
+    let names: Vec<&str> = scene.materials.iter().map(|m| m.name.as_str()).collect();
+    assert!(
+        !names.contains(&"unused") && !names.contains(&"also_unused"),
+        "{names:?}"
+    );
+    let material = &scene.materials[scene.objects[0].material];
+    assert_eq!((material.name.as_str(), material.diffuse.x), ("red", 0.9));
+}
+
+/// 1.1 million `newmtl` lines (16 MB) took 1.1 GB: a library that takes the libraries past
+/// 65 536 materials together is refused naming its line; the ones before it stay.
+#[test]
+fn material_libraries_past_the_material_limit_are_refused_by_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let limit = manylight::scene::obj::MAX_OBJ_MATERIALS;
+    let half: String = (0..limit / 2).map(|i| format!("newmtl a{i}\n")).collect();
+    write(dir.path(), "a.mtl", &half);
+    let rest: String = (0..limit / 2 + 1)
+        .map(|i| format!("newmtl b{i}\n"))
+        .collect();
+    write(dir.path(), "b.mtl", &rest);
+    let obj = "mtllib a.mtl\nmtllib b.mtl\nv -1 -1 0\nv 1 -1 0\nv 0 1 0\nusemtl a0\nf 1 2 3\n";
+    let path = write(dir.path(), "tri.obj", obj);
+    let (scene, report) = load_obj(&path).unwrap();
+    let all = report.warnings.join("\n");
+    assert!(
+        all.contains("b.mtl") && all.contains(&format!("line {}", limit / 2 + 1)),
+        "{all}"
+    );
+    // What the first library defined stays the face's.
+    assert_eq!(scene.materials[scene.objects[0].material].name, "a0");
+    // One library within the limit loads.
+    let path = write(dir.path(), "one.obj", &obj.replace("mtllib b.mtl\n", ""));
+    let (scene, report) = load_obj(&path).unwrap();
+    assert!(report.warnings.is_empty(), "{:?}", report.warnings);
+    assert_eq!(scene.materials[scene.objects[0].material].name, "a0");
+}

@@ -228,7 +228,16 @@ pub(super) fn undefined_materials(text: &str, defined: &HashSet<&str>) -> Option
 /// with fewer than three numbers, as a truncated file has; `d`, `Ns`, `Ni` or `illum` without
 /// its number; a texture statement or `newmtl` naming nothing), as a message naming the line
 /// (not showing it).
-pub(super) fn check_mtl(text: &str) -> Result<(), String> {
+/// Most materials the material libraries of one OBJ may define together: tobj keeps about a
+/// kilobyte for each, so 1.1 million `newmtl` lines (16 MB) took 1.1 GB, and every material
+/// kept costs each frame. Far more than a model uses.
+pub const MAX_OBJ_MATERIALS: usize = 65_536;
+
+/// Checks an MTL library for what tobj would panic on or take silently, and that its
+/// materials with the `defined` before it stay within [`MAX_OBJ_MATERIALS`]; the error names
+/// the line. Returns how many materials it defines.
+pub(super) fn check_mtl(text: &str, defined: usize) -> Result<usize, String> {
+    let mut materials = 0;
     for (number, line) in text.lines().enumerate() {
         let mut words = line.split_whitespace();
         let Some(key) = words.next() else {
@@ -254,11 +263,20 @@ pub(super) fn check_mtl(text: &str) -> Result<(), String> {
                 .then(|| format!("`{key}` names nothing")),
             _ => None,
         };
+        let fault = fault.or_else(|| {
+            materials += usize::from(key == "newmtl");
+            (defined + materials > MAX_OBJ_MATERIALS).then(|| {
+                format!(
+                    "`newmtl` defines more than the {MAX_OBJ_MATERIALS} materials an OBJ's \
+                     libraries may hold together"
+                )
+            })
+        });
         if let Some(fault) = fault {
             return Err(format!("line {}: {fault}", number + 1));
         }
     }
-    Ok(())
+    Ok(materials)
 }
 
 #[cfg(test)]
@@ -304,11 +322,11 @@ mod tests {
             ("newmtl\n", "line 1: `newmtl` names nothing"),
         ];
         for (text, expected) in cases {
-            let err = check_mtl(text).expect_err(text);
+            let err = check_mtl(text, 0).expect_err(text);
             assert!(err.starts_with(expected), "{text:?}: {err}");
         }
         let fine = "newmtl m\nKd 1 1 1\nd 0.5\nNs 10\nillum 2\nmap_Kd a b.png\n";
-        assert_eq!(check_mtl(fine), Ok(()));
+        assert!(check_mtl(fine, 0).is_ok());
     }
 
     #[test]
