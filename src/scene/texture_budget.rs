@@ -82,12 +82,64 @@ pub(crate) fn decode_texture_bytes(
         reader.limits(limits());
         Ok::<_, String>(reader)
     };
-    let (w, h) = reader()?.into_dimensions().map_err(undecodable)?;
-    let taken = budget.take(w, h)?;
-    reader()?.decode().map_err(|e| {
-        budget.give_back(taken);
-        undecodable(e)
-    })
+    let first = reader()?;
+    if first.format() == Some(image::ImageFormat::Jpeg) {
+        if let Some((w, h)) = progressive_jpeg_size(bytes) {
+            let pixels = u64::from(w) * u64::from(h);
+            if pixels * PROGRESSIVE_JPEG_BYTES_PER_PIXEL > MAX_PROGRESSIVE_DECODE_BYTES {
+                return Err(format!(
+                    "could not be decoded (a progressive JPEG of {w}×{h} holds its \
+                     coefficients besides its pixels to decode, past {} MiB)",
+                    MAX_PROGRESSIVE_DECODE_BYTES >> 20
+                ));
+            }
+        }
+    }
+    let (w, h) = first.into_dimensions().map_err(undecodable)?;
+    // A failed decode keeps its share taken: decoding is the work the budget bounds (60
+    // images of 16 384² that failed at their last row took 16 s, none of it counted).
+    budget.take(w, h)?;
+    reader()?.decode().map_err(undecodable)
+}
+
+/// Bytes a progressive JPEG's decode holds a pixel at most: its coefficients (two bytes a
+/// component, three components) besides its RGB pixels. A baseline JPEG decodes row by row.
+const PROGRESSIVE_JPEG_BYTES_PER_PIXEL: u64 = 9;
+
+/// Most bytes a progressive JPEG's decode may hold: 1 GiB, about 10 900² pixels (a
+/// 16 384 × 10 922 one within [`MAX_DECODE_BYTES`] of pixels took 1.06 GB).
+const MAX_PROGRESSIVE_DECODE_BYTES: u64 = 2 * MAX_DECODE_BYTES;
+
+/// The width and height of progressive JPEG `bytes`, as its first start-of-frame segment
+/// gives them (SOF2, SOF6, SOF10, SOF14); `None` for any other JPEG. Reads the segment
+/// headers only, within the bytes.
+fn progressive_jpeg_size(bytes: &[u8]) -> Option<(u32, u32)> {
+    let mut at = 2; // past SOI
+    while at + 4 <= bytes.len() {
+        if bytes[at] != 0xFF {
+            return None;
+        }
+        let marker = bytes[at + 1];
+        match marker {
+            // Fill bytes before a marker.
+            0xFF => at += 1,
+            0xC2 | 0xC6 | 0xCA | 0xCE => {
+                // Length (2), precision (1), height (2), width (2).
+                let frame = bytes.get(at + 5..at + 9)?;
+                let h = u16::from_be_bytes([frame[0], frame[1]]);
+                let w = u16::from_be_bytes([frame[2], frame[3]]);
+                return Some((w.into(), h.into()));
+            }
+            0xC0 | 0xC1 | 0xC3 | 0xC5 | 0xC7 | 0xC9 | 0xCB | 0xCD | 0xCF => return None,
+            // Markers without a length.
+            0x01 | 0xD0..=0xD9 => at += 2,
+            _ => {
+                let length = usize::from(u16::from_be_bytes([bytes[at + 2], bytes[at + 3]]));
+                at += 2 + length;
+            }
+        }
+    }
+    None
 }
 
 /// Why an image did not decode, by the kind of failure only: the decoders' own messages
@@ -184,6 +236,71 @@ impl TextureBudget {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A JPEG's start of frame alone (`marker`: SOF0 baseline, SOF2 progressive) for a
+    /// `w × h` image of three components, then its end: what a header read sees.
+    fn jpeg_header(marker: u8, w: u16, h: u16) -> Vec<u8> {
+        let mut b = vec![0xFF, 0xD8, 0xFF, 0xE0, 0, 4, 0, 0, 0xFF, marker, 0, 17, 8];
+        b.extend(h.to_be_bytes());
+        b.extend(w.to_be_bytes());
+        b.push(3);
+        for id in 1..=3 {
+            b.extend([id, 0x11, 0]);
+        }
+        b.extend([0xFF, 0xD9]);
+        b
+    }
+
+    /// A 521-byte progressive JPEG claiming 16 384 × 10 922 took 1.06 GB to decode: refused
+    /// from its frame header, before anything is taken.
+    #[test]
+    fn a_large_progressive_jpeg_is_refused_from_its_header() {
+        let jpeg = Some(image::ImageFormat::Jpeg);
+        let mut budget = TextureBudget::default();
+        let progressive = jpeg_header(0xC2, 16_384, 10_922);
+        assert_eq!(progressive_jpeg_size(&progressive), Some((16_384, 10_922)));
+        let err = decode_texture_bytes(&progressive, jpeg, &mut budget).unwrap_err();
+        assert!(err.contains("progressive JPEG of 16384×10922"), "{err}");
+        assert_eq!(
+            budget,
+            TextureBudget::default(),
+            "refused before anything was taken"
+        );
+        // Small ones, and baseline ones of any size, go to the decoder.
+        assert_eq!(
+            progressive_jpeg_size(&jpeg_header(0xC0, 16_384, 10_922)),
+            None
+        );
+        let small = jpeg_header(0xC2, 64, 64);
+        let err = decode_texture_bytes(&small, jpeg, &mut budget).unwrap_err();
+        assert!(!err.contains("progressive"), "{err}");
+        let mut encoded = Vec::new();
+        image::RgbImage::new(8, 8)
+            .write_to(
+                &mut std::io::Cursor::new(&mut encoded),
+                image::ImageFormat::Jpeg,
+            )
+            .unwrap();
+        assert_eq!(progressive_jpeg_size(&encoded), None);
+    }
+
+    /// A decode that fails keeps its share of the budget taken: decoding is the work the
+    /// budget bounds (60 images of 16 384² that failed at their last row took 16 s).
+    #[test]
+    fn a_failed_decode_is_charged() {
+        let mut encoded = Vec::new();
+        image::RgbImage::new(64, 32)
+            .write_to(
+                &mut std::io::Cursor::new(&mut encoded),
+                image::ImageFormat::Png,
+            )
+            .unwrap();
+        encoded.truncate(encoded.len() - 20);
+        let mut budget = TextureBudget::default();
+        let png = Some(image::ImageFormat::Png);
+        assert!(decode_texture_bytes(&encoded, png, &mut budget).is_err());
+        assert_eq!(MAX_SCENE_TEXTURE_BYTES - budget.left(), 64 * 32 * 4);
+    }
 
     #[test]
     fn large_images_are_scaled_down_keeping_their_aspect_and_named() {
