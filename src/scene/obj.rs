@@ -21,7 +21,7 @@ mod corners;
 mod lines;
 mod textures;
 
-pub use lines::MAX_OBJ_MATERIALS;
+pub use lines::{MAX_OBJ_CORNERS, MAX_OBJ_MATERIALS};
 pub use textures::resolve_texture;
 use textures::{find_texture, within_folder, TextureCache};
 

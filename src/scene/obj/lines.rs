@@ -19,8 +19,19 @@ use crate::scene::mesh::{MAX_SCENE_MESHES, MAX_TEXCOORD};
 ///   wrong element in release ones);
 /// - at most [`MAX_SCENE_MESHES`] objects have faces (tobj makes one at each `o`, `g` or change
 ///   of `usemtl` after faces): each is a mesh of its own, whose fixed cost (buffers, GL
-///   objects, the ray caster's hierarchy) would otherwise grow past memory before a frame.
+///   objects, the ray caster's hierarchy) would otherwise grow past memory before a frame;
+/// - the faces, triangulated, hold at most [`MAX_OBJ_CORNERS`] corners.
 pub(super) fn check_obj(text: &str) -> Result<(), String> {
+    check_obj_within(text, MAX_OBJ_CORNERS)
+}
+
+/// Most triangle corners the faces of one OBJ may hold once triangulated (as many indices as
+/// a glTF file may decode): parsed, each takes some 40 to 70 bytes, so a file's parse takes
+/// 16 to 35 times its size (a 67 MB face of 2²⁵ corners took 2.2 GB), and this bounds it.
+pub const MAX_OBJ_CORNERS: usize = 3 << 25;
+
+/// [`check_obj`] with at most `max_corners` triangle corners.
+fn check_obj_within(text: &str, max_corners: usize) -> Result<(), String> {
     let kind_of = |key: Option<&str>| match key {
         Some("v") => Some(0),
         Some("vt") => Some(1),
@@ -38,6 +49,7 @@ pub(super) fn check_obj(text: &str) -> Result<(), String> {
     }
     let mut defined = [0i64; 3];
     let mut objects = Objects::default();
+    let mut corners = 0usize;
     for (number, line) in text.lines().enumerate() {
         let at_line = |what: String| format!("line {}: {what}", number + 1);
         let mut words = line.split_whitespace();
@@ -58,6 +70,16 @@ pub(super) fn check_obj(text: &str) -> Result<(), String> {
         // tobj's "invalid polygon", without a line.
         if words.clone().next().is_none() {
             return Err(at_line(format!("`{key}` names no vertices")));
+        }
+        if key == "f" {
+            // Triangulated as a fan: three corners for each corner past the second.
+            corners += 3 * words.clone().count().saturating_sub(2);
+            if corners > max_corners {
+                return Err(at_line(format!(
+                    "the faces so far hold more than the {max_corners} triangle corners one \
+                     OBJ may (each takes some 40 bytes or more parsed)"
+                )));
+            }
         }
         for (at, word) in words.enumerate() {
             // tobj's "face parse error", without a line (it reads `1/2/3/` as `1/2/3`).
@@ -281,7 +303,22 @@ pub(super) fn check_mtl(text: &str, defined: usize) -> Result<usize, String> {
 
 #[cfg(test)]
 mod tests {
-    use super::{check_mtl, check_obj, undefined_materials, HashSet, Objects};
+    use super::{check_mtl, check_obj, check_obj_within, undefined_materials, HashSet, Objects};
+
+    /// Corners are counted triangulated, a fan of three for each past the second, and the
+    /// face that passes the limit is named.
+    #[test]
+    fn faces_past_the_corner_limit_are_refused_by_line() {
+        let text = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3 4\nf 1 2 3\nf 1 2 3\n";
+        assert_eq!(check_obj_within(text, 12), Ok(()));
+        let err = check_obj_within(text, 11).unwrap_err();
+        assert!(
+            err.starts_with("line 7:") && err.contains("11 triangle corners"),
+            "{err}"
+        );
+        // Lines (`l`) make no triangles.
+        assert_eq!(check_obj_within("v 0 0 0\nl 1 1 1 1\n", 0), Ok(()));
+    }
 
     /// Objects are counted as tobj splits them: a `usemtl` naming the whole rest of its line.
     #[test]
