@@ -543,3 +543,37 @@ fn variants_without_surface_inputs_contain_none_of_their_code() {
         }
     }
 }
+
+/// Values past f32 in the file (1e300 reads as infinity) were replaced without a word: each is
+/// now warned of, naming its path; an infinite emissive strength is clamped as a large one is.
+#[test]
+fn values_past_f32_are_warned_of_by_path() {
+    let dir = tempfile::tempdir().unwrap();
+    let material = json!({
+        "pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.7, 0.6, 1.0]},
+        "normalTexture": {"index": 0, "scale": 1e300},
+        "occlusionTexture": {"index": 0, "strength": 1e300},
+        "emissiveFactor": [1.0, 0.5, 0.0],
+        "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 1e300}},
+    });
+    let mut plane = Plane::new(material);
+    plane.images.push(png(1, 1, &[[128, 128, 255, 255]]));
+    plane.extensions.push("KHR_materials_emissive_strength");
+    let path = plane.write(dir.path(), "huge.gltf");
+    let (s, warnings) = scene_of(&path, grazing_light(), 0.02);
+    let all = warnings.join("\n");
+    for needle in [
+        "normalTexture.scale",
+        "occlusionTexture.strength",
+        "KHR_materials_emissive_strength",
+    ] {
+        assert!(all.contains(needle), "{needle}: {all}");
+    }
+    let maps = &s.materials[0].maps;
+    assert_eq!((maps.normal_scale, maps.occlusion_strength), (1.0, 1.0));
+    assert!(
+        maps.emissive.x > 1.0 && maps.emissive.z == 0.0,
+        "{}",
+        maps.emissive
+    );
+}

@@ -168,12 +168,8 @@ pub(super) fn convert(
             tex_coord: n.tex_coord(),
         };
         maps.normal = load_slot(slot, index, field, src, warnings)?;
-        let scale = n.scale();
-        maps.normal_scale = if scale.is_finite() {
-            scale.clamp(-16.0, 16.0)
-        } else {
-            1.0
-        };
+        let path = format!("{field}.normalTexture.scale");
+        maps.normal_scale = kept_in(n.scale(), (-16.0, 16.0), 1.0, &path, warnings);
     }
     if let Some(o) = m.occlusion_texture() {
         let slot = Slot {
@@ -183,12 +179,8 @@ pub(super) fn convert(
             tex_coord: o.tex_coord(),
         };
         maps.occlusion = load_slot(slot, index, field, src, warnings)?;
-        let strength = o.strength();
-        maps.occlusion_strength = if strength.is_finite() {
-            strength.clamp(0.0, 1.0)
-        } else {
-            1.0
-        };
+        let path = format!("{field}.occlusionTexture.strength");
+        maps.occlusion_strength = kept_in(o.strength(), (0.0, 1.0), 1.0, &path, warnings);
     }
     if let Some(info) = m.pbr_metallic_roughness().metallic_roughness_texture() {
         let slot = Slot {
@@ -199,8 +191,10 @@ pub(super) fn convert(
         };
         maps.metallic_roughness = load_slot(slot, index, field, src, warnings)?;
     }
+    // A strength past f32 (1e300 in the file) is infinite: the product is clamped and warned
+    // of below, as a large one is (0 × ∞ is NaN, which becomes 0).
     let strength = m.emissive_strength().unwrap_or(1.0);
-    let e = Vec3::from(m.emissive_factor()) * if strength.is_finite() { strength } else { 1.0 };
+    let e = Vec3::from(m.emissive_factor()) * strength;
     // NaN becomes 0 (max/min drop it).
     let emissive = e.max(Vec3::ZERO).min(Vec3::splat(MAX_EMISSIVE));
     if emissive != e {
@@ -222,4 +216,27 @@ pub(super) fn convert(
         }
     }
     Ok(maps)
+}
+
+/// `value` within `range`, or `default` where it is not finite (past f32 in the file), with a
+/// warning naming `path` whenever what is kept is not what was written.
+fn kept_in(
+    value: f32,
+    range: (f32, f32),
+    default: f32,
+    path: &str,
+    warnings: &mut Vec<String>,
+) -> f32 {
+    let kept = if value.is_finite() {
+        value.clamp(range.0, range.1)
+    } else {
+        default
+    };
+    if kept != value {
+        warnings.push(format!(
+            "{path}: {value} taken as {kept} (its range is [{}, {}])",
+            range.0, range.1
+        ));
+    }
+    kept
 }
