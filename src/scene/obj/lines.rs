@@ -50,14 +50,32 @@ fn check_obj_within(text: &str, max_corners: usize) -> Result<(), String> {
     let mut defined = [0i64; 3];
     let mut objects = Objects::default();
     let mut corners = 0usize;
+    // The first `v` line with a colour and the first without (tobj needs all or none).
+    let mut coloured: [Option<usize>; 2] = [None, None];
     for (number, line) in text.lines().enumerate() {
         let at_line = |what: String| format!("line {}: {what}", number + 1);
         let mut words = line.split_whitespace();
         let key = words.next();
         objects.read(key, line).map_err(at_line)?;
         if let Some(kind) = kind_of(key) {
-            check_vertex_data(key.unwrap_or_default(), words).map_err(at_line)?;
+            let colour = check_vertex_data(key.unwrap_or_default(), words).map_err(at_line)?;
             defined[kind] += 1;
+            if kind == 0 {
+                coloured[usize::from(colour)].get_or_insert(number + 1);
+                if let [Some(plain), Some(with)] = coloured {
+                    // tobj's "face vertex color index out of bounds", without a line.
+                    let (this, other) = if colour {
+                        ("has a colour", "none")
+                    } else {
+                        ("has no colour", "one")
+                    };
+                    return Err(at_line(format!(
+                        "`v` {this} where line {} has {other}: vertex colours must be on every \
+                         `v` or on none",
+                        plain.min(with)
+                    )));
+                }
+            }
             continue;
         }
         // tobj's "material parse error", without a line (and not about an MTL file).
@@ -166,7 +184,7 @@ impl<'a> Objects<'a> {
 fn check_vertex_data<'a>(
     key: &str,
     mut words: impl Iterator<Item = &'a str>,
-) -> Result<(), String> {
+) -> Result<bool, String> {
     let needs = if key == "vt" { 2 } else { 3 };
     let mut values = [0f32; 3];
     for (i, value) in values.iter_mut().enumerate().take(needs) {
@@ -190,13 +208,13 @@ fn check_vertex_data<'a>(
         }
     }
     if key != "v" {
-        return Ok(()); // tobj ignores what follows a texture coordinate or a normal
+        return Ok(false); // tobj ignores what follows a texture coordinate or a normal
     }
     let rest: Vec<&str> = words.take(4).collect();
     match rest[..] {
-        [] => Ok(()),
+        [] => Ok(false),
         [w] => match w.parse::<f32>() {
-            Ok(w) if w != 0.0 && values.iter().all(|x| (x / w).is_finite()) => Ok(()),
+            Ok(w) if w != 0.0 && values.iter().all(|x| (x / w).is_finite()) => Ok(false),
             Ok(_) => Err(format!(
                 "`v` w: the position divided by it must be finite (w not zero, within \
                  f32's range ±{:.1e})",
@@ -204,7 +222,7 @@ fn check_vertex_data<'a>(
             )),
             Err(_) => Err("`v` w (the 4th value) is not a number".into()),
         },
-        [_, _, _] => Ok(()), // a vertex colour, which tobj reads and manylight does not use
+        [_, _, _] => Ok(true), // a vertex colour, which tobj reads and manylight does not use
         _ => Err(format!(
             "`v` takes 3 numbers, then a w or an RGB colour (1 or 3 values); found {} more",
             if rest.len() > 3 { "4 or" } else { "2" }
@@ -304,6 +322,22 @@ pub(super) fn check_mtl(text: &str, defined: usize) -> Result<usize, String> {
 #[cfg(test)]
 mod tests {
     use super::{check_mtl, check_obj, check_obj_within, undefined_materials, HashSet, Objects};
+
+    /// Colours on some `v` lines and not others are named by the first line that differs.
+    #[test]
+    fn vertex_colours_on_some_positions_only_are_named_by_line() {
+        let err = check_obj("v 0 0 0 1 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap_err();
+        assert!(
+            err.starts_with("line 2: `v` has no colour where line 1 has one"),
+            "{err}"
+        );
+        let err = check_obj("v 0 0 0\nv 1 0 0 1 1 1\n").unwrap_err();
+        assert!(
+            err.starts_with("line 2: `v` has a colour where line 1 has none"),
+            "{err}"
+        );
+        assert_eq!(check_obj("v 0 0 0 1 0 0\nv 1 0 0 0 1 0\n"), Ok(()));
+    }
 
     /// Corners are counted triangulated, a fan of three for each past the second, and the
     /// face that passes the limit is named.
