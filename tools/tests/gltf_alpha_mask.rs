@@ -332,3 +332,23 @@ fn vertex_alpha_of_zero_everywhere_is_warned_of_as_fully_transparent() {
         assert_eq!(said, warned, "{last_alpha}: {:?}", report.warnings);
     }
 }
+
+/// Colours outside [0, 1] are clamped by the mesh: a `COLOR_0` of −1e30 drew black without a
+/// word. Said at load, naming the attribute and how many; colours within it say nothing.
+#[test]
+fn vertex_colours_outside_zero_to_one_are_warned_of() {
+    let dir = tempfile::tempdir().unwrap();
+    for (first, warned) in [(-1e30, true), (1.5, true), (0.25, false)] {
+        let mut b = Builder::default();
+        let p = b.floats(&[0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0], "VEC3");
+        let c = b.floats(&[first, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5], "VEC3");
+        let rest = json!({"scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+            "meshes": [{"primitives": [{"attributes": {"POSITION": p, "COLOR_0": c}}]}]});
+        let (_, report) = load(&write(dir.path(), "c.gltf", b.gltf(rest))).unwrap();
+        let said = report
+            .warnings
+            .iter()
+            .any(|w| w.contains("COLOR_0") && w.contains("outside [0, 1]"));
+        assert_eq!(said, warned, "{first}: {:?}", report.warnings);
+    }
+}

@@ -350,6 +350,15 @@ fn read_colors(
             "{field}: element {i} is not finite; colours must be"
         ));
     }
+    // The mesh clamps them: said, since a colour of −1e30 is black.
+    let outside = |c: &Vec4| c.cmplt(Vec4::ZERO).any() || c.cmpgt(Vec4::ONE).any();
+    if let Some(i) = colors.iter().position(outside) {
+        let count = colors.iter().filter(|c| outside(c)).count();
+        warnings.push(format!(
+            "{field}: {count} elements (the first, element {i}) have a component outside \
+             [0, 1], where glTF colours lie; clamped into it"
+        ));
+    }
     Ok(colors)
 }
 
