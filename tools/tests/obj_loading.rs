@@ -823,7 +823,7 @@ fn material_libraries_past_the_material_limit_are_refused_by_line() {
     // What the first library defined stays the face's.
     assert_eq!(scene.materials[scene.objects[0].material].name, "a0");
     // One library within the limit loads.
-    let path = write(dir.path(), "one.obj", &obj.replace("mtllib b.mtl\n", ""));
+    let path = write(dir.path(), "one.obj", obj.replace("mtllib b.mtl\n", ""));
     let (scene, report) = load_obj(&path).unwrap();
     assert!(report.warnings.is_empty(), "{:?}", report.warnings);
     assert_eq!(scene.materials[scene.objects[0].material].name, "a0");
