@@ -84,9 +84,10 @@ pub(crate) fn decode_texture_bytes(
     };
     let first = reader()?;
     if first.format() == Some(image::ImageFormat::Jpeg) {
-        if let Some((w, h)) = progressive_jpeg_size(bytes) {
-            let pixels = u64::from(w) * u64::from(h);
-            if pixels * PROGRESSIVE_JPEG_BYTES_PER_PIXEL > MAX_PROGRESSIVE_DECODE_BYTES {
+        if let Some(frame) = progressive_jpeg_frame(bytes) {
+            let (w, h) = (frame.width, frame.height);
+            let bytes_per_pixel = 2 * u64::from(frame.components) + JPEG_OUTPUT_BYTES_PER_PIXEL;
+            if u64::from(w) * u64::from(h) * bytes_per_pixel > MAX_PROGRESSIVE_DECODE_BYTES {
                 return Err(format!(
                     "could not be decoded (a progressive JPEG of {w}×{h} holds its \
                      coefficients besides its pixels to decode, past {} MiB)",
@@ -97,38 +98,57 @@ pub(crate) fn decode_texture_bytes(
     }
     let (w, h) = first.into_dimensions().map_err(undecodable)?;
     // A failed decode keeps its share taken: decoding is the work the budget bounds (60
-    // images of 16 384² that failed at their last row took 16 s, none of it counted).
-    budget.take(w, h)?;
-    reader()?.decode().map_err(undecodable)
+    // images of 16 384² that failed at their last row took 16 s, none of it counted). One
+    // refused by the decoder's limits decoded nothing, and gives it back.
+    let taken = budget.take(w, h)?;
+    reader()?.decode().map_err(|e| {
+        if matches!(e, image::ImageError::Limits(_)) {
+            budget.give_back(taken);
+        }
+        undecodable(e)
+    })
 }
 
-/// Bytes a progressive JPEG's decode holds a pixel at most: its coefficients (two bytes a
-/// component, three components) besides its RGB pixels. A baseline JPEG decodes row by row.
-const PROGRESSIVE_JPEG_BYTES_PER_PIXEL: u64 = 9;
+/// Bytes a JPEG decode's output holds a pixel at most (RGBA).
+const JPEG_OUTPUT_BYTES_PER_PIXEL: u64 = 4;
 
-/// Most bytes a progressive JPEG's decode may hold: 1 GiB, about 10 900² pixels (a
-/// 16 384 × 10 922 one within [`MAX_DECODE_BYTES`] of pixels took 1.06 GB).
+/// Most bytes a progressive JPEG's decode may hold, its coefficients (two bytes a component
+/// and pixel) and its output together: 1 GiB, about 10 400² pixels of three components (a
+/// 16 384 × 10 922 one within [`MAX_DECODE_BYTES`] of output took 1.06 GB). A baseline JPEG
+/// decodes row by row.
 const MAX_PROGRESSIVE_DECODE_BYTES: u64 = 2 * MAX_DECODE_BYTES;
 
-/// The width and height of progressive JPEG `bytes`, as its first start-of-frame segment
-/// gives them (SOF2, SOF6, SOF10, SOF14); `None` for any other JPEG. Reads the segment
-/// headers only, within the bytes.
-fn progressive_jpeg_size(bytes: &[u8]) -> Option<(u32, u32)> {
+/// What a progressive JPEG's start-of-frame segment says.
+#[derive(Debug, PartialEq)]
+struct JpegFrame {
+    width: u32,
+    height: u32,
+    components: u8,
+}
+
+/// The frame of progressive JPEG `bytes`, as its first start-of-frame segment gives it (SOF2,
+/// SOF6, SOF10, SOF14); `None` for any other JPEG. Reads the segment headers only, within the
+/// bytes, skipping what the decoder skips between segments (stray bytes, `FF 00`, fill).
+fn progressive_jpeg_frame(bytes: &[u8]) -> Option<JpegFrame> {
     let mut at = 2; // past SOI
     while at + 4 <= bytes.len() {
         if bytes[at] != 0xFF {
-            return None;
+            at += 1;
+            continue;
         }
         let marker = bytes[at + 1];
         match marker {
-            // Fill bytes before a marker.
+            // Fill bytes before a marker, and a stuffed zero.
             0xFF => at += 1,
+            0x00 => at += 2,
             0xC2 | 0xC6 | 0xCA | 0xCE => {
-                // Length (2), precision (1), height (2), width (2).
-                let frame = bytes.get(at + 5..at + 9)?;
-                let h = u16::from_be_bytes([frame[0], frame[1]]);
-                let w = u16::from_be_bytes([frame[2], frame[3]]);
-                return Some((w.into(), h.into()));
+                // Length (2), precision (1), height (2), width (2), components (1).
+                let frame = bytes.get(at + 5..at + 10)?;
+                return Some(JpegFrame {
+                    height: u16::from_be_bytes([frame[0], frame[1]]).into(),
+                    width: u16::from_be_bytes([frame[2], frame[3]]).into(),
+                    components: frame[4],
+                });
             }
             0xC0 | 0xC1 | 0xC3 | 0xC5 | 0xC7 | 0xC9 | 0xCB | 0xCD | 0xCF => return None,
             // Markers without a length.
@@ -258,7 +278,25 @@ mod tests {
         let jpeg = Some(image::ImageFormat::Jpeg);
         let mut budget = TextureBudget::default();
         let progressive = jpeg_header(0xC2, 16_384, 10_922);
-        assert_eq!(progressive_jpeg_size(&progressive), Some((16_384, 10_922)));
+        let frame = |width, height| JpegFrame {
+            width,
+            height,
+            components: 3,
+        };
+        assert_eq!(
+            progressive_jpeg_frame(&progressive),
+            Some(frame(16_384, 10_922))
+        );
+        // Stray bytes and a stuffed zero before the frame, which the decoder skips, hide it
+        // from no one.
+        for junk in [&[0x00][..], &[0xFF, 0x00], &[0x12, 0xFF, 0xFF]] {
+            let mut hidden = progressive[..2].to_vec();
+            hidden.extend(junk);
+            hidden.extend(&progressive[2..]);
+            assert_eq!(progressive_jpeg_frame(&hidden), Some(frame(16_384, 10_922)));
+            let err = decode_texture_bytes(&hidden, jpeg, &mut budget).unwrap_err();
+            assert!(err.contains("progressive JPEG"), "{junk:?}: {err}");
+        }
         let err = decode_texture_bytes(&progressive, jpeg, &mut budget).unwrap_err();
         assert!(err.contains("progressive JPEG of 16384×10922"), "{err}");
         assert_eq!(
@@ -268,7 +306,7 @@ mod tests {
         );
         // Small ones, and baseline ones of any size, go to the decoder.
         assert_eq!(
-            progressive_jpeg_size(&jpeg_header(0xC0, 16_384, 10_922)),
+            progressive_jpeg_frame(&jpeg_header(0xC0, 16_384, 10_922)),
             None
         );
         let small = jpeg_header(0xC2, 64, 64);
@@ -281,7 +319,23 @@ mod tests {
                 image::ImageFormat::Jpeg,
             )
             .unwrap();
-        assert_eq!(progressive_jpeg_size(&encoded), None);
+        assert_eq!(progressive_jpeg_frame(&encoded), None);
+    }
+
+    /// CRC-32 as PNG chunks carry it.
+    fn crc32(bytes: &[u8]) -> u32 {
+        let mut crc = !0u32;
+        for &b in bytes {
+            crc ^= u32::from(b);
+            for _ in 0..8 {
+                crc = if crc & 1 == 1 {
+                    (crc >> 1) ^ 0xEDB8_8320
+                } else {
+                    crc >> 1
+                };
+            }
+        }
+        !crc
     }
 
     /// A decode that fails keeps its share of the budget taken: decoding is the work the
@@ -300,6 +354,20 @@ mod tests {
         let png = Some(image::ImageFormat::Png);
         assert!(decode_texture_bytes(&encoded, png, &mut budget).is_err());
         assert_eq!(MAX_SCENE_TEXTURE_BYTES - budget.left(), 64 * 32 * 4);
+        // One past the decoder's limits decodes nothing and is not charged: an RGBA PNG of
+        // 11 600² claims more than MAX_DECODE_BYTES from its header.
+        let mut big = Vec::new();
+        image::RgbaImage::new(1, 1)
+            .write_to(&mut std::io::Cursor::new(&mut big), image::ImageFormat::Png)
+            .unwrap();
+        // IHDR's width and height (bytes 16..24), and its CRC (over type and data, 12..29).
+        big[16..20].copy_from_slice(&11_600u32.to_be_bytes());
+        big[20..24].copy_from_slice(&11_600u32.to_be_bytes());
+        let crc = crc32(&big[12..29]);
+        big[29..33].copy_from_slice(&crc.to_be_bytes());
+        let before = budget.left();
+        let err = decode_texture_bytes(&big, png, &mut budget).unwrap_err();
+        assert_eq!(budget.left(), before, "{err}");
     }
 
     #[test]
