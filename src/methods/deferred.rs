@@ -47,6 +47,10 @@ pub const DESC: MethodDesc = MethodDesc {
 };
 
 fn supported(caps: &Caps) -> Support {
+    // Its transparent objects are drawn forward, from the data textures.
+    if let Some(why) = super::forward::data_textures_unfit(caps) {
+        return Support::Unsupported(why);
+    }
     match gbuffer::unsupported_reason(caps) {
         Some(reason) => Support::Unsupported(reason),
         // Transparent objects take the documented forward fallback; opaque scenes are fully

@@ -49,8 +49,8 @@ pub(super) fn supported(caps: &Caps) -> Support {
 }
 
 /// Why the light, grid and index data textures (`DATA_TEXTURE_WIDTH` texels wide) cannot be
-/// made on `caps`' context, if they cannot: every method but deferred reads them. ES 2.0 only
-/// requires `GL_MAX_TEXTURE_SIZE` 64, ES 3.0 2048.
+/// made on `caps`' context, if they cannot: every method reads them (deferred for its
+/// transparent objects). ES 2.0 only requires `GL_MAX_TEXTURE_SIZE` 64, ES 3.0 2048.
 pub(crate) fn data_textures_unfit(caps: &Caps) -> Option<String> {
     (caps.max_texture_size < DATA_TEXTURE_WIDTH as i32).then(|| {
         format!(
