@@ -347,12 +347,31 @@ pub fn keep_stdout_for_own_output() {
 }
 
 /// The original standard output, for a path that names it (`/dev/stdout`, `/dev/fd/1`,
-/// `/proc/self/fd/1`), once descriptor 1 no longer does.
+/// `/proc/self/fd/1`, this process's `/proc/PID/fd/1`, or a link to one of them), once
+/// descriptor 1 no longer does.
 fn own_stdout_named(path: &Path) -> Option<&'static File> {
-    let names = ["/dev/stdout", "/dev/fd/1", "/proc/self/fd/1"];
-    OWN_STDOUT
-        .get()
-        .filter(|_| names.iter().any(|name| path == Path::new(name)))
+    let own = OWN_STDOUT.get()?;
+    let pid = format!("/proc/{}/fd/1", std::process::id());
+    let names = [
+        "/dev/stdout",
+        "/dev/fd/1",
+        "/proc/self/fd/1",
+        "/proc/thread-self/fd/1",
+        &pid,
+    ];
+    let mut hop = std::path::absolute(path).ok()?;
+    // Each link on the way, as `follow_links` takes them (40 at most).
+    for _ in 0..40 {
+        if names.iter().any(|name| hop == Path::new(name)) {
+            return Some(own);
+        }
+        let target = std::fs::read_link(&hop).ok()?;
+        hop = match hop.parent() {
+            Some(folder) => folder.join(target),
+            None => target,
+        };
+    }
+    None
 }
 
 /// Writes `text` to standard output and flushes it. A closed pipe (`manylight info | head`)
@@ -377,14 +396,6 @@ pub fn print_stdout(text: &str) -> Result<(), String> {
 /// absolute; for a file that does not exist yet, its folder resolved. Two outputs with the same
 /// identity would overwrite each other.
 pub fn identity(path: &Path) -> PathBuf {
-    #[cfg(unix)]
-    if let Some(own) = own_stdout_named(path) {
-        use std::os::fd::AsRawFd;
-        let fd = Path::new("/proc/self/fd").join(own.as_raw_fd().to_string());
-        if let Ok(p) = std::fs::canonicalize(fd) {
-            return p;
-        }
-    }
     if let Ok(p) = std::fs::canonicalize(path) {
         return p;
     }
