@@ -79,7 +79,8 @@ pub fn load_into(
     // A library's materials no face uses are not kept, nor their textures decoded: a shared
     // library may define hundreds, and every material kept costs each frame.
     let mut used = vec![false; mtl.len()];
-    for id in models.iter().filter_map(|m| m.mesh.material_id) {
+    let drawn = models.iter().filter(|m| !m.mesh.indices.is_empty());
+    for id in drawn.filter_map(|m| m.mesh.material_id) {
         if let Some(u) = used.get_mut(id) {
             *u = true;
         }
@@ -168,7 +169,8 @@ pub fn load_into(
             ..Material::default()
         });
     }
-    warn_unapplied_mtl(&mtl, path, &mut report);
+    let kept = mtl.iter().zip(&used).filter(|(_, &u)| u).map(|(m, _)| m);
+    warn_unapplied_mtl(kept, path, &mut report);
     let fallback = scene.add_material(Material {
         diffuse_texture: override_tex.clone(),
         ..Material::flat("obj-default", Vec3::splat(0.8))
@@ -260,10 +262,14 @@ fn text_of(bytes: &[u8]) -> (String, bool) {
 
 fn parse_obj(path: &Path, allow_outside: bool) -> Result<Parsed, SceneError> {
     let (text, not_utf8) = text_of(&read_bounded(path, FileKind::Model)?);
-    lines::check_obj(&text).map_err(|reason| SceneError::Obj {
+    let mixed_colours = lines::check_obj(&text).map_err(|reason| SceneError::Obj {
         path: path.to_path_buf(),
         reason,
     })?;
+    let text = match mixed_colours {
+        Some(_) => lines::strip_vertex_colours(&text),
+        None => text,
+    };
     let filled = corners::fill_missing(&text);
     let filled_corners = filled.is_some();
     let text = filled.unwrap_or(text);
@@ -284,6 +290,13 @@ fn parse_obj(path: &Path, allow_outside: bool) -> Result<Parsed, SceneError> {
         warnings.borrow_mut().push(format!(
             "{}: some face corners name a texture coordinate or normal and others do not; \
              those without take texture coordinate (0, 0) and their faces' normal",
+            path.display()
+        ));
+    }
+    if let Some((with, without)) = mixed_colours {
+        warnings.borrow_mut().push(format!(
+            "{}: vertex colours on some `v` lines only (line {with} has one, line {without} \
+             none); ignored, as manylight does not use OBJ vertex colours",
             path.display()
         ));
     }
@@ -355,7 +368,11 @@ fn parse_obj(path: &Path, allow_outside: bool) -> Result<Parsed, SceneError> {
 /// MTL statements the Blinn-Phong OBJ material does not read (normal maps, the PBR extension's
 /// `Pr`/`Pm`, emission): one warning per file naming them and how many materials use each, so
 /// a model that relies on them is not silently drawn flat.
-fn warn_unapplied_mtl(mtl: &[tobj::Material], path: &Path, report: &mut LoadReport) {
+fn warn_unapplied_mtl<'a>(
+    mtl: impl Iterator<Item = &'a tobj::Material>,
+    path: &Path,
+    report: &mut LoadReport,
+) {
     const UNAPPLIED: [&str; 9] = [
         "norm", "Pr", "Pm", "map_Pr", "map_Pm", "map_Ke", "Ps", "Pc", "aniso",
     ];

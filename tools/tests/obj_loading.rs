@@ -828,3 +828,23 @@ fn material_libraries_past_the_material_limit_are_refused_by_line() {
     assert!(report.warnings.is_empty(), "{:?}", report.warnings);
     assert_eq!(scene.materials[scene.objects[0].material].name, "a0");
 }
+
+/// Vertex colours on some `v` lines only: tobj failed a face using one without ("face vertex
+/// color index out of bounds", no line named). They are taken off with a warning naming the
+/// lines, and the model loads.
+#[test]
+fn vertex_colours_on_some_positions_only_are_ignored_with_a_warning() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = write(
+        dir.path(),
+        "tri.obj",
+        "v -1 -1 0 1 0 0\nv 1 -1 0\nv 0 1 0\nf 1 2 3\n",
+    );
+    let (scene, report) = load_obj(&path).unwrap();
+    assert_eq!(scene.objects.len(), 1);
+    let all = report.warnings.join("\n");
+    assert!(
+        all.contains("vertex colours on some `v` lines only (line 1 has one, line 2 none)"),
+        "{all}"
+    );
+}

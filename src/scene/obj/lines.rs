@@ -21,8 +21,32 @@ use crate::scene::mesh::{MAX_SCENE_MESHES, MAX_TEXCOORD};
 ///   of `usemtl` after faces): each is a mesh of its own, whose fixed cost (buffers, GL
 ///   objects, the ray caster's hierarchy) would otherwise grow past memory before a frame;
 /// - the faces, triangulated, hold at most [`MAX_OBJ_CORNERS`] corners.
-pub(super) fn check_obj(text: &str) -> Result<(), String> {
+///
+/// Returns, where some `v` lines have a colour and others none (tobj then fails a face that
+/// uses one without: "face vertex color index out of bounds", no line named), the first line
+/// with a colour and the first without: [`strip_vertex_colours`] makes the file loadable.
+pub(super) fn check_obj(text: &str) -> Result<Option<(usize, usize)>, String> {
     check_obj_within(text, MAX_OBJ_CORNERS)
+}
+
+/// `text` with the colour of every `v` line that has one taken off (manylight does not use
+/// OBJ vertex colours), for a file where only some have one.
+pub(super) fn strip_vertex_colours(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    for line in text.lines() {
+        let mut words = line.split_whitespace();
+        if words.next() == Some("v") && words.clone().count() == 6 {
+            out.push('v');
+            for word in words.take(3) {
+                out.push(' ');
+                out.push_str(word);
+            }
+        } else {
+            out.push_str(line);
+        }
+        out.push('\n');
+    }
+    out
 }
 
 /// Most triangle corners the faces of one OBJ may hold once triangulated (as many indices as
@@ -31,7 +55,7 @@ pub(super) fn check_obj(text: &str) -> Result<(), String> {
 pub const MAX_OBJ_CORNERS: usize = 3 << 25;
 
 /// [`check_obj`] with at most `max_corners` triangle corners.
-fn check_obj_within(text: &str, max_corners: usize) -> Result<(), String> {
+fn check_obj_within(text: &str, max_corners: usize) -> Result<Option<(usize, usize)>, String> {
     let kind_of = |key: Option<&str>| match key {
         Some("v") => Some(0),
         Some("vt") => Some(1),
@@ -50,7 +74,7 @@ fn check_obj_within(text: &str, max_corners: usize) -> Result<(), String> {
     let mut defined = [0i64; 3];
     let mut objects = Objects::default();
     let mut corners = 0usize;
-    // The first `v` line with a colour and the first without (tobj needs all or none).
+    // The first `v` line without a colour and the first with one.
     let mut coloured: [Option<usize>; 2] = [None, None];
     for (number, line) in text.lines().enumerate() {
         let at_line = |what: String| format!("line {}: {what}", number + 1);
@@ -62,19 +86,6 @@ fn check_obj_within(text: &str, max_corners: usize) -> Result<(), String> {
             defined[kind] += 1;
             if kind == 0 {
                 coloured[usize::from(colour)].get_or_insert(number + 1);
-                if let [Some(plain), Some(with)] = coloured {
-                    // tobj's "face vertex color index out of bounds", without a line.
-                    let (this, other) = if colour {
-                        ("has a colour", "none")
-                    } else {
-                        ("has no colour", "one")
-                    };
-                    return Err(at_line(format!(
-                        "`v` {this} where line {} has {other}: vertex colours must be on every \
-                         `v` or on none",
-                        plain.min(with)
-                    )));
-                }
             }
             continue;
         }
@@ -137,7 +148,10 @@ fn check_obj_within(text: &str, max_corners: usize) -> Result<(), String> {
             }
         }
     }
-    Ok(())
+    Ok(match coloured {
+        [Some(without), Some(with)] => Some((with, without)),
+        _ => None,
+    })
 }
 
 /// The objects tobj makes of a file, counted as [`check_obj`] reads it: one where faces
@@ -264,18 +278,16 @@ pub(super) fn undefined_materials(text: &str, defined: &HashSet<&str>) -> Option
     })
 }
 
-/// The first MTL line tobj would panic on, misread or reject without saying where (a colour
-/// with fewer than three numbers, as a truncated file has; `d`, `Ns`, `Ni` or `illum` without
-/// its number; a texture statement or `newmtl` naming nothing), as a message naming the line
-/// (not showing it).
 /// Most materials the material libraries of one OBJ may define together: tobj keeps about a
 /// kilobyte for each, so 1.1 million `newmtl` lines (16 MB) took 1.1 GB, and every material
 /// kept costs each frame. Far more than a model uses.
 pub const MAX_OBJ_MATERIALS: usize = 65_536;
 
-/// Checks an MTL library for what tobj would panic on or take silently, and that its
-/// materials with the `defined` before it stay within [`MAX_OBJ_MATERIALS`]; the error names
-/// the line. Returns how many materials it defines.
+/// The first MTL line tobj would panic on, misread or reject without saying where (a colour
+/// with fewer than three numbers, as a truncated file has; `d`, `Ns`, `Ni` or `illum` without
+/// its number; a texture statement or `newmtl` naming nothing), or whose `newmtl` takes the
+/// materials past [`MAX_OBJ_MATERIALS`] with the `defined` before it, as a message naming the
+/// line (not showing it). Returns how many materials the library defines.
 pub(super) fn check_mtl(text: &str, defined: usize) -> Result<usize, String> {
     let mut materials = 0;
     for (number, line) in text.lines().enumerate() {
@@ -321,22 +333,23 @@ pub(super) fn check_mtl(text: &str, defined: usize) -> Result<usize, String> {
 
 #[cfg(test)]
 mod tests {
-    use super::{check_mtl, check_obj, check_obj_within, undefined_materials, HashSet, Objects};
+    use super::{
+        check_mtl, check_obj, check_obj_within, strip_vertex_colours, undefined_materials, HashSet,
+        Objects,
+    };
 
-    /// Colours on some `v` lines and not others are named by the first line that differs.
+    /// Colours on some `v` lines and not others are found (the first line with, the first
+    /// without) and taken off every line that has one; `w` stays.
     #[test]
-    fn vertex_colours_on_some_positions_only_are_named_by_line() {
-        let err = check_obj("v 0 0 0 1 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap_err();
-        assert!(
-            err.starts_with("line 2: `v` has no colour where line 1 has one"),
-            "{err}"
+    fn vertex_colours_on_some_positions_only_are_found_and_stripped() {
+        let text = "v 0 0 0 1 0 0\nv 1 0 0\nv 0 1 0 2\nf 1 2 3\n";
+        assert_eq!(check_obj(text), Ok(Some((1, 2))));
+        assert_eq!(
+            strip_vertex_colours(text),
+            "v 0 0 0\nv 1 0 0\nv 0 1 0 2\nf 1 2 3\n"
         );
-        let err = check_obj("v 0 0 0\nv 1 0 0 1 1 1\n").unwrap_err();
-        assert!(
-            err.starts_with("line 2: `v` has a colour where line 1 has none"),
-            "{err}"
-        );
-        assert_eq!(check_obj("v 0 0 0 1 0 0\nv 1 0 0 0 1 0\n"), Ok(()));
+        assert_eq!(check_obj("v 0 0 0 1 0 0\nv 1 0 0 0 1 0\n"), Ok(None));
+        assert_eq!(check_obj("v 0 0 0\nv 1 0 0\n"), Ok(None));
     }
 
     /// Corners are counted triangulated, a fan of three for each past the second, and the
@@ -344,14 +357,14 @@ mod tests {
     #[test]
     fn faces_past_the_corner_limit_are_refused_by_line() {
         let text = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3 4\nf 1 2 3\nf 1 2 3\n";
-        assert_eq!(check_obj_within(text, 12), Ok(()));
+        assert_eq!(check_obj_within(text, 12), Ok(None));
         let err = check_obj_within(text, 11).unwrap_err();
         assert!(
             err.starts_with("line 7:") && err.contains("11 triangle corners"),
             "{err}"
         );
         // Lines (`l`) make no triangles.
-        assert_eq!(check_obj_within("v 0 0 0\nl 1 1 1 1\n", 0), Ok(()));
+        assert_eq!(check_obj_within("v 0 0 0\nl 1 1 1 1\n", 0), Ok(None));
     }
 
     /// Objects are counted as tobj splits them: a `usemtl` naming the whole rest of its line.
@@ -403,7 +416,7 @@ mod tests {
     #[test]
     fn vertex_lines_tobj_rejects_or_overflows_are_named_by_line() {
         let triangle = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
-        assert_eq!(check_obj(triangle), Ok(()));
+        assert_eq!(check_obj(triangle), Ok(None));
         let cases = [
             ("v 0 0 0\nv 1 0 0 \\\n", "line 2: `v` w (the 4th value) is not a number"),
             ("v 0 1e39 0\n", "line 1: `v` number 2: not a finite number"),
@@ -439,7 +452,7 @@ mod tests {
             "vt 0 1 0\n",
             "v 0 0 0\nvt 0 0\nvn 0 0 1\nf 1/1/1/ 1 1\n",
         ] {
-            assert_eq!(check_obj(text), Ok(()), "{text:?}");
+            assert_eq!(check_obj(text), Ok(None), "{text:?}");
         }
     }
 }
