@@ -88,9 +88,10 @@ impl GpuTimer {
         })
     }
 
-    /// Starts timing frame `serial` on a free query; a frame finds none when every query is
-    /// still in flight, and goes untimed.
-    pub fn begin(&self, dev: &Device, serial: u64) {
+    /// Starts timing frame `serial` on a free query. Where every query is still in flight, a
+    /// frame that `wait`s for the GPU first waits for the oldest one's result (it waits for
+    /// all that frame's work anyway); one that does not goes untimed.
+    pub fn begin(&self, dev: &Device, serial: u64, wait: bool) {
         if self.failed.get() {
             return;
         }
@@ -103,9 +104,15 @@ impl GpuTimer {
             return;
         }
         self.take_disjoint(dev);
-        let Some(slot) = self.in_flight.iter().position(|f| f.get().is_none()) else {
+        let free = self.in_flight.iter().position(|f| f.get().is_none());
+        let oldest = || (0..RING).min_by_key(|&slot| self.in_flight[slot].get());
+        let Some(slot) = free.or_else(|| oldest().filter(|_| wait)) else {
             return;
         };
+        if self.in_flight[slot].take().is_some() {
+            // The result, waited for and dropped: a newer frame's is the one reported.
+            self.result(slot, QUERY_RESULT);
+        }
         unsafe { (self.fns.begin_query)(TIME_ELAPSED, self.queries[slot]) };
         if self.check(dev, "glBeginQueryEXT") {
             self.running.set(Some(slot));

@@ -288,7 +288,7 @@ impl Renderer {
             if options.wait_for_gpu {
                 t.poll(&self.dev);
             }
-            t.begin(&self.dev, serial);
+            t.begin(&self.dev, serial, options.wait_for_gpu);
         }
         // No lights: no assignment, no uploads, the light loop compiled out — whatever the
         // method (a scene pays only for what it has).

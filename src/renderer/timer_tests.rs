@@ -34,7 +34,7 @@ fn a_frame_that_panicked_mid_query_leaves_gpu_timing_on() {
     let caught = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
         let _ = renderer.hosted(|r| -> Result<(), crate::Error> {
             if let Some(Some(timer)) = &r.timer {
-                timer.begin(&r.dev, 0);
+                timer.begin(&r.dev, 0, true);
             }
             panic!("a bug between the query's begin and end");
         });
@@ -121,4 +121,30 @@ fn a_frame_inside_the_applications_own_query_goes_untimed() {
     assert!(untimed.timer.is_none(), "no query made");
     untimed.destroy();
     renderer.destroy();
+}
+
+/// A frame that waits for the GPU, after frames that did not while the GPU lagged, finds every
+/// query in flight: it waits for the oldest one's result and is timed, not left without.
+#[test]
+fn a_waiting_frame_is_timed_when_every_query_is_in_flight() {
+    let Some((_ctx, renderer)) = timed_renderer() else {
+        return;
+    };
+    let dev = &renderer.dev;
+    let timer = crate::gl::timer::GpuTimer::new(dev).expect("timer queries");
+    for serial in 0..crate::gl::timer::RING as u64 {
+        timer.begin(dev, serial, false);
+        assert_eq!(timer.end(dev, false), None);
+    }
+    // Not waiting: no query is free, so the frame goes untimed.
+    timer.begin(dev, 10, false);
+    assert_eq!(
+        timer.end(dev, true),
+        None,
+        "a frame without a free query was timed"
+    );
+    timer.begin(dev, 11, true);
+    let ms = timer.end(dev, true);
+    assert!(ms.is_some_and(|ms| ms.is_finite() && ms >= 0.0), "{ms:?}");
+    timer.destroy(dev);
 }
