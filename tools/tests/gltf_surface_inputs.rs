@@ -452,7 +452,11 @@ fn other_texture_sets_malformed_transforms_and_every_colour_format_are_handled()
     );
     assert!(all.contains("emissiveTexture: uses TEXCOORD_1"), "{all}");
     assert!(all.contains("occlusionTexture: uses TEXCOORD_1"), "{all}");
-    assert_eq!(warnings.len(), 3, "{all}");
+    assert!(
+        all.contains("COLOR_0") && all.contains("outside [0, 1]"),
+        "{all}"
+    );
+    assert_eq!(warnings.len(), 4, "{all}");
     let m = &s.materials[0];
     assert!(m.diffuse_texture.is_some() && m.maps.base_transform.is_identity());
     let normal = m.maps.normal.as_ref().expect("normal map bound");
@@ -460,7 +464,7 @@ fn other_texture_sets_malformed_transforms_and_every_colour_format_are_handled()
     assert!(m.maps.metallic_roughness.is_some());
     assert!(m.maps.emissive_texture.is_none() && m.maps.occlusion.is_none());
     let mesh = &s.objects[0].mesh;
-    // Float colours are clamped to [0, 1]; VEC3 gets alpha 1.
+    // Float colours are clamped to [0, 1] (warned of above); VEC3 gets alpha 1.
     assert!(mesh
         .colors
         .iter()

@@ -14,12 +14,12 @@ use super::uri::{self, Uri};
 use crate::scene::access;
 use crate::scene::input::{read_bounded_prefix, FileKind};
 
-/// Lazily loaded buffer contents of one glTF document.
 /// Most elements one glTF file's accessors without a buffer view may hold together (16 MiB
 /// of `VEC4` floats): their count is free to claim, so without a bound a file of a few hundred
 /// bytes took gigabytes.
 pub const MAX_UNBACKED_ELEMENTS: usize = 1 << 20;
 
+/// Lazily loaded buffer contents of one glTF document.
 pub(super) struct Buffers<'a> {
     document: &'a gltf::Document,
     bin: Option<&'a [u8]>,

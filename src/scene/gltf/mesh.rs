@@ -28,8 +28,9 @@ impl Budget {
             "vertices" => (&mut self.vertices, super::MAX_VERTICES),
             _ => (&mut self.indices, super::MAX_INDICES),
         };
-        let taken = limit - *left;
+        let before = *left;
         *left = left.checked_sub(n).ok_or_else(|| {
+            let taken = limit.saturating_sub(before);
             format!(
                 "{field}: {n} {what} more than the file's {taken} before would pass the limit \
                  of {limit} {what} per file"
@@ -351,7 +352,10 @@ fn read_colors(
         ));
     }
     // The mesh clamps them: said, since a colour of −1e30 is black.
-    let outside = |c: &Vec4| c.cmplt(Vec4::ZERO).any() || c.cmpgt(Vec4::ONE).any();
+    // Exporters write float colours a rounding past 1 (1.0000001): not worth a word.
+    const SLACK: f32 = 1e-5;
+    let outside =
+        |c: &Vec4| c.cmplt(Vec4::splat(-SLACK)).any() || c.cmpgt(Vec4::splat(1.0 + SLACK)).any();
     if let Some(i) = colors.iter().position(outside) {
         let count = colors.iter().filter(|c| outside(c)).count();
         warnings.push(format!(
