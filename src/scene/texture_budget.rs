@@ -312,14 +312,17 @@ mod tests {
         let small = jpeg_header(0xC2, 64, 64);
         let err = decode_texture_bytes(&small, jpeg, &mut budget).unwrap_err();
         assert!(!err.contains("progressive"), "{err}");
-        let mut encoded = Vec::new();
-        image::RgbImage::new(8, 8)
-            .write_to(
-                &mut std::io::Cursor::new(&mut encoded),
-                image::ImageFormat::Jpeg,
-            )
+        let baseline = encoded(image::RgbImage::new(8, 8).into(), image::ImageFormat::Jpeg);
+        assert_eq!(progressive_jpeg_frame(&baseline), None);
+    }
+
+    /// `image` encoded as `format`.
+    fn encoded(image: DynamicImage, format: image::ImageFormat) -> Vec<u8> {
+        let mut bytes = Vec::new();
+        image
+            .write_to(&mut std::io::Cursor::new(&mut bytes), format)
             .unwrap();
-        assert_eq!(progressive_jpeg_frame(&encoded), None);
+        bytes
     }
 
     /// CRC-32 as PNG chunks carry it.
@@ -342,24 +345,15 @@ mod tests {
     /// budget bounds (60 images of 16 384² that failed at their last row took 16 s).
     #[test]
     fn a_failed_decode_is_charged() {
-        let mut encoded = Vec::new();
-        image::RgbImage::new(64, 32)
-            .write_to(
-                &mut std::io::Cursor::new(&mut encoded),
-                image::ImageFormat::Png,
-            )
-            .unwrap();
-        encoded.truncate(encoded.len() - 20);
+        let mut truncated = encoded(image::RgbImage::new(64, 32).into(), image::ImageFormat::Png);
+        truncated.truncate(truncated.len() - 20);
         let mut budget = TextureBudget::default();
         let png = Some(image::ImageFormat::Png);
-        assert!(decode_texture_bytes(&encoded, png, &mut budget).is_err());
+        assert!(decode_texture_bytes(&truncated, png, &mut budget).is_err());
         assert_eq!(MAX_SCENE_TEXTURE_BYTES - budget.left(), 64 * 32 * 4);
         // One past the decoder's limits decodes nothing and is not charged: an RGBA PNG of
         // 11 600² claims more than MAX_DECODE_BYTES from its header.
-        let mut big = Vec::new();
-        image::RgbaImage::new(1, 1)
-            .write_to(&mut std::io::Cursor::new(&mut big), image::ImageFormat::Png)
-            .unwrap();
+        let mut big = encoded(image::RgbaImage::new(1, 1).into(), image::ImageFormat::Png);
         // IHDR's width and height (bytes 16..24), and its CRC (over type and data, 12..29).
         big[16..20].copy_from_slice(&11_600u32.to_be_bytes());
         big[20..24].copy_from_slice(&11_600u32.to_be_bytes());
