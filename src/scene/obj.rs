@@ -262,13 +262,14 @@ fn text_of(bytes: &[u8]) -> (String, bool) {
 
 fn parse_obj(path: &Path, allow_outside: bool) -> Result<Parsed, SceneError> {
     let (text, not_utf8) = text_of(&read_bounded(path, FileKind::Model)?);
-    let mixed_colours = lines::check_obj(&text).map_err(|reason| SceneError::Obj {
+    let rewrites = lines::check_obj(&text).map_err(|reason| SceneError::Obj {
         path: path.to_path_buf(),
         reason,
     })?;
-    let text = match mixed_colours {
-        Some(_) => lines::strip_vertex_colours(&text),
-        None => text,
+    let text = if rewrites.needed() {
+        lines::rewrite(&text, &rewrites)
+    } else {
+        text
     };
     let filled = corners::fill_missing(&text);
     let filled_corners = filled.is_some();
@@ -293,7 +294,7 @@ fn parse_obj(path: &Path, allow_outside: bool) -> Result<Parsed, SceneError> {
             path.display()
         ));
     }
-    if let Some((with, without)) = mixed_colours {
+    if let Some((with, without)) = rewrites.mixed_colours {
         warnings.borrow_mut().push(format!(
             "{}: vertex colours on some `v` lines only (line {with} has one, line {without} \
              none); ignored, as manylight does not use OBJ vertex colours",

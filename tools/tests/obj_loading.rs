@@ -848,3 +848,19 @@ fn vertex_colours_on_some_positions_only_are_ignored_with_a_warning() {
         "{all}"
     );
 }
+
+/// OBJ's `vt u` (its v 0): tobj needs two numbers and refused the file; it loads, with the
+/// coordinate (u, 0) (flipped to (u, 1) for the image's rows).
+#[test]
+fn a_texture_coordinate_of_one_number_has_v_zero() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = write(
+        dir.path(),
+        "tri.obj",
+        "v -1 -1 0\nv 1 -1 0\nv 0 1 0\nvt 0.25\nvt 0.5 0.5\nf 1/1 2/2 3/2\n",
+    );
+    let (scene, report) = load_obj(&path).unwrap();
+    assert!(report.warnings.is_empty(), "{:?}", report.warnings);
+    let uvs = &scene.objects[0].mesh.uvs;
+    assert!(uvs.contains(&glam::Vec2::new(0.25, 1.0)), "{uvs:?}");
+}

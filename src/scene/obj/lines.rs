@@ -22,25 +22,47 @@ use crate::scene::mesh::{MAX_SCENE_MESHES, MAX_TEXCOORD};
 ///   objects, the ray caster's hierarchy) would otherwise grow past memory before a frame;
 /// - the faces, triangulated, hold at most [`MAX_OBJ_CORNERS`] corners.
 ///
-/// Returns, where some `v` lines have a colour and others none (tobj then fails a face that
-/// uses one without: "face vertex color index out of bounds", no line named), the first line
-/// with a colour and the first without: [`strip_vertex_colours`] makes the file loadable.
-pub(super) fn check_obj(text: &str) -> Result<Option<(usize, usize)>, String> {
+/// Returns what [`rewrite`] must change for tobj to read the file.
+pub(super) fn check_obj(text: &str) -> Result<Rewrites, String> {
     check_obj_within(text, MAX_OBJ_CORNERS)
 }
 
-/// `text` with the colour of every `v` line that has one taken off (manylight does not use
-/// OBJ vertex colours), for a file where only some have one.
-pub(super) fn strip_vertex_colours(text: &str) -> String {
-    let mut out = String::with_capacity(text.len());
+/// What a valid OBJ needs rewritten before tobj reads it.
+#[derive(Debug, Default, PartialEq)]
+pub(super) struct Rewrites {
+    /// Where some `v` lines have a colour and others none (tobj then fails a face that uses
+    /// one without: "face vertex color index out of bounds", no line named), the first line
+    /// with a colour and the first without: the colours are taken off (manylight does not use
+    /// OBJ vertex colours).
+    pub mixed_colours: Option<(usize, usize)>,
+    /// Some `vt` line gives one number (its `v` is then 0, as OBJ has it; tobj needs two).
+    pub one_number_texcoords: bool,
+}
+
+impl Rewrites {
+    /// Whether anything needs rewriting.
+    pub fn needed(&self) -> bool {
+        self.mixed_colours.is_some() || self.one_number_texcoords
+    }
+}
+
+/// `text` with what `rewrites` names changed: every `v` line's colour taken off, every `vt`
+/// line of one number given its `v` of 0.
+pub(super) fn rewrite(text: &str, rewrites: &Rewrites) -> String {
+    let mut out = String::with_capacity(text.len() + text.len() / 8);
     for line in text.lines() {
         let mut words = line.split_whitespace();
-        if words.next() == Some("v") && words.clone().count() == 6 {
+        let key = words.next();
+        let count = words.clone().count();
+        if rewrites.mixed_colours.is_some() && key == Some("v") && count == 6 {
             out.push('v');
             for word in words.take(3) {
                 out.push(' ');
                 out.push_str(word);
             }
+        } else if rewrites.one_number_texcoords && key == Some("vt") && count == 1 {
+            out.push_str(line.trim_end());
+            out.push_str(" 0");
         } else {
             out.push_str(line);
         }
@@ -55,7 +77,7 @@ pub(super) fn strip_vertex_colours(text: &str) -> String {
 pub const MAX_OBJ_CORNERS: usize = 3 << 25;
 
 /// [`check_obj`] with at most `max_corners` triangle corners.
-fn check_obj_within(text: &str, max_corners: usize) -> Result<Option<(usize, usize)>, String> {
+fn check_obj_within(text: &str, max_corners: usize) -> Result<Rewrites, String> {
     let kind_of = |key: Option<&str>| match key {
         Some("v") => Some(0),
         Some("vt") => Some(1),
@@ -76,17 +98,20 @@ fn check_obj_within(text: &str, max_corners: usize) -> Result<Option<(usize, usi
     let mut corners = 0usize;
     // The first `v` line without a colour and the first with one.
     let mut coloured: [Option<usize>; 2] = [None, None];
+    let mut one_number_texcoords = false;
     for (number, line) in text.lines().enumerate() {
         let at_line = |what: String| format!("line {}: {what}", number + 1);
         let mut words = line.split_whitespace();
         let key = words.next();
         objects.read(key, line).map_err(at_line)?;
         if let Some(kind) = kind_of(key) {
-            let colour = check_vertex_data(key.unwrap_or_default(), words).map_err(at_line)?;
+            let read = check_vertex_data(key.unwrap_or_default(), words).map_err(at_line)?;
             defined[kind] += 1;
             if kind == 0 {
+                let colour = read == VertexLine::Coloured;
                 coloured[usize::from(colour)].get_or_insert(number + 1);
             }
+            one_number_texcoords |= read == VertexLine::OneTexcoord;
             continue;
         }
         // tobj's "material parse error", without a line (and not about an MTL file).
@@ -148,10 +173,23 @@ fn check_obj_within(text: &str, max_corners: usize) -> Result<Option<(usize, usi
             }
         }
     }
-    Ok(match coloured {
-        [Some(without), Some(with)] => Some((with, without)),
-        _ => None,
+    Ok(Rewrites {
+        mixed_colours: match coloured {
+            [Some(without), Some(with)] => Some((with, without)),
+            _ => None,
+        },
+        one_number_texcoords,
     })
+}
+
+/// What [`check_vertex_data`] found a line to be, besides valid.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum VertexLine {
+    Plain,
+    /// A `v` with a colour.
+    Coloured,
+    /// A `vt` of one number.
+    OneTexcoord,
 }
 
 /// The objects tobj makes of a file, counted as [`check_obj`] reads it: one where faces
@@ -198,7 +236,7 @@ impl<'a> Objects<'a> {
 fn check_vertex_data<'a>(
     key: &str,
     mut words: impl Iterator<Item = &'a str>,
-) -> Result<bool, String> {
+) -> Result<VertexLine, String> {
     let needs = if key == "vt" { 2 } else { 3 };
     let mut values = [0f32; 3];
     for (i, value) in values.iter_mut().enumerate().take(needs) {
@@ -218,17 +256,21 @@ fn check_vertex_data<'a>(
                     f32::MAX
                 ))
             }
+            // OBJ's `vt u`: its `v` is 0.
+            None if key == "vt" && i == 1 => return Ok(VertexLine::OneTexcoord),
             _ => return Err(format!("`{key}` needs {needs} numbers, found {i}")),
         }
     }
     if key != "v" {
-        return Ok(false); // tobj ignores what follows a texture coordinate or a normal
+        return Ok(VertexLine::Plain); // tobj ignores what follows a texture coordinate or a normal
     }
     let rest: Vec<&str> = words.take(4).collect();
     match rest[..] {
-        [] => Ok(false),
+        [] => Ok(VertexLine::Plain),
         [w] => match w.parse::<f32>() {
-            Ok(w) if w != 0.0 && values.iter().all(|x| (x / w).is_finite()) => Ok(false),
+            Ok(w) if w != 0.0 && values.iter().all(|x| (x / w).is_finite()) => {
+                Ok(VertexLine::Plain)
+            }
             Ok(_) => Err(format!(
                 "`v` w: the position divided by it must be finite (w not zero, within \
                  f32's range ±{:.1e})",
@@ -236,7 +278,7 @@ fn check_vertex_data<'a>(
             )),
             Err(_) => Err("`v` w (the 4th value) is not a number".into()),
         },
-        [_, _, _] => Ok(true), // a vertex colour, which tobj reads and manylight does not use
+        [_, _, _] => Ok(VertexLine::Coloured), // which tobj reads and manylight does not use
         _ => Err(format!(
             "`v` takes 3 numbers, then a w or an RGB colour (1 or 3 values); found {} more",
             if rest.len() > 3 { "4 or" } else { "2" }
@@ -334,8 +376,7 @@ pub(super) fn check_mtl(text: &str, defined: usize) -> Result<usize, String> {
 #[cfg(test)]
 mod tests {
     use super::{
-        check_mtl, check_obj, check_obj_within, strip_vertex_colours, undefined_materials, HashSet,
-        Objects,
+        check_mtl, check_obj, check_obj_within, rewrite, undefined_materials, HashSet, Objects,
     };
 
     /// Colours on some `v` lines and not others are found (the first line with, the first
@@ -343,13 +384,31 @@ mod tests {
     #[test]
     fn vertex_colours_on_some_positions_only_are_found_and_stripped() {
         let text = "v 0 0 0 1 0 0\nv 1 0 0\nv 0 1 0 2\nf 1 2 3\n";
-        assert_eq!(check_obj(text), Ok(Some((1, 2))));
+        let found = check_obj(text).unwrap();
+        assert_eq!(found.mixed_colours, Some((1, 2)));
         assert_eq!(
-            strip_vertex_colours(text),
+            rewrite(text, &found),
             "v 0 0 0\nv 1 0 0\nv 0 1 0 2\nf 1 2 3\n"
         );
-        assert_eq!(check_obj("v 0 0 0 1 0 0\nv 1 0 0 0 1 0\n"), Ok(None));
-        assert_eq!(check_obj("v 0 0 0\nv 1 0 0\n"), Ok(None));
+        assert!(!check_obj("v 0 0 0 1 0 0\nv 1 0 0 0 1 0\n")
+            .unwrap()
+            .needed());
+        assert!(!check_obj("v 0 0 0\nv 1 0 0\n").unwrap().needed());
+    }
+
+    /// OBJ's `vt u` (its `v` 0) is read, where tobj needs two numbers; one that is not a
+    /// number is still named.
+    #[test]
+    fn a_texture_coordinate_of_one_number_gets_v_zero() {
+        let text = "v 0 0 0\nvt 0.5\nvt 0.25 1\nf 1/1 1/2 1/1\n";
+        let found = check_obj(text).unwrap();
+        assert!(found.one_number_texcoords && found.mixed_colours.is_none());
+        assert_eq!(
+            rewrite(text, &found),
+            "v 0 0 0\nvt 0.5 0\nvt 0.25 1\nf 1/1 1/2 1/1\n"
+        );
+        let err = check_obj("vt 0.5 x\n").unwrap_err();
+        assert!(err.contains("`vt` needs 2 numbers"), "{err}");
     }
 
     /// Corners are counted triangulated, a fan of three for each past the second, and the
@@ -357,14 +416,14 @@ mod tests {
     #[test]
     fn faces_past_the_corner_limit_are_refused_by_line() {
         let text = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3 4\nf 1 2 3\nf 1 2 3\n";
-        assert_eq!(check_obj_within(text, 12), Ok(None));
+        assert!(check_obj_within(text, 12).is_ok());
         let err = check_obj_within(text, 11).unwrap_err();
         assert!(
             err.starts_with("line 7:") && err.contains("11 triangle corners"),
             "{err}"
         );
         // Lines (`l`) make no triangles.
-        assert_eq!(check_obj_within("v 0 0 0\nl 1 1 1 1\n", 0), Ok(None));
+        assert!(check_obj_within("v 0 0 0\nl 1 1 1 1\n", 0).is_ok());
     }
 
     /// Objects are counted as tobj splits them: a `usemtl` naming the whole rest of its line.
@@ -416,7 +475,7 @@ mod tests {
     #[test]
     fn vertex_lines_tobj_rejects_or_overflows_are_named_by_line() {
         let triangle = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
-        assert_eq!(check_obj(triangle), Ok(None));
+        assert_eq!(check_obj(triangle), Ok(Default::default()));
         let cases = [
             ("v 0 0 0\nv 1 0 0 \\\n", "line 2: `v` w (the 4th value) is not a number"),
             ("v 0 1e39 0\n", "line 1: `v` number 2: not a finite number"),
@@ -427,7 +486,7 @@ mod tests {
             ("v 1 2 3 0.5 0.5\n", "line 1: `v` takes 3 numbers, then a w or an RGB colour (1 or 3 values); found 2 more"),
             ("v 1 2 3 1 1 1 1\n", "found 4 or more"),
             ("v 1 2\n", "line 1: `v` needs 3 numbers, found 2"),
-            ("vt 0.5\n", "line 1: `vt` needs 2 numbers, found 1"),
+            ("vt\n", "line 1: `vt` needs 2 numbers, found 0"),
             ("v 0 0 0\nf\n", "line 2: `f` names no vertices"),
             ("v 0 0 0\nl \n", "line 2: `l` names no vertices"),
             ("v 0 0 0\nusemtl\nf 1 1 1\n", "line 2: `usemtl` names no material"),
@@ -452,7 +511,7 @@ mod tests {
             "vt 0 1 0\n",
             "v 0 0 0\nvt 0 0\nvn 0 0 1\nf 1/1/1/ 1 1\n",
         ] {
-            assert_eq!(check_obj(text), Ok(None), "{text:?}");
+            assert_eq!(check_obj(text), Ok(Default::default()), "{text:?}");
         }
     }
 }
