@@ -396,3 +396,27 @@ fn every_subcommand_that_cannot_do_its_job_exits_non_zero_naming_why() {
         }
     }
 }
+
+/// The command line points descriptor 1 at standard error for what libraries print there; an
+/// output named as standard output in any spelling (`/proc/self/fd/1`, a link to
+/// `/dev/stdout`) still reaches the real one, not standard error.
+#[cfg(unix)]
+#[test]
+fn every_spelling_of_standard_output_reaches_it() {
+    let dir = tempfile::tempdir().unwrap();
+    std::os::unix::fs::symlink("/dev/stdout", dir.path().join("link")).unwrap();
+    for name in ["/proc/self/fd/1", "/dev/fd/1", "link"] {
+        let args = [
+            "--size", "16x9", "--lights", "4", "--frames", "0", "--stats", name,
+        ];
+        let out = manylight(&args, &[], dir.path());
+        assert!(out.status.success(), "{name}: {}", text(&out));
+        let stdout = String::from_utf8_lossy(&out.stdout);
+        assert!(stdout.starts_with('{'), "{name}: stdout {stdout:?}");
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            !stderr.contains("\"method\""),
+            "{name}: the stats went to stderr"
+        );
+    }
+}
