@@ -14,13 +14,14 @@ const FULL_DEPTH_BITS: i32 = 24;
 
 impl Renderer {
     /// Refuses a bound framebuffer that cannot take a `width × height` frame; warns once of a
-    /// shallow depth buffer. `drawn_here`: the frame is drawn in it (no MSAA of the renderer's).
+    /// shallow depth buffer. `drawn_here`: the frame is drawn in it (no MSAA of the renderer's);
+    /// then its depth bits (24 where the driver would not say).
     pub(super) fn check_bound_target(
         &mut self,
         width: u32,
         height: u32,
         drawn_here: bool,
-    ) -> Result<(), Error> {
+    ) -> Result<Option<u32>, Error> {
         let [max_w, max_h] = self.dev.caps().max_viewport_dims;
         if (max_w > 0 && width > max_w as u32) || (max_h > 0 && height > max_h as u32) {
             return Err(Error::Limit(format!(
@@ -38,40 +39,33 @@ impl Renderer {
             .into());
         }
         if !drawn_here {
-            return Ok(());
+            return Ok(None);
         }
-        match self.dev.bound_depth_bits() {
-            Some(0) => Err(GlError::BoundFramebuffer(
-                "it has no depth buffer, which the frame is drawn against: attach one \
-                 (24-bit; 16-bit loses precision), or render with MSAA, whose target has its \
-                 own"
-                .to_string(),
-            )
-            .into()),
+        let bits = self.dev.bound_depth_bits();
+        match bits {
+            Some(0) => {
+                return Err(GlError::BoundFramebuffer(
+                    "it has no depth buffer, which the frame is drawn against: attach one \
+                     (24-bit; 16-bit loses precision), or render with MSAA, whose target has \
+                     its own"
+                        .to_string(),
+                )
+                .into())
+            }
             Some(bits) if bits < FULL_DEPTH_BITS && !self.warned_depth_bits => {
                 self.warned_depth_bits = true;
                 log::warn!(
                     "the bound framebuffer's depth buffer has {bits} bits: surfaces close \
                      together in depth may show the one behind (a 24-bit one does not)"
                 );
-                Ok(())
             }
-            _ => Ok(()),
+            _ => {}
         }
+        Ok(Some(bits.map_or(FULL_DEPTH_BITS, |b| b.max(0)) as u32))
     }
-}
 
-impl Renderer {
-    /// Depth bits of the frame's depth buffer: the bound framebuffer's where the frame is
-    /// drawn in it (24 where the driver would not say), else the renderer's own target's, a
-    /// 16-bit one warned of once.
-    pub(super) fn depth_bits_of_frame(&mut self, drawn_in_games: bool) -> u32 {
-        if drawn_in_games {
-            return self
-                .dev
-                .bound_depth_bits()
-                .map_or(FULL_DEPTH_BITS as u32, |bits| bits.max(0) as u32);
-        }
+    /// Depth bits of the renderer's own targets, a 16-bit one warned of once.
+    pub(super) fn own_depth_bits(&mut self) -> u32 {
         let (_, bits) = self.dev.caps().own_depth_format();
         if bits < FULL_DEPTH_BITS as u32 && !self.warned_own_depth_bits {
             self.warned_own_depth_bits = true;

@@ -118,12 +118,15 @@ impl Renderer {
                 ));
             }
         }
-        let drawn_in_games = applications && samples <= 1;
-        if applications {
-            self.check_bound_target(width, height, drawn_in_games)?;
-        }
-        self.frame_depth_bits = self.depth_bits_of_frame(drawn_in_games);
-        stats.depth_bits = self.frame_depth_bits;
+        let games_depth_bits = if applications {
+            self.check_bound_target(width, height, samples <= 1)?
+        } else {
+            None
+        };
+        stats.depth_bits = match games_depth_bits {
+            Some(bits) => bits,
+            None => self.own_depth_bits(),
+        };
         // A framebuffer that encodes sRGB itself is given linear values, not encoded twice.
         self.srgb_destination = applications && self.dev.bound_color_is_srgb();
         if self.srgb_destination && matches!(options.count, CountKind::Evals | CountKind::Reaching)
@@ -239,7 +242,7 @@ impl Renderer {
         super::depth_warning::warn_of_coarse_depth(
             &scene.camera,
             content_far,
-            self.frame_depth_bits,
+            stats.depth_bits,
             &mut self.warned_depth_step,
         );
         let reach = super::fp16_range::view_reach(scene, width as f64 / height as f64, content_far);

@@ -75,8 +75,6 @@ pub struct Renderer {
     srgb_destination: bool,
     /// A camera too coarse in depth for the scene was announced (once per renderer).
     warned_depth_step: bool,
-    /// Depth bits of the frame being drawn's depth buffer (the game's, or the renderer's own).
-    frame_depth_bits: u32,
     /// The renderer's own 16-bit depth buffer was announced (once per renderer).
     warned_own_depth_bits: bool,
     /// The frame's objects in draw order (kept likewise).
@@ -145,7 +143,6 @@ impl Renderer {
             warned_depth_bits: false,
             srgb_destination: false,
             warned_depth_step: false,
-            frame_depth_bits: 24,
             warned_own_depth_bits: false,
             draw_order: methods::geometry::DrawOrder::default(),
             lp_num_threads: std::env::var("LP_NUM_THREADS").ok(),
