@@ -10,6 +10,7 @@ pub mod access;
 pub mod brdf;
 pub mod builtin;
 pub mod camera;
+mod dark_frame;
 pub mod direction;
 pub mod directional;
 mod duplicates;
@@ -452,39 +453,7 @@ pub fn load_with(
         });
     }
     let (scene, mut report) = loaded;
-    // Drawn, but a frame of background only: said, not left silent.
-    let invisible = |o: &Object| {
-        scene.materials.get(o.material).is_some_and(|m| {
-            let colors = &o.mesh.colors;
-            m.alpha <= 0.0
-                || (m.alpha_vertex && !colors.is_empty() && colors.iter().all(|c| c.w <= 0.0))
-        })
-    };
-    if !scene.objects.is_empty() && scene.objects.iter().all(invisible) {
-        let warning = format!(
-            "{}: every object is fully transparent (alpha 0: MTL `d 0`, a glTF base colour or \
-             COLOR_0 alpha of 0, or a glTF MASK material cut out everywhere): the frame shows \
-             the background only",
-            shown::text(&path.display().to_string())
-        );
-        log::warn!("{warning}");
-        report.warnings.push(warning);
-    }
-    // A model so small that its lights' spheres fit inside the distance the shaders leave out
-    // around a light: said, not drawn dark.
-    let near = shading::LIGHT_MIN_DISTANCE;
-    let unlit = (scene.lights.iter())
-        .filter(|l| l.radius > 0.0 && f64::from(l.radius) <= near)
-        .count();
-    if unlit > 0 {
-        let warning = format!(
-            "{}: {unlit} of {} lights have a radius of at most 2⁻¹³ ({near:.3e}) and light \
-             nothing: the shaders leave out what lies that near a light (above fp16's smallest \
-             normal, docs/precision.md); scale the model up (its transform, or the units it \
-             was exported in)",
-            shown::text(&path.display().to_string()),
-            scene.lights.len()
-        );
+    for warning in dark_frame::warnings(&scene, path) {
         log::warn!("{warning}");
         report.warnings.push(warning);
     }

@@ -72,6 +72,53 @@ fn point_and_spot_lights_come_with_positions_directions_radii_and_cones() {
     assert!((outer_deg - 28.6479).abs() < 1e-3, "{outer_deg}");
 }
 
+/// A light without a `range` whose brightest channel is at most the cut-off (2.05 cd on the
+/// photometric scale) would light nothing anywhere: left out with a warning naming it, not
+/// kept silently with a radius of 0 (the file would then count as lit). With a `range`, or a
+/// little brighter, it is kept; a light of intensity 0 is the file's own choice, kept silently.
+#[test]
+fn a_light_too_dim_to_reach_anywhere_without_a_range_is_left_out_and_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut b = Builder::default();
+    let mut doc = lights_document(&mut b);
+    let cut_cd = scene::gltf::UNBOUNDED_CUTOFF / scene::gltf::CANDELA_TO_INTENSITY;
+    doc["extensions"]["KHR_lights_punctual"]["lights"] = json!([
+        {"type": "point", "intensity": 1.0},
+        {"type": "point", "intensity": 1.0, "range": 5},
+        {"type": "point", "intensity": cut_cd * 1.01},
+        {"type": "spot", "intensity": 4.0, "color": [0.5, 0.2, 0.1], "spot": {}},
+        {"type": "point", "intensity": 0.0}
+    ]);
+    let lights: Vec<Value> = (0..5)
+        .map(|i| json!({"translation": [0, i, 0], "extensions": {"KHR_lights_punctual": {"light": i}}}))
+        .collect();
+    let mut nodes = lights;
+    nodes.push(json!({"mesh": 0}));
+    doc["nodes"] = json!(nodes);
+    doc["scenes"] = json!([{"nodes": [0, 1, 2, 3, 4, 5]}]);
+    let path = write(dir.path(), "dim.gltf", b.gltf(doc));
+    let (scene, report) = load(&path).unwrap();
+    let heights: Vec<f64> = scene.lights.iter().map(|l| l.position.y).collect();
+    assert_eq!(heights, [1.0, 2.0, 4.0], "{:?}", scene.lights);
+    assert!(scene.lights[1].radius > 0.0);
+    let dim: Vec<&String> = report
+        .warnings
+        .iter()
+        .filter(|w| w.contains("left out"))
+        .collect();
+    assert_eq!(dim.len(), 2, "{:?}", report.warnings);
+    assert!(
+        dim[0].contains("lights[0]") && dim[0].contains("1.000 cd"),
+        "{}",
+        dim[0]
+    );
+    assert!(
+        dim[1].contains("lights[3]") && dim[1].contains("2.000 cd"),
+        "{}",
+        dim[1]
+    );
+}
+
 #[test]
 fn a_gltf_object_in_a_json_scene_brings_its_lights_and_camera_placed_by_its_transform() {
     let dir = tempfile::tempdir().unwrap();

@@ -683,9 +683,11 @@ fn faces_with_and_without_texture_coordinates_in_one_object_load() {
 
 /// A model so small (a box of 2·10⁻⁵) that the random lights fitted to it have radii below the
 /// distance the shaders leave out around a light (2⁻¹³): they light nothing, and the loader
-/// says so rather than leaving a dark frame unexplained. At 1 unit, no such warning.
+/// says so rather than leaving a dark frame unexplained. A box of 6·10⁻³ (under 64 · 2⁻¹³)
+/// has lights that reach further, but a light near it leaves a fair part of it unlit: said
+/// too. At 10⁻² and at 2 units, neither.
 #[test]
-fn lights_too_small_to_light_anything_are_named_at_load() {
+fn models_too_small_for_the_distance_left_out_around_lights_are_named_at_load() {
     let dir = tempfile::tempdir().unwrap();
     let scaled = |s: f64| {
         let line = |l: &str| {
@@ -701,15 +703,20 @@ fn lights_too_small_to_light_anything_are_named_at_load() {
         BOX_OBJ.lines().map(line).collect::<String>()
     };
     write(dir.path(), "box.mtl", BOX_MTL);
-    for (scale, warned) in [(1.0, false), (1e-5, true)] {
+    // (scale, lights named as lighting nothing, model named as tiny)
+    for (scale, unlit, tiny) in [
+        (1.0, false, false),
+        (5e-3, false, false),
+        (3e-3, false, true),
+        (1e-5, true, false),
+    ] {
         let path = write(dir.path(), "box.obj", scaled(scale));
         let (scene, report) = scene::load(path.to_str().unwrap(), Some((64, 3))).unwrap();
         let radius = scene.lights.iter().map(|l| l.radius).fold(0.0, f32::max);
-        let said = report.warnings.iter().any(|w| w.contains("light nothing"));
-        assert_eq!(
-            said, warned,
-            "scale {scale:e}, radii up to {radius:e}: {report:?}"
-        );
+        let said = |what: &str| report.warnings.iter().any(|w| w.contains(what));
+        let at = format!("scale {scale:e}, radii up to {radius:e}: {report:?}");
+        assert_eq!(said("light nothing"), unlit, "{at}");
+        assert_eq!(said("the model is"), tiny, "{at}");
     }
 }
 

@@ -1,0 +1,59 @@
+//! Scenes that load and draw but would show a dark or empty frame for a reason the user can
+//! fix: said at load as warnings, never left silent.
+
+use super::{shading, shown, Object, Scene};
+use std::path::Path;
+
+/// A model whose largest extent is at most this many times the distance the shaders leave
+/// out around a light ([`shading::LIGHT_MIN_DISTANCE`], 2⁻¹³) is warned of: a light near
+/// it leaves more than 1/64 of the model unlit. 2⁻⁷: about 8 mm, in metres.
+pub(crate) const TINY_MODEL_EXTENT: f64 = 64.0 * shading::LIGHT_MIN_DISTANCE;
+
+/// The warnings for `scene`, loaded from `path`.
+pub(crate) fn warnings(scene: &Scene, path: &Path) -> Vec<String> {
+    let shown_path = path.display().to_string();
+    let name = shown::text(&shown_path);
+    let mut warnings = Vec::new();
+    if !scene.objects.is_empty() && scene.objects.iter().all(|o| invisible(scene, o)) {
+        warnings.push(format!(
+            "{name}: every object is fully transparent (alpha 0: MTL `d 0`, a glTF base colour or \
+             COLOR_0 alpha of 0, or a glTF MASK material cut out everywhere): the frame shows \
+             the background only"
+        ));
+    }
+    let near = shading::LIGHT_MIN_DISTANCE;
+    let unlit = (scene.lights.iter())
+        .filter(|l| l.radius > 0.0 && f64::from(l.radius) <= near)
+        .count();
+    if unlit > 0 {
+        warnings.push(format!(
+            "{name}: {unlit} of {} lights have a radius of at most 2⁻¹³ ({near:.3e}) and light \
+             nothing: the shaders leave out what lies that near a light (above fp16's smallest \
+             normal, docs/precision.md); scale the model up (its transform, or the units it \
+             was exported in)",
+            scene.lights.len()
+        ));
+    }
+    let extent = scene
+        .bounds()
+        .map_or(0.0, |b| (b.max - b.min).max_element());
+    if unlit < scene.lights.len() && extent > 0.0 && extent <= TINY_MODEL_EXTENT {
+        warnings.push(format!(
+            "{name}: the model is {extent:.3e} across, and the shaders leave out what lies \
+             within 2⁻¹³ ({near:.3e}) of a light (above fp16's smallest normal, \
+             docs/precision.md): more than 1/64 of it, so surfaces near a light show unlit; \
+             scale the model up (its transform, or the units it was exported in)"
+        ));
+    }
+    warnings
+}
+
+/// Whether `object` is drawn fully transparent: its material's alpha is 0, or its vertex
+/// colours' alpha is 0 everywhere where the material takes it.
+fn invisible(scene: &Scene, object: &Object) -> bool {
+    scene.materials.get(object.material).is_some_and(|m| {
+        let colors = &object.mesh.colors;
+        m.alpha <= 0.0
+            || (m.alpha_vertex && !colors.is_empty() && colors.iter().all(|c| c.w <= 0.0))
+    })
+}
