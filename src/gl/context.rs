@@ -116,6 +116,11 @@ fn egl_error_text(e: egl::Error) -> String {
     format!("{name}: {text}")
 }
 
+/// Said when an EGL without a surfaceless platform fails and no display server runs.
+const NO_DISPLAY_HINT: &str = "this EGL has no surfaceless platform and needs a display \
+     server, and none is set (DISPLAY and WAYLAND_DISPLAY are unset): run under one, for \
+     example `xvfb-run -a`";
+
 impl HeadlessContext {
     /// Creates a context for `es` and makes it current on this thread.
     pub fn new(es: EsVersion) -> Result<Self, GlError> {
@@ -159,7 +164,15 @@ impl HeadlessContext {
                 }
             }
         }
-        Err(last_err.expect("at least one platform tried"))
+        let err = last_err.expect("at least one platform tried");
+        Err(match err {
+            // An EGL that needs a window system (ANGLE's on Linux) where none runs.
+            GlError::Egl { call, error } if !surfaceless_ok && !window_system => GlError::Egl {
+                call,
+                error: format!("{error}; {NO_DISPLAY_HINT}"),
+            },
+            other => other,
+        })
     }
 
     fn open_display(egl: &Egl, platform: &str) -> Result<egl::Display, GlError> {

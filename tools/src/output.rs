@@ -67,7 +67,7 @@ static TEMP_COUNTER: AtomicU32 = AtomicU32::new(0);
 
 impl OutputFile {
     /// Opens `path` for writing: fails now, naming it, where it cannot be written (a folder, a
-    /// missing folder, a read-only file or folder).
+    /// missing folder, a read-only file or folder). `-` is standard output.
     pub fn create(path: &Path) -> Result<OutputFile, WriteError> {
         let fail = |source| WriteError {
             path: path.to_path_buf(),
@@ -75,14 +75,16 @@ impl OutputFile {
         };
         // An existing file is opened for writing (not truncated) to learn whether it may be
         // written at all and what it is; a symbolic link is followed, and its target replaced.
+        let dash = path == Path::new("-");
         let opened = match own_stdout_named(path) {
+            _ if dash => stdout_file(),
             Some(own) => own.try_clone(),
             None => OpenOptions::new().write(true).open(path),
         };
         let (target, file) = match opened {
             Ok(existing) => {
                 let meta = existing.metadata().map_err(fail)?;
-                if meta.is_file() && is_system_path(path) {
+                if meta.is_file() && (dash || is_system_path(path)) {
                     // `/dev/stdout` redirected to a file: that file, truncated, as before.
                     existing.set_len(0).map_err(fail)?;
                     (Target::InPlace, existing)
@@ -372,6 +374,26 @@ fn own_stdout_named(path: &Path) -> Option<&'static File> {
         };
     }
     None
+}
+
+/// Whether `path` names standard output: `-`, or one of the system's names for descriptor 1
+/// (see [`own_stdout_named`]) once [`keep_stdout_for_own_output`] has run.
+pub fn names_stdout(path: &Path) -> bool {
+    path == Path::new("-") || own_stdout_named(path).is_some()
+}
+
+/// Standard output as a file of its own (the original one, where descriptor 1 was redirected).
+fn stdout_file() -> io::Result<File> {
+    if let Some(own) = OWN_STDOUT.get() {
+        return own.try_clone();
+    }
+    #[cfg(unix)]
+    {
+        use std::os::fd::AsFd;
+        io::stdout().as_fd().try_clone_to_owned().map(File::from)
+    }
+    #[cfg(not(unix))]
+    Err(io::ErrorKind::Unsupported.into())
 }
 
 /// Writes `text` to standard output and flushes it. A closed pipe (`manylight info | head`)

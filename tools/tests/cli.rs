@@ -332,6 +332,13 @@ fn usage_errors_exit_2_and_name_the_flags() {
             &["render", "--gles-lib", "a", "--gles-lib", "b"],
             "only `matrix` compares several",
         ),
+        // A negative count is a bad value of its option, not a stray argument `-1`.
+        (
+            &["render", "--lights", "-1"],
+            "invalid value '-1' for '--lights",
+        ),
+        (&["matrix", "--max-error", "-1"], "for '--max-error"),
+        (&["bench-assign", "--runs", "-2"], "for '--runs"),
     ];
     for (args, needle) in cases {
         expect_exit(args, &[], dir.path(), 2, needle);

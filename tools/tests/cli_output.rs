@@ -172,6 +172,116 @@ fn stats_to_standard_output_are_json_alone() {
     );
 }
 
+/// `--out -` puts the PNG alone on standard output (the summary line on standard error), as
+/// `--stats -` does its JSON; it wrote a file named `-`. Both on standard output (either
+/// spelling) is a usage error saying so, not one calling them the same file.
+#[test]
+fn a_picture_to_standard_output_is_the_png_alone() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = manylight(
+        &["--size", "16x9", "--lights", "4", "--out", "-"],
+        &[],
+        dir.path(),
+    );
+    assert!(out.status.success(), "{}", text(&out));
+    let png = image::load_from_memory_with_format(&out.stdout, image::ImageFormat::Png)
+        .unwrap_or_else(|e| panic!("standard output is not a PNG ({e}): {}", text(&out)));
+    assert_eq!((png.width(), png.height()), (16, 9));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("4 lights"), "{stderr}");
+    assert!(
+        !dir.path().join("-").exists(),
+        "a file named `-` was written"
+    );
+    for picture in ["-", "/dev/stdout"] {
+        let args = ["--size", "16x9", "--out", picture, "--stats", "-"];
+        let msg = expect(&args, dir.path(), 2);
+        assert!(
+            msg.contains("both name standard output"),
+            "{picture}: {msg}"
+        );
+    }
+}
+
+/// `--frames 0` times no frame: the summary line said "ms/frame" of the one frame it rendered,
+/// shader compilation included. It now says the frame was not timed.
+#[test]
+fn no_timed_frames_are_not_called_a_frame_time() {
+    let dir = tempfile::tempdir().unwrap();
+    let args = [
+        "--size", "16x9", "--lights", "4", "--frames", "0", "--stats", "s.json",
+    ];
+    let out = manylight(&args, &[], dir.path());
+    assert!(out.status.success(), "{}", text(&out));
+    let summary = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        summary.contains("one untimed frame") && !summary.contains("ms/frame"),
+        "{summary}"
+    );
+    let stats: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.path().join("s.json")).unwrap()).unwrap();
+    let spread = stats.get("frame_ms_spread");
+    assert!(spread.is_some_and(serde_json::Value::is_null), "{stats}");
+}
+
+/// `--grid` and `--slice-depth` with a method that has no clustered grid changed nothing in
+/// silence (tiled's tiles are fixed): now a warning names them and the method. Clustered
+/// takes them without a word.
+#[test]
+fn grid_options_a_method_cannot_take_are_named() {
+    let dir = tempfile::tempdir().unwrap();
+    for (method, warned) in [("tiled", true), ("forward", true), ("clustered", false)] {
+        let args = [
+            "--size",
+            "16x9",
+            "--method",
+            method,
+            "--grid",
+            "8",
+            "--slice-depth",
+            "2",
+            "--out",
+            "p.png",
+        ];
+        let out = manylight(&args, &[], dir.path());
+        assert!(out.status.success(), "{}", text(&out));
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        let said = stderr.contains("--grid, --slice-depth set the clustered grid");
+        assert_eq!(said, warned, "{method}: {stderr}");
+        assert_eq!(
+            stderr.contains("fixed at 32 px"),
+            method == "tiled",
+            "{stderr}"
+        );
+    }
+}
+
+/// Recording into a folder that holds another recording's frames left them beside the new
+/// ones in silence (a longer earlier clip's tail): a warning counts them. Frames this run
+/// overwrites are not counted, and an empty folder gets no warning.
+#[test]
+fn frames_left_from_an_earlier_recording_are_counted() {
+    let dir = tempfile::tempdir().unwrap();
+    let rec = dir.path().join("rec");
+    std::fs::create_dir(&rec).unwrap();
+    let args = [
+        "--size", "16x9", "--lights", "2", "--frames", "2", "--record", "rec",
+    ];
+    let run = || {
+        let out = manylight(&args, &[], dir.path());
+        assert!(out.status.success(), "{}", text(&out));
+        String::from_utf8_lossy(&out.stderr).into_owned()
+    };
+    assert!(!run().contains("from before"));
+    // The run's own two frames now exist: still nothing to say.
+    assert!(!run().contains("from before"));
+    for stale in ["frame_00002.png", "frame_0001.png", "frame_00099.png"] {
+        std::fs::write(rec.join(stale), b"old").unwrap();
+    }
+    let stderr = run();
+    assert!(stderr.contains("3 frame_*.png from before"), "{stderr}");
+}
+
 /// A driver's own `printf` on standard output (Mesa's "extension … cannot be disabled" under
 /// `MESA_EXTENSION_OVERRIDE`, flushed at exit) goes to standard error: `info --json` and
 /// `--stats -` stay the JSON alone, as a CI script parses them.

@@ -235,3 +235,31 @@ fn matrix_adds_a_row_group_per_implementation() {
         "{stdout}"
     );
 }
+
+/// ANGLE's EGL on Linux has no surfaceless platform and needs an X display: without one it
+/// failed with a bare "eglInitialize failed". The error now says what is missing and how to
+/// run it (or, should a later ANGLE run without a display, `info` succeeds).
+#[test]
+#[cfg_attr(
+    not(manylight_gles),
+    ignore = "needs SwiftShader and ANGLE: scripts/fetch-gles, then set MANYLIGHT_GLES_DIR"
+)]
+fn angle_without_a_display_says_how_to_run_it() {
+    if in_another_implementations_run() {
+        return;
+    }
+    let out = Command::new(BIN)
+        .env_remove("DISPLAY")
+        .env_remove("WAYLAND_DISPLAY")
+        .env("MANYLIGHT_GLES_LIB", gles_dir().join("angle"))
+        .args(["info", "--es", "2"])
+        .output()
+        .expect("run manylight info");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    if !out.status.success() {
+        assert!(
+            stderr.contains("needs a display server") && stderr.contains("xvfb-run -a"),
+            "{stderr}"
+        );
+    }
+}

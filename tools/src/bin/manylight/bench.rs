@@ -28,7 +28,7 @@ use crate::EsArg;
 #[derive(Parser, Debug)]
 pub struct BenchArgs {
     /// A small sweep: the default scene at 0, 64 and 1 024 lights on ES 2.0 and 3.0 at
-    /// 320×180, one timed frame, the main knobs (one to two minutes on a 2-core machine with
+    /// 320×180, one timed frame, the main knobs (one to three minutes on a 2-core machine with
     /// llvmpipe, most of it the CPU reference).
     #[arg(long)]
     pub quick: bool,

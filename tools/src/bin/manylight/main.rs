@@ -26,7 +26,7 @@ use std::path::Path;
 use std::process::ExitCode;
 
 use clap::error::ErrorKind;
-use clap::{CommandFactory, Parser, Subcommand, ValueEnum};
+use clap::{CommandFactory, FromArgMatches, Parser, Subcommand, ValueEnum};
 use manylight::scene::shown;
 use manylight::{EsVersion, LoadOptions};
 use manylight_tools::output;
@@ -225,9 +225,25 @@ fn check_usage(cli: &Cli) {
     }
 }
 
-/// Two options naming one file (through any spelling or symbolic link) would overwrite each
-/// other's output: a usage error naming both. A device or FIFO (`/dev/null`) may take both.
+/// Two options naming one file (through any spelling or symbolic link), or both standard output,
+/// would overwrite each other's output: a usage error naming both. A device or FIFO
+/// (`/dev/null`) other than standard output may take both.
 fn check_distinct_outputs(outputs: &[Option<(&str, &Path)>]) {
+    let to_stdout: Vec<_> = (outputs.iter().flatten())
+        .filter(|(_, path)| output::names_stdout(path))
+        .collect();
+    if let [(a, a_path), (b, b_path), ..] = to_stdout[..] {
+        Cli::command()
+            .error(
+                ErrorKind::ArgumentConflict,
+                format!(
+                    "{a} {} and {b} {} both name standard output: one would run into the other",
+                    a_path.display(),
+                    b_path.display()
+                ),
+            )
+            .exit();
+    }
     let is_stream = |p: &Path| std::fs::metadata(p).is_ok_and(|m| !m.is_file() && !m.is_dir());
     let named: Vec<_> = outputs
         .iter()
@@ -305,6 +321,17 @@ pub(crate) fn version_unavailable(e: &(dyn std::error::Error + 'static)) -> bool
     matches!(gl, Some(manylight::GlError::VersionUnavailable { .. }))
 }
 
+/// Every option that takes a value reads a negative number as one: `--lights -1` is then
+/// refused as a bad value of `--lights`, not as an unexpected argument `-1`.
+fn negative_values(command: clap::Command) -> clap::Command {
+    command
+        .mut_args(|a| {
+            let takes = a.get_action().takes_values();
+            a.allow_negative_numbers(takes)
+        })
+        .mut_subcommands(negative_values)
+}
+
 fn main() -> ExitCode {
     // env_logger's own layout, each message with its control characters escaped but its line
     // ends (a model's names reach warnings, and a terminal acts on escape sequences).
@@ -321,7 +348,10 @@ fn main() -> ExitCode {
             )
         })
         .init();
-    let cli = Cli::try_parse().unwrap_or_else(|e| {
+    let parsed = negative_values(Cli::command())
+        .try_get_matches()
+        .and_then(|m| Cli::from_arg_matches(&m));
+    let cli = parsed.unwrap_or_else(|e| {
         // As clap's own `exit`, but help or a version that cannot be written is a failure too.
         let code = if e
             .print()
@@ -334,8 +364,9 @@ fn main() -> ExitCode {
         };
         std::process::exit(code)
     });
-    check_usage(&cli);
+    // Before the usage checks: they ask whether an output names standard output.
     output::keep_stdout_for_own_output();
+    check_usage(&cli);
     let mut options = LoadOptions::default();
     options.allow_outside_files = cli.allow_outside_files;
     let _ = LOAD_OPTIONS.set(options);

@@ -34,8 +34,8 @@ pub struct RenderArgs {
     /// Image size as WIDTHxHEIGHT.
     #[arg(long, default_value = "1280x720", value_parser = parse_size)]
     pub size: (u32, u32),
-    /// Output PNG. Default: manylight.png, or none with `--record` (the recording has every
-    /// frame).
+    /// Output PNG (`-`: to standard output, and the summary line to standard error). Default:
+    /// manylight.png, or none with `--record` (the recording has every frame).
     #[arg(long)]
     pub out: Option<PathBuf>,
     /// Write frame statistics as JSON to this file (`-`: to standard output, and the summary
@@ -151,6 +151,31 @@ pub fn parse_slice_depth(s: &str) -> Result<f64, String> {
     }
 }
 
+/// The grid options given (`--grid` other than `auto`, `--slice-depth`, `--assign-budget`) when
+/// the method drawn has no clustered grid to take them: said, not ignored in silence.
+fn unused_grid_options(args: &RenderArgs, stats: &manylight::FrameStats) -> Option<String> {
+    let given: Vec<&str> = [
+        ("--grid", !matches!(args.grid, GridArg::Auto)),
+        ("--slice-depth", args.slice_depth != 1.0),
+        ("--assign-budget", args.assign_budget.is_some()),
+    ]
+    .into_iter()
+    .filter_map(|(flag, set)| set.then_some(flag))
+    .collect();
+    let drawn = stats.auto_choice.as_deref().unwrap_or(&stats.method);
+    if given.is_empty() || drawn == "clustered" {
+        return None;
+    }
+    let tiles = match stats.grid.footprint_px {
+        Some(px) => format!(" (its tiles are fixed at {px} px)"),
+        None => String::new(),
+    };
+    Some(format!(
+        "{} set the clustered grid: {drawn} has none{tiles}, so they change nothing",
+        given.join(", ")
+    ))
+}
+
 /// Parses a frame count (`render --frames`, `bench --frames`, `--animated-frames`): at most
 /// [`manylight::MAX_TIMED_FRAMES`], whose figures a run keeps.
 pub fn frame_count() -> clap::builder::RangedI64ValueParser<u32> {
@@ -247,7 +272,9 @@ pub fn run(args: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
     // Opened before rendering: a path that cannot be written fails now, not after the frames.
     let out_file = out.map(OutputFile::create).transpose()?;
     let stats_out = args.stats.as_deref().map(JsonOut::create).transpose()?;
-    let stats_to_stdout = stats_out.as_ref().is_some_and(JsonOut::is_stdout);
+    // Standard output holds the statistics or the picture alone when one of them goes there.
+    let summary_to_stderr = stats_out.as_ref().is_some_and(JsonOut::is_stdout)
+        || out.is_some_and(manylight_tools::output::names_stdout);
     let es = args.es.into();
     let ctx = HeadlessContext::new(es)?;
     let restrictions = manylight::gl::Restrictions {
@@ -310,6 +337,9 @@ pub fn run(args: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
     };
     drop(renderer);
     let (image, stats) = result?;
+    if let Some(warning) = unused_grid_options(args, &stats) {
+        log::warn!("{warning}");
+    }
     if let Some(warning) = crate::black_frame::warning(&image, &scene) {
         log::warn!("{warning}");
     }
@@ -341,18 +371,20 @@ pub fn run(args: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
         _ => stats.method.clone(),
     };
     let written = out.map_or(String::new(), |p| format!(" → {}", p.display()));
+    // No timed frame: the one frame's time includes compiling shaders and uploading meshes.
+    let time = if args.frames == 0 {
+        format!(
+            "one untimed frame, {:.1} ms with shaders compiled (--frames 0)",
+            stats.time.frame_ms
+        )
+    } else {
+        format!("{:.1} ms/frame", stats.time.frame_ms)
+    };
     let summary = format!(
-        "{} {}x{} · {method} · {} lights · {} on {} · {:.1} ms/frame{tail}{written}\n",
-        args.scene,
-        width,
-        height,
-        stats.lights.total,
-        stats.context.es,
-        stats.context.renderer,
-        stats.time.frame_ms,
+        "{} {}x{} · {method} · {} lights · {} on {} · {time}{tail}{written}\n",
+        args.scene, width, height, stats.lights.total, stats.context.es, stats.context.renderer,
     );
-    // Standard output holds the statistics alone when they go there.
-    if stats_to_stdout {
+    if summary_to_stderr {
         eprint!("{summary}");
     } else {
         print_stdout(&summary)?;

@@ -76,9 +76,21 @@ impl Recorder {
         std::fs::create_dir_all(path)
             .map_err(|e| format!("--record: cannot create {}: {e}", path.display()))?;
         let last = timeline.frames.saturating_sub(1);
+        let digits = last.to_string().len().max(5);
+        let stale = stale_frames(path, timeline.frames, digits);
+        if stale > 0 {
+            log::warn!(
+                "--record {}: {stale} frame_*.png from before stay beside this recording's \
+                 {} frames (this run writes frame_{:0digits$} to frame_{last:0digits$}): \
+                 record into an empty folder",
+                path.display(),
+                timeline.frames,
+                0
+            );
+        }
         Ok(Recorder::Pngs {
             dir: path.to_path_buf(),
-            digits: last.to_string().len().max(5),
+            digits,
         })
     }
 
@@ -114,6 +126,26 @@ impl Recorder {
         }
         Ok(())
     }
+}
+
+/// How many files in `dir` look like recorded frames (`frame_*.png`) but are not among the
+/// `frames` this recording writes with `digits`-digit numbers: left over from another one.
+fn stale_frames(dir: &Path, frames: u32, digits: usize) -> usize {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return 0;
+    };
+    let written = |name: &str| {
+        let number = name.strip_prefix("frame_")?.strip_suffix(".png")?;
+        let k: u32 = number.parse().ok()?;
+        (number.len() == digits && number.bytes().all(|b| b.is_ascii_digit()) && k < frames)
+            .then_some(())
+    };
+    entries
+        .flatten()
+        .filter_map(|e| e.file_name().into_string().ok())
+        .filter(|name| name.starts_with("frame_") && name.ends_with(".png"))
+        .filter(|name| written(name).is_none())
+        .count()
 }
 
 /// What a sequence produced.
