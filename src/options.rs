@@ -97,6 +97,12 @@ pub struct RenderOptions {
     /// an editor's panel). `[0, 0]` by default. The offscreen renders ignore it: their image is
     /// the frame.
     pub origin: [u32; 2],
+    /// Most threads the CPU light assignment (tiled, clustered) takes from rayon's pool, the
+    /// calling thread included: 1 keeps it on the calling thread and never enters rayon (for a
+    /// game whose own rayon jobs fill the pool: an assignment waits for a worker of the pool
+    /// it shares, README "Embedding"). At most 8 are used whatever this says; the pool's
+    /// size, and a measure of whether more threads pay, decide below that. 0 is refused.
+    pub max_assign_threads: usize,
     /// Knobs for measuring and testing the renderer (timed frames, forced encodings, caps that
     /// exercise the overflow policy); a game leaves them at their defaults.
     pub measure: MeasureOptions,
@@ -120,6 +126,7 @@ impl Default for RenderOptions {
             samples: 1,
             clear: Clear::All,
             origin: [0, 0],
+            max_assign_threads: crate::cluster::assign::MAX_ASSIGN_THREADS,
             measure: MeasureOptions::default(),
         }
     }

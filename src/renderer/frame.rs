@@ -510,6 +510,10 @@ fn check_options(options: &RenderOptions) -> Result<(), Error> {
             );
         }
     }
+    if options.max_assign_threads == 0 {
+        let why = "must be at least 1 (1: the calling thread alone)".to_string();
+        return invalid("max_assign_threads", why);
+    }
     if options.measure.timed_frames > crate::options::MAX_TIMED_FRAMES {
         let why = format!(
             "must be at most {}, got {}",

@@ -58,7 +58,7 @@ mod types;
 
 pub use types::{
     assign_work, AssignLimits, AssignStats, Assignment, INDEX_WEIGHT, MAX_ASSIGN_CELLS,
-    PARALLEL_INDICES, PARALLEL_MIN_LIGHTS, PARALLEL_SECONDS,
+    MAX_ASSIGN_THREADS, PARALLEL_INDICES, PARALLEL_MIN_LIGHTS, PARALLEL_SECONDS,
 };
 
 use crate::cluster::grid::ClusterGrid;
@@ -195,13 +195,13 @@ impl Assigner {
             return &self.out;
         }
         let started = std::time::Instant::now();
-        let rule = threads_for(
-            lights.len(),
-            last_indices,
-            last_cpu_seconds,
-            limits,
-            rayon::current_num_threads(),
-        );
+        // Asking rayon for its pool's size would build the global pool: not where the caller
+        // keeps the assignment on its own thread.
+        let pool = match limits.max_threads {
+            0 | 1 => 1,
+            most => rayon::current_num_threads().min(most),
+        };
+        let rule = threads_for(lights.len(), last_indices, last_cpu_seconds, limits, pool);
         // Lights past the caller's threshold take the pool; the rules' other reasons are
         // weighed against one thread by measure.
         let chosen = rule > 1 && lights.len() < limits.parallel_threshold;
@@ -297,7 +297,7 @@ fn threads_for(
     limits: &AssignLimits,
     pool: usize,
 ) -> usize {
-    let most = pool.clamp(1, 8);
+    let most = pool.clamp(1, MAX_ASSIGN_THREADS);
     if limits.parallel_threshold == usize::MAX {
         1
     } else if lights >= limits.parallel_threshold || last_indices >= PARALLEL_INDICES {

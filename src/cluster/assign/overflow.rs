@@ -35,7 +35,7 @@ pub(super) fn apply_cap(
     if max <= cap {
         return false;
     }
-    trim_overfull_cells(out, grid, lights, cap, scratch);
+    trim_overfull_cells(out, grid, lights, cap, limits.max_threads > 1, scratch);
     // Compact: every cell keeps the first `cap` entries of its list (the trim put the kept
     // lights there, in ascending order).
     let total: usize = out.counts.iter().map(|&n| n.min(cap) as usize).sum();
@@ -92,6 +92,7 @@ fn trim_overfull_cells(
     grid: &ClusterGrid,
     lights: &[GpuLight],
     cap: u32,
+    may_share: bool,
     scratch: &mut Overflow,
 ) {
     let cap = cap as usize;
@@ -113,7 +114,8 @@ fn trim_overfull_cells(
         [p.x, p.y, p.z, light.radiance.max_element()]
     }));
     let packed = &scratch.packed[..];
-    let parallel = scratch.lists.iter().map(|&(_, _, n)| n).sum::<usize>() >= PARALLEL_INDICES;
+    let parallel =
+        may_share && scratch.lists.iter().map(|&(_, _, n)| n).sum::<usize>() >= PARALLEL_INDICES;
     let lists = &scratch.lists[..];
     match out.indices.entries_mut() {
         EntriesMut::Narrow(list) => trim_lists(lists, list, 0, parallel, &|cell, list| {

@@ -3,6 +3,10 @@
 
 use super::index_list::IndexList;
 
+/// Most threads one assignment takes (see [`AssignLimits::max_threads`]): its bands and
+/// chunks are cut for at most this many.
+pub const MAX_ASSIGN_THREADS: usize = 8;
+
 /// An assignment whose previous frame listed this many indices runs on all cores whatever its
 /// light count: fine grids give each light hundreds of cells, and scattering that many indices
 /// outweighs the cost of waking rayon's workers.
@@ -61,6 +65,9 @@ pub struct AssignLimits {
     /// estimate of it: what its workers spent working; tries of the other mode now and then).
     /// From this count of lights up the pool always runs.
     pub parallel_threshold: usize,
+    /// Most threads, the caller included (at most [`MAX_ASSIGN_THREADS`](super::MAX_ASSIGN_THREADS)
+    /// are used); 1 never enters rayon, not even to learn the pool's size.
+    pub max_threads: usize,
 }
 
 impl Default for AssignLimits {
@@ -69,6 +76,7 @@ impl Default for AssignLimits {
             cell_cap: 255,
             max_indices: 1 << 24,
             parallel_threshold: 4096,
+            max_threads: super::MAX_ASSIGN_THREADS,
         }
     }
 }

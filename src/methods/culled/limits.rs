@@ -27,6 +27,7 @@ pub(super) fn assign_limits(ctx: &FrameContext) -> AssignLimits {
     AssignLimits {
         cell_cap,
         max_indices,
+        max_threads: ctx.options.max_assign_threads,
         ..AssignLimits::default()
     }
 }

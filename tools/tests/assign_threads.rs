@@ -1,0 +1,100 @@
+//! `RenderOptions::max_assign_threads`: a game whose own rayon jobs fill the global pool can
+//! keep the light assignment on its render thread. With the default, a frame called from
+//! outside the pool waits for one of the pool's workers (the frame stalled behind a game's
+//! long job, an embedding review found); with 1 it never enters rayon. One test in its own
+//! process: it holds every worker of the global pool.
+
+mod common;
+
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{mpsc, Arc, Barrier};
+use std::time::Duration;
+
+use common::Gpu;
+use manylight::{EsVersion, RenderOptions};
+
+/// Lights enough that the assignment's rules take the pool (from 4 096).
+const LIGHTS: usize = 8192;
+
+/// Holds every worker of rayon's global pool in a job until the returned sender is dropped or
+/// sent to; returns once all of them are held.
+fn hold_the_global_pool() -> mpsc::Sender<()> {
+    let workers = rayon::current_num_threads();
+    let (release, wait) = mpsc::channel::<()>();
+    let wait = Arc::new(std::sync::Mutex::new(wait));
+    let held = Arc::new(Barrier::new(workers + 1));
+    for _ in 0..workers {
+        let (wait, held) = (wait.clone(), held.clone());
+        rayon::spawn(move || {
+            held.wait();
+            // Each job waits for the one release (or the sender's drop) in turn.
+            let _ = wait.lock().unwrap().recv();
+        });
+    }
+    held.wait();
+    release
+}
+
+/// Renders on `gpu` while the global pool is held; a watchdog lets the pool go after `patience`
+/// and says whether it had to (the frame waited for a worker).
+fn frame_waited_for_the_pool(
+    gpu: &mut Gpu,
+    options: &RenderOptions,
+    patience: Duration,
+) -> (bool, usize) {
+    let scene = manylight::scene::builtin::build("courtyard", Some((LIGHTS, 5))).unwrap();
+    let release = hold_the_global_pool();
+    let workers = rayon::current_num_threads();
+    let had_to = Arc::new(AtomicBool::new(false));
+    let (done, finished) = mpsc::channel::<()>();
+    let watchdog = {
+        let had_to = had_to.clone();
+        std::thread::spawn(move || {
+            if finished.recv_timeout(patience).is_err() {
+                had_to.store(true, Ordering::SeqCst);
+            }
+            // Every held job takes one release.
+            for _ in 0..workers {
+                let _ = release.send(());
+            }
+        })
+    };
+    let (_, stats) = gpu
+        .r()
+        .render_offscreen(&scene, 64, 36, options)
+        .expect("render");
+    let _ = done.send(());
+    watchdog.join().unwrap();
+    (had_to.load(Ordering::SeqCst), stats.assignment.threads)
+}
+
+#[test]
+fn one_assignment_thread_never_waits_for_a_busy_pool() {
+    let mut gpu = Gpu::new(EsVersion::Es3);
+    let one = RenderOptions {
+        max_assign_threads: 1,
+        ..RenderOptions::default()
+    };
+    for method in ["clustered", "tiled"] {
+        gpu.r().set_method_named(method).unwrap();
+        let (waited, threads) = frame_waited_for_the_pool(&mut gpu, &one, Duration::from_secs(60));
+        assert!(!waited, "{method}: the frame waited for the held pool");
+        assert_eq!(threads, 1, "{method}");
+    }
+    // The hazard the option avoids: by default the same frame takes the pool, and waits.
+    if rayon::current_num_threads() >= 2 {
+        gpu.r().set_method_named("clustered").unwrap();
+        let default = RenderOptions::default();
+        let (waited, threads) =
+            frame_waited_for_the_pool(&mut gpu, &default, Duration::from_secs(2));
+        assert!(waited && threads >= 2, "waited {waited}, {threads} threads");
+    }
+    // 0 threads is refused naming the field.
+    let none = RenderOptions {
+        max_assign_threads: 0,
+        ..RenderOptions::default()
+    };
+    let scene = manylight::scene::builtin::build("plane", Some((4, 1))).unwrap();
+    let err = gpu.r().render_offscreen(&scene, 8, 8, &none).unwrap_err();
+    assert!(err.to_string().contains("max_assign_threads"), "{err}");
+}
