@@ -371,6 +371,7 @@ fn past_65536_visible_lights_the_list_is_32_bit_and_the_same() {
                 parallel_threshold: threshold,
                 cell_cap: cap,
                 max_indices: usize::MAX,
+                ..AssignLimits::default()
             };
             let a = assign(&grid, &lights, 50.0, &limits);
             let what = format!(
