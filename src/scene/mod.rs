@@ -21,6 +21,7 @@ pub mod framing;
 pub mod gltf;
 pub mod input;
 pub mod light;
+mod light_list;
 pub mod material;
 pub mod mesh;
 pub mod meshbuild;
@@ -284,7 +285,8 @@ impl Scene {
                     field(),
                     format!(
                         "moves lights {}..{} but the scene has {}: remove lights with \
-                         Scene::remove_light, which removes them from their motions too",
+                         Scene::remove_light, retain_lights or truncate_lights, which remove \
+                         them from their motions too",
                         track.first,
                         track.first.saturating_add(track.rest.len()),
                         self.lights.len()
