@@ -23,8 +23,9 @@ impl Renderer {
     /// whose lower-left corner is `options.origin` (for embedding: a game binds its own target
     /// or the default framebuffer first); only that rectangle is cleared and drawn. With
     /// `options.samples` > 1 the frame is drawn into the renderer's own multisampled target
-    /// and resolved into that rectangle, and on ES 3.0 the bound framebuffer must then be
-    /// RGBA8 (GL resolves between identical formats only). The application's GL state
+    /// and resolved into that rectangle, in whatever colour format the bound framebuffer has
+    /// (on ES 3.0 through a single-sampled copy where it is not the target's RGBA8 or sRGB
+    /// RGBA8: GL resolves between identical formats only). The application's GL state
     /// (bindings, viewport, blend, depth, …) is given back as it was, and its scissor,
     /// stencil or blend equations do not change the frame (the README's
     /// "Sharing the context with a game"); another EGL context current is

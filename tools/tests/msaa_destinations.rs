@@ -1,12 +1,12 @@
 //! MSAA into the framebuffers a game really binds: window surfaces without alpha (`RGB8`,
-//! `RGB565`) and other normalized formats, which a multisample resolve cannot blit into
+//! `RGB565`) and other normalized and float formats, which a multisample resolve cannot blit into
 //! directly (it needs identical formats), and a framebuffer that is multisampled itself (a
 //! window surface made with `EGL_SAMPLES`), which samples the frame on its own.
 #![allow(unsafe_code)] // the game's side: raw glow calls
 
 mod common;
 
-use common::game_target::{sized_framebuffer, stored_then_free};
+use common::game_target::{free_game_framebuffer, sized_framebuffer, stored_then_free};
 use common::Gpu;
 use manylight::glow::{self, HasContext};
 use manylight::{scene, EsVersion, RenderOptions};
@@ -58,6 +58,46 @@ fn msaa_resolves_into_framebuffers_of_other_colour_formats() {
         ("RGB10_A2", glow::RGB10_A2, 2),
     ] {
         let pixels = stored(&mut gpu, colour, &s);
+        let diff = max_rgb_diff(&rgba8, &pixels);
+        assert!(diff <= bound, "{name}: {diff}/255 from RGBA8");
+    }
+}
+
+/// Float colour formats a game may render into (`GL_EXT_color_buffer_float`) take the resolved
+/// frame too, through the same copy: the values RGBA8 stores, within its rounding.
+#[test]
+fn msaa_resolves_into_float_framebuffers() {
+    let s = scene::builtin::build(scene::builtin::DEFAULT, Some((128, 3))).unwrap();
+    let mut gpu = Gpu::new(EsVersion::Es3);
+    let gl = gpu.gl();
+    let extensions = gl.supported_extensions().clone();
+    if !extensions.contains("GL_EXT_color_buffer_float") {
+        common::skip("no GL_EXT_color_buffer_float: float framebuffers are not renderable");
+        return;
+    }
+    let rgba8 = stored(&mut gpu, glow::RGBA8, &s);
+    // Each format's bound: half its step below 1 (blue's 5-bit mantissa: 2⁻⁶) and 2/255.
+    for (name, colour, bound) in [
+        ("RGBA16F", glow::RGBA16F, 2),
+        ("R11F_G11F_B10F", glow::R11F_G11F_B10F, 4),
+        ("RGBA32F", glow::RGBA32F, 2),
+    ] {
+        let gl = gpu.gl();
+        let target = unsafe { sized_framebuffer(&gl, colour, (W as i32, H as i32)) };
+        let rendered = gpu.r().render(&s, W, H, &msaa());
+        let mut bytes = vec![0u8; (W * H * 16) as usize];
+        unsafe {
+            let pack = glow::PixelPackData::Slice(Some(&mut bytes));
+            gl.read_pixels(0, 0, W as i32, H as i32, glow::RGBA, glow::FLOAT, pack);
+            assert_eq!(gl.get_error(), glow::NO_ERROR, "{name}: reading floats");
+            free_game_framebuffer(&gl, target);
+        }
+        rendered.unwrap_or_else(|e| panic!("{name}: {e}"));
+        let pixels: Vec<u8> = bytes
+            .chunks(4)
+            .map(|b| f32::from_ne_bytes([b[0], b[1], b[2], b[3]]))
+            .map(|v| (v.clamp(0.0, 1.0) * 255.0).round() as u8)
+            .collect();
         let diff = max_rgb_diff(&rgba8, &pixels);
         assert!(diff <= bound, "{name}: {diff}/255 from RGBA8");
     }

@@ -134,7 +134,7 @@ pub unsafe fn stored_then_free(
 
 /// Frees the game's framebuffer and puts back the defaults it changed, so the pooled context
 /// reaches the next test clean.
-unsafe fn free_game_framebuffer(gl: &glow::Context, target: GameTarget) {
+pub unsafe fn free_game_framebuffer(gl: &glow::Context, target: GameTarget) {
     gl.bind_framebuffer(glow::FRAMEBUFFER, None);
     gl.clear_color(0.0, 0.0, 0.0, 0.0);
     gl.clear_depth_f32(1.0);
