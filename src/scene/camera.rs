@@ -115,7 +115,9 @@ impl Camera {
         if worst > VIEW_RIGID_TOLERANCE {
             return Err(invalid(format!(
                 "must be rigid (a rotation and a translation): its 3 × 3 part is off \
-                 orthonormal by {worst:.2e}, past {VIEW_RIGID_TOLERANCE:e} (a scale or a shear)"
+                 orthonormal by {worst:.2e}, past {VIEW_RIGID_TOLERANCE:e} (a scale or a shear; \
+                 a rotation built up from many small ones drifts: renormalize it, e.g. through \
+                 a normalized quaternion)"
             )));
         }
         if rotation.determinant() < 0.0 {
