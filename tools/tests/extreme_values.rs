@@ -292,3 +292,36 @@ fn a_huge_timed_frame_count_is_refused_naming_the_field() {
     let (_, stats) = gpu.r().render_offscreen(&s, 16, 16, &options).unwrap();
     assert_eq!(stats.time.frame_ms_spread.map(|s| s.frames), Some(3));
 }
+
+/// 1 100 lights all covering a plane, on a 1-px fixed grid: the cells' lists would hold some
+/// 5·10⁹ references before the cell cap, which the assignment allocated (an abort, 14 GB) or
+/// misnumbered past 2³² (a panic). Clustered refuses the frame naming the footprint, with no
+/// overflow warning for a frame it did not draw; the automatic grid draws it; tiled, whose
+/// tiles the lights cover too, draws it.
+#[test]
+fn lights_overlapping_on_a_fine_fixed_grid_are_refused_naming_the_footprint() {
+    common::warnings::install();
+    let lights = vec![Light::point(DVec3::new(0.0, 0.0, 1.0), 30.0, Vec3::ONE, 0.01); 1100];
+    let s = plane(lights);
+    let mut gpu = Gpu::new(EsVersion::Es3);
+    gpu.r().set_method_named("clustered").unwrap();
+    let fine = RenderOptions {
+        grid: manylight::GridConfig::fixed(1.0),
+        ..Default::default()
+    };
+    // 160 × 90 px: 4.5 million 1-px cells.
+    let msg = (gpu.r().render_offscreen(&s, 160, 90, &fine))
+        .map(|_| ())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        msg.contains("would list at least") && msg.contains("grid.footprint_px"),
+        "{msg}"
+    );
+    let dropped = common::warnings::warnings_containing("light references left out");
+    assert!(dropped.is_empty(), "{dropped:?}");
+    let auto = gpu.render(&s, 16, 16, &RenderOptions::default());
+    assert!(mean(&auto) > 0.0);
+    gpu.r().set_method_named("tiled").unwrap();
+    gpu.render(&s, 16, 16, &RenderOptions::default());
+}

@@ -13,7 +13,7 @@ mod shared;
 pub(super) use scatter::FORCED_SCATTER_BLOCKS;
 
 use super::cells::{for_each_run_in, SliceWindow};
-use super::types::{Assignment, Run, Totals, PARALLEL_SECONDS};
+use super::types::{Assignment, Run, Totals, MAX_UNTRIMMED_INDICES, PARALLEL_SECONDS};
 use crate::cluster::grid::ClusterGrid;
 use crate::cluster::headroom::{clear_with_room_for, room_for, share_of, WHOLE_UP_TO};
 use crate::cluster::view_light::GpuLight;
@@ -274,6 +274,7 @@ impl Band {
         let window = self.window.expect("a band has a window");
         let first = self.first_cell as u32;
         let runs = &mut self.runs;
+        let mut listed = 0usize;
         for (i, light) in lights.iter().enumerate() {
             let before = runs.len();
             // Taking `first` by value and summing the indices after: the closure lives on the
@@ -289,9 +290,18 @@ impl Band {
             for_each_run_in(grid, &window, light, camera_far, &mut emit);
             if runs.len() > before {
                 self.lights.push((i as u32, before as u32));
+                listed += runs[before..]
+                    .iter()
+                    .map(|run| run.len as usize)
+                    .sum::<usize>();
+                // Past this the list is refused anyway: the runs would go on taking memory
+                // (and past 2³² be misnumbered).
+                if listed > MAX_UNTRIMMED_INDICES {
+                    break;
+                }
             }
         }
-        self.indices = runs.iter().map(|run| run.len as usize).sum();
+        self.indices = listed;
         self.seconds = started.elapsed().as_secs_f64();
     }
 
@@ -308,6 +318,11 @@ impl Band {
         out.visible.clear();
         out.visible
             .extend(self.lights.iter().map(|&(light, _)| light));
+        if self.indices > MAX_UNTRIMMED_INDICES {
+            out.unlisted = Some(self.indices);
+            self.totals = Totals::default();
+            return;
+        }
         self.ids.clear();
         self.ids.extend(0..self.lights.len() as u32);
         self.base = 0;

@@ -6,7 +6,7 @@ use rayon::prelude::*;
 
 use super::cells::for_each_run;
 use super::index_list::{EntriesMut, IndexList, LightIndex};
-use super::types::{Assignment, Run, Totals};
+use super::types::{Assignment, Run, Totals, MAX_UNTRIMMED_INDICES};
 use crate::cluster::grid::ClusterGrid;
 use crate::cluster::headroom::{clear_with_room_for, room_for, share_of, zeroed_with_room};
 use crate::cluster::view_light::GpuLight;
@@ -52,7 +52,10 @@ impl Chunks {
             .zip(lights.par_chunks(chunk_len))
             .for_each(|(chunk, part)| {
                 chunk.find(grid, part, camera_far, shares);
-                chunk.prefix();
+                // Offsets are 32-bit: only for a list that is built.
+                if chunk.listed <= MAX_UNTRIMMED_INDICES {
+                    chunk.prefix();
+                }
             });
         // Phase 2: the visible lights (numbered chunk after chunk: each chunk listed its own
         // in phase 1, so this is a copy, not a pass over every light), then counts and
@@ -63,6 +66,11 @@ impl Chunks {
             first_ids.push(out.visible.len() as u32);
             let first = (t * chunk_len) as u32;
             out.visible.extend(chunk.visible.iter().map(|&i| first + i));
+        }
+        let listed = (self.chunks.iter()).fold(0usize, |n, k| n.saturating_add(k.listed));
+        if listed > MAX_UNTRIMMED_INDICES {
+            out.unlisted = Some(listed);
+            return Totals::default();
         }
         let chunks = &self.chunks;
         out.counts.clear();
@@ -109,6 +117,8 @@ struct Chunk {
     runs: Vec<Run>,
     /// Per light of the chunk: the end of its runs in `runs`.
     ends: Vec<u32>,
+    /// The entries its runs list (phase 1; past [`MAX_UNTRIMMED_INDICES`], at least that).
+    listed: usize,
     /// The chunk's lights with a run (positions in the chunk), ascending.
     visible: Vec<u32>,
     /// Per cell (plus one): where the cell's run starts in `sorted` (phase 2).
@@ -136,6 +146,7 @@ impl Chunk {
         self.ends.clear();
         clear_with_room_for(&mut self.visible, visible_share);
         let (deltas, runs) = (&mut self.deltas[..], &mut self.runs);
+        let mut listed = 0usize;
         for (i, light) in lights.iter().enumerate() {
             let before = runs.len();
             // The callback lives on the stack (the refinement takes it out of line): it holds
@@ -149,9 +160,18 @@ impl Chunk {
             for_each_run(grid, light, camera_far, &mut emit);
             if runs.len() > before {
                 self.visible.push(i as u32);
+                listed += runs[before..]
+                    .iter()
+                    .map(|run| run.len as usize)
+                    .sum::<usize>();
             }
             self.ends.push(runs.len() as u32);
+            // As a band's phase 1: past this the list is refused, so stop taking memory.
+            if listed > MAX_UNTRIMMED_INDICES {
+                break;
+            }
         }
+        self.listed = listed;
     }
 
     /// Phase 2: per-cell offsets into the chunk's own sorted list.

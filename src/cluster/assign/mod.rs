@@ -55,10 +55,13 @@ mod simd;
 mod tests;
 mod thread_choice;
 mod types;
+#[cfg(test)]
+mod unlisted_tests;
 
 pub use types::{
     assign_work, AssignLimits, AssignStats, Assignment, INDEX_WEIGHT, MAX_ASSIGN_CELLS,
-    MAX_ASSIGN_THREADS, PARALLEL_INDICES, PARALLEL_MIN_LIGHTS, PARALLEL_SECONDS,
+    MAX_ASSIGN_THREADS, MAX_UNTRIMMED_INDICES, PARALLEL_INDICES, PARALLEL_MIN_LIGHTS,
+    PARALLEL_SECONDS,
 };
 
 use crate::cluster::grid::ClusterGrid;
@@ -150,7 +153,10 @@ impl Assigner {
     /// A grid of more than [`MAX_ASSIGN_CELLS`] cells is not assigned: its per-cell arrays
     /// would take gigabytes. The result then has no offsets, counts or indices,
     /// [`AssignStats::overflowed_lights`] counts every light once, and the first such call of
-    /// this assigner logs a warning.
+    /// this assigner logs a warning. Lists that would hold more than [`MAX_UNTRIMMED_INDICES`]
+    /// references before the overflow policy are not built either: [`Assignment::unlisted`]
+    /// says so (the renderer refuses such a frame), every cell is empty and every visible
+    /// light counts as overflowed.
     pub fn assign(
         &mut self,
         grid: &ClusterGrid,
@@ -161,6 +167,7 @@ impl Assigner {
         let cells = grid.total_cells as usize;
         let out = &mut self.out;
         out.visible.clear();
+        out.unlisted = None;
         out.stats = AssignStats {
             clusters: grid.total_cells,
             threads: 1,
@@ -233,6 +240,18 @@ impl Assigner {
                 }
             })
         };
+        if out.unlisted.is_some() {
+            // Nothing listed: empty cells, every visible light overflowed.
+            out.indices.clear();
+            out.counts.clear();
+            out.counts.resize(cells, 0);
+            out.offsets.clear();
+            out.offsets.resize(cells, 0);
+            out.stats.visible_lights = out.visible.len();
+            out.stats.overflowed_lights = out.visible.len() as u64;
+            out.stats.threads = threads;
+            return &self.out;
+        }
         // Overflow, then the figures.
         out.stats.max_lights_per_cluster = totals.max;
         out.stats.runs = totals.runs;

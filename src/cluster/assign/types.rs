@@ -3,6 +3,13 @@
 
 use super::index_list::IndexList;
 
+/// Most light references an assignment lists before the overflow policy trims them: a grid
+/// whose cells and overlapping lights would give more is not listed (see
+/// [`Assignment::unlisted`]). 2²⁶ entries, what an index texture of 16 384 rows holds, take
+/// 128 or 256 MiB, and their runs at most 512 MiB; a list past 2³² entries would not even be
+/// numbered by the 32-bit offsets.
+pub const MAX_UNTRIMMED_INDICES: usize = 1 << 26;
+
 /// Most threads one assignment takes (see [`AssignLimits::max_threads`]): its bands and
 /// chunks are cut for at most this many.
 pub const MAX_ASSIGN_THREADS: usize = 8;
@@ -125,6 +132,10 @@ pub struct Assignment {
     pub indices: IndexList,
     /// Figures.
     pub stats: AssignStats,
+    /// `Some(n)`: the cells' lists would hold at least `n` references before the overflow
+    /// policy, more than [`MAX_UNTRIMMED_INDICES`], so none were listed (every cell is empty;
+    /// the lights found visible, which may stop short of all of them, count as overflowed).
+    pub unlisted: Option<usize>,
 }
 
 /// Consecutive cells one light touches (numbered from its band's first cell in a band).

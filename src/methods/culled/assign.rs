@@ -39,9 +39,9 @@ impl Assign {
         let assignment = self.assigner.assign(grid, ctx.lights, ctx.far, limits);
         let ms = started.elapsed().as_secs_f64() * 1e3;
         let dropped = assignment.stats.overflowed_lights;
-        // A frame refused for too many visible lights drops nothing: the warning (once a
-        // renderer) is kept for one that draws.
-        let drawn = assignment.visible.len() <= MAX_INDEXED_LIGHTS;
+        // A frame refused for too many visible lights or references drops nothing: the
+        // warning (once a renderer) is kept for one that draws.
+        let drawn = assignment.visible.len() <= MAX_INDEXED_LIGHTS && assignment.unlisted.is_none();
         if dropped > 0 && drawn && !self.warned_overflow {
             self.warned_overflow = true;
             warn_overflow(method, dropped, limits);

@@ -1,7 +1,7 @@
 //! Stage limits: what one frame may hold on this context (the cell cap, the index list, the
 //! grid and the lights the textures can address), from its capacities and the options.
 
-use crate::cluster::assign::AssignLimits;
+use crate::cluster::assign::{AssignLimits, MAX_UNTRIMMED_INDICES};
 use crate::cluster::grid::ClusterGrid;
 use crate::cluster::pack::DATA_TEXTURE_WIDTH;
 use crate::cluster::pack::{grid_fits_table, grid_texels, MAX_INDEXED_LIGHTS};
@@ -57,6 +57,20 @@ pub(super) fn check_grid(dev: &Device, grid: &ClusterGrid, footprint_px: f64) ->
         )));
     }
     Ok(())
+}
+
+/// The error of a frame whose cells' lists would hold more references before the cell cap than
+/// an assignment builds (many lights overlapping on a fine fixed grid).
+pub(super) fn too_many_references(method: &str, cells: u32, references: usize) -> Error {
+    let knob = match method {
+        "tiled" => "a larger tile_px",
+        _ => "a larger grid.footprint_px, deeper slices (grid.slice_depth) or the automatic grid",
+    };
+    Error::Limit(format!(
+        "{method}: the frame's {cells} cells would list at least {references} light references before \
+         the cell cap trims them, more than the {MAX_UNTRIMMED_INDICES} an assignment builds \
+         (the lights overlap too much for cells this fine): {knob}, or fewer overlapping lights"
+    ))
 }
 
 /// The error of a frame with more visible lights than the index list can number.

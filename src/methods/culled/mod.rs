@@ -96,6 +96,10 @@ impl CulledForward {
         let (grid_key, grid) = self.grid.as_ref().expect("updated above");
         limits::check_grid(ctx.dev, grid, grid_key.config.footprint_px)?;
         let assigned = self.assign.run(method, grid, ctx, &limits);
+        if let Some(references) = assigned.assignment.unlisted {
+            let cells = grid.total_cells;
+            return Err(limits::too_many_references(method, cells, references));
+        }
         let visible = assigned.assignment.visible.len();
         if visible > MAX_INDEXED_LIGHTS {
             return Ok(CulledFrame::TooManyVisible(visible));

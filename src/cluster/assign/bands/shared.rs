@@ -3,7 +3,7 @@
 
 use super::{number_listed, Band, CellsOut, MAX_BANDS};
 use crate::cluster::assign::index_list::EntriesMut;
-use crate::cluster::assign::types::Assignment;
+use crate::cluster::assign::types::{Assignment, Totals, MAX_UNTRIMMED_INDICES};
 use crate::cluster::grid::ClusterGrid;
 use crate::cluster::view_light::GpuLight;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
@@ -62,7 +62,10 @@ pub(super) fn assign_shared(
             return;
         }
         while let Some(i) = claim(&scatter_next, n) {
-            lock(&scatters[i]).take().expect("phase 3's band").run();
+            // None where phase 2 listed nothing (too many references).
+            if let Some(scatter) = lock(&scatters[i]).take() {
+                scatter.run();
+            }
         }
     };
     on_workers(workers.min(n), &work);
@@ -99,6 +102,15 @@ fn between_phases<'a>(
     for band in taken.iter_mut().flatten() {
         band.base = indices;
         indices += band.indices;
+    }
+    if indices > MAX_UNTRIMMED_INDICES {
+        // Not listed: phase 3 finds no band to scatter.
+        out.unlisted = Some(indices);
+        taken
+            .iter_mut()
+            .flatten()
+            .for_each(|b| b.totals = Totals::default());
+        return;
     }
     // The bands cover the grid, from cell 0 to the last band's end.
     let cells = taken
