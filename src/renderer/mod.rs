@@ -8,6 +8,7 @@
 
 mod bound_target;
 mod depth_warning;
+mod fp16_channels;
 mod fp16_range;
 mod frame;
 mod frame_setup;

@@ -325,3 +325,34 @@ fn lights_overlapping_on_a_fine_fixed_grid_are_refused_naming_the_footprint() {
     gpu.r().set_method_named("tiled").unwrap();
     gpu.render(&s, 16, 16, &RenderOptions::default());
 }
+
+/// Without fragment highp a light's radiance is scaled by its brightest channel into fp16: a
+/// light of colour (10⁶, 0.5, 0.5) lost its green and blue (a red disc where highp shows
+/// white) without a word. The loss is now named, once; a light whose channels lie within 2¹⁴
+/// of each other is not.
+#[test]
+fn channels_fp16_cannot_keep_beside_a_bright_one_are_named() {
+    common::warnings::install();
+    let restrictions = manylight::gl::Restrictions {
+        no_fragment_highp: true,
+    };
+    let mut gpu = Gpu::restricted(EsVersion::Es2, &restrictions);
+    let said = || common::warnings::warnings_containing("spans more than fp16 keeps");
+    let mut even = point(4.0);
+    even.color = Vec3::new(1e4, 1.0, 1.0);
+    gpu.render(&plane(vec![even]), 32, 18, &RenderOptions::default());
+    assert!(said().is_empty(), "{:?}", said());
+    let mut lopsided = point(4.0);
+    lopsided.color = Vec3::new(1e6, 0.5, 0.5);
+    let lights = vec![point(4.0), lopsided];
+    for _ in 0..2 {
+        gpu.render(&plane(lights.clone()), 32, 18, &RenderOptions::default());
+    }
+    let warned = said();
+    assert_eq!(warned.len(), 1, "{warned:?}");
+    assert!(
+        warned[0].starts_with("lights[1]:") && warned[0].contains("green and blue"),
+        "{}",
+        warned[0]
+    );
+}

@@ -1,0 +1,75 @@
+//! Without fragment `highp` a light's radiance is uploaded divided by `k²`, `k` taken from its
+//! brightest channel, so that it fits fp16 (`cluster::pack::fp16_radiance`): a channel more
+//! than 2¹⁴ below the brightest then falls under fp16's smallest normal and is lost (flushed
+//! to zero, or a few bits left). Said once a process, naming the light: a warning each frame
+//! would flood a game's log.
+
+use std::sync::atomic::{AtomicBool, Ordering};
+
+use glam::Vec3;
+
+use crate::cluster::pack::fp16_radiance;
+use crate::gl::Caps;
+use crate::scene::Scene;
+
+/// fp16's smallest normal number, 2⁻¹⁴.
+const FP16_MIN_NORMAL: f32 = 1.0 / 16384.0;
+
+/// A channel worth less than this at full strength would not show in 8 bits anyway.
+const VISIBLE: f32 = 1.0 / 255.0;
+
+/// Whether a light losing channels was said (once a process).
+static WARNED: AtomicBool = AtomicBool::new(false);
+
+/// Which channels of `radiance` (red, green, blue) would show but its fp16 form loses.
+fn lost_channels(radiance: Vec3) -> [bool; 3] {
+    let (scaled, _) = fp16_radiance(radiance);
+    [0, 1, 2].map(|c| radiance[c] >= VISIBLE && scaled[c] < FP16_MIN_NORMAL)
+}
+
+/// Without fragment `highp`: warns (once) of the first light, point, spot or directional,
+/// whose colour × intensity spans more than its fp16 form keeps. Allocates nothing unless it
+/// warns.
+pub(super) fn warn_of_lost_channels(caps: &Caps, scene: &Scene) {
+    if caps.fragment_has_highp() || WARNED.load(Ordering::Relaxed) {
+        return;
+    }
+    let points = (scene.lights.iter().enumerate())
+        .filter(|(_, l)| l.is_active())
+        .map(|(i, l)| (("lights", i), l.color * l.intensity));
+    let suns = (scene.directional_lights.iter().enumerate())
+        .filter(|(_, l)| l.is_active())
+        .map(|(i, l)| (("directional_lights", i), l.radiance()));
+    let lossy = |(_, r): &(_, Vec3)| lost_channels(*r).contains(&true);
+    let Some(((list, i), radiance)) = points.chain(suns).find(lossy) else {
+        return;
+    };
+    WARNED.store(true, Ordering::Relaxed);
+    let lost: Vec<&str> = (["red", "green", "blue"].into_iter())
+        .zip(lost_channels(radiance))
+        .filter_map(|(name, lost)| lost.then_some(name))
+        .collect();
+    log::warn!(
+        "{list}[{i}]: colour × intensity {radiance:?} spans more than fp16 keeps: without \
+         fragment highp a light's radiance is scaled by its brightest channel, and channels \
+         more than 2¹⁴ below it are lost, so this light shows without its {} (keep a light's \
+         channels within 2¹⁴ of each other)",
+        lost.join(" and ")
+    );
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn only_channels_that_would_show_and_fall_below_fp16_are_lost() {
+        // The review's light: red 10⁶ scales green and blue (0.5) to 5·10⁻⁷.
+        assert_eq!(lost_channels(Vec3::new(1e6, 0.5, 0.5)), [false, true, true]);
+        // Within 2¹⁴ of the brightest: kept.
+        assert_eq!(lost_channels(Vec3::new(1e4, 1.0, 1.0)), [false; 3]);
+        // Too dim to show at full strength anyway, or zero: nothing lost that would show.
+        assert_eq!(lost_channels(Vec3::new(1e6, 1e-3, 0.0)), [false; 3]);
+        assert_eq!(lost_channels(Vec3::new(0.5, 0.5, 0.5)), [false; 3]);
+    }
+}
