@@ -6,11 +6,18 @@ use glam::{DMat4, DVec3, Vec3};
 use crate::scene::direction::unit;
 use crate::scene::{Light, LightKind};
 
-/// Largest radius a light is given on the GPU. The shader divides by the radius, and past
-/// about 10¹⁹ times the distance to a surface the quotient's square underflows f32 and the
-/// light vanishes (a radius of 10²⁰ lit nothing); capped here, the window term `1 − (d/r)⁴`
-/// still differs from 1 by under 10⁻¹² anywhere within 1 000 km of the light.
+/// Largest radius a light near the eye is given on the GPU. The shader divides by the radius,
+/// and past about 10¹⁹ times the distance to a surface the quotient's square underflows f32 and
+/// the light vanishes (a radius of 10²⁰ lit nothing); capped here, the window term
+/// `1 − (d/r)⁴` still differs from 1 by under 10⁻¹² anywhere within 1 000 km of the light. A
+/// light farther from the eye than that keeps [`FAR_RADIUS_FACTOR`] times its distance: capped
+/// at 10¹² it would lie outside its own sphere and light nothing in view.
 pub const MAX_EFFECTIVE_RADIUS: f32 = 1e12;
+
+/// A light's radius is capped at no less than this many times its distance from the eye: the
+/// window term then differs from 1 by under 10⁻²⁴ at the eye, and `d/r` stays far above what
+/// underflows f32 for anything in view.
+pub const FAR_RADIUS_FACTOR: f32 = 1e6;
 
 /// A light as the shader sees it: view space, radiance premultiplied, spot terms precomputed.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -56,10 +63,13 @@ impl GpuLight {
                 (outer_deg as f32, inner_deg as f32),
             ),
         };
+        let position = view.transform_point3(light.position).as_vec3();
+        // Past f32 for lights beyond 3·10³², where `min` then keeps the radius as it is.
+        let cap = MAX_EFFECTIVE_RADIUS.max(position.length() * FAR_RADIUS_FACTOR);
         GpuLight {
-            position: view.transform_point3(light.position).as_vec3(),
-            radius: light.radius.min(MAX_EFFECTIVE_RADIUS),
-            cull_radius: light.radius.min(MAX_EFFECTIVE_RADIUS),
+            position,
+            radius: light.radius.min(cap),
+            cull_radius: light.radius.min(cap),
             radiance: light.radiance(),
             spot_scale,
             direction,

@@ -356,3 +356,29 @@ fn channels_fp16_cannot_keep_beside_a_bright_one_are_named() {
         warned[0]
     );
 }
+
+/// A light 10¹³ from the scene with a radius of 10²⁰ reaches it, but its radius was capped at
+/// 10¹² on the GPU, putting it outside its own sphere: every method drew ambient only, without
+/// a word. A far light now keeps a radius past its distance; every method lights the plane as
+/// forward does, as the light model says (intensity over the squared distance).
+#[test]
+fn a_light_farther_than_the_radius_cap_still_reaches_the_scene() {
+    let mut far = point(1e20);
+    far.position = DVec3::new(0.0, 0.0, 1e13);
+    far.color = Vec3::ONE;
+    far.intensity = 5e25;
+    let s = plane(vec![far]);
+    for es in [EsVersion::Es2, EsVersion::Es3] {
+        let mut gpu = Gpu::new(es);
+        let ambient = mean(&gpu.render(&plane(vec![]), 64, 36, &RenderOptions::default()));
+        gpu.r().set_method_named("forward").unwrap();
+        let forward = gpu.render(&s, 64, 36, &RenderOptions::default());
+        assert!(mean(&forward) > ambient + 60.0, "{es}: {}", mean(&forward));
+        for method in common::methods_on(es) {
+            gpu.r().set_method_named(method).unwrap();
+            let image = gpu.render(&s, 64, 36, &RenderOptions::default());
+            let d = manylight::metrics::diff(&forward, &image).max_abs;
+            assert!(d <= 2, "{es} {method}: {d} / 255 from forward");
+        }
+    }
+}
