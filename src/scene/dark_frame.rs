@@ -22,15 +22,17 @@ pub(crate) fn warnings(scene: &Scene, path: &Path) -> Vec<String> {
         ));
     }
     let near = shading::LIGHT_MIN_DISTANCE;
-    let unlit = (scene.lights.iter())
-        .filter(|l| l.radius > 0.0 && f64::from(l.radius) <= near)
+    // Lights that would shine (some radiance) but reach nothing.
+    let shining = |l: &&super::Light| l.intensity > 0.0 && l.color.max_element() > 0.0;
+    let unlit = (scene.lights.iter().filter(shining))
+        .filter(|l| f64::from(l.radius) <= near)
         .count();
     if unlit > 0 {
         warnings.push(format!(
-            "{name}: {unlit} of {} lights have a radius of at most 2⁻¹³ ({near:.3e}) and light \
-             nothing: the shaders leave out what lies that near a light (above fp16's smallest \
-             normal, docs/precision.md); scale the model up (its transform, or the units it \
-             was exported in)",
+            "{name}: {unlit} of {} lights have a radius of at most 2⁻¹³ ({near:.3e}; 0 \
+             included) and light nothing: the shaders leave out what lies that near a light \
+             (above fp16's smallest normal, docs/precision.md); give them a radius, or scale \
+             the model up (its transform, or the units it was exported in)",
             scene.lights.len()
         ));
     }
@@ -56,4 +58,32 @@ fn invisible(scene: &Scene, object: &Object) -> bool {
         m.alpha <= 0.0
             || (m.alpha_vertex && !colors.is_empty() && colors.iter().all(|c| c.w <= 0.0))
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::Light;
+    use glam::{DVec3, Vec3};
+
+    fn unlit_said(lights: Vec<Light>) -> bool {
+        let scene = Scene {
+            lights,
+            ..Scene::empty()
+        };
+        let said = warnings(&scene, Path::new("s.json"));
+        said.iter().any(|w| w.contains("light nothing"))
+    }
+
+    /// A shining light of radius 0 lights nothing, as one of 10⁻⁵ does: both said (radius 0
+    /// was passed over). One that does not shine (intensity or colour 0) is off, not unlit.
+    #[test]
+    fn shining_lights_that_reach_nothing_are_said_off_ones_are_not() {
+        let light = |radius, intensity, color| Light::point(DVec3::ZERO, radius, color, intensity);
+        assert!(unlit_said(vec![light(0.0, 2.0, Vec3::ONE)]));
+        assert!(unlit_said(vec![light(1e-5, 2.0, Vec3::ONE)]));
+        assert!(!unlit_said(vec![light(0.0, 0.0, Vec3::ONE)]));
+        assert!(!unlit_said(vec![light(0.0, 2.0, Vec3::ZERO)]));
+        assert!(!unlit_said(vec![light(1.0, 2.0, Vec3::ONE)]));
+    }
 }
