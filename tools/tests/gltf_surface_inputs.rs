@@ -223,16 +223,21 @@ fn a_normal_map_tilts_the_shading_normal_with_file_and_generated_tangents() {
     check_every_method("mirrored normal map", &s, &want, 3.0);
 }
 
+/// (metallic, roughness) = (metallicFactor, roughnessFactor) × the texture's (B, G), linear:
+/// factors below 1 and distinct channels, so reading the wrong channel, dropping the factors
+/// or the texture, each changes the picture beyond the bar (with both factors 1 and blue 255 a
+/// shader ignoring blue passed).
 #[test]
 fn the_metallic_roughness_texture_multiplies_the_factors_by_its_blue_and_green() {
     let dir = tempfile::tempdir().unwrap();
-    // B: metallic 1, G: roughness 77/255 (linear data, not sRGB).
-    let texel = [0u8, 77, 255, 255];
+    // R 30 (unused), G 204 (0.8), B 64 (0.251): linear data, not sRGB.
+    let texel = [30u8, 204, 64, 255];
+    let (metallic_factor, roughness_factor) = (0.9, 0.4);
     let material = json!({
         "pbrMetallicRoughness": {
             "baseColorFactor": [0.9, 0.6, 0.3, 1.0],
-            "metallicFactor": 1.0,
-            "roughnessFactor": 1.0,
+            "metallicFactor": metallic_factor,
+            "roughnessFactor": roughness_factor,
             "metallicRoughnessTexture": {"index": 0},
         },
     });
@@ -250,12 +255,28 @@ fn the_metallic_roughness_texture_multiplies_the_factors_by_its_blue_and_green()
             (surface, DVec3::ZERO, 1.0)
         }
     };
-    let want = oracle(&s, &model(1.0, 77.0 / 255.0));
-    let gap = oracle_gap(&want, &oracle(&s, &model(1.0, 1.0)));
-    assert!(
-        gap > 20.0,
-        "the texture changes the picture by only {gap:.1}/255"
-    );
+    let [r, g, b] = [texel[0], texel[1], texel[2]].map(|c| f64::from(c) / 255.0);
+    let want = oracle(&s, &model(metallic_factor * b, roughness_factor * g));
+    for (wrong, metallic, roughness) in [
+        ("the texture ignored", metallic_factor, roughness_factor),
+        ("the factors ignored", b, g),
+        (
+            "blue and green swapped",
+            metallic_factor * g,
+            roughness_factor * b,
+        ),
+        (
+            "metallic from red",
+            metallic_factor * r,
+            roughness_factor * g,
+        ),
+    ] {
+        let gap = oracle_gap(&want, &oracle(&s, &model(metallic, roughness)));
+        assert!(
+            gap > 6.0,
+            "{wrong} changes the picture by only {gap:.1}/255"
+        );
+    }
     check_every_method("metallic-roughness texture", &s, &want, 3.0);
 }
 
