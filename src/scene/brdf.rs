@@ -76,8 +76,9 @@ pub fn reflectance(
 mod tests {
     use super::*;
 
-    /// The spec's Appendix B as written: `mix(dielectric_brdf, metal_brdf, metallic)`, times
-    /// π·N·L; no rewriting, no clamps.
+    /// The spec's Appendix B written out directly: `mix(dielectric_brdf, metal_brdf,
+    /// metallic)`, times π·N·L, with GGX and the height-correlated Smith visibility (the form
+    /// the Khronos Sample Viewer evaluates); no rewriting, no clamps.
     fn textbook(l: DVec3, n: DVec3, v: DVec3, base: DVec3, metallic: f64, roughness: f64) -> DVec3 {
         let pi = std::f64::consts::PI;
         let h = (l + v).normalize();
