@@ -64,7 +64,8 @@ impl GpuLight {
             ),
         };
         let position = view.transform_point3(light.position).as_vec3();
-        // Past f32 for lights beyond 3·10³², where `min` then keeps the radius as it is.
+        // The length is infinite for lights beyond about 10¹⁹ (f32 squares it), where `min`
+        // then keeps the radius as it is.
         let cap = MAX_EFFECTIVE_RADIUS.max(position.length() * FAR_RADIUS_FACTOR);
         GpuLight {
             position,

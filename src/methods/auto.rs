@@ -168,7 +168,17 @@ impl ShadingMethod for Auto {
                 }
                 // Forward this frame; clustered keeps its resources and tries again next frame
                 // (the visible lights change as they and the camera move).
-                CulledFrame::TooManyVisible(visible) => {
+                refused @ (CulledFrame::TooManyVisible(_) | CulledFrame::Unlisted { .. }) => {
+                    let too_many = match refused {
+                        CulledFrame::Unlisted { references, .. } => format!(
+                            "{references} or more light references, more than clustered lists"
+                        ),
+                        CulledFrame::TooManyVisible(visible) => format!(
+                            "{visible} lights visible > {MAX_INDEXED_LIGHTS}, more than \
+                             clustered can index"
+                        ),
+                        CulledFrame::Rendered(_) => unreachable!("matched above"),
+                    };
                     let refusal = deferred_refusal(ctx);
                     let instead = if refusal.is_none() {
                         "deferred"
@@ -176,11 +186,7 @@ impl ShadingMethod for Auto {
                         "forward"
                     };
                     self.reason.clear();
-                    let _ = write!(
-                        self.reason,
-                        "{visible} lights visible > {MAX_INDEXED_LIGHTS}, more than clustered \
-                         can index: {instead} renders this frame"
-                    );
+                    let _ = write!(self.reason, "{too_many}: {instead} renders this frame");
                     if let Some(why) = refusal {
                         let _ = write!(self.reason, " (deferred cannot: {why})");
                     }

@@ -13,7 +13,7 @@ mod shared;
 pub(super) use scatter::FORCED_SCATTER_BLOCKS;
 
 use super::cells::{for_each_run_in, SliceWindow};
-use super::types::{Assignment, Run, Totals, MAX_UNTRIMMED_INDICES, PARALLEL_SECONDS};
+use super::types::{Assignment, Run, Tally, Totals, PARALLEL_SECONDS};
 use crate::cluster::grid::ClusterGrid;
 use crate::cluster::headroom::{clear_with_room_for, room_for, share_of, WHOLE_UP_TO};
 use crate::cluster::view_light::GpuLight;
@@ -33,6 +33,14 @@ impl Bands {
     /// The last split's bands.
     fn active(&self) -> &[Band] {
         &self.bands[..self.active]
+    }
+
+    /// Frees the runs a refused assignment found ([`Assignment::unlisted`]): up to the bound's
+    /// worth, which the next assignment would otherwise keep room for in every band.
+    pub(super) fn release_runs(&mut self) {
+        for band in &mut self.bands {
+            band.runs = Vec::new();
+        }
     }
 
     /// Seconds the last split's bands spent in their phases 1 and 3, all together: the
@@ -164,6 +172,7 @@ impl Bands {
         camera_far: f64,
         out: &mut Assignment,
         threads: usize,
+        tally: &Tally,
     ) -> Totals {
         // The last assignment's runs and listed lights over all bands, before the split
         // moves the bands' borders.
@@ -181,10 +190,11 @@ impl Bands {
         }
         let bands = &mut self.bands[..self.active];
         if let [band] = bands {
-            band.assign_alone(grid, lights, camera_far, out);
+            band.assign_alone(grid, lights, camera_far, out, tally);
         } else {
             let numbers = &mut self.numbers;
-            shared::assign_shared(bands, threads, grid, lights, camera_far, out, numbers);
+            let work = (grid, lights, camera_far, tally);
+            shared::assign_shared(bands, threads, work, out, numbers);
         }
         let mut totals = Totals::default();
         for band in self.active() {
@@ -269,12 +279,12 @@ impl Band {
     /// Phase 1: the band's runs of every light, the lights that have any, and the number of
     /// indices they give (so the bands' parts of the list are known before phase 3), timed
     /// for the next split.
-    fn find(&mut self, grid: &ClusterGrid, lights: &[GpuLight], camera_far: f64) {
+    fn find(&mut self, grid: &ClusterGrid, lights: &[GpuLight], camera_far: f64, tally: &Tally) {
         let started = Instant::now();
         let window = self.window.expect("a band has a window");
         let first = self.first_cell as u32;
         let runs = &mut self.runs;
-        let mut listed = 0usize;
+        let (mut listed, mut added) = (0usize, 0usize);
         for (i, light) in lights.iter().enumerate() {
             let before = runs.len();
             // Taking `first` by value and summing the indices after: the closure lives on the
@@ -294,9 +304,9 @@ impl Band {
                     .iter()
                     .map(|run| run.len as usize)
                     .sum::<usize>();
-                // Past this the list is refused anyway: the runs would go on taking memory
-                // (and past 2³² be misnumbered).
-                if listed > MAX_UNTRIMMED_INDICES {
+                // Past the bound the list is refused anyway: the runs would go on taking
+                // memory (and past 2³² be misnumbered).
+                if listed > tally.limit || !tally.keeps_within(listed, &mut added) {
                     break;
                 }
             }
@@ -313,12 +323,13 @@ impl Band {
         lights: &[GpuLight],
         camera_far: f64,
         out: &mut Assignment,
+        tally: &Tally,
     ) {
-        self.find(grid, lights, camera_far);
+        self.find(grid, lights, camera_far, tally);
         out.visible.clear();
         out.visible
             .extend(self.lights.iter().map(|&(light, _)| light));
-        if self.indices > MAX_UNTRIMMED_INDICES {
+        if self.indices > tally.limit {
             out.unlisted = Some(self.indices);
             self.totals = Totals::default();
             return;

@@ -6,7 +6,7 @@ use rayon::prelude::*;
 
 use super::cells::for_each_run;
 use super::index_list::{EntriesMut, IndexList, LightIndex};
-use super::types::{Assignment, Run, Totals, MAX_UNTRIMMED_INDICES};
+use super::types::{Assignment, Run, Tally, Totals};
 use crate::cluster::grid::ClusterGrid;
 use crate::cluster::headroom::{clear_with_room_for, room_for, share_of, zeroed_with_room};
 use crate::cluster::view_light::GpuLight;
@@ -22,6 +22,13 @@ pub(super) struct Chunks {
 }
 
 impl Chunks {
+    /// Frees the runs a refused assignment found (see [`Bands::release_runs`](super::bands)).
+    pub(super) fn release_runs(&mut self) {
+        for chunk in &mut self.chunks {
+            chunk.runs = Vec::new();
+        }
+    }
+
     /// Phases 1 to 3 over `threads` (at least two) chunks of lights, in parallel (called
     /// inside rayon's pool), into `out`; the list's totals before any cap.
     pub(super) fn assign(
@@ -31,6 +38,7 @@ impl Chunks {
         camera_far: f64,
         out: &mut Assignment,
         threads: usize,
+        tally: &Tally,
     ) -> Totals {
         let cells = grid.total_cells as usize;
         // Phase 1: runs and counts per chunk of lights.
@@ -51,9 +59,9 @@ impl Chunks {
             .par_iter_mut()
             .zip(lights.par_chunks(chunk_len))
             .for_each(|(chunk, part)| {
-                chunk.find(grid, part, camera_far, shares);
+                chunk.find(grid, part, camera_far, shares, tally);
                 // Offsets are 32-bit: only for a list that is built.
-                if chunk.listed <= MAX_UNTRIMMED_INDICES {
+                if chunk.listed <= tally.limit {
                     chunk.prefix();
                 }
             });
@@ -68,7 +76,7 @@ impl Chunks {
             out.visible.extend(chunk.visible.iter().map(|&i| first + i));
         }
         let listed = (self.chunks.iter()).fold(0usize, |n, k| n.saturating_add(k.listed));
-        if listed > MAX_UNTRIMMED_INDICES {
+        if listed > tally.limit {
             out.unlisted = Some(listed);
             return Totals::default();
         }
@@ -117,7 +125,7 @@ struct Chunk {
     runs: Vec<Run>,
     /// Per light of the chunk: the end of its runs in `runs`.
     ends: Vec<u32>,
-    /// The entries its runs list (phase 1; past [`MAX_UNTRIMMED_INDICES`], at least that).
+    /// The entries its runs list (phase 1; past the [`Tally`]'s limit, at least that).
     listed: usize,
     /// The chunk's lights with a run (positions in the chunk), ascending.
     visible: Vec<u32>,
@@ -140,13 +148,14 @@ impl Chunk {
         lights: &[GpuLight],
         camera_far: f64,
         (runs_share, visible_share): (usize, usize),
+        tally: &Tally,
     ) {
         zeroed_with_room(&mut self.deltas, grid.total_cells as usize + 1);
         clear_with_room_for(&mut self.runs, runs_share);
         self.ends.clear();
         clear_with_room_for(&mut self.visible, visible_share);
         let (deltas, runs) = (&mut self.deltas[..], &mut self.runs);
-        let mut listed = 0usize;
+        let (mut listed, mut added) = (0usize, 0usize);
         for (i, light) in lights.iter().enumerate() {
             let before = runs.len();
             // The callback lives on the stack (the refinement takes it out of line): it holds
@@ -167,7 +176,7 @@ impl Chunk {
             }
             self.ends.push(runs.len() as u32);
             // As a band's phase 1: past this the list is refused, so stop taking memory.
-            if listed > MAX_UNTRIMMED_INDICES {
+            if listed > tally.limit || !tally.keeps_within(listed, &mut added) {
                 break;
             }
         }
@@ -259,22 +268,23 @@ fn merge<T: LightIndex>(
     blocks: &mut Vec<(usize, usize)>,
 ) {
     split_cells_into(offsets, indices.len(), threads * 2, blocks);
-    merge_blocks(chunks, offsets, blocks, indices);
+    merge_blocks(chunks, offsets, blocks, indices, threads);
 }
 
 /// Gathers the cells of `blocks` (contiguous, in cell order) into `out`, which starts at the
-/// first block's first index: the two halves of the blocks in parallel (`rayon::join` keeps
-/// its jobs on the stack, so no list of jobs is allocated).
+/// first block's first index: the two halves of the blocks in parallel, each with half of
+/// `threads`, so at most `threads` at once (`rayon::join` keeps its jobs on the stack, so no
+/// list of jobs is allocated); with one thread, block after block.
 fn merge_blocks<T: LightIndex>(
     chunks: &[Chunk],
     offsets: &[u32],
     blocks: &[(usize, usize)],
     out: &mut [T],
+    threads: usize,
 ) {
-    match blocks {
-        [] => {}
-        &[(c0, c1)] => {
-            let mut at = 0;
+    if threads < 2 || blocks.len() < 2 {
+        let mut at = 0;
+        for &(c0, c1) in blocks {
             for cell in c0..c1 {
                 for chunk in chunks {
                     let (o, n) = (chunk.offsets[cell] as usize, chunk.count(cell) as usize);
@@ -283,16 +293,16 @@ fn merge_blocks<T: LightIndex>(
                 }
             }
         }
-        _ => {
-            let (left, right) = blocks.split_at(blocks.len() / 2);
-            let split = (offsets[right[0].0] - offsets[left[0].0]) as usize;
-            let (out_left, out_right) = out.split_at_mut(split);
-            rayon::join(
-                || merge_blocks(chunks, offsets, left, out_left),
-                || merge_blocks(chunks, offsets, right, out_right),
-            );
-        }
+        return;
     }
+    let (left, right) = blocks.split_at(blocks.len() / 2);
+    let split = (offsets[right[0].0] - offsets[left[0].0]) as usize;
+    let (out_left, out_right) = out.split_at_mut(split);
+    let half = threads / 2;
+    rayon::join(
+        || merge_blocks(chunks, offsets, left, out_left, threads - half),
+        || merge_blocks(chunks, offsets, right, out_right, half),
+    );
 }
 
 /// Splits the cells into at most `parts` contiguous, non-empty blocks with about equal numbers

@@ -224,9 +224,10 @@ impl Assigner {
             threads,
         );
         self.last_threads = threads;
+        let tally = types::Tally::new(limits.max_untrimmed);
         let by_bands = threads == 1 || cells >= lights.len();
         let totals = if threads == 1 {
-            self.bands.assign(grid, lights, camera_far, out, 1)
+            self.bands.assign(grid, lights, camera_far, out, 1, &tally)
         } else {
             // One entry into rayon's pool for all the phases: every entry from outside the
             // pool queues a job in rayon's global injector, which allocates a block of slots
@@ -234,14 +235,16 @@ impl Assigner {
             let (bands, chunks) = (&mut self.bands, &mut self.chunks);
             rayon::scope(|_| {
                 if by_bands {
-                    bands.assign(grid, lights, camera_far, out, threads)
+                    bands.assign(grid, lights, camera_far, out, threads, &tally)
                 } else {
-                    chunks.assign(grid, lights, camera_far, out, threads)
+                    chunks.assign(grid, lights, camera_far, out, threads, &tally)
                 }
             })
         };
         if out.unlisted.is_some() {
             // Nothing listed: empty cells, every visible light overflowed.
+            self.bands.release_runs();
+            self.chunks.release_runs();
             out.indices.clear();
             out.counts.clear();
             out.counts.resize(cells, 0);

@@ -35,7 +35,8 @@ pub(super) fn apply_cap(
     if max <= cap {
         return false;
     }
-    trim_overfull_cells(out, grid, lights, cap, limits.max_threads > 1, scratch);
+    let parts = limits.max_threads.clamp(1, super::MAX_ASSIGN_THREADS);
+    trim_overfull_cells(out, grid, lights, cap, parts, scratch);
     // Compact: every cell keeps the first `cap` entries of its list (the trim put the kept
     // lights there, in ascending order).
     let total: usize = out.counts.iter().map(|&n| n.min(cap) as usize).sum();
@@ -92,7 +93,7 @@ fn trim_overfull_cells(
     grid: &ClusterGrid,
     lights: &[GpuLight],
     cap: u32,
-    may_share: bool,
+    parts: usize,
     scratch: &mut Overflow,
 ) {
     let cap = cap as usize;
@@ -114,14 +115,14 @@ fn trim_overfull_cells(
         [p.x, p.y, p.z, light.radiance.max_element()]
     }));
     let packed = &scratch.packed[..];
-    let parallel =
-        may_share && scratch.lists.iter().map(|&(_, _, n)| n).sum::<usize>() >= PARALLEL_INDICES;
+    let many = scratch.lists.iter().map(|&(_, _, n)| n).sum::<usize>() >= PARALLEL_INDICES;
+    let parts = if many { parts } else { 1 };
     let lists = &scratch.lists[..];
     match out.indices.entries_mut() {
-        EntriesMut::Narrow(list) => trim_lists(lists, list, 0, parallel, &|cell, list| {
+        EntriesMut::Narrow(list) => trim_lists(lists, list, 0, parts, &|cell, list| {
             trim_cell(grid, packed, cap, cell, list)
         }),
-        EntriesMut::Wide(list) => trim_lists(lists, list, 0, parallel, &|cell, list| {
+        EntriesMut::Wide(list) => trim_lists(lists, list, 0, parts, &|cell, list| {
             trim_cell(grid, packed, cap, cell, list)
         }),
     }
@@ -181,17 +182,18 @@ fn trim_cell<T: LightIndex>(
 const TRIM_GRAIN: usize = 1 << 14;
 
 /// Trims the lists `lists` (cell, offset, count; in cell order) of `indices`, whose first
-/// entry is list entry `base`: on the calling thread, or with `parallel` the two halves of
-/// the lists at once (`rayon::join` keeps its jobs on the stack), down to [`TRIM_GRAIN`].
+/// entry is list entry `base`: on the calling thread, or, for `parts` above 1, the two halves
+/// of the lists at once (`rayon::join` keeps its jobs on the stack), each with half the
+/// parts, so at most `parts` at once; down to [`TRIM_GRAIN`].
 fn trim_lists<T: LightIndex>(
     lists: &[(u32, usize, usize)],
     indices: &mut [T],
     base: usize,
-    parallel: bool,
+    parts: usize,
     trim: &(dyn Fn(u32, &mut [T]) + Sync),
 ) {
     let span = lists.last().map_or(0, |&(_, o, n)| o + n) - lists.first().map_or(0, |l| l.1);
-    if !parallel || lists.len() < 2 || span < TRIM_GRAIN {
+    if parts < 2 || lists.len() < 2 || span < TRIM_GRAIN {
         for &(cell, o, n) in lists {
             trim(cell, &mut indices[o - base..o - base + n]);
         }
@@ -201,8 +203,8 @@ fn trim_lists<T: LightIndex>(
     let split = right[0].1 - base;
     let (head, tail) = indices.split_at_mut(split);
     rayon::join(
-        || trim_lists(left, head, base, true, trim),
-        || trim_lists(right, tail, base + split, true, trim),
+        || trim_lists(left, head, base, parts - parts / 2, trim),
+        || trim_lists(right, tail, base + split, parts / 2, trim),
     );
 }
 

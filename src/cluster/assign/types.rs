@@ -10,6 +10,44 @@ use super::index_list::IndexList;
 /// numbered by the 32-bit offsets.
 pub const MAX_UNTRIMMED_INDICES: usize = 1 << 26;
 
+/// The references the phase-1 workers of one assignment found, all together: each adds its
+/// own every [`TALLY_STEP`] references, so past [`MAX_UNTRIMMED_INDICES`] every worker stops
+/// soon after (the runs found meanwhile stay within the bound plus a step a worker). The
+/// bound is [`AssignLimits::max_untrimmed`].
+pub(super) struct Tally {
+    total: std::sync::atomic::AtomicUsize,
+    /// The bound ([`AssignLimits::max_untrimmed`]).
+    pub(super) limit: usize,
+}
+
+/// References a worker finds between two additions to the [`Tally`].
+const TALLY_STEP: usize = 1 << 18;
+
+impl Tally {
+    /// A tally against `limit`.
+    pub(super) fn new(limit: usize) -> Tally {
+        Tally {
+            total: std::sync::atomic::AtomicUsize::new(0),
+            limit,
+        }
+    }
+
+    /// A worker's running count `listed`, of which `added` were added already: adds the rest
+    /// once it makes a step; false once the assignment's total is past the bound.
+    #[inline]
+    pub(super) fn keeps_within(&self, listed: usize, added: &mut usize) -> bool {
+        if listed - *added < TALLY_STEP {
+            return true;
+        }
+        let step = listed - *added;
+        *added = listed;
+        let total = self
+            .total
+            .fetch_add(step, std::sync::atomic::Ordering::Relaxed);
+        total + step <= self.limit
+    }
+}
+
 /// Most threads one assignment takes (see [`AssignLimits::max_threads`]): its bands and
 /// chunks are cut for at most this many.
 pub const MAX_ASSIGN_THREADS: usize = 8;
@@ -72,6 +110,9 @@ pub struct AssignLimits {
     /// estimate of it: what its workers spent working; tries of the other mode now and then).
     /// From this count of lights up the pool always runs.
     pub parallel_threshold: usize,
+    /// Most references listed before the overflow policy: past it nothing is listed
+    /// ([`Assignment::unlisted`]); [`MAX_UNTRIMMED_INDICES`] by default.
+    pub max_untrimmed: usize,
     /// Most threads, the caller included (at most [`MAX_ASSIGN_THREADS`](super::MAX_ASSIGN_THREADS)
     /// are used); 1 never enters rayon, not even to learn the pool's size.
     pub max_threads: usize,
@@ -84,6 +125,7 @@ impl Default for AssignLimits {
             max_indices: 1 << 24,
             parallel_threshold: 4096,
             max_threads: super::MAX_ASSIGN_THREADS,
+            max_untrimmed: MAX_UNTRIMMED_INDICES,
         }
     }
 }

@@ -92,8 +92,15 @@ impl ChoiceSearch {
             predicted_ms: costs.predict_ms(evals_per_pixel * covered, work, bytes as f64),
             assign_ms: costs.assign_ms(work),
             over_budget: false,
-            overflowed_lights: a.stats.overflowed_lights,
+            // Unlisted (too many references to build): worse than any grid that lists, and
+            // finer grids only list more.
+            overflowed_lights: if a.unlisted.is_some() {
+                u64::MAX
+            } else {
+                a.stats.overflowed_lights
+            },
         };
+        let unlisted = a.unlisted.is_some();
         // A NaN budget (refused by the renderer) keeps every grid in.
         candidate.over_budget = candidate.assigns_over(inputs.base.assign_budget());
         // Past here finer grids only assign more than a coarser grid that kept within the CPU
@@ -121,8 +128,11 @@ impl ChoiceSearch {
         // Past here finer grids only rise further, or overflow the index list more (a per-cell
         // cap overflows less in finer cells, so overflow alone does not stop the search), or
         // pass the CPU budget (above).
-        self.done =
-            self.rises == 2 || overflow_grew || budget_passed || self.next == self.footprints.len();
+        self.done = self.rises == 2
+            || overflow_grew
+            || budget_passed
+            || unlisted
+            || self.next == self.footprints.len();
         self.done
     }
 

@@ -413,3 +413,37 @@ fn the_first_split_comes_from_the_nearest_surface() {
     assert_eq!(first_split(&samples, 10.0), None);
     assert_eq!(first_split(&SurfaceSamples::default(), 0.1), None);
 }
+
+/// A candidate too fine to list (`Assignment::unlisted`: more references than
+/// `max_untrimmed`) reports no overflow of its own and empty cells, which looked cheap: it
+/// must lose to a coarser grid that lists, even one that overflows the index list, and the
+/// search stops there (finer grids only list more).
+#[test]
+fn a_grid_too_fine_to_list_is_not_chosen() {
+    let (lights, samples) = workload(600);
+    let roomy = choose(
+        &inputs(&lights),
+        &samples,
+        &GridCosts::default(),
+        &mut Assigner::new(),
+    );
+    let coarsest = roomy.candidates[0].indices;
+    assert!(
+        roomy.candidates[1].indices > coarsest,
+        "{:?}",
+        roomy.candidates
+    );
+    let mut tight = inputs(&lights);
+    tight.limits.max_untrimmed = coarsest;
+    // The coarsest overflows too, so overflow alone does not decide against the finer one.
+    tight.limits.max_indices = coarsest / 2;
+    let choice = choose(
+        &tight,
+        &samples,
+        &GridCosts::default(),
+        &mut Assigner::new(),
+    );
+    assert_eq!(choice.config.footprint_px, CANDIDATE_FOOTPRINTS[0]);
+    assert_eq!(choice.candidates.len(), 2, "{:?}", choice.candidates);
+    assert!(choice.candidates[0].overflowed_lights > 0);
+}

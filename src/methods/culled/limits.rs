@@ -61,9 +61,15 @@ pub(super) fn check_grid(dev: &Device, grid: &ClusterGrid, footprint_px: f64) ->
 
 /// The error of a frame whose cells' lists would hold more references before the cell cap than
 /// an assignment builds (many lights overlapping on a fine fixed grid).
-pub(super) fn too_many_references(method: &str, cells: u32, references: usize) -> Error {
+pub(super) fn too_many_references(
+    method: &str,
+    cells: u32,
+    references: usize,
+    automatic: bool,
+) -> Error {
     let knob = match method {
         "tiled" => "a larger tile_px",
+        _ if automatic => "deeper slices (grid.slice_depth), the auto method (deferred past this)",
         _ => "a larger grid.footprint_px, deeper slices (grid.slice_depth) or the automatic grid",
     };
     Error::Limit(format!(

@@ -49,6 +49,9 @@ pub(crate) enum CulledFrame<'a> {
     Rendered(MethodStats<'a>),
     /// Not rendered: this many lights were visible, more than the index list can number.
     TooManyVisible(usize),
+    /// Not rendered: the grid's cells would list at least `references` light references
+    /// before the cell cap, more than an assignment builds.
+    Unlisted { cells: u32, references: usize },
 }
 
 /// Tiled or clustered forward.
@@ -98,7 +101,7 @@ impl CulledForward {
         let assigned = self.assign.run(method, grid, ctx, &limits);
         if let Some(references) = assigned.assignment.unlisted {
             let cells = grid.total_cells;
-            return Err(limits::too_many_references(method, cells, references));
+            return Ok(CulledFrame::Unlisted { cells, references });
         }
         let visible = assigned.assignment.visible.len();
         if visible > MAX_INDEXED_LIGHTS {
@@ -163,9 +166,13 @@ impl ShadingMethod for CulledForward {
 
     /// Renders one frame; more visible lights than the index list can number is an error.
     fn render(&mut self, ctx: &mut FrameContext) -> Result<MethodStats<'_>, Error> {
+        let (name, automatic) = (self.name(), self.automatic(ctx));
         match self.render_unless_too_many(ctx)? {
             CulledFrame::Rendered(stats) => Ok(stats),
             CulledFrame::TooManyVisible(visible) => Err(limits::too_many_visible(visible)),
+            CulledFrame::Unlisted { cells, references } => Err(limits::too_many_references(
+                name, cells, references, automatic,
+            )),
         }
     }
 

@@ -3,7 +3,7 @@
 
 use super::{number_listed, Band, CellsOut, MAX_BANDS};
 use crate::cluster::assign::index_list::EntriesMut;
-use crate::cluster::assign::types::{Assignment, Totals, MAX_UNTRIMMED_INDICES};
+use crate::cluster::assign::types::{Assignment, Tally, Totals};
 use crate::cluster::grid::ClusterGrid;
 use crate::cluster::view_light::GpuLight;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
@@ -22,9 +22,7 @@ use std::sync::{Mutex, MutexGuard};
 pub(super) fn assign_shared(
     bands: &mut [Band],
     workers: usize,
-    grid: &ClusterGrid,
-    lights: &[GpuLight],
-    camera_far: f64,
+    (grid, lights, camera_far, tally): (&ClusterGrid, &[GpuLight], f64, &Tally),
     out: &mut Assignment,
     numbers: &mut Vec<u32>,
 ) {
@@ -49,12 +47,13 @@ pub(super) fn assign_shared(
             let mut band = lock(&found[i]);
             band.as_mut()
                 .expect("phase 1's band")
-                .find(grid, lights, camera_far);
+                .find(grid, lights, camera_far, tally);
             drop(band);
             if find_done.fetch_add(1, Ordering::AcqRel) + 1 == n {
                 let (out, numbers) = lock(&between).take().expect("phase 2 runs once");
                 let taken = found.each_ref().map(|band| lock(band).take());
-                between_phases(taken, lights.len(), out, numbers, &scatters);
+                let limit = tally.limit;
+                between_phases(taken, (lights.len(), limit), out, numbers, &scatters);
                 scatter_open.store(true, Ordering::Release);
             }
         }
@@ -91,7 +90,7 @@ fn on_workers(count: usize, work: &(dyn Fn() + Sync)) {
 /// phase 3's jobs: each band's parts of the per-cell arrays and of the list, in `scatters`.
 fn between_phases<'a>(
     mut taken: [Option<&'a mut Band>; MAX_BANDS],
-    lights: usize,
+    (lights, limit): (usize, usize),
     out: &'a mut Assignment,
     numbers: &'a mut Vec<u32>,
     scatters: &[Mutex<Option<Scatter<'a>>>; MAX_BANDS],
@@ -103,7 +102,7 @@ fn between_phases<'a>(
         band.base = indices;
         indices += band.indices;
     }
-    if indices > MAX_UNTRIMMED_INDICES {
+    if indices > limit {
         // Not listed: phase 3 finds no band to scatter.
         out.unlisted = Some(indices);
         taken
