@@ -23,6 +23,11 @@ static WARNED: AtomicBool = AtomicBool::new(false);
 
 /// Which channels of `radiance` (red, green, blue) would show but its fp16 form loses.
 fn lost_channels(radiance: Vec3) -> [bool; 3] {
+    // Up to 16, k² ≤ 16 and a channel of 1/255 keeps 1/255 / 16 > 2⁻¹⁴: the cheap test that
+    // spares most lights the scaling, every frame on these devices.
+    if radiance.max_element() <= 16.0 {
+        return [false; 3];
+    }
     let (scaled, _) = fp16_radiance(radiance);
     [0, 1, 2].map(|c| radiance[c] >= VISIBLE && scaled[c] < FP16_MIN_NORMAL)
 }

@@ -5,8 +5,9 @@ use super::{shading, shown, Object, Scene};
 use std::path::Path;
 
 /// A model whose largest extent is at most this many times the distance the shaders leave
-/// out around a light ([`shading::LIGHT_MIN_DISTANCE`], 2⁻¹³) is warned of: a light near
-/// it leaves more than 1/64 of the model unlit. 2⁻⁷: about 8 mm, in metres.
+/// out around a light ([`shading::LIGHT_MIN_DISTANCE`], 2⁻¹³) is warned of when a light lies
+/// at it (within 2⁻¹³ of its bounds): that light leaves more than 1/64 of the model unlit.
+/// 2⁻⁷: about 8 mm, in metres.
 pub(crate) const TINY_MODEL_EXTENT: f64 = 64.0 * shading::LIGHT_MIN_DISTANCE;
 
 /// The warnings for `scene`, loaded from `path`.
@@ -36,10 +37,20 @@ pub(crate) fn warnings(scene: &Scene, path: &Path) -> Vec<String> {
             scene.lights.len()
         ));
     }
-    let extent = scene
-        .bounds()
-        .map_or(0.0, |b| (b.max - b.min).max_element());
-    if unlit < scene.lights.len() && extent > 0.0 && extent <= TINY_MODEL_EXTENT {
+    // A tiny model matters where a light that reaches further lies within 2⁻¹³ of it: a light
+    // a metre from a 5 mm model leaves out none of it.
+    let bounds = scene.bounds();
+    let extent = bounds.map_or(0.0, |b| (b.max - b.min).max_element());
+    let at_model = |l: &super::Light| {
+        bounds.is_some_and(|b| {
+            (l.position - b.min).min_element() >= -near
+                && (b.max - l.position).min_element() >= -near
+        })
+    };
+    let reaching = (scene.lights.iter().filter(shining))
+        .filter(|l| f64::from(l.radius) > near)
+        .any(at_model);
+    if reaching && extent > 0.0 && extent <= TINY_MODEL_EXTENT {
         warnings.push(format!(
             "{name}: the model is {extent:.3e} across, and the shaders leave out what lies \
              within 2⁻¹³ ({near:.3e}) of a light (above fp16's smallest normal, \
@@ -85,5 +96,26 @@ mod tests {
         assert!(!unlit_said(vec![light(0.0, 0.0, Vec3::ONE)]));
         assert!(!unlit_said(vec![light(0.0, 2.0, Vec3::ZERO)]));
         assert!(!unlit_said(vec![light(1.0, 2.0, Vec3::ONE)]));
+    }
+
+    /// A 5 mm model is said to be too small only where a light that reaches it lies at it.
+    #[test]
+    fn a_tiny_model_is_said_only_with_a_light_at_it() {
+        let tiny_said = |at: DVec3| {
+            let mut scene = crate::scene::builtin::build("plane", None).unwrap();
+            let b = scene.bounds().unwrap();
+            // Scaled about the origin to 5 mm across.
+            let scale = 5e-3 / (b.max - b.min).max_element();
+            for o in &mut scene.objects {
+                o.transform = glam::DMat4::from_scale(DVec3::splat(scale)) * o.transform;
+            }
+            let b = scene.bounds().unwrap();
+            let at = b.min + (b.max - b.min) * 0.5 + at;
+            scene.lights = vec![Light::point(at, 1.0, Vec3::ONE, 2.0)];
+            let said = warnings(&scene, Path::new("s.json"));
+            said.iter().any(|w| w.contains("the model is"))
+        };
+        assert!(tiny_said(DVec3::new(0.0, 1e-4, 0.0)));
+        assert!(!tiny_said(DVec3::new(0.0, 1.0, 0.0)));
     }
 }

@@ -377,7 +377,8 @@ fn own_stdout_named(path: &Path) -> Option<&'static File> {
 }
 
 /// Whether `path` names standard output: `-`, or one of the system's names for descriptor 1
-/// (see [`own_stdout_named`]) once [`keep_stdout_for_own_output`] has run.
+/// (`/dev/stdout`, `/dev/fd/1`, `/proc/self/fd/1`, or a link to one) once
+/// [`keep_stdout_for_own_output`] has run.
 pub fn names_stdout(path: &Path) -> bool {
     path == Path::new("-") || own_stdout_named(path).is_some()
 }

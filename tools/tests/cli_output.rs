@@ -201,6 +201,23 @@ fn a_picture_to_standard_output_is_the_png_alone() {
             "{picture}: {msg}"
         );
     }
+    // Standard output is no file of a recording's folder, even the current one.
+    let args = [
+        "--size", "16x9", "--frames", "1", "--record", ".", "--out", "-",
+    ];
+    let out = manylight(&args, &[], dir.path());
+    assert!(out.status.success(), "{}", text(&out));
+    assert!(
+        image::load_from_memory(&out.stdout).is_ok(),
+        "{}",
+        text(&out)
+    );
+    // `--stats /dev/stdout` is the JSON alone too, the summary line on standard error.
+    let args = ["--size", "16x9", "--out", "p.png", "--stats", "/dev/stdout"];
+    let out = manylight(&args, &[], dir.path());
+    assert!(out.status.success(), "{}", text(&out));
+    let json = serde_json::from_slice::<serde_json::Value>(&out.stdout);
+    assert!(json.is_ok(), "{json:?}: {}", text(&out));
 }
 
 /// `--frames 0` times no frame: the summary line said "ms/frame" of the one frame it rendered,

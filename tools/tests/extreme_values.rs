@@ -296,8 +296,8 @@ fn a_huge_timed_frame_count_is_refused_naming_the_field() {
 /// 1 100 lights all covering a plane, on a 1-px fixed grid: the cells' lists would hold some
 /// 5·10⁹ references before the cell cap, which the assignment allocated (an abort, 14 GB) or
 /// misnumbered past 2³² (a panic). Clustered refuses the frame naming the footprint, with no
-/// overflow warning for a frame it did not draw; the automatic grid draws it; tiled, whose
-/// tiles the lights cover too, draws it.
+/// overflow warning for a frame it did not draw; `auto` draws it with deferred; the automatic
+/// grid draws it; tiled, whose tiles the lights cover too, draws it.
 #[test]
 fn lights_overlapping_on_a_fine_fixed_grid_are_refused_naming_the_footprint() {
     common::warnings::install();
@@ -320,6 +320,17 @@ fn lights_overlapping_on_a_fine_fixed_grid_are_refused_naming_the_footprint() {
     );
     let dropped = common::warnings::warnings_containing("light references left out");
     assert!(dropped.is_empty(), "{dropped:?}");
+    // `auto` on the same grid draws the frame with deferred instead, as past clustered's
+    // index limit.
+    gpu.r().set_method_named("auto").unwrap();
+    let (_, stats) = gpu.r().render_offscreen(&s, 160, 90, &fine).unwrap();
+    assert_eq!(
+        stats.auto_choice.as_deref(),
+        Some("deferred"),
+        "{:?}",
+        stats.auto_reason
+    );
+    gpu.r().set_method_named("clustered").unwrap();
     let auto = gpu.render(&s, 16, 16, &RenderOptions::default());
     assert!(mean(&auto) > 0.0);
     gpu.r().set_method_named("tiled").unwrap();

@@ -55,16 +55,15 @@ pub fn unbounded_radius(peak: f64) -> f64 {
     (peak / UNBOUNDED_CUTOFF - 1.0).sqrt()
 }
 
-/// Why a light without a `range` whose brightest channel peaks at `peak` (renderer intensity,
-/// at most [`UNBOUNDED_CUTOFF`]) is left out: it would be cut off everywhere.
-fn too_dim(field: &str, peak: f64) -> String {
-    let candela = |x: f64| x / CANDELA_TO_INTENSITY;
+/// Why a light without a `range` whose brightest channel is at most [`UNBOUNDED_CUTOFF`] is
+/// left out: it would be cut off everywhere. The same words for every such light, so that a
+/// file of many is one warning (`ignored::once_per_feature`).
+fn too_dim(field: &str) -> String {
     format!(
-        "{field}: no `range`, and its brightest channel (colour × intensity, {:.3} cd) is at \
-         most the {:.3} cd where a light without a range is cut off (docs/gltf.md, \"Lights\"): \
-         it would light nothing, so it is left out; give it a `range` or more intensity to keep it",
-        candela(peak),
-        candela(UNBOUNDED_CUTOFF)
+        "{field}: no `range`, and its brightest channel (colour × intensity) is at most the \
+         {} cd where a light without a range is cut off (docs/gltf.md, \"Lights\"): it would \
+         light nothing, so it is left out; give it a `range` or more intensity to keep it",
+        UNBOUNDED_CUTOFF / CANDELA_TO_INTENSITY
     )
 }
 
@@ -179,7 +178,7 @@ pub(super) fn convert(
         None => {
             let peak = f64::from(color.max_element()) * f64::from(intensity);
             if peak > 0.0 && unbounded_radius(peak) == 0.0 {
-                return Ok(Converted::Skipped(too_dim(field, peak)));
+                return Ok(Converted::Skipped(too_dim(field)));
             }
             unbounded_radius(peak) as f32
         }

@@ -271,7 +271,12 @@ fn check_distinct_outputs(outputs: &[Option<(&str, &Path)>]) {
 /// naming both options.
 fn check_outside_folder(outputs: &[Option<(&str, &Path)>], (folder_option, folder): (&str, &Path)) {
     let folder_id = output::identity(folder);
-    for &(option, path) in outputs.iter().flatten() {
+    // Standard output (`-`, `/dev/stdout`) is no file of the folder's.
+    let files = outputs
+        .iter()
+        .flatten()
+        .filter(|(_, p)| !output::names_stdout(p));
+    for &(option, path) in files {
         if output::identity(path).parent() == Some(folder_id.as_path()) {
             Cli::command()
                 .error(

@@ -162,8 +162,9 @@ fn unused_grid_options(args: &RenderArgs, stats: &manylight::FrameStats) -> Opti
     .into_iter()
     .filter_map(|(flag, set)| set.then_some(flag))
     .collect();
-    let drawn = stats.auto_choice.as_deref().unwrap_or(&stats.method);
-    if given.is_empty() || drawn == "clustered" {
+    // `auto` may draw clustered in other frames than the last.
+    let drawn = &stats.method;
+    if given.is_empty() || drawn == "clustered" || drawn == "auto" {
         return None;
     }
     let tiles = match stats.grid.footprint_px {
@@ -273,8 +274,9 @@ pub fn run(args: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
     let out_file = out.map(OutputFile::create).transpose()?;
     let stats_out = args.stats.as_deref().map(JsonOut::create).transpose()?;
     // Standard output holds the statistics or the picture alone when one of them goes there.
-    let summary_to_stderr = stats_out.as_ref().is_some_and(JsonOut::is_stdout)
-        || out.is_some_and(manylight_tools::output::names_stdout);
+    let names_stdout = manylight_tools::output::names_stdout;
+    let summary_to_stderr =
+        args.stats.as_deref().is_some_and(names_stdout) || out.is_some_and(names_stdout);
     let es = args.es.into();
     let ctx = HeadlessContext::new(es)?;
     let restrictions = manylight::gl::Restrictions {
