@@ -153,8 +153,9 @@ impl Assigner {
     /// A grid of more than [`MAX_ASSIGN_CELLS`] cells is not assigned: its per-cell arrays
     /// would take gigabytes. The result then has no offsets, counts or indices,
     /// [`AssignStats::overflowed_lights`] counts every light once, and the first such call of
-    /// this assigner logs a warning. Lists that would hold more than [`MAX_UNTRIMMED_INDICES`]
-    /// references before the overflow policy are not built either: [`Assignment::unlisted`]
+    /// this assigner logs a warning. Lists that would hold more than `limits.max_untrimmed`
+    /// ([`MAX_UNTRIMMED_INDICES`] by default) references before the overflow policy are not
+    /// built either: [`Assignment::unlisted`]
     /// says so (the renderer refuses such a frame), every cell is empty and every visible
     /// light counts as overflowed.
     pub fn assign(

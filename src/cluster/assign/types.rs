@@ -175,7 +175,7 @@ pub struct Assignment {
     /// Figures.
     pub stats: AssignStats,
     /// `Some(n)`: the cells' lists would hold at least `n` references before the overflow
-    /// policy, more than [`MAX_UNTRIMMED_INDICES`], so none were listed (every cell is empty;
+    /// policy, more than [`AssignLimits::max_untrimmed`], so none were listed (every cell is empty;
     /// the lights found visible, which may stop short of all of them, count as overflowed).
     pub unlisted: Option<usize>,
 }
