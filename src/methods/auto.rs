@@ -159,55 +159,50 @@ impl ShadingMethod for Auto {
             let clustered = self
                 .clustered
                 .get_or_insert_with(|| CulledForward::new(Culling::Clustered));
-            match clustered.render_unless_too_many(ctx)? {
+            // Else forward this frame; clustered keeps its resources and tries again next
+            // frame (the visible lights change as they and the camera move).
+            let too_many = match clustered.render_unless_too_many(ctx)? {
                 CulledFrame::Rendered(mut stats) => {
                     self.forward.destroy(ctx.dev);
                     retire_deferred(&mut self.deferred, &mut self.deferred_idle, ctx.dev);
                     stats.auto_choice = Some((choice, &self.reason));
                     return Ok(stats);
                 }
-                // Forward this frame; clustered keeps its resources and tries again next frame
-                // (the visible lights change as they and the camera move).
-                refused @ (CulledFrame::TooManyVisible(_) | CulledFrame::Unlisted { .. }) => {
-                    let too_many = match refused {
-                        CulledFrame::Unlisted { references, .. } => format!(
-                            "{references} or more light references, more than clustered lists"
-                        ),
-                        CulledFrame::TooManyVisible(visible) => format!(
-                            "{visible} lights visible > {MAX_INDEXED_LIGHTS}, more than \
-                             clustered can index"
-                        ),
-                        CulledFrame::Rendered(_) => unreachable!("matched above"),
-                    };
-                    let refusal = deferred_refusal(ctx);
-                    let instead = if refusal.is_none() {
-                        "deferred"
-                    } else {
-                        "forward"
-                    };
-                    self.reason.clear();
-                    let _ = write!(self.reason, "{too_many}: {instead} renders this frame");
-                    if let Some(why) = refusal {
-                        let _ = write!(self.reason, " (deferred cannot: {why})");
-                    }
-                    if !self.warned_too_many {
-                        self.warned_too_many = true;
-                        log::warn!("auto: {}", self.reason);
-                    }
-                    let mut stats = if instead == "deferred" {
-                        self.forward.destroy(ctx.dev);
-                        self.deferred_idle = 0;
-                        self.deferred
-                            .get_or_insert_with(Deferred::default)
-                            .render(ctx)?
-                    } else {
-                        retire_deferred(&mut self.deferred, &mut self.deferred_idle, ctx.dev);
-                        self.forward.render(ctx)?
-                    };
-                    stats.auto_choice = Some((instead, &self.reason));
-                    return Ok(stats);
+                CulledFrame::TooManyVisible(visible) => format!(
+                    "{visible} lights visible > {MAX_INDEXED_LIGHTS}, more than clustered can \
+                     index"
+                ),
+                CulledFrame::Unlisted { references, .. } => {
+                    format!("{references} or more light references, more than clustered lists")
                 }
+            };
+            let refusal = deferred_refusal(ctx);
+            let instead = if refusal.is_none() {
+                "deferred"
+            } else {
+                "forward"
+            };
+            self.reason.clear();
+            let _ = write!(self.reason, "{too_many}: {instead} renders this frame");
+            if let Some(why) = refusal {
+                let _ = write!(self.reason, " (deferred cannot: {why})");
             }
+            if !self.warned_too_many {
+                self.warned_too_many = true;
+                log::warn!("auto: {}", self.reason);
+            }
+            let mut stats = if instead == "deferred" {
+                self.forward.destroy(ctx.dev);
+                self.deferred_idle = 0;
+                self.deferred
+                    .get_or_insert_with(Deferred::default)
+                    .render(ctx)?
+            } else {
+                retire_deferred(&mut self.deferred, &mut self.deferred_idle, ctx.dev);
+                self.forward.render(ctx)?
+            };
+            stats.auto_choice = Some((instead, &self.reason));
+            return Ok(stats);
         }
         if let Some(mut c) = self.clustered.take() {
             c.destroy(ctx.dev);

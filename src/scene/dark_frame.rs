@@ -40,7 +40,7 @@ pub(crate) fn warnings(scene: &Scene, path: &Path) -> Vec<String> {
     // A tiny model matters where a light that reaches further lies within 2⁻¹³ of it: a light
     // a metre from a 5 mm model leaves out none of it.
     let bounds = scene.bounds();
-    let extent = bounds.map_or(0.0, |b| (b.max - b.min).max_element());
+    let extent = bounds.map_or(0.0, |b| b.size().max_element());
     let at_model = |l: &super::Light| {
         bounds.is_some_and(|b| {
             (l.position - b.min).min_element() >= -near
@@ -105,12 +105,11 @@ mod tests {
             let mut scene = crate::scene::builtin::build("plane", None).unwrap();
             let b = scene.bounds().unwrap();
             // Scaled about the origin to 5 mm across.
-            let scale = 5e-3 / (b.max - b.min).max_element();
+            let scale = 5e-3 / b.size().max_element();
             for o in &mut scene.objects {
                 o.transform = glam::DMat4::from_scale(DVec3::splat(scale)) * o.transform;
             }
-            let b = scene.bounds().unwrap();
-            let at = b.min + (b.max - b.min) * 0.5 + at;
+            let at = scene.bounds().unwrap().center() + at;
             scene.lights = vec![Light::point(at, 1.0, Vec3::ONE, 2.0)];
             let said = warnings(&scene, Path::new("s.json"));
             said.iter().any(|w| w.contains("the model is"))

@@ -195,11 +195,7 @@ impl Assigner {
             return &self.out;
         }
         if lights.is_empty() {
-            out.indices.clear();
-            out.offsets.clear();
-            out.offsets.resize(cells, 0);
-            out.counts.clear();
-            out.counts.resize(cells, 0);
+            out.empty_lists(cells);
             return &self.out;
         }
         let started = std::time::Instant::now();
@@ -246,11 +242,7 @@ impl Assigner {
             // Nothing listed: empty cells, every visible light overflowed.
             self.bands.release_runs();
             self.chunks.release_runs();
-            out.indices.clear();
-            out.counts.clear();
-            out.counts.resize(cells, 0);
-            out.offsets.clear();
-            out.offsets.resize(cells, 0);
+            out.empty_lists(cells);
             out.stats.visible_lights = out.visible.len();
             out.stats.overflowed_lights = out.visible.len() as u64;
             out.stats.threads = threads;

@@ -180,6 +180,17 @@ pub struct Assignment {
     pub unlisted: Option<usize>,
 }
 
+impl Assignment {
+    /// No lists: every one of `cells` cells empty (offsets and counts 0), no indices.
+    pub(super) fn empty_lists(&mut self, cells: usize) {
+        self.indices.clear();
+        self.offsets.clear();
+        self.offsets.resize(cells, 0);
+        self.counts.clear();
+        self.counts.resize(cells, 0);
+    }
+}
+
 /// Consecutive cells one light touches (numbered from its band's first cell in a band).
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Run {
