@@ -60,6 +60,16 @@ fn inputs(lights: &[GpuLight]) -> ChoiceInputs<'_> {
     }
 }
 
+/// The choice for `lights` under the default limits and costs: what a test then tightens.
+fn roomy_choice(lights: &[GpuLight], samples: &SurfaceSamples) -> GridChoice {
+    choose(
+        &inputs(lights),
+        samples,
+        &GridCosts::default(),
+        &mut Assigner::new(),
+    )
+}
+
 /// A framebuffer whose every standard candidate passes the cell budget still gets a grid:
 /// a coarser one.
 #[test]
@@ -379,12 +389,7 @@ fn overflow_outranks_the_cpu_budget() {
 #[test]
 fn a_grid_that_overflows_is_not_chosen() {
     let (lights, samples) = workload(600);
-    let roomy = choose(
-        &inputs(&lights),
-        &samples,
-        &GridCosts::default(),
-        &mut Assigner::new(),
-    );
+    let roomy = roomy_choice(&lights, &samples);
     let coarsest = roomy.candidates[0].indices;
     let mut tight = inputs(&lights);
     tight.limits.max_indices = coarsest + 1;
@@ -421,12 +426,7 @@ fn the_first_split_comes_from_the_nearest_surface() {
 #[test]
 fn a_grid_too_fine_to_list_is_not_chosen() {
     let (lights, samples) = workload(600);
-    let roomy = choose(
-        &inputs(&lights),
-        &samples,
-        &GridCosts::default(),
-        &mut Assigner::new(),
-    );
+    let roomy = roomy_choice(&lights, &samples);
     let coarsest = roomy.candidates[0].indices;
     assert!(
         roomy.candidates[1].indices > coarsest,
