@@ -47,7 +47,7 @@ vec3 linearToSrgb(vec3 c) {
 // A uniform rather than glFrontFace: SwiftShader's gl_FrontFacing ignores glFrontFace.
 uniform float u_frontSign;
 
-// The shading normal of the side the eye sees (surfaces are two-sided): the interpolated unit
+// The shading normal of the side the eye sees (a single-sided surface's back is culled): the interpolated unit
 // normal N, normal-mapped in its own tangent frame, then reversed whole on a back face (glTF
 // 2.0 §3.9.5). The side is the winding's (meshes are wound towards their normals): turned by
 // N · V instead, a front face's normal leaning away near a silhouette lit it from behind.

@@ -36,7 +36,7 @@ pub enum DepthTest {
 /// Face culling.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Cull {
-    /// Draw both sides (every surface is two-sided).
+    /// Draw both sides.
     None,
     /// Cull back faces.
     Back,
@@ -164,7 +164,28 @@ impl RenderState {
                     );
                 }
             }
-            match self.cull {
+        }
+        self.cull.apply(dev);
+    }
+}
+
+impl Cull {
+    /// What a surface drawn from `double_sided` (else its front only) takes, placed by a
+    /// transform that is `mirrored` or not: the glTF front is counter-clockwise on screen,
+    /// clockwise under a mirroring transform (GL's back face, so its front is culled then).
+    pub fn for_surface(double_sided: bool, mirrored: bool) -> Cull {
+        match (double_sided, mirrored) {
+            (true, _) => Cull::None,
+            (false, false) => Cull::Back,
+            (false, true) => Cull::Front,
+        }
+    }
+
+    /// Sets culling alone (a pass's objects differ only in it).
+    pub fn apply(self, dev: &Device) {
+        let gl = &dev.gl;
+        unsafe {
+            match self {
                 Cull::None => gl.disable(glow::CULL_FACE),
                 Cull::Back => {
                     gl.enable(glow::CULL_FACE);

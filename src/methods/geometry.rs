@@ -5,8 +5,9 @@ use super::directional::DirectionalUniforms;
 use super::uniforms::{is_mirroring, Surface, SurfaceFrame, Transforms};
 use super::{FrameContext, ShaderFeatures};
 use crate::gl::program::{ProgramKey, Resolver, UniformSet};
-use crate::gl::state::RenderState;
+use crate::gl::state::{Cull, RenderState};
 use crate::gl::Device;
+use crate::scene::Scene;
 use crate::Error;
 
 /// Texture unit of the diffuse map.
@@ -107,7 +108,9 @@ fn depth_prepass(ctx: &mut FrameContext) -> Result<(), Error> {
     let DepthProgram(transforms) = ctx.programs.bind::<DepthProgram>(dev, key, Vec::new)?;
     for &i in &ctx.order.opaque[..ctx.order.cut_out_from] {
         let (mesh, model) = ctx.gpu_scene.drawn(i, &ctx.scene.objects[i]);
-        transforms.set(dev, &(ctx.view * model), &ctx.projection);
+        let view_model = ctx.view * model;
+        object_cull(ctx.scene, i, &view_model).apply(dev);
+        transforms.set(dev, &view_model, &ctx.projection);
         mesh.draw(dev);
     }
     Ok(())
@@ -137,6 +140,7 @@ pub fn draw_objects<P: GeometryProgram>(
             state.apply(ctx.dev);
         }
         let i = ctx.order.opaque[k];
+        cull_object(ctx, i);
         shade_object(ctx, i, shader, max_lights, bind_method)?;
     }
     // Counts are of the visible opaque surface: blending would mix two counts in 8 bits.
@@ -157,13 +161,30 @@ pub fn draw_objects<P: GeometryProgram>(
         if is_mirroring(&(ctx.view * model)) {
             passes.reverse();
         }
-        for state in passes {
+        // A single-sided surface has its front only: the second pass.
+        let double_sided = ctx.scene.materials[ctx.scene.objects[i].material].double_sided;
+        let first = if double_sided { 0 } else { 1 };
+        for state in &passes[first..] {
             state.apply(ctx.dev);
             shade_object(ctx, i, shader, max_lights, bind_method)?;
         }
     }
     crate::gl::device::gl_check!(ctx.dev, "geometry pass");
     Ok(())
+}
+
+/// Culls object `i`'s back faces when its material is single-sided, else draws both sides:
+/// before each opaque draw (the depth prepass, the shading pass, deferred's G-buffer), so
+/// every pass covers the same pixels.
+pub(crate) fn cull_object(ctx: &FrameContext, i: usize) {
+    let (_, model) = ctx.gpu_scene.drawn(i, &ctx.scene.objects[i]);
+    object_cull(ctx.scene, i, &(ctx.view * model)).apply(ctx.dev);
+}
+
+/// The culling of `scene`'s object `i` placed in view space by `view_model`.
+fn object_cull(scene: &Scene, i: usize, view_model: &glam::DMat4) -> Cull {
+    let double_sided = scene.materials[scene.objects[i].material].double_sided;
+    Cull::for_surface(double_sided, is_mirroring(view_model))
 }
 
 /// One object with its material's shader variant.

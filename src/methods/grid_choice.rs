@@ -28,8 +28,9 @@ const RECHOOSE_PERIOD: u32 = 240;
 /// new grid (its buffers growing, its pool threads waking).
 const FIRST_CALIBRATED_CHOICE: u32 = 8;
 
-/// The scene's geometry by identity: each object's mesh and transform bits.
-type GeometryKey = Vec<(usize, [u64; 16])>;
+/// The scene's geometry by identity: each object's mesh, transform bits and whether its
+/// material is double-sided (the caster hits a single-sided one's front only).
+type GeometryKey = Vec<(usize, [u64; 16], bool)>;
 
 /// What makes the current choice stale at once.
 #[derive(Clone, Debug, PartialEq)]
@@ -262,10 +263,14 @@ impl AutoGrid {
             (
                 std::sync::Arc::as_ptr(&o.mesh) as usize,
                 o.transform.to_cols_array().map(f64::to_bits),
+                scene
+                    .materials
+                    .get(o.material)
+                    .is_some_and(|m| m.double_sided),
             )
         };
-        // The caster is rebuilt only when the geometry changed (compared without collecting
-        // a key, which would allocate every re-choice).
+        // The caster is rebuilt only when the geometry or a surface's sides changed (compared
+        // without collecting a key, which would allocate every re-choice).
         let same_geometry = self.caster.as_ref().is_some_and(|(key, _)| {
             key.len() == scene.objects.len()
                 && key

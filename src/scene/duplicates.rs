@@ -1,6 +1,7 @@
 //! Exact duplicate triangles: the same three corners (position, normal and texture coordinate
-//! alike) as an earlier triangle of the mesh, in any rotation or winding. On an opaque surface
-//! drawn two-sided they add nothing to the picture, only overdraw (a 16 MB OBJ can repeat one
+//! alike) as an earlier triangle of the mesh, in any rotation or winding (in any rotation
+//! alone on a single-sided surface, whose two windings are its two sides). On an opaque
+//! surface they add nothing to the picture, only overdraw (a 16 MB OBJ can repeat one
 //! triangle 2 M times). Transparent surfaces keep them (each copy blends once more).
 
 use super::{Material, Mesh};
@@ -19,7 +20,7 @@ pub fn drop_from_opaque(
     if material.is_transparent() {
         return (mesh, None);
     }
-    let dropped = drop_duplicate_triangles(&mut mesh);
+    let dropped = drop_duplicate_triangles(&mut mesh, material.double_sided);
     let warning = (dropped > 0).then(|| {
         format!(
             "{}: {dropped} duplicate triangles dropped (the same corners as an earlier one; \
@@ -30,9 +31,10 @@ pub fn drop_from_opaque(
     (mesh, warning)
 }
 
-/// Drops every triangle whose corners equal an earlier one's, keeping the order of the rest;
-/// returns how many were dropped. Needs 16 bytes a triangle of scratch.
-pub fn drop_duplicate_triangles(mesh: &mut Mesh) -> usize {
+/// Drops every triangle whose corners equal an earlier one's (in the same winding unless
+/// `double_sided`), keeping the order of the rest; returns how many were dropped. Needs 16
+/// bytes a triangle of scratch.
+pub fn drop_duplicate_triangles(mesh: &mut Mesh, double_sided: bool) -> usize {
     let triangles = mesh.triangle_count();
     if triangles < 2 {
         return 0;
@@ -41,7 +43,7 @@ pub fn drop_duplicate_triangles(mesh: &mut Mesh) -> usize {
     use std::hash::BuildHasher;
     let state = std::collections::hash_map::RandomState::new();
     let mut keyed: Vec<(u64, u32)> = (0..triangles as u32)
-        .map(|t| (state.hash_one(canonical(mesh, t)), t))
+        .map(|t| (state.hash_one(canonical(mesh, t, double_sided)), t))
         .collect();
     keyed.sort_unstable();
     let mut dropped = vec![false; triangles];
@@ -50,7 +52,7 @@ pub fn drop_duplicate_triangles(mesh: &mut Mesh) -> usize {
     for run in keyed.chunk_by(|a, b| a.0 == b.0) {
         kept.clear();
         for &(_, t) in run {
-            let corners = canonical(mesh, t);
+            let corners = canonical(mesh, t, double_sided);
             if kept.contains(&corners) {
                 dropped[t as usize] = true;
             } else {
@@ -71,9 +73,10 @@ pub fn drop_duplicate_triangles(mesh: &mut Mesh) -> usize {
     count
 }
 
-/// The triangle's corners, rotated and mirrored to the smallest of its six orders, so equal
-/// triangles compare equal whichever corner and winding they start with.
-fn canonical(mesh: &Mesh, triangle: u32) -> [Corner; 3] {
+/// The triangle's corners, rotated (and with `any_winding` mirrored) to the smallest of its
+/// three (six) orders, so equal triangles compare equal whichever corner (and winding) they
+/// start with.
+fn canonical(mesh: &Mesh, triangle: u32, any_winding: bool) -> [Corner; 3] {
     let i = 3 * triangle as usize;
     let corner = |k: usize| -> Corner {
         let v = mesh.indices[i + k] as usize;
@@ -88,17 +91,20 @@ fn canonical(mesh: &Mesh, triangle: u32) -> [Corner; 3] {
         .map(f32::to_bits)
     };
     let [a, b, c] = [corner(0), corner(1), corner(2)];
-    [
+    let orders = [
         [a, b, c],
         [b, c, a],
         [c, a, b],
         [a, c, b],
         [c, b, a],
         [b, a, c],
-    ]
-    .into_iter()
-    .min()
-    .expect("six orders")
+    ];
+    let orders = if any_winding {
+        &orders[..]
+    } else {
+        &orders[..3]
+    };
+    orders.iter().copied().min().expect("three orders")
 }
 
 #[cfg(test)]
@@ -127,15 +133,20 @@ mod tests {
             3, 2, 1, // kept
         ];
         // Built as a struct: `Mesh::new` would wind each triangle towards its normals.
-        let mut mesh = Mesh {
+        let mesh = Mesh {
             positions: p,
             normals,
             indices,
             ..Mesh::default()
         };
-        assert_eq!(drop_duplicate_triangles(&mut mesh), 4);
-        assert_eq!(mesh.indices, [0, 1, 2, 0, 3, 1, 3, 2, 1]);
-        assert_eq!(drop_duplicate_triangles(&mut mesh), 0);
+        let mut both = mesh.clone();
+        assert_eq!(drop_duplicate_triangles(&mut both, true), 4);
+        assert_eq!(both.indices, [0, 1, 2, 0, 3, 1, 3, 2, 1]);
+        assert_eq!(drop_duplicate_triangles(&mut both, true), 0);
+        // Single-sided: a reversed copy is the other side, and stays.
+        let mut front = mesh;
+        assert_eq!(drop_duplicate_triangles(&mut front, false), 2);
+        assert_eq!(front.indices, [0, 1, 2, 0, 3, 1, 2, 1, 0, 0, 1, 3, 3, 2, 1]);
     }
 
     #[test]
@@ -143,7 +154,7 @@ mod tests {
         let p = vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::ZERO];
         let normals = vec![Vec3::Z, Vec3::Z, Vec3::Z, Vec3::X];
         let mut mesh = Mesh::new(p, normals, vec![], vec![0, 1, 2, 3, 1, 2]).unwrap();
-        assert_eq!(drop_duplicate_triangles(&mut mesh), 0);
+        assert_eq!(drop_duplicate_triangles(&mut mesh, true), 0);
         let uvs = vec![
             glam::Vec2::ZERO,
             glam::Vec2::X,
@@ -152,6 +163,6 @@ mod tests {
         ];
         let p = vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::ZERO];
         let mut mesh = Mesh::new(p, vec![Vec3::Z; 4], uvs, vec![0, 1, 2, 3, 1, 2]).unwrap();
-        assert_eq!(drop_duplicate_triangles(&mut mesh), 0);
+        assert_eq!(drop_duplicate_triangles(&mut mesh, true), 0);
     }
 }

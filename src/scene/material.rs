@@ -63,6 +63,12 @@ pub struct Material {
     /// Normal, emissive, occlusion and metallic-roughness inputs and texture transforms
     /// (glTF; defaults for OBJ and built-in materials).
     pub maps: SurfaceMaps,
+    /// Drawn from both sides, a back face with its normals reversed (OBJ, scene files and
+    /// built-in materials, glTF `doubleSided: true`); `false` draws only the side the
+    /// triangles' winding faces (counter-clockwise, clockwise under a mirroring transform), as
+    /// glTF's default `doubleSided: false` asks: a back face is culled, and what lies behind
+    /// it shows.
+    pub double_sided: bool,
 }
 
 impl Default for Material {
@@ -94,6 +100,7 @@ impl Material {
             metallic: 0.0,
             roughness: 1.0,
             maps: SurfaceMaps::default(),
+            double_sided: true,
         }
     }
 

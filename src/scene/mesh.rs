@@ -127,6 +127,29 @@ impl Mesh {
         uvs: Vec<Vec2>,
         indices: Vec<u32>,
     ) -> Result<Mesh, SceneError> {
+        Self::checked(positions, normals, uvs, indices, false)
+    }
+
+    /// [`Mesh::new`] keeping every triangle wound as listed, for a single-sided surface, whose
+    /// front is its winding's side (glTF `doubleSided: false`): missing normals are the faces'
+    /// (area-weighted, no triangle turned to agree with its neighbours), and given ones turn
+    /// no triangle round (a front face whose normals point away is lit from behind).
+    pub fn new_as_wound(
+        positions: Vec<Vec3>,
+        normals: Vec<Vec3>,
+        uvs: Vec<Vec2>,
+        indices: Vec<u32>,
+    ) -> Result<Mesh, SceneError> {
+        Self::checked(positions, normals, uvs, indices, true)
+    }
+
+    fn checked(
+        positions: Vec<Vec3>,
+        normals: Vec<Vec3>,
+        uvs: Vec<Vec2>,
+        indices: Vec<u32>,
+        as_wound: bool,
+    ) -> Result<Mesh, SceneError> {
         let mut indices = indices;
         let n = positions.len();
         check_indices(&indices, n, "mesh.indices")?;
@@ -169,8 +192,12 @@ impl Mesh {
         }
         let normals = if normals.len() == n {
             let normals = repair_normals(normals, &positions, &indices);
-            wind_to_normals(&positions, &normals, &mut indices);
+            if !as_wound {
+                wind_to_normals(&positions, &normals, &mut indices);
+            }
             normals
+        } else if as_wound {
+            compute_normals(&positions, &indices)
         } else {
             consistent_face_normals(&positions, &mut indices)
         };
@@ -519,6 +546,27 @@ mod tests {
         for w in windings(&m) {
             assert!(w.z < 0.0, "{w}");
         }
+    }
+
+    #[test]
+    fn a_single_sided_mesh_keeps_every_winding_as_listed() {
+        // The two triangles of `triangles_are_wound_towards_their_normals`, wound oppositely.
+        let positions = vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::new(1.0, 1.0, 0.0)];
+        let listed = vec![0, 1, 2, 1, 2, 3];
+        let m = Mesh::new_as_wound(positions.clone(), vec![Vec3::Z; 4], vec![], listed.clone())
+            .unwrap();
+        assert_eq!(m.indices, listed, "normals turn no triangle round");
+        assert_eq!(m.normals, vec![Vec3::Z; 4]);
+        // Without normals (vertices unshared, as glTF's flat case makes them): each face's
+        // own, no triangle turned to agree with its neighbour across their common edge.
+        let mut unshared = positions.clone();
+        unshared.extend([Vec3::X, Vec3::Y, Vec3::new(1.0, 1.0, 0.0)]);
+        let m = Mesh::new_as_wound(unshared, vec![], vec![], vec![0, 1, 2, 4, 5, 6]).unwrap();
+        assert_eq!(m.indices, [0, 1, 2, 4, 5, 6]);
+        assert_eq!(m.normals[0], Vec3::Z);
+        assert_eq!(m.normals[4], -Vec3::Z);
+        let w = windings(&m);
+        assert!(w[0].z > 0.0 && w[1].z < 0.0, "{w:?}");
     }
 
     #[test]

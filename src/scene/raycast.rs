@@ -8,8 +8,9 @@
 //! a placement costs a few hundred bytes whatever its mesh. A transform without a usable
 //! inverse (flattened to a plane) is traced in world space instead, its triangles carried
 //! through the transform as they are tested. The ray test is Möller–Trumbore with both faces
-//! accepted (the renderer draws surfaces two-sided, [`Hit::face`] tells which); `t` is the world ray's parameter in
-//! either space, since an affine map keeps it.
+//! accepted on a double-sided material ([`Hit::face`] tells which) and the front alone on a
+//! single-sided one, as the renderer culls them; `t` is the world ray's parameter in either
+//! space, since an affine map keeps it.
 
 mod bvh;
 
@@ -75,6 +76,23 @@ struct Instance {
     to_object: Option<DMat4>,
     mesh: u32,
     object: u32,
+    /// Its material is single-sided: only its front faces are surfaces.
+    front_only: bool,
+    /// `to_world` mirrors, which turns the placed winding round.
+    mirrored: bool,
+}
+
+impl Instance {
+    /// The sign of a hit's winding (Möller–Trumbore's determinant) that is a surface in
+    /// `frame`: `None` for both (double-sided). In object space the front is the positive
+    /// one; carried into world space by a mirroring transform it turns negative.
+    fn front_sign(&self, frame: &Frame) -> Option<bool> {
+        let positive = match frame {
+            Frame::Object { .. } => true,
+            Frame::World { .. } => !self.mirrored,
+        };
+        self.front_only.then_some(positive)
+    }
 }
 
 /// Per-thread traversal stacks (top level, mesh level): the automatic grid casts rays during
@@ -169,11 +187,14 @@ impl SceneRaycaster {
                 continue; // a scene that validates has finite transforms
             }
             boxes.push(world);
+            let material = scene.materials.get(o.material);
             instances.push(Instance {
                 to_world: o.transform,
                 to_object: usable_inverse(&o.transform),
                 mesh,
                 object: object as u32,
+                front_only: material.is_some_and(|m| !m.double_sided),
+                mirrored: super::normal_matrix::mirrors(&DMat3::from_mat4(o.transform)),
             });
         }
         let (nodes, order) = bvh::build(&boxes);
@@ -219,7 +240,8 @@ impl SceneRaycaster {
             + self.nodes.capacity() * size_of::<Node>()
     }
 
-    /// Nearest surface along `origin + t·dir` with `t > 0`, either face.
+    /// Nearest surface along `origin + t·dir` with `t > 0` (either face of a double-sided
+    /// material).
     pub fn hit(&self, origin: DVec3, dir: DVec3) -> Option<Hit> {
         self.first_opaque_hit(origin, dir, f64::INFINITY, |_| true)
             .hit
@@ -264,7 +286,8 @@ impl SceneRaycaster {
                         },
                     };
                     let mesh = &self.meshes[instance.mesh as usize];
-                    mesh.search(&frame, &mut inner, s, |s, t, u, v, triangle| {
+                    let front = instance.front_sign(&frame);
+                    mesh.search(&frame, front, &mut inner, s, |s, t, u, v, triangle| {
                         if !opaque {
                             if t <= s.best_t {
                                 s.transparent_t = s.transparent_t.min(t);
@@ -364,10 +387,12 @@ impl MeshBvh {
     }
 
     /// Tests the ray against every triangle whose boxes it reaches, calling `found` with
-    /// `(t, u, v, triangle)` for each hit within the search's reach.
+    /// `(t, u, v, triangle)` for each hit within the search's reach whose winding's sign is
+    /// `front` (any with `None`).
     fn search(
         &self,
         frame: &Frame,
+        front: Option<bool>,
         stack: &mut Vec<u32>,
         s: &mut Search,
         mut found: impl FnMut(&mut Search, f64, f64, f64, u32),
@@ -396,8 +421,8 @@ impl MeshBvh {
             },
             |s, range| {
                 for &triangle in &self.order[range] {
-                    if let Some((t, u, v)) = intersect(vertices(triangle), origin, dir) {
-                        if t <= s.reach() {
+                    if let Some((t, u, v, positive)) = intersect(vertices(triangle), origin, dir) {
+                        if t <= s.reach() && front.is_none_or(|f| f == positive) {
                             found(s, t, u, v, triangle);
                         }
                     }
@@ -424,9 +449,10 @@ fn usable_inverse(m: &DMat4) -> Option<DMat4> {
     (det.abs() > 1e-9 * columns && columns.is_finite() && inverse.is_finite()).then_some(inverse)
 }
 
-/// Möller–Trumbore, both faces: `(t, u, v)` with `t > 0`, the hit at
-/// `(1 − u − v)·v0 + u·v1 + v·v2`.
-fn intersect([v0, v1, v2]: [DVec3; 3], origin: DVec3, dir: DVec3) -> Option<(f64, f64, f64)> {
+/// Möller–Trumbore, both faces: `(t, u, v, positive)` with `t > 0`, the hit at
+/// `(1 − u − v)·v0 + u·v1 + v·v2`; `positive` when the ray meets the side the winding faces
+/// (counter-clockwise seen from the origin).
+fn intersect([v0, v1, v2]: [DVec3; 3], origin: DVec3, dir: DVec3) -> Option<(f64, f64, f64, bool)> {
     let (e1, e2) = (v1 - v0, v2 - v0);
     let p = dir.cross(e2);
     let det = e1.dot(p);
@@ -445,7 +471,7 @@ fn intersect([v0, v1, v2]: [DVec3; 3], origin: DVec3, dir: DVec3) -> Option<(f64
         return None;
     }
     let t = e2.dot(q) * inv;
-    (t > 0.0).then_some((t, u, v))
+    (t > 0.0).then_some((t, u, v, det > 0.0))
 }
 
 /// World-space ray `(origin, unit direction)` through window position (`px`, `py`) in pixels

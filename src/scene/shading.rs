@@ -17,8 +17,9 @@
 //! That is the Blinn-Phong model; a metallic-roughness material replaces `diffuse + specular`
 //! with the glTF BRDF times π·N·L ([`super::brdf::reflectance`]); `albedo` is its base colour.
 //!
-//! Surfaces are two-sided: a back face is shaded with its normals reversed ([`seen_side`]),
-//! a front face with them as they are, even where one leans away from the eye. In view space, `V` is
+//! A double-sided surface's back face is shaded with its normals reversed ([`seen_side`]),
+//! a front face with them as they are, even where one leans away from the eye (a
+//! single-sided surface has no back face: it is culled). In view space, `V` is
 //! `normalize(−P)` for perspective cameras and `+Z` for orthographic ones.
 //!
 //! The shaders compute the same quantities in forms that survive fp16 (the distance as

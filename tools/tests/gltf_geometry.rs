@@ -308,8 +308,9 @@ fn a_primitive_without_normals_ignores_its_tangents() {
 }
 
 /// A primitive listing one triangle over and over (through its indices, in either winding)
-/// keeps one copy with a warning counting the rest; a copy whose colour differs stays, and a
-/// blended surface keeps every copy (they blend).
+/// keeps one copy with a warning counting the rest (one of each winding when single-sided:
+/// the two windings are its two sides); a copy whose colour differs stays, and a blended
+/// surface keeps every copy (they blend).
 #[test]
 fn duplicate_triangles_are_dropped_from_opaque_primitives_only() {
     let dir = tempfile::tempdir().unwrap();
@@ -329,17 +330,32 @@ fn duplicate_triangles_are_dropped_from_opaque_primitives_only() {
         .collect();
     indices.extend([3, 1, 2]);
     let i = b.u16s(&indices);
-    for (mode, kept) in [("OPAQUE", 2), ("BLEND", 1001)] {
+    let cases = [
+        ("OPAQUE", true, 2, Some(999)),
+        ("OPAQUE", false, 3, Some(998)),
+        ("BLEND", false, 1001, None),
+    ];
+    for (mode, double_sided, kept, dropped) in cases {
         let rest = json!({"scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
-            "materials": [{"alphaMode": mode}],
+            "materials": [{"alphaMode": mode, "doubleSided": double_sided}],
             "meshes": [{"primitives": [{"attributes": {"POSITION": p, "NORMAL": n, "COLOR_0": c},
                 "indices": i, "material": 0}]}]});
         let (scene, report) = load(&write(dir.path(), "dup.gltf", b.gltf(rest))).unwrap();
-        assert_eq!(scene.objects[0].mesh.triangle_count(), kept, "{mode}");
+        let what = format!("{mode}, doubleSided {double_sided}");
+        assert_eq!(scene.objects[0].mesh.triangle_count(), kept, "{what}");
         let warned = report
             .warnings
             .iter()
-            .any(|w| w.contains("999 duplicate triangles"));
-        assert_eq!(warned, mode == "OPAQUE", "{mode}: {:?}", report.warnings);
+            .find(|w| w.contains("duplicate triangles"));
+        let said = dropped.map(|n| format!("{n} duplicate triangles"));
+        assert_eq!(
+            warned.is_some(),
+            said.is_some(),
+            "{what}: {:?}",
+            report.warnings
+        );
+        if let (Some(w), Some(said)) = (warned, said) {
+            assert!(w.contains(&said), "{what}: {w}");
+        }
     }
 }

@@ -139,10 +139,12 @@ fn a_normal_map_tilts_the_shading_normal_with_file_and_generated_tangents() {
     // does the twin here).
     let down = [60u8, 215, 200, 255];
     let up = [60u8, 40, 200, 255];
+    // Double-sided: the plane is also seen from behind (below).
     let material = json!({
         "pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.7, 0.6, 1.0], "roughnessFactor": 1.0,
                                  "metallicFactor": 0.0},
         "normalTexture": {"index": 0, "scale": 0.8},
+        "doubleSided": true,
     });
     let mut plane = Plane::new(material);
     plane.images.push(png(1, 1, &[up]));

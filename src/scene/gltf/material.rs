@@ -19,8 +19,9 @@
 //!   `baseColorFactor.a` is below `alphaCutoff` — and else, with a base colour texture or
 //!   such vertex colours, each fragment whose texture alpha times vertex alpha times that
 //!   factor is below it ([`Material::alpha_cutoff`]: leaves, fences).
-//! - `doubleSided`: the renderer draws every surface from both sides (no culling, a back face
-//!   with its normals reversed), so `doubleSided: false` surfaces are visible from behind too.
+//! - `doubleSided` → [`Material::double_sided`]: `true` draws both sides (a back face with its
+//!   normals reversed); `false`, glTF's default and the default material's, culls back faces
+//!   (the winding's, turned round under a mirroring transform).
 
 use std::collections::HashMap;
 use std::path::Path;
@@ -283,6 +284,7 @@ impl Materials {
             alpha_cutoff,
             alpha_texture,
             maps,
+            double_sided: m.double_sided(),
             ..Material::metallic_roughness(
                 &name,
                 diffuse,

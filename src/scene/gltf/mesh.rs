@@ -201,8 +201,14 @@ pub(super) fn build(
     } else {
         (positions, uvs, indices)
     };
-    let mut mesh =
-        Mesh::new(positions, normals, uvs, indices).map_err(|e| format!("{field}: {e}"))?;
+    // A single-sided surface's front is its winding's side: kept as listed.
+    let double_sided = p.material().double_sided();
+    let mesh = if double_sided {
+        Mesh::new(positions, normals, uvs, indices)
+    } else {
+        Mesh::new_as_wound(positions, normals, uvs, indices)
+    };
+    let mut mesh = mesh.map_err(|e| format!("{field}: {e}"))?;
     if !colors.is_empty() {
         mesh = mesh
             .with_colors(colors)
@@ -237,7 +243,7 @@ pub(super) fn build(
     // Exact copies of a triangle add only overdraw (a file listing one a million times took
     // seconds a frame); a blended surface keeps them, as its copies do blend.
     if p.material().alpha_mode() != gltf::material::AlphaMode::Blend {
-        let dropped = crate::scene::duplicates::drop_duplicate_triangles(&mut mesh);
+        let dropped = crate::scene::duplicates::drop_duplicate_triangles(&mut mesh, double_sided);
         if dropped > 0 {
             warnings.push(format!(
                 "{field}: {dropped} duplicate triangles dropped (the same corners as an earlier \

@@ -128,7 +128,8 @@ fn a_nearly_coplanar_second_surface_is_reported() {
 
 /// The nearest hits found the simple way: every triangle of every object carried to world
 /// space and tested (what the caster did before it was instance-aware), with the normal
-/// interpolated from world-space barycentrics.
+/// interpolated from world-space barycentrics; a single-sided material's triangle only where
+/// the ray meets its front (its winding's normal, carried as a normal, faces the ray).
 fn brute_force(
     scene: &Scene,
     origin: DVec3,
@@ -142,9 +143,16 @@ fn brute_force(
         for triangle in 0..m.triangle_count() {
             let c = corners(m, triangle as u32);
             let v = c.map(|i| o.transform.transform_point3(m.positions[i].as_dvec3()));
-            let Some((t, u, w)) = intersect(v, origin, dir) else {
+            let Some((t, u, w, _)) = intersect(v, origin, dir) else {
                 continue;
             };
+            // The object-space winding's normal carried as a normal is, by definition,
+            // the front side's.
+            let p = c.map(|i| m.positions[i].as_dvec3());
+            let face = (nm * (p[1] - p[0]).cross(p[2] - p[0])).normalize();
+            if !scene.materials[o.material].double_sided && dir.dot(face) >= 0.0 {
+                continue;
+            }
             if !opaque(object) {
                 transparent = transparent.min(t);
             } else if best.is_none_or(|b| t < b.t) {
@@ -152,10 +160,6 @@ fn brute_force(
                     crate::scene::direction::unit(nm * m.normals[i].as_dvec3())
                         .unwrap_or(DVec3::ZERO)
                 });
-                // The object-space winding's normal carried as a normal is, by definition,
-                // the front side's.
-                let p = c.map(|i| m.positions[i].as_dvec3());
-                let face = (nm * (p[1] - p[0]).cross(p[2] - p[0])).normalize();
                 best = Some(Hit {
                     t,
                     position: origin + dir * t,
@@ -327,6 +331,79 @@ fn repeated_placements_share_one_hierarchy_and_agree_with_brute_force() {
         }
     }
     assert!(found > 50, "{found}");
+}
+
+/// Single-sided placements of the same mesh (moved, mirrored, flattened) beside double-sided
+/// ones: only their fronts are hit, where the brute force finds them, and a ray from behind
+/// passes through them to what lies beyond.
+#[test]
+fn single_sided_placements_are_hit_on_their_front_only() {
+    let mut rng = rand_pcg::Pcg64::seed_from_u64(8);
+    let mesh = Arc::new(random_mesh(&mut rng, 300, 3.0));
+    let mut scene = Scene::empty();
+    let both = scene.add_material(Material::default());
+    let front = scene.add_material(Material {
+        double_sided: false,
+        ..Material::default()
+    });
+    let transforms = [
+        DMat4::IDENTITY,
+        DMat4::from_translation(DVec3::new(-3.0, 2.0, 1.0))
+            * DMat4::from_scale(DVec3::new(-1.0, 1.0, 1.0)),
+        DMat4::from_translation(DVec3::new(2.0, 3.0, 4.0))
+            * DMat4::from_scale(DVec3::new(1.0, 1.0, 0.0)),
+        DMat4::from_translation(DVec3::new(2.0, -3.0, -1.0))
+            * DMat4::from_scale(DVec3::new(1.0, -1.0, 0.0)),
+        // Nearly flat and mirroring: traced in world space, its winding turned round.
+        DMat4::from_cols(
+            DVec4::X,
+            DVec4::Y,
+            DVec4::new(0.6, 0.6, -1e-12, 0.0),
+            DVec4::new(-1.0, 0.0, 2.0, 1.0),
+        ),
+        DMat4::from_rotation_y(2.0) * DMat4::from_scale(DVec3::splat(-0.7)),
+    ];
+    for (i, transform) in transforms.into_iter().enumerate() {
+        scene.add_object(mesh.clone(), front, transform);
+        if i < 2 {
+            scene.add_object(mesh.clone(), both, transform * DMat4::from_rotation_x(0.5));
+        }
+    }
+    let rc = SceneRaycaster::new(&scene);
+    let world_mirrored = rc
+        .instances
+        .iter()
+        .filter(|i| i.to_object.is_none() && i.mirrored);
+    assert_eq!(
+        world_mirrored.count(),
+        1,
+        "one mirrored placement in world space"
+    );
+    let (hits, transparent) = agrees_with_brute_force(&scene, &mut rng, 1500, 5.0, |o| o % 3 != 1);
+    assert!(hits > 500 && transparent > 50, "{hits} hits, {transparent}");
+
+    // One triangle facing +Z in front of a double-sided one: from +Z the front is hit, from −Z
+    // the ray passes through to the one behind; mirrored, the other way round.
+    for (mirror, seen_from) in [(1.0, 1.0), (-1.0, -1.0)] {
+        let mut scene = Scene::empty();
+        let both = scene.add_material(Material::default());
+        let front = scene.add_material(Material {
+            double_sided: false,
+            ..Material::default()
+        });
+        let flip = DMat4::from_scale(DVec3::new(1.0, 1.0, mirror));
+        scene.add_object(Arc::new(triangle_at(0.0)), front, flip);
+        let behind = DMat4::from_translation(DVec3::new(0.0, 0.0, -2.0 * seen_from));
+        scene.add_object(Arc::new(triangle_at(0.0)), both, behind);
+        let rc = SceneRaycaster::new(&scene);
+        let from = |z: f64| rc.hit(DVec3::new(0.0, 0.0, z), DVec3::new(0.0, 0.0, -z.signum()));
+        assert_eq!(from(5.0 * seen_from).map(|h| h.object), Some(0));
+        let through = from(-5.0 * seen_from).expect("the far triangle");
+        assert_eq!(through.object, 1, "mirror {mirror}");
+        // The front's face points at the eye it is seen from.
+        let h = from(5.0 * seen_from).unwrap();
+        assert!(h.face.z * seen_from > 0.99, "{:?}", h.face);
+    }
 }
 
 /// The memory a placement costs does not depend on its mesh: 100 000 placements of a
