@@ -21,9 +21,10 @@ pub struct GpuScene {
     /// once, not every frame). Each is uploaded about its bounds' centre (see
     /// [`GpuScene::model`]).
     meshes: HashMap<usize, (Arc<Mesh>, GpuMesh, Option<Aabb>, f64)>,
-    /// Per texture: its upload as linear data and as sRGB colour (each made when a material
+    /// Per image (the textures reading it share it): its upload as linear data and as sRGB
+    /// colour (each made when a material
     /// first samples it so: a base colour or emission is colour, a normal map data).
-    textures: HashMap<usize, (Arc<Texture>, [Option<ImageTexture>; 2])>,
+    textures: HashMap<usize, (Arc<image::RgbaImage>, [Option<ImageTexture>; 2])>,
     /// 1×1 white texture for full variants on untextured materials (made on first use).
     white: Option<ImageTexture>,
     /// Colour textures are uploaded as sRGB textures, in their own slot of `textures`
@@ -66,11 +67,11 @@ impl GpuScene {
                 .map(|(slot, t)| (&t.texture, slot == "emissive"));
             for (t, colour) in m.diffuse_texture.iter().map(|t| (t, true)).chain(maps) {
                 let srgb = self.upload_slot(colour);
-                let key = Arc::as_ptr(t) as usize;
+                let key = Arc::as_ptr(&t.image) as usize;
                 let (_, uploads) = self
                     .textures
                     .entry(key)
-                    .or_insert_with(|| (t.clone(), [None, None]));
+                    .or_insert_with(|| (t.image.clone(), [None, None]));
                 if uploads[srgb as usize].is_none() {
                     uploads[srgb as usize] = Some(ImageTexture::new(dev, &t.image, srgb)?);
                 }
@@ -170,8 +171,8 @@ impl GpuScene {
 
     /// The upload of one of the scene's textures, as colour (`colour`: an sRGB texture where
     /// the context has them) or as data.
-    pub fn texture_of(&self, texture: &Arc<Texture>, colour: bool) -> Option<&ImageTexture> {
-        let (_, uploads) = self.textures.get(&(Arc::as_ptr(texture) as usize))?;
+    pub fn texture_of(&self, texture: &Texture, colour: bool) -> Option<&ImageTexture> {
+        let (_, uploads) = self.textures.get(&(Arc::as_ptr(&texture.image) as usize))?;
         uploads[self.upload_slot(colour) as usize].as_ref()
     }
 

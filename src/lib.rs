@@ -122,6 +122,11 @@ pub mod motion {
     };
 }
 
+/// How a [`Texture`] is read: its wrapping and filtering ([`Texture::sampling`]; glTF samplers).
+pub mod sampling {
+    pub use crate::scene::texture::{Filter, Sampling, Wrap};
+}
+
 // The crates whose types the API takes and returns, so a game needs no second version of them.
 pub use glam;
 pub use glow;

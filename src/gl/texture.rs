@@ -5,6 +5,7 @@
 use glow::HasContext;
 
 use super::{Device, EsVersion, GlError};
+use crate::scene::texture::{Filter, Sampling, Wrap};
 
 /// Texel format of a data texture.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -63,6 +64,41 @@ pub struct DataTexture {
 /// targets read texel by texel need.
 pub(crate) fn set_nearest_clamp(gl: &glow::Context) {
     set_sampling(gl, glow::NEAREST, glow::CLAMP_TO_EDGE, glow::NEAREST);
+}
+
+/// `sampling`'s parameters on the bound 2D texture (one with mipmaps).
+fn set_image_sampling(gl: &glow::Context, sampling: &Sampling) {
+    let wrap = |w: Wrap| match w {
+        Wrap::Repeat => glow::REPEAT,
+        Wrap::ClampToEdge => glow::CLAMP_TO_EDGE,
+        Wrap::MirroredRepeat => glow::MIRRORED_REPEAT,
+    } as i32;
+    let magnify = match sampling.magnify {
+        Filter::Nearest => glow::NEAREST,
+        Filter::Linear => glow::LINEAR,
+    };
+    let minify = match (sampling.minify, sampling.mipmap) {
+        (Filter::Nearest, None) => glow::NEAREST,
+        (Filter::Linear, None) => glow::LINEAR,
+        (Filter::Nearest, Some(Filter::Nearest)) => glow::NEAREST_MIPMAP_NEAREST,
+        (Filter::Linear, Some(Filter::Nearest)) => glow::LINEAR_MIPMAP_NEAREST,
+        (Filter::Nearest, Some(Filter::Linear)) => glow::NEAREST_MIPMAP_LINEAR,
+        (Filter::Linear, Some(Filter::Linear)) => glow::LINEAR_MIPMAP_LINEAR,
+    };
+    unsafe {
+        gl.tex_parameter_i32(glow::TEXTURE_2D, glow::TEXTURE_MAG_FILTER, magnify as i32);
+        gl.tex_parameter_i32(glow::TEXTURE_2D, glow::TEXTURE_MIN_FILTER, minify as i32);
+        gl.tex_parameter_i32(
+            glow::TEXTURE_2D,
+            glow::TEXTURE_WRAP_S,
+            wrap(sampling.wrap_u),
+        );
+        gl.tex_parameter_i32(
+            glow::TEXTURE_2D,
+            glow::TEXTURE_WRAP_T,
+            wrap(sampling.wrap_v),
+        );
+    }
 }
 
 fn set_sampling(gl: &glow::Context, filter: u32, wrap: u32, min_filter: u32) {
@@ -230,6 +266,9 @@ pub fn upload_size((w, h): (u32, u32), max: u32, power_of_two: bool) -> (u32, u3
 pub struct ImageTexture {
     raw: glow::Texture,
     destroyed: bool,
+    /// The sampling its parameters are set for (ES 2.0 has no sampler objects: each bind
+    /// sets the parameters a texture's [`Sampling`] asks, where they differ).
+    sampling: std::cell::Cell<Sampling>,
 }
 
 impl ImageTexture {
@@ -275,19 +314,25 @@ impl ImageTexture {
             );
             gl.generate_mipmap(glow::TEXTURE_2D);
         }
-        set_sampling(gl, glow::LINEAR, glow::REPEAT, glow::LINEAR_MIPMAP_LINEAR);
+        let sampling = Sampling::default();
+        set_image_sampling(gl, &sampling);
         dev.check(&format!("uploading a {pw}×{ph} image texture"))?;
         Ok(ImageTexture {
             raw,
             destroyed: false,
+            sampling: std::cell::Cell::new(sampling),
         })
     }
 
-    /// Binds to texture unit `unit`.
-    pub fn bind(&self, dev: &Device, unit: u32) {
+    /// Binds to texture unit `unit`, read as `sampling` says.
+    pub fn bind(&self, dev: &Device, unit: u32, sampling: &Sampling) {
         unsafe {
             dev.gl.active_texture(glow::TEXTURE0 + unit);
             dev.gl.bind_texture(glow::TEXTURE_2D, Some(self.raw));
+        }
+        if self.sampling.get() != *sampling {
+            set_image_sampling(&dev.gl, sampling);
+            self.sampling.set(*sampling);
         }
     }
 

@@ -245,7 +245,11 @@ pub(crate) fn shade_object<P: GeometryProgram>(
         .transforms()
         .set(dev, &(ctx.view * model), &ctx.projection);
     if let Some(t) = texture {
-        t.bind(dev, UNIT_ALBEDO);
+        let sampling = material
+            .diffuse_texture
+            .as_ref()
+            .map_or_else(Default::default, |t| t.sampling);
+        t.bind(dev, UNIT_ALBEDO, &sampling);
     }
     let frame = SurfaceFrame {
         ambient: ctx.scene.ambient,

@@ -170,7 +170,7 @@ impl MapUniforms {
                 continue;
             };
             if let Some(t) = scene.texture_of(&map.texture, bit == F::EMISSIVE_MAP) {
-                t.bind(dev, unit);
+                t.bind(dev, unit, &map.texture.sampling);
             }
             sampler.set(dev, unit);
             if features.has(F::TEXTURE_TRANSFORM) {

@@ -477,10 +477,10 @@ mod tests {
     #[test]
     fn textured_surfaces_are_skipped() {
         let mut scene = lit_plane();
-        scene.materials[0].diffuse_texture = Some(Arc::new(Texture {
-            name: "white".into(),
-            image: image::RgbaImage::from_pixel(1, 1, image::Rgba([255; 4])),
-        }));
+        scene.materials[0].diffuse_texture = Some(Arc::new(Texture::new(
+            "white",
+            image::RgbaImage::from_pixel(1, 1, image::Rgba([255; 4])),
+        )));
         let set = reference_samples(&scene, W, H, 200, Encoding::Srgb, snapping_reach(8));
         assert!(set.samples.is_empty());
         assert_eq!(

@@ -318,10 +318,8 @@ fn meshes_and_textures_the_game_dropped_are_freed() {
         // A new mesh and a new texture each frame, the old ones dropped.
         let mesh = (*s.objects[0].mesh).clone();
         s.objects[0].mesh = Arc::new(mesh);
-        let fresh = manylight::scene::Texture {
-            name: format!("frame {frame}"),
-            image: image.clone(),
-        };
+        // A new image too: textures reading one image share its upload.
+        let fresh = manylight::scene::Texture::new(format!("frame {frame}"), image.clone());
         s.materials[0].diffuse_texture = Some(Arc::new(fresh));
         gpu.render(&s, 32, 18, &options);
         let live = gpu.r().live_gl_objects();

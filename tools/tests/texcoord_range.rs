@@ -67,16 +67,16 @@ fn a_gltf_texture_coordinate_out_of_range_is_an_error_and_a_transform_is_ignored
 /// One textured quad facing the camera, lit by a point light and ambient.
 fn quad_scene(uv_at: f32, transform: TextureTransform) -> Scene {
     let mut scene = Scene::empty();
-    let texture = Arc::new(Texture {
-        name: "checker".into(),
-        image: image::RgbaImage::from_fn(4, 4, |x, y| {
+    let texture = Arc::new(Texture::new(
+        "checker",
+        image::RgbaImage::from_fn(4, 4, |x, y| {
             image::Rgba(if (x + y) % 2 == 0 {
                 [220, 200, 180, 255]
             } else {
                 [90, 120, 200, 255]
             })
         }),
-    });
+    ));
     let mut material = Material::flat("quad", Vec3::ONE);
     material.diffuse_texture = Some(texture);
     material.maps.base_transform = transform;

@@ -107,48 +107,7 @@ pub(super) fn unused_features(document: &gltf::Document, camera_nodes: usize) ->
              ignored"
         ));
     }
-    out.extend(unapplied_samplers(document));
     out
-}
-
-/// The samplers' settings that change a texture's look but are not applied (every texture is
-/// drawn linear, mipmapped and repeating): one warning naming what the file's textures ask.
-fn unapplied_samplers(document: &gltf::Document) -> Option<String> {
-    use gltf::texture::{MagFilter, MinFilter, WrappingMode};
-    let (mut clamp, mut mirror, mut nearest, mut textures) = (false, false, false, 0);
-    for texture in document.textures() {
-        let sampler = texture.sampler();
-        let wraps = [sampler.wrap_s(), sampler.wrap_t()];
-        let c = wraps.contains(&WrappingMode::ClampToEdge);
-        let m = wraps.contains(&WrappingMode::MirroredRepeat);
-        let n = sampler.mag_filter() == Some(MagFilter::Nearest)
-            || matches!(
-                sampler.min_filter(),
-                Some(
-                    MinFilter::Nearest
-                        | MinFilter::NearestMipmapNearest
-                        | MinFilter::NearestMipmapLinear
-                )
-            );
-        (clamp, mirror, nearest) = (clamp || c, mirror || m, nearest || n);
-        textures += usize::from(c || m || n);
-    }
-    let asked: Vec<&str> = [
-        (clamp, "CLAMP_TO_EDGE wrapping"),
-        (mirror, "MIRRORED_REPEAT wrapping"),
-        (nearest, "NEAREST filtering"),
-    ]
-    .into_iter()
-    .filter_map(|(used, what)| used.then_some(what))
-    .collect();
-    (textures > 0).then(|| {
-        format!(
-            "samplers: {textures} textures ask for {}, which is not applied: every texture is \
-             drawn linear, mipmapped and repeating (pixel art blurs, a clamped atlas or decal \
-             may show its opposite edge at its border)",
-            asked.join(" and ")
-        )
-    })
 }
 
 /// What ignoring extension `name` does to the picture, in a few words.
@@ -211,36 +170,6 @@ mod tests {
                 "meshes[2].primitives[0]: mode Lines is not drawn",
                 "skins (1) are not applied",
             ]
-        );
-    }
-
-    /// Samplers asking for clamping, mirroring or nearest filtering are named with the
-    /// textures that use them; defaults (absent, or REPEAT with linear filters) are not.
-    #[test]
-    fn samplers_that_change_the_look_are_named() {
-        let document = |samplers: &str| {
-            let json = format!(
-                r#"{{"asset": {{"version": "2.0"}},
-                    "images": [{{"uri": "a.png"}}],
-                    "samplers": {samplers},
-                    "textures": [{{"source": 0, "sampler": 0}}, {{"source": 0, "sampler": 1}},
-                                 {{"source": 0}}]}}"#
-            );
-            gltf::Gltf::from_slice(json.as_bytes()).unwrap().document
-        };
-        let plain = r#"[{}, {"wrapS": 10497, "magFilter": 9729, "minFilter": 9987}]"#;
-        assert_eq!(unapplied_samplers(&document(plain)), None);
-        let pixel_art = r#"[{"magFilter": 9728}, {"wrapT": 33071}]"#;
-        let said = unapplied_samplers(&document(pixel_art)).unwrap();
-        assert!(
-            said.starts_with("samplers: 2 textures ask for CLAMP_TO_EDGE wrapping and NEAREST"),
-            "{said}"
-        );
-        let mirrored = r#"[{"wrapS": 33648}, {"minFilter": 9984}]"#;
-        let said = unapplied_samplers(&document(mirrored)).unwrap();
-        assert!(
-            said.contains("MIRRORED_REPEAT wrapping and NEAREST"),
-            "{said}"
         );
     }
 }

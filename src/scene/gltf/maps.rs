@@ -52,7 +52,7 @@ impl RawMaterials {
 pub(super) struct Slot<'a> {
     pub name: &'a str,
     pub path: &'a [&'a str],
-    pub image: gltf::Image<'a>,
+    pub texture: gltf::Texture<'a>,
     pub tex_coord: u32,
 }
 
@@ -146,7 +146,7 @@ pub(super) fn load_slot(
     }
     let texture = src
         .textures
-        .load(&slot.image, src.buffers, src.gltf_path, warnings)
+        .load_texture(&slot.texture, src.buffers, src.gltf_path, warnings)
         .map_err(|e| format!("{tfield}: {e}"))?;
     Ok(texture.map(|texture| MapTexture { texture, transform }))
 }
@@ -164,7 +164,7 @@ pub(super) fn convert(
         let slot = Slot {
             name: "normal",
             path: &["normalTexture"],
-            image: n.texture().source(),
+            texture: n.texture(),
             tex_coord: n.tex_coord(),
         };
         maps.normal = load_slot(slot, index, field, src, warnings)?;
@@ -175,7 +175,7 @@ pub(super) fn convert(
         let slot = Slot {
             name: "occlusion",
             path: &["occlusionTexture"],
-            image: o.texture().source(),
+            texture: o.texture(),
             tex_coord: o.tex_coord(),
         };
         maps.occlusion = load_slot(slot, index, field, src, warnings)?;
@@ -186,7 +186,7 @@ pub(super) fn convert(
         let slot = Slot {
             name: "metallic-roughness",
             path: &["pbrMetallicRoughness", "metallicRoughnessTexture"],
-            image: info.texture().source(),
+            texture: info.texture(),
             tex_coord: info.tex_coord(),
         };
         maps.metallic_roughness = load_slot(slot, index, field, src, warnings)?;
@@ -208,7 +208,7 @@ pub(super) fn convert(
         let slot = Slot {
             name: "emissive",
             path: &["emissiveTexture"],
-            image: info.texture().source(),
+            texture: info.texture(),
             tex_coord: info.tex_coord(),
         };
         if emissive.max_element() > 0.0 {

@@ -224,10 +224,9 @@ impl Materials {
                      TEXCOORD_0 is read, so it is not bound (flat colour)"
                 ));
             } else {
-                let image = info.texture().source();
                 diffuse_texture = self
                     .textures
-                    .load(&image, buffers, gltf_path, warnings)
+                    .load_texture(&info.texture(), buffers, gltf_path, warnings)
                     .map_err(|e| format!("{field}.pbrMetallicRoughness.baseColorTexture: {e}"))?;
             }
         }
@@ -238,7 +237,7 @@ impl Materials {
                 // The texture's alpha multiplies the factor's where some texel is not opaque
                 // (exporters often say BLEND of opaque textures: those stay opaque objects).
                 if let Some(t) = &diffuse_texture {
-                    let key = std::sync::Arc::as_ptr(t) as usize;
+                    let key = std::sync::Arc::as_ptr(&t.image) as usize;
                     alpha_texture = *self
                         .translucent
                         .entry(key)

@@ -13,15 +13,18 @@ use super::buffers::Buffers;
 use super::uri::{self, Uri};
 use crate::scene::input::{read_bounded, FileKind, LIMIT_VARIABLE};
 use crate::scene::obj::resolve_texture;
+use crate::scene::texture::{Filter, Sampling, Wrap};
 use crate::scene::texture_budget::{self, decode_texture_bytes, TextureBudget};
 use crate::scene::Texture;
 use crate::scene::{access, shown};
 
 /// Decoded images of one glTF file, by image index and by where their bytes lie (`None`:
-/// failed, warned once), and what is left of the scene's texture budget and of the bytes
-/// the images may read.
+/// failed, warned once), the textures reading them through a sampler other than the default,
+/// and what is left of the scene's texture budget and of the bytes the images may read.
 pub(super) struct Textures {
     loaded: HashMap<usize, Option<Arc<Texture>>>,
+    /// By image index and sampling: each shares its image's pixels.
+    sampled: HashMap<(usize, Sampling), Arc<Texture>>,
     by_source: HashMap<Source, Option<Arc<Texture>>>,
     /// Encoded bytes the model's images may still read from files or decode from buffer
     /// views, all together: the limit on a model's buffers, so many images of large distinct
@@ -43,10 +46,40 @@ impl Textures {
     pub fn new(budget: TextureBudget) -> Textures {
         Textures {
             loaded: HashMap::new(),
+            sampled: HashMap::new(),
             by_source: HashMap::new(),
             encoded_left: FileKind::GltfBuffer.limit(),
             budget,
         }
+    }
+
+    /// `texture`: its image (see [`Textures::load`]) read through its sampler.
+    pub fn load_texture(
+        &mut self,
+        texture: &gltf::Texture,
+        buffers: &mut Buffers,
+        gltf_path: &Path,
+        warnings: &mut Vec<String>,
+    ) -> Result<Option<Arc<Texture>>, String> {
+        let image = texture.source();
+        let Some(plain) = self.load(&image, buffers, gltf_path, warnings)? else {
+            return Ok(None);
+        };
+        let sampling = sampling_of(&texture.sampler());
+        if sampling == plain.sampling {
+            return Ok(Some(plain));
+        }
+        let sampled = self
+            .sampled
+            .entry((image.index(), sampling))
+            .or_insert_with(|| {
+                Arc::new(Texture {
+                    name: plain.name.clone(),
+                    image: plain.image.clone(),
+                    sampling,
+                })
+            });
+        Ok(Some(sampled.clone()))
     }
 
     /// The texture of `image`, decoded once. Problems with the image data itself are warnings
@@ -148,10 +181,7 @@ impl Textures {
                 Ok(img) => {
                     let (image, scaled) = texture_budget::to_rgba8(img, &located.name);
                     warnings.extend(scaled);
-                    Some(Arc::new(Texture {
-                        name: located.name,
-                        image,
-                    }))
+                    Some(Arc::new(Texture::new(located.name, image)))
                 }
                 Err(why) => {
                     warnings.push(format!(
@@ -162,6 +192,36 @@ impl Textures {
                 }
             },
         )
+    }
+}
+
+/// A glTF sampler as [`Sampling`]: a filter the file leaves out is linear, mipmapped
+/// between the two nearest levels (the renderer's default).
+pub(super) fn sampling_of(sampler: &gltf::texture::Sampler) -> Sampling {
+    use gltf::texture::{MagFilter, MinFilter, WrappingMode};
+    let wrap = |mode| match mode {
+        WrappingMode::Repeat => Wrap::Repeat,
+        WrappingMode::ClampToEdge => Wrap::ClampToEdge,
+        WrappingMode::MirroredRepeat => Wrap::MirroredRepeat,
+    };
+    let magnify = match sampler.mag_filter() {
+        Some(MagFilter::Nearest) => Filter::Nearest,
+        Some(MagFilter::Linear) | None => Filter::Linear,
+    };
+    let (minify, mipmap) = match sampler.min_filter() {
+        Some(MinFilter::Nearest) => (Filter::Nearest, None),
+        Some(MinFilter::Linear) => (Filter::Linear, None),
+        Some(MinFilter::NearestMipmapNearest) => (Filter::Nearest, Some(Filter::Nearest)),
+        Some(MinFilter::LinearMipmapNearest) => (Filter::Linear, Some(Filter::Nearest)),
+        Some(MinFilter::NearestMipmapLinear) => (Filter::Nearest, Some(Filter::Linear)),
+        Some(MinFilter::LinearMipmapLinear) | None => (Filter::Linear, Some(Filter::Linear)),
+    };
+    Sampling {
+        wrap_u: wrap(sampler.wrap_s()),
+        wrap_v: wrap(sampler.wrap_t()),
+        magnify,
+        minify,
+        mipmap,
     }
 }
 
@@ -295,6 +355,72 @@ fn decode(bytes: &[u8], format: Option<image::ImageFormat>) -> Result<image::Dyn
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Every wrap and filter code of glTF 2.0 §5.26 as the GL parameter of the same name;
+    /// left out, a filter is the renderer's default and a wrap `REPEAT`.
+    #[test]
+    fn samplers_map_to_their_gl_parameters() {
+        let samplers = r#"[
+            {},
+            {"wrapS": 33071, "wrapT": 33648, "magFilter": 9728, "minFilter": 9728},
+            {"wrapS": 33648, "wrapT": 10497, "magFilter": 9729, "minFilter": 9729},
+            {"minFilter": 9984}, {"minFilter": 9985}, {"minFilter": 9986}, {"minFilter": 9987}
+        ]"#;
+        let json = format!(
+            r#"{{"asset": {{"version": "2.0"}}, "images": [{{"uri": "a.png"}}],
+                "samplers": {samplers},
+                "textures": [{}]}}"#,
+            (0..7)
+                .map(|i| format!(r#"{{"source": 0, "sampler": {i}}}"#))
+                .chain([r#"{"source": 0}"#.to_string()])
+                .collect::<Vec<_>>()
+                .join(", ")
+        );
+        let document = gltf::Gltf::from_slice(json.as_bytes()).unwrap().document;
+        let got: Vec<Sampling> = document
+            .textures()
+            .map(|t| sampling_of(&t.sampler()))
+            .collect();
+        let (n, l) = (Filter::Nearest, Filter::Linear);
+        let with = |minify, mipmap| Sampling {
+            minify,
+            mipmap,
+            ..Sampling::default()
+        };
+        let want = [
+            Sampling::default(),
+            Sampling {
+                wrap_u: Wrap::ClampToEdge,
+                wrap_v: Wrap::MirroredRepeat,
+                magnify: n,
+                minify: n,
+                mipmap: None,
+            },
+            Sampling {
+                wrap_u: Wrap::MirroredRepeat,
+                wrap_v: Wrap::Repeat,
+                magnify: l,
+                minify: l,
+                mipmap: None,
+            },
+            with(n, Some(n)),
+            with(l, Some(n)),
+            with(n, Some(l)),
+            with(l, Some(l)),
+            Sampling::default(),
+        ];
+        assert_eq!(got, want);
+        assert_eq!(
+            Sampling::default(),
+            Sampling {
+                wrap_u: Wrap::Repeat,
+                wrap_v: Wrap::Repeat,
+                magnify: l,
+                minify: l,
+                mipmap: Some(l),
+            }
+        );
+    }
 
     #[test]
     fn decodes_a_png_and_refuses_a_claimed_giant() {

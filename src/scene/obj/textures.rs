@@ -42,7 +42,7 @@ impl TextureCache {
                 if let Some(w) = scaled {
                     warn(w);
                 }
-                Some(Arc::new(Texture { name, image }))
+                Some(Arc::new(Texture::new(name, image)))
             }
             Err(why) => {
                 warn(format!(
