@@ -17,6 +17,7 @@ use super::access::LoadOptions;
 use super::camera::MAX_CAMERA_COORD;
 use super::mesh::MAX_SCENE_MESHES;
 use super::obj::{self, LoadReport};
+use super::texture::Sampling;
 use super::texture_budget::TextureBudget;
 use super::{Aabb, Material, Mesh, Object, Scene, SceneError, Texture};
 
@@ -142,8 +143,10 @@ pub(super) struct ModelCache {
     gltf: HashMap<PathBuf, Option<Loaded>>,
     /// The distinct meshes of each model file's first load, in first-use order.
     meshes: HashMap<PathBuf, Vec<Arc<Mesh>>>,
-    /// Every texture loaded so far, by name (its path).
-    textures: HashMap<String, Arc<Texture>>,
+    /// Every image loaded so far, by name (its path): the pixels every later copy shares.
+    images: HashMap<String, Arc<image::RgbaImage>>,
+    /// Every texture kept so far, by name and sampling (one image read through several).
+    textures: HashMap<(String, Sampling), Arc<Texture>>,
     builtin: HashMap<String, Option<Scene>>,
 }
 
@@ -332,19 +335,32 @@ impl ModelCache {
         charged: bool,
     ) -> bool {
         // Every texture slot: a model named many times holds each image once, and a copy
-        // dropped for the one held gives its memory back to the budget (once per copy).
+        // dropped for the one held gives its memory back to the budget (once per copy of the
+        // pixels, however many samplings read it); each texture keeps its own sampling.
         let mut dropped = std::collections::HashSet::new();
         for t in scene.materials[first_material..]
             .iter_mut()
             .flat_map(|m| m.diffuse_texture.iter_mut().chain(m.maps.textures_mut()))
         {
-            match self.textures.get(&t.name) {
-                Some(known) if Arc::ptr_eq(known, t) => {}
-                Some(known) if known.image == t.image => {
-                    if charged && dropped.insert(Arc::as_ptr(t)) {
+            let key = (t.name.clone(), t.sampling);
+            match self.images.get(&t.name) {
+                Some(known) if Arc::ptr_eq(known, &t.image) => {
+                    let kept = self.textures.entry(key).or_insert_with(|| t.clone());
+                    *t = kept.clone();
+                }
+                Some(known) if **known == *t.image => {
+                    if charged && dropped.insert(Arc::as_ptr(&t.image)) {
                         self.texture_budget.give_back(t.image.as_raw().len() as u64);
                     }
-                    *t = known.clone();
+                    let image = known.clone();
+                    let kept = self.textures.entry(key).or_insert_with(|| {
+                        Arc::new(Texture {
+                            name: t.name.clone(),
+                            image,
+                            sampling: t.sampling,
+                        })
+                    });
+                    *t = kept.clone();
                 }
                 Some(_) => {}
                 None => {
@@ -354,7 +370,8 @@ impl ModelCache {
                         let (w, h) = t.image.dimensions();
                         let _ = self.texture_budget.take(w, h);
                     }
-                    self.textures.insert(t.name.clone(), t.clone());
+                    self.images.insert(t.name.clone(), t.image.clone());
+                    self.textures.insert(key, t.clone());
                 }
             }
         }
@@ -540,6 +557,70 @@ mod tests {
         let path = dir.join(name);
         std::fs::write(&path, doc.to_string()).unwrap();
         path
+    }
+
+    /// One image file read through two samplers (two materials) by two glTF files, the first
+    /// placed three times: each texture keeps its sampling, all share one copy of the pixels,
+    /// and the second file's copy, dropped, is given back to the budget once (not once a
+    /// sampling).
+    #[test]
+    fn textures_of_one_image_keep_their_samplings_and_one_copy_of_its_pixels() {
+        use crate::scene::texture::{Filter, Wrap};
+        let dir = tempfile::tempdir().unwrap();
+        image::RgbaImage::from_pixel(4, 4, image::Rgba([200, 100, 50, 255]))
+            .save(dir.path().join("tex.png"))
+            .unwrap();
+        let two_samplers = |name: &str| {
+            let path = lit_textured_gltf(dir.path(), name);
+            let mut doc: serde_json::Value =
+                serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+            let primitive = doc["meshes"][0]["primitives"][0].clone();
+            let mut second = primitive.clone();
+            second["material"] = serde_json::json!(1);
+            doc["meshes"][0]["primitives"] = serde_json::json!([primitive, second]);
+            doc["materials"] = serde_json::json!([
+                {"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}},
+                {"pbrMetallicRoughness": {"baseColorTexture": {"index": 1}}}
+            ]);
+            doc["samplers"] = serde_json::json!([{"wrapS": 33071, "magFilter": 9728}]);
+            doc["textures"] = serde_json::json!([{"source": 0}, {"source": 0, "sampler": 0}]);
+            doc["images"] = serde_json::json!([{"uri": "tex.png"}]);
+            std::fs::write(&path, doc.to_string()).unwrap();
+            path
+        };
+        let (first, second) = (two_samplers("a.gltf"), two_samplers("b.gltf"));
+        let mut cache = ModelCache::new(LoadOptions::default());
+        // Room for two copies of the 4 × 4 image while the second file decodes its own.
+        cache.texture_budget = TextureBudget::with_left(2 * 64 + 63);
+        let mut scene = Scene::empty();
+        for (x, path) in [&first, &first, &first, &second].into_iter().enumerate() {
+            let transform = DMat4::from_translation(glam::DVec3::new(x as f64, 0.0, 0.0));
+            let loaded = cache
+                .place_gltf(&mut scene, path, transform, false, "objects[0].transform")
+                .unwrap();
+            assert!(loaded.report.warnings.is_empty(), "{:?}", loaded.report);
+        }
+        assert_eq!(cache.texture_budget, TextureBudget::with_left(64 + 63));
+        let clamped = Sampling {
+            wrap_u: Wrap::ClampToEdge,
+            magnify: Filter::Nearest,
+            ..Sampling::default()
+        };
+        let textures: Vec<&Arc<Texture>> = scene
+            .materials
+            .iter()
+            .map(|m| m.diffuse_texture.as_ref().expect("kept"))
+            .collect();
+        assert_eq!(textures.len(), 8);
+        for (i, t) in textures.iter().enumerate() {
+            let want = if i % 2 == 0 {
+                Sampling::default()
+            } else {
+                clamped
+            };
+            assert_eq!(t.sampling, want, "material {i}");
+            assert!(Arc::ptr_eq(&t.image, &textures[0].image), "material {i}");
+        }
     }
 
     #[test]

@@ -13,6 +13,9 @@ pub struct Texture {
     /// one image with different [`Sampling`]s (uploaded once).
     pub image: Arc<image::RgbaImage>,
     /// How it is read between and beyond its texels (glTF's sampler; the default for OBJ).
+    /// A draw binds each image once: a material whose slots read one image through
+    /// different samplings reads it through one of them (the glTF loader makes them agree,
+    /// with a warning).
     pub sampling: Sampling,
 }
 

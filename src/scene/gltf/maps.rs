@@ -8,6 +8,7 @@
 //! override) is a warning and not bound, as the base colour's always was.
 
 use std::path::Path;
+use std::sync::Arc;
 
 use glam::{Vec2, Vec3};
 use serde_json::Value;
@@ -16,6 +17,7 @@ use super::buffers::Buffers;
 use super::texture::Textures;
 use crate::scene::mesh::MAX_TEXCOORD;
 use crate::scene::surface_maps::{MapTexture, SurfaceMaps, TextureTransform, MAX_EMISSIVE};
+use crate::scene::{shown, Texture};
 
 /// The file's `materials` array as plain JSON, for the transforms.
 pub(super) struct RawMaterials(Vec<Value>);
@@ -149,6 +151,51 @@ pub(super) fn load_slot(
         .load_texture(&slot.texture, src.buffers, src.gltf_path, warnings)
         .map_err(|e| format!("{tfield}: {e}"))?;
     Ok(texture.map(|texture| MapTexture { texture, transform }))
+}
+
+/// Makes every slot of one material that reads an image read it through one sampling, the
+/// first slot's (base colour, normal, emissive, occlusion, metallic-roughness): a draw binds
+/// each image once (on ES 2.0 colour and data share an upload), and its sampling is the
+/// texture's. Each slot changed is warned of.
+pub(super) fn one_sampling_per_image(
+    base: &mut Option<Arc<Texture>>,
+    maps: &mut SurfaceMaps,
+    field: &str,
+    warnings: &mut Vec<String>,
+) {
+    let mut slots: Vec<(&str, &mut Arc<Texture>)> = Vec::new();
+    if let Some(t) = base.as_mut() {
+        slots.push(("base colour", t));
+    }
+    let maps = [
+        ("normal", &mut maps.normal),
+        ("emissive", &mut maps.emissive_texture),
+        ("occlusion", &mut maps.occlusion),
+        ("metallic-roughness", &mut maps.metallic_roughness),
+    ];
+    for (name, map) in maps {
+        if let Some(map) = map.as_mut() {
+            slots.push((name, &mut map.texture));
+        }
+    }
+    for i in 1..slots.len() {
+        let (earlier, later) = slots.split_at_mut(i);
+        let (name, texture) = &mut later[0];
+        let first = earlier
+            .iter()
+            .find(|(_, e)| Arc::ptr_eq(&e.image, &texture.image) && e.sampling != texture.sampling);
+        if let Some((first_name, first)) = first {
+            warnings.push(format!(
+                "{field}: the {name} and {first_name} textures read one image ({}) through                  different samplers; a draw reads an image through one, so the {name} texture                  takes the {first_name} one's",
+                shown::name(&texture.name)
+            ));
+            **texture = Arc::new(Texture {
+                name: texture.name.clone(),
+                image: texture.image.clone(),
+                sampling: first.sampling,
+            });
+        }
+    }
 }
 
 /// The maps of material `m` (the base colour's transform is the caller's).

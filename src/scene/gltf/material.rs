@@ -275,6 +275,7 @@ impl Materials {
         };
         let mut maps = maps::convert(m, &field, &mut sources, warnings)?;
         maps.base_transform = base_transform;
+        maps::one_sampling_per_image(&mut diffuse_texture, &mut maps, &field, warnings);
         Ok(Material {
             diffuse_texture,
             specular: Vec3::splat(DIELECTRIC_SPECULAR),
