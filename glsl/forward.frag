@@ -43,7 +43,7 @@ void main() {
 #else
     vec3 N = normalize(v_normal);
     vec3 V = viewDirection(v_viewPos);
-    // Two-sided: the side the eye sees.
+    // The side the eye sees (a back face only on a double-sided surface).
     N = shadingNormal(N, v_uv);
     MEDP vec3 albedo = surfaceAlbedo(v_uv);
     SurfaceParams surface = materialSurface(albedo, v_uv);

@@ -21,7 +21,7 @@ void main() {
     }
 #endif
     vec3 N = normalize(v_normal);
-    // Two-sided: the side the eye sees.
+    // The side the eye sees (a back face only on a double-sided surface).
     N = shadingNormal(N, v_uv);
     // The surface point as its depth and its window offset from the pixel centre (see
     // windowPosition): the light pass shades the very point forward shades.

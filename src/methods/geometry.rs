@@ -118,7 +118,8 @@ fn depth_prepass(ctx: &mut FrameContext) -> Result<(), Error> {
 
 /// Draws the scene with `shader`: a depth prepass of the opaque objects, the opaque objects,
 /// then the transparent ones back to front — each in two passes, back faces then front faces,
-/// so a closed convex object blends in the right order. `bind_method` is called on each
+/// so a closed convex object blends in the right order (a single-sided one in the second
+/// alone). `bind_method` is called on each
 /// program before a draw so the method can set its uniforms and bind its textures; transparent
 /// surfaces are lit by the same data (the dense grid covers every depth, not just the visible
 /// surface).

@@ -63,8 +63,8 @@ pub struct Material {
     /// Normal, emissive, occlusion and metallic-roughness inputs and texture transforms
     /// (glTF; defaults for OBJ and built-in materials).
     pub maps: SurfaceMaps,
-    /// Drawn from both sides, a back face with its normals reversed (OBJ, scene files and
-    /// built-in materials, glTF `doubleSided: true`); `false` draws only the side the
+    /// Drawn from both sides, a back face with its normals reversed (OBJ and built-in
+    /// materials, also in scene files; glTF `doubleSided: true`); `false` draws only the side the
     /// triangles' winding faces (counter-clockwise, clockwise under a mirroring transform), as
     /// glTF's default `doubleSided: false` asks: a back face is culled, and what lies behind
     /// it shows.

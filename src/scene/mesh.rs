@@ -92,9 +92,11 @@ impl Aabb {
 }
 
 /// An indexed triangle mesh in object space. Normals are always present (computed from the
-/// faces when the source had none); texture coordinates are optional. Drawn double-sided: no
-/// back face is culled, and a back face (clockwise on screen; [`Mesh::new`] winds each
-/// triangle towards its normals) is shaded with its normals reversed.
+/// faces when the source had none); texture coordinates are optional. Which sides are drawn is
+/// its material's ([`Material::double_sided`](super::Material::double_sided)): a back face
+/// (clockwise on screen; [`Mesh::new`] winds each triangle towards its normals,
+/// [`Mesh::new_as_wound`] keeps the winding listed) is culled, or shaded with its normals
+/// reversed.
 #[derive(Clone, Debug, Default)]
 pub struct Mesh {
     /// Vertex positions.

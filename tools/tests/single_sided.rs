@@ -185,8 +185,13 @@ fn a_single_sided_surface_is_seen_from_its_front_only_with_every_method() {
 
 /// A glTF pane in front of a double-sided wall, both facing the camera on +Z, the pane's
 /// winding (`wound_away`) and normals (`normals_away`) turned to face away or not, with
-/// `doubleSided` left out, `false` or `true`.
-fn gltf_pane(wound_away: bool, normals_away: bool, double_sided: Option<bool>) -> String {
+/// `doubleSided` left out, `false` or `true`, its node `mirrored` along x or not.
+fn gltf_pane(
+    wound_away: bool,
+    normals_away: bool,
+    double_sided: Option<bool>,
+    mirrored: bool,
+) -> String {
     let mut b = Builder::default();
     let mut near = pane(2.0, 2.0);
     if wound_away {
@@ -210,7 +215,8 @@ fn gltf_pane(wound_away: bool, normals_away: bool, double_sided: Option<bool>) -
     b.gltf(json!({
         "scenes": [{"nodes": [0, 1, 2]}],
         "nodes": [
-            {"mesh": 0, "translation": [0, -1, 0]},
+            {"mesh": 0, "translation": [0, -1, 0],
+             "scale": [if mirrored { -1 } else { 1 }, 1, 1]},
             {"mesh": 1, "translation": [0, -2, -2]},
             {"camera": 0, "translation": [0, 0, 4]}
         ],
@@ -244,14 +250,18 @@ fn a_gltf_material_is_single_sided_unless_it_says_double_sided() {
         (true, false, None, false),
         (true, false, Some(true), true),
     ];
-    for (wound_away, normals_away, double_sided, seen) in cases {
+    // Mirrored along x by its node (a negative determinant): the pane maps onto itself and
+    // its front (now clockwise on screen, §3.7.2.1) still faces the same way.
+    let mirrorings = cases.iter().flat_map(|&c| [(c, false), (c, true)]);
+    for ((wound_away, normals_away, double_sided, seen), mirrored) in mirrorings {
         let what = format!(
-            "wound away {wound_away}, normals away {normals_away}, doubleSided {double_sided:?}"
+            "wound away {wound_away}, normals away {normals_away}, doubleSided \
+             {double_sided:?}, mirrored {mirrored}"
         );
         let path = common::files::write(
             dir.path(),
             "pane.gltf",
-            gltf_pane(wound_away, normals_away, double_sided),
+            gltf_pane(wound_away, normals_away, double_sided, mirrored),
         );
         let (mut s, _) = common::files::load(&path).unwrap();
         assert_eq!(
