@@ -42,6 +42,8 @@ pub fn mediump_is_fp16(dev: &Device) -> Result<bool, GlError> {
         target.bind(dev);
         gl.disable(glow::DEPTH_TEST);
         gl.disable(glow::BLEND);
+        // A game's culling (kept while the renderer works) could cull the probe's triangle.
+        gl.disable(glow::CULL_FACE);
         gl.color_mask(true, true, true, true);
         program.bind(dev);
         if let Some(u) = program.uniforms::<ProbeUniforms>() {

@@ -275,6 +275,7 @@ fn every_call_gives_the_games_gl_state_back_and_draws_as_from_a_clean_one() {
             .collect();
         // What each draws from the default state, on a renderer of its own.
         let mut clean = Gpu::fresh(es);
+        let fp16 = clean.r().mediump_is_fp16().unwrap();
         let expected: Vec<_> = cases
             .iter()
             .map(|(m, opts)| {
@@ -315,7 +316,14 @@ fn every_call_gives_the_games_gl_state_back_and_draws_as_from_a_clean_one() {
                 "{what}: render changed the game's state"
             );
         }
-        renderer.mediump_is_fp16().unwrap();
+        // The game culls front faces: the probe's triangle must still be drawn (culled, an
+        // empty pixel read as fp16: wrong on SwiftShader, whose mediump is fp32; llvmpipe's
+        // is fp16, so there the two agree).
+        assert_eq!(
+            renderer.mediump_is_fp16().unwrap(),
+            fp16,
+            "{es}: the game's state changed what the precision probe measured"
+        );
         assert_eq!(
             snapshot(&gl, es3_state),
             before,
