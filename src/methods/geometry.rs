@@ -53,6 +53,9 @@ pub struct DrawOrder {
     pub cut_out_from: usize,
     /// Transparent objects, back to front.
     pub transparent: Vec<usize>,
+    /// Some opaque object's material is single-sided: the opaque passes set culling object
+    /// by object ([`cull_object`]); else the passes' own (none) holds and they set nothing.
+    pub single_sided: bool,
     /// (view depth, object) of the transparent objects, to sort them.
     depths: Vec<(f64, usize)>,
 }
@@ -65,6 +68,7 @@ pub(crate) fn sort_objects(ctx: &mut FrameContext) {
     let order = &mut *ctx.order;
     order.opaque.clear();
     order.depths.clear();
+    order.single_sided = false;
     let cut_out = |o: &crate::scene::Object| scene.materials[o.material].alpha_cutoff.is_some();
     for (i, o) in scene.objects.iter().enumerate() {
         if scene.materials[o.material].is_transparent() {
@@ -73,8 +77,11 @@ pub(crate) fn sort_objects(ctx: &mut FrameContext) {
                 .world_bounds(o)
                 .map_or(glam::DVec3::ZERO, |b| b.center());
             order.depths.push((-ctx.view.transform_point3(centre).z, i));
-        } else if !ctx.transparent_only && !cut_out(o) {
-            order.opaque.push(i);
+        } else if !ctx.transparent_only {
+            order.single_sided |= !scene.materials[o.material].double_sided;
+            if !cut_out(o) {
+                order.opaque.push(i);
+            }
         }
     }
     order.cut_out_from = order.opaque.len();
@@ -109,7 +116,9 @@ fn depth_prepass(ctx: &mut FrameContext) -> Result<(), Error> {
     for &i in &ctx.order.opaque[..ctx.order.cut_out_from] {
         let (mesh, model) = ctx.gpu_scene.drawn(i, &ctx.scene.objects[i]);
         let view_model = ctx.view * model;
-        object_cull(ctx.scene, i, &view_model).apply(dev);
+        if ctx.order.single_sided {
+            object_cull(ctx.scene, i, &view_model).apply(dev);
+        }
         transforms.set(dev, &view_model, &ctx.projection);
         mesh.draw(dev);
     }
@@ -178,6 +187,9 @@ pub fn draw_objects<P: GeometryProgram>(
 /// before each opaque draw (the depth prepass, the shading pass, deferred's G-buffer), so
 /// every pass covers the same pixels.
 pub(crate) fn cull_object(ctx: &FrameContext, i: usize) {
+    if !ctx.order.single_sided {
+        return;
+    }
     let (_, model) = ctx.gpu_scene.drawn(i, &ctx.scene.objects[i]);
     object_cull(ctx.scene, i, &(ctx.view * model)).apply(ctx.dev);
 }
