@@ -258,11 +258,11 @@ pub fn upload_size((w, h): (u32, u32), max: u32, power_of_two: bool) -> (u32, u3
     (fit(w), fit(h))
 }
 
-/// A mipmapped RGBA8 image texture, read as each bind's [`Sampling`] says. A colour one (sRGB-encoded) is an
-/// `SRGB8_ALPHA8` texture at the ES 3.0 level, so texels are decoded before they are filtered
-/// (glTF 2.0 §3.9.2; filtering encoded values darkens fine high-contrast detail); ES 2.0 has
-/// no sRGB textures in core (`GL_EXT_sRGB` cannot make their mipmaps), so there the shader
-/// decodes the filtered value (`SRGB_TEXTURES` off).
+/// A mipmapped RGBA8 image texture, read as each bind's [`Sampling`] says. A colour one
+/// (sRGB-encoded) is an `SRGB8_ALPHA8` texture at the ES 3.0 level, so texels are decoded
+/// before they are filtered (glTF 2.0 §3.9.2; filtering encoded values darkens fine
+/// high-contrast detail); ES 2.0 has no sRGB textures in core (`GL_EXT_sRGB` cannot make their
+/// mipmaps), so there the shader decodes the filtered value (`SRGB_TEXTURES` off).
 pub struct ImageTexture {
     raw: glow::Texture,
     destroyed: bool,

@@ -186,7 +186,9 @@ pub(super) fn one_sampling_per_image(
             .find(|(_, e)| Arc::ptr_eq(&e.image, &texture.image) && e.sampling != texture.sampling);
         if let Some((first_name, first)) = first {
             warnings.push(format!(
-                "{field}: the {name} and {first_name} textures read one image ({}) through                  different samplers; a draw reads an image through one, so the {name} texture                  takes the {first_name} one's",
+                "{field}: the {name} and {first_name} textures read one image ({}) through \
+                 different samplers; a draw reads an image through one, so the {name} texture \
+                 takes the {first_name} one's",
                 shown::name(&texture.name)
             ));
             **texture = Arc::new(Texture {
