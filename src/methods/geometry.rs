@@ -54,7 +54,7 @@ pub struct DrawOrder {
     /// Transparent objects, back to front.
     pub transparent: Vec<usize>,
     /// Some opaque object's material is single-sided: the opaque passes set culling object
-    /// by object ([`cull_object`]); else the passes' own (none) holds and they set nothing.
+    /// by object (`cull_object`); else the passes' own (none) holds and they set nothing.
     pub single_sided: bool,
     /// (view depth, object) of the transparent objects, to sort them.
     depths: Vec<(f64, usize)>,
