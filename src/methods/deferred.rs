@@ -21,7 +21,7 @@ use glam::{Mat4, Vec3, Vec4};
 
 use super::directional::DirectionalUniforms;
 use super::forward::Forward;
-use super::geometry::{cull_object, shade_object, sort_objects, GeometryProgram, UNIT_METHOD};
+use super::geometry::{shade_object, sort_objects, GeometryProgram, UNIT_METHOD};
 use super::uniforms::{self, Surface, Transforms};
 use super::{FrameContext, MethodDesc, MethodStats, ShaderFeatures, ShadingMethod, Support};
 use crate::cluster::grid::GridProjection;
@@ -247,7 +247,6 @@ impl Deferred {
         let mut drawn = Ok(());
         for k in 0..ctx.order.opaque.len() {
             let i = ctx.order.opaque[k];
-            cull_object(ctx, i);
             drawn = shade_object(ctx, i, "gbuffer", 1, &mut |p: &GBufferProgram, dev| {
                 p.viewport.set(dev, viewport);
                 p.half_extent.set(dev, half);

@@ -7,7 +7,6 @@ use super::{FrameContext, ShaderFeatures};
 use crate::gl::program::{ProgramKey, Resolver, UniformSet};
 use crate::gl::state::{Cull, RenderState};
 use crate::gl::Device;
-use crate::scene::Scene;
 use crate::Error;
 
 /// Texture unit of the diffuse map.
@@ -54,7 +53,8 @@ pub struct DrawOrder {
     /// Transparent objects, back to front.
     pub transparent: Vec<usize>,
     /// Some opaque object's material is single-sided: the opaque passes set culling object
-    /// by object (`cull_object`); else the passes' own (none) holds and they set nothing.
+    /// by object (in `shade_object` and the depth prepass); else the passes' own (none)
+    /// holds and they set nothing.
     pub single_sided: bool,
     /// (view depth, object) of the transparent objects, to sort them.
     depths: Vec<(f64, usize)>,
@@ -117,7 +117,8 @@ fn depth_prepass(ctx: &mut FrameContext) -> Result<(), Error> {
         let (mesh, model) = ctx.gpu_scene.drawn(i, &ctx.scene.objects[i]);
         let view_model = ctx.view * model;
         if ctx.order.single_sided {
-            object_cull(ctx.scene, i, &view_model).apply(dev);
+            let double_sided = ctx.scene.materials[ctx.scene.objects[i].material].double_sided;
+            Cull::for_surface(double_sided, is_mirroring(&view_model)).apply(dev);
         }
         transforms.set(dev, &view_model, &ctx.projection);
         mesh.draw(dev);
@@ -150,7 +151,6 @@ pub fn draw_objects<P: GeometryProgram>(
             state.apply(ctx.dev);
         }
         let i = ctx.order.opaque[k];
-        cull_object(ctx, i);
         shade_object(ctx, i, shader, max_lights, bind_method)?;
     }
     // Counts are of the visible opaque surface: blending would mix two counts in 8 bits.
@@ -183,24 +183,9 @@ pub fn draw_objects<P: GeometryProgram>(
     Ok(())
 }
 
-/// Culls object `i`'s back faces when its material is single-sided, else draws both sides:
-/// before each opaque draw (the depth prepass, the shading pass, deferred's G-buffer), so
-/// every pass covers the same pixels.
-pub(crate) fn cull_object(ctx: &FrameContext, i: usize) {
-    if !ctx.order.single_sided {
-        return;
-    }
-    let (_, model) = ctx.gpu_scene.drawn(i, &ctx.scene.objects[i]);
-    object_cull(ctx.scene, i, &(ctx.view * model)).apply(ctx.dev);
-}
-
-/// The culling of `scene`'s object `i` placed in view space by `view_model`.
-fn object_cull(scene: &Scene, i: usize, view_model: &glam::DMat4) -> Cull {
-    let double_sided = scene.materials[scene.objects[i].material].double_sided;
-    Cull::for_surface(double_sided, is_mirroring(view_model))
-}
-
-/// One object with its material's shader variant.
+/// One object with its material's shader variant. An opaque one's back faces are culled here
+/// when its material is single-sided, as in the depth prepass, so every opaque pass (shading,
+/// deferred's G-buffer) covers the same pixels; a transparent one's culling is its pass's.
 pub(crate) fn shade_object<P: GeometryProgram>(
     ctx: &mut FrameContext,
     index: usize,
@@ -254,9 +239,12 @@ pub(crate) fn shade_object<P: GeometryProgram>(
         .bind(dev, key, || features.defines(dialect, max_lights))?;
     // The camera is subtracted in f64 here, so far-from-origin scenes stay exact in f32.
     let (mesh, model) = ctx.gpu_scene.drawn(index, object);
-    program
-        .transforms()
-        .set(dev, &(ctx.view * model), &ctx.projection);
+    let view_model = ctx.view * model;
+    let mirrored = is_mirroring(&view_model);
+    if ctx.order.single_sided && !material.is_transparent() {
+        Cull::for_surface(material.double_sided, mirrored).apply(dev);
+    }
+    program.transforms().set(dev, &view_model, &ctx.projection);
     if let Some(t) = texture {
         let sampling = material
             .diffuse_texture
@@ -277,9 +265,7 @@ pub(crate) fn shade_object<P: GeometryProgram>(
         &frame,
         features.has(ShaderFeatures::COUNT_HEATMAP),
     );
-    program
-        .surface()
-        .set_mirrored(dev, is_mirroring(&(ctx.view * model)));
+    program.surface().set_mirrored(dev, mirrored);
     if let Some(directional) = program.directional() {
         directional.set(dev, &ctx.directional);
     }
