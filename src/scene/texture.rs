@@ -28,6 +28,15 @@ impl Texture {
             sampling: Sampling::default(),
         }
     }
+
+    /// The same image (shared, not copied) read through `sampling`.
+    pub fn with_sampling(&self, sampling: Sampling) -> Texture {
+        Texture {
+            name: self.name.clone(),
+            image: self.image.clone(),
+            sampling,
+        }
+    }
 }
 
 /// How a texture is read: its wrapping beyond [0, 1] along each axis and its filtering

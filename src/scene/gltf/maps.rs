@@ -191,11 +191,7 @@ pub(super) fn one_sampling_per_image(
                  takes the {first_name} one's",
                 shown::name(&texture.name)
             ));
-            **texture = Arc::new(Texture {
-                name: texture.name.clone(),
-                image: texture.image.clone(),
-                sampling: first.sampling,
-            });
+            **texture = Arc::new(texture.with_sampling(first.sampling));
         }
     }
 }

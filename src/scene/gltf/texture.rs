@@ -72,13 +72,7 @@ impl Textures {
         let sampled = self
             .sampled
             .entry((image.index(), sampling))
-            .or_insert_with(|| {
-                Arc::new(Texture {
-                    name: plain.name.clone(),
-                    image: plain.image.clone(),
-                    sampling,
-                })
-            });
+            .or_insert_with(|| Arc::new(plain.with_sampling(sampling)));
         Ok(Some(sampled.clone()))
     }
 
