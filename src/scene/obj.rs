@@ -14,11 +14,15 @@ use glam::{DMat4, DVec3, Vec2, Vec3};
 use super::access::LoadOptions;
 use super::input::{read_bounded, FileKind};
 use super::material::{MAX_COLOR_FACTOR, MAX_SHININESS};
+use super::surface_maps::{SurfaceMaps, TextureTransform};
+use super::texture::{Sampling, Texture, Wrap};
 use super::texture_budget::TextureBudget;
 use super::{shown, Aabb, Material, Mesh, Object, Scene, SceneError};
+use map_options::MapStatement;
 
 mod corners;
 mod lines;
+mod map_options;
 mod textures;
 
 pub use lines::{MAX_OBJ_CORNERS, MAX_OBJ_MATERIALS};
@@ -94,14 +98,15 @@ pub fn load_into(
         let material_name = shown::name(&m.name);
         // The caller's texture replaces the MTL's, which is then not even decoded (it would
         // take its part of the budget for nothing).
-        let texture = match &m.diffuse_texture {
+        let statement = m.diffuse_texture.as_deref().map(MapStatement::parse);
+        let texture = match &statement {
             _ if override_tex.is_some() => None,
-            Some(name) if !name.trim().is_empty() => {
+            Some(MapStatement { file: name, .. }) if !name.is_empty() => {
                 match find_texture(base_dir, name, allow_outside) {
                     Ok(Some(p)) => textures.load(&p, budget, &mut |w| report.warn(w)),
                     Ok(None) => {
                         // Something there that is not a file (`/dev/zero`, a folder) is named so.
-                        let what = if base_dir.join(name.trim()).exists() {
+                        let what = if base_dir.join(name).exists() {
                             "is not a regular file"
                         } else {
                             "not found"
@@ -158,6 +163,16 @@ pub fn load_into(
         };
         let shininess = number("Ns", m.shininess, 1.0, (0.0, MAX_SHININESS));
         let alpha = number("d", m.dissolve, 1.0, (0.0, 1.0));
+        let mut maps = SurfaceMaps::default();
+        let texture = match (texture, &statement) {
+            (Some(texture), Some(statement)) => {
+                let (texture, transform) =
+                    apply_map_options(texture, statement, &material_name, &mut report);
+                maps.base_transform = transform;
+                Some(texture)
+            }
+            (texture, _) => texture,
+        };
         material_of[id] = Some(scene.materials.len());
         scene.materials.push(Material {
             name: material_name,
@@ -166,6 +181,7 @@ pub fn load_into(
             specular,
             shininess,
             alpha,
+            maps,
             ..Material::default()
         });
     }
@@ -229,6 +245,43 @@ pub fn load_into(
         });
     }
     Ok(report)
+}
+
+/// `texture` as `map_Kd`'s options read it (`-clamp`), and the base colour's transform
+/// (`-o`, `-s`); a warning names the options that are not applied and a transform that is
+/// not usable (left out).
+fn apply_map_options(
+    texture: Arc<Texture>,
+    statement: &MapStatement,
+    material_name: &str,
+    report: &mut LoadReport,
+) -> (Arc<Texture>, TextureTransform) {
+    let texture = if statement.clamp {
+        Arc::new(texture.with_sampling(Sampling {
+            wrap_u: Wrap::ClampToEdge,
+            wrap_v: Wrap::ClampToEdge,
+            ..Sampling::default()
+        }))
+    } else {
+        texture
+    };
+    if !statement.unapplied.is_empty() {
+        report.warn(format!(
+            "material `{material_name}`: map_Kd options not applied: {}",
+            statement.unapplied.join(", ")
+        ));
+    }
+    let transform = statement.transform().unwrap_or_else(|| {
+        report.warn(format!(
+            "material `{material_name}`: map_Kd -o {:?} -s {:?} left out (texture coordinate \
+             offsets and scales must be finite and within ±{:e})",
+            statement.offset,
+            statement.scale,
+            super::mesh::MAX_TEXCOORD
+        ));
+        TextureTransform::IDENTITY
+    });
+    (texture, transform)
 }
 
 /// Parses an OBJ read within its size limit, its MTL libraries read the same way and checked

@@ -12,7 +12,8 @@ pub struct Texture {
     /// Pixels, row 0 at the top as image files store them. Shared by the textures that read
     /// one image with different [`Sampling`]s (uploaded once).
     pub image: Arc<image::RgbaImage>,
-    /// How it is read between and beyond its texels (glTF's sampler; the default for OBJ).
+    /// How it is read between and beyond its texels (glTF's sampler; for OBJ the default, or
+    /// clamped by `map_Kd -clamp on`).
     /// A draw binds each image once: a material whose slots read one image through
     /// different samplings reads it through one of them (the glTF loader makes them agree,
     /// with a warning).

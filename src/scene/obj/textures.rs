@@ -67,18 +67,30 @@ fn decode_texture(path: &Path, budget: &mut TextureBudget) -> Result<image::Dyna
     decode_texture_bytes(&bytes, image::ImageFormat::from_path(path).ok(), budget)
 }
 
-/// The file an MTL texture reference names, inside `base_dir` (links resolved) unless
-/// `allow_outside`: `Ok(None)` when none is found, `Err` with the refusal when the name leads
-/// out of the folder and its bare file name is not in it either.
+/// The file an MTL texture statement's file name (after its options) names, inside
+/// `base_dir` (links resolved) unless `allow_outside`: `Ok(None)` when none is found, `Err`
+/// with the refusal when the name leads out of the folder and its bare file name is not in
+/// it either. A name of several words not found is tried by its last word too (a name
+/// written after options the MTL reader does not know).
 pub(super) fn find_texture(
     base_dir: &Path,
     name: &str,
     allow_outside: bool,
 ) -> Result<Option<PathBuf>, String> {
-    let Some(written) = name.split_whitespace().last() else {
+    let name = name.trim();
+    let found = find_named(base_dir, name, allow_outside)?;
+    match name.split_whitespace().last() {
+        Some(last) if found.is_none() && last != name => find_named(base_dir, last, allow_outside),
+        _ => Ok(found),
+    }
+}
+
+/// [`find_texture`] for the whole of `name`.
+fn find_named(base_dir: &Path, name: &str, allow_outside: bool) -> Result<Option<PathBuf>, String> {
+    if name.is_empty() {
         return Ok(None);
-    };
-    let written = written.replace('\\', "/");
+    }
+    let written = name.replace('\\', "/");
     within_folder(base_dir, &written, allow_outside, |_| {
         resolve_texture(base_dir, name)
     })
@@ -113,10 +125,10 @@ fn bare_file_in(dir: &Path, name: &str) -> Option<PathBuf> {
     find_case_insensitive(dir, file_name).filter(|p| p.is_file())
 }
 
-/// Finds the file an MTL texture reference means (see the module docs for the order).
+/// Finds the file a texture name (an MTL statement's after its options, or a glTF URI,
+/// either of which may hold spaces) means (see the module docs for the order).
 pub fn resolve_texture(base_dir: &Path, name: &str) -> Option<PathBuf> {
-    // MTL options such as `-bm 0.5 file.png` put the file name last.
-    let name = name.split_whitespace().last()?.replace('\\', "/");
+    let name = name.replace('\\', "/");
     let as_written = base_dir.join(&name);
     if as_written.is_file() {
         return Some(as_written);
@@ -176,8 +188,13 @@ mod tests {
             Some(want.clone())
         );
         assert_eq!(
-            resolve_texture(dir.path(), "-bm 1 Textures/Brick.PNG"),
-            Some(want)
+            find_texture(dir.path(), "-unknown 1 Textures/Brick.PNG", false),
+            Ok(Some(want))
+        );
+        std::fs::write(dir.path().join("Textures").join("Old Brick.png"), b"x").unwrap();
+        assert_eq!(
+            resolve_texture(dir.path(), "textures/old brick.PNG"),
+            Some(dir.path().join("Textures").join("Old Brick.png"))
         );
         assert_eq!(resolve_texture(dir.path(), "missing.png"), None);
     }
