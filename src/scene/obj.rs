@@ -21,6 +21,8 @@ use super::{shown, Aabb, Material, Mesh, Object, Scene, SceneError};
 use map_options::MapStatement;
 
 mod corners;
+#[cfg(test)]
+mod hostile_tests;
 mod lines;
 mod map_options;
 mod textures;
@@ -284,6 +286,10 @@ fn apply_map_options(
     (texture, transform)
 }
 
+/// Most material libraries one OBJ's `mtllib` lines may name (distinct names; a model uses
+/// one or a few). Each is read within its own limit, so this bounds what they read together.
+const MAX_MTL_LIBRARIES: usize = 64;
+
 /// Parses an OBJ read within its size limit, its MTL libraries read the same way and checked
 /// first for what tobj would panic on. tobj runs under `catch_unwind` as a last guard: a panic
 /// inside it becomes an error naming the file, never an abort of the caller. The last value
@@ -335,8 +341,11 @@ fn parse_obj(path: &Path, allow_outside: bool) -> Result<Parsed, SceneError> {
         ignore_lines: true,
     };
     // Each library is read once: tobj reads and merges one again for every `mtllib` line, so
-    // a file repeating the line millions of times would exhaust memory.
+    // a file repeating the line millions of times would exhaust memory. Each name is looked
+    // up once, and at most `MAX_MTL_LIBRARIES` of them (each looks at the disk and may warn).
+    let named = std::cell::RefCell::new(std::collections::HashSet::new());
     let seen = std::cell::RefCell::new(std::collections::HashSet::new());
+    let past_libraries = std::cell::Cell::new(false);
     // Materials the libraries read so far define (within `lines::MAX_OBJ_MATERIALS`).
     let defined = std::cell::Cell::new(0);
     let warnings = std::cell::RefCell::new(Vec::new());
@@ -345,6 +354,14 @@ fn parse_obj(path: &Path, allow_outside: bool) -> Result<Parsed, SceneError> {
             "{}: some face corners name a texture coordinate or normal and others do not; \
              those without take texture coordinate (0, 0) and their faces' normal",
             path.display()
+        ));
+    }
+    if let Some(line) = rewrites.long_name {
+        warnings.borrow_mut().push(format!(
+            "{}: object or group names longer than {} bytes (the first at line {line}) are cut \
+             to that length",
+            path.display(),
+            lines::MAX_OBJ_NAME_BYTES
         ));
     }
     if let Some((with, without)) = rewrites.mixed_colours {
@@ -357,6 +374,23 @@ fn parse_obj(path: &Path, allow_outside: bool) -> Result<Parsed, SceneError> {
     let warn = |w: String| warnings.borrow_mut().push(w);
     let load_mtl = |name: &Path| -> tobj::MTLLoadResult {
         let name = name.to_string_lossy().replace('\\', "/");
+        {
+            let mut named = named.borrow_mut();
+            if named.contains(&name) {
+                return Ok(Default::default());
+            }
+            if named.len() >= MAX_MTL_LIBRARIES {
+                if !past_libraries.replace(true) {
+                    warn(format!(
+                        "{}: more than {MAX_MTL_LIBRARIES} material libraries named; the rest \
+                         are not read",
+                        path.display()
+                    ));
+                }
+                return Ok(Default::default());
+            }
+            named.insert(name.clone());
+        }
         // `find` is `Some`: the library is read as joined (reading it says if it is
         // missing), or as its bare file name was found; there is always a path.
         let mtl_path = within_folder(&base_dir, &name, allow_outside, Some)
@@ -365,7 +399,9 @@ fn parse_obj(path: &Path, allow_outside: bool) -> Result<Parsed, SceneError> {
                 warn(format!("{}: mtllib {refusal}", path.display()));
                 tobj::LoadError::OpenFileFailed
             })?;
-        if !seen.borrow_mut().insert(mtl_path.clone()) {
+        // By the file it is (a link in the folder or another letter case may name it again).
+        let file = std::fs::canonicalize(&mtl_path).unwrap_or_else(|_| mtl_path.clone());
+        if !seen.borrow_mut().insert(file) {
             return Ok(Default::default());
         }
         let bytes = read_bounded(&mtl_path, FileKind::Materials).map_err(|e| {

@@ -17,10 +17,13 @@ use crate::scene::mesh::{MAX_SCENE_MESHES, MAX_TEXCOORD};
 ///   file defines (negative indices count back from the last one defined before the line):
 ///   an index beyond them overflowed tobj's arithmetic (a panic in debug builds, a read of the
 ///   wrong element in release ones);
-/// - at most [`MAX_SCENE_MESHES`] objects have faces (tobj makes one at each `o`, `g` or change
-///   of `usemtl` after faces): each is a mesh of its own, whose fixed cost (buffers, GL
-///   objects, the ray caster's hierarchy) would otherwise grow past memory before a frame;
-/// - the faces, triangulated, hold at most [`MAX_OBJ_CORNERS`] corners.
+/// - at most [`MAX_SCENE_MESHES`] objects have faces or lines (tobj makes one at each `o`, `g`
+///   or change of `usemtl` after them, even of lines it then drops): each is a mesh of its
+///   own, whose fixed cost (buffers, GL objects, the ray caster's hierarchy) would otherwise
+///   grow past memory before a frame;
+/// - the faces, triangulated, hold at most [`MAX_OBJ_CORNERS`] corners, a face or line of
+///   fewer than three corners (which tobj keeps until its object ends, then drops) counted as
+///   a triangle.
 ///
 /// Returns what [`rewrite`] must change for tobj to read the file.
 pub(super) fn check_obj(text: &str) -> Result<Rewrites, String> {
@@ -37,17 +40,21 @@ pub(super) struct Rewrites {
     pub mixed_colours: Option<(usize, usize)>,
     /// Some `vt` line gives one number (its `v` is then 0, as OBJ has it; tobj needs two).
     pub one_number_texcoords: bool,
+    /// The first `o` or `g` line whose name passes [`MAX_OBJ_NAME_BYTES`]: such names are cut
+    /// to it (tobj copies an object's name into every mesh it splits the object into).
+    pub long_name: Option<usize>,
 }
 
 impl Rewrites {
     /// Whether anything needs rewriting.
     pub fn needed(&self) -> bool {
-        self.mixed_colours.is_some() || self.one_number_texcoords
+        self.mixed_colours.is_some() || self.one_number_texcoords || self.long_name.is_some()
     }
 }
 
 /// `text` with what `rewrites` names changed: every `v` line's colour taken off, every `vt`
-/// line of one number given its `v` of 0.
+/// line of one number given its `v` of 0, every object or group name cut to
+/// [`MAX_OBJ_NAME_BYTES`].
 pub(super) fn rewrite(text: &str, rewrites: &Rewrites) -> String {
     let mut out = String::with_capacity(text.len() + text.len() / 8);
     for line in text.lines() {
@@ -63,12 +70,33 @@ pub(super) fn rewrite(text: &str, rewrites: &Rewrites) -> String {
         } else if rewrites.one_number_texcoords && key == Some("vt") && count == 1 {
             out.push_str(line.trim_end());
             out.push_str(" 0");
+        } else if let (Some(_), Some(name)) = (rewrites.long_name, long_object_name(line)) {
+            out.push_str(&line.trim_start()[..1]);
+            out.push(' ');
+            let end = (0..=MAX_OBJ_NAME_BYTES)
+                .rev()
+                .find(|&i| name.is_char_boundary(i))
+                .unwrap_or(0);
+            out.push_str(&name[..end]);
         } else {
             out.push_str(line);
         }
         out.push('\n');
     }
     out
+}
+
+/// Longest object or group name kept, in bytes: longer ones are cut (a name is copied into
+/// each of up to [`MAX_SCENE_MESHES`] meshes).
+pub const MAX_OBJ_NAME_BYTES: usize = 256;
+
+/// The name of an `o` or `g` line, as tobj reads it (all after the key, trimmed), when it is
+/// longer than [`MAX_OBJ_NAME_BYTES`].
+fn long_object_name(line: &str) -> Option<&str> {
+    let line = line.trim_start();
+    let key = line.split_whitespace().next()?;
+    let name = line[key.len()..].trim();
+    (matches!(key, "o" | "g") && name.len() > MAX_OBJ_NAME_BYTES).then_some(name)
 }
 
 /// Most triangle corners the faces of one OBJ may hold once triangulated (as many indices as
@@ -99,11 +127,15 @@ fn check_obj_within(text: &str, max_corners: usize) -> Result<Rewrites, String> 
     // The first `v` line without a colour and the first with one.
     let mut coloured: [Option<usize>; 2] = [None, None];
     let mut one_number_texcoords = false;
+    let mut long_name = None;
     for (number, line) in text.lines().enumerate() {
         let at_line = |what: String| format!("line {}: {what}", number + 1);
         let mut words = line.split_whitespace();
         let key = words.next();
         objects.read(key, line).map_err(at_line)?;
+        if long_name.is_none() && long_object_name(line).is_some() {
+            long_name = Some(number + 1);
+        }
         if let Some(kind) = kind_of(key) {
             let read = check_vertex_data(key.unwrap_or_default(), words).map_err(at_line)?;
             defined[kind] += 1;
@@ -125,15 +157,15 @@ fn check_obj_within(text: &str, max_corners: usize) -> Result<Rewrites, String> 
         if words.clone().next().is_none() {
             return Err(at_line(format!("`{key}` names no vertices")));
         }
-        if key == "f" {
-            // Triangulated as a fan: three corners for each corner past the second.
-            corners += 3 * words.clone().count().saturating_sub(2);
-            if corners > max_corners {
-                return Err(at_line(format!(
-                    "the faces so far hold more than the {max_corners} triangle corners one \
-                     OBJ may (each takes some 40 bytes or more parsed)"
-                )));
-            }
+        // Triangulated as a fan: three corners for each corner past the second; a shorter
+        // face or a line is kept by tobj as a triangle is, until its object ends.
+        corners += 3 * words.clone().count().saturating_sub(2).max(1);
+        if corners > max_corners {
+            return Err(at_line(format!(
+                "the faces and lines so far hold more than the {max_corners} triangle corners \
+                 one OBJ may (each takes some 40 bytes or more parsed; a face or line of fewer \
+                 than three corners counts as three)"
+            )));
         }
         for (at, word) in words.enumerate() {
             // tobj's "face parse error", without a line (it reads `1/2/3/` as `1/2/3`).
@@ -179,6 +211,7 @@ fn check_obj_within(text: &str, max_corners: usize) -> Result<Rewrites, String> 
             _ => None,
         },
         one_number_texcoords,
+        long_name,
     })
 }
 
@@ -214,14 +247,14 @@ impl<'a> Objects<'a> {
                     self.material = name;
                 }
             }
-            Some("f") if !self.current_has_faces => {
+            Some("f" | "l") if !self.current_has_faces => {
                 self.current_has_faces = true;
                 self.with_faces += 1;
                 if self.with_faces > MAX_SCENE_MESHES {
                     return Err(format!(
-                        "a face of object {}: more than {MAX_SCENE_MESHES} objects with faces \
-                         (`o`, `g` and material changes), the limit per file; merge objects \
-                         that share a material in the exporter",
+                        "a face or line of object {}: more than {MAX_SCENE_MESHES} objects \
+                         with faces or lines (`o`, `g` and material changes), the limit per \
+                         file; merge objects that share a material in the exporter",
                         self.with_faces
                     ));
                 }
@@ -377,6 +410,7 @@ pub(super) fn check_mtl(text: &str, defined: usize) -> Result<usize, String> {
 mod tests {
     use super::{
         check_mtl, check_obj, check_obj_within, rewrite, undefined_materials, HashSet, Objects,
+        MAX_OBJ_NAME_BYTES,
     };
 
     /// Colours on some `v` lines and not others are found (the first line with, the first
@@ -422,20 +456,40 @@ mod tests {
             err.starts_with("line 7:") && err.contains("11 triangle corners"),
             "{err}"
         );
-        // Lines (`l`) make no triangles.
-        assert!(check_obj_within("v 0 0 0\nl 1 1 1 1\n", 0).is_ok());
+        // Lines (`l`) and faces of one or two corners make no triangles, but tobj keeps
+        // them as long as triangles until their object ends.
+        assert!(check_obj_within("v 0 0 0\nl 1 1 1 1\nf 1\nl 1 1\n", 12).is_ok());
+        let err = check_obj_within("v 0 0 0\nl 1 1 1 1\nf 1\nl 1 1\n", 11).unwrap_err();
+        assert!(err.starts_with("line 4:"), "{err}");
+    }
+
+    /// Object and group names past the limit are cut to it at a character's boundary, the
+    /// first such line named.
+    #[test]
+    fn long_object_names_are_cut() {
+        // Byte 256 falls inside a two-byte character.
+        let long = format!("a{}", "é".repeat(MAX_OBJ_NAME_BYTES));
+        let text = format!("v 0 0 0\no short\n  g {long} \nf 1 1 1\no {long}x\n");
+        let found = check_obj(&text).unwrap();
+        assert_eq!(found.long_name, Some(3));
+        let cut = &long[..MAX_OBJ_NAME_BYTES - 1];
+        assert_eq!(
+            rewrite(&text, &found),
+            format!("v 0 0 0\no short\ng {cut}\nf 1 1 1\no {cut}\n")
+        );
+        assert_eq!(check_obj("o short\n").unwrap().long_name, None);
     }
 
     /// Objects are counted as tobj splits them: a `usemtl` naming the whole rest of its line.
     #[test]
     fn objects_split_at_o_g_and_a_change_of_the_whole_material_name() {
         let text = "f 1 1 1\nusemtl red paint\nf 1 1 1\nusemtl red brick\nf 1 1 1\n\
-                    usemtl red brick\nf 1 1 1\ng a\ng b\nf 1 1 1\n";
+                    usemtl red brick\nf 1 1 1\ng a\ng b\nf 1 1 1\ng c\nl 1 1\n";
         let mut objects = Objects::default();
         for line in text.lines() {
             objects.read(line.split_whitespace().next(), line).unwrap();
         }
-        assert_eq!(objects.with_faces, 4);
+        assert_eq!(objects.with_faces, 5);
     }
 
     #[test]

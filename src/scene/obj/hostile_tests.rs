@@ -1,0 +1,106 @@
+//! OBJ files written to make the loader read, warn or keep without end: each read and each
+//! warning is bounded.
+
+use super::textures::TextureCache;
+use super::{load_into, LoadReport};
+use crate::scene::access::LoadOptions;
+use crate::scene::texture_budget::TextureBudget;
+use crate::scene::Scene;
+use glam::DMat4;
+use std::path::Path;
+use std::sync::Arc;
+
+fn load(obj: &Path) -> (Scene, LoadReport) {
+    let mut scene = Scene::empty();
+    let mut budget = TextureBudget::default();
+    let options = LoadOptions::default();
+    let report = load_into(
+        &mut scene,
+        obj,
+        DMat4::IDENTITY,
+        None,
+        &options,
+        &mut budget,
+    )
+    .unwrap();
+    (scene, report)
+}
+
+/// `mtllib` lines repeating a name, or naming thousands of libraries, warn a bounded number of
+/// times; the library named before them is still read.
+#[test]
+fn mtllib_lines_without_end_warn_a_bounded_number_of_times() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("m.mtl"), "newmtl red\nKd 1 0 0\n").unwrap();
+    let mut obj = String::from("mtllib m.mtl\n");
+    obj += &"mtllib ../outside.mtl\n".repeat(1000);
+    for i in 0..1000 {
+        obj += &format!("mtllib missing{i}.mtl\n");
+    }
+    obj += "v 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl red\nf 1 2 3\n";
+    let path = dir.path().join("m.obj");
+    std::fs::write(&path, obj).unwrap();
+    let (scene, report) = load(&path);
+    let refused = report
+        .warnings
+        .iter()
+        .filter(|w| w.contains("outside.mtl"))
+        .count();
+    assert_eq!(refused, 1, "{:?}", report.warnings);
+    assert!(
+        report.warnings.len() <= super::MAX_MTL_LIBRARIES + 4,
+        "{} warnings",
+        report.warnings.len()
+    );
+    assert!(report
+        .warnings
+        .iter()
+        .any(|w| w.contains("material libraries named; the rest are not read")));
+    assert_eq!(scene.materials[0].name, "red");
+}
+
+/// One texture file named through a link to the folder is decoded once; past what the
+/// model's textures may read together, a texture is left out with a warning.
+#[cfg(unix)]
+#[test]
+fn a_texture_is_decoded_once_whatever_names_it_and_reads_are_bounded() {
+    let dir = tempfile::tempdir().unwrap();
+    image::RgbaImage::from_pixel(2, 2, image::Rgba([9, 9, 9, 255]))
+        .save(dir.path().join("t.png"))
+        .unwrap();
+    std::os::unix::fs::symlink(".", dir.path().join("d")).unwrap();
+    let mut cache = TextureCache::default();
+    let mut budget = TextureBudget::default();
+    let mut warnings = Vec::new();
+    let mut warn = |w: String| warnings.push(w);
+    let names = ["t.png", "d/t.png", "d/d/t.png"];
+    let loaded: Vec<_> = names
+        .iter()
+        .map(|n| {
+            cache
+                .load(&dir.path().join(n), &mut budget, &mut warn)
+                .unwrap()
+        })
+        .collect();
+    assert!(loaded.iter().all(|t| Arc::ptr_eq(t, &loaded[0])));
+    let mut once = TextureBudget::default();
+    once.take(2, 2).unwrap();
+    assert_eq!(budget, once, "decoded once");
+
+    let size = std::fs::metadata(dir.path().join("t.png")).unwrap().len();
+    let mut cache = TextureCache::with_read_limit(size);
+    std::fs::copy(dir.path().join("t.png"), dir.path().join("u.png")).unwrap();
+    let mut budget = TextureBudget::default();
+    assert!(cache
+        .load(&dir.path().join("t.png"), &mut budget, &mut warn)
+        .is_some());
+    assert!(cache
+        .load(&dir.path().join("u.png"), &mut budget, &mut warn)
+        .is_none());
+    assert!(
+        warnings
+            .iter()
+            .any(|w| w.contains("u.png is not read: the model's textures together")),
+        "{warnings:?}"
+    );
+}
