@@ -312,6 +312,28 @@ fn a_json_file_that_is_not_gltf_shows_none_of_its_strings() {
     let path = write(dir.path(), "none.gltf", "{}");
     let err = load(&path).unwrap_err().to_string();
     assert!(err.contains("missing field `asset`"), "{err}");
+    // Keys the file made up are not shown where an error names a field: a number past u32
+    // under one, an application-specific attribute (`_NAME`) with an index out of range.
+    let made_up_key = SENTINEL.replace('-', "_");
+    for (name, text) in [
+        (
+            "wide.gltf",
+            format!(r#"{{"{made_up_key}": [{{"n": 1700000000000}}]}}"#),
+        ),
+        (
+            "attribute.gltf",
+            format!(
+                r#"{{"asset": {{"version": "2.0"}}, "meshes": [{{"primitives":
+                [{{"attributes": {{"_{made_up_key}": 5}}}}]}}]}}"#
+            ),
+        ),
+    ] {
+        let err = load(&write(dir.path(), name, text))
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("meshes[0]") || err.contains("…[0]"), "{err}");
+        assert!(!err.contains(&made_up_key), "{err}");
+    }
 }
 
 /// Distinct meshes each cost a fixed few KB besides their data: a small file listing more than

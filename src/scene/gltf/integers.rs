@@ -8,6 +8,8 @@ use std::fmt;
 
 use serde::de::{self, DeserializeSeed, IgnoredAny, MapAccess, SeqAccess, Visitor};
 
+use super::schema_path::is_schema_name;
+
 /// The first integer past `u32::MAX` where glTF allows none, as an error naming its field.
 pub(super) fn check(json: &[u8]) -> Result<(), String> {
     let mut path = Vec::new();
@@ -44,13 +46,20 @@ struct Walk<'a> {
 }
 
 impl Walk<'_> {
+    /// The path down to the value, a key the file made up shown as `…` (a message never
+    /// carries the file's text).
     fn field(&self) -> String {
         let mut out = String::new();
         for part in self.path.iter() {
             if !part.starts_with('[') && !out.is_empty() {
                 out.push('.');
             }
-            out.push_str(part);
+            let index = part.starts_with('[');
+            out.push_str(if index || is_schema_name(part) {
+                part
+            } else {
+                "…"
+            });
         }
         out
     }
@@ -155,6 +164,9 @@ mod tests {
                 .unwrap_err();
         assert!(err.contains("KHR_lights_punctual.light"), "{err}");
         assert!(check(br#"{"nodes":[{"mesh":4294967295}]}"#).is_ok());
+        // A key the file made up is not shown (a message never carries the file's text).
+        let err = check(br#"{"user_token_abc":[{"n":1700000000000}]}"#).unwrap_err();
+        assert!(err.starts_with("…[0].…:"), "{err}");
     }
 
     #[test]

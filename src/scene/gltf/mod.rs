@@ -497,8 +497,7 @@ fn validate(root: &gltf::json::Root) -> Result<(), String> {
     let mut errors = Vec::new();
     root.validate(root, gltf::json::Path::new, &mut |path, error| {
         // The crate spells the extension's key in camelCase; name it as the file does.
-        let path = path()
-            .to_string()
+        let path = schema_path::without_made_up_keys(&path().to_string())
             .replace("khrLightsPunctual", "KHR_lights_punctual");
         let bounds = path.ends_with(".min") || path.ends_with(".max");
         let ignored_bounds = bounds && matches!(error, Error::Missing | Error::Invalid);

@@ -30,6 +30,33 @@ pub(super) fn misfit(json: &[u8]) -> Option<String> {
     })
 }
 
+/// A path the `gltf` crate's validation wrote (`….attributes["NAME"]`) with a key the file
+/// made up (not [`is_schema_name`]) and all after it shown as `[…]`: the key is the file's
+/// text, written unescaped, so nothing after its start can be trusted to end it.
+pub(super) fn without_made_up_keys(path: &str) -> String {
+    let mut out = String::new();
+    let mut rest = path;
+    while let Some(start) = rest.find("[\"") {
+        out.push_str(&rest[..start]);
+        let after = &rest[start + 2..];
+        match after
+            .find("\"]")
+            .map(|end| (&after[..end], &after[end + 2..]))
+        {
+            Some((key, next)) if is_schema_name(key) => {
+                out.push_str(&format!("[\"{key}\"]"));
+                rest = next;
+            }
+            _ => {
+                out.push_str("[…]");
+                return out;
+            }
+        }
+    }
+    out.push_str(rest);
+    out
+}
+
 /// Property names of the glTF 2.0 schema and of the extensions the loader reads, and the
 /// attribute semantics.
 pub(super) fn is_schema_name(key: &str) -> bool {
@@ -155,7 +182,20 @@ pub(super) fn is_schema_name(key: &str) -> bool {
 
 #[cfg(test)]
 mod tests {
-    use super::misfit;
+    use super::{misfit, without_made_up_keys};
+
+    #[test]
+    fn validation_paths_hide_keys_the_file_made_and_what_follows() {
+        assert_eq!(
+            without_made_up_keys(r#"meshes[0].primitives[1].attributes["SECRET"].x"#),
+            "meshes[0].primitives[1].attributes[…]"
+        );
+        assert_eq!(
+            without_made_up_keys(r#"a["POSITION"].b["x\"]y"]"#),
+            r#"a["POSITION"].b[…]"#
+        );
+        assert_eq!(without_made_up_keys("nodes[2].mesh"), "nodes[2].mesh");
+    }
 
     #[test]
     fn the_path_names_schema_fields_and_hides_names_the_file_made() {
