@@ -121,10 +121,17 @@ impl Loaded {
     }
 }
 
-/// Most bytes a scene file's load reads again for glTF files with lights or a camera (such a
-/// file is read for each reference; its buffers and images count): many references to a
-/// large file would keep a load busy without end.
+/// Most bytes a scene file's load reads and decodes again for models read more than once (a
+/// glTF file with lights or a camera, for each reference; an OBJ, for each other texture
+/// override): the files, their buffers and images, and the images' decoded pixels count
+/// (a small image may decode to 512 MiB). Many references to a large file would keep a load
+/// busy without end.
 pub const MAX_REREAD_BYTES: u64 = 1 << 30;
+
+/// Bytes read and pixel bytes decoded on this thread so far: what a re-read costs.
+fn work_so_far() -> u64 {
+    super::input::bytes_read().saturating_add(super::texture_budget::pixel_bytes_decoded())
+}
 
 /// The models one scene file has loaded, by canonical path (and texture override for OBJ).
 #[derive(Default)]
@@ -133,9 +140,10 @@ pub(super) struct ModelCache {
     options: LoadOptions,
     /// What is left of the scene's texture memory.
     texture_budget: TextureBudget,
-    /// Bytes of glTF files read again for references after their first (files with lights
-    /// or a camera).
+    /// Bytes read and decoded again for models read more than once ([`MAX_REREAD_BYTES`]).
     reread_bytes: u64,
+    /// Every OBJ file read so far (canonical): another read of one is a re-read.
+    obj_read: std::collections::HashSet<PathBuf>,
     /// Texture bytes the first read of each such file kept.
     reread_textures: HashMap<PathBuf, u64>,
     obj: HashMap<(PathBuf, Option<PathBuf>), Loaded>,
@@ -186,19 +194,39 @@ impl ModelCache {
             loaded.place(scene, transform, recolour, transform_field)?;
             return Ok(LoadReport::default());
         }
+        // Read again for another texture override: bounded in total, as a glTF's re-reads.
+        let reread = key.as_ref().is_some_and(|k| self.obj_read.contains(&k.0));
+        if reread && self.reread_bytes > MAX_REREAD_BYTES {
+            return Err(SceneError::Obj {
+                path: path.to_path_buf(),
+                reason: format!(
+                    "an OBJ file is read again for each other `texture`, and this scene \
+                     file's re-reads (the files, their textures and the pixels decoded) passed \
+                     {} MiB before {transform_field}'s (fewer distinct textures)",
+                    MAX_REREAD_BYTES >> 20
+                ),
+            });
+        }
         let first = (scene.objects.len(), scene.materials.len());
+        let work_before = work_so_far();
         // Loaded at the identity: each object's transform is then its own (its mesh is stored
         // about its centre), recorded once and placed below.
-        let report = obj::load_into(
+        let loaded = obj::load_into(
             scene,
             path,
             DMat4::IDENTITY,
             texture,
             &self.options,
             &mut self.texture_budget,
-        )?;
+        );
+        if reread {
+            let work = work_so_far().wrapping_sub(work_before);
+            self.reread_bytes = self.reread_bytes.saturating_add(work);
+        }
+        let report = loaded?;
         self.share(scene, first.0, first.1, key.as_ref().map(|k| &k.0), true);
         if let Some(key) = key {
+            self.obj_read.insert(key.0.clone());
             let mut loaded = Loaded::record(scene, first, |o| o.transform, false);
             loaded.uncoloured_at = (!recolour).then_some(first.1);
             self.obj.insert(key, loaded);
@@ -272,7 +300,8 @@ impl ModelCache {
                 path: path.to_path_buf(),
                 reason: format!(
                     "a glTF file with lights or a camera is read again for each reference, and \
-                     this scene file's re-reads (the files, their buffers and images) passed \
+                     this scene file's re-reads (the files, their buffers and images, and the \
+                     pixels decoded) passed \
                      {} MiB before {transform_field}'s (fewer references, or a file without \
                      its lights: place lights in the scene file)",
                     MAX_REREAD_BYTES >> 20
@@ -280,7 +309,7 @@ impl ModelCache {
             });
         }
         let (first_object, first_material) = (scene.objects.len(), scene.materials.len());
-        let read_before = super::input::bytes_read();
+        let read_before = work_so_far();
         // The file's first read takes its textures' part of the scene's budget. A later one's
         // are the first read's: decoded again within what is left and what the first read
         // kept, then swapped for those held (charged again, a scene near its budget lost them
@@ -306,7 +335,7 @@ impl ModelCache {
         );
         self.reread_bytes = self
             .reread_bytes
-            .saturating_add(super::input::bytes_read().wrapping_sub(read_before));
+            .saturating_add(work_so_far().wrapping_sub(read_before));
         let mut loaded = read?;
         let charged = kept_earlier.is_none();
         if let (true, Some(k)) = (charged, &key) {

@@ -101,12 +101,24 @@ pub(crate) fn decode_texture_bytes(
     // images of 16 384² that failed at their last row took 16 s, none of it counted). One
     // refused by the decoder's limits decoded nothing, and gives it back.
     let taken = budget.take(w, h)?;
+    PIXEL_BYTES_DECODED.with(|n| n.set(n.get().saturating_add(u64::from(w) * u64::from(h) * 4)));
     reader()?.decode().map_err(|e| {
         if matches!(e, image::ImageError::Limits(_)) {
             budget.give_back(taken);
         }
         undecodable(e)
     })
+}
+
+thread_local! {
+    /// RGBA bytes of the images [`decode_texture_bytes`] set out to decode on this thread.
+    static PIXEL_BYTES_DECODED: std::cell::Cell<u64> = const { std::cell::Cell::new(0) };
+}
+
+/// RGBA bytes of the images decoded on this thread so far, at their full size (a running
+/// count, as [`super::input::bytes_read`]): a small file may decode to 512 MiB.
+pub(crate) fn pixel_bytes_decoded() -> u64 {
+    PIXEL_BYTES_DECODED.with(std::cell::Cell::get)
 }
 
 /// Bytes a JPEG decode's output holds a pixel at most (RGBA).

@@ -189,6 +189,49 @@ fn a_gltf_named_many_times_shares_its_meshes_and_textures() {
         err.contains("passed 1024 MiB before objects[256].transform's"),
         "{err}"
     );
+    // Re-reads count the pixels they decode as well as the bytes they read: an 8192² PNG of
+    // one colour (a few hundred KB) decodes to 256 MiB, so the fifth read passes 1 GiB.
+    lit.as_object_mut().unwrap().remove("extras");
+    image::RgbaImage::new(8192, 8192)
+        .save(dir.path().join("big.png"))
+        .unwrap();
+    lit["images"][0]["uri"] = "big.png".into();
+    std::fs::write(dir.path().join("lit.gltf"), lit.to_string()).unwrap();
+    let objects: Vec<serde_json::Value> = (0..8)
+        .map(|i| serde_json::json!({"gltf": "lit.gltf", "transform": {"translate": [i, 0, 0]}}))
+        .collect();
+    std::fs::write(&file, serde_json::json!({"objects": objects}).to_string()).unwrap();
+    let Err(err) = scene::load(file.to_str().unwrap(), None) else {
+        panic!("eight decodes of 256 MiB loaded");
+    };
+    let err = err.to_string();
+    assert!(err.contains("passed 1024 MiB before objects[4]"), "{err}");
+}
+
+/// An OBJ is read again for each other texture override (each may name a file of its own):
+/// such re-reads stop once past 1 GiB, naming the reference, as a glTF's do.
+#[test]
+fn obj_rereads_for_other_textures_are_bounded() {
+    let dir = tempfile::tempdir().unwrap();
+    write_model(dir.path());
+    let obj = dir.path().join("m.obj");
+    let mut text = std::fs::read_to_string(&obj).unwrap();
+    text += &format!("# {}\n", "x".repeat(4 << 20));
+    std::fs::write(&obj, text).unwrap();
+    let objects: Vec<serde_json::Value> = (0..300)
+        .map(|i| serde_json::json!({"obj": "m.obj", "texture": format!("missing{i}.png")}))
+        .collect();
+    let file = dir.path().join("s.json");
+    std::fs::write(&file, serde_json::json!({"objects": objects}).to_string()).unwrap();
+    let Err(err) = scene::load(file.to_str().unwrap(), None) else {
+        panic!("300 re-reads of a 4 MiB OBJ loaded");
+    };
+    let err = err.to_string();
+    assert!(
+        err.contains("read again for each other `texture`")
+            && err.contains("passed 1024 MiB before objects[257]"),
+        "{err}"
+    );
 }
 
 /// An OBJ repeating a quad thousands of times (in every rotation and winding) loads as the
