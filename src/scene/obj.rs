@@ -29,7 +29,7 @@ mod textures;
 
 pub use lines::{MAX_OBJ_CORNERS, MAX_OBJ_MATERIALS};
 pub use textures::resolve_texture;
-use textures::{find_texture, within_folder, TextureCache};
+use textures::{within_folder, TextureCache, TextureFinder};
 
 /// What an OBJ load produced besides the objects: non-fatal problems, for the caller to show.
 #[derive(Debug, Default)]
@@ -70,6 +70,7 @@ pub fn load_into(
     }
     let base_dir = path.parent().unwrap_or(Path::new("."));
     let mut textures = TextureCache::default();
+    let mut finder = TextureFinder::default();
     let override_tex =
         texture_override.and_then(|p| textures.load(p, budget, &mut |w| report.warn(w)));
     let mtl = match materials {
@@ -104,7 +105,7 @@ pub fn load_into(
         let texture = match &statement {
             _ if override_tex.is_some() => None,
             Some(MapStatement { file: name, .. }) if !name.is_empty() => {
-                match find_texture(base_dir, name, allow_outside) {
+                match finder.find(base_dir, name, allow_outside) {
                     Ok(Some(p)) => textures.load(&p, budget, &mut |w| report.warn(w)),
                     Ok(None) => {
                         // Something there that is not a file (`/dev/zero`, a folder) is named so.
@@ -393,7 +394,7 @@ fn parse_obj(path: &Path, allow_outside: bool) -> Result<Parsed, SceneError> {
         }
         // `find` is `Some`: the library is read as joined (reading it says if it is
         // missing), or as its bare file name was found; there is always a path.
-        let mtl_path = within_folder(&base_dir, &name, allow_outside, Some)
+        let mtl_path = within_folder(&base_dir, &name, allow_outside, true, Some)
             .map(|found| found.unwrap_or_default())
             .map_err(|refusal| {
                 warn(format!("{}: mtllib {refusal}", path.display()));

@@ -104,3 +104,35 @@ fn a_texture_is_decoded_once_whatever_names_it_and_reads_are_bounded() {
         "{warnings:?}"
     );
 }
+
+/// Each texture name is searched for beyond its spelling (other letter case, bare file name)
+/// once, and only so many names: past them a name is found as written (a name found before
+/// is remembered); a name is matched folder by folder only so deep.
+#[cfg(unix)]
+#[test]
+fn texture_searches_are_bounded_in_number_and_depth() {
+    use super::textures::{TextureFinder, MAX_MATCHED_COMPONENTS, MAX_SEARCHED_NAMES};
+    let dir = tempfile::tempdir().unwrap();
+    let base = dir.path();
+    std::fs::create_dir(base.join("sub")).unwrap();
+    std::fs::write(base.join("sub").join("t.png"), b"x").unwrap();
+    std::os::unix::fs::symlink(".", base.join("d")).unwrap();
+    let want = Ok(Some(base.join("sub").join("t.png").canonicalize().unwrap()));
+    let mut finder = TextureFinder::default();
+    // What is found is kept as found (through the links): compared by the file it is.
+    let mut find = |name: &str| {
+        finder
+            .find(base, name, false)
+            .map(|found| found.map(|p| p.canonicalize().unwrap()))
+    };
+    let deep = |links: usize| format!("{}SUB/T.PNG", "d/".repeat(links));
+    assert_eq!(find(&deep(MAX_MATCHED_COMPONENTS - 2)), want);
+    assert_eq!(find(&deep(MAX_MATCHED_COMPONENTS - 1)), Ok(None));
+    assert_eq!(find("Sub/T.png"), want);
+    for i in 0..MAX_SEARCHED_NAMES {
+        let _ = find(&format!("missing{i}.png"));
+    }
+    assert_eq!(find("sub/t.png"), want, "as written");
+    assert_eq!(find("Sub/T.png"), want, "remembered");
+    assert_eq!(find("SUB/t.png"), Ok(None), "not searched");
+}

@@ -6,7 +6,8 @@
 //! folder; the same path matched case-insensitively component by component; the bare file
 //! name, case-insensitively, in the MTL's folder. A name leading out of the model's folder is
 //! refused unless allowed, but its bare file name is still looked for in the folder (an
-//! exporter's `C:\Users\…\wood.png`).
+//! exporter's `C:\Users\…\wood.png`). Each name is looked up once a load, and the searches
+//! beyond a name's spelling, which list folders, are bounded in number and depth.
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -101,49 +102,107 @@ impl TextureCache {
     }
 }
 
+/// Most texture names one OBJ load searches for beyond their spelling (in other letter case,
+/// by bare file name): each search lists folders, so a library of thousands of names missing
+/// from a folder of thousands of files would take minutes. Later names are found as written.
+pub(super) const MAX_SEARCHED_NAMES: usize = 1024;
+
+/// Most components of a name matched folder by folder in other letter case (a name through a
+/// link to its own folder, `d/d/d/…/t.png`, would list a folder for each).
+pub(super) const MAX_MATCHED_COMPONENTS: usize = 32;
+
+/// Finds the textures one OBJ load's MTL statements name: each name once (materials often
+/// share one), and at most [`MAX_SEARCHED_NAMES`] names searched beyond their spelling.
+#[derive(Default)]
+pub(super) struct TextureFinder {
+    found: HashMap<String, Result<Option<PathBuf>, String>>,
+    searched: usize,
+}
+
+impl TextureFinder {
+    /// [`find_texture`], remembered by name.
+    pub(super) fn find(
+        &mut self,
+        base_dir: &Path,
+        name: &str,
+        allow_outside: bool,
+    ) -> Result<Option<PathBuf>, String> {
+        if let Some(found) = self.found.get(name) {
+            return found.clone();
+        }
+        let search = self.searched < MAX_SEARCHED_NAMES;
+        let written = name.trim().replace('\\', "/");
+        let as_written = access::join(base_dir, &written, allow_outside).is_ok_and(|p| p.is_file());
+        self.searched += usize::from(!as_written);
+        let found = find_texture_searching(base_dir, name, allow_outside, search);
+        self.found.insert(name.to_string(), found.clone());
+        found
+    }
+}
+
 /// The file an MTL texture statement's file name (after its options) names, inside
 /// `base_dir` (links resolved) unless `allow_outside`: `Ok(None)` when none is found, `Err`
 /// with the refusal when the name leads out of the folder and its bare file name is not in
 /// it either. A name of several words not found is tried by its last word too (a name
 /// written after options the MTL reader does not know).
+#[cfg(test)]
 pub(super) fn find_texture(
     base_dir: &Path,
     name: &str,
     allow_outside: bool,
 ) -> Result<Option<PathBuf>, String> {
+    find_texture_searching(base_dir, name, allow_outside, true)
+}
+
+/// [`find_texture`], looking beyond the name's spelling only with `search`.
+fn find_texture_searching(
+    base_dir: &Path,
+    name: &str,
+    allow_outside: bool,
+    search: bool,
+) -> Result<Option<PathBuf>, String> {
     let name = name.trim();
-    let found = find_named(base_dir, name, allow_outside)?;
+    let found = find_named(base_dir, name, allow_outside, search)?;
     match name.split_whitespace().last() {
-        Some(last) if found.is_none() && last != name => find_named(base_dir, last, allow_outside),
+        Some(last) if found.is_none() && last != name => {
+            find_named(base_dir, last, allow_outside, search)
+        }
         _ => Ok(found),
     }
 }
 
-/// [`find_texture`] for the whole of `name`.
-fn find_named(base_dir: &Path, name: &str, allow_outside: bool) -> Result<Option<PathBuf>, String> {
+/// [`find_texture_searching`] for the whole of `name`.
+fn find_named(
+    base_dir: &Path,
+    name: &str,
+    allow_outside: bool,
+    search: bool,
+) -> Result<Option<PathBuf>, String> {
     if name.is_empty() {
         return Ok(None);
     }
     let written = name.replace('\\', "/");
-    within_folder(base_dir, &written, allow_outside, |_| {
-        resolve_texture(base_dir, name)
+    within_folder(base_dir, &written, allow_outside, search, |_| {
+        resolve_searching(base_dir, name, search)
     })
 }
 
 /// What `find` finds of `written` (`/` separating) from `base_dir`, given the path as joined,
 /// where the name stays in the folder; else, unless `allow_outside`, its bare file name in
-/// the folder, or the refusal when it is not there (an exporter's absolute path). What is found
-/// is checked with its links resolved and kept as found (its name in messages stays the
-/// model's).
+/// the folder (with `search`), or the refusal when it is not there (an exporter's absolute
+/// path). What is found is checked with its links resolved and kept as found (its name in
+/// messages stays the model's).
 pub(super) fn within_folder(
     base_dir: &Path,
     written: &str,
     allow_outside: bool,
+    search: bool,
     find: impl FnOnce(PathBuf) -> Option<PathBuf>,
 ) -> Result<Option<PathBuf>, String> {
     let found = match access::join(base_dir, written, allow_outside) {
         Ok(joined) => find(joined),
-        Err(refusal) => Some(bare_file_in(base_dir, written).ok_or(refusal)?),
+        Err(refusal) if search => Some(bare_file_in(base_dir, written).ok_or(refusal)?),
+        Err(refusal) => return Err(refusal),
     };
     found
         .map(|p| access::resolve(base_dir, &p, allow_outside).map(|_| p))
@@ -162,20 +221,32 @@ fn bare_file_in(dir: &Path, name: &str) -> Option<PathBuf> {
 /// Finds the file a texture name (an MTL statement's after its options, or a glTF URI,
 /// either of which may hold spaces) means (see the module docs for the order).
 pub fn resolve_texture(base_dir: &Path, name: &str) -> Option<PathBuf> {
+    resolve_searching(base_dir, name, true)
+}
+
+/// [`resolve_texture`], looking beyond the name's spelling only with `search`.
+fn resolve_searching(base_dir: &Path, name: &str, search: bool) -> Option<PathBuf> {
     let name = name.replace('\\', "/");
     let as_written = base_dir.join(&name);
     if as_written.is_file() {
         return Some(as_written);
     }
+    if !search {
+        return None;
+    }
+    let parts: Vec<&str> = name
+        .split('/')
+        .filter(|p| !p.is_empty() && *p != ".")
+        .collect();
     let mut dir = base_dir.to_path_buf();
-    let mut matched = true;
-    for part in name.split('/').filter(|p| !p.is_empty() && *p != ".") {
+    let mut matched = parts.len() <= MAX_MATCHED_COMPONENTS;
+    for part in parts {
+        if !matched {
+            break;
+        }
         match find_case_insensitive(&dir, part) {
             Some(p) => dir = p,
-            None => {
-                matched = false;
-                break;
-            }
+            None => matched = false,
         }
     }
     if matched && dir.is_file() {
