@@ -242,9 +242,9 @@ pub fn hardware_srgb(caps: &super::Caps) -> bool {
 }
 
 /// The size an image of `size` is uploaded at: each side within `max` (the context's
-/// `GL_MAX_TEXTURE_SIZE`), and with `power_of_two` (ES 2.0, which allows neither mipmaps nor
-/// `REPEAT` on other sizes, and OBJ texture coordinates tile) the largest power of two not above
-/// that. Images are only ever scaled down: rounding up made a 12 000² PNG a 16 384² texture,
+/// `GL_MAX_TEXTURE_SIZE`), and with `power_of_two` (ES 2.0 without `GL_OES_texture_npot`,
+/// which allows neither mipmaps nor `REPEAT` on other sizes, and OBJ texture coordinates tile)
+/// the largest power of two not above that. Images are only ever scaled down: rounding up made a 12 000² PNG a 16 384² texture,
 /// minutes of resizing and 4.7 GB.
 pub fn upload_size((w, h): (u32, u32), max: u32, power_of_two: bool) -> (u32, u32) {
     let fit = |side: u32| {
@@ -273,7 +273,8 @@ pub struct ImageTexture {
 
 impl ImageTexture {
     /// Uploads an image, downscaled where it is larger than the context's texture limit and,
-    /// on ES 2.0, to a power of two (see [`upload_size`]); `srgb` for colour (see above).
+    /// on ES 2.0 without `GL_OES_texture_npot`, to a power of two (see [`upload_size`]);
+    /// `srgb` for colour (see above).
     pub fn new(
         dev: &Device,
         image: &image::RgbaImage,
@@ -281,7 +282,7 @@ impl ImageTexture {
     ) -> Result<ImageTexture, GlError> {
         let max = dev.caps().max_texture_size.max(1) as u32;
         let (w, h) = image.dimensions();
-        let (pw, ph) = upload_size((w, h), max, dev.es() == EsVersion::Es2);
+        let (pw, ph) = upload_size((w, h), max, !dev.caps().npot_textures);
         let resized;
         let img = if (pw, ph) != (w, h) {
             // Area averaging (upload sizes only ever shrink) without `resize`'s full-width f32

@@ -214,6 +214,29 @@ fn capped_driver_says_clearly_that_es3_is_unavailable() {
     assert!(out.status.success(), "{}", text(&out));
 }
 
+/// ES 2.0 without `GL_OES_texture_npot` (Mali-400 has none) scales images to a power of two,
+/// and says so in its capabilities; with it (as Mesa lists it) images keep their size
+/// (`npot_textures.rs`).
+#[test]
+fn es2_lists_whether_images_keep_their_size() {
+    let dir = tempfile::tempdir().unwrap();
+    if !mesa_driver(dir.path()) {
+        return;
+    }
+    for (env, npot) in [
+        (&[][..], true),
+        (
+            &[("MESA_EXTENSION_OVERRIDE", "-GL_OES_texture_npot")][..],
+            false,
+        ),
+    ] {
+        let out = manylight(&["info", "--es", "2", "--json"], env, dir.path());
+        assert!(out.status.success(), "{}", text(&out));
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        assert_eq!(v["caps"]["npot_textures"], npot, "{env:?}");
+    }
+}
+
 #[test]
 fn without_float_textures_es2_falls_back_to_rgba8_lights_with_a_warning() {
     let dir = tempfile::tempdir().unwrap();
