@@ -175,7 +175,12 @@ impl Caps {
             fragment_highp = precision(glow::HIGH_FLOAT);
             fragment_mediump = precision(glow::MEDIUM_FLOAT);
             // Querying an unsupported enum must not leave an error behind for later checks.
-            while gl.get_error() != glow::NO_ERROR {}
+            // Bounded, as `Device::drain_errors`: a lost context may report errors forever.
+            for _ in 0..16 {
+                if gl.get_error() == glow::NO_ERROR {
+                    break;
+                }
+            }
         }
         Ok(Caps {
             es,

@@ -60,6 +60,10 @@ pub(crate) struct HostState {
     toggled: [bool; TOGGLED.len()],
     off_inside: [bool; OFF_INSIDE.len()],
     rasterizer_discard: bool,
+    /// `PRIMITIVE_RESTART_FIXED_INDEX` (ES 3.0, desktop 4.3): the renderer's 16-bit index
+    /// 65 535 is a vertex of any mesh chunk of 65 536 vertices. `None` where the context has
+    /// no such capability.
+    fixed_index_restart: Option<bool>,
     blend_func: [i32; 4],
     blend_equation: [i32; 2],
     depth_func: i32,
@@ -84,6 +88,8 @@ pub(crate) struct HostState {
 struct DesktopState {
     polygon_mode: i32,
     framebuffer_srgb: bool,
+    /// `PRIMITIVE_RESTART` (desktop 3.1), restarting at the game's own index.
+    primitive_restart: bool,
 }
 
 impl HostState {
@@ -92,7 +98,8 @@ impl HostState {
     /// the capabilities of `OFF_INSIDE` off, additive blend equations, counter-clockwise
     /// front faces, the full depth range, a clear depth of 1, pixel rows that start where
     /// the data does and texture unit 0 active (a game's active unit past the saved ones
-    /// keeps its texture); on `desktop` GL, filled polygons and no sRGB encoding.
+    /// keeps its texture), no primitive restart; on `desktop` GL, filled polygons and no sRGB
+    /// encoding.
     pub(crate) fn enter(
         gl: &glow::Context,
         es3: bool,
@@ -129,6 +136,7 @@ impl HostState {
                 int(glow::BLEND_SRC_ALPHA),
                 int(glow::BLEND_DST_ALPHA),
             ];
+            let gl_version = (gl.version().major, gl.version().minor);
             let saved = HostState {
                 es3,
                 vertex_array: vao
@@ -165,6 +173,8 @@ impl HostState {
                 toggled: TOGGLED.map(|c| gl.is_enabled(c)),
                 off_inside: OFF_INSIDE.map(|c| gl.is_enabled(c)),
                 rasterizer_discard: es3 && gl.is_enabled(glow::RASTERIZER_DISCARD),
+                fixed_index_restart: (es3 && (!desktop || gl_version >= (4, 3)))
+                    .then(|| gl.is_enabled(glow::PRIMITIVE_RESTART_FIXED_INDEX)),
                 blend_func,
                 blend_equation: [
                     int(glow::BLEND_EQUATION_RGB),
@@ -191,12 +201,17 @@ impl HostState {
                     DesktopState {
                         polygon_mode: polygon_mode[0],
                         framebuffer_srgb: gl.is_enabled(glow::FRAMEBUFFER_SRGB),
+                        primitive_restart: gl.is_enabled(glow::PRIMITIVE_RESTART),
                     }
                 }),
             };
             if desktop {
                 gl.polygon_mode(glow::FRONT_AND_BACK, glow::FILL);
                 gl.disable(glow::FRAMEBUFFER_SRGB);
+                gl.disable(glow::PRIMITIVE_RESTART);
+            }
+            if saved.fixed_index_restart.is_some() {
+                gl.disable(glow::PRIMITIVE_RESTART_FIXED_INDEX);
             }
             if let Some(vao) = vao {
                 gl.bind_vertex_array(Some(vao));
@@ -273,6 +288,9 @@ impl HostState {
             if self.es3 {
                 enable(glow::RASTERIZER_DISCARD, self.rasterizer_discard);
             }
+            if let Some(on) = self.fixed_index_restart {
+                enable(glow::PRIMITIVE_RESTART_FIXED_INDEX, on);
+            }
             let [sr, dr, sa, da] = self.blend_func.map(|v| v as u32);
             gl.blend_func_separate(sr, dr, sa, da);
             let [er, ea] = self.blend_equation.map(|v| v as u32);
@@ -292,6 +310,7 @@ impl HostState {
             if let Some(desktop) = &self.desktop {
                 gl.polygon_mode(glow::FRONT_AND_BACK, desktop.polygon_mode as u32);
                 enable(glow::FRAMEBUFFER_SRGB, desktop.framebuffer_srgb);
+                enable(glow::PRIMITIVE_RESTART, desktop.primitive_restart);
             }
         }
     }

@@ -69,6 +69,7 @@ fn snapshot(gl: &glow::Context, es3: bool) -> Snapshot {
             glow::PACK_ROW_LENGTH,
         ]);
         enabled.push(glow::RASTERIZER_DISCARD);
+        enabled.push(glow::PRIMITIVE_RESTART_FIXED_INDEX);
     }
     unsafe {
         let floats = [
@@ -208,6 +209,7 @@ unsafe fn set_game_state(gl: &glow::Context, es3: bool, vao: bool, size: (i32, i
         gl.bind_framebuffer(glow::READ_FRAMEBUFFER, Some(read));
         gl.blend_equation_separate(glow::MAX, glow::MIN);
         gl.enable(glow::RASTERIZER_DISCARD);
+        gl.enable(glow::PRIMITIVE_RESTART_FIXED_INDEX);
     } else {
         gl.blend_equation_separate(glow::FUNC_SUBTRACT, glow::FUNC_REVERSE_SUBTRACT);
     }
@@ -380,4 +382,65 @@ fn a_renderer_refuses_another_current_context_and_leaves_its_objects() {
         manylight::metrics::diff(&reference, &after_abandon).max_abs,
         0
     );
+}
+
+/// A mesh whose first 16-bit chunk holds 65 536 vertices, the last of them (local index
+/// 65 535, the fixed restart index) a corner of a large triangle in view: 21 844 triangles of
+/// zero area, then a quad before the camera.
+fn scene_with_index_65535_in_view() -> manylight::Scene {
+    use manylight::glam::{DMat4, Vec3};
+    let mut scene = scene::builtin::build("plane", Some((8, 1))).unwrap();
+    let cam = &scene.camera;
+    let forward = (cam.target - cam.position).normalize();
+    let right = forward.cross(cam.up).normalize();
+    let up = right.cross(forward);
+    let centre = cam.position + forward * 3.0;
+    let mut positions = vec![centre.as_vec3(); 21_844 * 3];
+    let corner = |x: f64, y: f64| (centre + right * x + up * y).as_vec3();
+    positions.extend([
+        corner(-1.0, -1.0),
+        corner(1.0, -1.0),
+        corner(1.0, 1.0),
+        corner(-1.0, 1.0),
+    ]);
+    let mut indices: Vec<u32> = (0..21_844 * 3).collect();
+    indices.extend([65_532, 65_533, 65_534, 65_532, 65_534, 65_535]);
+    let mesh = manylight::Mesh::new(positions, vec![], vec![], indices).unwrap();
+    let material = scene.add_material(manylight::Material::flat("quad", Vec3::splat(0.8)));
+    scene.objects.push(manylight::Object {
+        mesh: std::sync::Arc::new(mesh),
+        material,
+        transform: DMat4::IDENTITY,
+    });
+    scene
+}
+
+/// The game's `PRIMITIVE_RESTART_FIXED_INDEX` (ES 3.0 state) does not cut the triangles of a
+/// mesh chunk that use local index 65 535: the picture equals a clean renderer's.
+#[test]
+fn the_games_primitive_restart_does_not_cut_large_meshes() {
+    let scene = scene_with_index_65535_in_view();
+    let (w, h) = (64, 36);
+    for es in [EsVersion::Es2, EsVersion::Es3] {
+        let mut clean = Gpu::fresh(es);
+        let expected = clean
+            .r()
+            .render_offscreen(&scene, w, h, &RenderOptions::default())
+            .unwrap()
+            .0;
+        drop(clean);
+        let ctx = HeadlessContext::new(es).unwrap();
+        let gl = ctx.load_gl().unwrap();
+        let mut renderer = Renderer::new(ctx.load_gl().unwrap(), es).unwrap();
+        if !renderer.caps().context_has_es3_state() {
+            continue;
+        }
+        unsafe { gl.enable(glow::PRIMITIVE_RESTART_FIXED_INDEX) };
+        let (img, _) = renderer
+            .render_offscreen(&scene, w, h, &RenderOptions::default())
+            .unwrap();
+        let d = manylight::metrics::diff(&expected, &img);
+        assert_eq!(d.max_abs, 0, "{es}: the game's restart cut the quad");
+        assert!(unsafe { gl.is_enabled(glow::PRIMITIVE_RESTART_FIXED_INDEX) });
+    }
 }
