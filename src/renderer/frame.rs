@@ -512,6 +512,17 @@ fn check_options(options: &RenderOptions) -> Result<(), Error> {
             );
         }
     }
+    for (field, value) in [
+        ("grid.first_split", options.grid.first_split),
+        (
+            "grid.measure.min_cell_size",
+            options.grid.measure.min_cell_size,
+        ),
+    ] {
+        if let Some(v) = value.filter(|v| !v.is_finite()) {
+            return invalid(field, format!("must be finite (or None), got {v}"));
+        }
+    }
     if options.max_assign_threads == 0 {
         let why = "must be at least 1 (1: the calling thread alone)".to_string();
         return invalid("max_assign_threads", why);

@@ -4,7 +4,7 @@ use std::sync::Arc;
 
 use glam::Vec3;
 
-use super::surface_maps::SurfaceMaps;
+use super::surface_maps::{SurfaceMaps, MAX_NORMAL_SCALE};
 pub use super::texture::Texture;
 use super::SceneError;
 
@@ -200,6 +200,38 @@ impl Material {
                 ),
             ));
         }
+        let maps = &self.maps;
+        let scale = maps.normal_scale;
+        if !(scale.is_finite() && scale.abs() <= MAX_NORMAL_SCALE) {
+            return Err(SceneError::invalid(
+                format!("{field}.maps.normal_scale"),
+                format!("must be within ±{MAX_NORMAL_SCALE}, got {scale:?}"),
+            ));
+        }
+        let strength = maps.occlusion_strength;
+        if !(strength.is_finite() && (0.0..=1.0).contains(&strength)) {
+            return Err(SceneError::invalid(
+                format!("{field}.maps.occlusion_strength"),
+                format!("must be in [0, 1], got {strength:?}"),
+            ));
+        }
+        // An image without pixels has nothing to sample (uploaded, it read as black).
+        let base = self
+            .diffuse_texture
+            .as_ref()
+            .map(|t| ("diffuse_texture".to_string(), t));
+        let in_maps = maps
+            .textures()
+            .map(|(n, t)| (format!("maps.{n}"), &t.texture));
+        for (name, texture) in base.into_iter().chain(in_maps) {
+            let (w, h) = texture.image.dimensions();
+            if w == 0 || h == 0 {
+                return Err(SceneError::invalid(
+                    format!("{field}.{name}"),
+                    format!("an image of {w}×{h} pixels has nothing to sample"),
+                ));
+            }
+        }
         if !(self.shininess.is_finite() && self.shininess >= 0.0) {
             return Err(SceneError::invalid(
                 format!("{field}.shininess"),
@@ -236,5 +268,53 @@ mod tests {
         m.metallic = 1.5;
         let err = m.validate("materials[1]").unwrap_err().to_string();
         assert!(err.contains("materials[1].metallic"), "{err}");
+    }
+
+    /// What the glTF loader keeps in range with a warning, and images without pixels (which
+    /// drew black), are refused in a material built in code, naming the field.
+    #[test]
+    fn map_strengths_out_of_range_and_empty_images_are_refused_naming_the_field() {
+        use crate::scene::surface_maps::MapTexture;
+        let ok = Material::metallic_roughness("m", Vec3::ONE, 0.0, 0.5);
+        let texture = |w, h| Arc::new(Texture::new("t", image::RgbaImage::new(w, h)));
+        let refused = |change: &dyn Fn(&mut Material), said: &str| {
+            let mut m = ok.clone();
+            change(&mut m);
+            let err = m.validate("materials[2]").unwrap_err().to_string();
+            assert!(err.contains(said), "{said}: {err}");
+        };
+        refused(
+            &|m| m.maps.normal_scale = f32::INFINITY,
+            "materials[2].maps.normal_scale",
+        );
+        refused(
+            &|m| m.maps.normal_scale = -17.0,
+            "materials[2].maps.normal_scale",
+        );
+        refused(
+            &|m| m.maps.occlusion_strength = 2.0,
+            "maps.occlusion_strength",
+        );
+        refused(
+            &|m| m.maps.occlusion_strength = f32::NAN,
+            "maps.occlusion_strength",
+        );
+        refused(
+            &|m| m.diffuse_texture = Some(texture(0, 0)),
+            "materials[2].diffuse_texture",
+        );
+        let empty = MapTexture {
+            texture: texture(4, 0),
+            transform: Default::default(),
+        };
+        refused(
+            &|m| m.maps.occlusion = Some(empty.clone()),
+            "materials[2].maps.occlusion",
+        );
+        let mut edges = ok.clone();
+        edges.maps.normal_scale = -MAX_NORMAL_SCALE;
+        edges.maps.occlusion_strength = 0.0;
+        edges.diffuse_texture = Some(texture(1, 1));
+        assert!(edges.validate("materials[2]").is_ok());
     }
 }

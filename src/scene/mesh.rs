@@ -155,43 +155,14 @@ impl Mesh {
         let mut indices = indices;
         let n = positions.len();
         check_indices(&indices, n, "mesh.indices")?;
-        if let Some(i) = positions.iter().position(|p| !p.is_finite()) {
-            return Err(SceneError::invalid(
-                format!("mesh.positions[{i}]"),
-                format!("must be finite, got {:?}", positions[i]),
-            ));
-        }
-        if let Some(i) = positions
-            .iter()
-            .position(|p| p.abs().max_element() > MAX_VERTEX_COORD)
-        {
-            return Err(SceneError::invalid(
-                format!("mesh.positions[{i}]"),
-                format!(
-                    "must be within ±{MAX_VERTEX_COORD:e} (object space is f32; place far \
-                     objects with their transform, which is f64), got {:?}",
-                    positions[i]
-                ),
-            ));
-        }
+        check_positions(&positions, "mesh")?;
         if !uvs.is_empty() && uvs.len() != n {
             return Err(SceneError::invalid(
                 "mesh.uvs",
                 format!("{} texture coordinates for {n} vertices", uvs.len()),
             ));
         }
-        if let Some(i) = uvs
-            .iter()
-            .position(|t| !(t.is_finite() && t.abs().max_element() <= MAX_TEXCOORD))
-        {
-            return Err(SceneError::invalid(
-                format!("mesh.uvs[{i}]"),
-                format!(
-                    "must be finite and within ±{MAX_TEXCOORD:e}, got {:?}",
-                    uvs[i]
-                ),
-            ));
-        }
+        check_uvs(&uvs, "mesh")?;
         let normals = if normals.len() == n {
             let normals = repair_normals(normals, &positions, &indices);
             if !as_wound {
@@ -343,9 +314,11 @@ impl Mesh {
 impl Mesh {
     /// Whether the mesh's arrays fit together as [`Mesh::new`] and the `with_*` methods make
     /// them: whole triangles of indices in range, one normal per position, and texture
-    /// coordinates, colours and tangents either none or one per position. The fields are
-    /// public, so a mesh edited in code is checked again before it is uploaded; errors name
-    /// the field under `field` (`objects[3].mesh`).
+    /// coordinates, colours and tangents either none or one per position; and whether their
+    /// values are what [`Mesh::new`] keeps (positions and texture coordinates within their
+    /// limits, normals of some length, every number finite). The fields are public, so a mesh
+    /// built or edited in code is checked again before it is uploaded; errors name the field
+    /// under `field` (`objects[3].mesh`).
     pub(crate) fn check_shape(&self, field: &str) -> Result<(), SceneError> {
         let n = self.positions.len();
         let at = |what: &str| format!("{field}.{what}");
@@ -361,8 +334,71 @@ impl Mesh {
                 check_per_vertex(&at(name), len, n)?;
             }
         }
+        check_positions(&self.positions, field)?;
+        check_uvs(&self.uvs, field)?;
+        // A zero normal normalises to NaN in the shader (`Mesh::new` puts the face's there).
+        let unusable = |v: Vec3| !(v.is_finite() && v.length_squared() > 0.0);
+        if let Some(i) = self.normals.iter().position(|&v| unusable(v)) {
+            return Err(SceneError::invalid(
+                format!("{field}.normals[{i}]"),
+                format!("must be finite and not zero, got {:?}", self.normals[i]),
+            ));
+        }
+        if let Some(i) = self.colors.iter().position(|c| !c.is_finite()) {
+            return Err(SceneError::invalid(
+                format!("{field}.colors[{i}]"),
+                format!("must be finite, got {:?}", self.colors[i]),
+            ));
+        }
+        if let Some(i) = self.tangents.iter().position(|t| !t.is_finite()) {
+            return Err(SceneError::invalid(
+                format!("{field}.tangents[{i}]"),
+                format!("must be finite, got {:?}", self.tangents[i]),
+            ));
+        }
         Ok(())
     }
+}
+
+/// Positions finite and within [`MAX_VERTEX_COORD`]; errors name `{field}.positions[i]`.
+fn check_positions(positions: &[Vec3], field: &str) -> Result<(), SceneError> {
+    if let Some(i) = positions.iter().position(|p| !p.is_finite()) {
+        return Err(SceneError::invalid(
+            format!("{field}.positions[{i}]"),
+            format!("must be finite, got {:?}", positions[i]),
+        ));
+    }
+    if let Some(i) = positions
+        .iter()
+        .position(|p| p.abs().max_element() > MAX_VERTEX_COORD)
+    {
+        return Err(SceneError::invalid(
+            format!("{field}.positions[{i}]"),
+            format!(
+                "must be within ±{MAX_VERTEX_COORD:e} (object space is f32; place far objects \
+                 with their transform, which is f64), got {:?}",
+                positions[i]
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// Texture coordinates finite and within [`MAX_TEXCOORD`]; errors name `{field}.uvs[i]`.
+fn check_uvs(uvs: &[Vec2], field: &str) -> Result<(), SceneError> {
+    if let Some(i) = uvs
+        .iter()
+        .position(|t| !(t.is_finite() && t.abs().max_element() <= MAX_TEXCOORD))
+    {
+        return Err(SceneError::invalid(
+            format!("{field}.uvs[{i}]"),
+            format!(
+                "must be finite and within ±{MAX_TEXCOORD:e}, got {:?}",
+                uvs[i]
+            ),
+        ));
+    }
+    Ok(())
 }
 
 /// Whole triangles of indices, each below `n` (the vertex count); errors name `field`.
@@ -459,6 +495,44 @@ pub fn compute_normals(positions: &[Vec3], indices: &[u32]) -> Vec<Vec3> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A mesh whose public fields were set in code to values `Mesh::new` refuses or repairs
+    /// is refused before upload, naming the field (it drew black or not at all).
+    #[test]
+    fn values_set_in_code_are_checked_before_upload() {
+        let good = Mesh::new(
+            vec![Vec3::ZERO, Vec3::X, Vec3::Y],
+            vec![],
+            vec![Vec2::ZERO; 3],
+            vec![0, 1, 2],
+        )
+        .unwrap();
+        assert!(good.check_shape("objects[1].mesh").is_ok());
+        type Change = dyn Fn(&mut Mesh);
+        let cases: [(&Change, &str); 6] = [
+            (
+                &|m| m.positions[1].x = f32::NAN,
+                "objects[1].mesh.positions[1]",
+            ),
+            (&|m| m.positions[2].y = 3e38, "objects[1].mesh.positions[2]"),
+            (&|m| m.uvs[0] = Vec2::splat(3e38), "objects[1].mesh.uvs[0]"),
+            (&|m| m.normals[2] = Vec3::ZERO, "objects[1].mesh.normals[2]"),
+            (
+                &|m| m.tangents = vec![Vec4::NAN; 3],
+                "objects[1].mesh.tangents[0]",
+            ),
+            (
+                &|m| m.colors = vec![Vec4::INFINITY; 3],
+                "objects[1].mesh.colors[0]",
+            ),
+        ];
+        for (change, field) in cases {
+            let mut m = good.clone();
+            change(&mut m);
+            let err = m.check_shape("objects[1].mesh").unwrap_err().to_string();
+            assert!(err.contains(field), "{field}: {err}");
+        }
+    }
 
     #[test]
     fn computes_face_normals_when_missing() {

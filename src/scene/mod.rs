@@ -264,18 +264,7 @@ impl Scene {
                 format!("must be finite and >= 0, got {:?}", self.ambient),
             ));
         }
-        // Checked without a name first and named only on failure: a scene is validated every
-        // frame, and a valid one costs no allocation.
-        for (i, light) in self.lights.iter().enumerate() {
-            if light.validate("").is_err() {
-                light.validate(&format!("lights[{i}]"))?;
-            }
-        }
-        for (i, light) in self.directional_lights.iter().enumerate() {
-            if light.validate("").is_err() {
-                light.validate(&format!("directional_lights[{i}]"))?;
-            }
-        }
+        // Motions before lights: a bad motion poses its lights at NaN, which is its fault.
         for track in &self.animation {
             let field = || format!("lights[{}].motion", track.first);
             // Lights removed without their tracks: a track would pose whatever lights take
@@ -301,6 +290,18 @@ impl Scene {
                     .all(|l| matches!(l.kind, LightKind::Spot { .. }));
             if track.motion.validate("", is_spot).is_err() {
                 track.motion.validate(&field(), is_spot)?;
+            }
+        }
+        // Checked without a name first and named only on failure: a scene is validated every
+        // frame, and a valid one costs no allocation.
+        for (i, light) in self.lights.iter().enumerate() {
+            if light.validate("").is_err() {
+                light.validate(&format!("lights[{i}]"))?;
+            }
+        }
+        for (i, light) in self.directional_lights.iter().enumerate() {
+            if light.validate("").is_err() {
+                light.validate(&format!("directional_lights[{i}]"))?;
             }
         }
         for (i, m) in self.materials.iter().enumerate() {

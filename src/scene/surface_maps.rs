@@ -125,6 +125,10 @@ impl Default for SurfaceMaps {
     }
 }
 
+/// Largest `normal_scale` magnitude: a normal map's x and y scaled past it point the shading
+/// normal within a degree of the surface (and 16 × 2 stays exact in fp16).
+pub const MAX_NORMAL_SCALE: f32 = 16.0;
+
 /// Largest emitted radiance per channel: the colour tier is fp16 (the same cap as
 /// `material::MAX_COLOR_FACTOR`).
 pub const MAX_EMISSIVE: f32 = 1024.0;

@@ -92,6 +92,31 @@ fn every_unusable_option_is_refused_naming_its_field() {
                 ..Default::default()
             },
         ),
+        (
+            "clustered",
+            "grid.first_split",
+            RenderOptions {
+                grid: manylight::GridConfig {
+                    first_split: Some(f64::NAN),
+                    ..Default::default()
+                },
+                ..Default::default()
+            },
+        ),
+        (
+            "tiled",
+            "grid.measure.min_cell_size",
+            RenderOptions {
+                grid: manylight::GridConfig {
+                    measure: manylight::GridMeasure {
+                        min_cell_size: Some(f64::INFINITY),
+                        ..Default::default()
+                    },
+                    ..Default::default()
+                },
+                ..Default::default()
+            },
+        ),
     ];
     // MSAA asked for on a method without it: the option's error still comes first.
     let mut cases = cases;

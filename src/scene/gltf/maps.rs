@@ -16,7 +16,9 @@ use serde_json::Value;
 use super::buffers::Buffers;
 use super::texture::Textures;
 use crate::scene::mesh::MAX_TEXCOORD;
-use crate::scene::surface_maps::{MapTexture, SurfaceMaps, TextureTransform, MAX_EMISSIVE};
+use crate::scene::surface_maps::{
+    MapTexture, SurfaceMaps, TextureTransform, MAX_EMISSIVE, MAX_NORMAL_SCALE,
+};
 use crate::scene::{shown, Texture};
 
 /// The file's `materials` array as plain JSON, for the transforms.
@@ -214,7 +216,13 @@ pub(super) fn convert(
         };
         maps.normal = load_slot(slot, index, field, src, warnings)?;
         let path = format!("{field}.normalTexture.scale");
-        maps.normal_scale = kept_in(n.scale(), (-16.0, 16.0), 1.0, &path, warnings);
+        maps.normal_scale = kept_in(
+            n.scale(),
+            (-MAX_NORMAL_SCALE, MAX_NORMAL_SCALE),
+            1.0,
+            &path,
+            warnings,
+        );
     }
     if let Some(o) = m.occlusion_texture() {
         let slot = Slot {

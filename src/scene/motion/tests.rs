@@ -302,3 +302,29 @@ fn varied_motions_differ_per_light_and_repeat_per_seed() {
     let rest = spot();
     assert!((a.apply(&rest, 0.0).position - rest.position).length() < 1e-12);
 }
+
+/// A motion set in code that poses its light at NaN is named by the scene's check, not the
+/// light it moved there.
+#[test]
+fn a_scene_names_a_bad_motion_before_the_light_it_posed() {
+    let mut scene = crate::scene::Scene::empty();
+    scene
+        .lights
+        .push(crate::scene::Light::point(DVec3::ZERO, 1.0, Vec3::ONE, 1.0));
+    let orbit = Orbit {
+        about: OrbitAbout::Point(DVec3::X),
+        axis: DVec3::ZERO,
+        period_s: 2.0,
+        phase_deg: 0.0,
+    };
+    scene.animate_light(
+        0,
+        Motion {
+            orbit: Some(orbit),
+            ..Motion::default()
+        },
+    );
+    scene.set_time(0.5);
+    let err = scene.validate().unwrap_err().to_string();
+    assert!(err.contains("lights[0].motion.orbit.axis"), "{err}");
+}
