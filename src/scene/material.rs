@@ -215,22 +215,21 @@ impl Material {
                 format!("must be in [0, 1], got {strength:?}"),
             ));
         }
-        // An image without pixels has nothing to sample (uploaded, it read as black).
+        // An image without pixels has nothing to sample (uploaded, it read as black). Named
+        // only on failure: a scene is validated every frame.
         let base = self
             .diffuse_texture
             .as_ref()
-            .map(|t| ("diffuse_texture".to_string(), t));
-        let in_maps = maps
-            .textures()
-            .map(|(n, t)| (format!("maps.{n}"), &t.texture));
-        for (name, texture) in base.into_iter().chain(in_maps) {
+            .map(|t| ("", "diffuse_texture", t));
+        let in_maps = maps.textures().map(|(n, t)| ("maps.", n, &t.texture));
+        let empty = |t: &Arc<Texture>| t.image.width() == 0 || t.image.height() == 0;
+        let mut textures = base.into_iter().chain(in_maps);
+        if let Some((prefix, name, texture)) = textures.find(|(_, _, t)| empty(t)) {
             let (w, h) = texture.image.dimensions();
-            if w == 0 || h == 0 {
-                return Err(SceneError::invalid(
-                    format!("{field}.{name}"),
-                    format!("an image of {w}×{h} pixels has nothing to sample"),
-                ));
-            }
+            return Err(SceneError::invalid(
+                format!("{field}.{prefix}{name}"),
+                format!("an image of {w}×{h} pixels has nothing to sample"),
+            ));
         }
         if !(self.shininess.is_finite() && self.shininess >= 0.0) {
             return Err(SceneError::invalid(

@@ -25,11 +25,13 @@ mod corners;
 mod hostile_tests;
 mod lines;
 mod map_options;
+mod texture_names;
 mod textures;
 
 pub use lines::{MAX_OBJ_CORNERS, MAX_OBJ_MATERIALS};
-pub use textures::resolve_texture;
-use textures::{within_folder, TextureCache, TextureFinder};
+pub use texture_names::resolve_texture;
+use texture_names::{within_folder, Listings, TextureFinder};
+use textures::TextureCache;
 
 /// What an OBJ load produced besides the objects: non-fatal problems, for the caller to show.
 #[derive(Debug, Default)]
@@ -357,6 +359,13 @@ fn parse_obj(path: &Path, allow_outside: bool) -> Result<Parsed, SceneError> {
             path.display()
         ));
     }
+    if let Some((count, line)) = rewrites.not_faces {
+        warnings.borrow_mut().push(format!(
+            "{}: {count} lines (`l`) and faces of fewer than three corners (the first at line \
+             {line}) are not drawn; manylight draws triangles",
+            path.display()
+        ));
+    }
     if let Some(line) = rewrites.long_name {
         warnings.borrow_mut().push(format!(
             "{}: object or group names longer than {} bytes (the first at line {line}) are cut \
@@ -394,7 +403,8 @@ fn parse_obj(path: &Path, allow_outside: bool) -> Result<Parsed, SceneError> {
         }
         // `find` is `Some`: the library is read as joined (reading it says if it is
         // missing), or as its bare file name was found; there is always a path.
-        let mtl_path = within_folder(&base_dir, &name, allow_outside, true, Some)
+        let listings = &mut Listings::default();
+        let mtl_path = within_folder(&base_dir, &name, allow_outside, listings, |p, _| Some(p))
             .map(|found| found.unwrap_or_default())
             .map_err(|refusal| {
                 warn(format!("{}: mtllib {refusal}", path.display()));

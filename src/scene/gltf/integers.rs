@@ -37,9 +37,25 @@ const WIDE: &[&str] = &["byteOffset", "byteLength", "count"];
 /// Extensions whose contents the loader reads (others are skipped).
 const READ_EXTENSIONS: &[&str] = &["KHR_lights_punctual"];
 
+/// One step down a JSON document: an array's element or an object's member.
+enum Part {
+    Index(usize),
+    Key(String),
+}
+
+impl Part {
+    /// The member's key, if this is one.
+    fn key(&self) -> Option<&str> {
+        match self {
+            Part::Key(k) => Some(k),
+            Part::Index(_) => None,
+        }
+    }
+}
+
 struct Walk<'a> {
     /// `meshes`, `[0]`, `primitives`, … down to the value being read.
-    path: &'a mut Vec<String>,
+    path: &'a mut Vec<Part>,
     /// False inside `extras` and unsupported extensions.
     look: bool,
     found: &'a mut Option<String>,
@@ -51,20 +67,20 @@ impl Walk<'_> {
     fn field(&self) -> String {
         let mut out = String::new();
         for part in self.path.iter() {
-            if !part.starts_with('[') && !out.is_empty() {
-                out.push('.');
+            match part {
+                Part::Index(i) => out.push_str(&format!("[{i}]")),
+                Part::Key(key) => {
+                    if !out.is_empty() {
+                        out.push('.');
+                    }
+                    out.push_str(if is_schema_name(key) { key } else { "…" });
+                }
             }
-            let index = part.starts_with('[');
-            out.push_str(if index || is_schema_name(part) {
-                part
-            } else {
-                "…"
-            });
         }
         out
     }
 
-    fn child(&mut self, part: String, look: bool) -> Walk<'_> {
+    fn child(&mut self, part: Part, look: bool) -> Walk<'_> {
         self.path.push(part);
         Walk {
             path: &mut *self.path,
@@ -94,7 +110,11 @@ impl<'de> Visitor<'de> for Walk<'_> {
     }
 
     fn visit_u64<E>(self, v: u64) -> Result<(), E> {
-        let wide = self.path.last().is_some_and(|k| WIDE.contains(&k.as_str()));
+        let wide = self
+            .path
+            .last()
+            .and_then(Part::key)
+            .is_some_and(|k| WIDE.contains(&k));
         if v > u64::from(u32::MAX) && !wide {
             *self.found = Some(self.field());
         }
@@ -125,7 +145,7 @@ impl<'de> Visitor<'de> for Walk<'_> {
         let mut i = 0usize;
         loop {
             let look = self.look;
-            let element = self.child(format!("[{i}]"), look);
+            let element = self.child(Part::Index(i), look);
             let more = seq.next_element_seed(element)?.is_some();
             self.path.pop();
             if !more {
@@ -136,12 +156,12 @@ impl<'de> Visitor<'de> for Walk<'_> {
     }
 
     fn visit_map<A: MapAccess<'de>>(mut self, mut map: A) -> Result<(), A::Error> {
-        let in_extensions = self.path.last().is_some_and(|k| k == "extensions");
+        let in_extensions = self.path.last().and_then(Part::key) == Some("extensions");
         while let Some(key) = map.next_key::<String>()? {
             let look = self.look
                 && key != "extras"
                 && (!in_extensions || READ_EXTENSIONS.contains(&key.as_str()));
-            let value = self.child(key, look);
+            let value = self.child(Part::Key(key), look);
             map.next_value_seed(value)?;
             self.path.pop();
         }
@@ -167,6 +187,9 @@ mod tests {
         // A key the file made up is not shown (a message never carries the file's text).
         let err = check(br#"{"user_token_abc":[{"n":1700000000000}]}"#).unwrap_err();
         assert!(err.starts_with("…[0].…:"), "{err}");
+        // Nor one written like an index.
+        let err = check(br#"{"[token=abc]":5000000000}"#).unwrap_err();
+        assert!(err.starts_with("…:") && !err.contains("token"), "{err}");
     }
 
     #[test]

@@ -105,13 +105,13 @@ fn a_texture_is_decoded_once_whatever_names_it_and_reads_are_bounded() {
     );
 }
 
-/// Each texture name is searched for beyond its spelling (other letter case, bare file name)
-/// once, and only so many names: past them a name is found as written (a name found before
-/// is remembered); a name is matched folder by folder only so deep.
+/// Each texture name is looked up once a load and each folder listed once, however many
+/// names are missing from it; a name is matched folder by folder only so deep (past it, it
+/// is found as written or by its bare file name).
 #[cfg(unix)]
 #[test]
-fn texture_searches_are_bounded_in_number_and_depth() {
-    use super::textures::{TextureFinder, MAX_MATCHED_COMPONENTS, MAX_SEARCHED_NAMES};
+fn texture_lookups_list_each_folder_once_and_match_so_deep() {
+    use super::texture_names::{TextureFinder, MAX_MATCHED_COMPONENTS};
     let dir = tempfile::tempdir().unwrap();
     let base = dir.path();
     std::fs::create_dir(base.join("sub")).unwrap();
@@ -128,11 +128,31 @@ fn texture_searches_are_bounded_in_number_and_depth() {
     let deep = |links: usize| format!("{}SUB/T.PNG", "d/".repeat(links));
     assert_eq!(find(&deep(MAX_MATCHED_COMPONENTS - 2)), want);
     assert_eq!(find(&deep(MAX_MATCHED_COMPONENTS - 1)), Ok(None));
-    assert_eq!(find("Sub/T.png"), want);
-    for i in 0..MAX_SEARCHED_NAMES {
-        let _ = find(&format!("missing{i}.png"));
+    for i in 0..2000 {
+        assert_eq!(find(&format!("Missing{i}.png")), Ok(None));
     }
-    assert_eq!(find("sub/t.png"), want, "as written");
-    assert_eq!(find("Sub/T.png"), want, "remembered");
-    assert_eq!(find("SUB/t.png"), Ok(None), "not searched");
+    assert_eq!(find("Sub/T.png"), want, "found past 2 000 missing names");
+    // The base folder (through every `d`, the same folder) and `sub`.
+    assert_eq!(finder.listings.listed(), 2);
+}
+
+/// A polyline (`l`) of three points is not drawn as a filled triangle (tobj read it as one),
+/// and lines and faces of fewer than three corners are named in one warning.
+#[test]
+fn lines_are_not_drawn_as_faces() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("m.obj");
+    let text = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 0 1 1\n\
+                f 1 2 3\nl 4 5 6\nl 4 5\nf 4\n";
+    std::fs::write(&path, text).unwrap();
+    let (scene, report) = load(&path);
+    let triangles: usize = scene.objects.iter().map(|o| o.mesh.indices.len() / 3).sum();
+    assert_eq!(triangles, 1);
+    let said: Vec<_> = report
+        .warnings
+        .iter()
+        .filter(|w| w.contains("3 lines (`l`) and faces of fewer than three corners"))
+        .collect();
+    assert_eq!(said.len(), 1, "{:?}", report.warnings);
+    assert!(said[0].contains("line 8"), "{}", said[0]);
 }

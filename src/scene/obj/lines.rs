@@ -17,13 +17,15 @@ use crate::scene::mesh::{MAX_SCENE_MESHES, MAX_TEXCOORD};
 ///   file defines (negative indices count back from the last one defined before the line):
 ///   an index beyond them overflowed tobj's arithmetic (a panic in debug builds, a read of the
 ///   wrong element in release ones);
-/// - at most [`MAX_SCENE_MESHES`] objects have faces or lines (tobj makes one at each `o`, `g`
-///   or change of `usemtl` after them, even of lines it then drops): each is a mesh of its
-///   own, whose fixed cost (buffers, GL objects, the ray caster's hierarchy) would otherwise
-///   grow past memory before a frame;
-/// - the faces, triangulated, hold at most [`MAX_OBJ_CORNERS`] corners, a face or line of
-///   fewer than three corners (which tobj keeps until its object ends, then drops) counted as
-///   a triangle.
+/// - at most [`MAX_SCENE_MESHES`] objects have faces (tobj makes one at each `o`, `g` or change
+///   of `usemtl` after faces): each is a mesh of its own, whose fixed cost (buffers, GL
+///   objects, the ray caster's hierarchy) would otherwise grow past memory before a frame;
+/// - the faces, triangulated, hold at most [`MAX_OBJ_CORNERS`] corners.
+///
+/// Lines (`l`) and faces of fewer than three corners are taken out before tobj reads the file
+/// ([`Rewrites::not_faces`]): tobj drew an `l` of three or more points as a filled polygon,
+/// and kept the others (some 100 bytes each) until their object ended, making an empty model
+/// of them.
 ///
 /// Returns what [`rewrite`] must change for tobj to read the file.
 pub(super) fn check_obj(text: &str) -> Result<Rewrites, String> {
@@ -43,25 +45,33 @@ pub(super) struct Rewrites {
     /// The first `o` or `g` line whose name passes [`MAX_OBJ_NAME_BYTES`]: such names are cut
     /// to it (tobj copies an object's name into every mesh it splits the object into).
     pub long_name: Option<usize>,
+    /// How many `l` lines and `f` lines of fewer than three corners there are, and the first's
+    /// line: taken out (manylight draws triangles; points and lines are not drawn).
+    pub not_faces: Option<(usize, usize)>,
 }
 
 impl Rewrites {
     /// Whether anything needs rewriting.
     pub fn needed(&self) -> bool {
-        self.mixed_colours.is_some() || self.one_number_texcoords || self.long_name.is_some()
+        self.mixed_colours.is_some()
+            || self.one_number_texcoords
+            || self.long_name.is_some()
+            || self.not_faces.is_some()
     }
 }
 
 /// `text` with what `rewrites` names changed: every `v` line's colour taken off, every `vt`
 /// line of one number given its `v` of 0, every object or group name cut to
-/// [`MAX_OBJ_NAME_BYTES`].
+/// [`MAX_OBJ_NAME_BYTES`], every line and face of fewer than three corners left empty.
 pub(super) fn rewrite(text: &str, rewrites: &Rewrites) -> String {
     let mut out = String::with_capacity(text.len() + text.len() / 8);
     for line in text.lines() {
         let mut words = line.split_whitespace();
         let key = words.next();
         let count = words.clone().count();
-        if rewrites.mixed_colours.is_some() && key == Some("v") && count == 6 {
+        if rewrites.not_faces.is_some() && is_not_a_face(key, count) {
+            // Left empty: nothing of it reaches tobj.
+        } else if rewrites.mixed_colours.is_some() && key == Some("v") && count == 6 {
             out.push('v');
             for word in words.take(3) {
                 out.push(' ');
@@ -84,6 +94,12 @@ pub(super) fn rewrite(text: &str, rewrites: &Rewrites) -> String {
         out.push('\n');
     }
     out
+}
+
+/// True for a line statement (`l`) or a face of fewer than three corners (`count` words after
+/// the key).
+fn is_not_a_face(key: Option<&str>, count: usize) -> bool {
+    key == Some("l") || (key == Some("f") && count < 3)
 }
 
 /// Longest object or group name kept, in bytes: longer ones are cut (a name is copied into
@@ -128,6 +144,7 @@ fn check_obj_within(text: &str, max_corners: usize) -> Result<Rewrites, String> 
     let mut coloured: [Option<usize>; 2] = [None, None];
     let mut one_number_texcoords = false;
     let mut long_name = None;
+    let mut not_faces: Option<(usize, usize)> = None;
     for (number, line) in text.lines().enumerate() {
         let at_line = |what: String| format!("line {}: {what}", number + 1);
         let mut words = line.split_whitespace();
@@ -157,14 +174,18 @@ fn check_obj_within(text: &str, max_corners: usize) -> Result<Rewrites, String> 
         if words.clone().next().is_none() {
             return Err(at_line(format!("`{key}` names no vertices")));
         }
-        // Triangulated as a fan: three corners for each corner past the second; a shorter
-        // face or a line is kept by tobj as a triangle is, until its object ends.
-        corners += 3 * words.clone().count().saturating_sub(2).max(1);
+        let count = words.clone().count();
+        if is_not_a_face(Some(key), count) {
+            let (n, _) = not_faces.get_or_insert((0, number + 1));
+            *n += 1;
+        } else {
+            // Triangulated as a fan: three corners for each corner past the second.
+            corners += 3 * (count - 2);
+        }
         if corners > max_corners {
             return Err(at_line(format!(
-                "the faces and lines so far hold more than the {max_corners} triangle corners \
-                 one OBJ may (each takes some 40 bytes or more parsed; a face or line of fewer \
-                 than three corners counts as three)"
+                "the faces so far hold more than the {max_corners} triangle corners one OBJ \
+                 may (each takes some 40 bytes or more parsed)"
             )));
         }
         for (at, word) in words.enumerate() {
@@ -212,6 +233,7 @@ fn check_obj_within(text: &str, max_corners: usize) -> Result<Rewrites, String> 
         },
         one_number_texcoords,
         long_name,
+        not_faces,
     })
 }
 
@@ -247,14 +269,15 @@ impl<'a> Objects<'a> {
                     self.material = name;
                 }
             }
-            Some("f" | "l") if !self.current_has_faces => {
+            // A face of three corners or more (the others do not reach tobj).
+            Some("f") if !self.current_has_faces && line.split_whitespace().nth(3).is_some() => {
                 self.current_has_faces = true;
                 self.with_faces += 1;
                 if self.with_faces > MAX_SCENE_MESHES {
                     return Err(format!(
-                        "a face or line of object {}: more than {MAX_SCENE_MESHES} objects \
-                         with faces or lines (`o`, `g` and material changes), the limit per \
-                         file; merge objects that share a material in the exporter",
+                        "a face of object {}: more than {MAX_SCENE_MESHES} objects with faces \
+                         (`o`, `g` and material changes), the limit per file; merge objects \
+                         that share a material in the exporter",
                         self.with_faces
                     ));
                 }
@@ -456,11 +479,12 @@ mod tests {
             err.starts_with("line 7:") && err.contains("11 triangle corners"),
             "{err}"
         );
-        // Lines (`l`) and faces of one or two corners make no triangles, but tobj keeps
-        // them as long as triangles until their object ends.
-        assert!(check_obj_within("v 0 0 0\nl 1 1 1 1\nf 1\nl 1 1\n", 12).is_ok());
-        let err = check_obj_within("v 0 0 0\nl 1 1 1 1\nf 1\nl 1 1\n", 11).unwrap_err();
-        assert!(err.starts_with("line 4:"), "{err}");
+        // Lines (`l`) and faces of one or two corners make no triangles, and are taken out
+        // (tobj filled an `l` of four points as a quad), counted with the first's line.
+        let text = "v 0 0 0\nl 1 1 1 1\nf 1\nf 1 1 1\nl 1 1\nf 1 1\n";
+        let found = check_obj_within(text, 3).unwrap();
+        assert_eq!(found.not_faces, Some((4, 2)));
+        assert_eq!(rewrite(text, &found), "v 0 0 0\n\n\nf 1 1 1\n\n\n");
     }
 
     /// Object and group names past the limit are cut to it at a character's boundary, the
@@ -484,12 +508,12 @@ mod tests {
     #[test]
     fn objects_split_at_o_g_and_a_change_of_the_whole_material_name() {
         let text = "f 1 1 1\nusemtl red paint\nf 1 1 1\nusemtl red brick\nf 1 1 1\n\
-                    usemtl red brick\nf 1 1 1\ng a\ng b\nf 1 1 1\ng c\nl 1 1\n";
+                    usemtl red brick\nf 1 1 1\ng a\ng b\nf 1 1 1\ng c\nl 1 1 1\nf 1 1\n";
         let mut objects = Objects::default();
         for line in text.lines() {
             objects.read(line.split_whitespace().next(), line).unwrap();
         }
-        assert_eq!(objects.with_faces, 5);
+        assert_eq!(objects.with_faces, 4);
     }
 
     #[test]

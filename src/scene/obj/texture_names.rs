@@ -1,0 +1,309 @@
+//! An MTL file's texture names: found, confined to the model's folder.
+//!
+//! Real MTL files name textures with other letter case than the file on disk, with Windows
+//! backslashes, or with folders that were flattened when the model was shared. Resolution
+//! tries, in order: the path as written (backslashes turned into `/`) relative to the MTL's
+//! folder; the same path matched case-insensitively component by component; the bare file
+//! name, case-insensitively, in the MTL's folder. A name leading out of the model's folder is
+//! refused unless allowed, but its bare file name is still looked for in the folder (an
+//! exporter's `C:\Users\…\wood.png`). Each name is looked up once a load, each folder listed
+//! once a load however many names are looked for in it, and a name is matched folder by folder
+//! only so deep.
+
+use std::collections::HashMap;
+use std::ffi::OsString;
+use std::path::{Path, PathBuf};
+
+use crate::scene::access;
+
+/// Most components of a name matched folder by folder in other letter case (a name through a
+/// link to its own folder, `d/d/d/…/t.png`, would look into a folder for each); a deeper name
+/// is still found as written or by its bare file name.
+pub(super) const MAX_MATCHED_COMPONENTS: usize = 32;
+
+/// The folders one load has listed, by the folder each is (links resolved): each is listed
+/// once, however many names are looked for in it (a library of thousands of names missing
+/// from a folder of thousands of files listed it for each, for minutes).
+#[derive(Default)]
+pub(super) struct Listings {
+    /// Per folder: each entry's name in lower case, and as it is.
+    by_folder: HashMap<PathBuf, HashMap<String, OsString>>,
+}
+
+impl Listings {
+    /// The entry of `dir` named `name` in any letter case (`dir` empty: the working folder,
+    /// which a model named without a folder lies in); of two that differ only in case, the
+    /// one the folder lists first.
+    fn find(&mut self, dir: &Path, name: &str) -> Option<PathBuf> {
+        if name == ".." {
+            return Some(dir.join(".."));
+        }
+        let listed = if dir.as_os_str().is_empty() {
+            Path::new(".")
+        } else {
+            dir
+        };
+        let folder = std::fs::canonicalize(listed).ok()?;
+        let entries = self.by_folder.entry(folder).or_insert_with(|| {
+            let mut entries = HashMap::new();
+            for entry in std::fs::read_dir(listed).into_iter().flatten().flatten() {
+                let file_name = entry.file_name();
+                let lower = file_name.to_string_lossy().to_lowercase();
+                entries.entry(lower).or_insert(file_name);
+            }
+            entries
+        });
+        entries
+            .get(&name.to_lowercase())
+            .map(|file_name| listed.join(file_name))
+    }
+
+    /// How many folders were listed.
+    #[cfg(test)]
+    pub(super) fn listed(&self) -> usize {
+        self.by_folder.len()
+    }
+}
+
+/// Finds the textures one OBJ load's MTL statements name: each name once (materials often
+/// share one), each folder listed once.
+#[derive(Default)]
+pub(super) struct TextureFinder {
+    found: HashMap<String, Result<Option<PathBuf>, String>>,
+    pub(super) listings: Listings,
+}
+
+impl TextureFinder {
+    /// The file an MTL texture statement's file name (after its options) names, inside
+    /// `base_dir` (links resolved) unless `allow_outside`: `Ok(None)` when none is found,
+    /// `Err` with the refusal when the name leads out of the folder and its bare file name is
+    /// not in it either. A name of several words not found is tried by its last word too (a
+    /// name written after options the MTL reader does not know). Remembered by name.
+    pub(super) fn find(
+        &mut self,
+        base_dir: &Path,
+        name: &str,
+        allow_outside: bool,
+    ) -> Result<Option<PathBuf>, String> {
+        if let Some(found) = self.found.get(name) {
+            return found.clone();
+        }
+        let found = self.find_anew(base_dir, name.trim(), allow_outside);
+        self.found.insert(name.to_string(), found.clone());
+        found
+    }
+
+    fn find_anew(
+        &mut self,
+        base_dir: &Path,
+        name: &str,
+        allow_outside: bool,
+    ) -> Result<Option<PathBuf>, String> {
+        let found = self.find_named(base_dir, name, allow_outside)?;
+        match name.split_whitespace().last() {
+            Some(last) if found.is_none() && last != name => {
+                self.find_named(base_dir, last, allow_outside)
+            }
+            _ => Ok(found),
+        }
+    }
+
+    /// [`TextureFinder::find`] for the whole of `name`.
+    fn find_named(
+        &mut self,
+        base_dir: &Path,
+        name: &str,
+        allow_outside: bool,
+    ) -> Result<Option<PathBuf>, String> {
+        if name.is_empty() {
+            return Ok(None);
+        }
+        let written = name.replace('\\', "/");
+        let listings = &mut self.listings;
+        within_folder(
+            base_dir,
+            &written,
+            allow_outside,
+            listings,
+            |_, listings| resolve_in(base_dir, name, listings),
+        )
+    }
+}
+
+/// What `find` finds of `written` (`/` separating) from `base_dir`, given the path as joined,
+/// where the name stays in the folder; else, unless `allow_outside`, its bare file name in
+/// the folder, or the refusal when it is not there (an exporter's absolute path). What is
+/// found is checked with its links resolved and kept as found (its name in messages stays
+/// the model's).
+pub(super) fn within_folder(
+    base_dir: &Path,
+    written: &str,
+    allow_outside: bool,
+    listings: &mut Listings,
+    find: impl FnOnce(PathBuf, &mut Listings) -> Option<PathBuf>,
+) -> Result<Option<PathBuf>, String> {
+    let found = match access::join(base_dir, written, allow_outside) {
+        Ok(joined) => find(joined, listings),
+        Err(refusal) => Some(bare_file_in(base_dir, written, listings).ok_or(refusal)?),
+    };
+    found
+        .map(|p| access::resolve(base_dir, &p, allow_outside).map(|_| p))
+        .transpose()
+}
+
+/// The file `name`'s last component names in `dir` (in any letter case), if it is one.
+fn bare_file_in(dir: &Path, name: &str, listings: &mut Listings) -> Option<PathBuf> {
+    let file_name = name
+        .rsplit('/')
+        .next()
+        .filter(|n| !n.is_empty() && *n != "..")?;
+    listings.find(dir, file_name).filter(|p| p.is_file())
+}
+
+/// Finds the file a texture name (an MTL statement's after its options, or a glTF URI,
+/// either of which may hold spaces) means (see the module docs for the order).
+pub fn resolve_texture(base_dir: &Path, name: &str) -> Option<PathBuf> {
+    resolve_in(base_dir, name, &mut Listings::default())
+}
+
+/// [`resolve_texture`] with the folders `listings` has listed.
+fn resolve_in(base_dir: &Path, name: &str, listings: &mut Listings) -> Option<PathBuf> {
+    let name = name.replace('\\', "/");
+    let as_written = base_dir.join(&name);
+    if as_written.is_file() {
+        return Some(as_written);
+    }
+    let parts: Vec<&str> = name
+        .split('/')
+        .filter(|p| !p.is_empty() && *p != ".")
+        .collect();
+    let mut dir = base_dir.to_path_buf();
+    let mut matched = parts.len() <= MAX_MATCHED_COMPONENTS;
+    for part in parts {
+        if !matched {
+            break;
+        }
+        match listings.find(&dir, part) {
+            Some(p) => dir = p,
+            None => matched = false,
+        }
+    }
+    if matched && dir.is_file() {
+        return Some(dir);
+    }
+    bare_file_in(base_dir, &name, listings)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn resolves_case_and_backslashes() {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::create_dir(dir.path().join("Textures")).unwrap();
+        std::fs::write(dir.path().join("Textures").join("Brick.PNG"), b"x").unwrap();
+        let want = dir.path().join("Textures").join("Brick.PNG");
+        assert_eq!(
+            resolve_texture(dir.path(), "textures\\brick.png"),
+            Some(want.clone())
+        );
+        assert_eq!(
+            resolve_texture(dir.path(), "TEXTURES/BRICK.png"),
+            Some(want.clone())
+        );
+        assert_eq!(
+            TextureFinder::default().find(dir.path(), "-unknown 1 Textures/Brick.PNG", false),
+            Ok(Some(want))
+        );
+        std::fs::write(dir.path().join("Textures").join("Old Brick.png"), b"x").unwrap();
+        assert_eq!(
+            resolve_texture(dir.path(), "textures/old brick.PNG"),
+            Some(dir.path().join("Textures").join("Old Brick.png"))
+        );
+        assert_eq!(resolve_texture(dir.path(), "missing.png"), None);
+    }
+
+    /// A model folder inside a temporary root holding `secret.png`.
+    fn model_beside_a_secret_image() -> (tempfile::TempDir, PathBuf) {
+        let root = tempfile::tempdir().unwrap();
+        let model = root.path().join("model");
+        std::fs::create_dir(&model).unwrap();
+        image::RgbaImage::from_pixel(2, 2, image::Rgba([255, 0, 0, 255]))
+            .save(root.path().join("secret.png"))
+            .unwrap();
+        (root, model)
+    }
+
+    #[test]
+    fn textures_outside_the_models_folder_are_refused_unless_allowed() {
+        let (root, model) = model_beside_a_secret_image();
+        let secret = root.path().join("secret.png");
+        let absolute = secret.to_str().unwrap().to_string();
+        for name in ["../secret.png", "./../secret.png", absolute.as_str()] {
+            let refusal = TextureFinder::default()
+                .find(&model, name, false)
+                .unwrap_err();
+            assert!(
+                refusal.contains("outside the model's folder"),
+                "{name}: {refusal}"
+            );
+            assert!(
+                TextureFinder::default()
+                    .find(&model, name, true)
+                    .unwrap()
+                    .is_some(),
+                "{name}"
+            );
+        }
+        #[cfg(unix)]
+        {
+            std::os::unix::fs::symlink(&secret, model.join("link.png")).unwrap();
+            let refusal = TextureFinder::default()
+                .find(&model, "link.png", false)
+                .unwrap_err();
+            assert!(refusal.contains("a link leads out"), "{refusal}");
+            assert!(TextureFinder::default()
+                .find(&model, "link.png", true)
+                .unwrap()
+                .is_some());
+        }
+        // An exporter's absolute path is still found by its file name in the folder.
+        std::fs::write(model.join("wood.png"), b"x").unwrap();
+        let found = TextureFinder::default()
+            .find(&model, "C:\\Users\\bob\\Wood.PNG", false)
+            .unwrap();
+        assert_eq!(found, Some(model.join("wood.png")));
+        let found = TextureFinder::default()
+            .find(&model, "/home/bob/maps/wood.png", false)
+            .unwrap();
+        assert_eq!(found, Some(model.join("wood.png")));
+        assert_eq!(
+            TextureFinder::default()
+                .find(&model, "missing.png", false)
+                .unwrap(),
+            None
+        );
+    }
+
+    #[test]
+    fn a_model_in_the_working_folder_finds_a_bare_file_name_there() {
+        // The tests run in the package's folder, beside its Cargo.toml.
+        let found = bare_file_in(
+            Path::new(""),
+            "C:/Users/bob/CARGO.toml",
+            &mut Listings::default(),
+        );
+        assert_eq!(found, Some(Path::new(".").join("Cargo.toml")));
+    }
+
+    #[test]
+    fn flattened_folders_fall_back_to_the_file_name() {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join("wood.jpg"), b"x").unwrap();
+        assert_eq!(
+            resolve_texture(dir.path(), "C:\\models\\maps\\Wood.JPG"),
+            Some(dir.path().join("wood.jpg"))
+        );
+    }
+}
