@@ -66,8 +66,8 @@ pub struct Caps {
     pub fragment_mediump: Precision,
     /// RGBA32F data textures can be sampled (ES 3.0, or `GL_OES_texture_float`).
     pub float_textures: bool,
-    /// Textures of any size with mipmaps and `REPEAT` (ES 3.0, or `GL_OES_texture_npot`):
-    /// without it, ES 2.0 images are scaled to a power of two.
+    /// Textures of any size with mipmaps and `REPEAT` (an ES 3.0 context, or
+    /// `GL_OES_texture_npot`): without it, ES 2.0 images are scaled to a power of two.
     pub npot_textures: bool,
     /// 24-bit depth renderbuffers (ES 3.0, or `GL_OES_depth24`).
     pub depth24: bool,
@@ -201,7 +201,8 @@ impl Caps {
             fragment_highp,
             fragment_mediump,
             float_textures: es3 || has("GL_OES_texture_float"),
-            npot_textures: es3 || has("GL_OES_texture_npot"),
+            // A context of ES 3.0 or later has them whatever level the renderer keeps to.
+            npot_textures: es3 || desktop || v.major >= 3 || has("GL_OES_texture_npot"),
             depth24: es3 || has("GL_OES_depth24"),
             packed_depth_stencil: es3 || has("GL_OES_packed_depth_stencil"),
             timer_query: has("GL_EXT_disjoint_timer_query"),

@@ -225,8 +225,13 @@ fn es2_lists_whether_images_keep_their_size() {
     }
     for (env, npot) in [
         (&[][..], true),
+        // An ES 2.0 context (an ES 3.x one has them whatever level the renderer keeps to)
+        // without the extension.
         (
-            &[("MESA_EXTENSION_OVERRIDE", "-GL_OES_texture_npot")][..],
+            &[
+                ("MESA_GLES_VERSION_OVERRIDE", "2.0"),
+                ("MESA_EXTENSION_OVERRIDE", "-GL_OES_texture_npot"),
+            ][..],
             false,
         ),
     ] {
