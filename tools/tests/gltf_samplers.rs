@@ -36,17 +36,10 @@ const SAMPLERS: [Option<(u32, u32, u32)>; 4] = [
 ];
 
 fn png() -> Vec<u8> {
-    let img = image::RgbaImage::from_fn(2, 2, |x, y| {
+    common::gltf_models::png_bytes(&image::RgbaImage::from_fn(2, 2, |x, y| {
         let [r, g, b] = TEXELS[(2 * y + x) as usize];
         image::Rgba([r, g, b, 255])
-    });
-    let mut bytes = Vec::new();
-    img.write_to(
-        &mut std::io::Cursor::new(&mut bytes),
-        image::ImageFormat::Png,
-    )
-    .unwrap();
-    bytes
+    }))
 }
 
 /// Half the view's width (its height is 2): the quads tile the whole view.
@@ -144,16 +137,6 @@ fn quad_and_uv(x: u32, y: u32) -> (usize, f64, f64) {
     (q, -1.0 + 3.0 * fx.fract(), -1.0 + 3.0 * fy.fract())
 }
 
-/// Which of the texels a pixel shows: the set of its channels above half its brightest.
-fn texel_shown(p: &image::Rgba<u8>) -> Option<usize> {
-    let max = p[0].max(p[1]).max(p[2]);
-    if max < 40 {
-        return None;
-    }
-    let bright = [0, 1, 2].map(|c| p[c] as u32 * 2 > max as u32);
-    TEXELS.iter().position(|t| t.map(|c| c > 0) == bright)
-}
-
 /// Distance of wrapped coordinate `u` (in texels of the 2-texel image) from the nearest
 /// place where the texel read changes: the middle, and with `REPEAT` the image's ends too
 /// (where the next copy starts; clamping and mirroring read the same texel on both sides).
@@ -187,7 +170,7 @@ fn each_texture_wraps_and_filters_as_its_sampler_says_with_every_method() {
                     let (q, u, v) = quad_and_uv(x, y);
                     let (wrap_u, wrap_v, filter) = SAMPLERS[q].unwrap_or((REPEAT, REPEAT, LINEAR));
                     let (wu, wv) = (wrap(u, wrap_u), wrap(v, wrap_v));
-                    let shown = texel_shown(img.get_pixel(x, y));
+                    let shown = common::texel_shown(img.get_pixel(x, y), &TEXELS);
                     let edge = from_edge(wu, wrap_u).min(from_edge(wv, wrap_v));
                     let near_edge = edge < 0.08;
                     // The quads' own borders and the texels' edges are left to rounding.

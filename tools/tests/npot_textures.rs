@@ -19,17 +19,10 @@ const H: u32 = 32;
 const TEXELS: [[u8; 3]; 3] = [[255, 0, 0], [0, 255, 0], [0, 0, 255]];
 
 fn png() -> Vec<u8> {
-    let img = image::RgbaImage::from_fn(3, 1, |x, _| {
+    common::gltf_models::png_bytes(&image::RgbaImage::from_fn(3, 1, |x, _| {
         let [r, g, b] = TEXELS[x as usize];
         image::Rgba([r, g, b, 255])
-    });
-    let mut bytes = Vec::new();
-    img.write_to(
-        &mut std::io::Cursor::new(&mut bytes),
-        image::ImageFormat::Png,
-    )
-    .unwrap();
-    bytes
+    }))
 }
 
 /// One quad filling an orthographic view, texture coordinates 0 to 1 across it, its image

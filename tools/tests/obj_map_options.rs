@@ -94,16 +94,6 @@ fn quad_and_uv(x: u32, y: u32) -> (usize, f64, f64) {
     (q, -1.0 + 3.0 * fx.fract(), 2.0 - 3.0 * fy.fract())
 }
 
-/// Which of the texels a pixel shows: the set of its channels above half its brightest.
-fn texel_shown(p: &image::Rgba<u8>) -> Option<usize> {
-    let max = p[0].max(p[1]).max(p[2]);
-    if max < 40 {
-        return None;
-    }
-    let bright = [0, 1, 2].map(|c| p[c] as u32 * 2 > max as u32);
-    TEXELS.iter().position(|t| t.map(|c| c > 0) == bright)
-}
-
 /// Coordinate `u` (the image's width or height from 0 to 1) of a repeating or clamped texture,
 /// and its distance in texels from the nearest place the texel read changes.
 fn wrapped(u: f64, clamp: bool) -> (f64, f64) {
@@ -164,7 +154,7 @@ fn map_kd_options_clamp_scale_and_move_the_texture_with_every_method() {
                     }
                     let column = ((wu * 2.0).floor() as usize).min(1);
                     let row = ((wt * 2.0).floor() as usize).min(1);
-                    let shown = texel_shown(img.get_pixel(x, y));
+                    let shown = common::texel_shown(img.get_pixel(x, y), &TEXELS);
                     assert_eq!(
                         shown,
                         Some(2 * row + column),

@@ -87,6 +87,11 @@ pub fn checker_png() -> Vec<u8> {
             image::Rgba([40, 70, 120, 255])
         }
     });
+    png_bytes(&img)
+}
+
+/// `img` encoded as a PNG file's bytes.
+pub fn png_bytes(img: &image::RgbaImage) -> Vec<u8> {
     let mut png = Vec::new();
     img.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
         .unwrap();

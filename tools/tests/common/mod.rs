@@ -331,3 +331,15 @@ pub fn assert_methods_match_forward_with_4_samples(
     }
     reference
 }
+
+/// Which of `texels` (pure colours: each channel 0 or not) a pixel shows: the one whose set
+/// of lit channels is the pixel's channels above half its brightest; `None` for a dark pixel
+/// or a blend no texel matches.
+pub fn texel_shown(p: &image::Rgba<u8>, texels: &[[u8; 3]]) -> Option<usize> {
+    let max = p[0].max(p[1]).max(p[2]);
+    if max < 40 {
+        return None;
+    }
+    let bright = [0, 1, 2].map(|c| p[c] as u32 * 2 > max as u32);
+    texels.iter().position(|t| t.map(|c| c > 0) == bright)
+}
