@@ -80,8 +80,8 @@ pub(super) fn rewrite(text: &str, rewrites: &Rewrites) -> String {
         } else if rewrites.one_number_texcoords && key == Some("vt") && count == 1 {
             out.push_str(line.trim_end());
             out.push_str(" 0");
-        } else if let (Some(_), Some(name)) = (rewrites.long_name, long_object_name(line)) {
-            out.push_str(&line.trim_start()[..1]);
+        } else if let (Some(_), Some(name)) = (rewrites.long_name, long_object_name(key, line)) {
+            out.push_str(key.unwrap_or_default());
             out.push(' ');
             let end = (0..=MAX_OBJ_NAME_BYTES)
                 .rev()
@@ -106,13 +106,12 @@ fn is_not_a_face(key: Option<&str>, count: usize) -> bool {
 /// each of up to [`MAX_SCENE_MESHES`] meshes).
 pub const MAX_OBJ_NAME_BYTES: usize = 256;
 
-/// The name of an `o` or `g` line, as tobj reads it (all after the key, trimmed), when it is
-/// longer than [`MAX_OBJ_NAME_BYTES`].
-fn long_object_name(line: &str) -> Option<&str> {
-    let line = line.trim_start();
-    let key = line.split_whitespace().next()?;
-    let name = line[key.len()..].trim();
-    (matches!(key, "o" | "g") && name.len() > MAX_OBJ_NAME_BYTES).then_some(name)
+/// The name of an `o` or `g` line (`key` its first word), as tobj reads it (all after the
+/// key, trimmed), when it is longer than [`MAX_OBJ_NAME_BYTES`].
+fn long_object_name<'a>(key: Option<&str>, line: &'a str) -> Option<&'a str> {
+    let key = key.filter(|k| matches!(*k, "o" | "g"))?;
+    let name = line.trim_start()[key.len()..].trim();
+    (name.len() > MAX_OBJ_NAME_BYTES).then_some(name)
 }
 
 /// Most triangle corners the faces of one OBJ may hold once triangulated (as many indices as
@@ -150,7 +149,7 @@ fn check_obj_within(text: &str, max_corners: usize) -> Result<Rewrites, String> 
         let mut words = line.split_whitespace();
         let key = words.next();
         objects.read(key, line).map_err(at_line)?;
-        if long_name.is_none() && long_object_name(line).is_some() {
+        if long_name.is_none() && long_object_name(key, line).is_some() {
             long_name = Some(number + 1);
         }
         if let Some(kind) = kind_of(key) {
@@ -181,12 +180,12 @@ fn check_obj_within(text: &str, max_corners: usize) -> Result<Rewrites, String> 
         } else {
             // Triangulated as a fan: three corners for each corner past the second.
             corners += 3 * (count - 2);
-        }
-        if corners > max_corners {
-            return Err(at_line(format!(
-                "the faces so far hold more than the {max_corners} triangle corners one OBJ \
-                 may (each takes some 40 bytes or more parsed)"
-            )));
+            if corners > max_corners {
+                return Err(at_line(format!(
+                    "the faces so far hold more than the {max_corners} triangle corners one \
+                     OBJ may (each takes some 40 bytes or more parsed)"
+                )));
+            }
         }
         for (at, word) in words.enumerate() {
             // tobj's "face parse error", without a line (it reads `1/2/3/` as `1/2/3`).
@@ -270,7 +269,10 @@ impl<'a> Objects<'a> {
                 }
             }
             // A face of three corners or more (the others do not reach tobj).
-            Some("f") if !self.current_has_faces && line.split_whitespace().nth(3).is_some() => {
+            Some("f")
+                if !self.current_has_faces
+                    && !is_not_a_face(key, line.split_whitespace().count() - 1) =>
+            {
                 self.current_has_faces = true;
                 self.with_faces += 1;
                 if self.with_faces > MAX_SCENE_MESHES {
