@@ -142,8 +142,6 @@ pub(super) struct ModelCache {
     texture_budget: TextureBudget,
     /// Bytes read and decoded again for models read more than once ([`MAX_REREAD_BYTES`]).
     reread_bytes: u64,
-    /// Every OBJ file read so far (canonical): another read of one is a re-read.
-    obj_read: std::collections::HashSet<PathBuf>,
     /// Texture bytes the first read of each such file kept.
     reread_textures: HashMap<PathBuf, u64>,
     obj: HashMap<(PathBuf, Option<PathBuf>), Loaded>,
@@ -194,8 +192,9 @@ impl ModelCache {
             loaded.place(scene, transform, recolour, transform_field)?;
             return Ok(LoadReport::default());
         }
-        // Read again for another texture override: bounded in total, as a glTF's re-reads.
-        let reread = key.as_ref().is_some_and(|k| self.obj_read.contains(&k.0));
+        // Read again for another texture override (its meshes are kept from the first read):
+        // bounded in total, as a glTF's re-reads.
+        let reread = key.as_ref().is_some_and(|k| self.meshes.contains_key(&k.0));
         if reread && self.reread_bytes > MAX_REREAD_BYTES {
             return Err(SceneError::Obj {
                 path: path.to_path_buf(),
@@ -226,7 +225,6 @@ impl ModelCache {
         let report = loaded?;
         self.share(scene, first.0, first.1, key.as_ref().map(|k| &k.0), true);
         if let Some(key) = key {
-            self.obj_read.insert(key.0.clone());
             let mut loaded = Loaded::record(scene, first, |o| o.transform, false);
             loaded.uncoloured_at = (!recolour).then_some(first.1);
             self.obj.insert(key, loaded);
