@@ -18,9 +18,8 @@ pub struct Device {
     /// The renderer's own vertex array object (ES 3.0 and desktop), bound only during its
     /// calls, so a game's bound one keeps its buffers and attributes.
     vertex_array: Option<glow::VertexArray>,
-    /// Without a vertex array of its own (ES 2.0): what saves the application's attribute
-    /// arrays around each call.
-    attrib_pointer_fns: Option<super::ext_fns::AttribPointerFns>,
+    /// What the context has of the application's state each call saves.
+    host: super::host_state::HostFeatures,
     /// Nesting depth of [`Device::enter_host`] (the outermost call saves the state).
     host_depth: std::cell::Cell<u32>,
     /// Whether a GL error the application left pending has been reported (once a device).
@@ -117,9 +116,10 @@ impl Device {
     ) -> Result<Device, GlError> {
         let mut caps = Caps::probe(&gl, es)?;
         caps.restrict(restrictions)?;
-        // A core profile draws nothing without a bound vertex array object; on ES 3.0 one of
-        // the renderer's own leaves a game's untouched.
-        let vertex_array = if caps.desktop || es == EsVersion::Es3 {
+        // A core profile draws nothing without a bound vertex array object; on an ES 3.x
+        // context one of the renderer's own (at either level) leaves a game's untouched: its
+        // arrays, and their divisors, which ES 2.0 calls cannot reset.
+        let vertex_array = if caps.desktop || caps.context_has_es3_state() {
             Some(unsafe { gl.create_vertex_array() }.map_err(GlError::Create)?)
         } else {
             None
@@ -139,15 +139,13 @@ impl Device {
         } else {
             None
         };
+        let host = super::host_state::HostFeatures::of(&caps, vertex_array.is_some());
         Ok(Device {
             gl,
             caps,
             live: std::cell::Cell::new(LiveObjects::default()),
             renderbuffer_storage_multisample_ext,
-            attrib_pointer_fns: vertex_array
-                .is_none()
-                .then(super::ext_fns::attrib_pointer_fns)
-                .flatten(),
+            host,
             vertex_array,
             host_depth: std::cell::Cell::new(0),
             warned_pending_error: std::cell::Cell::new(false),
@@ -189,13 +187,7 @@ impl Device {
         self.host_depth.set(depth + 1);
         (depth == 0).then(|| {
             self.clear_pending_errors();
-            super::host_state::HostState::enter(
-                &self.gl,
-                self.caps.context_has_es3_state(),
-                self.caps.desktop,
-                self.vertex_array,
-                self.attrib_pointer_fns,
-            )
+            super::host_state::HostState::enter(&self.gl, &self.host, self.vertex_array)
         })
     }
 

@@ -65,6 +65,28 @@ pub fn attrib_pointer_fns() -> Option<AttribPointerFns> {
     }
 }
 
+/// `glVertexAttribDivisor{ANGLE,EXT,NV}(index, divisor)`: ES 2.0's instanced arrays.
+pub type VertexAttribDivisor = unsafe extern "system" fn(index: u32, divisor: u32);
+
+/// The instanced-arrays extensions of ES 2.0 and their divisor setters' names.
+const DIVISOR_EXTENSIONS: [(&str, &str); 3] = [
+    ("GL_ANGLE_instanced_arrays", "glVertexAttribDivisorANGLE"),
+    ("GL_EXT_instanced_arrays", "glVertexAttribDivisorEXT"),
+    ("GL_NV_instanced_arrays", "glVertexAttribDivisorNV"),
+];
+
+/// The divisor setter of the first instanced-arrays extension `has` lists whose entry point
+/// loads; `None` without one (the arrays then have no divisors).
+pub fn vertex_attrib_divisor_ext(has: impl Fn(&str) -> bool) -> Option<VertexAttribDivisor> {
+    DIVISOR_EXTENSIONS
+        .iter()
+        .filter(|(extension, _)| has(extension))
+        .find_map(|(_, name)| entry_point(name))
+        // SAFETY: each extension specifies this signature for its entry point of that name,
+        // and the library stays loaded for the whole process.
+        .map(|f| unsafe { std::mem::transmute::<*const std::ffi::c_void, VertexAttribDivisor>(f) })
+}
+
 /// A core ES 2.0 entry point: from the implementation manylight loaded where it did (a
 /// `HeadlessContext`'s), else from the system's `libGLESv2`, the one a window toolkit's context
 /// (glutin's, Android's) draws through. Loading manylight's own EGL here instead would tie the

@@ -1,13 +1,15 @@
 //! The application's vertex attributes at the renderer's locations. Their current (constant)
 //! values are context state on every version, and the renderer sets them where a mesh lacks an
 //! attribute. ES 2.0 has no vertex array objects, so there the arrays themselves are the
-//! application's too. Each call saves both and gives them back: an engine that caches which
-//! arrays it enabled, or a constant colour it set, draws wrong when they change behind it.
+//! application's too, with their divisors where an instanced-arrays extension gives them (a
+//! game's per-instance array would collapse the renderer's meshes to their first vertex).
+//! Each call saves them and gives them back: an engine that caches which arrays it enabled,
+//! or a constant colour it set, draws wrong when they change behind it.
 #![allow(unsafe_code)]
 
 use glow::HasContext;
 
-use super::ext_fns::AttribPointerFns;
+use super::ext_fns::{AttribPointerFns, VertexAttribDivisor};
 
 /// Locations 0 to 4: where `program::ATTRIBUTES` binds the renderer's attributes (its tests
 /// check that they all fall below this), the precision probe's 0 among them.
@@ -31,6 +33,8 @@ pub(crate) struct HostAttributes {
     /// Without a vertex array object of the renderer's own: the arrays, and what sets their
     /// pointers back (`None` where those entry points could not be loaded).
     arrays: Option<([Array; LOCATIONS], AttribPointerFns)>,
+    /// Their divisors and what sets them, where the context has instanced arrays.
+    divisors: Option<([u32; LOCATIONS], VertexAttribDivisor)>,
 }
 
 /// One attribute parameter of location `index` (up to four values).
@@ -41,11 +45,30 @@ fn read(gl: &glow::Context, index: u32, pname: u32) -> [f32; 4] {
 }
 
 impl HostAttributes {
-    /// Reads them: the arrays too where `fns` is given (the renderer has no vertex array).
-    pub(crate) fn save(gl: &glow::Context, fns: Option<AttribPointerFns>) -> Self {
+    /// Reads them: the arrays too where `fns` is given (the renderer has no vertex array),
+    /// and their divisors where `divisor` is, which it then sets to 0 for the renderer's draws.
+    pub(crate) fn save(
+        gl: &glow::Context,
+        fns: Option<AttribPointerFns>,
+        divisor: Option<VertexAttribDivisor>,
+    ) -> Self {
         let current = std::array::from_fn(|i| read(gl, i as u32, glow::CURRENT_VERTEX_ATTRIB));
         let arrays = fns.map(|fns| (std::array::from_fn(|i| save_array(gl, fns, i as u32)), fns));
-        HostAttributes { current, arrays }
+        let divisors = divisor.map(|set| {
+            let saved = std::array::from_fn(|i| {
+                read(gl, i as u32, glow::VERTEX_ATTRIB_ARRAY_DIVISOR)[0] as u32
+            });
+            for index in 0..LOCATIONS as u32 {
+                // SAFETY: the extension's entry point, for a location below the context's 8.
+                unsafe { set(index, 0) };
+            }
+            (saved, set)
+        });
+        HostAttributes {
+            current,
+            arrays,
+            divisors,
+        }
     }
 
     /// Gives them back; leaves `GL_ARRAY_BUFFER` bound to whatever an array needed last (the
@@ -64,6 +87,12 @@ impl HostAttributes {
                         gl.disable_vertex_attrib_array(index);
                     }
                 }
+            }
+        }
+        if let Some((divisors, set)) = self.divisors {
+            for (index, divisor) in divisors.into_iter().enumerate() {
+                // SAFETY: as in `save`.
+                unsafe { set(index as u32, divisor) };
             }
         }
         for (index, [x, y, z, w]) in self.current.iter().copied().enumerate() {

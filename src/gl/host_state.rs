@@ -10,7 +10,8 @@
 
 use glow::HasContext;
 
-use super::ext_fns::AttribPointerFns;
+use super::caps::Caps;
+use super::ext_fns::{AttribPointerFns, VertexAttribDivisor};
 use super::host_attributes::HostAttributes;
 
 /// Texture units the renderer binds: 0 to 7 (`methods::maps::UNIT_MAPS` + 3), within the
@@ -30,15 +31,60 @@ const OFF_INSIDE: [u32; 5] = [
     glow::SAMPLE_COVERAGE,
 ];
 
-/// ES 3.0 pixel-store settings that move where uploads and read-backs start: 0 inside.
-const STORE_ES3: [u32; 6] = [
+/// Pixel-store settings that move where uploads start: 0 inside. ES 3.0 state, and ES 2.0's
+/// with `GL_EXT_unpack_subimage`.
+const UNPACK_ROWS: [u32; 3] = [
     glow::UNPACK_ROW_LENGTH,
     glow::UNPACK_SKIP_ROWS,
     glow::UNPACK_SKIP_PIXELS,
+];
+
+/// The same for read-backs: ES 3.0, and ES 2.0 with `GL_NV_pack_subimage`.
+const PACK_ROWS: [u32; 3] = [
     glow::PACK_ROW_LENGTH,
     glow::PACK_SKIP_ROWS,
     glow::PACK_SKIP_PIXELS,
 ];
+
+/// What the context has of the state a call saves, found once a device.
+#[derive(Clone, Copy)]
+pub(crate) struct HostFeatures {
+    /// ES 3.0 state (an ES 3.x or desktop context, whatever level the renderer plays).
+    es3: bool,
+    desktop: bool,
+    /// [`UNPACK_ROWS`] and [`PACK_ROWS`] exist.
+    unpack_rows: bool,
+    pack_rows: bool,
+    /// ES's `GL_EXT_sRGB_write_control`: whether writes to an sRGB attachment encode is state
+    /// a game may switch off (the renderer's picture assumes they do).
+    srgb_write_control: bool,
+    /// Without a vertex array of the renderer's own: what saves the application's arrays,
+    /// and an instanced-arrays extension's divisor setter (their divisors are theirs too).
+    attrib_fns: Option<AttribPointerFns>,
+    divisor: Option<VertexAttribDivisor>,
+}
+
+impl HostFeatures {
+    /// From the context's capabilities; `own_vertex_array` when the renderer binds its own
+    /// vertex array object (which keeps its arrays and divisors apart from the game's).
+    pub(crate) fn of(caps: &Caps, own_vertex_array: bool) -> HostFeatures {
+        let es3 = caps.context_has_es3_state();
+        let has = |name: &str| caps.has_extension(name);
+        HostFeatures {
+            es3,
+            desktop: caps.desktop,
+            unpack_rows: es3 || has("GL_EXT_unpack_subimage"),
+            pack_rows: es3 || has("GL_NV_pack_subimage"),
+            srgb_write_control: !caps.desktop && has("GL_EXT_sRGB_write_control"),
+            attrib_fns: (!own_vertex_array)
+                .then(super::ext_fns::attrib_pointer_fns)
+                .flatten(),
+            divisor: (!own_vertex_array)
+                .then(|| super::ext_fns::vertex_attrib_divisor_ext(has))
+                .flatten(),
+        }
+    }
+}
 
 /// The application's state on entry; [`HostState::leave`] sets it back.
 pub(crate) struct HostState {
@@ -75,9 +121,13 @@ pub(crate) struct HostState {
     clear_color: [f32; 4],
     clear_depth: f32,
     alignment: [i32; 2],
-    store_es3: [i32; STORE_ES3.len()],
-    /// The attributes' constant values, and on ES 2.0 their arrays (no vertex array object
-    /// keeps them apart).
+    /// [`UNPACK_ROWS`] and [`PACK_ROWS`], where the context has them.
+    unpack_rows: Option<[i32; 3]>,
+    pack_rows: Option<[i32; 3]>,
+    /// `GL_FRAMEBUFFER_SRGB_EXT` on ES with `GL_EXT_sRGB_write_control`.
+    srgb_write: Option<bool>,
+    /// The attributes' constant values, and on ES 2.0 their arrays and divisors (no vertex
+    /// array object keeps them apart).
     attributes: HostAttributes,
     /// Desktop GL's own state that changes the picture: its polygon mode (a wireframe debug
     /// view) and whether sRGB framebuffers encode (the shaders encode already).
@@ -94,19 +144,27 @@ struct DesktopState {
 
 impl HostState {
     /// Saves the application's state and sets what the renderer assumes: its own vertex
-    /// array (`vao`, ES 3.0 and desktop), no pixel buffer, no sampler objects on its units,
+    /// array (`vao`, on an ES 3.x or desktop context), no pixel buffer, no sampler objects on its units,
     /// the capabilities of `OFF_INSIDE` off, additive blend equations, counter-clockwise
     /// front faces, the full depth range, a clear depth of 1, pixel rows that start where
     /// the data does and texture unit 0 active (a game's active unit past the saved ones
-    /// keeps its texture), no primitive restart; on `desktop` GL, filled polygons and no sRGB
-    /// encoding.
+    /// keeps its texture), no primitive restart, no attribute divisors; on ES with
+    /// `GL_EXT_sRGB_write_control` sRGB encoding on; on desktop GL, filled polygons and no
+    /// sRGB encoding.
     pub(crate) fn enter(
         gl: &glow::Context,
-        es3: bool,
-        desktop: bool,
+        features: &HostFeatures,
         vao: Option<glow::VertexArray>,
-        attrib_fns: Option<AttribPointerFns>,
     ) -> Self {
+        let HostFeatures {
+            es3,
+            desktop,
+            unpack_rows,
+            pack_rows,
+            srgb_write_control,
+            attrib_fns,
+            divisor,
+        } = *features;
         unsafe {
             let int = |p| gl.get_parameter_i32(p);
             let units = (int(glow::MAX_COMBINED_TEXTURE_IMAGE_UNITS).max(0) as usize).min(UNITS);
@@ -189,12 +247,14 @@ impl HostState {
                 clear_color,
                 clear_depth: gl.get_parameter_f32(glow::DEPTH_CLEAR_VALUE),
                 alignment: [int(glow::PACK_ALIGNMENT), int(glow::UNPACK_ALIGNMENT)],
-                store_es3: if es3 {
-                    STORE_ES3.map(int)
-                } else {
-                    [0; STORE_ES3.len()]
-                },
-                attributes: HostAttributes::save(gl, vao.is_none().then_some(attrib_fns).flatten()),
+                unpack_rows: unpack_rows.then(|| UNPACK_ROWS.map(int)),
+                pack_rows: pack_rows.then(|| PACK_ROWS.map(int)),
+                srgb_write: srgb_write_control.then(|| gl.is_enabled(glow::FRAMEBUFFER_SRGB)),
+                attributes: HostAttributes::save(
+                    gl,
+                    vao.is_none().then_some(attrib_fns).flatten(),
+                    vao.is_none().then_some(divisor).flatten(),
+                ),
                 desktop: desktop.then(|| {
                     let mut polygon_mode = [glow::FILL as i32; 2];
                     gl.get_parameter_i32_slice(glow::POLYGON_MODE, &mut polygon_mode);
@@ -220,9 +280,18 @@ impl HostState {
                 gl.bind_buffer(glow::PIXEL_PACK_BUFFER, None);
                 gl.bind_buffer(glow::PIXEL_UNPACK_BUFFER, None);
                 gl.disable(glow::RASTERIZER_DISCARD);
-                for p in STORE_ES3 {
+            }
+            let rows = [
+                (saved.unpack_rows, UNPACK_ROWS),
+                (saved.pack_rows, PACK_ROWS),
+            ];
+            for (_, names) in rows.iter().filter(|(kept, _)| kept.is_some()) {
+                for &p in names {
                     gl.pixel_store_i32(p, 0);
                 }
+            }
+            if saved.srgb_write.is_some() {
+                gl.enable(glow::FRAMEBUFFER_SRGB);
             }
             for c in OFF_INSIDE {
                 gl.disable(c);
@@ -268,9 +337,6 @@ impl HostState {
                 gl.bind_framebuffer(glow::READ_FRAMEBUFFER, self.framebuffers[1]);
                 gl.bind_buffer(glow::PIXEL_PACK_BUFFER, self.pixel_buffers[0]);
                 gl.bind_buffer(glow::PIXEL_UNPACK_BUFFER, self.pixel_buffers[1]);
-                for (p, v) in STORE_ES3.into_iter().zip(self.store_es3) {
-                    gl.pixel_store_i32(p, v);
-                }
             } else {
                 gl.bind_framebuffer(glow::FRAMEBUFFER, self.framebuffers[0]);
             }
@@ -307,6 +373,17 @@ impl HostState {
             gl.clear_depth(self.clear_depth.into());
             gl.pixel_store_i32(glow::PACK_ALIGNMENT, self.alignment[0]);
             gl.pixel_store_i32(glow::UNPACK_ALIGNMENT, self.alignment[1]);
+            for (kept, names) in [(self.unpack_rows, UNPACK_ROWS), (self.pack_rows, PACK_ROWS)] {
+                for (p, v) in kept
+                    .into_iter()
+                    .flat_map(|values| names.into_iter().zip(values))
+                {
+                    gl.pixel_store_i32(p, v);
+                }
+            }
+            if let Some(on) = self.srgb_write {
+                enable(glow::FRAMEBUFFER_SRGB, on);
+            }
             if let Some(desktop) = &self.desktop {
                 gl.polygon_mode(glow::FRONT_AND_BACK, desktop.polygon_mode as u32);
                 enable(glow::FRAMEBUFFER_SRGB, desktop.framebuffer_srgb);

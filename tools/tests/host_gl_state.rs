@@ -18,6 +18,53 @@ use manylight::{EsVersion, HeadlessContext, RenderOptions, Renderer};
 /// 16 combined units).
 const GAME_UNITS: u32 = 12;
 
+/// What the game's context has of the state the game sets here.
+#[derive(Clone, Copy)]
+struct Has {
+    /// ES 3.0 state: vertex arrays, samplers, pixel buffers, a separate read framebuffer.
+    es3: bool,
+    /// Attribute divisors: ES 3.0's, or an ES 2.0 instanced-arrays extension's setter.
+    divisors: Option<Divisors>,
+    /// Row lengths and skips: ES 3.0, `GL_EXT_unpack_subimage`, `GL_NV_pack_subimage`.
+    unpack_rows: bool,
+    pack_rows: bool,
+    /// `GL_FRAMEBUFFER_SRGB_EXT` (`GL_EXT_sRGB_write_control`).
+    srgb_write_control: bool,
+}
+
+#[derive(Clone, Copy)]
+enum Divisors {
+    Core,
+    Extension(manylight::gl::ext_fns::VertexAttribDivisor),
+}
+
+impl Has {
+    fn of(caps: &manylight::Caps) -> Has {
+        let es3 = caps.context_has_es3_state();
+        let has = |name: &str| caps.has_extension(name);
+        let extension = manylight::gl::ext_fns::vertex_attrib_divisor_ext(has);
+        Has {
+            es3,
+            divisors: if es3 {
+                Some(Divisors::Core)
+            } else {
+                extension.map(Divisors::Extension)
+            },
+            unpack_rows: es3 || has("GL_EXT_unpack_subimage"),
+            pack_rows: es3 || has("GL_NV_pack_subimage"),
+            srgb_write_control: has("GL_EXT_sRGB_write_control"),
+        }
+    }
+
+    fn set_divisor(&self, gl: &glow::Context, index: u32, divisor: u32) {
+        match self.divisors {
+            Some(Divisors::Core) => unsafe { gl.vertex_attrib_divisor(index, divisor) },
+            Some(Divisors::Extension(set)) => unsafe { set(index, divisor) },
+            None => {}
+        }
+    }
+}
+
 /// Everything the game set, read back the same way after each renderer call.
 #[derive(Debug, PartialEq)]
 struct Snapshot {
@@ -26,11 +73,12 @@ struct Snapshot {
     enabled: Vec<(u32, bool)>,
     units: Vec<(u32, i32, i32)>,
     /// Locations 0 to 4 (the renderer's): enabled, size, type, normalized, stride, buffer,
-    /// pointer and current value.
-    attributes: Vec<([i32; 6], usize, [f32; 4])>,
+    /// divisor, pointer and current value.
+    attributes: Vec<([i32; 7], usize, [f32; 4])>,
 }
 
-fn snapshot(gl: &glow::Context, es3: bool) -> Snapshot {
+fn snapshot(gl: &glow::Context, has: Has) -> Snapshot {
+    let es3 = has.es3;
     let mut ints = vec![
         glow::ARRAY_BUFFER_BINDING,
         glow::ELEMENT_ARRAY_BUFFER_BINDING,
@@ -65,11 +113,18 @@ fn snapshot(gl: &glow::Context, es3: bool) -> Snapshot {
             glow::VERTEX_ARRAY_BINDING,
             glow::READ_FRAMEBUFFER_BINDING,
             glow::PIXEL_UNPACK_BUFFER_BINDING,
-            glow::UNPACK_ROW_LENGTH,
-            glow::PACK_ROW_LENGTH,
         ]);
         enabled.push(glow::RASTERIZER_DISCARD);
         enabled.push(glow::PRIMITIVE_RESTART_FIXED_INDEX);
+    }
+    if has.unpack_rows {
+        ints.extend([glow::UNPACK_ROW_LENGTH, glow::UNPACK_SKIP_ROWS]);
+    }
+    if has.pack_rows {
+        ints.extend([glow::PACK_ROW_LENGTH, glow::PACK_SKIP_PIXELS]);
+    }
+    if has.srgb_write_control {
+        enabled.push(glow::FRAMEBUFFER_SRGB);
     }
     unsafe {
         let floats = [
@@ -117,8 +172,12 @@ fn snapshot(gl: &glow::Context, es3: bool) -> Snapshot {
                     glow::VERTEX_ATTRIB_ARRAY_NORMALIZED,
                     glow::VERTEX_ATTRIB_ARRAY_STRIDE,
                     glow::VERTEX_ATTRIB_ARRAY_BUFFER_BINDING,
+                    glow::VERTEX_ATTRIB_ARRAY_DIVISOR,
                 ]
-                .map(|p| read(p)[0] as i32);
+                .map(|p| match p {
+                    glow::VERTEX_ATTRIB_ARRAY_DIVISOR if has.divisors.is_none() => 0,
+                    p => read(p)[0] as i32,
+                });
                 let mut pointer = std::ptr::null_mut();
                 (pointers.get)(index, glow::VERTEX_ATTRIB_ARRAY_POINTER, &mut pointer);
                 (array, pointer as usize, read(glow::CURRENT_VERTEX_ATTRIB))
@@ -140,8 +199,9 @@ fn snapshot(gl: &glow::Context, es3: bool) -> Snapshot {
 /// Sets state a game might leave on (every value unlike the GL default), with its own objects
 /// bound: a vertex array (ES 3.0), buffers, a program, textures on eight units, a sampler, a
 /// framebuffer with a texture, bound.
-unsafe fn set_game_state(gl: &glow::Context, es3: bool, vao: bool, size: (i32, i32)) {
-    if vao {
+unsafe fn set_game_state(gl: &glow::Context, has: Has, size: (i32, i32)) {
+    let es3 = has.es3;
+    if es3 {
         let vao = gl.create_vertex_array().unwrap();
         gl.bind_vertex_array(Some(vao));
     }
@@ -157,6 +217,10 @@ unsafe fn set_game_state(gl: &glow::Context, es3: bool, vao: bool, size: (i32, i
     gl.vertex_attrib_pointer_f32(2, 3, glow::SHORT, false, 16, 6);
     gl.vertex_attrib_4_f32(3, 0.25, 0.5, 0.75, 2.0);
     gl.vertex_attrib_4_f32(4, -1.0, 3.0, 0.0, 0.5);
+    // Per-instance arrays where the renderer's positions and normals go: its meshes would
+    // collapse to their first vertex.
+    has.set_divisor(gl, 0, 1);
+    has.set_divisor(gl, 1, 3);
     let ibo = gl.create_buffer().unwrap();
     gl.bind_buffer(glow::ELEMENT_ARRAY_BUFFER, Some(ibo));
     gl.buffer_data_size(glow::ELEMENT_ARRAY_BUFFER, 12, glow::STATIC_DRAW);
@@ -202,8 +266,6 @@ unsafe fn set_game_state(gl: &glow::Context, es3: bool, vao: bool, size: (i32, i
         let unpack = gl.create_buffer().unwrap();
         gl.bind_buffer(glow::PIXEL_UNPACK_BUFFER, Some(unpack));
         gl.buffer_data_size(glow::PIXEL_UNPACK_BUFFER, 16, glow::STATIC_DRAW);
-        gl.pixel_store_i32(glow::UNPACK_ROW_LENGTH, 7);
-        gl.pixel_store_i32(glow::PACK_ROW_LENGTH, 5);
         // A read framebuffer of its own, apart from the draw one.
         let read = gl.create_framebuffer().unwrap();
         gl.bind_framebuffer(glow::READ_FRAMEBUFFER, Some(read));
@@ -212,6 +274,18 @@ unsafe fn set_game_state(gl: &glow::Context, es3: bool, vao: bool, size: (i32, i
         gl.enable(glow::PRIMITIVE_RESTART_FIXED_INDEX);
     } else {
         gl.blend_equation_separate(glow::FUNC_SUBTRACT, glow::FUNC_REVERSE_SUBTRACT);
+    }
+    if has.unpack_rows {
+        gl.pixel_store_i32(glow::UNPACK_ROW_LENGTH, 7);
+        gl.pixel_store_i32(glow::UNPACK_SKIP_ROWS, 1);
+    }
+    if has.pack_rows {
+        gl.pixel_store_i32(glow::PACK_ROW_LENGTH, 5);
+        gl.pixel_store_i32(glow::PACK_SKIP_PIXELS, 2);
+    }
+    if has.srgb_write_control {
+        // Drawing linear values into an sRGB target unencoded (a game's UI pass, say).
+        gl.disable(glow::FRAMEBUFFER_SRGB);
     }
     gl.viewport(3, 4, 50, 60);
     gl.clear_color(0.25, 0.5, 0.75, 1.0);
@@ -246,11 +320,20 @@ unsafe fn set_game_state(gl: &glow::Context, es3: bool, vao: bool, size: (i32, i
     gl.front_face(glow::CW);
 }
 
+/// Set in the child process that runs the test below on Mesa capped to ES 2.0.
+const PURE_ES2: &str = "MANYLIGHT_TEST_PURE_ES2";
+
 #[test]
 fn every_call_gives_the_games_gl_state_back_and_draws_as_from_a_clean_one() {
     let scene = scene::builtin::build("pillars", Some((300, 4))).unwrap();
     let (w, h) = (96, 54);
-    for es in [EsVersion::Es2, EsVersion::Es3] {
+    let pure_es2 = std::env::var_os(PURE_ES2).is_some();
+    let levels: &[EsVersion] = if pure_es2 {
+        &[EsVersion::Es2]
+    } else {
+        &[EsVersion::Es2, EsVersion::Es3]
+    };
+    for &es in levels {
         let es3 = es == EsVersion::Es3;
         // MSAA: ES 3.0's renderbuffers (llvmpipe's ES 2.0 has no multisampled extension).
         let sample_counts: &[u32] = if es3 { &[1, 4] } else { &[1] };
@@ -290,15 +373,17 @@ fn every_call_gives_the_games_gl_state_back_and_draws_as_from_a_clean_one() {
         let gl = ctx.load_gl().unwrap();
         let mut renderer = Renderer::new(ctx.load_gl().unwrap(), es).unwrap();
         // An ES 2.0-level renderer on an ES 3.x context (Mesa's, asked for 2.0) meets the
-        // context's ES 3.0 state too: samplers, pixel buffers, a separate read framebuffer.
-        let es3_state = renderer.caps().context_has_es3_state();
-        unsafe { set_game_state(&gl, es3_state, es3, (w as i32, h as i32)) };
-        let before = snapshot(&gl, es3_state);
+        // context's ES 3.0 state too: a vertex array, samplers, pixel buffers, a separate read
+        // framebuffer.
+        let has = Has::of(renderer.caps());
+        assert!(!(pure_es2 && has.es3), "the cap gave an ES 3.x context");
+        unsafe { set_game_state(&gl, has, (w as i32, h as i32)) };
+        let before = snapshot(&gl, has);
         for ((m, opts), expected) in cases.iter().zip(&expected) {
             let what = format!("{es} {m} ×{}", opts.samples);
             renderer.set_method_named(m).unwrap();
             assert_eq!(
-                snapshot(&gl, es3_state),
+                snapshot(&gl, has),
                 before,
                 "{what}: set_method changed the game's state"
             );
@@ -306,14 +391,14 @@ fn every_call_gives_the_games_gl_state_back_and_draws_as_from_a_clean_one() {
             let d = manylight::metrics::diff(expected, &img);
             assert_eq!(d.max_abs, 0, "{what}: the game's state changed the picture");
             assert_eq!(
-                snapshot(&gl, es3_state),
+                snapshot(&gl, has),
                 before,
                 "{what}: render_offscreen changed the game's state"
             );
             // Into the game's own framebuffer, as a game draws.
             renderer.render(&scene, w, h, opts).unwrap();
             assert_eq!(
-                snapshot(&gl, es3_state),
+                snapshot(&gl, has),
                 before,
                 "{what}: render changed the game's state"
             );
@@ -327,13 +412,40 @@ fn every_call_gives_the_games_gl_state_back_and_draws_as_from_a_clean_one() {
             "{es}: the game's state changed what the precision probe measured"
         );
         assert_eq!(
-            snapshot(&gl, es3_state),
+            snapshot(&gl, has),
             before,
             "{es}: the precision probe changed the game's state"
         );
         drop(renderer);
         drop(ctx);
     }
+}
+
+/// Mesa asked for ES 2.0 gives an ES 3.2 context, where the renderer keeps its arrays in a
+/// vertex array object of its own. Capped to ES 2.0 (a Mali-400's context) the game's arrays
+/// are the context's, and its row lengths come from `GL_EXT_unpack_subimage`: the test above
+/// runs again there, in a child process, since Mesa reads the cap once per process.
+/// (SwiftShader's and ANGLE's ES 2.0 contexts are ES 2.0 already, with instanced arrays.)
+#[test]
+fn every_call_gives_the_games_gl_state_back_on_a_pure_es2_context() {
+    if std::env::var_os(PURE_ES2).is_some()
+        || common::other_implementation_than_mesa("MESA_GLES_VERSION_OVERRIDE")
+    {
+        return;
+    }
+    let test = "every_call_gives_the_games_gl_state_back_and_draws_as_from_a_clean_one";
+    let out = std::process::Command::new(std::env::current_exe().unwrap())
+        .args(["--exact", test, "--test-threads=1"])
+        .env("MESA_GLES_VERSION_OVERRIDE", "2.0")
+        .env(PURE_ES2, "1")
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success() && stdout.contains("1 passed"),
+        "on ES 2.0: {stdout}{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
 }
 
 #[test]

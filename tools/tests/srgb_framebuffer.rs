@@ -8,7 +8,7 @@ mod common;
 
 use common::game_target::{sized_framebuffer, stored_then_free};
 use common::Gpu;
-use manylight::glow;
+use manylight::glow::{self, HasContext};
 use manylight::{scene, EsVersion, RenderOptions};
 
 const W: u32 = 128;
@@ -165,4 +165,39 @@ fn the_clear_colour_and_the_heatmap_are_stored_as_given_and_exact_counts_are_ref
     }
     // Into an RGBA8 one they are drawn.
     try_stored(&mut gpu, glow::RGBA8, &plane, &exact).unwrap();
+}
+
+/// A game that switched sRGB writes off (`GL_EXT_sRGB_write_control`: a UI pass that stores
+/// values it encoded itself) still gets the RGBA8 picture: the renderer's calls switch them
+/// on, then back off.
+#[test]
+fn srgb_writes_the_game_switched_off_still_encode_the_renderers_picture() {
+    let s = scene::builtin::build(scene::builtin::DEFAULT, Some((128, 3))).unwrap();
+    let mut gpu = Gpu::new(EsVersion::Es3);
+    if !gpu.r().caps().has_extension("GL_EXT_sRGB_write_control") {
+        eprintln!("no GL_EXT_sRGB_write_control here: sRGB writes always encode");
+        return;
+    }
+    let options = RenderOptions::default();
+    let plain = stored(&mut gpu, glow::RGBA8, &s, &options);
+    let gl = gpu.gl();
+    unsafe { gl.disable(glow::FRAMEBUFFER_SRGB) };
+    let srgb = stored(&mut gpu, glow::SRGB8_ALPHA8, &s, &options);
+    assert!(
+        !unsafe { gl.is_enabled(glow::FRAMEBUFFER_SRGB) },
+        "the game's setting was not given back"
+    );
+    unsafe { gl.enable(glow::FRAMEBUFFER_SRGB) };
+    let worst = plain
+        .chunks(4)
+        .zip(srgb.chunks(4))
+        .flat_map(|(a, b)| (0..3).map(move |c| a[c].abs_diff(b[c])))
+        .max()
+        .unwrap_or(0);
+    let lit = plain.chunks(4).filter(|p| p[0] > 20).count();
+    assert!(lit > (W * H / 4) as usize, "only {lit} lit pixels");
+    assert!(
+        worst <= 2,
+        "with sRGB writes off, the sRGB framebuffer stores values {worst}/255 from the RGBA8 one's"
+    );
 }
