@@ -21,7 +21,8 @@ void main() {
         discard;
     }
 #endif
-    // A highp copy: gl_FragCoord may be mediump on ES 2.0, too coarse past 2048 pixels.
+    // In highp from here: GLSL ES 1.00 declares gl_FragCoord mediump, whose pixel centres
+    // (x.5) are exact only below 1024; a driver that keeps it in fp16 loses them past that.
     HIGHP vec2 fragXY = gl_FragCoord.xy - u_frameOrigin;
     HIGHP float viewDepth = -v_viewPos.z;
 #if COUNT_EVALS

@@ -91,7 +91,9 @@ MEDP vec3 metallicRoughness(HIGHP vec3 L, vec3 N, vec3 V, MEDP float nDotL, Surf
     MEDP float x = 1.0 - vDotH;
     MEDP float x2 = x * x;
     MEDP float x5 = x2 * x2 * x;
-    MEDP vec3 f0 = mix(vec3(0.04), s.albedo, s.metallic);
+    // A base colour past 1 (glTF's range) reflects at most all: F0 > 1 times the capped lobe
+    // was past fp16 (Inf, then NaN where the spot or falloff is 0).
+    MEDP vec3 f0 = mix(vec3(0.04), min(s.albedo, vec3(1.0)), s.metallic);
     MEDP vec3 fresnel = f0 + (1.0 - f0) * x5;
     MEDP float dielectric = 0.04 + 0.96 * x5;
     MEDP vec3 diffuse = s.albedo * ((1.0 - s.metallic) * (1.0 - dielectric) * nDotL);
@@ -136,11 +138,12 @@ vec3 shadeLight(Light light, HIGHP vec3 P, vec3 N, vec3 V, SurfaceParams surface
     // Read only where d ≤ 1.
     HIGHP float d = m / invLen;
 #if FP16_LIGHTS
-    // Radiance came divided by k² (light_struct.glsl): k² goes into the falloff as (k/d)², and
-    // the product is capped where only a saturated pixel could come out (no Inf, no Inf·0).
-    HIGHP float k = light.radianceRoot;
-    HIGHP float kInv = k * inv;
-    HIGHP float falloff = min(w * w * (inv < 1.0 ? kInv * kInv / (1.0 + inv * inv) : k * k / (d * d + 1.0)), 60000.0);
+    // Radiance came divided by k² (light_struct.glsl): the falloff takes it back as (w·k·g)²,
+    // g = 1/√(d² + 1), capped in the root where only a saturated pixel could come out (k² is
+    // past fp16 from k = 2⁸ on; 244² < 60000; no Inf, no Inf·0).
+    HIGHP float g = inv < 1.0 ? inv * inversesqrt(1.0 + inv * inv) : inversesqrt(d * d + 1.0);
+    HIGHP float root = min(w * (light.radianceRoot * g), 244.0);
+    HIGHP float falloff = root * root;
 #else
     HIGHP float falloff = w * w * (inv < 1.0 ? inv * inv / (1.0 + inv * inv) : 1.0 / (d * d + 1.0));
 #endif
@@ -159,8 +162,9 @@ vec3 shadeLight(Light light, HIGHP vec3 P, vec3 N, vec3 V, SurfaceParams surface
 #endif
     MEDP vec3 reflectance = surfaceReflectance(L, N, V, surface);
 #if FP16_LIGHTS
-    // fp16 everywhere: falloff (≤ 60000) × reflectance (≤ 16385) is capped before it could
-    // overflow; radiance is ≤ 1 here, so only a pixel far past saturation is changed.
+    // fp16 everywhere: falloff (≤ 60000) × reflectance (≤ 16384 + the base colour) is capped
+    // before it could overflow; radiance is ≤ 1 here, so only a pixel far past saturation is
+    // changed.
     return light.radiance * (min(vec3(falloff * spot), 60000.0 / max(reflectance, vec3(1.0))) * reflectance);
 #else
     return light.radiance * (falloff * spot) * reflectance;

@@ -293,6 +293,7 @@ fn evaluate(
         || maps.emits()
         || maps.normal.is_some()
         || maps.occlusion.is_some()
+        || maps.metallic_roughness.is_some()
     {
         return Outcome::Texture;
     }
@@ -476,18 +477,46 @@ mod tests {
 
     #[test]
     fn textured_surfaces_are_skipped() {
-        let mut scene = lit_plane();
-        scene.materials[0].diffuse_texture = Some(Arc::new(Texture::new(
-            "white",
-            image::RgbaImage::from_pixel(1, 1, image::Rgba([255; 4])),
-        )));
-        let set = reference_samples(&scene, W, H, 200, Encoding::Srgb, snapping_reach(8));
-        assert!(set.samples.is_empty());
-        assert_eq!(
-            set.skipped_texture + set.skipped_edge + set.skipped_coplanar,
-            200
-        );
-        assert!(set.skipped_texture > 150);
+        let texture = Arc::new(Texture::new(
+            "grey",
+            image::RgbaImage::from_pixel(1, 1, image::Rgba([0, 128, 128, 255])),
+        ));
+        let map = Some(crate::scene::surface_maps::MapTexture {
+            texture: texture.clone(),
+            transform: crate::scene::surface_maps::TextureTransform::IDENTITY,
+        });
+        // Each texture a material may have: the reference evaluates none of them.
+        let with: [(&str, &dyn Fn(&mut Material)); 5] = [
+            ("base colour", &|m| {
+                m.diffuse_texture = Some(texture.clone())
+            }),
+            ("normal", &|m| m.maps.normal = map.clone()),
+            ("occlusion", &|m| m.maps.occlusion = map.clone()),
+            ("emissive", &|m| {
+                m.maps.emissive = Vec3::ONE;
+                m.maps.emissive_texture = map.clone();
+            }),
+            ("metallic-roughness", &|m| {
+                m.model = crate::scene::MaterialModel::MetallicRoughness;
+                m.maps.metallic_roughness = map.clone();
+            }),
+        ];
+        for (what, set_texture) in with {
+            let mut scene = lit_plane();
+            set_texture(&mut scene.materials[0]);
+            scene.validate().unwrap();
+            let set = reference_samples(&scene, W, H, 200, Encoding::Srgb, snapping_reach(8));
+            assert!(
+                set.samples.is_empty(),
+                "{what}: {} samples",
+                set.samples.len()
+            );
+            assert_eq!(
+                set.skipped_texture + set.skipped_edge + set.skipped_coplanar,
+                200
+            );
+            assert!(set.skipped_texture > 150, "{what}");
+        }
     }
 
     #[test]

@@ -8,12 +8,14 @@
 //! D        = α² / (π ((N·H)²(α² − 1) + 1)²)            GGX / Trowbridge-Reitz
 //! Vis      = 0.5 / (N·L √((N·V)²(1 − α²) + α²) + N·V √((N·L)²(1 − α²) + α²))
 //!                                                        height-correlated Smith, N·V ≥ 10⁻⁴
-//! F        = F0 + (1 − F0) x⁵,  F0 = mix(0.04, base, metallic)
+//! F        = F0 + (1 − F0) x⁵,  F0 = mix(0.04, min(base, 1), metallic)
 //! c_diff   = mix(base, 0, metallic),  F_d = 0.04 + 0.96 x⁵   (the dielectric's Fresnel)
 //! π f N·L  = (1 − F_d) c_diff N·L + F min(π D Vis N·L, MAX_SPECULAR_LOBE)
 //! ```
 //!
-//! The spec's `mix(dielectric_brdf, metal_brdf, metallic)` expands to exactly this. The result
+//! The spec's `mix(dielectric_brdf, metal_brdf, metallic)` expands to exactly this (its base
+//! colour lies in [0, 1]; past 1, which the loaders allow up to `MAX_COLOR_FACTOR`, F0 stays 1:
+//! a reflectance above 1 times the capped lobe overflowed fp16 into Inf, then NaN). The result
 //! is multiplied by π like the Blinn-Phong model's Lambert term (`albedo·N·L`, no 1/π): a light
 //! of radiance 1 at distance 0 makes a white rough dielectric as bright as a white Lambert
 //! surface, so both models share the lights' units.
@@ -65,7 +67,7 @@ pub fn reflectance(
     let vis_cos = 0.5 / (lambda_v + n_dot_v * lambda_l / n_dot_l);
     let lobe = (k * k * vis_cos).min(MAX_SPECULAR_LOBE);
     let x5 = (1.0 - v_dot_h).powi(5);
-    let f0 = DVec3::splat(DIELECTRIC_F0).lerp(base, metallic);
+    let f0 = DVec3::splat(DIELECTRIC_F0).lerp(base.min(DVec3::ONE), metallic);
     let fresnel = f0 + (DVec3::ONE - f0) * x5;
     let dielectric = DIELECTRIC_F0 + (1.0 - DIELECTRIC_F0) * x5;
     let c_diff = base * (1.0 - metallic);
@@ -118,10 +120,12 @@ mod tests {
         for (l, v) in [(n, n), (grazing, mirror), (mirror, n), (n, grazing)] {
             for roughness in [0.0, 1e-4, 0.05, 0.5, 1.0] {
                 for metallic in [0.0, 1.0] {
-                    for base in [DVec3::ZERO, DVec3::ONE] {
+                    for base in [DVec3::ZERO, DVec3::ONE, DVec3::splat(1024.0)] {
                         let c = reflectance(l, n, v, base, metallic, roughness);
                         assert!(c.is_finite() && c.min_element() >= 0.0, "{c}");
-                        assert!(c.max_element() <= MAX_SPECULAR_LOBE + 1.0, "{c}");
+                        // fp16 holds it: the lobe's cap, plus the diffuse term's base colour.
+                        let most = MAX_SPECULAR_LOBE + base.max_element();
+                        assert!(c.max_element() <= most, "{base} {c}");
                     }
                 }
             }

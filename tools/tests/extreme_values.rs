@@ -393,3 +393,77 @@ fn a_light_farther_than_the_radius_cap_still_reaches_the_scene() {
         }
     }
 }
+
+/// Without fragment highp a light's radiance goes up divided by k², k = 2^⌈log₂(c)/2⌉, and
+/// the falloff multiplies k² back: past c = 2¹⁴ (k ≥ 2⁸) that square is past fp16, and
+/// within a unit of the light the falloff became its cap, 1.8× too bright with a ring where
+/// d = 1 (or NaN where the window flushed to 0). Drawn at its true brightness (exposure −15,
+/// linear output), such a light now draws on the no-highp tier what highp draws.
+#[test]
+fn a_light_whose_fp16_scale_squares_past_fp16_draws_as_with_highp() {
+    let restrictions = manylight::gl::Restrictions {
+        no_fragment_highp: true,
+    };
+    let mut mediump = Gpu::restricted(EsVersion::Es2, &restrictions);
+    let mut highp = Gpu::new(EsVersion::Es3);
+    let opts = RenderOptions {
+        exposure_ev: -15.0,
+        linear: true,
+        ..Default::default()
+    };
+    // Past 2¹⁶ the sum before exposure is itself past fp16 (docs/precision.md).
+    for intensity in [2f32.powi(15), 2f32.powi(16)] {
+        let mut light = point(3.0);
+        light.position = DVec3::new(0.0, 0.0, 0.5);
+        light.color = Vec3::ONE;
+        light.intensity = intensity;
+        let s = plane(vec![light]);
+        let exact = highp.render(&s, 64, 36, &opts);
+        let lit = exact.pixels().filter(|p| p[0] > 100).count();
+        assert!(
+            lit > 30,
+            "intensity {intensity:e}: {lit} pixels lit, too few to tell"
+        );
+        // Forward: the one method this tier runs (the others address textures in highp).
+        let image = mediump.render(&s, 64, 36, &opts);
+        let d = manylight::metrics::diff(&exact, &image).max_abs;
+        assert!(d <= 3, "intensity {intensity:e}: {d} / 255 from highp");
+    }
+}
+
+/// A metal whose base colour is past glTF's [0, 1] (the loaders take up to 1 024): its Fresnel
+/// reflectance F0 grew with it, and times the capped lobe went past fp16, Inf, then NaN where
+/// the falloff or spot was 0 (black holes without fragment highp). F0 now stays at most 1, and
+/// the no-highp frame is what highp draws, highlight included.
+#[test]
+fn a_metal_brighter_than_white_stays_finite_and_equals_highp() {
+    let restrictions = manylight::gl::Restrictions {
+        no_fragment_highp: true,
+    };
+    let mut mediump = Gpu::restricted(EsVersion::Es2, &restrictions);
+    let mut highp = Gpu::new(EsVersion::Es3);
+    let opts = RenderOptions {
+        linear: true,
+        ..Default::default()
+    };
+    let mut light = point(3.0);
+    light.position = DVec3::new(-1.0, 0.5, 1.0);
+    light.color = Vec3::ONE;
+    // A spot turned sideways: the mirror peak below it lies outside its cone (spot 0).
+    let cone = manylight::Cone {
+        direction: DVec3::X,
+        inner_deg: 20.0,
+        outer_deg: 30.0,
+    };
+    let spot = Light::spot(DVec3::new(0.0, 0.0, 1.0), 10.0, Vec3::ONE, 1.0, cone);
+    let mut s = plane(vec![light, spot]);
+    s.camera = Camera::perspective(DVec3::new(0.0, 0.0, 5.0), DVec3::ZERO, 60.0, 0.1, 50.0);
+    s.ambient = Vec3::ZERO;
+    s.materials[0] = manylight::Material::metallic_roughness("hot", Vec3::splat(1024.0), 1.0, 0.2);
+    let exact = highp.render(&s, 64, 36, &opts);
+    let lit = exact.pixels().filter(|p| p[0] > 20).count();
+    assert!(lit > 4, "{lit} pixels lit, too few to tell");
+    let image = mediump.render(&s, 64, 36, &opts);
+    let d = manylight::metrics::diff(&exact, &image).max_abs;
+    assert!(d <= 3, "{d} / 255 from highp");
+}
