@@ -131,6 +131,16 @@ impl Light {
                 format!("must be finite, got {:?}", self.position),
             ));
         }
+        if self.position.abs().max_element() > MAX_LIGHT_COORD {
+            return Err(SceneError::invalid(
+                format!("{field}.position"),
+                format!(
+                    "must be within ±{MAX_LIGHT_COORD:e} (past it the falloff's 1/d² leaves \
+                     f32 and the light vanishes), got {:?}",
+                    self.position
+                ),
+            ));
+        }
         if !(self.radius.is_finite() && self.radius >= 0.0) {
             return Err(SceneError::invalid(
                 format!("{field}.radius"),
@@ -173,6 +183,11 @@ impl Light {
         Ok(())
     }
 }
+
+/// Largest light position coordinate, in world units: from the camera (at most
+/// [`super::camera::MAX_CAMERA_COORD`] away) `1/d²` stays a normal `f32` (10⁻³⁶), where a light
+/// 10¹⁹ away drew nothing at all, however bright.
+pub const MAX_LIGHT_COORD: f64 = 1e18;
 
 /// Smallest `cos(inner) − cos(outer)` used for the spot smoothstep, so a hard-edged cone
 /// (`inner == outer`) has a finite slope.

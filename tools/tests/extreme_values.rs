@@ -175,6 +175,15 @@ fn values_the_maths_cannot_carry_are_refused_naming_the_real_field() {
             }),
             "camera.height",
         ),
+        // Its 1/d² underflowed f32: no light at all, however bright.
+        (
+            Box::new(|s: &mut Scene| {
+                s.lights[0].position = DVec3::new(0.0, 0.0, 2e19);
+                s.lights[0].radius = 3e38;
+                s.lights[0].intensity = 3e38;
+            }),
+            "lights[0].position",
+        ),
     ];
     for (break_it, field) in cases {
         let mut s = plane(vec![point(3.0)]);

@@ -66,6 +66,22 @@ fn finite_numbers_past_f32_are_named_as_written_not_as_infinite() {
     }
 }
 
+/// A colour past the materials' range is named as the file wrote it, not as the material the
+/// object's model made (`materials[6] (plane).diffuse` said nothing the user wrote).
+#[test]
+fn an_objects_colour_out_of_range_names_the_object() {
+    for (color, shown) in [("[2000, 0, 0]", "2000"), ("[0.5, -1, 0]", "-1")] {
+        let text = format!(
+            r#"{{"objects": [{{"builtin": "plane"}}, {{"builtin": "plane", "color": {color}}}]}}"#
+        );
+        let err = parse_str(&text).unwrap_err().to_string();
+        assert!(
+            err.contains("`objects[1].color`") && err.contains(shown),
+            "{err}"
+        );
+    }
+}
+
 #[test]
 fn anything_after_the_scenes_object_is_an_error_and_keys_are_shown_escaped() {
     let scene = r#"{"objects": [{"builtin": "plane"}]}"#;
