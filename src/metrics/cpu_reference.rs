@@ -486,7 +486,8 @@ mod tests {
             transform: crate::scene::surface_maps::TextureTransform::IDENTITY,
         });
         // Each texture a material may have: the reference evaluates none of them.
-        let with: [(&str, &dyn Fn(&mut Material)); 5] = [
+        type SetTexture<'a> = &'a dyn Fn(&mut Material);
+        let with: [(&str, SetTexture); 5] = [
             ("base colour", &|m| {
                 m.diffuse_texture = Some(texture.clone())
             }),

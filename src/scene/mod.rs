@@ -431,8 +431,12 @@ pub fn load_with(
         }
         "gltf" | "glb" => gltf::load(path, lights, options),
         "json" => file::load(path, lights, options),
-        // Built-in names have no extension: anything else that looks like a file is one.
-        _ if !ext.is_empty() || path.is_file() || spec.contains(std::path::MAIN_SEPARATOR) => {
+        // Built-in names have no extension: anything else that looks like a file is one (a
+        // file without an extension named like a built-in could not be read as a scene anyway).
+        _ if !ext.is_empty()
+            || (path.is_file() && !builtin::NAMES.contains(&spec))
+            || spec.contains(std::path::MAIN_SEPARATOR) =>
+        {
             Err(SceneError::UnsupportedFile {
                 path: path.to_path_buf(),
             })

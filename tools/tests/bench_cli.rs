@@ -261,3 +261,33 @@ fn knobs_a_context_cannot_run_are_skipped_not_fatal() {
     );
     assert!(rows.iter().any(|r| r["knob"] == "cell_cap=16"), "{rows:?}");
 }
+
+/// Two scenes whose files share a stem (`a/room.obj`, `c/room.obj`; or a built-in twice) were
+/// both labelled `room`: the second's pictures overwrote the first's and the charts merged them
+/// into one series. The sweep now refuses them before it measures anything.
+#[test]
+fn scenes_that_would_report_under_one_name_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    for sub in ["a", "c"] {
+        std::fs::create_dir(dir.path().join(sub)).unwrap();
+        let scene = r#"{"objects": [{"builtin": "plane"}]}"#;
+        std::fs::write(dir.path().join(sub).join("room.json"), scene).unwrap();
+    }
+    for scenes in ["a/room.json,c/room.json", "plane,plane"] {
+        let out = Command::new(env!("CARGO_BIN_EXE_manylight"))
+            .args(["bench", "--scenes", scenes, "--lights", "8", "--es", "3"])
+            .args(["--size", "16x9", "--no-knobs", "--animated-frames", "0"])
+            .arg("--out")
+            .arg(dir.path().join("report"))
+            .current_dir(dir.path())
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{scenes}: {stderr}");
+        assert!(stderr.contains("both report as"), "{scenes}: {stderr}");
+        let measured = std::fs::read_dir(dir.path().join("report"))
+            .map(|files| files.count())
+            .unwrap_or(0);
+        assert_eq!(measured, 0, "{scenes}: files written before the refusal");
+    }
+}

@@ -23,6 +23,33 @@ fn a_file_of_another_type_is_called_unsupported_not_an_unknown_built_in() {
     // A name without an extension is still looked up among the built-ins.
     let msg = expect(&["--scene", "atlantis", "--size", "8x8"], dir.path(), 1);
     assert!(msg.contains("unknown built-in scene"), "{msg}");
+    // A file in the folder named like a built-in does not hide it (plain `manylight` failed
+    // as an unsupported file beside one called `courtyard`).
+    std::fs::write(dir.path().join("courtyard"), "notes\n").unwrap();
+    let args = ["--size", "8x8", "--lights", "0", "--out", "c.png"];
+    let out = manylight(&args, &[], dir.path());
+    assert!(out.status.success(), "{}", text(&out));
+}
+
+/// An output naming the scene file (in any spelling) would replace the scene with a picture or
+/// with statistics: a usage error naming both, and the scene is left as it was.
+#[test]
+fn an_output_that_would_overwrite_the_scene_is_a_usage_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = r#"{"objects": [{"builtin": "plane"}]}"#;
+    std::fs::write(dir.path().join("s.json"), scene).unwrap();
+    for (option, path) in [("--out", "s.json"), ("--stats", "./s.json")] {
+        let args = ["--scene", "s.json", "--size", "8x8", option, path];
+        let msg = expect(&args, dir.path(), 2);
+        assert!(
+            msg.contains(&format!("{option} {path} names the scene file")),
+            "{msg}"
+        );
+        assert_eq!(
+            std::fs::read_to_string(dir.path().join("s.json")).unwrap(),
+            scene
+        );
+    }
 }
 
 #[test]

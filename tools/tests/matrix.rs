@@ -199,8 +199,13 @@ fn vs_forward_is_each_image_against_its_cells_forward(rows: &serde_json::Value, 
 #[test]
 fn matrix_json_on_stdout_ignores_the_callers_driver_switches_and_writes_no_images() {
     let dir = tempfile::tempdir().unwrap();
+    // A scene file whose name starts with `-`: each cell gets it as one argument, not a flag.
+    let scene = "-plane.json";
+    let scene_text = r#"{"objects": [{"builtin": "plane"}]}"#;
+    std::fs::write(dir.path().join(scene), scene_text).unwrap();
     let out = Command::new(env!("CARGO_BIN_EXE_manylight"))
         .args(["matrix", "--size", "32x18", "--lights", "8", "--json", "-"])
+        .arg(format!("--scene={scene}"))
         .args(["--max-error", "0"])
         .env("MESA_GLES_VERSION_OVERRIDE", "2.0")
         .env("TMPDIR", dir.path())
@@ -253,7 +258,11 @@ fn matrix_json_on_stdout_ignores_the_callers_driver_switches_and_writes_no_image
             assert!(m["image"].is_null(), "an image without --out: {m}");
         }
     }
-    let written: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();
+    let written: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .filter(|name| name != scene)
+        .collect();
     assert!(written.is_empty(), "files written: {written:?}");
 }
 

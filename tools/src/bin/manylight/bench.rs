@@ -351,6 +351,19 @@ pub fn run(args: &BenchArgs) -> Result<(), Box<dyn std::error::Error>> {
     std::fs::write(&probe, b"")
         .and_then(|()| std::fs::remove_file(&probe))
         .map_err(|e| format!("cannot write into {}: {e}", args.out.display()))?;
+    // Rows, pictures and chart series are named by the scene's file stem: two alike would
+    // overwrite each other's pictures and merge into one series.
+    let mut labels = std::collections::HashMap::new();
+    for spec in &plan.scenes {
+        let label = report::file_tag(&scene_name(spec));
+        if let Some(first) = labels.insert(label.clone(), spec) {
+            return Err(format!(
+                "--scenes names `{first}` and `{spec}`, which both report as `{label}`: their \
+                 rows and pictures would overwrite each other (give each its own file name)"
+            )
+            .into());
+        }
+    }
     // Every scene loads once here, so a bad one fails the sweep before its first row, not
     // after the scenes before it were measured.
     let first_count = plan.lights.first().copied().unwrap_or(0);
@@ -699,7 +712,8 @@ impl AnimatedWorkload {
             renderer.set_method_named("forward")?;
             let (w, h) = self.size;
             let (reference, _) = renderer.render_offscreen(&scene, w, h, &options)?;
-            Some(manylight::metrics::diff(&reference, &rendered.last).max_abs)
+            let last = rendered.last.as_ref().unwrap_or(&rendered.first);
+            Some(manylight::metrics::diff(&reference, last).max_abs)
         };
         let (Some(frame_ms), Some(assign_ms), Some(upload_bytes)) = (
             stats.time.frame_ms_spread,

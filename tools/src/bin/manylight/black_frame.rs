@@ -13,12 +13,17 @@ pub fn warning(image: &image::RgbaImage, scene: &Scene) -> Option<String> {
         return Some("the picture is black: the scene has no geometry".into());
     };
     let mut causes = Vec::new();
-    let unlit = scene.lights.is_empty()
-        && scene.directional_lights.is_empty()
+    // A light of intensity or colour 0 lights nothing either.
+    let shines = |color: glam::Vec3, intensity: f32| intensity > 0.0 && color.max_element() > 0.0;
+    let unlit = !scene.lights.iter().any(|l| shines(l.color, l.intensity))
+        && !(scene.directional_lights.iter()).any(|l| shines(l.color, l.intensity))
         && scene.ambient == glam::Vec3::ZERO
         && !scene.materials.iter().any(|m| m.maps.emits());
     if unlit {
-        causes.push("nothing lights it (no lights, ambient 0, no emissive material)".to_string());
+        causes.push(
+            "nothing lights it (no light brighter than 0, ambient 0, no emissive material)"
+                .to_string(),
+        );
     }
     let camera = &scene.camera;
     let (near, far) = camera.near_far();
@@ -53,6 +58,16 @@ mod tests {
             text.contains("nothing lights it") && text.contains("camera"),
             "{text}"
         );
+        // A light of intensity 0 is no light.
+        let mut dark = manylight::Light::point(glam::DVec3::Z, 3.0, glam::Vec3::ONE, 0.0);
+        scene.lights.push(dark);
+        let text = warning(&image, &scene).expect("black");
+        assert!(text.contains("nothing lights it"), "{text}");
+        dark.intensity = 1.0;
+        scene.lights = vec![dark];
+        let text = warning(&image, &scene).expect("black");
+        assert!(!text.contains("nothing lights it"), "{text}");
+        scene.lights.clear();
         scene.ambient = glam::Vec3::splat(0.1);
         let text = warning(&image, &scene).expect("black");
         assert!(!text.contains("nothing lights it"), "{text}");

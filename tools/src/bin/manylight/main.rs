@@ -166,6 +166,7 @@ fn check_usage(cli: &Cli) {
         let stats = a.stats.as_deref().map(|p| ("--stats", p));
         let record = a.record.as_deref().map(|p| ("--record", p));
         check_distinct_outputs(&[out, stats, record]);
+        check_not_the_input(&[out, stats], Path::new(&a.scene));
         if let Some(folder) = a.record.as_deref().filter(|p| !sequence::records_gif(p)) {
             check_outside_folder(&[out, stats], ("--record", folder));
         }
@@ -264,6 +265,31 @@ fn check_distinct_outputs(outputs: &[Option<(&str, &Path)>]) {
                 )
                 .exit();
         }
+    }
+}
+
+/// An output naming the scene file itself (through any spelling or link) would replace it with
+/// a picture or statistics: a usage error naming both.
+fn check_not_the_input(outputs: &[Option<(&str, &Path)>], scene: &Path) {
+    if !scene.is_file() {
+        return; // a built-in scene's name, or a file that reading will say is missing
+    }
+    let scene_id = output::identity(scene);
+    if let Some((option, path)) = outputs
+        .iter()
+        .flatten()
+        .find(|(_, path)| output::identity(path) == scene_id)
+    {
+        Cli::command()
+            .error(
+                ErrorKind::ArgumentConflict,
+                format!(
+                    "{option} {} names the scene file --scene {}: it would be overwritten",
+                    path.display(),
+                    scene.display()
+                ),
+            )
+            .exit();
     }
 }
 

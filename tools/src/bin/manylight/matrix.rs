@@ -306,8 +306,7 @@ fn group_rows(
             "matrix-cell",
             "--es",
             config.es,
-            "--scene",
-            &args.scene,
+            &scene_arg(&args.scene),
             "--size",
             config.size.unwrap_or(size),
         ])
@@ -361,8 +360,16 @@ fn cell_environment(cmd: &mut Command, out: Option<&Path>) {
         cmd.env_remove(var);
     }
     if let Some(out) = out {
-        cmd.arg("--out").arg(out);
+        // One argument: a folder named `-x` is no flag.
+        let mut arg = std::ffi::OsString::from("--out=");
+        arg.push(out);
+        cmd.arg(arg);
     }
+}
+
+/// `--scene=NAME` as one argument: a file named `-x.json` is no flag.
+fn scene_arg(scene: &str) -> String {
+    format!("--scene={scene}")
 }
 
 /// A cell's row: the last line of its output that is a JSON object (a driver may print lines
@@ -428,8 +435,7 @@ fn osmesa_row(
         "--es",
         "3",
         "--osmesa",
-        "--scene",
-        &args.scene,
+        &scene_arg(&args.scene),
         "--size",
         size,
     ])
@@ -525,6 +531,24 @@ fn markdown(rows: &[Value]) -> String {
     s
 }
 
+/// Longest side of a contact sheet's thumbnail: the sheet holds every cell's at once (full
+/// pictures at 4096² took 2.7 GB and aborted; at 16384², about 75 GB).
+const THUMB_MAX: u32 = 512;
+
+/// The picture in `file`, scaled down to fit [`THUMB_MAX`] (one full picture decoded at a time).
+fn thumbnail(file: &Path) -> Option<image::RgbaImage> {
+    let picture = image::open(file).ok()?;
+    let fits = picture.width().max(picture.height()) <= THUMB_MAX;
+    Some(
+        if fits {
+            picture
+        } else {
+            picture.thumbnail(THUMB_MAX, THUMB_MAX)
+        }
+        .to_rgba8(),
+    )
+}
+
 fn sheet(rows: &[Value], out: &Path) -> image::RgbaImage {
     let mut cells = Vec::new();
     for (row, (implementation, config)) in rows.iter().zip(row_labels(rows)) {
@@ -535,10 +559,7 @@ fn sheet(rows: &[Value], out: &Path) -> image::RgbaImage {
         }
         for m in row["methods"].as_array().into_iter().flatten() {
             let name = m["name"].as_str().unwrap_or("?");
-            let thumb = m["image"]
-                .as_str()
-                .and_then(|f| image::open(out.join(f)).ok())
-                .map(|i| i.to_rgba8());
+            let thumb = m["image"].as_str().and_then(|f| thumbnail(&out.join(f)));
             let detail = match (m["support"]["status"].as_str(), m["max_abs"].as_f64()) {
                 _ if m["error"].is_string() => "error".to_string(),
                 (Some("unsupported"), _) => "unsupported".to_string(),
@@ -727,8 +748,30 @@ pub fn run_cell(args: &MatrixCellArgs) -> Result<(), Box<dyn std::error::Error>>
 
 #[cfg(test)]
 mod tests {
-    use super::{cell_error, cell_row, markdown};
+    use super::{cell_error, cell_row, markdown, sheet, THUMB_MAX};
     use serde_json::json;
+
+    /// Large pictures go on the sheet scaled down to fit [`THUMB_MAX`], their shape kept; small
+    /// ones as they are.
+    #[test]
+    fn the_sheet_holds_large_pictures_as_thumbnails() {
+        let dir = tempfile::tempdir().unwrap();
+        let picture = image::RgbaImage::from_pixel(2048, 1152, image::Rgba([200, 0, 0, 255]));
+        picture.save(dir.path().join("big.png")).unwrap();
+        let small = image::RgbaImage::from_pixel(64, 36, image::Rgba([0, 200, 0, 255]));
+        small.save(dir.path().join("small.png")).unwrap();
+        let rows = [
+            json!({"implementation": "Mesa llvmpipe", "config": "ES 3.0",
+            "methods": [{"name": "forward", "image": "big.png"},
+                        {"name": "clustered", "image": "small.png"}]}),
+        ];
+        let sheet = sheet(&rows, dir.path());
+        assert!(sheet.height() < THUMB_MAX + 100, "{:?}", sheet.dimensions());
+        let red = |p: &&image::Rgba<u8>| p.0 == [200, 0, 0, 255];
+        let green = |p: &&image::Rgba<u8>| p.0 == [0, 200, 0, 255];
+        assert_eq!(sheet.pixels().filter(red).count(), 512 * 288);
+        assert_eq!(sheet.pixels().filter(green).count(), 64 * 36);
+    }
 
     /// Two implementations of one family (two Mesa builds) are told apart by their folders;
     /// auto's row says what it ran.

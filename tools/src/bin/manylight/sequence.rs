@@ -152,8 +152,9 @@ fn stale_frames(dir: &Path, frames: u32, digits: usize) -> usize {
 pub struct Rendered {
     /// The warm-up frame, at `start_s`.
     pub first: RgbaImage,
-    /// The last timed frame (the first one when none was timed).
-    pub last: RgbaImage,
+    /// The last timed frame, unless none was timed or it went to the recording (kept without
+    /// a copy: at 8192² a frame is 256 MiB).
+    pub last: Option<RgbaImage>,
     /// The last frame's stats, frame and assignment time replaced by the medians and the
     /// spreads (frame, assignment, upload bytes) filled in.
     pub stats: FrameStats,
@@ -187,13 +188,10 @@ pub fn render(
     for k in 0..timeline.frames {
         pose(scene, timeline.time_of(k));
         let (image, s) = renderer.render_offscreen(scene, width, height, &one_frame)?;
-        if k + 1 == timeline.frames {
-            if let Some(r) = &mut recorder {
-                r.add(k, image.clone(), timeline.fps)?;
-            }
-            last = Some(image);
-        } else if let Some(r) = &mut recorder {
-            r.add(k, image, timeline.fps)?;
+        match &mut recorder {
+            Some(r) => r.add(k, image, timeline.fps)?,
+            None if k + 1 == timeline.frames => last = Some(image),
+            None => {}
         }
         timed.push(s);
     }
@@ -203,9 +201,5 @@ pub fn render(
     let upload = Spread::of(timed.iter().map(|s| s.memory.upload_bytes as f64));
     let mut stats = FrameStats::summarize(timed).unwrap_or(warm_up);
     stats.memory.upload_bytes_spread = upload;
-    Ok(Rendered {
-        last: last.unwrap_or_else(|| first.clone()),
-        first,
-        stats,
-    })
+    Ok(Rendered { first, last, stats })
 }
