@@ -91,7 +91,9 @@ pub struct Renderer {
 
 impl Renderer {
     /// Creates a renderer on a current GL context, restricted to feature level `es`. The
-    /// context must stay current (and alive) for the renderer's whole life.
+    /// context must be current during each of its calls and when it is dropped; between them
+    /// it may be made not current (an app's suspend keeps it so). A context lost or destroyed
+    /// before the renderer: let the renderer go with [`Renderer::abandon`].
     pub fn new(gl: glow::Context, es: EsVersion) -> Result<Renderer, Error> {
         Renderer::restricted(gl, es, &crate::gl::Restrictions::default())
     }
@@ -340,8 +342,8 @@ impl Renderer {
 }
 
 impl Drop for Renderer {
-    /// The context must still be current, as [`Renderer::new`] requires for the renderer's
-    /// whole life.
+    /// Frees the GL objects on the renderer's context, which must be current (another one
+    /// current, or none, leaves them with a warning; see [`Renderer::new`]).
     fn drop(&mut self) {
         self.free_gl();
     }
