@@ -28,10 +28,19 @@ HIGHP vec4 lightTexel(HIGHP float i, HIGHP float k) {
 #endif
 
 #if LIGHTS_RGBA8
-// Two bytes (as 0..1 channels) → 0..1 with 16 bits, without forming the 16-bit integer
-// (65 535 is past fp16's largest value where HIGHP is mediump).
+// Two bytes (as 0..1 channels) → 0..1 with 16 bits, without forming the 16-bit integer:
+// where HIGHP is mediump, 65 535 is past fp16's largest value, and so is a constant the
+// compiler folds from it (256.0 / 65535.0 folded in fp16 was 0: no light moved off the
+// origin). 0.0039063096 is 256 / 65 535.
 HIGHP float unpack16(vec2 bytes) {
-    return byteOf(bytes.x) * (256.0 / 65535.0) + byteOf(bytes.y) * (1.0 / 65535.0);
+    return (byteOf(bytes.x) + byteOf(bytes.y) * (1.0 / 256.0)) * 0.0039063096;
+}
+
+// unpack16 · 2 − 1 formed about the centre (127.998046875 = 32 767.5 / 256), so that in fp16
+// a coordinate near the middle of the range keeps its low byte, as a float texel keeps a small
+// value's bits; 0.0078126192 is 512 / 65 535.
+HIGHP float unpackSigned16(vec2 bytes) {
+    return ((byteOf(bytes.x) - 127.998046875) + byteOf(bytes.y) * (1.0 / 256.0)) * 0.0078126192;
 }
 #endif
 
@@ -43,7 +52,7 @@ Light fetchLight(int i) {
     vec4 t1 = LIGHT_TEXEL(i, 1);
 #if LIGHTS_RGBA8
     vec4 t2 = LIGHT_TEXEL(i, 2);
-    light.position = (vec3(unpack16(t0.xy), unpack16(t0.zw), unpack16(t1.xy)) * 2.0 - 1.0) * u_lightRanges.x;
+    light.position = vec3(unpackSigned16(t0.xy), unpackSigned16(t0.zw), unpackSigned16(t1.xy)) * u_lightRanges.x;
     light.radius = unpack16(t1.zw) * u_lightRanges.y;
     vec4 rgbe = floor(t2 * 255.0 + 0.5);
 #if FP16_LIGHTS

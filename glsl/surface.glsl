@@ -188,10 +188,12 @@ vec4 encodeCount(HIGHP float n) {
 #endif
     return vec4(c, 1.0);
 #else
-    HIGHP float high = floor(n / 65536.0);
-    HIGHP float rest = n - high * 65536.0;
-    HIGHP float middle = floor(rest / 256.0);
-    return vec4(rest - middle * 256.0, middle, high, 255.0) / 255.0;
+    // Byte by byte: 65 536 is past fp16 where HIGHP is mediump (n / 65536.0 was 0 and
+    // high * 65536.0 NaN: every count read back 0).
+    HIGHP float above = floor(n / 256.0);
+    HIGHP float high = floor(above / 256.0);
+    HIGHP float middle = above - high * 256.0;
+    return vec4(n - above * 256.0, middle, high, 255.0) / 255.0;
 #endif
 }
 #endif

@@ -260,3 +260,22 @@ fn tight_coverage_never_evaluates_more_than_the_cascade_box() {
         );
     }
 }
+
+/// Without fragment highp every shader float is mediump (fp16 on llvmpipe, as on a Mali-400):
+/// the count encoder divided by 65 536, past fp16, and every count read back 0. Forward's
+/// counts there are every light at every covered pixel, as with highp.
+#[test]
+fn counts_without_fragment_highp_are_every_light_at_every_pixel() {
+    let lights = 300;
+    let scene = scene::builtin::build("courtyard", Some((lights, 5))).unwrap();
+    let restrictions = manylight::gl::Restrictions {
+        no_fragment_highp: true,
+    };
+    let mut gpu = Gpu::restricted(EsVersion::Es2, &restrictions);
+    let evals = counts(&mut gpu, &scene, "forward", CountKind::Evals);
+    assert!(evals.covered_pixels() > 1000, "the view shows little");
+    let wrong = (evals.counts.iter().zip(&evals.covered))
+        .filter(|&(&n, &c)| c && n as usize != lights)
+        .count();
+    assert_eq!(wrong, 0, "covered pixels whose count is not {lights}");
+}

@@ -106,6 +106,16 @@ const CONFIGS: &[Config] = &[
         size: None,
     },
     Config {
+        // A Mali-400's pair: its lights as 16-bit RGBA8 records decoded in fp16.
+        name: "ES 2.0 without fragment highp or float textures (played)",
+        slug: "es2-mediump-rgba8",
+        es: "2",
+        env: &[],
+        args: &["--no-fragment-highp", "--rgba8-lights"],
+        groups: Groups::All,
+        size: None,
+    },
+    Config {
         name: "ES 2.0 with RGBA8 light data (played)",
         slug: "es2-rgba8",
         es: "2",
