@@ -1,7 +1,7 @@
 //! The camera as the grid sees it: the depth mapping `f(d)` ([`DepthMapping`]) and the
 //! projection's extent at a depth ([`GridProjection`]).
 
-use glam::DMat4;
+use glam::{DMat4, DVec3};
 
 /// How view depth maps to the grid coordinate `t`.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
@@ -47,6 +47,27 @@ impl GridProjection {
         }
     }
 
+    /// True when the view-space sphere (`center`, `radius`) lies wholly outside the view
+    /// between the depths `near` and `far` (outside a side plane, before `near` or past
+    /// `far`): it reaches no pixel. Conservative by a part in 10⁶ of the radius.
+    pub fn sphere_outside_view(&self, center: DVec3, radius: f64, near: f64, far: f64) -> bool {
+        let radius = radius * (1.0 + 1e-6);
+        let d = -center.z;
+        if d + radius < near || d - radius > far {
+            return true;
+        }
+        match *self {
+            GridProjection::Perspective { tan_x, tan_y } => {
+                // Distance past the plane |x| = tan · d, along its unit normal.
+                let past = |c: f64, t: f64| (c.abs() - t * d) / (1.0 + t * t).sqrt();
+                past(center.x, tan_x) > radius || past(center.y, tan_y) > radius
+            }
+            GridProjection::Orthographic { half_x, half_y } => {
+                center.x.abs() - half_x > radius || center.y.abs() - half_y > radius
+            }
+        }
+    }
+
     /// View-space half extent in x and y at view depth `d`.
     pub fn half_extent(&self, d: f64) -> (f64, f64) {
         match *self {
@@ -65,5 +86,42 @@ impl GridProjection {
             tan_x: t * 16.0 / 9.0,
             tan_y: t,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A sphere just inside a side plane, or reaching over the near or far depth, is in view;
+    /// one just past them is not.
+    #[test]
+    fn spheres_outside_the_view_are_told_from_those_touching_it() {
+        let view = GridProjection::test_view();
+        let GridProjection::Perspective { tan_x, .. } = view else {
+            unreachable!()
+        };
+        let (near, far) = (0.5, 40.0);
+        let d = 10.0;
+        // The right plane's unit normal, pointing out of the view.
+        let normal = DVec3::new(1.0, 0.0, tan_x).normalize();
+        let on_plane = DVec3::new(tan_x * d, 0.0, -d);
+        for (gap, outside) in [(0.999, false), (1.001, true)] {
+            let center = on_plane + normal * (2.0 * gap);
+            let got = view.sphere_outside_view(center, 2.0, near, far);
+            assert_eq!(got, outside, "side, {gap}");
+            let mirrored = DVec3::new(-center.x, center.y, center.z);
+            assert_eq!(view.sphere_outside_view(mirrored, 2.0, near, far), outside);
+        }
+        for (z, outside) in [(0.0, false), (0.6, true), (-40.9, false), (-41.1, true)] {
+            let got = view.sphere_outside_view(DVec3::new(0.0, 0.0, z), 1.0, near, far);
+            assert_eq!(got, outside, "depth {z}");
+        }
+        let ortho = GridProjection::Orthographic {
+            half_x: 4.0,
+            half_y: 3.0,
+        };
+        assert!(!ortho.sphere_outside_view(DVec3::new(4.9, 0.0, -5.0), 1.0, 0.0, 10.0));
+        assert!(ortho.sphere_outside_view(DVec3::new(0.0, 4.1, -5.0), 1.0, 0.0, 10.0));
     }
 }

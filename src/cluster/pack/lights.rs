@@ -167,7 +167,8 @@ pub fn pack_lights_into(lights: &[GpuLight], encoding: LightEncoding, packed: &m
                 bytes[start..start + 64].copy_from_slice(bytemuck::cast_slice(&rec));
             }
             LightEncoding::Rgba8 => {
-                coarse += usize::from(step > 0.1 * l.radius);
+                // A light of radius 0 (forward's darkened unseen ones) lights nothing anyway.
+                coarse += usize::from(l.radius > 0.0 && step > 0.1 * l.radius);
                 let p = |v: f32| unorm16(v / pos_range * 0.5 + 0.5);
                 let s = |v: f32| unorm16(v * 0.5 + 0.5);
                 let words = [
