@@ -160,8 +160,15 @@ impl ShadingMethod for Auto {
                 .clustered
                 .get_or_insert_with(|| CulledForward::new(Culling::Clustered));
             // Else forward this frame; clustered keeps its resources and tries again next
-            // frame (the visible lights change as they and the camera move).
-            let too_many = match clustered.render_unless_too_many(ctx)? {
+            // frame (the visible lights change as they and the camera move). Cells past their
+            // cap leave lights out: where forward's one loop holds every light, it draws them
+            // (deferred's half-float accumulation, without GL_EXT_float_blend, drifts under
+            // thousands of lights on one pixel: 107/255 on ANGLE).
+            let forward_holds_all =
+                ctx.lights.len() <= super::forward::max_lights(ctx.dev.caps()) as usize;
+            let frame = clustered.render_unless_too_many(ctx, forward_holds_all)?;
+            let overflowed = matches!(frame, CulledFrame::Overflowed(_));
+            let too_many = match frame {
                 CulledFrame::Rendered(mut stats) => {
                     self.forward.destroy(ctx.dev);
                     retire_deferred(&mut self.deferred, &mut self.deferred_idle, ctx.dev);
@@ -175,12 +182,16 @@ impl ShadingMethod for Auto {
                 CulledFrame::Unlisted { references, .. } => {
                     format!("{references} or more light references, more than clustered lists")
                 }
+                CulledFrame::Overflowed(references) => format!(
+                    "{references} light references past clustered's per-cell cap would be \
+                     left out"
+                ),
             };
-            let refusal = deferred_refusal(ctx);
-            let instead = if refusal.is_none() {
-                "deferred"
-            } else {
+            let refusal = (!overflowed).then(|| deferred_refusal(ctx)).flatten();
+            let instead = if overflowed || refusal.is_some() {
                 "forward"
+            } else {
+                "deferred"
             };
             self.reason.clear();
             let _ = write!(self.reason, "{too_many}: {instead} renders this frame");

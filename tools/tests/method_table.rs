@@ -212,3 +212,55 @@ fn support_answers_without_switching_and_a_refusal_keeps_the_default_methods_war
         .unwrap();
     assert_eq!(warnings_containing(&warning).len(), before + 1, "{warning}");
 }
+
+/// More lights over one spot than a cell lists (4 400 against ES 2.0's cap of 4 095): clustered leaves
+/// references out (warned, the overflow policy), where forward and deferred draw every light.
+/// `auto` picked clustered anyway, 23/255 off forward; it now draws such a frame with forward
+/// where forward's one loop holds every light, and says why (not deferred: its half-float
+/// accumulation, without float blending, drifts under thousands of lights on one pixel).
+#[test]
+fn auto_draws_every_light_where_clustered_cells_would_overflow() {
+    use manylight::scene::Light;
+    let mut s = scene::builtin::build("plane", None).unwrap();
+    s.lights = (0..4_400)
+        .map(|i| {
+            let colour = if i < 4_000 {
+                glam::Vec3::X
+            } else {
+                glam::Vec3::Y
+            };
+            let at = glam::DVec3::new(0.0, 0.0, 0.3 + i as f64 * 1e-5);
+            Light::point(at, 2.0, colour, 2e-3)
+        })
+        .collect();
+    let (w, h) = (32, 18);
+    // ES 3.0 lists more a cell: there a smaller cap plays the same crowd.
+    let es3_cap = RenderOptions {
+        measure: manylight::MeasureOptions {
+            cell_cap: Some(1_000),
+            ..Default::default()
+        },
+        ..Default::default()
+    };
+    let cases = [
+        (EsVersion::Es2, RenderOptions::default(), "forward"),
+        (EsVersion::Es3, es3_cap, "forward"),
+    ];
+    for (es, options, expected) in cases {
+        let mut gpu = Gpu::new(es);
+        let mut render = |method: &str| {
+            gpu.r().set_method_named(method).unwrap();
+            gpu.r().render_offscreen(&s, w, h, &options).unwrap()
+        };
+        let (_, clustered) = render("clustered");
+        assert!(clustered.lights.overflowed > 0, "{es}: nothing overflowed");
+        let (reference, _) = render("forward");
+        let (img, stats) = render("auto");
+        assert_eq!(stats.auto_choice.as_deref(), Some(expected), "{es}");
+        let reason = stats.auto_reason.unwrap_or_default();
+        assert!(reason.contains("per-cell cap"), "{es}: {reason}");
+        assert_eq!(stats.lights.overflowed, 0, "{es}");
+        let d = manylight::metrics::diff(&reference, &img).max_abs;
+        assert!(d <= 2, "{es}: auto {d} / 255 from forward");
+    }
+}

@@ -52,6 +52,8 @@ pub(crate) enum CulledFrame<'a> {
     /// Not rendered: the grid's cells would list at least `references` light references
     /// before the cell cap, more than an assignment builds.
     Unlisted { cells: u32, references: usize },
+    /// Not rendered, as asked: the per-cell cap left this many light references out.
+    Overflowed(u64),
 }
 
 /// Tiled or clustered forward.
@@ -88,6 +90,7 @@ impl CulledForward {
     pub(crate) fn render_unless_too_many(
         &mut self,
         ctx: &mut FrameContext,
+        refuse_overflow: bool,
     ) -> Result<CulledFrame<'_>, Error> {
         let method = self.name();
         let automatic = self.automatic(ctx);
@@ -106,6 +109,10 @@ impl CulledForward {
         let visible = assigned.assignment.visible.len();
         if visible > MAX_INDEXED_LIGHTS {
             return Ok(CulledFrame::TooManyVisible(visible));
+        }
+        let overflowed = assigned.assignment.stats.overflowed_lights;
+        if refuse_overflow && overflowed > 0 {
+            return Ok(CulledFrame::Overflowed(overflowed));
         }
         let uploaded = self
             .upload
@@ -167,12 +174,13 @@ impl ShadingMethod for CulledForward {
     /// Renders one frame; more visible lights than the index list can number is an error.
     fn render(&mut self, ctx: &mut FrameContext) -> Result<MethodStats<'_>, Error> {
         let (name, automatic) = (self.name(), self.automatic(ctx));
-        match self.render_unless_too_many(ctx)? {
+        match self.render_unless_too_many(ctx, false)? {
             CulledFrame::Rendered(stats) => Ok(stats),
             CulledFrame::TooManyVisible(visible) => Err(limits::too_many_visible(visible)),
             CulledFrame::Unlisted { cells, references } => Err(limits::too_many_references(
                 name, cells, references, automatic,
             )),
+            CulledFrame::Overflowed(_) => unreachable!("overflow is refused only when asked"),
         }
     }
 
