@@ -38,7 +38,8 @@ HIGHP float unpack16(vec2 bytes) {
 
 // unpack16 · 2 − 1 formed about the centre (127.998046875 = 32 767.5 / 256), so that in fp16
 // a coordinate near the middle of the range keeps its low byte, as a float texel keeps a small
-// value's bits; 0.0078126192 is 512 / 65 535.
+// value's bits; 0.0078126192 is 512 / 65 535. Exact in highp; fp16 rounds both constants
+// (to 128 and 2⁻⁷), which moves the ends by at most one 16-bit step.
 HIGHP float unpackSigned16(vec2 bytes) {
     return ((byteOf(bytes.x) - 127.998046875) + byteOf(bytes.y) * (1.0 / 256.0)) * 0.0078126192;
 }

@@ -143,7 +143,8 @@ pub struct MeasureOptions {
     /// Pack lights as RGBA8 even where float textures exist (to measure the packing error).
     pub force_rgba8_lights: bool,
     /// Most lights per cell (tiled/clustered); ES 2.0 never exceeds 4 095 (its shader's loop
-    /// bound). `None`: no cap beyond the encoding's.
+    /// bound). `None`: no cap beyond the encoding's. With `auto`, a frame that overflows it
+    /// is drawn by forward where forward holds every light (at most 8 192).
     pub cell_cap: Option<u32>,
     /// Most indices in a frame's light lists (tiled/clustered); `None`: what the index texture
     /// holds. Lower values exercise the overflow policy.

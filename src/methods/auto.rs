@@ -130,6 +130,12 @@ fn retire_deferred(deferred: &mut Option<Deferred>, idle: &mut u32, dev: &Device
 
 /// Why deferred cannot render this frame, if it cannot: no G-buffer on this context, or the
 /// frame is drawn into the renderer's multisampled target, which deferred does not support.
+/// Most lights a frame whose clustered cells would overflow is drawn with forward instead:
+/// every pixel then loops over them all, at most twice ES 2.0's full cell (4 095). Past it the
+/// frame stays clustered, under its overflow policy: a forward loop over 200 000 lights took
+/// seconds, and on a phone trips the GPU watchdog.
+pub const OVERFLOW_TO_FORWARD: usize = 8_192;
+
 fn deferred_refusal(ctx: &FrameContext) -> Option<String> {
     let caps = ctx.dev.caps();
     if let Some(why) = gbuffer::unsupported_reason(caps) {
@@ -164,8 +170,8 @@ impl ShadingMethod for Auto {
             // cap leave lights out: where forward's one loop holds every light, it draws them
             // (deferred's half-float accumulation, without GL_EXT_float_blend, drifts under
             // thousands of lights on one pixel: 107/255 on ANGLE).
-            let forward_holds_all =
-                ctx.lights.len() <= super::forward::max_lights(ctx.dev.caps()) as usize;
+            let forward_holds_all = ctx.lights.len()
+                <= (super::forward::max_lights(ctx.dev.caps()) as usize).min(OVERFLOW_TO_FORWARD);
             let frame = clustered.render_unless_too_many(ctx, forward_holds_all)?;
             let overflowed = matches!(frame, CulledFrame::Overflowed(_));
             let too_many = match frame {

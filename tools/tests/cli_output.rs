@@ -29,6 +29,10 @@ fn a_file_of_another_type_is_called_unsupported_not_an_unknown_built_in() {
     let args = ["--size", "8x8", "--lights", "0", "--out", "c.png"];
     let out = manylight(&args, &[], dir.path());
     assert!(out.status.success(), "{}", text(&out));
+    // Nor is writing over that file writing over the scene.
+    let args = ["--size", "8x8", "--lights", "0", "--out", "courtyard"];
+    let out = manylight(&args, &[], dir.path());
+    assert!(out.status.success(), "{}", text(&out));
 }
 
 /// An output naming the scene file (in any spelling) would replace the scene with a picture or

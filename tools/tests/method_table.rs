@@ -263,4 +263,17 @@ fn auto_draws_every_light_where_clustered_cells_would_overflow() {
         let d = manylight::metrics::diff(&reference, &img).max_abs;
         assert!(d <= 2, "{es}: auto {d} / 255 from forward");
     }
+    // Past OVERFLOW_TO_FORWARD lights forward's loop would cost every pixel them all: the
+    // frame stays clustered, under its overflow policy.
+    let extra = manylight::methods::auto::OVERFLOW_TO_FORWARD + 1 - s.lights.len();
+    let crowd = s.lights[0];
+    s.lights.extend(std::iter::repeat_n(crowd, extra));
+    let mut gpu = Gpu::new(EsVersion::Es2);
+    gpu.r().set_method_named("auto").unwrap();
+    let (_, stats) = gpu
+        .r()
+        .render_offscreen(&s, w, h, &RenderOptions::default())
+        .unwrap();
+    assert_eq!(stats.auto_choice.as_deref(), Some("clustered"));
+    assert!(stats.lights.overflowed > 0);
 }

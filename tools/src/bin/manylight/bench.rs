@@ -694,7 +694,13 @@ impl AnimatedWorkload {
         renderer.set_method_named(method)?;
         let options = RenderOptions::default();
         let rendered = match crate::sequence::render(
-            renderer, &mut scene, self.size, &options, &timeline, &mut pose, None,
+            renderer,
+            &mut scene,
+            self.size,
+            &options,
+            &timeline,
+            &mut pose,
+            crate::sequence::Keep::Last,
         ) {
             Ok(r) => r,
             // Past a method's limits (forward's loop bound, say): skipped, as in the sweep.

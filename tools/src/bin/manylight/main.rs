@@ -166,7 +166,7 @@ fn check_usage(cli: &Cli) {
         let stats = a.stats.as_deref().map(|p| ("--stats", p));
         let record = a.record.as_deref().map(|p| ("--record", p));
         check_distinct_outputs(&[out, stats, record]);
-        check_not_the_input(&[out, stats], Path::new(&a.scene));
+        check_not_the_input(&[out, stats], &a.scene);
         if let Some(folder) = a.record.as_deref().filter(|p| !sequence::records_gif(p)) {
             check_outside_folder(&[out, stats], ("--record", folder));
         }
@@ -270,10 +270,13 @@ fn check_distinct_outputs(outputs: &[Option<(&str, &Path)>]) {
 
 /// An output naming the scene file itself (through any spelling or link) would replace it with
 /// a picture or statistics: a usage error naming both.
-fn check_not_the_input(outputs: &[Option<(&str, &Path)>], scene: &Path) {
-    if !scene.is_file() {
-        return; // a built-in scene's name, or a file that reading will say is missing
+fn check_not_the_input(outputs: &[Option<(&str, &Path)>], scene: &str) {
+    // A built-in's name is the built-in, even beside a file of that name.
+    let scene_file = Path::new(scene);
+    if manylight::BUILTIN_SCENES.contains(&scene) || !scene_file.is_file() {
+        return;
     }
+    let scene = scene_file;
     let scene_id = output::identity(scene);
     if let Some((option, path)) = outputs
         .iter()

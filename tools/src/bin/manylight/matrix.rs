@@ -7,9 +7,9 @@
 //! has) on the same configuration.
 //!
 //! With `--gles-lib DIR` (more than once; `system` for the system's libraries) each
-//! implementation gets a row group: ES 2.0, ES 2.0 without fragment highp and with RGBA8 light
-//! data (both played) and ES 3.x on it; the Mesa restrictions, softpipe and OSMesa rows belong
-//! to the system's group.
+//! implementation gets a row group: ES 2.0, ES 2.0 without fragment highp (with float and with
+//! RGBA8 light data), ES 2.0 with RGBA8 light data (all played) and ES 3.x on it; the Mesa
+//! restrictions, softpipe and OSMesa rows belong to the system's group.
 
 mod verdict;
 

@@ -320,7 +320,10 @@ pub fn run(args: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
             frames: args.frames,
         };
         let size = (width, height);
-        let record = args.record.as_deref();
+        let keep = match args.record.as_deref() {
+            Some(path) => crate::sequence::Keep::Record(path),
+            None => crate::sequence::Keep::Stats,
+        };
         let mut pose = |s: &mut scene::Scene, t| s.set_time(t);
         crate::sequence::render(
             &mut renderer,
@@ -329,7 +332,7 @@ pub fn run(args: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
             &options,
             &timeline,
             &mut pose,
-            record,
+            keep,
         )
         .map(|r| (r.first, r.stats))
     } else {

@@ -148,12 +148,22 @@ fn stale_frames(dir: &Path, frames: u32, digits: usize) -> usize {
         .count()
 }
 
+/// What a sequence keeps of its timed frames besides their stats.
+pub enum Keep<'a> {
+    /// Nothing.
+    Stats,
+    /// The last one, in [`Rendered::last`].
+    Last,
+    /// Every one, recorded to this path (see `--record`).
+    Record(&'a Path),
+}
+
 /// What a sequence produced.
 pub struct Rendered {
     /// The warm-up frame, at `start_s`.
     pub first: RgbaImage,
-    /// The last timed frame, unless none was timed or it went to the recording (kept without
-    /// a copy: at 8192² a frame is 256 MiB).
+    /// The last timed frame where the caller asked for it and it did not go to the recording
+    /// (kept without a copy: at 8192² a frame is 256 MiB).
     pub last: Option<RgbaImage>,
     /// The last frame's stats, frame and assignment time replaced by the medians and the
     /// spreads (frame, assignment, upload bytes) filled in.
@@ -170,7 +180,7 @@ pub fn render(
     options: &RenderOptions,
     timeline: &Timeline,
     pose: &mut dyn FnMut(&mut Scene, f64),
-    record: Option<&Path>,
+    keep: Keep<'_>,
 ) -> Result<Rendered, Box<dyn std::error::Error>> {
     let one_frame = RenderOptions {
         measure: manylight::MeasureOptions {
@@ -179,7 +189,11 @@ pub fn render(
         },
         ..options.clone()
     };
-    let mut recorder = record.map(|p| Recorder::open(p, timeline)).transpose()?;
+    let mut recorder = match keep {
+        Keep::Record(path) => Some(Recorder::open(path, timeline)?),
+        Keep::Last | Keep::Stats => None,
+    };
+    let keep_last = matches!(keep, Keep::Last);
     pose(scene, timeline.start_s);
     // The warm-up frame compiles shaders and uploads meshes: its picture, not its time.
     let (first, warm_up) = renderer.render_offscreen(scene, width, height, &one_frame)?;
@@ -190,7 +204,7 @@ pub fn render(
         let (image, s) = renderer.render_offscreen(scene, width, height, &one_frame)?;
         match &mut recorder {
             Some(r) => r.add(k, image, timeline.fps)?,
-            None if k + 1 == timeline.frames => last = Some(image),
+            None if keep_last && k + 1 == timeline.frames => last = Some(image),
             None => {}
         }
         timed.push(s);
