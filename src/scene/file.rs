@@ -39,7 +39,7 @@ use serde::Deserialize;
 
 use super::access::LoadOptions;
 use super::camera::{Projection, MAX_CAMERA_COORD};
-use super::material::MAX_COLOR_FACTOR;
+use super::material::check_color_factor;
 use super::model_cache::{self, ModelCache};
 use super::motion::{Bob, Flicker, Motion, Orbit, OrbitAbout, Sweep, Wander};
 use super::obj::LoadReport;
@@ -395,12 +395,7 @@ pub fn parse(
         if let Some(c) = spec.color {
             let c = narrow3(&format!("{field}.color"), c)?;
             // Checked here, where the file's field is known (the materials' own check names them).
-            if c.min_element() < 0.0 || c.max_element() > MAX_COLOR_FACTOR {
-                return Err(SceneError::invalid(
-                    format!("{field}.color"),
-                    format!("must be in [0, {MAX_COLOR_FACTOR}], got {c:?}"),
-                ));
-            }
+            check_color_factor(c, &field, "color")?;
             // Recolour this object's materials only (they were appended for it).
             for m in &mut scene.materials[first_material..] {
                 m.diffuse = c;

@@ -83,6 +83,20 @@ impl Default for Material {
 /// physical anyway (MTL files with `Kd 30000` or `Ks 1e20` exist, and turned surfaces black).
 pub const MAX_COLOR_FACTOR: f32 = 1024.0;
 
+/// Checks that a colour factor is finite and within [0, [`MAX_COLOR_FACTOR`]], naming
+/// `field.name` (built only when it is not).
+pub(crate) fn check_color_factor(v: Vec3, field: &str, name: &str) -> Result<(), SceneError> {
+    if v.is_finite() && v.min_element() >= 0.0 && v.max_element() <= MAX_COLOR_FACTOR {
+        return Ok(());
+    }
+    Err(SceneError::invalid(
+        format!("{field}.{name}"),
+        format!(
+            "must be in [0, {MAX_COLOR_FACTOR}] (the range the fp16 colour tier holds), got {v:?}"
+        ),
+    ))
+}
+
 impl Material {
     /// A matte material of one colour with a faint highlight.
     pub fn flat(name: &str, diffuse: Vec3) -> Self {
@@ -152,15 +166,7 @@ impl Material {
     /// Checks colours and exponent; `field` names the material in errors.
     pub fn validate(&self, field: &str) -> Result<(), SceneError> {
         for (name, v) in [("diffuse", self.diffuse), ("specular", self.specular)] {
-            if !v.is_finite() || v.min_element() < 0.0 || v.max_element() > MAX_COLOR_FACTOR {
-                return Err(SceneError::invalid(
-                    format!("{field}.{name}"),
-                    format!(
-                        "must be in [0, {MAX_COLOR_FACTOR}] (the range the fp16 colour tier \
-                         holds), got {v:?}"
-                    ),
-                ));
-            }
+            check_color_factor(v, field, name)?;
         }
         if !(self.alpha.is_finite() && (0.0..=1.0).contains(&self.alpha)) {
             return Err(SceneError::invalid(
@@ -184,13 +190,7 @@ impl Material {
                 ));
             }
         }
-        let e = self.maps.emissive;
-        if !e.is_finite() || e.min_element() < 0.0 || e.max_element() > MAX_COLOR_FACTOR {
-            return Err(SceneError::invalid(
-                format!("{field}.emissive"),
-                format!("must be in [0, {MAX_COLOR_FACTOR}], got {e:?}"),
-            ));
-        }
+        check_color_factor(self.maps.emissive, field, "emissive")?;
         if let Some(t) = self.maps.unusable_transform() {
             return Err(SceneError::invalid(
                 format!("{field}.maps.{t}"),
