@@ -15,8 +15,8 @@ pub struct Device {
     /// `GL_EXT_multisampled_render_to_texture` (see [`super::ext_fns`]).
     pub(crate) renderbuffer_storage_multisample_ext:
         Option<super::ext_fns::RenderbufferStorageMultisampleExt>,
-    /// The renderer's own vertex array object (ES 3.0 and desktop), bound only during its
-    /// calls, so a game's bound one keeps its buffers and attributes.
+    /// The renderer's own vertex array object (an ES 3.x or desktop context), bound only
+    /// during its calls, so a game's bound one keeps its buffers and attributes.
     vertex_array: Option<glow::VertexArray>,
     /// What the context has of the application's state each call saves.
     host: super::host_state::HostFeatures,

@@ -144,13 +144,13 @@ struct DesktopState {
 
 impl HostState {
     /// Saves the application's state and sets what the renderer assumes: its own vertex
-    /// array (`vao`, on an ES 3.x or desktop context), no pixel buffer, no sampler objects on its units,
-    /// the capabilities of `OFF_INSIDE` off, additive blend equations, counter-clockwise
-    /// front faces, the full depth range, a clear depth of 1, pixel rows that start where
-    /// the data does and texture unit 0 active (a game's active unit past the saved ones
-    /// keeps its texture), no primitive restart, no attribute divisors; on ES with
-    /// `GL_EXT_sRGB_write_control` sRGB encoding on; on desktop GL, filled polygons and no
-    /// sRGB encoding.
+    /// array (`vao`, on an ES 3.x or desktop context), no pixel buffer, no sampler objects on
+    /// its units, the capabilities of `OFF_INSIDE` off, additive blend equations,
+    /// counter-clockwise front faces, the full depth range, a clear depth of 1, pixel rows
+    /// that start where the data does and texture unit 0 active (a game's active unit past
+    /// the saved ones keeps its texture), no primitive restart, no attribute divisors; on ES
+    /// with `GL_EXT_sRGB_write_control` sRGB encoding on; on desktop GL, filled polygons and
+    /// no sRGB encoding.
     pub(crate) fn enter(
         gl: &glow::Context,
         features: &HostFeatures,

@@ -128,14 +128,14 @@ fn retire_deferred(deferred: &mut Option<Deferred>, idle: &mut u32, dev: &Device
     }
 }
 
-/// Why deferred cannot render this frame, if it cannot: no G-buffer on this context, or the
-/// frame is drawn into the renderer's multisampled target, which deferred does not support.
 /// Most lights a frame whose clustered cells would overflow is drawn with forward instead:
 /// every pixel then loops over them all, at most twice ES 2.0's full cell (4 095). Past it the
-/// frame stays clustered, under its overflow policy: a forward loop over 200 000 lights took
+/// frame stays clustered, under its overflow policy: a forward loop over 200 000 lights takes
 /// seconds, and on a phone trips the GPU watchdog.
 pub const OVERFLOW_TO_FORWARD: usize = 8_192;
 
+/// Why deferred cannot render this frame, if it cannot: no G-buffer on this context, or the
+/// frame is drawn into the renderer's multisampled target, which deferred does not support.
 fn deferred_refusal(ctx: &FrameContext) -> Option<String> {
     let caps = ctx.dev.caps();
     if let Some(why) = gbuffer::unsupported_reason(caps) {
