@@ -149,12 +149,7 @@ impl ClusterGrid {
             GridProjection::Perspective { tan_x, tan_y } => [1.0 / tan_x, 1.0 / tan_y],
             GridProjection::Orthographic { half_x, half_y } => [1.0 / half_x, 1.0 / half_y],
         };
-        self.side_plane_norm = match projection {
-            GridProjection::Perspective { tan_x, tan_y } => {
-                [tan_x, tan_y].map(|t| 1.0 / (1.0 + t * t).sqrt())
-            }
-            GridProjection::Orthographic { .. } => [1.0; 2],
-        };
+        self.side_plane_norm = projection.side_plane_norms();
         // Per-slice arrays with room for the most slices these settings allow (a few
         // kilobytes): the automatic grid rebuilds a grid for finer and coarser footprints,
         // and a finer one than any before would otherwise grow them in a later frame.

@@ -47,25 +47,43 @@ impl GridProjection {
         }
     }
 
+    /// What turns the side planes' offsets (`|x| − tan·d`) into distances along their unit
+    /// normals: `1/√(1 + tan²)` per axis in perspective, 1 in orthographic.
+    pub fn side_plane_norms(&self) -> [f64; 2] {
+        match *self {
+            GridProjection::Perspective { tan_x, tan_y } => {
+                [tan_x, tan_y].map(|t| 1.0 / (1.0 + t * t).sqrt())
+            }
+            GridProjection::Orthographic { .. } => [1.0; 2],
+        }
+    }
+
+    /// True when the view-space sphere (`center`, `radius`) lies wholly outside one of the
+    /// view frustum's four side planes; `norms` is [`GridProjection::side_plane_norms`].
+    #[inline]
+    pub fn sphere_outside_sides(&self, center: DVec3, radius: f64, norms: [f64; 2]) -> bool {
+        // By symmetry the nearer of the two planes of an axis decides: |x| against the right.
+        match *self {
+            GridProjection::Perspective { tan_x, tan_y } => {
+                let d = -center.z;
+                (center.x.abs() - tan_x * d) * norms[0] > radius
+                    || (center.y.abs() - tan_y * d) * norms[1] > radius
+            }
+            GridProjection::Orthographic { half_x, half_y } => {
+                center.x.abs() - half_x > radius || center.y.abs() - half_y > radius
+            }
+        }
+    }
+
     /// True when the view-space sphere (`center`, `radius`) lies wholly outside the view
     /// between the depths `near` and `far` (outside a side plane, before `near` or past
     /// `far`): it reaches no pixel. Conservative by a part in 10⁶ of the radius.
     pub fn sphere_outside_view(&self, center: DVec3, radius: f64, near: f64, far: f64) -> bool {
         let radius = radius * (1.0 + 1e-6);
         let d = -center.z;
-        if d + radius < near || d - radius > far {
-            return true;
-        }
-        match *self {
-            GridProjection::Perspective { tan_x, tan_y } => {
-                // Distance past the plane |x| = tan · d, along its unit normal.
-                let past = |c: f64, t: f64| (c.abs() - t * d) / (1.0 + t * t).sqrt();
-                past(center.x, tan_x) > radius || past(center.y, tan_y) > radius
-            }
-            GridProjection::Orthographic { half_x, half_y } => {
-                center.x.abs() - half_x > radius || center.y.abs() - half_y > radius
-            }
-        }
+        d + radius < near
+            || d - radius > far
+            || self.sphere_outside_sides(center, radius, self.side_plane_norms())
     }
 
     /// View-space half extent in x and y at view depth `d`.

@@ -8,18 +8,10 @@ use crate::cluster::min_max::MinMax;
 impl ClusterGrid {
     /// True when the view-space sphere (`center`, `radius`) lies wholly outside one of the
     /// view frustum's four side planes, so it touches no cell (the assignment's first cull).
+    #[inline]
     pub fn sphere_outside_sides(&self, center: glam::DVec3, radius: f64) -> bool {
-        // By symmetry the nearer of the two planes of an axis decides: |x| against the right.
-        match self.projection {
-            GridProjection::Perspective { tan_x, tan_y } => {
-                let d = -center.z;
-                (center.x.abs() - tan_x * d) * self.side_plane_norm[0] > radius
-                    || (center.y.abs() - tan_y * d) * self.side_plane_norm[1] > radius
-            }
-            GridProjection::Orthographic { half_x, half_y } => {
-                center.x.abs() - half_x > radius || center.y.abs() - half_y > radius
-            }
-        }
+        self.projection
+            .sphere_outside_sides(center, radius, self.side_plane_norm)
     }
 
     /// The bounding spheres of the cells of row `y` of slice `slice` (numbered across
