@@ -2,7 +2,7 @@
 //! bounding sphere of a cell (the spot-cone test), from a per-slice table.
 
 use super::tables::SliceFrustum;
-use super::{ClusterGrid, GridProjection};
+use super::ClusterGrid;
 use crate::cluster::min_max::MinMax;
 
 impl ClusterGrid {
