@@ -93,10 +93,7 @@ fn every_method_matches_forward_with_suns_and_point_lights() {
 
 #[test]
 fn a_bright_sun_without_fragment_highp_stays_finite_and_right() {
-    let restricted = manylight::gl::Restrictions {
-        no_fragment_highp: true,
-    };
-    let mut gpu = Gpu::restricted(EsVersion::Es2, &restricted);
+    let mut gpu = Gpu::without_fragment_highp();
     // 100 000 lux, past fp16's 65 504, and as bright a sun shining on the plane's back (its
     // contribution there is radiance × 0: Inf × 0 if the radiance overflowed).
     let bright = 1e5f32;

@@ -63,10 +63,7 @@ fn a_light_whose_radius_dwarfs_the_scene_lights_it_as_a_large_one_does() {
 /// A light that bright saturates the plane under it, as it does with highp.
 #[test]
 fn a_light_brighter_than_2_to_the_126_still_lights_without_fragment_highp() {
-    let restrictions = manylight::gl::Restrictions {
-        no_fragment_highp: true,
-    };
-    let mut gpu = Gpu::restricted(EsVersion::Es2, &restrictions);
+    let mut gpu = Gpu::without_fragment_highp();
     let opts = RenderOptions::default();
     let ambient = mean(&gpu.render(&plane(vec![]), 64, 36, &opts));
     for intensity in [5e37f32, 1e38, 3e38] {
@@ -353,10 +350,7 @@ fn lights_overlapping_on_a_fine_fixed_grid_are_refused_naming_the_footprint() {
 #[test]
 fn channels_fp16_cannot_keep_beside_a_bright_one_are_named() {
     common::warnings::install();
-    let restrictions = manylight::gl::Restrictions {
-        no_fragment_highp: true,
-    };
-    let mut gpu = Gpu::restricted(EsVersion::Es2, &restrictions);
+    let mut gpu = Gpu::without_fragment_highp();
     let said = || common::warnings::warnings_containing("spans more than fp16 keeps");
     let mut even = point(4.0);
     even.color = Vec3::new(1e4, 1.0, 1.0);
@@ -410,10 +404,7 @@ fn a_light_farther_than_the_radius_cap_still_reaches_the_scene() {
 /// linear output), such a light now draws on the no-highp tier what highp draws.
 #[test]
 fn a_light_whose_fp16_scale_squares_past_fp16_draws_as_with_highp() {
-    let restrictions = manylight::gl::Restrictions {
-        no_fragment_highp: true,
-    };
-    let mut mediump = Gpu::restricted(EsVersion::Es2, &restrictions);
+    let mut mediump = Gpu::without_fragment_highp();
     let mut highp = Gpu::new(EsVersion::Es3);
     let opts = RenderOptions {
         exposure_ev: -15.0,
@@ -446,10 +437,7 @@ fn a_light_whose_fp16_scale_squares_past_fp16_draws_as_with_highp() {
 /// the no-highp frame is what highp draws, highlight included.
 #[test]
 fn a_metal_brighter_than_white_stays_finite_and_equals_highp() {
-    let restrictions = manylight::gl::Restrictions {
-        no_fragment_highp: true,
-    };
-    let mut mediump = Gpu::restricted(EsVersion::Es2, &restrictions);
+    let mut mediump = Gpu::without_fragment_highp();
     let mut highp = Gpu::new(EsVersion::Es3);
     let opts = RenderOptions {
         linear: true,

@@ -268,10 +268,7 @@ fn tight_coverage_never_evaluates_more_than_the_cascade_box() {
 fn counts_without_fragment_highp_are_every_light_at_every_pixel() {
     let lights = 300;
     let scene = scene::builtin::build("courtyard", Some((lights, 5))).unwrap();
-    let restrictions = manylight::gl::Restrictions {
-        no_fragment_highp: true,
-    };
-    let mut gpu = Gpu::restricted(EsVersion::Es2, &restrictions);
+    let mut gpu = Gpu::without_fragment_highp();
     let evals = counts(&mut gpu, &scene, "forward", CountKind::Evals);
     assert!(evals.covered_pixels() > 1000, "the view shows little");
     let wrong = (evals.counts.iter().zip(&evals.covered))

@@ -180,10 +180,7 @@ fn auto_renders_with_forward_past_the_index_limit_on_es2() {
 fn support_answers_without_switching_and_a_refusal_keeps_the_default_methods_warning() {
     use common::warnings::warnings_containing;
     use manylight::Method;
-    let restrictions = manylight::Restrictions {
-        no_fragment_highp: true,
-    };
-    let mut gpu = Gpu::restricted(EsVersion::Es2, &restrictions);
+    let mut gpu = Gpu::without_fragment_highp();
     let caps = gpu.r().caps().clone();
     for m in Method::ALL {
         let row = METHODS.iter().find(|d| d.name == m.name()).unwrap();

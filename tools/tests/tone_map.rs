@@ -158,12 +158,7 @@ fn tone_maps_do_not_overflow_without_fragment_highp() {
         .render_offscreen_hdr(&scene, 64, 36, &RenderOptions::default())
         .unwrap();
     drop(full);
-    let mut gpu = Gpu::restricted(
-        EsVersion::Es2,
-        &manylight::gl::Restrictions {
-            no_fragment_highp: true,
-        },
-    );
+    let mut gpu = Gpu::without_fragment_highp();
     for curve in [ToneMap::Reinhard, ToneMap::Aces, ToneMap::Neutral] {
         let opts = RenderOptions {
             tone_map: curve,

@@ -43,6 +43,14 @@ impl Gpu {
         Gpu::restricted(es, &Restrictions::default())
     }
 
+    /// A renderer playing an ES 2.0 device whose fragment stage has no highp (Mali-400 class).
+    pub fn without_fragment_highp() -> Gpu {
+        let restrictions = Restrictions {
+            no_fragment_highp: true,
+        };
+        Gpu::restricted(EsVersion::Es2, &restrictions)
+    }
+
     /// A renderer playing a weaker device (see `manylight::gl::Restrictions`).
     pub fn restricted(es: EsVersion, restrictions: &Restrictions) -> Gpu {
         let kind = (es, *restrictions);
