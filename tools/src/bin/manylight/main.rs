@@ -270,13 +270,12 @@ fn check_distinct_outputs(outputs: &[Option<(&str, &Path)>]) {
 
 /// An output naming the scene file itself (through any spelling or link) would replace it with
 /// a picture or statistics: a usage error naming both.
-fn check_not_the_input(outputs: &[Option<(&str, &Path)>], scene: &str) {
+fn check_not_the_input(outputs: &[Option<(&str, &Path)>], spec: &str) {
     // A built-in's name is the built-in, even beside a file of that name.
-    let scene_file = Path::new(scene);
-    if manylight::BUILTIN_SCENES.contains(&scene) || !scene_file.is_file() {
+    let scene = Path::new(spec);
+    if manylight::BUILTIN_SCENES.contains(&spec) || !scene.is_file() {
         return;
     }
-    let scene = scene_file;
     let scene_id = output::identity(scene);
     if let Some((option, path)) = outputs
         .iter()
