@@ -29,9 +29,8 @@ HIGHP vec4 lightTexel(HIGHP float i, HIGHP float k) {
 
 #if LIGHTS_RGBA8
 // Two bytes (as 0..1 channels) → 0..1 with 16 bits, without forming the 16-bit integer:
-// where HIGHP is mediump, 65 535 is past fp16's largest value, and so is a constant the
-// compiler folds from it (256.0 / 65535.0 folded in fp16 was 0: no light moved off the
-// origin). 0.0039063096 is 256 / 65 535.
+// where HIGHP is mediump, 65 535 is past fp16's largest value, and so is any constant the
+// compiler folds from it. 0.0039063096 is 256 / 65 535.
 HIGHP float unpack16(vec2 bytes) {
     return (byteOf(bytes.x) + byteOf(bytes.y) * (1.0 / 256.0)) * 0.0039063096;
 }

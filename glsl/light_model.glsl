@@ -92,7 +92,7 @@ MEDP vec3 metallicRoughness(HIGHP vec3 L, vec3 N, vec3 V, MEDP float nDotL, Surf
     MEDP float x2 = x * x;
     MEDP float x5 = x2 * x2 * x;
     // A base colour past 1 (glTF's range) reflects at most all: F0 > 1 times the capped lobe
-    // was past fp16 (Inf, then NaN where the spot or falloff is 0).
+    // is past fp16 (Inf, then NaN where the spot or falloff is 0).
     MEDP vec3 f0 = mix(vec3(0.04), min(s.albedo, vec3(1.0)), s.metallic);
     MEDP vec3 fresnel = f0 + (1.0 - f0) * x5;
     MEDP float dielectric = 0.04 + 0.96 * x5;

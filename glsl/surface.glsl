@@ -188,8 +188,7 @@ vec4 encodeCount(HIGHP float n) {
 #endif
     return vec4(c, 1.0);
 #else
-    // Byte by byte: 65 536 is past fp16 where HIGHP is mediump (n / 65536.0 was 0 and
-    // high * 65536.0 NaN: every count read back 0).
+    // Byte by byte: 65 536 is past fp16 where HIGHP is mediump.
     HIGHP float above = floor(n / 256.0);
     HIGHP float high = floor(above / 256.0);
     HIGHP float middle = above - high * 256.0;

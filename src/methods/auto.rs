@@ -130,8 +130,8 @@ fn retire_deferred(deferred: &mut Option<Deferred>, idle: &mut u32, dev: &Device
 
 /// Most lights a frame whose clustered cells would overflow is drawn with forward instead:
 /// every pixel then loops over them all, at most twice ES 2.0's full cell (4 095). Past it the
-/// frame stays clustered, under its overflow policy: a forward loop over 200 000 lights takes
-/// seconds, and on a phone trips the GPU watchdog.
+/// frame stays clustered, under its overflow policy: a far longer loop at every pixel could
+/// trip a phone's GPU watchdog.
 pub const OVERFLOW_TO_FORWARD: usize = 8_192;
 
 /// Why deferred cannot render this frame, if it cannot: no G-buffer on this context, or the
@@ -168,8 +168,8 @@ impl ShadingMethod for Auto {
             // Else forward this frame; clustered keeps its resources and tries again next
             // frame (the visible lights change as they and the camera move). Cells past their
             // cap leave lights out: where forward's one loop holds every light, it draws them
-            // (deferred's half-float accumulation, without GL_EXT_float_blend, drifts under
-            // thousands of lights on one pixel: 107/255 on ANGLE).
+            // (not deferred: its half-float accumulation, without GL_EXT_float_blend, drifts
+            // under thousands of lights on one pixel).
             let forward_holds_all = ctx.lights.len()
                 <= (super::forward::max_lights(ctx.dev.caps()) as usize).min(OVERFLOW_TO_FORWARD);
             let frame = clustered.render_unless_too_many(ctx, forward_holds_all)?;

@@ -224,9 +224,8 @@ impl ShadingMethod for Forward {
 
 /// `lights` into `seen`, each light whose sphere lies wholly outside the view (the frustum up
 /// to the farthest geometry) made radius 0 at the eye: it lights no pixel either way, and the
-/// RGBA8 records' fixed-point range is then set by the lights that do (a light 3 km behind
-/// the camera made the step 9 cm, 30/255 off near the others). Forward still loops over it,
-/// so its counts stay every light.
+/// RGBA8 records' fixed-point range is then set by the lights that do. Forward still loops
+/// over it, so its counts stay every light.
 fn darken_unseen_into(ctx: &FrameContext, lights: &[GpuLight], seen: &mut Vec<GpuLight>) {
     let projection = GridProjection::from_matrix(&ctx.projection.as_dmat4());
     seen.clear();

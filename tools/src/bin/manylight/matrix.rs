@@ -541,8 +541,8 @@ fn markdown(rows: &[Value]) -> String {
     s
 }
 
-/// Longest side of a contact sheet's thumbnail: the sheet holds every cell's at once (full
-/// pictures at 4096² took 2.7 GB and aborted; at 16384², about 75 GB).
+/// Longest side of a contact sheet's thumbnail: the sheet holds every cell's at once, so full
+/// pictures would make its memory grow with the frame's size.
 const THUMB_MAX: u32 = 512;
 
 /// The picture in `file`, scaled down to fit [`THUMB_MAX`] (one full picture decoded at a time).
