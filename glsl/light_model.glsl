@@ -36,8 +36,13 @@ struct SurfaceParams {
 SurfaceParams materialSurface(MEDP vec3 albedo, vec2 uv) {
     SurfaceParams s;
     s.albedo = albedo;
+#if HAS_SPECULAR
     s.Ks = u_specular;
     s.Ns = u_shininess;
+#else
+    s.Ks = vec3(0.0);
+    s.Ns = 1.0;
+#endif
 #if METALLIC_ROUGHNESS
     vec2 mr = surfaceMetallicRoughness(uv);
     s.metallic = mr.x;

@@ -1,7 +1,9 @@
 // Material inputs, sRGB conversions and the output encoding.
 uniform vec3 u_albedo;
+#if HAS_SPECULAR
 uniform vec3 u_specular;
 uniform float u_shininess;
+#endif
 // Material opacity (1 for opaque objects; blended when below 1, and by the texture's alpha
 // too with HAS_TEXTURE_ALPHA).
 uniform float u_alpha;

@@ -44,6 +44,8 @@ pub trait UniformType {
     type Value;
     /// The GLSL type, for errors.
     const GLSL: &'static str;
+    /// Elements: 1, or an array's length.
+    const LEN: i32 = 1;
     /// Whether a uniform the driver reports with type `gl_type` takes this.
     fn accepts(gl_type: u32) -> bool;
     /// Sets the uniform at `location` of the current program.
@@ -105,6 +107,18 @@ uniform_type!(Mat3, Mat3, "mat3", [glow::FLOAT_MAT3], |gl, l, m| unsafe {
 uniform_type!(Mat4, Mat4, "mat4", [glow::FLOAT_MAT4], |gl, l, m| unsafe {
     gl.uniform_matrix_4_f32_slice(Some(l), false, &m.to_cols_array())
 });
+impl UniformType for [Vec3; 4] {
+    type Value = [Vec3; 4];
+    const GLSL: &'static str = "vec3[4]";
+    const LEN: i32 = 4;
+    fn accepts(gl_type: u32) -> bool {
+        gl_type == glow::FLOAT_VEC3
+    }
+    fn set(dev: &Device, location: &glow::UniformLocation, value: [Vec3; 4]) {
+        let flat: [f32; 12] = std::array::from_fn(|i| value[i / 3][i % 3]);
+        unsafe { dev.gl.uniform_3_f32_slice(Some(location), &flat) }
+    }
+}
 
 /// One uniform of a linked program, its location looked up at link time. Setting one the
 /// variant compiled out (no location) does nothing.
@@ -144,8 +158,8 @@ pub struct Resolver<'a> {
     features: u64,
     /// Every uniform the shader's sources declare, in any variant.
     declared: Vec<String>,
-    /// The linked program's active uniforms and their GL types.
-    active: Vec<(String, u32)>,
+    /// The linked program's active uniforms, their GL types and sizes (elements).
+    active: Vec<(String, u32, i32)>,
     problems: Vec<String>,
 }
 
@@ -188,7 +202,9 @@ impl Resolver<'_> {
             ));
             return Uniform::inactive();
         }
-        match self.active.iter().find(|(n, _)| n == name) {
+        // GL names an array uniform by its first element.
+        let is_name = |n: &str| n == name || n.strip_suffix("[0]") == Some(name);
+        match self.active.iter().find(|(n, _, _)| is_name(n)) {
             None => {
                 if required {
                     self.problems.push(format!(
@@ -197,10 +213,10 @@ impl Resolver<'_> {
                 }
                 Uniform::inactive()
             }
-            Some(&(_, gl_type)) if !T::accepts(gl_type) => {
+            Some(&(_, gl_type, size)) if !T::accepts(gl_type) || size != T::LEN => {
                 self.problems.push(format!(
                     "uniform `{name}` is declared `{}`, set as `{}`",
-                    gl_type_name(gl_type),
+                    gl_type_name(gl_type, size),
                     T::GLSL
                 ));
                 Uniform::inactive()
@@ -213,8 +229,8 @@ impl Resolver<'_> {
     }
 }
 
-fn gl_type_name(gl_type: u32) -> String {
-    match gl_type {
+fn gl_type_name(gl_type: u32, size: i32) -> String {
+    let name = match gl_type {
         glow::FLOAT => "float".into(),
         glow::FLOAT_VEC2 => "vec2".into(),
         glow::FLOAT_VEC3 => "vec3".into(),
@@ -225,6 +241,11 @@ fn gl_type_name(gl_type: u32) -> String {
         glow::SAMPLER_2D => "sampler2D".into(),
         glow::UNSIGNED_INT_SAMPLER_2D => "usampler2D".into(),
         other => format!("GL type 0x{other:04x}"),
+    };
+    if size == 1 {
+        name
+    } else {
+        format!("{name}[{size}]")
     }
 }
 
@@ -240,7 +261,7 @@ fn resolve<U: UniformSet>(
     let active = unsafe {
         (0..gl.get_active_uniforms(raw))
             .filter_map(|i| gl.get_active_uniform(raw, i))
-            .map(|u| (u.name, u.utype))
+            .map(|u| (u.name, u.utype, u.size))
             .collect()
     };
     let mut r = Resolver {
@@ -600,6 +621,39 @@ mod tests {
             .location
             .is_none());
         forward.destroy(&dev);
+    }
+
+    /// The suns' radiance, an array uniform, taken as `T`.
+    struct SunRadiance<T: UniformType>(Uniform<T>);
+    impl<T: UniformType + 'static> UniformSet for SunRadiance<T> {
+        fn resolve(r: &mut Resolver<'_>) -> Self {
+            SunRadiance(r.required("u_directionalRadiance"))
+        }
+    }
+
+    #[test]
+    fn an_array_uniform_is_found_by_its_name_and_checked_for_its_length() {
+        let Some((dev, _ctx)) = device() else {
+            return;
+        };
+        let sunny = crate::methods::ShaderFeatures(crate::methods::ShaderFeatures::DIRECTIONAL)
+            .defines(EsVersion::Es3, 1);
+        let mut forward =
+            Program::build::<SunRadiance<[Vec3; 4]>>(&dev, "forward", &sunny, 0).unwrap();
+        assert!(forward
+            .uniforms::<SunRadiance<[Vec3; 4]>>()
+            .unwrap()
+            .0
+            .location
+            .is_some());
+        forward.destroy(&dev);
+        match Program::build::<SunRadiance<Vec3>>(&dev, "forward", &sunny, 0) {
+            Err(GlError::ProgramLink { log, .. }) => assert_eq!(
+                log,
+                "uniform `u_directionalRadiance` is declared `vec3[4]`, set as `vec3`"
+            ),
+            other => panic!("{:?}", other.map(|_| "linked")),
+        }
     }
 
     #[test]

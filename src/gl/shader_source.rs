@@ -215,6 +215,8 @@ pub fn declared_uniforms(shader_name: &str) -> Result<Vec<String>, GlError> {
             continue;
         };
         let name = declaration.split(';').next().unwrap_or_default();
+        // An array's name without its size (`u_x[N]`).
+        let name = name.split('[').next().unwrap_or_default();
         if let Some(name) = name.split_whitespace().last() {
             if !names.iter().any(|n| n == name) {
                 names.push(name.to_string());
@@ -556,6 +558,11 @@ mod tests {
         ] {
             assert!(names.iter().any(|n| n == name), "{name} in {names:?}");
         }
+        // An array, by its name alone.
+        assert!(
+            names.iter().any(|n| n == "u_directionalRadiance"),
+            "{names:?}"
+        );
         // Declared twice (one per dialect), listed once.
         assert_eq!(names.iter().filter(|n| *n == "u_grid").count(), 1);
         assert!(!names.iter().any(|n| n.contains(';') || n == "u_grid;"));

@@ -2,7 +2,7 @@
 //! `glsl/directional.glsl`, evaluated by every method for every pixel outside its light lists
 //! (forward and the culled methods in their shading pass, deferred in its composite).
 
-use glam::{DMat4, Mat4};
+use glam::{DMat4, Mat4, Vec3};
 
 use super::ShaderFeatures;
 use crate::cluster::pack::fp16_radiance;
@@ -19,10 +19,11 @@ const FP16_MAX_RADIANCE: f32 = (1u32 << 30) as f32;
 pub struct DirectionalFrame {
     /// How many columns are used (at most [`MAX_DIRECTIONAL_LIGHTS`]).
     pub count: i32,
-    /// Column i: unit direction from a surface to light i, in view space.
+    /// Column i: unit direction from a surface to light i, in view space (xyz); for `fp16`
+    /// frames k in w.
     pub to_light: Mat4,
-    /// Column i: radiance (rgb); for `fp16` frames radiance / k² and k in w.
-    pub radiance: Mat4,
+    /// Light i's radiance; for `fp16` frames radiance / k².
+    pub radiance: [Vec3; MAX_DIRECTIONAL_LIGHTS],
 }
 
 impl DirectionalFrame {
@@ -43,17 +44,16 @@ impl DirectionalFrame {
                 .unwrap_or_default()
                 .as_vec3();
             let radiance = light.radiance();
-            let radiance = if fp16 {
-                let (scaled, k) = fp16_radiance(radiance.min(glam::Vec3::splat(FP16_MAX_RADIANCE)));
-                scaled.extend(k)
+            let (radiance, k) = if fp16 {
+                fp16_radiance(radiance.min(Vec3::splat(FP16_MAX_RADIANCE)))
             } else {
-                radiance.extend(1.0)
+                (radiance, 1.0)
             };
-            *frame.to_light.col_mut(column) = to_light.extend(0.0);
-            *frame.radiance.col_mut(column) = radiance;
+            *frame.to_light.col_mut(column) = to_light.extend(k);
+            frame.radiance[column] = radiance;
             frame.count += 1;
         }
-        debug_assert!(frame.radiance.is_finite() && frame.to_light.is_finite());
+        debug_assert!(frame.radiance.iter().all(|r| r.is_finite()) && frame.to_light.is_finite());
         (frame, dropped)
     }
 }
@@ -62,7 +62,7 @@ impl DirectionalFrame {
 pub struct DirectionalUniforms {
     count: Uniform<i32>,
     to_light: Uniform<Mat4>,
-    radiance: Uniform<Mat4>,
+    radiance: Uniform<[Vec3; MAX_DIRECTIONAL_LIGHTS]>,
 }
 
 impl DirectionalUniforms {

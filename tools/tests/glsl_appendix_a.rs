@@ -2,8 +2,10 @@
 //! Appendix A limits strict mobile compilers enforce (no non-inductive or while loops, no
 //! general indexing) and the ES 2.0 minimum resource limits; GLSL ES 3.00 with the defaults.
 //! Mesa accepts far more than phones do, so compiling on llvmpipe proves little for ES 2.0.
+//! The uniform, varying and attribute space of the ES 2.0 variants is counted here by §A.7's
+//! packing (`glsl_packing`), which glslangValidator does not do.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use manylight::gl::shader_source::{assemble, assemble_without_fragment_highp, Stage, SHADERS};
@@ -11,6 +13,9 @@ use manylight::methods::ShaderFeatures;
 use manylight::EsVersion;
 
 mod common;
+mod glsl_packing;
+
+use glsl_packing::{attribute_slots, declarations, packs, rows_needed};
 
 /// Whether this run validates: glslangValidator must run here, or the test is skipped (a failure where
 /// `MANYLIGHT_REQUIRE_ALL_TESTS` is set, as in CI, which installs it). False, without a
@@ -62,8 +67,8 @@ fn appendix_a_config(dir: &Path) -> std::path::PathBuf {
         ("MaxVertexTextureImageUnits", 0),
         ("MaxCombinedTextureImageUnits", 8),
         ("MaxTextureImageUnits", 8),
-        // Not enforced by glslangValidator (a fragment shader of 40 vec4 uniforms passes): the
-        // driver's link is what refuses a variant past a device's limit.
+        // Not enforced by glslangValidator (a fragment shader of 40 vec4 uniforms passes):
+        // every_es2_variant_fits_the_minimum_resources_of_every_device counts them.
         ("MaxFragmentUniformVectors", 16),
         ("MaxDrawBuffers", 1),
     ] {
@@ -250,19 +255,20 @@ fn strip_unused_defines(src: &str) -> String {
         .join("\n")
 }
 
-#[test]
-fn every_shader_variant_passes_the_strict_validator() {
-    if !validates_here() {
-        return;
-    }
-    let dir = tempfile::tempdir().unwrap();
-    let conf = appendix_a_config(dir.path());
-    let mut failures = Vec::new();
-    let mut checked = 0;
-    // Distinct sources to validate (file, variant): ES 3.0's, and ES 2.0's under Appendix A.
-    let (mut es3, mut es2): (Vec<(std::path::PathBuf, String)>, Vec<_>) = Default::default();
+/// The distinct sources of every variant, written to a folder: (file, variant's name) for
+/// ES 3.0 and for ES 2.0, and how many variants they came from.
+struct Sources {
+    es3: Vec<(PathBuf, String)>,
+    es2: Vec<(PathBuf, String)>,
+    variants: usize,
+    distinct: usize,
+}
+
+fn write_distinct_sources(dir: &Path) -> Sources {
+    let mut variants = 0;
+    let (mut es3, mut es2): (Vec<(PathBuf, String)>, Vec<_>) = Default::default();
     // Variants whose assembled text is identical (a define the shader does not use) are
-    // validated once.
+    // written once.
     let mut seen = std::collections::HashSet::new();
     for shader in SHADERS {
         for es in [EsVersion::Es2, EsVersion::Es3] {
@@ -292,11 +298,11 @@ fn every_shader_variant_passes_the_strict_validator() {
                     } else {
                         assemble(shader.name, stage, es, &defines).unwrap()
                     };
-                    checked += 1;
+                    variants += 1;
                     if !seen.insert(strip_unused_defines(&src)) {
                         continue;
                     }
-                    let file = dir.path().join(format!(
+                    let file = dir.join(format!(
                         "{}_{}_{:x}{}.{ext}",
                         shader.name,
                         es.major(),
@@ -322,8 +328,28 @@ fn every_shader_variant_passes_the_strict_validator() {
             }
         }
     }
-    eprintln!("{checked} variants, {} distinct sources", seen.len());
-    for (conf, group) in [(None, &es3), (Some(conf.as_path()), &es2)] {
+    Sources {
+        es3,
+        es2,
+        variants,
+        distinct: seen.len(),
+    }
+}
+
+#[test]
+fn every_shader_variant_passes_the_strict_validator() {
+    if !validates_here() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let conf = appendix_a_config(dir.path());
+    let sources = write_distinct_sources(dir.path());
+    let mut failures = Vec::new();
+    eprintln!(
+        "{} variants, {} distinct sources",
+        sources.variants, sources.distinct
+    );
+    for (conf, group) in [(None, &sources.es3), (Some(conf.as_path()), &sources.es2)] {
         for batch in group.chunks(BATCH) {
             let files: Vec<&Path> = batch.iter().map(|(f, _)| f.as_path()).collect();
             if validate_all(conf, &files).is_ok() {
@@ -337,13 +363,15 @@ fn every_shader_variant_passes_the_strict_validator() {
         }
     }
     assert!(
-        checked >= (SHADERS.len() + 2 * SHADERS.iter().filter(|s| !s.es3_only).count()) * 2 * 256,
-        "only {checked} variants checked"
+        sources.variants
+            >= (SHADERS.len() + 2 * SHADERS.iter().filter(|s| !s.es3_only).count()) * 2 * 256,
+        "only {} variants checked",
+        sources.variants
     );
     assert!(
-        seen.len() > SHADERS.len() * 4,
+        sources.distinct > SHADERS.len() * 4,
         "only {} distinct sources",
-        seen.len()
+        sources.distinct
     );
     assert!(
         failures.is_empty(),
@@ -351,6 +379,108 @@ fn every_shader_variant_passes_the_strict_validator() {
         failures.len(),
         failures.join("\n")
     );
+}
+
+/// The ES 2.0 minimum resources (GLSL ES 1.00 §7.4, §A.7) a variant may use: uniform rows and
+/// texture units per stage, varying rows, attribute slots. Every ES 2.0 device offers these.
+const FRAGMENT_UNIFORM_ROWS: usize = 16;
+const VERTEX_UNIFORM_ROWS: usize = 128;
+const VARYING_ROWS: usize = 8;
+const FRAGMENT_SAMPLERS: usize = 8;
+const ATTRIBUTE_SLOTS: usize = 8;
+
+/// Every ES 2.0 variant's uniforms, varyings, samplers and attributes fit the minimum
+/// resources by §A.7's packing, so no device may refuse one for space (glslangValidator does
+/// not check this: a fragment shader of 40 vec4 uniforms passes it).
+#[test]
+fn every_es2_variant_fits_the_minimum_resources_of_every_device() {
+    if !validates_here() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let sources = write_distinct_sources(dir.path());
+    let mut failures = Vec::new();
+    let mut fullest = (0, String::new());
+    for batch in sources.es2.chunks(BATCH) {
+        let files: Vec<&Path> = batch.iter().map(|(f, _)| f.as_path()).collect();
+        for ((file, name), text) in batch.iter().zip(preprocessed(&files)) {
+            let found = declarations(&text).unwrap_or_else(|e| panic!("{name}: {e}"));
+            let fragment = file.extension().is_some_and(|e| e == "frag");
+            let (uniform_rows, samplers) = if fragment {
+                (FRAGMENT_UNIFORM_ROWS, FRAGMENT_SAMPLERS)
+            } else {
+                // ES 2.0 need not have vertex texture units.
+                (VERTEX_UNIFORM_ROWS, 0)
+            };
+            let needed = rows_needed(&found.uniforms);
+            if fragment && needed > fullest.0 {
+                fullest = (needed, name.clone());
+            }
+            if !packs(&found.uniforms, uniform_rows) {
+                failures.push(format!(
+                    "{name}: uniforms need {needed} rows of {uniform_rows}"
+                ));
+            }
+            if found.samplers > samplers {
+                failures.push(format!(
+                    "{name}: {} samplers, {samplers} units",
+                    found.samplers
+                ));
+            }
+            if !packs(&found.varyings, VARYING_ROWS) {
+                failures.push(format!(
+                    "{name}: varyings need {} rows of {VARYING_ROWS}",
+                    rows_needed(&found.varyings)
+                ));
+            }
+            if attribute_slots(&found.attributes) > ATTRIBUTE_SLOTS {
+                failures.push(format!(
+                    "{name}: more than {ATTRIBUTE_SLOTS} attribute slots"
+                ));
+            }
+        }
+    }
+    eprintln!(
+        "fullest fragment variant: {} ({} of {FRAGMENT_UNIFORM_ROWS} uniform rows)",
+        fullest.1, fullest.0
+    );
+    assert!(
+        failures.is_empty(),
+        "{} variants past the ES 2.0 minimums:\n{}",
+        failures.len(),
+        failures.join("\n")
+    );
+    // The count read the sources: the sun, surface-input and cluster uniforms of the fullest
+    // variant take most of the grid.
+    assert!(fullest.0 > FRAGMENT_UNIFORM_ROWS / 2, "{fullest:?}");
+}
+
+/// `files` preprocessed by glslangValidator (`-E`), one text a file, in order.
+fn preprocessed(files: &[&Path]) -> Vec<String> {
+    let out = Command::new("glslangValidator")
+        .arg("-E")
+        .args(files)
+        .output()
+        .expect("run glslangValidator");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stdout)
+    );
+    let text = String::from_utf8(out.stdout).unwrap();
+    // Each file's text starts with its `#version` line.
+    let mut texts: Vec<String> = Vec::new();
+    for line in text.lines() {
+        if line.starts_with("#version") {
+            texts.push(String::new());
+        }
+        if let Some(t) = texts.last_mut() {
+            t.push_str(line);
+            t.push('\n');
+        }
+    }
+    assert_eq!(texts.len(), files.len(), "one preprocessed text a file");
+    texts
 }
 
 /// The configuration has teeth: a loop bounded by a uniform, accepted by Mesa, is rejected.
