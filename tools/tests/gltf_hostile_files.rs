@@ -380,6 +380,32 @@ fn more_distinct_meshes_than_the_limit_are_refused_naming_the_first_past_it() {
     assert_eq!(scene.objects.len(), 1);
 }
 
+/// Placements count toward the limit whether their primitive is drawn or skipped: nodes that
+/// place a mesh of skipped (points) primitives were walked nodes × primitives times, with no
+/// limit (half a million nodes and 250 000 primitives: hours).
+#[test]
+fn placements_of_skipped_primitives_count_toward_the_limit() {
+    use manylight::scene::MAX_SCENE_OBJECTS;
+    let mut b = Builder::default();
+    let p = b.floats(&[0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0], "VEC3");
+    let points = json!({"attributes": {"POSITION": p}, "mode": 0});
+    let nodes = MAX_SCENE_OBJECTS / 2 + 1;
+    let model = b.gltf(json!({
+        "scene": 0,
+        "scenes": [{"nodes": (0..nodes).collect::<Vec<_>>()}],
+        "nodes": vec![json!({"mesh": 0}); nodes],
+        "meshes": [{"primitives": [points.clone(), points]}],
+    }));
+    let dir = tempfile::tempdir().unwrap();
+    let err = load(&write(dir.path(), "points.gltf", model))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("placed primitives") && err.contains(&MAX_SCENE_OBJECTS.to_string()),
+        "{err}"
+    );
+}
+
 /// Images that do not decode are named with the kind of failure only: the decoders' own
 /// messages quote the file (a PNG chunk's type, a BMP header read as a number, a TGA's image
 /// type), and no message may show a file's bytes.

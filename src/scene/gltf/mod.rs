@@ -340,6 +340,9 @@ fn import(
     };
     let mut camera_nodes = 0;
     let mut mesh_count = 0;
+    // Primitives placed, drawn or skipped: a skipped one makes no object, but N nodes placing
+    // a mesh of P of them would otherwise be walked N·P times.
+    let mut placements = 0usize;
     for p in &placed {
         let Some(node) = document.nodes().nth(p.node) else {
             continue;
@@ -349,6 +352,14 @@ fn import(
         let placing = |e: String| Fault::Placing(format!("placing {field}: {e}"));
         if let Some(m) = node.mesh() {
             for prim in m.primitives() {
+                placements += 1;
+                if placements > MAX_OBJECTS {
+                    return Err(format!(
+                        "{field}: more than {MAX_OBJECTS} placed primitives, drawn or skipped \
+                         (the limit per file)"
+                    )
+                    .into());
+                }
                 let key = (m.index(), prim.index());
                 let pfield = format!("meshes[{}].primitives[{}]", key.0, key.1);
                 let cached = match meshes.entry(key) {
@@ -395,12 +406,6 @@ fn import(
                 } else {
                     materials.get(&prim.material(), &mut buffers, path, &mut warnings)?
                 };
-                if out.objects.len() >= MAX_OBJECTS {
-                    return Err(format!(
-                        "{field}: more than {MAX_OBJECTS} placed primitives (the limit per file)"
-                    )
-                    .into());
-                }
                 out.objects.push(Object {
                     mesh,
                     material,
