@@ -145,11 +145,14 @@ fn an_external_buffer_file_and_a_sparse_accessor_are_read() {
     b.accessors[p]["sparse"] = json!({"count": 1,
         "indices": {"bufferView": indices, "componentType": UNSIGNED_SHORT},
         "values": {"bufferView": values}});
-    // And a sparse accessor with no buffer view at all: zeros, then the substitution.
+    // And a sparse accessor with no buffer view at all: zeros, then the substitution (its
+    // index read from byte 2 of its view).
+    let offset_indices = b.view(&[u16::MAX, 2].map(u16::to_le_bytes).concat());
     b.accessors
         .push(json!({"componentType": FLOAT, "type": "VEC3", "count": 3,
         "sparse": {"count": 1,
-            "indices": {"bufferView": indices, "componentType": UNSIGNED_SHORT},
+            "indices": {"bufferView": offset_indices, "byteOffset": 2,
+                "componentType": UNSIGNED_SHORT},
             "values": {"bufferView": values}}}));
     let doc = json!({"scenes": [{"nodes": [0, 1]}], "nodes": [{"mesh": 0}, {"mesh": 1}],
         "meshes": [{"primitives": [{"attributes": {"POSITION": p}}]},

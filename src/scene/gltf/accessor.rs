@@ -187,13 +187,19 @@ fn read<T: Copy + Default>(
         let isize = size(itype);
         let view = indices.view();
         let view_index = view.index();
-        let ibytes = buffers.view(&view)?.to_vec();
-        check_span(n, isize, isize, indices.offset(), ibytes.len()).map_err(|e| {
+        let whole = buffers.view(&view)?;
+        check_span(n, isize, isize, indices.offset(), whole.len()).map_err(|e| {
             format!(
                 "{field}.indices: {e} bufferViews[{view_index}] ({} bytes)",
-                ibytes.len()
+                whole.len()
             )
         })?;
+        // Only the indices' bytes, not their whole view (the values' view is borrowed next).
+        // (In range once `check_span` passed; none at all for a sparse count of 0.)
+        let ibytes = whole
+            .get(indices.offset()..indices.offset() + n * isize)
+            .unwrap_or_default()
+            .to_vec();
         let values = sparse.values();
         let view = values.view();
         let view_index = view.index();
@@ -205,7 +211,7 @@ fn read<T: Copy + Default>(
             )
         })?;
         for k in 0..n {
-            let at = indices.offset() + k * isize;
+            let at = k * isize;
             let target = component_u32(&ibytes[at..at + isize], itype) as usize;
             if target >= count {
                 return Err(format!(
