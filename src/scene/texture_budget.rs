@@ -97,6 +97,10 @@ pub(crate) fn decode_texture_bytes(
         }
     }
     let (w, h) = first.into_dimensions().map_err(undecodable)?;
+    // Some decoders (GIF) give an image of no rows or columns rather than an error.
+    if w == 0 || h == 0 {
+        return Err(format!("could not be decoded (it has no pixels: {w}×{h})"));
+    }
     // A failed decode keeps its share taken: decoding is the work the budget bounds (60
     // images of 16 384² that failed at their last row took 16 s, none of it counted). One
     // refused by the decoder's limits decoded nothing, and gives it back.
@@ -374,6 +378,36 @@ mod tests {
         let before = budget.left();
         let err = decode_texture_bytes(&big, png, &mut budget).unwrap_err();
         assert_eq!(budget.left(), before, "{err}");
+    }
+
+    /// A GIF whose screen and only frame are `width` wide and 0 high (interlaced, so the
+    /// decoder runs no rows and checks nothing).
+    fn gif_without_rows(width: u16) -> Vec<u8> {
+        let mut gif = b"GIF89a".to_vec();
+        gif.extend(width.to_le_bytes());
+        gif.extend(0u16.to_le_bytes());
+        // A global palette of two entries, no background, square pixels.
+        gif.extend([0x80, 0, 0, 0, 0, 0, 0xFF, 0xFF, 0xFF]);
+        // The frame: at (0, 0), `width` × 0, interlaced; LZW of no data; the trailer.
+        gif.push(0x2C);
+        gif.extend([0, 0, 0, 0]);
+        gif.extend(width.to_le_bytes());
+        gif.extend(0u16.to_le_bytes());
+        gif.extend([0x40, 0x02, 0x00, 0x3B]);
+        gif
+    }
+
+    /// An image of no pixels is refused (it would reach the scene as a texture with nothing
+    /// to sample, failing the whole load, or, past the size cap, as a black stripe).
+    #[test]
+    fn an_image_without_pixels_is_refused() {
+        for width in [4, 5_000] {
+            let mut budget = TextureBudget::default();
+            let gif = gif_without_rows(width);
+            let err =
+                decode_texture_bytes(&gif, Some(image::ImageFormat::Gif), &mut budget).unwrap_err();
+            assert!(err.contains(&format!("{width}×0")), "{err}");
+        }
     }
 
     #[test]
