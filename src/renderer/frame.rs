@@ -49,7 +49,7 @@ impl Renderer {
     /// [`Renderer::render`], writing the frame's figures into `stats` and reusing its
     /// strings. In steady state (the same method and scene shape for a few frames: shaders
     /// built, buffers grown) the renderer makes no heap allocation for a frame, lights moving
-    /// or not, the automatic grid's re-choices included (`tests/soak.rs` counts them; see
+    /// or not, the automatic grid's re-choices included (`tools/tests/soak.rs` counts them; see
     /// docs/performance.md). Keep one `FrameStats` and pass it every frame. After an error,
     /// `stats` holds no meaningful figures.
     pub fn render_reusing(

@@ -79,7 +79,8 @@ pub struct ViewArgs {
     /// `--screenshot`, the picture is then the frame at `--time`, as `render --time` draws it.
     #[arg(long)]
     pub paused: bool,
-    /// Samples per pixel to start with (M toggles between 1 and 4): ES 3.0, not deferred.
+    /// Samples per pixel to start with (M toggles between 1 and 4): ES 3.0, or ES 2.0 with
+    /// GL_EXT_multisampled_render_to_texture; not deferred.
     #[arg(long, default_value_t = 1, value_parser = crate::render::parse_samples)]
     pub msaa: u32,
 }
