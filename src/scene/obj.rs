@@ -433,7 +433,8 @@ fn parse_obj(path: &Path, allow_outside: bool) -> Result<Parsed, SceneError> {
                 return Err(tobj::LoadError::MaterialParseError);
             }
         }
-        tobj::load_mtl_buf(&mut std::io::BufReader::new(text.as_bytes()))
+        let kept = lines::mtl_statements_kept(&text, &UNAPPLIED_MTL);
+        tobj::load_mtl_buf(&mut std::io::BufReader::new(kept.as_bytes()))
     };
     let parsed = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
         tobj::load_obj_buf(
@@ -466,17 +467,20 @@ fn parse_obj(path: &Path, allow_outside: bool) -> Result<Parsed, SceneError> {
     }
 }
 
-/// MTL statements the Blinn-Phong OBJ material does not read (normal maps, the PBR extension's
-/// `Pr`/`Pm`, emission): one warning per file naming them and how many materials use each, so
-/// a model that relies on them is not silently drawn flat.
+/// MTL statements the Blinn-Phong OBJ material does not read but warns of (normal maps, the
+/// PBR extension's `Pr`/`Pm`, emission maps): tobj keeps them as unknown statements.
+const UNAPPLIED_MTL: [&str; 9] = [
+    "norm", "Pr", "Pm", "map_Pr", "map_Pm", "map_Ke", "Ps", "Pc", "aniso",
+];
+
+/// [`UNAPPLIED_MTL`] statements and the others the material does not read: one warning per
+/// file naming them and how many materials use each, so a model that relies on them is not
+/// silently drawn flat.
 fn warn_unapplied_mtl<'a>(
     mtl: impl Iterator<Item = &'a tobj::Material>,
     path: &Path,
     report: &mut LoadReport,
 ) {
-    const UNAPPLIED: [&str; 9] = [
-        "norm", "Pr", "Pm", "map_Pr", "map_Pm", "map_Ke", "Ps", "Pc", "aniso",
-    ];
     let mut used: Vec<(&str, usize)> = Vec::new();
     let mut count = |name: &'static str| match used.iter_mut().find(|(n, _)| *n == name) {
         Some((_, k)) => *k += 1,
@@ -489,7 +493,7 @@ fn warn_unapplied_mtl<'a>(
         if m.emissive.is_some_and(|e| e.iter().any(|&c| c != 0.0)) {
             count("Ke");
         }
-        for key in UNAPPLIED {
+        for key in UNAPPLIED_MTL {
             // `Ke 0 0 0` and the like change nothing (exporters write them for every material).
             let zero = |v: &str| v.split_whitespace().all(|x| x.parse() == Ok(0.0f64));
             if m.unknown_param.get(key).is_some_and(|v| !zero(v)) {

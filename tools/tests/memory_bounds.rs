@@ -562,6 +562,46 @@ fn a_root_list_repeating_one_node_is_refused_within_bounded_memory() {
     assert!(stderr.contains("nodes[0] is reached from both"), "{stderr}");
 }
 
+/// tobj keeps every MTL statement it does not read as a string in a map per material, about
+/// 100 bytes a line: four libraries of 16 MiB of distinct short statements (`#c0`, `#c1`, …,
+/// comments to anyone else) held some 2 GB. The loader now gives tobj only the statements it
+/// reads or the loader looks up, so under a 384 MiB address-space limit the model renders.
+#[test]
+fn mtl_statements_tobj_would_keep_do_not_grow_memory() {
+    let Ok(prlimit) = which_prlimit() else {
+        common::skip("no prlimit (util-linux) to bound the child's memory");
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let mut obj = String::new();
+    for library in 0..4 {
+        let mut mtl = format!("newmtl m{library}\nKd 0.8 0.8 0.8\n");
+        let mut i = 0u64;
+        while mtl.len() < (16 << 20) - 32 {
+            mtl.push_str(&format!("#{i:x}\n"));
+            i += 1;
+        }
+        std::fs::write(dir.path().join(format!("l{library}.mtl")), mtl).unwrap();
+        obj.push_str(&format!("mtllib l{library}.mtl\n"));
+    }
+    obj.push_str("usemtl m0\nv -1 -1 0\nv 1 -1 0\nv 0 1 0\nf 1 2 3\n");
+    let path = dir.path().join("m.obj");
+    std::fs::write(&path, obj).unwrap();
+    let out = std::process::Command::new(prlimit)
+        .arg("--as=402653184")
+        .arg(env!("CARGO_BIN_EXE_manylight"))
+        .env("RAYON_NUM_THREADS", "1")
+        .env("MALLOC_ARENA_MAX", "1")
+        .args(["render", "--size", "8x8", "--scene"])
+        .arg(&path)
+        .arg("--out")
+        .arg(dir.path().join("x.png"))
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{stderr}");
+}
+
 fn which_prlimit() -> Result<std::path::PathBuf, ()> {
     ["/usr/bin/prlimit", "/bin/prlimit"]
         .iter()

@@ -431,12 +431,44 @@ pub(super) fn check_mtl(text: &str, defined: usize) -> Result<usize, String> {
     Ok(materials)
 }
 
+/// The MTL statements tobj reads into a material's fields; it keeps any other as a string in a
+/// map per material (some 100 bytes a line, `#comment` included), with no bound.
+const TOBJ_MTL_STATEMENTS: [&str; 19] = [
+    "newmtl", "Ka", "Kd", "Ks", "Ke", "Ns", "Ni", "d", "illum", "map_Ka", "map_Kd", "map_Ks",
+    "map_Bump", "map_bump", "map_Ns", "map_ns", "map_NS", "bump", "map_d",
+];
+
+/// The library's lines that tobj reads into fields or that `also` names (statements the loader
+/// looks up in tobj's map); the others are left out before tobj parses, so what it keeps per
+/// material is bounded. Run after [`check_mtl`], whose messages number the file's own lines.
+pub(super) fn mtl_statements_kept(text: &str, also: &[&str]) -> String {
+    let mut kept = String::with_capacity(text.len());
+    for line in text.lines() {
+        let key = line.split_whitespace().next().unwrap_or_default();
+        if TOBJ_MTL_STATEMENTS.contains(&key) || also.contains(&key) {
+            kept.push_str(line);
+            kept.push('\n');
+        }
+    }
+    kept
+}
+
 #[cfg(test)]
 mod tests {
     use super::{
-        check_mtl, check_obj, check_obj_within, rewrite, undefined_materials, HashSet, Objects,
-        MAX_OBJ_NAME_BYTES,
+        check_mtl, check_obj, check_obj_within, mtl_statements_kept, rewrite, undefined_materials,
+        HashSet, Objects, MAX_OBJ_NAME_BYTES,
     };
+
+    #[test]
+    fn only_statements_tobj_reads_or_the_loader_looks_up_reach_tobj() {
+        let text = "# comment\n#note\nnewmtl m\nKd 1 0 0\nPr 0.5\nzz unknown\n  map_Kd a b.png\n\
+                    Tf 1 1 1\nillum 2\n";
+        assert_eq!(
+            mtl_statements_kept(text, &["Pr"]),
+            "newmtl m\nKd 1 0 0\nPr 0.5\n  map_Kd a b.png\nillum 2\n"
+        );
+    }
 
     /// Colours on some `v` lines and not others are found (the first line with, the first
     /// without) and taken off every line that has one; `w` stays.
