@@ -30,7 +30,10 @@ mod textures;
 
 pub use lines::{MAX_OBJ_CORNERS, MAX_OBJ_MATERIALS};
 pub use texture_names::resolve_texture;
-use texture_names::{within_folder, Listings, TextureFinder};
+#[cfg(test)]
+pub(crate) use texture_names::FOLDERS_LISTED;
+pub(crate) use texture_names::{resolve_in as resolve_texture_in, Listings};
+use texture_names::{within_folder, TextureFinder};
 use textures::TextureCache;
 
 /// What an OBJ load produced besides the objects: non-fatal problems, for the caller to show.

@@ -25,7 +25,7 @@ pub(super) const MAX_MATCHED_COMPONENTS: usize = 32;
 /// once, however many names are looked for in it (a library of thousands of names missing
 /// from a folder of thousands of files listed it for each, for minutes).
 #[derive(Default)]
-pub(super) struct Listings {
+pub(crate) struct Listings {
     /// Per folder: each entry's name in lower case, and as it is.
     by_folder: HashMap<PathBuf, HashMap<String, OsString>>,
 }
@@ -45,6 +45,8 @@ impl Listings {
         };
         let folder = std::fs::canonicalize(listed).ok()?;
         let entries = self.by_folder.entry(folder).or_insert_with(|| {
+            #[cfg(test)]
+            FOLDERS_LISTED.with(|n| n.set(n.get() + 1));
             let mut entries = HashMap::new();
             for entry in std::fs::read_dir(listed).into_iter().flatten().flatten() {
                 let file_name = entry.file_name();
@@ -63,6 +65,12 @@ impl Listings {
     pub(super) fn listed(&self) -> usize {
         self.by_folder.len()
     }
+}
+
+#[cfg(test)]
+thread_local! {
+    /// Folders listed on this thread by any [`Listings`], for tests of whole loads.
+    pub(crate) static FOLDERS_LISTED: std::cell::Cell<usize> = const { std::cell::Cell::new(0) };
 }
 
 /// Finds the textures one OBJ load's MTL statements name: each name once (materials often
@@ -166,8 +174,9 @@ pub fn resolve_texture(base_dir: &Path, name: &str) -> Option<PathBuf> {
     resolve_in(base_dir, name, &mut Listings::default())
 }
 
-/// [`resolve_texture`] with the folders `listings` has listed.
-fn resolve_in(base_dir: &Path, name: &str, listings: &mut Listings) -> Option<PathBuf> {
+/// [`resolve_texture`] with the folders `listings` has listed (one load's, so each folder is
+/// listed once however many names it is searched for).
+pub(crate) fn resolve_in(base_dir: &Path, name: &str, listings: &mut Listings) -> Option<PathBuf> {
     let name = name.replace('\\', "/");
     let as_written = base_dir.join(&name);
     if as_written.is_file() {
