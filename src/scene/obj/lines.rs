@@ -144,10 +144,17 @@ fn check_obj_within(text: &str, max_corners: usize) -> Result<Rewrites, String> 
     let mut one_number_texcoords = false;
     let mut long_name = None;
     let mut not_faces: Option<(usize, usize)> = None;
+    // Per kind, the largest positive index the current object's faces use, and where.
+    let mut pending: [Option<PendingIndex>; 3] = [None; 3];
     for (number, line) in text.lines().enumerate() {
         let at_line = |what: String| format!("line {}: {what}", number + 1);
         let mut words = line.split_whitespace();
         let key = words.next();
+        // tobj resolves an object's positive indices when it ends, at the next `o` or `g`
+        // (or a change of material, not checked here: a later check is never stricter).
+        if matches!(key, Some("o" | "g")) {
+            check_pending(&mut pending, &defined, number + 1)?;
+        }
         objects.read(key, line).map_err(at_line)?;
         if long_name.is_none() && long_object_name(key, line).is_some() {
             long_name = Some(number + 1);
@@ -187,6 +194,7 @@ fn check_obj_within(text: &str, max_corners: usize) -> Result<Rewrites, String> 
                 )));
             }
         }
+        let reaches_tobj = !is_not_a_face(Some(key), count);
         for (at, word) in words.enumerate() {
             // tobj's "face parse error", without a line (it reads `1/2/3/` as `1/2/3`).
             // Up to the last one written: `1/1/1/1/` has four.
@@ -202,18 +210,27 @@ fn check_obj_within(text: &str, max_corners: usize) -> Result<Rewrites, String> 
                 if kind > 0 && part.is_empty() {
                     continue;
                 }
-                let index = part.parse::<i64>();
+                let index = part.parse::<i64>().ok();
                 // tobj ignores them where the file has none, but parses them all the same.
-                if kind > 0 && totals[kind] == 0 && index.is_ok() {
+                if kind > 0 && totals[kind] == 0 && index.is_some() {
                     continue;
                 }
-                let resolves = index.is_ok_and(|i| match i {
+                let resolves = index.is_some_and(|i| match i {
                     0 => false,
                     i if i > 0 => i <= totals[kind],
                     i => i.unsigned_abs() <= defined[kind].unsigned_abs(),
                 });
+                if let (true, Some(index @ 1..)) = (reaches_tobj, index) {
+                    if pending[kind].is_none_or(|p| index > p.index) {
+                        pending[kind] = Some(PendingIndex {
+                            index,
+                            line: number + 1,
+                            corner: at + 1,
+                        });
+                    }
+                }
                 if !resolves {
-                    let what = ["vertex", "texture coordinate", "normal"][kind];
+                    let what = INDEX_KINDS[kind];
                     return Err(at_line(format!(
                         "`{key}` corner {}: its {what} index is not one of the {} the file \
                          defines ({} before this line)",
@@ -234,6 +251,36 @@ fn check_obj_within(text: &str, max_corners: usize) -> Result<Rewrites, String> 
         long_name,
         not_faces,
     })
+}
+
+/// What a face corner's indices refer to, in their order.
+const INDEX_KINDS: [&str; 3] = ["vertex", "texture coordinate", "normal"];
+
+/// A positive index of a face, kept until its object ends.
+#[derive(Clone, Copy)]
+struct PendingIndex {
+    index: i64,
+    line: usize,
+    corner: usize,
+}
+
+/// At the end of an object (line `end`), every positive index its faces used must be defined
+/// by then (tobj's "face vertex index out of bounds", without a line, otherwise); clears them.
+fn check_pending(
+    pending: &mut [Option<PendingIndex>; 3],
+    defined: &[i64; 3],
+    end: usize,
+) -> Result<(), String> {
+    for (kind, p) in pending.iter_mut().enumerate() {
+        if let Some(p) = p.take().filter(|p| p.index > defined[kind]) {
+            return Err(format!(
+                "line {}: `f` corner {}: its {} index is past the {} defined before its object \
+                 ends (line {end}), where its indices are read",
+                p.line, p.corner, INDEX_KINDS[kind], defined[kind]
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// What [`check_vertex_data`] found a line to be, besides valid.
@@ -336,7 +383,10 @@ fn check_vertex_data<'a>(
             )),
             Err(_) => Err("`v` w (the 4th value) is not a number".into()),
         },
-        [_, _, _] => Ok(VertexLine::Coloured), // which tobj reads and manylight does not use
+        // Which tobj reads (and manylight does not use): a word that is not a number ends
+        // tobj's read of the line and leaves the colours out of step with the positions.
+        [_, _, _] if rest.iter().all(|c| c.parse::<f32>().is_ok()) => Ok(VertexLine::Coloured),
+        [_, _, _] => Err("`v` colour (the 4th to 6th values) is not three numbers".into()),
         _ => Err(format!(
             "`v` takes 3 numbers, then a w or an RGB colour (1 or 3 values); found {} more",
             if rest.len() > 3 { "4 or" } else { "2" }
@@ -607,6 +657,20 @@ mod tests {
                 "v 0 0 0\nvt 0 0\nvn 0 0 1\nf 1/1/1/1 1 1\n",
                 "line 4: `f` corner 1 has 4 indices",
             ),
+            (
+                "v 0 0 0 1 1 1\nv 1 0 0 1 1 1\nv 0 1 0 a b c\nf 1 2 3\n",
+                "line 3: `v` colour (the 4th to 6th values) is not three numbers",
+            ),
+            // tobj reads an object's faces when it ends: vertex 3 comes after `o b`.
+            (
+                "v 0 0 0\nv 1 0 0\nf 1 2 3\no b\nv 0 1 0\n",
+                "line 3: `f` corner 3: its vertex index is past the 2 defined before its \
+                 object ends (line 4)",
+            ),
+            (
+                "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1/1 2/2 3/1\ng x\nvt 1 1\nf 1/2 2/2 3/2\n",
+                "line 5: `f` corner 2: its texture coordinate index is past the 1 defined",
+            ),
         ];
         for (text, expected) in cases {
             let err = check_obj(text).expect_err(text);
@@ -622,8 +686,12 @@ mod tests {
             "vn 0 0 1 extra\n",
             "vt 0 1 0\n",
             "v 0 0 0\nvt 0 0\nvn 0 0 1\nf 1/1/1/ 1 1\n",
+            // Faces before their vertices, within their object.
+            "f 1 2 3\nv 0 0 0\nv 1 0 0\nv 0 1 0\no b\n",
         ] {
             assert_eq!(check_obj(text), Ok(Default::default()), "{text:?}");
         }
+        // A polyline, which never reaches tobj, across an object's end.
+        assert!(check_obj("v 0 0 0\nv 1 0 0\nl 1 2 3\no b\nv 0 1 0\n").is_ok());
     }
 }
