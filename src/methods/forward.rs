@@ -9,6 +9,7 @@
 //! most to the view ([`super::forward_cap`]), with a warning and the rest counted.
 
 use super::directional::DirectionalUniforms;
+use super::forward_cap::CapView;
 use super::geometry::{self, GeometryProgram, UNIT_METHOD};
 use super::uniforms::{self, LightData, Surface, Transforms};
 use super::{FrameContext, MethodDesc, MethodStats, ShaderFeatures, ShadingMethod, Support};
@@ -150,6 +151,7 @@ impl ShadingMethod for Forward {
             super::forward_cap::keep_most_important_into(
                 ctx.lights,
                 limit as usize,
+                &CapView::new(&ctx.projection, ctx.near),
                 &mut self.cap_order,
                 &mut self.capped,
             );

@@ -77,6 +77,34 @@ fn a_light_brighter_than_2_to_the_126_still_lights_without_fragment_highp() {
     }
 }
 
+/// Past forward's light cap (no fragment highp: 1 023 lights), bright lights just beside the
+/// camera, outside the view, were kept before the one light in it, being nearer the eye: the
+/// plane went unlit. They reach no pixel, so they are the first left out.
+#[test]
+fn forwards_cap_keeps_the_light_in_view_over_lights_beside_it() {
+    let mut gpu = Gpu::without_fragment_highp();
+    let opts = RenderOptions::default();
+    let limit = manylight::methods::forward::max_lights(gpu.r().caps()) as usize;
+    let in_view = point(10.0);
+    let alone = gpu.render(&plane(vec![in_view]), 64, 36, &opts);
+    let mut s = plane(vec![]);
+    // 60 units to the right in view space, radius 15: outside the right plane for any field
+    // of view up to 90° at 16:9, and ten thousand times as bright as the light in view.
+    let to_world = s.camera.view_matrix().inverse();
+    let beside = to_world.transform_point3(DVec3::new(60.0, 0.0, -2.0));
+    s.lights = vec![Light::point(beside, 15.0, Vec3::ONE, 1e4); limit];
+    s.lights.push(in_view);
+    let capped = gpu.render(&s, 64, 36, &opts);
+    let d = manylight::metrics::diff(&alone, &capped);
+    assert!(
+        d.max_abs <= 2,
+        "the light in view was left out: {} / 255 from it alone (mean {:.1} against {:.1})",
+        d.max_abs,
+        mean(&capped),
+        mean(&alone)
+    );
+}
+
 /// How far deferred's 128 × 72 frame of `s` lies from forward's, per channel (0–255).
 fn deferred_from_forward(gpu: &mut Gpu, s: &Scene) -> u8 {
     let opts = RenderOptions::default();

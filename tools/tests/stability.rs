@@ -131,7 +131,11 @@ fn check_without_fragment_highp(
             .iter()
             .map(|l| manylight::cluster::view_light::GpuLight::from_light(l, &view))
             .collect();
-        let kept = manylight::methods::forward_cap::most_important_indices(&gpu_lights, limit);
+        let (near, _) = scene.camera.near_far();
+        let projection = scene.camera.projection_matrix(f64::from(w) / f64::from(h));
+        let view = manylight::methods::forward_cap::CapView::new(&projection.as_mat4(), near);
+        let kept =
+            manylight::methods::forward_cap::most_important_indices(&gpu_lights, limit, &view);
         assert_eq!(stats.lights.overflowed as usize, active.len() - kept.len());
         eprintln!(
             "{name} without fragment highp: forward kept {} of {} lights",
