@@ -212,7 +212,16 @@ impl Renderer {
         stats: &mut FrameStats,
     ) -> Result<(), Error> {
         let start = Instant::now();
-        let method_name = self.method.name();
+        // Reaching counts are a plain-forward pass's, whatever the method (`CountKind`).
+        let reaching_pass = options.count == CountKind::Reaching && self.method.name() != "forward";
+        if reaching_pass && self.reaching_pass.is_none() {
+            self.reaching_pass = Some((methods::find("forward")?.create)(&self.dev)?);
+        }
+        let method_name = if reaching_pass {
+            "forward"
+        } else {
+            self.method.name()
+        };
         if let Some(warning) = self.pending_warning.take() {
             log::warn!("{warning}");
         }
@@ -297,11 +306,15 @@ impl Renderer {
         }
         // No lights: no assignment, no uploads, the light loop compiled out — whatever the
         // method (a scene pays only for what it has).
+        let method = match &mut self.reaching_pass {
+            Some(pass) if reaching_pass => pass,
+            _ => &mut self.method,
+        };
         let rendered = if self.lights.is_empty() {
-            self.method.skip_frame(&self.dev);
+            method.skip_frame(&self.dev);
             methods::forward::draw_ambient_only(&mut ctx)
         } else {
-            self.method.render(&mut ctx)
+            method.render(&mut ctx)
         };
         // Likewise the draws' errors, before the query ends (on the error path too: one left
         // active makes the next frame's `glBeginQuery` fail).

@@ -45,6 +45,9 @@ pub struct Renderer {
     programs: ProgramCache,
     gpu_scene: GpuScene,
     method: Box<dyn ShadingMethod>,
+    /// The plain-forward pass that draws `CountKind::Reaching` frames whatever the method:
+    /// made at the first such frame, kept for the next.
+    reaching_pass: Option<Box<dyn ShadingMethod>>,
     support: Support,
     target: Option<OffscreenTarget>,
     /// The multisampled target `render_offscreen` draws into with `RenderOptions::samples`.
@@ -131,6 +134,7 @@ impl Renderer {
             programs: ProgramCache::new(),
             gpu_scene: GpuScene::default(),
             method,
+            reaching_pass: None,
             support,
             target: None,
             msaa: None,
@@ -329,6 +333,9 @@ impl Renderer {
             t.destroy(&self.dev);
         }
         self.method.destroy(&self.dev);
+        if let Some(mut pass) = self.reaching_pass.take() {
+            pass.destroy(&self.dev);
+        }
         self.programs.destroy(&self.dev);
         self.gpu_scene.destroy(&self.dev);
         if let Some(mut t) = self.target.take() {

@@ -4,7 +4,6 @@
 
 use super::{FrameStats, Renderer};
 use crate::gl::framebuffer::{ColorFormat, OffscreenTarget};
-use crate::methods;
 use crate::metrics::counts::LightCounts;
 use crate::options::{CountKind, RenderOptions};
 use crate::scene::Scene;
@@ -119,18 +118,7 @@ impl Renderer {
             ..options.clone()
         };
         options.measure.timed_frames = 0;
-        let (image, stats) = self.hosted(|r| {
-            if kind != CountKind::Reaching {
-                return r.render_offscreen(scene, width, height, &options);
-            }
-            // A plain-forward pass whatever the method: swap one in for this frame.
-            let forward = (methods::find("forward")?.create)(&r.dev)?;
-            let current = std::mem::replace(&mut r.method, forward);
-            let result = r.render_offscreen(scene, width, height, &options);
-            let mut forward = std::mem::replace(&mut r.method, current);
-            forward.destroy(&r.dev);
-            result
-        })?;
+        let (image, stats) = self.hosted(|r| r.render_offscreen(scene, width, height, &options))?;
         Ok((LightCounts::try_decode(&image)?, stats))
     }
 }

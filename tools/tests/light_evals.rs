@@ -68,6 +68,42 @@ fn every_method_evaluates_at_least_the_lights_that_reach_each_pixel() {
     }
 }
 
+/// `Reaching` counts are a plain-forward pass's whatever the method, through
+/// `render_offscreen` too: under tiled, clustered, deferred and auto (past its forward
+/// threshold) it gave the colour frame, which decodes as counts as well.
+#[test]
+fn reaching_counts_are_forwards_whatever_the_method_and_the_call() {
+    let scene = scene::builtin::build("courtyard", Some((256, 5))).unwrap();
+    let mut gpu = Gpu::new(EsVersion::Es3);
+    let bound = counts(&mut gpu, &scene, "forward", CountKind::Reaching);
+    let options = RenderOptions {
+        count: CountKind::Reaching,
+        clear_color: [0.0; 4],
+        ..RenderOptions::default()
+    };
+    for method in ["forward", "tiled", "clustered", "deferred", "auto"] {
+        gpu.r().set_method_named(method).unwrap();
+        let (image, stats) = gpu
+            .r()
+            .render_offscreen(&scene, 256, 144, &options)
+            .unwrap_or_else(|e| panic!("{method}: {e}"));
+        let drawn = LightCounts::decode(&image);
+        let differing = (drawn.counts.iter().zip(&bound.counts)).filter(|(a, b)| a != b);
+        assert_eq!(
+            differing.count(),
+            0,
+            "{method}: pixels not forward's counts"
+        );
+        assert_eq!(stats.method, "forward", "{method}");
+        // The frame after is the method's own colour again.
+        let (_, stats) = gpu
+            .r()
+            .render_offscreen(&scene, 256, 144, &RenderOptions::default())
+            .unwrap();
+        assert_eq!(stats.method, method);
+    }
+}
+
 /// The papers' result: on a scene of many small lights, clustered evaluates no more lights
 /// than tiled, and far fewer than forward.
 #[test]
