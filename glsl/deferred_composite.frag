@@ -8,6 +8,9 @@
 #include "deferred_common.glsl"
 
 uniform HIGHP sampler2D u_accum;
+// The light pass added radiance pre-exposed (times a power of two, deferred.rs
+// accumulation_scale) so a half-float accumulation holds it; this undoes it.
+uniform HIGHP float u_accumToRadiance;
 // The geometry pass's depth, written into the target's depth buffer (see deferred.rs).
 uniform HIGHP sampler2D u_gDepth;
 // The viewport's lower-left corner in the target: the G-buffer's pixel (0, 0).
@@ -25,7 +28,7 @@ void main() {
 #else
     HIGHP vec4 albedoOffset = texelFetch(u_gAlbedo, px, 0);
     MEDP vec3 albedo = albedoOffset.rgb;
-    HIGHP vec3 color = u_ambient * albedo + texelFetch(u_accum, px, 0).rgb;
+    HIGHP vec3 color = u_ambient * albedo + texelFetch(u_accum, px, 0).rgb * u_accumToRadiance;
 #if HAS_DIRECTIONAL
     // Directional lights light every pixel: here, once, rather than as a light volume. The
     // surface point comes back from the G-buffer as in the light pass.

@@ -13,6 +13,8 @@ layout(location = 2) out vec4 o_specular;
 // The accumulation buffer's start: what the surface adds besides ambient × albedo and the
 // lights (emission, the ambient term's occlusion), so the composite's sum equals forward's.
 layout(location = 3) out vec4 o_extra;
+// The light pass's pre-exposure (deferred.rs accumulation_scale), which the composite undoes.
+uniform HIGHP float u_accumScale;
 
 void main() {
 #if HAS_ALPHA_MASK
@@ -37,7 +39,7 @@ void main() {
 #if HAS_EMISSIVE
     extra += surfaceEmission(v_uv);
 #endif
-    o_extra = vec4(extra, 0.0);
+    o_extra = vec4(extra * u_accumScale, 0.0);
     // Any view depth marks a covered pixel (the buffer is cleared to −10³⁰: noSurface).
     o_normalDepth = vec4(octEncode(N), -v_viewPos.z, offset.x);
 #if METALLIC_ROUGHNESS

@@ -59,6 +59,15 @@ fn supported(caps: &Caps) -> Support {
     }
 }
 
+/// What the light pass scales radiance by before the accumulation adds it (the composite
+/// undoes it): the exposure rounded to a power of two, so the scaling is exact, and at most 1.
+/// The accumulation is half-float without `GL_EXT_float_blend`, where a bright frame at a low
+/// exposure summed past 65 504 to Inf (a 2·10⁵ light at −15 EV: white where forward's
+/// Reinhard gives 238/255); pre-exposed it holds about the displayed range.
+fn accumulation_scale(exposure_ev: f32) -> f32 {
+    exposure_ev.round().min(0.0).exp2()
+}
+
 /// Proxy spheres are drawn this much larger than the light radius: the 16×8 tessellation's
 /// faces lie inside the true sphere by up to 1 − cos(π/16)·cos(π/16) ≈ 4 %.
 const VOLUME_SCALE: f32 = 1.1;
@@ -83,15 +92,20 @@ pub struct GBufferProgram {
     surface: Surface,
     viewport: Uniform<[f32; 2]>,
     half_extent: Uniform<[f32; 2]>,
+    /// [`accumulation_scale`], for what the surface itself adds (emission, occlusion).
+    accum_scale: Uniform<f32>,
 }
 
 impl UniformSet for GBufferProgram {
     fn resolve(r: &mut Resolver<'_>) -> Self {
+        let f = uniforms::features(r);
+        let adds = f.has(ShaderFeatures::EMISSIVE) || f.has(ShaderFeatures::OCCLUSION);
         GBufferProgram {
             transforms: Transforms::resolve(r, true),
             surface: Surface::gbuffer(r),
             viewport: r.required("u_viewport"),
             half_extent: r.required("u_halfExtent"),
+            accum_scale: r.required_when(adds, "u_accumScale"),
         }
     }
 }
@@ -152,6 +166,8 @@ pub struct CompositeProgram {
     frame_origin: Uniform<[f32; 2]>,
     ambient: Uniform<Vec3>,
     exposure: Uniform<f32>,
+    /// Undoes [`accumulation_scale`].
+    accum_to_radiance: Uniform<f32>,
     alpha: Uniform<f32>,
     heat_scale: Uniform<f32>,
     /// Directional lights: the G-buffer's specular and the surface point's reconstruction.
@@ -177,6 +193,7 @@ impl UniformSet for CompositeProgram {
             frame_origin: r.required("u_frameOrigin"),
             ambient: r.required_when(colour, "u_ambient"),
             exposure: r.required_when(colour && !f.has(ShaderFeatures::OUTPUT_HDR), "u_exposure"),
+            accum_to_radiance: r.required_when(colour, "u_accumToRadiance"),
             alpha: r.required_when(colour, "u_alpha"),
             heat_scale: r.required_when(
                 f.has(ShaderFeatures::COUNT_EVALS) && f.has(ShaderFeatures::COUNT_HEATMAP),
@@ -244,12 +261,14 @@ impl Deferred {
         // Directional lights are the composite's: the G-buffer variant is the same without.
         let features = ctx.features;
         ctx.features = features.with(ShaderFeatures::DIRECTIONAL, false);
+        let scale = accumulation_scale(ctx.options.exposure_ev);
         let mut drawn = Ok(());
         for k in 0..ctx.order.opaque.len() {
             let i = ctx.order.opaque[k];
             drawn = shade_object(ctx, i, "gbuffer", 1, &mut |p: &GBufferProgram, dev| {
                 p.viewport.set(dev, viewport);
                 p.half_extent.set(dev, half);
+                p.accum_scale.set(dev, scale);
             });
             if drawn.is_err() {
                 break;
@@ -278,6 +297,7 @@ impl Deferred {
             )
             .with(ShaderFeatures::DIRECTIONAL, false);
         let (half, ortho) = half_extent(ctx);
+        let scale = accumulation_scale(ctx.options.exposure_ev);
         let viewport = [ctx.viewport.0 as f32, ctx.viewport.1 as f32];
         let far = ctx.far as f32;
         for light in ctx.lights.iter().filter(|l| l.cull_radius > 0.0) {
@@ -354,7 +374,7 @@ impl Deferred {
             }
             let [light0, light1, light2] = &p.light;
             light0.set(dev, light.position.extend(light.radius));
-            light1.set(dev, light.radiance.extend(light.spot_scale));
+            light1.set(dev, (light.radiance * scale).extend(light.spot_scale));
             light2.set(dev, light.direction.extend(light.spot_offset));
             mesh.expect("allocated").draw(dev);
         }
@@ -411,6 +431,8 @@ impl Deferred {
         p.frame_origin.set(dev, ctx.origin.map(|v| v as f32));
         p.ambient.set(dev, ctx.scene.ambient);
         p.exposure.set(dev, ctx.options.exposure_ev.exp2());
+        p.accum_to_radiance
+            .set(dev, accumulation_scale(ctx.options.exposure_ev).recip());
         p.alpha.set(dev, 1.0);
         p.heat_scale.set(dev, ctx.options.heat_scale.max(1.0));
         p.g_specular.set(dev, UNIT_G_SPECULAR);

@@ -71,3 +71,71 @@ fn deferred_is_unsupported_on_es2_with_a_reason() {
         .render_offscreen(&s, 32, 18, &RenderOptions::default())
         .is_ok());
 }
+
+/// Set in the child process that runs the test below without `GL_EXT_float_blend` on Mesa.
+const NO_FLOAT_BLEND: &str = "MANYLIGHT_TEST_NO_FLOAT_BLEND";
+
+/// A frame brighter than half floats hold, at an exposure that shows it: a 2·10⁵ light over
+/// the plane at −15 EV with Reinhard. Without `GL_EXT_float_blend` (ANGLE; Mesa in the child
+/// below) the light accumulation is half-float, where the sum passed 65 504 to Inf and the
+/// plane came out white (forward: 238/255 under the light). Now within 2/255 of forward.
+#[test]
+fn deferred_equals_forward_on_a_frame_brighter_than_half_floats_hold() {
+    let mut s = scene::builtin::build("plane", None).unwrap();
+    s.lights = vec![manylight::scene::Light::point(
+        glam::DVec3::new(0.0, 0.0, 1.0),
+        10.0,
+        glam::Vec3::ONE,
+        2e5,
+    )];
+    let opts = RenderOptions {
+        exposure_ev: -15.0,
+        tone_map: manylight::ToneMap::Reinhard,
+        ..Default::default()
+    };
+    let mut gpu = Gpu::new(EsVersion::Es3);
+    if std::env::var_os(NO_FLOAT_BLEND).is_some() {
+        assert!(!gpu.r().caps().has_extension("GL_EXT_float_blend"));
+    }
+    // Emission too, which the geometry pass writes into the same accumulation.
+    for emission in [0.0, 500.0] {
+        for m in &mut s.materials {
+            m.maps.emissive = glam::Vec3::splat(emission);
+        }
+        gpu.r().set_method_named("forward").unwrap();
+        let (reference, _) = gpu.r().render_offscreen(&s, 128, 72, &opts).unwrap();
+        assert!(common::mean(&reference) > 60.0, "the light shows");
+        gpu.r().set_method_named("deferred").unwrap();
+        let (img, _) = gpu.r().render_offscreen(&s, 128, 72, &opts).unwrap();
+        let d = manylight::metrics::diff(&reference, &img);
+        assert!(
+            d.max_abs <= 2,
+            "emission {emission}: deferred is {} / 255 from forward",
+            d.max_abs
+        );
+    }
+}
+
+/// The test above on Mesa without `GL_EXT_float_blend`, in a child process (Mesa reads its
+/// extension override once per process).
+#[test]
+fn deferred_equals_forward_on_a_bright_frame_without_float_blending() {
+    if std::env::var_os(NO_FLOAT_BLEND).is_some()
+        || common::other_implementation_than_mesa("MESA_EXTENSION_OVERRIDE")
+    {
+        return;
+    }
+    let test = "deferred_equals_forward_on_a_frame_brighter_than_half_floats_hold";
+    let out = std::process::Command::new(std::env::current_exe().unwrap())
+        .args(["--exact", test, "--test-threads=1"])
+        .env("MESA_EXTENSION_OVERRIDE", "-GL_EXT_float_blend")
+        .env(NO_FLOAT_BLEND, "1")
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success() && stdout.contains("1 passed"),
+        "without float blending: {stdout}{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
