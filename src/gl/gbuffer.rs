@@ -30,22 +30,22 @@
 use glow::HasContext;
 
 use super::target_size::{self, TargetStorage};
-use super::{Device, EsVersion, GlError};
+use super::{Caps, Device, EsVersion, GlError};
 
 /// The normal buffer's view depth where no surface was drawn (below `noSurface`'s −10²⁹).
 const NO_SURFACE_DEPTH: f32 = -1.0e30;
 
 /// Bytes of GPU memory per pixel on this context (see the module docs).
-pub fn bytes_per_pixel(caps: &super::Caps) -> usize {
-    if caps.has_extension("GL_EXT_float_blend") {
-        52
-    } else {
+pub fn bytes_per_pixel(caps: &Caps) -> usize {
+    if half_float_accumulation(caps) {
         44
+    } else {
+        52
     }
 }
 
 /// Why deferred cannot run on this context, if it cannot.
-pub fn unsupported_reason(dev_caps: &super::Caps) -> Option<String> {
+pub fn unsupported_reason(dev_caps: &Caps) -> Option<String> {
     if dev_caps.es != EsVersion::Es3 {
         return Some(if dev_caps.has_extension("GL_EXT_draw_buffers") {
             "needs OpenGL ES 3.0 (GL_EXT_draw_buffers exists, but float G-buffers and texelFetch do not on ES 2.0)".into()
@@ -88,6 +88,16 @@ fn texture(dev: &Device, w: u32, h: u32, internal: u32) -> Result<glow::Texture,
     Ok(t)
 }
 
+/// The light accumulation is RGBA16F: the context cannot blend into 32-bit floats
+/// (`GL_EXT_float_blend`).
+pub fn half_float_accumulation(caps: &Caps) -> bool {
+    !caps.has_extension("GL_EXT_float_blend")
+}
+
+/// Most lights a half-float accumulation counts exactly at a pixel (fp16 holds every integer
+/// up to 2¹¹; 2 048 + 1 rounds back to 2 048).
+pub const HALF_FLOAT_EXACT_COUNT: usize = 2_048;
+
 impl GBuffer {
     /// Allocates the buffers for a `width × height` viewport.
     pub fn new(dev: &Device, width: u32, height: u32) -> Result<GBuffer, GlError> {
@@ -103,10 +113,10 @@ impl GBuffer {
         let albedo = texture(dev, w, h, glow::RGBA16F)?;
         let normal = texture(dev, w, h, glow::RGBA32F)?;
         let specular = texture(dev, w, h, glow::RGBA16F)?;
-        let accum_format = if dev.caps().has_extension("GL_EXT_float_blend") {
-            glow::RGBA32F
-        } else {
+        let accum_format = if half_float_accumulation(dev.caps()) {
             glow::RGBA16F
+        } else {
+            glow::RGBA32F
         };
         let accum = texture(dev, w, h, accum_format)?;
         let depth = texture(dev, w, h, glow::DEPTH_COMPONENT24)?;

@@ -462,6 +462,18 @@ impl ShadingMethod for Deferred {
 
     fn render(&mut self, ctx: &mut FrameContext) -> Result<MethodStats<'_>, Error> {
         let dev = ctx.dev;
+        if ctx.features.counting()
+            && gbuffer::half_float_accumulation(dev.caps())
+            && ctx.lights.len() > gbuffer::HALF_FLOAT_EXACT_COUNT
+        {
+            // A count that stopped at 2 048 would pass for an exact one.
+            return Err(Error::Limit(format!(
+                "deferred counts its proxies in a half-float buffer here (no \
+                 GL_EXT_float_blend), exact up to {} lights at a pixel; the scene has {}",
+                gbuffer::HALF_FLOAT_EXACT_COUNT,
+                ctx.lights.len()
+            )));
+        }
         let target = dev.bound_framebuffer();
         self.ensure_resources(dev, ctx.viewport)?;
         sort_objects(ctx);

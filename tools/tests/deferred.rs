@@ -3,6 +3,7 @@
 mod common;
 
 use common::Gpu;
+use manylight::renderer::CountKind;
 use manylight::scene;
 use manylight::{EsVersion, RenderOptions};
 
@@ -78,9 +79,10 @@ const NO_FLOAT_BLEND: &str = "MANYLIGHT_TEST_NO_FLOAT_BLEND";
 /// A frame brighter than half floats hold, at an exposure that shows it: a 2·10⁵ light over
 /// the plane at −15 EV with Reinhard. Without `GL_EXT_float_blend` (ANGLE; Mesa in the child
 /// below) the light accumulation is half-float, where the sum passed 65 504 to Inf and the
-/// plane came out white (forward: 238/255 under the light). Now within 2/255 of forward.
+/// plane came out white (forward: 238/255 under the light). Now within 2/255 of forward. And
+/// its light counts, which stopped at 2 048 there, are refused past 2 048 lights.
 #[test]
-fn deferred_equals_forward_on_a_frame_brighter_than_half_floats_hold() {
+fn deferred_holds_bright_frames_and_refuses_counts_past_what_its_accumulation_holds() {
     let mut s = scene::builtin::build("plane", None).unwrap();
     s.lights = vec![manylight::scene::Light::point(
         glam::DVec3::new(0.0, 0.0, 1.0),
@@ -114,6 +116,31 @@ fn deferred_equals_forward_on_a_frame_brighter_than_half_floats_hold() {
             d.max_abs
         );
     }
+    // Counts: a half-float accumulation holds every count up to 2 048 (2 048 + 1 rounds back
+    // to 2 048); past that many lights the count is refused rather than stopped there.
+    let half = manylight::gl::gbuffer::half_float_accumulation(gpu.r().caps());
+    for n in [2_048, 2_049] {
+        let light = manylight::scene::Light::point(glam::DVec3::ZERO, 1e4, glam::Vec3::ONE, 1.0);
+        s.lights = vec![light; n];
+        let counts =
+            gpu.r()
+                .render_light_counts(&s, 32, 18, &RenderOptions::default(), CountKind::Evals);
+        match counts {
+            Err(manylight::Error::Limit(e)) if half && n > 2_048 => {
+                assert!(e.contains("2048"), "{e}")
+            }
+            Ok((counts, _)) if !half || n <= 2_048 => assert!(
+                counts
+                    .counts
+                    .iter()
+                    .zip(&counts.covered)
+                    .all(|(&c, &covered)| !covered || c as usize == n),
+                "{n} lights: counts {:?}",
+                counts.max()
+            ),
+            other => panic!("{n} lights, half-float {half}: {:?}", other.map(|_| ())),
+        }
+    }
 }
 
 /// The test above on Mesa without `GL_EXT_float_blend`, in a child process (Mesa reads its
@@ -125,7 +152,7 @@ fn deferred_equals_forward_on_a_bright_frame_without_float_blending() {
     {
         return;
     }
-    let test = "deferred_equals_forward_on_a_frame_brighter_than_half_floats_hold";
+    let test = "deferred_holds_bright_frames_and_refuses_counts_past_what_its_accumulation_holds";
     let out = std::process::Command::new(std::env::current_exe().unwrap())
         .args(["--exact", test, "--test-threads=1"])
         .env("MESA_EXTENSION_OVERRIDE", "-GL_EXT_float_blend")
