@@ -219,6 +219,35 @@ fn cameras_perspective_with_infinite_far_and_orthographic() {
             far: 40.0
         }
     );
+    // Values the renderer cannot take are named as the file writes them (radians, `ymag`).
+    for (camera, named) in [
+        (
+            json!({"type": "perspective", "perspective": {"yfov": 3.2, "znear": 0.1}}),
+            "`cameras[0].perspective.yfov` must be in",
+        ),
+        (
+            json!({"type": "perspective", "perspective": {"yfov": 0.7, "znear": 0.1, "zfar": 0.05}}),
+            "`cameras[0].perspective.zfar` must be finite and > znear",
+        ),
+        (
+            json!({"type": "orthographic",
+                "orthographic": {"xmag": 1, "ymag": 1e-9, "znear": 0, "zfar": 4}}),
+            "`cameras[0].orthographic.ymag` must be finite",
+        ),
+        (
+            json!({"type": "orthographic",
+                "orthographic": {"xmag": 1, "ymag": 1, "znear": 2, "zfar": 1}}),
+            "`cameras[0].orthographic.zfar`",
+        ),
+    ] {
+        let path = write(dir.path(), "bad.gltf", b.gltf(doc(camera)));
+        let err = load(&path).unwrap_err().to_string();
+        assert!(err.contains(named), "{named}: {err}");
+        assert!(
+            !err.contains("camera.fov_y_deg") && !err.contains("camera.far"),
+            "{err}"
+        );
+    }
     // No camera: framed on the bounds as for OBJ.
     let mut none = doc(json!({"type": "perspective", "perspective": {"yfov": 0.7, "znear": 0.05}}));
     none["nodes"] = json!([{"mesh": 0}]);

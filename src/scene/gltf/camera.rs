@@ -8,6 +8,7 @@
 use glam::{DMat4, DVec3};
 use gltf::camera::Projection as GltfProjection;
 
+use crate::scene::camera::{MIN_FOV_Y_DEG, MIN_ORTHO_HEIGHT};
 use crate::scene::{Camera, Projection};
 
 /// Converts `camera` of `document` on a node with world transform `world`; `field` names it
@@ -44,6 +45,7 @@ pub(super) fn convert(
     // Any look-at distance gives the same view; one proportionate to the position keeps the
     // direction exact in f64 far from the origin.
     let distance = (position.abs().max_element() * 1e-3).max(1.0);
+    check_projection(&camera.projection(), camera.index()).map_err(|e| format!("{field}: {e}"))?;
     let projection = match camera.projection() {
         GltfProjection::Perspective(p) => Projection::Perspective {
             fov_y_deg: f64::from(p.yfov()).to_degrees(),
@@ -64,4 +66,57 @@ pub(super) fn convert(
     };
     camera.validate().map_err(|e| format!("{field}: {e}"))?;
     Ok(camera)
+}
+
+/// The projection's values the renderer cannot take, named as the file writes them
+/// (`cameras[i].perspective.yfov` in radians, not the converted `camera.fov_y_deg`).
+fn check_projection(projection: &GltfProjection, index: usize) -> Result<(), String> {
+    let bad = |name: &str, why: String| Err(format!("`cameras[{index}].{name}` {why}"));
+    let (kind, znear, zfar) = match projection {
+        GltfProjection::Perspective(p) => {
+            let (min, yfov) = (MIN_FOV_Y_DEG.to_radians(), f64::from(p.yfov()));
+            if !(min..std::f64::consts::PI).contains(&yfov) {
+                return bad(
+                    "perspective.yfov",
+                    format!("must be in [{min:e}, π) radians, got {yfov}"),
+                );
+            }
+            let znear = f64::from(p.znear());
+            if !(znear > 0.0 && znear.is_finite()) {
+                return bad(
+                    "perspective.znear",
+                    format!("must be finite and > 0, got {znear}"),
+                );
+            }
+            ("perspective", znear, p.zfar().map(f64::from))
+        }
+        GltfProjection::Orthographic(o) => {
+            let ymag = f64::from(o.ymag()).abs();
+            if !(2.0 * ymag >= MIN_ORTHO_HEIGHT && ymag.is_finite()) {
+                return bad(
+                    "orthographic.ymag",
+                    format!(
+                        "must be finite with a magnitude of at least {:e}, got {}",
+                        MIN_ORTHO_HEIGHT / 2.0,
+                        o.ymag()
+                    ),
+                );
+            }
+            let znear = f64::from(o.znear());
+            if !(znear >= 0.0 && znear.is_finite()) {
+                return bad(
+                    "orthographic.znear",
+                    format!("must be finite and >= 0, got {znear}"),
+                );
+            }
+            ("orthographic", znear, Some(f64::from(o.zfar())))
+        }
+    };
+    match zfar {
+        Some(zfar) if !(zfar > znear && zfar.is_finite()) => bad(
+            &format!("{kind}.zfar"),
+            format!("must be finite and > znear ({znear}), got {zfar}"),
+        ),
+        _ => Ok(()),
+    }
 }
