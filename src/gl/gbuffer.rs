@@ -94,6 +94,13 @@ pub fn half_float_accumulation(caps: &Caps) -> bool {
     !caps.has_extension("GL_EXT_float_blend")
 }
 
+#[cfg(test)]
+thread_local! {
+    /// Makes the next [`GBuffer::new`] on this thread fail as out of memory (tests of what
+    /// a driver that has none does).
+    pub(crate) static REFUSE_NEXT: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+}
+
 /// Most lights a half-float accumulation counts exactly at a pixel (fp16 holds every integer
 /// up to 2¹¹; 2 048 + 1 rounds back to 2 048).
 pub const HALF_FLOAT_EXACT_COUNT: usize = 2_048;
@@ -103,6 +110,10 @@ impl GBuffer {
     pub fn new(dev: &Device, width: u32, height: u32) -> Result<GBuffer, GlError> {
         if let Some(reason) = unsupported_reason(dev.caps()) {
             return Err(GlError::Unsupported(reason));
+        }
+        #[cfg(test)]
+        if REFUSE_NEXT.with(|r| r.replace(false)) {
+            return Err(GlError::OutOfMemory("refused by a test".into()));
         }
         let (w, h) = (width, height);
         let storage = TargetStorage {

@@ -17,7 +17,7 @@ use super::forward::Forward;
 use super::{FrameContext, MethodDesc, MethodStats, ShadingMethod, Support};
 use crate::cluster::pack::MAX_INDEXED_LIGHTS;
 use crate::gl::target_size::{self, TargetStorage};
-use crate::gl::{gbuffer, Device, EsVersion};
+use crate::gl::{gbuffer, Device, EsVersion, GlError};
 use crate::Error;
 
 /// The table row.
@@ -80,6 +80,9 @@ pub struct Auto {
     clustered_support: Option<Support>,
     /// Whether the log has said that a frame had more visible lights than clustered indexes.
     warned_too_many: bool,
+    /// The smallest frame (in pixels) whose G-buffer the driver could not allocate: deferred
+    /// is not tried again at that size or larger (each try would ask for it again).
+    gbuffer_refused_at: Option<(u64, String)>,
 }
 
 impl Auto {
@@ -154,6 +157,38 @@ fn deferred_refusal(ctx: &FrameContext) -> Option<String> {
         .then(|| format!("{} MSAA samples, one G-buffer sample", ctx.options.samples))
 }
 
+/// Makes `deferred`'s G-buffer for this frame; when the driver has no memory for it, says so
+/// (forward draws the frame then, rather than every such frame failing), remembering the size
+/// in `refused_at` so frames as large do not ask again.
+fn allocate_deferred(
+    deferred: &mut Option<Deferred>,
+    refused_at: &mut Option<(u64, String)>,
+    ctx: &FrameContext,
+) -> Result<Option<String>, Error> {
+    let pixels = u64::from(ctx.viewport.0) * u64::from(ctx.viewport.1);
+    if let Some((at, why)) = refused_at {
+        if pixels >= *at {
+            return Ok(Some(why.clone()));
+        }
+    }
+    match deferred
+        .get_or_insert_with(Deferred::default)
+        .prepare(ctx.dev, ctx.viewport)
+    {
+        Ok(()) => Ok(None),
+        Err(Error::Gl(GlError::OutOfMemory(e))) => {
+            let (w, h) = ctx.viewport;
+            let why = format!("no memory for a {w}×{h} G-buffer ({e})");
+            if let Some(mut d) = deferred.take() {
+                d.destroy(ctx.dev);
+            }
+            *refused_at = Some((pixels, why.clone()));
+            Ok(Some(why))
+        }
+        Err(e) => Err(e),
+    }
+}
+
 impl ShadingMethod for Auto {
     fn name(&self) -> &'static str {
         DESC.name
@@ -193,7 +228,10 @@ impl ShadingMethod for Auto {
                      left out"
                 ),
             };
-            let refusal = (!overflowed).then(|| deferred_refusal(ctx)).flatten();
+            let mut refusal = (!overflowed).then(|| deferred_refusal(ctx)).flatten();
+            if !overflowed && refusal.is_none() {
+                refusal = allocate_deferred(&mut self.deferred, &mut self.gbuffer_refused_at, ctx)?;
+            }
             let instead = if overflowed || refusal.is_some() {
                 "forward"
             } else {

@@ -224,6 +224,11 @@ fn unit_sphere() -> Mesh {
 }
 
 impl Deferred {
+    /// Allocates what a frame of `size` needs (kept while the size stays).
+    pub(super) fn prepare(&mut self, dev: &Device, size: (u32, u32)) -> Result<(), Error> {
+        self.ensure_resources(dev, size)
+    }
+
     fn ensure_resources(&mut self, dev: &Device, size: (u32, u32)) -> Result<(), Error> {
         if self.gbuffer.as_ref().map(|g| g.size()) != Some(size) {
             if let Some(mut g) = self.gbuffer.take() {

@@ -5,6 +5,8 @@
 //! capability matrix all iterate this one table.
 
 pub mod auto;
+#[cfg(test)]
+mod auto_memory_tests;
 pub mod capacity;
 pub mod clustered;
 pub mod culled;

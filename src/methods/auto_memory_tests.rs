@@ -1,0 +1,46 @@
+//! `auto` on a driver with no memory for deferred's G-buffer (played by a test hook in
+//! `gl::gbuffer`, since a real driver's out-of-memory cannot be provoked safely).
+
+use crate::cluster::pack::MAX_INDEXED_LIGHTS;
+use crate::gl::context::context_or_skip;
+use crate::gl::gbuffer::REFUSE_NEXT;
+use crate::gl::EsVersion;
+use crate::scene::Light;
+use crate::{RenderOptions, Renderer};
+
+/// More lights in view than clustered indexes: `auto`'s turn for deferred. When its G-buffer
+/// cannot be allocated, forward draws the frame (an error before) and says why; a frame as
+/// large does not ask the driver again, a smaller one does.
+#[test]
+fn auto_draws_with_forward_when_the_gbuffer_does_not_fit_in_memory() {
+    let Some(ctx) = context_or_skip(EsVersion::Es3) else {
+        return;
+    };
+    let mut renderer = Renderer::new(ctx.load_gl().unwrap(), EsVersion::Es3).unwrap();
+    let mut s = crate::scene::builtin::build("plane", None).unwrap();
+    let side = 320;
+    s.lights = (0..MAX_INDEXED_LIGHTS + 1_000)
+        .map(|i| {
+            let (x, y) = ((i % side) as f64, (i / side) as f64);
+            let at = glam::DVec3::new(x / side as f64 * 4.0 - 2.0, y / 208.0 * 2.4 - 1.2, 0.2);
+            Light::point(at, 0.3, glam::Vec3::ONE, 1e-3)
+        })
+        .collect();
+    renderer.set_method_named("auto").unwrap();
+    let options = RenderOptions::default();
+    REFUSE_NEXT.with(|r| r.set(true));
+    let (_, stats) = renderer.render_offscreen(&s, 32, 18, &options).unwrap();
+    assert_eq!(stats.auto_choice.as_deref(), Some("forward"));
+    let reason = stats.auto_reason.unwrap_or_default();
+    assert!(
+        reason.contains("deferred cannot: no memory for a 32×18 G-buffer"),
+        "{reason}"
+    );
+    // Refused once: the next frame of that size does not try (the hook would let it).
+    let (_, stats) = renderer.render_offscreen(&s, 32, 18, &options).unwrap();
+    assert_eq!(stats.auto_choice.as_deref(), Some("forward"));
+    // A smaller one does, and gets its G-buffer.
+    let (_, stats) = renderer.render_offscreen(&s, 16, 9, &options).unwrap();
+    assert_eq!(stats.auto_choice.as_deref(), Some("deferred"));
+    assert!(stats.memory.gbuffer_bytes > 0);
+}
