@@ -224,9 +224,13 @@ fn unit_sphere() -> Mesh {
 }
 
 impl Deferred {
-    /// Allocates what a frame of `size` needs (kept while the size stays).
+    /// Allocates what a frame of `size` needs (kept while the size stays), leaving the
+    /// frame's framebuffer bound (making the G-buffer binds its own).
     pub(super) fn prepare(&mut self, dev: &Device, size: (u32, u32)) -> Result<(), Error> {
-        self.ensure_resources(dev, size)
+        let target = dev.bound_framebuffer();
+        let prepared = self.ensure_resources(dev, size);
+        dev.bind_framebuffer(target);
+        prepared
     }
 
     fn ensure_resources(&mut self, dev: &Device, size: (u32, u32)) -> Result<(), Error> {
