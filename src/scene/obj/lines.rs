@@ -383,10 +383,12 @@ fn check_vertex_data<'a>(
             )),
             Err(_) => Err("`v` w (the 4th value) is not a number".into()),
         },
-        // Which tobj reads (and manylight does not use): a word that is not a number ends
-        // tobj's read of the line and leaves the colours out of step with the positions.
+        // A colour, which tobj reads (and manylight does not use) value by value until one is
+        // not a number: none read (`v 1 2 3 # id 5`) is no colour; one or two leave the
+        // colours out of step with the positions.
+        [first, _, _] if first.parse::<f32>().is_err() => Ok(VertexLine::Plain),
         [_, _, _] if rest.iter().all(|c| c.parse::<f32>().is_ok()) => Ok(VertexLine::Coloured),
-        [_, _, _] => Err("`v` colour (the 4th to 6th values) is not three numbers".into()),
+        [_, _, _] => Err("`v` colour: its 4th value is a number, a later one is not".into()),
         _ => Err(format!(
             "`v` takes 3 numbers, then a w or an RGB colour (1 or 3 values); found {} more",
             if rest.len() > 3 { "4 or" } else { "2" }
@@ -658,8 +660,8 @@ mod tests {
                 "line 4: `f` corner 1 has 4 indices",
             ),
             (
-                "v 0 0 0 1 1 1\nv 1 0 0 1 1 1\nv 0 1 0 a b c\nf 1 2 3\n",
-                "line 3: `v` colour (the 4th to 6th values) is not three numbers",
+                "v 0 0 0 1 1 1\nv 1 0 0 1 1 1\nv 0 1 0 1 b c\nf 1 2 3\n",
+                "line 3: `v` colour: its 4th value is a number, a later one is not",
             ),
             // tobj reads an object's faces when it ends: vertex 3 comes after `o b`.
             (
@@ -691,6 +693,14 @@ mod tests {
         ] {
             assert_eq!(check_obj(text), Ok(Default::default()), "{text:?}");
         }
+        // A tail whose first word is not a number is no colour to tobj: alone, nothing to
+        // rewrite; beside colours, a mix whose colours are taken off.
+        assert_eq!(
+            check_obj("v 1 2 3 # id 5\nv 0 0 0\n"),
+            Ok(Default::default())
+        );
+        let mixed = check_obj("v 0 0 0 1 1 1\nv 1 0 0 1 1 1\nv 0 1 0 a b c\nf 1 2 3\n");
+        assert_eq!(mixed.unwrap().mixed_colours, Some((1, 3)));
         // A polyline, which never reaches tobj, across an object's end.
         assert!(check_obj("v 0 0 0\nv 1 0 0\nl 1 2 3\no b\nv 0 1 0\n").is_ok());
     }
