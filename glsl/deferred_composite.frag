@@ -24,7 +24,8 @@ void main() {
     }
     gl_FragDepth = texelFetch(u_gDepth, px, 0).r;
 #if COUNT_EVALS
-    FRAG_COLOR = encodeCount(texelFetch(u_accum, px, 0).r);
+    // The count's channels added (each exact in half floats up to 2 048: deferred.rs).
+    FRAG_COLOR = encodeCount(dot(texelFetch(u_accum, px, 0), vec4(1.0)));
 #else
     HIGHP vec4 albedoOffset = texelFetch(u_gAlbedo, px, 0);
     MEDP vec3 albedo = albedoOffset.rgb;

@@ -13,6 +13,8 @@ uniform HIGHP vec4 u_light0;
 uniform vec4 u_light1;
 // xyz: spot axis, w: spot offset.
 uniform vec4 u_light2;
+// Counts: the one channel this light adds 1 to (deferred.rs COUNT_CHANNELS).
+uniform vec4 u_countChannel;
 
 void main() {
     ivec2 px = ivec2(gl_FragCoord.xy);
@@ -21,8 +23,8 @@ void main() {
         discard;
     }
 #if COUNT_EVALS
-    // One evaluation of this light here, summed by the additive blend.
-    FRAG_COLOR = vec4(1.0);
+    // One evaluation of this light here, summed by the additive blend in its channel.
+    FRAG_COLOR = u_countChannel;
 #else
     HIGHP vec4 albedoOffset = texelFetch(u_gAlbedo, px, 0);
     HIGHP vec3 P = viewPosition(gl_FragCoord.xy + vec2(nd.w, albedoOffset.a), nd.z);

@@ -63,10 +63,19 @@ fn supported(caps: &Caps) -> Support {
 /// undoes it): the exposure rounded to a power of two, so the scaling is exact, and at most 1.
 /// The accumulation is half-float without `GL_EXT_float_blend`, where a bright frame at a low
 /// exposure summed past 65 504 to Inf (a 2·10⁵ light at −15 EV: white where forward's
-/// Reinhard gives 238/255); pre-exposed it holds about the displayed range.
-fn accumulation_scale(exposure_ev: f32) -> f32 {
-    exposure_ev.round().min(0.0).exp2()
+/// Reinhard gives 238/255); pre-exposed it holds about the displayed range. HDR output, which
+/// takes no exposure, keeps radiance as it is (scaled, small values would fall into fp16's
+/// subnormals).
+fn accumulation_scale(ctx: &FrameContext) -> f32 {
+    if ctx.features.has(ShaderFeatures::OUTPUT_HDR) {
+        return 1.0;
+    }
+    ctx.options.exposure_ev.round().min(0.0).exp2()
 }
+
+/// Channels a count frame spreads its proxies over, light after light, each adding 1 to one:
+/// in half floats each channel counts exactly up to 2 048, the four together up to 8 192.
+const COUNT_CHANNELS: usize = 4;
 
 /// Proxy spheres are drawn this much larger than the light radius: the 16×8 tessellation's
 /// faces lie inside the true sphere by up to 1 − cos(π/16)·cos(π/16) ≈ 4 %.
@@ -133,6 +142,8 @@ pub struct LightProgram {
     orthographic: Uniform<f32>,
     /// Position and radius; radiance and spot scale; spot axis and offset.
     light: [Uniform<Vec4>; 3],
+    /// A count variant's one channel this light adds 1 to.
+    count_channel: Uniform<Vec4>,
 }
 
 impl UniformSet for LightProgram {
@@ -153,6 +164,7 @@ impl UniformSet for LightProgram {
                 r.required_when(colour, "u_light1"),
                 r.required_when(colour && f.has(ShaderFeatures::SPOT), "u_light2"),
             ],
+            count_channel: r.required_when(!colour, "u_countChannel"),
         }
     }
 }
@@ -270,7 +282,7 @@ impl Deferred {
         // Directional lights are the composite's: the G-buffer variant is the same without.
         let features = ctx.features;
         ctx.features = features.with(ShaderFeatures::DIRECTIONAL, false);
-        let scale = accumulation_scale(ctx.options.exposure_ev);
+        let scale = accumulation_scale(ctx);
         let mut drawn = Ok(());
         for k in 0..ctx.order.opaque.len() {
             let i = ctx.order.opaque[k];
@@ -306,10 +318,15 @@ impl Deferred {
             )
             .with(ShaderFeatures::DIRECTIONAL, false);
         let (half, ortho) = half_extent(ctx);
-        let scale = accumulation_scale(ctx.options.exposure_ev);
+        let scale = accumulation_scale(ctx);
         let viewport = [ctx.viewport.0 as f32, ctx.viewport.1 as f32];
         let far = ctx.far as f32;
-        for light in ctx.lights.iter().filter(|l| l.cull_radius > 0.0) {
+        for (k, light) in ctx
+            .lights
+            .iter()
+            .filter(|l| l.cull_radius > 0.0)
+            .enumerate()
+        {
             // The proxy bounds the light's reach: its culling radius (the radius, or less
             // under a light cut-off).
             let radius = light.cull_radius * VOLUME_SCALE;
@@ -381,6 +398,8 @@ impl Deferred {
                 projection.set(dev, ctx.projection);
                 volume.set(dev, light.position.extend(radius));
             }
+            // A count adds 1 in one channel, light by light in turn (see COUNT_CHANNELS).
+            p.count_channel.set(dev, Vec4::AXES[k % COUNT_CHANNELS]);
             let [light0, light1, light2] = &p.light;
             light0.set(dev, light.position.extend(light.radius));
             light1.set(dev, (light.radiance * scale).extend(light.spot_scale));
@@ -422,6 +441,7 @@ impl Deferred {
                 .iter()
                 .any(|m| m.is_metallic_roughness()),
         );
+        let accum_to_radiance = accumulation_scale(ctx).recip();
         let key = ProgramKey {
             shader: "deferred_composite",
             features: features.0,
@@ -440,8 +460,7 @@ impl Deferred {
         p.frame_origin.set(dev, ctx.origin.map(|v| v as f32));
         p.ambient.set(dev, ctx.scene.ambient);
         p.exposure.set(dev, ctx.options.exposure_ev.exp2());
-        p.accum_to_radiance
-            .set(dev, accumulation_scale(ctx.options.exposure_ev).recip());
+        p.accum_to_radiance.set(dev, accum_to_radiance);
         p.alpha.set(dev, 1.0);
         p.heat_scale.set(dev, ctx.options.heat_scale.max(1.0));
         p.g_specular.set(dev, UNIT_G_SPECULAR);
@@ -471,15 +490,17 @@ impl ShadingMethod for Deferred {
 
     fn render(&mut self, ctx: &mut FrameContext) -> Result<MethodStats<'_>, Error> {
         let dev = ctx.dev;
-        if ctx.features.counting()
+        let exact = COUNT_CHANNELS * gbuffer::HALF_FLOAT_EXACT_COUNT;
+        if ctx.features.has(ShaderFeatures::COUNT_EVALS)
+            && !ctx.features.has(ShaderFeatures::COUNT_HEATMAP)
             && gbuffer::half_float_accumulation(dev.caps())
-            && ctx.lights.len() > gbuffer::HALF_FLOAT_EXACT_COUNT
+            && ctx.lights.len() > exact
         {
-            // A count that stopped at 2 048 would pass for an exact one.
+            // A count that stopped short would pass for an exact one (a heatmap's colours
+            // stop long before).
             return Err(Error::Limit(format!(
                 "deferred counts its proxies in a half-float buffer here (no \
-                 GL_EXT_float_blend), exact up to {} lights at a pixel; the scene has {}",
-                gbuffer::HALF_FLOAT_EXACT_COUNT,
+                 GL_EXT_float_blend), exact up to {exact} lights at a pixel; the scene has {}",
                 ctx.lights.len()
             )));
         }

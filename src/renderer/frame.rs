@@ -403,7 +403,8 @@ impl Renderer {
                 gpu,
             });
         }
-        stats.memory.method_gpu_bytes = self.method.gpu_bytes();
+        stats.memory.method_gpu_bytes =
+            self.method.gpu_bytes() + self.reaching_pass.as_ref().map_or(0, |p| p.gpu_bytes());
         Ok(())
     }
 

@@ -97,7 +97,7 @@ impl Renderer {
     /// proxy volumes covering the pixel), or `Reaching`, the lights whose sphere (and cone)
     /// contains the pixel's surface point, the lower bound of any culling (always evaluated
     /// by a plain-forward pass). Counts are exact (24 bits in an RGBA8 target); where they
-    /// cannot be ([`Error::Limit`]): forward's past its loop bound, deferred's past 2 048 lights
+    /// cannot be ([`Error::Limit`]): forward's past its loop bound, deferred's past 8 192 lights
     /// without `GL_EXT_float_blend` (a half-float accumulation). `None` and
     /// `Heatmap` are colour, not counts: [`Error::InvalidOption`] naming `kind`.
     pub fn render_light_counts(

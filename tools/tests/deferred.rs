@@ -80,7 +80,8 @@ const NO_FLOAT_BLEND: &str = "MANYLIGHT_TEST_NO_FLOAT_BLEND";
 /// the plane at −15 EV with Reinhard. Without `GL_EXT_float_blend` (ANGLE; Mesa in the child
 /// below) the light accumulation is half-float, where the sum passed 65 504 to Inf and the
 /// plane came out white (forward: 238/255 under the light). Now within 2/255 of forward. And
-/// its light counts, which stopped at 2 048 there, are refused past 2 048 lights.
+/// its light counts, which stopped at 2 048 there, are exact up to 8 192 lights and refused
+/// past that.
 #[test]
 fn deferred_holds_bright_frames_and_refuses_counts_past_what_its_accumulation_holds() {
     let mut s = scene::builtin::build("plane", None).unwrap();
@@ -116,20 +117,45 @@ fn deferred_holds_bright_frames_and_refuses_counts_past_what_its_accumulation_ho
             d.max_abs
         );
     }
-    // Counts: a half-float accumulation holds every count up to 2 048 (2 048 + 1 rounds back
-    // to 2 048); past that many lights the count is refused rather than stopped there.
+    // HDR output takes no exposure: radiance is accumulated as it is, so a dim one is not
+    // pushed into fp16's subnormals (at −15 EV, 0.01 would have kept about 3 bits).
+    let mut dim = s.clone();
+    dim.lights[0].intensity = 0.05;
+    for m in &mut dim.materials {
+        m.maps.emissive = glam::Vec3::ZERO;
+    }
+    let mut hdr = |method: &str| {
+        gpu.r().set_method_named(method).unwrap();
+        gpu.r().render_offscreen_hdr(&dim, 64, 36, &opts).unwrap().0
+    };
+    let (forward, deferred) = (hdr("forward"), hdr("deferred"));
+    let lit: Vec<(f32, f32)> = forward
+        .iter()
+        .zip(&deferred)
+        .map(|(f, d)| (f[0], d[0]))
+        .filter(|&(f, _)| f > 1e-3)
+        .collect();
+    assert!(lit.len() > 100, "the dim light shows");
+    let worst = lit
+        .iter()
+        .map(|&(f, d)| ((d - f) / f).abs())
+        .fold(0.0f32, f32::max);
+    assert!(worst < 2e-3, "HDR radiance off by {worst} (relative)");
+    // Counts: each channel of a half-float accumulation holds every count up to 2 048 (2 048 + 1
+    // rounds back to 2 048), and a frame spreads its lights over the four; past 8 192 lights
+    // the count is refused rather than stopped short.
     let half = manylight::gl::gbuffer::half_float_accumulation(gpu.r().caps());
-    for n in [2_048, 2_049] {
+    for n in [8_192, 8_193] {
         let light = manylight::scene::Light::point(glam::DVec3::ZERO, 1e4, glam::Vec3::ONE, 1.0);
         s.lights = vec![light; n];
         let counts =
             gpu.r()
                 .render_light_counts(&s, 32, 18, &RenderOptions::default(), CountKind::Evals);
         match counts {
-            Err(manylight::Error::Limit(e)) if half && n > 2_048 => {
-                assert!(e.contains("2048"), "{e}")
+            Err(manylight::Error::Limit(e)) if half && n > 8_192 => {
+                assert!(e.contains("8192"), "{e}")
             }
-            Ok((counts, _)) if !half || n <= 2_048 => assert!(
+            Ok((counts, _)) if !half || n <= 8_192 => assert!(
                 counts
                     .counts
                     .iter()
