@@ -17,15 +17,16 @@ fn auto_draws_with_forward_when_the_gbuffer_does_not_fit_in_memory() {
         return;
     };
     let mut renderer = Renderer::new(ctx.load_gl().unwrap(), EsVersion::Es3).unwrap();
+    // 260 rows of 256 small dim lights just above the plane, all in view.
     let mut s = crate::scene::builtin::build("plane", None).unwrap();
-    let side = 320;
-    s.lights = (0..MAX_INDEXED_LIGHTS + 1_000)
-        .map(|i| {
-            let (x, y) = ((i % side) as f64, (i / side) as f64);
-            let at = glam::DVec3::new(x / side as f64 * 4.0 - 2.0, y / 208.0 * 2.4 - 1.2, 0.2);
-            Light::point(at, 0.3, glam::Vec3::ONE, 1e-3)
-        })
-        .collect();
+    s.lights.clear();
+    for row in 0..260 {
+        for column in 0..256 {
+            let at = glam::DVec3::new(column as f64 / 64.0 - 2.0, row as f64 / 108.0 - 1.2, 0.2);
+            s.lights.push(Light::point(at, 0.3, glam::Vec3::ONE, 1e-3));
+        }
+    }
+    assert!(s.lights.len() > MAX_INDEXED_LIGHTS);
     renderer.set_method_named("auto").unwrap();
     let options = RenderOptions::default();
     REFUSE_NEXT.with(|r| r.set(true));

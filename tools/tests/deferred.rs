@@ -178,17 +178,12 @@ fn deferred_equals_forward_on_a_bright_frame_without_float_blending() {
     {
         return;
     }
-    let test = "deferred_holds_bright_frames_and_refuses_counts_past_what_its_accumulation_holds";
-    let out = std::process::Command::new(std::env::current_exe().unwrap())
-        .args(["--exact", test, "--test-threads=1"])
-        .env("MESA_EXTENSION_OVERRIDE", "-GL_EXT_float_blend")
-        .env(NO_FLOAT_BLEND, "1")
-        .output()
-        .unwrap();
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(
-        out.status.success() && stdout.contains("1 passed"),
-        "without float blending: {stdout}{}",
-        String::from_utf8_lossy(&out.stderr)
+    common::child::rerun_with(
+        "deferred_holds_bright_frames_and_refuses_counts_past_what_its_accumulation_holds",
+        &[
+            ("MESA_EXTENSION_OVERRIDE", "-GL_EXT_float_blend"),
+            (NO_FLOAT_BLEND, "1"),
+        ],
+        "without float blending",
     );
 }

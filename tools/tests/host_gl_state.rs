@@ -433,18 +433,10 @@ fn every_call_gives_the_games_gl_state_back_on_a_pure_es2_context() {
     {
         return;
     }
-    let test = "every_call_gives_the_games_gl_state_back_and_draws_as_from_a_clean_one";
-    let out = std::process::Command::new(std::env::current_exe().unwrap())
-        .args(["--exact", test, "--test-threads=1"])
-        .env("MESA_GLES_VERSION_OVERRIDE", "2.0")
-        .env(PURE_ES2, "1")
-        .output()
-        .unwrap();
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(
-        out.status.success() && stdout.contains("1 passed"),
-        "on ES 2.0: {stdout}{}",
-        String::from_utf8_lossy(&out.stderr)
+    common::child::rerun_with(
+        "every_call_gives_the_games_gl_state_back_and_draws_as_from_a_clean_one",
+        &[("MESA_GLES_VERSION_OVERRIDE", "2.0"), (PURE_ES2, "1")],
+        "on ES 2.0",
     );
 }
 

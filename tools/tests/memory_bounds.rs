@@ -544,19 +544,7 @@ fn a_root_list_repeating_one_node_is_refused_within_bounded_memory() {
     let repeats = 4_000_000;
     doc["scenes"] = serde_json::json!([{"nodes": vec![0; repeats]}]);
     let path = common::files::write(dir.path(), "m.gltf", b.gltf(doc));
-    let out = std::process::Command::new(prlimit)
-        .arg("--as=402653184")
-        .arg(env!("CARGO_BIN_EXE_manylight"))
-        // What the address space holds besides the load, the same on any machine: one
-        // worker thread, one malloc arena.
-        .env("RAYON_NUM_THREADS", "1")
-        .env("MALLOC_ARENA_MAX", "1")
-        .args(["render", "--size", "8x8", "--scene"])
-        .arg(&path)
-        .arg("--out")
-        .arg(dir.path().join("x.png"))
-        .output()
-        .unwrap();
+    let out = render_within_384_mib(&prlimit, &path, dir.path());
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(1), "{stderr}");
     assert!(stderr.contains("nodes[0] is reached from both"), "{stderr}");
@@ -587,19 +575,26 @@ fn mtl_statements_tobj_would_keep_do_not_grow_memory() {
     obj.push_str("usemtl m0\nv -1 -1 0\nv 1 -1 0\nv 0 1 0\nf 1 2 3\n");
     let path = dir.path().join("m.obj");
     std::fs::write(&path, obj).unwrap();
-    let out = std::process::Command::new(prlimit)
+    let out = render_within_384_mib(&prlimit, &path, dir.path());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{stderr}");
+}
+
+/// `manylight render` of `scene` (8 × 8, into `dir`) under a 384 MiB address-space limit.
+fn render_within_384_mib(prlimit: &Path, scene: &Path, dir: &Path) -> std::process::Output {
+    std::process::Command::new(prlimit)
         .arg("--as=402653184")
         .arg(env!("CARGO_BIN_EXE_manylight"))
+        // What the address space holds besides the load, the same on any machine: one
+        // worker thread, one malloc arena.
         .env("RAYON_NUM_THREADS", "1")
         .env("MALLOC_ARENA_MAX", "1")
         .args(["render", "--size", "8x8", "--scene"])
-        .arg(&path)
+        .arg(scene)
         .arg("--out")
-        .arg(dir.path().join("x.png"))
+        .arg(dir.join("x.png"))
         .output()
-        .unwrap();
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(0), "{stderr}");
+        .unwrap()
 }
 
 fn which_prlimit() -> Result<std::path::PathBuf, ()> {
