@@ -212,6 +212,9 @@ enum RaySees {
 /// chosen so the cells are roughly square; every pixel when `count` covers the image.
 fn sample_pixels(width: u32, height: u32, count: usize) -> Vec<(u32, u32)> {
     let (w, h) = (width as usize, height as usize);
+    if count == 0 {
+        return Vec::new();
+    }
     if count >= w * h {
         return (0..height)
             .flat_map(|y| (0..width).map(move |x| (x, y)))

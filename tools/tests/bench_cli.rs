@@ -291,3 +291,59 @@ fn scenes_that_would_report_under_one_name_are_refused() {
         assert_eq!(measured, 0, "{scenes}: files written before the refusal");
     }
 }
+
+/// Edge values of the sweep: `--cpu-samples 0` (no CPU reference, documented as "—") panicked
+/// at its first reference; an output folder whose name is not Unicode panicked once every row
+/// was measured, before the report; a light count past what forward's loop holds here (no
+/// reference over every light) ended the whole sweep at its counts instead of being skipped;
+/// a light count past a scene's limit is a usage error before anything runs.
+#[test]
+fn edge_values_of_the_sweep_are_measured_skipped_or_refused_not_fatal() {
+    use std::os::unix::ffi::OsStrExt;
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join(std::ffi::OsStr::from_bytes(b"r\xff"));
+    let forward_max = {
+        let mut es3 = common::Gpu::new(manylight::EsVersion::Es3);
+        manylight::methods::forward::max_lights(es3.r().caps()) as usize
+    };
+    let past = (forward_max + 1).to_string();
+    let lights = format!("8,{past}");
+    let run = Command::new(env!("CARGO_BIN_EXE_manylight"))
+        .args([
+            "bench", "--scenes", "plane", "--lights", &lights, "--es", "3",
+        ])
+        .args(["--methods", "forward", "--size", "16x9", "--frames", "0"])
+        .args(["--cpu-samples", "0", "--no-knobs", "--animated-frames", "0"])
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    let log = String::from_utf8_lossy(&run.stderr);
+    assert!(run.status.success(), "{log}");
+    assert!(log.contains(&format!("{past} lights: skipped")), "{log}");
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    let rows = report["rows"].as_array().unwrap();
+    assert_eq!(rows.len(), 1, "{rows:?}");
+    assert_eq!(rows[0]["lights"], 8);
+    assert_eq!(rows[0]["cpu_samples"], 0);
+    assert!(rows[0]["cpu_max_abs_err"].is_null(), "{:?}", rows[0]);
+    // Past the scene limit: refused as a usage error naming the flag.
+    let too_many = (manylight::scene::input::MAX_LIGHTS + 1).to_string();
+    let refused = Command::new(env!("CARGO_BIN_EXE_manylight"))
+        .args([
+            "bench",
+            "--scenes",
+            "plane",
+            "--lights",
+            &format!("8,{too_many}"),
+        ])
+        .arg("--out")
+        .arg(dir.path().join("never"))
+        .output()
+        .unwrap();
+    let log = String::from_utf8_lossy(&refused.stderr);
+    assert_eq!(refused.status.code(), Some(2), "{log}");
+    assert!(log.contains("--lights") && log.contains(&too_many), "{log}");
+    assert!(!dir.path().join("never").exists());
+}

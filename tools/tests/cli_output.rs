@@ -54,6 +54,17 @@ fn an_output_that_would_overwrite_the_scene_is_a_usage_error() {
             scene
         );
     }
+    // `matrix --json` too (the matrix was renamed over the scene once its cells had run).
+    let msg = expect(
+        &["matrix", "--scene", "s.json", "--json", "s.json"],
+        dir.path(),
+        2,
+    );
+    assert!(msg.contains("--json s.json names the scene file"), "{msg}");
+    assert_eq!(
+        std::fs::read_to_string(dir.path().join("s.json")).unwrap(),
+        scene
+    );
 }
 
 #[test]

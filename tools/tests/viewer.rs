@@ -364,3 +364,26 @@ fn without_a_display_view_says_how_to_get_one() {
     );
     assert!(!msg.contains(".rs:"), "winit's source path leaked: {msg}");
 }
+
+/// A screenshot naming the scene file would replace it with a PNG: a usage error before any
+/// window opens (no display needed), the scene left as it was.
+#[test]
+fn a_screenshot_naming_the_scene_is_a_usage_error() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let scene = r#"{"objects": [{"builtin": "plane"}]}"#;
+    let path = dir.path().join("s.json");
+    std::fs::write(&path, scene).unwrap();
+    let out = Command::new(BIN)
+        .env_remove("DISPLAY")
+        .env_remove("WAYLAND_DISPLAY")
+        .args(["view", "--frames", "1", "--scene"])
+        .arg(&path)
+        .arg("--screenshot")
+        .arg(&path)
+        .output()
+        .expect("run manylight view");
+    let msg = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{msg}");
+    assert!(msg.contains("names the scene file"), "{msg}");
+    assert_eq!(std::fs::read_to_string(&path).unwrap(), scene);
+}

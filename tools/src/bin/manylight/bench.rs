@@ -40,7 +40,7 @@ pub struct BenchArgs {
     #[arg(long, value_delimiter = ',')]
     pub scenes: Vec<String>,
     /// Light counts, comma separated (default 0,8,64,256,1024,4096).
-    #[arg(long, value_delimiter = ',')]
+    #[arg(long, value_delimiter = ',', value_parser = crate::bench_assign::parse_light_count)]
     pub lights: Vec<usize>,
     /// Methods, comma separated (default: every method in the table).
     #[arg(long, value_delimiter = ',')]
@@ -387,7 +387,7 @@ pub fn run(args: &BenchArgs) -> Result<(), Box<dyn std::error::Error>> {
         .lights
         .iter()
         .copied()
-        .min_by_key(|&n| (n as i64 - 1024).abs())
+        .min_by_key(|&n| n.abs_diff(1024))
         .unwrap_or(0);
     let knob_scene = plan.scenes.first().cloned().unwrap_or_default();
     let knob_runs: usize = knob_list
@@ -420,6 +420,14 @@ pub fn run(args: &BenchArgs) -> Result<(), Box<dyn std::error::Error>> {
                     .entry(spec.clone())
                     .or_insert_with(|| SceneRaycaster::new(&scene));
                 let base = baseline(&mut renderer, &scene, caster, plan.size, args.cpu_samples)?;
+                let base = match base {
+                    Ok(base) => base,
+                    // Every configuration at this count is compared with that reference.
+                    Err(why) => {
+                        log::warn!("{es} {name} {count} lights: skipped: {why}");
+                        continue;
+                    }
+                };
                 let measure = Measure {
                     scene: &scene,
                     name: &name,
@@ -488,7 +496,11 @@ pub fn run(args: &BenchArgs) -> Result<(), Box<dyn std::error::Error>> {
     }
     progress.finish();
     let report = Report {
-        command: std::env::args().collect::<Vec<_>>().join(" "),
+        // Lossy: a path need not be Unicode (`args` would panic on it).
+        command: std::env::args_os()
+            .map(|a| a.to_string_lossy().into_owned())
+            .collect::<Vec<_>>()
+            .join(" "),
         cpus: std::thread::available_parallelism().map_or(1, |n| n.get()),
         seconds: started.elapsed().as_secs_f64(),
         rows,
@@ -511,13 +523,15 @@ fn scene_name(spec: &str) -> String {
         .map_or(spec.to_string(), |s| s.to_string_lossy().into_owned())
 }
 
+/// Forward's reference picture, its reaching counts and the CPU reference samples; `Ok(Err)`
+/// with the reason where forward cannot draw every light here (no reference to compare with).
 fn baseline(
     renderer: &mut Renderer,
     scene: &Scene,
     caster: &SceneRaycaster,
     (w, h): (u32, u32),
     cpu_samples: usize,
-) -> Result<Baseline, Box<dyn std::error::Error>> {
+) -> Result<Result<Baseline, String>, Box<dyn std::error::Error>> {
     renderer.set_method_named("forward")?;
     let reference_opts = RenderOptions {
         measure: manylight::MeasureOptions {
@@ -527,8 +541,13 @@ fn baseline(
         ..RenderOptions::default()
     };
     let (reference, _) = renderer.render_offscreen(scene, w, h, &reference_opts)?;
-    let (bound, _) =
-        renderer.render_light_counts(scene, w, h, &reference_opts, CountKind::Reaching)?;
+    let bound = renderer.render_light_counts(scene, w, h, &reference_opts, CountKind::Reaching);
+    let (bound, _) = match bound {
+        Ok(counted) => counted,
+        // More lights than forward's loop holds here: no reference over all of them.
+        Err(manylight::Error::Limit(e)) => return Ok(Err(e)),
+        Err(e) => return Err(e.into()),
+    };
     let subpixel = cpu_reference::snapping_reach(renderer.caps().subpixel_bits);
     let cpu = cpu_reference::reference_samples_with(
         caster,
@@ -539,11 +558,11 @@ fn baseline(
         Encoding::Srgb,
         subpixel,
     );
-    Ok(Baseline {
+    Ok(Ok(Baseline {
         reference,
         bound,
         cpu,
-    })
+    }))
 }
 
 /// One configuration's row, with its image and light counts (kept for the pictures).
@@ -608,7 +627,16 @@ impl Measure<'_> {
             }
             Err(e) => return Err(e.into()),
         };
-        let (evals, _) = renderer.render_light_counts(self.scene, w, h, &opts, CountKind::Evals)?;
+        let evals = renderer.render_light_counts(self.scene, w, h, &opts, CountKind::Evals);
+        let (evals, _) = match evals {
+            Ok(counted) => counted,
+            // Counts this configuration cannot give exactly: skipped, as a render past a limit.
+            Err(e @ manylight::Error::Limit(_)) => {
+                log::warn!("{} {method} {knob}: skipped: {e}", self.name);
+                return Ok(None);
+            }
+            Err(e) => return Err(e.into()),
+        };
         let d = manylight::metrics::diff(&self.base.reference, &image);
         let cpu = cpu_reference::compare(&image, &self.base.cpu);
         let bound = self.base.bound.total();

@@ -49,7 +49,7 @@ fn parse_pool_size(s: &str) -> Result<usize, String> {
 }
 
 /// Parses a light count of `--lights`: at most what a scene may hold.
-fn parse_light_count(s: &str) -> Result<usize, String> {
+pub(crate) fn parse_light_count(s: &str) -> Result<usize, String> {
     count_within(s, 0, manylight::scene::input::MAX_LIGHTS, "a light count")
 }
 

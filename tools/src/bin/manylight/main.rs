@@ -195,6 +195,12 @@ fn check_usage(cli: &Cli) {
         let sheet = a.out.as_ref().map(|p| p.join("matrix.png"));
         check_distinct_outputs(&[json, a.out.as_deref().map(|p| ("--out", p))]);
         check_distinct_outputs(&[json, sheet.as_deref().map(|p| ("--out", p))]);
+        check_not_the_input(&[json, sheet.as_deref().map(|p| ("--out", p))], &a.scene);
+    }
+    #[cfg(feature = "window")]
+    if let Some(Command::View(a)) = &cli.command {
+        let screenshot = a.screenshot.as_deref().map(|p| ("--screenshot", p));
+        check_not_the_input(&[screenshot], &a.scene);
     }
     #[cfg(feature = "window")]
     if !cli.gles_lib.is_empty() && matches!(cli.command, Some(Command::View(_))) {
