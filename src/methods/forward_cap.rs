@@ -3,33 +3,26 @@
 //! coordinates address no more rows), forward keeps the lights that matter most for this view
 //! and leaves the rest out — the same policy the cluster grid's overflow applies per cell.
 
-use crate::cluster::grid::GridProjection;
+use crate::cluster::grid::{GridProjection, ViewVolume};
 use crate::cluster::view_light::GpuLight;
 
 /// The view the cap ranks lights for: its side planes and near plane (a light beside or
 /// behind the camera is near the eye but reaches no pixel).
 #[derive(Clone, Copy, Debug)]
-pub struct CapView {
-    projection: GridProjection,
-    near: f64,
-}
+pub struct CapView(ViewVolume);
 
 impl CapView {
     /// The view of the projection matrix `projection` with its near plane at `near`.
     pub fn new(projection: &glam::Mat4, near: f64) -> CapView {
-        CapView {
-            projection: GridProjection::from_matrix(&projection.as_dmat4()),
-            near,
-        }
+        let projection = GridProjection::from_matrix(&projection.as_dmat4());
+        CapView(ViewVolume::new(projection, near, f64::INFINITY))
     }
 
     /// Whether any of the light's sphere (the radius forward shades with) lies in the view.
     fn sees(&self, light: &GpuLight) -> bool {
-        let center = light.position.as_dvec3();
-        let radius = f64::from(light.radius);
         !self
-            .projection
-            .sphere_outside_view(center, radius, self.near, f64::INFINITY)
+            .0
+            .excludes(light.position.as_dvec3(), f64::from(light.radius))
     }
 }
 

@@ -43,7 +43,7 @@ mod tests;
 pub use config::{
     Coverage, GridConfig, GridMeasure, GridMode, DEFAULT_ASSIGN_BUDGET, MAX_CASCADES,
 };
-pub use projection::{DepthMapping, GridProjection};
+pub use projection::{DepthMapping, GridProjection, ViewVolume};
 
 pub(crate) use spheres::SliceCells;
 pub(crate) use tables::CascadeConstants;

@@ -3,6 +3,41 @@
 
 use glam::{DMat4, DVec3};
 
+/// The view between two depths, for testing many spheres against it: the side planes' norms
+/// are worked out once.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ViewVolume {
+    projection: GridProjection,
+    norms: [f64; 2],
+    near: f64,
+    far: f64,
+}
+
+impl ViewVolume {
+    /// `projection`'s view from the depth `near` to `far` (which may be infinite).
+    pub fn new(projection: GridProjection, near: f64, far: f64) -> ViewVolume {
+        ViewVolume {
+            projection,
+            norms: projection.side_plane_norms(),
+            near,
+            far,
+        }
+    }
+
+    /// True when the view-space sphere (`center`, `radius`) lies wholly outside the volume
+    /// (outside a side plane, before `near` or past `far`): it reaches no pixel. Conservative
+    /// by a part in 10⁶ of the radius.
+    pub fn excludes(&self, center: DVec3, radius: f64) -> bool {
+        let radius = radius * (1.0 + 1e-6);
+        let d = -center.z;
+        d + radius < self.near
+            || d - radius > self.far
+            || self
+                .projection
+                .sphere_outside_sides(center, radius, self.norms)
+    }
+}
+
 /// How view depth maps to the grid coordinate `t`.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub enum DepthMapping {
@@ -76,14 +111,9 @@ impl GridProjection {
     }
 
     /// True when the view-space sphere (`center`, `radius`) lies wholly outside the view
-    /// between the depths `near` and `far` (outside a side plane, before `near` or past
-    /// `far`): it reaches no pixel. Conservative by a part in 10⁶ of the radius.
+    /// between the depths `near` and `far`: [`ViewVolume::excludes`] for one sphere.
     pub fn sphere_outside_view(&self, center: DVec3, radius: f64, near: f64, far: f64) -> bool {
-        let radius = radius * (1.0 + 1e-6);
-        let d = -center.z;
-        d + radius < near
-            || d - radius > far
-            || self.sphere_outside_sides(center, radius, self.side_plane_norms())
+        ViewVolume::new(*self, near, far).excludes(center, radius)
     }
 
     /// View-space half extent in x and y at view depth `d`.
