@@ -429,14 +429,16 @@ fn parse_obj(path: &Path, allow_outside: bool) -> Result<Parsed, SceneError> {
                 mtl_path.display()
             ));
         }
-        match lines::check_mtl(&text, defined.get()) {
-            Ok(materials) => defined.set(defined.get() + materials),
+        let kept = match lines::check_mtl(&text, defined.get(), &UNAPPLIED_MTL) {
+            Ok((materials, kept)) => {
+                defined.set(defined.get() + materials);
+                kept
+            }
             Err(line) => {
                 warn(format!("{}: {line}", mtl_path.display()));
                 return Err(tobj::LoadError::MaterialParseError);
             }
-        }
-        let kept = lines::mtl_statements_kept(&text, &UNAPPLIED_MTL);
+        };
         tobj::load_mtl_buf(&mut std::io::BufReader::new(kept.as_bytes()))
     };
     let parsed = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {

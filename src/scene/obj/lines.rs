@@ -181,7 +181,8 @@ fn check_obj_within(text: &str, max_corners: usize) -> Result<Rewrites, String> 
             return Err(at_line(format!("`{key}` names no vertices")));
         }
         let count = words.clone().count();
-        if is_not_a_face(Some(key), count) {
+        let reaches_tobj = !is_not_a_face(Some(key), count);
+        if !reaches_tobj {
             let (n, _) = not_faces.get_or_insert((0, number + 1));
             *n += 1;
         } else {
@@ -194,7 +195,6 @@ fn check_obj_within(text: &str, max_corners: usize) -> Result<Rewrites, String> 
                 )));
             }
         }
-        let reaches_tobj = !is_not_a_face(Some(key), count);
         for (at, word) in words.enumerate() {
             // tobj's "face parse error", without a line (it reads `1/2/3/` as `1/2/3`).
             // Up to the last one written: `1/1/1/1/` has four.
@@ -439,35 +439,53 @@ pub const MAX_OBJ_MATERIALS: usize = 65_536;
 /// with fewer than three numbers, as a truncated file has; `d`, `Ns`, `Ni` or `illum` without
 /// its number; a texture statement or `newmtl` naming nothing), or whose `newmtl` takes the
 /// materials past [`MAX_OBJ_MATERIALS`] with the `defined` before it, as a message naming the
-/// line (not showing it). Returns how many materials the library defines.
-pub(super) fn check_mtl(text: &str, defined: usize) -> Result<usize, String> {
+/// line (not showing it). Returns how many materials the library defines, and the lines to give
+/// tobj: those it reads into a material's fields and those `also` names (statements the loader
+/// looks up in tobj's map). tobj keeps any other statement as a string in a map per material
+/// (some 100 bytes a line, `#comment` included) with no bound, so they are left out.
+pub(super) fn check_mtl(
+    text: &str,
+    defined: usize,
+    also: &[&str],
+) -> Result<(usize, String), String> {
     let mut materials = 0;
+    let mut kept = String::with_capacity(text.len());
     for (number, line) in text.lines().enumerate() {
         let mut words = line.split_whitespace();
         let Some(key) = words.next() else {
             continue;
         };
-        let fault = match key {
+        // `None` for a statement tobj does not read into a field.
+        let checked = match key {
             "Ka" | "Kd" | "Ks" | "Ke" => {
                 let numbers = words.take(3).filter(|w| w.parse::<f32>().is_ok()).count();
-                (numbers < 3).then(|| format!("`{key}` needs three numbers, found {numbers}"))
+                Some((numbers < 3).then(|| format!("`{key}` needs three numbers, found {numbers}")))
             }
-            "Ns" | "Ni" | "d" => words
-                .next()
-                .is_none_or(|w| w.parse::<f32>().is_err())
-                .then(|| format!("`{key}` needs a number")),
-            "illum" => words
-                .next()
-                .is_none_or(|w| w.parse::<u8>().is_err())
-                .then(|| "`illum` needs an illumination model number (0 to 255)".to_string()),
+            "Ns" | "Ni" | "d" => Some(
+                words
+                    .next()
+                    .is_none_or(|w| w.parse::<f32>().is_err())
+                    .then(|| format!("`{key}` needs a number")),
+            ),
+            "illum" => Some(
+                words
+                    .next()
+                    .is_none_or(|w| w.parse::<u8>().is_err())
+                    .then(|| "`illum` needs an illumination model number (0 to 255)".to_string()),
+            ),
             "newmtl" | "map_Ka" | "map_Kd" | "map_Ks" | "map_Bump" | "map_bump" | "map_Ns"
-            | "map_ns" | "map_NS" | "bump" | "map_d" => words
-                .next()
-                .is_none()
-                .then(|| format!("`{key}` names nothing")),
+            | "map_ns" | "map_NS" | "bump" | "map_d" => Some(
+                words
+                    .next()
+                    .is_none()
+                    .then(|| format!("`{key}` names nothing")),
+            ),
             _ => None,
         };
-        let fault = fault.or_else(|| {
+        if checked.is_none() && !also.contains(&key) {
+            continue;
+        }
+        let fault = checked.flatten().or_else(|| {
             materials += usize::from(key == "newmtl");
             (defined + materials > MAX_OBJ_MATERIALS).then(|| {
                 format!(
@@ -479,37 +497,17 @@ pub(super) fn check_mtl(text: &str, defined: usize) -> Result<usize, String> {
         if let Some(fault) = fault {
             return Err(format!("line {}: {fault}", number + 1));
         }
+        kept.push_str(line);
+        kept.push('\n');
     }
-    Ok(materials)
-}
-
-/// The MTL statements tobj reads into a material's fields; it keeps any other as a string in a
-/// map per material (some 100 bytes a line, `#comment` included), with no bound.
-const TOBJ_MTL_STATEMENTS: [&str; 19] = [
-    "newmtl", "Ka", "Kd", "Ks", "Ke", "Ns", "Ni", "d", "illum", "map_Ka", "map_Kd", "map_Ks",
-    "map_Bump", "map_bump", "map_Ns", "map_ns", "map_NS", "bump", "map_d",
-];
-
-/// The library's lines that tobj reads into fields or that `also` names (statements the loader
-/// looks up in tobj's map); the others are left out before tobj parses, so what it keeps per
-/// material is bounded. Run after [`check_mtl`], whose messages number the file's own lines.
-pub(super) fn mtl_statements_kept(text: &str, also: &[&str]) -> String {
-    let mut kept = String::with_capacity(text.len());
-    for line in text.lines() {
-        let key = line.split_whitespace().next().unwrap_or_default();
-        if TOBJ_MTL_STATEMENTS.contains(&key) || also.contains(&key) {
-            kept.push_str(line);
-            kept.push('\n');
-        }
-    }
-    kept
+    Ok((materials, kept))
 }
 
 #[cfg(test)]
 mod tests {
     use super::{
-        check_mtl, check_obj, check_obj_within, mtl_statements_kept, rewrite, undefined_materials,
-        HashSet, Objects, MAX_OBJ_NAME_BYTES,
+        check_mtl, check_obj, check_obj_within, rewrite, undefined_materials, HashSet, Objects,
+        MAX_OBJ_NAME_BYTES,
     };
 
     #[test]
@@ -517,8 +515,11 @@ mod tests {
         let text = "# comment\n#note\nnewmtl m\nKd 1 0 0\nPr 0.5\nzz unknown\n  map_Kd a b.png\n\
                     Tf 1 1 1\nillum 2\n";
         assert_eq!(
-            mtl_statements_kept(text, &["Pr"]),
-            "newmtl m\nKd 1 0 0\nPr 0.5\n  map_Kd a b.png\nillum 2\n"
+            check_mtl(text, 0, &["Pr"]),
+            Ok((
+                1,
+                "newmtl m\nKd 1 0 0\nPr 0.5\n  map_Kd a b.png\nillum 2\n".to_string()
+            ))
         );
     }
 
@@ -629,11 +630,11 @@ mod tests {
             ("newmtl\n", "line 1: `newmtl` names nothing"),
         ];
         for (text, expected) in cases {
-            let err = check_mtl(text, 0).expect_err(text);
+            let err = check_mtl(text, 0, &[]).expect_err(text);
             assert!(err.starts_with(expected), "{text:?}: {err}");
         }
         let fine = "newmtl m\nKd 1 1 1\nd 0.5\nNs 10\nillum 2\nmap_Kd a b.png\n";
-        assert!(check_mtl(fine, 0).is_ok());
+        assert!(check_mtl(fine, 0, &[]).is_ok());
     }
 
     #[test]
