@@ -540,7 +540,7 @@ fn baseline(
         },
         ..RenderOptions::default()
     };
-    let (reference, _) = renderer.render_offscreen(scene, w, h, &reference_opts)?;
+    // The counts first: where they are refused, a reference would not be over every light.
     let bound = renderer.render_light_counts(scene, w, h, &reference_opts, CountKind::Reaching);
     let (bound, _) = match bound {
         Ok(counted) => counted,
@@ -548,6 +548,7 @@ fn baseline(
         Err(manylight::Error::Limit(e)) => return Ok(Err(e)),
         Err(e) => return Err(e.into()),
     };
+    let (reference, _) = renderer.render_offscreen(scene, w, h, &reference_opts)?;
     let subpixel = cpu_reference::snapping_reach(renderer.caps().subpixel_bits);
     let cpu = cpu_reference::reference_samples_with(
         caster,
