@@ -18,10 +18,8 @@ fn deferred_matches_forward_within_2_of_255_on_opaque_scenes() {
                     linear,
                     ..Default::default()
                 };
-                gpu.r().set_method_named("forward").unwrap();
-                let (reference, _) = gpu.r().render_offscreen(&s, 256, 144, &opts).unwrap();
-                gpu.r().set_method_named("deferred").unwrap();
-                let (img, stats) = gpu.r().render_offscreen(&s, 256, 144, &opts).unwrap();
+                let (reference, _) = gpu.render_with("forward", &s, (256, 144), &opts);
+                let (img, stats) = gpu.render_with("deferred", &s, (256, 144), &opts);
                 let d = manylight::metrics::diff(&reference, &img);
                 eprintln!(
                     "{name} {lights} linear={linear}: max {} rmse {:.3}",
@@ -44,10 +42,8 @@ fn transparent_objects_take_the_forward_fallback() {
     let s = scene::builtin::build("bubbles", Some((128, 2))).unwrap();
     let mut gpu = Gpu::new(EsVersion::Es3);
     let opts = RenderOptions::default();
-    gpu.r().set_method_named("forward").unwrap();
-    let (reference, _) = gpu.r().render_offscreen(&s, 192, 108, &opts).unwrap();
-    gpu.r().set_method_named("deferred").unwrap();
-    let (img, _) = gpu.r().render_offscreen(&s, 192, 108, &opts).unwrap();
+    let (reference, _) = gpu.render_with("forward", &s, (192, 108), &opts);
+    let (img, _) = gpu.render_with("deferred", &s, (192, 108), &opts);
     let d = manylight::metrics::diff(&reference, &img);
     assert!(
         d.max_abs <= 2,
@@ -105,11 +101,9 @@ fn deferred_holds_bright_frames_and_refuses_counts_past_what_its_accumulation_ho
         for m in &mut s.materials {
             m.maps.emissive = glam::Vec3::splat(emission);
         }
-        gpu.r().set_method_named("forward").unwrap();
-        let (reference, _) = gpu.r().render_offscreen(&s, 128, 72, &opts).unwrap();
+        let (reference, _) = gpu.render_with("forward", &s, (128, 72), &opts);
         assert!(common::mean(&reference) > 60.0, "the light shows");
-        gpu.r().set_method_named("deferred").unwrap();
-        let (img, _) = gpu.r().render_offscreen(&s, 128, 72, &opts).unwrap();
+        let (img, _) = gpu.render_with("deferred", &s, (128, 72), &opts);
         let d = manylight::metrics::diff(&reference, &img);
         assert!(
             d.max_abs <= 2,

@@ -122,6 +122,20 @@ impl Gpu {
             .expect("render")
             .0
     }
+
+    /// A frame rendered with the method `method` (which must run here), and its stats.
+    pub fn render_with(
+        &mut self,
+        method: &str,
+        scene: &Scene,
+        (w, h): (u32, u32),
+        opts: &RenderOptions,
+    ) -> (image::RgbaImage, manylight::FrameStats) {
+        self.r().set_method_named(method).unwrap();
+        self.r()
+            .render_offscreen(scene, w, h, opts)
+            .unwrap_or_else(|e| panic!("{method}: {e}"))
+    }
 }
 
 impl Drop for Gpu {
