@@ -315,7 +315,7 @@ fn locate<'d>(
                     shown::name(&name)
                 )));
             } else {
-                resolve_texture_in(base_dir, &name, listings)
+                resolve_texture_in(base_dir, &name, allow_outside, listings)
             };
             let path = match path {
                 Some(p) => Some(

@@ -33,17 +33,23 @@ pub(crate) struct Listings {
 impl Listings {
     /// The entry of `dir` named `name` in any letter case (`dir` empty: the working folder,
     /// which a model named without a folder lies in); of two that differ only in case, the
-    /// one the folder lists first.
-    fn find(&mut self, dir: &Path, name: &str) -> Option<PathBuf> {
+    /// one the folder lists first. A folder whose real location is not inside `within` (a
+    /// real folder; `None`: anywhere) is not listed: [`Found::Outside`].
+    fn find(&mut self, dir: &Path, name: &str, within: Option<&Path>) -> Found {
         if name == ".." {
-            return Some(dir.join(".."));
+            return Found::Entry(dir.join(".."));
         }
         let listed = if dir.as_os_str().is_empty() {
             Path::new(".")
         } else {
             dir
         };
-        let folder = std::fs::canonicalize(listed).ok()?;
+        let Ok(folder) = std::fs::canonicalize(listed) else {
+            return Found::Nothing;
+        };
+        if within.is_some_and(|root| !folder.starts_with(root)) {
+            return Found::Outside;
+        }
         let entries = self.by_folder.entry(folder).or_insert_with(|| {
             #[cfg(test)]
             FOLDERS_LISTED.with(|n| n.set(n.get() + 1));
@@ -55,9 +61,10 @@ impl Listings {
             }
             entries
         });
-        entries
-            .get(&name.to_lowercase())
-            .map(|file_name| listed.join(file_name))
+        match entries.get(&name.to_lowercase()) {
+            Some(file_name) => Found::Entry(listed.join(file_name)),
+            None => Found::Nothing,
+        }
     }
 
     /// How many folders were listed.
@@ -65,6 +72,15 @@ impl Listings {
     pub(super) fn listed(&self) -> usize {
         self.by_folder.len()
     }
+}
+
+/// What [`Listings::find`] found in a folder.
+enum Found {
+    Entry(PathBuf),
+    Nothing,
+    /// The folder lies outside the one the search is confined to (a link leads out): it was
+    /// not listed.
+    Outside,
 }
 
 #[cfg(test)]
@@ -133,7 +149,7 @@ impl TextureFinder {
             &written,
             allow_outside,
             listings,
-            |_, listings| resolve_in(base_dir, name, listings),
+            |_, listings| resolve_in(base_dir, name, allow_outside, listings),
         )
     }
 }
@@ -165,23 +181,46 @@ fn bare_file_in(dir: &Path, name: &str, listings: &mut Listings) -> Option<PathB
         .rsplit('/')
         .next()
         .filter(|n| !n.is_empty() && *n != "..")?;
-    listings.find(dir, file_name).filter(|p| p.is_file())
+    // `dir` is the model's folder itself: no need to confine it to itself.
+    match listings.find(dir, file_name, None) {
+        Found::Entry(p) => p.is_file().then_some(p),
+        Found::Nothing | Found::Outside => None,
+    }
 }
 
 /// Finds the file a texture name (an MTL statement's after its options, or a glTF URI,
 /// either of which may hold spaces) means (see the module docs for the order).
+/// Links may lead anywhere (the caller checks where what is found lies).
 pub fn resolve_texture(base_dir: &Path, name: &str) -> Option<PathBuf> {
-    resolve_in(base_dir, name, &mut Listings::default())
+    resolve_in(base_dir, name, true, &mut Listings::default())
 }
 
 /// [`resolve_texture`] with the folders `listings` has listed (one load's, so each folder is
-/// listed once however many names it is searched for).
-pub(crate) fn resolve_in(base_dir: &Path, name: &str, listings: &mut Listings) -> Option<PathBuf> {
+/// listed once however many names it is searched for). Unless `allow_outside`, no folder
+/// outside `base_dir` (links resolved) is listed: where a link in the name's folders leads
+/// out, the path up to that link comes back, for the caller's check of where it lies
+/// ([`access::resolve`]) to refuse by name.
+pub(crate) fn resolve_in(
+    base_dir: &Path,
+    name: &str,
+    allow_outside: bool,
+    listings: &mut Listings,
+) -> Option<PathBuf> {
     let name = name.replace('\\', "/");
     let as_written = base_dir.join(&name);
     if as_written.is_file() {
         return Some(as_written);
     }
+    let real_base = if allow_outside {
+        None
+    } else {
+        let base = if base_dir.as_os_str().is_empty() {
+            Path::new(".")
+        } else {
+            base_dir
+        };
+        Some(std::fs::canonicalize(base).ok()?)
+    };
     let parts: Vec<&str> = name
         .split('/')
         .filter(|p| !p.is_empty() && *p != ".")
@@ -192,9 +231,10 @@ pub(crate) fn resolve_in(base_dir: &Path, name: &str, listings: &mut Listings) -
         if !matched {
             break;
         }
-        match listings.find(&dir, part) {
-            Some(p) => dir = p,
-            None => matched = false,
+        match listings.find(&dir, part, real_base.as_deref()) {
+            Found::Entry(p) => dir = p,
+            Found::Nothing => matched = false,
+            Found::Outside => return Some(dir),
         }
     }
     if matched && dir.is_file() {
@@ -293,6 +333,25 @@ mod tests {
                 .unwrap(),
             None
         );
+    }
+
+    /// A name matched in other letter case through a link to a folder outside the model's
+    /// is refused by the link's name, and the folder it leads to is never listed (a link to a
+    /// huge folder, or to `/proc`, would be read whole).
+    #[cfg(unix)]
+    #[test]
+    fn folders_a_link_leads_out_to_are_not_listed() {
+        let (root, model) = model_beside_a_secret_image();
+        std::os::unix::fs::symlink(root.path(), model.join("d")).unwrap();
+        let mut finder = TextureFinder::default();
+        let refusal = finder.find(&model, "D/SECRET.png", false).unwrap_err();
+        assert!(refusal.contains("`d` is outside"), "{refusal}");
+        assert!(refusal.contains("a link leads out"), "{refusal}");
+        assert_eq!(finder.listings.listed(), 1, "only the model's folder");
+        let mut finder = TextureFinder::default();
+        let found = finder.find(&model, "D/SECRET.png", true).unwrap();
+        assert_eq!(found, Some(model.join("d").join("secret.png")));
+        assert_eq!(finder.listings.listed(), 2);
     }
 
     #[test]
