@@ -219,7 +219,8 @@ fn cameras_perspective_with_infinite_far_and_orthographic() {
             far: 40.0
         }
     );
-    // Values the renderer cannot take are named as the file writes them (radians, `ymag`).
+    // Values the renderer cannot take are named as the file writes them (radians, `ymag`),
+    // in a warning: the model is drawn, framed on its bounds.
     for (camera, named) in [
         (
             json!({"type": "perspective", "perspective": {"yfov": 3.2, "znear": 0.1}}),
@@ -241,12 +242,17 @@ fn cameras_perspective_with_infinite_far_and_orthographic() {
         ),
     ] {
         let path = write(dir.path(), "bad.gltf", b.gltf(doc(camera)));
-        let err = load(&path).unwrap_err().to_string();
-        assert!(err.contains(named), "{named}: {err}");
+        let (mut scene, report) = load(&path).unwrap();
+        let said = report.warnings.join("\n");
+        assert!(said.contains(named), "{named}: {said}");
+        assert!(said.contains("this camera is not used"), "{said}");
         assert!(
-            !err.contains("camera.fov_y_deg") && !err.contains("camera.far"),
-            "{err}"
+            !said.contains("camera.fov_y_deg") && !said.contains("camera.far"),
+            "{said}"
         );
+        let camera = scene.camera;
+        scene.frame_camera();
+        assert_eq!(camera, scene.camera, "{named}: framed");
     }
     // No camera: framed on the bounds as for OBJ.
     let mut none = doc(json!({"type": "perspective", "perspective": {"yfov": 0.7, "znear": 0.05}}));

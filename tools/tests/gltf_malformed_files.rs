@@ -346,6 +346,27 @@ fn a_scene_files_transform_that_places_a_model_out_of_range_is_blamed_on_the_sce
             "{err}"
         );
     }
+    // Only the file's camera out of range (far from its triangle): the scene loads framed on
+    // the triangle, and the warning blames the placing.
+    let mut cam = triangle(&mut t);
+    cam["cameras"] = json!([{"type": "perspective", "perspective": {"yfov": 0.8, "znear": 0.1}}]);
+    cam["nodes"] = json!([{"mesh": 0}, {"camera": 0, "translation": [0, 0, 5]}]);
+    cam["scenes"] = json!([{"nodes": [0, 1]}]);
+    write(dir.path(), "seen.gltf", t.gltf(cam));
+    let path = write(
+        dir.path(),
+        "seen.json",
+        r#"{"objects": [{"gltf": "seen.gltf", "transform": {"scale": 4e11}}]}"#,
+    );
+    let (mut scene, report) = load(&path).unwrap();
+    let said = report.warnings.join("\n");
+    assert!(
+        said.contains("placing nodes[1] (cameras[0])") && said.contains("is not used"),
+        "{said}"
+    );
+    let camera = scene.camera;
+    scene.frame_camera();
+    assert_eq!(camera, scene.camera);
     // Within range, but too large for a camera framing it to stay within range: the missing
     // `camera` is named, and giving one loads.
     let big = r#"{"builtin": "plane", "transform": {"scale": 1e11}}"#;

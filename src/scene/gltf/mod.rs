@@ -441,11 +441,24 @@ fn import(
                 lights::Converted::Skipped(why) => warnings.push(why),
             }
         }
-        camera_nodes += usize::from(node.camera().is_some());
-        if let (Some(cam), None) = (node.camera(), &out.camera) {
-            let cfield = format!("{field} (cameras[{}])", cam.index());
-            camera::convert(&document, &cam, &p.world, &cfield)?;
-            out.camera = Some(camera::convert(&document, &cam, &world, &cfield).map_err(placing)?);
+        if let Some(cam) = node.camera() {
+            camera_nodes += 1;
+            if camera_nodes == 1 {
+                // The file's view is a suggestion: one the renderer cannot take (or that the
+                // caller's transform puts out of range) gives way to the framed view.
+                let cfield = format!("{field} (cameras[{}])", cam.index());
+                let converted =
+                    camera::convert(&document, &cam, &p.world, &cfield).and_then(|_| {
+                        camera::convert(&document, &cam, &world, &cfield)
+                            .map_err(|e| format!("placing {e}"))
+                    });
+                match converted {
+                    Ok(camera) => out.camera = Some(camera),
+                    Err(e) => warnings.push(format!(
+                        "{e}; this camera is not used: the view is framed on the bounds"
+                    )),
+                }
+            }
         }
     }
     if out.objects.is_empty() && out.lights.is_empty() && out.directional_lights.is_empty() {
