@@ -296,7 +296,8 @@ fn scenes_that_would_report_under_one_name_are_refused() {
 /// at its first reference; an output folder whose name is not Unicode panicked once every row
 /// was measured, before the report; a light count past what forward's loop holds here (no
 /// reference over every light) ended the whole sweep at its counts instead of being skipped;
-/// a light count past a scene's limit is a usage error before anything runs.
+/// a light count past a scene's limit, and no timed frames (a row's time would be one cold
+/// frame's), are usage errors before anything runs.
 #[test]
 fn edge_values_of_the_sweep_are_measured_skipped_or_refused_not_fatal() {
     use std::os::unix::ffi::OsStrExt;
@@ -312,7 +313,7 @@ fn edge_values_of_the_sweep_are_measured_skipped_or_refused_not_fatal() {
         .args([
             "bench", "--scenes", "plane", "--lights", &lights, "--es", "3",
         ])
-        .args(["--methods", "forward", "--size", "16x9", "--frames", "0"])
+        .args(["--methods", "forward", "--size", "16x9", "--frames", "1"])
         .args(["--cpu-samples", "0", "--no-knobs", "--animated-frames", "0"])
         .arg("--out")
         .arg(&out)
@@ -345,5 +346,17 @@ fn edge_values_of_the_sweep_are_measured_skipped_or_refused_not_fatal() {
     let log = String::from_utf8_lossy(&refused.stderr);
     assert_eq!(refused.status.code(), Some(2), "{log}");
     assert!(log.contains("--lights") && log.contains(&too_many), "{log}");
+    assert!(!dir.path().join("never").exists());
+    let untimed = Command::new(env!("CARGO_BIN_EXE_manylight"))
+        .args([
+            "bench", "--scenes", "plane", "--lights", "8", "--frames", "0",
+        ])
+        .arg("--out")
+        .arg(dir.path().join("never"))
+        .output()
+        .unwrap();
+    let log = String::from_utf8_lossy(&untimed.stderr);
+    assert_eq!(untimed.status.code(), Some(2), "{log}");
+    assert!(log.contains("--frames"), "{log}");
     assert!(!dir.path().join("never").exists());
 }

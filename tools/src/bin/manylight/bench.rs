@@ -55,8 +55,8 @@ pub struct BenchArgs {
     /// row's figure, outvotes the few slow frames a pool wake-up or the first frames after a
     /// grid change make; 3 for a configuration whose first frame took over 100 ms, whose
     /// frames vary little against their length: forward, tiled and deferred over hundreds of
-    /// lights; 1 with `--quick`).
-    #[arg(long, value_parser = crate::render::frame_count())]
+    /// lights; 1 with `--quick`). At least 1.
+    #[arg(long, value_parser = crate::render::timed_frame_count())]
     pub frames: Option<u32>,
     /// Pixels sampled for the f64 CPU reference (default 256).
     #[arg(long, default_value_t = 256)]

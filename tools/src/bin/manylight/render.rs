@@ -183,6 +183,12 @@ pub fn frame_count() -> clap::builder::RangedI64ValueParser<u32> {
     clap::value_parser!(u32).range(0..=i64::from(manylight::MAX_TIMED_FRAMES))
 }
 
+/// Parses a count of timed frames that must time something (`bench --frames`: a row's figure
+/// is their median, and with none it would be one cold frame's time).
+pub fn timed_frame_count() -> clap::builder::RangedI64ValueParser<u32> {
+    clap::value_parser!(u32).range(1..=i64::from(manylight::MAX_TIMED_FRAMES))
+}
+
 /// Parses `--assign-budget`: a share of the frame from 0 to 1.
 pub fn parse_assign_budget(s: &str) -> Result<f64, String> {
     match s.parse::<f64>() {
