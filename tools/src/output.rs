@@ -310,11 +310,6 @@ impl JsonOut {
         }
     }
 
-    /// Whether it is standard output.
-    pub fn is_stdout(&self) -> bool {
-        matches!(self, JsonOut::Stdout)
-    }
-
     /// Writes `json` and commits the file.
     pub fn commit(self, json: &str) -> Result<(), Box<dyn std::error::Error>> {
         match self {

@@ -200,7 +200,8 @@ fn vs_forward_is_each_image_against_its_cells_forward(rows: &serde_json::Value, 
     assert!(compared >= 20, "only {compared} renders compared");
 }
 
-/// As a CI script runs it: `--json -` prints only JSON on stdout (the table goes to stderr);
+/// As a CI script runs it: `--json /dev/stdout` (as `-`) prints only JSON on stdout (the table
+/// goes to stderr);
 /// the caller's own Mesa switches do not reach the cells, whose rows are then what their
 /// labels say (a capped caller turned the ES 3 rows into failures); and without `--out` no
 /// image is written anywhere.
@@ -212,7 +213,15 @@ fn matrix_json_on_stdout_ignores_the_callers_driver_switches_and_writes_no_image
     let scene_text = r#"{"objects": [{"builtin": "plane"}]}"#;
     std::fs::write(dir.path().join(scene), scene_text).unwrap();
     let out = Command::new(env!("CARGO_BIN_EXE_manylight"))
-        .args(["matrix", "--size", "32x18", "--lights", "8", "--json", "-"])
+        .args([
+            "matrix",
+            "--size",
+            "32x18",
+            "--lights",
+            "8",
+            "--json",
+            "/dev/stdout",
+        ])
         .arg(format!("--scene={scene}"))
         .args(["--max-error", "0"])
         .env("MESA_GLES_VERSION_OVERRIDE", "2.0")

@@ -32,21 +32,52 @@ fn which(name: &str) -> Option<PathBuf> {
 }
 
 /// Waits for `child` at most [`TIMEOUT`]; kills it (our own child) when it runs over. Its
-/// output is read at the end: the viewer prints a few lines, far below a pipe's buffer.
+/// output is read meanwhile, on threads of its own: a screenshot sent to standard output
+/// is more than a pipe's buffer holds.
 fn wait_with_timeout(mut child: Child, what: &str) -> Output {
+    use std::io::Read;
+    let drain = |pipe: Option<Box<dyn Read + Send>>| {
+        std::thread::spawn(move || {
+            let mut bytes = Vec::new();
+            if let Some(mut pipe) = pipe {
+                pipe.read_to_end(&mut bytes)
+                    .expect("read the child's output");
+            }
+            bytes
+        })
+    };
+    let stdout = drain(
+        child
+            .stdout
+            .take()
+            .map(|p| Box::new(p) as Box<dyn Read + Send>),
+    );
+    let stderr = drain(
+        child
+            .stderr
+            .take()
+            .map(|p| Box::new(p) as Box<dyn Read + Send>),
+    );
     let start = Instant::now();
-    while child.try_wait().expect("try_wait").is_none() {
+    let status = loop {
+        if let Some(status) = child.try_wait().expect("try_wait") {
+            break status;
+        }
         if start.elapsed() > TIMEOUT {
             let _ = child.kill();
-            let out = child.wait_with_output().expect("wait");
+            let _ = child.wait();
             panic!(
                 "{what} ran over {TIMEOUT:?}; stderr:\n{}",
-                String::from_utf8_lossy(&out.stderr)
+                String::from_utf8_lossy(&stderr.join().expect("stderr"))
             );
         }
         std::thread::sleep(Duration::from_millis(50));
+    };
+    Output {
+        status,
+        stdout: stdout.join().expect("stdout"),
+        stderr: stderr.join().expect("stderr"),
     }
-    child.wait_with_output().expect("wait_with_output")
 }
 
 /// An `Xvfb` this test started; stopped with SIGTERM when dropped, so it removes its socket
@@ -282,10 +313,10 @@ fn view_rejects_bad_input_without_panicking() {
 
 /// The heatmap view (`--heatmap`, H in the window): every covered pixel is a colour of the
 /// viridis map the shader draws counts with, and the counts vary across the clustered view.
+/// The screenshot goes to standard output (`-`), which then holds the PNG alone: the viewer's
+/// lines go to standard error.
 #[test]
 fn view_draws_the_light_evaluation_heatmap() {
-    let dir = tempfile::tempdir().expect("tempdir");
-    let shot = dir.path().join("heat.png");
     let size = format!("{}x{}", SIZE.0, SIZE.1);
     let args = [
         "--frames",
@@ -296,17 +327,25 @@ fn view_draws_the_light_evaluation_heatmap() {
         "--size",
         &size,
         "--screenshot",
-        shot.to_str().expect("utf-8 temp path"),
+        "-",
     ];
     let Some(out) = run_view(&args, &[]) else {
         return;
     };
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
     assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+        stderr.contains("controls:") && stderr.contains("3 frames"),
+        "{stderr}"
     );
-    let image = image::open(&shot).expect("screenshot").to_rgba8();
+    // A PNG ends with its IEND chunk (its 4-byte CRC after the type).
+    let png = &out.stdout;
+    assert!(
+        png.len() > 12 && &png[png.len() - 8..png.len() - 4] == b"IEND",
+        "standard output is not the PNG alone: {:?}",
+        String::from_utf8_lossy(&png[png.len().saturating_sub(200)..])
+    );
+    let image = image::load_from_memory(png).expect("screenshot").to_rgba8();
     // The five stops of the shader's map (glsl/surface.glsl), in 8-bit steps.
     let stops: Vec<[f64; 3]> = [
         [0.267, 0.005, 0.329],

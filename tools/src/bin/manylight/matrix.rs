@@ -222,7 +222,8 @@ pub fn run(args: &MatrixArgs, gles_libs: &[PathBuf]) -> Result<(), Box<dyn std::
             .map_err(|e| format!("cannot create {}: {e}", out.display()))?;
     }
     let json_out = args.json.as_deref().map(JsonOut::create).transpose()?;
-    let json_to_stdout = json_out.as_ref().is_some_and(JsonOut::is_stdout);
+    // `-`, or a name of standard output (`/dev/stdout`): the table then goes to stderr.
+    let json_to_stdout = args.json.as_deref().is_some_and(output::names_stdout);
     let sheet_file = out
         .map(|out| OutputFile::create(&out.join("matrix.png")))
         .transpose()?;

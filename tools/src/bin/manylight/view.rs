@@ -132,10 +132,13 @@ pub fn run(args: &ViewArgs) -> Result<(), Box<dyn std::error::Error>> {
         format!("{NO_DISPLAY} ({})", e.rsplit(": ").next().unwrap_or(&e))
     })?;
     event_loop.set_control_flow(ControlFlow::Poll);
-    manylight_tools::output::print_stdout(&format!(
-        "controls: WASD move, Q/E down/up, Shift faster, drag to look, 1-{} method, +/- lights, H heatmap, M MSAA, T tone map, Space pause, Esc quit\n",
-        METHODS.len()
-    ))?;
+    say(
+        args,
+        &format!(
+            "controls: WASD move, Q/E down/up, Shift faster, drag to look, 1-{} method, +/- lights, H heatmap, M MSAA, T tone map, Space pause, Esc quit\n",
+            METHODS.len()
+        ),
+    )?;
     let mut app = App {
         args,
         light_count: lights.unwrap_or(scene.lights.len()),
@@ -452,7 +455,7 @@ impl App<'_> {
                 manylight_tools::output::save_png(path, &image).map_err(|e| e.to_string())?;
                 line += &format!(" → {}", path.display());
             }
-            manylight_tools::output::print_stdout(&format!("{line}\n"))?;
+            say(self.args, &format!("{line}\n"))?;
             self.done = true;
             event_loop.exit();
         }
@@ -481,6 +484,18 @@ impl App<'_> {
 }
 
 /// `manylight · method · ES x · N lights`.
+/// Prints `text` on standard output, or on standard error when the screenshot goes there (so
+/// that standard output is the PNG alone).
+fn say(args: &ViewArgs, text: &str) -> Result<(), String> {
+    let names_stdout = manylight_tools::output::names_stdout;
+    if args.screenshot.as_deref().is_some_and(names_stdout) {
+        eprint!("{text}");
+        Ok(())
+    } else {
+        manylight_tools::output::print_stdout(text)
+    }
+}
+
 fn summary(stats: &FrameStats, es: EsVersion) -> String {
     format!(
         "manylight · {} · {es} · {} lights",
