@@ -330,7 +330,7 @@ fn ignored_features_are_warned_once_each_by_name() {
         "morph targets (1 meshes) are not applied",
         "animations (1) are not played",
         "2 scenes: only the default one",
-        "2 nodes place cameras: the first",
+        "2 nodes place cameras: only the first",
         // Two line primitives, placed twice each: one line.
         "mode Lines is not drawn",
     ] {

@@ -281,6 +281,20 @@ fn matrix_json_on_stdout_ignores_the_callers_driver_switches_and_writes_no_image
         .filter(|name| name != scene)
         .collect();
     assert!(written.is_empty(), "files written: {written:?}");
+    // `-` too.
+    let out = Command::new(env!("CARGO_BIN_EXE_manylight"))
+        .args(["matrix", "--size", "16x9", "--lights", "4", "--json", "-"])
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    let rows: serde_json::Value = serde_json::from_slice(&out.stdout)
+        .unwrap_or_else(|e| panic!("`-`: stdout is not JSON alone ({e}): {stderr}"));
+    assert!(rows.as_array().is_some_and(|r| !r.is_empty()), "{rows}");
+    assert!(
+        stderr.contains("| implementation | configuration |"),
+        "{stderr}"
+    );
 }
 
 /// A `--gles-lib` folder that cannot serve is an error of the matrix, before any cell runs.

@@ -103,8 +103,8 @@ pub(super) fn unused_features(document: &gltf::Document, camera_nodes: usize) ->
     }
     if camera_nodes > 1 {
         out.push(format!(
-            "{camera_nodes} nodes place cameras: the first (depth first) is used, the others \
-             ignored"
+            "{camera_nodes} nodes place cameras: only the first (depth first) is read, the \
+             others are ignored"
         ));
     }
     out

@@ -455,7 +455,8 @@ fn import(
                 match converted {
                     Ok(camera) => out.camera = Some(camera),
                     Err(e) => warnings.push(format!(
-                        "{e}; this camera is not used: the view is framed on the bounds"
+                        "{e}; this camera is not used: without a scene file's camera, the view is \
+                         framed on the bounds"
                     )),
                 }
             }

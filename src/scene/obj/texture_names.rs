@@ -198,8 +198,8 @@ pub fn resolve_texture(base_dir: &Path, name: &str) -> Option<PathBuf> {
 /// [`resolve_texture`] with the folders `listings` has listed (one load's, so each folder is
 /// listed once however many names it is searched for). Unless `allow_outside`, no folder
 /// outside `base_dir` (links resolved) is listed: where a link in the name's folders leads
-/// out, the path up to that link comes back, for the caller's check of where it lies
-/// ([`access::resolve`]) to refuse by name.
+/// out, the name's bare file name in `base_dir`, or else the path up to that link, for the
+/// caller's check of where it lies ([`access::resolve`]) to refuse by name.
 pub(crate) fn resolve_in(
     base_dir: &Path,
     name: &str,
@@ -234,7 +234,8 @@ pub(crate) fn resolve_in(
         match listings.find(&dir, part, real_base.as_deref()) {
             Found::Entry(p) => dir = p,
             Found::Nothing => matched = false,
-            Found::Outside => return Some(dir),
+            // The bare file name in the folder first, as for any name not matched.
+            Found::Outside => return bare_file_in(base_dir, &name, listings).or(Some(dir)),
         }
     }
     if matched && dir.is_file() {
@@ -348,6 +349,11 @@ mod tests {
         assert!(refusal.contains("`d` is outside"), "{refusal}");
         assert!(refusal.contains("a link leads out"), "{refusal}");
         assert_eq!(finder.listings.listed(), 1, "only the model's folder");
+        // Its bare file name in the model's folder is still found (a flattened folder).
+        std::fs::write(model.join("Secret.png"), b"x").unwrap();
+        let found = TextureFinder::default().find(&model, "D/SECRET.png", false);
+        assert_eq!(found, Ok(Some(model.join("Secret.png"))));
+        std::fs::remove_file(model.join("Secret.png")).unwrap();
         let mut finder = TextureFinder::default();
         let found = finder.find(&model, "D/SECRET.png", true).unwrap();
         assert_eq!(found, Some(model.join("d").join("secret.png")));

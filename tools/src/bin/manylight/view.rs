@@ -483,19 +483,21 @@ impl App<'_> {
     }
 }
 
-/// `manylight · method · ES x · N lights`.
 /// Prints `text` on standard output, or on standard error when the screenshot goes there (so
-/// that standard output is the PNG alone).
+/// that standard output is the PNG alone; an unwritable standard error is ignored, as by the
+/// binary's `eprintln!`).
 fn say(args: &ViewArgs, text: &str) -> Result<(), String> {
     let names_stdout = manylight_tools::output::names_stdout;
     if args.screenshot.as_deref().is_some_and(names_stdout) {
-        eprint!("{text}");
+        use std::io::Write;
+        let _ = std::io::stderr().write_all(text.as_bytes());
         Ok(())
     } else {
         manylight_tools::output::print_stdout(text)
     }
 }
 
+/// `manylight · method · ES x · N lights`.
 fn summary(stats: &FrameStats, es: EsVersion) -> String {
     format!(
         "manylight · {} · {es} · {} lights",
