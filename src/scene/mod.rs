@@ -299,6 +299,22 @@ impl Scene {
             if track.motion.validate("", is_spot).is_err() {
                 track.motion.validate(&field(), is_spot)?;
             }
+            // Where its lights can go, so a light does not leave the lights' range at some
+            // frame of a sequence, named by a position the file never wrote.
+            for (k, rest) in track.rest.iter().enumerate() {
+                let farthest = track.motion.farthest_coordinate(rest.position);
+                if farthest > light::MAX_LIGHT_COORD {
+                    return Err(SceneError::invalid(
+                        field(),
+                        format!(
+                            "can carry lights[{}] to a coordinate of {farthest:e}, past the \
+                             ±{:e} a light may be at",
+                            track.first + k,
+                            light::MAX_LIGHT_COORD
+                        ),
+                    ));
+                }
+            }
         }
         // Checked without a name first and named only on failure: a scene is validated every
         // frame, and a valid one costs no allocation.

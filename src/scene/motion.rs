@@ -25,7 +25,8 @@ pub const MIN_PERIOD_S: f64 = 1e-3;
 /// Longest period accepted, in seconds (about 30 years).
 pub const MAX_PERIOD_S: f64 = 1e9;
 /// Largest displacement a motion may add (orbit radius, bob amplitude, wander radius, an
-/// orbit centre's coordinates), the scene's coordinate limit for lights.
+/// orbit centre's coordinates); where the moving light may go is checked against the
+/// lights' own limit (`MAX_LIGHT_COORD`) as well.
 pub const MAX_DISPLACEMENT: f64 = 1e9;
 
 /// Where an orbit goes round.
@@ -155,9 +156,9 @@ impl LightTrack {
 }
 
 /// Angle `2π·(t/T + φ/360)`, reduced to one turn before scaling so a large `t` keeps its
-/// precision.
+/// precision; `t` is reduced to one period first (exactly), so no finite `t` overflows `t/T`.
 fn angle(t: f64, period_s: f64, phase_deg: f64) -> f64 {
-    TAU * (t / period_s + phase_deg / 360.0).rem_euclid(1.0)
+    TAU * (t.rem_euclid(period_s) / period_s + phase_deg / 360.0).rem_euclid(1.0)
 }
 
 /// `sin(2π t/T + φ) − sin φ`: zero at `t = 0`, within [−2, 2].
@@ -223,7 +224,7 @@ impl Motion {
             // n(t) = mean of (1 − cos)/2 terms: in [0, 1], 0 at t = 0.
             let noise: f64 = partials(f.seed, 4)
                 .iter()
-                .map(|&(freq, _)| (1.0 - angle(t * f.rate_hz * freq, 1.0, 0.0).cos()) / 6.0)
+                .map(|&(freq, _)| (1.0 - angle(t, 1.0 / (f.rate_hz * freq), 0.0).cos()) / 6.0)
                 .sum();
             light.intensity = rest.intensity * (1.0 - f.amount * noise as f32).max(0.0);
         }
@@ -235,6 +236,30 @@ impl Motion {
             *direction = turn * *direction;
         }
         light
+    }
+
+    /// A bound of the largest position coordinate (in magnitude) a light at rest at `rest`
+    /// reaches at any time: an orbit about a point keeps its distance to the centre, one of a
+    /// radius, a bob (`A·swing`, the swing within ±2) and a wander add at most `2r`, `2|A|`
+    /// and `r`. (A varied motion has the same sizes: only its periods and phases differ.)
+    pub(crate) fn farthest_coordinate(&self, rest: DVec3) -> f64 {
+        let mut base = rest.abs().max_element();
+        let mut added = 0.0;
+        if let Some(o) = &self.orbit {
+            match o.about {
+                OrbitAbout::Point(centre) => {
+                    base = centre.abs().max_element() + (rest - centre).length();
+                }
+                OrbitAbout::Radius(r) => added += 2.0 * r.abs(),
+            }
+        }
+        if let Some(b) = &self.bob {
+            added += 2.0 * b.amplitude.abs().max_element();
+        }
+        if let Some(w) = &self.wander {
+            added += w.radius.abs();
+        }
+        base + added
     }
 
     /// Checks every parameter; `field` is the path used in errors (`lights[3].motion`).

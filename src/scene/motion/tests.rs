@@ -186,6 +186,41 @@ fn late_frames_stay_finite_and_periodic() {
         ..Motion::default()
     };
     assert!((orbit.apply(&point(), 2e6).position - point().position).length() < 1e-6);
+    // Short periods and a fast flicker at the largest times: `t/T` and `t·rate` overflowed,
+    // posing the light at NaN and the flicker's NaN noise at intensity 0.
+    let fast = Motion {
+        orbit: Some(Orbit {
+            period_s: 1e-3,
+            ..every_motion().orbit.unwrap()
+        }),
+        bob: Some(Bob {
+            period_s: 1e-3,
+            ..every_motion().bob.unwrap()
+        }),
+        wander: Some(Wander {
+            period_s: 1e-3,
+            ..every_motion().wander.unwrap()
+        }),
+        flicker: Some(Flicker {
+            rate_hz: 1e3,
+            ..every_motion().flicker.unwrap()
+        }),
+        sweep: Some(Sweep {
+            period_s: 1e-3,
+            ..every_motion().sweep.unwrap()
+        }),
+    };
+    for t in [1e300, f64::MAX, -f64::MAX] {
+        let l = fast.apply(&spot(), t);
+        l.validate("late").unwrap();
+        assert!(l.position.is_finite(), "{t}: {:?}", l.position);
+        // The deepest dip is 0.4 of the intensity.
+        assert!(
+            l.intensity >= 0.6 * spot().intensity - 1e-6,
+            "{t}: {}",
+            l.intensity
+        );
+    }
 }
 
 #[test]
@@ -327,4 +362,51 @@ fn a_scene_names_a_bad_motion_before_the_light_it_posed() {
     scene.set_time(0.5);
     let err = scene.validate().unwrap_err().to_string();
     assert!(err.contains("lights[0].motion.orbit.axis"), "{err}");
+}
+
+/// A light valid at rest that its motion can carry past the lights' coordinate limit is
+/// refused at once, naming the motion, not at the frame where it gets there (by a position
+/// the file never wrote).
+#[test]
+fn a_motion_that_can_carry_a_light_out_of_range_is_named_at_once() {
+    let orbit = Motion {
+        orbit: Some(Orbit {
+            about: OrbitAbout::Point(DVec3::ZERO),
+            axis: DVec3::Y,
+            period_s: 8.0,
+            phase_deg: 0.0,
+        }),
+        ..Motion::default()
+    };
+    let bob = Motion {
+        bob: Some(Bob {
+            amplitude: DVec3::new(1e9, 0.0, 0.0),
+            period_s: 4.0,
+            phase_deg: 0.0,
+        }),
+        ..Motion::default()
+    };
+    let point =
+        |x: f64, z: f64| crate::scene::Light::point(DVec3::new(x, 0.0, z), 1.0, Vec3::ONE, 1.0);
+    let mut scene = crate::scene::Scene::empty();
+    scene.lights = vec![point(6e17, 6e17), point(1e18 - 1e10, 0.0)];
+    scene.animate_light(0, orbit);
+    scene.animate_light(1, bob);
+    scene.validate().unwrap();
+    for (light, motion) in [(point(9e17, 9e17), orbit), (point(1e18 - 5e8, 0.0), bob)] {
+        let mut scene = crate::scene::Scene::empty();
+        scene.lights = vec![point(0.0, 0.0), light];
+        scene.animate_light(1, motion);
+        let err = scene.validate().unwrap_err().to_string();
+        assert!(
+            err.contains("lights[1].motion") && err.contains("carry lights[1]"),
+            "{err}"
+        );
+        // It does get there: at 45° (x = 1.27e18), or at the bob's crest.
+        let far = (0..16).any(|i| {
+            scene.set_time(f64::from(i) * 0.5);
+            scene.lights[1].position.abs().max_element() > crate::scene::light::MAX_LIGHT_COORD
+        });
+        assert!(far, "{motion:?}");
+    }
 }
