@@ -31,9 +31,9 @@ pub struct Device {
 /// Which EGL says what context is current, and the device's own context there.
 #[derive(Clone, Copy, Debug)]
 enum ContextWatch {
-    /// The EGL manylight loaded (a `HeadlessContext`'s): the context current at creation,
-    /// where there was one.
-    Loaded(Option<usize>),
+    /// The EGL manylight loaded (a `HeadlessContext`'s), which reported this context current
+    /// at creation.
+    Loaded(usize),
     /// The system's EGL, which reported this context current at creation: the application's
     /// context came from it (glutin's, Android's).
     System(usize),
@@ -46,17 +46,15 @@ impl ContextWatch {
     fn of_current() -> ContextWatch {
         let loaded = super::gles_lib::current_context();
         if let Some(Some(context)) = loaded {
-            return ContextWatch::Loaded(Some(context));
+            return ContextWatch::Loaded(context);
         }
         // The EGL manylight loaded has none current (or none was loaded): the context may be a
         // toolkit's, from the system's EGL (a process that also made a `HeadlessContext`).
         match super::ext_fns::system_current_context() {
             Some(Some(context)) => ContextWatch::System(context),
-            _ => match loaded {
-                Some(current) => ContextWatch::Loaded(current),
-                // No EGL context current while a context works: it is not the system EGL's.
-                None => ContextWatch::Unknown,
-            },
+            // No EGL context current while a context works: it is neither EGL's (GLX, WGL,
+            // OSMesa), and watching one that has none would refuse every call.
+            _ => ContextWatch::Unknown,
         }
     }
 }
@@ -158,12 +156,12 @@ impl Device {
     pub(crate) fn check_current(&self) -> Result<(), GlError> {
         let (now, own) = match self.context {
             ContextWatch::Loaded(own) => (super::gles_lib::current_context(), own),
-            ContextWatch::System(own) => (super::ext_fns::system_current_context(), Some(own)),
+            ContextWatch::System(own) => (super::ext_fns::system_current_context(), own),
             ContextWatch::Unknown => return Ok(()),
         };
-        match (now, own) {
-            (Some(None), _) => Err(GlError::NotCurrent),
-            (Some(Some(now)), Some(own)) if now != own => Err(GlError::OtherContext),
+        match now {
+            Some(None) => Err(GlError::NotCurrent),
+            Some(Some(now)) if now != own => Err(GlError::OtherContext),
             _ => Ok(()),
         }
     }

@@ -108,3 +108,22 @@ fn a_desktop_games_polygon_mode_and_srgb_switch_neither_change_the_frame_nor_sta
     );
     r.destroy();
 }
+
+/// A process that made (and dropped) a `HeadlessContext` still renders on a context EGL does
+/// not know (OSMesa here; a GLX or WGL game's alike): the renderer took EGL's "no context
+/// current" for its own context's state and refused every call as not current.
+#[test]
+fn a_context_egl_does_not_know_renders_after_a_headless_context_was_dropped() {
+    drop(HeadlessContext::new(EsVersion::Es3).unwrap());
+    let Some(ctx) = osmesa_or_skip() else {
+        return;
+    };
+    let s = scene::builtin::build(scene::builtin::DEFAULT, Some((16, 5))).unwrap();
+    let mut r = Renderer::new(ctx.load_gl(), EsVersion::Es3).unwrap();
+    let (img, _) = r
+        .render_offscreen(&s, 32, 18, &RenderOptions::default())
+        .unwrap();
+    assert!(img.pixels().any(|p| p.0[..3] != [0, 0, 0]), "a lit frame");
+    r.set_method_named("clustered").unwrap();
+    r.destroy();
+}
