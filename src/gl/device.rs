@@ -112,6 +112,16 @@ impl Device {
         es: EsVersion,
         restrictions: &Restrictions,
     ) -> Result<Device, GlError> {
+        // The probe clears errors its own queries may leave: one the application left is said
+        // first, as a call of the renderer says it.
+        let pending = drain_errors(&gl);
+        if pending != glow::NO_ERROR {
+            log::warn!(
+                "{} (0x{pending:04x}) was pending when the renderer was created: the \
+                 application's, cleared so that it is not taken for the renderer's",
+                error_name(pending)
+            );
+        }
         let mut caps = Caps::probe(&gl, es)?;
         caps.restrict(restrictions)?;
         // A core profile draws nothing without a bound vertex array object; on an ES 3.x
@@ -436,15 +446,7 @@ impl Device {
     /// per error kind is pending, so a few reads empty it (bounded all the same, for a driver
     /// that keeps reporting a lost context).
     pub(crate) fn drain_errors(&self) -> u32 {
-        let first = unsafe { self.gl.get_error() };
-        if first != glow::NO_ERROR {
-            for _ in 0..16 {
-                if unsafe { self.gl.get_error() } == glow::NO_ERROR {
-                    break;
-                }
-            }
-        }
-        first
+        drain_errors(&self.gl)
     }
 
     /// Binds `fbo` (`None`: the default framebuffer).
@@ -509,6 +511,20 @@ macro_rules! gl_check {
     };
 }
 pub(crate) use gl_check;
+
+/// Clears the context's pending GL errors (at most 17: a lost context may report errors
+/// forever) and returns the first, or `NO_ERROR`.
+fn drain_errors(gl: &glow::Context) -> u32 {
+    let first = unsafe { gl.get_error() };
+    if first != glow::NO_ERROR {
+        for _ in 0..16 {
+            if unsafe { gl.get_error() } == glow::NO_ERROR {
+                break;
+            }
+        }
+    }
+    first
+}
 
 /// Name of a `glGetError` code.
 pub fn error_name(code: u32) -> &'static str {

@@ -171,6 +171,22 @@ fn a_gl_error_the_game_left_pending_is_not_the_renderers() {
     assert!(warnings_containing("GPU timing off").is_empty());
 }
 
+/// A GL error the game left pending when it makes the renderer is cleared by the capability
+/// probe (its queries may leave errors of their own): said, as at a call, not dropped silently.
+#[test]
+fn a_gl_error_pending_when_the_renderer_is_made_is_said() {
+    common::warnings::install();
+    let ctx = HeadlessContext::new(EsVersion::Es3).unwrap();
+    let gl = ctx.load_gl().unwrap();
+    unsafe { gl.enable(0x1235) };
+    let _r = Renderer::new(ctx.load_gl().unwrap(), EsVersion::Es3).unwrap();
+    assert!(
+        !warnings_containing("GL_INVALID_ENUM (0x0500) was pending when the renderer was created")
+            .is_empty(),
+        "the cleared error is said"
+    );
+}
+
 /// `abandon` (the context is lost) and a drop with no context current leave the renderer's
 /// objects with one warning at most, where each object used to add its own "leaked".
 #[test]
