@@ -81,7 +81,9 @@ pub struct RenderOptions {
     /// framebuffer that was bound, whose depth buffer it leaves as it was (ES 3.0, and ES 2.0
     /// with `GL_EXT_multisampled_render_to_texture`; forward, tiled, clustered and auto; not
     /// deferred, not HDR output; light counts are never multisampled). A bound framebuffer
-    /// that is multisampled itself is drawn into directly.
+    /// that is multisampled itself is drawn into directly. The target is kept while frames
+    /// use it and freed at the first frame that does not (a game that draws some views with
+    /// MSAA and some without keeps a renderer for each).
     pub samples: u32,
     /// What [`Renderer::render`](crate::Renderer::render) clears of its rectangle before it
     /// draws: everything (the default), or only depth, or nothing, so the frame draws over

@@ -197,3 +197,38 @@ fn a_multisampled_game_framebuffer_samples_the_frame_itself() {
     let diff = max_rgb_diff(&reference, &pixels);
     assert!(diff <= 2, "{diff}/255 from the renderer's own MSAA");
 }
+
+/// A game that turns MSAA off gets the target's memory back at its next frame (it was held
+/// until the renderer was dropped: tens of MB at 1080p).
+#[test]
+fn turning_msaa_off_frees_the_multisampled_target() {
+    let s = scene::builtin::build(scene::builtin::DEFAULT, Some((16, 3))).unwrap();
+    let mut gpu = Gpu::new(EsVersion::Es3);
+    let (_, single) = gpu
+        .r()
+        .render_offscreen(&s, W, H, &RenderOptions::default())
+        .unwrap();
+    let before = gpu.r().live_gl_objects();
+    let (_, multi) = gpu.r().render_offscreen(&s, W, H, &msaa()).unwrap();
+    assert!(multi.memory.msaa_bytes > 0);
+    let held = gpu.r().live_gl_objects();
+    assert!(
+        held.renderbuffers > before.renderbuffers,
+        "{held:?} {before:?}"
+    );
+    let (_, after) = gpu
+        .r()
+        .render_offscreen(&s, W, H, &RenderOptions::default())
+        .unwrap();
+    assert_eq!(after.memory.msaa_bytes, single.memory.msaa_bytes);
+    // (Textures are the method's, which may grow with the frame's needs.)
+    let live = gpu.r().live_gl_objects();
+    assert_eq!(
+        (live.renderbuffers, live.framebuffers),
+        (before.renderbuffers, before.framebuffers),
+        "the target is freed"
+    );
+    // And made again when asked.
+    let (_, again) = gpu.r().render_offscreen(&s, W, H, &msaa()).unwrap();
+    assert_eq!(again.memory.msaa_bytes, multi.memory.msaa_bytes);
+}
