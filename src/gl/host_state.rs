@@ -106,6 +106,9 @@ pub(crate) struct HostState {
     toggled: [bool; TOGGLED.len()],
     off_inside: [bool; OFF_INSIDE.len()],
     rasterizer_discard: bool,
+    /// `SAMPLE_MASK` (ES 3.1, desktop 3.2): a game's sample mask would drop samples of the
+    /// renderer's MSAA target. `None` where the context has no such capability.
+    sample_mask: Option<bool>,
     /// `PRIMITIVE_RESTART_FIXED_INDEX` (ES 3.0, desktop 4.3): the renderer's 16-bit index
     /// 65 535 is a vertex of any mesh chunk of 65 536 vertices. `None` where the context has
     /// no such capability.
@@ -145,9 +148,9 @@ struct DesktopState {
 impl HostState {
     /// Saves the application's state and sets what the renderer assumes: its own vertex
     /// array (`vao`, on an ES 3.x or desktop context), no pixel buffer, no sampler objects on
-    /// its units, the capabilities of `OFF_INSIDE` off, additive blend equations,
-    /// counter-clockwise front faces, the full depth range, a clear depth of 1, pixel rows
-    /// that start where the data does and texture unit 0 active (a game's active unit past
+    /// its units, the capabilities of `OFF_INSIDE` off, additive blend equations, no sample
+    /// mask, counter-clockwise front faces, the full depth range, a clear depth of 1, pixel
+    /// rows that start where the data does and texture unit 0 active (a game's active unit past
     /// the saved ones keeps its texture), no primitive restart, no attribute divisors; on ES
     /// with `GL_EXT_sRGB_write_control` sRGB encoding on; on desktop GL, filled polygons and
     /// no sRGB encoding.
@@ -231,6 +234,8 @@ impl HostState {
                 toggled: TOGGLED.map(|c| gl.is_enabled(c)),
                 off_inside: OFF_INSIDE.map(|c| gl.is_enabled(c)),
                 rasterizer_discard: es3 && gl.is_enabled(glow::RASTERIZER_DISCARD),
+                sample_mask: (gl_version >= if desktop { (3, 2) } else { (3, 1) })
+                    .then(|| gl.is_enabled(glow::SAMPLE_MASK)),
                 fixed_index_restart: (es3 && (!desktop || gl_version >= (4, 3)))
                     .then(|| gl.is_enabled(glow::PRIMITIVE_RESTART_FIXED_INDEX)),
                 blend_func,
@@ -272,6 +277,9 @@ impl HostState {
             }
             if saved.fixed_index_restart.is_some() {
                 gl.disable(glow::PRIMITIVE_RESTART_FIXED_INDEX);
+            }
+            if saved.sample_mask.is_some() {
+                gl.disable(glow::SAMPLE_MASK);
             }
             if let Some(vao) = vao {
                 gl.bind_vertex_array(Some(vao));
@@ -356,6 +364,9 @@ impl HostState {
             }
             if let Some(on) = self.fixed_index_restart {
                 enable(glow::PRIMITIVE_RESTART_FIXED_INDEX, on);
+            }
+            if let Some(on) = self.sample_mask {
+                enable(glow::SAMPLE_MASK, on);
             }
             let [sr, dr, sa, da] = self.blend_func.map(|v| v as u32);
             gl.blend_func_separate(sr, dr, sa, da);

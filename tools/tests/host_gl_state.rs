@@ -548,3 +548,38 @@ fn the_games_primitive_restart_does_not_cut_large_meshes() {
         assert!(unsafe { gl.is_enabled(glow::PRIMITIVE_RESTART_FIXED_INDEX) });
     }
 }
+
+/// The game's sample mask (ES 3.1 state) does not drop samples of the renderer's MSAA target:
+/// with a mask that keeps none, the picture still equals a clean renderer's, and the game's
+/// mask is on again after the call.
+#[test]
+fn the_games_sample_mask_does_not_drop_the_renderers_samples() {
+    let scene = scene::builtin::build(scene::builtin::DEFAULT, Some((16, 3))).unwrap();
+    let opts = RenderOptions {
+        samples: 4,
+        ..RenderOptions::default()
+    };
+    let (w, h) = (64, 36);
+    let expected = Gpu::fresh(EsVersion::Es3).render(&scene, w, h, &opts);
+    let ctx = HeadlessContext::new(EsVersion::Es3).unwrap();
+    let gl = ctx.load_gl().unwrap();
+    let mut renderer = Renderer::new(ctx.load_gl().unwrap(), EsVersion::Es3).unwrap();
+    let version = gl.version();
+    if (version.major, version.minor) < (3, 1) {
+        return common::skip("an ES 3.0 context has no sample mask");
+    }
+    let sample_mask_i = manylight::gl::gles_lib::library()
+        .unwrap()
+        .proc_address("glSampleMaski");
+    assert!(!sample_mask_i.is_null(), "ES 3.1 has glSampleMaski");
+    // SAFETY: glSampleMaski's type in the ES 3.1 specification.
+    let sample_mask_i: extern "system" fn(u32, u32) = unsafe { std::mem::transmute(sample_mask_i) };
+    unsafe { gl.enable(glow::SAMPLE_MASK) };
+    sample_mask_i(0, 0);
+    let (img, _) = renderer.render_offscreen(&scene, w, h, &opts).unwrap();
+    let d = manylight::metrics::diff(&expected, &img);
+    assert_eq!(d.max_abs, 0, "the game's sample mask changed the frame");
+    assert!(unsafe { gl.is_enabled(glow::SAMPLE_MASK) });
+    sample_mask_i(0, !0);
+    unsafe { gl.disable(glow::SAMPLE_MASK) };
+}
