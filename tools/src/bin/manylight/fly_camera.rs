@@ -7,6 +7,7 @@
 //! kept short of straight up or down so the camera's `up` never lines up with the view.
 
 use glam::{DQuat, DVec3};
+use manylight::scene::camera::MAX_CAMERA_COORD;
 use manylight::scene::Camera;
 
 /// Radians turned per pixel of mouse drag.
@@ -134,8 +135,21 @@ impl FlyCamera {
         } else {
             0.0
         };
-        camera.position += direction * step;
-        camera.target = camera.position + forward * distance;
+        // The eye and its target stay within the coordinates the view maths holds: at the
+        // edge the camera stops (and does not turn where its target would leave them), where
+        // the next frame used to refuse the camera and end the viewer.
+        let within = |v: DVec3| v.abs().max_element() <= MAX_CAMERA_COORD;
+        let moved = camera.position + direction * step;
+        let target = moved + forward * distance;
+        if within(moved) && within(target) {
+            camera.position = moved;
+            camera.target = target;
+        } else {
+            let turned = camera.position + forward * distance;
+            if within(turned) {
+                camera.target = turned;
+            }
+        }
     }
 }
 
@@ -201,6 +215,33 @@ mod tests {
         fly.cursor_moved(500.0, 500.0);
         fly.update(0.016, &mut cam);
         assert_eq!(before, cam);
+    }
+
+    /// Flying on past the coordinates a camera may have stops at their edge: the next frame
+    /// refused the camera and ended the viewer.
+    #[test]
+    fn the_camera_stops_at_the_edge_of_its_range() {
+        let mut fly = FlyCamera::new(1e11);
+        let edge = MAX_CAMERA_COORD - 5e10;
+        let mut cam = Camera::perspective(
+            DVec3::new(edge, 0.0, 0.0),
+            DVec3::new(edge + 1.0, 0.0, 0.0),
+            60.0,
+            0.1,
+            100.0,
+        );
+        fly.set_key(Move::Forward, true);
+        for _ in 0..10 {
+            fly.update(1.0, &mut cam);
+            cam.validate().unwrap();
+        }
+        assert_eq!(cam.position.x, edge, "it stopped");
+        // Back in it moves again.
+        fly.set_key(Move::Forward, false);
+        fly.set_key(Move::Back, true);
+        fly.update(1.0, &mut cam);
+        assert!(cam.position.x < edge);
+        cam.validate().unwrap();
     }
 
     #[test]
