@@ -73,11 +73,11 @@ Light fetchLight(int i) {
     // arithmetic only (GLSL ES leaves sin's precision to the implementation).
     float sinOuter = unpack16(t5.xy);
     float sinInner = unpack16(t5.zw);
-    float oneMinusCosOuter = 2.0 * sinOuter * sinOuter;
-    float scale = 1.0 / max(oneMinusCosOuter - 2.0 * sinInner * sinInner, SPOT_MIN_COS_DELTA);
+    float oneMinusCosInner = 2.0 * sinInner * sinInner;
+    float scale = 1.0 / max(2.0 * sinOuter * sinOuter - oneMinusCosInner, SPOT_MIN_COS_DELTA);
     bool omni = t4.z > 0.5;
     light.spotScale = omni ? 0.0 : scale;
-    light.spotOffset = omni ? 1.0 : oneMinusCosOuter * scale;
+    light.spotOffset = omni ? 1.0 : 1.0 + oneMinusCosInner * scale;
 #endif
 #else
     light.position = t0.xyz;

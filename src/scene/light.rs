@@ -190,7 +190,9 @@ impl Light {
 pub const MAX_LIGHT_COORD: f64 = 1e18;
 
 /// Smallest `cos(inner) − cos(outer)` used for the spot smoothstep, so a hard-edged cone
-/// (`inner == outer`) has a finite slope.
+/// (`inner == outer`) has a finite slope. A cone whose edge is sharper than this fades out
+/// over this width just outside its inner angle, so it keeps full intensity up to the inner
+/// angle however narrow it is (a 0.5° cone faded from its axis when the width lay inside it).
 pub const SPOT_MIN_COS_DELTA: f64 = 1e-4;
 
 /// `(scale, offset)` of a cone of half-angles `outer_deg` ≥ `inner_deg` (see
@@ -208,10 +210,14 @@ pub fn half_sine(deg: f64) -> f64 {
 
 /// [`spot_terms`] from the cone's [`half_sine`]s: `1 − cos α = 2 sin²(α/2)`, precise for small
 /// angles. The RGBA8 light shader and decoder compute exactly this.
+///
+/// `t = offset − scale·(1 − cos θ)` is 1 at the inner angle and 0 one width (`1/scale`)
+/// further out: at the outer angle, or [`SPOT_MIN_COS_DELTA`] past the inner one when the edge
+/// is sharper than that (whose `1 − cos` the cluster assignment reads as `offset / scale`).
 pub fn spot_terms_from_half_sines(outer: f64, inner: f64) -> (f64, f64) {
     let (outer, inner) = (2.0 * outer * outer, 2.0 * inner * inner);
     let scale = 1.0 / (outer - inner).max(SPOT_MIN_COS_DELTA);
-    (scale, scale * outer)
+    (scale, 1.0 + scale * inner)
 }
 
 /// A light's `color` and `intensity` (point, spot or directional): finite, non-negative, and
@@ -341,5 +347,37 @@ mod tests {
         assert!(s.is_finite() && o.is_finite());
         let (s, o) = base().spot_scale_offset();
         assert_eq!((s, o), (0.0, 1.0));
+    }
+
+    /// The spot term `t = offset − scale·(1 − cos θ)` is full (≥ 1) up to the inner angle and
+    /// gone (≤ 0) one width past it, at the outer angle where the edge is wider than
+    /// `SPOT_MIN_COS_DELTA`: cones narrower than that width (under 0.81°) kept their axis at
+    /// (1 − cos(outer)) / 10⁻⁴ of the intensity (32 % at 0.5°, 0 at 0°).
+    #[test]
+    fn every_cone_is_full_up_to_its_inner_angle_and_dark_past_its_edge() {
+        let one_minus_cos = |deg: f64| 1.0 - deg.to_radians().cos();
+        for outer in [0.0, 0.2, 0.5, 0.8, 1.0, 10.0, 35.0, 89.0, 170.0] {
+            for inner in [0.0, 0.5 * outer, outer] {
+                let (scale, offset) = spot_terms(outer, inner);
+                let t = |deg: f64| offset - scale * one_minus_cos(deg);
+                assert!(t(0.0) >= 1.0 - 1e-9, "{outer}/{inner}: axis {}", t(0.0));
+                assert!(
+                    t(inner) >= 1.0 - 1e-6,
+                    "{outer}/{inner}: inner {}",
+                    t(inner)
+                );
+                let width = (one_minus_cos(outer) - one_minus_cos(inner)).max(SPOT_MIN_COS_DELTA);
+                let edge = (1.0 - one_minus_cos(inner) - width).acos().to_degrees();
+                assert!(
+                    t(edge + 1e-3) <= 0.0,
+                    "{outer}/{inner}: past the edge {}",
+                    t(edge)
+                );
+                assert!(
+                    edge >= outer - 1e-9,
+                    "{outer}/{inner}: the edge {edge} inside the cone"
+                );
+            }
+        }
     }
 }

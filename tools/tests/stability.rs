@@ -719,3 +719,82 @@ fn mediump_precision_canary() {
         }
     }
 }
+
+/// Set in the child that reruns the narrow-cone test with RGBA8 light records.
+const RGBA8_LIGHTS: &str = "MANYLIGHT_TEST_RGBA8_LIGHTS";
+
+/// A cone narrower than the spot term's smallest width (10⁻⁴ of `1 − cos`, 0.81°) is at full
+/// intensity on its axis, as a point light there: a 0.5° cone drew 32 % of it, and a 0.2° cone
+/// 1 %. Compared where the spot's disc is brightest, on the float light records and (in a child
+/// process without float textures) on the RGBA8 ones, whose shader rebuilds the cone itself.
+#[test]
+fn a_narrow_cone_is_as_bright_as_a_point_light_on_its_axis() {
+    for outer in [0.5, 0.2] {
+        let rgba8 = std::env::var_os(RGBA8_LIGHTS).is_some();
+        let lit = |light: Light| {
+            let mut s = plane();
+            s.lights = vec![light];
+            // ES 2.0 without `GL_OES_texture_float` keeps lights in RGBA8 records.
+            let mut gpu = Gpu::new(if rgba8 {
+                EsVersion::Es2
+            } else {
+                EsVersion::Es3
+            });
+            gpu.r().set_method_named("forward").unwrap();
+            let (img, stats) = gpu
+                .r()
+                .render_offscreen(&s, 256, 144, &RenderOptions::default())
+                .unwrap();
+            assert_eq!(
+                stats.lights.encoding == manylight::LightEncoding::Rgba8,
+                rgba8
+            );
+            img
+        };
+        let at = DVec3::new(0.3, -0.2, 20.0);
+        let spot = lit(Light::spot(
+            at,
+            25.0,
+            Vec3::ONE,
+            150.0,
+            manylight::Cone {
+                direction: DVec3::new(0.0, 0.0, -1.0),
+                inner_deg: outer,
+                outer_deg: outer,
+            },
+        ));
+        let point = lit(Light::point(at, 25.0, Vec3::ONE, 150.0));
+        let luma = |p: &image::Rgba<u8>| u32::from(p[0]) + u32::from(p[1]) + u32::from(p[2]);
+        let (x, y, brightest) = spot
+            .enumerate_pixels()
+            .max_by_key(|(_, _, p)| luma(p))
+            .unwrap();
+        let expected = point.get_pixel(x, y);
+        let d = (0..3)
+            .map(|c| brightest[c].abs_diff(expected[c]))
+            .max()
+            .unwrap();
+        assert!(
+            d <= 2 && expected[0] < 250,
+            "{outer}°: axis {brightest:?}, a point light there {expected:?}"
+        );
+    }
+}
+
+/// The test above with RGBA8 light records (no `GL_OES_texture_float`), in a child process.
+#[test]
+fn a_narrow_cone_is_as_bright_as_a_point_light_on_its_axis_in_rgba8_records() {
+    if std::env::var_os(RGBA8_LIGHTS).is_some()
+        || common::other_implementation_than_mesa("MESA_EXTENSION_OVERRIDE")
+    {
+        return;
+    }
+    common::child::rerun_with(
+        "a_narrow_cone_is_as_bright_as_a_point_light_on_its_axis",
+        &[
+            ("MESA_EXTENSION_OVERRIDE", "-GL_OES_texture_float"),
+            (RGBA8_LIGHTS, "1"),
+        ],
+        "RGBA8 light records",
+    );
+}

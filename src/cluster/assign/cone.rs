@@ -32,8 +32,9 @@ impl Cone {
     /// component): those are bounded by the light's whole sphere.
     #[inline(always)]
     pub fn of(light: &GpuLight, range: f64) -> Option<Cone> {
-        // 1 − cos(outer) = offset / scale (see `Light::spot_scale_offset`): no trigonometry
-        // per light. Cones of 89° and wider are not worth testing.
+        // 1 − cos(outer) = offset / scale (see `spot_terms_from_half_sines`; the edge where the
+        // light ends, past the outer angle for a cone sharper than its smallest width): no
+        // trigonometry per light. Cones of 89° and wider are not worth testing.
         if light.spot_scale == 0.0 {
             return None;
         }
