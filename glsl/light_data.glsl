@@ -56,9 +56,14 @@ Light fetchLight(int i) {
     light.radius = unpack16(t1.zw) * u_lightRanges.y;
     vec4 rgbe = floor(t2 * 255.0 + 0.5);
 #if FP16_LIGHTS
-    // The fp16-range form (see light_struct.glsl): the exponent split as 2e + rest, e ≥ 0.
-    HIGHP float e = max(0.0, ceil((rgbe.a - 128.0) * 0.5));
-    light.radiance = rgbe.rgb / 255.0 * exp2(rgbe.a - 128.0 - 2.0 * e);
+    // The fp16-range form (see light_struct.glsl): the exponent split as 2e + rest, e ≥ 0,
+    // at most 15 (2^16 is past fp16). Past 2^30 (a rest above 0) the brightest channel is
+    // taken as 2^30, the others scaled alike, as fp16_radiance takes them.
+    HIGHP float e = clamp(ceil((rgbe.a - 128.0) * 0.5), 0.0, 15.0);
+    HIGHP float rest = rgbe.a - 128.0 - 2.0 * e;
+    light.radiance = rest > 0.0
+        ? rgbe.rgb / max(max(rgbe.r, rgbe.g), max(rgbe.b, 1.0))
+        : rgbe.rgb / 255.0 * exp2(rest);
     light.radianceRoot = exp2(e);
 #else
     light.radiance = rgbe.rgb / 255.0 * exp2(rgbe.a - 128.0);

@@ -11,9 +11,6 @@ use crate::gl::Device;
 use crate::scene::directional::shown_directional_lights;
 use crate::scene::{Scene, MAX_DIRECTIONAL_LIGHTS};
 
-/// Without fragment highp, radiance above this is uploaded as this (its `k` then fits fp16).
-const FP16_MAX_RADIANCE: f32 = (1u32 << 30) as f32;
-
 /// The frame's directional lights as the shader reads them.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct DirectionalFrame {
@@ -45,7 +42,7 @@ impl DirectionalFrame {
                 .as_vec3();
             let radiance = light.radiance();
             let (radiance, k) = if fp16 {
-                fp16_radiance(radiance.min(Vec3::splat(FP16_MAX_RADIANCE)))
+                fp16_radiance(radiance)
             } else {
                 (radiance, 1.0)
             };

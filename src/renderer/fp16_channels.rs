@@ -8,7 +8,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 use glam::Vec3;
 
-use crate::cluster::pack::fp16_radiance;
+use crate::cluster::pack::{fp16_radiance, FP16_MAX_RADIANCE};
 use crate::gl::Caps;
 use crate::scene::Scene;
 
@@ -32,6 +32,35 @@ fn lost_channels(radiance: Vec3) -> [bool; 3] {
     [0, 1, 2].map(|c| radiance[c] >= VISIBLE && scaled[c] < FP16_MIN_NORMAL)
 }
 
+/// Every active light's name and radiance, point, spot or directional.
+fn radiances(scene: &Scene) -> impl Iterator<Item = ((&'static str, usize), Vec3)> + '_ {
+    let points = (scene.lights.iter().enumerate())
+        .filter(|(_, l)| l.is_active())
+        .map(|(i, l)| (("lights", i), l.color * l.intensity));
+    let suns = (scene.directional_lights.iter().enumerate())
+        .filter(|(_, l)| l.is_active())
+        .map(|(i, l)| (("directional_lights", i), l.radiance()));
+    points.chain(suns)
+}
+
+/// Without fragment `highp`: warns (once, `warned`) of the first light whose colour ×
+/// intensity is past [`FP16_MAX_RADIANCE`] (2³⁰), which its fp16 form takes as 2³⁰. Allocates
+/// nothing unless it warns.
+pub(super) fn warn_of_capped_radiance(caps: &Caps, scene: &Scene, warned: &mut bool) {
+    if caps.fragment_has_highp() || *warned {
+        return;
+    }
+    let past = |(_, r): &(_, Vec3)| r.max_element() > FP16_MAX_RADIANCE;
+    let Some(((list, i), radiance)) = radiances(scene).find(past) else {
+        return;
+    };
+    *warned = true;
+    log::warn!(
+        "{list}[{i}]: colour × intensity {radiance:?} is past 2³⁰, the brightest radiance a \
+         light has without fragment highp (fp16): it is drawn as 2³⁰, its channels scaled alike"
+    );
+}
+
 /// Without fragment `highp`: warns (once) of the first light, point, spot or directional,
 /// whose colour × intensity spans more than its fp16 form keeps. Allocates nothing unless it
 /// warns.
@@ -39,14 +68,8 @@ pub(super) fn warn_of_lost_channels(caps: &Caps, scene: &Scene) {
     if caps.fragment_has_highp() || WARNED.load(Ordering::Relaxed) {
         return;
     }
-    let points = (scene.lights.iter().enumerate())
-        .filter(|(_, l)| l.is_active())
-        .map(|(i, l)| (("lights", i), l.color * l.intensity));
-    let suns = (scene.directional_lights.iter().enumerate())
-        .filter(|(_, l)| l.is_active())
-        .map(|(i, l)| (("directional_lights", i), l.radiance()));
     let lossy = |(_, r): &(_, Vec3)| lost_channels(*r).contains(&true);
-    let Some(((list, i), radiance)) = points.chain(suns).find(lossy) else {
+    let Some(((list, i), radiance)) = radiances(scene).find(lossy) else {
         return;
     };
     WARNED.store(true, Ordering::Relaxed);

@@ -262,6 +262,11 @@ impl Renderer {
         let reach = super::fp16_range::view_reach(scene, width as f64 / height as f64, content_far);
         super::fp16_range::check(self.dev.caps(), scene, &mut self.lights, reach)?;
         super::fp16_channels::warn_of_lost_channels(self.dev.caps(), scene);
+        super::fp16_channels::warn_of_capped_radiance(
+            self.dev.caps(),
+            scene,
+            &mut self.warned_capped_radiance,
+        );
         let frame_rect = [origin[0], origin[1], width, height].map(|v| v as i32);
         self.dev
             .viewport(frame_rect[0], frame_rect[1], frame_rect[2], frame_rect[3]);

@@ -79,6 +79,9 @@ pub struct Renderer {
     srgb_destination: bool,
     /// A camera too coarse in depth for the scene was announced (once per renderer).
     warned_depth_step: bool,
+    /// Whether a light brighter than the fp16 radiance form holds was said (without fragment
+    /// highp; once a renderer).
+    warned_capped_radiance: bool,
     /// The renderer's own 16-bit depth buffer was announced (once per renderer).
     warned_own_depth_bits: bool,
     /// The frame's objects in draw order (kept likewise).
@@ -150,6 +153,7 @@ impl Renderer {
             warned_depth_bits: false,
             srgb_destination: false,
             warned_depth_step: false,
+            warned_capped_radiance: false,
             warned_own_depth_bits: false,
             draw_order: methods::geometry::DrawOrder::default(),
             lp_num_threads: std::env::var("LP_NUM_THREADS").ok(),

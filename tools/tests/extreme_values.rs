@@ -492,3 +492,72 @@ fn a_metal_brighter_than_white_stays_finite_and_equals_highp() {
     let d = manylight::metrics::diff(&exact, &image).max_abs;
     assert!(d <= 3, "{d} / 255 from highp");
 }
+
+/// Without fragment highp a light's fp16 scale `k` went past fp16 for radiance past 2³²
+/// (k = 2¹⁶): read as infinity, every pixel the light reached was drawn at the shader's cap,
+/// white at any exposure. Radiance is now taken as 2³⁰ there (k ≤ 2¹⁵), as a sun's always
+/// was, with a warning: the frame is highp's frame of that light at 2³⁰.
+#[test]
+fn a_light_past_what_fp16_radiance_holds_is_drawn_at_that_limit_with_a_warning() {
+    common::warnings::install();
+    let mut mediump = Gpu::without_fragment_highp();
+    // ES 2.0, which Mesa still offers without float textures (the RGBA8 child).
+    let mut highp = Gpu::new(EsVersion::Es2);
+    let opts = RenderOptions {
+        exposure_ev: -15.0,
+        linear: true,
+        ..Default::default()
+    };
+    let light = |intensity: f32| {
+        let mut l = point(2000.0);
+        l.position = DVec3::new(0.0, 0.0, 330.0);
+        l.color = Vec3::ONE;
+        l.intensity = intensity;
+        l
+    };
+    let capped = highp.render(&plane(vec![light(2f32.powi(30))]), 64, 36, &opts);
+    let lit = capped
+        .pixels()
+        .filter(|p| (40..200).contains(&p[0]))
+        .count();
+    assert!(lit > 500, "{lit} pixels in the middle, too few to tell");
+    let (image, stats) = mediump
+        .r()
+        .render_offscreen(&plane(vec![light(1e10)]), 64, 36, &opts)
+        .unwrap();
+    let rgba8 = std::env::var_os(RGBA8_LIGHTS).is_some();
+    assert_eq!(
+        stats.lights.encoding == manylight::LightEncoding::Rgba8,
+        rgba8
+    );
+    let d = manylight::metrics::diff(&capped, &image).max_abs;
+    assert!(d <= 3, "{d} / 255 from highp's frame at 2³⁰");
+    // (Other tests' renderers may say it of their lights too: all are their `lights[0]`.)
+    let said = common::warnings::warnings_containing("is past 2³⁰");
+    assert!(
+        !said.is_empty() && said.iter().all(|w| w.starts_with("lights[0]:")),
+        "{said:?}"
+    );
+}
+
+/// Set in the child that reruns the test above with RGBA8 light records.
+const RGBA8_LIGHTS: &str = "MANYLIGHT_TEST_RGBA8_LIGHTS";
+
+/// The test above with RGBA8 light records (no `GL_OES_texture_float`), whose shader splits
+/// the shared exponent into `k` itself, in a child process.
+#[test]
+fn a_light_past_what_fp16_radiance_holds_in_rgba8_records_too() {
+    if std::env::var_os(RGBA8_LIGHTS).is_some()
+        || common::other_implementation_than_mesa("MESA_EXTENSION_OVERRIDE")
+    {
+        return;
+    }
+    common::child::rerun_with(
+        "a_light_past_what_fp16_radiance_holds_is_drawn_at_that_limit_with_a_warning",
+        &[
+            ("MESA_EXTENSION_OVERRIDE", "-GL_OES_texture_float"),
+            (RGBA8_LIGHTS, "1"),
+        ],
+        "RGBA8 light records",
+    );
+}

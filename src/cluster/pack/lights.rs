@@ -12,8 +12,9 @@
 //!   t1: rad.r   rad.g   rad.b   spot_scale    radiance = colour × intensity
 //!   t2: dir.x   dir.y   dir.z   spot_offset   unit view-space spot axis
 //!   t3: rad.r/k² rad.g/k² rad.b/k² k          radiance in fp16 range: k = 2^e, e ≥ 0 the
-//!                                             least with max(rad)/k² ≤ 1 (read only by
-//!                                             devices without fragment highp, FP16_LIGHTS)
+//!                                             least with max(rad)/k² ≤ 1, rad at most 2³⁰
+//!                                             (read only by devices without fragment
+//!                                             highp, FP16_LIGHTS)
 //!
 //! Rgba8 (RGBA8, 8 texels = 32 bytes per light; ES 2.0 without OES_texture_float). Lossy:
 //!   t0: x.hi x.lo y.hi y.lo      16-bit fixed point over [−pos_range, +pos_range]
@@ -273,11 +274,22 @@ pub fn unpack_light(packed: &PackedLights, i: usize) -> GpuLight {
     }
 }
 
+/// Brightest radiance channel the fp16 form holds: `k` is then at most 2¹⁵, within fp16's
+/// 65 504 (a `k` of 2¹⁶ and up read as infinity, lighting every pixel the light reaches at the
+/// shader's cap). Radiance past it is taken as it, its channels scaled alike.
+pub const FP16_MAX_RADIANCE: f32 = (1u32 << 30) as f32;
+
 /// Radiance in a range fp16 holds, for devices without fragment highp: `(c / k², k)` with
-/// `k = 2^e`, `e ≥ 0` the least with `max(c) / k² ≤ 1`. The shader multiplies `k²` back into
-/// the falloff, which is small wherever the light is not saturating the pixel anyway (see
-/// `glsl/light_model.glsl`).
+/// `k = 2^e`, `e ≥ 0` the least with `max(c) / k² ≤ 1`, `c` first scaled down to at most
+/// [`FP16_MAX_RADIANCE`]. The shader multiplies `k²` back into the falloff, which is small
+/// wherever the light is not saturating the pixel anyway (see `glsl/light_model.glsl`).
 pub fn fp16_radiance(c: Vec3) -> (Vec3, f32) {
+    let brightest = c.max_element();
+    let c = if brightest > FP16_MAX_RADIANCE {
+        c * (FP16_MAX_RADIANCE / brightest)
+    } else {
+        c
+    };
     let m = c.max_element();
     let e = if m > 1.0 {
         (m.log2() * 0.5).ceil() as i32
@@ -285,8 +297,7 @@ pub fn fp16_radiance(c: Vec3) -> (Vec3, f32) {
         0
     };
     let k = 2f32.powi(e);
-    // Divided twice: k² itself is past f32 above 2¹²⁶ (k = 2⁶⁴), and c / ∞ would be 0.
-    (c / k / k, k)
+    (c / (k * k), k)
 }
 
 fn unorm16(x: f32) -> u16 {
@@ -380,9 +391,10 @@ mod tests {
             (1.01, 2.0),
             (4.0, 2.0),
             (1e6, 1024.0),
-            // k² is past f32 here: the radiance must still come out, not as 0.
-            (1e38, 2f32.powi(64)),
-            (f32::MAX, 2f32.powi(64)),
+            (1e9, 2f32.powi(15)),
+            // Past 2³⁰, taken as 2³⁰: k stays within fp16 (2¹⁶ and up read as infinity).
+            (1e10, 2f32.powi(15)),
+            (f32::MAX, 2f32.powi(15)),
         ] {
             let (scaled, root) = fp16_radiance(Vec3::splat(c));
             assert_eq!(root, k, "radiance {c}");
@@ -390,6 +402,7 @@ mod tests {
                 scaled.x <= 1.0 && (c <= 1.0 || scaled.x > 0.25),
                 "radiance {c}"
             );
+            assert!(root <= 65504.0, "radiance {c}: k past fp16");
         }
     }
 

@@ -12,5 +12,5 @@ pub use grid::{
 };
 pub use lights::{
     fp16_radiance, pack_lights, pack_lights_into, unpack_light, LightEncoding, PackedLights,
-    DATA_TEXTURE_WIDTH,
+    DATA_TEXTURE_WIDTH, FP16_MAX_RADIANCE,
 };
