@@ -13,7 +13,8 @@ pub enum LightKind {
     /// Emits in all directions.
     Point,
     /// Emits in a cone around `direction`, full intensity inside `inner_deg` (half-angle),
-    /// fading smoothly to zero at `outer_deg`.
+    /// fading smoothly to zero at `outer_deg` (an edge sharper than [`SPOT_MIN_COS_DELTA`] of
+    /// `1 − cos` fades over that much just past it).
     Spot {
         /// Cone axis in world space (need not be normalised; must not be zero).
         direction: DVec3,
@@ -31,7 +32,8 @@ pub struct Cone {
     pub direction: DVec3,
     /// Half-angle in degrees of full intensity, 0 ≤ inner ≤ outer.
     pub inner_deg: f64,
-    /// Half-angle in degrees where the light reaches zero, inner ≤ outer ≤ 180.
+    /// Half-angle in degrees where the light reaches zero, inner ≤ outer ≤ 180 (just past it
+    /// for an edge sharper than [`SPOT_MIN_COS_DELTA`] of `1 − cos`).
     pub outer_deg: f64,
 }
 
@@ -96,8 +98,11 @@ impl Light {
     }
 
     /// Spot cone as `(scale, offset)` with `t = clamp(offset − scale · (1 − cos θ), 0, 1)`, the
-    /// argument of the smoothstep, θ the angle off the axis: `scale = 1 / (cos inner − cos
-    /// outer)` and `offset = scale · (1 − cos outer)`. Point lights get `(0, 1)` so `t = 1`.
+    /// argument of the smoothstep, θ the angle off the axis: `scale = 1 / max(cos inner − cos
+    /// outer, SPOT_MIN_COS_DELTA)` and `offset = 1 + scale · (1 − cos inner)` (`scale · (1 −
+    /// cos outer)` where the edge is wider than the minimum): 1 at the inner angle, 0 one width
+    /// past it, so `offset / scale` is `1 − cos` of where the light ends. Point lights get
+    /// `(0, 1)` so `t = 1`.
     /// Precomputed on the CPU (in `f64`) so that `inner == outer`, where GLSL's `smoothstep`
     /// is undefined, is still a well-defined (steep) edge.
     ///

@@ -303,7 +303,8 @@ impl Scene {
             // frame of a sequence, named by a position the file never wrote.
             for (k, rest) in track.rest.iter().enumerate() {
                 let farthest = track.motion.farthest_coordinate(rest.position);
-                if farthest > light::MAX_LIGHT_COORD {
+                // With room for the rotation's rounding (a light at the limit stays there).
+                if farthest * (1.0 + 1e-12) > light::MAX_LIGHT_COORD {
                     return Err(SceneError::invalid(
                         field(),
                         format!(

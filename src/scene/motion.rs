@@ -239,16 +239,26 @@ impl Motion {
     }
 
     /// A bound of the largest position coordinate (in magnitude) a light at rest at `rest`
-    /// reaches at any time: an orbit about a point keeps its distance to the centre, one of a
-    /// radius, a bob (`A·swing`, the swing within ±2) and a wander add at most `2r`, `2|A|`
-    /// and `r`. (A varied motion has the same sizes: only its periods and phases differ.)
+    /// reaches at any time: an orbit about a point goes round a circle about its axis (whose
+    /// coordinate `k` lies within `ρ·√(1 − a_k²)` of the circle's centre), one of a radius, a
+    /// bob (`A·swing`, the swing within ±2) and a wander add at most `2r`, `2|A|` and `r`. (A
+    /// varied motion has the same sizes: only its periods and phases differ.) Call it on a
+    /// validated motion (its axis not zero).
     pub(crate) fn farthest_coordinate(&self, rest: DVec3) -> f64 {
         let mut base = rest.abs().max_element();
         let mut added = 0.0;
         if let Some(o) = &self.orbit {
             match o.about {
                 OrbitAbout::Point(centre) => {
-                    base = centre.abs().max_element() + (rest - centre).length();
+                    let axis = o.axis.normalize();
+                    let v = rest - centre;
+                    let along = v.dot(axis);
+                    let rho = (v - axis * along).length();
+                    let middle = centre + axis * along;
+                    let reach = |k: usize| {
+                        middle[k].abs() + rho * (1.0 - axis[k] * axis[k]).max(0.0).sqrt()
+                    };
+                    base = reach(0).max(reach(1)).max(reach(2));
                 }
                 OrbitAbout::Radius(r) => added += 2.0 * r.abs(),
             }

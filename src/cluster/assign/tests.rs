@@ -144,8 +144,11 @@ fn reaches(light: &GpuLight, p: DVec3) -> bool {
         return false;
     }
     if light.spot_scale != 0.0 && dist > 0.0 {
+        // Where the spot term is above 0 (the shader's test): up to the outer angle, or just
+        // past it for an edge sharper than the smallest fade width.
         let cos = (to / dist).dot(light.direction.as_dvec3());
-        return cos >= (light.cone_deg.0 as f64).to_radians().cos() - 1e-9;
+        let edge = 1.0 - light.spot_offset as f64 / light.spot_scale as f64;
+        return cos >= edge - 1e-9;
     }
     true
 }

@@ -292,7 +292,8 @@ pub fn fp16_radiance(c: Vec3) -> (Vec3, f32) {
     };
     let m = c.max_element();
     let e = if m > 1.0 {
-        (m.log2() * 0.5).ceil() as i32
+        // At most 15 (k = 2¹⁵) however the scaling above rounded.
+        ((m.log2() * 0.5).ceil() as i32).min(15)
     } else {
         0
     };

@@ -389,10 +389,26 @@ fn a_motion_that_can_carry_a_light_out_of_range_is_named_at_once() {
     let point =
         |x: f64, z: f64| crate::scene::Light::point(DVec3::new(x, 0.0, z), 1.0, Vec3::ONE, 1.0);
     let mut scene = crate::scene::Scene::empty();
-    scene.lights = vec![point(6e17, 6e17), point(1e18 - 1e10, 0.0)];
+    // About X, a light at (9e17, 9e17, 0) keeps x and goes round a circle of 9e17.
+    let about_x = Motion {
+        orbit: Some(Orbit {
+            axis: DVec3::X,
+            ..orbit.orbit.unwrap()
+        }),
+        ..orbit
+    };
+    let mut turning = DVec3::new(9e17, 9e17, 0.0);
+    scene.lights = vec![point(6e17, 6e17), point(1e18 - 1e10, 0.0), point(9e17, 0.0)];
+    scene.lights[2].position = turning;
     scene.animate_light(0, orbit);
     scene.animate_light(1, bob);
+    scene.animate_light(2, about_x);
     scene.validate().unwrap();
+    for i in 0..16 {
+        scene.set_time(f64::from(i) * 0.5);
+        turning = turning.abs().max(scene.lights[2].position.abs());
+    }
+    assert!(turning.max_element() <= 9e17 * (1.0 + 1e-12), "{turning}");
     for (light, motion) in [(point(9e17, 9e17), orbit), (point(1e18 - 5e8, 0.0), bob)] {
         let mut scene = crate::scene::Scene::empty();
         scene.lights = vec![point(0.0, 0.0), light];
