@@ -13,8 +13,8 @@ pub enum LightKind {
     /// Emits in all directions.
     Point,
     /// Emits in a cone around `direction`, full intensity inside `inner_deg` (half-angle),
-    /// fading smoothly to zero at `outer_deg` (an edge sharper than [`SPOT_MIN_COS_DELTA`] of
-    /// `1 − cos` fades over that much just past it).
+    /// fading smoothly to zero at `outer_deg` (an edge sharper than 10⁻⁴ of `1 − cos` fades
+    /// over that much just past it).
     Spot {
         /// Cone axis in world space (need not be normalised; must not be zero).
         direction: DVec3,
@@ -33,7 +33,7 @@ pub struct Cone {
     /// Half-angle in degrees of full intensity, 0 ≤ inner ≤ outer.
     pub inner_deg: f64,
     /// Half-angle in degrees where the light reaches zero, inner ≤ outer ≤ 180 (just past it
-    /// for an edge sharper than [`SPOT_MIN_COS_DELTA`] of `1 − cos`).
+    /// for an edge sharper than 10⁻⁴ of `1 − cos`).
     pub outer_deg: f64,
 }
 

@@ -57,7 +57,7 @@ pub use model_cache::{MAX_SCENE_MATERIALS, MAX_SCENE_OBJECTS};
 pub use motion::Motion;
 
 /// Largest ambient radiance a channel may have: the ambient term runs at `mediump` (fp16 on
-/// phones, max 65 504) times colour factors of up to [`material::MAX_COLOR_FACTOR`] (1 024), and
+/// phones, max 65 504) times colour factors of up to the largest colour factor (1 024), and
 /// must stay finite there with room for the lights' terms (an ambient past 65 504 was itself
 /// infinite there, and times a black texel NaN).
 pub const MAX_AMBIENT: f32 = 32.0;
