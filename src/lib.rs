@@ -110,7 +110,7 @@ pub use scene::surface_maps::{MapTexture, SurfaceMaps, TextureTransform};
 pub use scene::{
     builtin::DEFAULT as DEFAULT_SCENE, builtin::NAMES as BUILTIN_SCENES, builtin_scene, load_scene,
     load_scene_with, Aabb, Camera, Cone, DirectionalLight, Light, LightKind, LoadOptions, Material,
-    MaterialModel, Mesh, Object, Projection, RandomLights, Scene, SceneError, Texture, MAX_AMBIENT,
+    MaterialModel, Mesh, Object, Projection, RandomLights, Scene, SceneError, Texture,
     MAX_DIRECTIONAL_LIGHTS,
 };
 

@@ -56,12 +56,6 @@ pub use mesh::{Aabb, Mesh};
 pub use model_cache::{MAX_SCENE_MATERIALS, MAX_SCENE_OBJECTS};
 pub use motion::Motion;
 
-/// Largest ambient radiance a channel may have: the ambient term runs at `mediump` (fp16 on
-/// phones, max 65 504) times colour factors of up to the largest colour factor (1 024), and
-/// must stay finite there with room for the lights' terms (an ambient past 65 504 was itself
-/// infinite there, and times a black texel NaN).
-pub const MAX_AMBIENT: f32 = 32.0;
-
 /// One placed mesh: shared geometry, its material and a model transform (`f64`, so objects
 /// can be placed far from the origin).
 #[derive(Clone, Debug)]
@@ -86,8 +80,7 @@ pub struct Scene {
     /// Lights from infinitely far away (a sun), evaluated for every pixel outside the light
     /// lists; at most [`MAX_DIRECTIONAL_LIGHTS`] are shown (the brightest, with a warning).
     pub directional_lights: Vec<DirectionalLight>,
-    /// Ambient radiance in linear RGB, multiplied by the albedo; each channel in [0,
-    /// [`MAX_AMBIENT`]].
+    /// Ambient radiance in linear RGB, multiplied by the albedo.
     pub ambient: Vec3,
     /// The viewpoint.
     pub camera: Camera,
@@ -265,11 +258,10 @@ impl Scene {
     /// ambient colour, camera, material indices and material values. Errors name the field.
     pub fn validate(&self) -> Result<(), SceneError> {
         self.camera.validate()?;
-        let a = self.ambient;
-        if !(a.is_finite() && a.min_element() >= 0.0 && a.max_element() <= MAX_AMBIENT) {
+        if !self.ambient.is_finite() || self.ambient.min_element() < 0.0 {
             return Err(SceneError::invalid(
                 "ambient",
-                format!("must be in [0, {MAX_AMBIENT}], got {a:?}"),
+                format!("must be finite and >= 0, got {:?}", self.ambient),
             ));
         }
         // Motions before lights: a bad motion poses its lights at NaN, which is its fault.
