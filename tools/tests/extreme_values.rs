@@ -525,7 +525,7 @@ fn a_light_past_what_fp16_radiance_holds_is_drawn_at_that_limit_with_a_warning()
         .r()
         .render_offscreen(&plane(vec![light(1e10)]), 64, 36, &opts)
         .unwrap();
-    let rgba8 = std::env::var_os(RGBA8_LIGHTS).is_some();
+    let rgba8 = common::child::rgba8_lights();
     assert_eq!(
         stats.lights.encoding == manylight::LightEncoding::Rgba8,
         rgba8
@@ -542,24 +542,11 @@ fn a_light_past_what_fp16_radiance_holds_is_drawn_at_that_limit_with_a_warning()
         .all(|w| w.starts_with("lights[0]:")));
 }
 
-/// Set in the child that reruns the test above with RGBA8 light records.
-const RGBA8_LIGHTS: &str = "MANYLIGHT_TEST_RGBA8_LIGHTS";
-
 /// The test above with RGBA8 light records (no `GL_OES_texture_float`), whose shader splits
 /// the shared exponent into `k` itself, in a child process.
 #[test]
 fn a_light_past_what_fp16_radiance_holds_in_rgba8_records_too() {
-    if std::env::var_os(RGBA8_LIGHTS).is_some()
-        || common::other_implementation_than_mesa("MESA_EXTENSION_OVERRIDE")
-    {
-        return;
-    }
-    common::child::rerun_with(
+    common::child::rerun_with_rgba8_lights(
         "a_light_past_what_fp16_radiance_holds_is_drawn_at_that_limit_with_a_warning",
-        &[
-            ("MESA_EXTENSION_OVERRIDE", "-GL_OES_texture_float"),
-            (RGBA8_LIGHTS, "1"),
-        ],
-        "RGBA8 light records",
     );
 }

@@ -720,9 +720,6 @@ fn mediump_precision_canary() {
     }
 }
 
-/// Set in the child that reruns the narrow-cone test with RGBA8 light records.
-const RGBA8_LIGHTS: &str = "MANYLIGHT_TEST_RGBA8_LIGHTS";
-
 /// A cone narrower than the spot term's smallest width (10⁻⁴ of `1 − cos`, 0.81°) is at full
 /// intensity on its axis, as a point light there: a 0.5° cone drew 32 % of it, and a 0.2° cone
 /// 1 %. Compared where the spot's disc is brightest, on the float light records and (in a child
@@ -730,7 +727,7 @@ const RGBA8_LIGHTS: &str = "MANYLIGHT_TEST_RGBA8_LIGHTS";
 #[test]
 fn a_narrow_cone_is_as_bright_as_a_point_light_on_its_axis() {
     for outer in [0.5, 0.2] {
-        let rgba8 = std::env::var_os(RGBA8_LIGHTS).is_some();
+        let rgba8 = common::child::rgba8_lights();
         let lit = |light: Light| {
             let mut s = plane();
             s.lights = vec![light];
@@ -784,17 +781,7 @@ fn a_narrow_cone_is_as_bright_as_a_point_light_on_its_axis() {
 /// The test above with RGBA8 light records (no `GL_OES_texture_float`), in a child process.
 #[test]
 fn a_narrow_cone_is_as_bright_as_a_point_light_on_its_axis_in_rgba8_records() {
-    if std::env::var_os(RGBA8_LIGHTS).is_some()
-        || common::other_implementation_than_mesa("MESA_EXTENSION_OVERRIDE")
-    {
-        return;
-    }
-    common::child::rerun_with(
+    common::child::rerun_with_rgba8_lights(
         "a_narrow_cone_is_as_bright_as_a_point_light_on_its_axis",
-        &[
-            ("MESA_EXTENSION_OVERRIDE", "-GL_OES_texture_float"),
-            (RGBA8_LIGHTS, "1"),
-        ],
-        "RGBA8 light records",
     );
 }

@@ -113,6 +113,7 @@ impl FlyCamera {
             Some(f) => (f, distance),
             None => (-DVec3::Z, 1.0),
         };
+        let unturned = forward;
         let (dx, dy) = std::mem::take(&mut self.pending_look);
         if dx != 0.0 || dy != 0.0 {
             forward = turn(
@@ -135,21 +136,24 @@ impl FlyCamera {
         } else {
             0.0
         };
-        // The eye and its target stay within the coordinates the view maths holds: at the
-        // edge the camera stops (and does not turn where its target would leave them), where
-        // the next frame used to refuse the camera and end the viewer.
+        // The eye and its target stay within the coordinates the view maths holds, where the
+        // next frame used to refuse the camera and end the viewer: at the edge the camera
+        // slides along it (each axis of the step taken where it stays within), and does not
+        // turn where its target would leave it.
         let within = |v: DVec3| v.abs().max_element() <= MAX_CAMERA_COORD;
-        let moved = camera.position + direction * step;
-        let target = moved + forward * distance;
-        if within(moved) && within(target) {
-            camera.position = moved;
-            camera.target = target;
-        } else {
-            let turned = camera.position + forward * distance;
-            if within(turned) {
-                camera.target = turned;
+        let turned = camera.position + forward * distance;
+        if !within(turned) {
+            forward = unturned;
+        }
+        let step = direction * step;
+        for k in 0..3 {
+            let mut moved = camera.position;
+            moved[k] += step[k];
+            if within(moved) && within(moved + forward * distance) {
+                camera.position = moved;
             }
         }
+        camera.target = camera.position + forward * distance;
     }
 }
 
@@ -236,6 +240,17 @@ mod tests {
             cam.validate().unwrap();
         }
         assert_eq!(cam.position.x, edge, "it stopped");
+        // Sideways along the edge it slides.
+        fly.set_key(Move::Left, true);
+        fly.update(1.0, &mut cam);
+        assert_eq!(cam.position.x, edge);
+        assert!(
+            cam.position.y.abs() + cam.position.z.abs() > 1e10,
+            "{}",
+            cam.position
+        );
+        cam.validate().unwrap();
+        fly.set_key(Move::Left, false);
         // Back in it moves again.
         fly.set_key(Move::Forward, false);
         fly.set_key(Move::Back, true);
