@@ -294,6 +294,11 @@ impl Scene {
             // Where its lights can go, so a light does not leave the lights' range at some
             // frame of a sequence, named by a position the file never wrote.
             for (k, rest) in track.rest.iter().enumerate() {
+                // A motion moves a light by at most `MAX_DISPLACEMENT` (1e9): one within a
+                // quarter of the limit stays inside it, and costs no roots every frame.
+                if rest.position.abs().max_element() <= light::MAX_LIGHT_COORD / 4.0 {
+                    continue;
+                }
                 let farthest = track.motion.farthest_coordinate(rest.position);
                 // With room for the rotation's rounding (a light at the limit stays there).
                 if farthest * (1.0 + 1e-12) > light::MAX_LIGHT_COORD {
