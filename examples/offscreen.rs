@@ -16,7 +16,7 @@ use manylight::{
 };
 
 /// A floor with a row of boxes, lit by a ring of coloured point lights and one white spot.
-pub fn build_scene() -> Scene {
+pub fn build_scene() -> Result<Scene, manylight::SceneError> {
     let mut scene = Scene::empty();
     let stone = scene.add_material(Material::flat("stone", Vec3::new(0.6, 0.58, 0.55)));
     let painted = scene.add_material(Material::glossy(
@@ -37,8 +37,8 @@ pub fn build_scene() -> Scene {
         let x = i as f32 * 2.5;
         boxes.cuboid(Vec3::new(x - 0.5, 0.0, -0.5), Vec3::new(x + 0.5, 1.5, 0.5));
     }
-    scene.add_object(floor.build(), stone, DMat4::IDENTITY);
-    scene.add_object(boxes.build(), painted, DMat4::IDENTITY);
+    scene.add_object(floor.build()?, stone, DMat4::IDENTITY);
+    scene.add_object(boxes.build()?, painted, DMat4::IDENTITY);
     // 200 point lights on a ring just above the floor, hue going round.
     for i in 0..200 {
         let t = i as f64 / 200.0 * std::f64::consts::TAU;
@@ -68,7 +68,7 @@ pub fn build_scene() -> Scene {
         0.1,
         60.0,
     );
-    scene
+    Ok(scene)
 }
 
 /// Renders [`build_scene`] at `width × height` on ES 3.0 (ES 2.0 where that is all the driver
@@ -79,7 +79,7 @@ pub fn run(out: &Path, width: u32, height: u32) -> Result<FrameStats, Box<dyn st
         Err(_) => (HeadlessContext::new(EsVersion::Es2)?, EsVersion::Es2),
     };
     let mut renderer = Renderer::new(ctx.load_gl()?, es)?;
-    let scene = build_scene();
+    let scene = build_scene()?;
     let result = renderer.render_offscreen(&scene, width, height, &RenderOptions::default());
     // Free the GL objects before the context goes, whatever happened.
     renderer.destroy();

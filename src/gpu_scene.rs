@@ -9,7 +9,8 @@ use glam::{DMat4, DVec3};
 use crate::gl::mesh::GpuMesh;
 use crate::gl::texture::ImageTexture;
 use crate::gl::Device;
-use crate::scene::{Aabb, Material, Mesh, Scene, Texture};
+use crate::scene::camera::MAX_CAMERA_COORD;
+use crate::scene::{Aabb, Material, Mesh, Scene, SceneError, Texture};
 use crate::Error;
 
 /// Meshes and textures of scenes, uploaded once and found again by identity. The cache holds
@@ -153,6 +154,28 @@ impl GpuScene {
     /// been uploaded).
     pub fn longest_edge(&self, object: &crate::scene::Object) -> f64 {
         self.meshes[&(Arc::as_ptr(&object.mesh) as usize)].3
+    }
+
+    /// Refuses an object its transform places past the camera's coordinate limit, naming the
+    /// transform: a scale or translation past it overflowed the view matrix's `f32` form and
+    /// left the object out of the frame without a word. (The file loaders check the same.)
+    pub fn check_placement(&self, scene: &Scene) -> Result<(), SceneError> {
+        for (i, o) in scene.objects.iter().enumerate() {
+            let Some(b) = self.world_bounds(o) else {
+                continue;
+            };
+            let reach = b.min.abs().max(b.max.abs()).max_element();
+            if !reach.is_finite() || reach > MAX_CAMERA_COORD {
+                return Err(SceneError::invalid(
+                    format!("objects[{i}].transform"),
+                    format!(
+                        "places the object's bounds {reach:e} from the origin, past \
+                         ±{MAX_CAMERA_COORD:e} (the camera's limit)"
+                    ),
+                ));
+            }
+        }
+        Ok(())
     }
 
     /// World-space bounds of the whole scene ([`Scene::bounds`] without walking every vertex).

@@ -28,7 +28,10 @@ fn offscreen_writes_a_lit_picture_of_the_scene_built_in_code() {
     let stats = offscreen::run(&out, 256, 144).expect("example runs");
     let img = image::open(&out).unwrap().to_rgba8();
     assert_eq!(img.dimensions(), (256, 144));
-    assert_eq!(stats.lights.total, offscreen::build_scene().lights.len());
+    assert_eq!(
+        stats.lights.total,
+        offscreen::build_scene().unwrap().lights.len()
+    );
     assert!(
         lit_fraction(&img, 20.0) > 0.3,
         "too dark: {:.2} lit",

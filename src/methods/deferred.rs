@@ -232,7 +232,7 @@ pub struct Deferred {
 fn unit_sphere() -> Mesh {
     let mut b = MeshBuilder::new();
     b.sphere(Vec3::ZERO, 1.0, 16, 8);
-    b.build()
+    b.build_fixed()
 }
 
 impl Deferred {

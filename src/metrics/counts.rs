@@ -76,9 +76,13 @@ impl LightCounts {
         self.counts.iter().copied().max().unwrap_or(0)
     }
 
-    /// Count at pixel (x, y), top row first.
-    pub fn at(&self, x: u32, y: u32) -> u32 {
-        self.counts[(y * self.width + x) as usize]
+    /// Count at pixel (x, y), top row first; `None` outside the image.
+    pub fn at(&self, x: u32, y: u32) -> Option<u32> {
+        if x >= self.width {
+            return None;
+        }
+        let i = (y as usize).checked_mul(self.width as usize)? + x as usize;
+        self.counts.get(i).copied()
     }
 }
 
@@ -100,7 +104,13 @@ mod tests {
             (0x01_1234, 2, 0x01_1234)
         );
         assert_eq!(c.mean(), 0x01_1234 as f64 / 2.0);
-        assert_eq!(c.at(0, 0), 0x01_1234);
+        assert_eq!(c.at(0, 0), Some(0x01_1234));
+        assert_eq!(c.at(2, 0), Some(0));
+        // Past the row's end is outside, not the next row's first pixel.
+        assert_eq!(
+            (c.at(3, 0), c.at(0, 1), c.at(0, u32::MAX)),
+            (None, None, None)
+        );
         assert_eq!(LightCounts::try_decode(&img).unwrap(), c);
     }
 }

@@ -541,7 +541,7 @@ mod tests {
                 Vec3::new(-s, s, z),
             );
             scene.objects.push(Object {
-                mesh: Arc::new(pane.build()),
+                mesh: Arc::new(pane.build().unwrap()),
                 material: glass,
                 transform: DMat4::IDENTITY,
             });

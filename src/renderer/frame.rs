@@ -232,6 +232,7 @@ impl Renderer {
         scene.validate()?;
         self.gpu_scene
             .upload(&self.dev, scene, options.measure.full_variants)?;
+        self.gpu_scene.check_placement(scene)?;
         self.gpu_scene.split_for_frame(&self.dev, scene)?;
         let view: DMat4 = scene.camera.view_matrix();
         let projection = scene

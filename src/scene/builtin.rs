@@ -116,7 +116,7 @@ fn courtyard() -> (Scene, Aabb, LightSetStyle) {
     );
     push(
         &mut scene,
-        floor.build(),
+        floor.build_fixed(),
         Material::glossy(
             "floor",
             Vec3::new(0.45, 0.42, 0.38),
@@ -146,7 +146,7 @@ fn courtyard() -> (Scene, Aabb, LightSetStyle) {
         );
     push(
         &mut scene,
-        walls.build(),
+        walls.build_fixed(),
         Material::flat("walls", Vec3::new(0.72, 0.64, 0.52)),
     );
 
@@ -205,17 +205,17 @@ fn courtyard() -> (Scene, Aabb, LightSetStyle) {
     }
     push(
         &mut scene,
-        columns.build(),
+        columns.build_fixed(),
         Material::glossy("marble", Vec3::new(0.85, 0.84, 0.8), Vec3::splat(0.5), 96.0),
     );
     push(
         &mut scene,
-        arches.build(),
+        arches.build_fixed(),
         Material::flat("arches", Vec3::new(0.78, 0.6, 0.45)),
     );
     push(
         &mut scene,
-        gallery.build(),
+        gallery.build_fixed(),
         Material::flat("gallery", Vec3::new(0.6, 0.58, 0.55)),
     );
 
@@ -226,7 +226,7 @@ fn courtyard() -> (Scene, Aabb, LightSetStyle) {
         .cylinder(Vec3::new(0.0, 2.2, 0.0), 1.0, 0.25, 24);
     push(
         &mut scene,
-        fountain.build(),
+        fountain.build_fixed(),
         Material::glossy(
             "fountain",
             Vec3::new(0.3, 0.45, 0.55),
@@ -275,7 +275,7 @@ fn bubbles() -> (Scene, Aabb, LightSetStyle) {
             alpha: 0.3 + 0.04 * (i % 5) as f32,
             ..Material::glossy(&format!("bubble{i}"), tint, Vec3::splat(0.8), 128.0)
         };
-        push(&mut scene, mesh.build(), material);
+        push(&mut scene, mesh.build_fixed(), material);
     }
     (scene, volume, style)
 }
@@ -286,7 +286,7 @@ fn pillars() -> (Scene, Aabb, LightSetStyle) {
     floor.cuboid(Vec3::new(-15.0, -0.2, -20.0), Vec3::new(15.0, 0.0, 15.0));
     push(
         &mut scene,
-        floor.build(),
+        floor.build_fixed(),
         Material::flat("floor", Vec3::new(0.5, 0.5, 0.52)),
     );
     let mut pillars = MeshBuilder::new();
@@ -306,7 +306,7 @@ fn pillars() -> (Scene, Aabb, LightSetStyle) {
     }
     push(
         &mut scene,
-        pillars.build(),
+        pillars.build_fixed(),
         Material::glossy(
             "pillars",
             Vec3::new(0.75, 0.72, 0.68),
@@ -342,7 +342,7 @@ fn plane() -> (Scene, Aabb, LightSetStyle) {
     );
     push(
         &mut scene,
-        quad.build(),
+        quad.build_fixed(),
         Material::glossy("plane", Vec3::splat(0.8), Vec3::splat(0.25), 24.0),
     );
     scene.camera = Camera::perspective(DVec3::new(0.0, 0.0, 5.0), DVec3::ZERO, 60.0, 0.1, 50.0);

@@ -288,6 +288,17 @@ impl Camera {
                         ),
                     ));
                 }
+                // Wider than the coordinates a scene may span: its f32 projection scale was 0
+                // and drew nothing.
+                if height > 2.0 * MAX_CAMERA_COORD {
+                    return Err(SceneError::invalid(
+                        "camera.height",
+                        format!(
+                            "must be at most {:e} (twice the coordinate limit), got {height:e}",
+                            2.0 * MAX_CAMERA_COORD
+                        ),
+                    ));
+                }
                 if !(near >= 0.0 && near.is_finite()) {
                     return Err(SceneError::invalid(
                         "camera.near",

@@ -50,14 +50,17 @@ fn split_kept(track: LightTrack, kept: &[bool], new_index: &[usize], out: &mut V
     } = track;
     let mut run: Option<LightTrack> = None;
     for (k, light) in rest.into_iter().enumerate() {
-        let i = first + k;
+        // A track placed (in code) past any index a light can have keeps nothing.
+        let Some(i) = first.checked_add(k) else {
+            break;
+        };
         if kept.get(i).copied().unwrap_or(false) {
             run.get_or_insert_with(|| LightTrack {
                 first: new_index[i],
                 rest: Vec::new(),
                 motion,
                 vary,
-                variation_start: variation_start + k,
+                variation_start: variation_start.wrapping_add(k),
             })
             .rest
             .push(light);
@@ -104,5 +107,35 @@ mod tests {
         three.truncate_lights(3);
         three.validate().unwrap();
         assert_eq!(three.lights.len(), 3);
+    }
+
+    /// Tracks whose public indices were set in code near `usize::MAX` neither overflow nor
+    /// pose a light they do not move: one placed past every light is dropped by the cuts, and
+    /// variation numbers past the top wrap.
+    #[test]
+    fn tracks_placed_near_the_top_of_usize_neither_overflow_nor_wrap_onto_lights() {
+        let mut scene = builtin::build("courtyard", Some((8, 3))).unwrap();
+        let mut track = scene.animation[0].clone();
+        track.first = usize::MAX - 1;
+        track.variation_start = usize::MAX;
+        track.vary = Some(5);
+        track.rest.truncate(3);
+        scene.animation.push(track);
+        let before = scene.lights.clone();
+        let mut posed = scene.clone();
+        posed.set_time(0.0);
+        assert_eq!(posed.lights, before, "the stray track posed a light");
+        assert!(
+            scene.validate().is_err(),
+            "a track past the lights validates"
+        );
+        let mut kept = scene.clone();
+        kept.retain_lights(|_| true);
+        kept.validate().unwrap();
+        assert_eq!(kept.lights, before);
+        scene.remove_light(0).unwrap();
+        let k = scene.animation.last().unwrap();
+        assert_eq!(k.first, usize::MAX - 2);
+        assert!(k.motion_of(2).validate("", false).is_ok());
     }
 }

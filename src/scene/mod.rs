@@ -211,7 +211,8 @@ impl Scene {
                 let after = motion::LightTrack {
                     first: index,
                     rest: track.rest.split_off(k + 1),
-                    variation_start: track.variation_start + k + 1,
+                    // Variation numbers only seed a generator: wrapping is harmless.
+                    variation_start: track.variation_start.wrapping_add(k + 1),
                     ..track
                 };
                 track.rest.truncate(k);
@@ -226,8 +227,20 @@ impl Scene {
 
     /// Poses every animated light at time `t` (seconds; 0 is the scene as built). A pure
     /// function of `t`: frames can be rendered in any order. Allocates nothing; the part of a
-    /// track past the end of `lights` is skipped. Large sets are posed in parallel.
+    /// track past the end of `lights` is skipped. Sets of 4 096 lights and more are posed in
+    /// parallel on rayon's global pool (see [`Scene::set_time_on_this_thread`]).
     pub fn set_time(&mut self, t: f64) {
+        self.pose(t, true);
+    }
+
+    /// [`Scene::set_time`] on the calling thread alone, never entering rayon: for a game whose
+    /// own jobs fill rayon's global pool, where `set_time` would wait for one of them to end
+    /// (as `RenderOptions::max_assign_threads` of 1 does for the light assignment).
+    pub fn set_time_on_this_thread(&mut self, t: f64) {
+        self.pose(t, false);
+    }
+
+    fn pose(&mut self, t: f64, parallel: bool) {
         /// Below this many lights a thread hand-off costs more than it saves.
         const PARALLEL_FROM: usize = 4096;
         for track in &self.animation {
@@ -236,7 +249,7 @@ impl Scene {
             };
             let n = track.rest.len().min(lights.len());
             let lights = &mut lights[..n];
-            if lights.len() < PARALLEL_FROM {
+            if !parallel || lights.len() < PARALLEL_FROM {
                 track.pose(lights, t);
             } else {
                 use rayon::prelude::*;
@@ -307,7 +320,7 @@ impl Scene {
                         format!(
                             "can carry lights[{}] to a coordinate of {farthest:e}, past the \
                              ±{:e} a light may be at",
-                            track.first + k,
+                            track.first.saturating_add(k),
                             light::MAX_LIGHT_COORD
                         ),
                     ));
@@ -524,7 +537,7 @@ mod area_tests {
         );
         let mut cube = meshbuild::MeshBuilder::default();
         cube.cuboid(Vec3::splat(-1.0), Vec3::splat(1.0));
-        let (quad, cube) = (quad.build(), cube.build());
+        let (quad, cube) = (quad.build().unwrap(), cube.build().unwrap());
         assert_eq!(quad.normal_span().len(), 1);
         assert_eq!(cube.normal_span().len(), 3);
         let scale = |x, y, z| DMat4::from_scale(DVec3::new(x, y, z));

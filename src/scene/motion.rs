@@ -141,7 +141,8 @@ impl LightTrack {
         match (self.vary, self.rest.get(k)) {
             (Some(seed), Some(rest)) => {
                 let is_spot = matches!(rest.kind, LightKind::Spot { .. });
-                self.motion.varied(seed, self.variation_start + k, is_spot)
+                self.motion
+                    .varied(seed, self.variation_start.wrapping_add(k), is_spot)
             }
             _ => self.motion,
         }
@@ -190,8 +191,13 @@ impl Motion {
     pub fn apply(&self, rest: &Light, t: f64) -> Light {
         let t = if t.is_finite() { t } else { 0.0 };
         let mut light = *rest;
-        if let Some(o) = &self.orbit {
-            let axis = o.axis.normalize();
+        // An axis validation refuses (zero, NaN) turns nothing here rather than make NaN
+        // (or trip glam's assertions, where a dependency turns them on).
+        if let Some((o, axis)) = self
+            .orbit
+            .as_ref()
+            .and_then(|o| Some((o, o.axis.try_normalize()?)))
+        {
             light.position += match o.about {
                 OrbitAbout::Point(centre) => {
                     let turn = DQuat::from_axis_angle(axis, angle(t, o.period_s, 0.0));
@@ -229,11 +235,10 @@ impl Motion {
             light.intensity = rest.intensity * (1.0 - f.amount * noise as f32).max(0.0);
         }
         if let (Some(s), LightKind::Spot { direction, .. }) = (&self.sweep, &mut light.kind) {
-            let turn = DQuat::from_axis_angle(
-                s.axis.normalize(),
-                s.angle_deg.to_radians() * swing(t, s.period_s, s.phase_deg),
-            );
-            *direction = turn * *direction;
+            if let Some(axis) = s.axis.try_normalize() {
+                let angle = s.angle_deg.to_radians() * swing(t, s.period_s, s.phase_deg);
+                *direction = DQuat::from_axis_angle(axis, angle) * *direction;
+            }
         }
         light
     }

@@ -262,7 +262,7 @@ mod tests {
             glam::Vec3::new(1.0, 1.0, 0.0),
             glam::Vec3::new(-1.0, 1.0, 0.0),
         );
-        b.build()
+        b.build().unwrap()
     }
 
     #[test]

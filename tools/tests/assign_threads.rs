@@ -43,6 +43,20 @@ fn frame_waited_for_the_pool(
     patience: Duration,
 ) -> (bool, usize) {
     let scene = manylight::scene::builtin::build("courtyard", Some((LIGHTS, 5))).unwrap();
+    let mut threads = 0;
+    let waited = waited_for_the_held_pool(patience, || {
+        let (_, stats) = gpu
+            .r()
+            .render_offscreen(&scene, 64, 36, options)
+            .expect("render");
+        threads = stats.assignment.threads;
+    });
+    (waited, threads)
+}
+
+/// Runs `work` while every worker of the global pool is held; a watchdog lets the pool go
+/// after `patience` and says whether it had to (`work` waited for a worker).
+fn waited_for_the_held_pool(patience: Duration, work: impl FnOnce()) -> bool {
     let release = hold_the_global_pool();
     let workers = rayon::current_num_threads();
     let had_to = Arc::new(AtomicBool::new(false));
@@ -59,13 +73,10 @@ fn frame_waited_for_the_pool(
             }
         })
     };
-    let (_, stats) = gpu
-        .r()
-        .render_offscreen(&scene, 64, 36, options)
-        .expect("render");
+    work();
     let _ = done.send(());
     watchdog.join().unwrap();
-    (had_to.load(Ordering::SeqCst), stats.assignment.threads)
+    had_to.load(Ordering::SeqCst)
 }
 
 #[test]
@@ -89,6 +100,22 @@ fn one_assignment_thread_never_waits_for_a_busy_pool() {
             frame_waited_for_the_pool(&mut gpu, &default, Duration::from_secs(2));
         assert!(waited && threads >= 2, "waited {waited}, {threads} threads");
     }
+    // Posing moving lights: `set_time_on_this_thread` never waits for the pool and poses
+    // what `set_time` poses; `set_time` itself takes the pool at this many lights, and waits.
+    let mut scene = manylight::scene::builtin::build("courtyard", Some((LIGHTS, 5))).unwrap();
+    assert!(scene.animation.iter().any(|t| t.rest.len() >= 4096));
+    let mut posed = scene.clone();
+    let waited = waited_for_the_held_pool(Duration::from_secs(60), || {
+        scene.set_time_on_this_thread(2.5);
+    });
+    assert!(!waited, "set_time_on_this_thread waited for the held pool");
+    if rayon::current_num_threads() >= 2 {
+        let waited = waited_for_the_held_pool(Duration::from_secs(2), || posed.set_time(2.5));
+        assert!(waited, "set_time did not take the pool");
+    } else {
+        posed.set_time(2.5);
+    }
+    assert_eq!(scene.lights, posed.lights);
     // 0 threads is refused naming the field.
     let none = RenderOptions {
         max_assign_threads: 0,

@@ -32,7 +32,7 @@ fn scene() -> Scene {
             Vec3::new(x + 0.6, 0.6, 0.0),
             Vec3::new(x - 0.6, 0.6, 0.0),
         );
-        Arc::new(b.build())
+        Arc::new(b.build().unwrap())
     };
     let mut cube = MeshBuilder::new();
     cube.cuboid(Vec3::splat(-0.5), Vec3::splat(0.5));
@@ -40,7 +40,7 @@ fn scene() -> Scene {
         (quad(-1.7), glass, DMat4::IDENTITY),
         (quad(0.0), stone, DMat4::IDENTITY),
         (
-            Arc::new(cube.build()),
+            Arc::new(cube.build().unwrap()),
             glass,
             DMat4::from_translation(DVec3::new(1.7, 0.0, 0.0)),
         ),

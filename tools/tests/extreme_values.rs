@@ -5,7 +5,7 @@
 mod common;
 
 use common::{mean, Gpu};
-use glam::{DVec3, Vec3};
+use glam::{DMat4, DVec3, Vec3};
 use manylight::scene::{self, Camera, Light, Projection, Scene};
 use manylight::{EsVersion, RenderOptions};
 
@@ -208,6 +208,30 @@ fn values_the_maths_cannot_carry_are_refused_naming_the_real_field() {
                 s.lights[0].intensity = 3e38;
             }),
             "lights[0].position",
+        ),
+        // Finite, but past f32 in the view matrix: the object vanished without a word.
+        (
+            Box::new(|s: &mut Scene| {
+                s.objects[0].transform = DMat4::from_scale(DVec3::splat(1e39))
+            }),
+            "objects[0].transform",
+        ),
+        (
+            Box::new(|s: &mut Scene| {
+                s.objects[0].transform = DMat4::from_translation(DVec3::new(0.0, 2e12, 0.0))
+            }),
+            "objects[0].transform",
+        ),
+        // Its f32 projection scale was 0: nothing drawn, no error.
+        (
+            Box::new(|s: &mut Scene| {
+                s.camera.projection = Projection::Orthographic {
+                    height: 1e39,
+                    near: 0.0,
+                    far: 10.0,
+                }
+            }),
+            "camera.height",
         ),
     ];
     for (break_it, field) in cases {

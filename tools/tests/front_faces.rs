@@ -173,7 +173,7 @@ fn glass_box(mirrored: bool) -> Scene {
     let mirror = if mirrored { -1.0 } else { 1.0 };
     let turn = DMat4::from_rotation_y(0.6) * DMat4::from_rotation_x(0.4);
     s.objects.push(Object {
-        mesh: Arc::new(b.build()),
+        mesh: Arc::new(b.build().unwrap()),
         material: glass,
         transform: turn * DMat4::from_scale(DVec3::new(mirror, 1.0, 1.0)),
     });

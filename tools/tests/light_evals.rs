@@ -180,7 +180,7 @@ fn counts_equal_the_cpu_cluster_lists_at_sampled_pixels() {
                     let expected = lists.counts[here as usize];
                     assert_eq!(
                         gpu_counts.at(x, y),
-                        expected,
+                        Some(expected),
                         "{es} {method}: pixel ({x}, {y}) in cell {here}"
                     );
                     checked += 1;

@@ -54,7 +54,7 @@ fn sweep(case: LightCase, intensity: f32) -> Scene {
                 let mut mesh = MeshBuilder::new();
                 mesh.sphere(Vec3::ZERO, 0.42, 32, 16);
                 s.objects.push(Object {
-                    mesh: Arc::new(mesh.build()),
+                    mesh: Arc::new(mesh.build().unwrap()),
                     material: m,
                     transform: DMat4::from_translation(centre),
                 });
@@ -243,7 +243,7 @@ fn metal_spheres_under_a_sun_match_the_twin_and_every_method_equals_forward() {
         let mut mesh = MeshBuilder::new();
         mesh.sphere(Vec3::ZERO, 0.9, 40, 20);
         s.objects.push(Object {
-            mesh: Arc::new(mesh.build()),
+            mesh: Arc::new(mesh.build().unwrap()),
             material: m,
             transform: DMat4::from_translation(DVec3::new(i as f64 * 2.0 - 2.0, 0.0, 0.0)),
         });

@@ -426,3 +426,26 @@ fn a_motion_that_can_carry_a_light_out_of_range_is_named_at_once() {
         assert!(far, "{motion:?}");
     }
 }
+
+/// A motion set in code with an axis validation refuses (zero, NaN) poses the light without
+/// that turn: finite, not NaN, and without the normalisations glam's assertions would stop at.
+/// Validation still names the axis.
+#[test]
+fn an_axis_validation_refuses_turns_nothing_when_posed() {
+    for axis in [DVec3::ZERO, DVec3::NAN] {
+        let mut m = every_motion();
+        m.orbit.as_mut().unwrap().axis = axis;
+        m.sweep.as_mut().unwrap().axis = axis;
+        let posed = m.apply(&spot(), 1.3);
+        assert!(posed.position.is_finite(), "{axis:?}: {:?}", posed.position);
+        let LightKind::Spot { direction, .. } = posed.kind else {
+            panic!("not a spot");
+        };
+        assert_eq!(direction, DVec3::NEG_Y, "{axis:?}");
+        let err = m
+            .validate("lights[0].motion", true)
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("axis"), "{err}");
+    }
+}

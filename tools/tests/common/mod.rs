@@ -290,7 +290,7 @@ pub fn turned_square() -> Scene {
         Vec3::new(-1.0, 1.0, 0.0),
     );
     s.objects.push(Object {
-        mesh: Arc::new(square.build()),
+        mesh: Arc::new(square.build().unwrap()),
         material: white,
         transform: DMat4::from_rotation_z(30f64.to_radians()),
     });
