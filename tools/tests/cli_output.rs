@@ -397,13 +397,16 @@ fn a_sixteen_bit_own_depth_buffer_is_said() {
 /// softpipe has ES 3.0 but one sample: `info` says that, not that MSAA needs ES 3.0.
 #[test]
 fn info_gives_the_real_reason_msaa_is_missing() {
+    if common::other_implementation_than_mesa("GALLIUM_DRIVER=softpipe") {
+        return;
+    }
     let dir = tempfile::tempdir().unwrap();
     let out = manylight(&["info"], &[("GALLIUM_DRIVER", "softpipe")], dir.path());
     let shown = text(&out);
     assert_eq!(out.status.code(), Some(0), "{shown}");
     let msaa = shown.lines().find(|l| l.starts_with("MSAA")).unwrap();
     if !shown.contains("softpipe") {
-        eprintln!("no softpipe here: {msaa}");
+        common::skip(&format!("no softpipe here: {msaa}"));
         return;
     }
     assert!(msaa.contains("GL_MAX_SAMPLES is 1"), "{msaa}");

@@ -276,7 +276,12 @@ fn never_misses_on_cell_boundaries() {
                 }
             }
         }
-        check_points(&grid, &lights, &a, &points, case.name);
+        let checked = check_points(&grid, &lights, &a, &points, case.name);
+        assert!(
+            checked > 500,
+            "{}: {checked} point-light pairs checked",
+            case.name
+        );
     }
 }
 
