@@ -338,20 +338,29 @@ fn extreme_near_and_far_planes_and_orthographic() {
 
 #[test]
 fn lights_on_cell_boundaries_and_one_ulp_either_side() {
-    use manylight::cluster::grid::{ClusterGrid, GridProjection};
     let mut s = plane();
     let (w, h) = (128u32, 72u32);
-    let proj = s.camera.projection_matrix(w as f64 / h as f64);
-    let (near, far) = s.camera.near_far();
-    let grid = ClusterGrid::new(
-        w,
-        h,
-        GridProjection::from_matrix(&proj),
-        near,
-        5.0,
-        &fine_grid(),
-    );
-    let _ = far;
+    // Small cells, so a light that misses a cell it touches shows in the image.
+    let opts = RenderOptions {
+        grid: fine_grid(),
+        tile_px: 8.0,
+        ..Default::default()
+    };
+    // The grid the renderer builds for this view (a fixed grid: the lights do not change it),
+    // from a frame with one dim light.
+    let mut gpu = Gpu::new(EsVersion::Es3);
+    gpu.r().set_method_named("clustered").unwrap();
+    let grid_of = |gpu: &mut Gpu, s: &Scene| {
+        gpu.r().render_offscreen(s, w, h, &opts).unwrap();
+        gpu.r()
+            .last_light_lists()
+            .expect("clustered lists")
+            .0
+            .clone()
+    };
+    let mut probe = s.clone();
+    probe.lights = vec![point([0.0, 0.0, 4.0], 0.5, 0.1)];
+    let grid = grid_of(&mut gpu, &probe);
     // The slice boundary nearest to 4.6 (just in front of the plane at depth 5), so lights on
     // it reach the plane and a miss shows in the image.
     let (k, z0) = (0..grid.cascades.len() as u32)
@@ -359,6 +368,10 @@ fn lights_on_cell_boundaries_and_one_ulp_either_side() {
         .map(|(k, sl)| (k, grid.slice_depth_range(k, sl).0))
         .min_by(|a, b| (a.1 - 4.6).abs().total_cmp(&(b.1 - 4.6).abs()))
         .unwrap();
+    assert!(
+        (z0 - 4.6).abs() < 0.5,
+        "no slice boundary near the plane: {z0}"
+    );
     let c = &grid.cascades[k as usize];
     let (hx, hy) = grid.projection.half_extent(z0);
     let x = (-1.0 + 2.0 * (c.tiles_x / 2) as f64 / c.tiles_x as f64) * hx;
@@ -372,23 +385,17 @@ fn lights_on_cell_boundaries_and_one_ulp_either_side() {
     ] {
         s.lights.push(Light::point(p, 0.9, Vec3::ONE, 0.4));
     }
-    // Small cells (the same configuration as the grid above), so a light that misses a cell
-    // it touches shows in the image.
-    let opts = RenderOptions {
-        grid: fine_grid(),
-        tile_px: 8.0,
-        ..Default::default()
-    };
+    // The lights sit on a boundary of the grid the renderer uses with them too.
+    let used = grid_of(&mut gpu, &s);
+    assert_eq!(used.slice_depth_range(k, 0), grid.slice_depth_range(k, 0));
+    assert!((0..used.cascades[k as usize].slices).any(|sl| used.slice_depth_range(k, sl).0 == z0));
     check_with("cell boundaries", &s, w, h, &opts);
     assert_matches_oracle("cell boundaries", &s, w, h);
 }
 
-/// 8-pixel cells without a minimum size: cells small enough that culling decides pixels.
+/// A fixed grid of 8-pixel cells: cells small enough that culling decides pixels.
 fn fine_grid() -> manylight::cluster::grid::GridConfig {
-    manylight::cluster::grid::GridConfig {
-        footprint_px: 8.0,
-        ..Default::default()
-    }
+    manylight::cluster::grid::GridConfig::fixed(8.0)
 }
 
 #[test]

@@ -280,7 +280,41 @@ fn view_resolves_es2_msaa_through_the_extension() {
 #[test]
 fn view_poses_moving_lights_at_the_given_time() {
     let at = ["--time", "2.5"];
-    check_window_frame(&at, &at, &[]);
+    if check_window_frame(&at, &at, &[]).is_none() {
+        return;
+    }
+    // The window matched `render --time 2.5` on 99 % of its pixels; that frame must differ from
+    // t = 0's on far more, or a window that ignored `--time` would pass too.
+    let dir = tempfile::tempdir().expect("tempdir");
+    let size = format!("{}x{}", SIZE.0, SIZE.1);
+    let frame_at = |t: &str| {
+        let out_path = dir.path().join(format!("t{t}.png"));
+        let out = Command::new(BIN)
+            .args([
+                "render", "--lights", "256", "--frames", "0", "--size", &size,
+            ])
+            .args(["--time", t, "--out"])
+            .arg(&out_path)
+            .output()
+            .expect("run manylight render");
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        image::open(&out_path).expect("render png").to_rgba8()
+    };
+    let (moved, rest) = (frame_at("2.5"), frame_at("0"));
+    let differ = fraction(&moved, |x, y| {
+        let (a, b) = (moved.get_pixel(x, y), rest.get_pixel(x, y));
+        (0..3).any(|c| a.0[c].abs_diff(b.0[c]) > 2)
+    });
+    println!("t = 2.5 and t = 0 differ on {:.2}%", differ * 100.0);
+    assert!(
+        differ > 0.05,
+        "t = 2.5 and t = 0 differ on {:.2}%",
+        differ * 100.0
+    );
 }
 
 #[test]

@@ -626,6 +626,14 @@ fn a_spot_without_an_axis_direction_is_its_sphere_in_every_band() {
                 cone_deg: (180.0, 180.0),
             };
             let sphere = cells(&point, &SliceWindow::ALL);
+            // Or every comparison below would pass with no cells at all.
+            assert_eq!(
+                sphere.is_empty(),
+                position.z > 0.0,
+                "{}: the sphere at {position} reaches {} cells",
+                case.name,
+                sphere.len()
+            );
             for direction in [
                 Vec3::ZERO,
                 Vec3::new(-0.24, 0.0, f32::NEG_INFINITY),
