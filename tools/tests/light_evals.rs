@@ -195,6 +195,113 @@ fn counts_equal_the_cpu_cluster_lists_at_sampled_pixels() {
     }
 }
 
+/// Lights a CPU finds reaching `p` (world space): within the radius and, for a spot, the
+/// cone; `grow` (±) widens or narrows both, by a fraction of the radius and an angle in
+/// degrees, so that lights within rounding of either edge count in one bound only.
+fn reaching_on_the_cpu(lights: &[manylight::scene::Light], p: glam::DVec3, grow: f64) -> u32 {
+    use manylight::scene::LightKind;
+    let mut n = 0;
+    for l in lights {
+        let to_p = p - l.position;
+        let d = to_p.length();
+        if d >= l.radius as f64 * (1.0 + 2e-3 * grow) {
+            continue;
+        }
+        if let LightKind::Spot {
+            direction,
+            outer_deg,
+            ..
+        } = l.kind
+        {
+            if outer_deg < 90.0 && d < 1e-9 {
+                // At the apex the direction to the point is undefined.
+                n += u32::from(grow > 0.0);
+                continue;
+            }
+            let angle = to_p.angle_between(direction).to_degrees();
+            // A sharp edge fades just past the outer angle (at most 1e-4 of 1 − cos: 0.81°).
+            let edge = outer_deg + if grow > 0.0 { 0.85 } else { 0.0 };
+            if d > 1e-9 && angle >= edge + 0.3 * grow {
+                continue;
+            }
+        }
+        n += 1;
+    }
+    n
+}
+
+/// The reaching counts (the lower bound every method is checked against above) are what the
+/// light model says: at sampled pixels the surface point a CPU ray cast finds is reached by as
+/// many lights as the GPU counted, within the rounding of each light's radius and cone.
+#[test]
+fn reaching_counts_equal_a_cpu_count_at_sampled_pixels() {
+    use manylight::scene::raycast::{pixel_ray, SceneRaycaster};
+    let (w, h) = (256u32, 144u32);
+    for (name, lights) in [("courtyard", 256), ("pillars", 512)] {
+        let scene = scene::builtin::build(name, Some((lights, 5))).unwrap();
+        let spots = scene
+            .lights
+            .iter()
+            .filter(|l| matches!(l.kind, manylight::scene::LightKind::Spot { .. }))
+            .count();
+        let caster = SceneRaycaster::new(&scene);
+        for es in [EsVersion::Es2, EsVersion::Es3] {
+            let mut gpu = Gpu::new(es);
+            let gpu_counts = counts(&mut gpu, &scene, "forward", CountKind::Reaching);
+            let (mut checked, mut lit, mut tight) = (0, 0, 0);
+            for y in (0..h).step_by(3) {
+                for x in (0..w).step_by(3) {
+                    // The surface at the pixel's centre, and the same one at about the same depth a
+                    // little either side (not a silhouette, where the rasterizer may pick the
+                    // surface behind).
+                    let hit_at = |dx: f64, dy: f64| {
+                        let (o, d) = pixel_ray(
+                            &scene.camera,
+                            w,
+                            h,
+                            x as f64 + 0.5 + dx,
+                            y as f64 + 0.5 + dy,
+                        );
+                        caster.hit(o, d)
+                    };
+                    let Some(hit) = hit_at(0.0, 0.0) else {
+                        continue;
+                    };
+                    let same = [(0.3, 0.0), (-0.3, 0.0), (0.0, 0.3), (0.0, -0.3)]
+                        .iter()
+                        .all(|&(dx, dy)| {
+                            hit_at(dx, dy).is_some_and(|o| {
+                                o.object == hit.object && (o.t - hit.t).abs() < 1e-2 * hit.t
+                            })
+                        });
+                    if !same {
+                        continue;
+                    }
+                    let (lo, hi) = (
+                        reaching_on_the_cpu(&scene.lights, hit.position, -1.0),
+                        reaching_on_the_cpu(&scene.lights, hit.position, 1.0),
+                    );
+                    let got = gpu_counts.at(x, y).expect("in the image");
+
+                    assert!(
+                    (lo..=hi).contains(&got),
+                    "{name} {es}: pixel ({x}, {y}) at {}: the GPU counts {got} lights reaching, the CPU {lo}..={hi}",
+                    hit.position
+                );
+                    checked += 1;
+                    lit += usize::from(lo > 0);
+                    tight += usize::from(lo == hi);
+                }
+            }
+            eprintln!("{name} {es}: {checked} pixels checked, {lit} reached, {tight} without an edge; {spots} spots");
+            assert!(
+                checked > 2000 && lit * 4 > checked && tight * 10 > checked * 9,
+                "{name} {es}: {checked} pixels checked, {lit} reached, {tight} without an edge"
+            );
+        }
+    }
+}
+
 /// Deferred's proxies skip the surfaces a light cannot reach: a sphere behind the wall by its
 /// near side, a sphere around the eye by its far side — which replaced a full-screen pass, so
 /// a light around the eye short of the wall now evaluates nowhere, and one reaching the wall
