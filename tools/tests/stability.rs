@@ -219,9 +219,10 @@ fn assert_matches_oracle(name: &str, scene: &Scene, w: u32, h: u32) {
     );
     let (err, at, n) = max_oracle_error(&img, scene, Encoding::Linear, gpu.r().caps());
     // Each case's plane covers a third of the frame or more (the orthographic and the
-    // 4096×8 views the least): a reference that kept few pixels compares too little.
+    // 4096×8 views the least): a reference that kept few pixels compares too little. (A 1×1
+    // frame's one pixel may be an edge at an implementation's sub-pixel snapping.)
     assert!(
-        n * 4 >= (w * h) as usize,
+        n * 4 >= (w * h) as usize || w * h < 16,
         "{name}: {n} of {w}×{h} pixels compared"
     );
     assert!(
