@@ -253,7 +253,10 @@ pub(crate) fn shade_object<P: GeometryProgram>(
         t.bind(dev, UNIT_ALBEDO, &sampling);
     }
     let frame = SurfaceFrame {
-        ambient: ctx.scene.ambient,
+        ambient: super::uniforms::ambient_uniform(
+            ctx.scene.ambient,
+            ctx.features.has(ShaderFeatures::FP16_LIGHTS),
+        ),
         exposure: ctx.options.exposure_ev.exp2(),
         orthographic: ctx.orthographic,
         heat_scale: ctx.options.heat_scale.max(1.0),

@@ -76,6 +76,21 @@ pub struct Surface {
     maps: MapUniforms,
 }
 
+/// Largest ambient (a channel) and ambient term (ambient × albedo) without fragment `highp`,
+/// where both are fp16: past 65 504 they were infinity. The uniform is capped here, the term
+/// (albedo may pass 1) in `glsl/surface_maps.glsl`.
+pub(crate) const FP16_MAX_AMBIENT: f32 = 60000.0;
+
+/// The ambient uniform's value: capped at [`FP16_MAX_AMBIENT`] where it is fp16 (`fp16`: the
+/// `FP16_LIGHTS` tier).
+pub(crate) fn ambient_uniform(ambient: Vec3, fp16: bool) -> Vec3 {
+    if fp16 {
+        ambient.min(Vec3::splat(FP16_MAX_AMBIENT))
+    } else {
+        ambient
+    }
+}
+
 /// What a frame sets on every object's [`Surface`] besides its material.
 pub(crate) struct SurfaceFrame {
     /// The scene's ambient radiance.

@@ -10,6 +10,7 @@ use glam::Vec3;
 
 use crate::cluster::pack::{fp16_radiance, FP16_MAX_RADIANCE};
 use crate::gl::Caps;
+use crate::methods::uniforms::FP16_MAX_AMBIENT;
 use crate::scene::Scene;
 
 /// fp16's smallest normal number, 2⁻¹⁴.
@@ -58,6 +59,20 @@ pub(super) fn warn_of_capped_radiance(caps: &Caps, scene: &Scene, warned: &mut b
     log::warn!(
         "{list}[{i}]: colour × intensity {radiance:?} is past 2³⁰, the brightest radiance a \
          light has without fragment highp (fp16): it is drawn as 2³⁰, its channels scaled alike"
+    );
+}
+
+/// Without fragment `highp`: warns (once, `warned`) when the ambient passes
+/// [`FP16_MAX_AMBIENT`] in a channel, where it is drawn at that cap.
+pub(super) fn warn_of_capped_ambient(caps: &Caps, scene: &Scene, warned: &mut bool) {
+    if caps.fragment_has_highp() || *warned || scene.ambient.max_element() <= FP16_MAX_AMBIENT {
+        return;
+    }
+    *warned = true;
+    log::warn!(
+        "ambient {:?} is past {FP16_MAX_AMBIENT}, the most the ambient light holds without \
+         fragment highp (fp16): it is drawn as {FP16_MAX_AMBIENT} in those channels",
+        scene.ambient
     );
 }
 

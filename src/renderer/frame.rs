@@ -268,6 +268,11 @@ impl Renderer {
             scene,
             &mut self.warned_capped_radiance,
         );
+        super::fp16_channels::warn_of_capped_ambient(
+            self.dev.caps(),
+            scene,
+            &mut self.warned_capped_ambient,
+        );
         let frame_rect = [origin[0], origin[1], width, height].map(|v| v as i32);
         self.dev
             .viewport(frame_rect[0], frame_rect[1], frame_rect[2], frame_rect[3]);

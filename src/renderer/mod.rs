@@ -82,6 +82,8 @@ pub struct Renderer {
     /// Whether a light brighter than the fp16 radiance form holds was said (without fragment
     /// highp; once a renderer).
     warned_capped_radiance: bool,
+    /// Whether the fp16 cap of the ambient term was said (`fp16_channels`).
+    warned_capped_ambient: bool,
     /// The renderer's own 16-bit depth buffer was announced (once per renderer).
     warned_own_depth_bits: bool,
     /// The frame's objects in draw order (kept likewise).
@@ -154,6 +156,7 @@ impl Renderer {
             srgb_destination: false,
             warned_depth_step: false,
             warned_capped_radiance: false,
+            warned_capped_ambient: false,
             warned_own_depth_bits: false,
             draw_order: methods::geometry::DrawOrder::default(),
             lp_num_threads: std::env::var("LP_NUM_THREADS").ok(),

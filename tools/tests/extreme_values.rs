@@ -574,3 +574,51 @@ fn a_light_past_what_fp16_radiance_holds_in_rgba8_records_too() {
         "a_light_past_what_fp16_radiance_holds_is_drawn_at_that_limit_with_a_warning",
     );
 }
+
+/// Without fragment highp the ambient uniform and its term are fp16: an ambient past 65 504
+/// read as infinity, white at any exposure through a tone map (and NaN where a texture or the
+/// occlusion is 0). Ambient is now capped at 60 000 a channel there, with a warning: the frame
+/// is highp's frame at an ambient of 60 000.
+#[test]
+fn an_ambient_past_fp16_is_drawn_at_the_fp16_cap_with_a_warning() {
+    common::warnings::install();
+    let mut mediump = Gpu::without_fragment_highp();
+    let mut highp = Gpu::new(EsVersion::Es2);
+    let opts = RenderOptions {
+        exposure_ev: -15.0,
+        tone_map: manylight::ToneMap::Reinhard,
+        linear: true,
+        ..Default::default()
+    };
+    let with_ambient = |a: f32| {
+        let mut s = plane(vec![]);
+        s.ambient = Vec3::splat(a);
+        s
+    };
+    let capped = highp.render(&with_ambient(60_000.0), 64, 36, &opts);
+    let exact = highp.render(&with_ambient(1e6), 64, 36, &opts);
+    assert!(
+        manylight::metrics::diff(&capped, &exact).max_abs > 20,
+        "the cap shows at this exposure"
+    );
+    let said = || common::warnings::warnings_containing("ambient").len();
+    let before = said();
+    let image = mediump.render(&with_ambient(1e6), 64, 36, &opts);
+    let d = manylight::metrics::diff(&capped, &image).max_abs;
+    assert!(d <= 3, "{d} / 255 from highp's frame at the cap");
+    assert_eq!(said(), before + 1, "said once");
+    mediump.render(&with_ambient(1e6), 64, 36, &opts);
+    assert_eq!(said(), before + 1, "said once a renderer");
+    // A diffuse factor past 1 (up to MAX_COLOR_FACTOR) takes the term past fp16 from a valid
+    // ambient: 1 000 × 100 is drawn as a term of 60 000, highp's frame at an ambient of 600.
+    let bright = |a: f32| {
+        let mut s = with_ambient(a);
+        s.materials[0].diffuse = Vec3::splat(100.0);
+        s.materials[0].specular = Vec3::ZERO;
+        s
+    };
+    let capped = highp.render(&bright(600.0), 64, 36, &opts);
+    let image = mediump.render(&bright(1000.0), 64, 36, &opts);
+    let d = manylight::metrics::diff(&capped, &image).max_abs;
+    assert!(d <= 3, "{d} / 255 from highp's frame at the term's cap");
+}
