@@ -12,7 +12,7 @@ use std::fs::{File, OpenOptions, Permissions};
 use std::io::{self, BufWriter, Write};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU32, Ordering};
-use std::sync::OnceLock;
+use std::sync::{Mutex, MutexGuard, OnceLock};
 
 /// A file that could not be written, and why (the OS error).
 #[derive(Debug)]
@@ -64,6 +64,45 @@ pub struct OutputFile {
 
 /// Numbers the temporary files of one process.
 static TEMP_COUNTER: AtomicU32 = AtomicU32::new(0);
+
+/// The temporary files being written now, which a signal that ends the process removes
+/// ([`remove_temporaries_on_signals`]).
+static LIVE_TEMPORARIES: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+
+fn live_temporaries() -> MutexGuard<'static, Vec<PathBuf>> {
+    LIVE_TEMPORARIES.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+fn forget_temporary(temp: &Path) {
+    live_temporaries().retain(|t| t != temp);
+}
+
+/// On SIGINT, SIGTERM or SIGHUP (Ctrl-C, `kill`, a closed terminal) removes the temporary files
+/// being written, then ends the process as the signal's default action does (the same exit
+/// status): a long `--record` stopped half-way used to leave its `.NAME.PID.N.tmp` behind.
+#[cfg(unix)]
+pub fn remove_temporaries_on_signals() {
+    use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
+    let Ok(mut signals) = signal_hook::iterator::Signals::new([SIGINT, SIGTERM, SIGHUP]) else {
+        return;
+    };
+    let watch = move || {
+        if let Some(signal) = signals.forever().next() {
+            for temp in live_temporaries().drain(..) {
+                let _ = std::fs::remove_file(temp);
+            }
+            let _ = signal_hook::low_level::emulate_default_handler(signal);
+        }
+    };
+    // Without the thread the signals keep their default action.
+    let _ = std::thread::Builder::new()
+        .name("signals".into())
+        .spawn(watch);
+}
+
+/// Elsewhere a signal ends the process as it always did.
+#[cfg(not(unix))]
+pub fn remove_temporaries_on_signals() {}
 
 impl OutputFile {
     /// Opens `path` for writing: fails now, naming it, where it cannot be written (a folder, a
@@ -158,6 +197,7 @@ impl OutputFile {
                 std::fs::set_permissions(&*temp, p)?;
             }
             std::fs::rename(&*temp, &*dest)?;
+            forget_temporary(temp);
             self.target = Target::InPlace;
         }
         Ok(())
@@ -193,6 +233,7 @@ impl Drop for OutputFile {
         if let Target::Replace { temp, .. } = &self.target {
             drop(self.writer.take());
             let _ = std::fs::remove_file(temp);
+            forget_temporary(temp);
         }
     }
 }
@@ -235,6 +276,7 @@ fn create_temp(dest: &Path) -> io::Result<(PathBuf, File)> {
         .write(true)
         .create_new(true)
         .open(&temp)?;
+    live_temporaries().push(temp.clone());
     Ok((temp, file))
 }
 

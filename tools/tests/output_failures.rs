@@ -425,3 +425,54 @@ fn every_spelling_of_standard_output_reaches_it() {
         );
     }
 }
+
+/// A render stopped by a signal (Ctrl-C, `kill`, a closed terminal) half-way through a
+/// recording leaves no hidden temporary file, and still ends by that signal. It used to leave
+/// `.r.gif.PID.N.tmp` beside where the GIF would go.
+#[test]
+fn a_signal_half_way_through_a_recording_leaves_no_temporary_file() {
+    use std::os::unix::process::ExitStatusExt;
+    let dir = tempfile::tempdir().unwrap();
+    let temporaries = || {
+        std::fs::read_dir(dir.path())
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .filter(|n| n.ends_with(".tmp"))
+            .collect::<Vec<_>>()
+    };
+    for (signal, number) in [("TERM", 15), ("INT", 2), ("HUP", 1)] {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_manylight"))
+            .args(["--size", "32x18", "--lights", "4", "--frames", "65536"])
+            .args(["--record", "r.gif"])
+            .current_dir(dir.path())
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn()
+            .unwrap();
+        // The recording's temporary file appears when the render starts.
+        let deadline = std::time::Instant::now() + std::time::Duration::from_secs(60);
+        while temporaries().is_empty() {
+            assert!(
+                std::time::Instant::now() < deadline,
+                "no temporary file appeared"
+            );
+            assert!(
+                child.try_wait().unwrap().is_none(),
+                "the render ended early"
+            );
+            std::thread::sleep(std::time::Duration::from_millis(20));
+        }
+        let kill = Command::new("kill")
+            .args([format!("-{signal}"), child.id().to_string()])
+            .status()
+            .unwrap();
+        assert!(kill.success());
+        let status = child.wait().unwrap();
+        assert_eq!(status.signal(), Some(number), "SIG{signal}: {status:?}");
+        assert_eq!(temporaries(), Vec::<String>::new(), "SIG{signal}");
+        assert!(
+            !dir.path().join("r.gif").exists(),
+            "SIG{signal}: a GIF was left"
+        );
+    }
+}
