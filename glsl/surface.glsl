@@ -154,6 +154,11 @@ vec4 encodeOutput(vec3 color) {
     // Float targets: unclamped, so NaN and Inf stay visible to the stability tests.
     return vec4(color, u_alpha);
 #else
+#if FP16_LIGHTS
+    // A sum past fp16's largest value is infinity, white at any exposure: taken as that value
+    // instead (too dark at a low exposure, never brighter than the scene).
+    color = min(color, vec3(65504.0));
+#endif
     HIGHP vec3 exposed = color * u_exposure;
 #if TONEMAP
     exposed = toneMap(exposed);

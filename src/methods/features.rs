@@ -11,6 +11,12 @@ use crate::scene::light::SPOT_MIN_COS_DELTA;
 /// −11 EV and up (−2 EV and up through a tone map, whose input is capped at 1 000).
 pub const DIRECTIONAL_FP16_CAP: f32 = 16000.0;
 
+/// Without fragment highp (where they are fp16, past 65 504 infinity), the largest ambient a
+/// channel and the largest ambient term (ambient × albedo, which may pass 1): the uniform is
+/// scaled down to it, its channels alike (`uniforms::ambient_uniform`); the term is capped at
+/// it per channel in `glsl/surface_maps.glsl`.
+pub const FP16_MAX_AMBIENT: f32 = 60000.0;
+
 /// Feature bitset of a shader variant.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub struct ShaderFeatures(pub u64);
@@ -191,6 +197,7 @@ impl ShaderFeatures {
                 "DIRECTIONAL_FP16_CAP".into(),
                 format!("{DIRECTIONAL_FP16_CAP:.1}"),
             ),
+            ("FP16_MAX_AMBIENT".into(), format!("{FP16_MAX_AMBIENT:.1}")),
             (
                 "MAX_DIRECTIONAL".into(),
                 crate::scene::MAX_DIRECTIONAL_LIGHTS.to_string(),

@@ -7,6 +7,7 @@
 
 use glam::{DMat3, DMat4, Mat3, Mat4, Vec3};
 
+use super::features::FP16_MAX_AMBIENT;
 use super::maps::MapUniforms;
 use super::ShaderFeatures;
 use crate::gl::program::{Resolver, Sampler, Uniform};
@@ -76,16 +77,12 @@ pub struct Surface {
     maps: MapUniforms,
 }
 
-/// Largest ambient (a channel) and ambient term (ambient × albedo) without fragment `highp`,
-/// where both are fp16: past 65 504 they were infinity. The uniform is capped here, the term
-/// (albedo may pass 1) in `glsl/surface_maps.glsl`.
-pub(crate) const FP16_MAX_AMBIENT: f32 = 60000.0;
-
-/// The ambient uniform's value: capped at [`FP16_MAX_AMBIENT`] where it is fp16 (`fp16`: the
-/// `FP16_LIGHTS` tier).
+/// The ambient uniform's value: where it is fp16 (`fp16`: the `FP16_LIGHTS` tier) scaled down,
+/// its channels alike, so that none passes [`FP16_MAX_AMBIENT`].
 pub(crate) fn ambient_uniform(ambient: Vec3, fp16: bool) -> Vec3 {
-    if fp16 {
-        ambient.min(Vec3::splat(FP16_MAX_AMBIENT))
+    let brightest = ambient.max_element();
+    if fp16 && brightest > FP16_MAX_AMBIENT {
+        ambient * (FP16_MAX_AMBIENT / brightest)
     } else {
         ambient
     }

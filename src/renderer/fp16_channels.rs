@@ -10,7 +10,7 @@ use glam::Vec3;
 
 use crate::cluster::pack::{fp16_radiance, FP16_MAX_RADIANCE};
 use crate::gl::Caps;
-use crate::methods::uniforms::FP16_MAX_AMBIENT;
+use crate::methods::features::FP16_MAX_AMBIENT;
 use crate::scene::Scene;
 
 /// fp16's smallest normal number, 2⁻¹⁴.
@@ -62,16 +62,26 @@ pub(super) fn warn_of_capped_radiance(caps: &Caps, scene: &Scene, warned: &mut b
     );
 }
 
-/// Without fragment `highp`: warns (once, `warned`) when the ambient passes
-/// [`FP16_MAX_AMBIENT`] in a channel, where it is drawn at that cap.
+/// Without fragment `highp`: warns (once, `warned`) when the ambient or its term (ambient ×
+/// the largest diffuse factor of a material; textures and vertex colours only darken) passes
+/// [`FP16_MAX_AMBIENT`], where it is drawn at that cap.
 pub(super) fn warn_of_capped_ambient(caps: &Caps, scene: &Scene, warned: &mut bool) {
-    if caps.fragment_has_highp() || *warned || scene.ambient.max_element() <= FP16_MAX_AMBIENT {
+    if caps.fragment_has_highp() || *warned {
+        return;
+    }
+    let albedo = (scene.materials.iter())
+        .map(|m| m.diffuse.max_element())
+        .fold(1.0, f32::max);
+    let peak = scene.ambient.max_element() * albedo;
+    if peak <= FP16_MAX_AMBIENT {
         return;
     }
     *warned = true;
     log::warn!(
-        "ambient {:?} is past {FP16_MAX_AMBIENT}, the most the ambient light holds without \
-         fragment highp (fp16): it is drawn as {FP16_MAX_AMBIENT} in those channels",
+        "ambient {:?} times a diffuse factor of up to {albedo} reaches {peak:e}, past the \
+         {FP16_MAX_AMBIENT} the ambient term holds without fragment highp (fp16): the ambient \
+         is drawn at most {FP16_MAX_AMBIENT} (its channels scaled alike), and so is each \
+         channel of its term",
         scene.ambient
     );
 }

@@ -9,8 +9,9 @@ use glam::{Vec2, Vec3};
 use super::mesh::{MAX_TEXCOORD, MAX_VERTEX_COORD};
 use super::{Mesh, SceneError};
 
-/// Most vertices one [`MeshBuilder`] holds (32 bytes each: 1 GiB), as many as one glTF file
-/// may decode into. A shape that would pass it adds nothing and [`MeshBuilder::build`] names it.
+/// Most vertices one [`MeshBuilder`] holds (32 bytes each, and up to six 4-byte indices: about
+/// 2 GiB at most), as many as one glTF file may decode into. A shape that would pass it adds
+/// nothing and [`MeshBuilder::build`] names it.
 pub const MAX_BUILT_VERTICES: usize = 1 << 25;
 
 /// Accumulates triangles; [`MeshBuilder::build`] turns them into a [`Mesh`].

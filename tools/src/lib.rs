@@ -12,4 +12,5 @@ pub mod output;
 pub mod plot;
 pub mod report;
 pub mod sheet;
+pub mod signals;
 pub mod workload;

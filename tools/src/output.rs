@@ -66,43 +66,23 @@ pub struct OutputFile {
 static TEMP_COUNTER: AtomicU32 = AtomicU32::new(0);
 
 /// The temporary files being written now, which a signal that ends the process removes
-/// ([`remove_temporaries_on_signals`]).
+/// (`crate::signals`). Each is listed while its file exists: created, renamed and removed with
+/// the lock held, so that a signal's removal never races them.
 static LIVE_TEMPORARIES: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
 
 fn live_temporaries() -> MutexGuard<'static, Vec<PathBuf>> {
     LIVE_TEMPORARIES.lock().unwrap_or_else(|e| e.into_inner())
 }
 
-fn forget_temporary(temp: &Path) {
-    live_temporaries().retain(|t| t != temp);
+/// Removes every temporary file being written, then runs `then` with the list still locked, so
+/// that no new one is made, renamed or removed meanwhile (`then` ends the process).
+pub(crate) fn remove_temporaries_then(then: impl FnOnce()) {
+    let mut live = live_temporaries();
+    for temp in live.drain(..) {
+        let _ = std::fs::remove_file(temp);
+    }
+    then();
 }
-
-/// On SIGINT, SIGTERM or SIGHUP (Ctrl-C, `kill`, a closed terminal) removes the temporary files
-/// being written, then ends the process as the signal's default action does (the same exit
-/// status): a long `--record` stopped half-way used to leave its `.NAME.PID.N.tmp` behind.
-#[cfg(unix)]
-pub fn remove_temporaries_on_signals() {
-    use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
-    let Ok(mut signals) = signal_hook::iterator::Signals::new([SIGINT, SIGTERM, SIGHUP]) else {
-        return;
-    };
-    let watch = move || {
-        if let Some(signal) = signals.forever().next() {
-            for temp in live_temporaries().drain(..) {
-                let _ = std::fs::remove_file(temp);
-            }
-            let _ = signal_hook::low_level::emulate_default_handler(signal);
-        }
-    };
-    // Without the thread the signals keep their default action.
-    let _ = std::thread::Builder::new()
-        .name("signals".into())
-        .spawn(watch);
-}
-
-/// Elsewhere a signal ends the process as it always did.
-#[cfg(not(unix))]
-pub fn remove_temporaries_on_signals() {}
 
 impl OutputFile {
     /// Opens `path` for writing: fails now, naming it, where it cannot be written (a folder, a
@@ -196,8 +176,10 @@ impl OutputFile {
             if let Some(p) = permissions.take() {
                 std::fs::set_permissions(&*temp, p)?;
             }
+            let mut live = live_temporaries();
             std::fs::rename(&*temp, &*dest)?;
-            forget_temporary(temp);
+            live.retain(|t| t != temp);
+            drop(live);
             self.target = Target::InPlace;
         }
         Ok(())
@@ -232,8 +214,9 @@ impl Drop for OutputFile {
     fn drop(&mut self) {
         if let Target::Replace { temp, .. } = &self.target {
             drop(self.writer.take());
+            let mut live = live_temporaries();
             let _ = std::fs::remove_file(temp);
-            forget_temporary(temp);
+            live.retain(|t| t != temp);
         }
     }
 }
@@ -272,11 +255,12 @@ fn create_temp(dest: &Path) -> io::Result<(PathBuf, File)> {
     let n = TEMP_COUNTER.fetch_add(1, Ordering::Relaxed);
     temp_name.push(format!(".{}.{n}.tmp", std::process::id()));
     let temp = dest.with_file_name(temp_name);
+    let mut live = live_temporaries();
     let file = OpenOptions::new()
         .write(true)
         .create_new(true)
         .open(&temp)?;
-    live_temporaries().push(temp.clone());
+    live.push(temp.clone());
     Ok((temp, file))
 }
 

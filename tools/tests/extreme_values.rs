@@ -601,7 +601,7 @@ fn an_ambient_past_fp16_is_drawn_at_the_fp16_cap_with_a_warning() {
         manylight::metrics::diff(&capped, &exact).max_abs > 20,
         "the cap shows at this exposure"
     );
-    let said = || common::warnings::warnings_containing("ambient").len();
+    let said = || common::warnings::warnings_containing("the ambient term holds").len();
     let before = said();
     let image = mediump.render(&with_ambient(1e6), 64, 36, &opts);
     let d = manylight::metrics::diff(&capped, &image).max_abs;
@@ -621,4 +621,45 @@ fn an_ambient_past_fp16_is_drawn_at_the_fp16_cap_with_a_warning() {
     let image = mediump.render(&bright(1000.0), 64, 36, &opts);
     let d = manylight::metrics::diff(&capped, &image).max_abs;
     assert!(d <= 3, "{d} / 255 from highp's frame at the term's cap");
+}
+
+/// Without fragment highp the sum of a pixel's lights is fp16 too: eight lights each at the
+/// shader's per-light cap summed past 65 504 to infinity, white at any exposure. The sum is
+/// now capped there: where it passes, the frame is highp's frame of a pixel value of 65 504 (an
+/// ambient term of 65 504 alone), too dark at this exposure as precision.md says, never white.
+#[test]
+fn a_light_sum_past_fp16_is_drawn_at_fp16s_largest_value() {
+    let mut mediump = Gpu::without_fragment_highp();
+    let mut highp = Gpu::new(EsVersion::Es2);
+    let opts = RenderOptions {
+        exposure_ev: -15.0,
+        tone_map: manylight::ToneMap::Reinhard,
+        linear: true,
+        ..Default::default()
+    };
+    let lights = (0..8)
+        .map(|i| {
+            let mut l = point(1000.0);
+            l.position = DVec3::new(0.1 * i as f64 - 0.35, 0.0, 1.0);
+            l.color = Vec3::ONE;
+            l.intensity = 2f32.powi(29);
+            l
+        })
+        .collect();
+    let mut bright = plane(lights);
+    bright.ambient = Vec3::ZERO;
+    let mut at_the_cap = plane(vec![]);
+    // The plane's albedo is 0.8.
+    at_the_cap.ambient = Vec3::splat(65504.0 / 0.8);
+    let expected = highp.render(&at_the_cap, 64, 36, &opts);
+    let image = mediump.render(&bright, 64, 36, &opts);
+    let cap = expected.get_pixel(32, 18)[0];
+    // Where the lights sum past 65 504 (the middle) the pixel shows that value; nowhere more
+    // (it was white, 255, there).
+    for (x, y, p) in image.enumerate_pixels() {
+        assert!(p[0] <= cap + 1, "pixel ({x}, {y}) is {p:?}, past {cap}");
+        if (24..40).contains(&x) && (12..24).contains(&y) {
+            assert!(p[0] + 1 >= cap, "pixel ({x}, {y}) is {p:?}, not {cap}");
+        }
+    }
 }

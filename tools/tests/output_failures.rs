@@ -426,53 +426,97 @@ fn every_spelling_of_standard_output_reaches_it() {
     }
 }
 
+/// Starts a long recording render in `dir` with SIGINT, SIGTERM and SIGHUP at their default
+/// action (whatever this test inherited: `nohup`, a shell's `cmd &`), but `ignored` ignored,
+/// and returns once its temporary file exists.
+fn recording(dir: &Path, ignored: Option<i32>) -> std::process::Child {
+    use std::os::unix::process::CommandExt;
+    let mut command = Command::new(env!("CARGO_BIN_EXE_manylight"));
+    command
+        .args(["--size", "32x18", "--lights", "4", "--frames", "65536"])
+        .args(["--record", "r.gif"])
+        .current_dir(dir)
+        .stdout(Stdio::null())
+        .stderr(Stdio::null());
+    // SAFETY: `signal` is async-signal-safe, as code between fork and exec must be.
+    unsafe {
+        command.pre_exec(move || {
+            for s in [libc::SIGINT, libc::SIGTERM, libc::SIGHUP] {
+                let action = if Some(s) == ignored {
+                    libc::SIG_IGN
+                } else {
+                    libc::SIG_DFL
+                };
+                libc::signal(s, action);
+            }
+            Ok(())
+        });
+    }
+    let mut child = command.spawn().unwrap();
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(60);
+    while temporaries(dir).is_empty() {
+        assert!(
+            std::time::Instant::now() < deadline,
+            "no temporary file appeared"
+        );
+        assert!(
+            child.try_wait().unwrap().is_none(),
+            "the render ended early"
+        );
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    child
+}
+
+/// The hidden temporary files in `dir`.
+fn temporaries(dir: &Path) -> Vec<String> {
+    std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.ends_with(".tmp"))
+        .collect()
+}
+
+fn send(signal: &str, child: &std::process::Child) {
+    let kill = Command::new("kill")
+        .args([format!("-{signal}"), child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(kill.success());
+}
+
 /// A render stopped by a signal (Ctrl-C, `kill`, a closed terminal) half-way through a
 /// recording leaves no hidden temporary file, and still ends by that signal. It used to leave
-/// `.r.gif.PID.N.tmp` beside where the GIF would go.
+/// `.r.gif.PID.N.tmp` beside where the GIF would go. A signal it started with ignored (`nohup`)
+/// stays ignored.
 #[test]
 fn a_signal_half_way_through_a_recording_leaves_no_temporary_file() {
     use std::os::unix::process::ExitStatusExt;
     let dir = tempfile::tempdir().unwrap();
-    let temporaries = || {
-        std::fs::read_dir(dir.path())
-            .unwrap()
-            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-            .filter(|n| n.ends_with(".tmp"))
-            .collect::<Vec<_>>()
-    };
-    for (signal, number) in [("TERM", 15), ("INT", 2), ("HUP", 1)] {
-        let mut child = Command::new(env!("CARGO_BIN_EXE_manylight"))
-            .args(["--size", "32x18", "--lights", "4", "--frames", "65536"])
-            .args(["--record", "r.gif"])
-            .current_dir(dir.path())
-            .stdout(Stdio::null())
-            .stderr(Stdio::null())
-            .spawn()
-            .unwrap();
-        // The recording's temporary file appears when the render starts.
-        let deadline = std::time::Instant::now() + std::time::Duration::from_secs(60);
-        while temporaries().is_empty() {
-            assert!(
-                std::time::Instant::now() < deadline,
-                "no temporary file appeared"
-            );
-            assert!(
-                child.try_wait().unwrap().is_none(),
-                "the render ended early"
-            );
-            std::thread::sleep(std::time::Duration::from_millis(20));
-        }
-        let kill = Command::new("kill")
-            .args([format!("-{signal}"), child.id().to_string()])
-            .status()
-            .unwrap();
-        assert!(kill.success());
+    for (signal, number) in [
+        ("TERM", libc::SIGTERM),
+        ("INT", libc::SIGINT),
+        ("HUP", libc::SIGHUP),
+    ] {
+        let mut child = recording(dir.path(), None);
+        send(signal, &child);
         let status = child.wait().unwrap();
         assert_eq!(status.signal(), Some(number), "SIG{signal}: {status:?}");
-        assert_eq!(temporaries(), Vec::<String>::new(), "SIG{signal}");
+        assert_eq!(temporaries(dir.path()), Vec::<String>::new(), "SIG{signal}");
         assert!(
             !dir.path().join("r.gif").exists(),
             "SIG{signal}: a GIF was left"
         );
     }
+    // Under `nohup`: SIGHUP changes nothing, SIGTERM still ends it cleanly.
+    let mut child = recording(dir.path(), Some(libc::SIGHUP));
+    send("HUP", &child);
+    std::thread::sleep(std::time::Duration::from_millis(300));
+    assert!(
+        child.try_wait().unwrap().is_none(),
+        "an ignored SIGHUP ended the render"
+    );
+    send("TERM", &child);
+    assert_eq!(child.wait().unwrap().signal(), Some(libc::SIGTERM));
+    assert_eq!(temporaries(dir.path()), Vec::<String>::new());
 }

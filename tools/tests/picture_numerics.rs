@@ -205,7 +205,9 @@ fn a_scene_scaled_up_renders_as_the_f64_model_says_or_is_refused_without_highp()
                 continue;
             }
             let (img, _) = result.unwrap_or_else(|e| panic!("{device} ×{k:e}: {e}"));
-            let (e, at, _) = max_oracle_error(&img, &s, Encoding::Srgb, &caps);
+            let (e, at, n) = max_oracle_error(&img, &s, Encoding::Srgb, &caps);
+            // A reference that kept (almost) no pixel would compare nothing and read 0.
+            assert!(n >= 50, "only {n} pixels compared");
             assert!(
                 e <= 2.0,
                 "{device} ×{k:e}: {e:.1} / 255 off the f64 model at {at:?}"
@@ -338,7 +340,9 @@ fn lights_of_large_radius_light_as_every_method_and_the_f64_model_say() {
             let caps = gpu.r().caps().clone();
             let forward = render(gpu, "forward", &s);
             assert!(mean(&forward) > 20.0, "{device} radius {radius:e}: dark");
-            let (e, at, _) = max_oracle_error(&forward, &s, Encoding::Srgb, &caps);
+            let (e, at, n) = max_oracle_error(&forward, &s, Encoding::Srgb, &caps);
+            // A reference that kept (almost) no pixel would compare nothing and read 0.
+            assert!(n >= 50, "only {n} pixels compared");
             assert!(
                 e <= 2.0,
                 "{device} radius {radius:e}: {e:.1} / 255 off at {at:?}"
@@ -407,7 +411,9 @@ fn without_highp_a_light_too_far_to_place_is_refused_by_name_or_left_out_when_it
                     !device.contains("without"),
                     "{device}: the sun cannot be placed"
                 );
-                let (e, at, _) = max_oracle_error(&img, &s, Encoding::Srgb, &caps);
+                let (e, at, n) = max_oracle_error(&img, &s, Encoding::Srgb, &caps);
+                // A reference that kept (almost) no pixel would compare nothing and read 0.
+                assert!(n >= 50, "only {n} pixels compared");
                 assert!(
                     e <= 2.0,
                     "{device}: {e:.1} / 255 off the f64 model at {at:?}"

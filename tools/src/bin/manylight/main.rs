@@ -372,7 +372,7 @@ fn negative_values(command: clap::Command) -> clap::Command {
 }
 
 fn main() -> ExitCode {
-    output::remove_temporaries_on_signals();
+    manylight_tools::signals::remove_temporaries_on_signals();
     // env_logger's own layout, each message with its control characters escaped but its line
     // ends (a model's names reach warnings, and a terminal acts on escape sequences).
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn"))
