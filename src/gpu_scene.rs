@@ -9,7 +9,6 @@ use glam::{DMat4, DVec3};
 use crate::gl::mesh::GpuMesh;
 use crate::gl::texture::ImageTexture;
 use crate::gl::Device;
-use crate::scene::camera::MAX_CAMERA_COORD;
 use crate::scene::{Aabb, Material, Mesh, Scene, SceneError, Texture};
 use crate::Error;
 
@@ -161,18 +160,10 @@ impl GpuScene {
     /// left the object out of the frame without a word. (The file loaders check the same.)
     pub fn check_placement(&self, scene: &Scene) -> Result<(), SceneError> {
         for (i, o) in scene.objects.iter().enumerate() {
-            let Some(b) = self.world_bounds(o) else {
-                continue;
-            };
-            let reach = b.min.abs().max(b.max.abs()).max_element();
-            if !reach.is_finite() || reach > MAX_CAMERA_COORD {
-                return Err(SceneError::invalid(
-                    format!("objects[{i}].transform"),
-                    format!(
-                        "places the object's bounds {reach:e} from the origin, past \
-                         ±{MAX_CAMERA_COORD:e} (the camera's limit)"
-                    ),
-                ));
+            if let Some(b) = self.world_bounds(o) {
+                if b.check_placed_by("").is_err() {
+                    b.check_placed_by(&format!("objects[{i}]"))?;
+                }
             }
         }
         Ok(())

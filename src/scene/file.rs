@@ -502,18 +502,8 @@ fn check_placed(scene: &Scene, first: usize, field: &str) -> Result<(), SceneErr
         let bounds = *mesh_bounds
             .entry(std::sync::Arc::as_ptr(&o.mesh))
             .or_insert_with(|| o.mesh.bounds());
-        let Some(b) = bounds.map(|b| b.transformed(&o.transform)) else {
-            continue;
-        };
-        let reach = b.min.abs().max(b.max.abs()).max_element();
-        if !reach.is_finite() || reach > MAX_CAMERA_COORD {
-            return Err(SceneError::invalid(
-                format!("{field}.transform"),
-                format!(
-                    "places the object's bounds {reach:e} from the origin, past \
-                     ±{MAX_CAMERA_COORD:e} (the camera's limit)"
-                ),
-            ));
+        if let Some(b) = bounds.map(|b| b.transformed(&o.transform)) {
+            b.check_placed_by(field)?;
         }
     }
     Ok(())

@@ -4,6 +4,7 @@ use std::collections::HashMap;
 
 use glam::{DMat4, DVec3, Vec2, Vec3, Vec4};
 
+use super::camera::MAX_CAMERA_COORD;
 use super::SceneError;
 
 /// Largest object-space vertex coordinate. Vertices are f32 (their spacing there is 64 units)
@@ -34,6 +35,22 @@ pub struct Aabb {
 }
 
 impl Aabb {
+    /// Refuses world bounds (of an object placed by `field`'s transform) that are not finite or
+    /// reach past the camera's coordinate limit, naming `field.transform`.
+    pub(crate) fn check_placed_by(&self, field: &str) -> Result<(), SceneError> {
+        let reach = self.min.abs().max(self.max.abs()).max_element();
+        if reach.is_finite() && reach <= MAX_CAMERA_COORD {
+            return Ok(());
+        }
+        Err(SceneError::invalid(
+            format!("{field}.transform"),
+            format!(
+                "places the object's bounds {reach:e} from the origin, past \
+                 ±{MAX_CAMERA_COORD:e} (the camera's limit)"
+            ),
+        ))
+    }
+
     /// Bounds of a point set (`None` when empty).
     pub fn from_points(points: impl IntoIterator<Item = DVec3>) -> Option<Aabb> {
         let mut it = points.into_iter();

@@ -227,8 +227,8 @@ impl Scene {
 
     /// Poses every animated light at time `t` (seconds; 0 is the scene as built). A pure
     /// function of `t`: frames can be rendered in any order. Allocates nothing; the part of a
-    /// track past the end of `lights` is skipped. A motion moving 4 096 lights or more poses them in
-    /// parallel on rayon's global pool (see [`Scene::set_time_on_this_thread`]).
+    /// track past the end of `lights` is skipped. A motion moving 4 096 lights or more poses
+    /// them in parallel on rayon's global pool (see [`Scene::set_time_on_this_thread`]).
     pub fn set_time(&mut self, t: f64) {
         self.pose(t, true);
     }
