@@ -38,7 +38,7 @@ impl Aabb {
     /// Refuses world bounds (of an object placed by `field`'s transform) that are not finite or
     /// reach past the camera's coordinate limit, naming `field.transform`.
     pub(crate) fn check_placed_by(&self, field: &str) -> Result<(), SceneError> {
-        let reach = self.min.abs().max(self.max.abs()).max_element();
+        let reach = self.reach();
         if reach.is_finite() && reach <= MAX_CAMERA_COORD {
             return Ok(());
         }
@@ -49,6 +49,11 @@ impl Aabb {
                  ±{MAX_CAMERA_COORD:e} (the camera's limit)"
             ),
         ))
+    }
+
+    /// The largest coordinate magnitude of the box (NaN or infinite where a corner is).
+    pub(crate) fn reach(&self) -> f64 {
+        self.min.abs().max(self.max.abs()).max_element()
     }
 
     /// Bounds of a point set (`None` when empty).

@@ -584,12 +584,7 @@ fn an_ambient_past_fp16_is_drawn_at_the_fp16_cap_with_a_warning() {
     common::warnings::install();
     let mut mediump = Gpu::without_fragment_highp();
     let mut highp = Gpu::new(EsVersion::Es2);
-    let opts = RenderOptions {
-        exposure_ev: -15.0,
-        tone_map: manylight::ToneMap::Reinhard,
-        linear: true,
-        ..Default::default()
-    };
+    let opts = dark_through_reinhard();
     let with_ambient = |a: f32| {
         let mut s = plane(vec![]);
         s.ambient = Vec3::splat(a);
@@ -631,12 +626,7 @@ fn an_ambient_past_fp16_is_drawn_at_the_fp16_cap_with_a_warning() {
 fn a_light_sum_past_fp16_is_drawn_at_fp16s_largest_value() {
     let mut mediump = Gpu::without_fragment_highp();
     let mut highp = Gpu::new(EsVersion::Es2);
-    let opts = RenderOptions {
-        exposure_ev: -15.0,
-        tone_map: manylight::ToneMap::Reinhard,
-        linear: true,
-        ..Default::default()
-    };
+    let opts = dark_through_reinhard();
     let lights = (0..8)
         .map(|i| {
             let mut l = point(1000.0);
@@ -661,5 +651,16 @@ fn a_light_sum_past_fp16_is_drawn_at_fp16s_largest_value() {
         if (24..40).contains(&x) && (12..24).contains(&y) {
             assert!(p[0] + 1 >= cap, "pixel ({x}, {y}) is {p:?}, not {cap}");
         }
+    }
+}
+
+/// −15 EV through Reinhard, linear output: a pixel value of 2¹⁵ shows at half, so the fp16
+/// caps (60 000, 65 504) and infinity (white) all tell apart.
+fn dark_through_reinhard() -> RenderOptions {
+    RenderOptions {
+        exposure_ev: -15.0,
+        tone_map: manylight::ToneMap::Reinhard,
+        linear: true,
+        ..Default::default()
     }
 }

@@ -547,7 +547,7 @@ fn check_placement(bounds: Option<Aabb>, world: &DMat4) -> Result<(), String> {
         return Err("the world transform is not finite".into());
     }
     if let Some(b) = bounds.map(|b| b.transformed(world)) {
-        let reach = b.min.abs().max(b.max.abs()).max_element();
+        let reach = b.reach();
         if !reach.is_finite() || reach > MAX_CAMERA_COORD {
             return Err(format!(
                 "world-space bounds reach {reach:e}, past ±{MAX_CAMERA_COORD:e}"
