@@ -73,8 +73,8 @@ uniform float u_occlusionStrength;
 #endif
 
 // The ambient term of a surface of this albedo. In fp16 (no fragment highp) the uniform and
-// the term are capped at FP16_MAX_AMBIENT: past fp16's 65 504 they were infinity, white at any
-// exposure.
+// the term are capped at FP16_MAX_AMBIENT: past fp16's 65 504 they would be infinity, white at
+// any exposure.
 vec3 surfaceAmbient(vec3 albedo, vec2 uv) {
     vec3 a = u_ambient * albedo;
 #if FP16_LIGHTS

@@ -1,7 +1,7 @@
 //! Signals that end the command line (SIGINT, SIGTERM, SIGHUP: Ctrl-C, `kill`, a closed
 //! terminal) first remove the temporary output files being written (`output`), then end the
-//! process by the signal's default action, with the same exit status as before. A long
-//! `--record` stopped half-way used to leave its `.NAME.PID.N.tmp` behind.
+//! process by the signal's default action, with the same exit status: a `--record` stopped
+//! half-way leaves no `.NAME.PID.N.tmp` behind.
 
 /// Starts the thread that watches the signals. A signal the process started with ignored
 /// (`nohup` ignores SIGHUP, a shell's `cmd &` SIGINT) stays ignored.

@@ -136,10 +136,10 @@ impl FlyCamera {
         } else {
             0.0
         };
-        // The eye and its target stay within the coordinates the view maths holds, where the
-        // next frame used to refuse the camera and end the viewer: at the edge the camera
-        // slides along it (each axis of the step taken where it stays within), and does not
-        // turn where its target would leave it.
+        // The eye and its target stay within the coordinates the view maths holds (past them
+        // the next frame refuses the camera): at the edge the camera slides along it (each axis
+        // of the step taken where it stays within), and does not turn where its target would
+        // leave it.
         let within = |v: DVec3| v.abs().max_element() <= MAX_CAMERA_COORD;
         let turned = camera.position + forward * distance;
         if !within(turned) {
