@@ -1,0 +1,444 @@
+//! What the command line writes and says in the cases a newcomer met: files it should not
+//! write, timings that add up, messages that name the flag typed rather than a library field.
+
+use crate::common;
+
+use common::cli::{expect_status, manylight, text};
+
+/// [`expect_status`] without extra environment.
+fn expect(args: &[&str], cwd: &std::path::Path, code: i32) -> String {
+    expect_status(args, &[], cwd, code)
+}
+
+#[test]
+fn a_file_of_another_type_is_called_unsupported_not_an_unknown_built_in() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("notes.md"), "# not a scene\n").unwrap();
+    let msg = expect(&["--scene", "notes.md", "--size", "8x8"], dir.path(), 1);
+    assert!(msg.contains("unsupported scene file type"), "{msg}");
+    assert!(
+        msg.contains("notes.md") && !msg.contains("built-in scene `"),
+        "{msg}"
+    );
+    // A name without an extension is still looked up among the built-ins.
+    let msg = expect(&["--scene", "atlantis", "--size", "8x8"], dir.path(), 1);
+    assert!(msg.contains("unknown built-in scene"), "{msg}");
+    // A file in the folder named like a built-in does not hide it (plain `manylight` failed
+    // as an unsupported file beside one called `courtyard`).
+    std::fs::write(dir.path().join("courtyard"), "notes\n").unwrap();
+    let args = ["--size", "8x8", "--lights", "0", "--out", "c.png"];
+    let out = manylight(&args, &[], dir.path());
+    assert!(out.status.success(), "{}", text(&out));
+    // Nor is writing over that file writing over the scene.
+    let args = ["--size", "8x8", "--lights", "0", "--out", "courtyard"];
+    let out = manylight(&args, &[], dir.path());
+    assert!(out.status.success(), "{}", text(&out));
+}
+
+/// An output naming the scene file (in any spelling) would replace the scene with a picture or
+/// with statistics: a usage error naming both, and the scene is left as it was.
+#[test]
+fn an_output_that_would_overwrite_the_scene_is_a_usage_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = r#"{"objects": [{"builtin": "plane"}]}"#;
+    std::fs::write(dir.path().join("s.json"), scene).unwrap();
+    for (option, path) in [("--out", "s.json"), ("--stats", "./s.json")] {
+        let args = ["--scene", "s.json", "--size", "8x8", option, path];
+        let msg = expect(&args, dir.path(), 2);
+        assert!(
+            msg.contains(&format!("{option} {path} names the scene file")),
+            "{msg}"
+        );
+        assert_eq!(
+            std::fs::read_to_string(dir.path().join("s.json")).unwrap(),
+            scene
+        );
+    }
+    // `matrix --json` too (the matrix was renamed over the scene once its cells had run).
+    let msg = expect(
+        &["matrix", "--scene", "s.json", "--json", "s.json"],
+        dir.path(),
+        2,
+    );
+    assert!(msg.contains("--json s.json names the scene file"), "{msg}");
+    assert_eq!(
+        std::fs::read_to_string(dir.path().join("s.json")).unwrap(),
+        scene
+    );
+}
+
+#[test]
+fn linear_output_and_a_tone_map_are_a_usage_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let msg = expect(&["--linear", "--tonemap", "reinhard"], dir.path(), 2);
+    assert!(
+        msg.contains("--linear") && msg.contains("--tonemap"),
+        "{msg}"
+    );
+}
+
+#[test]
+fn an_msaa_refusal_names_the_flag() {
+    let dir = tempfile::tempdir().unwrap();
+    let args = [
+        "--msaa", "64", "--size", "16x9", "--lights", "4", "--frames", "0",
+    ];
+    // More samples than the context has: status 3, what this context cannot do.
+    let msg = expect(&args, dir.path(), 3);
+    assert!(msg.contains("--msaa 64"), "{msg}");
+    assert!(!msg.contains("RenderOptions"), "{msg}");
+}
+
+#[test]
+fn a_recording_writes_no_default_picture_beside_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let base = ["--size", "16x9", "--lights", "4", "--frames", "2"];
+    expect(&[&base[..], &["--record", "a.gif"]].concat(), dir.path(), 0);
+    assert!(dir.path().join("a.gif").is_file());
+    assert!(
+        !dir.path().join("manylight.png").exists(),
+        "--record wrote ./manylight.png"
+    );
+    // Asked for, the picture is written as well.
+    let args = [&base[..], &["--record", "b.gif", "--out", "x.png"]].concat();
+    expect(&args, dir.path(), 0);
+    assert!(dir.path().join("x.png").is_file());
+}
+
+#[test]
+fn gif_frame_delays_add_up_to_the_animation_time() {
+    use image::AnimationDecoder;
+    let dir = tempfile::tempdir().unwrap();
+    // 9 frames at 30 fps last 0.3 s: whole hundredths that each round 3.33 alone would make 0.27.
+    let args = [
+        "--size", "8x8", "--lights", "4", "--frames", "9", "--fps", "30", "--record", "a.gif",
+    ];
+    expect(&args, dir.path(), 0);
+    let file = std::io::BufReader::new(std::fs::File::open(dir.path().join("a.gif")).unwrap());
+    let frames = image::codecs::gif::GifDecoder::new(file)
+        .unwrap()
+        .into_frames()
+        .collect_frames()
+        .unwrap();
+    assert_eq!(frames.len(), 9);
+    let total_ms: u32 = frames
+        .iter()
+        .map(|f| {
+            let (n, d) = f.delay().numer_denom_ms();
+            n / d
+        })
+        .sum();
+    assert_eq!(total_ms, 300, "frame delays sum to {total_ms} ms");
+}
+
+#[test]
+fn the_summary_line_says_what_auto_picked_and_which_time_the_picture_shows() {
+    let dir = tempfile::tempdir().unwrap();
+    let args = [
+        "--method", "auto", "--size", "16x9", "--lights", "8", "--out", "a.png",
+    ];
+    let msg = expect(&args, dir.path(), 0);
+    assert!(msg.contains("auto → "), "{msg}");
+    let msg = expect(
+        &["--size", "16x9", "--lights", "8", "--out", "b.png"],
+        dir.path(),
+        0,
+    );
+    assert!(msg.contains("picture at t = 0.000 s"), "{msg}");
+    assert!(!msg.contains("t = 0.000 to"), "{msg}");
+}
+
+#[test]
+fn info_shows_the_methods_before_any_extension_list() {
+    let dir = tempfile::tempdir().unwrap();
+    let msg = expect(&["info"], dir.path(), 0);
+    let methods = msg.find("\nmethods\n").expect("a methods table");
+    let extensions = msg.find("\nextensions").expect("the extension count");
+    assert!(methods < extensions, "{msg}");
+    assert!(!msg.contains("\n  GL_"), "extensions listed unasked: {msg}");
+    let listed = expect(&["info", "--extensions"], dir.path(), 0);
+    assert!(listed.contains("\n  GL_"), "{listed}");
+}
+
+#[test]
+fn bench_assign_runs_what_runs_asks_and_says_how_many() {
+    let dir = tempfile::tempdir().unwrap();
+    let msg = expect(
+        &[
+            "bench-assign",
+            "--lights",
+            "100001",
+            "--runs",
+            "9",
+            "--json",
+        ],
+        dir.path(),
+        0,
+    );
+    let rows: serde_json::Value = serde_json::from_str(&msg[msg.find('[').unwrap()..]).unwrap();
+    assert_eq!(rows[0]["runs"], 9, "{msg}");
+    let msg = expect(&["bench-assign", "--lights", "8"], dir.path(), 0);
+    assert!(msg.contains("median of 101 runs"), "{msg}");
+}
+
+#[test]
+fn a_budget_for_a_fixed_grid_is_a_usage_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let msg = expect(&["--grid", "16", "--assign-budget", "0.1"], dir.path(), 2);
+    assert!(
+        msg.contains("--assign-budget") && msg.contains("fixed"),
+        "{msg}"
+    );
+}
+
+/// `--stats -` puts the statistics alone on standard output, for a pipe into a JSON reader,
+/// and the summary line on standard error; it wrote a file named `-`. Without lights, the
+/// summary says nothing of moving lights.
+#[test]
+fn stats_to_standard_output_are_json_alone() {
+    let dir = tempfile::tempdir().unwrap();
+    let args = [
+        "--size", "16x9", "--lights", "0", "--out", "a.png", "--stats", "-",
+    ];
+    let out = manylight(&args, &[], dir.path());
+    assert!(out.status.success(), "{}", text(&out));
+    let stats: serde_json::Value = serde_json::from_slice(&out.stdout)
+        .unwrap_or_else(|e| panic!("standard output is not JSON ({e}): {}", text(&out)));
+    assert_eq!(stats["lights"], 0, "{stats}");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("0 lights"), "{stderr}");
+    assert!(!stderr.contains("moving lights"), "{stderr}");
+    assert!(
+        !dir.path().join("-").exists(),
+        "a file named `-` was written"
+    );
+}
+
+/// `--out -` puts the PNG alone on standard output (the summary line on standard error), as
+/// `--stats -` does its JSON; it wrote a file named `-`. Both on standard output (either
+/// spelling) is a usage error saying so, not one calling them the same file.
+#[test]
+fn a_picture_to_standard_output_is_the_png_alone() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = manylight(
+        &["--size", "16x9", "--lights", "4", "--out", "-"],
+        &[],
+        dir.path(),
+    );
+    assert!(out.status.success(), "{}", text(&out));
+    let png = image::load_from_memory_with_format(&out.stdout, image::ImageFormat::Png)
+        .unwrap_or_else(|e| panic!("standard output is not a PNG ({e}): {}", text(&out)));
+    assert_eq!((png.width(), png.height()), (16, 9));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("4 lights"), "{stderr}");
+    assert!(
+        !dir.path().join("-").exists(),
+        "a file named `-` was written"
+    );
+    for picture in ["-", "/dev/stdout"] {
+        let args = ["--size", "16x9", "--out", picture, "--stats", "-"];
+        let msg = expect(&args, dir.path(), 2);
+        assert!(
+            msg.contains("both name standard output"),
+            "{picture}: {msg}"
+        );
+    }
+    // Standard output is no file of a recording's folder, even the current one.
+    let args = [
+        "--size", "16x9", "--frames", "1", "--record", ".", "--out", "-",
+    ];
+    let out = manylight(&args, &[], dir.path());
+    assert!(out.status.success(), "{}", text(&out));
+    assert!(
+        image::load_from_memory(&out.stdout).is_ok(),
+        "{}",
+        text(&out)
+    );
+    // `--stats /dev/stdout` is the JSON alone too, the summary line on standard error.
+    let args = ["--size", "16x9", "--out", "p.png", "--stats", "/dev/stdout"];
+    let out = manylight(&args, &[], dir.path());
+    assert!(out.status.success(), "{}", text(&out));
+    let json = serde_json::from_slice::<serde_json::Value>(&out.stdout);
+    assert!(json.is_ok(), "{json:?}: {}", text(&out));
+}
+
+/// `--frames 0` times no frame: the summary line said "ms/frame" of the one frame it rendered,
+/// shader compilation included. It now says the frame was not timed.
+#[test]
+fn no_timed_frames_are_not_called_a_frame_time() {
+    let dir = tempfile::tempdir().unwrap();
+    let args = [
+        "--size", "16x9", "--lights", "4", "--frames", "0", "--stats", "s.json",
+    ];
+    let out = manylight(&args, &[], dir.path());
+    assert!(out.status.success(), "{}", text(&out));
+    let summary = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        summary.contains("one untimed frame") && !summary.contains("ms/frame"),
+        "{summary}"
+    );
+    let stats: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.path().join("s.json")).unwrap()).unwrap();
+    let spread = stats.get("frame_ms_spread");
+    assert!(spread.is_some_and(serde_json::Value::is_null), "{stats}");
+}
+
+/// `--grid` and `--slice-depth` with a method that has no clustered grid changed nothing in
+/// silence (tiled's tiles are fixed): now a warning names them and the method. Clustered
+/// takes them without a word.
+#[test]
+fn grid_options_a_method_cannot_take_are_named() {
+    let dir = tempfile::tempdir().unwrap();
+    for (method, warned) in [("tiled", true), ("forward", true), ("clustered", false)] {
+        let args = [
+            "--size",
+            "16x9",
+            "--method",
+            method,
+            "--grid",
+            "8",
+            "--slice-depth",
+            "2",
+            "--out",
+            "p.png",
+        ];
+        let out = manylight(&args, &[], dir.path());
+        assert!(out.status.success(), "{}", text(&out));
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        let said = stderr.contains("--grid, --slice-depth set the clustered grid");
+        assert_eq!(said, warned, "{method}: {stderr}");
+        assert_eq!(
+            stderr.contains("fixed at 32 px"),
+            method == "tiled",
+            "{stderr}"
+        );
+    }
+}
+
+/// Recording into a folder that holds another recording's frames left them beside the new
+/// ones in silence (a longer earlier clip's tail): a warning counts them. Frames this run
+/// overwrites are not counted, and an empty folder gets no warning.
+#[test]
+fn frames_left_from_an_earlier_recording_are_counted() {
+    let dir = tempfile::tempdir().unwrap();
+    let rec = dir.path().join("rec");
+    std::fs::create_dir(&rec).unwrap();
+    let args = [
+        "--size", "16x9", "--lights", "2", "--frames", "2", "--record", "rec",
+    ];
+    let run = || {
+        let out = manylight(&args, &[], dir.path());
+        assert!(out.status.success(), "{}", text(&out));
+        String::from_utf8_lossy(&out.stderr).into_owned()
+    };
+    assert!(!run().contains("from before"));
+    // The run's own two frames now exist: still nothing to say.
+    assert!(!run().contains("from before"));
+    for stale in ["frame_00002.png", "frame_0001.png", "frame_00099.png"] {
+        std::fs::write(rec.join(stale), b"old").unwrap();
+    }
+    let stderr = run();
+    assert!(stderr.contains("3 frame_*.png from before"), "{stderr}");
+}
+
+/// A driver's own `printf` on standard output (Mesa's "extension … cannot be disabled" under
+/// `MESA_EXTENSION_OVERRIDE`, flushed at exit) goes to standard error: `info --json` and
+/// `--stats -` stay the JSON alone, as a CI script parses them.
+#[test]
+fn a_drivers_own_line_on_stdout_leaves_the_json_alone() {
+    let dir = tempfile::tempdir().unwrap();
+    let env = [(
+        "MESA_EXTENSION_OVERRIDE",
+        "-GL_OES_texture_float -GL_EXT_color_buffer_float",
+    )];
+    let info: &[&str] = &["info", "--es", "2", "--json"];
+    let render: &[&str] = &[
+        "--es", "2", "--size", "16x9", "--lights", "4", "--stats", "-", "--out", "p.png",
+    ];
+    let mut chatter = false;
+    for args in [info, render] {
+        let out = manylight(args, &env, dir.path());
+        assert_eq!(out.status.code(), Some(0), "{args:?}: {}", text(&out));
+        let parsed = serde_json::from_slice::<serde_json::Value>(&out.stdout);
+        assert!(parsed.is_ok(), "{args:?}: {parsed:?} in {}", text(&out));
+        chatter |= String::from_utf8_lossy(&out.stderr).contains("cannot be disabled");
+    }
+    if !chatter {
+        eprintln!("this Mesa printed nothing for the override: the JSON was checked alone");
+    }
+}
+
+/// An ES 2.0 context without 24-bit depth (`GL_OES_depth24` removed; Mesa then offers no
+/// `GL_OES_packed_depth_stencil` either): the renderer's own target has 16 bits, which the
+/// stats say and a warning names; with it, 24 and no warning.
+#[test]
+fn a_sixteen_bit_own_depth_buffer_is_said() {
+    if common::other_implementation_than_mesa("MESA_EXTENSION_OVERRIDE") {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let args = [
+        "--es", "2", "--size", "16x9", "--lights", "4", "--stats", "s.json", "--out", "p.png",
+    ];
+    for (env, bits) in [
+        (&[("MESA_EXTENSION_OVERRIDE", "-GL_OES_depth24")][..], 16),
+        (&[], 24),
+    ] {
+        let out = manylight(&args, env, dir.path());
+        assert_eq!(out.status.code(), Some(0), "{env:?}: {}", text(&out));
+        let stats: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(dir.path().join("s.json")).unwrap()).unwrap();
+        assert_eq!(stats["depth_bits"], bits, "{env:?}");
+        let warned = text(&out).contains("own depth buffer has 16 bits");
+        assert_eq!(warned, bits == 16, "{env:?}: {}", text(&out));
+    }
+}
+
+/// softpipe has ES 3.0 but one sample: `info` says that, not that MSAA needs ES 3.0.
+#[test]
+fn info_gives_the_real_reason_msaa_is_missing() {
+    if common::other_implementation_than_mesa("GALLIUM_DRIVER=softpipe") {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let out = manylight(&["info"], &[("GALLIUM_DRIVER", "softpipe")], dir.path());
+    let shown = text(&out);
+    assert_eq!(out.status.code(), Some(0), "{shown}");
+    let msaa = shown.lines().find(|l| l.starts_with("MSAA")).unwrap();
+    if !shown.contains("softpipe") {
+        common::skip(&format!("no softpipe here: {msaa}"));
+        return;
+    }
+    assert!(msaa.contains("GL_MAX_SAMPLES is 1"), "{msaa}");
+}
+
+/// `info` without `--es` reports what the device has: ES 2.0, with a warning, where the driver
+/// gives no ES 3.0; `--es 3` still insists (status 3).
+#[test]
+fn info_probes_es_2_where_es_3_is_missing() {
+    if common::other_implementation_than_mesa("MESA_GLES_VERSION_OVERRIDE") {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let capped = [("MESA_GLES_VERSION_OVERRIDE", "2.0")];
+    let out = manylight(&["info", "--json"], &capped, dir.path());
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out));
+    let info: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(info["caps"]["es"], "2.0");
+    assert!(
+        String::from_utf8_lossy(&out.stderr).contains("probing OpenGL ES 2.0"),
+        "{}",
+        text(&out)
+    );
+    let out = manylight(&["info", "--es", "3"], &capped, dir.path());
+    assert_eq!(out.status.code(), Some(3), "{}", text(&out));
+    // Uncapped, the default is ES 3.0, said without a warning.
+    let out = manylight(&["info", "--json"], &[], dir.path());
+    let info: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(info["caps"]["es"], "3.0");
+    assert!(!text(&out).contains("probing"), "{}", text(&out));
+    // A device without fragment highp is an ES 2.0 one: probed as such.
+    let out = manylight(&["info", "--json", "--no-fragment-highp"], &[], dir.path());
+    let info: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(info["caps"]["es"], "2.0");
+}

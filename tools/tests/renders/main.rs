@@ -1,0 +1,23 @@
+//! Pictures of the built-in scenes: each method against forward and the CPU oracle as lights
+//! move, framebuffers, viewports, MSAA, tone maps and sRGB. One test program of one module per
+//! file, so that its tests share their contexts and the shaders built on them: a software
+//! implementation compiles each shader anew in every process (docs/testing.md).
+
+#[path = "../common/mod.rs"]
+mod common;
+
+mod animation;
+mod background_alpha;
+mod front_faces;
+mod invalid_options;
+mod keep_framebuffer;
+mod light_evals;
+mod long_loops;
+mod msaa;
+mod msaa_destinations;
+mod picture_numerics;
+mod plane_oracle;
+mod single_sided;
+mod srgb_framebuffer;
+mod tone_map;
+mod viewport_origin;

@@ -1,0 +1,123 @@
+//! Multisampling (`RenderOptions::samples`): every method that supports it still equals plain
+//! forward with the same samples; along a polygon edge the resolved pixels take exactly the
+//! coverage fractions of 4 samples, where without MSAA they are all-or-nothing; unsupported
+//! cases are clear errors.
+
+use crate::common;
+
+use common::{msaa, Gpu};
+use manylight::scene;
+use manylight::{EsVersion, RenderOptions};
+
+#[test]
+fn every_method_with_msaa_matches_forward_with_msaa() {
+    let mut gpu = Gpu::new(EsVersion::Es3);
+    // 4 bytes of colour and 4 of depth per sample.
+    let reference = common::assert_methods_match_forward_with_4_samples(&mut gpu, 4 * 8);
+    let scene = scene::builtin::build("courtyard", Some((64, 2))).unwrap();
+    gpu.r().set_method_named("forward").unwrap();
+    let single = gpu.render(&scene, 128, 72, &msaa(1));
+    assert_ne!(reference, single, "4 samples changed nothing");
+}
+
+#[test]
+fn edges_get_the_coverage_fractions_of_their_samples() {
+    let scene = common::turned_square();
+    let mut gpu = Gpu::new(EsVersion::Es3);
+    let linear = |samples| RenderOptions {
+        linear: true,
+        ..msaa(samples)
+    };
+    let plain = gpu.render(&scene, 96, 96, &linear(1));
+    assert!(
+        plain.pixels().all(|p| p[0] == 0 || p[0] == 255),
+        "without MSAA every pixel is covered or not"
+    );
+    let smooth = gpu.render(&scene, 96, 96, &linear(4));
+    common::assert_coverage_of_4_samples(&smooth);
+}
+
+#[test]
+fn unsupported_msaa_is_a_clear_error() {
+    let scene = scene::builtin::build("plane", Some((4, 1))).unwrap();
+    let mut es3 = Gpu::new(EsVersion::Es3);
+    es3.r().set_method_named("deferred").unwrap();
+    let err = es3
+        .r()
+        .render_offscreen(&scene, 16, 16, &msaa(4))
+        .unwrap_err();
+    assert!(err.to_string().contains("deferred"), "{err}");
+    es3.r().set_method_named("clustered").unwrap();
+    let err = es3
+        .r()
+        .render_offscreen(&scene, 16, 16, &msaa(64))
+        .unwrap_err();
+    assert!(err.to_string().contains("GL_MAX_SAMPLES"), "{err}");
+    // Its own variant, so a caller (the CLI names --msaa) can tell it from other limits.
+    assert!(
+        matches!(err, manylight::Error::Msaa { samples: 64, .. }),
+        "{err:?}"
+    );
+    let err = es3
+        .r()
+        .render_offscreen_hdr(&scene, 16, 16, &msaa(4))
+        .unwrap_err();
+    assert!(err.to_string().contains("HDR"), "{err}");
+    drop(es3);
+    // This binary's contexts have no MESA_EXTENSION_OVERRIDE: llvmpipe's ES 2.0 lacks
+    // GL_EXT_multisampled_render_to_texture (tests/msaa_es2.rs adds it). An implementation
+    // whose ES 2.0 has it (NVIDIA's) must render instead.
+    let mut es2 = Gpu::new(EsVersion::Es2);
+    if es2.r().caps().max_samples >= 4 {
+        let (img, stats) = es2.r().render_offscreen(&scene, 16, 16, &msaa(4)).unwrap();
+        assert_eq!((img.width(), stats.samples), (16, 4));
+        return;
+    }
+    let err = es2
+        .r()
+        .render_offscreen(&scene, 16, 16, &msaa(4))
+        .unwrap_err();
+    assert!(
+        err.to_string()
+            .contains("GL_EXT_multisampled_render_to_texture"),
+        "{err}"
+    );
+}
+
+/// GL rounds a sample count it lacks up to one it has: the stats name the count the frame was
+/// drawn with, which is what GL itself says a renderbuffer of that many samples gets.
+#[test]
+fn stats_name_the_samples_gl_gave() {
+    use manylight::glow::{self, HasContext};
+    let es = EsVersion::Es3;
+    let ctx = manylight::HeadlessContext::new(es).expect("headless ES 3.0 context");
+    let gl = ctx.load_gl().unwrap();
+    let mut renderer = manylight::Renderer::new(ctx.load_gl().unwrap(), es).expect("renderer");
+    let scene = scene::builtin::build("courtyard", Some((4, 1))).unwrap();
+    let max = renderer.caps().max_samples.max(0) as u32;
+    // ES 3.0 requires GL_MAX_SAMPLES of at least 4: the loop below is never empty.
+    assert!(max >= 4, "GL_MAX_SAMPLES {max} on an ES 3.0 context");
+    for asked in 2..=max {
+        // SAFETY: a renderbuffer of the test's own, on the current context, deleted at once.
+        let given = unsafe {
+            let rb = gl.create_renderbuffer().expect("renderbuffer");
+            gl.bind_renderbuffer(glow::RENDERBUFFER, Some(rb));
+            gl.renderbuffer_storage_multisample(
+                glow::RENDERBUFFER,
+                asked as i32,
+                glow::RGBA8,
+                4,
+                4,
+            );
+            let n =
+                gl.get_renderbuffer_parameter_i32(glow::RENDERBUFFER, glow::RENDERBUFFER_SAMPLES);
+            gl.delete_renderbuffer(rb);
+            n as u32
+        };
+        let (_, stats) = renderer
+            .render_offscreen(&scene, 16, 9, &msaa(asked))
+            .unwrap_or_else(|e| panic!("{asked} samples: {e}"));
+        assert_eq!(stats.samples, given, "{asked} samples asked");
+    }
+    renderer.destroy();
+}

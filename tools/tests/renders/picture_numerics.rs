@@ -1,0 +1,432 @@
+//! Numbers that used to give a silently wrong picture: flat objects, vertex normals of no use,
+//! large coordinates, spot axes of any length and large light radii without fragment highp.
+//! Each renders what the f64 light model says — checked against the same scene moved to the
+//! origin or scaled back, or the CPU reference, all computed here — on ES 3.0, ES 2.0 and a
+//! device without fragment highp (fp16), or is refused naming what is at fault.
+
+use crate::common;
+
+use std::sync::Arc;
+
+use common::{max_oracle_error, mean, Gpu};
+use glam::{DMat4, DVec3, Vec3};
+use manylight::metrics::cpu_reference::Encoding;
+use manylight::scene::{self, Camera, Light, Mesh, Object, Scene};
+use manylight::{EsVersion, RenderOptions};
+
+const W: u32 = 64;
+const H: u32 = 36;
+
+/// RMSE bound of a device without fragment highp against the highp picture (as in
+/// stability.rs: fp16 positions are 2⁻¹¹ of the view distance apart).
+const MEDIUMP_ONLY_RMSE: f64 = 2.0;
+
+/// The three devices every case runs on, made one at a time (a new context becomes current).
+fn each_device(mut case: impl FnMut(&str, &mut Gpu)) {
+    for (name, es, no_fragment_highp) in [
+        ("ES 3.0", EsVersion::Es3, false),
+        ("ES 2.0", EsVersion::Es2, false),
+        ("ES 2.0 without fragment highp", EsVersion::Es2, true),
+    ] {
+        let mut gpu = Gpu::restricted(es, &manylight::gl::Restrictions { no_fragment_highp });
+        case(name, &mut gpu);
+    }
+}
+
+/// Every method the device runs.
+fn methods(gpu: &mut Gpu) -> Vec<&'static str> {
+    ["forward", "tiled", "clustered", "deferred"]
+        .into_iter()
+        .filter(|m| gpu.r().set_method_named(m).is_ok())
+        .collect()
+}
+
+fn render(gpu: &mut Gpu, method: &str, s: &Scene) -> image::RgbaImage {
+    gpu.r().set_method_named(method).unwrap();
+    gpu.render(s, W, H, &RenderOptions::default())
+}
+
+/// The `plane` scene without ambient light, lit by one point light 1 m in front of it.
+fn lit_plane() -> Scene {
+    let mut s = scene::builtin::build("plane", None).unwrap();
+    s.ambient = Vec3::ZERO;
+    s.lights = vec![Light::point(DVec3::new(0.5, 0.0, 1.0), 3.0, Vec3::ONE, 2.0)];
+    s
+}
+
+/// Every method of every device draws `s` as it draws `oracle` (within 1/255; the RMSE bound
+/// without fragment highp, where fp16 positions differ between the two).
+fn assert_draws_as(s: &Scene, oracle: &Scene, what: &str) {
+    each_device(|device, gpu| {
+        for method in methods(gpu) {
+            let want = render(gpu, method, oracle);
+            let got = render(gpu, method, s);
+            assert!(
+                mean(&want) > 2.0,
+                "{device} {method}: the oracle of {what} is black"
+            );
+            let d = manylight::metrics::diff(&want, &got);
+            assert!(
+                d.max_abs <= 1 || d.rmse <= MEDIUMP_ONLY_RMSE && device.contains("without"),
+                "{device} {method} {what}: {} / 255 (rmse {:.2}) from the oracle",
+                d.max_abs,
+                d.rmse
+            );
+        }
+    });
+}
+
+/// Scaled to 0 or 10⁻²⁰ along its normal (the scene-file and glTF forms), or by 10⁹ (the
+/// normal matrix then shrinks the normal to 10⁻⁹, which fp16 varyings flushed to zero: NaN).
+#[test]
+fn a_plane_scaled_to_nothing_or_vastly_along_its_normal_is_lit_as_the_plane() {
+    for z in [1e-20, 0.0, 1e9] {
+        let mut flat = lit_plane();
+        for o in &mut flat.objects {
+            o.transform = DMat4::from_scale(DVec3::new(1.0, 1.0, z)) * o.transform;
+        }
+        assert_draws_as(&flat, &lit_plane(), &format!("scale [1, 1, {z:e}]"));
+    }
+}
+
+#[test]
+fn random_lights_of_a_flat_scene_file_light_it() {
+    let dir = tempfile::tempdir().unwrap();
+    for scale in ["[1, 1, 1e-20]", "[1, 1, 1]"] {
+        let path = dir.path().join("flat.json");
+        std::fs::write(
+            &path,
+            format!(
+                r#"{{"objects": [{{"builtin": "plane", "transform": {{"scale": {scale}}}}},
+                                 {{"builtin": "plane", "transform": {{"translate": [0, 0, -1e-9], "scale": 1e-3}}}}],
+                    "ambient": [0, 0, 0],
+                    "camera": {{"position": [0, 0, 12], "target": [0, 0, 0], "up": [0, 1, 0]}},
+                    "random_lights": {{"count": 24, "seed": 3}}}}"#
+            ),
+        )
+        .unwrap();
+        let (s, _) = scene::load(path.to_str().unwrap(), None).unwrap();
+        each_device(|device, gpu| {
+            let img = render(gpu, "forward", &s);
+            // Lights in the plane itself (the bounds of a flat scene) lit nothing.
+            assert!(mean(&img) > 10.0, "{device} {scale}: {:.1}", mean(&img));
+            let (e, at, n) = max_oracle_error(&img, &s, Encoding::Srgb, gpu.r().caps());
+            // All but the patch where the small plane just behind fights the large one.
+            let pixels = (img.width() * img.height()) as usize;
+            assert!(
+                n * 2 >= pixels,
+                "{device} {scale}: {n} of {pixels} compared"
+            );
+            let bound = f64_model_bound(device);
+            assert!(
+                e <= bound,
+                "{device} {scale}: {e:.1} / 255 off the f64 model at {at:?}"
+            );
+        });
+    }
+}
+
+/// Largest error in 8-bit steps allowed against the f64 model: fp16 positions without fragment
+/// `highp` round at about 10⁻³ of their distance.
+fn f64_model_bound(device: &str) -> f64 {
+    if device.contains("without") {
+        24.0
+    } else {
+        2.0
+    }
+}
+
+/// The plane's quad with the given vertex normals (one for all four corners).
+fn plane_with_normals(normal: Vec3) -> Scene {
+    let mut s = lit_plane();
+    let quad = &s.objects[0].mesh;
+    let mesh = Mesh::new(
+        quad.positions.clone(),
+        vec![normal; quad.positions.len()],
+        quad.uvs.clone(),
+        quad.indices.clone(),
+    )
+    .unwrap();
+    s.objects[0].mesh = Arc::new(mesh);
+    s
+}
+
+#[test]
+fn vertex_normals_of_no_direction_are_the_faces_and_huge_ones_keep_theirs() {
+    for normal in [
+        Vec3::ZERO,
+        Vec3::NAN,
+        Vec3::new(0.0, 0.0, f32::INFINITY),
+        Vec3::new(0.0, 0.0, 3e30),
+    ] {
+        assert_draws_as(
+            &plane_with_normals(normal),
+            &lit_plane(),
+            &format!("normals {normal}"),
+        );
+    }
+}
+
+/// `s` with every position (objects, lights, camera) scaled by `k` about the origin, radii by
+/// `k` and intensities by `k²`: the same picture where the falloff's `+1` is negligible.
+fn scaled(s: &Scene, k: f64) -> Scene {
+    let mut out = s.clone();
+    for o in &mut out.objects {
+        o.transform = DMat4::from_scale(DVec3::splat(k)) * o.transform;
+    }
+    for l in &mut out.lights {
+        l.position *= k;
+        l.radius *= k as f32;
+        l.intensity *= (k * k) as f32;
+    }
+    let c = &s.camera;
+    let (near, far) = c.near_far();
+    out.camera = Camera::perspective(c.position * k, c.target * k, 60.0, near * k, far * k);
+    out
+}
+
+#[test]
+fn a_scene_scaled_up_renders_as_the_f64_model_says_or_is_refused_without_highp() {
+    let base = scaled(&lit_plane(), 100.0);
+    each_device(|device, gpu| {
+        let caps = gpu.r().caps().clone();
+        let want = render(gpu, "forward", &base);
+        for k in [1e3, 1e6, 1e8] {
+            let s = scaled(&base, k);
+            let result = gpu
+                .r()
+                .render_offscreen(&s, W, H, &RenderOptions::default());
+            if device.contains("without") {
+                if k * 500.0 > 32768.0 {
+                    // fp16 view positions end at 65 504: refused by the field to change.
+                    let err = result.unwrap_err().to_string();
+                    assert!(err.contains("camera.far"), "{device} ×{k:e}: {err}");
+                }
+                continue;
+            }
+            let (img, _) = result.unwrap_or_else(|e| panic!("{device} ×{k:e}: {e}"));
+            let (e, at, n) = max_oracle_error(&img, &s, Encoding::Srgb, &caps);
+            // A reference that kept (almost) no pixel would compare nothing and read 0.
+            assert!(n >= 50, "only {n} pixels compared");
+            assert!(
+                e <= 2.0,
+                "{device} ×{k:e}: {e:.1} / 255 off the f64 model at {at:?}"
+            );
+            let d = manylight::metrics::diff(&want, &img);
+            assert!(d.max_abs <= 1, "{device} ×{k:e}: {} / 255", d.max_abs);
+        }
+    });
+}
+
+#[test]
+fn a_triangle_huge_beside_the_camera_renders_as_the_f64_model_says() {
+    let wide = |k: f64| {
+        let mut s = lit_plane();
+        s.objects[0].transform = DMat4::from_scale(DVec3::new(k, k, 1.0));
+        s
+    };
+    each_device(|device, gpu| {
+        let caps = gpu.r().caps().clone();
+        // 10⁶ put the light off centre (29/255), 10⁸ left half the frame black: the plane is
+        // split near the eye for the frame.
+        for k in [1e3, 1e6, 1e8, 1e11] {
+            let s = wide(k);
+            for method in methods(gpu) {
+                let img = render(gpu, method, &s);
+                let (e, at, n) = max_oracle_error(&img, &s, Encoding::Srgb, &caps);
+                // The plane fills the frame: most pixels are compared.
+                let pixels = (img.width() * img.height()) as usize;
+                assert!(
+                    n * 10 >= pixels * 9,
+                    "{device} {method} ×{k:e}: {n} of {pixels} compared"
+                );
+                let bound = f64_model_bound(device);
+                assert!(
+                    e <= bound,
+                    "{device} {method} ×{k:e}: {e:.1} / 255 off the f64 model at {at:?}"
+                );
+            }
+        }
+    });
+}
+
+/// An OBJ quad of half-size `half` with its corners `offset` from the origin, with its camera
+/// framed and 32 random lights as the CLI loads it.
+fn obj_quad(dir: &std::path::Path, offset: f64, half: f64) -> Scene {
+    let path = dir.join(format!("quad{offset}-{half}.obj"));
+    let v = |x: f64, y: f64| format!("v {} {} {}\n", offset + x, offset + y, offset);
+    let text = [
+        v(-half, -half),
+        v(half, -half),
+        v(half, half),
+        v(-half, half),
+    ]
+    .concat()
+        + "f 1 2 3 4\n";
+    std::fs::write(&path, text).unwrap();
+    let (mut s, _) = scene::load(path.to_str().unwrap(), Some((32, 5))).unwrap();
+    s.ambient = Vec3::ZERO;
+    s
+}
+
+#[test]
+fn an_obj_modelled_far_from_its_origin_renders_as_at_the_origin() {
+    let dir = tempfile::tempdir().unwrap();
+    let at_origin = obj_quad(dir.path(), 0.0, 4.0);
+    for offset in [1e5, 1e7] {
+        assert_draws_as(
+            &obj_quad(dir.path(), offset, 4.0),
+            &at_origin,
+            &format!("quad at {offset:e}"),
+        );
+    }
+    // Corners 0.1 apart 1e7 and 1e8 from the origin: f32 there rounds to 1 and 8, but the
+    // file is read in f64 and the mesh stored about its centre.
+    let fine = obj_quad(dir.path(), 0.0, 0.05);
+    for offset in [1e7, 1e8] {
+        assert_draws_as(
+            &obj_quad(dir.path(), offset, 0.05),
+            &fine,
+            &format!("fine quad at {offset:e}"),
+        );
+    }
+    // The same through an object transform (f64 all the way).
+    let mut moved = at_origin.clone();
+    let shift = DVec3::splat(1e9);
+    for o in &mut moved.objects {
+        o.transform = DMat4::from_translation(shift) * o.transform;
+    }
+    for l in &mut moved.lights {
+        l.position += shift;
+    }
+    moved.camera.position += shift;
+    moved.camera.target += shift;
+    assert_draws_as(&moved, &at_origin, "quad moved by 1e9");
+}
+
+#[test]
+fn spot_axes_of_any_finite_length_light_alike() {
+    let spot = |length: f64| {
+        let mut s = lit_plane();
+        let cone = manylight::Cone {
+            direction: DVec3::new(0.2, 0.1, -1.0) * length,
+            inner_deg: 30.0,
+            outer_deg: 70.0,
+        };
+        s.lights = vec![Light::spot(
+            DVec3::new(0.0, 0.0, 1.5),
+            4.0,
+            Vec3::ONE,
+            2.0,
+            cone,
+        )];
+        s
+    };
+    for length in [1e155, 1e-200, 1e300] {
+        assert_draws_as(
+            &spot(length),
+            &spot(1.0),
+            &format!("spot axis × {length:e}"),
+        );
+    }
+}
+
+#[test]
+fn lights_of_large_radius_light_as_every_method_and_the_f64_model_say() {
+    for radius in [6e3f32, 6e4, 1e6] {
+        let mut s = lit_plane();
+        s.lights[0].radius = radius;
+        each_device(|device, gpu| {
+            let caps = gpu.r().caps().clone();
+            let forward = render(gpu, "forward", &s);
+            assert!(mean(&forward) > 20.0, "{device} radius {radius:e}: dark");
+            let (e, at, n) = max_oracle_error(&forward, &s, Encoding::Srgb, &caps);
+            // A reference that kept (almost) no pixel would compare nothing and read 0.
+            assert!(n >= 50, "only {n} pixels compared");
+            assert!(
+                e <= 2.0,
+                "{device} radius {radius:e}: {e:.1} / 255 off at {at:?}"
+            );
+            for method in methods(gpu) {
+                let d = manylight::metrics::diff(&forward, &render(gpu, method, &s));
+                assert!(
+                    d.max_abs <= 2,
+                    "{device} {method} radius {radius:e}: {}",
+                    d.max_abs
+                );
+            }
+        });
+    }
+}
+
+#[test]
+fn an_object_placed_with_translation_only_keeps_its_own_picture() {
+    // A mesh whose vertices are all far from its own origin and an object that moves it back:
+    // the picture is the mesh drawn at the origin.
+    let s = lit_plane();
+    let mesh = &s.objects[0].mesh;
+    let offset = Vec3::splat(3e6);
+    let far = Mesh::new(
+        mesh.positions.iter().map(|p| *p + offset).collect(),
+        mesh.normals.clone(),
+        mesh.uvs.clone(),
+        mesh.indices.clone(),
+    )
+    .unwrap();
+    let mut moved = s.clone();
+    moved.objects = vec![Object {
+        mesh: Arc::new(far),
+        material: s.objects[0].material,
+        transform: DMat4::from_translation(-offset.as_dvec3()),
+    }];
+    assert_draws_as(&moved, &s, "vertices 3e6 from their origin");
+}
+
+#[test]
+fn without_highp_a_light_too_far_to_place_is_refused_by_name_or_left_out_when_it_reaches_nothing() {
+    let with = |light: Light| {
+        let mut s = lit_plane();
+        s.lights.push(light);
+        s
+    };
+    // A sun 70 km away whose sphere takes in the plane; a lamp as far whose sphere does not.
+    let sun = Light::point(DVec3::new(0.0, 0.0, 7e4), 1e5, Vec3::ONE, 2e9);
+    let far_lamp = Light::point(DVec3::new(0.0, 0.0, 7e4), 100.0, Vec3::ONE, 2.0);
+    each_device(|device, gpu| {
+        let caps = gpu.r().caps().clone();
+        let alone = render(gpu, "forward", &lit_plane());
+        let lamp = render(gpu, "forward", &with(far_lamp));
+        assert_eq!(
+            manylight::metrics::diff(&alone, &lamp).max_abs,
+            0,
+            "{device}"
+        );
+        let s = with(sun);
+        match gpu
+            .r()
+            .render_offscreen(&s, W, H, &RenderOptions::default())
+        {
+            Ok((img, _)) => {
+                assert!(
+                    !device.contains("without"),
+                    "{device}: the sun cannot be placed"
+                );
+                let (e, at, n) = max_oracle_error(&img, &s, Encoding::Srgb, &caps);
+                // A reference that kept (almost) no pixel would compare nothing and read 0.
+                assert!(n >= 50, "only {n} pixels compared");
+                assert!(
+                    e <= 2.0,
+                    "{device}: {e:.1} / 255 off the f64 model at {at:?}"
+                );
+                assert!(
+                    mean(&img) > mean(&alone) + 5.0,
+                    "{device}: the sun lights nothing"
+                );
+            }
+            Err(e) => {
+                assert!(device.contains("without"), "{device}: {e}");
+                assert!(e.to_string().contains("lights[1]"), "{e}");
+            }
+        }
+    });
+}
