@@ -226,7 +226,7 @@ fn capped_driver_says_clearly_that_es3_is_unavailable() {
 
 /// ES 2.0 without `GL_OES_texture_npot` (Mali-400 has none) scales images to a power of two,
 /// and says so in its capabilities; with it (as Mesa lists it) images keep their size
-/// (`npot_textures.rs`).
+/// (`model_files/npot_textures.rs`).
 #[test]
 fn es2_lists_whether_images_keep_their_size() {
     let dir = tempfile::tempdir().unwrap();

@@ -2,7 +2,7 @@
 //! with `GL_OES_texture_npot`, which Mesa, SwiftShader and ANGLE all list): a 3 × 1 image
 //! read through a nearest filter shows its three texels exactly, with every method on ES 2.0
 //! and 3.0. Scaled to a power of two (2 × 1, area-averaged) its middle third would show blends.
-//! `cli.rs` checks the context without the extension.
+//! `command_line/cli.rs` checks the context without the extension.
 
 use crate::common;
 
