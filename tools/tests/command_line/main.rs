@@ -1,6 +1,6 @@
 //! The `manylight` command line, run as a user runs it: rendering, outputs and their failures,
-//! `bench` and `matrix`. One test program of one module per file (each file once a program of
-//! its own, built and linked apart: docs/testing.md).
+//! `bench` and `matrix`. One test program of one module per file, built and linked once
+//! (docs/testing.md).
 
 #[path = "../common/mod.rs"]
 mod common;
