@@ -213,6 +213,18 @@ pub fn methods_on(es: EsVersion) -> &'static [&'static str] {
     }
 }
 
+/// Calls `check(es, method, gpu)` with `gpu`'s renderer set to each method of ES 2.0 and then
+/// of ES 3.0 ([`methods_on`]), one context per version.
+pub fn each_method(mut check: impl FnMut(EsVersion, &str, &mut Gpu)) {
+    for es in [EsVersion::Es2, EsVersion::Es3] {
+        let mut gpu = Gpu::new(es);
+        for method in methods_on(es) {
+            gpu.r().set_method_named(method).unwrap();
+            check(es, method, &mut gpu);
+        }
+    }
+}
+
 /// The mean of a picture's red, green and blue values, in 8-bit steps.
 pub fn mean(img: &image::RgbaImage) -> f64 {
     let sum: u64 = img

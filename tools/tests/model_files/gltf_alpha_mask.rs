@@ -13,7 +13,6 @@ use std::path::Path;
 use common::files::{load, write};
 use common::gltf::{base64, Builder};
 use common::gltf_models::{floor, pane, primitive, quat};
-use common::Gpu;
 use glam::{DQuat, DVec3, Vec3};
 use manylight::scene::{Light, Scene};
 use manylight::{EsVersion, RenderOptions};
@@ -293,17 +292,13 @@ fn for_every_method(
     mut check: impl FnMut(EsVersion, &str, [image::RgbaImage; 3]),
 ) {
     let opts = RenderOptions::default();
-    for es in [EsVersion::Es2, EsVersion::Es3] {
-        let mut gpu = Gpu::new(es);
-        for method in common::methods_on(es) {
-            gpu.r().set_method_named(method).unwrap();
-            check(
-                es,
-                method,
-                scenes.map(|scene| gpu.render(scene, W, H, &opts)),
-            );
-        }
-    }
+    common::each_method(|es, method, gpu| {
+        check(
+            es,
+            method,
+            scenes.map(|scene| gpu.render(scene, W, H, &opts)),
+        );
+    });
 }
 
 /// A blended primitive whose `COLOR_0` alpha is 0 at every vertex draws nothing: said at

@@ -5,46 +5,40 @@
 //! and a linear filter blends neighbouring texels where a nearest one never does.
 
 use crate::common;
+use crate::texel_quads::{self, texel_at, wrapped, H, TEXELS, W};
 
 use common::gltf::{base64, Builder};
-use common::Gpu;
 use glam::Vec3;
-use manylight::{EsVersion, RenderOptions};
+use manylight::sampling::Wrap;
+use manylight::RenderOptions;
 use serde_json::{json, Value};
 
-const W: u32 = 192;
-const H: u32 = 108;
-
-/// The image's texels, row by row from the top: red, green / blue, white.
-const TEXELS: [[u8; 3]; 4] = [[255, 0, 0], [0, 255, 0], [0, 0, 255], [255, 255, 255]];
-
-/// glTF's wrap codes.
-const REPEAT: u32 = 10497;
+/// glTF's wrap and filter codes.
 const CLAMP: u32 = 33071;
-const MIRROR: u32 = 33648;
 const NEAREST: u32 = 9728;
 const LINEAR: u32 = 9729;
 
 /// The four quads' samplers, left to right then top to bottom: (wrapS, wrapT, filter), or
 /// none (the third: repeating, linear, mipmapped), drawn after one that is not the default
 /// (the shared upload's parameters must be set back).
-const SAMPLERS: [Option<(u32, u32, u32)>; 4] = [
-    Some((MIRROR, REPEAT, NEAREST)),
-    Some((CLAMP, MIRROR, NEAREST)),
+const SAMPLERS: [Option<(Wrap, Wrap, u32)>; 4] = [
+    Some((Wrap::MirroredRepeat, Wrap::Repeat, NEAREST)),
+    Some((Wrap::ClampToEdge, Wrap::MirroredRepeat, NEAREST)),
     None,
-    Some((REPEAT, CLAMP, NEAREST)),
+    Some((Wrap::Repeat, Wrap::ClampToEdge, NEAREST)),
 ];
 
-fn png() -> Vec<u8> {
-    common::gltf_models::png_bytes(&image::RgbaImage::from_fn(2, 2, |x, y| {
-        let [r, g, b] = TEXELS[(2 * y + x) as usize];
-        image::Rgba([r, g, b, 255])
-    }))
+/// glTF's code for `wrap`.
+fn code(wrap: Wrap) -> u32 {
+    match wrap {
+        Wrap::Repeat => 10497,
+        Wrap::ClampToEdge => CLAMP,
+        Wrap::MirroredRepeat => 33648,
+    }
 }
 
-/// Half the view's width (its height is 2): the quads tile the whole view.
-fn half_width() -> f32 {
-    W as f32 / H as f32
+fn png() -> Vec<u8> {
+    common::gltf_models::png_bytes(&texel_quads::image())
 }
 
 /// The document: an orthographic camera looking down −Z at the four quads, each a quarter of
@@ -52,15 +46,12 @@ fn half_width() -> f32 {
 /// right.
 fn document() -> String {
     let mut b = Builder::default();
-    let a = half_width();
+    let a = texel_quads::half_width() as f32;
     let mut meshes = Vec::new();
     let mut nodes = Vec::new();
     for q in 0..4 {
-        let (x0, y1) = (
-            if q % 2 == 0 { -a } else { 0.0 },
-            if q < 2 { 1.0 } else { 0.0 },
-        );
-        let (x1, y0) = (x0 + a, y1 - 1.0);
+        let (x0, y0, x1, y1) = texel_quads::quad_corners(q);
+        let [x0, y0, x1, y1] = [x0, y0, x1, y1].map(|c| c as f32);
         let p = b.floats(
             &[x0, y0, 0.0, x1, y0, 0.0, x1, y1, 0.0, x0, y1, 0.0],
             "VEC3",
@@ -78,7 +69,9 @@ fn document() -> String {
     let samplers: Vec<Value> = SAMPLERS
         .iter()
         .flatten()
-        .map(|&(s, t, f)| json!({"wrapS": s, "wrapT": t, "magFilter": f, "minFilter": f}))
+        .map(|&(s, t, f)| {
+            json!({"wrapS": code(s), "wrapT": code(t), "magFilter": f, "minFilter": f})
+        })
         .collect();
     let mut sampler = 0;
     let textures: Vec<Value> = SAMPLERS
@@ -110,45 +103,6 @@ fn document() -> String {
     }))
 }
 
-/// Coordinate `u` wrapped into [0, 1] as `mode` says (the test's own reading of §5.26).
-fn wrap(u: f64, mode: u32) -> f64 {
-    match mode {
-        REPEAT => u - u.floor(),
-        CLAMP => u.clamp(0.0, 1.0),
-        MIRROR => {
-            let t = u.rem_euclid(2.0);
-            if t > 1.0 {
-                2.0 - t
-            } else {
-                t
-            }
-        }
-        _ => unreachable!(),
-    }
-}
-
-/// The quad pixel (x, y) lies in and its texture coordinates there.
-fn quad_and_uv(x: u32, y: u32) -> (usize, f64, f64) {
-    let (fx, fy) = (
-        (x as f64 + 0.5) / (W as f64 / 2.0),
-        (y as f64 + 0.5) / (H as f64 / 2.0),
-    );
-    let q = (fx >= 1.0) as usize + 2 * (fy >= 1.0) as usize;
-    (q, -1.0 + 3.0 * fx.fract(), -1.0 + 3.0 * fy.fract())
-}
-
-/// Distance of wrapped coordinate `u` (in texels of the 2-texel image) from the nearest
-/// place where the texel read changes: the middle, and with `REPEAT` the image's ends too
-/// (where the next copy starts; clamping and mirroring read the same texel on both sides).
-fn from_edge(u: f64, mode: u32) -> f64 {
-    let middle = (u - 0.5).abs() * 2.0;
-    if mode == REPEAT {
-        middle.min(u.min(1.0 - u) * 2.0)
-    } else {
-        middle
-    }
-}
-
 #[test]
 fn each_texture_wraps_and_filters_as_its_sampler_says_with_every_method() {
     let dir = tempfile::tempdir().unwrap();
@@ -159,56 +113,44 @@ fn each_texture_wraps_and_filters_as_its_sampler_says_with_every_method() {
         linear: true,
         ..Default::default()
     };
-    for es in [EsVersion::Es2, EsVersion::Es3] {
-        let mut gpu = Gpu::new(es);
-        for method in common::methods_on(es) {
-            gpu.r().set_method_named(method).unwrap();
-            let img = gpu.render(&scene, W, H, &opts);
-            let (mut checked, mut blended) = ([0usize; 4], 0);
-            for y in 0..H {
-                for x in 0..W {
-                    let (q, u, v) = quad_and_uv(x, y);
-                    let (wrap_u, wrap_v, filter) = SAMPLERS[q].unwrap_or((REPEAT, REPEAT, LINEAR));
-                    let (wu, wv) = (wrap(u, wrap_u), wrap(v, wrap_v));
-                    let shown = common::texel_shown(img.get_pixel(x, y), &TEXELS);
-                    let edge = from_edge(wu, wrap_u).min(from_edge(wv, wrap_v));
-                    let near_edge = edge < 0.08;
-                    // The quads' own borders and the texels' edges are left to rounding.
-                    let (px, py) = (
-                        (x as f64 + 0.5) % (W as f64 / 2.0),
-                        (y as f64 + 0.5) % (H as f64 / 2.0),
-                    );
-                    if near_edge || px < 1.0 || py < 1.0 {
-                        continue;
-                    }
-                    let column = ((wu * 2.0).floor() as usize).min(1);
-                    let row = ((wv * 2.0).floor() as usize).min(1);
-                    let want = 2 * row + column;
-                    if filter == LINEAR && edge < 0.25 {
-                        // Within a quarter texel of an edge a linear filter blends.
-                        blended += (shown != Some(want)) as usize;
-                        continue;
-                    }
-                    assert_eq!(
-                        shown,
-                        Some(want),
-                        "{es} {method}: pixel ({x}, {y}) of quad {q} at uv ({u:.3}, {v:.3}) \
-                         is {:?}",
-                        img.get_pixel(x, y)
-                    );
-                    checked[q] += 1;
-                }
+    common::each_method(|es, method, gpu| {
+        let img = gpu.render(&scene, W, H, &opts);
+        let (mut checked, mut blended) = ([0usize; 4], 0);
+        for (x, y, p) in img.enumerate_pixels() {
+            let Some((q, u, v)) = texel_quads::quad_and_uv(x, y) else {
+                continue;
+            };
+            let (wrap_u, wrap_v, filter) =
+                SAMPLERS[q].unwrap_or((Wrap::Repeat, Wrap::Repeat, LINEAR));
+            let ((wu, edge_u), (wv, edge_v)) = (wrapped(u, wrap_u), wrapped(v, wrap_v));
+            let edge = edge_u.min(edge_v);
+            // The texels' edges are left to rounding.
+            if edge < 0.08 {
+                continue;
             }
-            assert!(
-                checked.iter().all(|&n| n > 500),
-                "{es} {method}: pixels checked per quad {checked:?}"
+            let shown = common::texel_shown(p, &TEXELS);
+            let want = texel_at(wu, wv);
+            if filter == LINEAR && edge < 0.25 {
+                // Within a quarter texel of an edge a linear filter blends.
+                blended += (shown != Some(want)) as usize;
+                continue;
+            }
+            assert_eq!(
+                shown,
+                Some(want),
+                "{es} {method}: pixel ({x}, {y}) of quad {q} at uv ({u:.3}, {v:.3}) is {p:?}"
             );
-            assert!(
-                blended > 20,
-                "{es} {method}: the linear filter blended only {blended} pixels near edges"
-            );
+            checked[q] += 1;
         }
-    }
+        assert!(
+            checked.iter().all(|&n| n > 500),
+            "{es} {method}: pixels checked per quad {checked:?}"
+        );
+        assert!(
+            blended > 20,
+            "{es} {method}: the linear filter blended only {blended} pixels near edges"
+        );
+    });
 }
 
 /// A material whose base colour and occlusion textures read one image through different

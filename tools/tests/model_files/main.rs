@@ -17,3 +17,4 @@ mod metallic_roughness;
 mod npot_textures;
 mod obj_map_options;
 mod texcoord_range;
+mod texel_quads;

@@ -7,9 +7,8 @@
 use crate::common;
 
 use common::gltf::{base64, Builder};
-use common::Gpu;
 use glam::Vec3;
-use manylight::{EsVersion, RenderOptions};
+use manylight::RenderOptions;
 use serde_json::json;
 
 const W: u32 = 96;
@@ -65,31 +64,27 @@ fn an_image_of_three_texels_shows_each_exactly_with_every_method() {
         linear: true,
         ..Default::default()
     };
-    for es in [EsVersion::Es2, EsVersion::Es3] {
-        let mut gpu = Gpu::new(es);
+    common::each_method(|es, method, gpu| {
         assert!(
             gpu.r().caps().npot_textures,
             "{es}: this implementation lists no GL_OES_texture_npot"
         );
-        for method in common::methods_on(es) {
-            gpu.r().set_method_named(method).unwrap();
-            let img = gpu.render(&scene, W, H, &opts);
-            for y in 1..H - 1 {
-                for x in 0..W {
-                    // Two pixels each side of a texel's edge are left to rounding.
-                    let third = W / 3;
-                    if x % third < 2 || x % third >= third - 2 {
-                        continue;
-                    }
-                    let p = img.get_pixel(x, y);
-                    let want = TEXELS[(x / third) as usize];
-                    let off = (0..3).map(|c| p[c].abs_diff(want[c])).max().unwrap();
-                    assert!(
-                        off <= 2,
-                        "{es} {method}: pixel ({x}, {y}) is {p:?}, texel {want:?}"
-                    );
+        let img = gpu.render(&scene, W, H, &opts);
+        for y in 1..H - 1 {
+            for x in 0..W {
+                // Two pixels each side of a texel's edge are left to rounding.
+                let third = W / 3;
+                if x % third < 2 || x % third >= third - 2 {
+                    continue;
                 }
+                let p = img.get_pixel(x, y);
+                let want = TEXELS[(x / third) as usize];
+                let off = (0..3).map(|c| p[c].abs_diff(want[c])).max().unwrap();
+                assert!(
+                    off <= 2,
+                    "{es} {method}: pixel ({x}, {y}) is {p:?}, texel {want:?}"
+                );
             }
         }
-    }
+    });
 }

@@ -5,19 +5,13 @@
 //! test works out from the MTL format's reading of the options.
 
 use crate::common;
+use crate::texel_quads::{self, texel_at, wrapped, H, TEXELS, W};
 
-use common::Gpu;
 use glam::{DVec3, Vec3};
 use manylight::sampling::Wrap;
 use manylight::scene::{Camera, Projection};
-use manylight::{EsVersion, RenderOptions};
+use manylight::RenderOptions;
 use std::sync::Arc;
-
-const W: u32 = 192;
-const H: u32 = 108;
-
-/// The image's texels, row by row from the top: red, green / blue, white.
-const TEXELS: [[u8; 3]; 4] = [[255, 0, 0], [0, 255, 0], [0, 0, 255], [255, 255, 255]];
 
 /// Each quad's `map_Kd` (left to right, then top to bottom) and what the test reads from it:
 /// (clamp, scale, offset) of OBJ's coordinates (v up).
@@ -39,17 +33,9 @@ const QUADS: [(&str, bool, [f64; 2], [f64; 2]); 4] = [
 ];
 
 fn save_image(path: &std::path::Path) {
-    image::RgbaImage::from_fn(2, 2, |x, y| {
-        let [r, g, b] = TEXELS[(2 * y + x) as usize];
-        image::Rgba([r, g, b, 255])
-    })
-    .save_with_format(path, image::ImageFormat::Png)
-    .unwrap();
-}
-
-/// Half the view's width (its height is 2): the quads tile the whole view.
-fn half_width() -> f64 {
-    W as f64 / H as f64
+    texel_quads::image()
+        .save_with_format(path, image::ImageFormat::Png)
+        .unwrap();
 }
 
 /// The model's folder: the OBJ (four quads facing +Z, texture coordinates from (−1, −1) at
@@ -60,12 +46,9 @@ fn model() -> (tempfile::TempDir, std::path::PathBuf) {
     save_image(&dir.path().join("my texels.png"));
     let mut mtl = String::new();
     let mut obj = String::from("mtllib m.mtl\nvt -1 -1\nvt 2 -1\nvt 2 2\nvt -1 2\nvn 0 0 1\n");
-    let a = half_width();
     for (q, (statement, ..)) in QUADS.iter().enumerate() {
         mtl += &format!("newmtl q{q}\nKd 1 1 1\nmap_Kd {statement}\n");
-        let x0 = if q % 2 == 0 { -a } else { 0.0 };
-        let y1 = if q < 2 { 1.0 } else { 0.0 };
-        let (x1, y0) = (x0 + a, y1 - 1.0);
+        let (x0, y0, x1, y1) = texel_quads::quad_corners(q);
         for (x, y) in [(x0, y0), (x1, y0), (x1, y1), (x0, y1)] {
             obj += &format!("v {x} {y} 0\n");
         }
@@ -82,28 +65,6 @@ fn model() -> (tempfile::TempDir, std::path::PathBuf) {
     let path = dir.path().join("m.obj");
     std::fs::write(&path, obj).unwrap();
     (dir, path)
-}
-
-/// The quad pixel (x, y) lies in and its OBJ texture coordinates there (v up).
-fn quad_and_uv(x: u32, y: u32) -> (usize, f64, f64) {
-    let (fx, fy) = (
-        (x as f64 + 0.5) / (W as f64 / 2.0),
-        (y as f64 + 0.5) / (H as f64 / 2.0),
-    );
-    let q = (fx >= 1.0) as usize + 2 * (fy >= 1.0) as usize;
-    (q, -1.0 + 3.0 * fx.fract(), 2.0 - 3.0 * fy.fract())
-}
-
-/// Coordinate `u` (the image's width or height from 0 to 1) of a repeating or clamped texture,
-/// and its distance in texels from the nearest place the texel read changes.
-fn wrapped(u: f64, clamp: bool) -> (f64, f64) {
-    if clamp {
-        let u = u.clamp(0.0, 1.0);
-        (u, (u - 0.5).abs() * 2.0)
-    } else {
-        let u = u - u.floor();
-        (u, ((u - 0.5).abs() * 2.0).min(u.min(1.0 - u) * 2.0))
-    }
 }
 
 #[test]
@@ -130,47 +91,40 @@ fn map_kd_options_clamp_scale_and_move_the_texture_with_every_method() {
         linear: true,
         ..Default::default()
     };
-    for es in [EsVersion::Es2, EsVersion::Es3] {
-        let mut gpu = Gpu::new(es);
-        for method in common::methods_on(es) {
-            gpu.r().set_method_named(method).unwrap();
-            let img = gpu.render(&scene, W, H, &opts);
-            let mut checked = [0usize; 4];
-            for y in 0..H {
-                for x in 0..W {
-                    let (q, u, v) = quad_and_uv(x, y);
-                    let (_, clamp, [su, sv], [ou, ov]) = QUADS[q];
-                    let (wu, edge_u) = wrapped(su * u + ou, clamp);
-                    // Rows from the image's top: 1 − v.
-                    let (wt, edge_t) = wrapped(1.0 - (sv * v + ov), clamp);
-                    let (px, py) = (
-                        (x as f64 + 0.5) % (W as f64 / 2.0),
-                        (y as f64 + 0.5) % (H as f64 / 2.0),
-                    );
-                    // Within a quarter texel of an edge the linear filter blends; the quads'
-                    // own borders are left to rounding.
-                    if edge_u.min(edge_t) < 0.25 || px < 1.0 || py < 1.0 {
-                        continue;
-                    }
-                    let column = ((wu * 2.0).floor() as usize).min(1);
-                    let row = ((wt * 2.0).floor() as usize).min(1);
-                    let shown = common::texel_shown(img.get_pixel(x, y), &TEXELS);
-                    assert_eq!(
-                        shown,
-                        Some(2 * row + column),
-                        "{es} {method}: pixel ({x}, {y}) of quad {q} at uv ({u:.3}, {v:.3}) \
-                         is {:?}",
-                        img.get_pixel(x, y)
-                    );
-                    checked[q] += 1;
-                }
+    common::each_method(|es, method, gpu| {
+        let img = gpu.render(&scene, W, H, &opts);
+        let mut checked = [0usize; 4];
+        for (x, y, p) in img.enumerate_pixels() {
+            let Some((q, u, t)) = texel_quads::quad_and_uv(x, y) else {
+                continue;
+            };
+            // OBJ's v runs up.
+            let v = 1.0 - t;
+            let (_, clamp, [su, sv], [ou, ov]) = QUADS[q];
+            let wrap = if clamp {
+                Wrap::ClampToEdge
+            } else {
+                Wrap::Repeat
+            };
+            let (wu, edge_u) = wrapped(su * u + ou, wrap);
+            // Rows from the image's top: 1 − v.
+            let (wt, edge_t) = wrapped(1.0 - (sv * v + ov), wrap);
+            // Within a quarter texel of an edge the linear filter blends.
+            if edge_u.min(edge_t) < 0.25 {
+                continue;
             }
-            assert!(
-                checked.iter().all(|&n| n > 500),
-                "{es} {method}: pixels checked per quad {checked:?}"
+            assert_eq!(
+                common::texel_shown(p, &TEXELS),
+                Some(texel_at(wu, wt)),
+                "{es} {method}: pixel ({x}, {y}) of quad {q} at uv ({u:.3}, {v:.3}) is {p:?}"
             );
+            checked[q] += 1;
         }
-    }
+        assert!(
+            checked.iter().all(|&n| n > 500),
+            "{es} {method}: pixels checked per quad {checked:?}"
+        );
+    });
 }
 
 /// A clamped texture shares the image of a repeating one on the same file (uploaded once).

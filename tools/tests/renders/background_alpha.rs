@@ -8,10 +8,9 @@ use crate::common;
 
 use std::sync::Arc;
 
-use common::Gpu;
 use glam::{DMat4, DVec3, Vec3};
 use manylight::scene::{Light, Material, Object, Scene};
-use manylight::{Camera, EsVersion, MeshBuilder, RenderOptions};
+use manylight::{Camera, MeshBuilder, RenderOptions};
 
 const W: u32 = 96;
 const H: u32 = 54;
@@ -65,24 +64,20 @@ fn alpha_over_a_transparent_background_is_coverage() {
         ..Default::default()
     };
     let s = scene();
-    for es in [EsVersion::Es2, EsVersion::Es3] {
-        let mut gpu = Gpu::new(es);
-        for method in common::methods_on(es) {
-            gpu.r().set_method_named(method).unwrap();
-            let img = gpu.render(&s, W, H, &opts);
-            let alpha = |x: u32| img.get_pixel(x, H / 2)[3];
-            // Columns through the middle of each object, and one between them.
-            let (quad, opaque, cube, empty) = (
-                alpha(W / 2 - 27),
-                alpha(W / 2),
-                alpha(W / 2 + 27),
-                alpha(W / 2 - 12),
-            );
-            let place = format!("{es} {method}");
-            assert!(quad.abs_diff(128) <= 1, "{place}: glass quad alpha {quad}");
-            assert_eq!(opaque, 255, "{place}: opaque quad");
-            assert!(cube.abs_diff(191) <= 1, "{place}: glass box alpha {cube}");
-            assert_eq!(empty, 0, "{place}: background");
-        }
-    }
+    common::each_method(|es, method, gpu| {
+        let img = gpu.render(&s, W, H, &opts);
+        let alpha = |x: u32| img.get_pixel(x, H / 2)[3];
+        // Columns through the middle of each object, and one between them.
+        let (quad, opaque, cube, empty) = (
+            alpha(W / 2 - 27),
+            alpha(W / 2),
+            alpha(W / 2 + 27),
+            alpha(W / 2 - 12),
+        );
+        let place = format!("{es} {method}");
+        assert!(quad.abs_diff(128) <= 1, "{place}: glass quad alpha {quad}");
+        assert_eq!(opaque, 255, "{place}: opaque quad");
+        assert!(cube.abs_diff(191) <= 1, "{place}: glass box alpha {cube}");
+        assert_eq!(empty, 0, "{place}: background");
+    });
 }

@@ -120,44 +120,40 @@ fn the_side_seen_is_the_windings_with_every_method() {
         ..Default::default()
     };
     let mirror = DMat4::from_scale(DVec3::new(-1.0, 1.0, 1.0));
-    for es in [EsVersion::Es2, EsVersion::Es3] {
-        let mut gpu = Gpu::new(es);
-        for method in common::methods_on(es) {
-            gpu.r().set_method_named(method).unwrap();
-            for (i, (what, s)) in scenes().iter().enumerate() {
-                let img = gpu.render(s, W, H, &opts);
-                let caps = gpu.r().caps().clone();
-                let (err, at, covered) = max_oracle_error(&img, s, Encoding::Linear, &caps);
-                assert!(
-                    covered > 2000,
-                    "{es} {method} {what}: {covered} pixels compared"
-                );
-                assert!(
-                    err <= 2.0,
-                    "{es} {method} {what}: {err:.1}/255 from the light model at {at:?}"
-                );
-                let transform = if i == 1 { mirror } else { DMat4::IDENTITY };
-                let leaning = leaning_pixels(s, transform, i == 3);
-                eprintln!(
-                    "{es} {method} {what}: {} leaning pixels, error {err:.2}",
-                    leaning.len()
-                );
-                assert!(leaning.len() > 100, "{what}: {} pixels", leaning.len());
-                // Ambient alone is 0.05 · 0.8 = 0.04 of white, about 10/255.
-                let dark = leaning
-                    .iter()
-                    .filter(|&&(x, y)| img.get_pixel(x, y)[0] < 40)
-                    .count();
-                assert_eq!(
-                    dark,
-                    0,
-                    "{es} {method} {what}: {dark} of {} pixels whose normal faces the light \
-                     but leans away from the eye are lit as if from behind",
-                    leaning.len()
-                );
-            }
+    common::each_method(|es, method, gpu| {
+        for (i, (what, s)) in scenes().iter().enumerate() {
+            let img = gpu.render(s, W, H, &opts);
+            let caps = gpu.r().caps().clone();
+            let (err, at, covered) = max_oracle_error(&img, s, Encoding::Linear, &caps);
+            assert!(
+                covered > 2000,
+                "{es} {method} {what}: {covered} pixels compared"
+            );
+            assert!(
+                err <= 2.0,
+                "{es} {method} {what}: {err:.1}/255 from the light model at {at:?}"
+            );
+            let transform = if i == 1 { mirror } else { DMat4::IDENTITY };
+            let leaning = leaning_pixels(s, transform, i == 3);
+            eprintln!(
+                "{es} {method} {what}: {} leaning pixels, error {err:.2}",
+                leaning.len()
+            );
+            assert!(leaning.len() > 100, "{what}: {} pixels", leaning.len());
+            // Ambient alone is 0.05 · 0.8 = 0.04 of white, about 10/255.
+            let dark = leaning
+                .iter()
+                .filter(|&&(x, y)| img.get_pixel(x, y)[0] < 40)
+                .count();
+            assert_eq!(
+                dark,
+                0,
+                "{es} {method} {what}: {dark} of {} pixels whose normal faces the light \
+                 but leans away from the eye are lit as if from behind",
+                leaning.len()
+            );
         }
-    }
+    });
 }
 
 /// A half-transparent box centred on the origin, turned so that three faces show, placed

@@ -141,46 +141,42 @@ fn a_single_sided_surface_is_seen_from_its_front_only_with_every_method() {
         linear: true,
         ..Default::default()
     };
-    for es in [EsVersion::Es2, EsVersion::Es3] {
-        let mut gpu = Gpu::new(es);
-        for method in common::methods_on(es) {
-            gpu.r().set_method_named(method).unwrap();
-            let wall_alone = gpu.render(&scene(None), W, H, &opts);
-            // The wall alone is green where the pane would be.
-            assert!(middle().all(|(x, y)| {
-                let p = wall_alone.get_pixel(x, y);
-                p[1] > p[0] + 40
-            }));
-            for pane in every_pane() {
-                let s = scene(Some(pane));
-                let img = gpu.render(&s, W, H, &opts);
-                let what = format!("{es} {method} {pane:?}");
-                let from_wall = max_difference(&img, &wall_alone, middle());
-                if pane.seen() {
-                    assert!(from_wall > 40, "{what}: the pane is missing ({from_wall})");
-                    let red = middle().all(|(x, y)| {
-                        let p = img.get_pixel(x, y);
-                        p[0] > p[1]
-                    });
-                    assert!(red || pane.transparent, "{what}: not red");
-                } else {
-                    // Culled: the picture is the wall's alone, everywhere.
-                    let everywhere = (0..W).flat_map(|x| (0..H).map(move |y| (x, y)));
-                    let d = max_difference(&img, &wall_alone, everywhere);
-                    assert!(d <= 2, "{what}: {d}/255 from the wall alone");
-                }
-                if !pane.transparent {
-                    let caps = gpu.r().caps().clone();
-                    let (err, at, covered) = max_oracle_error(&img, &s, Encoding::Linear, &caps);
-                    assert!(covered > 3000, "{what}: {covered} pixels compared");
-                    assert!(
-                        err <= 2.0,
-                        "{what}: {err:.1}/255 from the light model at {at:?}"
-                    );
-                }
+    common::each_method(|es, method, gpu| {
+        let wall_alone = gpu.render(&scene(None), W, H, &opts);
+        // The wall alone is green where the pane would be.
+        assert!(middle().all(|(x, y)| {
+            let p = wall_alone.get_pixel(x, y);
+            p[1] > p[0] + 40
+        }));
+        for pane in every_pane() {
+            let s = scene(Some(pane));
+            let img = gpu.render(&s, W, H, &opts);
+            let what = format!("{es} {method} {pane:?}");
+            let from_wall = max_difference(&img, &wall_alone, middle());
+            if pane.seen() {
+                assert!(from_wall > 40, "{what}: the pane is missing ({from_wall})");
+                let red = middle().all(|(x, y)| {
+                    let p = img.get_pixel(x, y);
+                    p[0] > p[1]
+                });
+                assert!(red || pane.transparent, "{what}: not red");
+            } else {
+                // Culled: the picture is the wall's alone, everywhere.
+                let everywhere = (0..W).flat_map(|x| (0..H).map(move |y| (x, y)));
+                let d = max_difference(&img, &wall_alone, everywhere);
+                assert!(d <= 2, "{what}: {d}/255 from the wall alone");
+            }
+            if !pane.transparent {
+                let caps = gpu.r().caps().clone();
+                let (err, at, covered) = max_oracle_error(&img, &s, Encoding::Linear, &caps);
+                assert!(covered > 3000, "{what}: {covered} pixels compared");
+                assert!(
+                    err <= 2.0,
+                    "{what}: {err:.1}/255 from the light model at {at:?}"
+                );
             }
         }
-    }
+    });
 }
 
 /// A glTF pane in front of a double-sided wall, both facing the camera on +Z, the pane's
