@@ -27,7 +27,7 @@ pub fn half_width() -> f64 {
 /// bottom.
 pub fn quad_corners(q: usize) -> (f64, f64, f64, f64) {
     let a = half_width();
-    let x0 = if q % 2 == 0 { -a } else { 0.0 };
+    let x0 = if q.is_multiple_of(2) { -a } else { 0.0 };
     let y1 = if q < 2 { 1.0 } else { 0.0 };
     (x0, y1 - 1.0, x0 + a, y1)
 }
