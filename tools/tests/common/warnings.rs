@@ -1,9 +1,13 @@
-//! The warnings a test binary's renderers log: a logger of its own (the library logs through
-//! `log`, and a warning is what a user is told).
+//! The warnings a test's renderers log: a logger of the test program's own (the library logs
+//! through `log`, and a warning is what a user is told), read back per thread. The library
+//! logs on the thread that calls it, and each test runs on a thread of its own, so a test sees
+//! its own warnings and not those of the tests running beside it in the same program.
 
 use std::sync::{Mutex, Once};
+use std::thread::ThreadId;
 
-struct Warnings(Mutex<Vec<String>>);
+/// Each warning with the thread that logged it.
+struct Warnings(Mutex<Vec<(ThreadId, String)>>);
 
 impl log::Log for Warnings {
     fn enabled(&self, metadata: &log::Metadata) -> bool {
@@ -12,7 +16,8 @@ impl log::Log for Warnings {
 
     fn log(&self, record: &log::Record) {
         if self.enabled(record.metadata()) {
-            self.0.lock().unwrap().push(record.args().to_string());
+            let logged = (std::thread::current().id(), record.args().to_string());
+            self.0.lock().unwrap().push(logged);
         }
     }
 
@@ -30,13 +35,15 @@ pub fn install() {
     });
 }
 
-/// The warnings logged so far that contain `text` (installs the logger on first use).
+/// The warnings this thread logged so far that contain `text` (installs the logger on first
+/// use).
 pub fn warnings_containing(text: &str) -> Vec<String> {
     install();
+    let here = std::thread::current().id();
     let logged = WARNINGS.0.lock().unwrap();
     logged
         .iter()
-        .filter(|w| w.contains(text))
-        .cloned()
+        .filter(|(thread, w)| *thread == here && w.contains(text))
+        .map(|(_, w)| w.clone())
         .collect()
 }

@@ -1,5 +1,6 @@
 //! Pictures of the built-in scenes: each method against forward and the CPU oracle as lights
-//! move, framebuffers, viewports, MSAA, tone maps and sRGB. One test program of one module per
+//! move, framebuffers (the renderer's and a game's), viewports, MSAA, tone maps, sRGB, suns,
+//! the method table and the overflow policy. One test program of one module per
 //! file, so that its tests share their contexts and the shaders built on them: a software
 //! implementation compiles each shader anew in every process (docs/testing.md).
 
@@ -8,13 +9,18 @@ mod common;
 
 mod animation;
 mod background_alpha;
+mod culled_vs_forward;
+mod directional_lights;
 mod front_faces;
+mod game_framebuffer_checks;
 mod invalid_options;
 mod keep_framebuffer;
 mod light_evals;
 mod long_loops;
+mod method_table;
 mod msaa;
 mod msaa_destinations;
+mod overflow_warning;
 mod picture_numerics;
 mod plane_oracle;
 mod single_sided;

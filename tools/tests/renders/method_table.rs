@@ -1,6 +1,6 @@
 //! The method table: what each context supports, and `auto`'s choices.
 
-mod common;
+use crate::common;
 
 use common::Gpu;
 use manylight::methods::{Support, METHODS};

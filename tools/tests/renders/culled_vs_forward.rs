@@ -1,7 +1,7 @@
 //! Tiled and clustered images against plain forward over all lights (the oracle), pixel by
 //! pixel, on ES 2.0 and ES 3.0 contexts, and the overflow policy under a real render.
 
-mod common;
+use crate::common;
 
 use common::warnings::warnings_containing;
 use common::Gpu;

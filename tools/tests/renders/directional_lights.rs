@@ -3,7 +3,7 @@
 //! highp (no Inf or NaN, the model's picture where it is not white anyway) and the warning
 //! when a scene has more suns than a frame shows.
 
-mod common;
+use crate::common;
 
 use common::{max_oracle_error, mean, warnings, Gpu};
 use glam::{DVec3, Vec3};

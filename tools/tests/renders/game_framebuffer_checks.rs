@@ -5,7 +5,7 @@
 //! behind with its context says so once, not once for each of its objects.
 #![allow(unsafe_code)] // the game's side: raw glow calls
 
-mod common;
+use crate::common;
 
 use common::warnings::warnings_containing;
 use manylight::glow::{self, HasContext};

@@ -1,9 +1,8 @@
 //! The overflow warning (said once a renderer) is kept for a frame that draws: a frame refused
 //! for more visible lights than the lists can number used to spend it, and a later frame
-//! that really dropped light references then went unsaid. Its own binary: the warning is
-//! counted process-wide.
+//! that really dropped light references then went unsaid.
 
-mod common;
+use crate::common;
 
 use common::warnings::warnings_containing;
 use common::Gpu;
