@@ -9,7 +9,7 @@ use glam::{DMat4, DVec3};
 use crate::gl::mesh::GpuMesh;
 use crate::gl::texture::ImageTexture;
 use crate::gl::Device;
-use crate::scene::{Aabb, Material, Mesh, Scene, SceneError, Texture};
+use crate::scene::{triangle_reach, Aabb, Material, Mesh, Scene, SceneError, Texture};
 use crate::Error;
 
 /// Meshes and textures of scenes, uploaded once and found again by identity. The cache holds
@@ -34,6 +34,8 @@ pub struct GpuScene {
     /// eye: object index → the split mesh and its model matrix (see
     /// `scene::triangle_reach`).
     splits: HashMap<usize, (GpuMesh, DMat4)>,
+    /// A frame's splits ran out of triangles and said so (once a renderer).
+    warned_split_budget: bool,
 }
 
 impl GpuScene {
@@ -56,7 +58,7 @@ impl GpuScene {
                 let bounds = o.mesh.bounds();
                 let origin = bounds.map_or(DVec3::ZERO, |b| b.center());
                 let gpu = GpuMesh::new_about(dev, &o.mesh, origin)?;
-                let longest = crate::scene::triangle_reach::longest_edge(&o.mesh);
+                let longest = triangle_reach::longest_edge(&o.mesh);
                 e.insert((o.mesh.clone(), gpu, bounds, longest));
             }
         }
@@ -110,9 +112,21 @@ impl GpuScene {
             m.destroy(dev);
         }
         let model = DMat4::from_translation(scene.camera.position);
-        for (i, mesh) in crate::scene::triangle_reach::split_objects(scene, |o| {
-            (self.longest_edge(o), self.world_bounds(o))
-        }) {
+        let splits =
+            triangle_reach::split_objects(scene, |o| (self.longest_edge(o), self.world_bounds(o)));
+        if let Some(i) = splits.cut_short {
+            if !self.warned_split_budget {
+                self.warned_split_budget = true;
+                log::warn!(
+                    "objects[{i}] and any after it: triangles far longer than their distance \
+                     from the camera need more than {} splits this frame, so the rest are \
+                     drawn unsplit and may be off by f32 rounding near the eye (a huge mesh \
+                     seen from close by, or many such objects)",
+                    triangle_reach::MAX_SPLIT_TRIANGLES
+                );
+            }
+        }
+        for (i, mesh) in splits.meshes {
             self.splits.insert(i, (GpuMesh::new(dev, &mesh)?, model));
         }
         Ok(())

@@ -5,9 +5,11 @@
 //! much larger than its distance from the eye that error is a visible part of the distance
 //! itself: a plane scaled 10⁸ seen from 5 m was half black, at 10⁶ its light sat off centre.
 //! Such an object is drawn, for the frame, from a copy of its mesh in camera-relative world
-//! space whose triangles near the eye are split until none is longer than
-//! [`MAX_TRIANGLE_REACH`] times its distance (a few hundred triangles: only those near the
-//! eye split, and each level halves them).
+//! space whose triangles near the eye are cut in two across their longest edge until none is
+//! longer than [`MAX_TRIANGLE_REACH`] times its distance. Only those near the eye are cut,
+//! and a long, thin triangle only along its length, so a plane seen from close by takes a few
+//! hundred pieces however unevenly it is scaled; a frame makes at most
+//! [`MAX_SPLIT_TRIANGLES`] new ones, and past that draws the rest uncut.
 
 use glam::{DMat3, DMat4, DVec2, DVec3, DVec4, Vec2};
 
@@ -18,9 +20,20 @@ use super::{Aabb, Camera, Mesh, Object, Projection, Scene};
 /// plane's) that is drawn as it is: positions are then within about 10⁻³ of their distance.
 pub const MAX_TRIANGLE_REACH: f64 = 16384.0;
 
-/// Most halvings of one triangle: 2⁻⁶⁰ of the largest edge f64 holds is below any near plane
-/// that edge could need.
-const MAX_SPLITS: u32 = 60;
+/// Most cuts in one triangle's line: two cuts leave its longest edge at most √3/2 as long, so
+/// 600 leave at most 2⁻⁶² of it, below any near plane that edge could need.
+const MAX_CUTS: u32 = 600;
+
+/// Most triangles a frame's splits add (each cut adds one), over all objects: about 12 MiB of
+/// split copies. Past it the remaining triangles are drawn as they are, with a warning.
+pub const MAX_SPLIT_TRIANGLES: usize = 1 << 16;
+
+/// A frame's split copies: per object that needs one, its index and split mesh.
+pub struct Splits {
+    pub meshes: Vec<(usize, Mesh)>,
+    /// The first object whose split ran out of [`MAX_SPLIT_TRIANGLES`].
+    pub cut_short: Option<usize>,
+}
 
 /// The longest triangle edge of a mesh in object space (0 without triangles).
 pub fn longest_edge(mesh: &Mesh) -> f64 {
@@ -37,14 +50,15 @@ pub fn longest_edge(mesh: &Mesh) -> f64 {
 /// camera-relative world space (drawn with the model matrix `translation(eye)`). `measure`
 /// gives an object's longest edge in object space and its world bounds (kept by the caller
 /// per mesh); objects whose longest edge and bounds clear the limit cost one test.
-pub fn split_objects(
-    scene: &Scene,
-    measure: impl Fn(&Object) -> (f64, Option<Aabb>),
-) -> Vec<(usize, Mesh)> {
+pub fn split_objects(scene: &Scene, measure: impl Fn(&Object) -> (f64, Option<Aabb>)) -> Splits {
     let camera = &scene.camera;
     let floor = closest_fragment(camera);
     let eye = camera.position;
-    let mut out = Vec::new();
+    let mut budget = MAX_SPLIT_TRIANGLES;
+    let mut out = Splits {
+        meshes: Vec::new(),
+        cut_short: None,
+    };
     for (i, object) in scene.objects.iter().enumerate() {
         let scale = largest_scale(&object.transform);
         let (longest, bounds) = measure(object);
@@ -55,8 +69,16 @@ pub fn split_objects(
         if longest <= MAX_TRIANGLE_REACH * distance.max(floor) {
             continue;
         }
-        if let Some(mesh) = split_mesh(&object.mesh, &object.transform, eye, floor) {
-            out.push((i, mesh));
+        if budget == 0 {
+            out.cut_short.get_or_insert(i);
+            continue;
+        }
+        let split = split_mesh(&object.mesh, &object.transform, eye, floor, &mut budget);
+        if let Some((mesh, cut_short)) = split {
+            out.meshes.push((i, mesh));
+            if cut_short {
+                out.cut_short.get_or_insert(i);
+            }
         }
     }
     out
@@ -121,10 +143,38 @@ fn too_long(a: DVec3, b: DVec3, c: DVec3, floor: f64) -> bool {
     edge > MAX_TRIANGLE_REACH * distance.max(floor / unit)
 }
 
+/// Triangle `[a, b, c]` turned (its winding kept) so that `a`–`b` is its longest edge,
+/// measured in units of its largest coordinate difference so no square leaves f64.
+fn longest_edge_first([a, b, c]: [Vertex; 3]) -> [Vertex; 3] {
+    let edges = [b.p - a.p, c.p - b.p, a.p - c.p];
+    let unit = edges
+        .iter()
+        .map(|e| e.abs().max_element())
+        .fold(0.0, f64::max);
+    if !(unit > 0.0 && unit.is_finite()) {
+        return [a, b, c];
+    }
+    let [ab, bc, ca] = edges.map(|e| (e / unit).length_squared());
+    if ab >= bc && ab >= ca {
+        [a, b, c]
+    } else if bc >= ca {
+        [b, c, a]
+    } else {
+        [c, a, b]
+    }
+}
+
 /// `mesh` placed by `transform`, relative to `eye`, with the triangles too long for their
-/// distance split in four until they are not; `None` when no triangle needs it (or the
-/// placed mesh is not finite, which no split can mend).
-fn split_mesh(mesh: &Mesh, transform: &DMat4, eye: DVec3, floor: f64) -> Option<Mesh> {
+/// distance cut in two across their longest edge until they are not, each cut taken from
+/// `budget`, and whether one was left too long for want of budget; `None` when no triangle
+/// needs it (or the placed mesh is not finite, which no split can mend).
+fn split_mesh(
+    mesh: &Mesh,
+    transform: &DMat4,
+    eye: DVec3,
+    floor: f64,
+    budget: &mut usize,
+) -> Option<(Mesh, bool)> {
     let linear = DMat3::from_mat4(*transform);
     let normals = normal_matrix(&linear);
     // A mirroring transform flips the bitangent's handedness; the split copy is drawn
@@ -165,17 +215,22 @@ fn split_mesh(mesh: &Mesh, transform: &DMat4, eye: DVec3, floor: f64) -> Option<
     }
     let mut out = Mesh::default();
     let mut stack: Vec<([Vertex; 3], u32)> = placed.into_iter().map(|t| (t, 0)).collect();
+    let mut cut_short = false;
     while let Some(([a, b, c], depth)) = stack.pop() {
-        if depth < MAX_SPLITS && too_long(a.p, b.p, c.p, floor) {
-            let (ab, bc, ca) = (
-                Vertex::mid(&a, &b),
-                Vertex::mid(&b, &c),
-                Vertex::mid(&c, &a),
-            );
-            for t in [[a, ab, ca], [ab, b, bc], [ca, bc, c], [ab, bc, ca]] {
-                stack.push((t, depth + 1));
+        if depth < MAX_CUTS && too_long(a.p, b.p, c.p, floor) {
+            if *budget == 0 {
+                cut_short = true;
+            } else {
+                // Across the longest edge only: a long, thin triangle is cut along its length,
+                // never across its width (cuts in four made rows of pieces as many as it is
+                // long for its width: a plane scaled 10¹⁰ one way took gigabytes).
+                *budget -= 1;
+                let [a, b, c] = longest_edge_first([a, b, c]);
+                let m = Vertex::mid(&a, &b);
+                stack.push(([a, m, c], depth + 1));
+                stack.push(([m, b, c], depth + 1));
+                continue;
             }
-            continue;
         }
         for v in [a, b, c] {
             out.indices.push(out.positions.len() as u32);
@@ -195,7 +250,7 @@ fn split_mesh(mesh: &Mesh, transform: &DMat4, eye: DVec3, floor: f64) -> Option<
     if mesh.tangents.is_empty() {
         out.tangents.clear();
     }
-    Some(out)
+    Some((out, cut_short))
 }
 
 /// The point of triangle `abc` closest to the origin (Ericson, Real-Time Collision Detection,
@@ -265,26 +320,116 @@ mod tests {
         b.build().unwrap()
     }
 
+    /// [`split_mesh`] with the whole budget.
+    fn split(transform: &DMat4, eye: DVec3) -> Option<Mesh> {
+        let mut budget = MAX_SPLIT_TRIANGLES;
+        let split = split_mesh(&quad(), transform, eye, 0.1, &mut budget);
+        split.map(|(mesh, cut_short)| {
+            assert!(!cut_short);
+            mesh
+        })
+    }
+
+    /// Every triangle of `split` within the limit, all together `area`, normals +Z.
+    fn assert_split_within_the_limit(split: &Mesh, area: f64) {
+        let mut sum = 0.0;
+        for t in split.indices.chunks_exact(3) {
+            let [a, b, c] = [t[0], t[1], t[2]].map(|i| split.positions[i as usize].as_dvec3());
+            assert!(!too_long(a, b, c, 0.1));
+            sum += (b - a).cross(c - a).length() * 0.5;
+        }
+        assert!(
+            (sum / area - 1.0).abs() < 1e-4,
+            "area {sum:e}, not {area:e}"
+        );
+        assert!(split.normals.iter().all(|n| n.normalize() == glam::Vec3::Z));
+    }
+
     #[test]
     fn only_triangles_too_long_for_their_distance_are_split() {
         let eye = DVec3::new(0.0, 0.0, 5.0);
         let scaled = |s: f64| DMat4::from_scale(DVec3::new(s, s, 1.0));
-        assert!(split_mesh(&quad(), &scaled(1e4), eye, 0.1).is_none());
-        let split = split_mesh(&quad(), &scaled(1e8), eye, 0.1).unwrap();
-        let n = split.triangle_count();
+        assert!(split(&scaled(1e4), eye).is_none());
+        let mesh = split(&scaled(1e8), eye).unwrap();
+        let n = mesh.triangle_count();
         assert!(n > 2 && n < 2000, "{n} triangles");
-        // Every triangle now within the limit, all together the same area, normals kept.
-        let mut area = 0.0;
-        for t in split.indices.chunks_exact(3) {
-            let [a, b, c] = [t[0], t[1], t[2]].map(|i| split.positions[i as usize].as_dvec3());
-            assert!(!too_long(a, b, c, 0.1));
-            area += (b - a).cross(c - a).length() * 0.5;
-        }
-        assert!((area / 4e16 - 1.0).abs() < 1e-4, "area {area:e}");
-        assert!(split.normals.iter().all(|n| n.normalize() == glam::Vec3::Z));
+        assert_split_within_the_limit(&mesh, 4e16);
         // Seen from within its own plane, the near plane bounds how close a fragment can be.
-        assert!(split_mesh(&quad(), &scaled(1e2), DVec3::ZERO, 0.1).is_none());
-        assert!(split_mesh(&quad(), &scaled(1e4), DVec3::ZERO, 0.1).is_some());
+        assert!(split(&scaled(1e2), DVec3::ZERO).is_none());
+        assert!(split(&scaled(1e4), DVec3::ZERO).is_some());
+    }
+
+    /// Cut in four, a quad scaled 10¹⁰ one way made pieces by the million (gigabytes, then an
+    /// abort): every level cut its whole width into rows. At 10⁷ that made 20 258 pieces, and
+    /// 60 638 sheared; cut across the longest edge, 442 and 492.
+    #[test]
+    fn a_long_thin_or_sheared_quad_splits_into_few_triangles() {
+        let eye = DVec3::new(0.0, 0.0, 1.0);
+        let thin = DMat4::from_scale(DVec3::new(1e7, 1.0, 1.0));
+        let sheared = DMat4::from_cols(
+            glam::DVec4::new(1e7, 0.0, 0.0, 0.0),
+            glam::DVec4::new(1e7, 1.0, 0.0, 0.0),
+            glam::DVec4::Z,
+            glam::DVec4::W,
+        );
+        for (what, transform) in [("thin", thin), ("sheared", sheared)] {
+            let area = 4e7;
+            let mesh = split(&transform, eye).unwrap();
+            let n = mesh.triangle_count();
+            assert!(n > 2 && n < 2000, "{what}: {n} triangles");
+            assert_split_within_the_limit(&mesh, area);
+        }
+    }
+
+    /// Many objects each split near the eye: past the frame's budget the rest are drawn as
+    /// they are, and the first of them is named.
+    #[test]
+    fn a_frame_past_the_budget_names_the_first_object_left_unsplit() {
+        let mut scene = Scene::empty();
+        scene.camera = Camera::perspective(DVec3::new(0.0, 0.0, 5.0), DVec3::ZERO, 60.0, 0.1, 50.0);
+        let mesh = std::sync::Arc::new(quad());
+        let transform = DMat4::from_scale(DVec3::new(1e8, 1e8, 1.0));
+        for _ in 0..2000 {
+            scene.objects.push(Object {
+                mesh: mesh.clone(),
+                material: 0,
+                transform,
+            });
+        }
+        let measure = |o: &Object| {
+            let bounds = o.mesh.bounds().map(|b| b.transformed(&o.transform));
+            (longest_edge(&o.mesh), bounds)
+        };
+        let splits = split_objects(&scene, measure);
+        let first = splits.cut_short.expect("past the budget");
+        assert!(first > 0 && first < 2000, "{first}");
+        // Every object before it split whole; it and those after it as far as the budget went.
+        assert!(splits.meshes.iter().all(|(i, _)| *i <= first));
+        let added: usize = splits
+            .meshes
+            .iter()
+            .map(|(_, m)| m.triangle_count() - 2)
+            .sum();
+        assert_eq!(added, MAX_SPLIT_TRIANGLES);
+        // One object alone is within it.
+        scene.objects.truncate(1);
+        assert!(split_objects(&scene, measure).cut_short.is_none());
+    }
+
+    #[test]
+    fn splits_stop_at_the_budget_and_say_so() {
+        let eye = DVec3::new(0.0, 0.0, 5.0);
+        let transform = DMat4::from_scale(DVec3::new(1e8, 1e8, 1.0));
+        let mut budget = 10;
+        let (mesh, cut_short) = split_mesh(&quad(), &transform, eye, 0.1, &mut budget).unwrap();
+        assert!(cut_short);
+        assert_eq!(budget, 0);
+        // Each cut adds one triangle to the quad's two.
+        assert_eq!(mesh.triangle_count(), 12);
+        let mut budget = MAX_SPLIT_TRIANGLES;
+        let (_, cut_short) = split_mesh(&quad(), &transform, eye, 0.1, &mut budget).unwrap();
+        assert!(!cut_short);
+        assert!(budget < MAX_SPLIT_TRIANGLES);
     }
 
     #[test]
@@ -292,7 +437,7 @@ mod tests {
         let eye = DVec3::new(0.0, 0.0, 5.0);
         for mirror in [1.0, -1.0] {
             let transform = DMat4::from_scale(DVec3::new(1e8 * mirror, 1e8, 1.0));
-            let split = split_mesh(&quad(), &transform, eye, 0.1).unwrap();
+            let split = split(&transform, eye).unwrap();
             // Drawn unmirrored: each winding must face the way its normals do.
             for t in split.indices.chunks_exact(3) {
                 let [a, b, c] = [t[0], t[1], t[2]].map(|i| split.positions[i as usize]);

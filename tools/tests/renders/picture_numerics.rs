@@ -9,7 +9,7 @@ use crate::common;
 use std::sync::Arc;
 
 use common::{max_oracle_error, mean, Gpu};
-use glam::{DMat4, DVec3, Vec3};
+use glam::{DMat4, DVec3, DVec4, Vec3};
 use manylight::metrics::cpu_reference::Encoding;
 use manylight::scene::{self, Camera, Light, Mesh, Object, Scene};
 use manylight::{EsVersion, RenderOptions};
@@ -220,17 +220,34 @@ fn a_scene_scaled_up_renders_as_the_f64_model_says_or_is_refused_without_highp()
 
 #[test]
 fn a_triangle_huge_beside_the_camera_renders_as_the_f64_model_says() {
-    let wide = |k: f64| {
+    let placed = |transform: DMat4| {
         let mut s = lit_plane();
-        s.objects[0].transform = DMat4::from_scale(DVec3::new(k, k, 1.0));
+        s.objects[0].transform = transform;
         s
     };
+    let scaled = |x: f64, y: f64| DMat4::from_scale(DVec3::new(x, y, 1.0));
+    // x' = 10¹⁰ (x + y): the plane still fills the view, its triangles long and slanted.
+    let sheared = DMat4::from_cols(
+        DVec4::new(1e10, 0.0, 0.0, 0.0),
+        DVec4::new(1e10, 1.0, 0.0, 0.0),
+        DVec4::Z,
+        DVec4::W,
+    );
+    // 10⁶ put the light off centre (29/255), 10⁸ left half the frame black: the plane is
+    // split near the eye for the frame. Stretched one way (10¹¹ by 1, or sheared), its splits
+    // took gigabytes before they cut only across the longest edge.
+    let cases = [
+        ("×1e3", scaled(1e3, 1e3)),
+        ("×1e6", scaled(1e6, 1e6)),
+        ("×1e8", scaled(1e8, 1e8)),
+        ("×1e11", scaled(1e11, 1e11)),
+        ("×(1e11, 1)", scaled(1e11, 1.0)),
+        ("sheared 1e10", sheared),
+    ];
     each_device(|device, gpu| {
         let caps = gpu.r().caps().clone();
-        // 10⁶ put the light off centre (29/255), 10⁸ left half the frame black: the plane is
-        // split near the eye for the frame.
-        for k in [1e3, 1e6, 1e8, 1e11] {
-            let s = wide(k);
+        for (k, transform) in cases {
+            let s = placed(transform);
             for method in methods(gpu) {
                 let img = render(gpu, method, &s);
                 let (e, at, n) = max_oracle_error(&img, &s, Encoding::Srgb, &caps);
@@ -238,16 +255,40 @@ fn a_triangle_huge_beside_the_camera_renders_as_the_f64_model_says() {
                 let pixels = (img.width() * img.height()) as usize;
                 assert!(
                     n * 10 >= pixels * 9,
-                    "{device} {method} ×{k:e}: {n} of {pixels} compared"
+                    "{device} {method} {k}: {n} of {pixels} compared"
                 );
                 let bound = f64_model_bound(device);
                 assert!(
                     e <= bound,
-                    "{device} {method} ×{k:e}: {e:.1} / 255 off the f64 model at {at:?}"
+                    "{device} {method} {k}: {e:.1} / 255 off the f64 model at {at:?}"
                 );
             }
         }
     });
+}
+
+/// Past a frame's budget of split triangles (many huge objects beside the camera) the rest
+/// are drawn unsplit, with one warning a renderer naming the first of them; the frame still
+/// draws the plane.
+#[test]
+fn splits_past_the_frames_budget_are_warned_of_once() {
+    let mut s = lit_plane();
+    s.objects[0].transform = DMat4::from_scale(DVec3::new(1e8, 1e8, 1.0));
+    let one = s.objects[0].clone();
+    s.objects.resize(2000, one);
+    let mut gpu = Gpu::new(EsVersion::Es3);
+    let said = || common::warnings::warnings_containing("splits this frame");
+    let before = said().len();
+    let img = render(&mut gpu, "forward", &s);
+    render(&mut gpu, "forward", &s);
+    let warned = said();
+    assert_eq!(warned.len() - before, 1, "{warned:?}");
+    let first = warned.last().unwrap();
+    assert!(
+        first.starts_with("objects[") && first.contains("65536"),
+        "{first}"
+    );
+    assert!(mean(&img) > 2.0, "the plane is drawn");
 }
 
 /// An OBJ quad of half-size `half` with its corners `offset` from the origin, with its camera
