@@ -268,13 +268,13 @@ impl Camera {
                 if !(MIN_FOV_Y_DEG..180.0).contains(&fov_y_deg) {
                     return Err(SceneError::invalid(
                         "camera.fov_y_deg",
-                        format!("must be in [{MIN_FOV_Y_DEG:e}, 180), got {fov_y_deg}"),
+                        format!("must be in [{MIN_FOV_Y_DEG:e}, 180), got {fov_y_deg:?}"),
                     ));
                 }
                 if !(near > 0.0 && near.is_finite()) {
                     return Err(SceneError::invalid(
                         "camera.near",
-                        format!("must be finite and > 0 for a perspective camera, got {near}"),
+                        format!("must be finite and > 0 for a perspective camera, got {near:?}"),
                     ));
                 }
             }
@@ -284,7 +284,7 @@ impl Camera {
                         "camera.height",
                         format!(
                             "must be finite and >= {MIN_ORTHO_HEIGHT:e} (smaller views fall \
-                             between f32 view-space values), got {height}"
+                             between f32 view-space values), got {height:?}"
                         ),
                     ));
                 }
@@ -302,7 +302,7 @@ impl Camera {
                 if !(near >= 0.0 && near.is_finite()) {
                     return Err(SceneError::invalid(
                         "camera.near",
-                        format!("must be finite and >= 0, got {near}"),
+                        format!("must be finite and >= 0, got {near:?}"),
                     ));
                 }
                 if far.is_infinite() {
@@ -316,7 +316,7 @@ impl Camera {
         if far.is_nan() || far <= near {
             return Err(SceneError::invalid(
                 "camera.far",
-                format!("must be > near ({near}), got {far}"),
+                format!("must be > near ({near:?}), got {far:?}"),
             ));
         }
         Ok(())
@@ -467,5 +467,19 @@ mod tests {
             .unwrap_err()
             .to_string()
             .contains("camera.position"));
+        // Numbers in messages are short: -1e308 once printed as 309 digits.
+        let cam = Camera {
+            projection: Projection::Orthographic {
+                height: 2.0,
+                near: -1e308,
+                far: 10.0,
+            },
+            ..Camera::default()
+        };
+        let err = cam.validate().unwrap_err().to_string();
+        assert!(
+            err.contains("camera.near") && err.contains("got -1e308"),
+            "{err}"
+        );
     }
 }

@@ -380,7 +380,6 @@ pub fn parse(
                         "{field}: {} has nothing to draw: only its lights are used",
                         gltf_path.display()
                     );
-                    log::warn!("{msg}");
                     report.warnings.push(msg);
                 }
             }

@@ -495,9 +495,12 @@ pub fn load_with(
         });
     }
     let (scene, mut report) = loaded;
-    for warning in dark_frame::warnings(&scene, path) {
+    report.warnings.extend(dark_frame::warnings(&scene, path));
+    // Each said once, here: a model named again in a scene file repeats its own.
+    let mut said = std::collections::HashSet::new();
+    report.warnings.retain(|w| said.insert(w.clone()));
+    for warning in &report.warnings {
         log::warn!("{warning}");
-        report.warnings.push(warning);
     }
     Ok((scene, report))
 }

@@ -39,7 +39,8 @@ use textures::TextureCache;
 /// What an OBJ load produced besides the objects: non-fatal problems, for the caller to show.
 #[derive(Debug, Default)]
 pub struct LoadReport {
-    /// Human-readable warnings (missing textures, missing MTL, …), also logged.
+    /// Human-readable warnings (missing textures, missing MTL, …), each once; `scene::load_with`
+    /// also logs them.
     pub warnings: Vec<String>,
 }
 
@@ -139,11 +140,12 @@ pub fn load_into(
         };
         let mut factor = |key: &str, value: Option<[f64; 3]>, default: f32| {
             let v = value.map_or(Vec3::splat(default), |v| DVec3::from(v).as_vec3());
-            // NaN becomes 0: f32::clamp keeps NaN, max/min do not.
-            let clamped = v.max(Vec3::ZERO).min(Vec3::splat(MAX_COLOR_FACTOR));
+            // A NaN component takes the default's, as `Ns` and `d` do.
+            let known = Vec3::select(v.is_nan_mask(), Vec3::splat(default), v);
+            let clamped = known.max(Vec3::ZERO).min(Vec3::splat(MAX_COLOR_FACTOR));
             if clamped != v {
                 report.warn(format!(
-                    "material `{material_name}`: {key} {v} clamped to {clamped} (factors are \
+                    "material `{material_name}`: {key} {v} taken as {clamped} (factors are \
                      limited to [0, {MAX_COLOR_FACTOR}], the range the fp16 colour tier holds)"
                 ));
             }
@@ -526,11 +528,10 @@ fn warn_unapplied_mtl<'a>(
 pub const MAX_TEXTURE_SIDE: u32 = super::texture_budget::MAX_DECODED_SIDE;
 
 impl LoadReport {
-    /// Logs and keeps `msg`, its control characters escaped ([`shown::text`]).
+    /// Keeps `msg`, its control characters escaped ([`shown::text`]); the load logs its
+    /// warnings once it ends (`scene::load_with`).
     fn warn(&mut self, msg: String) {
-        let msg = shown::reason(&msg);
-        log::warn!("{msg}");
-        self.warnings.push(msg);
+        self.warnings.push(shown::reason(&msg));
     }
 }
 
@@ -669,7 +670,8 @@ mod tests {
     #[test]
     fn out_of_range_mtl_numbers_are_warnings_naming_the_statement() {
         let dir = tempfile::tempdir().unwrap();
-        let mtl = "newmtl a\nNs nan\nd -5\nnewmtl b\nNs 1e308\nd nan\nnewmtl c\nNs -1\nd 0.5\n";
+        let mtl = "newmtl a\nNs nan\nd -5\nKd nan nan nan\nnewmtl b\nNs 1e308\nd nan\n\
+                   Ks nan 0.5 2000\nnewmtl c\nNs -1\nd 0.5\n";
         std::fs::write(dir.path().join("m.mtl"), mtl).unwrap();
         let mut obj = String::from("mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\n");
         for name in ["a", "b", "c"] {
@@ -691,12 +693,18 @@ mod tests {
             .map(|m| (m.shininess, m.alpha))
             .collect();
         assert_eq!(kept, [(1.0, 0.0), (MAX_SHININESS, 1.0), (0.0, 0.5)]);
+        // A NaN colour component takes the default's (Kd 0.8, Ks 0), not black.
+        assert_eq!(scene.materials[0].diffuse, Vec3::splat(0.8));
+        let specular = scene.materials[1].specular;
+        assert_eq!(specular, Vec3::new(0.0, 0.5, MAX_COLOR_FACTOR));
         assert!(scene.validate().is_ok());
         for said in [
             "`a`: Ns NaN",
             "`a`: d -5",
+            "`a`: Kd [NaN, NaN, NaN] taken as [0.8, 0.8, 0.8]",
             "`b`: Ns 1e308",
             "`b`: d NaN",
+            "`b`: Ks [NaN, 0.5, 2000] taken as [0, 0.5, 1024]",
             "`c`: Ns -1",
         ] {
             assert!(

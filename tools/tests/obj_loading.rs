@@ -245,6 +245,16 @@ fn malformed_obj_files_are_clear_errors() {
             "line 4: `f` corner 3: its vertex index is not one of the 3",
         ),
         (
+            "word.obj",
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 three\n",
+            "line 4: `f` corner 3: its vertex index is not a whole number",
+        ),
+        (
+            "past_i64.obj",
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 99999999999999999999\n",
+            "line 4: `f` corner 3: its vertex index is not one of the 3",
+        ),
+        (
             "vt.obj",
             "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1/1 2/-3 3/1\n",
             "corner 2: its texture coordinate index",

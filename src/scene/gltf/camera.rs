@@ -68,6 +68,24 @@ pub(super) fn convert(
     Ok(camera)
 }
 
+/// What reading a glTF number as f32 (as the loader does) made of `v`, where it is not what the
+/// file says: 0 from a tiny magnitude, infinite from a huge one.
+fn as_f32_reads(v: f64) -> String {
+    if v == 0.0 {
+        format!(
+            " (read as f32: magnitudes below {:e} read as 0)",
+            f32::from_bits(1)
+        )
+    } else if v.is_infinite() {
+        format!(
+            " (read as f32: magnitudes past {:.1e} read as infinite)",
+            f32::MAX
+        )
+    } else {
+        String::new()
+    }
+}
+
 /// The projection's values the renderer cannot take, named as the file writes them
 /// (`cameras[i].perspective.yfov` in radians, not the converted `camera.fov_y_deg`).
 fn check_projection(projection: &GltfProjection, index: usize) -> Result<(), String> {
@@ -78,14 +96,20 @@ fn check_projection(projection: &GltfProjection, index: usize) -> Result<(), Str
             if !(min..std::f64::consts::PI).contains(&yfov) {
                 return bad(
                     "perspective.yfov",
-                    format!("must be in [{min:e}, π) radians, got {yfov}"),
+                    format!(
+                        "must be in [{min:e}, π) radians, got {yfov:?}{}",
+                        as_f32_reads(yfov)
+                    ),
                 );
             }
             let znear = f64::from(p.znear());
             if !(znear > 0.0 && znear.is_finite()) {
                 return bad(
                     "perspective.znear",
-                    format!("must be finite and > 0, got {znear}"),
+                    format!(
+                        "must be finite and > 0, got {znear:?}{}",
+                        as_f32_reads(znear)
+                    ),
                 );
             }
             ("perspective", znear, p.zfar().map(f64::from))
@@ -106,7 +130,7 @@ fn check_projection(projection: &GltfProjection, index: usize) -> Result<(), Str
             if !(znear >= 0.0 && znear.is_finite()) {
                 return bad(
                     "orthographic.znear",
-                    format!("must be finite and >= 0, got {znear}"),
+                    format!("must be finite and >= 0, got {znear:?}"),
                 );
             }
             ("orthographic", znear, Some(f64::from(o.zfar())))
@@ -115,7 +139,7 @@ fn check_projection(projection: &GltfProjection, index: usize) -> Result<(), Str
     match zfar {
         Some(zfar) if !(zfar > znear && zfar.is_finite()) => bad(
             &format!("{kind}.zfar"),
-            format!("must be finite and > znear ({znear}), got {zfar}"),
+            format!("must be finite and > znear ({znear:?}), got {zfar:?}"),
         ),
         _ => Ok(()),
     }

@@ -152,10 +152,12 @@ pub(super) fn convert(
                     "{field}: the node's transform has no direction (zero scale); skipped"
                 )));
             };
+            // f32's π is 180.000005°: an angle the check above lets through is at most 180°.
+            let degrees = |radians: f32| f64::from(radians).to_degrees().min(180.0);
             LightKind::Spot {
                 direction,
-                inner_deg: f64::from(inner_cone_angle).to_degrees(),
-                outer_deg: f64::from(outer_cone_angle).to_degrees(),
+                inner_deg: degrees(inner_cone_angle),
+                outer_deg: degrees(outer_cone_angle),
             }
         }
     };

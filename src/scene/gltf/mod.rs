@@ -139,7 +139,6 @@ pub fn load(
             "no lights in {}: ambient only; add lights (`Scene::lights`; `--lights N` on the command line)",
             path.display()
         );
-        log::warn!("{hint}");
         loaded.report.warnings.push(hint);
     }
     scene.validate()?;
@@ -207,9 +206,9 @@ pub fn load_into(
     scene.directional_lights.extend(imported.directional_lights);
     let mut report = LoadReport::default();
     for w in imported.warnings {
-        let msg = shown::reason(&format!("{}: {w}", path.display()));
-        log::warn!("{msg}");
-        report.warnings.push(msg);
+        report
+            .warnings
+            .push(shown::reason(&format!("{}: {w}", path.display())));
     }
     Ok(GltfLoad {
         report,

@@ -229,6 +229,16 @@ fn check_obj_within(text: &str, max_corners: usize) -> Result<Rewrites, String> 
                         });
                     }
                 }
+                // Digits past i64's range are an index out of range (below), not a word.
+                let digits = part.strip_prefix('-').unwrap_or(part);
+                let word = digits.is_empty() || !digits.bytes().all(|b| b.is_ascii_digit());
+                if index.is_none() && word {
+                    let what = INDEX_KINDS[kind];
+                    return Err(at_line(format!(
+                        "`{key}` corner {}: its {what} index is not a whole number",
+                        at + 1
+                    )));
+                }
                 if !resolves {
                     let what = INDEX_KINDS[kind];
                     return Err(at_line(format!(

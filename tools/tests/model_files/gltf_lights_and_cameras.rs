@@ -240,6 +240,12 @@ fn cameras_perspective_with_infinite_far_and_orthographic() {
                 "orthographic": {"xmag": 1, "ymag": 1, "znear": 2, "zfar": 1}}),
             "`cameras[0].orthographic.zfar`",
         ),
+        // The file's 1e-300 is f32's 0: the message says why it reads 0.
+        (
+            json!({"type": "perspective", "perspective": {"yfov": 0.7, "znear": 1e-300}}),
+            "`cameras[0].perspective.znear` must be finite and > 0, got 0.0 (read as f32: \
+             magnitudes below 1e-45 read as 0)",
+        ),
     ] {
         let path = write(dir.path(), "bad.gltf", b.gltf(doc(camera)));
         let (mut scene, report) = load(&path).unwrap();
@@ -341,6 +347,21 @@ fn a_spot_cone_wider_than_the_spec_allows_is_drawn_as_given_with_a_warning() {
         err.contains("spot.outerConeAngle (10.0) must be within [0, π] radians"),
         "{err}"
     );
+    // π itself is a cone (half the sphere's directions lit): f32's π, 180.000005°, was refused
+    // as `outer_deg`.
+    let pi = std::f64::consts::PI;
+    let spot = json!({"type": "spot", "intensity": 100,
+        "spot": {"innerConeAngle": pi, "outerConeAngle": pi}});
+    let path = write(dir.path(), "pi.gltf", triangle_lit_by(spot));
+    let (scene, _) = load(&path).unwrap();
+    match scene.lights[0].kind {
+        manylight::scene::LightKind::Spot {
+            inner_deg,
+            outer_deg,
+            ..
+        } => assert_eq!((inner_deg, outer_deg), (180.0, 180.0)),
+        ref other => panic!("not a spot: {other:?}"),
+    }
 }
 
 #[test]
@@ -431,4 +452,34 @@ fn a_sun_only_gltf_placed_from_a_scene_file_brings_its_sun_each_time() {
     assert_eq!(suns.len(), 2, "one sun a placement: {suns:?}");
     assert!((suns[0] - DVec3::NEG_Z).length() < 1e-9, "{suns:?}");
     assert!((suns[1] - DVec3::NEG_X).length() < 1e-9, "{suns:?}");
+}
+
+/// A glTF with lights is read again for each placement in a scene file (its lights move with
+/// it); its warnings are said once, in the report and in the log (its re-reads logged them
+/// again, three times for two placements).
+#[test]
+fn a_gltf_with_lights_placed_twice_warns_once() {
+    let dir = tempfile::tempdir().unwrap();
+    let light = json!({"type": "point", "intensity": 100});
+    let mut doc: Value = serde_json::from_str(&triangle_lit_by(light)).unwrap();
+    doc["extensionsUsed"] = json!(["KHR_lights_punctual", "EXT_not_a_real_one"]);
+    write(dir.path(), "lamp.gltf", doc.to_string());
+    let json_path = write(
+        dir.path(),
+        "scene.json",
+        r#"{"objects": [{"gltf": "lamp.gltf"},
+                        {"gltf": "lamp.gltf", "transform": {"translate": [3, 0, 0]}}]}"#,
+    );
+    let unsupported = "extension EXT_not_a_real_one is not supported";
+    let logged_before = common::warnings::warnings_containing(unsupported).len();
+    let (scene, report) = scene::load(json_path.to_str().unwrap(), None).unwrap();
+    assert_eq!(scene.lights.len(), 2, "one lamp a placement");
+    let said: Vec<_> = report
+        .warnings
+        .iter()
+        .filter(|w| w.contains(unsupported))
+        .collect();
+    assert_eq!(said.len(), 1, "{:?}", report.warnings);
+    let logged = common::warnings::warnings_containing(unsupported).len();
+    assert_eq!(logged - logged_before, 1, "logged once");
 }
