@@ -662,7 +662,9 @@ fn bench_assign_times_pools_side_by_side() {
     let nine = ["1"; 9].join(",");
     for threads in ["0", nine.as_str()] {
         let args = ["bench-assign", "--threads", threads];
-        expect_exit(&args, &[], dir.path(), 2, "--threads");
+        let said = expect_exit(&args, &[], dir.path(), 2, "--threads");
+        // A usage line, where there is one, is the subcommand's.
+        assert!(!said.contains("Usage: manylight ["), "{said}");
     }
 }
 

@@ -173,7 +173,11 @@ fn check_usage(cli: &Cli) {
     }
     if let Some(Command::BenchAssign(a)) = &cli.command {
         if a.threads.len() > bench_assign::MAX_POOLS {
-            Cli::command()
+            // Built, so that the subcommand's usage line under the message names it.
+            let mut cli = Cli::command();
+            cli.build();
+            cli.find_subcommand_mut("bench-assign")
+                .expect("the bench-assign subcommand")
                 .error(
                     ErrorKind::ValueValidation,
                     format!(

@@ -343,16 +343,7 @@ fn group_rows(
             .collect::<Vec<_>>());
         rows.push(row);
     }
-    // A row whose context could not be made names the implementation its group's other EGL
-    // rows do (not OSMesa's, another library), else the group's label.
-    let implementation = rows
-        .iter()
-        .find_map(|r| r["implementation"].as_str().map(String::from));
-    for row in &mut rows {
-        if row["implementation"].is_null() {
-            row["implementation"] = json!(implementation.as_deref().unwrap_or(&label));
-        }
-    }
+    name_failed_rows(&mut rows, &label);
     if lib.is_none() {
         let mut row = osmesa_row(exe, args, size, out)?;
         row["gles_lib"] = json!(label);
@@ -457,6 +448,27 @@ fn osmesa_row(
     row["config"] = json!("desktop GL (OSMesa)");
     row["env"] = json!([]);
     Ok(row)
+}
+
+/// Names the implementation of each row of one group whose context could not be made (its
+/// `implementation` null): the one its group's other EGL rows name (not OSMesa's, another
+/// library), else the group's `label`. Only rows on the group's own driver count: a failed
+/// llvmpipe row is not softpipe's, which `GALLIUM_DRIVER` picks.
+fn name_failed_rows(rows: &mut [Value], label: &str) {
+    let own_driver = |row: &Value| {
+        let env = row["env"].as_array().into_iter().flatten();
+        !env.filter_map(Value::as_str)
+            .any(|e| e.starts_with("GALLIUM_DRIVER="))
+    };
+    let implementation = rows
+        .iter()
+        .filter(|r| own_driver(r))
+        .find_map(|r| r["implementation"].as_str().map(String::from));
+    for row in rows {
+        if row["implementation"].is_null() {
+            row["implementation"] = json!(implementation.as_deref().unwrap_or(label));
+        }
+    }
 }
 
 /// A row's implementation (its folder where the context could not say) and configuration.
@@ -759,8 +771,25 @@ pub fn run_cell(args: &MatrixCellArgs) -> Result<(), Box<dyn std::error::Error>>
 
 #[cfg(test)]
 mod tests {
-    use super::{cell_error, cell_row, markdown, sheet, THUMB_MAX};
+    use super::{cell_error, cell_row, markdown, name_failed_rows, sheet, THUMB_MAX};
     use serde_json::json;
+
+    /// A row whose context failed (an llvmpipe row at a size it cannot take) is named after
+    /// its group's rows on the same driver, never after softpipe's, which succeeded.
+    #[test]
+    fn a_failed_row_takes_its_own_drivers_name() {
+        let softpipe = json!({"implementation": "Mesa softpipe", "config": "ES 3.x on softpipe",
+            "env": ["GALLIUM_DRIVER=softpipe"]});
+        let failed = json!({"implementation": null, "config": "ES 3.0", "env": []});
+        let mut rows = [softpipe.clone(), failed.clone()];
+        name_failed_rows(&mut rows, "system");
+        assert_eq!(rows[1]["implementation"], "system");
+        let llvmpipe = json!({"implementation": "Mesa llvmpipe", "config": "ES 2.0", "env": []});
+        let mut rows = [softpipe, llvmpipe, failed];
+        name_failed_rows(&mut rows, "system");
+        assert_eq!(rows[2]["implementation"], "Mesa llvmpipe");
+        assert_eq!(rows[0]["implementation"], "Mesa softpipe");
+    }
 
     /// Large pictures go on the sheet scaled down to fit [`THUMB_MAX`], their shape kept; small
     /// ones as they are.
