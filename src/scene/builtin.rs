@@ -371,6 +371,24 @@ mod tests {
         ));
     }
 
+    /// A projective object transform drew a wrong picture or none, unsaid; an affine one
+    /// that rounding left a little off (an inverse's) is kept.
+    #[test]
+    fn an_object_transform_that_is_not_affine_is_refused_naming_it() {
+        let mut scene = build("plane", None).unwrap();
+        let turned = DMat4::from_rotation_y(0.3) * DMat4::from_translation(DVec3::X);
+        scene.objects[0].transform = turned.inverse().inverse();
+        scene.validate().unwrap();
+        let mut projective = DMat4::IDENTITY;
+        projective.x_axis.w = 0.5;
+        scene.objects[0].transform = projective;
+        let e = scene.validate().unwrap_err().to_string();
+        assert!(
+            e.contains("objects[0].transform") && e.contains("affine"),
+            "{e}"
+        );
+    }
+
     #[test]
     fn lights_are_seeded() {
         let a = build("courtyard", Some((50, 9))).unwrap().lights;

@@ -142,7 +142,8 @@ pub struct Mesh {
 
 impl Mesh {
     /// Builds a mesh and checks it: indices in range, a multiple of three, finite values.
-    /// Missing normals (`normals` empty) are computed as area-weighted face normals; given
+    /// Missing normals (`normals` empty, or not one per position) are computed as
+    /// area-weighted face normals; given
     /// ones turn each triangle whose winding faces away from them round (its front face is
     /// the side its normals point to).
     pub fn new(
@@ -232,6 +233,7 @@ impl Mesh {
     /// normal and unit, `w` made ±1; one with no usable direction is replaced by the
     /// generated one (MikkTSpace, see `docs/gltf.md`).
     pub fn with_tangents(mut self, tangents: Vec<Vec4>) -> Result<Mesh, SceneError> {
+        self.validate()?;
         check_per_vertex("mesh.tangents", tangents.len(), self.positions.len())?;
         self.tangents = super::tangents::repair(self.geometry(), tangents);
         Ok(self)
@@ -241,9 +243,11 @@ impl Mesh {
     /// many triangle corners got the fallback tangent (see `docs/gltf.md`). MikkTSpace works
     /// per corner: a vertex whose corners get different tangents (a mirrored UV seam through
     /// shared vertices) is split, one copy per tangent, so adds at most one vertex per index.
-    pub fn with_generated_tangents(mut self) -> (Mesh, usize) {
+    /// A mesh that fails [`Mesh::validate`] is that error.
+    pub fn with_generated_tangents(mut self) -> Result<(Mesh, usize), SceneError> {
+        self.validate()?;
         if !self.tangents.is_empty() || self.uvs.is_empty() {
-            return (self, 0);
+            return Ok((self, 0));
         }
         let corners = super::tangents::generate_corners(self.geometry());
         // Vertices no triangle uses keep the fallback tangent.
@@ -270,7 +274,7 @@ impl Mesh {
             }
         }
         self.tangents = tangents;
-        (self, corners.fallbacks)
+        Ok((self, corners.fallbacks))
     }
 
     fn geometry(&self) -> super::tangents::Geometry<'_> {
@@ -338,9 +342,14 @@ impl Mesh {
     /// them: whole triangles of indices in range, one normal per position, and texture
     /// coordinates, colours and tangents either none or one per position; and whether their
     /// values are what [`Mesh::new`] keeps (positions and texture coordinates within their
-    /// limits, normals of some length, every number finite). The fields are public, so a mesh
-    /// built or edited in code is checked again before it is uploaded; errors name the field
-    /// under `field` (`objects[3].mesh`).
+    /// limits, normals of some length, every number finite, colours within [0, 1]). The
+    /// fields are public, so a mesh built or edited in code is checked again before it is
+    /// uploaded; errors name the field (`mesh.normals`).
+    pub fn validate(&self) -> Result<(), SceneError> {
+        self.check_shape("mesh")
+    }
+
+    /// [`Mesh::validate`] with errors named under `field` (`objects[3].mesh`).
     pub(crate) fn check_shape(&self, field: &str) -> Result<(), SceneError> {
         let n = self.positions.len();
         let at = |what: &str| format!("{field}.{what}");
@@ -366,10 +375,13 @@ impl Mesh {
                 format!("must be finite and not zero, got {:?}", self.normals[i]),
             ));
         }
-        if let Some(i) = self.colors.iter().position(|c| !c.is_finite()) {
+        // They multiply the albedo and alpha: a negative one drew black, one past 1 escaped
+        // the colour factors' cap.
+        let unit = |c: &Vec4| c.cmpge(Vec4::ZERO).all() && c.cmple(Vec4::ONE).all();
+        if let Some(i) = self.colors.iter().position(|c| !unit(c)) {
             return Err(SceneError::invalid(
                 format!("{field}.colors[{i}]"),
-                format!("must be finite, got {:?}", self.colors[i]),
+                format!("must be within [0, 1], got {:?}", self.colors[i]),
             ));
         }
         if let Some(i) = self.tangents.iter().position(|t| !t.is_finite()) {
@@ -712,5 +724,38 @@ mod tests {
         assert!(Mesh::new(vec![Vec3::ZERO], vec![], vec![], vec![0, 0, 1]).is_err());
         let e = Mesh::new(vec![Vec3::NAN; 3], vec![], vec![], vec![0, 1, 2]).unwrap_err();
         assert!(e.to_string().contains("positions[0]"));
+    }
+
+    /// A mesh edited through its public fields: the tangent builders and `validate` name the
+    /// field that disagrees (they indexed past the arrays and panicked).
+    #[test]
+    fn a_mesh_whose_fields_disagree_is_an_error_naming_the_field() {
+        let good = || {
+            let uvs = vec![Vec2::ZERO, Vec2::X, Vec2::Y];
+            Mesh::new(
+                vec![Vec3::ZERO, Vec3::X, Vec3::Y],
+                vec![],
+                uvs,
+                vec![0, 1, 2],
+            )
+            .unwrap()
+        };
+        assert!(good().validate().is_ok());
+        let mut index_past = good();
+        index_past.indices[2] = 3;
+        let e = index_past.with_generated_tangents().unwrap_err();
+        assert!(e.to_string().contains("mesh.indices"), "{e}");
+        let mut no_normals = good();
+        no_normals.normals.clear();
+        let e = no_normals.with_tangents(vec![Vec4::X; 3]).unwrap_err();
+        assert!(e.to_string().contains("mesh.normals"), "{e}");
+        let mut short_colours = good();
+        short_colours.colors = vec![Vec4::ONE; 2];
+        let e = short_colours.with_generated_tangents().unwrap_err();
+        assert!(e.to_string().contains("mesh.colors"), "{e}");
+        let mut negative = good();
+        negative.colors = vec![Vec4::ONE, Vec4::new(-1.0, 0.5, 0.5, 1.0), Vec4::ONE];
+        let e = negative.validate().unwrap_err();
+        assert!(e.to_string().contains("mesh.colors[1]"), "{e}");
     }
 }

@@ -43,7 +43,7 @@ pub(crate) mod triangle_reach;
 use std::ops::Range;
 use std::sync::Arc;
 
-use glam::{DMat4, Vec3};
+use glam::{DMat4, DVec4, Vec3};
 
 pub use access::LoadOptions;
 pub use camera::{Camera, Projection};
@@ -55,6 +55,10 @@ pub use mesh::MAX_SCENE_MESHES;
 pub use mesh::{Aabb, Mesh};
 pub use model_cache::{MAX_SCENE_MATERIALS, MAX_SCENE_OBJECTS};
 pub use motion::Motion;
+
+/// Most a transform's last row may differ from `0 0 0 1` (exporters and inverses round) before
+/// it is refused as not affine.
+pub(crate) const AFFINE_TOLERANCE: f64 = 1e-6;
 
 /// One placed mesh: shared geometry, its material and a model transform (`f64`, so objects
 /// can be placed far from the origin).
@@ -359,6 +363,18 @@ impl Scene {
                 return Err(SceneError::invalid(
                     format!("objects[{i}].transform"),
                     "must be finite",
+                ));
+            }
+            // A projective one puts its vertices at w ≠ 1 (a last row of zeros, at infinity):
+            // a wrong picture or none.
+            let last = o.transform.row(3);
+            if (last - DVec4::W).abs().max_element() > AFFINE_TOLERANCE {
+                return Err(SceneError::invalid(
+                    format!("objects[{i}].transform"),
+                    format!(
+                        "must be affine (last row {} {} {} {}, must be 0 0 0 1)",
+                        last.x, last.y, last.z, last.w
+                    ),
                 ));
             }
         }

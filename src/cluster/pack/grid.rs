@@ -140,7 +140,10 @@ fn be24(v: u32) -> [u8; 3] {
 /// Texels of `grid`'s grid texture: the cascade table, then one per cell (and one more, where
 /// the last cell's list ends).
 pub fn grid_texels(grid: &ClusterGrid) -> usize {
-    grid.cascades.len() * TABLE_TEXELS_PER_CASCADE as usize + grid.total_cells as usize + 1
+    // Saturating: a refused grid's cell count saturates at u32::MAX, past a 32-bit usize.
+    (grid.cascades.len() * TABLE_TEXELS_PER_CASCADE as usize)
+        .saturating_add(grid.total_cells as usize)
+        .saturating_add(1)
 }
 
 impl Default for PackedTexels {

@@ -226,7 +226,9 @@ pub(super) fn build(
                  the map is not applied"
             ));
         } else {
-            let (with, fallbacks) = mesh.with_generated_tangents();
+            let (with, fallbacks) = mesh
+                .with_generated_tangents()
+                .map_err(|e| format!("{field}: {e}"))?;
             mesh = with;
             if fallbacks > 0 {
                 warnings.push(format!(

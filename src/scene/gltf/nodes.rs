@@ -59,9 +59,6 @@ pub(super) fn local_transforms(json: &[u8]) -> Result<Vec<DMat4>, String> {
         .collect()
 }
 
-/// Most a `matrix`'s last row may differ from `0 0 0 1` (exporters round) before it is refused.
-const AFFINE_TOLERANCE: f64 = 1e-6;
-
 /// A node's `matrix` (column-major): finite and affine (glTF asks for a TRS matrix; a
 /// projective one would put every vertex at w ≠ 1, a last row of zeros at infinity). A
 /// singular one is kept: it flattens its node, as a zero scale does.
@@ -71,7 +68,7 @@ fn matrix(m: &[f64; 16]) -> Result<DMat4, String> {
         return Err("must be finite".into());
     }
     let last = m.row(3);
-    if (last - glam::DVec4::W).abs().max_element() > AFFINE_TOLERANCE {
+    if (last - glam::DVec4::W).abs().max_element() > crate::scene::AFFINE_TOLERANCE {
         return Err(format!(
             "not an affine transform (last row {} {} {} {}, must be 0 0 0 1)",
             last.x, last.y, last.z, last.w

@@ -254,7 +254,7 @@ fn a_mirrored_seam_through_shared_vertices_splits_them() {
         .collect();
     let indices = vec![0, 1, 4, 0, 4, 3, 1, 2, 5, 1, 5, 4];
     let m = Mesh::new(positions, vec![], uvs, indices).unwrap();
-    let (m, fallbacks) = m.with_generated_tangents();
+    let (m, fallbacks) = m.with_generated_tangents().unwrap();
     assert_eq!(fallbacks, 0);
     assert_eq!(m.positions.len(), 8, "the two seam vertices are split");
     assert_eq!((m.normals.len(), m.uvs.len(), m.tangents.len()), (8, 8, 8));
