@@ -32,6 +32,7 @@ pub mod obj;
 mod orientation;
 pub mod random;
 pub mod raycast;
+mod said;
 pub mod shading;
 pub mod shown;
 pub mod surface_maps;
@@ -446,8 +447,18 @@ pub fn load(
     load_with(spec, lights, &LoadOptions::default())
 }
 
-/// [`load`] with `options`.
+/// [`load`] with `options`. Its warnings are logged once each when it ends (also when it
+/// fails) and kept in the report.
 pub fn load_with(
+    spec: &str,
+    lights: Option<(usize, u64)>,
+    options: &LoadOptions,
+) -> Result<(Scene, obj::LoadReport), SceneError> {
+    said::once_each(|| load_held(spec, lights, options))
+}
+
+/// [`load_with`], its warnings held back by the caller.
+fn load_held(
     spec: &str,
     lights: Option<(usize, u64)>,
     options: &LoadOptions,
@@ -511,13 +522,13 @@ pub fn load_with(
         });
     }
     let (scene, mut report) = loaded;
-    report.warnings.extend(dark_frame::warnings(&scene, path));
-    // Each said once, here: a model named again in a scene file repeats its own.
-    let mut said = std::collections::HashSet::new();
-    report.warnings.retain(|w| said.insert(w.clone()));
-    for warning in &report.warnings {
-        log::warn!("{warning}");
+    for warning in dark_frame::warnings(&scene, path) {
+        said::warn(&warning);
+        report.warnings.push(warning);
     }
+    // Each once: a model named again in a scene file is read again and says its own again.
+    let mut seen = std::collections::HashSet::new();
+    report.warnings.retain(|w| seen.insert(w.clone()));
     Ok((scene, report))
 }
 

@@ -39,8 +39,8 @@ use textures::TextureCache;
 /// What an OBJ load produced besides the objects: non-fatal problems, for the caller to show.
 #[derive(Debug, Default)]
 pub struct LoadReport {
-    /// Human-readable warnings (missing textures, missing MTL, …), each once; `scene::load_with`
-    /// also logs them.
+    /// Human-readable warnings (missing textures, missing MTL, …), also logged; from
+    /// `scene::load_with`, each once.
     pub warnings: Vec<String>,
 }
 
@@ -528,10 +528,12 @@ fn warn_unapplied_mtl<'a>(
 pub const MAX_TEXTURE_SIDE: u32 = super::texture_budget::MAX_DECODED_SIDE;
 
 impl LoadReport {
-    /// Keeps `msg`, its control characters escaped ([`shown::text`]); the load logs its
-    /// warnings once it ends (`scene::load_with`).
+    /// Logs and keeps `msg`, its control characters escaped ([`shown::text`]) (logged when
+    /// the load ends, inside `scene::load_with`).
     fn warn(&mut self, msg: String) {
-        self.warnings.push(shown::reason(&msg));
+        let msg = shown::reason(&msg);
+        super::said::warn(&msg);
+        self.warnings.push(msg);
     }
 }
 

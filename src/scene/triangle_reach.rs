@@ -24,8 +24,10 @@ pub const MAX_TRIANGLE_REACH: f64 = 16384.0;
 /// 600 leave at most 2⁻⁶² of it, below any near plane that edge could need.
 const MAX_CUTS: u32 = 600;
 
-/// Most triangles a frame's splits add (each cut adds one), over all objects: about 12 MiB of
-/// split copies. Past it the remaining triangles are drawn as they are, with a warning.
+/// Most triangles a frame's splits add (each cut adds one), over all objects: about 12 MiB
+/// besides the split objects' own triangles, which their copies hold too. Past it the
+/// remaining triangles are drawn as they are, with a warning; the budget goes to the objects
+/// in scene order.
 pub const MAX_SPLIT_TRIANGLES: usize = 1 << 16;
 
 /// A frame's split copies: per object that needs one, its index and split mesh.
@@ -69,15 +71,15 @@ pub fn split_objects(scene: &Scene, measure: impl Fn(&Object) -> (f64, Option<Aa
         if longest <= MAX_TRIANGLE_REACH * distance.max(floor) {
             continue;
         }
-        if budget == 0 {
-            out.cut_short.get_or_insert(i);
-            continue;
-        }
+        let cuts_left = budget;
         let split = split_mesh(&object.mesh, &object.transform, eye, floor, &mut budget);
         if let Some((mesh, cut_short)) = split {
-            out.meshes.push((i, mesh));
             if cut_short {
                 out.cut_short.get_or_insert(i);
+            }
+            // With no cut left the copy is the object as it is: drawn from its own mesh.
+            if cuts_left > 0 {
+                out.meshes.push((i, mesh));
             }
         }
     }

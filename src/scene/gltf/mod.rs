@@ -139,6 +139,7 @@ pub fn load(
             "no lights in {}: ambient only; add lights (`Scene::lights`; `--lights N` on the command line)",
             path.display()
         );
+        super::said::warn(&hint);
         loaded.report.warnings.push(hint);
     }
     scene.validate()?;
@@ -206,9 +207,9 @@ pub fn load_into(
     scene.directional_lights.extend(imported.directional_lights);
     let mut report = LoadReport::default();
     for w in imported.warnings {
-        report
-            .warnings
-            .push(shown::reason(&format!("{}: {w}", path.display())));
+        let msg = shown::reason(&format!("{}: {w}", path.display()));
+        super::said::warn(&msg);
+        report.warnings.push(msg);
     }
     Ok(GltfLoad {
         report,

@@ -663,8 +663,11 @@ fn bench_assign_times_pools_side_by_side() {
     for threads in ["0", nine.as_str()] {
         let args = ["bench-assign", "--threads", threads];
         let said = expect_exit(&args, &[], dir.path(), 2, "--threads");
-        // A usage line, where there is one, is the subcommand's.
+        // A usage line, where there is one, is the subcommand's (the nine pools' has one).
         assert!(!said.contains("Usage: manylight ["), "{said}");
+        if threads == nine {
+            assert!(said.contains("Usage: manylight bench-assign"), "{said}");
+        }
     }
 }
 

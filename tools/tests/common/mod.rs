@@ -54,6 +54,8 @@ impl Gpu {
 
     /// A renderer playing a weaker device (see `manylight::gl::Restrictions`).
     pub fn restricted(es: EsVersion, restrictions: &Restrictions) -> Gpu {
+        // A test that reads its warnings back finds every one its renderers logged.
+        warnings::install();
         let kind = (es, *restrictions);
         let pooled = {
             let mut pool = POOL.lock().unwrap_or_else(|e| e.into_inner());
@@ -81,6 +83,7 @@ impl Gpu {
     }
 
     fn fresh_restricted(es: EsVersion, restrictions: &Restrictions) -> Gpu {
+        warnings::install();
         let ctx = HeadlessContext::new(es).unwrap_or_else(|e| {
             panic!("no headless {es} context ({e}); install libegl1 libegl-mesa0 libgles2 libgl1-mesa-dri")
         });

@@ -347,8 +347,8 @@ fn a_spot_cone_wider_than_the_spec_allows_is_drawn_as_given_with_a_warning() {
         err.contains("spot.outerConeAngle (10.0) must be within [0, π] radians"),
         "{err}"
     );
-    // π itself is a cone (half the sphere's directions lit): f32's π, 180.000005°, was refused
-    // as `outer_deg`.
+    // π itself is a cone (a half-angle of π lights every direction): f32's π, 180.000005°,
+    // was refused as `outer_deg`.
     let pi = std::f64::consts::PI;
     let spot = json!({"type": "spot", "intensity": 100,
         "spot": {"innerConeAngle": pi, "outerConeAngle": pi}});
@@ -482,4 +482,23 @@ fn a_gltf_with_lights_placed_twice_warns_once() {
     assert_eq!(said.len(), 1, "{:?}", report.warnings);
     let logged = common::warnings::warnings_containing(unsupported).len();
     assert_eq!(logged - logged_before, 1, "logged once");
+}
+
+/// Warnings said before a load fails are still logged: they may explain the error.
+#[test]
+fn warnings_before_a_failed_load_are_logged() {
+    common::warnings::install();
+    let dir = tempfile::tempdir().unwrap();
+    let light = json!({"type": "point", "intensity": 100});
+    let mut doc: Value = serde_json::from_str(&triangle_lit_by(light)).unwrap();
+    doc["extensionsUsed"] = json!(["KHR_lights_punctual", "EXT_said_before_failing"]);
+    write(dir.path(), "lamp.gltf", doc.to_string());
+    let json_path = write(
+        dir.path(),
+        "scene.json",
+        r#"{"objects": [{"gltf": "lamp.gltf"}, {"gltf": "missing.gltf"}]}"#,
+    );
+    let said = "extension EXT_said_before_failing is not supported";
+    assert!(scene::load(json_path.to_str().unwrap(), None).is_err());
+    assert_eq!(common::warnings::warnings_containing(said).len(), 1);
 }

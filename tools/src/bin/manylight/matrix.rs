@@ -451,9 +451,10 @@ fn osmesa_row(
 }
 
 /// Names the implementation of each row of one group whose context could not be made (its
-/// `implementation` null): the one its group's other EGL rows name (not OSMesa's, another
-/// library), else the group's `label`. Only rows on the group's own driver count: a failed
-/// llvmpipe row is not softpipe's, which `GALLIUM_DRIVER` picks.
+/// `implementation` null): the one its group's other EGL rows on the same driver name (not
+/// OSMesa's, another library), else the group's `label`. A row whose `GALLIUM_DRIVER` picks
+/// another driver (softpipe) shares no name: a failed llvmpipe row is not softpipe's, nor the
+/// other way round.
 fn name_failed_rows(rows: &mut [Value], label: &str) {
     let own_driver = |row: &Value| {
         let env = row["env"].as_array().into_iter().flatten();
@@ -466,7 +467,8 @@ fn name_failed_rows(rows: &mut [Value], label: &str) {
         .find_map(|r| r["implementation"].as_str().map(String::from));
     for row in rows {
         if row["implementation"].is_null() {
-            row["implementation"] = json!(implementation.as_deref().unwrap_or(label));
+            let named = implementation.as_deref().filter(|_| own_driver(row));
+            row["implementation"] = json!(named.unwrap_or(label));
         }
     }
 }
@@ -785,10 +787,16 @@ mod tests {
         name_failed_rows(&mut rows, "system");
         assert_eq!(rows[1]["implementation"], "system");
         let llvmpipe = json!({"implementation": "Mesa llvmpipe", "config": "ES 2.0", "env": []});
-        let mut rows = [softpipe, llvmpipe, failed];
+        let mut rows = [softpipe, llvmpipe.clone(), failed];
         name_failed_rows(&mut rows, "system");
         assert_eq!(rows[2]["implementation"], "Mesa llvmpipe");
         assert_eq!(rows[0]["implementation"], "Mesa softpipe");
+        // Nor the other way round: a failed softpipe row is not llvmpipe's.
+        let failed_softpipe = json!({"implementation": null, "config": "ES 3.x on softpipe",
+            "env": ["GALLIUM_DRIVER=softpipe"]});
+        let mut rows = [llvmpipe, failed_softpipe];
+        name_failed_rows(&mut rows, "system");
+        assert_eq!(rows[1]["implementation"], "system");
     }
 
     /// Large pictures go on the sheet scaled down to fit [`THUMB_MAX`], their shape kept; small
