@@ -454,22 +454,25 @@ fn a_sun_only_gltf_placed_from_a_scene_file_brings_its_sun_each_time() {
     assert!((suns[1] - DVec3::NEG_X).length() < 1e-9, "{suns:?}");
 }
 
+/// A scene file in `dir` placing `objects` (JSON), beside `lamp.gltf`: a triangle lit by a
+/// point light whose file uses the unsupported `extension` (a warning).
+fn scene_with_lamp(dir: &std::path::Path, extension: &str, objects: &str) -> std::path::PathBuf {
+    let light = json!({"type": "point", "intensity": 100});
+    let mut doc: Value = serde_json::from_str(&triangle_lit_by(light)).unwrap();
+    doc["extensionsUsed"] = json!(["KHR_lights_punctual", extension]);
+    write(dir, "lamp.gltf", doc.to_string());
+    write(dir, "scene.json", format!(r#"{{"objects": {objects}}}"#))
+}
+
 /// A glTF with lights is read again for each placement in a scene file (its lights move with
 /// it); its warnings are said once, in the report and in the log (its re-reads logged them
 /// again, three times for two placements).
 #[test]
 fn a_gltf_with_lights_placed_twice_warns_once() {
     let dir = tempfile::tempdir().unwrap();
-    let light = json!({"type": "point", "intensity": 100});
-    let mut doc: Value = serde_json::from_str(&triangle_lit_by(light)).unwrap();
-    doc["extensionsUsed"] = json!(["KHR_lights_punctual", "EXT_not_a_real_one"]);
-    write(dir.path(), "lamp.gltf", doc.to_string());
-    let json_path = write(
-        dir.path(),
-        "scene.json",
-        r#"{"objects": [{"gltf": "lamp.gltf"},
-                        {"gltf": "lamp.gltf", "transform": {"translate": [3, 0, 0]}}]}"#,
-    );
+    let twice =
+        r#"[{"gltf": "lamp.gltf"}, {"gltf": "lamp.gltf", "transform": {"translate": [3, 0, 0]}}]"#;
+    let json_path = scene_with_lamp(dir.path(), "EXT_not_a_real_one", twice);
     let unsupported = "extension EXT_not_a_real_one is not supported";
     let logged_before = common::warnings::warnings_containing(unsupported).len();
     let (scene, report) = scene::load(json_path.to_str().unwrap(), None).unwrap();
@@ -489,15 +492,8 @@ fn a_gltf_with_lights_placed_twice_warns_once() {
 fn warnings_before_a_failed_load_are_logged() {
     common::warnings::install();
     let dir = tempfile::tempdir().unwrap();
-    let light = json!({"type": "point", "intensity": 100});
-    let mut doc: Value = serde_json::from_str(&triangle_lit_by(light)).unwrap();
-    doc["extensionsUsed"] = json!(["KHR_lights_punctual", "EXT_said_before_failing"]);
-    write(dir.path(), "lamp.gltf", doc.to_string());
-    let json_path = write(
-        dir.path(),
-        "scene.json",
-        r#"{"objects": [{"gltf": "lamp.gltf"}, {"gltf": "missing.gltf"}]}"#,
-    );
+    let then_missing = r#"[{"gltf": "lamp.gltf"}, {"gltf": "missing.gltf"}]"#;
+    let json_path = scene_with_lamp(dir.path(), "EXT_said_before_failing", then_missing);
     let said = "extension EXT_said_before_failing is not supported";
     assert!(scene::load(json_path.to_str().unwrap(), None).is_err());
     assert_eq!(common::warnings::warnings_containing(said).len(), 1);
