@@ -53,10 +53,18 @@ pub fn longest_edge(mesh: &Mesh) -> f64 {
 /// gives an object's longest edge in object space and its world bounds (kept by the caller
 /// per mesh); objects whose longest edge and bounds clear the limit cost one test.
 pub fn split_objects(scene: &Scene, measure: impl Fn(&Object) -> (f64, Option<Aabb>)) -> Splits {
+    split_objects_within(scene, measure, MAX_SPLIT_TRIANGLES)
+}
+
+/// [`split_objects`] with a budget of `budget` cuts.
+fn split_objects_within(
+    scene: &Scene,
+    measure: impl Fn(&Object) -> (f64, Option<Aabb>),
+    mut budget: usize,
+) -> Splits {
     let camera = &scene.camera;
     let floor = closest_fragment(camera);
     let eye = camera.position;
-    let mut budget = MAX_SPLIT_TRIANGLES;
     let mut out = Splits {
         meshes: Vec::new(),
         cut_short: None,
@@ -416,6 +424,34 @@ mod tests {
         // One object alone is within it.
         scene.objects.truncate(1);
         assert!(split_objects(&scene, measure).cut_short.is_none());
+        // A budget the first object spends exactly: a later one that needs no split is not
+        // named (it was, unchecked), one that needs a split is.
+        let cuts = split_objects(&scene, measure).meshes[0].1.triangle_count() - 2;
+        // Its bounds and longest edge pass the first test, its triangles not: a long one far
+        // off, a small one near the eye.
+        let (near, far) = (glam::Vec3::ZERO, glam::Vec3::new(1e5, 0.0, 0.0));
+        let positions = vec![
+            near,
+            near + glam::Vec3::X * 0.1,
+            near + glam::Vec3::Y * 0.1,
+            far,
+            far + glam::Vec3::X * 5e8,
+            far + glam::Vec3::Y,
+        ];
+        let mesh = Mesh::new(positions, vec![], vec![], vec![0, 1, 2, 3, 4, 5]).unwrap();
+        scene.objects.push(Object {
+            mesh: std::sync::Arc::new(mesh),
+            material: 0,
+            transform: DMat4::IDENTITY,
+        });
+        let splits = split_objects_within(&scene, measure, cuts);
+        assert_eq!(splits.cut_short, None);
+        assert_eq!(splits.meshes.len(), 1);
+        scene.objects[1] = scene.objects[0].clone();
+        assert_eq!(
+            split_objects_within(&scene, measure, cuts).cut_short,
+            Some(1)
+        );
     }
 
     #[test]
