@@ -375,8 +375,8 @@ impl Mesh {
                 format!("must be finite and not zero, got {:?}", self.normals[i]),
             ));
         }
-        // They multiply the albedo and alpha: a negative one drew black, one past 1 escaped
-        // the colour factors' cap.
+        // They multiply the albedo and alpha: a negative one would draw black, one past 1
+        // escape the colour factors' cap.
         let unit = |c: &Vec4| c.cmpge(Vec4::ZERO).all() && c.cmple(Vec4::ONE).all();
         if let Some(i) = self.colors.iter().position(|c| !unit(c)) {
             return Err(SceneError::invalid(

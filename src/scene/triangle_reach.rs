@@ -232,8 +232,7 @@ fn split_mesh(
                 cut_short = true;
             } else {
                 // Across the longest edge only: a long, thin triangle is cut along its length,
-                // never across its width (cuts in four made rows of pieces as many as it is
-                // long for its width: a plane scaled 10¹⁰ one way took gigabytes).
+                // never across its width, so its pieces grow with the levels, not its area.
                 *budget -= 1;
                 let [a, b, c] = longest_edge_first([a, b, c]);
                 let m = Vertex::mid(&a, &b);
