@@ -380,8 +380,7 @@ pub fn parse(
                         "{field}: {} has nothing to draw: only its lights are used",
                         gltf_path.display()
                     );
-                    super::said::warn(&msg);
-                    report.warnings.push(msg);
+                    report.say(msg);
                 }
             }
             _ => {

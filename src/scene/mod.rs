@@ -523,8 +523,7 @@ fn load_held(
     }
     let (scene, mut report) = loaded;
     for warning in dark_frame::warnings(&scene, path) {
-        said::warn(&warning);
-        report.warnings.push(warning);
+        report.say(warning);
     }
     // Each once: a model named again in a scene file is read again and says its own again.
     let mut seen = std::collections::HashSet::new();

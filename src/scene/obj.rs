@@ -528,10 +528,13 @@ fn warn_unapplied_mtl<'a>(
 pub const MAX_TEXTURE_SIDE: u32 = super::texture_budget::MAX_DECODED_SIDE;
 
 impl LoadReport {
-    /// Logs and keeps `msg`, its control characters escaped ([`shown::text`]) (logged when
-    /// the load ends, inside `scene::load_with`).
-    fn warn(&mut self, msg: String) {
-        let msg = shown::reason(&msg);
+    /// [`LoadReport::say`]s `msg`, its control characters escaped ([`shown::text`]).
+    pub(crate) fn warn(&mut self, msg: String) {
+        self.say(shown::reason(&msg));
+    }
+
+    /// Logs and keeps `msg` as it is (logged when the load ends, inside `scene::load_with`).
+    pub(crate) fn say(&mut self, msg: String) {
         super::said::warn(&msg);
         self.warnings.push(msg);
     }

@@ -62,7 +62,7 @@ use super::mesh::MAX_SCENE_MESHES;
 use super::obj::LoadReport;
 use super::texture_budget::TextureBudget;
 use super::{
-    random, shown, Aabb, Camera, DirectionalLight, Light, Material, Mesh, Object, Scene, SceneError,
+    random, Aabb, Camera, DirectionalLight, Light, Material, Mesh, Object, Scene, SceneError,
 };
 
 /// Most vertices one glTF file may decode into (33.5 M, about 1 GiB of vertex data: what
@@ -139,8 +139,7 @@ pub fn load(
             "no lights in {}: ambient only; add lights (`Scene::lights`; `--lights N` on the command line)",
             path.display()
         );
-        super::said::warn(&hint);
-        loaded.report.warnings.push(hint);
+        loaded.report.say(hint);
     }
     scene.validate()?;
     Ok((scene, loaded.report))
@@ -207,9 +206,7 @@ pub fn load_into(
     scene.directional_lights.extend(imported.directional_lights);
     let mut report = LoadReport::default();
     for w in imported.warnings {
-        let msg = shown::reason(&format!("{}: {w}", path.display()));
-        super::said::warn(&msg);
-        report.warnings.push(msg);
+        report.warn(format!("{}: {w}", path.display()));
     }
     Ok(GltfLoad {
         report,
