@@ -228,6 +228,27 @@ pub fn each_method(mut check: impl FnMut(EsVersion, &str, &mut Gpu)) {
     }
 }
 
+/// Calls `check(es, method, gpu, picture)` with `scene` drawn by each method ([`each_method`])
+/// at `w` × `h` in linear output, lit by an ambient light of one alone: every surface shows its
+/// colour, and every texel its value, as they are.
+pub fn each_method_showing_colours(
+    scene: &Scene,
+    w: u32,
+    h: u32,
+    mut check: impl FnMut(EsVersion, &str, &mut Gpu, &image::RgbaImage),
+) {
+    let mut scene = scene.clone();
+    scene.ambient = Vec3::ONE;
+    let opts = RenderOptions {
+        linear: true,
+        ..Default::default()
+    };
+    each_method(|es, method, gpu| {
+        let picture = gpu.render(&scene, w, h, &opts);
+        check(es, method, gpu, &picture);
+    });
+}
+
 /// The mean of a picture's red, green and blue values, in 8-bit steps.
 pub fn mean(img: &image::RgbaImage) -> f64 {
     let sum: u64 = img

@@ -8,9 +8,7 @@ use crate::common;
 use crate::texel_quads::{self, texel_at, wrapped, H, TEXELS, W};
 
 use common::gltf::{base64, Builder};
-use glam::Vec3;
 use manylight::sampling::Wrap;
-use manylight::RenderOptions;
 use serde_json::{json, Value};
 
 /// glTF's wrap and filter codes.
@@ -107,14 +105,8 @@ fn document() -> String {
 fn each_texture_wraps_and_filters_as_its_sampler_says_with_every_method() {
     let dir = tempfile::tempdir().unwrap();
     let path = common::files::write(dir.path(), "samplers.gltf", document());
-    let (mut scene, _) = common::files::load(&path).unwrap();
-    scene.ambient = Vec3::ONE;
-    let opts = RenderOptions {
-        linear: true,
-        ..Default::default()
-    };
-    common::each_method(|es, method, gpu| {
-        let img = gpu.render(&scene, W, H, &opts);
+    let (scene, _) = common::files::load(&path).unwrap();
+    common::each_method_showing_colours(&scene, W, H, |es, method, _, img| {
         let (mut checked, mut blended) = ([0usize; 4], 0);
         for (x, y, p) in img.enumerate_pixels() {
             let Some((q, u, v)) = texel_quads::quad_and_uv(x, y) else {

@@ -7,8 +7,6 @@
 use crate::common;
 
 use common::gltf::{base64, Builder};
-use glam::Vec3;
-use manylight::RenderOptions;
 use serde_json::json;
 
 const W: u32 = 96;
@@ -58,18 +56,12 @@ fn document() -> String {
 fn an_image_of_three_texels_shows_each_exactly_with_every_method() {
     let dir = tempfile::tempdir().unwrap();
     let path = common::files::write(dir.path(), "npot.gltf", document());
-    let (mut scene, _) = common::files::load(&path).unwrap();
-    scene.ambient = Vec3::ONE;
-    let opts = RenderOptions {
-        linear: true,
-        ..Default::default()
-    };
-    common::each_method(|es, method, gpu| {
+    let (scene, _) = common::files::load(&path).unwrap();
+    common::each_method_showing_colours(&scene, W, H, |es, method, gpu, img| {
         assert!(
             gpu.r().caps().npot_textures,
             "{es}: this implementation lists no GL_OES_texture_npot"
         );
-        let img = gpu.render(&scene, W, H, &opts);
         for y in 1..H - 1 {
             for x in 0..W {
                 // Two pixels each side of a texel's edge are left to rounding.

@@ -7,10 +7,9 @@
 use crate::common;
 use crate::texel_quads::{self, texel_at, wrapped, H, TEXELS, W};
 
-use glam::{DVec3, Vec3};
+use glam::DVec3;
 use manylight::sampling::Wrap;
 use manylight::scene::{Camera, Projection};
-use manylight::RenderOptions;
 use std::sync::Arc;
 
 /// Each quad's `map_Kd` (left to right, then top to bottom) and what the test reads from it:
@@ -76,7 +75,6 @@ fn map_kd_options_clamp_scale_and_move_the_texture_with_every_method() {
         "warnings: {:?}",
         report.warnings
     );
-    scene.ambient = Vec3::ONE;
     scene.camera = Camera {
         position: DVec3::new(0.0, 0.0, 1.0),
         target: DVec3::ZERO,
@@ -87,12 +85,7 @@ fn map_kd_options_clamp_scale_and_move_the_texture_with_every_method() {
             far: 10.0,
         },
     };
-    let opts = RenderOptions {
-        linear: true,
-        ..Default::default()
-    };
-    common::each_method(|es, method, gpu| {
-        let img = gpu.render(&scene, W, H, &opts);
+    common::each_method_showing_colours(&scene, W, H, |es, method, _, img| {
         let mut checked = [0usize; 4];
         for (x, y, p) in img.enumerate_pixels() {
             let Some((q, u, t)) = texel_quads::quad_and_uv(x, y) else {
