@@ -11,9 +11,11 @@ use manylight::{EsVersion, RenderOptions};
 fn deferred_matches_forward_within_2_of_255_on_opaque_scenes() {
     let mut gpu = Gpu::new(EsVersion::Es3);
     for name in ["courtyard", "pillars", "plane"] {
-        for lights in [64, 1024] {
+        // Linear output changes only the last step, the encoding, whatever the lights: the
+        // smaller count checks it (forward over 1 024 lights is a software GPU's slow part).
+        for (lights, encodings) in [(64, &[false, true][..]), (1024, &[false][..])] {
             let s = scene::builtin::build(name, Some((lights, 21))).unwrap();
-            for linear in [false, true] {
+            for &linear in encodings {
                 let opts = RenderOptions {
                     linear,
                     ..Default::default()

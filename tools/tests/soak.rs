@@ -241,9 +241,8 @@ struct Case {
 
 /// A case with still camera, waiting for the GPU, every method, nothing allowed. 64 lights:
 /// enough that `auto` picks clustered, few enough to keep a software GPU's frames short. What a
-/// frame allocates does not depend on its size, so the frame is small: 32×18, one 32-pixel
-/// tile high and wide (forward and tiled over 64 lights at every pixel are most of a software
-/// GPU's time here).
+/// frame allocates does not depend on its size, so the frame is small: 16×9, within one tile
+/// (forward and tiled over 64 lights at every pixel are most of a software GPU's time here).
 const CASE: Case = Case {
     scene: "courtyard",
     lights: 64,
@@ -252,7 +251,7 @@ const CASE: Case = Case {
     auto_grid: false,
     methods: &[],
     samples: 1,
-    size: (32, 18),
+    size: (16, 9),
     cell_cap: None,
     measured: MEASURED,
 };
@@ -321,13 +320,11 @@ fn common_cases() -> Vec<Case> {
         },
         // Enough lights for the assignment to run on all cores on any host: one entry into
         // rayon's pool a frame (see RAYON_INJECTOR_BLOCK). The count decides that, not the
-        // size: the smallest frame (the same view) spares a software GPU thousands of lights
-        // a pixel.
+        // size.
         Case {
             lights: 5000,
             wait_for_gpu: false,
             methods: &["clustered"],
-            size: (16, 9),
             ..CASE
         },
     ]
@@ -503,7 +500,6 @@ fn no_heap_allocation_per_frame_in_steady_state_es3() {
         wait_for_gpu: false,
         samples: 4,
         methods: &["forward", "tiled", "clustered", "auto"],
-        size: (16, 9),
         ..CASE
     });
     let failures = allocations_per_frame(EsVersion::Es3, &Restrictions::default(), &cases);
@@ -523,14 +519,10 @@ fn no_heap_allocation_per_frame_in_steady_state_es2() {
 fn no_heap_allocation_per_frame_in_steady_state_es2_without_fragment_highp() {
     let _serial = serial();
     let cases = [
-        Case {
-            size: (16, 9),
-            ..CASE
-        },
+        CASE,
         Case {
             lights: 1100,
             wait_for_gpu: false,
-            size: (16, 9),
             ..CASE
         },
     ];
