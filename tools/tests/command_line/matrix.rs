@@ -212,13 +212,15 @@ fn matrix_json_on_stdout_ignores_the_callers_driver_switches_and_writes_no_image
     let scene = "-plane.json";
     let scene_text = r#"{"objects": [{"builtin": "plane"}]}"#;
     std::fs::write(dir.path().join(scene), scene_text).unwrap();
+    // No light: each cell's programs are then small for a software GPU to compile, and the
+    // lines naming renders over the bound are the verdict's unit tests' (matrix/verdict.rs).
     let out = Command::new(env!("CARGO_BIN_EXE_manylight"))
         .args([
             "matrix",
             "--size",
             "32x18",
             "--lights",
-            "8",
+            "0",
             "--json",
             "/dev/stdout",
         ])
