@@ -671,6 +671,48 @@ fn bench_assign_times_pools_side_by_side() {
     }
 }
 
+/// A list option of `bench` or `bench-assign` takes at most 64 values (each a run of its own),
+/// over all its uses: more is a usage error naming the option, before any work.
+#[test]
+fn bench_lists_past_64_values_are_usage_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    let many = |value: &str| vec![value; 65].join(",");
+    let cases: [(&str, &str, String); 5] = [
+        ("bench-assign", "--lights", many("1")),
+        ("bench", "--lights", many("1")),
+        ("bench", "--scenes", many("plane")),
+        ("bench", "--methods", many("forward")),
+        ("bench", "--es", many("3")),
+    ];
+    for (subcommand, option, list) in cases {
+        let args = [subcommand, option, list.as_str(), "--out", "r"];
+        let args = if subcommand == "bench" {
+            &args[..]
+        } else {
+            &args[..3]
+        };
+        let said = expect_exit(args, &[], dir.path(), 2, option);
+        assert!(said.contains("lists 65 values; at most 64"), "{said}");
+        assert!(
+            said.contains(&format!("Usage: manylight {subcommand}")),
+            "{said}"
+        );
+    }
+    // The uses of an option add up.
+    let sixty_four = vec!["1"; 64].join(",");
+    let split = ["bench-assign", "--lights", &sixty_four, "--lights", "1,1"];
+    let said = expect_exit(&split, &[], dir.path(), 2, "--lights");
+    assert!(said.contains("lists 66 values"), "{said}");
+    // 64 values pass the check: the sweep goes on to load its scene.
+    let args = ["bench", "--lights", &sixty_four, "--scenes", "missing.obj"];
+    let said = expect_exit(&args, &[], dir.path(), 1, "missing.obj");
+    assert!(!said.contains("at most 64"), "{said}");
+    assert!(
+        !dir.path().join("r").exists(),
+        "a refused bench wrote its report"
+    );
+}
+
 /// The command line's thread (which renders, and so assigns the lights) is one of rayon's pool,
 /// so a parallel assignment starts on it at once; the pool still has the threads asked for.
 #[test]

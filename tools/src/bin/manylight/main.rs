@@ -173,21 +173,22 @@ fn check_usage(cli: &Cli) {
     }
     if let Some(Command::BenchAssign(a)) = &cli.command {
         if a.threads.len() > bench_assign::MAX_POOLS {
-            // Built, so that the subcommand's usage line under the message names it.
-            let mut cli = Cli::command();
-            cli.build();
-            cli.find_subcommand_mut("bench-assign")
-                .expect("the bench-assign subcommand")
-                .error(
-                    ErrorKind::ValueValidation,
-                    format!(
-                        "--threads lists {} pools; at most {} (each pool's threads exist at once)",
-                        a.threads.len(),
-                        bench_assign::MAX_POOLS
-                    ),
-                )
-                .exit();
+            subcommand_usage_error(
+                "bench-assign",
+                format!(
+                    "--threads lists {} pools; at most {} (each pool's threads exist at once)",
+                    a.threads.len(),
+                    bench_assign::MAX_POOLS
+                ),
+            );
         }
+        check_list_length("bench-assign", "--lights", a.lights.len());
+    }
+    if let Some(Command::Bench(a)) = &cli.command {
+        check_list_length("bench", "--scenes", a.scenes.len());
+        check_list_length("bench", "--lights", a.lights.len());
+        check_list_length("bench", "--methods", a.methods.len());
+        check_list_length("bench", "--es", a.es.len());
     }
     if let Some(Command::Matrix(a)) = &cli.command {
         // `--json -` is stdout, no file.
@@ -233,6 +234,32 @@ fn check_usage(cli: &Cli) {
                  cargo run --release --features window -- view",
             )
             .exit();
+    }
+}
+
+/// Most values a list option of `bench` or `bench-assign` takes: each is a run of its own (a
+/// sweep's scenes are all loaded at its start), so a list as long as a command line holds would
+/// take days, or the memory of a hundred thousand scenes.
+const MAX_LIST_VALUES: usize = 64;
+
+/// A usage error of `subcommand` (exit status 2), its usage line under the message.
+fn subcommand_usage_error(subcommand: &str, message: String) -> ! {
+    // Built, so that the subcommand's usage line under the message names it.
+    let mut cli = Cli::command();
+    cli.build();
+    cli.find_subcommand_mut(subcommand)
+        .expect("a subcommand of the command line")
+        .error(ErrorKind::ValueValidation, message)
+        .exit()
+}
+
+/// `option` of `subcommand` lists at most [`MAX_LIST_VALUES`] values (over all its uses).
+fn check_list_length(subcommand: &str, option: &str, len: usize) {
+    if len > MAX_LIST_VALUES {
+        subcommand_usage_error(
+            subcommand,
+            format!("{option} lists {len} values; at most {MAX_LIST_VALUES}"),
+        );
     }
 }
 
