@@ -131,6 +131,46 @@ struct GpuChunk {
     layout: VertexLayout,
 }
 
+impl GpuChunk {
+    /// Binds the chunk's buffers and points the program's attributes into them, for as many
+    /// draws as wanted.
+    fn bind_arrays(&self, dev: &Device) -> BoundMesh {
+        let gl = &dev.gl;
+        let stride = (self.layout.floats() * 4) as i32;
+        unsafe {
+            gl.bind_buffer(glow::ARRAY_BUFFER, Some(self.vbo));
+            gl.bind_buffer(glow::ELEMENT_ARRAY_BUFFER, Some(self.ibo));
+            // Optional attributes the mesh lacks read a constant instead of a stale array.
+            for (loc, value) in ABSENT {
+                gl.disable_vertex_attrib_array(loc);
+                gl.vertex_attrib_4_f32(loc, value[0], value[1], value[2], value[3]);
+            }
+            for (loc, size, offset) in self.layout.attributes() {
+                gl.enable_vertex_attrib_array(loc);
+                gl.vertex_attrib_pointer_f32(loc, size, glow::FLOAT, false, stride, offset);
+            }
+        }
+        BoundMesh {
+            index_count: self.index_count,
+        }
+    }
+}
+
+/// A one-chunk mesh whose arrays are bound ([`GpuMesh::bind_single_chunk`]).
+pub struct BoundMesh {
+    index_count: i32,
+}
+
+impl BoundMesh {
+    /// Draws the mesh once more with the bound program.
+    pub fn draw(&self, dev: &Device) {
+        unsafe {
+            dev.gl
+                .draw_elements(glow::TRIANGLES, self.index_count, glow::UNSIGNED_SHORT, 0);
+        }
+    }
+}
+
 /// A mesh uploaded as static vertex and index buffers.
 pub struct GpuMesh {
     chunks: Vec<GpuChunk>,
@@ -184,23 +224,18 @@ impl GpuMesh {
 
     /// Draws all chunks with the bound program (attributes at [`super::program::ATTRIBUTES`]).
     pub fn draw(&self, dev: &Device) {
-        let gl = &dev.gl;
-        unsafe {
-            for c in &self.chunks {
-                let stride = (c.layout.floats() * 4) as i32;
-                gl.bind_buffer(glow::ARRAY_BUFFER, Some(c.vbo));
-                gl.bind_buffer(glow::ELEMENT_ARRAY_BUFFER, Some(c.ibo));
-                // Optional attributes the mesh lacks read a constant instead of a stale array.
-                for (loc, value) in ABSENT {
-                    gl.disable_vertex_attrib_array(loc);
-                    gl.vertex_attrib_4_f32(loc, value[0], value[1], value[2], value[3]);
-                }
-                for (loc, size, offset) in c.layout.attributes() {
-                    gl.enable_vertex_attrib_array(loc);
-                    gl.vertex_attrib_pointer_f32(loc, size, glow::FLOAT, false, stride, offset);
-                }
-                gl.draw_elements(glow::TRIANGLES, c.index_count, glow::UNSIGNED_SHORT, 0);
-            }
+        for c in &self.chunks {
+            c.bind_arrays(dev).draw(dev);
+        }
+    }
+
+    /// A mesh of one chunk with its arrays bound for the bound program, to be drawn again and
+    /// again with nothing but the draw call (deferred's proxies, one a light); `None` for a
+    /// mesh of several chunks. Valid until other arrays or buffers are bound.
+    pub fn bind_single_chunk(&self, dev: &Device) -> Option<BoundMesh> {
+        match &self.chunks[..] {
+            [c] => Some(c.bind_arrays(dev)),
+            _ => None,
         }
     }
 

@@ -25,6 +25,7 @@ use super::geometry::{shade_object, sort_objects, GeometryProgram, UNIT_METHOD};
 use super::uniforms::{self, Surface, Transforms};
 use super::{FrameContext, MethodDesc, MethodStats, ShaderFeatures, ShadingMethod, Support};
 use crate::cluster::grid::GridProjection;
+use crate::cluster::view_light::GpuLight;
 use crate::gl::gbuffer::{self, GBuffer};
 use crate::gl::mesh::GpuMesh;
 use crate::gl::program::{ProgramKey, Resolver, Sampler, Uniform, UniformSet};
@@ -85,6 +86,67 @@ const VOLUME_SCALE: f32 = 1.1;
 /// or it takes the full-screen path (the far side must not be clipped; the margin covers `f32`
 /// rounding of the projection).
 const FAR_MARGIN: f32 = 0.999;
+
+/// Which side of a light's proxy is drawn and depth tested against the surfaces:
+/// - wholly in front of the near plane: the near side, `LEQUAL` — where a surface lies in front
+///   of the whole sphere the light cannot reach it and the pixel is skipped;
+/// - reaching the near plane (the eye inside or beside it), whose near side would be clipped:
+///   the far side, `GEQUAL` — surfaces behind the whole sphere are skipped;
+/// - that far side reaching the far plane too, or depth too coarse there for either side's
+///   test: a full-screen triangle.
+///
+/// Each is one-sided (no stencil). The far side everywhere would skip more in open scenes but
+/// evaluate far more in enclosed ones (the conference room); the near side first avoids that
+/// worst case.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Proxy {
+    NearSide,
+    FarSide,
+    FullScreen,
+}
+
+impl Proxy {
+    fn cull(self) -> Cull {
+        match self {
+            Proxy::NearSide => Cull::Back,
+            Proxy::FarSide => Cull::Front,
+            Proxy::FullScreen => Cull::None,
+        }
+    }
+
+    fn depth_test(self) -> DepthTest {
+        match self {
+            Proxy::NearSide => DepthTest::LessEqual,
+            Proxy::FarSide => DepthTest::GreaterEqual,
+            Proxy::FullScreen => DepthTest::Off,
+        }
+    }
+}
+
+/// What decides a light's [`Proxy`]: the view's camera and depth range.
+struct ProxyReach<'a> {
+    camera: &'a crate::scene::Camera,
+    near: f32,
+    far: f32,
+}
+
+impl ProxyReach<'_> {
+    fn proxy(&self, light: &GpuLight) -> Proxy {
+        let radius = light.cull_radius * VOLUME_SCALE;
+        let depth = -light.position.z;
+        // A proxy's one-sided depth test needs depth steps well inside the light's reach
+        // where it ends (a tiny near plane makes them wider; docs/precision.md).
+        let coarse = self.camera.depth_step_at(f64::from(depth + radius), 24)
+            > 0.1 * f64::from(light.cull_radius);
+        if !coarse && depth - radius >= 2.0 * self.near {
+            Proxy::NearSide
+        } else if !coarse && depth + radius < FAR_MARGIN * self.far {
+            Proxy::FarSide
+        } else {
+            Proxy::FullScreen
+        }
+    }
+}
 
 /// Texture units of the G-buffer's textures, in `GBuffer::bind_textures` order, and of its
 /// depth.
@@ -320,63 +382,35 @@ impl Deferred {
         let (half, ortho) = half_extent(ctx);
         let scale = accumulation_scale(ctx);
         let viewport = [ctx.viewport.0 as f32, ctx.viewport.1 as f32];
-        let far = ctx.far as f32;
-        for (k, light) in ctx
-            .lights
-            .iter()
-            .filter(|l| l.cull_radius > 0.0)
-            .enumerate()
-        {
-            // The proxy bounds the light's reach: its culling radius (the radius, or less
-            // under a light cut-off).
-            let radius = light.cull_radius * VOLUME_SCALE;
-            // Which side of the proxy is drawn and depth tested against the surfaces:
-            // - wholly in front of the near plane: the near side, LEQUAL — where a surface lies
-            //   in front of the whole sphere the light cannot reach it and the pixel is
-            //   skipped;
-            // - reaching the near plane (the eye inside or beside it), whose near side would be
-            //   clipped: the far side, GEQUAL — surfaces behind the whole sphere are skipped;
-            // - that far side reaching the far plane too, or depth too coarse there for either
-            //   side's test: a full-screen triangle.
-            // Each is one-sided (no stencil). The far side everywhere would skip more in open
-            // scenes but evaluate far more in enclosed ones (the conference room); the near
-            // side first avoids that worst case.
-            let depth = -light.position.z;
-            // A proxy's one-sided depth test needs depth steps well inside the light's reach
-            // where it ends (a tiny near plane makes them wider; docs/precision.md).
-            let coarse = ctx
-                .scene
-                .camera
-                .depth_step_at(f64::from(depth + radius), 24)
-                > 0.1 * f64::from(light.cull_radius);
-            let (shader, mesh, cull, depth_test) =
-                if !coarse && depth - radius >= 2.0 * ctx.near as f32 {
-                    (
-                        "deferred_light",
-                        self.sphere.as_ref(),
-                        Cull::Back,
-                        DepthTest::LessEqual,
-                    )
-                } else if !coarse && depth + radius < FAR_MARGIN * far {
-                    (
-                        "deferred_light",
-                        self.sphere.as_ref(),
-                        Cull::Front,
-                        DepthTest::GreaterEqual,
-                    )
-                } else {
-                    (
-                        "deferred_light_fullscreen",
-                        self.fullscreen.as_ref(),
-                        Cull::None,
-                        DepthTest::Off,
-                    )
-                };
+        let reach = ProxyReach {
+            camera: &ctx.scene.camera,
+            near: ctx.near as f32,
+            far: ctx.far as f32,
+        };
+        // Lights with the same proxy drawn together: the state, program, constant uniforms and
+        // arrays set once for them, and a light's own uniforms and draw call each (a mobile
+        // driver spends about a microsecond on a call). `k` numbers the lights drawn, whatever
+        // their proxy.
+        let drawn = || {
+            ctx.lights
+                .iter()
+                .filter(|l| l.cull_radius > 0.0)
+                .enumerate()
+        };
+        for proxy in [Proxy::NearSide, Proxy::FarSide, Proxy::FullScreen] {
+            let mut lights = drawn().filter(|(_, l)| reach.proxy(l) == proxy).peekable();
+            if lights.peek().is_none() {
+                continue;
+            }
+            let (shader, mesh) = match proxy {
+                Proxy::FullScreen => ("deferred_light_fullscreen", self.fullscreen.as_ref()),
+                _ => ("deferred_light", self.sphere.as_ref()),
+            };
             RenderState {
-                depth_test,
+                depth_test: proxy.depth_test(),
                 depth_write: false,
                 blend: Blend::Additive,
-                cull,
+                cull: proxy.cull(),
                 color_write: true,
             }
             .apply(dev);
@@ -394,17 +428,25 @@ impl Deferred {
             p.viewport.set(dev, viewport);
             p.half_extent.set(dev, half);
             p.orthographic.set(dev, if ortho { 1.0 } else { 0.0 });
-            if let Some((volume, projection)) = &p.proxy {
+            if let Some((_, projection)) = &p.proxy {
                 projection.set(dev, ctx.projection);
-                volume.set(dev, light.position.extend(radius));
             }
-            // A count adds 1 in one channel, light by light in turn (see COUNT_CHANNELS).
-            p.count_channel.set(dev, Vec4::AXES[k % COUNT_CHANNELS]);
-            let [light0, light1, light2] = &p.light;
-            light0.set(dev, light.position.extend(light.radius));
-            light1.set(dev, (light.radiance * scale).extend(light.spot_scale));
-            light2.set(dev, light.direction.extend(light.spot_offset));
-            mesh.expect("allocated").draw(dev);
+            let mesh = (mesh.expect("allocated").bind_single_chunk(dev))
+                .expect("a proxy mesh is one chunk");
+            for (k, light) in lights {
+                if let Some((volume, _)) = &p.proxy {
+                    // The proxy bounds the light's reach: its culling radius (the radius, or
+                    // less under a light cut-off).
+                    volume.set(dev, light.position.extend(light.cull_radius * VOLUME_SCALE));
+                }
+                // A count adds 1 in one channel, light by light in turn (see COUNT_CHANNELS).
+                p.count_channel.set(dev, Vec4::AXES[k % COUNT_CHANNELS]);
+                let [light0, light1, light2] = &p.light;
+                light0.set(dev, light.position.extend(light.radius));
+                light1.set(dev, (light.radiance * scale).extend(light.spot_scale));
+                light2.set(dev, light.direction.extend(light.spot_offset));
+                mesh.draw(dev);
+            }
         }
         Ok(())
     }
