@@ -388,9 +388,8 @@ impl Deferred {
             far: ctx.far as f32,
         };
         // Lights with the same proxy drawn together: the state, program, constant uniforms and
-        // arrays set once for them, and a light's own uniforms and draw call each (a mobile
-        // driver spends about a microsecond on a call). `k` numbers the lights drawn, whatever
-        // their proxy.
+        // arrays set once for them, and each light only its own uniforms and draw call. `k`
+        // numbers the lights drawn, whatever their proxy.
         let drawn = || {
             ctx.lights
                 .iter()
