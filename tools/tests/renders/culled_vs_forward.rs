@@ -8,20 +8,10 @@ use common::Gpu;
 use glam::{DVec3, Vec3};
 use manylight::metrics::diff;
 use manylight::scene::{self, Light};
-use manylight::{EsVersion, FrameStats, RenderOptions};
+use manylight::{EsVersion, RenderOptions};
 
 const W: u32 = 256;
 const H: u32 = 144;
-
-fn render(
-    gpu: &mut Gpu,
-    method: &str,
-    scene: &scene::Scene,
-    opts: &RenderOptions,
-) -> (image::RgbaImage, FrameStats) {
-    gpu.r().set_method_named(method).unwrap();
-    gpu.r().render_offscreen(scene, W, H, opts).unwrap()
-}
 
 #[test]
 fn tiled_and_clustered_match_forward_within_2_of_255() {
@@ -38,18 +28,14 @@ fn tiled_and_clustered_match_forward_within_2_of_255() {
             ];
             for (lights, encodings, (w, h)) in cases {
                 let scene = scene::builtin::build(name, Some((lights, 11))).unwrap();
-                let mut render = |method: &str, opts: &RenderOptions| {
-                    gpu.r().set_method_named(method).unwrap();
-                    gpu.r().render_offscreen(&scene, w, h, opts).unwrap()
-                };
                 for &linear in encodings {
                     let opts = RenderOptions {
                         linear,
                         ..Default::default()
                     };
-                    let (reference, _) = render("forward", &opts);
+                    let (reference, _) = gpu.render_with("forward", &scene, (w, h), &opts);
                     for method in ["tiled", "clustered"] {
-                        let (img, stats) = render(method, &opts);
+                        let (img, stats) = gpu.render_with(method, &scene, (w, h), &opts);
                         let d = diff(&reference, &img);
                         eprintln!("{es} {name} {lights} lights {method} linear={linear}: max {} rmse {:.3}, {} cells, {:.1} lights/cell", d.max_abs, d.rmse, stats.assignment.nonempty_clusters, stats.assignment.avg_lights_per_nonempty);
                         assert!(
@@ -71,8 +57,8 @@ fn tiled_and_clustered_match_forward_within_2_of_255() {
 fn clustered_lists_are_short() {
     let mut gpu = Gpu::new(EsVersion::Es3);
     let scene = scene::builtin::build("pillars", Some((1024, 5))).unwrap();
-    let (_, tiled) = render(&mut gpu, "tiled", &scene, &RenderOptions::default());
-    let (_, clustered) = render(&mut gpu, "clustered", &scene, &RenderOptions::default());
+    let (_, tiled) = gpu.render_with("tiled", &scene, (W, H), &RenderOptions::default());
+    let (_, clustered) = gpu.render_with("clustered", &scene, (W, H), &RenderOptions::default());
     assert!(
         clustered.assignment.avg_lights_per_nonempty < 1024.0 / 10.0,
         "{}",
@@ -121,9 +107,9 @@ fn overflow_policy_holds_in_a_real_render() {
     uncrowded.lights.drain(..300);
     for (run, es) in [EsVersion::Es2, EsVersion::Es3].into_iter().enumerate() {
         let mut gpu = Gpu::new(es);
-        let (reference, _) = render(&mut gpu, "forward", &scene, &opts);
-        let (floor, _) = render(&mut gpu, "forward", &uncrowded, &opts);
-        let (img, stats) = render(&mut gpu, "clustered", &scene, &opts);
+        let (reference, _) = gpu.render_with("forward", &scene, (W, H), &opts);
+        let (floor, _) = gpu.render_with("forward", &uncrowded, (W, H), &opts);
+        let (img, stats) = gpu.render_with("clustered", &scene, (W, H), &opts);
         assert!(
             stats.assignment.max_lights_per_cluster >= 300,
             "{es}: {}",
@@ -181,7 +167,7 @@ fn overflow_policy_holds_in_a_real_render() {
             },
             ..opts.clone()
         };
-        let (_, stats) = render(&mut gpu, "clustered", &scene, &tight);
+        let (_, stats) = gpu.render_with("clustered", &scene, (W, H), &tight);
         assert!(stats.lights.overflowed > 0);
         let said = warnings_containing(warning);
         assert_eq!(
