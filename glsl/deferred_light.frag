@@ -1,20 +1,12 @@
 // Deferred, pass 2: one light, drawn as a proxy volume (or a full-screen triangle when the eye
-// is inside it), added to the accumulation buffer.
+// is inside it) instanced light by light, added to the accumulation buffer.
 // Materials of both models share the G-buffer: the BRDF is chosen per pixel.
 #define PER_PIXEL_MODEL 1
 #include "surface.glsl"
 #include "light_struct.glsl"
 #include "light_model.glsl"
 #include "deferred_common.glsl"
-
-// x y z: view-space position, w: radius.
-uniform HIGHP vec4 u_light0;
-// rgb: radiance, a: spot scale.
-uniform vec4 u_light1;
-// xyz: spot axis, w: spot offset.
-uniform vec4 u_light2;
-// Counts: the one channel this light adds 1 to (deferred.rs COUNT_CHANNELS).
-uniform vec4 u_countChannel;
+#include "deferred_light_varyings.glsl"
 
 void main() {
     ivec2 px = ivec2(gl_FragCoord.xy);
@@ -24,19 +16,19 @@ void main() {
     }
 #if COUNT_EVALS
     // One evaluation of this light here, summed by the additive blend in its channel.
-    FRAG_COLOR = u_countChannel;
+    FRAG_COLOR = vec4(equal(vec4(v_proxy.y), vec4(0.0, 1.0, 2.0, 3.0)));
 #else
     HIGHP vec4 albedoOffset = texelFetch(u_gAlbedo, px, 0);
     HIGHP vec3 P = viewPosition(gl_FragCoord.xy + vec2(nd.w, albedoOffset.a), nd.z);
     vec4 spec = texelFetch(u_gSpecular, px, 0);
     Light light;
-    light.position = u_light0.xyz;
-    light.radius = u_light0.w;
-    light.radiance = u_light1.rgb;
+    light.position = v_light0.xyz;
+    light.radius = v_light0.w;
+    light.radiance = v_light1.rgb;
 #if HAS_SPOT
-    light.spotScale = u_light1.a;
-    light.direction = u_light2.xyz;
-    light.spotOffset = u_light2.w;
+    light.spotScale = v_light1.a;
+    light.direction = v_light2.xyz;
+    light.spotOffset = v_light2.w;
 #endif
     SurfaceParams surface;
     surface.albedo = albedoOffset.rgb;

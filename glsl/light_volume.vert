@@ -1,9 +1,10 @@
-// A unit-sphere proxy placed around a light in view space.
+// Deferred's light proxy: a unit sphere placed around each instance's light in view space.
 ATTRIBUTE vec3 a_position;
+#include "deferred_light_instance.glsl"
 
-uniform HIGHP vec4 u_volume;
 uniform mat4 u_projection;
 
 void main() {
-    gl_Position = u_projection * vec4(a_position * u_volume.w + u_volume.xyz, 1.0);
+    passLight();
+    gl_Position = u_projection * vec4(a_position * a_proxy.x + a_light0.xyz, 1.0);
 }

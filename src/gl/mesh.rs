@@ -169,6 +169,20 @@ impl BoundMesh {
                 .draw_elements(glow::TRIANGLES, self.index_count, glow::UNSIGNED_SHORT, 0);
         }
     }
+
+    /// Draws `instances` copies of the mesh with the bound program and instance arrays
+    /// (ES 3.0).
+    pub fn draw_instanced(&self, dev: &Device, instances: i32) {
+        unsafe {
+            dev.gl.draw_elements_instanced(
+                glow::TRIANGLES,
+                self.index_count,
+                glow::UNSIGNED_SHORT,
+                0,
+                instances,
+            );
+        }
+    }
 }
 
 /// A mesh uploaded as static vertex and index buffers.
@@ -230,7 +244,7 @@ impl GpuMesh {
     }
 
     /// A mesh of one chunk with its arrays bound for the bound program, to be drawn again and
-    /// again with nothing but the draw call (deferred's proxies, one a light); `None` for a
+    /// again with nothing but the draw call (deferred's proxies); `None` for a
     /// mesh of several chunks. Valid until other arrays or buffers are bound.
     pub fn bind_single_chunk(&self, dev: &Device) -> Option<BoundMesh> {
         match &self.chunks[..] {

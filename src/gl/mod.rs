@@ -21,6 +21,7 @@ pub mod gbuffer;
 pub mod gles_lib;
 pub(crate) mod host_attributes;
 pub(crate) mod host_state;
+pub(crate) mod instances;
 pub(crate) mod left_objects;
 pub mod mesh;
 pub mod multisample;

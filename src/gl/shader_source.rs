@@ -108,7 +108,7 @@ pub const SHADERS: &[ShaderDesc] = &[
     },
     ShaderDesc {
         name: "deferred_light_fullscreen",
-        vertex: "fullscreen.vert",
+        vertex: "light_fullscreen.vert",
         fragment: "deferred_light.frag",
         es3_only: true,
         mrt: false,
@@ -173,6 +173,18 @@ pub const FILES: &[(&str, &str)] = &[
     (
         "light_volume.vert",
         include_str!("../../glsl/light_volume.vert"),
+    ),
+    (
+        "light_fullscreen.vert",
+        include_str!("../../glsl/light_fullscreen.vert"),
+    ),
+    (
+        "deferred_light_instance.glsl",
+        include_str!("../../glsl/deferred_light_instance.glsl"),
+    ),
+    (
+        "deferred_light_varyings.glsl",
+        include_str!("../../glsl/deferred_light_varyings.glsl"),
     ),
     (
         "fullscreen.vert",

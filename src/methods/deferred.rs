@@ -2,7 +2,8 @@
 //!
 //! 1. **Geometry pass** — opaque objects write albedo, normal + view depth and specular into
 //!    the G-buffer (layout and memory per pixel: `gl::gbuffer`).
-//! 2. **Light pass** — every light is drawn as a proxy sphere around it, its near side depth
+//! 2. **Light pass** — every light is drawn as a proxy sphere around it (instanced: a light is
+//!    64 bytes of a batch, not a draw call of its own), its near side depth
 //!    tested so surfaces in front of the sphere are skipped, or its far side (surfaces behind
 //!    skipped) when the near side would be clipped by the near plane (a full-screen triangle
 //!    only when the far side would be clipped too); each covered pixel reads the G-buffer once
@@ -17,7 +18,9 @@
 //! forward within 2/255 (tested); its cost is memory and bandwidth: 52 bytes per pixel, 44
 //! without `GL_EXT_float_blend` (`gl::gbuffer`).
 
-use glam::{Mat4, Vec3, Vec4};
+mod light_instances;
+
+use glam::{Mat4, Vec3};
 
 use super::directional::DirectionalUniforms;
 use super::forward::Forward;
@@ -34,6 +37,7 @@ use crate::gl::{Caps, Device, EsVersion};
 use crate::scene::meshbuild::MeshBuilder;
 use crate::scene::Mesh;
 use crate::Error;
+use light_instances::{light_instance, LightInstances};
 
 /// The table row.
 pub const DESC: MethodDesc = MethodDesc {
@@ -190,22 +194,17 @@ impl GeometryProgram for GBufferProgram {
     }
 }
 
-/// The light pass's program (`deferred_light`, `deferred_light_fullscreen`). A count variant
-/// reads only the G-buffer's coverage.
+/// The light pass's program (`deferred_light`, `deferred_light_fullscreen`), whose lights are
+/// its instances (`light_instances.rs`). A count variant reads only the G-buffer's coverage.
 pub struct LightProgram {
-    /// The proxy sphere and the projection (`deferred_light` only: the full-screen triangle
-    /// has neither).
-    proxy: Option<(Uniform<Vec4>, Uniform<Mat4>)>,
+    /// The projection (`deferred_light` only: the full-screen triangle has none).
+    projection: Option<Uniform<Mat4>>,
     g_albedo: Uniform<Sampler>,
     g_normal_depth: Uniform<Sampler>,
     g_specular: Uniform<Sampler>,
     viewport: Uniform<[f32; 2]>,
     half_extent: Uniform<[f32; 2]>,
     orthographic: Uniform<f32>,
-    /// Position and radius; radiance and spot scale; spot axis and offset.
-    light: [Uniform<Vec4>; 3],
-    /// A count variant's one channel this light adds 1 to.
-    count_channel: Uniform<Vec4>,
 }
 
 impl UniformSet for LightProgram {
@@ -214,19 +213,13 @@ impl UniformSet for LightProgram {
         let colour = !f.counting();
         let proxy = r.shader() == "deferred_light";
         LightProgram {
-            proxy: proxy.then(|| (r.required("u_volume"), r.required("u_projection"))),
+            projection: proxy.then(|| r.required("u_projection")),
             g_albedo: r.required_when(colour, "u_gAlbedo"),
             g_normal_depth: r.required("u_gNormalDepth"),
             g_specular: r.required_when(colour && f.has(ShaderFeatures::SPECULAR), "u_gSpecular"),
             viewport: r.required_when(colour, "u_viewport"),
             half_extent: r.required_when(colour, "u_halfExtent"),
             orthographic: r.required_when(colour, "u_orthographic"),
-            light: [
-                r.required_when(colour, "u_light0"),
-                r.required_when(colour, "u_light1"),
-                r.required_when(colour && f.has(ShaderFeatures::SPOT), "u_light2"),
-            ],
-            count_channel: r.required_when(!colour, "u_countChannel"),
         }
     }
 }
@@ -288,6 +281,7 @@ pub struct Deferred {
     gbuffer: Option<GBuffer>,
     sphere: Option<GpuMesh>,
     fullscreen: Option<GpuMesh>,
+    lights: Option<LightInstances>,
     transparent: Forward,
 }
 
@@ -361,7 +355,8 @@ impl Deferred {
         drawn
     }
 
-    fn light_pass(&self, ctx: &mut FrameContext) -> Result<(), Error> {
+    /// Returns the bytes of lights uploaded.
+    fn light_pass(&mut self, ctx: &mut FrameContext) -> Result<usize, Error> {
         let dev = ctx.dev;
         let gb = self.gbuffer.as_ref().expect("allocated");
         gb.begin_accumulation(dev);
@@ -387,19 +382,24 @@ impl Deferred {
             near: ctx.near as f32,
             far: ctx.far as f32,
         };
-        // Lights with the same proxy drawn together: the state, program, constant uniforms and
-        // arrays set once for them, and each light only its own uniforms and draw call. `k`
-        // numbers the lights drawn, whatever their proxy.
+        // Lights with the same proxy drawn together, as instances of it, in their order: the
+        // state, program, uniforms and arrays set once for them. `k` numbers the lights drawn,
+        // whatever their proxy.
         let drawn = || {
             ctx.lights
                 .iter()
                 .filter(|l| l.cull_radius > 0.0)
                 .enumerate()
         };
+        let mut uploaded = 0;
         for proxy in [Proxy::NearSide, Proxy::FarSide, Proxy::FullScreen] {
             let mut lights = drawn().filter(|(_, l)| reach.proxy(l) == proxy).peekable();
             if lights.peek().is_none() {
                 continue;
+            }
+            // Made for the first frame with lights: a scene without pays nothing for it.
+            if self.lights.is_none() {
+                self.lights = Some(LightInstances::new(dev)?);
             }
             let (shader, mesh) = match proxy {
                 Proxy::FullScreen => ("deferred_light_fullscreen", self.fullscreen.as_ref()),
@@ -427,27 +427,26 @@ impl Deferred {
             p.viewport.set(dev, viewport);
             p.half_extent.set(dev, half);
             p.orthographic.set(dev, if ortho { 1.0 } else { 0.0 });
-            if let Some((_, projection)) = &p.proxy {
+            if let Some(projection) = &p.projection {
                 projection.set(dev, ctx.projection);
             }
             let mesh = (mesh.expect("allocated").bind_single_chunk(dev))
                 .expect("a proxy mesh is one chunk");
-            for (k, light) in lights {
-                if let Some((volume, _)) = &p.proxy {
-                    // The proxy bounds the light's reach: its culling radius (the radius, or
-                    // less under a light cut-off).
-                    volume.set(dev, light.position.extend(light.cull_radius * VOLUME_SCALE));
-                }
-                // A count adds 1 in one channel, light by light in turn (see COUNT_CHANNELS).
-                p.count_channel.set(dev, Vec4::AXES[k % COUNT_CHANNELS]);
-                let [light0, light1, light2] = &p.light;
-                light0.set(dev, light.position.extend(light.radius));
-                light1.set(dev, (light.radiance * scale).extend(light.spot_scale));
-                light2.set(dev, light.direction.extend(light.spot_offset));
-                mesh.draw(dev);
-            }
+            // The proxy bounds the light's reach: its culling radius (the radius, or less under
+            // a light cut-off). A count adds 1 in one channel, light by light in turn (see
+            // COUNT_CHANNELS).
+            let instances = lights.map(|(k, light)| {
+                light_instance(
+                    light,
+                    light.cull_radius * VOLUME_SCALE,
+                    k % COUNT_CHANNELS,
+                    scale,
+                )
+            });
+            let batches = self.lights.as_mut().expect("allocated");
+            uploaded += batches.draw(dev, &mesh, instances);
         }
-        Ok(())
+        Ok(uploaded)
     }
 
     fn composite(
@@ -549,10 +548,11 @@ impl ShadingMethod for Deferred {
         self.ensure_resources(dev, ctx.viewport)?;
         sort_objects(ctx);
         self.geometry_pass(ctx)?;
-        self.light_pass(ctx)?;
+        let upload_bytes = self.light_pass(ctx)?;
         self.composite(ctx, target)?;
         let mut stats = MethodStats {
             gbuffer_bytes: self.gbuffer.as_ref().map_or(0, GBuffer::gpu_bytes),
+            upload_bytes,
             ..MethodStats::default()
         };
         if !ctx.order.transparent.is_empty() && !ctx.features.counting() {
@@ -574,6 +574,7 @@ impl ShadingMethod for Deferred {
         self.gbuffer.as_ref().map_or(0, GBuffer::gpu_bytes)
             + self.sphere.as_ref().map_or(0, GpuMesh::gpu_bytes)
             + self.fullscreen.as_ref().map_or(0, GpuMesh::gpu_bytes)
+            + self.lights.as_ref().map_or(0, LightInstances::gpu_bytes)
             + self.transparent.gpu_bytes()
     }
 
@@ -587,6 +588,9 @@ impl ShadingMethod for Deferred {
         {
             let mut m = m;
             m.destroy(dev);
+        }
+        if let Some(mut lights) = self.lights.take() {
+            lights.destroy(dev);
         }
         self.transparent.destroy(dev);
     }

@@ -39,6 +39,25 @@ fn deferred_matches_forward_within_2_of_255_on_opaque_scenes() {
     }
 }
 
+/// Lights are drawn as instances of their proxy, 4 096 a batch: a scene of more matches
+/// forward, and each light is uploaded once, as its four `vec4`s.
+#[test]
+fn lights_past_one_instance_batch_match_forward_and_upload_once() {
+    let mut gpu = Gpu::new(EsVersion::Es3);
+    let s = scene::builtin::build("courtyard", Some((5_000, 3))).unwrap();
+    let opts = RenderOptions::default();
+    let (reference, _) = gpu.render_with("forward", &s, (64, 36), &opts);
+    let (img, stats) = gpu.render_with("deferred", &s, (64, 36), &opts);
+    let d = manylight::metrics::diff(&reference, &img);
+    assert!(
+        d.max_abs <= 2,
+        "5 000 lights: deferred is {} / 255 from forward",
+        d.max_abs
+    );
+    let drawn = s.lights.iter().filter(|l| l.radius > 0.0).count();
+    assert_eq!(stats.memory.upload_bytes, drawn * 4 * 16);
+}
+
 #[test]
 fn transparent_objects_take_the_forward_fallback() {
     let s = scene::builtin::build("bubbles", Some((128, 2))).unwrap();

@@ -1,0 +1,127 @@
+//! Per-instance vertex attributes streamed each frame (ES 3.0 instanced drawing): a buffer of
+//! instances, each a few `vec4`s read at consecutive attribute locations, refilled batch by
+//! batch. Deferred draws its light proxies this way, one instance a light.
+#![allow(unsafe_code)]
+
+use glam::Vec4;
+use glow::HasContext;
+
+use super::mesh::BoundMesh;
+use super::{Device, GlError};
+
+/// A stream of instances of `attributes` `vec4`s at locations `first..first + attributes`,
+/// at most `capacity` a draw. Its store is allocated once; each batch orphans it (so the
+/// driver need not wait for the previous draw) and writes it anew.
+pub(crate) struct InstanceStream {
+    buffer: glow::Buffer,
+    first: u32,
+    attributes: usize,
+    capacity: usize,
+    destroyed: bool,
+}
+
+impl InstanceStream {
+    /// A stream whose buffer holds `capacity` instances.
+    pub(crate) fn new(
+        dev: &Device,
+        first: u32,
+        attributes: usize,
+        capacity: usize,
+    ) -> Result<InstanceStream, GlError> {
+        let buffer = dev.create_buffer()?;
+        let stream = InstanceStream {
+            buffer,
+            first,
+            attributes,
+            capacity,
+            destroyed: false,
+        };
+        unsafe {
+            dev.gl.bind_buffer(glow::ARRAY_BUFFER, Some(buffer));
+            dev.gl
+                .buffer_data_size(glow::ARRAY_BUFFER, stream.bytes() as i32, glow::STREAM_DRAW);
+        }
+        dev.check("instance buffer")?;
+        Ok(stream)
+    }
+
+    /// Instances a draw takes at most.
+    pub(crate) fn capacity(&self) -> usize {
+        self.capacity
+    }
+
+    /// `vec4`s an instance holds.
+    pub(crate) fn attributes(&self) -> usize {
+        self.attributes
+    }
+
+    /// Bytes of its buffer.
+    pub(crate) fn bytes(&self) -> usize {
+        self.capacity * self.attributes * std::mem::size_of::<Vec4>()
+    }
+
+    /// Points its locations into the buffer, one step an instance (with a mesh's arrays
+    /// bound for the vertices); [`InstanceStream::unbind`] undoes it.
+    pub(crate) fn bind(&self, dev: &Device) {
+        let stride = (self.attributes * std::mem::size_of::<Vec4>()) as i32;
+        unsafe {
+            dev.gl.bind_buffer(glow::ARRAY_BUFFER, Some(self.buffer));
+            for (i, location) in self.locations().enumerate() {
+                dev.gl.enable_vertex_attrib_array(location);
+                let offset = (i * std::mem::size_of::<Vec4>()) as i32;
+                dev.gl
+                    .vertex_attrib_pointer_f32(location, 4, glow::FLOAT, false, stride, offset);
+                dev.gl.vertex_attrib_divisor(location, 1);
+            }
+        }
+    }
+
+    /// Draws `mesh` once per instance of `instances` (`attributes` `vec4`s each, at most
+    /// `capacity` instances), with the stream bound. Returns the bytes uploaded.
+    pub(crate) fn draw(&self, dev: &Device, mesh: &BoundMesh, instances: &[[f32; 4]]) -> usize {
+        let count = instances.len() / self.attributes;
+        debug_assert!(count <= self.capacity && instances.len().is_multiple_of(self.attributes));
+        if count == 0 {
+            return 0;
+        }
+        let bytes: &[u8] = bytemuck::cast_slice(instances);
+        unsafe {
+            dev.gl
+                .buffer_data_size(glow::ARRAY_BUFFER, self.bytes() as i32, glow::STREAM_DRAW);
+            dev.gl
+                .buffer_sub_data_u8_slice(glow::ARRAY_BUFFER, 0, bytes);
+        }
+        mesh.draw_instanced(dev, count as i32);
+        bytes.len()
+    }
+
+    /// Leaves its locations as every other draw expects them: no array, divisor 0.
+    pub(crate) fn unbind(&self, dev: &Device) {
+        for location in self.locations() {
+            unsafe {
+                dev.gl.vertex_attrib_divisor(location, 0);
+                dev.gl.disable_vertex_attrib_array(location);
+            }
+        }
+    }
+
+    fn locations(&self) -> impl Iterator<Item = u32> {
+        self.first..self.first + self.attributes as u32
+    }
+
+    /// Frees the buffer.
+    pub(crate) fn destroy(&mut self, dev: &Device) {
+        if !self.destroyed {
+            dev.delete_buffer(self.buffer);
+            self.destroyed = true;
+        }
+    }
+}
+
+impl Drop for InstanceStream {
+    fn drop(&mut self) {
+        if !self.destroyed && !super::left_objects::left_on_purpose() {
+            log::warn!("InstanceStream dropped without destroy(): a GL buffer leaked");
+        }
+    }
+}
