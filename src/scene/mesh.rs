@@ -141,11 +141,11 @@ pub struct Mesh {
 }
 
 impl Mesh {
-    /// Builds a mesh and checks it: indices in range, a multiple of three, finite values.
-    /// Missing normals (`normals` empty, or not one per position) are computed as
-    /// area-weighted face normals; given
-    /// ones turn each triangle whose winding faces away from them round (its front face is
-    /// the side its normals point to).
+    /// Builds a mesh and checks it: indices in range, a multiple of three, finite values,
+    /// normals and texture coordinates each empty or one per position. Missing normals
+    /// (`normals` empty) are computed as area-weighted face normals; given ones turn each
+    /// triangle whose winding faces away from them round (its front face is the side its
+    /// normals point to).
     pub fn new(
         positions: Vec<Vec3>,
         normals: Vec<Vec3>,
@@ -186,6 +186,12 @@ impl Mesh {
             ));
         }
         check_uvs(&uvs, "mesh")?;
+        if !normals.is_empty() && normals.len() != n {
+            return Err(SceneError::invalid(
+                "mesh.normals",
+                format!("{} normals for {n} vertices", normals.len()),
+            ));
+        }
         let normals = if normals.len() == n {
             let normals = repair_normals(normals, &positions, &indices);
             if !as_wound {
@@ -724,6 +730,24 @@ mod tests {
         assert!(Mesh::new(vec![Vec3::ZERO], vec![], vec![], vec![0, 0, 1]).is_err());
         let e = Mesh::new(vec![Vec3::NAN; 3], vec![], vec![], vec![0, 1, 2]).unwrap_err();
         assert!(e.to_string().contains("positions[0]"));
+    }
+
+    /// Normals, like texture coordinates, are one per position or none: a count between is
+    /// the caller's error, not normals to compute silently.
+    #[test]
+    fn normals_of_another_count_than_the_positions_are_refused() {
+        let positions = vec![Vec3::ZERO, Vec3::X, Vec3::Y];
+        for normals in [vec![Vec3::Z; 2], vec![Vec3::Z; 4]] {
+            let count = normals.len();
+            let e = Mesh::new(positions.clone(), normals, vec![], vec![0, 1, 2]).unwrap_err();
+            assert!(e.to_string().contains("mesh.normals"), "{e}");
+            assert!(
+                e.to_string().contains(&format!("{count} normals for 3")),
+                "{e}"
+            );
+        }
+        let m = Mesh::new_as_wound(positions, vec![], vec![], vec![0, 1, 2]).unwrap();
+        assert_eq!(m.normals, vec![Vec3::Z; 3]);
     }
 
     /// A mesh edited through its public fields: the tangent builders and `validate` name the
