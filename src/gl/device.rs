@@ -11,6 +11,8 @@ pub struct Device {
     pub(crate) gl: glow::Context,
     caps: Caps,
     live: std::cell::Cell<LiveObjects>,
+    /// Draw calls made since the device was created (`gl::mesh` makes every one of a frame).
+    draw_calls: std::cell::Cell<u64>,
     /// `glRenderbufferStorageMultisampleEXT`, on ES 2.0 with
     /// `GL_EXT_multisampled_render_to_texture` (see [`super::ext_fns`]).
     pub(crate) renderbuffer_storage_multisample_ext:
@@ -152,6 +154,7 @@ impl Device {
             gl,
             caps,
             live: std::cell::Cell::new(LiveObjects::default()),
+            draw_calls: std::cell::Cell::new(0),
             renderbuffer_storage_multisample_ext,
             host,
             vertex_array,
@@ -242,6 +245,16 @@ impl Device {
     /// `n`: handed to another), for `Renderer::adopt_programs` (with `lab`).
     pub(crate) fn count_handed_programs(&self, n: i64) {
         self.count(|l| l.programs += n);
+    }
+
+    /// Counts one draw call.
+    pub(crate) fn count_draw_call(&self) {
+        self.draw_calls.set(self.draw_calls.get() + 1);
+    }
+
+    /// Draw calls made so far (a frame's: the difference across it).
+    pub(crate) fn draw_calls(&self) -> u64 {
+        self.draw_calls.get()
     }
 
     fn count(&self, f: impl FnOnce(&mut LiveObjects)) {

@@ -164,6 +164,7 @@ pub struct BoundMesh {
 impl BoundMesh {
     /// Draws the mesh once more with the bound program.
     pub fn draw(&self, dev: &Device) {
+        dev.count_draw_call();
         unsafe {
             dev.gl
                 .draw_elements(glow::TRIANGLES, self.index_count, glow::UNSIGNED_SHORT, 0);
@@ -173,6 +174,7 @@ impl BoundMesh {
     /// Draws `instances` copies of the mesh with the bound program and instance arrays
     /// (ES 3.0).
     pub fn draw_instanced(&self, dev: &Device, instances: i32) {
+        dev.count_draw_call();
         unsafe {
             dev.gl.draw_elements_instanced(
                 glow::TRIANGLES,

@@ -72,6 +72,22 @@ impl Renderer {
     pub(super) fn render_hosted(
         &mut self,
         scene: &Scene,
+        size: (u32, u32),
+        options: &RenderOptions,
+        origin: [u32; 2],
+        stats: &mut FrameStats,
+        applications: bool,
+    ) -> Result<(), Error> {
+        let draw_calls = self.dev.draw_calls();
+        let drawn = self.render_counted(scene, size, options, origin, stats, applications);
+        stats.draw_calls = self.dev.draw_calls() - draw_calls;
+        drawn
+    }
+
+    /// [`Renderer::render_hosted`] but for its draw calls' count.
+    fn render_counted(
+        &mut self,
+        scene: &Scene,
         (width, height): (u32, u32),
         options: &RenderOptions,
         origin: [u32; 2],

@@ -38,6 +38,10 @@ pub struct FrameStats {
     pub depth_bits: u32,
     /// Triangles drawn.
     pub triangles: usize,
+    /// Draw calls the frame made, in every pass (depth prepass, shading, deferred's lights and
+    /// composite, transparent objects, MSAA's fill and resolve): each costs a GPU's driver
+    /// CPU time, which a software rasterizer's frame time hides.
+    pub draw_calls: u64,
     /// What the scene uses (and so what the shader variants were built with).
     pub scene_features: SceneFeatures,
     /// Frame, GPU and assignment times.
@@ -159,6 +163,7 @@ impl Default for FrameStats {
             samples: 1,
             depth_bits: 24,
             triangles: 0,
+            draw_calls: 0,
             scene_features: SceneFeatures::default(),
             time: TimeStats::default(),
             lights: LightStats::default(),

@@ -40,9 +40,10 @@ fn deferred_matches_forward_within_2_of_255_on_opaque_scenes() {
 }
 
 /// Lights are drawn as instances of their proxy, 4 096 a batch: a scene of more matches
-/// forward, and each light is uploaded once, as its four `vec4`s.
+/// forward, each light is uploaded once, as its four `vec4`s, and the draw calls do not grow
+/// with the lights.
 #[test]
-fn lights_past_one_instance_batch_match_forward_and_upload_once() {
+fn lights_past_one_instance_batch_match_forward_upload_once_and_add_no_draw_calls() {
     let mut gpu = Gpu::new(EsVersion::Es3);
     let s = scene::builtin::build("courtyard", Some((5_000, 3))).unwrap();
     let opts = RenderOptions::default();
@@ -56,6 +57,22 @@ fn lights_past_one_instance_batch_match_forward_and_upload_once() {
     );
     let drawn = s.lights.iter().filter(|l| l.radius > 0.0).count();
     assert_eq!(stats.memory.upload_bytes, drawn * 4 * 16);
+    // Draw calls grow by batches, not by lights: from 64 to 5 000 lights at most one more
+    // batch in each of the three kinds of proxy, and a fourth where one kind passes 4 096
+    // (a draw call a light before). Forward's are its objects', whatever the lights.
+    let few = scene::builtin::build("courtyard", Some((64, 3))).unwrap();
+    let (_, few_stats) = gpu.render_with("deferred", &few, (64, 36), &opts);
+    assert!(few_stats.draw_calls > 2, "{}", few_stats.draw_calls);
+    assert!(
+        stats.draw_calls <= few_stats.draw_calls + 4,
+        "{} draw calls at 5 000 lights, {} at 64",
+        stats.draw_calls,
+        few_stats.draw_calls
+    );
+    let (_, forward_few) = gpu.render_with("forward", &few, (64, 36), &opts);
+    let (_, forward_many) = gpu.render_with("forward", &s, (64, 36), &opts);
+    assert!(forward_few.draw_calls > 0);
+    assert_eq!(forward_few.draw_calls, forward_many.draw_calls);
 }
 
 #[test]
