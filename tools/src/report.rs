@@ -42,6 +42,8 @@ pub struct BenchRow {
     pub assign_ms: f64,
     /// Bytes uploaded per frame.
     pub upload_bytes: usize,
+    /// Draw calls of a frame, every pass's.
+    pub draw_calls: u64,
     /// Light evaluations summed over the covered pixels.
     pub light_evals: u64,
     /// Mean light evaluations per covered pixel.
@@ -406,8 +408,8 @@ pub fn markdown(report: &Report) -> String {
                 continue;
             }
             let _ = writeln!(s, "## {scene}, ES {es}\n");
-            s += "| method | lights | frame ms | assign ms | evals/px | × bound | RMSE | max | f64 max |\n\
-                  |---|---|---|---|---|---|---|---|---|\n";
+            s += "| method | lights | frame ms | assign ms | draws | evals/px | × bound | RMSE | max | f64 max |\n\
+                  |---|---|---|---|---|---|---|---|---|---|\n";
             for r in these {
                 s += &table_row(r);
             }
@@ -488,7 +490,8 @@ pub fn markdown(report: &Report) -> String {
 
 /// What the table columns hold, and what a "—" in one means.
 const COLUMNS: &str = "Columns: *frame ms* and *assign ms* (CPU light assignment) are medians; \
-    *evals/px* is light evaluations per covered pixel and *× bound* its ratio to the lower \
+    *draws* is the frame's draw calls, each of which costs a GPU driver CPU time that a software \
+    rasterizer's frame time hides; *evals/px* is light evaluations per covered pixel and *× bound* its ratio to the lower \
     bound (1 is perfect culling); *RMSE* and *max* are against the reference image and \
     *f64 max* the largest error against the f64 light model at sampled pixels, all in 8-bit \
     steps; *grid px* and *cells* (knob table) are the cell grid the frame used.\n\n\
@@ -537,11 +540,12 @@ fn opt(v: Option<f64>, digits: usize) -> String {
 
 fn table_row(r: &BenchRow) -> String {
     format!(
-        "| {} | {} | {:.1} | {:.2} | {:.1} | {} | {:.3} | {} | {} |\n",
+        "| {} | {} | {:.1} | {:.2} | {} | {:.1} | {} | {:.3} | {} | {} |\n",
         r.method,
         r.lights,
         r.frame_ms,
         r.assign_ms,
+        r.draw_calls,
         r.evals_per_pixel,
         opt(r.evals_ratio, 1),
         r.rmse,
@@ -578,6 +582,7 @@ mod tests {
             gpu_ms: None,
             assign_ms: 0.0,
             upload_bytes: 0,
+            draw_calls: 0,
             light_evals: 0,
             evals_per_pixel: lights as f64 / 4.0 + 1.0,
             max_evals: 0,
@@ -725,6 +730,13 @@ mod tests {
         assert_eq!(workload_lights(&r, "b"), 64);
         r.rows.retain(|r| r.lights == 8);
         assert_eq!(workload_lights(&r, "b"), 8);
+    }
+
+    #[test]
+    fn a_rows_draw_calls_are_in_its_table_row() {
+        let mut r = row("a", "deferred", 64, "default", 2.0, 0.5);
+        r.draw_calls = 9;
+        assert!(table_row(&r).starts_with("| deferred | 64 | 2.0 | 0.00 | 9 | 17.0 |"));
     }
 
     #[test]

@@ -653,6 +653,7 @@ impl Measure<'_> {
             gpu_ms: stats.time.gpu_ms,
             assign_ms: stats.time.assign_ms,
             upload_bytes: stats.memory.upload_bytes,
+            draw_calls: stats.draw_calls,
             light_evals: evals.total(),
             evals_per_pixel: evals.mean(),
             max_evals: evals.max(),
