@@ -45,16 +45,6 @@ impl InstanceStream {
         Ok(stream)
     }
 
-    /// Instances a draw takes at most.
-    pub(crate) fn capacity(&self) -> usize {
-        self.capacity
-    }
-
-    /// `vec4`s an instance holds.
-    pub(crate) fn attributes(&self) -> usize {
-        self.attributes
-    }
-
     /// Bytes of its buffer.
     pub(crate) fn bytes(&self) -> usize {
         self.capacity * self.attributes * std::mem::size_of::<Vec4>()

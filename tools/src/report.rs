@@ -491,8 +491,8 @@ pub fn markdown(report: &Report) -> String {
 /// What the table columns hold, and what a "—" in one means.
 const COLUMNS: &str = "Columns: *frame ms* and *assign ms* (CPU light assignment) are medians; \
     *draws* is the frame's draw calls, each of which costs a GPU driver CPU time that a software \
-    rasterizer's frame time hides; *evals/px* is light evaluations per covered pixel and *× bound* its ratio to the lower \
-    bound (1 is perfect culling); *RMSE* and *max* are against the reference image and \
+    rasterizer's frame time hides; *evals/px* is light evaluations per covered pixel and \
+    *× bound* its ratio to the lower bound (1 is perfect culling); *RMSE* and *max* are against the reference image and \
     *f64 max* the largest error against the f64 light model at sampled pixels, all in 8-bit \
     steps; *grid px* and *cells* (knob table) are the cell grid the frame used.\n\n\
     A \"—\" means the figure does not exist for that row, not that it is zero: in *× bound*, \

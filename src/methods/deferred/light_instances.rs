@@ -20,6 +20,9 @@ const LIGHT_VEC4S: usize = 4;
 /// has.
 const BATCH_LIGHTS: usize = 4096;
 
+/// `vec4`s a full batch holds.
+const BATCH_VEC4S: usize = BATCH_LIGHTS * LIGHT_VEC4S;
+
 /// A light as its proxy's instance draws it: position and radius; radiance (times the
 /// accumulation's `scale`) and spot scale; spot axis and offset; the proxy sphere's radius and
 /// the count channel (0 to 3) it adds 1 to.
@@ -48,7 +51,7 @@ impl LightInstances {
     pub(super) fn new(dev: &Device) -> Result<LightInstances, GlError> {
         Ok(LightInstances {
             stream: InstanceStream::new(dev, LIGHT_LOCATION, LIGHT_VEC4S, BATCH_LIGHTS)?,
-            batch: Vec::with_capacity(BATCH_LIGHTS * LIGHT_VEC4S),
+            batch: Vec::with_capacity(BATCH_VEC4S),
         })
     }
 
@@ -60,13 +63,12 @@ impl LightInstances {
         mesh: &BoundMesh,
         lights: impl Iterator<Item = [Vec4; LIGHT_VEC4S]>,
     ) -> usize {
-        let full = self.stream.capacity() * self.stream.attributes();
         self.stream.bind(dev);
         self.batch.clear();
         let mut uploaded = 0;
         for light in lights {
             self.batch.extend(light.map(|v| v.to_array()));
-            if self.batch.len() == full {
+            if self.batch.len() == BATCH_VEC4S {
                 uploaded += self.stream.draw(dev, mesh, &self.batch);
                 self.batch.clear();
             }
