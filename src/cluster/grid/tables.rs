@@ -67,8 +67,16 @@ impl SliceLookup {
             address.push(slice);
         }
         let far = far.max(f64::MIN_POSITIVE);
-        // Every depth before the second slice's start is in the first slice.
-        let base = bucket(start.get(1).copied().unwrap_or(far).min(far));
+        // Every depth before the second slice's start is in the first slice, and clamps to
+        // the first bucket: so the first bucket is the one of the last depth before that
+        // start, whose first slice is the first (the start's own bucket begins at the start
+        // itself where it is a bucket's first depth, as 1.0 is).
+        let second = start.get(1).copied().unwrap_or(far).min(far);
+        let base = bucket(if second > 0.0 {
+            second.next_down()
+        } else {
+            second
+        });
         let last = bucket(far).max(base);
         start.push(f64::NAN);
         self.buckets.clear();

@@ -12,7 +12,22 @@ fn persp_with(near: f64, far: f64, config: &GridConfig) -> ClusterGrid {
 
 #[test]
 fn depth_ranges_never_miss_a_slice() {
-    for g in [persp(1e-4, 1e5), persp(0.1, 80.0), persp(0.5, 0.6)] {
+    // Cascades of one slice from 0.1 to 100: the second slice starts at exactly 1.0, the
+    // first depth of a bucket of the slice table (found by the `assign` fuzz target: depths
+    // before it were put in the second slice, so a light there missed the first).
+    let one_slice = GridConfig {
+        cascades: 3,
+        max_slices: 1,
+        ..GridConfig::default()
+    };
+    let on_bucket = persp_with(0.1, 100.0, &one_slice);
+    assert_eq!(on_bucket.slice_depth_range(1, 0).0, 1.0);
+    for g in [
+        persp(1e-4, 1e5),
+        persp(0.1, 80.0),
+        persp(0.5, 0.6),
+        on_bucket,
+    ] {
         let mut d = g.near;
         while d < g.far * 2.0 {
             // Around `d`, and on every slice boundary too.
