@@ -1,0 +1,22 @@
+//! An OBJ file, its MTL file and one texture, loaded as `manylight --scene m.obj` loads them.
+//! The input is the three files' bytes, separated by a byte 0xFF (`m.obj`, `m.mtl`, `t.png`:
+//! the seeds name them; the texture's bytes may be in any format the library reads).
+#![no_main]
+
+use libfuzzer_sys::fuzz_target;
+use manylight_fuzz::{load_and_check, split, Folder};
+
+fuzz_target!(|data: &[u8]| {
+    let folder = Folder::get();
+    let parts = split(data, 3);
+    let names = ["m.obj", "m.mtl", "t.png"];
+    for (i, name) in names.iter().enumerate() {
+        match parts.get(i) {
+            Some(bytes) => {
+                folder.write(name, bytes);
+            }
+            None => folder.remove(name),
+        }
+    }
+    load_and_check(&folder.path("m.obj"), true);
+});
