@@ -81,8 +81,18 @@ fn grid(bytes: &mut Bytes) -> (ClusterGrid, f64) {
     };
     let mut config = GridConfig::fixed(2.0 + bytes.byte() as f64 / 4.0);
     config.mode = GridMode::Fixed;
-    config.cascades = 1 + bytes.byte() as u32 % 16;
-    config.slice_depth = [1.0, 0.25, 4.0, 1.0 / 16.0][bytes.byte() as usize % 4];
+    // Low bits: cascades; high bits: where the first cascade starts (on values that begin
+    // the slice table's buckets, and off them).
+    let cascades = bytes.byte();
+    config.cascades = 1 + cascades as u32 % 16;
+    config.first_split =
+        [None, Some(1.0), Some(0.25), Some(near * 1.5 + 0.3)][cascades as usize >> 6];
+    // Low bits: slice depth; the next two: the most slices a cascade has.
+    let slices = bytes.byte() as usize;
+    config.slice_depth = [1.0, 0.25, 4.0, 1.0 / 16.0][slices % 4];
+    if let Some(most) = [None, Some(1), Some(2), Some(255)][(slices >> 2) % 4] {
+        config.max_slices = most;
+    }
     if bytes.byte() % 4 == 1 {
         config.measure.coverage = Coverage::CascadeBox;
     }
@@ -174,8 +184,9 @@ fn cell_of(grid: &ClusterGrid, p: DVec3) -> Option<usize> {
     Some(grid.cell_index(grid.cell_of_fragment(px, py, d)) as usize)
 }
 
-/// Points `light` reaches: its centre, and points 0.9 of its radius from it along each axis
-/// and towards the eye.
+/// Points `light` reaches: its centre, points 0.9 of its radius from it along each axis and
+/// towards the eye, and 0.99 of it along the eight diagonals (near its edge, where a bound
+/// that is a little too tight shows first).
 fn points(light: &GpuLight) -> Vec<DVec3> {
     let c = light.position.as_dvec3();
     let r = light.radius as f64 * 0.9;
@@ -189,6 +200,11 @@ fn points(light: &GpuLight) -> Vec<DVec3> {
         -DVec3::Z,
     ] {
         out.push(c + axis * r);
+    }
+    for diagonal in 0..8 {
+        let sign = |bit: i32| if diagonal & bit == 0 { 1.0 } else { -1.0 };
+        let direction = DVec3::new(sign(1), sign(2), sign(4)) / 3f64.sqrt();
+        out.push(c + direction * light.radius as f64 * 0.99);
     }
     if c.length() > 0.0 {
         out.push(c - c.normalize() * r.min(c.length()));
