@@ -67,10 +67,10 @@ impl SliceLookup {
             address.push(slice);
         }
         let far = far.max(f64::MIN_POSITIVE);
-        // Every depth before the second slice's start is in the first slice, and clamps to
-        // the first bucket: so the first bucket is the one of the last depth before that
-        // start, whose first slice is the first (the start's own bucket begins at the start
-        // itself where it is a bucket's first depth, as 1.0 is).
+        // Depths before the second slice's start (all in the first slice) clamp to the first
+        // bucket, so that bucket must begin in the first slice: it is the bucket of the last
+        // depth before that start. (The start's own bucket begins in the second slice when
+        // the start is a bucket's first depth, as 1.0 is.)
         let second = start.get(1).copied().unwrap_or(far).min(far);
         let base = bucket(if second > 0.0 {
             second.next_down()
