@@ -1,11 +1,11 @@
 //! The light assignment on grids and lights made from the input: any view size, projection,
-//! near and far plane, footprint, cascades and slice depth; lights anywhere, of any radius,
-//! points and spots with any axis and cone, non-finite values among them.
+//! near and far plane, footprint, cascades, slice depth, first split and most slices; lights
+//! anywhere, of any radius, points and spots with any axis and cone, non-finite values among
+//! them.
 //!
 //! Checks: no panic; one thread and a pool of two (bands, or chunks of lights) list the same
 //! lights in every cell; and where the lights and the grid are of a size the checks can
-//! compute exactly, a point a light reaches (its centre, and points inside it towards each
-//! axis and the eye) is in a cell that lists it.
+//! compute exactly, a point a light reaches ([`points`]) is in a cell that lists it.
 #![no_main]
 
 use std::sync::OnceLock;

@@ -19,13 +19,6 @@ fuzz_target!(|data: &[u8]| {
     } else {
         vec![rest]
     };
-    for (i, name) in [model, "b.bin", "t.png"].iter().enumerate() {
-        match parts.get(i) {
-            Some(bytes) => {
-                folder.write(name, bytes);
-            }
-            None => folder.remove(name),
-        }
-    }
+    folder.write_parts(&[model, "b.bin", "t.png"], &parts);
     load_and_check(&folder.path(model), true);
 });

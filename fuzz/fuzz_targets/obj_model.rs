@@ -8,15 +8,6 @@ use manylight_fuzz::{load_and_check, split, Folder};
 
 fuzz_target!(|data: &[u8]| {
     let folder = Folder::get();
-    let parts = split(data, 3);
-    let names = ["m.obj", "m.mtl", "t.png"];
-    for (i, name) in names.iter().enumerate() {
-        match parts.get(i) {
-            Some(bytes) => {
-                folder.write(name, bytes);
-            }
-            None => folder.remove(name),
-        }
-    }
+    folder.write_parts(&["m.obj", "m.mtl", "t.png"], &split(data, 3));
     load_and_check(&folder.path("m.obj"), true);
 });

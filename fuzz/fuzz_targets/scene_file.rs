@@ -7,7 +7,5 @@ use libfuzzer_sys::fuzz_target;
 use manylight_fuzz::{load_and_check, Folder};
 
 fuzz_target!(|data: &[u8]| {
-    let folder = Folder::get();
-    folder.write_models_once();
-    load_and_check(&folder.write("s.json", data), false);
+    load_and_check(&Folder::get().write("s.json", data), false);
 });

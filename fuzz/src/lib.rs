@@ -36,8 +36,8 @@ const SENTINEL_MATERIAL: &str = "outside_sentinel";
 /// (which the library cuts at 1 000 characters).
 const MAX_MESSAGE: usize = 4096;
 
-/// A fuzz process's folder: `root/model/` holds the files a target writes, `root/` the
-/// sentinels, and links inside `model/` lead to them.
+/// A fuzz process's folder: `root/model/` holds the files a target writes and the models the
+/// scene files name, `root/` the sentinels, and links inside `model/` lead to them.
 pub struct Folder {
     model: PathBuf,
     /// The hashes of the sentinel image and material name.
@@ -81,6 +81,11 @@ impl Folder {
                 std::os::unix::fs::symlink(target, at)?;
             }
         }
+        // The models the scene-file seeds name: a square with a material, and a triangle
+        // with a light and a camera, its buffer inline.
+        std::fs::write(model.join("s_model.obj"), SCENE_OBJ)?;
+        std::fs::write(model.join("s_model.mtl"), SCENE_MTL)?;
+        std::fs::write(model.join("s_model.gltf"), SCENE_GLTF)?;
         Ok(Folder {
             model,
             image_hash: hash(&(sentinel.dimensions(), sentinel.as_raw())),
@@ -100,20 +105,19 @@ impl Folder {
         self.model.join(name)
     }
 
-    /// Writes the models the scene-file seeds name, once: `s_model.obj` (a square with a
-    /// material) and `s_model.gltf` (a triangle with a light and a camera, its buffer inline).
-    pub fn write_models_once(&self) {
-        static WRITTEN: OnceLock<()> = OnceLock::new();
-        WRITTEN.get_or_init(|| {
-            self.write("s_model.obj", SCENE_OBJ.as_bytes());
-            self.write("s_model.mtl", SCENE_MTL.as_bytes());
-            self.write("s_model.gltf", SCENE_GLTF.as_bytes());
-        });
-    }
-
-    /// Removes `name` from the model's folder, if there.
-    pub fn remove(&self, name: &str) {
-        let _ = std::fs::remove_file(self.model.join(name));
+    /// Writes each of `parts` as the file `names` gives it in the model's folder, and removes
+    /// the named files that get no part (an input that ends early has no texture, say).
+    pub fn write_parts(&self, names: &[&str], parts: &[&[u8]]) {
+        for (i, name) in names.iter().enumerate() {
+            match parts.get(i) {
+                Some(bytes) => {
+                    self.write(name, bytes);
+                }
+                None => {
+                    let _ = std::fs::remove_file(self.model.join(name));
+                }
+            }
+        }
     }
 }
 
