@@ -13,8 +13,8 @@ fn persp_with(near: f64, far: f64, config: &GridConfig) -> ClusterGrid {
 #[test]
 fn depth_ranges_never_miss_a_slice() {
     // Cascades of one slice from 0.1 to 100: the second slice starts at exactly 1.0, the
-    // first depth of a bucket of the slice table (found by the `assign` fuzz target: depths
-    // before it were put in the second slice, so a light there missed the first).
+    // first depth of one of the slice table's buckets, where depths before it once fell in
+    // the second slice.
     let one_slice = GridConfig {
         cascades: 3,
         max_slices: 1,
