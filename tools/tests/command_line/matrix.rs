@@ -7,6 +7,10 @@ use std::process::Command;
 
 #[test]
 fn matrix_covers_es2_es2_without_float_and_es3_and_every_supported_cell_matches_forward() {
+    // Its matrix renders on the system's GL whatever this run's implementation is (below).
+    if common::picks_its_own_implementations("the system's matrix") {
+        return;
+    }
     let dir = tempfile::tempdir().unwrap();
     let json = dir.path().join("m.json");
     let out = Command::new(env!("CARGO_BIN_EXE_manylight"))

@@ -34,6 +34,9 @@ fn fails_naming(args: &[&str], cwd: &Path, file: &str) -> String {
 
 #[test]
 fn every_render_output_onto_a_full_disk_fails_naming_the_file() {
+    if common::checks_the_command_line_alone("outputs onto a full disk") {
+        return;
+    }
     let dir = tempfile::tempdir().unwrap();
     let cwd = dir.path();
     std::os::unix::fs::symlink("/dev/full", cwd.join("full.gif")).unwrap();
@@ -62,6 +65,9 @@ fn every_render_output_onto_a_full_disk_fails_naming_the_file() {
 
 #[test]
 fn every_bench_and_matrix_output_onto_a_full_disk_fails_naming_the_file() {
+    if common::checks_the_command_line_alone("bench and matrix outputs onto a full disk") {
+        return;
+    }
     let dir = tempfile::tempdir().unwrap();
     let cwd = dir.path();
     let bench = [
@@ -206,6 +212,9 @@ fn with_file_size_limit(args: &[&str], cwd: &Path, kib: u32) -> std::process::Ou
 
 #[test]
 fn an_output_failing_half_way_leaves_the_old_file_whole_and_no_partial_one() {
+    if common::checks_the_command_line_alone("an output failing half way") {
+        return;
+    }
     let dir = tempfile::tempdir().unwrap();
     let cwd = dir.path();
     std::fs::write(cwd.join("a.png"), "the old picture").unwrap();
@@ -236,6 +245,9 @@ fn an_output_failing_half_way_leaves_the_old_file_whole_and_no_partial_one() {
 
 #[test]
 fn two_options_naming_one_file_are_a_usage_error_naming_both() {
+    if common::checks_the_command_line_alone("two options naming one file") {
+        return;
+    }
     let dir = tempfile::tempdir().unwrap();
     let cwd = dir.path();
     std::fs::create_dir(cwd.join("sub")).unwrap();
@@ -311,6 +323,9 @@ fn two_options_naming_one_file_are_a_usage_error_naming_both() {
 
 #[test]
 fn signed_options_take_a_negative_number_as_a_separate_word() {
+    if common::checks_the_command_line_alone("negative numbers as option values") {
+        return;
+    }
     let dir = tempfile::tempdir().unwrap();
     let cwd = dir.path();
     // The built-in scene's lights move: a picture at t = -1.5 s differs from one at 0.
@@ -495,6 +510,9 @@ fn send(signal: &str, child: &std::process::Child) {
 /// stays ignored.
 #[test]
 fn a_signal_half_way_through_a_recording_leaves_no_temporary_file() {
+    if common::checks_the_command_line_alone("a recording stopped by a signal") {
+        return;
+    }
     use std::os::unix::process::ExitStatusExt;
     let dir = tempfile::tempdir().unwrap();
     for (signal, number) in [

@@ -301,6 +301,18 @@ pub fn independent_of_the_implementation(what: &str) -> bool {
     })
 }
 
+/// For a test of what the command line does with its arguments and output files, whose renders
+/// only lead up to that (a tiny frame, then a write that fails or a file checked): true, after
+/// saying so on stderr, when this run renders with another GLES implementation
+/// (`MANYLIGHT_GLES_LIB`). Its verdict is the same on every implementation, so it runs once, in
+/// the suite's run on the system's GL, and `MANYLIGHT_REQUIRE_ALL_TESTS` does not turn this
+/// into a failure. Not for standard output (a driver may print there) or what a render shows.
+pub fn checks_the_command_line_alone(what: &str) -> bool {
+    not_applicable_on_another_implementation(|dir| {
+        format!("{what} checks the command line's files and arguments, whatever renders; it runs without MANYLIGHT_GLES_LIB, not again with {dir}")
+    })
+}
+
 /// True, after printing `NOT APPLICABLE:` and `why` (given the implementation's folder) on
 /// stderr, when this run renders with another GLES implementation (`MANYLIGHT_GLES_LIB`).
 fn not_applicable_on_another_implementation(why: impl FnOnce(&str) -> String) -> bool {
