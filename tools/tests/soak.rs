@@ -130,14 +130,11 @@ fn serial() -> std::sync::MutexGuard<'static, ()> {
     SERIAL.lock().unwrap_or_else(|e| e.into_inner())
 }
 
-/// Moves every light in place along its own small orbit (nothing is allocated).
-/// The built-in scene `name` with `lights` lights, each object's mesh replaced by its bounding
-/// box: the same objects, materials, bounds, lights and camera, so the same draws, sorting and
-/// grid, with 12 triangles an object. What a frame allocates does not depend on the triangles,
-/// and the courtyard's 6 000 (the bubbles' 13 000) through every pass were most of a software
-/// GPU's time here.
-fn boxed_scene(name: &str, lights: usize) -> Scene {
-    let mut scene = scene::builtin::build(name, Some((lights, 5))).unwrap();
+/// `scene` with each object's mesh replaced by its bounding box: the same objects, materials,
+/// bounds, lights and camera, so the same draws, sorting and grid, with 12 triangles an object.
+/// What a frame allocates does not depend on the triangles, and the courtyard's 6 000 (the
+/// bubbles' 13 000) through every pass were most of a software GPU's time here.
+fn with_boxes(mut scene: Scene) -> Scene {
     for object in &mut scene.objects {
         let bounds = object.mesh.bounds().expect("a built-in mesh has vertices");
         let mut boxed = MeshBuilder::new();
@@ -147,6 +144,7 @@ fn boxed_scene(name: &str, lights: usize) -> Scene {
     scene
 }
 
+/// Moves every light in place along its own small orbit (nothing is allocated).
 fn move_lights(scene: &mut Scene, start: &[DVec3], frame: usize) {
     let t = frame as f64 / 30.0;
     for (i, (light, origin)) in scene.lights.iter_mut().zip(start).enumerate() {
@@ -166,7 +164,7 @@ fn move_camera(scene: &mut Scene, eye: DVec3, frame: usize) {
 fn live_heap_and_gl_objects_stay_flat_over_frames_of_moving_lights() {
     let _serial = serial();
     let mut gpu = Gpu::new(EsVersion::Es3);
-    let mut scene = boxed_scene("courtyard", 64);
+    let mut scene = with_boxes(scene::builtin::build("courtyard", Some((64, 5))).unwrap());
     let start: Vec<DVec3> = scene.lights.iter().map(|l| l.position).collect();
     let options = RenderOptions::default();
     let (warm_up, measured) = (40, 120);
@@ -383,11 +381,8 @@ fn allocations_per_frame(
         let mut target = OffscreenTarget::new(&app, width, height).expect("application target");
         // The automatic grid's case keeps the real meshes: its choices follow the frames' measured
         // time, and its light count and size were chosen with those (see `common_cases`).
-        let mut scene = if auto_grid {
-            scene::builtin::build(name, Some((lights, 5))).unwrap()
-        } else {
-            boxed_scene(name, lights)
-        };
+        let built = scene::builtin::build(name, Some((lights, 5))).unwrap();
+        let mut scene = if auto_grid { built } else { with_boxes(built) };
         let start: Vec<DVec3> = scene.lights.iter().map(|l| l.position).collect();
         let eye = scene.camera.position;
         let options = RenderOptions {
