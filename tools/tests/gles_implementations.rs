@@ -5,7 +5,11 @@
 //! process), ANGLE under `xvfb-run` (it needs an X display). Without the variable at build
 //! time these tests are listed as ignored with the command that fetches the libraries. In a
 //! run of the suite on another implementation (`MANYLIGHT_GLES_LIB` set) they do nothing:
-//! their children would do the same work as in the run on the system's GL.
+//! their children would do the same work as in the run on the system's GL; there one test
+//! checks instead that the run renders with the implementation its folder holds. Where the
+//! whole suite runs on each implementation as well (`.ci/run` says so with
+//! `MANYLIGHT_SUITE_ON_EACH_GLES`), the comparisons of every method with forward leave it to
+//! those runs.
 #![cfg_attr(not(manylight_gles), allow(dead_code, unused_imports))]
 
 use std::path::PathBuf;
@@ -33,6 +37,20 @@ fn gles_dir() -> PathBuf {
 /// (see the top).
 fn in_another_implementations_run() -> bool {
     common::picks_its_own_implementations("tools/tests/gles_implementations.rs")
+}
+
+/// Whether the whole suite runs on each implementation in this job's company (`.ci/run`), where
+/// [`methods_equal_forward`]'s few scenes repeat what those runs check (every method against
+/// forward on every scene the suite draws): true after saying so on stderr.
+fn the_suite_runs_on_each_implementation(what: &str) -> bool {
+    let set = std::env::var_os("MANYLIGHT_SUITE_ON_EACH_GLES").is_some_and(|v| !v.is_empty());
+    if set {
+        eprintln!(
+            "NOT APPLICABLE: {what}: MANYLIGHT_SUITE_ON_EACH_GLES says the whole suite runs on \
+             each implementation of MANYLIGHT_GLES_DIR, which holds every method to forward there"
+        );
+    }
+    set
 }
 
 /// One matrix cell on implementation `name` (a folder of `MANYLIGHT_GLES_DIR`).
@@ -112,7 +130,7 @@ fn methods_equal_forward(name: &str, family: &str) {
     ignore = "needs SwiftShader and ANGLE: scripts/fetch-gles, then set MANYLIGHT_GLES_DIR"
 )]
 fn every_method_equals_forward_on_swiftshader() {
-    if in_another_implementations_run() {
+    if in_another_implementations_run() || the_suite_runs_on_each_implementation("SwiftShader") {
         return;
     }
     methods_equal_forward("swiftshader", "SwiftShader");
@@ -124,7 +142,7 @@ fn every_method_equals_forward_on_swiftshader() {
     ignore = "needs SwiftShader and ANGLE: scripts/fetch-gles, then set MANYLIGHT_GLES_DIR"
 )]
 fn every_method_equals_forward_on_angle() {
-    if in_another_implementations_run() {
+    if in_another_implementations_run() || the_suite_runs_on_each_implementation("ANGLE") {
         return;
     }
     methods_equal_forward("angle", "ANGLE");
@@ -184,6 +202,10 @@ fn matrix_adds_a_row_group_per_implementation() {
             "64x36",
             "--lights",
             "64",
+            // Its pictures do not matter here, and SwiftShader compiles the plane's programs
+            // in a third of the courtyard's time.
+            "--scene",
+            "plane",
             "--gles-lib",
             "system",
         ])
@@ -264,6 +286,43 @@ fn angle_without_a_display_says_how_to_run_it() {
         assert!(
             stderr.contains("needs a display server") && stderr.contains("xvfb-run -a"),
             "{stderr}"
+        );
+    }
+}
+
+/// In the suite's run on another implementation: what renders is what the folder holds
+/// (`scripts/fetch-gles` names them `swiftshader` and `angle`), not the system's GL or the
+/// other one, so that run tests what it says. A folder of another name is not checked.
+#[test]
+#[cfg_attr(
+    not(manylight_gles),
+    ignore = "needs SwiftShader and ANGLE: scripts/fetch-gles, then set MANYLIGHT_GLES_DIR"
+)]
+fn a_run_on_another_implementation_renders_with_the_one_its_folder_holds() {
+    let Some(folder) = manylight::gl::gles_lib::chosen_folder() else {
+        eprintln!("NOT APPLICABLE: this run renders with the system's GL (no MANYLIGHT_GLES_LIB)");
+        return;
+    };
+    let expected = match folder.file_name().and_then(|n| n.to_str()) {
+        Some("swiftshader") => "SwiftShader",
+        Some("angle") => "ANGLE",
+        _ => {
+            eprintln!(
+                "NOT CHECKED: {} is not a folder scripts/fetch-gles names",
+                folder.display()
+            );
+            return;
+        }
+    };
+    for es in [manylight::EsVersion::Es2, manylight::EsVersion::Es3] {
+        let mut gpu = common::Gpu::new(es);
+        let caps = gpu.r().caps();
+        assert_eq!(
+            caps.implementation(),
+            expected,
+            "{es} from {}: GL_RENDERER {}",
+            folder.display(),
+            caps.renderer
         );
     }
 }
