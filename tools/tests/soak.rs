@@ -335,11 +335,12 @@ fn common_cases() -> Vec<Case> {
         },
         // Enough lights for the assignment to run on all cores on any host: one entry into
         // rayon's pool a frame (see RAYON_INJECTOR_BLOCK). The count decides that, not the
-        // size.
+        // size, and a software GPU's fragments loop over thousands of lights: 4×2 pixels.
         Case {
             lights: 5000,
             wait_for_gpu: false,
             methods: &["clustered"],
+            size: (4, 2),
             ..CASE
         },
     ]
