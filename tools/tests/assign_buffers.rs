@@ -1,6 +1,7 @@
 //! An assigner's buffers stop growing after a warm-up on any number of workers: frames of
 //! moving lights reuse every buffer however the work is split (bands of slices, chunks of
-//! lights) and however the split moves from frame to frame. The soak test checks the same
+//! lights), however the split moves from frame to frame and whichever chunks' lights are in
+//! view. The soak test checks the same
 //! rule for whole frames, but the 2-core CI host's renderer keeps small scenes on one thread;
 //! here every assignment runs on a pool of 2, 4 or 8 workers (as many of those as the host
 //! has cores for).
@@ -14,7 +15,7 @@ use manylight::cluster::view_light::GpuLight;
 use manylight_tools::workload::AssignWorkload;
 
 /// The system allocator, counting the calls that allocate while [`COUNTING`] is set (on every
-/// thread: this binary runs one test, and its pool's workers are the assignment's).
+/// thread: one test counts at a time ([`serial`]), and its pool's workers are the assignment's).
 struct Counting;
 
 static COUNTING: AtomicBool = AtomicBool::new(false);
@@ -61,6 +62,18 @@ unsafe impl GlobalAlloc for Counting {
 
 #[global_allocator]
 static ALLOCATOR: Counting = Counting;
+
+/// Held by each test for its whole run: the counter counts every thread's calls, so one test
+/// counts at a time.
+fn serial() -> std::sync::MutexGuard<'static, ()> {
+    static SERIAL: std::sync::Mutex<()> = std::sync::Mutex::new(());
+    let guard = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
+    TRACE.store(
+        std::env::var_os("MANYLIGHT_ALLOC_TRACE").is_some(),
+        Ordering::Relaxed,
+    );
+    guard
+}
 
 /// Frames before counting (as the soak test's warm-up), and frames counted.
 const WARM_UP: usize = 40;
@@ -110,6 +123,7 @@ fn allocations(workload: &AssignWorkload, pool: &rayon::ThreadPool) -> usize {
 
 #[test]
 fn moving_lights_on_two_to_eight_workers_allocate_nothing_after_a_warm_up() {
+    let _serial = serial();
     let fixed = |px: f64| move |_: f64, _: f64| GridConfig::fixed(px);
     let workloads = [
         // More cells than lights: bands of slices.
@@ -147,10 +161,6 @@ fn moving_lights_on_two_to_eight_workers_allocate_nothing_after_a_warm_up() {
         })
         .collect();
     let mut failures = Vec::new();
-    TRACE.store(
-        std::env::var_os("MANYLIGHT_ALLOC_TRACE").is_some(),
-        Ordering::Relaxed,
-    );
     for (name, workload) in &workloads {
         for pool in &pools {
             let threads = pool.current_num_threads();
@@ -162,4 +172,59 @@ fn moving_lights_on_two_to_eight_workers_allocate_nothing_after_a_warm_up() {
         }
     }
     assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+/// Lights that take turns in view: the first half by index during the warm-up, the second
+/// half after it, each half's away from the camera behind it. The whole list stays at its
+/// warm-up size, but the chunks that hold the second half reach their own peaks only after the
+/// warm-up; what each chunk keeps room for must follow the whole, not its own history.
+#[test]
+fn chunks_whose_lights_come_into_view_after_a_warm_up_allocate_nothing() {
+    let _serial = serial();
+    let workload = AssignWorkload::view_with(512, 3, (48, 27), |_, _| GridConfig::fixed(32.0));
+    let limits = AssignLimits {
+        cell_cap: u32::MAX,
+        parallel_threshold: 0,
+        ..AssignLimits::default()
+    };
+    let behind = |light: &GpuLight| GpuLight {
+        position: glam::Vec3::new(light.position.x, light.position.y, 1.0e3),
+        ..*light
+    };
+    let half = workload.lights.len() / 2;
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(2)
+        .build()
+        .expect("a thread pool");
+    pool.broadcast(|_| ());
+    // Both sets made before counting: index 0 for the warm-up, 1 after it.
+    let sets = [false, true].map(|later| {
+        (workload.lights.iter().enumerate())
+            .map(|(i, l)| if (i < half) == later { behind(l) } else { *l })
+            .collect::<Vec<GpuLight>>()
+    });
+    let (mut before, mut listed) = (0, [0usize; 2]);
+    pool.install(|| {
+        let mut assigner = Assigner::new();
+        for frame in 0..WARM_UP + MEASURED {
+            let later = frame >= WARM_UP;
+            let lights = &sets[usize::from(later)];
+            if frame == WARM_UP {
+                before = CALLS.load(Ordering::Relaxed);
+                COUNTING.store(true, Ordering::Relaxed);
+            }
+            let a = assigner.assign(&workload.grid, lights, workload.far, &limits);
+            assert!(a.stats.threads > 1, "frame {frame} ran on one thread");
+            listed[usize::from(later)] = a.indices.len();
+        }
+        COUNTING.store(false, Ordering::Relaxed);
+    });
+    let n = CALLS.load(Ordering::Relaxed) - before;
+    // The test means something: both halves list lights, and the whole list after the
+    // warm-up stays within the room it kept (a quarter more than its peak).
+    assert!(
+        listed.iter().all(|&l| l > 100) && listed[1] <= listed[0] + listed[0] / 4,
+        "{listed:?}"
+    );
+    assert_eq!(n, 0, "{n} allocations after the warm-up (lists {listed:?})");
 }

@@ -46,13 +46,15 @@ impl Chunks {
         // Fewer chunks than threads when lights are few (49 lights in chunks of 7 make 7, not
         // 8): a chunk past the last would keep an earlier frame's runs.
         let chunks = lights.len().div_ceil(chunk_len);
-        // Each chunk keeps room for its share (`share_of`) of the last assignment's runs and
-        // visible lights: which chunk's lights are in view changes with the camera, and a
-        // chunk would otherwise grow at each new peak of its own.
+        // Each chunk keeps room for its share (`share_of`) of the last assignment's runs,
+        // visible lights and entries: which chunk's lights are in view changes with the camera
+        // and the lights, and a chunk would otherwise grow at each new peak of its own.
         let last_runs: usize = self.chunks.iter().map(|k| k.runs.len()).sum();
         let last_visible: usize = self.chunks.iter().map(|k| k.visible.len()).sum();
+        let last_sorted: usize = self.chunks.iter().map(|k| k.sorted.len()).sum();
         let share = |total: usize| share_of(total, chunks);
         let shares = (share(last_runs), share(last_visible));
+        let sorted_share = share(last_sorted);
         self.chunks.resize_with(chunks, Chunk::default);
         self.chunks.truncate(chunks);
         self.chunks
@@ -97,7 +99,9 @@ impl Chunks {
         self.chunks
             .par_iter_mut()
             .zip(first_ids.par_iter())
-            .for_each(|(chunk, &first_id)| chunk.sort_locally(first_id, cells, visible));
+            .for_each(|(chunk, &first_id)| {
+                chunk.sort_locally(first_id, cells, visible, sorted_share);
+            });
         let (chunks, blocks) = (&self.chunks, &mut self.blocks);
         match out.indices.prepare(total as usize, out.visible.len()) {
             EntriesMut::Narrow(list) => merge(chunks, &out.offsets, list, threads, blocks),
@@ -242,15 +246,16 @@ impl Chunk {
     }
 
     /// Phase 3 of one of several chunks: scatters into the chunk's own list, at the width of
-    /// a list of `visible` lights, with one spare entry at its end (see [`Chunk::scatter`]).
-    fn sort_locally(&mut self, first_id: u32, cells: usize, visible: usize) {
+    /// a list of `visible` lights, with one spare entry at its end (see [`Chunk::scatter`]),
+    /// keeping room for `share` entries (its share of the last assignment's).
+    fn sort_locally(&mut self, first_id: u32, cells: usize, visible: usize, share: usize) {
         let mut sorted = std::mem::take(&mut self.sorted);
         let len = self.offsets[cells];
         room_for(&mut self.cursor, cells + 1);
         self.cursor.clear();
         self.cursor.extend_from_slice(&self.offsets[..cells]);
         self.cursor.push(len);
-        match sorted.prepare(len as usize + 1, visible) {
+        match sorted.prepare_with_room(len as usize + 1, share, visible) {
             EntriesMut::Narrow(list) => self.scatter(first_id, list),
             EntriesMut::Wide(list) => self.scatter(first_id, list),
         }

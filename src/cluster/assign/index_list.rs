@@ -80,15 +80,27 @@ impl IndexList {
     /// written: every entry must then be written (growth is zero-filled, the rest keeps an
     /// earlier frame's entries).
     pub(super) fn prepare(&mut self, len: usize, visible: usize) -> EntriesMut<'_> {
+        self.prepare_with_room(len, 0, visible)
+    }
+
+    /// [`prepare`](Self::prepare), keeping room for at least `room` entries: for a part of a
+    /// list whose share of the whole moves (a chunk's), so that it stops growing at the whole's
+    /// peak rather than at each peak of its own.
+    pub(super) fn prepare_with_room(
+        &mut self,
+        len: usize,
+        room: usize,
+        visible: usize,
+    ) -> EntriesMut<'_> {
         self.is_wide = visible > NARROW_LIGHTS;
         if self.is_wide {
             self.narrow.clear();
-            room_for(&mut self.wide, len);
+            room_for(&mut self.wide, len.max(room));
             self.wide.resize(len, 0);
             EntriesMut::Wide(&mut self.wide)
         } else {
             self.wide.clear();
-            room_for(&mut self.narrow, len);
+            room_for(&mut self.narrow, len.max(room));
             self.narrow.resize(len, 0);
             EntriesMut::Narrow(&mut self.narrow)
         }
