@@ -75,7 +75,7 @@ fn auto_renders_with_deferred_or_forward_when_more_lights_are_visible_than_clust
         })
         .collect();
     // Small: forward and deferred over 66 536 lights are a software GPU's slow part.
-    let (w, h) = (16, 9);
+    let (w, h) = (8, 4);
     let mut gpu = Gpu::new(EsVersion::Es3);
     let mut render = |method: &str, options: &RenderOptions| {
         gpu.r().set_method_named(method).unwrap();
