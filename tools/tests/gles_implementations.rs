@@ -39,9 +39,10 @@ fn in_another_implementations_run() -> bool {
     common::picks_its_own_implementations("tools/tests/gles_implementations.rs")
 }
 
-/// Whether the whole suite runs on each implementation in this job's company (`.ci/run`), where
-/// [`methods_equal_forward`]'s few scenes repeat what those runs check (every method against
-/// forward on every scene the suite draws): true after saying so on stderr.
+/// Whether the whole suite also runs on each implementation, as `.ci/run` says with
+/// `MANYLIGHT_SUITE_ON_EACH_GLES`: those runs check what [`methods_equal_forward`]'s few scenes
+/// would (every method against forward, on every scene the suite draws). True after saying so
+/// on stderr.
 fn the_suite_runs_on_each_implementation(what: &str) -> bool {
     let set = std::env::var_os("MANYLIGHT_SUITE_ON_EACH_GLES").is_some_and(|v| !v.is_empty());
     if set {
