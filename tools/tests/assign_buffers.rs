@@ -93,22 +93,23 @@ fn move_lights(lights: &mut [GpuLight], start: &[GpuLight], frame: usize) {
     }
 }
 
-/// Allocations in the counted frames of moving lights assigned by one assigner on `pool`,
-/// every assignment on the pool.
-fn allocations(workload: &AssignWorkload, pool: &rayon::ThreadPool) -> usize {
-    let limits = AssignLimits {
-        cell_cap: u32::MAX,
-        parallel_threshold: 0,
-        ..AssignLimits::default()
-    };
+/// Allocations in the counted frames of `workload`'s lights, posed for each frame by `pose`
+/// (in place: nothing allocated), assigned by one assigner on `pool`, every assignment on the
+/// pool.
+fn allocations(
+    workload: &AssignWorkload,
+    pool: &rayon::ThreadPool,
+    pose: impl Fn(&mut [GpuLight], usize) + Sync,
+) -> usize {
     // Inside the pool: an entry from outside would queue a job in rayon's global queue,
     // which allocates a block now and then (the soak test tells those apart).
     pool.install(|| {
         let mut assigner = Assigner::new();
+        let limits = limits();
         let mut lights = workload.lights.clone();
         let mut before = 0;
         for frame in 0..WARM_UP + MEASURED {
-            move_lights(&mut lights, &workload.lights, frame);
+            pose(&mut lights, frame);
             if frame == WARM_UP {
                 before = CALLS.load(Ordering::Relaxed);
                 COUNTING.store(true, Ordering::Relaxed);
@@ -119,6 +120,26 @@ fn allocations(workload: &AssignWorkload, pool: &rayon::ThreadPool) -> usize {
         COUNTING.store(false, Ordering::Relaxed);
         CALLS.load(Ordering::Relaxed) - before
     })
+}
+
+/// Every light listed (no cap), and every assignment on the pool.
+fn limits() -> AssignLimits {
+    AssignLimits {
+        cell_cap: u32::MAX,
+        parallel_threshold: 0,
+        ..AssignLimits::default()
+    }
+}
+
+/// A pool of `threads` workers, every worker started (a worker starting allocates on its own
+/// thread, whenever the system runs it): made before any counting and kept to the end.
+fn pool_of(threads: usize) -> rayon::ThreadPool {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .expect("a thread pool");
+    pool.broadcast(|_| ());
+    pool
 }
 
 #[test]
@@ -150,21 +171,15 @@ fn moving_lights_on_two_to_eight_workers_allocate_nothing_after_a_warm_up() {
     let pools: Vec<rayon::ThreadPool> = [2, 4, 8]
         .into_iter()
         .filter(|&threads| threads <= cores.max(2))
-        .map(|threads| {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(threads)
-                .build()
-                .expect("a thread pool");
-            // Every worker started before any counting.
-            pool.broadcast(|_| ());
-            pool
-        })
+        .map(pool_of)
         .collect();
     let mut failures = Vec::new();
     for (name, workload) in &workloads {
         for pool in &pools {
             let threads = pool.current_num_threads();
-            let n = allocations(workload, pool);
+            let n = allocations(workload, pool, |lights, frame| {
+                move_lights(lights, &workload.lights, frame);
+            });
             eprintln!("{name}, {threads} workers: {n} allocations in {MEASURED} frames");
             if n > 0 {
                 failures.push(format!("{name}, {threads} workers: {n} allocations"));
@@ -182,46 +197,28 @@ fn moving_lights_on_two_to_eight_workers_allocate_nothing_after_a_warm_up() {
 fn chunks_whose_lights_come_into_view_after_a_warm_up_allocate_nothing() {
     let _serial = serial();
     let workload = AssignWorkload::view_with(512, 3, (48, 27), |_, _| GridConfig::fixed(32.0));
-    let limits = AssignLimits {
-        cell_cap: u32::MAX,
-        parallel_threshold: 0,
-        ..AssignLimits::default()
-    };
     let behind = |light: &GpuLight| GpuLight {
         position: glam::Vec3::new(light.position.x, light.position.y, 1.0e3),
         ..*light
     };
     let half = workload.lights.len() / 2;
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(2)
-        .build()
-        .expect("a thread pool");
-    pool.broadcast(|_| ());
     // Both sets made before counting: index 0 for the warm-up, 1 after it.
     let sets = [false, true].map(|later| {
         (workload.lights.iter().enumerate())
             .map(|(i, l)| if (i < half) == later { behind(l) } else { *l })
             .collect::<Vec<GpuLight>>()
     });
-    let (mut before, mut listed) = (0, [0usize; 2]);
-    pool.install(|| {
-        let mut assigner = Assigner::new();
-        for frame in 0..WARM_UP + MEASURED {
-            let later = frame >= WARM_UP;
-            let lights = &sets[usize::from(later)];
-            if frame == WARM_UP {
-                before = CALLS.load(Ordering::Relaxed);
-                COUNTING.store(true, Ordering::Relaxed);
-            }
-            let a = assigner.assign(&workload.grid, lights, workload.far, &limits);
-            assert!(a.stats.threads > 1, "frame {frame} ran on one thread");
-            listed[usize::from(later)] = a.indices.len();
-        }
-        COUNTING.store(false, Ordering::Relaxed);
+    let n = allocations(&workload, &pool_of(2), |lights, frame| {
+        lights.copy_from_slice(&sets[usize::from(frame >= WARM_UP)]);
     });
-    let n = CALLS.load(Ordering::Relaxed) - before;
     // The test means something: both halves list lights, and the whole list after the
     // warm-up stays within the room it kept (a quarter more than its peak).
+    let listed = sets.map(|lights| {
+        let mut assigner = Assigner::new();
+        (assigner.assign(&workload.grid, &lights, workload.far, &limits()))
+            .indices
+            .len()
+    });
     assert!(
         listed.iter().all(|&l| l > 100) && listed[1] <= listed[0] + listed[0] / 4,
         "{listed:?}"
