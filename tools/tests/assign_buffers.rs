@@ -7,6 +7,7 @@
 //! has cores for).
 
 use std::alloc::{GlobalAlloc, Layout, System};
+use std::cell::Cell;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
 use manylight::cluster::assign::{AssignLimits, Assigner};
@@ -14,22 +15,31 @@ use manylight::cluster::grid::GridConfig;
 use manylight::cluster::view_light::GpuLight;
 use manylight_tools::workload::AssignWorkload;
 
-/// The system allocator, counting the calls that allocate while [`COUNTING`] is set (on every
-/// thread: one test counts at a time ([`serial`]), and its pool's workers are the assignment's).
+/// The system allocator, counting the calls that allocate on the workers of the pool that
+/// [`COUNTED_POOL`] names: those run every assignment. The test harness's threads (printing
+/// one test's result while the next counts) and an earlier pool's workers (ending whenever the
+/// system runs them) are not counted.
 struct Counting;
 
-static COUNTING: AtomicBool = AtomicBool::new(false);
+/// The number [`pool_of`] gave the pool whose workers are counted; 0 while none is.
+static COUNTED_POOL: AtomicUsize = AtomicUsize::new(0);
 static CALLS: AtomicUsize = AtomicUsize::new(0);
 
 thread_local! {
     /// This thread is printing a backtrace: what that allocates is not counted.
-    static IN_TRACE: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+    static IN_TRACE: Cell<bool> = const { Cell::new(false) };
+    /// The number of the pool this thread works in ([`pool_of`]); 0 outside any.
+    static POOL: Cell<usize> = const { Cell::new(0) };
 }
 /// With `MANYLIGHT_ALLOC_TRACE` set (any value), every counted call prints its backtrace.
 static TRACE: AtomicBool = AtomicBool::new(false);
 
 fn count(bytes: usize) {
-    if COUNTING.load(Ordering::Relaxed) && !IN_TRACE.try_with(|t| t.get()).unwrap_or(true) {
+    let counted = COUNTED_POOL.load(Ordering::Relaxed);
+    if counted != 0
+        && POOL.try_with(Cell::get) == Ok(counted)
+        && !IN_TRACE.try_with(Cell::get).unwrap_or(true)
+    {
         CALLS.fetch_add(1, Ordering::Relaxed);
         if TRACE.load(Ordering::Relaxed) {
             IN_TRACE.with(|t| t.set(true));
@@ -63,8 +73,7 @@ unsafe impl GlobalAlloc for Counting {
 #[global_allocator]
 static ALLOCATOR: Counting = Counting;
 
-/// Held by each test for its whole run: the counter counts every thread's calls, so one test
-/// counts at a time.
+/// Held by each test for its whole run: the counter is global, so one test counts at a time.
 fn serial() -> std::sync::MutexGuard<'static, ()> {
     static SERIAL: std::sync::Mutex<()> = std::sync::Mutex::new(());
     let guard = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
@@ -112,12 +121,12 @@ fn allocations(
             pose(&mut lights, frame);
             if frame == WARM_UP {
                 before = CALLS.load(Ordering::Relaxed);
-                COUNTING.store(true, Ordering::Relaxed);
+                COUNTED_POOL.store(POOL.with(Cell::get), Ordering::Relaxed);
             }
             let a = assigner.assign(&workload.grid, &lights, workload.far, &limits);
             assert!(a.stats.threads > 1, "frame {frame} ran on one thread");
         }
-        COUNTING.store(false, Ordering::Relaxed);
+        COUNTED_POOL.store(0, Ordering::Relaxed);
         CALLS.load(Ordering::Relaxed) - before
     })
 }
@@ -132,10 +141,14 @@ fn limits() -> AssignLimits {
 }
 
 /// A pool of `threads` workers, every worker started (a worker starting allocates on its own
-/// thread, whenever the system runs it): made before any counting and kept to the end.
+/// thread, whenever the system runs it): made before any counting and kept to the end. Its
+/// workers know it by a number of its own ([`POOL`]).
 fn pool_of(threads: usize) -> rayon::ThreadPool {
+    static MADE: AtomicUsize = AtomicUsize::new(0);
+    let number = MADE.fetch_add(1, Ordering::Relaxed) + 1;
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
+        .start_handler(move |_| POOL.with(|p| p.set(number)))
         .build()
         .expect("a thread pool");
     pool.broadcast(|_| ());
@@ -162,8 +175,8 @@ fn moving_lights_on_two_to_eight_workers_allocate_nothing_after_a_warm_up() {
             AssignWorkload::view_with(512, 3, (48, 27), fixed(32.0)),
         ),
     ];
-    // Made once and kept to the end: a worker starting or ending (a dropped pool's) allocates
-    // on its own thread, whenever the system runs it.
+    // Made once and kept to the end: a worker starting allocates on its own thread, whenever
+    // the system runs it.
     // No more workers than cores (but two): on fewer cores the workers preempt one another, so
     // each band's measured time, and the split that follows it, is noise, which no device
     // running a pool of its own size sees.
