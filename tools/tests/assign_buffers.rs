@@ -120,8 +120,11 @@ fn allocations(
         for frame in 0..WARM_UP + MEASURED {
             pose(&mut lights, frame);
             if frame == WARM_UP {
+                let number = POOL.with(Cell::get);
+                // 0 would count nothing, and every test would pass.
+                assert_ne!(number, 0, "the pool's workers are not numbered (pool_of)");
                 before = CALLS.load(Ordering::Relaxed);
-                COUNTED_POOL.store(POOL.with(Cell::get), Ordering::Relaxed);
+                COUNTED_POOL.store(number, Ordering::Relaxed);
             }
             let a = assigner.assign(&workload.grid, &lights, workload.far, &limits);
             assert!(a.stats.threads > 1, "frame {frame} ran on one thread");
@@ -225,7 +228,8 @@ fn chunks_whose_lights_come_into_view_after_a_warm_up_allocate_nothing() {
         lights.copy_from_slice(&sets[usize::from(frame >= WARM_UP)]);
     });
     // The test means something: both halves list lights, and the whole list after the
-    // warm-up stays within the room it kept (a quarter more than its peak).
+    // warm-up stays within a quarter more than its warm-up size (the least room that any of
+    // the assigner's buffers keeps past its peak).
     let listed = sets.map(|lights| {
         let mut assigner = Assigner::new();
         (assigner.assign(&workload.grid, &lights, workload.far, &limits()))
