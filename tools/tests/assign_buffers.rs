@@ -1,10 +1,9 @@
 //! An assigner's buffers stop growing after a warm-up on any number of workers: frames of
 //! moving lights reuse every buffer however the work is split (bands of slices, chunks of
 //! lights), however the split moves from frame to frame and whichever chunks' lights are in
-//! view. The soak test checks the same
-//! rule for whole frames, but the 2-core CI host's renderer keeps small scenes on one thread;
-//! here every assignment runs on a pool of 2, 4 or 8 workers (as many of those as the host
-//! has cores for).
+//! view. The soak test checks the same rule for whole frames, but the 2-core CI host's
+//! renderer keeps small scenes on one thread; here every assignment runs on a pool of 2, 4 or
+//! 8 workers (as many of those as the host has cores for).
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
