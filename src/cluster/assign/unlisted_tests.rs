@@ -36,8 +36,9 @@ fn refused_then_listed(grid: &ClusterGrid, lights: usize, threads: usize) {
     };
     let cells = grid.total_cells as usize;
     let what = format!("{cells} cells, {lights} lights, {threads} threads");
+    // In u64: the product passes a 32-bit usize.
     assert!(
-        cells * lights > MAX_UNTRIMMED_INDICES,
+        cells as u64 * lights as u64 > MAX_UNTRIMMED_INDICES as u64,
         "{what}: too small a case"
     );
     pool.install(|| {
