@@ -161,13 +161,19 @@ fn read_limited(path: &Path, kind: FileKind, prefix: Option<u64>) -> Result<Vec<
 
 /// Checks a light count before lights are made: `field` names where it came from.
 pub fn check_light_count(count: usize, field: &str) -> Result<(), SceneError> {
-    if count > MAX_LIGHTS {
-        return Err(SceneError::invalid(
+    light_count(count as u64, field).map(|_| ())
+}
+
+/// A light count given as a 64-bit number (a command line's): refused like
+/// [`check_light_count`]'s, also where it does not fit `usize` (past 2³² on a 32-bit target).
+pub fn light_count(count: u64, field: &str) -> Result<usize, SceneError> {
+    match usize::try_from(count) {
+        Ok(n) if n <= MAX_LIGHTS => Ok(n),
+        _ => Err(SceneError::invalid(
             field,
             format!("{count} lights is more than the {MAX_LIGHTS} a scene may hold"),
-        ));
+        )),
     }
-    Ok(())
 }
 
 #[cfg(test)]
@@ -198,5 +204,12 @@ mod tests {
         assert!(check_light_count(MAX_LIGHTS, "n").is_ok());
         let err = check_light_count(usize::MAX, "random_lights.count").unwrap_err();
         assert!(err.to_string().contains("random_lights.count"), "{err}");
+        assert_eq!(light_count(MAX_LIGHTS as u64, "n").unwrap(), MAX_LIGHTS);
+        // Past 2³², which a 32-bit usize does not hold: the number as given, not a wrapped one.
+        let err = light_count(1 << 32, "lights").unwrap_err().to_string();
+        assert!(
+            err.contains("lights") && err.contains("4294967296 lights"),
+            "{err}"
+        );
     }
 }

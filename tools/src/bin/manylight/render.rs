@@ -4,6 +4,7 @@ use std::path::PathBuf;
 
 use clap::Parser;
 use manylight::gl::HeadlessContext;
+use manylight::scene::input::light_count;
 use manylight::{scene, RenderOptions, Renderer};
 use manylight_tools::output::{print_stdout, JsonOut, OutputFile};
 
@@ -26,8 +27,9 @@ pub struct RenderArgs {
     pub es: EsArg,
     /// Number of seeded random lights (for scene files: replaces their random_lights count).
     /// Default: 1024 for built-ins and OBJ files; a scene file or glTF file keeps its own lights.
+    // A u64, so that a count past a 32-bit target's usize gets the loader's error, not clap's.
     #[arg(long)]
-    pub lights: Option<usize>,
+    pub lights: Option<u64>,
     /// Seed of the random lights.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
@@ -267,7 +269,8 @@ pub fn lights_for(spec: &str, count: Option<usize>, seed: u64) -> Option<(usize,
 
 /// Runs the command.
 pub fn run(args: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
-    let lights = lights_for(&args.scene, args.lights, args.seed);
+    let count = args.lights.map(|n| light_count(n, "lights")).transpose()?;
+    let lights = lights_for(&args.scene, count, args.seed);
     // The loader logs each warning (at `warn`, shown by default): not printed again here.
     let (mut scene, _logged_warnings) =
         scene::load_with(&args.scene, lights, &crate::load_options())?;

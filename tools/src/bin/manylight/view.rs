@@ -29,6 +29,7 @@ use clap::Parser;
 use fly_camera::{FlyCamera, Move};
 use manylight::methods::METHODS;
 use manylight::renderer::CountKind;
+use manylight::scene::input::light_count;
 use manylight::scene::{self, Scene};
 use manylight::{EsVersion, FrameStats, RenderOptions};
 use window_gl::Gfx;
@@ -55,8 +56,9 @@ pub struct ViewArgs {
     #[arg(long, value_enum)]
     pub es: Option<EsArg>,
     /// Number of seeded random lights (default: 1024; a scene or glTF file's own lights).
+    // A u64, so that a count past a 32-bit target's usize gets the loader's error, not clap's.
     #[arg(long)]
-    pub lights: Option<usize>,
+    pub lights: Option<u64>,
     /// Seed of the random lights.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
@@ -111,7 +113,8 @@ const NO_DISPLAY: &str = "cannot open a window: no X11 or Wayland display (DISPL
 
 pub fn run(args: &ViewArgs) -> Result<(), Box<dyn std::error::Error>> {
     let is_file_scene = scene::brings_own_lights(&args.scene);
-    let lights = match (args.lights, is_file_scene) {
+    let count = args.lights.map(|n| light_count(n, "lights")).transpose()?;
+    let lights = match (count, is_file_scene) {
         (Some(n), _) => Some(n),
         (None, true) => None,
         (None, false) => Some(DEFAULT_LIGHTS),
