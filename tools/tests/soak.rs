@@ -53,9 +53,11 @@ static MEASURING: AtomicBool = AtomicBool::new(false);
 /// Blocks of rayon's global job queue allocated in the counted frames (see
 /// [`RAYON_INJECTOR_BLOCK`]).
 static INJECTOR_BLOCKS: AtomicUsize = AtomicUsize::new(0);
-/// Bytes below which a call is not looked at as a job-queue block (crossbeam's block of 63
-/// jobs is about 1.5 KiB; the frames' own few calls, their stats' strings, are far smaller).
-const INJECTOR_BLOCK_MIN_BYTES: usize = 1024;
+/// Bytes below which a call is not looked at as a job-queue block: crossbeam's block of 63
+/// jobs is 190 pointers (1 520 bytes on a 64-bit target, 760 on a 32-bit one), and the frames'
+/// own few calls, their stats' strings, are far smaller. A call past this that is not such a
+/// block is counted like any other; the bound only spares the others a backtrace.
+const INJECTOR_BLOCK_MIN_BYTES: usize = 128 * std::mem::size_of::<usize>();
 
 thread_local! {
     /// This thread is printing a backtrace: what that allocates is neither counted nor traced.
