@@ -257,20 +257,24 @@ pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
     Ok((w, h))
 }
 
-/// The random lights a scene gets: `count` where asked, else [`DEFAULT_LIGHTS`] for
+/// The random lights a scene gets: `count` where asked (`--lights`, refused past
+/// [`MAX_LIGHTS`](manylight::scene::input::MAX_LIGHTS) naming it), else [`DEFAULT_LIGHTS`] for
 /// built-ins and OBJ files, none for a scene or glTF file (which keeps its own).
-pub fn lights_for(spec: &str, count: Option<usize>, seed: u64) -> Option<(usize, u64)> {
-    match (count, scene::brings_own_lights(spec)) {
-        (Some(n), _) => Some((n, seed)),
+pub fn lights_for(
+    spec: &str,
+    count: Option<u64>,
+    seed: u64,
+) -> Result<Option<(usize, u64)>, scene::SceneError> {
+    Ok(match (count, scene::brings_own_lights(spec)) {
+        (Some(n), _) => Some((light_count(n, "lights")?, seed)),
         (None, true) => None,
         (None, false) => Some((DEFAULT_LIGHTS, seed)),
-    }
+    })
 }
 
 /// Runs the command.
 pub fn run(args: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
-    let count = args.lights.map(|n| light_count(n, "lights")).transpose()?;
-    let lights = lights_for(&args.scene, count, args.seed);
+    let lights = lights_for(&args.scene, args.lights, args.seed)?;
     // The loader logs each warning (at `warn`, shown by default): not printed again here.
     let (mut scene, _logged_warnings) =
         scene::load_with(&args.scene, lights, &crate::load_options())?;

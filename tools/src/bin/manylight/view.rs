@@ -29,7 +29,6 @@ use clap::Parser;
 use fly_camera::{FlyCamera, Move};
 use manylight::methods::METHODS;
 use manylight::renderer::CountKind;
-use manylight::scene::input::light_count;
 use manylight::scene::{self, Scene};
 use manylight::{EsVersion, FrameStats, RenderOptions};
 use window_gl::Gfx;
@@ -87,8 +86,6 @@ pub struct ViewArgs {
     pub msaa: u32,
 }
 
-/// Random lights for built-ins and OBJ files when `--lights` is not given.
-const DEFAULT_LIGHTS: usize = 1024;
 /// Most random lights `+` goes to.
 const MAX_LIGHTS: usize = 1 << 20;
 /// The tone map after `current`, in a cycle.
@@ -112,19 +109,11 @@ const NO_DISPLAY: &str = "cannot open a window: no X11 or Wayland display (DISPL
     manylight view`, or render headless without a window: `manylight --out F.png`";
 
 pub fn run(args: &ViewArgs) -> Result<(), Box<dyn std::error::Error>> {
-    let is_file_scene = scene::brings_own_lights(&args.scene);
-    let count = args.lights.map(|n| light_count(n, "lights")).transpose()?;
-    let lights = match (count, is_file_scene) {
-        (Some(n), _) => Some(n),
-        (None, true) => None,
-        (None, false) => Some(DEFAULT_LIGHTS),
-    };
+    let lights = crate::render::lights_for(&args.scene, args.lights, args.seed)?;
     // The loader logs each warning (at `warn`, shown by default): not printed again here.
-    let (mut scene, _logged_warnings) = scene::load_with(
-        &args.scene,
-        lights.map(|n| (n, args.seed)),
-        &crate::load_options(),
-    )?;
+    let (mut scene, _logged_warnings) =
+        scene::load_with(&args.scene, lights, &crate::load_options())?;
+    let lights = lights.map(|(n, _)| n);
     scene.set_time(args.time);
     // Validate the method name before opening a window.
     manylight::methods::find(&args.method)?;
