@@ -266,7 +266,10 @@ impl HeadlessContext {
                     config,
                     &[egl::WIDTH, 1, egl::HEIGHT, 1, egl::NONE],
                 )
-                .map_err(egl_err("eglCreatePbufferSurface"))?,
+                .map_err(|e| {
+                    let _ = egl.destroy_context(display, context);
+                    egl_err("eglCreatePbufferSurface")(e)
+                })?,
             )
         };
         if let Err(e) = egl.make_current(display, surface, surface, Some(context)) {

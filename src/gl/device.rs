@@ -28,6 +28,10 @@ pub struct Device {
     warned_pending_error: std::cell::Cell<bool>,
     /// How the device tells whether its context is current.
     context: ContextWatch,
+    /// `lab`: checks whose description contains this fail as out of memory (see
+    /// [`Device::fail_checks_naming`]).
+    #[cfg(feature = "lab")]
+    failing_checks: std::cell::Cell<Option<&'static str>>,
 }
 
 /// Which EGL says what context is current, and the device's own context there.
@@ -161,6 +165,8 @@ impl Device {
             host_depth: std::cell::Cell::new(0),
             warned_pending_error: std::cell::Cell::new(false),
             context: ContextWatch::of_current(),
+            #[cfg(feature = "lab")]
+            failing_checks: std::cell::Cell::new(None),
         })
     }
 
@@ -234,6 +240,14 @@ impl Device {
         if let Some(vao) = self.vertex_array.take() {
             unsafe { self.gl.delete_vertex_array(vao) };
         }
+    }
+
+    /// `lab`: from now on, every [`Device::check`] whose description contains `name` fails as if
+    /// the driver had run out of memory there (`None`: none), so tests can reach the error
+    /// paths of uploads and allocations that a real driver fails only under memory pressure.
+    #[cfg(feature = "lab")]
+    pub fn fail_checks_naming(&self, name: Option<&'static str>) {
+        self.failing_checks.set(name);
     }
 
     /// GL objects alive now (created and not yet deleted by this crate).
@@ -497,6 +511,17 @@ impl Device {
 
     /// Returns the first pending GL error as [`GlError::Driver`], draining the queue.
     pub fn check(&self, what: &str) -> Result<(), GlError> {
+        #[cfg(feature = "lab")]
+        if self
+            .failing_checks
+            .get()
+            .is_some_and(|name| what.contains(name))
+        {
+            self.drain_errors();
+            return Err(GlError::OutOfMemory(format!(
+                "the driver reported GL_OUT_OF_MEMORY after {what} (injected)"
+            )));
+        }
         let code = self.drain_errors();
         if code == glow::NO_ERROR {
             return Ok(());

@@ -86,7 +86,13 @@ impl OffscreenTarget {
                 glow::PixelUnpackData::Slice(None),
             );
             super::texture::set_nearest_clamp(gl);
-            let depth = dev.create_renderbuffer()?;
+            let depth = match dev.create_renderbuffer() {
+                Ok(depth) => depth,
+                Err(e) => {
+                    dev.delete_texture(color);
+                    return Err(e);
+                }
+            };
             gl.bind_renderbuffer(glow::RENDERBUFFER, Some(depth));
             let (depth_format, _) = dev.caps().own_depth_format();
             gl.renderbuffer_storage(
@@ -102,7 +108,14 @@ impl OffscreenTarget {
                 dev.delete_renderbuffer(depth);
                 return Err(e);
             }
-            let fbo = dev.create_framebuffer()?;
+            let fbo = match dev.create_framebuffer() {
+                Ok(fbo) => fbo,
+                Err(e) => {
+                    dev.delete_texture(color);
+                    dev.delete_renderbuffer(depth);
+                    return Err(e);
+                }
+            };
             gl.bind_framebuffer(glow::FRAMEBUFFER, Some(fbo));
             gl.framebuffer_texture_2d(
                 glow::FRAMEBUFFER,
@@ -131,7 +144,10 @@ impl OffscreenTarget {
                 target.destroy(dev);
                 return Err(GlError::FramebufferIncomplete(status));
             }
-            dev.check("offscreen target creation")?;
+            if let Err(e) = dev.check("offscreen target creation") {
+                target.destroy(dev);
+                return Err(e);
+            }
             Ok(target)
         }
     }

@@ -29,7 +29,7 @@ impl InstanceStream {
         capacity: usize,
     ) -> Result<InstanceStream, GlError> {
         let buffer = dev.create_buffer()?;
-        let stream = InstanceStream {
+        let mut stream = InstanceStream {
             buffer,
             first,
             attributes,
@@ -41,7 +41,10 @@ impl InstanceStream {
             dev.gl
                 .buffer_data_size(glow::ARRAY_BUFFER, stream.bytes() as i32, glow::STREAM_DRAW);
         }
-        dev.check("instance buffer")?;
+        if let Err(e) = dev.check("instance buffer") {
+            stream.destroy(dev);
+            return Err(e);
+        }
         Ok(stream)
     }
 

@@ -203,39 +203,54 @@ impl GpuMesh {
     /// Uploads a mesh with its positions relative to `origin` (drawn with the model matrix
     /// translated by `origin`).
     pub fn new_about(dev: &Device, mesh: &Mesh, origin: DVec3) -> Result<GpuMesh, GlError> {
-        let gl = &dev.gl;
         let mut out = GpuMesh {
             chunks: Vec::new(),
             bytes: 0,
             destroyed: false,
         };
-        for chunk in split_u16_about(mesh, origin) {
-            unsafe {
-                let vbo = dev.create_buffer()?;
-                gl.bind_buffer(glow::ARRAY_BUFFER, Some(vbo));
-                gl.buffer_data_u8_slice(
-                    glow::ARRAY_BUFFER,
-                    bytemuck::cast_slice(&chunk.vertices),
-                    glow::STATIC_DRAW,
-                );
-                let ibo = dev.create_buffer()?;
-                gl.bind_buffer(glow::ELEMENT_ARRAY_BUFFER, Some(ibo));
-                gl.buffer_data_u8_slice(
-                    glow::ELEMENT_ARRAY_BUFFER,
-                    bytemuck::cast_slice(&chunk.indices),
-                    glow::STATIC_DRAW,
-                );
-                out.bytes += chunk.vertices.len() * 4 + chunk.indices.len() * 2;
-                out.chunks.push(GpuChunk {
-                    vbo,
-                    ibo,
-                    index_count: chunk.indices.len() as i32,
-                    layout: chunk.layout,
-                });
+        // A failed upload (out of memory, most likely) frees what it made: the caller may try
+        // again next frame.
+        let uploaded = out
+            .upload_chunks(dev, mesh, origin)
+            .and_then(|()| dev.check("mesh upload"));
+        match uploaded {
+            Ok(()) => Ok(out),
+            Err(e) => {
+                out.destroy(dev);
+                Err(e)
             }
         }
-        dev.check("mesh upload")?;
-        Ok(out)
+    }
+
+    /// Uploads the mesh's chunks into `self.chunks`, which holds every buffer made so far
+    /// when it fails.
+    fn upload_chunks(&mut self, dev: &Device, mesh: &Mesh, origin: DVec3) -> Result<(), GlError> {
+        for chunk in split_u16_about(mesh, origin) {
+            let vbo = static_buffer(
+                dev,
+                glow::ARRAY_BUFFER,
+                bytemuck::cast_slice(&chunk.vertices),
+            )?;
+            let ibo = match static_buffer(
+                dev,
+                glow::ELEMENT_ARRAY_BUFFER,
+                bytemuck::cast_slice(&chunk.indices),
+            ) {
+                Ok(ibo) => ibo,
+                Err(e) => {
+                    dev.delete_buffer(vbo);
+                    return Err(e);
+                }
+            };
+            self.bytes += chunk.vertices.len() * 4 + chunk.indices.len() * 2;
+            self.chunks.push(GpuChunk {
+                vbo,
+                ibo,
+                index_count: chunk.indices.len() as i32,
+                layout: chunk.layout,
+            });
+        }
+        Ok(())
     }
 
     /// Draws all chunks with the bound program (attributes at [`super::program::ATTRIBUTES`]).
@@ -278,6 +293,17 @@ impl Drop for GpuMesh {
             log::warn!("GpuMesh dropped without destroy(): GL buffers leaked");
         }
     }
+}
+
+/// A new buffer bound to `target`, holding `bytes` for drawing.
+fn static_buffer(dev: &Device, target: u32, bytes: &[u8]) -> Result<glow::Buffer, GlError> {
+    let buffer = dev.create_buffer()?;
+    unsafe {
+        dev.gl.bind_buffer(target, Some(buffer));
+        dev.gl
+            .buffer_data_u8_slice(target, bytes, glow::STATIC_DRAW);
+    }
+    Ok(buffer)
 }
 
 /// One triangle covering the whole viewport in clip space (full-screen passes).

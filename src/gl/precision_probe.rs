@@ -27,11 +27,29 @@ impl UniformSet for ProbeUniforms {
 /// True when `mediump` arithmetic in the fragment stage rounds like fp16.
 pub fn mediump_is_fp16(dev: &Device) -> Result<bool, GlError> {
     let mut target = OffscreenTarget::new(dev, 1, 1)?;
-    let mut program = Program::build::<ProbeUniforms>(dev, "precision_probe", &[], 0)?;
+    let result = match Program::build::<ProbeUniforms>(dev, "precision_probe", &[], 0) {
+        Ok(mut program) => {
+            let pixel = draw_probe(dev, &target, &program);
+            program.destroy(dev);
+            pixel
+        }
+        Err(e) => Err(e),
+    };
+    target.destroy(dev);
+    dev.bind_default_framebuffer();
+    Ok(result?.get_pixel(0, 0)[0] < 128)
+}
+
+/// Draws the probe's pixel into `target` with `program` and reads it back.
+fn draw_probe(
+    dev: &Device,
+    target: &OffscreenTarget,
+    program: &Program,
+) -> Result<image::RgbaImage, GlError> {
     let gl = &dev.gl;
     // One clip-space triangle covering the pixel.
     let vertices: [f32; 9] = [-1.0, -1.0, 0.0, 3.0, -1.0, 0.0, -1.0, 3.0, 0.0];
-    let result = unsafe {
+    unsafe {
         let buffer = dev.create_buffer()?;
         gl.bind_buffer(glow::ARRAY_BUFFER, Some(buffer));
         gl.buffer_data_u8_slice(
@@ -59,9 +77,5 @@ pub fn mediump_is_fp16(dev: &Device) -> Result<bool, GlError> {
         let pixel = target.read_rgba8(dev);
         dev.delete_buffer(buffer);
         pixel
-    };
-    program.destroy(dev);
-    target.destroy(dev);
-    dev.bind_default_framebuffer();
-    Ok(result?.get_pixel(0, 0)[0] < 128)
+    }
 }

@@ -196,7 +196,12 @@ impl DataTexture {
                 glow::PixelUnpackData::Slice(Some(bytes)),
             );
         }
-        dev.check("data texture upload")
+        let uploaded = dev.check("data texture upload");
+        if uploaded.is_err() {
+            // The allocation may have failed: the next upload allocates again.
+            self.size = (0, 0);
+        }
+        uploaded
     }
 
     /// Binds to texture unit `unit`.
@@ -317,7 +322,10 @@ impl ImageTexture {
         }
         let sampling = Sampling::default();
         set_image_sampling(gl, &sampling);
-        dev.check(&format!("uploading a {pw}×{ph} image texture"))?;
+        if let Err(e) = dev.check(&format!("uploading a {pw}×{ph} image texture")) {
+            dev.delete_texture(raw);
+            return Err(e);
+        }
         Ok(ImageTexture {
             raw,
             destroyed: false,

@@ -221,6 +221,13 @@ impl Renderer {
         result.unwrap_or_else(|panic| std::panic::resume_unwind(panic))
     }
 
+    /// `lab`: makes the GL checks whose description contains `name` fail as out of memory
+    /// (`None`: none), to test what a failed upload or allocation leaves behind.
+    #[cfg(feature = "lab")]
+    pub fn fail_gl_checks_naming(&self, name: Option<&'static str>) {
+        self.dev.fail_checks_naming(name);
+    }
+
     /// GL objects the renderer holds now (`lab`: the soak tests count them).
     #[cfg(feature = "lab")]
     pub fn live_gl_objects(&self) -> crate::gl::device::LiveObjects {

@@ -647,3 +647,69 @@ fn gltf_accessors_without_a_buffer_view_are_bounded() {
         "{err}"
     );
 }
+
+/// A driver out of memory in an upload or an allocation fails that frame with an error naming
+/// the step, and the renderer keeps nothing the failed step made: a game that logs the error
+/// and renders on (each frame tries the step again) does not lose GPU memory frame after frame,
+/// and once memory is back its frame and its objects are those of a renderer that never failed.
+/// The failures are injected (`Renderer::fail_gl_checks_naming`): a real driver fails these
+/// steps only under memory pressure.
+#[test]
+fn a_failed_upload_or_allocation_keeps_nothing_it_made() {
+    let mut s = scene::builtin::build("plane", Some((16, 1))).unwrap();
+    let image = image::RgbaImage::from_pixel(2, 2, image::Rgba([200, 100, 50, 255]));
+    s.materials[0].diffuse_texture = Some(Arc::new(manylight::scene::Texture::new(
+        "orange".to_string(),
+        image,
+    )));
+    let options = RenderOptions::default();
+    let objects = |l: manylight::gl::device::LiveObjects| {
+        (l.buffers, l.textures, l.framebuffers, l.renderbuffers)
+    };
+    for (es, method, step) in [
+        (EsVersion::Es3, "clustered", "mesh upload"),
+        (EsVersion::Es3, "clustered", "image texture"),
+        (EsVersion::Es3, "clustered", "offscreen target creation"),
+        (EsVersion::Es3, "deferred", "G-buffer"),
+        (EsVersion::Es3, "deferred", "instance buffer"),
+        (EsVersion::Es2, "forward", "mesh upload"),
+        (EsVersion::Es2, "clustered", "image texture"),
+    ] {
+        let mut healthy = Gpu::new(es);
+        healthy.r().set_method_named(method).unwrap();
+        let expected = healthy.render(&s, 32, 18, &options);
+        let expected_objects = objects(healthy.r().live_gl_objects());
+        drop(healthy);
+
+        let mut gpu = Gpu::new(es);
+        gpu.r().set_method_named(method).unwrap();
+        gpu.r().fail_gl_checks_naming(Some(step));
+        let mut first = None;
+        for frame in 0..3 {
+            let error = gpu.r().render_offscreen(&s, 32, 18, &options).unwrap_err();
+            let message = error.to_string();
+            assert!(
+                message.contains("GL_OUT_OF_MEMORY") && message.contains(step),
+                "{es} {method}, {step}: {message}"
+            );
+            let live = objects(gpu.r().live_gl_objects());
+            let first = *first.get_or_insert(live);
+            assert_eq!(
+                live, first,
+                "{es} {method}, {step}: frame {frame} kept more GL objects (buffers, textures, \
+                 framebuffers, renderbuffers) than the first failed frame"
+            );
+        }
+        gpu.r().fail_gl_checks_naming(None);
+        let recovered = gpu.render(&s, 32, 18, &options);
+        assert!(
+            recovered == expected,
+            "{es} {method}, {step}: the frame after the failures differs"
+        );
+        assert_eq!(
+            objects(gpu.r().live_gl_objects()),
+            expected_objects,
+            "{es} {method}, {step}: the failures left GL objects behind"
+        );
+    }
+}
