@@ -2,7 +2,8 @@
 //! that keep hostile input from hanging the loader or exhausting memory.
 //!
 //! Only regular files are read: a FIFO would block `open` forever and `/dev/zero` never ends,
-//! so anything else (device, FIFO, socket, folder) is refused before it is opened. A file
+//! so anything else (device, FIFO, socket, folder), and on Linux any file of `/proc` or `/sys`,
+//! is refused before it is opened. A file
 //! larger than its kind's limit is refused from its size, and the read itself stops one byte
 //! past the limit, so a file that grows while it is read cannot get around it. The limits can
 //! be raised (or lowered) for every kind at once with `MANYLIGHT_MAX_FILE_MB`.
@@ -131,6 +132,17 @@ fn read_limited(path: &Path, kind: FileKind, prefix: Option<u64>) -> Result<Vec<
             ),
         ));
     }
+    if let Some(root) = kernel_file_system(&meta) {
+        return Err(refuse(
+            path,
+            std::io::ErrorKind::InvalidInput,
+            format!(
+                "a file of the kernel's {root} (one can block a read forever or change as it \
+                 is read), not a {}",
+                kind.name()
+            ),
+        ));
+    }
     let limit = kind.limit();
     let too_big = |size: u64| {
         refuse(
@@ -157,6 +169,22 @@ fn read_limited(path: &Path, kind: FileKind, prefix: Option<u64>) -> Result<Vec<
         return Err(too_big(bytes.len() as u64));
     }
     Ok(bytes)
+}
+
+/// `/proc` or `/sys` when the file lies on that pseudo file system. Their files pass for
+/// regular ones, but some block a read until the kernel has something to say (`/proc/kmsg`)
+/// and others never end or change as they are read: no scene has a reason to name one.
+#[cfg(any(target_os = "linux", target_os = "android"))]
+fn kernel_file_system(meta: &std::fs::Metadata) -> Option<&'static str> {
+    use std::os::unix::fs::MetadataExt;
+    ["/proc", "/sys"]
+        .into_iter()
+        .find(|root| std::fs::metadata(root).is_ok_and(|m| m.dev() == meta.dev()))
+}
+
+#[cfg(not(any(target_os = "linux", target_os = "android")))]
+fn kernel_file_system(_: &std::fs::Metadata) -> Option<&'static str> {
+    None
 }
 
 /// Checks a light count before lights are made: `field` names where it came from.
@@ -197,6 +225,30 @@ mod tests {
             let err = read_bounded(Path::new(device), FileKind::Materials).unwrap_err();
             assert!(err.to_string().contains("not a regular file"), "{err}");
         }
+    }
+
+    /// `/proc/kmsg`, readable by root, passes for a regular file and blocked the read until
+    /// the kernel logged something; `/proc/self/status` (readable by anyone) stands for it.
+    #[cfg(target_os = "linux")]
+    #[test]
+    fn files_of_proc_and_sys_are_refused_without_reading() {
+        for file in [
+            "/proc/self/status",
+            "/proc/kmsg",
+            "/sys/kernel/mm/transparent_hugepage/enabled",
+        ] {
+            if !Path::new(file).exists() {
+                continue;
+            }
+            let err = read_bounded(Path::new(file), FileKind::SceneFile).unwrap_err();
+            assert!(
+                err.to_string().contains("a file of the kernel's"),
+                "{file}: {err}"
+            );
+        }
+        let before = bytes_read();
+        let _ = read_bounded(Path::new("/proc/self/status"), FileKind::Texture);
+        assert_eq!(bytes_read(), before, "nothing read");
     }
 
     #[test]
