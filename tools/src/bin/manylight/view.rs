@@ -123,7 +123,9 @@ pub fn run(args: &ViewArgs) -> Result<(), Box<dyn std::error::Error>> {
         let e = e.to_string();
         format!("{NO_DISPLAY} ({})", e.rsplit(": ").next().unwrap_or(&e))
     })?;
-    event_loop.set_control_flow(ControlFlow::Poll);
+    // Frames follow one another through `about_to_wait`'s redraw requests (paced by vsync);
+    // with none asked for (hidden, or a size it cannot draw), the loop sleeps.
+    event_loop.set_control_flow(ControlFlow::Wait);
     say(
         args,
         &format!(
@@ -145,6 +147,9 @@ pub fn run(args: &ViewArgs) -> Result<(), Box<dyn std::error::Error>> {
         fly: FlyCamera::new(FlyCamera::speed_for_extent(extent)),
         gfx: None,
         frames: 0,
+        drawn_size: None,
+        refused_size: None,
+        occluded: false,
         last_frame: Instant::now(),
         title: TitleStats::default(),
         done: false,
@@ -187,6 +192,13 @@ struct App<'a> {
     fly: FlyCamera,
     gfx: Option<Gfx>,
     frames: u64,
+    /// The window size of the last frame that rendered.
+    drawn_size: Option<(u32, u32)>,
+    /// A size whose frame failed after others had rendered: not tried again until the window
+    /// is resized (see [`after_failure`]).
+    refused_size: Option<(u32, u32)>,
+    /// The window is fully hidden: no frames until it shows.
+    occluded: bool,
     last_frame: Instant,
     title: TitleStats,
     /// Set once exit was requested: no more frames.
@@ -225,8 +237,10 @@ impl ApplicationHandler for App<'_> {
             WindowEvent::Resized(size) => {
                 if let Some(g) = &self.gfx {
                     g.resize(size);
+                    g.window.request_redraw();
                 }
             }
+            WindowEvent::Occluded(occluded) => self.occluded = occluded,
             WindowEvent::Focused(false) => self.fly.release_all(),
             WindowEvent::KeyboardInput { event, .. } => self.key(event_loop, &event),
             WindowEvent::MouseInput {
@@ -247,7 +261,12 @@ impl ApplicationHandler for App<'_> {
     }
 
     fn about_to_wait(&mut self, _: &ActiveEventLoop) {
-        if let (false, Some(g)) = (self.done, &self.gfx) {
+        let Some(g) = self.gfx.as_ref().filter(|_| !self.done && !self.occluded) else {
+            return;
+        };
+        let size = g.window.inner_size();
+        let size = (size.width, size.height);
+        if size.0 > 0 && size.1 > 0 && self.refused_size != Some(size) {
             g.window.request_redraw();
         }
     }
@@ -428,8 +447,25 @@ impl App<'_> {
                 self.samples = 1;
                 return Ok(());
             }
-            Err(e) => return self.undo_change(e.to_string()),
+            Err(e) => {
+                let size = (size.width, size.height);
+                return match after_failure(self.drawn_size, size) {
+                    Failure::SkipSize => {
+                        if self.refused_size != Some(size) {
+                            eprintln!(
+                                "error: {e}; no frames at {}x{} until the window is resized",
+                                size.0, size.1
+                            );
+                            self.refused_size = Some(size);
+                        }
+                        Ok(())
+                    }
+                    Failure::UndoOrEnd => self.undo_change(e.to_string()),
+                };
+            }
         };
+        self.drawn_size = Some((size.width, size.height));
+        self.refused_size = None;
         if self.good.0 != stats.method || self.good.1 != self.light_count {
             self.good = (stats.method.clone(), self.light_count);
         }
@@ -472,6 +508,27 @@ impl App<'_> {
             self.set_lights(lights);
         }
         Ok(())
+    }
+}
+
+/// What a failed frame leads to.
+#[derive(Debug, PartialEq, Eq)]
+enum Failure {
+    /// The window has a size no frame has been drawn at since the last one that rendered (a
+    /// maximised window past the driver's largest viewport or render target, say): frames
+    /// wait for the next resize, and the keys' changes stand.
+    SkipSize,
+    /// At the size frames rendered at: the last key's change is undone, or, with none to undo,
+    /// the viewer ends ([`App::undo_change`]).
+    UndoOrEnd,
+}
+
+/// [`Failure`] for a frame of `size` that failed, `drawn` the size of the last that rendered
+/// (`None`: none has, and the first frame's failure ends the viewer).
+fn after_failure(drawn: Option<(u32, u32)>, size: (u32, u32)) -> Failure {
+    match drawn {
+        Some(drawn) if drawn != size => Failure::SkipSize,
+        _ => Failure::UndoOrEnd,
     }
 }
 
@@ -521,5 +578,26 @@ fn update_title(t: &mut TitleStats, g: &Gfx, stats: &FrameStats, dt: f64) {
         mean.time.assign_ms = t.assign_ms / n;
         g.window.set_title(&title(&mean, g.es, t.wall_s * 1e3 / n));
         *t = TitleStats::default();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{after_failure, Failure};
+
+    #[test]
+    fn a_failure_at_a_new_size_waits_for_a_resize_and_one_at_a_drawn_size_undoes() {
+        // Maximised past the driver's limits after frames at 1280x720: wait, keep the keys.
+        assert_eq!(
+            after_failure(Some((1280, 720)), (20000, 12000)),
+            Failure::SkipSize
+        );
+        // At the size frames were drawn at, the last key's change is what failed.
+        assert_eq!(
+            after_failure(Some((1280, 720)), (1280, 720)),
+            Failure::UndoOrEnd
+        );
+        // No frame ever rendered: nothing to wait for.
+        assert_eq!(after_failure(None, (1280, 720)), Failure::UndoOrEnd);
     }
 }
