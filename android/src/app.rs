@@ -10,25 +10,29 @@ use glutin::context::{ContextApi, ContextAttributesBuilder, Version};
 use glutin::context::{NotCurrentContext, NotCurrentGlContext};
 use glutin::context::{PossiblyCurrentContext, PossiblyCurrentGlContext};
 use glutin::display::{Display, DisplayApiPreference, GlDisplay};
+use glutin::error::ErrorKind;
 use glutin::surface::{GlSurface, Surface, SurfaceAttributesBuilder, SwapInterval, WindowSurface};
 use manylight::{builtin_scene, Method, RandomLights, Scene, DEFAULT_SCENE};
 use manylight::{EsVersion, RenderOptions, Renderer};
 use winit::application::ApplicationHandler;
 use winit::dpi::PhysicalPosition;
 use winit::event::{Touch, TouchPhase, WindowEvent};
-use winit::event_loop::{ActiveEventLoop, EventLoop};
+use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop};
 use winit::platform::android::EventLoopBuilderExtAndroid;
 use winit::raw_window_handle::{HasDisplayHandle, HasWindowHandle};
 use winit::window::{Window, WindowId};
 
 use crate::orbit::Orbit;
+use crate::retry::Retry;
 
 /// Seeded random lights in the default scene.
 const LIGHTS: usize = 1024;
 /// Seconds between frame-statistics lines in logcat.
 const LOG_EVERY_S: f64 = 2.0;
 
-/// Sets up logging and runs the event loop until the activity is destroyed.
+/// Sets up logging and runs the event loop until the activity is destroyed; then ends the
+/// process, since winit allows one event loop a process and android-activity keeps the process
+/// for the next launch, which would find none.
 pub fn run(activity: AndroidApp) {
     android_logger::init_once(
         android_logger::Config::default()
@@ -58,10 +62,14 @@ pub fn run(activity: AndroidApp) {
         touch: None,
         frames: 0,
         since: Instant::now(),
+        retry: Retry::default(),
+        resumed: false,
     };
     if let Err(e) = event_loop.run_app(&mut shell) {
         log::error!("event loop failed: {e}");
     }
+    drop(shell);
+    std::process::exit(0);
 }
 
 /// The EGL display and the config and version chosen on it (kept for the process).
@@ -91,17 +99,30 @@ struct Shell {
     touch: Option<(u64, PhysicalPosition<f64>)>,
     frames: u32,
     since: Instant,
+    /// A frame or resume that failed, to be tried again.
+    retry: Retry,
+    /// Between `resumed` and `suspended`.
+    resumed: bool,
+}
+
+/// Why a frame was not presented.
+enum FrameError {
+    /// EGL lost the context (`EGL_CONTEXT_LOST`): it and the renderer are made anew.
+    ContextLost(String),
+    /// Anything else: tried again a little later.
+    Other(String),
 }
 
 impl ApplicationHandler for Shell {
     fn resumed(&mut self, event_loop: &ActiveEventLoop) {
-        if let Err(e) = self.show(event_loop) {
-            log::error!("{e}");
-            event_loop.exit();
-        }
+        self.resumed = true;
+        self.try_show(event_loop);
     }
 
     fn suspended(&mut self, _: &ActiveEventLoop) {
+        self.resumed = false;
+        // A finger down when the activity paused may never be reported lifted.
+        self.touch = None;
         // The native window goes away: drop the surface (and window), keep the context.
         if let Some(Live {
             surface,
@@ -128,16 +149,38 @@ impl ApplicationHandler for Shell {
                     NonZeroU32::new(size.height),
                 ) {
                     live.surface.resize(&live.context, w, h);
+                    live.window.request_redraw();
                 }
             }
             WindowEvent::Touch(touch) => self.touch(touch),
-            WindowEvent::RedrawRequested => {
-                if let Err(e) = self.frame() {
-                    log::error!("{e}");
-                    event_loop.exit();
+            WindowEvent::RedrawRequested => match self.frame() {
+                Ok(()) => {
+                    if self.retry.succeeded() {
+                        log::info!("rendering again");
+                    }
                 }
-            }
+                Err(FrameError::ContextLost(e)) => {
+                    log::warn!("{e}: the context was lost; rebuilding it and the renderer");
+                    self.lose_context();
+                    self.try_show(event_loop);
+                }
+                Err(FrameError::Other(e)) => self.failed(event_loop, &e),
+            },
             _ => {}
+        }
+    }
+
+    fn about_to_wait(&mut self, event_loop: &ActiveEventLoop) {
+        if !self.retry.due(Instant::now()) {
+            return;
+        }
+        event_loop.set_control_flow(ControlFlow::Wait);
+        if !self.resumed {
+            // The next resume tries.
+        } else if let Some(live) = &self.live {
+            live.window.request_redraw();
+        } else {
+            self.try_show(event_loop);
         }
     }
 
@@ -157,6 +200,38 @@ impl ApplicationHandler for Shell {
 }
 
 impl Shell {
+    /// [`Shell::show`], tried again a second later while it fails.
+    fn try_show(&mut self, event_loop: &ActiveEventLoop) {
+        match self.show(event_loop) {
+            Ok(()) => {
+                if self.retry.succeeded() {
+                    log::info!("shown again");
+                }
+            }
+            Err(e) => self.failed(event_loop, &e),
+        }
+    }
+
+    /// Logs a failure (once while it repeats) and wakes the loop for the next try.
+    fn failed(&mut self, event_loop: &ActiveEventLoop, error: &str) {
+        if self.retry.failed(error, Instant::now()) {
+            log::error!("{error}; trying again every second");
+        }
+        if let Some(at) = self.retry.next() {
+            event_loop.set_control_flow(ControlFlow::WaitUntil(at));
+        }
+    }
+
+    /// Lets the lost context go with everything made in it: the renderer without a GL call,
+    /// then the surface, the context and the window, so that [`Shell::show`] makes them anew.
+    fn lose_context(&mut self) {
+        if let Some(r) = self.renderer.take() {
+            r.abandon();
+        }
+        self.parked = None;
+        self.live = None;
+    }
+
     /// Makes the display and context on first use, a surface for the new native window, and
     /// the renderer when there is none.
     fn show(&mut self, event_loop: &ActiveEventLoop) -> Result<(), String> {
@@ -235,6 +310,9 @@ impl Shell {
             self.renderer = Some(renderer);
         }
         window.request_redraw();
+        // The first statistics line after a pause covers frames, not the pause.
+        self.frames = 0;
+        self.since = Instant::now();
         self.live = Some(Live {
             surface,
             context,
@@ -270,7 +348,7 @@ impl Shell {
     }
 
     /// Renders and presents one frame, then asks for the next.
-    fn frame(&mut self) -> Result<(), String> {
+    fn frame(&mut self) -> Result<(), FrameError> {
         let (Some(live), Some(renderer)) = (&self.live, self.renderer.as_mut()) else {
             return Ok(()); // suspended
         };
@@ -285,10 +363,14 @@ impl Shell {
         };
         let stats = renderer
             .render(&self.scene, size.width, size.height, &options)
-            .map_err(|e| format!("render failed: {e}"))?;
+            .map_err(|e| FrameError::Other(format!("render failed: {e}")))?;
         if let Err(e) = live.surface.swap_buffers(&live.context) {
-            // A surface that went away mid-frame; the next resume makes a new one.
-            log::warn!("eglSwapBuffers: {e}");
+            let message = format!("eglSwapBuffers: {e}");
+            return Err(match e.error_kind() {
+                ErrorKind::ContextLost => FrameError::ContextLost(message),
+                // A surface that went away mid-frame: the next resume makes a new one.
+                _ => FrameError::Other(message),
+            });
         }
         live.window.request_redraw();
         self.frames += 1;

@@ -10,10 +10,14 @@
 //! renderer's GPU resources survive; on resume a new surface is made for the new native
 //! window. If the context cannot be made current again, it is rebuilt with a fresh renderer.
 //!
-//! Only [`orbit`] is built on other targets (so it is unit-tested on the host); everything
-//! else is Android-only.
+//! A frame or a resume that fails is logged (once while it fails the same way) and tried again
+//! a second later ([`retry`]); a context lost while shown is rebuilt at once.
+//!
+//! Only [`orbit`] and [`retry`] are built on other targets (so they are unit-tested on the
+//! host); everything else is Android-only.
 
 pub mod orbit;
+pub mod retry;
 
 #[cfg(target_os = "android")]
 mod app;
