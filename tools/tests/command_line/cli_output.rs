@@ -451,3 +451,34 @@ fn info_probes_es_2_where_es_3_is_missing() {
     let info: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(info["caps"]["es"], "2.0");
 }
+
+/// An OBJ whose 300 materials each name a missing texture: 60 000 of them wrote 60 000 lines.
+/// The first 50 are said, then one line of how many more, and the frame still renders.
+#[test]
+fn a_load_with_many_warnings_says_the_first_and_counts_the_rest() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut obj = String::from("mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\n");
+    let mut mtl = String::new();
+    for i in 0..300 {
+        obj += &format!("usemtl m{i}\nf 1 2 3\n");
+        mtl += &format!("newmtl m{i}\nKd 0.5 0.5 0.5\nmap_Kd missing{i}.png\n");
+    }
+    std::fs::write(dir.path().join("m.obj"), obj).unwrap();
+    std::fs::write(dir.path().join("m.mtl"), mtl).unwrap();
+    let args = ["--scene", "m.obj", "--size", "16x9", "--out", "m.png"];
+    let msg = expect(&args, dir.path(), 0);
+    let missing = msg
+        .lines()
+        .filter(|l| l.contains("not found next to"))
+        .count();
+    assert_eq!(missing, 50, "{msg}");
+    assert!(
+        msg.contains("missing0.png") && !msg.contains("missing299.png"),
+        "{msg}"
+    );
+    assert!(
+        msg.contains("250 more warnings of this load are logged at the debug level"),
+        "{msg}"
+    );
+    assert!(dir.path().join("m.png").is_file());
+}
