@@ -320,13 +320,19 @@ impl Mesh {
     }
 
     /// The triangles' (unnormalised) normals, out-of-range corners at the origin. In f64: an
-    /// f32 cross product of edges near 10⁻²³ underflows to zero, a real triangle to none.
+    /// f32 cross product of edges near 10⁻²³ underflows to zero, a real triangle to none. The
+    /// corners as a GPU reads them: subnormal coordinates (below 1.2·10⁻³⁸) are zero there
+    /// (llvmpipe drew a mesh at 10⁻³⁸ as nothing).
     fn triangle_normals(&self) -> impl Iterator<Item = DVec3> + '_ {
-        self.indices.chunks_exact(3).map(|t| {
+        let read = |p: Vec3| {
+            let normal = p.abs().cmpge(Vec3::splat(f32::MIN_POSITIVE));
+            Vec3::select(normal, p, Vec3::ZERO).as_dvec3()
+        };
+        self.indices.chunks_exact(3).map(move |t| {
             let p = |k: usize| {
                 self.positions
                     .get(t[k] as usize)
-                    .map_or(DVec3::ZERO, |p| p.as_dvec3())
+                    .map_or(DVec3::ZERO, |p| read(*p))
             };
             (p(1) - p(0)).cross(p(2) - p(0))
         })
@@ -722,7 +728,10 @@ mod tests {
             tiny(1e-23),
             "its f32 cross product underflows, its area does not"
         );
+        assert!(tiny(1e-36));
         assert!(!tiny(0.0));
+        // Subnormal coordinates, which GPUs read as zero: nothing to draw.
+        assert!(!tiny(1e-38) && !tiny(1e-40));
     }
 
     #[test]

@@ -399,4 +399,8 @@ fn a_file_whose_triangles_all_have_zero_area_is_refused_not_drawn_black() {
     )
     .unwrap();
     assert!(manylight::scene::load(obj.to_str().unwrap(), Some((4, 1))).is_ok());
+    // A triangle of subnormal coordinates, which a GPU reads as zero (llvmpipe drew it black).
+    std::fs::write(&obj, "v 0 0 0\nv 1e-38 0 0\nv 0 1e-38 0\nf 1 2 3\n").unwrap();
+    let err = manylight::scene::load(obj.to_str().unwrap(), Some((4, 1))).unwrap_err();
+    assert!(err.to_string().contains("zero area"), "{err}");
 }
