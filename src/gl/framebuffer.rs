@@ -102,13 +102,10 @@ impl OffscreenTarget {
                 height as i32,
             );
             // Out of memory here is an error naming the size, not an incomplete framebuffer.
-            if let Err(e) = dev.check(&format!("allocating a {width}×{height} {format:?} target"))
-            {
-                dev.delete_texture(color);
-                dev.delete_renderbuffer(depth);
-                return Err(e);
-            }
-            let fbo = match dev.create_framebuffer() {
+            let fbo = dev
+                .check(&format!("allocating a {width}×{height} {format:?} target"))
+                .and_then(|()| dev.create_framebuffer());
+            let fbo = match fbo {
                 Ok(fbo) => fbo,
                 Err(e) => {
                     dev.delete_texture(color);

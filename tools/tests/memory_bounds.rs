@@ -669,6 +669,7 @@ fn a_failed_upload_or_allocation_keeps_nothing_it_made() {
     for (es, method, step) in [
         (EsVersion::Es3, "clustered", "mesh upload"),
         (EsVersion::Es3, "clustered", "image texture"),
+        (EsVersion::Es3, "forward", "allocating a"),
         (EsVersion::Es3, "clustered", "offscreen target creation"),
         (EsVersion::Es3, "deferred", "G-buffer"),
         (EsVersion::Es3, "deferred", "instance buffer"),
