@@ -164,24 +164,28 @@ impl ApplicationHandler for Shell {
                     self.lose_context();
                     self.try_show(event_loop);
                 }
-                Err(FrameError::Other(e)) => self.failed(event_loop, &e),
+                Err(FrameError::Other(e)) => self.failed(&e),
             },
             _ => {}
         }
     }
 
     fn about_to_wait(&mut self, event_loop: &ActiveEventLoop) {
-        if !self.retry.due(Instant::now()) {
-            return;
+        if self.retry.due(Instant::now()) {
+            if !self.resumed {
+                // The next resume tries.
+            } else if let Some(live) = &self.live {
+                live.window.request_redraw();
+            } else {
+                self.try_show(event_loop);
+            }
         }
-        event_loop.set_control_flow(ControlFlow::Wait);
-        if !self.resumed {
-            // The next resume tries.
-        } else if let Some(live) = &self.live {
-            live.window.request_redraw();
-        } else {
-            self.try_show(event_loop);
-        }
+        // Asleep until an event, or the next try: never a wake-up time already past.
+        let flow = self
+            .retry
+            .next()
+            .map_or(ControlFlow::Wait, ControlFlow::WaitUntil);
+        event_loop.set_control_flow(flow);
     }
 
     fn exiting(&mut self, _: &ActiveEventLoop) {
@@ -208,17 +212,14 @@ impl Shell {
                     log::info!("shown again");
                 }
             }
-            Err(e) => self.failed(event_loop, &e),
+            Err(e) => self.failed(&e),
         }
     }
 
-    /// Logs a failure (once while it repeats) and wakes the loop for the next try.
-    fn failed(&mut self, event_loop: &ActiveEventLoop, error: &str) {
+    /// Logs a failure (once while it repeats); `about_to_wait` wakes the loop for the next try.
+    fn failed(&mut self, error: &str) {
         if self.retry.failed(error, Instant::now()) {
             log::error!("{error}; trying again every second");
-        }
-        if let Some(at) = self.retry.next() {
-            event_loop.set_control_flow(ControlFlow::WaitUntil(at));
         }
     }
 
