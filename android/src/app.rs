@@ -171,13 +171,11 @@ impl ApplicationHandler for Shell {
     }
 
     fn about_to_wait(&mut self, event_loop: &ActiveEventLoop) {
-        if self.retry.due(Instant::now()) {
-            if !self.resumed {
-                // The next resume tries.
-            } else if let Some(live) = &self.live {
-                live.window.request_redraw();
-            } else {
-                self.try_show(event_loop);
+        // Due while suspended, the try is the next resume's.
+        if self.retry.due(Instant::now()) && self.resumed {
+            match &self.live {
+                Some(live) => live.window.request_redraw(),
+                None => self.try_show(event_loop),
             }
         }
         // Asleep until an event, or the next try: never a wake-up time already past.

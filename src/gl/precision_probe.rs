@@ -27,14 +27,12 @@ impl UniformSet for ProbeUniforms {
 /// True when `mediump` arithmetic in the fragment stage rounds like fp16.
 pub fn mediump_is_fp16(dev: &Device) -> Result<bool, GlError> {
     let mut target = OffscreenTarget::new(dev, 1, 1)?;
-    let result = match Program::build::<ProbeUniforms>(dev, "precision_probe", &[], 0) {
-        Ok(mut program) => {
+    let result =
+        Program::build::<ProbeUniforms>(dev, "precision_probe", &[], 0).and_then(|mut program| {
             let pixel = draw_probe(dev, &target, &program);
             program.destroy(dev);
             pixel
-        }
-        Err(e) => Err(e),
-    };
+        });
     target.destroy(dev);
     dev.bind_default_framebuffer();
     Ok(result?.get_pixel(0, 0)[0] < 128)

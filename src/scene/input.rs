@@ -3,9 +3,9 @@
 //!
 //! Only regular files are read: a FIFO would block `open` forever and `/dev/zero` never ends,
 //! so anything else (device, FIFO, socket, folder), and on Linux any file of `/proc` or `/sys`,
-//! is refused before it is opened. A file
-//! larger than its kind's limit is refused from its size, and the read itself stops one byte
-//! past the limit, so a file that grows while it is read cannot get around it. The limits can
+//! is refused before it is opened. A file larger than its kind's limit is refused from its
+//! size, and the read itself stops one byte past the limit, so a file that grows while it is
+//! read cannot get around it. The limits can
 //! be raised (or lowered) for every kind at once with `MANYLIGHT_MAX_FILE_MB`.
 
 use std::io::Read;
@@ -14,9 +14,8 @@ use std::path::Path;
 use super::SceneError;
 
 /// Most lights a scene may hold (file lights plus random ones; `--lights`). Checked before
-/// anything is allocated: 4 Mi lights are about 400 MB of light data on the CPU (a 1.4 GB peak
-/// in `manylight --lights 4194304`, one host's figure), and at most 65 536 of them can be
-/// visible in a frame anyway.
+/// anything is allocated: 4 Mi lights are about 400 MB of light data on the CPU, and at most
+/// 65 536 of them can be visible in a frame anyway.
 pub const MAX_LIGHTS: usize = 1 << 22;
 
 /// What a file is, for its size limit and the error message.
@@ -178,9 +177,17 @@ fn read_limited(path: &Path, kind: FileKind, prefix: Option<u64>) -> Result<Vec<
 #[cfg(any(target_os = "linux", target_os = "android"))]
 fn kernel_file_system(meta: &std::fs::Metadata) -> Option<&'static str> {
     use std::os::unix::fs::MetadataExt;
-    ["/proc", "/sys"]
-        .into_iter()
-        .find(|root| std::fs::metadata(root).is_ok_and(|m| m.dev() == meta.dev()))
+    static DEVICES: std::sync::OnceLock<Vec<(&'static str, u64)>> = std::sync::OnceLock::new();
+    let devices = DEVICES.get_or_init(|| {
+        ["/proc", "/sys"]
+            .into_iter()
+            .filter_map(|root| Some((root, std::fs::metadata(root).ok()?.dev())))
+            .collect()
+    });
+    devices
+        .iter()
+        .find(|(_, device)| *device == meta.dev())
+        .map(|(root, _)| *root)
 }
 
 #[cfg(not(any(target_os = "linux", target_os = "android")))]

@@ -321,8 +321,7 @@ impl Mesh {
 
     /// The triangles' (unnormalised) normals, out-of-range corners at the origin. In f64: an
     /// f32 cross product of edges near 10⁻²³ underflows to zero, a real triangle to none. The
-    /// corners as a GPU reads them: subnormal coordinates (below 1.2·10⁻³⁸) are zero there
-    /// (llvmpipe drew a mesh at 10⁻³⁸ as nothing).
+    /// corners as a GPU reads them: subnormal coordinates (below 1.2·10⁻³⁸) are zero there.
     fn triangle_normals(&self) -> impl Iterator<Item = DVec3> + '_ {
         let read = |p: Vec3| {
             let normal = p.abs().cmpge(Vec3::splat(f32::MIN_POSITIVE));

@@ -1,8 +1,8 @@
 //! A load's warnings, logged once each when the load ends: also when it fails, where the
 //! warnings before the error explain it, and once however often a model named again in a
-//! scene file is read. At most [`MOST_SHOWN`] distinct ones a load are logged as warnings
-//! (an OBJ naming 60 000 missing textures wrote 60 000 lines); the rest go to the debug level,
-//! and one line says how many.
+//! scene file is read. At most [`MOST_SHOWN`] distinct ones a load are logged as warnings, so
+//! a model with thousands of faults cannot flood the log; the rest go to the debug level, and
+//! one line says how many.
 
 use std::cell::RefCell;
 use std::collections::HashSet;
