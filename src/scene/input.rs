@@ -161,7 +161,18 @@ fn read_limited(path: &Path, kind: FileKind, prefix: Option<u64>) -> Result<Vec<
         return Err(too_big(size));
     }
     let file = std::fs::File::open(path).map_err(io)?;
-    let mut bytes = Vec::with_capacity(size as usize);
+    // Asked for, not taken: a failed allocation would abort the process.
+    let mut bytes = Vec::new();
+    if bytes.try_reserve_exact(size as usize).is_err() {
+        return Err(refuse(
+            path,
+            std::io::ErrorKind::OutOfMemory,
+            format!(
+                "{} of {size} bytes: more than this process can allocate now",
+                kind.name()
+            ),
+        ));
+    }
     let most = prefix.map_or(limit.saturating_add(1), |p| p.min(limit.saturating_add(1)));
     file.take(most).read_to_end(&mut bytes).map_err(io)?;
     BYTES_READ.with(|read| read.set(read.get().saturating_add(bytes.len() as u64)));

@@ -25,6 +25,7 @@ mod corners;
 mod hostile_tests;
 mod lines;
 mod map_options;
+mod parse_memory;
 mod texture_names;
 mod textures;
 
@@ -257,6 +258,19 @@ pub fn load_into(
     Ok(report)
 }
 
+/// What [`load_into`] asks of the allocator for an OBJ whose text is `text`, before it
+/// rewrites the text (where it does) and before tobj parses it, besides the text: the parse
+/// bounded from the corners written or (where that is refused) from the distinct ones
+/// counted (`lab`: the tests hold loads to both).
+#[cfg(feature = "lab")]
+pub fn load_memory_bounds(text: &str, distinct_counted: bool) -> (u64, u64) {
+    let mut counts = parse_memory::ObjCounts::of(text);
+    if distinct_counted {
+        assert!(counts.count_distinct(text), "no room to count the corners");
+    }
+    (counts.rewrite_bytes(), counts.parse_bytes())
+}
+
 /// `texture` as `map_Kd`'s options read it (`-clamp`), and the base colour's transform
 /// (`-o`, `-s`); a warning names the options that are not applied and a transform that is
 /// not usable (left out).
@@ -315,30 +329,70 @@ type Parsed = (
 /// taken as a line end, as CRLF is; a UTF-8 byte-order mark (Windows editors write one) is
 /// dropped, else tobj would not know the first line's keyword. Also says whether any byte was
 /// not UTF-8.
-fn text_of(bytes: &[u8]) -> (String, bool) {
-    let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
-    let text = String::from_utf8_lossy(bytes);
-    let not_utf8 = matches!(text, std::borrow::Cow::Owned(_));
+fn text_of(mut bytes: Vec<u8>) -> (String, bool) {
+    if bytes.starts_with(b"\xEF\xBB\xBF") {
+        bytes.drain(..3);
+    }
+    // Valid UTF-8 (the common file) becomes the text without a copy.
+    let (text, not_utf8) = match String::from_utf8(bytes) {
+        Ok(text) => (text, false),
+        Err(e) => (String::from_utf8_lossy(e.as_bytes()).into_owned(), true),
+    };
     let text = if text.contains('\r') {
         text.replace("\r\n", "\n").replace('\r', "\n")
     } else {
-        text.into_owned()
+        text
     };
     (text, not_utf8)
 }
 
+/// The error for an OBJ whose `step` may take `bytes`, which the allocator refused.
+fn too_large(path: &Path, step: &str, counts: &parse_memory::ObjCounts, bytes: u64) -> SceneError {
+    let reason = format!(
+        "{step} it (faces: {}, vertices: {}) may take up to {} MiB, more than this process can \
+         allocate now",
+        counts.faces,
+        counts.positions,
+        bytes.div_ceil(1 << 20)
+    );
+    SceneError::Io {
+        path: path.to_path_buf(),
+        source: std::io::Error::new(std::io::ErrorKind::OutOfMemory, reason),
+    }
+}
+
 fn parse_obj(path: &Path, allow_outside: bool) -> Result<Parsed, SceneError> {
-    let (text, not_utf8) = text_of(&read_bounded(path, FileKind::Model)?);
+    let (text, not_utf8) = text_of(read_bounded(path, FileKind::Model)?);
     let rewrites = lines::check_obj(&text).map_err(|reason| SceneError::Obj {
         path: path.to_path_buf(),
         reason,
     })?;
+    // Every step after the read asks for its most first: a failed allocation in tobj (or in
+    // a copy of the text) would abort the process.
+    let mut counts = parse_memory::ObjCounts::of(&text);
+    let rewrite = counts.rewrite_bytes();
+    if rewrites.needed() && !parse_memory::can_allocate(rewrite) {
+        return Err(too_large(path, "rewriting", &counts, rewrite));
+    }
     let text = if rewrites.needed() {
         lines::rewrite(&text, &rewrites)
     } else {
         text
     };
-    let filled = corners::fill_missing(&text);
+    let mixed = corners::mixed(&text);
+    if mixed.contains(&true) && !parse_memory::can_allocate(rewrite) {
+        return Err(too_large(path, "rewriting", &counts, rewrite));
+    }
+    let filled = corners::fill_missing(&text, mixed);
+    // The bound from the corners written first; where that is refused, from the distinct
+    // ones, counted (real meshes share each vertex among about six triangles).
+    let mut parse = counts.parse_bytes();
+    if !parse_memory::can_allocate(parse) && counts.count_distinct(&text) {
+        parse = counts.parse_bytes();
+    }
+    if !parse_memory::can_allocate(parse) {
+        return Err(too_large(path, "loading", &counts, parse));
+    }
     let filled_corners = filled.is_some();
     let text = filled.unwrap_or(text);
     let base_dir = path.parent().unwrap_or(Path::new(".")).to_path_buf();
@@ -424,7 +478,7 @@ fn parse_obj(path: &Path, allow_outside: bool) -> Result<Parsed, SceneError> {
             warn(e.to_string());
             tobj::LoadError::OpenFileFailed
         })?;
-        let (text, not_utf8) = text_of(&bytes);
+        let (text, not_utf8) = text_of(bytes);
         if not_utf8 {
             warn(format!(
                 "{}: not UTF-8 text; bytes that are not (in names) were replaced by U+FFFD",

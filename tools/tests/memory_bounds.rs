@@ -580,6 +580,52 @@ fn mtl_statements_tobj_would_keep_do_not_grow_memory() {
     assert_eq!(out.status.code(), Some(0), "{stderr}");
 }
 
+/// A failed allocation inside tobj aborts the process, and so did the read of a file larger
+/// than the memory left. Under a 384 MiB address-space limit, a face of 2²³ corners (a 16 MB
+/// OBJ whose load peaks at about 0.55 GB, which aborted here) and a 512 MiB file are refused
+/// with an error naming the file, each before its memory is taken, and a small OBJ renders.
+#[test]
+fn an_obj_larger_than_the_memory_left_is_an_error_not_an_abort() {
+    let Ok(prlimit) = which_prlimit() else {
+        common::skip("no prlimit (util-linux) to bound the child's memory");
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let mut fan = String::from("v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf");
+    for i in 0..1 << 23 {
+        fan.push_str([" 1", " 2", " 3", " 4"][i % 4]);
+    }
+    fan.push('\n');
+    let fan_path = dir.path().join("fan.obj");
+    std::fs::write(&fan_path, fan).unwrap();
+    // A sparse file: no disk taken, and the reader refuses it before reading a byte.
+    let big_path = dir.path().join("big.obj");
+    let big = std::fs::File::create(&big_path).unwrap();
+    big.set_len(512 << 20).unwrap();
+    for (path, says) in [
+        (
+            &fan_path,
+            "loading it (faces: 1, vertices: 4) may take up to",
+        ),
+        (&big_path, "OBJ file of 536870912 bytes: more than"),
+    ] {
+        let out = render_within_384_mib(&prlimit, path, dir.path());
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{}: {stderr}", path.display());
+        assert!(stderr.contains(says), "{stderr}");
+        assert!(stderr.contains("this process can allocate now"), "{stderr}");
+    }
+    let small = dir.path().join("small.obj");
+    std::fs::write(&small, "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n").unwrap();
+    let out = render_within_384_mib(&prlimit, &small, dir.path());
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
 /// `manylight render` of `scene` (8 × 8, into `dir`) under a 384 MiB address-space limit.
 fn render_within_384_mib(prlimit: &Path, scene: &Path, dir: &Path) -> std::process::Output {
     std::process::Command::new(prlimit)

@@ -9,9 +9,10 @@
 //! normal is then replaced by the faces' own, as for any unusable normal in a file.
 
 /// The text with every face corner naming a texture coordinate where the file has any, and a
-/// normal where it has any; `None` when every corner already does (the common file).
-pub(super) fn fill_missing(text: &str) -> Option<String> {
-    let [fill_uvs, fill_normals] = mixed(text);
+/// normal where it has any (`mixed`, from [`mixed`]); `None` when every corner already does
+/// (the common file).
+pub(super) fn fill_missing(text: &str, mixed: [bool; 2]) -> Option<String> {
+    let [fill_uvs, fill_normals] = mixed;
     if !fill_uvs && !fill_normals {
         return None;
     }
@@ -58,7 +59,7 @@ pub(super) fn fill_missing(text: &str) -> Option<String> {
 /// next `o` or `g` line; tobj also starts a new mesh at a `usemtl` that changes the material,
 /// so this may see a mix tobj would not (then the rewrite only costs a warning), never the
 /// other way round.
-fn mixed(text: &str) -> [bool; 2] {
+pub(super) fn mixed(text: &str) -> [bool; 2] {
     let (mut has, mut mixed) = ([false; 2], [false; 2]);
     let (mut with, mut without) = ([false; 2], [false; 2]);
     for line in text.lines() {
@@ -107,19 +108,23 @@ fn filled(index: Option<&str>, fill: bool) -> Option<String> {
 
 #[cfg(test)]
 mod tests {
-    use super::fill_missing;
+    use super::{fill_missing, mixed};
+
+    fn filled(text: &str) -> Option<String> {
+        fill_missing(text, mixed(text))
+    }
 
     #[test]
     fn corners_without_a_texture_coordinate_or_normal_name_the_ones_put_first() {
         let uniform = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1/1 2/1 3/1\nf 1 2 3\n";
         assert_eq!(
-            fill_missing(uniform).as_deref(),
+            filled(uniform).as_deref(),
             Some("vt 0 0\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1/2 2/2 3/2\nf 1/1 2/1 3/1\n")
         );
         // Normals too, negative indices kept, a corner with only a normal keeps its `//`.
         let mixed = "v 0 0 0\nvt 0 0\nvn 0 0 1\nf 1/1/1 1/-1 1//-1\n";
         assert_eq!(
-            fill_missing(mixed).as_deref(),
+            filled(mixed).as_deref(),
             Some("vt 0 0\nvn 0 0 0\nv 0 0 0\nvt 0 0\nvn 0 0 1\nf 1/2/2 1/-1/1 1/1/-1\n")
         );
         // Files whose corners all name them, or that have none, or whose objects each do or
@@ -130,7 +135,7 @@ mod tests {
             "v 0 0 0\nf 1 1 1\n",
             "v 0 0 0\nvn 0 0 1\nf 1//1 1//1 1//1\n",
         ] {
-            assert_eq!(fill_missing(text), None, "{text:?}");
+            assert_eq!(filled(text), None, "{text:?}");
         }
     }
 }

@@ -306,14 +306,14 @@ enum VertexLine {
 /// The objects tobj makes of a file, counted as [`check_obj`] reads it: one where faces
 /// follow an `o`, a `g` or a `usemtl` naming another material.
 #[derive(Default)]
-struct Objects<'a> {
-    with_faces: usize,
+pub(super) struct Objects<'a> {
+    pub with_faces: usize,
     current_has_faces: bool,
     material: Option<&'a str>,
 }
 
 impl<'a> Objects<'a> {
-    fn read(&mut self, key: Option<&str>, line: &'a str) -> Result<(), String> {
+    pub fn read(&mut self, key: Option<&str>, line: &'a str) -> Result<(), String> {
         match key {
             Some("o" | "g") => self.current_has_faces = false,
             Some("usemtl") => {
