@@ -626,6 +626,38 @@ fn an_obj_larger_than_the_memory_left_is_an_error_not_an_abort() {
     );
 }
 
+/// A glTF primitive without normals is drawn flat: each triangle's corners get their own
+/// copies of the vertex colours. Those copies (16 bytes a corner) were made before the
+/// unshared vertices were counted against the file's limit, so a 12 MB strip of byte indices
+/// (36 M corners, 0.58 GB of colours) aborted under 384 MiB before its error.
+#[test]
+fn flat_shaded_gltf_vertices_are_counted_before_they_are_copied() {
+    use common::gltf::{Builder, UNSIGNED_BYTE};
+    let Ok(prlimit) = which_prlimit() else {
+        common::skip("no prlimit (util-linux) to bound the child's memory");
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let mut b = Builder::default();
+    let corners: Vec<f32> = (0..256)
+        .flat_map(|i| [i as f32, (i % 7) as f32, 0.0])
+        .collect();
+    let p = b.floats(&corners, "VEC3");
+    let c = b.floats(&[0.5; 4 * 256], "VEC4");
+    let strip: Vec<u8> = (0..12_000_000u32).map(|i| (i % 256) as u8).collect();
+    let i = b.accessor(&strip, UNSIGNED_BYTE, "SCALAR", strip.len());
+    let doc = serde_json::json!({"scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": p, "COLOR_0": c},
+                                    "indices": i, "mode": 5}]}]});
+    let path = dir.path().join("strip.glb");
+    std::fs::write(&path, b.glb(doc)).unwrap();
+    let out = render_within_384_mib(&prlimit, &path, dir.path());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("meshes[0].primitives[0]"), "{stderr}");
+    assert!(stderr.contains("vertices"), "{stderr}");
+}
+
 /// `manylight render` of `scene` (8 × 8, into `dir`) under a 384 MiB address-space limit.
 fn render_within_384_mib(prlimit: &Path, scene: &Path, dir: &Path) -> std::process::Output {
     std::process::Command::new(prlimit)

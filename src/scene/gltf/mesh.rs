@@ -90,7 +90,7 @@ pub(super) fn build(
     for (i, v) in positions.iter().enumerate() {
         if !v.is_finite() {
             return Err(format!(
-                "{pos_field}: element {i} is not finite; positions must be"
+                "{pos_field}: element {i} is not finite; positions must be finite"
             ));
         }
         if v.abs().max_element() > MAX_VERTEX_COORD {
@@ -119,7 +119,7 @@ pub(super) fn build(
             uvs = raw.chunks_exact(2).map(Vec2::from_slice).collect();
             if let Some(i) = uvs.iter().position(|t| !t.is_finite()) {
                 return Err(format!(
-                    "{}: element {i} is not finite; texture coordinates must be",
+                    "{}: element {i} is not finite; texture coordinates must be finite",
                     attr("TEXCOORD_0", &a)
                 ));
             }
@@ -182,11 +182,13 @@ pub(super) fn build(
     // Without normals the file's tangents are ignored (glTF 2.0 §3.7.2.1): they were made for
     // normals the file does not give, so a normal map takes generated ones.
     let tangents = if flat { Vec::new() } else { tangents };
-    let (colors, tangents) = (unshare(colors), unshare(tangents));
-    let (positions, uvs, indices) = if flat {
-        // The unshared vertices replace the file's.
+    if flat {
+        // The unshared vertices replace the file's, counted before any is made.
         budget.give_back_vertices(n);
         budget.take("vertices", indices.len(), field)?;
+    }
+    let (colors, tangents) = (unshare(colors), unshare(tangents));
+    let (positions, uvs, indices) = if flat {
         let pick = |i: &u32| positions[*i as usize];
         let flat_uvs = if uvs.is_empty() {
             Vec::new()
@@ -356,7 +358,7 @@ fn read_colors(
         .collect();
     if let Some(i) = colors.iter().position(|c| !c.is_finite()) {
         return Err(format!(
-            "{field}: element {i} is not finite; colours must be"
+            "{field}: element {i} is not finite; colours must be finite"
         ));
     }
     // The mesh clamps them: said, since a colour of −1e30 is black.
