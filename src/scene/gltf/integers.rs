@@ -1,8 +1,10 @@
 //! Integers past `u32`: the `gltf` crate reads indices (`"mesh": 4294967296`) and enum codes
 //! (`mode`, `componentType`, `target`, sampler filters and wraps) as `value as u32`, so 2³²
 //! would wrap to 0 (mesh 0, mode POINTS). Refused here first, naming the field. Only
-//! `byteOffset`, `byteLength` and `count` may be larger; `extras` and unsupported extensions
-//! are not looked into (any JSON is valid there). Walks the JSON without building it.
+//! `byteOffset`, `byteLength` and `count` may be larger, and the schema's numbers (a
+//! translation, a factor, a camera's `zfar`: JavaScript writes `1e10` as `10000000000`);
+//! `extras` and unsupported extensions are not looked into (any JSON is valid there). Walks
+//! the JSON without building it.
 
 use std::fmt;
 
@@ -33,6 +35,35 @@ pub(super) fn check(json: &[u8]) -> Result<(), String> {
 
 /// Fields whose values may pass `u32` (the crate reads them as `u64`).
 const WIDE: &[&str] = &["byteOffset", "byteLength", "count"];
+
+/// Fields (or arrays) of numbers, not integers, in the schema and the extensions read: a
+/// whole number written without a fraction is still their number.
+const NUMBERS: &[&str] = &[
+    "translation",
+    "rotation",
+    "scale",
+    "matrix",
+    "weights",
+    "min",
+    "max",
+    "baseColorFactor",
+    "metallicFactor",
+    "roughnessFactor",
+    "emissiveFactor",
+    "alphaCutoff",
+    "strength",
+    "yfov",
+    "znear",
+    "zfar",
+    "aspectRatio",
+    "xmag",
+    "ymag",
+    "color",
+    "intensity",
+    "range",
+    "innerConeAngle",
+    "outerConeAngle",
+];
 
 /// Extensions whose contents the loader reads (others are skipped).
 const READ_EXTENSIONS: &[&str] = &["KHR_lights_punctual"];
@@ -110,11 +141,14 @@ impl<'de> Visitor<'de> for Walk<'_> {
     }
 
     fn visit_u64<E>(self, v: u64) -> Result<(), E> {
+        // The nearest key: an element of `translation` is one of its numbers.
+        let key = self.path.iter().rev().find_map(Part::key);
         let wide = self
             .path
             .last()
             .and_then(Part::key)
-            .is_some_and(|k| WIDE.contains(&k));
+            .is_some_and(|k| WIDE.contains(&k))
+            || key.is_some_and(|k| NUMBERS.contains(&k));
         if v > u64::from(u32::MAX) && !wide {
             *self.found = Some(self.field());
         }
@@ -199,5 +233,19 @@ mod tests {
             "extras":{"mesh":8589934592},
             "nodes":[{"extras":[8589934592],"extensions":{"EXT_other":{"n":8589934592}}}]}"#;
         assert!(check(json).is_ok());
+    }
+
+    #[test]
+    fn numbers_written_as_whole_numbers_may_pass_u32() {
+        let json = br#"{"nodes":[{"translation":[5000000000,0,0],"scale":[1,1,8589934592]}],
+            "cameras":[{"perspective":{"yfov":1,"znear":1,"zfar":10000000000}}],
+            "accessors":[{"min":[0],"max":[5000000000]}],
+            "materials":[{"emissiveFactor":[5000000000,0,0]}],
+            "extensions":{"KHR_lights_punctual":{"lights":[{"type":"point",
+                "intensity":5000000000,"range":5000000000}]}}}"#;
+        assert_eq!(check(json), Ok(()));
+        // Indices among them are still refused: a node's children, a camera's index.
+        let err = check(br#"{"nodes":[{"translation":[0,0,0],"camera":4294967296}]}"#);
+        assert!(err.unwrap_err().starts_with("nodes[0].camera:"));
     }
 }
