@@ -30,6 +30,7 @@ pub mod motion;
 pub mod normal_matrix;
 pub mod obj;
 mod orientation;
+mod png_profile;
 pub mod random;
 pub mod raycast;
 mod said;

@@ -658,6 +658,51 @@ fn flat_shaded_gltf_vertices_are_counted_before_they_are_copied() {
     assert!(stderr.contains("vertices"), "{stderr}");
 }
 
+/// A PNG's colour profile is never used (textures are taken as sRGB), but the decoder
+/// inflated it up to its 512 MiB limit: a 4×4 texture whose 0.3 MB profile inflates to
+/// 300 MiB aborted a render under 384 MiB. The profile is now taken out unread, and the
+/// texture's colour reaches the frame.
+#[test]
+fn a_pngs_colour_profile_is_not_inflated() {
+    use image::ImageEncoder;
+    let Ok(prlimit) = which_prlimit() else {
+        common::skip("no prlimit (util-linux) to bound the child's memory");
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let mut png = Vec::new();
+    let mut encoder = image::codecs::png::PngEncoder::new(&mut png);
+    encoder.set_icc_profile(vec![0; 300 << 20]).unwrap();
+    let red = [230u8, 20, 20, 255].repeat(16);
+    encoder
+        .write_image(&red, 4, 4, image::ExtendedColorType::Rgba8)
+        .unwrap();
+    assert!(png.len() < 1 << 20, "{} bytes", png.len());
+    std::fs::write(dir.path().join("t.png"), png).unwrap();
+    std::fs::write(
+        dir.path().join("m.mtl"),
+        "newmtl m\nKd 1 1 1\nmap_Kd t.png\n",
+    )
+    .unwrap();
+    let path = dir.path().join("m.obj");
+    std::fs::write(
+        &path,
+        "mtllib m.mtl\nusemtl m\nv -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\n\
+         vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nf 1/1 2/2 3/3 4/4\n",
+    )
+    .unwrap();
+    let out = render_within_384_mib(&prlimit, &path, dir.path());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{stderr}");
+    assert!(
+        !stderr.contains("t.png"),
+        "no warning of the texture: {stderr}"
+    );
+    let frame = image::open(dir.path().join("x.png")).unwrap().to_rgba8();
+    let centre = frame.get_pixel(4, 4).0;
+    assert!(centre[0] > 2 * centre[1].max(centre[2]), "{centre:?}");
+}
+
 /// `manylight render` of `scene` (8 × 8, into `dir`) under a 384 MiB address-space limit.
 fn render_within_384_mib(prlimit: &Path, scene: &Path, dir: &Path) -> std::process::Output {
     std::process::Command::new(prlimit)
