@@ -169,14 +169,16 @@ impl GpuScene {
         self.meshes[&(Arc::as_ptr(&object.mesh) as usize)].3
     }
 
-    /// Refuses an object its transform places past the camera's coordinate limit, naming the
-    /// transform: a scale or translation past it overflowed the view matrix's `f32` form and
-    /// left the object out of the frame without a word. (The file loaders check the same.)
+    /// Refuses an object its transform places past the camera's coordinate limit or shrinks
+    /// into f32's subnormal numbers, naming the transform: a scale or translation past it
+    /// overflowed the view matrix's `f32` form and left the object out of the frame without a
+    /// word, a tiny one drew black. (The file loaders check the same.)
     pub fn check_placement(&self, scene: &Scene) -> Result<(), SceneError> {
         for (i, o) in scene.objects.iter().enumerate() {
-            if let Some(b) = self.world_bounds(o) {
-                if b.check_placed_by("").is_err() {
-                    b.check_placed_by(&format!("objects[{i}]"))?;
+            let (_, _, bounds, _) = &self.meshes[&(Arc::as_ptr(&o.mesh) as usize)];
+            if let Some(b) = bounds {
+                if b.check_placed_by(&o.transform, "").is_err() {
+                    b.check_placed_by(&o.transform, &format!("objects[{i}]"))?;
                 }
             }
         }

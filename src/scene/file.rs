@@ -501,8 +501,8 @@ fn check_placed(scene: &Scene, first: usize, field: &str) -> Result<(), SceneErr
         let bounds = *mesh_bounds
             .entry(std::sync::Arc::as_ptr(&o.mesh))
             .or_insert_with(|| o.mesh.bounds());
-        if let Some(b) = bounds.map(|b| b.transformed(&o.transform)) {
-            b.check_placed_by(field)?;
+        if let Some(b) = bounds {
+            b.check_placed_by(&o.transform, field)?;
         }
     }
     Ok(())

@@ -222,6 +222,13 @@ fn values_the_maths_cannot_carry_are_refused_naming_the_real_field() {
             }),
             "objects[0].transform",
         ),
+        // Shrunk into f32's subnormal numbers, which a GPU reads as zero: a black frame.
+        (
+            Box::new(|s: &mut Scene| {
+                s.objects[0].transform = DMat4::from_scale(DVec3::splat(1e-40))
+            }),
+            "objects[0].transform",
+        ),
         // Its f32 projection scale was 0: nothing drawn, no error.
         (
             Box::new(|s: &mut Scene| {

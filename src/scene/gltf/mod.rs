@@ -58,7 +58,7 @@ pub use material::{shininess, DIELECTRIC_SPECULAR};
 use super::access::LoadOptions;
 use super::camera::MAX_CAMERA_COORD;
 use super::input::{self, read_bounded, FileKind};
-use super::mesh::MAX_SCENE_MESHES;
+use super::mesh::{placed_too_small, MAX_SCENE_MESHES, MIN_PLACED_SIZE};
 use super::obj::LoadReport;
 use super::texture_budget::TextureBudget;
 use super::{
@@ -543,12 +543,16 @@ fn check_placement(bounds: Option<Aabb>, world: &DMat4) -> Result<(), String> {
     if !world.is_finite() {
         return Err("the world transform is not finite".into());
     }
-    if let Some(b) = bounds.map(|b| b.transformed(world)) {
-        let reach = b.reach();
+    if let Some(bounds) = bounds {
+        let reach = bounds.transformed(world).reach();
         if !reach.is_finite() || reach > MAX_CAMERA_COORD {
             return Err(format!(
                 "world-space bounds reach {reach:e}, past ±{MAX_CAMERA_COORD:e}"
             ));
+        }
+        let size = bounds.placed_size(world);
+        if size < MIN_PLACED_SIZE {
+            return Err(format!("the world transform {}", placed_too_small(size)));
         }
     }
     Ok(())

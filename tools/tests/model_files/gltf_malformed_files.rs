@@ -146,6 +146,13 @@ fn malformed_files_are_errors_naming_the_file_and_what_is_wrong() {
             b.gltf(doc.clone()).into_bytes(),
             vec!["nodes[0]", "bounds"],
         ));
+        // Scaled into f32's subnormal numbers: a black frame, not an object.
+        doc["nodes"][0]["scale"] = json!([1e-40, 1e-40, 1e-40]);
+        cases.push((
+            "tiny.gltf",
+            b.gltf(doc.clone()).into_bytes(),
+            vec!["nodes[0]", "shrinks the object to"],
+        ));
         doc["nodes"][0] = json!({"mesh": 0, "rotation": [0, 0, 0, 0]});
         cases.push((
             "rotation.gltf",
@@ -334,6 +341,8 @@ fn a_scene_files_transform_that_places_a_model_out_of_range_is_blamed_on_the_sce
         (r#""gltf": "tri.gltf""#, r#"{"translate": [0, 0, 5e12]}"#),
         (r#""obj": "q.obj""#, r#"{"translate": [0, 0, 5e12]}"#),
         (r#""builtin": "plane""#, r#"{"scale": [1e200, 1, 1]}"#),
+        (r#""gltf": "tri.gltf""#, r#"{"scale": 1e-40}"#),
+        (r#""obj": "q.obj""#, r#"{"scale": 1e-40}"#),
     ] {
         let text = format!(
             r#"{{"objects": [{{"builtin": "plane"}}, {{{model}, "transform": {transform}}}]}}"#
