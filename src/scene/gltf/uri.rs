@@ -67,7 +67,8 @@ fn scheme(uri: &str) -> Option<&str> {
 /// `%XX` sequences to bytes; everything else as it is.
 pub(super) fn percent_decode(s: &str) -> Result<Vec<u8>, String> {
     let bytes = s.as_bytes();
-    let mut out = Vec::with_capacity(bytes.len());
+    let mut out = Vec::new();
+    reserve(&mut out, bytes.len())?;
     let mut i = 0;
     while i < bytes.len() {
         if bytes[i] == b'%' {
@@ -98,25 +99,42 @@ pub(super) fn decode_base64(s: &str) -> Result<Vec<u8>, String> {
             .with_decode_padding_mode(DecodePaddingMode::Indifferent)
             .with_decode_allow_trailing_bits(true),
     );
-    // The URL-safe alphabet's two characters, mapped to the standard ones: exporters mix them.
-    let standard: Vec<u8> = s
-        .trim_end_matches('=')
-        .bytes()
-        .map(|c| match c {
+    // The URL-safe alphabet's two characters, mapped to the standard ones (exporters mix
+    // them) in a copy made only where there are any: a payload may be a gigabyte.
+    let payload = s.trim_end_matches('=');
+    let mapped;
+    let input = if payload.contains(['-', '_']) {
+        let mut copy = Vec::new();
+        reserve(&mut copy, payload.len())?;
+        copy.extend(payload.bytes().map(|c| match c {
             b'-' => b'+',
             b'_' => b'/',
             c => c,
-        })
-        .collect();
-    LENIENT.decode(standard).map_err(|e| match e {
-        DecodeError::InvalidByte(i, c) => format!(
-            "base64 payload has an invalid character {:?} at position {i}",
-            c as char
-        ),
+        }));
+        mapped = copy;
+        &mapped[..]
+    } else {
+        payload.as_bytes()
+    };
+    let mut out = Vec::new();
+    reserve(&mut out, base64::decoded_len_estimate(input.len()))?;
+    LENIENT.decode_vec(input, &mut out).map_err(|e| match e {
+        // The position only: the payload is the file's data.
+        DecodeError::InvalidByte(i, _) => {
+            format!("base64 payload has an invalid character at position {i}")
+        }
         DecodeError::InvalidLength(_) | DecodeError::InvalidLastSymbol(..) => {
             "base64 payload is truncated (its length is not valid)".into()
         }
         DecodeError::InvalidPadding => "base64 payload has invalid padding".into(),
+    })?;
+    Ok(out)
+}
+
+/// Room for `bytes` more in `v`, asked of the allocator (a failed allocation would abort).
+fn reserve(v: &mut Vec<u8>, bytes: usize) -> Result<(), String> {
+    v.try_reserve_exact(bytes).map_err(|_| {
+        format!("a data URI of {bytes} bytes: more than this process can allocate now")
     })
 }
 
@@ -132,7 +150,14 @@ mod tests {
         assert_eq!(decode_base64("").unwrap(), b"");
         assert_eq!(decode_base64("AAECAw==").unwrap(), [0, 1, 2, 3]);
         let err = decode_base64("aGV*bG8=").unwrap_err();
-        assert!(err.contains("position 3"), "{err}");
+        assert!(err.contains("position 3") && !err.contains('*'), "{err}");
+        // URL-safe characters, mapped; and a character that is not ASCII is not shown.
+        assert_eq!(decode_base64("-_-_").unwrap(), [0xfb, 0xff, 0xbf]);
+        let err = decode_base64("aGV\u{c3}bG8=").unwrap_err();
+        assert!(
+            err.contains("position 3") && !err.contains('\u{c3}'),
+            "{err}"
+        );
         assert!(
             decode_base64("aGVsb").is_err(),
             "one character past a whole byte"
