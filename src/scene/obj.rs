@@ -461,10 +461,14 @@ fn parse_obj(path: &Path, allow_outside: bool) -> Result<Parsed, SceneError> {
             }
             named.insert(name.clone());
         }
-        // `find` is `Some`: the library is read as joined (reading it says if it is
-        // missing), or as its bare file name was found; there is always a path.
+        // Found as written or in another letter case (an exporter on Windows), as textures
+        // are, or by its bare file name; else read as joined, which says it is missing:
+        // there is always a path.
         let listings = &mut Listings::default();
-        let mtl_path = within_folder(&base_dir, &name, allow_outside, listings, |p, _| Some(p))
+        let in_any_case = |joined, listings: &mut Listings| {
+            resolve_texture_in(&base_dir, &name, allow_outside, listings).or(Some(joined))
+        };
+        let mtl_path = within_folder(&base_dir, &name, allow_outside, listings, in_any_case)
             .map(|found| found.unwrap_or_default())
             .map_err(|refusal| {
                 warn(format!("{}: mtllib {refusal}", path.display()));
@@ -647,6 +651,9 @@ mod tests {
         // its file name.
         std::fs::write(model.join("own.mtl"), "newmtl red\nKd 0 0 1\n").unwrap();
         write("C:\\Users\\bob\\Own.MTL").unwrap();
+        assert_eq!(diffuse(false).0, Vec3::new(0.0, 0.0, 1.0));
+        // Named in another letter case, as a Windows exporter may.
+        write("OWN.Mtl").unwrap();
         assert_eq!(diffuse(false).0, Vec3::new(0.0, 0.0, 1.0));
     }
 
