@@ -30,14 +30,6 @@ pub const MAX_TEXCOORD: f32 = 1e9;
 /// numbers, which GPUs read as zero, and the frame is black (a glTF node scaled by 1e-40).
 pub const MIN_PLACED_SIZE: f64 = 1e-36;
 
-/// Why world bounds `size` across are refused.
-pub(crate) fn placed_too_small(size: f64) -> String {
-    format!(
-        "shrinks the object to {size:e} across, below {MIN_PLACED_SIZE:e} (f32's \
-         subnormal numbers, which GPUs read as zero)"
-    )
-}
-
 /// Axis-aligned bounding box in `f64`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Aabb {
@@ -48,28 +40,38 @@ pub struct Aabb {
 }
 
 impl Aabb {
-    /// Refuses these object-space bounds placed by `transform` (`field`'s) where their world
-    /// bounds are not finite, reach past the camera's coordinate limit or shrink below
-    /// [`MIN_PLACED_SIZE`], naming `field.transform`.
+    /// Refuses these object-space bounds placed by `transform` (`field`'s) as
+    /// [`Aabb::placement_refusal`] says, naming `field.transform`.
     pub(crate) fn check_placed_by(&self, transform: &DMat4, field: &str) -> Result<(), SceneError> {
+        match self.placement_refusal(transform) {
+            None => Ok(()),
+            Some(reason) => Err(SceneError::invalid(format!("{field}.transform"), reason)),
+        }
+    }
+
+    /// Why these object-space bounds cannot be placed by `transform`, if they cannot: their
+    /// world bounds are not finite or reach past the camera's coordinate limit, or shrink
+    /// below [`MIN_PLACED_SIZE`]. The message completes "the transform …".
+    pub(crate) fn placement_refusal(&self, transform: &DMat4) -> Option<String> {
         let reach = self.transformed(transform).reach();
-        let size = self.placed_size(transform);
-        let reason = if !(reach.is_finite() && reach <= MAX_CAMERA_COORD) {
-            format!(
+        if !(reach.is_finite() && reach <= MAX_CAMERA_COORD) {
+            return Some(format!(
                 "places the object's bounds {reach:e} from the origin, past \
                  ±{MAX_CAMERA_COORD:e} (the camera's limit)"
+            ));
+        }
+        let size = self.placed_size(transform);
+        (size < MIN_PLACED_SIZE).then(|| {
+            format!(
+                "shrinks the object to {size:e} across, below {MIN_PLACED_SIZE:e} (f32's \
+                 subnormal numbers, which GPUs read as zero)"
             )
-        } else if size < MIN_PLACED_SIZE {
-            placed_too_small(size)
-        } else {
-            return Ok(());
-        };
-        Err(SceneError::invalid(format!("{field}.transform"), reason))
+        })
     }
 
     /// The largest side of these bounds scaled, turned and sheared by `transform`, not moved
     /// (a tiny object far out rounds to one point in f64 too, and is refused by area later).
-    pub(crate) fn placed_size(&self, transform: &DMat4) -> f64 {
+    fn placed_size(&self, transform: &DMat4) -> f64 {
         // A box's extent under a linear map is the map's absolute values times its sides.
         let m = glam::DMat3::from_mat4(*transform);
         let abs = glam::DMat3::from_cols(m.x_axis.abs(), m.y_axis.abs(), m.z_axis.abs());

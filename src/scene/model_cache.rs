@@ -14,7 +14,6 @@ use std::sync::Arc;
 use glam::DMat4;
 
 use super::access::LoadOptions;
-use super::camera::MAX_CAMERA_COORD;
 use super::mesh::MAX_SCENE_MESHES;
 use super::obj::{self, LoadReport};
 use super::texture::Sampling;
@@ -72,8 +71,9 @@ impl Loaded {
     }
 
     /// Places the model again with `transform`, reusing an unrecoloured copy of its materials
-    /// unless the caller will `recolour` them. Errors (from `path`) when a placed object's
-    /// bounds pass the camera's coordinate limit, as the glTF loader's own check does.
+    /// unless the caller will `recolour` them. Errors (from `path`) where a placed object's
+    /// transform is not finite or its bounds cannot be placed (`Aabb::placement_refusal`),
+    /// as the glTF loader's own check says.
     fn place(
         &mut self,
         scene: &mut Scene,
@@ -83,18 +83,12 @@ impl Loaded {
     ) -> Result<(), SceneError> {
         for (_, _, relative, bounds) in &self.objects {
             let world = transform * *relative;
-            let reach = bounds.map_or(0.0, |b| {
-                let b = b.transformed(&world);
-                b.min.abs().max(b.max.abs()).max_element()
-            });
-            if !world.is_finite() || !reach.is_finite() || reach > MAX_CAMERA_COORD {
-                return Err(SceneError::invalid(
-                    transform_field,
-                    format!(
-                        "places the object's bounds {reach:e} from the origin, past \
-                         ±{MAX_CAMERA_COORD:e} (the camera's limit)"
-                    ),
-                ));
+            let refusal = match bounds {
+                Some(b) => b.placement_refusal(&world),
+                None => (!world.is_finite()).then(|| "is not finite".to_string()),
+            };
+            if let Some(reason) = refusal {
+                return Err(SceneError::invalid(transform_field, reason));
             }
         }
         let base = match self.uncoloured_at {

@@ -56,9 +56,8 @@ pub use lights::{
 pub use material::{shininess, DIELECTRIC_SPECULAR};
 
 use super::access::LoadOptions;
-use super::camera::MAX_CAMERA_COORD;
 use super::input::{self, read_bounded, FileKind};
-use super::mesh::{placed_too_small, MAX_SCENE_MESHES, MIN_PLACED_SIZE};
+use super::mesh::MAX_SCENE_MESHES;
 use super::obj::LoadReport;
 use super::texture_budget::TextureBudget;
 use super::{
@@ -537,23 +536,14 @@ fn validate(root: &gltf::json::Root) -> Result<(), String> {
     ))
 }
 
-/// A placed mesh's world bounds must stay within the camera's coordinate limit (the view
-/// maths keeps precision only up to there), and its transform finite.
+/// A placed mesh's transform must be finite and place it as `Aabb::placement_refusal` says
+/// (within the camera's coordinate limit, not shrunk into f32's subnormal numbers).
 fn check_placement(bounds: Option<Aabb>, world: &DMat4) -> Result<(), String> {
     if !world.is_finite() {
         return Err("the world transform is not finite".into());
     }
-    if let Some(bounds) = bounds {
-        let reach = bounds.transformed(world).reach();
-        if !reach.is_finite() || reach > MAX_CAMERA_COORD {
-            return Err(format!(
-                "world-space bounds reach {reach:e}, past ±{MAX_CAMERA_COORD:e}"
-            ));
-        }
-        let size = bounds.placed_size(world);
-        if size < MIN_PLACED_SIZE {
-            return Err(format!("the world transform {}", placed_too_small(size)));
-        }
+    if let Some(reason) = bounds.and_then(|b| b.placement_refusal(world)) {
+        return Err(format!("the world transform {reason}"));
     }
     Ok(())
 }
