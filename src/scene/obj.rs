@@ -267,7 +267,8 @@ pub fn load_into(
 pub fn load_memory_bounds(text: &str, distinct_counted: bool) -> (u64, u64) {
     let mut counts = parse_memory::ObjCounts::of(text);
     if distinct_counted {
-        assert!(counts.count_distinct(text), "no room to count the corners");
+        counts.count_distinct(text);
+        assert!(counts.distinct.is_some(), "no room to count the corners");
     }
     (counts.rewrite_bytes(), counts.parse_bytes())
 }
@@ -347,8 +348,17 @@ fn text_of(mut bytes: Vec<u8>) -> (String, bool) {
     (text, not_utf8)
 }
 
-/// The error for an OBJ whose `step` may take `bytes`, which the allocator refused.
-fn too_large(path: &Path, step: &str, counts: &parse_memory::ObjCounts, bytes: u64) -> SceneError {
+/// Asks the allocator for the `bytes` an OBJ's `step` may take: an error naming the file and
+/// its counts where they cannot be had.
+fn ask_for(
+    path: &Path,
+    step: &str,
+    counts: &parse_memory::ObjCounts,
+    bytes: u64,
+) -> Result<(), SceneError> {
+    if parse_memory::can_allocate(bytes) {
+        return Ok(());
+    }
     let reason = format!(
         "{step} it (faces: {}, vertices: {}) may take up to {} MiB, more than this process can \
          allocate now",
@@ -356,10 +366,10 @@ fn too_large(path: &Path, step: &str, counts: &parse_memory::ObjCounts, bytes: u
         counts.positions,
         bytes.div_ceil(1 << 20)
     );
-    SceneError::Io {
+    Err(SceneError::Io {
         path: path.to_path_buf(),
         source: std::io::Error::new(std::io::ErrorKind::OutOfMemory, reason),
-    }
+    })
 }
 
 fn parse_obj(path: &Path, allow_outside: bool) -> Result<Parsed, SceneError> {
@@ -371,28 +381,22 @@ fn parse_obj(path: &Path, allow_outside: bool) -> Result<Parsed, SceneError> {
     // Every step after the read asks for its most first: a failed allocation in tobj (or in
     // a copy of the text) would abort the process.
     let mut counts = parse_memory::ObjCounts::of(&text);
-    let rewrite = counts.rewrite_bytes();
-    if rewrites.needed() && !parse_memory::can_allocate(rewrite) {
-        return Err(too_large(path, "rewriting", &counts, rewrite));
-    }
     let text = if rewrites.needed() {
+        ask_for(path, "rewriting", &counts, counts.rewrite_bytes())?;
         lines::rewrite(&text, &rewrites)
     } else {
         text
     };
     let mixed = corners::mixed(&text);
-    if mixed.contains(&true) && !parse_memory::can_allocate(rewrite) {
-        return Err(too_large(path, "rewriting", &counts, rewrite));
+    if mixed.contains(&true) {
+        ask_for(path, "rewriting", &counts, counts.rewrite_bytes())?;
     }
     let filled = corners::fill_missing(&text, mixed);
     // The bound from the corners written first; where that is refused, from the distinct
     // ones, counted (real meshes share each vertex among about six triangles).
-    let mut parse = counts.parse_bytes();
-    if !parse_memory::can_allocate(parse) && counts.count_distinct(&text) {
-        parse = counts.parse_bytes();
-    }
-    if !parse_memory::can_allocate(parse) {
-        return Err(too_large(path, "loading", &counts, parse));
+    if !parse_memory::can_allocate(counts.parse_bytes()) {
+        counts.count_distinct(&text);
+        ask_for(path, "loading", &counts, counts.parse_bytes())?;
     }
     let filled_corners = filled.is_some();
     let text = filled.unwrap_or(text);

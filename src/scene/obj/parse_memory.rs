@@ -91,11 +91,11 @@ impl ObjCounts {
     /// Counts the distinct corners each object's faces write (`1/2/3` and `1/2/3` once, a
     /// corner with a negative index every time) into [`Self::distinct`]: tobj makes a vertex
     /// of each distinct index triple of an object, and two equal words of positive indices
-    /// name one. Takes a set as large as the largest
-    /// object's distinct corners, asked of the allocator first (false when refused).
-    pub fn count_distinct(&mut self, text: &str) -> bool {
+    /// name one. Takes a set as large as the largest object's distinct corners, asked of the
+    /// allocator first (where refused, [`Self::distinct`] stays unknown).
+    pub fn count_distinct(&mut self, text: &str) {
         if !can_allocate(self.corners * SET_ENTRY) {
-            return false;
+            return;
         }
         let mut seen = std::collections::HashSet::new();
         let (mut objects, mut sum) = (Objects::default(), 0);
@@ -121,7 +121,6 @@ impl ObjCounts {
             }
         }
         self.distinct = Some(sum + seen.len() as u64);
-        true
     }
 
     /// At most how many bytes a rewrite of the text takes (either of them, whose copy then
@@ -203,7 +202,7 @@ mod tests {
         // `1 2 1` and `1 2 1 2 1` are two distinct corners in object `a`; `1 2 1 2` in the
         // object `usemtl` starts, two more.
         let mut counted = counts;
-        assert!(counted.count_distinct(text));
+        counted.count_distinct(text);
         assert_eq!(counted.distinct, Some(4));
         assert!(counted.parse_bytes() < counts.parse_bytes());
     }
