@@ -1,144 +1,19 @@
-//! Triangle meshes in object space and axis-aligned bounds.
+//! Triangle meshes in object space.
 
 use std::collections::HashMap;
 
-use glam::{DMat4, DVec3, Vec2, Vec3, Vec4};
+use glam::{DVec3, Vec2, Vec3, Vec4};
 
-use super::camera::MAX_CAMERA_COORD;
+pub use super::aabb::{Aabb, MIN_PLACED_SIZE};
+use super::mesh_limits::{check_indices, check_per_vertex, check_positions, check_uvs};
+pub use super::mesh_limits::{MAX_TEXCOORD, MAX_VERTEX_COORD};
 use super::SceneError;
-
-/// Largest object-space vertex coordinate. Vertices are f32 (their spacing there is 64 units)
-/// and a model framed at that size still leaves the camera inside its own limit
-/// ([`super::camera::MAX_CAMERA_COORD`]); coordinates near f32's limit made lights overflow
-/// and were reported as a bad light intensity.
-pub const MAX_VERTEX_COORD: f32 = 1e9;
 
 /// Most distinct meshes a model file, or a scene file with all its references, may make: each
 /// has a fixed cost besides its data (its buffers and their GL objects, the automatic grid's
 /// ray-caster hierarchy; about 4.4 KB measured with llvmpipe), so the limit holds that near
 /// 300 MB. Objects placing one mesh many times cost far less ([`MAX_SCENE_OBJECTS`](super::MAX_SCENE_OBJECTS)).
 pub const MAX_SCENE_MESHES: usize = 1 << 16;
-
-/// Largest texture coordinate, and texture-transform offset or scale: far past any tiling (an
-/// f32 there has no fraction left), and small enough that a transformed coordinate and its
-/// differences across a triangle stay finite (past ±1.7e38 they overflowed, the texture
-/// lookup gave NaN and the whole surface drew black).
-pub const MAX_TEXCOORD: f32 = 1e9;
-
-/// Smallest largest side of an object's world bounds: smaller, the automatic camera's near
-/// plane (framed on the bounds) and the vertices' differences fall among f32's subnormal
-/// numbers, which GPUs read as zero, and the frame is black (a glTF node scaled by 1e-40).
-pub const MIN_PLACED_SIZE: f64 = 1e-36;
-
-/// Axis-aligned bounding box in `f64`.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Aabb {
-    /// Minimum corner.
-    pub min: DVec3,
-    /// Maximum corner.
-    pub max: DVec3,
-}
-
-impl Aabb {
-    /// Refuses these object-space bounds placed by `transform` (`field`'s) as
-    /// [`Aabb::placement_refusal`] says, naming `field.transform`.
-    pub(crate) fn check_placed_by(&self, transform: &DMat4, field: &str) -> Result<(), SceneError> {
-        match self.placement_refusal(transform) {
-            None => Ok(()),
-            Some(reason) => Err(SceneError::invalid(format!("{field}.transform"), reason)),
-        }
-    }
-
-    /// Why these object-space bounds cannot be placed by `transform`, if they cannot: their
-    /// world bounds are not finite or reach past the camera's coordinate limit, or shrink
-    /// below [`MIN_PLACED_SIZE`]. The message completes "the transform …".
-    pub(crate) fn placement_refusal(&self, transform: &DMat4) -> Option<String> {
-        let reach = self.transformed(transform).reach();
-        if !(reach.is_finite() && reach <= MAX_CAMERA_COORD) {
-            return Some(format!(
-                "places the object's bounds {reach:e} from the origin, past \
-                 ±{MAX_CAMERA_COORD:e} (the camera's limit)"
-            ));
-        }
-        let size = self.placed_size(transform);
-        (size < MIN_PLACED_SIZE).then(|| {
-            format!(
-                "shrinks the object to {size:e} across, below {MIN_PLACED_SIZE:e} (f32's \
-                 subnormal numbers, which GPUs read as zero)"
-            )
-        })
-    }
-
-    /// The largest side of these bounds scaled, turned and sheared by `transform`, not moved
-    /// (a tiny object far out rounds to one point in f64 too, and is refused by area later).
-    fn placed_size(&self, transform: &DMat4) -> f64 {
-        // A box's extent under a linear map is the map's absolute values times its sides.
-        let m = glam::DMat3::from_mat4(*transform);
-        let abs = glam::DMat3::from_cols(m.x_axis.abs(), m.y_axis.abs(), m.z_axis.abs());
-        (abs * self.size()).max_element()
-    }
-
-    /// The largest coordinate magnitude of the box (NaN or infinite where a corner is).
-    pub(crate) fn reach(&self) -> f64 {
-        self.min.abs().max(self.max.abs()).max_element()
-    }
-
-    /// Bounds of a point set (`None` when empty).
-    pub fn from_points(points: impl IntoIterator<Item = DVec3>) -> Option<Aabb> {
-        let mut it = points.into_iter();
-        let first = it.next()?;
-        Some(it.fold(
-            Aabb {
-                min: first,
-                max: first,
-            },
-            |b, p| Aabb {
-                min: b.min.min(p),
-                max: b.max.max(p),
-            },
-        ))
-    }
-
-    /// Centre point.
-    pub fn center(&self) -> DVec3 {
-        (self.min + self.max) * 0.5
-    }
-
-    /// Edge lengths.
-    pub fn size(&self) -> DVec3 {
-        self.max - self.min
-    }
-
-    /// The box grown by `fraction` of its size on every side.
-    pub fn expanded(&self, fraction: f64) -> Aabb {
-        let pad = self.size() * fraction;
-        Aabb {
-            min: self.min - pad,
-            max: self.max + pad,
-        }
-    }
-
-    /// Smallest box containing both.
-    pub fn union(&self, other: &Aabb) -> Aabb {
-        Aabb {
-            min: self.min.min(other.min),
-            max: self.max.max(other.max),
-        }
-    }
-
-    /// Bounds of this box's eight corners after a transform.
-    pub fn transformed(&self, m: &DMat4) -> Aabb {
-        let corners = (0..8).map(|i| {
-            let pick = |bit: u32, lo: f64, hi: f64| if i & (1 << bit) != 0 { hi } else { lo };
-            m.transform_point3(DVec3::new(
-                pick(0, self.min.x, self.max.x),
-                pick(1, self.min.y, self.max.y),
-                pick(2, self.min.z, self.max.z),
-            ))
-        });
-        Aabb::from_points(corners).expect("eight corners")
-    }
-}
 
 /// An indexed triangle mesh in object space. Normals are always present (computed from the
 /// faces when the source had none); texture coordinates are optional. Which sides are drawn is
@@ -430,73 +305,6 @@ impl Mesh {
         }
         Ok(())
     }
-}
-
-/// Positions finite and within [`MAX_VERTEX_COORD`]; errors name `{field}.positions[i]`.
-fn check_positions(positions: &[Vec3], field: &str) -> Result<(), SceneError> {
-    if let Some(i) = positions.iter().position(|p| !p.is_finite()) {
-        return Err(SceneError::invalid(
-            format!("{field}.positions[{i}]"),
-            "must be finite".to_string(),
-        ));
-    }
-    if let Some(i) = positions
-        .iter()
-        .position(|p| p.abs().max_element() > MAX_VERTEX_COORD)
-    {
-        return Err(SceneError::invalid(
-            format!("{field}.positions[{i}]"),
-            format!(
-                "must be within ±{MAX_VERTEX_COORD:e} (object space is f32; place far objects \
-                 with their transform, which is f64)"
-            ),
-        ));
-    }
-    Ok(())
-}
-
-/// Texture coordinates finite and within [`MAX_TEXCOORD`]; errors name `{field}.uvs[i]`.
-fn check_uvs(uvs: &[Vec2], field: &str) -> Result<(), SceneError> {
-    if let Some(i) = uvs
-        .iter()
-        .position(|t| !(t.is_finite() && t.abs().max_element() <= MAX_TEXCOORD))
-    {
-        return Err(SceneError::invalid(
-            format!("{field}.uvs[{i}]"),
-            format!("must be finite and within ±{MAX_TEXCOORD:e}"),
-        ));
-    }
-    Ok(())
-}
-
-/// Whole triangles of indices, each below `n` (the vertex count); errors name `field`.
-fn check_indices(indices: &[u32], n: usize, field: &str) -> Result<(), SceneError> {
-    if !indices.len().is_multiple_of(3) {
-        return Err(SceneError::invalid(
-            field,
-            format!(
-                "{} indices is not a whole number of triangles",
-                indices.len()
-            ),
-        ));
-    }
-    if let Some(bad) = indices.iter().find(|&&i| i as usize >= n) {
-        return Err(SceneError::invalid(
-            field,
-            format!("index {bad} out of range for {n} vertices"),
-        ));
-    }
-    Ok(())
-}
-
-fn check_per_vertex(field: &str, got: usize, n: usize) -> Result<(), SceneError> {
-    if got != n {
-        return Err(SceneError::invalid(
-            field,
-            format!("{got} values for {n} vertices"),
-        ));
-    }
-    Ok(())
 }
 
 /// Given normals made unit; those with no direction (zero, NaN or infinite) replaced by the

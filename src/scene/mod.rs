@@ -6,6 +6,7 @@
 //! the renderer subtracts the camera in `f64` before anything reaches the GPU as `f32`, so a
 //! scene 10 km from the origin loses no precision on the device.
 
+mod aabb;
 pub mod access;
 pub mod brdf;
 pub mod builtin;
@@ -24,6 +25,7 @@ pub mod light;
 mod light_list;
 pub mod material;
 pub mod mesh;
+mod mesh_limits;
 pub mod meshbuild;
 mod model_cache;
 pub mod motion;

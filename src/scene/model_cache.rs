@@ -83,11 +83,7 @@ impl Loaded {
     ) -> Result<(), SceneError> {
         for (_, _, relative, bounds) in &self.objects {
             let world = transform * *relative;
-            let refusal = match bounds {
-                Some(b) => b.placement_refusal(&world),
-                None => (!world.is_finite()).then(|| "is not finite".to_string()),
-            };
-            if let Some(reason) = refusal {
+            if let Some(reason) = Aabb::placement_refusal_of(bounds.as_ref(), &world) {
                 return Err(SceneError::invalid(transform_field, reason));
             }
         }

@@ -539,10 +539,7 @@ fn validate(root: &gltf::json::Root) -> Result<(), String> {
 /// A placed mesh's transform must be finite and place it as `Aabb::placement_refusal` says
 /// (within the camera's coordinate limit, not shrunk into f32's subnormal numbers).
 fn check_placement(bounds: Option<Aabb>, world: &DMat4) -> Result<(), String> {
-    if !world.is_finite() {
-        return Err("the world transform is not finite".into());
-    }
-    if let Some(reason) = bounds.and_then(|b| b.placement_refusal(world)) {
+    if let Some(reason) = Aabb::placement_refusal_of(bounds.as_ref(), world) {
         return Err(format!("the world transform {reason}"));
     }
     Ok(())
