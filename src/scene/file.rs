@@ -32,6 +32,8 @@
 //! Paths are relative to the scene file. Unknown fields are errors; so are invalid values,
 //! which are reported with the path of the field (`lights[1].outer_deg`).
 
+mod json_error;
+
 use std::path::{Path, PathBuf};
 
 use glam::{DMat4, DVec3, Vec3};
@@ -256,19 +258,7 @@ fn deserialize(text: &str) -> Result<SceneFile, String> {
     // A UTF-8 byte order mark, as some Windows editors write: skipped, as for OBJ and MTL.
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let mut json = serde_json::Deserializer::from_str(text);
-    let file = serde_path_to_error::deserialize(&mut json).map_err(|e| {
-        let path = e.path().to_string();
-        let inner = e.inner().to_string();
-        let inner = match inner.strip_prefix("trailing characters") {
-            Some(position) if path != "." => format!("too many values{position}"),
-            _ => inner,
-        };
-        if path == "." {
-            inner
-        } else {
-            format!("{path}: {inner}")
-        }
-    })?;
+    let file = serde_path_to_error::deserialize(&mut json).map_err(|e| json_error::message(&e))?;
     json.end()
         .map_err(|e| format!("something follows the scene's JSON object: {e}"))?;
     Ok(file)

@@ -11,12 +11,13 @@ pub const MAX_SHOWN_NAME: usize = 64;
 /// or a URI); longer ones are cut, with the count left out.
 pub const MAX_SHOWN_REASON: usize = 1000;
 
-/// Whether `c` is escaped: a control character, or one that reorders the text around it
-/// (bidirectional marks, embeddings, overrides and isolates: a name could make a message
-/// read other than it is).
+/// Whether `c` is escaped: a control character, a line or paragraph separator (U+2028,
+/// U+2029: a new line to many terminals and log viewers, a forged line of output), or one
+/// that reorders the text around it (bidirectional marks, embeddings, overrides and
+/// isolates: a name could make a message read other than it is).
 fn escaped(c: char) -> bool {
     c.is_control()
-        || matches!(c, '\u{61c}' | '\u{200e}' | '\u{200f}' | '\u{202a}'..='\u{202e}' | '\u{2066}'..='\u{2069}')
+        || matches!(c, '\u{61c}' | '\u{200e}' | '\u{200f}' | '\u{2028}'..='\u{202e}' | '\u{2066}'..='\u{2069}')
 }
 
 /// `text` with every control and reordering character escaped (`\u{1b}`), the rest as it is.
@@ -75,6 +76,7 @@ mod tests {
         assert_eq!(text("plain name ü"), "plain name ü");
         assert_eq!(text("\u{1b}]0;PWN\u{7}x\0"), "\\u{1b}]0;PWN\\u{7}x\\u{0}");
         assert_eq!(text("a\nb\u{9b}c"), "a\\u{a}b\\u{9b}c");
+        assert_eq!(text("a\u{2028}b\u{2029}"), "a\\u{2028}b\\u{2029}");
         assert_eq!(name("short"), "short");
         let long = "n".repeat(10_000_000);
         let shown = name(&long);

@@ -351,3 +351,24 @@ fn a_camera_too_near_its_target_or_with_a_tiny_up_says_so() {
     let err = camera("[0, 0, 0]", "[0, 0, 0]");
     assert!(err.contains("must be non-zero"), "{err}");
 }
+
+/// A key, a name or a string from the file is quoted at most `MAX_SHOWN_NAME` characters long
+/// wherever a JSON error shows it (a 300-character key was shown whole, twice).
+#[test]
+fn file_text_in_json_errors_is_cut() {
+    let k = "k".repeat(300);
+    let errors = [
+        format!(r#"{{"{k}": 1}}"#),
+        format!(r#"{{"objects": [{{"builtin": "plane", "{k}": 2}}]}}"#),
+        format!(r#"{{"objects": [{{"builtin": "plane"}}], "ambient": "{k}"}}"#),
+        format!(
+            r#"{{"objects": [{{"builtin": "plane"}}], "lights": [{{"position": [0, 1, "{k}"]}}]}}"#
+        ),
+    ]
+    .map(|s| parse_str(&s).unwrap_err().to_string());
+    let cut = format!("{}… (236 characters more)", "k".repeat(64));
+    for err in errors {
+        assert!(err.contains(&cut), "{err}");
+        assert!(!err.contains(&"k".repeat(65)), "{err}");
+    }
+}
