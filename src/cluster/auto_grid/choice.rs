@@ -160,16 +160,25 @@ pub fn first_split(samples: &SurfaceSamples, near: f64) -> Option<f64> {
 }
 
 /// Whether candidate `a` beats `b`: a grid whose lists overflow drops lights from the image,
-/// so the least overflow first, then one within the CPU budget, then the smallest prediction.
+/// so the least overflow first, then one within the CPU budget, then the smallest prediction;
+/// between two past the budget, the one nearer it (the smaller share), so that a budget no
+/// grid keeps (`0`) gets the least CPU, not the most.
 pub(super) fn better(a: &Candidate, b: &Candidate) -> bool {
-    (a.overflowed_lights, a.over_budget, a.predicted_ms)
-        < (b.overflowed_lights, b.over_budget, b.predicted_ms)
+    let key = |c: &Candidate| {
+        let cost = if c.over_budget {
+            c.assign_share()
+        } else {
+            c.predicted_ms
+        };
+        (c.overflowed_lights, c.over_budget, cost)
+    };
+    key(a) < key(b)
 }
 
 /// Whether `new` should replace `current`: only when predicted at least [`HYSTERESIS`] cheaper
 /// than the current footprint under the same measurement (or when the current one was not
-/// measured this time, overflows or passes the CPU budget where the new one does not, or its
-/// first split moved). The current grid has to pass the budget by more than [`HYSTERESIS`]
+/// measured this time, overflows or passes the CPU budget where the new one does not, passes
+/// it further than the new one by [`HYSTERESIS`] (relative share), or its first split moved). The current grid has to pass the budget by more than [`HYSTERESIS`]
 /// (relative) to be left for it, and a grid left for the budget is not taken back until it is
 /// predicted clearly cheaper, so a grid near the budget does not alternate with its neighbour.
 pub fn should_switch(current: &GridConfig, new: &GridChoice) -> bool {
@@ -185,10 +194,14 @@ pub fn should_switch(current: &GridConfig, new: &GridChoice) -> bool {
             // The current grid must pass the budget clearly too, or a grid whose share sits
             // at the budget would be swapped out whenever a measurement put it a hair over.
             let clearly_over = now.assigns_over(current.assign_budget() * (1.0 + HYSTERESIS));
+            let same_overflow = best.overflowed_lights == now.overflowed_lights;
+            // Past the budget both: the new one must be clearly nearer it.
+            let nearer_budget = now.over_budget
+                && best.over_budget
+                && best.assign_share() < now.assign_share() * (1.0 - HYSTERESIS);
             best.overflowed_lights < now.overflowed_lights
-                || (best.overflowed_lights == now.overflowed_lights
-                    && clearly_over
-                    && !best.over_budget)
+                || (same_overflow && clearly_over && !best.over_budget)
+                || (same_overflow && nearer_budget)
                 || best.predicted_ms < now.predicted_ms * (1.0 - HYSTERESIS)
         }
         _ => true,

@@ -214,7 +214,9 @@ impl ChoiceSearch {
                 && c.overflowed_lights <= best.overflowed_lights
                 && c.predicted_ms < best.predicted_ms
         });
-        if let (Some(c), false) = (turned_down, best.over_budget) {
+        if best.over_budget {
+            let _ = write!(out.reason, "; no grid kept within it: the smallest share");
+        } else if let Some(c) = turned_down {
             let _ = write!(
                 out.reason,
                 "; {} px was predicted {:.2} ms faster but assigns {:.1} %",

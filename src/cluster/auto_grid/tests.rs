@@ -335,11 +335,33 @@ fn the_cpu_budget_bounds_the_assignment() {
         ..unbounded.config.clone()
     };
     assert!(should_switch(&free_config, &bounded));
-    // No candidate within a zero budget: the cheapest prediction, as without one.
+    // No candidate within a zero budget: the one nearest it, the smallest share, so a
+    // tighter budget never buys a finer grid (it took the free choice's, the most CPU).
     let mut none = inputs(&lights);
     none.base.mode = GridMode::Auto { assign_budget: 0.0 };
     let zero = choose(&none, &samples, &costs, &mut Assigner::new());
-    assert_eq!(zero.config.footprint_px, free_pick.footprint_px);
+    let zero_pick = chosen(&zero);
+    assert!(zero.candidates.iter().all(|c| c.over_budget), "{zero:?}");
+    assert!(
+        zero.candidates
+            .iter()
+            .all(|c| share(&zero_pick) <= share(c)),
+        "{zero:?}"
+    );
+    assert!(zero_pick.footprint_px >= pick.footprint_px, "{zero:?}");
+    assert!(
+        zero.reason.contains("no grid kept within it"),
+        "{}",
+        zero.reason
+    );
+    // A grid past the budget gives way to one clearly nearer it, not to one a hair nearer.
+    let zero_config = |footprint_px: f64| GridConfig {
+        footprint_px,
+        mode: GridMode::Auto { assign_budget: 0.0 },
+        ..zero.config.clone()
+    };
+    assert!(should_switch(&zero_config(free_pick.footprint_px), &zero));
+    assert!(!should_switch(&zero_config(zero_pick.footprint_px), &zero));
 }
 
 /// Overflow outranks the budget: with a per-cell cap that coarse cells overflow, a grid

@@ -69,8 +69,8 @@ pub enum GridMode {
         /// the cheapest predicted frame wins; a finer grid that would save a little frame time
         /// for much more CPU is not taken (the CPU a game spends here is taken from its own
         /// work, and on a phone the GPU's frame does not pay it back). 1 (or more) leaves the
-        /// frame time alone to decide; when no candidate fits, the cheapest predicted frame
-        /// wins. A finite value from 0 up: the renderer refuses others naming
+        /// frame time alone to decide; when no candidate fits, the one whose assignment takes
+        /// the smallest share wins (the least CPU, not the most). A finite value from 0 up: the renderer refuses others naming
         /// `grid.assign_budget`.
         assign_budget: f64,
     },

@@ -92,7 +92,7 @@ pub struct RenderArgs {
     pub slice_depth: f64,
     /// With `--grid auto` (a fixed grid has none): the largest share of the predicted frame
     /// time the CPU light assignment may take (default 0.05: 5 %; 1 lets the frame time alone
-    /// decide).
+    /// decide; where no grid keeps within it, the smallest share wins).
     #[arg(long, value_parser = parse_assign_budget, allow_hyphen_values = true)]
     pub assign_budget: Option<f64>,
 }
