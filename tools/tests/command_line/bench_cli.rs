@@ -260,6 +260,9 @@ fn knobs_a_context_cannot_run_are_skipped_not_fatal() {
         "{rows:?}"
     );
     assert!(rows.iter().any(|r| r["knob"] == "cell_cap=16"), "{rows:?}");
+    // Deferred needs ES 3.0: no row, and a warning says why (its rows vanished silently).
+    assert!(!rows.iter().any(|r| r["method"] == "deferred"), "{rows:?}");
+    assert!(log.contains("ES 2.0 deferred: skipped"), "{log}");
 }
 
 /// Two scenes whose files share a stem (`a/room.obj`, `c/room.obj`; or a built-in twice) were

@@ -410,6 +410,7 @@ pub fn run(args: &BenchArgs) -> Result<(), Box<dyn std::error::Error>> {
         // One context per ES version, made current for its renderer's whole life.
         let ctx = HeadlessContext::new(es)?;
         let mut renderer = Renderer::new(ctx.load_gl()?, es)?;
+        warn_unsupported(&renderer, es, &plan.methods, &knob_list)?;
         for spec in &plan.scenes {
             for &count in &plan.lights {
                 let scene = load_bench_scene(spec, count, args)?;
@@ -514,6 +515,31 @@ pub fn run(args: &BenchArgs) -> Result<(), Box<dyn std::error::Error>> {
         report.seconds,
         args.out.display()
     );
+    Ok(())
+}
+
+/// One warning for each method of the sweep or its knobs this context cannot run: their rows
+/// are left out of the report (`Measure::run` gives `None`), which said nothing.
+fn warn_unsupported(
+    renderer: &Renderer,
+    es: EsVersion,
+    methods: &[String],
+    knobs: &[Knob],
+) -> Result<(), Box<dyn std::error::Error>> {
+    let knob_methods = knobs.iter().map(|k| k.method);
+    let mut names: Vec<&str> = methods
+        .iter()
+        .map(String::as_str)
+        .chain(knob_methods)
+        .collect();
+    names.sort_unstable();
+    names.dedup();
+    for name in names {
+        let desc = manylight::methods::find(name)?;
+        if let Support::Unsupported(why) = (desc.supported)(renderer.caps()) {
+            log::warn!("{es} {name}: skipped, this context cannot run it: {why}");
+        }
+    }
     Ok(())
 }
 
