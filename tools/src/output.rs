@@ -155,7 +155,7 @@ impl OutputFile {
     /// file.
     pub fn commit(mut self) -> Result<(), WriteError> {
         let result = self.finish();
-        result.map_err(|source| self.error(source))
+        self.outcome(result)
     }
 
     fn finish(&mut self) -> io::Result<()> {
@@ -269,7 +269,7 @@ impl OutputFile {
     pub fn commit_bytes(mut self, bytes: &[u8]) -> Result<(), WriteError> {
         match self.write_all(bytes) {
             Ok(()) => self.commit(),
-            Err(source) => Err(self.error(source)),
+            Err(source) => self.outcome(Err(source)),
         }
     }
 
@@ -282,14 +282,20 @@ impl OutputFile {
         let encoder = image::codecs::png::PngEncoder::new(&mut self);
         match image.write_with_encoder(encoder) {
             Ok(()) => self.commit(),
-            Err(e) => Err(self.error(image_to_io(e))),
+            Err(e) => self.outcome(Err(image_to_io(e))),
         }
     }
 
-    fn error(&self, source: io::Error) -> WriteError {
-        WriteError {
-            path: self.path.clone(),
-            source,
+    /// `result` naming the file; a closed pipe on standard output (`--out - | head`) ends the
+    /// output quietly, as [`print_stdout`] does (a named FIFO's reader leaving is an error).
+    fn outcome(&self, result: io::Result<()>) -> Result<(), WriteError> {
+        match result {
+            Err(e) if e.kind() == io::ErrorKind::BrokenPipe && names_stdout(&self.path) => Ok(()),
+            Err(source) => Err(WriteError {
+                path: self.path.clone(),
+                source,
+            }),
+            Ok(()) => Ok(()),
         }
     }
 }

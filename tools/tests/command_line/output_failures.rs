@@ -184,16 +184,25 @@ fn standard_output_onto_a_full_disk_fails_but_a_closed_pipe_does_not() {
     );
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(stderr.contains("untimed frame"), "{stderr}");
-    // `manylight info | head -c 1`: the reader leaving ends the output, not in an error.
-    let mut child = Command::new(env!("CARGO_BIN_EXE_manylight"))
-        .args(["info"])
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    drop(child.stdout.take());
-    let out = child.wait_with_output().unwrap();
-    assert!(!String::from_utf8_lossy(&out.stderr).contains("panicked"));
+    // `manylight info | head -c 1`, `manylight --out - | head -c 1`: the reader leaving ends
+    // the output, not in an error (the picture's was `cannot write -: Broken pipe`, exit 1).
+    let picture = [
+        "--size", "16x9", "--lights", "4", "--frames", "0", "--out", "-",
+    ];
+    for args in [&["info"][..], &picture] {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_manylight"))
+            .args(args)
+            .current_dir(dir.path())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        drop(child.stdout.take());
+        let out = child.wait_with_output().unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success(), "{args:?}: {stderr}");
+        assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+    }
 }
 
 /// Runs `manylight ARGS` with its file size limited to `kib` KiB (writes past it fail with
