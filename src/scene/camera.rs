@@ -139,7 +139,13 @@ impl Camera {
 
     /// World → view transform (right-handed, looking down −Z).
     pub fn view_matrix(&self) -> DMat4 {
-        glam::dcamera::rh::view::look_at_mat4(self.position, self.target, self.up)
+        glam::dcamera::rh::view::look_at_mat4(self.position, self.target, self.up_direction())
+    }
+
+    /// `up` scaled to a largest component of 1: any finite non-zero length gives a direction
+    /// (the view maths squares it, which overflowed past 1e154 and underflowed below 1e-154).
+    fn up_direction(&self) -> DVec3 {
+        self.up / self.up.abs().max_element()
     }
 
     /// View → clip transform for a viewport of the given aspect ratio (width / height).
@@ -205,10 +211,10 @@ impl Camera {
                 ));
             }
         }
+        // `up` is a direction: its length is not a coordinate.
         for (name, v) in [
             ("camera.position", self.position),
             ("camera.target", self.target),
-            ("camera.up", self.up),
         ] {
             if v.abs().max_element() > MAX_CAMERA_COORD {
                 return Err(SceneError::invalid(
@@ -241,19 +247,10 @@ impl Camera {
         if self.up == DVec3::ZERO {
             return Err(SceneError::invalid("camera.up", "must be non-zero"));
         }
-        if self.up.length_squared() == 0.0 {
-            return Err(SceneError::invalid(
-                "camera.up",
-                format!(
-                    "is too short to give a direction ({:?}): a unit vector is the usual",
-                    self.up
-                ),
-            ));
-        }
         // Unit vectors first: the squared lengths of raw ones can overflow or underflow.
         if forward
             .normalize()
-            .cross(self.up.normalize())
+            .cross(self.up_direction().normalize())
             .length_squared()
             <= 1e-24
         {
@@ -263,6 +260,16 @@ impl Camera {
             ));
         }
         let (near, far) = self.near_far();
+        // A near plane past every coordinate a scene may hold sees nothing (and was blamed on
+        // `camera.far`, "must be > near").
+        if near > MAX_CAMERA_COORD {
+            return Err(SceneError::invalid(
+                "camera.near",
+                format!(
+                    "must be at most {MAX_CAMERA_COORD:e} (the coordinate limit), got {near:e}"
+                ),
+            ));
+        }
         match self.projection {
             Projection::Perspective { fov_y_deg, .. } => {
                 if !(MIN_FOV_Y_DEG..180.0).contains(&fov_y_deg) {

@@ -434,7 +434,7 @@ pub fn parse(
         scene.directional_lights.push(light);
     }
     match (&file.camera, builtin_camera) {
-        (Some(c), _) => scene.camera = c.to_camera(),
+        (Some(c), _) => scene.camera = c.to_camera()?,
         (None, Some(c)) if file.objects.len() == 1 => scene.camera = c,
         _ => {
             scene.frame_camera();
@@ -574,10 +574,24 @@ impl MotionSpec {
 }
 
 impl CameraSpec {
-    fn to_camera(&self) -> Camera {
+    fn to_camera(&self) -> Result<Camera, SceneError> {
+        // The other projection's field would be ignored without a word, as a light's cone on
+        // a point light would: an error, as that is.
+        let (stray, wanted, article) = match self.projection {
+            ProjectionKind::Perspective => (self.height.map(|_| "height"), "orthographic", "an"),
+            ProjectionKind::Orthographic => {
+                (self.fov_y_deg.map(|_| "fov_y_deg"), "perspective", "a")
+            }
+        };
+        if let Some(name) = stray {
+            return Err(SceneError::invalid(
+                format!("camera.{name}"),
+                format!("only {article} {wanted} camera has one; use \"projection\": \"{wanted}\""),
+            ));
+        }
         let near = self.near.unwrap_or(0.1);
         let far = self.far.unwrap_or(1000.0);
-        Camera {
+        Ok(Camera {
             position: DVec3::from(self.position),
             target: DVec3::from(self.target),
             up: DVec3::from(self.up.unwrap_or([0.0, 1.0, 0.0])),
@@ -593,7 +607,7 @@ impl CameraSpec {
                     far,
                 },
             },
-        }
+        })
     }
 }
 

@@ -330,26 +330,57 @@ fn a_byte_order_mark_is_skipped_and_huge_values_are_shown_short() {
 }
 
 #[test]
-fn a_camera_too_near_its_target_or_with_a_tiny_up_says_so() {
-    let camera = |target: &str, up: &str| {
+fn a_camera_too_near_its_target_says_so_and_up_of_any_length_is_a_direction() {
+    let scene = |target: &str, up: &str, near: &str| {
         parse_str(&format!(
             r#"{{"objects": [{{"builtin": "plane"}}],
-                "camera": {{"position": [0, 0, 4], "target": {target}, "up": {up}}}}}"#
+                "camera": {{"position": [0, 0, 4], "target": {target}, "up": {up},
+                            "near": {near}}}}}"#
         ))
-        .unwrap_err()
-        .to_string()
     };
+    let camera = |target: &str, up: &str| scene(target, up, "0.1").unwrap_err().to_string();
     let err = camera("[0, 0, 3.9999999999999999]", "[0, 1, 0]");
     assert!(err.contains("equals camera.position"), "{err}");
     let err = camera("[1e-170, 0, 4]", "[0, 1, 0]");
     assert!(err.contains("too near"), "{err}");
-    let err = camera("[0, 0, 0]", "[0, 1e-200, 0]");
-    assert!(
-        err.contains("camera.up") && err.contains("too short"),
-        "{err}"
-    );
     let err = camera("[0, 0, 0]", "[0, 0, 0]");
     assert!(err.contains("must be non-zero"), "{err}");
+    // A direction's length is no coordinate: a tiny or huge `up` (refused as too short, or
+    // as past the coordinate limit) gives the unit one's view.
+    let view = |up: &str| scene("[0, 0, 0]", up, "0.1").unwrap().camera.view_matrix();
+    let unit = view("[0, 1, 0]");
+    for up in ["[0, 1e-200, 0]", "[0, 1e308, 0]", "[1e-300, 3e-300, 0]"] {
+        let v = view(up);
+        assert!(v.is_finite(), "{up}: {v}");
+        if up != "[1e-300, 3e-300, 0]" {
+            assert!(v.abs_diff_eq(unit, 1e-12), "{up}: {v} against {unit}");
+        }
+    }
+    // The other projection's field is an error naming it (it was ignored without a word).
+    let other = |camera: &str| {
+        let text = format!(r#"{{"objects": [{{"builtin": "plane"}}], "camera": {camera}}}"#);
+        parse_str(&text).unwrap_err().to_string()
+    };
+    let err = other(r#"{"position": [0, 0, 4], "target": [0, 0, 0], "height": 3}"#);
+    assert!(
+        err.contains("`camera.height`") && err.contains("orthographic"),
+        "{err}"
+    );
+    let err = other(
+        r#"{"position": [0, 0, 4], "target": [0, 0, 0], "projection": "orthographic",
+            "fov_y_deg": 30}"#,
+    );
+    assert!(
+        err.contains("`camera.fov_y_deg`") && err.contains("a perspective"),
+        "{err}"
+    );
+    // A near plane past the coordinate limit is `camera.near`'s fault, not `camera.far`'s.
+    for near in ["1e308", "3.5e38", "18446744073709551615"] {
+        let err = scene("[0, 0, 0]", "[0, 1, 0]", near)
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("`camera.near`"), "{near}: {err}");
+    }
 }
 
 /// A key, a name or a string from the file is quoted at most `MAX_SHOWN_NAME` characters long
