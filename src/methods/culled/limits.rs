@@ -83,6 +83,7 @@ pub(super) fn too_many_references(
 pub(super) fn too_many_visible(visible: usize) -> Error {
     Error::Limit(format!(
         "{visible} lights are visible in this frame; tiled and clustered shading index at most \
-         {MAX_INDEXED_LIGHTS}"
+         {MAX_INDEXED_LIGHTS}: the auto method (deferred past that, on ES 3.0) or forward \
+         renders more"
     ))
 }

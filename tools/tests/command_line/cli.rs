@@ -1172,6 +1172,31 @@ fn info_scene_reports_the_scenes_own_features_and_variants() {
     }
 }
 
+/// A method past its limits with the scene is reported with its reason, and the others still
+/// are (over 65 536 visible lights tiled and clustered cannot index, and the whole report
+/// failed with their error).
+#[test]
+fn info_scene_reports_a_method_that_cannot_render_it_and_the_rest() {
+    let dir = tempfile::tempdir().unwrap();
+    let light = r#"{"kind": "point", "position": [0, 0, 1], "radius": 1, "color": [1, 1, 1]}"#;
+    let lights = vec![light; 65_600].join(",");
+    let scene = format!(r#"{{"objects": [{{"builtin": "plane"}}], "lights": [{lights}]}}"#);
+    std::fs::write(dir.path().join("many.json"), scene).unwrap();
+    let out = manylight(&["info", "--json", "--scene", "many.json"], &[], dir.path());
+    assert!(out.status.success(), "{}", text(&out));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let methods = v["scene"]["methods"].as_array().unwrap();
+    let error = |name: &str| {
+        let m = methods.iter().find(|m| m["method"] == name).unwrap();
+        m["error"].as_str().map(str::to_string)
+    };
+    for name in ["tiled", "clustered"] {
+        let e = error(name).unwrap_or_default();
+        assert!(e.contains("65536"), "{name}: {methods:?}");
+    }
+    assert_eq!(error("forward"), None, "{methods:?}");
+}
+
 /// A built-in scene is reported with the lights `render` gives it by default (it had none:
 /// every method then held no light data and only the no-lights variant was built).
 #[test]

@@ -43,17 +43,29 @@ fn scene_report(
     let (scene, _) = manylight::scene::load_with(spec, lights, &crate::load_options())?;
     let mut methods = Vec::new();
     let mut features = None;
+    let mut first_error = None;
     for m in METHODS {
         if matches!((m.supported)(renderer.caps()), Support::Unsupported(_)) {
             continue;
         }
         renderer.set_method_named(m.name)?;
-        let (_, stats) =
-            renderer.render_offscreen(&scene, 64, 36, &manylight::RenderOptions::default())?;
-        features = Some(stats.scene_features);
-        methods.push(
-            serde_json::json!({"method": m.name, "gpu_bytes": stats.memory.method_gpu_bytes}),
-        );
+        // A method past its limits with this scene (tiled and clustered over 65 536 visible
+        // lights) is reported as such; the others still are.
+        match renderer.render_offscreen(&scene, 64, 36, &manylight::RenderOptions::default()) {
+            Ok((_, stats)) => {
+                features = Some(stats.scene_features);
+                methods.push(serde_json::json!({
+                    "method": m.name, "gpu_bytes": stats.memory.method_gpu_bytes
+                }));
+            }
+            Err(e) => {
+                methods.push(serde_json::json!({"method": m.name, "error": e.to_string()}));
+                first_error.get_or_insert(e);
+            }
+        }
+    }
+    if let (None, Some(e)) = (&features, first_error) {
+        return Err(e.into());
     }
     let variants: Vec<_> = renderer
         .program_report()
@@ -305,12 +317,15 @@ fn format_scene_report(r: &serde_json::Value) -> String {
         r["features"]
     );
     for m in r["methods"].as_array().into_iter().flatten() {
-        w!(
-            out,
-            "  {:<10} holds {} bytes of GPU memory",
-            m["method"].as_str().unwrap_or("?"),
-            m["gpu_bytes"]
-        );
+        let method = m["method"].as_str().unwrap_or("?");
+        match m["error"].as_str() {
+            Some(e) => w!(out, "  {method:<10} cannot render it: {e}"),
+            None => w!(
+                out,
+                "  {method:<10} holds {} bytes of GPU memory",
+                m["gpu_bytes"]
+            ),
+        }
     }
     w!(out, "shader variants built");
     for v in r["variants"].as_array().into_iter().flatten() {
