@@ -564,6 +564,23 @@ fn drain_errors(gl: &glow::Context) -> u32 {
     first
 }
 
+/// Name of a `glCheckFramebufferStatus` result.
+pub fn framebuffer_status_name(status: u32) -> &'static str {
+    match status {
+        glow::FRAMEBUFFER_INCOMPLETE_ATTACHMENT => {
+            "GL_FRAMEBUFFER_INCOMPLETE_ATTACHMENT (an attachment the driver could not make, \
+             as when it runs out of memory at this size)"
+        }
+        glow::FRAMEBUFFER_INCOMPLETE_MISSING_ATTACHMENT => {
+            "GL_FRAMEBUFFER_INCOMPLETE_MISSING_ATTACHMENT"
+        }
+        glow::FRAMEBUFFER_INCOMPLETE_DIMENSIONS => "GL_FRAMEBUFFER_INCOMPLETE_DIMENSIONS",
+        glow::FRAMEBUFFER_INCOMPLETE_MULTISAMPLE => "GL_FRAMEBUFFER_INCOMPLETE_MULTISAMPLE",
+        glow::FRAMEBUFFER_UNSUPPORTED => "GL_FRAMEBUFFER_UNSUPPORTED",
+        _ => "an unknown status",
+    }
+}
+
 /// Name of a `glGetError` code.
 pub fn error_name(code: u32) -> &'static str {
     match code {
@@ -573,5 +590,26 @@ pub fn error_name(code: u32) -> &'static str {
         glow::INVALID_FRAMEBUFFER_OPERATION => "GL_INVALID_FRAMEBUFFER_OPERATION",
         glow::OUT_OF_MEMORY => "GL_OUT_OF_MEMORY",
         _ => "unknown GL error",
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// An incomplete target names itself and its size (a 16 384² MSAA target said only
+    /// `framebuffer incomplete: status 0x8cd6`).
+    #[test]
+    fn an_incomplete_framebuffer_names_the_target_and_the_status() {
+        let e = GlError::FramebufferIncomplete {
+            what: "a 16384×16384 target with 4 samples".into(),
+            status: glow::FRAMEBUFFER_INCOMPLETE_ATTACHMENT,
+        }
+        .to_string();
+        assert!(e.contains("16384×16384 target with 4 samples"), "{e}");
+        assert!(e.contains("GL_FRAMEBUFFER_INCOMPLETE_ATTACHMENT"), "{e}");
+        assert!(e.contains("0x8cd6"), "{e}");
+        let unknown = framebuffer_status_name(0x1234);
+        assert_eq!(unknown, "an unknown status");
     }
 }

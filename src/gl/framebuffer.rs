@@ -139,7 +139,10 @@ impl OffscreenTarget {
             };
             if status != glow::FRAMEBUFFER_COMPLETE {
                 target.destroy(dev);
-                return Err(GlError::FramebufferIncomplete(status));
+                return Err(GlError::FramebufferIncomplete {
+                    what: format!("a {width}×{height} offscreen target"),
+                    status,
+                });
             }
             if let Err(e) = dev.check("offscreen target creation") {
                 target.destroy(dev);

@@ -196,7 +196,10 @@ impl GBuffer {
                 if s != glow::FRAMEBUFFER_COMPLETE {
                     let mut gb = gb;
                     gb.destroy(dev);
-                    return Err(GlError::FramebufferIncomplete(s));
+                    return Err(GlError::FramebufferIncomplete {
+                        what: format!("a {width}×{height} G-buffer"),
+                        status: s,
+                    });
                 }
             }
         }

@@ -152,9 +152,17 @@ pub enum GlError {
     /// A required capability is missing.
     #[error("{0}")]
     Unsupported(String),
-    /// A framebuffer is incomplete.
-    #[error("framebuffer incomplete: status 0x{0:04x}")]
-    FramebufferIncomplete(u32),
+    /// A framebuffer is incomplete (a driver says so of a target it could not allocate, too).
+    #[error(
+        "framebuffer incomplete for {what}: 0x{status:04x}, {}",
+        device::framebuffer_status_name(*status)
+    )]
+    FramebufferIncomplete {
+        /// The target being made, with its size (`a 16384×16384 target with 4 samples`).
+        what: String,
+        /// The status `glCheckFramebufferStatus` gave.
+        status: u32,
+    },
     /// The framebuffer the application bound cannot take the frame: incomplete, or without a
     /// depth buffer (the frame is drawn against one, unless with MSAA).
     #[error("the bound framebuffer cannot take the frame: {0}")]

@@ -233,15 +233,15 @@ impl MultisampleTarget {
                 Some(depth),
             );
             // Out of memory is an error naming the size, not an incomplete framebuffer.
-            let what = format!("allocating a {width}×{height} target with {samples} samples");
-            if let Err(e) = dev.check(&what) {
+            let what = format!("a {width}×{height} target with {samples} samples");
+            if let Err(e) = dev.check(&format!("allocating {what}")) {
                 target.destroy(dev);
                 return Err(e);
             }
             let status = gl.check_framebuffer_status(glow::FRAMEBUFFER);
             if status != glow::FRAMEBUFFER_COMPLETE {
                 target.destroy(dev);
-                return Err(GlError::FramebufferIncomplete(status));
+                return Err(GlError::FramebufferIncomplete { what, status });
             }
             // At least the count asked for (a driver saying less is not believed).
             let drawn = gl.get_parameter_i32(glow::SAMPLES);
@@ -388,7 +388,10 @@ impl MultisampleTarget {
         let complete = if status == glow::FRAMEBUFFER_COMPLETE {
             Ok(())
         } else {
-            Err(GlError::FramebufferIncomplete(status))
+            Err(GlError::FramebufferIncomplete {
+                what: format!("the MSAA resolve's {w}×{h} copy"),
+                status,
+            })
         };
         let made = dev
             .check("allocating the MSAA resolve's copy")
