@@ -19,6 +19,7 @@ mod matrix;
 mod progress;
 mod render;
 mod sequence;
+mod thread_pool;
 #[cfg(feature = "window")]
 mod view;
 
@@ -358,17 +359,6 @@ fn check_outside_folder(outputs: &[Option<(&str, &Path)>], (folder_option, folde
     }
 }
 
-/// Makes this thread (the one that renders and assigns lights) one of rayon's global pool, so
-/// a parallel light assignment starts on it at once. From outside the pool the caller would
-/// queue the work and wait, its own core idle, until a pool thread woke to take it
-/// (milliseconds for a core that slept: docs/performance.md, `pool_wake`).
-fn join_rayon_pool() {
-    let pool = rayon::ThreadPoolBuilder::new().use_current_thread();
-    if let Err(e) = pool.build_global() {
-        log::debug!("rayon's global pool left as it was: {e}");
-    }
-}
-
 /// The exit status of a request this context cannot do (docs/cli.md, "Exit codes"), so that a
 /// capability script tells what a device cannot do from a failure without reading stderr.
 const CANNOT_ON_THIS_CONTEXT: u8 = 3;
@@ -441,7 +431,7 @@ fn main() -> ExitCode {
     let mut options = LoadOptions::default();
     options.allow_outside_files = cli.allow_outside_files;
     let _ = LOAD_OPTIONS.set(options);
-    join_rayon_pool();
+    thread_pool::join_rayon_pool();
     if !matches!(cli.command, Some(Command::Matrix(_))) {
         if let Some(dir) = cli.gles_lib.first() {
             if let Err(e) = manylight::gl::gles_lib::select(dir) {
