@@ -1149,7 +1149,20 @@ fn bad_animation_flags_are_usage_errors() {
     let args = [
         "render", "--size", "8x8", "--frames", "1", "--record", "taken",
     ];
-    expect_exit(&args, &[], dir.path(), 1, "--record");
+    let msg = expect_exit(&args, &[], dir.path(), 1, "--record");
+    assert!(msg.contains("not a folder"), "{msg}");
+    // A device there too (it said "cannot create /dev/null: File exists").
+    let args = [
+        "render",
+        "--size",
+        "8x8",
+        "--frames",
+        "1",
+        "--record",
+        "/dev/null",
+    ];
+    let msg = expect_exit(&args, &[], dir.path(), 1, "--record");
+    assert!(msg.contains("not a folder"), "{msg}");
 }
 
 #[test]

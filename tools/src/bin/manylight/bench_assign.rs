@@ -72,7 +72,10 @@ pub fn run(args: &BenchAssignArgs) -> Result<(), Box<dyn std::error::Error>> {
     let pools = args
         .threads
         .iter()
-        .map(|&n| rayon::ThreadPoolBuilder::new().num_threads(n).build())
+        .map(|&n| {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(n).build();
+            pool.map_err(|e| format!("--threads {n}: cannot start a pool of {n} threads: {e}"))
+        })
         .collect::<Result<Vec<_>, _>>()?;
     let mut rows = Vec::new();
     for &count in &args.lights {

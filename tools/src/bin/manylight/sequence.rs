@@ -73,6 +73,14 @@ impl Recorder {
                 .map_err(|e| format!("--record {}: {e}", path.display()))?;
             return Ok(Recorder::Gif(Box::new(encoder), file));
         }
+        // A device or file there said only "File exists".
+        if path.exists() && !path.is_dir() {
+            return Err(format!(
+                "--record {}: not a folder (frames go into a folder as PNGs; a name ending in \
+                 .gif records an animated GIF)",
+                path.display()
+            ));
+        }
         std::fs::create_dir_all(path)
             .map_err(|e| format!("--record: cannot create {}: {e}", path.display()))?;
         let last = timeline.frames.saturating_sub(1);
