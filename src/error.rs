@@ -13,7 +13,10 @@ pub enum Error {
     #[error(transparent)]
     Scene(#[from] SceneError),
     /// A method name that is not in the method table.
-    #[error("unknown method `{name}` (available: {available})")]
+    #[error(
+        "unknown method `{}` (available: {available})",
+        crate::scene::shown::name(name)
+    )]
     UnknownMethod {
         /// What was asked for.
         name: String,

@@ -43,8 +43,8 @@ pub fn select(folder: &Path) -> Result<(), GlError> {
         if current.as_deref() != Some(folder.as_path()) {
             return Err(GlError::GlesLibrary(format!(
                 "the GLES implementation is already loaded ({}); {} must be chosen before the first context",
-                current.map_or("the system's".into(), |f| f.display().to_string()),
-                folder.display()
+                current.map_or("the system's".into(), |f| shown(&f)),
+                shown(&folder)
             )));
         }
         return Ok(());
@@ -86,11 +86,16 @@ pub fn files_in(folder: &Path) -> Result<(PathBuf, PathBuf), GlError> {
     library_files(folder).map_err(GlError::GlesLibrary)
 }
 
+/// `path` as a message shows it: a user's path may hold line ends or be very long.
+fn shown(path: &Path) -> String {
+    crate::scene::shown::reason(&path.to_string_lossy())
+}
+
 fn library_files(folder: &Path) -> Result<(PathBuf, PathBuf), String> {
     if !folder.is_dir() {
         return Err(format!(
             "{} (from --gles-lib or {GLES_LIB_ENV}) is not a folder",
-            folder.display()
+            shown(folder)
         ));
     }
     let gles_path = find_in(folder, &["libGLESv2.so.2", "libGLESv2.so"])?;
@@ -107,7 +112,7 @@ fn find_in(folder: &Path, names: &[&str]) -> Result<PathBuf, String> {
         .ok_or_else(|| {
             format!(
                 "{} (from --gles-lib or {GLES_LIB_ENV}) holds none of {}",
-                folder.display(),
+                shown(folder),
                 names.join(", ")
             )
         })
@@ -129,9 +134,9 @@ impl GlesLibrary {
         // SAFETY: loading a GLES implementation runs its initialisers; that is what the user
         // asked for by naming the folder.
         let gles = unsafe { libloading::Library::new(&gles_path) }
-            .map_err(|e| format!("cannot load {}: {e}", gles_path.display()))?;
+            .map_err(|e| format!("cannot load {}: {e}", shown(&gles_path)))?;
         let egl = unsafe { Egl::load_required_from_filename(&egl_path) }
-            .map_err(|e| format!("cannot load {}: {e}", egl_path.display()))?;
+            .map_err(|e| format!("cannot load {}: {e}", shown(&egl_path)))?;
         Ok(GlesLibrary {
             egl,
             gles: Some(gles),

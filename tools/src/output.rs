@@ -25,7 +25,9 @@ pub struct WriteError {
 
 impl std::fmt::Display for WriteError {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "cannot write {}: {}", self.path.display(), self.source)
+        // A path from the command line may hold line ends or escape sequences.
+        let path = manylight::scene::shown::reason(&self.path.to_string_lossy());
+        write!(f, "cannot write {path}: {}", self.source)
     }
 }
 

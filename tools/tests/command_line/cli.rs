@@ -1303,3 +1303,43 @@ fn a_black_picture_is_warned_of_with_its_likely_causes() {
     let msg = run("plane");
     assert!(!msg.contains("the picture is black"), "{msg}");
 }
+
+/// A method name, an output path or a GLES folder from the command line reaches its error with
+/// line ends escaped and cut short (they were printed as given: a line end split the one-line
+/// error, a 3 000-character name came back whole).
+#[test]
+fn command_line_names_in_errors_are_escaped_and_cut() {
+    let dir = tempfile::tempdir().unwrap();
+    let long = "m".repeat(3000);
+    let cases: [&[&str]; 4] = [
+        &["--size", "8x8", "--frames", "0", "--method", "a\nb"],
+        &[
+            "--size",
+            "8x8",
+            "--frames",
+            "0",
+            "--out",
+            "missing/a\nb.png",
+        ],
+        &["info", "--gles-lib", "/missing\nfolder"],
+        &["--size", "8x8", "--frames", "0", "--method", &long],
+    ];
+    for args in cases {
+        let out = manylight(args, &[], dir.path());
+        assert!(!out.status.success(), "{args:?}");
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        let error = stderr
+            .lines()
+            .find(|l| l.starts_with("error:"))
+            .unwrap_or("");
+        assert!(
+            error.contains("\\u{a}") || error.contains("…"),
+            "{args:?}: {stderr}"
+        );
+        assert!(error.len() < 1500, "{args:?}: {stderr}");
+        assert!(
+            !stderr.contains("a\nb") && !stderr.contains("missing\nfolder"),
+            "{stderr}"
+        );
+    }
+}
