@@ -363,3 +363,42 @@ fn edge_values_of_the_sweep_are_measured_skipped_or_refused_not_fatal() {
     assert!(log.contains("--frames"), "{log}");
     assert!(!dir.path().join("never").exists());
 }
+
+/// A value listed twice is measured once, with a warning (`--methods forward,forward` gave
+/// every row twice).
+#[test]
+fn values_listed_twice_are_measured_once() {
+    let dir = tempfile::tempdir().unwrap();
+    let log = bench(
+        &[
+            "--scenes",
+            "plane",
+            "--lights",
+            "8,8",
+            "--es",
+            "3,3",
+            "--methods",
+            "forward,forward",
+            "--size",
+            "32x18",
+            "--frames",
+            "1",
+            "--cpu-samples",
+            "0",
+            "--animated-frames",
+            "0",
+            "--no-knobs",
+        ],
+        dir.path(),
+    );
+    for flag in ["--lights", "--es", "--methods"] {
+        assert!(
+            log.contains(&format!("{flag} lists a value more than once")),
+            "{log}"
+        );
+    }
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("report.json")).unwrap())
+            .unwrap();
+    assert_eq!(report["rows"].as_array().unwrap().len(), 1, "{report}");
+}

@@ -169,20 +169,23 @@ impl Plan {
         let lights = match (&args.lights[..], args.quick) {
             ([], true) => vec![0, 64, 1024],
             ([], false) => vec![0, 8, 64, 256, 1024, 4096],
-            (given, _) => given.to_vec(),
+            (given, _) => once("--lights", given.to_vec()),
         };
         let es = match (&args.es[..], args.quick) {
             ([], true) => vec![EsVersion::Es2, EsVersion::Es3],
             ([], false) => vec![EsVersion::Es2, EsVersion::Es3],
-            (given, _) => given.iter().map(|&e| e.into()).collect(),
+            (given, _) => once("--es", given.iter().map(|&e| e.into()).collect()),
         };
         let default_size = if args.quick { (320, 180) } else { (640, 360) };
         Plan {
             scenes,
             lights,
-            methods: or(
-                &args.methods,
-                METHODS.iter().map(|m| m.name.to_string()).collect(),
+            methods: once(
+                "--methods",
+                or(
+                    &args.methods,
+                    METHODS.iter().map(|m| m.name.to_string()).collect(),
+                ),
             ),
             es,
             size: args.size.unwrap_or(default_size),
@@ -541,6 +544,22 @@ fn warn_unsupported(
         }
     }
     Ok(())
+}
+
+/// `items` with each value once, in their first order; a warning where `flag` listed one
+/// twice (`--methods forward,forward` measured every row twice).
+fn once<T: PartialEq>(flag: &str, items: Vec<T>) -> Vec<T> {
+    let given = items.len();
+    let mut kept: Vec<T> = Vec::with_capacity(given);
+    for item in items {
+        if !kept.contains(&item) {
+            kept.push(item);
+        }
+    }
+    if kept.len() < given {
+        log::warn!("{flag} lists a value more than once: each is measured once");
+    }
+    kept
 }
 
 fn scene_name(spec: &str) -> String {

@@ -25,6 +25,18 @@ pub fn warning(image: &image::RgbaImage, scene: &Scene) -> Option<String> {
                 .to_string(),
         );
     }
+    // A spot of a closed cone lights a sliver (its edge fades over 10⁻⁴ of `1 − cos`).
+    let narrow = |l: &manylight::Light| matches!(l.kind, manylight::LightKind::Spot { outer_deg, .. } if outer_deg < 1.0);
+    let lit = scene.lights.iter().filter(|l| shines(l.color, l.intensity));
+    let suns = scene.directional_lights.iter();
+    if !unlit
+        && lit.clone().next().is_some()
+        && lit.clone().all(narrow)
+        && !suns.clone().any(|l| shines(l.color, l.intensity))
+        && scene.ambient == glam::Vec3::ZERO
+    {
+        causes.push("every light is a spot whose cone (outer_deg) is under 1°".to_string());
+    }
     let camera = &scene.camera;
     let (near, far) = camera.near_far();
     causes.push(format!(
@@ -71,6 +83,22 @@ mod tests {
         scene.ambient = glam::Vec3::splat(0.1);
         let text = warning(&image, &scene).expect("black");
         assert!(!text.contains("nothing lights it"), "{text}");
+        // Spots of closed cones alone (a cone of 0° was blamed on the camera alone).
+        scene.ambient = glam::Vec3::ZERO;
+        let cone = |outer_deg| manylight::Cone {
+            direction: -glam::DVec3::Z,
+            inner_deg: 0.0,
+            outer_deg,
+        };
+        let spot = |outer_deg| {
+            manylight::Light::spot(glam::DVec3::Z, 3.0, glam::Vec3::ONE, 1.0, cone(outer_deg))
+        };
+        scene.lights = vec![spot(0.0), spot(0.5)];
+        let text = warning(&image, &scene).expect("black");
+        assert!(text.contains("cone (outer_deg) is under 1°"), "{text}");
+        scene.lights.push(spot(30.0));
+        let text = warning(&image, &scene).expect("black");
+        assert!(!text.contains("outer_deg"), "{text}");
         image.put_pixel(3, 1, image::Rgba([0, 0, 1, 255]));
         assert_eq!(warning(&image, &scene), None);
     }
