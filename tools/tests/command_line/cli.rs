@@ -1343,3 +1343,20 @@ fn command_line_names_in_errors_are_escaped_and_cut() {
         );
     }
 }
+
+/// The summary line is one line whatever the output's name, and counts in words that agree
+/// (`1 lights` and a raw line end from `--out` were printed).
+#[test]
+fn the_summary_line_escapes_the_output_name_and_counts_one_light() {
+    let dir = tempfile::tempdir().unwrap();
+    let args = [
+        "--size", "8x8", "--frames", "1", "--lights", "1", "--out", "a\nb.png",
+    ];
+    let out = manylight(&args, &[], dir.path());
+    assert!(out.status.success(), "{}", text(&out));
+    assert!(dir.path().join("a\nb.png").is_file());
+    let summary = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(summary.lines().count(), 1, "{summary}");
+    assert!(summary.contains("a\\u{a}b.png"), "{summary}");
+    assert!(summary.contains(" · 1 light · "), "{summary}");
+}

@@ -382,13 +382,14 @@ pub fn run(args: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
         }
     }
     if let Some(path) = &args.record {
-        tail += &format!(" · {} frames → {}", args.frames, path.display());
+        let frames = counted(args.frames.into(), "frame");
+        tail += &format!(" · {frames} → {}", shown_path(path));
     }
     let method = match (&stats.auto_choice, &stats.auto_reason) {
         (Some(choice), Some(reason)) => format!("{} → {choice} ({reason})", stats.method),
         _ => stats.method.clone(),
     };
-    let written = out.map_or(String::new(), |p| format!(" → {}", p.display()));
+    let written = out.map_or(String::new(), |p| format!(" → {}", shown_path(p)));
     // No timed frame: the one frame's time includes compiling shaders and uploading meshes.
     let time = if args.frames == 0 {
         format!(
@@ -399,8 +400,13 @@ pub fn run(args: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
         format!("{:.1} ms/frame", stats.time.frame_ms)
     };
     let summary = format!(
-        "{} {}x{} · {method} · {} lights · {} on {} · {time}{tail}{written}\n",
-        args.scene, width, height, stats.lights.total, stats.context.es, stats.context.renderer,
+        "{} {}x{} · {method} · {} · {} on {} · {time}{tail}{written}\n",
+        manylight::scene::shown::reason(&args.scene),
+        width,
+        height,
+        counted(stats.lights.total as u64, "light"),
+        stats.context.es,
+        stats.context.renderer,
     );
     if summary_to_stderr {
         eprint!("{summary}");
@@ -408,4 +414,18 @@ pub fn run(args: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
         print_stdout(&summary)?;
     }
     Ok(())
+}
+
+/// `n noun`, the noun in the plural but for one (`1 light`, `2 lights`).
+fn counted(n: u64, noun: &str) -> String {
+    if n == 1 {
+        format!("1 {noun}")
+    } else {
+        format!("{n} {noun}s")
+    }
+}
+
+/// A path from the command line as the summary line shows it (escaped, cut: it is one line).
+fn shown_path(path: &std::path::Path) -> String {
+    manylight::scene::shown::reason(&path.to_string_lossy())
 }
