@@ -44,8 +44,11 @@ impl Aabb {
                  ±{MAX_CAMERA_COORD:e} (the camera's limit)"
             ));
         }
+        // A mesh of one point (a degenerate face alone) has no size to lose: it draws nothing
+        // whatever the transform, as it would unplaced.
         let size = self.placed_size(transform);
-        (size < MIN_PLACED_SIZE).then(|| {
+        let has_size = self.size().max_element() > 0.0;
+        (has_size && size < MIN_PLACED_SIZE).then(|| {
             format!(
                 "shrinks the object to {size:e} across, below {MIN_PLACED_SIZE:e} (f32's \
                  subnormal numbers, which GPUs read as zero)"
@@ -160,6 +163,13 @@ mod tests {
         assert_eq!(b.placement_refusal(&far(MAX_CAMERA_COORD - 1.0)), None);
         let beyond = b.placement_refusal(&far(MAX_CAMERA_COORD));
         assert!(beyond.is_some_and(|r| r.starts_with("places")));
+        // A point has no size to lose (a mesh of one degenerate face was refused).
+        let point = Aabb {
+            min: DVec3::splat(3.0),
+            max: DVec3::splat(3.0),
+        };
+        assert_eq!(point.placement_refusal(&DMat4::IDENTITY), None);
+        assert_eq!(point.placement_refusal(&scaled(1e-300)), None);
         let nan = DMat4::from_scale(DVec3::new(1.0, f64::NAN, 1.0));
         assert!(b.placement_refusal(&nan).is_some());
     }
