@@ -2,7 +2,7 @@
 //! grid and the lights the textures can address), from its capacities and the options.
 
 use crate::cluster::assign::{AssignLimits, MAX_UNTRIMMED_INDICES};
-use crate::cluster::grid::ClusterGrid;
+use crate::cluster::grid::{ClusterGrid, GridConfig};
 use crate::cluster::pack::DATA_TEXTURE_WIDTH;
 use crate::cluster::pack::{grid_fits_table, grid_texels, MAX_INDEXED_LIGHTS};
 use crate::gl::Device;
@@ -34,15 +34,39 @@ pub(super) fn assign_limits(ctx: &FrameContext) -> AssignLimits {
 
 /// Refuses, before any assignment, a grid the grid texture cannot hold (it would only fail at
 /// the upload, after allocating its lists) or whose table cannot address its cells.
-pub(super) fn check_grid(dev: &Device, grid: &ClusterGrid, footprint_px: f64) -> Result<(), Error> {
+pub(super) fn check_grid(
+    dev: &Device,
+    grid: &ClusterGrid,
+    config: &GridConfig,
+) -> Result<(), Error> {
+    let footprint_px = config.footprint_px;
     let max_rows = dev.caps().max_texture_size.max(1) as usize;
     let texels = grid_texels(grid);
     if texels > max_rows * DATA_TEXTURE_WIDTH as usize {
+        // Where the caps bound the grid, a finer footprint adds no cells (every size said
+        // the same count), and where slices are at theirs deeper ones remove none.
+        let max_slices = config.max_slices.clamp(1, 255);
+        let capped =
+            (grid.cascades.iter()).any(|c| c.tiles_x.max(c.tiles_y) >= config.max_tiles.max(1));
+        let slices_capped = grid.cascades.iter().all(|c| c.slices >= max_slices);
+        let caps = if capped {
+            format!(
+                " (at the caps of {} tiles a side and {max_slices} slices a cascade: \
+                 grid.max_tiles, grid.max_slices)",
+                config.max_tiles
+            )
+        } else {
+            String::new()
+        };
+        let slices = if slices_capped {
+            ""
+        } else {
+            "deeper slices (grid.slice_depth), "
+        };
         return Err(Error::Limit(format!(
-            "a {} px cell footprint (grid.footprint_px) makes {} grid cells; this context's \
-             grid texture holds {}: use a larger footprint, deeper slices (grid.slice_depth) \
-             or the automatic grid",
-            footprint_px,
+            "a {footprint_px} px cell footprint (grid.footprint_px) makes {} grid cells{caps}; \
+             this context's grid texture holds {}: use a larger footprint, {slices}or the \
+             automatic grid",
             grid.total_cells,
             max_rows * DATA_TEXTURE_WIDTH as usize - (texels - grid.total_cells as usize)
         )));

@@ -100,7 +100,7 @@ impl CulledForward {
         self.update_grid(ctx, &limits, grid_encoding);
         self.write_grid_reason(ctx);
         let (grid_key, grid) = self.grid.as_ref().expect("updated above");
-        limits::check_grid(ctx.dev, grid, grid_key.config.footprint_px)?;
+        limits::check_grid(ctx.dev, grid, &grid_key.config)?;
         let assigned = self.assign.run(method, grid, ctx, &limits);
         if let Some(references) = assigned.assignment.unlisted {
             let cells = grid.total_cells;

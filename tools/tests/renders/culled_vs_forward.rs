@@ -215,6 +215,21 @@ fn a_grid_the_texture_cannot_hold_is_a_clear_error() {
             other.map(|(_, s)| s.grid.cells)
         ),
     }
+    // At the default caps (256 tiles a side, 32 slices) one-pixel cells make 25 million cells
+    // at any size, past a texture of 16 384 rows: the message says the caps bound the grid
+    // (every size reported the same count, as if a finer footprint added cells).
+    if gpu.r().caps().max_texture_size <= 16_384 {
+        let capped = RenderOptions {
+            grid: GridConfig::fixed(1.0),
+            ..RenderOptions::default()
+        };
+        match gpu.r().render_offscreen(&scene, 640, 360, &capped) {
+            Err(manylight::Error::Limit(message)) => {
+                assert!(message.contains("grid.max_tiles"), "{message}")
+            }
+            other => panic!("expected a limit error, got {:?}", other.map(|_| ())),
+        }
+    }
     let (_, stats) = gpu
         .r()
         .render_offscreen(&scene, 640, 360, &RenderOptions::default())
