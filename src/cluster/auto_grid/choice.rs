@@ -178,9 +178,10 @@ pub(super) fn better(a: &Candidate, b: &Candidate) -> bool {
 /// Whether `new` should replace `current`: only when predicted at least [`HYSTERESIS`] cheaper
 /// than the current footprint under the same measurement (or when the current one was not
 /// measured this time, overflows or passes the CPU budget where the new one does not, passes
-/// it further than the new one by [`HYSTERESIS`] (relative share), or its first split moved). The current grid has to pass the budget by more than [`HYSTERESIS`]
-/// (relative) to be left for it, and a grid left for the budget is not taken back until it is
-/// predicted clearly cheaper, so a grid near the budget does not alternate with its neighbour.
+/// it further than the new one by [`HYSTERESIS`] (relative share), or its first split moved).
+/// The current grid has to pass the budget by more than [`HYSTERESIS`] (relative) to be left
+/// for it, and a grid left for the budget is not taken back until it is predicted clearly
+/// cheaper, so a grid near the budget does not alternate with its neighbour.
 pub fn should_switch(current: &GridConfig, new: &GridChoice) -> bool {
     if current.first_split != new.config.first_split {
         return true;
