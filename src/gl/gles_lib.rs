@@ -14,6 +14,7 @@ use std::sync::{Mutex, OnceLock};
 use khronos_egl as egl;
 
 use super::GlError;
+use crate::scene::shown;
 
 /// The environment variable naming the folder of the GLES implementation to load.
 pub const GLES_LIB_ENV: &str = "MANYLIGHT_GLES_LIB";
@@ -43,8 +44,8 @@ pub fn select(folder: &Path) -> Result<(), GlError> {
         if current.as_deref() != Some(folder.as_path()) {
             return Err(GlError::GlesLibrary(format!(
                 "the GLES implementation is already loaded ({}); {} must be chosen before the first context",
-                current.map_or("the system's".into(), |f| shown(&f)),
-                shown(&folder)
+                current.map_or("the system's".into(), |f| shown::path(&f)),
+                shown::path(&folder)
             )));
         }
         return Ok(());
@@ -86,16 +87,11 @@ pub fn files_in(folder: &Path) -> Result<(PathBuf, PathBuf), GlError> {
     library_files(folder).map_err(GlError::GlesLibrary)
 }
 
-/// `path` as a message shows it: a user's path may hold line ends or be very long.
-fn shown(path: &Path) -> String {
-    crate::scene::shown::reason(&path.to_string_lossy())
-}
-
 fn library_files(folder: &Path) -> Result<(PathBuf, PathBuf), String> {
     if !folder.is_dir() {
         return Err(format!(
             "{} (from --gles-lib or {GLES_LIB_ENV}) is not a folder",
-            shown(folder)
+            shown::path(folder)
         ));
     }
     let gles_path = find_in(folder, &["libGLESv2.so.2", "libGLESv2.so"])?;
@@ -112,7 +108,7 @@ fn find_in(folder: &Path, names: &[&str]) -> Result<PathBuf, String> {
         .ok_or_else(|| {
             format!(
                 "{} (from --gles-lib or {GLES_LIB_ENV}) holds none of {}",
-                shown(folder),
+                shown::path(folder),
                 names.join(", ")
             )
         })
@@ -134,9 +130,9 @@ impl GlesLibrary {
         // SAFETY: loading a GLES implementation runs its initialisers; that is what the user
         // asked for by naming the folder.
         let gles = unsafe { libloading::Library::new(&gles_path) }
-            .map_err(|e| format!("cannot load {}: {e}", shown(&gles_path)))?;
+            .map_err(|e| format!("cannot load {}: {e}", shown::path(&gles_path)))?;
         let egl = unsafe { Egl::load_required_from_filename(&egl_path) }
-            .map_err(|e| format!("cannot load {}: {e}", shown(&egl_path)))?;
+            .map_err(|e| format!("cannot load {}: {e}", shown::path(&egl_path)))?;
         Ok(GlesLibrary {
             egl,
             gles: Some(gles),

@@ -3,14 +3,9 @@
 //! error quotes from a file (a path, a name, a key) has its control characters escaped and is
 //! cut at a length ([`shown`]).
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use super::shown;
-
-/// A path as an error shows it ([`shown::reason`]).
-fn shown_path(path: &Path) -> String {
-    shown::reason(&path.to_string_lossy())
-}
 
 /// What went wrong while building, loading or validating a scene.
 #[derive(Debug, thiserror::Error)]
@@ -28,7 +23,7 @@ pub enum SceneError {
         reason: String,
     },
     /// A file could not be read.
-    #[error("cannot read {}: {source}", shown_path(path))]
+    #[error("cannot read {}: {source}", shown::path(path))]
     Io {
         /// The file.
         path: PathBuf,
@@ -36,7 +31,7 @@ pub enum SceneError {
         source: std::io::Error,
     },
     /// An OBJ file could not be parsed.
-    #[error("malformed OBJ {}: {}", shown_path(path), shown::reason(reason))]
+    #[error("malformed OBJ {}: {}", shown::path(path), shown::reason(reason))]
     Obj {
         /// The file.
         path: PathBuf,
@@ -45,7 +40,7 @@ pub enum SceneError {
     },
     /// A glTF file (`.gltf` or `.glb`) is malformed or cannot be shown; `reason` names the
     /// part of the file at fault, e.g. `meshes[2].primitives[0]: index 9 out of range …`.
-    #[error("malformed glTF {}: {}", shown_path(path), shown::reason(reason))]
+    #[error("malformed glTF {}: {}", shown::path(path), shown::reason(reason))]
     Gltf {
         /// The `.gltf` or `.glb` file.
         path: PathBuf,
@@ -54,7 +49,7 @@ pub enum SceneError {
     },
     /// A glTF file asks for what the renderer cannot do (an extension it requires, or
     /// nothing to draw); `reason` names it.
-    #[error("unsupported glTF {}: {}", shown_path(path), shown::reason(reason))]
+    #[error("unsupported glTF {}: {}", shown::path(path), shown::reason(reason))]
     GltfUnsupported {
         /// The `.gltf` or `.glb` file.
         path: PathBuf,
@@ -62,7 +57,7 @@ pub enum SceneError {
         reason: String,
     },
     /// A scene file is not valid JSON for the scene schema.
-    #[error("scene file {}: {}", shown_path(path), shown::reason(reason))]
+    #[error("scene file {}: {}", shown::path(path), shown::reason(reason))]
     SceneFile {
         /// The file.
         path: PathBuf,
@@ -70,7 +65,7 @@ pub enum SceneError {
         reason: String,
     },
     /// A file whose type the loader does not read (by its extension).
-    #[error("unsupported scene file type: {} (a scene is a built-in name, or a .obj, .gltf, .glb or .json file)", shown_path(path))]
+    #[error("unsupported scene file type: {} (a scene is a built-in name, or a .obj, .gltf, .glb or .json file)", shown::path(path))]
     UnsupportedFile {
         /// The file.
         path: PathBuf,

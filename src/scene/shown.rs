@@ -52,6 +52,12 @@ pub fn reason(reason: &str) -> String {
     cut(reason, MAX_SHOWN_REASON)
 }
 
+/// A path as a message shows it: [`reason`] of its text (a path may hold line ends, escape
+/// sequences or be very long).
+pub fn path(path: &std::path::Path) -> String {
+    reason(&path.to_string_lossy())
+}
+
 /// A name from a file as a message quotes it: [`text`], at most [`MAX_SHOWN_NAME`] characters.
 pub fn name(name: &str) -> String {
     cut(name, MAX_SHOWN_NAME)

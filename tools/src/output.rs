@@ -25,8 +25,7 @@ pub struct WriteError {
 
 impl std::fmt::Display for WriteError {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        // A path from the command line may hold line ends or escape sequences.
-        let path = manylight::scene::shown::reason(&self.path.to_string_lossy());
+        let path = manylight::scene::shown::path(&self.path);
         write!(f, "cannot write {path}: {}", self.source)
     }
 }

@@ -383,13 +383,15 @@ pub fn run(args: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
     }
     if let Some(path) = &args.record {
         let frames = counted(args.frames.into(), "frame");
-        tail += &format!(" · {frames} → {}", shown_path(path));
+        tail += &format!(" · {frames} → {}", manylight::scene::shown::path(path));
     }
     let method = match (&stats.auto_choice, &stats.auto_reason) {
         (Some(choice), Some(reason)) => format!("{} → {choice} ({reason})", stats.method),
         _ => stats.method.clone(),
     };
-    let written = out.map_or(String::new(), |p| format!(" → {}", shown_path(p)));
+    let written = out.map_or(String::new(), |p| {
+        format!(" → {}", manylight::scene::shown::path(p))
+    });
     // No timed frame: the one frame's time includes compiling shaders and uploading meshes.
     let time = if args.frames == 0 {
         format!(
@@ -423,9 +425,4 @@ fn counted(n: u64, noun: &str) -> String {
     } else {
         format!("{n} {noun}s")
     }
-}
-
-/// A path from the command line as the summary line shows it (escaped, cut: it is one line).
-fn shown_path(path: &std::path::Path) -> String {
-    manylight::scene::shown::reason(&path.to_string_lossy())
 }
