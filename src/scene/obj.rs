@@ -424,9 +424,16 @@ fn parse_obj(path: &Path, allow_outside: bool) -> Result<Parsed, SceneError> {
         ));
     }
     if let Some((count, line)) = rewrites.not_faces {
+        let what = if count == 1 {
+            format!("a line (`l`) or face of fewer than three corners (at line {line}) is")
+        } else {
+            format!(
+                "{count} lines (`l`) and faces of fewer than three corners (the first at line \
+                 {line}) are"
+            )
+        };
         warnings.borrow_mut().push(format!(
-            "{}: {count} lines (`l`) and faces of fewer than three corners (the first at line \
-             {line}) are not drawn; manylight draws triangles",
+            "{}: {what} not drawn; manylight draws triangles",
             path.display()
         ));
     }

@@ -156,3 +156,23 @@ fn lines_are_not_drawn_as_faces() {
     assert_eq!(said.len(), 1, "{:?}", report.warnings);
     assert!(said[0].contains("line 8"), "{}", said[0]);
 }
+
+/// One line (`l`) is named in the singular.
+#[test]
+fn one_line_is_named_in_the_singular() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("m.obj");
+    std::fs::write(&path, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nl 1 2\n").unwrap();
+    let (_, report) = load(&path);
+    let said: Vec<_> = report
+        .warnings
+        .iter()
+        .filter(|w| w.contains("(`l`)"))
+        .collect();
+    assert_eq!(said.len(), 1, "{:?}", report.warnings);
+    assert!(
+        said[0].contains("a line (`l`) or face of fewer than three corners (at line 5) is not"),
+        "{}",
+        said[0]
+    );
+}
