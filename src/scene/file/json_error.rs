@@ -1,14 +1,19 @@
 //! A scene file's JSON error as a message shows it: the path to the value at fault, with the
 //! file's own text in it (keys, unknown names, strings) cut to [`shown::MAX_SHOWN_NAME`].
 
-use serde_path_to_error::{Path, Segment};
+use serde_path_to_error::Segment;
 
 use crate::scene::shown;
 
 /// The message for `e`: `path: reason`, or the reason alone at the top level.
 pub(super) fn message(e: &serde_path_to_error::Error<serde_json::Error>) -> String {
     let inner = file_text_cut(&e.inner().to_string());
-    if e.path().iter().next().is_none() {
+    let mut path: Vec<&Segment> = e.path().iter().collect();
+    // The reason names an unknown key itself: the path ends at the object holding it.
+    if inner.starts_with("unknown field `") && matches!(path.last(), Some(Segment::Map { .. })) {
+        path.pop();
+    }
+    if path.is_empty() {
         return inner;
     }
     // serde says only "trailing characters" of an array with more values than it takes.
@@ -16,13 +21,13 @@ pub(super) fn message(e: &serde_path_to_error::Error<serde_json::Error>) -> Stri
         Some(position) => format!("too many values{position}"),
         None => inner,
     };
-    format!("{}: {inner}", shown_path(e.path()))
+    format!("{}: {inner}", shown_path(&path))
 }
 
 /// `lights[0].position`, each key as [`shown::name`] quotes it.
-fn shown_path(path: &Path) -> String {
+fn shown_path(path: &[&Segment]) -> String {
     let mut out = String::new();
-    for segment in path.iter() {
+    for segment in path {
         let name = match segment {
             Segment::Seq { index } => {
                 out.push_str(&format!("[{index}]"));

@@ -403,3 +403,24 @@ fn file_text_in_json_errors_is_cut() {
         assert!(!err.contains(&"k".repeat(65)), "{err}");
     }
 }
+
+/// An unknown key is named once, in serde's reason, after the path to the object holding it.
+#[test]
+fn an_unknown_key_is_named_once() {
+    let top = parse_str(r#"{"objects": [{"builtin": "plane"}], "lightz": []}"#)
+        .unwrap_err()
+        .to_string();
+    assert_eq!(top.matches("lightz").count(), 1, "{top}");
+    assert!(
+        top.contains("unknown field `lightz`, expected one of"),
+        "{top}"
+    );
+    let nested = parse_str(r#"{"objects": [{"builtin": "plane", "colour": 1}]}"#)
+        .unwrap_err()
+        .to_string();
+    assert_eq!(nested.matches("colour").count(), 1, "{nested}");
+    assert!(
+        nested.contains("objects[0]: unknown field `colour`"),
+        "{nested}"
+    );
+}
