@@ -55,10 +55,15 @@ impl Write for SharedFile {
     }
 }
 
-/// Whether `--record PATH` records an animated GIF (else a folder of PNG frames).
+/// Whether `--record PATH` records an animated GIF (else a folder of PNG frames): a name ending
+/// in `.gif`, `.gif` alone included; a trailing `/` names a folder.
 pub fn records_gif(path: &Path) -> bool {
-    path.extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("gif"))
+    let ends_in_gif =
+        |bytes: &[u8]| bytes.len() >= 4 && bytes[bytes.len() - 4..].eq_ignore_ascii_case(b".gif");
+    !path.as_os_str().as_encoded_bytes().ends_with(b"/")
+        && path
+            .file_name()
+            .is_some_and(|name| ends_in_gif(name.as_encoded_bytes()))
 }
 
 impl Recorder {
@@ -224,4 +229,20 @@ pub fn render(
     let mut stats = FrameStats::summarize(timed).unwrap_or(warm_up);
     stats.memory.upload_bytes_spread = upload;
     Ok(Rendered { first, last, stats })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::records_gif;
+    use std::path::Path;
+
+    #[test]
+    fn a_name_ending_in_gif_records_a_gif() {
+        for gif in ["a.gif", "dir/a.GIF", ".gif", "dir/.gif"] {
+            assert!(records_gif(Path::new(gif)), "{gif}");
+        }
+        for folder in ["frames", "a.gif/", "gif", "dir/gif", "a.gif.d", "."] {
+            assert!(!records_gif(Path::new(folder)), "{folder}");
+        }
+    }
 }
