@@ -379,7 +379,15 @@ fn usage_errors_exit_2_and_name_the_flags() {
         (&["bench-assign", "--runs", "-2"], "for '--runs"),
     ];
     for (args, needle) in cases {
-        expect_exit(args, &[], dir.path(), 2, needle);
+        let msg = expect_exit(args, &[], dir.path(), 2, needle);
+        // A usage line under the message is the subcommand's, as clap's own errors show it.
+        assert!(
+            !msg.contains("Usage: manylight [OPTIONS]"),
+            "{args:?}: {msg}"
+        );
+        if args[..2] == ["info", "--no-fragment-highp"] {
+            assert!(msg.contains("Usage: manylight info [OPTIONS]"), "{msg}");
+        }
     }
 }
 
@@ -813,12 +821,31 @@ fn hostile_files_and_counts_are_refused_quickly_and_clearly() {
             "random_lights.count",
             1,
         ),
-        (vec!["render", "--lights", "4294967296"], &[], "lights", 1),
+        // A count past the scene's limit is a bad value of the option (exit 2), on every path,
+        // near 2⁶⁴ and past it alike.
+        (
+            vec!["render", "--lights", "4294967296"],
+            &[],
+            "not a light count from 0 to 4194304",
+            2,
+        ),
         (
             vec!["render", "--lights", "18446744073709551615"],
             &[],
-            "lights",
-            1,
+            "not a light count",
+            2,
+        ),
+        (
+            vec!["render", "--lights", "18446744073709551616"],
+            &[],
+            "not a light count",
+            2,
+        ),
+        (
+            vec!["matrix", "--lights", "4194305"],
+            &[],
+            "not a light count",
+            2,
         ),
         (
             vec!["render", "--scene", "plain.obj", "--lights", "2"],

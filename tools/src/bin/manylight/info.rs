@@ -39,7 +39,7 @@ fn scene_report(
     spec: &str,
 ) -> Result<serde_json::Value, Box<dyn std::error::Error>> {
     // The lights `render` gives it by default (seed 1): a glTF or scene file its own.
-    let lights = crate::render::lights_for(spec, None, 1)?;
+    let lights = crate::render::lights_for(spec, None, 1);
     let (scene, _) = manylight::scene::load_with(spec, lights, &crate::load_options())?;
     let mut methods = Vec::new();
     let mut features = None;

@@ -118,7 +118,7 @@ impl From<EsArg> for EsVersion {
 
 /// Usage errors clap's attributes cannot express, reported the way clap reports its own
 /// (exit status 2).
-fn check_usage(cli: &Cli) {
+fn check_usage(cli: &Cli, subcommand: Option<&str>) {
     let render = match &cli.command {
         None => Some(&cli.render),
         Some(Command::Render(a)) => Some(a),
@@ -129,34 +129,31 @@ fn check_usage(cli: &Cli) {
         _ => render.map(|a| (a.no_fragment_highp, a.es)),
     };
     if let Some((true, EsArg::Three)) = no_highp_es {
-        Cli::command()
-            .error(
-                ErrorKind::ArgumentConflict,
-                "--no-fragment-highp plays an OpenGL ES 2.0 device (ES 3.0 requires fragment \
+        usage_error(
+            subcommand,
+            ErrorKind::ArgumentConflict,
+            "--no-fragment-highp plays an OpenGL ES 2.0 device (ES 3.0 requires fragment \
                  highp): add `--es 2`",
-            )
-            .exit();
+        );
     }
     if let Some(a) = render.filter(|a| a.assign_budget.is_some()) {
         if let render::GridArg::Fixed(_) = a.grid {
-            Cli::command()
-                .error(
-                    ErrorKind::ArgumentConflict,
-                    "--assign-budget is the automatic grid's CPU budget: a fixed --grid has none",
-                )
-                .exit();
+            usage_error(
+                subcommand,
+                ErrorKind::ArgumentConflict,
+                "--assign-budget is the automatic grid's CPU budget: a fixed --grid has none",
+            );
         }
     }
     if let Some(record) = render.and_then(|a| a.record.as_deref().filter(|_| a.frames == 0)) {
-        Cli::command()
-            .error(
-                ErrorKind::ArgumentConflict,
-                format!(
-                    "--record {} writes the timed frames, and --frames 0 times none",
-                    record.display()
-                ),
-            )
-            .exit();
+        usage_error(
+            subcommand,
+            ErrorKind::ArgumentConflict,
+            format!(
+                "--record {} writes the timed frames, and --frames 0 times none",
+                record.display()
+            ),
+        );
     }
     if let Some(a) = render {
         let out = match (&a.out, &a.record) {
@@ -166,16 +163,17 @@ fn check_usage(cli: &Cli) {
         };
         let stats = a.stats.as_deref().map(|p| ("--stats", p));
         let record = a.record.as_deref().map(|p| ("--record", p));
-        check_distinct_outputs(&[out, stats, record]);
-        check_not_the_input(&[out, stats], &a.scene);
+        check_distinct_outputs(subcommand, &[out, stats, record]);
+        check_not_the_input(subcommand, &[out, stats], &a.scene);
         if let Some(folder) = a.record.as_deref().filter(|p| !sequence::records_gif(p)) {
-            check_outside_folder(&[out, stats], ("--record", folder));
+            check_outside_folder(subcommand, &[out, stats], ("--record", folder));
         }
     }
     if let Some(Command::BenchAssign(a)) = &cli.command {
         if a.threads.len() > bench_assign::MAX_POOLS {
-            subcommand_usage_error(
-                "bench-assign",
+            usage_error(
+                subcommand,
+                ErrorKind::ValueValidation,
                 format!(
                     "--threads lists {} pools; at most {} (each pool's threads exist at once)",
                     a.threads.len(),
@@ -183,13 +181,13 @@ fn check_usage(cli: &Cli) {
                 ),
             );
         }
-        check_list_length("bench-assign", "--lights", a.lights.len());
+        check_list_length(subcommand, "--lights", a.lights.len());
     }
     if let Some(Command::Bench(a)) = &cli.command {
-        check_list_length("bench", "--scenes", a.scenes.len());
-        check_list_length("bench", "--lights", a.lights.len());
-        check_list_length("bench", "--methods", a.methods.len());
-        check_list_length("bench", "--es", a.es.len());
+        check_list_length(subcommand, "--scenes", a.scenes.len());
+        check_list_length(subcommand, "--lights", a.lights.len());
+        check_list_length(subcommand, "--methods", a.methods.len());
+        check_list_length(subcommand, "--es", a.es.len());
     }
     if let Some(Command::Matrix(a)) = &cli.command {
         // `--json -` is stdout, no file.
@@ -199,42 +197,43 @@ fn check_usage(cli: &Cli) {
             .filter(|p| *p != Path::new("-"))
             .map(|p| ("--json", p));
         let sheet = a.out.as_ref().map(|p| p.join("matrix.png"));
-        check_distinct_outputs(&[json, a.out.as_deref().map(|p| ("--out", p))]);
-        check_distinct_outputs(&[json, sheet.as_deref().map(|p| ("--out", p))]);
-        check_not_the_input(&[json, sheet.as_deref().map(|p| ("--out", p))], &a.scene);
+        check_distinct_outputs(subcommand, &[json, a.out.as_deref().map(|p| ("--out", p))]);
+        check_distinct_outputs(subcommand, &[json, sheet.as_deref().map(|p| ("--out", p))]);
+        check_not_the_input(
+            subcommand,
+            &[json, sheet.as_deref().map(|p| ("--out", p))],
+            &a.scene,
+        );
     }
     #[cfg(feature = "window")]
     if let Some(Command::View(a)) = &cli.command {
         let screenshot = a.screenshot.as_deref().map(|p| ("--screenshot", p));
-        check_not_the_input(&[screenshot], &a.scene);
+        check_not_the_input(subcommand, &[screenshot], &a.scene);
     }
     #[cfg(feature = "window")]
     if !cli.gles_lib.is_empty() && matches!(cli.command, Some(Command::View(_))) {
-        Cli::command()
-            .error(
-                ErrorKind::ArgumentConflict,
-                "--gles-lib does not reach `view`: its window comes from glutin, which loads the \
+        usage_error(
+            subcommand,
+            ErrorKind::ArgumentConflict,
+            "--gles-lib does not reach `view`: its window comes from glutin, which loads the \
                  system's libEGL.so.1 (point LD_LIBRARY_PATH at the folder instead)",
-            )
-            .exit();
+        );
     }
     if cli.gles_lib.len() > 1 && !matches!(cli.command, Some(Command::Matrix(_))) {
-        Cli::command()
-            .error(
-                ErrorKind::ArgumentConflict,
-                "--gles-lib names one implementation here; only `matrix` compares several",
-            )
-            .exit();
+        usage_error(
+            subcommand,
+            ErrorKind::ArgumentConflict,
+            "--gles-lib names one implementation here; only `matrix` compares several",
+        );
     }
     #[cfg(not(feature = "window"))]
     if let Some(Command::View { .. }) = cli.command {
-        Cli::command()
-            .error(
-                ErrorKind::InvalidSubcommand,
-                "`view` needs the `window` feature, which this build left out: \
+        usage_error(
+            subcommand,
+            ErrorKind::InvalidSubcommand,
+            "`view` needs the `window` feature, which this build left out: \
                  cargo run --release --features window -- view",
-            )
-            .exit();
+        );
     }
 }
 
@@ -243,22 +242,24 @@ fn check_usage(cli: &Cli) {
 /// take days, or the memory of a hundred thousand scenes.
 const MAX_LIST_VALUES: usize = 64;
 
-/// A usage error of `subcommand` (exit status 2), its usage line under the message.
-fn subcommand_usage_error(subcommand: &str, message: String) -> ! {
-    // Built, so that the subcommand's usage line under the message names it.
+/// A usage error (exit status 2), the usage line of `subcommand` (or the top level's) under
+/// the message.
+fn usage_error(subcommand: Option<&str>, kind: ErrorKind, message: impl std::fmt::Display) -> ! {
+    // Built, so that a subcommand's usage line names it.
     let mut cli = Cli::command();
     cli.build();
-    cli.find_subcommand_mut(subcommand)
-        .expect("a subcommand of the command line")
-        .error(ErrorKind::ValueValidation, message)
-        .exit()
+    match subcommand.and_then(|name| cli.find_subcommand_mut(name)) {
+        Some(sub) => sub.error(kind, message).exit(),
+        None => cli.error(kind, message).exit(),
+    }
 }
 
 /// `option` of `subcommand` lists at most [`MAX_LIST_VALUES`] values (over all its uses).
-fn check_list_length(subcommand: &str, option: &str, len: usize) {
+fn check_list_length(subcommand: Option<&str>, option: &str, len: usize) {
     if len > MAX_LIST_VALUES {
-        subcommand_usage_error(
+        usage_error(
             subcommand,
+            ErrorKind::ValueValidation,
             format!("{option} lists {len} values; at most {MAX_LIST_VALUES}"),
         );
     }
@@ -267,21 +268,20 @@ fn check_list_length(subcommand: &str, option: &str, len: usize) {
 /// Two options naming one file (through any spelling or symbolic link), or both standard output,
 /// would overwrite each other's output: a usage error naming both. A device or FIFO
 /// (`/dev/null`) other than standard output may take both.
-fn check_distinct_outputs(outputs: &[Option<(&str, &Path)>]) {
+fn check_distinct_outputs(subcommand: Option<&str>, outputs: &[Option<(&str, &Path)>]) {
     let to_stdout: Vec<_> = (outputs.iter().flatten())
         .filter(|(_, path)| output::names_stdout(path))
         .collect();
     if let [(a, a_path), (b, b_path), ..] = to_stdout[..] {
-        Cli::command()
-            .error(
-                ErrorKind::ArgumentConflict,
-                format!(
-                    "{a} {} and {b} {} both name standard output: one would run into the other",
-                    a_path.display(),
-                    b_path.display()
-                ),
-            )
-            .exit();
+        usage_error(
+            subcommand,
+            ErrorKind::ArgumentConflict,
+            format!(
+                "{a} {} and {b} {} both name standard output: one would run into the other",
+                a_path.display(),
+                b_path.display()
+            ),
+        );
     }
     let is_stream = |p: &Path| std::fs::metadata(p).is_ok_and(|m| !m.is_file() && !m.is_dir());
     let named: Vec<_> = outputs
@@ -292,23 +292,22 @@ fn check_distinct_outputs(outputs: &[Option<(&str, &Path)>]) {
         .collect();
     for (i, (a, a_path, a_id)) in named.iter().enumerate() {
         if let Some((b, b_path, _)) = named[i + 1..].iter().find(|(_, _, id)| id == a_id) {
-            Cli::command()
-                .error(
-                    ErrorKind::ArgumentConflict,
-                    format!(
-                        "{a} {} and {b} {} name the same file: one would overwrite the other",
-                        a_path.display(),
-                        b_path.display()
-                    ),
-                )
-                .exit();
+            usage_error(
+                subcommand,
+                ErrorKind::ArgumentConflict,
+                format!(
+                    "{a} {} and {b} {} name the same file: one would overwrite the other",
+                    a_path.display(),
+                    b_path.display()
+                ),
+            );
         }
     }
 }
 
 /// An output naming the scene file itself (through any spelling or link) would replace it with
 /// a picture or statistics: a usage error naming both.
-fn check_not_the_input(outputs: &[Option<(&str, &Path)>], spec: &str) {
+fn check_not_the_input(subcommand: Option<&str>, outputs: &[Option<(&str, &Path)>], spec: &str) {
     // A built-in's name is the built-in, even beside a file of that name.
     let scene = Path::new(spec);
     if manylight::BUILTIN_SCENES.contains(&spec) || !scene.is_file() {
@@ -320,22 +319,25 @@ fn check_not_the_input(outputs: &[Option<(&str, &Path)>], spec: &str) {
         .flatten()
         .find(|(_, path)| output::identity(path) == scene_id)
     {
-        Cli::command()
-            .error(
-                ErrorKind::ArgumentConflict,
-                format!(
-                    "{option} {} names the scene file --scene {}: it would be overwritten",
-                    path.display(),
-                    scene.display()
-                ),
-            )
-            .exit();
+        usage_error(
+            subcommand,
+            ErrorKind::ArgumentConflict,
+            format!(
+                "{option} {} names the scene file --scene {}: it would be overwritten",
+                path.display(),
+                scene.display()
+            ),
+        );
     }
 }
 
 /// A file inside the folder `--record` fills with frames could be one of them: a usage error
 /// naming both options.
-fn check_outside_folder(outputs: &[Option<(&str, &Path)>], (folder_option, folder): (&str, &Path)) {
+fn check_outside_folder(
+    subcommand: Option<&str>,
+    outputs: &[Option<(&str, &Path)>],
+    (folder_option, folder): (&str, &Path),
+) {
     let folder_id = output::identity(folder);
     // Standard output (`-`, `/dev/stdout`) is no file of the folder's.
     let files = outputs
@@ -344,17 +346,16 @@ fn check_outside_folder(outputs: &[Option<(&str, &Path)>], (folder_option, folde
         .filter(|(_, p)| !output::names_stdout(p));
     for &(option, path) in files {
         if output::identity(path).parent() == Some(folder_id.as_path()) {
-            Cli::command()
-                .error(
-                    ErrorKind::ArgumentConflict,
-                    format!(
-                        "{option} {} lies in the folder {folder_option} {} fills with frames: \
+            usage_error(
+                subcommand,
+                ErrorKind::ArgumentConflict,
+                format!(
+                    "{option} {} lies in the folder {folder_option} {} fills with frames: \
                          a frame could overwrite it",
-                        path.display(),
-                        folder.display()
-                    ),
-                )
-                .exit();
+                    path.display(),
+                    folder.display()
+                ),
+            );
         }
     }
 }
@@ -411,8 +412,13 @@ fn main() -> ExitCode {
         .init();
     let parsed = negative_values(Cli::command())
         .try_get_matches()
-        .and_then(|m| Cli::from_arg_matches(&m));
-    let cli = parsed.unwrap_or_else(|e| {
+        .and_then(|m| {
+            Ok((
+                Cli::from_arg_matches(&m)?,
+                m.subcommand_name().map(str::to_owned),
+            ))
+        });
+    let (cli, subcommand) = parsed.unwrap_or_else(|e| {
         // As clap's own `exit`, but help or a version that cannot be written is a failure too.
         let code = if e
             .print()
@@ -427,7 +433,7 @@ fn main() -> ExitCode {
     });
     // Before the usage checks: they ask whether an output names standard output.
     output::keep_stdout_for_own_output();
-    check_usage(&cli);
+    check_usage(&cli, subcommand.as_deref());
     let mut options = LoadOptions::default();
     options.allow_outside_files = cli.allow_outside_files;
     let _ = LOAD_OPTIONS.set(options);

@@ -32,7 +32,7 @@ pub struct MatrixArgs {
     #[arg(long, default_value = scene::builtin::DEFAULT)]
     pub scene: String,
     /// Seeded random lights.
-    #[arg(long, default_value_t = 256)]
+    #[arg(long, default_value_t = 256, value_parser = crate::bench_assign::parse_light_count)]
     pub lights: usize,
     /// Thumbnail size as WIDTHxHEIGHT.
     #[arg(long, default_value = "192x108", value_parser = crate::render::parse_size)]

@@ -4,7 +4,6 @@ use std::path::PathBuf;
 
 use clap::Parser;
 use manylight::gl::HeadlessContext;
-use manylight::scene::input::light_count;
 use manylight::{scene, RenderOptions, Renderer};
 use manylight_tools::output::{print_stdout, JsonOut, OutputFile};
 
@@ -27,9 +26,8 @@ pub struct RenderArgs {
     pub es: EsArg,
     /// Number of seeded random lights (for scene files: replaces their random_lights count).
     /// Default: 1024 for built-ins and OBJ files; a scene file or glTF file keeps its own lights.
-    // A u64, so that a count past a 32-bit target's usize gets the loader's error, not clap's.
-    #[arg(long)]
-    pub lights: Option<u64>,
+    #[arg(long, value_parser = crate::bench_assign::parse_light_count)]
+    pub lights: Option<usize>,
     /// Seed of the random lights.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
@@ -257,24 +255,20 @@ pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
     Ok((w, h))
 }
 
-/// The random lights a scene gets: `count` where asked (`--lights`, refused past
-/// [`MAX_LIGHTS`](manylight::scene::input::MAX_LIGHTS) naming it), else [`DEFAULT_LIGHTS`] for
-/// built-ins and OBJ files, none for a scene or glTF file (which keeps its own).
-pub fn lights_for(
-    spec: &str,
-    count: Option<u64>,
-    seed: u64,
-) -> Result<Option<(usize, u64)>, scene::SceneError> {
-    Ok(match (count, scene::brings_own_lights(spec)) {
-        (Some(n), _) => Some((light_count(n, "lights")?, seed)),
+/// The random lights a scene gets: `count` where asked (`--lights`, which clap bounds by
+/// [`MAX_LIGHTS`](manylight::scene::input::MAX_LIGHTS)), else [`DEFAULT_LIGHTS`] for built-ins
+/// and OBJ files, none for a scene or glTF file (which keeps its own).
+pub fn lights_for(spec: &str, count: Option<usize>, seed: u64) -> Option<(usize, u64)> {
+    match (count, scene::brings_own_lights(spec)) {
+        (Some(n), _) => Some((n, seed)),
         (None, true) => None,
         (None, false) => Some((DEFAULT_LIGHTS, seed)),
-    })
+    }
 }
 
 /// Runs the command.
 pub fn run(args: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
-    let lights = lights_for(&args.scene, args.lights, args.seed)?;
+    let lights = lights_for(&args.scene, args.lights, args.seed);
     // The loader logs each warning (at `warn`, shown by default): not printed again here.
     let (mut scene, _logged_warnings) =
         scene::load_with(&args.scene, lights, &crate::load_options())?;
