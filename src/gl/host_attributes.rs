@@ -1,6 +1,7 @@
 //! The application's vertex attributes at the renderer's locations. Their current (constant)
 //! values are context state on every version, and the renderer sets them where a mesh lacks an
-//! attribute. ES 2.0 has no vertex array objects, so there the arrays themselves are the
+//! attribute (only there: a compatibility profile refuses to read location 0's, which is
+//! `glVertex`'s). ES 2.0 has no vertex array objects, so there the arrays themselves are the
 //! application's too, with their divisors where an instanced-arrays extension gives them (a
 //! game's per-instance array would collapse the renderer's meshes to their first vertex).
 //! Each call saves them and gives them back: an engine that caches which arrays it enabled,
@@ -9,6 +10,7 @@
 
 use glow::HasContext;
 
+use super::absent_attributes::ABSENT;
 use super::ext_fns::{AttribPointerFns, VertexAttribDivisor};
 
 /// Locations 0 to 4: where `program::ATTRIBUTES` binds the renderer's attributes (its tests
@@ -29,7 +31,8 @@ struct Array {
 
 /// The application's attributes at the renderer's locations.
 pub(crate) struct HostAttributes {
-    current: [[f32; 4]; LOCATIONS],
+    /// The current values at the locations [`ABSENT`] sets.
+    current: [(u32, [f32; 4]); ABSENT.len()],
     /// Without a vertex array object of the renderer's own: the arrays, and what sets their
     /// pointers back (`None` where those entry points could not be loaded).
     arrays: Option<([Array; LOCATIONS], AttribPointerFns)>,
@@ -52,7 +55,8 @@ impl HostAttributes {
         fns: Option<AttribPointerFns>,
         divisor: Option<VertexAttribDivisor>,
     ) -> Self {
-        let current = std::array::from_fn(|i| read(gl, i as u32, glow::CURRENT_VERTEX_ATTRIB));
+        let current =
+            ABSENT.map(|(index, _)| (index, read(gl, index, glow::CURRENT_VERTEX_ATTRIB)));
         let arrays = fns.map(|fns| (std::array::from_fn(|i| save_array(gl, fns, i as u32)), fns));
         let divisors = divisor.map(|set| {
             let saved = std::array::from_fn(|i| {
@@ -95,8 +99,8 @@ impl HostAttributes {
                 unsafe { set(index as u32, divisor) };
             }
         }
-        for (index, [x, y, z, w]) in self.current.iter().copied().enumerate() {
-            unsafe { gl.vertex_attrib_4_f32(index as u32, x, y, z, w) };
+        for (index, [x, y, z, w]) in self.current {
+            unsafe { gl.vertex_attrib_4_f32(index, x, y, z, w) };
         }
     }
 }

@@ -8,6 +8,7 @@ use std::collections::HashMap;
 use glam::DVec3;
 use glow::HasContext;
 
+use super::absent_attributes::ABSENT;
 use super::{Device, GlError};
 use crate::scene::Mesh;
 
@@ -53,9 +54,6 @@ impl VertexLayout {
         .flatten()
     }
 }
-
-/// Values a shader reads for an optional attribute the mesh lacks (white, +X tangent).
-const ABSENT: [(u32, [f32; 4]); 2] = [(3, [1.0; 4]), (4, [1.0, 0.0, 0.0, 1.0])];
 
 /// One chunk of a mesh, CPU side: interleaved vertices and 16-bit indices.
 #[derive(Clone, Debug, PartialEq)]

@@ -11,6 +11,7 @@
 //! Every GL object has an explicit `destroy(&Device)`; `Drop` only warns when it was never
 //! called, because GL objects cannot be freed without the context at hand.
 
+pub(crate) mod absent_attributes;
 pub mod alloc;
 pub mod caps;
 pub mod context;

@@ -18,10 +18,11 @@ const OSMESA_RGBA: c_int = 0x1908;
 const OSMESA_DEPTH_BITS: c_int = 0x30;
 const OSMESA_PROFILE: c_int = 0x33;
 const OSMESA_CORE_PROFILE: c_int = 0x34;
+const OSMESA_COMPAT_PROFILE: c_int = 0x35;
 const OSMESA_CONTEXT_MAJOR_VERSION: c_int = 0x36;
 const OSMESA_CONTEXT_MINOR_VERSION: c_int = 0x37;
 
-/// A current OSMesa core-profile context. Keep it alive while anything uses its GL context.
+/// A current OSMesa context. Keep it alive while anything uses its GL context.
 pub struct OsMesaContext {
     _lib: libloading::Library,
     context: *mut c_void,
@@ -34,6 +35,15 @@ pub struct OsMesaContext {
 impl OsMesaContext {
     /// Loads libOSMesa and makes a 3.3 core-profile context current on this thread.
     pub fn new() -> Result<OsMesaContext, GlError> {
+        Self::with_profile(OSMESA_CORE_PROFILE, "core")
+    }
+
+    /// As [`new`](Self::new), a compatibility-profile context: what a toolkit gives by default.
+    pub fn compatibility() -> Result<OsMesaContext, GlError> {
+        Self::with_profile(OSMESA_COMPAT_PROFILE, "compatibility")
+    }
+
+    fn with_profile(profile: c_int, name: &str) -> Result<OsMesaContext, GlError> {
         let unavailable = |e: String| {
             GlError::Unsupported(format!("OSMesa is not available: {e}; install libosmesa6"))
         };
@@ -64,7 +74,7 @@ impl OsMesaContext {
             OSMESA_DEPTH_BITS,
             24,
             OSMESA_PROFILE,
-            OSMESA_CORE_PROFILE,
+            profile,
             OSMESA_CONTEXT_MAJOR_VERSION,
             3,
             OSMESA_CONTEXT_MINOR_VERSION,
@@ -74,9 +84,9 @@ impl OsMesaContext {
         // SAFETY: a zero-terminated attribute list, no share context.
         let context = unsafe { create(attribs.as_ptr(), std::ptr::null_mut()) };
         if context.is_null() {
-            return Err(unavailable(
-                "OSMesaCreateContextAttribs refused a 3.3 core context".into(),
-            ));
+            return Err(unavailable(format!(
+                "OSMesaCreateContextAttribs refused a 3.3 {name} context"
+            )));
         }
         let mut buffer = vec![0u8; 4];
         // SAFETY: a 1×1 RGBA8 buffer that lives as long as the context.

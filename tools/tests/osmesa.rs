@@ -127,3 +127,45 @@ fn a_context_egl_does_not_know_renders_after_a_headless_context_was_dropped() {
     r.set_method_named("clustered").unwrap();
     r.destroy();
 }
+
+/// A compatibility-profile context (what a toolkit gives by default) renders every method as
+/// the core profile does, and keeps the game's constant attributes: saving the game's state
+/// read location 0's current value, which that profile refuses (`GL_INVALID_OPERATION`, every
+/// offscreen render failed).
+#[test]
+#[allow(unsafe_code)] // the game's side: raw glow calls
+fn a_compatibility_profile_context_renders_as_the_core_profile() {
+    use manylight::glow::{self, HasContext};
+    let Some(core) = osmesa_or_skip() else {
+        return;
+    };
+    let s = scene::builtin::build(scene::builtin::DEFAULT, Some((64, 5))).unwrap();
+    let opts = RenderOptions::default();
+    let mut r = Renderer::new(core.load_gl(), EsVersion::Es3).unwrap();
+    let (reference, _) = r.render_offscreen(&s, 96, 54, &opts).unwrap();
+    r.destroy();
+    drop(core);
+    let compat = OsMesaContext::compatibility().expect("OSMesa gives a compatibility profile");
+    let gl = compat.load_gl();
+    let colour = [0.25, 0.5, 0.75, 1.0];
+    unsafe { gl.vertex_attrib_4_f32(3, colour[0], colour[1], colour[2], colour[3]) };
+    let mut r = Renderer::new(compat.load_gl(), EsVersion::Es3).unwrap();
+    for m in METHODS {
+        r.set_method_named(m.name).unwrap();
+        let (img, _) = r
+            .render_offscreen(&s, 96, 54, &opts)
+            .unwrap_or_else(|e| panic!("{}: {e}", m.name));
+        let d = manylight::metrics::diff(&reference, &img);
+        assert!(d.max_abs <= 2, "{}: {} / 255 from core", m.name, d.max_abs);
+    }
+    let mut current = [0f32; 4];
+    unsafe {
+        gl.get_vertex_attrib_parameter_f32_slice(3, glow::CURRENT_VERTEX_ATTRIB, &mut current);
+        assert_eq!(
+            current, colour,
+            "the game's constant colour was not given back"
+        );
+        assert_eq!(gl.get_error(), glow::NO_ERROR);
+    }
+    r.destroy();
+}
