@@ -128,6 +128,11 @@ impl Device {
                 error_name(pending)
             );
         }
+        // With no context current, GL calls do nothing and `glGetString` gives null, on which
+        // the probe's glow call panics; any context's largest texture is 64 texels or more.
+        if unsafe { gl.get_parameter_i32(glow::MAX_TEXTURE_SIZE) } <= 0 {
+            return Err(GlError::NotCurrent);
+        }
         let mut caps = Caps::probe(&gl, es)?;
         caps.restrict(restrictions)?;
         // A core profile draws nothing without a bound vertex array object; on an ES 3.x

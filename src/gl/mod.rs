@@ -185,8 +185,9 @@ pub enum GlError {
     /// size.
     #[error("out of memory: {0}")]
     OutOfMemory(String),
-    /// EGL says no context is current on this thread.
-    #[error("no GL context is current on this thread: was the renderer's context (its HeadlessContext, or the application's own) dropped or released while the Renderer lived? Keep it alive and current on this thread as long as the renderer")]
+    /// No context is current on this thread (EGL says so, or, at `Renderer::new`, GL answers
+    /// no query).
+    #[error("no GL context is current on this thread: was the renderer's context (its HeadlessContext, or the application's own) dropped or released while the Renderer lived, or not yet made current at Renderer::new? Keep it alive and current on this thread as long as the renderer")]
     NotCurrent,
     /// A [`HeadlessContext`] used on a thread where it is not current.
     #[error("this context is not current on the calling thread: call make_current here first (after release_current on the thread where it is current)")]

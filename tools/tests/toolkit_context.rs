@@ -149,11 +149,18 @@ fn calls_with_no_context_current_are_not_current_errors() {
     };
     let context = game.context();
     game.make_current(Some(context));
+    let gl_for_later = game.glow();
     let mut renderer = Renderer::new(game.glow(), EsVersion::Es3).unwrap();
     let scene = manylight::scene::builtin::build("plane", Some((16, 1))).unwrap();
     game.make_current(None);
     let not_current =
         |e: manylight::Error| matches!(e, manylight::Error::Gl(manylight::gl::GlError::NotCurrent));
+    // A renderer made before the game makes its context current (the probe panicked).
+    let made = Renderer::new(gl_for_later, EsVersion::Es3);
+    assert!(
+        made.is_err_and(not_current),
+        "Renderer::new with no context current"
+    );
     let switched = renderer.set_method_named("tiled");
     assert!(
         switched.is_err_and(not_current),
