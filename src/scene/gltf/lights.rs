@@ -10,7 +10,7 @@
 //!   This is the default exposure of glTF scenes, −11 EV against the raw numbers: a lamp of a
 //!   few hundred cd lights a room a few metres across, and a sun of a few thousand lux an
 //!   outdoor scene, without going black or white (the real sun's 100 000 lux needs
-//!   `--exposure -5` or a tone map); `--exposure` works on top. The renderer's
+//!   `--exposure -6` or a tone map); `--exposure` works on top. The renderer's
 //!   falloff is `w(d)² / (d² + 1)` (see [`crate::scene::shading::falloff`]), not glTF's
 //!   `w(d) / d²`: within about 1 unit of a light it is dimmer than glTF's, and never
 //!   infinite.
