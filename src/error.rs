@@ -5,6 +5,7 @@ use crate::scene::SceneError;
 
 /// Anything the library can fail with.
 #[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
 pub enum Error {
     /// From the GL layer (context, shaders, resources).
     #[error(transparent)]
@@ -52,7 +53,16 @@ pub enum Error {
         /// What it must be, and what it was.
         reason: String,
     },
-    /// A request the renderer cannot satisfy (too many lights for a method, bad size, …).
+    /// A frame of no pixels (a minimised window): nothing to draw, which a game skips.
+    #[error("viewport {width}×{height} is empty")]
+    EmptyViewport {
+        /// The frame's width asked for.
+        width: u32,
+        /// Its height.
+        height: u32,
+    },
+    /// A request the renderer cannot satisfy (too many lights for a method, a frame past the
+    /// context's size limits, …).
     #[error("{0}")]
     Limit(String),
     /// Writing an output file failed.

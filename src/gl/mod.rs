@@ -94,6 +94,7 @@ impl std::fmt::Display for EsVersion {
 
 /// Errors of the GL layer.
 #[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
 pub enum GlError {
     /// libEGL could not be loaded or lacks EGL 1.4.
     #[error("cannot load libEGL.so.1 ({0}); install libegl1 and a driver such as libegl-mesa0")]

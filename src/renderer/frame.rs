@@ -29,7 +29,8 @@ impl Renderer {
     /// (bindings, viewport, blend, depth, …) is given back as it was, and its scissor,
     /// stencil or blend equations do not change the frame (the README's
     /// "Sharing the context with a game"); another EGL context current is
-    /// [`GlError::OtherContext`](crate::GlError::OtherContext).
+    /// [`GlError::OtherContext`](crate::GlError::OtherContext), and a frame of no pixels (a
+    /// minimised window, which a game skips) [`Error::EmptyViewport`].
     ///
     /// The returned stats own their texts (method, GL strings, reasons): in steady state they
     /// are all the renderer allocates for a frame. A game's per-frame loop calls
@@ -487,7 +488,7 @@ impl Renderer {
 /// Refuses an empty frame (the same error whichever call was given it).
 pub(super) fn check_viewport(width: u32, height: u32) -> Result<(), Error> {
     if width == 0 || height == 0 {
-        return Err(Error::Limit(format!("viewport {width}×{height} is empty")));
+        return Err(Error::EmptyViewport { width, height });
     }
     Ok(())
 }

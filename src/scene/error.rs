@@ -9,6 +9,7 @@ use super::shown;
 
 /// What went wrong while building, loading or validating a scene.
 #[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
 pub enum SceneError {
     /// A value is out of its valid range (NaN, negative radius, outer < inner, …).
     #[error(
