@@ -8,8 +8,9 @@
 //! The "application" here makes its GL context with `HeadlessContext` to stay short; a game
 //! has one from glutin, SDL or Android's EGL already. What matters is the order:
 //!
-//! 1. make a `glow::Context` for manylight from the same (current) context — `glow::Context`
-//!    only holds function pointers, so the application keeps its own;
+//! 1. hand manylight the application's `glow::Context`, shared as an `Arc` (as egui and
+//!    three-d hold theirs; a `glow::Context` of its own, loaded from the same current context,
+//!    works as well);
 //! 2. bind the target (here an FBO with a texture; in a game, often the default framebuffer)
 //!    and call [`Renderer::render`], which draws into whatever is bound, with the viewport it
 //!    is given;
@@ -97,8 +98,8 @@ impl AppTarget {
 /// scissored bar along the bottom) after it, reads the result back and writes it to `out`.
 pub fn run(out: &Path, width: u32, height: u32) -> Result<(), Box<dyn std::error::Error>> {
     let ctx = HeadlessContext::new(EsVersion::Es3)?;
-    let app_gl = ctx.load_gl()?;
-    let mut renderer = Renderer::new(ctx.load_gl()?, EsVersion::Es3)?;
+    let app_gl = std::sync::Arc::new(ctx.load_gl()?);
+    let mut renderer = Renderer::new(app_gl.clone(), EsVersion::Es3)?;
     let scene = builtin_scene(
         "courtyard",
         Some(RandomLights {

@@ -8,7 +8,7 @@ use super::{Caps, EsVersion, GlError, Restrictions};
 /// The GL context the renderer draws with. Created from a glow context the caller owns (a
 /// game's, or [`super::HeadlessContext::load_gl`]) and the ES level to restrict itself to.
 pub struct Device {
-    pub(crate) gl: glow::Context,
+    pub(crate) gl: std::sync::Arc<glow::Context>,
     caps: Caps,
     live: std::cell::Cell<LiveObjects>,
     /// Draw calls made since the device was created (`gl::mesh` makes every one of a frame).
@@ -108,16 +108,20 @@ fn creation_failed(reason: String) -> GlError {
 
 impl Device {
     /// Wraps a current glow context and probes its capabilities.
-    pub fn new(gl: glow::Context, es: EsVersion) -> Result<Device, GlError> {
+    pub fn new(
+        gl: impl Into<std::sync::Arc<glow::Context>>,
+        es: EsVersion,
+    ) -> Result<Device, GlError> {
         Device::restricted(gl, es, &Restrictions::default())
     }
 
     /// [`Device::new`] playing a weaker device (see [`Restrictions`]).
     pub fn restricted(
-        gl: glow::Context,
+        gl: impl Into<std::sync::Arc<glow::Context>>,
         es: EsVersion,
         restrictions: &Restrictions,
     ) -> Result<Device, GlError> {
+        let gl = gl.into();
         // The probe clears errors its own queries may leave: one the application left is said
         // first, as a call of the renderer says it.
         let pending = drain_errors(&gl);

@@ -101,8 +101,13 @@ impl Renderer {
     /// Creates a renderer on a current GL context, restricted to feature level `es`. The
     /// context must be current during each of its calls and when it is dropped; between them
     /// it may be made not current (an app's suspend keeps it so). A context lost or destroyed
-    /// before the renderer: let the renderer go with [`Renderer::abandon`].
-    pub fn new(gl: glow::Context, es: EsVersion) -> Result<Renderer, Error> {
+    /// before the renderer: let the renderer go with [`Renderer::abandon`]. `gl` is a
+    /// `glow::Context` of its own or one the game shares (`Arc<glow::Context>`, as egui and
+    /// three-d hold theirs).
+    pub fn new(
+        gl: impl Into<std::sync::Arc<glow::Context>>,
+        es: EsVersion,
+    ) -> Result<Renderer, Error> {
         Renderer::restricted(gl, es, &crate::gl::Restrictions::default())
     }
 
@@ -110,7 +115,7 @@ impl Renderer {
     /// [`crate::gl::Restrictions`]): for example one without fragment highp, where only
     /// methods that need no highp run (the default method falls back to forward).
     pub fn restricted(
-        gl: glow::Context,
+        gl: impl Into<std::sync::Arc<glow::Context>>,
         es: EsVersion,
         restrictions: &crate::gl::Restrictions,
     ) -> Result<Renderer, Error> {
