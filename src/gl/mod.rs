@@ -13,6 +13,7 @@
 
 pub(crate) mod absent_attributes;
 pub mod alloc;
+pub(crate) mod bound_size;
 pub mod caps;
 pub mod context;
 pub mod device;

@@ -1,6 +1,7 @@
 //! What a frame needs of the framebuffer the application bound ([`Renderer::render`]): complete,
 //! no larger than the driver's viewport, and with a depth buffer when the frame is drawn in it
-//! (an MSAA frame brings its own and only resolves there). Forward, tiled and clustered draw
+//! (an MSAA frame brings its own and only resolves there); a frame reaching past its colour
+//! buffer is warned of. Forward, tiled and clustered draw
 //! with the depth test there, and so does deferred for transparent objects and for a frame
 //! without lights; deferred's opaque composite alone does not, but one rule for every method
 //! and frame is what the README asks of a game.
@@ -20,6 +21,7 @@ impl Renderer {
         &mut self,
         width: u32,
         height: u32,
+        origin: [u32; 2],
         drawn_here: bool,
     ) -> Result<Option<u32>, Error> {
         let [max_w, max_h] = self.dev.caps().max_viewport_dims;
@@ -38,6 +40,7 @@ impl Renderer {
             ))
             .into());
         }
+        self.warn_past_bound_colour((width, height), origin);
         if !drawn_here {
             return Ok(None);
         }
@@ -62,6 +65,28 @@ impl Renderer {
             _ => {}
         }
         Ok(Some(bits.map_or(FULL_DEPTH_BITS, |b| b.max(0)) as u32))
+    }
+
+    /// Warns once of a frame reaching past the bound framebuffer object's colour buffer, where
+    /// GL can say its size: GL draws only the part inside, and a game that did not resize its
+    /// framebuffer with the window would see a cut frame with no error.
+    fn warn_past_bound_colour(&mut self, (width, height): (u32, u32), [x, y]: [u32; 2]) {
+        if self.warned_past_framebuffer {
+            return;
+        }
+        let Some((w, h)) = self.dev.bound_color_size() else {
+            return;
+        };
+        if u64::from(x) + u64::from(width) > u64::from(w)
+            || u64::from(y) + u64::from(height) > u64::from(h)
+        {
+            self.warned_past_framebuffer = true;
+            log::warn!(
+                "the {width}×{height} frame at ({x}, {y}) reaches past the bound framebuffer's \
+                 {w}×{h} colour buffer: only the part inside is drawn (a framebuffer not resized \
+                 with the window?)"
+            );
+        }
     }
 
     /// Depth bits of the renderer's own targets, a 16-bit one warned of once.

@@ -137,7 +137,7 @@ impl Renderer {
             }
         }
         let games_depth_bits = if applications {
-            self.check_bound_target(width, height, samples <= 1)?
+            self.check_bound_target(width, height, origin, samples <= 1)?
         } else {
             None
         };

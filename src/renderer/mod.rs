@@ -74,6 +74,8 @@ pub struct Renderer {
     warned_directional: bool,
     /// A bound framebuffer's shallow depth buffer was announced (once per renderer).
     warned_depth_bits: bool,
+    /// A frame past the bound framebuffer's colour buffer was warned of.
+    warned_past_framebuffer: bool,
     /// The frame being drawn goes to a framebuffer that encodes sRGB itself: drawn with linear
     /// output (and, with MSAA on ES 3.0, an sRGB multisampled target).
     srgb_destination: bool,
@@ -158,6 +160,7 @@ impl Renderer {
             shown_directional: Vec::new(),
             warned_directional: false,
             warned_depth_bits: false,
+            warned_past_framebuffer: false,
             srgb_destination: false,
             warned_depth_step: false,
             warned_capped_radiance: false,

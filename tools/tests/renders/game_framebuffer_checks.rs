@@ -144,6 +144,56 @@ fn a_frame_past_the_viewport_limit_is_refused() {
     );
 }
 
+/// A frame reaching past the game's framebuffer (one not resized with the window) is drawn in
+/// part, as GL draws it, and warned of once (it passed in silence); the game's bindings the
+/// size query used are as they were. Renderbuffer colour on every context; texture colour where
+/// the context can say a texture's size (ES 3.1 and later: Mesa's 3.2 and ES 2.0 played on it).
+#[test]
+fn a_frame_past_the_games_framebuffer_is_warned_of_once() {
+    use common::game_target::{free_game_framebuffer, sized_framebuffer};
+    common::warnings::install();
+    let past = "reaches past the bound framebuffer's 64×36 colour buffer";
+    for es in [EsVersion::Es3, EsVersion::Es2] {
+        let (_ctx, gl, mut r) = game(es);
+        let texture_sizes = r.caps().context_version.as_str() >= "3.1";
+        unsafe { game_fbo(&gl, Some(glow::DEPTH_COMPONENT24)) };
+        let before = warnings_containing(past).len();
+        render(&mut r, &RenderOptions::default()).unwrap();
+        let moved = RenderOptions {
+            origin: [8, 0],
+            ..Default::default()
+        };
+        render(&mut r, &moved).unwrap();
+        let said = warnings_containing(past);
+        assert_eq!(said.len(), before + 1, "{es}: {said:?}");
+        assert!(
+            said[before].contains("64×36 frame at (8, 0)"),
+            "{}",
+            said[before]
+        );
+        r.render(&plane(), 128, 72, &RenderOptions::default())
+            .unwrap();
+        assert_eq!(warnings_containing(past).len(), before + 1, "{es}: once");
+        if texture_sizes {
+            let (_ctx, gl, mut r) = game(es);
+            let target = unsafe { sized_framebuffer(&gl, glow::RGBA8, SIZE) };
+            let bound_texture = unsafe { gl.get_parameter_texture(glow::TEXTURE_BINDING_2D) };
+            let before = warnings_containing(past).len();
+            render(&mut r, &RenderOptions::default()).unwrap();
+            r.render(&plane(), 65, 36, &RenderOptions::default())
+                .unwrap();
+            assert_eq!(warnings_containing(past).len(), before + 1, "{es} texture");
+            unsafe {
+                assert_eq!(
+                    gl.get_parameter_texture(glow::TEXTURE_BINDING_2D),
+                    bound_texture
+                );
+                free_game_framebuffer(&gl, target);
+            }
+        }
+    }
+}
+
 /// A GL error the game left pending was the first check's error (`render_offscreen`: "after
 /// allocating a target"), and turned GPU timing off for good; it is now cleared at the call,
 /// with a warning.

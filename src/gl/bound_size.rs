@@ -1,0 +1,79 @@
+//! The size of the bound framebuffer object's colour buffer, where GL can say it: a
+//! renderbuffer's always, a texture level's where `glGetTexLevelParameteriv` exists (ES 3.1,
+//! desktop GL). A window surface's (the default framebuffer) is EGL's to say, and not asked.
+#![allow(unsafe_code)]
+
+use glow::HasContext;
+
+use super::Device;
+
+impl Device {
+    /// The bound framebuffer object's colour attachment 0 as `(width, height)`, or `None`
+    /// where GL cannot say (the default framebuffer, a texture on ES 3.0 or 2.0, a texture
+    /// that is not a 2D one or a cube face). Leaves the bindings it used as they were.
+    pub(crate) fn bound_color_size(&self) -> Option<(u32, u32)> {
+        self.bound_framebuffer()?;
+        let gl = &self.gl;
+        let param = |pname| unsafe {
+            gl.get_framebuffer_attachment_parameter_i32(
+                glow::FRAMEBUFFER,
+                glow::COLOR_ATTACHMENT0,
+                pname,
+            )
+        };
+        let kind = param(glow::FRAMEBUFFER_ATTACHMENT_OBJECT_TYPE) as u32;
+        let name =
+            std::num::NonZeroU32::new(param(glow::FRAMEBUFFER_ATTACHMENT_OBJECT_NAME) as u32);
+        let size = match (kind, name) {
+            (glow::RENDERBUFFER, Some(name)) => unsafe {
+                let before = gl.get_parameter_i32(glow::RENDERBUFFER_BINDING);
+                gl.bind_renderbuffer(glow::RENDERBUFFER, Some(glow::NativeRenderbuffer(name)));
+                let w =
+                    gl.get_renderbuffer_parameter_i32(glow::RENDERBUFFER, glow::RENDERBUFFER_WIDTH);
+                let h = gl
+                    .get_renderbuffer_parameter_i32(glow::RENDERBUFFER, glow::RENDERBUFFER_HEIGHT);
+                gl.bind_renderbuffer(glow::RENDERBUFFER, renderbuffer(before));
+                (w, h)
+            },
+            (glow::TEXTURE, Some(name)) if self.has_texture_level_queries() => unsafe {
+                let level = param(glow::FRAMEBUFFER_ATTACHMENT_TEXTURE_LEVEL);
+                let face = param(glow::FRAMEBUFFER_ATTACHMENT_TEXTURE_CUBE_MAP_FACE) as u32;
+                let (target, binding, query) = if face == 0 {
+                    (glow::TEXTURE_2D, glow::TEXTURE_BINDING_2D, glow::TEXTURE_2D)
+                } else {
+                    (glow::TEXTURE_CUBE_MAP, glow::TEXTURE_BINDING_CUBE_MAP, face)
+                };
+                let before = gl.get_parameter_i32(binding);
+                // A texture of another target (an array's layer) is a GL error here: no size.
+                gl.bind_texture(target, Some(glow::NativeTexture(name)));
+                let w = gl.get_tex_level_parameter_i32(query, level, glow::TEXTURE_WIDTH);
+                let h = gl.get_tex_level_parameter_i32(query, level, glow::TEXTURE_HEIGHT);
+                gl.bind_texture(target, texture(before));
+                (w, h)
+            },
+            _ => return None,
+        };
+        let answered = self.drain_errors() == glow::NO_ERROR;
+        match size {
+            (w, h) if answered && w > 0 && h > 0 => Some((w as u32, h as u32)),
+            _ => None,
+        }
+    }
+
+    /// Whether `glGetTexLevelParameteriv` exists: ES 3.1 and desktop GL.
+    fn has_texture_level_queries(&self) -> bool {
+        let caps = self.caps();
+        let number = |n: Option<&str>| n.and_then(|n| n.parse::<u32>().ok()).unwrap_or(0);
+        let mut version = caps.context_version.split('.');
+        let (major, minor) = (number(version.next()), number(version.next()));
+        caps.desktop || (major, minor) >= (3, 1)
+    }
+}
+
+fn renderbuffer(binding: i32) -> Option<glow::Renderbuffer> {
+    std::num::NonZeroU32::new(binding as u32).map(glow::NativeRenderbuffer)
+}
+
+fn texture(binding: i32) -> Option<glow::Texture> {
+    std::num::NonZeroU32::new(binding as u32).map(glow::NativeTexture)
+}
