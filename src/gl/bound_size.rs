@@ -22,6 +22,11 @@ impl Device {
             )
         };
         let kind = param(glow::FRAMEBUFFER_ATTACHMENT_OBJECT_TYPE) as u32;
+        // Nothing attached: its name is no query on ES 2.0 (`GL_INVALID_ENUM`).
+        if kind == glow::NONE {
+            self.drain_errors();
+            return None;
+        }
         let name =
             std::num::NonZeroU32::new(param(glow::FRAMEBUFFER_ATTACHMENT_OBJECT_NAME) as u32);
         let size = match (kind, name) {
@@ -51,7 +56,11 @@ impl Device {
                 gl.bind_texture(target, texture(before));
                 (w, h)
             },
-            _ => return None,
+            _ => {
+                // A driver's error on a query here is not the frame's.
+                self.drain_errors();
+                return None;
+            }
         };
         let answered = self.drain_errors() == glow::NO_ERROR;
         match size {
