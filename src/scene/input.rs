@@ -211,7 +211,7 @@ pub fn check_light_count(count: usize, field: &str) -> Result<(), SceneError> {
     light_count(count as u64, field).map(|_| ())
 }
 
-/// A light count given as a 64-bit number (a command line's): refused like
+/// A light count given as a 64-bit number: refused like
 /// [`check_light_count`]'s, also where it does not fit `usize` (past 2³² on a 32-bit target).
 pub fn light_count(count: u64, field: &str) -> Result<usize, SceneError> {
     match usize::try_from(count) {
