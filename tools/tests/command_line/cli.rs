@@ -376,6 +376,12 @@ fn usage_errors_exit_2_and_name_the_flags() {
             "invalid value '-1' for '--lights",
         ),
         (&["matrix", "--max-error", "-1"], "for '--max-error"),
+        // Not a negative number either, but the value of the option it follows.
+        (
+            &["render", "--lights", "-inf"],
+            "invalid value '-inf' for '--lights",
+        ),
+        (&["bench-assign", "--runs", "-nan"], "for '--runs"),
         (&["bench-assign", "--runs", "-2"], "for '--runs"),
     ];
     for (args, needle) in cases {

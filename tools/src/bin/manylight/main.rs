@@ -383,12 +383,23 @@ pub(crate) fn version_unavailable(e: &(dyn std::error::Error + 'static)) -> bool
 }
 
 /// Every option that takes a value reads a negative number as one: `--lights -1` is then
-/// refused as a bad value of `--lights`, not as an unexpected argument `-1`.
+/// refused as a bad value of `--lights`, not as an unexpected argument `-1`; an option whose
+/// value is a number takes anything after it (`--lights -inf`: not the flags `-i`, `-n`, …).
 fn negative_values(command: clap::Command) -> clap::Command {
+    use std::any::TypeId;
+    let numbers = [
+        TypeId::of::<u32>(),
+        TypeId::of::<u64>(),
+        TypeId::of::<usize>(),
+        TypeId::of::<f32>(),
+        TypeId::of::<f64>(),
+    ];
     command
         .mut_args(|a| {
             let takes = a.get_action().takes_values();
+            let number = numbers.iter().any(|n| a.get_value_parser().type_id() == *n);
             a.allow_negative_numbers(takes)
+                .allow_hyphen_values(takes && number)
         })
         .mut_subcommands(negative_values)
 }
