@@ -13,7 +13,7 @@ use glutin::display::{Display, DisplayApiPreference, GlDisplay};
 use glutin::error::ErrorKind;
 use glutin::surface::{GlSurface, Surface, SurfaceAttributesBuilder, SwapInterval, WindowSurface};
 use manylight::{builtin_scene, Method, RandomLights, Scene, DEFAULT_SCENE};
-use manylight::{EsVersion, RenderOptions, Renderer};
+use manylight::{EsVersion, FrameStats, RenderOptions, Renderer};
 use winit::application::ApplicationHandler;
 use winit::dpi::PhysicalPosition;
 use winit::event::{Touch, TouchPhase, WindowEvent};
@@ -62,6 +62,7 @@ pub fn run(activity: AndroidApp) {
         touch: None,
         frames: 0,
         since: Instant::now(),
+        stats: FrameStats::default(),
         retry: Retry::default(),
         resumed: false,
     };
@@ -99,6 +100,8 @@ struct Shell {
     touch: Option<(u64, PhysicalPosition<f64>)>,
     frames: u32,
     since: Instant,
+    /// The last frame's figures, filled in place: `render_reusing` allocates nothing per frame.
+    stats: FrameStats,
     /// A frame or resume that failed, to be tried again.
     retry: Retry,
     /// Between `resumed` and `suspended`.
@@ -243,17 +246,6 @@ impl Shell {
             self.parked = Some(context);
         }
         let egl = self.egl.as_ref().ok_or("no EGL display")?;
-        // The kept context, or a new one (first start, or the old one could not be released).
-        let (parked, kept) = match self.parked.take() {
-            Some(c) => (c, true),
-            None => {
-                // Its objects went with the old context: let it go without a GL call.
-                if let Some(old) = self.renderer.take() {
-                    old.abandon();
-                }
-                (create_context(egl)?, false)
-            }
-        };
         let window = event_loop
             .create_window(Window::default_attributes())
             .map_err(|e| format!("cannot create the window: {e}"))?;
@@ -271,6 +263,18 @@ impl Shell {
         // `suspended` drops both before Android destroys the window).
         let surface = unsafe { egl.display.create_window_surface(&egl.config, &attributes) }
             .map_err(|e| format!("cannot create the window surface: {e}"))?;
+        // The kept context, or a new one (first start, or the old one could not be released);
+        // taken once the surface exists, so a failed window or surface keeps it for the retry.
+        let (parked, kept) = match self.parked.take() {
+            Some(c) => (c, true),
+            None => {
+                // Its objects went with the old context: let it go without a GL call.
+                if let Some(old) = self.renderer.take() {
+                    old.abandon();
+                }
+                (create_context(egl)?, false)
+            }
+        };
         let context = match parked.make_current(&surface) {
             Ok(c) => c,
             Err(e) if kept => {
@@ -292,7 +296,7 @@ impl Shell {
             // SAFETY: glutin returns EGL's entry points (or null); glow stores them, and the
             // context stays current on this thread whenever the renderer draws.
             let gl = unsafe {
-                glow::Context::from_loader_function_cstr(|name: &CStr| {
+                manylight::glow::Context::from_loader_function_cstr(|name: &CStr| {
                     egl.display.get_proc_address(name)
                 })
             };
@@ -360,8 +364,9 @@ impl Shell {
             wait_for_gpu: false,
             ..RenderOptions::default()
         };
-        let stats = renderer
-            .render(&self.scene, size.width, size.height, &options)
+        let stats = &mut self.stats;
+        renderer
+            .render_reusing(&self.scene, size.width, size.height, &options, stats)
             .map_err(|e| FrameError::Other(format!("render failed: {e}")))?;
         if let Err(e) = live.surface.swap_buffers(&live.context) {
             let message = format!("eglSwapBuffers: {e}");

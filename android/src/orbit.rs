@@ -1,7 +1,7 @@
 //! An orbit camera for touch input: a one-finger drag turns the eye around the scene centre at
 //! a fixed distance. GL- and Android-free, so it is unit-tested on the host.
 
-use glam::DVec3;
+use manylight::glam::DVec3;
 use manylight::Camera;
 
 /// Largest angle above or below the horizon, radians (just under 90°, so `up` stays valid).
