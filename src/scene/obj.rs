@@ -423,35 +423,7 @@ fn parse_obj(path: &Path, allow_outside: bool) -> Result<Parsed, SceneError> {
             path.display()
         ));
     }
-    if let Some((count, line)) = rewrites.not_faces {
-        let what = if count == 1 {
-            format!("a line (`l`) or face of fewer than three corners (at line {line}) is")
-        } else {
-            format!(
-                "{count} lines (`l`) and faces of fewer than three corners (the first at line \
-                 {line}) are"
-            )
-        };
-        warnings.borrow_mut().push(format!(
-            "{}: {what} not drawn; manylight draws triangles",
-            path.display()
-        ));
-    }
-    if let Some(line) = rewrites.long_name {
-        warnings.borrow_mut().push(format!(
-            "{}: object or group names longer than {} bytes (the first at line {line}) are cut \
-             to that length",
-            path.display(),
-            lines::MAX_OBJ_NAME_BYTES
-        ));
-    }
-    if let Some((with, without)) = rewrites.mixed_colours {
-        warnings.borrow_mut().push(format!(
-            "{}: vertex colours on some `v` lines only (line {with} has one, line {without} \
-             none); ignored, as manylight does not use OBJ vertex colours",
-            path.display()
-        ));
-    }
+    warnings.borrow_mut().extend(rewrites.warnings(path));
     let warn = |w: String| warnings.borrow_mut().push(w);
     let load_mtl = |name: &Path| -> tobj::MTLLoadResult {
         let name = name.to_string_lossy().replace('\\', "/");

@@ -2,6 +2,7 @@
 //! before it parses: each error names the line and the statement, never the file's text.
 
 use std::collections::HashSet;
+use std::path::Path;
 
 use crate::scene::mesh::{MAX_SCENE_MESHES, MAX_TEXCOORD};
 
@@ -51,6 +52,40 @@ pub(super) struct Rewrites {
 }
 
 impl Rewrites {
+    /// What the rewrites change of the file at `path`, one warning each.
+    pub fn warnings(&self, path: &Path) -> Vec<String> {
+        let mut warnings = Vec::new();
+        if let Some((count, line)) = self.not_faces {
+            let what = if count == 1 {
+                format!("a line (`l`) or face of fewer than three corners (at line {line}) is")
+            } else {
+                format!(
+                    "{count} lines (`l`) and faces of fewer than three corners (the first at \
+                     line {line}) are"
+                )
+            };
+            warnings.push(format!(
+                "{}: {what} not drawn; manylight draws triangles",
+                path.display()
+            ));
+        }
+        if let Some(line) = self.long_name {
+            warnings.push(format!(
+                "{}: object or group names longer than {MAX_OBJ_NAME_BYTES} bytes (the first at \
+                 line {line}) are cut to that length",
+                path.display()
+            ));
+        }
+        if let Some((with, without)) = self.mixed_colours {
+            warnings.push(format!(
+                "{}: vertex colours on some `v` lines only (line {with} has one, line {without} \
+                 none); ignored, as manylight does not use OBJ vertex colours",
+                path.display()
+            ));
+        }
+        warnings
+    }
+
     /// Whether anything needs rewriting.
     pub fn needed(&self) -> bool {
         self.mixed_colours.is_some()
