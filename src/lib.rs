@@ -10,7 +10,8 @@
 //! - A [`Renderer`] on it: [`Renderer::render`] into the bound framebuffer (a game's),
 //!   [`Renderer::render_reusing`] the same without allocating per frame,
 //!   [`Renderer::render_offscreen`] into an image; [`Renderer::set_method`] picks forward,
-//!   tiled, clustered (the default), deferred or auto.
+//!   tiled, clustered (the default), deferred or auto; [`Renderer::warm_up`] builds a scene's
+//!   shaders before its first frame.
 //! - A [`Scene`]: [`builtin_scene`] or [`load_scene`] (OBJ, glTF, JSON scene files;
 //!   [`load_scene_with`] and [`LoadOptions`] let a trusted model read outside its folder), or built
 //!   in code with [`Scene::add_material`], [`MeshBuilder`], [`Scene::add_object`],
@@ -102,6 +103,7 @@ pub use options::{
 };
 pub use renderer::{
     ContextStats, FrameStats, GridStats, LightStats, MemoryStats, Method, Renderer, TimeStats,
+    WarmUp,
 };
 pub use scene::features::SceneFeatures;
 pub use scene::meshbuild::MeshBuilder;

@@ -302,6 +302,12 @@ impl Shell {
             };
             let mut renderer = Renderer::new(gl, egl.es).map_err(|e| e.to_string())?;
             pick_method(&mut renderer)?;
+            // The scene's shaders built now, into the window's framebuffer as frames draw,
+            // rather than in the first frames (a hitch of tens of milliseconds a variant).
+            match renderer.warm_up(&self.scene, &frame_options()) {
+                Ok(w) => log::info!("warmed up: {} programs in {:.0} ms", w.programs_built, w.ms),
+                Err(e) => log::warn!("warm-up failed (the first frames build what it did not): {e}"),
+            }
             let caps = renderer.caps();
             log::info!(
                 "{} on {} ({}), method {}",
@@ -360,14 +366,13 @@ impl Shell {
             return Ok(());
         }
         self.orbit.apply(&mut self.scene.camera);
-        let options = RenderOptions {
-            wait_for_gpu: false,
-            ..RenderOptions::default()
-        };
         let stats = &mut self.stats;
         renderer
-            .render_reusing(&self.scene, size.width, size.height, &options, stats)
+            .render_reusing(&self.scene, size.width, size.height, &frame_options(), stats)
             .map_err(|e| FrameError::Other(format!("render failed: {e}")))?;
+        if stats.programs_built > 0 {
+            log::info!("a frame built {} shader programs", stats.programs_built);
+        }
         if let Err(e) = live.surface.swap_buffers(&live.context) {
             let message = format!("eglSwapBuffers: {e}");
             return Err(match e.error_kind() {
@@ -393,6 +398,14 @@ impl Shell {
             self.since = Instant::now();
         }
         Ok(())
+    }
+}
+
+/// What every frame is drawn with: a game's frame does not wait for the GPU.
+fn frame_options() -> RenderOptions {
+    RenderOptions {
+        wait_for_gpu: false,
+        ..RenderOptions::default()
     }
 }
 

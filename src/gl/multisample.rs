@@ -426,6 +426,12 @@ impl MultisampleTarget {
     }
 }
 
+/// Builds the program [`MultisampleTarget::fill`] draws an sRGB target's background with, for a
+/// warm-up whose own frames draw into no sRGB target.
+pub(crate) fn build_fill_program(dev: &Device, programs: &mut ProgramCache) -> Result<(), GlError> {
+    full_screen::<SolidUniforms>(dev, programs, "solid").map(|_| ())
+}
+
 /// Sets the full-screen state and binds `shader`'s one variant from `programs`.
 fn full_screen<'p, U: UniformSet>(
     dev: &Device,

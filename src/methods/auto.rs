@@ -59,6 +59,20 @@ fn supported(caps: &crate::gl::Caps) -> Support {
 /// Up to this many visible lights, plain forward is chosen.
 pub const FORWARD_UP_TO: usize = 32;
 
+/// The methods auto may draw a frame with on a context with `caps`: forward always, clustered
+/// where it runs, deferred where a G-buffer can be made and the frame is not drawn into the
+/// renderer's own multisampled target (`own_msaa`; see [`deferred_refusal`]).
+pub(crate) fn methods_it_may_run(caps: &crate::gl::Caps, own_msaa: bool) -> Vec<&'static str> {
+    let mut names = vec![super::forward::DESC.name];
+    if !matches!(culled_support(caps), Support::Unsupported(_)) {
+        names.push(super::clustered::DESC.name);
+    }
+    if gbuffer::unsupported_reason(caps).is_none() && !own_msaa {
+        names.push(super::deferred::DESC.name);
+    }
+    names
+}
+
 /// Frames deferred's resources are kept after the last frame it rendered (two seconds at
 /// 60 frames a second).
 pub const DEFERRED_KEPT_FRAMES: u32 = 120;

@@ -393,18 +393,28 @@ impl Deferred {
         };
         let mut uploaded = 0;
         for proxy in [Proxy::NearSide, Proxy::FarSide, Proxy::FullScreen] {
+            let (shader, mesh) = match proxy {
+                Proxy::FullScreen => ("deferred_light_fullscreen", self.fullscreen.as_ref()),
+                _ => ("deferred_light", self.sphere.as_ref()),
+            };
+            let key = ProgramKey {
+                shader,
+                features: features.0,
+                dialect: dev.es(),
+            };
+            let defines = || features.defines(dev.es(), 1);
             let mut lights = drawn().filter(|(_, l)| reach.proxy(l) == proxy).peekable();
             if lights.peek().is_none() {
+                if ctx.warm_up {
+                    // Built all the same: a light may take this proxy in a later frame.
+                    ctx.programs.bind::<LightProgram>(dev, key, defines)?;
+                }
                 continue;
             }
             // Made for the first frame with lights: a scene without pays nothing for it.
             if self.lights.is_none() {
                 self.lights = Some(LightInstances::new(dev)?);
             }
-            let (shader, mesh) = match proxy {
-                Proxy::FullScreen => ("deferred_light_fullscreen", self.fullscreen.as_ref()),
-                _ => ("deferred_light", self.sphere.as_ref()),
-            };
             RenderState {
                 depth_test: proxy.depth_test(),
                 depth_write: false,
@@ -413,14 +423,7 @@ impl Deferred {
                 color_write: true,
             }
             .apply(dev);
-            let key = ProgramKey {
-                shader,
-                features: features.0,
-                dialect: dev.es(),
-            };
-            let p = ctx
-                .programs
-                .bind::<LightProgram>(dev, key, || features.defines(dev.es(), 1))?;
+            let p = ctx.programs.bind::<LightProgram>(dev, key, defines)?;
             p.g_albedo.set(dev, UNIT_G_ALBEDO);
             p.g_normal_depth.set(dev, UNIT_G_NORMAL_DEPTH);
             p.g_specular.set(dev, UNIT_G_SPECULAR);

@@ -102,6 +102,9 @@ pub struct FrameContext<'a> {
     /// What the frame cleared before it was drawn (`RenderOptions::clear`; everything in an
     /// offscreen render, which ignores it).
     pub clear: crate::options::Clear,
+    /// A frame of [`Renderer::warm_up`](crate::Renderer::warm_up): a pass with nothing to draw
+    /// this time (a deferred proxy no light takes) still builds its program.
+    pub warm_up: bool,
 }
 
 /// Which grid a tiled or clustered frame used, and why.

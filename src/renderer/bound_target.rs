@@ -92,7 +92,7 @@ impl Renderer {
     /// Depth bits of the renderer's own targets, a 16-bit one warned of once.
     pub(super) fn own_depth_bits(&mut self) -> u32 {
         let (_, bits) = self.dev.caps().own_depth_format();
-        if bits < FULL_DEPTH_BITS as u32 && !self.warned_own_depth_bits {
+        if bits < FULL_DEPTH_BITS as u32 && !self.warned_own_depth_bits && !self.warming_up {
             self.warned_own_depth_bits = true;
             log::warn!(
                 "the renderer's own depth buffer has {bits} bits on this context (it has \

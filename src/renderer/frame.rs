@@ -79,9 +79,10 @@ impl Renderer {
         stats: &mut FrameStats,
         applications: bool,
     ) -> Result<(), Error> {
-        let draw_calls = self.dev.draw_calls();
+        let (draw_calls, programs) = (self.dev.draw_calls(), self.programs.len());
         let drawn = self.render_counted(scene, size, options, origin, stats, applications);
         stats.draw_calls = self.dev.draw_calls() - draw_calls;
+        stats.programs_built = self.programs.len() - programs;
         drawn
     }
 
@@ -271,12 +272,14 @@ impl Renderer {
         );
         let (near, far) = scene.camera.near_far();
         let content_far = content_far(self.gpu_scene.scene_bounds(scene), &view, near, far);
-        super::depth_warning::warn_of_coarse_depth(
-            &scene.camera,
-            content_far,
-            stats.depth_bits,
-            &mut self.warned_depth_step,
-        );
+        if !self.warming_up {
+            super::depth_warning::warn_of_coarse_depth(
+                &scene.camera,
+                content_far,
+                stats.depth_bits,
+                &mut self.warned_depth_step,
+            );
+        }
         let reach = super::fp16_range::view_reach(scene, width as f64 / height as f64, content_far);
         super::fp16_range::check(self.dev.caps(), scene, &mut self.lights, reach)?;
         super::fp16_channels::warn_of_lost_channels(self.dev.caps(), scene);
@@ -318,6 +321,7 @@ impl Renderer {
             transparent_only: false,
             own_msaa: self.own_msaa_frame,
             clear,
+            warm_up: self.warming_up,
         };
         // The frame's errors so far are its own: the timer's calls (creating the queries too)
         // would drain them as theirs.

@@ -19,6 +19,7 @@ mod offscreen;
 mod stats;
 #[cfg(test)]
 mod timer_tests;
+mod warm_up;
 
 use crate::cluster::view_light::GpuLight;
 use crate::gl::framebuffer::OffscreenTarget;
@@ -32,6 +33,7 @@ pub use crate::options::{CountKind, RenderOptions, ToneMap};
 use crate::Error;
 pub use method::Method;
 pub use stats::{ContextStats, FrameStats, GridStats, LightStats, MemoryStats, TimeStats};
+pub use warm_up::WarmUp;
 
 /// Renders scenes with one shading method at a time.
 ///
@@ -88,6 +90,9 @@ pub struct Renderer {
     warned_capped_ambient: bool,
     /// The renderer's own 16-bit depth buffer was announced (once per renderer).
     warned_own_depth_bits: bool,
+    /// The frame being drawn is a warm-up's ([`Renderer::warm_up`]): into a target of its own,
+    /// so what it would say of its depth buffer is not the game's.
+    warming_up: bool,
     /// The frame's objects in draw order (kept likewise).
     draw_order: methods::geometry::DrawOrder,
     /// `LP_NUM_THREADS` when the renderer was made (llvmpipe reads it when the context is
@@ -166,6 +171,7 @@ impl Renderer {
             warned_capped_radiance: false,
             warned_capped_ambient: false,
             warned_own_depth_bits: false,
+            warming_up: false,
             draw_order: methods::geometry::DrawOrder::default(),
             lp_num_threads: std::env::var("LP_NUM_THREADS").ok(),
             left: LeftObjects::default(),

@@ -42,6 +42,10 @@ pub struct FrameStats {
     /// composite, transparent objects, MSAA's fill and resolve): each costs a GPU's driver
     /// CPU time, which a software rasterizer's frame time hides.
     pub draw_calls: u64,
+    /// Shader programs the frame compiled and linked (variants met for the first time): each
+    /// costs milliseconds on llvmpipe and more on a phone's driver, a hitch in a game's frame.
+    /// [`Renderer::warm_up`](super::Renderer::warm_up) builds them beforehand.
+    pub programs_built: usize,
     /// What the scene uses (and so what the shader variants were built with).
     pub scene_features: SceneFeatures,
     /// Frame, GPU and assignment times.
@@ -164,6 +168,7 @@ impl Default for FrameStats {
             depth_bits: 24,
             triangles: 0,
             draw_calls: 0,
+            programs_built: 0,
             scene_features: SceneFeatures::default(),
             time: TimeStats::default(),
             lights: LightStats::default(),

@@ -387,6 +387,13 @@ fn every_call_gives_the_games_gl_state_back_and_draws_as_from_a_clean_one() {
                 before,
                 "{what}: set_method changed the game's state"
             );
+            // Warmed up first: the picture below must be the clean renderer's all the same.
+            renderer.warm_up(&scene, opts).unwrap();
+            assert_eq!(
+                snapshot(&gl, has),
+                before,
+                "{what}: warm_up changed the game's state"
+            );
             let (img, _) = renderer.render_offscreen(&scene, w, h, opts).unwrap();
             let d = manylight::metrics::diff(expected, &img);
             assert_eq!(d.max_abs, 0, "{what}: the game's state changed the picture");

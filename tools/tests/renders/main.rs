@@ -27,3 +27,4 @@ mod single_sided;
 mod srgb_framebuffer;
 mod tone_map;
 mod viewport_origin;
+mod warm_up;

@@ -220,7 +220,14 @@ impl ApplicationHandler for App<'_> {
             Ok(g)
         });
         match made {
-            Ok(g) => {
+            Ok(mut g) => {
+                // The scene's shaders built before the first frame (the window stays blank
+                // meanwhile, not a first frame that stalls).
+                if let Some(r) = g.renderer.as_mut() {
+                    if let Err(e) = r.warm_up(&self.scene, &self.frame_options()) {
+                        log::warn!("warm-up failed (the first frames build what it did not): {e}");
+                    }
+                }
                 self.good.0 = self.args.method.clone();
                 g.window.request_redraw();
                 self.gfx = Some(g);
@@ -279,6 +286,21 @@ impl ApplicationHandler for App<'_> {
 }
 
 impl App<'_> {
+    /// What the next frame is drawn with: the keys' heatmap, tone map and MSAA.
+    fn frame_options(&self) -> RenderOptions {
+        RenderOptions {
+            wait_for_gpu: false,
+            count: if self.heatmap {
+                CountKind::Heatmap
+            } else {
+                CountKind::None
+            },
+            tone_map: self.tone_map,
+            samples: self.samples,
+            ..RenderOptions::default()
+        }
+    }
+
     /// Stops the loop; the first error is the one reported.
     fn fail(&mut self, event_loop: &ActiveEventLoop, error: String) {
         if self.result.is_ok() {
@@ -407,6 +429,7 @@ impl App<'_> {
 
     /// Moves the camera, renders one frame, handles `--frames`/`--screenshot`, swaps.
     fn redraw(&mut self, event_loop: &ActiveEventLoop) -> Result<(), String> {
+        let options = self.frame_options();
         let Some(g) = self.gfx.as_mut().filter(|_| !self.done) else {
             return Ok(());
         };
@@ -422,17 +445,6 @@ impl App<'_> {
             self.time_s += dt;
             self.scene.set_time(self.time_s);
         }
-        let options = RenderOptions {
-            wait_for_gpu: false,
-            count: if self.heatmap {
-                CountKind::Heatmap
-            } else {
-                CountKind::None
-            },
-            tone_map: self.tone_map,
-            samples: self.samples,
-            ..RenderOptions::default()
-        };
         let renderer = g.renderer.as_mut().ok_or("renderer already destroyed")?;
         // One FrameStats kept across frames: a steady frame allocates nothing.
         let mut stats = std::mem::take(&mut self.stats);
