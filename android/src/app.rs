@@ -302,11 +302,13 @@ impl Shell {
             };
             let mut renderer = Renderer::new(gl, egl.es).map_err(|e| e.to_string())?;
             pick_method(&mut renderer)?;
-            // The scene's shaders built now, into the window's framebuffer as frames draw,
-            // rather than in the first frames (a hitch of tens of milliseconds a variant).
+            // The scene's shaders built now, for the window's framebuffer the frames draw into,
+            // rather than in the first frames (each compile a hitch).
             match renderer.warm_up(&self.scene, &frame_options()) {
                 Ok(w) => log::info!("warmed up: {} programs in {:.0} ms", w.programs_built, w.ms),
-                Err(e) => log::warn!("warm-up failed (the first frames build what it did not): {e}"),
+                Err(e) => {
+                    log::warn!("warm-up failed (the first frames build what it did not): {e}")
+                }
             }
             let caps = renderer.caps();
             log::info!(
@@ -368,7 +370,13 @@ impl Shell {
         self.orbit.apply(&mut self.scene.camera);
         let stats = &mut self.stats;
         renderer
-            .render_reusing(&self.scene, size.width, size.height, &frame_options(), stats)
+            .render_reusing(
+                &self.scene,
+                size.width,
+                size.height,
+                &frame_options(),
+                stats,
+            )
             .map_err(|e| FrameError::Other(format!("render failed: {e}")))?;
         if stats.programs_built > 0 {
             log::info!("a frame built {} shader programs", stats.programs_built);

@@ -30,14 +30,15 @@ pub struct WarmUp {
 impl Renderer {
     /// Builds what drawing `scene` with `options` into the framebuffer bound now needs (every
     /// shader variant of its materials and lights, its meshes and textures), so that the first
-    /// [`Renderer::render`] builds nothing: on a phone's driver a variant costs tens of
-    /// milliseconds, a visible hitch. A game calls it while it shows a loading screen, and again
-    /// when the scene gains a kind of material or light (a first spot light, a first normal
-    /// map) or the options change what is drawn (tone map, MSAA, linear output).
+    /// [`Renderer::render`] builds nothing: compiling a variant takes a driver milliseconds to
+    /// tens of milliseconds, a visible hitch. A game calls it while it shows a loading screen,
+    /// and again when the scene gains a kind of material or light (a first spot light, a first
+    /// normal map) or loses its last light (drawn then by ambient-only variants), or when the
+    /// options change what is drawn (tone map, MSAA, linear output).
     ///
     /// It draws one small frame offscreen with the current method, or with each method `auto`
     /// may pick (forward, clustered, deferred), including the passes the camera does not need
-    /// yet (deferred's light volumes around the eye). The method's own state (its grid, its
+    /// yet (deferred's full-screen lights). The method's own state (its grid, its
     /// thread choice, `auto`'s choice) is not touched: the frames are drawn by fresh instances,
     /// freed afterwards. Like a frame, it gives the application's GL state back as it was.
     /// [`FrameStats::programs_built`] says what a frame built after all.
