@@ -61,8 +61,9 @@ pub enum Error {
         /// Its height.
         height: u32,
     },
-    /// A request the renderer cannot satisfy (too many lights for a method, a frame past the
-    /// context's size limits, …).
+    /// A request the renderer cannot satisfy (too many lights for a method, light counts past
+    /// what a target can hold, …). A frame too large for the context is
+    /// [`GlError::TooLarge`].
     #[error("{0}")]
     Limit(String),
     /// Writing an output file failed.

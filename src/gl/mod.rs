@@ -155,6 +155,28 @@ pub enum GlError {
     /// A required capability is missing.
     #[error("{0}")]
     Unsupported(String),
+    /// A frame, or a render target made for one, larger than the context allows: past
+    /// `GL_MAX_VIEWPORT_DIMS` (a frame into the game's framebuffer), or past
+    /// `GL_MAX_TEXTURE_SIZE` or `GL_MAX_RENDERBUFFER_SIZE` (the renderer's own targets:
+    /// offscreen, MSAA, deferred's G-buffer). Whichever call meets it, a game renders smaller.
+    #[error(
+        "{what} of {width}×{height} pixels is larger than this context allows: {limit} allows \
+         {max_width}×{max_height}"
+    )]
+    TooLarge {
+        /// What was being made (`a frame`, `an MSAA target`, …).
+        what: &'static str,
+        /// Width asked for.
+        width: u32,
+        /// Height asked for.
+        height: u32,
+        /// The GL limit it passes, by name.
+        limit: &'static str,
+        /// The widest the limit allows.
+        max_width: u32,
+        /// The tallest the limit allows.
+        max_height: u32,
+    },
     /// A framebuffer is incomplete (a driver says so of a target it could not allocate, too).
     #[error(
         "framebuffer incomplete for {what}: 0x{status:04x}, {}",

@@ -18,7 +18,7 @@ pub(crate) struct TargetStorage {
 /// `what` (the target, as "a deferred G-buffer") and the limit it passes.
 pub(crate) fn check(
     caps: &Caps,
-    what: &str,
+    what: &'static str,
     (width, height): (u32, u32),
     storage: TargetStorage,
 ) -> Result<(), GlError> {
@@ -39,13 +39,17 @@ pub(crate) fn check(
             "GL_MAX_RENDERBUFFER_SIZE",
         ),
     ];
-    for (applies, max, name) in limits {
+    for (applies, max, limit) in limits {
         // A driver that reports no limit (0) is taken at its word by the allocation itself.
         if applies && max > 0 && width.max(height) > max as u32 {
-            return Err(GlError::Unsupported(format!(
-                "{what} of {width}×{height} pixels is larger than this context allows: {name} \
-                 is {max}; render at most {max} pixels a side"
-            )));
+            return Err(GlError::TooLarge {
+                what,
+                width,
+                height,
+                limit,
+                max_width: max as u32,
+                max_height: max as u32,
+            });
         }
     }
     Ok(())
@@ -73,7 +77,8 @@ mod tests {
     fn refused(dev: &Device, make: impl FnOnce() -> Result<(), GlError>, limit: &str) {
         let live = dev.live_objects();
         match make() {
-            Err(GlError::Unsupported(msg)) => assert!(msg.contains(limit), "{msg}"),
+            Err(e @ GlError::TooLarge { limit: named, .. }) => assert_eq!(named, limit, "{e}"),
+            Err(GlError::Unsupported(msg)) if limit == "at least 1" => assert!(msg.contains(limit)),
             other => panic!("expected an error naming {limit}, got {other:?}"),
         }
         assert_eq!(dev.live_objects(), live);

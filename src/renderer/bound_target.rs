@@ -14,6 +14,23 @@ use crate::Error;
 const FULL_DEPTH_BITS: i32 = 24;
 
 impl Renderer {
+    /// Refuses a frame past `GL_MAX_VIEWPORT_DIMS`, which GL would clamp: into any target.
+    pub(super) fn check_viewport_limit(&self, width: u32, height: u32) -> Result<(), Error> {
+        let [max_w, max_h] = self.dev.caps().max_viewport_dims;
+        if (max_w > 0 && width > max_w as u32) || (max_h > 0 && height > max_h as u32) {
+            return Err(GlError::TooLarge {
+                what: "a frame",
+                width,
+                height,
+                limit: "GL_MAX_VIEWPORT_DIMS",
+                max_width: max_w as u32,
+                max_height: max_h as u32,
+            }
+            .into());
+        }
+        Ok(())
+    }
+
     /// Refuses a bound framebuffer that cannot take a `width × height` frame; warns once of a
     /// shallow depth buffer. `drawn_here`: the frame is drawn in it (no MSAA of the renderer's);
     /// then its depth bits (24 where the driver would not say).
@@ -24,13 +41,7 @@ impl Renderer {
         origin: [u32; 2],
         drawn_here: bool,
     ) -> Result<Option<u32>, Error> {
-        let [max_w, max_h] = self.dev.caps().max_viewport_dims;
-        if (max_w > 0 && width > max_w as u32) || (max_h > 0 && height > max_h as u32) {
-            return Err(Error::Limit(format!(
-                "a {width}×{height} frame is larger than the driver's largest viewport, \
-                 {max_w}×{max_h} (GL_MAX_VIEWPORT_DIMS)"
-            )));
-        }
+        self.check_viewport_limit(width, height)?;
         let status = self.dev.bound_framebuffer_status();
         if status != glow::FRAMEBUFFER_COMPLETE {
             return Err(GlError::BoundFramebuffer(format!(

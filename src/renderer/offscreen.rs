@@ -64,6 +64,7 @@ impl Renderer {
     ) -> Result<FrameStats, Error> {
         // As `render` says it, before the target is made.
         super::frame::check_viewport(width, height)?;
+        self.check_viewport_limit(width, height)?;
         let current = self.target.as_ref().map(|t| (t.size(), t.format()));
         if current != Some(((width, height), format)) {
             if let Some(mut t) = self.target.take() {

@@ -90,6 +90,18 @@ fn an_msaa_refusal_names_the_flag() {
 }
 
 #[test]
+fn a_frame_larger_than_the_context_allows_names_the_flag_and_the_limit() {
+    let dir = tempfile::tempdir().unwrap();
+    // Past every implementation's largest viewport and texture (16 384 at most here).
+    let args = ["--size", "40000x9", "--lights", "4", "--frames", "0"];
+    let msg = expect(&args, dir.path(), 3);
+    assert!(
+        msg.contains("--size 40000x9") && msg.contains("GL_MAX_"),
+        "{msg}"
+    );
+}
+
+#[test]
 fn a_recording_writes_no_default_picture_beside_it() {
     if common::checks_the_command_line_alone("a recording without a picture") {
         return;

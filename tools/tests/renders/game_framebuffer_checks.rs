@@ -10,7 +10,7 @@ use crate::common;
 use common::warnings::warnings_containing;
 use manylight::glow::{self, HasContext};
 use manylight::scene;
-use manylight::{EsVersion, GlError, HeadlessContext, RenderOptions, Renderer};
+use manylight::{Error, EsVersion, GlError, HeadlessContext, RenderOptions, Renderer};
 
 const SIZE: (i32, i32) = (64, 36);
 
@@ -127,21 +127,36 @@ fn an_incomplete_framebuffer_is_refused_naming_its_status() {
 }
 
 /// A frame wider than `GL_MAX_VIEWPORT_DIMS` is refused naming the limit (GL clamped the
-/// viewport and the call returned `Ok`).
+/// viewport and the call returned `Ok`), by `render` and `render_offscreen` alike (one gave a
+/// limit's text and the other an unsupported capability): a game matches one error. (The
+/// renderer's own targets' limits give the same error: `src/gl/target_size.rs`.)
 #[test]
-fn a_frame_past_the_viewport_limit_is_refused() {
+fn a_frame_past_the_viewport_limit_is_refused_alike_by_every_call() {
     let (_ctx, gl, mut r) = game(EsVersion::Es3);
-    let [max_w, _] = r.caps().max_viewport_dims;
+    let [max_w, max_h] = r.caps().max_viewport_dims;
     assert!(max_w > 0, "GL_MAX_VIEWPORT_DIMS was not read");
     unsafe { game_fbo(&gl, Some(glow::DEPTH_COMPONENT24)) };
-    let err = r
-        .render(&plane(), max_w as u32 + 1, 8, &RenderOptions::default())
-        .unwrap_err();
-    assert!(
-        matches!(err, manylight::Error::Limit(_))
-            && err.to_string().contains("GL_MAX_VIEWPORT_DIMS"),
-        "{err}"
-    );
+    let options = RenderOptions::default();
+    let (w, h) = (max_w as u32 + 1, 8);
+    let expected = (w, h, "GL_MAX_VIEWPORT_DIMS", max_w as u32, max_h as u32);
+    let refusals = [
+        r.render(&plane(), w, h, &options).unwrap_err(),
+        r.render_offscreen(&plane(), w, h, &options).unwrap_err(),
+    ];
+    for err in refusals {
+        match &err {
+            Error::Gl(GlError::TooLarge {
+                width,
+                height,
+                limit,
+                max_width,
+                max_height,
+                ..
+            }) => assert_eq!((*width, *height, *limit, *max_width, *max_height), expected),
+            other => panic!("{other}"),
+        }
+        assert!(err.to_string().contains("GL_MAX_VIEWPORT_DIMS"), "{err}");
+    }
 }
 
 /// A frame reaching past the game's framebuffer (one not resized with the window) is drawn in

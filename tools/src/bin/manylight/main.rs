@@ -364,11 +364,16 @@ fn check_outside_folder(
 /// capability script tells what a device cannot do from a failure without reading stderr.
 const CANNOT_ON_THIS_CONTEXT: u8 = 3;
 
-/// Whether `e` says the context cannot do what was asked: its ES version, the method, MSAA.
+/// Whether `e` says the context cannot do what was asked: its ES version, the method, MSAA, a
+/// frame larger than it allows.
 fn cannot_on_this_context(e: &(dyn std::error::Error + 'static)) -> bool {
     matches!(
         e.downcast_ref::<manylight::Error>(),
-        Some(manylight::Error::UnsupportedMethod { .. } | manylight::Error::Msaa { .. })
+        Some(
+            manylight::Error::UnsupportedMethod { .. }
+                | manylight::Error::Msaa { .. }
+                | manylight::Error::Gl(manylight::GlError::TooLarge { .. })
+        )
     ) || version_unavailable(e)
 }
 
@@ -478,6 +483,9 @@ fn main() -> ExitCode {
                 Some(manylight::Error::Msaa { samples, reason }) => {
                     eprintln!("error: --msaa {samples}: {reason}")
                 }
+                Some(manylight::Error::Gl(
+                    too_large @ manylight::GlError::TooLarge { width, height, .. },
+                )) => eprintln!("error: --size {width}x{height}: {too_large}"),
                 // Line ends kept: a shader's compile error lists its source.
                 _ => eprintln!("error: {}", shown::lines(&e.to_string())),
             }
