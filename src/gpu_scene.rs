@@ -1,7 +1,7 @@
 //! The scene's meshes and textures on the GPU, uploaded once and shared by every shading
 //! method. Below the methods and the renderer.
 
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 use std::sync::Arc;
 
 use glam::{DMat4, DVec3};
@@ -38,6 +38,13 @@ pub struct GpuScene {
     warned_split_budget: bool,
 }
 
+/// The textures a material samples, each with whether it is colour (base colour, emission:
+/// sRGB-encoded) or data (normal, metallic-roughness and occlusion maps).
+fn textures_of(m: &Material) -> impl Iterator<Item = (&Texture, bool)> {
+    let maps = (m.maps.textures()).map(|(slot, t)| (&*t.texture, slot == "emissive"));
+    m.diffuse_texture.iter().map(|t| (&**t, true)).chain(maps)
+}
+
 impl GpuScene {
     pub(crate) fn upload(
         &mut self,
@@ -63,11 +70,7 @@ impl GpuScene {
             }
         }
         for m in &scene.materials {
-            let maps = m
-                .maps
-                .textures()
-                .map(|(slot, t)| (&t.texture, slot == "emissive"));
-            for (t, colour) in m.diffuse_texture.iter().map(|t| (t, true)).chain(maps) {
+            for (t, colour) in textures_of(m) {
                 let srgb = self.upload_slot(colour);
                 let key = Arc::as_ptr(&t.image) as usize;
                 let (_, uploads) = self
@@ -103,6 +106,46 @@ impl GpuScene {
             }
             held
         });
+    }
+
+    /// Frees the uploads of meshes and images no scene of `scenes` uses, whether or not the
+    /// application still holds them; the bytes freed.
+    pub(crate) fn free_unused(&mut self, dev: &Device, scenes: &[&Scene]) -> usize {
+        let meshes: HashSet<usize> = (scenes.iter())
+            .flat_map(|s| s.objects.iter().map(|o| Arc::as_ptr(&o.mesh) as usize))
+            .collect();
+        let images: HashSet<usize> = (scenes.iter())
+            .flat_map(|s| s.materials.iter().flat_map(textures_of))
+            .map(|(t, _)| Arc::as_ptr(&t.image) as usize)
+            .collect();
+        let mut freed = 0;
+        self.meshes.retain(|key, (_, gpu, _, _)| {
+            let used = meshes.contains(key);
+            if !used {
+                freed += gpu.gpu_bytes();
+                gpu.destroy(dev);
+            }
+            used
+        });
+        self.textures.retain(|key, (_, uploads)| {
+            let used = images.contains(key);
+            if !used {
+                for gpu in uploads.iter_mut().flatten() {
+                    freed += gpu.gpu_bytes();
+                    gpu.destroy(dev);
+                }
+            }
+            used
+        });
+        freed
+    }
+
+    /// GPU bytes of the uploaded meshes and images (a frame's split copies aside).
+    pub(crate) fn gpu_bytes(&self) -> usize {
+        let meshes = self.meshes.values().map(|(_, gpu, _, _)| gpu.gpu_bytes());
+        let images = (self.textures.values())
+            .flat_map(|(_, uploads)| uploads.iter().flatten().map(ImageTexture::gpu_bytes));
+        meshes.sum::<usize>() + images.sum::<usize>()
     }
 
     /// Replaces last frame's split meshes with this frame's: objects of `scene` with triangles

@@ -271,6 +271,8 @@ pub fn upload_size((w, h): (u32, u32), max: u32, power_of_two: bool) -> (u32, u3
 pub struct ImageTexture {
     raw: glow::Texture,
     destroyed: bool,
+    /// GPU bytes of its texels, mipmaps included (about a third more than the base level).
+    bytes: usize,
     /// The sampling its parameters are set for (ES 2.0 has no sampler objects: each bind
     /// sets the parameters a texture's [`Sampling`] asks, where they differ).
     sampling: std::cell::Cell<Sampling>,
@@ -326,11 +328,18 @@ impl ImageTexture {
             dev.delete_texture(raw);
             return Err(e);
         }
+        let base = pw as usize * ph as usize * 4;
         Ok(ImageTexture {
             raw,
             destroyed: false,
+            bytes: base + base / 3,
             sampling: std::cell::Cell::new(sampling),
         })
+    }
+
+    /// GPU bytes of its texels, mipmaps included.
+    pub fn gpu_bytes(&self) -> usize {
+        self.bytes
     }
 
     /// Binds to texture unit `unit`, read as `sampling` says.

@@ -429,6 +429,7 @@ impl Renderer {
             method_gpu_bytes: 0,
             gbuffer_bytes: method_stats.gbuffer_bytes,
             msaa_bytes: 0,
+            scene_gpu_bytes: self.gpu_scene.gpu_bytes(),
         };
         // Only colour frames that waited for the GPU (or were timed on it) say what shading
         // costs: count passes run other shaders.

@@ -19,6 +19,7 @@ mod offscreen;
 mod stats;
 #[cfg(test)]
 mod timer_tests;
+mod uploads;
 mod warm_up;
 
 use crate::cluster::view_light::GpuLight;

@@ -150,6 +150,10 @@ pub struct MemoryStats {
     pub gbuffer_bytes: usize,
     /// GPU memory of the multisampled target (0 without MSAA).
     pub msaa_bytes: usize,
+    /// GPU memory of the uploaded meshes and images (mipmaps included), this frame's scene's
+    /// and those of earlier scenes the game still holds
+    /// ([`Renderer::free_unused_uploads`](super::Renderer::free_unused_uploads) frees them).
+    pub scene_gpu_bytes: usize,
 }
 
 impl Default for FrameStats {

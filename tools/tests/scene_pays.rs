@@ -5,6 +5,8 @@
 
 mod common;
 
+use std::sync::Arc;
+
 use common::Gpu;
 use glam::{DVec3, Vec3};
 use manylight::gl::shader_source::{assemble, Stage};
@@ -256,4 +258,58 @@ fn bubbles_match_forward_with_every_forward_method() {
 
 fn opaque_is_transparent(s: &scene::Scene, o: &scene::Object) -> bool {
     s.materials[o.material].is_transparent()
+}
+
+/// The pillars with a 64×64 texture on their first material: a level with a mesh and an image
+/// of its own.
+fn textured_pillars() -> scene::Scene {
+    let mut s = scene::builtin::build("pillars", Some((8, 1))).unwrap();
+    let image = image::RgbaImage::from_fn(64, 64, |x, y| {
+        image::Rgba([(x * 4) as u8, (y * 4) as u8, 90, 255])
+    });
+    s.materials[0].diffuse_texture = Some(Arc::new(scene::Texture::new("checks", image)));
+    s
+}
+
+#[test]
+fn uploads_no_scene_draws_are_freed_on_request_while_the_game_holds_them() {
+    let mut gpu = Gpu::new(EsVersion::Es3);
+    let (level_a, level_b) = (
+        textured_pillars(),
+        scene::builtin::build("plane", Some((8, 1))).unwrap(),
+    );
+    let opts = RenderOptions::default();
+    let render =
+        |gpu: &mut Gpu, s: &scene::Scene| gpu.r().render_offscreen(s, 32, 18, &opts).unwrap();
+    let (first_a, stats) = render(&mut gpu, &level_a);
+    let a = stats.memory.scene_gpu_bytes;
+    // At least the texture's 64×64 texels and their mipmaps.
+    assert!(a > 64 * 64 * 4, "{a}");
+    let (first_b, stats) = render(&mut gpu, &level_b);
+    let both = stats.memory.scene_gpu_bytes;
+    assert!(
+        both > a,
+        "the plane's mesh is uploaded beside the pillars' ({a}, {both})"
+    );
+    // The game still holds level A's meshes and image: only asked, they go.
+    let before = gpu.r().live_gl_objects();
+    let freed = gpu.r().free_unused_uploads(&[&level_b]).unwrap();
+    assert_eq!(freed, a, "level A's uploads, and only those");
+    let after = gpu.r().live_gl_objects();
+    assert!(
+        after.buffers < before.buffers && after.textures < before.textures,
+        "{before:?} → {after:?}"
+    );
+    let (again_b, stats) = render(&mut gpu, &level_b);
+    assert_eq!(stats.memory.scene_gpu_bytes, both - a);
+    assert_eq!(manylight::metrics::diff(&first_b, &again_b).max_abs, 0);
+    assert_eq!(gpu.r().free_unused_uploads(&[&level_b]).unwrap(), 0);
+    // Level A drawn again uploads what it needs, and looks as it did.
+    let (again_a, stats) = render(&mut gpu, &level_a);
+    assert_eq!(stats.memory.scene_gpu_bytes, both);
+    assert_eq!(manylight::metrics::diff(&first_a, &again_a).max_abs, 0);
+    assert_eq!(
+        gpu.r().free_unused_uploads(&[&level_a, &level_b]).unwrap(),
+        0
+    );
 }
