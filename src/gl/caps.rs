@@ -313,7 +313,7 @@ impl Caps {
                 let context = if self.desktop {
                     "desktop OpenGL".to_string()
                 } else {
-                    format!("OpenGL ES {}", self.es)
+                    format!("OpenGL {}", self.es)
                 };
                 return Err(GlError::Unsupported(format!(
                     "no_fragment_highp needs an OpenGL ES 2.0 context (a fragment stage without \

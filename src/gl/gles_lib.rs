@@ -35,13 +35,23 @@ static SELECTED: Mutex<Option<PathBuf>> = Mutex::new(None);
 static LOADED: OnceLock<Result<GlesLibrary, String>> = OnceLock::new();
 
 /// Chooses the folder holding `libEGL.so[.1]` and `libGLESv2.so[.2]` for this process, over
-/// `MANYLIGHT_GLES_LIB`. Must come before the first context; choosing another folder after
-/// that is an error (the first stays loaded).
+/// `MANYLIGHT_GLES_LIB`: a folder that is not one or lacks either library is an error at once.
+/// Must come before the first context; choosing another folder after that is an error (the
+/// first stays loaded, or its failure stands).
 pub fn select(folder: &Path) -> Result<(), GlError> {
     let folder = folder.to_path_buf();
     if let Some(loaded) = LOADED.get() {
-        let current = loaded.as_ref().ok().and_then(|l| l.folder.clone());
-        if current.as_deref() != Some(folder.as_path()) {
+        let current = match loaded {
+            Ok(l) => l.folder.clone(),
+            Err(e) => {
+                return Err(GlError::GlesLibrary(format!(
+                    "loading the GLES implementation failed already ({e}); {} must be chosen \
+                     before the first context, and a process loads one implementation once",
+                    shown::path(&folder)
+                )))
+            }
+        };
+        if !current.as_deref().is_some_and(|c| same_folder(c, &folder)) {
             return Err(GlError::GlesLibrary(format!(
                 "the GLES implementation is already loaded ({}); {} must be chosen before the first context",
                 current.map_or("the system's".into(), |f| shown::path(&f)),
@@ -50,8 +60,38 @@ pub fn select(folder: &Path) -> Result<(), GlError> {
         }
         return Ok(());
     }
+    library_files(&folder, Origin::Selected).map_err(GlError::GlesLibrary)?;
     *SELECTED.lock().unwrap_or_else(|e| e.into_inner()) = Some(folder);
     Ok(())
+}
+
+/// Whether two paths name one folder (`swiftshader` from its parent and its absolute path).
+fn same_folder(a: &Path, b: &Path) -> bool {
+    match (std::fs::canonicalize(a), std::fs::canonicalize(b)) {
+        (Ok(a), Ok(b)) => a == b,
+        _ => a == b,
+    }
+}
+
+/// Where a folder was named, for messages.
+#[derive(Clone, Copy)]
+enum Origin {
+    /// [`select`] (the command line's `--gles-lib` calls it).
+    Selected,
+    /// The environment variable.
+    Environment,
+    /// Either (a folder `manylight matrix` compares).
+    Either,
+}
+
+impl Origin {
+    fn says(self) -> String {
+        match self {
+            Origin::Selected => "chosen with select_gles_library or --gles-lib".into(),
+            Origin::Environment => format!("from {GLES_LIB_ENV}"),
+            Origin::Either => format!("from --gles-lib or {GLES_LIB_ENV}"),
+        }
+    }
 }
 
 /// The folder this process loads (or will load) its implementation from, if not the system's.
@@ -73,7 +113,15 @@ pub fn chosen_folder() -> Option<PathBuf> {
 /// The process's implementation, loaded on first use.
 pub fn library() -> Result<&'static GlesLibrary, GlError> {
     LOADED
-        .get_or_init(|| GlesLibrary::load(chosen_folder()))
+        .get_or_init(|| {
+            let selected = SELECTED.lock().unwrap_or_else(|e| e.into_inner()).is_some();
+            let origin = if selected {
+                Origin::Selected
+            } else {
+                Origin::Environment
+            };
+            GlesLibrary::load(chosen_folder(), origin)
+        })
         .as_ref()
         .map_err(|e| match chosen_folder() {
             Some(_) => GlError::GlesLibrary(e.clone()),
@@ -84,38 +132,40 @@ pub fn library() -> Result<&'static GlesLibrary, GlError> {
 /// The `libGLESv2` and `libEGL` files of `folder`, loaded by nothing yet: an error naming
 /// the folder when it is not one or lacks either.
 pub fn files_in(folder: &Path) -> Result<(PathBuf, PathBuf), GlError> {
-    library_files(folder).map_err(GlError::GlesLibrary)
+    library_files(folder, Origin::Either).map_err(GlError::GlesLibrary)
 }
 
-fn library_files(folder: &Path) -> Result<(PathBuf, PathBuf), String> {
+fn library_files(folder: &Path, origin: Origin) -> Result<(PathBuf, PathBuf), String> {
     if !folder.is_dir() {
         return Err(format!(
-            "{} (from --gles-lib or {GLES_LIB_ENV}) is not a folder",
-            shown::path(folder)
+            "{} ({}) is not a folder",
+            shown::path(folder),
+            origin.says()
         ));
     }
-    let gles_path = find_in(folder, &["libGLESv2.so.2", "libGLESv2.so"])?;
-    let egl_path = find_in(folder, &["libEGL.so.1", "libEGL.so"])?;
+    let gles_path = find_in(folder, &["libGLESv2.so.2", "libGLESv2.so"], origin)?;
+    let egl_path = find_in(folder, &["libEGL.so.1", "libEGL.so"], origin)?;
     Ok((gles_path, egl_path))
 }
 
 /// The first of `names` that exists in `folder`.
-fn find_in(folder: &Path, names: &[&str]) -> Result<PathBuf, String> {
+fn find_in(folder: &Path, names: &[&str], origin: Origin) -> Result<PathBuf, String> {
     names
         .iter()
         .map(|n| folder.join(n))
         .find(|p| p.is_file())
         .ok_or_else(|| {
             format!(
-                "{} (from --gles-lib or {GLES_LIB_ENV}) holds none of {}",
+                "{} ({}) holds none of {}",
                 shown::path(folder),
+                origin.says(),
                 names.join(", ")
             )
         })
 }
 
 impl GlesLibrary {
-    fn load(folder: Option<PathBuf>) -> Result<GlesLibrary, String> {
+    fn load(folder: Option<PathBuf>, origin: Origin) -> Result<GlesLibrary, String> {
         let Some(folder) = folder else {
             let egl = unsafe { Egl::load_required_from_filename("libEGL.so.1") }
                 .or_else(|_| unsafe { Egl::load_required_from_filename("libEGL.so") })
@@ -126,7 +176,7 @@ impl GlesLibrary {
                 folder: None,
             });
         };
-        let (gles_path, egl_path) = library_files(&folder)?;
+        let (gles_path, egl_path) = library_files(&folder, origin)?;
         // SAFETY: loading a GLES implementation runs its initialisers; that is what the user
         // asked for by naming the folder.
         let gles = unsafe { libloading::Library::new(&gles_path) }

@@ -83,12 +83,17 @@ impl Renderer {
         };
         let mut stats = frame(self)?;
         if options.measure.timed_frames > 0 {
-            // The warm-up frame compiled shaders and uploaded meshes; report the timed ones.
+            // The warm-up frame compiled shaders and uploaded meshes; report the timed ones,
+            // but the programs the whole call built.
+            let mut built = stats.programs_built;
             let mut frames = Vec::new();
             for _ in 0..options.measure.timed_frames {
-                frames.push(frame(self)?);
+                let timed = frame(self)?;
+                built += timed.programs_built;
+                frames.push(timed);
             }
             stats = FrameStats::summarize(frames).expect("at least one timed frame");
+            stats.programs_built = built;
         }
         Ok(stats)
     }

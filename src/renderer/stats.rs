@@ -44,7 +44,9 @@ pub struct FrameStats {
     pub draw_calls: u64,
     /// Shader programs the frame compiled and linked (variants met for the first time): each
     /// costs milliseconds on llvmpipe and more on a phone's driver, a hitch in a game's frame.
-    /// [`Renderer::warm_up`](super::Renderer::warm_up) builds them beforehand.
+    /// [`Renderer::warm_up`](super::Renderer::warm_up) builds them beforehand. With
+    /// [`MeasureOptions::timed_frames`](crate::MeasureOptions::timed_frames): those every frame
+    /// of the call built, its untimed first frame included.
     pub programs_built: usize,
     /// What the scene uses (and so what the shader variants were built with).
     pub scene_features: SceneFeatures,

@@ -327,3 +327,46 @@ fn a_run_on_another_implementation_renders_with_the_one_its_folder_holds() {
         );
     }
 }
+
+/// Choosing a GLES folder in code (`select_gles_library`): a folder that is not one is refused
+/// at once, naming where it was chosen (it was accepted, and the first context blamed the
+/// command line or the variable); after a first load that failed, choosing another says that
+/// it failed, not that "the system's" implementation is loaded. In a child process, whose
+/// `MANYLIGHT_GLES_LIB` names no folder: a process loads its implementation once.
+#[test]
+fn choosing_a_gles_folder_in_code_says_what_went_wrong() {
+    const CHILD: &str = "MANYLIGHT_TEST_GLES_CHOICE_CHILD";
+    if std::env::var_os(CHILD).is_none() {
+        if in_another_implementations_run() {
+            return;
+        }
+        common::child::rerun_with(
+            "choosing_a_gles_folder_in_code_says_what_went_wrong",
+            &[(CHILD, "1"), ("MANYLIGHT_GLES_LIB", "/nonexistent")],
+            "the child choosing folders",
+        );
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let err = manylight::select_gles_library(&dir.path().join("nowhere")).unwrap_err();
+    let err = err.to_string();
+    assert!(
+        err.contains("is not a folder") && err.contains("select_gles_library"),
+        "{err}"
+    );
+    let first = match manylight::HeadlessContext::new(manylight::EsVersion::Es3) {
+        Ok(_) => panic!("a context from /nonexistent"),
+        Err(e) => e.to_string(),
+    };
+    assert!(
+        first.contains("/nonexistent") && first.contains("MANYLIGHT_GLES_LIB"),
+        "{first}"
+    );
+    let err = manylight::select_gles_library(dir.path())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("failed already") && !err.contains("the system's"),
+        "{err}"
+    );
+}

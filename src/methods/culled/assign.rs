@@ -44,7 +44,8 @@ impl Assign {
         let drawn = assignment.visible.len() <= MAX_INDEXED_LIGHTS && assignment.unlisted.is_none();
         if dropped > 0 && drawn && !self.warned_overflow {
             self.warned_overflow = true;
-            warn_overflow(method, dropped, limits);
+            let automatic = method == "clustered" && ctx.options.grid.is_auto();
+            warn_overflow(method, dropped, limits, automatic);
         }
         Assigned { assignment, ms }
     }
@@ -62,10 +63,19 @@ impl Assign {
     }
 }
 
-fn warn_overflow(method: &str, dropped: u64, limits: &AssignLimits) {
+/// Says once that a frame left light references out, and what would avoid it: another grid,
+/// unless the automatic grid (`automatic`) chose this one already.
+fn warn_overflow(method: &str, dropped: u64, limits: &AssignLimits, automatic: bool) {
     let cap = match limits.cell_cap {
         u32::MAX => "no cap per cell".to_string(),
         cap => format!("a cell keeps at most {cap} lights"),
+    };
+    let remedy = if automatic {
+        "the automatic grid chose these cells already: fewer lights over one spot, or \
+         Method::Auto (which draws such a frame with forward or deferred) avoid it"
+    } else {
+        "a coarser grid (grid.footprint_px), deeper slices (grid.slice_depth) or the \
+         automatic grid avoid it"
     };
     log::warn!(
         "{method}: {dropped} light references left out of this frame's cell lists, so \
@@ -73,8 +83,7 @@ fn warn_overflow(method: &str, dropped: u64, limits: &AssignLimits) {
          references fit in the index list here: the index texture's capacity on this \
          context or MeasureOptions::max_indices; each cell keeps the lights that matter \
          most to it, and FrameStats::lights.overflowed counts the dropped ones every \
-         frame): a coarser grid (grid.footprint_px), deeper slices (grid.slice_depth) \
-         or the automatic grid avoid it",
+         frame): {remedy}",
         limits.max_indices
     );
 }

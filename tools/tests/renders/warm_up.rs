@@ -152,6 +152,14 @@ fn a_warmed_up_renderer_builds_nothing_in_its_frames() {
         assert!(first.programs_built > 0, "{es}: {first:?}");
         let second = frame(&mut gpu, glow::RGBA8, &scene, &aces);
         assert_eq!(second.programs_built, 0, "{es}");
+        // Timed frames report what the whole call built, its untimed first frame's too.
+        let mut timed = RenderOptions {
+            tone_map: ToneMap::Reinhard,
+            ..Default::default()
+        };
+        timed.measure.timed_frames = 2;
+        let (_, stats) = gpu.r().render_offscreen(&scene, W, H, &timed).unwrap();
+        assert!(stats.programs_built > 0, "{es}: timed frames {stats:?}");
     }
 }
 
