@@ -7,8 +7,7 @@
 //! colour 1 normal   RGBA32F     16    view-space normal (of the side seen) in
 //!                                     octahedral form (xy), view depth (z), window x offset
 //! colour 2 specular RGBA16F      8    Ks, Blinn-Phong exponent
-//! depth             DEPTH32F     4    for the geometry pass's depth test; the composite writes
-//!                                     it to the target exactly (a fixed-point one rounds)
+//! depth             DEPTH24      4    for the geometry pass's depth test
 //! accumulation      RGBA32F     16    Σ light radiance (additive blending; RGBA16F, 8 bytes,
 //!                                     where GL_EXT_float_blend is missing), started by the
 //!                                     geometry pass (colour 3) with the surface's emission
@@ -131,7 +130,7 @@ impl GBuffer {
             glow::RGBA32F
         };
         let accum = texture(dev, w, h, accum_format)?;
-        let depth = texture(dev, w, h, glow::DEPTH_COMPONENT32F)?;
+        let depth = texture(dev, w, h, glow::DEPTH_COMPONENT24)?;
         let geometry_fbo = dev.create_framebuffer()?;
         let accum_fbo = dev.create_framebuffer()?;
         let gb = GBuffer {

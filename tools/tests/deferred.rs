@@ -93,45 +93,6 @@ fn transparent_objects_take_the_forward_fallback() {
     );
 }
 
-/// A transparent quad lying on an opaque floor (a decal): deferred's transparent pass tests
-/// against the depth its composite wrote, which must be the depth forward's prepass writes to
-/// the bit. Through a 24-bit G-buffer depth read back as a float and written again, some
-/// pixels came back one step nearer, and the quad showed there (34/255 on llvmpipe).
-#[test]
-fn a_transparent_surface_on_an_opaque_one_is_hidden_or_shown_as_forward_does() {
-    use glam::{DMat4, DVec3, Vec3};
-    use manylight::{Camera, Light, Material, MeshBuilder, Scene};
-    let mut s = Scene::empty();
-    let stone = s.add_material(Material::flat("stone", Vec3::splat(0.6)));
-    let mut glass = Material::flat("glass", Vec3::new(0.9, 0.1, 0.1));
-    glass.alpha = 0.5;
-    let glass = s.add_material(glass);
-    for (half, material) in [(5.0, stone), (2.0, glass)] {
-        let corner = |x: f32, z: f32| Vec3::new(x * half, 0.0, z * half);
-        let mut quad = MeshBuilder::new();
-        quad.quad(
-            corner(-1.0, 1.0),
-            corner(1.0, 1.0),
-            corner(1.0, -1.0),
-            corner(-1.0, -1.0),
-        );
-        s.add_object(quad.build().unwrap(), material, DMat4::IDENTITY);
-    }
-    s.lights
-        .push(Light::point(DVec3::new(0.0, 1.0, 0.0), 4.0, Vec3::ONE, 1.0));
-    s.camera = Camera::perspective(DVec3::new(0.0, 5.0, 8.0), DVec3::ZERO, 50.0, 0.1, 50.0);
-    let mut gpu = Gpu::new(EsVersion::Es3);
-    let opts = RenderOptions::default();
-    let (reference, _) = gpu.render_with("forward", &s, (128, 72), &opts);
-    let (img, _) = gpu.render_with("deferred", &s, (128, 72), &opts);
-    let d = manylight::metrics::diff(&reference, &img);
-    assert!(
-        d.max_abs <= 2,
-        "the decal: deferred {} / 255 from forward",
-        d.max_abs
-    );
-}
-
 #[test]
 fn deferred_is_unsupported_on_es2_with_a_reason() {
     let mut gpu = Gpu::new(EsVersion::Es2);
