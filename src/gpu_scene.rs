@@ -89,23 +89,8 @@ impl GpuScene {
     /// `Arc` is the last one, so no scene can draw them again (a game that rebuilds a mesh, or
     /// changes one through `Arc::make_mut`, makes a new one each time).
     fn forget_unreferenced(&mut self, dev: &Device) {
-        self.meshes.retain(|_, (source, gpu, _, _)| {
-            let held = Arc::strong_count(source) > 1;
-            if !held {
-                gpu.destroy(dev);
-            }
-            held
-        });
-        self.textures.retain(|_, (source, uploads)| {
-            let held = Arc::strong_count(source) > 1;
-            if !held {
-                uploads
-                    .iter_mut()
-                    .flatten()
-                    .for_each(|gpu| gpu.destroy(dev));
-            }
-            held
-        });
+        let held = |_: usize, count: usize| count > 1;
+        self.free_where(dev, held, held);
     }
 
     /// Frees the uploads of meshes and images no scene of `scenes` uses, whether or not the
@@ -118,24 +103,37 @@ impl GpuScene {
             .flat_map(|s| s.materials.iter().flat_map(textures_of))
             .map(|(t, _)| Arc::as_ptr(&t.image) as usize)
             .collect();
+        let mesh_used = |key, _| meshes.contains(&key);
+        let image_used = |key, _| images.contains(&key);
+        self.free_where(dev, mesh_used, image_used)
+    }
+
+    /// Frees every mesh upload `keep_mesh` and every image's uploads `keep_image` refuse, each
+    /// asked with the entry's key and its source's `Arc` count; the bytes freed.
+    fn free_where(
+        &mut self,
+        dev: &Device,
+        keep_mesh: impl Fn(usize, usize) -> bool,
+        keep_image: impl Fn(usize, usize) -> bool,
+    ) -> usize {
         let mut freed = 0;
-        self.meshes.retain(|key, (_, gpu, _, _)| {
-            let used = meshes.contains(key);
-            if !used {
+        self.meshes.retain(|&key, (source, gpu, _, _)| {
+            let keep = keep_mesh(key, Arc::strong_count(source));
+            if !keep {
                 freed += gpu.gpu_bytes();
                 gpu.destroy(dev);
             }
-            used
+            keep
         });
-        self.textures.retain(|key, (_, uploads)| {
-            let used = images.contains(key);
-            if !used {
+        self.textures.retain(|&key, (source, uploads)| {
+            let keep = keep_image(key, Arc::strong_count(source));
+            if !keep {
                 for gpu in uploads.iter_mut().flatten() {
                     freed += gpu.gpu_bytes();
                     gpu.destroy(dev);
                 }
             }
-            used
+            keep
         });
         freed
     }
