@@ -43,7 +43,7 @@ pub struct FrameStats {
     /// CPU time, which a software rasterizer's frame time hides.
     pub draw_calls: u64,
     /// Shader programs the frame compiled and linked (variants met for the first time): each
-    /// costs milliseconds on llvmpipe and more on a phone's driver, a hitch in a game's frame.
+    /// costs the driver milliseconds or more, a hitch in a game's frame.
     /// [`Renderer::warm_up`](super::Renderer::warm_up) builds them beforehand. With
     /// [`MeasureOptions::timed_frames`](crate::MeasureOptions::timed_frames): those every frame
     /// of the call built, its untimed first frame included.
