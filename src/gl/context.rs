@@ -10,6 +10,9 @@
 //! the renderer's own framebuffer objects.
 #![allow(unsafe_code)]
 
+use std::sync::{Condvar, Mutex, MutexGuard};
+use std::time::Duration;
+
 use khronos_egl as egl;
 
 use super::gles_lib::{self, Egl, GlesLibrary};
@@ -80,6 +83,11 @@ pub struct EglInfo {
     /// thread). Only for ANGLE: elsewhere the display may be shared with an application's own
     /// contexts.
     pub terminate_when_unused: bool,
+    /// A driver workaround: the implementation's headless contexts live on one thread at a
+    /// time, so [`HeadlessContext::new`] on another thread waits until they are gone. ANGLE,
+    /// for the reason above: a context made on a second thread while the first one's were
+    /// alive crashed it in `eglMakeCurrent`.
+    pub one_thread_at_a_time: bool,
 }
 
 fn egl_err(call: &'static str) -> impl Fn(egl::Error) -> GlError {
@@ -123,7 +131,19 @@ const NO_DISPLAY_HINT: &str = "this EGL has no surfaceless platform and needs a 
 
 impl HeadlessContext {
     /// Creates a context for `es` and makes it current on this thread.
+    ///
+    /// Where the implementation runs its contexts on one thread at a time (ANGLE's GL back end,
+    /// [`EglInfo::one_thread_at_a_time`]), a thread asking while another thread's contexts are
+    /// alive waits until they are all dropped, as a test harness running tests in parallel
+    /// needs: ANGLE crashed the process there. It waits as long as the other thread drops a
+    /// context now and then, and fails after a minute in which none went (a thread holding a
+    /// context while it waits for this one would otherwise hang both).
     pub fn new(es: EsVersion) -> Result<Self, GlError> {
+        Self::new_waiting_at_most(es, ONE_THREAD_PATIENCE)
+    }
+
+    /// [`HeadlessContext::new`] with its patience given (the tests shorten it).
+    fn new_waiting_at_most(es: EsVersion, patience: Duration) -> Result<Self, GlError> {
         let lib = gles_lib::library()?;
         let egl = lib.egl();
         let client_ext = egl
@@ -142,12 +162,15 @@ impl HeadlessContext {
         };
         // Held while the display is initialised and the context made, so a drop on another
         // thread cannot terminate the display in between (see `LIVE_CONTEXTS`).
-        let mut live = LIVE_CONTEXTS.lock().unwrap_or_else(|e| e.into_inner());
+        let mut live = wait_for_other_threads(lock_live(), patience)?;
         let mut last_err = None;
         for platform in order {
             match Self::with_platform(egl, platform, es) {
                 Ok((display, context, surface, info)) => {
-                    *live += 1;
+                    live.count += 1;
+                    if info.one_thread_at_a_time {
+                        live.only_thread = Some(std::thread::current().id());
+                    }
                     return Ok(HeadlessContext {
                         lib,
                         display,
@@ -295,6 +318,7 @@ impl HeadlessContext {
             requested: es,
             gles_lib: gles_lib::chosen_folder(),
             terminate_when_unused: egl_version_string.contains("ANGLE"),
+            one_thread_at_a_time: egl_version_string.contains("ANGLE"),
         };
         Ok((display, context, surface, info))
     }
@@ -330,7 +354,7 @@ impl HeadlessContext {
                 self.info.egl_vendor
             )));
         }
-        let _lock = LIVE_CONTEXTS.lock().unwrap_or_else(|e| e.into_inner());
+        let _lock = lock_live();
         self.lib
             .egl()
             .make_current(self.display, self.surface, self.surface, Some(self.context))
@@ -351,7 +375,7 @@ impl HeadlessContext {
     /// Makes no context current on the calling thread, so that another thread may make this
     /// one current. Nothing may draw with it here until [`HeadlessContext::make_current`].
     pub fn release_current(&self) -> Result<(), GlError> {
-        let _lock = LIVE_CONTEXTS.lock().unwrap_or_else(|e| e.into_inner());
+        let _lock = lock_live();
         self.lib
             .egl()
             .make_current(self.display, None, None, None)
@@ -372,7 +396,7 @@ impl Drop for HeadlessContext {
         let egl = self.lib.egl();
         // Under the lock `new` holds too: SwiftShader's display keeps its surfaces and contexts
         // in sets it does not lock, and tore them when two threads created or destroyed at once.
-        let mut live = LIVE_CONTEXTS.lock().unwrap_or_else(|e| e.into_inner());
+        let mut live = lock_live();
         // Released only where it is current: another context current on this thread (a test
         // holding an ES 2.0 and an ES 3.0 context) stays current.
         if egl.get_current_context() == Some(self.context) {
@@ -382,14 +406,75 @@ impl Drop for HeadlessContext {
             let _ = egl.destroy_surface(self.display, s);
         }
         let _ = egl.destroy_context(self.display, self.context);
-        *live -= 1;
-        if *live == 0 && self.info.terminate_when_unused {
-            let _ = egl.terminate(self.display);
+        live.count -= 1;
+        if live.count == 0 {
+            live.only_thread = None;
+            if self.info.terminate_when_unused {
+                let _ = egl.terminate(self.display);
+            }
         }
+        CONTEXT_DROPPED.notify_all();
     }
 }
 
-/// Headless contexts alive in the process, for the ANGLE workaround of
-/// [`EglInfo::terminate_when_unused`]; its lock also serialises making, moving and destroying
-/// contexts (SwiftShader's EGL display is not thread-safe there).
-static LIVE_CONTEXTS: std::sync::Mutex<usize> = std::sync::Mutex::new(0);
+/// How long [`HeadlessContext::new`] waits for another thread's contexts where contexts live on
+/// one thread at a time ([`EglInfo::one_thread_at_a_time`]) without any of them being dropped.
+const ONE_THREAD_PATIENCE: Duration = Duration::from_secs(60);
+
+/// The headless contexts alive in the process.
+struct LiveContexts {
+    count: usize,
+    /// The thread they live on, where the implementation allows one at a time
+    /// ([`EglInfo::one_thread_at_a_time`]).
+    only_thread: Option<std::thread::ThreadId>,
+}
+
+/// Headless contexts alive in the process, for the ANGLE workarounds of
+/// [`EglInfo::terminate_when_unused`] and [`EglInfo::one_thread_at_a_time`]; its lock also
+/// serialises making, moving and destroying contexts (SwiftShader's EGL display is not
+/// thread-safe there).
+static LIVE_CONTEXTS: Mutex<LiveContexts> = Mutex::new(LiveContexts {
+    count: 0,
+    only_thread: None,
+});
+
+/// Signalled whenever a headless context is dropped.
+static CONTEXT_DROPPED: Condvar = Condvar::new();
+
+fn lock_live() -> MutexGuard<'static, LiveContexts> {
+    LIVE_CONTEXTS.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// Waits, where contexts live on one thread at a time, until no other thread's are alive; an
+/// error once `patience` passes without one of them being dropped.
+fn wait_for_other_threads(
+    mut live: MutexGuard<'static, LiveContexts>,
+    patience: Duration,
+) -> Result<MutexGuard<'static, LiveContexts>, GlError> {
+    let here = std::thread::current().id();
+    let mut said = false;
+    while live.only_thread.is_some_and(|owner| owner != here) {
+        if !said {
+            log::info!(
+                "waiting for another thread's {} headless contexts: this implementation runs \
+                 contexts on one thread at a time",
+                live.count
+            );
+            said = true;
+        }
+        let (guard, wait) = CONTEXT_DROPPED
+            .wait_timeout(live, patience)
+            .unwrap_or_else(|e| e.into_inner());
+        live = guard;
+        if wait.timed_out() && live.only_thread.is_some_and(|owner| owner != here) {
+            return Err(GlError::Unsupported(format!(
+                "this implementation (ANGLE) runs headless contexts on one thread at a time, \
+                 and another thread kept its {} for {} s without dropping one: drop them \
+                 first, or make this context on that thread",
+                live.count,
+                patience.as_secs_f64()
+            )));
+        }
+    }
+    Ok(live)
+}

@@ -100,3 +100,82 @@ fn a_context_kept_by_an_ended_thread_says_so() {
         assert!(err.contains("EGL_BAD_ACCESS"), "{err}");
     }
 }
+
+/// Threads that each make a context at once (a test harness running tests in parallel) draw the
+/// same picture. Where contexts live on one thread at a time (ANGLE, which crashed here), the
+/// threads take turns: no two threads' contexts were alive at once.
+#[test]
+fn threads_making_contexts_at_once_draw_the_same_picture() {
+    const THREADS: usize = 4;
+    let start = std::sync::Barrier::new(THREADS);
+    let lives = std::thread::scope(|s| {
+        let threads: Vec<_> = (0..THREADS)
+            .map(|_| {
+                s.spawn(|| {
+                    start.wait();
+                    let ctx = super::context_or_skip(EsVersion::Es3)?;
+                    let made = std::time::Instant::now();
+                    let img = render_plane(&ctx);
+                    let turns = ctx.info().one_thread_at_a_time;
+                    let ended = std::time::Instant::now();
+                    drop(ctx);
+                    Some((made, ended, turns, img))
+                })
+            })
+            .collect();
+        let lives: Vec<_> = threads.into_iter().map(|t| t.join().unwrap()).collect();
+        lives.into_iter().collect::<Option<Vec<_>>>()
+    });
+    let Some(lives) = lives else {
+        return;
+    };
+    for (_, _, _, img) in &lives[1..] {
+        assert!(*img == lives[0].3, "another picture on another thread");
+    }
+    if lives[0].2 {
+        for (i, a) in lives.iter().enumerate() {
+            for b in &lives[i + 1..] {
+                assert!(
+                    a.1 <= b.0 || b.1 <= a.0,
+                    "two threads' contexts alive at once"
+                );
+            }
+        }
+    }
+}
+
+/// Where contexts live on one thread at a time, a thread asking while another's context is
+/// alive gets it once that one is dropped, and an error, not a wait without end, when none is
+/// dropped in its patience. Elsewhere both threads have theirs at once.
+#[test]
+fn a_thread_waits_for_another_threads_context_within_its_patience() {
+    let Some(ctx) = super::context_or_skip(EsVersion::Es3) else {
+        return;
+    };
+    let patience = std::time::Duration::from_millis(200);
+    let refused = std::thread::spawn(move || {
+        HeadlessContext::new_waiting_at_most(EsVersion::Es3, patience).map(drop)
+    })
+    .join()
+    .unwrap();
+    if !ctx.info().one_thread_at_a_time {
+        refused.expect("a context on a second thread at once");
+        return;
+    }
+    let err = refused
+        .expect_err("made while another thread's context lived")
+        .to_string();
+    assert!(err.contains("one thread at a time"), "{err}");
+    let patient = std::thread::spawn(move || {
+        let ctx = HeadlessContext::new_waiting_at_most(EsVersion::Es3, 30 * patience)?;
+        Ok::<_, crate::gl::GlError>(render_plane(&ctx))
+    });
+    std::thread::sleep(patience);
+    let here = render_plane(&ctx);
+    drop(ctx);
+    let there = patient
+        .join()
+        .unwrap()
+        .expect("made once the other was dropped");
+    assert!(here == there, "another picture on another thread");
+}
