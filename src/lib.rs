@@ -12,7 +12,8 @@
 //!   [`Renderer::render_offscreen`] into an image; [`Renderer::set_method`] picks forward,
 //!   tiled, clustered (the default), deferred or auto; [`Renderer::warm_up`] builds a scene's
 //!   shaders before its first frame.
-//! - A [`Scene`]: [`builtin_scene`] or [`load_scene`] (OBJ, glTF, JSON scene files;
+//! - A [`Scene`]: [`builtin_scene`] or [`load_scene`] (OBJ, glTF, JSON scene files, each a
+//!   cargo feature on by default, as are the texture decoders: README, "Embedding";
 //!   [`load_scene_with`] and [`LoadOptions`] let a trusted model read outside its folder), or built
 //!   in code with [`Scene::add_material`], [`MeshBuilder`], [`Scene::add_object`],
 //!   [`Light::point`] and [`Light::spot`]; [`Scene::set_time`] poses moving lights
@@ -107,8 +108,8 @@ pub use renderer::{
 };
 pub use scene::features::SceneFeatures;
 pub use scene::meshbuild::MeshBuilder;
-pub use scene::obj::LoadReport;
 pub use scene::surface_maps::{MapTexture, SurfaceMaps, TextureTransform};
+pub use scene::LoadReport;
 pub use scene::{
     builtin::DEFAULT as DEFAULT_SCENE, builtin::NAMES as BUILTIN_SCENES, builtin_scene, load_scene,
     load_scene_with, Aabb, Camera, Cone, DirectionalLight, Light, LightKind, LoadOptions, Material,

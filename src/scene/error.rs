@@ -71,6 +71,19 @@ pub enum SceneError {
         /// The file.
         path: PathBuf,
     },
+    /// A file of a kind whose loader this build of the crate left out (a cargo feature).
+    #[error(
+        "{} is {kind}, and this build of manylight reads none: its `{feature}` feature is off",
+        shown::path(path)
+    )]
+    NotBuilt {
+        /// The file.
+        path: PathBuf,
+        /// What kind of file it is (`an OBJ model`).
+        kind: &'static str,
+        /// The crate's feature that reads it.
+        feature: &'static str,
+    },
     /// A built-in scene name that does not exist.
     #[error("unknown built-in scene `{}` (available: {})", shown::name(name), available.join(", "))]
     UnknownBuiltin {
@@ -82,6 +95,19 @@ pub enum SceneError {
 }
 
 impl SceneError {
+    /// Shorthand for [`SceneError::NotBuilt`].
+    pub(crate) fn not_built(
+        path: &std::path::Path,
+        kind: &'static str,
+        feature: &'static str,
+    ) -> Self {
+        SceneError::NotBuilt {
+            path: path.to_path_buf(),
+            kind,
+            feature,
+        }
+    }
+
     /// Shorthand for [`SceneError::Invalid`].
     pub fn invalid(field: impl Into<String>, reason: impl Into<String>) -> Self {
         SceneError::Invalid {

@@ -44,8 +44,8 @@ use super::camera::{Projection, MAX_CAMERA_COORD};
 use super::material::check_color_factor;
 use super::model_cache::{self, ModelCache};
 use super::motion::{Bob, Flicker, Motion, Orbit, OrbitAbout, Sweep, Wander};
-use super::obj::LoadReport;
 use super::random::{self, LightSetStyle};
+use super::LoadReport;
 use super::{Camera, DirectionalLight, Light, LightKind, MaterialModel, Scene, SceneError};
 
 #[derive(Deserialize)]
@@ -353,17 +353,17 @@ pub fn parse(
                         "only OBJ objects take a texture",
                     ));
                 }
-                let loaded = models.place_gltf(
+                let (model_report, camera) = models.place_gltf(
                     &mut scene,
                     &base_dir.join(gltf_path),
                     transform,
                     spec.color.is_some(),
                     &format!("{field}.transform"),
                 )?;
-                if let Some(camera) = loaded.camera {
+                if let Some(camera) = camera {
                     builtin_camera.get_or_insert(camera);
                 }
-                report.warnings.extend(loaded.report.warnings);
+                report.warnings.extend(model_report.warnings);
                 if scene.objects.len() == first_object {
                     // A light rig is fine here (on its own, `--scene` refuses it).
                     let msg = format!(

@@ -12,8 +12,16 @@ use super::SceneError;
 /// Most distinct meshes a model file, or a scene file with all its references, may make: each
 /// has a fixed cost besides its data (its buffers and their GL objects, the automatic grid's
 /// ray-caster hierarchy; about 4.4 KB measured with llvmpipe), so the limit holds that near
-/// 300 MB. Objects placing one mesh many times cost far less ([`MAX_SCENE_OBJECTS`](super::MAX_SCENE_OBJECTS)).
+/// 300 MB. Objects placing one mesh many times cost far less ([`MAX_SCENE_OBJECTS`]).
 pub const MAX_SCENE_MESHES: usize = 1 << 16;
+
+/// Most objects a scene file may place (all its references together), the per-file limit of
+/// glTF too: each costs about 0.6 KB of CPU state besides its mesh (placement, draw order,
+/// the automatic grid's ray caster), so the limit holds that near 600 MB.
+pub const MAX_SCENE_OBJECTS: usize = 1 << 20;
+
+/// Most materials a scene file may make (references that recolour a model copy its materials).
+pub const MAX_SCENE_MATERIALS: usize = 1 << 20;
 
 /// An indexed triangle mesh in object space. Normals are always present (computed from the
 /// faces when the source had none); texture coordinates are optional. Which sides are drawn is

@@ -17,19 +17,26 @@ pub mod directional;
 mod duplicates;
 pub mod error;
 pub mod features;
+#[cfg(feature = "scene-files")]
 pub mod file;
 pub mod framing;
+#[cfg(feature = "gltf")]
 pub mod gltf;
 pub mod input;
+#[cfg(test)]
+mod left_out_tests;
 pub mod light;
 mod light_list;
+mod load_report;
 pub mod material;
 pub mod mesh;
 mod mesh_limits;
 pub mod meshbuild;
+#[cfg(feature = "scene-files")]
 mod model_cache;
 pub mod motion;
 pub mod normal_matrix;
+#[cfg(feature = "obj")]
 pub mod obj;
 mod orientation;
 mod png_profile;
@@ -42,6 +49,8 @@ pub mod surface_maps;
 pub mod tangents;
 pub mod texture;
 pub mod texture_budget;
+#[cfg(any(feature = "obj", feature = "gltf"))]
+mod texture_names;
 pub(crate) mod triangle_reach;
 
 use std::ops::Range;
@@ -54,10 +63,10 @@ pub use camera::{Camera, Projection};
 pub use directional::{DirectionalLight, MAX_DIRECTIONAL_LIGHTS};
 pub use error::SceneError;
 pub use light::{Cone, Light, LightKind};
+pub use load_report::LoadReport;
 pub use material::{Material, MaterialModel, Texture};
-pub use mesh::MAX_SCENE_MESHES;
 pub use mesh::{Aabb, Mesh};
-pub use model_cache::{MAX_SCENE_MATERIALS, MAX_SCENE_OBJECTS};
+pub use mesh::{MAX_SCENE_MATERIALS, MAX_SCENE_MESHES, MAX_SCENE_OBJECTS};
 pub use motion::Motion;
 
 /// Most a transform's last row may differ from `0 0 0 1` (exporters and inverses round) before
@@ -418,7 +427,7 @@ pub fn builtin_scene(name: &str, lights: Option<RandomLights>) -> Result<Scene, 
 pub fn load_scene(
     spec: &str,
     lights: Option<RandomLights>,
-) -> Result<(Scene, obj::LoadReport), SceneError> {
+) -> Result<(Scene, LoadReport), SceneError> {
     load(spec, lights.map(|l| (l.count, l.seed)))
 }
 
@@ -428,7 +437,7 @@ pub fn load_scene_with(
     spec: &str,
     lights: Option<RandomLights>,
     options: &LoadOptions,
-) -> Result<(Scene, obj::LoadReport), SceneError> {
+) -> Result<(Scene, LoadReport), SceneError> {
     load_with(spec, lights.map(|l| (l.count, l.seed)), options)
 }
 
@@ -443,10 +452,7 @@ pub fn brings_own_lights(spec: &str) -> bool {
 /// bounds), a `.gltf` or `.glb` file (its own camera and lights; see `gltf::load`) or a
 /// `.json` scene file. `lights` = `Some((count, seed))` sets seeded random lights
 /// (for scene files, it replaces their `random_lights` count but keeps explicit lights).
-pub fn load(
-    spec: &str,
-    lights: Option<(usize, u64)>,
-) -> Result<(Scene, obj::LoadReport), SceneError> {
+pub fn load(spec: &str, lights: Option<(usize, u64)>) -> Result<(Scene, LoadReport), SceneError> {
     load_with(spec, lights, &LoadOptions::default())
 }
 
@@ -456,22 +462,41 @@ pub fn load_with(
     spec: &str,
     lights: Option<(usize, u64)>,
     options: &LoadOptions,
-) -> Result<(Scene, obj::LoadReport), SceneError> {
+) -> Result<(Scene, LoadReport), SceneError> {
     said::once_each(|| load_held(spec, lights, options))
 }
 
+/// What a file with extension `ext` is and the feature that reads it, where this build left
+/// its loader out (`None` where it is built, or no loader reads it).
+fn left_out_loader(ext: &str) -> Option<(&'static str, &'static str)> {
+    match ext {
+        "obj" if !cfg!(feature = "obj") => Some(("an OBJ model", "obj")),
+        "gltf" | "glb" if !cfg!(feature = "gltf") => Some(("a glTF model", "gltf")),
+        "json" if !cfg!(feature = "scene-files") => Some(("a JSON scene file", "scene-files")),
+        _ => None,
+    }
+}
+
 /// [`load_with`], its warnings held back by the caller.
+#[cfg_attr(
+    not(any(feature = "obj", feature = "gltf", feature = "scene-files")),
+    allow(unused_variables)
+)]
 fn load_held(
     spec: &str,
     lights: Option<(usize, u64)>,
     options: &LoadOptions,
-) -> Result<(Scene, obj::LoadReport), SceneError> {
+) -> Result<(Scene, LoadReport), SceneError> {
     let path = std::path::Path::new(spec);
     let ext = path
         .extension()
         .map(|e| e.to_string_lossy().to_lowercase())
         .unwrap_or_default();
-    let loaded = match ext.as_str() {
+    if let Some((kind, feature)) = left_out_loader(&ext) {
+        return Err(SceneError::not_built(path, kind, feature));
+    }
+    let loaded: (Scene, LoadReport) = match ext.as_str() {
+        #[cfg(feature = "obj")]
         "obj" => {
             if let Some((count, _)) = lights {
                 input::check_light_count(count, "lights")?;
@@ -494,7 +519,9 @@ fn load_held(
             scene.validate()?;
             Ok((scene, report))
         }
+        #[cfg(feature = "gltf")]
         "gltf" | "glb" => gltf::load(path, lights, options),
+        #[cfg(feature = "scene-files")]
         "json" => file::load(path, lights, options),
         // Built-in names have no extension: anything else that looks like a file is one (a
         // file without an extension named like a built-in could not be read as a scene anyway).
@@ -506,7 +533,7 @@ fn load_held(
                 path: path.to_path_buf(),
             })
         }
-        _ => return Ok((builtin::build(spec, lights)?, obj::LoadReport::default())),
+        _ => return Ok((builtin::build(spec, lights)?, LoadReport::default())),
     }?;
     // Triangles that are all points or lines draw nothing: refused as an empty file is, not
     // rendered as a black frame.

@@ -14,19 +14,13 @@ use std::sync::Arc;
 use glam::DMat4;
 
 use super::access::LoadOptions;
-use super::mesh::MAX_SCENE_MESHES;
-use super::obj::{self, LoadReport};
+use super::mesh::{MAX_SCENE_MATERIALS, MAX_SCENE_MESHES, MAX_SCENE_OBJECTS};
+#[cfg(feature = "obj")]
+use super::obj;
 use super::texture::Sampling;
 use super::texture_budget::TextureBudget;
-use super::{Aabb, Material, Mesh, Object, Scene, SceneError, Texture};
-
-/// Most objects a scene file may place (all its references together), the per-file limit of
-/// glTF too: each costs about 0.6 KB of CPU state besides its mesh (placement, draw order,
-/// the automatic grid's ray caster), so the limit holds that near 600 MB.
-pub const MAX_SCENE_OBJECTS: usize = super::gltf::MAX_OBJECTS;
-
-/// Most materials a scene file may make (references that recolour a model copy its materials).
-pub const MAX_SCENE_MATERIALS: usize = 1 << 20;
+use super::LoadReport;
+use super::{Aabb, Camera, Material, Mesh, Object, Scene, SceneError, Texture};
 
 /// A model as loaded, to be placed again without reading it.
 struct Loaded {
@@ -165,6 +159,7 @@ impl ModelCache {
 
     /// Places an OBJ file with `transform`, loading it on first use. `recolour`: the caller
     /// will recolour the materials appended from `scene.materials.len()` on.
+    #[cfg(feature = "obj")]
     pub fn place_obj(
         &mut self,
         scene: &mut Scene,
@@ -225,9 +220,25 @@ impl ModelCache {
         Ok(report)
     }
 
+    /// A build without the OBJ loader refuses an OBJ file.
+    #[cfg(not(feature = "obj"))]
+    pub fn place_obj(
+        &mut self,
+        _: &mut Scene,
+        path: &Path,
+        _: DMat4,
+        _: Option<&Path>,
+        _: bool,
+        _: &str,
+    ) -> Result<LoadReport, SceneError> {
+        Err(SceneError::not_built(path, "an OBJ model", "obj"))
+    }
+
     /// Places a glTF file with `transform`. A file without lights (suns included) or cameras
     /// is read once, at the identity, and placed from that; one with them is read for each
-    /// reference (they depend on the transform), sharing the meshes and textures of earlier reads.
+    /// reference (they depend on the transform), sharing the meshes and textures of earlier
+    /// reads. Returns the load's warnings and the first camera the file instances.
+    #[cfg(feature = "gltf")]
     pub fn place_gltf(
         &mut self,
         scene: &mut Scene,
@@ -235,7 +246,7 @@ impl ModelCache {
         transform: DMat4,
         recolour: bool,
         transform_field: &str,
-    ) -> Result<super::gltf::GltfLoad, SceneError> {
+    ) -> Result<(LoadReport, Option<Camera>), SceneError> {
         let key = std::fs::canonicalize(path).ok();
         if let Some(k) = &key {
             if !self.gltf.contains_key(k) {
@@ -270,14 +281,11 @@ impl ModelCache {
                 self.gltf.insert(k.clone(), loaded);
                 if let Some(Some(loaded)) = self.gltf.get_mut(k) {
                     loaded.place(scene, transform, recolour, transform_field)?;
-                    return Ok(super::gltf::GltfLoad {
-                        report: report.unwrap_or_default(),
-                        camera: None,
-                    });
+                    return Ok((report.unwrap_or_default(), None));
                 }
             } else if let Some(Some(loaded)) = self.gltf.get_mut(k) {
                 loaded.place(scene, transform, recolour, transform_field)?;
-                return Ok(super::gltf::GltfLoad::default());
+                return Ok((LoadReport::default(), None));
             }
         }
         // Read again for this reference: bounded in total (the file, its buffers and images),
@@ -333,7 +341,20 @@ impl ModelCache {
         if self.share(scene, first_object, first_material, key.as_ref(), charged) {
             loaded.report.warnings.clear();
         }
-        Ok(loaded)
+        Ok((loaded.report, loaded.camera))
+    }
+
+    /// A build without the glTF loader refuses a glTF file.
+    #[cfg(not(feature = "gltf"))]
+    pub fn place_gltf(
+        &mut self,
+        _: &mut Scene,
+        path: &Path,
+        _: DMat4,
+        _: bool,
+        _: &str,
+    ) -> Result<(LoadReport, Option<Camera>), SceneError> {
+        Err(SceneError::not_built(path, "a glTF model", "gltf"))
     }
 
     /// Swaps the meshes of the objects from `first_object` on for those of an earlier load of
@@ -481,7 +502,7 @@ fn check_counts(objects: usize, materials: usize, field: &str) -> Result<(), Sce
     Ok(())
 }
 
-#[cfg(test)]
+#[cfg(all(test, feature = "loaders"))]
 mod tests {
     use super::*;
 
@@ -615,7 +636,7 @@ mod tests {
             let loaded = cache
                 .place_gltf(&mut scene, path, transform, false, "objects[0].transform")
                 .unwrap();
-            assert!(loaded.report.warnings.is_empty(), "{:?}", loaded.report);
+            assert!(loaded.0.warnings.is_empty(), "{:?}", loaded.0);
         }
         assert_eq!(cache.texture_budget, TextureBudget::with_left(64 + 63));
         let clamped = Sampling {
@@ -653,7 +674,7 @@ mod tests {
             let loaded = cache
                 .place_gltf(&mut scene, &path, transform, false, "objects[0].transform")
                 .unwrap();
-            assert!(loaded.report.warnings.is_empty(), "{:?}", loaded.report);
+            assert!(loaded.0.warnings.is_empty(), "{:?}", loaded.0);
         }
         assert_eq!(scene.lights.len(), 3, "read per reference");
         let textures: std::collections::HashSet<_> = scene
@@ -673,7 +694,7 @@ mod tests {
                 .unwrap();
             let material = scene.objects.last().unwrap().material;
             assert!(scene.materials[material].diffuse_texture.is_none());
-            let warnings = &loaded.report.warnings;
+            let warnings = &loaded.0.warnings;
             let said = warnings.iter().any(|w| w.contains("left out"));
             assert_eq!(said, reference == 0, "{warnings:?}");
         }

@@ -17,7 +17,7 @@ use super::material::{MAX_COLOR_FACTOR, MAX_SHININESS};
 use super::surface_maps::{SurfaceMaps, TextureTransform};
 use super::texture::{Sampling, Texture, Wrap};
 use super::texture_budget::TextureBudget;
-use super::{shown, Aabb, Material, Mesh, Object, Scene, SceneError};
+use super::{shown, Aabb, LoadReport, Material, Mesh, Object, Scene, SceneError};
 use map_options::MapStatement;
 
 mod corners;
@@ -26,24 +26,13 @@ mod hostile_tests;
 mod lines;
 mod map_options;
 mod parse_memory;
-mod texture_names;
 mod textures;
 
+pub use super::texture_names::resolve_texture;
+use super::texture_names::{resolve_in as resolve_texture_in, Listings};
+use super::texture_names::{within_folder, TextureFinder};
 pub use lines::{MAX_OBJ_CORNERS, MAX_OBJ_MATERIALS};
-pub use texture_names::resolve_texture;
-#[cfg(test)]
-pub(crate) use texture_names::FOLDERS_LISTED;
-pub(crate) use texture_names::{resolve_in as resolve_texture_in, Listings};
-use texture_names::{within_folder, TextureFinder};
 use textures::TextureCache;
-
-/// What an OBJ load produced besides the objects: non-fatal problems, for the caller to show.
-#[derive(Debug, Default)]
-pub struct LoadReport {
-    /// Human-readable warnings (missing textures, missing MTL, …), also logged; from
-    /// `scene::load_with`, each once.
-    pub warnings: Vec<String>,
-}
 
 /// Loads an OBJ file (and its MTL) into `scene`, placing it with `transform`. Returns the
 /// warnings. `texture_override` binds a diffuse texture to every material (for models that
@@ -568,19 +557,6 @@ fn warn_unapplied_mtl<'a>(
 /// Largest texture side decoded, in pixels (the largest `GL_MAX_TEXTURE_SIZE` common on phones;
 /// the image is then kept within [`super::texture_budget::MAX_STORED_TEXTURE_SIDE`]).
 pub const MAX_TEXTURE_SIDE: u32 = super::texture_budget::MAX_DECODED_SIDE;
-
-impl LoadReport {
-    /// [`LoadReport::say`]s `msg`, its control characters escaped ([`shown::text`]).
-    pub(crate) fn warn(&mut self, msg: String) {
-        self.say(shown::reason(&msg));
-    }
-
-    /// Logs and keeps `msg` as it is (logged when the load ends, inside `scene::load_with`).
-    pub(crate) fn say(&mut self, msg: String) {
-        super::said::warn(&msg);
-        self.warnings.push(msg);
-    }
-}
 
 #[cfg(test)]
 mod tests {

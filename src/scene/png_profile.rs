@@ -39,7 +39,7 @@ pub(crate) fn without_colour_profile(bytes: &[u8]) -> Option<Vec<u8>> {
     Some(kept)
 }
 
-#[cfg(test)]
+#[cfg(all(test, feature = "png"))]
 mod tests {
     use super::without_colour_profile;
     use image::ImageEncoder;

@@ -180,6 +180,19 @@ fn progressive_jpeg_frame(bytes: &[u8]) -> Option<JpegFrame> {
     None
 }
 
+/// The crate's feature that decodes `format`, where this build left it out.
+fn decoder_left_out(format: image::ImageFormat) -> Option<&'static str> {
+    use image::ImageFormat::*;
+    match format {
+        Png if !cfg!(feature = "png") => Some("png"),
+        Jpeg if !cfg!(feature = "jpeg") => Some("jpeg"),
+        Tga if !cfg!(feature = "tga") => Some("tga"),
+        Bmp if !cfg!(feature = "bmp") => Some("bmp"),
+        Gif if !cfg!(feature = "gif") => Some("gif"),
+        _ => None,
+    }
+}
+
 /// Why an image did not decode, by the kind of failure only: the decoders' own messages
 /// quote the file (a PNG chunk's type, a BMP header's bytes read as a number), and no message
 /// may show a file's bytes.
@@ -198,10 +211,18 @@ fn undecodable(e: &image::ImageError) -> String {
             "could not be decoded (past the decoder's limits: {MAX_DECODED_SIDE} pixels a side, \
              {MAX_DECODE_BYTES} bytes decoded)"
         ),
-        ImageError::Unsupported(u) => format!(
-            "could not be decoded ({} data with a format or feature the decoder does not support)",
-            format(u.format_hint())
-        ),
+        ImageError::Unsupported(u) => match u.format_hint() {
+            ImageFormatHint::Exact(f) if decoder_left_out(f).is_some() => format!(
+                "could not be decoded (this build of manylight has no {f:?} decoder: its `{}` \
+                 feature is off)",
+                decoder_left_out(f).unwrap_or_default()
+            ),
+            hint => format!(
+                "could not be decoded ({} data with a format or feature the decoder does not \
+                 support)",
+                format(hint)
+            ),
+        },
         ImageError::IoError(io) => format!("could not be decoded (read failed: {})", io.kind()),
         ImageError::Parameter(_) | ImageError::Encoding(_) => "could not be decoded".to_string(),
     }
@@ -271,7 +292,7 @@ impl TextureBudget {
     }
 }
 
-#[cfg(test)]
+#[cfg(all(test, feature = "loaders"))]
 mod tests {
     use super::*;
 

@@ -215,7 +215,7 @@ fn a_textured_model_without_normals_gets_its_texture_and_outward_normals() {
     }
 }
 
-fn load_obj(path: &Path) -> Result<(Scene, obj::LoadReport), SceneError> {
+fn load_obj(path: &Path) -> Result<(Scene, scene::LoadReport), SceneError> {
     let mut scene = Scene::empty();
     let options = manylight::LoadOptions::default();
     let mut textures = manylight::scene::texture_budget::TextureBudget::default();

@@ -58,8 +58,8 @@ pub use material::{shininess, DIELECTRIC_SPECULAR};
 use super::access::LoadOptions;
 use super::input::{self, read_bounded, FileKind};
 use super::mesh::MAX_SCENE_MESHES;
-use super::obj::LoadReport;
 use super::texture_budget::TextureBudget;
+use super::LoadReport;
 use super::{
     random, Aabb, Camera, DirectionalLight, Light, Material, Mesh, Object, Scene, SceneError,
 };
@@ -74,7 +74,7 @@ pub use buffers::MAX_UNBACKED_ELEMENTS;
 pub const MAX_INDICES: usize = 3 << 25;
 
 /// Most objects (placed primitives) one glTF file may make.
-pub const MAX_OBJECTS: usize = 1 << 20;
+pub const MAX_OBJECTS: usize = super::mesh::MAX_SCENE_OBJECTS;
 
 pub use ignored::SUPPORTED_EXTENSIONS;
 

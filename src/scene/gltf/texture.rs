@@ -12,9 +12,9 @@ use std::sync::Arc;
 use super::buffers::Buffers;
 use super::uri::{self, Uri};
 use crate::scene::input::{read_bounded, FileKind, LIMIT_VARIABLE};
-use crate::scene::obj::{resolve_texture_in, Listings};
 use crate::scene::texture::{Filter, Sampling, Wrap};
 use crate::scene::texture_budget::{self, decode_texture_bytes, TextureBudget};
+use crate::scene::texture_names::{resolve_in as resolve_texture_in, Listings};
 use crate::scene::Texture;
 use crate::scene::{access, shown};
 
@@ -390,9 +390,10 @@ mod tests {
         });
         let path = dir.path().join("m.gltf");
         std::fs::write(&path, doc.to_string()).unwrap();
-        let before = crate::scene::obj::FOLDERS_LISTED.with(std::cell::Cell::get);
+        let before = crate::scene::texture_names::FOLDERS_LISTED.with(std::cell::Cell::get);
         let (_, report) = crate::scene::load(path.to_str().unwrap(), None).unwrap();
-        let listed = crate::scene::obj::FOLDERS_LISTED.with(std::cell::Cell::get) - before;
+        let listed =
+            crate::scene::texture_names::FOLDERS_LISTED.with(std::cell::Cell::get) - before;
         let missing = report
             .warnings
             .iter()

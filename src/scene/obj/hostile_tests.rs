@@ -111,7 +111,7 @@ fn a_texture_is_decoded_once_whatever_names_it_and_reads_are_bounded() {
 #[cfg(unix)]
 #[test]
 fn texture_lookups_list_each_folder_once_and_match_so_deep() {
-    use super::texture_names::{TextureFinder, MAX_MATCHED_COMPONENTS};
+    use crate::scene::texture_names::{TextureFinder, MAX_MATCHED_COMPONENTS};
     let dir = tempfile::tempdir().unwrap();
     let base = dir.path();
     std::fs::create_dir(base.join("sub")).unwrap();

@@ -3,7 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
-use manylight::scene::{self, obj::LoadReport, Scene, SceneError};
+use manylight::scene::{self, LoadReport, Scene, SceneError};
 
 /// Writes `bytes` to `dir/name`; the path written.
 pub fn write(dir: &Path, name: &str, bytes: impl AsRef<[u8]>) -> PathBuf {

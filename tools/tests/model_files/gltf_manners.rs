@@ -12,7 +12,7 @@ use common::gltf::Builder;
 use common::{max_oracle_error, mean, Gpu};
 use glam::Vec3;
 use manylight::metrics::cpu_reference::Encoding;
-use manylight::scene::{self, obj::LoadReport, Scene, SceneError};
+use manylight::scene::{self, LoadReport, Scene, SceneError};
 use manylight::{EsVersion, RenderOptions};
 use serde_json::{json, Value};
 

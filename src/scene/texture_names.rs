@@ -1,4 +1,5 @@
-//! An MTL file's texture names: found, confined to the model's folder.
+//! A model's texture names (an MTL file's, a glTF file's relative URIs): found, confined to
+//! the model's folder.
 //!
 //! Real MTL files name textures with other letter case than the file on disk, with Windows
 //! backslashes, or with folders that were flattened when the model was shared. Resolution
