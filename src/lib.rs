@@ -14,7 +14,8 @@
 //!   shaders before its first frame.
 //! - A [`Scene`]: [`builtin_scene`] or [`load_scene`] (OBJ, glTF, JSON scene files, each a
 //!   cargo feature on by default, as are the texture decoders: README, "Embedding";
-//!   [`load_scene_with`] and [`LoadOptions`] let a trusted model read outside its folder), or built
+//!   [`load_scene_with`] and [`LoadOptions`] let a trusted model read outside its folder;
+//!   `load_gltf_from_memory` a GLB held in memory, such as an Android APK asset), or built
 //!   in code with [`Scene::add_material`], [`MeshBuilder`], [`Scene::add_object`],
 //!   [`Light::point`] and [`Light::spot`]; [`Scene::set_time`] poses moving lights
 //!   ([`motion`]).
@@ -107,6 +108,8 @@ pub use renderer::{
     WarmUp,
 };
 pub use scene::features::SceneFeatures;
+#[cfg(feature = "gltf")]
+pub use scene::load_gltf_from_memory;
 pub use scene::meshbuild::MeshBuilder;
 pub use scene::surface_maps::{MapTexture, SurfaceMaps, TextureTransform};
 pub use scene::LoadReport;

@@ -441,6 +441,26 @@ pub fn load_scene_with(
     load_with(spec, lights.map(|l| (l.count, l.seed)), options)
 }
 
+/// A glTF 2.0 model held in memory — a GLB, or glTF JSON whose buffers and images are
+/// embedded (`data:` URIs) — such as an Android game's APK asset or a download; `name` names
+/// it in messages. Loaded as [`load_scene`] loads a `.glb` file (its camera or one framing
+/// it, its lights, and `lights` random ones added), but it reads no file: a buffer whose URI
+/// names one is an error, an image a warning (its material keeps its flat colour).
+#[cfg(feature = "gltf")]
+pub fn load_gltf_from_memory(
+    bytes: &[u8],
+    name: &str,
+    lights: Option<RandomLights>,
+) -> Result<(Scene, LoadReport), SceneError> {
+    let name = std::path::Path::new(name);
+    said::once_each(|| {
+        let source = gltf::Source::Memory { bytes, name };
+        let lights = lights.map(|l| (l.count, l.seed));
+        let loaded = gltf::load_source(source, lights, &LoadOptions::default())?;
+        finish_load(loaded, name, "glb")
+    })
+}
+
 /// True when `spec` names a file that brings its own lights (a `.json` scene file, a `.gltf`
 /// or `.glb` file): the CLI then adds random lights only when asked to.
 pub fn brings_own_lights(spec: &str) -> bool {
@@ -535,11 +555,21 @@ fn load_held(
         }
         _ => return Ok((builtin::build(spec, lights)?, LoadReport::default())),
     }?;
+    finish_load(loaded, path, &ext)
+}
+
+/// A model or scene file's load (`ext` its extension) checked for something to draw and for
+/// a dark frame, each warning once.
+fn finish_load(
+    loaded: (Scene, LoadReport),
+    path: &std::path::Path,
+    ext: &str,
+) -> Result<(Scene, LoadReport), SceneError> {
     // Triangles that are all points or lines draw nothing: refused as an empty file is, not
     // rendered as a black frame.
     if !loaded.0.objects.is_empty() && !loaded.0.has_visible_area() {
         let reason = "nothing to draw: every triangle has zero area".to_string();
-        return Err(match ext.as_str() {
+        return Err(match ext {
             "obj" => SceneError::Obj {
                 path: path.to_path_buf(),
                 reason,

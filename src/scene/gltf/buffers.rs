@@ -23,7 +23,7 @@ pub const MAX_UNBACKED_ELEMENTS: usize = 1 << 20;
 pub(super) struct Buffers<'a> {
     document: &'a gltf::Document,
     bin: Option<&'a [u8]>,
-    base_dir: &'a Path,
+    base_dir: Option<&'a Path>,
     allow_outside: bool,
     loaded: Vec<Option<Cow<'a, [u8]>>>,
     /// Bytes still allowed to be read or decoded into buffers.
@@ -34,11 +34,12 @@ pub(super) struct Buffers<'a> {
 
 impl<'a> Buffers<'a> {
     /// Buffers of `document`; `bin` is the GLB's BIN chunk, `base_dir` the folder relative
-    /// file URIs start from; `allow_outside` lets URIs name files outside it.
+    /// file URIs start from (`None`: a glTF read from memory, which reads no file);
+    /// `allow_outside` lets URIs name files outside it.
     pub fn new(
         document: &'a gltf::Document,
         bin: Option<&'a [u8]>,
-        base_dir: &'a Path,
+        base_dir: Option<&'a Path>,
         allow_outside: bool,
     ) -> Self {
         Buffers {
@@ -68,14 +69,16 @@ impl<'a> Buffers<'a> {
     /// The file a URI of this document names (`name`, percent-decoded), refused when it lies
     /// outside the glTF file's folder and the load does not allow that. `field` names the URI.
     pub fn file(&self, field: &str, name: &str) -> Result<PathBuf, String> {
-        let path = access::join(self.base_dir, name, self.allow_outside)
-            .and_then(|p| access::resolve(self.base_dir, &p, self.allow_outside))
+        let base_dir = self.base_dir.ok_or_else(|| reads_no_files(field, name))?;
+        let path = access::join(base_dir, name, self.allow_outside)
+            .and_then(|p| access::resolve(base_dir, &p, self.allow_outside))
             .map_err(|e| format!("{field}: {e}"))?;
         Ok(path)
     }
 
-    /// The folder relative file URIs start from, and whether names may leave it.
-    pub fn base_dir(&self) -> (&'a Path, bool) {
+    /// The folder relative file URIs start from (`None` for a glTF read from memory), and
+    /// whether names may leave it.
+    pub fn base_dir(&self) -> (Option<&'a Path>, bool) {
         (self.base_dir, self.allow_outside)
     }
 
@@ -172,4 +175,13 @@ impl<'a> Buffers<'a> {
         bytes.truncate(length);
         Ok(Cow::Owned(bytes))
     }
+}
+
+/// Why a glTF read from memory does not read the file URI `name` at `field`.
+pub(super) fn reads_no_files(field: &str, name: &str) -> String {
+    format!(
+        "{field}: names the file `{}`, and a glTF read from memory reads no files (embed it: \
+         the GLB's BIN chunk, a bufferView or a data: URI)",
+        crate::scene::shown::name(name)
+    )
 }

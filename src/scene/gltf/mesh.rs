@@ -448,7 +448,7 @@ mod tests {
         let root: gltf::json::Root = serde_json::from_value(json).unwrap();
         let document = gltf::Document::from_json_without_validation(root);
         let dir = std::env::temp_dir();
-        let mut buffers = Buffers::new(&document, None, &dir, false);
+        let mut buffers = Buffers::new(&document, None, Some(&dir), false);
         let primitive = document
             .meshes()
             .next()

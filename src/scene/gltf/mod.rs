@@ -96,14 +96,24 @@ pub fn load(
     lights: Option<(usize, u64)>,
     options: &LoadOptions,
 ) -> Result<(Scene, LoadReport), SceneError> {
+    load_source(Source::File(path), lights, options)
+}
+
+/// [`load`] from `source`.
+pub(crate) fn load_source(
+    source: Source,
+    lights: Option<(usize, u64)>,
+    options: &LoadOptions,
+) -> Result<(Scene, LoadReport), SceneError> {
+    let path = source.name();
     if let Some((count, _)) = lights {
         input::check_light_count(count, "lights")?;
     }
     let mut scene = Scene::empty();
     let mut textures = TextureBudget::default();
-    let mut loaded = load_into(
+    let mut loaded = load_source_into(
         &mut scene,
-        path,
+        source,
         DMat4::IDENTITY,
         "transform",
         options,
@@ -159,16 +169,56 @@ pub fn load_into(
     options: &LoadOptions,
     textures: &mut TextureBudget,
 ) -> Result<GltfLoad, SceneError> {
+    let source = Source::File(path);
+    load_source_into(scene, source, transform, transform_field, options, textures)
+}
+
+/// Where a glTF's bytes come from.
+#[derive(Clone, Copy)]
+pub(crate) enum Source<'a> {
+    /// A file, whose folder its file URIs are read from.
+    File(&'a Path),
+    /// Memory: no file is read; `name` names it in messages.
+    Memory { bytes: &'a [u8], name: &'a Path },
+}
+
+impl Source<'_> {
+    /// What messages call it.
+    fn name(&self) -> &Path {
+        match self {
+            Source::File(path) => path,
+            Source::Memory { name, .. } => name,
+        }
+    }
+}
+
+/// [`load_into`] from `source`.
+fn load_source_into(
+    scene: &mut Scene,
+    source: Source,
+    transform: DMat4,
+    transform_field: &str,
+    options: &LoadOptions,
+    textures: &mut TextureBudget,
+) -> Result<GltfLoad, SceneError> {
     if !transform.is_finite() {
         return Err(SceneError::invalid(transform_field, "must be finite"));
     }
-    let bytes = read_bounded(path, FileKind::Gltf)?;
+    let path = source.name();
+    let read;
+    let bytes = match source {
+        Source::File(path) => {
+            read = read_bounded(path, FileKind::Gltf)?;
+            &read[..]
+        }
+        Source::Memory { bytes, .. } => bytes,
+    };
     let error = |reason: String| SceneError::Gltf {
         path: path.to_path_buf(),
         reason,
     };
     let imported = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        import(&bytes, path, transform, options, textures)
+        import(bytes, source, transform, options, textures)
     }));
     let imported = match imported {
         Ok(Ok(imported)) => imported,
@@ -278,11 +328,12 @@ struct Imported {
 /// then placed by `transform` and checked again (faults are the transform's).
 fn import(
     bytes: &[u8],
-    path: &Path,
+    source: Source,
     transform: DMat4,
     options: &LoadOptions,
     textures: &mut TextureBudget,
 ) -> Result<Imported, Fault> {
+    let path = source.name();
     let (json, bin) = if bytes.starts_with(glb::MAGIC) {
         let g = glb::split(bytes)?;
         (g.json, g.bin)
@@ -312,7 +363,10 @@ fn import(
         .into());
     }
     let mut warnings = Vec::new();
-    let base_dir = path.parent().unwrap_or(Path::new("."));
+    let base_dir = match source {
+        Source::File(path) => Some(path.parent().unwrap_or(Path::new("."))),
+        Source::Memory { .. } => None,
+    };
     let mut buffers = buffers::Buffers::new(&document, bin, base_dir, options.allow_outside_files);
     let (roots, from) = nodes::roots(&document);
     let placed = nodes::walk(&document, &roots, &locals, DMat4::IDENTITY)?;

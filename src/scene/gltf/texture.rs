@@ -297,6 +297,10 @@ fn locate<'d>(
         Ok(Uri::File(name)) => {
             let (base_dir, allow_outside) = buffers.base_dir();
             let uri_field = format!("{field}.uri");
+            let Some(base_dir) = base_dir else {
+                let why = super::buffers::reads_no_files(&uri_field, &name);
+                return Ok(Err(format!("{why}; using the flat colour")));
+            };
             let as_written = access::join(base_dir, &name, allow_outside)
                 .map_err(|e| format!("{uri_field}: {e}"))?;
             // As written first (names may hold spaces); then in other letter case or

@@ -7,6 +7,7 @@
 mod common;
 
 mod gltf_alpha_mask;
+mod gltf_from_memory;
 mod gltf_geometry;
 mod gltf_lights_and_cameras;
 mod gltf_malformed_files;
