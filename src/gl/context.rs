@@ -86,7 +86,9 @@ pub struct EglInfo {
     /// A driver workaround: the implementation's headless contexts live on one thread at a
     /// time, so [`HeadlessContext::new`] on another thread waits until they are gone. ANGLE,
     /// for the reason above: a context made on a second thread while the first one's were
-    /// alive crashed it in `eglMakeCurrent`.
+    /// alive crashed it in `eglMakeCurrent`. There a context is dropped on the thread that
+    /// made it (where it is current): dropped elsewhere, it counts as gone while it may still
+    /// be current on its own thread.
     pub one_thread_at_a_time: bool,
 }
 
@@ -136,8 +138,9 @@ impl HeadlessContext {
     /// [`EglInfo::one_thread_at_a_time`]), a thread asking while another thread's contexts are
     /// alive waits until they are all dropped, as a test harness running tests in parallel
     /// needs: ANGLE crashed the process there. It waits as long as the other thread drops a
-    /// context now and then, and fails after a minute in which none went (a thread holding a
-    /// context while it waits for this one would otherwise hang both).
+    /// context now and then, and fails with [`GlError::ContextsOnAnotherThread`] after a minute
+    /// in which none went (a thread holding a context while it waits for this one would
+    /// otherwise hang both).
     pub fn new(es: EsVersion) -> Result<Self, GlError> {
         Self::new_waiting_at_most(es, ONE_THREAD_PATIENCE)
     }
@@ -467,13 +470,10 @@ fn wait_for_other_threads(
             .unwrap_or_else(|e| e.into_inner());
         live = guard;
         if wait.timed_out() && live.only_thread.is_some_and(|owner| owner != here) {
-            return Err(GlError::Unsupported(format!(
-                "this implementation (ANGLE) runs headless contexts on one thread at a time, \
-                 and another thread kept its {} for {} s without dropping one: drop them \
-                 first, or make this context on that thread",
-                live.count,
-                patience.as_secs_f64()
-            )));
+            return Err(GlError::ContextsOnAnotherThread {
+                contexts: live.count,
+                waited_s: patience.as_secs_f64(),
+            });
         }
     }
     Ok(live)

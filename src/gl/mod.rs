@@ -155,6 +155,20 @@ pub enum GlError {
     /// A required capability is missing.
     #[error("{0}")]
     Unsupported(String),
+    /// [`HeadlessContext::new`] waited in vain where the implementation runs headless contexts
+    /// on one thread at a time (ANGLE): another thread kept its contexts for `waited_s`
+    /// seconds without dropping one. It may be asked again once they are gone.
+    #[error(
+        "this implementation (ANGLE) runs headless contexts on one thread at a time, and \
+         another thread kept its {contexts} for {waited_s} s without dropping one: drop them \
+         first, or make this context on that thread"
+    )]
+    ContextsOnAnotherThread {
+        /// The other thread's contexts alive.
+        contexts: usize,
+        /// Seconds waited without one being dropped.
+        waited_s: f64,
+    },
     /// A frame, or a render target made for one, larger than the context allows: past
     /// `GL_MAX_VIEWPORT_DIMS` (a frame into the game's framebuffer), or past
     /// `GL_MAX_TEXTURE_SIZE` or `GL_MAX_RENDERBUFFER_SIZE` (the renderer's own targets:

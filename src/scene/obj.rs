@@ -617,6 +617,7 @@ mod tests {
     }
 
     #[test]
+    #[cfg(feature = "png")]
     fn a_texture_override_leaves_the_mtls_texture_undecoded() {
         let dir = tempfile::tempdir().unwrap();
         for (name, side) in [("big.png", 64), ("small.png", 2)] {
@@ -652,6 +653,7 @@ mod tests {
     }
 
     #[test]
+    #[cfg(feature = "png")]
     fn textures_past_the_scenes_budget_are_left_out_with_a_warning() {
         let dir = tempfile::tempdir().unwrap();
         let mut mtl = String::new();

@@ -180,15 +180,19 @@ fn progressive_jpeg_frame(bytes: &[u8]) -> Option<JpegFrame> {
     None
 }
 
-/// The crate's feature that decodes `format`, where this build left it out.
+/// The crate's feature that decodes `format`, where the build has no decoder for it (asked of
+/// `image`, whose decoders another crate of the build may have turned on).
 fn decoder_left_out(format: image::ImageFormat) -> Option<&'static str> {
     use image::ImageFormat::*;
+    if format.reading_enabled() {
+        return None;
+    }
     match format {
-        Png if !cfg!(feature = "png") => Some("png"),
-        Jpeg if !cfg!(feature = "jpeg") => Some("jpeg"),
-        Tga if !cfg!(feature = "tga") => Some("tga"),
-        Bmp if !cfg!(feature = "bmp") => Some("bmp"),
-        Gif if !cfg!(feature = "gif") => Some("gif"),
+        Png => Some("png"),
+        Jpeg => Some("jpeg"),
+        Tga => Some("tga"),
+        Bmp => Some("bmp"),
+        Gif => Some("gif"),
         _ => None,
     }
 }

@@ -275,14 +275,13 @@ mod tests {
         assert_eq!(resolve_texture(dir.path(), "missing.png"), None);
     }
 
-    /// A model folder inside a temporary root holding `secret.png`.
+    /// A model folder inside a temporary root holding `secret.png` (found by name only, never
+    /// decoded here).
     fn model_beside_a_secret_image() -> (tempfile::TempDir, PathBuf) {
         let root = tempfile::tempdir().unwrap();
         let model = root.path().join("model");
         std::fs::create_dir(&model).unwrap();
-        image::RgbaImage::from_pixel(2, 2, image::Rgba([255, 0, 0, 255]))
-            .save(root.path().join("secret.png"))
-            .unwrap();
+        std::fs::write(root.path().join("secret.png"), b"secret").unwrap();
         (root, model)
     }
 

@@ -69,7 +69,8 @@ impl<'a> Buffers<'a> {
     /// The file a URI of this document names (`name`, percent-decoded), refused when it lies
     /// outside the glTF file's folder and the load does not allow that. `field` names the URI.
     pub fn file(&self, field: &str, name: &str) -> Result<PathBuf, String> {
-        let base_dir = self.base_dir.ok_or_else(|| reads_no_files(field, name))?;
+        let base_dir =
+            (self.base_dir).ok_or_else(|| reads_no_files(field, name, BUFFER_EMBEDDED))?;
         let path = access::join(base_dir, name, self.allow_outside)
             .and_then(|p| access::resolve(base_dir, &p, self.allow_outside))
             .map_err(|e| format!("{field}: {e}"))?;
@@ -177,11 +178,27 @@ impl<'a> Buffers<'a> {
     }
 }
 
-/// Why a glTF read from memory does not read the file URI `name` at `field`.
-pub(super) fn reads_no_files(field: &str, name: &str) -> String {
+/// Why a glTF read from memory does not read the file URI `name` at `field`; `embedded` says
+/// where the file's bytes could go instead.
+pub(super) fn reads_no_files(field: &str, name: &str, embedded: &str) -> String {
     format!(
         "{field}: names the file `{}`, and a glTF read from memory reads no files (embed it: \
-         the GLB's BIN chunk, a bufferView or a data: URI)",
+         {embedded})",
         crate::scene::shown::name(name)
     )
+}
+
+/// Where a buffer's bytes go in a glTF read from memory.
+pub(super) const BUFFER_EMBEDDED: &str = "the GLB's BIN chunk or a data: URI";
+
+/// A glTF read from memory whose buffer names a file: refused before anything is decoded.
+pub(super) fn file_buffer(document: &gltf::Document) -> Option<String> {
+    document.buffers().find_map(|b| match b.source() {
+        gltf::buffer::Source::Uri(text) if !uri::is_data(text) => Some(reads_no_files(
+            &format!("buffers[{}].uri", b.index()),
+            text,
+            BUFFER_EMBEDDED,
+        )),
+        _ => None,
+    })
 }

@@ -365,7 +365,12 @@ fn import(
     let mut warnings = Vec::new();
     let base_dir = match source {
         Source::File(path) => Some(path.parent().unwrap_or(Path::new("."))),
-        Source::Memory { .. } => None,
+        Source::Memory { .. } => {
+            if let Some(reason) = buffers::file_buffer(&document) {
+                return Err(Fault::Unsupported(reason));
+            }
+            None
+        }
     };
     let mut buffers = buffers::Buffers::new(&document, bin, base_dir, options.allow_outside_files);
     let (roots, from) = nodes::roots(&document);

@@ -298,7 +298,8 @@ fn locate<'d>(
             let (base_dir, allow_outside) = buffers.base_dir();
             let uri_field = format!("{field}.uri");
             let Some(base_dir) = base_dir else {
-                let why = super::buffers::reads_no_files(&uri_field, &name);
+                let embedded = "a bufferView or a data: URI";
+                let why = super::buffers::reads_no_files(&uri_field, &name, embedded);
                 return Ok(Err(format!("{why}; using the flat colour")));
             };
             let as_written = access::join(base_dir, &name, allow_outside)
@@ -474,6 +475,7 @@ mod tests {
     }
 
     #[test]
+    #[cfg(feature = "png")]
     fn decodes_a_png_and_refuses_a_claimed_giant() {
         let img = image::RgbaImage::from_pixel(3, 2, image::Rgba([10, 20, 30, 255]));
         let mut png = Vec::new();

@@ -16,6 +16,11 @@ pub(super) enum Uri {
     File(String),
 }
 
+/// Whether `uri` is a `data:` URI (its scheme alone, nothing decoded).
+pub(super) fn is_data(uri: &str) -> bool {
+    strip_prefix_ignore_case(uri, "data:").is_some()
+}
+
 /// Classifies and decodes `uri`; errors say what is wrong with it.
 pub(super) fn parse(uri: &str) -> Result<Uri, String> {
     if let Some(rest) = strip_prefix_ignore_case(uri, "data:") {

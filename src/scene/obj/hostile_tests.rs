@@ -61,7 +61,7 @@ fn mtllib_lines_without_end_warn_a_bounded_number_of_times() {
 
 /// One texture file named through a link to the folder is decoded once; past what the
 /// model's textures may read together, a texture is left out with a warning.
-#[cfg(unix)]
+#[cfg(all(unix, feature = "png"))]
 #[test]
 fn a_texture_is_decoded_once_whatever_names_it_and_reads_are_bounded() {
     let dir = tempfile::tempdir().unwrap();
