@@ -95,19 +95,6 @@ pub enum SceneError {
 }
 
 impl SceneError {
-    /// Shorthand for [`SceneError::NotBuilt`].
-    pub(crate) fn not_built(
-        path: &std::path::Path,
-        kind: &'static str,
-        feature: &'static str,
-    ) -> Self {
-        SceneError::NotBuilt {
-            path: path.to_path_buf(),
-            kind,
-            feature,
-        }
-    }
-
     /// Shorthand for [`SceneError::Invalid`].
     pub fn invalid(field: impl Into<String>, reason: impl Into<String>) -> Self {
         SceneError::Invalid {

@@ -28,6 +28,7 @@ mod left_out_tests;
 pub mod light;
 mod light_list;
 mod load_report;
+mod loaders;
 pub mod material;
 pub mod mesh;
 mod mesh_limits;
@@ -57,6 +58,8 @@ use std::ops::Range;
 use std::sync::Arc;
 
 use glam::{DMat4, DVec4, Vec3};
+
+use loaders::Loader;
 
 pub use access::LoadOptions;
 pub use camera::{Camera, Projection};
@@ -486,17 +489,6 @@ pub fn load_with(
     said::once_each(|| load_held(spec, lights, options))
 }
 
-/// What a file with extension `ext` is and the feature that reads it, where this build left
-/// its loader out (`None` where it is built, or no loader reads it).
-fn left_out_loader(ext: &str) -> Option<(&'static str, &'static str)> {
-    match ext {
-        "obj" if !cfg!(feature = "obj") => Some(("an OBJ model", "obj")),
-        "gltf" | "glb" if !cfg!(feature = "gltf") => Some(("a glTF model", "gltf")),
-        "json" if !cfg!(feature = "scene-files") => Some(("a JSON scene file", "scene-files")),
-        _ => None,
-    }
-}
-
 /// [`load_with`], its warnings held back by the caller.
 #[cfg_attr(
     not(any(feature = "obj", feature = "gltf", feature = "scene-files")),
@@ -512,8 +504,8 @@ fn load_held(
         .extension()
         .map(|e| e.to_string_lossy().to_lowercase())
         .unwrap_or_default();
-    if let Some((kind, feature)) = left_out_loader(&ext) {
-        return Err(SceneError::not_built(path, kind, feature));
+    if let Some(loader) = Loader::for_extension(&ext).filter(|l| !l.built()) {
+        return Err(loader.left_out(path));
     }
     let loaded: (Scene, LoadReport) = match ext.as_str() {
         #[cfg(feature = "obj")]

@@ -14,6 +14,8 @@ use std::sync::Arc;
 use glam::DMat4;
 
 use super::access::LoadOptions;
+#[cfg(not(all(feature = "obj", feature = "gltf")))]
+use super::loaders::Loader;
 use super::mesh::{MAX_SCENE_MATERIALS, MAX_SCENE_MESHES, MAX_SCENE_OBJECTS};
 #[cfg(feature = "obj")]
 use super::obj;
@@ -231,7 +233,7 @@ impl ModelCache {
         _: bool,
         _: &str,
     ) -> Result<LoadReport, SceneError> {
-        Err(SceneError::not_built(path, "an OBJ model", "obj"))
+        Err(Loader::Obj.left_out(path))
     }
 
     /// Places a glTF file with `transform`. A file without lights (suns included) or cameras
@@ -354,7 +356,7 @@ impl ModelCache {
         _: bool,
         _: &str,
     ) -> Result<(LoadReport, Option<Camera>), SceneError> {
-        Err(SceneError::not_built(path, "a glTF model", "gltf"))
+        Err(Loader::Gltf.left_out(path))
     }
 
     /// Swaps the meshes of the objects from `first_object` on for those of an earlier load of
