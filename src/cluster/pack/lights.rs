@@ -141,6 +141,9 @@ pub fn pack_lights_into(lights: &[GpuLight], encoding: LightEncoding, packed: &m
     let radius_range = lights.iter().map(|l| l.radius).fold(1e-6f32, f32::max);
     // Fixed-point steps: positions over 2·pos_range, radii over radius_range, in 65 535 steps.
     let step = (2.0 * pos_range).max(radius_range) / 65535.0;
+    // How far a decoded centre may lie from the light's: a whole position step on each axis
+    // (half a step rounding here, the shader's fp16 decoding up to one more).
+    let centre_error = 3f32.sqrt() * 2.0 * pos_range / 65535.0;
     let mut coarse = 0;
     for (i, l) in lights.iter().enumerate() {
         match encoding {
@@ -176,7 +179,10 @@ pub fn pack_lights_into(lights: &[GpuLight], encoding: LightEncoding, packed: &m
                     p(l.position.x),
                     p(l.position.y),
                     p(l.position.z),
-                    unorm16(l.radius / radius_range),
+                    // Rounded down and less the centre's error, so the sphere a record
+                    // lights lies inside the one the light was culled with: a radius rounded
+                    // up would light pixels of cells whose lists leave the light out.
+                    unorm16_down((l.radius - centre_error).max(0.0) / radius_range),
                 ];
                 let start = i * tpl * 4;
                 let rec = &mut bytes[start..start + 32];
@@ -305,6 +311,11 @@ fn unorm16(x: f32) -> u16 {
     (x.clamp(0.0, 1.0) * 65535.0).round() as u16
 }
 
+/// [`unorm16`] rounded towards zero.
+fn unorm16_down(x: f32) -> u16 {
+    (x.clamp(0.0, 1.0) * 65535.0).floor() as u16
+}
+
 /// Shared-exponent RGB: the largest channel keeps 8 bits of mantissa.
 fn rgbe(c: Vec3) -> [u8; 4] {
     let m = c.max_element();
@@ -418,6 +429,16 @@ mod tests {
         with_huge[0].radius = 1e6;
         let packed = pack_lights(&with_huge, LightEncoding::Rgba8);
         assert_eq!(packed.coarse, lights.len() - 1);
+        // What a record keeps of a radius lies within it, however coarse the steps.
+        for (i, light) in with_huge.iter().enumerate() {
+            let decoded = unpack_light(&packed, i);
+            let reach = (decoded.position - light.position).length() + decoded.radius;
+            assert!(
+                reach <= light.radius,
+                "light {i}: {reach} past {}",
+                light.radius
+            );
+        }
         let small = unpack_light(&packed, 1);
         assert!(small.radius < 0.5 * lights[1].radius, "{}", small.radius);
     }
@@ -433,7 +454,16 @@ mod tests {
                 (u.position - l.position).abs().max_element() <= pos_step * 0.51,
                 "light {i}"
             );
-            assert!((u.radius - l.radius).abs() <= packed.radius_range / 65535.0 * 0.51);
+            // Rounded down, less the centre's error: the decoded sphere lies in the light's.
+            let radius_step = packed.radius_range / 65535.0;
+            let centre_error = 3f32.sqrt() * pos_step;
+            assert!(u.radius <= l.radius && u.radius >= l.radius - radius_step - centre_error);
+            let reach = (u.position - l.position).length() + u.radius;
+            assert!(
+                reach <= l.radius,
+                "light {i}: reaches {reach}, radius {}",
+                l.radius
+            );
             // Shared exponent: a step is 2^e / 255 with 2^e <= 2·max, so half a step is at most
             // max / 255 (reached when max is a power of two); 1e-4 covers f32 rounding.
             let tol = l.radiance.max_element() / 255.0 * (1.0 + 1e-4);

@@ -239,3 +239,35 @@ fn a_grid_the_texture_cannot_hold_is_a_clear_error() {
     assert!(stats.grid.cells <= manylight::cluster::auto_grid::CELL_BUDGET);
     assert!(stats.grid.reason.unwrap().starts_with("auto"));
 }
+
+/// RGBA8 light records (ES 2.0 without float textures) hold every radius in steps of the
+/// largest: beside one light of radius 10⁶ the others' radii are a few steps. A radius rounded
+/// up past the one the lights were culled with lit pixels of cells that do not list the light
+/// (36/255 from forward); records now round inside the culled sphere, so every method draws
+/// forward's picture, however coarse the records (the renderer warns of that).
+#[test]
+fn rgba8_records_light_nothing_outside_the_culled_spheres() {
+    let opts = RenderOptions {
+        measure: manylight::MeasureOptions {
+            force_rgba8_lights: true,
+            ..Default::default()
+        },
+        ..Default::default()
+    };
+    let mut scene = scene::builtin::build("courtyard", Some((64, 3))).unwrap();
+    let huge = Light::point(scene.camera.target, 1e6, Vec3::splat(0.02), 1e-3);
+    scene.lights.push(huge);
+    let mut gpu = Gpu::new(EsVersion::Es2);
+    let (w, h) = (W / 2, H / 2);
+    let (reference, stats) = gpu.render_with("forward", &scene, (w, h), &opts);
+    assert_eq!(stats.lights.encoding, manylight::LightEncoding::Rgba8);
+    assert!(
+        common::mean(&reference) > 5.0,
+        "the small lights light nothing"
+    );
+    for method in ["tiled", "clustered"] {
+        let (img, _) = gpu.render_with(method, &scene, (w, h), &opts);
+        let d = diff(&reference, &img);
+        assert!(d.max_abs <= 2, "{method}: {}/255 from forward", d.max_abs);
+    }
+}
