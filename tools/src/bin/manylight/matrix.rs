@@ -11,6 +11,7 @@
 //! RGBA8 light data), ES 2.0 with RGBA8 light data (all played) and ES 3.x on it; the Mesa
 //! restrictions, softpipe and OSMesa rows belong to the system's group.
 
+mod restriction;
 mod verdict;
 
 use std::path::{Path, PathBuf};
@@ -24,6 +25,7 @@ use manylight_tools::output::{self, print_stdout, JsonOut, OutputFile};
 use serde_json::{json, Value};
 
 use crate::EsArg;
+use restriction::Shows;
 
 /// Options of `manylight matrix`.
 #[derive(Parser, Debug)]
@@ -73,6 +75,8 @@ struct Config {
     size: Option<&'static str>,
     /// Which row groups have it.
     groups: Groups,
+    /// What its context shows when `env` took effect.
+    shows: Shows,
 }
 
 /// The row groups a configuration belongs to.
@@ -95,6 +99,7 @@ const CONFIGS: &[Config] = &[
         args: &[],
         groups: Groups::All,
         size: None,
+        shows: Shows::Nothing,
     },
     Config {
         name: "ES 2.0 without fragment highp (played)",
@@ -104,6 +109,7 @@ const CONFIGS: &[Config] = &[
         args: &["--no-fragment-highp"],
         groups: Groups::All,
         size: None,
+        shows: Shows::Nothing,
     },
     Config {
         // A Mali-400's pair: its lights as 16-bit RGBA8 records decoded in fp16.
@@ -114,6 +120,7 @@ const CONFIGS: &[Config] = &[
         args: &["--no-fragment-highp", "--rgba8-lights"],
         groups: Groups::All,
         size: None,
+        shows: Shows::Nothing,
     },
     Config {
         name: "ES 2.0 with RGBA8 light data (played)",
@@ -123,6 +130,7 @@ const CONFIGS: &[Config] = &[
         args: &["--rgba8-lights"],
         groups: Groups::Others,
         size: None,
+        shows: Shows::Nothing,
     },
     Config {
         name: "ES 2.0 without float textures",
@@ -135,6 +143,7 @@ const CONFIGS: &[Config] = &[
         args: &[],
         groups: Groups::System,
         size: None,
+        shows: Shows::NoFloatTextures,
     },
     Config {
         name: "ES 2.0 driver (capped)",
@@ -144,6 +153,7 @@ const CONFIGS: &[Config] = &[
         args: &[],
         groups: Groups::System,
         size: None,
+        shows: Shows::GlVersion("OpenGL ES 2.0"),
     },
     Config {
         name: "ES 3.0 driver (capped)",
@@ -153,6 +163,7 @@ const CONFIGS: &[Config] = &[
         args: &[],
         groups: Groups::System,
         size: None,
+        shows: Shows::GlVersion("OpenGL ES 3.0"),
     },
     Config {
         name: "ES 3.x as the driver gives it",
@@ -162,6 +173,7 @@ const CONFIGS: &[Config] = &[
         args: &[],
         groups: Groups::All,
         size: None,
+        shows: Shows::Nothing,
     },
     // A second Mesa rasterizer (mediump at fp32, no LLVM): slow, so a small image. Where it
     // and llvmpipe differ, it is on triangle edges only (tests/second_driver.rs).
@@ -173,6 +185,7 @@ const CONFIGS: &[Config] = &[
         args: &[],
         groups: Groups::System,
         size: Some("96x54"),
+        shows: Shows::Renderer("softpipe"),
     },
 ];
 
@@ -332,16 +345,7 @@ fn group_rows(
             Some(dir) => cmd.env(manylight::gl::gles_lib::GLES_LIB_ENV, dir),
             None => cmd.env_remove(manylight::gl::gles_lib::GLES_LIB_ENV),
         };
-        let mut row = cell_row(&cmd.output()?);
-        row["config"] = json!(config.name);
-        row["gles_lib"] = json!(label);
-        row["env"] = json!(config
-            .env
-            .iter()
-            .map(|(k, v)| format!("{k}={v}"))
-            .chain(config.args.iter().map(|a| a.to_string()))
-            .collect::<Vec<_>>());
-        rows.push(row);
+        rows.push(labelled_row(config, cell_row(&cmd.output()?), &label));
     }
     name_failed_rows(&mut rows, &label);
     if lib.is_none() {
@@ -353,6 +357,21 @@ fn group_rows(
         rows.push(row);
     }
     Ok(rows)
+}
+
+/// A cell's `row` named by its configuration and implementation (`label`), and marked where
+/// the configuration's driver switch did not take effect.
+fn labelled_row(config: &Config, mut row: Value, label: &str) -> Value {
+    restriction::check(&mut row, config.shows, config.env);
+    row["config"] = json!(config.name);
+    row["gles_lib"] = json!(label);
+    row["env"] = json!(config
+        .env
+        .iter()
+        .map(|(k, v)| format!("{k}={v}"))
+        .chain(config.args.iter().map(|a| a.to_string()))
+        .collect::<Vec<_>>());
+    row
 }
 
 /// What every cell's child gets: no driver switch from the caller ([`DRIVER_ENV`]), and the
@@ -774,7 +793,29 @@ pub fn run_cell(args: &MatrixCellArgs) -> Result<(), Box<dyn std::error::Error>>
 #[cfg(test)]
 mod tests {
     use super::{cell_error, cell_row, markdown, name_failed_rows, sheet, THUMB_MAX};
+    use super::{labelled_row, CONFIGS};
     use serde_json::json;
+
+    /// The system's libraries need not be Mesa (a device farm's driver): there every row of a
+    /// Mesa switch is unavailable, not a pass of the unrestricted driver under its name, and
+    /// every other row stays as its cell made it.
+    #[test]
+    fn every_mesa_switch_row_on_another_implementation_is_unavailable() {
+        let swiftshader = json!({"implementation": "SwiftShader", "float_textures": true,
+            "gl_version": "OpenGL ES 3.2 SwiftShader", "renderer": "Google SwiftShader",
+            "methods": [{"name": "forward", "max_abs_vs_forward": 0}]});
+        for config in CONFIGS {
+            let row = labelled_row(config, swiftshader.clone(), "system");
+            if config.env.is_empty() {
+                assert!(row["error"].is_null(), "{}: {row}", config.name);
+                assert_eq!(row["methods"], swiftshader["methods"], "{}", config.name);
+            } else {
+                assert_eq!(row["refused"], true, "{}: {row}", config.name);
+                assert_eq!(row["methods"], json!([]), "{}", config.name);
+                assert!(row["error"].as_str().unwrap().contains("not applied"));
+            }
+        }
+    }
 
     /// A row whose context failed (an llvmpipe row at a size it cannot take) is named after
     /// its group's rows on the same driver, never after softpipe's, which succeeded.
