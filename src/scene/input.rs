@@ -79,6 +79,15 @@ impl FileKind {
             FileKind::Texture => "texture",
         }
     }
+
+    /// The name with its article ("an OBJ file").
+    fn a_name(self) -> String {
+        let article = match self {
+            FileKind::Model | FileKind::Materials => "an",
+            _ => "a",
+        };
+        format!("{article} {}", self.name())
+    }
 }
 
 fn refuse(path: &Path, kind: std::io::ErrorKind, reason: String) -> SceneError {
@@ -138,8 +147,8 @@ fn read_limited(path: &Path, kind: FileKind, prefix: Option<u64>) -> Result<Vec<
             std::io::ErrorKind::InvalidInput,
             format!(
                 "a file of the kernel's {root} (one can block a read forever or change as it \
-                 is read), not a {}",
-                kind.name()
+                 is read), not {}",
+                kind.a_name()
             ),
         ));
     }
@@ -265,6 +274,8 @@ mod tests {
                 "{file}: {err}"
             );
         }
+        let err = read_bounded(Path::new("/proc/self/status"), FileKind::Model).unwrap_err();
+        assert!(err.to_string().ends_with("not an OBJ file"), "{err}");
         let before = bytes_read();
         let _ = read_bounded(Path::new("/proc/self/status"), FileKind::Texture);
         assert_eq!(bytes_read(), before, "nothing read");
