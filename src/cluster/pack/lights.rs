@@ -142,7 +142,9 @@ pub fn pack_lights_into(lights: &[GpuLight], encoding: LightEncoding, packed: &m
     // Fixed-point steps: positions over 2·pos_range, radii over radius_range, in 65 535 steps.
     let step = (2.0 * pos_range).max(radius_range) / 65535.0;
     // How far a decoded centre may lie from the light's: a whole position step on each axis
-    // (half a step rounding here, the shader's fp16 decoding up to one more).
+    // (half a step rounding here, up to one more from the shader's constants rounded to fp16).
+    // Without fragment highp, fp16 also rounds the decoded centre itself, as it rounds a float
+    // record's: that moves a light's faint edge, not the gross rounding this guards against.
     let centre_error = 3f32.sqrt() * 2.0 * pos_range / 65535.0;
     let mut coarse = 0;
     for (i, l) in lights.iter().enumerate() {
