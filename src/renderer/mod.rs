@@ -131,11 +131,14 @@ impl Renderer {
         let mut desc = methods::find(methods::DEFAULT_METHOD)?;
         let mut support = (desc.supported)(dev.caps());
         let mut pending_warning = None;
+        let mut replaced = None;
         if let Support::Unsupported(reason) = &support {
-            pending_warning = Some(format!(
-                "the default method `{}` is unsupported here ({reason}); rendering with `forward`",
+            let why = format!(
+                "the default method `{}` is unsupported here ({reason})",
                 desc.name
-            ));
+            );
+            pending_warning = Some(format!("{why}; rendering with `forward`"));
+            replaced = Some(why);
             desc = methods::find("forward")?;
             support = (desc.supported)(dev.caps());
         }
@@ -146,6 +149,12 @@ impl Renderer {
                 None => note,
             });
         }
+        // Forward standing in for the default is a fallback too, which the frames' stats say.
+        support = match (replaced, support) {
+            (Some(why), Support::Supported) => Support::Fallback(why),
+            (Some(why), Support::Fallback(reason)) => Support::Fallback(format!("{why}; {reason}")),
+            (_, support) => support,
+        };
         let method = dev.host_call(|| (desc.create)(&dev))?;
         Ok(Renderer {
             dev,

@@ -16,7 +16,8 @@ use crate::scene::features::SceneFeatures;
 pub struct FrameStats {
     /// Shading method.
     pub method: String,
-    /// The method's support status on this context (fallbacks say what degrades).
+    /// The method's support status on this context (fallbacks say what degrades; forward
+    /// standing in for a default method the context cannot run is a fallback naming it).
     pub support: Support,
     /// The method `auto` picked for this frame (`None` for the other methods).
     pub auto_choice: Option<String>,

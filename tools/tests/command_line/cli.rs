@@ -303,6 +303,13 @@ fn without_fragment_highp_es2_renders_with_forward_and_says_why() {
     let s = stats(&dir.path().join("s.json"));
     assert_eq!(s["method"], "forward");
     assert_eq!(s["support"]["status"], "fallback");
+    // The stats say forward stands in for the default, not only the warning does.
+    let reason = s["support"]["reason"].as_str().unwrap();
+    assert!(
+        reason.starts_with("the default method `clustered` is unsupported here (")
+            && reason.contains("mediump"),
+        "{reason}"
+    );
     let img = image::open(dir.path().join("manylight.png"))
         .unwrap()
         .to_rgba8();
