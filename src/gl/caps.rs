@@ -97,6 +97,14 @@ const LLVMPIPE_LOOP_ITERATIONS: u32 = 65_535;
 /// directional lights', at most four) when a light loop is bounded by it.
 const LOOP_RESERVE: u32 = 64;
 
+/// The ES 2.0 extensions of float textures, which a device without them lacks.
+const FLOAT_TEXTURE_EXTENSIONS: [&str; 4] = [
+    "GL_OES_texture_float",
+    "GL_OES_texture_half_float",
+    "GL_OES_texture_float_linear",
+    "GL_OES_texture_half_float_linear",
+];
+
 /// The ES 2.0 extension MSAA renders through.
 pub const MSAA_RENDER_TO_TEXTURE: &str = "GL_EXT_multisampled_render_to_texture";
 
@@ -304,10 +312,22 @@ impl Caps {
         self.fragment_highp.precision > 0
     }
 
-    /// Applies `restrictions` (see [`super::Restrictions`]). ES 3.0 requires fragment highp,
-    /// so taking it away is only possible at the ES 2.0 level.
+    /// Applies `restrictions` (see [`super::Restrictions`]). ES 3.0 requires fragment highp
+    /// and float textures, so taking either away is only possible at the ES 2.0 level.
     pub fn restrict(&mut self, restrictions: &super::Restrictions) -> Result<(), GlError> {
-        if restrictions.no_fragment_highp {
+        let taken = [
+            (
+                restrictions.no_fragment_highp,
+                "no_fragment_highp",
+                "a fragment stage without highp",
+            ),
+            (
+                restrictions.no_float_textures,
+                "no_float_textures",
+                "a device without float textures",
+            ),
+        ];
+        for (_, name, what) in taken.iter().filter(|(on, _, _)| *on) {
             if self.es != EsVersion::Es2 || self.desktop {
                 // The restriction is the caller's contradiction, not the driver's limit.
                 let context = if self.desktop {
@@ -316,11 +336,19 @@ impl Caps {
                     format!("OpenGL {}", self.es)
                 };
                 return Err(GlError::Unsupported(format!(
-                    "no_fragment_highp needs an OpenGL ES 2.0 context (a fragment stage without \
-                     highp exists only there: ES 3.0 requires it); this is {context}"
+                    "{name} needs an OpenGL ES 2.0 context ({what} exists only there: ES 3.0 \
+                     requires it); this is {context}"
                 )));
             }
+        }
+        if restrictions.no_fragment_highp {
             self.fragment_highp = Precision::default();
+        }
+        if restrictions.no_float_textures {
+            self.float_textures = false;
+            for float in FLOAT_TEXTURE_EXTENSIONS {
+                self.extensions.remove(float);
+            }
         }
         Ok(())
     }

@@ -52,6 +52,10 @@ pub struct Restrictions {
     /// the caps report none, and fragment shaders are compiled with every float at `mediump`,
     /// which llvmpipe evaluates in fp16 as such a device does.
     pub no_fragment_highp: bool,
+    /// Behave as an ES 2.0 device without float textures (`GL_OES_texture_float` and
+    /// `_half_float` unlisted, as `MESA_EXTENSION_OVERRIDE` removes them): the caps report
+    /// none, so light records are packed in RGBA8 and every method says so.
+    pub no_float_textures: bool,
 }
 
 /// The OpenGL ES feature level the renderer targets. With [`EsVersion::Es2`] the renderer uses

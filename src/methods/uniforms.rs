@@ -317,7 +317,10 @@ mod tests {
             let Some(ctx) = context_or_skip(es) else {
                 return;
             };
-            let restrictions = crate::gl::Restrictions { no_fragment_highp };
+            let restrictions = crate::gl::Restrictions {
+                no_fragment_highp,
+                ..Default::default()
+            };
             let dev =
                 Device::restricted(ctx.load_gl().expect("gl"), es, &restrictions).expect("device");
             let mut programs = ProgramCache::new();

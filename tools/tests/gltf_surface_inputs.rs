@@ -59,7 +59,10 @@ fn check_every_method_by_level(
         (EsVersion::Es2, true),
         (EsVersion::Es3, false),
     ] {
-        let restrictions = manylight::gl::Restrictions { no_fragment_highp };
+        let restrictions = manylight::gl::Restrictions {
+            no_fragment_highp,
+            ..Default::default()
+        };
         let mut gpu = Gpu::restricted(es, &restrictions);
         let want = if es == EsVersion::Es3 {
             want_es3

@@ -549,6 +549,7 @@ fn no_heap_allocation_per_frame_in_steady_state_es2_without_fragment_highp() {
     ];
     let restrictions = Restrictions {
         no_fragment_highp: true,
+        ..Default::default()
     };
     let failures = allocations_per_frame(EsVersion::Es2, &restrictions, &cases);
     assert!(failures.is_empty(), "{}", failures.join("\n"));

@@ -116,6 +116,7 @@ fn check_without_fragment_highp(
         EsVersion::Es2,
         &manylight::gl::Restrictions {
             no_fragment_highp: true,
+            ..Default::default()
         },
     );
     assert_eq!(gpu.r().method(), "forward", "{name}: the fallback method");

@@ -1404,3 +1404,69 @@ fn the_summary_line_escapes_the_output_name_and_counts_one_light() {
     assert!(summary.contains("a\\u{a}b.png"), "{summary}");
     assert!(summary.contains(" · 1 light · "), "{summary}");
 }
+
+/// `--no-float-textures` plays the device `MESA_EXTENSION_OVERRIDE` makes by removing float
+/// textures: the same light records, so the same picture from every method that runs, and the
+/// same capabilities and fallback in the JSON (the matrix's played rows reported float textures
+/// and a method `supported` while their lights went through RGBA8 records). ES 3.0 has float
+/// textures core, so the restriction is refused there.
+#[test]
+fn no_float_textures_plays_the_device_without_them() {
+    let dir = tempfile::tempdir().unwrap();
+    if !mesa_driver(dir.path()) {
+        return;
+    }
+    let removed = [(
+        "MESA_EXTENSION_OVERRIDE",
+        "-GL_OES_texture_float -GL_OES_texture_half_float",
+    )];
+    let info = |args: &[&str], env: &[(&str, &str)]| {
+        let out = manylight(args, env, dir.path());
+        assert!(out.status.success(), "{args:?}: {}", text(&out));
+        serde_json::from_slice::<serde_json::Value>(&out.stdout).unwrap()
+    };
+    let played = info(&["info", "--es", "2", "--no-float-textures", "--json"], &[]);
+    let real = info(&["info", "--es", "2", "--json"], &removed);
+    for v in [&played, &real] {
+        assert_eq!(v["caps"]["float_textures"], false, "{}", v["caps"]);
+        let listed = v["caps"]["extensions"].as_array().unwrap();
+        assert!(
+            !listed.iter().any(|e| e == "GL_OES_texture_float"),
+            "{listed:?}"
+        );
+    }
+    assert_eq!(played["methods"], real["methods"]);
+    assert_eq!(played["methods"][0]["support"]["status"], "fallback");
+    for method in ["forward", "clustered"] {
+        let picture = |png: &str, extra: &[&str], env: &[(&str, &str)]| {
+            let mut args = vec!["--es", "2", "--method", method, "--size", "48x27"];
+            args.extend([
+                "--lights", "32", "--frames", "0", "--out", png, "--stats", "s.json",
+            ]);
+            args.extend(extra);
+            let out = manylight(&args, env, dir.path());
+            assert!(out.status.success(), "{method}: {}", text(&out));
+            assert_eq!(stats(&dir.path().join("s.json"))["light_encoding"], "rgba8");
+            image::open(dir.path().join(png)).unwrap().into_rgba8()
+        };
+        let a = picture("played.png", &["--no-float-textures"], &[]);
+        let b = picture("real.png", &[], &removed);
+        let d = manylight::metrics::diff(&a, &b);
+        assert!(
+            d.max_abs <= 1,
+            "{method}: played {}/255 from the real one",
+            d.max_abs
+        );
+    }
+    let out = manylight(
+        &["info", "--es", "3", "--no-float-textures"],
+        &[],
+        dir.path(),
+    );
+    assert!(!out.status.success());
+    assert!(
+        text(&out).contains("no_float_textures needs an OpenGL ES 2.0 context"),
+        "{}",
+        text(&out)
+    );
+}

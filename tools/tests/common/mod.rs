@@ -48,6 +48,7 @@ impl Gpu {
     pub fn without_fragment_highp() -> Gpu {
         let restrictions = Restrictions {
             no_fragment_highp: true,
+            ..Default::default()
         };
         Gpu::restricted(EsVersion::Es2, &restrictions)
     }

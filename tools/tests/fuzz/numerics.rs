@@ -174,7 +174,10 @@ pub fn check(case: &Case) {
                 Device::Es2 => (EsVersion::Es2, false),
                 Device::NoFragmentHighp => (EsVersion::Es2, true),
             };
-            let restrictions = manylight::gl::Restrictions { no_fragment_highp };
+            let restrictions = manylight::gl::Restrictions {
+                no_fragment_highp,
+                ..Default::default()
+            };
             *cell = Some((kind, Gpu::restricted(es, &restrictions)));
         }
         let gpu = &mut cell.as_mut().unwrap().1;

@@ -125,6 +125,7 @@ fn gpu(tier: &Tier) -> Gpu {
         tier.es,
         &Restrictions {
             no_fragment_highp: tier.no_fragment_highp,
+            ..Default::default()
         },
     )
 }

@@ -28,7 +28,13 @@ fn each_device(mut case: impl FnMut(&str, &mut Gpu)) {
         ("ES 2.0", EsVersion::Es2, false),
         ("ES 2.0 without fragment highp", EsVersion::Es2, true),
     ] {
-        let mut gpu = Gpu::restricted(es, &manylight::gl::Restrictions { no_fragment_highp });
+        let mut gpu = Gpu::restricted(
+            es,
+            &manylight::gl::Restrictions {
+                no_fragment_highp,
+                ..Default::default()
+            },
+        );
         case(name, &mut gpu);
     }
 }

@@ -27,6 +27,9 @@ pub struct InfoArgs {
     /// Play a device whose fragment stage has no highp (needs `--es 2`; see `render`).
     #[arg(long)]
     pub no_fragment_highp: bool,
+    /// Play a device without float textures (needs `--es 2`; see `render`).
+    #[arg(long)]
+    pub no_float_textures: bool,
     /// List every extension of the context (the text output gives only their number).
     #[arg(long)]
     pub extensions: bool,
@@ -87,6 +90,7 @@ fn scene_report(
 pub fn run(args: &InfoArgs) -> Result<(), Box<dyn std::error::Error>> {
     let restrictions = manylight::gl::Restrictions {
         no_fragment_highp: args.no_fragment_highp,
+        no_float_textures: args.no_float_textures,
     };
     let probe = |es: EsVersion| -> Result<_, Box<dyn std::error::Error>> {
         let ctx = HeadlessContext::new(es)?;
@@ -95,7 +99,7 @@ pub fn run(args: &InfoArgs) -> Result<(), Box<dyn std::error::Error>> {
     };
     let (ctx, mut renderer) = match args.es {
         Some(es) => probe(es.into())?,
-        None if args.no_fragment_highp => probe(EsVersion::Es2)?,
+        None if args.no_fragment_highp || args.no_float_textures => probe(EsVersion::Es2)?,
         // A capability probe reports what the device has: ES 2.0 where ES 3.0 is missing.
         None => match probe(EsVersion::Es3) {
             Err(e) if crate::version_unavailable(e.as_ref()) => {

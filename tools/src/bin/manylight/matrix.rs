@@ -639,8 +639,8 @@ pub struct MatrixCellArgs {
     #[arg(long)]
     no_fragment_highp: bool,
     /// Play a device without float textures: light records packed in RGBA8.
-    #[arg(long)]
-    rgba8_lights: bool,
+    #[arg(long = "rgba8-lights")]
+    no_float_textures: bool,
 }
 
 /// The context a matrix cell renders with (kept alive for the renderer's life).
@@ -689,7 +689,6 @@ pub fn run_cell(args: &MatrixCellArgs) -> Result<(), Box<dyn std::error::Error>>
     let opts = RenderOptions {
         measure: manylight::MeasureOptions {
             timed_frames: 3,
-            force_rgba8_lights: args.rgba8_lights,
             ..Default::default()
         },
         ..RenderOptions::default()
@@ -723,6 +722,7 @@ pub fn run_cell(args: &MatrixCellArgs) -> Result<(), Box<dyn std::error::Error>>
     let ctx = CellContext::new(es, args.osmesa)?;
     let restrictions = manylight::gl::Restrictions {
         no_fragment_highp: args.no_fragment_highp,
+        no_float_textures: args.no_float_textures,
     };
     let mut renderer = match Renderer::restricted(ctx.load_gl()?, es, &restrictions) {
         Err(e) if crate::version_unavailable(&e) => return print_refusal(&e),

@@ -67,6 +67,10 @@ pub struct RenderArgs {
     /// unsupported there.
     #[arg(long)]
     pub no_fragment_highp: bool,
+    /// Play a device without float textures (`GL_OES_texture_float`; needs `--es 2`): light
+    /// records are packed in RGBA8, as `MESA_EXTENSION_OVERRIDE` removing them makes them.
+    #[arg(long)]
+    pub no_float_textures: bool,
     /// Tone map applied before the sRGB encode: `none` (the default: the light model's own
     /// values, clipped at 1), `reinhard`, `aces` or `neutral` (Khronos PBR Neutral).
     #[arg(long, value_enum, default_value_t = ToneMapArg::None)]
@@ -288,6 +292,7 @@ pub fn run(args: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
     let ctx = HeadlessContext::new(es)?;
     let restrictions = manylight::gl::Restrictions {
         no_fragment_highp: args.no_fragment_highp,
+        no_float_textures: args.no_float_textures,
     };
     let mut renderer = Renderer::restricted(ctx.load_gl()?, es, &restrictions)?;
     // A fallback is logged as a warning by the renderer.
