@@ -362,15 +362,12 @@ fn group_rows(
 /// A cell's `row` named by its configuration and implementation (`label`), and marked where
 /// the configuration's driver switch did not take effect.
 fn labelled_row(config: &Config, mut row: Value, label: &str) -> Value {
-    restriction::check(&mut row, config.shows, config.env);
+    let mut env: Vec<String> = config.env.iter().map(|(k, v)| format!("{k}={v}")).collect();
+    restriction::check(&mut row, config.shows, &env);
+    env.extend(config.args.iter().map(|a| a.to_string()));
     row["config"] = json!(config.name);
     row["gles_lib"] = json!(label);
-    row["env"] = json!(config
-        .env
-        .iter()
-        .map(|(k, v)| format!("{k}={v}"))
-        .chain(config.args.iter().map(|a| a.to_string()))
-        .collect::<Vec<_>>());
+    row["env"] = json!(env);
     row
 }
 

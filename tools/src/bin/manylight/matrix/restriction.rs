@@ -33,17 +33,16 @@ impl Shows {
     }
 }
 
-/// Marks `row` when its switch (`env`, shown as `shows`) did not take effect: unavailable on an
-/// implementation other than Mesa, whose switches it ignores, and a failure on Mesa itself. Its
-/// methods ran without the restriction, so they are dropped from the row.
-pub fn check(row: &mut Value, shows: Shows, env: &[(&str, &str)]) {
+/// Marks `row` when its switch (`switches`, each `VAR=value`, shown as `shows`) did not take
+/// effect: unavailable on an implementation other than Mesa, whose switches it ignores, and a
+/// failure on Mesa itself. Its methods ran without the restriction, so they are dropped.
+pub fn check(row: &mut Value, shows: Shows, switches: &[String]) {
     if row["error"].is_string() {
         return;
     }
     let Some(missing) = shows.missing(row) else {
         return;
     };
-    let switches: Vec<String> = env.iter().map(|(k, v)| format!("{k}={v}")).collect();
     let implementation = row["implementation"].as_str().unwrap_or("?").to_string();
     let mesa = implementation.starts_with("Mesa");
     let why = if mesa {
@@ -69,7 +68,11 @@ mod tests {
                "methods": [{"name": "forward", "max_abs_vs_forward": 0}]})
     }
 
-    const NO_FLOAT: &[(&str, &str)] = &[("MESA_EXTENSION_OVERRIDE", "-GL_OES_texture_float")];
+    fn switch(text: &str) -> Vec<String> {
+        vec![text.to_string()]
+    }
+
+    const NO_FLOAT: &str = "MESA_EXTENSION_OVERRIDE=-GL_OES_texture_float";
 
     #[test]
     fn a_switch_that_took_effect_leaves_the_row_as_it_was() {
@@ -98,7 +101,7 @@ mod tests {
         ];
         for (shows, mut r) in cases {
             let before = r.clone();
-            check(&mut r, shows, NO_FLOAT);
+            check(&mut r, shows, &switch(NO_FLOAT));
             assert_eq!(r, before);
         }
     }
@@ -111,7 +114,7 @@ mod tests {
             "OpenGL ES 2.0 SwiftShader 4.0",
             "Google SwiftShader",
         );
-        check(&mut r, Shows::NoFloatTextures, NO_FLOAT);
+        check(&mut r, Shows::NoFloatTextures, &switch(NO_FLOAT));
         assert_eq!(r["refused"], true);
         assert_eq!(r["methods"], json!([]));
         let error = r["error"].as_str().unwrap();
@@ -129,7 +132,7 @@ mod tests {
         check(
             &mut r,
             Shows::Renderer("softpipe"),
-            &[("GALLIUM_DRIVER", "softpipe")],
+            &switch("GALLIUM_DRIVER=softpipe"),
         );
         assert!(r["error"]
             .as_str()
@@ -148,7 +151,7 @@ mod tests {
         check(
             &mut r,
             Shows::GlVersion("OpenGL ES 2.0"),
-            &[("MESA_GLES_VERSION_OVERRIDE", "2.0")],
+            &switch("MESA_GLES_VERSION_OVERRIDE=2.0"),
         );
         assert_eq!(r["refused"], false);
         assert!(r["error"]
@@ -160,7 +163,7 @@ mod tests {
     #[test]
     fn a_failed_cell_keeps_its_own_error() {
         let mut r = json!({"error": "no context", "methods": []});
-        check(&mut r, Shows::NoFloatTextures, NO_FLOAT);
+        check(&mut r, Shows::NoFloatTextures, &switch(NO_FLOAT));
         assert_eq!(r["error"], "no context");
     }
 }
