@@ -243,8 +243,8 @@ fn a_grid_the_texture_cannot_hold_is_a_clear_error() {
 /// RGBA8 light records (ES 2.0 without float textures) hold every radius in steps of the
 /// largest: beside one light of radius 10⁶ the others' radii are a few steps. A radius rounded
 /// up past the one the lights were culled with lit pixels of cells that do not list the light
-/// (tiled 25/255 from forward here); records now round inside the culled sphere, so every method draws
-/// forward's picture, however coarse the records (the renderer warns of that).
+/// (tiled 25/255 from forward here); records now round inside the culled sphere, so every
+/// method draws forward's picture, however coarse the records (the renderer warns of that).
 #[test]
 fn rgba8_records_light_nothing_outside_the_culled_spheres() {
     let opts = RenderOptions {
