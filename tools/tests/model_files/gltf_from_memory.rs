@@ -4,7 +4,7 @@
 use crate::common;
 
 use common::files::write;
-use common::gltf::{base64, Builder};
+use common::gltf::{base64, glb, Builder};
 use common::gltf_models::{checker_png, floor, primitive};
 use common::Gpu;
 use manylight::{load_gltf_from_memory, load_scene, EsVersion, RenderOptions, SceneError};
@@ -96,4 +96,58 @@ fn a_gltf_from_memory_reads_no_file() {
         "{:?}",
         report.warnings
     );
+}
+
+/// A byte order mark before the JSON, which the glTF specification lets readers ignore, changes
+/// nothing: a GLB's JSON chunk and a `.gltf` file with one draw what they draw without.
+#[test]
+fn a_byte_order_mark_before_the_json_changes_nothing() {
+    const BOM: &[u8] = b"\xEF\xBB\xBF";
+    let mut b = Builder::default();
+    let floor = primitive(&mut b, &floor(), None);
+    let scene = json!({
+        "extensionsUsed": ["KHR_lights_punctual"],
+        "extensions": {"KHR_lights_punctual": {"lights": [
+            {"type": "point", "intensity": 20, "range": 8}
+        ]}},
+        "scenes": [{"nodes": [0, 1]}],
+        "nodes": [
+            {"mesh": 0},
+            {"translation": [0.5, 1.5, 0.5], "extensions": {"KHR_lights_punctual": {"light": 0}}}
+        ],
+        "meshes": [{"primitives": [floor]}]
+    });
+    let text = b.gltf(scene.clone());
+    let with_bom = |json: &[u8]| [BOM, json].concat();
+    let plain_json = b.document(scene, None).to_string();
+    let cases = [
+        (
+            text.as_bytes().to_vec(),
+            with_bom(text.as_bytes()),
+            "level.gltf",
+        ),
+        (
+            glb(plain_json.as_bytes(), Some(&b.bin)),
+            glb(&with_bom(plain_json.as_bytes()), Some(&b.bin)),
+            "level.glb",
+        ),
+    ];
+    let mut gpu = Gpu::new(EsVersion::Es3);
+    let opts = RenderOptions::default();
+    for (plain, marked, name) in cases {
+        let (expected, _) = load_gltf_from_memory(&plain, name, None).expect(name);
+        let (loaded, report) = load_gltf_from_memory(&marked, name, None)
+            .unwrap_or_else(|e| panic!("{name} with a byte order mark: {e}"));
+        assert!(report.warnings.is_empty(), "{name}: {:?}", report.warnings);
+        assert_eq!(loaded.lights.len(), 1, "{name}");
+        let image = gpu.render(&loaded, 64, 36, &opts);
+        assert!(
+            image.pixels().any(|p| p[0] > 16),
+            "{name}: the lit floor drew nothing"
+        );
+        assert!(
+            image == gpu.render(&expected, 64, 36, &opts),
+            "{name}: another picture"
+        );
+    }
 }
