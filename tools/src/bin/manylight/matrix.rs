@@ -117,7 +117,7 @@ const CONFIGS: &[Config] = &[
         slug: "es2-mediump-rgba8",
         es: "2",
         env: &[],
-        args: &["--no-fragment-highp", "--rgba8-lights"],
+        args: &["--no-fragment-highp", "--no-float-textures"],
         groups: Groups::All,
         size: None,
         shows: Shows::Nothing,
@@ -127,7 +127,7 @@ const CONFIGS: &[Config] = &[
         slug: "es2-rgba8",
         es: "2",
         env: &[],
-        args: &["--rgba8-lights"],
+        args: &["--no-float-textures"],
         groups: Groups::Others,
         size: None,
         shows: Shows::Nothing,
@@ -636,7 +636,7 @@ pub struct MatrixCellArgs {
     #[arg(long)]
     no_fragment_highp: bool,
     /// Play a device without float textures: light records packed in RGBA8.
-    #[arg(long = "rgba8-lights")]
+    #[arg(long)]
     no_float_textures: bool,
 }
 
