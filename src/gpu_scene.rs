@@ -147,14 +147,21 @@ impl GpuScene {
     }
 
     /// Replaces last frame's split meshes with this frame's: objects of `scene` with triangles
-    /// too long for their distance from its camera are drawn from a copy split near the eye.
-    pub(crate) fn split_for_frame(&mut self, dev: &Device, scene: &Scene) -> Result<(), Error> {
+    /// too long for their distance from its camera, or spanning too many of the `frame`'s
+    /// pixels, are drawn from a copy split near the eye.
+    pub(crate) fn split_for_frame(
+        &mut self,
+        dev: &Device,
+        scene: &Scene,
+        frame: (u32, u32),
+    ) -> Result<(), Error> {
         for (_, (mut m, _)) in self.splits.drain() {
             m.destroy(dev);
         }
         let model = DMat4::from_translation(scene.camera.position);
-        let splits =
-            triangle_reach::split_objects(scene, |o| (self.longest_edge(o), self.world_bounds(o)));
+        let splits = triangle_reach::split_objects(scene, frame, |o| {
+            (self.longest_edge(o), self.world_bounds(o))
+        });
         if let Some(i) = splits.cut_short {
             if !self.warned_split_budget {
                 self.warned_split_budget = true;

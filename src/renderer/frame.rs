@@ -251,7 +251,8 @@ impl Renderer {
         self.gpu_scene
             .upload(&self.dev, scene, options.measure.full_variants)?;
         self.gpu_scene.check_placement(scene)?;
-        self.gpu_scene.split_for_frame(&self.dev, scene)?;
+        self.gpu_scene
+            .split_for_frame(&self.dev, scene, (width, height))?;
         let view: DMat4 = scene.camera.view_matrix();
         let projection = scene
             .camera

@@ -122,16 +122,21 @@ impl Aabb {
         }
     }
 
-    /// Bounds of this box's eight corners after a transform.
-    pub fn transformed(&self, m: &DMat4) -> Aabb {
-        let corners = (0..8).map(|i| {
+    /// The box's eight corners.
+    pub fn corners(&self) -> [DVec3; 8] {
+        std::array::from_fn(|i| {
             let pick = |bit: u32, lo: f64, hi: f64| if i & (1 << bit) != 0 { hi } else { lo };
-            m.transform_point3(DVec3::new(
+            DVec3::new(
                 pick(0, self.min.x, self.max.x),
                 pick(1, self.min.y, self.max.y),
                 pick(2, self.min.z, self.max.z),
-            ))
-        });
+            )
+        })
+    }
+
+    /// Bounds of this box's eight corners after a transform.
+    pub fn transformed(&self, m: &DMat4) -> Aabb {
+        let corners = self.corners().map(|c| m.transform_point3(c));
         Aabb::from_points(corners).expect("eight corners")
     }
 }

@@ -142,6 +142,13 @@ impl Camera {
         glam::dcamera::rh::view::look_at_mat4(self.position, self.target, self.up_direction())
     }
 
+    /// [`Camera::view_matrix`] without its translation, for positions already relative to the
+    /// camera (formed in f64, exact for scenes far from the origin).
+    pub(crate) fn view_rotation(&self) -> DMat4 {
+        let forward = self.target - self.position;
+        glam::dcamera::rh::view::look_at_mat4(DVec3::ZERO, forward, self.up_direction())
+    }
+
     /// `up` scaled to a largest component of 1: any finite non-zero length gives a direction
     /// (the view maths squares it, which overflowed past 1e154 and underflowed below 1e-154).
     fn up_direction(&self) -> DVec3 {

@@ -6,19 +6,23 @@
 //! itself: a plane scaled 10⁸ seen from 5 m was half black, at 10⁶ its light sat off centre.
 //! Such an object is drawn, for the frame, from a copy of its mesh in camera-relative world
 //! space whose triangles near the eye are cut in two across their longest edge until none is
-//! longer than [`MAX_TRIANGLE_REACH`] times its distance. Only those near the eye are cut,
-//! and a long, thin triangle only along its length, so a plane seen from close by takes a few
-//! hundred pieces however unevenly it is scaled; a frame makes at most
+//! longer than [`reach::MAX_TRIANGLE_REACH`] times its distance. Only those near the eye are
+//! cut, and a long, thin triangle only along its length, so a plane seen from close by takes
+//! a few hundred pieces however unevenly it is scaled; a frame makes at most
 //! [`MAX_SPLIT_TRIANGLES`] new ones, and past that draws the rest uncut.
+//!
+//! A triangle in view is also cut until it spans at most [`reach::MAX_TRIANGLE_SPAN_PX`]
+//! pixels: SwiftShader drew a plane seen through a 0.001° lens, or a 10⁻⁵-high orthographic
+//! view, unlit past about 2²⁷ pixels a triangle and not at all past 2²⁸, without an error.
 
 use glam::{DMat3, DMat4, DVec2, DVec3, DVec4, Vec2};
 
 use super::normal_matrix::normal_matrix;
-use super::{Aabb, Camera, Mesh, Object, Projection, Scene};
+use super::{Aabb, Mesh, Object, Scene};
 
-/// Largest ratio of a triangle's longest edge to its distance from the eye (at least the near
-/// plane's) that is drawn as it is: positions are then within about 10⁻³ of their distance.
-pub const MAX_TRIANGLE_REACH: f64 = 16384.0;
+mod reach;
+
+use reach::Reach;
 
 /// Most cuts in one triangle's line: two cuts leave its longest edge at most √3/2 as long, so
 /// 600 leave at most 2⁻⁶² of it, below any near plane that edge could need.
@@ -48,23 +52,28 @@ pub fn longest_edge(mesh: &Mesh) -> f64 {
         .fold(0.0, f64::max)
 }
 
-/// The objects of `scene` that need splitting this frame, each with its split mesh in
-/// camera-relative world space (drawn with the model matrix `translation(eye)`). `measure`
-/// gives an object's longest edge in object space and its world bounds (kept by the caller
-/// per mesh); objects whose longest edge and bounds clear the limit cost one test.
-pub fn split_objects(scene: &Scene, measure: impl Fn(&Object) -> (f64, Option<Aabb>)) -> Splits {
-    split_objects_within(scene, measure, MAX_SPLIT_TRIANGLES)
+/// The objects of `scene` that need splitting this frame of `frame` pixels (width, height),
+/// each with its split mesh in camera-relative world space (drawn with the model matrix
+/// `translation(eye)`). `measure` gives an object's longest edge in object space and its world
+/// bounds (kept by the caller per mesh); objects whose longest edge and bounds clear the
+/// limit cost one test.
+pub fn split_objects(
+    scene: &Scene,
+    frame: (u32, u32),
+    measure: impl Fn(&Object) -> (f64, Option<Aabb>),
+) -> Splits {
+    let reach = Reach::new(&scene.camera, frame);
+    split_objects_within(scene, &reach, measure, MAX_SPLIT_TRIANGLES)
 }
 
 /// [`split_objects`] with a budget of `budget` cuts.
 fn split_objects_within(
     scene: &Scene,
+    reach: &Reach,
     measure: impl Fn(&Object) -> (f64, Option<Aabb>),
     mut budget: usize,
 ) -> Splits {
-    let camera = &scene.camera;
-    let floor = closest_fragment(camera);
-    let eye = camera.position;
+    let eye = scene.camera.position;
     let mut out = Splits {
         meshes: Vec::new(),
         cut_short: None,
@@ -76,11 +85,12 @@ fn split_objects_within(
         let distance = bounds.map_or(f64::INFINITY, |b| {
             (b.min - eye).max(eye - b.max).max(DVec3::ZERO).length()
         });
-        if longest <= MAX_TRIANGLE_REACH * distance.max(floor) {
+        let in_view = bounds.is_some_and(|b| reach.may_see(b.corners().map(|c| c - eye)));
+        if longest <= reach.longest(distance, 1.0, in_view) {
             continue;
         }
         let cuts_left = budget;
-        let split = split_mesh(&object.mesh, &object.transform, eye, floor, &mut budget);
+        let split = split_mesh(&object.mesh, &object.transform, eye, reach, &mut budget);
         if let Some((mesh, cut_short)) = split {
             if cut_short {
                 out.cut_short.get_or_insert(i);
@@ -92,14 +102,6 @@ fn split_objects_within(
         }
     }
     out
-}
-
-/// How close to the eye a fragment can be: the near plane, or an orthographic view's height.
-fn closest_fragment(camera: &Camera) -> f64 {
-    match camera.projection {
-        Projection::Perspective { near, .. } => near,
-        Projection::Orthographic { height, near, .. } => height.max(near),
-    }
 }
 
 /// An upper bound of how much `m` lengthens a vector (3 × its largest entry bounds the
@@ -132,9 +134,9 @@ impl Vertex {
     }
 }
 
-/// Whether triangle `abc` (relative to the eye) is longer than the limit allows at its
-/// distance, measured in units of its largest coordinate so no square leaves f64.
-fn too_long(a: DVec3, b: DVec3, c: DVec3, floor: f64) -> bool {
+/// Whether triangle `abc` (relative to the eye) is longer than `reach` allows at its distance
+/// and place, measured in units of its largest coordinate so no square leaves f64.
+fn too_long(a: DVec3, b: DVec3, c: DVec3, reach: &Reach) -> bool {
     let unit = [a, b, c]
         .iter()
         .map(|v| v.abs().max_element())
@@ -142,6 +144,7 @@ fn too_long(a: DVec3, b: DVec3, c: DVec3, floor: f64) -> bool {
     if !(unit > 0.0 && unit.is_finite()) {
         return false;
     }
+    let in_view = reach.may_see([a, b, c]);
     let [a, b, c] = [a, b, c].map(|v| v / unit);
     let edge = a.distance(b).max(b.distance(c)).max(c.distance(a));
     let distance = closest_point(a, b, c).length();
@@ -150,7 +153,7 @@ fn too_long(a: DVec3, b: DVec3, c: DVec3, floor: f64) -> bool {
     } else {
         a.length().min(b.length()).min(c.length())
     };
-    edge > MAX_TRIANGLE_REACH * distance.max(floor / unit)
+    edge > reach.longest(distance, unit, in_view)
 }
 
 /// Triangle `[a, b, c]` turned (its winding kept) so that `a`–`b` is its longest edge,
@@ -182,7 +185,7 @@ fn split_mesh(
     mesh: &Mesh,
     transform: &DMat4,
     eye: DVec3,
-    floor: f64,
+    reach: &Reach,
     budget: &mut usize,
 ) -> Option<(Mesh, bool)> {
     let linear = DMat3::from_mat4(*transform);
@@ -219,7 +222,7 @@ fn split_mesh(
     }
     if !placed
         .iter()
-        .any(|[a, b, c]| too_long(a.p, b.p, c.p, floor))
+        .any(|[a, b, c]| too_long(a.p, b.p, c.p, reach))
     {
         return None;
     }
@@ -227,7 +230,7 @@ fn split_mesh(
     let mut stack: Vec<([Vertex; 3], u32)> = placed.into_iter().map(|t| (t, 0)).collect();
     let mut cut_short = false;
     while let Some(([a, b, c], depth)) = stack.pop() {
-        if depth < MAX_CUTS && too_long(a.p, b.p, c.p, floor) {
+        if depth < MAX_CUTS && too_long(a.p, b.p, c.p, reach) {
             if *budget == 0 {
                 cut_short = true;
             } else {
@@ -297,202 +300,4 @@ fn closest_point(a: DVec3, b: DVec3, c: DVec3) -> DVec3 {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn closest_point_finds_the_face_the_edge_and_the_corner() {
-        let (a, b, c) = (
-            DVec3::new(-1.0, -1.0, 2.0),
-            DVec3::new(3.0, -1.0, 2.0),
-            DVec3::new(-1.0, 3.0, 2.0),
-        );
-        assert_eq!(closest_point(a, b, c), DVec3::new(0.0, 0.0, 2.0));
-        let shifted = DVec3::new(5.0, 5.0, 0.0);
-        let edge = closest_point(a - shifted, b - shifted, c - shifted) + shifted;
-        assert!(
-            (edge - DVec3::new(1.0, 1.0, 2.0)).length() < 1e-12,
-            "{edge}"
-        );
-        let far = DVec3::new(-9.0, -9.0, 0.0);
-        assert_eq!(closest_point(a - far, b - far, c - far) + far, a);
-    }
-
-    fn quad() -> Mesh {
-        let mut b = crate::MeshBuilder::new();
-        b.quad(
-            glam::Vec3::new(-1.0, -1.0, 0.0),
-            glam::Vec3::new(1.0, -1.0, 0.0),
-            glam::Vec3::new(1.0, 1.0, 0.0),
-            glam::Vec3::new(-1.0, 1.0, 0.0),
-        );
-        b.build().unwrap()
-    }
-
-    /// [`split_mesh`] with the whole budget.
-    fn split(transform: &DMat4, eye: DVec3) -> Option<Mesh> {
-        let mut budget = MAX_SPLIT_TRIANGLES;
-        let split = split_mesh(&quad(), transform, eye, 0.1, &mut budget);
-        split.map(|(mesh, cut_short)| {
-            assert!(!cut_short);
-            mesh
-        })
-    }
-
-    /// Every triangle of `split` within the limit, all together `area`, normals +Z.
-    fn assert_split_within_the_limit(split: &Mesh, area: f64) {
-        let mut sum = 0.0;
-        for t in split.indices.chunks_exact(3) {
-            let [a, b, c] = [t[0], t[1], t[2]].map(|i| split.positions[i as usize].as_dvec3());
-            assert!(!too_long(a, b, c, 0.1));
-            sum += (b - a).cross(c - a).length() * 0.5;
-        }
-        assert!(
-            (sum / area - 1.0).abs() < 1e-4,
-            "area {sum:e}, not {area:e}"
-        );
-        assert!(split.normals.iter().all(|n| n.normalize() == glam::Vec3::Z));
-    }
-
-    #[test]
-    fn only_triangles_too_long_for_their_distance_are_split() {
-        let eye = DVec3::new(0.0, 0.0, 5.0);
-        let scaled = |s: f64| DMat4::from_scale(DVec3::new(s, s, 1.0));
-        assert!(split(&scaled(1e4), eye).is_none());
-        let mesh = split(&scaled(1e8), eye).unwrap();
-        let n = mesh.triangle_count();
-        assert!(n > 2 && n < 2000, "{n} triangles");
-        assert_split_within_the_limit(&mesh, 4e16);
-        // Seen from within its own plane, the near plane bounds how close a fragment can be.
-        assert!(split(&scaled(1e2), DVec3::ZERO).is_none());
-        assert!(split(&scaled(1e4), DVec3::ZERO).is_some());
-    }
-
-    /// Cut in four, a quad scaled 10¹⁰ one way made pieces by the million (gigabytes, then an
-    /// abort): every level cut its whole width into rows. At 10⁷ that made 20 258 pieces, and
-    /// 60 638 sheared; cut across the longest edge, 442 and 492.
-    #[test]
-    fn a_long_thin_or_sheared_quad_splits_into_few_triangles() {
-        let eye = DVec3::new(0.0, 0.0, 1.0);
-        let thin = DMat4::from_scale(DVec3::new(1e7, 1.0, 1.0));
-        let sheared = DMat4::from_cols(
-            glam::DVec4::new(1e7, 0.0, 0.0, 0.0),
-            glam::DVec4::new(1e7, 1.0, 0.0, 0.0),
-            glam::DVec4::Z,
-            glam::DVec4::W,
-        );
-        for (what, transform) in [("thin", thin), ("sheared", sheared)] {
-            let area = 4e7;
-            let mesh = split(&transform, eye).unwrap();
-            let n = mesh.triangle_count();
-            assert!(n > 2 && n < 2000, "{what}: {n} triangles");
-            assert_split_within_the_limit(&mesh, area);
-        }
-    }
-
-    /// Many objects each split near the eye: past the frame's budget the rest are drawn as
-    /// they are, and the first of them is named.
-    #[test]
-    fn a_frame_past_the_budget_names_the_first_object_left_unsplit() {
-        let mut scene = Scene::empty();
-        scene.camera = Camera::perspective(DVec3::new(0.0, 0.0, 5.0), DVec3::ZERO, 60.0, 0.1, 50.0);
-        let mesh = std::sync::Arc::new(quad());
-        let transform = DMat4::from_scale(DVec3::new(1e8, 1e8, 1.0));
-        for _ in 0..2000 {
-            scene.objects.push(Object {
-                mesh: mesh.clone(),
-                material: 0,
-                transform,
-            });
-        }
-        let measure = |o: &Object| {
-            let bounds = o.mesh.bounds().map(|b| b.transformed(&o.transform));
-            (longest_edge(&o.mesh), bounds)
-        };
-        let splits = split_objects(&scene, measure);
-        let first = splits.cut_short.expect("past the budget");
-        assert!(first > 0 && first < 2000, "{first}");
-        // Every object before it split whole; it and those after it as far as the budget went.
-        assert!(splits.meshes.iter().all(|(i, _)| *i <= first));
-        let added: usize = splits
-            .meshes
-            .iter()
-            .map(|(_, m)| m.triangle_count() - 2)
-            .sum();
-        assert_eq!(added, MAX_SPLIT_TRIANGLES);
-        // One object alone is within it.
-        scene.objects.truncate(1);
-        assert!(split_objects(&scene, measure).cut_short.is_none());
-        // A budget the first object spends exactly: a later one that needs no split is not
-        // named (it was, unchecked), one that needs a split is.
-        let cuts = split_objects(&scene, measure).meshes[0].1.triangle_count() - 2;
-        // Its bounds and longest edge pass the first test, its triangles not: a long one far
-        // off, a small one near the eye.
-        let (near, far) = (glam::Vec3::ZERO, glam::Vec3::new(1e5, 0.0, 0.0));
-        let positions = vec![
-            near,
-            near + glam::Vec3::X * 0.1,
-            near + glam::Vec3::Y * 0.1,
-            far,
-            far + glam::Vec3::X * 5e8,
-            far + glam::Vec3::Y,
-        ];
-        let mesh = Mesh::new(positions, vec![], vec![], vec![0, 1, 2, 3, 4, 5]).unwrap();
-        scene.objects.push(Object {
-            mesh: std::sync::Arc::new(mesh),
-            material: 0,
-            transform: DMat4::IDENTITY,
-        });
-        let splits = split_objects_within(&scene, measure, cuts);
-        assert_eq!(splits.cut_short, None);
-        assert_eq!(splits.meshes.len(), 1);
-        scene.objects[1] = scene.objects[0].clone();
-        assert_eq!(
-            split_objects_within(&scene, measure, cuts).cut_short,
-            Some(1)
-        );
-    }
-
-    #[test]
-    fn splits_stop_at_the_budget_and_say_so() {
-        let eye = DVec3::new(0.0, 0.0, 5.0);
-        let transform = DMat4::from_scale(DVec3::new(1e8, 1e8, 1.0));
-        let mut budget = 10;
-        let (mesh, cut_short) = split_mesh(&quad(), &transform, eye, 0.1, &mut budget).unwrap();
-        assert!(cut_short);
-        assert_eq!(budget, 0);
-        // Each cut adds one triangle to the quad's two.
-        assert_eq!(mesh.triangle_count(), 12);
-        let mut budget = MAX_SPLIT_TRIANGLES;
-        let (_, cut_short) = split_mesh(&quad(), &transform, eye, 0.1, &mut budget).unwrap();
-        assert!(!cut_short);
-        assert!(budget < MAX_SPLIT_TRIANGLES);
-    }
-
-    #[test]
-    fn a_mirrored_copy_keeps_its_front_faces_on_its_normals_side() {
-        let eye = DVec3::new(0.0, 0.0, 5.0);
-        for mirror in [1.0, -1.0] {
-            let transform = DMat4::from_scale(DVec3::new(1e8 * mirror, 1e8, 1.0));
-            let split = split(&transform, eye).unwrap();
-            // Drawn unmirrored: each winding must face the way its normals do.
-            for t in split.indices.chunks_exact(3) {
-                let [a, b, c] = [t[0], t[1], t[2]].map(|i| split.positions[i as usize]);
-                let winding = (b - a).cross(c - a).as_dvec3();
-                let normal = split.normals[t[0] as usize].as_dvec3();
-                assert!(winding.dot(normal) > 0.0, "mirror {mirror}: {winding}");
-            }
-        }
-    }
-
-    #[test]
-    fn coordinates_whose_squares_overflow_still_measure() {
-        let [a, b, c] = [
-            DVec3::new(-1e200, -1e200, -5e190),
-            DVec3::new(1e200, -1e200, -5e190),
-            DVec3::new(0.0, 1e200, -5e190),
-        ];
-        assert!(too_long(a, b, c, 1.0));
-        assert!(!too_long(a * 1e-20, b * 1e-20, c * 1e-20, 1e180));
-    }
-}
+mod tests;

@@ -273,6 +273,51 @@ fn a_triangle_huge_beside_the_camera_renders_as_the_f64_model_says() {
     });
 }
 
+/// A plane seen through the narrowest lens a camera may have, or in an orthographic view
+/// 10⁻⁶ high, spans 10⁸–10⁹ pixels a triangle. SwiftShader drew such triangles unlit past
+/// about 2²⁷ pixels and not at all past 2²⁸, with no error (llvmpipe drew them): the triangles
+/// in view are now split for the frame, and the picture is the f64 model's on every
+/// implementation.
+#[test]
+fn a_triangle_spanning_a_billion_pixels_renders_as_the_f64_model_says() {
+    let (eye, target) = (DVec3::new(0.3, 0.2, 5.0), DVec3::new(0.3, 0.2, 0.0));
+    let mut orthographic = lit_plane();
+    orthographic.camera = Camera {
+        projection: manylight::Projection::Orthographic {
+            height: 1e-6,
+            near: 0.0,
+            far: 50.0,
+        },
+        ..Camera::perspective(eye, target, 60.0, 0.1, 50.0)
+    };
+    let mut narrow = lit_plane();
+    narrow.objects[0].transform = DMat4::from_scale(DVec3::new(100.0, 100.0, 1.0));
+    narrow.camera = Camera::perspective(eye, target, 0.001, 0.1, 50.0);
+    each_device(|device, gpu| {
+        let caps = gpu.r().caps().clone();
+        for (what, s) in [("orthographic 1e-6", &orthographic), ("0.001°", &narrow)] {
+            for method in methods(gpu) {
+                let img = render(gpu, method, s);
+                let (e, at, n) = max_oracle_error(&img, s, Encoding::Srgb, &caps);
+                let pixels = (img.width() * img.height()) as usize;
+                assert!(
+                    n == pixels,
+                    "{device} {method} {what}: {n} of {pixels} compared"
+                );
+                assert!(
+                    mean(&img) > 20.0,
+                    "{device} {method} {what}: the lit plane came out dark"
+                );
+                let bound = f64_model_bound(device);
+                assert!(
+                    e <= bound,
+                    "{device} {method} {what}: {e:.1} / 255 off the f64 model at {at:?}"
+                );
+            }
+        }
+    });
+}
+
 /// Past a frame's budget of split triangles (many huge objects beside the camera) the rest
 /// are drawn unsplit, with one warning a renderer naming the first of them; the frame still
 /// draws the plane.
