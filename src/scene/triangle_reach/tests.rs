@@ -273,28 +273,17 @@ fn triangles_in_view_are_cut_to_the_pixels_they_may_span() {
 fn splits_stop_at_the_budget_and_say_so() {
     let eye = DVec3::new(0.0, 0.0, 5.0);
     let transform = DMat4::from_scale(DVec3::new(1e8, 1e8, 1.0));
+    let reach = Reach::distance_only(0.1);
+    let split_within =
+        |budget: &mut usize| split_mesh(&quad(), &transform, eye, &reach, budget).expect("a split");
     let mut budget = 10;
-    let (mesh, cut_short) = split_mesh(
-        &quad(),
-        &transform,
-        eye,
-        &Reach::distance_only(0.1),
-        &mut budget,
-    )
-    .unwrap();
+    let (mesh, cut_short) = split_within(&mut budget);
     assert!(cut_short);
     assert_eq!(budget, 0);
     // Each cut adds one triangle to the quad's two.
     assert_eq!(mesh.triangle_count(), 12);
     let mut budget = MAX_SPLIT_TRIANGLES;
-    let (_, cut_short) = split_mesh(
-        &quad(),
-        &transform,
-        eye,
-        &Reach::distance_only(0.1),
-        &mut budget,
-    )
-    .unwrap();
+    let (_, cut_short) = split_within(&mut budget);
     assert!(!cut_short);
     assert!(budget < MAX_SPLIT_TRIANGLES);
 }
