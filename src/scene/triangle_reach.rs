@@ -85,8 +85,11 @@ fn split_objects_within(
         let distance = bounds.map_or(f64::INFINITY, |b| {
             (b.min - eye).max(eye - b.max).max(DVec3::ZERO).length()
         });
-        let in_view = bounds.is_some_and(|b| reach.may_see(b.corners().map(|c| c - eye)));
-        if longest <= reach.longest(distance, 1.0, in_view) {
+        // The view test only where the object passes the limit out of view but not in it.
+        let seen = || bounds.is_some_and(|b| reach.may_see(b.corners().map(|c| c - eye)));
+        if longest <= reach.longest(distance, 1.0, true)
+            || longest <= reach.longest(distance, 1.0, false) && !seen()
+        {
             continue;
         }
         let cuts_left = budget;
@@ -144,8 +147,8 @@ fn too_long(a: DVec3, b: DVec3, c: DVec3, reach: &Reach) -> bool {
     if !(unit > 0.0 && unit.is_finite()) {
         return false;
     }
-    let in_view = reach.may_see([a, b, c]);
-    let [a, b, c] = [a, b, c].map(|v| v / unit);
+    let placed = [a, b, c];
+    let [a, b, c] = placed.map(|v| v / unit);
     let edge = a.distance(b).max(b.distance(c)).max(c.distance(a));
     let distance = closest_point(a, b, c).length();
     let distance = if distance.is_finite() {
@@ -153,7 +156,9 @@ fn too_long(a: DVec3, b: DVec3, c: DVec3, reach: &Reach) -> bool {
     } else {
         a.length().min(b.length()).min(c.length())
     };
-    edge > reach.longest(distance, unit, in_view)
+    // The view test only where the triangle passes the limit out of view but not in it.
+    edge > reach.longest(distance, unit, false)
+        || edge > reach.longest(distance, unit, true) && reach.may_see(placed)
 }
 
 /// Triangle `[a, b, c]` turned (its winding kept) so that `a`–`b` is its longest edge,
