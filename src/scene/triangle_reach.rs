@@ -85,11 +85,8 @@ fn split_objects_within(
         let distance = bounds.map_or(f64::INFINITY, |b| {
             (b.min - eye).max(eye - b.max).max(DVec3::ZERO).length()
         });
-        // The view test only where the object passes the limit out of view but not in it.
         let seen = || bounds.is_some_and(|b| reach.may_see(b.corners().map(|c| c - eye)));
-        if longest <= reach.longest(distance, 1.0, true)
-            || longest <= reach.longest(distance, 1.0, false) && !seen()
-        {
+        if !reach.exceeded(longest, distance, 1.0, seen) {
             continue;
         }
         let cuts_left = budget;
@@ -156,9 +153,7 @@ fn too_long(a: DVec3, b: DVec3, c: DVec3, reach: &Reach) -> bool {
     } else {
         a.length().min(b.length()).min(c.length())
     };
-    // The view test only where the triangle passes the limit out of view but not in it.
-    edge > reach.longest(distance, unit, false)
-        || edge > reach.longest(distance, unit, true) && reach.may_see(placed)
+    reach.exceeded(edge, distance, unit, || reach.may_see(placed))
 }
 
 /// Triangle `[a, b, c]` turned (its winding kept) so that `a`–`b` is its longest edge,

@@ -69,9 +69,23 @@ impl Reach {
         }
     }
 
+    /// Whether an edge of length `edge` at `distance` from the eye (both in units of `unit`) is
+    /// past the limit; `seen` (whether it may lie in view, a few matrix products) is asked
+    /// only where the answer turns on it.
+    pub(super) fn exceeded(
+        &self,
+        edge: f64,
+        distance: f64,
+        unit: f64,
+        seen: impl FnOnce() -> bool,
+    ) -> bool {
+        edge > self.longest(distance, unit, false)
+            || edge > self.longest(distance, unit, true) && seen()
+    }
+
     /// The longest edge allowed at `distance` from the eye (both in units of `unit`), for a
     /// triangle in view or not.
-    pub(super) fn longest(&self, distance: f64, unit: f64, in_view: bool) -> f64 {
+    fn longest(&self, distance: f64, unit: f64, in_view: bool) -> f64 {
         let distance = distance.max(self.floor / unit);
         let mut longest = MAX_TRIANGLE_REACH * distance;
         if in_view {
@@ -87,9 +101,6 @@ impl Reach {
     /// Whether some of the eye-relative `points` may lie in view (within [`GUARD`] frames of
     /// it): false when all lie beyond one side of the frame, or behind the near plane.
     pub(super) fn may_see<const N: usize>(&self, points: [DVec3; N]) -> bool {
-        if self.in_view_per_distance.is_infinite() && self.in_view_at_most.is_infinite() {
-            return false;
-        }
         let clip = points.map(|p| self.clip * p.extend(1.0));
         let beyond = |side: fn(DVec4) -> f64| clip.iter().all(|&c| side(c) < 0.0);
         !(beyond(|c| c.x + GUARD * c.w)
