@@ -11,8 +11,7 @@ pub const MAX_TRIANGLE_REACH: f64 = 16384.0;
 
 /// Most pixels a triangle in view may span at its closest point to the eye: SwiftShader lost
 /// a triangle's lights past about 2²⁷ pixels and the triangle past 2²⁸; this leaves eight
-/// times less. At a 60° field of view it is the looser limit up to 1 182 rows of frame
-/// (2²⁴ · 2 tan 30° / 16 384); at 2 160 rows it cuts at 8 970 times the distance.
+/// times less. At a 60° field of view it is the looser limit up to 1 182 rows of frame.
 pub const MAX_TRIANGLE_SPAN_PX: f64 = (1u64 << 24) as f64;
 
 /// How far beyond the frame's edges, in frame sizes, a triangle counts as in view.
