@@ -1339,11 +1339,14 @@ fn a_black_picture_is_warned_of_with_its_likely_causes() {
     };
     let msg = run("away.json");
     assert!(
-        msg.contains("the picture is black") && msg.contains("sees none of the geometry"),
+        msg.contains("the picture is black") && msg.contains("looks away from all the geometry"),
         "{msg}"
     );
     let msg = run("unlit.json");
-    assert!(msg.contains("nothing lights it"), "{msg}");
+    assert!(
+        msg.contains("nothing lights it") && !msg.contains("looks away"),
+        "{msg}"
+    );
     let msg = run("plane");
     assert!(!msg.contains("the picture is black"), "{msg}");
 }

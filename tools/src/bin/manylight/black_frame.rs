@@ -39,19 +39,52 @@ pub fn warning(image: &image::RgbaImage, scene: &Scene) -> Option<String> {
     }
     let camera = &scene.camera;
     let (near, far) = camera.near_far();
-    causes.push(format!(
-        "the camera (at {:?} looking at {:?}, near {near:?}, far {far:?}) sees none of the \
-         geometry (from {:?} to {:?})",
+    let where_ = format!(
+        "the camera (at {:?} looking at {:?}, near {near:?}, far {far:?}) ",
         camera.position.to_array(),
         camera.target.to_array(),
-        bounds.min.to_array(),
-        bounds.max.to_array()
+    );
+    let (min, max) = (bounds.min.to_array(), bounds.max.to_array());
+    let aspect = f64::from(image.width().max(1)) / f64::from(image.height().max(1));
+    if !box_may_be_in_view(camera, &bounds, aspect) {
+        // Nothing else matters: no object can be in view.
+        return Some(format!(
+            "the picture is black: {where_}looks away from all the geometry (from {min:?} to \
+             {max:?})"
+        ));
+    }
+    causes.push(format!(
+        "{where_}sees only the space between the objects (their bounds, from {min:?} to \
+         {max:?}, reach into its view)"
     ));
     causes.push("every surface in view is fully transparent, cut out or black".into());
+    causes.push(
+        "the GL implementation drew nothing (try `--method forward`, or another one with \
+         `--gles-lib`)"
+            .into(),
+    );
     Some(format!(
         "the picture is black; it may be that {}",
         causes.join(", or ")
     ))
+}
+
+/// Whether a world-space box may lie in the camera's view at `aspect`: false only where all
+/// eight corners lie beyond one of the view's six planes (clip space, in f64).
+fn box_may_be_in_view(
+    camera: &manylight::scene::Camera,
+    bounds: &manylight::scene::Aabb,
+    aspect: f64,
+) -> bool {
+    let clip = camera.projection_matrix(aspect) * camera.view_matrix();
+    let corners = bounds.corners().map(|c| clip * c.extend(1.0));
+    let outside = |beyond: &dyn Fn(&glam::DVec4) -> bool| corners.iter().all(beyond);
+    !(outside(&|c| c.x < -c.w)
+        || outside(&|c| c.x > c.w)
+        || outside(&|c| c.y < -c.w)
+        || outside(&|c| c.y > c.w)
+        || outside(&|c| c.z < -c.w)
+        || outside(&|c| c.z > c.w))
 }
 
 #[cfg(test)]
@@ -101,5 +134,57 @@ mod tests {
         assert!(!text.contains("outer_deg"), "{text}");
         image.put_pixel(3, 1, image::Rgba([0, 0, 1, 255]));
         assert_eq!(warning(&image, &scene), None);
+    }
+
+    /// The camera is named the cause, alone, only where no object can be in its view; where
+    /// the geometry's bounds reach into the view it stays one possible cause among the others.
+    #[test]
+    fn the_camera_is_blamed_alone_only_where_it_looks_away_from_the_bounds() {
+        let mut scene = manylight::builtin_scene("plane", None).unwrap();
+        let image = image::RgbaImage::new(16, 9);
+        let looking_at = |scene: &Scene| warning(&image, scene).expect("black");
+        let text = looking_at(&scene);
+        assert!(
+            text.contains("space between the objects")
+                && text.contains("transparent")
+                && text.contains("drew nothing"),
+            "{text}"
+        );
+        let bounds = scene.bounds().unwrap();
+        // Looking up from above the plane, then along it from far beside it, then with the
+        // plane past the far plane: each misses the bounds through another of the view's
+        // planes.
+        assert_eq!(bounds.size().z, 0.0, "the plane lies across Z");
+        let eye = bounds.center() + glam::DVec3::Z;
+        let beside = eye + glam::DVec3::X * bounds.size().x * 10.0;
+        let views = [
+            (eye, eye + glam::DVec3::Z, glam::DVec3::Y),
+            (beside, beside + glam::DVec3::Y, glam::DVec3::Z),
+        ];
+        for (position, target, up) in views {
+            scene.camera.position = position;
+            scene.camera.target = target;
+            scene.camera.up = up;
+            let text = looking_at(&scene);
+            assert!(
+                text.contains("looks away from all the geometry") && !text.contains("transparent"),
+                "{position} → {target}: {text}"
+            );
+        }
+        scene.camera.position = bounds.center() + glam::DVec3::Z * 1e4;
+        scene.camera.target = bounds.center();
+        scene.camera.up = glam::DVec3::Y;
+        scene.camera.projection = manylight::scene::Projection::Perspective {
+            fov_y_deg: 60.0,
+            near: 1.0,
+            far: 100.0,
+        };
+        assert!(looking_at(&scene).contains("looks away"));
+        scene.camera.projection = manylight::scene::Projection::Perspective {
+            fov_y_deg: 60.0,
+            near: 1.0,
+            far: 2e4,
+        };
+        assert!(looking_at(&scene).contains("space between the objects"));
     }
 }
