@@ -207,7 +207,12 @@ pub(crate) fn shade_object<P: GeometryProgram>(
         ShaderFeatures::default()
     } else {
         let units = dev.caps().max_texture_image_units;
-        super::maps::features(material, &object.mesh, units)
+        let inputs = super::maps::features(material, &object.mesh, units);
+        // Only a light reads the shading normal: without one the map would be compiled out.
+        let shades = !ctx.features.has(ShaderFeatures::NO_LIGHTS)
+            || ctx.features.has(ShaderFeatures::DIRECTIONAL);
+        let mapped = inputs.has(ShaderFeatures::NORMAL_MAP) && shades;
+        inputs.with(ShaderFeatures::NORMAL_MAP, mapped)
     };
     let features = ShaderFeatures(ctx.features.0 | inputs.0)
         .with(ShaderFeatures::TEXTURE, texture.is_some())

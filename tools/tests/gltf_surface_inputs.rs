@@ -188,6 +188,11 @@ fn a_normal_map_tilts_the_shading_normal_with_file_and_generated_tangents() {
         );
         check_every_method("normal map", &s, &want, 3.0);
     }
+    // Without a light nothing reads the normal: ambient only, as without the map (the
+    // ambient-only variant asked for the map's uniforms, which its compiler had dropped, and
+    // failed to link).
+    let (s, _) = scene_of(&generated, Vec::new(), 0.3);
+    check_every_method("normal map without lights", &s, &oracle(&s, &flat), 3.0);
     // Seen from behind, with the light on the eye's side: the back face's shading normal is
     // the front's reversed whole (glTF 2.0 §3.9.5); mapped in a frame flipped with the
     // normal, the tilt along the tangent would be mirrored.
