@@ -36,19 +36,21 @@ struct Loaded {
 }
 
 impl Loaded {
-    /// What `scene` holds from `first_object` and `first_material` on; `relative` gives an
-    /// object's transform relative to the placing one and `checked` whether to keep bounds.
+    /// What `scene` holds from `first_object` and `first_material` on; `relative` gives the
+    /// model's `i`th object's transform relative to the placing one and `checked` whether to
+    /// keep bounds.
     fn record(
         scene: &Scene,
         (first_object, first_material): (usize, usize),
-        relative: impl Fn(&Object) -> DMat4,
+        relative: impl Fn(usize, &Object) -> DMat4,
         checked: bool,
     ) -> Loaded {
         // Bounds once a mesh: a file may place one large mesh many times.
         let mut bounds = HashMap::new();
         let objects = scene.objects[first_object..]
             .iter()
-            .map(|o| {
+            .enumerate()
+            .map(|(i, o)| {
                 let b = checked
                     .then(|| {
                         *bounds
@@ -56,7 +58,12 @@ impl Loaded {
                             .or_insert_with(|| o.mesh.bounds())
                     })
                     .flatten();
-                (o.mesh.clone(), o.material - first_material, relative(o), b)
+                (
+                    o.mesh.clone(),
+                    o.material - first_material,
+                    relative(i, o),
+                    b,
+                )
             })
             .collect();
         Loaded {
@@ -212,7 +219,7 @@ impl ModelCache {
         let report = loaded?;
         self.share(scene, first.0, first.1, key.as_ref().map(|k| &k.0), true);
         if let Some(key) = key {
-            let mut loaded = Loaded::record(scene, first, |o| o.transform, false);
+            let mut loaded = Loaded::record(scene, first, |_, o| o.transform, false);
             loaded.uncoloured_at = (!recolour).then_some(first.1);
             self.obj.insert(key, loaded);
         }
@@ -236,10 +243,11 @@ impl ModelCache {
         Err(Loader::Obj.left_out(path))
     }
 
-    /// Places a glTF file with `transform`. A file without lights (suns included) or cameras
-    /// is read once, at the identity, and placed from that; one with them is read for each
-    /// reference (they depend on the transform), sharing the meshes and textures of earlier
-    /// reads. Returns the load's warnings and the first camera the file instances.
+    /// Places a glTF file with `transform`, reading it at its first reference. A file without
+    /// lights (suns included) or cameras is placed from that read at every later one; one
+    /// with them is read again for each reference (they depend on the transform), sharing the
+    /// meshes and textures of earlier reads. Returns the load's warnings and the first camera
+    /// the file instances.
     #[cfg(feature = "gltf")]
     pub fn place_gltf(
         &mut self,
@@ -250,50 +258,15 @@ impl ModelCache {
         transform_field: &str,
     ) -> Result<(LoadReport, Option<Camera>), SceneError> {
         let key = std::fs::canonicalize(path).ok();
-        if let Some(k) = &key {
-            if !self.gltf.contains_key(k) {
-                let mut alone = Scene::empty();
-                let budget_before = self.texture_budget;
-                let read = super::gltf::load_into(
-                    &mut alone,
-                    path,
-                    DMat4::IDENTITY,
-                    transform_field,
-                    &self.options,
-                    &mut self.texture_budget,
-                );
-                let entry = match read {
-                    // A sun's direction turns with the placement as a lamp's position moves.
-                    Ok(read)
-                        if alone.lights.is_empty()
-                            && alone.directional_lights.is_empty()
-                            && read.camera.is_none() =>
-                    {
-                        self.share(&mut alone, 0, 0, Some(k), true);
-                        let loaded = Loaded::record(&alone, (0, 0), |o| o.transform, true);
-                        Some((loaded, read.report))
-                    }
-                    // Read again per reference below: this read's textures are dropped.
-                    _ => {
-                        self.texture_budget = budget_before;
-                        None
-                    }
-                };
-                let (loaded, report) = entry.unzip();
-                self.gltf.insert(k.clone(), loaded);
-                if let Some(Some(loaded)) = self.gltf.get_mut(k) {
-                    loaded.place(scene, transform, recolour, transform_field)?;
-                    return Ok((report.unwrap_or_default(), None));
-                }
-            } else if let Some(Some(loaded)) = self.gltf.get_mut(k) {
-                loaded.place(scene, transform, recolour, transform_field)?;
-                return Ok((LoadReport::default(), None));
-            }
+        if let Some(Some(loaded)) = key.as_ref().and_then(|k| self.gltf.get_mut(k)) {
+            loaded.place(scene, transform, recolour, transform_field)?;
+            return Ok((LoadReport::default(), None));
         }
+        let first_read = key.as_ref().is_some_and(|k| !self.gltf.contains_key(k));
         // Read again for this reference: bounded in total (the file, its buffers and images),
         // so a scene file of many references to a large file with lights cannot keep the load
         // busy for hours.
-        if self.reread_bytes > MAX_REREAD_BYTES {
+        if !first_read && self.reread_bytes > MAX_REREAD_BYTES {
             return Err(SceneError::GltfUnsupported {
                 path: path.to_path_buf(),
                 reason: format!(
@@ -323,7 +296,7 @@ impl ModelCache {
         } else {
             &mut self.texture_budget
         };
-        let read = super::gltf::load_into(
+        let read = super::gltf::load_placed_into(
             scene,
             path,
             transform,
@@ -331,11 +304,23 @@ impl ModelCache {
             &self.options,
             budget,
         );
-        self.reread_bytes = self
-            .reread_bytes
-            .saturating_add(work_so_far().wrapping_sub(read_before));
-        let mut loaded = read?;
+        let work = work_so_far().wrapping_sub(read_before);
+        let (mut loaded, placement) = read?;
         let charged = kept_earlier.is_none();
+        if let (true, Some(k)) = (first_read, &key) {
+            if !placement.lights_or_camera {
+                // Placed from this read from now on: its objects' own transforms are kept.
+                self.share(scene, first_object, first_material, Some(k), true);
+                let first = (first_object, first_material);
+                let relative = |i: usize, _: &Object| placement.relative[i];
+                let mut kept = Loaded::record(scene, first, relative, true);
+                kept.uncoloured_at = (!recolour).then_some(first_material);
+                self.gltf.insert(k.clone(), Some(kept));
+                return Ok((loaded.report, None));
+            }
+            self.gltf.insert(k.clone(), None);
+        }
+        self.reread_bytes = self.reread_bytes.saturating_add(work);
         if let (true, Some(k)) = (charged, &key) {
             let kept = left_before.saturating_sub(self.texture_budget.left());
             self.reread_textures.insert(k.clone(), kept);
@@ -661,6 +646,55 @@ mod tests {
             assert_eq!(t.sampling, want, "material {i}");
             assert!(Arc::ptr_eq(&t.image, &textures[0].image), "material {i}");
         }
+    }
+
+    /// Each reference reads a file at most once: a lit one once each (it was read at the
+    /// identity first, then again at its transform), one without lights only at its first,
+    /// whose objects later references place as reading the file there would.
+    #[test]
+    fn a_reference_reads_a_file_at_most_once_and_an_unlit_one_only_at_its_first() {
+        let dir = tempfile::tempdir().unwrap();
+        let lit = lit_textured_gltf(dir.path(), "lit.gltf");
+        let unlit = dir.path().join("unlit.gltf");
+        let mut doc: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&lit).unwrap()).unwrap();
+        doc["nodes"][0] = serde_json::json!({"mesh": 0});
+        std::fs::write(&unlit, doc.to_string()).unwrap();
+        let size = |path: &Path| std::fs::metadata(path).unwrap().len();
+        let at = |x: f64| {
+            DMat4::from_translation(glam::DVec3::new(x, 1.0, 0.0))
+                * DMat4::from_rotation_z(x)
+                * DMat4::from_scale(glam::DVec3::splat(x))
+        };
+        let mut cache = ModelCache::new(LoadOptions::default());
+        let mut scene = Scene::empty();
+        let mut reads = |path: &Path, x: f64| {
+            let before = crate::scene::input::bytes_read();
+            let field = "objects[0].transform";
+            cache
+                .place_gltf(&mut scene, path, at(x), false, field)
+                .unwrap();
+            crate::scene::input::bytes_read() - before
+        };
+        assert_eq!([reads(&lit, 2.0), reads(&lit, 3.0)], [size(&lit); 2]);
+        assert_eq!([reads(&unlit, 2.0), reads(&unlit, 3.0)], [size(&unlit), 0]);
+        assert_eq!(scene.lights.len(), 2);
+        let mut read_there = Scene::empty();
+        let field = "transform";
+        let options = LoadOptions::default();
+        let mut budget = TextureBudget::default();
+        crate::scene::gltf::load_into(
+            &mut read_there,
+            &unlit,
+            at(3.0),
+            field,
+            &options,
+            &mut budget,
+        )
+        .unwrap();
+        let placed = scene.objects.last().unwrap();
+        assert_eq!(placed.transform, read_there.objects[0].transform);
+        assert_ne!(placed.transform, scene.objects[2].transform);
     }
 
     #[test]

@@ -111,7 +111,7 @@ pub(crate) fn load_source(
     }
     let mut scene = Scene::empty();
     let mut textures = TextureBudget::default();
-    let mut loaded = load_source_into(
+    let (mut loaded, _) = load_source_into(
         &mut scene,
         source,
         DMat4::IDENTITY,
@@ -171,6 +171,29 @@ pub fn load_into(
 ) -> Result<GltfLoad, SceneError> {
     let source = Source::File(path);
     load_source_into(scene, source, transform, transform_field, options, textures)
+        .map(|(load, _)| load)
+}
+
+/// How a load placed the file, for placing it again without reading it.
+pub(crate) struct Placement {
+    /// Each object's transform before the placing one, in the order the objects were added.
+    pub relative: Vec<DMat4>,
+    /// Whether the file instances a light or a camera (one valid in the file's own space):
+    /// those move with the placing transform, so another placement reads the file again.
+    pub lights_or_camera: bool,
+}
+
+/// [`load_into`], with how the file was placed.
+pub(crate) fn load_placed_into(
+    scene: &mut Scene,
+    path: &Path,
+    transform: DMat4,
+    transform_field: &str,
+    options: &LoadOptions,
+    textures: &mut TextureBudget,
+) -> Result<(GltfLoad, Placement), SceneError> {
+    let source = Source::File(path);
+    load_source_into(scene, source, transform, transform_field, options, textures)
 }
 
 /// Where a glTF's bytes come from.
@@ -200,7 +223,7 @@ fn load_source_into(
     transform_field: &str,
     options: &LoadOptions,
     textures: &mut TextureBudget,
-) -> Result<GltfLoad, SceneError> {
+) -> Result<(GltfLoad, Placement), SceneError> {
     if !transform.is_finite() {
         return Err(SceneError::invalid(transform_field, "must be finite"));
     }
@@ -257,10 +280,15 @@ fn load_source_into(
     for w in imported.warnings {
         report.warn(format!("{}: {w}", path.display()));
     }
-    Ok(GltfLoad {
+    let load = GltfLoad {
         report,
         camera: imported.camera,
-    })
+    };
+    let placement = Placement {
+        relative: imported.relative,
+        lights_or_camera: imported.lights_or_camera,
+    };
+    Ok((load, placement))
 }
 
 /// A JSON error said by its kind and place: serde's own text quotes the offending value,
@@ -322,6 +350,10 @@ struct Imported {
     directional_lights: Vec<DirectionalLight>,
     camera: Option<Camera>,
     warnings: Vec<String>,
+    /// Each object's transform before the placing one.
+    relative: Vec<DMat4>,
+    /// A light or camera valid in the file's own space was instanced.
+    lights_or_camera: bool,
 }
 
 /// Everything is converted and checked in the file's own space first (faults are the file's),
@@ -394,6 +426,8 @@ fn import(
         directional_lights: Vec::new(),
         camera: None,
         warnings: Vec::new(),
+        relative: Vec::new(),
+        lights_or_camera: false,
     };
     let mut camera_nodes = 0;
     let mut mesh_count = 0;
@@ -468,6 +502,7 @@ fn import(
                     material,
                     transform: world,
                 });
+                out.relative.push(p.world);
             }
         }
         if let Some(light) = node.light() {
@@ -489,6 +524,7 @@ fn import(
             match lights::convert(&light, &p.world, &lfield)? {
                 // Checked in the file's space; now placed.
                 lights::Converted::Light(_) | lights::Converted::Directional(_) => {
+                    out.lights_or_camera = true;
                     match lights::convert(&light, &world, &lfield).map_err(placing)? {
                         lights::Converted::Light(l) => out.lights.push(l),
                         lights::Converted::Directional(l) => out.directional_lights.push(l),
@@ -506,6 +542,7 @@ fn import(
                 let cfield = format!("{field} (cameras[{}])", cam.index());
                 let converted =
                     camera::convert(&document, &cam, &p.world, &cfield).and_then(|_| {
+                        out.lights_or_camera = true;
                         camera::convert(&document, &cam, &world, &cfield)
                             .map_err(|e| format!("placing {e}"))
                     });
