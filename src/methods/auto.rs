@@ -56,7 +56,8 @@ fn supported(caps: &crate::gl::Caps) -> Support {
     }
 }
 
-/// Up to this many visible lights, plain forward is chosen.
+/// Up to this many lights, plain forward is chosen: its loop runs every light, in view or not
+/// (a frame with none in view is drawn ambient-only, whatever the method).
 pub const FORWARD_UP_TO: usize = 32;
 
 /// The methods auto may draw a frame with on a context with `caps`: forward always, clustered

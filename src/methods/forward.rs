@@ -13,7 +13,6 @@ use super::forward_cap::CapView;
 use super::geometry::{self, GeometryProgram, UNIT_METHOD};
 use super::uniforms::{self, LightData, Surface, Transforms};
 use super::{FrameContext, MethodDesc, MethodStats, ShaderFeatures, ShadingMethod, Support};
-use crate::cluster::grid::{GridProjection, ViewVolume};
 use crate::cluster::pack::{pack_lights_into, LightEncoding, PackedLights, DATA_TEXTURE_WIDTH};
 use crate::cluster::view_light::GpuLight;
 use crate::gl::program::{Resolver, Uniform, UniformSet};
@@ -229,8 +228,7 @@ impl ShadingMethod for Forward {
 /// RGBA8 records' fixed-point range is then set by the lights that do. Forward still loops
 /// over it, so its counts stay every light.
 fn darken_unseen_into(ctx: &FrameContext, lights: &[GpuLight], seen: &mut Vec<GpuLight>) {
-    let projection = GridProjection::from_matrix(&ctx.projection.as_dmat4());
-    let volume = ViewVolume::new(projection, ctx.near, ctx.content_far);
+    let volume = ctx.view_volume();
     seen.clear();
     seen.extend(lights.iter().map(|l| {
         if volume.excludes(l.position.as_dvec3(), f64::from(l.radius)) {

@@ -21,6 +21,7 @@ pub mod maps;
 pub mod tiled;
 pub mod uniforms;
 
+use crate::cluster::grid::{GridProjection, ViewVolume};
 use crate::cluster::view_light::GpuLight;
 use crate::gl::program::ProgramCache;
 use crate::gl::{Caps, Device, EsVersion};
@@ -105,6 +106,23 @@ pub struct FrameContext<'a> {
     /// A frame of [`Renderer::warm_up`](crate::Renderer::warm_up): a pass with nothing to draw
     /// this time (a deferred proxy no light takes) still builds its program.
     pub warm_up: bool,
+}
+
+impl FrameContext<'_> {
+    /// The view from the near plane to the farthest geometry: a light whose sphere lies wholly
+    /// outside it lights no pixel of the frame.
+    pub fn view_volume(&self) -> ViewVolume {
+        let projection = GridProjection::from_matrix(&self.projection.as_dmat4());
+        ViewVolume::new(projection, self.near, self.content_far)
+    }
+
+    /// How many of the frame's lights reach into [`FrameContext::view_volume`], counted up to
+    /// `at_most` (the count stops there, so a frame of many lights in view pays little).
+    pub fn lights_in_view(&self, at_most: usize) -> usize {
+        let volume = self.view_volume();
+        let reaches = |l: &&GpuLight| !volume.excludes(l.position.as_dvec3(), f64::from(l.radius));
+        self.lights.iter().filter(reaches).take(at_most).count()
+    }
 }
 
 /// Which grid a tiled or clustered frame used, and why.

@@ -341,13 +341,14 @@ impl Renderer {
             }
             t.begin(&self.dev, serial, options.wait_for_gpu);
         }
-        // No lights: no assignment, no uploads, the light loop compiled out — whatever the
-        // method (a scene pays only for what it has).
+        // No lights, or none that reaches the view: no assignment, no uploads, the light loop
+        // compiled out — whatever the method (a scene pays only for what it has in view).
         let method = match &mut self.reaching_pass {
             Some(pass) if reaching_pass => pass,
             _ => &mut self.method,
         };
-        let rendered = if self.lights.is_empty() {
+        let lit = ctx.lights_in_view(1) > 0;
+        let rendered = if !lit {
             method.skip_frame(&self.dev);
             methods::forward::draw_ambient_only(&mut ctx)
         } else {
@@ -414,9 +415,11 @@ impl Renderer {
         stats.lights = LightStats {
             total: scene.lights.len(),
             active: self.lights.len(),
-            visible: method_stats
-                .assign
-                .map_or(self.lights.len(), |a| a.visible_lights),
+            visible: match method_stats.assign {
+                _ if !lit => 0,
+                Some(a) => a.visible_lights,
+                None => self.lights.len(),
+            },
             overflowed: assignment.overflowed_lights + method_stats.dropped_lights,
             encoding: features.light_encoding(),
         };

@@ -112,7 +112,8 @@ pub struct LightStats {
     #[serde(rename = "active_lights")]
     pub active: usize,
     /// Lights that reached the screen (touched at least one cell) with tiled and clustered;
-    /// all active lights with forward and deferred, which do not cull by cell.
+    /// all active lights with forward and deferred, which do not cull by cell; none in a
+    /// frame whose lights all lie outside the view (drawn ambient-only, whatever the method).
     #[serde(rename = "visible_lights")]
     pub visible: usize,
     /// Light references dropped by the overflow policy (docs/grid.md), or lights forward left

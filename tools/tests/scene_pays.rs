@@ -313,3 +313,66 @@ fn uploads_no_scene_draws_are_freed_on_request_while_the_game_holds_them() {
         0
     );
 }
+
+/// Lights that reach nothing in view cost what no lights cost, with every method: no
+/// assignment, no upload, none counted visible, the ambient-only picture. One whose centre
+/// lies outside the view but whose sphere reaches into it still lights the frame's edge.
+#[test]
+fn lights_out_of_view_cost_nothing_and_one_reaching_in_still_lights() {
+    let (w, h) = (64u32, 36u32);
+    let mut s = scene::builtin::build("plane", None).unwrap();
+    // Straight down at the plane (it lies across z = 0), 2 high and 2·16/9 wide.
+    s.camera = scene::Camera {
+        position: DVec3::new(0.0, 0.0, 5.0),
+        target: DVec3::ZERO,
+        up: DVec3::Y,
+        projection: scene::Projection::Orthographic {
+            height: 4.0,
+            near: 0.1,
+            far: 10.0,
+        },
+    };
+    let half_x = 2.0 * w as f64 / h as f64;
+    let point = |x: f64, z: f64| Light::point(DVec3::new(x, 0.0, z), 1.0, Vec3::ONE, 2.0);
+    // Behind the camera, past the far plane and past the right edge, each by more than its
+    // radius; then one past the right edge by less.
+    let out = vec![point(0.0, 7.0), point(0.0, -6.0), point(half_x + 1.5, 0.2)];
+    let mut reaching_in = out.clone();
+    reaching_in.push(point(half_x + 0.5, 0.2));
+    let mut unlit = s.clone();
+    unlit.lights.clear();
+    common::each_method(|es, method, gpu| {
+        let opts = RenderOptions::default();
+        let ambient = gpu.render(&unlit, w, h, &opts);
+        s.lights = out.clone();
+        let (img, stats) = gpu.r().render_offscreen(&s, w, h, &opts).unwrap();
+        assert_eq!(
+            (
+                stats.memory.upload_bytes,
+                stats.time.assign_ms,
+                stats.lights.active,
+                stats.lights.visible
+            ),
+            (0, 0.0, 3, 0),
+            "{es} {method}: lights out of view did light work"
+        );
+        assert_eq!(
+            manylight::metrics::diff(&ambient, &img).max_abs,
+            0,
+            "{es} {method}"
+        );
+        s.lights = reaching_in.clone();
+        let (img, stats) = gpu.r().render_offscreen(&s, w, h, &opts).unwrap();
+        assert!(
+            stats.lights.visible >= 1,
+            "{es} {method}: {:?}",
+            stats.lights
+        );
+        let edge = |img: &image::RgbaImage| img.get_pixel(w - 1, h / 2).0;
+        let (lit, dark) = (edge(&img), edge(&ambient));
+        assert!(
+            lit[0] > dark[0] + 20,
+            "{es} {method}: the light reaching in left the edge at {lit:?} (ambient {dark:?})"
+        );
+    });
+}
