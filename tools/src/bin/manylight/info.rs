@@ -13,7 +13,7 @@ use crate::EsArg;
 #[derive(Parser, Debug)]
 pub struct InfoArgs {
     /// OpenGL ES version of the context to probe (default: 3 where the driver gives it, else 2
-    /// with a warning; 2 with `--no-fragment-highp`).
+    /// with a warning; 2 with `--no-fragment-highp` or `--no-float-textures`).
     #[arg(long, value_enum)]
     pub es: Option<EsArg>,
     /// Print JSON instead of text.

@@ -45,7 +45,9 @@ pub fn load_options() -> LoadOptions {
 #[command(
     name = "manylight",
     version,
-    about,
+    // Not the package's description, which names `view` also where the build leaves it out.
+    about = "Thousands of dynamic lights on OpenGL ES 2.0 and 3.0: render scenes, probe \
+             contexts, compare methods and time them",
     args_conflicts_with_subcommands = true
 )]
 struct Cli {
