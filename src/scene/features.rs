@@ -27,19 +27,24 @@ pub struct SceneFeatures {
 }
 
 impl SceneFeatures {
-    /// The features of `scene` (only lights that can contribute count).
+    /// The features of `scene`: only lights that can contribute count, and only materials an
+    /// object draws with (an OBJ's fallback material, say, may have none).
     pub fn of(scene: &Scene) -> SceneFeatures {
         let active = || scene.lights.iter().filter(|l| l.is_active());
-        SceneFeatures {
+        let mut features = SceneFeatures {
             point_lights: active().any(|l| matches!(l.kind, LightKind::Point)),
             spot_lights: active().any(|l| matches!(l.kind, LightKind::Spot { .. })),
             directional_lights: scene.directional_lights.iter().any(|l| l.is_active()),
-            textures: scene.materials.iter().any(|m| m.diffuse_texture.is_some()),
-            specular: scene.materials.iter().any(|m| m.has_specular()),
-            transparency: scene.materials.iter().any(|m| m.is_transparent()),
-            metallic_roughness: scene.materials.iter().any(|m| m.is_metallic_roughness()),
             lights: active().next().is_some(),
+            ..SceneFeatures::default()
+        };
+        for m in (scene.objects.iter()).filter_map(|o| scene.materials.get(o.material)) {
+            features.textures |= m.diffuse_texture.is_some();
+            features.specular |= m.has_specular();
+            features.transparency |= m.is_transparent();
+            features.metallic_roughness |= m.is_metallic_roughness();
         }
+        features
     }
 }
 
@@ -70,6 +75,13 @@ mod tests {
         assert!(!SceneFeatures::of(&sunny).metallic_roughness);
         let mr = crate::scene::Material::metallic_roughness("m", glam::Vec3::ONE, 1.0, 0.5);
         sunny.materials.push(mr);
+        assert!(
+            !SceneFeatures::of(&sunny).metallic_roughness,
+            "no object draws with it"
+        );
+        sunny.objects[0].material = sunny.materials.len() - 1;
         assert!(SceneFeatures::of(&sunny).metallic_roughness);
+        // The plane's own material, specular, is now drawn by nothing.
+        assert!(!SceneFeatures::of(&sunny).specular);
     }
 }
