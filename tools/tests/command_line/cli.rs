@@ -1097,6 +1097,19 @@ fn timed_frames_report_their_spread() {
         assert!(at("p50") <= at("p95") && at("p95") <= at("p99") && at("p99") <= at("max"));
     }
     assert_eq!(s["frame_ms"], s["frame_ms_spread"]["p50"]);
+    // The run's programs, its untimed first frame's included, as one frame alone builds them
+    // (the moving built-in's timed frames reported 0).
+    let out = manylight(
+        &[
+            "render", "--size", "32x18", "--lights", "64", "--frames", "0", "--stats", "one.json",
+        ],
+        &[],
+        dir.path(),
+    );
+    assert!(out.status.success(), "{}", text(&out));
+    let one = stats(&dir.path().join("one.json"));
+    assert!(one["programs_built"].as_u64().unwrap() > 0, "{one}");
+    assert_eq!(s["programs_built"], one["programs_built"]);
 }
 
 #[test]

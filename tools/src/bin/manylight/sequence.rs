@@ -226,8 +226,12 @@ pub fn render(
         recorder.finish()?;
     }
     let upload = Spread::of(timed.iter().map(|s| s.memory.upload_bytes as f64));
+    // The programs the whole run built, the warm-up's too, as a still scene's timed frames
+    // report them (`render_offscreen`).
+    let built = warm_up.programs_built + timed.iter().map(|s| s.programs_built).sum::<usize>();
     let mut stats = FrameStats::summarize(timed).unwrap_or(warm_up);
     stats.memory.upload_bytes_spread = upload;
+    stats.programs_built = built;
     Ok(Rendered { first, last, stats })
 }
 
