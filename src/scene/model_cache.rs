@@ -296,9 +296,9 @@ impl ModelCache {
         } else {
             &mut self.texture_budget
         };
-        let read = super::gltf::load_placed_into(
+        let read = super::gltf::load_source_into(
             scene,
-            path,
+            super::gltf::Source::File(path),
             transform,
             transform_field,
             &self.options,

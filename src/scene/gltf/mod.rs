@@ -183,19 +183,6 @@ pub(crate) struct Placement {
     pub lights_or_camera: bool,
 }
 
-/// [`load_into`], with how the file was placed.
-pub(crate) fn load_placed_into(
-    scene: &mut Scene,
-    path: &Path,
-    transform: DMat4,
-    transform_field: &str,
-    options: &LoadOptions,
-    textures: &mut TextureBudget,
-) -> Result<(GltfLoad, Placement), SceneError> {
-    let source = Source::File(path);
-    load_source_into(scene, source, transform, transform_field, options, textures)
-}
-
 /// Where a glTF's bytes come from.
 #[derive(Clone, Copy)]
 pub(crate) enum Source<'a> {
@@ -215,8 +202,8 @@ impl Source<'_> {
     }
 }
 
-/// [`load_into`] from `source`.
-fn load_source_into(
+/// [`load_into`] from `source`, with how the file was placed.
+pub(crate) fn load_source_into(
     scene: &mut Scene,
     source: Source,
     transform: DMat4,
