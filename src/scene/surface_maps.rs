@@ -151,6 +151,17 @@ impl SurfaceMaps {
         .filter_map(|(n, t)| t.as_ref().map(|t| (n, t)))
     }
 
+    /// The textures a shader samples: a normal map of scale 0, an occlusion map of strength 0
+    /// and an emissive texture without emission change no pixel, so they are not uploaded.
+    pub fn sampled_textures(&self) -> impl Iterator<Item = (&'static str, &MapTexture)> {
+        self.textures().filter(|(slot, _)| match *slot {
+            "normal" => self.normal_scale != 0.0,
+            "occlusion" => self.occlusion_strength > 0.0,
+            "emissive" => self.emits(),
+            _ => true,
+        })
+    }
+
     /// Every texture of the maps, to share equal ones between loads.
     pub fn textures_mut(&mut self) -> impl Iterator<Item = &mut Arc<Texture>> {
         [

@@ -376,3 +376,44 @@ fn lights_out_of_view_cost_nothing_and_one_reaching_in_still_lights() {
         );
     });
 }
+
+/// A normal map of scale 0, an occlusion map of strength 0 and an emissive texture without
+/// emission change no pixel: none of them is uploaded; given a scale, the normal map is.
+#[test]
+fn maps_that_change_no_pixel_are_not_uploaded() {
+    use manylight::scene::surface_maps::{MapTexture, TextureTransform};
+    let mut s = scene::builtin::build("plane", Some((8, 1))).unwrap();
+    let mut gpu = Gpu::new(EsVersion::Es3);
+    let mut scene_bytes = |s: &scene::Scene| {
+        let (_, stats) = (gpu.r())
+            .render_offscreen(s, 32, 18, &RenderOptions::default())
+            .unwrap();
+        stats.memory.scene_gpu_bytes
+    };
+    let bare = scene_bytes(&s);
+    let map = |v: u8| {
+        let image = image::RgbaImage::from_pixel(64, 64, image::Rgba([v, v, 255, 255]));
+        Some(MapTexture {
+            texture: Arc::new(scene::Texture::new(format!("map {v}"), image)),
+            transform: TextureTransform::IDENTITY,
+        })
+    };
+    for m in &mut s.materials {
+        m.maps.normal = map(128);
+        m.maps.normal_scale = 0.0;
+        m.maps.occlusion = map(100);
+        m.maps.occlusion_strength = 0.0;
+        m.maps.emissive_texture = map(50);
+        m.maps.emissive = Vec3::ZERO;
+    }
+    assert_eq!(
+        scene_bytes(&s),
+        bare,
+        "maps that change nothing were uploaded"
+    );
+    for m in &mut s.materials {
+        m.maps.normal_scale = 1.0;
+    }
+    let mapped = scene_bytes(&s);
+    assert!(mapped >= bare + 64 * 64 * 4, "{bare} → {mapped} bytes");
+}
