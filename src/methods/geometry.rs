@@ -198,9 +198,10 @@ pub(crate) fn shade_object<P: GeometryProgram>(
     let object = &ctx.scene.objects[index];
     let material = &ctx.scene.materials[object.material];
     let full = ctx.options.measure.full_variants;
-    let texture = ctx
-        .gpu_scene
-        .texture_for(material)
+    // A mesh without texture coordinates samples no texture (every pixel would read the
+    // corner texel): its material's flat colours draw it, as the loaders warn.
+    let mapped = !object.mesh.uvs.is_empty();
+    let texture = (ctx.gpu_scene.texture_for(material).filter(|_| mapped))
         .or_else(|| full.then(|| ctx.gpu_scene.white()).flatten());
     // Surface inputs only where a colour is computed (counts read none).
     let inputs = if ctx.features.counting() {

@@ -42,6 +42,8 @@ static WARNED: [AtomicBool; 4] = [
 pub fn features(material: &Material, mesh: &Mesh, units: i32) -> F {
     let maps = &material.maps;
     let emits = maps.emits();
+    // Only a mesh with texture coordinates samples a map.
+    let mapped = !mesh.uvs.is_empty();
     let mut bits = [
         (F::VERTEX_COLOR, !mesh.colors.is_empty()),
         (
@@ -50,15 +52,21 @@ pub fn features(material: &Material, mesh: &Mesh, units: i32) -> F {
         ),
         (
             F::NORMAL_MAP,
-            maps.normal.is_some() && !mesh.tangents.is_empty() && maps.normal_scale != 0.0,
+            mapped
+                && maps.normal.is_some()
+                && !mesh.tangents.is_empty()
+                && maps.normal_scale != 0.0,
         ),
         (F::EMISSIVE, emits),
-        (F::EMISSIVE_MAP, emits && maps.emissive_texture.is_some()),
+        (
+            F::EMISSIVE_MAP,
+            mapped && emits && maps.emissive_texture.is_some(),
+        ),
         (
             F::OCCLUSION,
-            maps.occlusion.is_some() && maps.occlusion_strength > 0.0,
+            mapped && maps.occlusion.is_some() && maps.occlusion_strength > 0.0,
         ),
-        (F::MR_TEXTURE, maps.metallic_roughness.is_some()),
+        (F::MR_TEXTURE, mapped && maps.metallic_roughness.is_some()),
     ]
     .into_iter()
     .fold(F::default(), |f, (bit, on)| f.with(bit, on));

@@ -192,6 +192,8 @@ pub fn load_into(
         diffuse_texture: override_tex.clone(),
         ..Material::flat("obj-default", Vec3::splat(0.8))
     });
+    // Materials whose texture a mesh without `vt` was warned of, once each.
+    let mut unmapped = std::collections::HashSet::new();
     for model in models {
         let m = model.mesh;
         if m.indices.is_empty() {
@@ -227,6 +229,16 @@ pub fn load_into(
             .material_id
             .and_then(|id| material_of.get(id).copied().flatten())
             .unwrap_or(fallback);
+        let textured = scene.materials[material].diffuse_texture.is_some();
+        if textured && mesh.uvs.is_empty() && unmapped.insert(material) {
+            report.warn(format!(
+                "{}: object `{}` has no texture coordinates (`vt`), so material `{}`'s texture \
+                 is not applied there (its Kd draws it)",
+                path.display(),
+                shown::name(&model.name),
+                shown::name(&scene.materials[material].name)
+            ));
+        }
         let (mut mesh, dropped) =
             super::duplicates::drop_from_opaque(mesh, &scene.materials[material], || {
                 format!("{}: object `{}`", path.display(), shown::name(&model.name))
@@ -569,6 +581,57 @@ mod tests {
         std::fs::create_dir(&model).unwrap();
         std::fs::write(root.path().join("secret.mtl"), "newmtl red\nKd 1 0 0\n").unwrap();
         (root, model)
+    }
+
+    /// Objects without `vt` whose material has a texture (two here, beside one with `vt`):
+    /// said once for the material, as the renderer leaves the texture out there.
+    #[test]
+    fn a_textured_material_on_objects_without_texture_coordinates_is_said_once() {
+        let dir = tempfile::tempdir().unwrap();
+        image::RgbaImage::from_pixel(2, 2, image::Rgba([200, 20, 20, 255]))
+            .save(dir.path().join("t.png"))
+            .unwrap();
+        std::fs::write(
+            dir.path().join("m.mtl"),
+            "newmtl tex\nKd 1 1 1\nmap_Kd t.png\n",
+        )
+        .unwrap();
+        let obj = dir.path().join("m.obj");
+        let tri = |o: &str, first: u32| {
+            let f = |i: u32| first + i;
+            format!("o {o}\nusemtl tex\nf {} {} {}\n", f(0), f(1), f(2))
+        };
+        let text = format!(
+            "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\n{}{}\
+             o mapped\nusemtl tex\nf 1/1 2/2 3/3\n",
+            tri("bare", 1),
+            tri("bare_too", 1)
+        );
+        std::fs::write(&obj, text).unwrap();
+        let mut scene = Scene::empty();
+        let mut budget = TextureBudget::default();
+        let options = LoadOptions::default();
+        let report = load_into(
+            &mut scene,
+            &obj,
+            DMat4::IDENTITY,
+            None,
+            &options,
+            &mut budget,
+        )
+        .unwrap();
+        let said: Vec<_> = (report.warnings.iter())
+            .filter(|w| w.contains("no texture coordinates (`vt`)"))
+            .collect();
+        assert_eq!(said.len(), 1, "{:?}", report.warnings);
+        assert!(
+            said[0].contains("`bare`") && said[0].contains("`tex`"),
+            "{said:?}"
+        );
+        let uvs: Vec<bool> = (scene.objects.iter())
+            .map(|o| o.mesh.uvs.is_empty())
+            .collect();
+        assert_eq!(uvs, [true, true, false]);
     }
 
     #[test]

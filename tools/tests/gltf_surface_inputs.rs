@@ -233,6 +233,53 @@ fn a_normal_map_tilts_the_shading_normal_with_file_and_generated_tangents() {
     check_every_method("mirrored normal map", &s, &want, 3.0);
 }
 
+/// A primitive without `TEXCOORD_0` samples none of its material's textures (each pixel would
+/// read the corner texel): its factors draw it, with every method, and the load says which
+/// textures went unapplied.
+#[test]
+fn textures_of_a_primitive_without_texture_coordinates_are_not_applied_and_said() {
+    let dir = tempfile::tempdir().unwrap();
+    let material = json!({
+        "pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.7, 0.6, 1.0], "roughnessFactor": 1.0,
+                                 "metallicFactor": 0.0, "baseColorTexture": {"index": 0}},
+        "normalTexture": {"index": 1},
+    });
+    let mut plane = Plane::new(material);
+    plane.images.push(png(1, 1, &[[20, 200, 40, 255]]));
+    plane.images.push(png(1, 1, &[[60, 40, 200, 255]]));
+    let path = plane.write(dir.path(), "no_uvs.gltf");
+    let mut doc: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    let attributes = &mut doc["meshes"][0]["primitives"][0]["attributes"];
+    attributes.as_object_mut().unwrap().remove("TEXCOORD_0");
+    std::fs::write(&path, doc.to_string()).unwrap();
+    let (s, warnings) = scene_of(&path, grazing_light(), 0.02);
+    assert!(
+        warnings.iter().any(|w| w.contains("no TEXCOORD_0")
+            && w.contains("baseColorTexture, normalTexture")
+            && w.contains("not applied")),
+        "{warnings:?}"
+    );
+    assert!(
+        s.materials[0].diffuse_texture.is_some(),
+        "kept for meshes that have them"
+    );
+    let albedo = DVec3::new(0.8, 0.7, 0.6);
+    let flat = |p: DVec3, _: DVec2, _: [f64; 4]| (surface(p, DVec3::Z, albedo), DVec3::ZERO, 1.0);
+    let want = oracle(&s, &flat);
+    let green = DVec3::new(20.0, 200.0, 40.0) / 255.0;
+    let sampled = |p: DVec3, _: DVec2, _: [f64; 4]| {
+        let corner = albedo * green.map(srgb_to_linear);
+        (surface(p, DVec3::Z, corner), DVec3::ZERO, 1.0)
+    };
+    let gap = oracle_gap(&want, &oracle(&s, &sampled));
+    assert!(
+        gap > 20.0,
+        "the texture changes the picture by only {gap:.1}/255"
+    );
+    check_every_method("textures without texture coordinates", &s, &want, 3.0);
+}
+
 /// (metallic, roughness) = (metallicFactor, roughnessFactor) × the texture's (B, G), linear:
 /// factors below 1 and distinct channels, so reading the wrong channel, dropping the factors
 /// or the texture, each changes the picture beyond the bar (with both factors 1 and blue 255 a

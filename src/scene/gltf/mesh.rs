@@ -216,17 +216,22 @@ pub(super) fn build(
             .with_colors(colors)
             .map_err(|e| format!("{field}: {e}"))?;
     }
+    if mesh.uvs.is_empty() {
+        let textures = textures_named(&p.material());
+        if !textures.is_empty() {
+            warnings.push(format!(
+                "{field}: its material has textures ({}) but the primitive has no \
+                 TEXCOORD_0; they are not applied (its factors draw it)",
+                textures.join(", ")
+            ));
+        }
+    }
     // Tangents only where a normal map will use them (they cost a vertex attribute).
-    if p.material().normal_texture().is_some() {
+    if p.material().normal_texture().is_some() && !mesh.uvs.is_empty() {
         if !tangents.is_empty() {
             mesh = mesh
                 .with_tangents(tangents)
                 .map_err(|e| format!("{field}: {e}"))?;
-        } else if mesh.uvs.is_empty() {
-            warnings.push(format!(
-                "{field}: its material has a normal map but the primitive has no TEXCOORD_0; \
-                 the map is not applied"
-            ));
         } else {
             let (with, fallbacks) = mesh
                 .with_generated_tangents()
@@ -256,6 +261,24 @@ pub(super) fn build(
         }
     }
     Ok(Built::Mesh(mesh))
+}
+
+/// The glTF names of the textures `material` has.
+fn textures_named(material: &gltf::Material) -> Vec<&'static str> {
+    let pbr = material.pbr_metallic_roughness();
+    [
+        ("baseColorTexture", pbr.base_color_texture().is_some()),
+        (
+            "metallicRoughnessTexture",
+            pbr.metallic_roughness_texture().is_some(),
+        ),
+        ("normalTexture", material.normal_texture().is_some()),
+        ("occlusionTexture", material.occlusion_texture().is_some()),
+        ("emissiveTexture", material.emissive_texture().is_some()),
+    ]
+    .into_iter()
+    .filter_map(|(name, has)| has.then_some(name))
+    .collect()
 }
 
 /// A FLOAT vector attribute that the loader replaces when it has another type.
