@@ -246,7 +246,9 @@ fn darken_unseen_into(ctx: &FrameContext, lights: &[GpuLight], seen: &mut Vec<Gp
 
 /// A frame without lights: ambient only, with the light loop compiled out and nothing uploaded.
 pub fn draw_ambient_only(ctx: &mut FrameContext) -> Result<MethodStats<'static>, Error> {
-    ctx.features = ctx.features.with(ShaderFeatures::NO_LIGHTS, true);
+    // One variant whether the scene has spots out of view or no lights at all.
+    ctx.features =
+        (ctx.features.with(ShaderFeatures::NO_LIGHTS, true)).with(ShaderFeatures::SPOT, false);
     geometry::draw_objects::<ForwardProgram>(ctx, "forward", 1, &mut |_, _| {})?;
     Ok(MethodStats::default())
 }

@@ -347,7 +347,12 @@ impl Renderer {
             Some(pass) if reaching_pass => pass,
             _ => &mut self.method,
         };
-        let lit = ctx.lights_in_view(1) > 0;
+        // A warm-up draws the lit variants whatever its camera sees (and the unlit ones in a
+        // frame of their own).
+        let lit = match self.warming_up {
+            true => !ctx.lights.is_empty(),
+            false => ctx.lights_in_view(1) > 0,
+        };
         let rendered = if !lit {
             method.skip_frame(&self.dev);
             methods::forward::draw_ambient_only(&mut ctx)

@@ -33,8 +33,8 @@ impl Renderer {
     /// [`Renderer::render`] builds nothing: compiling a variant takes a driver milliseconds to
     /// tens of milliseconds, a visible hitch. A game calls it while it shows a loading screen,
     /// and again when the scene gains a kind of material or light (a first spot light, a first
-    /// normal map) or loses its last light (drawn then by ambient-only variants), or when the
-    /// options change what is drawn (tone map, MSAA, linear output).
+    /// normal map), or when the options change what is drawn (tone map, MSAA, linear output).
+    /// The ambient-only variants, which draw a frame with no light in view, are built too.
     ///
     /// It draws one small frame offscreen with the current method, or with each method `auto`
     /// may pick (forward, clustered, deferred), including the passes the camera does not need
@@ -102,15 +102,31 @@ impl Renderer {
         names: &[&'static str],
         options: &RenderOptions,
     ) -> Result<(), Error> {
-        let mut stats = FrameStats::default();
         for name in names {
-            let fresh = (methods::find(name)?.create)(&self.dev)?;
-            let kept = std::mem::replace(&mut self.method, fresh);
-            let drawn = self.render_hosted(scene, WARM_UP_SIZE, options, [0, 0], &mut stats, false);
-            let mut used = std::mem::replace(&mut self.method, kept);
-            used.destroy(&self.dev);
-            drawn?;
+            self.warm_up_frame(scene, name, options)?;
+        }
+        // A frame with no light in view is drawn ambient-only, whatever the method.
+        if !scene.lights.is_empty() {
+            let mut unlit = scene.clone();
+            unlit.truncate_lights(0);
+            self.warm_up_frame(&unlit, methods::forward::DESC.name, options)?;
         }
         Ok(())
+    }
+
+    /// One frame of `scene` with a fresh instance of the method `name`.
+    fn warm_up_frame(
+        &mut self,
+        scene: &Scene,
+        name: &str,
+        options: &RenderOptions,
+    ) -> Result<(), Error> {
+        let mut stats = FrameStats::default();
+        let fresh = (methods::find(name)?.create)(&self.dev)?;
+        let kept = std::mem::replace(&mut self.method, fresh);
+        let drawn = self.render_hosted(scene, WARM_UP_SIZE, options, [0, 0], &mut stats, false);
+        let mut used = std::mem::replace(&mut self.method, kept);
+        used.destroy(&self.dev);
+        drawn
     }
 }

@@ -85,6 +85,11 @@ fn frame(gpu: &mut Gpu, colour: u32, scene: &Scene, options: &RenderOptions) -> 
 fn a_warmed_up_renderer_builds_nothing_in_its_frames() {
     let scene = game_scene();
     let few = with_lights(&scene, 8);
+    // Every light far below the ground, out of view: the frame is drawn ambient-only.
+    let mut away = scene.clone();
+    for l in &mut away.lights {
+        l.position.y -= 1e5;
+    }
     for es in [EsVersion::Es2, EsVersion::Es3] {
         // Fresh: a pooled context's renderer starts with programs other tests built.
         let mut gpu = Gpu::fresh(es);
@@ -123,11 +128,13 @@ fn a_warmed_up_renderer_builds_nothing_in_its_frames() {
                 };
                 assert_eq!(warm.methods, expected, "{what}");
             }
-            // Auto draws forward for the few lights, clustered for the many.
-            for s in [&scene, &few, &scene] {
+            // Auto draws forward for the few lights, clustered for the many; with none in
+            // view any method draws ambient-only.
+            for s in [&scene, &few, &away, &scene] {
                 let stats = frame(&mut gpu, colour, s, &options);
                 assert_eq!(stats.programs_built, 0, "{what}: {:?}", stats.auto_choice);
             }
+            assert_eq!(frame(&mut gpu, colour, &away, &options).lights.visible, 0);
         }
         // What auto may pick, each on its own: built already.
         let methods: &[&str] = if es3 {
