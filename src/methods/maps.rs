@@ -52,20 +52,11 @@ pub fn features(material: &Material, mesh: &Mesh, units: i32) -> F {
         ),
         (
             F::NORMAL_MAP,
-            mapped
-                && maps.normal.is_some()
-                && !mesh.tangents.is_empty()
-                && maps.normal_scale != 0.0,
+            mapped && maps.sampled_normal().is_some() && !mesh.tangents.is_empty(),
         ),
         (F::EMISSIVE, emits),
-        (
-            F::EMISSIVE_MAP,
-            mapped && emits && maps.emissive_texture.is_some(),
-        ),
-        (
-            F::OCCLUSION,
-            mapped && maps.occlusion.is_some() && maps.occlusion_strength > 0.0,
-        ),
+        (F::EMISSIVE_MAP, mapped && maps.sampled_emissive().is_some()),
+        (F::OCCLUSION, mapped && maps.sampled_occlusion().is_some()),
         (F::MR_TEXTURE, mapped && maps.metallic_roughness.is_some()),
     ]
     .into_iter()

@@ -154,12 +154,31 @@ impl SurfaceMaps {
     /// The textures a shader samples: a normal map of scale 0, an occlusion map of strength 0
     /// and an emissive texture without emission change no pixel, so they are not uploaded.
     pub fn sampled_textures(&self) -> impl Iterator<Item = (&'static str, &MapTexture)> {
-        self.textures().filter(|(slot, _)| match *slot {
-            "normal" => self.normal_scale != 0.0,
-            "occlusion" => self.occlusion_strength > 0.0,
-            "emissive" => self.emits(),
-            _ => true,
-        })
+        [
+            ("normal", self.sampled_normal()),
+            ("emissive", self.sampled_emissive()),
+            ("occlusion", self.sampled_occlusion()),
+            ("metallic_roughness", self.metallic_roughness.as_ref()),
+        ]
+        .into_iter()
+        .filter_map(|(n, t)| t.map(|t| (n, t)))
+    }
+
+    /// The normal map, where its scale bends the normal.
+    pub(crate) fn sampled_normal(&self) -> Option<&MapTexture> {
+        self.normal.as_ref().filter(|_| self.normal_scale != 0.0)
+    }
+
+    /// The emissive texture, where the material emits.
+    pub(crate) fn sampled_emissive(&self) -> Option<&MapTexture> {
+        self.emissive_texture.as_ref().filter(|_| self.emits())
+    }
+
+    /// The occlusion map, where its strength darkens the ambient.
+    pub(crate) fn sampled_occlusion(&self) -> Option<&MapTexture> {
+        self.occlusion
+            .as_ref()
+            .filter(|_| self.occlusion_strength > 0.0)
     }
 
     /// Every texture of the maps, to share equal ones between loads.
