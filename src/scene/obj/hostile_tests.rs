@@ -1,30 +1,10 @@
 //! OBJ files written to make the loader read, warn or keep without end: each read and each
 //! warning is bounded.
 
+use super::tests::load;
 use super::textures::TextureCache;
-use super::{load_into, LoadReport};
-use crate::scene::access::LoadOptions;
 use crate::scene::texture_budget::TextureBudget;
-use crate::scene::Scene;
-use glam::DMat4;
-use std::path::Path;
 use std::sync::Arc;
-
-fn load(obj: &Path) -> (Scene, LoadReport) {
-    let mut scene = Scene::empty();
-    let mut budget = TextureBudget::default();
-    let options = LoadOptions::default();
-    let report = load_into(
-        &mut scene,
-        obj,
-        DMat4::IDENTITY,
-        None,
-        &options,
-        &mut budget,
-    )
-    .unwrap();
-    (scene, report)
-}
 
 /// `mtllib` lines repeating a name, or naming thousands of libraries, warn a bounded number of
 /// times; the library named before them is still read.
