@@ -349,9 +349,10 @@ impl Renderer {
         };
         // A warm-up draws the lit variants whatever its camera sees (and the unlit ones in a
         // frame of their own).
-        let lit = match self.warming_up {
-            true => !ctx.lights.is_empty(),
-            false => ctx.lights_in_view(1) > 0,
+        let lit = if self.warming_up {
+            !ctx.lights.is_empty()
+        } else {
+            ctx.lights_in_view(1) > 0
         };
         let rendered = if !lit {
             method.skip_frame(&self.dev);

@@ -263,9 +263,9 @@ impl ModelCache {
             return Ok((LoadReport::default(), None));
         }
         let first_read = key.as_ref().is_some_and(|k| !self.gltf.contains_key(k));
-        // Read again for this reference: bounded in total (the file, its buffers and images),
-        // so a scene file of many references to a large file with lights cannot keep the load
-        // busy for hours.
+        // A file read again for this reference is bounded in total (the file, its buffers and
+        // images), so a scene file of many references to a large file with lights cannot keep
+        // the load busy for hours.
         if !first_read && self.reread_bytes > MAX_REREAD_BYTES {
             return Err(SceneError::GltfUnsupported {
                 path: path.to_path_buf(),
