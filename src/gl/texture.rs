@@ -140,10 +140,11 @@ impl DataTexture {
         })
     }
 
-    /// Uploads `bytes` (`width × height` texels) into the top rows. Storage grows to the next
-    /// power of two of rows and never shrinks, so a list that changes length every frame does
-    /// not reallocate every frame; shaders address rows with the allocated height
-    /// ([`DataTexture::size`]).
+    /// Uploads `bytes`, whole texels row after row from the top, into a texture `width`
+    /// texels wide with at least `height` rows: the rows they fill, then the part of the next
+    /// row they reach (the rest of it is not sent). Storage grows to the next power of two of
+    /// rows and never shrinks, so a list that changes length every frame does not reallocate
+    /// every frame; shaders address rows with the allocated height ([`DataTexture::size`]).
     pub fn upload(
         &mut self,
         dev: &Device,
@@ -151,10 +152,11 @@ impl DataTexture {
         height: u32,
         bytes: &[u8],
     ) -> Result<(), GlError> {
-        let expected = width as usize * height as usize * self.format.bytes_per_texel();
-        if bytes.len() != expected {
+        let texel = self.format.bytes_per_texel();
+        let row = width as usize * texel;
+        if !bytes.len().is_multiple_of(texel) || bytes.len() > row * height as usize {
             return Err(GlError::Unsupported(format!(
-                "data texture upload of {} bytes for {width}×{height} texels (expected {expected})",
+                "data texture upload of {} bytes into {width}×{height} texels of {texel} bytes",
                 bytes.len()
             )));
         }
@@ -166,6 +168,8 @@ impl DataTexture {
         }
         let gl = &dev.gl;
         let (internal, format, ty) = self.format.gl_formats(dev.es());
+        let full_rows = bytes.len().checked_div(row).unwrap_or(0);
+        let rest = bytes.len() - full_rows * row;
         unsafe {
             gl.bind_texture(glow::TEXTURE_2D, Some(self.raw));
             gl.pixel_store_i32(glow::UNPACK_ALIGNMENT, 1);
@@ -184,17 +188,25 @@ impl DataTexture {
                 );
                 self.size = (width, rows);
             }
-            gl.tex_sub_image_2d(
-                glow::TEXTURE_2D,
-                0,
-                0,
-                0,
-                width as i32,
-                height as i32,
-                format,
-                ty,
-                glow::PixelUnpackData::Slice(Some(bytes)),
-            );
+            let sub_image = |y: usize, w: usize, h: usize, part: &[u8]| {
+                gl.tex_sub_image_2d(
+                    glow::TEXTURE_2D,
+                    0,
+                    0,
+                    y as i32,
+                    w as i32,
+                    h as i32,
+                    format,
+                    ty,
+                    glow::PixelUnpackData::Slice(Some(part)),
+                )
+            };
+            if full_rows > 0 {
+                sub_image(0, width as usize, full_rows, &bytes[..full_rows * row]);
+            }
+            if rest > 0 {
+                sub_image(full_rows, rest / texel, 1, &bytes[full_rows * row..]);
+            }
         }
         let uploaded = dev.check("data texture upload");
         if uploaded.is_err() {

@@ -417,3 +417,48 @@ fn maps_that_change_no_pixel_are_not_uploaded() {
     let mapped = scene_bytes(&s);
     assert!(mapped >= bare + 64 * 64 * 4, "{bare} → {mapped} bytes");
 }
+
+/// A frame uploads the texels its shaders read and no more: forward and deferred their light
+/// records, the culled methods also one grid texel a cell (after a two-texel table a cascade,
+/// and one more where the last list ends) and the index list's texels. Packed whole rows of
+/// 1 024 texels, one light cost 16 KB.
+#[test]
+fn a_frame_uploads_only_the_texels_its_shaders_read() {
+    let mut s = scene::builtin::build("plane", None).unwrap();
+    common::each_method(|es, method, gpu| {
+        // One light, then 300 (1 200 float texels: a row and part of the next).
+        for n in [1usize, 300] {
+            s.lights = (0..n)
+                .map(|i| {
+                    let f = i as f64;
+                    let at = DVec3::new((f * 0.37).sin() * 3.0, 0.3, (f * 0.23).cos() * 3.0);
+                    Light::point(at, 1.5, Vec3::ONE, 1.0)
+                })
+                .collect();
+            let (_, stats) = (gpu.r())
+                .render_offscreen(&s, 64, 36, &RenderOptions::default())
+                .unwrap();
+            let encoding = stats.lights.encoding;
+            let record = encoding.texels_per_light() as usize * encoding.bytes_per_texel();
+            let records = stats.lights.visible * record;
+            let uploaded = stats.memory.upload_bytes;
+            assert!(stats.lights.visible > 0, "{es} {method}: no light in view");
+            if matches!(method, "forward" | "deferred") {
+                assert_eq!(uploaded, records, "{es} {method}, {n} lights");
+                continue;
+            }
+            let a = &stats.assignment;
+            let per_texel = if es == EsVersion::Es2 { 2 } else { 4 };
+            let cells = (a.clusters as usize + 1) * 4;
+            let indices = a.indices.div_ceil(per_texel) * per_texel * 2;
+            // What is left is the table: 8 bytes a cascade.
+            let table = uploaded.checked_sub(records + cells + indices);
+            let most = manylight::cluster::grid::MAX_CASCADES as usize * 8;
+            assert!(
+                table.is_some_and(|t| t > 0 && t <= most && t % 8 == 0),
+                "{es} {method}, {n} lights: {uploaded} bytes uploaded for {records} of records, \
+                 {cells} of cells and {indices} of indices"
+            );
+        }
+    });
+}

@@ -122,9 +122,10 @@ impl GridEncoding {
 pub struct PackedTexels {
     /// Width in texels.
     pub width: u32,
-    /// Rows.
+    /// Rows the texels take (at least 1): the texture's height.
     pub height: u32,
-    /// Bytes, row-major.
+    /// The texels in use, row-major: the last row only as far as they reach (the rest of it
+    /// is never read, so it is neither packed nor uploaded).
     pub bytes: Vec<u8>,
 }
 
@@ -182,7 +183,7 @@ pub fn pack_grid_into(
     let table = grid.cascades.len() * TABLE_TEXELS_PER_CASCADE as usize;
     let height = rows_for(grid_texels(grid));
     let bytes = &mut packed.bytes;
-    zeroed_with_room(bytes, DATA_TEXTURE_WIDTH as usize * height as usize * 4);
+    zeroed_with_room(bytes, grid_texels(grid) * 4);
     let mut put =
         |texel: usize, value: [u8; 4]| bytes[texel * 4..texel * 4 + 4].copy_from_slice(&value);
     match encoding {
@@ -234,13 +235,10 @@ pub fn pack_indices(indices: &IndexList, encoding: GridEncoding) -> PackedTexels
 /// [`pack_indices`] into `packed`, reusing its bytes (no allocation once they have grown).
 pub fn pack_indices_into(indices: &IndexList, encoding: GridEncoding, packed: &mut PackedTexels) {
     let per_texel = encoding.indices_per_texel();
-    let height = rows_for(indices.len().div_ceil(per_texel));
-    let texel_bytes = per_texel * encoding.index_bytes();
+    let texels = indices.len().div_ceil(per_texel);
+    let height = rows_for(texels);
     let bytes = &mut packed.bytes;
-    zeroed_with_room(
-        bytes,
-        DATA_TEXTURE_WIDTH as usize * height as usize * texel_bytes,
-    );
+    zeroed_with_room(bytes, texels * per_texel * encoding.index_bytes());
     match (indices.as_u16(), indices.as_u32()) {
         (Some(list), _) => put_indices(bytes, list.iter().copied(), encoding),
         (_, Some(list)) => put_indices(bytes, list.iter().map(|&v| v as u16), encoding),
@@ -369,10 +367,11 @@ mod tests {
                 .indices
                 .len()
                 .div_ceil(per_texel * DATA_TEXTURE_WIDTH as usize);
-            assert_eq!(ix.height as usize, rows);
+            assert_eq!(ix.height as usize, rows.max(1));
+            // Only the texels the list fills: the last row's rest is not uploaded.
             assert_eq!(
                 ix.bytes.len(),
-                rows * DATA_TEXTURE_WIDTH as usize * texel_bytes
+                a.indices.len().div_ceil(per_texel) * texel_bytes
             );
         }
     }
@@ -428,10 +427,11 @@ mod tests {
         assert!(huge.total_cells >= MAX_TABLE_CELLS);
         let said = grid_fits_table(&huge).expect("refused");
         assert!(said.contains("cells"), "{said}");
+        // The table, one texel a cell and the end: the rows' rest is left out.
+        assert_eq!(g.bytes.len(), grid_texels(&grid) * 4);
         assert_eq!(
-            g.bytes.len(),
-            g.height as usize * DATA_TEXTURE_WIDTH as usize * 4
+            g.height as usize,
+            grid_texels(&grid).div_ceil(DATA_TEXTURE_WIDTH as usize)
         );
-        assert!(g.height as usize * DATA_TEXTURE_WIDTH as usize >= grid_texels(&grid));
     }
 }

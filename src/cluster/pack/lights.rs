@@ -79,9 +79,10 @@ pub struct PackedLights {
     pub count: usize,
     /// Texture width in texels ([`DATA_TEXTURE_WIDTH`]).
     pub width: u32,
-    /// Texture height in rows (at least 1).
+    /// Rows the records take (at least 1): the texture's height.
     pub height: u32,
-    /// Texel bytes, row-major (f32 little-endian for Float32).
+    /// The records' texels, row-major (f32 little-endian for Float32): `count` records, the
+    /// last row only as far as they reach.
     pub bytes: Vec<u8>,
     /// Rgba8 only: positions are fixed point over `[−pos_range, pos_range]`.
     pub pos_range: f32,
@@ -133,7 +134,7 @@ pub fn pack_lights_into(lights: &[GpuLight], encoding: LightEncoding, packed: &m
     let width = DATA_TEXTURE_WIDTH as usize;
     let height = (lights.len() * tpl).div_ceil(width).max(1);
     let bytes = &mut packed.bytes;
-    zeroed_with_room(bytes, width * height * encoding.bytes_per_texel());
+    zeroed_with_room(bytes, lights.len() * tpl * encoding.bytes_per_texel());
     let pos_range = lights
         .iter()
         .map(|l| l.position.abs().max_element())
@@ -375,6 +376,7 @@ mod tests {
         let packed = pack_lights(&lights, LightEncoding::Float32);
         assert_eq!(packed.width, DATA_TEXTURE_WIDTH);
         assert_eq!(packed.height, 2); // 300 × 4 texels over 1024-wide rows
+        assert_eq!(packed.bytes.len(), 300 * 4 * 16); // the second row's rest left out
         for (i, l) in lights.iter().enumerate() {
             let u = unpack_light(&packed, i);
             assert_eq!(
