@@ -10,18 +10,24 @@ use super::mesh::BoundMesh;
 use super::{Device, GlError};
 
 /// A stream of instances of `attributes` `vec4`s at locations `first..first + attributes`,
-/// at most `capacity` a draw. Its store is allocated once; each batch orphans it (so the
-/// driver need not wait for the previous draw) and writes it anew.
+/// at most `capacity` a draw. Its store holds the largest batch drawn so far (a power of two
+/// of instances, at most `capacity`), so a scene of a few lights holds a few kilobytes; each
+/// batch orphans it (so the driver need not wait for the previous draw) and writes it anew.
 pub(crate) struct InstanceStream {
     buffer: glow::Buffer,
     first: u32,
     attributes: usize,
     capacity: usize,
+    /// Instances the store holds.
+    store: usize,
     destroyed: bool,
 }
 
+/// Instances a new stream's store holds.
+const FIRST_STORE: usize = 64;
+
 impl InstanceStream {
-    /// A stream whose buffer holds `capacity` instances.
+    /// A stream of at most `capacity` instances a draw.
     pub(crate) fn new(
         dev: &Device,
         first: u32,
@@ -34,6 +40,7 @@ impl InstanceStream {
             first,
             attributes,
             capacity,
+            store: FIRST_STORE.min(capacity),
             destroyed: false,
         };
         unsafe {
@@ -50,7 +57,7 @@ impl InstanceStream {
 
     /// Bytes of its buffer.
     pub(crate) fn bytes(&self) -> usize {
-        self.capacity * self.attributes * std::mem::size_of::<Vec4>()
+        self.store * self.attributes * std::mem::size_of::<Vec4>()
     }
 
     /// Points its locations into the buffer, one step an instance (with a mesh's arrays
@@ -71,13 +78,16 @@ impl InstanceStream {
 
     /// Draws `mesh` once per instance of `instances` (`attributes` `vec4`s each, at most
     /// `capacity` instances), with the stream bound. Returns the bytes uploaded.
-    pub(crate) fn draw(&self, dev: &Device, mesh: &BoundMesh, instances: &[[f32; 4]]) -> usize {
+    pub(crate) fn draw(&mut self, dev: &Device, mesh: &BoundMesh, instances: &[[f32; 4]]) -> usize {
         let count = instances.len() / self.attributes;
         debug_assert!(count <= self.capacity && instances.len().is_multiple_of(self.attributes));
         if count == 0 {
             return 0;
         }
         let bytes: &[u8] = bytemuck::cast_slice(instances);
+        if count > self.store {
+            self.store = count.next_power_of_two().min(self.capacity);
+        }
         unsafe {
             dev.gl
                 .buffer_data_size(glow::ARRAY_BUFFER, self.bytes() as i32, glow::STREAM_DRAW);

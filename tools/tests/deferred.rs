@@ -78,6 +78,31 @@ fn lights_past_one_instance_batch_match_forward_upload_once_and_add_no_draw_call
     assert_eq!(forward_few.draw_calls, forward_many.draw_calls);
 }
 
+/// Deferred's instance buffer holds the batches it has drawn: a few lights keep a few
+/// kilobytes, where a fixed buffer of a full batch (4 096 lights, 256 KiB) was held whatever
+/// the scene; 5 000 lights grow it to the full batch.
+#[test]
+fn the_light_instance_buffer_grows_with_the_lights() {
+    const FULL_BATCH: usize = 4096 * 4 * 16;
+    let mut gpu = Gpu::new(EsVersion::Es3);
+    let opts = RenderOptions::default();
+    let mut beyond_the_gbuffer = |lights: usize| {
+        let s = scene::builtin::build("courtyard", Some((lights, 3))).unwrap();
+        let (_, stats) = gpu.render_with("deferred", &s, (32, 18), &opts);
+        stats.memory.method_gpu_bytes - stats.memory.gbuffer_bytes
+    };
+    let few = beyond_the_gbuffer(8);
+    assert!(
+        few < FULL_BATCH / 4,
+        "8 lights held {few} bytes past the G-buffer"
+    );
+    let many = beyond_the_gbuffer(5_000);
+    assert!(
+        many >= FULL_BATCH,
+        "5 000 lights held {many} bytes past the G-buffer"
+    );
+}
+
 #[test]
 fn transparent_objects_take_the_forward_fallback() {
     let s = scene::builtin::build("bubbles", Some((128, 2))).unwrap();
