@@ -1,4 +1,4 @@
-// Reads light records from the light data texture (layout: src/cluster/pack.rs).
+// Reads light records from the light data texture (layout: src/cluster/pack/lights.rs).
 // LIGHT_TEXELS and LIGHTS_RGBA8 come from Rust as #defines. Needs data_texture.glsl.
 uniform HIGHP sampler2D u_lights;
 uniform int u_lightCount;
@@ -87,18 +87,19 @@ Light fetchLight(int i) {
 #else
     light.position = t0.xyz;
     light.radius = t0.w;
-#if FP16_LIGHTS
-    vec4 t3 = LIGHT_TEXEL(i, 3);
-    light.radiance = t3.rgb;
-    light.radianceRoot = t3.a;
-#else
     light.radiance = t1.rgb;
+#if FP16_LIGHTS
+    light.radianceRoot = t1.a;
 #endif
 #if HAS_SPOT
     vec4 t2 = LIGHT_TEXEL(i, 2);
-    light.spotScale = t1.w;
     light.direction = t2.xyz;
     light.spotOffset = t2.w;
+#if FP16_LIGHTS
+    light.spotScale = LIGHT_TEXEL(i, 3).x;
+#else
+    light.spotScale = t1.w;
+#endif
 #endif
 #endif
     return light;

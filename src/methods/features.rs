@@ -1,7 +1,7 @@
 //! Shader feature bits → `#define`s. A variant depends only on what the scene and material
 //! have, never on how many lights there are, so the program cache stays small.
 
-use crate::cluster::pack::{LightEncoding, DATA_TEXTURE_WIDTH};
+use crate::cluster::pack::{LightEncoding, LightLayout, DATA_TEXTURE_WIDTH};
 use crate::gl::EsVersion;
 use crate::scene::light::SPOT_MIN_COS_DELTA;
 
@@ -175,6 +175,15 @@ impl ShaderFeatures {
         }
     }
 
+    /// How this variant's light records are laid out.
+    pub fn light_layout(self) -> LightLayout {
+        LightLayout {
+            encoding: self.light_encoding(),
+            spots: self.has(Self::SPOT),
+            fp16: self.has(Self::FP16_LIGHTS),
+        }
+    }
+
     /// The `#define`s of this variant: feature switches plus the constants shared with Rust.
     pub fn defines(self, dialect: EsVersion, max_lights: u32) -> Vec<(String, String)> {
         let flag = |bit| if self.has(bit) { "1" } else { "0" }.to_string();
@@ -241,7 +250,7 @@ impl ShaderFeatures {
             ("DATA_WIDTH".into(), DATA_TEXTURE_WIDTH.to_string()),
             (
                 "LIGHT_TEXELS".into(),
-                self.light_encoding().texels_per_light().to_string(),
+                self.light_layout().texels_per_light().to_string(),
             ),
             ("MAX_LIGHTS".into(), max_lights.to_string()),
             (

@@ -197,7 +197,7 @@ impl ShadingMethod for Forward {
             }
             LightEncoding::Float32 => lights,
         };
-        pack_lights_into(lights, encoding, packed);
+        pack_lights_into(lights, ctx.features.light_layout(), packed);
         // With no lights the shader never reads the texture: upload only to give it storage.
         if count > 0 || fresh {
             texture.upload(dev, packed.width, packed.height, &packed.bytes)?;

@@ -12,7 +12,7 @@ use glam::{DVec3, Vec3};
 use manylight::gl::shader_source::{assemble, Stage};
 use manylight::methods::ShaderFeatures;
 use manylight::scene::{self, Light};
-use manylight::{EsVersion, HeadlessContext, RenderOptions, Renderer};
+use manylight::{EsVersion, HeadlessContext, LightEncoding, RenderOptions, Renderer};
 
 #[test]
 fn variants_without_spots_or_textures_contain_no_such_code() {
@@ -418,16 +418,19 @@ fn maps_that_change_no_pixel_are_not_uploaded() {
     assert!(mapped >= bare + 64 * 64 * 4, "{bare} → {mapped} bytes");
 }
 
-/// A frame uploads the texels its shaders read and no more: forward and deferred their light
-/// records, the culled methods also one grid texel a cell (after a two-texel table a cascade,
-/// and one more where the last list ends) and the index list's texels. Packed whole rows of
-/// 1 024 texels, one light cost 16 KB.
+/// A frame uploads the texels its shaders read and no more: forward its light records,
+/// deferred its light instances, the culled methods also one grid texel a cell (after a
+/// two-texel table a cascade, and one more where the last list ends) and the index list's
+/// texels. A record is 32 bytes (float) or 16 (RGBA8) without spots in the scene, 64 or 32
+/// with them. Packed whole rows of 1 024 texels, one light cost 16 KB; points took a spot's
+/// record.
 #[test]
 fn a_frame_uploads_only_the_texels_its_shaders_read() {
     let mut s = scene::builtin::build("plane", None).unwrap();
     common::each_method(|es, method, gpu| {
-        // One light, then 300 (1 200 float texels: a row and part of the next).
-        for n in [1usize, 300] {
+        // One light, then 300 (600 float texels without spots, 1 200 with: a row and part of
+        // the next), each without spots and with one.
+        for (n, spots) in [(1usize, false), (300, false), (1, true), (300, true)] {
             s.lights = (0..n)
                 .map(|i| {
                     let f = i as f64;
@@ -435,30 +438,46 @@ fn a_frame_uploads_only_the_texels_its_shaders_read() {
                     Light::point(at, 1.5, Vec3::ONE, 1.0)
                 })
                 .collect();
+            if spots {
+                let cone = scene::Cone {
+                    direction: DVec3::NEG_Y,
+                    inner_deg: 20.0,
+                    outer_deg: 40.0,
+                };
+                s.lights[0] = Light::spot(DVec3::new(0.0, 1.0, 0.0), 3.0, Vec3::ONE, 1.0, cone);
+            }
             let (_, stats) = (gpu.r())
                 .render_offscreen(&s, 64, 36, &RenderOptions::default())
                 .unwrap();
-            let encoding = stats.lights.encoding;
-            let record = encoding.texels_per_light() as usize * encoding.bytes_per_texel();
-            let records = stats.lights.visible * record;
+            let record = match (stats.lights.encoding, spots) {
+                (LightEncoding::Float32, false) => 32,
+                (LightEncoding::Float32, true) => 64,
+                (LightEncoding::Rgba8, false) => 16,
+                (LightEncoding::Rgba8, true) => 32,
+            };
+            let what = format!("{es} {method}, {n} lights, spots {spots}");
+            assert!(stats.lights.visible > 0, "{what}: no light in view");
             let uploaded = stats.memory.upload_bytes;
-            assert!(stats.lights.visible > 0, "{es} {method}: no light in view");
-            if matches!(method, "forward" | "deferred") {
-                assert_eq!(uploaded, records, "{es} {method}, {n} lights");
-                continue;
+            match method {
+                "forward" => assert_eq!(uploaded, stats.lights.visible * record, "{what}"),
+                // Instances: four vec4s a light, whatever the scene.
+                "deferred" => assert_eq!(uploaded, stats.lights.visible * 64, "{what}"),
+                _ => {
+                    let a = &stats.assignment;
+                    let per_texel = if es == EsVersion::Es2 { 2 } else { 4 };
+                    let records = stats.lights.visible * record;
+                    let cells = (a.clusters as usize + 1) * 4;
+                    let indices = a.indices.div_ceil(per_texel) * per_texel * 2;
+                    // What is left is the table: 8 bytes a cascade.
+                    let table = uploaded.checked_sub(records + cells + indices);
+                    let most = manylight::cluster::grid::MAX_CASCADES as usize * 8;
+                    assert!(
+                        table.is_some_and(|t| t > 0 && t <= most && t % 8 == 0),
+                        "{what}: {uploaded} bytes uploaded for {records} of records, {cells} \
+                         of cells and {indices} of indices"
+                    );
+                }
             }
-            let a = &stats.assignment;
-            let per_texel = if es == EsVersion::Es2 { 2 } else { 4 };
-            let cells = (a.clusters as usize + 1) * 4;
-            let indices = a.indices.div_ceil(per_texel) * per_texel * 2;
-            // What is left is the table: 8 bytes a cascade.
-            let table = uploaded.checked_sub(records + cells + indices);
-            let most = manylight::cluster::grid::MAX_CASCADES as usize * 8;
-            assert!(
-                table.is_some_and(|t| t > 0 && t <= most && t % 8 == 0),
-                "{es} {method}, {n} lights: {uploaded} bytes uploaded for {records} of records, \
-                 {cells} of cells and {indices} of indices"
-            );
         }
     });
 }

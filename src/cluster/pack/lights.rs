@@ -3,27 +3,31 @@
 //! All data textures are [`DATA_TEXTURE_WIDTH`] texels wide (a power of two, so texel
 //! addresses `i % W`, `i / W` and the ES 2.0 coordinates `(x + 0.5) / W` are exact in float
 //! arithmetic) and as many rows high as needed. Light `i` occupies texels
-//! `i·T … i·T + T−1` where `T` = [`LightEncoding::texels_per_light`] (also a power of two, so a
-//! light never straddles a row).
+//! `i·T … i·T + T−1` where `T` = [`LightLayout::texels_per_light`] (also a power of two, so a
+//! light never straddles a row). A frame without spot lights reads no spot texels, and its
+//! records leave them out: half the bytes.
 //!
 //! ```text
-//! Float32 (RGBA32F, 4 texels = 64 bytes per light; ES 3.0, or ES 2.0 with OES_texture_float)
+//! Float32 (RGBA32F, 16 bytes a texel; ES 3.0, or ES 2.0 with OES_texture_float)
 //!   t0: pos.x   pos.y   pos.z   radius        view-space position (metres)
 //!   t1: rad.r   rad.g   rad.b   spot_scale    radiance = colour × intensity
-//!   t2: dir.x   dir.y   dir.z   spot_offset   unit view-space spot axis
-//!   t3: rad.r/k² rad.g/k² rad.b/k² k          radiance in fp16 range: k = 2^e, e ≥ 0 the
+//!   or, for variants without fragment highp (FP16_LIGHTS):
+//!   t1: rad.r/k² rad.g/k² rad.b/k² k          radiance in fp16 range: k = 2^e, e ≥ 0 the
 //!                                             least with max(rad)/k² ≤ 1, rad at most 2³⁰
-//!                                             (read only by devices without fragment
-//!                                             highp, FP16_LIGHTS)
+//!   spots only:
+//!   t2: dir.x   dir.y   dir.z   spot_offset   unit view-space spot axis
+//!   t3: spot_scale  -  -  -                   (FP16_LIGHTS, where t1.w holds k)
+//!   → 2 texels (32 bytes) a light, 4 (64 bytes) with spots
 //!
-//! Rgba8 (RGBA8, 8 texels = 32 bytes per light; ES 2.0 without OES_texture_float). Lossy:
+//! Rgba8 (RGBA8, 4 bytes a texel; ES 2.0 without OES_texture_float). Lossy:
 //!   t0: x.hi x.lo y.hi y.lo      16-bit fixed point over [−pos_range, +pos_range]
 //!   t1: z.hi z.lo r.hi r.lo      radius 16-bit over [0, radius_range]
 //!   t2: R    G    B    E         shared-exponent radiance: c = m/255 · 2^(E−128)
+//!   spots only:
 //!   t3: dx.hi dx.lo dy.hi dy.lo  axis 16-bit snorm
 //!   t4: dz.hi dz.lo  omni  -     omni: 255 for a point light, 0 for a spot
 //!   t5: so.hi so.lo si.hi si.lo  sin(α/2) of the outer and inner half-angles, 16-bit unorm
-//!   t6, t7: (unused padding)
+//!   → 4 texels (16 bytes) a light (t3 unused), 8 (32 bytes) with spots (t6, t7 unused)
 //! ```
 //!
 //! The spot terms are `t = clamp(spot_offset − spot_scale·(1 − cos), 0, 1)` (see
@@ -53,7 +57,7 @@ pub enum LightEncoding {
 }
 
 impl LightEncoding {
-    /// Texels per light record (a power of two dividing the data textures' width, 1024).
+    /// Most texels a light record takes (with spots; [`LightLayout::texels_per_light`]).
     pub const fn texels_per_light(self) -> u32 {
         match self {
             LightEncoding::Float32 => 4,
@@ -70,11 +74,40 @@ impl LightEncoding {
     }
 }
 
+/// How a frame's light records are laid out: their encoding, and what the shader variant
+/// reading them needs (spot terms; radiance in fp16 range where fragments lack highp).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct LightLayout {
+    /// The records' encoding.
+    pub encoding: LightEncoding,
+    /// The records hold spot terms (the variant has spots).
+    pub spots: bool,
+    /// Float32 records hold radiance in fp16 range (the variant lacks fragment highp).
+    pub fp16: bool,
+}
+
+impl LightLayout {
+    /// Texels per light record: a power of two dividing the data textures' width, 1024.
+    pub const fn texels_per_light(self) -> u32 {
+        match (self.encoding, self.spots) {
+            (LightEncoding::Float32, false) => 2,
+            (LightEncoding::Float32, true) => 4,
+            (LightEncoding::Rgba8, false) => 4,
+            (LightEncoding::Rgba8, true) => 8,
+        }
+    }
+
+    /// Bytes per light record.
+    pub const fn bytes_per_light(self) -> usize {
+        self.texels_per_light() as usize * self.encoding.bytes_per_texel()
+    }
+}
+
 /// A light texture ready to upload.
 #[derive(Clone, Debug)]
 pub struct PackedLights {
-    /// Encoding of the records.
-    pub encoding: LightEncoding,
+    /// Layout of the records.
+    pub layout: LightLayout,
     /// Number of lights.
     pub count: usize,
     /// Texture width in texels ([`DATA_TEXTURE_WIDTH`]).
@@ -99,15 +132,15 @@ pub struct PackedLights {
 impl Default for PackedLights {
     /// [`PackedLights::empty`] for float records.
     fn default() -> Self {
-        PackedLights::empty(LightEncoding::Float32)
+        PackedLights::empty(LightLayout::default())
     }
 }
 
 impl PackedLights {
     /// No lights, and no bytes yet: a buffer for [`pack_lights_into`] to fill frame after frame.
-    pub fn empty(encoding: LightEncoding) -> PackedLights {
+    pub fn empty(layout: LightLayout) -> PackedLights {
         PackedLights {
-            encoding,
+            layout,
             count: 0,
             width: DATA_TEXTURE_WIDTH,
             height: 0,
@@ -121,20 +154,22 @@ impl PackedLights {
 }
 
 /// Packs lights into texels.
-pub fn pack_lights(lights: &[GpuLight], encoding: LightEncoding) -> PackedLights {
-    let mut packed = PackedLights::empty(encoding);
-    pack_lights_into(lights, encoding, &mut packed);
+pub fn pack_lights(lights: &[GpuLight], layout: LightLayout) -> PackedLights {
+    let mut packed = PackedLights::empty(layout);
+    pack_lights_into(lights, layout, &mut packed);
     packed
 }
 
 /// [`pack_lights`] into `packed`, reusing its bytes: once they have grown to a frame's size,
 /// packing allocates nothing.
-pub fn pack_lights_into(lights: &[GpuLight], encoding: LightEncoding, packed: &mut PackedLights) {
-    let tpl = encoding.texels_per_light() as usize;
+pub fn pack_lights_into(lights: &[GpuLight], layout: LightLayout, packed: &mut PackedLights) {
+    let (encoding, record) = (layout.encoding, layout.bytes_per_light());
     let width = DATA_TEXTURE_WIDTH as usize;
-    let height = (lights.len() * tpl).div_ceil(width).max(1);
+    let height = (lights.len() * layout.texels_per_light() as usize)
+        .div_ceil(width)
+        .max(1);
     let bytes = &mut packed.bytes;
-    zeroed_with_room(bytes, lights.len() * tpl * encoding.bytes_per_texel());
+    zeroed_with_room(bytes, lights.len() * record);
     let pos_range = lights
         .iter()
         .map(|l| l.position.abs().max_element())
@@ -151,27 +186,32 @@ pub fn pack_lights_into(lights: &[GpuLight], encoding: LightEncoding, packed: &m
     for (i, l) in lights.iter().enumerate() {
         match encoding {
             LightEncoding::Float32 => {
-                let (fp16_radiance, root) = fp16_radiance(l.radiance);
+                let (radiance, w) = if layout.fp16 {
+                    fp16_radiance(l.radiance)
+                } else {
+                    (l.radiance, l.spot_scale)
+                };
                 let rec: [f32; 16] = [
                     l.position.x,
                     l.position.y,
                     l.position.z,
                     l.radius, //
-                    l.radiance.x,
-                    l.radiance.y,
-                    l.radiance.z,
-                    l.spot_scale, //
+                    radiance.x,
+                    radiance.y,
+                    radiance.z,
+                    w, //
                     l.direction.x,
                     l.direction.y,
                     l.direction.z,
                     l.spot_offset, //
-                    fp16_radiance.x,
-                    fp16_radiance.y,
-                    fp16_radiance.z,
-                    root,
+                    l.spot_scale,
+                    0.0,
+                    0.0,
+                    0.0,
                 ];
-                let start = i * tpl * 16;
-                bytes[start..start + 64].copy_from_slice(bytemuck::cast_slice(&rec));
+                let floats = record / 4;
+                bytes[i * record..(i + 1) * record]
+                    .copy_from_slice(bytemuck::cast_slice(&rec[..floats]));
             }
             LightEncoding::Rgba8 => {
                 // A light of radius 0 (forward's darkened unseen ones) lights nothing anyway.
@@ -187,12 +227,14 @@ pub fn pack_lights_into(lights: &[GpuLight], encoding: LightEncoding, packed: &m
                     // up would light pixels of cells whose lists leave the light out.
                     unorm16_down((l.radius - centre_error).max(0.0) / radius_range),
                 ];
-                let start = i * tpl * 4;
-                let rec = &mut bytes[start..start + 32];
+                let rec = &mut bytes[i * record..(i + 1) * record];
                 for (k, w) in words.iter().enumerate() {
                     rec[k * 2..k * 2 + 2].copy_from_slice(&w.to_be_bytes());
                 }
                 rec[8..12].copy_from_slice(&rgbe(l.radiance));
+                if !layout.spots {
+                    continue;
+                }
                 for (k, w) in [s(l.direction.x), s(l.direction.y), s(l.direction.z)]
                     .iter()
                     .enumerate()
@@ -208,7 +250,7 @@ pub fn pack_lights_into(lights: &[GpuLight], encoding: LightEncoding, packed: &m
             }
         }
     }
-    packed.encoding = encoding;
+    packed.layout = layout;
     packed.count = lights.len();
     packed.width = DATA_TEXTURE_WIDTH;
     packed.height = height as u32;
@@ -231,54 +273,63 @@ pub fn pack_lights_into(lights: &[GpuLight], encoding: LightEncoding, packed: &m
 /// Decodes light `i` exactly as the shader does (used to test round trips and to measure the
 /// Rgba8 error).
 pub fn unpack_light(packed: &PackedLights, i: usize) -> GpuLight {
-    let tpl = packed.encoding.texels_per_light() as usize;
-    match packed.encoding {
+    let layout = packed.layout;
+    let record = layout.bytes_per_light();
+    let rec = &packed.bytes[i * record..(i + 1) * record];
+    // What a record without spot terms stands for: a point light (Light::spot_scale_offset).
+    let point = |position: Vec3, radius: f32, radiance: Vec3| GpuLight {
+        position,
+        radius,
+        cull_radius: radius,
+        radiance,
+        spot_scale: 0.0,
+        direction: Vec3::ZERO,
+        spot_offset: 1.0,
+        cone_deg: (180.0, 180.0),
+    };
+    match layout.encoding {
         LightEncoding::Float32 => {
-            let start = i * tpl * 16;
-            let f: &[f32] = bytemuck::cast_slice(&packed.bytes[start..start + 64]);
-            GpuLight {
-                position: Vec3::new(f[0], f[1], f[2]),
-                radius: f[3],
-                cull_radius: f[3],
-                radiance: Vec3::new(f[4], f[5], f[6]),
-                spot_scale: f[7],
-                direction: Vec3::new(f[8], f[9], f[10]),
-                spot_offset: f[11],
-                cone_deg: (f32::NAN, f32::NAN),
+            let f: &[f32] = bytemuck::cast_slice(rec);
+            // Powers of two: k² scales the fp16 form back exactly.
+            let k2 = if layout.fp16 { f[7] * f[7] } else { 1.0 };
+            let mut light = point(
+                Vec3::new(f[0], f[1], f[2]),
+                f[3],
+                Vec3::new(f[4], f[5], f[6]) * k2,
+            );
+            if layout.spots {
+                light.spot_scale = if layout.fp16 { f[12] } else { f[7] };
+                light.direction = Vec3::new(f[8], f[9], f[10]);
+                light.spot_offset = f[11];
+                light.cone_deg = (f32::NAN, f32::NAN);
             }
+            light
         }
         LightEncoding::Rgba8 => {
-            let start = i * tpl * 4;
-            let rec = &packed.bytes[start..start + 32];
             let w = |k: usize| u16::from_be_bytes([rec[k], rec[k + 1]]) as f32 / 65535.0;
             let pos = |k: usize| (w(k) * 2.0 - 1.0) * packed.pos_range;
             let snorm = |k: usize| w(k) * 2.0 - 1.0;
             let e = rec[11] as i32 - 128;
             let radiance =
                 Vec3::new(rec[8] as f32, rec[9] as f32, rec[10] as f32) / 255.0 * 2f32.powi(e);
-            let dir = Vec3::new(snorm(12), snorm(14), snorm(16));
-            let (sine_outer, sine_inner) = (w(20), w(22));
-            let angle = |sine: f32| 2.0 * (sine as f64).asin().to_degrees() as f32;
-            let ((scale, offset), (outer, inner)) = if rec[18] == 255 {
-                ((0.0, 1.0), (180.0, 180.0))
-            } else {
+            let mut light = point(
+                Vec3::new(pos(0), pos(2), pos(4)),
+                w(6) * packed.radius_range,
+                radiance,
+            );
+            if layout.spots && rec[18] != 255 {
+                let (sine_outer, sine_inner) = (w(20), w(22));
+                let angle = |sine: f32| 2.0 * (sine as f64).asin().to_degrees() as f32;
                 let (scale, offset) =
                     spot_terms_from_half_sines(sine_outer as f64, sine_inner as f64);
-                (
-                    (scale as f32, offset as f32),
-                    (angle(sine_outer), angle(sine_inner)),
-                )
-            };
-            GpuLight {
-                position: Vec3::new(pos(0), pos(2), pos(4)),
-                radius: w(6) * packed.radius_range,
-                cull_radius: w(6) * packed.radius_range,
-                radiance,
-                spot_scale: scale,
-                direction: dir.normalize_or_zero(),
-                spot_offset: offset,
-                cone_deg: (outer, inner),
+                light.spot_scale = scale as f32;
+                light.spot_offset = offset as f32;
+                light.cone_deg = (angle(sine_outer), angle(sine_inner));
             }
+            if layout.spots {
+                light.direction = Vec3::new(snorm(12), snorm(14), snorm(16)).normalize_or_zero();
+            }
+            light
         }
     }
 }
@@ -370,36 +421,67 @@ mod tests {
             .collect()
     }
 
+    /// Records with spot terms in `encoding`, radiance as fragments with highp read it.
+    fn with_spots(encoding: LightEncoding) -> LightLayout {
+        LightLayout {
+            encoding,
+            spots: true,
+            fp16: false,
+        }
+    }
+
     #[test]
-    fn float32_round_trips_exactly() {
+    fn float32_round_trips_exactly_in_every_layout() {
         let lights = sample_lights();
-        let packed = pack_lights(&lights, LightEncoding::Float32);
-        assert_eq!(packed.width, DATA_TEXTURE_WIDTH);
-        assert_eq!(packed.height, 2); // 300 × 4 texels over 1024-wide rows
-        assert_eq!(packed.bytes.len(), 300 * 4 * 16); // the second row's rest left out
-        for (i, l) in lights.iter().enumerate() {
-            let u = unpack_light(&packed, i);
-            assert_eq!(
-                (u.position, u.radius, u.radiance),
-                (l.position, l.radius, l.radiance)
-            );
-            assert_eq!(
-                (u.direction, u.spot_scale, u.spot_offset),
-                (l.direction, l.spot_scale, l.spot_offset)
-            );
+        for (spots, fp16) in [(true, false), (true, true), (false, false), (false, true)] {
+            let layout = LightLayout {
+                encoding: LightEncoding::Float32,
+                spots,
+                fp16,
+            };
+            let packed = pack_lights(&lights, layout);
+            let texels = if spots { 4 } else { 2 };
+            assert_eq!(packed.width, DATA_TEXTURE_WIDTH);
+            // 300 records over 1 024-texel rows, the last row's rest left out.
+            assert_eq!(packed.height, if spots { 2 } else { 1 });
+            assert_eq!(packed.bytes.len(), 300 * texels * 16);
+            for (i, l) in lights.iter().enumerate() {
+                let u = unpack_light(&packed, i);
+                assert_eq!(
+                    (u.position, u.radius, u.radiance),
+                    (l.position, l.radius, l.radiance),
+                    "light {i}, {layout:?}"
+                );
+                // Without spots a record is a point light's, whatever the light was.
+                let spot = |l: &GpuLight| (l.direction, l.spot_scale, l.spot_offset);
+                let expected = if spots {
+                    spot(l)
+                } else {
+                    (Vec3::ZERO, 0.0, 1.0)
+                };
+                assert_eq!(spot(&u), expected, "light {i}, {layout:?}");
+            }
         }
     }
 
     #[test]
     fn fp16_radiance_fits_fp16_and_scales_back_exactly() {
         let lights = sample_lights();
-        let packed = pack_lights(&lights, LightEncoding::Float32);
-        for (i, l) in lights.iter().enumerate() {
-            let f: &[f32] = bytemuck::cast_slice(&packed.bytes[i * 64..i * 64 + 64]);
-            let (scaled, k) = (Vec3::new(f[12], f[13], f[14]), f[15]);
-            assert!(scaled.max_element() <= 1.0 && k >= 1.0 && k.log2().fract() == 0.0);
-            // Powers of two scale exactly.
-            assert_eq!(scaled * (k * k), l.radiance, "light {i}");
+        for spots in [true, false] {
+            let layout = LightLayout {
+                encoding: LightEncoding::Float32,
+                spots,
+                fp16: true,
+            };
+            let packed = pack_lights(&lights, layout);
+            let record = layout.bytes_per_light();
+            for (i, l) in lights.iter().enumerate() {
+                let f: &[f32] = bytemuck::cast_slice(&packed.bytes[i * record..(i + 1) * record]);
+                let (scaled, k) = (Vec3::new(f[4], f[5], f[6]), f[7]);
+                assert!(scaled.max_element() <= 1.0 && k >= 1.0 && k.log2().fract() == 0.0);
+                // Powers of two scale exactly.
+                assert_eq!(scaled * (k * k), l.radiance, "light {i}");
+            }
         }
         for (c, k) in [
             (0.5, 1.0),
@@ -427,11 +509,17 @@ mod tests {
     #[test]
     fn rgba8_counts_the_lights_its_ranges_cannot_hold() {
         let lights = sample_lights();
-        assert_eq!(pack_lights(&lights, LightEncoding::Rgba8).coarse, 0);
-        assert_eq!(pack_lights(&lights, LightEncoding::Float32).coarse, 0);
+        assert_eq!(
+            pack_lights(&lights, with_spots(LightEncoding::Rgba8)).coarse,
+            0
+        );
+        assert_eq!(
+            pack_lights(&lights, with_spots(LightEncoding::Float32)).coarse,
+            0
+        );
         let mut with_huge = lights.clone();
         with_huge[0].radius = 1e6;
-        let packed = pack_lights(&with_huge, LightEncoding::Rgba8);
+        let packed = pack_lights(&with_huge, with_spots(LightEncoding::Rgba8));
         assert_eq!(packed.coarse, lights.len() - 1);
         // What a record keeps of a radius lies within it, however coarse the steps.
         for (i, light) in with_huge.iter().enumerate() {
@@ -450,7 +538,7 @@ mod tests {
     #[test]
     fn rgba8_error_stays_within_its_quantisation_bounds() {
         let lights = sample_lights();
-        let packed = pack_lights(&lights, LightEncoding::Rgba8);
+        let packed = pack_lights(&lights, with_spots(LightEncoding::Rgba8));
         let pos_step = 2.0 * packed.pos_range / 65535.0;
         for (i, l) in lights.iter().enumerate() {
             let u = unpack_light(&packed, i);
@@ -481,6 +569,35 @@ mod tests {
                 assert!((u.direction - l.direction).length() < 1e-4);
                 assert!((u.cone_deg.0 - l.cone_deg.0).abs() < 0.002);
             }
+        }
+    }
+
+    /// Without spots an RGBA8 record is its first four texels (t3 unused): the same
+    /// position, radius and radiance as with spots, at half the bytes.
+    #[test]
+    fn rgba8_points_keep_the_first_texels_at_half_the_bytes() {
+        let lights = sample_lights();
+        let full = pack_lights(&lights, with_spots(LightEncoding::Rgba8));
+        let points = LightLayout {
+            spots: false,
+            ..with_spots(LightEncoding::Rgba8)
+        };
+        let half = pack_lights(&lights, points);
+        assert_eq!(half.bytes.len() * 2, full.bytes.len());
+        for i in 0..lights.len() {
+            let (a, b) = (unpack_light(&full, i), unpack_light(&half, i));
+            assert_eq!(
+                (a.position, a.radius, a.radiance),
+                (b.position, b.radius, b.radiance)
+            );
+            assert_eq!(
+                (b.spot_scale, b.spot_offset, b.direction),
+                (0.0, 1.0, Vec3::ZERO)
+            );
+            assert_eq!(
+                full.bytes[i * 32..i * 32 + 12],
+                half.bytes[i * 16..i * 16 + 12]
+            );
         }
     }
 

@@ -11,6 +11,6 @@ pub use grid::{
     RGBA8_CELL_CAP, RGBA8_OFFSET_LIMIT, TABLE_TEXELS_PER_CASCADE,
 };
 pub use lights::{
-    fp16_radiance, pack_lights, pack_lights_into, unpack_light, LightEncoding, PackedLights,
-    DATA_TEXTURE_WIDTH, FP16_MAX_RADIANCE,
+    fp16_radiance, pack_lights, pack_lights_into, unpack_light, LightEncoding, LightLayout,
+    PackedLights, DATA_TEXTURE_WIDTH, FP16_MAX_RADIANCE,
 };

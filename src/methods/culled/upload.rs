@@ -109,7 +109,7 @@ impl Uploads {
             .extend(assignment.visible.iter().map(|&i| ctx.lights[i as usize]));
         let encoding = ctx.features.light_encoding();
         let grid_encoding = GridEncoding::for_es(dev.es());
-        pack_lights_into(&self.visible, encoding, &mut self.lights);
+        pack_lights_into(&self.visible, ctx.features.light_layout(), &mut self.lights);
         pack_grid_into(grid, assignment, grid_encoding, &mut self.grid);
         pack_indices_into(&assignment.indices, grid_encoding, &mut self.indices);
 

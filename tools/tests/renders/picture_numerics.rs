@@ -522,3 +522,69 @@ fn without_highp_a_light_too_far_to_place_is_refused_by_name_or_left_out_when_it
         }
     });
 }
+
+/// A record holds spot terms only where the scene has spots, so its size and layout follow the
+/// scene: six point lights of their own colours, then the same with one a spot, on float and
+/// RGBA8 records and on the fp16 form, every method, each the f64 model's picture. Forward
+/// reads the records as the other methods do and would share a mistake; the model does not.
+#[test]
+fn records_with_and_without_spot_terms_draw_the_f64_models_picture() {
+    let mut s = lit_plane();
+    s.lights = (0..6)
+        .map(|i| {
+            let f = i as f64;
+            let colour = Vec3::new(1.0 - 0.15 * i as f32, 0.2 + 0.1 * i as f32, 0.5);
+            Light::point(
+                DVec3::new(f * 0.6 - 1.5, 0.4 - 0.2 * f, 0.8),
+                2.0,
+                colour,
+                1.5,
+            )
+        })
+        .collect();
+    let mut with_spot = s.clone();
+    with_spot.lights[2] = Light::spot(
+        DVec3::new(0.0, 0.0, 1.5),
+        3.0,
+        Vec3::new(0.3, 1.0, 0.6),
+        2.0,
+        scene::Cone {
+            direction: DVec3::new(0.3, 0.0, -1.0),
+            inner_deg: 15.0,
+            outer_deg: 35.0,
+        },
+    );
+    for (device, es, restrictions) in [
+        ("ES 3.0", EsVersion::Es3, Default::default()),
+        (
+            "ES 2.0 without fragment highp",
+            EsVersion::Es2,
+            manylight::gl::Restrictions {
+                no_fragment_highp: true,
+                ..Default::default()
+            },
+        ),
+        (
+            "ES 2.0 without float textures",
+            EsVersion::Es2,
+            manylight::gl::Restrictions {
+                no_float_textures: true,
+                ..Default::default()
+            },
+        ),
+    ] {
+        let mut gpu = Gpu::restricted(es, &restrictions);
+        for method in methods(&mut gpu) {
+            for (scene, what) in [(&s, "points"), (&with_spot, "a spot among them")] {
+                let img = render(&mut gpu, method, scene);
+                let (e, at, n) = max_oracle_error(&img, scene, Encoding::Srgb, gpu.r().caps());
+                assert!(n > 1000, "{device} {method} {what}: {n} compared");
+                let bound = f64_model_bound(device);
+                assert!(
+                    e <= bound,
+                    "{device} {method} {what}: {e:.1} / 255 off the f64 model at {at:?}"
+                );
+            }
+        }
+    }
+}
