@@ -6,7 +6,7 @@
 //! refused or does not decode is a warning and the material keeps its flat `Kd` colour — the
 //! load never aborts for a texture.
 
-use std::path::Path;
+use std::path::{Component, Path};
 use std::sync::Arc;
 
 use glam::{DMat4, DVec3, Vec2, Vec3};
@@ -466,7 +466,7 @@ fn parse_obj(path: &Path, allow_outside: bool) -> Result<Parsed, SceneError> {
             return Ok(Default::default());
         }
         let bytes = read_bounded(&mtl_path, FileKind::Materials).map_err(|e| {
-            warn(e.to_string());
+            warn(library_unread(path, &name, e));
             tobj::LoadError::OpenFileFailed
         })?;
         let (text, not_utf8) = text_of(bytes);
@@ -488,11 +488,43 @@ fn parse_obj(path: &Path, allow_outside: bool) -> Result<Parsed, SceneError> {
         };
         tobj::load_mtl_buf(&mut std::io::BufReader::new(kept.as_bytes()))
     };
+    // tobj passes an `mtllib` line's rest as one name: one library whose name has spaces, or
+    // several libraries (`mtllib a.mtl b.mtl`, as the format has it), each read in turn.
+    let load_line = |line: &Path| -> tobj::MTLLoadResult {
+        let whole = line.to_string_lossy();
+        let names: Vec<&str> = whole.split_whitespace().collect();
+        let plain = line.components().all(|c| matches!(c, Component::Normal(_)));
+        if names.len() < 2 || (plain && base_dir.join(line).is_file()) {
+            return load_mtl(line);
+        }
+        let mut merged = None;
+        let mut failed = None;
+        for name in names {
+            match load_mtl(Path::new(name)) {
+                Ok(library) => match &mut merged {
+                    None => merged = Some(library),
+                    Some((materials, by_name)) => {
+                        let (more, more_names) = library;
+                        for (material, i) in more_names {
+                            by_name.entry(material).or_insert(i + materials.len());
+                        }
+                        materials.extend(more);
+                    }
+                },
+                Err(e) => failed = Some(e),
+            }
+        }
+        match (merged, failed) {
+            (Some(merged), _) => Ok(merged),
+            (None, Some(e)) => Err(e),
+            (None, None) => Ok(Default::default()),
+        }
+    };
     let parsed = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
         tobj::load_obj_buf(
             &mut std::io::BufReader::new(text.as_bytes()),
             &options,
-            load_mtl,
+            load_line,
         )
     }));
     let obj_error = |reason: String| SceneError::Obj {
@@ -517,6 +549,20 @@ fn parse_obj(path: &Path, allow_outside: bool) -> Result<Parsed, SceneError> {
             "the OBJ parser (tobj) failed on this file; it is malformed".into(),
         )),
     }
+}
+
+/// A material library that could not be read, as its warning says it: the OBJ, the name its
+/// `mtllib` line gives (cut as a name from a file is) and why.
+fn library_unread(obj: &Path, name: &str, error: SceneError) -> String {
+    let why = match error {
+        SceneError::Io { source, .. } => source.to_string(),
+        other => other.to_string(),
+    };
+    format!(
+        "{}: mtllib `{}` cannot be read: {why}",
+        obj.display(),
+        shown::name(name)
+    )
 }
 
 /// MTL statements the Blinn-Phong OBJ material does not read but warns of (normal maps, the

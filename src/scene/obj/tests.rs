@@ -239,3 +239,57 @@ fn out_of_range_mtl_numbers_are_warnings_naming_the_statement() {
         report.warnings
     );
 }
+
+/// `mtllib a.mtl b.mtl` names two libraries, as the format has it: both are read (a name
+/// with a space that is one file is still read as one).
+#[test]
+fn one_mtllib_line_naming_several_libraries_reads_each() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("l0.mtl"), "newmtl red\nKd 1 0 0\n").unwrap();
+    std::fs::write(dir.path().join("l1.mtl"), "newmtl green\nKd 0 1 0\n").unwrap();
+    std::fs::write(dir.path().join("my lib.mtl"), "newmtl blue\nKd 0 0 1\n").unwrap();
+    let obj = dir.path().join("m.obj");
+    let tri =
+        |m: &str, first: u32| format!("usemtl {m}\nf {} {} {}\n", first, first + 1, first + 2);
+    let text = format!(
+        "mtllib l0.mtl l1.mtl\nmtllib my lib.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\n{}{}{}",
+        tri("red", 1),
+        tri("green", 1),
+        tri("blue", 1)
+    );
+    std::fs::write(&obj, text).unwrap();
+    let (scene, report) = load(&obj);
+    let diffuse: Vec<Vec3> = (scene.objects.iter())
+        .map(|o| scene.materials[o.material].diffuse)
+        .collect();
+    assert_eq!(
+        diffuse,
+        [Vec3::X, Vec3::Y, Vec3::Z],
+        "{:?}",
+        report.warnings
+    );
+    assert!(report.warnings.is_empty(), "{:?}", report.warnings);
+}
+
+/// A library that cannot be read is named as a name from a file is, cut after 64
+/// characters: a line of the OBJ does not reach the message whole.
+#[test]
+fn an_unread_librarys_warning_names_the_obj_and_cuts_the_name() {
+    let dir = tempfile::tempdir().unwrap();
+    let obj = dir.path().join("m.obj");
+    let name = format!("{}.mtl", "x/".repeat(900));
+    std::fs::write(
+        &obj,
+        format!("mtllib {name}\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"),
+    )
+    .unwrap();
+    let (_, report) = load(&obj);
+    let said = report
+        .warnings
+        .iter()
+        .find(|w| w.contains("mtllib"))
+        .unwrap_or_else(|| panic!("{:?}", report.warnings));
+    assert!(said.starts_with(&obj.display().to_string()), "{said}");
+    assert!(said.contains("characters more"), "{said}");
+    assert!(said.len() < obj.display().to_string().len() + 300, "{said}");
+}
