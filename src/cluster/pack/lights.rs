@@ -57,7 +57,8 @@ pub enum LightEncoding {
 }
 
 impl LightEncoding {
-    /// Most texels a light record takes (with spots; [`LightLayout::texels_per_light`]).
+    /// Most texels a light record takes: with spots (`LightLayout::texels_per_light` gives a
+    /// frame's).
     pub const fn texels_per_light(self) -> u32 {
         match self {
             LightEncoding::Float32 => 4,
