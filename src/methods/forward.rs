@@ -13,7 +13,9 @@ use super::forward_cap::CapView;
 use super::geometry::{self, GeometryProgram, UNIT_METHOD};
 use super::uniforms::{self, LightData, Surface, Transforms};
 use super::{FrameContext, MethodDesc, MethodStats, ShaderFeatures, ShadingMethod, Support};
-use crate::cluster::pack::{pack_lights_into, LightEncoding, PackedLights, DATA_TEXTURE_WIDTH};
+use crate::cluster::pack::{
+    pack_lights_into, LightEncoding, LightLayout, PackedLights, DATA_TEXTURE_WIDTH,
+};
 use crate::cluster::view_light::GpuLight;
 use crate::gl::program::{Resolver, Uniform, UniformSet};
 use crate::gl::texture::{DataFormat, DataTexture};
@@ -67,7 +69,7 @@ pub(crate) fn data_textures_unfit(caps: &Caps) -> Option<String> {
 /// and a driver that ends long loops early bounds any loop ([`Caps::light_loop_budget`]).
 pub fn max_lights(caps: &Caps) -> u32 {
     let texture_rows = caps.max_texture_size.max(1) as u32;
-    let by_texture = texture_rows * (DATA_TEXTURE_WIDTH / LightEncoding::Rgba8.texels_per_light());
+    let by_texture = texture_rows * (DATA_TEXTURE_WIDTH / LightLayout::MOST_TEXELS_PER_LIGHT);
     let by_loop = match (caps.es, caps.fragment_has_highp()) {
         (EsVersion::Es3, _) => u32::MAX,
         (EsVersion::Es2, true) => 65_535,

@@ -57,15 +57,6 @@ pub enum LightEncoding {
 }
 
 impl LightEncoding {
-    /// Most texels a light record takes: with spots (`LightLayout::texels_per_light` gives a
-    /// frame's).
-    pub const fn texels_per_light(self) -> u32 {
-        match self {
-            LightEncoding::Float32 => 4,
-            LightEncoding::Rgba8 => 8,
-        }
-    }
-
     /// Bytes per texel.
     pub const fn bytes_per_texel(self) -> usize {
         match self {
@@ -88,6 +79,14 @@ pub struct LightLayout {
 }
 
 impl LightLayout {
+    /// Most texels a light record takes, whatever the frame: RGBA8 with spot terms.
+    pub const MOST_TEXELS_PER_LIGHT: u32 = LightLayout {
+        encoding: LightEncoding::Rgba8,
+        spots: true,
+        fp16: false,
+    }
+    .texels_per_light();
+
     /// Texels per light record: a power of two dividing the data textures' width, 1024.
     pub const fn texels_per_light(self) -> u32 {
         match (self.encoding, self.spots) {
@@ -318,17 +317,18 @@ pub fn unpack_light(packed: &PackedLights, i: usize) -> GpuLight {
                 w(6) * packed.radius_range,
                 radiance,
             );
-            if layout.spots && rec[18] != 255 {
-                let (sine_outer, sine_inner) = (w(20), w(22));
-                let angle = |sine: f32| 2.0 * (sine as f64).asin().to_degrees() as f32;
-                let (scale, offset) =
-                    spot_terms_from_half_sines(sine_outer as f64, sine_inner as f64);
-                light.spot_scale = scale as f32;
-                light.spot_offset = offset as f32;
-                light.cone_deg = (angle(sine_outer), angle(sine_inner));
-            }
             if layout.spots {
                 light.direction = Vec3::new(snorm(12), snorm(14), snorm(16)).normalize_or_zero();
+                // 255 in t4.z: a point light among spots.
+                if rec[18] != 255 {
+                    let (sine_outer, sine_inner) = (w(20), w(22));
+                    let angle = |sine: f32| 2.0 * (sine as f64).asin().to_degrees() as f32;
+                    let (scale, offset) =
+                        spot_terms_from_half_sines(sine_outer as f64, sine_inner as f64);
+                    light.spot_scale = scale as f32;
+                    light.spot_offset = offset as f32;
+                    light.cone_deg = (angle(sine_outer), angle(sine_inner));
+                }
             }
             light
         }
