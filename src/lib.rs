@@ -1,7 +1,8 @@
 //! # manylight
 //!
 //! Thousands of dynamic point and spot lights on OpenGL ES 2.0 and 3.0, mobile first: lights
-//! are assigned to a cascaded cluster grid on the CPU every frame and uploaded as textures.
+//! are assigned to a cascaded cluster grid on the CPU every frame (every frame in which
+//! something moved) and uploaded as textures.
 //!
 //! ## Start here
 //!

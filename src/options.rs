@@ -140,7 +140,9 @@ impl Default for RenderOptions {
 pub struct MeasureOptions {
     /// Frames timed after one warm-up frame by [`Renderer::render_offscreen`](crate::Renderer::render_offscreen); the median is
     /// reported. 0 times the single (cold) frame. At most [`MAX_TIMED_FRAMES`] (the frames'
-    /// figures are kept for the percentiles): more is refused naming `timed_frames`.
+    /// figures are kept for the percentiles): more is refused naming `timed_frames`. Each timed
+    /// frame assigns and uploads its light lists as a frame of moving lights does, where
+    /// frames of a still scene would reuse the last ones ([`FrameStats::lists_reused`](crate::FrameStats::lists_reused)).
     pub timed_frames: u32,
     /// Pack lights as RGBA8 even where float textures exist (to measure the packing error).
     pub force_rgba8_lights: bool,

@@ -78,4 +78,35 @@ impl GpuLight {
             cone_deg,
         }
     }
+
+    /// Whether `other` holds the same bits in every field: what an assignment and the packed
+    /// records are functions of (`==` would take `-0.0` for `0.0` and no NaN for itself).
+    pub fn same_bits(&self, other: &GpuLight) -> bool {
+        self.bits() == other.bits()
+    }
+
+    fn bits(&self) -> [u32; 15] {
+        let [px, py, pz] = self.position.to_array();
+        let [rx, ry, rz] = self.radiance.to_array();
+        let [dx, dy, dz] = self.direction.to_array();
+        let (outer, inner) = self.cone_deg;
+        [
+            px,
+            py,
+            pz,
+            self.radius,
+            self.cull_radius,
+            rx,
+            ry,
+            rz,
+            self.spot_scale,
+            dx,
+            dy,
+            dz,
+            self.spot_offset,
+            outer,
+            inner,
+        ]
+        .map(f32::to_bits)
+    }
 }

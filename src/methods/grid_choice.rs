@@ -158,6 +158,12 @@ impl AutoGrid {
         self.choice.as_ref().expect("chosen on the first frame")
     }
 
+    /// Whether this frame's [`AutoGrid::config`] measured candidates, with the assigner it was
+    /// given (whose last assignment is then a candidate's).
+    pub(crate) fn measured_candidates(&self) -> bool {
+        self.chose_this_frame
+    }
+
     /// Ends the search: its choice replaces the current grid unless the hysteresis keeps it.
     /// Written through kept buffers (the scratch choice, the current one's reason and
     /// candidates), so a re-choice allocates nothing once they have grown.

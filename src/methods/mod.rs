@@ -75,6 +75,10 @@ pub struct FrameContext<'a> {
     pub orthographic: bool,
     /// Active lights in view space (radius and radiance > 0).
     pub lights: &'a [GpuLight],
+    /// Changes whenever `lights` may differ from the last frame's (the renderer compares them
+    /// bit for bit as it gathers them): what a method built from lights of the same
+    /// generation, with everything else it depends on unchanged, it may keep.
+    pub lights_generation: u64,
     /// The frame's directional lights (shaded outside the light lists).
     pub directional: directional::DirectionalFrame,
     /// Scene-level shader features (spots present, output encoding, light encoding).
@@ -148,6 +152,8 @@ pub struct MethodStats<'a> {
     pub assign_ms: Option<f64>,
     /// Assignment figures (culling methods).
     pub assign: Option<crate::cluster::assign::AssignStats>,
+    /// The frame drew with the method's last lists and uploads (see `FrameStats`).
+    pub lists_reused: bool,
     /// G-buffer memory (deferred).
     pub gbuffer_bytes: usize,
     /// The grid the frame used (tiled, clustered).

@@ -258,7 +258,9 @@ impl Renderer {
             .camera
             .projection_matrix(width as f64 / height as f64)
             .as_mat4();
-        gather_lights(&mut self.lights, scene, &view, options);
+        if gather_lights(&mut self.lights, scene, &view, options) || self.timing_frames {
+            self.lights_generation += 1;
+        }
         let scene_features = SceneFeatures::of(scene);
         let features = shader_features(&scene_features, options, self.dev.caps()).with(
             methods::ShaderFeatures::OUTPUT_LINEAR,
@@ -282,7 +284,11 @@ impl Renderer {
             );
         }
         let reach = super::fp16_range::view_reach(scene, width as f64 / height as f64, content_far);
+        let gathered = self.lights.len();
         super::fp16_range::check(self.dev.caps(), scene, &mut self.lights, reach)?;
+        if self.lights.len() != gathered {
+            self.lights_generation += 1;
+        }
         super::fp16_channels::warn_of_lost_channels(self.dev.caps(), scene);
         super::fp16_channels::warn_of_capped_radiance(
             self.dev.caps(),
@@ -310,6 +316,7 @@ impl Renderer {
             projection,
             orthographic: matches!(scene.camera.projection, Projection::Orthographic { .. }),
             lights: &self.lights,
+            lights_generation: self.lights_generation,
             directional,
             features,
             viewport: (width, height),
@@ -430,6 +437,7 @@ impl Renderer {
             encoding: features.light_encoding(),
         };
         stats.assignment = assignment;
+        stats.lists_reused = method_stats.lists_reused;
         stats.grid.footprint_px = grid.map(|g| g.footprint_px);
         stats.grid.cells = grid.map_or(0, |g| g.cells);
         copy_opt_str(&mut stats.grid.reason, grid.map(|g| g.reason));

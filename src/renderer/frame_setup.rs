@@ -14,16 +14,17 @@ use crate::scene::{Aabb, Scene};
 
 /// Refills `lights` (keeping its buffer) with the scene's active lights in view space, each
 /// light's cull radius shortened to where it falls below `options.light_cutoff` when one is
-/// set.
+/// set. Returns whether the list differs, bit for bit, from the one `lights` held.
 pub(super) fn gather_lights(
     lights: &mut Vec<GpuLight>,
     scene: &Scene,
     view: &DMat4,
     options: &RenderOptions,
-) {
-    lights.clear();
-    lights.extend(scene.lights.iter().filter(|l| l.is_active()).map(|l| {
-        let mut g = GpuLight::from_light(l, view);
+) -> bool {
+    let mut changed = false;
+    let mut count = 0;
+    for light in scene.lights.iter().filter(|l| l.is_active()) {
+        let mut g = GpuLight::from_light(light, view);
         if let Some(cutoff) = options.light_cutoff {
             g.cull_radius = crate::scene::shading::cutoff_distance(
                 g.radiance.max_element() as f64,
@@ -31,8 +32,23 @@ pub(super) fn gather_lights(
                 cutoff as f64,
             ) as f32;
         }
-        g
-    }));
+        // Written over the last frame's list, compared on the way.
+        match lights.get_mut(count) {
+            Some(old) if old.same_bits(&g) => {}
+            Some(old) => {
+                *old = g;
+                changed = true;
+            }
+            None => {
+                lights.push(g);
+                changed = true;
+            }
+        }
+        count += 1;
+    }
+    changed |= lights.len() != count;
+    lights.truncate(count);
+    changed
 }
 
 /// The frame's directional lights in view space (the brightest

@@ -71,6 +71,12 @@ pub struct Renderer {
     freed: bool,
     /// The frame's active lights in view space (kept: a frame fills it without allocating).
     lights: Vec<GpuLight>,
+    /// Changes whenever `lights` may differ from the last frame's ([`FrameContext`]'s
+    /// `lights_generation`).
+    lights_generation: u64,
+    /// The frames being drawn are timed ([`MeasureOptions::timed_frames`]): each counts as
+    /// one whose lights moved, so it times an assignment, not a reuse.
+    timing_frames: bool,
     /// Which directional lights the frame shows (kept likewise).
     shown_directional: Vec<usize>,
     /// More directional lights than are shown was announced (once per renderer).
@@ -172,6 +178,8 @@ impl Renderer {
             pending_warning,
             freed: false,
             lights: Vec::new(),
+            lights_generation: 0,
+            timing_frames: false,
             shown_directional: Vec::new(),
             warned_directional: false,
             warned_depth_bits: false,

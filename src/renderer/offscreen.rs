@@ -15,7 +15,7 @@ impl Renderer {
     /// the clear colour's where nothing was drawn;
     /// the application's framebuffer binding and other GL state are as they were. With
     /// `options.measure.timed_frames > 0`, renders one warm-up frame and reports the median of
-    /// the timed ones.
+    /// the timed ones (each assigning its light lists anew, as `timed_frames` says).
     pub fn render_offscreen(
         &mut self,
         scene: &Scene,
@@ -87,11 +87,15 @@ impl Renderer {
             // but the programs the whole call built.
             let mut built = stats.programs_built;
             let mut frames = Vec::new();
-            for _ in 0..options.measure.timed_frames {
+            self.timing_frames = true;
+            let timed = (0..options.measure.timed_frames).try_for_each(|_| {
                 let timed = frame(self)?;
                 built += timed.programs_built;
                 frames.push(timed);
-            }
+                Ok::<(), Error>(())
+            });
+            self.timing_frames = false;
+            timed?;
             stats = FrameStats::summarize(frames).expect("at least one timed frame");
             stats.programs_built = built;
         }

@@ -60,6 +60,11 @@ pub struct FrameStats {
     /// The light assignment's figures (tiled, clustered; zeros for the other methods).
     #[serde(flatten)]
     pub assignment: AssignStats,
+    /// The frame drew with its method's last light lists and uploads (tiled, clustered):
+    /// nothing they are built from had changed (the lights in view space, the grid, the
+    /// limits, the light record layout), so it neither assigned nor uploaded them
+    /// (`assign_ms` and `upload_bytes` 0, the assignment's figures the lists' own).
+    pub lists_reused: bool,
     /// The cell grid (tiled, clustered).
     #[serde(flatten)]
     pub grid: GridStats,
@@ -181,6 +186,7 @@ impl Default for FrameStats {
             time: TimeStats::default(),
             lights: LightStats::default(),
             assignment: AssignStats::default(),
+            lists_reused: false,
             grid: GridStats::default(),
             memory: MemoryStats::default(),
         }

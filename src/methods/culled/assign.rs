@@ -23,6 +23,8 @@ pub(super) struct Assign {
 pub(super) struct Assigned<'a> {
     pub assignment: &'a Assignment,
     pub ms: f64,
+    /// The last frame's assignment, kept: nothing it depends on changed (no time, no work).
+    pub reused: bool,
 }
 
 impl Assign {
@@ -47,7 +49,21 @@ impl Assign {
             let automatic = method == "clustered" && ctx.options.grid.is_auto();
             warn_overflow(method, dropped, limits, automatic);
         }
-        Assigned { assignment, ms }
+        Assigned {
+            assignment,
+            ms,
+            reused: false,
+        }
+    }
+
+    /// The last frame's assignment as this frame's, when no automatic grid's candidate was
+    /// assigned since.
+    pub(super) fn reuse(&self) -> Option<Assigned<'_>> {
+        Some(Assigned {
+            assignment: self.last()?,
+            ms: 0.0,
+            reused: true,
+        })
     }
 
     /// The last frame's assignment; `None` when an automatic grid's candidate was assigned
@@ -57,9 +73,14 @@ impl Assign {
     }
 
     /// The assigner, for the automatic grid's candidates: they share the frame's buffers.
-    pub(super) fn assigner_mut(&mut self) -> &mut Assigner {
-        self.holds_candidate = true;
+    /// [`Assign::holds_candidates`] says when it assigned one.
+    pub(super) fn candidates_assigner(&mut self) -> &mut Assigner {
         &mut self.assigner
+    }
+
+    /// The assigner's last assignment is an automatic grid candidate's.
+    pub(super) fn holds_candidates(&mut self) {
+        self.holds_candidate = true;
     }
 }
 

@@ -41,9 +41,13 @@ impl CulledForward {
                     projection,
                     limits,
                     encoding,
-                    self.assign.assigner_mut(),
+                    self.assign.candidates_assigner(),
                 );
-                choice.config.clone()
+                let config = choice.config.clone();
+                if self.auto.measured_candidates() {
+                    self.assign.holds_candidates();
+                }
+                config
             }
             Culling::Clustered => ctx.options.grid.clone(),
             // Tiled shares the clustered grid's coverage setting (to measure it).
@@ -60,6 +64,7 @@ impl CulledForward {
             config: config.clone(),
         };
         if self.grid.as_ref().map(|(k, _)| k) != Some(&key) {
+            self.grid_generation += 1;
             let (w, h) = ctx.viewport;
             match &mut self.grid {
                 // In place: a moving camera changes the depth range, and so the grid, every
@@ -102,11 +107,15 @@ pub(super) fn record_cost(
     uploaded: &Uploaded,
 ) {
     let assignment = assigned.assignment;
-    let work = assign_work(
-        assignment.stats.runs,
-        assignment.indices.len(),
-        grid.total_cells,
-    );
+    // Reused lists cost no CPU work: such a frame calibrates the shading alone.
+    let work = match assigned.reused {
+        true => 0.0,
+        false => assign_work(
+            assignment.stats.runs,
+            assignment.indices.len(),
+            grid.total_cells,
+        ),
+    };
     auto.record(
         grid,
         &assignment.counts,

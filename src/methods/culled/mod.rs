@@ -1,6 +1,7 @@
 //! The shared engine of tiled and clustered forward: assign lights to a grid on the CPU every
 //! frame, upload three data textures (lights, grid, indices), and shade in one geometry pass
-//! where each fragment loops over its cell's lights only.
+//! where each fragment loops over its cell's lights only. A still frame (its `ListsKey` the
+//! last frame's) skips stages 3 and 4 and draws with the last upload.
 //!
 //! A frame runs these stages in order, each in its own file:
 //!
@@ -14,7 +15,7 @@
 //! 6. `draw` (here): the geometry pass, each program bound with them.
 //!
 //! Uploads are ring-buffered over `upload::RING` texture sets: a frame writes the set the GPU used
-//! `RING` frames ago, never one an in-flight frame may still read (drivers would otherwise stall
+//! `RING` uploads ago, never one an in-flight frame may still read (drivers would otherwise stall
 //! or copy on a rewrite).
 
 mod assign;
@@ -29,8 +30,9 @@ use super::geometry;
 use super::grid_choice::AutoGrid;
 use super::GridReport;
 use super::{FrameContext, MethodStats, ShadingMethod};
+use crate::cluster::assign::{AssignLimits, Assignment};
 use crate::cluster::grid::ClusterGrid;
-use crate::cluster::pack::{GridEncoding, MAX_INDEXED_LIGHTS, RGBA8_CELL_CAP};
+use crate::cluster::pack::{GridEncoding, LightLayout, MAX_INDEXED_LIGHTS, RGBA8_CELL_CAP};
 use crate::gl::Device;
 use crate::Error;
 
@@ -69,6 +71,22 @@ pub struct CulledForward {
     assign: assign::Assign,
     /// The packing buffers and the texture ring.
     upload: upload::Uploads,
+    /// Bumped whenever the grid is rebuilt.
+    grid_generation: u64,
+    /// What the last uploaded lists were built from: a frame with the same draws with them.
+    lists_key: Option<ListsKey>,
+}
+
+/// Everything a frame's light lists and uploaded textures are a function of: the lights (by
+/// generation), the grid (likewise), the camera's far plane, the assignment's limits and the
+/// light record layout. The ES version, also one, is the device's for good.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct ListsKey {
+    lights_generation: u64,
+    grid_generation: u64,
+    far: u64,
+    limits: AssignLimits,
+    layout: LightLayout,
 }
 
 impl CulledForward {
@@ -81,6 +99,8 @@ impl CulledForward {
             reason: String::new(),
             assign: assign::Assign::default(),
             upload: upload::Uploads::default(),
+            grid_generation: 0,
+            lists_key: None,
         }
     }
 
@@ -101,22 +121,35 @@ impl CulledForward {
         self.write_grid_reason(ctx);
         let (grid_key, grid) = self.grid.as_ref().expect("updated above");
         limits::check_grid(ctx.dev, grid, &grid_key.config)?;
-        let assigned = self.assign.run(method, grid, ctx, &limits);
-        if let Some(references) = assigned.assignment.unlisted {
-            let cells = grid.total_cells;
-            return Ok(CulledFrame::Unlisted { cells, references });
+        let key = ListsKey {
+            lights_generation: ctx.lights_generation,
+            grid_generation: self.grid_generation,
+            far: ctx.far.to_bits(),
+            limits,
+            layout: ctx.features.light_layout(),
+        };
+        // A still frame (nothing the lists depend on changed) draws with the last ones.
+        let reused = (self.lists_key == Some(key))
+            .then(|| self.assign.reuse().zip(self.upload.last_upload()))
+            .flatten();
+        let (assigned, uploaded) = match reused {
+            Some(reused) => reused,
+            None => {
+                self.lists_key = None;
+                let assigned = self.assign.run(method, grid, ctx, &limits);
+                if let Some(frame) = refused(assigned.assignment, refuse_overflow) {
+                    return Ok(frame);
+                }
+                let uploaded = self
+                    .upload
+                    .pack_and_upload(ctx, grid, assigned.assignment)?;
+                self.lists_key = Some(key);
+                (assigned, uploaded)
+            }
+        };
+        if let Some(frame) = refused(assigned.assignment, refuse_overflow) {
+            return Ok(frame);
         }
-        let visible = assigned.assignment.visible.len();
-        if visible > MAX_INDEXED_LIGHTS {
-            return Ok(CulledFrame::TooManyVisible(visible));
-        }
-        let overflowed = assigned.assignment.stats.overflowed_lights;
-        if refuse_overflow && overflowed > 0 {
-            return Ok(CulledFrame::Overflowed(overflowed));
-        }
-        let uploaded = self
-            .upload
-            .pack_and_upload(ctx, grid, assigned.assignment)?;
         if automatic {
             grid::record_cost(&mut self.auto, grid, &assigned, &uploaded);
         }
@@ -133,6 +166,7 @@ impl CulledForward {
             upload_bytes: uploaded.bytes,
             assign_ms: Some(assigned.ms),
             assign: Some(assigned.assignment.stats),
+            lists_reused: assigned.reused,
             grid: Some(GridReport {
                 footprint_px: grid_key.config.footprint_px,
                 cells: grid.total_cells,
@@ -150,6 +184,20 @@ impl CulledForward {
     fn automatic(&self, ctx: &FrameContext) -> bool {
         self.culling == Culling::Clustered && ctx.options.grid.is_auto()
     }
+}
+
+/// Why a frame with `assignment` is not drawn (see [`CulledFrame`]), if it is not.
+fn refused(assignment: &Assignment, refuse_overflow: bool) -> Option<CulledFrame<'static>> {
+    if let Some(references) = assignment.unlisted {
+        let cells = assignment.stats.clusters;
+        return Some(CulledFrame::Unlisted { cells, references });
+    }
+    let visible = assignment.visible.len();
+    if visible > MAX_INDEXED_LIGHTS {
+        return Some(CulledFrame::TooManyVisible(visible));
+    }
+    let overflowed = assignment.stats.overflowed_lights;
+    (refuse_overflow && overflowed > 0).then_some(CulledFrame::Overflowed(overflowed))
 }
 
 /// The geometry pass with the `clustered` shader, each program bound with the frame's
@@ -199,6 +247,7 @@ impl ShadingMethod for CulledForward {
 
     /// Frees the ring.
     fn destroy(&mut self, dev: &Device) {
+        self.lists_key = None;
         self.upload.destroy(dev);
     }
 }

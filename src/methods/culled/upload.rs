@@ -60,6 +60,9 @@ impl TextureSet {
 pub(super) struct Uploads {
     ring: Vec<Option<TextureSet>>,
     frame: usize,
+    /// The ring slot and light ranges of the last upload, which a frame with the same lists
+    /// draws with again ([`Uploads::last_upload`]).
+    last: Option<(usize, [f32; 2])>,
     /// The visible lights, their texels, the grid's and the index list's texels.
     visible: Vec<GpuLight>,
     lights: PackedLights,
@@ -72,6 +75,7 @@ impl Default for Uploads {
         Uploads {
             ring: (0..RING).map(|_| None).collect(),
             frame: 0,
+            last: None,
             visible: Vec::new(),
             lights: PackedLights::default(),
             grid: PackedTexels::default(),
@@ -103,6 +107,7 @@ impl Uploads {
     ) -> Result<Uploaded<'_>, Error> {
         let dev = ctx.dev;
         let started = Instant::now();
+        self.last = None;
         self.visible.clear();
         room_for(&mut self.visible, assignment.visible.len());
         self.visible
@@ -113,18 +118,33 @@ impl Uploads {
         pack_grid_into(grid, assignment, grid_encoding, &mut self.grid);
         pack_indices_into(&assignment.indices, grid_encoding, &mut self.indices);
 
-        let set = next_set(&mut self.ring, &mut self.frame, dev, encoding)?;
+        let slot = next_slot(&mut self.frame);
+        let set = set_at(&mut self.ring, slot, dev, encoding)?;
         let (lights, grid, indices) = (&self.lights, &self.grid, &self.indices);
         set.lights
             .upload(dev, lights.width, lights.height, &lights.bytes)?;
         set.grid.upload(dev, grid.width, grid.height, &grid.bytes)?;
         set.indices
             .upload(dev, indices.width, indices.height, &indices.bytes)?;
+        let light_ranges = [lights.pos_range, lights.radius_range];
+        self.last = Some((slot, light_ranges));
         Ok(Uploaded {
             set,
-            light_ranges: [lights.pos_range, lights.radius_range],
+            light_ranges,
             bytes: lights.bytes.len() + grid.bytes.len() + indices.bytes.len(),
             ms: started.elapsed().as_secs_f64() * 1e3,
+        })
+    }
+
+    /// The last upload's textures, for a frame whose lists and light records are that
+    /// upload's (nothing uploaded, nothing rewritten); `None` when it failed or was freed.
+    pub(super) fn last_upload(&self) -> Option<Uploaded<'_>> {
+        let (slot, light_ranges) = self.last?;
+        Some(Uploaded {
+            set: self.ring[slot].as_ref()?,
+            light_ranges,
+            bytes: 0,
+            ms: 0.0,
         })
     }
 
@@ -135,22 +155,28 @@ impl Uploads {
 
     /// Frees the ring.
     pub(super) fn destroy(&mut self, dev: &Device) {
+        self.last = None;
         for set in self.ring.iter_mut().filter_map(Option::take) {
             set.destroy(dev);
         }
     }
 }
 
-/// The ring's set for this frame: the one used `RING` frames ago, made anew when the light
-/// encoding changed.
-fn next_set<'r>(
+/// The ring's slot for this frame: the one used `RING` uploads ago.
+fn next_slot(frame: &mut usize) -> usize {
+    let slot = *frame % RING;
+    *frame += 1;
+    slot
+}
+
+/// The ring's set at `slot`, made anew when the light encoding changed.
+fn set_at<'r>(
     ring: &'r mut [Option<TextureSet>],
-    frame: &mut usize,
+    slot: usize,
     dev: &Device,
     encoding: LightEncoding,
 ) -> Result<&'r mut TextureSet, Error> {
-    let slot = &mut ring[*frame % RING];
-    *frame += 1;
+    let slot = &mut ring[slot];
     if slot.as_ref().is_some_and(|s| s.light_encoding != encoding) {
         if let Some(old) = slot.take() {
             old.destroy(dev);

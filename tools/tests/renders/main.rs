@@ -25,6 +25,7 @@ mod picture_numerics;
 mod plane_oracle;
 mod single_sided;
 mod srgb_framebuffer;
+mod still_frames;
 mod tone_map;
 mod viewport_origin;
 mod warm_up;
