@@ -2,14 +2,14 @@
 //! method. Below the methods and the renderer.
 
 use std::collections::{HashMap, HashSet};
-use std::sync::Arc;
+use std::sync::{Arc, Weak};
 
 use glam::{DMat4, DVec3};
 
 use crate::gl::mesh::GpuMesh;
 use crate::gl::texture::ImageTexture;
 use crate::gl::Device;
-use crate::scene::{triangle_reach, Aabb, Material, Mesh, Scene, SceneError, Texture};
+use crate::scene::{triangle_reach, Aabb, Camera, Material, Mesh, Scene, SceneError, Texture};
 use crate::Error;
 
 /// Meshes and textures of scenes, uploaded once and found again by identity. The cache holds
@@ -34,8 +34,51 @@ pub struct GpuScene {
     /// eye: object index → the split mesh and its model matrix (see
     /// `scene::triangle_reach`).
     splits: HashMap<usize, (GpuMesh, DMat4)>,
+    /// What `splits` were made for.
+    split_for: SplitInputs,
     /// A frame's splits ran out of triangles and said so (once a renderer).
     warned_split_budget: bool,
+}
+
+/// Everything a frame's split copies depend on: the camera, the frame's size and each
+/// object's mesh and transform. A frame with the same keeps the last frame's copies.
+#[derive(Default)]
+struct SplitInputs {
+    camera: Option<Camera>,
+    frame: (u32, u32),
+    /// Each object's mesh, weakly (the allocation stays, so no other mesh takes its address),
+    /// and transform bits.
+    objects: Vec<(Weak<Mesh>, [u64; 16])>,
+}
+
+impl SplitInputs {
+    fn object_key(o: &crate::scene::Object) -> [u64; 16] {
+        o.transform.to_cols_array().map(f64::to_bits)
+    }
+
+    fn same(&self, scene: &Scene, frame: (u32, u32)) -> bool {
+        self.camera == Some(scene.camera)
+            && self.frame == frame
+            && self.objects.len() == scene.objects.len()
+            && (self.objects.iter().zip(&scene.objects)).all(|((mesh, transform), o)| {
+                std::ptr::eq(mesh.as_ptr(), Arc::as_ptr(&o.mesh))
+                    && *transform == Self::object_key(o)
+            })
+    }
+
+    /// Refilled in place (no allocation once the list has grown).
+    fn set(&mut self, scene: &Scene, frame: (u32, u32)) {
+        self.camera = Some(scene.camera);
+        self.frame = frame;
+        self.objects.clear();
+        let objects = scene.objects.iter();
+        (self.objects).extend(objects.map(|o| (Arc::downgrade(&o.mesh), Self::object_key(o))));
+    }
+
+    fn clear(&mut self) {
+        self.camera = None;
+        self.objects.clear();
+    }
 }
 
 /// The textures a material samples, each with whether it is colour (base colour, emission:
@@ -148,13 +191,18 @@ impl GpuScene {
 
     /// Replaces last frame's split meshes with this frame's: objects of `scene` with triangles
     /// too long for their distance from its camera, or spanning too many of the `frame`'s
-    /// pixels, are drawn from a copy split near the eye.
+    /// pixels, are drawn from a copy split near the eye. Keeps them when neither the camera,
+    /// the frame's size nor any object changed. Returns the bytes it uploaded.
     pub(crate) fn split_for_frame(
         &mut self,
         dev: &Device,
         scene: &Scene,
         frame: (u32, u32),
-    ) -> Result<(), Error> {
+    ) -> Result<usize, Error> {
+        if self.split_for.same(scene, frame) {
+            return Ok(0);
+        }
+        self.split_for.clear();
         for (_, (mut m, _)) in self.splits.drain() {
             m.destroy(dev);
         }
@@ -174,10 +222,14 @@ impl GpuScene {
                 );
             }
         }
+        let mut uploaded = 0;
         for (i, mesh) in splits.meshes {
-            self.splits.insert(i, (GpuMesh::new(dev, &mesh)?, model));
+            let gpu = GpuMesh::new(dev, &mesh)?;
+            uploaded += gpu.gpu_bytes();
+            self.splits.insert(i, (gpu, model));
         }
-        Ok(())
+        self.split_for.set(scene, frame);
+        Ok(uploaded)
     }
 
     /// The mesh object `index` is drawn with this frame, and its model matrix: its uploaded
@@ -275,6 +327,7 @@ impl GpuScene {
                 .flatten()
                 .for_each(|mut t| t.destroy(dev));
         }
+        self.split_for.clear();
         for (_, (mut m, _)) in self.splits.drain() {
             m.destroy(dev);
         }

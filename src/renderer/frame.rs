@@ -251,7 +251,8 @@ impl Renderer {
         self.gpu_scene
             .upload(&self.dev, scene, options.measure.full_variants)?;
         self.gpu_scene.check_placement(scene)?;
-        self.gpu_scene
+        let split_bytes = self
+            .gpu_scene
             .split_for_frame(&self.dev, scene, (width, height))?;
         let view: DMat4 = scene.camera.view_matrix();
         let projection = scene
@@ -442,7 +443,7 @@ impl Renderer {
         stats.grid.cells = grid.map_or(0, |g| g.cells);
         copy_opt_str(&mut stats.grid.reason, grid.map(|g| g.reason));
         stats.memory = MemoryStats {
-            upload_bytes: method_stats.upload_bytes,
+            upload_bytes: method_stats.upload_bytes + split_bytes,
             upload_bytes_spread: None,
             method_gpu_bytes: 0,
             gbuffer_bytes: method_stats.gbuffer_bytes,

@@ -148,7 +148,10 @@ pub struct GridStats {
 /// What a frame uploaded and what GPU memory its method holds.
 #[derive(Clone, Copy, Debug, Default, Serialize)]
 pub struct MemoryStats {
-    /// Bytes uploaded for the frame.
+    /// Bytes uploaded for the frame: the method's light data (records, grids, index lists) and
+    /// the copies of huge triangles split near the eye (made again when the camera, the
+    /// viewport or an object moved). A scene's meshes and images, uploaded the first time a
+    /// frame shows them, are in `scene_gpu_bytes` instead.
     pub upload_bytes: usize,
     /// Bytes uploaded per frame over the timed frames of an animated sequence (lights that
     /// move change what is uploaded); `None` for a single frame.

@@ -318,6 +318,46 @@ fn a_triangle_spanning_a_billion_pixels_renders_as_the_f64_model_says() {
     });
 }
 
+/// The split copies count in the frame's uploads, and a frame in which nothing moved keeps
+/// them; a camera that moved splits anew, and the picture is still the f64 model's and what a
+/// renderer that split nothing before draws.
+#[test]
+fn split_copies_are_counted_and_kept_while_nothing_moves() {
+    let unsplit = lit_plane();
+    let mut split = lit_plane();
+    split.objects[0].transform = DMat4::from_scale(DVec3::new(1e8, 1e8, 1.0));
+    let mut moved = split.clone();
+    moved.camera.position.x += 0.01;
+    let mut gpu = Gpu::new(EsVersion::Es3);
+    let caps = gpu.r().caps().clone();
+    let opts = RenderOptions::default();
+    let frame = |gpu: &mut Gpu, s: &Scene| gpu.render_with("forward", s, (W, H), &opts);
+    // Forward uploads its one light's record every frame: the rest is split copies.
+    let record = frame(&mut gpu, &unsplit).1.memory.upload_bytes;
+    let first = frame(&mut gpu, &split).1.memory.upload_bytes;
+    // At least a triangle: three positions of three floats.
+    assert!(
+        first >= record + 36,
+        "{first} bytes against {record} unsplit"
+    );
+    let (kept, still) = frame(&mut gpu, &split);
+    assert_eq!(
+        still.memory.upload_bytes, record,
+        "the still frame split again"
+    );
+    let (image, again) = frame(&mut gpu, &moved);
+    assert!(again.memory.upload_bytes >= record + 36, "the camera moved");
+    let fresh = Gpu::new(EsVersion::Es3)
+        .render_with("forward", &moved, (W, H), &opts)
+        .0;
+    assert!(image == fresh, "not what a first split draws");
+    for (picture, s) in [(&kept, &split), (&image, &moved)] {
+        let (e, at, _) = max_oracle_error(picture, s, Encoding::Srgb, &caps);
+        let bound = f64_model_bound("ES 3.0");
+        assert!(e <= bound, "{e:.1} / 255 off the f64 model at {at:?}");
+    }
+}
+
 /// Past a frame's budget of split triangles (many huge objects beside the camera) the rest
 /// are drawn unsplit, with one warning a renderer naming the first of them; the frame still
 /// draws the plane.
