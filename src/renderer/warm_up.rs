@@ -107,8 +107,17 @@ impl Renderer {
         }
         // A frame with no light in view is drawn ambient-only, whatever the method.
         if !scene.lights.is_empty() {
-            let mut unlit = scene.clone();
-            unlit.truncate_lights(0);
+            // Everything but the lights and their motion: a copy of those would cost a scene
+            // of a million lights about 100 MB for one frame that draws none of them.
+            let unlit = Scene {
+                objects: scene.objects.clone(),
+                materials: scene.materials.clone(),
+                lights: Vec::new(),
+                directional_lights: scene.directional_lights.clone(),
+                ambient: scene.ambient,
+                camera: scene.camera,
+                animation: Vec::new(),
+            };
             self.warm_up_frame(&unlit, methods::forward::DESC.name, options)?;
         }
         Ok(())

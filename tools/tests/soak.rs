@@ -13,6 +13,9 @@
 //!   it knows whether there is an error to name) is counted separately and allowed for: that
 //!   is `src/scene`'s to fix, and once it allocates nothing the test demands zero outright.
 //!
+//! * a warm-up copies none of the scene's lights (its memory grows by 8 bytes a light, where
+//!   a copy of the lights and their motion took 201).
+//!
 //! `cargo bench --bench soak` runs the long version (2 000 frames a method, resident memory
 //! sampled; docs/performance.md has its figures). To find an allocation that crept into the
 //! frame, run `MANYLIGHT_ALLOC_TRACE=TEXT cargo test --test soak -- --nocapture` (TEXT: part of
@@ -41,6 +44,14 @@ struct Counting;
 
 /// Bytes allocated and not yet freed.
 static LIVE: AtomicIsize = AtomicIsize::new(0);
+/// The most `LIVE` has been since a test last set it.
+static PEAK: AtomicIsize = AtomicIsize::new(0);
+
+/// Adds `bytes` to [`LIVE`], keeping [`PEAK`].
+fn grow_live(bytes: isize) {
+    let live = LIVE.fetch_add(bytes, Ordering::Relaxed) + bytes;
+    PEAK.fetch_max(live, Ordering::Relaxed);
+}
 /// `alloc`, `alloc_zeroed` and `realloc` calls of the frames: on the thread that renders them
 /// and on rayon's workers (not on the test harness's threads, which print results and start
 /// other tests meanwhile).
@@ -100,12 +111,12 @@ fn count_call(bytes: usize) {
 unsafe impl GlobalAlloc for Counting {
     unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
         count_call(layout.size());
-        LIVE.fetch_add(layout.size() as isize, Ordering::Relaxed);
+        grow_live(layout.size() as isize);
         unsafe { System.alloc(layout) }
     }
     unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
         count_call(layout.size());
-        LIVE.fetch_add(layout.size() as isize, Ordering::Relaxed);
+        grow_live(layout.size() as isize);
         unsafe { System.alloc_zeroed(layout) }
     }
     unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
@@ -114,10 +125,7 @@ unsafe impl GlobalAlloc for Counting {
     }
     unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
         count_call(new_size);
-        LIVE.fetch_add(
-            new_size as isize - layout.size() as isize,
-            Ordering::Relaxed,
-        );
+        grow_live(new_size as isize - layout.size() as isize);
         unsafe { System.realloc(ptr, layout, new_size) }
     }
 }
@@ -553,4 +561,36 @@ fn no_heap_allocation_per_frame_in_steady_state_es2_without_fragment_highp() {
     };
     let failures = allocations_per_frame(EsVersion::Es2, &restrictions, &cases);
     assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+/// A warm-up copies none of the scene's lights. Forward keeps a capped number of lights, so
+/// what its warm-up allocates grows with the scene's lights by its ordering's 8 bytes a light;
+/// a copy of the lights would add a `Light` (96 bytes) a light.
+#[test]
+fn a_warm_up_copies_none_of_the_lights() {
+    let _serial = serial();
+    let mut gpu = Gpu::new(EsVersion::Es3);
+    let options = RenderOptions::default();
+    let renderer = gpu.r();
+    renderer.set_method_named("forward").unwrap();
+    let mut grew = Vec::new();
+    for lights in [400_000, 200_000] {
+        let scene = with_boxes(scene::builtin::build("courtyard", Some((lights, 5))).unwrap());
+        // Grows the renderer's own buffers, which a game's first frame keeps.
+        let (_, stats) = renderer.render_offscreen(&scene, 32, 18, &options).unwrap();
+        if stats.lights.overflowed == 0 {
+            return common::skip("forward holds every light of 200 000 here: nothing is capped");
+        }
+        let before = LIVE.load(Ordering::Relaxed);
+        PEAK.store(before, Ordering::Relaxed);
+        renderer.warm_up(&scene, &options).unwrap();
+        grew.push(PEAK.load(Ordering::Relaxed) - before);
+    }
+    let per_light = (grew[0] - grew[1]) / 200_000;
+    let light = std::mem::size_of::<manylight::scene::Light>() as isize;
+    assert!(
+        per_light < light / 2,
+        "the warm-up took {per_light} bytes a light more ({grew:?} bytes at 400 000 and \
+         200 000 lights): a copy of the lights takes {light}"
+    );
 }
