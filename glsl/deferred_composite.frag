@@ -35,7 +35,11 @@ void main() {
     // surface point comes back from the G-buffer as in the light pass.
     HIGHP vec4 nd = texelFetch(u_gNormalDepth, px, 0);
     HIGHP vec3 P = viewPosition(frameXY + vec2(nd.w, albedoOffset.a), nd.z);
+#if HAS_SPECULAR
     vec4 spec = texelFetch(u_gSpecular, px, 0);
+#else
+    vec4 spec = vec4(0.0, 0.0, 0.0, 1.0);
+#endif
     SurfaceParams surface;
     surface.albedo = albedo;
     surface.Ks = spec.rgb;

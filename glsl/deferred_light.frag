@@ -20,7 +20,12 @@ void main() {
 #else
     HIGHP vec4 albedoOffset = texelFetch(u_gAlbedo, px, 0);
     HIGHP vec3 P = viewPosition(gl_FragCoord.xy + vec2(nd.w, albedoOffset.a), nd.z);
+#if HAS_SPECULAR
     vec4 spec = texelFetch(u_gSpecular, px, 0);
+#else
+    // No specular target: no material has a lobe.
+    vec4 spec = vec4(0.0, 0.0, 0.0, 1.0);
+#endif
     Light light;
     light.position = v_light0.xyz;
     light.radius = v_light0.w;

@@ -6,14 +6,17 @@
 //!                                     point's window y offset from the pixel centre
 //! colour 1 normal   RGBA32F     16    view-space normal (of the side seen) in
 //!                                     octahedral form (xy), view depth (z), window x offset
-//! colour 2 specular RGBA16F      8    Ks, Blinn-Phong exponent
+//! colour 2 specular RGBA16F      8    Ks, Blinn-Phong exponent (metallic, roughness, −1 for a
+//!                                     metallic-roughness material); none in a scene without
+//!                                     either kind of material
 //! depth             DEPTH24      4    for the geometry pass's depth test
 //! accumulation      RGBA32F     16    Σ light radiance (additive blending; RGBA16F, 8 bytes,
 //!                                     where GL_EXT_float_blend is missing), started by the
 //!                                     geometry pass (colour 3) with the surface's emission
 //!                                     and the ambient term's occlusion
 //!                              ----
-//!                               52 bytes per pixel (1280×720: 47.9 MB), 44 with RGBA16F
+//!                               52 bytes per pixel (1280×720: 47.9 MB), 44 with RGBA16F;
+//!                               8 fewer without the specular target
 //! ```
 //!
 //! The accumulation buffer is 32-bit where float blending allows: hundreds of small
@@ -35,13 +38,12 @@ use super::{Caps, Device, EsVersion, GlError};
 /// The normal buffer's view depth where no surface was drawn (below `noSurface`'s −10²⁹).
 const NO_SURFACE_DEPTH: f32 = -1.0e30;
 
-/// Bytes of GPU memory per pixel on this context (see the module docs).
-pub fn bytes_per_pixel(caps: &Caps) -> usize {
-    if half_float_accumulation(caps) {
-        44
-    } else {
-        52
-    }
+/// Bytes of GPU memory per pixel on this context, with or without the specular target (see
+/// the module docs).
+pub fn bytes_per_pixel(caps: &Caps, specular: bool) -> usize {
+    let accumulation = if half_float_accumulation(caps) { 8 } else { 16 };
+    let specular = if specular { 8 } else { 0 };
+    8 + 16 + specular + 4 + accumulation
 }
 
 /// Why deferred cannot run on this context, if it cannot.
@@ -69,8 +71,8 @@ pub fn unsupported_reason(dev_caps: &Caps) -> Option<String> {
 pub struct GBuffer {
     geometry_fbo: glow::Framebuffer,
     accum_fbo: glow::Framebuffer,
-    /// albedo, normal+depth, specular, accumulation
-    color: [glow::Texture; 4],
+    /// albedo, normal+depth, specular (where the scene has such materials), accumulation
+    color: [Option<glow::Texture>; 4],
     depth: glow::Texture,
     size: (u32, u32),
     bytes_per_pixel: usize,
@@ -106,8 +108,9 @@ thread_local! {
 pub const HALF_FLOAT_EXACT_COUNT: usize = 2_048;
 
 impl GBuffer {
-    /// Allocates the buffers for a `width × height` viewport.
-    pub fn new(dev: &Device, width: u32, height: u32) -> Result<GBuffer, GlError> {
+    /// Allocates the buffers for a `width × height` viewport, with the specular target when
+    /// `specular` (a scene with specular or metallic-roughness materials).
+    pub fn new(dev: &Device, width: u32, height: u32, specular: bool) -> Result<GBuffer, GlError> {
         if let Some(reason) = unsupported_reason(dev.caps()) {
             return Err(GlError::Unsupported(reason));
         }
@@ -123,7 +126,10 @@ impl GBuffer {
         target_size::check(dev.caps(), "a deferred G-buffer", (w, h), storage)?;
         let albedo = texture(dev, w, h, glow::RGBA16F)?;
         let normal = texture(dev, w, h, glow::RGBA32F)?;
-        let specular = texture(dev, w, h, glow::RGBA16F)?;
+        let specular = match specular {
+            true => Some(texture(dev, w, h, glow::RGBA16F)?),
+            false => None,
+        };
         let accum_format = if half_float_accumulation(dev.caps()) {
             glow::RGBA16F
         } else {
@@ -136,10 +142,10 @@ impl GBuffer {
         let gb = GBuffer {
             geometry_fbo,
             accum_fbo,
-            color: [albedo, normal, specular, accum],
+            color: [Some(albedo), Some(normal), specular, Some(accum)],
             depth,
             size: (w, h),
-            bytes_per_pixel: bytes_per_pixel(dev.caps()),
+            bytes_per_pixel: bytes_per_pixel(dev.caps(), specular.is_some()),
             destroyed: false,
         };
         // Out of memory is an error naming the size, not an incomplete framebuffer.
@@ -157,7 +163,7 @@ impl GBuffer {
                     glow::FRAMEBUFFER,
                     glow::COLOR_ATTACHMENT0 + i as u32,
                     glow::TEXTURE_2D,
-                    Some(*t),
+                    *t,
                     0,
                 );
             }
@@ -168,10 +174,16 @@ impl GBuffer {
                 Some(depth),
                 0,
             );
+            // Without the specular target its output goes nowhere (the shader writes it all
+            // the same: locations are fixed).
+            let specular = match gb.color[2] {
+                Some(_) => glow::COLOR_ATTACHMENT2,
+                None => glow::NONE,
+            };
             gl.draw_buffers(&[
                 glow::COLOR_ATTACHMENT0,
                 glow::COLOR_ATTACHMENT1,
-                glow::COLOR_ATTACHMENT2,
+                specular,
                 glow::COLOR_ATTACHMENT3,
             ]);
             let status = gl.check_framebuffer_status(glow::FRAMEBUFFER);
@@ -216,6 +228,11 @@ impl GBuffer {
         self.size
     }
 
+    /// Whether it has the specular target.
+    pub fn has_specular(&self) -> bool {
+        self.color[2].is_some()
+    }
+
     /// GPU bytes held.
     pub fn gpu_bytes(&self) -> usize {
         self.size.0 as usize * self.size.1 as usize * self.bytes_per_pixel
@@ -255,12 +272,13 @@ impl GBuffer {
         }
     }
 
-    /// Binds albedo, normal+depth, specular and accumulation to units `first..first + 4`.
+    /// Binds albedo, normal+depth, specular (none without the target) and accumulation to
+    /// units `first..first + 4`.
     pub fn bind_textures(&self, dev: &Device, first: u32) {
         for (i, t) in self.color.iter().enumerate() {
             unsafe {
                 dev.gl.active_texture(glow::TEXTURE0 + first + i as u32);
-                dev.gl.bind_texture(glow::TEXTURE_2D, Some(*t));
+                dev.gl.bind_texture(glow::TEXTURE_2D, *t);
             }
         }
     }
@@ -270,7 +288,7 @@ impl GBuffer {
         if !self.destroyed {
             dev.delete_framebuffer(self.geometry_fbo);
             dev.delete_framebuffer(self.accum_fbo);
-            for t in self.color {
+            for t in self.color.into_iter().flatten() {
                 dev.delete_texture(t);
             }
             dev.delete_texture(self.depth);

@@ -91,7 +91,7 @@ mod tests {
             return;
         };
         let before = dev.live_objects();
-        let gbuffer = |w, h| GBuffer::new(&dev, w, h).map(|mut g| g.destroy(&dev));
+        let gbuffer = |w, h| GBuffer::new(&dev, w, h, true).map(|mut g| g.destroy(&dev));
         let offscreen = |w, h| OffscreenTarget::new(&dev, w, h).map(|mut t| t.destroy(&dev));
         let msaa = |w, h| MultisampleTarget::new(&dev, w, h, 4).map(|mut t| t.destroy(&dev));
         refused(&dev, || gbuffer(65, 10), "GL_MAX_TEXTURE_SIZE");
@@ -100,7 +100,7 @@ mod tests {
         refused(&dev, || msaa(10, 49), "GL_MAX_RENDERBUFFER_SIZE");
         refused(&dev, || gbuffer(0, 10), "at least 1");
         // At the limits every one is made.
-        GBuffer::new(&dev, 64, 64).unwrap().destroy(&dev);
+        GBuffer::new(&dev, 64, 64, true).unwrap().destroy(&dev);
         OffscreenTarget::new(&dev, 48, 48).unwrap().destroy(&dev);
         MultisampleTarget::new(&dev, 48, 48, 4)
             .unwrap()

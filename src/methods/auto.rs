@@ -186,10 +186,7 @@ fn allocate_deferred(
             return Ok(Some(why.clone()));
         }
     }
-    match deferred
-        .get_or_insert_with(Deferred::default)
-        .prepare(ctx.dev, ctx.viewport)
-    {
+    match deferred.get_or_insert_with(Deferred::default).prepare(ctx) {
         Ok(()) => Ok(None),
         Err(Error::Gl(GlError::OutOfMemory(e))) => {
             let (w, h) = ctx.viewport;

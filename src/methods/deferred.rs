@@ -292,21 +292,30 @@ fn unit_sphere() -> Mesh {
 }
 
 impl Deferred {
-    /// Allocates what a frame of `size` needs (kept while the size stays), leaving the
-    /// frame's framebuffer bound (making the G-buffer binds its own).
-    pub(super) fn prepare(&mut self, dev: &Device, size: (u32, u32)) -> Result<(), Error> {
+    /// Allocates what a frame of `ctx` needs (kept while its size and specular target stay),
+    /// leaving the frame's framebuffer bound (making the G-buffer binds its own).
+    pub(super) fn prepare(&mut self, ctx: &FrameContext) -> Result<(), Error> {
+        let dev = ctx.dev;
         let target = dev.bound_framebuffer();
-        let prepared = self.ensure_resources(dev, size);
+        let prepared = self.ensure_resources(dev, ctx.viewport, needs_specular_target(ctx));
         dev.bind_framebuffer(target);
         prepared
     }
 
-    fn ensure_resources(&mut self, dev: &Device, size: (u32, u32)) -> Result<(), Error> {
-        if self.gbuffer.as_ref().map(|g| g.size()) != Some(size) {
+    /// The G-buffer of `size`, with the specular target if `specular` (made anew when the
+    /// scene gains or loses its specular materials), and the meshes.
+    fn ensure_resources(
+        &mut self,
+        dev: &Device,
+        size: (u32, u32),
+        specular: bool,
+    ) -> Result<(), Error> {
+        let fits = |g: &GBuffer| g.size() == size && g.has_specular() == specular;
+        if !self.gbuffer.as_ref().is_some_and(fits) {
             if let Some(mut g) = self.gbuffer.take() {
                 g.destroy(dev);
             }
-            self.gbuffer = Some(GBuffer::new(dev, size.0, size.1)?);
+            self.gbuffer = Some(GBuffer::new(dev, size.0, size.1, specular)?);
         }
         if self.sphere.is_none() {
             self.sphere = Some(GpuMesh::new(dev, &unit_sphere())?);
@@ -365,7 +374,7 @@ impl Deferred {
         // chosen per pixel from the G-buffer); directional lights are the composite's.
         let features = ctx
             .features
-            .with(ShaderFeatures::SPECULAR, true)
+            .with(ShaderFeatures::SPECULAR, gb.has_specular())
             .with(
                 ShaderFeatures::METALLIC_ROUGHNESS,
                 ctx.scene
@@ -476,14 +485,18 @@ impl Deferred {
         let (half, ortho) = half_extent(ctx);
         // Directional lights are shaded here, with the light pass's full material.
         let sun = ctx.features.has(ShaderFeatures::DIRECTIONAL);
-        let features = ctx.features.with(ShaderFeatures::SPECULAR, sun).with(
-            ShaderFeatures::METALLIC_ROUGHNESS,
-            sun && ctx
-                .scene
-                .materials
-                .iter()
-                .any(|m| m.is_metallic_roughness()),
-        );
+        let specular = self.gbuffer.as_ref().is_some_and(GBuffer::has_specular);
+        let features = ctx
+            .features
+            .with(ShaderFeatures::SPECULAR, sun && specular)
+            .with(
+                ShaderFeatures::METALLIC_ROUGHNESS,
+                sun && ctx
+                    .scene
+                    .materials
+                    .iter()
+                    .any(|m| m.is_metallic_roughness()),
+            );
         let accum_to_radiance = accumulation_scale(ctx).recip();
         let key = ProgramKey {
             shader: "deferred_composite",
@@ -519,6 +532,13 @@ impl Deferred {
 
 /// View-space half extents of the projection (per unit depth when perspective) and whether it
 /// is orthographic: how the G-buffer passes map window positions to view space.
+/// Whether the frame's G-buffer needs its specular target: a material has a specular lobe or
+/// is metallic-roughness (every variant has them with `full_variants`).
+fn needs_specular_target(ctx: &FrameContext) -> bool {
+    let specular = |m: &crate::scene::Material| m.has_specular() || m.is_metallic_roughness();
+    ctx.options.measure.full_variants || ctx.scene.materials.iter().any(specular)
+}
+
 fn half_extent(ctx: &FrameContext) -> ([f32; 2], bool) {
     match GridProjection::from_matrix(&ctx.projection.as_dmat4()) {
         GridProjection::Perspective { tan_x, tan_y } => ([tan_x as f32, tan_y as f32], false),
@@ -548,7 +568,7 @@ impl ShadingMethod for Deferred {
             )));
         }
         let target = dev.bound_framebuffer();
-        self.ensure_resources(dev, ctx.viewport)?;
+        self.ensure_resources(dev, ctx.viewport, needs_specular_target(ctx))?;
         sort_objects(ctx);
         self.geometry_pass(ctx)?;
         let upload_bytes = self.light_pass(ctx)?;

@@ -3,9 +3,16 @@
 mod common;
 
 use common::Gpu;
+use glam::{DVec3, Vec3};
+use manylight::gl::gbuffer;
 use manylight::renderer::CountKind;
-use manylight::scene;
+use manylight::scene::{self, DirectionalLight, Material};
 use manylight::{EsVersion, RenderOptions};
+
+/// A material the G-buffer's specular target is for.
+fn reads_specular(m: &Material) -> bool {
+    m.has_specular() || m.is_metallic_roughness()
+}
 
 #[test]
 fn deferred_matches_forward_within_2_of_255_on_opaque_scenes() {
@@ -36,10 +43,65 @@ fn deferred_matches_forward_within_2_of_255_on_opaque_scenes() {
                     "{name} {lights}: deferred is {} / 255 from forward",
                     d.max_abs
                 );
-                let per_pixel = manylight::gl::gbuffer::bytes_per_pixel(gpu.r().caps());
+                let specular = s.materials.iter().any(reads_specular);
+                let per_pixel = gbuffer::bytes_per_pixel(gpu.r().caps(), specular);
                 assert_eq!(stats.memory.gbuffer_bytes, (w * h) as usize * per_pixel);
             }
         }
+    }
+}
+
+/// The specular target is made only for a scene with a specular or metallic-roughness
+/// material: 8 bytes a pixel fewer without, the picture forward's either way, a sun's
+/// included (the composite reads the target too), as the scene gains and loses such a
+/// material.
+#[test]
+fn the_specular_target_is_there_only_for_materials_that_read_it() {
+    let mut gpu = Gpu::new(EsVersion::Es3);
+    let (w, h) = (128, 72);
+    let mut s = scene::builtin::build("pillars", Some((64, 3))).unwrap();
+    let sun = DirectionalLight::new(DVec3::new(1.0, -2.0, -1.0), Vec3::ONE, 0.6);
+    s.directional_lights.push(sun);
+    let matte = |s: &mut scene::Scene| {
+        for m in &mut s.materials {
+            m.specular = Vec3::ZERO;
+        }
+    };
+    matte(&mut s);
+    let mut shiny = s.clone();
+    shiny.materials[0].specular = Vec3::splat(0.6);
+    shiny.materials[0].shininess = 24.0;
+    let mut metal = s.clone();
+    metal.materials[0] = Material::metallic_roughness("metal", Vec3::splat(0.8), 1.0, 0.3);
+    let pixels = (w * h) as usize;
+    let opts = RenderOptions::default();
+    for (what, scene, specular) in [
+        ("matte", &s, false),
+        ("one specular material", &shiny, true),
+        ("matte again", &s, false),
+        ("one metallic-roughness material", &metal, true),
+    ] {
+        assert_eq!(
+            scene.materials.iter().any(reads_specular),
+            specular,
+            "{what}"
+        );
+        let (reference, _) = gpu.render_with("forward", scene, (w, h), &opts);
+        let (img, stats) = gpu.render_with("deferred", scene, (w, h), &opts);
+        let d = manylight::metrics::diff(&reference, &img);
+        assert!(
+            d.max_abs <= 2,
+            "{what}: deferred is {} / 255 from forward",
+            d.max_abs
+        );
+        let accumulation = if gbuffer::half_float_accumulation(gpu.r().caps()) {
+            8
+        } else {
+            16
+        };
+        // Albedo 8, normal and depth 16, depth buffer 4, specular 8 where it is made.
+        let per_pixel = 28 + accumulation + if specular { 8 } else { 0 };
+        assert_eq!(stats.memory.gbuffer_bytes, pixels * per_pixel, "{what}");
     }
 }
 
