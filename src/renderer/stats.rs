@@ -63,7 +63,8 @@ pub struct FrameStats {
     /// The frame drew with its method's last light lists and uploads (tiled, clustered):
     /// nothing they are built from had changed (the lights in view space, the grid, the
     /// limits, the light record layout), so it neither assigned nor uploaded them
-    /// (`assign_ms` and `upload_bytes` 0, the assignment's figures the lists' own).
+    /// (`assign_ms` 0, the assignment's figures the lists' own, and `upload_bytes` 0 unless
+    /// an object moved and its split copies of huge triangles were made again).
     pub lists_reused: bool,
     /// The cell grid (tiled, clustered).
     #[serde(flatten)]

@@ -3,7 +3,7 @@
 //! with nothing to reuse draws. Every input of the lists that changes makes the next frame
 //! assign again; timed frames always assign.
 
-use glam::{DVec3, Vec3};
+use glam::{DMat4, DVec3, Vec3};
 use manylight::cluster::grid::GridConfig;
 use manylight::scene::{self, Light, Projection, Scene};
 use manylight::{EsVersion, FrameStats, MeasureOptions, RenderOptions};
@@ -205,4 +205,40 @@ fn opts_untimed(opts: &RenderOptions) -> RenderOptions {
     let mut opts = opts.clone();
     opts.measure.timed_frames = 0;
     opts
+}
+
+/// An object that moves changes no list: a huge plane sliding along itself keeps the lists
+/// (its split copies, made again, are all the frame uploads) and draws what a first frame
+/// draws.
+#[test]
+fn a_moving_object_keeps_the_lists() {
+    let mut s = scene::builtin::build("plane", None).unwrap();
+    s.lights = (0..40)
+        .map(|i| {
+            Light::point(
+                DVec3::new(i as f64 * 0.1 - 2.0, 0.0, 1.0),
+                2.0,
+                Vec3::ONE,
+                1.0,
+            )
+        })
+        .collect();
+    s.objects[0].transform = DMat4::from_scale(DVec3::new(1e8, 1e8, 1.0));
+    let mut gpu = Gpu::new(EsVersion::Es3);
+    for method in ["tiled", "clustered"] {
+        let (_, first) = gpu.render_with(method, &s, SIZE, &fixed_grid());
+        let mut moved = s.clone();
+        moved.objects[0].transform =
+            DMat4::from_translation(DVec3::new(0.25, 0.0, 0.0)) * s.objects[0].transform;
+        let (image, stats) = gpu.render_with(method, &moved, SIZE, &fixed_grid());
+        assert!(stats.lists_reused, "{method}: the lists were built again");
+        assert_eq!(stats.time.assign_ms, 0.0, "{method}");
+        let splits = stats.memory.upload_bytes;
+        assert!(
+            splits > 0 && splits < first.memory.upload_bytes,
+            "{method}: {splits}"
+        );
+        let fresh = first_frame(EsVersion::Es3, method, &moved, &fixed_grid());
+        assert!(image == fresh, "{method}: not what a first frame draws");
+    }
 }
