@@ -13,6 +13,7 @@ use glam::{DMat4, DVec3, Vec3};
 use manylight::gl::HeadlessContext;
 use manylight::scene::{self, DirectionalLight, Material, Object, Scene};
 use manylight::{EsVersion, RenderOptions, Renderer};
+use manylight_tools::frame_bench::{median, FrameBenchArgs};
 
 /// The default scene with what selects more shader variants: a sun and a metallic object.
 fn scene() -> Result<Scene, Box<dyn std::error::Error>> {
@@ -64,31 +65,9 @@ fn one_round(
     Ok([warm_ms, first_ms, second_ms])
 }
 
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
-}
-
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let args: Vec<String> = std::env::args()
-        .skip(1)
-        .filter(|a| !a.starts_with("--"))
-        .collect();
-    let rounds: usize = args
-        .first()
-        .and_then(|a| a.parse().ok())
-        .unwrap_or(5)
-        .max(1);
-    let size = args
-        .get(1)
-        .and_then(|s| s.split_once('x'))
-        .and_then(|(a, b)| Some((a.parse().ok()?, b.parse().ok()?)))
-        .unwrap_or((640, 360));
-    let method = args.get(2).map_or("auto", String::as_str);
-    let es = match args.get(3).map(String::as_str) {
-        Some("es2") => EsVersion::Es2,
-        _ => EsVersion::Es3,
-    };
+    let args = FrameBenchArgs::from_env("auto");
+    let (rounds, size, method, es) = (args.rounds, args.size, args.method.as_str(), args.es);
     let scene = scene()?;
     let (mut cold, mut warm) = (Vec::new(), Vec::new());
     for _ in 0..rounds {

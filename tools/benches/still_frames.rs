@@ -12,7 +12,8 @@ use std::time::Instant;
 
 use manylight::gl::HeadlessContext;
 use manylight::scene::{self, Scene};
-use manylight::{EsVersion, RenderOptions, Renderer};
+use manylight::{RenderOptions, Renderer};
+use manylight_tools::frame_bench::{median, FrameBenchArgs};
 
 const FRAMES: usize = 20;
 
@@ -43,31 +44,9 @@ fn frames(
         .collect()
 }
 
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
-}
-
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let args: Vec<String> = std::env::args()
-        .skip(1)
-        .filter(|a| !a.starts_with("--"))
-        .collect();
-    let rounds: usize = args
-        .first()
-        .and_then(|a| a.parse().ok())
-        .unwrap_or(5)
-        .max(1);
-    let size = args
-        .get(1)
-        .and_then(|s| s.split_once('x'))
-        .and_then(|(a, b)| Some((a.parse().ok()?, b.parse().ok()?)))
-        .unwrap_or((640, 360));
-    let method = args.get(2).map_or("clustered", String::as_str);
-    let es = match args.get(3).map(String::as_str) {
-        Some("es2") => EsVersion::Es2,
-        _ => EsVersion::Es3,
-    };
+    let args = FrameBenchArgs::from_env("clustered");
+    let (rounds, size, method, es) = (args.rounds, args.size, args.method.as_str(), args.es);
     let mut scene = scene::builtin::build("courtyard", Some((1024, 7)))?;
     let ctx = HeadlessContext::new(es)?;
     let mut renderer = Renderer::new(ctx.load_gl()?, es)?;

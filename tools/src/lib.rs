@@ -7,6 +7,7 @@
 #![warn(missing_docs)]
 
 pub mod animated;
+pub mod frame_bench;
 pub mod heatmap;
 pub mod output;
 pub mod plot;
