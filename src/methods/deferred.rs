@@ -530,8 +530,6 @@ impl Deferred {
     }
 }
 
-/// View-space half extents of the projection (per unit depth when perspective) and whether it
-/// is orthographic: how the G-buffer passes map window positions to view space.
 /// Whether the frame's G-buffer needs its specular target: a material has a specular lobe or
 /// is metallic-roughness (every variant has them with `full_variants`).
 fn needs_specular_target(ctx: &FrameContext) -> bool {
@@ -539,6 +537,8 @@ fn needs_specular_target(ctx: &FrameContext) -> bool {
     ctx.options.measure.full_variants || ctx.scene.materials.iter().any(specular)
 }
 
+/// View-space half extents of the projection (per unit depth when perspective) and whether it
+/// is orthographic: how the G-buffer passes map window positions to view space.
 fn half_extent(ctx: &FrameContext) -> ([f32; 2], bool) {
     match GridProjection::from_matrix(&ctx.projection.as_dmat4()) {
         GridProjection::Perspective { tan_x, tan_y } => ([tan_x as f32, tan_y as f32], false),

@@ -133,8 +133,15 @@ impl CulledForward {
             .then(|| self.assign.reuse().zip(self.upload.last_upload()))
             .flatten();
         let (assigned, uploaded) = match reused {
-            Some(reused) => reused,
+            Some((assigned, uploaded)) => {
+                // Checked again: `auto` refuses overflow in some frames only.
+                if let Some(frame) = refused(assigned.assignment, refuse_overflow) {
+                    return Ok(frame);
+                }
+                (assigned, uploaded)
+            }
             None => {
+                // Cleared first: a refused frame leaves the assigner holding other lists.
                 self.lists_key = None;
                 let assigned = self.assign.run(method, grid, ctx, &limits);
                 if let Some(frame) = refused(assigned.assignment, refuse_overflow) {
@@ -147,9 +154,6 @@ impl CulledForward {
                 (assigned, uploaded)
             }
         };
-        if let Some(frame) = refused(assigned.assignment, refuse_overflow) {
-            return Ok(frame);
-        }
         if automatic {
             grid::record_cost(&mut self.auto, grid, &assigned, &uploaded);
         }
