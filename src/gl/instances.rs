@@ -98,6 +98,13 @@ impl InstanceStream {
         bytes.len()
     }
 
+    /// Draws `mesh` once per instance of the last [`InstanceStream::draw`], `count` of them
+    /// (with the stream bound), uploading nothing: the store still holds them.
+    pub(crate) fn draw_held(&self, dev: &Device, mesh: &BoundMesh, count: usize) {
+        debug_assert!(count <= self.store);
+        mesh.draw_instanced(dev, count as i32);
+    }
+
     /// Leaves its locations as every other draw expects them: no array, divisor 0.
     pub(crate) fn unbind(&self, dev: &Device) {
         for location in self.locations() {

@@ -281,8 +281,29 @@ pub struct Deferred {
     gbuffer: Option<GBuffer>,
     sphere: Option<GpuMesh>,
     fullscreen: Option<GpuMesh>,
-    lights: Option<LightInstances>,
+    lights: LightInstances,
+    /// What the light instances were last made from: a frame with the same draws them again.
+    instances_key: Option<InstancesKey>,
     transparent: Forward,
+}
+
+/// Everything a frame's light instances are a function of: the lights (by generation), the
+/// camera's kind and planes, which choose each light's proxy, and the accumulation's scale.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct InstancesKey {
+    lights_generation: u64,
+    orthographic: bool,
+    near: u64,
+    far: u64,
+    scale: u32,
+}
+
+/// What a light pass did.
+struct LightPass {
+    /// Bytes of light instances uploaded.
+    uploaded: usize,
+    /// It drew the last frame's instances.
+    reused: bool,
 }
 
 fn unit_sphere() -> Mesh {
@@ -364,8 +385,7 @@ impl Deferred {
         drawn
     }
 
-    /// Returns the bytes of lights uploaded.
-    fn light_pass(&mut self, ctx: &mut FrameContext) -> Result<usize, Error> {
+    fn light_pass(&mut self, ctx: &mut FrameContext) -> Result<LightPass, Error> {
         let dev = ctx.dev;
         let gb = self.gbuffer.as_ref().expect("allocated");
         gb.begin_accumulation(dev);
@@ -400,29 +420,44 @@ impl Deferred {
                 .filter(|l| l.cull_radius > 0.0)
                 .enumerate()
         };
+        // A still frame (nothing the instances are made from changed) draws the last ones.
+        let key = InstancesKey {
+            lights_generation: ctx.lights_generation,
+            orthographic: ctx.orthographic,
+            near: ctx.near.to_bits(),
+            far: ctx.far.to_bits(),
+            scale: scale.to_bits(),
+        };
+        let reused = self.instances_key == Some(key) && self.lights.hold_all();
+        self.instances_key = None;
         let mut uploaded = 0;
-        for proxy in [Proxy::NearSide, Proxy::FarSide, Proxy::FullScreen] {
+        for (slot, proxy) in [Proxy::NearSide, Proxy::FarSide, Proxy::FullScreen]
+            .into_iter()
+            .enumerate()
+        {
             let (shader, mesh) = match proxy {
                 Proxy::FullScreen => ("deferred_light_fullscreen", self.fullscreen.as_ref()),
                 _ => ("deferred_light", self.sphere.as_ref()),
             };
-            let key = ProgramKey {
+            let program = ProgramKey {
                 shader,
                 features: features.0,
                 dialect: dev.es(),
             };
             let defines = || features.defines(dev.es(), 1);
             let mut lights = drawn().filter(|(_, l)| reach.proxy(l) == proxy).peekable();
-            if lights.peek().is_none() {
+            let none = if reused {
+                self.lights.held(slot) == Some(0)
+            } else {
+                lights.peek().is_none()
+            };
+            if none {
+                self.lights.draw_none(slot);
                 if ctx.warm_up {
                     // Built all the same: a light may take this proxy in a later frame.
-                    ctx.programs.bind::<LightProgram>(dev, key, defines)?;
+                    ctx.programs.bind::<LightProgram>(dev, program, defines)?;
                 }
                 continue;
-            }
-            // Made for the first frame with lights: a scene without pays nothing for it.
-            if self.lights.is_none() {
-                self.lights = Some(LightInstances::new(dev)?);
             }
             RenderState {
                 depth_test: proxy.depth_test(),
@@ -432,7 +467,7 @@ impl Deferred {
                 color_write: true,
             }
             .apply(dev);
-            let p = ctx.programs.bind::<LightProgram>(dev, key, defines)?;
+            let p = ctx.programs.bind::<LightProgram>(dev, program, defines)?;
             p.g_albedo.set(dev, UNIT_G_ALBEDO);
             p.g_normal_depth.set(dev, UNIT_G_NORMAL_DEPTH);
             p.g_specular.set(dev, UNIT_G_SPECULAR);
@@ -444,6 +479,10 @@ impl Deferred {
             }
             let mesh = (mesh.expect("allocated").bind_single_chunk(dev))
                 .expect("a proxy mesh is one chunk");
+            if reused {
+                self.lights.draw_held(dev, slot, &mesh);
+                continue;
+            }
             // The proxy bounds the light's reach: its culling radius (the radius, or less under
             // a light cut-off). A count adds 1 in one channel, light by light in turn (see
             // COUNT_CHANNELS).
@@ -455,10 +494,10 @@ impl Deferred {
                     scale,
                 )
             });
-            let batches = self.lights.as_mut().expect("allocated");
-            uploaded += batches.draw(dev, &mesh, instances);
+            uploaded += self.lights.draw(dev, slot, &mesh, instances)?;
         }
-        Ok(uploaded)
+        self.instances_key = Some(key);
+        Ok(LightPass { uploaded, reused })
     }
 
     fn composite(
@@ -571,11 +610,12 @@ impl ShadingMethod for Deferred {
         self.ensure_resources(dev, ctx.viewport, needs_specular_target(ctx))?;
         sort_objects(ctx);
         self.geometry_pass(ctx)?;
-        let upload_bytes = self.light_pass(ctx)?;
+        let light_pass = self.light_pass(ctx)?;
         self.composite(ctx, target)?;
         let mut stats = MethodStats {
             gbuffer_bytes: self.gbuffer.as_ref().map_or(0, GBuffer::gpu_bytes),
-            upload_bytes,
+            upload_bytes: light_pass.uploaded,
+            lists_reused: light_pass.reused,
             ..MethodStats::default()
         };
         if !ctx.order.transparent.is_empty() && !ctx.features.counting() {
@@ -587,7 +627,9 @@ impl ShadingMethod for Deferred {
                 transparent_only: true,
                 ..*ctx
             };
-            stats.upload_bytes += self.transparent.render(&mut sub)?.upload_bytes;
+            let transparent = self.transparent.render(&mut sub)?;
+            stats.upload_bytes += transparent.upload_bytes;
+            stats.lists_reused &= transparent.lists_reused;
         }
         crate::gl::device::gl_check!(dev, "deferred frame");
         Ok(stats)
@@ -597,7 +639,7 @@ impl ShadingMethod for Deferred {
         self.gbuffer.as_ref().map_or(0, GBuffer::gpu_bytes)
             + self.sphere.as_ref().map_or(0, GpuMesh::gpu_bytes)
             + self.fullscreen.as_ref().map_or(0, GpuMesh::gpu_bytes)
-            + self.lights.as_ref().map_or(0, LightInstances::gpu_bytes)
+            + self.lights.gpu_bytes()
             + self.transparent.gpu_bytes()
     }
 
@@ -612,9 +654,8 @@ impl ShadingMethod for Deferred {
             let mut m = m;
             m.destroy(dev);
         }
-        if let Some(mut lights) = self.lights.take() {
-            lights.destroy(dev);
-        }
+        self.lights.destroy(dev);
+        self.instances_key = None;
         self.transparent.destroy(dev);
     }
 }

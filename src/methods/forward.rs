@@ -130,24 +130,14 @@ pub struct Forward {
     /// RGBA8 records: the lights with those that reach no pixel darkened (see
     /// [`darken_unseen_into`]).
     seen: Vec<GpuLight>,
+    /// What the texture's records were packed from, once uploaded.
+    uploaded: Option<RecordsKey>,
 }
 
-impl ShadingMethod for Forward {
-    fn name(&self) -> &'static str {
-        DESC.name
-    }
-
-    fn render(&mut self, ctx: &mut FrameContext) -> Result<MethodStats<'_>, Error> {
-        let dev = ctx.dev;
-        let limit = max_lights(dev.caps());
-        if ctx.lights.len() > limit as usize && ctx.features.counting() {
-            // A count over a subset of the lights is no lower bound and no evaluation count.
-            return Err(Error::Limit(format!(
-                "light counts need every light in one forward loop, which holds at most \
-                 {limit} here; the scene has {}",
-                ctx.lights.len()
-            )));
-        }
+impl Forward {
+    /// Packs the frame's records: the lights that matter most to the view when there are
+    /// more than one draw loops over (`limit`), with those out of view darkened for RGBA8.
+    fn pack(&mut self, ctx: &FrameContext, limit: u32, layout: LightLayout) {
         let lights = if ctx.lights.len() > limit as usize {
             super::forward_cap::keep_most_important_into(
                 ctx.lights,
@@ -170,43 +160,106 @@ impl ShadingMethod for Forward {
         } else {
             ctx.lights
         };
-        let count = lights.len();
-        let encoding = ctx.features.light_encoding();
-        let mut stats = MethodStats {
-            dropped_lights: (ctx.lights.len() - count) as u64,
-            ..MethodStats::default()
-        };
-        // Recreate the texture when the encoding changes.
-        if self.lights.as_ref().is_some_and(|(_, e)| *e != encoding) {
-            if let Some((mut t, _)) = self.lights.take() {
-                t.destroy(dev);
-            }
-        }
-        let fresh = self.lights.is_none();
-        if fresh {
-            let format = match encoding {
-                LightEncoding::Float32 => DataFormat::Rgba32F,
-                LightEncoding::Rgba8 => DataFormat::Rgba8,
-            };
-            self.lights = Some((DataTexture::new(dev, format)?, encoding));
-        }
-        let (texture, _) = self.lights.as_mut().expect("created above");
-        let packed = &mut self.packed;
-        let lights = match encoding {
+        let lights = match layout.encoding {
             LightEncoding::Rgba8 => {
                 darken_unseen_into(ctx, lights, &mut self.seen);
                 &self.seen[..]
             }
             LightEncoding::Float32 => lights,
         };
-        pack_lights_into(lights, ctx.features.light_layout(), packed);
-        // With no lights the shader never reads the texture: upload only to give it storage.
-        if count > 0 || fresh {
-            texture.upload(dev, packed.width, packed.height, &packed.bytes)?;
-            stats.upload_bytes = packed.bytes.len();
+        pack_lights_into(lights, layout, &mut self.packed);
+    }
+}
+
+/// Everything a frame's packed records are a function of: the lights (by generation), their
+/// layout, and the view where the cap or RGBA8's darkening selects lights by it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct RecordsKey {
+    lights_generation: u64,
+    layout: LightLayout,
+    /// The projection, near plane and farthest geometry, where lights are selected by them
+    /// (elsewhere a zoom or a moving object keeps the records).
+    view: Option<([u32; 16], u64, u64)>,
+}
+
+impl RecordsKey {
+    fn new(ctx: &FrameContext, layout: LightLayout, limit: u32) -> RecordsKey {
+        let by_view = layout.encoding == LightEncoding::Rgba8 || ctx.lights.len() > limit as usize;
+        RecordsKey {
+            lights_generation: ctx.lights_generation,
+            layout,
+            view: by_view.then(|| {
+                (
+                    ctx.projection.to_cols_array().map(f32::to_bits),
+                    ctx.near.to_bits(),
+                    ctx.content_far.to_bits(),
+                )
+            }),
         }
-        let ranges = [packed.pos_range, packed.radius_range];
-        let texture = &*texture;
+    }
+}
+
+impl ShadingMethod for Forward {
+    fn name(&self) -> &'static str {
+        DESC.name
+    }
+
+    fn render(&mut self, ctx: &mut FrameContext) -> Result<MethodStats<'_>, Error> {
+        let dev = ctx.dev;
+        let limit = max_lights(dev.caps());
+        if ctx.lights.len() > limit as usize && ctx.features.counting() {
+            // A count over a subset of the lights is no lower bound and no evaluation count.
+            return Err(Error::Limit(format!(
+                "light counts need every light in one forward loop, which holds at most \
+                 {limit} here; the scene has {}",
+                ctx.lights.len()
+            )));
+        }
+        let layout = ctx.features.light_layout();
+        // Recreate the texture when the encoding changes.
+        if self
+            .lights
+            .as_ref()
+            .is_some_and(|(_, e)| *e != layout.encoding)
+        {
+            if let Some((mut t, _)) = self.lights.take() {
+                t.destroy(dev);
+            }
+        }
+        let fresh = self.lights.is_none();
+        if fresh {
+            self.uploaded = None;
+            let format = match layout.encoding {
+                LightEncoding::Float32 => DataFormat::Rgba32F,
+                LightEncoding::Rgba8 => DataFormat::Rgba8,
+            };
+            self.lights = Some((DataTexture::new(dev, format)?, layout.encoding));
+        }
+        let key = RecordsKey::new(ctx, layout, limit);
+        // A still frame (nothing the records are packed from changed) draws with the last ones.
+        let reused = self.uploaded == Some(key);
+        let mut upload_bytes = 0;
+        if !reused {
+            self.uploaded = None;
+            self.pack(ctx, limit, layout);
+            let packed = &self.packed;
+            // With no lights the shader never reads the texture: upload only to give it storage.
+            if packed.count > 0 || fresh {
+                let (texture, _) = self.lights.as_mut().expect("created above");
+                texture.upload(dev, packed.width, packed.height, &packed.bytes)?;
+                upload_bytes = packed.bytes.len();
+            }
+            self.uploaded = Some(key);
+        }
+        let count = self.packed.count;
+        let stats = MethodStats {
+            upload_bytes,
+            dropped_lights: (ctx.lights.len() - count) as u64,
+            lists_reused: reused,
+            ..MethodStats::default()
+        };
+        let ranges = [self.packed.pos_range, self.packed.radius_range];
+        let (texture, _) = self.lights.as_ref().expect("created above");
         geometry::draw_objects(ctx, "forward", limit, &mut |p: &ForwardProgram, dev| {
             p.lights.bind(dev, texture, UNIT_METHOD, ranges);
             p.count.set(dev, count as i32);

@@ -60,11 +60,12 @@ pub struct FrameStats {
     /// The light assignment's figures (tiled, clustered; zeros for the other methods).
     #[serde(flatten)]
     pub assignment: AssignStats,
-    /// The frame drew with its method's last light lists and uploads (tiled, clustered):
-    /// nothing they are built from had changed (the lights in view space, the grid, the
-    /// limits, the light record layout), so it neither assigned nor uploaded them
-    /// (`assign_ms` 0, the assignment's figures the lists' own, and `upload_bytes` 0 unless
-    /// an object moved and its split copies of huge triangles were made again).
+    /// The frame drew with its method's last light lists and uploads: nothing they are built
+    /// from had changed (the lights in view space, and the grid, the limits and the light
+    /// record layout for tiled and clustered; forward's and deferred's light records likewise,
+    /// docs/architecture.md), so it neither assigned nor uploaded them (`assign_ms` 0, the
+    /// assignment's figures the lists' own, and `upload_bytes` 0 unless an object moved and its
+    /// split copies of huge triangles were made again).
     pub lists_reused: bool,
     /// The cell grid (tiled, clustered).
     #[serde(flatten)]

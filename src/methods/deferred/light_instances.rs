@@ -1,6 +1,6 @@
 //! Deferred's lights as instances of their proxy: each light four `vec4`s in the layout of
 //! `glsl/deferred_light_instance.glsl`, drawn a batch at a time, so a light costs its 64 bytes
-//! and no GL call of its own.
+//! and no GL call of its own. A still frame draws the instances the last frame uploaded.
 
 use glam::Vec4;
 
@@ -40,49 +40,101 @@ pub(super) fn light_instance(
     ]
 }
 
-/// The instance buffer and the batch being filled (kept between frames: a frame allocates
-/// nothing).
+/// Proxies a light pass draws with, each from its own stream.
+pub(super) const PROXIES: usize = 3;
+
+/// A stream of instances for each proxy and the batch being filled (kept between frames: a
+/// frame allocates nothing). A proxy whose lights fit one batch keeps them in its stream, so a
+/// still frame draws them again without uploading.
+#[derive(Default)]
 pub(super) struct LightInstances {
-    stream: InstanceStream,
+    streams: [Option<InstanceStream>; PROXIES],
     batch: Vec<[f32; 4]>,
+    /// Per proxy: how many lights its stream holds from its last draw, when that was all of
+    /// them (none is 0); `None` when they took more than a batch or were never drawn.
+    held: [Option<usize>; PROXIES],
 }
 
 impl LightInstances {
-    pub(super) fn new(dev: &Device) -> Result<LightInstances, GlError> {
-        Ok(LightInstances {
-            stream: InstanceStream::new(dev, LIGHT_LOCATION, LIGHT_VEC4S, BATCH_LIGHTS)?,
-            batch: Vec::with_capacity(BATCH_VEC4S),
-        })
-    }
-
     /// Draws `mesh` (its arrays bound, with the light program) once for each light, in their
-    /// order, a batch at a time; returns the bytes uploaded.
+    /// order, a batch at a time, through `proxy`'s stream (made on its first lights); returns
+    /// the bytes uploaded.
     pub(super) fn draw(
         &mut self,
         dev: &Device,
+        proxy: usize,
         mesh: &BoundMesh,
         lights: impl Iterator<Item = [Vec4; LIGHT_VEC4S]>,
-    ) -> usize {
-        self.stream.bind(dev);
+    ) -> Result<usize, GlError> {
+        self.held[proxy] = None;
+        let stream = match &mut self.streams[proxy] {
+            Some(stream) => stream,
+            empty => empty.insert(InstanceStream::new(
+                dev,
+                LIGHT_LOCATION,
+                LIGHT_VEC4S,
+                BATCH_LIGHTS,
+            )?),
+        };
+        if self.batch.capacity() < BATCH_VEC4S {
+            self.batch.reserve_exact(BATCH_VEC4S);
+        }
+        stream.bind(dev);
         self.batch.clear();
-        let mut uploaded = 0;
+        let (mut uploaded, mut drawn) = (0, 0);
         for light in lights {
             self.batch.extend(light.map(|v| v.to_array()));
+            drawn += 1;
             if self.batch.len() == BATCH_VEC4S {
-                uploaded += self.stream.draw(dev, mesh, &self.batch);
+                uploaded += stream.draw(dev, mesh, &self.batch);
                 self.batch.clear();
             }
         }
-        uploaded += self.stream.draw(dev, mesh, &self.batch);
-        self.stream.unbind(dev);
-        uploaded
+        uploaded += stream.draw(dev, mesh, &self.batch);
+        stream.unbind(dev);
+        self.held[proxy] = (drawn <= BATCH_LIGHTS).then_some(drawn);
+        Ok(uploaded)
+    }
+
+    /// Records that `proxy` has no lights this frame.
+    pub(super) fn draw_none(&mut self, proxy: usize) {
+        self.held[proxy] = Some(0);
+    }
+
+    /// Whether every proxy's stream holds all its lights of the last light pass.
+    pub(super) fn hold_all(&self) -> bool {
+        self.held.iter().all(Option::is_some)
+    }
+
+    /// Lights `proxy`'s stream holds from the last light pass, when it holds them all.
+    pub(super) fn held(&self, proxy: usize) -> Option<usize> {
+        self.held[proxy]
+    }
+
+    /// Draws `mesh` once for each light `proxy`'s stream holds (see [`Self::held`]), uploading
+    /// nothing.
+    pub(super) fn draw_held(&self, dev: &Device, proxy: usize, mesh: &BoundMesh) {
+        if let (Some(stream), Some(count @ 1..)) = (&self.streams[proxy], self.held[proxy]) {
+            stream.bind(dev);
+            stream.draw_held(dev, mesh, count);
+            stream.unbind(dev);
+        }
     }
 
     pub(super) fn gpu_bytes(&self) -> usize {
-        self.stream.bytes()
+        self.streams
+            .iter()
+            .flatten()
+            .map(InstanceStream::bytes)
+            .sum()
     }
 
     pub(super) fn destroy(&mut self, dev: &Device) {
-        self.stream.destroy(dev);
+        for stream in &mut self.streams {
+            if let Some(mut stream) = stream.take() {
+                stream.destroy(dev);
+            }
+        }
+        self.held = [None; PROXIES];
     }
 }

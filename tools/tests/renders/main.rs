@@ -26,6 +26,7 @@ mod plane_oracle;
 mod single_sided;
 mod srgb_framebuffer;
 mod still_frames;
+mod still_records;
 mod tone_map;
 mod viewport_origin;
 mod warm_up;
