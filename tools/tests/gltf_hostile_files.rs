@@ -11,7 +11,7 @@ use std::path::PathBuf;
 use common::files::{load, load_with, write};
 use common::gltf::{base64, Builder};
 use common::gltf_models::{checker_png, floor, primitive, triangle};
-use serde_json::json;
+use serde_json::{json, Value};
 
 /// What a test model may not read: files beside its folder, with bytes a message must never
 /// show. `b.bin` is a valid buffer for the model (so a load that reads it succeeds).
@@ -443,4 +443,65 @@ fn an_image_that_does_not_decode_is_warned_of_without_its_bytes() {
             assert!(!warning.contains(quoted), "{name}: {warning}");
         }
     }
+}
+
+/// serde_json reads 128 levels of nesting at most, where the `gltf` crate skips any depth: a
+/// deeply nested value must neither hide a later field from the loader's checks nor make it
+/// drop a material's texture transform without a word.
+#[test]
+fn deep_nesting_hides_no_field_and_drops_no_transform() {
+    let dir = tempfile::tempdir().unwrap();
+    let deep = format!("{}{}", "[".repeat(300), "]".repeat(300));
+    let with_deep = |text: String| text.replace("\"DEEP\"", &deep);
+
+    // An index past u32, which the crate would read as mesh 0, after a deep made-up member.
+    let mut b = Builder::default();
+    let mut doc = triangle(&mut b);
+    doc["made_up"] = json!("DEEP");
+    doc["nodes"][0]["mesh"] = json!(4_294_967_296u64);
+    let path = write(dir.path(), "index.gltf", with_deep(b.gltf(doc)));
+    let err = load(&path).unwrap_err().to_string();
+    assert!(err.contains("nodes[0].mesh"), "{err}");
+
+    // A textured floor whose base colour texture is shifted and scaled.
+    let transform = json!({"offset": [0.5, 0.0], "scale": [0.5, 1.0]});
+    let textured = |b: &mut Builder, info_extras: Value, material_extras: Value| {
+        let prim = primitive(b, &floor(), Some(0));
+        json!({"scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+               "meshes": [{"primitives": [prim]}],
+               "materials": [{"extras": material_extras, "pbrMetallicRoughness": {
+                   "baseColorTexture": {"index": 0, "extensions": {
+                       "KHR_texture_transform": info_extras}}}}],
+               "textures": [{"source": 0}],
+               "images": [{"uri": format!("data:image/png;base64,{}", base64(&checker_png()))}],
+               "extensionsUsed": ["KHR_texture_transform"]})
+    };
+    let shifted = manylight::scene::surface_maps::TextureTransform {
+        offset: glam::Vec2::new(0.5, 0.0),
+        rotation: 0.0,
+        scale: glam::Vec2::new(0.5, 1.0),
+    };
+    let mut b = Builder::default();
+    let doc = textured(&mut b, transform.clone(), json!("DEEP"));
+    let path = write(dir.path(), "extras.gltf", with_deep(b.gltf(doc)));
+    let (scene, report) = load(&path).unwrap();
+    assert_eq!(scene.materials[0].maps.base_transform, shifted);
+    assert!(report.warnings.is_empty(), "{:?}", report.warnings);
+
+    // Nested deep inside the transform itself: drawn untransformed, and said so.
+    let mut deep_transform = transform;
+    deep_transform["extras"] = json!("DEEP");
+    let mut b = Builder::default();
+    let doc = textured(&mut b, deep_transform, json!(null));
+    let path = write(dir.path(), "inside.gltf", with_deep(b.gltf(doc)));
+    let (scene, report) = load(&path).unwrap();
+    assert_eq!(
+        scene.materials[0].maps.base_transform,
+        manylight::scene::surface_maps::TextureTransform::IDENTITY
+    );
+    let all = report.warnings.join("\n");
+    assert!(
+        all.contains("KHR_texture_transform unreadable") && all.contains("untransformed"),
+        "{all}"
+    );
 }

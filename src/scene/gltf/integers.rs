@@ -65,6 +65,10 @@ const NUMBERS: &[&str] = &[
     "outerConeAngle",
 ];
 
+/// Deeper than any of the schema's integers lie (`extensions.KHR_lights_punctual.lights[0]
+/// .spot` is five levels): a value this deep is skipped, not walked.
+const SCHEMA_DEPTH: usize = 16;
+
 /// Extensions whose contents the loader reads (others are skipped).
 const READ_EXTENSIONS: &[&str] = &["KHR_lights_punctual"];
 
@@ -125,7 +129,9 @@ impl<'de> DeserializeSeed<'de> for Walk<'_> {
     type Value = ();
 
     fn deserialize<D: de::Deserializer<'de>>(self, d: D) -> Result<(), D::Error> {
-        if self.look && self.found.is_none() {
+        // Skipped at any depth, as the crate skips it; walked, serde_json would stop at 128
+        // levels and leave the rest of the file unchecked.
+        if self.look && self.found.is_none() && self.path.len() < SCHEMA_DEPTH {
             d.deserialize_any(self)
         } else {
             d.deserialize_ignored_any(IgnoredAny).map(|_| ())
@@ -224,6 +230,20 @@ mod tests {
         // Nor one written like an index.
         let err = check(br#"{"[token=abc]":5000000000}"#).unwrap_err();
         assert!(err.starts_with("…:") && !err.contains("token"), "{err}");
+    }
+
+    /// serde_json stops a walk at 128 levels, where the crate skips any depth: a deep value
+    /// before a field must not leave the field unchecked.
+    #[test]
+    fn a_deeply_nested_value_leaves_no_field_unchecked() {
+        for depth in [20, 127, 128, 5000] {
+            let deep = format!("{}{}", "[".repeat(depth), "]".repeat(depth));
+            let json = format!(r#"{{"made_up":{deep},"nodes":[{{"mesh":4294967296}}]}}"#);
+            let err = check(json.as_bytes()).unwrap_err();
+            assert!(err.starts_with("nodes[0].mesh:"), "{depth}: {err}");
+            let json = format!(r#"{{"nodes":[{{"mesh":1,"extras":{deep}}}],"made_up":{deep}}}"#);
+            assert!(check(json.as_bytes()).is_ok(), "{depth}");
+        }
     }
 
     #[test]

@@ -21,34 +21,87 @@ use crate::scene::surface_maps::{
 };
 use crate::scene::{shown, Texture};
 
-/// The file's `materials` array as plain JSON, for the transforms.
-pub(super) struct RawMaterials(Vec<Value>);
+/// The file's materials' `KHR_texture_transform` objects, as plain JSON. Only the texture
+/// infos' extensions are built: the rest of the document (`extras` too) is skipped, at any
+/// depth.
+pub(super) struct RawMaterials(Vec<RawMaterial>);
+
+#[derive(Default, serde::Deserialize)]
+#[serde(default, rename_all = "camelCase")]
+struct RawMaterial {
+    pbr_metallic_roughness: Option<RawPbr>,
+    normal_texture: Option<RawInfo>,
+    occlusion_texture: Option<RawInfo>,
+    emissive_texture: Option<RawInfo>,
+}
+
+#[derive(Default, serde::Deserialize)]
+#[serde(default, rename_all = "camelCase")]
+struct RawPbr {
+    base_color_texture: Option<RawInfo>,
+    metallic_roughness_texture: Option<RawInfo>,
+}
+
+#[derive(Default, serde::Deserialize)]
+#[serde(default)]
+struct RawInfo {
+    extensions: Option<RawInfoExtensions>,
+}
+
+#[derive(Default, serde::Deserialize)]
+#[serde(default)]
+struct RawInfoExtensions {
+    #[serde(rename = "KHR_texture_transform")]
+    texture_transform: Option<Value>,
+}
 
 impl RawMaterials {
-    /// From the file's JSON chunk (already parsed once by the `gltf` crate, so valid).
-    pub fn parse(json: &[u8]) -> RawMaterials {
-        // Only `materials` is built: the rest of the document is skipped, not parsed into
-        // values (tens of bytes each).
+    /// From the file's JSON chunk (already parsed once by the `gltf` crate, so valid). Where
+    /// a transform cannot be read (nested past serde_json's 128 levels), all are ignored,
+    /// with a warning.
+    pub fn parse(json: &[u8], warnings: &mut Vec<String>) -> RawMaterials {
         #[derive(serde::Deserialize)]
         struct Root {
             #[serde(default)]
-            materials: Option<Value>,
+            materials: Option<Vec<RawMaterial>>,
         }
         match serde_json::from_slice::<Root>(json) {
-            Ok(Root {
-                materials: Some(Value::Array(list)),
-            }) => RawMaterials(list),
-            _ => RawMaterials(Vec::new()),
+            Ok(root) => RawMaterials(root.materials.unwrap_or_default()),
+            Err(e) => {
+                warnings.push(format!(
+                    "materials: KHR_texture_transform unreadable ({}, line {} column {}); \
+                     every texture is drawn untransformed",
+                    match e.classify() {
+                        serde_json::error::Category::Data => "not of the schema's types",
+                        _ => "nested too deep",
+                    },
+                    e.line(),
+                    e.column()
+                ));
+                RawMaterials(Vec::new())
+            }
         }
     }
 
-    /// The texture info at `path` (keys from the material object) of material `index`.
-    fn info(&self, index: Option<usize>, path: &[&str]) -> Option<&Value> {
-        let mut v = self.0.get(index?)?;
-        for key in path {
-            v = v.get(key)?;
-        }
-        Some(v)
+    /// The `KHR_texture_transform` of the texture info at `path` (keys from the material
+    /// object) of material `index`.
+    fn transform(&self, index: Option<usize>, path: &[&str]) -> Option<&Value> {
+        let m = self.0.get(index?)?;
+        let pbr = m.pbr_metallic_roughness.as_ref();
+        let info = match path {
+            ["normalTexture"] => m.normal_texture.as_ref(),
+            ["occlusionTexture"] => m.occlusion_texture.as_ref(),
+            ["emissiveTexture"] => m.emissive_texture.as_ref(),
+            ["pbrMetallicRoughness", "baseColorTexture"] => pbr?.base_color_texture.as_ref(),
+            ["pbrMetallicRoughness", "metallicRoughnessTexture"] => {
+                pbr?.metallic_roughness_texture.as_ref()
+            }
+            _ => {
+                debug_assert!(false, "no texture info at {path:?}");
+                None
+            }
+        };
+        info?.extensions.as_ref()?.texture_transform.as_ref()
     }
 }
 
@@ -78,11 +131,7 @@ pub(super) fn transform_of(
     field: &str,
     warnings: &mut Vec<String>,
 ) -> (TextureTransform, u32) {
-    let Some(ext) = raw
-        .info(index, path)
-        .and_then(|i| i.get("extensions"))
-        .and_then(|e| e.get("KHR_texture_transform"))
-    else {
+    let Some(ext) = raw.transform(index, path) else {
         return (TextureTransform::IDENTITY, tex_coord);
     };
     let pair = |key: &str, default: Vec2| -> Option<Vec2> {

@@ -106,13 +106,13 @@ pub(super) struct Materials {
 
 impl Materials {
     /// For the file whose JSON chunk is `json`, its textures taking their part of `budget`.
-    pub fn new(json: &[u8], budget: TextureBudget) -> Materials {
+    pub fn new(json: &[u8], budget: TextureBudget, warnings: &mut Vec<String>) -> Materials {
         Materials {
             list: Vec::new(),
             by_index: HashMap::new(),
             with_vertex_alpha: HashMap::new(),
             textures: Textures::new(budget),
-            raw: RawMaterials::parse(json),
+            raw: RawMaterials::parse(json, warnings),
             translucent: HashMap::new(),
         }
     }

@@ -405,7 +405,7 @@ fn import(
     let mut meshes: HashMap<(usize, usize), Option<BuiltMesh>> = HashMap::new();
     // Lent to the materials' textures, handed back at the end (an error keeps none of it).
     let lent = std::mem::replace(textures, TextureBudget::spent());
-    let mut materials = material::Materials::new(json, lent);
+    let mut materials = material::Materials::new(json, lent, &mut warnings);
     let mut out = Imported {
         objects: Vec::new(),
         materials: Vec::new(),
