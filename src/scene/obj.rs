@@ -28,12 +28,14 @@ mod map_options;
 mod parse_memory;
 #[cfg(test)]
 mod tests;
+mod text;
 mod textures;
 
 pub use super::texture_names::resolve_texture;
 use super::texture_names::{resolve_in as resolve_texture_in, Listings};
 use super::texture_names::{within_folder, TextureFinder};
 pub use lines::{MAX_OBJ_CORNERS, MAX_OBJ_MATERIALS};
+use text::text_of;
 use textures::TextureCache;
 
 /// Loads an OBJ file (and its MTL) into `scene`, placing it with `transform`. Returns the
@@ -329,28 +331,6 @@ type Parsed = (
     Vec<String>,
 );
 
-/// OBJ or MTL bytes as the text tobj reads: bytes that are not UTF-8 (a Latin-1 name)
-/// replaced by U+FFFD rather than failing the whole read, and a lone CR (old Mac line ends)
-/// taken as a line end, as CRLF is; a UTF-8 byte-order mark (Windows editors write one) is
-/// dropped, else tobj would not know the first line's keyword. Also says whether any byte was
-/// not UTF-8.
-fn text_of(mut bytes: Vec<u8>) -> (String, bool) {
-    if bytes.starts_with(b"\xEF\xBB\xBF") {
-        bytes.drain(..3);
-    }
-    // Valid UTF-8 (the common file) becomes the text without a copy.
-    let (text, not_utf8) = match String::from_utf8(bytes) {
-        Ok(text) => (text, false),
-        Err(e) => (String::from_utf8_lossy(e.as_bytes()).into_owned(), true),
-    };
-    let text = if text.contains('\r') {
-        text.replace("\r\n", "\n").replace('\r', "\n")
-    } else {
-        text
-    };
-    (text, not_utf8)
-}
-
 /// Asks the allocator for the `bytes` an OBJ's `step` may take: an error naming the file and
 /// its counts where they cannot be had.
 fn ask_for(
@@ -376,7 +356,17 @@ fn ask_for(
 }
 
 fn parse_obj(path: &Path, allow_outside: bool) -> Result<Parsed, SceneError> {
-    let (text, not_utf8) = text_of(read_bounded(path, FileKind::Model)?);
+    let (text, not_utf8) = text_of(read_bounded(path, FileKind::Model)?).map_err(|bytes| {
+        let reason = format!(
+            "reading it as text (bytes that are not UTF-8 replaced by U+FFFD) may take up to {} \
+             MiB, more than this process can allocate now",
+            bytes.div_ceil(1 << 20)
+        );
+        SceneError::Io {
+            path: path.to_path_buf(),
+            source: std::io::Error::new(std::io::ErrorKind::OutOfMemory, reason),
+        }
+    })?;
     let rewrites = lines::check_obj(&text).map_err(|reason| SceneError::Obj {
         path: path.to_path_buf(),
         reason,
@@ -469,7 +459,15 @@ fn parse_obj(path: &Path, allow_outside: bool) -> Result<Parsed, SceneError> {
             warn(library_unread(path, &name, e));
             tobj::LoadError::OpenFileFailed
         })?;
-        let (text, not_utf8) = text_of(bytes);
+        let (text, not_utf8) = text_of(bytes).map_err(|bytes| {
+            warn(format!(
+                "{}: not read: as text (bytes that are not UTF-8 replaced by U+FFFD) it may \
+                 take up to {} MiB, more than this process can allocate now",
+                mtl_path.display(),
+                bytes.div_ceil(1 << 20)
+            ));
+            tobj::LoadError::OpenFileFailed
+        })?;
         if not_utf8 {
             warn(format!(
                 "{}: not UTF-8 text; bytes that are not (in names) were replaced by U+FFFD",
