@@ -1,11 +1,12 @@
 //! A picture that came out black is said, with what can make it so, rather than written in
 //! silence: the camera looking away from the geometry or past it, nothing lighting it, every
-//! surface cut out or fully transparent.
+//! surface cut out or fully transparent, an exposure below 0 EV.
 
 use manylight::scene::Scene;
 
-/// The warning for `image` when every pixel of it is black; `None` otherwise.
-pub fn warning(image: &image::RgbaImage, scene: &Scene) -> Option<String> {
+/// The warning for `image`, drawn at `exposure_ev` stops, when every pixel of it is black;
+/// `None` otherwise.
+pub fn warning(image: &image::RgbaImage, scene: &Scene, exposure_ev: f32) -> Option<String> {
     if image.pixels().any(|p| p[0] | p[1] | p[2] != 0) {
         return None;
     }
@@ -36,6 +37,12 @@ pub fn warning(image: &image::RgbaImage, scene: &Scene) -> Option<String> {
         && scene.ambient == glam::Vec3::ZERO
     {
         causes.push("every light is a spot whose cone (outer_deg) is under 1°".to_string());
+    }
+    if exposure_ev < 0.0 {
+        causes.push(format!(
+            "the exposure of {exposure_ev} EV (`--exposure`) scales every pixel by {:.1e}",
+            f64::from(exposure_ev).exp2()
+        ));
     }
     let camera = &scene.camera;
     let (near, far) = camera.near_far();
@@ -98,7 +105,7 @@ mod tests {
         scene.lights.clear();
         scene.directional_lights.clear();
         scene.ambient = glam::Vec3::ZERO;
-        let text = warning(&image, &scene).expect("black");
+        let text = warning(&image, &scene, 0.0).expect("black");
         assert!(
             text.contains("nothing lights it") && text.contains("camera"),
             "{text}"
@@ -106,15 +113,15 @@ mod tests {
         // A light of intensity 0 is no light.
         let mut dark = manylight::Light::point(glam::DVec3::Z, 3.0, glam::Vec3::ONE, 0.0);
         scene.lights.push(dark);
-        let text = warning(&image, &scene).expect("black");
+        let text = warning(&image, &scene, 0.0).expect("black");
         assert!(text.contains("nothing lights it"), "{text}");
         dark.intensity = 1.0;
         scene.lights = vec![dark];
-        let text = warning(&image, &scene).expect("black");
+        let text = warning(&image, &scene, 0.0).expect("black");
         assert!(!text.contains("nothing lights it"), "{text}");
         scene.lights.clear();
         scene.ambient = glam::Vec3::splat(0.1);
-        let text = warning(&image, &scene).expect("black");
+        let text = warning(&image, &scene, 0.0).expect("black");
         assert!(!text.contains("nothing lights it"), "{text}");
         // Spots of closed cones alone (a cone of 0° was blamed on the camera alone).
         scene.ambient = glam::Vec3::ZERO;
@@ -127,13 +134,19 @@ mod tests {
             manylight::Light::spot(glam::DVec3::Z, 3.0, glam::Vec3::ONE, 1.0, cone(outer_deg))
         };
         scene.lights = vec![spot(0.0), spot(0.5)];
-        let text = warning(&image, &scene).expect("black");
+        let text = warning(&image, &scene, 0.0).expect("black");
         assert!(text.contains("cone (outer_deg) is under 1°"), "{text}");
         scene.lights.push(spot(30.0));
-        let text = warning(&image, &scene).expect("black");
+        let text = warning(&image, &scene, 0.0).expect("black");
         assert!(!text.contains("outer_deg"), "{text}");
+        // An exposure below 0 EV is one of the causes (it was left out, and the camera blamed).
+        let text = warning(&image, &scene, -15.0).expect("black");
+        assert!(
+            text.contains("exposure of -15 EV") && text.contains("3.1e-5"),
+            "{text}"
+        );
         image.put_pixel(3, 1, image::Rgba([0, 0, 1, 255]));
-        assert_eq!(warning(&image, &scene), None);
+        assert_eq!(warning(&image, &scene, 0.0), None);
     }
 
     /// The camera is named the cause, alone, only where no object can be in its view; where
@@ -142,7 +155,7 @@ mod tests {
     fn the_camera_is_blamed_alone_only_where_it_looks_away_from_the_bounds() {
         let mut scene = manylight::builtin_scene("plane", None).unwrap();
         let image = image::RgbaImage::new(16, 9);
-        let looking_at = |scene: &Scene| warning(&image, scene).expect("black");
+        let looking_at = |scene: &Scene| warning(&image, scene, 0.0).expect("black");
         let text = looking_at(&scene);
         assert!(
             text.contains("space between the objects")

@@ -357,7 +357,7 @@ pub fn run(args: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
     if let Some(warning) = unused_grid_options(args, &stats) {
         log::warn!("{warning}");
     }
-    if let Some(warning) = crate::black_frame::warning(&image, &scene) {
+    if let Some(warning) = crate::black_frame::warning(&image, &scene, options.exposure_ev) {
         log::warn!("{warning}");
     }
     if let Some(file) = out_file {
