@@ -1,6 +1,6 @@
 //! What a still frame costs against a moving one, taking turns in one run: a still frame
 //! (nothing the light lists are built from changed) draws with the last frame's lists, so it
-//! neither assigns nor uploads them.
+//! neither assigns nor uploads them (forward's and deferred's light records likewise).
 //! `cargo bench --bench still_frames -- [ROUNDS] [WxH] [METHOD] [es2|es3]` (default 5 rounds,
 //! 640x360, clustered, ES 3.0: the courtyard with 1 024 lights). Each round renders 20 frames
 //! of the lights standing at t = 1 s, then 20 of them moving on from there at 30 frames a second,
