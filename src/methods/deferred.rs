@@ -304,6 +304,8 @@ struct LightPass {
     uploaded: usize,
     /// It drew the last frame's instances.
     reused: bool,
+    /// What its instances were made from: kept once the frame's GL check passes.
+    key: InstancesKey,
 }
 
 fn unit_sphere() -> Mesh {
@@ -496,8 +498,11 @@ impl Deferred {
             });
             uploaded += self.lights.draw(dev, slot, &mesh, instances)?;
         }
-        self.instances_key = Some(key);
-        Ok(LightPass { uploaded, reused })
+        Ok(LightPass {
+            uploaded,
+            reused,
+            key,
+        })
     }
 
     fn composite(
@@ -631,7 +636,10 @@ impl ShadingMethod for Deferred {
             stats.upload_bytes += transparent.upload_bytes;
             stats.lists_reused &= transparent.lists_reused;
         }
+        // Only a frame that passed its check leaves instances to draw again: its error may be
+        // the instance upload's.
         crate::gl::device::gl_check!(dev, "deferred frame");
+        self.instances_key = Some(light_pass.key);
         Ok(stats)
     }
 

@@ -266,6 +266,37 @@ fn deferred_uploads_again_the_lights_of_more_than_a_batch() {
     assert!(image == first, "the second frame's picture differs");
 }
 
+/// A frame that fails (its error may be the records' upload) leaves no records to draw again:
+/// the next frame of the same lights uploads them, and draws what a fresh renderer draws. The
+/// failures are injected at the step that reports them.
+#[test]
+fn a_failed_frame_leaves_no_records_to_draw_again() {
+    let before = still_scene();
+    let mut after = still_scene();
+    after.lights[3].position.x += 1.0;
+    let opts = RenderOptions::default();
+    for (method, es, step) in [
+        ("forward", EsVersion::Es2, "data texture upload"),
+        ("forward", EsVersion::Es3, "data texture upload"),
+        ("deferred", EsVersion::Es3, "data texture upload"),
+        ("deferred", EsVersion::Es3, "deferred frame"),
+    ] {
+        let what = format!("{es} {method}, failed at {step}");
+        let mut gpu = Gpu::new(es);
+        gpu.render_with(method, &before, SIZE, &opts);
+        gpu.r().fail_gl_checks_naming(Some(step));
+        let failed = gpu.r().render_offscreen(&after, SIZE.0, SIZE.1, &opts);
+        gpu.r().fail_gl_checks_naming(None);
+        assert!(failed.is_err(), "{what}: the frame did not fail");
+        let (image, stats) = gpu.render_with(method, &after, SIZE, &opts);
+        assert_uploaded(&stats, &what);
+        assert!(
+            image == first_frame(es, method, &after, &opts),
+            "{what}: the next frame's picture differs"
+        );
+    }
+}
+
 /// Timed frames time a frame's whole cost: each uploads the records.
 #[test]
 fn timed_frames_upload_the_records() {
