@@ -4,6 +4,7 @@
 //! refused naming the field to change; lights past it that reach nothing visible are left out
 //! (exactly what they add).
 
+use super::frame_setup::overwrite_lights;
 use crate::cluster::view_light::GpuLight;
 use crate::gl::Caps;
 use crate::scene::{Projection, Scene};
@@ -32,15 +33,17 @@ pub(super) fn view_reach(scene: &Scene, aspect: f64, content_far: f64) -> f64 {
 
 /// Without fragment `highp`: refuses a frame whose visible geometry reaches past
 /// [`MAX_FP16_VIEW_REACH`] (naming `camera.far`) or with a light too far to place that
-/// reaches it (naming the light); drops the lights too far to place that reach nothing.
+/// reaches it (naming the light), and warns of radii fp16 caps where that shows. Returns how
+/// far from the eye a light may lie when some lie farther (reaching nothing: they are to be
+/// left out, see [`placeable`]); `None` when every light is placed.
 pub(super) fn check(
     caps: &Caps,
     scene: &Scene,
-    lights: &mut Vec<GpuLight>,
+    lights: &[GpuLight],
     reach: f64,
-) -> Result<(), Error> {
+) -> Result<Option<f64>, Error> {
     if caps.fragment_has_highp() {
-        return Ok(());
+        return Ok(None);
     }
     if reach > MAX_FP16_VIEW_REACH {
         return Err(Error::Limit(format!(
@@ -50,9 +53,9 @@ pub(super) fn check(
         )));
     }
     let farthest = MAX_FP16_SPAN - reach;
-    let placeable = |l: &GpuLight| (l.position.length() as f64) <= farthest;
-    if lights.iter().all(placeable) {
-        return Ok(());
+    if lights.iter().all(|l| placeable(l, farthest)) {
+        warn_of_capped_radii(lights.iter(), reach);
+        return Ok(None);
     }
     // The gathered lights are the scene's active ones in order: name the scene's index.
     let active = scene
@@ -71,9 +74,46 @@ pub(super) fn check(
             )));
         }
     }
-    lights.retain(placeable);
-    warn_of_capped_radii(lights, reach);
-    Ok(())
+    warn_of_capped_radii(lights.iter().filter(|l| placeable(l, farthest)), reach);
+    Ok(Some(farthest))
+}
+
+/// Whether a light lies within `farthest` of the eye (as [`check`] returned it).
+fn placeable(light: &GpuLight, farthest: f64) -> bool {
+    (light.position.length() as f64) <= farthest
+}
+
+/// The lights a frame draws when [`check`] leaves some out: kept between frames and compared
+/// as the gathered ones are, so that a still frame stays one.
+#[derive(Default)]
+pub(super) struct PlacedLights {
+    lights: Vec<GpuLight>,
+    leaving_out: bool,
+}
+
+impl PlacedLights {
+    /// Takes in this frame's gathered lights and what [`check`] returned for them. Returns
+    /// whether the lights drawn may differ from the last frame's beyond the gathered ones'
+    /// own changes.
+    pub(super) fn update(&mut self, gathered: &[GpuLight], farthest: Option<f64>) -> bool {
+        match farthest {
+            None => std::mem::take(&mut self.leaving_out),
+            Some(farthest) => {
+                let placed = gathered.iter().filter(|l| placeable(l, farthest)).copied();
+                let changed = overwrite_lights(&mut self.lights, placed);
+                changed | !std::mem::replace(&mut self.leaving_out, true)
+            }
+        }
+    }
+
+    /// The lights the frame draws: `gathered`, or those of them it can place.
+    pub(super) fn of<'a>(&'a self, gathered: &'a [GpuLight]) -> &'a [GpuLight] {
+        if self.leaving_out {
+            &self.lights
+        } else {
+            gathered
+        }
+    }
 }
 
 /// Largest value fp16 holds: a larger radius reads as this in a mediump shader.
@@ -111,7 +151,7 @@ fn window(d: f64, r: f64) -> f64 {
 
 /// Warns (once) of a light whose radius fp16 caps at [`FP16_MAX`] while it reaches geometry
 /// far enough that the capped window differs from the true one by more than 1/255.
-fn warn_of_capped_radii(lights: &[GpuLight], reach: f64) {
+fn warn_of_capped_radii<'a>(lights: impl Iterator<Item = &'a GpuLight>, reach: f64) {
     use std::sync::atomic::Ordering;
     if WARNED_CAPPED_RADIUS.load(Ordering::Relaxed) {
         return;

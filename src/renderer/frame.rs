@@ -285,11 +285,11 @@ impl Renderer {
             );
         }
         let reach = super::fp16_range::view_reach(scene, width as f64 / height as f64, content_far);
-        let gathered = self.lights.len();
-        super::fp16_range::check(self.dev.caps(), scene, &mut self.lights, reach)?;
-        if self.lights.len() != gathered {
+        let farthest = super::fp16_range::check(self.dev.caps(), scene, &self.lights, reach)?;
+        if self.placed.update(&self.lights, farthest) {
             self.lights_generation += 1;
         }
+        let frame_lights = self.placed.of(&self.lights);
         super::fp16_channels::warn_of_lost_channels(self.dev.caps(), scene);
         super::fp16_channels::warn_of_capped_radiance(
             self.dev.caps(),
@@ -316,7 +316,7 @@ impl Renderer {
             view,
             projection,
             orthographic: matches!(scene.camera.projection, Projection::Orthographic { .. }),
-            lights: &self.lights,
+            lights: frame_lights,
             lights_generation: self.lights_generation,
             directional,
             features,
@@ -428,11 +428,11 @@ impl Renderer {
         };
         stats.lights = LightStats {
             total: scene.lights.len(),
-            active: self.lights.len(),
+            active: frame_lights.len(),
             visible: match method_stats.assign {
                 _ if !lit => 0,
                 Some(a) => a.visible_lights,
-                None => self.lights.len(),
+                None => frame_lights.len(),
             },
             overflowed: assignment.overflowed_lights + method_stats.dropped_lights,
             encoding: features.light_encoding(),

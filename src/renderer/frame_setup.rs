@@ -21,9 +21,7 @@ pub(super) fn gather_lights(
     view: &DMat4,
     options: &RenderOptions,
 ) -> bool {
-    let mut changed = false;
-    let mut count = 0;
-    for light in scene.lights.iter().filter(|l| l.is_active()) {
+    let gathered = scene.lights.iter().filter(|l| l.is_active()).map(|light| {
         let mut g = GpuLight::from_light(light, view);
         if let Some(cutoff) = options.light_cutoff {
             g.cull_radius = crate::scene::shading::cutoff_distance(
@@ -32,7 +30,20 @@ pub(super) fn gather_lights(
                 cutoff as f64,
             ) as f32;
         }
-        // Written over the last frame's list, compared on the way.
+        g
+    });
+    overwrite_lights(lights, gathered)
+}
+
+/// Writes `new` over `lights` (keeping its buffer), comparing on the way. Returns whether the
+/// list differs, bit for bit, from the one `lights` held.
+pub(super) fn overwrite_lights(
+    lights: &mut Vec<GpuLight>,
+    new: impl Iterator<Item = GpuLight>,
+) -> bool {
+    let mut changed = false;
+    let mut count = 0;
+    for g in new {
         match lights.get_mut(count) {
             Some(old) if old.same_bits(&g) => {}
             Some(old) => {

@@ -71,6 +71,8 @@ pub struct Renderer {
     freed: bool,
     /// The frame's active lights in view space (kept: a frame fills it without allocating).
     lights: Vec<GpuLight>,
+    /// Those of `lights` a context without fragment `highp` can place, when it leaves some out.
+    placed: fp16_range::PlacedLights,
     /// Changes whenever `lights` may differ from the last frame's ([`FrameContext`]'s
     /// `lights_generation`).
     lights_generation: u64,
@@ -178,6 +180,7 @@ impl Renderer {
             pending_warning,
             freed: false,
             lights: Vec::new(),
+            placed: fp16_range::PlacedLights::default(),
             lights_generation: 0,
             timing_frames: false,
             shown_directional: Vec::new(),

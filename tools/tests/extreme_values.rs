@@ -456,6 +456,32 @@ fn a_light_farther_than_the_radius_cap_still_reaches_the_scene() {
     }
 }
 
+/// Without fragment highp a radius past fp16 acts as 65 504: a light of radius 10⁵ lighting a
+/// plane up to ~29 000 away is visibly too dark there. That was said only in a frame that also
+/// left a light out (too far to place); it is said whenever it shows.
+#[test]
+fn a_radius_fp16_caps_is_named_where_it_shows() {
+    common::warnings::install();
+    let mut s = plane(vec![]);
+    s.objects[0].transform = DMat4::from_scale(DVec3::splat(3000.0));
+    s.camera = Camera::perspective(
+        DVec3::new(0.0, 0.0, 15000.0),
+        DVec3::ZERO,
+        60.0,
+        10.0,
+        20000.0,
+    );
+    s.lights = vec![Light::point(
+        DVec3::new(0.0, 0.0, 5000.0),
+        1e5,
+        Vec3::ONE,
+        1.0,
+    )];
+    Gpu::without_fragment_highp().render(&s, 16, 16, &RenderOptions::default());
+    let said = common::warnings::warnings_containing("radius 1.000e5 acts as 65504");
+    assert_eq!(said.len(), 1, "{said:?}");
+}
+
 /// Without fragment highp a light's radiance goes up divided by k², k = 2^⌈log₂(c)/2⌉, and
 /// the falloff multiplies k² back: past c = 2¹⁴ (k ≥ 2⁸) that square is past fp16, and
 /// within a unit of the light the falloff became its cap, 1.8× too bright with a ring where

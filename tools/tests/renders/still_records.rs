@@ -297,6 +297,45 @@ fn a_failed_frame_leaves_no_records_to_draw_again() {
     }
 }
 
+/// Without fragment highp a light too far from the eye for fp16 that reaches nothing is left
+/// out: still frames stay still (they drew again every frame), and a far plane that makes
+/// it placeable, or no longer, makes the next frame upload. The lamp lies 59 990 behind the
+/// eye, where fp16 places it under a far plane of 2 (the view reaches about 3 deep) and not
+/// under the scene's (tens deep).
+#[test]
+fn without_highp_a_light_left_out_keeps_still_frames_still() {
+    let mut scene = still_scene();
+    let eye = scene.camera.position;
+    let behind = (eye - scene.camera.target).normalize();
+    scene
+        .lights
+        .push(Light::point(eye + behind * 59990.0, 1.0, Vec3::ONE, 1.0));
+    let mut near_far = scene.clone();
+    set_plane(&mut near_far, |_, far| *far = 2.0);
+    let mut gpu = Gpu::without_fragment_highp();
+    let opts = RenderOptions::default();
+    let frame = |gpu: &mut Gpu, s: &Scene| gpu.render_with("forward", s, SIZE, &opts);
+    let (first, _) = frame(&mut gpu, &scene);
+    for (s, what, active) in [
+        (&scene, "a still frame, the lamp left out", None),
+        (&near_far, "the far plane at 2", Some(41)),
+        (&near_far, "a still frame, the lamp placed", None),
+        (&scene, "the scene's far plane", Some(40)),
+    ] {
+        let (image, stats) = frame(&mut gpu, s);
+        match active {
+            None => assert_reused(&stats, what),
+            Some(n) => {
+                assert_uploaded(&stats, what);
+                assert_eq!(stats.lights.active, n, "{what}: lights drawn");
+            }
+        }
+        if std::ptr::eq(s, &scene) {
+            assert!(image == first, "{what}: not the first frame's picture");
+        }
+    }
+}
+
 /// Timed frames time a frame's whole cost: each uploads the records.
 #[test]
 fn timed_frames_upload_the_records() {
