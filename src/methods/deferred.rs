@@ -637,8 +637,8 @@ impl ShadingMethod for Deferred {
             stats.lists_reused &= transparent.lists_reused;
         }
         // Only a frame that passed its check leaves instances to draw again: its error may be
-        // the instance upload's.
-        crate::gl::device::gl_check!(dev, "deferred frame");
+        // the instance upload's. A real check, in release builds too.
+        dev.check("deferred frame")?;
         self.instances_key = Some(light_pass.key);
         Ok(stats)
     }

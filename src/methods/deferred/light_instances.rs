@@ -16,8 +16,8 @@ const LIGHT_LOCATION: u32 = 5;
 /// `vec4`s a light takes.
 const LIGHT_VEC4S: usize = 4;
 
-/// Lights a draw takes at most: the buffer grows with the scene's lights up to 4 096 of them,
-/// 256 KiB, however many the scene has.
+/// Lights a draw takes at most: each proxy kind's buffer grows with its lights up to 4 096 of
+/// them, 256 KiB (768 KiB for the three kinds), however many the scene has.
 const BATCH_LIGHTS: usize = 4096;
 
 /// `vec4`s a full batch holds.
