@@ -1,8 +1,6 @@
 //! OBJ and MTL bytes as the text tobj reads, made within the memory the process can have: a
 //! file of any bytes takes at most the room its conversion asks for first.
 
-use super::parse_memory::can_allocate;
-
 /// `bytes` as text: bytes that are not UTF-8 (a Latin-1 name) replaced by U+FFFD rather than
 /// failing the whole read, and a lone CR (old Mac line ends) taken as a line end, as CRLF is;
 /// a UTF-8 byte-order mark (Windows editors write one) is dropped, else tobj would not know
@@ -20,12 +18,24 @@ pub(super) fn text_of(mut bytes: Vec<u8>) -> Result<(String, bool), u64> {
         Err(e) => {
             let bytes = e.into_bytes();
             let needed = replaced_len(&bytes);
-            if !can_allocate(needed) {
-                return Err(needed);
-            }
-            Ok((String::from_utf8_lossy(&bytes).into_owned(), true))
+            Ok((replaced(&bytes, needed).ok_or(needed)?, true))
         }
     }
+}
+
+/// `bytes` with each invalid run replaced by U+FFFD, in one allocation of exactly `needed`
+/// bytes (`String::from_utf8_lossy` grows by doubling: up to twice that, past what was
+/// asked for). `None` where the allocator cannot give it.
+fn replaced(bytes: &[u8], needed: u64) -> Option<String> {
+    let mut text = String::new();
+    text.try_reserve_exact(usize::try_from(needed).ok()?).ok()?;
+    for chunk in bytes.utf8_chunks() {
+        text.push_str(chunk.valid());
+        if !chunk.invalid().is_empty() {
+            text.push(char::REPLACEMENT_CHARACTER);
+        }
+    }
+    Some(text)
 }
 
 /// Bytes of `bytes` as text with each invalid run replaced by U+FFFD (three bytes): up to three
@@ -99,12 +109,29 @@ mod tests {
         }
     }
 
+    /// Bytes of address space this process may still map: its limit less what it has.
+    fn room_left() -> u64 {
+        let field = |file: &str, key: &str, at: usize| -> u64 {
+            let text = std::fs::read_to_string(file).unwrap();
+            let line = text.lines().find(|l| l.starts_with(key)).unwrap();
+            line[key.len()..]
+                .split_whitespace()
+                .nth(at)
+                .unwrap()
+                .parse()
+                .unwrap()
+        };
+        let limit = field("/proc/self/limits", "Max address space", 0);
+        limit - 1024 * field("/proc/self/status", "VmSize:", 0)
+    }
+
     /// Set in the child process of the test below.
     const CHILD: &str = "MANYLIGHT_TEST_TEXT_UNDER_LIMIT";
 
     /// Under an address-space limit, a file not UTF-8 whose replaced text would not fit is
     /// refused with the size it needs, where a copy made without asking would abort the
-    /// process; a file of lone CRs as large takes no copy at all.
+    /// process; one whose text fits is made within what it needs; a file of lone CRs as large
+    /// takes no copy at all.
     #[test]
     fn a_file_whose_text_would_not_fit_is_refused_not_aborted() {
         const MIB: usize = 1 << 20;
@@ -114,6 +141,12 @@ mod tests {
             assert_eq!(needed, 3 * 150 * MIB as u64);
             let (text, lossy) = text_of(vec![b'\r'; 150 * MIB]).unwrap();
             assert!(!lossy && text.len() == 150 * MIB && !text.contains('\r'));
+            drop(text);
+            // A file whose text fits the room left with 10 % to spare, where text grown by
+            // doubling (to four times the file) would not.
+            let file = (room_left() as f64 / 4.5) as usize;
+            let (text, lossy) = text_of(vec![0xFF; file]).unwrap();
+            assert!(lossy && text.len() == 3 * file && text.capacity() == text.len());
             return;
         }
         if !cfg!(target_os = "linux") {
