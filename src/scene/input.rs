@@ -3,7 +3,8 @@
 //!
 //! Only regular files are read: a FIFO would block `open` forever and `/dev/zero` never ends,
 //! so anything else (device, FIFO, socket, folder), and on Linux any file of `/proc` or `/sys`,
-//! is refused before it is opened. A file larger than its kind's limit is refused from its
+//! is refused before it is opened, and looked at again once opened (without waiting, so a
+//! FIFO put in its place meanwhile does not block). A file larger than its kind's limit is refused from its
 //! size, and the read itself stops one byte past the limit, so a file that grows while it is
 //! read cannot get around it. The limits can
 //! be raised (or lowered) for every kind at once with `MANYLIGHT_MAX_FILE_MB`.
@@ -130,28 +131,12 @@ fn read_limited(path: &Path, kind: FileKind, prefix: Option<u64>) -> Result<Vec<
         source,
     };
     // `metadata` follows symlinks and does not open the file: a FIFO is refused unopened.
-    let meta = std::fs::metadata(path).map_err(io)?;
-    if !meta.is_file() {
-        return Err(refuse(
-            path,
-            std::io::ErrorKind::InvalidInput,
-            format!(
-                "not a regular file (the {} must be a file, not a folder, device or FIFO)",
-                kind.name()
-            ),
-        ));
-    }
-    if let Some(root) = kernel_file_system(&meta) {
-        return Err(refuse(
-            path,
-            std::io::ErrorKind::InvalidInput,
-            format!(
-                "a file of the kernel's {root} (one can block a read forever or change as it \
-                 is read), not {}",
-                kind.a_name()
-            ),
-        ));
-    }
+    check_readable(path, &std::fs::metadata(path).map_err(io)?, kind)?;
+    let file = open_without_waiting(path).map_err(io)?;
+    // What is read is what was opened, looked at again: a FIFO or device put in the file's
+    // place after the look above is refused now, not read.
+    let meta = file.metadata().map_err(io)?;
+    check_readable(path, &meta, kind)?;
     let limit = kind.limit();
     let too_big = |size: u64| {
         refuse(
@@ -169,7 +154,6 @@ fn read_limited(path: &Path, kind: FileKind, prefix: Option<u64>) -> Result<Vec<
     if size > limit {
         return Err(too_big(size));
     }
-    let file = std::fs::File::open(path).map_err(io)?;
     // Asked for, not taken: a failed allocation would abort the process.
     let mut bytes = Vec::new();
     if bytes.try_reserve_exact(size as usize).is_err() {
@@ -189,6 +173,46 @@ fn read_limited(path: &Path, kind: FileKind, prefix: Option<u64>) -> Result<Vec<
         return Err(too_big(bytes.len() as u64));
     }
     Ok(bytes)
+}
+
+/// Refuses anything but a regular file outside the kernel's pseudo file systems.
+fn check_readable(path: &Path, meta: &std::fs::Metadata, kind: FileKind) -> Result<(), SceneError> {
+    if !meta.is_file() {
+        return Err(refuse(
+            path,
+            std::io::ErrorKind::InvalidInput,
+            format!(
+                "not a regular file (the {} must be a file, not a folder, device or FIFO)",
+                kind.name()
+            ),
+        ));
+    }
+    if let Some(root) = kernel_file_system(meta) {
+        return Err(refuse(
+            path,
+            std::io::ErrorKind::InvalidInput,
+            format!(
+                "a file of the kernel's {root} (one can block a read forever or change as it \
+                 is read), not {}",
+                kind.a_name()
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// `path` opened for reading without waiting: opening a FIFO blocks until a writer comes,
+/// unless non-blocking (which a regular file's reads ignore). Nor may a terminal become the
+/// process's controlling one.
+fn open_without_waiting(path: &Path) -> std::io::Result<std::fs::File> {
+    let mut options = std::fs::OpenOptions::new();
+    options.read(true);
+    #[cfg(unix)]
+    std::os::unix::fs::OpenOptionsExt::custom_flags(
+        &mut options,
+        libc::O_NONBLOCK | libc::O_NOCTTY,
+    );
+    options.open(path)
 }
 
 /// `/proc` or `/sys` when the file lies on that pseudo file system. Their files pass for
@@ -279,6 +303,80 @@ mod tests {
         let before = bytes_read();
         let _ = read_bounded(Path::new("/proc/self/status"), FileKind::Texture);
         assert_eq!(bytes_read(), before, "nothing read");
+    }
+
+    /// A FIFO opened as a file would block until a writer came, as when one takes a checked
+    /// file's place before it is opened: it is opened without waiting and then refused.
+    #[cfg(unix)]
+    #[test]
+    fn a_fifo_opened_is_refused_without_waiting() {
+        let dir = tempfile::tempdir().unwrap();
+        let fifo = dir.path().join("scene.json");
+        let made = std::process::Command::new("mkfifo").arg(&fifo).status();
+        if !made.is_ok_and(|s| s.success()) {
+            eprintln!("SKIPPED: mkfifo failed");
+            return;
+        }
+        let (send, receive) = std::sync::mpsc::channel();
+        let path = fifo.clone();
+        std::thread::spawn(move || {
+            let opened = open_without_waiting(&path).and_then(|f| f.metadata());
+            let _ = send.send(opened.map(|m| check_readable(&path, &m, FileKind::SceneFile)));
+        });
+        let outcome = receive.recv_timeout(std::time::Duration::from_secs(20));
+        if outcome.is_err() {
+            // Lets the blocked open go before failing.
+            let _ = std::fs::OpenOptions::new().write(true).open(&fifo);
+        }
+        let err = outcome
+            .expect("opening the FIFO waited")
+            .unwrap()
+            .unwrap_err();
+        assert!(err.to_string().contains("not a regular file"), "{err}");
+    }
+
+    /// A file swapped between a regular file and a FIFO while it is read over and over: each
+    /// read gets the file's bytes or refuses a FIFO, never the FIFO's (nothing: no writer).
+    #[cfg(unix)]
+    #[test]
+    fn a_fifo_swapped_in_after_the_check_is_not_read() {
+        let dir = tempfile::tempdir().unwrap();
+        let (regular, fifo) = (dir.path().join("regular"), dir.path().join("fifo"));
+        std::fs::write(&regular, b"x").unwrap();
+        let made = std::process::Command::new("mkfifo").arg(&fifo).status();
+        if !made.is_ok_and(|s| s.success()) {
+            eprintln!("SKIPPED: mkfifo failed");
+            return;
+        }
+        let (path, next) = (dir.path().join("scene.json"), dir.path().join("next"));
+        std::fs::hard_link(&regular, &path).unwrap();
+        let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+        let swapper = {
+            let (stop, path) = (stop.clone(), path.clone());
+            std::thread::spawn(move || {
+                while !stop.load(std::sync::atomic::Ordering::Relaxed) {
+                    for source in [&fifo, &regular] {
+                        std::fs::hard_link(source, &next).unwrap();
+                        std::fs::rename(&next, &path).unwrap();
+                    }
+                }
+            })
+        };
+        let mut outcomes = [0; 2];
+        for _ in 0..20_000 {
+            match read_bounded(&path, FileKind::SceneFile) {
+                Ok(bytes) => {
+                    assert_eq!(bytes, b"x", "a FIFO was read as the file");
+                    outcomes[0] += 1;
+                }
+                Err(e) if e.to_string().contains("not a regular file") => outcomes[1] += 1,
+                // A rename replaces the path at once: it is never missing.
+                Err(e) => panic!("{e}"),
+            }
+        }
+        stop.store(true, std::sync::atomic::Ordering::Relaxed);
+        swapper.join().unwrap();
+        assert!(outcomes.iter().all(|&n| n > 0), "{outcomes:?}");
     }
 
     #[test]
