@@ -10,6 +10,12 @@ use super::SceneError;
 /// numbers, which GPUs read as zero, and the frame is black (a glTF node scaled by 1e-40).
 pub const MIN_PLACED_SIZE: f64 = 1e-36;
 
+/// Largest entry a transform's linear part may hold: the model-view matrix the GPU reads is
+/// f32 (at most 3.4·10³⁸), and the view's rotation adds up to three entries into one. A flat
+/// object scaled past it along its own normal has finite bounds but infinite matrix entries,
+/// and its vertices become 0·∞ = NaN.
+pub const MAX_PLACED_SCALE: f64 = 1e37;
+
 /// Axis-aligned bounding box in `f64`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Aabb {
@@ -36,6 +42,13 @@ impl Aabb {
         // Bounds drop a NaN corner (`min` keeps the other operand), so NaN is refused here.
         if !transform.is_finite() {
             return Some("is not finite".to_string());
+        }
+        let scale = linear_part_largest(transform);
+        if scale > MAX_PLACED_SCALE {
+            return Some(format!(
+                "scales by {scale:e}, past {MAX_PLACED_SCALE:e} (the f32 matrices the GPU \
+                 reads overflow)"
+            ));
         }
         let reach = self.transformed(transform).reach();
         if !(reach.is_finite() && reach <= MAX_CAMERA_COORD) {
@@ -141,6 +154,15 @@ impl Aabb {
     }
 }
 
+/// The largest entry of `transform`'s linear part, in magnitude.
+fn linear_part_largest(transform: &DMat4) -> f64 {
+    glam::DMat3::from_mat4(*transform)
+        .abs()
+        .to_cols_array()
+        .into_iter()
+        .fold(0.0, f64::max)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -177,6 +199,15 @@ mod tests {
         assert_eq!(point.placement_refusal(&scaled(1e-300)), None);
         let nan = DMat4::from_scale(DVec3::new(1.0, f64::NAN, 1.0));
         assert!(b.placement_refusal(&nan).is_some());
+        // A flat box stretched along its normal keeps finite bounds, not finite f32 matrices.
+        let flat = Aabb {
+            min: DVec3::new(-1.0, -1.0, 0.0),
+            max: DVec3::new(1.0, 1.0, 0.0),
+        };
+        let stretched = |z: f64| DMat4::from_scale(DVec3::new(1.0, 1.0, z));
+        assert_eq!(flat.placement_refusal(&stretched(MAX_PLACED_SCALE)), None);
+        let overflowing = flat.placement_refusal(&stretched(MAX_PLACED_SCALE * 2.0));
+        assert!(overflowing.is_some_and(|r| r.starts_with("scales by 2e37")));
     }
 
     #[test]

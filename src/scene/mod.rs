@@ -584,22 +584,26 @@ fn finish_load(
 }
 
 /// Whether `transform` leaves a triangle whose normal lies in `span` ([`Mesh::normal_span`])
-/// an area: `cof(A)·n` not negligible next to the cofactors' largest (a scale of 10⁻³⁰⁰ on
-/// one axis of a flat mesh is no area in f32, whatever f64 makes of it).
+/// an area: the plane of some `n` in it not collapsed onto a line (or a point).
 fn keeps_an_area(transform: &DMat4, span: &[glam::DVec3]) -> bool {
     let a = glam::DMat3::from_mat4(*transform);
-    // cof(A) = det(A)·A⁻ᵀ, written without the inverse (A may be singular).
-    let (c0, c1, c2) = (a.x_axis, a.y_axis, a.z_axis);
-    let cofactor = glam::DMat3::from_cols(c1.cross(c2), c2.cross(c0), c0.cross(c1));
-    let largest = cofactor
-        .to_cols_array()
-        .iter()
-        .fold(0.0_f64, |m, v| m.max(v.abs()));
-    largest.is_finite()
-        && largest > 0.0
-        && span
-            .iter()
-            .any(|n| (cofactor * *n).length() > 1e-12 * largest)
+    a.is_finite() && span.iter().any(|n| plane_keeps_an_area(&a, *n))
+}
+
+/// Whether `a` keeps an area in the plane of unit normal `n`: for an orthonormal basis `u`,
+/// `v` of the plane, `|Au × Av|` not negligible next to `|Au|² + |Av|²` (a scale of 10⁻³⁰⁰ on
+/// one of the plane's axes is no area in f32, whatever f64 makes of it). Measured within the
+/// plane: a stretch along `n`, which moves none of its points, does not count.
+fn plane_keeps_an_area(a: &glam::DMat3, n: glam::DVec3) -> bool {
+    let (u, v) = n.any_orthonormal_pair();
+    let (au, av) = (*a * u, *a * v);
+    let largest = au.abs().max(av.abs()).max_element();
+    // Where the GPU reads the image as zero, or f64 would overflow below.
+    if !(largest >= f64::from(f32::MIN_POSITIVE) && largest.is_finite()) {
+        return false;
+    }
+    let (au, av) = (au / largest, av / largest);
+    au.cross(av).length() > 1e-12 * (au.length_squared() + av.length_squared())
 }
 
 #[cfg(test)]
@@ -637,6 +641,10 @@ mod area_tests {
             (&cube, scale(1.0, 0.0, 1.0), true),
             (&cube, scale(1.0, 0.0, 0.0), false),
             (&quad, scale(f64::NAN, 1.0, 1.0), false),
+            // Stretched along its normal: the plane's own area is untouched.
+            (&quad, scale(1.0, 1.0, 1e19), true),
+            (&quad, turned * scale(1.0, 1.0, 1e300), true),
+            (&cube, scale(1e300, 1e300, 1.0), true),
         ] {
             let mut scene = Scene::empty();
             let material = scene.add_material(Material::flat("m", Vec3::ONE));

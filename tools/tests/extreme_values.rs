@@ -216,6 +216,13 @@ fn values_the_maths_cannot_carry_are_refused_naming_the_real_field() {
             }),
             "objects[0].transform",
         ),
+        // A flat object stretched so far along its normal: finite bounds, infinite matrix.
+        (
+            Box::new(|s: &mut Scene| {
+                s.objects[0].transform = DMat4::from_scale(DVec3::new(1.0, 1.0, 1e38))
+            }),
+            "objects[0].transform",
+        ),
         (
             Box::new(|s: &mut Scene| {
                 s.objects[0].transform = DMat4::from_translation(DVec3::new(0.0, 2e12, 0.0))
@@ -247,6 +254,49 @@ fn values_the_maths_cannot_carry_are_refused_naming_the_real_field() {
         let err = refusal(&mut gpu, &s, &RenderOptions::default());
         assert!(err.contains(field), "expected `{field}` in: {err}");
     }
+}
+
+/// A flat object stretched along its own normal, which moves none of its points, renders as
+/// it did unstretched, turned aside too, on every method: it was refused as having no area
+/// (past 10¹²) or drawn unlit (its normal matrix's entry for the normal, the plane's size over
+/// the stretch, here 10⁻⁴⁰, flushed to zero in f32). A scene file stretching it loads.
+#[test]
+fn a_plane_stretched_along_its_normal_renders_as_it_was() {
+    // The plane at a thousandth of its size, seen and lit from a thousandth as far.
+    let placed = |stretch: f64, turn: f64| {
+        let lamp = Light::point(DVec3::new(0.0, 0.0, 1e-3), 3e-3, Vec3::ONE, 1e-6);
+        let mut s = plane(vec![lamp]);
+        s.camera = Camera::perspective(DVec3::new(0.0, 0.0, 5e-3), DVec3::ZERO, 60.0, 1e-4, 0.05);
+        s.objects[0].transform =
+            DMat4::from_rotation_y(turn) * DMat4::from_scale(DVec3::new(1e-3, 1e-3, stretch));
+        s
+    };
+    common::each_method(|es, method, gpu| {
+        for turn in [0.0, 0.4] {
+            let opts = RenderOptions::default();
+            let (want, _) = gpu.render_with(method, &placed(1.0, turn), (32, 18), &opts);
+            assert!(mean(&want) > 20.0, "{es} {method}: the plane is lit");
+            for stretch in [1e13, 1e30, 1e37] {
+                let (got, _) = gpu.render_with(method, &placed(stretch, turn), (32, 18), &opts);
+                let worst = want
+                    .pixels()
+                    .zip(got.pixels())
+                    .flat_map(|(a, b)| (0..3).map(move |c| a[c].abs_diff(b[c])))
+                    .max();
+                assert!(
+                    worst <= Some(1),
+                    "{es} {method}, stretched {stretch:e}, turned {turn}: {worst:?}/255"
+                );
+            }
+        }
+    });
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("stretched.json");
+    let json = r#"{"objects":[{"builtin":"plane","transform":{"scale":[1,1,1e19]}}],
+        "lights":[{"kind":"point","position":[0,0,1],"radius":4,"color":[1,1,1]}]}"#;
+    std::fs::write(&file, json).unwrap();
+    let loaded = scene::load_scene(file.to_str().unwrap(), None);
+    assert!(loaded.is_ok(), "{:?}", loaded.err());
 }
 
 /// Grid settings the grid cannot be built from are refused naming the field (a NaN would never
