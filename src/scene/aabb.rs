@@ -36,25 +36,28 @@ impl Aabb {
     }
 
     /// Why these object-space bounds cannot be placed by `transform`, if they cannot: it is
-    /// not finite, their world bounds reach past the camera's coordinate limit, or shrink
-    /// below [`MIN_PLACED_SIZE`]. The message completes "the transform …".
+    /// not finite, their world bounds reach past the camera's coordinate limit, it scales
+    /// past [`MAX_PLACED_SCALE`], or the bounds shrink below [`MIN_PLACED_SIZE`]. The message
+    /// completes "the transform …".
     pub(crate) fn placement_refusal(&self, transform: &DMat4) -> Option<String> {
         // Bounds drop a NaN corner (`min` keeps the other operand), so NaN is refused here.
         if !transform.is_finite() {
             return Some("is not finite".to_string());
-        }
-        let scale = linear_part_largest(transform);
-        if scale > MAX_PLACED_SCALE {
-            return Some(format!(
-                "scales by {scale:e}, past {MAX_PLACED_SCALE:e} (the f32 matrices the GPU \
-                 reads overflow)"
-            ));
         }
         let reach = self.transformed(transform).reach();
         if !(reach.is_finite() && reach <= MAX_CAMERA_COORD) {
             return Some(format!(
                 "places the object's bounds {reach:e} from the origin, past \
                  ±{MAX_CAMERA_COORD:e} (the camera's limit)"
+            ));
+        }
+        // Bounds that stay near (a flat object stretched along its normal) with matrix
+        // entries past f32.
+        let scale = linear_part_largest(transform);
+        if scale > MAX_PLACED_SCALE {
+            return Some(format!(
+                "scales by {scale:e}, past {MAX_PLACED_SCALE:e} (the f32 matrices the GPU \
+                 reads overflow)"
             ));
         }
         // A mesh of one point (a degenerate face alone) has no size to lose: it draws nothing
