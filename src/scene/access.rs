@@ -2,7 +2,8 @@
 //! URI, an OBJ file its material libraries and their textures by path; an untrusted model must
 //! not read the user's other files through them, so by default such a name may name only a
 //! file inside the model file's own folder: no `..`, no absolute path (`/x`, `C:/x`,
-//! `\\server\x`), no link that leads out of the folder. [`LoadOptions`] lifts this for trusted
+//! `\\server\x`), no link that leads out of the folder, looked at before a file is opened and,
+//! on Linux and Android, once it is open. [`LoadOptions`] lifts this for trusted
 //! local content. Scene files and command lines name models anywhere: they
 //! are the user's own.
 
@@ -94,6 +95,42 @@ pub(crate) fn resolve(dir: &Path, path: &Path, allow_outside: bool) -> Result<Pa
     }
 }
 
+/// The model's folder a load confines its reads to: `dir` (a model file's parent, which may
+/// be empty for the working folder) unless `allow_outside`.
+pub(crate) fn confinement(dir: &Path, allow_outside: bool) -> Option<&Path> {
+    (!allow_outside).then_some(dir)
+}
+
+/// Refuses `file`, opened from `path`, when it really lies outside `dir`. [`resolve`] looked
+/// before it was opened; a link swapped in since would lead where that look did not go, so
+/// this asks the kernel where the open handle is (`/proc/self/fd`, Linux and Android; where
+/// that cannot be read, the look before stands alone).
+pub(crate) fn opened_within(file: &std::fs::File, path: &Path, dir: &Path) -> Result<(), String> {
+    #[cfg(any(target_os = "linux", target_os = "android"))]
+    {
+        use std::os::fd::AsRawFd;
+        let dir = if dir.as_os_str().is_empty() {
+            Path::new(".")
+        } else {
+            dir
+        };
+        let opened = std::fs::read_link(format!("/proc/self/fd/{}", file.as_raw_fd()));
+        if let (Ok(opened), Ok(real_dir)) = (opened, dir.canonicalize()) {
+            if !opened.starts_with(&real_dir) {
+                let shown = path.strip_prefix(dir).unwrap_or(path);
+                return Err(format!(
+                    "`{}` is outside the model's folder (a link leads out of it, changed after \
+                     it was looked at); refused: {HOW_TO_ALLOW}",
+                    super::shown::name(&shown.to_string_lossy())
+                ));
+            }
+        }
+    }
+    #[cfg(not(any(target_os = "linux", target_os = "android")))]
+    let _ = (file, path, dir);
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -138,6 +175,31 @@ mod tests {
         assert_eq!(std::fs::read(real).unwrap(), b"I");
         let missing = model.join("missing.bin");
         assert_eq!(resolve(&model, &missing, false).unwrap(), missing);
+    }
+
+    /// A file opened through a link that leads out is refused once open, whatever the look
+    /// before said (a link swapped in between); unconfined, it is read.
+    #[cfg(any(target_os = "linux", target_os = "android"))]
+    #[test]
+    fn a_file_opened_outside_the_folder_is_refused() {
+        use crate::scene::input::{read_bounded_within, FileKind};
+        let root = tempfile::tempdir().unwrap();
+        let model = root.path().join("model");
+        std::fs::create_dir(&model).unwrap();
+        std::fs::write(root.path().join("secret.txt"), b"S").unwrap();
+        std::fs::write(model.join("inside.bin"), b"I").unwrap();
+        std::os::unix::fs::symlink("../secret.txt", model.join("out.bin")).unwrap();
+        std::os::unix::fs::symlink("inside.bin", model.join("in.bin")).unwrap();
+        let read = |name: &str, within: Option<&Path>| {
+            read_bounded_within(&model.join(name), FileKind::GltfBuffer, within)
+        };
+        let err = read("out.bin", Some(&model)).unwrap_err().to_string();
+        assert!(
+            err.contains("`out.bin` is outside the model's folder"),
+            "{err}"
+        );
+        assert_eq!(read("in.bin", Some(&model)).unwrap(), b"I");
+        assert_eq!(read("out.bin", None).unwrap(), b"S");
     }
 
     /// Links whose spelled-out target passes `PATH_MAX` (so resolving them fails with "file

@@ -111,21 +111,37 @@ pub fn bytes_read() -> u64 {
 
 /// Reads a whole file of `kind`, refusing anything but a regular file within the limit.
 pub fn read_bounded(path: &Path, kind: FileKind) -> Result<Vec<u8>, SceneError> {
-    read_limited(path, kind, None)
+    read_limited(path, kind, None, None)
+}
+
+/// [`read_bounded`] of a file a model names, refused once opened if it really lies outside
+/// `folder` (`None`: anywhere; see [`access::confinement`](super::access::confinement)).
+pub(crate) fn read_bounded_within(
+    path: &Path,
+    kind: FileKind,
+    folder: Option<&Path>,
+) -> Result<Vec<u8>, SceneError> {
+    read_limited(path, kind, None, folder)
 }
 
 /// Reads at most the first `wanted` bytes of a file of `kind` (a glTF buffer: its
-/// `byteLength`, however large the file is), refusing anything but a regular file; `wanted`
-/// above the kind's limit is refused.
-pub fn read_bounded_prefix(
+/// `byteLength`, however large the file is) confined to `folder` as [`read_bounded_within`]
+/// is, refusing anything but a regular file; `wanted` above the kind's limit is refused.
+pub(crate) fn read_bounded_prefix(
     path: &Path,
     kind: FileKind,
     wanted: u64,
+    folder: Option<&Path>,
 ) -> Result<Vec<u8>, SceneError> {
-    read_limited(path, kind, Some(wanted))
+    read_limited(path, kind, Some(wanted), folder)
 }
 
-fn read_limited(path: &Path, kind: FileKind, prefix: Option<u64>) -> Result<Vec<u8>, SceneError> {
+fn read_limited(
+    path: &Path,
+    kind: FileKind,
+    prefix: Option<u64>,
+    folder: Option<&Path>,
+) -> Result<Vec<u8>, SceneError> {
     let io = |source| SceneError::Io {
         path: path.to_path_buf(),
         source,
@@ -137,6 +153,10 @@ fn read_limited(path: &Path, kind: FileKind, prefix: Option<u64>) -> Result<Vec<
     // place after the look above is refused now, not read.
     let meta = file.metadata().map_err(io)?;
     check_readable(path, &meta, kind)?;
+    if let Some(folder) = folder {
+        super::access::opened_within(&file, path, folder)
+            .map_err(|reason| refuse(path, std::io::ErrorKind::PermissionDenied, reason))?;
+    }
     let limit = kind.limit();
     let too_big = |size: u64| {
         refuse(

@@ -11,8 +11,8 @@ use std::sync::Arc;
 
 use glam::{DMat4, DVec3, Vec2, Vec3};
 
-use super::access::LoadOptions;
-use super::input::{read_bounded, FileKind};
+use super::access::{self, LoadOptions};
+use super::input::{read_bounded, read_bounded_within, FileKind};
 use super::material::{MAX_COLOR_FACTOR, MAX_SHININESS};
 use super::surface_maps::{SurfaceMaps, TextureTransform};
 use super::texture::{Sampling, Texture, Wrap};
@@ -72,7 +72,7 @@ pub fn load_into(
     let mut textures = TextureCache::default();
     let mut finder = TextureFinder::default();
     let override_tex =
-        texture_override.and_then(|p| textures.load(p, budget, &mut |w| report.warn(w)));
+        texture_override.and_then(|p| textures.load(p, None, budget, &mut |w| report.warn(w)));
     let mtl = match materials {
         Ok(m) => m,
         Err(e) => {
@@ -106,7 +106,10 @@ pub fn load_into(
             _ if override_tex.is_some() => None,
             Some(MapStatement { file: name, .. }) if !name.is_empty() => {
                 match finder.find(base_dir, name, allow_outside) {
-                    Ok(Some(p)) => textures.load(&p, budget, &mut |w| report.warn(w)),
+                    Ok(Some(p)) => {
+                        let within = access::confinement(base_dir, allow_outside);
+                        textures.load(&p, within, budget, &mut |w| report.warn(w))
+                    }
                     Ok(None) => {
                         // Something there that is not a file (`/dev/zero`, a folder) is named so.
                         let what = if base_dir.join(name).exists() {
@@ -455,7 +458,8 @@ fn parse_obj(path: &Path, allow_outside: bool) -> Result<Parsed, SceneError> {
         if !seen.borrow_mut().insert(file) {
             return Ok(Default::default());
         }
-        let bytes = read_bounded(&mtl_path, FileKind::Materials).map_err(|e| {
+        let within = access::confinement(&base_dir, allow_outside);
+        let bytes = read_bounded_within(&mtl_path, FileKind::Materials, within).map_err(|e| {
             warn(library_unread(path, &name, e));
             tobj::LoadError::OpenFileFailed
         })?;

@@ -161,8 +161,12 @@ impl<'a> Buffers<'a> {
                         let path = self.file(&format!("{field}.uri"), &name)?;
                         // Only the buffer's own bytes: a file named by many buffers is
                         // read as often, each time no more than the budget was charged.
-                        let bytes = read_bounded_prefix(&path, FileKind::GltfBuffer, length as u64)
-                            .map_err(|e| format!("{field}: {e}"))?;
+                        let within = self
+                            .base_dir
+                            .and_then(|dir| access::confinement(dir, self.allow_outside));
+                        let bytes =
+                            read_bounded_prefix(&path, FileKind::GltfBuffer, length as u64, within)
+                                .map_err(|e| format!("{field}: {e}"))?;
                         if bytes.len() < length {
                             return Err(too_short(path.display().to_string(), bytes.len()));
                         }

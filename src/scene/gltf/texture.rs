@@ -11,7 +11,7 @@ use std::sync::Arc;
 
 use super::buffers::Buffers;
 use super::uri::{self, Uri};
-use crate::scene::input::{read_bounded, FileKind, LIMIT_VARIABLE};
+use crate::scene::input::{read_bounded_within, FileKind, LIMIT_VARIABLE};
 use crate::scene::texture::{Filter, Sampling, Wrap};
 use crate::scene::texture_budget::{self, decode_texture_bytes, TextureBudget};
 use crate::scene::texture_names::{resolve_in as resolve_texture_in, Listings};
@@ -155,10 +155,14 @@ impl Textures {
             return Ok(None);
         }
         let file_bytes;
+        let within = match buffers.base_dir() {
+            (Some(dir), allow_outside) => access::confinement(dir, allow_outside),
+            (None, _) => None,
+        };
         let bytes: &[u8] = match &located.bytes {
             Bytes::View(view) => buffers.view(view).map_err(|e| format!("{field}: {e}"))?,
             Bytes::Data(bytes) => bytes,
-            Bytes::File(path) => match read_bounded(path, FileKind::Texture) {
+            Bytes::File(path) => match read_bounded_within(path, FileKind::Texture, within) {
                 Ok(bytes) => {
                     file_bytes = bytes;
                     &file_bytes

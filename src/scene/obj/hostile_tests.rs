@@ -58,7 +58,7 @@ fn a_texture_is_decoded_once_whatever_names_it_and_reads_are_bounded() {
         .iter()
         .map(|n| {
             cache
-                .load(&dir.path().join(n), &mut budget, &mut warn)
+                .load(&dir.path().join(n), None, &mut budget, &mut warn)
                 .unwrap()
         })
         .collect();
@@ -72,10 +72,10 @@ fn a_texture_is_decoded_once_whatever_names_it_and_reads_are_bounded() {
     std::fs::copy(dir.path().join("t.png"), dir.path().join("u.png")).unwrap();
     let mut budget = TextureBudget::default();
     assert!(cache
-        .load(&dir.path().join("t.png"), &mut budget, &mut warn)
+        .load(&dir.path().join("t.png"), None, &mut budget, &mut warn)
         .is_some());
     assert!(cache
-        .load(&dir.path().join("u.png"), &mut budget, &mut warn)
+        .load(&dir.path().join("u.png"), None, &mut budget, &mut warn)
         .is_none());
     assert!(
         warnings
@@ -155,4 +155,59 @@ fn one_line_is_named_in_the_singular() {
         "{}",
         said[0]
     );
+}
+
+/// A texture's link swapped, load after load, between an image in the model's folder and one
+/// outside it: the outside image is never read. The look before opening follows the link as
+/// it was; the check of the open handle sees where it leads then.
+#[cfg(all(any(target_os = "linux", target_os = "android"), feature = "png"))]
+#[test]
+fn a_link_swapped_to_lead_out_of_the_folder_is_never_read() {
+    let root = tempfile::tempdir().unwrap();
+    let dir = root.path().join("model");
+    std::fs::create_dir(&dir).unwrap();
+    let image = |rgb: [u8; 3], path: std::path::PathBuf| {
+        let [r, g, b] = rgb;
+        image::RgbaImage::from_pixel(1, 1, image::Rgba([r, g, b, 255]))
+            .save_with_format(path, image::ImageFormat::Png)
+            .unwrap()
+    };
+    image([200, 0, 0], dir.join("inside.png"));
+    image([0, 200, 0], root.path().join("outside.png"));
+    std::fs::write(dir.join("m.mtl"), "newmtl m\nKd 1 1 1\nmap_Kd t.png\n").unwrap();
+    let path = dir.join("m.obj");
+    let obj = "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nusemtl m\nf 1/1 2/1 3/1\n";
+    std::fs::write(&path, obj).unwrap();
+    let (link, next) = (dir.join("t.png"), dir.join("next"));
+    std::os::unix::fs::symlink("inside.png", &link).unwrap();
+    let stop = Arc::new(std::sync::atomic::AtomicBool::new(false));
+    let swapper = {
+        let stop = stop.clone();
+        std::thread::spawn(move || {
+            while !stop.load(std::sync::atomic::Ordering::Relaxed) {
+                for target in ["../outside.png", "inside.png"] {
+                    std::os::unix::fs::symlink(target, &next).unwrap();
+                    std::fs::rename(&next, &link).unwrap();
+                }
+            }
+        })
+    };
+    let mut outcomes = [0; 2];
+    for _ in 0..2000 {
+        let (scene, _) = load(&path);
+        match &scene.materials[0].diffuse_texture {
+            Some(texture) => {
+                assert_eq!(
+                    texture.image.get_pixel(0, 0)[1],
+                    0,
+                    "the outside image was read"
+                );
+                outcomes[0] += 1;
+            }
+            None => outcomes[1] += 1,
+        }
+    }
+    stop.store(true, std::sync::atomic::Ordering::Relaxed);
+    swapper.join().unwrap();
+    assert!(outcomes.iter().all(|&n| n > 0), "{outcomes:?}");
 }

@@ -5,7 +5,7 @@ use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use crate::scene::input::{read_bounded, FileKind};
+use crate::scene::input::{read_bounded_within, FileKind};
 use crate::scene::texture_budget::{self, decode_texture_bytes, TextureBudget};
 use crate::scene::Texture;
 
@@ -38,6 +38,7 @@ impl TextureCache {
     pub(super) fn load(
         &mut self,
         path: &Path,
+        within: Option<&Path>,
         budget: &mut TextureBudget,
         warn: &mut dyn FnMut(String),
     ) -> Option<Arc<Texture>> {
@@ -46,7 +47,7 @@ impl TextureCache {
         if let Some(t) = self.loaded.get(&file) {
             return t.clone();
         }
-        let tex = match self.decode_texture(path, budget) {
+        let tex = match self.decode_texture(path, within, budget) {
             Ok(img) => {
                 let name = path.display().to_string();
                 let (image, scaled) = texture_budget::to_rgba8(img, &name);
@@ -75,6 +76,7 @@ impl TextureCache {
     fn decode_texture(
         &mut self,
         path: &Path,
+        within: Option<&Path>,
         budget: &mut TextureBudget,
     ) -> Result<image::DynamicImage, String> {
         let size = std::fs::metadata(path).map_or(0, |m| m.len());
@@ -85,7 +87,7 @@ impl TextureCache {
                 FileKind::Model.limit()
             ));
         }
-        let bytes = read_bounded(path, FileKind::Texture)
+        let bytes = read_bounded_within(path, FileKind::Texture, within)
             .map_err(|e| format!("could not be decoded ({e})"))?;
         self.read_left = self.read_left.saturating_sub(bytes.len() as u64);
         // The extension first: TGA has no magic bytes to guess from.
