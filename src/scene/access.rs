@@ -71,12 +71,7 @@ pub(crate) fn resolve(dir: &Path, path: &Path, allow_outside: bool) -> Result<Pa
     if allow_outside {
         return Ok(real);
     }
-    // A file named without a folder (`m.gltf`) has the empty path as its parent.
-    let dir = if dir.as_os_str().is_empty() {
-        Path::new(".")
-    } else {
-        dir
-    };
+    let dir = folder_or_here(dir);
     let real_dir = dir.canonicalize().map_err(|e| {
         format!(
             "the model's folder {} cannot be resolved ({e})",
@@ -86,13 +81,29 @@ pub(crate) fn resolve(dir: &Path, path: &Path, allow_outside: bool) -> Result<Pa
     if real.starts_with(&real_dir) {
         Ok(real)
     } else {
-        let shown = path.strip_prefix(dir).unwrap_or(path);
-        Err(format!(
-            "`{}` is outside the model's folder (a link leads out of it); refused: \
-             {HOW_TO_ALLOW}",
-            super::shown::name(&shown.to_string_lossy())
-        ))
+        Err(led_out(dir, path, ""))
     }
+}
+
+/// `dir`, or the working folder where it is empty: a file named without a folder (`m.gltf`)
+/// has the empty path as its parent.
+fn folder_or_here(dir: &Path) -> &Path {
+    if dir.as_os_str().is_empty() {
+        Path::new(".")
+    } else {
+        dir
+    }
+}
+
+/// The refusal of `path` (in `dir`), which a link leads out of the folder (`when`: more on
+/// when it was found).
+fn led_out(dir: &Path, path: &Path, when: &str) -> String {
+    let shown = path.strip_prefix(dir).unwrap_or(path);
+    format!(
+        "`{}` is outside the model's folder (a link leads out of it{when}); refused: \
+         {HOW_TO_ALLOW}",
+        super::shown::name(&shown.to_string_lossy())
+    )
 }
 
 /// The model's folder a load confines its reads to: `dir` (a model file's parent, which may
@@ -109,20 +120,11 @@ pub(crate) fn opened_within(file: &std::fs::File, path: &Path, dir: &Path) -> Re
     #[cfg(any(target_os = "linux", target_os = "android"))]
     {
         use std::os::fd::AsRawFd;
-        let dir = if dir.as_os_str().is_empty() {
-            Path::new(".")
-        } else {
-            dir
-        };
+        let dir = folder_or_here(dir);
         let opened = std::fs::read_link(format!("/proc/self/fd/{}", file.as_raw_fd()));
         if let (Ok(opened), Ok(real_dir)) = (opened, dir.canonicalize()) {
             if !opened.starts_with(&real_dir) {
-                let shown = path.strip_prefix(dir).unwrap_or(path);
-                return Err(format!(
-                    "`{}` is outside the model's folder (a link leads out of it, changed after \
-                     it was looked at); refused: {HOW_TO_ALLOW}",
-                    super::shown::name(&shown.to_string_lossy())
-                ));
+                return Err(led_out(dir, path, ", changed after it was looked at"));
             }
         }
     }

@@ -4,10 +4,10 @@
 //! Only regular files are read: a FIFO would block `open` forever and `/dev/zero` never ends,
 //! so anything else (device, FIFO, socket, folder), and on Linux any file of `/proc` or `/sys`,
 //! is refused before it is opened, and looked at again once opened (without waiting, so a
-//! FIFO put in its place meanwhile does not block). A file larger than its kind's limit is refused from its
-//! size, and the read itself stops one byte past the limit, so a file that grows while it is
-//! read cannot get around it. The limits can
-//! be raised (or lowered) for every kind at once with `MANYLIGHT_MAX_FILE_MB`.
+//! FIFO put in its place meanwhile does not block). A file larger than its kind's limit is
+//! refused from its size, and the read itself stops one byte past the limit, so a file that
+//! grows while it is read cannot get around it. The limits can be raised (or lowered) for
+//! every kind at once with `MANYLIGHT_MAX_FILE_MB`.
 
 use std::io::Read;
 use std::path::Path;

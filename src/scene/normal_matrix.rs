@@ -4,12 +4,13 @@ use glam::DMat3;
 
 /// The normal matrix of `m`: its cofactor matrix (`det(m) · m⁻ᵀ`, up to a positive scale),
 /// scaled so its largest entry is 1, or, where its entries spread past 10³⁰, so the
-/// smallest lies as far below 1 as the largest above (f32 would flush it to zero). Unlike the inverse transpose it exists for a singular `m`
-/// — a flat object scaled to 0 along its own normal keeps that normal (`diag(2, 2, 0)` maps
-/// `z` to `z`) instead of becoming NaN — and the scaling keeps huge or tiny transforms within
-/// `f32` (the shaders normalise per fragment, so a uniform scale changes nothing). A transform
-/// that collapses a whole plane (rank < 2) has no normal directions: the identity stands in
-/// (its triangles have no area anyway).
+/// smallest lies as far below 1 as the largest above (f32 would flush it to zero). Unlike
+/// the inverse transpose it exists for a singular `m` — a flat object scaled to 0 along its
+/// own normal keeps that normal (`diag(2, 2, 0)` maps `z` to `z`) instead of becoming NaN —
+/// and the scaling keeps huge or tiny transforms within `f32` (the shaders normalise per
+/// fragment, so a uniform scale changes nothing). A transform that collapses a whole plane
+/// (rank < 2) has no normal directions: the identity stands in (its triangles have no area
+/// anyway).
 pub fn normal_matrix(m: &DMat3) -> DMat3 {
     let cofactor = DMat3::from_cols(
         m.y_axis.cross(m.z_axis),
@@ -38,8 +39,7 @@ const SPREAD_KEPT: f64 = 1e-30;
 /// What to scale `unit` (largest entry 1) by so that the GPU, which reads f32's subnormal
 /// numbers as zero, keeps its small entries: 1 where none is below [`SPREAD_KEPT`], else the
 /// factor that puts the smallest and the largest as far below 1 as above (at most 10³⁰, so
-/// a normal's three products still sum within f32). A flat object stretched 10³⁸ along its
-/// own normal needs its entry of 10⁻³⁸, which flushed to zero and left it unlit.
+/// a normal's three products still sum within f32).
 fn f32_scale(unit: &DMat3) -> f64 {
     let smallest = unit
         .abs()

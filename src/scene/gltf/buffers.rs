@@ -83,6 +83,12 @@ impl<'a> Buffers<'a> {
         (self.base_dir, self.allow_outside)
     }
 
+    /// The folder the document's files must lie in (`None`: anywhere, or no folder to read).
+    pub fn confinement(&self) -> Option<&'a Path> {
+        self.base_dir
+            .and_then(|dir| access::confinement(dir, self.allow_outside))
+    }
+
     /// The document the buffers belong to.
     pub fn document(&self) -> &'a gltf::Document {
         self.document
@@ -161,9 +167,7 @@ impl<'a> Buffers<'a> {
                         let path = self.file(&format!("{field}.uri"), &name)?;
                         // Only the buffer's own bytes: a file named by many buffers is
                         // read as often, each time no more than the budget was charged.
-                        let within = self
-                            .base_dir
-                            .and_then(|dir| access::confinement(dir, self.allow_outside));
+                        let within = self.confinement();
                         let bytes =
                             read_bounded_prefix(&path, FileKind::GltfBuffer, length as u64, within)
                                 .map_err(|e| format!("{field}: {e}"))?;

@@ -155,10 +155,7 @@ impl Textures {
             return Ok(None);
         }
         let file_bytes;
-        let within = match buffers.base_dir() {
-            (Some(dir), allow_outside) => access::confinement(dir, allow_outside),
-            (None, _) => None,
-        };
+        let within = buffers.confinement();
         let bytes: &[u8] = match &located.bytes {
             Bytes::View(view) => buffers.view(view).map_err(|e| format!("{field}: {e}"))?,
             Bytes::Data(bytes) => bytes,
