@@ -21,6 +21,9 @@ use super::state::RenderState;
 use super::target_size::{self, TargetStorage};
 use super::{Device, EsVersion, GlError};
 
+#[cfg(test)]
+mod resolve_tests;
+
 /// A framebuffer whose colour and depth have several samples per pixel.
 pub struct MultisampleTarget {
     fbo: glow::Framebuffer,
@@ -294,7 +297,8 @@ impl MultisampleTarget {
     /// bound. ES 3.0 blits: straight into `into` where `same_format` (its colour is RGBA8, or
     /// SRGB8_ALPHA8 for a target made sRGB: a multisample resolve needs identical formats) and
     /// `origin` is (0, 0), else through a single-sampled copy, whose blit converts to any
-    /// normalized format (`RGB8`, `RGB565`); ES 2.0 draws the averaged texture over it with a
+    /// normalized format (`RGB8`, `RGB565`), and through the copy too where the driver refuses
+    /// the direct blit (a format it reports as RGBA8 but is not); ES 2.0 draws the averaged texture over it with a
     /// program from `programs`.
     pub fn resolve(
         &mut self,
@@ -308,13 +312,19 @@ impl MultisampleTarget {
         let colour = glow::COLOR_BUFFER_BIT;
         match &self.color {
             Color::Renderbuffer(_) if origin == [0, 0] && same_format => {
-                dev.blit(self.fbo, into, self.size, [0, 0], colour)
+                // The frame's own errors first: the blit's are read alone below.
+                dev.check("the frame before its MSAA resolve")?;
+                dev.blit(self.fbo, into, self.size, [0, 0], colour);
+                // NVIDIA says 8 bits a channel for an `RGBA4` destination it stores as RGBA8,
+                // then refuses the resolve because the formats asked for differ.
+                match dev.check("MSAA resolve") {
+                    Err(GlError::Driver { code, .. }) if code == glow::INVALID_OPERATION => {
+                        self.resolve_through_copy(dev, into, origin)?
+                    }
+                    other => other?,
+                }
             }
-            Color::Renderbuffer(_) => {
-                let copy = self.resolved_copy(dev)?;
-                dev.blit(self.fbo, Some(copy), self.size, [0, 0], colour);
-                dev.blit(copy, into, self.size, origin, colour);
-            }
+            Color::Renderbuffer(_) => self.resolve_through_copy(dev, into, origin)?,
             Color::Texture(texture) => {
                 // Unbinding the framebuffer is what makes the driver average the samples into
                 // the texture.
@@ -354,6 +364,21 @@ impl MultisampleTarget {
         uniforms.color.set(dev, glam::Vec4::from_array(color));
         self.triangle.as_ref().expect("made above").draw(dev);
         dev.check("filling an sRGB MSAA target")
+    }
+
+    /// ES 3.0's resolve into another format or rectangle: the samples into the single-sampled
+    /// copy, whose blit then converts to the destination's normalized format.
+    fn resolve_through_copy(
+        &mut self,
+        dev: &Device,
+        into: Option<glow::Framebuffer>,
+        origin: [u32; 2],
+    ) -> Result<(), GlError> {
+        let copy = self.resolved_copy(dev)?;
+        let colour = glow::COLOR_BUFFER_BIT;
+        dev.blit(self.fbo, Some(copy), self.size, [0, 0], colour);
+        dev.blit(copy, into, self.size, origin, colour);
+        Ok(())
     }
 
     /// The single-sampled copy (made now if it is not yet): its framebuffer.
