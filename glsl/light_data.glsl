@@ -73,7 +73,9 @@ Light fetchLight(int i) {
     vec4 t4 = LIGHT_TEXEL(i, 4);
     vec4 t5 = LIGHT_TEXEL(i, 5);
     vec3 dir = vec3(unpack16(t3.xy), unpack16(t3.zw), unpack16(t4.xy)) * 2.0 - 1.0;
-    light.direction = dir / max(length(dir), 1e-6);
+    // An omni light's stored direction decodes to zero; its floor is a normal fp16 number,
+    // since NVIDIA flushes fp16 subnormals (1e-6 became 0, and 0 / 0 unlit every light).
+    light.direction = dir / max(length(dir), 1e-4);
     // 1 − cos α as 2 sin²(α/2) from the stored sin(α/2), as spot_terms_from_half_sines does:
     // arithmetic only (GLSL ES leaves sin's precision to the implementation).
     float sinOuter = unpack16(t5.xy);

@@ -61,7 +61,8 @@ SurfaceParams materialSurface(MEDP vec3 albedo, vec2 uv) {
 MEDP vec3 blinnPhong(HIGHP vec3 L, vec3 N, vec3 V, MEDP float nDotL, SurfaceParams s) {
 #if HAS_SPECULAR
     HIGHP vec3 halfSum = L + V;
-    HIGHP vec3 H = halfSum / max(length(halfSum), 1e-6);
+    // Zero where L = −V; the floor is a normal fp16 number (drivers flush subnormals to 0).
+    HIGHP vec3 H = halfSum / max(length(halfSum), 1e-4);
     MEDP vec3 spec = s.Ks * pow(max(dot(N, H), 0.0), s.Ns);
 #else
     MEDP vec3 spec = vec3(0.0);
@@ -80,7 +81,7 @@ MEDP vec3 blinnPhong(HIGHP vec3 L, vec3 N, vec3 V, MEDP float nDotL, SurfacePara
 // The lobe runs at HIGHP (fp16 only where the device has no fragment highp), colours at MEDP.
 MEDP vec3 metallicRoughness(HIGHP vec3 L, vec3 N, vec3 V, MEDP float nDotL, SurfaceParams s) {
     HIGHP vec3 halfSum = L + V;
-    HIGHP vec3 H = halfSum / max(length(halfSum), 1e-6);
+    HIGHP vec3 H = halfSum / max(length(halfSum), 1e-4);
     HIGHP float nDotV = max(dot(N, V), 1e-4);
     HIGHP float nDotH = clamp(dot(N, H), 0.0, 1.0);
     MEDP float vDotH = clamp(dot(V, H), 0.0, 1.0);

@@ -504,6 +504,9 @@ pub fn numbered(source: &str) -> String {
 }
 
 #[cfg(test)]
+mod fp16_literal_tests;
+
+#[cfg(test)]
 mod tests {
     use super::*;
 
