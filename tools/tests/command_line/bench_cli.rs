@@ -310,8 +310,13 @@ fn edge_values_of_the_sweep_are_measured_skipped_or_refused_not_fatal() {
         let mut es3 = common::Gpu::new(manylight::EsVersion::Es3);
         manylight::methods::forward::max_lights(es3.r().caps()) as usize
     };
-    let past = (forward_max + 1).to_string();
-    let lights = format!("8,{past}");
+    // A count past forward's loop, where one lies within the scenes' limit (NVIDIA's loop
+    // holds every count a scene may have).
+    let past = (forward_max < manylight::scene::input::MAX_LIGHTS).then(|| forward_max + 1);
+    let lights = match past {
+        Some(past) => format!("8,{past}"),
+        None => "8".to_string(),
+    };
     let run = Command::new(env!("CARGO_BIN_EXE_manylight"))
         .args([
             "bench", "--scenes", "plane", "--lights", &lights, "--es", "3",
@@ -324,7 +329,10 @@ fn edge_values_of_the_sweep_are_measured_skipped_or_refused_not_fatal() {
         .unwrap();
     let log = String::from_utf8_lossy(&run.stderr);
     assert!(run.status.success(), "{log}");
-    assert!(log.contains(&format!("{past} lights: skipped")), "{log}");
+    match past {
+        Some(past) => assert!(log.contains(&format!("{past} lights: skipped")), "{log}"),
+        None => eprintln!("forward holds {forward_max} lights here: no count to skip"),
+    }
     let report: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
     let rows = report["rows"].as_array().unwrap();

@@ -18,7 +18,9 @@ pub fn rerun_with(test: &str, envs: &[(&str, &str)], what: &str) {
     );
 }
 
-/// Set in a child that reruns a test with RGBA8 light records.
+/// Set in a child that reruns a test with RGBA8 light records: `mesa` where Mesa's override
+/// took float textures away, `played` where the child's ES 2.0 renderers play a device
+/// without them (`Restrictions::no_float_textures`).
 const RGBA8_LIGHTS: &str = "MANYLIGHT_TEST_RGBA8_LIGHTS";
 
 /// Whether this process is a child rerunning a test with RGBA8 light records
@@ -27,19 +29,27 @@ pub fn rgba8_lights() -> bool {
     std::env::var_os(RGBA8_LIGHTS).is_some()
 }
 
-/// Runs `test` again in a child process whose Mesa has no `GL_OES_texture_float` (an ES 2.0
-/// context at most, whose lights go up in RGBA8 records), where [`rgba8_lights`] is true;
-/// nothing in such a child, or on another implementation than Mesa.
+/// Whether this child's ES 2.0 renderers play a device without float textures.
+pub fn plays_rgba8_lights() -> bool {
+    std::env::var_os(RGBA8_LIGHTS).is_some_and(|v| v == "played")
+}
+
+/// Runs `test` again in a child process whose ES 2.0 contexts have no float textures, so that
+/// lights go up in RGBA8 records and [`rgba8_lights`] is true; nothing in such a child. On
+/// Mesa the driver loses `GL_OES_texture_float` (`MESA_EXTENSION_OVERRIDE`); on another
+/// implementation, which ignores Mesa's switches, the renderers play the loss.
 pub fn rerun_with_rgba8_lights(test: &str) {
-    if rgba8_lights() || super::other_implementation_than_mesa("MESA_EXTENSION_OVERRIDE") {
+    if rgba8_lights() {
         return;
     }
-    rerun_with(
-        test,
-        &[
+    if super::renders_with_mesa() {
+        let envs = [
             ("MESA_EXTENSION_OVERRIDE", "-GL_OES_texture_float"),
-            (RGBA8_LIGHTS, "1"),
-        ],
-        "RGBA8 light records",
-    );
+            (RGBA8_LIGHTS, "mesa"),
+        ];
+        rerun_with(test, &envs, "RGBA8 light records");
+    } else {
+        let envs = [(RGBA8_LIGHTS, "played")];
+        rerun_with(test, &envs, "RGBA8 light records (played)");
+    }
 }

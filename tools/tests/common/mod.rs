@@ -15,7 +15,7 @@ use std::path::PathBuf;
 use manylight::gl::program::ProgramCache;
 use manylight::gl::{HeadlessContext, Restrictions};
 use manylight::metrics::cpu_reference::{self, Encoding};
-use std::sync::{Arc, Mutex};
+use std::sync::{Arc, Mutex, OnceLock};
 
 use glam::{DMat4, DVec3, Vec3};
 use manylight::scene::meshbuild::MeshBuilder;
@@ -57,6 +57,7 @@ impl Gpu {
     pub fn restricted(es: EsVersion, restrictions: &Restrictions) -> Gpu {
         // A test that reads its warnings back finds every one its renderers logged.
         warnings::install();
+        let restrictions = &as_this_child_plays(es, restrictions);
         let kind = (es, *restrictions);
         let pooled = {
             let mut pool = POOL.lock().unwrap_or_else(|e| e.into_inner());
@@ -85,6 +86,7 @@ impl Gpu {
 
     fn fresh_restricted(es: EsVersion, restrictions: &Restrictions) -> Gpu {
         warnings::install();
+        let restrictions = &as_this_child_plays(es, restrictions);
         let ctx = HeadlessContext::new(es).unwrap_or_else(|e| {
             panic!("no headless {es} context ({e}); install libegl1 libegl-mesa0 libgles2 libgl1-mesa-dri")
         });
@@ -140,6 +142,16 @@ impl Gpu {
             .render_offscreen(scene, w, h, opts)
             .unwrap_or_else(|e| panic!("{method}: {e}"))
     }
+}
+
+/// `restrictions`, plus a device without float textures on ES 2.0 in a child that plays one
+/// ([`child::rerun_with_rgba8_lights`]).
+fn as_this_child_plays(es: EsVersion, restrictions: &Restrictions) -> Restrictions {
+    let mut restrictions = *restrictions;
+    if es == EsVersion::Es2 && child::plays_rgba8_lights() {
+        restrictions.no_float_textures = true;
+    }
+    restrictions
 }
 
 impl Drop for Gpu {
@@ -271,14 +283,35 @@ pub fn skip(reason: &str) {
 
 /// For a test about a Mesa feature (its `MESA_*` overrides, its second driver, OSMesa against
 /// Mesa's EGL): true, after saying so on stderr, when this run renders with another GLES
-/// implementation (`MANYLIGHT_GLES_LIB`; docs/drivers.md), where the feature does not exist.
-/// Unlike [`skip`] this is not something missing from the environment: the test runs in the
-/// suite's run on the system's Mesa, so `MANYLIGHT_REQUIRE_ALL_TESTS` does not turn it into a
-/// failure.
+/// implementation (`MANYLIGHT_GLES_LIB`; docs/drivers.md) or the system's GL is not Mesa
+/// (NVIDIA's), where the feature does not exist. Unlike [`skip`] this is not something missing
+/// from the environment: the test runs in the suite's run on the system's Mesa, so
+/// `MANYLIGHT_REQUIRE_ALL_TESTS` does not turn it into a failure.
 pub fn other_implementation_than_mesa(what: &str) -> bool {
-    not_applicable_on_another_implementation(|dir| {
+    if not_applicable_on_another_implementation(|dir| {
         format!("{what} is a Mesa feature; this run renders with {dir}")
-    })
+    }) {
+        return true;
+    }
+    let system = system_implementation();
+    if system.starts_with("Mesa") {
+        return false;
+    }
+    eprintln!("NOT APPLICABLE: {what} is a Mesa feature; the system's GL is {system}");
+    true
+}
+
+/// Whether this run renders with Mesa: the system's GL, no `MANYLIGHT_GLES_LIB`.
+pub fn renders_with_mesa() -> bool {
+    manylight::gl::gles_lib::chosen_folder().is_none()
+        && system_implementation().starts_with("Mesa")
+}
+
+/// The system's GL implementation as the renderer names it (`Caps::implementation`), asked
+/// once per test program.
+fn system_implementation() -> &'static str {
+    static NAME: OnceLock<String> = OnceLock::new();
+    NAME.get_or_init(|| Gpu::new(EsVersion::Es2).r().caps().implementation())
 }
 
 /// For a test whose child processes each pick their own GLES implementation (the tests of

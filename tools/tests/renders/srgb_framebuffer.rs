@@ -109,11 +109,11 @@ fn the_clear_colour_and_the_heatmap_are_stored_as_given_and_exact_counts_are_ref
     gpu.r().set_method_named("clustered").unwrap();
     let cases = [
         RenderOptions {
-            clear_color: [0.5, 0.25, 0.75, 1.0],
+            clear_color: [0.4, 0.25, 0.75, 1.0],
             ..Default::default()
         },
         RenderOptions {
-            clear_color: [0.5, 0.25, 0.75, 1.0],
+            clear_color: [0.4, 0.25, 0.75, 1.0],
             samples: 4,
             ..Default::default()
         },
@@ -125,11 +125,15 @@ fn the_clear_colour_and_the_heatmap_are_stored_as_given_and_exact_counts_are_ref
     for options in &cases {
         let plain = stored(&mut gpu, glow::RGBA8, &plane, options);
         let srgb = stored(&mut gpu, glow::SRGB8_ALPHA8, &plane, options);
-        let background = plain.chunks(4).filter(|p| p[..3] == [128, 64, 191]).count();
+        // No channel halfway between two steps, where drivers round either way (NVIDIA
+        // stores 0.5 as 127).
+        let background = plain.chunks(4).filter(|p| p[..3] == [102, 64, 191]).count();
         if options.count == manylight::CountKind::None {
             assert!(
                 background > (W * H / 4) as usize,
-                "{background} background pixels"
+                "{background} background pixels, {} samples (a corner is {:?})",
+                options.samples,
+                &plain[..4]
             );
         }
         // With MSAA, edge pixels are averaged in linear space in the sRGB one (see above).
