@@ -17,18 +17,19 @@ use manylight::{EsVersion, RenderOptions};
 /// An ES 2.0 renderer on a context that has the extension; `None` on another implementation
 /// than Mesa, whose override adds it.
 fn es2_with_the_extension() -> Option<Gpu> {
-    if common::other_implementation_than_mesa("MESA_EXTENSION_OVERRIDE") {
-        return None;
-    }
     static ONCE: std::sync::Once = std::sync::Once::new();
     ONCE.call_once(|| {
         // Every test of this binary calls this before making a context, and the value is the
-        // same, so no thread sees it change.
+        // same, so no thread sees it change. Set before the question below, whose context
+        // would fix Mesa's extensions without it (Mesa reads the override once a process).
         std::env::set_var(
             "MESA_EXTENSION_OVERRIDE",
             "+GL_EXT_multisampled_render_to_texture",
         );
     });
+    if common::other_implementation_than_mesa("MESA_EXTENSION_OVERRIDE") {
+        return None;
+    }
     let mut gpu = Gpu::new(EsVersion::Es2);
     let caps = gpu.r().caps();
     assert!(
