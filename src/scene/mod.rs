@@ -23,6 +23,7 @@ pub mod framing;
 #[cfg(feature = "gltf")]
 pub mod gltf;
 pub mod input;
+mod jpeg_frame;
 #[cfg(test)]
 mod left_out_tests;
 pub mod light;

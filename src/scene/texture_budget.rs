@@ -6,6 +6,8 @@
 
 use image::DynamicImage;
 
+use super::jpeg_frame::{progressive_jpeg_frame, JpegFrame};
+
 /// Largest side of a texture as the scene keeps it: 4096² RGBA8 is 64 MiB (85 with the GPU's
 /// mipmaps), the largest `GL_MAX_TEXTURE_SIZE` many phones have, and more texels than a 4K
 /// frame can show of one surface. Larger images are scaled down, keeping their aspect ratio.
@@ -96,6 +98,7 @@ pub(crate) fn decode_texture_bytes(
                     MAX_PROGRESSIVE_DECODE_BYTES >> 20
                 ));
             }
+            budget.take_scans(&frame)?;
         }
     }
     let (w, h) = first.into_dimensions().map_err(undecodable)?;
@@ -135,50 +138,6 @@ const JPEG_OUTPUT_BYTES_PER_PIXEL: u64 = 4;
 /// 16 384 × 10 922 one within [`MAX_DECODE_BYTES`] of output took 1.06 GB). A baseline JPEG
 /// decodes row by row.
 const MAX_PROGRESSIVE_DECODE_BYTES: u64 = 2 * MAX_DECODE_BYTES;
-
-/// What a progressive JPEG's start-of-frame segment says.
-#[derive(Debug, PartialEq)]
-struct JpegFrame {
-    width: u32,
-    height: u32,
-    components: u8,
-}
-
-/// The frame of progressive JPEG `bytes`, as its first start-of-frame segment gives it (SOF2,
-/// SOF6, SOF10, SOF14); `None` for any other JPEG. Reads the segment headers only, within the
-/// bytes, skipping what the decoder skips between segments (stray bytes, `FF 00`, fill).
-fn progressive_jpeg_frame(bytes: &[u8]) -> Option<JpegFrame> {
-    let mut at = 2; // past SOI
-    while at + 4 <= bytes.len() {
-        if bytes[at] != 0xFF {
-            at += 1;
-            continue;
-        }
-        let marker = bytes[at + 1];
-        match marker {
-            // Fill bytes before a marker, and a stuffed zero.
-            0xFF => at += 1,
-            0x00 => at += 2,
-            0xC2 | 0xC6 | 0xCA | 0xCE => {
-                // Length (2), precision (1), height (2), width (2), components (1).
-                let frame = bytes.get(at + 5..at + 10)?;
-                return Some(JpegFrame {
-                    height: u16::from_be_bytes([frame[0], frame[1]]).into(),
-                    width: u16::from_be_bytes([frame[2], frame[3]]).into(),
-                    components: frame[4],
-                });
-            }
-            0xC0 | 0xC1 | 0xC3 | 0xC5 | 0xC7 | 0xC9 | 0xCB | 0xCD | 0xCF => return None,
-            // Markers without a length.
-            0x01 | 0xD0..=0xD9 => at += 2,
-            _ => {
-                let length = usize::from(u16::from_be_bytes([bytes[at + 2], bytes[at + 3]]));
-                at += 2 + length;
-            }
-        }
-    }
-    None
-}
 
 /// The crate's feature that decodes `format`, where the build has no decoder for it (asked of
 /// `image`, whose decoders another crate of the build may have turned on).
@@ -244,21 +203,48 @@ pub const MAX_SCENE_TEXTURE_BYTES: u64 = 1 << 30;
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct TextureBudget {
     left: u64,
+    /// What is left of [`MAX_SCENE_JPEG_SCAN_WORK`].
+    scan_work_left: u64,
 }
 
 impl Default for TextureBudget {
     fn default() -> Self {
         TextureBudget {
             left: MAX_SCENE_TEXTURE_BYTES,
+            scan_work_left: MAX_SCENE_JPEG_SCAN_WORK,
         }
     }
 }
+
+/// Most work the progressive JPEGs of one scene load may give the decoder, in component
+/// samples times scans: each scan walks every block of its components, however few bytes it
+/// has. 2³⁵ is 17 progressive RGB images of 8 192² with 10 scans (a usual progression), or
+/// about 7 s of one core here; 24 greyscale images of 16 384 × 10 922 with 100 scans (9 MB of
+/// files) took 100 s without it.
+pub const MAX_SCENE_JPEG_SCAN_WORK: u64 = 1 << 35;
 
 impl TextureBudget {
     /// Nothing left: what a loader holds while its budget is lent out (an interrupted load
     /// never hands back a fresh one).
     pub(crate) fn spent() -> TextureBudget {
-        TextureBudget { left: 0 }
+        TextureBudget {
+            left: 0,
+            scan_work_left: 0,
+        }
+    }
+
+    /// Takes the decoding work of a progressive JPEG's scans, or says why it is left out.
+    fn take_scans(&mut self, frame: &JpegFrame) -> Result<(), String> {
+        let work = frame.scan_work();
+        if work > self.scan_work_left {
+            return Err(format!(
+                "could not be decoded (a progressive JPEG of {}×{} in {} scans: the scene's \
+                 progressive JPEGs would take the decoder past 2^35 component samples of scans)",
+                frame.width, frame.height, frame.scans
+            ));
+        }
+        self.scan_work_left -= work;
+        Ok(())
     }
 
     /// Takes what a `w × h` image is kept as ([`stored_size`], RGBA8) and returns it, or says
@@ -282,7 +268,10 @@ impl TextureBudget {
     /// A budget of `left` bytes (tests of what is left out).
     #[cfg(test)]
     pub(crate) fn with_left(left: u64) -> TextureBudget {
-        TextureBudget { left }
+        TextureBudget {
+            left,
+            scan_work_left: MAX_SCENE_JPEG_SCAN_WORK,
+        }
     }
 
     /// Bytes left.
@@ -325,6 +314,7 @@ mod tests {
             width,
             height,
             components: 3,
+            scans: 0,
         };
         assert_eq!(
             progressive_jpeg_frame(&progressive),
@@ -357,6 +347,33 @@ mod tests {
         assert!(!err.contains("progressive"), "{err}");
         let baseline = encoded(image::RgbImage::new(8, 8).into(), image::ImageFormat::Jpeg);
         assert_eq!(progressive_jpeg_frame(&baseline), None);
+    }
+
+    /// The 24 greyscale 16 384 × 10 922 progressive JPEGs of 100 scans (380 KB each) that
+    /// kept a load busy for 100 s: past 2³⁵ samples of scans the rest are left out before
+    /// they are decoded.
+    #[test]
+    fn a_scenes_progressive_jpegs_are_refused_past_their_scans_work() {
+        let mut b = vec![0xFF, 0xD8, 0xFF, 0xC2, 0, 11, 8];
+        b.extend(10_922u16.to_be_bytes());
+        b.extend(16_384u16.to_be_bytes());
+        b.extend([1, 1, 0x11, 0]);
+        for _ in 0..100 {
+            b.extend([0xFF, 0xDA, 0, 8, 1, 1, 0, 0, 63, 0, 0x12, 0x34]);
+        }
+        b.extend([0xFF, 0xD9]);
+        let jpeg = Some(image::ImageFormat::Jpeg);
+        let mut budget = TextureBudget::default();
+        // The first takes 100 × 1.8·10⁸ of the 3.4·10¹⁰ and goes to the decoder (which finds
+        // no valid data in it); the second would pass the budget.
+        let err = decode_texture_bytes(&b, jpeg, &mut budget).unwrap_err();
+        assert!(!err.contains("scans"), "{err}");
+        let err = decode_texture_bytes(&b, jpeg, &mut budget).unwrap_err();
+        assert!(err.contains("16384×10922 in 100 scans"), "{err}");
+        // With fewer scans, the same frame still fits what is left.
+        let few = [&b[..15 + 12 * 10], &[0xFF, 0xD9]].concat();
+        let err = decode_texture_bytes(&few, jpeg, &mut budget).unwrap_err();
+        assert!(!err.contains("scans"), "{err}");
     }
 
     /// `image` encoded as `format`.
