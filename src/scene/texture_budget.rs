@@ -4,7 +4,7 @@
 //! dropped then: a 12 000² RGB PNG peaks near 0.55 GB (0.43 decoded, 0.05 scaled, 0.06 RGBA)
 //! and is kept as 64 MiB.
 
-use image::DynamicImage;
+use image::{DynamicImage, ImageDecoder};
 
 use super::jpeg_frame::{progressive_jpeg_frame, JpegFrame};
 
@@ -101,7 +101,10 @@ pub(crate) fn decode_texture_bytes(
             budget.take_scans(&frame)?;
         }
     }
-    let (w, h) = first.into_dimensions().map_err(undecodable)?;
+    let decoder = first.into_decoder().map_err(undecodable)?;
+    let (w, h) = decoder.dimensions();
+    let decoded = u64::from(w) * u64::from(h) * u64::from(decoder.color_type().bytes_per_pixel());
+    drop(decoder);
     // Some decoders (GIF) give an image of no rows or columns rather than an error.
     if w == 0 || h == 0 {
         return Err(format!("could not be decoded (it has no pixels: {w}×{h})"));
@@ -109,11 +112,15 @@ pub(crate) fn decode_texture_bytes(
     // A failed decode keeps its share taken: decoding is the work the budget bounds (60
     // images of 16 384² that failed at their last row took 16 s, none of it counted). One
     // refused by the decoder's limits decoded nothing, and gives it back.
-    let taken = budget.take(w, h)?;
+    budget.take_decoding(w, h, decoded)?;
+    let taken = budget
+        .take(w, h)
+        .inspect_err(|_| budget.give_back_decoding(decoded))?;
     PIXEL_BYTES_DECODED.with(|n| n.set(n.get().saturating_add(u64::from(w) * u64::from(h) * 4)));
     reader()?.decode().map_err(|e| {
         if matches!(e, image::ImageError::Limits(_)) {
             budget.give_back(taken);
+            budget.give_back_decoding(decoded);
         }
         undecodable(e)
     })
@@ -205,6 +212,8 @@ pub struct TextureBudget {
     left: u64,
     /// What is left of [`MAX_SCENE_JPEG_SCAN_WORK`].
     scan_work_left: u64,
+    /// What is left of [`MAX_SCENE_DECODED_BYTES`].
+    decoded_left: u64,
 }
 
 impl Default for TextureBudget {
@@ -212,9 +221,16 @@ impl Default for TextureBudget {
         TextureBudget {
             left: MAX_SCENE_TEXTURE_BYTES,
             scan_work_left: MAX_SCENE_JPEG_SCAN_WORK,
+            decoded_left: MAX_SCENE_DECODED_BYTES,
         }
     }
 }
+
+/// Most bytes the images of one scene load may decode to, in the decoder's own pixel format,
+/// before each is scaled down to what is kept: 8 GiB, 16 images at [`MAX_DECODE_BYTES`] (each
+/// kept within 64 MiB, so the kept bytes alone allowed 16 times this work). 64 RGBA16 PNGs of
+/// 16 384 × 4 096 (33 MB of files) decoded 32 GiB, a minute of a shared core, without it.
+pub const MAX_SCENE_DECODED_BYTES: u64 = 8 << 30;
 
 /// Most work the progressive JPEGs of one scene load may give the decoder, in component
 /// samples times scans: each scan walks every block of its components, however few bytes it
@@ -230,7 +246,27 @@ impl TextureBudget {
         TextureBudget {
             left: 0,
             scan_work_left: 0,
+            decoded_left: 0,
         }
+    }
+
+    /// Takes the `decoded` bytes a `w × h` image decodes to, or says why it is left out.
+    fn take_decoding(&mut self, w: u32, h: u32, decoded: u64) -> Result<(), String> {
+        if decoded > self.decoded_left {
+            return Err(format!(
+                "is left out: decoding its {w}×{h} pixels would take the scene's images past \
+                 the {} GiB they may decode to before they are scaled down",
+                MAX_SCENE_DECODED_BYTES >> 30
+            ));
+        }
+        self.decoded_left -= decoded;
+        Ok(())
+    }
+
+    /// Returns decoded bytes taken for an image that was not decoded after all.
+    fn give_back_decoding(&mut self, decoded: u64) {
+        self.decoded_left =
+            (self.decoded_left.saturating_add(decoded)).min(MAX_SCENE_DECODED_BYTES);
     }
 
     /// Takes the decoding work of a progressive JPEG's scans, or says why it is left out.
@@ -271,6 +307,7 @@ impl TextureBudget {
         TextureBudget {
             left,
             scan_work_left: MAX_SCENE_JPEG_SCAN_WORK,
+            decoded_left: MAX_SCENE_DECODED_BYTES,
         }
     }
 
@@ -422,6 +459,43 @@ mod tests {
         let before = budget.left();
         let err = decode_texture_bytes(&big, png, &mut budget).unwrap_err();
         assert_eq!(budget.left(), before, "{err}");
+    }
+
+    /// Images decode in the decoder's own format before they are scaled down: a scene's
+    /// decoding is bounded apart from what it keeps, and a truncated image is charged its
+    /// decoded bytes (three a pixel for RGB8).
+    #[test]
+    fn a_scenes_decoding_is_bounded_apart_from_what_it_keeps() {
+        let mut budget = TextureBudget::default();
+        // 16 RGBA16 images of 16 384 × 4 096, each kept as 4 096 × 1 024 (16 MiB).
+        for _ in 0..16 {
+            budget
+                .take_decoding(16_384, 4_096, 16_384 * 4_096 * 8)
+                .unwrap();
+            budget.take(16_384, 4_096).unwrap();
+        }
+        let err = budget
+            .take_decoding(16_384, 4_096, 16_384 * 4_096 * 8)
+            .unwrap_err();
+        assert!(err.contains("8 GiB they may decode to"), "{err}");
+        assert_eq!(
+            budget.left(),
+            MAX_SCENE_TEXTURE_BYTES - (256 << 20),
+            "kept: 16 × 16 MiB"
+        );
+        let mut truncated = encoded(image::RgbImage::new(64, 32).into(), image::ImageFormat::Png);
+        truncated.truncate(truncated.len() - 20);
+        let mut budget = TextureBudget::default();
+        let png = Some(image::ImageFormat::Png);
+        assert!(decode_texture_bytes(&truncated, png, &mut budget).is_err());
+        assert_eq!(MAX_SCENE_DECODED_BYTES - budget.decoded_left, 64 * 32 * 3);
+        // Past what is left, the image is refused before it is decoded and nothing is taken.
+        let mut nearly = TextureBudget::with_left(MAX_SCENE_TEXTURE_BYTES);
+        nearly.decoded_left = 64 * 32 * 3 - 1;
+        let before = nearly;
+        let err = decode_texture_bytes(&truncated, png, &mut nearly).unwrap_err();
+        assert!(err.contains("decoding its 64×32 pixels"), "{err}");
+        assert_eq!(nearly, before);
     }
 
     /// A GIF whose screen and only frame are `width` wide and 0 high (interlaced, so the

@@ -145,7 +145,11 @@ fn a_texture_override_leaves_the_mtls_texture_undecoded() {
     .unwrap();
     let mut expected = TextureBudget::default();
     expected.take(2, 2).unwrap();
-    assert_eq!(budget, expected, "only the override's 2 × 2 taken");
+    assert_eq!(
+        budget.left(),
+        expected.left(),
+        "only the override's 2 × 2 taken"
+    );
     let texture = scene.materials[0].diffuse_texture.as_ref().unwrap();
     assert_eq!(texture.image.dimensions(), (2, 2));
 }
@@ -184,7 +188,7 @@ fn textures_past_the_scenes_budget_are_left_out_with_a_warning() {
         .map(|m| m.diffuse_texture.is_some())
         .collect();
     assert_eq!(textured, [true, true, false]);
-    assert_eq!(budget, TextureBudget::with_left(15));
+    assert_eq!(budget.left(), 15);
     let left_out: Vec<_> = report
         .warnings
         .iter()
