@@ -160,14 +160,22 @@ mod tests {
         }
     }
 
+    /// A model folder holding `inside.bin` ("I") beside `secret.txt` ("S") in its parent; the
+    /// folder's path, and the parent (dropped with the files).
     #[cfg(unix)]
-    #[test]
-    fn a_link_leading_out_of_the_folder_is_refused() {
+    fn folder_beside_a_secret() -> (PathBuf, tempfile::TempDir) {
         let root = tempfile::tempdir().unwrap();
         let model = root.path().join("model");
         std::fs::create_dir(&model).unwrap();
         std::fs::write(root.path().join("secret.txt"), b"S").unwrap();
         std::fs::write(model.join("inside.bin"), b"I").unwrap();
+        (model, root)
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn a_link_leading_out_of_the_folder_is_refused() {
+        let (model, root) = folder_beside_a_secret();
         std::os::unix::fs::symlink(root.path().join("secret.txt"), model.join("out.bin")).unwrap();
         std::os::unix::fs::symlink(model.join("inside.bin"), model.join("in.bin")).unwrap();
         let err = resolve(&model, &model.join("out.bin"), false).unwrap_err();
@@ -185,11 +193,7 @@ mod tests {
     #[test]
     fn a_file_opened_outside_the_folder_is_refused() {
         use crate::scene::input::{read_bounded_within, FileKind};
-        let root = tempfile::tempdir().unwrap();
-        let model = root.path().join("model");
-        std::fs::create_dir(&model).unwrap();
-        std::fs::write(root.path().join("secret.txt"), b"S").unwrap();
-        std::fs::write(model.join("inside.bin"), b"I").unwrap();
+        let (model, _root) = folder_beside_a_secret();
         std::os::unix::fs::symlink("../secret.txt", model.join("out.bin")).unwrap();
         std::os::unix::fs::symlink("inside.bin", model.join("in.bin")).unwrap();
         let read = |name: &str, within: Option<&Path>| {

@@ -69,6 +69,7 @@ pub fn load_into(
         });
     }
     let base_dir = path.parent().unwrap_or(Path::new("."));
+    let within = access::confinement(base_dir, allow_outside);
     let mut textures = TextureCache::default();
     let mut finder = TextureFinder::default();
     let override_tex =
@@ -106,10 +107,7 @@ pub fn load_into(
             _ if override_tex.is_some() => None,
             Some(MapStatement { file: name, .. }) if !name.is_empty() => {
                 match finder.find(base_dir, name, allow_outside) {
-                    Ok(Some(p)) => {
-                        let within = access::confinement(base_dir, allow_outside);
-                        textures.load(&p, within, budget, &mut |w| report.warn(w))
-                    }
+                    Ok(Some(p)) => textures.load(&p, within, budget, &mut |w| report.warn(w)),
                     Ok(None) => {
                         // Something there that is not a file (`/dev/zero`, a folder) is named so.
                         let what = if base_dir.join(name).exists() {

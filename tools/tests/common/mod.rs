@@ -81,12 +81,12 @@ impl Gpu {
     /// A new context and renderer, which builds every program it draws with: for tests of
     /// what a renderer builds or holds.
     pub fn fresh(es: EsVersion) -> Gpu {
-        Gpu::fresh_restricted(es, &Restrictions::default())
+        Gpu::fresh_restricted(es, &as_this_child_plays(es, &Restrictions::default()))
     }
 
+    /// [`Gpu::fresh`] with `restrictions` as given (the entry points add a child's own).
     fn fresh_restricted(es: EsVersion, restrictions: &Restrictions) -> Gpu {
         warnings::install();
-        let restrictions = &as_this_child_plays(es, restrictions);
         let ctx = HeadlessContext::new(es).unwrap_or_else(|e| {
             panic!("no headless {es} context ({e}); install libegl1 libegl-mesa0 libgles2 libgl1-mesa-dri")
         });
