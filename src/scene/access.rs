@@ -2,8 +2,8 @@
 //! URI, an OBJ file its material libraries and their textures by path; an untrusted model must
 //! not read the user's other files through them, so by default such a name may name only a
 //! file inside the model file's own folder: no `..`, no absolute path (`/x`, `C:/x`,
-//! `\\server\x`), no link that leads out of the folder, looked at before a file is opened and,
-//! on Linux and Android, once it is open. [`LoadOptions`] lifts this for trusted
+//! `\\server\x`), no link that leads out of the folder, looked at before a file is opened and
+//! once it is open ([`opened_within`]). [`LoadOptions`] lifts this for trusted
 //! local content. Scene files and command lines name models anywhere: they
 //! are the user's own.
 
@@ -114,23 +114,71 @@ pub(crate) fn confinement(dir: &Path, allow_outside: bool) -> Option<&Path> {
 
 /// Refuses `file`, opened from `path`, when it really lies outside `dir`. [`resolve`] looked
 /// before it was opened; a link swapped in since would lead where that look did not go, so
-/// this asks the kernel where the open handle is (`/proc/self/fd`, Linux and Android; where
-/// that cannot be read, the look before stands alone).
+/// this asks the kernel where the open handle is (`/proc/self/fd` on Linux and Android,
+/// `F_GETPATH` on Apple's systems). Where it cannot say (another Unix, or no `/proc`), the
+/// file at `path`'s real place now must be the one opened, inside `dir`. On other systems
+/// (Windows) the look before stands alone.
 pub(crate) fn opened_within(file: &std::fs::File, path: &Path, dir: &Path) -> Result<(), String> {
+    let dir = folder_or_here(dir);
+    let changed = || led_out(dir, path, ", changed after it was looked at");
+    // The look before resolved this folder; failing now, it was changed since.
+    let real_dir = dir.canonicalize().map_err(|_| changed())?;
+    let within = match opened_path(file) {
+        Some(opened) => opened.starts_with(&real_dir),
+        None => same_file_within(file, path, &real_dir).unwrap_or(true),
+    };
+    if within {
+        Ok(())
+    } else {
+        Err(changed())
+    }
+}
+
+/// Where the kernel says the open `file` is, where it can say.
+fn opened_path(file: &std::fs::File) -> Option<PathBuf> {
     #[cfg(any(target_os = "linux", target_os = "android"))]
     {
         use std::os::fd::AsRawFd;
-        let dir = folder_or_here(dir);
-        let opened = std::fs::read_link(format!("/proc/self/fd/{}", file.as_raw_fd()));
-        if let (Ok(opened), Ok(real_dir)) = (opened, dir.canonicalize()) {
-            if !opened.starts_with(&real_dir) {
-                return Err(led_out(dir, path, ", changed after it was looked at"));
-            }
-        }
+        std::fs::read_link(format!("/proc/self/fd/{}", file.as_raw_fd())).ok()
     }
-    #[cfg(not(any(target_os = "linux", target_os = "android")))]
-    let _ = (file, path, dir);
-    Ok(())
+    #[cfg(target_vendor = "apple")]
+    {
+        use std::os::unix::ffi::OsStringExt;
+        let path = rustix::fs::getpath(file).ok()?;
+        Some(PathBuf::from(std::ffi::OsString::from_vec(
+            path.into_bytes(),
+        )))
+    }
+    #[cfg(not(any(target_os = "linux", target_os = "android", target_vendor = "apple")))]
+    {
+        let _ = file;
+        None
+    }
+}
+
+/// Whether `file` is the file `path` really leads to now (the same device and file number),
+/// and that lies within `real_dir`; `None` where a file's number is not known (not Unix).
+/// Narrower than asking the kernel: links swapped back and forth between the open, this
+/// look and the next can still pass it.
+fn same_file_within(file: &std::fs::File, path: &Path, real_dir: &Path) -> Option<bool> {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        let (Ok(opened), Ok(real)) = (file.metadata(), path.canonicalize()) else {
+            return Some(false);
+        };
+        // Looked at, not opened: a FIFO swapped in since cannot block it.
+        let now = std::fs::metadata(&real);
+        Some(
+            real.starts_with(real_dir)
+                && now.is_ok_and(|now| (now.dev(), now.ino()) == (opened.dev(), opened.ino())),
+        )
+    }
+    #[cfg(not(unix))]
+    {
+        let _ = (file, path, real_dir);
+        None
+    }
 }
 
 #[cfg(test)]
@@ -170,6 +218,51 @@ mod tests {
         std::fs::write(root.path().join("secret.txt"), b"S").unwrap();
         std::fs::write(model.join("inside.bin"), b"I").unwrap();
         (model, root)
+    }
+
+    /// Points the link `link` at `target`, replacing what it pointed at.
+    #[cfg(unix)]
+    fn repoint(link: &Path, target: &str) {
+        let _ = std::fs::remove_file(link);
+        std::os::unix::fs::symlink(target, link).unwrap();
+    }
+
+    /// A link swapped between the open and the look after it: the kernel's word on the open
+    /// file refuses it (Linux and Android here, Apple's systems alike).
+    #[cfg(any(target_os = "linux", target_os = "android"))]
+    #[test]
+    fn a_file_opened_through_a_link_swapped_back_is_refused() {
+        let (model, _root) = folder_beside_a_secret();
+        let link = model.join("swapped.bin");
+        repoint(&link, "../secret.txt");
+        let secret = std::fs::File::open(&link).unwrap();
+        repoint(&link, "inside.bin");
+        let err = opened_within(&secret, &link, &model).unwrap_err();
+        assert!(err.contains("changed after it was looked at"), "{err}");
+        let inside = std::fs::File::open(&link).unwrap();
+        assert_eq!(opened_within(&inside, &link, &model), Ok(()));
+        // The kernel's word stands where the path no longer leads anywhere.
+        std::fs::remove_file(&link).unwrap();
+        assert_eq!(opened_within(&inside, &link, &model), Ok(()));
+    }
+
+    /// Where the kernel cannot say where an open file is: the file the path leads to now must
+    /// be the one opened, and inside the folder.
+    #[cfg(unix)]
+    #[test]
+    fn without_the_kernels_word_the_file_at_the_path_now_must_be_the_one_opened() {
+        let (model, _root) = folder_beside_a_secret();
+        let real_dir = model.canonicalize().unwrap();
+        let link = model.join("swapped.bin");
+        repoint(&link, "../secret.txt");
+        let secret = std::fs::File::open(&link).unwrap();
+        assert_eq!(same_file_within(&secret, &link, &real_dir), Some(false));
+        repoint(&link, "inside.bin");
+        assert_eq!(same_file_within(&secret, &link, &real_dir), Some(false));
+        let inside = std::fs::File::open(&link).unwrap();
+        assert_eq!(same_file_within(&inside, &link, &real_dir), Some(true));
+        std::fs::remove_file(&link).unwrap();
+        assert_eq!(same_file_within(&inside, &link, &real_dir), Some(false));
     }
 
     #[cfg(unix)]
