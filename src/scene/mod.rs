@@ -578,7 +578,7 @@ fn finish_load(
     for warning in dark_frame::warnings(&scene, path) {
         report.say(warning);
     }
-    // Each once: a model named again in a scene file is read again and says its own again.
+    // Each once: an OBJ named again with another texture is read again and says its own again.
     let mut seen = std::collections::HashSet::new();
     report.warnings.retain(|w| seen.insert(w.clone()));
     Ok((scene, report))

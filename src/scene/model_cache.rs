@@ -1,11 +1,11 @@
 //! Models a scene file names more than once, kept once. A built-in scene is built once; an
-//! OBJ file (with the same texture override) and a glTF file without lights or cameras are
-//! read on their first reference only, later ones place the same `Arc<Mesh>`es and reuse the
-//! materials (copied when the reference recolours them). A glTF file with lights or cameras is
-//! read again for each reference (they depend on the placing transform), an OBJ again for
-//! another texture override, but their meshes are swapped for those of the file's first read
-//! when equal, and every texture for an equal one of the same name loaded before, so memory
-//! holds one copy. Repeats add no warnings: the first load said them.
+//! OBJ file (with the same texture override) and a glTF file are read on their first
+//! reference only: later ones place the same `Arc<Mesh>`es and reuse the materials (copied
+//! when the reference recolours them), and a glTF file's lights and camera, which move with
+//! the placing transform, are placed again from that read. An OBJ is read again for another
+//! texture override, but its meshes are swapped for those of its first read when equal, and
+//! every texture for an equal one of the same name loaded before, so memory holds one copy.
+//! Repeats add no warnings: the first load said them.
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -114,11 +114,51 @@ impl Loaded {
     }
 }
 
-/// Most bytes a scene file's load reads and decodes again for models read more than once (a
-/// glTF file with lights or a camera, for each reference; an OBJ, for each other texture
-/// override): the files, their buffers and images, and the images' decoded pixels count
-/// (a small image may decode to 512 MiB). Many references to a large file would keep a load
-/// busy without end.
+/// A glTF file as its first reference read it: its objects, and the lights and camera it
+/// instances, to be placed again by each later reference's transform.
+#[cfg(feature = "gltf")]
+struct GltfModel {
+    objects: Loaded,
+    instanced: Option<super::gltf::Instanced>,
+}
+
+#[cfg(feature = "gltf")]
+impl GltfModel {
+    /// Places the file (`path`) again with `transform`, as reading it there would: on error
+    /// `scene` is unchanged. Returns the warnings for lights and a camera the transform
+    /// leaves out, and the file's camera.
+    fn place(
+        &mut self,
+        scene: &mut Scene,
+        path: &Path,
+        transform: DMat4,
+        recolour: bool,
+        transform_field: &str,
+    ) -> Result<(LoadReport, Option<Camera>), SceneError> {
+        let placed = match &self.instanced {
+            Some(instanced) => {
+                super::gltf::place_again(instanced, path, transform, transform_field)?
+            }
+            None => Default::default(),
+        };
+        let lights = scene.lights.len().saturating_add(placed.lights.len());
+        super::input::check_light_count(lights, &format!("{} lights", path.display()))?;
+        self.objects
+            .place(scene, transform, recolour, transform_field)?;
+        scene.lights.extend(placed.lights);
+        scene.directional_lights.extend(placed.directional_lights);
+        let mut report = LoadReport::default();
+        for w in placed.warnings {
+            report.warn(format!("{}: {w}", path.display()));
+        }
+        Ok((report, placed.camera))
+    }
+}
+
+/// Most bytes a scene file's load reads and decodes again for OBJ files read more than once
+/// (for each other texture override): the files, their textures, and the images' decoded
+/// pixels count (a small image may decode to 512 MiB). Many references to a large file would
+/// keep a load busy without end.
 pub const MAX_REREAD_BYTES: u64 = 1 << 30;
 
 /// Bytes read and pixel bytes decoded on this thread so far: what a re-read costs.
@@ -135,11 +175,10 @@ pub(super) struct ModelCache {
     texture_budget: TextureBudget,
     /// Bytes read and decoded again for models read more than once ([`MAX_REREAD_BYTES`]).
     reread_bytes: u64,
-    /// Texture bytes the first read of each such file kept.
-    reread_textures: HashMap<PathBuf, u64>,
     obj: HashMap<(PathBuf, Option<PathBuf>), Loaded>,
-    /// glTF files without lights or cameras, read at the identity; `None`: read per reference.
-    gltf: HashMap<PathBuf, Option<Loaded>>,
+    /// glTF files as their first reference read them.
+    #[cfg(feature = "gltf")]
+    gltf: HashMap<PathBuf, GltfModel>,
     /// The distinct meshes of each model file's first load, in first-use order.
     meshes: HashMap<PathBuf, Vec<Arc<Mesh>>>,
     /// Every image loaded so far, by name (its path): the pixels every later copy shares.
@@ -187,7 +226,7 @@ impl ModelCache {
             return Ok(LoadReport::default());
         }
         // Read again for another texture override (its meshes are kept from the first read):
-        // bounded in total, as a glTF's re-reads.
+        // bounded in total.
         let reread = key.as_ref().is_some_and(|k| self.meshes.contains_key(&k.0));
         if reread && self.reread_bytes > MAX_REREAD_BYTES {
             return Err(SceneError::Obj {
@@ -217,7 +256,7 @@ impl ModelCache {
             self.reread_bytes = self.reread_bytes.saturating_add(work);
         }
         let report = loaded?;
-        self.share(scene, first.0, first.1, key.as_ref().map(|k| &k.0), true);
+        self.share(scene, first.0, first.1, key.as_ref().map(|k| &k.0));
         if let Some(key) = key {
             let mut loaded = Loaded::record(scene, first, |_, o| o.transform, false);
             loaded.uncoloured_at = (!recolour).then_some(first.1);
@@ -243,11 +282,11 @@ impl ModelCache {
         Err(Loader::Obj.left_out(path))
     }
 
-    /// Places a glTF file with `transform`, reading it at its first reference. A file without
-    /// lights (suns included) or cameras is placed from that read at every later one; one
-    /// with them is read again for each reference (they depend on the transform), sharing the
-    /// meshes and textures of earlier reads. Returns the load's warnings and the first camera
-    /// the file instances.
+    /// Places a glTF file with `transform`, reading it at its first reference only: later ones
+    /// place its objects, and its lights (suns included) and first camera, which move with
+    /// the transform, from that read. Returns the load's warnings (a later reference's:
+    /// only lights and a camera that its transform leaves out) and the first camera the file
+    /// instances.
     #[cfg(feature = "gltf")]
     pub fn place_gltf(
         &mut self,
@@ -258,75 +297,27 @@ impl ModelCache {
         transform_field: &str,
     ) -> Result<(LoadReport, Option<Camera>), SceneError> {
         let key = std::fs::canonicalize(path).ok();
-        if let Some(Some(loaded)) = key.as_ref().and_then(|k| self.gltf.get_mut(k)) {
-            loaded.place(scene, transform, recolour, transform_field)?;
-            return Ok((LoadReport::default(), None));
-        }
-        let first_read = key.as_ref().is_some_and(|k| !self.gltf.contains_key(k));
-        // A file read again for this reference is bounded in total (the file, its buffers and
-        // images), so a scene file of many references to a large file with lights cannot keep
-        // the load busy for hours.
-        if !first_read && self.reread_bytes > MAX_REREAD_BYTES {
-            return Err(SceneError::GltfUnsupported {
-                path: path.to_path_buf(),
-                reason: format!(
-                    "a glTF file with lights or a camera is read again for each reference, and \
-                     this scene file's re-reads (the files, their buffers and images, and the \
-                     pixels decoded) passed \
-                     {} MiB before {transform_field}'s (fewer references, or a file without \
-                     its lights: place lights in the scene file)",
-                    MAX_REREAD_BYTES >> 20
-                ),
-            });
+        if let Some(model) = key.as_ref().and_then(|k| self.gltf.get_mut(k)) {
+            return model.place(scene, path, transform, recolour, transform_field);
         }
         let (first_object, first_material) = (scene.objects.len(), scene.materials.len());
-        let read_before = work_so_far();
-        // The file's first read takes its textures' part of the scene's budget. A later one's
-        // are the first read's: decoded again within what is left and what the first read
-        // kept, then swapped for those held (charged again, a scene near its budget lost them
-        // on every later reference), so what the first read left out stays out.
-        let kept_earlier = key
-            .as_ref()
-            .and_then(|k| self.reread_textures.get(k).copied());
-        let mut lent = self.texture_budget;
-        lent.give_back(kept_earlier.unwrap_or(0));
-        let left_before = self.texture_budget.left();
-        let budget = if kept_earlier.is_some() {
-            &mut lent
-        } else {
-            &mut self.texture_budget
-        };
-        let read = super::gltf::load_source_into(
+        let (loaded, placement) = super::gltf::load_source_into(
             scene,
             super::gltf::Source::File(path),
             transform,
             transform_field,
             &self.options,
-            budget,
-        );
-        let work = work_so_far().wrapping_sub(read_before);
-        let (mut loaded, placement) = read?;
-        let charged = kept_earlier.is_none();
-        if let (true, Some(k)) = (first_read, &key) {
-            if !placement.lights_or_camera {
-                // Placed from this read from now on: its objects' own transforms are kept.
-                self.share(scene, first_object, first_material, Some(k), true);
-                let first = (first_object, first_material);
-                let relative = |i: usize, _: &Object| placement.relative[i];
-                let mut kept = Loaded::record(scene, first, relative, true);
-                kept.uncoloured_at = (!recolour).then_some(first_material);
-                self.gltf.insert(k.clone(), Some(kept));
-                return Ok((loaded.report, None));
-            }
-            self.gltf.insert(k.clone(), None);
-        }
-        self.reread_bytes = self.reread_bytes.saturating_add(work);
-        if let (true, Some(k)) = (charged, &key) {
-            let kept = left_before.saturating_sub(self.texture_budget.left());
-            self.reread_textures.insert(k.clone(), kept);
-        }
-        if self.share(scene, first_object, first_material, key.as_ref(), charged) {
-            loaded.report.warnings.clear();
+            &mut self.texture_budget,
+        )?;
+        if let Some(k) = key {
+            // Placed from this read from now on: its objects' own transforms are kept.
+            self.share(scene, first_object, first_material, Some(&k));
+            let first = (first_object, first_material);
+            let relative = |i: usize, _: &Object| placement.relative[i];
+            let mut objects = Loaded::record(scene, first, relative, true);
+            objects.uncoloured_at = (!recolour).then_some(first_material);
+            let instanced = placement.instanced;
+            self.gltf.insert(k, GltfModel { objects, instanced });
         }
         Ok((loaded.report, loaded.camera))
     }
@@ -347,18 +338,15 @@ impl ModelCache {
     /// Swaps the meshes of the objects from `first_object` on for those of an earlier load of
     /// the same file (`path`, canonical) when they are equal — the file may have changed
     /// between reads — and the textures of the materials from `first_material` on for equal
-    /// ones loaded before. Returns whether the file was loaded before with the same meshes.
-    /// With `charged`, the load's textures took their part of the scene's budget as they were
-    /// decoded; else they were decoded within a budget of their own: a copy dropped gives
-    /// nothing back, and one the cache did not hold takes its part of the scene's budget now.
+    /// ones loaded before (the load's textures took their part of the scene's budget as they
+    /// were decoded: a copy dropped gives it back).
     fn share(
         &mut self,
         scene: &mut Scene,
         first_object: usize,
         first_material: usize,
         path: Option<&PathBuf>,
-        charged: bool,
-    ) -> bool {
+    ) {
         // Every texture slot: a model named many times holds each image once, and a copy
         // dropped for the one held gives its memory back to the budget (once per copy of the
         // pixels, however many samplings read it); each texture keeps its own sampling.
@@ -374,7 +362,7 @@ impl ModelCache {
                     *t = kept.clone();
                 }
                 Some(known) if **known == *t.image => {
-                    if charged && dropped.insert(Arc::as_ptr(&t.image)) {
+                    if dropped.insert(Arc::as_ptr(&t.image)) {
                         self.texture_budget.give_back(t.image.as_raw().len() as u64);
                     }
                     let image = known.clone();
@@ -389,25 +377,19 @@ impl ModelCache {
                 }
                 Some(_) => {}
                 None => {
-                    if !charged {
-                        // Only where the file changed since its first read; kept either way
-                        // (its read was bounded by what was left and the first read's part).
-                        let (w, h) = t.image.dimensions();
-                        let _ = self.texture_budget.take(w, h);
-                    }
                     self.images.insert(t.name.clone(), t.image.clone());
                     self.textures.insert(key, t.clone());
                 }
             }
         }
         let Some(path) = path else {
-            return false;
+            return;
         };
         let objects = &mut scene.objects[first_object..];
         let meshes = distinct(objects.iter().map(|o| &o.mesh));
         let Some(earlier) = self.meshes.get(path) else {
             self.meshes.insert(path.clone(), meshes);
-            return false;
+            return;
         };
         let same = earlier.len() == meshes.len()
             && earlier.iter().zip(&meshes).all(|(a, b)| same_mesh(a, b));
@@ -417,7 +399,6 @@ impl ModelCache {
                 o.mesh = earlier[i.expect("listed above")].clone();
             }
         }
-        same
     }
 }
 
@@ -545,7 +526,7 @@ mod tests {
         );
     }
 
-    /// A glTF `name` with a light (read for each reference) and one texture, in a data URI.
+    /// A glTF `name` with a light and one texture, in a data URI.
     fn lit_textured_gltf(dir: &Path, name: &str) -> PathBuf {
         use base64::Engine;
         let b64 = |b: &[u8]| base64::engine::general_purpose::STANDARD.encode(b);
@@ -636,7 +617,8 @@ mod tests {
             .iter()
             .map(|m| m.diffuse_texture.as_ref().expect("kept"))
             .collect();
-        assert_eq!(textures.len(), 8);
+        // The first file's three references share its two materials.
+        assert_eq!(textures.len(), 4);
         for (i, t) in textures.iter().enumerate() {
             let want = if i % 2 == 0 {
                 Sampling::default()
@@ -648,18 +630,34 @@ mod tests {
         }
     }
 
-    /// Each reference reads a file at most once: a lit one once each (it was read at the
-    /// identity first, then again at its transform), one without lights only at its first,
-    /// whose objects later references place as reading the file there would.
+    /// A file is read at its first reference only: a later one places its objects, its
+    /// lights (a point light and a sun) and its camera as reading the file at that
+    /// reference's transform would.
     #[test]
-    fn a_reference_reads_a_file_at_most_once_and_an_unlit_one_only_at_its_first() {
+    fn a_file_is_read_at_its_first_reference_only_and_placed_as_reading_it_there_would() {
         let dir = tempfile::tempdir().unwrap();
         let lit = lit_textured_gltf(dir.path(), "lit.gltf");
-        let unlit = dir.path().join("unlit.gltf");
         let mut doc: serde_json::Value =
             serde_json::from_str(&std::fs::read_to_string(&lit).unwrap()).unwrap();
-        doc["nodes"][0] = serde_json::json!({"mesh": 0});
-        std::fs::write(&unlit, doc.to_string()).unwrap();
+        let unlit = dir.path().join("unlit.gltf");
+        let mut unlit_doc = doc.clone();
+        unlit_doc["nodes"][0] = serde_json::json!({"mesh": 0});
+        std::fs::write(&unlit, unlit_doc.to_string()).unwrap();
+        doc["extensions"]["KHR_lights_punctual"]["lights"]
+            .as_array_mut()
+            .unwrap()
+            .push(serde_json::json!({"type": "directional", "intensity": 3}));
+        doc["cameras"] = serde_json::json!([{"type": "perspective",
+            "perspective": {"yfov": 0.8, "znear": 0.1, "zfar": 50}}]);
+        doc["nodes"] = serde_json::json!([
+            {"mesh": 0, "extensions": {"KHR_lights_punctual": {"light": 0}},
+             "translation": [0.5, 0, 2]},
+            {"camera": 0, "translation": [0, 1, 6]},
+            {"rotation": [0.3826834, 0, 0, 0.9238795],
+             "extensions": {"KHR_lights_punctual": {"light": 1}}}
+        ]);
+        doc["scenes"] = serde_json::json!([{"nodes": [0, 1, 2]}]);
+        std::fs::write(&lit, doc.to_string()).unwrap();
         let size = |path: &Path| std::fs::metadata(path).unwrap().len();
         let at = |x: f64| {
             DMat4::from_translation(glam::DVec3::new(x, 1.0, 0.0))
@@ -668,37 +666,56 @@ mod tests {
         };
         let mut cache = ModelCache::new(LoadOptions::default());
         let mut scene = Scene::empty();
+        let mut cameras = Vec::new();
         let mut reads = |path: &Path, x: f64| {
             let before = crate::scene::input::bytes_read();
             let field = "objects[0].transform";
-            cache
+            let (report, camera) = cache
                 .place_gltf(&mut scene, path, at(x), false, field)
                 .unwrap();
+            cameras.push(camera);
+            if x == 3.0 {
+                assert!(report.warnings.is_empty(), "{:?}", report.warnings);
+            }
             crate::scene::input::bytes_read() - before
         };
-        assert_eq!([reads(&lit, 2.0), reads(&lit, 3.0)], [size(&lit); 2]);
+        assert_eq!([reads(&lit, 2.0), reads(&lit, 3.0)], [size(&lit), 0]);
         assert_eq!([reads(&unlit, 2.0), reads(&unlit, 3.0)], [size(&unlit), 0]);
+        let read_there = |path: &Path| {
+            let mut read_there = Scene::empty();
+            let mut budget = TextureBudget::default();
+            let options = LoadOptions::default();
+            let loaded = crate::scene::gltf::load_into(
+                &mut read_there,
+                path,
+                at(3.0),
+                "transform",
+                &options,
+                &mut budget,
+            )
+            .unwrap();
+            (read_there, loaded.camera)
+        };
+        let (lit_there, camera_there) = read_there(&lit);
         assert_eq!(scene.lights.len(), 2);
-        let mut read_there = Scene::empty();
-        let field = "transform";
-        let options = LoadOptions::default();
-        let mut budget = TextureBudget::default();
-        crate::scene::gltf::load_into(
-            &mut read_there,
-            &unlit,
-            at(3.0),
-            field,
-            &options,
-            &mut budget,
-        )
-        .unwrap();
+        assert_eq!(scene.lights[1], lit_there.lights[0]);
+        assert_ne!(scene.lights[0], scene.lights[1]);
+        assert_eq!(scene.directional_lights.len(), 2);
+        assert_eq!(scene.directional_lights[1], lit_there.directional_lights[0]);
+        assert_eq!(scene.objects[1].transform, lit_there.objects[0].transform);
+        assert!(camera_there.is_some());
+        assert_eq!(cameras[1], camera_there);
+        assert_ne!(cameras[0], cameras[1]);
+        assert_eq!(cameras[2..], [None, None]);
+        let (unlit_there, _) = read_there(&unlit);
         let placed = scene.objects.last().unwrap();
-        assert_eq!(placed.transform, read_there.objects[0].transform);
+        assert_eq!(placed.transform, unlit_there.objects[0].transform);
         assert_ne!(placed.transform, scene.objects[2].transform);
     }
 
+    /// A file placed again holds its textures once, within room for one copy.
     #[test]
-    fn a_file_read_per_reference_keeps_its_textures_with_room_for_one_copy() {
+    fn a_file_placed_again_keeps_its_textures_with_room_for_one_copy() {
         let dir = tempfile::tempdir().unwrap();
         let path = lit_textured_gltf(dir.path(), "lit.gltf");
         let mut cache = ModelCache::new(LoadOptions::default());
@@ -712,7 +729,7 @@ mod tests {
                 .unwrap();
             assert!(loaded.0.warnings.is_empty(), "{:?}", loaded.0);
         }
-        assert_eq!(scene.lights.len(), 3, "read per reference");
+        assert_eq!(scene.lights.len(), 3, "one light a reference");
         let textures: std::collections::HashSet<_> = scene
             .materials
             .iter()

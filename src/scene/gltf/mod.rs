@@ -30,8 +30,10 @@
 mod accessor;
 mod buffers;
 pub mod camera;
+mod fault;
 mod glb;
 mod ignored;
+mod instances;
 mod integers;
 mod json_size;
 pub mod lights;
@@ -54,6 +56,10 @@ pub use lights::{
     unbounded_radius, CANDELA_TO_INTENSITY, LUX_TO_INTENSITY, PHOTOMETRIC_SCALE, UNBOUNDED_CUTOFF,
 };
 pub use material::{shininess, DIELECTRIC_SPECULAR};
+
+use fault::{Fault, PARSER_FAILED};
+pub(crate) use instances::Instanced;
+use instances::Instances;
 
 use super::access::LoadOptions;
 use super::input::{self, read_bounded, FileKind};
@@ -178,9 +184,10 @@ pub fn load_into(
 pub(crate) struct Placement {
     /// Each object's transform before the placing one, in the order the objects were added.
     pub relative: Vec<DMat4>,
-    /// Whether the file instances a light or a camera (one valid in the file's own space):
-    /// those move with the placing transform, so another placement reads the file again.
-    pub lights_or_camera: bool,
+    /// The lights and camera the file instances (valid in the file's own space), when it
+    /// instances any: they move with the placing transform, so another placement places
+    /// them again.
+    pub instanced: Option<Instanced>,
 }
 
 /// Where a glTF's bytes come from.
@@ -231,25 +238,8 @@ pub(crate) fn load_source_into(
         import(bytes, source, transform, options, textures)
     }));
     let imported = match imported {
-        Ok(Ok(imported)) => imported,
-        Ok(Err(Fault::File(reason))) => return Err(error(reason)),
-        Ok(Err(Fault::Unsupported(reason))) => {
-            return Err(SceneError::GltfUnsupported {
-                path: path.to_path_buf(),
-                reason,
-            })
-        }
-        Ok(Err(Fault::Placing(reason))) => {
-            return Err(SceneError::invalid(
-                transform_field,
-                format!("{reason} (in {})", path.display()),
-            ))
-        }
-        Err(_) => {
-            return Err(error(
-                "the glTF parser (gltf crate) failed on this file; it is malformed".into(),
-            ))
-        }
+        Ok(imported) => imported.map_err(|fault| fault.into_error(path, transform_field))?,
+        Err(_) => return Err(error(PARSER_FAILED.into())),
     };
     let total_lights = scene.lights.len().saturating_add(imported.lights.len());
     input::check_light_count(total_lights, &format!("{} lights", path.display()))?;
@@ -273,7 +263,7 @@ pub(crate) fn load_source_into(
     };
     let placement = Placement {
         relative: imported.relative,
-        lights_or_camera: imported.lights_or_camera,
+        instanced: imported.instanced,
     };
     Ok((load, placement))
 }
@@ -312,17 +302,26 @@ fn json_error(e: &serde_json::Error, json: &[u8]) -> String {
     format!("JSON {what} at line {}, column {}", e.line(), e.column())
 }
 
-/// Why an import failed: the file itself, what it asks for that the loader cannot do, or the
-/// caller's transform placing what is in it.
-enum Fault {
-    File(String),
-    Unsupported(String),
-    Placing(String),
-}
-
-impl From<String> for Fault {
-    fn from(reason: String) -> Self {
-        Fault::File(reason)
+/// Places the lights and camera of a file loaded before (`instanced`, from its
+/// [`Placement`]) again with `transform`, as reading `path` again there would.
+pub(crate) fn place_again(
+    instanced: &Instanced,
+    path: &Path,
+    transform: DMat4,
+    transform_field: &str,
+) -> Result<instances::Placed, SceneError> {
+    if !transform.is_finite() {
+        return Err(SceneError::invalid(transform_field, "must be finite"));
+    }
+    // The parser's accessors, which the first read went through without failing.
+    let placed =
+        std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| instanced.place(transform)));
+    match placed {
+        Ok(placed) => placed.map_err(|fault| fault.into_error(path, transform_field)),
+        Err(_) => Err(SceneError::Gltf {
+            path: path.to_path_buf(),
+            reason: PARSER_FAILED.into(),
+        }),
     }
 }
 
@@ -339,8 +338,8 @@ struct Imported {
     warnings: Vec<String>,
     /// Each object's transform before the placing one.
     relative: Vec<DMat4>,
-    /// A light or camera valid in the file's own space was instanced.
-    lights_or_camera: bool,
+    /// The lights and camera instanced, valid in the file's own space, if any.
+    instanced: Option<Instanced>,
 }
 
 /// Everything is converted and checked in the file's own space first (faults are the file's),
@@ -414,8 +413,9 @@ fn import(
         camera: None,
         warnings: Vec::new(),
         relative: Vec::new(),
-        lights_or_camera: false,
+        instanced: None,
     };
+    let mut instances = Instances::default();
     let mut camera_nodes = 0;
     let mut mesh_count = 0;
     // Primitives placed, drawn or skipped: a skipped one makes no object, but N nodes placing
@@ -508,41 +508,24 @@ fn import(
                     ));
                 }
             }
-            match lights::convert(&light, &p.world, &lfield)? {
-                // Checked in the file's space; now placed.
-                lights::Converted::Light(_) | lights::Converted::Directional(_) => {
-                    out.lights_or_camera = true;
-                    match lights::convert(&light, &world, &lfield).map_err(placing)? {
-                        lights::Converted::Light(l) => out.lights.push(l),
-                        lights::Converted::Directional(l) => out.directional_lights.push(l),
-                        lights::Converted::Skipped(why) => warnings.push(why),
-                    }
-                }
-                lights::Converted::Skipped(why) => warnings.push(why),
-            }
+            instances.add_light(&light, p.node, p.world, &mut warnings)?;
         }
         if let Some(cam) = node.camera() {
             camera_nodes += 1;
             if camera_nodes == 1 {
                 // The file's view is a suggestion: one the renderer cannot take (or that the
                 // caller's transform puts out of range) gives way to the framed view.
-                let cfield = format!("{field} (cameras[{}])", cam.index());
-                let converted =
-                    camera::convert(&document, &cam, &p.world, &cfield).and_then(|_| {
-                        out.lights_or_camera = true;
-                        camera::convert(&document, &cam, &world, &cfield)
-                            .map_err(|e| format!("placing {e}"))
-                    });
-                match converted {
-                    Ok(camera) => out.camera = Some(camera),
-                    Err(e) => warnings.push(format!(
-                        "{e}; this camera is not used: without a scene file's camera, the view is \
-                         framed on the bounds"
-                    )),
-                }
+                instances.add_camera(&document, &cam, p.node, p.world, &mut warnings);
             }
         }
     }
+    // Lights and the camera placed after the objects, in node order, as a later reference
+    // to the file places them again (`Instances::place`).
+    let placed_instances = instances.place(&document, transform)?;
+    out.lights = placed_instances.lights;
+    out.directional_lights = placed_instances.directional_lights;
+    out.camera = placed_instances.camera;
+    warnings.extend(placed_instances.warnings);
     if out.objects.is_empty() && out.lights.is_empty() && out.directional_lights.is_empty() {
         return Err(Fault::Unsupported(format!(
             "nothing to show: {from} place no triangle mesh and no light"
@@ -552,6 +535,11 @@ fn import(
     // Features first, then what the parts said, each once.
     out.warnings = ignored::unused_features(&document, camera_nodes);
     out.warnings.extend(ignored::once_per_feature(warnings));
+    drop(buffers);
+    out.instanced = instances.any().then_some(Instanced {
+        document,
+        instances,
+    });
     Ok(out)
 }
 

@@ -464,9 +464,9 @@ fn scene_with_lamp(dir: &std::path::Path, extension: &str, objects: &str) -> std
     write(dir, "scene.json", format!(r#"{{"objects": {objects}}}"#))
 }
 
-/// A glTF with lights is read again for each placement in a scene file (its lights move with
-/// it); its warnings are said once, in the report and in the log (its re-reads logged them
-/// again, three times for two placements).
+/// A glTF with lights placed twice in a scene file (its lights move with it) says its
+/// warnings once, in the report and in the log (when it was read again for each placement,
+/// they were logged three times for two placements).
 #[test]
 fn a_gltf_with_lights_placed_twice_warns_once() {
     let dir = tempfile::tempdir().unwrap();
