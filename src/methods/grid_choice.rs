@@ -17,6 +17,16 @@ use crate::scene::raycast::SceneRaycaster;
 /// Rays of the surface sample, across and down (1 296 rays).
 const SAMPLE_GRID: (u32, u32) = (48, 27);
 
+/// Box and triangle tests the surface sample may make ([`SceneRaycaster::hit_within`]):
+/// triangles that overlap one another make every ray test most of them, and a 1 MB model of
+/// 915 k overlapping chords took 30 s a sample. Past it the rays cast so far are the sample.
+const SAMPLE_WORK: u64 = 1 << 22;
+
+/// Step between consecutive rays of the sample through its rays in reading order: prime, so
+/// coprime with their count, and near its golden section, so each first part of the rays is
+/// spread over the view.
+const SAMPLE_STRIDE: u32 = 797;
+
 /// A view or light set that changed is chosen for again after at most this many frames.
 const RECHOOSE_AFTER_CHANGE: u32 = 30;
 
@@ -78,6 +88,8 @@ pub(crate) struct AutoGrid {
     scratch: GridChoice,
     /// The current choice was made with the priors, before any frame was measured.
     choice_from_priors: bool,
+    /// A surface sample was cut short by its work bound, and a warning said so.
+    sample_cut_said: bool,
 }
 
 impl AutoGrid {
@@ -204,6 +216,15 @@ impl AutoGrid {
                 self.choice = Some(first);
             }
         }
+        let (nx, ny) = SAMPLE_GRID;
+        if let (Some(choice), true) = (&mut self.choice, self.samples.rays < (nx * ny) as usize) {
+            let _ = write!(
+                choice.reason,
+                "; surface sample cut to {} of {} rays (overlapping triangles)",
+                self.samples.rays,
+                nx * ny
+            );
+        }
         if self.layout.as_ref() != Some(&layout) {
             self.layout = Some(layout);
         }
@@ -300,27 +321,43 @@ impl AutoGrid {
             p.truncate() / p.w
         };
         let (nx, ny) = SAMPLE_GRID;
+        let rays = nx * ny;
         let samples = &mut self.samples;
         samples.points.clear();
-        samples.rays = (nx * ny) as usize;
+        samples.rays = 0;
         samples.pixels = w as f64 * h as f64;
-        for j in 0..ny {
-            for i in 0..nx {
-                let ndc_x = -1.0 + 2.0 * (i as f64 + 0.5) / nx as f64;
-                let ndc_y = -1.0 + 2.0 * (j as f64 + 0.5) / ny as f64;
-                let origin = unproject(ndc_x, ndc_y, -1.0);
-                // A point between the planes gives the ray's line even for an infinite far.
-                let dir: DVec3 = (unproject(ndc_x, ndc_y, 0.0) - origin).normalize();
-                if !dir.is_finite() {
-                    continue;
-                }
-                if let Some(hit) = caster.hit(origin, dir) {
+        let mut work = SAMPLE_WORK;
+        for k in 0..rays {
+            // Rays in an order whose every first part is spread over the whole view: the
+            // rays cast when the work runs out are a fair sample still.
+            let ray = k * SAMPLE_STRIDE % rays;
+            let (i, j) = (ray % nx, ray / nx);
+            let ndc_x = -1.0 + 2.0 * (i as f64 + 0.5) / nx as f64;
+            let ndc_y = -1.0 + 2.0 * (j as f64 + 0.5) / ny as f64;
+            let origin = unproject(ndc_x, ndc_y, -1.0);
+            // A point between the planes gives the ray's line even for an infinite far.
+            let dir: DVec3 = (unproject(ndc_x, ndc_y, 0.0) - origin).normalize();
+            if dir.is_finite() {
+                let Some(hit) = caster.hit_within(origin, dir, &mut work) else {
+                    break;
+                };
+                if let Some(hit) = hit {
                     let depth = -(view * hit.position.extend(1.0)).z;
                     let x = (ndc_x + 1.0) * 0.5 * w as f64;
                     let y = (ndc_y + 1.0) * 0.5 * h as f64;
                     samples.points.push([x, y, depth]);
                 }
             }
+            samples.rays += 1;
+        }
+        if samples.rays < rays as usize && !self.sample_cut_said {
+            self.sample_cut_said = true;
+            log::warn!(
+                "the automatic grid's surface sample stopped after {} of its {rays} rays: the \
+                 scene's triangles overlap so much that each ray tests most of them; the grid \
+                 is chosen from those rays (a fixed `--grid` needs no sample)",
+                samples.rays
+            );
         }
     }
 }

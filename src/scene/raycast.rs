@@ -123,9 +123,19 @@ struct Search {
     best_t: f64,
     runner_up: f64,
     transparent_t: f64,
+    /// Box and triangle tests it may still make (a shared reference: boxes are tested
+    /// through one).
+    work_left: std::cell::Cell<u64>,
 }
 
 impl Search {
+    /// Takes one test from the work left; false once none is left.
+    fn spend(&self) -> bool {
+        let left = self.work_left.get();
+        self.work_left.set(left.saturating_sub(1));
+        left > 0
+    }
+
     /// Boxes and hits are accepted a little beyond the best hit, so a near runner-up is found.
     fn reach(&self) -> f64 {
         if self.best_t.is_finite() {
@@ -247,6 +257,15 @@ impl SceneRaycaster {
             .hit
     }
 
+    /// [`Self::hit`] making at most `*work` box and triangle tests, taken from it; `None` when
+    /// they run out before the search ends (the nearest surface is then not known). Triangles
+    /// that overlap one another defeat any hierarchy: a ray then tests most of them.
+    pub fn hit_within(&self, origin: DVec3, dir: DVec3, work: &mut u64) -> Option<Option<Hit>> {
+        let (found, left) = self.search(origin, dir, f64::INFINITY, |_| true, *work);
+        *work = left;
+        (left > 0).then_some(found.hit)
+    }
+
     /// Nearest surface of an object for which `is_opaque(object index)` holds, with
     /// `0 < t <= t_max`, and the nearest other surface in front of it (for transparent objects
     /// that the GPU blends over what is behind them).
@@ -257,11 +276,24 @@ impl SceneRaycaster {
         t_max: f64,
         is_opaque: impl Fn(usize) -> bool,
     ) -> FirstOpaque {
+        self.search(origin, dir, t_max, is_opaque, u64::MAX).0
+    }
+
+    /// [`Self::first_opaque_hit`] within `work` box and triangle tests, and the work left.
+    fn search(
+        &self,
+        origin: DVec3,
+        dir: DVec3,
+        t_max: f64,
+        is_opaque: impl Fn(usize) -> bool,
+        work: u64,
+    ) -> (FirstOpaque, u64) {
         let mut search = Search {
             best: None,
             best_t: t_max,
             runner_up: f64::INFINITY,
             transparent_t: f64::INFINITY,
+            work_left: std::cell::Cell::new(work),
         };
         let inv = dir.recip();
         let (mut top, mut inner) = STACKS.with(|s| std::mem::take(&mut *s.borrow_mut()));
@@ -269,7 +301,11 @@ impl SceneRaycaster {
             &self.nodes,
             &mut top,
             &mut search,
-            |node, s| node.slab(origin, inv, s.reach()),
+            |node, s| {
+                s.spend()
+                    .then(|| node.slab(origin, inv, s.reach()))
+                    .flatten()
+            },
             |s, range| {
                 for slot in range {
                     let instance = &self.instances[slot];
@@ -309,13 +345,14 @@ impl SceneRaycaster {
         });
         // Ties count as in front: a transparent surface coplanar with an opaque one is blended.
         let limit = hit.map_or(t_max, |h| h.t);
-        FirstOpaque {
+        let found = FirstOpaque {
             hit,
             transparent_t: (search.transparent_t <= limit).then_some(search.transparent_t),
             runner_up_t: hit
                 .filter(|_| search.runner_up <= search.reach())
                 .map(|_| search.runner_up),
-        }
+        };
+        (found, search.work_left.get())
     }
 
     /// The hit at `(t, u, v)` on `triangle` of the object in `slot`.
@@ -414,6 +451,7 @@ impl MeshBvh {
             stack,
             s,
             |node, s| match frame {
+                _ if !s.spend() => None,
                 Frame::Object { .. } => node.slab(origin, inv, s.reach()),
                 Frame::World { to_world, .. } => {
                     node.slab_transformed(to_world, origin, inv, s.reach())
@@ -421,6 +459,9 @@ impl MeshBvh {
             },
             |s, range| {
                 for &triangle in &self.order[range] {
+                    if !s.spend() {
+                        return;
+                    }
                     if let Some((t, u, v, positive)) = intersect(vertices(triangle), origin, dir) {
                         if t <= s.reach() && front.is_none_or(|f| f == positive) {
                             found(s, t, u, v, triangle);

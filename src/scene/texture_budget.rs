@@ -312,6 +312,7 @@ impl TextureBudget {
     }
 
     /// Bytes left.
+    #[cfg(test)]
     pub(crate) fn left(&self) -> u64 {
         self.left
     }

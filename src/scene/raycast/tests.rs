@@ -510,3 +510,42 @@ fn a_rebuild_keeps_the_hierarchies_of_the_meshes_still_placed() {
     let replaced = SceneRaycaster::rebuilt(Some(moved), &scene);
     assert_eq!((replaced.meshes_built(), replaced.mesh_count()), (1, 2));
 }
+
+/// Half squares stacked over one another, whose boxes are whole squares: a ray through the
+/// other half misses them all and tests each, whatever the hierarchy. Within enough work the
+/// bounded search finds what the unbounded one does and leaves what it did not spend; with
+/// less it says it ran out.
+#[test]
+fn a_bounded_search_finds_the_same_hit_or_says_it_ran_out() {
+    let layers = 200;
+    let half_square = |z: f32| {
+        let p = vec![
+            Vec3::new(-5.0, -5.0, z),
+            Vec3::new(5.0, -5.0, z),
+            Vec3::new(-5.0, 5.0, z),
+        ];
+        Mesh::new(p, vec![], vec![], vec![0, 1, 2]).unwrap()
+    };
+    let meshes = (0..layers)
+        .map(|i| (half_square(-(i as f32) * 0.01), DMat4::IDENTITY))
+        .collect();
+    let rc = SceneRaycaster::new(&scene_of(meshes));
+    let dir = -DVec3::Z;
+    let (through, beside) = (DVec3::new(4.0, 4.0, 5.0), DVec3::new(-4.0, -4.0, 5.0));
+    assert_eq!(rc.hit(through, dir), None);
+    let mut work = u64::MAX;
+    assert_eq!(rc.hit_within(through, dir, &mut work), Some(None));
+    let spent = u64::MAX - work;
+    assert!(spent >= layers, "{spent} tests for {layers} triangles");
+    let mut just_enough = spent + 1;
+    assert_eq!(rc.hit_within(through, dir, &mut just_enough), Some(None));
+    assert_eq!(just_enough, 1);
+    let mut short = spent / 2;
+    assert_eq!(rc.hit_within(through, dir, &mut short), None);
+    assert_eq!(short, 0);
+    // A hit, the top layer, is found alike.
+    let top = rc.hit(beside, dir).expect("the top layer");
+    assert_eq!(top.position.z, 0.0);
+    let mut work = u64::MAX;
+    assert_eq!(rc.hit_within(beside, dir, &mut work), Some(Some(top)));
+}

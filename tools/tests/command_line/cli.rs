@@ -1473,3 +1473,55 @@ fn no_float_textures_plays_the_device_without_them() {
         text(&out)
     );
 }
+
+/// The automatic grid's surface sample is a ray cast bounded in work: half squares stacked
+/// 8 000 deep, whose boxes are whole squares, make each ray through their other half test
+/// every one (a 1 MB model of such triangles took 30 s a sample). The sample stops at its
+/// bound, and the grid's reason says so; 100 layers are sampled whole.
+#[test]
+fn the_automatic_grids_surface_sample_is_bounded_in_work() {
+    let dir = tempfile::tempdir().unwrap();
+    let reason = |layers: usize| {
+        let mut obj = String::new();
+        for i in 0..layers {
+            let z = -(i as f64) * 1e-3;
+            obj.push_str(&format!("v -5 -5 {z}\nv 5 -5 {z}\nv -5 5 {z}\n"));
+            let k = 3 * i + 1;
+            obj.push_str(&format!("f {k} {} {}\n", k + 1, k + 2));
+        }
+        std::fs::write(dir.path().join("stack.obj"), obj).unwrap();
+        // Looking straight down at the stack, whose boxes fill the view.
+        let scene = r#"{"camera": {"position": [0, 0, 3], "target": [0, 0, 0],
+            "up": [0, 1, 0], "projection": "perspective", "fov_y_deg": 60, "near": 0.1,
+            "far": 100}, "objects": [{"obj": "stack.obj"}], "random_lights": {"count": 4}}"#;
+        std::fs::write(dir.path().join("stack.json"), scene).unwrap();
+        let args = [
+            "render",
+            "--scene",
+            "stack.json",
+            "--size",
+            "64x36",
+            "--frames",
+            "0",
+            "--method",
+            "clustered",
+            "--stats",
+            "s.json",
+        ];
+        let out = manylight(&args, &[], dir.path());
+        assert!(out.status.success(), "{}", text(&out));
+        let said = text(&out).contains("surface sample stopped after");
+        let reason = stats(&dir.path().join("s.json"))["grid_reason"]
+            .as_str()
+            .unwrap()
+            .to_string();
+        (reason, said)
+    };
+    let (deep, said) = reason(8000);
+    assert!(deep.contains("surface sample cut to") && said, "{deep}");
+    let (shallow, said) = reason(100);
+    assert!(
+        !shallow.contains("surface sample cut") && !said,
+        "{shallow}"
+    );
+}
