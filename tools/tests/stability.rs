@@ -273,6 +273,18 @@ fn camera_inside_a_light_and_a_fragment_exactly_at_a_light() {
     assert_matches_oracle("camera inside / light on surface", &s, 97, 55);
 }
 
+/// A head lamp: a light exactly at the eye of a wide view. Deferred's proxy sphere around it
+/// had corners on the eye's plane (clip w = 0), whose triangles SwiftShader dropped once a
+/// view wider than about 110° took them in: the light was lost at the view's sides (240/255).
+#[test]
+fn a_light_at_the_eye_of_a_wide_view() {
+    let mut s = plane();
+    let eye = DVec3::new(0.0, 0.0, 0.3);
+    s.camera = Camera::perspective(eye, DVec3::new(1.0, 0.2, 0.0), 120.0, 0.1, 100.0);
+    s.lights = vec![point(eye.into(), 1.0, 1.0)];
+    check("head lamp, 120° view", &s, 128, 72);
+}
+
 #[test]
 fn lights_behind_the_camera_and_beyond_far() {
     let mut s = plane();
