@@ -312,6 +312,18 @@ pub fn parse(
             .map_or(Ok(DMat4::IDENTITY), |t| t.matrix(&field))?;
         let first_material = scene.materials.len();
         let first_object = scene.objects.len();
+        for (name, path) in [
+            ("obj", &spec.obj),
+            ("gltf", &spec.gltf),
+            ("texture", &spec.texture),
+        ] {
+            if path.as_ref().is_some_and(|p| p.as_os_str().is_empty()) {
+                return Err(SceneError::invalid(
+                    format!("{field}.{name}"),
+                    "is empty: it must name a file",
+                ));
+            }
+        }
         match (&spec.builtin, &spec.obj, &spec.gltf) {
             (Some(name), None, None) => {
                 let built = models

@@ -295,6 +295,19 @@ fn errors_name_the_field() {
             "objects[0]",
         ),
         (r#"{"objects": [{"builtin": "nope"}]}"#, "nope"),
+        // An empty name reads the scene file's folder: named as the field, not as a path.
+        (
+            r#"{"objects": [{"obj": ""}]}"#,
+            "`objects[0].obj`: is empty",
+        ),
+        (
+            r#"{"objects": [{"builtin": "plane"}, {"gltf": ""}]}"#,
+            "`objects[1].gltf`: is empty",
+        ),
+        (
+            r#"{"objects": [{"obj": "x.obj", "texture": ""}]}"#,
+            "`objects[0].texture`: is empty",
+        ),
         (
             r#"{"camera": {"position": [0,0,0], "target": [0,0,0]}}"#,
             "camera.target",
