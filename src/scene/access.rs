@@ -3,7 +3,7 @@
 //! not read the user's other files through them, so by default such a name may name only a
 //! file inside the model file's own folder: no `..`, no absolute path (`/x`, `C:/x`,
 //! `\\server\x`), no link that leads out of the folder, looked at before a file is opened and
-//! once it is open ([`opened_within`]). [`LoadOptions`] lifts this for trusted
+//! once it is open (`opened_within`). [`LoadOptions`] lifts this for trusted
 //! local content. Scene files and command lines name models anywhere: they
 //! are the user's own.
 
