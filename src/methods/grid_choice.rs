@@ -328,10 +328,7 @@ impl AutoGrid {
         samples.pixels = w as f64 * h as f64;
         let mut work = SAMPLE_WORK;
         for k in 0..rays {
-            // Rays in an order whose every first part is spread over the whole view: the
-            // rays cast when the work runs out are a fair sample still.
-            let ray = k * SAMPLE_STRIDE % rays;
-            let (i, j) = (ray % nx, ray / nx);
+            let (i, j) = sample_ray(k);
             let ndc_x = -1.0 + 2.0 * (i as f64 + 0.5) / nx as f64;
             let ndc_y = -1.0 + 2.0 * (j as f64 + 0.5) / ny as f64;
             let origin = unproject(ndc_x, ndc_y, -1.0);
@@ -362,6 +359,14 @@ impl AutoGrid {
     }
 }
 
+/// Column and row of the sample's `k`th ray: an order whose every first part is spread over
+/// the whole view, so the rays cast when the work runs out are a fair sample still.
+fn sample_ray(k: u32) -> (u32, u32) {
+    let (nx, ny) = SAMPLE_GRID;
+    let ray = k * SAMPLE_STRIDE % (nx * ny);
+    (ray % nx, ray / nx)
+}
+
 /// Whether a choice concluded now is the first made with calibrated figures (`calibrated`)
 /// after one made with the priors alone, and so replaces the current grid without the
 /// hysteresis; `chosen_with_priors` tracks whether the current choice was made with the
@@ -389,7 +394,43 @@ pub(crate) fn write_fixed_reason(out: &mut String, config: &GridConfig) {
 
 #[cfg(test)]
 mod tests {
-    use super::{first_calibrated, AutoGrid, FrameCost, FrameTiming};
+    use super::{first_calibrated, sample_ray, AutoGrid, FrameCost, FrameTiming, SAMPLE_GRID};
+
+    /// The sample's order takes each ray once, and its first 5 % (a sample cut short) already
+    /// reach most rows and columns and every quarter of the view.
+    #[test]
+    fn the_samples_rays_take_each_once_and_spread_from_the_first() {
+        let (nx, ny) = SAMPLE_GRID;
+        let rays = nx * ny;
+        let order: Vec<(u32, u32)> = (0..rays).map(sample_ray).collect();
+        let distinct: std::collections::HashSet<_> = order.iter().collect();
+        assert_eq!(distinct.len(), rays as usize);
+        let first = &order[..(rays / 20) as usize];
+        let rows: std::collections::HashSet<_> = first.iter().map(|r| r.1).collect();
+        let columns: std::collections::HashSet<_> = first.iter().map(|r| r.0).collect();
+        assert!(
+            rows.len() * 4 >= ny as usize * 3,
+            "{} of {ny} rows",
+            rows.len()
+        );
+        assert!(
+            columns.len() * 2 >= nx as usize,
+            "{} of {nx} columns",
+            columns.len()
+        );
+        for quarter in 0..4 {
+            let (right, top) = (quarter % 2 == 1, quarter / 2 == 1);
+            let n = first
+                .iter()
+                .filter(|&&(i, j)| (i >= nx / 2) == right && (j >= ny / 2) == top)
+                .count();
+            assert!(
+                n * 8 >= first.len(),
+                "{n} of {} in quarter {quarter}",
+                first.len()
+            );
+        }
+    }
 
     fn rendered(auto: &mut AutoGrid, evals: f64) {
         auto.pending = Some(FrameCost {

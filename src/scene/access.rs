@@ -124,13 +124,29 @@ pub(crate) fn opened_within(file: &std::fs::File, path: &Path, dir: &Path) -> Re
     // The look before resolved this folder; failing now, it was changed since.
     let real_dir = dir.canonicalize().map_err(|_| changed())?;
     let within = match opened_path(file) {
-        Some(opened) => opened.starts_with(&real_dir),
+        Some(opened) => opened.starts_with(kernel_spelling(dir).unwrap_or(real_dir)),
         None => same_file_within(file, path, &real_dir).unwrap_or(true),
     };
     if within {
         Ok(())
     } else {
         Err(changed())
+    }
+}
+
+/// The folder `dir` as the kernel spells an open file's place in it, where that may differ
+/// from its resolved path: Apple's `F_GETPATH` spells names as the disk holds them, which on a
+/// volume that ignores case a resolved path may not (`models/` for `Models/`).
+fn kernel_spelling(dir: &Path) -> Option<PathBuf> {
+    #[cfg(target_vendor = "apple")]
+    {
+        // A folder opens for reading on Apple's systems (as on any Unix).
+        opened_path(&std::fs::File::open(dir).ok()?)
+    }
+    #[cfg(not(target_vendor = "apple"))]
+    {
+        let _ = dir;
+        None
     }
 }
 

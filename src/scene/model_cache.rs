@@ -5,7 +5,8 @@
 //! the placing transform, are placed again from that read. An OBJ is read again for another
 //! texture override, but its meshes are swapped for those of its first read when equal, and
 //! every texture for an equal one of the same name loaded before, so memory holds one copy.
-//! Repeats add no warnings: the first load said them.
+//! Repeats add none of the warnings the first load said; a glTF file's later reference says
+//! only which of its lights and camera its transform leaves out.
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -84,12 +85,24 @@ impl Loaded {
         recolour: bool,
         transform_field: &str,
     ) -> Result<(), SceneError> {
+        self.check(transform, transform_field)?;
+        self.place_checked(scene, transform, recolour);
+        Ok(())
+    }
+
+    /// The refusal [`Self::place`] gives `transform`, if any.
+    fn check(&self, transform: DMat4, transform_field: &str) -> Result<(), SceneError> {
         for (_, _, relative, bounds) in &self.objects {
             let world = transform * *relative;
             if let Some(reason) = Aabb::placement_refusal_of(bounds.as_ref(), &world) {
                 return Err(SceneError::invalid(transform_field, reason));
             }
         }
+        Ok(())
+    }
+
+    /// [`Self::place`] with a transform [`Self::check`] passed.
+    fn place_checked(&mut self, scene: &mut Scene, transform: DMat4, recolour: bool) {
         let base = match self.uncoloured_at {
             Some(base) if !recolour => base,
             _ => {
@@ -110,7 +123,6 @@ impl Loaded {
                     transform: transform * *relative,
                 }),
         );
-        Ok(())
     }
 }
 
@@ -124,9 +136,9 @@ struct GltfModel {
 
 #[cfg(feature = "gltf")]
 impl GltfModel {
-    /// Places the file (`path`) again with `transform`, as reading it there would: on error
-    /// `scene` is unchanged. Returns the warnings for lights and a camera the transform
-    /// leaves out, and the file's camera.
+    /// Places the file (`path`) again with `transform`, as reading it there would (its
+    /// objects checked first, then its lights): on error `scene` is unchanged. Returns the
+    /// warnings for lights and a camera the transform leaves out, and the file's camera.
     fn place(
         &mut self,
         scene: &mut Scene,
@@ -135,16 +147,33 @@ impl GltfModel {
         recolour: bool,
         transform_field: &str,
     ) -> Result<(LoadReport, Option<Camera>), SceneError> {
+        if !transform.is_finite() {
+            return Err(SceneError::invalid(transform_field, "must be finite"));
+        }
+        self.objects.check(transform, transform_field)?;
         let placed = match &self.instanced {
             Some(instanced) => {
+                // Suns count as lights here: nothing else bounds how many a scene file's
+                // references to a file of many suns make. Checked before they are made.
+                let most =
+                    scene.lights.len() + scene.directional_lights.len() + instanced.most_lights();
+                super::input::check_light_count(most, &format!("{} lights", path.display()))?;
                 super::gltf::place_again(instanced, path, transform, transform_field)?
             }
             None => Default::default(),
         };
-        let lights = scene.lights.len().saturating_add(placed.lights.len());
-        super::input::check_light_count(lights, &format!("{} lights", path.display()))?;
-        self.objects
-            .place(scene, transform, recolour, transform_field)?;
+        let lights = placed.lights.len() + placed.directional_lights.len();
+        if self.objects.objects.is_empty() && lights == 0 {
+            // As a read at this transform says.
+            return Err(SceneError::GltfUnsupported {
+                path: path.to_path_buf(),
+                reason: format!(
+                    "nothing to show: the file places no triangle mesh, and {transform_field} \
+                     leaves out its lights"
+                ),
+            });
+        }
+        self.objects.place_checked(scene, transform, recolour);
         scene.lights.extend(placed.lights);
         scene.directional_lights.extend(placed.directional_lights);
         let mut report = LoadReport::default();
@@ -711,6 +740,109 @@ mod tests {
         let placed = scene.objects.last().unwrap();
         assert_eq!(placed.transform, unlit_there.objects[0].transform);
         assert_ne!(placed.transform, scene.objects[2].transform);
+    }
+
+    /// A later reference whose transform the file's contents refuse fails as reading the file
+    /// there fails, naming its own transform, and leaves the scene as it was; a file of lights
+    /// alone whose lights such a transform leaves out has nothing to show there either.
+    #[test]
+    fn a_later_reference_is_refused_as_reading_the_file_there_is() {
+        let dir = tempfile::tempdir().unwrap();
+        let lit = lit_textured_gltf(dir.path(), "lit.gltf");
+        let mut cache = ModelCache::new(LoadOptions::default());
+        let mut scene = Scene::empty();
+        let field = "objects[1].transform";
+        let far = DMat4::from_translation(glam::DVec3::new(1e13, 0.0, 0.0));
+        cache
+            .place_gltf(
+                &mut scene,
+                &lit,
+                DMat4::IDENTITY,
+                false,
+                "objects[0].transform",
+            )
+            .unwrap();
+        let counts = |s: &Scene| (s.objects.len(), s.materials.len(), s.lights.len());
+        let before = counts(&scene);
+        let err = cache
+            .place_gltf(&mut scene, &lit, far, false, field)
+            .unwrap_err()
+            .to_string();
+        assert_eq!(counts(&scene), before);
+        let read_there = |path: &Path, transform: DMat4| {
+            let mut budget = TextureBudget::default();
+            let options = LoadOptions::default();
+            let mut scene = Scene::empty();
+            crate::scene::gltf::load_into(&mut scene, path, transform, field, &options, &mut budget)
+                .unwrap_err()
+                .to_string()
+        };
+        // The read names the node and primitive too.
+        for said in [&err, &read_there(&lit, far)] {
+            assert!(
+                said.contains(field) && said.contains("past ±1e12"),
+                "{said}"
+            );
+        }
+        // A sun alone, left out by a transform that flattens its direction to nothing.
+        let lamp = dir.path().join("lamp.gltf");
+        let mut doc: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&lit).unwrap()).unwrap();
+        doc["extensions"]["KHR_lights_punctual"]["lights"] =
+            serde_json::json!([{"type": "directional", "intensity": 3}]);
+        doc["nodes"][0] = serde_json::json!({"extensions": {"KHR_lights_punctual": {"light": 0}}});
+        std::fs::write(&lamp, doc.to_string()).unwrap();
+        cache
+            .place_gltf(
+                &mut scene,
+                &lamp,
+                DMat4::IDENTITY,
+                false,
+                "objects[2].transform",
+            )
+            .unwrap();
+        let before = counts(&scene);
+        let flat = DMat4::from_scale(glam::DVec3::ZERO);
+        let err = cache
+            .place_gltf(&mut scene, &lamp, flat, false, field)
+            .unwrap_err()
+            .to_string();
+        assert_eq!(counts(&scene), before);
+        let there = read_there(&lamp, flat);
+        for said in [&err, &there] {
+            assert!(said.contains("nothing to show"), "{said}");
+        }
+    }
+
+    /// A glTF file's suns count against the scene's lights before a reference places them:
+    /// nothing else bounds what many references to a file of many suns make.
+    #[test]
+    fn suns_count_against_the_scenes_lights() {
+        let dir = tempfile::tempdir().unwrap();
+        let lit = lit_textured_gltf(dir.path(), "sun.gltf");
+        let mut doc: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&lit).unwrap()).unwrap();
+        doc["extensions"]["KHR_lights_punctual"]["lights"] =
+            serde_json::json!([{"type": "directional", "intensity": 3}]);
+        std::fs::write(&lit, doc.to_string()).unwrap();
+        let mut cache = ModelCache::new(LoadOptions::default());
+        let mut scene = Scene::empty();
+        let mut place = |scene: &mut Scene, i: usize| {
+            let field = format!("objects[{i}].transform");
+            cache.place_gltf(scene, &lit, DMat4::IDENTITY, false, &field)
+        };
+        place(&mut scene, 0).unwrap();
+        let sun = scene.directional_lights[0];
+        scene.directional_lights = vec![sun; crate::scene::input::MAX_LIGHTS - 1];
+        place(&mut scene, 1).unwrap();
+        let before = scene.objects.len();
+        let err = place(&mut scene, 2).unwrap_err().to_string();
+        assert!(err.contains("more than the"), "{err}");
+        assert_eq!(scene.objects.len(), before);
+        assert_eq!(
+            scene.directional_lights.len(),
+            crate::scene::input::MAX_LIGHTS
+        );
     }
 
     /// A file placed again holds its textures once, within room for one copy.

@@ -5,30 +5,73 @@
 use glam::DMat4;
 
 use super::fault::Fault;
-use super::{camera, lights};
+use super::{camera, ignored, lights};
 use crate::scene::{Camera, DirectionalLight, Light};
 
-/// The nodes whose light, or whose camera, is valid in the file's own space, with their
-/// transforms there.
-#[derive(Default)]
-pub(crate) struct Instances {
-    /// Nodes instancing a light, in node order.
-    lights: Vec<(usize, DMat4)>,
-    /// The first node instancing a camera, when that camera is valid.
-    camera: Option<(usize, DMat4)>,
+/// One node's light or camera: the node, the light's or camera's index, and the node's
+/// transform in the file's space.
+#[derive(Clone, Copy)]
+struct Instance {
+    node: usize,
+    index: usize,
+    world: DMat4,
 }
 
-/// A file's instances with the document they are read from: what placing the file again
-/// needs of it.
+impl Instance {
+    /// What messages call the node's light.
+    fn light_field(&self) -> String {
+        let Instance { node, index, .. } = self;
+        format!("nodes[{node}] (extensions.KHR_lights_punctual.lights[{index}])")
+    }
+
+    /// What messages call the node's camera.
+    fn camera_field(&self) -> String {
+        let Instance { node, index, .. } = self;
+        format!("nodes[{node}] (cameras[{index}])")
+    }
+}
+
+/// The lights, and the first camera, valid in the file's own space that its nodes instance.
+#[derive(Default)]
+pub(crate) struct Instances {
+    /// In node order.
+    lights: Vec<Instance>,
+    camera: Option<Instance>,
+}
+
+/// A file's instances with what placing them again needs of the file: its lights and cameras
+/// alone (the rest of a parsed file may take hundreds of MB).
 pub(crate) struct Instanced {
-    pub(super) document: gltf::Document,
-    pub(super) instances: Instances,
+    definitions: gltf::Document,
+    instances: Instances,
 }
 
 impl Instanced {
-    /// [`Instances::place`].
+    /// Keeps `instances` with the light and camera definitions of `document`.
+    pub(super) fn new(document: &gltf::Document, instances: Instances) -> Instanced {
+        let json = document.as_json();
+        let root = gltf::json::Root {
+            // The root's extensions: the lights, and nothing large besides.
+            extensions: json.extensions.clone(),
+            cameras: json.cameras.clone(),
+            ..Default::default()
+        };
+        Instanced {
+            definitions: gltf::Document::from_json_without_validation(root),
+            instances,
+        }
+    }
+
+    /// Lights placing them adds at most (suns included).
+    pub(crate) fn most_lights(&self) -> usize {
+        self.instances.lights.len()
+    }
+
+    /// [`Instances::place`], its warnings said as a load says them (one line for many alike).
     pub(super) fn place(&self, transform: DMat4) -> Result<Placed, Fault> {
-        self.instances.place(&self.document, transform)
+        let mut placed = self.instances.place(&self.definitions, transform)?;
+        placed.warnings = ignored::once_per_feature(std::mem::take(&mut placed.warnings));
+        Ok(placed)
     }
 }
 
@@ -40,16 +83,6 @@ pub(crate) struct Placed {
     pub camera: Option<Camera>,
     /// Lights and a camera the placing transform leaves out, each said why.
     pub warnings: Vec<String>,
-}
-
-/// What messages call node `node`'s light.
-fn light_field(node: usize, light: usize) -> String {
-    format!("nodes[{node}] (extensions.KHR_lights_punctual.lights[{light}])")
-}
-
-/// What messages call node `node`'s camera.
-fn camera_field(node: usize, camera: usize) -> String {
-    format!("nodes[{node}] (cameras[{camera}])")
 }
 
 impl Instances {
@@ -67,10 +100,14 @@ impl Instances {
         world: DMat4,
         warnings: &mut Vec<String>,
     ) -> Result<(), Fault> {
-        let field = light_field(node, light.index());
-        match lights::convert(light, &world, &field)? {
+        let instance = Instance {
+            node,
+            index: light.index(),
+            world,
+        };
+        match lights::convert(light, &world, &instance.light_field())? {
             lights::Converted::Skipped(why) => warnings.push(why),
-            _ => self.lights.push((node, world)),
+            _ => self.lights.push(instance),
         }
         Ok(())
     }
@@ -85,40 +122,43 @@ impl Instances {
         world: DMat4,
         warnings: &mut Vec<String>,
     ) {
-        let field = camera_field(node, cam.index());
-        match camera::convert(document, cam, &world, &field) {
-            Ok(_) => self.camera = Some((node, world)),
+        let instance = Instance {
+            node,
+            index: cam.index(),
+            world,
+        };
+        match camera::convert(document, cam, &world, &instance.camera_field()) {
+            Ok(_) => self.camera = Some(instance),
             Err(e) => warnings.push(unused_camera(&e)),
         }
     }
 
-    /// The lights and camera placed by `transform` (the file's `document`, as checked): a
-    /// light it puts out of range is a fault of the placing, a camera it does that to is left
-    /// out with a warning.
+    /// The lights and camera placed by `transform`, their definitions read from `document`
+    /// (the file's, or [`Instanced`]'s): a light it puts out of range is a fault of the
+    /// placing, a camera it does that to is left out with a warning.
     pub(super) fn place(
         &self,
         document: &gltf::Document,
         transform: DMat4,
     ) -> Result<Placed, Fault> {
         let mut placed = Placed::default();
-        let nodes = || document.nodes();
-        for &(node, world) in &self.lights {
-            let Some(light) = nodes().nth(node).and_then(|n| n.light()) else {
+        for instance in &self.lights {
+            let Some(light) = document.lights().and_then(|mut l| l.nth(instance.index)) else {
                 continue;
             };
-            let field = light_field(node, light.index());
-            let converted = lights::convert(&light, &(transform * world), &field)
-                .map_err(|e| Fault::Placing(format!("placing nodes[{node}]: {e}")))?;
+            let world = transform * instance.world;
+            let converted = lights::convert(&light, &world, &instance.light_field())
+                .map_err(|e| Fault::Placing(format!("placing nodes[{}]: {e}", instance.node)))?;
             match converted {
                 lights::Converted::Light(l) => placed.lights.push(l),
                 lights::Converted::Directional(l) => placed.directional_lights.push(l),
                 lights::Converted::Skipped(why) => placed.warnings.push(why),
             }
         }
-        if let Some((node, world)) = self.camera {
-            if let Some(cam) = nodes().nth(node).and_then(|n| n.camera()) {
-                let field = camera_field(node, cam.index());
-                match camera::convert(document, &cam, &(transform * world), &field) {
+        if let Some(instance) = self.camera {
+            if let Some(cam) = document.cameras().nth(instance.index) {
+                let world = transform * instance.world;
+                match camera::convert(document, &cam, &world, &instance.camera_field()) {
                     Ok(camera) => placed.camera = Some(camera),
                     Err(e) => placed.warnings.push(unused_camera(&format!("placing {e}"))),
                 }

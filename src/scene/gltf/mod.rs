@@ -241,7 +241,15 @@ pub(crate) fn load_source_into(
         Ok(imported) => imported.map_err(|fault| fault.into_error(path, transform_field))?,
         Err(_) => return Err(error(PARSER_FAILED.into())),
     };
-    let total_lights = scene.lights.len().saturating_add(imported.lights.len());
+    // Suns count too: a scene file may name a file of many suns many times.
+    let total_lights = [
+        scene.lights.len(),
+        scene.directional_lights.len(),
+        imported.lights.len(),
+        imported.directional_lights.len(),
+    ]
+    .into_iter()
+    .fold(0usize, usize::saturating_add);
     input::check_light_count(total_lights, &format!("{} lights", path.display()))?;
     let first_material = scene.materials.len();
     scene.materials.extend(imported.materials);
@@ -535,11 +543,9 @@ fn import(
     // Features first, then what the parts said, each once.
     out.warnings = ignored::unused_features(&document, camera_nodes);
     out.warnings.extend(ignored::once_per_feature(warnings));
-    drop(buffers);
-    out.instanced = instances.any().then_some(Instanced {
-        document,
-        instances,
-    });
+    out.instanced = instances
+        .any()
+        .then(|| Instanced::new(&document, instances));
     Ok(out)
 }
 

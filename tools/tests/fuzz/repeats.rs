@@ -97,7 +97,7 @@ proptest! {
         // The glTF places its mesh (two primitives) `placements` more times through nodes.
         let (mut doc, bin) = gltf_valid();
         if !lit {
-            // Without lights and cameras the file is read once; with them, per reference.
+            // Read once either way; with lights and a camera, each reference places them.
             let root = doc.as_object_mut().unwrap();
             root.remove("extensions");
             root.remove("extensionsUsed");
