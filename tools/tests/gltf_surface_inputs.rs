@@ -498,6 +498,37 @@ fn a_required_texture_transform_offsets_rotates_and_scales_the_base_colour() {
     check_every_method_by_level("texture transform", &s, [&want[0], &want[1]], 3.0);
 }
 
+/// A transform's `texCoord` that is not a set number (a string, a fraction, negative, past
+/// 2³² − 1) on a normal texture makes the transform malformed: a warning, and the texture
+/// bound on its own set without it, not the rest of the transform applied silently.
+#[test]
+fn a_transform_whose_set_is_not_a_number_is_malformed() {
+    let dir = tempfile::tempdir().unwrap();
+    for set in [json!("x"), json!(1.5), json!(-1), json!(4294967296u64)] {
+        let material = json!({
+            "pbrMetallicRoughness": {"baseColorTexture": {"index": 0}},
+            "normalTexture": {"index": 0, "extensions": {"KHR_texture_transform": {
+                "texCoord": set, "scale": [2, 2]}}},
+        });
+        let mut plane = Plane::new(material);
+        plane.images.push(png(1, 1, &[[128, 128, 255, 255]]));
+        plane.extensions.push("KHR_texture_transform");
+        let path = plane.write(dir.path(), "set.gltf");
+        let (s, warnings) = scene_of(&path, grazing_light(), 0.1);
+        let all = warnings.join("\n");
+        assert!(
+            all.contains("normalTexture.extensions.KHR_texture_transform: malformed"),
+            "texCoord {set}: {all}"
+        );
+        let normal = s.materials[0]
+            .maps
+            .normal
+            .as_ref()
+            .expect("normal map bound");
+        assert!(normal.transform.is_identity(), "texCoord {set}");
+    }
+}
+
 #[test]
 fn other_texture_sets_malformed_transforms_and_every_colour_format_are_handled() {
     let dir = tempfile::tempdir().unwrap();

@@ -147,34 +147,41 @@ pub(super) fn transform_of(
         None => Some(0.0),
         Some(v) => v.as_f64().map(|r| r as f32),
     };
+    // A set number that is not one (a string, a fraction, past 2³² − 1) makes the whole
+    // extension malformed, as an offset that is not a number does.
+    let set = match ext.get("texCoord") {
+        None => Some(tex_coord),
+        Some(v) => v.as_u64().and_then(|t| u32::try_from(t).ok()),
+    };
     let parsed = match (
         pair("offset", Vec2::ZERO),
         rotation,
         pair("scale", Vec2::ONE),
+        set,
     ) {
-        (Some(offset), Some(rotation), Some(scale)) => Some(TextureTransform {
-            offset,
-            rotation,
-            scale,
-        }),
+        (Some(offset), Some(rotation), Some(scale), Some(set)) => Some((
+            TextureTransform {
+                offset,
+                rotation,
+                scale,
+            },
+            set,
+        )),
         _ => None,
     };
-    let usable = |t: &TextureTransform| t.is_usable() && t.rows().iter().all(|r| r.is_finite());
-    let t = match parsed.filter(usable) {
-        Some(t) => t,
+    let usable =
+        |(t, _): &(TextureTransform, u32)| t.is_usable() && t.rows().iter().all(|r| r.is_finite());
+    match parsed.filter(usable) {
+        Some(parsed) => parsed,
         None => {
             warnings.push(format!(
                 "{field}.extensions.KHR_texture_transform: malformed (offset and scale are \
-                 two numbers within ±{MAX_TEXCOORD:e}, rotation one, all finite); ignored"
+                 two numbers within ±{MAX_TEXCOORD:e}, rotation one, all finite, texCoord a \
+                 set number); ignored"
             ));
-            TextureTransform::IDENTITY
+            (TextureTransform::IDENTITY, tex_coord)
         }
-    };
-    let tex_coord = ext
-        .get("texCoord")
-        .and_then(Value::as_u64)
-        .map_or(tex_coord, |t| u32::try_from(t).unwrap_or(u32::MAX));
-    (t, tex_coord)
+    }
 }
 
 /// Loads one slot's texture with its transform (`None`: absent, on another texture
