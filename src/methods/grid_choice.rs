@@ -17,6 +17,9 @@ use crate::scene::raycast::SceneRaycaster;
 /// Rays of the surface sample, across and down (1 296 rays).
 const SAMPLE_GRID: (u32, u32) = (48, 27);
 
+/// Rays of the surface sample.
+const SAMPLE_RAYS: u32 = SAMPLE_GRID.0 * SAMPLE_GRID.1;
+
 /// Box and triangle tests the surface sample may make ([`SceneRaycaster::hit_within`]):
 /// triangles that overlap one another make every ray test most of them, and a 1 MB model of
 /// 915 k overlapping chords took 30 s a sample. Past it the rays cast so far are the sample.
@@ -216,13 +219,12 @@ impl AutoGrid {
                 self.choice = Some(first);
             }
         }
-        let (nx, ny) = SAMPLE_GRID;
-        if let (Some(choice), true) = (&mut self.choice, self.samples.rays < (nx * ny) as usize) {
+        let cut = self.samples.rays < SAMPLE_RAYS as usize;
+        if let (Some(choice), true) = (&mut self.choice, cut) {
             let _ = write!(
                 choice.reason,
-                "; surface sample cut to {} of {} rays (overlapping triangles)",
+                "; surface sample cut to {} of {SAMPLE_RAYS} rays (overlapping triangles)",
                 self.samples.rays,
-                nx * ny
             );
         }
         if self.layout.as_ref() != Some(&layout) {
@@ -321,13 +323,12 @@ impl AutoGrid {
             p.truncate() / p.w
         };
         let (nx, ny) = SAMPLE_GRID;
-        let rays = nx * ny;
         let samples = &mut self.samples;
         samples.points.clear();
         samples.rays = 0;
         samples.pixels = w as f64 * h as f64;
         let mut work = SAMPLE_WORK;
-        for k in 0..rays {
+        for k in 0..SAMPLE_RAYS {
             let (i, j) = sample_ray(k);
             let ndc_x = -1.0 + 2.0 * (i as f64 + 0.5) / nx as f64;
             let ndc_y = -1.0 + 2.0 * (j as f64 + 0.5) / ny as f64;
@@ -347,10 +348,10 @@ impl AutoGrid {
             }
             samples.rays += 1;
         }
-        if samples.rays < rays as usize && !self.sample_cut_said {
+        if samples.rays < SAMPLE_RAYS as usize && !self.sample_cut_said {
             self.sample_cut_said = true;
             log::warn!(
-                "the automatic grid's surface sample stopped after {} of its {rays} rays: the \
+                "the automatic grid's surface sample stopped after {} of its {SAMPLE_RAYS} rays: the \
                  scene's triangles overlap so much that each ray tests most of them; the grid \
                  is chosen from those rays (a fixed `--grid` needs no sample)",
                 samples.rays
@@ -362,9 +363,8 @@ impl AutoGrid {
 /// Column and row of the sample's `k`th ray: an order whose every first part is spread over
 /// the whole view, so the rays cast when the work runs out are a fair sample still.
 fn sample_ray(k: u32) -> (u32, u32) {
-    let (nx, ny) = SAMPLE_GRID;
-    let ray = k * SAMPLE_STRIDE % (nx * ny);
-    (ray % nx, ray / nx)
+    let ray = k * SAMPLE_STRIDE % SAMPLE_RAYS;
+    (ray % SAMPLE_GRID.0, ray / SAMPLE_GRID.0)
 }
 
 /// Whether a choice concluded now is the first made with calibrated figures (`calibrated`)

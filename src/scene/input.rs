@@ -259,6 +259,19 @@ fn kernel_file_system(_: &std::fs::Metadata) -> Option<&'static str> {
     None
 }
 
+/// Checks that `scene`'s lights and suns, with `added` more, stay within [`MAX_LIGHTS`] before
+/// those are made: suns count too, since a scene file may name a file of many suns many times.
+pub(crate) fn check_lights_added(
+    scene: &super::Scene,
+    added: usize,
+    field: &str,
+) -> Result<(), SceneError> {
+    let total = [scene.lights.len(), scene.directional_lights.len(), added]
+        .into_iter()
+        .fold(0usize, usize::saturating_add);
+    check_light_count(total, field)
+}
+
 /// Checks a light count before lights are made: `field` names where it came from.
 pub fn check_light_count(count: usize, field: &str) -> Result<(), SceneError> {
     light_count(count as u64, field).map(|_| ())

@@ -241,16 +241,8 @@ pub(crate) fn load_source_into(
         Ok(imported) => imported.map_err(|fault| fault.into_error(path, transform_field))?,
         Err(_) => return Err(error(PARSER_FAILED.into())),
     };
-    // Suns count too: a scene file may name a file of many suns many times.
-    let total_lights = [
-        scene.lights.len(),
-        scene.directional_lights.len(),
-        imported.lights.len(),
-        imported.directional_lights.len(),
-    ]
-    .into_iter()
-    .fold(0usize, usize::saturating_add);
-    input::check_light_count(total_lights, &format!("{} lights", path.display()))?;
+    let added = imported.lights.len() + imported.directional_lights.len();
+    input::check_lights_added(scene, added, &format!("{} lights", path.display()))?;
     let first_material = scene.materials.len();
     scene.materials.extend(imported.materials);
     scene
@@ -311,16 +303,14 @@ fn json_error(e: &serde_json::Error, json: &[u8]) -> String {
 }
 
 /// Places the lights and camera of a file loaded before (`instanced`, from its
-/// [`Placement`]) again with `transform`, as reading `path` again there would.
+/// [`Placement`]) again with `transform` (finite: the caller checks it first, as a read
+/// does), as reading `path` again there would.
 pub(crate) fn place_again(
     instanced: &Instanced,
     path: &Path,
     transform: DMat4,
     transform_field: &str,
 ) -> Result<instances::Placed, SceneError> {
-    if !transform.is_finite() {
-        return Err(SceneError::invalid(transform_field, "must be finite"));
-    }
     // The parser's accessors, which the first read went through without failing.
     let placed =
         std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| instanced.place(transform)));
