@@ -1,8 +1,8 @@
 //! What a still frame costs against a moving one, taking turns in one run: a still frame
 //! (nothing the light lists are built from changed) draws with the last frame's lists, so it
 //! neither assigns nor uploads them (forward's and deferred's light records likewise).
-//! `cargo bench --bench still_frames -- [ROUNDS] [WxH] [METHOD] [es2|es3]` (default 5 rounds,
-//! 640x360, clustered, ES 3.0: the courtyard with 1 024 lights). Each round renders 20 frames
+//! `cargo bench --bench still_frames -- [ROUNDS] [WxH] [METHOD] [es2|es3] [LIGHTS]` (default 5
+//! rounds, 640x360, clustered, ES 3.0, the courtyard with 1 024 lights). Each round renders 20 frames
 //! of the lights standing at t = 1 s, then 20 of them moving on from there at 30 frames a second,
 //! on one renderer; prints the medians over all rounds of the frame time (`render_offscreen`,
 //! read-back included), the assignment time and the bytes uploaded, and the frames that reused
@@ -47,7 +47,8 @@ fn frames(
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args = FrameBenchArgs::from_env("clustered");
     let (rounds, size, method, es) = (args.rounds, args.size, args.method.as_str(), args.es);
-    let mut scene = scene::builtin::build("courtyard", Some((1024, 7)))?;
+    let lights = args.lights;
+    let mut scene = scene::builtin::build("courtyard", Some((lights, 7)))?;
     let ctx = HeadlessContext::new(es)?;
     let mut renderer = Renderer::new(ctx.load_gl()?, es)?;
     renderer.set_method_named(method)?;
@@ -58,7 +59,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         moving.extend(frames(&mut renderer, &mut scene, size, true)?);
     }
     println!(
-        "{es} {method} {}x{}, courtyard, 1 024 lights, {rounds} rounds of {FRAMES} frames each, \
+        "{es} {method} {}x{}, courtyard, {lights} lights, {rounds} rounds of {FRAMES} frames each, \
          medians: frame ms, assignment ms, bytes uploaded; frames that reused their lists",
         size.0, size.1
     );

@@ -14,6 +14,8 @@ pub struct FrameBenchArgs {
     pub method: String,
     /// Feature level (default ES 3.0).
     pub es: EsVersion,
+    /// Seeded random lights (default 1 024).
+    pub lights: usize,
 }
 
 impl FrameBenchArgs {
@@ -43,6 +45,7 @@ impl FrameBenchArgs {
                 Some("es2") => EsVersion::Es2,
                 _ => EsVersion::Es3,
             },
+            lights: args.get(4).and_then(|a| a.parse().ok()).unwrap_or(1024),
         }
     }
 }
@@ -60,13 +63,14 @@ mod tests {
     #[test]
     fn arguments_in_order_with_defaults_for_the_rest() {
         let args = |a: &[&str]| a.iter().map(|s| s.to_string()).collect::<Vec<_>>();
-        let read = FrameBenchArgs::parse(&args(&["3", "1280x720", "tiled", "es2"]), "auto");
+        let read = FrameBenchArgs::parse(&args(&["3", "1280x720", "tiled", "es2", "99"]), "auto");
         assert_eq!(read.rounds, 3);
         assert_eq!(read.size, (1280, 720));
         assert_eq!(read.method, "tiled");
         assert_eq!(read.es, EsVersion::Es2);
+        assert_eq!(read.lights, 99);
         let none = FrameBenchArgs::parse(&args(&["0", "wide"]), "clustered");
-        assert_eq!((none.rounds, none.size), (1, (640, 360)));
+        assert_eq!((none.rounds, none.size, none.lights), (1, (640, 360), 1024));
         assert_eq!(
             (none.method.as_str(), none.es),
             ("clustered", EsVersion::Es3)

@@ -1,6 +1,6 @@
 //! Deferred's lights as instances of their proxy: each light four `vec4`s in the layout of
-//! `glsl/deferred_light_instance.glsl`, drawn a batch at a time, so a light costs its 64 bytes
-//! and no GL call of its own. A still frame draws the instances the last frame uploaded.
+//! `glsl/deferred_light_instance.glsl`, uploaded and drawn together, so a light costs its 64
+//! bytes and no GL call of its own. A still frame draws the instances the last frame uploaded.
 
 use glam::Vec4;
 
@@ -16,9 +16,10 @@ const LIGHT_LOCATION: u32 = 5;
 /// `vec4`s a light takes.
 const LIGHT_VEC4S: usize = 4;
 
-/// Lights a draw takes at most: each proxy kind's buffer grows with its lights up to 4 096 of
-/// them, 256 KiB (768 KiB for the three kinds), however many the scene has.
-const BATCH_LIGHTS: usize = 4096;
+/// Lights a draw takes at most, and a proxy kind's buffer holds: it grows with its lights up to
+/// 65 536 of them, 4 MiB, however many the scene has. A kind with more streams them a batch of
+/// this many at a time, so its still frames upload them again.
+const BATCH_LIGHTS: usize = 1 << 16;
 
 /// `vec4`s a full batch holds.
 const BATCH_VEC4S: usize = BATCH_LIGHTS * LIGHT_VEC4S;
@@ -43,9 +44,9 @@ pub(super) fn light_instance(
 /// Proxies a light pass draws with, each from its own stream.
 pub(super) const PROXIES: usize = 3;
 
-/// A stream of instances for each proxy and the batch being filled (kept between frames: a
-/// frame allocates nothing). A proxy whose lights fit one batch keeps them in its stream, so a
-/// still frame draws them again without uploading.
+/// A stream of instances for each proxy and the batch being filled (kept between frames, so a
+/// frame with no more lights than one before allocates nothing). A proxy whose lights fit one
+/// batch keeps them in its stream, so a still frame draws them again without uploading.
 #[derive(Default)]
 pub(super) struct LightInstances {
     streams: [Option<InstanceStream>; PROXIES],
@@ -76,9 +77,6 @@ impl LightInstances {
                 BATCH_LIGHTS,
             )?),
         };
-        if self.batch.capacity() < BATCH_VEC4S {
-            self.batch.reserve_exact(BATCH_VEC4S);
-        }
         stream.bind(dev);
         self.batch.clear();
         let (mut uploaded, mut drawn) = (0, 0);

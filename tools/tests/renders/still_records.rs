@@ -240,32 +240,6 @@ fn each_input_of_the_records_makes_the_next_frame_upload_them() {
     }
 }
 
-/// Deferred streams more lights than a batch holds through one buffer a proxy, which then
-/// holds the last batch only: a still frame uploads them all again, and draws every one.
-#[test]
-fn deferred_uploads_again_the_lights_of_more_than_a_batch() {
-    let mut scene = still_scene();
-    scene.lights = (0..5000)
-        .map(|i| {
-            let f = i as f64;
-            let at = DVec3::new((f * 0.37).sin() * 9.0, 0.4, (f * 0.011).cos() * 11.0);
-            Light::point(at, 1.5, Vec3::new(0.3, 0.2, 0.1), 0.5)
-        })
-        .collect();
-    let mut gpu = Gpu::new(EsVersion::Es3);
-    let opts = RenderOptions::default();
-    let (first, _) = gpu.render_with("deferred", &scene, SIZE, &opts);
-    let (image, again) = gpu.render_with("deferred", &scene, SIZE, &opts);
-    assert_uploaded(&again, "the second frame");
-    // Four `vec4`s a light; the see-through objects' forward pass keeps its records.
-    assert_eq!(
-        again.memory.upload_bytes,
-        5000 * 64,
-        "every light's instance"
-    );
-    assert!(image == first, "the second frame's picture differs");
-}
-
 /// A frame that fails (its error may be the records' upload) leaves no records to draw again:
 /// the next frame of the same lights uploads them, and draws what a fresh renderer draws. The
 /// failures are injected at the step that reports them.
