@@ -36,6 +36,7 @@ pub enum Clear {
 pub struct RenderOptions {
     /// Write linear values (clamped to [0, 1], no sRGB encoding; exposure and tone map still
     /// apply when set, and are off by default) so pixels can be checked against the light model.
+    /// Refused into a framebuffer that encodes sRGB itself, which would encode them.
     pub linear: bool,
     /// Background colour (linear if `linear`, else as stored). Its alpha is what pixels that
     /// show nothing get; a transparent surface in front adds its opacity (`a + a_bg·(1 − a)`)

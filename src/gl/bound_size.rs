@@ -9,8 +9,8 @@ use super::Device;
 
 impl Device {
     /// The bound framebuffer object's colour attachment 0 as `(width, height)`, or `None`
-    /// where GL cannot say (the default framebuffer, a texture on ES 3.0 or 2.0, a texture
-    /// that is not a 2D one or a cube face). Leaves the bindings it used as they were.
+    /// where GL cannot say (the default framebuffer, a texture on ES 3.0 or 2.0). Leaves the
+    /// bindings it used as they were.
     pub(crate) fn bound_color_size(&self) -> Option<(u32, u32)> {
         self.bound_framebuffer()?;
         let gl = &self.gl;
@@ -40,22 +40,14 @@ impl Device {
                 gl.bind_renderbuffer(glow::RENDERBUFFER, renderbuffer(before));
                 (w, h)
             },
-            (glow::TEXTURE, Some(name)) if self.has_texture_level_queries() => unsafe {
+            (glow::TEXTURE, Some(name)) if self.has_texture_level_queries() => {
                 let level = param(glow::FRAMEBUFFER_ATTACHMENT_TEXTURE_LEVEL);
                 let face = param(glow::FRAMEBUFFER_ATTACHMENT_TEXTURE_CUBE_MAP_FACE) as u32;
-                let (target, binding, query) = if face == 0 {
-                    (glow::TEXTURE_2D, glow::TEXTURE_BINDING_2D, glow::TEXTURE_2D)
-                } else {
-                    (glow::TEXTURE_CUBE_MAP, glow::TEXTURE_BINDING_CUBE_MAP, face)
-                };
-                let before = gl.get_parameter_i32(binding);
-                // A texture of another target (an array's layer) is a GL error here: no size.
-                gl.bind_texture(target, Some(glow::NativeTexture(name)));
-                let w = gl.get_tex_level_parameter_i32(query, level, glow::TEXTURE_WIDTH);
-                let h = gl.get_tex_level_parameter_i32(query, level, glow::TEXTURE_HEIGHT);
-                gl.bind_texture(target, texture(before));
-                (w, h)
-            },
+                if self.drain_errors() != glow::NO_ERROR {
+                    return None;
+                }
+                self.texture_level_size(glow::NativeTexture(name), level, face)?
+            }
             _ => {
                 // A driver's error on a query here is not the frame's.
                 self.drain_errors();
@@ -67,6 +59,44 @@ impl Device {
             (w, h) if answered && w > 0 && h > 0 => Some((w as u32, h as u32)),
             _ => None,
         }
+    }
+
+    /// The size of `texture`'s `level` (of its cube face `face`, where not 0). Its target is
+    /// not asked of the attachment: each one a colour buffer may be a texture of (a 2D texture,
+    /// a layer of a 3D or array one, a multisampled one) is tried in turn, since binding a
+    /// texture to another target than its own is a GL error and binds nothing.
+    fn texture_level_size(
+        &self,
+        texture: glow::Texture,
+        level: i32,
+        face: u32,
+    ) -> Option<(i32, i32)> {
+        let gl = &self.gl;
+        let targets: &[(u32, u32)] = if face != 0 {
+            &[(glow::TEXTURE_CUBE_MAP, glow::TEXTURE_BINDING_CUBE_MAP)]
+        } else {
+            &[
+                (glow::TEXTURE_2D, glow::TEXTURE_BINDING_2D),
+                (glow::TEXTURE_2D_ARRAY, glow::TEXTURE_BINDING_2D_ARRAY),
+                (glow::TEXTURE_3D, glow::TEXTURE_BINDING_3D),
+                (
+                    glow::TEXTURE_2D_MULTISAMPLE,
+                    glow::TEXTURE_BINDING_2D_MULTISAMPLE,
+                ),
+            ]
+        };
+        targets.iter().find_map(|&(target, binding)| unsafe {
+            let before = gl.get_parameter_i32(binding);
+            gl.bind_texture(target, Some(texture));
+            if self.drain_errors() != glow::NO_ERROR {
+                return None;
+            }
+            let query = if face != 0 { face } else { target };
+            let w = gl.get_tex_level_parameter_i32(query, level, glow::TEXTURE_WIDTH);
+            let h = gl.get_tex_level_parameter_i32(query, level, glow::TEXTURE_HEIGHT);
+            gl.bind_texture(target, texture_binding(before));
+            Some((w, h))
+        })
     }
 
     /// Whether `glGetTexLevelParameteriv` exists: ES 3.1 and desktop GL.
@@ -83,6 +113,6 @@ fn renderbuffer(binding: i32) -> Option<glow::Renderbuffer> {
     std::num::NonZeroU32::new(binding as u32).map(glow::NativeRenderbuffer)
 }
 
-fn texture(binding: i32) -> Option<glow::Texture> {
+fn texture_binding(binding: i32) -> Option<glow::Texture> {
     std::num::NonZeroU32::new(binding as u32).map(glow::NativeTexture)
 }

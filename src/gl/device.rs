@@ -408,6 +408,17 @@ impl Device {
         encoding == Some(Some(glow::SRGB as i32))
     }
 
+    /// Whether the bound framebuffer object has nothing at `GL_COLOR_ATTACHMENT0`, where the
+    /// frame goes (its shaders write one output, to draw buffer 0). False for the default
+    /// framebuffer and where the driver would not say.
+    pub(crate) fn bound_colour_zero_is_empty(&self) -> bool {
+        if self.bound_framebuffer().is_none() {
+            return false;
+        }
+        let colour = [glow::COLOR_ATTACHMENT0, glow::BACK];
+        self.bound_attachment(colour, glow::FRAMEBUFFER_ATTACHMENT_OBJECT_TYPE) == Some(None)
+    }
+
     /// Samples per pixel of the bound framebuffer (`GL_SAMPLES`: 0 for a single-sampled
     /// one, and where the driver would not say).
     pub(crate) fn bound_samples(&self) -> i32 {

@@ -13,6 +13,7 @@ use glow::HasContext;
 use super::caps::Caps;
 use super::ext_fns::{AttribPointerFns, VertexAttribDivisor};
 use super::host_attributes::HostAttributes;
+use super::host_draw_buffers::HostDrawBuffers;
 
 /// Texture units the renderer binds: 0 to 7 (`methods::maps::UNIT_MAPS` + 3), within the
 /// 8 fragment units every ES 2.0 context has.
@@ -100,6 +101,8 @@ pub(crate) struct HostState {
     units: usize,
     framebuffers: [Option<glow::Framebuffer>; 2],
     renderbuffer: Option<glow::Renderbuffer>,
+    /// The bound draw framebuffer's draw buffers, where the call points them at attachment 0.
+    draw_buffers: Option<HostDrawBuffers>,
     viewport: [i32; 4],
     /// The scissor box (the renderer's scissored clear sets it).
     scissor: [i32; 4],
@@ -147,7 +150,8 @@ struct DesktopState {
 
 impl HostState {
     /// Saves the application's state and sets what the renderer assumes: its own vertex
-    /// array (`vao`, on an ES 3.x or desktop context), no pixel buffer, no sampler objects on
+    /// array (`vao`, on an ES 3.x or desktop context), the bound framebuffer drawing into its
+    /// attachment 0 alone (`host_draw_buffers.rs`), no pixel buffer, no sampler objects on
     /// its units, the capabilities of `OFF_INSIDE` off, additive blend equations, no sample
     /// mask, counter-clockwise front faces, the full depth range, a clear depth of 1, pixel
     /// rows that start where the data does and texture unit 0 active (a game's active unit past
@@ -229,6 +233,7 @@ impl HostState {
                     ]
                 },
                 renderbuffer: gl.get_parameter_renderbuffer(glow::RENDERBUFFER_BINDING),
+                draw_buffers: es3.then(|| HostDrawBuffers::enter(gl, desktop)).flatten(),
                 viewport,
                 scissor,
                 toggled: TOGGLED.map(|c| gl.is_enabled(c)),
@@ -342,6 +347,9 @@ impl HostState {
             gl.active_texture(self.active_texture as u32);
             if self.es3 {
                 gl.bind_framebuffer(glow::DRAW_FRAMEBUFFER, self.framebuffers[0]);
+                if let Some(draw_buffers) = &self.draw_buffers {
+                    draw_buffers.leave(gl);
+                }
                 gl.bind_framebuffer(glow::READ_FRAMEBUFFER, self.framebuffers[1]);
                 gl.bind_buffer(glow::PIXEL_PACK_BUFFER, self.pixel_buffers[0]);
                 gl.bind_buffer(glow::PIXEL_UNPACK_BUFFER, self.pixel_buffers[1]);

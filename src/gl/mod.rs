@@ -22,6 +22,7 @@ pub mod framebuffer;
 pub mod gbuffer;
 pub mod gles_lib;
 pub(crate) mod host_attributes;
+pub(crate) mod host_draw_buffers;
 pub(crate) mod host_state;
 pub(crate) mod instances;
 pub(crate) mod left_objects;

@@ -1,7 +1,7 @@
 //! What a frame needs of the framebuffer the application bound ([`Renderer::render`]): complete,
-//! no larger than the driver's viewport, and with a depth buffer when the frame is drawn in it
-//! (an MSAA frame brings its own and only resolves there); a frame reaching past its colour
-//! buffer is warned of. Forward, tiled and clustered draw
+//! no larger than the driver's viewport, its colour at attachment 0, and with a depth buffer
+//! when the frame is drawn in it (an MSAA frame brings its own and only resolves there); a
+//! frame reaching past its colour buffer is warned of. Forward, tiled and clustered draw
 //! with the depth test there, and so does deferred for transparent objects and for a frame
 //! without lights; deferred's opaque composite alone does not, but one rule for every method
 //! and frame is what the README asks of a game.
@@ -51,6 +51,14 @@ impl Renderer {
             ))
             .into());
         }
+        if self.dev.bound_colour_zero_is_empty() {
+            return Err(GlError::BoundFramebuffer(
+                "it has no colour buffer at GL_COLOR_ATTACHMENT0, the one the frame is drawn \
+                 into (a colour buffer at another attachment is not): attach it there"
+                    .to_string(),
+            )
+            .into());
+        }
         self.warn_past_bound_colour((width, height), origin);
         if !drawn_here {
             return Ok(None);
@@ -60,8 +68,8 @@ impl Renderer {
             Some(0) => {
                 return Err(GlError::BoundFramebuffer(
                     "it has no depth buffer, which the frame is drawn against: attach one \
-                     (24-bit; 16-bit loses precision), or render with MSAA, whose target has \
-                     its own"
+                     (24-bit; 16-bit loses precision), or render colour with MSAA, whose \
+                     target has its own (light counts and the heatmap are drawn single-sampled)"
                         .to_string(),
                 )
                 .into())

@@ -157,6 +157,14 @@ impl Renderer {
                     .into(),
             });
         }
+        if self.srgb_destination && options.linear {
+            return Err(Error::InvalidOption {
+                field: "linear",
+                reason: "a framebuffer that encodes sRGB stores every value encoded: draw \
+                         linear values into an RGBA8 one"
+                    .into(),
+            });
+        }
         self.own_msaa_frame = samples > 1;
         if samples <= 1 {
             // A game that turned MSAA off gets the target's memory back (tens of MB at 1080p).
@@ -208,10 +216,10 @@ impl Renderer {
     }
 
     /// What `clear_color` is cleared with: an sRGB destination encodes the clear value as it
-    /// does a fragment's, so one given as stored (not `linear`) is decoded first.
+    /// does a fragment's, so it is decoded first (it is given as stored).
     fn clear_value(&self, options: &RenderOptions) -> [f32; 4] {
         let color = options.clear_color;
-        if !self.srgb_destination || options.linear {
+        if !self.srgb_destination {
             return color;
         }
         let decode =

@@ -220,6 +220,65 @@ fn a_frame_past_the_games_framebuffer_is_warned_of_once() {
     }
 }
 
+/// The same for a layer of a 3D or array texture (no warning: only 2D textures were asked),
+/// where the context can say a texture's size; the game's bindings of those targets, which
+/// the size query tries in turn, are as they were.
+#[test]
+fn a_frame_past_a_layer_of_the_games_texture_is_warned_of_once() {
+    common::warnings::install();
+    let past = "reaches past the bound framebuffer's 64×36 colour buffer";
+    for target in [glow::TEXTURE_3D, glow::TEXTURE_2D_ARRAY] {
+        let (_ctx, gl, mut r) = game(EsVersion::Es3);
+        if r.caps().context_version.as_str() < "3.1" {
+            common::skip("no texture size to ask before ES 3.1");
+            return;
+        }
+        let (w, h) = SIZE;
+        let (fbo, layered, others) = unsafe {
+            let layered = gl.create_texture().unwrap();
+            gl.bind_texture(target, Some(layered));
+            gl.tex_storage_3d(target, 1, glow::RGBA8, w, h, 3);
+            let fbo = game_fbo(&gl, Some(glow::DEPTH_COMPONENT24));
+            let attachment = glow::COLOR_ATTACHMENT0;
+            gl.framebuffer_texture_layer(glow::FRAMEBUFFER, attachment, Some(layered), 0, 2);
+            let complete = gl.check_framebuffer_status(glow::FRAMEBUFFER);
+            assert_eq!(complete, glow::FRAMEBUFFER_COMPLETE);
+            // The game's own textures bound at the targets the query tries.
+            let others = [glow::TEXTURE_2D, glow::TEXTURE_2D_ARRAY, glow::TEXTURE_3D].map(|t| {
+                let texture = gl.create_texture().unwrap();
+                gl.bind_texture(t, Some(texture));
+                (t, texture)
+            });
+            (fbo, layered, others)
+        };
+        let before = warnings_containing(past).len();
+        render(&mut r, &RenderOptions::default()).unwrap();
+        assert_eq!(
+            warnings_containing(past).len(),
+            before,
+            "0x{target:x}: fits"
+        );
+        r.render(&plane(), 65, 36, &RenderOptions::default())
+            .unwrap();
+        assert_eq!(warnings_containing(past).len(), before + 1, "0x{target:x}");
+        unsafe {
+            for (t, texture) in others {
+                let binding = match t {
+                    glow::TEXTURE_2D => glow::TEXTURE_BINDING_2D,
+                    glow::TEXTURE_2D_ARRAY => glow::TEXTURE_BINDING_2D_ARRAY,
+                    _ => glow::TEXTURE_BINDING_3D,
+                };
+                let bound = gl.get_parameter_texture(binding);
+                assert_eq!(bound, Some(texture), "0x{target:x}: the game's 0x{t:x}");
+                gl.delete_texture(texture);
+            }
+            gl.bind_framebuffer(glow::FRAMEBUFFER, None);
+            gl.delete_framebuffer(fbo);
+            gl.delete_texture(layered);
+        }
+    }
+}
+
 /// A GL error the game left pending was the first check's error (`render_offscreen`: "after
 /// allocating a target"), and turned GPU timing off for good; it is now cleared at the call,
 /// with a warning.

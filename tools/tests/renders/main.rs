@@ -12,6 +12,7 @@ mod background_alpha;
 mod culled_vs_forward;
 mod directional_lights;
 mod front_faces;
+mod game_draw_buffers;
 mod game_framebuffer_checks;
 mod invalid_options;
 mod keep_framebuffer;

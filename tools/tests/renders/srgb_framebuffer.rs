@@ -95,7 +95,8 @@ fn an_srgb_framebuffer_stores_what_an_rgba8_one_does_with_every_method_and_msaa(
 /// The background and the light-count heatmap, given as stored values, are stored so in an
 /// sRGB framebuffer too; exact counts, which an encode would change, are refused there.
 #[test]
-fn the_clear_colour_and_the_heatmap_are_stored_as_given_and_exact_counts_are_refused() {
+fn the_clear_colour_and_the_heatmap_are_stored_as_given_and_exact_counts_and_linear_values_refused()
+{
     let mut plane = scene::builtin::build("plane", Some((64, 2))).unwrap();
     // Far enough that the background shows around the plane.
     plane.camera = manylight::Camera::perspective(
@@ -169,6 +170,21 @@ fn the_clear_colour_and_the_heatmap_are_stored_as_given_and_exact_counts_are_ref
     }
     // Into an RGBA8 one they are drawn.
     try_stored(&mut gpu, glow::RGBA8, &plane, &exact).unwrap();
+    // Linear values likewise: an sRGB framebuffer stored them encoded (74/255 from RGBA8's).
+    let linear = RenderOptions {
+        linear: true,
+        ..Default::default()
+    };
+    match try_stored(&mut gpu, glow::SRGB8_ALPHA8, &plane, &linear) {
+        Err(manylight::Error::InvalidOption {
+            field: "linear", ..
+        }) => {}
+        other => panic!(
+            "linear values into an sRGB framebuffer: {:?}",
+            other.map(|_| ())
+        ),
+    }
+    try_stored(&mut gpu, glow::RGBA8, &plane, &linear).unwrap();
 }
 
 /// A game that switched sRGB writes off (`GL_EXT_sRGB_write_control`: a UI pass that stores
