@@ -161,7 +161,8 @@ impl MeshBuilder {
                 format!("segments and rings must be at least 1, got {segments} and {rings}"),
             ));
         }
-        let vertices = (segments as u64 + 1) * (rings as u64 + 1);
+        // Saturating: (2³²)² is past u64, and would wrap to 0 vertices.
+        let vertices = (segments as u64 + 1).saturating_mul(rings as u64 + 1);
         self.shape("sphere", vertices, |s| {
             s.add_sphere(centre, radius, segments, rings)
         })
@@ -332,6 +333,11 @@ mod tests {
             e.contains("MeshBuilder::sphere") && e.contains("past the"),
             "{e}"
         );
+        // 2⁶⁴ vertices, past u64: they wrapped to 0 and were pushed without end.
+        let e = refused(&|b| {
+            b.sphere(Vec3::ZERO, 1.0, u32::MAX, u32::MAX);
+        });
+        assert!(e.contains("past the"), "{e}");
         let e = refused(&|b| {
             b.cylinder(Vec3::ZERO, 1.0, 1.0, u32::MAX);
         });
