@@ -12,7 +12,7 @@ use crate::cluster::auto_grid::{
 use crate::cluster::grid::{ClusterGrid, GridConfig, GridProjection};
 use crate::cluster::pack::GridEncoding;
 use crate::gl::timer::RING as TIMER_RING;
-use crate::scene::raycast::SceneRaycaster;
+use crate::scene::raycast::{KeptCaster, SceneRaycaster};
 
 /// Rays of the surface sample, across and down (1 296 rays).
 const SAMPLE_GRID: (u32, u32) = (48, 27);
@@ -72,8 +72,9 @@ pub(crate) struct AutoGrid {
     choices: u32,
     samples: SurfaceSamples,
     /// Ray caster of the scene's geometry, with the identity of the meshes and transforms it
-    /// was built from.
-    caster: Option<(GeometryKey, SceneRaycaster)>,
+    /// was built from; kept without its meshes between samples, so those a game drops are
+    /// freed at once (their GPU uploads too), not at the next choice.
+    caster: Option<(GeometryKey, KeptCaster)>,
     /// The frame rendered and not yet observed.
     pending: Option<FrameCost>,
     /// The last observed frames' numbers and light evaluations, by number modulo the ring:
@@ -307,13 +308,22 @@ impl AutoGrid {
                     .zip(&scene.objects)
                     .all(|(k, o)| *k == identity(o))
         });
-        if !same_geometry {
+        let woken = match self.caster.take() {
+            Some((key, kept)) if same_geometry => kept.wake().map(|c| (key, c)).map_err(Some),
+            kept => Err(kept.map(|(_, kept)| kept)),
+        };
+        let (key, caster) = woken.unwrap_or_else(|previous| {
             let key: GeometryKey = scene.objects.iter().map(identity).collect();
             // Moved objects keep their meshes' hierarchies: only the top level is rebuilt.
-            let previous = self.caster.take().map(|(_, caster)| caster);
-            self.caster = Some((key, SceneRaycaster::rebuilt(previous, scene)));
-        }
-        let caster = &self.caster.as_ref().expect("built above").1;
+            (key, SceneRaycaster::rebuilt(previous, scene))
+        });
+        self.cast_samples(ctx, &caster);
+        self.caster = Some((key, caster.keep()));
+    }
+
+    /// The sample rays of [`AutoGrid::sample`], cast with `caster`.
+    fn cast_samples(&mut self, ctx: &FrameContext, caster: &SceneRaycaster) {
+        let scene = ctx.scene;
         let (w, h) = ctx.viewport;
         let aspect = w as f64 / h as f64;
         let view = ctx.view;

@@ -15,7 +15,7 @@
 mod bvh;
 
 use std::collections::HashMap;
-use std::sync::Arc;
+use std::sync::{Arc, Weak};
 
 use glam::{DMat3, DMat4, DVec3, DVec4};
 
@@ -62,9 +62,66 @@ pub const COPLANAR: f64 = 1e-3;
 /// `order` (triangle indices), vertices are read from the shared mesh as they are tested.
 #[derive(Debug)]
 struct MeshBvh {
-    mesh: Arc<Mesh>,
+    mesh: Held,
     nodes: Vec<Node>,
     order: Vec<u32>,
+}
+
+/// A hierarchy's mesh: its `Arc` while a [`SceneRaycaster`] casts, a `Weak` while a
+/// [`KeptCaster`] waits, so a mesh the game drops meanwhile is freed (its GPU upload too). The
+/// `Weak` keeps the allocation, so no other mesh takes its address, the key it is found by.
+#[derive(Debug)]
+enum Held {
+    Live(Arc<Mesh>),
+    Kept(Weak<Mesh>),
+}
+
+impl Held {
+    fn address(&self) -> *const Mesh {
+        match self {
+            Held::Live(mesh) => Arc::as_ptr(mesh),
+            Held::Kept(mesh) => Weak::as_ptr(mesh),
+        }
+    }
+}
+
+impl MeshBvh {
+    /// Its mesh: a [`SceneRaycaster`]'s hierarchies are all live.
+    fn mesh(&self) -> &Mesh {
+        match &self.mesh {
+            Held::Live(mesh) => mesh,
+            Held::Kept(_) => unreachable!("a kept caster casts no ray"),
+        }
+    }
+}
+
+/// A [`SceneRaycaster`] put away between uses ([`SceneRaycaster::keep`]) without holding its
+/// meshes: [`KeptCaster::wake`] gives it back while the scene still has them all, and
+/// [`SceneRaycaster::rebuilt`] keeps the hierarchies of those it still has.
+#[derive(Debug)]
+pub struct KeptCaster(SceneRaycaster);
+
+impl KeptCaster {
+    /// The caster again, for the scene it was built from (the same meshes, transforms and
+    /// sides); itself back when one of its meshes was dropped since.
+    pub fn wake(mut self) -> Result<SceneRaycaster, KeptCaster> {
+        let alive = |m: &MeshBvh| match &m.mesh {
+            Held::Live(_) => true,
+            Held::Kept(mesh) => mesh.strong_count() > 0,
+        };
+        if !self.0.meshes.iter().all(alive) {
+            return Err(self);
+        }
+        for m in &mut self.0.meshes {
+            if let Held::Kept(mesh) = &m.mesh {
+                match mesh.upgrade() {
+                    Some(live) => m.mesh = Held::Live(live),
+                    None => return Err(self), // dropped on another thread just now
+                }
+            }
+        }
+        Ok(self.0)
+    }
 }
 
 /// One placed object.
@@ -164,16 +221,24 @@ impl SceneRaycaster {
         Self::rebuilt(None, scene)
     }
 
+    /// Puts the caster away: it keeps its hierarchies but not their meshes.
+    pub fn keep(mut self) -> KeptCaster {
+        for m in &mut self.meshes {
+            if let Held::Live(mesh) = &m.mesh {
+                m.mesh = Held::Kept(Arc::downgrade(mesh));
+            }
+        }
+        KeptCaster(self)
+    }
+
     /// [`SceneRaycaster::new`], keeping `previous`'s hierarchy of every mesh the scene still
-    /// places: objects that move rebuild only the level over the placed objects. (A kept
-    /// hierarchy holds its mesh's `Arc`, so the mesh it is found by cannot have been freed and
-    /// its address reused.)
-    pub fn rebuilt(previous: Option<SceneRaycaster>, scene: &Scene) -> Self {
+    /// places: objects that move rebuild only the level over the placed objects.
+    pub fn rebuilt(previous: Option<KeptCaster>, scene: &Scene) -> Self {
         let mut kept: HashMap<*const Mesh, MeshBvh> = previous
-            .map(|p| p.meshes)
+            .map(|p| p.0.meshes)
             .unwrap_or_default()
             .into_iter()
-            .map(|m| (Arc::as_ptr(&m.mesh), m))
+            .map(|m| (m.mesh.address(), m))
             .collect();
         let mut meshes: Vec<MeshBvh> = Vec::new();
         let mut mesh_index: HashMap<*const Mesh, u32> = HashMap::new();
@@ -183,10 +248,17 @@ impl SceneRaycaster {
         for (object, o) in scene.objects.iter().enumerate() {
             let key = Arc::as_ptr(&o.mesh);
             let mesh = *mesh_index.entry(key).or_insert_with(|| {
-                meshes.push(kept.remove(&key).unwrap_or_else(|| {
-                    meshes_built += 1;
-                    MeshBvh::new(&o.mesh)
-                }));
+                let bvh = match kept.remove(&key) {
+                    Some(bvh) => MeshBvh {
+                        mesh: Held::Live(o.mesh.clone()),
+                        ..bvh
+                    },
+                    None => {
+                        meshes_built += 1;
+                        MeshBvh::new(&o.mesh)
+                    }
+                };
+                meshes.push(bvh);
                 (meshes.len() - 1) as u32
             });
             let Some(root) = meshes[mesh as usize].nodes.first() else {
@@ -364,7 +436,7 @@ impl SceneRaycaster {
         dir: DVec3,
     ) -> Hit {
         let instance = &self.instances[slot];
-        let mesh = &self.meshes[instance.mesh as usize].mesh;
+        let mesh = self.meshes[instance.mesh as usize].mesh();
         let corners = corners(mesh, triangle);
         let world = corners.map(|i| {
             instance
@@ -417,7 +489,7 @@ impl MeshBvh {
             .collect();
         let (nodes, order) = bvh::build(&boxes);
         MeshBvh {
-            mesh: mesh.clone(),
+            mesh: Held::Live(mesh.clone()),
             nodes,
             order,
         }
@@ -434,13 +506,14 @@ impl MeshBvh {
         s: &mut Search,
         mut found: impl FnMut(&mut Search, f64, f64, f64, u32),
     ) {
-        let positions = &self.mesh.positions;
+        let mesh = self.mesh();
+        let positions = &mesh.positions;
         let (origin, dir) = match *frame {
             Frame::Object { origin, dir } | Frame::World { origin, dir, .. } => (origin, dir),
         };
         let inv = dir.recip();
         let vertices = |triangle: u32| {
-            let v = corners(&self.mesh, triangle).map(|i| positions[i].as_dvec3());
+            let v = corners(mesh, triangle).map(|i| positions[i].as_dvec3());
             match frame {
                 Frame::Object { .. } => v,
                 Frame::World { to_world, .. } => v.map(|p| to_world.transform_point3(p)),

@@ -314,6 +314,36 @@ fn uploads_no_scene_draws_are_freed_on_request_while_the_game_holds_them() {
     );
 }
 
+/// A level the game drops (it held the only `Arc`s of its meshes and images) is freed by the
+/// next frame of another, its CPU mesh and its GPU uploads, with every method. The automatic
+/// grid's ray caster kept the meshes until its next choice (240 frames of a still view): the
+/// default method held two levels' uploads for four seconds. The next level is the same one
+/// loaded again (new meshes, the same view and extent), so the grid has no cause to choose.
+#[test]
+fn a_level_the_game_drops_is_freed_by_the_next_frame() {
+    common::each_method(|es, method, gpu| {
+        let opts = RenderOptions::default();
+        let mut render = |s: &scene::Scene| {
+            let (_, stats) = gpu.r().render_offscreen(s, 32, 18, &opts).unwrap();
+            (stats.memory.scene_gpu_bytes, stats.grid.reason)
+        };
+        let level = textured_pillars();
+        let mesh = Arc::downgrade(&level.objects[0].mesh);
+        let (one_level, _) = render(&level);
+        assert!(one_level > 64 * 64 * 4);
+        for _ in 0..3 {
+            render(&level);
+        }
+        drop(level);
+        let (after, reason) = render(&textured_pillars());
+        assert!(
+            mesh.upgrade().is_none(),
+            "{es} {method}: the dropped level's mesh is alive ({reason:?})"
+        );
+        assert_eq!(after, one_level, "{es} {method}: two levels' uploads");
+    });
+}
+
 /// Lights that reach nothing in view cost what no lights cost, with every method: no
 /// assignment, no upload, none counted visible, the ambient-only picture. One whose centre
 /// lies outside the view but whose sphere reaches into it still lights the frame's edge.

@@ -489,7 +489,7 @@ fn a_rebuild_keeps_the_hierarchies_of_the_meshes_still_placed() {
     let first = SceneRaycaster::new(&scene);
     assert_eq!(first.meshes_built(), 2, "two distinct meshes");
     scene.objects[1].transform = DMat4::from_translation(DVec3::new(-2.0, 1.0, -6.0));
-    let moved = SceneRaycaster::rebuilt(Some(first), &scene);
+    let moved = SceneRaycaster::rebuilt(Some(first.keep()), &scene);
     assert_eq!(moved.meshes_built(), 0);
     let fresh = SceneRaycaster::new(&scene);
     let mut rng = rand::rngs::StdRng::seed_from_u64(5);
@@ -507,8 +507,32 @@ fn a_rebuild_keeps_the_hierarchies_of_the_meshes_still_placed() {
     }
     // A mesh replaced by a new one is built; the one no object places any more is dropped.
     scene.objects[0].mesh = Arc::new(triangle_at(-2.0));
-    let replaced = SceneRaycaster::rebuilt(Some(moved), &scene);
+    let replaced = SceneRaycaster::rebuilt(Some(moved.keep()), &scene);
     assert_eq!((replaced.meshes_built(), replaced.mesh_count()), (1, 2));
+}
+
+/// A kept caster holds no mesh: one the scene drops is freed, and the caster no longer
+/// wakes; while the scene keeps them all it wakes to the same hits.
+#[test]
+fn a_kept_caster_lets_dropped_meshes_go() {
+    let mut scene = scene_of(vec![
+        (triangle_at(-1.0), DMat4::IDENTITY),
+        (triangle_at(-3.0), DMat4::IDENTITY),
+    ]);
+    let ray = (DVec3::Z * 3.0, DVec3::new(0.1, 0.0, -1.0));
+    let first = SceneRaycaster::new(&scene);
+    let hit = first.hit(ray.0, ray.1).map(|h| h.position);
+    let woken = first.keep().wake().expect("the scene holds its meshes");
+    assert_eq!(woken.hit(ray.0, ray.1).map(|h| h.position), hit);
+    let kept = woken.keep();
+    let nearer = Arc::downgrade(&scene.objects[0].mesh);
+    scene.objects.remove(0);
+    assert!(nearer.upgrade().is_none(), "the kept caster held the mesh");
+    let kept = kept.wake().expect_err("a mesh is gone");
+    let rebuilt = SceneRaycaster::rebuilt(Some(kept), &scene);
+    assert_eq!((rebuilt.meshes_built(), rebuilt.mesh_count()), (0, 1));
+    let far = rebuilt.hit(ray.0, ray.1).expect("the far triangle");
+    assert!((far.position.z + 3.0).abs() < 1e-9, "{}", far.position);
 }
 
 /// Half squares stacked over one another, whose boxes are whole squares: a ray through the
