@@ -19,6 +19,7 @@
 //! without `GL_EXT_float_blend` (`gl::gbuffer`).
 
 mod light_instances;
+mod proxy_sphere;
 
 use glam::{Mat4, Vec3};
 
@@ -34,8 +35,6 @@ use crate::gl::mesh::GpuMesh;
 use crate::gl::program::{ProgramKey, Resolver, Sampler, Uniform, UniformSet};
 use crate::gl::state::{Blend, Cull, DepthTest, RenderState};
 use crate::gl::{Caps, Device, EsVersion};
-use crate::scene::meshbuild::MeshBuilder;
-use crate::scene::Mesh;
 use crate::Error;
 use light_instances::{light_instance, LightInstances};
 
@@ -308,24 +307,6 @@ struct LightPass {
     key: InstancesKey,
 }
 
-/// The proxy: a unit sphere of 16 segments and 9 rings, its poles on the view's z axis. An odd
-/// ring count leaves no corner on the plane through its centre across the view (the nearest
-/// lie 0.17 of the radius off it): a light at the eye, a head lamp, would put such corners at
-/// clip w = 0, and SwiftShader then dropped the triangles they start (docs/drivers.md).
-fn unit_sphere() -> Mesh {
-    let mut b = MeshBuilder::new();
-    b.sphere(Vec3::ZERO, 1.0, 16, PROXY_RINGS);
-    let mut sphere = b.build_fixed();
-    // A quarter turn about x takes the poles from y to z (and keeps the winding).
-    let turn = |v: &mut Vec3| *v = Vec3::new(v.x, -v.z, v.y);
-    sphere.positions.iter_mut().for_each(turn);
-    sphere.normals.iter_mut().for_each(turn);
-    sphere
-}
-
-/// Rings of the proxy sphere between its poles (odd: see [`unit_sphere`]).
-const PROXY_RINGS: u32 = 9;
-
 impl Deferred {
     /// Allocates what a frame of `ctx` needs (kept while its size and specular target stay),
     /// leaving the frame's framebuffer bound (making the G-buffer binds its own).
@@ -353,7 +334,7 @@ impl Deferred {
             self.gbuffer = Some(GBuffer::new(dev, size.0, size.1, specular)?);
         }
         if self.sphere.is_none() {
-            self.sphere = Some(GpuMesh::new(dev, &unit_sphere())?);
+            self.sphere = Some(GpuMesh::new(dev, &proxy_sphere::unit_sphere())?);
             self.fullscreen = Some(GpuMesh::new(dev, &crate::gl::mesh::fullscreen_triangle())?);
         }
         Ok(())

@@ -285,6 +285,30 @@ fn a_light_at_the_eye_of_a_wide_view() {
     check("head lamp, 120° view", &s, 128, 72);
 }
 
+/// A head lamp in a narrow view: an orthographic one 0.82 high, and a 1° lens with the lamp
+/// 0.1 mm behind the eye. Only a small patch around the far pole of deferred's proxy sphere
+/// covers the frame there, and the sphere's own seams (its pole and its first meridian
+/// repeated, a little apart in `f32`) drew the light twice along lines (47/255 and 18/255
+/// from forward on llvmpipe and ANGLE).
+#[test]
+fn a_light_at_the_eye_of_a_narrow_view() {
+    let mut s = plane();
+    let eye = DVec3::new(0.0, 1.5, 4.0);
+    let target = DVec3::new(-0.05, 0.1, 0.0);
+    s.camera = Camera::perspective(eye, target, 50.0, 0.1, 1000.0);
+    s.camera.projection = Projection::Orthographic {
+        height: 0.82,
+        near: 1.0,
+        far: 1000.0,
+    };
+    s.lights = vec![point(eye.into(), 500.0, 1.0)];
+    check("head lamp, orthographic 0.82 high", &s, 160, 90);
+    s.camera = Camera::perspective(eye, target, 1.0, 1.0, 1e6);
+    let behind = eye + DVec3::new(7.08e-5, 3.06e-5, 7.10e-5);
+    s.lights = vec![point(behind.into(), 205.5, 1.0)];
+    check("head lamp, 1° lens", &s, 31, 128);
+}
+
 #[test]
 fn lights_behind_the_camera_and_beyond_far() {
     let mut s = plane();
