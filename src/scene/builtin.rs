@@ -387,6 +387,12 @@ mod tests {
             e.contains("objects[0].transform") && e.contains("affine"),
             "{e}"
         );
+        // A tiny value reads as one: it was written out in 300 digits.
+        projective.x_axis.w = 1e-300;
+        projective.w_axis.w = 0.0;
+        scene.objects[0].transform = projective;
+        let e = scene.validate().unwrap_err().to_string();
+        assert!(e.contains("last row 1e-300 0 0 0,") && e.len() < 200, "{e}");
     }
 
     #[test]

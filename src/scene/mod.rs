@@ -73,6 +73,21 @@ pub use mesh::{Aabb, Mesh};
 pub use mesh::{MAX_SCENE_MATERIALS, MAX_SCENE_MESHES, MAX_SCENE_OBJECTS};
 pub use motion::Motion;
 
+/// A number as an error message writes it: as written for ordinary magnitudes, in exponent form
+/// for tiny and huge ones (`{}` writes 1e-300 in 300 digits).
+pub(crate) struct Short(pub f64);
+
+impl std::fmt::Display for Short {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let v = self.0.abs();
+        if v != 0.0 && !(1e-4..1e16).contains(&v) {
+            write!(f, "{:e}", self.0)
+        } else {
+            write!(f, "{}", self.0)
+        }
+    }
+}
+
 /// Most a transform's last row may differ from `0 0 0 1` (exporters and inverses round) before
 /// it is refused as not affine.
 pub(crate) const AFFINE_TOLERANCE: f64 = 1e-6;
@@ -390,7 +405,10 @@ impl Scene {
                     format!("objects[{i}].transform"),
                     format!(
                         "must be affine (last row {} {} {} {}, must be 0 0 0 1)",
-                        last.x, last.y, last.z, last.w
+                        Short(last.x),
+                        Short(last.y),
+                        Short(last.z),
+                        Short(last.w)
                     ),
                 ));
             }

@@ -6,6 +6,8 @@
 use glam::{DMat4, DQuat, DVec3};
 use serde::Deserialize;
 
+use crate::scene::Short;
+
 #[derive(Deserialize)]
 struct RawRoot {
     #[serde(default)]
@@ -71,7 +73,10 @@ fn matrix(m: &[f64; 16]) -> Result<DMat4, String> {
     if (last - glam::DVec4::W).abs().max_element() > crate::scene::AFFINE_TOLERANCE {
         return Err(format!(
             "not an affine transform (last row {} {} {} {}, must be 0 0 0 1)",
-            last.x, last.y, last.z, last.w
+            Short(last.x),
+            Short(last.y),
+            Short(last.z),
+            Short(last.w)
         ));
     }
     for col in [&mut m.x_axis, &mut m.y_axis, &mut m.z_axis] {
@@ -232,6 +237,11 @@ mod tests {
             ("1,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,0,0", "last row 0 0 0 0"),
             ("1,0,0,0.5, 0,1,0,0, 0,0,1,0, 0,0,0,1", "last row 0.5 0 0 1"),
             ("1,0,0,0, 0,1,0,0, 0,0,1,-1, 0,0,0,1", "last row 0 0 -1 1"),
+            // Written short: `{}` wrote 1e-300 in 300 digits.
+            (
+                "1,0,0,1e-300, 0,1,0,0, 0,0,1,0, 0,0,0,0",
+                "last row 1e-300 0 0 0,",
+            ),
             ("1,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,0,2", "last row 0 0 0 2"),
         ] {
             let err = local_transforms(node(m).as_bytes()).unwrap_err();
