@@ -105,18 +105,12 @@ impl KeptCaster {
     /// The caster again, for the scene it was built from (the same meshes, transforms and
     /// sides); itself back when one of its meshes was dropped since.
     pub fn wake(mut self) -> Result<SceneRaycaster, KeptCaster> {
-        let alive = |m: &MeshBvh| match &m.mesh {
-            Held::Live(_) => true,
-            Held::Kept(mesh) => mesh.strong_count() > 0,
-        };
-        if !self.0.meshes.iter().all(alive) {
-            return Err(self);
-        }
         for m in &mut self.0.meshes {
             if let Held::Kept(mesh) = &m.mesh {
                 match mesh.upgrade() {
                     Some(live) => m.mesh = Held::Live(live),
-                    None => return Err(self), // dropped on another thread just now
+                    // Those woken so far are put away again.
+                    None => return Err(self.0.keep()),
                 }
             }
         }

@@ -533,6 +533,18 @@ fn a_kept_caster_lets_dropped_meshes_go() {
     assert_eq!((rebuilt.meshes_built(), rebuilt.mesh_count()), (0, 1));
     let far = rebuilt.hit(ray.0, ray.1).expect("the far triangle");
     assert!((far.position.z + 3.0).abs() < 1e-9, "{}", far.position);
+    // A wake that fails past a live mesh holds that mesh no more than before.
+    let kept = rebuilt.keep();
+    scene.objects.push(Object {
+        mesh: Arc::new(triangle_at(-5.0)),
+        material: 0,
+        transform: DMat4::IDENTITY,
+    });
+    let kept = SceneRaycaster::rebuilt(Some(kept), &scene).keep();
+    scene.objects.pop();
+    let back = kept.wake().expect_err("a mesh is gone");
+    assert_eq!(Arc::strong_count(&scene.objects[0].mesh), 1);
+    drop(back);
 }
 
 /// Half squares stacked over one another, whose boxes are whole squares: a ray through the
