@@ -15,7 +15,7 @@ use crate::gl::framebuffer::ColorFormat;
 use crate::methods::{self, FrameContext};
 use crate::options::{Clear, CountKind, RenderOptions, MAX_EXPOSURE_EV};
 use crate::scene::features::SceneFeatures;
-use crate::scene::{Projection, Scene};
+use crate::scene::{Projection, Scene, Short};
 use crate::Error;
 
 impl Renderer {
@@ -549,7 +549,7 @@ fn check_options(options: &RenderOptions) -> Result<(), Error> {
     let positive = |v: f64| v.is_finite() && v > 0.0;
     if let Some(cutoff) = options.light_cutoff {
         if !(cutoff.is_finite() && cutoff >= 0.0) {
-            let why = format!("must be a finite radiance from 0 up, got {cutoff}");
+            let why = format!("must be a finite radiance from 0 up, got {}", Short(cutoff));
             return invalid("light_cutoff", why);
         }
     }
@@ -560,20 +560,23 @@ fn check_options(options: &RenderOptions) -> Result<(), Error> {
     // A NaN tile size, like a NaN grid setting, never equals itself: the tiles would be
     // rebuilt every frame.
     if !positive(options.tile_px) {
-        let why = format!("must be a finite number above 0, got {}", options.tile_px);
+        let why = format!(
+            "must be a finite number above 0, got {}",
+            Short(options.tile_px)
+        );
         return invalid("tile_px", why);
     }
     let heat = options.heat_scale;
     if !(heat.is_finite() && heat >= 1.0) {
         return invalid(
             "heat_scale",
-            format!("must be a finite count from 1 up, got {heat}"),
+            format!("must be a finite count from 1 up, got {}", Short(heat)),
         );
     }
     if !(options.exposure_ev.is_finite() && options.exposure_ev.abs() <= MAX_EXPOSURE_EV) {
         let why = format!(
             "must be within ±{MAX_EXPOSURE_EV} stops, got {}",
-            options.exposure_ev
+            Short(options.exposure_ev)
         );
         return invalid("exposure_ev", why);
     }
@@ -586,7 +589,7 @@ fn check_options(options: &RenderOptions) -> Result<(), Error> {
         if !positive(value) {
             return invalid(
                 field,
-                format!("must be a finite number above 0, got {value}"),
+                format!("must be a finite number above 0, got {}", Short(value)),
             );
         }
     }
@@ -598,7 +601,7 @@ fn check_options(options: &RenderOptions) -> Result<(), Error> {
         ),
     ] {
         if let Some(v) = value.filter(|v| !v.is_finite()) {
-            return invalid(field, format!("must be finite (or None), got {v}"));
+            return invalid(field, format!("must be finite (or None), got {}", Short(v)));
         }
     }
     if options.max_assign_threads == 0 {
@@ -623,7 +626,10 @@ fn check_options(options: &RenderOptions) -> Result<(), Error> {
     }
     let budget = options.grid.assign_budget();
     if !(budget.is_finite() && budget >= 0.0) {
-        let why = format!("must be a finite share of the frame from 0 up, got {budget}");
+        let why = format!(
+            "must be a finite share of the frame from 0 up, got {}",
+            Short(budget)
+        );
         return invalid("grid.assign_budget", why);
     }
     Ok(())

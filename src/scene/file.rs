@@ -45,8 +45,8 @@ use super::material::check_color_factor;
 use super::model_cache::{self, ModelCache};
 use super::motion::{Bob, Flicker, Motion, Orbit, OrbitAbout, Sweep, Wander};
 use super::random::{self, LightSetStyle};
-use super::LoadReport;
 use super::{Camera, DirectionalLight, Light, LightKind, MaterialModel, Scene, SceneError};
+use super::{LoadReport, Short};
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -407,7 +407,7 @@ pub fn parse(
                 Some(v) if v.is_finite() && (0.0..=1.0).contains(&v) => Ok(v as f32),
                 Some(v) => Err(SceneError::invalid(
                     format!("{field}.{name}"),
-                    format!("must be in [0, 1], got {v}"),
+                    format!("must be in [0, 1], got {}", Short(v)),
                 )),
                 None => Err(SceneError::invalid(
                     format!("{field}.{name}"),

@@ -17,7 +17,7 @@ use super::material::{MAX_COLOR_FACTOR, MAX_SHININESS};
 use super::surface_maps::{SurfaceMaps, TextureTransform};
 use super::texture::{Sampling, Texture, Wrap};
 use super::texture_budget::TextureBudget;
-use super::{shown, Aabb, LoadReport, Material, Mesh, Object, Scene, SceneError};
+use super::{short3, shown, Aabb, LoadReport, Material, Mesh, Object, Scene, SceneError};
 use map_options::MapStatement;
 
 mod corners;
@@ -140,8 +140,10 @@ pub fn load_into(
             let clamped = known.max(Vec3::ZERO).min(Vec3::splat(MAX_COLOR_FACTOR));
             if clamped != v {
                 report.warn(format!(
-                    "material `{material_name}`: {key} {v} taken as {clamped} (factors are \
-                     limited to [0, {MAX_COLOR_FACTOR}], the range the fp16 colour tier holds)"
+                    "material `{material_name}`: {key} {} taken as {} (factors are \
+                     limited to [0, {MAX_COLOR_FACTOR}], the range the fp16 colour tier holds)",
+                    short3(v),
+                    short3(clamped)
                 ));
             }
             clamped

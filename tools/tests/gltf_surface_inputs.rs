@@ -689,4 +689,19 @@ fn values_past_f32_are_warned_of_by_path() {
         "{}",
         maps.emissive
     );
+    // Finite and huge, the values are written short: `{}` wrote 3e38 in 39 digits.
+    let material = json!({
+        "normalTexture": {"index": 0, "scale": 3e38},
+        "emissiveFactor": [1.0, 0.5, 0.0],
+        "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 3e38}},
+    });
+    let mut plane = Plane::new(material);
+    plane.images.push(png(1, 1, &[[128, 128, 255, 255]]));
+    plane.extensions.push("KHR_materials_emissive_strength");
+    let path = plane.write(dir.path(), "finite.gltf");
+    let (_, warnings) = scene_of(&path, grazing_light(), 0.02);
+    let all = warnings.join("\n");
+    assert!(all.contains("normalTexture.scale: 3e38 taken as"), "{all}");
+    assert!(all.contains("strength [3e38, 1.5e38, 0] clamped"), "{all}");
+    assert!(!all.contains("00000000"), "{all}");
 }

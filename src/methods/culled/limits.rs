@@ -8,6 +8,7 @@ use crate::cluster::pack::{grid_fits_table, grid_texels, MAX_INDEXED_LIGHTS};
 use crate::gl::Device;
 use crate::methods::capacity::capacities;
 use crate::methods::FrameContext;
+use crate::scene::Short;
 use crate::Error;
 
 /// The assignment's limits: the context's cell and index-list capacities, lowered by
@@ -64,9 +65,10 @@ pub(super) fn check_grid(
             "deeper slices (grid.slice_depth), "
         };
         return Err(Error::Limit(format!(
-            "a {footprint_px} px cell footprint (grid.footprint_px) makes {} grid cells{caps}; \
+            "a {} px cell footprint (grid.footprint_px) makes {} grid cells{caps}; \
              this context's grid texture holds {}: use a larger footprint, {slices}or the \
              automatic grid",
+            Short(footprint_px),
             grid.total_cells,
             max_rows * DATA_TEXTURE_WIDTH as usize - (texels - grid.total_cells as usize)
         )));
@@ -75,9 +77,10 @@ pub(super) fn check_grid(
     // (16 384 rows of 1 024 texels hold 2²⁴ texels, table included).
     if let Some(what) = grid_fits_table(grid) {
         return Err(Error::Limit(format!(
-            "a {footprint_px} px cell footprint (grid.footprint_px) with these limits \
+            "a {} px cell footprint (grid.footprint_px) with these limits \
              (grid.max_tiles, grid.max_slices) makes {what}: use a larger footprint or the \
-             automatic grid"
+             automatic grid",
+            Short(footprint_px)
         )));
     }
     Ok(())

@@ -177,11 +177,17 @@ fn metallic_and_roughness_make_an_objects_materials_metallic_roughness() {
             r#"{"builtin": "plane", "metallic": 2, "roughness": 0}"#,
             "objects[0].metallic",
         ),
+        (
+            r#"{"builtin": "plane", "metallic": 0, "roughness": -1e300}"#,
+            "objects[0].roughness",
+        ),
     ] {
         let err = parse_str(&format!(r#"{{"objects": [{json}]}}"#))
             .unwrap_err()
             .to_string();
         assert!(err.contains(field), "{err}");
+        // Written short: `{}` wrote -1e300 in 301 digits.
+        assert!(err.len() < 200, "{err}");
     }
 }
 

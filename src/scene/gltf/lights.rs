@@ -28,7 +28,7 @@ use glam::{DMat4, DVec3, Vec3};
 use gltf::khr_lights_punctual::Kind;
 
 use crate::scene::camera::MAX_CAMERA_COORD;
-use crate::scene::{DirectionalLight, Light, LightKind};
+use crate::scene::{DirectionalLight, Light, LightKind, Short};
 
 /// The one scale of glTF's photometric units (candela, lux) to the renderer's intensity: in
 /// effect a default exposure of −11 EV for glTF files (see the module's notes).
@@ -101,7 +101,8 @@ pub(super) fn convert(
     let raw = light.intensity();
     if !raw.is_finite() || raw < 0.0 {
         return Err(format!(
-            "{field}: intensity must be finite and >= 0, got {raw}{}",
+            "{field}: intensity must be finite and >= 0, got {}{}",
+            Short(raw),
             past_f32(raw.is_infinite())
         ));
     }
@@ -173,7 +174,8 @@ pub(super) fn convert(
         Some(range) if range.is_finite() && range > 0.0 => range,
         Some(range) => {
             return Err(format!(
-                "{field}: range must be finite and > 0, got {range}{}",
+                "{field}: range must be finite and > 0, got {}{}",
+                Short(range),
                 past_f32(range.is_infinite())
             ))
         }

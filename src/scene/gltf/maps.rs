@@ -19,7 +19,7 @@ use crate::scene::mesh::MAX_TEXCOORD;
 use crate::scene::surface_maps::{
     MapTexture, SurfaceMaps, TextureTransform, MAX_EMISSIVE, MAX_NORMAL_SCALE,
 };
-use crate::scene::{shown, Texture};
+use crate::scene::{short3, shown, Short, Texture};
 
 /// The file's materials' `KHR_texture_transform` objects, as plain JSON. Only the texture
 /// infos' extensions are built: the rest of the document (`extras` too) is skipped, at any
@@ -308,8 +308,10 @@ pub(super) fn convert(
     let emissive = e.max(Vec3::ZERO).min(Vec3::splat(MAX_EMISSIVE));
     if emissive != e {
         warnings.push(format!(
-            "{field}: emissiveFactor × KHR_materials_emissive_strength {e} clamped to \
-             {emissive} (the fp16 colour tier's range)"
+            "{field}: emissiveFactor × KHR_materials_emissive_strength {} clamped to {} \
+             (the fp16 colour tier's range)",
+            short3(e),
+            short3(emissive)
         ));
     }
     maps.emissive = emissive;
@@ -343,8 +345,10 @@ fn kept_in(
     };
     if kept != value {
         warnings.push(format!(
-            "{path}: {value} taken as {kept} (its range is [{}, {}])",
-            range.0, range.1
+            "{path}: {} taken as {kept} (its range is [{}, {}])",
+            Short(value),
+            range.0,
+            range.1
         ));
     }
     kept

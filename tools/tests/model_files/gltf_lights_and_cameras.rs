@@ -384,6 +384,12 @@ fn light_values_past_f32_are_errors_naming_the_field_and_the_range() {
             "intensity",
             false,
         ),
+        (
+            json!({"type": "point", "intensity": -3.4e38}),
+            "intensity",
+            false,
+        ),
+        (json!({"type": "point", "range": -3.4e38}), "range", false),
     ];
     for (i, (light, field, past_f32)) in cases.into_iter().enumerate() {
         let path = write(
@@ -397,6 +403,8 @@ fn light_values_past_f32_are_errors_naming_the_field_and_the_range() {
             "{field}: {err}"
         );
         assert_eq!(err.contains("past f32's range"), past_f32, "{err}");
+        // A value is written short: `{}` wrote -3.4e38 in 39 digits.
+        assert!(!err.contains("00000000"), "{err}");
     }
 }
 

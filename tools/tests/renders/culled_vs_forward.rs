@@ -219,16 +219,21 @@ fn a_grid_the_texture_cannot_hold_is_a_clear_error() {
     }
     // At the default caps (256 tiles a side, 32 slices) one-pixel cells make 25 million cells
     // at any size, past a texture of 16 384 rows: the message says the caps bound the grid
-    // (every size reported the same count, as if a finer footprint added cells).
-    if gpu.r().caps().max_texture_size <= 16_384 {
+    // (every size reported the same count, as if a finer footprint added cells). A tiny
+    // footprint is written short (`{}` wrote 1e-30 in 32 digits).
+    for (footprint, shown) in [(1.0, "a 1 px"), (1e-30, "a 1e-30 px")] {
+        if gpu.r().caps().max_texture_size > 16_384 {
+            break;
+        }
         let capped = RenderOptions {
-            grid: GridConfig::fixed(1.0),
+            grid: GridConfig::fixed(footprint),
             ..RenderOptions::default()
         };
         match gpu.r().render_offscreen(&scene, 640, 360, &capped) {
-            Err(manylight::Error::Limit(message)) => {
-                assert!(message.contains("grid.max_tiles"), "{message}")
-            }
+            Err(manylight::Error::Limit(message)) => assert!(
+                message.contains("grid.max_tiles") && message.starts_with(shown),
+                "{message}"
+            ),
             other => panic!("expected a limit error, got {:?}", other.map(|_| ())),
         }
     }

@@ -152,6 +152,89 @@ fn every_unusable_option_is_refused_naming_its_field() {
     gpu.r().render_offscreen(&scene, 32, 18, &zero).unwrap();
 }
 
+/// A refusal quotes the value it refused written short: `{}` writes -1e300 in 301 digits and
+/// `f32::MAX` in 39, a line a log or a game's dialog cannot use.
+#[test]
+fn huge_and_tiny_refused_values_are_written_short() {
+    let scene = manylight::scene::builtin::build("plane", Some((8, 1))).unwrap();
+    let mut gpu = Gpu::new(EsVersion::Es3);
+    let grid = |g: manylight::GridConfig| RenderOptions {
+        grid: g,
+        ..Default::default()
+    };
+    let cases: Vec<(&str, &str, RenderOptions)> = vec![
+        (
+            "light_cutoff",
+            "-3.4028235e38",
+            RenderOptions {
+                light_cutoff: Some(f32::MIN),
+                ..Default::default()
+            },
+        ),
+        (
+            "tile_px",
+            "-1e300",
+            RenderOptions {
+                tile_px: -1e300,
+                ..Default::default()
+            },
+        ),
+        (
+            "heat_scale",
+            "1e-30",
+            RenderOptions {
+                heat_scale: 1e-30,
+                ..Default::default()
+            },
+        ),
+        (
+            "exposure_ev",
+            "1e30",
+            RenderOptions {
+                exposure_ev: 1e30,
+                ..Default::default()
+            },
+        ),
+        (
+            "grid.footprint_px",
+            "-1e300",
+            grid(manylight::GridConfig {
+                footprint_px: -1e300,
+                ..Default::default()
+            }),
+        ),
+        (
+            "grid.slice_depth",
+            "-1e-300",
+            grid(manylight::GridConfig {
+                slice_depth: -1e-300,
+                ..Default::default()
+            }),
+        ),
+        (
+            "grid.assign_budget",
+            "-1e300",
+            grid(manylight::GridConfig {
+                mode: manylight::GridMode::Auto {
+                    assign_budget: -1e300,
+                },
+                ..Default::default()
+            }),
+        ),
+    ];
+    gpu.r().set_method_named("clustered").unwrap();
+    for (field, shown, options) in cases {
+        let err = gpu
+            .r()
+            .render_offscreen(&scene, 32, 18, &options)
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains(field), "{err}");
+        assert!(err.ends_with(&format!("got {shown}")), "{field}: {err}");
+        assert!(err.len() < 120, "{field}: {} bytes: {err}", err.len());
+    }
+}
+
 /// `render_light_counts` counts: asked for colour (`None`, `Heatmap`) it refused nothing and
 /// returned the colour image read as counts.
 #[test]
