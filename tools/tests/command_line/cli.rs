@@ -1097,6 +1097,21 @@ fn timed_frames_report_their_spread() {
     let one = stats(&dir.path().join("one.json"));
     assert!(one["programs_built"].as_u64().unwrap() > 0, "{one}");
     assert_eq!(s["programs_built"], one["programs_built"]);
+    // Every timed frame of moving lights assigns and uploads its lists, the first too: it was
+    // posed at the warm-up frame's time and redrew its lists, so at the default two frames
+    // the median assignment read 0 ms and the median upload 0 bytes.
+    let out = manylight(
+        &["render", "--size", "32x18", "--stats", "two.json"],
+        &[],
+        dir.path(),
+    );
+    assert!(out.status.success(), "{}", text(&out));
+    let two = stats(&dir.path().join("two.json"));
+    let uploads = &two["upload_bytes_spread"];
+    assert_eq!(uploads["frames"], 2, "{two}");
+    assert!(uploads["p50"].as_f64().unwrap() > 0.0, "{uploads}");
+    assert!(two["assign_ms"].as_f64().unwrap() > 0.0, "{two}");
+    assert_eq!(two["lists_reused"], false, "{two}");
 }
 
 #[test]

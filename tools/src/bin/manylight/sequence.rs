@@ -30,6 +30,17 @@ impl Timeline {
     pub fn time_of(&self, k: u32) -> f64 {
         self.start_s + f64::from(k) / self.fps
     }
+
+    /// Animation time of the untimed warm-up frame: `start_s` without timed frames (it is then
+    /// the picture), else one frame before the first, so that the first assigns the lights it
+    /// shows as every later frame does (posed at the first's own time, it would redraw the
+    /// warm-up's lists without assigning).
+    pub fn warm_up_time(&self) -> f64 {
+        match self.frames {
+            0 => self.start_s,
+            _ => self.start_s - 1.0 / self.fps,
+        }
+    }
 }
 
 /// Where recorded frames go.
@@ -173,7 +184,8 @@ pub enum Keep<'a> {
 
 /// What a sequence produced.
 pub struct Rendered {
-    /// The warm-up frame, at `start_s`.
+    /// The picture at `start_s`: the first timed frame, or the warm-up frame where none is
+    /// timed.
     pub first: RgbaImage,
     /// The last timed frame where the caller asked for it and it did not go to the recording
     /// (kept without a copy: at 8192² a frame is 256 MiB).
@@ -183,9 +195,9 @@ pub struct Rendered {
     pub stats: FrameStats,
 }
 
-/// Renders the warm-up frame at `start_s` and then `timeline.frames` timed frames, each after
-/// `pose(scene, t)` (for instance [`Scene::set_time`]), recording them into `record` when
-/// given.
+/// Renders the warm-up frame (at [`Timeline::warm_up_time`]) and then `timeline.frames` timed
+/// frames, each after `pose(scene, t)` (for instance [`Scene::set_time`]), recording them into
+/// `record` when given.
 pub fn render(
     renderer: &mut Renderer,
     scene: &mut Scene,
@@ -207,20 +219,33 @@ pub fn render(
         Keep::Last | Keep::Stats => None,
     };
     let keep_last = matches!(keep, Keep::Last);
-    pose(scene, timeline.start_s);
-    // The warm-up frame compiles shaders and uploads meshes: its picture, not its time.
-    let (first, warm_up) = renderer.render_offscreen(scene, width, height, &one_frame)?;
+    pose(scene, timeline.warm_up_time());
+    // The warm-up frame compiles shaders and uploads meshes: not timed.
+    let (mut first, warm_up) = renderer.render_offscreen(scene, width, height, &one_frame)?;
     let mut last = None;
     let mut timed = Vec::with_capacity(timeline.frames.min(1 << 20) as usize);
     for k in 0..timeline.frames {
         pose(scene, timeline.time_of(k));
         let (image, s) = renderer.render_offscreen(scene, width, height, &one_frame)?;
+        timed.push(s);
+        let is_last = k + 1 == timeline.frames;
+        // Frame 0 is the picture: copied only where it goes on to the recording or `last`.
+        let image = match (k, &recorder) {
+            (0, None) if !(keep_last && is_last) => {
+                first = image;
+                continue;
+            }
+            (0, _) => {
+                first = image.clone();
+                image
+            }
+            _ => image,
+        };
         match &mut recorder {
             Some(r) => r.add(k, image, timeline.fps)?,
-            None if keep_last && k + 1 == timeline.frames => last = Some(image),
+            None if keep_last && is_last => last = Some(image),
             None => {}
         }
-        timed.push(s);
     }
     if let Some(recorder) = recorder {
         recorder.finish()?;
