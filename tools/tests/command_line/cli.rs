@@ -726,13 +726,19 @@ fn bench_lists_past_64_values_are_usage_errors() {
 #[test]
 fn the_command_lines_thread_is_one_of_the_assignment_pool() {
     let dir = tempfile::tempdir().unwrap();
-    for pool in [1, 3] {
+    for (pool, taken) in [(1, 1), (3, 3), (12, 8)] {
         let threads = pool.to_string();
         let env = [("RAYON_NUM_THREADS", threads.as_str())];
         let out = manylight(&["info", "--json"], &env, dir.path());
         assert!(out.status.success(), "{}", text(&out));
         let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
         assert_eq!(v["assign_pool"]["threads"], pool, "{}", v["assign_pool"]);
+        // One assignment takes at most 8 of them (MAX_ASSIGN_THREADS), and `info` says so.
+        let most = &v["assign_pool"]["most_an_assignment_takes"];
+        assert_eq!(*most, taken, "{}", v["assign_pool"]);
+        let out = manylight(&["info"], &env, dir.path());
+        let said = format!("up to {taken} CPU threads (of rayon's pool of {pool},");
+        assert!(text(&out).contains(&said), "{}", text(&out));
         assert_eq!(
             v["assign_pool"]["caller_in_pool"], true,
             "{}",

@@ -133,6 +133,7 @@ pub fn run(args: &InfoArgs) -> Result<(), Box<dyn std::error::Error>> {
             "mediump_is_fp16": fp16,
             "assign_pool": {
                 "threads": rayon::current_num_threads(),
+                "most_an_assignment_takes": assignment_threads(),
                 "caller_in_pool": caller_in_pool(),
             },
             "scene": report,
@@ -150,7 +151,8 @@ pub fn run(args: &InfoArgs) -> Result<(), Box<dyn std::error::Error>> {
             }
         ));
         text.push_str(&format!(
-            "light assignment     up to {} CPU threads (rayon's pool{})\n",
+            "light assignment     up to {} CPU threads (of rayon's pool of {}{})\n",
+            assignment_threads(),
             rayon::current_num_threads(),
             if caller_in_pool() {
                 ", this thread one of them"
@@ -342,4 +344,9 @@ fn format_scene_report(r: &serde_json::Value) -> String {
         );
     }
     out
+}
+
+/// The most threads of the pool one light assignment takes.
+fn assignment_threads() -> usize {
+    rayon::current_num_threads().min(manylight::cluster::assign::MAX_ASSIGN_THREADS)
 }
