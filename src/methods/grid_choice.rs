@@ -99,8 +99,9 @@ pub(crate) struct AutoGrid {
 impl AutoGrid {
     /// The grid settings for this frame: the current choice, or a new one when it is stale.
     ///
-    /// A grid is needed at once on the first frame and when the viewport, projection, near
-    /// plane or settings change: those choices measure every candidate in this frame (up to
+    /// A grid is needed at once on the first frame, when the viewport, projection, near
+    /// plane or settings change, and when the lights outgrew the grid
+    /// ([`AutoGrid::outgrown`]): those choices measure every candidate in this frame (up to
     /// thirteen assignments; the search's stops usually end it sooner). The others (the view
     /// or the lights moved, the period passed, the costs got calibrated) only refine a grid
     /// that works: they measure one candidate per frame, so no frame pays for many
@@ -172,6 +173,31 @@ impl AutoGrid {
             self.conclude(&inputs, layout, ctx);
         }
         self.choice.as_ref().expect("chosen on the first frame")
+    }
+
+    /// Whether the current grid no longer lists the frame's lights, so that the frame must
+    /// choose again at once: its assignment dropped `dropped` light references (`u64::MAX`:
+    /// could not list them), where the grid's own measurement when it was chosen, in an
+    /// earlier frame, dropped none. The lights changed under it (a few small lights became
+    /// many large ones), and waiting for the re-choice after a change would fail or darken
+    /// every frame until then. The next [`AutoGrid::config`] then chooses at once, as for a
+    /// new viewport. A grid chosen although it overflowed (every candidate did) is kept until
+    /// its re-choice is due: choosing again each frame would only find it again.
+    pub(crate) fn outgrown(&mut self, dropped: u64) -> bool {
+        let Some(choice) = &self.choice else {
+            return false;
+        };
+        let chosen = choice.config.footprint_px;
+        let fitted = choice
+            .candidates
+            .iter()
+            .find(|c| c.footprint_px == chosen)
+            .is_none_or(|c| c.overflowed_lights == 0);
+        let outgrown = dropped > 0 && fitted && self.frames_since_choice > 0;
+        if outgrown {
+            self.layout = None;
+        }
+        outgrown
     }
 
     /// Whether this frame's [`AutoGrid::config`] measured candidates, with the assigner it was
@@ -484,6 +510,57 @@ mod tests {
             (auto.costs.shade_ns - 6.0).abs() < 1e-9,
             "median of 5 and 7"
         );
+    }
+
+    /// A grid whose lists dropped nothing when it was chosen, and now drop references, is
+    /// chosen again at once (the next `config` is urgent); one chosen although it overflowed,
+    /// or chosen this very frame, is kept: choosing again would only find it again, each frame.
+    #[test]
+    fn only_a_grid_that_fitted_when_chosen_is_outgrown() {
+        use crate::cluster::auto_grid::{Candidate, GridChoice};
+        use crate::cluster::grid::GridConfig;
+        let with = |overflowed_lights: u64| {
+            let mut auto = AutoGrid::default();
+            let candidate = |footprint_px, overflowed_lights| Candidate {
+                footprint_px,
+                cells: 1,
+                indices: 1,
+                evals_per_pixel: 1.0,
+                bytes: 1,
+                predicted_ms: 1.0,
+                assign_ms: 0.1,
+                over_budget: false,
+                overflowed_lights,
+            };
+            auto.choice = Some(GridChoice {
+                config: GridConfig::fixed(16.0),
+                reason: String::new(),
+                candidates: vec![candidate(32.0, 0), candidate(16.0, overflowed_lights)],
+            });
+            auto.layout = Some(super::Layout {
+                size: (1, 1),
+                projection: crate::cluster::grid::GridProjection::from_matrix(
+                    &glam::DMat4::IDENTITY,
+                ),
+                near: 0,
+                base: GridConfig::default(),
+            });
+            auto.frames_since_choice = 3;
+            auto
+        };
+        let mut fitted = with(0);
+        assert!(!fitted.outgrown(0), "nothing dropped");
+        assert!(fitted.layout.is_some());
+        assert!(fitted.outgrown(7));
+        assert!(fitted.layout.is_none(), "the next choice is urgent");
+        assert!(with(0).outgrown(u64::MAX), "unlisted");
+        let mut overflowed = with(5);
+        assert!(!overflowed.outgrown(9));
+        assert!(overflowed.layout.is_some());
+        let mut just_chosen = with(0);
+        just_chosen.frames_since_choice = 0;
+        assert!(!just_chosen.outgrown(9));
+        assert!(!AutoGrid::default().outgrown(9), "no choice yet");
     }
 
     /// The hysteresis is skipped once, for the first calibrated choice after the priors' one,

@@ -28,18 +28,30 @@ pub(super) struct Assigned<'a> {
 }
 
 impl Assign {
-    /// Assigns `ctx.lights` to `grid`'s cells within `limits`.
+    /// Assigns `ctx.lights` to `grid`'s cells within `limits`: the time it took, and the
+    /// assignment ([`Assign::assigned`] takes it as the frame's).
     pub(super) fn run(
         &mut self,
-        method: &str,
         grid: &ClusterGrid,
         ctx: &FrameContext,
         limits: &AssignLimits,
-    ) -> Assigned<'_> {
+    ) -> (f64, &Assignment) {
         let started = Instant::now();
         self.holds_candidate = false;
         let assignment = self.assigner.assign(grid, ctx.lights, ctx.far, limits);
-        let ms = started.elapsed().as_secs_f64() * 1e3;
+        (started.elapsed().as_secs_f64() * 1e3, assignment)
+    }
+
+    /// The last [`Assign::run`]'s assignment, which took `ms`, as the frame's, with a warning
+    /// (once per method) where it drops light references.
+    pub(super) fn assigned(
+        &mut self,
+        method: &str,
+        ctx: &FrameContext,
+        limits: &AssignLimits,
+        ms: f64,
+    ) -> Assigned<'_> {
+        let assignment = self.assigner.assignment();
         let dropped = assignment.stats.overflowed_lights;
         // A frame refused for too many visible lights or references drops nothing: the
         // warning (once a renderer) is kept for one that draws.

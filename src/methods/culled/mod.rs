@@ -58,6 +58,17 @@ pub(crate) enum CulledFrame<'a> {
     Overflowed(u64),
 }
 
+/// What [`CulledForward::lists`] did.
+struct Lists {
+    /// What the lists are built from.
+    key: ListsKey,
+    /// The assignment's time.
+    ms: f64,
+    /// `None`: the last frame's lists are this frame's. Else light references the assignment
+    /// dropped: overflowed, or `u64::MAX` where it could not list them.
+    dropped: Option<u64>,
+}
+
 /// Tiled or clustered forward.
 pub struct CulledForward {
     culling: Culling,
@@ -118,18 +129,18 @@ impl CulledForward {
 
         let limits = limits::assign_limits(ctx);
         self.update_grid(ctx, &limits, grid_encoding);
+        let mut lists = self.lists(ctx, &limits)?;
+        if let Some(dropped) = lists.dropped.filter(|_| automatic) {
+            if self.auto.outgrown(dropped) {
+                self.update_grid(ctx, &limits, grid_encoding);
+                lists = self.lists(ctx, &limits)?;
+            }
+        }
         self.write_grid_reason(ctx);
         let (grid_key, grid) = self.grid.as_ref().expect("updated above");
-        limits::check_grid(ctx.dev, grid, &grid_key.config)?;
-        let key = ListsKey {
-            lights_generation: ctx.lights_generation,
-            grid_generation: self.grid_generation,
-            far: ctx.far.to_bits(),
-            limits,
-            layout: ctx.features.light_layout(),
-        };
-        // A still frame (nothing the lists depend on changed) draws with the last ones.
-        let reused = (self.lists_key == Some(key))
+        let reused = lists
+            .dropped
+            .is_none()
             .then(|| self.assign.reuse().zip(self.upload.last_upload()))
             .flatten();
         let (assigned, uploaded) = match reused {
@@ -141,16 +152,14 @@ impl CulledForward {
                 (assigned, uploaded)
             }
             None => {
-                // Cleared first: a refused frame leaves the assigner holding other lists.
-                self.lists_key = None;
-                let assigned = self.assign.run(method, grid, ctx, &limits);
+                let assigned = self.assign.assigned(method, ctx, &limits, lists.ms);
                 if let Some(frame) = refused(assigned.assignment, refuse_overflow) {
                     return Ok(frame);
                 }
                 let uploaded = self
                     .upload
                     .pack_and_upload(ctx, grid, assigned.assignment)?;
-                self.lists_key = Some(key);
+                self.lists_key = Some(lists.key);
                 (assigned, uploaded)
             }
         };
@@ -182,6 +191,44 @@ impl CulledForward {
             }),
             ..MethodStats::default()
         }))
+    }
+
+    /// The frame's light lists on the current grid: the last frame's where nothing they are
+    /// built from changed, else assigned now. Borrows nothing, so that the automatic grid can
+    /// choose again and the lists be assigned again where its choice no longer lists them.
+    fn lists(&mut self, ctx: &FrameContext, limits: &AssignLimits) -> Result<Lists, Error> {
+        let (grid_key, grid) = self.grid.as_ref().expect("updated before");
+        limits::check_grid(ctx.dev, grid, &grid_key.config)?;
+        let key = ListsKey {
+            lights_generation: ctx.lights_generation,
+            grid_generation: self.grid_generation,
+            far: ctx.far.to_bits(),
+            limits: *limits,
+            layout: ctx.features.light_layout(),
+        };
+        // A still frame (nothing the lists depend on changed) draws with the last ones.
+        let still = self.lists_key == Some(key)
+            && self.assign.last().is_some()
+            && self.upload.last_upload().is_some();
+        if still {
+            return Ok(Lists {
+                key,
+                ms: 0.0,
+                dropped: None,
+            });
+        }
+        // Cleared first: a refused frame leaves the assigner holding other lists.
+        self.lists_key = None;
+        let (ms, assignment) = self.assign.run(grid, ctx, limits);
+        let dropped = match assignment.unlisted {
+            Some(_) => u64::MAX,
+            None => assignment.stats.overflowed_lights,
+        };
+        Ok(Lists {
+            key,
+            ms,
+            dropped: Some(dropped),
+        })
     }
 
     /// Whether this frame's grid is the automatic one.

@@ -14,6 +14,7 @@ mod directional_lights;
 mod front_faces;
 mod game_draw_buffers;
 mod game_framebuffer_checks;
+mod grid_outgrown;
 mod invalid_options;
 mod keep_framebuffer;
 mod light_evals;
