@@ -7,7 +7,7 @@
 #include "directional.glsl"
 #include "cluster_lookup.glsl"
 
-VARYING HIGHP vec3 v_viewPos;
+CENTROID VARYING HIGHP vec3 v_viewPos;
 #if UNIFORM_LIGHT_LOOP
 // The longest cell list of the frame (the loop bound of the driver workaround).
 uniform HIGHP float u_longestList;

@@ -7,7 +7,7 @@
 #include "light_model.glsl"
 #include "directional.glsl"
 
-VARYING HIGHP vec3 v_viewPos;
+CENTROID VARYING HIGHP vec3 v_viewPos;
 VARYING vec3 v_normal;
 VARYING vec2 v_uv;
 

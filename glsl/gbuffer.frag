@@ -3,7 +3,7 @@
 #include "surface.glsl"
 #include "deferred_common.glsl"
 
-VARYING HIGHP vec3 v_viewPos;
+CENTROID VARYING HIGHP vec3 v_viewPos;
 VARYING vec3 v_normal;
 VARYING vec2 v_uv;
 

@@ -19,7 +19,9 @@ uniform mat4 u_modelView;
 uniform mat3 u_normalMatrix;
 uniform mat4 u_projection;
 
-VARYING vec3 v_viewPos;
+// Centroid (ES 3.0): with MSAA a pixel an edge crosses is shaded at a point of the triangle,
+// not at the pixel's centre off it, where the position runs far past the scene (and its cells).
+CENTROID VARYING vec3 v_viewPos;
 // The depth prepass and the shading pass are different programs: `invariant` guarantees they
 // compute bit-identical depths, so the shading pass's LEQUAL test passes exactly once.
 invariant gl_Position;

@@ -121,3 +121,76 @@ fn stats_name_the_samples_gl_gave() {
     }
     renderer.destroy();
 }
+
+/// A floor seen nearly edge-on with MSAA: a pixel its edge crosses is shaded once, and without
+/// `centroid` at the pixel's centre, off the triangle, where the interpolated position lies
+/// far beyond the scene's depths, past the grid's cells. Forward shaded that point with every
+/// light and tiled and clustered with the clamped cell's: 4/255 apart on pixels along the
+/// floor's far edge. Shaded inside the triangle (ES 3.0's `centroid`), they agree.
+#[test]
+fn a_floor_seen_edge_on_is_shaded_inside_its_triangles() {
+    use glam::{DMat4, DVec3, Vec3};
+    use manylight::scene::meshbuild::MeshBuilder;
+    let mut scene = manylight::Scene::empty();
+    let m = scene.add_material(manylight::Material::flat("floor", Vec3::splat(0.7)));
+    let mut floor = MeshBuilder::new();
+    let c = |x, z| Vec3::new(x, 0.0, z);
+    floor.quad(c(-6.0, 6.0), c(6.0, 6.0), c(6.0, -6.0), c(-6.0, -6.0));
+    scene.add_object(floor.build().unwrap(), m, DMat4::IDENTITY);
+    scene.lights = (0..60)
+        .map(|i| {
+            let f = i as f64;
+            let at = DVec3::new(
+                (f * 0.7).sin() * 5.0,
+                0.4 + (f * 0.3).cos().abs(),
+                (f * 0.13).cos() * 5.0,
+            );
+            let colour = Vec3::new(
+                0.5 + 0.5 * (f * 1.1).sin() as f32,
+                0.5 + 0.5 * (f * 1.7).cos() as f32,
+                0.5 + 0.5 * (f * 2.3).sin() as f32,
+            );
+            manylight::Light::point(at, 2.5, colour, 1.2)
+        })
+        .collect();
+    scene.camera = manylight::Camera {
+        position: DVec3::new(0.0, 0.05, 3.0),
+        target: DVec3::ZERO,
+        up: DVec3::Y,
+        projection: manylight::Projection::Orthographic {
+            height: 5.0,
+            near: 1.0,
+            far: 15.0,
+        },
+    };
+    let options = RenderOptions {
+        linear: true,
+        tone_map: manylight::ToneMap::Aces,
+        exposure_ev: 1.0,
+        tile_px: 8.0,
+        grid: manylight::GridConfig::fixed(8.0),
+        ..msaa(4)
+    };
+    let mut gpu = Gpu::new(EsVersion::Es3);
+    // SwiftShader interpolates a centroid varying at the pixel's centre all the same (its
+    // forward frame is the same with and without): its gap stays (docs/drivers.md).
+    let most = match gpu.r().caps().implementation().as_str() {
+        "SwiftShader" => 8,
+        _ => 2,
+    };
+    gpu.r().set_method_named("forward").unwrap();
+    let reference = gpu.render(&scene, 96, 64, &options);
+    for method in ["tiled", "clustered"] {
+        gpu.r().set_method_named(method).unwrap();
+        let got = gpu.render(&scene, 96, 64, &options);
+        let (worst, count) = got
+            .pixels()
+            .zip(reference.pixels())
+            .map(|(a, b)| (0..3).map(|c| a[c].abs_diff(b[c])).max().unwrap())
+            .fold((0, 0), |(w, n), d| (w.max(d), n + usize::from(d > 2)));
+        assert!(
+            worst <= most,
+            "{method}: {worst}/255 from forward on {count} pixels"
+        );
+    }
+}
