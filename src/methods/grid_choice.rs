@@ -94,6 +94,8 @@ pub(crate) struct AutoGrid {
     choice_from_priors: bool,
     /// A surface sample was cut short by its work bound, and a warning said so.
     sample_cut_said: bool,
+    /// Frames since the lights last outgrew a grid ([`AutoGrid::outgrown`]; `None`: never).
+    frames_since_outgrown: Option<u32>,
 }
 
 impl AutoGrid {
@@ -137,6 +139,9 @@ impl AutoGrid {
             encoding,
         };
         self.frames_since_choice += 1;
+        if let Some(n) = &mut self.frames_since_outgrown {
+            *n = n.saturating_add(1);
+        }
         let urgent = self.choice.is_none() || self.layout.as_ref() != Some(&layout);
         if urgent {
             self.sample(ctx);
@@ -177,12 +182,16 @@ impl AutoGrid {
 
     /// Whether the current grid no longer lists the frame's lights, so that the frame must
     /// choose again at once: its assignment dropped `dropped` light references (`u64::MAX`:
-    /// could not list them), where the grid's own measurement when it was chosen, in an
-    /// earlier frame, dropped none. The lights changed under it (a few small lights became
-    /// many large ones), and waiting for the re-choice after a change would fail or darken
-    /// every frame until then. The next [`AutoGrid::config`] then chooses at once, as for a
-    /// new viewport. A grid chosen although it overflowed (every candidate did) is kept until
-    /// its re-choice is due: choosing again each frame would only find it again.
+    /// could not list them), where the grid's own measurement when it was chosen dropped none.
+    /// The lights changed under it (a few small lights became many large ones), and waiting
+    /// for the re-choice after a change would fail or darken every frame until then. The next
+    /// [`AutoGrid::config`] then chooses at once, as for a new viewport, measuring every
+    /// candidate with this frame's lights: the grid it takes drops what its measurement says,
+    /// so it is not outgrown in turn. A grid chosen although it overflowed (every candidate
+    /// did), or without a measurement of its own, is kept until its re-choice is due. Lights
+    /// moving about the edge of what a grid lists would make every frame such a search: one
+    /// that drops references chooses again at most once in [`RECHOOSE_AFTER_CHANGE`] frames
+    /// (one that cannot list them, and so would fail, always).
     pub(crate) fn outgrown(&mut self, dropped: u64) -> bool {
         let Some(choice) = &self.choice else {
             return false;
@@ -192,10 +201,14 @@ impl AutoGrid {
             .candidates
             .iter()
             .find(|c| c.footprint_px == chosen)
-            .is_none_or(|c| c.overflowed_lights == 0);
-        let outgrown = dropped > 0 && fitted && self.frames_since_choice > 0;
+            .is_some_and(|c| c.overflowed_lights == 0);
+        let lately = self
+            .frames_since_outgrown
+            .is_some_and(|n| n < RECHOOSE_AFTER_CHANGE);
+        let outgrown = dropped > 0 && fitted && (dropped == u64::MAX || !lately);
         if outgrown {
             self.layout = None;
+            self.frames_since_outgrown = Some(0);
         }
         outgrown
     }
@@ -514,7 +527,7 @@ mod tests {
 
     /// A grid whose lists dropped nothing when it was chosen, and now drop references, is
     /// chosen again at once (the next `config` is urgent); one chosen although it overflowed,
-    /// or chosen this very frame, is kept: choosing again would only find it again, each frame.
+    /// or never measured, is kept: choosing again would only find it again, each frame.
     #[test]
     fn only_a_grid_that_fitted_when_chosen_is_outgrown() {
         use crate::cluster::auto_grid::{Candidate, GridChoice};
@@ -545,7 +558,6 @@ mod tests {
                 near: 0,
                 base: GridConfig::default(),
             });
-            auto.frames_since_choice = 3;
             auto
         };
         let mut fitted = with(0);
@@ -553,13 +565,18 @@ mod tests {
         assert!(fitted.layout.is_some());
         assert!(fitted.outgrown(7));
         assert!(fitted.layout.is_none(), "the next choice is urgent");
+        // Once in 30 frames for dropped references; always where none could be listed.
+        assert!(!fitted.outgrown(7), "again at once");
+        assert!(fitted.outgrown(u64::MAX));
+        fitted.frames_since_outgrown = Some(super::RECHOOSE_AFTER_CHANGE);
+        assert!(fitted.outgrown(7));
         assert!(with(0).outgrown(u64::MAX), "unlisted");
         let mut overflowed = with(5);
         assert!(!overflowed.outgrown(9));
         assert!(overflowed.layout.is_some());
-        let mut just_chosen = with(0);
-        just_chosen.frames_since_choice = 0;
-        assert!(!just_chosen.outgrown(9));
+        let mut unmeasured = with(0);
+        unmeasured.choice.as_mut().unwrap().candidates.pop();
+        assert!(!unmeasured.outgrown(9));
         assert!(!AutoGrid::default().outgrown(9), "no choice yet");
     }
 

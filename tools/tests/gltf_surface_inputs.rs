@@ -691,6 +691,7 @@ fn values_past_f32_are_warned_of_by_path() {
     );
     // Finite and huge, the values are written short: `{}` wrote 3e38 in 39 digits.
     let material = json!({
+        "pbrMetallicRoughness": {"baseColorFactor": [3e38, 0.5, 0.5, 1.0]},
         "normalTexture": {"index": 0, "scale": 3e38},
         "emissiveFactor": [1.0, 0.5, 0.0],
         "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 3e38}},
@@ -703,5 +704,9 @@ fn values_past_f32_are_warned_of_by_path() {
     let all = warnings.join("\n");
     assert!(all.contains("normalTexture.scale: 3e38 taken as"), "{all}");
     assert!(all.contains("strength [3e38, 1.5e38, 0] clamped"), "{all}");
+    assert!(
+        all.contains("baseColorFactor [3e38, 0.5, 0.5] clamped to [1024, 0.5, 0.5]"),
+        "{all}"
+    );
     assert!(!all.contains("00000000"), "{all}");
 }

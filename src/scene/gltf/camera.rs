@@ -9,7 +9,7 @@ use glam::{DMat4, DVec3};
 use gltf::camera::Projection as GltfProjection;
 
 use crate::scene::camera::{MIN_FOV_Y_DEG, MIN_ORTHO_HEIGHT};
-use crate::scene::{Camera, Projection};
+use crate::scene::{Camera, Projection, Short};
 
 /// Converts `camera` of `document` on a node with world transform `world`; `field` names it
 /// in errors.
@@ -122,7 +122,7 @@ fn check_projection(projection: &GltfProjection, index: usize) -> Result<(), Str
                     format!(
                         "must be finite with a magnitude of at least {:e}, got {}",
                         MIN_ORTHO_HEIGHT / 2.0,
-                        o.ymag()
+                        Short(o.ymag())
                     ),
                 );
             }

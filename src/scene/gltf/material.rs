@@ -35,7 +35,7 @@ use super::texture::Textures;
 use crate::scene::material::MAX_COLOR_FACTOR;
 use crate::scene::shown;
 use crate::scene::texture_budget::TextureBudget;
-use crate::scene::Material;
+use crate::scene::{short3, Material};
 
 /// Specular reflectance of dielectrics (4 %), the `specular` every glTF material gets.
 pub const DIELECTRIC_SPECULAR: f32 = 0.04;
@@ -200,8 +200,10 @@ impl Materials {
         let diffuse = base.max(Vec3::ZERO).min(Vec3::splat(MAX_COLOR_FACTOR));
         if diffuse != base {
             warnings.push(format!(
-                "{field} (`{name}`): baseColorFactor {base} clamped to {diffuse} (factors are \
-                 limited to [0, {MAX_COLOR_FACTOR}], the range the fp16 colour tier holds)"
+                "{field} (`{name}`): baseColorFactor {} clamped to {} (factors are \
+                 limited to [0, {MAX_COLOR_FACTOR}], the range the fp16 colour tier holds)",
+                short3(base),
+                short3(diffuse)
             ));
         }
         let factor_alpha = factor_alpha(m);

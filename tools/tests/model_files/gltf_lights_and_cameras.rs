@@ -252,6 +252,8 @@ fn cameras_perspective_with_infinite_far_and_orthographic() {
         let said = report.warnings.join("\n");
         assert!(said.contains(named), "{named}: {said}");
         assert!(said.contains("this camera is not used"), "{said}");
+        // A value is written short: `{}` wrote ymag 1e-9 as 0.000000001.
+        assert!(!said.contains("00000000"), "{said}");
         assert!(
             !said.contains("camera.fov_y_deg") && !said.contains("camera.far"),
             "{said}"
