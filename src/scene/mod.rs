@@ -98,7 +98,23 @@ pub(crate) fn short3(v: Vec3) -> String {
 
 /// Most a transform's last row may differ from `0 0 0 1` (exporters and inverses round) before
 /// it is refused as not affine.
-pub(crate) const AFFINE_TOLERANCE: f64 = 1e-6;
+const AFFINE_TOLERANCE: f64 = 1e-6;
+
+/// Where `m`'s last row is not `0 0 0 1` (within [`AFFINE_TOLERANCE`]), the refusal's reason:
+/// `last row … , must be 0 0 0 1`. A projective transform puts vertices at w ≠ 1 (a last row
+/// of zeros, at infinity): a wrong picture or none.
+pub(crate) fn not_affine(m: &DMat4) -> Option<String> {
+    let last = m.row(3);
+    ((last - DVec4::W).abs().max_element() > AFFINE_TOLERANCE).then(|| {
+        format!(
+            "last row {} {} {} {}, must be 0 0 0 1",
+            Short(last.x),
+            Short(last.y),
+            Short(last.z),
+            Short(last.w)
+        )
+    })
+}
 
 /// One placed mesh: shared geometry, its material and a model transform (`f64`, so objects
 /// can be placed far from the origin).
@@ -405,19 +421,10 @@ impl Scene {
                     "must be finite",
                 ));
             }
-            // A projective one puts its vertices at w ≠ 1 (a last row of zeros, at infinity):
-            // a wrong picture or none.
-            let last = o.transform.row(3);
-            if (last - DVec4::W).abs().max_element() > AFFINE_TOLERANCE {
+            if let Some(row) = not_affine(&o.transform) {
                 return Err(SceneError::invalid(
                     format!("objects[{i}].transform"),
-                    format!(
-                        "must be affine (last row {} {} {} {}, must be 0 0 0 1)",
-                        Short(last.x),
-                        Short(last.y),
-                        Short(last.z),
-                        Short(last.w)
-                    ),
+                    format!("must be affine ({row})"),
                 ));
             }
         }

@@ -6,7 +6,7 @@
 use glam::{DMat4, DQuat, DVec3};
 use serde::Deserialize;
 
-use crate::scene::Short;
+use crate::scene::not_affine;
 
 #[derive(Deserialize)]
 struct RawRoot {
@@ -69,15 +69,8 @@ fn matrix(m: &[f64; 16]) -> Result<DMat4, String> {
     if !m.is_finite() {
         return Err("must be finite".into());
     }
-    let last = m.row(3);
-    if (last - glam::DVec4::W).abs().max_element() > crate::scene::AFFINE_TOLERANCE {
-        return Err(format!(
-            "not an affine transform (last row {} {} {} {}, must be 0 0 0 1)",
-            Short(last.x),
-            Short(last.y),
-            Short(last.z),
-            Short(last.w)
-        ));
+    if let Some(row) = not_affine(&m) {
+        return Err(format!("not an affine transform ({row})"));
     }
     for col in [&mut m.x_axis, &mut m.y_axis, &mut m.z_axis] {
         col.w = 0.0;
