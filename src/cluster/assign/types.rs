@@ -181,6 +181,15 @@ pub struct Assignment {
 }
 
 impl Assignment {
+    /// Light references these lists leave out: those the overflow policy dropped, or
+    /// `u64::MAX` where none could be listed ([`Assignment::unlisted`]), worse than any lists.
+    pub(crate) fn dropped_references(&self) -> u64 {
+        match self.unlisted {
+            Some(_) => u64::MAX,
+            None => self.stats.overflowed_lights,
+        }
+    }
+
     /// No lists: every one of `cells` cells empty (offsets and counts 0), no indices.
     pub(super) fn empty_lists(&mut self, cells: usize) {
         self.indices.clear();

@@ -92,13 +92,9 @@ impl ChoiceSearch {
             predicted_ms: costs.predict_ms(evals_per_pixel * covered, work, bytes as f64),
             assign_ms: costs.assign_ms(work),
             over_budget: false,
-            // Unlisted (too many references to build): worse than any grid that lists, and
+            // Unlisted (too many references to build) is worse than any grid that lists, and
             // finer grids only list more.
-            overflowed_lights: if a.unlisted.is_some() {
-                u64::MAX
-            } else {
-                a.stats.overflowed_lights
-            },
+            overflowed_lights: a.dropped_references(),
         };
         let unlisted = a.unlisted.is_some();
         // A NaN budget (refused by the renderer) keeps every grid in.

@@ -220,14 +220,10 @@ impl CulledForward {
         // Cleared first: a refused frame leaves the assigner holding other lists.
         self.lists_key = None;
         let (ms, assignment) = self.assign.run(grid, ctx, limits);
-        let dropped = match assignment.unlisted {
-            Some(_) => u64::MAX,
-            None => assignment.stats.overflowed_lights,
-        };
         Ok(Lists {
             key,
             ms,
-            dropped: Some(dropped),
+            dropped: Some(assignment.dropped_references()),
         })
     }
 
