@@ -359,6 +359,18 @@ fn not_applicable_on_another_implementation(why: impl FnOnce(&str) -> String) ->
     }
 }
 
+/// A scene of one grey floor, 12 m square at y = 0 around the origin: no lights, the default
+/// camera.
+pub fn floor_12m() -> Scene {
+    let mut s = Scene::empty();
+    let grey = s.add_material(Material::flat("floor", Vec3::splat(0.7)));
+    let mut floor = MeshBuilder::new();
+    let c = |x, z| Vec3::new(x, 0.0, z);
+    floor.quad(c(-6.0, 6.0), c(6.0, 6.0), c(6.0, -6.0), c(-6.0, -6.0));
+    s.add_object(floor.build().unwrap(), grey, DMat4::IDENTITY);
+    s
+}
+
 /// A white square turned 30° about the view axis on black, lit by ambient light alone: each
 /// pixel's value is its coverage.
 pub fn turned_square() -> Scene {

@@ -9,9 +9,8 @@
 use crate::common;
 
 use common::Gpu;
-use glam::{DMat4, DVec3, Vec3};
-use manylight::scene::meshbuild::MeshBuilder;
-use manylight::{Camera, EsVersion, Light, Material, MeasureOptions, RenderOptions, Scene};
+use glam::{DVec3, Vec3};
+use manylight::{Camera, EsVersion, Light, MeasureOptions, RenderOptions, Scene};
 
 const SIZE: (u32, u32) = (96, 54);
 
@@ -20,12 +19,7 @@ const SIZE: (u32, u32) = (96, 54);
 const BUDGET: usize = 40_000;
 
 fn floor_lit_by(count: usize, radius: f32) -> Scene {
-    let mut s = Scene::empty();
-    let m = s.add_material(Material::flat("floor", Vec3::splat(0.7)));
-    let mut floor = MeshBuilder::new();
-    let c = |x, z| Vec3::new(x, 0.0, z);
-    floor.quad(c(-6.0, 6.0), c(6.0, 6.0), c(6.0, -6.0), c(-6.0, -6.0));
-    s.add_object(floor.build().unwrap(), m, DMat4::IDENTITY);
+    let mut s = common::floor_12m();
     let side = (count as f64).sqrt().ceil() as usize;
     s.lights = (0..count)
         .map(|i| {

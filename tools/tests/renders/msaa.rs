@@ -129,14 +129,8 @@ fn stats_name_the_samples_gl_gave() {
 /// floor's far edge. Shaded inside the triangle (ES 3.0's `centroid`), they agree.
 #[test]
 fn a_floor_seen_edge_on_is_shaded_inside_its_triangles() {
-    use glam::{DMat4, DVec3, Vec3};
-    use manylight::scene::meshbuild::MeshBuilder;
-    let mut scene = manylight::Scene::empty();
-    let m = scene.add_material(manylight::Material::flat("floor", Vec3::splat(0.7)));
-    let mut floor = MeshBuilder::new();
-    let c = |x, z| Vec3::new(x, 0.0, z);
-    floor.quad(c(-6.0, 6.0), c(6.0, 6.0), c(6.0, -6.0), c(-6.0, -6.0));
-    scene.add_object(floor.build().unwrap(), m, DMat4::IDENTITY);
+    use glam::{DVec3, Vec3};
+    let mut scene = common::floor_12m();
     scene.lights = (0..60)
         .map(|i| {
             let f = i as f64;
