@@ -256,27 +256,32 @@ const ES2_FRAGMENT_MEDIUMP_ONLY: &str = "#version 100\n#define GLSL_ES 100\n#def
 fn prelude(stage: Stage, dialect: EsVersion, mrt: bool) -> &'static str {
     match (dialect, stage) {
         (EsVersion::Es3, Stage::Fragment) if mrt => {
-            "#version 300 es\n#define GLSL_ES 300\n#define CENTROID centroid\nprecision highp float;\nprecision highp int;\n\
+            "#version 300 es\n#define GLSL_ES 300\n#define CENTROID centroid\n\
+             precision highp float;\nprecision highp int;\n\
              #define HIGHP highp\n#define VARYING in\n#define TEXTURE2D texture\n"
         }
         (EsVersion::Es2, Stage::Vertex) => {
-            "#version 100\n#define GLSL_ES 100\n#define CENTROID\nprecision highp float;\nprecision highp int;\n\
+            "#version 100\n#define GLSL_ES 100\n#define CENTROID\n\
+             precision highp float;\nprecision highp int;\n\
              #define HIGHP highp\n#define ATTRIBUTE attribute\n#define VARYING varying\n"
         }
         (EsVersion::Es3, Stage::Vertex) => {
-            "#version 300 es\n#define GLSL_ES 300\n#define CENTROID centroid\nprecision highp float;\nprecision highp int;\n\
+            "#version 300 es\n#define GLSL_ES 300\n#define CENTROID centroid\n\
+             precision highp float;\nprecision highp int;\n\
              #define HIGHP highp\n#define ATTRIBUTE in\n#define VARYING out\n"
         }
         // ES 2.0 fragment stages may lack highp; everything then runs at mediump (see
         // ES2_FRAGMENT_MEDIUMP_ONLY), which the caps report and the stability tests measure.
         (EsVersion::Es2, Stage::Fragment) => {
-            "#version 100\n#define GLSL_ES 100\n#define CENTROID\n#ifdef GL_FRAGMENT_PRECISION_HIGH\n\
+            "#version 100\n#define GLSL_ES 100\n#define CENTROID\n\
+             #ifdef GL_FRAGMENT_PRECISION_HIGH\n\
              precision highp float;\nprecision highp int;\n#define HIGHP highp\n#else\n\
              precision mediump float;\nprecision mediump int;\n#define HIGHP mediump\n#endif\n\
              #define VARYING varying\n#define TEXTURE2D texture2D\n#define FRAG_COLOR gl_FragColor\n"
         }
         (EsVersion::Es3, Stage::Fragment) => {
-            "#version 300 es\n#define GLSL_ES 300\n#define CENTROID centroid\nprecision highp float;\nprecision highp int;\n\
+            "#version 300 es\n#define GLSL_ES 300\n#define CENTROID centroid\n\
+             precision highp float;\nprecision highp int;\n\
              #define HIGHP highp\n#define VARYING in\n#define TEXTURE2D texture\n\
              out vec4 o_color;\n#define FRAG_COLOR o_color\n"
         }
