@@ -19,7 +19,7 @@ use std::sync::{Arc, Mutex, OnceLock};
 
 use glam::{DMat4, DVec3, Vec3};
 use manylight::scene::meshbuild::MeshBuilder;
-use manylight::scene::{Camera, Material, Object, Scene};
+use manylight::scene::{Camera, Cone, Light, Material, Object, Scene};
 use manylight::{EsVersion, RenderOptions, Renderer};
 
 /// A headless context and a new renderer on it. The context, and the programs the renderers
@@ -368,6 +368,26 @@ pub fn floor_12m() -> Scene {
     let c = |x, z| Vec3::new(x, 0.0, z);
     floor.quad(c(-6.0, 6.0), c(6.0, 6.0), c(6.0, -6.0), c(-6.0, -6.0));
     s.add_object(floor.build().unwrap(), grey, DMat4::IDENTITY);
+    s
+}
+
+/// The built-in pillars under `count` (at least 8) small warm lights that stand still, the
+/// eighth a spot pointing down.
+pub fn pillars_lit(count: usize) -> Scene {
+    let mut s = manylight::scene::builtin::build("pillars", None).unwrap();
+    s.lights = (0..count)
+        .map(|i| {
+            let f = i as f64;
+            let at = DVec3::new((f * 0.7).sin() * 10.0, 0.6, (f * 0.13).cos() * 12.0);
+            Light::point(at, 3.5, Vec3::new(1.0, 0.8, 0.5), 1.5)
+        })
+        .collect();
+    let cone = Cone {
+        direction: DVec3::NEG_Y,
+        inner_deg: 25.0,
+        outer_deg: 40.0,
+    };
+    s.lights[7] = Light::spot(DVec3::new(1.0, 3.0, 2.0), 6.0, Vec3::ONE, 2.0, cone);
     s
 }
 

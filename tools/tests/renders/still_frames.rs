@@ -16,21 +16,7 @@ const CULLED: [&str; 3] = ["tiled", "clustered", "auto"];
 
 /// The pillars under 60 lights (more than `auto` draws with forward), one of them a spot.
 fn still_scene() -> Scene {
-    let mut s = scene::builtin::build("pillars", None).unwrap();
-    s.lights = (0..60)
-        .map(|i| {
-            let f = i as f64;
-            let at = DVec3::new((f * 0.7).sin() * 10.0, 0.6, (f * 0.13).cos() * 12.0);
-            Light::point(at, 3.5, Vec3::new(1.0, 0.8, 0.5), 1.5)
-        })
-        .collect();
-    let cone = scene::Cone {
-        direction: DVec3::NEG_Y,
-        inner_deg: 25.0,
-        outer_deg: 40.0,
-    };
-    s.lights[7] = Light::spot(DVec3::new(1.0, 3.0, 2.0), 6.0, Vec3::ONE, 2.0, cone);
-    s
+    super::common::pillars_lit(60)
 }
 
 /// A fixed grid, so that a renderer with nothing to reuse builds the very same one.

@@ -5,7 +5,7 @@
 
 use glam::{DMat4, DVec3, Vec3};
 use manylight::cluster::grid::GridConfig;
-use manylight::scene::{self, Light, Projection, Scene};
+use manylight::scene::{Light, Projection, Scene};
 use manylight::{EsVersion, FrameStats, MeasureOptions, RenderOptions};
 
 use super::common::Gpu;
@@ -22,20 +22,7 @@ const RECORDS: [(&str, EsVersion); 3] = [
 /// The pillars under 40 lights, one a spot, with one material see-through: deferred draws
 /// its objects with forward.
 fn still_scene() -> Scene {
-    let mut s = scene::builtin::build("pillars", None).unwrap();
-    s.lights = (0..40)
-        .map(|i| {
-            let f = i as f64;
-            let at = DVec3::new((f * 0.7).sin() * 10.0, 0.6, (f * 0.13).cos() * 12.0);
-            Light::point(at, 3.5, Vec3::new(1.0, 0.8, 0.5), 1.5)
-        })
-        .collect();
-    let cone = scene::Cone {
-        direction: DVec3::NEG_Y,
-        inner_deg: 25.0,
-        outer_deg: 40.0,
-    };
-    s.lights[7] = Light::spot(DVec3::new(1.0, 3.0, 2.0), 6.0, Vec3::ONE, 2.0, cone);
+    let mut s = super::common::pillars_lit(40);
     let last = s.materials.len() - 1;
     assert!(last > 0, "the pillars have one material");
     s.materials[last].alpha = 0.6;
