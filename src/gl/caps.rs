@@ -12,9 +12,9 @@ use super::{EsVersion, GlError};
 /// A shader precision as `glGetShaderPrecisionFormat` reports it.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
 pub struct Precision {
-    /// log2 of the smallest magnitude.
+    /// The range reaches down to −2^`range_min` (log2 of the most negative value's magnitude).
     pub range_min: i32,
-    /// log2 of the largest magnitude.
+    /// The range reaches up to 2^`range_max`.
     pub range_max: i32,
     /// Bits of precision (0 = not supported).
     pub precision: i32,

@@ -261,8 +261,8 @@ fn format_text(
     }
     let p = |p: &manylight::gl::caps::Precision| {
         format!(
-            "2^{}..2^{}, {} bits",
-            -p.range_min, p.range_max, p.precision
+            "-2^{}..2^{}, {} bits",
+            p.range_min, p.range_max, p.precision
         )
     };
     w!(
