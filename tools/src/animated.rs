@@ -86,7 +86,7 @@ pub fn markdown(rows: &[AnimatedRow]) -> String {
             r.upload_bytes.p50 / 1024.0,
             r.upload_bytes.max / 1024.0,
             r.max_abs_err_vs_forward
-                .map_or("-".to_string(), |e| e.to_string()),
+                .map_or("—".to_string(), |e| e.to_string()),
         );
     }
     s += "\n";
@@ -127,7 +127,7 @@ mod tests {
         };
         let md = markdown(&[row("forward", None), row("clustered", Some(1))]);
         assert!(md.contains("| courtyard | 3.0 | clustered | 1024 | 10.00 | 12.50 | 15.00 | 16.50 | 1.50 | 0.500 | 0.900 | 2 | 4 | 1 |"), "{md}");
-        assert!(md.contains("| forward |") && md.contains("| - |"), "{md}");
+        assert!(md.contains("| forward |") && md.contains("| — |"), "{md}");
         assert!(markdown(&[]).is_empty());
         assert_eq!(AnimatedRow::tail_ratio(&spread(0.0, 1.0)), 0.0);
     }

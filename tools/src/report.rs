@@ -443,7 +443,7 @@ pub fn markdown(report: &Report) -> String {
                 r.method,
                 r.lights,
                 knob,
-                opt(r.grid_footprint_px, 0),
+                r.grid_footprint_px.map_or("—".into(), |px| px.to_string()),
                 r.grid_cells,
                 r.frame_ms,
                 r.assign_ms,
@@ -737,6 +737,22 @@ mod tests {
         let mut r = row("a", "deferred", 64, "default", 2.0, 0.5);
         r.draw_calls = 9;
         assert!(table_row(&r).starts_with("| deferred | 64 | 2.0 | 0.00 | 9 | 17.0 |"));
+    }
+
+    #[test]
+    fn the_knob_table_writes_half_pixel_grids_unrounded() {
+        let mut r = report();
+        for (row, px) in r
+            .rows
+            .iter_mut()
+            .filter(|r| r.knob != "default")
+            .zip([13.5, 16.0])
+        {
+            row.grid_footprint_px = Some(px);
+        }
+        let md = markdown(&r);
+        assert!(md.contains("| cutoff=0.01 | 13.5 |"), "{md}");
+        assert!(md.contains("| footprint_px=16 | 16 |"), "{md}");
     }
 
     #[test]
