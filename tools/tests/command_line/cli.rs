@@ -8,7 +8,7 @@ use std::process::Command;
 
 use common::cli::{expect_exit, manylight, text};
 
-fn stats(path: &Path) -> serde_json::Value {
+pub(super) fn stats(path: &Path) -> serde_json::Value {
     serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
 }
 
@@ -1067,57 +1067,6 @@ fn counts_near_two_to_the_32_or_64_are_usage_errors() {
             "not a number of runs",
         );
     }
-}
-
-#[test]
-fn timed_frames_report_their_spread() {
-    let dir = tempfile::tempdir().unwrap();
-    let out = manylight(
-        &[
-            "render", "--size", "32x18", "--lights", "64", "--frames", "12", "--stats", "s.json",
-        ],
-        &[],
-        dir.path(),
-    );
-    let msg = text(&out);
-    assert!(out.status.success(), "{msg}");
-    assert!(msg.contains("p99"), "{msg}");
-    let s = stats(&dir.path().join("s.json"));
-    for key in ["frame_ms_spread", "assign_ms_spread"] {
-        let spread = &s[key];
-        assert_eq!(spread["frames"], 12, "{key}: {spread}");
-        let at = |q: &str| spread[q].as_f64().unwrap();
-        assert!(at("p50") <= at("p95") && at("p95") <= at("p99") && at("p99") <= at("max"));
-    }
-    assert_eq!(s["frame_ms"], s["frame_ms_spread"]["p50"]);
-    // The run's programs, its untimed first frame's included, as one frame alone builds them
-    // (the moving built-in's timed frames reported 0).
-    let out = manylight(
-        &[
-            "render", "--size", "32x18", "--lights", "64", "--frames", "0", "--stats", "one.json",
-        ],
-        &[],
-        dir.path(),
-    );
-    assert!(out.status.success(), "{}", text(&out));
-    let one = stats(&dir.path().join("one.json"));
-    assert!(one["programs_built"].as_u64().unwrap() > 0, "{one}");
-    assert_eq!(s["programs_built"], one["programs_built"]);
-    // Every timed frame of moving lights assigns and uploads its lists, the first too: it was
-    // posed at the warm-up frame's time and redrew its lists, so at the default two frames
-    // the median assignment read 0 ms and the median upload 0 bytes.
-    let out = manylight(
-        &["render", "--size", "32x18", "--stats", "two.json"],
-        &[],
-        dir.path(),
-    );
-    assert!(out.status.success(), "{}", text(&out));
-    let two = stats(&dir.path().join("two.json"));
-    let uploads = &two["upload_bytes_spread"];
-    assert_eq!(uploads["frames"], 2, "{two}");
-    assert!(uploads["p50"].as_f64().unwrap() > 0.0, "{uploads}");
-    assert!(two["assign_ms"].as_f64().unwrap() > 0.0, "{two}");
-    assert_eq!(two["lists_reused"], false, "{two}");
 }
 
 #[test]

@@ -10,3 +10,4 @@ mod cli;
 mod cli_output;
 mod matrix;
 mod output_failures;
+mod timed_stats;
