@@ -59,7 +59,7 @@ impl Assign {
         if dropped > 0 && drawn && !self.warned_overflow {
             self.warned_overflow = true;
             let automatic = method == "clustered" && ctx.options.grid.is_auto();
-            warn_overflow(method, dropped, limits, automatic);
+            warn_overflow(method, assignment, limits, automatic);
         }
         Assigned {
             assignment,
@@ -96,26 +96,44 @@ impl Assign {
     }
 }
 
-/// Says once that a frame left light references out, and what would avoid it: another grid,
-/// unless the automatic grid (`automatic`) chose this one already.
-fn warn_overflow(method: &str, dropped: u64, limits: &AssignLimits, automatic: bool) {
+/// Says once that a frame left light references out, which limit left them out, and what
+/// would avoid it: other cells, unless the automatic grid (`automatic`) chose these already.
+fn warn_overflow(method: &str, assignment: &Assignment, limits: &AssignLimits, automatic: bool) {
+    let dropped = assignment.stats.overflowed_lights;
     let cap = match limits.cell_cap {
         u32::MAX => "no cap per cell".to_string(),
         cap => format!("a cell keeps at most {cap} lights"),
     };
-    let remedy = if automatic {
-        "the automatic grid chose these cells already: fewer lights over one spot, or \
-         Method::Auto (which draws such a frame with forward or deferred) avoid it"
+    // The policy's cap is uniform: below the cell cap only where the whole list was full.
+    let kept = assignment.counts.iter().copied().max().unwrap_or(0);
+    let list_full = kept < limits.cell_cap;
+    let remedy = match (automatic, method, list_full) {
+        (true, ..) => {
+            "the automatic grid chose these cells already: fewer lights over one spot, or \
+             Method::Auto (which draws such a frame with forward or deferred) avoid it"
+        }
+        (false, "tiled", false) => "smaller tiles (RenderOptions::tile_px) avoid it",
+        (false, "tiled", true) => "larger tiles (RenderOptions::tile_px) avoid it",
+        (false, _, false) => {
+            "smaller cells (a smaller grid.footprint_px), shallower slices (a smaller \
+             grid.slice_depth) or the automatic grid avoid it"
+        }
+        (false, _, true) => {
+            "a coarser grid (grid.footprint_px), deeper slices (grid.slice_depth) or the \
+             automatic grid avoid it"
+        }
+    };
+    let full = if list_full {
+        format!("the index list was full, so every cell kept at most {kept}")
     } else {
-        "a coarser grid (grid.footprint_px), deeper slices (grid.slice_depth) or the \
-         automatic grid avoid it"
+        "cells held more than that".to_string()
     };
     log::warn!(
         "{method}: {dropped} light references left out of this frame's cell lists, so \
          the image lacks those lights where they reach ({cap}, and at most {} \
          references fit in the index list here: the index texture's capacity on this \
-         context or MeasureOptions::max_indices; each cell keeps the lights that matter \
-         most to it, and FrameStats::lights.overflowed counts the dropped ones every \
+         context or MeasureOptions::max_indices; {full}; each cell keeps the lights that \
+         matter most to it, and FrameStats::lights.overflowed counts the dropped ones every \
          frame): {remedy}",
         limits.max_indices
     );

@@ -6,6 +6,7 @@ use crate::common;
 
 use common::warnings::warnings_containing;
 use common::Gpu;
+use manylight::cluster::grid::GridConfig;
 use manylight::scene;
 use manylight::{EsVersion, RenderOptions};
 
@@ -37,4 +38,48 @@ fn a_refused_frame_keeps_the_overflow_warning_for_one_that_draws() {
     let (_, stats) = gpu.r().render_offscreen(&crowded, 32, 18, &capped).unwrap();
     assert!(stats.lights.overflowed > 0, "nothing overflowed");
     assert_eq!(warnings_containing(warning).len(), 1);
+}
+
+/// The warning names the limit that left references out and the way round it for that
+/// limit: a cell's cap wants smaller cells (or tiles), a full index list a coarser grid (or
+/// larger tiles). It advised a coarser grid for both, which makes a cell's cap drop more.
+#[test]
+fn the_overflow_warning_advises_for_the_limit_that_bound() {
+    let warning = "light references left out";
+    common::warnings::install();
+    let crowded = scene::builtin::build("plane", Some((1024, 3))).unwrap();
+    let limited = |cell_cap, max_indices| RenderOptions {
+        grid: GridConfig::fixed(16.0),
+        measure: manylight::MeasureOptions {
+            cell_cap,
+            max_indices,
+            ..Default::default()
+        },
+        ..Default::default()
+    };
+    let cases = [
+        ("clustered", Some(4), None, "smaller cells", "coarser grid"),
+        ("clustered", None, Some(64), "coarser grid", "smaller cells"),
+        ("tiled", Some(4), None, "smaller tiles", "larger tiles"),
+        ("tiled", None, Some(64), "larger tiles", "smaller tiles"),
+    ];
+    for (method, cap, indices, advised, not_advised) in cases {
+        let mut gpu = Gpu::new(EsVersion::Es3);
+        gpu.r().set_method_named(method).unwrap();
+        let options = limited(cap, indices);
+        let (_, stats) = gpu
+            .r()
+            .render_offscreen(&crowded, 32, 18, &options)
+            .unwrap();
+        assert!(stats.lights.overflowed > 0, "{method}: nothing overflowed");
+        let said = warnings_containing(warning);
+        let last = said.last().expect("warned");
+        let full = indices.is_some();
+        assert!(
+            last.contains(advised)
+                && !last.contains(not_advised)
+                && last.contains("the index list was full") == full,
+            "{method}, cap {cap:?}, indices {indices:?}: {last}"
+        );
+    }
 }
