@@ -367,6 +367,16 @@ fn signed_options_take_a_negative_number_as_a_separate_word() {
         let code = if needle.is_empty() { 0 } else { 2 };
         expect_exit(&strs(&args), &[], cwd, code, needle);
     }
+    // Every timed frame can be rendered alone with `--time`: the last one too.
+    let timed = [
+        "--size", "16x9", "--lights", "4", "--out", "t.png", "--time",
+    ];
+    for (args, code, needle) in [
+        (&["1e9", "--frames", "2"][..], 2, "past ±1e9 s"),
+        (&["-1e9", "--fps", "0.001", "--frames", "3"], 0, ""),
+    ] {
+        expect_exit(&[&timed[..], args].concat(), &[], cwd, code, needle);
+    }
 }
 
 #[test]

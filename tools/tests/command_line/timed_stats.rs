@@ -89,3 +89,45 @@ fn timed_frames_count_the_last_frame() {
         "the lights moved by the last frame"
     );
 }
+
+/// A still scene is the same picture at any `--time`, and times the same way: its timed frames
+/// assign again, as at time 0. A `--time` used to draw it frame by frame, each reusing the last
+/// frame's lists, so it reported an assignment of 0 ms.
+#[test]
+fn a_still_scene_times_the_same_at_any_time() {
+    let dir = tempfile::tempdir().unwrap();
+    let floor = "v -5 0 -5\nv -5 0 5\nv 5 0 5\nv 5 0 -5\nf 1 2 3 4\n";
+    std::fs::write(dir.path().join("floor.obj"), floor).unwrap();
+    let run = |time: &str, file: &str| {
+        let args = [
+            "render",
+            "--scene",
+            "floor.obj",
+            "--size",
+            "64x36",
+            "--lights",
+            "32",
+            "--method",
+            "clustered",
+            "--frames",
+            "3",
+            "--time",
+            time,
+            "--stats",
+            file,
+        ];
+        let out = manylight(&args, &[], dir.path());
+        assert!(out.status.success(), "{}", text(&out));
+        stats(&dir.path().join(file))
+    };
+    for time in ["0", "2.5"] {
+        let s = run(time, "s.json");
+        assert!(s["visible_lights"].as_u64().unwrap() > 0, "{time}: {s}");
+        assert!(s["assign_ms"].as_f64().unwrap() > 0.0, "{time}: {s}");
+        assert_eq!(
+            s["upload_bytes_spread"],
+            serde_json::Value::Null,
+            "{time}: {s}"
+        );
+    }
+}

@@ -157,6 +157,24 @@ fn check_usage(cli: &Cli, subcommand: Option<&str>) {
             ),
         );
     }
+    if let Some(a) = render.filter(|a| a.frames > 1) {
+        // Each frame can be rendered alone with `--time`: the last one too.
+        let last = a.time + f64::from(a.frames - 1) / a.fps;
+        if last.abs() > render::MAX_TIME_S {
+            usage_error(
+                subcommand,
+                ErrorKind::ValueValidation,
+                format!(
+                    "--frames {} at --fps {} from --time {} end at {last:e} s, past ±{:e} s, \
+                     the times a frame can show",
+                    a.frames,
+                    a.fps,
+                    a.time,
+                    render::MAX_TIME_S
+                ),
+            );
+        }
+    }
     if let Some(a) = render {
         let out = match (&a.out, &a.record) {
             (Some(out), _) => Some(("--out", out.as_path())),

@@ -214,11 +214,16 @@ pub fn parse_samples(s: &str) -> Result<u32, String> {
     }
 }
 
+/// The times a frame can show, in seconds either side of 0 (`--time`, and every timed frame's).
+pub const MAX_TIME_S: f64 = 1e9;
+
 /// Parses `--time`: finite seconds.
 pub fn parse_time(s: &str) -> Result<f64, String> {
     match s.parse::<f64>() {
-        Ok(t) if t.is_finite() && t.abs() <= 1e9 => Ok(t),
-        _ => Err(format!("`{s}` is not a time in seconds within ±1e9")),
+        Ok(t) if t.is_finite() && t.abs() <= MAX_TIME_S => Ok(t),
+        _ => Err(format!(
+            "`{s}` is not a time in seconds within ±{MAX_TIME_S:e}"
+        )),
     }
 }
 
@@ -325,7 +330,8 @@ pub fn run(args: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
         ..RenderOptions::default()
     };
     let (width, height) = args.size;
-    let result = if scene.is_animated() || args.record.is_some() || args.time != 0.0 {
+    // A still scene is the same at every time: its timed frames are one frame timed again.
+    let result = if scene.is_animated() || args.record.is_some() {
         let timeline = crate::sequence::Timeline {
             start_s: args.time,
             fps: args.fps,

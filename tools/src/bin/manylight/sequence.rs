@@ -81,6 +81,9 @@ impl Recorder {
     /// A `.gif` path records an animated GIF, anything else is a directory for PNGs.
     fn open(path: &Path, timeline: &Timeline) -> Result<Recorder, String> {
         if records_gif(path) {
+            if let Some(warning) = gif_timing_warning(timeline.fps) {
+                log::warn!("--record {}: {warning}", path.display());
+            }
             let file = OutputFile::create(path).map_err(|e| format!("--record: {e}"))?;
             let file = SharedFile(Rc::new(RefCell::new(file)));
             let mut encoder = GifEncoder::new_with_speed(file.clone(), 10);
@@ -150,6 +153,22 @@ impl Recorder {
         }
         Ok(())
     }
+}
+
+/// Where a GIF cannot keep `fps`: its delays are whole hundredths of a second up to 65 535,
+/// and most viewers show a delay under 2 as 10.
+fn gif_timing_warning(fps: f64) -> Option<String> {
+    let why = if fps > 50.0 {
+        "under 1/50 s, which GIF viewers show at 1/10 s or 1/100 s, so it plays slower"
+    } else if fps < 100.0 / 65_535.0 {
+        "over 655.35 s, the longest a GIF frame lasts, so it plays faster"
+    } else {
+        return None;
+    };
+    Some(format!(
+        "at --fps {fps} a frame lasts {why} than the animation (a folder of PNG frames keeps \
+         any rate)"
+    ))
 }
 
 /// How many files in `dir` look like recorded frames (`frame_*.png`) but are not among the
@@ -262,8 +281,20 @@ pub fn render(
 
 #[cfg(test)]
 mod tests {
-    use super::records_gif;
+    use super::{gif_timing_warning, records_gif};
     use std::path::Path;
+
+    #[test]
+    fn a_gif_warns_of_rates_its_delays_cannot_keep() {
+        for fps in [0.5, 1.0, 30.0, 50.0, 0.002] {
+            assert_eq!(gif_timing_warning(fps), None, "{fps}");
+        }
+        assert!(gif_timing_warning(60.0).unwrap().contains("plays slower"));
+        assert!(gif_timing_warning(10_000.0)
+            .unwrap()
+            .contains("plays slower"));
+        assert!(gif_timing_warning(0.001).unwrap().contains("plays faster"));
+    }
 
     #[test]
     fn a_name_ending_in_gif_records_a_gif() {
