@@ -1177,6 +1177,12 @@ fn bad_animation_flags_are_usage_errors() {
     ];
     let msg = expect_exit(&args, &[], dir.path(), 1, "--record");
     assert!(msg.contains("not a folder"), "{msg}");
+    // `-` is standard output for --out and --stats; a recording cannot go there (it made a
+    // folder named `-`).
+    let args = ["render", "--size", "8x8", "--frames", "1", "--record", "-"];
+    let msg = expect_exit(&args, &[], dir.path(), 2, "--record -");
+    assert!(msg.contains("standard output"), "{msg}");
+    assert!(!dir.path().join("-").exists());
 }
 
 #[test]

@@ -157,6 +157,14 @@ fn check_usage(cli: &Cli, subcommand: Option<&str>) {
             ),
         );
     }
+    if render.is_some_and(|a| a.record.as_deref() == Some(Path::new("-"))) {
+        usage_error(
+            subcommand,
+            ErrorKind::ValueValidation,
+            "--record -: a recording is a folder of PNG frames or a .gif file, not standard \
+             output",
+        );
+    }
     if let Some(a) = render.filter(|a| a.frames > 1) {
         // Each frame can be rendered alone with `--time`: the last one too.
         let last = a.time + f64::from(a.frames - 1) / a.fps;

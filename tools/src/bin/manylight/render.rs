@@ -380,7 +380,8 @@ pub fn run(args: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
         _ => String::new(),
     };
     if scene.is_animated() {
-        tail += &format!(" · moving lights, picture at t = {:.3} s", args.time);
+        // `+ 0.0` writes -0 as 0.
+        tail += &format!(" · moving lights, picture at t = {:.3} s", args.time + 0.0);
         if args.frames > 1 {
             let last = args.time + f64::from(args.frames - 1) / args.fps;
             tail += &format!(", timed to t = {last:.3} s");
