@@ -542,20 +542,10 @@ impl Device {
                 "the driver reported GL_OUT_OF_MEMORY after {what} (injected)"
             )));
         }
-        let code = self.drain_errors();
-        if code == glow::NO_ERROR {
-            return Ok(());
+        match self.drain_errors() {
+            glow::NO_ERROR => Ok(()),
+            code => Err(driver_error(code, what)),
         }
-        if code == glow::OUT_OF_MEMORY {
-            return Err(GlError::OutOfMemory(format!(
-                "the driver reported GL_OUT_OF_MEMORY after {what}"
-            )));
-        }
-        Err(GlError::Driver {
-            what: what.to_string(),
-            name: error_name(code),
-            code,
-        })
     }
 }
 
@@ -601,9 +591,26 @@ pub fn framebuffer_status_name(status: u32) -> &'static str {
     }
 }
 
+/// The error a pending `glGetError` `code` after `what` is: running out of memory and a lost
+/// context by name, since a caller does something else about each.
+pub(crate) fn driver_error(code: u32, what: &str) -> GlError {
+    match code {
+        glow::OUT_OF_MEMORY => {
+            GlError::OutOfMemory(format!("the driver reported GL_OUT_OF_MEMORY after {what}"))
+        }
+        glow::CONTEXT_LOST => GlError::ContextLost(what.to_string()),
+        _ => GlError::Driver {
+            what: what.to_string(),
+            name: error_name(code),
+            code,
+        },
+    }
+}
+
 /// Name of a `glGetError` code.
 pub fn error_name(code: u32) -> &'static str {
     match code {
+        glow::CONTEXT_LOST => "GL_CONTEXT_LOST",
         glow::INVALID_ENUM => "GL_INVALID_ENUM",
         glow::INVALID_VALUE => "GL_INVALID_VALUE",
         glow::INVALID_OPERATION => "GL_INVALID_OPERATION",
@@ -631,5 +638,23 @@ mod tests {
         assert!(e.contains("0x8cd6"), "{e}");
         let unknown = framebuffer_status_name(0x1234);
         assert_eq!(unknown, "an unknown status");
+    }
+
+    /// A lost context is an error of its own (a game makes a new context for it) and says
+    /// what to do; it read "unknown GL error (0x0507)".
+    #[test]
+    fn a_lost_context_is_named_apart_from_other_driver_errors() {
+        let lost = driver_error(glow::CONTEXT_LOST, "a draw");
+        assert!(matches!(&lost, GlError::ContextLost(what) if what == "a draw"));
+        assert!(lost.to_string().contains("Renderer::abandon"), "{lost}");
+        assert!(matches!(
+            driver_error(glow::OUT_OF_MEMORY, "a draw"),
+            GlError::OutOfMemory(_)
+        ));
+        let other = driver_error(glow::INVALID_ENUM, "a draw");
+        assert!(other
+            .to_string()
+            .contains("GL_INVALID_ENUM (0x0500) after a draw"));
+        assert_eq!(error_name(glow::CONTEXT_LOST), "GL_CONTEXT_LOST");
     }
 }

@@ -238,4 +238,9 @@ pub enum GlError {
     /// EGL says another context than the renderer's is current on this thread.
     #[error("another GL context than the renderer's is current on this thread: make the renderer's context current again before using it (its objects are that context's)")]
     OtherContext,
+    /// The driver lost the context (`GL_CONTEXT_LOST`: a GPU reset, or a power event on a
+    /// phone): nothing made in it works any more. Let the renderer go with
+    /// [`Renderer::abandon`](crate::Renderer::abandon) and make a new one on a new context.
+    #[error("the GL context was lost (GL_CONTEXT_LOST after {0}): let the renderer go with Renderer::abandon and make a new one on a new context")]
+    ContextLost(String),
 }
