@@ -1,5 +1,6 @@
 //! The winit application: EGL setup, suspend/resume, touch input and the frame loop.
 
+use std::cmp::Reverse;
 use std::ffi::CStr;
 use std::num::NonZeroU32;
 use std::time::Instant;
@@ -13,6 +14,7 @@ use glutin::display::{Display, DisplayApiPreference, GlDisplay};
 use glutin::error::ErrorKind;
 use glutin::surface::{GlSurface, Surface, SurfaceAttributesBuilder, SwapInterval, WindowSurface};
 use manylight::{builtin_scene, Method, RandomLights, Scene, DEFAULT_SCENE};
+use manylight::{Error, GlError};
 use manylight::{EsVersion, FrameStats, RenderOptions, Renderer};
 use winit::application::ApplicationHandler;
 use winit::dpi::PhysicalPosition;
@@ -27,18 +29,30 @@ use crate::retry::Retry;
 
 /// Seeded random lights in the default scene.
 const LIGHTS: usize = 1024;
+/// The lights kept where the device runs only forward (an ES 2.0 GPU without fragment `highp`),
+/// which evaluates every light at every pixel.
+const FORWARD_LIGHTS: usize = 64;
 /// Seconds between frame-statistics lines in logcat.
 const LOG_EVERY_S: f64 = 2.0;
 
-/// Sets up logging and runs the event loop until the activity is destroyed; then ends the
-/// process, since winit allows one event loop a process and android-activity keeps the process
-/// for the next launch, which would find none.
+/// Sets up logging and the thread pool, and runs the event loop until the activity is
+/// destroyed (`android_main` then ends the process).
 pub fn run(activity: AndroidApp) {
     android_logger::init_once(
         android_logger::Config::default()
             .with_max_level(log::LevelFilter::Info)
             .with_tag("manylight"),
     );
+    // A panic's message goes to standard error, which Android drops: logcat gets it.
+    std::panic::set_hook(Box::new(|panic| log::error!("{panic}")));
+    // This thread lives as long as the process: as one of rayon's pool, a frame's light
+    // assignment starts on it at once instead of waiting for a sleeping worker to wake.
+    if let Err(e) = rayon::ThreadPoolBuilder::new()
+        .use_current_thread()
+        .build_global()
+    {
+        log::warn!("the render thread is not one of the assignment's pool: {e}");
+    }
     let lights = RandomLights {
         count: LIGHTS,
         seed: 1,
@@ -69,8 +83,6 @@ pub fn run(activity: AndroidApp) {
     if let Err(e) = event_loop.run_app(&mut shell) {
         log::error!("event loop failed: {e}");
     }
-    drop(shell);
-    std::process::exit(0);
 }
 
 /// The EGL display and the config and version chosen on it (kept for the process).
@@ -231,7 +243,9 @@ impl Shell {
             r.abandon();
         }
         self.parked = None;
-        self.live = None;
+        if let Some(live) = self.live.take() {
+            release(live.context, live.surface);
+        }
     }
 
     /// Makes the display and context on first use, a surface for the new native window, and
@@ -293,32 +307,18 @@ impl Shell {
             log::info!("no vsync: {e}");
         }
         if self.renderer.is_none() {
-            // SAFETY: glutin returns EGL's entry points (or null); glow stores them, and the
-            // context stays current on this thread whenever the renderer draws.
-            let gl = unsafe {
-                manylight::glow::Context::from_loader_function_cstr(|name: &CStr| {
-                    egl.display.get_proc_address(name)
-                })
-            };
-            let mut renderer = Renderer::new(gl, egl.es).map_err(|e| e.to_string())?;
-            pick_method(&mut renderer)?;
-            // The scene's shaders built now, for the window's framebuffer the frames draw into,
-            // rather than in the first frames (each compile a hitch).
-            match renderer.warm_up(&self.scene, &frame_options()) {
-                Ok(w) => log::info!("warmed up: {} programs in {:.0} ms", w.programs_built, w.ms),
+            match new_renderer(egl, &mut self.scene) {
+                Ok(renderer) => self.renderer = Some(renderer),
                 Err(e) => {
-                    log::warn!("warm-up failed (the first frames build what it did not): {e}")
+                    // Kept for the retry, released first: a surface dropped while current
+                    // stays bound to the window, whose next surface EGL then refuses.
+                    if let Ok(c) = context.make_not_current() {
+                        self.parked = Some(c);
+                    }
+                    drop(surface);
+                    return Err(e);
                 }
             }
-            let caps = renderer.caps();
-            log::info!(
-                "{} on {} ({}), method {}",
-                egl.es,
-                caps.renderer,
-                caps.gl_version,
-                renderer.method()
-            );
-            self.renderer = Some(renderer);
         }
         window.request_redraw();
         // The first statistics line after a pause covers frames, not the pause.
@@ -369,15 +369,27 @@ impl Shell {
         }
         self.orbit.apply(&mut self.scene.camera);
         let stats = &mut self.stats;
-        renderer
-            .render_reusing(
-                &self.scene,
-                size.width,
-                size.height,
-                &frame_options(),
-                stats,
-            )
-            .map_err(|e| FrameError::Other(format!("render failed: {e}")))?;
+        let rendered = renderer.render_reusing(
+            &self.scene,
+            size.width,
+            size.height,
+            &frame_options(),
+            stats,
+        );
+        if let Err(e) = rendered {
+            let message = format!("render failed: {e}");
+            // GL says so where it has robustness; EGL answers eglMakeCurrent with
+            // EGL_CONTEXT_LOST after a power event. Either way no swap comes to see it.
+            let gl_lost = matches!(e, Error::Gl(GlError::ContextLost(_)));
+            let egl_lost = live
+                .context
+                .make_current(&live.surface)
+                .is_err_and(|e| e.error_kind() == ErrorKind::ContextLost);
+            return Err(match gl_lost || egl_lost {
+                true => FrameError::ContextLost(message),
+                false => FrameError::Other(message),
+            });
+        }
         if stats.programs_built > 0 {
             log::info!("a frame built {} shader programs", stats.programs_built);
         }
@@ -407,6 +419,53 @@ impl Shell {
         }
         Ok(())
     }
+}
+
+/// Makes `context` not current, then drops it and `surface`. Dropped while current, EGL keeps
+/// both until another context is made current, and the surface keeps the native window:
+/// Android then refuses a new surface for it (`EGL_BAD_ALLOC`).
+fn release(context: PossiblyCurrentContext, surface: Surface<WindowSurface>) {
+    if let Err(e) = context.make_not_current() {
+        log::warn!("cannot release the lost context: {e}");
+    }
+    drop(surface);
+}
+
+/// A renderer on the current context, its method picked and the scene's shaders built (for
+/// the window's framebuffer the frames draw into, rather than in the first frames, each compile
+/// a hitch). Where the device runs only forward, the scene keeps the lights forward can draw
+/// on a weak GPU.
+fn new_renderer(egl: &Egl, scene: &mut Scene) -> Result<Renderer, String> {
+    // SAFETY: glutin returns EGL's entry points (or null); glow stores them, and the context
+    // stays current on this thread whenever the renderer draws.
+    let gl = unsafe {
+        manylight::glow::Context::from_loader_function_cstr(|name: &CStr| {
+            egl.display.get_proc_address(name)
+        })
+    };
+    let mut renderer = Renderer::new(gl, egl.es).map_err(|e| e.to_string())?;
+    pick_method(&mut renderer)?;
+    if renderer.method() == Method::Forward.name() && scene.lights.len() > FORWARD_LIGHTS {
+        log::warn!(
+            "only forward runs here: drawing {FORWARD_LIGHTS} of the {} lights, each of which \
+             it evaluates at every pixel",
+            scene.lights.len()
+        );
+        scene.truncate_lights(FORWARD_LIGHTS);
+    }
+    match renderer.warm_up(scene, &frame_options()) {
+        Ok(w) => log::info!("warmed up: {} programs in {:.0} ms", w.programs_built, w.ms),
+        Err(e) => log::warn!("warm-up failed (the first frames build what it did not): {e}"),
+    }
+    let caps = renderer.caps();
+    log::info!(
+        "{} on {} ({}), method {}",
+        egl.es,
+        caps.renderer,
+        caps.gl_version,
+        renderer.method()
+    );
+    Ok(renderer)
 }
 
 /// What every frame is drawn with: a game's frame does not wait for the GPU.
@@ -450,17 +509,25 @@ fn open_egl(event_loop: &ActiveEventLoop) -> Result<(Egl, NotCurrentContext), St
             EsVersion::Es2 => Api::GLES2,
             EsVersion::Es3 => Api::GLES3,
         };
+        // No stencil asked for (glutin's template asks for 8 bits): the renderer uses none.
         let template = ConfigTemplateBuilder::new()
             .with_api(api)
             .with_alpha_size(0)
             .with_depth_size(16)
+            .with_stencil_size(0)
             .build();
         // SAFETY: only queries the display's configs.
         let config = unsafe { display.find_configs(template) }
             .ok()
             .and_then(|configs| {
-                // No multisampling, then a 24-bit depth buffer if there is one.
-                configs.max_by_key(|c| (c.num_samples() == 0, c.depth_size().min(24)))
+                // No multisampling, then a 24-bit depth buffer if there is one; among equals
+                // the first, as EGL sorts them (slow and non-conformant configs last).
+                configs
+                    .enumerate()
+                    .max_by_key(|(i, c)| {
+                        (c.num_samples() == 0, c.depth_size().min(24), Reverse(*i))
+                    })
+                    .map(|(_, c)| c)
             });
         let Some(config) = config else {
             failures.push(format!("{es}: no window config with a depth buffer"));

@@ -23,8 +23,12 @@ pub mod retry;
 mod app;
 
 /// The entry point android-activity calls on its own thread once the activity is created.
+/// However the shell ends, a panic included, it ends the process: winit makes one event loop a
+/// process, and android-activity keeps the process for the next launch, which could not start
+/// another and would close at once, launch after launch.
 #[cfg(target_os = "android")]
 #[no_mangle]
 fn android_main(activity: android_activity::AndroidApp) {
-    app::run(activity);
+    let ended = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| app::run(activity)));
+    std::process::exit(i32::from(ended.is_err()));
 }
