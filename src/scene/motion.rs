@@ -17,7 +17,7 @@ use glam::{DQuat, DVec3};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 
-use super::{Light, LightKind, SceneError};
+use super::{Light, LightKind, SceneError, Short};
 
 /// Shortest period accepted, in seconds (a millisecond: faster is flicker noise at any
 /// frame rate).
@@ -196,7 +196,7 @@ impl Motion {
         if let Some((o, axis)) = self
             .orbit
             .as_ref()
-            .and_then(|o| Some((o, o.axis.try_normalize()?)))
+            .and_then(|o| Some((o, unit_axis(o.axis)?)))
         {
             light.position += match o.about {
                 OrbitAbout::Point(centre) => {
@@ -235,7 +235,7 @@ impl Motion {
             light.intensity = rest.intensity * (1.0 - f.amount * noise as f32).max(0.0);
         }
         if let (Some(s), LightKind::Spot { direction, .. }) = (&self.sweep, &mut light.kind) {
-            if let Some(axis) = s.axis.try_normalize() {
+            if let Some(axis) = unit_axis(s.axis) {
                 let angle = s.angle_deg.to_radians() * swing(t, s.period_s, s.phase_deg);
                 *direction = DQuat::from_axis_angle(axis, angle) * *direction;
             }
@@ -255,7 +255,7 @@ impl Motion {
         if let Some(o) = &self.orbit {
             match o.about {
                 OrbitAbout::Point(centre) => {
-                    let axis = o.axis.normalize();
+                    let axis = unit_axis(o.axis).unwrap_or(DVec3::Y);
                     let v = rest - centre;
                     let along = v.dot(axis);
                     let rho = (v - axis * along).length();
@@ -413,14 +413,27 @@ fn check_period(value: f64, field: &str, name: &str) -> Result<(), SceneError> {
     }
 }
 
+/// `axis` at unit length: any finite, non-zero vector has one (scaled by its largest
+/// component first, so a length of 1e200 does not overflow nor one of 1e-320 underflow).
+fn unit_axis(axis: DVec3) -> Option<DVec3> {
+    let largest = axis.abs().max_element();
+    (largest.is_finite() && largest > 0.0)
+        .then(|| axis / largest)
+        .and_then(DVec3::try_normalize)
+}
+
 fn check_axis(axis: DVec3, field: &str, name: &str) -> Result<(), SceneError> {
-    if axis.is_finite() && axis.length() > 1e-12 && axis.length().is_finite() {
-        Ok(())
-    } else {
-        Err(SceneError::invalid(
+    match unit_axis(axis) {
+        Some(_) => Ok(()),
+        None => Err(SceneError::invalid(
             format!("{field}.{name}"),
-            format!("must be finite and longer than 1e-12 (a direction), got {axis:?}"),
-        ))
+            format!(
+                "must be a finite, non-zero direction, got [{}, {}, {}]",
+                Short(axis.x),
+                Short(axis.y),
+                Short(axis.z)
+            ),
+        )),
     }
 }
 

@@ -449,3 +449,30 @@ fn an_axis_validation_refuses_turns_nothing_when_posed() {
         assert!(err.contains("axis"), "{err}");
     }
 }
+
+/// Any finite, non-zero axis is a direction, as a spot's is: one of length 1e200 or 1e-300
+/// turns as the unit axis does. Squared for its length, 1e200 overflowed and was refused as
+/// "not finite", and anything under 1e-12 as too short.
+#[test]
+fn an_axis_of_any_finite_length_turns_as_its_direction() {
+    let posed_about = |axis: DVec3| {
+        let mut m = every_motion();
+        m.orbit.as_mut().unwrap().axis = axis;
+        m.sweep.as_mut().unwrap().axis = axis;
+        m.validate("m", true).map(|()| m.apply(&spot(), 1.3))
+    };
+    let unit = posed_about(DVec3::new(0.6, 0.8, 0.0)).unwrap();
+    for scale in [1e200, 1e-13, 1e-300, f64::MAX / 2.0] {
+        let posed = posed_about(DVec3::new(0.6, 0.8, 0.0) * scale).unwrap();
+        assert!(
+            posed.position.abs_diff_eq(unit.position, 1e-9),
+            "{scale:e}: {posed:?} against {unit:?}"
+        );
+        let (LightKind::Spot { direction: d, .. }, LightKind::Spot { direction: u, .. }) =
+            (posed.kind, unit.kind)
+        else {
+            panic!("not a spot");
+        };
+        assert!(d.abs_diff_eq(u, 1e-12), "{scale:e}: {d} against {u}");
+    }
+}
