@@ -12,12 +12,33 @@ pub const MAX_SHOWN_NAME: usize = 64;
 pub const MAX_SHOWN_REASON: usize = 1000;
 
 /// Whether `c` is escaped: a control character, a line or paragraph separator (U+2028,
-/// U+2029: a new line to many terminals and log viewers, a forged line of output), or one
-/// that reorders the text around it (bidirectional marks, embeddings, overrides and
-/// isolates: a name could make a message read other than it is).
+/// U+2029: a new line to many terminals and log viewers, a forged line of output), one that
+/// reorders the text around it (bidirectional marks, embeddings, overrides and isolates: a
+/// name could make a message read other than it is), or one that shows as nothing or as
+/// nothing in particular (zero-width and other invisible format characters, the byte order
+/// mark, variation selectors, tags, private use: two names that look alike, or hidden text).
 fn escaped(c: char) -> bool {
     c.is_control()
-        || matches!(c, '\u{61c}' | '\u{200e}' | '\u{200f}' | '\u{2028}'..='\u{202e}' | '\u{2066}'..='\u{2069}')
+        || matches!(
+            c,
+            '\u{ad}'
+                | '\u{34f}'
+                | '\u{61c}'
+                | '\u{115f}'..='\u{1160}'
+                | '\u{17b4}'..='\u{17b5}'
+                | '\u{180b}'..='\u{180f}'
+                | '\u{200b}'..='\u{200f}'
+                | '\u{2028}'..='\u{202e}'
+                | '\u{2060}'..='\u{206f}'
+                | '\u{3164}'
+                | '\u{e000}'..='\u{f8ff}'
+                | '\u{fe00}'..='\u{fe0f}'
+                | '\u{feff}'
+                | '\u{ffa0}'
+                | '\u{fff0}'..='\u{fffb}'
+                | '\u{e0000}'..='\u{e0fff}'
+                | '\u{f0000}'..='\u{10ffff}'
+        )
 }
 
 /// `text` with every control and reordering character escaped (`\u{1b}`), the rest as it is.
@@ -90,6 +111,12 @@ mod tests {
         assert!(shown.ends_with("… (9999936 characters more)"), "{shown}");
         assert!(!name(&format!("{long}\u{1b}")).contains('\u{1b}'));
         assert_eq!(text("a\u{202e}b\u{2066}"), "a\\u{202e}b\\u{2066}");
+        // Invisible: a zero-width space, a byte order mark, a soft hyphen, a tag, private use.
+        assert_eq!(
+            text("a\u{200b}\u{feff}\u{ad}\u{e0041}\u{e000}b"),
+            "a\\u{200b}\\u{feff}\\u{ad}\\u{e0041}\\u{e000}b"
+        );
+        assert_eq!(text("Ünïcödé 名前 ✓"), "Ünïcödé 名前 ✓");
         assert_eq!(lines("log:\n\tline\u{1b}"), "log:\n\tline\\u{1b}");
         assert_eq!(
             reason(&long).chars().count(),
