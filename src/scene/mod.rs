@@ -72,29 +72,7 @@ pub use material::{Material, MaterialModel, Texture};
 pub use mesh::{Aabb, Mesh};
 pub use mesh::{MAX_SCENE_MATERIALS, MAX_SCENE_MESHES, MAX_SCENE_OBJECTS};
 pub use motion::Motion;
-
-/// A number as an error message writes it: as written for ordinary magnitudes, in exponent form
-/// for tiny and huge ones (`{}` writes 1e-300 in 300 digits, and `f32::MAX` in 39).
-pub(crate) struct Short<T>(pub T);
-
-impl<T> std::fmt::Display for Short<T>
-where
-    T: Copy + Into<f64> + std::fmt::Display + std::fmt::LowerExp,
-{
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        let v = self.0.into().abs();
-        if v != 0.0 && !(1e-4..1e16).contains(&v) {
-            write!(f, "{:e}", self.0)
-        } else {
-            write!(f, "{}", self.0)
-        }
-    }
-}
-
-/// A vector as a message writes it: `[x, y, z]`, each component [`Short`].
-pub(crate) fn short3(v: Vec3) -> String {
-    format!("[{}, {}, {}]", Short(v.x), Short(v.y), Short(v.z))
-}
+pub(crate) use shown::{short3, Short};
 
 /// Most a transform's last row may differ from `0 0 0 1` (exporters and inverses round) before
 /// it is refused as not affine.
@@ -644,19 +622,6 @@ fn plane_keeps_an_area(a: &glam::DMat3, n: glam::DVec3) -> bool {
 mod area_tests {
     use super::*;
     use glam::{DVec3, DVec4};
-
-    #[test]
-    fn numbers_in_messages_are_written_short_in_f32_and_f64() {
-        let shown = |s: &dyn std::fmt::Display| s.to_string();
-        assert_eq!(shown(&Short(16.0f32)), "16");
-        assert_eq!(shown(&Short(0.1f32)), "0.1");
-        assert_eq!(shown(&Short(f32::MAX)), "3.4028235e38");
-        assert_eq!(shown(&Short(-1e300f64)), "-1e300");
-        assert_eq!(shown(&Short(1e-300f64)), "1e-300");
-        assert_eq!(shown(&Short(0.0f64)), "0");
-        assert_eq!(shown(&Short(f64::NAN)), "NaN");
-        assert_eq!(shown(&Short(f32::NEG_INFINITY)), "-inf");
-    }
 
     #[test]
     fn a_transform_that_flattens_every_triangle_leaves_nothing_to_draw() {
