@@ -49,7 +49,7 @@ use super::{Camera, DirectionalLight, Light, LightKind, MaterialModel, Scene, Sc
 use super::{LoadReport, Short};
 
 #[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(deny_unknown_fields, expecting = "a scene: a JSON object")]
 struct SceneFile {
     camera: Option<CameraSpec>,
     #[serde(default)]
@@ -63,7 +63,7 @@ struct SceneFile {
 }
 
 #[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(deny_unknown_fields, expecting = "a camera object")]
 struct CameraSpec {
     position: [f64; 3],
     target: [f64; 3],
@@ -85,7 +85,7 @@ enum ProjectionKind {
 }
 
 #[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(deny_unknown_fields, expecting = "an object")]
 struct ObjectSpec {
     builtin: Option<String>,
     obj: Option<PathBuf>,
@@ -101,7 +101,7 @@ struct ObjectSpec {
 }
 
 #[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(deny_unknown_fields, expecting = "a transform object")]
 struct TransformSpec {
     #[serde(default)]
     translate: [f64; 3],
@@ -118,7 +118,7 @@ enum ScaleSpec {
 }
 
 #[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(deny_unknown_fields, expecting = "a light object")]
 struct LightSpec {
     kind: LightKindSpec,
     position: [f64; 3],
@@ -134,7 +134,7 @@ struct LightSpec {
 
 /// A sun: `direction` is the way the light travels (from it towards the scene).
 #[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(deny_unknown_fields, expecting = "a directional light object")]
 struct DirectionalSpec {
     direction: [f64; 3],
     color: [f64; 3],
@@ -152,7 +152,7 @@ fn up() -> [f64; 3] {
 
 /// `"motion"` of a light or a random set (see [`super::motion`]).
 #[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(deny_unknown_fields, expecting = "a motion object")]
 struct MotionSpec {
     orbit: Option<OrbitSpec>,
     bob: Option<BobSpec>,
@@ -162,7 +162,7 @@ struct MotionSpec {
 }
 
 #[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(deny_unknown_fields, expecting = "an orbit object")]
 struct OrbitSpec {
     center: Option<[f64; 3]>,
     radius: Option<f64>,
@@ -174,7 +174,7 @@ struct OrbitSpec {
 }
 
 #[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(deny_unknown_fields, expecting = "a bob object")]
 struct BobSpec {
     amplitude: [f64; 3],
     period_s: f64,
@@ -183,7 +183,7 @@ struct BobSpec {
 }
 
 #[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(deny_unknown_fields, expecting = "a wander object")]
 struct WanderSpec {
     radius: f64,
     period_s: f64,
@@ -192,7 +192,7 @@ struct WanderSpec {
 }
 
 #[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(deny_unknown_fields, expecting = "a flicker object")]
 struct FlickerSpec {
     amount: f64,
     rate_hz: f64,
@@ -201,7 +201,7 @@ struct FlickerSpec {
 }
 
 #[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(deny_unknown_fields, expecting = "a sweep object")]
 struct SweepSpec {
     axis: [f64; 3],
     angle_deg: f64,
@@ -218,7 +218,7 @@ enum LightKindSpec {
 }
 
 #[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(deny_unknown_fields, expecting = "a random lights object")]
 struct RandomLightsSpec {
     count: usize,
     #[serde(default)]
@@ -469,6 +469,17 @@ pub fn parse(
     };
     if let Some(((count, seed), field)) = random {
         let total = count.saturating_add(scene.lights.len());
+        if super::input::check_light_count(total, field).is_err() && !scene.lights.is_empty() {
+            return Err(SceneError::invalid(
+                field,
+                format!(
+                    "{count} random lights and the file's {} make {total}, more than the {} a \
+                     scene may hold",
+                    scene.lights.len(),
+                    super::input::MAX_LIGHTS
+                ),
+            ));
+        }
         super::input::check_light_count(total, field)?;
         let volume = scene.bounds().ok_or_else(|| {
             SceneError::invalid("random_lights", "needs geometry to place lights in")
@@ -520,7 +531,7 @@ impl TransformSpec {
         if !scale.is_finite() || scale.cmpeq(DVec3::ZERO).any() {
             return Err(SceneError::invalid(
                 format!("{field}.transform.scale"),
-                format!("must be finite and non-zero, got {scale:?}"),
+                format!("must be finite and non-zero, got {}", super::short3(scale)),
             ));
         }
         Ok(DMat4::from_translation(DVec3::from(self.translate))

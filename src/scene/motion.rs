@@ -17,6 +17,7 @@ use glam::{DQuat, DVec3};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 
+use super::direction::unit;
 use super::{Light, LightKind, SceneError, Short};
 
 /// Shortest period accepted, in seconds (a millisecond: faster is flicker noise at any
@@ -193,11 +194,7 @@ impl Motion {
         let mut light = *rest;
         // An axis validation refuses (zero, NaN) turns nothing here rather than make NaN
         // (or trip glam's assertions, where a dependency turns them on).
-        if let Some((o, axis)) = self
-            .orbit
-            .as_ref()
-            .and_then(|o| Some((o, unit_axis(o.axis)?)))
-        {
+        if let Some((o, axis)) = self.orbit.as_ref().and_then(|o| Some((o, unit(o.axis)?))) {
             light.position += match o.about {
                 OrbitAbout::Point(centre) => {
                     let turn = DQuat::from_axis_angle(axis, angle(t, o.period_s, 0.0));
@@ -235,7 +232,7 @@ impl Motion {
             light.intensity = rest.intensity * (1.0 - f.amount * noise as f32).max(0.0);
         }
         if let (Some(s), LightKind::Spot { direction, .. }) = (&self.sweep, &mut light.kind) {
-            if let Some(axis) = unit_axis(s.axis) {
+            if let Some(axis) = unit(s.axis) {
                 let angle = s.angle_deg.to_radians() * swing(t, s.period_s, s.phase_deg);
                 *direction = DQuat::from_axis_angle(axis, angle) * *direction;
             }
@@ -255,7 +252,7 @@ impl Motion {
         if let Some(o) = &self.orbit {
             match o.about {
                 OrbitAbout::Point(centre) => {
-                    let axis = unit_axis(o.axis).unwrap_or(DVec3::Y);
+                    let axis = unit(o.axis).unwrap_or(DVec3::Y);
                     let v = rest - centre;
                     let along = v.dot(axis);
                     let rho = (v - axis * along).length();
@@ -290,7 +287,10 @@ impl Motion {
                     if !(c.is_finite() && c.abs().max_element() <= MAX_DISPLACEMENT) {
                         return Err(SceneError::invalid(
                             format!("{field}.orbit.center"),
-                            format!("must be finite and within ±{MAX_DISPLACEMENT:e}, got {c:?}"),
+                            format!(
+                                "must be finite and within ±{MAX_DISPLACEMENT:e}, got {}",
+                                super::short3(c)
+                            ),
                         ));
                     }
                 }
@@ -304,8 +304,8 @@ impl Motion {
                 return Err(SceneError::invalid(
                     format!("{field}.bob.amplitude"),
                     format!(
-                        "must be finite and at most {MAX_DISPLACEMENT:e} long, got {:?}",
-                        b.amplitude
+                        "must be finite and at most {MAX_DISPLACEMENT:e} long, got {}",
+                        super::short3(b.amplitude)
                     ),
                 ));
             }
@@ -413,17 +413,8 @@ fn check_period(value: f64, field: &str, name: &str) -> Result<(), SceneError> {
     }
 }
 
-/// `axis` at unit length: any finite, non-zero vector has one (scaled by its largest
-/// component first, so a length of 1e200 does not overflow nor one of 1e-320 underflow).
-fn unit_axis(axis: DVec3) -> Option<DVec3> {
-    let largest = axis.abs().max_element();
-    (largest.is_finite() && largest > 0.0)
-        .then(|| axis / largest)
-        .and_then(DVec3::try_normalize)
-}
-
 fn check_axis(axis: DVec3, field: &str, name: &str) -> Result<(), SceneError> {
-    match unit_axis(axis) {
+    match unit(axis) {
         Some(_) => Ok(()),
         None => Err(SceneError::invalid(
             format!("{field}.{name}"),

@@ -4,8 +4,6 @@
 
 use std::borrow::Cow;
 
-use glam::Vec3;
-
 /// Most characters of a name a message quotes; longer ones are cut, with the count left out.
 pub const MAX_SHOWN_NAME: usize = 64;
 
@@ -114,9 +112,13 @@ where
     }
 }
 
-/// A vector as a message writes it: `[x, y, z]`, each component [`Short`].
-pub(crate) fn short3(v: Vec3) -> String {
-    format!("[{}, {}, {}]", Short(v.x), Short(v.y), Short(v.z))
+/// A vector (`Vec3`, `DVec3`) as a message writes it: `[x, y, z]`, each component [`Short`].
+pub(crate) fn short3<T>(v: impl Into<[T; 3]>) -> String
+where
+    T: Copy + Into<f64> + std::fmt::Display + std::fmt::LowerExp,
+{
+    let [x, y, z] = v.into();
+    format!("[{}, {}, {}]", Short(x), Short(y), Short(z))
 }
 
 #[cfg(test)]

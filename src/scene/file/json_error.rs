@@ -7,7 +7,7 @@ use crate::scene::shown;
 
 /// The message for `e`: `path: reason`, or the reason alone at the top level.
 pub(super) fn message(e: &serde_path_to_error::Error<serde_json::Error>) -> String {
-    let inner = file_text_cut(&e.inner().to_string());
+    let inner = plain_types(file_text_cut(&e.inner().to_string()));
     let mut path: Vec<&Segment> = e.path().iter().collect();
     // The reason names an unknown key itself: the path ends at the object holding it.
     if inner.starts_with("unknown field `") && matches!(path.last(), Some(Segment::Map { .. })) {
@@ -65,6 +65,21 @@ fn file_text_cut(reason: &str) -> String {
         }
     }
     reason.to_string()
+}
+
+/// `reason` with the Rust number types serde names (`expected usize`) in plain words.
+fn plain_types(reason: String) -> String {
+    let mut reason = reason;
+    for (rust, plain) in [
+        ("expected usize", "expected a whole number >= 0"),
+        ("expected u64", "expected a whole number >= 0"),
+        ("expected u32", "expected a whole number >= 0"),
+        ("expected f64", "expected a number"),
+        ("expected f32", "expected a number"),
+    ] {
+        reason = reason.replace(rust, plain);
+    }
+    reason
 }
 
 /// Where a `{:?}`-written string's closing quote lies in `s` (its text after the opening one).

@@ -32,6 +32,56 @@ fn json_errors_name_the_field_and_too_many_values_say_so() {
     assert!(err.contains("ambient"), "{err}");
 }
 
+/// A value of the wrong type is named in the file's words, not Rust's: serde wrote `expected
+/// struct SceneFile`, `expected struct LightSpec` and `expected usize`.
+#[test]
+fn wrong_types_are_named_without_rust_type_names() {
+    let cases = [
+        // serde reads a struct from an array too, field by field.
+        (
+            "[1, 2, 3]",
+            "[0]: invalid type: integer `1`, expected a camera object",
+        ),
+        ("1", "expected a scene: a JSON object"),
+        (
+            r#"{"objects": [{"builtin": "plane"}], "lights": [null]}"#,
+            "lights[0]: invalid type: null, expected a light object",
+        ),
+        (
+            r#"{"objects": [{"builtin": "plane"}], "random_lights": {"count": -1}}"#,
+            "expected a whole number >= 0",
+        ),
+        (
+            r#"{"objects": [{"builtin": "plane"}], "camera": {"fov_y_deg": "x"}}"#,
+            "expected a number",
+        ),
+    ];
+    for (json, want) in cases {
+        let err = parse_str(json).unwrap_err().to_string();
+        assert!(err.contains(want), "{json}: {err}");
+        for rust in ["struct ", "usize", "f64", "Spec"] {
+            assert!(!err.contains(rust), "{json}: {err}");
+        }
+    }
+}
+
+/// Random lights past the limit with the file's own: both counts named, not their sum as if it
+/// were the file's count.
+#[test]
+fn random_lights_past_the_limit_name_the_files_own_lights_too() {
+    let light = r#"{"kind": "point", "position": [0, 1, 1], "radius": 4, "color": [1, 1, 1]}"#;
+    let json = format!(
+        r#"{{"objects": [{{"builtin": "plane"}}], "lights": [{light}, {light}],
+            "random_lights": {{"count": 4194303}}}}"#
+    );
+    let err = parse_str(&json).unwrap_err().to_string();
+    assert!(
+        err.contains("random_lights.count")
+            && err.contains("4194303 random lights and the file's 2 make 4194305"),
+        "{err}"
+    );
+}
+
 #[test]
 fn finite_numbers_past_f32_are_named_as_written_not_as_infinite() {
     let light = |field: &str, value: &str| {

@@ -108,7 +108,8 @@ pub(super) fn convert(
     }
     if !color.is_finite() || color.min_element() < 0.0 {
         return Err(format!(
-            "{field}: color must be finite and >= 0, got {color:?}{}",
+            "{field}: color must be finite and >= 0, got {}{}",
+            crate::scene::short3(color),
             past_f32(color.to_array().iter().any(|c| c.is_infinite()))
         ));
     }

@@ -157,6 +157,9 @@ pub(super) fn walk(
 }
 
 fn reached_twice(node: usize, first: usize, now: usize, parent: &[Option<usize>]) -> String {
+    if first == usize::MAX && now == usize::MAX {
+        return format!("the scene's roots list nodes[{node}] twice: a node is placed once");
+    }
     let via = |p: usize| {
         if p == usize::MAX {
             "the scene's roots".to_string()
@@ -261,5 +264,9 @@ mod tests {
         let parent = vec![Some(usize::MAX), Some(usize::MAX), Some(0)];
         let msg = reached_twice(2, 0, 1, &parent);
         assert!(msg.contains("only one parent"), "{msg}");
+        // A root listed twice: it read "reached from both the scene's roots and the scene's
+        // roots".
+        let msg = reached_twice(1, usize::MAX, usize::MAX, &parent);
+        assert!(msg.contains("roots list nodes[1] twice"), "{msg}");
     }
 }
