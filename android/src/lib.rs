@@ -3,7 +3,8 @@
 //! The Android app shell of manylight: a `NativeActivity` (android-activity, driven through
 //! winit) that makes an EGL OpenGL ES context with glutin — ES 3.0, else ES 2.0 — builds a
 //! [`manylight::Renderer`] on it and renders the built-in default scene with 1 024 seeded
-//! random lights every frame. A one-finger drag orbits the camera around the scene centre.
+//! random lights every frame (64 where the device runs only forward). A one-finger drag orbits
+//! the camera around the scene centre.
 //!
 //! Lifecycle: the window surface exists only between `resumed` and `suspended`. On suspend
 //! the surface and window are dropped and the context is made not current but kept, so the
