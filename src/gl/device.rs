@@ -26,6 +26,9 @@ pub struct Device {
     host_depth: std::cell::Cell<u32>,
     /// Whether a GL error the application left pending has been reported (once a device).
     warned_pending_error: std::cell::Cell<bool>,
+    /// GL said the context was lost (`GL_CONTEXT_LOST`, which a driver may say only once): every
+    /// later check says so too, since a lost context never comes back.
+    lost: std::cell::Cell<bool>,
     /// How the device tells whether its context is current.
     context: ContextWatch,
     /// `lab`: checks whose description contains this fail as out of memory (see
@@ -173,6 +176,7 @@ impl Device {
             vertex_array,
             host_depth: std::cell::Cell::new(0),
             warned_pending_error: std::cell::Cell::new(false),
+            lost: std::cell::Cell::new(false),
             context: ContextWatch::of_current(),
             #[cfg(feature = "lab")]
             failing_checks: std::cell::Cell::new(None),
@@ -230,6 +234,11 @@ impl Device {
     fn clear_pending_errors(&self) {
         let first = self.drain_errors();
         if first == glow::NO_ERROR {
+            return;
+        }
+        if first == glow::CONTEXT_LOST {
+            // Not the application's: the call's first check reports it.
+            self.lost.set(true);
             return;
         }
         let message = format!(
@@ -390,6 +399,18 @@ impl Device {
     }
 
     /// `glCheckFramebufferStatus` of the bound framebuffer.
+    /// The error of a framebuffer `what` whose `glCheckFramebufferStatus` gave `status`, not
+    /// complete: a status of 0 is the call's own failure (as on a lost context), told by the
+    /// error it left pending.
+    pub(crate) fn incomplete_framebuffer(&self, what: String, status: u32) -> GlError {
+        if status == 0 {
+            if let Err(e) = self.check(&format!("checking {what}")) {
+                return e;
+            }
+        }
+        GlError::FramebufferIncomplete { what, status }
+    }
+
     pub(crate) fn bound_framebuffer_status(&self) -> u32 {
         unsafe { self.gl.check_framebuffer_status(glow::FRAMEBUFFER) }
     }
@@ -542,7 +563,12 @@ impl Device {
                 "the driver reported GL_OUT_OF_MEMORY after {what} (injected)"
             )));
         }
-        match self.drain_errors() {
+        let code = self.drain_errors();
+        if code == glow::CONTEXT_LOST {
+            self.lost.set(true);
+        }
+        match code {
+            _ if self.lost.get() => Err(GlError::ContextLost(what.to_string())),
             glow::NO_ERROR => Ok(()),
             code => Err(driver_error(code, what)),
         }
@@ -656,5 +682,24 @@ mod tests {
             .to_string()
             .contains("GL_INVALID_ENUM (0x0500) after a draw"));
         assert_eq!(error_name(glow::CONTEXT_LOST), "GL_CONTEXT_LOST");
+    }
+
+    /// A driver may say GL_CONTEXT_LOST once, and then nothing: once said, at a call's start
+    /// (where it was taken for the application's error) or by a check, every later check says
+    /// so too.
+    #[test]
+    fn a_lost_context_stays_lost() {
+        let Some(ctx) = crate::gl::context::context_or_skip(EsVersion::Es3) else {
+            return;
+        };
+        let dev = Device::new(ctx.load_gl().unwrap(), EsVersion::Es3).unwrap();
+        dev.check("a healthy context").unwrap();
+        dev.lost.set(true);
+        for what in ["a draw", "an upload"] {
+            let e = dev.check(what).unwrap_err();
+            assert!(matches!(&e, GlError::ContextLost(w) if w == what), "{e}");
+        }
+        let e = dev.incomplete_framebuffer("a target".into(), 0);
+        assert!(matches!(e, GlError::ContextLost(_)), "{e}");
     }
 }

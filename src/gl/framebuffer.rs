@@ -138,11 +138,10 @@ impl OffscreenTarget {
                 destroyed: false,
             };
             if status != glow::FRAMEBUFFER_COMPLETE {
+                let e = dev
+                    .incomplete_framebuffer(format!("a {width}×{height} offscreen target"), status);
                 target.destroy(dev);
-                return Err(GlError::FramebufferIncomplete {
-                    what: format!("a {width}×{height} offscreen target"),
-                    status,
-                });
+                return Err(e);
             }
             if let Err(e) = dev.check("offscreen target creation") {
                 target.destroy(dev);

@@ -206,12 +206,10 @@ impl GBuffer {
             let accum_status = gl.check_framebuffer_status(glow::FRAMEBUFFER);
             for s in [status, accum_status] {
                 if s != glow::FRAMEBUFFER_COMPLETE {
+                    let e = dev.incomplete_framebuffer(format!("a {width}×{height} G-buffer"), s);
                     let mut gb = gb;
                     gb.destroy(dev);
-                    return Err(GlError::FramebufferIncomplete {
-                        what: format!("a {width}×{height} G-buffer"),
-                        status: s,
-                    });
+                    return Err(e);
                 }
             }
         }

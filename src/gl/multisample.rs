@@ -243,8 +243,9 @@ impl MultisampleTarget {
             }
             let status = gl.check_framebuffer_status(glow::FRAMEBUFFER);
             if status != glow::FRAMEBUFFER_COMPLETE {
+                let e = dev.incomplete_framebuffer(what, status);
                 target.destroy(dev);
-                return Err(GlError::FramebufferIncomplete { what, status });
+                return Err(e);
             }
             // At least the count asked for (a driver saying less is not believed).
             let drawn = gl.get_parameter_i32(glow::SAMPLES);
@@ -413,10 +414,7 @@ impl MultisampleTarget {
         let complete = if status == glow::FRAMEBUFFER_COMPLETE {
             Ok(())
         } else {
-            Err(GlError::FramebufferIncomplete {
-                what: format!("the MSAA resolve's {w}×{h} copy"),
-                status,
-            })
+            Err(dev.incomplete_framebuffer(format!("the MSAA resolve's {w}×{h} copy"), status))
         };
         let made = dev
             .check("allocating the MSAA resolve's copy")
