@@ -122,7 +122,8 @@ struct Shell {
 
 /// Why a frame was not presented.
 enum FrameError {
-    /// EGL lost the context (`EGL_CONTEXT_LOST`): it and the renderer are made anew.
+    /// The context was lost (`EGL_CONTEXT_LOST`, `GL_CONTEXT_LOST`): it and the renderer are
+    /// made anew.
     ContextLost(String),
     /// Anything else: tried again a little later.
     Other(String),
@@ -309,14 +310,21 @@ impl Shell {
         if self.renderer.is_none() {
             match new_renderer(egl, &mut self.scene) {
                 Ok(renderer) => self.renderer = Some(renderer),
-                Err(e) => {
-                    // Kept for the retry, released first: a surface dropped while current
-                    // stays bound to the window, whose next surface EGL then refuses.
-                    if let Ok(c) = context.make_not_current() {
-                        self.parked = Some(c);
+                Err(Failed { message, lost }) => {
+                    // Released first: a surface dropped while current stays bound to the
+                    // window, whose next surface EGL then refuses. Kept for the retry unless
+                    // lost, GL or EGL says so (the retry then makes a new one).
+                    let lost = lost
+                        || context
+                            .make_current(&surface)
+                            .is_err_and(|e| e.error_kind() == ErrorKind::ContextLost);
+                    match (context.make_not_current(), lost) {
+                        (Ok(c), false) => self.parked = Some(c),
+                        (Ok(_), true) => {}
+                        (Err(e), _) => log::warn!("cannot release the context: {e}"),
                     }
                     drop(surface);
-                    return Err(e);
+                    return Err(message);
                 }
             }
         }
@@ -380,7 +388,7 @@ impl Shell {
             let message = format!("render failed: {e}");
             // GL says so where it has robustness; EGL answers eglMakeCurrent with
             // EGL_CONTEXT_LOST after a power event. Either way no swap comes to see it.
-            let gl_lost = matches!(e, Error::Gl(GlError::ContextLost(_)));
+            let gl_lost = is_lost(&e);
             let egl_lost = live
                 .context
                 .make_current(&live.surface)
@@ -435,7 +443,7 @@ fn release(context: PossiblyCurrentContext, surface: Surface<WindowSurface>) {
 /// the window's framebuffer the frames draw into, rather than in the first frames, each compile
 /// a hitch). Where the device runs only forward, the scene keeps the lights forward can draw
 /// on a weak GPU.
-fn new_renderer(egl: &Egl, scene: &mut Scene) -> Result<Renderer, String> {
+fn new_renderer(egl: &Egl, scene: &mut Scene) -> Result<Renderer, Failed> {
     // SAFETY: glutin returns EGL's entry points (or null); glow stores them, and the context
     // stays current on this thread whenever the renderer draws.
     let gl = unsafe {
@@ -443,7 +451,7 @@ fn new_renderer(egl: &Egl, scene: &mut Scene) -> Result<Renderer, String> {
             egl.display.get_proc_address(name)
         })
     };
-    let mut renderer = Renderer::new(gl, egl.es).map_err(|e| e.to_string())?;
+    let mut renderer = Renderer::new(gl, egl.es).map_err(|e| Failed::from(&e))?;
     pick_method(&mut renderer)?;
     if renderer.method() == Method::Forward.name() && scene.lights.len() > FORWARD_LIGHTS {
         log::warn!(
@@ -478,19 +486,40 @@ fn frame_options() -> RenderOptions {
 
 /// The default method, else the first of the table this device runs (an ES 2.0 GPU without
 /// fragment `highp` cannot run the culling methods).
-fn pick_method(renderer: &mut Renderer) -> Result<(), String> {
+fn pick_method(renderer: &mut Renderer) -> Result<(), Failed> {
     let methods = std::iter::once(Method::default()).chain(Method::ALL);
     let mut failures = Vec::new();
     for method in methods {
         match renderer.set_method(method) {
             Ok(_) => return Ok(()),
+            Err(e) if is_lost(&e) => return Err(Failed::from(&e)),
             Err(e) => failures.push(e.to_string()),
         }
     }
-    Err(format!(
-        "no shading method runs here: {}",
-        failures.join("; ")
-    ))
+    Err(Failed {
+        message: format!("no shading method runs here: {}", failures.join("; ")),
+        lost: false,
+    })
+}
+
+/// Why a renderer could not be made, and whether GL said the context was lost.
+struct Failed {
+    message: String,
+    lost: bool,
+}
+
+impl From<&Error> for Failed {
+    fn from(e: &Error) -> Failed {
+        Failed {
+            message: e.to_string(),
+            lost: is_lost(e),
+        }
+    }
+}
+
+/// GL said the context was lost (`GL_CONTEXT_LOST`).
+fn is_lost(e: &Error) -> bool {
+    matches!(e, Error::Gl(GlError::ContextLost(_)))
 }
 
 /// The EGL display of the event loop, the first of ES 3.0 / ES 2.0 that has a usable config
