@@ -468,8 +468,9 @@ pub fn parse(
         (None, None) => None,
     };
     if let Some(((count, seed), field)) = random {
+        super::input::check_light_count(count, field)?;
         let total = count.saturating_add(scene.lights.len());
-        if super::input::check_light_count(total, field).is_err() && !scene.lights.is_empty() {
+        if super::input::check_light_count(total, field).is_err() {
             return Err(SceneError::invalid(
                 field,
                 format!(
@@ -480,7 +481,6 @@ pub fn parse(
                 ),
             ));
         }
-        super::input::check_light_count(total, field)?;
         let volume = scene.bounds().ok_or_else(|| {
             SceneError::invalid("random_lights", "needs geometry to place lights in")
         })?;

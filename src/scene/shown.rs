@@ -36,12 +36,15 @@ fn escaped(c: char) -> bool {
                 | '\u{feff}'
                 | '\u{ffa0}'
                 | '\u{fff0}'..='\u{fffb}'
+                | '\u{1bca0}'..='\u{1bca3}'
+                | '\u{1d173}'..='\u{1d17a}'
                 | '\u{e0000}'..='\u{e0fff}'
                 | '\u{f0000}'..='\u{10ffff}'
         )
 }
 
-/// `text` with every control and reordering character escaped (`\u{1b}`), the rest as it is.
+/// `text` with every control, reordering and invisible character written `\u{1b}`, but for a
+/// joiner or a variation selector between two characters shown as they are; the rest as it is.
 pub fn text(text: &str) -> Cow<'_, str> {
     escape(text, |_| false)
 }
@@ -52,16 +55,31 @@ pub fn lines(text: &str) -> Cow<'_, str> {
     escape(text, |c| c == '\n' || c == '\t')
 }
 
+/// Joiners and variation selectors: part of emoji (`❤️`, `👨‍👩‍👧`), of Persian and Indic
+/// spelling (ZWNJ, ZWJ) and of ideographic variants, so kept where they join two characters.
+fn joins(c: char) -> bool {
+    matches!(
+        c,
+        '\u{200c}' | '\u{200d}' | '\u{fe0e}' | '\u{fe0f}' | '\u{e0100}'..='\u{e01ef}'
+    )
+}
+
 fn escape(text: &str, keep: impl Fn(char) -> bool) -> Cow<'_, str> {
     if !text.chars().any(|c| escaped(c) && !keep(c)) {
         return Cow::Borrowed(text);
     }
+    let shown = |c: char| (!escaped(c) || joins(c)) && !c.is_whitespace();
     let mut out = String::with_capacity(text.len() + 8);
-    for c in text.chars() {
-        if escaped(c) && !keep(c) {
+    let mut chars = text.chars().peekable();
+    let mut after_shown = false;
+    while let Some(c) = chars.next() {
+        let joining = joins(c) && after_shown && chars.peek().is_some_and(|&n| shown(n));
+        if escaped(c) && !keep(c) && !joining {
             out.extend(c.escape_unicode());
+            after_shown = false;
         } else {
             out.push(c);
+            after_shown = !c.is_whitespace();
         }
     }
     Cow::Owned(out)
@@ -157,6 +175,20 @@ mod tests {
             "a\\u{200b}\\u{feff}\\u{ad}\\u{e0041}\\u{e000}b"
         );
         assert_eq!(text("Ünïcödé 名前 ✓"), "Ünïcödé 名前 ✓");
+        // Joiners and variation selectors between two characters are text; alone, leading,
+        // trailing or beside a space they hide nothing else and are escaped.
+        for kept in [
+            "❤\u{fe0f}.png",
+            "👨\u{200d}👩\u{200d}👧",
+            "می\u{200c}خواهم",
+            "葛\u{e0100}城",
+        ] {
+            assert_eq!(text(kept), kept);
+        }
+        assert_eq!(text("\u{200d}a"), "\\u{200d}a");
+        assert_eq!(text("a\u{200d}"), "a\\u{200d}");
+        assert_eq!(text("a \u{200c}b"), "a \\u{200c}b");
+        assert_eq!(text("a\u{1b}\u{200d}b"), "a\\u{1b}\\u{200d}b");
         assert_eq!(lines("log:\n\tline\u{1b}"), "log:\n\tline\\u{1b}");
         assert_eq!(
             reason(&long).chars().count(),

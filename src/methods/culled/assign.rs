@@ -126,7 +126,7 @@ fn warn_overflow(method: &str, assignment: &Assignment, limits: &AssignLimits, a
     let full = if list_full {
         format!("the index list was full, so every cell kept at most {kept}")
     } else {
-        "cells held more than that".to_string()
+        "cells touched more lights than a cell keeps".to_string()
     };
     log::warn!(
         "{method}: {dropped} light references left out of this frame's cell lists, so \

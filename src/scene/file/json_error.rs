@@ -67,19 +67,27 @@ fn file_text_cut(reason: &str) -> String {
     reason.to_string()
 }
 
-/// `reason` with the Rust number types serde names (`expected usize`) in plain words.
+/// `reason` with the Rust number type serde names after its last "expected " (`expected
+/// usize`) in plain words; the file's text quoted before it is left as it is.
 fn plain_types(reason: String) -> String {
-    let mut reason = reason;
-    for (rust, plain) in [
-        ("expected usize", "expected a whole number >= 0"),
-        ("expected u64", "expected a whole number >= 0"),
-        ("expected u32", "expected a whole number >= 0"),
-        ("expected f64", "expected a number"),
-        ("expected f32", "expected a number"),
-    ] {
-        reason = reason.replace(rust, plain);
+    let Some(at) = reason.rfind("expected ") else {
+        return reason;
+    };
+    let (quoted, expected) = reason.split_at(at);
+    let whole = |most: u64| format!("expected a whole number from 0 to {most}");
+    let plain = [
+        ("expected usize", whole(usize::MAX as u64)),
+        ("expected u64", whole(u64::MAX)),
+        ("expected u32", whole(u32::MAX.into())),
+        ("expected f64", "expected a number".to_string()),
+        ("expected f32", "expected a number".to_string()),
+    ]
+    .into_iter()
+    .find_map(|(rust, plain)| Some(format!("{plain}{}", expected.strip_prefix(rust)?)));
+    match plain {
+        Some(tail) => format!("{quoted}{tail}"),
+        None => reason,
     }
-    reason
 }
 
 /// Where a `{:?}`-written string's closing quote lies in `s` (its text after the opening one).

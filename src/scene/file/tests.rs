@@ -49,7 +49,11 @@ fn wrong_types_are_named_without_rust_type_names() {
         ),
         (
             r#"{"objects": [{"builtin": "plane"}], "random_lights": {"count": -1}}"#,
-            "expected a whole number >= 0",
+            "expected a whole number from 0 to 18446744073709551615",
+        ),
+        (
+            r#"{"objects": [{"builtin": "plane"}], "random_lights": {"count": 1, "seed": 1e30}}"#,
+            "expected a whole number from 0 to 18446744073709551615",
         ),
         (
             r#"{"objects": [{"builtin": "plane"}], "camera": {"fov_y_deg": "x"}}"#,
@@ -78,6 +82,13 @@ fn random_lights_past_the_limit_name_the_files_own_lights_too() {
     assert!(
         err.contains("random_lights.count")
             && err.contains("4194303 random lights and the file's 2 make 4194305"),
+        "{err}"
+    );
+    // A count past the limit alone is named alone, not in a sum that saturates.
+    let json = json.replace("4194303", "18446744073709551615");
+    let err = parse_str(&json).unwrap_err().to_string();
+    assert!(
+        err.contains("18446744073709551615 lights is more than") && !err.contains("make"),
         "{err}"
     );
 }

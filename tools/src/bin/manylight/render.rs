@@ -380,8 +380,9 @@ pub fn run(args: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
         _ => String::new(),
     };
     if scene.is_animated() {
-        // `+ 0.0` writes -0 as 0.
-        tail += &format!(" · moving lights, picture at t = {:.3} s", args.time + 0.0);
+        // Rounded as written, then `+ 0.0`: -0.0001 reads 0.000, not -0.000.
+        let shown = (args.time * 1e3).round() / 1e3 + 0.0;
+        tail += &format!(" · moving lights, picture at t = {shown:.3} s");
         if args.frames > 1 {
             let last = args.time + f64::from(args.frames - 1) / args.fps;
             tail += &format!(", timed to t = {last:.3} s");
