@@ -483,6 +483,10 @@ impl Renderer {
         srgb: bool,
     ) -> Result<(), Error> {
         let refuse = |reason: String| Err(Error::Msaa { samples, reason });
+        // First: HDR output is refused on every context and method, whatever else says no.
+        if format != ColorFormat::Rgba8 {
+            return refuse("only 8-bit output is multisampled, not HDR".into());
+        }
         if let Some(reason) = crate::gl::multisample::unsupported_reason(&self.dev, samples) {
             return refuse(reason);
         }
@@ -497,9 +501,6 @@ impl Renderer {
                 self.method.name(),
                 able.join(", ")
             ));
-        }
-        if format != ColorFormat::Rgba8 {
-            return refuse("only 8-bit output is multisampled, not HDR".into());
         }
         let shape = ((width, height), samples);
         let kept = self.msaa.as_ref().map(|m| (m.shape(), m.is_srgb()));

@@ -63,6 +63,13 @@ fn unsupported_msaa_is_a_clear_error() {
         .render_offscreen_hdr(&scene, 16, 16, &msaa(4))
         .unwrap_err();
     assert!(err.to_string().contains("HDR"), "{err}");
+    // HDR is the reason with any method: deferred said it did not support MSAA.
+    es3.r().set_method_named("deferred").unwrap();
+    let err = es3
+        .r()
+        .render_offscreen_hdr(&scene, 16, 16, &msaa(4))
+        .unwrap_err();
+    assert!(err.to_string().contains("not HDR"), "{err}");
     drop(es3);
     // This binary's contexts have no MESA_EXTENSION_OVERRIDE: llvmpipe's ES 2.0 lacks
     // GL_EXT_multisampled_render_to_texture (tests/msaa_es2.rs adds it). An implementation
@@ -82,6 +89,11 @@ fn unsupported_msaa_is_a_clear_error() {
             .contains("GL_EXT_multisampled_render_to_texture"),
         "{err}"
     );
+    let err = es2
+        .r()
+        .render_offscreen_hdr(&scene, 16, 16, &msaa(4))
+        .unwrap_err();
+    assert!(err.to_string().contains("not HDR"), "{err}");
 }
 
 /// GL rounds a sample count it lacks up to one it has: the stats name the count the frame was
