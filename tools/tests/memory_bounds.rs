@@ -559,7 +559,7 @@ fn a_root_list_repeating_one_node_is_refused_within_bounded_memory() {
     let out = render_within_384_mib(&prlimit, &path, dir.path());
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(1), "{stderr}");
-    assert!(stderr.contains("nodes[0] is reached from both"), "{stderr}");
+    assert!(stderr.contains("roots list nodes[0] twice"), "{stderr}");
 }
 
 /// tobj keeps every MTL statement it does not read as a string in a map per material, about
