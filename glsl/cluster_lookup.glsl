@@ -2,7 +2,8 @@
 // (grid: src/cluster/grid.rs; texels: src/cluster/pack_grid.rs). Needs data_texture.glsl.
 // Tiled forward uses the same code with a one-cascade, one-slice grid.
 uniform HIGHP vec2 u_viewport;
-// The viewport's lower-left corner in the framebuffer: the frame's pixel (0, 0).
+// The viewport's lower-left corner in the framebuffer: the frame's pixel (0, 0) (ES 2.0,
+// whose cells are the pixel centre's).
 uniform HIGHP vec2 u_frameOrigin;
 // t = (f(d) - x) * y, with f = log2 when z > 0.5 (perspective) and f(d) = d otherwise.
 uniform HIGHP vec3 u_depthMap;
@@ -15,6 +16,16 @@ uniform HIGHP vec2 u_gridInvHeight;
 #else
 uniform HIGHP usampler2D u_grid;
 uniform HIGHP usampler2D u_indices;
+// The view's half extents, per unit depth (perspective) or absolute (z = 1: orthographic).
+uniform HIGHP vec3 u_cellProjection;
+
+// Frame position (pixels) of view-space point P: the cell of the point a fragment shades.
+// With MSAA a partly covered pixel shades at its centroid, which may lie in the next column
+// or row of cells when a cell border cuts the pixel (its centre's cell lacks the lights there).
+HIGHP vec2 shadedFrameXY(HIGHP vec3 P) {
+    HIGHP vec2 scale = mix(u_cellProjection.xy * -P.z, u_cellProjection.xy, u_cellProjection.z);
+    return (P.xy / scale * 0.5 + 0.5) * u_viewport;
+}
 #endif
 
 HIGHP float clusterT(HIGHP float viewDepth) {

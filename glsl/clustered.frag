@@ -21,9 +21,14 @@ void main() {
         discard;
     }
 #endif
+#if GLSL_ES == 100
     // In highp from here: GLSL ES 1.00 declares gl_FragCoord mediump, whose pixel centres
     // (x.5) are exact only below 1024; a driver that keeps it in fp16 loses them past that.
     HIGHP vec2 fragXY = gl_FragCoord.xy - u_frameOrigin;
+#else
+    // The cell of the point shaded: the centroid (v_viewPos), not the pixel centre.
+    HIGHP vec2 fragXY = shadedFrameXY(v_viewPos);
+#endif
     HIGHP float viewDepth = -v_viewPos.z;
 #if COUNT_EVALS
     // The loop below runs over the cell's list: its length is the evaluation count.

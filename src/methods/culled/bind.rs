@@ -5,7 +5,7 @@ use glam::Vec3;
 
 use super::upload::{TextureSet, Uploaded};
 use crate::cluster::assign::Assignment;
-use crate::cluster::grid::{ClusterGrid, DepthMapping};
+use crate::cluster::grid::{ClusterGrid, DepthMapping, GridProjection};
 use crate::gl::program::{Resolver, Sampler, Uniform, UniformSet};
 use crate::gl::texture::DataTexture;
 use crate::gl::{Device, EsVersion};
@@ -40,6 +40,8 @@ struct CellLookup {
     indices: Uniform<Sampler>,
     /// ES 2.0: 1 / the grid's and the index texture's heights.
     inv_heights: Uniform<[f32; 2]>,
+    /// ES 3.0: the view's half extents and whether it is orthographic (`shadedFrameXY`).
+    projection: Uniform<Vec3>,
 }
 
 impl UniformSet for ClusteredProgram {
@@ -54,12 +56,13 @@ impl UniformSet for ClusteredProgram {
             lights: LightData::resolve(r, lit),
             cells: CellLookup {
                 viewport: r.required("u_viewport"),
-                frame_origin: r.required("u_frameOrigin"),
+                frame_origin: r.required_when(es2, "u_frameOrigin"),
                 depth_map: r.required("u_depthMap"),
                 cascade_count: r.required("u_cascadeCount"),
                 grid: r.required("u_grid"),
                 indices: r.required_when(lit, "u_indices"),
                 inv_heights: r.required_when(es2, "u_gridInvHeight"),
+                projection: r.required_when(!es2, "u_cellProjection"),
             },
             // Only the ES 2.0 loop has a constant bound to stop early.
             longest_list: r.required_when(
@@ -93,6 +96,7 @@ pub(super) struct Bindings<'a> {
     depth_map: Vec3,
     cascades: f32,
     inv_heights: [f32; 2],
+    projection: Vec3,
     longest_list: f32,
 }
 
@@ -119,6 +123,14 @@ impl<'a> Bindings<'a> {
             depth_map: Vec3::new(grid.a as f32, grid.b as f32, log2),
             cascades: grid.cascades.len() as f32,
             inv_heights: [inv_height(&set.grid), inv_height(&set.indices)],
+            projection: match grid.projection {
+                GridProjection::Perspective { tan_x, tan_y } => {
+                    Vec3::new(tan_x as f32, tan_y as f32, 0.0)
+                }
+                GridProjection::Orthographic { half_x, half_y } => {
+                    Vec3::new(half_x as f32, half_y as f32, 1.0)
+                }
+            },
             longest_list: assignment.stats.max_lights_per_cluster as f32,
         }
     }
@@ -135,6 +147,7 @@ impl<'a> Bindings<'a> {
         cells.frame_origin.set(dev, self.frame_origin);
         cells.depth_map.set(dev, self.depth_map);
         cells.cascade_count.set(dev, self.cascades);
+        cells.projection.set(dev, self.projection);
         p.longest_list.set(dev, self.longest_list);
     }
 }

@@ -200,3 +200,56 @@ fn a_floor_seen_edge_on_is_shaded_inside_its_triangles() {
         );
     }
 }
+
+/// A cell border through a pixel that an edge crosses: with MSAA (ES 3.0) the pixel shades at
+/// its centroid, left of the border, under a light that reaches only the left. The lights of
+/// the pixel centre's cell, right of the border, lacked it: the pixel came out black where
+/// forward lights it (helper-122). Cells are found from the point shaded.
+#[test]
+fn a_cell_border_through_an_edge_pixel_keeps_the_lights_of_the_point_shaded() {
+    use glam::{DMat4, DVec3, Vec3};
+    let mut scene = manylight::Scene::empty();
+    scene.ambient = Vec3::ZERO;
+    let grey = scene.add_material(manylight::Material::flat("floor", Vec3::splat(0.8)));
+    let mut floor = manylight::MeshBuilder::new();
+    let c = |x: f32, z: f32| Vec3::new(x, 0.0, z);
+    // The floor ends at x = -0.2: the edge crosses pixel 48 of 97, whose centre is 0.
+    floor.quad(c(-60.0, 5.0), c(-0.2, 5.0), c(-0.2, -5.0), c(-60.0, -5.0));
+    scene.add_object(floor.build().unwrap(), grey, DMat4::IDENTITY);
+    // Reaches the floor left of x = -0.1 only.
+    let light = manylight::Light::point(DVec3::new(-2.0, 0.5, 0.0), 1.9, Vec3::ONE, 200.0);
+    scene.lights.push(light);
+    scene.camera = manylight::Camera {
+        position: DVec3::new(0.0, 10.0, 0.0),
+        target: DVec3::ZERO,
+        up: DVec3::NEG_Z,
+        projection: manylight::Projection::Orthographic {
+            height: 1.0,
+            near: 0.1,
+            far: 20.0,
+        },
+    };
+    let mut gpu = Gpu::new(EsVersion::Es3);
+    // A 64-px clustered grid and 48.5-px tiles put a border at x = 48.5, inside pixel 48.
+    let options = RenderOptions {
+        grid: manylight::GridConfig::fixed(64.0),
+        tile_px: 48.5,
+        ..msaa(4)
+    };
+    gpu.r().set_method_named("forward").unwrap();
+    let reference = gpu.render(&scene, 97, 1, &options);
+    // SwiftShader shades at the pixel's centre all the same (docs/drivers.md), unlit there.
+    if gpu.r().caps().implementation() != "SwiftShader" {
+        let lit = reference.get_pixel(48, 0)[0];
+        assert!(lit > 20, "the case lost its lit edge pixel: {lit}");
+    }
+    for method in ["tiled", "clustered"] {
+        gpu.r().set_method_named(method).unwrap();
+        let got = gpu.render(&scene, 97, 1, &options);
+        for x in 0..97 {
+            let (a, b) = (got.get_pixel(x, 0), reference.get_pixel(x, 0));
+            let worst = (0..3).map(|c| a[c].abs_diff(b[c])).max().unwrap();
+            assert!(worst <= 2, "{method}: pixel {x} {a:?}, forward {b:?}");
+        }
+    }
+}
