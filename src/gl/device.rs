@@ -398,19 +398,25 @@ impl Device {
         unsafe { self.gl.get_parameter_framebuffer(glow::FRAMEBUFFER_BINDING) }
     }
 
-    /// `glCheckFramebufferStatus` of the bound framebuffer.
-    /// The error of a framebuffer `what` whose `glCheckFramebufferStatus` gave `status`, not
-    /// complete: a status of 0 is the call's own failure (as on a lost context), told by the
-    /// error it left pending.
-    pub(crate) fn incomplete_framebuffer(&self, what: String, status: u32) -> GlError {
-        if status == 0 {
-            if let Err(e) = self.check(&format!("checking {what}")) {
-                return e;
-            }
+    /// The error a `glCheckFramebufferStatus` of `what` that gave `status` left pending: a
+    /// status of 0 is the call's own failure (as on a lost context), not a verdict.
+    pub(crate) fn check_status_call(&self, status: u32, what: &str) -> Result<(), GlError> {
+        match status {
+            0 => self.check(&format!("checking {what}")),
+            _ => Ok(()),
         }
-        GlError::FramebufferIncomplete { what, status }
     }
 
+    /// The error of a framebuffer `what` whose `glCheckFramebufferStatus` gave `status`, not
+    /// complete ([`Device::check_status_call`]'s where the call itself failed).
+    pub(crate) fn incomplete_framebuffer(&self, what: String, status: u32) -> GlError {
+        match self.check_status_call(status, &what) {
+            Err(e) => e,
+            Ok(()) => GlError::FramebufferIncomplete { what, status },
+        }
+    }
+
+    /// `glCheckFramebufferStatus` of the bound framebuffer.
     pub(crate) fn bound_framebuffer_status(&self) -> u32 {
         unsafe { self.gl.check_framebuffer_status(glow::FRAMEBUFFER) }
     }

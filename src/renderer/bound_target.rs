@@ -43,10 +43,8 @@ impl Renderer {
     ) -> Result<Option<u32>, Error> {
         self.check_viewport_limit(width, height)?;
         let status = self.dev.bound_framebuffer_status();
-        // A status of 0 is an error of the call itself, as on a lost context.
-        if status == 0 {
-            self.dev.check("glCheckFramebufferStatus")?;
-        }
+        self.dev
+            .check_status_call(status, "the bound framebuffer")?;
         if status != glow::FRAMEBUFFER_COMPLETE {
             return Err(GlError::BoundFramebuffer(format!(
                 "it is incomplete ({}; on a surfaceless context, framebuffer 0 has no surface: \
