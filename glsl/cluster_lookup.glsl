@@ -18,13 +18,13 @@ uniform HIGHP usampler2D u_grid;
 uniform HIGHP usampler2D u_indices;
 // The view's half extents, per unit depth (perspective) or absolute (z = 1: orthographic).
 uniform HIGHP vec3 u_cellProjection;
+#include "frame_position.glsl"
 
 // Frame position (pixels) of view-space point P: the cell of the point a fragment shades.
 // With MSAA a partly covered pixel shades at its centroid, which may lie in the next column
 // or row of cells when a cell border cuts the pixel (its centre's cell lacks the lights there).
 HIGHP vec2 shadedFrameXY(HIGHP vec3 P) {
-    HIGHP vec2 scale = mix(u_cellProjection.xy * -P.z, u_cellProjection.xy, u_cellProjection.z);
-    return (P.xy / scale * 0.5 + 0.5) * u_viewport;
+    return framePosition(P, u_cellProjection.xy, u_cellProjection.z, u_viewport);
 }
 #endif
 

@@ -1,5 +1,6 @@
 // The G-buffer's surface point and normal (written by gbuffer.frag, read back by the deferred
 // light and composite passes; layout in src/gl/gbuffer.rs).
+#include "frame_position.glsl"
 uniform HIGHP sampler2D u_gAlbedo;
 uniform HIGHP sampler2D u_gNormalDepth;
 uniform HIGHP sampler2D u_gSpecular;
@@ -25,9 +26,7 @@ HIGHP vec3 viewPosition(HIGHP vec2 windowXY, HIGHP float depth) {
 // forward shades need not lie on the centre's ray (rasterizers snap vertices to 1/16 to 1/256
 // of a pixel), and lights with steep falloff show the difference.
 HIGHP vec2 windowPosition(HIGHP vec3 P) {
-    HIGHP float depth = -P.z;
-    HIGHP vec2 scale = mix(u_halfExtent * depth, u_halfExtent, u_orthographic);
-    return (P.xy / scale * 0.5 + 0.5) * u_viewport;
+    return framePosition(P, u_halfExtent, u_orthographic, u_viewport);
 }
 
 HIGHP vec2 signNotZero(HIGHP vec2 v) {

@@ -203,6 +203,10 @@ pub const FILES: &[(&str, &str)] = &[
         "cluster_lookup.glsl",
         include_str!("../../glsl/cluster_lookup.glsl"),
     ),
+    (
+        "frame_position.glsl",
+        include_str!("../../glsl/frame_position.glsl"),
+    ),
 ];
 
 /// Looks up a shader by name.

@@ -577,10 +577,7 @@ fn needs_specular_target(ctx: &FrameContext) -> bool {
 /// View-space half extents of the projection (per unit depth when perspective) and whether it
 /// is orthographic: how the G-buffer passes map window positions to view space.
 fn half_extent(ctx: &FrameContext) -> ([f32; 2], bool) {
-    match GridProjection::from_matrix(&ctx.projection.as_dmat4()) {
-        GridProjection::Perspective { tan_x, tan_y } => ([tan_x as f32, tan_y as f32], false),
-        GridProjection::Orthographic { half_x, half_y } => ([half_x as f32, half_y as f32], true),
-    }
+    GridProjection::from_matrix(&ctx.projection.as_dmat4()).half_extents()
 }
 
 impl ShadingMethod for Deferred {

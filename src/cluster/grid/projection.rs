@@ -67,6 +67,17 @@ pub enum GridProjection {
 }
 
 impl GridProjection {
+    /// The view's half extents as the shaders take them (`u_halfExtent`, `u_cellProjection`):
+    /// per unit depth for a perspective, absolute for an orthographic one (then `true`).
+    pub fn half_extents(&self) -> ([f32; 2], bool) {
+        match *self {
+            GridProjection::Perspective { tan_x, tan_y } => ([tan_x as f32, tan_y as f32], false),
+            GridProjection::Orthographic { half_x, half_y } => {
+                ([half_x as f32, half_y as f32], true)
+            }
+        }
+    }
+
     /// From a GL projection matrix (perspective or orthographic, symmetric).
     pub fn from_matrix(p: &DMat4) -> GridProjection {
         if p.w_axis.w == 0.0 {

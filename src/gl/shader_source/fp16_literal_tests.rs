@@ -13,6 +13,10 @@ const HIGHP_ONLY: &[(&str, &str)] = &[
         "tiled and clustered need fragment highp",
     ),
     ("clustered.frag", "tiled and clustered need fragment highp"),
+    (
+        "frame_position.glsl",
+        "ES 3.0 tiled, clustered and deferred only, where fragment highp is required",
+    ),
     ("precision_probe.frag", "it measures the precision itself"),
     (
         "deferred_common.glsl",

@@ -5,7 +5,7 @@ use glam::Vec3;
 
 use super::upload::{TextureSet, Uploaded};
 use crate::cluster::assign::Assignment;
-use crate::cluster::grid::{ClusterGrid, DepthMapping, GridProjection};
+use crate::cluster::grid::{ClusterGrid, DepthMapping};
 use crate::gl::program::{Resolver, Sampler, Uniform, UniformSet};
 use crate::gl::texture::DataTexture;
 use crate::gl::{Device, EsVersion};
@@ -123,13 +123,9 @@ impl<'a> Bindings<'a> {
             depth_map: Vec3::new(grid.a as f32, grid.b as f32, log2),
             cascades: grid.cascades.len() as f32,
             inv_heights: [inv_height(&set.grid), inv_height(&set.indices)],
-            projection: match grid.projection {
-                GridProjection::Perspective { tan_x, tan_y } => {
-                    Vec3::new(tan_x as f32, tan_y as f32, 0.0)
-                }
-                GridProjection::Orthographic { half_x, half_y } => {
-                    Vec3::new(half_x as f32, half_y as f32, 1.0)
-                }
+            projection: {
+                let ([x, y], orthographic) = grid.projection.half_extents();
+                Vec3::new(x, y, f32::from(u8::from(orthographic)))
             },
             longest_list: assignment.stats.max_lights_per_cluster as f32,
         }
