@@ -18,7 +18,7 @@ use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 
 use super::direction::unit;
-use super::{Light, LightKind, SceneError, Short};
+use super::{Light, LightKind, SceneError};
 
 /// Shortest period accepted, in seconds (a millisecond: faster is flicker noise at any
 /// frame rate).
@@ -419,10 +419,8 @@ fn check_axis(axis: DVec3, field: &str, name: &str) -> Result<(), SceneError> {
         None => Err(SceneError::invalid(
             format!("{field}.{name}"),
             format!(
-                "must be a finite, non-zero direction, got [{}, {}, {}]",
-                Short(axis.x),
-                Short(axis.y),
-                Short(axis.z)
+                "must be a finite, non-zero direction, got {}",
+                super::short3(axis)
             ),
         )),
     }

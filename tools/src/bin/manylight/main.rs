@@ -167,7 +167,7 @@ fn check_usage(cli: &Cli, subcommand: Option<&str>) {
     }
     if let Some(a) = render.filter(|a| a.frames > 1) {
         // Each frame can be rendered alone with `--time`: the last one too.
-        let last = a.time + f64::from(a.frames - 1) / a.fps;
+        let last = a.timeline().time_of(a.frames - 1);
         if last.abs() > render::MAX_TIME_S {
             usage_error(
                 subcommand,

@@ -99,6 +99,17 @@ pub struct RenderArgs {
     pub assign_budget: Option<f64>,
 }
 
+impl RenderArgs {
+    /// The frames `--time`, `--fps` and `--frames` ask for.
+    pub fn timeline(&self) -> crate::sequence::Timeline {
+        crate::sequence::Timeline {
+            start_s: self.time,
+            fps: self.fps,
+            frames: self.frames,
+        }
+    }
+}
+
 /// `--tonemap`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum ToneMapArg {
@@ -332,11 +343,7 @@ pub fn run(args: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
     let (width, height) = args.size;
     // A still scene is the same at every time: its timed frames are one frame timed again.
     let result = if scene.is_animated() || args.record.is_some() {
-        let timeline = crate::sequence::Timeline {
-            start_s: args.time,
-            fps: args.fps,
-            frames: args.frames,
-        };
+        let timeline = args.timeline();
         let size = (width, height);
         let keep = match args.record.as_deref() {
             Some(path) => crate::sequence::Keep::Record(path),
@@ -384,7 +391,7 @@ pub fn run(args: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
         let shown = (args.time * 1e3).round() / 1e3 + 0.0;
         tail += &format!(" · moving lights, picture at t = {shown:.3} s");
         if args.frames > 1 {
-            let last = args.time + f64::from(args.frames - 1) / args.fps;
+            let last = args.timeline().time_of(args.frames - 1);
             tail += &format!(", timed to t = {last:.3} s");
         }
     }
