@@ -431,10 +431,29 @@ pub struct ProgramKey {
     pub dialect: EsVersion,
 }
 
-/// Built programs by key.
-#[derive(Default)]
+/// Built programs by key, each with the frame that last used it.
 pub struct ProgramCache {
-    programs: HashMap<ProgramKey, Program>,
+    programs: HashMap<ProgramKey, Cached>,
+    /// Frames begun (`begin_frame`).
+    frames: u64,
+    /// The frame a bind counts for: the current one, or the next one between frames.
+    stamp: u64,
+}
+
+impl Default for ProgramCache {
+    /// Empty; the programs bound before the first frame count as its.
+    fn default() -> Self {
+        ProgramCache {
+            programs: HashMap::new(),
+            frames: 0,
+            stamp: 1,
+        }
+    }
+}
+
+struct Cached {
+    program: Program,
+    last_used: u64,
 }
 
 /// One built variant, for reports.
@@ -465,15 +484,15 @@ impl ProgramCache {
         key: ProgramKey,
         defines: impl FnOnce() -> Vec<(String, String)>,
     ) -> Result<&U, GlError> {
-        let program = match self.programs.entry(key) {
+        let cached = match self.programs.entry(key) {
             std::collections::hash_map::Entry::Occupied(e) => e.into_mut(),
-            std::collections::hash_map::Entry::Vacant(e) => e.insert(Program::build::<U>(
-                dev,
-                key.shader,
-                &defines(),
-                key.features,
-            )?),
+            std::collections::hash_map::Entry::Vacant(e) => e.insert(Cached {
+                program: Program::build::<U>(dev, key.shader, &defines(), key.features)?,
+                last_used: 0,
+            }),
         };
+        cached.last_used = self.stamp;
+        let program = &cached.program;
         program.bind(dev);
         program.uniforms().ok_or_else(|| GlError::ProgramLink {
             shader: key.shader.to_string(),
@@ -494,7 +513,7 @@ impl ProgramCache {
                 shader: k.shader,
                 features: k.features,
                 dialect: k.dialect,
-                source_bytes: p.source_bytes,
+                source_bytes: p.program.source_bytes,
             })
             .collect();
         v.sort_by_key(|p| (p.shader, p.features));
@@ -511,10 +530,37 @@ impl ProgramCache {
         self.programs.is_empty()
     }
 
+    /// Starts a frame: the programs bound from now on count as its.
+    pub fn begin_frame(&mut self) {
+        self.frames += 1;
+        self.stamp = self.frames;
+    }
+
+    /// Counts the programs bound from now until the next frame as that frame's (a warm-up
+    /// builds them for it).
+    pub fn count_for_next_frame(&mut self) {
+        self.stamp = self.frames + 1;
+    }
+
+    /// Frees the programs none of the last `frames` frames used, nor anything since them
+    /// ([`ProgramCache::count_for_next_frame`]), and returns how many.
+    pub fn free_unused(&mut self, dev: &Device, frames: u64) -> usize {
+        let oldest_kept = self.frames.saturating_sub(frames) + 1;
+        let before = self.programs.len();
+        self.programs.retain(|_, cached| {
+            let keep = cached.last_used >= oldest_kept;
+            if !keep {
+                cached.program.destroy(dev);
+            }
+            keep
+        });
+        before - self.programs.len()
+    }
+
     /// Frees every program.
     pub fn destroy(&mut self, dev: &Device) {
-        for (_, mut p) in self.programs.drain() {
-            p.destroy(dev);
+        for (_, mut cached) in self.programs.drain() {
+            cached.program.destroy(dev);
         }
     }
 }

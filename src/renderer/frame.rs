@@ -80,9 +80,15 @@ impl Renderer {
         applications: bool,
     ) -> Result<(), Error> {
         let (draw_calls, programs) = (self.dev.draw_calls(), self.programs.len());
+        if self.warming_up {
+            self.programs.count_for_next_frame();
+        } else {
+            self.programs.begin_frame();
+        }
         let drawn = self.render_counted(scene, size, options, origin, stats, applications);
         stats.draw_calls = self.dev.draw_calls() - draw_calls;
         stats.programs_built = self.programs.len() - programs;
+        stats.memory.shader_programs = self.programs.len();
         drawn
     }
 
@@ -457,6 +463,7 @@ impl Renderer {
             gbuffer_bytes: method_stats.gbuffer_bytes,
             msaa_bytes: 0,
             scene_gpu_bytes: self.gpu_scene.gpu_bytes(),
+            shader_programs: 0,
         };
         // Only colour frames that waited for the GPU (or were timed on it) say what shading
         // costs: count passes run other shaders.

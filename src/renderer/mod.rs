@@ -16,6 +16,7 @@ mod frame_setup;
 mod hosted_tests;
 mod method;
 mod offscreen;
+mod programs;
 mod stats;
 #[cfg(test)]
 mod timer_tests;

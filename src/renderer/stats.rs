@@ -168,6 +168,10 @@ pub struct MemoryStats {
     /// and those of earlier scenes the game still holds
     /// ([`Renderer::free_unused_uploads`](super::Renderer::free_unused_uploads) frees them).
     pub scene_gpu_bytes: usize,
+    /// Shader programs (variants) the renderer holds after the frame, built for this frame
+    /// or earlier ones ([`Renderer::free_unused_programs`](super::Renderer::free_unused_programs)
+    /// frees those no recent frame drew with).
+    pub shader_programs: usize,
 }
 
 impl Default for FrameStats {

@@ -30,5 +30,6 @@ mod srgb_framebuffer;
 mod still_frames;
 mod still_records;
 mod tone_map;
+mod unused_programs;
 mod viewport_origin;
 mod warm_up;

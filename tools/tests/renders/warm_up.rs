@@ -17,7 +17,7 @@ const H: u32 = 36;
 
 /// The courtyard with 40 lights (spots among them), a sun, a metallic-roughness object and a
 /// transparent one: most of what selects a variant.
-fn game_scene() -> Scene {
+pub(crate) fn game_scene() -> Scene {
     let mut s = scene::builtin::build("courtyard", Some((40, 7))).unwrap();
     s.directional_lights.push(DirectionalLight::new(
         DVec3::new(1.0, -2.0, -1.0),

@@ -1,0 +1,24 @@
+//! [`Renderer::free_unused_programs`]: the shader variants a game's recent frames no longer
+//! draw with, freed when it asks.
+
+use super::Renderer;
+use crate::Error;
+
+impl Renderer {
+    /// Frees the shader variants that none of the last `frames` frames drew with, nor a
+    /// [`Renderer::warm_up`] since them, and returns how many it freed. Variants are otherwise
+    /// kept for the renderer's life, so that a material, light kind or option that comes back
+    /// costs no compile: a game that has drawn many kinds of content (levels, options menus,
+    /// methods switched) calls this when it leaves a level, with `frames` 1 after a frame of
+    /// the next one, or 0 after its warm-up. Each variant held costs the driver memory for its
+    /// code (a few hundred KB on llvmpipe); [`MemoryStats::shader_programs`](crate::MemoryStats::shader_programs)
+    /// counts them. A frame that needs a freed one builds it again, a hitch
+    /// ([`FrameStats::programs_built`](crate::FrameStats::programs_built)).
+    pub fn free_unused_programs(&mut self, frames: u32) -> Result<usize, Error> {
+        self.hosted(|r| {
+            let freed = r.programs.free_unused(&r.dev, u64::from(frames));
+            r.dev.check("freeing unused shader programs")?;
+            Ok(freed)
+        })
+    }
+}
