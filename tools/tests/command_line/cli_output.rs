@@ -325,12 +325,23 @@ fn grid_options_a_method_cannot_take_are_named() {
         let stderr = String::from_utf8_lossy(&out.stderr);
         let said = stderr.contains("--grid, --slice-depth set the clustered grid");
         assert_eq!(said, warned, "{method}: {stderr}");
+        assert_eq!(said, stderr.contains("so they change nothing"), "{stderr}");
         assert_eq!(
             stderr.contains("fixed at 32 px"),
             method == "tiled",
             "{stderr}"
         );
     }
+    // One option is "it".
+    let args = [
+        "--size", "16x9", "--method", "forward", "--grid", "8", "--out", "p.png",
+    ];
+    let out = manylight(&args, &[], dir.path());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("--grid set the clustered grid: forward has none, so it changes nothing"),
+        "{stderr}"
+    );
 }
 
 /// Recording into a folder that holds another recording's frames left them beside the new

@@ -56,7 +56,8 @@ struct Cli {
     /// Folder of the OpenGL ES implementation to render with (its libEGL.so[.1] and
     /// libGLESv2.so[.2]: SwiftShader, ANGLE, a device's driver) instead of the system's; the
     /// same as MANYLIGHT_GLES_LIB (docs/drivers.md). Only `matrix` takes it more than once,
-    /// and there `system` names the system's libraries.
+    /// and there `system` names the system's libraries. Not for `view`, whose window's GL comes
+    /// from glutin.
     #[arg(long, global = true, value_name = "DIR")]
     gles_lib: Vec<std::path::PathBuf>,
     /// Let a model's references (glTF buffer and image URIs, OBJ mtllib and texture paths)

@@ -186,8 +186,13 @@ fn unused_grid_options(args: &RenderArgs, stats: &manylight::FrameStats) -> Opti
         Some(px) => format!(" (its tiles are fixed at {px} px)"),
         None => String::new(),
     };
+    let they = if given.len() == 1 {
+        "it changes"
+    } else {
+        "they change"
+    };
     Some(format!(
-        "{} set the clustered grid: {drawn} has none{tiles}, so they change nothing",
+        "{} set the clustered grid: {drawn} has none{tiles}, so {they} nothing",
         given.join(", ")
     ))
 }
