@@ -434,10 +434,12 @@ pub struct ProgramKey {
 /// Built programs by key, each with the frame that last used it.
 pub struct ProgramCache {
     programs: HashMap<ProgramKey, Cached>,
-    /// Frames begun (`begin_frame`).
+    /// Frames that bound a program: a frame refused before it drew is not one.
     frames: u64,
     /// The frame a bind counts for: the current one, or the next one between frames.
     stamp: u64,
+    /// A frame has begun and not bound a program yet.
+    frame_pending: bool,
 }
 
 impl Default for ProgramCache {
@@ -447,6 +449,7 @@ impl Default for ProgramCache {
             programs: HashMap::new(),
             frames: 0,
             stamp: 1,
+            frame_pending: false,
         }
     }
 }
@@ -484,6 +487,11 @@ impl ProgramCache {
         key: ProgramKey,
         defines: impl FnOnce() -> Vec<(String, String)>,
     ) -> Result<&U, GlError> {
+        if self.frame_pending {
+            self.frame_pending = false;
+            self.frames += 1;
+            self.stamp = self.frames;
+        }
         let cached = match self.programs.entry(key) {
             std::collections::hash_map::Entry::Occupied(e) => e.into_mut(),
             std::collections::hash_map::Entry::Vacant(e) => e.insert(Cached {
@@ -530,20 +538,22 @@ impl ProgramCache {
         self.programs.is_empty()
     }
 
-    /// Starts a frame: the programs bound from now on count as its.
+    /// Starts a frame: the programs bound from now on count as its, and its first bind counts
+    /// it among the frames.
     pub fn begin_frame(&mut self) {
-        self.frames += 1;
-        self.stamp = self.frames;
+        self.frame_pending = true;
     }
 
     /// Counts the programs bound from now until the next frame as that frame's (a warm-up
     /// builds them for it).
     pub fn count_for_next_frame(&mut self) {
+        self.frame_pending = false;
         self.stamp = self.frames + 1;
     }
 
     /// Frees the programs none of the last `frames` frames used, nor anything since them
-    /// ([`ProgramCache::count_for_next_frame`]), and returns how many.
+    /// ([`ProgramCache::count_for_next_frame`]), and returns how many. A frame that bound no
+    /// program (refused, or failed before it drew) is not counted.
     pub fn free_unused(&mut self, dev: &Device, frames: u64) -> usize {
         let oldest_kept = self.frames.saturating_sub(frames) + 1;
         let before = self.programs.len();

@@ -38,6 +38,17 @@ fn variants_no_recent_frame_drew_with_are_freed_on_request() {
         let (first_b, b) = frame(&mut gpu, &level_b);
         let held = b.memory.shader_programs;
         let live = live_programs(&mut gpu);
+        // Calls refused before they drew (a minimised window's empty frame, a bad option)
+        // are no frames.
+        assert!(gpu
+            .r()
+            .render(&level_a, 0, 0, &RenderOptions::default())
+            .is_err());
+        let bad = RenderOptions {
+            tile_px: 0.0,
+            ..Default::default()
+        };
+        assert!(gpu.r().render_offscreen(&level_a, W, H, &bad).is_err());
         // Level B's frame is the last one: what only level A drew with goes.
         let freed = gpu.r().free_unused_programs(1).unwrap();
         assert!(freed > 0, "{es}: level A's own variants");
