@@ -357,6 +357,14 @@ fn usage_errors_exit_2_and_name_the_flags() {
             "--es 2",
         ),
         (&["info", "--no-fragment-highp", "--es", "3"], "--es 2"),
+        (
+            &["render", "--no-float-textures", "--size", "8x8"],
+            "--no-float-textures plays an OpenGL ES 2.0 device",
+        ),
+        (
+            &["info", "--no-float-textures", "--es", "3"],
+            "--no-float-textures plays",
+        ),
         (&["render", "--frames", "many"], "--frames"),
         (&["render", "--size", "0x10"], "empty"),
         (&["render", "--bogus"], "--bogus"),

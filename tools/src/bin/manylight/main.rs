@@ -127,17 +127,27 @@ fn check_usage(cli: &Cli, subcommand: Option<&str>) {
         Some(Command::Render(a)) => Some(a),
         _ => None,
     };
-    let no_highp_es = match &cli.command {
-        Some(Command::Info(a)) => a.es.map(|es| (a.no_fragment_highp, es)),
-        _ => render.map(|a| (a.no_fragment_highp, a.es)),
+    // (--no-fragment-highp, --no-float-textures, --es)
+    let es2_devices = match &cli.command {
+        Some(Command::Info(a)) => {
+            a.es.map(|es| (a.no_fragment_highp, a.no_float_textures, es))
+        }
+        _ => render.map(|a| (a.no_fragment_highp, a.no_float_textures, a.es)),
     };
-    if let Some((true, EsArg::Three)) = no_highp_es {
-        usage_error(
+    match es2_devices {
+        Some((true, _, EsArg::Three)) => usage_error(
             subcommand,
             ErrorKind::ArgumentConflict,
             "--no-fragment-highp plays an OpenGL ES 2.0 device (ES 3.0 requires fragment \
                  highp): add `--es 2`",
-        );
+        ),
+        Some((_, true, EsArg::Three)) => usage_error(
+            subcommand,
+            ErrorKind::ArgumentConflict,
+            "--no-float-textures plays an OpenGL ES 2.0 device (ES 3.0 has float textures in \
+                 core): add `--es 2`",
+        ),
+        _ => {}
     }
     if let Some(a) = render.filter(|a| a.assign_budget.is_some()) {
         if let render::GridArg::Fixed(_) = a.grid {
