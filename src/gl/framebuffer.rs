@@ -172,13 +172,18 @@ impl OffscreenTarget {
         self.format
     }
 
-    /// Reads a float colour buffer as f32 RGBA, top row first.
+    /// Reads a float colour buffer as f32 RGBA, top row first. ES 3.0 reads floats as
+    /// `RGBA`/`FLOAT`; an ES 2.0 context may take only its own read format (Mesa's: half
+    /// floats), which its `GL_IMPLEMENTATION_COLOR_READ_*` name.
     pub fn read_rgba_f32(&self, dev: &Device) -> Result<Vec<[f32; 4]>, GlError> {
+        unsafe { dev.gl.bind_framebuffer(glow::FRAMEBUFFER, Some(self.fbo)) };
+        if let Some(kind) = half_float_read_type(dev) {
+            return self.read_rgba_half(dev, kind);
+        }
         let (w, h) = (self.width as usize, self.height as usize);
         let mut texels: Vec<[f32; 4]> =
             super::alloc::zeroed(self.width, self.height, 1, "float read-back")?;
         unsafe {
-            dev.gl.bind_framebuffer(glow::FRAMEBUFFER, Some(self.fbo));
             dev.gl.pixel_store_i32(glow::PACK_ALIGNMENT, 4);
             dev.gl.read_pixels(
                 0,
@@ -192,6 +197,34 @@ impl OffscreenTarget {
         }
         dev.check("glReadPixels (float)")?;
         super::alloc::flip_rows(&mut texels, w);
+        Ok(texels)
+    }
+
+    /// [`OffscreenTarget::read_rgba_f32`] as `RGBA` half floats of type `kind`, its
+    /// framebuffer bound.
+    fn read_rgba_half(&self, dev: &Device, kind: u32) -> Result<Vec<[f32; 4]>, GlError> {
+        let w = self.width as usize;
+        let mut halves: Vec<[u16; 4]> =
+            super::alloc::zeroed(self.width, self.height, 1, "half-float read-back")?;
+        unsafe {
+            dev.gl.pixel_store_i32(glow::PACK_ALIGNMENT, 2);
+            dev.gl.read_pixels(
+                0,
+                0,
+                self.width as i32,
+                self.height as i32,
+                glow::RGBA,
+                kind,
+                glow::PixelPackData::Slice(Some(bytemuck::cast_slice_mut(&mut halves))),
+            );
+        }
+        dev.check("glReadPixels (half float)")?;
+        super::alloc::flip_rows(&mut halves, w);
+        let mut texels: Vec<[f32; 4]> =
+            super::alloc::zeroed(self.width, self.height, 1, "float read-back")?;
+        for (texel, half) in texels.iter_mut().zip(&halves) {
+            *texel = half.map(|bits| half::f16::from_bits(bits).to_f32());
+        }
         Ok(texels)
     }
 
@@ -273,4 +306,24 @@ mod tests {
             target.destroy(&dev);
         }
     }
+}
+
+/// ES 2.0's `OES_texture_half_float` type (ES 3.0's `HALF_FLOAT` has another value).
+const HALF_FLOAT_OES: u32 = 0x8D61;
+
+/// On an ES 2.0 renderer, the half-float type of the bound framebuffer's own read format when
+/// that is `RGBA` half floats, which the context accepts where it may refuse `RGBA`/`FLOAT`.
+fn half_float_read_type(dev: &Device) -> Option<u32> {
+    if dev.es() != EsVersion::Es2 {
+        return None;
+    }
+    let (format, kind) = unsafe {
+        (
+            dev.gl
+                .get_parameter_i32(glow::IMPLEMENTATION_COLOR_READ_FORMAT) as u32,
+            dev.gl
+                .get_parameter_i32(glow::IMPLEMENTATION_COLOR_READ_TYPE) as u32,
+        )
+    };
+    (format == glow::RGBA && matches!(kind, HALF_FLOAT_OES | glow::HALF_FLOAT)).then_some(kind)
 }

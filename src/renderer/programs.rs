@@ -6,8 +6,9 @@ use crate::Error;
 
 impl Renderer {
     /// Frees the shader variants that none of the last `frames` frames drew with, nor a
-    /// [`Renderer::warm_up`] since them, and returns how many it freed. A call refused before
-    /// it drew (an empty viewport, an invalid option) is not a frame. Variants are otherwise
+    /// [`Renderer::warm_up`] since them (a warm-up counts as the frame after it), and returns
+    /// how many it freed. A call refused before it drew (an empty viewport, an invalid option)
+    /// is not a frame. Variants are otherwise
     /// kept for the renderer's life, so that a material, light kind or option that comes back
     /// costs no compile: a game that has drawn many kinds of content (levels, options menus,
     /// methods switched) calls this when it leaves a level, with `frames` 1 after a frame of

@@ -15,6 +15,7 @@ mod front_faces;
 mod game_draw_buffers;
 mod game_framebuffer_checks;
 mod grid_outgrown;
+mod hdr_read_back;
 mod invalid_options;
 mod keep_framebuffer;
 mod light_evals;
