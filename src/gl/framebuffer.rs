@@ -269,6 +269,26 @@ impl Drop for OffscreenTarget {
     }
 }
 
+/// ES 2.0's `OES_texture_half_float` type (ES 3.0's `HALF_FLOAT` has another value).
+const HALF_FLOAT_OES: u32 = 0x8D61;
+
+/// On an ES 2.0 renderer, the half-float type of the bound framebuffer's own read format when
+/// that is `RGBA` half floats, which the context accepts where it may refuse `RGBA`/`FLOAT`.
+fn half_float_read_type(dev: &Device) -> Option<u32> {
+    if dev.es() != EsVersion::Es2 {
+        return None;
+    }
+    let (format, kind) = unsafe {
+        (
+            dev.gl
+                .get_parameter_i32(glow::IMPLEMENTATION_COLOR_READ_FORMAT) as u32,
+            dev.gl
+                .get_parameter_i32(glow::IMPLEMENTATION_COLOR_READ_TYPE) as u32,
+        )
+    };
+    (format == glow::RGBA && matches!(kind, HALF_FLOAT_OES | glow::HALF_FLOAT)).then_some(kind)
+}
+
 #[cfg(test)]
 mod tests {
     use super::OffscreenTarget;
@@ -306,24 +326,4 @@ mod tests {
             target.destroy(&dev);
         }
     }
-}
-
-/// ES 2.0's `OES_texture_half_float` type (ES 3.0's `HALF_FLOAT` has another value).
-const HALF_FLOAT_OES: u32 = 0x8D61;
-
-/// On an ES 2.0 renderer, the half-float type of the bound framebuffer's own read format when
-/// that is `RGBA` half floats, which the context accepts where it may refuse `RGBA`/`FLOAT`.
-fn half_float_read_type(dev: &Device) -> Option<u32> {
-    if dev.es() != EsVersion::Es2 {
-        return None;
-    }
-    let (format, kind) = unsafe {
-        (
-            dev.gl
-                .get_parameter_i32(glow::IMPLEMENTATION_COLOR_READ_FORMAT) as u32,
-            dev.gl
-                .get_parameter_i32(glow::IMPLEMENTATION_COLOR_READ_TYPE) as u32,
-        )
-    };
-    (format == glow::RGBA && matches!(kind, HALF_FLOAT_OES | glow::HALF_FLOAT)).then_some(kind)
 }
