@@ -62,12 +62,13 @@ impl OffscreenTarget {
             renderbuffers: true,
         };
         target_size::check(dev.caps(), "a render target", (width, height), storage)?;
+        // The frame is drawn and read in the lower-left corner of the storage.
+        let (storage_width, storage_height) =
+            target_size::texture_storage(dev.caps(), (width, height));
         let gl = &dev.gl;
         unsafe {
             let color = dev.create_texture()?;
             gl.bind_texture(glow::TEXTURE_2D, Some(color));
-            /// `GL_HALF_FLOAT_OES` (ES 2.0's half-float type differs from ES 3.0's).
-            const HALF_FLOAT_OES: u32 = 0x8D61;
             let (internal, ty) = match (format, dev.es()) {
                 (ColorFormat::Rgba8, EsVersion::Es3) => (glow::RGBA8, glow::UNSIGNED_BYTE),
                 (ColorFormat::Rgba8, EsVersion::Es2) => (glow::RGBA, glow::UNSIGNED_BYTE),
@@ -78,8 +79,8 @@ impl OffscreenTarget {
                 glow::TEXTURE_2D,
                 0,
                 internal as i32,
-                width as i32,
-                height as i32,
+                storage_width as i32,
+                storage_height as i32,
                 0,
                 glow::RGBA,
                 ty,
@@ -98,8 +99,8 @@ impl OffscreenTarget {
             gl.renderbuffer_storage(
                 glow::RENDERBUFFER,
                 depth_format,
-                width as i32,
-                height as i32,
+                storage_width as i32,
+                storage_height as i32,
             );
             // Out of memory here is an error naming the size, not an incomplete framebuffer.
             let fbo = dev
@@ -269,7 +270,8 @@ impl Drop for OffscreenTarget {
     }
 }
 
-/// ES 2.0's `OES_texture_half_float` type (ES 3.0's `HALF_FLOAT` has another value).
+/// `GL_HALF_FLOAT_OES`: ES 2.0's `OES_texture_half_float` type (ES 3.0's `HALF_FLOAT` has
+/// another value).
 const HALF_FLOAT_OES: u32 = 0x8D61;
 
 /// On an ES 2.0 renderer, the half-float type of the bound framebuffer's own read format when

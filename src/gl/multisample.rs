@@ -191,6 +191,10 @@ impl MultisampleTarget {
                     );
                 }
                 Color::Texture(texture) => {
+                    // The frame in the lower-left corner of a power-of-two texture where the
+                    // context has no other sizes; its depth the same size (ES 2.0 needs that).
+                    let (sw, sh) = target_size::texture_storage(dev.caps(), (width, height));
+                    let (w, h) = (sw as i32, sh as i32);
                     gl.bind_texture(glow::TEXTURE_2D, Some(*texture));
                     gl.tex_image_2d(
                         glow::TEXTURE_2D,
@@ -337,6 +341,12 @@ impl MultisampleTarget {
                     dev.gl.bind_texture(glow::TEXTURE_2D, Some(*texture));
                 }
                 uniforms.resolved.set(dev, 0);
+                let (sw, sh) = target_size::texture_storage(dev.caps(), self.size);
+                let frame_part = [
+                    self.size.0 as f32 / sw as f32,
+                    self.size.1 as f32 / sh as f32,
+                ];
+                uniforms.frame_part.set(dev, frame_part);
                 let triangle = self.triangle.as_ref();
                 triangle.expect("made with the ES 2.0 target").draw(dev);
             }
@@ -486,12 +496,14 @@ impl UniformSet for SolidUniforms {
 /// The ES 2.0 resolve program's texture of averaged samples.
 struct ResolveUniforms {
     resolved: Uniform<Sampler>,
+    frame_part: Uniform<[f32; 2]>,
 }
 
 impl UniformSet for ResolveUniforms {
     fn resolve(r: &mut Resolver<'_>) -> Self {
         ResolveUniforms {
             resolved: r.required("u_resolved"),
+            frame_part: r.required("u_framePart"),
         }
     }
 }

@@ -239,6 +239,51 @@ fn es2_lists_whether_images_keep_their_size() {
     }
 }
 
+/// Mesa's ES 2.0 without `GL_OES_texture_npot` refuses every texture of another size (ES 2.0
+/// itself allows them clamped and unmipmapped): every frame of a size not a power of two failed
+/// with `GL_INVALID_VALUE` allocating the renderer's own target. Its targets are now allocated
+/// at powers of two, the frame in their corner: the picture is the one with the extension,
+/// with every method, and through ES 2.0's MSAA extension (whose copy reads the frame's part).
+#[test]
+fn es2_without_npot_textures_renders_frames_of_any_size() {
+    let dir = tempfile::tempdir().unwrap();
+    if !mesa_driver() {
+        return;
+    }
+    let msaa_ext = "+GL_EXT_multisampled_render_to_texture";
+    for method in ["forward", "tiled", "clustered"] {
+        for msaa in [false, true] {
+            let mut pictures = Vec::new();
+            for npot in ["", "-GL_OES_texture_npot"] {
+                let extensions = if msaa {
+                    format!("{npot} {msaa_ext}")
+                } else {
+                    npot.to_string()
+                };
+                let env = [
+                    ("MESA_GLES_VERSION_OVERRIDE", "2.0"),
+                    ("MESA_EXTENSION_OVERRIDE", extensions.trim()),
+                ];
+                let out_file = format!("{method}{msaa}{}.png", npot.len());
+                let mut args = vec![
+                    "render", "--es", "2", "--method", method, "--lights", "32", "--size", "60x36",
+                    "--out", &out_file,
+                ];
+                if msaa {
+                    args.extend(["--msaa", "4"]);
+                }
+                let out = manylight(&args, &env, dir.path());
+                assert!(out.status.success(), "{env:?} {args:?}: {}", text(&out));
+                pictures.push(image::open(dir.path().join(&out_file)).unwrap().to_rgba8());
+            }
+            assert!(
+                pictures[0] == pictures[1],
+                "{method}, MSAA {msaa}: another picture without GL_OES_texture_npot"
+            );
+        }
+    }
+}
+
 #[test]
 fn without_float_textures_es2_falls_back_to_rgba8_lights_with_a_warning() {
     let dir = tempfile::tempdir().unwrap();
