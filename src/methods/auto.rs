@@ -10,8 +10,8 @@
 
 use std::fmt::Write as _;
 
-use super::clustered::culled_support;
 use super::culled::{CulledForward, CulledFrame, Culling};
+use super::culled_support::culled_support;
 use super::deferred::Deferred;
 use super::forward::Forward;
 use super::{FrameContext, MethodDesc, MethodStats, ShadingMethod, Support};

@@ -39,6 +39,16 @@ pub fn capacities(caps: &Caps) -> Capacities {
     let rows = caps.max_texture_size.max(1) as usize;
     let texels = rows * DATA_TEXTURE_WIDTH as usize;
     let es2 = caps.es == EsVersion::Es2;
+    if let super::Support::Unsupported(_) = super::culled_support::culled_support(caps) {
+        // Tiled and clustered do not run (no fragment highp on ES 2.0): no list fits.
+        return Capacities {
+            forward_lights: super::forward::max_lights(caps),
+            indexed_lights: 0,
+            index_entries: 0,
+            cell_lights: Some(0),
+            grid_texels: 0,
+        };
+    }
     let index_entries = texels * GridEncoding::for_es(caps.es).indices_per_texel();
     Capacities {
         forward_lights: super::forward::max_lights(caps),
@@ -92,5 +102,32 @@ mod tests {
             let forward_lights = capacities(dev.caps()).forward_lights;
             assert_eq!(forward_lights > 0, fits, "{limit}");
         }
+    }
+
+    /// Without fragment highp (a Mali-400) tiled and clustered do not run, so no list fits:
+    /// `info` said 65 536 visible lights there. Forward keeps its capacity.
+    #[test]
+    fn without_fragment_highp_only_forward_has_a_capacity() {
+        let Some(ctx) = context_or_skip(EsVersion::Es2) else {
+            return;
+        };
+        let mut dev = Device::new(ctx.load_gl().unwrap(), EsVersion::Es2).unwrap();
+        let with = capacities(dev.caps());
+        assert!(
+            with.indexed_lights > 0 && with.index_entries > 0,
+            "{with:?}"
+        );
+        dev.caps_mut().fragment_highp = crate::gl::caps::Precision::default();
+        let without = capacities(dev.caps());
+        assert_eq!(
+            (
+                without.indexed_lights,
+                without.index_entries,
+                without.cell_lights
+            ),
+            (0, 0, Some(0))
+        );
+        assert_eq!(without.grid_texels, 0);
+        assert!(without.forward_lights > 0, "{without:?}");
     }
 }

@@ -10,6 +10,7 @@ mod auto_memory_tests;
 pub mod capacity;
 pub mod clustered;
 pub mod culled;
+pub mod culled_support;
 pub mod deferred;
 pub mod directional;
 pub mod features;

@@ -1,8 +1,8 @@
 //! Tiled forward: the same engine as clustered with 2D screen tiles (`cluster::tiles`), so a
 //! tile's list holds every light crossing its frustum column at any depth.
 
-use super::clustered::culled_support;
 use super::culled::{CulledForward, Culling};
+use super::culled_support::culled_support;
 use super::MethodDesc;
 use crate::gl::EsVersion;
 
