@@ -69,6 +69,10 @@ pub struct Caps {
     /// Textures of any size with mipmaps and `REPEAT` (an ES 3.0 context, or
     /// `GL_OES_texture_npot`): without it, ES 2.0 images are scaled to a power of two.
     pub npot_textures: bool,
+    /// Render-target textures (clamped, unmipmapped) of any size: ES 2.0 allows them without
+    /// `GL_OES_texture_npot`, Mesa without it refuses them (probed). Without them the
+    /// renderer's own targets are allocated at powers of two, the frame in their corner.
+    pub npot_targets: bool,
     /// 24-bit depth renderbuffers (ES 3.0, or `GL_OES_depth24`).
     pub depth24: bool,
     /// Packed depth and stencil renderbuffers, 24 bits of depth (ES 3.0, or
@@ -190,6 +194,7 @@ impl Caps {
                 }
             }
         }
+        let npot_textures = es3 || desktop || v.major >= 3 || has("GL_OES_texture_npot");
         Ok(Caps {
             es,
             context_version,
@@ -210,7 +215,8 @@ impl Caps {
             fragment_mediump,
             float_textures: es3 || has("GL_OES_texture_float"),
             // A context of ES 3.0 or later has them whatever level the renderer keeps to.
-            npot_textures: es3 || desktop || v.major >= 3 || has("GL_OES_texture_npot"),
+            npot_textures,
+            npot_targets: npot_textures || unsafe { takes_npot_targets(gl) },
             depth24: es3 || has("GL_OES_depth24"),
             packed_depth_stencil: es3 || has("GL_OES_packed_depth_stencil"),
             timer_query: has("GL_EXT_disjoint_timer_query"),
@@ -376,4 +382,32 @@ pub(crate) fn mesa_switches_note() -> String {
     } else {
         format!(" ({})", notes.join("; "))
     }
+}
+/// Whether `gl` allocates a 3 × 3 RGBA texture, as ES 2.0 allows without
+/// `GL_OES_texture_npot` (clamped and unmipmapped, as render targets are). The binding of
+/// `TEXTURE_2D` is given back, and the texture deleted.
+///
+/// # Safety
+/// `gl` is current, with no pixel-unpack buffer bound (an ES 2.0 context has none).
+unsafe fn takes_npot_targets(gl: &glow::Context) -> bool {
+    let Ok(texture) = gl.create_texture() else {
+        return false;
+    };
+    let bound = gl.get_parameter_texture(glow::TEXTURE_BINDING_2D);
+    gl.bind_texture(glow::TEXTURE_2D, Some(texture));
+    gl.tex_image_2d(
+        glow::TEXTURE_2D,
+        0,
+        glow::RGBA as i32,
+        3,
+        3,
+        0,
+        glow::RGBA,
+        glow::UNSIGNED_BYTE,
+        glow::PixelUnpackData::Slice(None),
+    );
+    let taken = gl.get_error() == glow::NO_ERROR;
+    gl.bind_texture(glow::TEXTURE_2D, bound);
+    gl.delete_texture(texture);
+    taken
 }

@@ -30,6 +30,9 @@ pub struct MultisampleTarget {
     color: Color,
     depth: glow::Renderbuffer,
     size: (u32, u32),
+    /// The buffers' size: `size`, or for ES 2.0's texture on a context without non-power-of-two
+    /// textures the powers of two above it, the frame in their lower-left corner.
+    storage: (u32, u32),
     /// The samples asked for.
     samples: u32,
     /// The samples the implementation gave: GL rounds a count it lacks up to one it has.
@@ -138,6 +141,10 @@ impl MultisampleTarget {
             color,
             depth,
             size: (width, height),
+            storage: match dev.es() {
+                EsVersion::Es3 => (width, height),
+                EsVersion::Es2 => target_size::texture_storage(dev.caps(), (width, height)),
+            },
             samples,
             samples_drawn: samples,
             color_format: if srgb && dev.es() == EsVersion::Es3 {
@@ -191,17 +198,15 @@ impl MultisampleTarget {
                     );
                 }
                 Color::Texture(texture) => {
-                    // The frame in the lower-left corner of a power-of-two texture where the
-                    // context has no other sizes; its depth the same size (ES 2.0 needs that).
-                    let (sw, sh) = target_size::texture_storage(dev.caps(), (width, height));
-                    let (w, h) = (sw as i32, sh as i32);
+                    // The depth as large as the texture: ES 2.0 needs that.
+                    let (sw, sh) = (target.storage.0 as i32, target.storage.1 as i32);
                     gl.bind_texture(glow::TEXTURE_2D, Some(*texture));
                     gl.tex_image_2d(
                         glow::TEXTURE_2D,
                         0,
                         glow::RGBA as i32,
-                        w,
-                        h,
+                        sw,
+                        sh,
                         0,
                         glow::RGBA,
                         glow::UNSIGNED_BYTE,
@@ -230,7 +235,7 @@ impl MultisampleTarget {
                     // The single-sampled target's depth: the same precision with MSAA as
                     // without.
                     let (format, _) = dev.caps().own_depth_format();
-                    storage(glow::RENDERBUFFER, samples as i32, format, w, h);
+                    storage(glow::RENDERBUFFER, samples as i32, format, sw, sh);
                 }
             }
             gl.framebuffer_renderbuffer(
@@ -282,7 +287,7 @@ impl MultisampleTarget {
     /// 4-byte copy, once a frame was resolved to an origin other than (0, 0)) — what an
     /// immediate-mode GPU allocates; a tile-based one keeps the samples on chip.
     pub fn gpu_bytes(&self) -> usize {
-        let pixels = self.size.0 as usize * self.size.1 as usize;
+        let pixels = self.storage.0 as usize * self.storage.1 as usize;
         let per_sample = 4 + self.depth_bytes;
         let copy = if self.resolved_copy.is_some() { 4 } else { 0 };
         match self.color {
@@ -341,10 +346,9 @@ impl MultisampleTarget {
                     dev.gl.bind_texture(glow::TEXTURE_2D, Some(*texture));
                 }
                 uniforms.resolved.set(dev, 0);
-                let (sw, sh) = target_size::texture_storage(dev.caps(), self.size);
                 let frame_part = [
-                    self.size.0 as f32 / sw as f32,
-                    self.size.1 as f32 / sh as f32,
+                    self.size.0 as f32 / self.storage.0 as f32,
+                    self.size.1 as f32 / self.storage.1 as f32,
                 ];
                 uniforms.frame_part.set(dev, frame_part);
                 let triangle = self.triangle.as_ref();

@@ -55,12 +55,11 @@ pub(crate) fn check(
     Ok(())
 }
 
-/// The size a frame-sized texture of `caps` is allocated at: the frame's, or on a context
-/// without non-power-of-two textures (Mesa's ES 2.0 without `GL_OES_texture_npot`, which
-/// refuses them outright, where ES 2.0 itself allows them clamped and unmipmapped) the next
-/// powers of two, the frame drawn in its lower-left corner.
+/// The size a frame-sized texture of `caps` is allocated at: the frame's, or on a context that
+/// refuses render targets of other sizes ([`Caps::npot_targets`]) the next powers of two, the
+/// frame drawn in its lower-left corner.
 pub(crate) fn texture_storage(caps: &Caps, (width, height): (u32, u32)) -> (u32, u32) {
-    if caps.npot_textures {
+    if caps.npot_targets {
         (width, height)
     } else {
         (width.next_power_of_two(), height.next_power_of_two())

@@ -26,29 +26,27 @@ pub struct Capacities {
 
 /// The capacities of `caps`' context.
 pub fn capacities(caps: &Caps) -> Capacities {
+    let nothing = Capacities {
+        forward_lights: 0,
+        indexed_lights: 0,
+        index_entries: 0,
+        cell_lights: Some(0),
+        grid_texels: 0,
+    };
     if super::forward::data_textures_unfit(caps).is_some() {
         // No method that reads the data textures runs: nothing fits.
+        return nothing;
+    }
+    if let super::Support::Unsupported(_) = super::culled_support::culled_support(caps) {
+        // Tiled and clustered do not run (no fragment highp on ES 2.0): no list fits.
         return Capacities {
-            forward_lights: 0,
-            indexed_lights: 0,
-            index_entries: 0,
-            cell_lights: Some(0),
-            grid_texels: 0,
+            forward_lights: super::forward::max_lights(caps),
+            ..nothing
         };
     }
     let rows = caps.max_texture_size.max(1) as usize;
     let texels = rows * DATA_TEXTURE_WIDTH as usize;
     let es2 = caps.es == EsVersion::Es2;
-    if let super::Support::Unsupported(_) = super::culled_support::culled_support(caps) {
-        // Tiled and clustered do not run (no fragment highp on ES 2.0): no list fits.
-        return Capacities {
-            forward_lights: super::forward::max_lights(caps),
-            indexed_lights: 0,
-            index_entries: 0,
-            cell_lights: Some(0),
-            grid_texels: 0,
-        };
-    }
     let index_entries = texels * GridEncoding::for_es(caps.es).indices_per_texel();
     Capacities {
         forward_lights: super::forward::max_lights(caps),

@@ -236,14 +236,17 @@ fn es2_lists_whether_images_keep_their_size() {
         assert!(out.status.success(), "{}", text(&out));
         let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
         assert_eq!(v["caps"]["npot_textures"], npot, "{env:?}");
+        // Mesa without the extension refuses render targets of other sizes too (probed).
+        assert_eq!(v["caps"]["npot_targets"], npot, "{env:?}");
     }
 }
 
 /// Mesa's ES 2.0 without `GL_OES_texture_npot` refuses every texture of another size (ES 2.0
 /// itself allows them clamped and unmipmapped): every frame of a size not a power of two failed
-/// with `GL_INVALID_VALUE` allocating the renderer's own target. Its targets are now allocated
-/// at powers of two, the frame in their corner: the picture is the one with the extension,
-/// with every method, and through ES 2.0's MSAA extension (whose copy reads the frame's part).
+/// with `GL_INVALID_VALUE` allocating the renderer's own target. On such a context
+/// (`Caps::npot_targets` false) its targets are allocated at powers of two, the frame in their
+/// corner: the picture is the one with the extension, with every method, and through ES 2.0's
+/// MSAA extension (whose copy reads the frame's part).
 #[test]
 fn es2_without_npot_textures_renders_frames_of_any_size() {
     let dir = tempfile::tempdir().unwrap();
@@ -253,7 +256,7 @@ fn es2_without_npot_textures_renders_frames_of_any_size() {
     let msaa_ext = "+GL_EXT_multisampled_render_to_texture";
     for method in ["forward", "tiled", "clustered"] {
         for msaa in [false, true] {
-            let mut pictures = Vec::new();
+            let (mut pictures, mut msaa_bytes) = (Vec::new(), Vec::new());
             for npot in ["", "-GL_OES_texture_npot"] {
                 let extensions = if msaa {
                     format!("{npot} {msaa_ext}")
@@ -267,7 +270,7 @@ fn es2_without_npot_textures_renders_frames_of_any_size() {
                 let out_file = format!("{method}{msaa}{}.png", npot.len());
                 let mut args = vec![
                     "render", "--es", "2", "--method", method, "--lights", "32", "--size", "60x36",
-                    "--out", &out_file,
+                    "--out", &out_file, "--stats", "s.json",
                 ];
                 if msaa {
                     args.extend(["--msaa", "4"]);
@@ -275,11 +278,21 @@ fn es2_without_npot_textures_renders_frames_of_any_size() {
                 let out = manylight(&args, &env, dir.path());
                 assert!(out.status.success(), "{env:?} {args:?}: {}", text(&out));
                 pictures.push(image::open(dir.path().join(&out_file)).unwrap().to_rgba8());
+                msaa_bytes.push(
+                    stats(&dir.path().join("s.json"))["msaa_bytes"]
+                        .as_f64()
+                        .unwrap(),
+                );
             }
             assert!(
                 pictures[0] == pictures[1],
                 "{method}, MSAA {msaa}: another picture without GL_OES_texture_npot"
             );
+            // The MSAA target's memory is its 64 × 64 storage's.
+            if msaa {
+                let ratio = msaa_bytes[1] / msaa_bytes[0];
+                assert_eq!(ratio, 64.0 * 64.0 / (60.0 * 36.0), "{msaa_bytes:?}");
+            }
         }
     }
 }
