@@ -1,8 +1,8 @@
 // The full-screen triangle of the ES 2.0 MSAA copy, with the texture coordinate interpolated
 // at highp: GLSL ES 1.00 declares gl_FragCoord mediump, and at fp16 a pixel centre past 1 024
 // pixels is not representable (the copy could take the neighbouring texel).
-// u_framePart: the frame's part of the texture (1, 1 but where a context without
-// non-power-of-two textures gave the frame a larger one).
+// u_framePart: the frame's part of the texture (1, 1 but where a context refusing other sizes
+// gave the frame a power-of-two one).
 ATTRIBUTE vec3 a_position;
 uniform HIGHP vec2 u_framePart;
 VARYING HIGHP vec2 v_uv;

@@ -383,6 +383,7 @@ pub(crate) fn mesa_switches_note() -> String {
         format!(" ({})", notes.join("; "))
     }
 }
+
 /// Whether `gl` allocates a 3 × 3 RGBA texture, as ES 2.0 allows without
 /// `GL_OES_texture_npot` (clamped and unmipmapped, as render targets are). The binding of
 /// `TEXTURE_2D` is given back, and the texture deleted.

@@ -30,8 +30,9 @@ pub struct MultisampleTarget {
     color: Color,
     depth: glow::Renderbuffer,
     size: (u32, u32),
-    /// The buffers' size: `size`, or for ES 2.0's texture on a context without non-power-of-two
-    /// textures the powers of two above it, the frame in their lower-left corner.
+    /// The buffers' size: `size`, or for ES 2.0's texture on a context refusing render targets
+    /// of other sizes ([`Caps::npot_targets`](super::Caps::npot_targets)) the powers of two
+    /// above it, the frame in their lower-left corner.
     storage: (u32, u32),
     /// The samples asked for.
     samples: u32,
