@@ -276,6 +276,11 @@ fn es2_without_npot_textures_renders_frames_of_any_size() {
                     args.extend(["--msaa", "4"]);
                 }
                 let out = manylight(&args, &env, dir.path());
+                if msaa && text(&out).contains("GL_MAX_SAMPLES (1)") {
+                    // A driver without MSAA (softpipe) has no samples to give, extension or not.
+                    eprintln!("{method}: no MSAA on this driver");
+                    break;
+                }
                 assert!(out.status.success(), "{env:?} {args:?}: {}", text(&out));
                 pictures.push(image::open(dir.path().join(&out_file)).unwrap().to_rgba8());
                 msaa_bytes.push(
@@ -283,6 +288,9 @@ fn es2_without_npot_textures_renders_frames_of_any_size() {
                         .as_f64()
                         .unwrap(),
                 );
+            }
+            if pictures.is_empty() {
+                continue;
             }
             assert!(
                 pictures[0] == pictures[1],
