@@ -34,7 +34,9 @@ impl Renderer {
     ///
     /// The returned stats own their texts (method, GL strings, reasons): in steady state they
     /// are all the renderer allocates for a frame. A game's per-frame loop calls
-    /// [`Renderer::render_reusing`] instead, which allocates nothing.
+    /// [`Renderer::render_reusing`] instead, which allocates nothing, with
+    /// [`RenderOptions::wait_for_gpu`] `false`: the default options wait for the GPU at the end
+    /// of every frame (`glFinish`), as measurements want and a game does not.
     pub fn render(
         &mut self,
         scene: &Scene,

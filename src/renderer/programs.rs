@@ -14,9 +14,9 @@ impl Renderer {
     ///
     /// Variants are otherwise kept for the renderer's life, so that a material, light kind or
     /// option that comes back costs no compile: a game that has drawn many kinds of content
-    /// (levels, options menus, methods switched) calls this when it leaves a level, with
-    /// `frames` covering one displayed frame of the next level (1, or 2 for two views), or 0
-    /// after its warm-up. Each variant held costs the driver memory for its code (a few
+    /// (levels, options menus, methods switched) calls this once it has moved to the next
+    /// level: right after that level's warm-up with `frames` 0, or after its first displayed
+    /// frame with `frames` covering it (1, or 2 for two views). Each variant held costs the driver memory for its code (a few
     /// hundred KB on llvmpipe); [`MemoryStats::shader_programs`](crate::MemoryStats::shader_programs)
     /// counts them. A frame that needs a freed one builds it again, a hitch
     /// ([`FrameStats::programs_built`](crate::FrameStats::programs_built)).

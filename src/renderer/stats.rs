@@ -91,7 +91,10 @@ pub struct ContextStats {
 /// Where a frame's time went.
 #[derive(Clone, Copy, Debug, Default, Serialize)]
 pub struct TimeStats {
-    /// Frame time in milliseconds: CPU work plus `glFinish` (median of the timed frames).
+    /// Frame time in milliseconds (median of the timed frames): CPU work plus `glFinish` with
+    /// [`RenderOptions::wait_for_gpu`](crate::RenderOptions::wait_for_gpu), else the CPU's
+    /// submission alone (a game's frame). With the renderer's own MSAA target, its fill and
+    /// resolve are outside both this and `gpu_ms` (drawn before and after the timed part).
     pub frame_ms: f64,
     /// GPU time of the frame's GL work from a `GL_EXT_disjoint_timer_query` elapsed-time query
     /// (median of the timed frames). A frame that does not wait for the GPU (a game's) reports
@@ -156,7 +159,8 @@ pub struct MemoryStats {
     /// frame shows them, are in `scene_gpu_bytes` instead.
     pub upload_bytes: usize,
     /// Bytes uploaded per frame over the timed frames of an animated sequence (lights that
-    /// move change what is uploaded); `None` for a single frame.
+    /// move change what is uploaded): the command line's animated runs fill it; the library's
+    /// frames leave it `None`.
     pub upload_bytes_spread: Option<Spread>,
     /// GPU memory held by the method.
     pub method_gpu_bytes: usize,
