@@ -178,49 +178,20 @@ impl OffscreenTarget {
     /// floats), which its `GL_IMPLEMENTATION_COLOR_READ_*` name.
     pub fn read_rgba_f32(&self, dev: &Device) -> Result<Vec<[f32; 4]>, GlError> {
         unsafe { dev.gl.bind_framebuffer(glow::FRAMEBUFFER, Some(self.fbo)) };
-        if let Some(kind) = half_float_read_type(dev) {
-            return self.read_rgba_half(dev, kind);
-        }
-        let (w, h) = (self.width as usize, self.height as usize);
-        let mut texels: Vec<[f32; 4]> =
-            super::alloc::zeroed(self.width, self.height, 1, "float read-back")?;
-        unsafe {
-            dev.gl.pixel_store_i32(glow::PACK_ALIGNMENT, 4);
-            dev.gl.read_pixels(
-                0,
-                0,
-                w as i32,
-                h as i32,
-                glow::RGBA,
+        let Some(kind) = half_float_read_type(dev) else {
+            return self.read_pixels(
+                dev,
                 glow::FLOAT,
-                glow::PixelPackData::Slice(Some(bytemuck::cast_slice_mut(&mut texels))),
+                1,
+                ("float read-back", "glReadPixels (float)"),
             );
-        }
-        dev.check("glReadPixels (float)")?;
-        super::alloc::flip_rows(&mut texels, w);
-        Ok(texels)
-    }
-
-    /// [`OffscreenTarget::read_rgba_f32`] as `RGBA` half floats of type `kind`, its
-    /// framebuffer bound.
-    fn read_rgba_half(&self, dev: &Device, kind: u32) -> Result<Vec<[f32; 4]>, GlError> {
-        let w = self.width as usize;
-        let mut halves: Vec<[u16; 4]> =
-            super::alloc::zeroed(self.width, self.height, 1, "half-float read-back")?;
-        unsafe {
-            dev.gl.pixel_store_i32(glow::PACK_ALIGNMENT, 2);
-            dev.gl.read_pixels(
-                0,
-                0,
-                self.width as i32,
-                self.height as i32,
-                glow::RGBA,
-                kind,
-                glow::PixelPackData::Slice(Some(bytemuck::cast_slice_mut(&mut halves))),
-            );
-        }
-        dev.check("glReadPixels (half float)")?;
-        super::alloc::flip_rows(&mut halves, w);
+        };
+        let halves: Vec<[u16; 4]> = self.read_pixels(
+            dev,
+            kind,
+            1,
+            ("half-float read-back", "glReadPixels (half float)"),
+        )?;
         let mut texels: Vec<[f32; 4]> =
             super::alloc::zeroed(self.width, self.height, 1, "float read-back")?;
         for (texel, half) in texels.iter_mut().zip(&halves) {
@@ -231,24 +202,39 @@ impl OffscreenTarget {
 
     /// Reads the colour buffer, top row first (as image files store it).
     pub fn read_rgba8(&self, dev: &Device) -> Result<image::RgbaImage, GlError> {
-        let (w, h) = (self.width as usize, self.height as usize);
-        let mut pixels: Vec<u8> = super::alloc::zeroed(self.width, self.height, 4, "read-back")?;
+        unsafe { dev.gl.bind_framebuffer(glow::FRAMEBUFFER, Some(self.fbo)) };
+        let pixels =
+            self.read_pixels(dev, glow::UNSIGNED_BYTE, 4, ("read-back", "glReadPixels"))?;
+        Ok(image::RgbaImage::from_raw(self.width, self.height, pixels).expect("size matches"))
+    }
+
+    /// The bound framebuffer's `RGBA` pixels of type `kind`, `per_pixel` `T`s each, top row
+    /// first; `what` names the buffer and the call in errors.
+    fn read_pixels<T: bytemuck::Pod>(
+        &self,
+        dev: &Device,
+        kind: u32,
+        per_pixel: usize,
+        (buffer, call): (&str, &str),
+    ) -> Result<Vec<T>, GlError> {
+        let mut pixels: Vec<T> = super::alloc::zeroed(self.width, self.height, per_pixel, buffer)?;
         unsafe {
-            dev.gl.bind_framebuffer(glow::FRAMEBUFFER, Some(self.fbo));
-            dev.gl.pixel_store_i32(glow::PACK_ALIGNMENT, 1);
+            // Rows are whole pixels: no padding whatever `T`.
+            dev.gl
+                .pixel_store_i32(glow::PACK_ALIGNMENT, std::mem::align_of::<T>() as i32);
             dev.gl.read_pixels(
                 0,
                 0,
-                w as i32,
-                h as i32,
+                self.width as i32,
+                self.height as i32,
                 glow::RGBA,
-                glow::UNSIGNED_BYTE,
-                glow::PixelPackData::Slice(Some(&mut pixels)),
+                kind,
+                glow::PixelPackData::Slice(Some(bytemuck::cast_slice_mut(&mut pixels))),
             );
         }
-        dev.check("glReadPixels")?;
-        super::alloc::flip_rows(&mut pixels, w * 4);
-        Ok(image::RgbaImage::from_raw(self.width, self.height, pixels).expect("size matches"))
+        dev.check(call)?;
+        super::alloc::flip_rows(&mut pixels, self.width as usize * per_pixel);
+        Ok(pixels)
     }
 
     /// Frees the framebuffer and its attachments.
