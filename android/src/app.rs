@@ -453,7 +453,7 @@ fn new_renderer(egl: &Egl, scene: &mut Scene) -> Result<Renderer, Failed> {
     };
     let mut renderer = Renderer::new(gl, egl.es).map_err(|e| Failed::from(&e))?;
     pick_method(&mut renderer)?;
-    if renderer.method() == Method::Forward.name() && scene.lights.len() > FORWARD_LIGHTS {
+    if renderer.method() == Method::Forward && scene.lights.len() > FORWARD_LIGHTS {
         log::warn!(
             "only forward runs here: drawing {FORWARD_LIGHTS} of the {} lights, each of which \
              it evaluates at every pixel",

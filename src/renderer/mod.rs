@@ -277,9 +277,14 @@ impl Renderer {
         self.programs.report()
     }
 
-    /// The current method's name.
-    pub fn method(&self) -> &'static str {
-        self.method.name()
+    /// The method drawing now: the one set last, or [`Method::Clustered`] by default, or
+    /// what `Renderer::new` fell back to where the default cannot run here.
+    pub fn method(&self) -> Method {
+        let name = self.method.name();
+        Method::ALL
+            .into_iter()
+            .find(|m| m.name() == name)
+            .unwrap_or_default()
     }
 
     /// Whether `method` runs on this renderer's context, without switching to it: supported,

@@ -11,7 +11,7 @@ use common::{max_oracle_error, Gpu};
 use glam::{DVec3, Vec3};
 use manylight::metrics::cpu_reference::Encoding;
 use manylight::scene::{self, shading, Camera, Light, Projection, Scene};
-use manylight::{EsVersion, RenderOptions};
+use manylight::{EsVersion, Method, RenderOptions};
 
 const METHODS: [&str; 3] = ["forward", "tiled", "clustered"];
 
@@ -119,7 +119,11 @@ fn check_without_fragment_highp(
             ..Default::default()
         },
     );
-    assert_eq!(gpu.r().method(), "forward", "{name}: the fallback method");
+    assert_eq!(
+        gpu.r().method(),
+        Method::Forward,
+        "{name}: the fallback method"
+    );
     let limit = manylight::methods::forward::max_lights(gpu.r().caps()) as usize;
     let result = gpu.r().render_offscreen(scene, w, h, opts);
     if scene.lights.len() > limit {

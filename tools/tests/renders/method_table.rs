@@ -5,14 +5,15 @@ use crate::common;
 use common::Gpu;
 use manylight::methods::{Support, METHODS};
 use manylight::scene;
-use manylight::{EsVersion, RenderOptions};
+use manylight::{EsVersion, Method, RenderOptions};
 
 #[test]
 fn the_table_lists_every_method_with_its_support_per_context() {
     let names: Vec<_> = METHODS.iter().map(|m| m.name).collect();
     assert_eq!(names, ["forward", "tiled", "clustered", "deferred", "auto"]);
     for es in [EsVersion::Es2, EsVersion::Es3] {
-        let gpu = Gpu::new(es);
+        let mut gpu = Gpu::new(es);
+        assert_eq!(gpu.r().method(), Method::default(), "{es}: the default");
         let caps = gpu.renderer.as_ref().unwrap().caps().clone();
         for m in METHODS {
             let support = (m.supported)(&caps);
@@ -24,6 +25,11 @@ fn the_table_lists_every_method_with_its_support_per_context() {
                 m.name
             );
             assert!(m.min_es <= es || expect_unsupported, "{}", m.name);
+        }
+        for m in Method::ALL {
+            if gpu.r().set_method(m).is_ok() {
+                assert_eq!(gpu.r().method(), m, "{es}: the method just set");
+            }
         }
     }
 }
@@ -180,7 +186,6 @@ fn auto_renders_with_forward_past_the_index_limit_on_es2() {
 #[test]
 fn support_answers_without_switching_and_a_refusal_keeps_the_default_methods_warning() {
     use common::warnings::warnings_containing;
-    use manylight::Method;
     let mut gpu = Gpu::without_fragment_highp();
     let caps = gpu.r().caps().clone();
     for m in Method::ALL {

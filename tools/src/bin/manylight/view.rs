@@ -510,7 +510,7 @@ impl App<'_> {
             return Err(error);
         };
         let (method, lights) = self.good.clone();
-        if self.frames == 0 || (r.method() == method && self.light_count == lights) {
+        if self.frames == 0 || (r.method().name() == method && self.light_count == lights) {
             return Err(error);
         }
         eprintln!("error: {error}; back to {method} with {lights} lights");
