@@ -48,7 +48,7 @@ pub struct RenderOptions {
     /// Tile size in pixels of the tiled method.
     pub tile_px: f64,
     /// Wait for the GPU (`glFinish`) at the end of [`Renderer::render`](crate::Renderer::render) so `frame_ms` is the
-    /// frame's time (but for the renderer's own MSAA fill and resolve, outside it). Offscreen
+    /// frame's time (the renderer's own MSAA resolve included). Offscreen
     /// rendering and benchmarks want this, and it is the default; a game presenting to a
     /// window sets it to `false` and `frame_ms` is then the CPU submission time only.
     pub wait_for_gpu: bool,

@@ -179,7 +179,7 @@ impl Renderer {
             if let Some(mut m) = self.msaa.take() {
                 m.destroy(&self.dev);
             }
-            self.render_frame(scene, (width, height), options, origin, stats)?;
+            self.render_frame(scene, (width, height), options, origin, None, stats)?;
             stats.samples = stats.samples.max(destination_samples as u32);
             return Ok(());
         }
@@ -195,22 +195,25 @@ impl Renderer {
         // Creating the target binds (then leaves) framebuffers: the caller's comes back.
         self.dev.bind_framebuffer(destination);
         prepared?;
-        let background = self.clear_value(options);
-        let msaa = self.msaa.as_mut().expect("created by prepare_msaa");
+        let msaa = self.msaa.as_ref().expect("created by prepare_msaa");
         msaa.bind(&self.dev);
-        msaa.fill(&self.dev, &mut self.programs, background)?;
         // Drawn at the target's corner, resolved to the origin.
-        let rendered = self.render_frame(scene, (width, height), options, [0, 0], stats);
-        let msaa = self.msaa.as_mut().expect("created by prepare_msaa");
+        let resolve = Resolve {
+            destination,
+            origin,
+            same_format,
+        };
+        let rendered = self.render_frame(
+            scene,
+            (width, height),
+            options,
+            [0, 0],
+            Some(resolve),
+            stats,
+        );
+        let msaa = self.msaa.as_ref().expect("created by prepare_msaa");
         match rendered {
             Ok(()) => {
-                msaa.resolve(
-                    &self.dev,
-                    &mut self.programs,
-                    destination,
-                    origin,
-                    same_format,
-                )?;
                 stats.samples = msaa.samples_drawn();
                 stats.memory.msaa_bytes = msaa.gpu_bytes();
                 Ok(())
@@ -240,13 +243,15 @@ impl Renderer {
         ]
     }
 
-    /// One frame into the bound framebuffer (see [`Renderer::render_reusing`]).
+    /// One frame into the bound framebuffer (see [`Renderer::render_reusing`]); with
+    /// `resolve`, into the bound MSAA target, filled and resolved inside the frame's timing.
     fn render_frame(
         &mut self,
         scene: &Scene,
         (width, height): (u32, u32),
         options: &RenderOptions,
         origin: [u32; 2],
+        resolve: Option<Resolve>,
         stats: &mut FrameStats,
     ) -> Result<(), Error> {
         let start = Instant::now();
@@ -317,6 +322,11 @@ impl Renderer {
             scene,
             &mut self.warned_capped_ambient,
         );
+        // MSAA frames clear everything (`Clear::All`, checked above).
+        let background = self.clear_value(options);
+        if let Some(msaa) = self.msaa.as_mut().filter(|_| resolve.is_some()) {
+            msaa.fill(&self.dev, &mut self.programs, background)?;
+        }
         let frame_rect = [origin[0], origin[1], width, height].map(|v| v as i32);
         self.dev
             .viewport(frame_rect[0], frame_rect[1], frame_rect[2], frame_rect[3]);
@@ -383,6 +393,20 @@ impl Renderer {
             methods::forward::draw_ambient_only(&mut ctx)
         } else {
             method.render(&mut ctx)
+        };
+        // MSAA's resolve is the frame's too: timed with it, waited for with it.
+        let rendered = match (rendered, resolve, self.msaa.as_mut()) {
+            (Ok(stats), Some(to), Some(msaa)) => msaa
+                .resolve(
+                    &self.dev,
+                    &mut self.programs,
+                    to.destination,
+                    to.origin,
+                    to.same_format,
+                )
+                .map(|()| stats)
+                .map_err(Error::from),
+            (other, ..) => other,
         };
         // Likewise the draws' errors, before the query ends (on the error path too: one left
         // active makes the next frame's `glBeginQuery` fail).
@@ -525,6 +549,17 @@ impl Renderer {
         }
         Ok(())
     }
+}
+
+/// Where a frame drawn into the renderer's MSAA target is resolved to.
+#[derive(Clone, Copy)]
+struct Resolve {
+    /// The caller's framebuffer (`None`: the default one).
+    destination: Option<glow::Framebuffer>,
+    /// The frame's lower-left corner in it.
+    origin: [u32; 2],
+    /// Its colour is the target's format, so a blit can resolve into it directly.
+    same_format: bool,
 }
 
 /// Refuses an empty frame (the same error whichever call was given it).

@@ -93,8 +93,8 @@ pub struct ContextStats {
 pub struct TimeStats {
     /// Frame time in milliseconds (median of the timed frames): CPU work plus `glFinish` with
     /// [`RenderOptions::wait_for_gpu`](crate::RenderOptions::wait_for_gpu), else the CPU's
-    /// submission alone (a game's frame). With the renderer's own MSAA target, its fill and
-    /// resolve are outside both this and `gpu_ms` (drawn before and after the timed part).
+    /// submission alone (a game's frame). Both this and `gpu_ms` include the resolve of the
+    /// renderer's own MSAA target.
     pub frame_ms: f64,
     /// GPU time of the frame's GL work from a `GL_EXT_disjoint_timer_query` elapsed-time query
     /// (median of the timed frames). A frame that does not wait for the GPU (a game's) reports
