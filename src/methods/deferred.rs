@@ -90,6 +90,11 @@ const VOLUME_SCALE: f32 = 1.1;
 /// rounding of the projection).
 const FAR_MARGIN: f32 = 0.999;
 
+/// The largest proxy radius, in near-plane distances, drawn by its far side in perspective;
+/// past it, the full-screen path (which also shades the surfaces beyond the light). Head lamps
+/// lost light from 2.4·10⁴ up (`docs/precision.md`): a margin of ten.
+const FAR_SIDE_REACH: f32 = 2048.0;
+
 /// Which side of a light's proxy is drawn and depth tested against the surfaces:
 /// - wholly in front of the near plane: the near side, `LEQUAL` — where a surface lies in front
 ///   of the whole sphere the light cannot reach it and the pixel is skipped;
@@ -129,6 +134,7 @@ impl Proxy {
 /// What decides a light's [`Proxy`]: the view's camera and depth range.
 struct ProxyReach<'a> {
     camera: &'a crate::scene::Camera,
+    perspective: bool,
     near: f32,
     far: f32,
 }
@@ -141,9 +147,13 @@ impl ProxyReach<'_> {
         // where it ends (a tiny near plane makes them wider; docs/precision.md).
         let coarse = self.camera.depth_step_at(f64::from(depth + radius), 24)
             > 0.1 * f64::from(light.cull_radius);
+        // A far side around the eye is clipped at the near plane into faces reaching
+        // `radius / near` half-viewports off screen, across which depth is interpolated
+        // tens of steps off (a light at the eye at near 10⁻⁸ lit nothing).
+        let clipped_far = self.perspective && radius > FAR_SIDE_REACH * self.near;
         if !coarse && depth - radius >= 2.0 * self.near {
             Proxy::NearSide
-        } else if !coarse && depth + radius < FAR_MARGIN * self.far {
+        } else if !coarse && !clipped_far && depth + radius < FAR_MARGIN * self.far {
             Proxy::FarSide
         } else {
             Proxy::FullScreen
@@ -403,6 +413,7 @@ impl Deferred {
         let viewport = [ctx.viewport.0 as f32, ctx.viewport.1 as f32];
         let reach = ProxyReach {
             camera: &ctx.scene.camera,
+            perspective: !ctx.orthographic,
             near: ctx.near as f32,
             far: ctx.far as f32,
         };

@@ -330,3 +330,82 @@ fn deferred_equals_forward_on_a_bright_frame_without_float_blending() {
         "without float blending",
     );
 }
+
+/// Head lamps: a light at (or a hair from) the eye, over a floor, at near planes that put
+/// ten to 10⁹ near-plane distances across its proxy. Deferred's far side around the eye,
+/// clipped at a tiny near plane, spans that many half-viewports, and depth interpolated across
+/// it lost parts of the light or all of it: 7 of these cases, from 1.3·10⁵ up, before such a
+/// light past 2 048 was drawn full-screen (docs/precision.md).
+#[test]
+fn head_lamps_match_forward_at_any_near_plane() {
+    let mut gpu = Gpu::new(EsVersion::Es3);
+    let mut random = Xorshift(0x9e37_79b9_7f4a_7c15);
+    let mut worst = (0, String::new());
+    for case in 0..200 {
+        let height = 10f64.powf(random.uniform(-3.0, 1.0));
+        let radius = height * 10f64.powf(random.uniform(0.02, 0.6));
+        let near = (1.1 * radius / 10f64.powf(random.uniform(1.0, 9.0))).min(height / 3.0);
+        let eye = DVec3::new(random.uniform(-1.0, 1.0), random.uniform(-1.0, 1.0), height);
+        let (down, around) = (
+            random.uniform(10.0, 80.0).to_radians(),
+            random.uniform(0.0, std::f64::consts::TAU),
+        );
+        let look = DVec3::new(
+            around.cos() * down.cos(),
+            around.sin() * down.cos(),
+            -down.sin(),
+        );
+        let hair = DVec3::new(random.normal(), random.normal(), random.normal())
+            * height
+            * 10f64.powf(random.uniform(-12.0, -1.0));
+        let mut s = scene::builtin::build("plane", None).unwrap();
+        // The floor reaches well past the eye, as a level's would.
+        s.objects[0].transform = glam::DMat4::from_scale(DVec3::splat((height * 10.0).max(1.0)));
+        let fov = [40.0, 60.0, 90.0][case % 3];
+        s.camera = scene::Camera::perspective(eye, eye + look, fov, near, height * 100.0);
+        s.lights = vec![scene::Light::point(
+            eye + hair,
+            radius as f32,
+            Vec3::ONE,
+            (1e3 * height * height) as f32,
+        )];
+        let (reference, _) = gpu.render_with("forward", &s, (64, 36), &Default::default());
+        let (img, _) = gpu.render_with("deferred", &s, (64, 36), &Default::default());
+        let d = manylight::metrics::diff(&reference, &img);
+        if d.max_abs > worst.0 {
+            let reach = 1.1 * radius / near;
+            worst = (
+                d.max_abs,
+                format!("case {case}: {reach:.3e} near distances across"),
+            );
+        }
+    }
+    assert!(
+        worst.0 <= 2,
+        "deferred {} / 255 from forward, {}",
+        worst.0,
+        worst.1
+    );
+}
+
+/// A seeded generator for the random cases above.
+struct Xorshift(u64);
+
+impl Xorshift {
+    fn next(&mut self) -> f64 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 7;
+        self.0 ^= self.0 << 17;
+        (self.0 >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    fn uniform(&mut self, low: f64, high: f64) -> f64 {
+        low + (high - low) * self.next()
+    }
+
+    /// A standard normal value (Box–Muller).
+    fn normal(&mut self) -> f64 {
+        let u = self.next().max(1e-300);
+        (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * self.next()).cos()
+    }
+}

@@ -313,6 +313,20 @@ fn a_light_at_the_eye_of_a_narrow_view() {
     check("head lamp, 1° lens", &s, 31, 128);
 }
 
+/// A head lamp at a near plane of 10⁻⁸, a hand's width above the floor: deferred's proxy
+/// around the eye, clipped at that near plane, spans millions of viewports, and depth
+/// interpolated across it lost the whole light (89/255 from forward on llvmpipe here, 221 at
+/// intensity 10⁶ on llvmpipe, SwiftShader and ANGLE alike). Such a proxy now takes the
+/// full-screen path.
+#[test]
+fn a_light_at_the_eye_at_a_tiny_near_plane() {
+    let mut s = plane();
+    let eye = DVec3::new(0.9, 0.9, 0.01);
+    s.camera = Camera::perspective(eye, DVec3::new(0.914, 0.879, 0.0), 60.0, 1e-8, 1.0);
+    s.lights = vec![point(eye.into(), 0.0129, 1.0)];
+    check("head lamp, near 1e-8", &s, 64, 36);
+}
+
 #[test]
 fn lights_behind_the_camera_and_beyond_far() {
     let mut s = plane();
