@@ -415,7 +415,7 @@ impl Deferred {
             camera: &ctx.scene.camera,
             perspective: !ctx.orthographic,
             near: ctx.near as f32,
-            far: ctx.far as f32,
+            far: ctx.scene.camera.far_clip_range().0 as f32,
         };
         // Lights with the same proxy drawn together, as instances of it, in their order: the
         // state, program, uniforms and arrays set once for them. `k` numbers the lights drawn,

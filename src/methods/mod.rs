@@ -90,7 +90,9 @@ pub struct FrameContext<'a> {
     pub origin: [u32; 2],
     /// Near plane distance.
     pub near: f64,
-    /// Far plane distance (may be infinite).
+    /// The farthest view distance the GPU may draw: the far plane, widened by `f32`
+    /// rounding ([`Camera::far_clip_range`](crate::scene::Camera::far_clip_range); may be
+    /// infinite).
     pub far: f64,
     /// Farthest view depth the scene's geometry reaches, clipped to [near, far]: where a grid
     /// needs to end.

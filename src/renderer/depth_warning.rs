@@ -38,3 +38,21 @@ pub(super) fn warn_of_coarse_depth(
          range as tight) as the scene allows fixes it (docs/precision.md)"
     );
 }
+
+/// Warns (once: `warned`) when the camera's far plane lies so many near planes out that the
+/// GPU's `f32` projection may clip nothing there: geometry past it is drawn and lit.
+pub(super) fn warn_of_unclipped_far(camera: &Camera, warned: &mut bool) {
+    let Projection::Perspective { near, far, .. } = camera.projection else {
+        return;
+    };
+    if *warned || far.is_infinite() || camera.far_clip_range().1.is_finite() {
+        return;
+    }
+    *warned = true;
+    log::warn!(
+        "camera.far {far:e} is {:.1e} times camera.near {near:e}: past about 4e6 a 32-bit \
+         float projection has no far plane to clip at, so geometry beyond camera.far is drawn \
+         and lit; a larger near plane keeps it (docs/precision.md)",
+        far / near
+    );
+}

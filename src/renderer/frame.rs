@@ -295,9 +295,16 @@ impl Renderer {
             &mut self.shown_directional,
             &mut self.warned_directional,
         );
-        let (near, far) = scene.camera.near_far();
+        // Lights are culled at the farthest distance the GPU may draw, not the far plane
+        // asked for: a tiny near plane leaves `f32` no far plane to clip at.
+        let near = scene.camera.near_far().0;
+        let far = scene.camera.far_clip_range().1;
         let content_far = content_far(self.gpu_scene.scene_bounds(scene), &view, near, far);
         if !self.warming_up {
+            super::depth_warning::warn_of_unclipped_far(
+                &scene.camera,
+                &mut self.warned_unclipped_far,
+            );
             super::depth_warning::warn_of_coarse_depth(
                 &scene.camera,
                 content_far,

@@ -93,6 +93,8 @@ pub struct Renderer {
     srgb_destination: bool,
     /// A camera too coarse in depth for the scene was announced (once per renderer).
     warned_depth_step: bool,
+    /// A far plane the `f32` projection cannot clip at was announced (once per renderer).
+    warned_unclipped_far: bool,
     /// Whether a light brighter than the fp16 radiance form holds was said (without fragment
     /// highp; once a renderer).
     warned_capped_radiance: bool,
@@ -190,6 +192,7 @@ impl Renderer {
             warned_past_framebuffer: false,
             srgb_destination: false,
             warned_depth_step: false,
+            warned_unclipped_far: false,
             warned_capped_radiance: false,
             warned_capped_ambient: false,
             warned_own_depth_bits: false,

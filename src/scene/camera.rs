@@ -50,6 +50,10 @@ pub const VIEW_RIGID_TOLERANCE: f64 = 1e-4;
 /// A perspective far plane this many near planes away or more is treated as infinite.
 pub const FAR_AS_INFINITE: f64 = 1e20;
 
+/// Relative error of a clip-space depth the GPU computes in `f32`: eight roundings of 2⁻²⁴
+/// (the projection's terms, the view position, the clip test) — a bound, not a measurement.
+const FAR_ROUNDING: f64 = 1.0 / (1u64 << 21) as f64;
+
 /// A look-at camera. World positions are `f64` so scenes far from the origin keep precision.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Camera {
@@ -189,6 +193,31 @@ impl Camera {
         match self.projection {
             Projection::Perspective { near, far, .. }
             | Projection::Orthographic { near, far, .. } => (near, far),
+        }
+    }
+
+    /// The view distances between which the GPU's `f32` projection clips at the far plane:
+    /// rounding moves that plane by up to about 2⁻²² · far / near of its distance, and past
+    /// 2²² (4·10⁶) near planes it may clip nothing (docs/precision.md).
+    /// Lights are culled against the farther bound, proxies kept inside the nearer one.
+    pub fn far_clip_range(&self) -> (f64, f64) {
+        match self.projection {
+            Projection::Perspective { near, far, .. } => {
+                if far.is_infinite() || far / near > FAR_AS_INFINITE {
+                    return (f64::INFINITY, f64::INFINITY);
+                }
+                let spread = FAR_ROUNDING * far / (2.0 * near);
+                let farthest = if spread < 1.0 {
+                    far / (1.0 - spread)
+                } else {
+                    f64::INFINITY
+                };
+                (far / (1.0 + spread), farthest)
+            }
+            Projection::Orthographic { near, far, .. } => {
+                let spread = FAR_ROUNDING * (far.abs() + near.abs());
+                (far - spread, far + spread)
+            }
         }
     }
 
@@ -366,6 +395,34 @@ fn perspective_infinite_gl(fov_y: f64, aspect: f64, near: f64) -> DMat4 {
 mod tests {
     use super::*;
     use glam::DVec4;
+
+    /// Where the `f32` matrix itself puts the far plane (`m32 / (m22 + 1)`) lies inside
+    /// `far_clip_range`, whose upper end is infinite once `m22` rounds to −1.
+    #[test]
+    fn the_far_clip_range_holds_the_f32_projections_far_plane() {
+        for exponent in 1..=90 {
+            let ratio = 10f64.powf(f64::from(exponent) / 10.0);
+            for far in [1e-3, 0.7, 10.0, 3e4] {
+                let near = far / ratio;
+                let cam = Camera::perspective(DVec3::ZERO, -DVec3::Z, 60.0, near, far);
+                let p = cam.projection_matrix(1.5).as_mat4();
+                let (m22, m32) = (f64::from(p.z_axis.z), f64::from(p.w_axis.z));
+                let (low, high) = cam.far_clip_range();
+                assert!(low <= far && far <= high, "{near:e}..{far:e}");
+                if m22 + 1.0 >= 0.0 {
+                    assert_eq!(high, f64::INFINITY, "{near:e}..{far:e}: no far plane");
+                } else {
+                    let placed = m32 / (m22 + 1.0);
+                    assert!(
+                        low <= placed && placed <= high,
+                        "{near:e}..{far:e}: {placed:e}"
+                    );
+                }
+            }
+        }
+        let infinite = Camera::perspective(DVec3::ZERO, -DVec3::Z, 60.0, 0.1, f64::INFINITY);
+        assert_eq!(infinite.far_clip_range(), (f64::INFINITY, f64::INFINITY));
+    }
 
     #[test]
     fn perspective_maps_near_and_far_to_gl_depth_range() {

@@ -123,7 +123,7 @@ fn deferred_from_forward(gpu: &mut Gpu, s: &Scene) -> u8 {
 fn a_tiny_near_plane_is_warned_of_and_deferred_still_equals_forward() {
     common::warnings::install();
     let mut s = scene::builtin::build("courtyard", Some((256, 7))).unwrap();
-    let warned = || common::warnings::warnings_containing("camera.near 1e-5").len();
+    let warned = || common::warnings::warnings_containing("camera.near 1e-5 leaves").len();
     let mut gpu = Gpu::new(EsVersion::Es3);
     let opts = RenderOptions::default();
     gpu.render(&s, 128, 72, &opts);

@@ -351,6 +351,25 @@ fn lights_behind_the_camera_and_beyond_far() {
     );
 }
 
+/// A far plane 10⁸ near planes out, which an `f32` projection cannot place (its depth term
+/// rounds to −1): the floor beyond it is drawn, so the lights beyond it must light it in every
+/// method. Tiled and clustered culled them at the far plane asked for (221/255 from forward,
+/// ES 2.0 and 3.0, on llvmpipe, SwiftShader and ANGLE; helper-130). The renderer says so.
+#[test]
+fn a_far_plane_past_what_f32_can_place() {
+    use common::warnings::warnings_containing;
+    let mut s = plane();
+    s.camera = Camera::perspective(DVec3::new(0.0, 0.0, 20.0), DVec3::ZERO, 40.0, 1e-7, 10.0);
+    s.lights = vec![
+        point([0.5, 0.3, 1.0], 4.0, 4.0),
+        point([0.0, 0.0, 20.0], 0.01, 1.0),
+    ];
+    let warning = "has no far plane to clip at";
+    let before = warnings_containing(warning).len();
+    check("far plane 1e8 near planes out", &s, 64, 36);
+    assert!(warnings_containing(warning).len() > before, "no warning");
+}
+
 #[test]
 fn extreme_near_and_far_planes_and_orthographic() {
     let base = scene::builtin::build("pillars", Some((200, 3))).unwrap();
