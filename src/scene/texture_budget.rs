@@ -103,7 +103,8 @@ pub(crate) fn decode_texture_bytes(
     }
     let decoder = first.into_decoder().map_err(undecodable)?;
     let (w, h) = decoder.dimensions();
-    let decoded = u64::from(w) * u64::from(h) * u64::from(decoder.color_type().bytes_per_pixel());
+    let bytes_per_pixel = decoder.color_type().bytes_per_pixel();
+    let decoded = u64::from(w) * u64::from(h) * u64::from(bytes_per_pixel);
     drop(decoder);
     // Some decoders (GIF) give an image of no rows or columns rather than an error.
     if w == 0 || h == 0 {
@@ -116,6 +117,19 @@ pub(crate) fn decode_texture_bytes(
     let taken = budget
         .take(w, h)
         .inspect_err(|_| budget.give_back_decoding(decoded))?;
+    // `image` aborts the process where an allocation fails: the decode, a decoder's own
+    // canvas (GIF's), the scaled copy and the RGBA one are asked for first.
+    let (sw, sh) = stored_size(w, h);
+    let kept = u64::from(sw) * u64::from(sh) * (u64::from(bytes_per_pixel) + 4);
+    if !super::alloc_probe::can_allocate(2 * decoded + kept) {
+        budget.give_back(taken);
+        budget.give_back_decoding(decoded);
+        return Err(format!(
+            "could not be decoded ({w}×{h} pixels need {} MiB to decode, which cannot be \
+             allocated here)",
+            (2 * decoded + kept) >> 20
+        ));
+    }
     PIXEL_BYTES_DECODED.with(|n| n.set(n.get().saturating_add(u64::from(w) * u64::from(h) * 4)));
     reader()?.decode().map_err(|e| {
         if matches!(e, image::ImageError::Limits(_)) {

@@ -849,3 +849,40 @@ fn a_failed_upload_or_allocation_keeps_nothing_it_made() {
         );
     }
 }
+
+/// `image` aborts the process where an allocation fails. A 35-byte GIF whose screen is
+/// 11 585² (536 MB of RGBA), the texture of a small OBJ, aborted its load under a 384 MiB
+/// address-space limit (helper-129); the decode is now asked of the allocator first, and the
+/// material keeps its flat colour with a warning naming the texture.
+#[test]
+fn a_texture_larger_than_the_memory_left_keeps_the_flat_colour_not_an_abort() {
+    let Ok(prlimit) = which_prlimit() else {
+        common::skip("no prlimit (util-linux) to bound the child's memory");
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    // Logical screen 0x2d41 = 11 585 a side; one 1×1 frame of one colour.
+    let mut gif = b"GIF89a\x41\x2d\x41\x2d\x00\x00\x00".to_vec();
+    gif.extend_from_slice(b"\x2c\x00\x00\x00\x00\x01\x00\x01\x00\x80\x00\x00\x00\xff\xff\xff");
+    gif.extend_from_slice(b"\x02\x02\x44\x01\x00\x3b");
+    std::fs::write(dir.path().join("big.gif"), gif).unwrap();
+    std::fs::write(
+        dir.path().join("m.mtl"),
+        "newmtl m\nKd 0.8 0.8 0.8\nmap_Kd big.gif\n",
+    )
+    .unwrap();
+    let path = dir.path().join("m.obj");
+    std::fs::write(
+        &path,
+        "mtllib m.mtl\nusemtl m\nv -1 -1 0\nv 1 -1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\n\
+         f 1/1 2/2 3/3\n",
+    )
+    .unwrap();
+    let out = render_within_384_mib(&prlimit, &path, dir.path());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{stderr}");
+    assert!(
+        stderr.contains("big.gif could not be decoded (11585×11585 pixels need"),
+        "{stderr}"
+    );
+}

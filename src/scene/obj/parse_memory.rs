@@ -162,23 +162,11 @@ impl ObjCounts {
     }
 }
 
-/// Whether `bytes` can be allocated now: asked of the allocator and given back at once.
-/// Under an address-space limit, or a kernel that refuses what it could never back, a load
-/// that could not finish is refused before it starts.
-pub(super) fn can_allocate(bytes: u64) -> bool {
-    let Ok(bytes) = usize::try_from(bytes) else {
-        return false;
-    };
-    let mut probe = Vec::<u8>::new();
-    let granted = probe.try_reserve_exact(bytes).is_ok();
-    // Kept opaque: the optimiser may otherwise drop an allocation nothing reads.
-    std::hint::black_box(&mut probe);
-    granted
-}
+pub(super) use crate::scene::alloc_probe::can_allocate;
 
 #[cfg(test)]
 mod tests {
-    use super::{can_allocate, ObjCounts, CONVERTED_CORNER, FACE};
+    use super::{ObjCounts, CONVERTED_CORNER, FACE};
 
     #[test]
     fn counts_follow_what_tobj_reads() {
@@ -229,12 +217,5 @@ mod tests {
         let lists = 3 * FACE * 1_000_000 + (2 * 4 + CONVERTED_CORNER) * 3_000_000;
         assert!(few <= lists + 4_096, "{few} against {lists}");
         assert!(many > few + 3_000_000 * 100, "{many} against {few}");
-    }
-
-    #[test]
-    fn what_no_machine_holds_is_not_granted() {
-        assert!(can_allocate(1 << 20));
-        assert!(!can_allocate(u64::MAX));
-        assert!(!can_allocate(1 << 62));
     }
 }
