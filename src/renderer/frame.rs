@@ -280,6 +280,10 @@ impl Renderer {
             .camera
             .projection_matrix(width as f64 / height as f64)
             .as_mat4();
+        if scene.lights.len() != self.lights_probed {
+            super::frame_setup::check_light_memory(scene.lights.len())?;
+            self.lights_probed = scene.lights.len();
+        }
         if gather_lights(&mut self.lights, scene, &view, options) || self.timing_frames {
             self.lights_generation += 1;
         }

@@ -35,6 +35,21 @@ pub(super) fn gather_lights(
     overwrite_lights(lights, gathered)
 }
 
+/// Refuses a frame of `count` lights whose memory this process cannot allocate now (an
+/// allocation refused inside the frame would abort it): asked of the allocator for
+/// [`BYTES_PER_LIGHT`](crate::scene::input::BYTES_PER_LIGHT) a light and given back.
+pub(super) fn check_light_memory(count: usize) -> Result<(), crate::Error> {
+    let bytes = count as u64 * crate::scene::input::BYTES_PER_LIGHT;
+    if crate::scene::alloc_probe::can_allocate(bytes) {
+        return Ok(());
+    }
+    Err(crate::Error::Limit(format!(
+        "{count} lights need about {} MiB through a frame, which this process cannot \
+         allocate now",
+        bytes >> 20
+    )))
+}
+
 /// Writes `new` over `lights` (keeping its buffer), comparing on the way. Returns whether the
 /// list differs, bit for bit, from the one `lights` held.
 pub(super) fn overwrite_lights(

@@ -93,6 +93,8 @@ pub struct Renderer {
     srgb_destination: bool,
     /// A camera too coarse in depth for the scene was announced (once per renderer).
     warned_depth_step: bool,
+    /// The light count whose frame memory was last asked of the allocator.
+    lights_probed: usize,
     /// A far plane the `f32` projection cannot clip at was announced (once per renderer).
     warned_unclipped_far: bool,
     /// Whether a light brighter than the fp16 radiance form holds was said (without fragment
@@ -192,6 +194,7 @@ impl Renderer {
             warned_past_framebuffer: false,
             srgb_destination: false,
             warned_depth_step: false,
+            lights_probed: 0,
             warned_unclipped_far: false,
             warned_capped_radiance: false,
             warned_capped_ambient: false,

@@ -470,7 +470,7 @@ pub fn parse(
     if let Some(((count, seed), field)) = random {
         super::input::check_light_count(count, field)?;
         let total = count.saturating_add(scene.lights.len());
-        if super::input::check_light_count(total, field).is_err() {
+        if total > super::input::MAX_LIGHTS {
             return Err(SceneError::invalid(
                 field,
                 format!(
@@ -481,6 +481,7 @@ pub fn parse(
                 ),
             ));
         }
+        super::input::check_light_count(total, field)?;
         let volume = scene.bounds().ok_or_else(|| {
             SceneError::invalid("random_lights", "needs geometry to place lights in")
         })?;

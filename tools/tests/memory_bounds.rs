@@ -886,3 +886,32 @@ fn a_texture_larger_than_the_memory_left_keeps_the_flat_colour_not_an_abort() {
         "{stderr}"
     );
 }
+
+/// A 66-byte scene file asking for a million random lights (a quarter of the limit) aborted
+/// under a 384 MiB address-space limit: the lights are made at load, and the frame's copies of
+/// them were refused by the allocator (helper-129). The load and the frame now ask first, so
+/// it is an error naming the count; a few thousand lights still render there.
+#[test]
+fn lights_past_the_memory_left_are_an_error_not_an_abort() {
+    let Ok(prlimit) = which_prlimit() else {
+        common::skip("no prlimit (util-linux) to bound the child's memory");
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    for (count, code) in [(1_000_000, 1), (4_000, 0)] {
+        let path = common::files::write(
+            dir.path(),
+            &format!("l{count}.json"),
+            format!(r#"{{"objects":[{{"builtin":"plane"}}],"random_lights":{{"count":{count}}}}}"#),
+        );
+        let out = render_within_384_mib(&prlimit, &path, dir.path());
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(code), "{count}: {stderr}");
+        if code == 1 {
+            assert!(
+                stderr.contains(&format!("{count} lights need about")),
+                "{stderr}"
+            );
+        }
+    }
+}
