@@ -915,3 +915,66 @@ fn lights_past_the_memory_left_are_an_error_not_an_abort() {
         }
     }
 }
+
+/// A 16 MB glTF triangle strip of four vertices unrolls to 16 M triangles; building them (the
+/// duplicate search alone takes 16 bytes a triangle) aborted under a 384 MiB address-space
+/// limit (helper-129). The primitive is now asked of the allocator first: an error naming it,
+/// as the OBJ loader's.
+#[test]
+fn a_gltf_primitive_larger_than_the_memory_left_is_an_error_not_an_abort() {
+    let Ok(prlimit) = which_prlimit() else {
+        common::skip("no prlimit (util-linux) to bound the child's memory");
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let count = 1usize << 24;
+    let mut bin: Vec<u8> = [
+        [0f32, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [1.0, 1.0, 0.0],
+    ]
+    .iter()
+    .flatten()
+    .flat_map(|v| v.to_le_bytes())
+    .collect();
+    // Normals given, so no vertex is unshared for flat shading.
+    bin.extend(
+        [[0f32, 0.0, 1.0]; 4]
+            .iter()
+            .flatten()
+            .flat_map(|v| v.to_le_bytes()),
+    );
+    bin.extend((0..count).map(|i| (i % 4) as u8));
+    std::fs::write(dir.path().join("strip.bin"), &bin).unwrap();
+    let doc = serde_json::json!({
+        "asset": {"version": "2.0"},
+        "scenes": [{"nodes": [0]}],
+        "nodes": [{"mesh": 0}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "NORMAL": 2}, "indices": 1, "mode": 5}]}],
+        "accessors": [
+            {"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3",
+             "min": [0, 0, 0], "max": [1, 1, 0]},
+            {"bufferView": 1, "componentType": 5121, "count": count, "type": "SCALAR"},
+            {"bufferView": 2, "componentType": 5126, "count": 4, "type": "VEC3"}
+        ],
+        "bufferViews": [
+            {"buffer": 0, "byteLength": 48},
+            {"buffer": 0, "byteOffset": 96, "byteLength": count},
+            {"buffer": 0, "byteOffset": 48, "byteLength": 48}
+        ],
+        "buffers": [{"byteLength": bin.len(), "uri": "strip.bin"}]
+    });
+    let path = common::files::write(dir.path(), "strip.gltf", doc.to_string());
+    let out = render_within_384_mib(&prlimit, &path, dir.path());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.contains("meshes[0].primitives[0]: building its 4 vertices and 16777214 triangles"),
+        "{stderr}"
+    );
+    assert!(
+        stderr.contains("more than this process can allocate now"),
+        "{stderr}"
+    );
+}

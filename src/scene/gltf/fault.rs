@@ -8,12 +8,13 @@ use crate::scene::SceneError;
 pub(super) const PARSER_FAILED: &str =
     "the glTF parser (gltf crate) failed on this file; it is malformed";
 
-/// Why an import failed: the file itself, what it asks for that the loader cannot do, or the
-/// caller's transform placing what is in it.
+/// Why an import failed: the file itself, what it asks for that the loader cannot do, the
+/// caller's transform placing what is in it, or memory this process cannot allocate now.
 pub(super) enum Fault {
     File(String),
     Unsupported(String),
     Placing(String),
+    Memory(String),
 }
 
 impl Fault {
@@ -29,6 +30,10 @@ impl Fault {
             Fault::Unsupported(reason) => SceneError::GltfUnsupported {
                 path: path_buf,
                 reason,
+            },
+            Fault::Memory(reason) => SceneError::Io {
+                path: path_buf,
+                source: std::io::Error::new(std::io::ErrorKind::OutOfMemory, reason),
             },
             Fault::Placing(reason) => {
                 SceneError::invalid(transform_field, format!("{reason} (in {})", path.display()))

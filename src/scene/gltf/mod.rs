@@ -441,6 +441,7 @@ fn import(
                 let cached = match meshes.entry(key) {
                     Entry::Occupied(e) => e.into_mut(),
                     Entry::Vacant(e) => {
+                        mesh::check_memory(&prim, &pfield).map_err(Fault::Memory)?;
                         let built =
                             mesh::build(&prim, &pfield, &mut buffers, &mut budget, &mut warnings)?;
                         e.insert(match built {
