@@ -25,6 +25,7 @@ pub mod framing;
 pub mod gltf;
 pub mod input;
 mod jpeg_frame;
+mod json_count;
 #[cfg(test)]
 mod left_out_tests;
 pub mod light;

@@ -978,3 +978,35 @@ fn a_gltf_primitive_larger_than_the_memory_left_is_an_error_not_an_abort() {
         "{stderr}"
     );
 }
+
+/// A scene file is parsed whole before its objects are placed: 16 MiB of `{},` took 1.25 GB
+/// and 700 000 `{"builtin":"plane"}` some 700 MB placed, each aborting under a 384 MiB
+/// address-space limit (helper-129). The first is now refused before parsing (too many JSON
+/// objects), the second before placing (more than the process can allocate).
+#[test]
+fn a_scene_file_of_many_objects_is_an_error_not_an_abort() {
+    let Ok(prlimit) = which_prlimit() else {
+        common::skip("no prlimit (util-linux) to bound the child's memory");
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let list = |object: &str, n: usize| format!(r#"{{"objects":[{}]}}"#, vec![object; n].join(","));
+    for (name, text, says) in [
+        (
+            "empty.json",
+            list("{}", 5_000_000),
+            "objects and arrays, more than the",
+        ),
+        (
+            "planes.json",
+            list(r#"{"builtin":"plane"}"#, 700_000),
+            "placing its 700000 objects takes about",
+        ),
+    ] {
+        let path = common::files::write(dir.path(), name, text);
+        let out = render_within_384_mib(&prlimit, &path, dir.path());
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{name}: {stderr}");
+        assert!(stderr.contains(says), "{name}: {stderr}");
+    }
+}

@@ -22,7 +22,7 @@ pub const MAX_JSON_ELEMENTS: usize = 1 << 23;
 /// [`MAX_JSON_ELEMENTS`] elements and members. Brackets and commas inside strings do not
 /// count; what is not valid JSON is left for the parser to name.
 pub(super) fn check(json: &[u8]) -> Result<(), String> {
-    let (containers, separators) = count_containers(json);
+    let (containers, separators) = crate::scene::json_count::count_containers(json);
     if containers > MAX_JSON_CONTAINERS {
         return Err(format!(
             "its JSON holds {containers} objects and arrays, more than the \
@@ -39,41 +39,9 @@ pub(super) fn check(json: &[u8]) -> Result<(), String> {
     Ok(())
 }
 
-/// The `{` and `[`, and the `,`, outside strings.
-fn count_containers(json: &[u8]) -> (usize, usize) {
-    let mut commas = 0;
-    let (mut count, mut in_string, mut escaped) = (0, false, false);
-    for &b in json {
-        if in_string {
-            if escaped {
-                escaped = false;
-            } else if b == b'\\' {
-                escaped = true;
-            } else if b == b'"' {
-                in_string = false;
-            }
-        } else if b == b'"' {
-            in_string = true;
-        } else if b == b'{' || b == b'[' {
-            count += 1;
-        } else if b == b',' {
-            commas += 1;
-        }
-    }
-    (count, commas)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn objects_and_arrays_are_counted_outside_strings() {
-        assert_eq!(count_containers(br#"{"a": [1, {"b": []}]}"#), (4, 1));
-        // Brackets and commas in strings, escaped quotes and escaped backslashes.
-        assert_eq!(count_containers(br#"{"n": "{[\",[{\\", "m": [}"#), (2, 1));
-        assert_eq!(count_containers(b""), (0, 0));
-    }
 
     #[test]
     fn a_long_flat_array_is_refused_before_parsing() {
