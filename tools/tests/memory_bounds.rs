@@ -1010,3 +1010,28 @@ fn a_scene_file_of_many_objects_is_an_error_not_an_abort() {
         assert!(stderr.contains(says), "{name}: {stderr}");
     }
 }
+
+/// 3 MB of empty glTF nodes, within the JSON limits, parse into some 600 MB (every one of the
+/// loader's parses holds each node): it aborted under a 384 MiB address-space limit in the
+/// second parse (helper-129). The parses are now asked of the allocator first.
+#[test]
+fn a_gltf_whose_json_parse_cannot_be_allocated_is_an_error_not_an_abort() {
+    let Ok(prlimit) = which_prlimit() else {
+        common::skip("no prlimit (util-linux) to bound the child's memory");
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let mut b = common::gltf::Builder::default();
+    let mut doc = common::gltf_models::triangle(&mut b);
+    let nodes = doc["nodes"].as_array_mut().unwrap();
+    nodes.extend(std::iter::repeat_n(serde_json::json!({}), 1_000_000));
+    let path = common::files::write(dir.path(), "m.gltf", b.gltf(doc));
+    let out = render_within_384_mib(&prlimit, &path, dir.path());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("parsing its JSON ("), "{stderr}");
+    assert!(
+        stderr.contains("more than this process can allocate now"),
+        "{stderr}"
+    );
+}

@@ -21,7 +21,7 @@ pub const MAX_JSON_ELEMENTS: usize = 1 << 23;
 /// Refuses JSON holding more than [`MAX_JSON_CONTAINERS`] objects and arrays or more than
 /// [`MAX_JSON_ELEMENTS`] elements and members. Brackets and commas inside strings do not
 /// count; what is not valid JSON is left for the parser to name.
-pub(super) fn check(json: &[u8]) -> Result<(), String> {
+pub(super) fn check(json: &[u8]) -> Result<JsonSize, String> {
     let (containers, separators) = crate::scene::json_count::count_containers(json);
     if containers > MAX_JSON_CONTAINERS {
         return Err(format!(
@@ -36,7 +36,40 @@ pub(super) fn check(json: &[u8]) -> Result<(), String> {
              the {MAX_JSON_ELEMENTS} a glTF file may (refused before parsing)"
         ));
     }
-    Ok(())
+    Ok(JsonSize {
+        containers,
+        elements,
+    })
+}
+
+/// What a glTF file's JSON holds, counted by [`check`].
+#[derive(Debug)]
+pub(super) struct JsonSize {
+    containers: usize,
+    elements: usize,
+}
+
+/// What parsing takes an object or array (all the loader's parses together: about 600 bytes
+/// an empty node) and an element or member, with room to spare.
+const PARSED_CONTAINER_BYTES: u64 = 640;
+const PARSED_ELEMENT_BYTES: u64 = 64;
+
+impl JsonSize {
+    /// Refuses JSON whose parses this process cannot allocate now (serde aborts where an
+    /// allocation fails): 3 MB of empty nodes, within the limits, takes some 600 MB.
+    pub(super) fn check_memory(&self) -> Result<(), String> {
+        let bytes = self.containers as u64 * PARSED_CONTAINER_BYTES
+            + self.elements as u64 * PARSED_ELEMENT_BYTES;
+        if crate::scene::alloc_probe::can_allocate(bytes) {
+            return Ok(());
+        }
+        Err(format!(
+            "parsing its JSON ({} objects and arrays) takes about {} MiB, more than this \
+             process can allocate now",
+            self.containers,
+            bytes >> 20
+        ))
+    }
 }
 
 #[cfg(test)]
@@ -47,7 +80,7 @@ mod tests {
     fn a_long_flat_array_is_refused_before_parsing() {
         // n zeros: n − 1 commas.
         let zeros = |n: usize| format!("[{}0]", "0,".repeat(n - 1));
-        assert_eq!(check(zeros(MAX_JSON_ELEMENTS - 1).as_bytes()), Ok(()));
+        assert!(check(zeros(MAX_JSON_ELEMENTS - 1).as_bytes()).is_ok());
         let past = zeros(MAX_JSON_ELEMENTS + 1);
         let refusal = check(past.as_bytes()).unwrap_err();
         assert!(refusal.contains("array elements"), "{refusal}");
@@ -56,7 +89,7 @@ mod tests {
     #[test]
     fn json_past_the_limit_is_refused_before_parsing() {
         let at_limit = format!("[{}]", vec!["{}"; MAX_JSON_CONTAINERS - 1].join(","));
-        assert_eq!(check(at_limit.as_bytes()), Ok(()));
+        assert!(check(at_limit.as_bytes()).is_ok());
         let past = format!("[{}]", vec!["{}"; MAX_JSON_CONTAINERS].join(","));
         let refusal = check(past.as_bytes()).unwrap_err();
         assert!(

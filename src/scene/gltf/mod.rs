@@ -358,7 +358,9 @@ fn import(
     };
     // The glTF specification lets a reader ignore a byte order mark, which some editors write.
     let json = json.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(json);
-    json_size::check(json)?;
+    json_size::check(json)?
+        .check_memory()
+        .map_err(Fault::Memory)?;
     let root = gltf::json::deserialize::from_slice(json).map_err(|e| {
         // An integer past u32 fails the crate's parse as a wrong type: named as what it is.
         integers::check(json)
