@@ -1,7 +1,7 @@
-//! A warning, once a renderer, when the camera leaves the depth buffer too coarse at the
-//! scene's far content: surfaces closer together in depth than its step show the one behind on
-//! some pixels, in every method alike (so comparing methods with forward cannot see it;
-//! docs/precision.md).
+//! Warnings, once a renderer, about the camera's depth range: a depth buffer too coarse at the
+//! scene's far content (surfaces closer together in depth than its step show the one behind on
+//! some pixels, in every method alike, so comparing methods with forward cannot see it), and a
+//! far plane `f32` cannot place (docs/precision.md).
 
 use crate::scene::{Camera, Projection};
 

@@ -269,6 +269,7 @@ impl Renderer {
             log::warn!("{warning}");
         }
         scene.validate()?;
+        super::empty_scene::warn_of_nothing_to_draw(scene, &mut self.warned_nothing_to_draw);
         self.gpu_scene
             .upload(&self.dev, scene, options.measure.full_variants)?;
         self.gpu_scene.check_placement(scene)?;

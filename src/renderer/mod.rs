@@ -8,6 +8,7 @@
 
 mod bound_target;
 mod depth_warning;
+mod empty_scene;
 mod fp16_channels;
 mod fp16_range;
 mod frame;
@@ -93,6 +94,8 @@ pub struct Renderer {
     srgb_destination: bool,
     /// A camera too coarse in depth for the scene was announced (once per renderer).
     warned_depth_step: bool,
+    /// A scene without triangles was announced (once per renderer).
+    warned_nothing_to_draw: bool,
     /// The light count whose frame memory was last asked of the allocator.
     lights_probed: usize,
     /// A far plane the `f32` projection cannot clip at was announced (once per renderer).
@@ -194,6 +197,7 @@ impl Renderer {
             warned_past_framebuffer: false,
             srgb_destination: false,
             warned_depth_step: false,
+            warned_nothing_to_draw: false,
             lights_probed: 0,
             warned_unclipped_far: false,
             warned_capped_radiance: false,

@@ -11,6 +11,7 @@ mod animation;
 mod background_alpha;
 mod culled_vs_forward;
 mod directional_lights;
+mod empty_scene;
 mod front_faces;
 mod game_draw_buffers;
 mod game_framebuffer_checks;
