@@ -363,6 +363,8 @@ pub fn parse(
             .map_or(Ok(DMat4::IDENTITY), |t| t.matrix(&field))?;
         let first_material = scene.materials.len();
         let first_object = scene.objects.len();
+        // Materials this object changes are its own copy; unchanged ones are shared.
+        let recolour = spec.color.is_some() || spec.metallic.is_some() || spec.roughness.is_some();
         for (name, path) in [
             ("obj", &spec.obj),
             ("gltf", &spec.gltf),
@@ -404,7 +406,7 @@ pub fn parse(
                     &base_dir.join(obj_path),
                     transform,
                     tex.as_deref(),
-                    spec.color.is_some(),
+                    recolour,
                     &format!("{field}.transform"),
                 )?;
                 report.warnings.extend(r.warnings);
@@ -420,7 +422,7 @@ pub fn parse(
                     &mut scene,
                     &base_dir.join(gltf_path),
                     transform,
-                    spec.color.is_some(),
+                    recolour,
                     &format!("{field}.transform"),
                 )?;
                 if let Some(camera) = camera {

@@ -529,3 +529,34 @@ fn json_past_its_container_limit_is_refused_before_parsing() {
         "{err}"
     );
 }
+
+/// One OBJ placed twice, once made metallic-roughness: each placement keeps its own model.
+/// Unrecoloured placements share materials, and `metallic`/`roughness` did not count as a
+/// recolouring: the plain copy after a metallic one drew metallic, and a metallic one after a
+/// plain one changed nothing.
+#[cfg(feature = "obj")]
+#[test]
+fn metallic_and_roughness_change_only_their_own_placement_of_a_shared_obj() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(
+        dir.path().join("q.obj"),
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+    )
+    .unwrap();
+    let metallic = r#"{"obj": "q.obj", "metallic": 1, "roughness": 0.3}"#;
+    let plain = r#"{"obj": "q.obj"}"#;
+    for (objects, metallic_at) in [([metallic, plain], 0), ([plain, metallic], 1)] {
+        let text = format!(r#"{{"objects": [{}]}}"#, objects.join(","));
+        let path = dir.path().join("s.json");
+        let (s, _) = parse(&text, dir.path(), &path, None, &LoadOptions::default()).unwrap();
+        for (i, o) in s.objects.iter().enumerate() {
+            let model = s.materials[o.material].model;
+            let want = if i == metallic_at {
+                MaterialModel::MetallicRoughness
+            } else {
+                MaterialModel::BlinnPhong
+            };
+            assert_eq!(model, want, "{objects:?}: object {i}");
+        }
+    }
+}
