@@ -353,6 +353,7 @@ pub fn parse(
     let mut scene = Scene::empty();
     let mut report = LoadReport::default();
     let mut builtin_camera = None;
+    let mut builtin_materials = std::collections::HashMap::new();
     let mut models = ModelCache::new(*options);
     let mut meshes = model_cache::MeshCount::default();
     for (i, spec) in file.objects.iter().enumerate() {
@@ -392,12 +393,22 @@ pub fn parse(
                     ));
                 }
                 builtin_camera.get_or_insert(built.camera);
+                // Unrecoloured placements share one copy of the materials, as models' do.
+                let base = match builtin_materials.get(name) {
+                    Some(&base) if !recolour => base,
+                    _ => {
+                        if !recolour {
+                            builtin_materials.insert(name.clone(), first_material);
+                        }
+                        scene.materials.extend(built.materials);
+                        first_material
+                    }
+                };
                 for mut o in built.objects {
-                    o.material += first_material;
+                    o.material += base;
                     o.transform = transform * o.transform;
                     scene.objects.push(o);
                 }
-                scene.materials.extend(built.materials);
             }
             (None, Some(obj_path), None) => {
                 let tex = spec.texture.as_ref().map(|t| base_dir.join(t));

@@ -46,6 +46,7 @@ mod orientation;
 mod png_profile;
 pub mod random;
 pub mod raycast;
+mod repeated_objects;
 mod said;
 pub mod shading;
 pub mod shown;
@@ -587,7 +588,15 @@ fn finish_load(
             },
         });
     }
-    let (scene, mut report) = loaded;
+    let (mut scene, mut report) = loaded;
+    let repeated = repeated_objects::drop_repeated_objects(&mut scene);
+    if repeated > 0 {
+        report.say(format!(
+            "{}: {repeated} objects repeat an earlier one exactly (the same mesh, material and \
+             placement) and are dropped: each added only overdraw",
+            shown::path(path)
+        ));
+    }
     for warning in dark_frame::warnings(&scene, path) {
         report.say(warning);
     }

@@ -363,8 +363,16 @@ fn more_distinct_meshes_than_the_limit_are_refused_naming_the_first_past_it() {
         err.contains(&past) && err.contains(&MAX_SCENE_MESHES.to_string()),
         "{err}"
     );
-    let (scene, _) = load(&write(dir.path(), "shared.gltf", model(1))).unwrap();
-    assert_eq!(scene.objects.len(), n);
+    // They load; placed alike (one mesh, one material, the identity), all but one are
+    // dropped as repeats, with a warning.
+    let (scene, report) = load(&write(dir.path(), "shared.gltf", model(1))).unwrap();
+    assert_eq!(scene.objects.len(), 1);
+    let repeats = format!("{} objects repeat an earlier one", n - 1);
+    assert!(
+        report.warnings.iter().any(|w| w.contains(&repeats)),
+        "{:?}",
+        report.warnings
+    );
     // Primitives skipped as points hold nothing and do not count.
     let points = json!({"primitives": [{"attributes": {"POSITION": p}, "mode": 0}]});
     let triangle = json!({"primitives": [{"attributes": {"POSITION": p}}]});
