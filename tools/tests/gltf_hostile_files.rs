@@ -337,8 +337,9 @@ fn a_json_file_that_is_not_gltf_shows_none_of_its_strings() {
 }
 
 /// Distinct meshes each cost a fixed few KB besides their data: a small file listing more than
-/// `MAX_SCENE_MESHES` of them (one triangle's accessor shared by all) is refused naming the
-/// first one past the limit, before memory runs out; as many placements of one mesh load.
+/// `MAX_SCENE_MESHES` of them (one triangle's accessor shared by all, each with its own
+/// material) is refused naming the first one past the limit, before memory runs out; as many
+/// placements of one mesh load.
 #[test]
 fn more_distinct_meshes_than_the_limit_are_refused_naming_the_first_past_it() {
     use manylight::scene::MAX_SCENE_MESHES;
@@ -346,13 +347,17 @@ fn more_distinct_meshes_than_the_limit_are_refused_naming_the_first_past_it() {
     let p = b.floats(&[0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0], "VEC3");
     let n = MAX_SCENE_MESHES + 1;
     let dir = tempfile::tempdir().unwrap();
+    // Each mesh's primitive names its own material (the same accessors and material would
+    // build one mesh for all).
     let model = |meshes: usize| {
-        let mesh = json!({"primitives": [{"attributes": {"POSITION": p}}]});
+        let mesh =
+            |i: usize| json!({"primitives": [{"attributes": {"POSITION": p}, "material": i}]});
         b.gltf(json!({
             "scene": 0,
             "scenes": [{"nodes": (0..n).collect::<Vec<_>>()}],
             "nodes": (0..n).map(|i| json!({"mesh": i % meshes})).collect::<Vec<_>>(),
-            "meshes": vec![mesh; meshes],
+            "meshes": (0..meshes).map(mesh).collect::<Vec<_>>(),
+            "materials": vec![json!({}); meshes],
         }))
     };
     let err = load(&write(dir.path(), "many.gltf", model(n)))

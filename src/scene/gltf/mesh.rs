@@ -45,6 +45,32 @@ impl Budget {
     }
 }
 
+/// What a primitive's mesh is built from: its attributes' accessors, its indices' accessor,
+/// its mode and its material (sidedness, tangents and duplicate removal follow it). Two
+/// primitives alike in these build the same mesh.
+#[derive(Clone, PartialEq, Eq, Hash)]
+pub(super) struct ContentKey {
+    attributes: Vec<(String, usize)>,
+    indices: Option<usize>,
+    mode: u32,
+    material: Option<usize>,
+}
+
+/// [`ContentKey`] of `p`.
+pub(super) fn content_key(p: &gltf::Primitive) -> ContentKey {
+    let mut attributes: Vec<(String, usize)> = p
+        .attributes()
+        .map(|(semantic, a)| (semantic.to_string(), a.index()))
+        .collect();
+    attributes.sort();
+    ContentKey {
+        attributes,
+        indices: p.indices().map(|a| a.index()),
+        mode: p.mode().as_gl_enum(),
+        material: p.material().index(),
+    }
+}
+
 /// The outcome for one primitive.
 pub(super) enum Built {
     /// A triangle mesh.
