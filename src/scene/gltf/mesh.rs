@@ -192,7 +192,12 @@ pub(super) fn build(
         let unrolled = listed.len().saturating_sub(2).saturating_mul(3);
         budget.take("indices", unrolled.saturating_sub(listed.len()), field)?;
     }
-    let indices = triangles(mode, &listed).map_err(|e| format!("{field}: {e}"))?;
+    let listing = if p.indices().is_some() {
+        "indices"
+    } else {
+        "vertices (it has no indices)"
+    };
+    let indices = triangles(mode, &listed, listing).map_err(|e| format!("{field}: {e}"))?;
     if indices.is_empty() {
         return Ok(Built::Skipped(format!("{field}: has no triangles")));
     }
@@ -464,12 +469,13 @@ pub(super) fn check_memory(p: &gltf::Primitive, field: &str) -> Result<(), Strin
 }
 
 /// A triangle list from the primitive's mode and its (checked) vertex sequence.
-fn triangles(mode: Mode, v: &[u32]) -> Result<Vec<u32>, String> {
+/// `listing` names what `v` lists, for the error: indices, or the vertices themselves.
+fn triangles(mode: Mode, v: &[u32], listing: &str) -> Result<Vec<u32>, String> {
     match mode {
         Mode::Triangles => {
             if !v.len().is_multiple_of(3) {
                 return Err(format!(
-                    "{} indices is not a whole number of triangles",
+                    "{} {listing} is not a whole number of triangles",
                     v.len()
                 ));
             }
@@ -500,17 +506,24 @@ mod tests {
     #[test]
     fn strips_and_fans_unroll_with_their_winding() {
         assert_eq!(
-            triangles(Mode::TriangleStrip, &[0, 1, 2, 3, 4]).unwrap(),
+            triangles(Mode::TriangleStrip, &[0, 1, 2, 3, 4], "indices").unwrap(),
             [0, 1, 2, 1, 3, 2, 2, 3, 4]
         );
         assert_eq!(
-            triangles(Mode::TriangleFan, &[0, 1, 2, 3]).unwrap(),
+            triangles(Mode::TriangleFan, &[0, 1, 2, 3], "indices").unwrap(),
             [1, 2, 0, 2, 3, 0]
         );
-        assert!(triangles(Mode::TriangleStrip, &[0, 1]).unwrap().is_empty());
-        assert!(triangles(Mode::Triangles, &[0, 1, 2, 3])
+        assert!(triangles(Mode::TriangleStrip, &[0, 1], "indices")
+            .unwrap()
+            .is_empty());
+        assert!(triangles(Mode::Triangles, &[0, 1, 2, 3], "indices")
             .unwrap_err()
             .contains("4 indices"));
+        // A primitive without indices lists its vertices: the error says so.
+        let listing = "vertices (it has no indices)";
+        assert!(triangles(Mode::Triangles, &[0, 1, 2, 3], listing)
+            .unwrap_err()
+            .contains("4 vertices (it has no indices) is not a whole number"));
     }
 
     /// A non-indexed primitive without normals unshares nothing more than its own vertices:
