@@ -850,16 +850,26 @@ fn a_failed_upload_or_allocation_keeps_nothing_it_made() {
     }
 }
 
+/// [`render_within_384_mib`]'s exit code and standard error, or `None` (said) where this
+/// machine has no `prlimit`.
+fn rendered_within_384_mib(scene: &Path, dir: &Path) -> Option<(Option<i32>, String)> {
+    let Ok(prlimit) = which_prlimit() else {
+        common::skip("no prlimit (util-linux) to bound the child's memory");
+        return None;
+    };
+    let out = render_within_384_mib(&prlimit, scene, dir);
+    Some((
+        out.status.code(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    ))
+}
+
 /// `image` aborts the process where an allocation fails. A 35-byte GIF whose screen is
 /// 11 585² (536 MB of RGBA), the texture of a small OBJ, aborted its load under a 384 MiB
 /// address-space limit (helper-129); the decode is now asked of the allocator first, and the
 /// material keeps its flat colour with a warning naming the texture.
 #[test]
 fn a_texture_larger_than_the_memory_left_keeps_the_flat_colour_not_an_abort() {
-    let Ok(prlimit) = which_prlimit() else {
-        common::skip("no prlimit (util-linux) to bound the child's memory");
-        return;
-    };
     let dir = tempfile::tempdir().unwrap();
     // Logical screen 0x2d41 = 11 585 a side; one 1×1 frame of one colour.
     let mut gif = b"GIF89a\x41\x2d\x41\x2d\x00\x00\x00".to_vec();
@@ -878,9 +888,10 @@ fn a_texture_larger_than_the_memory_left_keeps_the_flat_colour_not_an_abort() {
          f 1/1 2/2 3/3\n",
     )
     .unwrap();
-    let out = render_within_384_mib(&prlimit, &path, dir.path());
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(0), "{stderr}");
+    let Some((code, stderr)) = rendered_within_384_mib(&path, dir.path()) else {
+        return;
+    };
+    assert_eq!(code, Some(0), "{stderr}");
     assert!(
         stderr.contains("big.gif could not be decoded (11585×11585 pixels need"),
         "{stderr}"
@@ -893,21 +904,18 @@ fn a_texture_larger_than_the_memory_left_keeps_the_flat_colour_not_an_abort() {
 /// it is an error naming the count; a few thousand lights still render there.
 #[test]
 fn lights_past_the_memory_left_are_an_error_not_an_abort() {
-    let Ok(prlimit) = which_prlimit() else {
-        common::skip("no prlimit (util-linux) to bound the child's memory");
-        return;
-    };
     let dir = tempfile::tempdir().unwrap();
-    for (count, code) in [(1_000_000, 1), (4_000, 0)] {
+    for (count, expected) in [(1_000_000, 1), (4_000, 0)] {
         let path = common::files::write(
             dir.path(),
             &format!("l{count}.json"),
             format!(r#"{{"objects":[{{"builtin":"plane"}}],"random_lights":{{"count":{count}}}}}"#),
         );
-        let out = render_within_384_mib(&prlimit, &path, dir.path());
-        let stderr = String::from_utf8_lossy(&out.stderr);
-        assert_eq!(out.status.code(), Some(code), "{count}: {stderr}");
-        if code == 1 {
+        let Some((code, stderr)) = rendered_within_384_mib(&path, dir.path()) else {
+            return;
+        };
+        assert_eq!(code, Some(expected), "{count}: {stderr}");
+        if expected == 1 {
             assert!(
                 stderr.contains(&format!("{count} lights need about")),
                 "{stderr}"
@@ -922,10 +930,6 @@ fn lights_past_the_memory_left_are_an_error_not_an_abort() {
 /// as the OBJ loader's.
 #[test]
 fn a_gltf_primitive_larger_than_the_memory_left_is_an_error_not_an_abort() {
-    let Ok(prlimit) = which_prlimit() else {
-        common::skip("no prlimit (util-linux) to bound the child's memory");
-        return;
-    };
     let dir = tempfile::tempdir().unwrap();
     let count = 1usize << 24;
     let mut bin: Vec<u8> = [
@@ -966,9 +970,10 @@ fn a_gltf_primitive_larger_than_the_memory_left_is_an_error_not_an_abort() {
         "buffers": [{"byteLength": bin.len(), "uri": "strip.bin"}]
     });
     let path = common::files::write(dir.path(), "strip.gltf", doc.to_string());
-    let out = render_within_384_mib(&prlimit, &path, dir.path());
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    let Some((code, stderr)) = rendered_within_384_mib(&path, dir.path()) else {
+        return;
+    };
+    assert_eq!(code, Some(1), "{stderr}");
     assert!(
         stderr.contains("meshes[0].primitives[0]: building its 4 vertices and 16777214 triangles"),
         "{stderr}"
@@ -985,10 +990,6 @@ fn a_gltf_primitive_larger_than_the_memory_left_is_an_error_not_an_abort() {
 /// objects), the second before placing (more than the process can allocate).
 #[test]
 fn a_scene_file_of_many_objects_is_an_error_not_an_abort() {
-    let Ok(prlimit) = which_prlimit() else {
-        common::skip("no prlimit (util-linux) to bound the child's memory");
-        return;
-    };
     let dir = tempfile::tempdir().unwrap();
     let list = |object: &str, n: usize| format!(r#"{{"objects":[{}]}}"#, vec![object; n].join(","));
     for (name, text, says) in [
@@ -1004,9 +1005,10 @@ fn a_scene_file_of_many_objects_is_an_error_not_an_abort() {
         ),
     ] {
         let path = common::files::write(dir.path(), name, text);
-        let out = render_within_384_mib(&prlimit, &path, dir.path());
-        let stderr = String::from_utf8_lossy(&out.stderr);
-        assert_eq!(out.status.code(), Some(1), "{name}: {stderr}");
+        let Some((code, stderr)) = rendered_within_384_mib(&path, dir.path()) else {
+            return;
+        };
+        assert_eq!(code, Some(1), "{name}: {stderr}");
         assert!(stderr.contains(says), "{name}: {stderr}");
     }
 }
@@ -1016,19 +1018,16 @@ fn a_scene_file_of_many_objects_is_an_error_not_an_abort() {
 /// second parse (helper-129). The parses are now asked of the allocator first.
 #[test]
 fn a_gltf_whose_json_parse_cannot_be_allocated_is_an_error_not_an_abort() {
-    let Ok(prlimit) = which_prlimit() else {
-        common::skip("no prlimit (util-linux) to bound the child's memory");
-        return;
-    };
     let dir = tempfile::tempdir().unwrap();
     let mut b = common::gltf::Builder::default();
     let mut doc = common::gltf_models::triangle(&mut b);
     let nodes = doc["nodes"].as_array_mut().unwrap();
     nodes.extend(std::iter::repeat_n(serde_json::json!({}), 1_000_000));
     let path = common::files::write(dir.path(), "m.gltf", b.gltf(doc));
-    let out = render_within_384_mib(&prlimit, &path, dir.path());
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    let Some((code, stderr)) = rendered_within_384_mib(&path, dir.path()) else {
+        return;
+    };
+    assert_eq!(code, Some(1), "{stderr}");
     assert!(stderr.contains("parsing its JSON ("), "{stderr}");
     assert!(
         stderr.contains("more than this process can allocate now"),
