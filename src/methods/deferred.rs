@@ -91,8 +91,8 @@ const VOLUME_SCALE: f32 = 1.1;
 const FAR_MARGIN: f32 = 0.999;
 
 /// The largest proxy radius, in near-plane distances, drawn by its far side in perspective;
-/// past it, the full-screen path (which also shades the surfaces beyond the light). Head lamps
-/// lost light from 2.4·10⁴ up (`docs/precision.md`): a margin of ten.
+/// past it, the full-screen path (which also shades the surfaces beyond the light). A tenth of
+/// where head lamps were seen to lose light (docs/precision.md).
 const FAR_SIDE_REACH: f32 = 2048.0;
 
 /// Which side of a light's proxy is drawn and depth tested against the surfaces:
@@ -149,7 +149,7 @@ impl ProxyReach<'_> {
             > 0.1 * f64::from(light.cull_radius);
         // A far side around the eye is clipped at the near plane into faces reaching
         // `radius / near` half-viewports off screen, across which depth is interpolated
-        // tens of steps off (a light at the eye at near 10⁻⁸ lit nothing).
+        // tens of steps off.
         let clipped_far = self.perspective && radius > FAR_SIDE_REACH * self.near;
         if !coarse && depth - radius >= 2.0 * self.near {
             Proxy::NearSide

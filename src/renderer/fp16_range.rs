@@ -46,10 +46,18 @@ pub(super) fn check(
         return Ok(None);
     }
     if reach > MAX_FP16_VIEW_REACH {
+        // Where `f32` cannot place the far plane, it clips nothing: the near plane is the cause.
+        let unclipped =
+            scene.camera.far_clip_range().1.is_infinite() && scene.camera.near_far().1.is_finite();
+        let remedy = if unclipped {
+            "a larger camera.near, which gives the projection a far plane to clip at"
+        } else {
+            "bring camera.far closer"
+        };
         return Err(Error::Limit(format!(
             "camera.far: without fragment highp view-space positions are fp16, but the \
              visible scene reaches {reach:.3e} from the camera, past {MAX_FP16_VIEW_REACH}; \
-             bring camera.far closer (or scale the scene down)"
+             {remedy} (or scale the scene down)"
         )));
     }
     let farthest = MAX_FP16_SPAN - reach;

@@ -39,7 +39,7 @@ pub(super) fn gather_lights(
 /// allocation refused inside the frame would abort it): asked of the allocator for
 /// [`BYTES_PER_LIGHT`](crate::scene::input::BYTES_PER_LIGHT) a light and given back.
 pub(super) fn check_light_memory(count: usize) -> Result<(), crate::Error> {
-    let bytes = count as u64 * crate::scene::input::BYTES_PER_LIGHT;
+    let bytes = (count as u64).saturating_mul(crate::scene::input::BYTES_PER_LIGHT);
     if crate::scene::alloc_probe::can_allocate(bytes) {
         return Ok(());
     }
@@ -175,5 +175,22 @@ pub(super) fn content_far(bounds: Option<Aabb>, view: &DMat4, near: f64, far: f6
         d
     } else {
         floor.max(1.0)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    /// A frame of more lights than any machine can hold memory for is refused naming the
+    /// count; a few are not asked twice about.
+    #[test]
+    fn a_frames_lights_are_asked_of_the_allocator() {
+        assert!(super::check_light_memory(1_000).is_ok());
+        let err = super::check_light_memory(usize::MAX / 512)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains(&format!("{} lights need about", usize::MAX / 512)),
+            "{err}"
+        );
     }
 }

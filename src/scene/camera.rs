@@ -422,6 +422,19 @@ mod tests {
         }
         let infinite = Camera::perspective(DVec3::ZERO, -DVec3::Z, 60.0, 0.1, f64::INFINITY);
         assert_eq!(infinite.far_clip_range(), (f64::INFINITY, f64::INFINITY));
+        // Orthographic depth is linear: the range is a few f32 steps of its largest distance.
+        let mut ortho = Camera::perspective(DVec3::ZERO, -DVec3::Z, 60.0, 0.1, 1.0);
+        for (near, far) in [(0.0, 100.0), (-5.0, 1e7), (1e6, 1e6 + 1.0)] {
+            ortho.projection = Projection::Orthographic {
+                height: 2.0,
+                near,
+                far,
+            };
+            let (low, high) = ortho.far_clip_range();
+            let spread = 1e-5 * (f64::abs(far) + f64::abs(near));
+            assert!(low < far && far < high, "{near}..{far}");
+            assert!(far - low <= spread && high - far <= spread, "{near}..{far}");
+        }
     }
 
     #[test]

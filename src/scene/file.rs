@@ -33,6 +33,8 @@
 //! which are reported with the path of the field (`lights[1].outer_deg`).
 
 mod json_error;
+mod json_size;
+pub use json_size::MAX_SCENE_FILE_CONTAINERS;
 
 use std::path::{Path, PathBuf};
 
@@ -257,7 +259,7 @@ fn narrow3(field: &str, v: [f64; 3]) -> Result<Vec3, SceneError> {
 fn deserialize(text: &str) -> Result<SceneFile, String> {
     // A UTF-8 byte order mark, as some Windows editors write: skipped, as for OBJ and MTL.
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
-    check_json_size(text)?;
+    json_size::check(text)?;
     let mut json = serde_json::Deserializer::from_str(text);
     let file = serde_path_to_error::deserialize(&mut json).map_err(|e| json_error::message(&e))?;
     json.end()
@@ -265,41 +267,9 @@ fn deserialize(text: &str) -> Result<SceneFile, String> {
     Ok(file)
 }
 
-/// Most JSON objects and arrays a scene file may hold: twice the objects it may place, each
-/// `{"builtin":"plane"}` one. 16 MiB of `{},` (5.6 M) parsed into 1.25 GB before the first
-/// was refused.
-pub const MAX_SCENE_FILE_CONTAINERS: usize = 2 * super::MAX_SCENE_OBJECTS;
-
-/// What an object of the file takes placed, through loading and a frame, with room to spare:
-/// 838 858 `{"builtin":"plane"}` peaked at 860 MB.
+/// What an object of the file takes placed, through loading and a frame, with room to spare
+/// over what was measured (docs/cli.md).
 const OBJECT_BYTES: u64 = 1024;
-
-/// What parsing takes an object or array, and an element or member, with room to spare (an
-/// empty object in the `objects` list took about 223 bytes).
-const PARSED_CONTAINER_BYTES: u64 = 256;
-const PARSED_ELEMENT_BYTES: u64 = 64;
-
-/// Refuses JSON past [`MAX_SCENE_FILE_CONTAINERS`] or whose parse this process cannot
-/// allocate now (serde aborts where an allocation fails), counted before parsing.
-fn check_json_size(text: &str) -> Result<(), String> {
-    let (containers, separators) = super::json_count::count_containers(text.as_bytes());
-    if containers > MAX_SCENE_FILE_CONTAINERS {
-        return Err(format!(
-            "its JSON holds {containers} objects and arrays, more than the \
-             {MAX_SCENE_FILE_CONTAINERS} a scene file may (refused before parsing)"
-        ));
-    }
-    let bytes =
-        containers as u64 * PARSED_CONTAINER_BYTES + separators as u64 * PARSED_ELEMENT_BYTES;
-    if !super::alloc_probe::can_allocate(bytes) {
-        return Err(format!(
-            "parsing its {containers} JSON objects and arrays takes about {} MiB, more than \
-             this process can allocate now",
-            bytes >> 20
-        ));
-    }
-    Ok(())
-}
 
 /// Loads a scene file. Returns the scene (validated) and the warnings of any OBJ loads.
 /// `random_override` = `Some((count, seed))` replaces the file's `random_lights`.

@@ -1,27 +1,54 @@
 //! Objects that repeat an earlier one exactly: the same mesh, material and placement. On an
-//! opaque surface each copy adds only overdraw, every copy of a pixel shaded again (10 000
-//! glTF nodes placing one triangle took minutes a frame). Transparent ones keep their copies
-//! (each blends once more).
+//! opaque surface each copy adds only overdraw, every copy of a pixel shaded again.
+//! Transparent ones keep their copies (each blends once more).
 
-use std::collections::HashSet;
+use std::cmp::Ordering;
 use std::sync::Arc;
 
-use super::Scene;
+use super::{Object, Scene};
 
 /// Drops every opaque object equal to an earlier one (mesh shared, same material index,
 /// bit-identical transform), keeping the order of the rest; returns how many were dropped.
+/// Sorts object numbers (4 bytes an object) rather than hashing the objects' keys, which
+/// took some 140 bytes an object besides the scene.
 pub(super) fn drop_repeated_objects(scene: &mut Scene) -> usize {
-    let mut seen = HashSet::new();
-    let before = scene.objects.len();
+    let objects = &scene.objects;
     let materials = &scene.materials;
-    scene.objects.retain(|o| {
-        if materials.get(o.material).is_none_or(|m| m.is_transparent()) {
-            return true;
+    let opaque = |o: &Object| {
+        materials
+            .get(o.material)
+            .is_some_and(|m| !m.is_transparent())
+    };
+    let mut order: Vec<u32> = (0..objects.len() as u32)
+        .filter(|&i| opaque(&objects[i as usize]))
+        .collect();
+    // Equal objects side by side, the earliest first among them.
+    order.sort_unstable_by(|&a, &b| {
+        compare(&objects[a as usize], &objects[b as usize]).then(a.cmp(&b))
+    });
+    let mut repeated = vec![false; objects.len()];
+    for pair in order.windows(2) {
+        let (first, next) = (&objects[pair[0] as usize], &objects[pair[1] as usize]);
+        if compare(first, next) == Ordering::Equal {
+            repeated[pair[1] as usize] = true;
         }
-        let placement = o.transform.to_cols_array().map(f64::to_bits);
-        seen.insert((Arc::as_ptr(&o.mesh), o.material, placement))
+    }
+    let before = objects.len();
+    let mut i = 0;
+    scene.objects.retain(|_| {
+        i += 1;
+        !repeated[i - 1]
     });
     before - scene.objects.len()
+}
+
+/// Orders objects by mesh, material and transform bits: equal when each is the same.
+fn compare(a: &Object, b: &Object) -> Ordering {
+    let bits = |o: &Object| o.transform.to_cols_array().map(f64::to_bits);
+    Arc::as_ptr(&a.mesh)
+        .cmp(&Arc::as_ptr(&b.mesh))
+        .then(a.material.cmp(&b.material))
+        .then_with(|| bits(a).cmp(&bits(b)))
 }
 
 #[cfg(test)]

@@ -430,12 +430,14 @@ fn read_colors(
     Ok(colors)
 }
 
-/// Bytes a vertex and a triangle take while a primitive is built (attributes, unshared
-/// copies, duplicate search), and a triangle corner while MikkTSpace makes tangents. Peak
-/// resident memory measured over the CLI's 93 MB at 8×8: 28 bytes a triangle for 16 M
-/// triangles of a strip (all duplicates), about 450 for a 1 M-triangle normal-mapped grid.
+/// Bytes a vertex takes while a primitive is built (its attributes and their copies), with
+/// room to spare over what was measured (docs/gltf.md).
 const VERTEX_BYTES: u64 = 128;
+
+/// Bytes a triangle takes while a primitive is built (indices, the duplicate search).
 const TRIANGLE_BYTES: u64 = 40;
+
+/// Bytes a triangle corner takes while MikkTSpace makes tangents.
 const TANGENT_CORNER_BYTES: u64 = 128;
 
 /// Refuses a primitive whose building this process cannot allocate now: the allocations
