@@ -54,11 +54,12 @@ fn compare(a: &Object, b: &Object) -> Ordering {
 #[cfg(test)]
 mod tests {
     use crate::scene::meshbuild::MeshBuilder;
-    use crate::scene::{load, Material, Scene};
+    use crate::scene::{Material, Scene};
     use glam::{DMat4, DVec3, Vec3};
 
     /// A scene file placing the plane five times: three alike, one moved, one recoloured.
     /// The two repeats go, with a warning; what differs stays.
+    #[cfg(feature = "scene-files")]
     #[test]
     fn exact_repeats_of_an_object_are_dropped_at_load_with_a_warning() {
         let dir = tempfile::tempdir().unwrap();
@@ -68,7 +69,7 @@ mod tests {
         let red = r#"{"builtin": "plane", "color": [1, 0, 0]}"#;
         let objects = [plane, plane, moved, plane, red].join(",");
         std::fs::write(&path, format!(r#"{{"objects": [{objects}]}}"#)).unwrap();
-        let (scene, report) = load(path.to_str().unwrap(), None).unwrap();
+        let (scene, report) = crate::scene::load(path.to_str().unwrap(), None).unwrap();
         let once = crate::scene::builtin::build("plane", None)
             .unwrap()
             .objects

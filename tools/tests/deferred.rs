@@ -372,16 +372,21 @@ fn head_lamps_match_forward_at_any_near_plane() {
         let (reference, _) = gpu.render_with("forward", &s, (64, 36), &Default::default());
         let (img, _) = gpu.render_with("deferred", &s, (64, 36), &Default::default());
         let d = manylight::metrics::diff(&reference, &img);
-        if d.max_abs > worst.0 {
+        // A light lost shows as tens of pixels far off. SwiftShader draws a few pixels along
+        // the edges of a proxy the near plane cuts a few /255 off at any size (4/255 on 4
+        // pixels at 1 592 near distances, 3/255 at 28), as softpipe does (docs/testing.md).
+        let off = (d.over_2 * 64.0 * 36.0).round() as usize;
+        if d.max_abs > 16 || off > 4 {
             let reach = 1.1 * radius / near;
             worst = (
                 d.max_abs,
-                format!("case {case}: {reach:.3e} near distances across"),
+                format!("case {case}: {off} pixels, {reach:.3e} near distances across"),
             );
+            break;
         }
     }
     assert!(
-        worst.0 <= 2,
+        worst.1.is_empty(),
         "deferred {} / 255 from forward, {}",
         worst.0,
         worst.1
