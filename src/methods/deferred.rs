@@ -134,7 +134,6 @@ impl Proxy {
 /// What decides a light's [`Proxy`]: the view's camera and depth range.
 struct ProxyReach<'a> {
     camera: &'a crate::scene::Camera,
-    perspective: bool,
     near: f32,
     far: f32,
 }
@@ -150,7 +149,11 @@ impl ProxyReach<'_> {
         // A far side around the eye is clipped at the near plane into faces reaching
         // `radius / near` half-viewports off screen, across which depth is interpolated
         // tens of steps off.
-        let clipped_far = self.perspective && radius > FAR_SIDE_REACH * self.near;
+        let perspective = matches!(
+            self.camera.projection,
+            crate::scene::Projection::Perspective { .. }
+        );
+        let clipped_far = perspective && radius > FAR_SIDE_REACH * self.near;
         if !coarse && depth - radius >= 2.0 * self.near {
             Proxy::NearSide
         } else if !coarse && !clipped_far && depth + radius < FAR_MARGIN * self.far {
@@ -413,7 +416,6 @@ impl Deferred {
         let viewport = [ctx.viewport.0 as f32, ctx.viewport.1 as f32];
         let reach = ProxyReach {
             camera: &ctx.scene.camera,
-            perspective: !ctx.orthographic,
             near: ctx.near as f32,
             far: ctx.scene.camera.far_clip_range().0 as f32,
         };

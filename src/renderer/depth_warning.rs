@@ -45,7 +45,7 @@ pub(super) fn warn_of_unclipped_far(camera: &Camera, warned: &mut bool) {
     let Projection::Perspective { near, far, .. } = camera.projection else {
         return;
     };
-    if *warned || far.is_infinite() || camera.far_clip_range().1.is_finite() {
+    if *warned || !camera.has_unclipped_far() {
         return;
     }
     *warned = true;

@@ -47,9 +47,7 @@ pub(super) fn check(
     }
     if reach > MAX_FP16_VIEW_REACH {
         // Where `f32` cannot place the far plane, it clips nothing: the near plane is the cause.
-        let unclipped =
-            scene.camera.far_clip_range().1.is_infinite() && scene.camera.near_far().1.is_finite();
-        let remedy = if unclipped {
+        let remedy = if scene.camera.has_unclipped_far() {
             "a larger camera.near, which gives the projection a far plane to clip at"
         } else {
             "bring camera.far closer"

@@ -334,16 +334,17 @@ impl Renderer {
             scene,
             &mut self.warned_capped_ambient,
         );
+        let clear = self.frame_clear;
+        let colour = (clear == Clear::All).then(|| self.clear_value(options));
         // MSAA frames clear everything (`Clear::All`, checked above).
-        let background = self.clear_value(options);
-        if let Some(msaa) = self.msaa.as_mut().filter(|_| resolve.is_some()) {
-            msaa.fill(&self.dev, &mut self.programs, background)?;
+        if let (Some(msaa), Some(colour)) =
+            (self.msaa.as_mut().filter(|_| resolve.is_some()), colour)
+        {
+            msaa.fill(&self.dev, &mut self.programs, colour)?;
         }
         let frame_rect = [origin[0], origin[1], width, height].map(|v| v as i32);
         self.dev
             .viewport(frame_rect[0], frame_rect[1], frame_rect[2], frame_rect[3]);
-        let clear = self.frame_clear;
-        let colour = (clear == Clear::All).then(|| self.clear_value(options));
         self.dev
             .clear_rect_of(frame_rect, colour, clear != Clear::Nothing);
         let mut ctx = FrameContext {

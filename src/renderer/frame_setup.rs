@@ -36,18 +36,12 @@ pub(super) fn gather_lights(
 }
 
 /// Refuses a frame of `count` lights whose memory this process cannot allocate now (an
-/// allocation refused inside the frame would abort it): asked of the allocator for
-/// [`BYTES_PER_LIGHT`](crate::scene::input::BYTES_PER_LIGHT) a light and given back.
+/// allocation refused inside the frame would abort it), as a load refuses making them.
 pub(super) fn check_light_memory(count: usize) -> Result<(), crate::Error> {
-    let bytes = (count as u64).saturating_mul(crate::scene::input::BYTES_PER_LIGHT);
-    if crate::scene::alloc_probe::can_allocate(bytes) {
-        return Ok(());
+    match crate::scene::input::light_memory_refusal(count) {
+        Some(reason) => Err(crate::Error::Limit(reason)),
+        None => Ok(()),
     }
-    Err(crate::Error::Limit(format!(
-        "{count} lights need about {} MiB through a frame, which this process cannot \
-         allocate now",
-        bytes >> 20
-    )))
 }
 
 /// Writes `new` over `lights` (keeping its buffer), comparing on the way. Returns whether the

@@ -221,6 +221,12 @@ impl Camera {
         }
     }
 
+    /// Whether a finite far plane was asked for that the GPU's `f32` projection cannot clip
+    /// at ([`Camera::far_clip_range`] unbounded): geometry past it is drawn.
+    pub fn has_unclipped_far(&self) -> bool {
+        self.near_far().1.is_finite() && self.far_clip_range().1.is_infinite()
+    }
+
     /// How far apart in depth two surfaces `distance` from the eye must be for the depth
     /// test of a `bits`-bit depth buffer to tell them apart: one step, `distance² / (near ·
     /// 2^bits)` in perspective (any far plane), the depth range over `2^bits` in orthographic

@@ -323,7 +323,6 @@ pub fn parse(
     let mut scene = Scene::empty();
     let mut report = LoadReport::default();
     let mut builtin_camera = None;
-    let mut builtin_materials = std::collections::HashMap::new();
     let mut models = ModelCache::new(*options);
     let mut meshes = model_cache::MeshCount::default();
     for (i, spec) in file.objects.iter().enumerate() {
@@ -350,35 +349,21 @@ pub fn parse(
         }
         match (&spec.builtin, &spec.obj, &spec.gltf) {
             (Some(name), None, None) => {
-                let built = models
-                    .builtin(name)
-                    .ok_or_else(|| SceneError::UnknownBuiltin {
-                        name: name.clone(),
-                        available: super::builtin::NAMES,
-                    })?;
+                let camera =
+                    models
+                        .builtin_camera(name)
+                        .ok_or_else(|| SceneError::UnknownBuiltin {
+                            name: name.clone(),
+                            available: super::builtin::NAMES,
+                        })?;
                 if spec.texture.is_some() {
                     return Err(SceneError::invalid(
                         format!("{field}.texture"),
                         "only OBJ objects take a texture",
                     ));
                 }
-                builtin_camera.get_or_insert(built.camera);
-                // Unrecoloured placements share one copy of the materials, as models' do.
-                let base = match builtin_materials.get(name) {
-                    Some(&base) if !recolour => base,
-                    _ => {
-                        if !recolour {
-                            builtin_materials.insert(name.clone(), first_material);
-                        }
-                        scene.materials.extend(built.materials);
-                        first_material
-                    }
-                };
-                for mut o in built.objects {
-                    o.material += base;
-                    o.transform = transform * o.transform;
-                    scene.objects.push(o);
-                }
+                builtin_camera.get_or_insert(camera);
+                models.place_builtin(&mut scene, name, transform, recolour);
             }
             (None, Some(obj_path), None) => {
                 let tex = spec.texture.as_ref().map(|t| base_dir.join(t));
@@ -502,7 +487,8 @@ pub fn parse(
         (None, None) => None,
     };
     if let Some(((count, seed), field)) = random {
-        super::input::check_light_count(count, field)?;
+        // The count alone here; memory is asked for the total below.
+        super::input::light_count(count as u64, field)?;
         let total = count.saturating_add(scene.lights.len());
         if total > super::input::MAX_LIGHTS {
             return Err(SceneError::invalid(

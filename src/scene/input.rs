@@ -277,18 +277,23 @@ pub(crate) fn check_lights_added(
 /// allocation refused later would abort it), it is an error.
 pub fn check_light_count(count: usize, field: &str) -> Result<(), SceneError> {
     light_count(count as u64, field)?;
-    let bytes = count as u64 * BYTES_PER_LIGHT;
-    if !super::alloc_probe::can_allocate(bytes) {
-        return Err(SceneError::invalid(
-            field,
-            format!(
-                "{count} lights need about {} MiB through a frame ({BYTES_PER_LIGHT} bytes \
-                 each), which this process cannot allocate now",
-                bytes >> 20
-            ),
-        ));
+    match light_memory_refusal(count) {
+        Some(reason) => Err(SceneError::invalid(field, reason)),
+        None => Ok(()),
     }
-    Ok(())
+}
+
+/// Why `count` lights cannot be made and drawn here, if this process cannot allocate
+/// [`BYTES_PER_LIGHT`] each now (asked of the allocator and given back); `None` if it can.
+pub(crate) fn light_memory_refusal(count: usize) -> Option<String> {
+    let bytes = (count as u64).saturating_mul(BYTES_PER_LIGHT);
+    (!super::alloc_probe::can_allocate(bytes)).then(|| {
+        format!(
+            "{count} lights need about {} MiB through a frame ({BYTES_PER_LIGHT} bytes each), \
+             which this process cannot allocate now",
+            bytes >> 20
+        )
+    })
 }
 
 /// Memory a light takes through loading and a frame, with room to spare over what was

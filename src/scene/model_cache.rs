@@ -212,7 +212,8 @@ pub(super) struct ModelCache {
     images: HashMap<String, Arc<image::RgbaImage>>,
     /// Every texture kept so far, by name and sampling (one image read through several).
     textures: HashMap<(String, Sampling), Arc<Texture>>,
-    builtin: HashMap<String, Option<Scene>>,
+    /// Built-in scenes as first built (`None`: no such name), with their cameras.
+    builtin: HashMap<String, Option<(Loaded, Camera)>>,
 }
 
 impl ModelCache {
@@ -224,12 +225,37 @@ impl ModelCache {
         }
     }
 
-    /// A built-in scene's geometry, built on first use (later ones share its meshes).
-    pub fn builtin(&mut self, name: &str) -> Option<Scene> {
+    /// A built-in scene's camera, its geometry built on first use; `None` for an unknown name.
+    pub fn builtin_camera(&mut self, name: &str) -> Option<Camera> {
+        self.builtin_model(name).map(|(_, camera)| *camera)
+    }
+
+    /// Places the built-in scene `name` with `transform`, sharing the meshes of every
+    /// placement and, unless the caller will `recolour` them, the materials too; nothing for
+    /// an unknown name ([`ModelCache::builtin_camera`] says which).
+    pub fn place_builtin(
+        &mut self,
+        scene: &mut Scene,
+        name: &str,
+        transform: DMat4,
+        recolour: bool,
+    ) {
+        if let Some((model, _)) = self.builtin_model(name) {
+            model.place_checked(scene, transform, recolour);
+        }
+    }
+
+    /// The built-in scene `name` as first built.
+    fn builtin_model(&mut self, name: &str) -> Option<&mut (Loaded, Camera)> {
         self.builtin
             .entry(name.to_string())
-            .or_insert_with(|| super::builtin::geometry(name))
-            .clone()
+            .or_insert_with(|| {
+                super::builtin::geometry(name).map(|built| {
+                    let model = Loaded::record(&built, (0, 0), |_, o| o.transform, false);
+                    (model, built.camera)
+                })
+            })
+            .as_mut()
     }
 
     /// Places an OBJ file with `transform`, loading it on first use. `recolour`: the caller

@@ -342,7 +342,7 @@ fn ask_for(
     counts: &parse_memory::ObjCounts,
     bytes: u64,
 ) -> Result<(), SceneError> {
-    if parse_memory::can_allocate(bytes) {
+    if super::alloc_probe::can_allocate(bytes) {
         return Ok(());
     }
     let reason = format!(
@@ -390,7 +390,7 @@ fn parse_obj(path: &Path, allow_outside: bool) -> Result<Parsed, SceneError> {
     let filled = corners::fill_missing(&text, mixed);
     // The bound from the corners written first; where that is refused, from the distinct
     // ones, counted (real meshes share each vertex among about six triangles).
-    if !parse_memory::can_allocate(counts.parse_bytes()) {
+    if !super::alloc_probe::can_allocate(counts.parse_bytes()) {
         counts.count_distinct(&text);
         ask_for(path, "loading", &counts, counts.parse_bytes())?;
     }

@@ -121,13 +121,14 @@ pub(crate) fn decode_texture_bytes(
     // canvas (GIF's), the scaled copy and the RGBA one are asked for first.
     let (sw, sh) = stored_size(w, h);
     let kept = u64::from(sw) * u64::from(sh) * (u64::from(bytes_per_pixel) + 4);
-    if !super::alloc_probe::can_allocate(2 * decoded + kept) {
+    let needed = 2 * decoded + kept;
+    if !super::alloc_probe::can_allocate(needed) {
         budget.give_back(taken);
         budget.give_back_decoding(decoded);
         return Err(format!(
             "could not be decoded ({w}×{h} pixels need {} MiB to decode, which cannot be \
              allocated here)",
-            (2 * decoded + kept) >> 20
+            needed >> 20
         ));
     }
     PIXEL_BYTES_DECODED.with(|n| n.set(n.get().saturating_add(u64::from(w) * u64::from(h) * 4)));

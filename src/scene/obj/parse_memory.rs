@@ -162,7 +162,7 @@ impl ObjCounts {
     }
 }
 
-pub(super) use crate::scene::alloc_probe::can_allocate;
+use crate::scene::alloc_probe::can_allocate;
 
 #[cfg(test)]
 mod tests {
