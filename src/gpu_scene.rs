@@ -25,7 +25,8 @@ pub struct GpuScene {
     /// colour (each made when a material
     /// first samples it so: a base colour or emission is colour, a normal map data).
     textures: HashMap<usize, (Arc<image::RgbaImage>, [Option<ImageTexture>; 2])>,
-    /// 1×1 white texture for full variants on untextured materials (made on first use).
+    /// 1×1 white texture for the inputs a shared variant samples and an object lacks (made on
+    /// first use).
     white: Option<ImageTexture>,
     /// Colour textures are uploaded as sRGB textures, in their own slot of `textures`
     /// (`texture::hardware_srgb`; set by each upload).
@@ -89,15 +90,17 @@ fn textures_of(m: &Material) -> impl Iterator<Item = (&Texture, bool)> {
 }
 
 impl GpuScene {
+    /// Uploads what the scene's objects draw with; `needs_white`: the white stand-in texture
+    /// too, for shared or full variants.
     pub(crate) fn upload(
         &mut self,
         dev: &Device,
         scene: &Scene,
-        full_variants: bool,
+        needs_white: bool,
     ) -> Result<(), Error> {
         self.forget_unreferenced(dev);
         self.srgb_textures = crate::gl::texture::hardware_srgb(dev.caps());
-        if full_variants && self.white.is_none() {
+        if needs_white && self.white.is_none() {
             let white = image::RgbaImage::from_pixel(1, 1, image::Rgba([255, 255, 255, 255]));
             self.white = Some(ImageTexture::new(dev, &white, false)?);
         }
@@ -312,7 +315,7 @@ impl GpuScene {
         colour && self.srgb_textures
     }
 
-    /// The white stand-in texture (only after an upload with full variants).
+    /// The white stand-in texture (only after an upload that needed it).
     pub fn white(&self) -> Option<&ImageTexture> {
         self.white.as_ref()
     }

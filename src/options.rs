@@ -159,9 +159,11 @@ pub struct MeasureOptions {
     /// variant): the reference image error is measured against. Off, colour factors run at
     /// mediump as a mobile build wants (see `glsl/light_model.glsl`).
     pub reference_precision: bool,
-    /// Compile every variant with spot, specular and texture code even where the scene lacks
-    /// them (a white texture stands in) — to measure what leaving features out saves, and to
-    /// test that it changes nothing in the image.
+    /// Compile every variant with spot code, and every object's with the shared surface
+    /// variant a scene of too many material variants takes (texture, specular, emission,
+    /// occlusion and metallic-roughness maps, texture transforms and vertex colours, with
+    /// neutral values where the object lacks them) — to measure what leaving features out
+    /// saves, and to test that it changes nothing in the image.
     pub full_variants: bool,
 }
 

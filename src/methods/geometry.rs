@@ -197,44 +197,36 @@ pub(crate) fn shade_object<P: GeometryProgram>(
     let dialect = dev.es();
     let object = &ctx.scene.objects[index];
     let material = &ctx.scene.materials[object.material];
-    let full = ctx.options.measure.full_variants;
+    let units = dev.caps().max_texture_image_units;
     // A mesh without texture coordinates samples no texture (every pixel would read the
     // corner texel): its material's flat colours draw it, as the loaders warn.
     let mapped = !object.mesh.uvs.is_empty();
-    let texture = (ctx.gpu_scene.texture_for(material).filter(|_| mapped))
-        .or_else(|| full.then(|| ctx.gpu_scene.white()).flatten());
-    // Surface inputs only where a colour is computed (counts read none).
-    let inputs = if ctx.features.counting() {
-        ShaderFeatures::default()
+    let own_texture = ctx.gpu_scene.texture_for(material).filter(|_| mapped);
+    let own = super::surface_variants::own(material, &object.mesh, own_texture.is_some(), units);
+    let features = if ctx.features.counting() {
+        // A count reads no surface input and cuts no fragment.
+        let kept =
+            ShaderFeatures::TEXTURE | ShaderFeatures::SPECULAR | ShaderFeatures::METALLIC_ROUGHNESS;
+        ShaderFeatures(own.0 & kept)
     } else {
-        let units = dev.caps().max_texture_image_units;
-        let inputs = super::maps::features(material, &object.mesh, units);
         // Only a light reads the shading normal: without one the map would be compiled out.
         let shades = !ctx.features.has(ShaderFeatures::NO_LIGHTS)
             || ctx.features.has(ShaderFeatures::DIRECTIONAL);
-        let mapped = inputs.has(ShaderFeatures::NORMAL_MAP) && shades;
-        inputs.with(ShaderFeatures::NORMAL_MAP, mapped)
-    };
-    let features = ShaderFeatures(ctx.features.0 | inputs.0)
-        .with(ShaderFeatures::TEXTURE, texture.is_some())
-        .with(
-            ShaderFeatures::ALPHA_MASK,
-            (texture.is_some() || inputs.has(ShaderFeatures::VERTEX_ALPHA))
-                && material.alpha_cutoff.is_some()
-                && !ctx.features.counting(),
-        )
-        .with(
-            ShaderFeatures::TEXTURE_ALPHA,
-            texture.is_some() && material.alpha_texture && !ctx.features.counting(),
-        )
-        .with(
-            ShaderFeatures::SPECULAR,
-            !material.is_metallic_roughness() && (material.has_specular() || full),
-        )
-        .with(
-            ShaderFeatures::METALLIC_ROUGHNESS,
-            material.is_metallic_roughness(),
+        let own = own.with(
+            ShaderFeatures::NORMAL_MAP,
+            own.has(ShaderFeatures::NORMAL_MAP) && shades,
         );
+        if ctx.shared_surfaces {
+            super::surface_variants::shared(own, units)
+        } else {
+            own
+        }
+    };
+    let texture = own_texture.or_else(|| {
+        let white = features.has(ShaderFeatures::TEXTURE);
+        white.then(|| ctx.gpu_scene.white()).flatten()
+    });
+    let features = ShaderFeatures(ctx.features.0 | features.0);
     let key = ProgramKey {
         shader,
         features: features.0,
@@ -281,7 +273,7 @@ pub(crate) fn shade_object<P: GeometryProgram>(
     program
         .surface()
         .maps()
-        .set(dev, material, features, ctx.gpu_scene);
+        .set(dev, material, features, own, ctx.gpu_scene);
     bind_method(program, dev);
     mesh.draw(dev);
     Ok(())

@@ -85,6 +85,11 @@ pub fn features(material: &Material, mesh: &Mesh, units: i32) -> F {
     bits.with(F::TEXTURE_TRANSFORM, transformed)
 }
 
+/// Whether the map of feature `bit` has its texture unit on a context with `units`.
+pub(crate) fn unit_fits(bit: u64, units: i32) -> bool {
+    (SLOTS.iter()).any(|(b, unit, _)| *b == bit && (*unit as i32) < units)
+}
+
 /// One map as [`MapUniforms::set`] binds it: feature bit, texture, sampler, UV transform.
 type MapSlot<'a> = (
     u64,
@@ -132,11 +137,23 @@ impl MapUniforms {
         }
     }
 
-    /// Binds the maps `features` selected and sets their uniforms.
-    pub(crate) fn set(&self, dev: &Device, material: &Material, features: F, scene: &GpuScene) {
+    /// Binds the maps `features` selected and sets their uniforms. Where `features` has an
+    /// input the object's `own` features lack (a shared variant:
+    /// [`super::surface_variants::shared`]), the input's neutral value stands in: the white
+    /// texture, no emission, an identity transform.
+    pub(crate) fn set(
+        &self,
+        dev: &Device,
+        material: &Material,
+        features: F,
+        own: F,
+        scene: &GpuScene,
+    ) {
         let maps = &material.maps;
+        let transformed = own.has(F::TEXTURE_TRANSFORM);
         if features.has(F::TEXTURE_TRANSFORM) {
-            self.albedo_uv.set(dev, uv_matrix(&maps.base_transform));
+            let albedo = transformed.then(|| uv_matrix(&maps.base_transform));
+            self.albedo_uv.set(dev, albedo.unwrap_or(Mat3::IDENTITY));
         }
         let slots: [MapSlot<'_>; 4] = [
             (
@@ -165,25 +182,49 @@ impl MapUniforms {
             ),
         ];
         for ((bit, map, sampler, uv), (_, unit, _)) in slots.into_iter().zip(SLOTS) {
-            let Some(map) = map.as_ref().filter(|_| features.has(bit)) else {
+            if !features.has(bit) {
                 continue;
-            };
-            if let Some(t) = scene.texture_of(&map.texture, bit == F::EMISSIVE_MAP) {
-                t.bind(dev, unit, &map.texture.sampling);
+            }
+            let own_map = map.as_ref().filter(|_| own.has(bit));
+            match own_map {
+                Some(map) => {
+                    if let Some(t) = scene.texture_of(&map.texture, bit == F::EMISSIVE_MAP) {
+                        t.bind(dev, unit, &map.texture.sampling);
+                    }
+                }
+                None => {
+                    if let Some(white) = scene.white() {
+                        white.bind(dev, unit, &Default::default());
+                    }
+                }
+            }
+            if features.has(F::TEXTURE_TRANSFORM) {
+                let transform = own_map.filter(|_| transformed);
+                uv.set(
+                    dev,
+                    transform.map_or(Mat3::IDENTITY, |m| uv_matrix(&m.transform)),
+                );
             }
             sampler.set(dev, unit);
-            if features.has(F::TEXTURE_TRANSFORM) {
-                uv.set(dev, uv_matrix(&map.transform));
-            }
         }
         if features.has(F::NORMAL_MAP) {
             self.normal_scale.set(dev, maps.normal_scale);
         }
         if features.has(F::EMISSIVE) {
-            self.emissive.set(dev, maps.emissive);
+            let emission = if own.has(F::EMISSIVE) {
+                maps.emissive
+            } else {
+                Vec3::ZERO
+            };
+            self.emissive.set(dev, emission);
         }
         if features.has(F::OCCLUSION) {
-            self.occlusion_strength.set(dev, maps.occlusion_strength);
+            let strength = if own.has(F::OCCLUSION) {
+                maps.occlusion_strength
+            } else {
+                0.0
+            };
+            self.occlusion_strength.set(dev, strength);
         }
     }
 }

@@ -19,6 +19,7 @@ pub mod forward_cap;
 pub mod geometry;
 mod grid_choice;
 pub mod maps;
+pub(crate) mod surface_variants;
 pub mod tiled;
 pub mod uniforms;
 
@@ -113,6 +114,10 @@ pub struct FrameContext<'a> {
     /// A frame of [`Renderer::warm_up`](crate::Renderer::warm_up): a pass with nothing to draw
     /// this time (a deferred proxy no light takes) still builds its program.
     pub warm_up: bool,
+    /// The scene's objects are drawn with the shared surface variants
+    /// (`surface_variants::shared`): it asks for more than `MAX_SURFACE_VARIANTS`, or the
+    /// options for full variants.
+    pub shared_surfaces: bool,
 }
 
 impl FrameContext<'_> {

@@ -270,8 +270,9 @@ impl Renderer {
         }
         scene.validate()?;
         super::empty_scene::warn_of_nothing_to_draw(scene, &mut self.warned_nothing_to_draw);
-        self.gpu_scene
-            .upload(&self.dev, scene, options.measure.full_variants)?;
+        let shared_surfaces =
+            options.measure.full_variants || self.shared_surfaces.needed(scene, self.dev.caps());
+        self.gpu_scene.upload(&self.dev, scene, shared_surfaces)?;
         self.gpu_scene.check_placement(scene)?;
         let split_bytes = self
             .gpu_scene
@@ -370,6 +371,7 @@ impl Renderer {
             own_msaa: self.own_msaa_frame,
             clear,
             warm_up: self.warming_up,
+            shared_surfaces,
         };
         // The frame's errors so far are its own: the timer's calls (creating the queries too)
         // would drain them as theirs.

@@ -18,6 +18,7 @@ mod hosted_tests;
 mod method;
 mod offscreen;
 mod programs;
+mod shared_surfaces;
 mod stats;
 #[cfg(test)]
 mod timer_tests;
@@ -96,6 +97,8 @@ pub struct Renderer {
     warned_depth_step: bool,
     /// A scene without triangles was announced (once per renderer).
     warned_nothing_to_draw: bool,
+    /// Whether frames take the shared surface variants.
+    shared_surfaces: shared_surfaces::SharedSurfaces,
     /// The light count whose frame memory was last asked of the allocator.
     lights_probed: usize,
     /// A far plane the `f32` projection cannot clip at was announced (once per renderer).
@@ -198,6 +201,7 @@ impl Renderer {
             srgb_destination: false,
             warned_depth_step: false,
             warned_nothing_to_draw: false,
+            shared_surfaces: Default::default(),
             lights_probed: 0,
             warned_unclipped_far: false,
             warned_capped_radiance: false,
