@@ -284,6 +284,14 @@ impl Caps {
         self.es == EsVersion::Es2 && !self.desktop && self.renderer.contains("SwiftShader")
     }
 
+    /// A driver workaround: SwiftShader 4 loses parts of triangles that cross the eye's plane
+    /// (clip w = 0), which its clipper should cut at the near plane; deferred's proxy spheres
+    /// reaching behind the eye lost wedges of their light (docs/drivers.md), so there it bounds
+    /// such a light by a full-screen triangle at its far end instead.
+    pub fn loses_triangles_crossing_the_eye_plane(&self) -> bool {
+        !self.desktop && self.renderer.contains("SwiftShader")
+    }
+
     /// Whether the context renders to half-float (RGBA16F) targets: what
     /// [`Renderer::render_offscreen_hdr`](crate::Renderer::render_offscreen_hdr) and HDR output
     /// need (ES 3.0: `GL_EXT_color_buffer_float` or `_half_float`; ES 2.0: `OES_texture_half_float`

@@ -19,6 +19,7 @@
 //! without `GL_EXT_float_blend` (`gl::gbuffer`).
 
 mod light_instances;
+mod proxy;
 mod proxy_sphere;
 
 use glam::{Mat4, Vec3};
@@ -29,7 +30,6 @@ use super::geometry::{shade_object, sort_objects, GeometryProgram, UNIT_METHOD};
 use super::uniforms::{self, Surface, Transforms};
 use super::{FrameContext, MethodDesc, MethodStats, ShaderFeatures, ShadingMethod, Support};
 use crate::cluster::grid::GridProjection;
-use crate::cluster::view_light::GpuLight;
 use crate::gl::gbuffer::{self, GBuffer};
 use crate::gl::mesh::GpuMesh;
 use crate::gl::program::{ProgramKey, Resolver, Sampler, Uniform, UniformSet};
@@ -37,6 +37,7 @@ use crate::gl::state::{Blend, Cull, DepthTest, RenderState};
 use crate::gl::{Caps, Device, EsVersion};
 use crate::Error;
 use light_instances::{light_instance, LightInstances};
+use proxy::{Proxy, ProxyReach, VOLUME_SCALE};
 
 /// The table row.
 pub const DESC: MethodDesc = MethodDesc {
@@ -80,89 +81,6 @@ fn accumulation_scale(ctx: &FrameContext) -> f32 {
 /// Channels a count frame spreads its proxies over, light after light, each adding 1 to one:
 /// in half floats each channel counts exactly up to 2 048, the four together up to 8 192.
 const COUNT_CHANNELS: usize = 4;
-
-/// Proxy spheres are drawn this much larger than the light radius: the 16 × 9 tessellation's
-/// faces lie inside the true sphere by up to 1 − cos(π/16)·cos(π/18) ≈ 3.4 %.
-const VOLUME_SCALE: f32 = 1.1;
-
-/// A proxy drawn by its far side must end before this fraction of the far plane's distance,
-/// or it takes the full-screen path (the far side must not be clipped; the margin covers `f32`
-/// rounding of the projection).
-const FAR_MARGIN: f32 = 0.999;
-
-/// The largest proxy radius, in near-plane distances, drawn by its far side in perspective;
-/// past it, the full-screen path (which also shades the surfaces beyond the light). A tenth of
-/// where head lamps were seen to lose light (docs/precision.md).
-const FAR_SIDE_REACH: f32 = 2048.0;
-
-/// Which side of a light's proxy is drawn and depth tested against the surfaces:
-/// - wholly in front of the near plane: the near side, `LEQUAL` — where a surface lies in front
-///   of the whole sphere the light cannot reach it and the pixel is skipped;
-/// - reaching the near plane (the eye inside or beside it), whose near side would be clipped:
-///   the far side, `GEQUAL` — surfaces behind the whole sphere are skipped;
-/// - that far side reaching the far plane too, or depth too coarse there for either side's
-///   test: a full-screen triangle.
-///
-/// Each is one-sided (no stencil). The far side everywhere would skip more in open scenes but
-/// evaluate far more in enclosed ones (the conference room); the near side first avoids that
-/// worst case.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Proxy {
-    NearSide,
-    FarSide,
-    FullScreen,
-}
-
-impl Proxy {
-    fn cull(self) -> Cull {
-        match self {
-            Proxy::NearSide => Cull::Back,
-            Proxy::FarSide => Cull::Front,
-            Proxy::FullScreen => Cull::None,
-        }
-    }
-
-    fn depth_test(self) -> DepthTest {
-        match self {
-            Proxy::NearSide => DepthTest::LessEqual,
-            Proxy::FarSide => DepthTest::GreaterEqual,
-            Proxy::FullScreen => DepthTest::Off,
-        }
-    }
-}
-
-/// What decides a light's [`Proxy`]: the view's camera and depth range.
-struct ProxyReach<'a> {
-    camera: &'a crate::scene::Camera,
-    near: f32,
-    far: f32,
-}
-
-impl ProxyReach<'_> {
-    fn proxy(&self, light: &GpuLight) -> Proxy {
-        let radius = light.cull_radius * VOLUME_SCALE;
-        let depth = -light.position.z;
-        // A proxy's one-sided depth test needs depth steps well inside the light's reach
-        // where it ends (a tiny near plane makes them wider; docs/precision.md).
-        let coarse = self.camera.depth_step_at(f64::from(depth + radius), 24)
-            > 0.1 * f64::from(light.cull_radius);
-        // A far side around the eye is clipped at the near plane into faces reaching
-        // `radius / near` half-viewports off screen, across which depth is interpolated
-        // tens of steps off.
-        let perspective = matches!(
-            self.camera.projection,
-            crate::scene::Projection::Perspective { .. }
-        );
-        let clipped_far = perspective && radius > FAR_SIDE_REACH * self.near;
-        if !coarse && depth - radius >= 2.0 * self.near {
-            Proxy::NearSide
-        } else if !coarse && !clipped_far && depth + radius < FAR_MARGIN * self.far {
-            Proxy::FarSide
-        } else {
-            Proxy::FullScreen
-        }
-    }
-}
 
 /// Texture units of the G-buffer's textures, in `GBuffer::bind_textures` order, and of its
 /// depth.
@@ -418,6 +336,8 @@ impl Deferred {
             camera: &ctx.scene.camera,
             near: ctx.near as f32,
             far: ctx.scene.camera.far_clip_range().0 as f32,
+            projection: ctx.projection.as_dmat4(),
+            eye_plane_unreliable: dev.caps().loses_triangles_crossing_the_eye_plane(),
         };
         // Lights with the same proxy drawn together, as instances of it, in their order: the
         // state, program, uniforms and arrays set once for them. `k` numbers the lights drawn,
@@ -439,13 +359,11 @@ impl Deferred {
         let reused = self.instances_key == Some(key) && self.lights.hold_all();
         self.instances_key = None;
         let mut uploaded = 0;
-        for (slot, proxy) in [Proxy::NearSide, Proxy::FarSide, Proxy::FullScreen]
-            .into_iter()
-            .enumerate()
-        {
-            let (shader, mesh) = match proxy {
-                Proxy::FullScreen => ("deferred_light_fullscreen", self.fullscreen.as_ref()),
-                _ => ("deferred_light", self.sphere.as_ref()),
+        for (slot, proxy) in Proxy::ALL.into_iter().enumerate() {
+            let (shader, mesh) = if proxy.full_screen() {
+                ("deferred_light_fullscreen", self.fullscreen.as_ref())
+            } else {
+                ("deferred_light", self.sphere.as_ref())
             };
             let program = ProgramKey {
                 shader,
@@ -495,9 +413,14 @@ impl Deferred {
             // a light cut-off). A count adds 1 in one channel, light by light in turn (see
             // COUNT_CHANNELS).
             let instances = lights.map(|(k, light)| {
+                let bound = if proxy == Proxy::Bounded {
+                    reach.bound_depth(light)
+                } else {
+                    0.0
+                };
                 light_instance(
                     light,
-                    light.cull_radius * VOLUME_SCALE,
+                    [light.cull_radius * VOLUME_SCALE, bound],
                     k % COUNT_CHANNELS,
                     scale,
                 )

@@ -8,6 +8,8 @@ use manylight::gl::gbuffer;
 use manylight::renderer::CountKind;
 use manylight::scene::{self, DirectionalLight, Material};
 use manylight::{EsVersion, RenderOptions};
+use rand::{Rng, SeedableRng};
+use rand_pcg::Pcg64Mcg;
 
 /// A material the G-buffer's specular target is for.
 fn reads_specular(m: &Material) -> bool {
@@ -139,8 +141,9 @@ fn lights_past_one_instance_batch_match_forward_and_upload_once_a_frame() {
 }
 
 /// Draw calls grow by batches of 65 536 lights, not by lights (a draw call a light before
-/// instancing): from 64 to 5 000 lights the same. Forward's are its objects', whatever the
-/// lights.
+/// instancing): from 64 to 5 000 lights the same, but for one more where a light of the 5 000
+/// takes a kind of proxy none of the 64 takes (on SwiftShader, a sphere reaching behind the
+/// eye). Forward's are its objects', whatever the lights.
 #[test]
 fn lights_add_no_draw_calls() {
     let mut gpu = Gpu::new(EsVersion::Es3);
@@ -151,7 +154,10 @@ fn lights_add_no_draw_calls() {
     };
     let (few, many) = (calls("deferred", 64), calls("deferred", 5_000));
     assert!(few > 2, "{few}");
-    assert_eq!(many, few, "{many} draw calls at 5 000 lights, {few} at 64");
+    assert!(
+        (few..=few + 1).contains(&many),
+        "{many} draw calls at 5 000 lights, {few} at 64"
+    );
     let (few, many) = (calls("forward", 64), calls("forward", 5_000));
     assert!(few > 0);
     assert_eq!(many, few);
@@ -334,13 +340,17 @@ fn deferred_equals_forward_on_a_bright_frame_without_float_blending() {
 /// Head lamps: a light at (or a hair from) the eye, over a floor, at near planes that put
 /// ten to 10⁹ near-plane distances across its proxy. Deferred's far side around the eye,
 /// clipped at a tiny near plane, spans that many half-viewports, and depth interpolated across
-/// it lost parts of the light or all of it: 7 of these cases, from 1.3·10⁵ up, before such a
-/// light past 2 048 was drawn full-screen (docs/precision.md).
+/// it lost parts of the light or all of it: 7 of 200 such cases, from 1.3·10⁵ up, before such a
+/// light past 2 048 was drawn full-screen (docs/precision.md). SwiftShader also lost wedges of
+/// light from 14 near distances up (case 35 here: 39/255 on 5 pixels), where its clipper drops
+/// parts of the far side's triangles that cross the eye's plane: there such a light is bounded
+/// by a full-screen triangle at its far end instead (docs/drivers.md). 1 500 cases of this
+/// generator measured 1/255 at most on llvmpipe, SwiftShader and ANGLE.
 #[test]
 fn head_lamps_match_forward_at_any_near_plane() {
     let mut gpu = Gpu::new(EsVersion::Es3);
-    let mut random = Xorshift(0x9e37_79b9_7f4a_7c15);
-    for case in 0..200 {
+    let mut random = Seeded(Pcg64Mcg::seed_from_u64(7));
+    for case in 0..300 {
         let height = 10f64.powf(random.uniform(-3.0, 1.0));
         let radius = height * 10f64.powf(random.uniform(0.02, 0.6));
         let near = (1.1 * radius / 10f64.powf(random.uniform(1.0, 9.0))).min(height / 3.0);
@@ -371,29 +381,21 @@ fn head_lamps_match_forward_at_any_near_plane() {
         let (reference, _) = gpu.render_with("forward", &s, (64, 36), &Default::default());
         let (img, _) = gpu.render_with("deferred", &s, (64, 36), &Default::default());
         let d = manylight::metrics::diff(&reference, &img);
-        // A light lost shows as tens of pixels far off. SwiftShader draws a few pixels along
-        // the edges of a proxy the near plane cuts a few /255 off at any size (4/255 on 4
-        // pixels at 1 592 near distances, 3/255 at 28), as softpipe does (docs/testing.md).
-        let off = (d.over_2 * 64.0 * 36.0).round() as usize;
         assert!(
-            d.max_abs <= 16 && off <= 4,
-            "deferred {} / 255 from forward on {off} pixels, case {case}: {:.3e} near \
-             distances across",
+            d.max_abs <= 2,
+            "deferred {} / 255 from forward, case {case}: {:.3e} near distances across",
             d.max_abs,
             1.1 * radius / near
         );
     }
 }
 
-/// A seeded generator for the random cases above.
-struct Xorshift(u64);
+/// A seeded generator for the random cases above: `rand_pcg` with a normal distribution.
+struct Seeded(Pcg64Mcg);
 
-impl Xorshift {
+impl Seeded {
     fn next(&mut self) -> f64 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        (self.0 >> 11) as f64 / (1u64 << 53) as f64
+        self.0.random::<f64>()
     }
 
     fn uniform(&mut self, low: f64, high: f64) -> f64 {

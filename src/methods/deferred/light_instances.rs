@@ -25,11 +25,12 @@ const BATCH_LIGHTS: usize = 1 << 16;
 const BATCH_VEC4S: usize = BATCH_LIGHTS * LIGHT_VEC4S;
 
 /// A light as its proxy's instance draws it: position and radius; radiance (times the
-/// accumulation's `scale`) and spot scale; spot axis and offset; the proxy sphere's radius and
-/// the count channel (0 to 3) it adds 1 to.
+/// accumulation's `scale`) and spot scale; spot axis and offset; the proxy sphere's radius,
+/// the count channel (0 to 3) it adds 1 to and the full-screen triangle's depth (`proxy`:
+/// radius and depth).
 pub(super) fn light_instance(
     light: &GpuLight,
-    proxy_radius: f32,
+    [proxy_radius, depth]: [f32; 2],
     channel: usize,
     scale: f32,
 ) -> [Vec4; LIGHT_VEC4S] {
@@ -37,12 +38,12 @@ pub(super) fn light_instance(
         light.position.extend(light.radius),
         (light.radiance * scale).extend(light.spot_scale),
         light.direction.extend(light.spot_offset),
-        Vec4::new(proxy_radius, channel as f32, 0.0, 0.0),
+        Vec4::new(proxy_radius, channel as f32, depth, 0.0),
     ]
 }
 
-/// Proxies a light pass draws with, each from its own stream.
-pub(super) const PROXIES: usize = 3;
+/// Proxies a light pass draws with, each from its own stream (`proxy::Proxy::ALL`).
+pub(super) const PROXIES: usize = super::proxy::Proxy::ALL.len();
 
 /// A stream of instances for each proxy and the batch being filled (kept between frames, so a
 /// frame with no more lights than one before allocates nothing). A proxy whose lights fit one

@@ -1,0 +1,205 @@
+//! Which proxy draws each of deferred's lights, and how its depth test bounds the surfaces it
+//! shades.
+
+use glam::DMat4;
+
+use crate::cluster::view_light::GpuLight;
+use crate::gl::state::{Cull, DepthTest};
+use crate::scene::{Camera, Projection};
+
+/// Proxies are drawn this much larger than the light radius: the 16 × 9 sphere's faces lie
+/// inside the true sphere by up to 1 − cos(π/16)·cos(π/18) ≈ 3.4 %, and the rest is the
+/// margin a depth test needs over the light's reach.
+pub(super) const VOLUME_SCALE: f32 = 1.1;
+
+/// A proxy drawn by its far side or bounded by its far end must end before this fraction of
+/// the far plane's distance, or it takes the full-screen path (the far side must not be
+/// clipped; the margin covers `f32` rounding of the projection).
+const FAR_MARGIN: f32 = 0.999;
+
+/// The largest proxy radius, in near-plane distances, drawn by its far side (or bounded by its
+/// far end) in perspective; past it, the full-screen path. A tenth of where head lamps were
+/// seen to lose light (docs/precision.md).
+const FAR_SIDE_REACH: f32 = 2048.0;
+
+/// How a light's proxy is drawn and depth tested against the surfaces:
+/// - wholly in front of the near plane: the sphere's near side, `LEQUAL` — where a surface
+///   lies in front of the whole sphere the light cannot reach it and the pixel is skipped;
+/// - reaching the near plane (the eye inside or beside it), whose near side would be clipped:
+///   the far side, `GEQUAL` — surfaces behind the whole sphere are skipped;
+/// - where the implementation loses triangles crossing the eye's plane
+///   ([`Caps::loses_triangles_crossing_the_eye_plane`](crate::gl::Caps)) and the sphere
+///   reaches behind the eye: a full-screen triangle at the depth of the light's far end,
+///   `GEQUAL` — surfaces behind that plane are skipped;
+/// - reaching the far plane too, depth too coarse there for any test, or a far side the near
+///   plane clips into faces too large to interpolate depth over: a full-screen triangle,
+///   untested.
+///
+/// Each is one-sided (no stencil). The far side everywhere would skip more in open scenes but
+/// evaluate far more in enclosed ones (the conference room); the near side first avoids that
+/// worst case.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Proxy {
+    NearSide,
+    FarSide,
+    Bounded,
+    FullScreen,
+}
+
+impl Proxy {
+    /// Every proxy, in the order the light pass draws them (each has its instance stream).
+    pub(super) const ALL: [Proxy; 4] = [
+        Proxy::NearSide,
+        Proxy::FarSide,
+        Proxy::Bounded,
+        Proxy::FullScreen,
+    ];
+
+    pub(super) fn cull(self) -> Cull {
+        match self {
+            Proxy::NearSide => Cull::Back,
+            Proxy::FarSide => Cull::Front,
+            Proxy::Bounded | Proxy::FullScreen => Cull::None,
+        }
+    }
+
+    pub(super) fn depth_test(self) -> DepthTest {
+        match self {
+            Proxy::NearSide => DepthTest::LessEqual,
+            Proxy::FarSide | Proxy::Bounded => DepthTest::GreaterEqual,
+            Proxy::FullScreen => DepthTest::Off,
+        }
+    }
+
+    /// Drawn as the full-screen triangle rather than the sphere.
+    pub(super) fn full_screen(self) -> bool {
+        matches!(self, Proxy::Bounded | Proxy::FullScreen)
+    }
+}
+
+/// What decides a light's [`Proxy`]: the view's camera, depth range and projection, and the
+/// implementation.
+pub(super) struct ProxyReach<'a> {
+    pub camera: &'a Camera,
+    pub near: f32,
+    pub far: f32,
+    /// The projection the frame draws with.
+    pub projection: DMat4,
+    /// [`Caps::loses_triangles_crossing_the_eye_plane`](crate::gl::Caps).
+    pub eye_plane_unreliable: bool,
+}
+
+impl ProxyReach<'_> {
+    pub(super) fn proxy(&self, light: &GpuLight) -> Proxy {
+        let radius = light.cull_radius * VOLUME_SCALE;
+        let depth = -light.position.z;
+        // A proxy's one-sided depth test needs depth steps well inside the light's reach
+        // where it ends (a tiny near plane makes them wider; docs/precision.md).
+        let coarse = self.camera.depth_step_at(f64::from(depth + radius), 24)
+            > 0.1 * f64::from(light.cull_radius);
+        if !coarse && depth - radius >= 2.0 * self.near {
+            return Proxy::NearSide;
+        }
+        if coarse || depth + radius >= FAR_MARGIN * self.far {
+            return Proxy::FullScreen;
+        }
+        let perspective = matches!(self.camera.projection, Projection::Perspective { .. });
+        // A far side around the eye is clipped at the near plane into faces reaching
+        // `radius / near` half-viewports off screen, and so are the surfaces there: depth
+        // interpolated across them is tens of steps off, too far for any depth test.
+        if perspective && radius > FAR_SIDE_REACH * self.near {
+            Proxy::FullScreen
+        } else if perspective && self.eye_plane_unreliable && depth - radius < 0.0 {
+            // A sphere reaching behind the eye has faces crossing its plane.
+            Proxy::Bounded
+        } else {
+            Proxy::FarSide
+        }
+    }
+
+    /// The normalized device depth of a [`Proxy::Bounded`] light's far end (its proxy
+    /// radius beyond its centre), rounded up to an `f32`: no surface the light reaches lies
+    /// behind it.
+    pub(super) fn bound_depth(&self, light: &GpuLight) -> f32 {
+        let far_end = f64::from(light.position.z) - f64::from(light.cull_radius * VOLUME_SCALE);
+        let clip = self.projection * glam::DVec4::new(0.0, 0.0, far_end, 1.0);
+        let depth = (clip.z / clip.w).min(1.0);
+        let rounded = depth as f32;
+        if f64::from(rounded) < depth {
+            rounded.next_up()
+        } else {
+            rounded
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::Light;
+    use glam::{DVec3, Vec3};
+
+    fn camera(near: f64) -> Camera {
+        Camera::perspective(DVec3::ZERO, DVec3::NEG_Z, 60.0, near, 100.0)
+    }
+
+    fn reach(camera: &Camera, eye_plane_unreliable: bool) -> ProxyReach<'_> {
+        let (near, far) = camera.near_far();
+        ProxyReach {
+            camera,
+            near: near as f32,
+            far: far as f32,
+            projection: camera.projection_matrix(16.0 / 9.0),
+            eye_plane_unreliable,
+        }
+    }
+
+    fn light(at: DVec3, radius: f32) -> GpuLight {
+        let l = Light::point(at, radius, Vec3::ONE, 1.0);
+        GpuLight::from_light(&l, &glam::DMat4::IDENTITY)
+    }
+
+    #[test]
+    fn a_sphere_behind_the_eye_is_bounded_only_where_its_faces_would_be_lost() {
+        let camera = camera(0.1);
+        let head_lamp = light(DVec3::ZERO, 2.0);
+        // Reaching the near plane, but not behind the eye.
+        let ahead = light(DVec3::new(0.0, 0.0, -2.15), 1.9);
+        let far_away = light(DVec3::new(0.0, 0.0, -20.0), 2.0);
+        for unreliable in [false, true] {
+            let r = reach(&camera, unreliable);
+            let bounded = if unreliable {
+                Proxy::Bounded
+            } else {
+                Proxy::FarSide
+            };
+            assert_eq!(r.proxy(&head_lamp), bounded);
+            assert_eq!(r.proxy(&ahead), Proxy::FarSide);
+            assert_eq!(r.proxy(&far_away), Proxy::NearSide);
+        }
+        // Past FAR_SIDE_REACH near distances, full screen on every implementation.
+        let huge = light(DVec3::ZERO, 0.1 * FAR_SIDE_REACH);
+        assert_eq!(reach(&camera, true).proxy(&huge), Proxy::FullScreen);
+        assert_eq!(reach(&camera, false).proxy(&huge), Proxy::FullScreen);
+    }
+
+    #[test]
+    fn the_bound_lies_behind_everything_the_light_reaches() {
+        let camera = camera(0.01);
+        let r = reach(&camera, true);
+        for (z, radius) in [(0.0, 2.0), (-0.5, 3.0), (0.3, 1.0), (-1.0, 20.0)] {
+            let l = light(DVec3::new(0.2, -0.1, z), radius);
+            let bound = f64::from(r.bound_depth(&l));
+            let reached = |depth: f64| {
+                let clip = r.projection * glam::DVec4::new(0.0, 0.0, -depth, 1.0);
+                clip.z / clip.w
+            };
+            let farthest = reached(-z + f64::from(radius));
+            let proxy_end = reached(-z + f64::from(radius * VOLUME_SCALE));
+            assert!(
+                bound > farthest && bound >= proxy_end && bound < 1.0,
+                "{z} {radius}: {bound}"
+            );
+        }
+    }
+}
