@@ -504,10 +504,11 @@ impl Deferred {
 }
 
 /// Whether the frame's G-buffer needs its specular target: a material has a specular lobe or
-/// is metallic-roughness (every shared variant has them: `surface_variants::shared`).
+/// is metallic-roughness (every variant has them with `full_variants`). A shared variant's
+/// specular term of 0 changes nothing: its output has no target to go to.
 fn needs_specular_target(ctx: &FrameContext) -> bool {
     let specular = |m: &crate::scene::Material| m.has_specular() || m.is_metallic_roughness();
-    ctx.shared_surfaces || ctx.scene.materials.iter().any(specular)
+    ctx.options.measure.full_variants || ctx.scene.materials.iter().any(specular)
 }
 
 /// View-space half extents of the projection (per unit depth when perspective) and whether it
