@@ -136,8 +136,18 @@ fn scene(objects: impl Iterator<Item = usize>) -> Scene {
                 0.0,
             );
             let mesh = &meshes[k & 1][usize::from(k % 7 == 3)];
+            // A few meshes without texture coordinates: their materials' textures are not
+            // sampled, and a shared variant reads the white texture there.
+            let mesh = if k % 9 == 4 {
+                let mut bare = (**mesh).clone();
+                bare.uvs.clear();
+                bare.tangents.clear();
+                Arc::new(bare)
+            } else {
+                Arc::clone(mesh)
+            };
             Object {
-                mesh: Arc::clone(mesh),
+                mesh,
                 material: k,
                 transform: DMat4::from_translation(at) * DMat4::from_scale(DVec3::splat(0.8)),
             }
