@@ -16,14 +16,37 @@ pub(crate) fn can_allocate(bytes: u64) -> bool {
     granted
 }
 
+/// Refuses work needing `bytes` that this process cannot allocate now. `what` says what
+/// needs them and ends in its verb ("parsing its 12 JSON objects and arrays takes"), so the
+/// error reads "… takes about N MiB, more than this process can allocate now".
+pub(crate) fn ask(bytes: u64, what: std::fmt::Arguments<'_>) -> Result<(), String> {
+    if can_allocate(bytes) {
+        return Ok(());
+    }
+    Err(format!(
+        "{what} about {} MiB, more than this process can allocate now",
+        bytes >> 20
+    ))
+}
+
 #[cfg(test)]
 mod tests {
-    use super::can_allocate;
+    use super::{ask, can_allocate};
 
     #[test]
     fn small_requests_are_granted_and_impossible_ones_refused() {
         assert!(can_allocate(1 << 20));
         assert!(!can_allocate(u64::MAX));
         assert!(!can_allocate(1 << 62));
+    }
+
+    #[test]
+    fn a_refusal_names_what_needs_the_memory_and_how_much() {
+        assert_eq!(ask(1 << 20, format_args!("a test takes")), Ok(()));
+        let refusal = ask(1 << 62, format_args!("a test takes")).unwrap_err();
+        assert_eq!(
+            refusal,
+            "a test takes about 4398046511104 MiB, more than this process can allocate now"
+        );
     }
 }

@@ -307,18 +307,11 @@ pub fn parse(
         reason,
     })?;
     // Past the count limit, that limit's error names the object at fault.
-    let placing = file.objects.len() as u64 * OBJECT_BYTES;
-    if file.objects.len() <= super::MAX_SCENE_OBJECTS && !super::alloc_probe::can_allocate(placing)
-    {
-        return Err(SceneError::invalid(
-            "objects",
-            format!(
-                "placing its {} objects takes about {} MiB, more than this process can \
-                 allocate now",
-                file.objects.len(),
-                placing >> 20
-            ),
-        ));
+    let count = file.objects.len();
+    if count <= super::MAX_SCENE_OBJECTS {
+        let placing = count as u64 * OBJECT_BYTES;
+        super::alloc_probe::ask(placing, format_args!("placing its {count} objects takes"))
+            .map_err(|reason| SceneError::invalid("objects", reason))?;
     }
     let mut scene = Scene::empty();
     let mut report = LoadReport::default();

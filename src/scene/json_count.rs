@@ -2,6 +2,16 @@
 //! object or array becomes a struct or a collection of its own, hundreds of bytes for the two
 //! an empty `{}` takes in the file.
 
+/// What parsing takes an array element or object member besides its container, with room to
+/// spare (docs/cli.md).
+const PARSED_ELEMENT_BYTES: u64 = 64;
+
+/// Bytes a parse of `containers` objects and arrays and `elements` elements and members takes,
+/// at `container_bytes` a container (what the format's parses build for each).
+pub(crate) fn parse_bytes(containers: usize, elements: usize, container_bytes: u64) -> u64 {
+    containers as u64 * container_bytes + elements as u64 * PARSED_ELEMENT_BYTES
+}
+
 /// The `{` and `[`, and the `,`, outside strings.
 pub(crate) fn count_containers(json: &[u8]) -> (usize, usize) {
     let mut commas = 0;

@@ -6,6 +6,8 @@
 //! two of `0,`. The objects and arrays, and the elements and members, are counted first, in
 //! one pass over the bytes, before anything is built.
 
+use crate::scene::{alloc_probe, json_count};
+
 /// Most JSON objects and arrays a glTF file's JSON may hold: about 600 MB parsed at some 600
 /// bytes an empty node, where 2²² let 16 MB of `{},` take 2.5 GB. A node placing a mesh is one
 /// (with a translation, a rotation, a scale and children, five): far more than the largest
@@ -22,7 +24,7 @@ pub const MAX_JSON_ELEMENTS: usize = 1 << 23;
 /// [`MAX_JSON_ELEMENTS`] elements and members. Brackets and commas inside strings do not
 /// count; what is not valid JSON is left for the parser to name.
 pub(super) fn check(json: &[u8]) -> Result<JsonSize, String> {
-    let (containers, separators) = crate::scene::json_count::count_containers(json);
+    let (containers, separators) = json_count::count_containers(json);
     if containers > MAX_JSON_CONTAINERS {
         return Err(format!(
             "its JSON holds {containers} objects and arrays, more than the \
@@ -50,25 +52,21 @@ pub(super) struct JsonSize {
 }
 
 /// What parsing takes an object or array (all the loader's parses together: about 600 bytes
-/// an empty node) and an element or member, with room to spare.
+/// an empty node), with room to spare.
 const PARSED_CONTAINER_BYTES: u64 = 640;
-const PARSED_ELEMENT_BYTES: u64 = 64;
 
 impl JsonSize {
     /// Refuses JSON whose parses this process cannot allocate now (serde aborts where an
     /// allocation fails): 3 MB of empty nodes, within the limits, takes some 600 MB.
     pub(super) fn check_memory(&self) -> Result<(), String> {
-        let bytes = self.containers as u64 * PARSED_CONTAINER_BYTES
-            + self.elements as u64 * PARSED_ELEMENT_BYTES;
-        if crate::scene::alloc_probe::can_allocate(bytes) {
-            return Ok(());
-        }
-        Err(format!(
-            "parsing its JSON ({} objects and arrays) takes about {} MiB, more than this \
-             process can allocate now",
-            self.containers,
-            bytes >> 20
-        ))
+        let bytes = json_count::parse_bytes(self.containers, self.elements, PARSED_CONTAINER_BYTES);
+        alloc_probe::ask(
+            bytes,
+            format_args!(
+                "parsing its JSON ({} objects and arrays) takes",
+                self.containers
+            ),
+        )
     }
 }
 

@@ -460,14 +460,10 @@ pub(super) fn check_memory(p: &gltf::Primitive, field: &str) -> Result<(), Strin
     let bytes = vertices as u64 * VERTEX_BYTES
         + triangles as u64 * TRIANGLE_BYTES
         + corners as u64 * TANGENT_CORNER_BYTES;
-    if crate::scene::alloc_probe::can_allocate(bytes) {
-        return Ok(());
-    }
-    Err(format!(
-        "{field}: building its {vertices} vertices and {triangles} triangles takes about {} MiB, \
-         more than this process can allocate now",
-        bytes >> 20
-    ))
+    crate::scene::alloc_probe::ask(
+        bytes,
+        format_args!("{field}: building its {vertices} vertices and {triangles} triangles takes"),
+    )
 }
 
 /// A triangle list from the primitive's mode and its (checked) vertex sequence.
