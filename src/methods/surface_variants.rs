@@ -120,17 +120,9 @@ fn attribute_class(mesh: &Mesh) -> usize {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::{builtin, Object};
-    use glam::Vec3;
+    use crate::scene::builtin;
+    use glam::{DMat4, Vec3};
     use std::sync::Arc;
-
-    fn object(mesh: &Arc<Mesh>, material: usize) -> Object {
-        Object {
-            mesh: Arc::clone(mesh),
-            material,
-            transform: glam::DMat4::IDENTITY,
-        }
-    }
 
     /// A scene of `n` objects sharing one mesh, each with its own material, the `k`-th
     /// emitting when bit 0 of `k` is set, blending when bit 1 is, glossy when bit 2 is.
@@ -151,7 +143,7 @@ mod tests {
                 m.specular = Vec3::ZERO;
             }
             scene.materials.push(m);
-            scene.objects.push(object(&mesh, k));
+            scene.add_object(Arc::clone(&mesh), k, DMat4::IDENTITY);
         }
         scene
     }
@@ -168,7 +160,9 @@ mod tests {
         // A material used by many objects counts once.
         let mut s = scene_of(2);
         let mesh = s.objects[0].mesh.clone();
-        s.objects.extend((0..100).map(|_| object(&mesh, 1)));
+        for _ in 0..100 {
+            s.add_object(Arc::clone(&mesh), 1, DMat4::IDENTITY);
+        }
         assert!(more_than(&s, 1) && !more_than(&s, 2));
         // The buffers are kept: a second scene is counted afresh.
         let mut count = VariantCount::default();
@@ -180,7 +174,7 @@ mod tests {
         let mut s = scene_of(1);
         let mut coloured = (*s.objects[0].mesh).clone();
         coloured.colors = vec![glam::Vec4::ONE; coloured.positions.len()];
-        s.objects.push(object(&Arc::new(coloured), 0));
+        s.add_object(coloured, 0, DMat4::IDENTITY);
         assert!(more_than(&s, 1) && !more_than(&s, 2));
     }
 

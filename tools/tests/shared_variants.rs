@@ -11,8 +11,9 @@ use std::sync::Arc;
 use common::Gpu;
 use glam::{DMat4, DVec3, Vec2, Vec3, Vec4};
 use manylight::methods::ShaderFeatures as F;
+use manylight::scene::meshbuild::MeshBuilder;
 use manylight::scene::surface_maps::{MapTexture, TextureTransform};
-use manylight::scene::{Camera, Light, Material, Mesh, Object, Scene, Texture};
+use manylight::scene::{Camera, Light, Material, Mesh, Scene, Texture};
 use manylight::{EsVersion, RenderOptions};
 
 const W: u32 = 256;
@@ -23,37 +24,34 @@ const ROWS: usize = 6;
 /// Objects drawn together in a group render: too few for shared variants.
 const GROUP: usize = 15;
 
-/// A unit quad in the z = 0 plane facing +Z, with texture coordinates, and vertex colours and
-/// tangents where asked.
-fn quad(colours: bool, tangents: bool) -> Arc<Mesh> {
-    let positions = vec![
-        Vec3::new(-0.5, -0.5, 0.0),
-        Vec3::new(0.5, -0.5, 0.0),
-        Vec3::new(0.5, 0.5, 0.0),
-        Vec3::new(-0.5, 0.5, 0.0),
-    ];
-    let colors = [
-        [1.0, 0.4, 0.2],
-        [0.3, 1.0, 0.5],
-        [0.2, 0.5, 1.0],
-        [0.9, 0.9, 0.3],
-    ];
-    Arc::new(Mesh {
-        normals: vec![Vec3::Z; 4],
-        uvs: vec![Vec2::ZERO, Vec2::X, Vec2::ONE, Vec2::Y],
-        indices: vec![0, 1, 2, 0, 2, 3],
-        colors: if colours {
-            colors.iter().map(|c| Vec3::from(*c).extend(1.0)).collect()
-        } else {
-            Vec::new()
-        },
-        tangents: if tangents {
-            vec![Vec4::new(1.0, 0.0, 0.0, 1.0); 4]
-        } else {
-            Vec::new()
-        },
-        positions,
-    })
+/// A unit quad in the z = 0 plane facing +Z, with vertex colours, tangents and texture
+/// coordinates where asked.
+fn quad([colours, tangents, uvs]: [bool; 3]) -> Mesh {
+    let corner = |x, y| Vec3::new(x, y, 0.0);
+    let mut b = MeshBuilder::new();
+    b.quad(
+        corner(-0.5, -0.5),
+        corner(0.5, -0.5),
+        corner(0.5, 0.5),
+        corner(-0.5, 0.5),
+    );
+    let mut mesh = b.build().unwrap();
+    if colours {
+        let colors = [
+            [1.0, 0.4, 0.2],
+            [0.3, 1.0, 0.5],
+            [0.2, 0.5, 1.0],
+            [0.9, 0.9, 0.3],
+        ];
+        mesh.colors = colors.map(|c| Vec3::from(c).extend(1.0)).to_vec();
+    }
+    if tangents {
+        mesh.tangents = vec![Vec4::new(1.0, 0.0, 0.0, 1.0); 4];
+    }
+    if !uvs {
+        mesh.uvs.clear();
+    }
+    mesh
 }
 
 /// A 4 × 4 texture whose texels differ, so where it is sampled shows; with `holes`, every
@@ -124,35 +122,22 @@ fn material(k: usize) -> Material {
 
 /// The objects `objects` of the full grid (the others left out), lit by point lights over it.
 fn scene(objects: impl Iterator<Item = usize>) -> Scene {
-    let meshes = [false, true].map(|c| [false, true].map(|t| quad(c, t)));
     let mut s = Scene::empty();
     s.materials = (0..COLUMNS * ROWS).map(material).collect();
-    s.objects = objects
-        .map(|k| {
-            let (column, row) = ((k % COLUMNS) as f64, (k / COLUMNS) as f64);
-            let at = DVec3::new(
-                column - COLUMNS as f64 / 2.0 + 0.5,
-                row - ROWS as f64 / 2.0 + 0.5,
-                0.0,
-            );
-            let mesh = &meshes[k & 1][usize::from(k % 7 == 3)];
-            // A few meshes without texture coordinates: their materials' textures are not
-            // sampled, and a shared variant reads the white texture there.
-            let mesh = if k % 9 == 4 {
-                let mut bare = (**mesh).clone();
-                bare.uvs.clear();
-                bare.tangents.clear();
-                Arc::new(bare)
-            } else {
-                Arc::clone(mesh)
-            };
-            Object {
-                mesh,
-                material: k,
-                transform: DMat4::from_translation(at) * DMat4::from_scale(DVec3::splat(0.8)),
-            }
-        })
-        .collect();
+    for k in objects {
+        let (column, row) = ((k % COLUMNS) as f64, (k / COLUMNS) as f64);
+        let at = DVec3::new(
+            column - COLUMNS as f64 / 2.0 + 0.5,
+            row - ROWS as f64 / 2.0 + 0.5,
+            0.0,
+        );
+        // A few meshes without texture coordinates: their materials' textures are not
+        // sampled, and a shared variant reads the white texture there.
+        let uvs = k % 9 != 4;
+        let mesh = quad([k & 1 != 0, k % 7 == 3 && uvs, uvs]);
+        let transform = DMat4::from_translation(at) * DMat4::from_scale(DVec3::splat(0.8));
+        s.add_object(mesh, k, transform);
+    }
     s.lights = (0..12)
         .map(|i| {
             let f = i as f64;
