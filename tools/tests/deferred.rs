@@ -338,14 +338,10 @@ fn deferred_equals_forward_on_a_bright_frame_without_float_blending() {
 }
 
 /// Head lamps: a light at (or a hair from) the eye, over a floor, at near planes that put
-/// ten to 10⁹ near-plane distances across its proxy. Deferred's far side around the eye,
-/// clipped at a tiny near plane, spans that many half-viewports, and depth interpolated across
-/// it lost parts of the light or all of it: 7 of 200 such cases, from 1.3·10⁵ up, before such a
-/// light past 2 048 was drawn full-screen (docs/precision.md). SwiftShader also lost wedges of
-/// light from 14 near distances up (case 35 here: 39/255 on 5 pixels), where its clipper drops
-/// parts of the far side's triangles that cross the eye's plane: there such a light is bounded
-/// by a full-screen triangle at its far end instead (docs/drivers.md). 1 500 cases of this
-/// generator measured 1/255 at most on llvmpipe, SwiftShader and ANGLE.
+/// ten to 10⁹ near-plane distances across its proxy. Guards the two ways deferred lost such
+/// light: depth interpolated across a far side the near plane clips into huge faces (drawn
+/// full-screen past 2 048; docs/precision.md), and SwiftShader dropping far-side triangles
+/// that cross the eye's plane (bounded by a plane there; docs/drivers.md, item 16).
 #[test]
 fn head_lamps_match_forward_at_any_near_plane() {
     let mut gpu = Gpu::new(EsVersion::Es3);
