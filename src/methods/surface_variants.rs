@@ -2,8 +2,8 @@
 //! scene with too many combinations of them is drawn with instead.
 //!
 //! Each distinct combination of surface inputs is a program of its own, compiled at first
-//! draw (about 0.2 s and 2.5 MB each on llvmpipe): a small file whose materials cover every
-//! combination would ask for hundreds. Past [`MAX_SURFACE_VARIANTS`] a scene's objects take the
+//! draw (compile time and driver memory; docs/gltf.md): a small file whose materials cover
+//! every combination would ask for hundreds. Past [`MAX_SURFACE_VARIANTS`] a scene's objects take the
 //! shared superset of the inputs that have a neutral value (below), so the picture stays the
 //! same and the programs stay few.
 
