@@ -1,6 +1,7 @@
 //! Scene-file parsing and validation: each field's errors and what a valid file builds.
 
 use super::*;
+use glam::{DVec3, Vec3};
 
 fn parse_str(s: &str) -> Result<Scene, SceneError> {
     parse(
