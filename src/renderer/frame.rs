@@ -5,16 +5,12 @@
 
 use std::time::Instant;
 
-use glam::DMat4;
-
-use super::frame_setup::{content_far, gather_directional, gather_lights, shader_features};
-use super::stats::{copy_opt_str, copy_str, copy_support};
-use super::stats::{LightStats, MemoryStats, TimeStats};
+use super::frame_inputs::FrameSetup;
+use super::frame_report::DrawnFrame;
 use super::{FrameStats, Renderer};
 use crate::gl::framebuffer::ColorFormat;
 use crate::methods::{self, FrameContext};
 use crate::options::{Clear, CountKind, RenderOptions, MAX_EXPOSURE_EV};
-use crate::scene::features::SceneFeatures;
 use crate::scene::{Projection, Scene, Short};
 use crate::Error;
 
@@ -265,76 +261,19 @@ impl Renderer {
         } else {
             self.method.name()
         };
-        if let Some(warning) = self.pending_warning.take() {
-            log::warn!("{warning}");
-        }
-        scene.validate()?;
-        super::empty_scene::warn_of_nothing_to_draw(scene, &mut self.warned_nothing_to_draw);
-        let shared_surfaces =
-            options.measure.full_variants || self.shared_surfaces.needed(scene, self.dev.caps());
-        self.gpu_scene.upload(&self.dev, scene, shared_surfaces)?;
-        self.gpu_scene.check_placement(scene)?;
-        let split_bytes = self
-            .gpu_scene
-            .split_for_frame(&self.dev, scene, (width, height))?;
-        let view: DMat4 = scene.camera.view_matrix();
-        let projection = scene
-            .camera
-            .projection_matrix(width as f64 / height as f64)
-            .as_mat4();
-        if scene.lights.len() != self.lights_probed {
-            super::frame_setup::check_light_memory(scene.lights.len())?;
-            self.lights_probed = scene.lights.len();
-        }
-        if gather_lights(&mut self.lights, scene, &view, options) || self.timing_frames {
-            self.lights_generation += 1;
-        }
-        let scene_features = SceneFeatures::of(scene);
-        let features = shader_features(&scene_features, options, self.dev.caps()).with(
-            methods::ShaderFeatures::OUTPUT_LINEAR,
-            options.linear || self.srgb_destination,
-        );
-        let directional = gather_directional(
-            scene,
-            &view,
+        let FrameSetup {
+            shared_surfaces,
+            split_bytes,
+            view,
+            projection,
+            scene_features,
             features,
-            &mut self.shown_directional,
-            &mut self.warned_directional,
-        );
-        // Lights are culled at the farthest distance the GPU may draw, not the far plane
-        // asked for: a tiny near plane leaves `f32` no far plane to clip at.
-        let near = scene.camera.near_far().0;
-        let far = scene.camera.far_clip_range().1;
-        let content_far = content_far(self.gpu_scene.scene_bounds(scene), &view, near, far);
-        if !self.warming_up {
-            super::depth_warning::warn_of_unclipped_far(
-                &scene.camera,
-                &mut self.warned_unclipped_far,
-            );
-            super::depth_warning::warn_of_coarse_depth(
-                &scene.camera,
-                content_far,
-                stats.depth_bits,
-                &mut self.warned_depth_step,
-            );
-        }
-        let reach = super::fp16_range::view_reach(scene, width as f64 / height as f64, content_far);
-        let farthest = super::fp16_range::check(self.dev.caps(), scene, &self.lights, reach)?;
-        if self.placed.update(&self.lights, farthest) {
-            self.lights_generation += 1;
-        }
+            directional,
+            near,
+            far,
+            content_far,
+        } = self.set_up_frame(scene, (width, height), options, stats.depth_bits)?;
         let frame_lights = self.placed.of(&self.lights);
-        super::fp16_channels::warn_of_lost_channels(self.dev.caps(), scene);
-        super::fp16_channels::warn_of_capped_radiance(
-            self.dev.caps(),
-            scene,
-            &mut self.warned_capped_radiance,
-        );
-        super::fp16_channels::warn_of_capped_ambient(
-            self.dev.caps(),
-            scene,
-            &mut self.warned_capped_ambient,
-        );
         let clear = self.frame_clear;
         let colour = (clear == Clear::All).then(|| self.clear_value(options));
         // MSAA frames clear everything (`Clear::All`, checked above).
@@ -456,56 +395,23 @@ impl Renderer {
         }
         self.dev.check("frame")?;
         let frame_ms = start.elapsed().as_secs_f64() * 1e3;
-        let caps = self.dev.caps();
-        let assignment = method_stats.assign.unwrap_or_default();
-        let grid = method_stats.grid.as_ref();
-        copy_str(&mut stats.method, method_name);
-        copy_support(&mut stats.support, &self.support);
-        let auto = method_stats.auto_choice;
-        copy_opt_str(&mut stats.auto_choice, auto.map(|(c, _)| c));
-        copy_opt_str(&mut stats.auto_reason, auto.map(|(_, r)| r));
-        let context = &mut stats.context;
-        context.es = caps.es;
-        copy_str(&mut context.gl_version, &caps.gl_version);
-        copy_str(&mut context.renderer, &caps.renderer);
-        copy_opt_str(&mut context.lp_num_threads, self.lp_num_threads.as_deref());
-        stats.width = width;
-        stats.height = height;
-        stats.samples = 1;
-        stats.triangles = scene.objects.iter().map(|o| o.mesh.triangle_count()).sum();
-        stats.scene_features = scene_features;
-        stats.time = TimeStats {
+        stats.record(&DrawnFrame {
+            method_name,
+            support: &self.support,
+            caps: self.dev.caps(),
+            lp_num_threads: self.lp_num_threads.as_deref(),
+            size: (width, height),
+            scene,
+            scene_features,
+            features,
+            active_lights: frame_lights.len(),
+            lit,
             frame_ms,
             gpu_ms,
-            assign_ms: method_stats.assign_ms.unwrap_or(0.0),
-            frame_ms_spread: None,
-            assign_ms_spread: None,
-        };
-        stats.lights = LightStats {
-            total: scene.lights.len(),
-            active: frame_lights.len(),
-            visible: match method_stats.assign {
-                _ if !lit => 0,
-                Some(a) => a.visible_lights,
-                None => frame_lights.len(),
-            },
-            overflowed: assignment.overflowed_lights + method_stats.dropped_lights,
-            encoding: features.light_encoding(),
-        };
-        stats.assignment = assignment;
-        stats.lists_reused = method_stats.lists_reused;
-        stats.grid.footprint_px = grid.map(|g| g.footprint_px);
-        stats.grid.cells = grid.map_or(0, |g| g.cells);
-        copy_opt_str(&mut stats.grid.reason, grid.map(|g| g.reason));
-        stats.memory = MemoryStats {
-            upload_bytes: method_stats.upload_bytes + split_bytes,
-            upload_bytes_spread: None,
-            method_gpu_bytes: 0,
-            gbuffer_bytes: method_stats.gbuffer_bytes,
-            msaa_bytes: 0,
+            method: &method_stats,
+            split_bytes,
             scene_gpu_bytes: self.gpu_scene.gpu_bytes(),
-            shader_programs: 0,
-        };
+        });
         // Only colour frames that waited for the GPU (or were timed on it) say what shading
         // costs: count passes run other shaders.
         if options.count == CountKind::None {

@@ -12,6 +12,8 @@ mod empty_scene;
 mod fp16_channels;
 mod fp16_range;
 mod frame;
+mod frame_inputs;
+mod frame_report;
 mod frame_setup;
 #[cfg(test)]
 mod hosted_tests;
