@@ -126,7 +126,8 @@ fn depth_prepass(ctx: &mut FrameContext) -> Result<(), Error> {
     Ok(())
 }
 
-/// Draws the scene with `shader`: a depth prepass of the opaque objects, the opaque objects,
+/// Draws the scene with `shader`: a depth prepass of the opaque objects (where the shader has a
+/// light loop), the opaque objects,
 /// then the transparent ones back to front — each in two passes, back faces then front faces,
 /// so a closed convex object blends in the right order (a single-sided one in the second
 /// alone). `bind_method` is called on each
@@ -140,10 +141,15 @@ pub fn draw_objects<P: GeometryProgram>(
     bind_method: &mut dyn FnMut(&P, &Device),
 ) -> Result<(), Error> {
     sort_objects(ctx);
-    depth_prepass(ctx)?;
+    // Without a light loop a fragment costs about what a depth-only one does: the opaque
+    // objects are then tested and written against their own depth, as the cut-out ones are.
+    let prepass = !ctx.features.has(ShaderFeatures::NO_LIGHTS);
+    if prepass {
+        depth_prepass(ctx)?;
+    }
     for k in 0..ctx.order.opaque.len() {
         if k == 0 || k == ctx.order.cut_out_from {
-            let state = if k < ctx.order.cut_out_from {
+            let state = if prepass && k < ctx.order.cut_out_from {
                 RenderState::OPAQUE_AFTER_PREPASS
             } else {
                 RenderState::CUT_OUT

@@ -511,3 +511,42 @@ fn a_frame_uploads_only_the_texels_its_shaders_read() {
         }
     });
 }
+
+/// A frame with no light in view draws each opaque object once: the depth prepass only saves
+/// a light loop, which such a frame has not. Its picture is that of a frame whose one light is
+/// in view but reaches no surface (drawn with the prepass).
+#[test]
+fn an_unlit_frame_draws_each_opaque_object_once() {
+    let (w, h) = (96, 54);
+    let mut unlit = scene::builtin::build("pillars", None).unwrap();
+    unlit.lights.clear();
+    let opaque = |o: &scene::Object| !unlit.materials[o.material].is_transparent();
+    assert!(unlit.objects.iter().all(opaque));
+    let mut lit = unlit.clone();
+    let eye = lit.camera.position;
+    // A tenth of the way to the target, 1.6 m from the eye and metres from every surface.
+    let p = eye + (lit.camera.target - eye) * 0.1;
+    lit.lights.push(Light::point(p, 0.05, Vec3::ONE, 1.0));
+    common::each_method(|es, method, gpu| {
+        let opts = RenderOptions::default();
+        let (ambient, unlit_stats) = gpu.r().render_offscreen(&unlit, w, h, &opts).unwrap();
+        let (dark, lit_stats) = gpu.r().render_offscreen(&lit, w, h, &opts).unwrap();
+        assert!(
+            lit_stats.lights.visible >= 1,
+            "{es} {method}: no light in view"
+        );
+        assert_eq!(
+            unlit_stats.draw_calls,
+            unlit.objects.len() as u64,
+            "{es} {method}: draws of an unlit frame"
+        );
+        assert!(
+            lit_stats.draw_calls > unlit_stats.draw_calls,
+            "{es} {method}: {} draws lit",
+            lit_stats.draw_calls
+        );
+        let d = manylight::metrics::diff(&ambient, &dark);
+        assert!(d.max_abs <= 1, "{es} {method}: {d:?}");
+    });
+}
+
