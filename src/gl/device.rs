@@ -24,6 +24,10 @@ pub struct Device {
     host: super::host_state::HostFeatures,
     /// Nesting depth of [`Device::enter_host`] (the outermost call saves the state).
     host_depth: std::cell::Cell<u32>,
+    /// The program this call made current (`None` outside a call): binding it again is
+    /// skipped, as a frame binds one program for many objects.
+    current_program: std::cell::Cell<Option<glow::Program>>,
+    state_calls: std::cell::Cell<StateCalls>,
     /// Whether a GL error the application left pending has been reported (once a device).
     warned_pending_error: std::cell::Cell<bool>,
     /// GL said the context was lost (`GL_CONTEXT_LOST`, which a driver may say only once): every
@@ -66,6 +70,16 @@ impl ContextWatch {
             _ => ContextWatch::Unknown,
         }
     }
+}
+
+/// State calls the renderer's caches made, counted since the device was created: what tests
+/// use to check that a frame sets what its objects share once, not once an object.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct StateCalls {
+    /// `glUseProgram` calls.
+    pub programs_bound: u64,
+    /// `glUniform*` calls.
+    pub uniforms_set: u64,
 }
 
 /// GL objects currently alive, as counted by the renderer's own create/delete calls: what
@@ -175,6 +189,8 @@ impl Device {
             host,
             vertex_array,
             host_depth: std::cell::Cell::new(0),
+            current_program: std::cell::Cell::new(None),
+            state_calls: Default::default(),
             warned_pending_error: std::cell::Cell::new(false),
             lost: std::cell::Cell::new(false),
             context: ContextWatch::of_current(),
@@ -216,6 +232,8 @@ impl Device {
         let depth = self.host_depth.get();
         self.host_depth.set(depth + 1);
         (depth == 0).then(|| {
+            // The application may have bound any program since the last call.
+            self.current_program.set(None);
             self.clear_pending_errors();
             super::host_state::HostState::enter(&self.gl, &self.host, self.vertex_array)
         })
@@ -226,6 +244,7 @@ impl Device {
         self.host_depth.set(self.host_depth.get().saturating_sub(1));
         if let Some(saved) = saved {
             saved.leave(&self.gl, self.vertex_array);
+            self.current_program.set(None);
         }
     }
 
@@ -279,6 +298,18 @@ impl Device {
         self.count(|l| l.programs += n);
     }
 
+    /// Counts a state call ([`StateCalls`]).
+    pub(crate) fn count_state_call(&self, f: impl FnOnce(&mut StateCalls)) {
+        let mut c = self.state_calls.get();
+        f(&mut c);
+        self.state_calls.set(c);
+    }
+
+    /// State calls made so far (a frame's: the difference across it).
+    pub(crate) fn state_calls(&self) -> StateCalls {
+        self.state_calls.get()
+    }
+
     /// Counts one draw call.
     pub(crate) fn count_draw_call(&self) {
         self.draw_calls.set(self.draw_calls.get() + 1);
@@ -309,7 +340,32 @@ impl Device {
         glow::Renderbuffer,
         renderbuffers
     );
-    tracked!(create_program, delete_program, glow::Program, programs);
+    pub(crate) fn create_program(&self) -> Result<glow::Program, GlError> {
+        let program = unsafe { self.gl.create_program() }.map_err(creation_failed)?;
+        self.count(|l| l.programs += 1);
+        Ok(program)
+    }
+
+    pub(crate) fn delete_program(&self, program: glow::Program) {
+        // A program made later may take the freed name: it must be bound, not skipped.
+        if self.current_program.get() == Some(program) {
+            self.current_program.set(None);
+        }
+        unsafe { self.gl.delete_program(program) };
+        self.count(|l| l.programs -= 1);
+    }
+
+    /// Makes `program` current, unless this call already did.
+    pub(crate) fn use_program(&self, program: glow::Program) {
+        if self.current_program.get() == Some(program) {
+            return;
+        }
+        unsafe { self.gl.use_program(Some(program)) };
+        self.count_state_call(|c| c.programs_bound += 1);
+        if self.host_depth.get() > 0 {
+            self.current_program.set(Some(program));
+        }
+    }
 
     /// The probed capabilities.
     pub fn caps(&self) -> &Caps {

@@ -10,6 +10,7 @@
 #![allow(unsafe_code)]
 
 use std::any::Any;
+use std::cell::Cell;
 use std::collections::HashMap;
 use std::marker::PhantomData;
 
@@ -40,8 +41,8 @@ pub struct Program {
 
 /// A GLSL uniform type: the GL types it may be declared as, and how a value is set.
 pub trait UniformType {
-    /// What a value is set from.
-    type Value;
+    /// What a value is set from (compared with the last value set, which is not set again).
+    type Value: Copy + PartialEq + Send;
     /// The GLSL type, for errors.
     const GLSL: &'static str;
     /// Elements: 1, or an array's length.
@@ -124,6 +125,8 @@ impl UniformType for [Vec3; 4] {
 /// variant compiled out (no location) does nothing.
 pub struct Uniform<T: UniformType> {
     location: Option<glow::UniformLocation>,
+    /// The value set last: a program keeps its uniforms, and only this crate sets them.
+    last: Cell<Option<T::Value>>,
     ty: PhantomData<fn(T)>,
 }
 
@@ -131,14 +134,20 @@ impl<T: UniformType> Uniform<T> {
     fn inactive() -> Self {
         Uniform {
             location: None,
+            last: Cell::new(None),
             ty: PhantomData,
         }
     }
 
-    /// Sets the uniform of the current program (which must be the one it was resolved in).
+    /// Sets the uniform of the current program (which must be the one it was resolved in),
+    /// unless it holds `value` already.
     pub fn set(&self, dev: &Device, value: T::Value) {
         if let Some(l) = &self.location {
-            T::set(dev, l, value);
+            if self.last.get() != Some(value) {
+                T::set(dev, l, value);
+                dev.count_state_call(|c| c.uniforms_set += 1);
+                self.last.set(Some(value));
+            }
         }
     }
 }
@@ -223,6 +232,7 @@ impl Resolver<'_> {
             }
             Some(_) => Uniform {
                 location: unsafe { self.dev.gl.get_uniform_location(self.raw, name) },
+                last: Cell::new(None),
                 ty: PhantomData,
             },
         }
@@ -394,7 +404,7 @@ impl Program {
 
     /// Makes this the current program.
     pub fn bind(&self, dev: &Device) {
-        unsafe { dev.gl.use_program(Some(self.raw)) }
+        dev.use_program(self.raw)
     }
 
     /// The uniform set the program was linked with, when it is a `U`.

@@ -280,6 +280,12 @@ impl Renderer {
         self.dev.fail_checks_naming(name);
     }
 
+    /// Programs bound and uniforms set so far (`lab`: tests count a frame's).
+    #[cfg(feature = "lab")]
+    pub fn gl_state_calls(&self) -> crate::gl::device::StateCalls {
+        self.dev.state_calls()
+    }
+
     /// GL objects the renderer holds now (`lab`: the soak tests count them).
     #[cfg(feature = "lab")]
     pub fn live_gl_objects(&self) -> crate::gl::device::LiveObjects {

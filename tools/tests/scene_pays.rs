@@ -8,9 +8,10 @@ mod common;
 use std::sync::Arc;
 
 use common::Gpu;
-use glam::{DVec3, Vec3};
+use glam::{DMat4, DVec3, Vec3};
 use manylight::gl::shader_source::{assemble, Stage};
 use manylight::methods::ShaderFeatures;
+use manylight::scene::meshbuild::MeshBuilder;
 use manylight::scene::{self, Light};
 use manylight::{EsVersion, HeadlessContext, LightEncoding, RenderOptions, Renderer};
 
@@ -550,3 +551,55 @@ fn an_unlit_frame_draws_each_opaque_object_once() {
     });
 }
 
+/// Objects that share a material set only their own transforms: the program, the material's
+/// values, the frame's constants and the method's light data stay set from one object to the
+/// next. 60 small boxes added to a scene cost at most three uniforms each (the model-view
+/// matrix in the depth prepass and in the shading pass, the normal matrix) and no program
+/// bind.
+#[test]
+fn objects_sharing_a_material_set_only_their_transforms() {
+    let (w, h) = (96, 54);
+    let base = point_light_scene();
+    let mut boxes = base.clone();
+    let mut b = MeshBuilder::new();
+    b.cuboid(Vec3::splat(-0.1), Vec3::splat(0.1));
+    let mesh = Arc::new(b.build().unwrap());
+    let material = boxes.objects[0].material;
+    let added = 60;
+    for i in 0..added {
+        let at = DVec3::new(
+            -3.0 + 0.5 * (i % 12) as f64,
+            1.0 + 0.5 * (i / 12) as f64,
+            8.0,
+        );
+        boxes.add_object(Arc::clone(&mesh), material, DMat4::from_translation(at));
+    }
+    common::each_method(|es, method, gpu| {
+        let opts = RenderOptions::default();
+        let mut frame_calls = |s: &scene::Scene| {
+            // Programs built and data uploaded in the frames before.
+            for _ in 0..3 {
+                gpu.r().render_offscreen(s, w, h, &opts).unwrap();
+            }
+            let before = gpu.r().gl_state_calls();
+            let (_, stats) = gpu.r().render_offscreen(s, w, h, &opts).unwrap();
+            let after = gpu.r().gl_state_calls();
+            (
+                after.programs_bound - before.programs_bound,
+                after.uniforms_set - before.uniforms_set,
+                stats.draw_calls,
+            )
+        };
+        let (base_programs, base_uniforms, base_draws) = frame_calls(&base);
+        let (programs, uniforms, draws) = frame_calls(&boxes);
+        assert!(
+            draws >= base_draws + added,
+            "{es} {method}: boxes not drawn"
+        );
+        assert_eq!(programs, base_programs, "{es} {method}: programs bound");
+        assert!(
+            uniforms <= base_uniforms + 3 * added,
+            "{es} {method}: {base_uniforms} uniforms set without the boxes, {uniforms} with"
+        );
+    });
+}
