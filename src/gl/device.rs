@@ -3,6 +3,7 @@
 
 use glow::HasContext;
 
+use super::absent_attributes::ABSENT;
 use super::{Caps, EsVersion, GlError, Restrictions};
 
 /// The GL context the renderer draws with. Created from a glow context the caller owns (a
@@ -28,6 +29,10 @@ pub struct Device {
     /// skipped, as a frame binds one program for many objects.
     current_program: std::cell::Cell<Option<glow::Program>>,
     state_calls: std::cell::Cell<StateCalls>,
+    /// The vertex array object bound in this call (`None` outside a call).
+    current_vertex_array: std::cell::Cell<Option<glow::VertexArray>>,
+    /// Whether this call has set the constant values of [`ABSENT`] attributes.
+    absent_values_set: std::cell::Cell<bool>,
     /// Whether a GL error the application left pending has been reported (once a device).
     warned_pending_error: std::cell::Cell<bool>,
     /// GL said the context was lost (`GL_CONTEXT_LOST`, which a driver may say only once): every
@@ -80,6 +85,9 @@ pub struct StateCalls {
     pub programs_bound: u64,
     /// `glUniform*` calls.
     pub uniforms_set: u64,
+    /// Calls that bind a mesh's vertex arrays: its vertex array object, or (without one) its
+    /// buffers and attribute arrays.
+    pub vertex_array_calls: u64,
 }
 
 /// GL objects currently alive, as counted by the renderer's own create/delete calls: what
@@ -96,6 +104,8 @@ pub struct LiveObjects {
     pub renderbuffers: i64,
     /// Programs.
     pub programs: i64,
+    /// Vertex array objects of meshes (an ES 3.x or desktop context).
+    pub vertex_arrays: i64,
 }
 
 macro_rules! tracked {
@@ -191,6 +201,8 @@ impl Device {
             host_depth: std::cell::Cell::new(0),
             current_program: std::cell::Cell::new(None),
             state_calls: Default::default(),
+            current_vertex_array: std::cell::Cell::new(None),
+            absent_values_set: std::cell::Cell::new(false),
             warned_pending_error: std::cell::Cell::new(false),
             lost: std::cell::Cell::new(false),
             context: ContextWatch::of_current(),
@@ -232,8 +244,11 @@ impl Device {
         let depth = self.host_depth.get();
         self.host_depth.set(depth + 1);
         (depth == 0).then(|| {
-            // The application may have bound any program since the last call.
+            // The application may have bound any program, or set any attribute value, since
+            // the last call; entering binds the renderer's own vertex array.
             self.current_program.set(None);
+            self.absent_values_set.set(false);
+            self.current_vertex_array.set(self.vertex_array);
             self.clear_pending_errors();
             super::host_state::HostState::enter(&self.gl, &self.host, self.vertex_array)
         })
@@ -245,6 +260,8 @@ impl Device {
         if let Some(saved) = saved {
             saved.leave(&self.gl, self.vertex_array);
             self.current_program.set(None);
+            self.current_vertex_array.set(None);
+            self.absent_values_set.set(false);
         }
     }
 
@@ -296,6 +313,55 @@ impl Device {
     /// `n`: handed to another), for `Renderer::adopt_programs` (with `lab`).
     pub(crate) fn count_handed_programs(&self, n: i64) {
         self.count(|l| l.programs += n);
+    }
+
+    /// Whether meshes keep their arrays in vertex array objects of their own: where the
+    /// renderer has one for its calls (an ES 3.x or desktop context).
+    pub(crate) fn mesh_vertex_arrays(&self) -> bool {
+        self.vertex_array.is_some()
+    }
+
+    pub(crate) fn create_mesh_vertex_array(&self) -> Result<glow::VertexArray, GlError> {
+        let vao = unsafe { self.gl.create_vertex_array() }.map_err(creation_failed)?;
+        self.count(|l| l.vertex_arrays += 1);
+        Ok(vao)
+    }
+
+    /// Deletes a mesh's vertex array; where it was bound, the renderer's own is bound instead
+    /// (GL would bind none, which a desktop core context cannot draw or point arrays with).
+    pub(crate) fn delete_mesh_vertex_array(&self, vao: glow::VertexArray) {
+        unsafe { self.gl.delete_vertex_array(vao) };
+        self.count(|l| l.vertex_arrays -= 1);
+        if self.current_vertex_array.get() == Some(vao) {
+            if let Some(own) = self.vertex_array {
+                unsafe { self.gl.bind_vertex_array(Some(own)) };
+            }
+            self.current_vertex_array.set(self.vertex_array);
+        }
+    }
+
+    /// Binds `vao`, unless this call already did.
+    pub(crate) fn bind_vertex_array(&self, vao: glow::VertexArray) {
+        if self.current_vertex_array.get() == Some(vao) {
+            return;
+        }
+        unsafe { self.gl.bind_vertex_array(Some(vao)) };
+        self.count_state_call(|c| c.vertex_array_calls += 1);
+        if self.host_depth.get() > 0 {
+            self.current_vertex_array.set(Some(vao));
+        }
+    }
+
+    /// Sets the constant value each [`ABSENT`] attribute reads where a mesh lacks its array,
+    /// unless this call already did (a value is the context's, not a vertex array's).
+    pub(crate) fn set_absent_values(&self) {
+        if self.absent_values_set.get() {
+            return;
+        }
+        for (loc, v) in ABSENT {
+            unsafe { self.gl.vertex_attrib_4_f32(loc, v[0], v[1], v[2], v[3]) };
+        }
+        self.absent_values_set.set(self.host_depth.get() > 0);
     }
 
     /// Counts a state call ([`StateCalls`]).

@@ -125,31 +125,97 @@ pub fn split_u16_about(mesh: &Mesh, origin: DVec3) -> Vec<Chunk> {
 struct GpuChunk {
     vbo: glow::Buffer,
     ibo: glow::Buffer,
+    /// Its arrays, set once, where meshes have vertex arrays of their own
+    /// ([`Device::mesh_vertex_arrays`]): a draw binds it instead of pointing five attributes.
+    vao: Option<glow::VertexArray>,
     index_count: i32,
     layout: VertexLayout,
 }
 
 impl GpuChunk {
+    /// Uploads `chunk`: its vertex array (where meshes have them) bound first, so that it
+    /// takes the index buffer and the arrays. What it made is freed when it fails.
+    fn upload(dev: &Device, chunk: &Chunk) -> Result<GpuChunk, GlError> {
+        let vao = match dev.mesh_vertex_arrays() {
+            true => Some(dev.create_mesh_vertex_array()?),
+            false => None,
+        };
+        if let Some(vao) = vao {
+            dev.bind_vertex_array(vao);
+        }
+        let vertices = bytemuck::cast_slice(&chunk.vertices);
+        let indices = bytemuck::cast_slice(&chunk.indices);
+        let vbo = static_buffer(dev, glow::ARRAY_BUFFER, vertices);
+        let ibo = static_buffer(dev, glow::ELEMENT_ARRAY_BUFFER, indices);
+        let (vbo, ibo) = match (vbo, ibo) {
+            (Ok(vbo), Ok(ibo)) => (vbo, ibo),
+            (vbo, ibo) => {
+                for buffer in [&vbo, &ibo].into_iter().flatten() {
+                    dev.delete_buffer(*buffer);
+                }
+                if let Some(vao) = vao {
+                    dev.delete_mesh_vertex_array(vao);
+                }
+                return Err(vbo.and(ibo).expect_err("one failed"));
+            }
+        };
+        let gpu = GpuChunk {
+            vbo,
+            ibo,
+            vao,
+            index_count: chunk.indices.len() as i32,
+            layout: chunk.layout,
+        };
+        if vao.is_some() {
+            // The vertex buffer is still bound; the arrays the mesh lacks stay disabled.
+            gpu.point_arrays(dev);
+        }
+        Ok(gpu)
+    }
+
     /// Binds the chunk's buffers and points the program's attributes into them, for as many
     /// draws as wanted.
     fn bind_arrays(&self, dev: &Device) -> BoundMesh {
         let gl = &dev.gl;
-        let stride = (self.layout.floats() * 4) as i32;
-        unsafe {
-            gl.bind_buffer(glow::ARRAY_BUFFER, Some(self.vbo));
-            gl.bind_buffer(glow::ELEMENT_ARRAY_BUFFER, Some(self.ibo));
-            // Optional attributes the mesh lacks read a constant instead of a stale array.
-            for (loc, value) in ABSENT {
-                gl.disable_vertex_attrib_array(loc);
-                gl.vertex_attrib_4_f32(loc, value[0], value[1], value[2], value[3]);
+        if let Some(vao) = self.vao {
+            dev.bind_vertex_array(vao);
+        } else {
+            unsafe {
+                gl.bind_buffer(glow::ARRAY_BUFFER, Some(self.vbo));
+                gl.bind_buffer(glow::ELEMENT_ARRAY_BUFFER, Some(self.ibo));
+                // Optional attributes the mesh lacks read a constant instead of a stale array.
+                for (loc, _) in ABSENT {
+                    gl.disable_vertex_attrib_array(loc);
+                }
             }
-            for (loc, size, offset) in self.layout.attributes() {
-                gl.enable_vertex_attrib_array(loc);
-                gl.vertex_attrib_pointer_f32(loc, size, glow::FLOAT, false, stride, offset);
-            }
+            self.point_arrays(dev);
+            let calls = 2 + ABSENT.len() + 2 * self.layout.attributes().count();
+            dev.count_state_call(|c| c.vertex_array_calls += calls as u64);
+        }
+        if !(self.layout.colors && self.layout.tangents) {
+            dev.set_absent_values();
         }
         BoundMesh {
             index_count: self.index_count,
+        }
+    }
+
+    /// Points the attributes the chunk has into its vertex buffer (bound to `ARRAY_BUFFER`).
+    fn point_arrays(&self, dev: &Device) {
+        let stride = (self.layout.floats() * 4) as i32;
+        for (loc, size, offset) in self.layout.attributes() {
+            unsafe {
+                dev.gl.enable_vertex_attrib_array(loc);
+                (dev.gl).vertex_attrib_pointer_f32(loc, size, glow::FLOAT, false, stride, offset);
+            }
+        }
+    }
+
+    fn destroy(&self, dev: &Device) {
+        dev.delete_buffer(self.vbo);
+        dev.delete_buffer(self.ibo);
+        if let Some(vao) = self.vao {
+            dev.delete_mesh_vertex_array(vao);
         }
     }
 }
@@ -224,29 +290,8 @@ impl GpuMesh {
     /// when it fails.
     fn upload_chunks(&mut self, dev: &Device, mesh: &Mesh, origin: DVec3) -> Result<(), GlError> {
         for chunk in split_u16_about(mesh, origin) {
-            let vbo = static_buffer(
-                dev,
-                glow::ARRAY_BUFFER,
-                bytemuck::cast_slice(&chunk.vertices),
-            )?;
-            let ibo = match static_buffer(
-                dev,
-                glow::ELEMENT_ARRAY_BUFFER,
-                bytemuck::cast_slice(&chunk.indices),
-            ) {
-                Ok(ibo) => ibo,
-                Err(e) => {
-                    dev.delete_buffer(vbo);
-                    return Err(e);
-                }
-            };
+            self.chunks.push(GpuChunk::upload(dev, &chunk)?);
             self.bytes += chunk.vertices.len() * 4 + chunk.indices.len() * 2;
-            self.chunks.push(GpuChunk {
-                vbo,
-                ibo,
-                index_count: chunk.indices.len() as i32,
-                layout: chunk.layout,
-            });
         }
         Ok(())
     }
@@ -277,8 +322,7 @@ impl GpuMesh {
     pub fn destroy(&mut self, dev: &Device) {
         if !self.destroyed {
             for c in self.chunks.drain(..) {
-                dev.delete_buffer(c.vbo);
-                dev.delete_buffer(c.ibo);
+                c.destroy(dev);
             }
             self.destroyed = true;
         }

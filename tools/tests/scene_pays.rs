@@ -553,9 +553,9 @@ fn an_unlit_frame_draws_each_opaque_object_once() {
 
 /// Objects that share a material set only their own transforms: the program, the material's
 /// values, the frame's constants and the method's light data stay set from one object to the
-/// next. 60 small boxes added to a scene cost at most three uniforms each (the model-view
-/// matrix in the depth prepass and in the shading pass, the normal matrix) and no program
-/// bind.
+/// next. 60 small boxes, each its own mesh, added to a scene cost at most three uniforms each
+/// (the model-view matrix in the depth prepass and in the shading pass, the normal matrix) and
+/// no program bind; on ES 3.0 a draw binds the mesh's vertex array and no attribute.
 #[test]
 fn objects_sharing_a_material_set_only_their_transforms() {
     let (w, h) = (96, 54);
@@ -563,7 +563,7 @@ fn objects_sharing_a_material_set_only_their_transforms() {
     let mut boxes = base.clone();
     let mut b = MeshBuilder::new();
     b.cuboid(Vec3::splat(-0.1), Vec3::splat(0.1));
-    let mesh = Arc::new(b.build().unwrap());
+    let mesh = b.build().unwrap();
     let material = boxes.objects[0].material;
     let added = 60;
     for i in 0..added {
@@ -572,7 +572,7 @@ fn objects_sharing_a_material_set_only_their_transforms() {
             1.0 + 0.5 * (i / 12) as f64,
             8.0,
         );
-        boxes.add_object(Arc::clone(&mesh), material, DMat4::from_translation(at));
+        boxes.add_object(mesh.clone(), material, DMat4::from_translation(at));
     }
     common::each_method(|es, method, gpu| {
         let opts = RenderOptions::default();
@@ -587,11 +587,12 @@ fn objects_sharing_a_material_set_only_their_transforms() {
             (
                 after.programs_bound - before.programs_bound,
                 after.uniforms_set - before.uniforms_set,
+                after.vertex_array_calls - before.vertex_array_calls,
                 stats.draw_calls,
             )
         };
-        let (base_programs, base_uniforms, base_draws) = frame_calls(&base);
-        let (programs, uniforms, draws) = frame_calls(&boxes);
+        let (base_programs, base_uniforms, base_arrays, base_draws) = frame_calls(&base);
+        let (programs, uniforms, arrays, draws) = frame_calls(&boxes);
         assert!(
             draws >= base_draws + added,
             "{es} {method}: boxes not drawn"
@@ -601,5 +602,13 @@ fn objects_sharing_a_material_set_only_their_transforms() {
             uniforms <= base_uniforms + 3 * added,
             "{es} {method}: {base_uniforms} uniforms set without the boxes, {uniforms} with"
         );
+        if es == EsVersion::Es3 {
+            assert!(
+                arrays - base_arrays <= draws - base_draws,
+                "{es} {method}: {} calls for the boxes' {} draws' arrays",
+                arrays - base_arrays,
+                draws - base_draws
+            );
+        }
     });
 }
