@@ -88,6 +88,8 @@ pub struct StateCalls {
     /// Calls that bind a mesh's vertex arrays: its vertex array object, or (without one) its
     /// buffers and attribute arrays.
     pub vertex_array_calls: u64,
+    /// Binds of the methods' data textures (lights, grids, lists), each choosing its unit.
+    pub data_textures_bound: u64,
 }
 
 /// GL objects currently alive, as counted by the renderer's own create/delete calls: what

@@ -222,6 +222,7 @@ impl DataTexture {
             dev.gl.active_texture(glow::TEXTURE0 + unit);
             dev.gl.bind_texture(glow::TEXTURE_2D, Some(self.raw));
         }
+        dev.count_state_call(|c| c.data_textures_bound += 1);
     }
 
     /// Allocated size in texels.

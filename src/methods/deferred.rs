@@ -296,13 +296,15 @@ impl Deferred {
         ctx.features = features.with(ShaderFeatures::DIRECTIONAL, false);
         let scale = accumulation_scale(ctx);
         let mut drawn = Ok(());
+        let mut bound = None;
         for k in 0..ctx.order.opaque.len() {
             let i = ctx.order.opaque[k];
-            drawn = shade_object(ctx, i, "gbuffer", 1, &mut |p: &GBufferProgram, dev| {
+            let mut bind = |p: &GBufferProgram, dev: &Device| {
                 p.viewport.set(dev, viewport);
                 p.half_extent.set(dev, half);
                 p.accum_scale.set(dev, scale);
-            });
+            };
+            drawn = shade_object(ctx, i, "gbuffer", 1, &mut bind, &mut bound);
             if drawn.is_err() {
                 break;
             }

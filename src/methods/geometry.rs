@@ -147,6 +147,7 @@ pub fn draw_objects<P: GeometryProgram>(
     if prepass {
         depth_prepass(ctx)?;
     }
+    let mut bound = None;
     for k in 0..ctx.order.opaque.len() {
         if k == 0 || k == ctx.order.cut_out_from {
             let state = if prepass && k < ctx.order.cut_out_from {
@@ -157,7 +158,7 @@ pub fn draw_objects<P: GeometryProgram>(
             state.apply(ctx.dev);
         }
         let i = ctx.order.opaque[k];
-        shade_object(ctx, i, shader, max_lights, bind_method)?;
+        shade_object(ctx, i, shader, max_lights, bind_method, &mut bound)?;
     }
     // Counts are of the visible opaque surface: blending would mix two counts in 8 bits.
     let transparent = if ctx.features.counting() {
@@ -182,7 +183,7 @@ pub fn draw_objects<P: GeometryProgram>(
         let first = if double_sided { 0 } else { 1 };
         for state in &passes[first..] {
             state.apply(ctx.dev);
-            shade_object(ctx, i, shader, max_lights, bind_method)?;
+            shade_object(ctx, i, shader, max_lights, bind_method, &mut bound)?;
         }
     }
     crate::gl::device::gl_check!(ctx.dev, "geometry pass");
@@ -192,12 +193,15 @@ pub fn draw_objects<P: GeometryProgram>(
 /// One object with its material's shader variant. An opaque one's back faces are culled here
 /// when its material is single-sided, as in the depth prepass, so every opaque pass (shading,
 /// deferred's G-buffer) covers the same pixels; a transparent one's culling is its pass's.
+/// `bind_method` runs where the program differs from the one `bound` names, the last it ran
+/// for: what it binds and sets holds for the frame, on texture units no object binds.
 pub(crate) fn shade_object<P: GeometryProgram>(
     ctx: &mut FrameContext,
     index: usize,
     shader: &'static str,
     max_lights: u32,
     bind_method: &mut dyn FnMut(&P, &Device),
+    bound: &mut Option<ProgramKey>,
 ) -> Result<(), Error> {
     let dev = ctx.dev;
     let dialect = dev.es();
@@ -280,7 +284,10 @@ pub(crate) fn shade_object<P: GeometryProgram>(
         .surface()
         .maps()
         .set(dev, material, features, own, ctx.gpu_scene);
-    bind_method(program, dev);
+    if *bound != Some(key) {
+        bind_method(program, dev);
+        *bound = Some(key);
+    }
     mesh.draw(dev);
     Ok(())
 }

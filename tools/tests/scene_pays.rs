@@ -555,7 +555,8 @@ fn an_unlit_frame_draws_each_opaque_object_once() {
 /// values, the frame's constants and the method's light data stay set from one object to the
 /// next. 60 small boxes, each its own mesh, added to a scene cost at most three uniforms each
 /// (the model-view matrix in the depth prepass and in the shading pass, the normal matrix) and
-/// no program bind; on ES 3.0 a draw binds the mesh's vertex array and no attribute.
+/// no program bind nor data texture; on ES 3.0 a draw binds the mesh's vertex array and no
+/// attribute.
 #[test]
 fn objects_sharing_a_material_set_only_their_transforms() {
     let (w, h) = (96, 54);
@@ -588,16 +589,22 @@ fn objects_sharing_a_material_set_only_their_transforms() {
                 after.programs_bound - before.programs_bound,
                 after.uniforms_set - before.uniforms_set,
                 after.vertex_array_calls - before.vertex_array_calls,
+                after.data_textures_bound - before.data_textures_bound,
                 stats.draw_calls,
             )
         };
-        let (base_programs, base_uniforms, base_arrays, base_draws) = frame_calls(&base);
-        let (programs, uniforms, arrays, draws) = frame_calls(&boxes);
+        let (base_programs, base_uniforms, base_arrays, base_textures, base_draws) =
+            frame_calls(&base);
+        let (programs, uniforms, arrays, textures, draws) = frame_calls(&boxes);
         assert!(
             draws >= base_draws + added,
             "{es} {method}: boxes not drawn"
         );
         assert_eq!(programs, base_programs, "{es} {method}: programs bound");
+        assert_eq!(
+            textures, base_textures,
+            "{es} {method}: data textures bound"
+        );
         assert!(
             uniforms <= base_uniforms + 3 * added,
             "{es} {method}: {base_uniforms} uniforms set without the boxes, {uniforms} with"
