@@ -191,7 +191,8 @@ impl Device {
         } else {
             None
         };
-        let host = super::host_state::HostFeatures::of(&caps, vertex_array.is_some());
+        let units = unsafe { gl.get_parameter_i32(glow::MAX_COMBINED_TEXTURE_IMAGE_UNITS) };
+        let host = super::host_state::HostFeatures::of(&caps, vertex_array.is_some(), units);
         Ok(Device {
             gl,
             caps,

@@ -63,12 +63,15 @@ pub(crate) struct HostFeatures {
     /// and an instanced-arrays extension's divisor setter (their divisors are theirs too).
     attrib_fns: Option<AttribPointerFns>,
     divisor: Option<VertexAttribDivisor>,
+    /// Texture units saved and given back: the context's, at most [`UNITS`].
+    units: usize,
 }
 
 impl HostFeatures {
     /// From the context's capabilities; `own_vertex_array` when the renderer binds its own
-    /// vertex array object (which keeps its arrays and divisors apart from the game's).
-    pub(crate) fn of(caps: &Caps, own_vertex_array: bool) -> HostFeatures {
+    /// vertex array object (which keeps its arrays and divisors apart from the game's);
+    /// `units`: its `GL_MAX_COMBINED_TEXTURE_IMAGE_UNITS`.
+    pub(crate) fn of(caps: &Caps, own_vertex_array: bool, units: i32) -> HostFeatures {
         let es3 = caps.context_has_es3_state();
         let has = |name: &str| caps.has_extension(name);
         HostFeatures {
@@ -83,6 +86,7 @@ impl HostFeatures {
             divisor: (!own_vertex_array)
                 .then(|| super::ext_fns::vertex_attrib_divisor_ext(has))
                 .flatten(),
+            units: (units.max(0) as usize).min(UNITS),
         }
     }
 }
@@ -171,10 +175,10 @@ impl HostState {
             srgb_write_control,
             attrib_fns,
             divisor,
+            units,
         } = *features;
         unsafe {
             let int = |p| gl.get_parameter_i32(p);
-            let units = (int(glow::MAX_COMBINED_TEXTURE_IMAGE_UNITS).max(0) as usize).min(UNITS);
             let active_texture = int(glow::ACTIVE_TEXTURE);
             let mut textures = [None; UNITS];
             let mut samplers = [None; UNITS];
@@ -275,39 +279,41 @@ impl HostState {
                     }
                 }),
             };
-            if desktop {
+            // What the renderer never switches on is switched off only where it is on, and
+            // (in `leave`) on again only where it was.
+            let off = |c, on: bool| {
+                if on {
+                    gl.disable(c)
+                }
+            };
+            if let Some(d) = &saved.desktop {
                 gl.polygon_mode(glow::FRONT_AND_BACK, glow::FILL);
                 gl.disable(glow::FRAMEBUFFER_SRGB);
-                gl.disable(glow::PRIMITIVE_RESTART);
+                off(glow::PRIMITIVE_RESTART, d.primitive_restart);
             }
-            if saved.fixed_index_restart.is_some() {
-                gl.disable(glow::PRIMITIVE_RESTART_FIXED_INDEX);
-            }
-            if saved.sample_mask.is_some() {
-                gl.disable(glow::SAMPLE_MASK);
-            }
+            off(
+                glow::PRIMITIVE_RESTART_FIXED_INDEX,
+                saved.fixed_index_restart == Some(true),
+            );
+            off(glow::SAMPLE_MASK, saved.sample_mask == Some(true));
             if let Some(vao) = vao {
                 gl.bind_vertex_array(Some(vao));
             }
             if es3 {
                 gl.bind_buffer(glow::PIXEL_PACK_BUFFER, None);
                 gl.bind_buffer(glow::PIXEL_UNPACK_BUFFER, None);
-                gl.disable(glow::RASTERIZER_DISCARD);
+                off(glow::RASTERIZER_DISCARD, saved.rasterizer_discard);
             }
-            let rows = [
-                (saved.unpack_rows, UNPACK_ROWS),
-                (saved.pack_rows, PACK_ROWS),
-            ];
-            for (_, names) in rows.iter().filter(|(kept, _)| kept.is_some()) {
-                for &p in names {
+            for (p, v) in saved.rows() {
+                if v != 0 {
                     gl.pixel_store_i32(p, 0);
                 }
             }
             if saved.srgb_write.is_some() {
                 gl.enable(glow::FRAMEBUFFER_SRGB);
             }
-            for c in OFF_INSIDE {
-                gl.disable(c);
+            for (c, on) in OFF_INSIDE.into_iter().zip(saved.off_inside) {
+                off(c, on);
             }
             gl.blend_equation(glow::FUNC_ADD);
             gl.front_face(glow::CCW);
@@ -316,6 +322,12 @@ impl HostState {
             gl.color_mask(true, true, true, true);
             saved
         }
+    }
+
+    /// The saved row lengths and skips (where the context has them), with their names.
+    fn rows(&self) -> impl Iterator<Item = (u32, i32)> {
+        let unpack = (self.unpack_rows.into_iter()).flat_map(|v| UNPACK_ROWS.into_iter().zip(v));
+        unpack.chain((self.pack_rows.into_iter()).flat_map(|v| PACK_ROWS.into_iter().zip(v)))
     }
 
     /// Gives the application its state back.
@@ -364,18 +376,20 @@ impl HostState {
             for (c, on) in TOGGLED.into_iter().zip(self.toggled) {
                 enable(c, on);
             }
+            let on_again = |c, on: bool| {
+                if on {
+                    gl.enable(c)
+                }
+            };
             for (c, on) in OFF_INSIDE.into_iter().zip(self.off_inside) {
-                enable(c, on);
+                on_again(c, on);
             }
-            if self.es3 {
-                enable(glow::RASTERIZER_DISCARD, self.rasterizer_discard);
-            }
-            if let Some(on) = self.fixed_index_restart {
-                enable(glow::PRIMITIVE_RESTART_FIXED_INDEX, on);
-            }
-            if let Some(on) = self.sample_mask {
-                enable(glow::SAMPLE_MASK, on);
-            }
+            on_again(glow::RASTERIZER_DISCARD, self.rasterizer_discard);
+            on_again(
+                glow::PRIMITIVE_RESTART_FIXED_INDEX,
+                self.fixed_index_restart == Some(true),
+            );
+            on_again(glow::SAMPLE_MASK, self.sample_mask == Some(true));
             let [sr, dr, sa, da] = self.blend_func.map(|v| v as u32);
             gl.blend_func_separate(sr, dr, sa, da);
             let [er, ea] = self.blend_equation.map(|v| v as u32);
@@ -392,11 +406,8 @@ impl HostState {
             gl.clear_depth(self.clear_depth.into());
             gl.pixel_store_i32(glow::PACK_ALIGNMENT, self.alignment[0]);
             gl.pixel_store_i32(glow::UNPACK_ALIGNMENT, self.alignment[1]);
-            for (kept, names) in [(self.unpack_rows, UNPACK_ROWS), (self.pack_rows, PACK_ROWS)] {
-                for (p, v) in kept
-                    .into_iter()
-                    .flat_map(|values| names.into_iter().zip(values))
-                {
+            for (p, v) in self.rows() {
+                if v != 0 {
                     gl.pixel_store_i32(p, v);
                 }
             }
@@ -406,7 +417,7 @@ impl HostState {
             if let Some(desktop) = &self.desktop {
                 gl.polygon_mode(glow::FRONT_AND_BACK, desktop.polygon_mode as u32);
                 enable(glow::FRAMEBUFFER_SRGB, desktop.framebuffer_srgb);
-                enable(glow::PRIMITIVE_RESTART, desktop.primitive_restart);
+                on_again(glow::PRIMITIVE_RESTART, desktop.primitive_restart);
             }
         }
     }
