@@ -4,6 +4,7 @@
 use glow::HasContext;
 
 use super::absent_attributes::ABSENT;
+use super::vertex_arrays::VertexArrays;
 use super::{Caps, EsVersion, GlError, Restrictions};
 
 /// The GL context the renderer draws with. Created from a glow context the caller owns (a
@@ -21,6 +22,9 @@ pub struct Device {
     /// The renderer's own vertex array object (an ES 3.x or desktop context), bound only
     /// during its calls, so a game's bound one keeps its buffers and attributes.
     vertex_array: Option<glow::VertexArray>,
+    /// How vertex arrays are made and bound here; `None` without them (ES 2.0 without
+    /// `GL_OES_vertex_array_object`).
+    vertex_arrays: Option<VertexArrays>,
     /// What the context has of the application's state each call saves.
     host: super::host_state::HostFeatures,
     /// Nesting depth of [`Device::enter_host`] (the outermost call saves the state).
@@ -169,12 +173,19 @@ impl Device {
         let mut caps = Caps::probe(&gl, es)?;
         caps.restrict(restrictions)?;
         // A core profile draws nothing without a bound vertex array object; on an ES 3.x
-        // context one of the renderer's own (at either level) leaves a game's untouched: its
-        // arrays, and their divisors, which ES 2.0 calls cannot reset.
-        let vertex_array = if caps.desktop || caps.context_has_es3_state() {
-            Some(unsafe { gl.create_vertex_array() }.map_err(GlError::Create)?)
+        // context, or ES 2.0 with `GL_OES_vertex_array_object`, one of the renderer's own (at
+        // either level) leaves a game's untouched: its arrays, and their divisors, which ES 2.0
+        // calls cannot reset.
+        let vertex_arrays = if caps.desktop || caps.context_has_es3_state() {
+            Some(VertexArrays::Core)
+        } else if caps.has_extension("GL_OES_vertex_array_object") {
+            VertexArrays::oes()
         } else {
             None
+        };
+        let vertex_array = match vertex_arrays {
+            Some(v) => Some(v.create(&gl).map_err(GlError::Create)?),
+            None => None,
         };
         let renderbuffer_storage_multisample_ext = if caps.msaa_render_to_texture {
             let f = super::ext_fns::renderbuffer_storage_multisample_ext();
@@ -201,6 +212,7 @@ impl Device {
             renderbuffer_storage_multisample_ext,
             host,
             vertex_array,
+            vertex_arrays,
             host_depth: std::cell::Cell::new(0),
             current_program: std::cell::Cell::new(None),
             state_calls: Default::default(),
@@ -253,7 +265,7 @@ impl Device {
             self.absent_values_set.set(false);
             self.current_vertex_array.set(self.vertex_array);
             self.clear_pending_errors();
-            super::host_state::HostState::enter(&self.gl, &self.host, self.vertex_array)
+            super::host_state::HostState::enter(&self.gl, &self.host, self.own_vertex_array())
         })
     }
 
@@ -261,7 +273,7 @@ impl Device {
     pub(crate) fn leave_host(&self, saved: Option<super::host_state::HostState>) {
         self.host_depth.set(self.host_depth.get().saturating_sub(1));
         if let Some(saved) = saved {
-            saved.leave(&self.gl, self.vertex_array);
+            saved.leave(&self.gl, self.own_vertex_array());
             self.current_program.set(None);
             self.current_vertex_array.set(None);
             self.absent_values_set.set(false);
@@ -294,8 +306,8 @@ impl Device {
 
     /// Deletes the renderer's vertex array object (with the renderer's other objects).
     pub(crate) fn delete_vertex_array(&mut self) {
-        if let Some(vao) = self.vertex_array.take() {
-            unsafe { self.gl.delete_vertex_array(vao) };
+        if let (Some(vao), Some(v)) = (self.vertex_array.take(), self.vertex_arrays) {
+            v.delete(&self.gl, vao);
         }
     }
 
@@ -318,14 +330,23 @@ impl Device {
         self.count(|l| l.programs += n);
     }
 
+    /// The renderer's own vertex array, with how to bind it, where it has one.
+    fn own_vertex_array(&self) -> Option<(glow::VertexArray, VertexArrays)> {
+        self.vertex_array.zip(self.vertex_arrays)
+    }
+
     /// Whether meshes keep their arrays in vertex array objects of their own: where the
-    /// renderer has one for its calls (an ES 3.x or desktop context).
+    /// renderer has one for its calls (an ES 3.x or desktop context, ES 2.0 with
+    /// `GL_OES_vertex_array_object`).
     pub(crate) fn mesh_vertex_arrays(&self) -> bool {
         self.vertex_array.is_some()
     }
 
     pub(crate) fn create_mesh_vertex_array(&self) -> Result<glow::VertexArray, GlError> {
-        let vao = unsafe { self.gl.create_vertex_array() }.map_err(creation_failed)?;
+        let v = self
+            .vertex_arrays
+            .ok_or_else(|| GlError::Create("no vertex arrays".into()))?;
+        let vao = v.create(&self.gl).map_err(creation_failed)?;
         self.count(|l| l.vertex_arrays += 1);
         Ok(vao)
     }
@@ -333,12 +354,13 @@ impl Device {
     /// Deletes a mesh's vertex array; where it was bound, the renderer's own is bound instead
     /// (GL would bind none, which a desktop core context cannot draw or point arrays with).
     pub(crate) fn delete_mesh_vertex_array(&self, vao: glow::VertexArray) {
-        unsafe { self.gl.delete_vertex_array(vao) };
+        let Some(v) = self.vertex_arrays else {
+            return;
+        };
+        v.delete(&self.gl, vao);
         self.count(|l| l.vertex_arrays -= 1);
         if self.current_vertex_array.get() == Some(vao) {
-            if let Some(own) = self.vertex_array {
-                unsafe { self.gl.bind_vertex_array(Some(own)) };
-            }
+            v.bind(&self.gl, self.vertex_array);
             self.current_vertex_array.set(self.vertex_array);
         }
     }
@@ -348,7 +370,9 @@ impl Device {
         if self.current_vertex_array.get() == Some(vao) {
             return;
         }
-        unsafe { self.gl.bind_vertex_array(Some(vao)) };
+        if let Some(v) = self.vertex_arrays {
+            v.bind(&self.gl, Some(vao));
+        }
         self.count_state_call(|c| c.vertex_array_calls += 1);
         if self.host_depth.get() > 0 {
             self.current_vertex_array.set(Some(vao));

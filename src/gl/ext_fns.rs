@@ -103,7 +103,7 @@ fn core_entry_point(name: &str) -> Option<*const std::ffi::c_void> {
 
 /// An extension's entry point, from the implementation as [`core_entry_point`] picks it, but
 /// through `eglGetProcAddress`: an extension's functions need not be exported by `libGLESv2`.
-fn entry_point(name: &str) -> Option<*const std::ffi::c_void> {
+pub(crate) fn entry_point(name: &str) -> Option<*const std::ffi::c_void> {
     if let Some(lib) = super::gles_lib::loaded() {
         return non_null(lib.proc_address(name));
     }

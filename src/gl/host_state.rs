@@ -14,6 +14,7 @@ use super::caps::Caps;
 use super::ext_fns::{AttribPointerFns, VertexAttribDivisor};
 use super::host_attributes::HostAttributes;
 use super::host_draw_buffers::HostDrawBuffers;
+use super::vertex_arrays::VertexArrays;
 
 /// Texture units the renderer binds: 0 to 7 (`methods::maps::UNIT_MAPS` + 3), within the
 /// 8 fragment units every ES 2.0 context has.
@@ -154,7 +155,8 @@ struct DesktopState {
 
 impl HostState {
     /// Saves the application's state and sets what the renderer assumes: its own vertex
-    /// array (`vao`, on an ES 3.x or desktop context), the bound framebuffer drawing into its
+    /// array (`vao` with how to bind it: an ES 3.x or desktop context, ES 2.0 with
+    /// `GL_OES_vertex_array_object`), the bound framebuffer drawing into its
     /// attachment 0 alone (`host_draw_buffers.rs`), no pixel buffer, no sampler objects on
     /// its units, the capabilities of `OFF_INSIDE` off, additive blend equations, no sample
     /// mask, counter-clockwise front faces, the full depth range, a clear depth of 1, pixel
@@ -165,7 +167,7 @@ impl HostState {
     pub(crate) fn enter(
         gl: &glow::Context,
         features: &HostFeatures,
-        vao: Option<glow::VertexArray>,
+        vao: Option<(glow::VertexArray, VertexArrays)>,
     ) -> Self {
         let HostFeatures {
             es3,
@@ -296,8 +298,8 @@ impl HostState {
                 saved.fixed_index_restart == Some(true),
             );
             off(glow::SAMPLE_MASK, saved.sample_mask == Some(true));
-            if let Some(vao) = vao {
-                gl.bind_vertex_array(Some(vao));
+            if let Some((vao, arrays)) = vao {
+                arrays.bind(gl, Some(vao));
             }
             if es3 {
                 gl.bind_buffer(glow::PIXEL_PACK_BUFFER, None);
@@ -331,7 +333,7 @@ impl HostState {
     }
 
     /// Gives the application its state back.
-    pub(crate) fn leave(self, gl: &glow::Context, vao: Option<glow::VertexArray>) {
+    pub(crate) fn leave(self, gl: &glow::Context, vao: Option<(glow::VertexArray, VertexArrays)>) {
         let enable = |c, on| unsafe {
             if on {
                 gl.enable(c)
@@ -341,8 +343,8 @@ impl HostState {
         };
         unsafe {
             // The vertex array first: on ES 3.0 the element buffer is its state.
-            if vao.is_some() {
-                gl.bind_vertex_array(self.vertex_array);
+            if let Some((_, arrays)) = vao {
+                arrays.bind(gl, self.vertex_array);
             } else {
                 gl.bind_buffer(glow::ELEMENT_ARRAY_BUFFER, self.element_buffer);
             }

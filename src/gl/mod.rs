@@ -37,6 +37,7 @@ pub mod state;
 pub(crate) mod target_size;
 pub mod texture;
 pub mod timer;
+pub(crate) mod vertex_arrays;
 
 pub use caps::Caps;
 pub use context::HeadlessContext;

@@ -429,10 +429,12 @@ fn every_call_gives_the_games_gl_state_back_and_draws_as_from_a_clean_one() {
 }
 
 /// Mesa asked for ES 2.0 gives an ES 3.2 context, where the renderer keeps its arrays in a
-/// vertex array object of its own. Capped to ES 2.0 (a Mali-400's context) the game's arrays
-/// are the context's, and its row lengths come from `GL_EXT_unpack_subimage`: the test above
-/// runs again there, in a child process, since Mesa reads the cap once per process.
-/// (SwiftShader's and ANGLE's ES 2.0 contexts are ES 2.0 already, with instanced arrays.)
+/// vertex array object of its own. Capped to ES 2.0 (a Mali-400's context) its row lengths
+/// come from `GL_EXT_unpack_subimage`, and its vertex arrays from
+/// `GL_OES_vertex_array_object`; without that extension the game's arrays are the context's,
+/// saved and given back one by one. The test above runs again in both, each in a child
+/// process, since Mesa reads the cap once per process. (SwiftShader's and ANGLE's ES 2.0
+/// contexts are ES 2.0 already, with instanced arrays.)
 #[test]
 fn every_call_gives_the_games_gl_state_back_on_a_pure_es2_context() {
     if std::env::var_os(PURE_ES2).is_some()
@@ -440,11 +442,15 @@ fn every_call_gives_the_games_gl_state_back_on_a_pure_es2_context() {
     {
         return;
     }
-    common::child::rerun_with(
-        "every_call_gives_the_games_gl_state_back_and_draws_as_from_a_clean_one",
-        &[("MESA_GLES_VERSION_OVERRIDE", "2.0"), (PURE_ES2, "1")],
-        "on ES 2.0",
-    );
+    let test = "every_call_gives_the_games_gl_state_back_and_draws_as_from_a_clean_one";
+    let es2 = [("MESA_GLES_VERSION_OVERRIDE", "2.0"), (PURE_ES2, "1")];
+    common::child::rerun_with(test, &es2, "on ES 2.0");
+    let without_vao = [
+        es2[0],
+        es2[1],
+        ("MESA_EXTENSION_OVERRIDE", "-GL_OES_vertex_array_object"),
+    ];
+    common::child::rerun_with(test, &without_vao, "on ES 2.0 without vertex arrays");
 }
 
 #[test]
