@@ -19,8 +19,9 @@ pub struct Device {
     /// `GL_EXT_multisampled_render_to_texture` (see [`super::ext_fns`]).
     pub(crate) renderbuffer_storage_multisample_ext:
         Option<super::ext_fns::RenderbufferStorageMultisampleExt>,
-    /// The renderer's own vertex array object (an ES 3.x or desktop context), bound only
-    /// during its calls, so a game's bound one keeps its buffers and attributes.
+    /// The renderer's own vertex array object (an ES 3.x or desktop context, ES 2.0 with
+    /// `GL_OES_vertex_array_object`), bound when each call starts, so a game's bound one keeps
+    /// its buffers and attributes.
     vertex_array: Option<glow::VertexArray>,
     /// How vertex arrays are made and bound here; `None` without them (ES 2.0 without
     /// `GL_OES_vertex_array_object`).
@@ -110,7 +111,7 @@ pub struct LiveObjects {
     pub renderbuffers: i64,
     /// Programs.
     pub programs: i64,
-    /// Vertex array objects of meshes (an ES 3.x or desktop context).
+    /// Vertex array objects of meshes (where the context has them).
     pub vertex_arrays: i64,
 }
 
@@ -362,6 +363,14 @@ impl Device {
         if self.current_vertex_array.get() == Some(vao) {
             v.bind(&self.gl, self.vertex_array);
             self.current_vertex_array.set(self.vertex_array);
+        }
+    }
+
+    /// Binds the renderer's own vertex array where it has one, for arrays that are no mesh's
+    /// (a mesh's vertex array keeps its arrays).
+    pub(crate) fn bind_own_vertex_array(&self) {
+        if let Some((vao, _)) = self.own_vertex_array() {
+            self.bind_vertex_array(vao);
         }
     }
 

@@ -66,6 +66,7 @@ fn draw_probe(
             u.big.set(dev, 2048.0);
             u.one.set(dev, 1.0);
         }
+        dev.bind_own_vertex_array();
         gl.enable_vertex_attrib_array(0);
         gl.vertex_attrib_pointer_f32(0, 3, glow::FLOAT, false, 12, 0);
         for loc in 1..3 {
