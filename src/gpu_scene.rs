@@ -90,14 +90,16 @@ fn textures_of(m: &Material) -> impl Iterator<Item = (&Texture, bool)> {
 }
 
 impl GpuScene {
-    /// Uploads what the scene's objects draw with; `needs_white`: the white stand-in texture
-    /// too, for shared or full variants.
+    /// Uploads what the scene's objects draw with and no earlier frame uploaded; `needs_white`:
+    /// the white stand-in texture too, for shared or full variants. Returns the GPU bytes it
+    /// uploaded.
     pub(crate) fn upload(
         &mut self,
         dev: &Device,
         scene: &Scene,
         needs_white: bool,
-    ) -> Result<(), Error> {
+    ) -> Result<usize, Error> {
+        let mut bytes = 0;
         self.forget_unreferenced(dev);
         self.srgb_textures = crate::gl::texture::hardware_srgb(dev.caps());
         if needs_white && self.white.is_none() {
@@ -112,6 +114,7 @@ impl GpuScene {
                 let origin = bounds.map_or(DVec3::ZERO, |b| b.center());
                 let gpu = GpuMesh::new_about(dev, &o.mesh, origin)?;
                 let longest = triangle_reach::longest_edge(&o.mesh);
+                bytes += gpu.gpu_bytes();
                 e.insert((o.mesh.clone(), gpu, bounds, longest));
             }
         }
@@ -124,11 +127,13 @@ impl GpuScene {
                     .entry(key)
                     .or_insert_with(|| (t.image.clone(), [None, None]));
                 if uploads[srgb as usize].is_none() {
-                    uploads[srgb as usize] = Some(ImageTexture::new(dev, &t.image, srgb)?);
+                    let texture = ImageTexture::new(dev, &t.image, srgb)?;
+                    bytes += texture.gpu_bytes();
+                    uploads[srgb as usize] = Some(texture);
                 }
             }
         }
-        Ok(())
+        Ok(bytes)
     }
 
     /// Frees the uploads of meshes and textures the application no longer holds: the cache's

@@ -264,6 +264,7 @@ impl Renderer {
         let FrameSetup {
             shared_surfaces,
             split_bytes,
+            scene_upload_bytes,
             view,
             projection,
             scene_features,
@@ -410,6 +411,7 @@ impl Renderer {
             gpu_ms,
             method: &method_stats,
             split_bytes,
+            scene_upload_bytes,
             scene_gpu_bytes: self.gpu_scene.gpu_bytes(),
         });
         // Only colour frames that waited for the GPU (or were timed on it) say what shading

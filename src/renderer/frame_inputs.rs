@@ -18,6 +18,8 @@ pub(super) struct FrameSetup {
     pub shared_surfaces: bool,
     /// Bytes the split copies of long triangles uploaded.
     pub split_bytes: usize,
+    /// Bytes of meshes and images uploaded for the first time.
+    pub scene_upload_bytes: usize,
     pub view: DMat4,
     pub projection: Mat4,
     pub scene_features: SceneFeatures,
@@ -48,7 +50,7 @@ impl Renderer {
         super::empty_scene::warn_of_nothing_to_draw(scene, &mut self.warned_nothing_to_draw);
         let shared_surfaces =
             options.measure.full_variants || self.shared_surfaces.needed(scene, self.dev.caps());
-        self.gpu_scene.upload(&self.dev, scene, shared_surfaces)?;
+        let scene_upload_bytes = self.gpu_scene.upload(&self.dev, scene, shared_surfaces)?;
         self.gpu_scene.check_placement(scene)?;
         let split_bytes = self
             .gpu_scene
@@ -113,6 +115,7 @@ impl Renderer {
         Ok(FrameSetup {
             shared_surfaces,
             split_bytes,
+            scene_upload_bytes,
             view,
             projection,
             scene_features,

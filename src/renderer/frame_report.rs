@@ -28,6 +28,7 @@ pub(super) struct DrawnFrame<'a> {
     pub method: &'a MethodStats<'a>,
     /// Bytes the split copies of long triangles uploaded.
     pub split_bytes: usize,
+    pub scene_upload_bytes: usize,
     pub scene_gpu_bytes: usize,
 }
 
@@ -78,6 +79,7 @@ impl FrameStats {
         self.memory = MemoryStats {
             upload_bytes: m.upload_bytes + frame.split_bytes,
             upload_bytes_spread: None,
+            scene_upload_bytes: frame.scene_upload_bytes,
             method_gpu_bytes: 0,
             gbuffer_bytes: m.gbuffer_bytes,
             msaa_bytes: 0,

@@ -156,12 +156,17 @@ pub struct MemoryStats {
     /// Bytes uploaded for the frame: the method's light data (records, grids, index lists) and
     /// the copies of huge triangles split near the eye (made again when the camera, the
     /// viewport or an object moved). A scene's meshes and images, uploaded the first time a
-    /// frame shows them, are in `scene_gpu_bytes` instead.
+    /// frame shows them, are in `scene_upload_bytes` instead.
     pub upload_bytes: usize,
     /// Bytes uploaded per frame over the timed frames of an animated sequence (lights that
     /// move change what is uploaded): the command line's animated runs fill it; the library's
     /// frames leave it `None`.
     pub upload_bytes_spread: Option<Spread>,
+    /// GPU bytes of the meshes and images the frame uploaded because no earlier frame had
+    /// (mipmaps included): a scene's whole content on its first frame, then 0 unless the
+    /// application made one anew (a mesh rebuilt every frame, a new `Arc` of the same data,
+    /// shows here every frame).
+    pub scene_upload_bytes: usize,
     /// GPU memory held by the method.
     pub method_gpu_bytes: usize,
     /// G-buffer memory (deferred only; 0 otherwise).

@@ -345,6 +345,38 @@ fn a_level_the_game_drops_is_freed_by_the_next_frame() {
     });
 }
 
+/// `scene_upload_bytes` says what a frame uploaded of the scene's meshes and images: all of
+/// it on the first frame, nothing on the next, and a mesh the game rebuilt (a new `Arc` of the
+/// same data) on the frame after that, every time it does.
+#[test]
+fn a_frame_reports_the_meshes_and_images_it_uploaded() {
+    common::each_method(|es, method, gpu| {
+        let opts = RenderOptions::default();
+        let mut uploaded = |s: &scene::Scene| {
+            let (_, stats) = gpu.r().render_offscreen(s, 32, 18, &opts).unwrap();
+            (
+                stats.memory.scene_upload_bytes,
+                stats.memory.scene_gpu_bytes,
+            )
+        };
+        let mut level = textured_pillars();
+        let (first, held) = uploaded(&level);
+        assert_eq!(first, held, "{es} {method}: the first frame");
+        assert_eq!(uploaded(&level).0, 0, "{es} {method}: a still frame");
+        let rebuilt = Arc::new((*level.objects[0].mesh).clone());
+        for _ in 0..2 {
+            level.objects[0].mesh = Arc::new((*rebuilt).clone());
+            let (bytes, _) = uploaded(&level);
+            // The mesh's vertices, 32 bytes or more each, and its indices.
+            let least = rebuilt.positions.len() * 32 + rebuilt.indices.len() * 2;
+            assert!(
+                bytes >= least && bytes < first,
+                "{es} {method}: {bytes} bytes for a rebuilt mesh of {least}"
+            );
+        }
+    });
+}
+
 /// Lights that reach nothing in view cost what no lights cost, with every method: no
 /// assignment, no upload, none counted visible, the ambient-only picture. One whose centre
 /// lies outside the view but whose sphere reaches into it still lights the frame's edge.
