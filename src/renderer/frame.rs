@@ -5,7 +5,6 @@
 
 use std::time::Instant;
 
-use super::frame_inputs::FrameSetup;
 use super::frame_report::DrawnFrame;
 use super::{FrameStats, Renderer};
 use crate::gl::framebuffer::ColorFormat;
@@ -261,19 +260,8 @@ impl Renderer {
         } else {
             self.method.name()
         };
-        let FrameSetup {
-            shared_surfaces,
-            split_bytes,
-            scene_upload_bytes,
-            view,
-            projection,
-            scene_features,
-            features,
-            directional,
-            near,
-            far,
-            content_far,
-        } = self.set_up_frame(scene, (width, height), options, stats.depth_bits)?;
+        let setup = self.set_up_frame(scene, (width, height), options, stats.depth_bits)?;
+        let features = setup.features;
         let frame_lights = self.placed.of(&self.lights);
         let clear = self.frame_clear;
         let colour = (clear == Clear::All).then(|| self.clear_value(options));
@@ -293,25 +281,25 @@ impl Renderer {
             programs: &mut self.programs,
             scene,
             gpu_scene: &self.gpu_scene,
-            view,
-            projection,
+            view: setup.view,
+            projection: setup.projection,
             orthographic: matches!(scene.camera.projection, Projection::Orthographic { .. }),
             lights: frame_lights,
             lights_generation: self.lights_generation,
-            directional,
+            directional: setup.directional,
             features,
             viewport: (width, height),
             origin,
-            near,
-            far,
-            content_far,
+            near: setup.near,
+            far: setup.far,
+            content_far: setup.content_far,
             options,
             order: &mut self.draw_order,
             transparent_only: false,
             own_msaa: self.own_msaa_frame,
             clear,
             warm_up: self.warming_up,
-            shared_surfaces,
+            shared_surfaces: setup.shared_surfaces,
         };
         // The frame's errors so far are its own: the timer's calls (creating the queries too)
         // would drain them as theirs.
@@ -403,15 +391,15 @@ impl Renderer {
             lp_num_threads: self.lp_num_threads.as_deref(),
             size: (width, height),
             scene,
-            scene_features,
+            scene_features: setup.scene_features,
             features,
             active_lights: frame_lights.len(),
             lit,
             frame_ms,
             gpu_ms,
             method: &method_stats,
-            split_bytes,
-            scene_upload_bytes,
+            split_bytes: setup.split_bytes,
+            scene_upload_bytes: setup.scene_upload_bytes,
             scene_gpu_bytes: self.gpu_scene.gpu_bytes(),
         });
         // Only colour frames that waited for the GPU (or were timed on it) say what shading
