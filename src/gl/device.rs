@@ -3,7 +3,8 @@
 
 use glow::HasContext;
 
-use super::absent_attributes::ABSENT;
+use super::call_state::CallState;
+pub use super::call_state::StateCalls;
 use super::vertex_arrays::VertexArrays;
 use super::{Caps, EsVersion, GlError, Restrictions};
 
@@ -19,25 +20,16 @@ pub struct Device {
     /// `GL_EXT_multisampled_render_to_texture` (see [`super::ext_fns`]).
     pub(crate) renderbuffer_storage_multisample_ext:
         Option<super::ext_fns::RenderbufferStorageMultisampleExt>,
-    /// The renderer's own vertex array object (an ES 3.x or desktop context, ES 2.0 with
-    /// `GL_OES_vertex_array_object`), bound when each call starts, so a game's bound one keeps
-    /// its buffers and attributes.
-    vertex_array: Option<glow::VertexArray>,
-    /// How vertex arrays are made and bound here; `None` without them (ES 2.0 without
-    /// `GL_OES_vertex_array_object`).
-    vertex_arrays: Option<VertexArrays>,
+    /// The renderer's own vertex array object, with how this context binds one (an ES 3.x or
+    /// desktop context, ES 2.0 with `GL_OES_vertex_array_object`), bound when each call
+    /// starts, so a game's bound one keeps its buffers and attributes.
+    own_vertex_array: Option<(glow::VertexArray, VertexArrays)>,
     /// What the context has of the application's state each call saves.
     host: super::host_state::HostFeatures,
     /// Nesting depth of [`Device::enter_host`] (the outermost call saves the state).
     host_depth: std::cell::Cell<u32>,
-    /// The program this call made current (`None` outside a call): binding it again is
-    /// skipped, as a frame binds one program for many objects.
-    current_program: std::cell::Cell<Option<glow::Program>>,
-    state_calls: std::cell::Cell<StateCalls>,
-    /// The vertex array object bound in this call (`None` outside a call).
-    current_vertex_array: std::cell::Cell<Option<glow::VertexArray>>,
-    /// Whether this call has set the constant values of [`ABSENT`] attributes.
-    absent_values_set: std::cell::Cell<bool>,
+    /// What this call has bound, and the state calls made.
+    call: CallState,
     /// Whether a GL error the application left pending has been reported (once a device).
     warned_pending_error: std::cell::Cell<bool>,
     /// GL said the context was lost (`GL_CONTEXT_LOST`, which a driver may say only once): every
@@ -80,21 +72,6 @@ impl ContextWatch {
             _ => ContextWatch::Unknown,
         }
     }
-}
-
-/// State calls the renderer's caches made, counted since the device was created: what tests
-/// use to check that a frame sets what its objects share once, not once an object.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct StateCalls {
-    /// `glUseProgram` calls.
-    pub programs_bound: u64,
-    /// `glUniform*` calls.
-    pub uniforms_set: u64,
-    /// Calls that bind a mesh's vertex arrays: its vertex array object, or (without one) its
-    /// buffers and attribute arrays.
-    pub vertex_array_calls: u64,
-    /// Binds of the methods' data textures (lights, grids, lists), each choosing its unit.
-    pub data_textures_bound: u64,
 }
 
 /// GL objects currently alive, as counted by the renderer's own create/delete calls: what
@@ -184,8 +161,8 @@ impl Device {
         } else {
             None
         };
-        let vertex_array = match vertex_arrays {
-            Some(v) => Some(v.create(&gl).map_err(GlError::Create)?),
+        let own_vertex_array = match vertex_arrays {
+            Some(v) => Some((v.create(&gl).map_err(GlError::Create)?, v)),
             None => None,
         };
         let renderbuffer_storage_multisample_ext = if caps.msaa_render_to_texture {
@@ -204,7 +181,7 @@ impl Device {
             None
         };
         let units = unsafe { gl.get_parameter_i32(glow::MAX_COMBINED_TEXTURE_IMAGE_UNITS) };
-        let host = super::host_state::HostFeatures::of(&caps, vertex_array.is_some(), units);
+        let host = super::host_state::HostFeatures::of(&caps, own_vertex_array.is_some(), units);
         Ok(Device {
             gl,
             caps,
@@ -212,13 +189,9 @@ impl Device {
             draw_calls: std::cell::Cell::new(0),
             renderbuffer_storage_multisample_ext,
             host,
-            vertex_array,
-            vertex_arrays,
+            own_vertex_array,
             host_depth: std::cell::Cell::new(0),
-            current_program: std::cell::Cell::new(None),
-            state_calls: Default::default(),
-            current_vertex_array: std::cell::Cell::new(None),
-            absent_values_set: std::cell::Cell::new(false),
+            call: CallState::default(),
             warned_pending_error: std::cell::Cell::new(false),
             lost: std::cell::Cell::new(false),
             context: ContextWatch::of_current(),
@@ -262,11 +235,9 @@ impl Device {
         (depth == 0).then(|| {
             // The application may have bound any program, or set any attribute value, since
             // the last call; entering binds the renderer's own vertex array.
-            self.current_program.set(None);
-            self.absent_values_set.set(false);
-            self.current_vertex_array.set(self.vertex_array);
+            self.call.forget(self.own_vertex_array.map(|(vao, _)| vao));
             self.clear_pending_errors();
-            super::host_state::HostState::enter(&self.gl, &self.host, self.own_vertex_array())
+            super::host_state::HostState::enter(&self.gl, &self.host, self.own_vertex_array)
         })
     }
 
@@ -274,11 +245,14 @@ impl Device {
     pub(crate) fn leave_host(&self, saved: Option<super::host_state::HostState>) {
         self.host_depth.set(self.host_depth.get().saturating_sub(1));
         if let Some(saved) = saved {
-            saved.leave(&self.gl, self.own_vertex_array());
-            self.current_program.set(None);
-            self.current_vertex_array.set(None);
-            self.absent_values_set.set(false);
+            saved.leave(&self.gl, self.own_vertex_array);
+            self.call.forget(None);
         }
+    }
+
+    /// Whether a call of the renderer is under way (what it binds is known only then).
+    fn in_call(&self) -> bool {
+        self.host_depth.get() > 0
     }
 
     /// Drains the GL errors pending when a call starts, saying so once: otherwise the first
@@ -307,7 +281,7 @@ impl Device {
 
     /// Deletes the renderer's vertex array object (with the renderer's other objects).
     pub(crate) fn delete_vertex_array(&mut self) {
-        if let (Some(vao), Some(v)) = (self.vertex_array.take(), self.vertex_arrays) {
+        if let Some((vao, v)) = self.own_vertex_array.take() {
             v.delete(&self.gl, vao);
         }
     }
@@ -329,87 +303,6 @@ impl Device {
     /// `n`: handed to another), for `Renderer::adopt_programs` (with `lab`).
     pub(crate) fn count_handed_programs(&self, n: i64) {
         self.count(|l| l.programs += n);
-    }
-
-    /// The renderer's own vertex array, with how to bind it, where it has one.
-    fn own_vertex_array(&self) -> Option<(glow::VertexArray, VertexArrays)> {
-        self.vertex_array.zip(self.vertex_arrays)
-    }
-
-    /// Whether meshes keep their arrays in vertex array objects of their own: where the
-    /// renderer has one for its calls (an ES 3.x or desktop context, ES 2.0 with
-    /// `GL_OES_vertex_array_object`).
-    pub(crate) fn mesh_vertex_arrays(&self) -> bool {
-        self.vertex_array.is_some()
-    }
-
-    pub(crate) fn create_mesh_vertex_array(&self) -> Result<glow::VertexArray, GlError> {
-        let v = self
-            .vertex_arrays
-            .ok_or_else(|| GlError::Create("no vertex arrays".into()))?;
-        let vao = v.create(&self.gl).map_err(creation_failed)?;
-        self.count(|l| l.vertex_arrays += 1);
-        Ok(vao)
-    }
-
-    /// Deletes a mesh's vertex array; where it was bound, the renderer's own is bound instead
-    /// (GL would bind none, which a desktop core context cannot draw or point arrays with).
-    pub(crate) fn delete_mesh_vertex_array(&self, vao: glow::VertexArray) {
-        let Some(v) = self.vertex_arrays else {
-            return;
-        };
-        v.delete(&self.gl, vao);
-        self.count(|l| l.vertex_arrays -= 1);
-        if self.current_vertex_array.get() == Some(vao) {
-            v.bind(&self.gl, self.vertex_array);
-            self.current_vertex_array.set(self.vertex_array);
-        }
-    }
-
-    /// Binds the renderer's own vertex array where it has one, for arrays that are no mesh's
-    /// (a mesh's vertex array keeps its arrays).
-    pub(crate) fn bind_own_vertex_array(&self) {
-        if let Some((vao, _)) = self.own_vertex_array() {
-            self.bind_vertex_array(vao);
-        }
-    }
-
-    /// Binds `vao`, unless this call already did.
-    pub(crate) fn bind_vertex_array(&self, vao: glow::VertexArray) {
-        if self.current_vertex_array.get() == Some(vao) {
-            return;
-        }
-        if let Some(v) = self.vertex_arrays {
-            v.bind(&self.gl, Some(vao));
-        }
-        self.count_state_call(|c| c.vertex_array_calls += 1);
-        if self.host_depth.get() > 0 {
-            self.current_vertex_array.set(Some(vao));
-        }
-    }
-
-    /// Sets the constant value each [`ABSENT`] attribute reads where a mesh lacks its array,
-    /// unless this call already did (a value is the context's, not a vertex array's).
-    pub(crate) fn set_absent_values(&self) {
-        if self.absent_values_set.get() {
-            return;
-        }
-        for (loc, v) in ABSENT {
-            unsafe { self.gl.vertex_attrib_4_f32(loc, v[0], v[1], v[2], v[3]) };
-        }
-        self.absent_values_set.set(self.host_depth.get() > 0);
-    }
-
-    /// Counts a state call ([`StateCalls`]).
-    pub(crate) fn count_state_call(&self, f: impl FnOnce(&mut StateCalls)) {
-        let mut c = self.state_calls.get();
-        f(&mut c);
-        self.state_calls.set(c);
-    }
-
-    /// State calls made so far (a frame's: the difference across it).
-    pub(crate) fn state_calls(&self) -> StateCalls {
-        self.state_calls.get()
     }
 
     /// Counts one draw call.
@@ -442,6 +335,66 @@ impl Device {
         glow::Renderbuffer,
         renderbuffers
     );
+    /// Whether meshes keep their arrays in vertex array objects of their own: where the
+    /// renderer has one for its calls.
+    pub(crate) fn mesh_vertex_arrays(&self) -> bool {
+        self.own_vertex_array.is_some()
+    }
+
+    pub(crate) fn create_mesh_vertex_array(&self) -> Result<glow::VertexArray, GlError> {
+        let (_, v) = self
+            .own_vertex_array
+            .ok_or_else(|| GlError::Create("no vertex arrays".into()))?;
+        let vao = v.create(&self.gl).map_err(creation_failed)?;
+        self.count(|l| l.vertex_arrays += 1);
+        Ok(vao)
+    }
+
+    /// Deletes a mesh's vertex array; where it was bound, the renderer's own is bound instead
+    /// (GL would bind none, which a desktop core context cannot draw or point arrays with).
+    pub(crate) fn delete_mesh_vertex_array(&self, vao: glow::VertexArray) {
+        let Some((own, v)) = self.own_vertex_array else {
+            return;
+        };
+        v.delete(&self.gl, vao);
+        self.count(|l| l.vertex_arrays -= 1);
+        if self.call.vertex_array() == Some(vao) {
+            self.call.forget_vertex_array();
+            self.bind_vertex_array(own);
+        }
+    }
+
+    /// Binds the renderer's own vertex array where it has one, for arrays that are no mesh's
+    /// (a mesh's vertex array keeps its arrays).
+    pub(crate) fn bind_own_vertex_array(&self) {
+        if let Some((vao, _)) = self.own_vertex_array {
+            self.bind_vertex_array(vao);
+        }
+    }
+
+    /// Binds `vao`, unless this call already did.
+    pub(crate) fn bind_vertex_array(&self, vao: glow::VertexArray) {
+        if let Some((_, arrays)) = self.own_vertex_array {
+            self.call
+                .bind_vertex_array(&self.gl, arrays, vao, self.in_call());
+        }
+    }
+
+    /// Sets the constant values of the attributes a mesh may lack, once a call.
+    pub(crate) fn set_absent_values(&self) {
+        self.call.set_absent_values(&self.gl, self.in_call());
+    }
+
+    /// Counts a state call ([`StateCalls`]).
+    pub(crate) fn count_state_call(&self, f: impl FnOnce(&mut StateCalls)) {
+        self.call.count(f);
+    }
+
+    /// State calls made so far (a frame's: the difference across it).
+    pub(crate) fn state_calls(&self) -> StateCalls {
+        self.call.calls()
+    }
+
     pub(crate) fn create_program(&self) -> Result<glow::Program, GlError> {
         let program = unsafe { self.gl.create_program() }.map_err(creation_failed)?;
         self.count(|l| l.programs += 1);
@@ -449,24 +402,14 @@ impl Device {
     }
 
     pub(crate) fn delete_program(&self, program: glow::Program) {
-        // A program made later may take the freed name: it must be bound, not skipped.
-        if self.current_program.get() == Some(program) {
-            self.current_program.set(None);
-        }
+        self.call.forget_program(program);
         unsafe { self.gl.delete_program(program) };
         self.count(|l| l.programs -= 1);
     }
 
     /// Makes `program` current, unless this call already did.
     pub(crate) fn use_program(&self, program: glow::Program) {
-        if self.current_program.get() == Some(program) {
-            return;
-        }
-        unsafe { self.gl.use_program(Some(program)) };
-        self.count_state_call(|c| c.programs_bound += 1);
-        if self.host_depth.get() > 0 {
-            self.current_program.set(Some(program));
-        }
+        self.call.use_program(&self.gl, program, self.in_call());
     }
 
     /// The probed capabilities.

@@ -14,6 +14,7 @@
 pub(crate) mod absent_attributes;
 pub mod alloc;
 pub(crate) mod bound_size;
+pub(crate) mod call_state;
 pub mod caps;
 pub mod context;
 pub mod device;
