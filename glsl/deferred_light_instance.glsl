@@ -1,12 +1,12 @@
 // Deferred's light pass, vertex side: one instance a light, its values read at attribute
-// locations 5 to 8 (LIGHT_LOCATION in src/methods/deferred/light_instances.rs), in the same
+// locations 6 to 9 (LIGHT_LOCATION in src/methods/deferred/light_instances.rs), in the same
 // layout as the varyings they are passed on as.
 #include "deferred_light_varyings.glsl"
 
-layout(location = 5) in HIGHP vec4 a_light0;
-layout(location = 6) in vec4 a_light1;
-layout(location = 7) in vec4 a_light2;
-layout(location = 8) in vec4 a_proxy;
+layout(location = 6) in HIGHP vec4 a_light0;
+layout(location = 7) in vec4 a_light1;
+layout(location = 8) in vec4 a_light2;
+layout(location = 9) in vec4 a_proxy;
 
 void passLight() {
     v_light0 = a_light0;

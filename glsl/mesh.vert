@@ -11,6 +11,12 @@
 #ifndef HAS_TEXTURE_TRANSFORM
 #define HAS_TEXTURE_TRANSFORM 0
 #endif
+#ifndef HAS_SECOND_UVS
+#define HAS_SECOND_UVS 0
+#endif
+#if HAS_SECOND_UVS && !HAS_TEXTURE_TRANSFORM
+#error "the second coordinate set is read through the per-texture coordinates"
+#endif
 ATTRIBUTE vec3 a_position;
 ATTRIBUTE vec3 a_normal;
 ATTRIBUTE vec2 a_uv;
@@ -48,6 +54,18 @@ uniform mat3 u_metallicRoughnessUvTransform;
 VARYING vec4 v_uvAlbedoNormal;
 VARYING vec4 v_uvEmissiveOcclusion;
 VARYING vec2 v_uvMetallicRoughness;
+#if HAS_SECOND_UVS
+// glTF TEXCOORD_1, and the set (0 or 1) each texture reads.
+ATTRIBUTE vec2 a_uv1;
+uniform float u_albedoUvSet;
+uniform float u_normalUvSet;
+uniform float u_emissiveUvSet;
+uniform float u_occlusionUvSet;
+uniform float u_metallicRoughnessUvSet;
+#define SET_UV(set) vec3((set) > 0.5 ? a_uv1 : a_uv, 1.0)
+#else
+#define SET_UV(set) vec3(a_uv, 1.0)
+#endif
 #endif
 
 void main() {
@@ -61,11 +79,12 @@ void main() {
     v_normal = largest > 0.0 ? normalize(n / largest) : vec3(0.0);
     v_uv = a_uv;
 #if HAS_TEXTURE_TRANSFORM
-    vec3 uv1 = vec3(a_uv, 1.0);
-    v_uvAlbedoNormal = vec4((u_albedoUvTransform * uv1).xy, (u_normalUvTransform * uv1).xy);
-    v_uvEmissiveOcclusion =
-        vec4((u_emissiveUvTransform * uv1).xy, (u_occlusionUvTransform * uv1).xy);
-    v_uvMetallicRoughness = (u_metallicRoughnessUvTransform * uv1).xy;
+    v_uvAlbedoNormal = vec4((u_albedoUvTransform * SET_UV(u_albedoUvSet)).xy,
+                            (u_normalUvTransform * SET_UV(u_normalUvSet)).xy);
+    v_uvEmissiveOcclusion = vec4((u_emissiveUvTransform * SET_UV(u_emissiveUvSet)).xy,
+                                 (u_occlusionUvTransform * SET_UV(u_occlusionUvSet)).xy);
+    v_uvMetallicRoughness =
+        (u_metallicRoughnessUvTransform * SET_UV(u_metallicRoughnessUvSet)).xy;
 #endif
 #if HAS_VERTEX_COLOR
     v_color = a_color;

@@ -13,9 +13,9 @@ use glow::HasContext;
 use super::absent_attributes::ABSENT;
 use super::ext_fns::{AttribPointerFns, VertexAttribDivisor};
 
-/// Locations 0 to 4: where `program::ATTRIBUTES` binds the renderer's attributes (its tests
+/// Locations 0 to 5: where `program::ATTRIBUTES` binds the renderer's attributes (its tests
 /// check that they all fall below this), the precision probe's 0 among them.
-pub(crate) const LOCATIONS: usize = 5;
+pub(crate) const LOCATIONS: usize = 6;
 
 /// One location's array (ES 2.0).
 #[derive(Clone, Copy)]

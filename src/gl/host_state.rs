@@ -3,7 +3,7 @@
 //! part it depends on to what it assumes, and gives everything back on the way out, so the
 //! game's vertex array, buffers, program, textures, samplers, framebuffers, viewport, blend,
 //! depth, culling and pixel-store settings are as it left them (the way Dear ImGui's GL
-//! back-end embeds). The attributes' constant values the renderer sets (locations 3 and 4), and
+//! back-end embeds). The attributes' constant values the renderer sets (locations 3 to 5), and
 //! on ES 2.0 (no vertex array objects) the arrays at its locations, are saved and given back
 //! one by one (`host_attributes.rs`).
 #![allow(unsafe_code)]

@@ -16,13 +16,16 @@ use crate::scene::Mesh;
 pub const VERTEX_FLOATS: usize = 8;
 
 /// Which optional attributes a mesh's vertices carry after the [`VERTEX_FLOATS`]: each is
-/// uploaded only when the mesh has it (colour: 4 floats, then tangent: 4 floats).
+/// uploaded only when the mesh has it (colour: 4 floats, then tangent: 4 floats, then the
+/// second texture coordinates: 2 floats).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct VertexLayout {
     /// `a_color` (location 3).
     pub colors: bool,
     /// `a_tangent` (location 4).
     pub tangents: bool,
+    /// `a_uv1` (location 5).
+    pub second_uvs: bool,
 }
 
 impl VertexLayout {
@@ -31,27 +34,45 @@ impl VertexLayout {
         VertexLayout {
             colors: !mesh.colors.is_empty(),
             tangents: !mesh.tangents.is_empty(),
+            second_uvs: !mesh.second_uvs.is_empty(),
         }
     }
 
     /// Floats per vertex.
     pub fn floats(self) -> usize {
-        VERTEX_FLOATS + 4 * usize::from(self.colors) + 4 * usize::from(self.tangents)
+        VERTEX_FLOATS
+            + self
+                .optional()
+                .map(|(_, size)| size as usize)
+                .sum::<usize>()
+    }
+
+    /// Whether every optional attribute is there (no constant stands in for one).
+    pub fn complete(self) -> bool {
+        self.colors && self.tangents && self.second_uvs
+    }
+
+    /// (location, components) of the optional attributes present, in vertex order.
+    fn optional(self) -> impl Iterator<Item = (u32, i32)> {
+        [
+            self.colors.then_some((3, 4)),
+            self.tangents.then_some((4, 4)),
+            self.second_uvs.then_some((5, 2)),
+        ]
+        .into_iter()
+        .flatten()
     }
 
     /// (location, components, byte offset) of every attribute present.
     fn attributes(self) -> impl Iterator<Item = (u32, i32, i32)> {
-        let colour_at = (VERTEX_FLOATS * 4) as i32;
-        let tangent_at = colour_at + if self.colors { 16 } else { 0 };
-        [
-            Some((0, 3, 0)),
-            Some((1, 3, 12)),
-            Some((2, 2, 24)),
-            self.colors.then_some((3, 4, colour_at)),
-            self.tangents.then_some((4, 4, tangent_at)),
-        ]
-        .into_iter()
-        .flatten()
+        let mut at = (VERTEX_FLOATS * 4) as i32;
+        let optional = self.optional().map(move |(loc, size)| {
+            at += 4 * size;
+            (loc, size, at - 4 * size)
+        });
+        [(0, 3, 0), (1, 3, 12), (2, 2, 24)]
+            .into_iter()
+            .chain(optional)
     }
 }
 
@@ -110,6 +131,10 @@ pub fn split_u16_about(mesh: &Mesh, origin: DVec3) -> Vec<Chunk> {
                 }
                 if layout.tangents {
                     cur.vertices.extend_from_slice(&mesh.tangents[v].to_array());
+                }
+                if layout.second_uvs {
+                    cur.vertices
+                        .extend_from_slice(&mesh.second_uvs[v].to_array());
                 }
                 (cur.vertices.len() / floats - 1) as u16
             });
@@ -192,7 +217,7 @@ impl GpuChunk {
             let calls = 2 + ABSENT.len() + 2 * self.layout.attributes().count();
             dev.count_state_call(|c| c.vertex_array_calls += calls as u64);
         }
-        if !(self.layout.colors && self.layout.tangents) {
+        if !self.layout.complete() {
             dev.set_absent_values();
         }
         BoundMesh {

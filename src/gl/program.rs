@@ -27,6 +27,7 @@ pub const ATTRIBUTES: &[(u32, &str)] = &[
     (2, "a_uv"),
     (3, "a_color"),
     (4, "a_tangent"),
+    (5, "a_uv1"),
 ];
 
 /// A linked program and the uniform set resolved for it.

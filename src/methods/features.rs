@@ -95,6 +95,10 @@ impl ShaderFeatures {
     /// With [`Self::VERTEX_COLOR`]: `COLOR_0`'s alpha multiplies the opacity (glTF `BLEND`) or
     /// takes part in the cut (glTF `MASK`).
     pub const VERTEX_ALPHA: u64 = 1 << 28;
+    /// Some texture the material samples reads the mesh's second coordinate set (glTF
+    /// `TEXCOORD_1`); implies [`Self::TEXTURE_TRANSFORM`], whose per-texture coordinates
+    /// carry each texture's set.
+    pub const SECOND_UVS: u64 = 1 << 29;
 
     /// The flags a material's (and its mesh's) surface inputs set, as opposed to the scene's,
     /// the frame's and the device's.
@@ -107,10 +111,11 @@ impl ShaderFeatures {
         | Self::TEXTURE_TRANSFORM
         | Self::ALPHA_MASK
         | Self::TEXTURE_ALPHA
-        | Self::VERTEX_ALPHA;
+        | Self::VERTEX_ALPHA
+        | Self::SECOND_UVS;
 
     /// Every flag with its name.
-    pub const NAMED: [(u64, &'static str); 29] = [
+    pub const NAMED: [(u64, &'static str); 30] = [
         (Self::TEXTURE, "texture"),
         (Self::SPOT, "spot"),
         (Self::SPECULAR, "specular"),
@@ -140,6 +145,7 @@ impl ShaderFeatures {
         (Self::SRGB_TEXTURES, "srgb_textures"),
         (Self::TEXTURE_ALPHA, "texture_alpha"),
         (Self::VERTEX_ALPHA, "vertex_alpha"),
+        (Self::SECOND_UVS, "second_uvs"),
     ];
 
     /// Names of the set flags.
@@ -225,6 +231,7 @@ impl ShaderFeatures {
             ("SRGB_TEXTURES".into(), flag(Self::SRGB_TEXTURES)),
             ("HAS_TEXTURE_ALPHA".into(), flag(Self::TEXTURE_ALPHA)),
             ("HAS_VERTEX_ALPHA".into(), flag(Self::VERTEX_ALPHA)),
+            ("HAS_SECOND_UVS".into(), flag(Self::SECOND_UVS)),
             (
                 "TONEMAP".into(),
                 if self.has(Self::TONEMAP_REINHARD) {

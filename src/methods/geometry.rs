@@ -208,9 +208,7 @@ pub(crate) fn shade_object<P: GeometryProgram>(
     let object = &ctx.scene.objects[index];
     let material = &ctx.scene.materials[object.material];
     let units = dev.caps().max_texture_image_units;
-    // A mesh without texture coordinates samples no texture (every pixel would read the
-    // corner texel): its material's flat colours draw it, as the loaders warn.
-    let mapped = !object.mesh.uvs.is_empty();
+    let mapped = super::maps::base_textured(material, &object.mesh);
     let own_texture = ctx.gpu_scene.texture_for(material).filter(|_| mapped);
     let own = super::surface_variants::own(material, &object.mesh, own_texture.is_some(), units);
     let features = if ctx.features.counting() {

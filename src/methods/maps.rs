@@ -37,13 +37,21 @@ static WARNED: [AtomicBool; 4] = [
     AtomicBool::new(false),
 ];
 
+/// Whether `material`'s base colour texture is sampled on `mesh`: the mesh has the
+/// coordinate set it reads. Without, every pixel would read one texel: the material's flat
+/// colours draw it, as the loaders warn.
+pub(crate) fn base_textured(material: &Material, mesh: &Mesh) -> bool {
+    material.diffuse_texture.is_some() && material.maps.base_transform.coordinates(mesh).is_some()
+}
+
 /// The surface-input features of `material` on `mesh`, on a context with `units` fragment
-/// texture units: each only where the material (or mesh) has it.
+/// texture units: each only where the material (or mesh) has it. A map is sampled only where
+/// the mesh has the coordinate set it reads.
 pub fn features(material: &Material, mesh: &Mesh, units: i32) -> F {
     let maps = &material.maps;
     let emits = maps.emits();
-    // Only a mesh with texture coordinates samples a map.
-    let mapped = !mesh.uvs.is_empty();
+    let sampled =
+        |map: Option<&MapTexture>| map.is_some_and(|m| m.transform.coordinates(mesh).is_some());
     let mut bits = [
         (F::VERTEX_COLOR, !mesh.colors.is_empty()),
         (
@@ -52,12 +60,12 @@ pub fn features(material: &Material, mesh: &Mesh, units: i32) -> F {
         ),
         (
             F::NORMAL_MAP,
-            mapped && maps.sampled_normal().is_some() && !mesh.tangents.is_empty(),
+            sampled(maps.sampled_normal()) && !mesh.tangents.is_empty(),
         ),
         (F::EMISSIVE, emits),
-        (F::EMISSIVE_MAP, mapped && maps.sampled_emissive().is_some()),
-        (F::OCCLUSION, mapped && maps.sampled_occlusion().is_some()),
-        (F::MR_TEXTURE, mapped && maps.metallic_roughness.is_some()),
+        (F::EMISSIVE_MAP, sampled(maps.sampled_emissive())),
+        (F::OCCLUSION, sampled(maps.sampled_occlusion())),
+        (F::MR_TEXTURE, sampled(maps.metallic_roughness.as_ref())),
     ]
     .into_iter()
     .fold(F::default(), |f, (bit, on)| f.with(bit, on));
@@ -73,16 +81,22 @@ pub fn features(material: &Material, mesh: &Mesh, units: i32) -> F {
             }
         }
     }
-    let transformed = (material.diffuse_texture.is_some() && !maps.base_transform.is_identity())
-        || [
-            (F::NORMAL_MAP, &maps.normal),
-            (F::EMISSIVE_MAP, &maps.emissive_texture),
-            (F::OCCLUSION, &maps.occlusion),
-            (F::MR_TEXTURE, &maps.metallic_roughness),
-        ]
+    let base = base_textured(material, mesh).then_some(&maps.base_transform);
+    let slots = [
+        (F::NORMAL_MAP, &maps.normal),
+        (F::EMISSIVE_MAP, &maps.emissive_texture),
+        (F::OCCLUSION, &maps.occlusion),
+        (F::MR_TEXTURE, &maps.metallic_roughness),
+    ];
+    let mut read = slots
         .iter()
-        .any(|(bit, t)| bits.has(*bit) && t.as_ref().is_some_and(|t| !t.transform.is_identity()));
+        .filter(|(bit, _)| bits.has(*bit))
+        .filter_map(|(_, t)| t.as_ref().map(|t| &t.transform))
+        .chain(base);
+    let second = read.clone().any(|t| t.uv_set == 1);
+    let transformed = read.any(|t| !t.is_identity());
     bits.with(F::TEXTURE_TRANSFORM, transformed)
+        .with(F::SECOND_UVS, second)
 }
 
 /// Whether the map of feature `bit` has its texture unit on a context with `units`.
@@ -90,12 +104,14 @@ pub(crate) fn unit_fits(bit: u64, units: i32) -> bool {
     (SLOTS.iter()).any(|(b, unit, _)| *b == bit && (*unit as i32) < units)
 }
 
-/// One map as [`MapUniforms::set`] binds it: feature bit, texture, sampler, UV transform.
+/// One map as [`MapUniforms::set`] binds it: feature bit, texture, sampler, UV transform and
+/// coordinate set.
 type MapSlot<'a> = (
     u64,
     &'a Option<MapTexture>,
     &'a Uniform<Sampler>,
     &'a Uniform<Mat3>,
+    &'a Uniform<f32>,
 );
 
 /// The uniforms of `surface_maps.glsl`.
@@ -105,6 +121,12 @@ pub struct MapUniforms {
     emissive_uv: Uniform<Mat3>,
     occlusion_uv: Uniform<Mat3>,
     mr_uv: Uniform<Mat3>,
+    /// Each texture's coordinate set (`HAS_SECOND_UVS`).
+    albedo_set: Uniform<f32>,
+    normal_set: Uniform<f32>,
+    emissive_set: Uniform<f32>,
+    occlusion_set: Uniform<f32>,
+    mr_set: Uniform<f32>,
     normal_tex: Uniform<Sampler>,
     normal_scale: Uniform<f32>,
     emissive: Uniform<Vec3>,
@@ -127,6 +149,11 @@ impl MapUniforms {
             emissive_uv: r.optional("u_emissiveUvTransform"),
             occlusion_uv: r.optional("u_occlusionUvTransform"),
             mr_uv: r.optional("u_metallicRoughnessUvTransform"),
+            albedo_set: r.optional("u_albedoUvSet"),
+            normal_set: r.optional("u_normalUvSet"),
+            emissive_set: r.optional("u_emissiveUvSet"),
+            occlusion_set: r.optional("u_occlusionUvSet"),
+            mr_set: r.optional("u_metallicRoughnessUvSet"),
             normal_tex: r.required_when(on(F::NORMAL_MAP), "u_normalTex"),
             normal_scale: r.required_when(on(F::NORMAL_MAP), "u_normalScale"),
             emissive: r.required_when(on(F::EMISSIVE), "u_emissive"),
@@ -140,7 +167,7 @@ impl MapUniforms {
     /// Binds the maps `features` selected and sets their uniforms. Where `features` has an
     /// input the object's `own` features lack (a shared variant:
     /// [`super::surface_variants::shared`]), the input's neutral value stands in: the white
-    /// texture, no emission, an identity transform.
+    /// texture, no emission, an identity transform on the first coordinate set.
     pub(crate) fn set(
         &self,
         dev: &Device,
@@ -151,9 +178,14 @@ impl MapUniforms {
     ) {
         let maps = &material.maps;
         let transformed = own.has(F::TEXTURE_TRANSFORM);
+        let second = features.has(F::SECOND_UVS);
         if features.has(F::TEXTURE_TRANSFORM) {
             let albedo = transformed.then(|| uv_matrix(&maps.base_transform));
             self.albedo_uv.set(dev, albedo.unwrap_or(Mat3::IDENTITY));
+        }
+        if second {
+            let base = own.has(F::TEXTURE).then_some(maps.base_transform.uv_set);
+            self.albedo_set.set(dev, base.unwrap_or(0) as f32);
         }
         let slots: [MapSlot<'_>; 4] = [
             (
@@ -161,27 +193,31 @@ impl MapUniforms {
                 &maps.normal,
                 &self.normal_tex,
                 &self.normal_uv,
+                &self.normal_set,
             ),
             (
                 F::EMISSIVE_MAP,
                 &maps.emissive_texture,
                 &self.emissive_tex,
                 &self.emissive_uv,
+                &self.emissive_set,
             ),
             (
                 F::OCCLUSION,
                 &maps.occlusion,
                 &self.occlusion_tex,
                 &self.occlusion_uv,
+                &self.occlusion_set,
             ),
             (
                 F::MR_TEXTURE,
                 &maps.metallic_roughness,
                 &self.mr_tex,
                 &self.mr_uv,
+                &self.mr_set,
             ),
         ];
-        for ((bit, map, sampler, uv), (_, unit, _)) in slots.into_iter().zip(SLOTS) {
+        for ((bit, map, sampler, uv, set), (_, unit, _)) in slots.into_iter().zip(SLOTS) {
             if !features.has(bit) {
                 continue;
             }
@@ -204,6 +240,9 @@ impl MapUniforms {
                     dev,
                     transform.map_or(Mat3::IDENTITY, |m| uv_matrix(&m.transform)),
                 );
+            }
+            if second {
+                set.set(dev, own_map.map_or(0, |m| m.transform.uv_set) as f32);
             }
             sampler.set(dev, unit);
         }

@@ -65,7 +65,7 @@ pub(crate) fn shared(own: F, units: i32) -> F {
 #[derive(Default)]
 pub(crate) struct VariantCount {
     /// For each material, the first object of each attribute class.
-    firsts: Vec<[u32; 8]>,
+    firsts: Vec<[u32; 16]>,
     /// The distinct feature sets found so far.
     seen: Vec<u64>,
 }
@@ -77,7 +77,7 @@ impl VariantCount {
     /// per object is a look-up.
     pub(crate) fn more_than(&mut self, scene: &Scene, units: i32, limit: usize) -> bool {
         self.firsts.clear();
-        self.firsts.resize(scene.materials.len(), [u32::MAX; 8]);
+        self.firsts.resize(scene.materials.len(), [u32::MAX; 16]);
         let mut pairs = 0usize;
         for (i, object) in scene.objects.iter().enumerate() {
             let Some(slot) = self.firsts.get_mut(object.material) else {
@@ -96,7 +96,7 @@ impl VariantCount {
         for (material, slot) in scene.materials.iter().zip(&self.firsts) {
             for &first in slot.iter().filter(|&&i| i != u32::MAX) {
                 let mesh = &scene.objects[first as usize].mesh;
-                let textured = material.diffuse_texture.is_some() && !mesh.uvs.is_empty();
+                let textured = maps::base_textured(material, mesh);
                 let bits = own(material, mesh, textured, units).0;
                 if !self.seen.contains(&bits) {
                     if self.seen.len() == limit {
@@ -110,11 +110,12 @@ impl VariantCount {
     }
 }
 
-/// Which of the attributes [`maps::features`] looks at `mesh` has, as three bits.
+/// Which of the attributes [`maps::features`] looks at `mesh` has, as four bits.
 fn attribute_class(mesh: &Mesh) -> usize {
     usize::from(!mesh.colors.is_empty())
         | usize::from(!mesh.uvs.is_empty()) << 1
         | usize::from(!mesh.tangents.is_empty()) << 2
+        | usize::from(!mesh.second_uvs.is_empty()) << 3
 }
 
 #[cfg(test)]

@@ -8,7 +8,7 @@ use super::{Material, Mesh};
 
 /// One corner as bits: position, normal, texture coordinate, colour, tangent (zero without
 /// them).
-type Corner = [u32; 16];
+type Corner = [u32; 18];
 
 /// `mesh` without its duplicate triangles when `material` is opaque, and a warning giving
 /// their count when there were any (`what` names the object).
@@ -83,10 +83,12 @@ fn canonical(mesh: &Mesh, triangle: u32, any_winding: bool) -> [Corner; 3] {
         let p = mesh.positions[v];
         let n = mesh.normals.get(v).copied().unwrap_or_default();
         let uv = mesh.uvs.get(v).copied().unwrap_or_default();
+        let uv1 = mesh.second_uvs.get(v).copied().unwrap_or_default();
         let c = mesh.colors.get(v).copied().unwrap_or_default();
         let t = mesh.tangents.get(v).copied().unwrap_or_default();
         [
-            p.x, p.y, p.z, n.x, n.y, n.z, uv.x, uv.y, c.x, c.y, c.z, c.w, t.x, t.y, t.z, t.w,
+            p.x, p.y, p.z, n.x, n.y, n.z, uv.x, uv.y, uv1.x, uv1.y, c.x, c.y, c.z, c.w, t.x, t.y,
+            t.z, t.w,
         ]
         .map(f32::to_bits)
     };

@@ -191,6 +191,12 @@ impl Material {
             }
         }
         check_color_factor(self.maps.emissive, field, "emissive")?;
+        if let Some((t, set)) = self.maps.unknown_uv_set() {
+            return Err(SceneError::invalid(
+                format!("{field}.maps.{t}.uv_set"),
+                format!("must be 0 or 1 (a mesh has at most two sets), got {set}"),
+            ));
+        }
         if let Some(t) = self.maps.unusable_transform() {
             return Err(SceneError::invalid(
                 format!("{field}.maps.{t}"),
@@ -273,7 +279,7 @@ mod tests {
     /// drew black), are refused in a material built in code, naming the field.
     #[test]
     fn map_strengths_out_of_range_and_empty_images_are_refused_naming_the_field() {
-        use crate::scene::surface_maps::MapTexture;
+        use crate::scene::surface_maps::{MapTexture, TextureTransform};
         let ok = Material::metallic_roughness("m", Vec3::ONE, 0.0, 0.5);
         let texture = |w, h| Arc::new(Texture::new("t", image::RgbaImage::new(w, h)));
         let refused = |change: &dyn Fn(&mut Material), said: &str| {
@@ -310,10 +316,26 @@ mod tests {
             &|m| m.maps.occlusion = Some(empty.clone()),
             "materials[2].maps.occlusion",
         );
+        let third_set = MapTexture {
+            texture: texture(1, 1),
+            transform: TextureTransform {
+                uv_set: 2,
+                ..Default::default()
+            },
+        };
+        refused(
+            &|m| m.maps.occlusion = Some(third_set.clone()),
+            "materials[2].maps.occlusion.transform.uv_set",
+        );
+        refused(
+            &|m| m.maps.base_transform.uv_set = u32::MAX,
+            "materials[2].maps.base_transform.uv_set",
+        );
         let mut edges = ok.clone();
         edges.maps.normal_scale = -MAX_NORMAL_SCALE;
         edges.maps.occlusion_strength = 0.0;
         edges.diffuse_texture = Some(texture(1, 1));
+        edges.maps.base_transform.uv_set = 1;
         assert!(edges.validate("materials[2]").is_ok());
     }
 }

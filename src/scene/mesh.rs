@@ -37,6 +37,10 @@ pub struct Mesh {
     pub normals: Vec<Vec3>,
     /// Texture coordinates, one per position, or empty.
     pub uvs: Vec<Vec2>,
+    /// A second set of texture coordinates (glTF `TEXCOORD_1`: a baked occlusion or light
+    /// map's own unwrap), one per position, or empty. Read by the textures whose
+    /// [`TextureTransform::uv_set`](super::surface_maps::TextureTransform::uv_set) is 1.
+    pub second_uvs: Vec<Vec2>,
     /// Triangle list, three indices per triangle. Its front face, the side `normals` point to,
     /// is counter-clockwise: [`Mesh::new`] turns a triangle listed the other way round; a mesh
     /// built or edited through these fields is drawn as listed.
@@ -95,7 +99,7 @@ impl Mesh {
                 format!("{} texture coordinates for {n} vertices", uvs.len()),
             ));
         }
-        check_uvs(&uvs, "mesh")?;
+        check_uvs(&uvs, "mesh.uvs")?;
         if !normals.is_empty() && normals.len() != n {
             return Err(SceneError::invalid(
                 "mesh.normals",
@@ -117,6 +121,7 @@ impl Mesh {
             positions,
             normals,
             uvs,
+            second_uvs: Vec::new(),
             indices,
             colors: Vec::new(),
             tangents: Vec::new(),
@@ -145,6 +150,15 @@ impl Mesh {
         Ok(self)
     }
 
+    /// The mesh with a second set of texture coordinates (one per position, finite, within
+    /// ±`MAX_TEXCOORD`), which textures of `uv_set` 1 read.
+    pub fn with_second_uvs(mut self, uvs: Vec<Vec2>) -> Result<Mesh, SceneError> {
+        check_per_vertex("mesh.second_uvs", uvs.len(), self.positions.len())?;
+        check_uvs(&uvs, "mesh.second_uvs")?;
+        self.second_uvs = uvs;
+        Ok(self)
+    }
+
     /// The mesh with tangents (one per position). Each is made orthogonal to its vertex's
     /// normal and unit, `w` made ±1; one with no usable direction is replaced by the
     /// generated one (MikkTSpace, see `docs/gltf.md`).
@@ -160,14 +174,23 @@ impl Mesh {
     /// per corner: a vertex whose corners get different tangents (a mirrored UV seam through
     /// shared vertices) is split, one copy per tangent, so adds at most one vertex per index.
     /// A mesh that fails [`Mesh::validate`] is that error.
-    pub fn with_generated_tangents(mut self) -> Result<(Mesh, usize), SceneError> {
+    pub fn with_generated_tangents(self) -> Result<(Mesh, usize), SceneError> {
+        self.with_tangents_along(0)
+    }
+
+    /// [`Mesh::with_generated_tangents`] along the coordinate set `uv_set` (0: `uvs`, 1:
+    /// `second_uvs`): the one its normal map reads, as glTF asks. Nothing is generated where
+    /// the mesh lacks that set.
+    pub fn with_tangents_along(mut self, uv_set: u32) -> Result<(Mesh, usize), SceneError> {
         self.validate()?;
-        if !self.tangents.is_empty() || self.uvs.is_empty() {
+        if !self.tangents.is_empty() || self.coordinate_set(uv_set).is_none() {
             return Ok((self, 0));
         }
-        let corners = super::tangents::generate_corners(self.geometry());
+        let uvs = self.coordinate_set(uv_set).unwrap_or_default();
+        let geometry = self.geometry_along(uvs);
+        let corners = super::tangents::generate_corners(geometry);
         // Vertices no triangle uses keep the fallback tangent.
-        let mut tangents = super::tangents::per_vertex_fallback(self.geometry());
+        let mut tangents = super::tangents::per_vertex_fallback(geometry);
         let mut taken = vec![false; tangents.len()];
         let mut copies: HashMap<(u32, [u32; 4]), u32> = HashMap::new();
         for (k, &t) in corners.tangents.iter().enumerate() {
@@ -179,7 +202,11 @@ impl Mesh {
                 let copy = *copies.entry(key).or_insert_with(|| {
                     self.positions.push(self.positions[v]);
                     self.normals.push(self.normals[v]);
-                    self.uvs.push(self.uvs[v]);
+                    for set in [&mut self.uvs, &mut self.second_uvs] {
+                        if !set.is_empty() {
+                            set.push(set[v]);
+                        }
+                    }
                     if !self.colors.is_empty() {
                         self.colors.push(self.colors[v]);
                     }
@@ -193,11 +220,25 @@ impl Mesh {
         Ok((self, corners.fallbacks))
     }
 
+    /// Texture coordinate set `set` (0: `uvs`, 1: `second_uvs`), where the mesh has it.
+    pub(crate) fn coordinate_set(&self, set: u32) -> Option<&[Vec2]> {
+        let coordinates = match set {
+            0 => &self.uvs,
+            1 => &self.second_uvs,
+            _ => return None,
+        };
+        (!coordinates.is_empty()).then_some(coordinates.as_slice())
+    }
+
     fn geometry(&self) -> super::tangents::Geometry<'_> {
+        self.geometry_along(&self.uvs)
+    }
+
+    fn geometry_along<'m>(&'m self, uvs: &'m [Vec2]) -> super::tangents::Geometry<'m> {
         super::tangents::Geometry {
             positions: &self.positions,
             normals: &self.normals,
-            uvs: &self.uvs,
+            uvs,
             indices: &self.indices,
         }
     }
@@ -278,6 +319,7 @@ impl Mesh {
         check_per_vertex(&at("normals"), self.normals.len(), n)?;
         let optional = [
             ("uvs", self.uvs.len()),
+            ("second_uvs", self.second_uvs.len()),
             ("colors", self.colors.len()),
             ("tangents", self.tangents.len()),
         ];
@@ -287,7 +329,8 @@ impl Mesh {
             }
         }
         check_positions(&self.positions, field)?;
-        check_uvs(&self.uvs, field)?;
+        check_uvs(&self.uvs, &at("uvs"))?;
+        check_uvs(&self.second_uvs, &at("second_uvs"))?;
         // A zero normal normalises to NaN in the shader (`Mesh::new` puts the face's there).
         let unusable = |v: Vec3| !(v.is_finite() && v.length_squared() > 0.0);
         if let Some(i) = self.normals.iter().position(|&v| unusable(v)) {
@@ -393,13 +436,21 @@ mod tests {
         .unwrap();
         assert!(good.check_shape("objects[1].mesh").is_ok());
         type Change = dyn Fn(&mut Mesh);
-        let cases: [(&Change, &str); 6] = [
+        let cases: [(&Change, &str); 8] = [
             (
                 &|m| m.positions[1].x = f32::NAN,
                 "objects[1].mesh.positions[1]",
             ),
             (&|m| m.positions[2].y = 3e38, "objects[1].mesh.positions[2]"),
             (&|m| m.uvs[0] = Vec2::splat(3e38), "objects[1].mesh.uvs[0]"),
+            (
+                &|m| m.second_uvs = vec![Vec2::ZERO, Vec2::NAN, Vec2::ZERO],
+                "objects[1].mesh.second_uvs[1]",
+            ),
+            (
+                &|m| m.second_uvs = vec![Vec2::ZERO; 2],
+                "objects[1].mesh.second_uvs",
+            ),
             (&|m| m.normals[2] = Vec3::ZERO, "objects[1].mesh.normals[2]"),
             (
                 &|m| m.tangents = vec![Vec4::NAN; 3],
@@ -420,6 +471,29 @@ mod tests {
                 assert!(!err.contains(value), "{field}: {err}");
             }
         }
+    }
+
+    #[test]
+    fn a_second_set_is_one_finite_coordinate_a_vertex_and_tangents_can_follow_it() {
+        let tri = || {
+            let p = vec![Vec3::ZERO, Vec3::X, Vec3::Y];
+            Mesh::new(p, vec![], vec![Vec2::ZERO, Vec2::X, Vec2::Y], vec![0, 1, 2]).unwrap()
+        };
+        let short = tri().with_second_uvs(vec![Vec2::ZERO; 2]).unwrap_err();
+        assert!(short.to_string().contains("mesh.second_uvs"), "{short}");
+        let far = vec![Vec2::ZERO, Vec2::splat(2e9), Vec2::ZERO];
+        let far = tri().with_second_uvs(far).unwrap_err();
+        assert!(far.to_string().contains("mesh.second_uvs[1]"), "{far}");
+        // The second set's u runs along +y (the first's along +x): tangents follow the set
+        // asked for, and none are made along a set the mesh lacks.
+        let second = vec![Vec2::ZERO, Vec2::Y, Vec2::X];
+        let mesh = tri().with_second_uvs(second).unwrap();
+        let (along_first, _) = mesh.clone().with_tangents_along(0).unwrap();
+        let (along_second, _) = mesh.with_tangents_along(1).unwrap();
+        assert!((along_first.tangents[0].truncate() - Vec3::X).length() < 1e-5);
+        assert!((along_second.tangents[0].truncate() - Vec3::Y).length() < 1e-5);
+        let (none, _) = tri().with_tangents_along(1).unwrap();
+        assert!(none.tangents.is_empty());
     }
 
     #[test]

@@ -39,14 +39,14 @@ pub(super) fn check_positions(positions: &[Vec3], field: &str) -> Result<(), Sce
     Ok(())
 }
 
-/// Texture coordinates finite and within [`MAX_TEXCOORD`]; errors name `{field}.uvs[i]`.
+/// Texture coordinates finite and within [`MAX_TEXCOORD`]; errors name `{field}[i]`.
 pub(super) fn check_uvs(uvs: &[Vec2], field: &str) -> Result<(), SceneError> {
     if let Some(i) = uvs
         .iter()
         .position(|t| !(t.is_finite() && t.abs().max_element() <= MAX_TEXCOORD))
     {
         return Err(SceneError::invalid(
-            format!("{field}.uvs[{i}]"),
+            format!("{field}[{i}]"),
             format!("must be finite and within ±{MAX_TEXCOORD:e}"),
         ));
     }

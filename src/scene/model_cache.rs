@@ -468,6 +468,7 @@ fn same_mesh(a: &Mesh, b: &Mesh) -> bool {
     a.positions == b.positions
         && a.normals == b.normals
         && a.uvs == b.uvs
+        && a.second_uvs == b.second_uvs
         && a.indices == b.indices
         && a.colors == b.colors
         && a.tangents == b.tangents

@@ -11,7 +11,8 @@ use glam::{DVec2, DVec3, Vec2, Vec3};
 
 use super::texture::Texture;
 
-/// Where a texture is sampled: `KHR_texture_transform`'s `uv' = T·R·S·uv` (offset, rotation
+/// Where a texture is sampled: which of the mesh's texture coordinate sets it reads (glTF's
+/// `texCoord`), through `KHR_texture_transform`'s `uv' = T·R·S·uv` (offset, rotation
 /// counter-clockwise in radians, scale), in the glTF convention (`u' = c·sx·u + s·sy·v + ox`,
 /// `v' = −s·sx·u + c·sy·v + oy`, the one its example's "lower left quadrant" needs).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -22,6 +23,10 @@ pub struct TextureTransform {
     pub rotation: f32,
     /// Scale of the UV coordinates.
     pub scale: Vec2,
+    /// The coordinate set read: 0 ([`Mesh::uvs`](super::Mesh::uvs), glTF `TEXCOORD_0`) or 1
+    /// ([`Mesh::second_uvs`](super::Mesh::second_uvs), `TEXCOORD_1`). A mesh without that
+    /// set does not sample the texture.
+    pub uv_set: u32,
 }
 
 impl Default for TextureTransform {
@@ -36,9 +41,10 @@ impl TextureTransform {
         offset: Vec2::ZERO,
         rotation: 0.0,
         scale: Vec2::ONE,
+        uv_set: 0,
     };
 
-    /// True when it leaves coordinates unchanged (its shader code can be compiled out).
+    /// True when it reads the first set unchanged (its shader code can be compiled out).
     pub fn is_identity(&self) -> bool {
         *self == TextureTransform::IDENTITY
     }
@@ -74,7 +80,15 @@ impl TextureTransform {
         let within = |v: Vec2| v.abs().max_element() <= super::mesh::MAX_TEXCOORD;
         self.is_finite() && within(self.offset) && within(self.scale)
     }
+
+    /// The coordinates this transform reads of `mesh`, if it has them.
+    pub(crate) fn coordinates<'m>(&self, mesh: &'m super::Mesh) -> Option<&'m [Vec2]> {
+        mesh.coordinate_set(self.uv_set)
+    }
 }
+
+/// Texture coordinate sets a mesh can have ([`TextureTransform::uv_set`] is below it).
+pub const UV_SETS: u32 = 2;
 
 /// A texture and where it is sampled.
 #[derive(Clone, Debug)]
@@ -205,7 +219,19 @@ impl SurfaceMaps {
             .map(|(name, _)| format!("{name}.transform"))
     }
 
-    /// True when some texture (the base colour's included) is sampled through a transform.
+    /// The first transform reading a set past `UV_SETS`: its field and set.
+    pub fn unknown_uv_set(&self) -> Option<(String, u32)> {
+        let slots = self
+            .textures()
+            .map(|(name, t)| (format!("{name}.transform"), t.transform));
+        std::iter::once(("base_transform".to_string(), self.base_transform))
+            .chain(slots)
+            .find(|(_, t)| t.uv_set >= UV_SETS)
+            .map(|(field, t)| (field, t.uv_set))
+    }
+
+    /// True when some texture (the base colour's included) is sampled through a transform or
+    /// from the second coordinate set.
     pub fn has_transform(&self) -> bool {
         !self.base_transform.is_identity()
             || self.textures().any(|(_, t)| !t.transform.is_identity())
@@ -240,6 +266,7 @@ mod tests {
             offset: Vec2::new(0.0, 1.0),
             rotation: std::f32::consts::FRAC_PI_2,
             scale: Vec2::splat(0.5),
+            uv_set: 0,
         };
         for (uv, want) in [
             ((0.0, 0.0), (0.0, 1.0)),
@@ -257,6 +284,11 @@ mod tests {
             assert!((r[1].dot(p) as f64 - got.y).abs() < 1e-6);
         }
         assert!(TextureTransform::default().is_identity());
+        let second = TextureTransform {
+            uv_set: 1,
+            ..TextureTransform::IDENTITY
+        };
+        assert!(!second.is_identity() && second.is_usable());
     }
 
     #[test]

@@ -15,7 +15,7 @@
 //! pixels: SwiftShader drew a plane seen through a 0.001° lens, or a 10⁻⁵-high orthographic
 //! view, unlit past about 2²⁷ pixels a triangle and not at all past 2²⁸, without an error.
 
-use glam::{DMat3, DMat4, DVec2, DVec3, DVec4, Vec2};
+use glam::{DMat3, DMat4, DVec2, DVec3, DVec4};
 
 use super::normal_matrix::normal_matrix;
 use super::{Aabb, Mesh, Object, Scene};
@@ -111,12 +111,13 @@ fn largest_scale(m: &DMat4) -> f64 {
     cols.into_iter().fold(0.0, f64::max) * 3.0
 }
 
-/// A vertex being split: camera-relative world position, world normal, texture coordinate.
+/// A vertex being split: camera-relative world position, world normal, texture coordinates.
 #[derive(Clone, Copy)]
 struct Vertex {
     p: DVec3,
     n: DVec3,
     uv: DVec2,
+    uv1: DVec2,
     /// Vertex colour and tangent (bitangent sign in `w`), kept when the mesh has them.
     color: DVec4,
     tangent: DVec4,
@@ -128,6 +129,7 @@ impl Vertex {
             p: (a.p + b.p) * 0.5,
             n: (a.n + b.n) * 0.5,
             uv: (a.uv + b.uv) * 0.5,
+            uv1: (a.uv1 + b.uv1) * 0.5,
             color: (a.color + b.color) * 0.5,
             tangent: ((a.tangent + b.tangent) * 0.5).with_w(a.tangent.w),
         }
@@ -200,6 +202,7 @@ fn split_mesh(
             p: transform.transform_point3(mesh.positions[i].as_dvec3()) - eye,
             n: normals * mesh.normals[i].as_dvec3(),
             uv: mesh.uvs.get(i).map_or(DVec2::ZERO, |t| t.as_dvec2()),
+            uv1: mesh.second_uvs.get(i).map_or(DVec2::ZERO, |t| t.as_dvec2()),
             color: mesh.colors.get(i).map_or(DVec4::ONE, |c| c.as_dvec4()),
             tangent: mesh.tangents.get(i).map_or(DVec4::X, |t| {
                 let t = t.as_dvec4();
@@ -248,13 +251,17 @@ fn split_mesh(
             out.indices.push(out.positions.len() as u32);
             out.positions.push(v.p.as_vec3());
             out.normals.push(v.n.as_vec3());
-            out.uvs.push(Vec2::new(v.uv.x as f32, v.uv.y as f32));
+            out.uvs.push(v.uv.as_vec2());
+            out.second_uvs.push(v.uv1.as_vec2());
             out.colors.push(v.color.as_vec4());
             out.tangents.push(v.tangent.as_vec4());
         }
     }
     if mesh.uvs.is_empty() {
         out.uvs.clear();
+    }
+    if mesh.second_uvs.is_empty() {
+        out.second_uvs.clear();
     }
     if mesh.colors.is_empty() {
         out.colors.clear();

@@ -189,6 +189,7 @@ fn all_features() -> Vec<ShaderFeatures> {
         F::EMISSIVE | F::EMISSIVE_MAP,
         F::OCCLUSION,
         F::MR_TEXTURE | F::METALLIC_ROUGHNESS,
+        F::SECOND_UVS | F::TEXTURE_TRANSFORM | F::OCCLUSION,
         F::SURFACE_INPUTS | F::METALLIC_ROUGHNESS | F::DIRECTIONAL,
     ] {
         for extra in [

@@ -493,6 +493,7 @@ fn deep_nesting_hides_no_field_and_drops_no_transform() {
         offset: glam::Vec2::new(0.5, 0.0),
         rotation: 0.0,
         scale: glam::Vec2::new(0.5, 1.0),
+        uv_set: 0,
     };
     let mut b = Builder::default();
     let doc = textured(&mut b, transform.clone(), json!("DEEP"));

@@ -7,6 +7,8 @@
 //! clustered and deferred must equal forward on ES 2.0 and 3.0.
 
 mod common;
+#[path = "gltf_surface_inputs/second_set.rs"]
+mod second_set;
 #[path = "gltf_surface_inputs/support.rs"]
 mod support;
 
@@ -255,9 +257,11 @@ fn textures_of_a_primitive_without_texture_coordinates_are_not_applied_and_said(
     std::fs::write(&path, doc.to_string()).unwrap();
     let (s, warnings) = scene_of(&path, grazing_light(), 0.02);
     assert!(
-        warnings.iter().any(|w| w.contains("no TEXCOORD_0")
-            && w.contains("baseColorTexture, normalTexture")
-            && w.contains("not applied")),
+        warnings
+            .iter()
+            .any(|w| w.contains("on TEXCOORD_0, which the primitive has not")
+                && w.contains("baseColorTexture, normalTexture")
+                && w.contains("not applied")),
         "{warnings:?}"
     );
     assert!(
@@ -451,6 +455,7 @@ fn a_required_texture_transform_offsets_rotates_and_scales_the_base_colour() {
         offset: Vec2::new(0.3, 0.1),
         rotation: 0.5,
         scale: Vec2::new(0.7, 1.3),
+        uv_set: 0,
     };
     let material = json!({
         "pbrMetallicRoughness": {
@@ -559,19 +564,23 @@ fn other_texture_sets_malformed_transforms_and_every_colour_format_are_handled()
         all.contains("normalTexture.extensions.KHR_texture_transform: malformed"),
         "{all}"
     );
-    assert!(all.contains("emissiveTexture: uses TEXCOORD_1"), "{all}");
-    assert!(all.contains("occlusionTexture: uses TEXCOORD_1"), "{all}");
+    assert!(
+        all.contains("(occlusionTexture, emissiveTexture) on TEXCOORD_1, which the primitive"),
+        "{all}"
+    );
     assert!(
         all.contains("COLOR_0") && all.contains("outside [0, 1]"),
         "{all}"
     );
-    assert_eq!(warnings.len(), 4, "{all}");
+    assert_eq!(warnings.len(), 3, "{all}");
     let m = &s.materials[0];
     assert!(m.diffuse_texture.is_some() && m.maps.base_transform.is_identity());
     let normal = m.maps.normal.as_ref().expect("normal map bound");
     assert!(normal.transform.is_identity());
     assert!(m.maps.metallic_roughness.is_some());
-    assert!(m.maps.emissive_texture.is_none() && m.maps.occlusion.is_none());
+    // Kept for a mesh with the second set; this one has none, so they are not sampled.
+    let second = |t: &Option<manylight::MapTexture>| t.as_ref().unwrap().transform.uv_set == 1;
+    assert!(second(&m.maps.emissive_texture) && second(&m.maps.occlusion));
     let mesh = &s.objects[0].mesh;
     // Float colours are clamped to [0, 1] (warned of above); VEC3 gets alpha 1.
     assert!(mesh
@@ -640,6 +649,12 @@ fn variants_without_surface_inputs_contain_none_of_their_code() {
         ),
         (F::TEXTURE_TRANSFORM, "u_albedoUvTransform", Stage::Vertex),
         (F::TEXTURE_TRANSFORM, "v_uvAlbedoNormal", Stage::Fragment),
+        (F::SECOND_UVS | F::TEXTURE_TRANSFORM, "a_uv1", Stage::Vertex),
+        (
+            F::SECOND_UVS | F::TEXTURE_TRANSFORM,
+            "u_occlusionUvSet",
+            Stage::Vertex,
+        ),
     ];
     for es in [EsVersion::Es2, EsVersion::Es3] {
         for shader in ["forward", "clustered"] {

@@ -158,7 +158,7 @@ fn snapshot(gl: &glow::Context, has: Has) -> Snapshot {
         gl.active_texture(active as u32);
         // The game's arrays (on ES 3.0 in its vertex array; on ES 2.0 the context's own).
         let pointers = manylight::gl::ext_fns::attrib_pointer_fns().expect("core entry points");
-        let attributes = (0..5)
+        let attributes = (0..6)
             .map(|index| {
                 let read = |pname| {
                     let mut v = [0f32; 4];
@@ -217,6 +217,11 @@ unsafe fn set_game_state(gl: &glow::Context, has: Has, size: (i32, i32)) {
     gl.vertex_attrib_pointer_f32(2, 3, glow::SHORT, false, 16, 6);
     gl.vertex_attrib_4_f32(3, 0.25, 0.5, 0.75, 2.0);
     gl.vertex_attrib_4_f32(4, -1.0, 3.0, 0.0, 0.5);
+    // Where the renderer's second texture coordinates go: an array of the game's, and the
+    // constant value under it.
+    gl.vertex_attrib_4_f32(5, 7.0, -2.0, 0.5, 3.0);
+    gl.vertex_attrib_pointer_f32(5, 2, glow::UNSIGNED_SHORT, true, 20, 8);
+    gl.enable_vertex_attrib_array(5);
     // Per-instance arrays where the renderer's positions and normals go: its meshes would
     // collapse to their first vertex.
     has.set_divisor(gl, 0, 1);
@@ -323,9 +328,39 @@ unsafe fn set_game_state(gl: &glow::Context, has: Has, size: (i32, i32)) {
 /// Set in the child process that runs the test below on Mesa capped to ES 2.0.
 const PURE_ES2: &str = "MANYLIGHT_TEST_PURE_ES2";
 
+/// The pillars, with one object drawn through a second coordinate set (its texture reads
+/// location 5, where the game keeps an array of its own).
+fn pillars_with_a_second_set() -> manylight::Scene {
+    let mut scene = scene::builtin::build("pillars", Some((300, 4))).unwrap();
+    let object = scene
+        .objects
+        .iter()
+        .position(|o| !o.mesh.uvs.is_empty())
+        .unwrap();
+    let mesh = &scene.objects[object].mesh;
+    let flipped = mesh
+        .uvs
+        .iter()
+        .map(|uv| manylight::glam::Vec2::ONE - *uv)
+        .collect();
+    let mesh = (**mesh).clone().with_second_uvs(flipped).unwrap();
+    let texels = image::RgbaImage::from_fn(2, 2, |x, y| {
+        image::Rgba([60 + 150 * x as u8, 90, 40 + 150 * y as u8, 255])
+    });
+    let mut material = manylight::Material::flat("second set", manylight::glam::Vec3::splat(0.9));
+    material.diffuse_texture = Some(std::sync::Arc::new(manylight::Texture::new(
+        "checks", texels,
+    )));
+    material.maps.base_transform.uv_set = 1;
+    let material = scene.add_material(material);
+    scene.objects[object].mesh = std::sync::Arc::new(mesh);
+    scene.objects[object].material = material;
+    scene
+}
+
 #[test]
 fn every_call_gives_the_games_gl_state_back_and_draws_as_from_a_clean_one() {
-    let scene = scene::builtin::build("pillars", Some((300, 4))).unwrap();
+    let scene = pillars_with_a_second_set();
     let (w, h) = (96, 54);
     let pure_es2 = std::env::var_os(PURE_ES2).is_some();
     let levels: &[EsVersion] = if pure_es2 {

@@ -86,6 +86,7 @@ fn material(k: usize) -> Material {
     };
     let scaled = TextureTransform {
         scale: Vec2::splat(2.0),
+        uv_set: 0,
         ..TextureTransform::IDENTITY
     };
     if bit(2) {

@@ -9,9 +9,9 @@ use crate::gl::instances::InstanceStream;
 use crate::gl::mesh::BoundMesh;
 use crate::gl::{Device, GlError};
 
-/// The first of the instance attributes' locations (`layout(location = 5)` onwards in
-/// `glsl/deferred_light_instance.glsl`), after the meshes' 0 to 4.
-const LIGHT_LOCATION: u32 = 5;
+/// The first of the instance attributes' locations (`layout(location = 6)` onwards in
+/// `glsl/deferred_light_instance.glsl`), after the meshes' 0 to 5.
+const LIGHT_LOCATION: u32 = 6;
 
 /// `vec4`s a light takes.
 const LIGHT_VEC4S: usize = 4;

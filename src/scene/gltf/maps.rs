@@ -4,8 +4,8 @@
 //! `KHR_texture_transform`, read from the file's JSON (the `gltf` crate exposes it on only
 //! some texture infos).
 //!
-//! Only `TEXCOORD_0` is read: a texture on another set (after the transform's `texCoord`
-//! override) is a warning and not bound, as the base colour's always was.
+//! `TEXCOORD_0` and `TEXCOORD_1` are read: a texture on another set (after the transform's
+//! `texCoord` override) is a warning and not bound.
 
 use std::path::Path;
 use std::sync::Arc;
@@ -17,7 +17,7 @@ use super::buffers::Buffers;
 use super::texture::Textures;
 use crate::scene::mesh::MAX_TEXCOORD;
 use crate::scene::surface_maps::{
-    MapTexture, SurfaceMaps, TextureTransform, MAX_EMISSIVE, MAX_NORMAL_SCALE,
+    MapTexture, SurfaceMaps, TextureTransform, MAX_EMISSIVE, MAX_NORMAL_SCALE, UV_SETS,
 };
 use crate::scene::{short3, shown, Short, Texture};
 
@@ -132,7 +132,14 @@ pub(super) fn transform_of(
     warnings: &mut Vec<String>,
 ) -> (TextureTransform, u32) {
     let Some(ext) = raw.transform(index, path) else {
-        return (TextureTransform::IDENTITY, tex_coord);
+        let uv_set = if tex_coord < UV_SETS { tex_coord } else { 0 };
+        return (
+            TextureTransform {
+                uv_set,
+                ..TextureTransform::IDENTITY
+            },
+            tex_coord,
+        );
     };
     let pair = |key: &str, default: Vec2| -> Option<Vec2> {
         match ext.get(key) {
@@ -164,6 +171,7 @@ pub(super) fn transform_of(
                 offset,
                 rotation,
                 scale,
+                uv_set: 0,
             },
             set,
         )),
@@ -171,7 +179,11 @@ pub(super) fn transform_of(
     };
     let usable =
         |(t, _): &(TextureTransform, u32)| t.is_usable() && t.rows().iter().all(|r| r.is_finite());
-    match parsed.filter(usable) {
+    let with_set = |(t, set): (TextureTransform, u32)| {
+        let uv_set = if set < UV_SETS { set } else { 0 };
+        (TextureTransform { uv_set, ..t }, set)
+    };
+    match parsed.filter(usable).map(with_set) {
         Some(parsed) => parsed,
         None => {
             warnings.push(format!(
@@ -179,9 +191,85 @@ pub(super) fn transform_of(
                  two numbers within ±{MAX_TEXCOORD:e}, rotation one, all finite, texCoord a \
                  set number); ignored"
             ));
-            (TextureTransform::IDENTITY, tex_coord)
+            with_set((TextureTransform::IDENTITY, tex_coord))
         }
     }
+}
+
+/// The coordinate set the texture info at `path` reads, after its transform's `texCoord`
+/// override, as [`transform_of`] finds it (its warnings are the material's to give).
+pub(super) fn set_read(
+    raw: &RawMaterials,
+    index: Option<usize>,
+    path: &[&str],
+    tex_coord: u32,
+) -> u32 {
+    transform_of(raw, index, path, tex_coord, "", &mut Vec::new()).1
+}
+
+/// Which coordinate set each of a glTF material's textures reads (after its transform's
+/// `texCoord` override): what its primitives' meshes keep.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub(super) struct SetsRead([(&'static str, Option<u32>); 5]);
+
+impl SetsRead {
+    /// Some texture reads `TEXCOORD_1`.
+    pub fn second(&self) -> bool {
+        self.0.iter().any(|(_, set)| *set == Some(1))
+    }
+
+    /// The set the normal texture reads (its tangents follow it), if it has one.
+    pub fn normal(&self) -> Option<u32> {
+        let normal = self.0.iter().find(|(name, _)| *name == "normalTexture");
+        normal.and_then(|(_, set)| *set)
+    }
+
+    /// The textures reading `set`, by their glTF names.
+    pub fn named_on(&self, set: u32) -> Vec<&'static str> {
+        let on = |(name, s): &(&'static str, Option<u32>)| (*s == Some(set)).then_some(*name);
+        self.0.iter().filter_map(on).collect()
+    }
+}
+
+/// [`SetsRead`] of `m`, whose texture infos' transforms are in `raw`.
+pub(super) fn sets_read(raw: &RawMaterials, m: &gltf::Material) -> SetsRead {
+    let index = m.index();
+    let pbr = m.pbr_metallic_roughness();
+    let set = |path: &[&str], tex_coord: u32| Some(set_read(raw, index, path, tex_coord));
+    let base = ["pbrMetallicRoughness", "baseColorTexture"];
+    let mr = ["pbrMetallicRoughness", "metallicRoughnessTexture"];
+    SetsRead([
+        (
+            "baseColorTexture",
+            pbr.base_color_texture()
+                .and_then(|t| set(&base, t.tex_coord())),
+        ),
+        (
+            "metallicRoughnessTexture",
+            pbr.metallic_roughness_texture()
+                .and_then(|t| set(&mr, t.tex_coord())),
+        ),
+        (
+            "normalTexture",
+            m.normal_texture()
+                .and_then(|t| set(&["normalTexture"], t.tex_coord())),
+        ),
+        (
+            "occlusionTexture",
+            m.occlusion_texture()
+                .and_then(|t| set(&["occlusionTexture"], t.tex_coord())),
+        ),
+        (
+            "emissiveTexture",
+            m.emissive_texture()
+                .and_then(|t| set(&["emissiveTexture"], t.tex_coord())),
+        ),
+    ])
+}
+
+/// The message for a texture on a set past [`UV_SETS`]: not bound.
+pub(super) fn unread_set(field: &str, set: u32, what: &str) -> String {
+    format!("{field}: uses TEXCOORD_{set}; only TEXCOORD_0 and TEXCOORD_1 are read, so {what}")
 }
 
 /// Loads one slot's texture with its transform (`None`: absent, on another texture
@@ -196,12 +284,9 @@ pub(super) fn load_slot(
     let tfield = format!("{field}.{}", slot.path.join("."));
     let (transform, tex_coord) =
         transform_of(src.raw, index, slot.path, slot.tex_coord, &tfield, warnings);
-    if tex_coord != 0 {
-        warnings.push(format!(
-            "{tfield}: uses TEXCOORD_{tex_coord}; only TEXCOORD_0 is read, so the {} texture \
-             is not bound",
-            slot.name
-        ));
+    if tex_coord >= UV_SETS {
+        let what = format!("the {} texture is not bound", slot.name);
+        warnings.push(unread_set(&tfield, tex_coord, &what));
         return Ok(None);
     }
     let texture = src

@@ -34,6 +34,7 @@ use super::maps::{self, RawMaterials, Sources};
 use super::texture::Textures;
 use crate::scene::material::MAX_COLOR_FACTOR;
 use crate::scene::shown;
+use crate::scene::surface_maps::UV_SETS;
 use crate::scene::texture_budget::TextureBudget;
 use crate::scene::{short3, Material};
 
@@ -120,6 +121,11 @@ impl Materials {
     /// The converted materials, and what is left of the texture budget.
     pub fn finish(self) -> (Vec<Material>, TextureBudget) {
         (self.list, self.textures.budget)
+    }
+
+    /// The coordinate sets `m`'s textures read, for its primitives' meshes.
+    pub fn sets_read(&self, m: &gltf::Material) -> maps::SetsRead {
+        maps::sets_read(&self.raw, m)
     }
 
     /// Index in [`Materials::list`] of `m`, converting it on first use.
@@ -220,10 +226,12 @@ impl Materials {
                 warnings,
             );
             base_transform = transform;
-            if tex_coord != 0 {
-                warnings.push(format!(
-                    "{field} (`{name}`): baseColorTexture uses TEXCOORD_{tex_coord}; only \
-                     TEXCOORD_0 is read, so it is not bound (flat colour)"
+            if tex_coord >= UV_SETS {
+                let at = format!("{field} (`{name}`).baseColorTexture");
+                warnings.push(maps::unread_set(
+                    &at,
+                    tex_coord,
+                    "it is not bound (flat colour)",
                 ));
             } else {
                 diffuse_texture = self

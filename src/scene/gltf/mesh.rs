@@ -1,5 +1,5 @@
 //! Mesh primitives → [`Mesh`]: positions, normals (flat ones computed when the primitive has
-//! none, as glTF asks), `TEXCOORD_0`, indices (u8, u16, u32 or none), triangle strips and fans
+//! none, as glTF asks), `TEXCOORD_0` (and `TEXCOORD_1` where a texture reads it), indices (u8, u16, u32 or none), triangle strips and fans
 //! unrolled into lists. Every index is checked against the vertex count and every position
 //! against [`MAX_VERTEX_COORD`], with the glTF path and the element's position in the message
 //! (never its value: buffer bytes are not shown).
@@ -10,6 +10,7 @@ use gltf::mesh::Mode;
 
 use super::accessor::{self, describe};
 use super::buffers::Buffers;
+use super::maps::SetsRead;
 use crate::scene::mesh::MAX_VERTEX_COORD;
 use crate::scene::Mesh;
 
@@ -79,9 +80,11 @@ pub(super) enum Built {
     Skipped(String),
 }
 
-/// Builds primitive `p` of its mesh; `field` is its glTF path (`meshes[2].primitives[0]`).
+/// Builds primitive `p` of its mesh; `field` is its glTF path (`meshes[2].primitives[0]`);
+/// `sets`: the coordinate sets its material's textures read.
 pub(super) fn build(
     p: &gltf::Primitive,
+    sets: SetsRead,
     field: &str,
     buffers: &mut Buffers,
     budget: &mut Budget,
@@ -130,33 +133,12 @@ pub(super) fn build(
         .chunks_exact(3)
         .map(Vec3::from_slice)
         .collect();
-    let mut uvs = Vec::new();
-    if let Some(a) = p.get(&gltf::Semantic::TexCoords(0)) {
-        same_count(&attr("TEXCOORD_0", &a), &a, n)?;
-        let ok_type = match a.data_type() {
-            DataType::F32 => true,
-            DataType::U8 | DataType::U16 => a.normalized(),
-            _ => false,
-        };
-        if a.dimensions() == Dimensions::Vec2 && ok_type {
-            let raw = accessor::read_f32(&a, buffers, n)
-                .map_err(|e| format!("{}: {e}", attr("TEXCOORD_0", &a)))?;
-            // glTF's (0, 0) is the image's top-left corner, as the renderer's is: no flip.
-            uvs = raw.chunks_exact(2).map(Vec2::from_slice).collect();
-            if let Some(i) = uvs.iter().position(|t| !t.is_finite()) {
-                return Err(format!(
-                    "{}: element {i} is not finite; texture coordinates must be finite",
-                    attr("TEXCOORD_0", &a)
-                ));
-            }
-        } else {
-            warnings.push(format!(
-                "{}: is {}, not VEC2 of FLOAT or normalized UNSIGNED_BYTE/SHORT; ignored",
-                attr("TEXCOORD_0", &a),
-                describe(&a)
-            ));
-        }
-    }
+    let uvs = read_uvs(p, 0, n, buffers, warnings, &attr)?;
+    let second_uvs = if sets.second() {
+        read_uvs(p, 1, n, buffers, warnings, &attr)?
+    } else {
+        Vec::new()
+    };
     let colors = read_colors(p, n, buffers, warnings, &attr)?;
     let tangents: Vec<Vec4> = read_vectors(p, &TANGENT, n, buffers, warnings, &attr)?
         .chunks_exact(4)
@@ -219,20 +201,22 @@ pub(super) fn build(
         budget.take("vertices", indices.len(), field)?;
     }
     let (colors, tangents) = (unshare(colors), unshare(tangents));
-    let (positions, uvs, indices) = if flat {
+    let (positions, uvs, second_uvs, indices) = if flat {
         let pick = |i: &u32| positions[*i as usize];
-        let flat_uvs = if uvs.is_empty() {
-            Vec::new()
-        } else {
-            indices.iter().map(|&i| uvs[i as usize]).collect()
+        let flat_uvs = |uvs: Vec<Vec2>| -> Vec<Vec2> {
+            match uvs.is_empty() {
+                true => uvs,
+                false => indices.iter().map(|&i| uvs[i as usize]).collect(),
+            }
         };
         (
             indices.iter().map(pick).collect(),
-            flat_uvs,
+            flat_uvs(uvs),
+            flat_uvs(second_uvs),
             (0..indices.len() as u32).collect(),
         )
     } else {
-        (positions, uvs, indices)
+        (positions, uvs, second_uvs, indices)
     };
     // A single-sided surface's front is its winding's side: kept as listed.
     let double_sided = p.material().double_sided();
@@ -247,25 +231,35 @@ pub(super) fn build(
             .with_colors(colors)
             .map_err(|e| format!("{field}: {e}"))?;
     }
-    if mesh.uvs.is_empty() {
-        let textures = textures_named(&p.material());
-        if !textures.is_empty() {
+    if !second_uvs.is_empty() {
+        mesh = mesh
+            .with_second_uvs(second_uvs)
+            .map_err(|e| format!("{field}: {e}"))?;
+    }
+    for (set, coordinates) in [(0, &mesh.uvs), (1, &mesh.second_uvs)] {
+        let textures = sets.named_on(set);
+        if coordinates.is_empty() && !textures.is_empty() {
             warnings.push(format!(
-                "{field}: its material has textures ({}) but the primitive has no \
-                 TEXCOORD_0; they are not applied (its factors draw it)",
+                "{field}: its material has textures ({}) on TEXCOORD_{set}, which the \
+                 primitive has not; they are not applied (its factors draw it)",
                 textures.join(", ")
             ));
         }
     }
-    // Tangents only where a normal map will use them (they cost a vertex attribute).
-    if p.material().normal_texture().is_some() && !mesh.uvs.is_empty() {
+    let normal_set = sets.normal().filter(|&set| match set {
+        0 => !mesh.uvs.is_empty(),
+        _ => !mesh.second_uvs.is_empty(),
+    });
+    // Tangents only where a normal map will use them (they cost a vertex attribute), along
+    // the set it reads.
+    if let Some(set) = normal_set {
         if !tangents.is_empty() {
             mesh = mesh
                 .with_tangents(tangents)
                 .map_err(|e| format!("{field}: {e}"))?;
         } else {
             let (with, fallbacks) = mesh
-                .with_generated_tangents()
+                .with_tangents_along(set)
                 .map_err(|e| format!("{field}: {e}"))?;
             mesh = with;
             if fallbacks > 0 {
@@ -294,22 +288,42 @@ pub(super) fn build(
     Ok(Built::Mesh(mesh))
 }
 
-/// The glTF names of the textures `material` has.
-fn textures_named(material: &gltf::Material) -> Vec<&'static str> {
-    let pbr = material.pbr_metallic_roughness();
-    [
-        ("baseColorTexture", pbr.base_color_texture().is_some()),
-        (
-            "metallicRoughnessTexture",
-            pbr.metallic_roughness_texture().is_some(),
-        ),
-        ("normalTexture", material.normal_texture().is_some()),
-        ("occlusionTexture", material.occlusion_texture().is_some()),
-        ("emissiveTexture", material.emissive_texture().is_some()),
-    ]
-    .into_iter()
-    .filter_map(|(name, has)| has.then_some(name))
-    .collect()
+/// `TEXCOORD_{set}` of `p` (`n` vertices): VEC2 of FLOAT or normalized UNSIGNED_BYTE/SHORT,
+/// every value finite; empty where it has none, or one of another type (with a warning).
+fn read_uvs(
+    p: &gltf::Primitive,
+    set: u32,
+    n: usize,
+    buffers: &mut Buffers,
+    warnings: &mut Vec<String>,
+    attr: &dyn Fn(&str, &gltf::Accessor) -> String,
+) -> Result<Vec<Vec2>, String> {
+    let Some(a) = p.get(&gltf::Semantic::TexCoords(set)) else {
+        return Ok(Vec::new());
+    };
+    let afield = attr(&format!("TEXCOORD_{set}"), &a);
+    same_count(&afield, &a, n)?;
+    let ok_type = match a.data_type() {
+        DataType::F32 => true,
+        DataType::U8 | DataType::U16 => a.normalized(),
+        _ => false,
+    };
+    if a.dimensions() != Dimensions::Vec2 || !ok_type {
+        warnings.push(format!(
+            "{afield}: is {}, not VEC2 of FLOAT or normalized UNSIGNED_BYTE/SHORT; ignored",
+            describe(&a)
+        ));
+        return Ok(Vec::new());
+    }
+    let raw = accessor::read_f32(&a, buffers, n).map_err(|e| format!("{afield}: {e}"))?;
+    // glTF's (0, 0) is the image's top-left corner, as the renderer's is: no flip.
+    let uvs: Vec<Vec2> = raw.chunks_exact(2).map(Vec2::from_slice).collect();
+    if let Some(i) = uvs.iter().position(|t| !t.is_finite()) {
+        return Err(format!(
+            "{afield}: element {i} is not finite; texture coordinates must be finite"
+        ));
+    }
+    Ok(uvs)
 }
 
 /// A FLOAT vector attribute that the loader replaces when it has another type.
@@ -558,7 +572,14 @@ mod tests {
             vertices: 5,
             indices: 10,
         };
-        let built = build(&primitive, "m", &mut buffers, &mut budget, &mut Vec::new());
+        let built = build(
+            &primitive,
+            SetsRead::default(),
+            "m",
+            &mut buffers,
+            &mut budget,
+            &mut Vec::new(),
+        );
         assert!(matches!(built, Ok(Built::Mesh(_))), "{:?}", built.err());
         assert_eq!(budget.vertices, 2);
     }

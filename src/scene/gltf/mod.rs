@@ -452,6 +452,7 @@ fn import(
                             None => {
                                 let built = build_primitive(
                                     &prim,
+                                    materials.sets_read(&prim.material()),
                                     &pfield,
                                     &mut buffers,
                                     &mut budget,
@@ -617,6 +618,7 @@ fn check_placement(bounds: Option<Aabb>, world: &DMat4) -> Result<(), String> {
 /// where it is skipped (points, lines), with a warning.
 fn build_primitive(
     p: &gltf::Primitive,
+    sets: maps::SetsRead,
     pfield: &str,
     buffers: &mut buffers::Buffers,
     budget: &mut mesh::Budget,
@@ -624,24 +626,26 @@ fn build_primitive(
     mesh_count: &mut usize,
 ) -> Result<Option<BuiltMesh>, Fault> {
     mesh::check_memory(p, pfield).map_err(Fault::Memory)?;
-    Ok(match mesh::build(p, pfield, buffers, budget, warnings)? {
-        mesh::Built::Mesh(mesh) => {
-            // Counted once made: a skipped primitive (points, lines) holds nothing.
-            *mesh_count += 1;
-            if *mesh_count > MAX_SCENE_MESHES {
-                return Err(format!(
-                    "{pfield}: more than {MAX_SCENE_MESHES} distinct meshes (primitives), the \
+    Ok(
+        match mesh::build(p, sets, pfield, buffers, budget, warnings)? {
+            mesh::Built::Mesh(mesh) => {
+                // Counted once made: a skipped primitive (points, lines) holds nothing.
+                *mesh_count += 1;
+                if *mesh_count > MAX_SCENE_MESHES {
+                    return Err(format!(
+                        "{pfield}: more than {MAX_SCENE_MESHES} distinct meshes (primitives), the \
                      limit per file"
-                )
-                .into());
+                    )
+                    .into());
+                }
+                let bounds = mesh.bounds();
+                let vertex_alpha = mesh.colors.iter().any(|c| c.w < 1.0);
+                Some((Arc::new(mesh), bounds, vertex_alpha))
             }
-            let bounds = mesh.bounds();
-            let vertex_alpha = mesh.colors.iter().any(|c| c.w < 1.0);
-            Some((Arc::new(mesh), bounds, vertex_alpha))
-        }
-        mesh::Built::Skipped(why) => {
-            warnings.push(format!("{why}; skipped"));
-            None
-        }
-    })
+            mesh::Built::Skipped(why) => {
+                warnings.push(format!("{why}; skipped"));
+                None
+            }
+        },
+    )
 }

@@ -146,6 +146,7 @@ impl<'a> MapStatement<'a> {
             offset: Vec2::new(ou as f32, (1.0 - sv - ov) as f32),
             rotation: 0.0,
             scale: Vec2::new(su as f32, sv as f32),
+            uv_set: 0,
         };
         transform.is_usable().then_some(transform)
     }

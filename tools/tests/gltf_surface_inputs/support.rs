@@ -228,6 +228,33 @@ pub fn bilinear_colour(
             srgb_to_linear(c.z),
         )
     };
+    let c = bilinear(texels, w, h, uv, &|c| {
+        if decoded_first {
+            decode(c)
+        } else {
+            c
+        }
+    });
+    if decoded_first {
+        c
+    } else {
+        decode(c)
+    }
+}
+
+/// Bilinear sample with REPEAT at `uv` of a texture holding linear data (0 to 1).
+pub fn bilinear_linear(texels: &[[u8; 4]], w: usize, h: usize, uv: DVec2) -> DVec3 {
+    bilinear(texels, w, h, uv, &|c| c)
+}
+
+/// Bilinear sample with REPEAT at `uv`, each texel (RGB, 0 to 1) mapped by `texel` first.
+fn bilinear(
+    texels: &[[u8; 4]],
+    w: usize,
+    h: usize,
+    uv: DVec2,
+    texel: &dyn Fn(DVec3) -> DVec3,
+) -> DVec3 {
     let (x, y) = (uv.x * w as f64 - 0.5, uv.y * h as f64 - 0.5);
     let (x0, y0) = (x.floor(), y.floor());
     let (fx, fy) = (x - x0, y - y0);
@@ -237,19 +264,9 @@ pub fn bilinear_colour(
             (j as i64).rem_euclid(h as i64) as usize,
         );
         let t = texels[j * w + i];
-        let c = DVec3::new(t[0] as f64, t[1] as f64, t[2] as f64) / 255.0;
-        if decoded_first {
-            decode(c)
-        } else {
-            c
-        }
+        texel(DVec3::new(t[0] as f64, t[1] as f64, t[2] as f64) / 255.0)
     };
     let top = at(x0, y0) * (1.0 - fx) + at(x0 + 1.0, y0) * fx;
     let bottom = at(x0, y0 + 1.0) * (1.0 - fx) + at(x0 + 1.0, y0 + 1.0) * fx;
-    let c = top * (1.0 - fy) + bottom * fy;
-    if decoded_first {
-        c
-    } else {
-        decode(c)
-    }
+    top * (1.0 - fy) + bottom * fy
 }

@@ -100,6 +100,7 @@ fn quad_scene(uv_at: f32, transform: TextureTransform) -> Scene {
 fn a_material_with_a_transform_out_of_range_is_refused_naming_it() {
     let transform = TextureTransform {
         scale: Vec2::new(1.0, 2.0 * MAX_TEXCOORD),
+        uv_set: 0,
         ..TextureTransform::IDENTITY
     };
     let err = quad_scene(1.0, transform)
@@ -117,6 +118,7 @@ fn a_surface_at_the_bounds_renders() {
         offset: Vec2::splat(MAX_TEXCOORD),
         rotation: 0.7,
         scale: Vec2::splat(MAX_TEXCOORD),
+        uv_set: 0,
     };
     let scene = quad_scene(MAX_TEXCOORD, transform);
     scene.validate().unwrap();
