@@ -23,6 +23,8 @@ pub struct StateCalls {
     pub vertex_array_calls: u64,
     /// Binds of the methods' data textures (lights, grids, lists), each choosing its unit.
     pub data_textures_bound: u64,
+    /// Times the constant values of the attributes a mesh may lack were set.
+    pub absent_values_set: u64,
 }
 
 /// What the call under way has bound. The application may bind anything between calls, so it
@@ -100,7 +102,15 @@ impl CallState {
         for (loc, v) in ABSENT {
             unsafe { gl.vertex_attrib_4_f32(loc, v[0], v[1], v[2], v[3]) };
         }
+        self.count(|c| c.absent_values_set += 1);
         self.absent_values_set.set(in_call);
+    }
+
+    /// A draw is to read arrays at some [`ABSENT`] locations. GL before 4.2 (and older drivers
+    /// after it) leaves the constant values there undefined after such a draw, so they are set
+    /// again before a mesh lacking those arrays draws.
+    pub(super) fn forget_absent_values(&self) {
+        self.absent_values_set.set(false);
     }
 
     /// Counts a state call.

@@ -385,6 +385,12 @@ impl Device {
         self.call.set_absent_values(&self.gl, self.in_call());
     }
 
+    /// A mesh with arrays at the locations [`Device::set_absent_values`] sets is to draw:
+    /// those constants are set again before the next mesh that lacks them.
+    pub(crate) fn forget_absent_values(&self) {
+        self.call.forget_absent_values();
+    }
+
     /// Counts a state call ([`StateCalls`]).
     pub(crate) fn count_state_call(&self, f: impl FnOnce(&mut StateCalls)) {
         self.call.count(f);

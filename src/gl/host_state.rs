@@ -222,7 +222,12 @@ impl HostState {
                 } else {
                     [None; 2]
                 },
-                program: gl.get_parameter_program(glow::CURRENT_PROGRAM),
+                // A program the game deleted while current lives only while it stays current:
+                // the renderer's programs end it, so none is given back (binding its name
+                // again would fail and leave the renderer's program for the game to write).
+                program: gl
+                    .get_parameter_program(glow::CURRENT_PROGRAM)
+                    .filter(|&p| gl.get_program_parameter_i32(p, glow::DELETE_STATUS) == 0),
                 active_texture,
                 textures,
                 samplers,

@@ -220,6 +220,9 @@ impl GpuChunk {
         if !self.layout.complete() {
             dev.set_absent_values();
         }
+        if self.layout.optional().next().is_some() {
+            dev.forget_absent_values();
+        }
         BoundMesh {
             index_count: self.index_count,
         }

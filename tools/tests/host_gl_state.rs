@@ -7,6 +7,9 @@
 
 mod common;
 
+#[path = "host_gl_state/deleted_program.rs"]
+mod deleted_program;
+
 use common::game_target::game_framebuffer;
 use common::Gpu;
 use manylight::gl::GlError;

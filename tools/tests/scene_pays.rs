@@ -651,3 +651,41 @@ fn objects_sharing_a_material_set_only_their_transforms() {
         }
     });
 }
+
+/// GL before 4.2 leaves an attribute's constant value undefined after a draw that read an
+/// array there: a mesh without vertex colours drawn after one with them sets its white again.
+#[test]
+fn a_mesh_lacking_an_attribute_sets_its_constant_again_after_one_that_had_it() {
+    let (w, h) = (96, 54);
+    let base = point_light_scene();
+    let mut b = MeshBuilder::new();
+    b.cuboid(Vec3::splat(-0.1), Vec3::splat(0.1));
+    let plain = Arc::new(b.build().unwrap());
+    let colours = vec![glam::Vec4::new(1.0, 0.5, 0.2, 1.0); plain.positions.len()];
+    let coloured = Arc::new((*plain).clone().with_colors(colours).unwrap());
+    let material = base.objects[0].material;
+    let with = |mesh: &Arc<manylight::Mesh>| {
+        let mut s = base.clone();
+        for i in 0..8 {
+            let at = DVec3::new(-2.0 + 0.5 * i as f64, 1.0, 8.0);
+            s.add_object(mesh.clone(), material, DMat4::from_translation(at));
+        }
+        s
+    };
+    let (plain_boxes, coloured_boxes) = (with(&plain), with(&coloured));
+    common::each_method(|es, method, gpu| {
+        let opts = RenderOptions::default();
+        let mut sets = |s: &scene::Scene| {
+            gpu.r().render_offscreen(s, w, h, &opts).unwrap();
+            let before = gpu.r().gl_state_calls().absent_values_set;
+            gpu.r().render_offscreen(s, w, h, &opts).unwrap();
+            gpu.r().gl_state_calls().absent_values_set - before
+        };
+        let (without, with_colours) = (sets(&plain_boxes), sets(&coloured_boxes));
+        assert!(
+            with_colours > without,
+            "{es} {method}: constants set {without} times a frame without coloured meshes, \
+             {with_colours} with"
+        );
+    });
+}
