@@ -13,6 +13,7 @@
 
 pub(crate) mod absent_attributes;
 pub mod alloc;
+pub(crate) mod bound_framebuffer;
 pub(crate) mod bound_size;
 pub(crate) mod call_state;
 pub mod caps;

@@ -74,6 +74,8 @@ fn draw_probe(
         }
         gl.draw_arrays(glow::TRIANGLES, 0, 3);
         let pixel = target.read_rgba8(dev);
+        // The renderer's own vertex array keeps no array into the buffer deleted below.
+        gl.disable_vertex_attrib_array(0);
         dev.delete_buffer(buffer);
         pixel
     }
