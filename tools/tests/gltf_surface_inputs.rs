@@ -55,17 +55,28 @@ fn check_every_method_by_level(
     [want_es2, want_es3]: [&[Option<[f64; 3]>]; 2],
     tolerance: f64,
 ) {
-    // ES 2.0, ES 2.0 on a device without fragment highp (every float fp16 here), ES 3.0.
-    for (es, no_fragment_highp) in [
+    // ES 2.0, ES 2.0 on a device without fragment highp (every float fp16 here), ES 3.0 (not
+    // in a child capped to ES 2.0: `second_set::PURE_ES2`).
+    let levels = [
         (EsVersion::Es2, false),
         (EsVersion::Es2, true),
         (EsVersion::Es3, false),
-    ] {
+    ];
+    let pure_es2 = std::env::var_os(second_set::PURE_ES2).is_some();
+    for (es, no_fragment_highp) in levels.into_iter().take(if pure_es2 { 2 } else { 3 }) {
         let restrictions = manylight::gl::Restrictions {
             no_fragment_highp,
             ..Default::default()
         };
         let mut gpu = Gpu::restricted(es, &restrictions);
+        if pure_es2 {
+            let caps = gpu.r().caps();
+            let vao = caps.has_extension("GL_OES_vertex_array_object");
+            assert!(
+                !caps.context_has_es3_state() && !vao,
+                "the cap left vertex arrays"
+            );
+        }
         let want = if es == EsVersion::Es3 {
             want_es3
         } else {

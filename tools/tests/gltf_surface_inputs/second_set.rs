@@ -4,6 +4,10 @@
 
 use super::*;
 
+/// Set in the child that runs a test again on Mesa capped to ES 2.0 without vertex array
+/// objects (a Mali-400's context): only the ES 2.0 levels are drawn there.
+pub const PURE_ES2: &str = "MANYLIGHT_TEST_PURE_ES2";
+
 /// The plane's second set: its first turned half a turn, `(1 − u, 1 − v)`, so a texture read
 /// through the wrong set shows.
 const SECOND_UVS: [f32; 8] = [1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0];
@@ -156,4 +160,26 @@ fn textures_on_a_set_the_primitive_lacks_are_said_and_not_applied() {
     let gap = oracle_gap(&want, &oracle(&s, &model(20.0 / 255.0)));
     assert!(gap > 20.0, "the occlusion would change only {gap:.1}/255");
     check_every_method("a set the primitive lacks", &s, &want, 3.0);
+}
+
+/// Without vertex array objects the arrays are the context's: the second set's array at
+/// location 5 is pointed and switched off draw by draw (`gl::mesh`).
+#[test]
+fn the_second_set_draws_on_es2_without_vertex_arrays() {
+    if std::env::var_os(PURE_ES2).is_some()
+        || crate::common::other_implementation_than_mesa("MESA_GLES_VERSION_OVERRIDE")
+    {
+        return;
+    }
+    let envs = [
+        ("MESA_GLES_VERSION_OVERRIDE", "2.0"),
+        ("MESA_EXTENSION_OVERRIDE", "-GL_OES_vertex_array_object"),
+        (PURE_ES2, "1"),
+    ];
+    for test in [
+        "second_set::the_base_colour_and_occlusion_sample_the_set_they_name",
+        "second_set::a_normal_map_on_the_second_set_gets_its_tangents_along_that_set",
+    ] {
+        crate::common::child::rerun_with(test, &envs, "on ES 2.0 without vertex arrays");
+    }
 }
