@@ -85,7 +85,8 @@ impl SplitInputs {
 /// The textures a material samples, each with whether it is colour (base colour, emission:
 /// sRGB-encoded) or data (normal, metallic-roughness and occlusion maps).
 fn textures_of(m: &Material) -> impl Iterator<Item = (&Texture, bool)> {
-    let maps = (m.maps.sampled_textures()).map(|(slot, t)| (&*t.texture, slot == "emissive"));
+    let maps =
+        (m.maps.sampled_textures()).map(|(slot, t)| (&*t.texture, slot == "emissive_texture"));
     m.diffuse_texture.iter().map(|t| (&**t, true)).chain(maps)
 }
 

@@ -33,8 +33,9 @@ pub struct StateCalls {
 pub(crate) struct CallState {
     program: Cell<Option<glow::Program>>,
     vertex_array: Cell<Option<glow::VertexArray>>,
-    /// Whether this call has set the constant values of the [`ABSENT`] attributes.
-    absent_values_set: Cell<bool>,
+    /// Which [`ABSENT`] attributes' constant values this call has set (bit `i`: `ABSENT[i]`)
+    /// and no draw has made undefined since.
+    absent_values_set: Cell<u8>,
     calls: Cell<StateCalls>,
 }
 
@@ -43,7 +44,7 @@ impl CallState {
     pub(super) fn forget(&self, vertex_array: Option<glow::VertexArray>) {
         self.program.set(None);
         self.vertex_array.set(vertex_array);
-        self.absent_values_set.set(false);
+        self.absent_values_set.set(0);
     }
 
     /// `program` is deleted: a program made later may take its name, and must be bound.
@@ -93,24 +94,31 @@ impl CallState {
         }
     }
 
-    /// Sets the constant value each [`ABSENT`] attribute reads where a mesh lacks its array,
-    /// unless this call already did (a value is the context's, not a vertex array's).
-    pub(super) fn set_absent_values(&self, gl: &glow::Context, in_call: bool) {
-        if self.absent_values_set.get() {
+    /// Sets the constant values of the [`ABSENT`] attributes in `needed` (bit `i`: `ABSENT[i]`)
+    /// that this call has not set since (a value is the context's, not a vertex array's).
+    pub(super) fn set_absent_values(&self, gl: &glow::Context, needed: u8, in_call: bool) {
+        let set = self.absent_values_set.get();
+        let missing = needed & !set;
+        if missing == 0 {
             return;
         }
-        for (loc, v) in ABSENT {
-            unsafe { gl.vertex_attrib_4_f32(loc, v[0], v[1], v[2], v[3]) };
+        for (i, (loc, v)) in ABSENT.into_iter().enumerate() {
+            if missing & (1 << i) != 0 {
+                unsafe { gl.vertex_attrib_4_f32(loc, v[0], v[1], v[2], v[3]) };
+            }
         }
         self.count(|c| c.absent_values_set += 1);
-        self.absent_values_set.set(in_call);
+        if in_call {
+            self.absent_values_set.set(set | missing);
+        }
     }
 
-    /// A draw is to read arrays at some [`ABSENT`] locations. GL before 4.2 (and older drivers
-    /// after it) leaves the constant values there undefined after such a draw, so they are set
-    /// again before a mesh lacking those arrays draws.
-    pub(super) fn forget_absent_values(&self) {
-        self.absent_values_set.set(false);
+    /// A draw is to read arrays at the [`ABSENT`] locations in `arrays`. GL before 4.2 (and
+    /// older drivers after it) leaves the constant values there undefined after such a draw,
+    /// so they are set again before a mesh lacking those arrays draws.
+    pub(super) fn forget_absent_values(&self, arrays: u8) {
+        let set = self.absent_values_set.get();
+        self.absent_values_set.set(set & !arrays);
     }
 
     /// Counts a state call.

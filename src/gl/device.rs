@@ -380,15 +380,17 @@ impl Device {
         }
     }
 
-    /// Sets the constant values of the attributes a mesh may lack, once a call.
-    pub(crate) fn set_absent_values(&self) {
-        self.call.set_absent_values(&self.gl, self.in_call());
+    /// Sets the constant values of the attributes a mesh lacks (`needed`, bit `i`:
+    /// `absent_attributes::ABSENT[i]`), each once a call unless a draw spent it.
+    pub(crate) fn set_absent_values(&self, needed: u8) {
+        self.call
+            .set_absent_values(&self.gl, needed, self.in_call());
     }
 
-    /// A mesh with arrays at the locations [`Device::set_absent_values`] sets is to draw:
-    /// those constants are set again before the next mesh that lacks them.
-    pub(crate) fn forget_absent_values(&self) {
-        self.call.forget_absent_values();
+    /// A mesh with arrays at those locations (`arrays`, the same bits) is to draw: their
+    /// constants are set again before the next mesh that lacks them.
+    pub(crate) fn forget_absent_values(&self, arrays: u8) {
+        self.call.forget_absent_values(arrays);
     }
 
     /// Counts a state call ([`StateCalls`]).

@@ -100,6 +100,8 @@ pub(crate) struct HostState {
     element_buffer: Option<glow::Buffer>,
     pixel_buffers: [Option<glow::Buffer>; 2],
     program: Option<glow::Program>,
+    /// The game deleted `program` while it was current: it lives only while it stays so.
+    program_deleted: bool,
     active_texture: i32,
     textures: [Option<glow::Texture>; UNITS],
     samplers: [Option<glow::Sampler>; UNITS],
@@ -154,6 +156,25 @@ struct DesktopState {
 }
 
 impl HostState {
+    /// Makes the game's program current again. One it deleted while current cannot be: once
+    /// the call made another current, GL ended it (binding its name again would fail and leave
+    /// the renderer's program for the game to write), so none is left current; a call that
+    /// bound none keeps it, still alive. A program of the renderer's given the ended one's
+    /// name is told apart by its delete status.
+    unsafe fn give_program_back(&self, gl: &glow::Context) {
+        match (self.program, self.program_deleted) {
+            (Some(program), true) => {
+                let current = gl.get_parameter_program(glow::CURRENT_PROGRAM);
+                let alive = current == Some(program)
+                    && gl.get_program_parameter_i32(program, glow::DELETE_STATUS) != 0;
+                if !alive {
+                    gl.use_program(None);
+                }
+            }
+            (program, _) => gl.use_program(program),
+        }
+    }
+
     /// Saves the application's state and sets what the renderer assumes: its own vertex
     /// array (`vao` with how to bind it: an ES 3.x or desktop context, ES 2.0 with
     /// `GL_OES_vertex_array_object`), the bound framebuffer drawing into its
@@ -208,6 +229,7 @@ impl HostState {
                 int(glow::BLEND_DST_ALPHA),
             ];
             let gl_version = (gl.version().major, gl.version().minor);
+            let program = gl.get_parameter_program(glow::CURRENT_PROGRAM);
             let saved = HostState {
                 es3,
                 vertex_array: vao
@@ -222,12 +244,9 @@ impl HostState {
                 } else {
                     [None; 2]
                 },
-                // A program the game deleted while current lives only while it stays current:
-                // the renderer's programs end it, so none is given back (binding its name
-                // again would fail and leave the renderer's program for the game to write).
-                program: gl
-                    .get_parameter_program(glow::CURRENT_PROGRAM)
-                    .filter(|&p| gl.get_program_parameter_i32(p, glow::DELETE_STATUS) == 0),
+                program,
+                program_deleted: program
+                    .is_some_and(|p| gl.get_program_parameter_i32(p, glow::DELETE_STATUS) != 0),
                 active_texture,
                 textures,
                 samplers,
@@ -355,7 +374,7 @@ impl HostState {
             }
             self.attributes.restore(gl);
             gl.bind_buffer(glow::ARRAY_BUFFER, self.array_buffer);
-            gl.use_program(self.program);
+            self.give_program_back(gl);
             for unit in 0..self.units {
                 gl.active_texture(glow::TEXTURE0 + unit as u32);
                 gl.bind_texture(glow::TEXTURE_2D, self.textures[unit]);

@@ -9,6 +9,9 @@ use glam::DVec3;
 use glow::HasContext;
 
 use super::absent_attributes::ABSENT;
+
+/// Every attribute of [`ABSENT`], as bits.
+const ABSENT_BITS: u8 = (1 << ABSENT.len()) - 1;
 use super::{Device, GlError};
 use crate::scene::Mesh;
 
@@ -47,9 +50,12 @@ impl VertexLayout {
                 .sum::<usize>()
     }
 
-    /// Whether every optional attribute is there (no constant stands in for one).
-    pub fn complete(self) -> bool {
-        self.colors && self.tangents && self.second_uvs
+    /// The optional attributes present, as bits of [`ABSENT`] (bit `i`: `ABSENT[i]`).
+    fn absent_bits(self) -> u8 {
+        let present = |loc| self.optional().any(|(l, _)| l == loc);
+        (ABSENT.iter().enumerate())
+            .filter(|(_, (loc, _))| present(*loc))
+            .fold(0, |bits, (i, _)| bits | 1 << i)
     }
 
     /// (location, components) of the optional attributes present, in vertex order.
@@ -217,12 +223,9 @@ impl GpuChunk {
             let calls = 2 + ABSENT.len() + 2 * self.layout.attributes().count();
             dev.count_state_call(|c| c.vertex_array_calls += calls as u64);
         }
-        if !self.layout.complete() {
-            dev.set_absent_values();
-        }
-        if self.layout.optional().next().is_some() {
-            dev.forget_absent_values();
-        }
+        let arrays = self.layout.absent_bits();
+        dev.set_absent_values(!arrays & ABSENT_BITS);
+        dev.forget_absent_values(arrays);
         BoundMesh {
             index_count: self.index_count,
         }

@@ -328,6 +328,10 @@ mod tests {
             "materials[2].maps.occlusion.transform.uv_set",
         );
         refused(
+            &|m| m.maps.emissive_texture = Some(third_set.clone()),
+            "materials[2].maps.emissive_texture.transform.uv_set",
+        );
+        refused(
             &|m| m.maps.base_transform.uv_set = u32::MAX,
             "materials[2].maps.base_transform.uv_set",
         );

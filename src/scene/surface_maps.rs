@@ -153,11 +153,11 @@ impl SurfaceMaps {
         self.emissive.max_element() > 0.0
     }
 
-    /// Every texture of the maps with its slot's name.
+    /// Every texture of the maps with its field's name (errors name `maps.<field>`).
     pub fn textures(&self) -> impl Iterator<Item = (&'static str, &MapTexture)> {
         [
             ("normal", &self.normal),
-            ("emissive", &self.emissive_texture),
+            ("emissive_texture", &self.emissive_texture),
             ("occlusion", &self.occlusion),
             ("metallic_roughness", &self.metallic_roughness),
         ]
@@ -170,7 +170,7 @@ impl SurfaceMaps {
     pub fn sampled_textures(&self) -> impl Iterator<Item = (&'static str, &MapTexture)> {
         [
             ("normal", self.sampled_normal()),
-            ("emissive", self.sampled_emissive()),
+            ("emissive_texture", self.sampled_emissive()),
             ("occlusion", self.sampled_occlusion()),
             ("metallic_roughness", self.metallic_roughness.as_ref()),
         ]

@@ -1,6 +1,7 @@
 //! A game that deletes its program while it is current (legal GL: the program lives on until
-//! another replaces it) gets no program back, rather than the renderer's left current for its
-//! uniform writes to land in.
+//! another replaces it) keeps it through a call that draws nothing, and after one that drew
+//! gets no program back, rather than the renderer's left current for its uniform writes to
+//! land in.
 
 use manylight::glow::{self, HasContext};
 use manylight::scene;
@@ -39,7 +40,7 @@ unsafe fn game_program(gl: &glow::Context, es3: bool) -> (glow::Program, glow::U
 }
 
 #[test]
-fn a_program_the_game_deleted_while_current_leaves_none_current() {
+fn a_program_the_game_deleted_while_current_is_kept_or_leaves_none_current() {
     let scene = scene::builtin::build("pillars", Some((40, 4))).unwrap();
     let (w, h, opts) = (96, 54, RenderOptions::default());
     for es in [EsVersion::Es2, EsVersion::Es3] {
@@ -53,6 +54,18 @@ fn a_program_the_game_deleted_while_current_leaves_none_current() {
             gl.use_program(Some(program));
             gl.delete_program(program);
             assert_eq!(gl.get_error(), glow::NO_ERROR);
+            // A call that makes no program current leaves the game's alive and current.
+            renderer.free_unused_uploads(&[&scene]).unwrap();
+            assert_eq!(
+                gl.get_parameter_program(glow::CURRENT_PROGRAM),
+                Some(program)
+            );
+            gl.uniform_matrix_4_f32_slice(Some(&location), false, &[1.0; 16]);
+            assert_eq!(
+                gl.get_error(),
+                glow::NO_ERROR,
+                "{es}: the game's program ended"
+            );
             renderer.render_offscreen(&scene, w, h, &opts).unwrap();
             // Before, the renderer's program was left current, with GL_INVALID_VALUE
             // pending from binding the ended program's name again.
