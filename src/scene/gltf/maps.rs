@@ -261,7 +261,9 @@ pub(super) fn sets_read(raw: &RawMaterials, m: &gltf::Material) -> SetsRead {
         ),
         (
             "emissiveTexture",
+            // Read only where the material emits ([`convert`]).
             m.emissive_texture()
+                .filter(|_| emits(m))
                 .and_then(|t| set(&["emissiveTexture"], t.tex_coord())),
         ),
     ])
@@ -410,8 +412,20 @@ pub(super) fn convert(
         if emissive.max_element() > 0.0 {
             maps.emissive_texture = load_slot(slot, index, field, src, warnings)?;
         }
+        debug_assert_eq!(emissive.max_element() > 0.0, emits(m));
     }
     Ok(maps)
+}
+
+/// Whether `m`'s emission (`emissiveFactor` × `KHR_materials_emissive_strength`, as
+/// [`convert`] clamps it) is more than black: only then is its emissive texture read.
+fn emits(m: &gltf::Material) -> bool {
+    let strength = m.emissive_strength().unwrap_or(1.0);
+    let e = Vec3::from(m.emissive_factor()) * strength;
+    e.max(Vec3::ZERO)
+        .min(Vec3::splat(MAX_EMISSIVE))
+        .max_element()
+        > 0.0
 }
 
 /// `value` within `range`, or `default` where it is not finite (past f32 in the file), with a

@@ -246,10 +246,9 @@ pub(super) fn build(
             ));
         }
     }
-    let normal_set = sets.normal().filter(|&set| match set {
-        0 => !mesh.uvs.is_empty(),
-        _ => !mesh.second_uvs.is_empty(),
-    });
+    let normal_set = sets
+        .normal()
+        .filter(|&set| mesh.coordinate_set(set).is_some());
     // Tangents only where a normal map will use them (they cost a vertex attribute), along
     // the set it reads.
     if let Some(set) = normal_set {

@@ -183,3 +183,40 @@ fn the_second_set_draws_on_es2_without_vertex_arrays() {
         crate::common::child::rerun_with(test, &envs, "on ES 2.0 without vertex arrays");
     }
 }
+
+/// The second set and tangents are kept only for textures that are drawn: an emissive texture
+/// of a material that does not emit reads nothing, a normal map on a set past 1 is not bound
+/// and takes none of the file's tangents.
+#[test]
+fn a_mesh_keeps_the_second_set_and_tangents_only_for_textures_drawn() {
+    let dir = tempfile::tempdir().unwrap();
+    let unlit = json!({"emissiveTexture": {"index": 0, "texCoord": 1}});
+    let mut plane = with_second_set(unlit);
+    plane.images.push(png(1, 1, &[[200, 200, 200, 255]]));
+    let (s, warnings) = scene_of(&plane.write(dir.path(), "unlit.gltf"), vec![], 0.5);
+    assert!(warnings.is_empty(), "{warnings:?}");
+    assert!(
+        s.objects[0].mesh.second_uvs.is_empty(),
+        "read for no texture"
+    );
+
+    let third = json!({"occlusionTexture": {"index": 0, "texCoord": 1},
+                       "normalTexture": {"index": 0, "texCoord": 2}});
+    let mut plane = with_second_set(third);
+    plane.images.push(png(1, 1, &[[200, 200, 200, 255]]));
+    let tangents = [1.0f32, 0.0, 0.0, 1.0].repeat(4);
+    let bytes = tangents.iter().flat_map(|v| v.to_le_bytes()).collect();
+    plane.extra.push(("TANGENT", FLOAT, "VEC4", bytes));
+    let (s, warnings) = scene_of(&plane.write(dir.path(), "third.gltf"), vec![], 0.5);
+    assert_eq!(warnings.len(), 1, "{warnings:?}");
+    assert!(
+        warnings[0].contains("normalTexture: uses TEXCOORD_2"),
+        "{warnings:?}"
+    );
+    let mesh = &s.objects[0].mesh;
+    assert_eq!(mesh.second_uvs.len(), 4, "read for the occlusion");
+    assert!(
+        mesh.tangents.is_empty(),
+        "tangents for an unbound normal map"
+    );
+}
