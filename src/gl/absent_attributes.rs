@@ -9,3 +9,6 @@ pub(crate) const ABSENT: [(u32, [f32; 4]); 3] = [
     (4, [1.0, 0.0, 0.0, 1.0]),
     (5, [0.0, 0.0, 0.0, 1.0]),
 ];
+
+/// Every attribute of [`ABSENT`], as bits (bit `i`: `ABSENT[i]`).
+pub(crate) const ABSENT_BITS: u8 = (1 << ABSENT.len()) - 1;

@@ -8,10 +8,7 @@ use std::collections::HashMap;
 use glam::DVec3;
 use glow::HasContext;
 
-use super::absent_attributes::ABSENT;
-
-/// Every attribute of [`ABSENT`], as bits.
-const ABSENT_BITS: u8 = (1 << ABSENT.len()) - 1;
+use super::absent_attributes::{ABSENT, ABSENT_BITS};
 use super::{Device, GlError};
 use crate::scene::Mesh;
 

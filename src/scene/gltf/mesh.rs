@@ -1,8 +1,9 @@
 //! Mesh primitives → [`Mesh`]: positions, normals (flat ones computed when the primitive has
-//! none, as glTF asks), `TEXCOORD_0` (and `TEXCOORD_1` where a texture reads it), indices (u8, u16, u32 or none), triangle strips and fans
-//! unrolled into lists. Every index is checked against the vertex count and every position
-//! against [`MAX_VERTEX_COORD`], with the glTF path and the element's position in the message
-//! (never its value: buffer bytes are not shown).
+//! none, as glTF asks), `TEXCOORD_0` (and `TEXCOORD_1` where a drawn texture reads it),
+//! indices (u8, u16, u32 or none), triangle strips and fans unrolled into lists. Every index
+//! is checked against the vertex count and every position against [`MAX_VERTEX_COORD`], with
+//! the glTF path and the element's position in the message (never its value: buffer bytes are
+//! not shown).
 
 use glam::{Vec2, Vec3, Vec4};
 use gltf::accessor::{DataType, Dimensions};
