@@ -207,34 +207,37 @@ impl SurfaceMaps {
         .filter_map(|t| t.as_mut().map(|t| &mut t.texture))
     }
 
+    /// Every transform with the texture it belongs to: `None` for the base colour's
+    /// (`base_transform`), else the texture's field name.
+    fn transforms(&self) -> impl Iterator<Item = (Option<&'static str>, &TextureTransform)> {
+        let textures = self.textures().map(|(name, t)| (Some(name), &t.transform));
+        std::iter::once((None, &self.base_transform)).chain(textures)
+    }
+
+    /// The field of a transform of [`SurfaceMaps::transforms`], relative to the maps, made
+    /// only for an error (validation runs every frame).
+    fn transform_field(texture: Option<&str>) -> String {
+        texture.map_or("base_transform".into(), |name| format!("{name}.transform"))
+    }
+
     /// The first transform whose numbers are not finite or whose offset or scale passes
     /// ±1e9 (`MAX_TEXCOORD`; a transformed coordinate would overflow
     /// and the surface draw black): its field, relative to the maps.
     pub fn unusable_transform(&self) -> Option<String> {
-        if !self.base_transform.is_usable() {
-            return Some("base_transform".into());
-        }
-        self.textures()
-            .find(|(_, t)| !t.transform.is_usable())
-            .map(|(name, _)| format!("{name}.transform"))
+        let (texture, _) = self.transforms().find(|(_, t)| !t.is_usable())?;
+        Some(Self::transform_field(texture))
     }
 
     /// The first transform reading a set past `UV_SETS`: its field and set.
     pub fn unknown_uv_set(&self) -> Option<(String, u32)> {
-        let slots = self
-            .textures()
-            .map(|(name, t)| (format!("{name}.transform"), t.transform));
-        std::iter::once(("base_transform".to_string(), self.base_transform))
-            .chain(slots)
-            .find(|(_, t)| t.uv_set >= UV_SETS)
-            .map(|(field, t)| (field, t.uv_set))
+        let (texture, t) = self.transforms().find(|(_, t)| t.uv_set >= UV_SETS)?;
+        Some((Self::transform_field(texture), t.uv_set))
     }
 
     /// True when some texture (the base colour's included) is sampled through a transform or
     /// from the second coordinate set.
     pub fn has_transform(&self) -> bool {
-        !self.base_transform.is_identity()
-            || self.textures().any(|(_, t)| !t.transform.is_identity())
+        self.transforms().any(|(_, t)| !t.is_identity())
     }
 }
 

@@ -131,15 +131,13 @@ pub(super) fn transform_of(
     field: &str,
     warnings: &mut Vec<String>,
 ) -> (TextureTransform, u32) {
+    // The transform reads the set, where a mesh can have it.
+    let with_set = |(t, set): (TextureTransform, u32)| {
+        let uv_set = if set < UV_SETS { set } else { 0 };
+        (TextureTransform { uv_set, ..t }, set)
+    };
     let Some(ext) = raw.transform(index, path) else {
-        let uv_set = if tex_coord < UV_SETS { tex_coord } else { 0 };
-        return (
-            TextureTransform {
-                uv_set,
-                ..TextureTransform::IDENTITY
-            },
-            tex_coord,
-        );
+        return with_set((TextureTransform::IDENTITY, tex_coord));
     };
     let pair = |key: &str, default: Vec2| -> Option<Vec2> {
         match ext.get(key) {
@@ -179,10 +177,6 @@ pub(super) fn transform_of(
     };
     let usable =
         |(t, _): &(TextureTransform, u32)| t.is_usable() && t.rows().iter().all(|r| r.is_finite());
-    let with_set = |(t, set): (TextureTransform, u32)| {
-        let uv_set = if set < UV_SETS { set } else { 0 };
-        (TextureTransform { uv_set, ..t }, set)
-    };
     match parsed.filter(usable).map(with_set) {
         Some(parsed) => parsed,
         None => {
@@ -387,12 +381,7 @@ pub(super) fn convert(
         };
         maps.metallic_roughness = load_slot(slot, index, field, src, warnings)?;
     }
-    // A strength past f32 (1e300 in the file) is infinite: the product is clamped and warned
-    // of below, as a large one is (0 × ∞ is NaN, which becomes 0).
-    let strength = m.emissive_strength().unwrap_or(1.0);
-    let e = Vec3::from(m.emissive_factor()) * strength;
-    // NaN becomes 0 (max/min drop it).
-    let emissive = e.max(Vec3::ZERO).min(Vec3::splat(MAX_EMISSIVE));
+    let (e, emissive) = emission(m);
     if emissive != e {
         warnings.push(format!(
             "{field}: emissiveFactor × KHR_materials_emissive_strength {} clamped to {} \
@@ -412,20 +401,23 @@ pub(super) fn convert(
         if emissive.max_element() > 0.0 {
             maps.emissive_texture = load_slot(slot, index, field, src, warnings)?;
         }
-        debug_assert_eq!(emissive.max_element() > 0.0, emits(m));
     }
     Ok(maps)
 }
 
-/// Whether `m`'s emission (`emissiveFactor` × `KHR_materials_emissive_strength`, as
-/// [`convert`] clamps it) is more than black: only then is its emissive texture read.
-fn emits(m: &gltf::Material) -> bool {
+/// `m`'s emission, `emissiveFactor` × `KHR_materials_emissive_strength`, as the file gives it
+/// and as kept: within [0, `MAX_EMISSIVE`]. A strength past f32 (1e300 in the file) is
+/// infinite: the product is clamped, as a large one is (0 × ∞ is NaN, which becomes 0: max
+/// and min drop it).
+fn emission(m: &gltf::Material) -> (Vec3, Vec3) {
     let strength = m.emissive_strength().unwrap_or(1.0);
     let e = Vec3::from(m.emissive_factor()) * strength;
-    e.max(Vec3::ZERO)
-        .min(Vec3::splat(MAX_EMISSIVE))
-        .max_element()
-        > 0.0
+    (e, e.max(Vec3::ZERO).min(Vec3::splat(MAX_EMISSIVE)))
+}
+
+/// Whether `m` emits: only then is its emissive texture read.
+fn emits(m: &gltf::Material) -> bool {
+    emission(m).1.max_element() > 0.0
 }
 
 /// `value` within `range`, or `default` where it is not finite (past f32 in the file), with a
