@@ -202,8 +202,25 @@ pub fn error(img: &image::RgbaImage, want: &[Option<[f64; 3]>]) -> (f64, (u32, u
     (worst, at, n)
 }
 
+/// Asserts that `other` (the twin's picture without a feature, or with it wrong) differs from
+/// `want` by more than `at_least` 8-bit steps somewhere, so the test comparing with `want` can
+/// fail; `what` names the change. The difference, for a log.
+pub fn assert_changes(
+    want: &[Option<[f64; 3]>],
+    other: &[Option<[f64; 3]>],
+    at_least: f64,
+    what: &str,
+) -> f64 {
+    let gap = oracle_gap(want, other);
+    assert!(
+        gap > at_least,
+        "{what} changes the picture by only {gap:.1}/255"
+    );
+    gap
+}
+
 /// Largest difference between two oracles (how much the feature changes the picture).
-pub fn oracle_gap(a: &[Option<[f64; 3]>], b: &[Option<[f64; 3]>]) -> f64 {
+fn oracle_gap(a: &[Option<[f64; 3]>], b: &[Option<[f64; 3]>]) -> f64 {
     a.iter()
         .zip(b)
         .filter_map(|(a, b)| Some((a.as_ref()?, b.as_ref()?)))
