@@ -67,8 +67,8 @@ fn a_program_the_game_deleted_while_current_is_kept_or_leaves_none_current() {
                 "{es}: the game's program ended"
             );
             renderer.render_offscreen(&scene, w, h, &opts).unwrap();
-            // Before, the renderer's program was left current, with GL_INVALID_VALUE
-            // pending from binding the ended program's name again.
+            // A frame made its own programs current, which ended the game's: none is left
+            // current, and no error is pending for the game.
             assert_eq!(
                 gl.get_parameter_program(glow::CURRENT_PROGRAM),
                 None,
