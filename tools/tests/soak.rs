@@ -8,10 +8,9 @@
 //!   allocations of the strings in the `FrameStats` it returns besides. Rayon's global job
 //!   queue allocates a block every 63 entries into its pool from outside, and whether an
 //!   assignment enters the pool depends on the host's speed: those blocks, told apart by their
-//!   backtrace, are allowed at that rate in every case and nothing else is. What `Scene::validate`
-//!   allocates (it runs every frame, and builds each light's and material's field name before
-//!   it knows whether there is an error to name) is counted separately and allowed for: that
-//!   is `src/scene`'s to fix, and once it allocates nothing the test demands zero outright.
+//!   backtrace, are allowed at that rate in every case and nothing else is. `Scene::validate`,
+//!   which every frame runs, is counted with the frame; a scene using every part it checks
+//!   (maps, transforms, suns, motions) is validated without an allocation too.
 //!
 //! * a warm-up copies none of the scene's lights: its peak heap is a fresh method's frame's,
 //!   where a copy of the lights and their motion added 201 bytes a light.
@@ -20,7 +19,7 @@
 //! sampled; docs/performance.md has its figures). To find an allocation that crept into the
 //! frame, run `MANYLIGHT_ALLOC_TRACE=TEXT cargo test --test soak -- --nocapture` (TEXT: part of
 //! the cases' names, as printed, e.g. `ES 3.0 courtyard 64`, or `all`): every allocation in
-//! those cases' `render_reusing` frames prints its backtrace (but `Scene::validate`'s).
+//! those cases' `render_reusing` frames prints its backtrace.
 
 mod common;
 
@@ -97,13 +96,11 @@ fn count_call(bytes: usize) {
     CALLS.fetch_add(1, Ordering::Relaxed);
     if TRACING.load(Ordering::Relaxed) {
         IN_TRACE.with(|t| t.set(true));
-        let trace = std::backtrace::Backtrace::force_capture().to_string();
-        if !trace.contains("Scene::validate") {
-            eprintln!(
-                "allocation on thread {:?}:\n{trace}",
-                std::thread::current().name()
-            );
-        }
+        let trace = std::backtrace::Backtrace::force_capture();
+        eprintln!(
+            "allocation on thread {:?}:\n{trace}",
+            std::thread::current().name()
+        );
         IN_TRACE.with(|t| t.set(false));
     }
 }
@@ -439,10 +436,6 @@ fn allocations_per_frame(
                 eprintln!("{case}: not supported here");
                 continue;
             }
-            // Scene::validate's own allocations, allowed for in every frame (see the top).
-            let before = CALLS.load(Ordering::Relaxed);
-            scene.validate().unwrap();
-            let validate = CALLS.load(Ordering::Relaxed) - before;
             let mut frame = 0;
             let mut next_frame = |scene: &mut Scene| {
                 move_lights(scene, &start, frame);
@@ -472,8 +465,7 @@ fn allocations_per_frame(
                     .unwrap_or_else(|e| panic!("{case} frame {frame}: {e}"));
                 expected += owned_strings(&stats) as i64;
             }
-            let by_render = (CALLS.load(Ordering::Relaxed) - before) as i64
-                - (MEASURED_RENDER * validate) as i64;
+            let by_render = (CALLS.load(Ordering::Relaxed) - before) as i64;
             // The game's path.
             let before = CALLS.load(Ordering::Relaxed);
             let trace = trace_cases
@@ -497,13 +489,11 @@ fn allocations_per_frame(
                     "{case}: the cap trimmed no cell"
                 );
             }
-            let reusing =
-                (CALLS.load(Ordering::Relaxed) - before) as i64 - (measured * validate) as i64;
+            let reusing = (CALLS.load(Ordering::Relaxed) - before) as i64;
             eprintln!(
                 "{case}: {reusing} allocations over {measured} frames (render_reusing); \
                  render: {by_render} over {MEASURED_RENDER} frames, {expected} of them its stats' \
-                 strings; besides, Scene::validate: {validate} a frame, rayon's job queue: \
-                 {blocks} blocks"
+                 strings; besides, rayon's job queue: {blocks} blocks"
             );
             if reusing > 0 || by_render != expected || blocks > allowed_blocks {
                 failures.push(format!(
@@ -599,5 +589,76 @@ fn a_warm_up_copies_none_of_the_lights() {
         warm_up - frame < copy / 2,
         "the warm-up took {warm_up} bytes at most, a fresh method's frame {frame}: a copy of \
          the lights takes {copy}"
+    );
+}
+
+/// `Scene::validate` runs every frame: a valid scene using every part it checks (point and
+/// spot lights moving, suns, textures on both coordinate sets through transforms) is checked
+/// without an allocation, while an invalid one names its field (which allocates: the count
+/// sees it).
+#[test]
+fn validating_a_scene_of_every_part_allocates_nothing() {
+    use glam::{Vec2, Vec3};
+    use manylight::scene::surface_maps::{MapTexture, TextureTransform};
+    use manylight::scene::{Cone, DirectionalLight, Light, Texture};
+    let _serial = serial();
+    let mut scene = scene::builtin::build("courtyard", Some((64, 5))).unwrap();
+    assert!(!scene.animation.is_empty(), "the courtyard's lights move");
+    scene.lights.push(Light::spot(
+        DVec3::new(0.0, 3.0, 0.0),
+        5.0,
+        Vec3::ONE,
+        2.0,
+        Cone {
+            direction: DVec3::NEG_Y,
+            inner_deg: 20.0,
+            outer_deg: 30.0,
+        },
+    ));
+    scene.directional_lights.push(DirectionalLight::new(
+        DVec3::new(-0.3, -1.0, 0.2),
+        Vec3::ONE,
+        1.5,
+    ));
+    let image = image::RgbaImage::from_pixel(4, 4, image::Rgba([128, 128, 255, 255]));
+    let texture = Arc::new(Texture::new("map", image));
+    let on_set = |uv_set| {
+        Some(MapTexture {
+            texture: texture.clone(),
+            transform: TextureTransform {
+                offset: Vec2::new(0.25, 0.5),
+                rotation: 0.3,
+                scale: Vec2::splat(2.0),
+                uv_set,
+            },
+        })
+    };
+    for m in &mut scene.materials {
+        m.diffuse_texture = Some(texture.clone());
+        m.maps.base_transform = on_set(1).unwrap().transform;
+        m.maps.normal = on_set(0);
+        m.maps.occlusion = on_set(1);
+        m.maps.emissive = Vec3::splat(0.5);
+        m.maps.emissive_texture = on_set(0);
+        m.maps.metallic_roughness = on_set(1);
+    }
+    let calls_of = |scene: &Scene| {
+        RENDERS.with(|r| r.set(true));
+        let before = CALLS.load(Ordering::Relaxed);
+        let result = scene.validate();
+        let calls = CALLS.load(Ordering::Relaxed) - before;
+        RENDERS.with(|r| r.set(false));
+        (result, calls)
+    };
+    let (result, calls) = calls_of(&scene);
+    result.unwrap();
+    assert_eq!(calls, 0, "validating a valid scene allocated {calls} times");
+    scene.lights[3].intensity = f32::NAN;
+    let (result, calls) = calls_of(&scene);
+    let error = result.unwrap_err().to_string();
+    assert!(error.contains("lights[3]"), "{error}");
+    assert!(
+        calls > 0,
+        "naming the field allocated nothing: the count sees nothing"
     );
 }
