@@ -190,23 +190,31 @@ pub(super) fn transform_of(
     }
 }
 
-/// The coordinate set the texture info at `path` reads, after its transform's `texCoord`
-/// override, as [`transform_of`] finds it (its warnings are the material's to give).
-pub(super) fn set_read(
-    raw: &RawMaterials,
-    index: Option<usize>,
-    path: &[&str],
-    tex_coord: u32,
-) -> u32 {
-    transform_of(raw, index, path, tex_coord, "", &mut Vec::new()).1
-}
-
-/// Which coordinate set each of a glTF material's textures reads (after its transform's
-/// `texCoord` override): what its primitives' meshes keep.
+/// Which coordinate set each texture a converted glTF material samples reads (after its
+/// transform's `texCoord` override): what its primitives' meshes keep. A texture not bound
+/// (on a set past 1, failing to load) or sampled to no effect (a normal map of scale 0) reads
+/// none.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub(super) struct SetsRead([(&'static str, Option<u32>); 5]);
 
 impl SetsRead {
+    /// The sets `material`'s textures read, by their glTF names.
+    pub fn of(material: &crate::scene::Material) -> SetsRead {
+        let maps = &material.maps;
+        let set = |t: Option<&MapTexture>| t.map(|t| t.transform.uv_set);
+        let base = material.diffuse_texture.as_ref();
+        SetsRead([
+            ("baseColorTexture", base.map(|_| maps.base_transform.uv_set)),
+            (
+                "metallicRoughnessTexture",
+                set(maps.metallic_roughness.as_ref()),
+            ),
+            ("normalTexture", set(maps.sampled_normal())),
+            ("occlusionTexture", set(maps.sampled_occlusion())),
+            ("emissiveTexture", set(maps.sampled_emissive())),
+        ])
+    }
+
     /// Some texture reads `TEXCOORD_1`.
     pub fn second(&self) -> bool {
         self.0.iter().any(|(_, set)| *set == Some(1))
@@ -223,44 +231,6 @@ impl SetsRead {
         let on = |(name, s): &(&'static str, Option<u32>)| (*s == Some(set)).then_some(*name);
         self.0.iter().filter_map(on).collect()
     }
-}
-
-/// [`SetsRead`] of `m`, whose texture infos' transforms are in `raw`.
-pub(super) fn sets_read(raw: &RawMaterials, m: &gltf::Material) -> SetsRead {
-    let index = m.index();
-    let pbr = m.pbr_metallic_roughness();
-    let set = |path: &[&str], tex_coord: u32| Some(set_read(raw, index, path, tex_coord));
-    let base = ["pbrMetallicRoughness", "baseColorTexture"];
-    let mr = ["pbrMetallicRoughness", "metallicRoughnessTexture"];
-    SetsRead([
-        (
-            "baseColorTexture",
-            pbr.base_color_texture()
-                .and_then(|t| set(&base, t.tex_coord())),
-        ),
-        (
-            "metallicRoughnessTexture",
-            pbr.metallic_roughness_texture()
-                .and_then(|t| set(&mr, t.tex_coord())),
-        ),
-        (
-            "normalTexture",
-            m.normal_texture()
-                .and_then(|t| set(&["normalTexture"], t.tex_coord())),
-        ),
-        (
-            "occlusionTexture",
-            m.occlusion_texture()
-                .and_then(|t| set(&["occlusionTexture"], t.tex_coord())),
-        ),
-        (
-            "emissiveTexture",
-            // Read only where the material emits ([`convert`]).
-            m.emissive_texture()
-                .filter(|_| emits(m))
-                .and_then(|t| set(&["emissiveTexture"], t.tex_coord())),
-        ),
-    ])
 }
 
 /// The message for a texture on a set past [`UV_SETS`]: not bound.
@@ -413,11 +383,6 @@ fn emission(m: &gltf::Material) -> (Vec3, Vec3) {
     let strength = m.emissive_strength().unwrap_or(1.0);
     let e = Vec3::from(m.emissive_factor()) * strength;
     (e, e.max(Vec3::ZERO).min(Vec3::splat(MAX_EMISSIVE)))
-}
-
-/// Whether `m` emits: only then is its emissive texture read.
-fn emits(m: &gltf::Material) -> bool {
-    emission(m).1.max_element() > 0.0
 }
 
 /// `value` within `range`, or `default` where it is not finite (past f32 in the file), with a

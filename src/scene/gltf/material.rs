@@ -123,9 +123,17 @@ impl Materials {
         (self.list, self.textures.budget)
     }
 
-    /// The coordinate sets `m`'s textures read, for its primitives' meshes.
-    pub fn sets_read(&self, m: &gltf::Material) -> maps::SetsRead {
-        maps::sets_read(&self.raw, m)
+    /// The coordinate sets `m`'s textures read, for its primitives' meshes: of `m` converted
+    /// (on first use), so a texture that failed to load reads none.
+    pub fn sets_read(
+        &mut self,
+        m: &gltf::Material,
+        buffers: &mut Buffers,
+        gltf_path: &Path,
+        warnings: &mut Vec<String>,
+    ) -> Result<maps::SetsRead, String> {
+        let i = self.get(m, buffers, gltf_path, warnings)?;
+        Ok(maps::SetsRead::of(&self.list[i]))
     }
 
     /// Index in [`Materials::list`] of `m`, converting it on first use.

@@ -81,11 +81,16 @@ pub(super) enum Built {
     Skipped(String),
 }
 
+/// The coordinate sets a primitive's material's textures read, asked once the primitive has
+/// triangles (its material is converted then, not for a primitive that is skipped).
+pub(super) type AskSets<'a> =
+    &'a mut dyn FnMut(&mut Buffers, &mut Vec<String>) -> Result<SetsRead, String>;
+
 /// Builds primitive `p` of its mesh; `field` is its glTF path (`meshes[2].primitives[0]`);
 /// `sets`: the coordinate sets its material's textures read.
 pub(super) fn build(
     p: &gltf::Primitive,
-    sets: SetsRead,
+    sets: AskSets<'_>,
     field: &str,
     buffers: &mut Buffers,
     budget: &mut Budget,
@@ -135,11 +140,6 @@ pub(super) fn build(
         .map(Vec3::from_slice)
         .collect();
     let uvs = read_uvs(p, 0, n, buffers, warnings, &attr)?;
-    let second_uvs = if sets.second() {
-        read_uvs(p, 1, n, buffers, warnings, &attr)?
-    } else {
-        Vec::new()
-    };
     let colors = read_colors(p, n, buffers, warnings, &attr)?;
     let tangents: Vec<Vec4> = read_vectors(p, &TANGENT, n, buffers, warnings, &attr)?
         .chunks_exact(4)
@@ -184,6 +184,12 @@ pub(super) fn build(
     if indices.is_empty() {
         return Ok(Built::Skipped(format!("{field}: has no triangles")));
     }
+    let sets = sets(buffers, warnings)?;
+    let second_uvs = if sets.second() {
+        read_uvs(p, 1, n, buffers, warnings, &attr)?
+    } else {
+        Vec::new()
+    };
     let flat = normals.is_empty();
     // glTF asks for flat normals when a primitive has none: each triangle gets its own
     // three vertices, and the mesh's area-weighted normals are then the face normals.
@@ -574,7 +580,7 @@ mod tests {
         };
         let built = build(
             &primitive,
-            SetsRead::default(),
+            &mut |_, _| Ok(SetsRead::default()),
             "m",
             &mut buffers,
             &mut budget,

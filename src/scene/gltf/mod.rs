@@ -452,7 +452,14 @@ fn import(
                             None => {
                                 let built = build_primitive(
                                     &prim,
-                                    materials.sets_read(&prim.material()),
+                                    &mut |buffers, warnings| {
+                                        materials.sets_read(
+                                            &prim.material(),
+                                            buffers,
+                                            path,
+                                            warnings,
+                                        )
+                                    },
                                     &pfield,
                                     &mut buffers,
                                     &mut budget,
@@ -618,7 +625,7 @@ fn check_placement(bounds: Option<Aabb>, world: &DMat4) -> Result<(), String> {
 /// where it is skipped (points, lines), with a warning.
 fn build_primitive(
     p: &gltf::Primitive,
-    sets: maps::SetsRead,
+    sets: mesh::AskSets<'_>,
     pfield: &str,
     buffers: &mut buffers::Buffers,
     budget: &mut mesh::Budget,

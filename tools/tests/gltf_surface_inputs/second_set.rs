@@ -187,7 +187,8 @@ fn the_second_set_draws_on_es2_without_vertex_arrays() {
 
 /// The second set and tangents are kept only for textures that are drawn: an emissive texture
 /// of a material that does not emit reads nothing, a normal map on a set past 1 is not bound
-/// and takes none of the file's tangents.
+/// and takes none of the file's tangents, and neither an occlusion map whose image does not
+/// decode nor a normal map of scale 0 keeps the set or tangents.
 #[test]
 fn a_mesh_keeps_the_second_set_and_tangents_only_for_textures_drawn() {
     let dir = tempfile::tempdir().unwrap();
@@ -219,5 +220,32 @@ fn a_mesh_keeps_the_second_set_and_tangents_only_for_textures_drawn() {
     assert!(
         mesh.tangents.is_empty(),
         "tangents for an unbound normal map"
+    );
+
+    let undecodable = json!({"occlusionTexture": {"index": 0, "texCoord": 1}});
+    let mut plane = with_second_set(undecodable);
+    plane.images.push(b"not a PNG".to_vec());
+    let (s, warnings) = scene_of(&plane.write(dir.path(), "broken.gltf"), vec![], 0.5);
+    assert_eq!(warnings.len(), 1, "{warnings:?}");
+    assert!(warnings[0].contains("images[0]"), "{warnings:?}");
+    assert!(s.materials[0].maps.occlusion.is_none());
+    assert!(
+        s.objects[0].mesh.second_uvs.is_empty(),
+        "read for an image that did not decode"
+    );
+
+    let flat = json!({"normalTexture": {"index": 0, "texCoord": 1, "scale": 0.0}});
+    let mut plane = with_second_set(flat);
+    plane.images.push(png(1, 1, &[[128, 128, 255, 255]]));
+    let (s, warnings) = scene_of(&plane.write(dir.path(), "flat.gltf"), vec![], 0.5);
+    assert!(warnings.is_empty(), "{warnings:?}");
+    let mesh = &s.objects[0].mesh;
+    assert!(
+        mesh.second_uvs.is_empty(),
+        "read for a normal map of scale 0"
+    );
+    assert!(
+        mesh.tangents.is_empty(),
+        "tangents for a normal map of scale 0"
     );
 }
