@@ -8,13 +8,14 @@
 
 use std::sync::atomic::{AtomicBool, Ordering};
 
-use glam::{Mat3, Vec3};
+use glam::{Mat3, Vec2, Vec3};
 
 use super::ShaderFeatures as F;
 use crate::gl::program::{Resolver, Sampler, Uniform};
 use crate::gl::Device;
 use crate::gpu_scene::GpuScene;
 use crate::scene::surface_maps::{MapTexture, TextureTransform};
+use crate::scene::texture::{Sampling, Wrap};
 use crate::scene::{Material, Mesh};
 
 /// First texture unit of the maps: after the most any geometry program's method uses
@@ -180,7 +181,8 @@ impl MapUniforms {
         let transformed = own.has(F::TEXTURE_TRANSFORM);
         let second = features.has(F::SECOND_UVS);
         if features.has(F::TEXTURE_TRANSFORM) {
-            let albedo = transformed.then(|| uv_matrix(&maps.base_transform));
+            let sampling = material.diffuse_texture.as_ref().map(|t| t.sampling);
+            let albedo = transformed.then(|| uv_matrix(&maps.base_transform, sampling));
             self.albedo_uv.set(dev, albedo.unwrap_or(Mat3::IDENTITY));
         }
         if second {
@@ -238,7 +240,9 @@ impl MapUniforms {
                 let transform = own_map.filter(|_| transformed);
                 uv.set(
                     dev,
-                    transform.map_or(Mat3::IDENTITY, |m| uv_matrix(&m.transform)),
+                    transform.map_or(Mat3::IDENTITY, |m| {
+                        uv_matrix(&m.transform, Some(m.texture.sampling))
+                    }),
                 );
             }
             if second {
@@ -268,12 +272,65 @@ impl MapUniforms {
     }
 }
 
-/// The transform as the shader's `mat3` (columns; `uv' = (M · (uv, 1)).xy`).
-fn uv_matrix(t: &TextureTransform) -> Mat3 {
-    let [r0, r1] = t.rows();
+/// The transform as the shader's `mat3` (columns; `uv' = (M · (uv, 1)).xy`), its offset
+/// reduced to one period of the wrap of the texture sampled (`sampling`), the same map
+/// through that wrap: an offset of 65 536.25 added in `f32` per vertex kept the coordinates
+/// 2⁻⁷ of the texture apart, one of 10⁶ 1/16 (a texture scrolled every frame gets there).
+fn uv_matrix(t: &TextureTransform, sampling: Option<Sampling>) -> Mat3 {
+    let reduced = |offset: f32, wrap: Option<Wrap>| {
+        let period = match wrap {
+            Some(Wrap::Repeat) => 1.0,
+            Some(Wrap::MirroredRepeat) => 2.0,
+            Some(Wrap::ClampToEdge) | None => return offset,
+        };
+        // Exact (an f32's remainder by a power of two is an f32), but that a tiny negative
+        // offset rounds to the period itself: the same map.
+        (offset as f64).rem_euclid(period) as f32
+    };
+    let offset = Vec2::new(
+        reduced(t.offset.x, sampling.map(|s| s.wrap_u)),
+        reduced(t.offset.y, sampling.map(|s| s.wrap_v)),
+    );
+    let [r0, r1] = TextureTransform { offset, ..*t }.rows();
     Mat3::from_cols(
         Vec3::new(r0.x, r1.x, 0.0),
         Vec3::new(r0.y, r1.y, 0.0),
         Vec3::new(r0.z, r1.z, 1.0),
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{uv_matrix, Sampling, TextureTransform, Vec2, Wrap};
+    use glam::Vec3;
+
+    /// The offset column `uv_matrix` gives for `offset` sampled with `wrap` on both axes.
+    fn offset_sent(offset: Vec2, wrap: Option<Wrap>) -> Vec2 {
+        let t = TextureTransform {
+            offset,
+            ..TextureTransform::IDENTITY
+        };
+        let sampling = wrap.map(|wrap| Sampling {
+            wrap_u: wrap,
+            wrap_v: wrap,
+            ..Sampling::default()
+        });
+        let column = uv_matrix(&t, sampling).z_axis;
+        assert_eq!(column.z, 1.0);
+        Vec3::truncate(column)
+    }
+
+    #[test]
+    fn an_offset_is_sent_as_its_remainder_by_the_wraps_period() {
+        let far = Vec2::new(65_536.25, -1_000_000.125);
+        assert_eq!(offset_sent(far, Some(Wrap::Repeat)), Vec2::new(0.25, 0.875));
+        // Every other copy mirrored: a period of two copies.
+        assert_eq!(
+            offset_sent(far + Vec2::X, Some(Wrap::MirroredRepeat)),
+            Vec2::new(1.25, 1.875)
+        );
+        // Clamped, or no texture: as given.
+        assert_eq!(offset_sent(far, Some(Wrap::ClampToEdge)), far);
+        assert_eq!(offset_sent(far, None), far);
+    }
 }

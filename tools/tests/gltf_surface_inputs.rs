@@ -433,6 +433,20 @@ fn vertex_colours_multiply_the_base_colour() {
 
 #[test]
 fn a_required_texture_transform_offsets_rotates_and_scales_the_base_colour() {
+    check_transformed_base_colour(Vec2::new(0.3, 0.1), "texture transform");
+}
+
+/// An offset far from 0 (a texture scrolled for hours) draws as its remainder through the
+/// REPEAT wrap: added in f32 per vertex, 65 536 kept coordinates 2⁻⁷ of the texture apart
+/// (19/255 on llvmpipe, 122/255 on SwiftShader) and 10⁶ 1/16 of it.
+#[test]
+fn a_far_texture_offset_draws_as_its_remainder() {
+    check_transformed_base_colour(Vec2::new(65536.3125, -1_000_000.125), "far offset");
+}
+
+/// A base colour texture through a required transform of `offset`, a rotation and a scale,
+/// against the twin on every method and level.
+fn check_transformed_base_colour(offset: Vec2, what: &str) {
     let dir = tempfile::tempdir().unwrap();
     let texels = [
         [230u8, 40, 40, 255],
@@ -441,7 +455,7 @@ fn a_required_texture_transform_offsets_rotates_and_scales_the_base_colour() {
         [230, 230, 60, 255],
     ];
     let transform = TextureTransform {
-        offset: Vec2::new(0.3, 0.1),
+        offset,
         rotation: 0.5,
         scale: Vec2::new(0.7, 1.3),
         uv_set: 0,
@@ -449,7 +463,7 @@ fn a_required_texture_transform_offsets_rotates_and_scales_the_base_colour() {
     let material = json!({
         "pbrMetallicRoughness": {
             "baseColorTexture": {"index": 0, "extensions": {"KHR_texture_transform": {
-                "offset": [0.3, 0.1], "rotation": 0.5, "scale": [0.7, 1.3]}}},
+                "offset": [offset.x, offset.y], "rotation": 0.5, "scale": [0.7, 1.3]}}},
             "roughnessFactor": 1.0,
             "metallicFactor": 0.0,
         },
@@ -486,7 +500,7 @@ fn a_required_texture_transform_offsets_rotates_and_scales_the_base_colour() {
     // texels than decoding the filtered value.
     let order = assert_changes(&want[0], &want[1], 10.0, "decode order");
     eprintln!("decoding before filtering changes the picture by {order:.1}/255");
-    check_every_method_by_level("texture transform", &s, [&want[0], &want[1]], 3.0);
+    check_every_method_by_level(what, &s, [&want[0], &want[1]], 3.0);
 }
 
 /// A transform's `texCoord` that is not a set number (a string, a fraction, negative, past
