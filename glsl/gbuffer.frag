@@ -10,8 +10,8 @@ VARYING vec2 v_uv;
 layout(location = 0) out vec4 o_albedo;
 layout(location = 1) out HIGHP vec4 o_normalDepth;
 layout(location = 2) out vec4 o_specular;
-// The accumulation buffer's start: what the surface adds besides ambient × albedo and the
-// lights (emission, the ambient term's occlusion), so the composite's sum equals forward's.
+// The accumulation buffer's start: what the surface adds besides the lights (its ambient
+// term, occlusion included, and emission), so the composite's sum equals forward's.
 layout(location = 3) out vec4 o_extra;
 // The light pass's pre-exposure (deferred.rs accumulation_scale), which the composite undoes.
 uniform HIGHP float u_accumScale;
@@ -30,11 +30,15 @@ void main() {
     HIGHP vec2 offset = windowPosition(v_viewPos) - gl_FragCoord.xy;
     vec3 albedo = surfaceAlbedo(v_uv);
     o_albedo = vec4(albedo, offset.y);
-    // Only what a material adds: the count variants' accumulation must start at exactly 0,
-    // and their albedo is not a colour (a − a of it need not be 0).
+    // The whole ambient term here, in f32 from the albedo forward shades with: added back in
+    // the composite from the G-buffer's 11-bit albedo, an occluded term written as its
+    // difference from ambient × albedo did not cancel (6/255 from forward), and in a half-float
+    // accumulation each light was rounded at that difference's magnitude. The count variants'
+    // accumulation starts at exactly 0.
+#if COUNT_EVALS || COUNT_REACHING
     vec3 extra = vec3(0.0);
-#if HAS_OCCLUSION
-    extra = surfaceAmbient(albedo, v_uv) - u_ambient * albedo;
+#else
+    vec3 extra = surfaceAmbient(albedo, v_uv);
 #endif
 #if HAS_EMISSIVE
     extra += surfaceEmission(v_uv);

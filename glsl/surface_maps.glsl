@@ -72,17 +72,18 @@ uniform sampler2D u_occlusionTex;
 uniform float u_occlusionStrength;
 #endif
 
-// The ambient term of a surface of this albedo. In fp16 (no fragment highp) the uniform and
-// the term are capped at FP16_MAX_AMBIENT: past fp16's 65 504 they would be infinity, white at
-// any exposure.
+// The ambient term of a surface of this albedo. The occlusion scales the albedo first: an
+// ambient × albedo past the float range times an occlusion of 0 was inf · 0, NaN. In fp16 (no
+// fragment highp) the uniform and the term are capped at FP16_MAX_AMBIENT: past fp16's
+// 65 504 they would be infinity, white at any exposure.
 vec3 surfaceAmbient(vec3 albedo, vec2 uv) {
+#if HAS_OCCLUSION
+    float ao = TEXTURE2D(u_occlusionTex, UV_OCCLUSION(uv)).r;
+    albedo *= 1.0 + u_occlusionStrength * (ao - 1.0);
+#endif
     vec3 a = u_ambient * albedo;
 #if FP16_LIGHTS
     a = min(a, vec3(FP16_MAX_AMBIENT));
-#endif
-#if HAS_OCCLUSION
-    float ao = TEXTURE2D(u_occlusionTex, UV_OCCLUSION(uv)).r;
-    a *= 1.0 + u_occlusionStrength * (ao - 1.0);
 #endif
     return a;
 }

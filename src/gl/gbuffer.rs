@@ -12,8 +12,8 @@
 //! depth             DEPTH24      4    for the geometry pass's depth test
 //! accumulation      RGBA32F     16    Σ light radiance (additive blending; RGBA16F, 8 bytes,
 //!                                     where GL_EXT_float_blend is missing), started by the
-//!                                     geometry pass (colour 3) with the surface's emission
-//!                                     and the ambient term's occlusion
+//!                                     geometry pass (colour 3) with the surface's ambient
+//!                                     term (its occlusion included) and emission
 //!                              ----
 //!                               52 bytes per pixel (1280×720: 47.9 MB), 44 with RGBA16F;
 //!                               8 fewer without the specular target

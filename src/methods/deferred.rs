@@ -9,7 +9,8 @@
 //!    only when the far side would be clipped too); each covered pixel reads the G-buffer once
 //!    and adds the light's contribution to a float accumulation buffer. The light model is the
 //!    same GLSL chunk as every other method's.
-//! 3. **Composite** — ambient plus the accumulated light, encoded like the forward methods.
+//! 3. **Composite** — the accumulation (the geometry pass starts it at each surface's ambient
+//!    term and emission; the lights add to it), encoded like the forward methods.
 //! 4. **Transparent objects** — documented forward fallback: the composite wrote the G-buffer's
 //!    depth into the target, and transparent objects are drawn back to front with plain
 //!    forward shading.
@@ -97,14 +98,16 @@ pub struct GBufferProgram {
     surface: Surface,
     viewport: Uniform<[f32; 2]>,
     half_extent: Uniform<[f32; 2]>,
-    /// [`accumulation_scale`], for what the surface itself adds (emission, occlusion).
+    /// [`accumulation_scale`], for what the surface itself adds (ambient, emission).
     accum_scale: Uniform<f32>,
 }
 
 impl UniformSet for GBufferProgram {
     fn resolve(r: &mut Resolver<'_>) -> Self {
         let f = uniforms::features(r);
-        let adds = f.has(ShaderFeatures::EMISSIVE) || f.has(ShaderFeatures::OCCLUSION);
+        // The colour variants start the accumulation at the surface's ambient term (count
+        // variants at 0, or at emission where they draw it).
+        let adds = !f.counting() || f.has(ShaderFeatures::EMISSIVE);
         GBufferProgram {
             transforms: Transforms::resolve(r, true),
             surface: Surface::gbuffer(r),
@@ -144,7 +147,7 @@ impl UniformSet for LightProgram {
         let proxy = r.shader() == "deferred_light";
         LightProgram {
             projection: proxy.then(|| r.required("u_projection")),
-            g_albedo: r.required_when(colour, "u_gAlbedo"),
+            g_albedo: r.required_when(colour && f.has(ShaderFeatures::DIRECTIONAL), "u_gAlbedo"),
             g_normal_depth: r.required("u_gNormalDepth"),
             g_specular: r.required_when(colour && f.has(ShaderFeatures::SPECULAR), "u_gSpecular"),
             viewport: r.required_when(colour, "u_viewport"),
@@ -161,7 +164,6 @@ pub struct CompositeProgram {
     accum: Uniform<Sampler>,
     g_depth: Uniform<Sampler>,
     frame_origin: Uniform<[f32; 2]>,
-    ambient: Uniform<Vec3>,
     exposure: Uniform<f32>,
     /// Undoes [`accumulation_scale`].
     accum_to_radiance: Uniform<f32>,
@@ -183,12 +185,11 @@ impl UniformSet for CompositeProgram {
         let directional =
             colour && f.has(ShaderFeatures::DIRECTIONAL) && f.has(ShaderFeatures::SPECULAR);
         CompositeProgram {
-            g_albedo: r.required_when(colour, "u_gAlbedo"),
+            g_albedo: r.required_when(colour && f.has(ShaderFeatures::DIRECTIONAL), "u_gAlbedo"),
             g_normal_depth: r.required("u_gNormalDepth"),
             accum: r.required("u_accum"),
             g_depth: r.required("u_gDepth"),
             frame_origin: r.required("u_frameOrigin"),
-            ambient: r.required_when(colour, "u_ambient"),
             exposure: r.required_when(colour && !f.has(ShaderFeatures::OUTPUT_HDR), "u_exposure"),
             accum_to_radiance: r.required_when(colour, "u_accumToRadiance"),
             alpha: r.required_when(colour, "u_alpha"),
@@ -489,7 +490,6 @@ impl Deferred {
         p.accum.set(dev, UNIT_ACCUM);
         p.g_depth.set(dev, UNIT_G_DEPTH);
         p.frame_origin.set(dev, ctx.origin.map(|v| v as f32));
-        p.ambient.set(dev, ctx.scene.ambient);
         p.exposure.set(dev, ctx.options.exposure_ev.exp2());
         p.accum_to_radiance.set(dev, accum_to_radiance);
         p.alpha.set(dev, 1.0);

@@ -701,6 +701,24 @@ fn an_ambient_past_fp16_is_drawn_at_the_fp16_cap_with_a_warning() {
     assert!(d <= 3, "{d} / 255 from highp's frame at the term's cap");
 }
 
+/// An ambient × albedo past f32 on a surface its occlusion map darkens to nothing: the map
+/// scales the albedo before the ambient multiplies it, so such a texel shows its lights
+/// alone, as the light model says (∞ · 0 was NaN: black in every method).
+#[test]
+fn an_ambient_past_f32_on_a_fully_occluded_surface_leaves_its_lights() {
+    let lit = common::occluded_quad(8.0, &[0], 0.0);
+    let mut huge = lit.clone();
+    huge.ambient = Vec3::splat(1e38);
+    let opts = RenderOptions::default();
+    common::each_method(|es, method, gpu| {
+        let want = gpu.render(&lit, 64, 36, &opts);
+        assert!(mean(&want) > 5.0, "the lights show");
+        let got = gpu.render(&huge, 64, 36, &opts);
+        let d = manylight::metrics::diff(&want, &got).max_abs;
+        assert!(d <= 1, "{es} {method}: {d} / 255 from the lights alone");
+    });
+}
+
 /// Without fragment highp the sum of a pixel's lights is fp16 too: eight lights each at the
 /// shader's per-light cap summed past 65 504 to infinity, white at any exposure. The sum is
 /// now capped there: where it passes, the frame is highp's frame of a pixel value of 65 504 (an

@@ -413,6 +413,36 @@ pub fn turned_square() -> Scene {
     s
 }
 
+/// A square of metallic-roughness `base` colour (rough, dielectric) facing the camera, its
+/// occlusion map of 1 × N texels reading `ao` (0–255) across it at full strength, under an
+/// `ambient`, with eight lights of rising intensity over it: a bright ambient that the map
+/// darkens to nothing in places.
+pub fn occluded_quad(base: f32, ao: &[u8], ambient: f32) -> Scene {
+    use manylight::scene::surface_maps::MapTexture;
+    use manylight::scene::Texture;
+    let mut s = turned_square();
+    let texels = image::RgbaImage::from_fn(ao.len() as u32, 1, |x, _| {
+        image::Rgba([ao[x as usize], 0, 0, 255])
+    });
+    let mut m = Material::metallic_roughness("occluded", Vec3::splat(base), 0.0, 1.0);
+    m.maps.occlusion = Some(MapTexture {
+        texture: Arc::new(Texture::new("ao", texels)),
+        transform: Default::default(),
+    });
+    s.materials[0] = m;
+    s.objects[0].transform = DMat4::IDENTITY;
+    s.ambient = Vec3::splat(ambient);
+    s.camera = Camera::perspective(DVec3::new(0.0, 0.0, 1.8), DVec3::ZERO, 60.0, 0.1, 10.0);
+    s.lights = (0..8)
+        .map(|i| {
+            let f = i as f64;
+            let at = DVec3::new(0.25 * f - 0.9, 0.4 * (f * 1.3).sin(), 0.3);
+            Light::point(at, 1.5, Vec3::ONE, 0.02 * (1.0 + f * f) as f32)
+        })
+        .collect();
+    s
+}
+
 /// Asserts that `img` (of [`turned_square`], linear, 4 samples) resolved every pixel to a
 /// coverage of 4 samples, k/4 of white, with the square's edges partly covered and its inside
 /// and outside untouched.
