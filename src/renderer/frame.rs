@@ -101,6 +101,9 @@ impl Renderer {
     ) -> Result<(), Error> {
         // The frame's own errors first: they do not depend on what is bound.
         check_viewport(width, height)?;
+        // The size before the origin: a frame of u32::MAX pixels is too large, whatever its
+        // origin (it was named an origin past GL's window coordinates).
+        self.check_viewport_limit(width, height)?;
         check_origin(origin, width, height)?;
         // Before MSAA's target is made: its refusal would hide the option's error.
         check_options(options)?;

@@ -129,7 +129,8 @@ fn an_incomplete_framebuffer_is_refused_naming_its_status() {
 /// A frame wider than `GL_MAX_VIEWPORT_DIMS` is refused naming the limit (GL clamped the
 /// viewport and the call returned `Ok`), by `render` and `render_offscreen` alike (one gave a
 /// limit's text and the other an unsupported capability): a game matches one error. (The
-/// renderer's own targets' limits give the same error: `src/gl/target_size.rs`.)
+/// renderer's own targets' limits give the same error: `src/gl/target_size.rs`.) A frame of
+/// `u32::MAX` pixels a side too (`render` named its origin, past GL's window coordinates).
 #[test]
 fn a_frame_past_the_viewport_limit_is_refused_alike_by_every_call() {
     let (_ctx, gl, mut r) = game(EsVersion::Es3);
@@ -137,25 +138,26 @@ fn a_frame_past_the_viewport_limit_is_refused_alike_by_every_call() {
     assert!(max_w > 0, "GL_MAX_VIEWPORT_DIMS was not read");
     unsafe { game_fbo(&gl, Some(glow::DEPTH_COMPONENT24)) };
     let options = RenderOptions::default();
-    let (w, h) = (max_w as u32 + 1, 8);
-    let expected = (w, h, "GL_MAX_VIEWPORT_DIMS", max_w as u32, max_h as u32);
-    let refusals = [
-        r.render(&plane(), w, h, &options).unwrap_err(),
-        r.render_offscreen(&plane(), w, h, &options).unwrap_err(),
-    ];
-    for err in refusals {
-        match &err {
-            Error::Gl(GlError::TooLarge {
-                width,
-                height,
-                limit,
-                max_width,
-                max_height,
-                ..
-            }) => assert_eq!((*width, *height, *limit, *max_width, *max_height), expected),
-            other => panic!("{other}"),
+    for (w, h) in [(max_w as u32 + 1, 8), (u32::MAX, u32::MAX)] {
+        let expected = (w, h, "GL_MAX_VIEWPORT_DIMS", max_w as u32, max_h as u32);
+        let refusals = [
+            r.render(&plane(), w, h, &options).unwrap_err(),
+            r.render_offscreen(&plane(), w, h, &options).unwrap_err(),
+        ];
+        for err in refusals {
+            match &err {
+                Error::Gl(GlError::TooLarge {
+                    width,
+                    height,
+                    limit,
+                    max_width,
+                    max_height,
+                    ..
+                }) => assert_eq!((*width, *height, *limit, *max_width, *max_height), expected),
+                other => panic!("{other}"),
+            }
+            assert!(err.to_string().contains("GL_MAX_VIEWPORT_DIMS"), "{err}");
         }
-        assert!(err.to_string().contains("GL_MAX_VIEWPORT_DIMS"), "{err}");
     }
 }
 
