@@ -38,6 +38,9 @@ static WARNED: [AtomicBool; 4] = [
     AtomicBool::new(false),
 ];
 
+/// Whether a normal map on a mesh without tangents was warned of (once a process).
+static WARNED_TANGENTLESS: AtomicBool = AtomicBool::new(false);
+
 /// Whether `material`'s base colour texture is sampled on `mesh`: the mesh has the
 /// coordinate set it reads. Without, every pixel would read one texel: the material's flat
 /// colours draw it, as the loaders warn.
@@ -53,16 +56,25 @@ pub fn features(material: &Material, mesh: &Mesh, units: i32) -> F {
     let emits = maps.emits();
     let sampled =
         |map: Option<&MapTexture>| map.is_some_and(|m| m.transform.coordinates(mesh).is_some());
+    let normal_mapped = sampled(maps.sampled_normal());
+    if normal_mapped
+        && mesh.tangents.is_empty()
+        && !WARNED_TANGENTLESS.swap(true, Ordering::Relaxed)
+    {
+        log::warn!(
+            "the normal map of material `{}` is not applied on a mesh without tangents: give a \
+             mesh built in code its tangents with Mesh::with_generated_tangents (the glTF \
+             loader makes them)",
+            material.name
+        );
+    }
     let mut bits = [
         (F::VERTEX_COLOR, !mesh.colors.is_empty()),
         (
             F::VERTEX_ALPHA,
             material.alpha_vertex && !mesh.colors.is_empty(),
         ),
-        (
-            F::NORMAL_MAP,
-            sampled(maps.sampled_normal()) && !mesh.tangents.is_empty(),
-        ),
+        (F::NORMAL_MAP, normal_mapped && !mesh.tangents.is_empty()),
         (F::EMISSIVE, emits),
         (F::EMISSIVE_MAP, sampled(maps.sampled_emissive())),
         (F::OCCLUSION, sampled(maps.sampled_occlusion())),

@@ -106,7 +106,9 @@ pub struct MapTexture {
 pub struct SurfaceMaps {
     /// Transform of the base colour (diffuse) texture.
     pub base_transform: TextureTransform,
-    /// Tangent-space normal map (linear RGB, `n = 2·rgb − 1`).
+    /// Tangent-space normal map (linear RGB, `n = 2·rgb − 1`), applied on meshes that have
+    /// [`Mesh::tangents`](super::Mesh::tangents) (a mesh built in code:
+    /// [`Mesh::with_generated_tangents`](super::Mesh::with_generated_tangents)).
     pub normal: Option<MapTexture>,
     /// `normalTexture.scale`: scales the map's x and y.
     pub normal_scale: f32,

@@ -243,6 +243,51 @@ fn a_normal_map_tilts_the_shading_normal_with_file_and_generated_tangents() {
 /// A primitive without `TEXCOORD_0` samples none of its material's textures (each pixel would
 /// read the corner texel): its factors draw it, with every method, and the load says which
 /// textures went unapplied.
+/// A normal map on a mesh built in code, which has no tangents, is not applied, and that is
+/// said once (it passed in silence); the mesh with `Mesh::with_generated_tangents` shows it.
+/// In a process of its own: the warning is said once a process.
+#[test]
+fn a_normal_map_on_a_mesh_without_tangents_is_not_applied_and_said() {
+    const CHILD: &str = "MANYLIGHT_TEST_TANGENTLESS";
+    if std::env::var_os(CHILD).is_none() {
+        common::child::rerun_with(
+            "a_normal_map_on_a_mesh_without_tangents_is_not_applied_and_said",
+            &[(CHILD, "1")],
+            "in a process of its own",
+        );
+        return;
+    }
+    use manylight::scene::surface_maps::MapTexture;
+    common::warnings::install();
+    let said =
+        || common::warnings::warnings_containing("is not applied on a mesh without tangents").len();
+    let bare = scene::builtin::build("plane", Some((8, 1))).unwrap();
+    let tilted = image::RgbaImage::from_pixel(4, 4, image::Rgba([230, 128, 160, 255]));
+    let mut mapped = bare.clone();
+    for m in &mut mapped.materials {
+        m.maps.normal = Some(MapTexture {
+            texture: std::sync::Arc::new(scene::Texture::new("tilted", tilted.clone())),
+            transform: TextureTransform::IDENTITY,
+        });
+    }
+    let mut gpu = Gpu::new(EsVersion::Es3);
+    let opts = RenderOptions::default();
+    let want = gpu.render(&bare, 64, 36, &opts);
+    for _ in 0..2 {
+        let got = gpu.render(&mapped, 64, 36, &opts);
+        assert_eq!(manylight::metrics::diff(&want, &got).max_abs, 0);
+    }
+    assert_eq!(said(), 1, "said once");
+    for o in &mut mapped.objects {
+        let mesh = (*o.mesh).clone().with_generated_tangents().unwrap().0;
+        o.mesh = std::sync::Arc::new(mesh);
+    }
+    let got = gpu.render(&mapped, 64, 36, &opts);
+    let d = manylight::metrics::diff(&want, &got).max_abs;
+    assert!(d > 20, "with tangents the map shows: {d} / 255");
+    assert_eq!(said(), 1);
+}
+
 #[test]
 fn textures_of_a_primitive_without_texture_coordinates_are_not_applied_and_said() {
     let dir = tempfile::tempdir().unwrap();
