@@ -308,8 +308,11 @@ impl Scene {
         }
     }
 
-    /// Checks every value the GPU will see: lights (finite, non-negative radius, valid cones),
-    /// ambient colour, camera, material indices and material values. Errors name the field.
+    /// Checks the scene's values the GPU will see besides its meshes: lights (finite,
+    /// non-negative radius, valid cones), ambient colour, camera, material indices, material
+    /// values and object transforms. Errors name the field. It runs every frame, so it stays
+    /// cheap: a mesh, whose check is a pass over its vertices, is checked when it is uploaded
+    /// (its first frame), or beforehand with [`Mesh::validate`].
     pub fn validate(&self) -> Result<(), SceneError> {
         self.camera.validate()?;
         if !self.ambient.is_finite() || self.ambient.min_element() < 0.0 {
