@@ -23,7 +23,7 @@ mod light_instances;
 mod proxy;
 mod proxy_sphere;
 
-use glam::{Mat4, Vec3};
+use glam::Mat4;
 
 use super::directional::DirectionalUniforms;
 use super::forward::Forward;

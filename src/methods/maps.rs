@@ -334,12 +334,12 @@ mod tests {
 
     #[test]
     fn an_offset_is_sent_as_its_remainder_by_the_wraps_period() {
-        let far = Vec2::new(65_536.25, -1_000_000.125);
-        assert_eq!(offset_sent(far, Some(Wrap::Repeat)), Vec2::new(0.25, 0.875));
+        let far = Vec2::new(65_536.25, -1_000_000.5);
+        assert_eq!(offset_sent(far, Some(Wrap::Repeat)), Vec2::new(0.25, 0.5));
         // Every other copy mirrored: a period of two copies.
         assert_eq!(
             offset_sent(far + Vec2::X, Some(Wrap::MirroredRepeat)),
-            Vec2::new(1.25, 1.875)
+            Vec2::new(1.25, 1.5)
         );
         // Clamped, or no texture: as given.
         assert_eq!(offset_sent(far, Some(Wrap::ClampToEdge)), far);

@@ -486,7 +486,7 @@ fn a_required_texture_transform_offsets_rotates_and_scales_the_base_colour() {
 /// (19/255 on llvmpipe, 122/255 on SwiftShader) and 10⁶ 1/16 of it.
 #[test]
 fn a_far_texture_offset_draws_as_its_remainder() {
-    check_transformed_base_colour(Vec2::new(65536.3125, -1_000_000.125), "far offset");
+    check_transformed_base_colour(Vec2::new(65_536.25, -1_000_000.5), "far offset");
 }
 
 /// A base colour texture through a required transform of `offset`, a rotation and a scale,
