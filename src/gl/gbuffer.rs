@@ -157,7 +157,7 @@ impl GBuffer {
         let gl = &dev.gl;
         unsafe {
             gl.bind_framebuffer(glow::FRAMEBUFFER, Some(geometry_fbo));
-            // The accumulation buffer too: the geometry pass starts it (emission, occlusion).
+            // The accumulation buffer too: the geometry pass starts it (ambient, emission).
             for (i, t) in gb.color.iter().enumerate() {
                 gl.framebuffer_texture_2d(
                     glow::FRAMEBUFFER,
@@ -250,8 +250,8 @@ impl GBuffer {
         unsafe { gl.clear_buffer_f32_slice(glow::COLOR, 1, &[0.0, 0.0, NO_SURFACE_DEPTH, 0.0]) };
     }
 
-    /// Binds the accumulation buffer as the geometry pass left it (each surface's emission
-    /// and occlusion; 0 elsewhere), with the geometry pass's depth attached (kept) for the
+    /// Binds the accumulation buffer as the geometry pass left it (each surface's ambient
+    /// term and emission; 0 elsewhere), with the geometry pass's depth attached (kept) for the
     /// light volumes' depth test.
     pub fn begin_accumulation(&self, dev: &Device) {
         unsafe {

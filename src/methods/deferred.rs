@@ -147,7 +147,7 @@ impl UniformSet for LightProgram {
         let proxy = r.shader() == "deferred_light";
         LightProgram {
             projection: proxy.then(|| r.required("u_projection")),
-            g_albedo: r.required_when(colour && f.has(ShaderFeatures::DIRECTIONAL), "u_gAlbedo"),
+            g_albedo: r.required_when(colour, "u_gAlbedo"),
             g_normal_depth: r.required("u_gNormalDepth"),
             g_specular: r.required_when(colour && f.has(ShaderFeatures::SPECULAR), "u_gSpecular"),
             viewport: r.required_when(colour, "u_viewport"),

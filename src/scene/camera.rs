@@ -43,10 +43,14 @@ pub const MIN_ORTHO_HEIGHT: f64 = 1e-6;
 /// frame black).
 pub const MIN_FOV_Y_DEG: f64 = 1e-3;
 
-/// How far from rigid [`Camera::from_view_matrix`]'s matrix may be: the largest entry of
-/// `RᵀR − I` for its rotation `R`, and of its last row less (0, 0, 0, 1). `f32` matrices a
-/// game builds are off by about 10⁻⁷.
+/// How far from orthonormal the rotation of [`Camera::from_view_matrix`]'s matrix may be
+/// (largest entry of `RᵀR − I`): `f32` matrices a game builds are off by about 10⁻⁷.
 pub const VIEW_RIGID_TOLERANCE: f64 = 1e-4;
+
+/// How far from 1 the last entry of [`Camera::from_view_matrix`]'s matrix may be (an `f32`
+/// rounding), and from 0 the rest of its last row (exactly 0 in an inverted transform).
+const LAST_ROW_W_ROUNDING: f64 = 1e-6;
+const LAST_ROW_XYZ_ROUNDING: f64 = 1e-12;
 
 /// A perspective far plane this many near planes away or more is treated as infinite.
 pub const FAR_AS_INFINITE: f64 = 1e20;
@@ -98,19 +102,21 @@ impl Camera {
     /// The camera a game's own view matrix (world → view, right-handed, looking down −Z, as
     /// [`Camera::view_matrix`] gives) describes, with `projection`: an engine keeps its camera
     /// as a transform, not as a look-at. The matrix must be rigid (a rotation and a
-    /// translation, to within `f32` rounding: each entry of its last row within 10⁻⁴ of
-    /// (0, 0, 0, 1), which it is then taken as, and its rotation orthonormal within it): one
-    /// that scales, shears, mirrors or projects is refused, naming `camera.view`, since the
-    /// light assignment works in its view space.
+    /// translation, to within `f32` rounding: its last row (0, 0, 0, 1) but for 10⁻⁶ in w,
+    /// which it is then taken as, and its rotation orthonormal within 10⁻⁴): one that scales,
+    /// shears, mirrors or projects is refused, naming `camera.view`, since the light
+    /// assignment works in its view space.
     pub fn from_view_matrix(view: DMat4, projection: Projection) -> Result<Camera, SceneError> {
         let invalid = |reason: String| SceneError::invalid("camera.view", reason);
         if !view.is_finite() {
             return Err(invalid("must be finite".into()));
         }
-        // An inverted transform's last row comes out a rounding off: w = 0.9999999999999999
-        // in f64 for one random camera in sixteen, 1.0000001 in f32.
+        // An inverted transform's last row comes out a rounding off in w: 0.9999999999999999
+        // in f64 for one random camera in sixteen, 1.0000001 in f32 (x, y and z stay 0; one
+        // of 10⁻⁴ would put a point 10⁴ away at half its depth).
         let bottom = view.row(3);
-        if (bottom - glam::DVec4::W).abs().max_element() > VIEW_RIGID_TOLERANCE {
+        let off = (bottom - glam::DVec4::W).abs();
+        if off.truncate().max_element() > LAST_ROW_XYZ_ROUNDING || off.w > LAST_ROW_W_ROUNDING {
             return Err(invalid(format!(
                 "must be rigid: its last row is {bottom:?}, not (0, 0, 0, 1) (a projection \
                  goes in the camera's projection)"
@@ -545,6 +551,9 @@ mod tests {
         let view = DMat4::from_rotation_y(0.3) * DMat4::from_translation(DVec3::new(1.0, 2.0, 3.0));
         let mut nan = view;
         nan.w_axis.x = f64::NAN;
+        // A trace of perspective: a point 10⁴ away would be drawn at half its depth.
+        let mut near_projective = view;
+        near_projective.z_axis.w = -1e-4;
         let refused = [
             (view * DMat4::from_scale(DVec3::splat(1.01)), "rigid"),
             (
@@ -552,6 +561,7 @@ mod tests {
                 "mirrors",
             ),
             (Camera::default().projection_matrix(1.5) * view, "last row"),
+            (near_projective, "last row"),
             (nan, "finite"),
         ];
         for (matrix, why) in refused {

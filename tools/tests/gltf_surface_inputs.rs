@@ -240,9 +240,6 @@ fn a_normal_map_tilts_the_shading_normal_with_file_and_generated_tangents() {
     check_every_method("mirrored normal map", &s, &want, 3.0);
 }
 
-/// A primitive without `TEXCOORD_0` samples none of its material's textures (each pixel would
-/// read the corner texel): its factors draw it, with every method, and the load says which
-/// textures went unapplied.
 /// A normal map on a mesh built in code, which has no tangents, is not applied, and that is
 /// said once (it passed in silence); the mesh with `Mesh::with_generated_tangents` shows it.
 /// In a process of its own: the warning is said once a process.
@@ -288,6 +285,9 @@ fn a_normal_map_on_a_mesh_without_tangents_is_not_applied_and_said() {
     assert_eq!(said(), 1);
 }
 
+/// A primitive without `TEXCOORD_0` samples none of its material's textures (each pixel would
+/// read the corner texel): its factors draw it, with every method, and the load says which
+/// textures went unapplied.
 #[test]
 fn textures_of_a_primitive_without_texture_coordinates_are_not_applied_and_said() {
     let dir = tempfile::tempdir().unwrap();
