@@ -341,6 +341,7 @@ impl Deferred {
             far: ctx.scene.camera.far_clip_range().0 as f32,
             projection: ctx.projection.as_dmat4(),
             eye_plane_unreliable: dev.caps().loses_triangles_crossing_the_eye_plane(),
+            rows: ctx.viewport.1,
         };
         // Lights with the same proxy drawn together, as instances of it, in their order: the
         // state, program, uniforms and arrays set once for them. `k` numbers the lights drawn,

@@ -22,6 +22,11 @@ const FAR_MARGIN: f32 = 0.999;
 /// seen to lose light (docs/precision.md).
 const FAR_SIDE_REACH: f32 = 2048.0;
 
+/// Most pixels a proxy may span across, as scene triangles (`scene::triangle_reach`): a sphere
+/// of about 2²⁷ pixels (a 10⁻⁵-high orthographic view) lost its light on every implementation
+/// here, without an error. Past it, the full-screen path: such a light covers the frame.
+const MAX_PROXY_SPAN_PX: f64 = (1u64 << 24) as f64;
+
 /// How a light's proxy is drawn and depth tested against the surfaces:
 /// - wholly in front of the near plane: the sphere's near side, `LEQUAL` — where a surface
 ///   lies in front of the whole sphere the light cannot reach it and the pixel is skipped;
@@ -31,9 +36,9 @@ const FAR_SIDE_REACH: f32 = 2048.0;
 ///   ([`Caps::loses_triangles_crossing_the_eye_plane`](crate::gl::Caps)) and the sphere
 ///   reaches behind the eye: a full-screen triangle at the depth of the light's far end,
 ///   `GEQUAL` — surfaces behind that plane are skipped;
-/// - reaching the far plane too, depth too coarse there for any test, or a far side the near
-///   plane clips into faces too large to interpolate depth over: a full-screen triangle,
-///   untested.
+/// - reaching the far plane too, depth too coarse there for any test, a far side the near
+///   plane clips into faces too large to interpolate depth over, or a sphere spanning more
+///   than [`MAX_PROXY_SPAN_PX`]: a full-screen triangle, untested.
 ///
 /// Each is one-sided (no stencil). The far side everywhere would skip more in open scenes but
 /// evaluate far more in enclosed ones (the conference room); the near side first avoids that
@@ -87,6 +92,8 @@ pub(super) struct ProxyReach<'a> {
     pub projection: DMat4,
     /// [`Caps::loses_triangles_crossing_the_eye_plane`](crate::gl::Caps).
     pub eye_plane_unreliable: bool,
+    /// The frame's height in pixels.
+    pub rows: u32,
 }
 
 impl ProxyReach<'_> {
@@ -97,10 +104,10 @@ impl ProxyReach<'_> {
         // where it ends (a tiny near plane makes them wider; docs/precision.md).
         let coarse = self.camera.depth_step_at(f64::from(depth + radius), 24)
             > 0.1 * f64::from(light.cull_radius);
-        if !coarse && depth - radius >= 2.0 * self.near {
+        if !coarse && depth - radius >= 2.0 * self.near && !self.too_wide(radius, depth) {
             return Proxy::NearSide;
         }
-        if coarse || depth + radius >= FAR_MARGIN * self.far {
+        if coarse || depth + radius >= FAR_MARGIN * self.far || self.too_wide(radius, depth) {
             return Proxy::FullScreen;
         }
         let perspective = matches!(self.camera.projection, Projection::Perspective { .. });
@@ -115,6 +122,21 @@ impl ProxyReach<'_> {
         } else {
             Proxy::FarSide
         }
+    }
+
+    /// Whether a proxy of `radius` at `depth` spans more than [`MAX_PROXY_SPAN_PX`] where it
+    /// comes nearest the eye (the near plane at most).
+    fn too_wide(&self, radius: f32, depth: f32) -> bool {
+        let rows = f64::from(self.rows.max(1));
+        // The size of a pixel where the proxy comes nearest.
+        let pixel = match self.camera.projection {
+            Projection::Perspective { fov_y_deg, .. } => {
+                let nearest = f64::from((depth - radius).max(self.near));
+                2.0 * nearest * (fov_y_deg.to_radians() * 0.5).tan() / rows
+            }
+            Projection::Orthographic { height, .. } => height / rows,
+        };
+        2.0 * f64::from(radius) > MAX_PROXY_SPAN_PX * pixel
     }
 
     /// The normalized device depth of a [`Proxy::Bounded`] light's far end (its proxy
@@ -151,6 +173,7 @@ mod tests {
             far: far as f32,
             projection: camera.projection_matrix(16.0 / 9.0),
             eye_plane_unreliable,
+            rows: 720,
         }
     }
 
@@ -181,6 +204,28 @@ mod tests {
         let huge = light(DVec3::ZERO, 0.1 * FAR_SIDE_REACH);
         assert_eq!(reach(&camera, true).proxy(&huge), Proxy::FullScreen);
         assert_eq!(reach(&camera, false).proxy(&huge), Proxy::FullScreen);
+    }
+
+    /// A sphere spanning more pixels than rasterizers keep (a 10⁻⁵-high orthographic view,
+    /// a 10⁻³° lens) is drawn full screen; the same sphere in an ordinary view is not.
+    #[test]
+    fn a_sphere_wider_than_rasterizers_keep_is_drawn_full_screen() {
+        let orthographic = |height| Camera {
+            projection: Projection::Orthographic {
+                height,
+                near: 0.0,
+                far: 100.0,
+            },
+            ..camera(0.1)
+        };
+        let narrow = Camera::perspective(DVec3::ZERO, DVec3::NEG_Z, 1e-3, 0.1, 100.0);
+        // 11 units across from 4.5 away: 10⁸ pixels through the 10⁻³° lens at 720 rows.
+        let ahead = light(DVec3::new(0.0, 0.0, -10.0), 5.0);
+        let proxy = |camera: &Camera| reach(camera, false).proxy(&ahead);
+        assert_eq!(proxy(&orthographic(1e-5)), Proxy::FullScreen);
+        assert_eq!(proxy(&narrow), Proxy::FullScreen);
+        assert_eq!(proxy(&orthographic(10.0)), Proxy::NearSide);
+        assert_eq!(proxy(&camera(0.1)), Proxy::NearSide);
     }
 
     #[test]
