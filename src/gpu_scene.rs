@@ -90,6 +90,23 @@ fn textures_of(m: &Material) -> impl Iterator<Item = (&Texture, bool)> {
     m.diffuse_texture.iter().map(|t| (&**t, true)).chain(maps)
 }
 
+/// Warns that `texture` is past the context's `GL_MAX_TEXTURE_SIZE`, and so uploaded smaller
+/// (each side within it: its coordinates still span it whole). A loaded file's image is
+/// already within 4 096; one a game made is not.
+fn warn_if_shrunk(dev: &Device, texture: &Texture) {
+    let max = dev.caps().max_texture_size.max(1) as u32;
+    let (w, h) = texture.image.dimensions();
+    if w > max || h > max {
+        let power_of_two = !dev.caps().npot_textures;
+        let (pw, ph) = crate::gl::texture::upload_size((w, h), max, power_of_two);
+        log::warn!(
+            "texture `{}` is {w}×{h}, past this context's GL_MAX_TEXTURE_SIZE of {max}: \
+             uploaded at {pw}×{ph}, finer detail lost",
+            texture.name
+        );
+    }
+}
+
 impl GpuScene {
     /// Uploads what the scene's objects draw with and no earlier frame uploaded; `needs_white`:
     /// the white stand-in texture too, for shared or full variants. Returns the GPU bytes it
@@ -128,6 +145,7 @@ impl GpuScene {
                     .entry(key)
                     .or_insert_with(|| (t.image.clone(), [None, None]));
                 if uploads[srgb as usize].is_none() {
+                    warn_if_shrunk(dev, t);
                     let texture = ImageTexture::new(dev, &t.image, srgb)?;
                     bytes += texture.gpu_bytes();
                     uploads[srgb as usize] = Some(texture);

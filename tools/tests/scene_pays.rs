@@ -272,6 +272,36 @@ fn textured_pillars() -> scene::Scene {
     s
 }
 
+/// A texture a game made past `GL_MAX_TEXTURE_SIZE` is uploaded within it, and that is said
+/// once, naming it and both sizes (it was shrunk in silence); one within the limit is not.
+#[test]
+fn a_texture_past_the_texture_limit_is_said_when_uploaded_smaller() {
+    common::warnings::install();
+    let said = || common::warnings::warnings_containing("past this context's GL_MAX_TEXTURE_SIZE");
+    let mut gpu = Gpu::new(EsVersion::Es3);
+    let opts = RenderOptions::default();
+    gpu.r()
+        .render_offscreen(&textured_pillars(), 32, 18, &opts)
+        .unwrap();
+    assert!(said().is_empty(), "{:?}", said());
+    let max = gpu.r().caps().max_texture_size as u32;
+    let mut s = textured_pillars();
+    let wide = image::RgbaImage::from_pixel(max + 1, 1, image::Rgba([200, 90, 40, 255]));
+    s.materials[0].diffuse_texture = Some(Arc::new(scene::Texture::new("wide", wide)));
+    for _ in 0..2 {
+        gpu.r().render_offscreen(&s, 32, 18, &opts).unwrap();
+    }
+    let said = said();
+    assert_eq!(said.len(), 1, "{said:?}");
+    let expected = format!("`wide` is {}×1, past", max + 1);
+    assert!(said[0].contains(&expected), "{}", said[0]);
+    assert!(
+        said[0].contains(&format!("uploaded at {max}×1")),
+        "{}",
+        said[0]
+    );
+}
+
 #[test]
 fn uploads_no_scene_draws_are_freed_on_request_while_the_game_holds_them() {
     let mut gpu = Gpu::new(EsVersion::Es3);
