@@ -36,6 +36,7 @@ use crate::gl::mesh::GpuMesh;
 use crate::gl::program::{ProgramKey, Resolver, Sampler, Uniform, UniformSet};
 use crate::gl::state::{Blend, Cull, DepthTest, RenderState};
 use crate::gl::{Caps, Device, EsVersion};
+use crate::scene::Projection;
 use crate::Error;
 use light_instances::{light_instance, LightInstances};
 use proxy::{Proxy, ProxyReach, VOLUME_SCALE};
@@ -219,14 +220,33 @@ pub struct Deferred {
 }
 
 /// Everything a frame's light instances are a function of: the lights (by generation), the
-/// camera's kind and planes, which choose each light's proxy, and the accumulation's scale.
+/// camera's kind, planes and lens and the frame's rows, which choose each light's proxy (a
+/// lens or frame height alone turns a sphere too wide for rasterizers full screen), and the
+/// accumulation's scale.
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct InstancesKey {
     lights_generation: u64,
     orthographic: bool,
     near: u64,
     far: u64,
+    /// The camera's projection, field by field (`projection_bits`).
+    projection: [u64; 3],
+    rows: u32,
     scale: u32,
+}
+
+/// `projection`'s fields as bits: its field of view or height, near and far planes.
+fn projection_bits(projection: &Projection) -> [u64; 3] {
+    match *projection {
+        Projection::Perspective {
+            fov_y_deg,
+            near,
+            far,
+        } => [fov_y_deg.to_bits(), near.to_bits(), far.to_bits()],
+        Projection::Orthographic { height, near, far } => {
+            [height.to_bits(), near.to_bits(), far.to_bits()]
+        }
+    }
 }
 
 /// What a light pass did.
@@ -358,6 +378,8 @@ impl Deferred {
             orthographic: ctx.orthographic,
             near: ctx.near.to_bits(),
             far: ctx.far.to_bits(),
+            projection: projection_bits(&ctx.scene.camera.projection),
+            rows: ctx.viewport.1,
             scale: scale.to_bits(),
         };
         let reused = self.instances_key == Some(key) && self.lights.hold_all();

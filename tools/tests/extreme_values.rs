@@ -158,31 +158,48 @@ fn deferred_keeps_surfaces_at_an_orthographic_eye_plane() {
 /// A light whose proxy spans more pixels than rasterizers keep, here 2²⁹ pixels across in a
 /// 10⁻⁵-high orthographic view, is drawn full screen: its sphere lost the light on every
 /// implementation (100/255 from forward on two thirds of a 3 × 2 000 frame, ambient alone).
+/// Also where the view shrinks, or the frame grows taller, under a renderer that drew the
+/// same lights before: its light instances were drawn again, spheres and all.
 #[test]
 fn deferred_keeps_a_light_whose_proxy_spans_more_pixels_than_rasterizers_keep() {
-    let mut s = plane(vec![Light::point(
-        DVec3::new(0.3, 0.1, 1.0),
-        4.0,
-        Vec3::new(1.0, 0.8, 0.6),
-        0.5,
-    )]);
-    s.camera = Camera {
-        position: DVec3::new(0.0, 0.0, 5.0),
-        target: DVec3::ZERO,
-        up: DVec3::Y,
-        projection: Projection::Orthographic {
-            height: 1e-5,
-            near: 0.0,
-            far: 10.0,
-        },
+    let view = |height: f64| {
+        let mut s = plane(vec![Light::point(
+            DVec3::new(0.3, 0.1, 1.0),
+            4.0,
+            Vec3::new(1.0, 0.8, 0.6),
+            0.5,
+        )]);
+        s.camera = Camera {
+            position: DVec3::new(0.0, 0.0, 5.0),
+            target: DVec3::ZERO,
+            up: DVec3::Y,
+            projection: Projection::Orthographic {
+                height,
+                near: 0.0,
+                far: 10.0,
+            },
+        };
+        s
     };
-    let mut gpu = Gpu::new(EsVersion::Es3);
+    let (tiny, size) = (view(1e-5), (3, 2000));
     let opts = RenderOptions::default();
-    let (forward, _) = gpu.render_with("forward", &s, (3, 2000), &opts);
+    let (forward, _) = Gpu::new(EsVersion::Es3).render_with("forward", &tiny, size, &opts);
     assert!(mean(&forward) > 50.0, "the light shows");
-    let (deferred, _) = gpu.render_with("deferred", &s, (3, 2000), &opts);
-    let off = manylight::metrics::diff(&forward, &deferred).max_abs;
-    assert!(off <= 2, "deferred {off} / 255 from forward");
+    let cases = [
+        ("fresh", None),
+        ("after a 1-high view", Some((view(1.0), size))),
+        ("after a frame 10 rows high", Some((view(1e-5), (3, 10)))),
+    ];
+    for (what, before) in cases {
+        let mut gpu = Gpu::new(EsVersion::Es3);
+        gpu.r().set_method_named("deferred").unwrap();
+        if let Some((scene, (w, h))) = before {
+            gpu.render(&scene, w, h, &opts);
+        }
+        let deferred = gpu.render(&tiny, size.0, size.1, &opts);
+        let off = manylight::metrics::diff(&forward, &deferred).max_abs;
+        assert!(off <= 2, "{what}: deferred {off} / 255 from forward");
+    }
 }
 
 #[test]
