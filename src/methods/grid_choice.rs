@@ -53,6 +53,9 @@ struct Layout {
     near: u64,
     /// The user's grid settings (what the choice does not set).
     base: GridConfig,
+    /// The assignment's per-cell cap and index budget (`MeasureOptions`): a choice made
+    /// under tight ones lasted hundreds of frames after they were lifted.
+    limits: (u32, usize),
 }
 
 /// A frame's slot in [`AutoGrid`]'s ring of recent evaluations.
@@ -126,6 +129,7 @@ impl AutoGrid {
             projection,
             near: ctx.near.to_bits(),
             base: ctx.options.grid.clone(),
+            limits: (limits.cell_cap, limits.max_indices),
         };
         let inputs = ChoiceInputs {
             size: ctx.viewport,
@@ -557,6 +561,7 @@ mod tests {
                 ),
                 near: 0,
                 base: GridConfig::default(),
+                limits: (0, 0),
             });
             auto
         };

@@ -95,3 +95,35 @@ fn a_grid_the_lights_outgrow_is_chosen_again_in_the_same_frame() {
         );
     }
 }
+
+/// A grid chosen under a tight index budget is chosen again in the first frame without it: a
+/// renderer kept its coarse grid for 16 to 249 frames after the limit was lifted, where a
+/// fresh one chose cells a sixth the size.
+#[test]
+fn a_grid_chosen_under_a_tight_budget_is_chosen_again_once_it_is_lifted() {
+    let tight = RenderOptions {
+        measure: MeasureOptions {
+            max_indices: Some(64),
+            ..Default::default()
+        },
+        ..Default::default()
+    };
+    let (w, h) = SIZE;
+    let mut gpu = Gpu::new(EsVersion::Es3);
+    gpu.r().set_method_named("clustered").unwrap();
+    let mut lights = floor_lit_by(60, 0.6);
+    let mut coarse = 0;
+    for k in 0..12 {
+        lights.lights[0].position.x += 0.01 * k as f64;
+        let (_, s) = gpu.r().render_offscreen(&lights, w, h, &tight).unwrap();
+        coarse = s.grid.cells;
+    }
+    let (_, s) = (gpu.r())
+        .render_offscreen(&lights, w, h, &RenderOptions::default())
+        .unwrap();
+    assert!(
+        s.grid.cells > coarse,
+        "the grid of {coarse} cells chosen under the budget was kept: {}",
+        s.grid.reason.unwrap_or_default()
+    );
+}
