@@ -39,6 +39,9 @@ pub struct GpuScene {
     split_for: SplitInputs,
     /// A frame's splits ran out of triangles and said so (once a renderer).
     warned_split_budget: bool,
+    /// An image past the context's texture size was said (once a renderer: a game replacing
+    /// one every frame would say it every frame).
+    warned_shrunk: bool,
 }
 
 /// Everything a frame's split copies depend on: the camera, the frame's size and each
@@ -90,13 +93,13 @@ fn textures_of(m: &Material) -> impl Iterator<Item = (&Texture, bool)> {
     m.diffuse_texture.iter().map(|t| (&**t, true)).chain(maps)
 }
 
-/// Warns that `texture` is past the context's `GL_MAX_TEXTURE_SIZE`, and so uploaded smaller
-/// (each side within it: its coordinates still span it whole). A loaded file's image is
-/// already within 4 096; one a game made is not.
-fn warn_if_shrunk(dev: &Device, texture: &Texture) {
+/// Warns (once, `warned`) that `texture` is past the context's `GL_MAX_TEXTURE_SIZE`, and so
+/// uploaded smaller (each side within it: its coordinates still span it whole). A loaded
+/// file's image is already within 4 096; one a game made is not.
+fn warn_if_shrunk(dev: &Device, texture: &Texture, warned: &mut bool) {
     let max = dev.caps().max_texture_size.max(1) as u32;
     let (w, h) = texture.image.dimensions();
-    if w > max || h > max {
+    if (w > max || h > max) && !std::mem::replace(warned, true) {
         let power_of_two = !dev.caps().npot_textures;
         let (pw, ph) = crate::gl::texture::upload_size((w, h), max, power_of_two);
         log::warn!(
@@ -145,7 +148,7 @@ impl GpuScene {
                     .entry(key)
                     .or_insert_with(|| (t.image.clone(), [None, None]));
                 if uploads[srgb as usize].is_none() {
-                    warn_if_shrunk(dev, t);
+                    warn_if_shrunk(dev, t, &mut self.warned_shrunk);
                     let texture = ImageTexture::new(dev, &t.image, srgb)?;
                     bytes += texture.gpu_bytes();
                     uploads[srgb as usize] = Some(texture);

@@ -106,9 +106,9 @@ pub struct GBufferProgram {
 impl UniformSet for GBufferProgram {
     fn resolve(r: &mut Resolver<'_>) -> Self {
         let f = uniforms::features(r);
-        // The colour variants start the accumulation at the surface's ambient term (count
-        // variants at 0, or at emission where they draw it).
-        let adds = !f.counting() || f.has(ShaderFeatures::EMISSIVE);
+        // The colour variants start the accumulation at the surface's ambient term and
+        // emission; the count variants (which have neither) at 0.
+        let adds = !f.counting();
         GBufferProgram {
             transforms: Transforms::resolve(r, true),
             surface: Surface::gbuffer(r),

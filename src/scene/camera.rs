@@ -102,10 +102,10 @@ impl Camera {
     /// The camera a game's own view matrix (world → view, right-handed, looking down −Z, as
     /// [`Camera::view_matrix`] gives) describes, with `projection`: an engine keeps its camera
     /// as a transform, not as a look-at. The matrix must be rigid (a rotation and a
-    /// translation, to within `f32` rounding: its last row (0, 0, 0, 1) but for 10⁻⁶ in w,
-    /// which it is then taken as, and its rotation orthonormal within 10⁻⁴): one that scales,
-    /// shears, mirrors or projects is refused, naming `camera.view`, since the light
-    /// assignment works in its view space.
+    /// translation, to within `f32` rounding: its last row (0, 0, 0, 1) but for 10⁻⁶ in w and
+    /// 10⁻¹² in x, y and z, which it is then taken as, and its rotation orthonormal within
+    /// 10⁻⁴): one that scales, shears, mirrors or projects is refused, naming `camera.view`,
+    /// since the light assignment works in its view space.
     pub fn from_view_matrix(view: DMat4, projection: Projection) -> Result<Camera, SceneError> {
         let invalid = |reason: String| SceneError::invalid("camera.view", reason);
         if !view.is_finite() {

@@ -22,8 +22,8 @@ pub struct Texture {
 
 impl Texture {
     /// A texture of `image` with the default [`Sampling`]. A side past the context's
-    /// `GL_MAX_TEXTURE_SIZE` is scaled down to it at upload, with a warning (a loaded file's
-    /// images are kept within 4 096 a side already).
+    /// `GL_MAX_TEXTURE_SIZE` is scaled down to it at upload, with a warning (once a renderer;
+    /// a loaded file's images are kept within 4 096 a side already).
     pub fn new(name: impl Into<String>, image: image::RgbaImage) -> Texture {
         Texture {
             name: name.into(),

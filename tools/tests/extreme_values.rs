@@ -155,7 +155,7 @@ fn deferred_keeps_surfaces_at_an_orthographic_eye_plane() {
     assert!(off <= 2, "deferred {off} / 255 from forward");
 }
 
-/// A light whose proxy spans more pixels than rasterizers keep, here 2²⁹ pixels across in a
+/// A light whose proxy spans more pixels than rasterizers keep, here over 2³⁰ pixels across in a
 /// 10⁻⁵-high orthographic view, is drawn full screen: its sphere lost the light on every
 /// implementation (100/255 from forward on two thirds of a 3 × 2 000 frame, ambient alone).
 /// Also where the view shrinks, or the frame grows taller, under a renderer that drew the

@@ -273,7 +273,8 @@ fn textured_pillars() -> scene::Scene {
 }
 
 /// A texture a game made past `GL_MAX_TEXTURE_SIZE` is uploaded within it, and that is said
-/// once, naming it and both sizes (it was shrunk in silence); one within the limit is not.
+/// once a renderer, naming it and both sizes (it was shrunk in silence), also when another
+/// replaces it; one within the limit is not.
 #[test]
 fn a_texture_past_the_texture_limit_is_said_when_uploaded_smaller() {
     common::warnings::install();
@@ -286,9 +287,9 @@ fn a_texture_past_the_texture_limit_is_said_when_uploaded_smaller() {
     assert!(said().is_empty(), "{:?}", said());
     let max = gpu.r().caps().max_texture_size as u32;
     let mut s = textured_pillars();
-    let wide = image::RgbaImage::from_pixel(max + 1, 1, image::Rgba([200, 90, 40, 255]));
-    s.materials[0].diffuse_texture = Some(Arc::new(scene::Texture::new("wide", wide)));
-    for _ in 0..2 {
+    for k in 0..3 {
+        let wide = image::RgbaImage::from_pixel(max + 1, 1, image::Rgba([200, 90, k, 255]));
+        s.materials[0].diffuse_texture = Some(Arc::new(scene::Texture::new("wide", wide)));
         gpu.r().render_offscreen(&s, 32, 18, &opts).unwrap();
     }
     let said = said();

@@ -24,7 +24,8 @@ const FAR_SIDE_REACH: f32 = 2048.0;
 
 /// Most pixels a proxy may span across, as scene triangles (`scene::triangle_reach`): a sphere
 /// of about 2²⁷ pixels (a 10⁻⁵-high orthographic view) lost its light on every implementation
-/// here, without an error. Past it, the full-screen path: such a light covers the frame.
+/// here, without an error. Past it, one in view takes the full-screen path (it covers much of
+/// the frame anyway).
 const MAX_PROXY_SPAN_PX: f64 = (1u64 << 24) as f64;
 
 /// How a light's proxy is drawn and depth tested against the surfaces:
@@ -104,10 +105,11 @@ impl ProxyReach<'_> {
         // where it ends (a tiny near plane makes them wider; docs/precision.md).
         let coarse = self.camera.depth_step_at(f64::from(depth + radius), 24)
             > 0.1 * f64::from(light.cull_radius);
-        if !coarse && depth - radius >= 2.0 * self.near && !self.too_wide(radius, depth) {
+        let wide = self.too_wide(light, radius);
+        if !coarse && depth - radius >= 2.0 * self.near && !wide {
             return Proxy::NearSide;
         }
-        if coarse || depth + radius >= FAR_MARGIN * self.far || self.too_wide(radius, depth) {
+        if coarse || depth + radius >= FAR_MARGIN * self.far || wide {
             return Proxy::FullScreen;
         }
         let perspective = matches!(self.camera.projection, Projection::Perspective { .. });
@@ -124,19 +126,43 @@ impl ProxyReach<'_> {
         }
     }
 
-    /// Whether a proxy of `radius` at `depth` spans more than [`MAX_PROXY_SPAN_PX`] where it
-    /// comes nearest the eye (the near plane at most).
-    fn too_wide(&self, radius: f32, depth: f32) -> bool {
+    /// Whether `light`'s proxy of `radius` may be in view and spans more than
+    /// [`MAX_PROXY_SPAN_PX`] where it comes nearest the eye (the near plane at most). One out
+    /// of view covers no pixel however wide, and keeps its sphere (drawn full screen, it would
+    /// be evaluated at every pixel). No trigonometry: the projection's scales give the view's
+    /// extent.
+    fn too_wide(&self, light: &GpuLight, radius: f32) -> bool {
+        let (c, r) = (light.position.as_dvec3(), f64::from(radius));
+        let depth = -c.z;
+        let near = f64::from(self.near);
+        if depth + r <= near {
+            return false;
+        }
+        // The view's half extents: per unit of depth in perspective, in units orthographic.
+        let (tx, ty) = (
+            1.0 / self.projection.x_axis.x,
+            1.0 / self.projection.y_axis.y,
+        );
+        let perspective = matches!(self.camera.projection, Projection::Perspective { .. });
+        let beside = |v: f64, t: f64| {
+            if perspective {
+                // The sphere's distance from the side plane |v| = t · depth.
+                v.abs() - t * depth > r * (1.0 + t * t).sqrt()
+            } else {
+                v.abs() - t > r
+            }
+        };
+        if beside(c.x, tx) || beside(c.y, ty) {
+            return false;
+        }
         let rows = f64::from(self.rows.max(1));
         // The size of a pixel where the proxy comes nearest.
-        let pixel = match self.camera.projection {
-            Projection::Perspective { fov_y_deg, .. } => {
-                let nearest = f64::from((depth - radius).max(self.near));
-                2.0 * nearest * (fov_y_deg.to_radians() * 0.5).tan() / rows
-            }
-            Projection::Orthographic { height, .. } => height / rows,
+        let pixel = if perspective {
+            2.0 * (depth - r).max(near) * ty / rows
+        } else {
+            2.0 * ty / rows
         };
-        2.0 * f64::from(radius) > MAX_PROXY_SPAN_PX * pixel
+        2.0 * r > MAX_PROXY_SPAN_PX * pixel
     }
 
     /// The normalized device depth of a [`Proxy::Bounded`] light's far end (its proxy
@@ -226,6 +252,17 @@ mod tests {
         assert_eq!(proxy(&narrow), Proxy::FullScreen);
         assert_eq!(proxy(&orthographic(10.0)), Proxy::NearSide);
         assert_eq!(proxy(&camera(0.1)), Proxy::NearSide);
+        // Beside the view or behind the eye it covers no pixel: not drawn full screen.
+        for at in [DVec3::new(40.0, 0.0, -10.0), DVec3::new(0.0, 0.0, 10.0)] {
+            let away = light(at, 5.0);
+            assert_ne!(
+                reach(&narrow, false).proxy(&away),
+                Proxy::FullScreen,
+                "{at}"
+            );
+            let tiny = orthographic(1e-5);
+            assert_ne!(reach(&tiny, false).proxy(&away), Proxy::FullScreen, "{at}");
+        }
     }
 
     #[test]
