@@ -1,6 +1,6 @@
-// Deferred, pass 3: the accumulation (the geometry pass's ambient and emission, then the
-// lights), encoded like every other method. Directional lights are shaded here, with the BRDF
-// chosen per pixel as in the light pass.
+// Deferred, pass 3: ambient (occluded as the geometry pass says) plus the accumulation (its
+// emission, then the lights), encoded like every other method. Directional lights are shaded
+// here, with the BRDF chosen per pixel as in the light pass.
 #define PER_PIXEL_MODEL 1
 #include "surface.glsl"
 #include "light_struct.glsl"
@@ -28,10 +28,13 @@ void main() {
     // The count's channels added (each exact in half floats up to 2 048: deferred.rs).
     FRAG_COLOR = encodeCount(dot(texelFetch(u_accum, px, 0), vec4(1.0)));
 #else
-    HIGHP vec3 color = texelFetch(u_accum, px, 0).rgb * u_accumToRadiance;
-#if HAS_DIRECTIONAL
+    HIGHP vec4 accum = texelFetch(u_accum, px, 0);
     HIGHP vec4 albedoOffset = texelFetch(u_gAlbedo, px, 0);
     MEDP vec3 albedo = albedoOffset.rgb;
+    // The ambient term, scaled by the occlusion the geometry pass left in alpha (on the
+    // albedo first: an ambient × albedo past the float range times 0 was NaN).
+    HIGHP vec3 color = u_ambient * (albedo * accum.a) + accum.rgb * u_accumToRadiance;
+#if HAS_DIRECTIONAL
     // Directional lights light every pixel: here, once, rather than as a light volume. The
     // surface point comes back from the G-buffer as in the light pass.
     HIGHP vec4 nd = texelFetch(u_gNormalDepth, px, 0);

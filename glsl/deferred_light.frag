@@ -41,6 +41,7 @@ void main() {
     surface.Ns = spec.a;
     surface.metallic = spec.r;
     surface.roughness = spec.g;
-    FRAG_COLOR = vec4(shadeLight(light, P, octDecode(nd.xy), viewDirection(P), surface), 1.0);
+    // Alpha 0: the accumulation's alpha is the geometry pass's occlusion.
+    FRAG_COLOR = vec4(shadeLight(light, P, octDecode(nd.xy), viewDirection(P), surface), 0.0);
 #endif
 }

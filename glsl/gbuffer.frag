@@ -10,8 +10,8 @@ VARYING vec2 v_uv;
 layout(location = 0) out vec4 o_albedo;
 layout(location = 1) out HIGHP vec4 o_normalDepth;
 layout(location = 2) out vec4 o_specular;
-// The accumulation buffer's start: what the surface adds besides the lights (its ambient
-// term, occlusion included, and emission), so the composite's sum equals forward's.
+// The accumulation buffer's start: the surface's emission, and its ambient occlusion in
+// alpha, so the composite's sum equals forward's.
 layout(location = 3) out vec4 o_extra;
 // The light pass's pre-exposure (deferred.rs accumulation_scale), which the composite undoes.
 uniform HIGHP float u_accumScale;
@@ -30,20 +30,25 @@ void main() {
     HIGHP vec2 offset = windowPosition(v_viewPos) - gl_FragCoord.xy;
     vec3 albedo = surfaceAlbedo(v_uv);
     o_albedo = vec4(albedo, offset.y);
-    // The whole ambient term here, in f32 from the albedo forward shades with: added back in
-    // the composite from the G-buffer's 11-bit albedo, an occluded term written as its
-    // difference from ambient × albedo did not cancel (6/255 from forward), and in a half-float
-    // accumulation each light was rounded at that difference's magnitude. The count variants'
-    // accumulation starts at exactly 0.
+    // What the surface adds besides the lights: emission in colour, and the ambient term's
+    // occlusion in alpha, which the composite scales ambient × albedo by (the lights add 0
+    // there). Written as its difference from ambient × albedo, an occluded term did not cancel
+    // against the composite's from the G-buffer's 11-bit albedo (6/255 from forward); started
+    // at the whole term, a half-float accumulation rounded each of thousands of faint lights
+    // at its size. The count variants' accumulation starts at exactly 0.
 #if COUNT_EVALS || COUNT_REACHING
-    vec3 extra = vec3(0.0);
+    o_extra = vec4(0.0);
 #else
-    vec3 extra = surfaceAmbient(albedo, v_uv);
-#endif
+    vec3 extra = vec3(0.0);
 #if HAS_EMISSIVE
-    extra += surfaceEmission(v_uv);
+    extra = surfaceEmission(v_uv);
 #endif
-    o_extra = vec4(extra * u_accumScale, 0.0);
+    float occlusion = 1.0;
+#if HAS_OCCLUSION
+    occlusion = surfaceOcclusion(v_uv);
+#endif
+    o_extra = vec4(extra * u_accumScale, occlusion);
+#endif
     // Any view depth marks a covered pixel (the buffer is cleared to −10³⁰: noSurface).
     o_normalDepth = vec4(octEncode(N), -v_viewPos.z, offset.x);
 #if METALLIC_ROUGHNESS

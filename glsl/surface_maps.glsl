@@ -76,10 +76,17 @@ uniform float u_occlusionStrength;
 // ambient × albedo past the float range times an occlusion of 0 was inf · 0, NaN. In fp16 (no
 // fragment highp) the uniform and the term are capped at FP16_MAX_AMBIENT: past fp16's
 // 65 504 they would be infinity, white at any exposure.
+#if HAS_OCCLUSION
+// The factor the occlusion map scales the ambient term by.
+float surfaceOcclusion(vec2 uv) {
+    float ao = TEXTURE2D(u_occlusionTex, UV_OCCLUSION(uv)).r;
+    return 1.0 + u_occlusionStrength * (ao - 1.0);
+}
+#endif
+
 vec3 surfaceAmbient(vec3 albedo, vec2 uv) {
 #if HAS_OCCLUSION
-    float ao = TEXTURE2D(u_occlusionTex, UV_OCCLUSION(uv)).r;
-    albedo *= 1.0 + u_occlusionStrength * (ao - 1.0);
+    albedo *= surfaceOcclusion(uv);
 #endif
     vec3 a = u_ambient * albedo;
 #if FP16_LIGHTS

@@ -12,8 +12,8 @@
 //! depth             DEPTH24      4    for the geometry pass's depth test
 //! accumulation      RGBA32F     16    Σ light radiance (additive blending; RGBA16F, 8 bytes,
 //!                                     where GL_EXT_float_blend is missing), started by the
-//!                                     geometry pass (colour 3) with the surface's ambient
-//!                                     term (its occlusion included) and emission
+//!                                     geometry pass (colour 3) with the surface's emission,
+//!                                     and its ambient occlusion in alpha
 //!                              ----
 //!                               52 bytes per pixel (1280×720: 47.9 MB), 44 with RGBA16F;
 //!                               8 fewer without the specular target
@@ -157,7 +157,7 @@ impl GBuffer {
         let gl = &dev.gl;
         unsafe {
             gl.bind_framebuffer(glow::FRAMEBUFFER, Some(geometry_fbo));
-            // The accumulation buffer too: the geometry pass starts it (ambient, emission).
+            // The accumulation buffer too: the geometry pass starts it (emission, occlusion).
             for (i, t) in gb.color.iter().enumerate() {
                 gl.framebuffer_texture_2d(
                     glow::FRAMEBUFFER,
@@ -250,8 +250,8 @@ impl GBuffer {
         unsafe { gl.clear_buffer_f32_slice(glow::COLOR, 1, &[0.0, 0.0, NO_SURFACE_DEPTH, 0.0]) };
     }
 
-    /// Binds the accumulation buffer as the geometry pass left it (each surface's ambient
-    /// term and emission; 0 elsewhere), with the geometry pass's depth attached (kept) for the
+    /// Binds the accumulation buffer as the geometry pass left it (each surface's emission,
+    /// and its occlusion in alpha; 0 elsewhere), with the geometry pass's depth attached (kept) for the
     /// light volumes' depth test.
     pub fn begin_accumulation(&self, dev: &Device) {
         unsafe {

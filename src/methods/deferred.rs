@@ -9,8 +9,8 @@
 //!    only when the far side would be clipped too); each covered pixel reads the G-buffer once
 //!    and adds the light's contribution to a float accumulation buffer. The light model is the
 //!    same GLSL chunk as every other method's.
-//! 3. **Composite** — the accumulation (the geometry pass starts it at each surface's ambient
-//!    term and emission; the lights add to it), encoded like the forward methods.
+//! 3. **Composite** — ambient, occluded by the factor the geometry pass leaves in the
+//!    accumulation's alpha, plus the accumulated light, encoded like the forward methods.
 //! 4. **Transparent objects** — documented forward fallback: the composite wrote the G-buffer's
 //!    depth into the target, and transparent objects are drawn back to front with plain
 //!    forward shading.
@@ -23,7 +23,7 @@ mod light_instances;
 mod proxy;
 mod proxy_sphere;
 
-use glam::Mat4;
+use glam::{Mat4, Vec3};
 
 use super::directional::DirectionalUniforms;
 use super::forward::Forward;
@@ -99,16 +99,15 @@ pub struct GBufferProgram {
     surface: Surface,
     viewport: Uniform<[f32; 2]>,
     half_extent: Uniform<[f32; 2]>,
-    /// [`accumulation_scale`], for what the surface itself adds (ambient, emission).
+    /// [`accumulation_scale`], for what the surface itself adds (emission).
     accum_scale: Uniform<f32>,
 }
 
 impl UniformSet for GBufferProgram {
     fn resolve(r: &mut Resolver<'_>) -> Self {
         let f = uniforms::features(r);
-        // The colour variants start the accumulation at the surface's ambient term and
-        // emission; the count variants (which have neither) at 0.
-        let adds = !f.counting();
+        // Emission starts the accumulation (the count variants have none: they start at 0).
+        let adds = f.has(ShaderFeatures::EMISSIVE);
         GBufferProgram {
             transforms: Transforms::resolve(r, true),
             surface: Surface::gbuffer(r),
@@ -165,6 +164,7 @@ pub struct CompositeProgram {
     accum: Uniform<Sampler>,
     g_depth: Uniform<Sampler>,
     frame_origin: Uniform<[f32; 2]>,
+    ambient: Uniform<Vec3>,
     exposure: Uniform<f32>,
     /// Undoes [`accumulation_scale`].
     accum_to_radiance: Uniform<f32>,
@@ -186,11 +186,12 @@ impl UniformSet for CompositeProgram {
         let directional =
             colour && f.has(ShaderFeatures::DIRECTIONAL) && f.has(ShaderFeatures::SPECULAR);
         CompositeProgram {
-            g_albedo: r.required_when(colour && f.has(ShaderFeatures::DIRECTIONAL), "u_gAlbedo"),
+            g_albedo: r.required_when(colour, "u_gAlbedo"),
             g_normal_depth: r.required("u_gNormalDepth"),
             accum: r.required("u_accum"),
             g_depth: r.required("u_gDepth"),
             frame_origin: r.required("u_frameOrigin"),
+            ambient: r.required_when(colour, "u_ambient"),
             exposure: r.required_when(colour && !f.has(ShaderFeatures::OUTPUT_HDR), "u_exposure"),
             accum_to_radiance: r.required_when(colour, "u_accumToRadiance"),
             alpha: r.required_when(colour, "u_alpha"),
@@ -513,6 +514,7 @@ impl Deferred {
         p.accum.set(dev, UNIT_ACCUM);
         p.g_depth.set(dev, UNIT_G_DEPTH);
         p.frame_origin.set(dev, ctx.origin.map(|v| v as f32));
+        p.ambient.set(dev, ctx.scene.ambient);
         p.exposure.set(dev, ctx.options.exposure_ev.exp2());
         p.accum_to_radiance.set(dev, accum_to_radiance);
         p.alpha.set(dev, 1.0);

@@ -153,8 +153,7 @@ impl Surface {
             roughness: r.required_when(f.has(ShaderFeatures::METALLIC_ROUGHNESS), "u_roughness"),
             alpha: r.optional("u_alpha"),
             alpha_cutoff: r.required_when(cuts(f), "u_alphaCutoff"),
-            // The colour variants start deferred's accumulation at the ambient term.
-            ambient: r.required_when(!f.counting(), "u_ambient"),
+            ambient: r.optional("u_ambient"),
             exposure: r.optional("u_exposure"),
             orthographic: r.required("u_orthographic"),
             heat_scale: r.optional("u_heatScale"),

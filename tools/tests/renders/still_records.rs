@@ -134,7 +134,8 @@ const INPUTS: [(&str, Change, &[&str]); 16] = [
     ),
     ("the light cut-off", |_, o| o.light_cutoff = Some(0.05), ALL),
     ("the camera moved", |s, _| s.camera.position.x += 0.5, ALL),
-    // The view selects lights for RGBA8 records; the planes choose deferred's proxies.
+    // The view selects lights for RGBA8 records; the planes and the lens choose deferred's
+    // proxies (a lens narrow enough sends a wide light full screen).
     (
         "the far plane",
         |s, _| set_plane(s, |_, far| *far = 30.0),
@@ -152,7 +153,7 @@ const INPUTS: [(&str, Change, &[&str]); 16] = [
                 *fov_y_deg *= 1.2;
             }
         },
-        &[FORWARD_RGBA8],
+        &[FORWARD_RGBA8, "deferred"],
     ),
     (
         "the farthest object moved away",
