@@ -227,27 +227,12 @@ pub struct Deferred {
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct InstancesKey {
     lights_generation: u64,
-    orthographic: bool,
+    /// The camera's projection: its kind, lens and planes.
+    projection: Projection,
     near: u64,
     far: u64,
-    /// The camera's projection, field by field (`projection_bits`).
-    projection: [u64; 3],
     rows: u32,
     scale: u32,
-}
-
-/// `projection`'s fields as bits: its field of view or height, near and far planes.
-fn projection_bits(projection: &Projection) -> [u64; 3] {
-    match *projection {
-        Projection::Perspective {
-            fov_y_deg,
-            near,
-            far,
-        } => [fov_y_deg.to_bits(), near.to_bits(), far.to_bits()],
-        Projection::Orthographic { height, near, far } => {
-            [height.to_bits(), near.to_bits(), far.to_bits()]
-        }
-    }
 }
 
 /// What a light pass did.
@@ -376,10 +361,9 @@ impl Deferred {
         // A still frame (nothing the instances are made from changed) draws the last ones.
         let key = InstancesKey {
             lights_generation: ctx.lights_generation,
-            orthographic: ctx.orthographic,
+            projection: ctx.scene.camera.projection,
             near: ctx.near.to_bits(),
             far: ctx.far.to_bits(),
-            projection: projection_bits(&ctx.scene.camera.projection),
             rows: ctx.viewport.1,
             scale: scale.to_bits(),
         };
