@@ -59,7 +59,8 @@ pub struct RenderOptions {
     /// disjoint event. A frame inside the application's own elapsed-time query goes untimed.
     pub gpu_timer: bool,
     /// Write linear, unclamped radiance (for float targets; see
-    /// [`Renderer::render_offscreen_hdr`](crate::Renderer::render_offscreen_hdr)).
+    /// [`Renderer::render_offscreen_hdr`](crate::Renderer::render_offscreen_hdr)). A
+    /// fixed-point framebuffer clamps it to [0, 1], which a renderer warns of once.
     pub hdr: bool,
     /// What the frame writes: colour, or per-pixel light counts (see
     /// [`Renderer::render_light_counts`](crate::Renderer::render_light_counts), which sets this).

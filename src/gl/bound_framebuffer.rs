@@ -33,6 +33,24 @@ impl Device {
         self.bound_attachment(colour, glow::FRAMEBUFFER_ATTACHMENT_OBJECT_TYPE) == Some(None)
     }
 
+    /// Whether the bound framebuffer's colour buffer stores fixed-point values, which clamp to
+    /// [0, 1]: its component type on ES 3.0 (`GL_UNSIGNED_NORMALIZED`), at most 8 red bits on
+    /// ES 2.0 (whose float colour buffers have 16 or 32). False on desktop GL and where the
+    /// driver would not say.
+    pub(crate) fn bound_color_is_fixed_point(&self) -> bool {
+        let caps = self.caps();
+        if caps.desktop {
+            return false;
+        }
+        if caps.context_has_es3_state() {
+            let colour = [glow::COLOR_ATTACHMENT0, glow::BACK];
+            let kind = self.bound_attachment(colour, glow::FRAMEBUFFER_ATTACHMENT_COMPONENT_TYPE);
+            return kind == Some(Some(glow::UNSIGNED_NORMALIZED as i32));
+        }
+        let bits = unsafe { self.gl.get_parameter_i32(glow::RED_BITS) };
+        self.drain_errors() == glow::NO_ERROR && (1..=8).contains(&bits)
+    }
+
     /// Samples per pixel of the bound framebuffer (`GL_SAMPLES`: 0 for a single-sampled
     /// one, and where the driver would not say).
     pub(crate) fn bound_samples(&self) -> i32 {

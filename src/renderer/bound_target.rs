@@ -8,7 +8,7 @@
 
 use super::Renderer;
 use crate::gl::GlError;
-use crate::Error;
+use crate::{CountKind, Error, RenderOptions};
 
 /// Depth bits below which surfaces close in depth show through (the README's 24).
 const FULL_DEPTH_BITS: i32 = 24;
@@ -108,6 +108,24 @@ impl Renderer {
                  with the window?)"
             );
         }
+    }
+
+    /// Warns once of HDR colour into a fixed-point framebuffer: its unclamped radiance is
+    /// clamped to [0, 1] there, with neither exposure nor tone map applied.
+    pub(super) fn warn_hdr_into_fixed_point(&mut self, options: &RenderOptions) {
+        if !options.hdr
+            || options.count != CountKind::None
+            || self.warned_hdr_fixed_point
+            || !self.dev.bound_color_is_fixed_point()
+        {
+            return;
+        }
+        self.warned_hdr_fixed_point = true;
+        log::warn!(
+            "RenderOptions::hdr writes unclamped linear radiance, but the bound framebuffer's \
+             colour is fixed-point: every value past 1 is clamped, untoned (bind a float colour \
+             buffer such as RGBA16F, or leave hdr off to get the exposed, tone-mapped image)"
+        );
     }
 
     /// Depth bits of the renderer's own targets, a 16-bit one warned of once.

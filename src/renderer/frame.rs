@@ -144,6 +144,7 @@ impl Renderer {
             }
         }
         let games_depth_bits = if applications {
+            self.warn_hdr_into_fixed_point(options);
             self.check_bound_target(width, height, origin, samples <= 1)?
         } else {
             None

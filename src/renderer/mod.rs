@@ -90,6 +90,8 @@ pub struct Renderer {
     warned_directional: bool,
     /// A bound framebuffer's shallow depth buffer was announced (once per renderer).
     warned_depth_bits: bool,
+    /// HDR colour into a fixed-point framebuffer was warned of.
+    warned_hdr_fixed_point: bool,
     /// A frame past the bound framebuffer's colour buffer was warned of.
     warned_past_framebuffer: bool,
     /// The frame being drawn goes to a framebuffer that encodes sRGB itself: drawn with linear
@@ -199,6 +201,7 @@ impl Renderer {
             shown_directional: Vec::new(),
             warned_directional: false,
             warned_depth_bits: false,
+            warned_hdr_fixed_point: false,
             warned_past_framebuffer: false,
             srgb_destination: false,
             warned_depth_step: false,

@@ -17,10 +17,15 @@ const SIZE: (i32, i32) = (64, 36);
 /// A game's RGBA8 framebuffer of [`SIZE`] with the depth renderbuffer `depth` (`None`:
 /// none), bound.
 unsafe fn game_fbo(gl: &glow::Context, depth: Option<u32>) -> glow::Framebuffer {
+    game_fbo_of(gl, glow::RGBA8, depth)
+}
+
+/// [`game_fbo`] with a colour renderbuffer of `format`.
+unsafe fn game_fbo_of(gl: &glow::Context, format: u32, depth: Option<u32>) -> glow::Framebuffer {
     let (w, h) = SIZE;
     let colour = gl.create_renderbuffer().unwrap();
     gl.bind_renderbuffer(glow::RENDERBUFFER, Some(colour));
-    gl.renderbuffer_storage(glow::RENDERBUFFER, glow::RGBA8, w, h);
+    gl.renderbuffer_storage(glow::RENDERBUFFER, format, w, h);
     let fbo = gl.create_framebuffer().unwrap();
     gl.bind_framebuffer(glow::FRAMEBUFFER, Some(fbo));
     gl.framebuffer_renderbuffer(
@@ -102,6 +107,48 @@ fn a_framebuffer_without_depth_is_refused_and_a_shallow_one_warned_of() {
             unsafe { game_fbo(&gl, Some(glow::DEPTH_COMPONENT24)) };
             render(&mut r, &RenderOptions::default()).unwrap();
         }
+    }
+}
+
+/// HDR colour into a game's RGBA8 framebuffer is clamped there, which was silent: it is warned
+/// of once a renderer, and neither an LDR frame there nor HDR into a float colour buffer
+/// (where the context can draw one) is.
+#[test]
+fn hdr_into_a_fixed_point_framebuffer_is_warned_of_once() {
+    common::warnings::install();
+    const SAID: &str = "colour is fixed-point";
+    let hdr = RenderOptions {
+        hdr: true,
+        ..Default::default()
+    };
+    for es in [EsVersion::Es3, EsVersion::Es2] {
+        let (_ctx, gl, mut r) = game(es);
+        let before = warnings_containing(SAID).len();
+        unsafe { game_fbo(&gl, Some(glow::DEPTH_COMPONENT16)) };
+        render(&mut r, &RenderOptions::default()).unwrap();
+        assert_eq!(
+            warnings_containing(SAID).len(),
+            before,
+            "{es}: LDR is not warned of"
+        );
+        render(&mut r, &hdr).unwrap();
+        render(&mut r, &hdr).unwrap();
+        assert_eq!(
+            warnings_containing(SAID).len(),
+            before + 1,
+            "{es}: warned once"
+        );
+    }
+    let (_ctx, gl, mut r) = game(EsVersion::Es3);
+    if r.caps().hdr_output() {
+        let before = warnings_containing(SAID).len();
+        unsafe { game_fbo_of(&gl, glow::RGBA16F, Some(glow::DEPTH_COMPONENT16)) };
+        render(&mut r, &hdr).unwrap();
+        assert_eq!(
+            warnings_containing(SAID).len(),
+            before,
+            "a float buffer keeps HDR"
+        );
     }
 }
 
