@@ -1,6 +1,7 @@
 //! The scene's meshes and textures on the GPU, uploaded once and shared by every shading
 //! method. Below the methods and the renderer.
 
+use std::collections::hash_map::Entry;
 use std::collections::{HashMap, HashSet};
 use std::sync::{Arc, Weak};
 
@@ -39,6 +40,9 @@ pub struct GpuScene {
     split_for: SplitInputs,
     /// A frame's splits ran out of triangles and said so (once a renderer).
     warned_split_budget: bool,
+    /// This frame's meshes whose second coordinate set some object's material reads (kept to
+    /// reuse its memory).
+    second_set_meshes: HashSet<usize>,
     /// An image past the context's texture size was said (once a renderer: a game replacing
     /// one every frame would say it every frame).
     warned_shrunk: bool,
@@ -127,16 +131,29 @@ impl GpuScene {
             let white = image::RgbaImage::from_pixel(1, 1, image::Rgba([255, 255, 255, 255]));
             self.white = Some(ImageTexture::new(dev, &white, false)?);
         }
+        self.note_second_set_meshes(scene);
         for (i, o) in scene.objects.iter().enumerate() {
             let key = Arc::as_ptr(&o.mesh) as usize;
-            if let std::collections::hash_map::Entry::Vacant(e) = self.meshes.entry(key) {
-                o.mesh.check_shape(&format!("objects[{i}].mesh"))?;
-                let bounds = o.mesh.bounds();
-                let origin = bounds.map_or(DVec3::ZERO, |b| b.center());
-                let gpu = GpuMesh::new_about(dev, &o.mesh, origin)?;
-                let longest = triangle_reach::longest_edge(&o.mesh);
-                bytes += gpu.gpu_bytes();
-                e.insert((o.mesh.clone(), gpu, bounds, longest));
+            let second = self.second_set_meshes.contains(&key);
+            match self.meshes.entry(key) {
+                Entry::Vacant(e) => {
+                    o.mesh.check_shape(&format!("objects[{i}].mesh"))?;
+                    let bounds = o.mesh.bounds();
+                    let origin = bounds.map_or(DVec3::ZERO, |b| b.center());
+                    let gpu = GpuMesh::new_about(dev, &o.mesh, origin, second)?;
+                    let longest = triangle_reach::longest_edge(&o.mesh);
+                    bytes += gpu.gpu_bytes();
+                    e.insert((o.mesh.clone(), gpu, bounds, longest));
+                }
+                // A material reads the second set of a mesh uploaded without it: again, with.
+                Entry::Occupied(mut e) if second && !e.get().1.has_second_uvs() => {
+                    let (mesh, gpu, bounds, _) = e.get_mut();
+                    let origin = bounds.map_or(DVec3::ZERO, |b| b.center());
+                    let with = GpuMesh::new_about(dev, mesh, origin, true)?;
+                    bytes += with.gpu_bytes();
+                    std::mem::replace(gpu, with).destroy(dev);
+                }
+                Entry::Occupied(_) => {}
             }
         }
         for m in &scene.materials {
@@ -156,6 +173,18 @@ impl GpuScene {
             }
         }
         Ok(bytes)
+    }
+
+    /// Notes the meshes whose second coordinate set an object's material reads: only they
+    /// upload it (a mesh built with one that no texture reads does not pay for it).
+    fn note_second_set_meshes(&mut self, scene: &Scene) {
+        self.second_set_meshes.clear();
+        for o in &scene.objects {
+            let reads = |m: &Material| m.reads_second_uvs();
+            if !o.mesh.second_uvs.is_empty() && scene.materials.get(o.material).is_some_and(reads) {
+                self.second_set_meshes.insert(Arc::as_ptr(&o.mesh) as usize);
+            }
+        }
     }
 
     /// Frees the uploads of meshes and textures the application no longer holds: the cache's

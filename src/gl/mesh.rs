@@ -29,12 +29,13 @@ pub struct VertexLayout {
 }
 
 impl VertexLayout {
-    /// The layout of `mesh`'s vertices.
-    pub fn of(mesh: &Mesh) -> VertexLayout {
+    /// The layout of `mesh`'s vertices, its second coordinate set where `second_uvs` (a
+    /// texture reads it).
+    pub fn of(mesh: &Mesh, second_uvs: bool) -> VertexLayout {
         VertexLayout {
             colors: !mesh.colors.is_empty(),
             tangents: !mesh.tangents.is_empty(),
-            second_uvs: !mesh.second_uvs.is_empty(),
+            second_uvs: second_uvs && !mesh.second_uvs.is_empty(),
         }
     }
 
@@ -92,14 +93,14 @@ pub struct Chunk {
 
 /// Splits a mesh into chunks whose vertices fit 16-bit indices; triangles stay whole.
 pub fn split_u16(mesh: &Mesh) -> Vec<Chunk> {
-    split_u16_about(mesh, DVec3::ZERO)
+    split_u16_about(mesh, DVec3::ZERO, true)
 }
 
 /// [`split_u16`] with `origin` subtracted from every position (in `f64`, before the vertex
-/// becomes `f32`).
-pub fn split_u16_about(mesh: &Mesh, origin: DVec3) -> Vec<Chunk> {
+/// becomes `f32`), and the second coordinate set only where `second_uvs`.
+pub fn split_u16_about(mesh: &Mesh, origin: DVec3, second_uvs: bool) -> Vec<Chunk> {
     const LIMIT: usize = u16::MAX as usize + 1;
-    let layout = VertexLayout::of(mesh);
+    let layout = VertexLayout::of(mesh, second_uvs);
     let floats = layout.floats();
     let mut chunks = Vec::new();
     let mut remap: HashMap<u32, u16> = HashMap::new();
@@ -283,27 +284,35 @@ impl BoundMesh {
 pub struct GpuMesh {
     chunks: Vec<GpuChunk>,
     bytes: usize,
+    /// Its vertices carry the mesh's second coordinate set.
+    second_uvs: bool,
     destroyed: bool,
 }
 
 impl GpuMesh {
-    /// Uploads a mesh.
+    /// Uploads a mesh, every attribute it has.
     pub fn new(dev: &Device, mesh: &Mesh) -> Result<GpuMesh, GlError> {
-        GpuMesh::new_about(dev, mesh, DVec3::ZERO)
+        GpuMesh::new_about(dev, mesh, DVec3::ZERO, true)
     }
 
     /// Uploads a mesh with its positions relative to `origin` (drawn with the model matrix
-    /// translated by `origin`).
-    pub fn new_about(dev: &Device, mesh: &Mesh, origin: DVec3) -> Result<GpuMesh, GlError> {
+    /// translated by `origin`), and its second coordinate set only where `second_uvs`.
+    pub fn new_about(
+        dev: &Device,
+        mesh: &Mesh,
+        origin: DVec3,
+        second_uvs: bool,
+    ) -> Result<GpuMesh, GlError> {
         let mut out = GpuMesh {
             chunks: Vec::new(),
             bytes: 0,
+            second_uvs: second_uvs && !mesh.second_uvs.is_empty(),
             destroyed: false,
         };
         // A failed upload (out of memory, most likely) frees what it made: the caller may try
         // again next frame.
         let uploaded = out
-            .upload_chunks(dev, mesh, origin)
+            .upload_chunks(dev, mesh, origin, second_uvs)
             .and_then(|()| dev.check("mesh upload"));
         match uploaded {
             Ok(()) => Ok(out),
@@ -316,12 +325,23 @@ impl GpuMesh {
 
     /// Uploads the mesh's chunks into `self.chunks`, which holds every buffer made so far
     /// when it fails.
-    fn upload_chunks(&mut self, dev: &Device, mesh: &Mesh, origin: DVec3) -> Result<(), GlError> {
-        for chunk in split_u16_about(mesh, origin) {
+    fn upload_chunks(
+        &mut self,
+        dev: &Device,
+        mesh: &Mesh,
+        origin: DVec3,
+        second_uvs: bool,
+    ) -> Result<(), GlError> {
+        for chunk in split_u16_about(mesh, origin, second_uvs) {
             self.chunks.push(GpuChunk::upload(dev, &chunk)?);
             self.bytes += chunk.vertices.len() * 4 + chunk.indices.len() * 2;
         }
         Ok(())
+    }
+
+    /// Whether its vertices carry the mesh's second coordinate set.
+    pub fn has_second_uvs(&self) -> bool {
+        self.second_uvs
     }
 
     /// Draws all chunks with the bound program (attributes at [`super::program::ATTRIBUTES`]).

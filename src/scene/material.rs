@@ -157,6 +157,30 @@ impl Material {
             || (self.alpha_vertex && self.alpha_cutoff.is_none())
     }
 
+    /// The coordinate set each texture the material samples reads, by its glTF name (`None`:
+    /// not sampled, or sampled to no effect, as a normal map of scale 0).
+    pub(crate) fn texture_sets(&self) -> [(&'static str, Option<u32>); 5] {
+        let maps = &self.maps;
+        let set = |t: Option<&super::surface_maps::MapTexture>| t.map(|t| t.transform.uv_set);
+        let base = self.diffuse_texture.as_ref();
+        [
+            ("baseColorTexture", base.map(|_| maps.base_transform.uv_set)),
+            (
+                "metallicRoughnessTexture",
+                set(maps.metallic_roughness.as_ref()),
+            ),
+            ("normalTexture", set(maps.sampled_normal())),
+            ("occlusionTexture", set(maps.sampled_occlusion())),
+            ("emissiveTexture", set(maps.sampled_emissive())),
+        ]
+    }
+
+    /// True when a texture of the material reads the second coordinate set: what its meshes'
+    /// `second_uvs` are uploaded for.
+    pub(crate) fn reads_second_uvs(&self) -> bool {
+        self.texture_sets().iter().any(|(_, set)| *set == Some(1))
+    }
+
     /// True when the material has a non-zero Blinn-Phong specular term (never for
     /// metallic-roughness, whose specular lobe is always there).
     pub fn has_specular(&self) -> bool {

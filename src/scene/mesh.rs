@@ -39,7 +39,8 @@ pub struct Mesh {
     pub uvs: Vec<Vec2>,
     /// A second set of texture coordinates (glTF `TEXCOORD_1`: a baked occlusion or light
     /// map's own unwrap), one per position, or empty. Read by the textures whose
-    /// [`TextureTransform::uv_set`](super::surface_maps::TextureTransform::uv_set) is 1.
+    /// [`TextureTransform::uv_set`](super::surface_maps::TextureTransform::uv_set) is 1, and
+    /// uploaded only while an object's material has such a texture.
     pub second_uvs: Vec<Vec2>,
     /// Triangle list, three indices per triangle. Its front face, the side `normals` point to,
     /// is counter-clockwise: [`Mesh::new`] turns a triangle listed the other way round; a mesh

@@ -512,6 +512,64 @@ fn maps_that_change_no_pixel_are_not_uploaded() {
     assert!(mapped >= bare + 64 * 64 * 4, "{bare} → {mapped} bytes");
 }
 
+/// A mesh built with a second coordinate set that no texture reads does not upload it (8 bytes
+/// a vertex); once a material reads it, the same renderer uploads it and draws what a fresh
+/// one does (the texture's colours at the flipped coordinates, not its texel at (0, 0)).
+#[test]
+fn a_second_coordinate_set_is_uploaded_once_a_texture_reads_it() {
+    let mut s = scene::builtin::build("plane", Some((8, 1))).unwrap();
+    let plain_mesh = s.objects[0].mesh.clone();
+    let flipped = (plain_mesh.uvs.iter())
+        .map(|uv| glam::Vec2::ONE - *uv)
+        .collect();
+    let with_second = Arc::new((*plain_mesh).clone().with_second_uvs(flipped).unwrap());
+    let vertices = with_second.positions.len();
+    let texels = image::RgbaImage::from_fn(2, 2, |x, y| {
+        image::Rgba([60 + 150 * x as u8, 90, 40 + 150 * y as u8, 255])
+    });
+    let m = s.objects[0].material;
+    s.materials[m].diffuse_texture = Some(Arc::new(scene::Texture::new("checks", texels)));
+    let render = |gpu: &mut Gpu, s: &scene::Scene| {
+        let (image, stats) = (gpu.r())
+            .render_offscreen(s, 64, 36, &RenderOptions::default())
+            .unwrap();
+        (image, stats.memory.scene_gpu_bytes)
+    };
+    for es in [EsVersion::Es3, EsVersion::Es2] {
+        let mut plain = s.clone();
+        plain.objects[0].mesh = plain_mesh.clone();
+        let mut unread = s.clone();
+        unread.objects[0].mesh = with_second.clone();
+        let mut gpu = Gpu::new(es);
+        let (_, plain_bytes) = render(&mut gpu, &plain);
+        let mut reused = Gpu::new(es);
+        let (_, unread_bytes) = render(&mut reused, &unread);
+        assert_eq!(
+            unread_bytes, plain_bytes,
+            "{es}: an unread second set was uploaded"
+        );
+        let mut read = unread.clone();
+        read.materials[m].maps.base_transform.uv_set = 1;
+        let (again, read_bytes) = render(&mut reused, &read);
+        assert_eq!(
+            read_bytes,
+            unread_bytes + 8 * vertices,
+            "{es}: the set uploaded"
+        );
+        let (fresh, _) = render(&mut Gpu::new(es), &read);
+        let d = manylight::metrics::diff(&fresh, &again);
+        assert_eq!(
+            d.max_abs, 0,
+            "{es}: the reused renderer drew the set it lacked"
+        );
+        let (first_set, _) = render(&mut Gpu::new(es), &unread);
+        assert!(
+            manylight::metrics::diff(&fresh, &first_set).max_abs > 20,
+            "{es}"
+        );
+    }
+}
+
 /// A frame uploads the texels its shaders read and no more: forward its light records,
 /// deferred its light instances, the culled methods also one grid texel a cell (after a
 /// two-texel table a cascade, and one more where the last list ends) and the index list's

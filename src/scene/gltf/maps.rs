@@ -200,19 +200,7 @@ pub(super) struct SetsRead([(&'static str, Option<u32>); 5]);
 impl SetsRead {
     /// The sets `material`'s textures read, by their glTF names.
     pub fn of(material: &crate::scene::Material) -> SetsRead {
-        let maps = &material.maps;
-        let set = |t: Option<&MapTexture>| t.map(|t| t.transform.uv_set);
-        let base = material.diffuse_texture.as_ref();
-        SetsRead([
-            ("baseColorTexture", base.map(|_| maps.base_transform.uv_set)),
-            (
-                "metallicRoughnessTexture",
-                set(maps.metallic_roughness.as_ref()),
-            ),
-            ("normalTexture", set(maps.sampled_normal())),
-            ("occlusionTexture", set(maps.sampled_occlusion())),
-            ("emissiveTexture", set(maps.sampled_emissive())),
-        ])
+        SetsRead(material.texture_sets())
     }
 
     /// Some texture reads `TEXCOORD_1`.
