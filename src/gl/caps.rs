@@ -292,6 +292,13 @@ impl Caps {
         !self.desktop && self.renderer.contains("SwiftShader")
     }
 
+    /// A driver workaround: SwiftShader 4's `glClear` of a multisampled sRGB renderbuffer fills
+    /// one sample (docs/drivers.md), so the renderer's MSAA target is filled by a draw first.
+    /// Elsewhere that draw would be a full-screen pass every frame for nothing.
+    pub fn clears_one_sample_of_srgb_msaa(&self) -> bool {
+        !self.desktop && self.renderer.contains("SwiftShader")
+    }
+
     /// Whether the context renders to half-float (RGBA16F) targets: what
     /// [`Renderer::render_offscreen_hdr`](crate::Renderer::render_offscreen_hdr) and HDR output
     /// need (ES 3.0: `GL_EXT_color_buffer_float` or `_half_float`; ES 2.0: `OES_texture_half_float`

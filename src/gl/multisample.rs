@@ -360,16 +360,17 @@ impl MultisampleTarget {
     }
 
     /// Draws `color` (linear: the target encodes it) over every sample of the bound target,
-    /// where a sRGB one's `glClear` may not reach them all (SwiftShader 4.0 fills one sample);
-    /// a no-op for a target that is not sRGB. The caller's clear follows as usual. Leaves the
-    /// full-screen state and the solid program bound.
+    /// where a sRGB one's `glClear` does not reach them all
+    /// ([`Caps::clears_one_sample_of_srgb_msaa`](super::Caps::clears_one_sample_of_srgb_msaa));
+    /// a no-op elsewhere. The caller's clear follows as usual. Leaves the full-screen state
+    /// and the solid program bound.
     pub fn fill(
         &mut self,
         dev: &Device,
         programs: &mut ProgramCache,
         color: [f32; 4],
     ) -> Result<(), GlError> {
-        if !self.is_srgb() {
+        if !self.is_srgb() || !dev.caps().clears_one_sample_of_srgb_msaa() {
             return Ok(());
         }
         if self.triangle.is_none() {

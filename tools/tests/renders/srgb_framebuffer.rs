@@ -92,6 +92,37 @@ fn an_srgb_framebuffer_stores_what_an_rgba8_one_does_with_every_method_and_msaa(
     }
 }
 
+/// 4× MSAA into an sRGB framebuffer draws what it draws into an RGBA8 one: the full-screen
+/// fill before its clear is SwiftShader's workaround alone (it ran on every implementation, a
+/// pass over every sample each frame), and there it is one draw more. The background it is
+/// for is checked by the test above and the next, on every implementation.
+#[test]
+fn msaa_into_an_srgb_framebuffer_fills_it_only_where_the_clear_misses_samples() {
+    let s = scene::builtin::build("plane", Some((20, 3))).unwrap();
+    let mut gpu = Gpu::new(EsVersion::Es3);
+    let options = RenderOptions {
+        samples: 4,
+        ..Default::default()
+    };
+    let mut calls = [0u64; 2];
+    for (format, calls) in [glow::RGBA8, glow::SRGB8_ALPHA8]
+        .into_iter()
+        .zip(&mut calls)
+    {
+        let gl = gpu.gl();
+        let target = unsafe { sized_framebuffer(&gl, format, (W as i32, H as i32)) };
+        let stats = gpu.r().render(&s, W, H, &options);
+        unsafe { stored_then_free(&gl, target, (W, H)) };
+        *calls = stats.unwrap().draw_calls;
+    }
+    let fill = u64::from(gpu.r().caps().clears_one_sample_of_srgb_msaa());
+    assert_eq!(
+        calls[1],
+        calls[0] + fill,
+        "draw calls into RGBA8 and into sRGB"
+    );
+}
+
 /// The background and the light-count heatmap, given as stored values, are stored so in an
 /// sRGB framebuffer too; exact counts, which an encode would change, are refused there.
 #[test]
