@@ -36,7 +36,7 @@ use crate::gl::mesh::GpuMesh;
 use crate::gl::program::{ProgramKey, Resolver, Sampler, Uniform, UniformSet};
 use crate::gl::state::{Blend, Cull, DepthTest, RenderState};
 use crate::gl::{Caps, Device, EsVersion};
-use crate::scene::Projection;
+use crate::scene::{Material, Projection};
 use crate::Error;
 use light_instances::{light_instance, LightInstances};
 use proxy::{Proxy, ProxyReach, VOLUME_SCALE};
@@ -332,10 +332,7 @@ impl Deferred {
             .with(ShaderFeatures::SPECULAR, gb.has_specular())
             .with(
                 ShaderFeatures::METALLIC_ROUGHNESS,
-                ctx.scene
-                    .materials
-                    .iter()
-                    .any(|m| m.is_metallic_roughness()),
+                in_gbuffer_any(ctx, Material::is_metallic_roughness),
             )
             .with(ShaderFeatures::DIRECTIONAL, false);
         let (half, ortho) = half_extent(ctx);
@@ -475,11 +472,7 @@ impl Deferred {
             .with(ShaderFeatures::SPECULAR, sun && specular)
             .with(
                 ShaderFeatures::METALLIC_ROUGHNESS,
-                sun && ctx
-                    .scene
-                    .materials
-                    .iter()
-                    .any(|m| m.is_metallic_roughness()),
+                sun && in_gbuffer_any(ctx, Material::is_metallic_roughness),
             );
         let accum_to_radiance = accumulation_scale(ctx).recip();
         let key = ProgramKey {
@@ -514,12 +507,22 @@ impl Deferred {
     }
 }
 
-/// Whether the frame's G-buffer needs its specular target: a material has a specular lobe or
-/// is metallic-roughness (every variant has them with `full_variants`). A shared variant's
-/// specular term of 0 changes nothing: its output has no target to go to.
+/// Whether the frame's G-buffer needs its specular target: a material it holds has a
+/// specular lobe or is metallic-roughness (every variant has them with `full_variants`). A
+/// shared variant's specular term of 0 changes nothing: its output has no target to go to.
 fn needs_specular_target(ctx: &FrameContext) -> bool {
-    let specular = |m: &crate::scene::Material| m.has_specular() || m.is_metallic_roughness();
-    ctx.options.measure.full_variants || ctx.scene.materials.iter().any(specular)
+    let specular = |m: &Material| m.has_specular() || m.is_metallic_roughness();
+    ctx.options.measure.full_variants || in_gbuffer_any(ctx, specular)
+}
+
+/// Whether a material an opaque object draws with, one the G-buffer holds, is `such`: a
+/// material no object draws with (an OBJ loader's unused default) or only transparent ones
+/// do (the forward fallback's) changes neither its targets nor the light pass's variant.
+fn in_gbuffer_any(ctx: &FrameContext, such: impl Fn(&Material) -> bool) -> bool {
+    let scene = ctx.scene;
+    (scene.objects.iter())
+        .filter_map(|o| scene.materials.get(o.material))
+        .any(|m| !m.is_transparent() && such(m))
 }
 
 /// View-space half extents of the projection (per unit depth when perspective) and whether it

@@ -5,6 +5,7 @@ mod common;
 use common::Gpu;
 use glam::{DVec3, Vec3};
 use manylight::gl::gbuffer;
+use manylight::methods::ShaderFeatures;
 use manylight::renderer::CountKind;
 use manylight::scene::{self, DirectionalLight, Material};
 use manylight::{EsVersion, RenderOptions};
@@ -438,4 +439,83 @@ impl Seeded {
         let u = self.next().max(1e-300);
         (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * self.next()).cos()
     }
+}
+
+/// The G-buffer's specular target (8 bytes a pixel) and the metallic-roughness BRDF of the
+/// light pass and a sunlit composite follow the materials the G-buffer holds: those of opaque
+/// objects. A material no object draws with (an OBJ loader's unused default, a game's
+/// palette) or only transparent objects do (the forward fallback's) cost nothing, and the
+/// picture stays forward's; an opaque glossy object still gets the target.
+#[test]
+fn only_materials_in_the_gbuffer_give_it_a_specular_target_or_the_light_pass_its_brdf() {
+    use manylight::scene::meshbuild::MeshBuilder;
+    let (w, h) = (128, 72);
+    let mut base = scene::builtin::build("plane", Some((20, 4))).unwrap();
+    for m in &mut base.materials {
+        m.specular = Vec3::ZERO;
+    }
+    base.directional_lights.push(DirectionalLight::new(
+        DVec3::new(1.0, -2.0, -1.0),
+        Vec3::ONE,
+        0.3,
+    ));
+    let cube = |s: &mut scene::Scene, material: Material| {
+        let mut b = MeshBuilder::new();
+        b.cuboid(Vec3::splat(-0.3), Vec3::splat(0.3));
+        let m = s.add_material(material);
+        let at = glam::DMat4::from_translation(DVec3::new(0.0, 0.0, 0.5));
+        s.add_object(b.build().unwrap(), m, at);
+    };
+    let glossy = Material::glossy("glossy", Vec3::ONE, Vec3::splat(0.5), 64.0);
+    let metal = Material::metallic_roughness("metal", Vec3::ONE, 1.0, 0.5);
+    let see_through = |mut m: Material| {
+        m.alpha = 0.5;
+        m
+    };
+    let mut unused = base.clone();
+    unused.add_material(glossy.clone());
+    unused.add_material(metal.clone());
+    let mut transparent = base.clone();
+    cube(&mut transparent, see_through(glossy.clone()));
+    cube(&mut transparent, see_through(metal.clone()));
+    let mut gpu = Gpu::fresh(EsVersion::Es3);
+    let matte_bytes = (w * h) as usize * gbuffer::bytes_per_pixel(gpu.r().caps(), false);
+    for (what, s) in [("unused", &unused), ("transparent", &transparent)] {
+        let (reference, _) = gpu.render_with("forward", s, (w, h), &RenderOptions::default());
+        let (img, stats) = gpu.render_with("deferred", s, (w, h), &RenderOptions::default());
+        assert_eq!(stats.memory.gbuffer_bytes, matte_bytes, "{what} materials");
+        let d = manylight::metrics::diff(&reference, &img);
+        assert!(
+            d.max_abs <= 2,
+            "{what}: deferred is {} / 255 from forward",
+            d.max_abs
+        );
+    }
+    let mr_light_passes = |gpu: &mut Gpu| {
+        (gpu.r().program_report().iter())
+            .filter(|p| p.shader.starts_with("deferred_"))
+            .filter(|p| ShaderFeatures(p.features).has(ShaderFeatures::METALLIC_ROUGHNESS))
+            .count()
+    };
+    assert_eq!(
+        mr_light_passes(&mut gpu),
+        0,
+        "the BRDF compiled in for nothing"
+    );
+    let mut opaque = base.clone();
+    cube(&mut opaque, glossy);
+    cube(&mut opaque, metal);
+    let (reference, _) = gpu.render_with("forward", &opaque, (w, h), &RenderOptions::default());
+    let (img, stats) = gpu.render_with("deferred", &opaque, (w, h), &RenderOptions::default());
+    let specular_bytes = (w * h) as usize * gbuffer::bytes_per_pixel(gpu.r().caps(), true);
+    assert_eq!(
+        stats.memory.gbuffer_bytes, specular_bytes,
+        "an opaque glossy object"
+    );
+    assert!(manylight::metrics::diff(&reference, &img).max_abs <= 2);
+    assert_eq!(
+        mr_light_passes(&mut gpu),
+        2,
+        "the light pass and the sunlit composite"
+    );
 }
