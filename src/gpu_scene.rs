@@ -93,7 +93,7 @@ impl SplitInputs {
 /// sRGB-encoded) or data (normal, metallic-roughness and occlusion maps).
 fn textures_of(m: &Material) -> impl Iterator<Item = (&Texture, bool)> {
     let maps =
-        (m.maps.sampled_textures()).map(|(slot, t)| (&*t.texture, slot == "emissive_texture"));
+        (m.sampled_map_textures()).map(|(slot, t)| (&*t.texture, slot == "emissive_texture"));
     m.diffuse_texture.iter().map(|t| (&**t, true)).chain(maps)
 }
 

@@ -78,7 +78,10 @@ pub fn features(material: &Material, mesh: &Mesh, units: i32) -> F {
         (F::EMISSIVE, emits),
         (F::EMISSIVE_MAP, sampled(maps.sampled_emissive())),
         (F::OCCLUSION, sampled(maps.sampled_occlusion())),
-        (F::MR_TEXTURE, sampled(maps.metallic_roughness.as_ref())),
+        (
+            F::MR_TEXTURE,
+            sampled(material.sampled_metallic_roughness()),
+        ),
     ]
     .into_iter()
     .fold(F::default(), |f, (bit, on)| f.with(bit, on));

@@ -167,12 +167,29 @@ impl Material {
             ("baseColorTexture", base.map(|_| maps.base_transform.uv_set)),
             (
                 "metallicRoughnessTexture",
-                set(maps.metallic_roughness.as_ref()),
+                set(self.sampled_metallic_roughness()),
             ),
             ("normalTexture", set(maps.sampled_normal())),
             ("occlusionTexture", set(maps.sampled_occlusion())),
             ("emissiveTexture", set(maps.sampled_emissive())),
         ]
+    }
+
+    /// The metallic-roughness texture, where the material is shaded with that BRDF (a
+    /// Blinn-Phong material's shader has nothing to read it with).
+    pub(crate) fn sampled_metallic_roughness(&self) -> Option<&super::surface_maps::MapTexture> {
+        (self.maps.metallic_roughness.as_ref()).filter(|_| self.is_metallic_roughness())
+    }
+
+    /// The textures of the maps a shader of this material samples
+    /// ([`SurfaceMaps::sampled_textures`], less a metallic-roughness texture on a Blinn-Phong
+    /// material), by their field names.
+    pub fn sampled_map_textures(
+        &self,
+    ) -> impl Iterator<Item = (&'static str, &super::surface_maps::MapTexture)> {
+        let read =
+            |(slot, _): &(&str, _)| *slot != "metallic_roughness" || self.is_metallic_roughness();
+        self.maps.sampled_textures().filter(read)
     }
 
     /// True when a texture of the material reads the second coordinate set: what its meshes'

@@ -168,7 +168,9 @@ impl SurfaceMaps {
     }
 
     /// The textures a shader samples: a normal map of scale 0, an occlusion map of strength 0
-    /// and an emissive texture without emission change no pixel, so they are not uploaded.
+    /// and an emissive texture without emission change no pixel, so they are not uploaded
+    /// (nor is a metallic-roughness texture on a Blinn-Phong material:
+    /// [`Material::sampled_map_textures`](super::Material::sampled_map_textures)).
     pub fn sampled_textures(&self) -> impl Iterator<Item = (&'static str, &MapTexture)> {
         [
             ("normal", self.sampled_normal()),

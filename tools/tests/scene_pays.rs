@@ -512,6 +512,50 @@ fn maps_that_change_no_pixel_are_not_uploaded() {
     assert!(mapped >= bare + 64 * 64 * 4, "{bare} → {mapped} bytes");
 }
 
+/// A metallic-roughness texture on a Blinn-Phong material, whose shader has nothing to read it
+/// with, is neither uploaded nor a variant of its own (it was both: 349 525 bytes and a
+/// program compiling the same code), and the picture is the same; on a metallic-roughness
+/// material it is both.
+#[test]
+fn a_metallic_roughness_texture_on_a_blinn_phong_material_costs_nothing() {
+    use manylight::methods::ShaderFeatures;
+    use manylight::scene::surface_maps::{MapTexture, TextureTransform};
+    let mut s = scene::builtin::build("plane", Some((20, 2))).unwrap();
+    let mut gpu = Gpu::fresh(EsVersion::Es3);
+    let mut render = |s: &scene::Scene| {
+        let (image, stats) = (gpu.r())
+            .render_offscreen(s, 96, 54, &RenderOptions::default())
+            .unwrap();
+        let report = gpu.r().program_report();
+        let mr = (report.iter())
+            .filter(|p| ShaderFeatures(p.features).has(ShaderFeatures::MR_TEXTURE))
+            .count();
+        (image, stats.memory.scene_gpu_bytes, report.len(), mr)
+    };
+    let (plain, bytes, programs, _) = render(&s);
+    let texels = image::RgbaImage::from_fn(256, 256, |x, y| {
+        image::Rgba([(x * 7) as u8, (y * 5) as u8, 90, 255])
+    });
+    for m in &mut s.materials {
+        m.maps.metallic_roughness = Some(MapTexture {
+            texture: Arc::new(scene::Texture::new("mr", texels.clone())),
+            transform: TextureTransform::IDENTITY,
+        });
+    }
+    let (mapped, mapped_bytes, mapped_programs, mr) = render(&s);
+    assert_eq!(mapped_bytes, bytes, "the texture was uploaded");
+    assert_eq!((mapped_programs, mr), (programs, 0), "a variant of its own");
+    assert_eq!(manylight::metrics::diff(&plain, &mapped).max_abs, 0);
+    for m in &mut s.materials {
+        m.model = scene::MaterialModel::MetallicRoughness;
+    }
+    let (_, metal_bytes, _, mr) = render(&s);
+    assert!(
+        metal_bytes >= bytes + 256 * 256 * 4 && mr > 0,
+        "{metal_bytes} bytes, {mr}"
+    );
+}
+
 /// A mesh built with a second coordinate set that no texture reads does not upload it (8 bytes
 /// a vertex); once a material reads it, the same renderer uploads it and draws what a fresh
 /// one does (the texture's colours at the flipped coordinates, not its texel at (0, 0)).
