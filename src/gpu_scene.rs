@@ -40,6 +40,9 @@ pub struct GpuScene {
     split_for: SplitInputs,
     /// A frame's splits ran out of triangles and said so (once a renderer).
     warned_split_budget: bool,
+    /// Per material of this frame's scene, which of its textures an object samples (bit
+    /// `slot` of [`slotted_textures_of`]; kept to reuse its memory).
+    drawn_slots: Vec<u8>,
     /// This frame's meshes whose second coordinate set some object's material reads (kept to
     /// reuse its memory).
     second_set_meshes: HashSet<usize>,
@@ -89,12 +92,32 @@ impl SplitInputs {
     }
 }
 
-/// The textures a material samples, each with whether it is colour (base colour, emission:
-/// sRGB-encoded) or data (normal, metallic-roughness and occlusion maps).
-fn textures_of(m: &Material) -> impl Iterator<Item = (&Texture, bool)> {
-    let maps =
-        (m.sampled_map_textures()).map(|(slot, t)| (&*t.texture, slot == "emissive_texture"));
-    m.diffuse_texture.iter().map(|t| (&**t, true)).chain(maps)
+/// Slots of [`slotted_textures_of`] sampled as colour (sRGB-encoded); the others are data.
+const BASE_SLOT: u8 = 0;
+const EMISSIVE_SLOT: u8 = 2;
+
+/// The textures a material samples, each with its slot (its bit in [`GpuScene::drawn_slots`]:
+/// [`BASE_SLOT`] the base colour, then the maps) and whether a mesh can sample it: it has the
+/// coordinate set the texture reads (and tangents, for a normal map).
+fn slotted_textures_of(
+    m: &Material,
+) -> impl Iterator<Item = (u8, &Texture, impl Fn(&Mesh) -> bool + '_)> {
+    let base = (m.diffuse_texture.iter()).map(|t| (BASE_SLOT, &**t, &m.maps.base_transform, false));
+    let maps = m.sampled_map_textures().map(|(name, t)| {
+        let slot = match name {
+            "normal" => 1,
+            "emissive_texture" => EMISSIVE_SLOT,
+            "occlusion" => 3,
+            _ => 4,
+        };
+        (slot, &*t.texture, &t.transform, slot == 1)
+    });
+    base.chain(maps).map(|(slot, t, transform, tangents)| {
+        let samples = move |mesh: &Mesh| {
+            transform.coordinates(mesh).is_some() && !(tangents && mesh.tangents.is_empty())
+        };
+        (slot, t, samples)
+    })
 }
 
 /// Warns (once, `warned`) that `texture` is past the context's `GL_MAX_TEXTURE_SIZE`, and so
@@ -156,8 +179,13 @@ impl GpuScene {
                 Entry::Occupied(_) => {}
             }
         }
-        for m in &scene.materials {
-            for (t, colour) in textures_of(m) {
+        self.note_drawn_slots(scene);
+        for (m, &drawn) in scene.materials.iter().zip(&self.drawn_slots) {
+            for (slot, t, _) in slotted_textures_of(m) {
+                if drawn & 1 << slot == 0 {
+                    continue;
+                }
+                let colour = slot == BASE_SLOT || slot == EMISSIVE_SLOT;
                 let srgb = self.upload_slot(colour);
                 let key = Arc::as_ptr(&t.image) as usize;
                 let (_, uploads) = self
@@ -173,6 +201,24 @@ impl GpuScene {
             }
         }
         Ok(bytes)
+    }
+
+    /// Notes which textures of each material an object draws with on a mesh that can sample
+    /// them: only those are uploaded (a material palette's, or a texture on a mesh without
+    /// coordinates, is not).
+    fn note_drawn_slots(&mut self, scene: &Scene) {
+        self.drawn_slots.clear();
+        self.drawn_slots.resize(scene.materials.len(), 0);
+        for o in &scene.objects {
+            let Some(m) = scene.materials.get(o.material) else {
+                continue;
+            };
+            for (slot, _, samples) in slotted_textures_of(m) {
+                if samples(&o.mesh) {
+                    self.drawn_slots[o.material] |= 1 << slot;
+                }
+            }
+        }
     }
 
     /// Notes the meshes whose second coordinate set an object's material reads: only they
@@ -202,8 +248,12 @@ impl GpuScene {
             .flat_map(|s| s.objects.iter().map(|o| Arc::as_ptr(&o.mesh) as usize))
             .collect();
         let images: HashSet<usize> = (scenes.iter())
-            .flat_map(|s| s.materials.iter().flat_map(textures_of))
-            .map(|(t, _)| Arc::as_ptr(&t.image) as usize)
+            .flat_map(|s| s.objects.iter().map(|o| (o, s.materials.get(o.material))))
+            .flat_map(|(o, m)| {
+                let textures = m.into_iter().flat_map(slotted_textures_of);
+                textures.filter_map(|(_, t, samples)| samples(&o.mesh).then_some(t))
+            })
+            .map(|t| Arc::as_ptr(&t.image) as usize)
             .collect();
         let mesh_used = |key, _| meshes.contains(&key);
         let image_used = |key, _| images.contains(&key);

@@ -12,7 +12,7 @@ use glam::{DMat4, DVec3, Vec3};
 use manylight::gl::shader_source::{assemble, Stage};
 use manylight::methods::ShaderFeatures;
 use manylight::scene::meshbuild::MeshBuilder;
-use manylight::scene::{self, Light};
+use manylight::scene::{self, Light, Material};
 use manylight::{EsVersion, HeadlessContext, LightEncoding, RenderOptions, Renderer};
 
 #[test]
@@ -472,7 +472,8 @@ fn lights_out_of_view_cost_nothing_and_one_reaching_in_still_lights() {
 }
 
 /// A normal map of scale 0, an occlusion map of strength 0 and an emissive texture without
-/// emission change no pixel: none of them is uploaded; given a scale, the normal map is.
+/// emission change no pixel: none of them is uploaded; given a scale, the normal map is, on a
+/// mesh with tangents.
 #[test]
 fn maps_that_change_no_pixel_are_not_uploaded() {
     use manylight::scene::surface_maps::{MapTexture, TextureTransform};
@@ -507,6 +508,16 @@ fn maps_that_change_no_pixel_are_not_uploaded() {
     );
     for m in &mut s.materials {
         m.maps.normal_scale = 1.0;
+    }
+    // Not on a mesh without tangents, which cannot apply it.
+    assert_eq!(
+        scene_bytes(&s),
+        bare,
+        "a normal map without tangents was uploaded"
+    );
+    for o in &mut s.objects {
+        let (mesh, _) = (*o.mesh).clone().with_generated_tangents().unwrap();
+        o.mesh = Arc::new(mesh);
     }
     let mapped = scene_bytes(&s);
     assert!(mapped >= bare + 64 * 64 * 4, "{bare} → {mapped} bytes");
@@ -553,6 +564,69 @@ fn a_metallic_roughness_texture_on_a_blinn_phong_material_costs_nothing() {
     assert!(
         metal_bytes >= bytes + 256 * 256 * 4 && mr > 0,
         "{metal_bytes} bytes, {mr}"
+    );
+}
+
+/// Textures no object can sample are not uploaded: a material no object draws with (a game's
+/// palette, an MTL's unused material: it was, 1.4 MB for 512²) and a texture on a mesh
+/// without the coordinates it reads. Once an object samples it, it is; and a material whose
+/// objects went is freed on request, though the scene still lists it.
+#[test]
+fn textures_no_object_samples_are_neither_uploaded_nor_kept() {
+    let base = scene::builtin::build("plane", Some((8, 1))).unwrap();
+    let texels = image::RgbaImage::from_fn(64, 64, |x, y| {
+        image::Rgba([(x * 4) as u8, (y * 4) as u8, 90, 255])
+    });
+    let mut textured = Material::flat("textured", Vec3::splat(0.8));
+    textured.diffuse_texture = Some(Arc::new(scene::Texture::new("texels", texels)));
+    let mut palette = base.clone();
+    let m = palette.add_material(textured);
+    let untextured = |s: &scene::Scene| {
+        let mut s = s.clone();
+        s.materials[m].diffuse_texture = None;
+        s
+    };
+    let mut without_uvs = palette.clone();
+    let mut mesh = (*without_uvs.objects[0].mesh).clone();
+    mesh.uvs.clear();
+    without_uvs.objects[0].mesh = Arc::new(mesh);
+    without_uvs.objects[0].material = m;
+    let mut drawn = palette.clone();
+    drawn.objects[0].material = m;
+    let fresh = |s: &scene::Scene| {
+        let (image, stats) = (Gpu::new(EsVersion::Es3).r())
+            .render_offscreen(s, 64, 36, &RenderOptions::default())
+            .unwrap();
+        (image, stats.memory.scene_gpu_bytes)
+    };
+    for (what, s) in [
+        ("of a palette material", &palette),
+        ("on a mesh without uvs", &without_uvs),
+    ] {
+        let (with, bytes) = fresh(s);
+        let (without, plain_bytes) = fresh(&untextured(s));
+        assert_eq!(bytes, plain_bytes, "a texture {what} was uploaded");
+        assert_eq!(
+            manylight::metrics::diff(&with, &without).max_abs,
+            0,
+            "{what}"
+        );
+    }
+    let (_, drawn_bytes) = fresh(&drawn);
+    let (_, palette_bytes) = fresh(&palette);
+    assert!(
+        drawn_bytes >= palette_bytes + 64 * 64 * 4,
+        "drawn: uploaded"
+    );
+    let mut gpu = Gpu::new(EsVersion::Es3);
+    let opts = RenderOptions::default();
+    gpu.r().render_offscreen(&drawn, 64, 36, &opts).unwrap();
+    gpu.r().render_offscreen(&palette, 64, 36, &opts).unwrap();
+    let freed = gpu.r().free_unused_uploads(&[&palette]).unwrap();
+    assert_eq!(
+        freed,
+        drawn_bytes - palette_bytes,
+        "the texture whose objects went"
     );
 }
 
