@@ -667,6 +667,22 @@ fn other_texture_sets_malformed_transforms_and_every_colour_format_are_handled()
             .any(|w| w.contains("COLOR_0") && w.contains("ignored")),
         "{warnings:?}"
     );
+    // All white and opaque multiplies by 1, as exporters often write it: the mesh keeps no
+    // colours (16 bytes a vertex and a variant less); one element off white keeps them all.
+    for (name, last, kept) in [("white.gltf", 65535u16, false), ("grey.gltf", 65534, true)] {
+        let mut plane = Plane::new(json!({}));
+        let mut colours = [65535u16; 16];
+        colours[15] = last;
+        let bytes = colours.iter().flat_map(|v| v.to_le_bytes()).collect();
+        plane.extra.push(("COLOR_0", UNSIGNED_SHORT, "VEC4", bytes));
+        let (s, _) = scene_of(&plane.write(dir.path(), name), vec![], 0.1);
+        assert_eq!(!s.objects[0].mesh.colors.is_empty(), kept, "{name}");
+    }
+    let mut plane = Plane::new(json!({}));
+    let white: Vec<u8> = [1.0f32; 12].iter().flat_map(|v| v.to_le_bytes()).collect();
+    plane.extra.push(("COLOR_0", FLOAT, "VEC3", white));
+    let (s, _) = scene_of(&plane.write(dir.path(), "white3.gltf"), vec![], 0.1);
+    assert!(s.objects[0].mesh.colors.is_empty(), "white VEC3");
 }
 
 /// Pay for use: a variant without the surface inputs has none of their code, attributes or

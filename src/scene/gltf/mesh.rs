@@ -447,6 +447,11 @@ fn read_colors(
              [0, 1], where glTF colours lie; clamped into it"
         ));
     }
+    // All white and opaque (as exporters often write it) multiplies by 1: left out, the mesh
+    // uploads no colours and draws without the vertex-colour variant.
+    if colors.iter().all(|c| c.cmpge(Vec4::ONE).all()) {
+        return Ok(Vec::new());
+    }
     Ok(colors)
 }
 
