@@ -18,10 +18,8 @@ use crate::Error;
 /// upload once it holds the last one.
 #[derive(Default)]
 pub struct GpuScene {
-    /// Uploaded meshes with their object-space bounds and longest triangle edge (computed
-    /// once, not every frame). Each is uploaded about its bounds' centre (see
-    /// [`GpuScene::model`]).
-    meshes: HashMap<usize, (Arc<Mesh>, GpuMesh, Option<Aabb>, f64)>,
+    /// Uploaded meshes by their source's address.
+    meshes: HashMap<usize, CachedMesh>,
     /// Per image (the textures reading it share it): its upload as linear data and as sRGB
     /// colour (each made when a material
     /// first samples it so: a base colour or emission is colour, a normal map data).
@@ -49,6 +47,19 @@ pub struct GpuScene {
     /// An image past the context's texture size was said (once a renderer: a game replacing
     /// one every frame would say it every frame).
     warned_shrunk: bool,
+}
+
+/// A mesh's upload and what is measured of it once, not every frame.
+struct CachedMesh {
+    source: Arc<Mesh>,
+    /// Uploaded about its bounds' centre (see [`GpuScene::model`]).
+    gpu: GpuMesh,
+    /// Object-space bounds.
+    bounds: Option<Aabb>,
+    /// Longest triangle edge, object space.
+    longest_edge: f64,
+    /// Its triangles lie in one plane and face one way ([`Mesh::faces_one_way`]).
+    faces_one_way: bool,
 }
 
 /// Everything a frame's split copies depend on: the camera, the frame's size and each
@@ -164,17 +175,22 @@ impl GpuScene {
                     let bounds = o.mesh.bounds();
                     let origin = bounds.map_or(DVec3::ZERO, |b| b.center());
                     let gpu = GpuMesh::new_about(dev, &o.mesh, origin, second)?;
-                    let longest = triangle_reach::longest_edge(&o.mesh);
                     bytes += gpu.gpu_bytes();
-                    e.insert((o.mesh.clone(), gpu, bounds, longest));
+                    e.insert(CachedMesh {
+                        source: o.mesh.clone(),
+                        gpu,
+                        bounds,
+                        longest_edge: triangle_reach::longest_edge(&o.mesh),
+                        faces_one_way: o.mesh.faces_one_way(),
+                    });
                 }
                 // A material reads the second set of a mesh uploaded without it: again, with.
-                Entry::Occupied(mut e) if second && !e.get().1.has_second_uvs() => {
-                    let (mesh, gpu, bounds, _) = e.get_mut();
-                    let origin = bounds.map_or(DVec3::ZERO, |b| b.center());
-                    let with = GpuMesh::new_about(dev, mesh, origin, true)?;
+                Entry::Occupied(mut e) if second && !e.get().gpu.has_second_uvs() => {
+                    let cached = e.get_mut();
+                    let origin = cached.bounds.map_or(DVec3::ZERO, |b| b.center());
+                    let with = GpuMesh::new_about(dev, &cached.source, origin, true)?;
                     bytes += with.gpu_bytes();
-                    std::mem::replace(gpu, with).destroy(dev);
+                    std::mem::replace(&mut cached.gpu, with).destroy(dev);
                 }
                 Entry::Occupied(_) => {}
             }
@@ -269,11 +285,11 @@ impl GpuScene {
         keep_image: impl Fn(usize, usize) -> bool,
     ) -> usize {
         let mut freed = 0;
-        self.meshes.retain(|&key, (source, gpu, _, _)| {
-            let keep = keep_mesh(key, Arc::strong_count(source));
+        self.meshes.retain(|&key, cached| {
+            let keep = keep_mesh(key, Arc::strong_count(&cached.source));
             if !keep {
-                freed += gpu.gpu_bytes();
-                gpu.destroy(dev);
+                freed += cached.gpu.gpu_bytes();
+                cached.gpu.destroy(dev);
             }
             keep
         });
@@ -292,7 +308,7 @@ impl GpuScene {
 
     /// GPU bytes of the uploaded meshes and images (a frame's split copies aside).
     pub(crate) fn gpu_bytes(&self) -> usize {
-        let meshes = self.meshes.values().map(|(_, gpu, _, _)| gpu.gpu_bytes());
+        let meshes = self.meshes.values().map(|m| m.gpu.gpu_bytes());
         let images = (self.textures.values())
             .flat_map(|(_, uploads)| uploads.iter().flatten().map(ImageTexture::gpu_bytes));
         meshes.sum::<usize>() + images.sum::<usize>()
@@ -352,7 +368,18 @@ impl GpuScene {
 
     /// The uploaded mesh of an object (the scene must have been uploaded).
     pub fn mesh(&self, object: &crate::scene::Object) -> &GpuMesh {
-        &self.meshes[&(Arc::as_ptr(&object.mesh) as usize)].1
+        &self.cached(object).gpu
+    }
+
+    /// What is cached of an object's mesh (the scene must have been uploaded).
+    fn cached(&self, object: &crate::scene::Object) -> &CachedMesh {
+        &self.meshes[&(Arc::as_ptr(&object.mesh) as usize)]
+    }
+
+    /// Whether an object's triangles lie in one plane and face one way: from any eye all show
+    /// the same side, so one draw without culling shows both sides of a transparent one.
+    pub(crate) fn faces_one_way(&self, object: &crate::scene::Object) -> bool {
+        self.cached(object).faces_one_way
     }
 
     /// The object's model matrix for its uploaded mesh: the object's transform after a move
@@ -360,22 +387,23 @@ impl GpuScene {
     /// 10⁷) are stored in `f32` relative to that centre, and the offset joins the `f64`
     /// transform, from which the camera is subtracted before anything becomes `f32`.
     pub fn model(&self, object: &crate::scene::Object) -> DMat4 {
-        let (_, _, bounds, _) = &self.meshes[&(Arc::as_ptr(&object.mesh) as usize)];
-        let origin = bounds.map_or(DVec3::ZERO, |b| b.center());
+        let origin = self
+            .cached(object)
+            .bounds
+            .map_or(DVec3::ZERO, |b| b.center());
         object.transform * DMat4::from_translation(origin)
     }
 
     /// World-space bounds of an object, from its mesh's cached bounds (the scene must have
     /// been uploaded).
     pub fn world_bounds(&self, object: &crate::scene::Object) -> Option<Aabb> {
-        let (_, _, bounds, _) = &self.meshes[&(Arc::as_ptr(&object.mesh) as usize)];
-        bounds.map(|b| b.transformed(&object.transform))
+        (self.cached(object).bounds).map(|b| b.transformed(&object.transform))
     }
 
     /// The longest triangle edge of an object's mesh, in object space (the scene must have
     /// been uploaded).
     pub fn longest_edge(&self, object: &crate::scene::Object) -> f64 {
-        self.meshes[&(Arc::as_ptr(&object.mesh) as usize)].3
+        self.cached(object).longest_edge
     }
 
     /// Refuses an object its transform places past the camera's coordinate limit or shrinks
@@ -384,8 +412,7 @@ impl GpuScene {
     /// word, a tiny one drew black. (The file loaders check the same.)
     pub fn check_placement(&self, scene: &Scene) -> Result<(), SceneError> {
         for (i, o) in scene.objects.iter().enumerate() {
-            let (_, _, bounds, _) = &self.meshes[&(Arc::as_ptr(&o.mesh) as usize)];
-            if let Some(b) = bounds {
+            if let Some(b) = &self.cached(o).bounds {
                 if b.check_placed_by(&o.transform, "").is_err() {
                     b.check_placed_by(&o.transform, &format!("objects[{i}]"))?;
                 }
@@ -427,8 +454,8 @@ impl GpuScene {
     }
 
     pub(crate) fn destroy(&mut self, dev: &Device) {
-        for (_, (_, mut m, _, _)) in self.meshes.drain() {
-            m.destroy(dev);
+        for (_, mut m) in self.meshes.drain() {
+            m.gpu.destroy(dev);
         }
         for (_, (_, uploads)) in self.textures.drain() {
             uploads

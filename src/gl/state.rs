@@ -120,6 +120,13 @@ impl RenderState {
         ..Self::TRANSPARENT_BACK_FACES
     };
 
+    /// Transparent objects whose triangles face one way: one pass shows whichever side the
+    /// eye sees.
+    pub const TRANSPARENT_BOTH_SIDES: RenderState = RenderState {
+        cull: Cull::None,
+        ..Self::TRANSPARENT_BACK_FACES
+    };
+
     /// Applies every field.
     pub fn apply(&self, dev: &Device) {
         let gl = &dev.gl;

@@ -178,10 +178,15 @@ pub fn draw_objects<P: GeometryProgram>(
         if is_mirroring(&(ctx.view * model)) {
             passes.reverse();
         }
-        // A single-sided surface has its front only: the second pass.
-        let double_sided = ctx.scene.materials[ctx.scene.objects[i].material].double_sided;
-        let first = if double_sided { 0 } else { 1 };
-        for state in &passes[first..] {
+        // A single-sided surface has its front only: the second pass. One whose triangles
+        // face one way shows one side from any eye: one pass without culling draws it.
+        let object = &ctx.scene.objects[i];
+        let passes = match ctx.scene.materials[object.material].double_sided {
+            false => &passes[1..],
+            true if ctx.gpu_scene.faces_one_way(object) => &[RenderState::TRANSPARENT_BOTH_SIDES],
+            true => &passes[..],
+        };
+        for state in passes {
             state.apply(ctx.dev);
             shade_object(ctx, i, shader, max_lights, bind_method, &mut bound)?;
         }

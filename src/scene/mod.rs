@@ -42,6 +42,7 @@ pub mod motion;
 pub mod normal_matrix;
 #[cfg(feature = "obj")]
 pub mod obj;
+mod one_way;
 mod orientation;
 mod png_profile;
 pub mod random;

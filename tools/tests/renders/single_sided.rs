@@ -271,3 +271,42 @@ fn a_gltf_material_is_single_sided_unless_it_says_double_sided() {
         assert_eq!(p[0] > p[1], seen, "{what}: the middle is {p:?}");
     }
 }
+
+/// A transparent double-sided pane, whose triangles lie in one plane and face one way, is drawn
+/// once without culling: as many draws as a single-sided pane facing the eye (it was drawn
+/// once a side, one of the two drawing nothing: particle and foliage cards paid double), and
+/// its picture, whichever way it is wound or mirrored, with every method.
+#[test]
+fn a_transparent_pane_showing_both_sides_is_drawn_once() {
+    let opts = RenderOptions {
+        linear: true,
+        ..Default::default()
+    };
+    let facing = Pane {
+        away: false,
+        mirrored: false,
+        double_sided: false,
+        transparent: true,
+    };
+    common::each_method(|es, method, gpu| {
+        let render = |gpu: &mut Gpu, pane| {
+            let s = scene(Some(pane));
+            gpu.r().render_offscreen(&s, W, H, &opts).unwrap()
+        };
+        let (reference, once) = render(gpu, facing);
+        for (away, mirrored) in [(false, false), (true, false), (false, true), (true, true)] {
+            let pane = Pane {
+                away,
+                mirrored,
+                double_sided: true,
+                ..facing
+            };
+            let (img, stats) = render(gpu, pane);
+            let what = format!("{es} {method} {pane:?}");
+            assert_eq!(stats.draw_calls, once.draw_calls, "{what}: draws");
+            let everywhere = (0..W).flat_map(|x| (0..H).map(move |y| (x, y)));
+            let d = max_difference(&img, &reference, everywhere);
+            assert!(d <= 1, "{what}: {d}/255 from the pane facing the eye");
+        }
+    });
+}
