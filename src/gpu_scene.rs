@@ -163,7 +163,7 @@ impl GpuScene {
         self.srgb_textures = crate::gl::texture::hardware_srgb(dev.caps());
         if needs_white && self.white.is_none() {
             let white = image::RgbaImage::from_pixel(1, 1, image::Rgba([255, 255, 255, 255]));
-            self.white = Some(ImageTexture::new(dev, &white, false)?);
+            self.white = Some(ImageTexture::new(dev, &white, false, false)?);
         }
         self.note_second_set_meshes(scene);
         for (i, o) in scene.objects.iter().enumerate() {
@@ -208,11 +208,17 @@ impl GpuScene {
                     .textures
                     .entry(key)
                     .or_insert_with(|| (t.image.clone(), [None, None]));
-                if uploads[srgb as usize].is_none() {
-                    warn_if_shrunk(dev, t, &mut self.warned_shrunk);
-                    let texture = ImageTexture::new(dev, &t.image, srgb)?;
-                    bytes += texture.gpu_bytes();
-                    uploads[srgb as usize] = Some(texture);
+                let mipmaps = t.sampling.mipmap.is_some();
+                match &uploads[srgb as usize] {
+                    None => {
+                        warn_if_shrunk(dev, t, &mut self.warned_shrunk);
+                        let texture = ImageTexture::new(dev, &t.image, srgb, mipmaps)?;
+                        bytes += texture.gpu_bytes();
+                        uploads[srgb as usize] = Some(texture);
+                    }
+                    // An image first sampled without mipmaps, now through them.
+                    Some(texture) if mipmaps => bytes += texture.make_mipmaps(dev),
+                    Some(_) => {}
                 }
             }
         }

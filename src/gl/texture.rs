@@ -276,7 +276,9 @@ pub fn upload_size((w, h): (u32, u32), max: u32, power_of_two: bool) -> (u32, u3
     (fit(w), fit(h))
 }
 
-/// A mipmapped RGBA8 image texture, read as each bind's [`Sampling`] says. A colour one
+/// An RGBA8 image texture, read as each bind's [`Sampling`] says, with mipmaps only once a
+/// sampling reads them (an image sampled only without, as pixel art, UI atlases and light
+/// maps are, has none: a third less memory). A colour one
 /// (sRGB-encoded) is an `SRGB8_ALPHA8` texture at the ES 3.0 level, so texels are decoded
 /// before they are filtered (glTF 2.0 §3.9.2; filtering encoded values darkens fine
 /// high-contrast detail); ES 2.0 has no sRGB textures in core (`GL_EXT_sRGB` cannot make their
@@ -284,8 +286,10 @@ pub fn upload_size((w, h): (u32, u32), max: u32, power_of_two: bool) -> (u32, u3
 pub struct ImageTexture {
     raw: glow::Texture,
     destroyed: bool,
-    /// GPU bytes of its texels, mipmaps included (about a third more than the base level).
-    bytes: usize,
+    /// Bytes of its base level.
+    base_bytes: usize,
+    /// Its mipmaps are made (about a third more than the base level).
+    mipmapped: std::cell::Cell<bool>,
     /// The sampling its parameters are set for (ES 2.0 has no sampler objects: each bind
     /// sets the parameters a texture's [`Sampling`] asks, where they differ).
     sampling: std::cell::Cell<Sampling>,
@@ -294,11 +298,12 @@ pub struct ImageTexture {
 impl ImageTexture {
     /// Uploads an image, downscaled where it is larger than the context's texture limit and,
     /// on ES 2.0 without `GL_OES_texture_npot`, to a power of two (see [`upload_size`]);
-    /// `srgb` for colour (see above).
+    /// `srgb` for colour (see above), with its mipmaps made where `mipmaps`.
     pub fn new(
         dev: &Device,
         image: &image::RgbaImage,
         srgb: bool,
+        mipmaps: bool,
     ) -> Result<ImageTexture, GlError> {
         let max = dev.caps().max_texture_size.max(1) as u32;
         let (w, h) = image.dimensions();
@@ -333,33 +338,56 @@ impl ImageTexture {
                 glow::UNSIGNED_BYTE,
                 glow::PixelUnpackData::Slice(Some(img.as_raw())),
             );
-            gl.generate_mipmap(glow::TEXTURE_2D);
+            if mipmaps {
+                gl.generate_mipmap(glow::TEXTURE_2D);
+            }
         }
-        let sampling = Sampling::default();
+        // Complete as it is: without mipmaps, a sampling that reads none.
+        let sampling = Sampling {
+            mipmap: Sampling::default().mipmap.filter(|_| mipmaps),
+            ..Sampling::default()
+        };
         set_image_sampling(gl, &sampling);
         if let Err(e) = dev.check(&format!("uploading a {pw}×{ph} image texture")) {
             dev.delete_texture(raw);
             return Err(e);
         }
-        let base = pw as usize * ph as usize * 4;
         Ok(ImageTexture {
             raw,
             destroyed: false,
-            bytes: base + base / 3,
+            base_bytes: pw as usize * ph as usize * 4,
+            mipmapped: std::cell::Cell::new(mipmaps),
             sampling: std::cell::Cell::new(sampling),
         })
     }
 
-    /// GPU bytes of its texels, mipmaps included.
+    /// GPU bytes of its texels, mipmaps included once made.
     pub fn gpu_bytes(&self) -> usize {
-        self.bytes
+        let base = self.base_bytes;
+        base + if self.mipmapped.get() { base / 3 } else { 0 }
     }
 
-    /// Binds to texture unit `unit`, read as `sampling` says.
+    /// Makes its mipmaps, unless made: the GPU bytes that adds. Binds it to the active unit.
+    pub fn make_mipmaps(&self, dev: &Device) -> usize {
+        if self.mipmapped.replace(true) {
+            return 0;
+        }
+        unsafe {
+            dev.gl.bind_texture(glow::TEXTURE_2D, Some(self.raw));
+            dev.gl.generate_mipmap(glow::TEXTURE_2D);
+        }
+        self.base_bytes / 3
+    }
+
+    /// Binds to texture unit `unit`, read as `sampling` says (its mipmaps made first where
+    /// that reads them and no upload has).
     pub fn bind(&self, dev: &Device, unit: u32, sampling: &Sampling) {
         unsafe {
             dev.gl.active_texture(glow::TEXTURE0 + unit);
             dev.gl.bind_texture(glow::TEXTURE_2D, Some(self.raw));
+        }
+        if sampling.mipmap.is_some() && !self.mipmapped.replace(true) {
+            unsafe { dev.gl.generate_mipmap(glow::TEXTURE_2D) };
         }
         if self.sampling.get() != *sampling {
             set_image_sampling(&dev.gl, sampling);

@@ -163,9 +163,10 @@ pub struct MemoryStats {
     /// frames leave it `None`.
     pub upload_bytes_spread: Option<Spread>,
     /// GPU bytes of the meshes and images the frame uploaded because no earlier frame had
-    /// (mipmaps included): a scene's whole content on its first frame, then 0 unless the
-    /// application made one anew (a mesh rebuilt every frame, a new `Arc` of the same data,
-    /// shows here every frame).
+    /// (mipmaps included, and mipmaps made for an image first sampled without): a scene's
+    /// whole content on its first frame, then 0 unless the application made one anew (a mesh
+    /// rebuilt every frame, a new `Arc` of the same data, shows here every frame) or an object
+    /// first samples a texture (a material it changed to, a second coordinate set).
     pub scene_upload_bytes: usize,
     /// GPU memory held by the method.
     pub method_gpu_bytes: usize,

@@ -630,6 +630,53 @@ fn textures_no_object_samples_are_neither_uploaded_nor_kept() {
     );
 }
 
+/// An image sampled only without mipmaps (glTF `minFilter` NEAREST or LINEAR: pixel art, UI
+/// atlases, light maps) has none made: its base level's bytes, a third less than it took.
+/// Sampled through mipmaps it gets them in the frame that first does (counted as that
+/// frame's scene upload), and the picture is a fresh renderer's.
+#[test]
+fn mipmaps_are_made_only_for_an_image_sampled_through_them() {
+    use manylight::scene::texture::{Filter, Sampling};
+    let mut s = scene::builtin::build("plane", Some((8, 1))).unwrap();
+    let base = |s: &scene::Scene| {
+        let mut s = s.clone();
+        s.materials[0].diffuse_texture = None;
+        s
+    };
+    let texels = image::RgbaImage::from_fn(64, 64, |x, y| {
+        image::Rgba([(x * 4) as u8, (y * 4) as u8, 90, 255])
+    });
+    let texture = scene::Texture::new("texels", texels);
+    let flat = Sampling {
+        mipmap: None,
+        ..texture.sampling
+    };
+    s.materials[0].diffuse_texture = Some(Arc::new(texture.with_sampling(flat)));
+    let mut gpu = Gpu::new(EsVersion::Es3);
+    let render = |gpu: &mut Gpu, s: &scene::Scene| {
+        let (image, stats) = (gpu.r())
+            .render_offscreen(s, 64, 36, &RenderOptions::default())
+            .unwrap();
+        let memory = stats.memory;
+        (image, memory.scene_gpu_bytes, memory.scene_upload_bytes)
+    };
+    let (_, untextured, _) = render(&mut Gpu::new(EsVersion::Es3), &base(&s));
+    let (_, bytes, _) = render(&mut gpu, &s);
+    assert_eq!(bytes, untextured + 64 * 64 * 4, "the base level alone");
+    let mipmapped = Sampling {
+        mipmap: Some(Filter::Linear),
+        ..flat
+    };
+    let m = &mut s.materials[0];
+    let texture = m.diffuse_texture.as_ref().unwrap().with_sampling(mipmapped);
+    m.diffuse_texture = Some(Arc::new(texture));
+    let (again, bytes, uploaded) = render(&mut gpu, &s);
+    assert_eq!(bytes, untextured + 64 * 64 * 4 * 4 / 3, "mipmaps made");
+    assert_eq!(uploaded, 64 * 64 * 4 / 3, "the frame's scene upload");
+    let (fresh, _, _) = render(&mut Gpu::new(EsVersion::Es3), &s);
+    assert_eq!(manylight::metrics::diff(&fresh, &again).max_abs, 0);
+}
+
 /// A mesh built with a second coordinate set that no texture reads does not upload it (8 bytes
 /// a vertex); once a material reads it, the same renderer uploads it and draws what a fresh
 /// one does (the texture's colours at the flipped coordinates, not its texel at (0, 0)).
