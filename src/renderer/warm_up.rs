@@ -82,7 +82,8 @@ impl Renderer {
         }
         target.destroy(&self.dev);
         drawn?;
-        if srgb && own_msaa && self.dev.es() == crate::gl::EsVersion::Es3 {
+        let fills = self.dev.caps().clears_one_sample_of_srgb_msaa();
+        if srgb && own_msaa && fills && self.dev.es() == crate::gl::EsVersion::Es3 {
             // The sRGB multisampled target's fill, which the frames' RGBA8 target did not need.
             crate::gl::multisample::build_fill_program(&self.dev, &mut self.programs)?;
         }

@@ -136,6 +136,11 @@ fn a_warmed_up_renderer_builds_nothing_in_its_frames() {
             }
             assert_eq!(frame(&mut gpu, colour, &away, &options).lights.visible, 0);
         }
+        // The sRGB MSAA target's fill program only where its clear misses samples.
+        let report = gpu.r().program_report();
+        let solid = report.iter().any(|p| p.shader == "solid");
+        let fills = es3 && gpu.r().caps().clears_one_sample_of_srgb_msaa();
+        assert_eq!(solid, fills, "{es}: the fill's program");
         // What auto may pick, each on its own: built already.
         let methods: &[&str] = if es3 {
             &["forward", "clustered", "deferred"]
