@@ -218,7 +218,14 @@ pub struct Deferred {
     /// What the light instances were last made from: a frame with the same draws them again.
     instances_key: Option<InstancesKey>,
     transparent: Forward,
+    /// Frames in a row that needed no specular target (see [`SPECULAR_KEPT_FRAMES`]).
+    frames_without_specular: u32,
 }
+
+/// Frames the G-buffer keeps its specular target after the last that needed it: an object
+/// that comes and goes (a pickup, a door, one the game culls) would otherwise remake the
+/// whole G-buffer each time (about 100 MB at 1080p).
+const SPECULAR_KEPT_FRAMES: u32 = 120;
 
 /// Everything a frame's light instances are a function of: the lights (by generation), the
 /// camera's kind, planes and lens and the frame's rows, which choose each light's proxy (a
@@ -251,13 +258,25 @@ impl Deferred {
     pub(super) fn prepare(&mut self, ctx: &FrameContext) -> Result<(), Error> {
         let dev = ctx.dev;
         let target = dev.bound_framebuffer();
-        let prepared = self.ensure_resources(dev, ctx.viewport, needs_specular_target(ctx));
+        let has = self.gbuffer.as_ref().is_some_and(GBuffer::has_specular);
+        let prepared = self.ensure_resources(dev, ctx.viewport, has || needs_specular_target(ctx));
         dev.bind_framebuffer(target);
         prepared
     }
 
-    /// The G-buffer of `size`, with the specular target if `specular` (made anew when the
-    /// scene gains or loses its specular materials), and the meshes.
+    /// Whether this frame's G-buffer has the specular target: where the frame needs it, and
+    /// kept for [`SPECULAR_KEPT_FRAMES`] frames after the last that did.
+    fn keeps_specular(&mut self, needed: bool) -> bool {
+        self.frames_without_specular = match needed {
+            true => 0,
+            false => self.frames_without_specular.saturating_add(1),
+        };
+        let has = self.gbuffer.as_ref().is_some_and(GBuffer::has_specular);
+        needed || (has && self.frames_without_specular < SPECULAR_KEPT_FRAMES)
+    }
+
+    /// The G-buffer of `size`, with the specular target if `specular` (made anew when that
+    /// changes), and the meshes.
     fn ensure_resources(
         &mut self,
         dev: &Device,
@@ -553,7 +572,8 @@ impl ShadingMethod for Deferred {
             )));
         }
         let target = dev.bound_framebuffer();
-        self.ensure_resources(dev, ctx.viewport, needs_specular_target(ctx))?;
+        let specular = self.keeps_specular(needs_specular_target(ctx));
+        self.ensure_resources(dev, ctx.viewport, specular)?;
         sort_objects(ctx);
         self.geometry_pass(ctx)?;
         let light_pass = self.light_pass(ctx)?;

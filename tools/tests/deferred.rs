@@ -445,7 +445,8 @@ impl Seeded {
 /// light pass and a sunlit composite follow the materials the G-buffer holds: those of opaque
 /// objects. A material no object draws with (an OBJ loader's unused default, a game's
 /// palette) or only transparent objects do (the forward fallback's) cost nothing, and the
-/// picture stays forward's; an opaque glossy object still gets the target.
+/// picture stays forward's; an opaque glossy object still gets the target, kept for 120
+/// frames after the last such object went (a pickup that comes and goes does not remake it).
 #[test]
 fn only_materials_in_the_gbuffer_give_it_a_specular_target_or_the_light_pass_its_brdf() {
     use manylight::scene::meshbuild::MeshBuilder;
@@ -518,4 +519,33 @@ fn only_materials_in_the_gbuffer_give_it_a_specular_target_or_the_light_pass_its
         2,
         "the light pass and the sunlit composite"
     );
+    // Objects that come and go keep the target, with forward's picture, until 120 frames
+    // pass without them: the G-buffer is not remade every time.
+    let options = RenderOptions::default();
+    let unused_reference = gpu.render_with("forward", &unused, (w, h), &options).0;
+    let opaque_reference = reference;
+    gpu.r().set_method_named("deferred").unwrap();
+    let deferred = |gpu: &mut Gpu, s: &scene::Scene, (w, h): (u32, u32)| {
+        gpu.r().render_offscreen(s, w, h, &options).unwrap()
+    };
+    deferred(&mut gpu, &opaque, (w, h));
+    let scenes = [&unused, &opaque, &unused, &opaque, &unused];
+    for (k, s) in scenes.into_iter().enumerate() {
+        let (img, stats) = deferred(&mut gpu, s, (w, h));
+        assert_eq!(
+            stats.memory.gbuffer_bytes, specular_bytes,
+            "frame {k}: kept"
+        );
+        let reference = [&unused_reference, &opaque_reference][k % 2];
+        assert!(
+            manylight::metrics::diff(reference, &img).max_abs <= 2,
+            "frame {k}"
+        );
+    }
+    let mut bytes = 0;
+    for _ in 0..120 {
+        bytes = deferred(&mut gpu, &unused, (8, 8)).1.memory.gbuffer_bytes;
+    }
+    let matte_8x8 = 64 * gbuffer::bytes_per_pixel(gpu.r().caps(), false);
+    assert_eq!(bytes, matte_8x8, "dropped after 120 frames without");
 }
