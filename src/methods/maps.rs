@@ -239,12 +239,16 @@ impl MapUniforms {
                 continue;
             }
             let own_map = map.as_ref().filter(|_| own.has(bit));
-            match own_map {
-                Some(map) => {
-                    if let Some(t) = scene.texture_of(&map.texture, bit == F::EMISSIVE_MAP) {
-                        t.bind(dev, unit, &map.texture.sampling);
-                    }
-                }
+            let uploaded = |m: &MapTexture| scene.texture_of(&m.texture, bit == F::EMISSIVE_MAP);
+            let own_texture = own_map.and_then(|m| Some((m, uploaded(m)?)));
+            // The upload follows the same conditions as the variant: a map without one would
+            // sample whatever the unit held last.
+            debug_assert!(
+                own_map.is_none() || own_texture.is_some(),
+                "a map not uploaded"
+            );
+            match own_texture {
+                Some((map, t)) => t.bind(dev, unit, &map.texture.sampling),
                 None => {
                     if let Some(white) = scene.white() {
                         white.bind(dev, unit, &Default::default());
