@@ -282,6 +282,9 @@ impl ShadingMethod for Auto {
 
     fn skip_frame(&mut self, dev: &Device) {
         retire_deferred(&mut self.deferred, &mut self.deferred_idle, dev);
+        if let Some(c) = &mut self.clustered {
+            c.skip_frame(dev);
+        }
     }
 
     fn observe_frame(&mut self, timing: super::FrameTiming) {

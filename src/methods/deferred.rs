@@ -220,6 +220,8 @@ pub struct Deferred {
     transparent: Forward,
     /// Frames in a row that needed no specular target (see [`SPECULAR_KEPT_FRAMES`]).
     frames_without_specular: u32,
+    /// Frames without lights in a row (see [`super::IDLE_FRAMES_KEPT`]).
+    idle_frames: u32,
 }
 
 /// Frames the G-buffer keeps its specular target after the last that needed it: an object
@@ -572,6 +574,7 @@ impl ShadingMethod for Deferred {
             )));
         }
         let target = dev.bound_framebuffer();
+        self.idle_frames = 0;
         let specular = self.keeps_specular(needs_specular_target(ctx));
         self.ensure_resources(dev, ctx.viewport, specular)?;
         sort_objects(ctx);
@@ -610,6 +613,12 @@ impl ShadingMethod for Deferred {
             + self.fullscreen.as_ref().map_or(0, GpuMesh::gpu_bytes)
             + self.lights.gpu_bytes()
             + self.transparent.gpu_bytes()
+    }
+
+    fn skip_frame(&mut self, dev: &Device) {
+        if super::idle_for_long(&mut self.idle_frames) {
+            self.destroy(dev);
+        }
     }
 
     fn destroy(&mut self, dev: &Device) {

@@ -197,10 +197,23 @@ pub trait ShadingMethod {
     /// methods that calibrate a cost model take it in.
     fn observe_frame(&mut self, _timing: FrameTiming) {}
     /// A frame with no lights, drawn without the method (ambient only): a method that keeps
-    /// resources for a number of frames counts it.
+    /// resources for a number of frames counts it, and frees its large ones after
+    /// [`IDLE_FRAMES_KEPT`] in a row.
     fn skip_frame(&mut self, _dev: &Device) {}
     /// Frees the method's GPU resources.
     fn destroy(&mut self, dev: &Device);
+}
+
+/// Frames without lights after which a method frees what it holds for lights (deferred's
+/// G-buffer and instances, the culled methods' texture ring): two seconds at 60 frames a
+/// second, so a light that blinks does not allocate every time; a sun-only stretch of a day
+/// cycle gets the memory back. The next lit frame makes them again.
+pub const IDLE_FRAMES_KEPT: u32 = 120;
+
+/// Counts `skip_frame`s in a row: true on the one that reaches [`IDLE_FRAMES_KEPT`].
+pub(crate) fn idle_for_long(idle: &mut u32) -> bool {
+    *idle = idle.saturating_add(1);
+    *idle == IDLE_FRAMES_KEPT
 }
 
 /// A row of the method table.

@@ -86,6 +86,8 @@ pub struct CulledForward {
     grid_generation: u64,
     /// What the last uploaded lists were built from: a frame with the same draws with them.
     lists_key: Option<ListsKey>,
+    /// Frames without lights in a row (see [`super::IDLE_FRAMES_KEPT`]).
+    idle_frames: u32,
 }
 
 /// Everything a frame's light lists and uploaded textures are a function of: the lights (by
@@ -112,6 +114,7 @@ impl CulledForward {
             upload: upload::Uploads::default(),
             grid_generation: 0,
             lists_key: None,
+            idle_frames: 0,
         }
     }
 
@@ -126,6 +129,7 @@ impl CulledForward {
         let method = self.name();
         let automatic = self.automatic(ctx);
         let grid_encoding = GridEncoding::for_es(ctx.dev.es());
+        self.idle_frames = 0;
 
         let limits = limits::assign_limits(ctx);
         self.update_grid(ctx, &limits, grid_encoding);
@@ -293,6 +297,12 @@ impl ShadingMethod for CulledForward {
     }
 
     /// Frees the ring.
+    fn skip_frame(&mut self, dev: &Device) {
+        if super::idle_for_long(&mut self.idle_frames) {
+            self.destroy(dev);
+        }
+    }
+
     fn destroy(&mut self, dev: &Device) {
         self.lists_key = None;
         self.upload.destroy(dev);
