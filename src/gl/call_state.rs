@@ -23,7 +23,8 @@ pub struct StateCalls {
     pub vertex_array_calls: u64,
     /// Binds of the methods' data textures (lights, grids, lists), each choosing its unit.
     pub data_textures_bound: u64,
-    /// Times the constant values of the attributes a mesh may lack were set.
+    /// Constant values of the attributes a mesh may lack that were set (one
+    /// `glVertexAttrib4f` each).
     pub absent_values_set: u64,
 }
 
@@ -107,7 +108,7 @@ impl CallState {
                 unsafe { gl.vertex_attrib_4_f32(loc, v[0], v[1], v[2], v[3]) };
             }
         }
-        self.count(|c| c.absent_values_set += 1);
+        self.count(|c| c.absent_values_set += u64::from(missing.count_ones()));
         if in_call {
             self.absent_values_set.set(set | missing);
         }

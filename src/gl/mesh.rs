@@ -12,14 +12,16 @@ use super::absent_attributes::{ABSENT, ABSENT_BITS};
 use super::{Device, GlError};
 use crate::scene::Mesh;
 
-/// Floats per interleaved vertex every mesh has: position (3), normal (3), uv (2).
-pub const VERTEX_FLOATS: usize = 8;
+/// Floats per interleaved vertex every mesh has: position (3), normal (3).
+pub const VERTEX_FLOATS: usize = 6;
 
 /// Which optional attributes a mesh's vertices carry after the [`VERTEX_FLOATS`]: each is
-/// uploaded only when the mesh has it (colour: 4 floats, then tangent: 4 floats, then the
-/// second texture coordinates: 2 floats).
+/// uploaded only when the mesh has it (texture coordinates: 2 floats, colour: 4, tangent: 4,
+/// the second texture coordinates: 2).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct VertexLayout {
+    /// `a_uv` (location 2).
+    pub uvs: bool,
     /// `a_color` (location 3).
     pub colors: bool,
     /// `a_tangent` (location 4).
@@ -33,6 +35,7 @@ impl VertexLayout {
     /// texture reads it).
     pub fn of(mesh: &Mesh, second_uvs: bool) -> VertexLayout {
         VertexLayout {
+            uvs: !mesh.uvs.is_empty(),
             colors: !mesh.colors.is_empty(),
             tangents: !mesh.tangents.is_empty(),
             second_uvs: second_uvs && !mesh.second_uvs.is_empty(),
@@ -59,6 +62,7 @@ impl VertexLayout {
     /// (location, components) of the optional attributes present, in vertex order.
     fn optional(self) -> impl Iterator<Item = (u32, i32)> {
         [
+            self.uvs.then_some((2, 2)),
             self.colors.then_some((3, 4)),
             self.tangents.then_some((4, 4)),
             self.second_uvs.then_some((5, 2)),
@@ -74,9 +78,7 @@ impl VertexLayout {
             at += 4 * size;
             (loc, size, at - 4 * size)
         });
-        [(0, 3, 0), (1, 3, 12), (2, 2, 24)]
-            .into_iter()
-            .chain(optional)
+        [(0, 3, 0), (1, 3, 12)].into_iter().chain(optional)
     }
 }
 
@@ -127,9 +129,11 @@ pub fn split_u16_about(mesh: &Mesh, origin: DVec3, second_uvs: bool) -> Vec<Chun
                 let v = i as usize;
                 let p = (mesh.positions[v].as_dvec3() - origin).as_vec3();
                 let n = mesh.normals[v];
-                let uv = mesh.uvs.get(v).copied().unwrap_or_default();
                 cur.vertices
-                    .extend_from_slice(&[p.x, p.y, p.z, n.x, n.y, n.z, uv.x, uv.y]);
+                    .extend_from_slice(&[p.x, p.y, p.z, n.x, n.y, n.z]);
+                if layout.uvs {
+                    cur.vertices.extend_from_slice(&mesh.uvs[v].to_array());
+                }
                 if layout.colors {
                     cur.vertices.extend_from_slice(&mesh.colors[v].to_array());
                 }

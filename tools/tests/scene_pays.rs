@@ -713,6 +713,43 @@ fn methods_free_their_light_resources_after_120_frames_without_lights() {
     }
 }
 
+/// A mesh without texture coordinates (an OBJ without `vt`, a code-built one) uploads its
+/// positions and normals alone, 24 bytes a vertex (it uploaded 8 bytes of zeros more), and
+/// draws the picture it drew with coordinates, on ES 2.0 and 3.0, after a textured mesh that
+/// had them (the constant stands in for the array).
+#[test]
+fn a_mesh_without_texture_coordinates_uploads_none() {
+    let with = scene::builtin::build("plane", Some((8, 2))).unwrap();
+    let mut without = with.clone();
+    let mut mesh = (*without.objects[0].mesh).clone();
+    mesh.uvs.clear();
+    let (vertices, indices) = (mesh.positions.len(), mesh.indices.len());
+    without.objects[0].mesh = Arc::new(mesh);
+    let mut textured = with.clone();
+    let texels = image::RgbaImage::from_fn(8, 8, |x, y| {
+        image::Rgba([(x * 30) as u8, (y * 30) as u8, 90, 255])
+    });
+    textured.materials[0].diffuse_texture = Some(Arc::new(scene::Texture::new("t", texels)));
+    for es in [EsVersion::Es3, EsVersion::Es2] {
+        let mut gpu = Gpu::new(es);
+        let mut render = |s: &scene::Scene| {
+            let (image, stats) = (gpu.r())
+                .render_offscreen(s, 64, 36, &RenderOptions::default())
+                .unwrap();
+            (image, stats.memory.scene_upload_bytes)
+        };
+        let (picture, _) = render(&with);
+        render(&textured);
+        let (bare, bytes) = render(&without);
+        assert_eq!(
+            bytes,
+            vertices * 24 + indices * 2,
+            "{es}: the mesh's upload"
+        );
+        assert_eq!(manylight::metrics::diff(&picture, &bare).max_abs, 0, "{es}");
+    }
+}
+
 /// A mesh built with a second coordinate set that no texture reads does not upload it (8 bytes
 /// a vertex); once a material reads it, the same renderer uploads it and draws what a fresh
 /// one does (the texture's colours at the flipped coordinates, not its texel at (0, 0)).
