@@ -57,8 +57,15 @@ pub struct DataTexture {
     raw: glow::Texture,
     format: DataFormat,
     size: (u32, u32),
+    /// Uploads in a row that filled at most a quarter of its rows (see [`SHRINK_AFTER`]).
+    small_uploads: u32,
     destroyed: bool,
 }
+
+/// Uploads in a row that fill at most a quarter of a data texture's rows after which it is
+/// allocated again at their size: a burst of lights (an explosion's sparks for a few frames)
+/// does not hold its memory for good, and a count that hovers does not reallocate often.
+pub const SHRINK_AFTER: u32 = 60;
 
 /// NEAREST filtering and CLAMP_TO_EDGE on the bound 2D texture: what data textures and render
 /// targets read texel by texel need.
@@ -136,6 +143,7 @@ impl DataTexture {
             raw,
             format,
             size: (0, 0),
+            small_uploads: 0,
             destroyed: false,
         })
     }
@@ -143,8 +151,9 @@ impl DataTexture {
     /// Uploads `bytes`, whole texels row after row from the top, into a texture `width`
     /// texels wide with at least `height` rows: the rows they fill, then the part of the next
     /// row they reach (the rest of it is not sent). Storage grows to the next power of two of
-    /// rows and never shrinks, so a list that changes length every frame does not reallocate
-    /// every frame; shaders address rows with the allocated height ([`DataTexture::size`]).
+    /// rows, and shrinks to it only after [`SHRINK_AFTER`] uploads in a row that fill a quarter
+    /// of it at most, so a list that changes length every frame does not reallocate every
+    /// frame; shaders address rows with the allocated height ([`DataTexture::size`]).
     pub fn upload(
         &mut self,
         dev: &Device,
@@ -173,8 +182,16 @@ impl DataTexture {
         unsafe {
             gl.bind_texture(glow::TEXTURE_2D, Some(self.raw));
             gl.pixel_store_i32(glow::UNPACK_ALIGNMENT, 1);
-            if self.size.0 != width || self.size.1 < height {
-                let rows = height.next_power_of_two().max(self.size.1).min(max);
+            let needed = height.next_power_of_two();
+            self.small_uploads = match needed.saturating_mul(4) <= self.size.1 {
+                true => self.small_uploads + 1,
+                false => 0,
+            };
+            let shrink = self.small_uploads >= SHRINK_AFTER;
+            if self.size.0 != width || self.size.1 < height || shrink {
+                let kept = if shrink { 0 } else { self.size.1 };
+                self.small_uploads = 0;
+                let rows = needed.max(kept).min(max);
                 gl.tex_image_2d(
                     glow::TEXTURE_2D,
                     0,

@@ -750,6 +750,66 @@ fn a_mesh_without_texture_coordinates_uploads_none() {
     }
 }
 
+/// A burst of lights (5 000 for three frames, an explosion's sparks) leaves the light data
+/// near the size the 20 moving lights after it need once the textures have been filled to a
+/// quarter at most for `SHRINK_AFTER` uploads (clustered held 36× its memory for good, tiled
+/// 16×), and the picture is a fresh renderer's.
+#[test]
+fn a_burst_of_lights_does_not_hold_its_memory_for_good() {
+    use manylight::gl::texture::SHRINK_AFTER;
+    let few = scene::builtin::build("plane", Some((20, 5))).unwrap();
+    let many = scene::builtin::build("plane", Some((5000, 5))).unwrap();
+    let opts = RenderOptions::default();
+    let moved = |s: &scene::Scene, k: usize| {
+        let mut s = s.clone();
+        for l in &mut s.lights {
+            l.position.x += 1e-3 * k as f64;
+        }
+        s
+    };
+    for method in ["forward", "tiled", "clustered"] {
+        let mut gpu = Gpu::new(EsVersion::Es3);
+        gpu.r().set_method_named(method).unwrap();
+        let mut bytes = |gpu: &mut Gpu, s: &scene::Scene| {
+            let (image, stats) = gpu.r().render_offscreen(s, 64, 36, &opts).unwrap();
+            (image, stats.memory.method_gpu_bytes)
+        };
+        // Three frames fill the culled methods' ring of three texture sets.
+        let mut small = 0;
+        for k in 0..3 {
+            small = bytes(&mut gpu, &moved(&few, k)).1;
+        }
+        let mut held = 0;
+        for k in 0..3 {
+            held = bytes(&mut gpu, &moved(&many, k)).1;
+        }
+        assert!(
+            held >= 4 * small,
+            "{method}: {small} → {held} bytes for the burst"
+        );
+        // The culled methods' three texture sets each take a third of the uploads.
+        let mut last = (image::RgbaImage::new(1, 1), held);
+        for k in 0..3 * SHRINK_AFTER as usize + 3 {
+            last = bytes(&mut gpu, &moved(&few, k));
+        }
+        // A texture the few fill more than a quarter of keeps its rows (tiled's grid: 2).
+        let kept = last.1;
+        assert!(
+            kept <= 2 * small && 4 * kept <= held,
+            "{method}: {small} → {held} → {kept}"
+        );
+        let k = 3 * SHRINK_AFTER as usize + 2;
+        let mut other = Gpu::fresh(EsVersion::Es3);
+        other.r().set_method_named(method).unwrap();
+        let fresh = bytes(&mut other, &moved(&few, k)).0;
+        assert_eq!(
+            manylight::metrics::diff(&fresh, &last.0).max_abs,
+            0,
+            "{method}"
+        );
+    }
+}
+
 /// A mesh built with a second coordinate set that no texture reads does not upload it (8 bytes
 /// a vertex); once a material reads it, the same renderer uploads it and draws what a fresh
 /// one does (the texture's colours at the flipped coordinates, not its texel at (0, 0)).

@@ -296,13 +296,14 @@ impl ShadingMethod for CulledForward {
         self.upload.gpu_bytes()
     }
 
-    /// Frees the ring.
+    /// Frees the ring after `IDLE_FRAMES_KEPT` frames without lights.
     fn skip_frame(&mut self, dev: &Device) {
         if super::idle_for_long(&mut self.idle_frames) {
             self.destroy(dev);
         }
     }
 
+    /// Frees the ring.
     fn destroy(&mut self, dev: &Device) {
         self.lists_key = None;
         self.upload.destroy(dev);
