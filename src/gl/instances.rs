@@ -11,8 +11,10 @@ use super::{Device, GlError};
 
 /// A stream of instances of `attributes` `vec4`s at locations `first..first + attributes`,
 /// at most `capacity` a draw. Its store holds the largest batch drawn so far (a power of two
-/// of instances, at most `capacity`), so a scene of a few lights holds a few kilobytes; each
-/// batch orphans it (so the driver need not wait for the previous draw) and writes it anew.
+/// of instances, at most `capacity`), so a scene of a few lights holds a few kilobytes, until
+/// [`SHRINK_AFTER`](super::texture::SHRINK_AFTER) batches in a row fill a quarter of it at
+/// most (a burst of lights does not hold its memory); each batch orphans it (so the driver
+/// need not wait for the previous draw) and writes it anew.
 pub(crate) struct InstanceStream {
     buffer: glow::Buffer,
     first: u32,
@@ -20,6 +22,8 @@ pub(crate) struct InstanceStream {
     capacity: usize,
     /// Instances the store holds.
     store: usize,
+    /// Batches in a row that filled a quarter of the store at most.
+    small_batches: u32,
     destroyed: bool,
 }
 
@@ -41,6 +45,7 @@ impl InstanceStream {
             attributes,
             capacity,
             store: FIRST_STORE.min(capacity),
+            small_batches: 0,
             destroyed: false,
         };
         unsafe {
@@ -85,8 +90,18 @@ impl InstanceStream {
             return 0;
         }
         let bytes: &[u8] = bytemuck::cast_slice(instances);
-        if count > self.store {
-            self.store = count.next_power_of_two().min(self.capacity);
+        let needed = count
+            .next_power_of_two()
+            .max(FIRST_STORE)
+            .min(self.capacity);
+        self.small_batches = match needed.saturating_mul(4) <= self.store {
+            true => self.small_batches + 1,
+            false => 0,
+        };
+        if count > self.store || self.small_batches >= super::texture::SHRINK_AFTER {
+            // The orphaning below allocates the store anew at its size either way.
+            self.store = needed;
+            self.small_batches = 0;
         }
         unsafe {
             dev.gl

@@ -751,9 +751,9 @@ fn a_mesh_without_texture_coordinates_uploads_none() {
 }
 
 /// A burst of lights (5 000 for three frames, an explosion's sparks) leaves the light data
-/// near the size the 20 moving lights after it need once the textures have been filled to a
-/// quarter at most for `SHRINK_AFTER` uploads (clustered held 36× its memory for good, tiled
-/// 16×), and the picture is a fresh renderer's.
+/// near the size the 20 moving lights after it need once the textures (deferred: instance
+/// buffers) have been filled to a quarter at most for `SHRINK_AFTER` uploads (clustered held
+/// 36× its memory for good, tiled 16×), and the picture is a fresh renderer's.
 #[test]
 fn a_burst_of_lights_does_not_hold_its_memory_for_good() {
     use manylight::gl::texture::SHRINK_AFTER;
@@ -767,7 +767,7 @@ fn a_burst_of_lights_does_not_hold_its_memory_for_good() {
         }
         s
     };
-    for method in ["forward", "tiled", "clustered"] {
+    for method in ["forward", "tiled", "clustered", "deferred"] {
         let mut gpu = Gpu::new(EsVersion::Es3);
         gpu.r().set_method_named(method).unwrap();
         let mut bytes = |gpu: &mut Gpu, s: &scene::Scene| {
