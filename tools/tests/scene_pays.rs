@@ -770,7 +770,7 @@ fn a_burst_of_lights_does_not_hold_its_memory_for_good() {
     for method in ["forward", "tiled", "clustered", "deferred"] {
         let mut gpu = Gpu::new(EsVersion::Es3);
         gpu.r().set_method_named(method).unwrap();
-        let mut bytes = |gpu: &mut Gpu, s: &scene::Scene| {
+        let bytes = |gpu: &mut Gpu, s: &scene::Scene| {
             let (image, stats) = gpu.r().render_offscreen(s, 64, 36, &opts).unwrap();
             (image, stats.memory.method_gpu_bytes)
         };
