@@ -407,7 +407,7 @@ impl Deferred {
                 lights.peek().is_none()
             };
             if none {
-                self.lights.draw_none(slot);
+                self.lights.draw_none(dev, slot);
                 if ctx.warm_up {
                     // Built all the same: a light may take this proxy in a later frame.
                     ctx.programs.bind::<LightProgram>(dev, program, defines)?;

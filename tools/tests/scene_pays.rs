@@ -810,6 +810,41 @@ fn a_burst_of_lights_does_not_hold_its_memory_for_good() {
     }
 }
 
+/// Deferred: a burst of lights that take a proxy the later lights do not (lights around the
+/// eye: far side or full screen) frees that proxy's instance stream after `SHRINK_AFTER`
+/// frames without lights for it; it kept the burst's store for good (helper-148).
+#[test]
+fn a_burst_on_a_proxy_later_lights_leave_unused_is_freed() {
+    use manylight::gl::texture::SHRINK_AFTER;
+    let few = scene::builtin::build("plane", Some((20, 5))).unwrap();
+    let mut many = scene::builtin::build("plane", Some((5000, 5))).unwrap();
+    let eye = many.camera.position;
+    for (i, l) in many.lights.iter_mut().enumerate() {
+        l.position = eye + DVec3::new((i % 7) as f64 * 0.01, 0.0, -0.05);
+        l.radius = 500.0;
+    }
+    let opts = RenderOptions::default();
+    let mut gpu = Gpu::new(EsVersion::Es3);
+    gpu.r().set_method_named("deferred").unwrap();
+    let mut bytes = |s: &scene::Scene| {
+        let (_, stats) = gpu.r().render_offscreen(s, 64, 36, &opts).unwrap();
+        stats.memory.method_gpu_bytes
+    };
+    let mut small = 0;
+    for _ in 0..3 {
+        small = bytes(&few);
+    }
+    let held = bytes(&many);
+    let mut kept = 0;
+    for _ in 0..SHRINK_AFTER {
+        kept = bytes(&few);
+    }
+    assert!(
+        4 * kept <= held && kept <= 2 * small,
+        "{small} → {held} → {kept} bytes"
+    );
+}
+
 /// A mesh built with a second coordinate set that no texture reads does not upload it (8 bytes
 /// a vertex); once a material reads it, the same renderer uploads it and draws what a fresh
 /// one does (the texture's colours at the flipped coordinates, not its texel at (0, 0)).

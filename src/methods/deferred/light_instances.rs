@@ -55,6 +55,10 @@ pub(super) struct LightInstances {
     /// Per proxy: how many lights its stream holds from its last draw, when that was all of
     /// them (none is 0); `None` when they took more than a batch or were never drawn.
     held: [Option<usize>; PROXIES],
+    /// Per proxy: light passes in a row that gave it no lights. At
+    /// [`SHRINK_AFTER`](crate::gl::texture::SHRINK_AFTER) its stream is freed, so one that a
+    /// burst of lights grew does not keep its store for good (its draws shrink it otherwise).
+    empty_passes: [u32; PROXIES],
 }
 
 impl LightInstances {
@@ -69,6 +73,7 @@ impl LightInstances {
         lights: impl Iterator<Item = [Vec4; LIGHT_VEC4S]>,
     ) -> Result<usize, GlError> {
         self.held[proxy] = None;
+        self.empty_passes[proxy] = 0;
         let stream = match &mut self.streams[proxy] {
             Some(stream) => stream,
             empty => empty.insert(InstanceStream::new(
@@ -95,9 +100,16 @@ impl LightInstances {
         Ok(uploaded)
     }
 
-    /// Records that `proxy` has no lights this frame.
-    pub(super) fn draw_none(&mut self, proxy: usize) {
+    /// Records that `proxy` has no lights this frame, freeing its stream after
+    /// [`SHRINK_AFTER`](crate::gl::texture::SHRINK_AFTER) such frames in a row.
+    pub(super) fn draw_none(&mut self, dev: &Device, proxy: usize) {
         self.held[proxy] = Some(0);
+        self.empty_passes[proxy] = self.empty_passes[proxy].saturating_add(1);
+        if self.empty_passes[proxy] == crate::gl::texture::SHRINK_AFTER {
+            if let Some(mut stream) = self.streams[proxy].take() {
+                stream.destroy(dev);
+            }
+        }
     }
 
     /// Whether every proxy's stream holds all its lights of the last light pass.
