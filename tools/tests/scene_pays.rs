@@ -691,7 +691,7 @@ fn methods_free_their_light_resources_after_120_frames_without_lights() {
     for method in ["tiled", "clustered", "deferred", "auto"] {
         gpu.r().set_method_named(method).unwrap();
         let mut frame = |s: &scene::Scene| {
-            let (image, stats) = gpu.r().render_offscreen(s, 160, 90, &opts).unwrap();
+            let (image, stats) = gpu.r().render_offscreen(s, 32, 18, &opts).unwrap();
             (image, stats.memory.method_gpu_bytes)
         };
         let (first, held) = frame(&lit);
@@ -771,7 +771,7 @@ fn a_burst_of_lights_does_not_hold_its_memory_for_good() {
         let mut gpu = Gpu::new(EsVersion::Es3);
         gpu.r().set_method_named(method).unwrap();
         let bytes = |gpu: &mut Gpu, s: &scene::Scene| {
-            let (image, stats) = gpu.r().render_offscreen(s, 64, 36, &opts).unwrap();
+            let (image, stats) = gpu.r().render_offscreen(s, 16, 9, &opts).unwrap();
             (image, stats.memory.method_gpu_bytes)
         };
         // Three frames fill the culled methods' ring of three texture sets.
@@ -827,7 +827,7 @@ fn a_burst_on_a_proxy_later_lights_leave_unused_is_freed() {
     let mut gpu = Gpu::new(EsVersion::Es3);
     gpu.r().set_method_named("deferred").unwrap();
     let mut bytes = |s: &scene::Scene| {
-        let (_, stats) = gpu.r().render_offscreen(s, 64, 36, &opts).unwrap();
+        let (_, stats) = gpu.r().render_offscreen(s, 16, 9, &opts).unwrap();
         stats.memory.method_gpu_bytes
     };
     let mut small = 0;
