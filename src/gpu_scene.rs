@@ -165,7 +165,7 @@ impl GpuScene {
             let white = image::RgbaImage::from_pixel(1, 1, image::Rgba([255, 255, 255, 255]));
             self.white = Some(ImageTexture::new(dev, &white, false, false)?);
         }
-        self.note_second_set_meshes(scene);
+        self.note_what_objects_sample(scene);
         for (i, o) in scene.objects.iter().enumerate() {
             let key = Arc::as_ptr(&o.mesh) as usize;
             let second = self.second_set_meshes.contains(&key);
@@ -195,7 +195,6 @@ impl GpuScene {
                 Entry::Occupied(_) => {}
             }
         }
-        self.note_drawn_slots(scene);
         for (m, &drawn) in scene.materials.iter().zip(&self.drawn_slots) {
             for (slot, t, _) in slotted_textures_of(m) {
                 if drawn & 1 << slot == 0 {
@@ -225,12 +224,15 @@ impl GpuScene {
         Ok(bytes)
     }
 
-    /// Notes which textures of each material an object draws with on a mesh that can sample
-    /// them: only those are uploaded (a material palette's, or a texture on a mesh without
-    /// coordinates, is not).
-    fn note_drawn_slots(&mut self, scene: &Scene) {
+    /// Notes, in one pass over the objects, what they sample: which textures of each
+    /// material an object draws with on a mesh that can sample them, and the meshes whose
+    /// second coordinate set an object's material reads. Only those are uploaded (a material
+    /// palette's textures, a texture on a mesh without coordinates, a second set no texture
+    /// reads are not).
+    fn note_what_objects_sample(&mut self, scene: &Scene) {
         self.drawn_slots.clear();
         self.drawn_slots.resize(scene.materials.len(), 0);
+        self.second_set_meshes.clear();
         for o in &scene.objects {
             let Some(m) = scene.materials.get(o.material) else {
                 continue;
@@ -240,16 +242,7 @@ impl GpuScene {
                     self.drawn_slots[o.material] |= 1 << slot;
                 }
             }
-        }
-    }
-
-    /// Notes the meshes whose second coordinate set an object's material reads: only they
-    /// upload it (a mesh built with one that no texture reads does not pay for it).
-    fn note_second_set_meshes(&mut self, scene: &Scene) {
-        self.second_set_meshes.clear();
-        for o in &scene.objects {
-            let reads = |m: &Material| m.reads_second_uvs();
-            if !o.mesh.second_uvs.is_empty() && scene.materials.get(o.material).is_some_and(reads) {
+            if !o.mesh.second_uvs.is_empty() && m.reads_second_uvs() {
                 self.second_set_meshes.insert(Arc::as_ptr(&o.mesh) as usize);
             }
         }
