@@ -12,9 +12,9 @@ use super::{Device, GlError};
 /// A stream of instances of `attributes` `vec4`s at locations `first..first + attributes`,
 /// at most `capacity` a draw. Its store holds the largest batch drawn so far (a power of two
 /// of instances, at most `capacity`), so a scene of a few lights holds a few kilobytes, until
-/// [`SHRINK_AFTER`](super::texture::SHRINK_AFTER) batches in a row fill a quarter of it at
-/// most (a burst of lights does not hold its memory); each batch orphans it (so the driver
-/// need not wait for the previous draw) and writes it anew.
+/// [`SHRINK_AFTER`](super::texture::SHRINK_AFTER) batches or still frames in a row fill a
+/// quarter of it at most (a burst of lights does not hold its memory); each batch orphans it
+/// (so the driver need not wait for the previous draw) and writes it anew.
 pub(crate) struct InstanceStream {
     buffer: glow::Buffer,
     first: u32,
@@ -22,7 +22,10 @@ pub(crate) struct InstanceStream {
     capacity: usize,
     /// Instances the store holds.
     store: usize,
-    /// Batches in a row that filled a quarter of the store at most.
+    /// Instances the last batch needed: its count's next power of two, within the bounds.
+    needed: usize,
+    /// Batches and still frames ([`InstanceStream::note_still_frame`]) in a row whose
+    /// instances filled a quarter of the store at most.
     small_batches: u32,
     destroyed: bool,
 }
@@ -45,6 +48,7 @@ impl InstanceStream {
             attributes,
             capacity,
             store: FIRST_STORE.min(capacity),
+            needed: 0,
             small_batches: 0,
             destroyed: false,
         };
@@ -90,17 +94,13 @@ impl InstanceStream {
             return 0;
         }
         let bytes: &[u8] = bytemuck::cast_slice(instances);
-        let needed = count
+        self.needed = count
             .next_power_of_two()
             .max(FIRST_STORE)
             .min(self.capacity);
-        self.small_batches = match needed.saturating_mul(4) <= self.store {
-            true => self.small_batches + 1,
-            false => 0,
-        };
-        if count > self.store || self.small_batches >= super::texture::SHRINK_AFTER {
+        if count > self.store || self.note_frame() {
             // The orphaning below allocates the store anew at its size either way.
-            self.store = needed;
+            self.store = self.needed;
             self.small_batches = 0;
         }
         unsafe {
@@ -118,6 +118,23 @@ impl InstanceStream {
     pub(crate) fn draw_held(&self, dev: &Device, mesh: &BoundMesh, count: usize) {
         debug_assert!(count <= self.store);
         mesh.draw_instanced(dev, count as i32);
+    }
+
+    /// Counts a frame that draws the last batch again ([`InstanceStream::draw_held`]), as a
+    /// batch counts: true once its instances have filled a quarter of the store at most for
+    /// [`SHRINK_AFTER`](super::texture::SHRINK_AFTER) frames, when drawing them again with
+    /// [`InstanceStream::draw`] allocates the store at their size.
+    pub(crate) fn note_still_frame(&mut self) -> bool {
+        self.note_frame()
+    }
+
+    /// Counts a frame whose instances need `needed`: whether it is time to shrink.
+    fn note_frame(&mut self) -> bool {
+        self.small_batches = match self.needed.saturating_mul(4) <= self.store {
+            true => self.small_batches.saturating_add(1),
+            false => 0,
+        };
+        self.small_batches >= super::texture::SHRINK_AFTER
     }
 
     /// Leaves its locations as every other draw expects them: no array, divisor 0.

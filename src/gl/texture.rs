@@ -57,13 +57,16 @@ pub struct DataTexture {
     raw: glow::Texture,
     format: DataFormat,
     size: (u32, u32),
-    /// Uploads in a row that filled at most a quarter of its rows (see [`SHRINK_AFTER`]).
-    small_uploads: u32,
+    /// Rows the last upload needed: its height's next power of two.
+    rows_needed: u32,
+    /// Frames in a row whose records filled at most a quarter of its rows, uploaded or drawn
+    /// again (see [`SHRINK_AFTER`] and [`DataTexture::note_still_frame`]).
+    small_frames: u32,
     destroyed: bool,
 }
 
-/// Uploads in a row that fill at most a quarter of a data texture's rows after which it is
-/// allocated again at their size: a burst of lights (an explosion's sparks for a few frames)
+/// Frames in a row whose records fill at most a quarter of a data texture's rows after which it
+/// is allocated again at their size: a burst of lights (an explosion's sparks for a few frames)
 /// does not hold its memory for good, and a count that hovers does not reallocate often.
 pub const SHRINK_AFTER: u32 = 60;
 
@@ -143,7 +146,8 @@ impl DataTexture {
             raw,
             format,
             size: (0, 0),
-            small_uploads: 0,
+            rows_needed: 0,
+            small_frames: 0,
             destroyed: false,
         })
     }
@@ -151,7 +155,7 @@ impl DataTexture {
     /// Uploads `bytes`, whole texels row after row from the top, into a texture `width`
     /// texels wide with at least `height` rows: the rows they fill, then the part of the next
     /// row they reach (the rest of it is not sent). Storage grows to the next power of two of
-    /// rows, and shrinks to it only after [`SHRINK_AFTER`] uploads in a row that fill a quarter
+    /// rows, and shrinks to it only after [`SHRINK_AFTER`] frames in a row that fill a quarter
     /// of it at most, so a list that changes length every frame does not reallocate every
     /// frame; shaders address rows with the allocated height ([`DataTexture::size`]).
     pub fn upload(
@@ -183,14 +187,11 @@ impl DataTexture {
             gl.bind_texture(glow::TEXTURE_2D, Some(self.raw));
             gl.pixel_store_i32(glow::UNPACK_ALIGNMENT, 1);
             let needed = height.next_power_of_two();
-            self.small_uploads = match needed.saturating_mul(4) <= self.size.1 {
-                true => self.small_uploads + 1,
-                false => 0,
-            };
-            let shrink = self.small_uploads >= SHRINK_AFTER;
+            self.rows_needed = needed;
+            let shrink = self.note_frame();
             if self.size.0 != width || self.size.1 < height || shrink {
                 let kept = if shrink { 0 } else { self.size.1 };
-                self.small_uploads = 0;
+                self.small_frames = 0;
                 let rows = needed.max(kept).min(max);
                 gl.tex_image_2d(
                     glow::TEXTURE_2D,
@@ -231,6 +232,23 @@ impl DataTexture {
             self.size = (0, 0);
         }
         uploaded
+    }
+
+    /// Counts a frame that draws with the last upload's records, as an upload counts: true once
+    /// they have filled a quarter of its rows at most for [`SHRINK_AFTER`] frames, when
+    /// uploading them again allocates it at their size. A still scene after a burst of lights
+    /// uploads nothing, and kept the burst's rows for good.
+    pub fn note_still_frame(&mut self) -> bool {
+        self.note_frame()
+    }
+
+    /// Counts a frame whose records need `rows_needed` rows: whether it is time to shrink.
+    fn note_frame(&mut self) -> bool {
+        self.small_frames = match self.rows_needed.saturating_mul(4) <= self.size.1 {
+            true => self.small_frames.saturating_add(1),
+            false => 0,
+        };
+        self.small_frames >= SHRINK_AFTER
     }
 
     /// Binds to texture unit `unit`.

@@ -385,7 +385,9 @@ impl Deferred {
             rows: ctx.viewport.1,
             scale: scale.to_bits(),
         };
-        let reused = self.instances_key == Some(key) && self.lights.hold_all();
+        let reused = self.instances_key == Some(key)
+            && self.lights.hold_all()
+            && !self.lights.note_still_frame();
         self.instances_key = None;
         let mut uploaded = 0;
         for (slot, proxy) in Proxy::ALL.into_iter().enumerate() {

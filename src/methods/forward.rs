@@ -236,8 +236,11 @@ impl ShadingMethod for Forward {
             self.lights = Some((DataTexture::new(dev, format)?, layout.encoding));
         }
         let key = RecordsKey::new(ctx, layout, limit);
-        // A still frame (nothing the records are packed from changed) draws with the last ones.
-        let reused = self.uploaded == Some(key);
+        // A still frame (nothing the records are packed from changed) draws with the last ones,
+        // unless they have filled a quarter of the texture for long: then it uploads them again,
+        // which shrinks it.
+        let reused = self.uploaded == Some(key)
+            && !(self.lights.as_mut()).is_some_and(|(t, _)| t.note_still_frame());
         let mut upload_bytes = 0;
         if !reused {
             self.uploaded = None;

@@ -810,6 +810,62 @@ fn a_burst_of_lights_does_not_hold_its_memory_for_good() {
     }
 }
 
+/// A burst of lights before a still scene: its frames upload nothing, yet after
+/// `SHRINK_AFTER` of them the light data holds what the few lights need (forward kept 16× it
+/// for good, clustered 18×), sent once more, and the picture does not change. Clustered's
+/// automatic grid settles first, which uploads lists; still frames count from the last.
+#[test]
+fn a_still_scene_after_a_burst_does_not_hold_its_memory() {
+    use manylight::gl::texture::SHRINK_AFTER;
+    let few = scene::builtin::build("plane", Some((20, 5))).unwrap();
+    let mut many = scene::builtin::build("plane", Some((5000, 5))).unwrap();
+    let opts = RenderOptions::default();
+    for method in ["forward", "tiled", "clustered", "deferred"] {
+        let mut gpu = Gpu::new(EsVersion::Es3);
+        gpu.r().set_method_named(method).unwrap();
+        let mut frame = |s: &scene::Scene| {
+            let (image, stats) = gpu.r().render_offscreen(s, 16, 9, &opts).unwrap();
+            (
+                image,
+                stats.memory.method_gpu_bytes,
+                stats.memory.upload_bytes,
+            )
+        };
+        let small = frame(&few).1;
+        let mut held = 0;
+        for k in 0..3 {
+            many.lights[0].position.x += 1e-3 * k as f64;
+            held = frame(&many).1;
+        }
+        assert!(held >= 4 * small, "{method}: {small} → {held} bytes");
+        // The last frame that uploaded lists (memory kept), and the last that freed memory.
+        let (mut listed, mut shrunk) = (0, None);
+        let mut before = frame(&few);
+        for i in 1..=2 * SHRINK_AFTER as usize {
+            let now = frame(&few);
+            if now.1 < before.1 {
+                let diff = manylight::metrics::diff(&before.0, &now.0);
+                assert_eq!(diff.max_abs, 0, "{method}: the frame that freed memory");
+                shrunk = Some(i);
+            } else if now.2 > 0 {
+                listed = i;
+            }
+            before = now;
+        }
+        let kept = before.1;
+        assert!(
+            kept <= 2 * small && 4 * kept <= held,
+            "{method}: {small} → {held} → {kept} bytes"
+        );
+        let shrunk = shrunk.expect("shrank above");
+        assert!(
+            listed < shrunk && shrunk <= listed + SHRINK_AFTER as usize,
+            "{method}: lists uploaded at frame {listed}, memory freed at {shrunk}"
+        );
+        assert_eq!(before.2, 0, "{method}: the last frame uploaded");
+    }
+}
+
 /// Deferred: a burst of lights that take a proxy the later lights do not (lights around the
 /// eye: far side or full screen) frees that proxy's instance stream after `SHRINK_AFTER`
 /// frames without lights for it; it kept the burst's store for good (helper-148).

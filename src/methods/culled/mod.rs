@@ -142,11 +142,10 @@ impl CulledForward {
         }
         self.write_grid_reason(ctx);
         let (grid_key, grid) = self.grid.as_ref().expect("updated above");
-        let reused = lists
-            .dropped
-            .is_none()
-            .then(|| self.assign.reuse().zip(self.upload.last_upload()))
-            .flatten();
+        let reused = match (lists.dropped, self.assign.reuse()) {
+            (None, Some(assigned)) => self.upload.still_frame(ctx.dev)?.map(|u| (assigned, u)),
+            _ => None,
+        };
         let (assigned, uploaded) = match reused {
             Some((assigned, uploaded)) => {
                 // Checked again: `auto` refuses overflow in some frames only.

@@ -9,7 +9,7 @@ use crate::cluster::headroom::room_for;
 use crate::cluster::pack::{pack_grid_into, pack_indices_into, GridEncoding, PackedTexels};
 use crate::cluster::pack::{pack_lights_into, LightEncoding, PackedLights};
 use crate::cluster::view_light::GpuLight;
-use crate::gl::texture::{DataFormat, DataTexture};
+use crate::gl::texture::{DataFormat, DataTexture, SHRINK_AFTER};
 use crate::gl::{Device, EsVersion};
 use crate::methods::FrameContext;
 use crate::Error;
@@ -63,6 +63,9 @@ pub(super) struct Uploads {
     /// The ring slot and light ranges of the last upload, which a frame with the same lists
     /// draws with again ([`Uploads::last_upload`]).
     last: Option<(usize, [f32; 2])>,
+    /// Frames drawn with the last upload's textures, its own included
+    /// ([`Uploads::still_frame`]).
+    frames_on_last: u32,
     /// The visible lights, their texels, the grid's and the index list's texels.
     visible: Vec<GpuLight>,
     lights: PackedLights,
@@ -76,6 +79,7 @@ impl Default for Uploads {
             ring: (0..RING).map(|_| None).collect(),
             frame: 0,
             last: None,
+            frames_on_last: 0,
             visible: Vec::new(),
             lights: PackedLights::default(),
             grid: PackedTexels::default(),
@@ -108,6 +112,7 @@ impl Uploads {
         let dev = ctx.dev;
         let started = Instant::now();
         self.last = None;
+        self.frames_on_last = 1;
         self.visible.clear();
         room_for(&mut self.visible, assignment.visible.len());
         self.visible
@@ -146,6 +151,56 @@ impl Uploads {
             bytes: 0,
             ms: 0.0,
         })
+    }
+
+    /// The last upload's textures for a still frame, as [`Uploads::last_upload`], counting the
+    /// frame: a texture its records have filled a quarter of at most for [`SHRINK_AFTER`]
+    /// frames gets them again at their size, and at [`SHRINK_AFTER`] frames on one upload the
+    /// ring's other sets, which a still frame does not read, are freed. A still scene after a
+    /// burst of lights uploads nothing, and kept the burst's textures for good.
+    pub(super) fn still_frame(&mut self, dev: &Device) -> Result<Option<Uploaded<'_>>, Error> {
+        let started = Instant::now();
+        let Some((slot, light_ranges)) = self.last else {
+            return Ok(None);
+        };
+        let Some(set) = self.ring[slot].as_mut() else {
+            return Ok(None);
+        };
+        // Cleared while uploading: a failed upload leaves nothing to draw again.
+        self.last = None;
+        let (lights, grid, indices) = (&self.lights, &self.grid, &self.indices);
+        let mut bytes = 0;
+        for (texture, (width, height, records)) in [
+            (
+                &mut set.lights,
+                (lights.width, lights.height, &lights.bytes),
+            ),
+            (&mut set.grid, (grid.width, grid.height, &grid.bytes)),
+            (
+                &mut set.indices,
+                (indices.width, indices.height, &indices.bytes),
+            ),
+        ] {
+            if texture.note_still_frame() {
+                texture.upload(dev, width, height, records)?;
+                bytes += records.len();
+            }
+        }
+        self.last = Some((slot, light_ranges));
+        self.frames_on_last = self.frames_on_last.saturating_add(1);
+        if self.frames_on_last == SHRINK_AFTER {
+            for (other, set) in self.ring.iter_mut().enumerate() {
+                if let Some(set) = set.take_if(|_| other != slot) {
+                    set.destroy(dev);
+                }
+            }
+        }
+        Ok(Some(Uploaded {
+            set: self.ring[slot].as_ref().expect("drawn above"),
+            light_ranges,
+            bytes,
+            ms: started.elapsed().as_secs_f64() * 1e3,
+        }))
     }
 
     /// GPU bytes of all ring sets.

@@ -117,6 +117,20 @@ impl LightInstances {
         self.held.iter().all(Option::is_some)
     }
 
+    /// Counts a still frame for each stream that holds lights to draw again: true when one has
+    /// held a quarter of its store at most for
+    /// [`SHRINK_AFTER`](crate::gl::texture::SHRINK_AFTER) frames, so the frame should draw its
+    /// lights anew, which shrinks it (a still scene after a burst of lights uploads nothing).
+    pub(super) fn note_still_frame(&mut self) -> bool {
+        let mut due = false;
+        for (stream, held) in self.streams.iter_mut().zip(self.held) {
+            if let (Some(stream), Some(1..)) = (stream, held) {
+                due |= stream.note_still_frame();
+            }
+        }
+        due
+    }
+
     /// Lights `proxy`'s stream holds from the last light pass, when it holds them all.
     pub(super) fn held(&self, proxy: usize) -> Option<usize> {
         self.held[proxy]
