@@ -157,13 +157,12 @@ impl Material {
             || (self.alpha_vertex && self.alpha_cutoff.is_none())
     }
 
-    /// The coordinate set each texture the material samples reads, by its glTF name (`None`:
-    /// not sampled, or sampled to no effect, as a normal map of scale 0).
-    pub(crate) fn texture_sets(&self) -> [(&'static str, Option<u32>); 5] {
+    /// The coordinate set each texture the material samples reads.
+    pub(crate) fn texture_sets(&self) -> super::texture_sets::TextureSets {
         let maps = &self.maps;
         let set = |t: Option<&super::surface_maps::MapTexture>| t.map(|t| t.transform.uv_set);
         let base = self.diffuse_texture.as_ref();
-        [
+        super::texture_sets::TextureSets([
             ("baseColorTexture", base.map(|_| maps.base_transform.uv_set)),
             (
                 "metallicRoughnessTexture",
@@ -172,7 +171,7 @@ impl Material {
             ("normalTexture", set(maps.sampled_normal())),
             ("occlusionTexture", set(maps.sampled_occlusion())),
             ("emissiveTexture", set(maps.sampled_emissive())),
-        ]
+        ])
     }
 
     /// The metallic-roughness texture, where the material is shaded with that BRDF (a
@@ -195,7 +194,7 @@ impl Material {
     /// True when a texture of the material reads the second coordinate set: what its meshes'
     /// `second_uvs` are uploaded for.
     pub(crate) fn reads_second_uvs(&self) -> bool {
-        self.texture_sets().iter().any(|(_, set)| *set == Some(1))
+        self.texture_sets().second()
     }
 
     /// True when the material has a non-zero Blinn-Phong specular term (never for

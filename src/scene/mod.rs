@@ -57,6 +57,7 @@ pub mod texture;
 pub mod texture_budget;
 #[cfg(any(feature = "obj", feature = "gltf"))]
 mod texture_names;
+mod texture_sets;
 pub(crate) mod triangle_reach;
 
 use std::ops::Range;

@@ -190,37 +190,6 @@ pub(super) fn transform_of(
     }
 }
 
-/// Which coordinate set each texture a converted glTF material samples reads (after its
-/// transform's `texCoord` override): what its primitives' meshes keep. A texture not bound
-/// (on a set past 1, failing to load) or sampled to no effect (a normal map of scale 0) reads
-/// none.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub(super) struct SetsRead([(&'static str, Option<u32>); 5]);
-
-impl SetsRead {
-    /// The sets `material`'s textures read, by their glTF names.
-    pub fn of(material: &crate::scene::Material) -> SetsRead {
-        SetsRead(material.texture_sets())
-    }
-
-    /// Some texture reads `TEXCOORD_1`.
-    pub fn second(&self) -> bool {
-        self.0.iter().any(|(_, set)| *set == Some(1))
-    }
-
-    /// The set the normal texture reads (its tangents follow it), if it has one.
-    pub fn normal(&self) -> Option<u32> {
-        let normal = self.0.iter().find(|(name, _)| *name == "normalTexture");
-        normal.and_then(|(_, set)| *set)
-    }
-
-    /// The textures reading `set`, by their glTF names.
-    pub fn named_on(&self, set: u32) -> Vec<&'static str> {
-        let on = |(name, s): &(&'static str, Option<u32>)| (*s == Some(set)).then_some(*name);
-        self.0.iter().filter_map(on).collect()
-    }
-}
-
 /// The message for a texture on a set past [`UV_SETS`]: not bound.
 pub(super) fn unread_set(field: &str, set: u32, what: &str) -> String {
     format!("{field}: uses TEXCOORD_{set}; only TEXCOORD_0 and TEXCOORD_1 are read, so {what}")

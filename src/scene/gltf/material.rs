@@ -131,9 +131,9 @@ impl Materials {
         buffers: &mut Buffers,
         gltf_path: &Path,
         warnings: &mut Vec<String>,
-    ) -> Result<maps::SetsRead, String> {
+    ) -> Result<crate::scene::texture_sets::TextureSets, String> {
         let i = self.get(m, buffers, gltf_path, warnings)?;
-        Ok(maps::SetsRead::of(&self.list[i]))
+        Ok(self.list[i].texture_sets())
     }
 
     /// Index in [`Materials::list`] of `m`, converting it on first use.

@@ -11,8 +11,8 @@ use gltf::mesh::Mode;
 
 use super::accessor::{self, describe};
 use super::buffers::Buffers;
-use super::maps::SetsRead;
 use crate::scene::mesh::MAX_VERTEX_COORD;
+use crate::scene::texture_sets::TextureSets;
 use crate::scene::Mesh;
 
 /// How many vertices and indices the file's primitives may still decode into.
@@ -84,7 +84,7 @@ pub(super) enum Built {
 /// The coordinate sets a primitive's material's textures read, asked once the primitive has
 /// triangles (its material is converted then, not for a primitive that is skipped).
 pub(super) type AskSets<'a> =
-    &'a mut dyn FnMut(&mut Buffers, &mut Vec<String>) -> Result<SetsRead, String>;
+    &'a mut dyn FnMut(&mut Buffers, &mut Vec<String>) -> Result<TextureSets, String>;
 
 /// Builds primitive `p` of its mesh; `field` is its glTF path (`meshes[2].primitives[0]`);
 /// `sets`: the coordinate sets its material's textures read.
@@ -585,7 +585,7 @@ mod tests {
         };
         let built = build(
             &primitive,
-            &mut |_, _| Ok(SetsRead::default()),
+            &mut |_, _| Ok(TextureSets::default()),
             "m",
             &mut buffers,
             &mut budget,
