@@ -8,11 +8,11 @@ use glow::HasContext;
 use super::Device;
 
 impl Device {
-    /// The bound framebuffer object's colour attachment 0 as `(width, height)`, or `None`
-    /// where GL cannot say (the default framebuffer, a texture on ES 3.0 or 2.0). Leaves the
-    /// bindings it used as they were.
-    pub(crate) fn bound_color_size(&self) -> Option<(u32, u32)> {
-        self.bound_framebuffer()?;
+    /// The colour attachment 0 of the bound framebuffer `target` as `(width, height)`, or
+    /// `None` where GL cannot say (the default framebuffer, a texture on ES 3.0 or 2.0). Leaves
+    /// the bindings it used as they were.
+    pub(crate) fn bound_color_size(&self, target: Option<glow::Framebuffer>) -> Option<(u32, u32)> {
+        target?;
         let gl = &self.gl;
         let param = |pname| unsafe {
             gl.get_framebuffer_attachment_parameter_i32(

@@ -28,6 +28,8 @@ pub struct Device {
     host: super::host_state::HostFeatures,
     /// Nesting depth of [`Device::enter_host`] (the outermost call saves the state).
     host_depth: std::cell::Cell<u32>,
+    /// The framebuffer the application had bound when the outermost call started.
+    host_framebuffer: std::cell::Cell<Option<glow::Framebuffer>>,
     /// What this call has bound, and the state calls made.
     call: CallState,
     /// Whether a GL error the application left pending has been reported (once a device).
@@ -181,7 +183,8 @@ impl Device {
             None
         };
         let units = unsafe { gl.get_parameter_i32(glow::MAX_COMBINED_TEXTURE_IMAGE_UNITS) };
-        let host = super::host_state::HostFeatures::of(&caps, own_vertex_array.is_some(), units);
+        let host =
+            super::host_state::HostFeatures::of(&gl, &caps, own_vertex_array.is_some(), units);
         Ok(Device {
             gl,
             caps,
@@ -191,6 +194,7 @@ impl Device {
             host,
             own_vertex_array,
             host_depth: std::cell::Cell::new(0),
+            host_framebuffer: std::cell::Cell::new(None),
             call: CallState::default(),
             warned_pending_error: std::cell::Cell::new(false),
             lost: std::cell::Cell::new(false),
@@ -237,8 +241,19 @@ impl Device {
             // the last call; entering binds the renderer's own vertex array.
             self.call.forget(self.own_vertex_array.map(|(vao, _)| vao));
             self.clear_pending_errors();
-            super::host_state::HostState::enter(&self.gl, &self.host, self.own_vertex_array)
+            let saved =
+                super::host_state::HostState::enter(&self.gl, &self.host, self.own_vertex_array);
+            self.host_framebuffer.set(saved.draw_framebuffer());
+            saved
         })
+    }
+
+    /// The framebuffer the application had bound for drawing when this call started (`None`:
+    /// the default one), as the state save read it: where [`Renderer::render`] draws.
+    ///
+    /// [`Renderer::render`]: crate::Renderer::render
+    pub(crate) fn host_framebuffer(&self) -> Option<glow::Framebuffer> {
+        self.host_framebuffer.get()
     }
 
     /// Ends a call started by [`Device::enter_host`], giving the application its state back.
@@ -596,8 +611,8 @@ impl Device {
 }
 
 /// Debug builds check `glGetError` after the wrapped step and return its error from the
-/// enclosing function; release builds compile it out (one check per frame still runs via
-/// [`Device::check`]).
+/// enclosing function; release builds compile it out (a frame's own checks still run via
+/// [`Device::check`]: a few a frame, none per draw or upload; `tools/tests/round_trips.rs`).
 macro_rules! gl_check {
     ($device:expr, $what:expr) => {
         #[cfg(debug_assertions)]

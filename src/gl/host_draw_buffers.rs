@@ -18,20 +18,23 @@ pub(crate) struct HostDrawBuffers {
 }
 
 impl HostDrawBuffers {
-    /// Points the bound draw framebuffer's draw buffer 0 at its attachment 0 (`GL_BACK` for
-    /// the default framebuffer on ES; desktop GL's default one is left as it is) and the others
-    /// at nothing, where they are not already; returns the game's list to give back then.
-    pub(crate) fn enter(gl: &glow::Context, desktop: bool) -> Option<HostDrawBuffers> {
+    /// Points the bound draw framebuffer's (`bound`) draw buffer 0 at its attachment 0
+    /// (`GL_BACK` for the default framebuffer on ES; desktop GL's default one is left as it is)
+    /// and the others at nothing, where they are not already; returns the game's list to give
+    /// back then. `most`: `GL_MAX_DRAW_BUFFERS`.
+    pub(crate) fn enter(
+        gl: &glow::Context,
+        desktop: bool,
+        bound: Option<glow::Framebuffer>,
+        most: usize,
+    ) -> Option<HostDrawBuffers> {
         unsafe {
-            let object = gl
-                .get_parameter_framebuffer(glow::DRAW_FRAMEBUFFER_BINDING)
-                .is_some();
+            let object = bound.is_some();
             if !object && desktop {
                 return None;
             }
             let (first, count) = if object {
-                let most = gl.get_parameter_i32(glow::MAX_DRAW_BUFFERS);
-                (glow::COLOR_ATTACHMENT0, (most.max(1) as usize).min(MOST))
+                (glow::COLOR_ATTACHMENT0, most.clamp(1, MOST))
             } else {
                 // A default framebuffer's list is one buffer long on ES.
                 (glow::BACK, 1)

@@ -66,13 +66,20 @@ pub(crate) struct HostFeatures {
     divisor: Option<VertexAttribDivisor>,
     /// Texture units saved and given back: the context's, at most [`UNITS`].
     units: usize,
+    /// `GL_MAX_DRAW_BUFFERS` (ES 3.0 state): a framebuffer object's draw buffers saved.
+    max_draw_buffers: usize,
 }
 
 impl HostFeatures {
     /// From the context's capabilities; `own_vertex_array` when the renderer binds its own
     /// vertex array object (which keeps its arrays and divisors apart from the game's);
-    /// `units`: its `GL_MAX_COMBINED_TEXTURE_IMAGE_UNITS`.
-    pub(crate) fn of(caps: &Caps, own_vertex_array: bool, units: i32) -> HostFeatures {
+    /// `units`: its `GL_MAX_COMBINED_TEXTURE_IMAGE_UNITS`. Asks `gl` for its constants.
+    pub(crate) fn of(
+        gl: &glow::Context,
+        caps: &Caps,
+        own_vertex_array: bool,
+        units: i32,
+    ) -> HostFeatures {
         let es3 = caps.context_has_es3_state();
         let has = |name: &str| caps.has_extension(name);
         HostFeatures {
@@ -88,6 +95,10 @@ impl HostFeatures {
                 .then(|| super::ext_fns::vertex_attrib_divisor_ext(has))
                 .flatten(),
             units: (units.max(0) as usize).min(UNITS),
+            max_draw_buffers: match es3 {
+                true => unsafe { gl.get_parameter_i32(glow::MAX_DRAW_BUFFERS) }.max(1) as usize,
+                false => 0,
+            },
         }
     }
 }
@@ -199,6 +210,7 @@ impl HostState {
             attrib_fns,
             divisor,
             units,
+            max_draw_buffers,
         } = *features;
         unsafe {
             let int = |p| gl.get_parameter_i32(p);
@@ -230,6 +242,18 @@ impl HostState {
             ];
             let gl_version = (gl.version().major, gl.version().minor);
             let program = gl.get_parameter_program(glow::CURRENT_PROGRAM);
+            let framebuffers = if es3 {
+                [
+                    gl.get_parameter_framebuffer(glow::DRAW_FRAMEBUFFER_BINDING),
+                    gl.get_parameter_framebuffer(glow::READ_FRAMEBUFFER_BINDING),
+                ]
+            } else {
+                [
+                    gl.get_parameter_framebuffer(glow::FRAMEBUFFER_BINDING),
+                    None,
+                ]
+            };
+            let draw_framebuffer = framebuffers[0];
             let saved = HostState {
                 es3,
                 vertex_array: vao
@@ -251,19 +275,13 @@ impl HostState {
                 textures,
                 samplers,
                 units,
-                framebuffers: if es3 {
-                    [
-                        gl.get_parameter_framebuffer(glow::DRAW_FRAMEBUFFER_BINDING),
-                        gl.get_parameter_framebuffer(glow::READ_FRAMEBUFFER_BINDING),
-                    ]
-                } else {
-                    [
-                        gl.get_parameter_framebuffer(glow::FRAMEBUFFER_BINDING),
-                        None,
-                    ]
-                },
+                framebuffers,
                 renderbuffer: gl.get_parameter_renderbuffer(glow::RENDERBUFFER_BINDING),
-                draw_buffers: es3.then(|| HostDrawBuffers::enter(gl, desktop)).flatten(),
+                draw_buffers: es3
+                    .then(|| {
+                        HostDrawBuffers::enter(gl, desktop, draw_framebuffer, max_draw_buffers)
+                    })
+                    .flatten(),
                 viewport,
                 scissor,
                 toggled: TOGGLED.map(|c| gl.is_enabled(c)),
@@ -354,6 +372,12 @@ impl HostState {
     fn rows(&self) -> impl Iterator<Item = (u32, i32)> {
         let unpack = (self.unpack_rows.into_iter()).flat_map(|v| UNPACK_ROWS.into_iter().zip(v));
         unpack.chain((self.pack_rows.into_iter()).flat_map(|v| PACK_ROWS.into_iter().zip(v)))
+    }
+
+    /// The framebuffer the application had bound for drawing (`None`: the default one): the
+    /// frame's target, read once a call.
+    pub(crate) fn draw_framebuffer(&self) -> Option<glow::Framebuffer> {
+        self.framebuffers[0]
     }
 
     /// Gives the application its state back.

@@ -297,6 +297,11 @@ impl MultisampleTarget {
         }
     }
 
+    /// Its framebuffer object.
+    pub fn fbo(&self) -> glow::Framebuffer {
+        self.fbo
+    }
+
     /// Binds the target and sets the viewport to cover it.
     pub fn bind(&self, dev: &Device) {
         unsafe { dev.gl.bind_framebuffer(glow::FRAMEBUFFER, Some(self.fbo)) };

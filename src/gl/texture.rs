@@ -183,13 +183,14 @@ impl DataTexture {
         let (internal, format, ty) = self.format.gl_formats(dev.es());
         let full_rows = bytes.len().checked_div(row).unwrap_or(0);
         let rest = bytes.len() - full_rows * row;
+        let needed = height.next_power_of_two();
+        self.rows_needed = needed;
+        let shrink = self.note_frame();
+        let allocate = self.size.0 != width || self.size.1 < height || shrink;
         unsafe {
             gl.bind_texture(glow::TEXTURE_2D, Some(self.raw));
             gl.pixel_store_i32(glow::UNPACK_ALIGNMENT, 1);
-            let needed = height.next_power_of_two();
-            self.rows_needed = needed;
-            let shrink = self.note_frame();
-            if self.size.0 != width || self.size.1 < height || shrink {
+            if allocate {
                 let kept = if shrink { 0 } else { self.size.1 };
                 self.small_frames = 0;
                 let rows = needed.max(kept).min(max);
@@ -225,6 +226,11 @@ impl DataTexture {
             if rest > 0 {
                 sub_image(full_rows, rest / texel, 1, &bytes[full_rows * row..]);
             }
+        }
+        if !allocate {
+            // Writing into storage it has: its errors are the frame's check's (a failed frame
+            // leaves nothing to draw again: the renderer's next frame uploads anew).
+            return Ok(());
         }
         let uploaded = dev.check("data texture upload");
         if uploaded.is_err() {

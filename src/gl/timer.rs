@@ -96,14 +96,6 @@ impl GpuTimer {
             return;
         }
         self.end_running(dev);
-        // An application timing its own work around the frame has a query running: one
-        // elapsed-time query at a time, so this frame goes untimed (beginning ours would fail).
-        let mut current = 0;
-        unsafe { (self.fns.get_queryiv)(TIME_ELAPSED, CURRENT_QUERY, &mut current) };
-        if !self.check(dev, "glGetQueryivEXT") || current != 0 {
-            return;
-        }
-        self.take_disjoint(dev);
         let free = self.in_flight.iter().position(|f| f.get().is_none());
         let oldest = || (0..RING).min_by_key(|&slot| self.in_flight[slot].get());
         let Some(slot) = free.or_else(|| oldest().filter(|_| wait)) else {
@@ -114,9 +106,19 @@ impl GpuTimer {
             self.result(slot, QUERY_RESULT);
         }
         unsafe { (self.fns.begin_query)(TIME_ELAPSED, self.queries[slot]) };
-        if self.check(dev, "glBeginQueryEXT") {
+        let error = dev.drain_errors();
+        if error == glow::NO_ERROR {
             self.running.set(Some(slot));
             self.in_flight[slot].set(Some(serial));
+            return;
+        }
+        // An application timing its own work around the frame has a query running: one
+        // elapsed-time query at a time, so this frame goes untimed. Asked only when the begin
+        // failed, not every frame.
+        let mut current = 0;
+        unsafe { (self.fns.get_queryiv)(TIME_ELAPSED, CURRENT_QUERY, &mut current) };
+        if dev.drain_errors() != glow::NO_ERROR || current == 0 {
+            self.refused(error, "glBeginQueryEXT");
         }
     }
 
@@ -133,7 +135,8 @@ impl GpuTimer {
     /// Stops timing. `wait`: reads the result now, waiting for it (call after the frame's
     /// work is submitted): GPU milliseconds, or `None` when the GPU reported a disjoint event
     /// or the driver refused the query. Otherwise the query stays in flight for
-    /// [`GpuTimer::poll`], and this returns `None`.
+    /// [`GpuTimer::poll`], which checks this call's errors too (call it next), and this
+    /// returns `None`.
     pub fn end(&self, dev: &Device, wait: bool) -> Option<f64> {
         let slot = self.running.take()?;
         if self.failed.get() {
@@ -141,7 +144,7 @@ impl GpuTimer {
         }
         unsafe { (self.fns.end_query)(TIME_ELAPSED) };
         if !wait {
-            self.check(dev, "glEndQueryEXT");
+            // Its error is checked by the `poll` that follows.
             return None;
         }
         self.in_flight[slot].set(None);
@@ -203,11 +206,16 @@ impl GpuTimer {
         if error == glow::NO_ERROR {
             return true;
         }
+        self.refused(error, what);
+        false
+    }
+
+    /// Turns the timer off, warned, after the driver refused `what` with `error`.
+    fn refused(&self, error: u32, what: &str) {
         log::warn!(
             "the driver refused {what} (GL error {error:#06x}): GPU timing off (gpu_ms absent)"
         );
         self.failed.set(true);
-        false
     }
 
     /// Frees the queries.

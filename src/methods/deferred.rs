@@ -259,7 +259,7 @@ impl Deferred {
     /// leaving the frame's framebuffer bound (making the G-buffer binds its own).
     pub(super) fn prepare(&mut self, ctx: &FrameContext) -> Result<(), Error> {
         let dev = ctx.dev;
-        let target = dev.bound_framebuffer();
+        let target = ctx.target;
         let has = self.gbuffer.as_ref().is_some_and(GBuffer::has_specular);
         let prepared = self.ensure_resources(dev, ctx.viewport, has || needs_specular_target(ctx));
         dev.bind_framebuffer(target);
@@ -575,7 +575,7 @@ impl ShadingMethod for Deferred {
                 ctx.lights.len()
             )));
         }
-        let target = dev.bound_framebuffer();
+        let target = ctx.target;
         self.idle_frames = 0;
         let specular = self.keeps_specular(needs_specular_target(ctx));
         self.ensure_resources(dev, ctx.viewport, specular)?;

@@ -81,6 +81,8 @@ pub struct FrameContext<'a> {
     /// bit for bit as it gathers them): what a method built from lights of the same
     /// generation, with everything else it depends on unchanged, it may keep.
     pub lights_generation: u64,
+    /// The framebuffer the frame is drawn into, bound (`None`: the default one).
+    pub target: Option<glow::Framebuffer>,
     /// The frame's directional lights (shaded outside the light lists).
     pub directional: directional::DirectionalFrame,
     /// Scene-level shader features (spots present, output encoding, light encoding).

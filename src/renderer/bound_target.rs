@@ -7,6 +7,7 @@
 //! and frame is what the README asks of a game.
 
 use super::Renderer;
+use crate::gl::bound_framebuffer::TargetFormat;
 use crate::gl::GlError;
 use crate::{CountKind, Error, RenderOptions};
 
@@ -31,18 +32,25 @@ impl Renderer {
         Ok(())
     }
 
-    /// Refuses a bound framebuffer that cannot take a `width × height` frame; warns once of a
-    /// shallow depth buffer. `drawn_here`: the frame is drawn in it (no MSAA of the renderer's);
-    /// then its depth bits (24 where the driver would not say).
+    /// Refuses the bound framebuffer `target` (of `format`) where it cannot take a
+    /// `width × height` frame; warns once of a shallow depth buffer. `drawn_here`: the frame is
+    /// drawn in it (no MSAA of the renderer's); then its depth bits (24 where the driver would
+    /// not say).
     pub(super) fn check_bound_target(
         &mut self,
-        width: u32,
-        height: u32,
+        (target, format): (Option<glow::Framebuffer>, &TargetFormat),
+        (width, height): (u32, u32),
         origin: [u32; 2],
         drawn_here: bool,
     ) -> Result<Option<u32>, Error> {
         self.check_viewport_limit(width, height)?;
-        let status = self.dev.bound_framebuffer_status();
+        // Asked again for another framebuffer, or after a failed frame: one the game made
+        // incomplete since fails its draws with GL_INVALID_FRAMEBUFFER_OPERATION, and the next
+        // frame names why.
+        let status = match self.complete_target.take() {
+            Some(complete) if complete == target => glow::FRAMEBUFFER_COMPLETE,
+            _ => self.dev.bound_framebuffer_status(),
+        };
         self.dev
             .check_status_call(status, "the bound framebuffer")?;
         if status != glow::FRAMEBUFFER_COMPLETE {
@@ -53,7 +61,7 @@ impl Renderer {
             ))
             .into());
         }
-        if self.dev.bound_colour_zero_is_empty() {
+        if format.colour_zero_empty {
             return Err(GlError::BoundFramebuffer(
                 "it has no colour buffer at GL_COLOR_ATTACHMENT0, the one the frame is drawn \
                  into (a colour buffer at another attachment is not): attach it there"
@@ -61,11 +69,11 @@ impl Renderer {
             )
             .into());
         }
-        self.warn_past_bound_colour((width, height), origin);
+        self.warn_past_bound_colour(target, (width, height), origin);
         if !drawn_here {
             return Ok(None);
         }
-        let bits = self.dev.bound_depth_bits();
+        let bits = format.depth_bits;
         match bits {
             Some(0) => {
                 return Err(GlError::BoundFramebuffer(
@@ -90,12 +98,20 @@ impl Renderer {
 
     /// Warns once of a frame reaching past the bound framebuffer object's colour buffer, where
     /// GL can say its size: GL draws only the part inside, and a game that did not resize its
-    /// framebuffer with the window would see a cut frame with no error.
-    fn warn_past_bound_colour(&mut self, (width, height): (u32, u32), [x, y]: [u32; 2]) {
-        if self.warned_past_framebuffer {
+    /// framebuffer with the window would see a cut frame with no error. Asked again only when
+    /// the framebuffer or the frame's place in it changes, not every frame.
+    fn warn_past_bound_colour(
+        &mut self,
+        target: Option<glow::Framebuffer>,
+        (width, height): (u32, u32),
+        [x, y]: [u32; 2],
+    ) {
+        let frame = Some((target, [x, y, width, height]));
+        if self.warned_past_framebuffer || self.placed_in == frame {
             return;
         }
-        let Some((w, h)) = self.dev.bound_color_size() else {
+        self.placed_in = frame;
+        let Some((w, h)) = self.dev.bound_color_size(target) else {
             return;
         };
         if u64::from(x) + u64::from(width) > u64::from(w)
@@ -110,13 +126,17 @@ impl Renderer {
         }
     }
 
-    /// Warns once of HDR colour into a fixed-point framebuffer: its unclamped radiance is
-    /// clamped to [0, 1] there, with neither exposure nor tone map applied.
-    pub(super) fn warn_hdr_into_fixed_point(&mut self, options: &RenderOptions) {
+    /// Warns once of HDR colour into a fixed-point framebuffer (of `format`): its unclamped
+    /// radiance is clamped to [0, 1] there, with neither exposure nor tone map applied.
+    pub(super) fn warn_hdr_into_fixed_point(
+        &mut self,
+        options: &RenderOptions,
+        format: &TargetFormat,
+    ) {
         if !options.hdr
             || options.count != CountKind::None
             || self.warned_hdr_fixed_point
-            || !self.dev.bound_color_is_fixed_point()
+            || !format.fixed_point
         {
             return;
         }

@@ -7,6 +7,7 @@ use std::time::Instant;
 
 use super::frame_report::DrawnFrame;
 use super::{FrameStats, Renderer};
+use crate::gl::bound_framebuffer::TargetQueries;
 use crate::gl::framebuffer::ColorFormat;
 use crate::methods::{self, FrameContext};
 use crate::options::{Clear, CountKind, RenderOptions, MAX_EXPOSURE_EV};
@@ -83,6 +84,11 @@ impl Renderer {
             self.programs.begin_frame();
         }
         let drawn = self.render_counted(scene, size, options, origin, stats, applications);
+        if drawn.is_err() {
+            // What the failed frame uploaded may not be there: the next one packs and uploads
+            // its light data anew, whatever its method kept (each keys it on the generation).
+            self.lights_generation += 1;
+        }
         stats.draw_calls = self.dev.draw_calls() - draw_calls;
         stats.programs_built = self.programs.len() - programs;
         stats.memory.shader_programs = self.programs.len();
@@ -113,13 +119,20 @@ impl Renderer {
         } else {
             1
         };
+        // The framebuffer the frame goes to and what it is, asked once a frame: the
+        // application's as the call found it bound, or the offscreen render's own.
+        let target = match applications {
+            true => self.dev.host_framebuffer(),
+            false => self.dev.bound_framebuffer(),
+        };
+        let queries = TargetQueries {
+            fixed_point: applications && options.hdr && !self.warned_hdr_fixed_point,
+            rgba8: samples > 1,
+        };
+        let format = self.dev.target_format(target, queries);
         // A game's multisampled framebuffer (a window surface with EGL_SAMPLES) samples the
         // frame itself; a resolve could not blit into it.
-        let destination_samples = if applications {
-            self.dev.bound_samples()
-        } else {
-            0
-        };
+        let destination_samples = if applications { format.samples } else { 0 };
         if destination_samples > 0 {
             samples = 1;
         }
@@ -144,8 +157,8 @@ impl Renderer {
             }
         }
         let games_depth_bits = if applications {
-            self.warn_hdr_into_fixed_point(options);
-            self.check_bound_target(width, height, origin, samples <= 1)?
+            self.warn_hdr_into_fixed_point(options, &format);
+            self.check_bound_target((target, &format), (width, height), origin, samples <= 1)?
         } else {
             None
         };
@@ -154,7 +167,7 @@ impl Renderer {
             None => self.own_depth_bits(),
         };
         // A framebuffer that encodes sRGB itself is given linear values, not encoded twice.
-        self.srgb_destination = applications && self.dev.bound_color_is_srgb();
+        self.srgb_destination = applications && format.srgb;
         if self.srgb_destination && matches!(options.count, CountKind::Evals | CountKind::Reaching)
         {
             return Err(Error::InvalidOption {
@@ -178,12 +191,20 @@ impl Renderer {
             if let Some(mut m) = self.msaa.take() {
                 m.destroy(&self.dev);
             }
-            self.render_frame(scene, (width, height), options, origin, None, stats)?;
+            self.render_frame(
+                scene,
+                (width, height),
+                options,
+                (target, origin),
+                None,
+                stats,
+            )?;
             stats.samples = stats.samples.max(destination_samples as u32);
+            self.complete_target = applications.then_some(target);
             return Ok(());
         }
-        let destination = self.dev.bound_framebuffer();
-        let same_format = self.dev.bound_color_is_rgba8();
+        let destination = target;
+        let same_format = format.rgba8;
         let format = if options.hdr {
             ColorFormat::Rgba16F
         } else {
@@ -196,6 +217,7 @@ impl Renderer {
         prepared?;
         let msaa = self.msaa.as_ref().expect("created by prepare_msaa");
         msaa.bind(&self.dev);
+        let own_target = Some(msaa.fbo());
         // Drawn at the target's corner, resolved to the origin.
         let resolve = Resolve {
             destination,
@@ -206,7 +228,7 @@ impl Renderer {
             scene,
             (width, height),
             options,
-            [0, 0],
+            (own_target, [0, 0]),
             Some(resolve),
             stats,
         );
@@ -215,6 +237,7 @@ impl Renderer {
             Ok(()) => {
                 stats.samples = msaa.samples_drawn();
                 stats.memory.msaa_bytes = msaa.gpu_bytes();
+                self.complete_target = applications.then_some(target);
                 Ok(())
             }
             // A failed frame is not resolved over the caller's picture.
@@ -242,14 +265,15 @@ impl Renderer {
         ]
     }
 
-    /// One frame into the bound framebuffer (see [`Renderer::render_reusing`]); with
-    /// `resolve`, into the bound MSAA target, filled and resolved inside the frame's timing.
+    /// One frame into the bound framebuffer `target` at `origin` (see
+    /// [`Renderer::render_reusing`]); with `resolve`, into the bound MSAA target, filled and
+    /// resolved inside the frame's timing.
     fn render_frame(
         &mut self,
         scene: &Scene,
         (width, height): (u32, u32),
         options: &RenderOptions,
-        origin: [u32; 2],
+        (target, origin): (Option<glow::Framebuffer>, [u32; 2]),
         resolve: Option<Resolve>,
         stats: &mut FrameStats,
     ) -> Result<(), Error> {
@@ -290,6 +314,7 @@ impl Renderer {
             orthographic: matches!(scene.camera.projection, Projection::Orthographic { .. }),
             lights: frame_lights,
             lights_generation: self.lights_generation,
+            target,
             directional: setup.directional,
             features,
             viewport: (width, height),
@@ -358,7 +383,9 @@ impl Renderer {
         // Likewise the draws' errors, before the query ends (on the error path too: one left
         // active makes the next frame's `glBeginQuery` fail).
         let rendered = match (rendered, timer) {
-            (Ok(stats), Some(_)) => self.dev.check("frame").map(|()| stats).map_err(Error::from),
+            (Ok(stats), Some(_)) => (self.dev.check("the frame's draws"))
+                .map(|()| stats)
+                .map_err(Error::from),
             // A failed frame's pending errors are its own, not the query's.
             (Err(e), Some(_)) => {
                 self.dev.drain_errors();
@@ -386,7 +413,10 @@ impl Renderer {
         if options.wait_for_gpu {
             self.dev.finish();
         }
-        self.dev.check("frame")?;
+        if timer.is_none() {
+            // With the timer, checked before its query ended (and the timer's own calls by it).
+            self.dev.check("the frame's draws")?;
+        }
         let frame_ms = start.elapsed().as_secs_f64() * 1e3;
         stats.record(&DrawnFrame {
             method_name,

@@ -94,6 +94,12 @@ pub struct Renderer {
     warned_hdr_fixed_point: bool,
     /// A frame past the bound framebuffer's colour buffer was warned of.
     warned_past_framebuffer: bool,
+    /// The framebuffer and the frame's rectangle in it the last frame checked its colour
+    /// buffer's size for (see `warn_past_bound_colour`).
+    placed_in: Option<(Option<glow::Framebuffer>, [u32; 4])>,
+    /// The application's framebuffer the last frame drew into without an error: complete, not
+    /// asked again while frames go there (see `check_bound_target`).
+    complete_target: Option<Option<glow::Framebuffer>>,
     /// The frame being drawn goes to a framebuffer that encodes sRGB itself: drawn with linear
     /// output (and, with MSAA on ES 3.0, an sRGB multisampled target).
     srgb_destination: bool,
@@ -203,6 +209,8 @@ impl Renderer {
             warned_depth_bits: false,
             warned_hdr_fixed_point: false,
             warned_past_framebuffer: false,
+            placed_in: None,
+            complete_target: None,
             srgb_destination: false,
             warned_depth_step: false,
             warned_nothing_to_draw: false,

@@ -51,7 +51,10 @@ impl Renderer {
         let programs = self.programs.len();
         // What `render` would draw with into the framebuffer bound now: linear output into one
         // that encodes sRGB, and no MSAA of the renderer's own into one multisampled itself.
-        let srgb = self.dev.bound_color_is_srgb();
+        let bound = self
+            .dev
+            .target_format(self.dev.host_framebuffer(), Default::default());
+        let srgb = bound.srgb;
         let mut options = RenderOptions {
             linear: options.linear || srgb,
             gpu_timer: false,
@@ -59,7 +62,7 @@ impl Renderer {
             origin: [0, 0],
             ..options.clone()
         };
-        if self.dev.bound_samples() > 0 || options.count != CountKind::None {
+        if bound.samples > 0 || options.count != CountKind::None {
             options.samples = 1;
         }
         options.measure.timed_frames = 0;

@@ -173,6 +173,45 @@ fn an_incomplete_framebuffer_is_refused_naming_its_status() {
     render(&mut r, &RenderOptions::default()).unwrap();
 }
 
+/// A framebuffer's completeness is asked when frames start going to it, not every frame (a
+/// round trip on a threaded driver): one the game makes incomplete after a frame (its colour
+/// storage respecified at 0×0) fails the next frame with GL's error, the frame after that names
+/// its status, and once the game repairs it the same renderer draws again.
+#[test]
+fn a_framebuffer_made_incomplete_after_a_frame_fails_and_is_then_named() {
+    let (_ctx, gl, mut r) = game(EsVersion::Es3);
+    let colour = unsafe {
+        game_fbo(&gl, Some(glow::DEPTH_COMPONENT24));
+        let name = gl.get_framebuffer_attachment_parameter_i32(
+            glow::FRAMEBUFFER,
+            glow::COLOR_ATTACHMENT0,
+            glow::FRAMEBUFFER_ATTACHMENT_OBJECT_NAME,
+        );
+        glow::NativeRenderbuffer(std::num::NonZeroU32::new(name as u32).unwrap())
+    };
+    let storage = |(w, h): (i32, i32)| unsafe {
+        gl.bind_renderbuffer(glow::RENDERBUFFER, Some(colour));
+        gl.renderbuffer_storage(glow::RENDERBUFFER, glow::RGBA8, w, h);
+    };
+    render(&mut r, &RenderOptions::default()).unwrap();
+    storage((0, 0));
+    let first = render(&mut r, &RenderOptions::default()).unwrap_err();
+    assert!(
+        first
+            .to_string()
+            .contains("GL_INVALID_FRAMEBUFFER_OPERATION"),
+        "{first}"
+    );
+    let named = render(&mut r, &RenderOptions::default()).unwrap_err();
+    let text = named.to_string();
+    assert!(
+        text.contains("incomplete") && text.contains("GL_FRAMEBUFFER_INCOMPLETE_ATTACHMENT"),
+        "{text}"
+    );
+    storage(SIZE);
+    render(&mut r, &RenderOptions::default()).unwrap();
+}
+
 /// A frame wider than `GL_MAX_VIEWPORT_DIMS` is refused naming the limit (GL clamped the
 /// viewport and the call returned `Ok`), by `render` and `render_offscreen` alike (one gave a
 /// limit's text and the other an unsupported capability): a game matches one error. (The

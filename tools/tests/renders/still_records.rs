@@ -230,7 +230,8 @@ fn each_input_of_the_records_makes_the_next_frame_upload_them() {
 
 /// A frame that fails (its error may be the records' upload) leaves no records to draw again:
 /// the next frame of the same lights uploads them, and draws what a fresh renderer draws. The
-/// failures are injected at the step that reports them.
+/// failures are injected at the step that reports them: the frame's check (a data texture's
+/// upload into storage it has is checked there), deferred's own before it keeps its instances.
 #[test]
 fn a_failed_frame_leaves_no_records_to_draw_again() {
     let before = still_scene();
@@ -238,9 +239,10 @@ fn a_failed_frame_leaves_no_records_to_draw_again() {
     after.lights[3].position.x += 1.0;
     let opts = RenderOptions::default();
     for (method, es, step) in [
-        ("forward", EsVersion::Es2, "data texture upload"),
-        ("forward", EsVersion::Es3, "data texture upload"),
-        ("deferred", EsVersion::Es3, "data texture upload"),
+        ("forward", EsVersion::Es2, "the frame's draws"),
+        ("forward", EsVersion::Es3, "the frame's draws"),
+        ("clustered", EsVersion::Es3, "the frame's draws"),
+        ("deferred", EsVersion::Es3, "the frame's draws"),
         ("deferred", EsVersion::Es3, "deferred frame"),
     ] {
         let what = format!("{es} {method}, failed at {step}");
