@@ -337,7 +337,8 @@ impl MultisampleTarget {
                     Err(GlError::Driver { code, .. }) if code == glow::INVALID_OPERATION => {
                         self.resolve_through_copy(dev, into, origin)?
                     }
-                    other => other?,
+                    // Checked: nothing more to check after it.
+                    other => return other,
                 }
             }
             Color::Renderbuffer(_) => self.resolve_through_copy(dev, into, origin)?,
