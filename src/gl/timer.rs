@@ -161,11 +161,21 @@ impl GpuTimer {
             return None;
         }
         let mut newest: Option<(u64, f64)> = None;
+        // Oldest first, up to the first without its result: GPUs finish frames in order (and
+        // a later one's result is read by a later poll), and each ask is a round trip on a
+        // threaded driver.
+        let mut waiting: [(u64, usize); RING] = [(u64::MAX, 0); RING];
         for (slot, flight) in self.in_flight.iter().enumerate() {
-            let Some(serial) = flight.get() else { continue };
-            if self.running.get() == Some(slot) || self.result(slot, QUERY_RESULT_AVAILABLE) == 0 {
-                continue;
+            if let Some(serial) = flight.get().filter(|_| self.running.get() != Some(slot)) {
+                waiting[slot] = (serial, slot);
             }
+        }
+        waiting.sort_unstable();
+        for &(serial, slot) in waiting.iter().filter(|(serial, _)| *serial != u64::MAX) {
+            if self.result(slot, QUERY_RESULT_AVAILABLE) == 0 {
+                break;
+            }
+            let flight = &self.in_flight[slot];
             flight.set(None);
             let ms = self.result(slot, QUERY_RESULT) as f64 * 1e-6;
             if newest.is_none_or(|(s, _)| serial > s) {

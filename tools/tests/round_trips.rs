@@ -234,10 +234,8 @@ fn a_frame_into_a_games_framebuffer_asks_the_driver_each_thing_once() {
             assert_eq!(of(&counts, &["glCheckFramebufferStatus"]), 0.0, "{what}");
             let errors = of(&counts, &["glGetError"]);
             let debug_checks = f64::from(u8::from(cfg!(debug_assertions)));
-            // Deferred checks its frame itself before it keeps its light instances.
-            let own = f64::from(u8::from(method == "deferred"));
             let resolve = if samples > 1 { 2.0 } else { 0.0 };
-            let most = 6.0 + debug_checks + own + resolve;
+            let most = 6.0 + debug_checks + resolve;
             assert!(errors <= most, "glGetError: {what}");
             // The colour and the depth attachment's: what is attached, once each.
             let kinds = attachment(&counts, glow::FRAMEBUFFER_ATTACHMENT_OBJECT_TYPE);

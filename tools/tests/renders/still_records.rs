@@ -231,7 +231,8 @@ fn each_input_of_the_records_makes_the_next_frame_upload_them() {
 /// A frame that fails (its error may be the records' upload) leaves no records to draw again:
 /// the next frame of the same lights uploads them, and draws what a fresh renderer draws. The
 /// failures are injected at the step that reports them: the frame's check (a data texture's
-/// upload into storage it has is checked there), deferred's own before it keeps its instances.
+/// upload into storage it has is checked there, and deferred's instances, which it checked
+/// itself).
 #[test]
 fn a_failed_frame_leaves_no_records_to_draw_again() {
     let before = still_scene();
@@ -243,7 +244,6 @@ fn a_failed_frame_leaves_no_records_to_draw_again() {
         ("forward", EsVersion::Es3, "the frame's draws"),
         ("clustered", EsVersion::Es3, "the frame's draws"),
         ("deferred", EsVersion::Es3, "the frame's draws"),
-        ("deferred", EsVersion::Es3, "deferred frame"),
     ] {
         let what = format!("{es} {method}, failed at {step}");
         let mut gpu = Gpu::new(es);
