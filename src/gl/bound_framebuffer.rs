@@ -1,7 +1,8 @@
 //! What the bound framebuffer is: the checks a frame makes of a game's framebuffer before
 //! drawing into it (its colour encoding and format, samples, depth bits), read once a frame.
-//! The queries are drained of errors once together; where a driver refused one, each is asked
-//! again with its own drain, and one it will not answer gives `None` or the cautious answer.
+//! The queries are drained of errors once together; where a driver refused one, they are
+//! asked again (and from then on) with a drain each, the colour attachment's parameters
+//! together, and one it will not answer gives `None` or the cautious answer.
 #![allow(unsafe_code)]
 
 use glow::HasContext;
@@ -24,7 +25,7 @@ pub(crate) struct TargetFormat {
     pub srgb: bool,
     /// The colour buffer stores fixed-point values, which clamp to [0, 1]: its component type
     /// on ES 3.0 (`GL_UNSIGNED_NORMALIZED`), at most 8 red bits on ES 2.0 (whose float colour
-    /// buffers have 16 or 32). Asked only where [`TargetQueries::fixed_point`].
+    /// buffers have 16 or 32). Asked only where [`TargetQueries`] asks it or `rgba8`.
     pub fixed_point: bool,
     /// The colour is 8-bit normalized RGBA (`RGBA8` or `SRGB8_ALPHA8`): what an ES 3.0
     /// multisample resolve may blit into, which needs identical formats (`RGB8`, `RGB565`, a
@@ -50,9 +51,12 @@ impl Device {
         target: Option<glow::Framebuffer>,
         queries: TargetQueries,
     ) -> TargetFormat {
-        let format = self.read_target_format(target, queries, false);
-        if self.drain_errors() == glow::NO_ERROR {
-            return format;
+        if !self.target_queries_refused.get() {
+            let format = self.read_target_format(target, queries, false);
+            if self.drain_errors() == glow::NO_ERROR {
+                return format;
+            }
+            self.target_queries_refused.set(true);
         }
         self.read_target_format(target, queries, true)
     }

@@ -30,6 +30,9 @@ pub struct Device {
     host_depth: std::cell::Cell<u32>,
     /// The framebuffer the application had bound when the outermost call started.
     host_framebuffer: std::cell::Cell<Option<glow::Framebuffer>>,
+    /// The driver refused a query of a frame's target once: each is drained on its own from
+    /// then on ([`Device::target_format`](super::bound_framebuffer)).
+    pub(super) target_queries_refused: std::cell::Cell<bool>,
     /// What this call has bound, and the state calls made.
     call: CallState,
     /// Whether a GL error the application left pending has been reported (once a device).
@@ -195,6 +198,7 @@ impl Device {
             own_vertex_array,
             host_depth: std::cell::Cell::new(0),
             host_framebuffer: std::cell::Cell::new(None),
+            target_queries_refused: std::cell::Cell::new(false),
             call: CallState::default(),
             warned_pending_error: std::cell::Cell::new(false),
             lost: std::cell::Cell::new(false),
@@ -612,7 +616,8 @@ impl Device {
 
 /// Debug builds check `glGetError` after the wrapped step and return its error from the
 /// enclosing function; release builds compile it out (a frame's own checks still run via
-/// [`Device::check`]: a few a frame, none per draw or upload; `tools/tests/round_trips.rs`).
+/// [`Device::check`]: a few a frame, none per draw, and per upload only where one allocates;
+/// `tools/tests/round_trips.rs`).
 macro_rules! gl_check {
     ($device:expr, $what:expr) => {
         #[cfg(debug_assertions)]

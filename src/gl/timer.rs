@@ -53,6 +53,10 @@ pub struct GpuTimer {
     running: Cell<Option<usize>>,
     /// Set when the driver refused a query call: the timer then stays off (warned once).
     failed: Cell<bool>,
+    /// The application was found timing its own work around a frame: each begin asks first
+    /// whether its query runs (else beginning ours raises a GL error the game would see), until
+    /// a frame finds none.
+    application_times: Cell<bool>,
 }
 
 impl GpuTimer {
@@ -85,6 +89,7 @@ impl GpuTimer {
             in_flight: Default::default(),
             running: Cell::new(None),
             failed: Cell::new(false),
+            application_times: Cell::new(false),
         })
     }
 
@@ -96,6 +101,13 @@ impl GpuTimer {
             return;
         }
         self.end_running(dev);
+        if self.application_times.get() {
+            let running = self.application_query(dev);
+            self.application_times.set(running != Some(false));
+            if running != Some(false) {
+                return;
+            }
+        }
         let free = self.in_flight.iter().position(|f| f.get().is_none());
         let oldest = || (0..RING).min_by_key(|&slot| self.in_flight[slot].get());
         let Some(slot) = free.or_else(|| oldest().filter(|_| wait)) else {
@@ -113,13 +125,20 @@ impl GpuTimer {
             return;
         }
         // An application timing its own work around the frame has a query running: one
-        // elapsed-time query at a time, so this frame goes untimed. Asked only when the begin
-        // failed, not every frame.
+        // elapsed-time query at a time, so this frame goes untimed. Asked only once a begin
+        // failed, not every frame, and before each begin from then on.
+        match self.application_query(dev) {
+            Some(true) => self.application_times.set(true),
+            _ => self.refused(error, "glBeginQueryEXT"),
+        }
+    }
+
+    /// Whether the application has an elapsed-time query running (`None`: the driver would not
+    /// say).
+    fn application_query(&self, dev: &Device) -> Option<bool> {
         let mut current = 0;
         unsafe { (self.fns.get_queryiv)(TIME_ELAPSED, CURRENT_QUERY, &mut current) };
-        if dev.drain_errors() != glow::NO_ERROR || current == 0 {
-            self.refused(error, "glBeginQueryEXT");
-        }
+        (dev.drain_errors() == glow::NO_ERROR).then_some(current != 0)
     }
 
     /// Ends, unread, a query left running by a frame that panicked between `begin` and `end`
@@ -170,6 +189,10 @@ impl GpuTimer {
                 waiting[slot] = (serial, slot);
             }
         }
+        if waiting.iter().all(|(serial, _)| *serial == u64::MAX) {
+            // Nothing to read, and no call since the last check: no round trip.
+            return None;
+        }
         waiting.sort_unstable();
         for &(serial, slot) in waiting.iter().filter(|(serial, _)| *serial != u64::MAX) {
             if self.result(slot, QUERY_RESULT_AVAILABLE) == 0 {
@@ -195,15 +218,14 @@ impl GpuTimer {
         value
     }
 
-    /// Reads (and so clears) the disjoint flag; when it was set, every result in flight is
-    /// unreliable and dropped, except the running query's (begun after the flag was read).
+    /// Reads (and so clears) the disjoint flag, once a frame after its query ended; when it was
+    /// set, every result in flight is unreliable and dropped (an event between two frames
+    /// drops the later one's too: a sample fewer, never a wrong one).
     fn take_disjoint(&self, dev: &Device) -> bool {
         let disjoint = unsafe { dev.gl.get_parameter_i32(GPU_DISJOINT) } != 0;
         if disjoint {
-            for (slot, flight) in self.in_flight.iter().enumerate() {
-                if self.running.get() != Some(slot) {
-                    flight.set(None);
-                }
+            for flight in &self.in_flight {
+                flight.set(None);
             }
         }
         disjoint

@@ -129,7 +129,12 @@ impl Renderer {
             fixed_point: applications && options.hdr && !self.warned_hdr_fixed_point,
             rgba8: samples > 1,
         };
-        let format = self.dev.target_format(target, queries);
+        // An offscreen render's target is the renderer's own: only an MSAA resolve into it
+        // asks what it is.
+        let format = match applications || samples > 1 {
+            true => self.dev.target_format(target, queries),
+            false => Default::default(),
+        };
         // A game's multisampled framebuffer (a window surface with EGL_SAMPLES) samples the
         // frame itself; a resolve could not blit into it.
         let destination_samples = if applications { format.samples } else { 0 };
@@ -332,7 +337,9 @@ impl Renderer {
         };
         // The frame's errors so far are its own: the timer's calls (creating the queries too)
         // would drain them as theirs.
-        self.dev.check("the frame's uploads")?;
+        if options.gpu_timer {
+            self.dev.check("the frame's uploads")?;
+        }
         if options.gpu_timer && self.timer.is_none() {
             self.timer = Some(crate::gl::timer::GpuTimer::new(&self.dev));
         }

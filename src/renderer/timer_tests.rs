@@ -148,3 +148,57 @@ fn a_waiting_frame_is_timed_when_every_query_is_in_flight() {
     assert!(ms.is_some_and(|ms| ms.is_finite() && ms >= 0.0), "{ms:?}");
     timer.destroy(dev);
 }
+
+/// A game timing its own work around many frames sees at most one GL error of the renderer's
+/// making in its debug callback: the first frame's begin finds its query (the frame goes
+/// untimed), and from then on each frame asks first. It saw one every frame (helper-150), and
+/// once its query ends the frames are timed again.
+#[test]
+fn frames_inside_the_applications_query_raise_one_error_at_most() {
+    let Some((ctx, mut renderer)) = timed_renderer() else {
+        return;
+    };
+    let gl = ctx.load_gl().unwrap();
+    if !renderer.caps().has_extension("GL_KHR_debug") {
+        eprintln!("skipped: no GL_KHR_debug here");
+        return;
+    }
+    let errors = std::sync::Arc::new(std::sync::atomic::AtomicUsize::new(0));
+    let seen = errors.clone();
+    let mut gl = gl;
+    unsafe {
+        gl.enable(glow::DEBUG_OUTPUT);
+        gl.enable(glow::DEBUG_OUTPUT_SYNCHRONOUS);
+        gl.debug_message_callback(move |_, kind, _, _, _| {
+            if kind == glow::DEBUG_TYPE_ERROR {
+                seen.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
+            }
+        });
+    }
+    let scene = crate::scene::builtin::build("plane", Some((4, 1))).unwrap();
+    let options = crate::RenderOptions {
+        wait_for_gpu: false,
+        ..Default::default()
+    };
+    let fns = crate::gl::ext_fns::timer_query_fns().unwrap();
+    let mut query = 0;
+    unsafe {
+        (fns.gen_queries)(1, &mut query);
+        (fns.begin_query)(0x88BF, query);
+        for _ in 0..5 {
+            renderer.render_offscreen(&scene, 16, 9, &options).unwrap();
+        }
+        (fns.end_query)(0x88BF);
+        (fns.delete_queries)(1, &query);
+    }
+    let inside = errors.load(std::sync::atomic::Ordering::SeqCst);
+    assert!(inside <= 1, "{inside} GL errors in 5 frames");
+    let timed = (0..8).any(|_| {
+        let (_, stats) = renderer.render_offscreen(&scene, 16, 9, &options).unwrap();
+        stats.time.gpu_ms.is_some()
+    });
+    assert!(timed, "GPU timing did not come back");
+    assert_eq!(errors.load(std::sync::atomic::Ordering::SeqCst), inside);
+    unsafe { gl.disable(glow::DEBUG_OUTPUT) };
+    renderer.destroy();
+}
