@@ -26,7 +26,7 @@ pub(crate) struct InstanceStream {
     needed: usize,
     /// Batches and still frames ([`InstanceStream::note_still_frame`]) in a row whose
     /// instances filled a quarter of the store at most.
-    small_batches: u32,
+    small_batches: super::shrink::SmallFrames,
     destroyed: bool,
 }
 
@@ -49,7 +49,7 @@ impl InstanceStream {
             capacity,
             store: FIRST_STORE.min(capacity),
             needed: 0,
-            small_batches: 0,
+            small_batches: Default::default(),
             destroyed: false,
         };
         unsafe {
@@ -98,10 +98,10 @@ impl InstanceStream {
             .next_power_of_two()
             .max(FIRST_STORE)
             .min(self.capacity);
-        if count > self.store || self.note_frame() {
+        if count > self.store || self.small_batches.note(self.needed, self.store) {
             // The orphaning below allocates the store anew at its size either way.
             self.store = self.needed;
-            self.small_batches = 0;
+            self.small_batches.reset();
         }
         unsafe {
             dev.gl
@@ -125,16 +125,7 @@ impl InstanceStream {
     /// [`SHRINK_AFTER`](super::texture::SHRINK_AFTER) frames, when drawing them again with
     /// [`InstanceStream::draw`] allocates the store at their size.
     pub(crate) fn note_still_frame(&mut self) -> bool {
-        self.note_frame()
-    }
-
-    /// Counts a frame whose instances need `needed`: whether it is time to shrink.
-    fn note_frame(&mut self) -> bool {
-        self.small_batches = match self.needed.saturating_mul(4) <= self.store {
-            true => self.small_batches.saturating_add(1),
-            false => 0,
-        };
-        self.small_batches >= super::texture::SHRINK_AFTER
+        self.small_batches.note(self.needed, self.store)
     }
 
     /// Leaves its locations as every other draw expects them: no array, divisor 0.

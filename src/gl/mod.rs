@@ -35,6 +35,7 @@ pub mod osmesa;
 pub mod precision_probe;
 pub mod program;
 pub mod shader_source;
+pub(crate) mod shrink;
 pub mod state;
 pub(crate) mod target_size;
 pub mod texture;

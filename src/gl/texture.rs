@@ -61,14 +61,11 @@ pub struct DataTexture {
     rows_needed: u32,
     /// Frames in a row whose records filled at most a quarter of its rows, uploaded or drawn
     /// again (see [`SHRINK_AFTER`] and [`DataTexture::note_still_frame`]).
-    small_frames: u32,
+    small_frames: super::shrink::SmallFrames,
     destroyed: bool,
 }
 
-/// Frames in a row whose records fill at most a quarter of a data texture's rows after which it
-/// is allocated again at their size: a burst of lights (an explosion's sparks for a few frames)
-/// does not hold its memory for good, and a count that hovers does not reallocate often.
-pub const SHRINK_AFTER: u32 = 60;
+pub use super::shrink::SHRINK_AFTER;
 
 /// NEAREST filtering and CLAMP_TO_EDGE on the bound 2D texture: what data textures and render
 /// targets read texel by texel need.
@@ -147,7 +144,7 @@ impl DataTexture {
             format,
             size: (0, 0),
             rows_needed: 0,
-            small_frames: 0,
+            small_frames: Default::default(),
             destroyed: false,
         })
     }
@@ -185,14 +182,14 @@ impl DataTexture {
         let rest = bytes.len() - full_rows * row;
         let needed = height.next_power_of_two();
         self.rows_needed = needed;
-        let shrink = self.note_frame();
+        let shrink = (self.small_frames).note(needed as usize, self.size.1 as usize);
         let allocate = self.size.0 != width || self.size.1 < height || shrink;
         unsafe {
             gl.bind_texture(glow::TEXTURE_2D, Some(self.raw));
             gl.pixel_store_i32(glow::UNPACK_ALIGNMENT, 1);
             if allocate {
                 let kept = if shrink { 0 } else { self.size.1 };
-                self.small_frames = 0;
+                self.small_frames.reset();
                 let rows = needed.max(kept).min(max);
                 gl.tex_image_2d(
                     glow::TEXTURE_2D,
@@ -245,16 +242,7 @@ impl DataTexture {
     /// uploading them again allocates it at their size. A still scene after a burst of lights
     /// uploads nothing, and kept the burst's rows for good.
     pub fn note_still_frame(&mut self) -> bool {
-        self.note_frame()
-    }
-
-    /// Counts a frame whose records need `rows_needed` rows: whether it is time to shrink.
-    fn note_frame(&mut self) -> bool {
-        self.small_frames = match self.rows_needed.saturating_mul(4) <= self.size.1 {
-            true => self.small_frames.saturating_add(1),
-            false => 0,
-        };
-        self.small_frames >= SHRINK_AFTER
+        (self.small_frames).note(self.rows_needed as usize, self.size.1 as usize)
     }
 
     /// Binds to texture unit `unit`.

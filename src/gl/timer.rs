@@ -179,31 +179,25 @@ impl GpuTimer {
         if self.failed.get() {
             return None;
         }
-        let mut newest: Option<(u64, f64)> = None;
+        // The frame the query in `slot` times, while its result is unread and it has ended.
+        let waiting =
+            |slot: usize| (self.in_flight[slot].get()).filter(|_| self.running.get() != Some(slot));
         // Oldest first, up to the first without its result: GPUs finish frames in order (and
         // a later one's result is read by a later poll), and each ask is a round trip on a
         // threaded driver.
-        let mut waiting: [(u64, usize); RING] = [(u64::MAX, 0); RING];
-        for (slot, flight) in self.in_flight.iter().enumerate() {
-            if let Some(serial) = flight.get().filter(|_| self.running.get() != Some(slot)) {
-                waiting[slot] = (serial, slot);
-            }
-        }
-        if waiting.iter().all(|(serial, _)| *serial == u64::MAX) {
-            // Nothing to read, and no call since the last check: no round trip.
-            return None;
-        }
-        waiting.sort_unstable();
-        for &(serial, slot) in waiting.iter().filter(|(serial, _)| *serial != u64::MAX) {
+        let mut slots: [usize; RING] = std::array::from_fn(|slot| slot);
+        slots.sort_by_key(|&slot| waiting(slot).unwrap_or(u64::MAX));
+        // Nothing to read, and no call since the last check: no round trip.
+        waiting(slots[0])?;
+        let mut newest: Option<(u64, f64)> = None;
+        for slot in slots {
+            let Some(serial) = waiting(slot) else { break };
             if self.result(slot, QUERY_RESULT_AVAILABLE) == 0 {
                 break;
             }
-            let flight = &self.in_flight[slot];
-            flight.set(None);
+            self.in_flight[slot].set(None);
             let ms = self.result(slot, QUERY_RESULT) as f64 * 1e-6;
-            if newest.is_none_or(|(s, _)| serial > s) {
-                newest = Some((serial, ms));
-            }
+            newest = Some((serial, ms));
         }
         if !self.check(dev, "the timer query's result") || self.take_disjoint(dev) {
             return None;
