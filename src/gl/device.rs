@@ -28,6 +28,8 @@ pub struct Device {
     host: super::host_state::HostFeatures,
     /// Nesting depth of [`Device::enter_host`] (the outermost call saves the state).
     host_depth: std::cell::Cell<u32>,
+    /// Calls take turns with other threads' ([`super::driver_turns`]: llvmpipe).
+    takes_turns: bool,
     /// The framebuffer the application had bound when the outermost call started.
     host_framebuffer: std::cell::Cell<Option<glow::Framebuffer>>,
     /// The driver refused a query of a frame's target once: each is drained on its own from
@@ -188,6 +190,7 @@ impl Device {
         let units = unsafe { gl.get_parameter_i32(glow::MAX_COMBINED_TEXTURE_IMAGE_UNITS) };
         let host =
             super::host_state::HostFeatures::of(&gl, &caps, own_vertex_array.is_some(), units);
+        let takes_turns = super::driver_turns::needed_by(&caps.renderer);
         Ok(Device {
             gl,
             caps,
@@ -197,6 +200,7 @@ impl Device {
             host,
             own_vertex_array,
             host_depth: std::cell::Cell::new(0),
+            takes_turns,
             host_framebuffer: std::cell::Cell::new(None),
             target_queries_refused: std::cell::Cell::new(false),
             call: CallState::default(),
@@ -235,12 +239,16 @@ impl Device {
 
     /// Starts a call of the renderer: clears GL errors the application left pending (they are
     /// not the renderer's), saves the application's GL state and sets what the renderer
-    /// assumes ([`super::host_state`]); `None` inside a call already started. Pair it with
+    /// assumes ([`super::host_state`]), after waiting for its turn where calls on several
+    /// threads take turns ([`super::driver_turns`]); `None` inside a call already started. Pair it with
     /// [`Device::leave_host`] in a way a panic cannot skip ([`Device::host_call`]).
     pub(crate) fn enter_host(&self) -> Option<super::host_state::HostState> {
         let depth = self.host_depth.get();
         self.host_depth.set(depth + 1);
         (depth == 0).then(|| {
+            if self.takes_turns {
+                super::driver_turns::take();
+            }
             // The application may have bound any program, or set any attribute value, since
             // the last call; entering binds the renderer's own vertex array.
             self.call.forget(self.own_vertex_array.map(|(vao, _)| vao));
@@ -266,6 +274,9 @@ impl Device {
         if let Some(saved) = saved {
             saved.leave(&self.gl, self.own_vertex_array);
             self.call.forget(None);
+            if self.takes_turns {
+                super::driver_turns::give_back();
+            }
         }
     }
 

@@ -19,6 +19,7 @@ pub(crate) mod call_state;
 pub mod caps;
 pub mod context;
 pub mod device;
+pub(crate) mod driver_turns;
 pub mod ext_fns;
 pub mod framebuffer;
 pub mod gbuffer;

@@ -6,6 +6,7 @@ use glow::HasContext;
 
 use crate::gl::context::context_or_skip;
 use crate::gl::EsVersion;
+use crate::gl::HeadlessContext;
 use crate::Renderer;
 
 fn viewport(gl: &glow::Context) -> [i32; 4] {
@@ -57,4 +58,52 @@ fn a_panicking_call_gives_the_state_back_and_the_next_calls_still_do() {
     assert_eq!(viewport(&game), [1, 2, 3, 4]);
     renderer.hosted(|_| Ok(())).unwrap();
     renderer.destroy();
+}
+
+/// On llvmpipe, a call of a renderer on another thread waits until this thread's call has
+/// ended (`gl::driver_turns`): two contexts at work at once crashed Mesa 22.3's llvmpipe.
+#[test]
+fn on_llvmpipe_calls_of_renderers_on_two_threads_take_turns() {
+    use std::sync::atomic::{AtomicBool, Ordering};
+    use std::sync::{mpsc, Arc};
+    let Some(ctx) = context_or_skip(EsVersion::Es3) else {
+        return;
+    };
+    let mut second = Renderer::new(ctx.load_gl().unwrap(), EsVersion::Es3).unwrap();
+    // ANGLE's contexts live on one thread at a time: a second thread's would wait for these.
+    if !crate::gl::driver_turns::needed_by(&second.caps().renderer)
+        || ctx.info().one_thread_at_a_time
+    {
+        eprintln!("skipped: not llvmpipe ({})", second.caps().renderer);
+        second.destroy();
+        return;
+    }
+    let (entered, wait_entered) = mpsc::channel();
+    let ended = Arc::new(AtomicBool::new(false));
+    let first = {
+        let ended = ended.clone();
+        std::thread::spawn(move || {
+            let ctx = HeadlessContext::new(EsVersion::Es3).unwrap();
+            let mut first = Renderer::new(ctx.load_gl().unwrap(), EsVersion::Es3).unwrap();
+            first
+                .hosted(|_| {
+                    entered.send(()).unwrap();
+                    // Time for the other thread's call to start wrongly meanwhile.
+                    std::thread::sleep(std::time::Duration::from_millis(100));
+                    ended.store(true, Ordering::SeqCst);
+                    Ok(())
+                })
+                .unwrap();
+            first.destroy();
+        })
+    };
+    wait_entered.recv().unwrap();
+    ctx.make_current().unwrap();
+    let waited = second.hosted(|_| Ok(ended.load(Ordering::SeqCst))).unwrap();
+    first.join().unwrap();
+    second.destroy();
+    assert!(
+        waited,
+        "a call started while another thread's was under way"
+    );
 }

@@ -1,0 +1,94 @@
+//! Renderer calls on different threads take turns where the driver crashes when two contexts
+//! work at once: on Mesa 22.3's llvmpipe, one context's `glClear` freed memory another
+//! context's flush then read (a segfault in about one run in 30 of two tests drawing
+//! thousands of lights with deferred at once; docs/drivers.md).
+
+use std::sync::{Condvar, Mutex, MutexGuard};
+use std::thread::ThreadId;
+
+/// Whether calls on contexts of the driver `renderer` (`GL_RENDERER`) take turns.
+pub(crate) fn needed_by(renderer: &str) -> bool {
+    renderer.contains("llvmpipe")
+}
+
+/// The thread whose calls hold the turn, and how many of them: nested calls, or calls of
+/// several renderers on one thread, hold it once.
+struct Holder {
+    thread: Option<ThreadId>,
+    calls: u32,
+}
+
+static HOLDER: Mutex<Holder> = Mutex::new(Holder {
+    thread: None,
+    calls: 0,
+});
+
+/// Signalled when a thread gives the turn back.
+static GIVEN_BACK: Condvar = Condvar::new();
+
+fn lock() -> MutexGuard<'static, Holder> {
+    HOLDER.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// Waits until no other thread holds the turn, then holds it for this thread (once more).
+/// Pair it with [`give_back`] on the same thread, in a way a panic cannot skip.
+pub(crate) fn take() {
+    let here = std::thread::current().id();
+    let mut holder = lock();
+    while holder.thread.is_some_and(|t| t != here) {
+        holder = GIVEN_BACK.wait(holder).unwrap_or_else(|e| e.into_inner());
+    }
+    holder.thread = Some(here);
+    holder.calls += 1;
+}
+
+/// Gives back a turn [`take`] held for this thread; the last one lets other threads in.
+pub(crate) fn give_back() {
+    let mut holder = lock();
+    debug_assert_eq!(holder.thread, Some(std::thread::current().id()));
+    holder.calls = holder.calls.saturating_sub(1);
+    if holder.calls == 0 {
+        holder.thread = None;
+        GIVEN_BACK.notify_all();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::sync::atomic::{AtomicBool, Ordering};
+    use std::sync::{mpsc, Arc};
+    use std::time::Duration;
+
+    #[test]
+    fn only_llvmpipe_takes_turns() {
+        assert!(super::needed_by("llvmpipe (LLVM 15.0.6, 256 bits)"));
+        assert!(!super::needed_by("softpipe"));
+        assert!(!super::needed_by("Google SwiftShader"));
+    }
+
+    /// A second thread's turn waits for the first thread's last nested call to give its back.
+    #[test]
+    fn another_thread_waits_for_the_turn_and_this_one_nests() {
+        let (entered, wait_entered) = mpsc::channel();
+        let given = Arc::new(AtomicBool::new(false));
+        let first = {
+            let given = given.clone();
+            std::thread::spawn(move || {
+                super::take();
+                super::take();
+                entered.send(()).unwrap();
+                super::give_back();
+                // The other thread is waiting, or about to: give it time to go wrongly.
+                std::thread::sleep(Duration::from_millis(100));
+                given.store(true, Ordering::SeqCst);
+                super::give_back();
+            })
+        };
+        wait_entered.recv().unwrap();
+        super::take();
+        let after = given.load(Ordering::SeqCst);
+        super::give_back();
+        first.join().unwrap();
+        assert!(after, "the turn was taken while another thread held it");
+    }
+}
