@@ -74,7 +74,8 @@ fn on_llvmpipe_calls_of_renderers_on_two_threads_take_turns() {
     if !crate::gl::driver_turns::needed_by(&second.caps().renderer)
         || ctx.info().one_thread_at_a_time
     {
-        eprintln!("skipped: not llvmpipe ({})", second.caps().renderer);
+        let renderer = &second.caps().renderer;
+        eprintln!("skipped: not llvmpipe, or ANGLE's one thread at a time ({renderer})");
         second.destroy();
         return;
     }
