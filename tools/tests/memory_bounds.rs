@@ -808,6 +808,8 @@ fn a_failed_upload_or_allocation_keeps_nothing_it_made() {
         (EsVersion::Es3, "clustered", "offscreen target creation"),
         (EsVersion::Es3, "deferred", "G-buffer"),
         (EsVersion::Es3, "deferred", "instance buffer"),
+        (EsVersion::Es3, "clustered", "data texture upload"),
+        (EsVersion::Es2, "forward", "data texture upload"),
         (EsVersion::Es2, "forward", "mesh upload"),
         (EsVersion::Es2, "clustered", "image texture"),
     ] {

@@ -126,11 +126,22 @@ impl Uploads {
         let slot = next_slot(&mut self.frame);
         let set = set_at(&mut self.ring, slot, dev, encoding)?;
         let (lights, grid, indices) = (&self.lights, &self.grid, &self.indices);
-        set.lights
-            .upload(dev, lights.width, lights.height, &lights.bytes)?;
-        set.grid.upload(dev, grid.width, grid.height, &grid.bytes)?;
-        set.indices
-            .upload(dev, indices.width, indices.height, &indices.bytes)?;
+        let uploaded = set
+            .lights
+            .upload(dev, lights.width, lights.height, &lights.bytes)
+            .and_then(|()| set.grid.upload(dev, grid.width, grid.height, &grid.bytes))
+            .and_then(|()| {
+                (set.indices).upload(dev, indices.width, indices.height, &indices.bytes)
+            });
+        if let Err(e) = uploaded {
+            // A failed frame keeps nothing it made: the next one to reach this slot makes it
+            // anew (a game that renders on through failures held a set in every slot).
+            if let Some(set) = self.ring[slot].take() {
+                set.destroy(dev);
+            }
+            return Err(e.into());
+        }
+        let set = self.ring[slot].as_ref().expect("uploaded above");
         let light_ranges = [lights.pos_range, lights.radius_range];
         self.last = Some((slot, light_ranges));
         Ok(Uploaded {
