@@ -246,9 +246,8 @@ impl Device {
         let depth = self.host_depth.get();
         self.host_depth.set(depth + 1);
         (depth == 0).then(|| {
-            if self.takes_turns {
-                super::driver_turns::take();
-            }
+            // Given back here should the state save panic, else by the matching leave_host.
+            let turn = super::driver_turns::Turn::take_if(self.takes_turns);
             // The application may have bound any program, or set any attribute value, since
             // the last call; entering binds the renderer's own vertex array.
             self.call.forget(self.own_vertex_array.map(|(vao, _)| vao));
@@ -256,6 +255,7 @@ impl Device {
             let saved =
                 super::host_state::HostState::enter(&self.gl, &self.host, self.own_vertex_array);
             self.host_framebuffer.set(saved.draw_framebuffer());
+            turn.keep();
             saved
         })
     }
@@ -272,12 +272,17 @@ impl Device {
     pub(crate) fn leave_host(&self, saved: Option<super::host_state::HostState>) {
         self.host_depth.set(self.host_depth.get().saturating_sub(1));
         if let Some(saved) = saved {
+            // Given back once the state is, or should giving it back panic.
+            let _turn = super::driver_turns::Turn::held(self.takes_turns);
             saved.leave(&self.gl, self.own_vertex_array);
             self.call.forget(None);
-            if self.takes_turns {
-                super::driver_turns::give_back();
-            }
         }
+    }
+
+    /// This thread's turn, for GL work outside a renderer call (freeing the renderer's
+    /// objects), where calls take turns ([`super::driver_turns`]); held until dropped.
+    pub(crate) fn turn(&self) -> super::driver_turns::Turn {
+        super::driver_turns::Turn::take_if(self.takes_turns)
     }
 
     /// Whether a call of the renderer is under way (what it binds is known only then).

@@ -53,6 +53,38 @@ pub(crate) fn give_back() {
     }
 }
 
+/// A turn this thread holds (or `None`: none was needed), given back when dropped, panics
+/// included, unless [`Turn::keep`] leaves it for a later [`give_back`].
+pub(crate) struct Turn(bool);
+
+impl Turn {
+    /// Takes the turn where `needed` ([`take`]).
+    pub(crate) fn take_if(needed: bool) -> Turn {
+        if needed {
+            take();
+        }
+        Turn(needed)
+    }
+
+    /// The turn [`take`] held earlier where `held`, to be given back by this guard.
+    pub(crate) fn held(held: bool) -> Turn {
+        Turn(held)
+    }
+
+    /// Keeps the turn past this guard: a later [`give_back`] or [`Turn::held`] gives it back.
+    pub(crate) fn keep(mut self) {
+        self.0 = false;
+    }
+}
+
+impl Drop for Turn {
+    fn drop(&mut self) {
+        if self.0 {
+            give_back();
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use std::sync::atomic::{AtomicBool, Ordering};
@@ -64,6 +96,31 @@ mod tests {
         assert!(super::needed_by("llvmpipe (LLVM 15.0.6, 256 bits)"));
         assert!(!super::needed_by("softpipe"));
         assert!(!super::needed_by("Google SwiftShader"));
+    }
+
+    /// A turn's guard gives it back when a panic unwinds past it: other threads do not wait
+    /// for good.
+    #[test]
+    fn a_panic_gives_the_turn_back() {
+        let caught = std::thread::spawn(|| {
+            std::panic::catch_unwind(|| {
+                let _turn = super::Turn::take_if(true);
+                panic!("a bug inside a renderer call");
+            })
+            .is_err()
+        })
+        .join()
+        .unwrap();
+        assert!(caught);
+        let (taken, wait_taken) = mpsc::channel();
+        std::thread::spawn(move || {
+            let _turn = super::Turn::take_if(true);
+            taken.send(()).unwrap();
+        });
+        assert!(
+            wait_taken.recv_timeout(Duration::from_secs(60)).is_ok(),
+            "the panicking thread kept the turn"
+        );
     }
 
     /// A second thread's turn waits for the first thread's last nested call to give its back.

@@ -245,6 +245,7 @@ impl Renderer {
     pub fn adopt_programs(&mut self, programs: ProgramCache) {
         self.dev.count_handed_programs(programs.len() as i64);
         let mut own = std::mem::replace(&mut self.programs, programs);
+        let _turn = self.dev.turn();
         own.destroy(&self.dev);
     }
 
@@ -416,6 +417,8 @@ impl Renderer {
             self.left.leave();
             return;
         }
+        // Deleting large textures while another context drew may crash llvmpipe too.
+        let _turn = self.dev.turn();
         if let Some(Some(t)) = self.timer.take() {
             t.end_running(&self.dev);
             t.destroy(&self.dev);
