@@ -240,8 +240,9 @@ impl Device {
     /// Starts a call of the renderer: clears GL errors the application left pending (they are
     /// not the renderer's), saves the application's GL state and sets what the renderer
     /// assumes ([`super::host_state`]), after waiting for its turn where calls on several
-    /// threads take turns ([`super::driver_turns`]); `None` inside a call already started. Pair it with
-    /// [`Device::leave_host`] in a way a panic cannot skip ([`Device::host_call`]).
+    /// threads take turns ([`super::driver_turns`]); `None` inside a call already started.
+    /// Pair it with [`Device::leave_host`] in a way a panic cannot skip
+    /// ([`Device::host_call`]).
     pub(crate) fn enter_host(&self) -> Option<super::host_state::HostState> {
         let depth = self.host_depth.get();
         self.host_depth.set(depth + 1);

@@ -53,7 +53,7 @@ pub(crate) fn give_back() {
     }
 }
 
-/// A turn this thread holds (or `None`: none was needed), given back when dropped, panics
+/// A turn this thread holds (none where none was needed), given back when dropped, panics
 /// included, unless [`Turn::keep`] leaves it for a later [`give_back`].
 pub(crate) struct Turn(bool);
 
