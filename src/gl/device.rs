@@ -248,7 +248,7 @@ impl Device {
         self.host_depth.set(depth + 1);
         (depth == 0).then(|| {
             // Given back here should the state save panic, else by the matching leave_host.
-            let turn = super::driver_turns::Turn::take_if(self.takes_turns);
+            let turn = self.turn();
             // The application may have bound any program, or set any attribute value, since
             // the last call; entering binds the renderer's own vertex array.
             self.call.forget(self.own_vertex_array.map(|(vao, _)| vao));

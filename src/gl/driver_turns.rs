@@ -1,7 +1,6 @@
 //! Renderer calls on different threads take turns where the driver crashes when two contexts
 //! work at once: on Mesa 22.3's llvmpipe, one context's `glClear` freed memory another
-//! context's flush then read (a segfault in about one run in 30 of two tests drawing
-//! thousands of lights with deferred at once; docs/drivers.md).
+//! context's flush then read (docs/drivers.md, item 20). [`Turn`] takes and gives it back.
 
 use std::sync::{Condvar, Mutex, MutexGuard};
 use std::thread::ThreadId;
@@ -31,8 +30,8 @@ fn lock() -> MutexGuard<'static, Holder> {
 }
 
 /// Waits until no other thread holds the turn, then holds it for this thread (once more).
-/// Pair it with [`give_back`] on the same thread, in a way a panic cannot skip.
-pub(crate) fn take() {
+/// Pair it with [`give_back`] on the same thread, in a way a panic cannot skip ([`Turn`]).
+fn take() {
     let here = std::thread::current().id();
     let mut holder = lock();
     while holder.thread.is_some_and(|t| t != here) {
@@ -43,7 +42,7 @@ pub(crate) fn take() {
 }
 
 /// Gives back a turn [`take`] held for this thread; the last one lets other threads in.
-pub(crate) fn give_back() {
+fn give_back() {
     let mut holder = lock();
     debug_assert_eq!(holder.thread, Some(std::thread::current().id()));
     holder.calls = holder.calls.saturating_sub(1);
