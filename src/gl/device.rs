@@ -155,6 +155,10 @@ impl Device {
         if unsafe { gl.get_parameter_i32(glow::MAX_TEXTURE_SIZE) } <= 0 {
             return Err(GlError::NotCurrent);
         }
+        // The probe makes and deletes GL objects, so it takes the turn too (driver_turns).
+        let renderer = unsafe { gl.get_parameter_string(glow::RENDERER) };
+        let takes_turns = super::driver_turns::needed_by(&renderer);
+        let _turn = super::driver_turns::Turn::take_if(takes_turns);
         let mut caps = Caps::probe(&gl, es)?;
         caps.restrict(restrictions)?;
         // A core profile draws nothing without a bound vertex array object; on an ES 3.x
@@ -190,7 +194,6 @@ impl Device {
         let units = unsafe { gl.get_parameter_i32(glow::MAX_COMBINED_TEXTURE_IMAGE_UNITS) };
         let host =
             super::host_state::HostFeatures::of(&gl, &caps, own_vertex_array.is_some(), units);
-        let takes_turns = super::driver_turns::needed_by(&caps.renderer);
         Ok(Device {
             gl,
             caps,
@@ -739,6 +742,44 @@ mod tests {
             .to_string()
             .contains("GL_INVALID_ENUM (0x0500) after a draw"));
         assert_eq!(error_name(glow::CONTEXT_LOST), "GL_CONTEXT_LOST");
+    }
+
+    /// On llvmpipe, a new device's capability probe (GL objects made and deleted) waits while
+    /// another thread holds the turn (`driver_turns`), as a renderer's calls do.
+    #[test]
+    fn on_llvmpipe_the_probe_waits_for_the_turn() {
+        use std::sync::atomic::{AtomicBool, Ordering};
+        use std::sync::{mpsc, Arc};
+        let Some(ctx) = crate::gl::context::context_or_skip(EsVersion::Es3) else {
+            return;
+        };
+        let renderer = Device::new(ctx.load_gl().unwrap(), EsVersion::Es3)
+            .unwrap()
+            .caps()
+            .renderer
+            .clone();
+        if !super::super::driver_turns::needed_by(&renderer) {
+            eprintln!("skipped: not llvmpipe ({renderer})");
+            return;
+        }
+        let (held, wait_held) = mpsc::channel();
+        let given = Arc::new(AtomicBool::new(false));
+        let holder = {
+            let given = given.clone();
+            std::thread::spawn(move || {
+                let turn = super::super::driver_turns::Turn::take_if(true);
+                held.send(()).unwrap();
+                // Time for the other thread's probe to start wrongly meanwhile.
+                std::thread::sleep(std::time::Duration::from_millis(100));
+                given.store(true, Ordering::SeqCst);
+                drop(turn);
+            })
+        };
+        wait_held.recv().unwrap();
+        Device::new(ctx.load_gl().unwrap(), EsVersion::Es3).unwrap();
+        let waited = given.load(Ordering::SeqCst);
+        holder.join().unwrap();
+        assert!(waited, "the probe ran while another thread held the turn");
     }
 
     /// A driver may say GL_CONTEXT_LOST once, and then nothing: once said, at a call's start
