@@ -852,6 +852,77 @@ fn a_failed_upload_or_allocation_keeps_nothing_it_made() {
     }
 }
 
+/// A still scene after a burst of lights: the frame that would shrink the light data to the
+/// few lights' size uploads it again, and where that upload fails (out of memory), clustered
+/// kept the burst's texture sets: with memory back, the next frame uploaded into one of them
+/// and held 9× the light data of a renderer that never failed. Now the failure frees the
+/// ring. The grid is fixed, so that only the shrink uploads in the still frames.
+#[test]
+fn a_failed_shrink_after_a_burst_frees_the_burst_sets() {
+    use manylight::cluster::grid::GridMode;
+    use manylight::gl::texture::SHRINK_AFTER;
+    let few = scene::builtin::build("plane", Some((20, 5))).unwrap();
+    let mut many = scene::builtin::build("plane", Some((5000, 5))).unwrap();
+    let mut options = RenderOptions::default();
+    options.grid.mode = GridMode::Fixed;
+    let objects = |l: manylight::gl::device::LiveObjects| (l.buffers, l.textures);
+    let mut healthy = Gpu::new(EsVersion::Es3);
+    let mut failing = Gpu::new(EsVersion::Es3);
+    for gpu in [&mut healthy, &mut failing] {
+        gpu.r().set_method_named("clustered").unwrap();
+        gpu.render(&few, 32, 18, &options);
+        for k in 0..3 {
+            many.lights[0].position.x += 1e-3 * k as f64;
+            gpu.render(&many, 32, 18, &options);
+        }
+        // Lists uploaded again: the still frames count from here.
+        gpu.render(&few, 32, 18, &options);
+    }
+    failing
+        .r()
+        .fail_gl_checks_naming(Some("data texture upload"));
+    let mut failed_at = None;
+    for frame in 0..2 * SHRINK_AFTER {
+        match failing.r().render_offscreen(&few, 32, 18, &options) {
+            Ok(_) => {}
+            Err(e) => {
+                let message = e.to_string();
+                assert!(message.contains("GL_OUT_OF_MEMORY"), "{message}");
+                failed_at = Some(frame);
+                break;
+            }
+        }
+    }
+    let failed_at = failed_at.expect("a still frame uploaded the light data again");
+    failing.r().fail_gl_checks_naming(None);
+    for _ in 0..=failed_at {
+        healthy.render(&few, 32, 18, &options);
+    }
+    let (expected, expected_stats) = healthy
+        .r()
+        .render_offscreen(&few, 32, 18, &options)
+        .unwrap();
+    let (recovered, stats) = failing
+        .r()
+        .render_offscreen(&few, 32, 18, &options)
+        .unwrap();
+    assert!(recovered == expected, "the frame after the failure differs");
+    // The fresh set is sized to the few lights; the healthy renderer's kept what a quarter
+    // or more of it holds.
+    assert!(
+        stats.memory.method_gpu_bytes <= expected_stats.memory.method_gpu_bytes,
+        "clustered's light data after the failed shrink (at still frame {failed_at}): {} bytes, \
+         {} without the failure",
+        stats.memory.method_gpu_bytes,
+        expected_stats.memory.method_gpu_bytes
+    );
+    assert_eq!(
+        objects(failing.r().live_gl_objects()),
+        objects(healthy.r().live_gl_objects()),
+        "GL objects (buffers, textures) after the failed shrink"
+    );
+}
+
 /// [`render_within_384_mib`]'s exit code and standard error, or `None` (said) where this
 /// machine has no `prlimit`.
 fn rendered_within_384_mib(scene: &Path, dir: &Path) -> Option<(Option<i32>, String)> {

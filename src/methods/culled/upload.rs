@@ -168,7 +168,8 @@ impl Uploads {
     /// frame: a texture its records have filled a quarter of at most for [`SHRINK_AFTER`]
     /// frames gets them again at their size, and at [`SHRINK_AFTER`] frames on one upload the
     /// ring's other sets, which a still frame does not read, are freed. A still scene after a
-    /// burst of lights uploads nothing, and kept the burst's textures for good.
+    /// burst of lights uploads nothing, and kept the burst's textures for good. Where that
+    /// upload fails, the whole ring is freed.
     pub(super) fn still_frame(&mut self, dev: &Device) -> Result<Option<Uploaded<'_>>, Error> {
         let started = Instant::now();
         let Some((slot, light_ranges)) = self.last else {
@@ -181,6 +182,7 @@ impl Uploads {
         self.last = None;
         let (lights, grid, indices) = (&self.lights, &self.grid, &self.indices);
         let mut bytes = 0;
+        let mut failed = None;
         for (texture, (width, height, records)) in [
             (
                 &mut set.lights,
@@ -193,9 +195,18 @@ impl Uploads {
             ),
         ] {
             if texture.note_still_frame() {
-                texture.upload(dev, width, height, records)?;
+                if let Err(e) = texture.upload(dev, width, height, records) {
+                    failed = Some(e);
+                    break;
+                }
                 bytes += records.len();
             }
+        }
+        if let Some(e) = failed {
+            // The driver is out of memory: the ring's sets (the burst's size) go, and the
+            // next frame uploads its lists into a set made at their size.
+            self.destroy(dev);
+            return Err(e.into());
         }
         self.last = Some((slot, light_ranges));
         self.frames_on_last = self.frames_on_last.saturating_add(1);
