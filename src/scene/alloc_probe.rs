@@ -6,6 +6,13 @@
 /// Under an address-space limit, or a kernel that refuses what it could never back, work that
 /// could not finish is refused before it starts.
 pub(crate) fn can_allocate(bytes: u64) -> bool {
+    #[cfg(test)]
+    if ALLOCATABLE
+        .with(std::cell::Cell::get)
+        .is_some_and(|most| bytes > most)
+    {
+        return false;
+    }
     let Ok(bytes) = usize::try_from(bytes) else {
         return false;
     };
@@ -14,6 +21,22 @@ pub(crate) fn can_allocate(bytes: u64) -> bool {
     // Kept opaque: the optimiser may otherwise drop an allocation nothing reads.
     std::hint::black_box(&mut probe);
     granted
+}
+
+#[cfg(test)]
+thread_local! {
+    /// Most bytes [`can_allocate`] grants on this thread ([`with_allocatable`]).
+    static ALLOCATABLE: std::cell::Cell<Option<u64>> = const { std::cell::Cell::new(None) };
+}
+
+/// Runs `f` as if at most `bytes` could be allocated (tests of what a memory limit refuses,
+/// without a child process under one).
+#[cfg(test)]
+pub(crate) fn with_allocatable<T>(bytes: u64, f: impl FnOnce() -> T) -> T {
+    let before = ALLOCATABLE.with(|a| a.replace(Some(bytes)));
+    let result = f();
+    ALLOCATABLE.with(|a| a.set(before));
+    result
 }
 
 /// Refuses work needing `bytes` that this process cannot allocate now. `what` says what

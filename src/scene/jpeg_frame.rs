@@ -1,7 +1,9 @@
-//! What a progressive JPEG's segment headers say, read before it is decoded: its frame (the
-//! coefficients it holds) and its scans (each one walks every block of its components).
+//! What a JPEG's segment headers say, read before it is decoded, where the decoder holds
+//! every coefficient besides the pixels: its frame and its scans (each one walks every block
+//! of its components).
 
-/// A progressive JPEG's first start-of-frame segment and the scans that follow it.
+/// The first start-of-frame segment of a JPEG whose decoder holds its coefficients, and the
+/// scans that follow it.
 #[derive(Debug, PartialEq)]
 pub(crate) struct JpegFrame {
     pub width: u32,
@@ -9,6 +11,9 @@ pub(crate) struct JpegFrame {
     pub components: u8,
     /// Start-of-scan segments after the frame.
     pub scans: u32,
+    /// Progressive (SOF2, SOF6, SOF10, SOF14); else a sequential frame whose first scan holds
+    /// some of its components only.
+    pub progressive: bool,
 }
 
 impl JpegFrame {
@@ -18,13 +23,21 @@ impl JpegFrame {
         let samples = u64::from(self.width) * u64::from(self.height) * u64::from(self.components);
         samples.saturating_mul(u64::from(self.scans))
     }
+
+    /// Bytes of the coefficients the decoder holds: two a component and pixel (the blocks'
+    /// padding past the edges left out, within 0.6 % from 4 096 pixels a side).
+    pub fn coefficient_bytes(&self) -> u64 {
+        2 * u64::from(self.components) * u64::from(self.width) * u64::from(self.height)
+    }
 }
 
-/// The frame of progressive JPEG `bytes` (SOF2, SOF6, SOF10, SOF14) with the scans after it;
+/// The frame of a JPEG whose decoder holds all its coefficients before it makes pixels, with
+/// the scans after it: a progressive one, or a sequential one whose first scan holds fewer
+/// components than the frame (zune-jpeg then keeps every component's coefficients);
 /// `None` for any other JPEG. Reads the segment headers only, within the bytes, skipping what
 /// the decoder skips between segments (stray bytes, `FF 00`, fill, restart markers), so
 /// entropy-coded data hides no marker from it.
-pub(crate) fn progressive_jpeg_frame(bytes: &[u8]) -> Option<JpegFrame> {
+pub(crate) fn coefficient_jpeg_frame(bytes: &[u8]) -> Option<JpegFrame> {
     let mut frame: Option<JpegFrame> = None;
     let mut at = 2; // past SOI
     while at + 2 <= bytes.len() {
@@ -47,7 +60,7 @@ pub(crate) fn progressive_jpeg_frame(bytes: &[u8]) -> Option<JpegFrame> {
                 };
                 let length = usize::from(u16::from_be_bytes([length[0], length[1]]));
                 match (marker, &mut frame) {
-                    (0xC2 | 0xC6 | 0xCA | 0xCE, None) => {
+                    (0xC0..=0xC3 | 0xC5..=0xC7 | 0xC9..=0xCB | 0xCD..=0xCF, None) => {
                         // Length (2), precision (1), height (2), width (2), components (1).
                         let header = bytes.get(at + 5..at + 10)?;
                         frame = Some(JpegFrame {
@@ -55,19 +68,26 @@ pub(crate) fn progressive_jpeg_frame(bytes: &[u8]) -> Option<JpegFrame> {
                             width: u16::from_be_bytes([header[2], header[3]]).into(),
                             components: header[4],
                             scans: 0,
+                            progressive: matches!(marker, 0xC2 | 0xC6 | 0xCA | 0xCE),
                         });
                     }
-                    (0xC0 | 0xC1 | 0xC3 | 0xC5 | 0xC7 | 0xC9 | 0xCB | 0xCD | 0xCF, None) => {
-                        return None
+                    (0xDA, Some(f)) => {
+                        f.scans = f.scans.saturating_add(1);
+                        // A sequential frame whose first scan holds all its components makes
+                        // pixels as it goes.
+                        let in_scan = *bytes.get(at + 4)?;
+                        if f.scans == 1 && !f.progressive && in_scan >= f.components {
+                            return None;
+                        }
                     }
-                    (0xDA, Some(f)) => f.scans = f.scans.saturating_add(1),
                     _ => {}
                 }
                 at += 2 + length;
             }
         }
     }
-    frame
+    // A sequential frame with no scan was not seen to hold anything.
+    frame.filter(|f| f.progressive || f.scans > 0)
 }
 
 #[cfg(test)]
@@ -93,18 +113,52 @@ mod tests {
         // Plain bytes, stuffed zeros, restart markers and fill inside a scan's data.
         let data = [0x12, 0xFF, 0x00, 0x34, 0xFF, 0xD3, 0xFF, 0xFF, 0x00, 0x56];
         for scans in [0, 1, 10, 100] {
-            let f = progressive_jpeg_frame(&progressive(64, 32, scans, &data)).unwrap();
+            let f = coefficient_jpeg_frame(&progressive(64, 32, scans, &data)).unwrap();
             assert_eq!((f.width, f.height, f.components), (64, 32, 1));
             assert_eq!(f.scans, scans as u32);
             assert_eq!(f.scan_work(), 64 * 32 * scans as u64);
         }
-        // A baseline frame is not read further.
+        // A baseline frame whose first scan holds its one component is not read further.
         let mut baseline = progressive(64, 32, 3, &data);
         baseline[3] = 0xC0;
-        assert_eq!(progressive_jpeg_frame(&baseline), None);
+        assert_eq!(coefficient_jpeg_frame(&baseline), None);
         // A file cut inside a segment's length ends the count there.
         let whole = progressive(64, 32, 2, &data);
         let cut = &whole[..whole.len() - data.len() - 2 - 10 + 3];
-        assert_eq!(progressive_jpeg_frame(cut).unwrap().scans, 1);
+        assert_eq!(coefficient_jpeg_frame(cut).unwrap().scans, 1);
+    }
+
+    /// A baseline frame of three components whose first scan holds `first` of them.
+    fn baseline_in_scans(w: u16, h: u16, first: u8) -> Vec<u8> {
+        let mut b = vec![0xFF, 0xD8, 0xFF, 0xC0, 0, 17, 8];
+        b.extend(h.to_be_bytes());
+        b.extend(w.to_be_bytes());
+        b.push(3);
+        for id in 1..=3 {
+            b.extend([id, 0x11, 0]);
+        }
+        b.extend([0xFF, 0xDA, 0, 6 + 2 * first, first]);
+        for id in 1..=first {
+            b.extend([id, 0]);
+        }
+        b.extend([0, 63, 0, 0x12, 0x34, 0xFF, 0xD9]);
+        b
+    }
+
+    /// zune-jpeg holds every component's coefficients (two bytes a sample) for a baseline
+    /// JPEG whose first scan leaves components to later ones: a 382-byte 12 000² one
+    /// aborted a load under a memory limit that the check of its pixels had passed.
+    #[test]
+    fn a_baseline_frame_in_separate_scans_holds_its_coefficients() {
+        let f = coefficient_jpeg_frame(&baseline_in_scans(12_000, 12_000, 1)).unwrap();
+        assert_eq!(
+            (f.width, f.height, f.components, f.scans),
+            (12_000, 12_000, 3, 1)
+        );
+        assert!(!f.progressive);
+        assert_eq!(f.coefficient_bytes(), 2 * 3 * 12_000 * 12_000);
+        assert_eq!(coefficient_jpeg_frame(&baseline_in_scans(64, 64, 3)), None);
+        let two = coefficient_jpeg_frame(&baseline_in_scans(33, 1, 2)).unwrap();
+        assert_eq!((two.scans, two.coefficient_bytes()), (1, 2 * 3 * 33));
     }
 }

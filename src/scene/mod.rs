@@ -21,6 +21,7 @@ pub mod features;
 #[cfg(feature = "scene-files")]
 pub mod file;
 pub mod framing;
+mod gif_frame;
 #[cfg(feature = "gltf")]
 pub mod gltf;
 pub mod input;

@@ -6,7 +6,8 @@
 
 use image::{DynamicImage, ImageDecoder};
 
-use super::jpeg_frame::{progressive_jpeg_frame, JpegFrame};
+use super::gif_frame::first_gif_frame;
+use super::jpeg_frame::{coefficient_jpeg_frame, JpegFrame};
 
 /// Largest side of a texture as the scene keeps it: 4096² RGBA8 is 64 MiB (85 with the GPU's
 /// mipmaps), the largest `GL_MAX_TEXTURE_SIZE` many phones have, and more texels than a 4K
@@ -87,15 +88,24 @@ pub(crate) fn decode_texture_bytes(
         Ok::<_, String>(reader)
     };
     let first = reader()?;
-    if first.format() == Some(image::ImageFormat::Jpeg) {
-        if let Some(frame) = progressive_jpeg_frame(bytes) {
+    let format = first.format();
+    // Bytes the decoder holds besides the image it gives: a JPEG's coefficients.
+    let mut held = 0;
+    if format == Some(image::ImageFormat::Jpeg) {
+        if let Some(frame) = coefficient_jpeg_frame(bytes) {
             let (w, h) = (frame.width, frame.height);
-            let bytes_per_pixel = 2 * u64::from(frame.components) + JPEG_OUTPUT_BYTES_PER_PIXEL;
-            if u64::from(w) * u64::from(h) * bytes_per_pixel > MAX_PROGRESSIVE_DECODE_BYTES {
+            held = frame.coefficient_bytes();
+            let output = u64::from(w) * u64::from(h) * JPEG_OUTPUT_BYTES_PER_PIXEL;
+            if held + output > MAX_COEFFICIENT_DECODE_BYTES {
+                let kind = if frame.progressive {
+                    "a progressive JPEG"
+                } else {
+                    "a JPEG in separate scans"
+                };
                 return Err(format!(
-                    "could not be decoded (a progressive JPEG of {w}×{h} holds its \
-                     coefficients besides its pixels to decode, past {} MiB)",
-                    MAX_PROGRESSIVE_DECODE_BYTES >> 20
+                    "could not be decoded ({kind} of {w}×{h} holds its coefficients besides \
+                     its pixels to decode, past {} MiB)",
+                    MAX_COEFFICIENT_DECODE_BYTES >> 20
                 ));
             }
             budget.take_scans(&frame)?;
@@ -104,12 +114,26 @@ pub(crate) fn decode_texture_bytes(
     let decoder = first.into_decoder().map_err(undecodable)?;
     let (w, h) = decoder.dimensions();
     let bytes_per_pixel = decoder.color_type().bytes_per_pixel();
-    let decoded = u64::from(w) * u64::from(h) * u64::from(bytes_per_pixel);
     drop(decoder);
     // Some decoders (GIF) give an image of no rows or columns rather than an error.
     if w == 0 || h == 0 {
         return Err(format!("could not be decoded (it has no pixels: {w}×{h})"));
     }
+    // A GIF's first frame may be larger than its screen, which is all `dimensions` says: the
+    // decoder holds the whole frame, and decodes every pixel of it.
+    let frame = first_gif_frame(bytes).filter(|_| format == Some(image::ImageFormat::Gif));
+    if let Some(f) = frame {
+        if f.width.max(f.height) > MAX_DECODED_SIDE {
+            return Err(format!(
+                "could not be decoded (its first frame is {}×{}, past the decoder's limit of \
+                 {MAX_DECODED_SIDE} pixels a side)",
+                f.width, f.height
+            ));
+        }
+        held = f.extra_bytes((w, h));
+    }
+    let pixels = u64::from(w) * u64::from(h) * u64::from(bytes_per_pixel);
+    let decoded = pixels + held;
     // A failed decode keeps its share taken: decoding is the work the budget bounds (60
     // images of 16 384² that failed at their last row took 16 s, none of it counted). One
     // refused by the decoder's limits decoded nothing, and gives it back.
@@ -117,17 +141,23 @@ pub(crate) fn decode_texture_bytes(
     let taken = budget
         .take(w, h)
         .inspect_err(|_| budget.give_back_decoding(decoded))?;
-    // `image` aborts the process where an allocation fails: the decode, a decoder's own
-    // canvas (GIF's), the scaled copy and the RGBA one are asked for first.
+    // `image` aborts the process where an allocation fails: the decode, what the decoder
+    // holds besides it (a GIF's frame, a JPEG's coefficients), the scaled copy and the RGBA
+    // one are asked for first.
     let (sw, sh) = stored_size(w, h);
     let kept = u64::from(sw) * u64::from(sh) * (u64::from(bytes_per_pixel) + 4);
-    let needed = 2 * decoded + kept;
+    let needed = 2 * pixels + held + kept;
     if !super::alloc_probe::can_allocate(needed) {
         budget.give_back(taken);
         budget.give_back_decoding(decoded);
+        let besides = if held > 0 {
+            " and what the decoder holds besides them"
+        } else {
+            ""
+        };
         return Err(format!(
-            "could not be decoded ({w}×{h} pixels need {} MiB to decode, which cannot be \
-             allocated here)",
+            "could not be decoded ({w}×{h} pixels{besides} need {} MiB to decode, which \
+             cannot be allocated here)",
             needed >> 20
         ));
     }
@@ -155,11 +185,11 @@ pub(crate) fn pixel_bytes_decoded() -> u64 {
 /// Bytes a JPEG decode's output holds a pixel at most (RGBA).
 const JPEG_OUTPUT_BYTES_PER_PIXEL: u64 = 4;
 
-/// Most bytes a progressive JPEG's decode may hold, its coefficients (two bytes a component
-/// and pixel) and its output together: 1 GiB, about 10 400² pixels of three components (a
-/// 16 384 × 10 922 one within [`MAX_DECODE_BYTES`] of output took 1.06 GB). A baseline JPEG
-/// decodes row by row.
-const MAX_PROGRESSIVE_DECODE_BYTES: u64 = 2 * MAX_DECODE_BYTES;
+/// Most bytes the decode of a JPEG that holds its coefficients (two bytes a component and
+/// pixel: a progressive one, or one in separate scans) may hold with its output: 1 GiB, about
+/// 10 400² pixels of three components (a progressive 16 384 × 10 922 one within
+/// [`MAX_DECODE_BYTES`] of output took 1.06 GB). Other JPEGs decode row by row.
+const MAX_COEFFICIENT_DECODE_BYTES: u64 = 2 * MAX_DECODE_BYTES;
 
 /// The crate's feature that decodes `format`, where the build has no decoder for it (asked of
 /// `image`, whose decoders another crate of the build may have turned on).
@@ -368,9 +398,10 @@ mod tests {
             height,
             components: 3,
             scans: 0,
+            progressive: true,
         };
         assert_eq!(
-            progressive_jpeg_frame(&progressive),
+            coefficient_jpeg_frame(&progressive),
             Some(frame(16_384, 10_922))
         );
         // Stray bytes and a stuffed zero before the frame, which the decoder skips, hide it
@@ -379,7 +410,7 @@ mod tests {
             let mut hidden = progressive[..2].to_vec();
             hidden.extend(junk);
             hidden.extend(&progressive[2..]);
-            assert_eq!(progressive_jpeg_frame(&hidden), Some(frame(16_384, 10_922)));
+            assert_eq!(coefficient_jpeg_frame(&hidden), Some(frame(16_384, 10_922)));
             let err = decode_texture_bytes(&hidden, jpeg, &mut budget).unwrap_err();
             assert!(err.contains("progressive JPEG"), "{junk:?}: {err}");
         }
@@ -392,14 +423,115 @@ mod tests {
         );
         // Small ones, and baseline ones of any size, go to the decoder.
         assert_eq!(
-            progressive_jpeg_frame(&jpeg_header(0xC0, 16_384, 10_922)),
+            coefficient_jpeg_frame(&jpeg_header(0xC0, 16_384, 10_922)),
             None
         );
         let small = jpeg_header(0xC2, 64, 64);
         let err = decode_texture_bytes(&small, jpeg, &mut budget).unwrap_err();
         assert!(!err.contains("progressive"), "{err}");
         let baseline = encoded(image::RgbImage::new(8, 8).into(), image::ImageFormat::Jpeg);
-        assert_eq!(progressive_jpeg_frame(&baseline), None);
+        assert_eq!(coefficient_jpeg_frame(&baseline), None);
+    }
+
+    /// A JPEG that the decoder reads up to its first scan: a quantisation table, a frame of
+    /// `w × h` (`marker`: SOF0 baseline, SOF2 progressive) in `components` components, a DC
+    /// and an AC Huffman table of one code each, and a first scan holding `first` of them.
+    fn jpeg_to_first_scan(marker: u8, w: u16, h: u16, components: u8, first: u8) -> Vec<u8> {
+        let segment = |b: &mut Vec<u8>, marker: u8, body: &[u8]| {
+            b.extend([0xFF, marker]);
+            b.extend((body.len() as u16 + 2).to_be_bytes());
+            b.extend(body);
+        };
+        let mut b = vec![0xFF, 0xD8];
+        segment(&mut b, 0xDB, &[[0].as_slice(), &[1; 64]].concat());
+        let mut frame = vec![8];
+        frame.extend(h.to_be_bytes());
+        frame.extend(w.to_be_bytes());
+        frame.push(components);
+        for id in 1..=components {
+            frame.extend([id, 0x11, 0]);
+        }
+        segment(&mut b, marker, &frame);
+        for class in [0x00, 0x10] {
+            let mut table = vec![class, 1];
+            table.extend([0; 15]);
+            table.push(0);
+            segment(&mut b, 0xC4, &table);
+        }
+        let mut scan = vec![first];
+        for id in 1..=first {
+            scan.extend([id, 0]);
+        }
+        let spectrum = if marker == 0xC2 {
+            [0, 0, 0]
+        } else {
+            [0, 63, 0]
+        };
+        scan.extend(spectrum);
+        segment(&mut b, 0xDA, &scan);
+        b.extend([0; 64]);
+        b.extend([0xFF, 0xD9]);
+        b
+    }
+
+    /// A decode's error, or what it decoded (an image's debug print is its every byte).
+    fn refusal(decoded: Result<DynamicImage, String>) -> String {
+        decoded.map_or_else(|e| e, |i| format!("decoded {}×{}", i.width(), i.height()))
+    }
+
+    /// What the decoder holds besides the image it gives is asked of the allocator with it.
+    /// Under address-space limits a 391-byte progressive CMYK JPEG of 9 400² (its
+    /// coefficients 707 MB) and an 83-kB GIF whose 11 000² first frame lies on a screen of
+    /// 1×1 (the frame 484 MB) aborted the process: the check had counted the output alone.
+    #[test]
+    fn what_the_decoder_holds_besides_the_image_is_asked_for() {
+        use crate::scene::alloc_probe::with_allocatable;
+        let mut budget = TextureBudget::default();
+        let cmyk = jpeg_to_first_scan(0xC2, 9_400, 9_400, 4, 1);
+        let err = refusal(with_allocatable(1 << 30, || {
+            decode_texture_bytes(&cmyk, Some(image::ImageFormat::Jpeg), &mut budget)
+        }));
+        assert!(
+            err.contains("9400×9400 pixels and what the decoder holds besides them need"),
+            "{err}"
+        );
+        let mut gif = b"GIF89a\x01\x00\x01\x00\x80\x00\x00\x00\x00\x00\xff\xff\xff".to_vec();
+        gif.extend(b"\x2c\x00\x00\x00\x00\xf8\x2a\xf8\x2a\x00\x02\x02\x44\x01\x00\x3b");
+        let err = refusal(with_allocatable(256 << 20, || {
+            decode_texture_bytes(&gif, Some(image::ImageFormat::Gif), &mut budget)
+        }));
+        assert!(
+            err.contains("1×1 pixels and what the decoder holds besides them need 461 MiB"),
+            "{err}"
+        );
+        // A frame past the decoder's side limit is refused however much memory there is.
+        gif[24..26].copy_from_slice(&20_000u16.to_le_bytes());
+        let err = refusal(decode_texture_bytes(
+            &gif,
+            Some(image::ImageFormat::Gif),
+            &mut budget,
+        ));
+        assert!(err.contains("its first frame is 20000×11000"), "{err}");
+    }
+
+    /// zune-jpeg holds every coefficient of a baseline JPEG whose first scan leaves
+    /// components to later ones, as of a progressive one: a 382-byte 12 000² one needed
+    /// 1.4 GB. Past 1 GiB it is refused from its headers.
+    #[test]
+    fn a_large_jpeg_in_separate_scans_is_refused_from_its_headers() {
+        let mut budget = TextureBudget::default();
+        let jpeg = Some(image::ImageFormat::Jpeg);
+        let separate = jpeg_to_first_scan(0xC0, 12_000, 12_000, 3, 1);
+        let err = refusal(decode_texture_bytes(&separate, jpeg, &mut budget));
+        assert!(
+            err.contains("a JPEG in separate scans of 12000×12000"),
+            "{err}"
+        );
+        assert_eq!(budget, TextureBudget::default());
+        // Interleaved, it decodes row by row, and is the decoder's to read.
+        let interleaved = jpeg_to_first_scan(0xC0, 64, 64, 3, 3);
+        let decoded = decode_texture_bytes(&interleaved, jpeg, &mut budget);
+        assert_eq!(decoded.map(|i| i.width()), Ok(64));
     }
 
     /// The 24 greyscale 16 384 × 10 922 progressive JPEGs of 100 scans (380 KB each) that

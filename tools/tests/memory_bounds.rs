@@ -971,6 +971,42 @@ fn a_texture_larger_than_the_memory_left_keeps_the_flat_colour_not_an_abort() {
     );
 }
 
+/// A GIF's first frame may be larger than its logical screen, which is the size `image`
+/// reports: a 1×1 screen with an 11 000² frame (484 MB for the decoder's frame buffer), the
+/// texture of a small OBJ, aborted its load under a 384 MiB address-space limit (helper-153).
+/// The frame is now read from its descriptor and asked of the allocator with the image.
+#[test]
+fn a_gif_frame_larger_than_its_screen_is_asked_for_not_an_abort() {
+    let dir = tempfile::tempdir().unwrap();
+    // Screen 1×1 with a palette of two; the frame at (0, 0), 0x2af8 = 11 000 a side.
+    let mut gif = b"GIF89a\x01\x00\x01\x00\x80\x00\x00\x00\x00\x00\xff\xff\xff".to_vec();
+    gif.extend_from_slice(b"\x2c\x00\x00\x00\x00\xf8\x2a\xf8\x2a\x00\x02\x02\x44\x01\x00\x3b");
+    std::fs::write(dir.path().join("wide.gif"), gif).unwrap();
+    std::fs::write(
+        dir.path().join("m.mtl"),
+        "newmtl m\nKd 0.8 0.8 0.8\nmap_Kd wide.gif\n",
+    )
+    .unwrap();
+    let path = dir.path().join("m.obj");
+    std::fs::write(
+        &path,
+        "mtllib m.mtl\nusemtl m\nv -1 -1 0\nv 1 -1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\n\
+         f 1/1 2/2 3/3\n",
+    )
+    .unwrap();
+    let Some((code, stderr)) = rendered_within_384_mib(&path, dir.path()) else {
+        return;
+    };
+    assert_eq!(code, Some(0), "{stderr}");
+    assert!(
+        stderr.contains(
+            "wide.gif could not be decoded (1×1 pixels and what the decoder holds \
+                         besides them need"
+        ),
+        "{stderr}"
+    );
+}
+
 /// A 66-byte scene file asking for a million random lights (a quarter of the limit) aborted
 /// under a 384 MiB address-space limit: the lights are made at load, and the frame's copies of
 /// them were refused by the allocator (helper-129). The load and the frame now ask first, so
