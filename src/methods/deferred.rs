@@ -60,11 +60,19 @@ fn supported(caps: &Caps) -> Support {
     }
     match gbuffer::unsupported_reason(caps) {
         Some(reason) => Support::Unsupported(reason),
+        None if gbuffer::half_float_accumulation(caps) => Support::Fallback(HALF_FLOAT_SUMS.into()),
         // Transparent objects take the documented forward fallback; opaque scenes are fully
         // deferred, so this is not reported as a degradation.
         None => Support::Supported,
     }
 }
+
+/// What a half-float accumulation costs: each light's proxy adds its radiance to the pixel's
+/// sum by blending, rounded to fp16's 11 bits of the sum, so a light whose share falls below
+/// half a step is lost and a pixel many lights reach darkens (docs/drivers.md).
+pub const HALF_FLOAT_SUMS: &str = "lights summed in half floats (RGBA16F) because \
+     GL_EXT_float_blend is missing: where hundreds of lights reach one pixel it darkens (255 \
+     equal ones: up to 9/255 from forward, 1 000: 23/255); tiled and clustered sum in the shader";
 
 /// What the light pass scales radiance by before the accumulation adds it (the composite
 /// undoes it): the exposure rounded to a power of two, so the scaling is exact, and at most 1.

@@ -349,6 +349,76 @@ fn deferred_matches_forward_on_occluded_surfaces_under_a_bright_ambient() {
     }
 }
 
+/// `n` equal lights on a ring over the plane, each reaching all of it, `total` their summed
+/// intensity.
+fn ring_of_lights(n: usize, total: f32) -> scene::Scene {
+    let mut s = scene::builtin::build("plane", None).unwrap();
+    s.lights = (0..n)
+        .map(|i| {
+            let a = std::f64::consts::TAU * i as f64 / n as f64;
+            let at = glam::DVec3::new(0.5 * a.cos(), 0.5 * a.sin(), 1.0);
+            manylight::scene::Light::point(at, 1e3, glam::Vec3::ONE, total / n as f32)
+        })
+        .collect();
+    s
+}
+
+/// Many lights on every pixel (helper-152): where the context blends 32-bit floats, deferred
+/// sums 1 000 equal lights as forward does (within 2/255). Where it cannot (ANGLE; Mesa in
+/// the child below), each proxy's blend rounds the pixel's sum to fp16, and at 1 000 lights
+/// deferred was 23/255 from forward with nothing said: it now names that in its support (a
+/// fallback, as `Renderer::set_method` warns), and its HDR radiance keeps within what the
+/// rounding allows, half a step of the sum for each of `n` additions: `n · 2⁻¹¹` of it.
+#[test]
+fn many_lights_on_a_pixel_sum_as_forward_or_deferred_says_why_not() {
+    use manylight::methods::deferred::HALF_FLOAT_SUMS;
+    use manylight::methods::Support;
+    use manylight::Method;
+    let mut gpu = Gpu::new(EsVersion::Es3);
+    let half = manylight::gl::gbuffer::half_float_accumulation(gpu.r().caps());
+    let support = gpu.r().support(Method::Deferred);
+    if !half {
+        assert_eq!(support, Support::Supported);
+        let s = ring_of_lights(1_000, 2.0);
+        let opts = RenderOptions::default();
+        let (forward, _) = gpu.render_with("forward", &s, (64, 36), &opts);
+        assert!(common::mean(&forward) > 60.0, "the lights show");
+        let (deferred, _) = gpu.render_with("deferred", &s, (64, 36), &opts);
+        let d = manylight::metrics::diff(&forward, &deferred);
+        assert!(
+            d.max_abs <= 2,
+            "deferred is {} / 255 from forward",
+            d.max_abs
+        );
+        return;
+    }
+    assert_eq!(support, Support::Fallback(HALF_FLOAT_SUMS.into()));
+    let fallback = gpu.r().set_method(Method::Deferred).unwrap();
+    assert_eq!(fallback.as_deref(), Some(HALF_FLOAT_SUMS));
+    let n = 64;
+    let s = ring_of_lights(n, 2.0);
+    let opts = RenderOptions::default();
+    let mut hdr = |method: &str| {
+        gpu.r().set_method_named(method).unwrap();
+        gpu.r().render_offscreen_hdr(&s, 64, 36, &opts).unwrap().0
+    };
+    let (forward, deferred) = (hdr("forward"), hdr("deferred"));
+    let lit: Vec<(f32, f32)> = (forward.iter().zip(&deferred))
+        .map(|(f, d)| (f[0], d[0]))
+        .filter(|&(f, _)| f > 1e-2)
+        .collect();
+    assert!(lit.len() > 1_000, "the lights show");
+    let worst = (lit.iter())
+        .map(|&(f, d)| ((d - f) / f).abs())
+        .fold(0.0f32, f32::max);
+    let bound = n as f32 * 2f32.powi(-11);
+    eprintln!("{n} lights in half floats: HDR radiance off by {worst} at most (bound {bound})");
+    assert!(
+        worst <= bound,
+        "{n} lights: HDR radiance off by {worst} (bound {bound})"
+    );
+}
+
 /// The tests above on Mesa without `GL_EXT_float_blend` (a half-float accumulation, as on
 /// ANGLE), in a child process (Mesa reads its extension override once per process).
 #[test]
@@ -361,6 +431,7 @@ fn deferred_equals_forward_on_a_bright_frame_without_float_blending() {
     for test in [
         "deferred_holds_bright_frames_and_refuses_counts_past_what_its_accumulation_holds",
         "deferred_matches_forward_on_occluded_surfaces_under_a_bright_ambient",
+        "many_lights_on_a_pixel_sum_as_forward_or_deferred_says_why_not",
     ] {
         common::child::rerun_with(
             test,
