@@ -150,7 +150,8 @@ pub(crate) fn decode_texture_bytes(
     if !super::alloc_probe::can_allocate(needed) {
         budget.give_back(taken);
         budget.give_back_decoding(decoded);
-        let besides = if held > 0 {
+        // Named where it shows in the MiB given.
+        let besides = if held >= 1 << 20 {
             " and what the decoder holds besides them"
         } else {
             ""

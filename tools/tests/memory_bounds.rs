@@ -937,6 +937,26 @@ fn rendered_within_384_mib(scene: &Path, dir: &Path) -> Option<(Option<i32>, Str
     ))
 }
 
+/// [`rendered_within_384_mib`] of an OBJ triangle in `dir` whose material's texture is
+/// `image`, written as `name`.
+fn textured_triangle_within_384_mib(
+    dir: &Path,
+    name: &str,
+    image: &[u8],
+) -> Option<(Option<i32>, String)> {
+    std::fs::write(dir.join(name), image).unwrap();
+    let mtl = format!("newmtl m\nKd 0.8 0.8 0.8\nmap_Kd {name}\n");
+    std::fs::write(dir.join("m.mtl"), mtl).unwrap();
+    let path = dir.join("m.obj");
+    std::fs::write(
+        &path,
+        "mtllib m.mtl\nusemtl m\nv -1 -1 0\nv 1 -1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\n\
+         f 1/1 2/2 3/3\n",
+    )
+    .unwrap();
+    rendered_within_384_mib(&path, dir)
+}
+
 /// `image` aborts the process where an allocation fails. A 35-byte GIF whose screen is
 /// 11 585² (536 MB of RGBA), the texture of a small OBJ, aborted its load under a 384 MiB
 /// address-space limit (helper-129); the decode is now asked of the allocator first, and the
@@ -948,20 +968,7 @@ fn a_texture_larger_than_the_memory_left_keeps_the_flat_colour_not_an_abort() {
     let mut gif = b"GIF89a\x41\x2d\x41\x2d\x00\x00\x00".to_vec();
     gif.extend_from_slice(b"\x2c\x00\x00\x00\x00\x01\x00\x01\x00\x80\x00\x00\x00\xff\xff\xff");
     gif.extend_from_slice(b"\x02\x02\x44\x01\x00\x3b");
-    std::fs::write(dir.path().join("big.gif"), gif).unwrap();
-    std::fs::write(
-        dir.path().join("m.mtl"),
-        "newmtl m\nKd 0.8 0.8 0.8\nmap_Kd big.gif\n",
-    )
-    .unwrap();
-    let path = dir.path().join("m.obj");
-    std::fs::write(
-        &path,
-        "mtllib m.mtl\nusemtl m\nv -1 -1 0\nv 1 -1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\n\
-         f 1/1 2/2 3/3\n",
-    )
-    .unwrap();
-    let Some((code, stderr)) = rendered_within_384_mib(&path, dir.path()) else {
+    let Some((code, stderr)) = textured_triangle_within_384_mib(dir.path(), "big.gif", &gif) else {
         return;
     };
     assert_eq!(code, Some(0), "{stderr}");
@@ -981,20 +988,8 @@ fn a_gif_frame_larger_than_its_screen_is_asked_for_not_an_abort() {
     // Screen 1×1 with a palette of two; the frame at (0, 0), 0x2af8 = 11 000 a side.
     let mut gif = b"GIF89a\x01\x00\x01\x00\x80\x00\x00\x00\x00\x00\xff\xff\xff".to_vec();
     gif.extend_from_slice(b"\x2c\x00\x00\x00\x00\xf8\x2a\xf8\x2a\x00\x02\x02\x44\x01\x00\x3b");
-    std::fs::write(dir.path().join("wide.gif"), gif).unwrap();
-    std::fs::write(
-        dir.path().join("m.mtl"),
-        "newmtl m\nKd 0.8 0.8 0.8\nmap_Kd wide.gif\n",
-    )
-    .unwrap();
-    let path = dir.path().join("m.obj");
-    std::fs::write(
-        &path,
-        "mtllib m.mtl\nusemtl m\nv -1 -1 0\nv 1 -1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\n\
-         f 1/1 2/2 3/3\n",
-    )
-    .unwrap();
-    let Some((code, stderr)) = rendered_within_384_mib(&path, dir.path()) else {
+    let Some((code, stderr)) = textured_triangle_within_384_mib(dir.path(), "wide.gif", &gif)
+    else {
         return;
     };
     assert_eq!(code, Some(0), "{stderr}");
