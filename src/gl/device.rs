@@ -745,7 +745,8 @@ mod tests {
     }
 
     /// On llvmpipe, a new device's capability probe (GL objects made and deleted) waits while
-    /// another thread holds the turn (`driver_turns`), as a renderer's calls do.
+    /// another thread holds the turn (`driver_turns`), as a renderer's calls do: the holder
+    /// sees no device made while it holds the turn, however slow the probe.
     #[test]
     fn on_llvmpipe_the_probe_waits_for_the_turn() {
         use std::sync::atomic::{AtomicBool, Ordering};
@@ -763,23 +764,27 @@ mod tests {
             return;
         }
         let (held, wait_held) = mpsc::channel();
-        let given = Arc::new(AtomicBool::new(false));
+        let made = Arc::new(AtomicBool::new(false));
         let holder = {
-            let given = given.clone();
+            let made = made.clone();
             std::thread::spawn(move || {
                 let turn = super::super::driver_turns::Turn::take_if(true);
                 held.send(()).unwrap();
-                // Time for the other thread's probe to start wrongly meanwhile.
-                std::thread::sleep(std::time::Duration::from_millis(100));
-                given.store(true, Ordering::SeqCst);
+                // Time for the other thread's probe to finish wrongly meanwhile.
+                std::thread::sleep(std::time::Duration::from_millis(500));
+                let made_meanwhile = made.load(Ordering::SeqCst);
                 drop(turn);
+                made_meanwhile
             })
         };
         wait_held.recv().unwrap();
         Device::new(ctx.load_gl().unwrap(), EsVersion::Es3).unwrap();
-        let waited = given.load(Ordering::SeqCst);
-        holder.join().unwrap();
-        assert!(waited, "the probe ran while another thread held the turn");
+        made.store(true, Ordering::SeqCst);
+        let made_meanwhile = holder.join().unwrap();
+        assert!(
+            !made_meanwhile,
+            "a device was made while another thread held the turn"
+        );
     }
 
     /// A driver may say GL_CONTEXT_LOST once, and then nothing: once said, at a call's start

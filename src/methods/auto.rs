@@ -31,8 +31,8 @@ pub const DESC: MethodDesc = MethodDesc {
     create: |_| Ok(Box::new(Auto::default())),
 };
 
-/// As degraded as what it runs: forward's notes, and clustered's when it can pick clustered
-/// (or that it never can).
+/// As degraded as what it runs: forward's notes, clustered's when it can pick clustered (or
+/// that it never can), and deferred's when it can pick deferred.
 fn supported(caps: &crate::gl::Caps) -> Support {
     let mut notes = Vec::new();
     match super::forward::supported(caps) {
@@ -48,6 +48,9 @@ fn supported(caps: &crate::gl::Caps) -> Support {
         Support::Unsupported(why) => {
             notes.push(format!("always forward: clustered cannot run ({why})"))
         }
+    }
+    if let Support::Fallback(why) = (super::deferred::DESC.supported)(caps) {
+        notes.push(format!("past clustered's index limit, deferred with {why}"));
     }
     if notes.is_empty() {
         Support::Supported

@@ -1,6 +1,6 @@
 //! A GIF's first frame as its image descriptor states it, read before it is decoded: the
 //! frame may be larger than the logical screen `image` reports, and the decoder holds the
-//! whole frame (four bytes a pixel) before it clips it to the screen.
+//! whole frame (five bytes a pixel) before it clips it to the screen.
 
 /// The first image descriptor's rectangle.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -14,7 +14,8 @@ pub(crate) struct GifFrame {
 impl GifFrame {
     /// Bytes the decoder allocates for this frame apart from the screen's image: none where
     /// the frame spans the screen's width from its left edge and ends within its height (it
-    /// is decoded in place), else the frame's RGBA (image 0.25's `GifDecoder::read_image`).
+    /// is decoded in place), else the frame's RGBA (image 0.25's `GifDecoder::read_image`)
+    /// and its palette indices, a byte a pixel (gif 0.14's `read_into_buffer`).
     pub fn extra_bytes(&self, screen: (u32, u32)) -> u64 {
         let in_place = self.left == 0
             && self.width == screen.0
@@ -22,7 +23,7 @@ impl GifFrame {
         if in_place {
             0
         } else {
-            u64::from(self.width) * u64::from(self.height) * 4
+            u64::from(self.width) * u64::from(self.height) * 5
         }
     }
 }
@@ -109,11 +110,11 @@ mod tests {
                 height: 11_000
             }
         );
-        assert_eq!(frame.extra_bytes((1, 1)), 11_000 * 11_000 * 4);
+        assert_eq!(frame.extra_bytes((1, 1)), 11_000 * 11_000 * 5);
         // A frame across the screen from its left edge is decoded in place.
         let rows = first_gif_frame(&gif((64, 32), [0, 8, 64, 24])).unwrap();
         assert_eq!(rows.extra_bytes((64, 32)), 0);
-        assert_eq!(rows.extra_bytes((64, 31)), 64 * 24 * 4);
+        assert_eq!(rows.extra_bytes((64, 31)), 64 * 24 * 5);
         // Cut anywhere before the frame's size, or not a GIF: none.
         let whole = gif((1, 1), [0, 0, 5, 5]);
         for end in 0..whole.len() - 4 {

@@ -501,8 +501,9 @@ mod tests {
         let err = refusal(with_allocatable(256 << 20, || {
             decode_texture_bytes(&gif, Some(image::ImageFormat::Gif), &mut budget)
         }));
+        // The frame's RGBA and its palette indices, 11 000² × 5 bytes, and the 1×1 image.
         assert!(
-            err.contains("1×1 pixels and what the decoder holds besides them need 461 MiB"),
+            err.contains("1×1 pixels and what the decoder holds besides them need 576 MiB"),
             "{err}"
         );
         // A frame past the decoder's side limit is refused however much memory there is.

@@ -367,8 +367,9 @@ fn ring_of_lights(n: usize, total: f32) -> scene::Scene {
 /// sums 1 000 equal lights as forward does (within 2/255). Where it cannot (ANGLE; Mesa in
 /// the child below), each proxy's blend rounds the pixel's sum to fp16, and at 1 000 lights
 /// deferred was 23/255 from forward with nothing said: it now names that in its support (a
-/// fallback, as `Renderer::set_method` warns), and its HDR radiance keeps within what the
-/// rounding allows, half a step of the sum for each of `n` additions: `n · 2⁻¹¹` of it.
+/// fallback, as `Renderer::set_method` warns; `auto`, which may run it, too), and its HDR
+/// radiance keeps within what the rounding allows, half a step of the sum for each of `n`
+/// additions: `n · 2⁻¹¹` of it.
 #[test]
 fn many_lights_on_a_pixel_sum_as_forward_or_deferred_says_why_not() {
     use manylight::methods::deferred::HALF_FLOAT_SUMS;
@@ -379,6 +380,11 @@ fn many_lights_on_a_pixel_sum_as_forward_or_deferred_says_why_not() {
     let support = gpu.r().support(Method::Deferred);
     if !half {
         assert_eq!(support, Support::Supported);
+        let auto = gpu.r().support(Method::Auto);
+        assert!(
+            !matches!(&auto, Support::Fallback(why) if why.contains(HALF_FLOAT_SUMS)),
+            "{auto:?}"
+        );
         let s = ring_of_lights(1_000, 2.0);
         let opts = RenderOptions::default();
         let (forward, _) = gpu.render_with("forward", &s, (64, 36), &opts);
@@ -393,6 +399,12 @@ fn many_lights_on_a_pixel_sum_as_forward_or_deferred_says_why_not() {
         return;
     }
     assert_eq!(support, Support::Fallback(HALF_FLOAT_SUMS.into()));
+    // `auto` runs deferred past clustered's index limit: it says so too.
+    let auto = gpu.r().support(Method::Auto);
+    assert!(
+        matches!(&auto, Support::Fallback(why) if why.contains(HALF_FLOAT_SUMS)),
+        "{auto:?}"
+    );
     let fallback = gpu.r().set_method(Method::Deferred).unwrap();
     assert_eq!(fallback.as_deref(), Some(HALF_FLOAT_SUMS));
     let n = 64;

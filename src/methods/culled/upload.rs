@@ -203,8 +203,8 @@ impl Uploads {
             }
         }
         if let Some(e) = failed {
-            // The driver is out of memory: the ring's sets (the burst's size) go, and the
-            // next frame uploads its lists into a set made at their size.
+            // Most likely out of memory: the ring's sets (the burst's size) go, and the next
+            // frame uploads its lists into a set made at their size.
             self.destroy(dev);
             return Err(e.into());
         }
