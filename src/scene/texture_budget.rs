@@ -89,7 +89,8 @@ pub(crate) fn decode_texture_bytes(
     };
     let first = reader()?;
     let format = first.format();
-    // Bytes the decoder holds besides the image it gives: a JPEG's coefficients.
+    // Bytes the decoder holds besides the image it gives: a JPEG's coefficients (here), a
+    // GIF's frame decoded apart from its screen (below).
     let mut held = 0;
     if format == Some(image::ImageFormat::Jpeg) {
         if let Some(frame) = coefficient_jpeg_frame(bytes) {
