@@ -69,7 +69,7 @@ fn supported(caps: &Caps) -> Support {
 
 /// What a half-float accumulation costs: each light's proxy adds its radiance to the pixel's
 /// sum by blending, rounded to fp16's 11 bits of the sum, so a light whose share falls below
-/// half a step is lost and a pixel many lights reach darkens (docs/drivers.md).
+/// half a step is lost and a pixel many lights reach darkens (docs/architecture.md, "Deferred").
 pub const HALF_FLOAT_SUMS: &str = "lights summed in half floats (RGBA16F) because \
      GL_EXT_float_blend is missing: where hundreds of lights reach one pixel it darkens (255 \
      equal ones: up to 9/255 from forward, 1 000: 23/255); tiled and clustered sum in the shader";
