@@ -274,22 +274,8 @@ fn deferred_holds_bright_frames_and_refuses_counts_past_what_its_accumulation_ho
     for m in &mut dim.materials {
         m.maps.emissive = glam::Vec3::ZERO;
     }
-    let mut hdr = |method: &str| {
-        gpu.r().set_method_named(method).unwrap();
-        gpu.r().render_offscreen_hdr(&dim, 64, 36, &opts).unwrap().0
-    };
-    let (forward, deferred) = (hdr("forward"), hdr("deferred"));
-    let lit: Vec<(f32, f32)> = forward
-        .iter()
-        .zip(&deferred)
-        .map(|(f, d)| (f[0], d[0]))
-        .filter(|&(f, _)| f > 1e-3)
-        .collect();
-    assert!(lit.len() > 100, "the dim light shows");
-    let worst = lit
-        .iter()
-        .map(|&(f, d)| ((d - f) / f).abs())
-        .fold(0.0f32, f32::max);
+    let (lit, worst) = deferred_hdr_from_forward(&mut gpu, &dim, &opts, 1e-3);
+    assert!(lit > 100, "the dim light shows");
     assert!(worst < 2e-3, "HDR radiance off by {worst} (relative)");
     // Counts: each channel of a half-float accumulation holds every count up to 2 048 (2 048 + 1
     // rounds back to 2 048), and a frame spreads its lights over the four; past 8 192 lights
@@ -347,6 +333,29 @@ fn deferred_matches_forward_on_occluded_surfaces_under_a_bright_ambient() {
             d.max_abs
         );
     }
+}
+
+/// Deferred's HDR radiance against forward's at 64×36 (red): the pixels forward lights above
+/// `floor`, and the largest relative difference among them.
+fn deferred_hdr_from_forward(
+    gpu: &mut Gpu,
+    s: &scene::Scene,
+    opts: &RenderOptions,
+    floor: f32,
+) -> (usize, f32) {
+    let mut hdr = |method: &str| {
+        gpu.r().set_method_named(method).unwrap();
+        gpu.r().render_offscreen_hdr(s, 64, 36, opts).unwrap().0
+    };
+    let (forward, deferred) = (hdr("forward"), hdr("deferred"));
+    let lit: Vec<(f32, f32)> = (forward.iter().zip(&deferred))
+        .map(|(f, d)| (f[0], d[0]))
+        .filter(|&(f, _)| f > floor)
+        .collect();
+    let worst = (lit.iter())
+        .map(|&(f, d)| ((d - f) / f).abs())
+        .fold(0.0f32, f32::max);
+    (lit.len(), worst)
 }
 
 /// `n` equal lights on a ring over the plane, each reaching all of it, `total` their summed
@@ -410,19 +419,8 @@ fn many_lights_on_a_pixel_sum_as_forward_or_deferred_says_why_not() {
     let n = 64;
     let s = ring_of_lights(n, 2.0);
     let opts = RenderOptions::default();
-    let mut hdr = |method: &str| {
-        gpu.r().set_method_named(method).unwrap();
-        gpu.r().render_offscreen_hdr(&s, 64, 36, &opts).unwrap().0
-    };
-    let (forward, deferred) = (hdr("forward"), hdr("deferred"));
-    let lit: Vec<(f32, f32)> = (forward.iter().zip(&deferred))
-        .map(|(f, d)| (f[0], d[0]))
-        .filter(|&(f, _)| f > 1e-2)
-        .collect();
-    assert!(lit.len() > 1_000, "the lights show");
-    let worst = (lit.iter())
-        .map(|&(f, d)| ((d - f) / f).abs())
-        .fold(0.0f32, f32::max);
+    let (lit, worst) = deferred_hdr_from_forward(&mut gpu, &s, &opts, 1e-2);
+    assert!(lit > 1_000, "the lights show");
     let bound = n as f32 * 2f32.powi(-11);
     eprintln!("{n} lights in half floats: HDR radiance off by {worst} at most (bound {bound})");
     assert!(
