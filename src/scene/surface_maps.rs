@@ -167,8 +167,8 @@ impl SurfaceMaps {
         .filter_map(|(n, t)| t.as_ref().map(|t| (n, t)))
     }
 
-    /// The textures a shader samples: a normal map of scale 0, an occlusion map of strength 0
-    /// and an emissive texture without emission change no pixel, so they are not uploaded
+    /// The textures a shader samples: an occlusion map of strength 0 and an emissive texture
+    /// without emission change no pixel, so they are not uploaded
     /// (nor is a metallic-roughness texture on a Blinn-Phong material:
     /// [`Material::sampled_map_textures`](super::Material::sampled_map_textures)).
     pub fn sampled_textures(&self) -> impl Iterator<Item = (&'static str, &MapTexture)> {
@@ -182,9 +182,11 @@ impl SurfaceMaps {
         .filter_map(|(n, t)| t.map(|t| (n, t)))
     }
 
-    /// The normal map, where its scale bends the normal.
+    /// The normal map, whatever its scale: at scale 0 a texel whose blue is below 128 still
+    /// turns the normal round (glTF's `(2·rgb − 1)·(0, 0, 1)`, [`perturbed_normal`]). The glTF
+    /// loader leaves out a map of scale 0 that has no such texel ([`turns_no_normal`]).
     pub(crate) fn sampled_normal(&self) -> Option<&MapTexture> {
-        self.normal.as_ref().filter(|_| self.normal_scale != 0.0)
+        self.normal.as_ref()
     }
 
     /// The emissive texture, where the material emits.
@@ -256,6 +258,12 @@ pub fn perturbed_normal(normal: DVec3, tangent: DVec3, w: f64, rgb: DVec3, scale
     let m = (rgb * 2.0 - DVec3::ONE) * DVec3::new(scale, scale, 1.0);
     let n = t * m.x + b * m.y + normal * m.z;
     n.try_normalize().unwrap_or(normal)
+}
+
+/// Whether a normal map of scale 0 leaves every normal as it is: each texel's blue is 128 or
+/// more, so `2·b − 1 > 0`, and filtering between such texels keeps it so.
+pub fn turns_no_normal(image: &image::RgbaImage) -> bool {
+    image.pixels().all(|p| p[2] >= 128)
 }
 
 /// Occlusion as it scales the ambient term: `1 + strength·(ao − 1)`.

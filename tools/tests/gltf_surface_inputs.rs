@@ -240,6 +240,37 @@ fn a_normal_map_tilts_the_shading_normal_with_file_and_generated_tangents() {
     check_every_method("mirrored normal map", &s, &want, 3.0);
 }
 
+/// At `scale` 0 glTF's normal is `normalize((2·rgb − 1)·(0, 0, 1))`: the surface's own where a
+/// texel's blue is 128 or more, turned round where it is less. Such a map was left out as one
+/// that changes nothing, and the plane drawn lit where it faces away from the light.
+#[test]
+fn a_normal_map_of_scale_0_turns_the_normal_where_its_blue_is_below_half() {
+    let dir = tempfile::tempdir().unwrap();
+    let material = json!({
+        "pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.7, 0.6, 1.0], "roughnessFactor": 1.0,
+                                 "metallicFactor": 0.0},
+        "normalTexture": {"index": 0, "scale": 0.0},
+    });
+    let mut plane = Plane::new(material);
+    // Blue 127: just below half, z = 2·127/255 − 1 < 0.
+    let turned = [128u8, 128, 127, 255];
+    plane.images.push(png(1, 1, &[turned]));
+    let path = plane.write(dir.path(), "scale0.gltf");
+    let (s, warnings) = scene_of(&path, grazing_light(), 0.02);
+    assert!(warnings.is_empty(), "{warnings:?}");
+    assert!(s.materials[0].maps.normal.is_some(), "the map was left out");
+    let rgb = DVec3::new(128.0, 128.0, 127.0) / 255.0;
+    let albedo = DVec3::new(0.8, 0.7, 0.6);
+    let mapped = |p: DVec3, _: DVec2, _: [f64; 4]| {
+        let n = perturbed_normal(DVec3::Z, DVec3::X, 1.0, rgb, 0.0);
+        (surface(p, n, albedo), DVec3::ZERO, 1.0)
+    };
+    let flat = |p: DVec3, _: DVec2, _: [f64; 4]| (surface(p, DVec3::Z, albedo), DVec3::ZERO, 1.0);
+    let want = oracle(&s, &mapped);
+    assert_changes(&want, &oracle(&s, &flat), 30.0, "the turned normal");
+    check_every_method("normal map of scale 0", &s, &want, 3.0);
+}
+
 /// A normal map on a mesh built in code, which has no tangents, is not applied, and that is
 /// said once (it passed in silence); the mesh with `Mesh::with_generated_tangents` shows it.
 /// In a process of its own: the warning is said once a process.

@@ -17,7 +17,8 @@ use super::buffers::Buffers;
 use super::texture::Textures;
 use crate::scene::mesh::MAX_TEXCOORD;
 use crate::scene::surface_maps::{
-    MapTexture, SurfaceMaps, TextureTransform, MAX_EMISSIVE, MAX_NORMAL_SCALE, UV_SETS,
+    turns_no_normal, MapTexture, SurfaceMaps, TextureTransform, MAX_EMISSIVE, MAX_NORMAL_SCALE,
+    UV_SETS,
 };
 use crate::scene::{short3, shown, Short, Texture};
 
@@ -287,6 +288,13 @@ pub(super) fn convert(
             &path,
             warnings,
         );
+        // At scale 0 a map whose texels all point out of the surface changes no pixel: not
+        // drawn, so it costs no upload, texture unit, tangents or coordinate set.
+        if maps.normal_scale == 0.0
+            && (maps.normal.as_ref()).is_some_and(|m| turns_no_normal(&m.texture.image))
+        {
+            maps.normal = None;
+        }
     }
     if let Some(o) = m.occlusion_texture() {
         let slot = Slot {

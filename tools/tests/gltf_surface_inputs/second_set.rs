@@ -188,7 +188,8 @@ fn the_second_set_draws_on_es2_without_vertex_arrays() {
 /// The second set and tangents are kept only for textures that are drawn: an emissive texture
 /// of a material that does not emit reads nothing, a normal map on a set past 1 is not bound
 /// and takes none of the file's tangents, and neither an occlusion map whose image does not
-/// decode nor a normal map of scale 0 keeps the set or tangents.
+/// decode nor a normal map of scale 0 whose texels all face out (`turns_no_normal`) keeps the
+/// set or tangents.
 #[test]
 fn a_mesh_keeps_the_second_set_and_tangents_only_for_textures_drawn() {
     let dir = tempfile::tempdir().unwrap();
@@ -239,6 +240,10 @@ fn a_mesh_keeps_the_second_set_and_tangents_only_for_textures_drawn() {
     plane.images.push(png(1, 1, &[[128, 128, 255, 255]]));
     let (s, warnings) = scene_of(&plane.write(dir.path(), "flat.gltf"), vec![], 0.5);
     assert!(warnings.is_empty(), "{warnings:?}");
+    assert!(
+        s.materials[0].maps.normal.is_none(),
+        "a normal map of scale 0 whose texels all face out was kept"
+    );
     let mesh = &s.objects[0].mesh;
     assert!(
         mesh.second_uvs.is_empty(),
