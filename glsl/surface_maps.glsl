@@ -27,7 +27,9 @@ VARYING vec4 v_color;
 #endif
 
 #if HAS_NORMAL_MAP
-uniform sampler2D u_normalTex;
+// HIGHP: a sampler is lowp by default, and a lowp texel (fp16 on llvmpipe) tilts the normal by
+// ~3e-4, which a light a millimetre from the surface turns into 25/255 (docs/precision.md).
+uniform HIGHP sampler2D u_normalTex;
 uniform float u_normalScale;
 // View-space tangent, bitangent sign in w.
 VARYING vec4 v_tangent;

@@ -52,8 +52,29 @@ fn check_every_method(what: &str, scene: &Scene, want: &[Option<[f64; 3]>], tole
 fn check_every_method_by_level(
     what: &str,
     scene: &Scene,
+    wants: [&[Option<[f64; 3]>]; 2],
+    tolerance: f64,
+) {
+    check_levels(what, scene, wants, tolerance, true)
+}
+
+/// [`check_every_method`] on contexts with fragment highp only: for a picture that fp16
+/// positions and normals cannot place (docs/precision.md).
+fn check_every_method_with_highp(
+    what: &str,
+    scene: &Scene,
+    want: &[Option<[f64; 3]>],
+    tolerance: f64,
+) {
+    check_levels(what, scene, [want, want], tolerance, false)
+}
+
+fn check_levels(
+    what: &str,
+    scene: &Scene,
     [want_es2, want_es3]: [&[Option<[f64; 3]>]; 2],
     tolerance: f64,
+    without_highp: bool,
 ) {
     // ES 2.0, ES 2.0 on a device without fragment highp (every float fp16 here), ES 3.0 (not
     // in a child capped to ES 2.0: `second_set::PURE_ES2`).
@@ -63,7 +84,11 @@ fn check_every_method_by_level(
         (EsVersion::Es3, false),
     ];
     let pure_es2 = std::env::var_os(second_set::PURE_ES2).is_some();
-    for (es, no_fragment_highp) in levels.into_iter().take(if pure_es2 { 2 } else { 3 }) {
+    let levels = levels
+        .into_iter()
+        .take(if pure_es2 { 2 } else { 3 })
+        .filter(|&(_, no_highp)| without_highp || !no_highp);
+    for (es, no_fragment_highp) in levels {
         let restrictions = manylight::gl::Restrictions {
             no_fragment_highp,
             ..Default::default()
@@ -238,6 +263,43 @@ fn a_normal_map_tilts_the_shading_normal_with_file_and_generated_tangents() {
     let want = oracle(&s, &mirrored(1.0));
     assert_changes(&want, &oracle(&s, &mirrored(-1.0)), 10.0, "the handedness");
     check_every_method("mirrored normal map", &s, &want, 3.0);
+}
+
+/// A bright light a millimetre above a normal-mapped surface: where the mapped normal turns
+/// away from it decides the picture. A sampler is `lowp` unless declared otherwise, and
+/// llvmpipe reads a `lowp` texel in fp16, which tilted the normal by ~3e-4 and moved that
+/// line: 226/255 from the twin on pixels along it, in every method (read at `highp` now).
+#[test]
+fn a_normal_map_is_read_precisely_enough_for_a_light_just_above_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let material = json!({
+        "pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.7, 0.6, 1.0], "roughnessFactor": 1.0,
+                                 "metallicFactor": 0.0},
+        "normalTexture": {"index": 0},
+    });
+    let mut plane = Plane::new(material);
+    let texel = [200u8, 90, 200, 255];
+    plane.images.push(png(1, 1, &[texel]));
+    let path = plane.write(dir.path(), "close.gltf");
+    // Above where pixel (46, 40)'s centre meets the plane: bright enough to saturate wherever
+    // the mapped normal faces it, so the line where it turns away (N·L = 0) crosses the
+    // picture, and pixels by that line show how precisely the normal was read.
+    let (s, _) = scene_of(&path, vec![], 0.02);
+    let (o, d) = manylight::scene::raycast::pixel_ray(&s.camera, W, H, 46.5, 40.5);
+    let under = o - d * (o.z / d.z);
+    let light = Light::point(DVec3::new(under.x, under.y, 1e-3), 3.0, Vec3::ONE, 6e4);
+    let (s, warnings) = scene_of(&path, vec![light], 0.02);
+    assert!(warnings.is_empty(), "{warnings:?}");
+    let rgb = DVec3::new(texel[0] as f64, texel[1] as f64, texel[2] as f64) / 255.0;
+    let albedo = DVec3::new(0.8, 0.7, 0.6);
+    let mapped = |p: DVec3, _: DVec2, _: [f64; 4]| {
+        let n = perturbed_normal(DVec3::Z, DVec3::X, 1.0, rgb, 1.0);
+        (surface(p, n, albedo), DVec3::ZERO, 1.0)
+    };
+    let flat = |p: DVec3, _: DVec2, _: [f64; 4]| (surface(p, DVec3::Z, albedo), DVec3::ZERO, 1.0);
+    let want = oracle(&s, &mapped);
+    assert_changes(&want, &oracle(&s, &flat), 30.0, "the normal map");
+    check_every_method_with_highp("a light just above a normal map", &s, &want, 3.0);
 }
 
 /// At `scale` 0 glTF's normal is `normalize((2·rgb − 1)·(0, 0, 1))`: the surface's own where a
