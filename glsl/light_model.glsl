@@ -143,37 +143,43 @@ vec3 shadeLight(Light light, HIGHP vec3 P, vec3 N, vec3 V, SurfaceParams surface
     HIGHP float inv = min(invLen / m, 1.0);
     // Read only where d ≤ 1.
     HIGHP float d = m / invLen;
-#if FP16_LIGHTS
-    // Radiance came divided by k² (light_struct.glsl): the falloff takes it back as (w·k·g)²,
-    // g = 1/√(d² + 1), capped in the root where only a saturated pixel could come out (k² is
-    // past fp16 from k = 2⁸ on; 244² < 60000; no Inf, no Inf·0).
-    HIGHP float g = inv < 1.0 ? inv * inversesqrt(1.0 + inv * inv) : inversesqrt(d * d + 1.0);
-    HIGHP float root = min(w * (light.radianceRoot * g), 244.0);
-    HIGHP float falloff = root * root;
-#else
-    HIGHP float falloff = w * w * (inv < 1.0 ? inv * inv / (1.0 + inv * inv) : 1.0 / (d * d + 1.0));
-#endif
     HIGHP vec3 L = s * invLen;
-    if (falloff <= 0.0 || dot(N, L) <= 0.0) {
+    if (dot(N, L) <= 0.0) {
         return vec3(0.0);
     }
 #if HAS_SPOT
     // 1 − cos of the angle off the axis as half the squared chord |L + axis|²: small and
-    // accurate for narrow cones even in fp16 (see Light::spot_scale_offset).
+    // accurate for narrow cones even in fp16 (see Light::spot_scale_offset). A cone wider than
+    // 90° comes with its axis, scale and offset turned round (pack/lights.rs), so the chord is
+    // measured from the back axis, where its edge lies.
     HIGHP vec3 chord = L + light.direction;
     HIGHP float t = clamp(light.spotOffset - 0.5 * light.spotScale * dot(chord, chord), 0.0, 1.0);
     HIGHP float spot = t * t * (3.0 - 2.0 * t);
 #else
     HIGHP float spot = 1.0;
 #endif
+#if FP16_LIGHTS
+    // Radiance came divided by k² (light_struct.glsl): the falloff takes it back as (w·k·g)²,
+    // g = 1/√(d² + 1), with the spot's root in it, capped in the root where only a saturated
+    // pixel could come out (k² is past fp16 from k = 2⁸ on; 244² < 60000; no Inf, no Inf·0).
+    // The spot goes in before the cap: the faint edge of a bright spot is not saturated.
+    HIGHP float g = inv < 1.0 ? inv * inversesqrt(1.0 + inv * inv) : inversesqrt(d * d + 1.0);
+    HIGHP float root = min(w * (light.radianceRoot * g) * sqrt(spot), 244.0);
+    HIGHP float falloff = root * root;
+#else
+    HIGHP float falloff = w * w * (inv < 1.0 ? inv * inv / (1.0 + inv * inv) : 1.0 / (d * d + 1.0)) * spot;
+#endif
+    if (falloff <= 0.0) {
+        return vec3(0.0);
+    }
     MEDP vec3 reflectance = surfaceReflectance(L, N, V, surface);
 #if FP16_LIGHTS
     // fp16 everywhere: falloff (≤ 60000) × reflectance (≤ 16384 + the base colour) is capped
     // before it could overflow; radiance is ≤ 1 here, so only a pixel far past saturation is
     // changed.
-    return light.radiance * (min(vec3(falloff * spot), 60000.0 / max(reflectance, vec3(1.0))) * reflectance);
+    return light.radiance * (min(vec3(falloff), 60000.0 / max(reflectance, vec3(1.0))) * reflectance);
 #else
-    return light.radiance * (falloff * spot) * reflectance;
+    return light.radiance * falloff * reflectance;
 #endif
 }
 

@@ -526,6 +526,55 @@ fn degenerate_and_huge_radii_and_intensities() {
     check("1100 lights, past forward's mediump loop", &past, 64, 36);
 }
 
+/// A spot far brighter than fp16 holds, over a plane near it: without fragment highp its
+/// radiance comes divided by k² and its falloff takes k back in a root capped at 244, where
+/// only a saturated pixel could come out. The cap was taken before the spot factor, so the
+/// cone's faint edge (spot · reflectance under 1/59 536 of the root's cap) was cut down too:
+/// 79/255 dark on 176 pixels at 2.5e5, 140/255 at 1e8 (softpipe's fp32 too, so not rounding).
+#[test]
+fn a_bright_spots_faint_edge_without_fragment_highp() {
+    for intensity in [2.5e5f32, 1e8] {
+        let mut s = plane();
+        s.ambient = Vec3::ZERO;
+        s.camera = Camera::perspective(DVec3::new(0.0, -0.4, 1.6), DVec3::ZERO, 60.0, 0.1, 20.0);
+        for m in &mut s.materials {
+            m.model = manylight::MaterialModel::MetallicRoughness;
+            (m.diffuse, m.metallic, m.roughness) = (Vec3::splat(0.8), 0.0, 1.0);
+        }
+        s.lights = vec![Light::spot(
+            DVec3::new(0.0, 0.0, 0.5),
+            3.0,
+            Vec3::ONE,
+            intensity,
+            manylight::Cone {
+                direction: DVec3::X,
+                inner_deg: 0.0,
+                outer_deg: 60.0,
+            },
+        )];
+        let name = format!("a spot of {intensity:e} and its faint edge");
+        check(&name, &s, 64, 36);
+        assert_matches_oracle(&name, &s, 64, 36);
+        // The edge alone: a few pixels, which the RMSE over the frame above does not weigh.
+        let highp = Gpu::new(EsVersion::Es2).render(&s, 64, 36, &RenderOptions::default());
+        let no_highp = Gpu::restricted(
+            EsVersion::Es2,
+            &manylight::gl::Restrictions {
+                no_fragment_highp: true,
+                ..Default::default()
+            },
+        )
+        .render(&s, 64, 36, &RenderOptions::default());
+        let d = manylight::metrics::diff(&highp, &no_highp);
+        assert!(
+            d.max_abs <= 3,
+            "{name}: without fragment highp {}/255 from highp ({:.3} % of pixels over 2/255)",
+            d.max_abs,
+            d.over_2 * 100.0
+        );
+    }
+}
+
 #[test]
 fn crowded_cells_and_index_lists_past_16_bits() {
     for n in [255usize, 256, 257] {
