@@ -77,14 +77,19 @@ Light fetchLight(int i) {
     // since NVIDIA flushes fp16 subnormals (1e-6 became 0, and 0 / 0 unlit every light).
     light.direction = dir / max(length(dir), 1e-4);
     // 1 − cos α as 2 sin²(α/2) from the stored sin(α/2), as spot_terms_from_half_sines does:
-    // arithmetic only (GLSL ES leaves sin's precision to the implementation).
-    float sinOuter = unpack16(t5.xy);
-    float sinInner = unpack16(t5.zw);
-    float oneMinusCosInner = 2.0 * sinInner * sinInner;
-    float scale = 1.0 / max(2.0 * sinOuter * sinOuter - oneMinusCosInner, SPOT_MIN_COS_DELTA);
-    bool omni = t4.z > 0.5;
-    light.spotScale = omni ? 0.0 : scale;
-    light.spotOffset = omni ? 1.0 : 1.0 + oneMinusCosInner * scale;
+    // arithmetic only (GLSL ES leaves sin's precision to the implementation). A cone turned
+    // round (t4.z 128/255: axis reversed) stores cos(α/2): 1 + cos α as 2 cos²(α/2), and its
+    // scale negated (spot_terms_from_half_cosines).
+    float halfOuter = unpack16(t5.xy);
+    float halfInner = unpack16(t5.zw);
+    float edgeInner = 2.0 * halfInner * halfInner;
+    float edgeOuter = 2.0 * halfOuter * halfOuter;
+    bool omni = t4.z > 0.75;
+    bool turned = t4.z > 0.25 && !omni;
+    float width = turned ? edgeInner - edgeOuter : edgeOuter - edgeInner;
+    float scale = 1.0 / max(width, SPOT_MIN_COS_DELTA);
+    light.spotScale = omni ? 0.0 : (turned ? -scale : scale);
+    light.spotOffset = omni ? 1.0 : (turned ? 1.0 - edgeInner * scale : 1.0 + edgeInner * scale);
 #endif
 #else
     light.position = t0.xyz;

@@ -575,6 +575,66 @@ fn a_bright_spots_faint_edge_without_fragment_highp() {
     }
 }
 
+/// Cones wider than a hemisphere (inner and outer angle 120–180°): their fade lies near the
+/// back axis. Measured from the front axis, `t = offset − scale·(1 − cos θ)` had an offset of
+/// 131.6 for 170–180° (fp16 steps of 1/16), and without fragment highp the fade came out
+/// 86/255 wrong; the records now carry such a cone turned round (`shader_spot_terms`).
+#[test]
+fn cones_wider_than_a_hemisphere_fade_alike_without_fragment_highp() {
+    for (inner_deg, outer_deg) in [
+        (170.0, 180.0),
+        (150.0, 170.0),
+        (120.0, 140.0),
+        (179.0, 179.0),
+    ] {
+        let mut s = plane();
+        s.ambient = Vec3::ZERO;
+        s.camera = Camera::perspective(DVec3::new(0.0, -0.4, 1.6), DVec3::ZERO, 60.0, 0.1, 20.0);
+        s.lights = vec![Light::spot(
+            DVec3::new(0.0, 0.0, 0.5),
+            3.0,
+            Vec3::ONE,
+            3.0,
+            manylight::Cone {
+                direction: DVec3::Z,
+                inner_deg,
+                outer_deg,
+            },
+        )];
+        let name = format!("a cone of {inner_deg}–{outer_deg}°");
+        check(&name, &s, 64, 36);
+        assert_matches_oracle(&name, &s, 64, 36);
+        let highp = Gpu::new(EsVersion::Es2).render(&s, 64, 36, &RenderOptions::default());
+        for rgba8 in [false, true] {
+            let opts = RenderOptions {
+                measure: manylight::MeasureOptions {
+                    force_rgba8_lights: rgba8,
+                    ..Default::default()
+                },
+                ..Default::default()
+            };
+            let no_highp = Gpu::restricted(
+                EsVersion::Es2,
+                &manylight::gl::Restrictions {
+                    no_fragment_highp: true,
+                    ..Default::default()
+                },
+            )
+            .render(&s, 64, 36, &opts);
+            let d = manylight::metrics::diff(&highp, &no_highp);
+            eprintln!(
+                "{name} rgba8 {rgba8}: {} / 255, rmse {:.3}",
+                d.max_abs, d.rmse
+            );
+            assert!(
+                d.max_abs <= 3,
+                "{name} (RGBA8 records: {rgba8}): without fragment highp {}/255 from highp",
+                d.max_abs
+            );
+        }
+    }
+}
+
 #[test]
 fn crowded_cells_and_index_lists_past_16_bits() {
     for n in [255usize, 256, 257] {

@@ -25,8 +25,10 @@
 //!   t2: R    G    B    E         shared-exponent radiance: c = m/255 · 2^(E−128)
 //!   spots only:
 //!   t3: dx.hi dx.lo dy.hi dy.lo  axis 16-bit snorm
-//!   t4: dz.hi dz.lo  omni  -     omni: 255 for a point light, 0 for a spot
+//!   t4: dz.hi dz.lo  omni  -     omni: 255 for a point light, 0 for a spot, 128 for a
+//!                                spot past 90° inside, turned round (axis reversed)
 //!   t5: so.hi so.lo si.hi si.lo  sin(α/2) of the outer and inner half-angles, 16-bit unorm
+//!                                (cos(α/2) for a cone turned round)
 //!   → 4 texels (16 bytes) a light (t3 unused), 8 (32 bytes) with spots (t6, t7 unused)
 //! ```
 //!
@@ -40,7 +42,9 @@ use glam::Vec3;
 
 use crate::cluster::headroom::zeroed_with_room;
 use crate::cluster::view_light::GpuLight;
-use crate::scene::light::{half_sine, spot_terms_from_half_sines};
+use crate::scene::light::{
+    half_cosine, half_sine, spot_terms_from_half_cosines, spot_terms_from_half_sines,
+};
 
 /// Width in texels of every data texture (a power of two ≤ 1024: exact under mediump math).
 pub const DATA_TEXTURE_WIDTH: u32 = 1024;
@@ -186,10 +190,11 @@ pub fn pack_lights_into(lights: &[GpuLight], layout: LightLayout, packed: &mut P
     for (i, l) in lights.iter().enumerate() {
         match encoding {
             LightEncoding::Float32 => {
+                let (direction, spot_scale, spot_offset) = shader_spot_terms(l);
                 let (radiance, w) = if layout.fp16 {
                     fp16_radiance(l.radiance)
                 } else {
-                    (l.radiance, l.spot_scale)
+                    (l.radiance, spot_scale)
                 };
                 let rec: [f32; 16] = [
                     l.position.x,
@@ -200,11 +205,11 @@ pub fn pack_lights_into(lights: &[GpuLight], layout: LightLayout, packed: &mut P
                     radiance.y,
                     radiance.z,
                     w, //
-                    l.direction.x,
-                    l.direction.y,
-                    l.direction.z,
-                    l.spot_offset, //
-                    l.spot_scale,
+                    direction.x,
+                    direction.y,
+                    direction.z,
+                    spot_offset, //
+                    spot_scale,
                     0.0,
                     0.0,
                     0.0,
@@ -235,17 +240,28 @@ pub fn pack_lights_into(lights: &[GpuLight], layout: LightLayout, packed: &mut P
                 if !layout.spots {
                     continue;
                 }
-                for (k, w) in [s(l.direction.x), s(l.direction.y), s(l.direction.z)]
-                    .iter()
-                    .enumerate()
-                {
+                let axis = if l.cone_deg.1 > 90.0 && l.cone_deg.1 < 180.0 {
+                    -l.direction
+                } else {
+                    l.direction
+                };
+                for (k, w) in [s(axis.x), s(axis.y), s(axis.z)].iter().enumerate() {
                     rec[12 + k * 2..14 + k * 2].copy_from_slice(&w.to_be_bytes());
                 }
                 let omni = l.cone_deg.1 >= 180.0;
-                rec[18] = if omni { 255 } else { 0 };
+                // A cone past 90° inside, turned round: its axis reversed and its angles'
+                // half cosines, precise near 180° where their sines are not (t4.z 128).
+                let back = !omni && l.cone_deg.1 > 90.0;
+                rec[18] = if omni {
+                    255
+                } else if back {
+                    128
+                } else {
+                    0
+                };
                 for (k, deg) in [l.cone_deg.0, l.cone_deg.1].into_iter().enumerate() {
-                    let sine = half_sine(deg as f64) as f32;
-                    rec[20 + 2 * k..22 + 2 * k].copy_from_slice(&unorm16(sine).to_be_bytes());
+                    let half = if back { half_cosine } else { half_sine }(deg as f64) as f32;
+                    rec[20 + 2 * k..22 + 2 * k].copy_from_slice(&unorm16(half).to_be_bytes());
                 }
             }
         }
@@ -267,6 +283,23 @@ pub fn pack_lights_into(lights: &[GpuLight], layout: LightLayout, packed: &mut P
              float textures (said once)",
             lights.len()
         );
+    }
+}
+
+/// A spot's axis, scale and offset as the shaders read them from a float record or a deferred
+/// instance. A cone whose inner angle is past 90° comes turned round: axis `−a`, scale `−s`,
+/// offset `o − 2s`, so `t = o' − s'·|L + a'|²/2` measures `1 + cos θ` from the back axis,
+/// where its edge lies. The same `t`, but small terms where fp16 holds them: from the front,
+/// a 170–180° cone's offset was 131.6, fp16 steps of 1/16 there, and the fade came out
+/// 86/255 wrong without fragment highp.
+pub(crate) fn shader_spot_terms(l: &GpuLight) -> (Vec3, f32, f32) {
+    let (scale, offset) = (l.spot_scale, l.spot_offset);
+    // 1 − cos(inner) = (offset − 1) / scale: past 1, the inner angle is past 90°.
+    if scale > 0.0 && offset - 1.0 > scale {
+        let back = (f64::from(offset) - 2.0 * f64::from(scale)) as f32;
+        (-l.direction, -scale, back)
+    } else {
+        (l.direction, scale, offset)
     }
 }
 
@@ -319,15 +352,18 @@ pub fn unpack_light(packed: &PackedLights, i: usize) -> GpuLight {
             );
             if layout.spots {
                 light.direction = Vec3::new(snorm(12), snorm(14), snorm(16)).normalize_or_zero();
-                // 255 in t4.z: a point light among spots.
+                // 255 in t4.z: a point light among spots; 128: a cone turned round.
                 if rec[18] != 255 {
-                    let (sine_outer, sine_inner) = (w(20), w(22));
-                    let angle = |sine: f32| 2.0 * (sine as f64).asin().to_degrees() as f32;
-                    let (scale, offset) =
-                        spot_terms_from_half_sines(sine_outer as f64, sine_inner as f64);
+                    let (outer, inner) = (w(20) as f64, w(22) as f64);
+                    let ((scale, offset), angle): (_, fn(f64) -> f64) = if rec[18] == 128 {
+                        (spot_terms_from_half_cosines(outer, inner), f64::acos)
+                    } else {
+                        (spot_terms_from_half_sines(outer, inner), f64::asin)
+                    };
+                    let degrees = |half: f64| 2.0 * angle(half).to_degrees() as f32;
                     light.spot_scale = scale as f32;
                     light.spot_offset = offset as f32;
-                    light.cone_deg = (angle(sine_outer), angle(sine_inner));
+                    light.cone_deg = (degrees(outer), degrees(inner));
                 }
             }
             light
@@ -405,8 +441,9 @@ mod tests {
                         (1.0 + f) as f32,
                         crate::scene::Cone {
                             direction: DVec3::new(0.2, -1.0, 0.1),
-                            inner_deg: 10.0 + f % 20.0,
-                            outer_deg: 30.0 + f % 40.0,
+                            // Every other spot wider than a hemisphere (turned round).
+                            inner_deg: 10.0 + f % 20.0 + if i % 2 == 0 { 120.0 } else { 0.0 },
+                            outer_deg: 30.0 + f % 40.0 + if i % 2 == 0 { 110.0 } else { 0.0 },
                         },
                     )
                 } else {
@@ -456,7 +493,7 @@ mod tests {
                 // Without spots a record is a point light's, whatever the light was.
                 let spot = |l: &GpuLight| (l.direction, l.spot_scale, l.spot_offset);
                 let expected = if spots {
-                    spot(l)
+                    shader_spot_terms(l)
                 } else {
                     (Vec3::ZERO, 0.0, 1.0)
                 };
@@ -567,8 +604,12 @@ mod tests {
                 l.radiance
             );
             if l.spot_scale != 0.0 {
-                assert!((u.direction - l.direction).length() < 1e-4);
-                assert!((u.cone_deg.0 - l.cone_deg.0).abs() < 0.002);
+                // As the float records give the shaders: turned round past 90° inside.
+                let (axis, scale, _) = shader_spot_terms(l);
+                assert!((u.direction - axis).length() < 1e-4, "light {i}");
+                assert_eq!(u.spot_scale < 0.0, scale < 0.0, "light {i}");
+                assert!((u.cone_deg.0 - l.cone_deg.0).abs() < 0.002, "light {i}");
+                assert!((u.cone_deg.1 - l.cone_deg.1).abs() < 0.002, "light {i}");
             }
         }
     }

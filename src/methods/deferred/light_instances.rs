@@ -4,6 +4,7 @@
 
 use glam::Vec4;
 
+use crate::cluster::pack::shader_spot_terms;
 use crate::cluster::view_light::GpuLight;
 use crate::gl::instances::InstanceStream;
 use crate::gl::mesh::BoundMesh;
@@ -34,10 +35,11 @@ pub(super) fn light_instance(
     channel: usize,
     scale: f32,
 ) -> [Vec4; LIGHT_VEC4S] {
+    let (direction, spot_scale, spot_offset) = shader_spot_terms(light);
     [
         light.position.extend(light.radius),
-        (light.radiance * scale).extend(light.spot_scale),
-        light.direction.extend(light.spot_offset),
+        (light.radiance * scale).extend(spot_scale),
+        direction.extend(spot_offset),
         Vec4::new(proxy_radius, channel as f32, depth, 0.0),
     ]
 }
