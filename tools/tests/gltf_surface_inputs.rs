@@ -827,7 +827,8 @@ fn variants_without_surface_inputs_contain_none_of_their_code() {
 }
 
 /// Values past f32 in the file (1e300 reads as infinity) were replaced without a word: each is
-/// now warned of, naming its path; an infinite emissive strength is clamped as a large one is.
+/// now warned of, naming its path; an infinite emissive strength is clamped as a large one is,
+/// both keeping the emission's hue.
 #[test]
 fn values_past_f32_are_warned_of_by_path() {
     let dir = tempfile::tempdir().unwrap();
@@ -853,11 +854,8 @@ fn values_past_f32_are_warned_of_by_path() {
     }
     let maps = &s.materials[0].maps;
     assert_eq!((maps.normal_scale, maps.occlusion_strength), (1.0, 1.0));
-    assert!(
-        maps.emissive.x > 1.0 && maps.emissive.z == 0.0,
-        "{}",
-        maps.emissive
-    );
+    // The factor's hue at the cap: clamped channel by channel it was (1024, 1024, 0).
+    assert_eq!(maps.emissive, Vec3::new(1024.0, 512.0, 0.0));
     // Finite and huge, the values are written short: `{}` wrote 3e38 in 39 digits.
     let material = json!({
         "pbrMetallicRoughness": {"baseColorFactor": [3e38, 0.5, 0.5, 1.0]},
@@ -869,10 +867,14 @@ fn values_past_f32_are_warned_of_by_path() {
     plane.images.push(png(1, 1, &[[128, 128, 255, 255]]));
     plane.extensions.push("KHR_materials_emissive_strength");
     let path = plane.write(dir.path(), "finite.gltf");
-    let (_, warnings) = scene_of(&path, grazing_light(), 0.02);
+    let (s, warnings) = scene_of(&path, grazing_light(), 0.02);
     let all = warnings.join("\n");
     assert!(all.contains("normalTexture.scale: 3e38 taken as"), "{all}");
-    assert!(all.contains("strength [3e38, 1.5e38, 0] clamped"), "{all}");
+    assert!(
+        all.contains("strength [3e38, 1.5e38, 0] clamped to [1024, 512, 0]"),
+        "{all}"
+    );
+    assert_eq!(s.materials[0].maps.emissive, Vec3::new(1024.0, 512.0, 0.0));
     assert!(
         all.contains("baseColorFactor [3e38, 0.5, 0.5] clamped to [1024, 0.5, 0.5]"),
         "{all}"

@@ -320,7 +320,7 @@ pub(super) fn convert(
     if emissive != e {
         warnings.push(format!(
             "{field}: emissiveFactor × KHR_materials_emissive_strength {} clamped to {} \
-             (the fp16 colour tier's range)",
+             (the fp16 colour tier's range, the hue kept)",
             short3(e),
             short3(emissive)
         ));
@@ -341,13 +341,41 @@ pub(super) fn convert(
 }
 
 /// `m`'s emission, `emissiveFactor` × `KHR_materials_emissive_strength`, as the file gives it
-/// and as kept: within [0, `MAX_EMISSIVE`]. A strength past f32 (1e300 in the file) is
-/// infinite: the product is clamped, as a large one is (0 × ∞ is NaN, which becomes 0: max
-/// and min drop it).
+/// and as kept: within [0, `MAX_EMISSIVE`], scaled down as a whole where a channel passes it,
+/// so its hue is kept (clamped channel by channel, (1e6, 5e5, 0) became white-yellow
+/// (1024, 1024, 0)). A strength past f32 (1e300 in the file) is infinite: the factor's hue at
+/// the cap (the limit of ever larger strengths).
 fn emission(m: &gltf::Material) -> (Vec3, Vec3) {
     let strength = m.emissive_strength().unwrap_or(1.0);
-    let e = Vec3::from(m.emissive_factor()) * strength;
-    (e, e.max(Vec3::ZERO).min(Vec3::splat(MAX_EMISSIVE)))
+    let factor = Vec3::from(m.emissive_factor());
+    // Negative and NaN channels are 0 (`>` is false for NaN).
+    let factor = Vec3::select(factor.cmpgt(Vec3::ZERO), factor, Vec3::ZERO);
+    let written = Vec3::from(m.emissive_factor()) * strength;
+    // In f64, where the product of two f32s is finite; NaN strength is 0, infinity stays.
+    let strength = if strength > 0.0 {
+        f64::from(strength)
+    } else {
+        0.0
+    };
+    let brightest = f64::from(factor.max_element());
+    let kept = if brightest == 0.0 {
+        Vec3::ZERO
+    } else if brightest.is_infinite() {
+        // A factor past f32 in the file: its infinite channels at the cap, the rest dark.
+        Vec3::select(
+            factor.cmpeq(Vec3::INFINITY),
+            Vec3::splat(MAX_EMISSIVE),
+            Vec3::ZERO,
+        )
+    } else if brightest * strength <= f64::from(MAX_EMISSIVE) {
+        (factor.as_dvec3() * strength).as_vec3()
+    } else {
+        let cap = f64::from(MAX_EMISSIVE) / brightest;
+        (factor.as_dvec3() * cap)
+            .as_vec3()
+            .min(Vec3::splat(MAX_EMISSIVE))
+    };
+    (written, kept)
 }
 
 /// `value` within `range`, or `default` where it is not finite (past f32 in the file), with a
