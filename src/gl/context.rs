@@ -76,12 +76,13 @@ pub struct EglInfo {
     /// The folder the implementation was loaded from (`--gles-lib`, `MANYLIGHT_GLES_LIB`);
     /// `None`: the system's `libEGL.so.1`.
     pub gles_lib: Option<std::path::PathBuf>,
-    /// A driver workaround: the display is terminated when its last headless context goes
-    /// (and initialised again by the next). ANGLE's GL back end keeps a native context current
-    /// on the thread that initialised the display, and a context made on another thread after
-    /// that one ended crashed it in `eglMakeCurrent` (a test harness runs each test on a new
-    /// thread). Only for ANGLE: elsewhere the display may be shared with an application's own
-    /// contexts.
+    /// A driver workaround: once its last headless context is gone, the display is terminated
+    /// before a context is made on another thread (and initialised again by it). ANGLE's GL
+    /// back end keeps a native context current on the thread that initialised the display, and
+    /// a context made on another thread after that one ended crashed it in `eglMakeCurrent` (a
+    /// test harness runs each test on a new thread). Not at each last drop: ANGLE keeps an X
+    /// connection from every `eglInitialize`. Only for ANGLE: elsewhere the display may be
+    /// shared with an application's own contexts.
     pub terminate_when_unused: bool,
     /// A driver workaround: the implementation's headless contexts live on one thread at a
     /// time, so [`HeadlessContext::new`] on another thread waits until they are gone. ANGLE,
@@ -166,6 +167,15 @@ impl HeadlessContext {
         // Held while the display is initialised and the context made, so a drop on another
         // thread cannot terminate the display in between (see `LIVE_CONTEXTS`).
         let mut live = wait_for_other_threads(lock_live(), patience)?;
+        // ANGLE's display, left initialised by another thread's contexts, all gone
+        // (`LiveContexts::initialised_by`): terminated before this thread initialises it.
+        let here = std::thread::current().id();
+        if live.count == 0 && live.initialised_by.is_some_and(|by| by != here) {
+            if let Some(display) = unsafe { egl.get_display(egl::DEFAULT_DISPLAY) } {
+                let _ = egl.terminate(display);
+            }
+            live.initialised_by = None;
+        }
         let mut last_err = None;
         for platform in order {
             match Self::with_platform(egl, platform, es) {
@@ -394,8 +404,8 @@ impl HeadlessContext {
 impl Drop for HeadlessContext {
     fn drop(&mut self) {
         // The display is shared by every context of the process (EGL returns the same handle),
-        // so it is terminated only on ANGLE and only once no headless context is left
-        // (`EglInfo::terminate_when_unused`).
+        // so it is terminated only on ANGLE, only once no headless context is left, and only
+        // when another thread makes the next (`EglInfo::terminate_when_unused`).
         let egl = self.lib.egl();
         // Under the lock `new` holds too: SwiftShader's display keeps its surfaces and contexts
         // in sets it does not lock, and tore them when two threads created or destroyed at once.
@@ -413,7 +423,8 @@ impl Drop for HeadlessContext {
         if live.count == 0 {
             live.only_thread = None;
             if self.info.terminate_when_unused {
-                let _ = egl.terminate(self.display);
+                // Terminated by the next context made on another thread (`new`).
+                live.initialised_by = Some(self.made_on);
             }
         }
         CONTEXT_DROPPED.notify_all();
@@ -430,6 +441,12 @@ struct LiveContexts {
     /// The thread they live on, where the implementation allows one at a time
     /// ([`EglInfo::one_thread_at_a_time`]).
     only_thread: Option<std::thread::ThreadId>,
+    /// Where the display is terminated only when a context is made on another thread
+    /// ([`EglInfo::terminate_when_unused`]): the thread whose contexts left it initialised.
+    /// ANGLE opens a connection to the X server at each `eglInitialize` and keeps it after
+    /// `eglTerminate`, so terminating at every last drop made the 255th context of a thread
+    /// fail (Xvfb's 256 clients).
+    initialised_by: Option<std::thread::ThreadId>,
 }
 
 /// Headless contexts alive in the process, for the ANGLE workarounds of
@@ -439,6 +456,7 @@ struct LiveContexts {
 static LIVE_CONTEXTS: Mutex<LiveContexts> = Mutex::new(LiveContexts {
     count: 0,
     only_thread: None,
+    initialised_by: None,
 });
 
 /// Signalled whenever a headless context is dropped.
