@@ -104,8 +104,14 @@ impl OutputFile {
         let (target, file) = match opened {
             Ok(existing) => {
                 let meta = existing.metadata().map_err(fail)?;
-                if meta.is_file() && (dash || is_system_path(path)) {
-                    // `/dev/stdout` redirected to a file: that file, truncated, as before.
+                if names_stdout(path) {
+                    // Standard output, whatever it is: written where the shell left it (after
+                    // what came before in `{ echo; manylight; } > f`, at the end under `>>`),
+                    // never truncated, as `print_stdout` writes.
+                    (Target::InPlace, existing)
+                } else if meta.is_file() && is_descriptor_alias(path) {
+                    // `/dev/fd/N`, `/proc/self/fd/N`: reopened at its start, so truncated, as
+                    // any program opening that name for writing does.
                     existing.set_len(0).map_err(fail)?;
                     (Target::InPlace, existing)
                 } else if meta.is_file() {
@@ -222,10 +228,23 @@ impl Drop for OutputFile {
     }
 }
 
-/// Whether `path` is one of the system's names for a stream (`/dev/stdout`, `/proc/self/fd/1`):
-/// written in place, whatever it points at.
-fn is_system_path(path: &Path) -> bool {
-    path.starts_with("/dev") || path.starts_with("/proc")
+/// Whether `path` is one of the system's names for an open descriptor (`/dev/stdout`,
+/// `/dev/fd/N`, `/proc/self/fd/N`): written in place, whatever it points at. Other files under
+/// `/dev` (`/dev/shm`'s) are files like any other, replaced whole; all of `/dev` was taken as
+/// a stream, and a file there was truncated before a write that then failed.
+fn is_descriptor_alias(path: &Path) -> bool {
+    let mut parts = path.components().map(|c| c.as_os_str());
+    let mut next = || parts.next().and_then(|p| p.to_str());
+    matches!(
+        (next(), next(), next(), next()),
+        (
+            Some("/"),
+            Some("dev"),
+            Some("stdout" | "stderr" | "stdin"),
+            None
+        ) | (Some("/"), Some("dev"), Some("fd"), Some(_))
+            | (Some("/"), Some("proc"), Some(_), Some("fd"))
+    )
 }
 
 /// `path` with symbolic links followed to the last one's target, which need not exist (at most
@@ -411,6 +430,32 @@ pub fn names_stdout(path: &Path) -> bool {
     path == Path::new("-") || own_stdout_named(path).is_some()
 }
 
+/// What standard output is redirected to, as [`identity`] spells it: `-` and `/dev/stdout`
+/// named the file a shell's `> f` or `>> f` opened no more than any other name did, so an output
+/// or the scene there went unnoticed (`--out - >> scene.json` replaced the scene).
+fn stdout_identity() -> PathBuf {
+    #[cfg(unix)]
+    {
+        use std::os::fd::AsRawFd;
+        let fd = OWN_STDOUT.get().map_or(1, |own| own.as_raw_fd());
+        let alias = PathBuf::from(format!("/proc/self/fd/{fd}"));
+        std::fs::canonicalize(&alias).unwrap_or(alias)
+    }
+    #[cfg(not(unix))]
+    PathBuf::from("-")
+}
+
+/// Whether `path` is a stream (a device, FIFO or socket, standard output's included), which
+/// two outputs may share: neither overwrites the other there.
+pub fn is_stream(path: &Path) -> bool {
+    let meta = if names_stdout(path) {
+        stdout_file().and_then(|f| f.metadata())
+    } else {
+        std::fs::metadata(path)
+    };
+    meta.is_ok_and(|m| !m.is_file() && !m.is_dir())
+}
+
 /// Standard output as a file of its own (the original one, where descriptor 1 was redirected).
 fn stdout_file() -> io::Result<File> {
     if let Some(own) = OWN_STDOUT.get() {
@@ -447,6 +492,9 @@ pub fn print_stdout(text: &str) -> Result<(), String> {
 /// absolute; for a file that does not exist yet, its folder resolved. Two outputs with the same
 /// identity would overwrite each other.
 pub fn identity(path: &Path) -> PathBuf {
+    if names_stdout(path) {
+        return stdout_identity();
+    }
     if let Ok(p) = std::fs::canonicalize(path) {
         return p;
     }

@@ -1,6 +1,8 @@
 //! What the command line writes and says in the cases a newcomer met: files it should not
 //! write, timings that add up, messages that name the flag typed rather than a library field.
 
+use std::path::Path;
+
 use crate::common;
 
 use common::cli::{expect_status, manylight, text};
@@ -504,4 +506,106 @@ fn a_load_with_many_warnings_says_the_first_and_counts_the_rest() {
         "{msg}"
     );
     assert!(dir.path().join("m.png").is_file());
+}
+
+/// Runs `manylight ARGS` in `cwd` with standard output going into `stdout` (a file, as a
+/// shell's `> f` or `>> f` gives it); returns the exit status and standard error.
+fn into_file(args: &[&str], stdout: std::fs::File, cwd: &Path) -> (Option<i32>, String) {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_manylight"))
+        .args(args)
+        .current_dir(cwd)
+        .stdout(stdout)
+        .output()
+        .expect("run manylight");
+    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+    (out.status.code(), stderr)
+}
+
+/// Standard output redirected to a file is written where the shell left it: after what came
+/// before (`{ echo header; manylight --out -; } > f`) and at the end under `>>`. It was
+/// truncated first, which left a hole of NULs where "header" was, and under `>>` wiped the
+/// file. And that file is the file the checks of outputs and scene see: `--out - >> s.json`
+/// replaced the scene, `--out - --stats x.json > x.json` lost the picture, both exit 0.
+#[test]
+fn standard_output_into_a_file_is_written_after_what_it_holds_and_checked_as_that_file() {
+    use std::io::Write;
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("out.bin");
+    let args = ["--size", "16x9", "--lights", "2", "--out", "-"];
+    for append in [false, true] {
+        std::fs::write(&path, b"header\n").unwrap();
+        let mut file = std::fs::OpenOptions::new()
+            .write(true)
+            .append(append)
+            .open(&path)
+            .unwrap();
+        if !append {
+            // The shell's descriptor, where `echo header` left it.
+            file.write_all(b"header\n").unwrap();
+        }
+        let (code, stderr) = into_file(&args, file, dir.path());
+        assert_eq!(code, Some(0), "{stderr}");
+        let written = std::fs::read(&path).unwrap();
+        assert!(
+            written.starts_with(b"header\n\x89PNG"),
+            "append {append}: {:?}",
+            &written[..written.len().min(12)]
+        );
+        assert!(image::load_from_memory(&written[7..]).is_ok());
+    }
+    for picture in ["-", "/dev/stdout"] {
+        // The scene file behind standard output.
+        let scene = dir.path().join("s.json");
+        let text = r#"{"objects":[{"builtin":"plane"}],"random_lights":{"count":4}}"#;
+        std::fs::write(&scene, text).unwrap();
+        let file = std::fs::OpenOptions::new()
+            .append(true)
+            .open(&scene)
+            .unwrap();
+        let args = ["--scene", "s.json", "--size", "16x9", "--out", picture];
+        let (code, stderr) = into_file(&args, file, dir.path());
+        assert_eq!(code, Some(2), "{picture}: {stderr}");
+        assert!(stderr.contains("names the scene file"), "{stderr}");
+        assert_eq!(std::fs::read_to_string(&scene).unwrap(), text);
+        // Another output's file behind standard output.
+        let file = std::fs::File::create(dir.path().join("x.json")).unwrap();
+        let args = ["--size", "16x9", "--out", picture, "--stats", "x.json"];
+        let (code, stderr) = into_file(&args, file, dir.path());
+        assert_eq!(code, Some(2), "{picture}: {stderr}");
+        assert!(stderr.contains("name the same file"), "{stderr}");
+    }
+}
+
+/// A file under `/dev` that is a file (`/dev/shm`'s) is replaced whole, as any other output:
+/// all of `/dev` was taken as streams, so such a file was truncated and written in place, and
+/// a write that failed half-way (a full disk, `ulimit -f`) left it cut short.
+#[test]
+fn a_file_under_dev_is_replaced_whole() {
+    use std::os::unix::fs::MetadataExt;
+    let shm = Path::new("/dev/shm");
+    if !shm.is_dir() {
+        eprintln!("no /dev/shm here: nothing to check");
+        return;
+    }
+    let dir = tempfile::tempdir_in(shm).unwrap();
+    let path = dir.path().join("keep.png");
+    std::fs::write(&path, b"old").unwrap();
+    let before = std::fs::metadata(&path).unwrap().ino();
+    let out = manylight(
+        &[
+            "--size",
+            "16x9",
+            "--lights",
+            "2",
+            "--out",
+            path.to_str().unwrap(),
+        ],
+        &[],
+        dir.path(),
+    );
+    assert!(out.status.success(), "{}", text(&out));
+    // A new file renamed over the old one, not the old one rewritten.
+    assert_ne!(std::fs::metadata(&path).unwrap().ino(), before);
+    assert!(image::open(&path).is_ok());
 }

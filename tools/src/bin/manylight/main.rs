@@ -164,7 +164,7 @@ fn check_usage(cli: &Cli, subcommand: Option<&str>) {
             ErrorKind::ArgumentConflict,
             format!(
                 "--record {} writes the timed frames, and --frames 0 times none",
-                record.display()
+                shown::path(record)
             ),
         );
     }
@@ -317,16 +317,15 @@ fn check_distinct_outputs(subcommand: Option<&str>, outputs: &[Option<(&str, &Pa
             ErrorKind::ArgumentConflict,
             format!(
                 "{a} {} and {b} {} both name standard output: one would run into the other",
-                a_path.display(),
-                b_path.display()
+                shown::path(a_path),
+                shown::path(b_path)
             ),
         );
     }
-    let is_stream = |p: &Path| std::fs::metadata(p).is_ok_and(|m| !m.is_file() && !m.is_dir());
     let named: Vec<_> = outputs
         .iter()
         .flatten()
-        .filter(|(_, path)| !is_stream(path))
+        .filter(|(_, path)| !output::is_stream(path))
         .map(|&(option, path)| (option, path, output::identity(path)))
         .collect();
     for (i, (a, a_path, a_id)) in named.iter().enumerate() {
@@ -336,8 +335,8 @@ fn check_distinct_outputs(subcommand: Option<&str>, outputs: &[Option<(&str, &Pa
                 ErrorKind::ArgumentConflict,
                 format!(
                     "{a} {} and {b} {} name the same file: one would overwrite the other",
-                    a_path.display(),
-                    b_path.display()
+                    shown::path(a_path),
+                    shown::path(b_path)
                 ),
             );
         }
@@ -363,8 +362,8 @@ fn check_not_the_input(subcommand: Option<&str>, outputs: &[Option<(&str, &Path)
             ErrorKind::ArgumentConflict,
             format!(
                 "{option} {} names the scene file --scene {}: it would be overwritten",
-                path.display(),
-                scene.display()
+                shown::path(path),
+                shown::path(scene)
             ),
         );
     }
@@ -391,8 +390,8 @@ fn check_outside_folder(
                 format!(
                     "{option} {} lies in the folder {folder_option} {} fills with frames: \
                          a frame could overwrite it",
-                    path.display(),
-                    folder.display()
+                    shown::path(path),
+                    shown::path(folder)
                 ),
             );
         }

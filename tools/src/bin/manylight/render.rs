@@ -4,6 +4,7 @@ use std::path::PathBuf;
 
 use clap::Parser;
 use manylight::gl::HeadlessContext;
+use manylight::scene::shown;
 use manylight::{scene, RenderOptions, Renderer};
 use manylight_tools::output::{print_stdout, JsonOut, OutputFile};
 
@@ -271,8 +272,9 @@ const DEFAULT_LIGHTS: usize = 1024;
 pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
     let (w, h) = s
         .split_once(['x', 'X', '×'])
-        .ok_or_else(|| format!("`{s}` is not WIDTHxHEIGHT"))?;
-    let parse = |v: &str| v.trim().parse::<u32>().map_err(|e| format!("`{v}`: {e}"));
+        .ok_or_else(|| format!("`{}` is not WIDTHxHEIGHT", shown::name(s)))?;
+    let parse =
+        |v: &str| (v.trim().parse::<u32>()).map_err(|e| format!("`{}`: {e}", shown::name(v)));
     let (w, h) = (parse(w)?, parse(h)?);
     if w == 0 || h == 0 {
         return Err(format!("size {w}x{h} is empty"));
