@@ -343,6 +343,13 @@ fn view_rejects_bad_input_without_panicking() {
     assert_eq!(out.status.code(), Some(1), "stderr: {stderr}");
     assert!(stderr.contains("unknown method"), "stderr: {stderr}");
     assert!(!stderr.contains("panicked"), "stderr: {stderr}");
+    // A side past X11's 16 bits panicked inside winit (exit 101): a usage error now.
+    let Some(out) = run_view(&["--frames", "1", "--size", "65536x36"], &[]) else {
+        return;
+    };
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "stderr: {stderr}");
+    assert!(stderr.contains("at most 65535"), "stderr: {stderr}");
 }
 
 /// The heatmap view (`--heatmap`, H in the window): every covered pixel is a colour of the

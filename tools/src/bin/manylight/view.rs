@@ -61,7 +61,7 @@ pub struct ViewArgs {
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
     /// Initial window size as WIDTHxHEIGHT.
-    #[arg(long, default_value = "1280x720", value_parser = crate::render::parse_size)]
+    #[arg(long, default_value = "1280x720", value_parser = parse_window_size)]
     pub size: (u32, u32),
     /// Quit after this many frames (for scripts and tests).
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
@@ -590,6 +590,21 @@ fn update_title(t: &mut TitleStats, g: &Gfx, stats: &FrameStats, dt: f64) {
         g.window.set_title(&title(&mean, g.es, t.wall_s * 1e3 / n));
         *t = TitleStats::default();
     }
+}
+
+/// Largest side a window may ask for: X11's sizes are 16-bit, and winit panicked converting a
+/// side of 65 536 (a side the GL cannot draw is refused later, naming its limit).
+const MAX_WINDOW_SIDE: u32 = u16::MAX as u32;
+
+/// `--size` of a window: [`crate::render::parse_size`], each side at most [`MAX_WINDOW_SIDE`].
+fn parse_window_size(s: &str) -> Result<(u32, u32), String> {
+    let (w, h) = crate::render::parse_size(s)?;
+    if w.max(h) > MAX_WINDOW_SIDE {
+        return Err(format!(
+            "size {w}x{h}: a window side is at most {MAX_WINDOW_SIDE}"
+        ));
+    }
+    Ok((w, h))
 }
 
 #[cfg(test)]
