@@ -819,6 +819,18 @@ fn the_command_lines_thread_is_one_of_the_assignment_pool() {
             v["assign_pool"]
         );
     }
+    // rayon's older variable, read where the first is no count, within the same cap: rayon
+    // itself read it unchecked, and 3 000 started 3 000 threads.
+    let env = [("RAYON_NUM_THREADS", ""), ("RAYON_RS_NUM_CPUS", "3000")];
+    let out = manylight(&["info", "--json"], &env, dir.path());
+    assert!(out.status.success(), "{}", text(&out));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["assign_pool"]["threads"], 256, "{}", v["assign_pool"]);
+    let said = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        said.contains("RAYON_RS_NUM_CPUS=3000 taken as 256"),
+        "{said}"
+    );
 }
 
 #[test]

@@ -1,5 +1,5 @@
-//! rayon's global pool as the command line builds it: its size from `RAYON_NUM_THREADS`,
-//! checked, and the main thread one of its threads.
+//! rayon's global pool as the command line builds it: its size from `RAYON_NUM_THREADS` (or
+//! the older `RAYON_RS_NUM_CPUS`), checked, and the main thread one of its threads.
 
 use manylight::scene::shown;
 
@@ -12,33 +12,39 @@ const MAX_POOL_THREADS: usize = 256;
 /// queue the work and wait, its own core idle, until a pool thread woke to take it
 /// (milliseconds for a core that slept: docs/performance.md, `pool_wake`).
 pub fn join_rayon_pool() {
-    let mut pool = rayon::ThreadPoolBuilder::new().use_current_thread();
-    if let Some(threads) = std::env::var_os("RAYON_NUM_THREADS").and_then(|v| threads_asked(&v)) {
-        pool = pool.num_threads(threads);
-    }
+    // Always a count of our own: rayon falls back to the deprecated `RAYON_RS_NUM_CPUS`
+    // unchecked, and 3 000 there started 3 000 threads (10 s before `info` printed a line).
+    let asked = ["RAYON_NUM_THREADS", "RAYON_RS_NUM_CPUS"]
+        .into_iter()
+        .find_map(|name| threads_asked(name, &std::env::var_os(name)?));
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let threads = asked.unwrap_or(cores.min(MAX_POOL_THREADS));
+    let pool = rayon::ThreadPoolBuilder::new()
+        .use_current_thread()
+        .num_threads(threads);
     if let Err(e) = pool.build_global() {
-        log::debug!("rayon's global pool left as it was: {e}");
+        log::warn!("rayon's pool of {threads} threads could not start ({e}): the counts of threads said may be wrong");
     }
 }
 
-/// The pool size `RAYON_NUM_THREADS=value` asks for, as rayon reads it (`0`: one a core, `None`
-/// here), with a warning where it is no count (rayon ignored it without a word: one a core)
-/// or past [`MAX_POOL_THREADS`] (taken as that).
-fn threads_asked(value: &std::ffi::OsStr) -> Option<usize> {
+/// The pool size `name=value` asks for, as rayon reads it (`0`: one a core, `None` here), with
+/// a warning where it is no count (rayon ignored it without a word) or past
+/// [`MAX_POOL_THREADS`] (taken as that).
+fn threads_asked(name: &str, value: &std::ffi::OsStr) -> Option<usize> {
     let text = value.to_string_lossy();
     match text.parse::<usize>() {
         Ok(0) => None,
         Ok(n) if n > MAX_POOL_THREADS => {
             log::warn!(
-                "RAYON_NUM_THREADS={n} taken as {MAX_POOL_THREADS}, the most the pool takes \
-                 (each thread costs a stack)"
+                "{name}={n} taken as {MAX_POOL_THREADS}, the most the pool takes (each thread \
+                 costs a stack)"
             );
             Some(MAX_POOL_THREADS)
         }
         Ok(n) => Some(n),
         Err(_) => {
             let value = shown::name(&text);
-            log::warn!("RAYON_NUM_THREADS={value} is not a thread count: one thread a core");
+            log::warn!("{name}={value} is not a thread count: ignored");
             None
         }
     }
@@ -50,7 +56,7 @@ mod tests {
 
     #[test]
     fn a_thread_count_past_the_most_or_no_count_is_said_and_replaced() {
-        let asked = |v: &str| threads_asked(std::ffi::OsStr::new(v));
+        let asked = |v: &str| threads_asked("RAYON_NUM_THREADS", std::ffi::OsStr::new(v));
         assert_eq!(asked("2"), Some(2));
         assert_eq!(asked("0"), None);
         assert_eq!(asked("5000"), Some(MAX_POOL_THREADS));
