@@ -4,8 +4,10 @@
 //!
 //! A regular file is written to a hidden temporary file beside it (`.NAME.PID.N.tmp`) that is
 //! renamed over it once complete: a failure half-way (a full disk) leaves the old file, or
-//! none, never a truncated one that looks valid. A device, FIFO or socket, and any path under
-//! `/dev` or `/proc` (`/dev/stdout`, whatever it points at), is written in place.
+//! none, never a truncated one that looks valid. A device, FIFO or socket, standard output
+//! (`-`, `/dev/stdout`: from where the shell left it, whatever it is) and a name that reopens a
+//! descriptor (`/dev/fd/N`, `/proc/self/fd/N`: truncated) are written in place. A FIFO that no
+//! process reads is an error, not a wait.
 
 use std::ffi::OsString;
 use std::fs::{File, OpenOptions, Permissions};
@@ -48,7 +50,8 @@ enum Target {
         dest: PathBuf,
         permissions: Option<Permissions>,
     },
-    /// A device, FIFO or socket, written in place.
+    /// Written in place: a device, FIFO or socket, standard output, or a regular file a
+    /// descriptor's name reopens.
     InPlace,
 }
 
@@ -99,7 +102,7 @@ impl OutputFile {
         let opened = match own_stdout_named(path) {
             _ if dash => stdout_file(),
             Some(own) => own.try_clone(),
-            None => OpenOptions::new().write(true).open(path),
+            None => open_without_waiting(path),
         };
         let (target, file) = match opened {
             Ok(existing) => {
@@ -226,6 +229,39 @@ impl Drop for OutputFile {
             live.retain(|t| t != temp);
         }
     }
+}
+
+/// `path` opened for writing, without waiting for a reader: opening a FIFO that no process
+/// reads blocked until one came, so `--out fifo` hung before any work, saying nothing. Such a
+/// FIFO is an error now; one with a reader is opened again as usual (blocking writes).
+fn open_without_waiting(path: &Path) -> io::Result<File> {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::{FileTypeExt, OpenOptionsExt};
+        let probe = OpenOptions::new()
+            .write(true)
+            .custom_flags(libc::O_NONBLOCK | libc::O_NOCTTY)
+            .open(path);
+        match probe {
+            Err(e)
+                if e.raw_os_error() == Some(libc::ENXIO)
+                    && std::fs::metadata(path).is_ok_and(|m| m.file_type().is_fifo()) =>
+            {
+                Err(io::Error::other(
+                    "a FIFO that no process reads: start its reader first",
+                ))
+            }
+            Ok(file) if file.metadata()?.file_type().is_fifo() => {
+                OpenOptions::new().write(true).open(path)
+            }
+            Ok(file) if file.metadata()?.is_file() => Ok(file),
+            // A device (a terminal's writes must not fail for want of room): as usual.
+            Ok(_) => OpenOptions::new().write(true).open(path),
+            Err(e) => Err(e),
+        }
+    }
+    #[cfg(not(unix))]
+    OpenOptions::new().write(true).open(path)
 }
 
 /// Whether `path` is one of the system's names for an open descriptor (`/dev/stdout`,

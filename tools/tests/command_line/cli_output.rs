@@ -609,3 +609,76 @@ fn a_file_under_dev_is_replaced_whole() {
     assert_ne!(std::fs::metadata(&path).unwrap().ino(), before);
     assert!(image::open(&path).is_ok());
 }
+
+/// An output naming a FIFO that no process reads is an error at once: opening it waited for a
+/// reader, so `--out fifo` hung before any work, saying nothing. With a reader it is written.
+#[test]
+#[cfg(unix)]
+fn a_fifo_without_a_reader_is_an_error_not_a_wait() {
+    let dir = tempfile::tempdir().unwrap();
+    let fifo = dir.path().join("fifo");
+    let made = std::process::Command::new("mkfifo").arg(&fifo).status();
+    if !made.is_ok_and(|s| s.success()) {
+        eprintln!("no mkfifo here: nothing to check");
+        return;
+    }
+    let run = |args: &[&str]| {
+        let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_manylight"))
+            .args(args)
+            .current_dir(dir.path())
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        let start = std::time::Instant::now();
+        while child.try_wait().unwrap().is_none() {
+            if start.elapsed() > std::time::Duration::from_secs(120) {
+                child.kill().unwrap();
+                panic!("{args:?} still waits after two minutes");
+            }
+            std::thread::sleep(std::time::Duration::from_millis(20));
+        }
+        child.wait_with_output().unwrap()
+    };
+    for args in [
+        ["--size", "16x9", "--lights", "2", "--out", "fifo"],
+        ["--size", "16x9", "--out", "a.png", "--stats", "fifo"],
+    ] {
+        let out = run(&args);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {stderr}");
+        assert!(stderr.contains("no process reads"), "{stderr}");
+    }
+    // A reader waiting (opened without waiting for a writer, so it is there before the
+    // command starts): the PNG reaches it.
+    use std::io::Read;
+    use std::os::unix::fs::OpenOptionsExt;
+    let mut source = std::fs::OpenOptions::new()
+        .read(true)
+        .custom_flags(libc::O_NONBLOCK)
+        .open(&fifo)
+        .unwrap();
+    let reader = std::thread::spawn(move || {
+        let (mut png, mut buffer) = (Vec::new(), [0u8; 4096]);
+        let start = std::time::Instant::now();
+        // Until the writer has come and gone: no writer yet reads as an end too.
+        while start.elapsed() < std::time::Duration::from_secs(120) {
+            match source.read(&mut buffer) {
+                Ok(0) if !png.is_empty() => break,
+                Ok(n) => png.extend_from_slice(&buffer[..n]),
+                Err(e) if e.kind() == std::io::ErrorKind::WouldBlock => {}
+                Err(e) => panic!("reading the FIFO: {e}"),
+            }
+            std::thread::sleep(std::time::Duration::from_millis(5));
+        }
+        png
+    });
+    let out = run(&["--size", "16x9", "--lights", "2", "--out", "fifo"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let png = reader.join().unwrap();
+    assert!(image::load_from_memory(&png).is_ok());
+}
