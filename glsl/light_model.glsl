@@ -193,12 +193,17 @@ bool lightReaches(Light light, HIGHP vec3 P) {
     if (m >= light.radius) {
         return false;
     }
-    HIGHP vec3 s = m > LIGHT_MIN_DISTANCE ? toLight / m : vec3(0.0);
+    // At the light (the cone's apex) there is no direction: it reaches, whichever way its
+    // cone's terms are written (from the front or turned round, they disagree at L = 0).
+    if (m <= LIGHT_MIN_DISTANCE) {
+        return true;
+    }
+    HIGHP vec3 s = toLight / m;
     if (m / light.radius * length(s) >= 1.0) {
         return false;
     }
 #if HAS_SPOT
-    HIGHP vec3 L = m > LIGHT_MIN_DISTANCE ? normalize(s) : vec3(0.0);
+    HIGHP vec3 L = normalize(s);
     HIGHP vec3 chord = L + light.direction;
     return light.spotOffset - 0.5 * light.spotScale * dot(chord, chord) > 0.0;
 #else

@@ -28,7 +28,7 @@ VARYING vec4 v_color;
 
 #if HAS_NORMAL_MAP
 // HIGHP: a sampler is lowp by default, and a lowp texel (fp16 on llvmpipe) tilts the normal by
-// ~3e-4, which a light a millimetre from the surface turns into 25/255 (docs/precision.md).
+// ~3e-4, which a bright light a millimetre above the surface turned into 226/255 (docs/gltf.md).
 uniform HIGHP sampler2D u_normalTex;
 uniform float u_normalScale;
 // View-space tangent, bitangent sign in w.

@@ -371,29 +371,6 @@ mod tests {
 
     /// The spot term `t = offset − scale·(1 − cos θ)` is full (≥ 1) up to the inner angle and
     /// gone (≤ 0) one width past it, at the outer angle where the edge is wider than
-    /// A cone turned round (RGBA8 records and the shaders, past 90° inside) fades as the
-    /// cone does from the front: the same `t` at every angle.
-    #[test]
-    fn a_cone_turned_round_has_the_same_fade() {
-        for outer in [95.0, 120.0, 170.0, 179.9, 180.0] {
-            for inner in [91.0, outer - 10.0, outer - 0.01, outer] {
-                let (scale, offset) = spot_terms(outer, inner);
-                let (back_scale, back_offset) =
-                    spot_terms_from_half_cosines(half_cosine(outer), half_cosine(inner));
-                assert!(back_scale < 0.0, "{outer}/{inner}");
-                for deg in (0..=1800).map(|d| d as f64 * 0.1) {
-                    let cos = deg.to_radians().cos();
-                    let front = offset - scale * (1.0 - cos);
-                    let back = back_offset - back_scale * (1.0 + cos);
-                    assert!(
-                        (front - back).abs() <= 1e-9 * scale.max(1.0) * offset.max(1.0),
-                        "{outer}/{inner} at {deg}°: {front} from the front, {back} turned"
-                    );
-                }
-            }
-        }
-    }
-
     /// `SPOT_MIN_COS_DELTA`: cones narrower than that width (under 0.81°) kept their axis at
     /// (1 − cos(outer)) / 10⁻⁴ of the intensity (32 % at 0.5°, 0 at 0°).
     #[test]
@@ -420,6 +397,29 @@ mod tests {
                     edge >= outer - 1e-9,
                     "{outer}/{inner}: the edge {edge} inside the cone"
                 );
+            }
+        }
+    }
+
+    /// A cone turned round (RGBA8 records and the shaders, past 90° inside) fades as the
+    /// cone does from the front: the same `t` at every angle.
+    #[test]
+    fn a_cone_turned_round_has_the_same_fade() {
+        for outer in [95.0, 120.0, 170.0, 179.9, 180.0] {
+            for inner in [91.0, outer - 10.0, outer - 0.01, outer] {
+                let (scale, offset) = spot_terms(outer, inner);
+                let (back_scale, back_offset) =
+                    spot_terms_from_half_cosines(half_cosine(outer), half_cosine(inner));
+                assert!(back_scale < 0.0, "{outer}/{inner}");
+                for deg in (0..=1800).map(|d| d as f64 * 0.1) {
+                    let cos = deg.to_radians().cos();
+                    let front = offset - scale * (1.0 - cos);
+                    let back = back_offset - back_scale * (1.0 + cos);
+                    assert!(
+                        (front - back).abs() <= 1e-9 * offset.abs().max(1.0),
+                        "{outer}/{inner} at {deg}°: {front} from the front, {back} turned"
+                    );
+                }
             }
         }
     }

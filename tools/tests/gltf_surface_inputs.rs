@@ -875,6 +875,17 @@ fn values_past_f32_are_warned_of_by_path() {
         "{all}"
     );
     assert_eq!(s.materials[0].maps.emissive, Vec3::new(1024.0, 512.0, 0.0));
+    // A factor past f32 at strength 0 emits nothing (0 × ∞), as at any other strength 0.
+    let material = json!({
+        "pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.7, 0.6, 1.0]},
+        "emissiveFactor": [1e300, 0.5, 0.0],
+        "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 0.0}},
+    });
+    let mut plane = Plane::new(material);
+    plane.extensions.push("KHR_materials_emissive_strength");
+    let path = plane.write(dir.path(), "dark.gltf");
+    let (s, _) = scene_of(&path, grazing_light(), 0.02);
+    assert_eq!(s.materials[0].maps.emissive, Vec3::ZERO);
     assert!(
         all.contains("baseColorFactor [3e38, 0.5, 0.5] clamped to [1024, 0.5, 0.5]"),
         "{all}"

@@ -663,11 +663,13 @@ fn validating_a_scene_of_every_part_allocates_nothing() {
     );
 }
 
-/// Contexts made and dropped again and again, on one thread and on one thread after another
-/// (a test harness's way), keep no file descriptor or connection behind. ANGLE kept an X
-/// connection from each `eglInitialize`, and the display was terminated at each last drop and
-/// initialised again: its 255th context failed ("eglInitialize failed: EGL_NOT_INITIALIZED",
-/// Xvfb's 256 clients). It is now terminated only when another thread makes the next one.
+/// Contexts made and dropped again and again on one thread keep no file descriptor or
+/// connection behind, and on one thread after another (a test harness's way) at most one a
+/// thread. ANGLE keeps an X connection from each `eglInitialize`, and the display was
+/// terminated at each last drop and initialised again: its 255th context failed
+/// ("eglInitialize failed: EGL_NOT_INITIALIZED", Xvfb's 256 clients). It is now terminated
+/// only when another thread makes the next one (docs/drivers.md: a thread change still costs
+/// a connection there).
 #[test]
 #[cfg(target_os = "linux")]
 fn contexts_made_and_dropped_again_and_again_keep_nothing_open() {

@@ -15,7 +15,9 @@
 //!   t1: rad.r/k² rad.g/k² rad.b/k² k          radiance in fp16 range: k = 2^e, e ≥ 0 the
 //!                                             least with max(rad)/k² ≤ 1, rad at most 2³⁰
 //!   spots only:
-//!   t2: dir.x   dir.y   dir.z   spot_offset   unit view-space spot axis
+//!   t2: dir.x   dir.y   dir.z   spot_offset   unit view-space spot axis (reversed, with
+//!                                             scale and offset, past 90° inside:
+//!                                             [`shader_spot_terms`])
 //!   t3: spot_scale  -  -  -                   (FP16_LIGHTS, where t1.w holds k)
 //!   → 2 texels (32 bytes) a light, 4 (64 bytes) with spots
 //!
@@ -34,7 +36,8 @@
 //!
 //! The spot terms are `t = clamp(spot_offset − spot_scale·(1 − cos), 0, 1)` (see
 //! [`crate::scene::Light::spot_scale_offset`]); the Rgba8 layout stores the half-angles' sines
-//! instead and the shader rebuilds scale and offset with arithmetic alone (`scale` reaches 10⁴
+//! (cosines for a cone turned round) instead and the shader rebuilds scale and offset with
+//! arithmetic alone (`scale` reaches 10⁴
 //! for hard-edged cones; rebuilding it from angles needed `sin`, whose precision GLSL ES leaves
 //! to the implementation: SwiftShader's moved hard cone edges by up to 55/255).
 

@@ -358,7 +358,7 @@ fn emission(m: &gltf::Material) -> (Vec3, Vec3) {
         0.0
     };
     let brightest = f64::from(factor.max_element());
-    let kept = if brightest == 0.0 {
+    let kept = if brightest == 0.0 || strength == 0.0 {
         Vec3::ZERO
     } else if brightest.is_infinite() {
         // A factor past f32 in the file: its infinite channels at the cap, the rest dark.

@@ -14,9 +14,11 @@ const MAX_POOL_THREADS: usize = 256;
 pub fn join_rayon_pool() {
     // Always a count of our own: rayon falls back to the deprecated `RAYON_RS_NUM_CPUS`
     // unchecked, and 3 000 there started 3 000 threads (10 s before `info` printed a line).
+    // The first variable that is a count decides (`0`: the cores), as rayon reads them.
     let asked = ["RAYON_NUM_THREADS", "RAYON_RS_NUM_CPUS"]
         .into_iter()
-        .find_map(|name| threads_asked(name, &std::env::var_os(name)?));
+        .find_map(|name| threads_asked(name, &std::env::var_os(name)?).ok())
+        .flatten();
     let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
     let threads = asked.unwrap_or(cores.min(MAX_POOL_THREADS));
     let pool = rayon::ThreadPoolBuilder::new()
@@ -27,25 +29,25 @@ pub fn join_rayon_pool() {
     }
 }
 
-/// The pool size `name=value` asks for, as rayon reads it (`0`: one a core, `None` here), with
-/// a warning where it is no count (rayon ignored it without a word) or past
+/// The pool size `name=value` asks for, as rayon reads it (`0`: one a core, `Ok(None)`
+/// here), with a warning where it is no count (`Err`: rayon ignored it without a word) or past
 /// [`MAX_POOL_THREADS`] (taken as that).
-fn threads_asked(name: &str, value: &std::ffi::OsStr) -> Option<usize> {
+fn threads_asked(name: &str, value: &std::ffi::OsStr) -> Result<Option<usize>, ()> {
     let text = value.to_string_lossy();
     match text.parse::<usize>() {
-        Ok(0) => None,
+        Ok(0) => Ok(None),
         Ok(n) if n > MAX_POOL_THREADS => {
             log::warn!(
                 "{name}={n} taken as {MAX_POOL_THREADS}, the most the pool takes (each thread \
                  costs a stack)"
             );
-            Some(MAX_POOL_THREADS)
+            Ok(Some(MAX_POOL_THREADS))
         }
-        Ok(n) => Some(n),
+        Ok(n) => Ok(Some(n)),
         Err(_) => {
             let value = shown::name(&text);
             log::warn!("{name}={value} is not a thread count: ignored");
-            None
+            Err(())
         }
     }
 }
@@ -57,11 +59,11 @@ mod tests {
     #[test]
     fn a_thread_count_past_the_most_or_no_count_is_said_and_replaced() {
         let asked = |v: &str| threads_asked("RAYON_NUM_THREADS", std::ffi::OsStr::new(v));
-        assert_eq!(asked("2"), Some(2));
-        assert_eq!(asked("0"), None);
-        assert_eq!(asked("5000"), Some(MAX_POOL_THREADS));
-        assert_eq!(asked("18446744073709551616"), None);
-        assert_eq!(asked("-1"), None);
-        assert_eq!(asked("abc"), None);
+        assert_eq!(asked("2"), Ok(Some(2)));
+        assert_eq!(asked("0"), Ok(None));
+        assert_eq!(asked("5000"), Ok(Some(MAX_POOL_THREADS)));
+        assert_eq!(asked("18446744073709551616"), Err(()));
+        assert_eq!(asked("-1"), Err(()));
+        assert_eq!(asked("abc"), Err(()));
     }
 }
