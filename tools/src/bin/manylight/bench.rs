@@ -482,12 +482,8 @@ pub fn run(args: &BenchArgs) -> Result<(), Box<dyn std::error::Error>> {
         }
         if plan.animated_frames > 0 && !knob_scene.is_empty() {
             let scene = load_bench_scene(&knob_scene, knob_lights, args)?;
-            let workload = AnimatedWorkload {
-                scene,
-                name: scene_name(&knob_scene),
-                size: plan.size,
-                frames: plan.animated_frames,
-            };
+            let name = scene_name(&knob_scene);
+            let mut workload = AnimatedWorkload::new(scene, name, plan.size, plan.animated_frames);
             for method in &plan.methods {
                 let name = &workload.name;
                 progress.set_message(format!("{es} {name} animated: {method}"));
@@ -729,16 +725,37 @@ const ANIMATED_FPS: f64 = 30.0;
 /// The animated workload: the scene's lights moving (the lively default where the scene has
 /// no motion of its own) and the camera panning ±8° about its target every 4 s.
 struct AnimatedWorkload {
+    /// Posed by each method's run in turn, never copied: a copy a method doubled the lights'
+    /// memory, which the light count's memory check had not allowed for (4 194 304 lights
+    /// aborted under a 3 GiB limit).
     scene: Scene,
+    /// The camera the pan swings about.
+    start: scene::Camera,
     name: String,
     size: (u32, u32),
     frames: u32,
 }
 
 impl AnimatedWorkload {
+    fn new(mut scene: Scene, name: String, size: (u32, u32), frames: u32) -> AnimatedWorkload {
+        if !scene.is_animated() {
+            if let Some(bounds) = scene.bounds() {
+                let motion = scene::builtin::lively_motion(&name, &bounds);
+                scene.animate_lights(0..scene.lights.len(), motion, 1);
+            }
+        }
+        AnimatedWorkload {
+            start: scene.camera,
+            scene,
+            name,
+            size,
+            frames,
+        }
+    }
+
     /// One method's row; `None` where it cannot run here.
     fn run(
-        &self,
+        &mut self,
         renderer: &mut Renderer,
         method: &str,
         es: EsVersion,
@@ -747,14 +764,9 @@ impl AnimatedWorkload {
         if matches!((desc.supported)(renderer.caps()), Support::Unsupported(_)) {
             return Ok(None);
         }
-        let mut scene = self.scene.clone();
-        if !scene.is_animated() {
-            if let Some(bounds) = scene.bounds() {
-                let motion = scene::builtin::lively_motion(&self.name, &bounds);
-                scene.animate_lights(0..scene.lights.len(), motion, 1);
-            }
-        }
-        let start = scene.camera;
+        // Every frame poses the scene (its time and the camera) before it is drawn.
+        let scene = &mut self.scene;
+        let start = self.start;
         let mut pose = move |s: &mut Scene, t: f64| {
             s.set_time(t);
             let swing = 8f64.to_radians() * (std::f64::consts::TAU * t / 4.0).sin();
@@ -770,7 +782,7 @@ impl AnimatedWorkload {
         let options = RenderOptions::default();
         let rendered = match crate::sequence::render(
             renderer,
-            &mut scene,
+            scene,
             self.size,
             &options,
             &timeline,
@@ -792,7 +804,7 @@ impl AnimatedWorkload {
         } else {
             renderer.set_method_named("forward")?;
             let (w, h) = self.size;
-            let (reference, _) = renderer.render_offscreen(&scene, w, h, &options)?;
+            let (reference, _) = renderer.render_offscreen(scene, w, h, &options)?;
             let last = rendered.last.as_ref().unwrap_or(&rendered.first);
             Some(manylight::metrics::diff(&reference, last).max_abs)
         };
