@@ -682,3 +682,27 @@ fn a_fifo_without_a_reader_is_an_error_not_a_wait() {
     let png = reader.join().unwrap();
     assert!(image::load_from_memory(&png).is_ok());
 }
+
+/// `--out a.jpg` writes a PNG (the only format), which it did without a word: a warning says
+/// so; `.png` in any case and no extension say nothing.
+#[test]
+fn a_picture_named_as_another_format_is_warned_of() {
+    let dir = tempfile::tempdir().unwrap();
+    for (name, warned) in [("a.jpg", true), ("b.PNG", false), ("c", false)] {
+        let out = manylight(
+            &["--size", "16x9", "--lights", "2", "--out", name],
+            &[],
+            dir.path(),
+        );
+        assert!(out.status.success(), "{}", text(&out));
+        let said = text(&out);
+        assert_eq!(
+            said.contains("the picture is a PNG"),
+            warned,
+            "{name}: {said}"
+        );
+        let bytes = std::fs::read(dir.path().join(name)).unwrap();
+        let format = image::guess_format(&bytes).unwrap();
+        assert_eq!(format, image::ImageFormat::Png, "{name}");
+    }
+}

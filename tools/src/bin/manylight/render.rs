@@ -293,6 +293,21 @@ pub fn lights_for(spec: &str, count: Option<usize>, seed: u64) -> Option<(usize,
     }
 }
 
+/// Warns where `--out` names another image format by its extension (`a.jpg`): the picture is
+/// a PNG whatever the name, which was written without a word.
+fn warn_not_png(path: &std::path::Path) {
+    let extension = path
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase());
+    if let Some(extension) = extension.filter(|e| e != "png") {
+        log::warn!(
+            "--out {}: the picture is a PNG, whatever its name's .{} says",
+            shown::path(path),
+            shown::name(&extension)
+        );
+    }
+}
+
 /// Runs the command.
 pub fn run(args: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
     let lights = lights_for(&args.scene, args.lights, args.seed);
@@ -304,6 +319,9 @@ pub fn run(args: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
         (None, None) => Some(std::path::Path::new(DEFAULT_OUT)),
         (None, Some(_)) => None,
     };
+    if let Some(path) = out.filter(|p| !manylight_tools::output::names_stdout(p)) {
+        warn_not_png(path);
+    }
     // Opened before rendering: a path that cannot be written fails now, not after the frames.
     let out_file = out.map(OutputFile::create).transpose()?;
     let stats_out = args.stats.as_deref().map(JsonOut::create).transpose()?;

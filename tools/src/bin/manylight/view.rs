@@ -454,7 +454,7 @@ impl App<'_> {
             Ok(()) => {}
             // MSAA this context or method cannot do: said once, and off again.
             Err(e) if self.samples > 1 && e.to_string().contains("MSAA") => {
-                eprintln!("error: {e}; MSAA off");
+                eprintln!("warning: {e}; MSAA off");
                 self.samples = 1;
                 return Ok(());
             }
