@@ -295,6 +295,31 @@ fn scenes_that_would_report_under_one_name_are_refused() {
     }
 }
 
+/// A report file that cannot be written (a folder named `report.json` in the output folder)
+/// ends the sweep before it measures anything: it was found once every row was measured.
+#[test]
+fn a_report_file_in_the_way_is_refused_before_the_sweep() {
+    let dir = tempfile::tempdir().unwrap();
+    let report = dir.path().join("report");
+    std::fs::create_dir_all(report.join("report.json")).unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_manylight"))
+        .args(["bench", "--scenes", "plane", "--lights", "8", "--es", "3"])
+        .args(["--size", "16x9", "--no-knobs", "--animated-frames", "0"])
+        .arg("--out")
+        .arg(&report)
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("report.json") && stderr.contains("a folder is in the way"),
+        "{stderr}"
+    );
+    // Nothing measured: only the folder in the way is there.
+    assert_eq!(std::fs::read_dir(&report).unwrap().count(), 1, "{stderr}");
+}
+
 /// Edge values of the sweep: `--cpu-samples 0` (no CPU reference, documented as "—") panicked
 /// at its first reference; an output folder whose name is not Unicode panicked once every row
 /// was measured, before the report; a light count past what forward's loop holds here (no

@@ -17,7 +17,7 @@ use manylight::methods::{Support, METHODS};
 use manylight::metrics::cpu_reference::{self, Encoding, ReferenceSet};
 use manylight::renderer::{CountKind, LightCounts};
 use manylight::scene::raycast::SceneRaycaster;
-use manylight::scene::{self, Scene};
+use manylight::scene::{self, shown, Scene};
 use manylight::{EsVersion, RenderOptions, Renderer};
 use manylight_tools::animated::AnimatedRow;
 use manylight_tools::report::{self, BenchRow, Pictures, Report};
@@ -354,6 +354,21 @@ pub fn run(args: &BenchArgs) -> Result<(), Box<dyn std::error::Error>> {
     std::fs::write(&probe, b"")
         .and_then(|()| std::fs::remove_file(&probe))
         .map_err(|e| format!("cannot write into {}: {e}", args.out.display()))?;
+    // The report's own files, where something is in the way (a folder of that name, a file
+    // that cannot be written): found after the whole sweep before.
+    for name in ["report.json", "report.md"] {
+        let path = args.out.join(name);
+        let blocked = match std::fs::symlink_metadata(&path) {
+            Ok(meta) if meta.is_dir() => Some("a folder is in the way".to_string()),
+            Ok(_) => {
+                (std::fs::OpenOptions::new().write(true).open(&path).err()).map(|e| e.to_string())
+            }
+            Err(_) => None,
+        };
+        if let Some(why) = blocked {
+            return Err(format!("cannot write {}: {why}", shown::path(&path)).into());
+        }
+    }
     // Rows, pictures and chart series are named by the scene's file stem: two alike would
     // overwrite each other's pictures and merge into one series.
     let mut labels = std::collections::HashMap::new();
