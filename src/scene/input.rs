@@ -10,7 +10,7 @@
 //! every kind at once with `MANYLIGHT_MAX_FILE_MB`.
 
 use std::io::Read;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use super::SceneError;
 
@@ -103,6 +103,26 @@ thread_local! {
     static BYTES_READ: std::cell::Cell<u64> = const { std::cell::Cell::new(0) };
 }
 
+thread_local! {
+    /// The files [`read_bounded`] has read on this thread while [`recording_files_read`] runs.
+    static FILES_READ: std::cell::RefCell<Option<std::collections::BTreeSet<PathBuf>>> =
+        const { std::cell::RefCell::new(None) };
+}
+
+/// Runs `load`, returning what it returned and every file it read (canonical paths, each
+/// once). Nested, the inner load's files count for the outer one too.
+pub(crate) fn recording_files_read<T>(load: impl FnOnce() -> T) -> (T, Vec<PathBuf>) {
+    let outer = FILES_READ.with(|f| f.replace(Some(Default::default())));
+    let value = load();
+    let read = FILES_READ.with(|f| f.replace(outer)).unwrap_or_default();
+    FILES_READ.with(|f| {
+        if let Some(outer) = f.borrow_mut().as_mut() {
+            outer.extend(read.iter().cloned());
+        }
+    });
+    (value, read.into_iter().collect())
+}
+
 /// Bytes [`read_bounded`] has read on this thread so far (a running count: a caller takes
 /// the difference over what it measures).
 pub fn bytes_read() -> u64 {
@@ -189,6 +209,11 @@ fn read_limited(
     let most = prefix.map_or(limit.saturating_add(1), |p| p.min(limit.saturating_add(1)));
     file.take(most).read_to_end(&mut bytes).map_err(io)?;
     BYTES_READ.with(|read| read.set(read.get().saturating_add(bytes.len() as u64)));
+    FILES_READ.with(|files| {
+        if let Some(files) = files.borrow_mut().as_mut() {
+            files.insert(std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf()));
+        }
+    });
     if bytes.len() as u64 > limit {
         return Err(too_big(bytes.len() as u64));
     }

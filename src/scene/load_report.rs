@@ -1,4 +1,4 @@
-//! What a scene load produced besides the scene: its warnings.
+//! What a scene load produced besides the scene: its warnings and the files it read.
 
 use super::{said, shown};
 
@@ -8,6 +8,10 @@ use super::{said, shown};
 pub struct LoadReport {
     /// Human-readable warnings, also logged; from `scene::load_with`, each once.
     pub warnings: Vec<String>,
+    /// Every file the load read (the scene file, models, MTL libraries, buffers, textures),
+    /// each once, by its canonical path: for a caller that writes files, where writing one of
+    /// these would replace the scene's own input.
+    pub files: Vec<std::path::PathBuf>,
 }
 
 impl LoadReport {

@@ -507,7 +507,12 @@ pub fn load_with(
     lights: Option<(usize, u64)>,
     options: &LoadOptions,
 ) -> Result<(Scene, LoadReport), SceneError> {
-    said::once_each(|| load_held(spec, lights, options))
+    let (loaded, files) =
+        input::recording_files_read(|| said::once_each(|| load_held(spec, lights, options)));
+    loaded.map(|(scene, mut report)| {
+        report.files = files;
+        (scene, report)
+    })
 }
 
 /// [`load_with`], its warnings held back by the caller.

@@ -706,3 +706,43 @@ fn a_picture_named_as_another_format_is_warned_of() {
         assert_eq!(format, image::ImageFormat::Png, "{name}");
     }
 }
+
+/// An output naming a file the scene reads (its model, the model's MTL library, a texture) is
+/// an error before anything is written: `--out q.obj` replaced the model with a picture, exit 0.
+#[test]
+fn an_output_naming_a_file_the_scene_reads_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let obj = "mtllib q.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nusemtl m\nf 1/1 2/2 3/3\n";
+    std::fs::write(dir.path().join("q.obj"), obj).unwrap();
+    std::fs::write(
+        dir.path().join("q.mtl"),
+        "newmtl m\nKd 1 1 1\nmap_Kd t.png\n",
+    )
+    .unwrap();
+    image::RgbaImage::from_pixel(2, 2, image::Rgba([200, 100, 50, 255]))
+        .save(dir.path().join("t.png"))
+        .unwrap();
+    let scene = r#"{"objects":[{"obj":"q.obj"}],"random_lights":{"count":4}}"#;
+    std::fs::write(dir.path().join("s.json"), scene).unwrap();
+    for (option, file) in [
+        ("--out", "q.obj"),
+        ("--stats", "q.mtl"),
+        ("--out", "./t.png"),
+    ] {
+        let before = std::fs::read(dir.path().join(file)).unwrap();
+        let args = ["--scene", "s.json", "--size", "16x9", option, file];
+        let out = manylight(&args, &[], dir.path());
+        let said = text(&out);
+        assert_eq!(out.status.code(), Some(1), "{option} {file}: {said}");
+        assert!(said.contains("names a file the scene reads"), "{said}");
+        assert_eq!(
+            std::fs::read(dir.path().join(file)).unwrap(),
+            before,
+            "{file}"
+        );
+    }
+    // Another name is written as usual.
+    let args = ["--scene", "s.json", "--size", "16x9", "--out", "p.png"];
+    let out = manylight(&args, &[], dir.path());
+    assert!(out.status.success(), "{}", text(&out));
+}

@@ -293,6 +293,28 @@ pub fn lights_for(spec: &str, count: Option<usize>, seed: u64) -> Option<(usize,
     }
 }
 
+/// An output naming a file the scene read (a model, a texture: `--out model.obj`) would replace
+/// it: an error naming both, before anything is written. (The scene file itself is a usage
+/// error before the load: `check_not_the_input`.)
+fn check_not_read(
+    outputs: &[(&str, Option<&std::path::Path>)],
+    read: &[PathBuf],
+) -> Result<(), String> {
+    for (option, path) in outputs {
+        let Some(path) = path.filter(|p| !manylight_tools::output::is_stream(p)) else {
+            continue;
+        };
+        let id = manylight_tools::output::identity(path);
+        if read.contains(&id) {
+            return Err(format!(
+                "{option} {} names a file the scene reads: it would be overwritten",
+                shown::path(path)
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// Warns where `--out` names another image format by its extension (`a.jpg`): the picture is
 /// a PNG whatever the name, which was written without a word.
 fn warn_not_png(path: &std::path::Path) {
@@ -312,13 +334,14 @@ fn warn_not_png(path: &std::path::Path) {
 pub fn run(args: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
     let lights = lights_for(&args.scene, args.lights, args.seed);
     // The loader logs each warning (at `warn`, shown by default): not printed again here.
-    let (mut scene, _logged_warnings) =
-        scene::load_with(&args.scene, lights, &crate::load_options())?;
+    let (mut scene, report) = scene::load_with(&args.scene, lights, &crate::load_options())?;
     let out = match (&args.out, &args.record) {
         (Some(path), _) => Some(path.as_path()),
         (None, None) => Some(std::path::Path::new(DEFAULT_OUT)),
         (None, Some(_)) => None,
     };
+    let outputs = [("--out", out), ("--stats", args.stats.as_deref())];
+    check_not_read(&outputs, &report.files)?;
     if let Some(path) = out.filter(|p| !manylight_tools::output::names_stdout(p)) {
         warn_not_png(path);
     }
