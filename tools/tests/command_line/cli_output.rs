@@ -746,3 +746,29 @@ fn an_output_naming_a_file_the_scene_reads_is_refused() {
     let out = manylight(&args, &[], dir.path());
     assert!(out.status.success(), "{}", text(&out));
 }
+
+/// A `--scene` path that is not UTF-8 is a usage error naming `--scene` (scene paths are
+/// text); it was clap's "invalid UTF-8 was detected in one or more arguments", no option named.
+#[test]
+#[cfg(unix)]
+fn a_scene_path_that_is_not_utf8_is_named_as_the_scene() {
+    use std::os::unix::ffi::OsStrExt;
+    let dir = tempfile::tempdir().unwrap();
+    let name = std::ffi::OsStr::from_bytes(b"x\xff.json");
+    for subcommand in [&["render"][..], &["info"], &["view"]] {
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_manylight"))
+            .args(subcommand)
+            .arg("--scene")
+            .arg(name)
+            .current_dir(dir.path())
+            .env_remove("DISPLAY")
+            .output()
+            .unwrap();
+        let said = text(&out);
+        assert_eq!(out.status.code(), Some(2), "{subcommand:?}: {said}");
+        assert!(
+            said.contains("--scene") && said.contains("not UTF-8"),
+            "{subcommand:?}: {said}"
+        );
+    }
+}

@@ -22,7 +22,7 @@ pub struct InfoArgs {
     /// Also render this scene (built-in, .obj, .gltf/.glb or .json) once with every supported
     /// method and report the shader variants built (features, source size) and each method's
     /// GPU memory.
-    #[arg(long)]
+    #[arg(long, value_parser = crate::SceneSpec)]
     pub scene: Option<String>,
     /// Play a device whose fragment stage has no highp (needs `--es 2`; see `render`).
     #[arg(long)]

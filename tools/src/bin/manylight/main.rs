@@ -304,6 +304,36 @@ fn check_list_length(subcommand: Option<&str>, option: &str, len: usize) {
     }
 }
 
+/// `--scene`'s value as text: a built-in's name or a path the loaders take as UTF-8. A path
+/// that is not UTF-8 was clap's "invalid UTF-8 was detected in one or more arguments", which
+/// named no option.
+#[derive(Clone)]
+struct SceneSpec;
+
+impl clap::builder::TypedValueParser for SceneSpec {
+    type Value = String;
+
+    fn parse_ref(
+        &self,
+        cmd: &clap::Command,
+        arg: Option<&clap::Arg>,
+        value: &std::ffi::OsStr,
+    ) -> Result<String, clap::Error> {
+        value.to_str().map(str::to_owned).ok_or_else(|| {
+            let option = arg.map_or("--scene".to_string(), ToString::to_string);
+            let shown = shown::path(Path::new(value));
+            clap::Error::raw(
+                ErrorKind::InvalidValue,
+                format!(
+                    "{option} {shown}: the path is not UTF-8, which scene paths must be (rename \
+                     the file or its folder)\n"
+                ),
+            )
+            .with_cmd(cmd)
+        })
+    }
+}
+
 /// Two options naming one file (through any spelling or symbolic link), or both standard output,
 /// would overwrite each other's output: a usage error naming both. A device or FIFO
 /// (`/dev/null`) other than standard output may take both.

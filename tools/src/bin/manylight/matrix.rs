@@ -31,7 +31,7 @@ use restriction::Shows;
 #[derive(Parser, Debug)]
 pub struct MatrixArgs {
     /// Scene rendered in every cell.
-    #[arg(long, default_value = scene::builtin::DEFAULT)]
+    #[arg(long, default_value = scene::builtin::DEFAULT, value_parser = crate::SceneSpec)]
     pub scene: String,
     /// Seeded random lights.
     #[arg(long, default_value_t = 256, value_parser = crate::bench_assign::parse_light_count)]

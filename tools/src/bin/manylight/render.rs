@@ -16,7 +16,7 @@ use crate::EsArg;
 pub struct RenderArgs {
     /// A built-in scene (courtyard, pillars, plane, bubbles), an .obj file, a .gltf/.glb file or a
     /// .json scene file.
-    #[arg(long, default_value = scene::builtin::DEFAULT)]
+    #[arg(long, default_value = scene::builtin::DEFAULT, value_parser = crate::SceneSpec)]
     pub scene: String,
     /// Shading method (see `manylight info` for the table). Default: clustered, or forward
     /// on a context where clustered cannot run.

@@ -45,7 +45,7 @@ use crate::EsArg;
 #[command(name = "view")]
 pub struct ViewArgs {
     /// A built-in scene (an unknown name lists them), an .obj, .gltf/.glb or .json scene file.
-    #[arg(long, default_value = scene::builtin::DEFAULT)]
+    #[arg(long, default_value = scene::builtin::DEFAULT, value_parser = crate::SceneSpec)]
     pub scene: String,
     /// Shading method to start with (keys 1–5 switch: forward, tiled, clustered, deferred,
     /// auto, the order of `manylight info`).
