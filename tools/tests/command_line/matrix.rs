@@ -377,6 +377,48 @@ fn a_cell_the_driver_cannot_give_is_marked_refused() {
     );
 }
 
+/// The hidden child's `--tag` starts its image files' names inside `--out`: `../x` wrote
+/// outside it. A tag that is not one plain name is a usage error, and nothing is written.
+#[test]
+fn a_cell_tag_that_leaves_its_folder_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::create_dir_all(dir.path().join("mc/a")).unwrap();
+    for tag in ["../../escape", "a/b", "..", ""] {
+        let out = Command::new(env!("CARGO_BIN_EXE_manylight"))
+            .args([
+                "matrix-cell",
+                "--es",
+                "3",
+                "--scene",
+                "plane",
+                "--size",
+                "16x9",
+            ])
+            .args(["--lights", "4", "--tag", tag, "--out", "mc/a"])
+            .current_dir(dir.path())
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{tag}: {stderr}");
+        assert!(stderr.contains("--tag"), "{tag}: {stderr}");
+    }
+    let written: Vec<_> = walk(dir.path());
+    assert!(written.is_empty(), "{written:?}");
+}
+
+/// Every file under `dir`.
+fn walk(dir: &std::path::Path) -> Vec<std::path::PathBuf> {
+    let mut files = Vec::new();
+    for entry in std::fs::read_dir(dir).unwrap().flatten() {
+        if entry.path().is_dir() {
+            files.extend(walk(&entry.path()));
+        } else {
+            files.push(entry.path());
+        }
+    }
+    files
+}
+
 /// Libraries that cannot load are not a configuration this machine cannot give: every cell of
 /// their group fails, unmarked, and `--max-error` fails on them (it passed a broken machine
 /// when any failure to make a context read as a refusal). `MANYLIGHT_GLES_LIB` names the

@@ -613,6 +613,16 @@ fn sheet(rows: &[Value], out: &Path) -> image::RgbaImage {
     manylight_tools::sheet::contact_sheet(&cells, METHODS.len())
 }
 
+/// `--tag` of the hidden child: letters, digits, `-`, `_` and `.` only, not starting with `.`,
+/// so `TAG-METHOD.png` is a file inside `--out`.
+fn parse_tag(s: &str) -> Result<String, String> {
+    let fits = |c: char| c.is_ascii_alphanumeric() || matches!(c, '-' | '_' | '.');
+    if s.is_empty() || s.starts_with('.') || !s.chars().all(fits) {
+        return Err("a tag is letters, digits, `-`, `_` and `.`, not starting with `.`".into());
+    }
+    Ok(s.to_string())
+}
+
 /// Options of the hidden per-configuration child.
 #[derive(Parser, Debug)]
 pub struct MatrixCellArgs {
@@ -624,7 +634,8 @@ pub struct MatrixCellArgs {
     size: (u32, u32),
     #[arg(long)]
     lights: usize,
-    #[arg(long)]
+    /// Starts each image's file name: one name, no folder (`../x` wrote outside `--out`).
+    #[arg(long, value_parser = parse_tag)]
     tag: String,
     /// The folder for the cell's images (none written without it).
     #[arg(long)]
