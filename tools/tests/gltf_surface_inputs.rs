@@ -265,6 +265,26 @@ fn a_normal_map_tilts_the_shading_normal_with_file_and_generated_tangents() {
     check_every_method("mirrored normal map", &s, &want, 3.0);
 }
 
+/// The twin's picture of the plane (its base colour, roughness 1) under a normal map of one
+/// `texel` at `scale`, checked to differ from the plane's without it by 30/255 somewhere.
+fn one_texel_map_oracle(
+    s: &Scene,
+    texel: [u8; 4],
+    scale: f64,
+    what: &str,
+) -> Vec<Option<[f64; 3]>> {
+    let rgb = DVec3::new(texel[0] as f64, texel[1] as f64, texel[2] as f64) / 255.0;
+    let albedo = DVec3::new(0.8, 0.7, 0.6);
+    let mapped = |p: DVec3, _: DVec2, _: [f64; 4]| {
+        let n = perturbed_normal(DVec3::Z, DVec3::X, 1.0, rgb, scale);
+        (surface(p, n, albedo), DVec3::ZERO, 1.0)
+    };
+    let flat = |p: DVec3, _: DVec2, _: [f64; 4]| (surface(p, DVec3::Z, albedo), DVec3::ZERO, 1.0);
+    let want = oracle(s, &mapped);
+    assert_changes(&want, &oracle(s, &flat), 30.0, what);
+    want
+}
+
 /// A bright light a millimetre above a normal-mapped surface: where the mapped normal turns
 /// away from it decides the picture. A sampler is `lowp` unless declared otherwise, and
 /// llvmpipe reads a `lowp` texel in fp16, which tilted the normal by ~3e-4 and moved that
@@ -290,15 +310,7 @@ fn a_normal_map_is_read_precisely_enough_for_a_light_just_above_it() {
     let light = Light::point(DVec3::new(under.x, under.y, 1e-3), 3.0, Vec3::ONE, 6e4);
     let (s, warnings) = scene_of(&path, vec![light], 0.02);
     assert!(warnings.is_empty(), "{warnings:?}");
-    let rgb = DVec3::new(texel[0] as f64, texel[1] as f64, texel[2] as f64) / 255.0;
-    let albedo = DVec3::new(0.8, 0.7, 0.6);
-    let mapped = |p: DVec3, _: DVec2, _: [f64; 4]| {
-        let n = perturbed_normal(DVec3::Z, DVec3::X, 1.0, rgb, 1.0);
-        (surface(p, n, albedo), DVec3::ZERO, 1.0)
-    };
-    let flat = |p: DVec3, _: DVec2, _: [f64; 4]| (surface(p, DVec3::Z, albedo), DVec3::ZERO, 1.0);
-    let want = oracle(&s, &mapped);
-    assert_changes(&want, &oracle(&s, &flat), 30.0, "the normal map");
+    let want = one_texel_map_oracle(&s, texel, 1.0, "the normal map");
     check_every_method_with_highp("a light just above a normal map", &s, &want, 3.0);
 }
 
@@ -321,15 +333,7 @@ fn a_normal_map_of_scale_0_turns_the_normal_where_its_blue_is_below_half() {
     let (s, warnings) = scene_of(&path, grazing_light(), 0.02);
     assert!(warnings.is_empty(), "{warnings:?}");
     assert!(s.materials[0].maps.normal.is_some(), "the map was left out");
-    let rgb = DVec3::new(128.0, 128.0, 127.0) / 255.0;
-    let albedo = DVec3::new(0.8, 0.7, 0.6);
-    let mapped = |p: DVec3, _: DVec2, _: [f64; 4]| {
-        let n = perturbed_normal(DVec3::Z, DVec3::X, 1.0, rgb, 0.0);
-        (surface(p, n, albedo), DVec3::ZERO, 1.0)
-    };
-    let flat = |p: DVec3, _: DVec2, _: [f64; 4]| (surface(p, DVec3::Z, albedo), DVec3::ZERO, 1.0);
-    let want = oracle(&s, &mapped);
-    assert_changes(&want, &oracle(&s, &flat), 30.0, "the turned normal");
+    let want = one_texel_map_oracle(&s, turned, 0.0, "the turned normal");
     check_every_method("normal map of scale 0", &s, &want, 3.0);
 }
 

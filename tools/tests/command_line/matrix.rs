@@ -340,6 +340,23 @@ fn matrix_refuses_a_gles_lib_that_is_not_a_folder_before_any_cell() {
     );
 }
 
+/// `manylight matrix-cell` on an ES 3.0 context, the plane at 16×9 with 4 lights, then `rest`.
+fn matrix_cell(rest: &[&str]) -> Command {
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_manylight"));
+    cmd.args([
+        "matrix-cell",
+        "--es",
+        "3",
+        "--scene",
+        "plane",
+        "--size",
+        "16x9",
+    ])
+    .args(["--lights", "4"])
+    .args(rest);
+    cmd
+}
+
 /// A configuration the driver cannot give is a row marked `refused`, which `--max-error` does
 /// not count; any other failure of a cell is not marked, and fails the gate (the verdict's
 /// unit tests). Here a driver capped at ES 2.0 asked for ES 3.0.
@@ -348,17 +365,7 @@ fn a_cell_the_driver_cannot_give_is_marked_refused() {
     if common::other_implementation_than_mesa("MESA_GLES_VERSION_OVERRIDE") {
         return;
     }
-    let out = Command::new(env!("CARGO_BIN_EXE_manylight"))
-        .args([
-            "matrix-cell",
-            "--es",
-            "3",
-            "--scene",
-            "plane",
-            "--size",
-            "16x9",
-        ])
-        .args(["--lights", "4", "--tag", "t"])
+    let out = matrix_cell(&["--tag", "t"])
         .env("MESA_GLES_VERSION_OVERRIDE", "2.0")
         .output()
         .unwrap();
@@ -384,17 +391,7 @@ fn a_cell_tag_that_leaves_its_folder_is_refused() {
     let dir = tempfile::tempdir().unwrap();
     std::fs::create_dir_all(dir.path().join("mc/a")).unwrap();
     for tag in ["../../escape", "a/b", "..", ""] {
-        let out = Command::new(env!("CARGO_BIN_EXE_manylight"))
-            .args([
-                "matrix-cell",
-                "--es",
-                "3",
-                "--scene",
-                "plane",
-                "--size",
-                "16x9",
-            ])
-            .args(["--lights", "4", "--tag", tag, "--out", "mc/a"])
+        let out = matrix_cell(&["--tag", tag, "--out", "mc/a"])
             .current_dir(dir.path())
             .output()
             .unwrap();
