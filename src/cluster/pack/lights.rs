@@ -243,18 +243,15 @@ pub fn pack_lights_into(lights: &[GpuLight], layout: LightLayout, packed: &mut P
                 if !layout.spots {
                     continue;
                 }
-                let axis = if l.cone_deg.1 > 90.0 && l.cone_deg.1 < 180.0 {
-                    -l.direction
-                } else {
-                    l.direction
-                };
+                // A cone past 90° inside comes turned round as in the float records: its axis
+                // reversed and its angles' half cosines, precise near 180° where their sines
+                // are not (t4.z 128).
+                let (axis, scale, _) = shader_spot_terms(l);
                 for (k, w) in [s(axis.x), s(axis.y), s(axis.z)].iter().enumerate() {
                     rec[12 + k * 2..14 + k * 2].copy_from_slice(&w.to_be_bytes());
                 }
                 let omni = l.cone_deg.1 >= 180.0;
-                // A cone past 90° inside, turned round: its axis reversed and its angles'
-                // half cosines, precise near 180° where their sines are not (t4.z 128).
-                let back = !omni && l.cone_deg.1 > 90.0;
+                let back = scale < 0.0;
                 rec[18] = if omni {
                     255
                 } else if back {
