@@ -14,7 +14,7 @@ mod common;
 
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Output, Stdio};
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 const BIN: &str = env!("CARGO_BIN_EXE_manylight");
 /// Window size asked for (Xvfb has no window manager, so the window gets exactly this).
@@ -29,55 +29,6 @@ fn which(name: &str) -> Option<PathBuf> {
     std::env::split_paths(&std::env::var_os("PATH")?)
         .map(|dir| dir.join(name))
         .find(|p| p.is_file())
-}
-
-/// Waits for `child` at most [`TIMEOUT`]; kills it (our own child) when it runs over. Its
-/// output is read meanwhile, on threads of its own: a screenshot sent to standard output
-/// is more than a pipe's buffer holds.
-fn wait_with_timeout(mut child: Child, what: &str) -> Output {
-    use std::io::Read;
-    let drain = |pipe: Option<Box<dyn Read + Send>>| {
-        std::thread::spawn(move || {
-            let mut bytes = Vec::new();
-            if let Some(mut pipe) = pipe {
-                pipe.read_to_end(&mut bytes)
-                    .expect("read the child's output");
-            }
-            bytes
-        })
-    };
-    let stdout = drain(
-        child
-            .stdout
-            .take()
-            .map(|p| Box::new(p) as Box<dyn Read + Send>),
-    );
-    let stderr = drain(
-        child
-            .stderr
-            .take()
-            .map(|p| Box::new(p) as Box<dyn Read + Send>),
-    );
-    let start = Instant::now();
-    let status = loop {
-        if let Some(status) = child.try_wait().expect("try_wait") {
-            break status;
-        }
-        if start.elapsed() > TIMEOUT {
-            let _ = child.kill();
-            let _ = child.wait();
-            panic!(
-                "{what} ran over {TIMEOUT:?}; stderr:\n{}",
-                String::from_utf8_lossy(&stderr.join().expect("stderr"))
-            );
-        }
-        std::thread::sleep(Duration::from_millis(50));
-    };
-    Output {
-        status,
-        stdout: stdout.join().expect("stdout"),
-        stderr: stderr.join().expect("stderr"),
-    }
 }
 
 /// An `Xvfb` this test started; stopped with SIGTERM when dropped, so it removes its socket
@@ -146,7 +97,11 @@ fn run_view(args: &[&str], env: &[(&str, &str)]) -> Option<Output> {
         .stdout(Stdio::piped())
         .stderr(Stdio::piped());
     let child = cmd.spawn().expect("spawn manylight view");
-    Some(wait_with_timeout(child, "manylight view"))
+    Some(common::cli::wait_with_timeout(
+        child,
+        "manylight view",
+        TIMEOUT,
+    ))
 }
 
 /// The fraction of `image`'s pixels for which `keep(x, y)` holds.

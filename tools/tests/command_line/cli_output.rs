@@ -623,22 +623,15 @@ fn a_fifo_without_a_reader_is_an_error_not_a_wait() {
         return;
     }
     let run = |args: &[&str]| {
-        let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_manylight"))
+        let child = std::process::Command::new(env!("CARGO_BIN_EXE_manylight"))
             .args(args)
             .current_dir(dir.path())
             .stdout(std::process::Stdio::null())
             .stderr(std::process::Stdio::piped())
             .spawn()
             .unwrap();
-        let start = std::time::Instant::now();
-        while child.try_wait().unwrap().is_none() {
-            if start.elapsed() > std::time::Duration::from_secs(120) {
-                child.kill().unwrap();
-                panic!("{args:?} still waits after two minutes");
-            }
-            std::thread::sleep(std::time::Duration::from_millis(20));
-        }
-        child.wait_with_output().unwrap()
+        let what = format!("{args:?}");
+        common::cli::wait_with_timeout(child, &what, std::time::Duration::from_secs(120))
     };
     for args in [
         ["--size", "16x9", "--lights", "2", "--out", "fifo"],

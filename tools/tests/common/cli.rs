@@ -1,7 +1,8 @@
 //! Running the `manylight` binary the way a user does, for the command-line tests.
 
 use std::path::Path;
-use std::process::{Command, Output};
+use std::process::{Child, Command, Output};
+use std::time::{Duration, Instant};
 
 /// Runs `manylight ARGS` in `cwd` with extra environment.
 pub fn manylight(args: &[&str], env: &[(&str, &str)], cwd: &Path) -> Output {
@@ -46,4 +47,53 @@ pub fn expect_exit(
         "{args:?}: expected `{needle}` in: {msg}"
     );
     msg
+}
+
+/// Waits for `child` at most `timeout`; kills it (our own child) when it runs over. Its
+/// output is read meanwhile, on threads of its own: a screenshot sent to standard output
+/// is more than a pipe's buffer holds.
+pub fn wait_with_timeout(mut child: Child, what: &str, timeout: Duration) -> Output {
+    use std::io::Read;
+    let drain = |pipe: Option<Box<dyn Read + Send>>| {
+        std::thread::spawn(move || {
+            let mut bytes = Vec::new();
+            if let Some(mut pipe) = pipe {
+                pipe.read_to_end(&mut bytes)
+                    .expect("read the child's output");
+            }
+            bytes
+        })
+    };
+    let stdout = drain(
+        child
+            .stdout
+            .take()
+            .map(|p| Box::new(p) as Box<dyn Read + Send>),
+    );
+    let stderr = drain(
+        child
+            .stderr
+            .take()
+            .map(|p| Box::new(p) as Box<dyn Read + Send>),
+    );
+    let start = Instant::now();
+    let status = loop {
+        if let Some(status) = child.try_wait().expect("try_wait") {
+            break status;
+        }
+        if start.elapsed() > timeout {
+            let _ = child.kill();
+            let _ = child.wait();
+            panic!(
+                "{what} ran over {timeout:?}; stderr:\n{}",
+                String::from_utf8_lossy(&stderr.join().expect("stderr"))
+            );
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    };
+    Output {
+        status,
+        stdout: stdout.join().expect("stdout"),
+        stderr: stderr.join().expect("stderr"),
+    }
 }
