@@ -858,6 +858,37 @@ fn a_missing_texture_is_warned_once() {
     assert_eq!(msg.matches("nothere.png").count(), 1, "{msg}");
 }
 
+/// `--seed` where the scene keeps its own lights changes nothing: it says so, rather than
+/// rendering the file's own lights as if the seed had been taken.
+#[test]
+fn a_seed_the_scene_does_not_use_is_warned() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(
+        dir.path().join("s.json"),
+        r#"{"objects": [{"builtin": "plane"}], "random_lights": {"count": 4, "seed": 3}}"#,
+    )
+    .unwrap();
+    let run = |args: &[&str]| {
+        let mut all = vec!["render", "--size", "16x9", "--frames", "0"];
+        all.extend_from_slice(args);
+        let out = manylight(&all, &[], dir.path());
+        let msg = text(&out);
+        assert!(out.status.success(), "{args:?}: {msg}");
+        msg
+    };
+    let unused = run(&["--scene", "s.json", "--seed", "7"]);
+    assert!(unused.contains("--seed 7 is not used"), "{unused}");
+    // Taken with --lights, and by a built-in: no warning, nor without --seed.
+    for args in [
+        &["--scene", "s.json", "--seed", "7", "--lights", "4"][..],
+        &["--scene", "plane", "--seed", "7", "--lights", "4"],
+        &["--scene", "s.json"],
+    ] {
+        let msg = run(args);
+        assert!(!msg.contains("--seed"), "{args:?}: {msg}");
+    }
+}
+
 /// Hostile files and counts end in one clear error or a documented fallback: no panic, no
 /// hang on a FIFO, no endless read of `/dev/zero`, no allocation for 2⁶⁴ lights.
 #[test]

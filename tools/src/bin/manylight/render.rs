@@ -29,9 +29,10 @@ pub struct RenderArgs {
     /// Default: 1024 for built-ins and OBJ files; a scene file or glTF file keeps its own lights.
     #[arg(long, value_parser = crate::bench_assign::parse_light_count)]
     pub lights: Option<usize>,
-    /// Seed of the random lights.
-    #[arg(long, default_value_t = 1)]
-    pub seed: u64,
+    /// Seed of the random lights (default 1). Unused, with a warning, where the scene keeps
+    /// its own lights (a scene or glTF file without `--lights`).
+    #[arg(long)]
+    pub seed: Option<u64>,
     /// Image size as WIDTHxHEIGHT.
     #[arg(long, default_value = "1280x720", value_parser = parse_size)]
     pub size: (u32, u32),
@@ -268,6 +269,8 @@ pub const DEFAULT_OUT: &str = "manylight.png";
 
 /// Random lights for built-ins and OBJ files when `--lights` is not given.
 const DEFAULT_LIGHTS: usize = 1024;
+/// The random lights' seed without `--seed`.
+const DEFAULT_SEED: u64 = 1;
 
 pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
     let (w, h) = s
@@ -332,7 +335,13 @@ fn warn_not_png(path: &std::path::Path) {
 
 /// Runs the command.
 pub fn run(args: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
-    let lights = lights_for(&args.scene, args.lights, args.seed);
+    let lights = lights_for(&args.scene, args.lights, args.seed.unwrap_or(DEFAULT_SEED));
+    if let (None, Some(seed)) = (lights, args.seed) {
+        log::warn!(
+            "--seed {seed} is not used: the scene keeps its own lights (a scene file's \
+             random_lights their own seed); --lights N replaces them with seeded ones"
+        );
+    }
     // The loader logs each warning (at `warn`, shown by default): not printed again here.
     let (mut scene, report) = scene::load_with(&args.scene, lights, &crate::load_options())?;
     let out = match (&args.out, &args.record) {
