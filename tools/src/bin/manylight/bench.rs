@@ -202,19 +202,29 @@ impl Plan {
     }
 }
 
-/// The conference room of $MANYLIGHT_ASSETS, when set and present; otherwise says how to get
-/// the row.
+/// The conference room of $MANYLIGHT_ASSETS, when set and present; otherwise says why the
+/// row is left out.
 fn conference() -> Option<String> {
-    let obj = std::env::var_os("MANYLIGHT_ASSETS")
+    conference_in(std::env::var_os("MANYLIGHT_ASSETS"))
+        .map_err(|why| eprintln!("bench: the conference-room rows are left out: {why}"))
+        .ok()
+}
+
+/// The conference room's OBJ in the assets folder `assets`, as the scene name bench loads, or
+/// why there is none. Scene names are UTF-8, so a folder whose path is not cannot be loaded.
+fn conference_in(assets: Option<std::ffi::OsString>) -> Result<String, String> {
+    const HOW: &str = "set MANYLIGHT_ASSETS to a folder with the real scenes \
+        (scripts/fetch-assets; docs/assets.md)";
+    let obj = assets
         .map(|dir| PathBuf::from(dir).join("conference/conference.obj"))
-        .filter(|obj| obj.is_file());
-    if obj.is_none() {
-        eprintln!(
-            "bench: the conference-room rows are left out: set MANYLIGHT_ASSETS to a folder \
-             with the real scenes (scripts/fetch-assets; docs/assets.md)"
-        );
-    }
-    obj.map(|o| o.to_string_lossy().into_owned())
+        .filter(|obj| obj.is_file())
+        .ok_or_else(|| HOW.to_string())?;
+    obj.into_os_string().into_string().map_err(|obj| {
+        format!(
+            "MANYLIGHT_ASSETS's {} is not UTF-8, which scene paths must be; {HOW}",
+            shown::path(std::path::Path::new(&obj))
+        )
+    })
 }
 
 /// A knob varied from the defaults, on one method.
@@ -913,4 +923,33 @@ fn write_pictures(
     }
     save_png(&out.join(&pictures.reference), &base.reference)?;
     Ok(pictures)
+}
+
+#[cfg(test)]
+mod tests {
+    use std::os::unix::ffi::OsStrExt;
+
+    use super::*;
+
+    #[test]
+    fn the_conference_room_is_found_or_its_absence_explained() {
+        let root = tempfile::tempdir().unwrap();
+        let utf8 = root.path().join("assets");
+        let other = root.path().join(std::ffi::OsStr::from_bytes(b"assets\xff"));
+        for dir in [&utf8, &other] {
+            std::fs::create_dir_all(dir.join("conference")).unwrap();
+            std::fs::write(dir.join("conference/conference.obj"), "").unwrap();
+        }
+        let found = conference_in(Some(utf8.clone().into())).unwrap();
+        assert!(std::path::Path::new(&found).is_file(), "{found}");
+        let why = conference_in(Some(other.into())).unwrap_err();
+        assert!(
+            why.contains("is not UTF-8") && why.contains("assets"),
+            "{why}"
+        );
+        let why = conference_in(None).unwrap_err();
+        assert!(why.contains("set MANYLIGHT_ASSETS"), "{why}");
+        let why = conference_in(Some(root.path().join("none").into())).unwrap_err();
+        assert!(why.contains("set MANYLIGHT_ASSETS"), "{why}");
+    }
 }
