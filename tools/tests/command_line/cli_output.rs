@@ -740,6 +740,45 @@ fn an_output_naming_a_file_the_scene_reads_is_refused() {
     assert!(out.status.success(), "{}", text(&out));
 }
 
+/// `--record` is checked against the files the scene reads too: a texture that is one of the
+/// frames a recording writes, or the GIF it writes, was replaced by a frame of the recording.
+#[test]
+fn a_recording_that_would_overwrite_a_file_the_scene_reads_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let obj = "mtllib r.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\n\
+               usemtl m\nf 1/1 2/2 3/3\nusemtl g\nf 1/1 3/3 2/2\n";
+    std::fs::write(dir.path().join("r.obj"), obj).unwrap();
+    let mtl = "newmtl m\nmap_Kd rec/frame_00001.png\nnewmtl g\nmap_Kd t.gif\n";
+    std::fs::write(dir.path().join("r.mtl"), mtl).unwrap();
+    std::fs::create_dir(dir.path().join("rec")).unwrap();
+    let texel = image::RgbaImage::from_pixel(2, 2, image::Rgba([200, 100, 50, 255]));
+    texel.save(dir.path().join("rec/frame_00001.png")).unwrap();
+    texel.save(dir.path().join("t.gif")).unwrap();
+    let render = |record: &str, frames: &str| {
+        let args = [
+            "--scene", "r.obj", "--size", "16x9", "--lights", "2", "--record", record, "--frames",
+            frames,
+        ];
+        manylight(&args, &[], dir.path())
+    };
+    for (record, file) in [("rec", "rec/frame_00001.png"), ("./t.gif", "t.gif")] {
+        let before = std::fs::read(dir.path().join(file)).unwrap();
+        let out = render(record, "3");
+        let said = text(&out);
+        assert_eq!(out.status.code(), Some(1), "--record {record}: {said}");
+        assert!(said.contains("which the scene reads"), "{said}");
+        assert_eq!(
+            std::fs::read(dir.path().join(file)).unwrap(),
+            before,
+            "{file}"
+        );
+    }
+    // One frame writes frame_00000.png alone, which the scene does not read.
+    let out = render("rec", "1");
+    assert!(out.status.success(), "{}", text(&out));
+    assert!(dir.path().join("rec/frame_00000.png").is_file());
+}
+
 /// A `--scene` path that is not UTF-8 is a usage error naming `--scene` (scene paths are
 /// text); it was clap's "invalid UTF-8 was detected in one or more arguments", no option named.
 #[test]

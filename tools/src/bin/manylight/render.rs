@@ -351,6 +351,16 @@ pub fn run(args: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
     };
     let outputs = [("--out", out), ("--stats", args.stats.as_deref())];
     check_not_read(&outputs, &report.files)?;
+    if let Some(record) = &args.record {
+        if let Some(file) = crate::sequence::overwritten_input(record, args.frames, &report.files) {
+            return Err(format!(
+                "--record {} would overwrite {}, which the scene reads",
+                shown::path(record),
+                shown::path(&file)
+            )
+            .into());
+        }
+    }
     if let Some(path) = out.filter(|p| !manylight_tools::output::names_stdout(p)) {
         warn_not_png(path);
     }

@@ -103,7 +103,7 @@ impl Recorder {
         std::fs::create_dir_all(path)
             .map_err(|e| format!("--record: cannot create {}: {e}", path.display()))?;
         let last = timeline.frames.saturating_sub(1);
-        let digits = last.to_string().len().max(5);
+        let digits = frame_digits(timeline.frames);
         let stale = stale_frames(path, timeline.frames, digits);
         if stale > 0 {
             log::warn!(
@@ -171,24 +171,55 @@ fn gif_timing_warning(fps: f64) -> Option<String> {
     ))
 }
 
+/// Digits of a recording's frame numbers: five, or as many as its last frame needs.
+fn frame_digits(frames: u32) -> usize {
+    frames.saturating_sub(1).to_string().len().max(5)
+}
+
+/// Whether `name` is one of the `frames` PNGs a recording with `digits`-digit numbers writes.
+fn is_recorded_frame(name: &str, frames: u32, digits: usize) -> bool {
+    let Some(number) = name
+        .strip_prefix("frame_")
+        .and_then(|n| n.strip_suffix(".png"))
+    else {
+        return false;
+    };
+    number.len() == digits
+        && number.bytes().all(|b| b.is_ascii_digit())
+        && number.parse::<u32>().is_ok_and(|k| k < frames)
+}
+
 /// How many files in `dir` look like recorded frames (`frame_*.png`) but are not among the
 /// `frames` this recording writes with `digits`-digit numbers: left over from another one.
 fn stale_frames(dir: &Path, frames: u32, digits: usize) -> usize {
     let Ok(entries) = std::fs::read_dir(dir) else {
         return 0;
     };
-    let written = |name: &str| {
-        let number = name.strip_prefix("frame_")?.strip_suffix(".png")?;
-        let k: u32 = number.parse().ok()?;
-        (number.len() == digits && number.bytes().all(|b| b.is_ascii_digit()) && k < frames)
-            .then_some(())
-    };
     entries
         .flatten()
         .filter_map(|e| e.file_name().into_string().ok())
         .filter(|name| name.starts_with("frame_") && name.ends_with(".png"))
-        .filter(|name| written(name).is_none())
+        .filter(|name| !is_recorded_frame(name, frames, digits))
         .count()
+}
+
+/// The first of the files the scene `read` (as [`output::identity`] spells them) that
+/// `--record path` would overwrite: the GIF itself, or one of the folder's frame PNGs.
+pub fn overwritten_input(path: &Path, frames: u32, read: &[PathBuf]) -> Option<PathBuf> {
+    let id = output::identity(path);
+    if records_gif(path) {
+        return read.contains(&id).then_some(id);
+    }
+    let digits = frame_digits(frames);
+    read.iter()
+        .find(|file| {
+            file.parent() == Some(id.as_path())
+                && file
+                    .file_name()
+                    .and_then(|n| n.to_str())
+                    .is_some_and(|n| is_recorded_frame(n, frames, digits))
+        })
+        .cloned()
 }
 
 /// What a sequence keeps of its timed frames besides their stats.
