@@ -307,6 +307,40 @@ fn view_rejects_bad_input_without_panicking() {
     assert!(stderr.contains("at most 65535"), "stderr: {stderr}");
 }
 
+/// `--screenshot` naming a texture the scene reads is refused once the scene is loaded, before
+/// any window opens (so no display is needed); it replaced the texture with the screenshot.
+#[test]
+fn a_screenshot_naming_a_file_the_scene_reads_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let obj = "mtllib q.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nusemtl m\nf 1/1 2/2 3/3\n";
+    std::fs::write(dir.path().join("q.obj"), obj).unwrap();
+    std::fs::write(dir.path().join("q.mtl"), "newmtl m\nmap_Kd t.png\n").unwrap();
+    let texture = dir.path().join("t.png");
+    image::RgbaImage::from_pixel(2, 2, image::Rgba([200, 100, 50, 255]))
+        .save(&texture)
+        .unwrap();
+    let before = std::fs::read(&texture).unwrap();
+    let out = Command::new(BIN)
+        .current_dir(dir.path())
+        .env_remove("DISPLAY")
+        .env_remove("WAYLAND_DISPLAY")
+        .args([
+            "view",
+            "--scene",
+            "q.obj",
+            "--frames",
+            "1",
+            "--screenshot",
+            "t.png",
+        ])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("names a file the scene reads"), "{stderr}");
+    assert_eq!(std::fs::read(&texture).unwrap(), before);
+}
+
 /// The heatmap view (`--heatmap`, H in the window): every covered pixel is a colour of the
 /// viridis map the shader draws counts with, and the counts vary across the clustered view.
 /// The screenshot goes to standard output (`-`), which then holds the PNG alone: the viewer's

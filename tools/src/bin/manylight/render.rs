@@ -299,7 +299,7 @@ pub fn lights_for(spec: &str, count: Option<usize>, seed: u64) -> Option<(usize,
 /// An output naming a file the scene read (a model, a texture: `--out model.obj`) would replace
 /// it: an error naming the option and the file, before anything is written. (The scene file itself is a usage
 /// error before the load: `check_not_the_input`.)
-fn check_not_read(
+pub fn check_not_read(
     outputs: &[(&str, Option<&std::path::Path>)],
     read: &[PathBuf],
 ) -> Result<(), String> {

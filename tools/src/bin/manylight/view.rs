@@ -110,8 +110,11 @@ const NO_DISPLAY: &str = "cannot open a window: no X11 or Wayland display (DISPL
 pub fn run(args: &ViewArgs) -> Result<(), Box<dyn std::error::Error>> {
     let lights = crate::render::lights_for(&args.scene, args.lights, args.seed);
     // The loader logs each warning (at `warn`, shown by default): not printed again here.
-    let (mut scene, _logged_warnings) =
-        scene::load_with(&args.scene, lights, &crate::load_options())?;
+    let (mut scene, report) = scene::load_with(&args.scene, lights, &crate::load_options())?;
+    crate::render::check_not_read(
+        &[("--screenshot", args.screenshot.as_deref())],
+        &report.files,
+    )?;
     let lights = lights.map(|(n, _)| n);
     scene.set_time(args.time);
     // Validate the method name before opening a window.
