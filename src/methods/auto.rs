@@ -3,10 +3,10 @@
 //! a grid); many → clustered; clustered unsupported → forward. A frame with more lights visible
 //! than clustered can index → deferred where it runs (ES 3.0 G-buffer, not the renderer's own
 //! MSAA target): one proxy per light has no index limit, where forward's loop is capped by the
-//! driver and leaves lights out. The method not in use holds no GPU resources, except
-//! clustered's while a frame has too many visible lights for it (it tries again every frame),
-//! and deferred's for [`DEFERRED_KEPT_FRAMES`] after its last frame (a count hovering round the
-//! limit would otherwise allocate a G-buffer every other frame).
+//! driver and leaves lights out. A method not in use keeps its GPU resources (clustered its
+//! grid's calibration too) for [`IDLE_FRAMES_KEPT`] frames after its last one, then frees
+//! them: a count hovering round a limit would otherwise free and make them every other frame.
+//! Clustered is in use while a frame has too many visible lights for it (it tries every frame).
 
 use std::fmt::Write as _;
 
@@ -14,7 +14,9 @@ use super::culled::{CulledForward, CulledFrame, Culling};
 use super::culled_support::culled_support;
 use super::deferred::Deferred;
 use super::forward::Forward;
-use super::{FrameContext, MethodDesc, MethodStats, ShadingMethod, Support};
+use super::{
+    idle_for_long, FrameContext, MethodDesc, MethodStats, ShadingMethod, Support, IDLE_FRAMES_KEPT,
+};
 use crate::cluster::pack::MAX_INDEXED_LIGHTS;
 use crate::gl::target_size::{self, TargetStorage};
 use crate::gl::{gbuffer, Device, EsVersion, GlError};
@@ -77,21 +79,17 @@ pub(crate) fn methods_it_may_run(caps: &crate::gl::Caps, own_msaa: bool) -> Vec<
     names
 }
 
-/// Frames deferred's resources are kept after the last frame it rendered (two seconds at
-/// 60 frames a second).
-pub const DEFERRED_KEPT_FRAMES: u32 = 120;
-
 /// The adaptive method.
 #[derive(Default)]
 pub struct Auto {
-    forward: Forward,
+    forward: Option<Forward>,
     clustered: Option<CulledForward>,
     /// For frames with more visible lights than clustered indexes, where deferred runs.
     deferred: Option<Deferred>,
-    /// Frames since deferred last rendered one: its G-buffer is freed after
-    /// [`DEFERRED_KEPT_FRAMES`], not at once, so a visible count that hovers round the limit
-    /// does not allocate a full-screen G-buffer every other frame.
-    deferred_idle: u32,
+    /// Frames in a row each method did not draw (forward, clustered, deferred); see [`rest`].
+    idle: [u32; 3],
+    /// Whether clustered drew the last frame: only its own frames' timings calibrate its grid.
+    clustered_drew_last: bool,
     /// Why this frame's method was chosen (rewritten every frame, its buffer kept).
     reason: String,
     /// Whether clustered runs on this context (asked once: the context does not change).
@@ -135,16 +133,11 @@ impl Auto {
     }
 }
 
-/// Counts a frame deferred did not render; frees its resources once it has been idle for
-/// [`DEFERRED_KEPT_FRAMES`].
-fn retire_deferred(deferred: &mut Option<Deferred>, idle: &mut u32, dev: &Device) {
-    if deferred.is_none() {
-        return;
-    }
-    *idle += 1;
-    if *idle > DEFERRED_KEPT_FRAMES {
-        if let Some(mut d) = deferred.take() {
-            d.destroy(dev);
+/// Counts a frame `method` did not draw; on the [`IDLE_FRAMES_KEPT`]th in a row it is freed.
+fn rest<M: ShadingMethod>(method: &mut Option<M>, idle: &mut u32, dev: &Device) {
+    if method.is_some() && idle_for_long(idle) {
+        if let Some(mut m) = method.take() {
+            m.destroy(dev);
         }
     }
 }
@@ -226,8 +219,11 @@ impl ShadingMethod for Auto {
             let overflowed = matches!(frame, CulledFrame::Overflowed(_));
             let too_many = match frame {
                 CulledFrame::Rendered(mut stats) => {
-                    self.forward.destroy(ctx.dev);
-                    retire_deferred(&mut self.deferred, &mut self.deferred_idle, ctx.dev);
+                    let [forward_idle, clustered_idle, deferred_idle] = &mut self.idle;
+                    rest(&mut self.forward, forward_idle, ctx.dev);
+                    rest(&mut self.deferred, deferred_idle, ctx.dev);
+                    *clustered_idle = 0;
+                    self.clustered_drew_last = true;
                     stats.auto_choice = Some((choice, &self.reason));
                     return Ok(stats);
                 }
@@ -261,49 +257,63 @@ impl ShadingMethod for Auto {
                 self.warned_too_many = true;
                 log::warn!("auto: {}", self.reason);
             }
+            // Clustered tried this frame: it is still in use.
+            self.idle[1] = 0;
+            self.clustered_drew_last = false;
+            let [forward_idle, _, deferred_idle] = &mut self.idle;
             let mut stats = if instead == "deferred" {
-                self.forward.destroy(ctx.dev);
-                self.deferred_idle = 0;
+                rest(&mut self.forward, forward_idle, ctx.dev);
+                *deferred_idle = 0;
                 self.deferred
                     .get_or_insert_with(Deferred::default)
                     .render(ctx)?
             } else {
-                retire_deferred(&mut self.deferred, &mut self.deferred_idle, ctx.dev);
-                self.forward.render(ctx)?
+                rest(&mut self.deferred, deferred_idle, ctx.dev);
+                *forward_idle = 0;
+                self.forward
+                    .get_or_insert_with(Forward::default)
+                    .render(ctx)?
             };
             stats.auto_choice = Some((instead, &self.reason));
             return Ok(stats);
         }
-        if let Some(mut c) = self.clustered.take() {
-            c.destroy(ctx.dev);
-        }
-        retire_deferred(&mut self.deferred, &mut self.deferred_idle, ctx.dev);
-        let mut stats = self.forward.render(ctx)?;
+        let [forward_idle, clustered_idle, deferred_idle] = &mut self.idle;
+        rest(&mut self.clustered, clustered_idle, ctx.dev);
+        rest(&mut self.deferred, deferred_idle, ctx.dev);
+        *forward_idle = 0;
+        self.clustered_drew_last = false;
+        let mut stats = self
+            .forward
+            .get_or_insert_with(Forward::default)
+            .render(ctx)?;
         stats.auto_choice = Some((choice, &self.reason));
         Ok(stats)
     }
 
     fn skip_frame(&mut self, dev: &Device) {
-        retire_deferred(&mut self.deferred, &mut self.deferred_idle, dev);
-        if let Some(c) = &mut self.clustered {
-            c.skip_frame(dev);
-        }
+        let [forward_idle, clustered_idle, deferred_idle] = &mut self.idle;
+        rest(&mut self.forward, forward_idle, dev);
+        rest(&mut self.clustered, clustered_idle, dev);
+        rest(&mut self.deferred, deferred_idle, dev);
+        self.clustered_drew_last = false;
     }
 
     fn observe_frame(&mut self, timing: super::FrameTiming) {
-        if let Some(c) = &mut self.clustered {
+        if let Some(c) = self.clustered.as_mut().filter(|_| self.clustered_drew_last) {
             c.observe_frame(timing);
         }
     }
 
     fn gpu_bytes(&self) -> usize {
-        self.forward.gpu_bytes()
+        self.forward.as_ref().map_or(0, Forward::gpu_bytes)
             + self.clustered.as_ref().map_or(0, CulledForward::gpu_bytes)
             + self.deferred.as_ref().map_or(0, Deferred::gpu_bytes)
     }
 
     fn destroy(&mut self, dev: &Device) {
-        self.forward.destroy(dev);
+        if let Some(mut f) = self.forward.take() {
+            f.destroy(dev);
+        }
         if let Some(mut c) = self.clustered.take() {
             c.destroy(dev);
         }
