@@ -307,6 +307,22 @@ impl Deferred {
         Ok(())
     }
 
+    /// Frees what the G-buffer passes hold: the G-buffer, the proxy meshes, the light
+    /// instances (the transparent objects' forward pass keeps its own).
+    fn free_gbuffer_passes(&mut self, dev: &Device) {
+        if let Some(mut g) = self.gbuffer.take() {
+            g.destroy(dev);
+        }
+        for mut m in [self.sphere.take(), self.fullscreen.take()]
+            .into_iter()
+            .flatten()
+        {
+            m.destroy(dev);
+        }
+        self.lights.destroy(dev);
+        self.instances_key = None;
+    }
+
     /// Draws the opaque objects of `ctx.order` into the G-buffer.
     fn geometry_pass(&self, ctx: &mut FrameContext) -> Result<(), Error> {
         self.gbuffer
@@ -584,18 +600,33 @@ impl ShadingMethod for Deferred {
             )));
         }
         let target = ctx.target;
-        self.idle_frames = 0;
-        let specular = self.keeps_specular(needs_specular_target(ctx));
-        self.ensure_resources(dev, ctx.viewport, specular)?;
         sort_objects(ctx);
-        self.geometry_pass(ctx)?;
-        let light_pass = self.light_pass(ctx)?;
-        self.composite(ctx, target)?;
-        let mut stats = MethodStats {
-            gbuffer_bytes: self.gbuffer.as_ref().map_or(0, GBuffer::gpu_bytes),
-            upload_bytes: light_pass.uploaded,
-            lists_reused: light_pass.reused,
-            ..MethodStats::default()
+        let mut light_pass = None;
+        let mut stats = if ctx.order.opaque.is_empty() {
+            // Nothing opaque in view: a G-buffer would hold nothing and its light pass light
+            // nothing (the composite writes surfaces only). Kept a while, as without lights.
+            if super::idle_for_long(&mut self.idle_frames) {
+                self.free_gbuffer_passes(dev);
+            }
+            MethodStats {
+                lists_reused: true,
+                ..MethodStats::default()
+            }
+        } else {
+            self.idle_frames = 0;
+            let specular = self.keeps_specular(needs_specular_target(ctx));
+            self.ensure_resources(dev, ctx.viewport, specular)?;
+            self.geometry_pass(ctx)?;
+            let pass = self.light_pass(ctx)?;
+            self.composite(ctx, target)?;
+            let stats = MethodStats {
+                gbuffer_bytes: self.gbuffer.as_ref().map_or(0, GBuffer::gpu_bytes),
+                upload_bytes: pass.uploaded,
+                lists_reused: pass.reused,
+                ..MethodStats::default()
+            };
+            light_pass = Some(pass.key);
+            stats
         };
         if !ctx.order.transparent.is_empty() && !ctx.features.counting() {
             // Forward fallback for what a G-buffer cannot hold: plain forward over the
@@ -612,7 +643,9 @@ impl ShadingMethod for Deferred {
         }
         // A frame that fails after this (its error may be the instance upload's) leaves none to
         // draw again: the renderer's next frame has lights of a new generation.
-        self.instances_key = Some(light_pass.key);
+        if light_pass.is_some() {
+            self.instances_key = light_pass;
+        }
         Ok(stats)
     }
 
@@ -631,18 +664,7 @@ impl ShadingMethod for Deferred {
     }
 
     fn destroy(&mut self, dev: &Device) {
-        if let Some(mut g) = self.gbuffer.take() {
-            g.destroy(dev);
-        }
-        for m in [self.sphere.take(), self.fullscreen.take()]
-            .into_iter()
-            .flatten()
-        {
-            let mut m = m;
-            m.destroy(dev);
-        }
-        self.lights.destroy(dev);
-        self.instances_key = None;
+        self.free_gbuffer_passes(dev);
         self.transparent.destroy(dev);
     }
 }

@@ -143,7 +143,8 @@ pub fn draw_objects<P: GeometryProgram>(
     sort_objects(ctx);
     // Without a light loop a fragment costs about what a depth-only one does: the opaque
     // objects are then tested and written against their own depth, as the cut-out ones are.
-    let prepass = !ctx.features.has(ShaderFeatures::NO_LIGHTS);
+    // Nothing opaque but cut-outs (or transparent objects alone): no prepass, no program.
+    let prepass = !ctx.features.has(ShaderFeatures::NO_LIGHTS) && ctx.order.cut_out_from > 0;
     if prepass {
         depth_prepass(ctx)?;
     }

@@ -257,6 +257,58 @@ fn bubbles_match_forward_with_every_forward_method() {
     }
 }
 
+/// Transparent objects alone: no method draws a depth prepass (its program built and bound
+/// with nothing to draw), and deferred makes no G-buffer nor light pass, which would hold and
+/// light nothing (405 504 bytes and four programs at 128×72 for one forward draw's picture).
+/// With an opaque object too, deferred's transparent pass still builds no depth program.
+#[test]
+fn transparent_objects_alone_pay_for_no_depth_pass_or_gbuffer() {
+    let mut glass = scene::builtin::build("bubbles", Some((16, 4))).unwrap();
+    let all = glass.clone();
+    glass.objects.retain(|o| opaque_is_transparent(&all, o));
+    assert!(!glass.objects.is_empty());
+    let mut mixed = glass.clone();
+    let floor = all.objects.iter().find(|o| !opaque_is_transparent(&all, o));
+    mixed.objects.push(floor.expect("an opaque object").clone());
+    let opts = RenderOptions::default();
+    for es in [EsVersion::Es2, EsVersion::Es3] {
+        let mut gpu = Gpu::new(es);
+        gpu.r().set_method_named("forward").unwrap();
+        let (reference, _) = gpu.r().render_offscreen(&glass, 128, 72, &opts).unwrap();
+        for method in common::methods_on(es) {
+            // A renderer of its own: the first frame builds every program it draws with.
+            let mut fresh = Gpu::fresh(es);
+            fresh.r().set_method_named(method).unwrap();
+            let (img, stats) = fresh.r().render_offscreen(&glass, 128, 72, &opts).unwrap();
+            let what = format!("{es} {method}");
+            assert!(stats.lights.visible > 0, "{what}");
+            // The shading program alone (auto draws these 16 lights with forward).
+            assert_eq!(stats.programs_built, 1, "{what}: programs");
+            assert_eq!(stats.memory.gbuffer_bytes, 0, "{what}: G-buffer");
+            let d = manylight::metrics::diff(&reference, &img);
+            assert!(d.max_abs <= 2, "{what}: {d:?}");
+            if *method == "deferred" {
+                // The G-buffer, light and composite programs, and forward's for the glass.
+                let (_, stats) = fresh.r().render_offscreen(&mixed, 128, 72, &opts).unwrap();
+                assert_eq!(stats.memory.shader_programs, 4, "{what} with a floor");
+                let gbuffer = stats.memory.gbuffer_bytes;
+                assert!(gbuffer > 0, "{what} with a floor");
+                // The floor gone, the G-buffer is kept a while (it may come back), then freed.
+                let held: Vec<_> = (0..manylight::methods::IDLE_FRAMES_KEPT)
+                    .map(|_| {
+                        let (_, stats) =
+                            fresh.r().render_offscreen(&glass, 128, 72, &opts).unwrap();
+                        stats.memory.method_gpu_bytes
+                    })
+                    .collect();
+                let last = held.len() - 1;
+                assert!(held[..last].iter().all(|&b| b == held[0]), "{held:?}");
+                assert!(held[last] + gbuffer <= held[0], "{held:?}");
+            }
+        }
+    }
+}
+
 fn opaque_is_transparent(s: &scene::Scene, o: &scene::Object) -> bool {
     s.materials[o.material].is_transparent()
 }
