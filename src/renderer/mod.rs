@@ -285,6 +285,19 @@ impl Renderer {
         result.unwrap_or_else(|panic| std::panic::resume_unwind(panic))
     }
 
+    /// Runs `f`, then `restore` whether `f` returned or panicked (the panic then goes on): what
+    /// a call sets aside for its length (a method, a target, a flag) comes back also for a
+    /// caller that catches the panic, and is not leaked with it.
+    fn restoring<T>(
+        &mut self,
+        f: impl FnOnce(&mut Self) -> T,
+        restore: impl FnOnce(&mut Self),
+    ) -> T {
+        let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| f(self)));
+        restore(self);
+        result.unwrap_or_else(|panic| std::panic::resume_unwind(panic))
+    }
+
     /// `lab`: makes the GL checks whose description contains `name` fail as out of memory
     /// (`None`: none), to test what a failed upload or allocation leaves behind.
     #[cfg(feature = "lab")]

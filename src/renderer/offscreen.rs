@@ -88,13 +88,17 @@ impl Renderer {
             let mut built = stats.programs_built;
             let mut frames = Vec::new();
             self.timing_frames = true;
-            let timed = (0..options.measure.timed_frames).try_for_each(|_| {
-                let timed = frame(self)?;
-                built += timed.programs_built;
-                frames.push(timed);
-                Ok::<(), Error>(())
-            });
-            self.timing_frames = false;
+            let timed = self.restoring(
+                |r| {
+                    (0..options.measure.timed_frames).try_for_each(|_| {
+                        let timed = frame(r)?;
+                        built += timed.programs_built;
+                        frames.push(timed);
+                        Ok::<(), Error>(())
+                    })
+                },
+                |r| r.timing_frames = false,
+            );
             timed?;
             stats = FrameStats::summarize(frames).expect("at least one timed frame");
             stats.programs_built = built;

@@ -78,12 +78,16 @@ impl Renderer {
         // The game's multisampled target stays as it is (a frame would make it again).
         let kept_msaa = self.msaa.take();
         self.warming_up = true;
-        let drawn = self.warm_up_frames(scene, &names, &options);
-        self.warming_up = false;
-        if let Some(mut m) = std::mem::replace(&mut self.msaa, kept_msaa) {
-            m.destroy(&self.dev);
-        }
-        target.destroy(&self.dev);
+        let drawn = self.restoring(
+            |r| r.warm_up_frames(scene, &names, &options),
+            move |r| {
+                r.warming_up = false;
+                if let Some(mut m) = std::mem::replace(&mut r.msaa, kept_msaa) {
+                    m.destroy(&r.dev);
+                }
+                target.destroy(&r.dev);
+            },
+        );
         drawn?;
         let fills = self.dev.caps().clears_one_sample_of_srgb_msaa();
         if srgb && own_msaa && fills && self.dev.es() == crate::gl::EsVersion::Es3 {
@@ -137,9 +141,12 @@ impl Renderer {
         let mut stats = FrameStats::default();
         let fresh = (methods::find(name)?.create)(&self.dev)?;
         let kept = std::mem::replace(&mut self.method, fresh);
-        let drawn = self.render_hosted(scene, WARM_UP_SIZE, options, [0, 0], &mut stats, false);
-        let mut used = std::mem::replace(&mut self.method, kept);
-        used.destroy(&self.dev);
-        drawn
+        self.restoring(
+            |r| r.render_hosted(scene, WARM_UP_SIZE, options, [0, 0], &mut stats, false),
+            move |r| {
+                let mut used = std::mem::replace(&mut r.method, kept);
+                used.destroy(&r.dev);
+            },
+        )
     }
 }

@@ -3,6 +3,7 @@
 //! logs on the thread that calls it, and each test runs on a thread of its own, so a test sees
 //! its own warnings and not those of the tests running beside it in the same program.
 
+use std::cell::Cell;
 use std::sync::{Mutex, Once};
 use std::thread::ThreadId;
 
@@ -16,8 +17,21 @@ impl log::Log for Warnings {
 
     fn log(&self, record: &log::Record) {
         if self.enabled(record.metadata()) {
-            let logged = (std::thread::current().id(), record.args().to_string());
-            self.0.lock().unwrap().push(logged);
+            let text = record.args().to_string();
+            let panics = PANIC_ON.with(|on| {
+                let hit = on.get().is_some_and(|t| text.contains(t));
+                if hit {
+                    on.set(None);
+                }
+                hit
+            });
+            self.0
+                .lock()
+                .unwrap()
+                .push((std::thread::current().id(), text.clone()));
+            if panics {
+                panic!("the game's logger panics on: {text}");
+            }
         }
     }
 
@@ -25,6 +39,19 @@ impl log::Log for Warnings {
 }
 
 static WARNINGS: Warnings = Warnings(Mutex::new(Vec::new()));
+
+thread_local! {
+    /// Text whose next warning on this thread panics (see [`panic_on_next_warning_containing`]).
+    static PANIC_ON: Cell<Option<&'static str>> = const { Cell::new(None) };
+}
+
+/// Makes this thread's next warning containing `text` panic, once, as a game's own logger
+/// might: for tests of what a renderer keeps when a call panics and the caller catches it.
+#[allow(dead_code)] // not every test program uses it
+pub fn panic_on_next_warning_containing(text: &'static str) {
+    install();
+    PANIC_ON.with(|on| on.set(Some(text)));
+}
 
 /// Installs the logger (once per test binary).
 pub fn install() {

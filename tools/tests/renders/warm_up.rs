@@ -206,3 +206,67 @@ fn deferred_builds_nothing_when_a_light_takes_the_whole_screen() {
         "a light around the eye, past the far plane"
     );
 }
+
+/// A warm-up that panics (a game's logger panicking on the warning one of its frames logs)
+/// and is caught leaves the renderer as it was: its own method (`auto` stayed the warm-up's
+/// forward), its frames counted (`free_unused_programs` freed nothing for good after it), its
+/// MSAA target, and no GL object of the warm-up's (a clustered one left 4 textures, a
+/// framebuffer and a renderbuffer, each time).
+#[test]
+fn a_warm_up_that_panics_leaves_the_renderer_as_it_was() {
+    use manylight::Method;
+    let mut suns = scene::builtin::build("courtyard", Some((16, 7))).unwrap();
+    suns.directional_lights.clear();
+    let plain = suns.clone();
+    for k in 0..=scene::MAX_DIRECTIONAL_LIGHTS {
+        let direction = DVec3::new(k as f64 - 2.0, -2.0, -1.0);
+        let sun = DirectionalLight::new(direction, Vec3::ONE, 0.2);
+        suns.directional_lights.push(sun);
+    }
+    for (method, samples) in [
+        (Method::Clustered, 1),
+        (Method::Auto, 4),
+        (Method::Deferred, 1),
+    ] {
+        let mut gpu = Gpu::fresh(EsVersion::Es3);
+        gpu.r().set_method(method).unwrap();
+        let opts = RenderOptions {
+            samples,
+            ..RenderOptions::default()
+        };
+        gpu.r().render_offscreen(&plain, W, H, &opts).unwrap();
+        let before = gpu.r().live_gl_objects();
+        common::warnings::panic_on_next_warning_containing("directional lights");
+        let caught = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+            gpu.r().warm_up(&suns, &opts)
+        }));
+        assert!(caught.is_err(), "{method:?}: the warm-up did not panic");
+        assert_eq!(gpu.r().method(), method);
+        let after = gpu.r().live_gl_objects();
+        let held = |o: manylight::gl::device::LiveObjects| {
+            (
+                o.textures,
+                o.buffers,
+                o.framebuffers,
+                o.renderbuffers,
+                o.vertex_arrays,
+            )
+        };
+        assert_eq!(held(after), held(before), "{method:?}: objects left");
+        // The suns' variants, unused by the last two frames, are freed.
+        for scene in [&suns, &suns, &plain, &plain] {
+            gpu.r().render_offscreen(scene, W, H, &opts).unwrap();
+        }
+        let freed = gpu.r().free_unused_programs(2).unwrap();
+        assert!(freed > 0, "{method:?}: frames are not counted");
+        let (img, _) = gpu.r().render_offscreen(&plain, W, H, &opts).unwrap();
+        let mut clean = Gpu::new(EsVersion::Es3);
+        clean.r().set_method(method).unwrap();
+        let (reference, _) = clean.r().render_offscreen(&plain, W, H, &opts).unwrap();
+        assert_eq!(
+            manylight::metrics::diff(&reference, &img).max_abs,
+            0,
+            "{method:?}"
+        );
+    }
+}
