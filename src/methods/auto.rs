@@ -4,9 +4,10 @@
 //! than clustered can index → deferred where it runs (ES 3.0 G-buffer, not the renderer's own
 //! MSAA target): one proxy per light has no index limit, where forward's loop is capped by the
 //! driver and leaves lights out. A method not in use keeps its GPU resources (clustered its
-//! grid's calibration too) for [`IDLE_FRAMES_KEPT`] frames after its last one, then frees
-//! them: a count hovering round a limit would otherwise free and make them every other frame.
-//! Clustered is in use while a frame has too many visible lights for it (it tries every frame).
+//! grid's calibration too) for [`IDLE_FRAMES_KEPT`](super::IDLE_FRAMES_KEPT) frames after its
+//! last one, then frees them: a count hovering round a limit would otherwise free and make
+//! them every other frame. Clustered is in use while a frame has too many visible lights for
+//! it (it tries every frame).
 
 use std::fmt::Write as _;
 
@@ -14,9 +15,7 @@ use super::culled::{CulledForward, CulledFrame, Culling};
 use super::culled_support::culled_support;
 use super::deferred::Deferred;
 use super::forward::Forward;
-use super::{
-    idle_for_long, FrameContext, MethodDesc, MethodStats, ShadingMethod, Support, IDLE_FRAMES_KEPT,
-};
+use super::{idle_for_long, FrameContext, MethodDesc, MethodStats, ShadingMethod, Support};
 use crate::cluster::pack::MAX_INDEXED_LIGHTS;
 use crate::gl::target_size::{self, TargetStorage};
 use crate::gl::{gbuffer, Device, EsVersion, GlError};
@@ -133,7 +132,8 @@ impl Auto {
     }
 }
 
-/// Counts a frame `method` did not draw; on the [`IDLE_FRAMES_KEPT`]th in a row it is freed.
+/// Counts a frame `method` did not draw; on the
+/// [`IDLE_FRAMES_KEPT`](super::IDLE_FRAMES_KEPT)th in a row it is freed.
 fn rest<M: ShadingMethod>(method: &mut Option<M>, idle: &mut u32, dev: &Device) {
     if method.is_some() && idle_for_long(idle) {
         if let Some(mut m) = method.take() {
