@@ -9,6 +9,7 @@ use glam::{DMat4, DVec3};
 
 use crate::gl::mesh::GpuMesh;
 use crate::gl::texture::ImageTexture;
+use crate::gl::uv_sets::UvSets;
 use crate::gl::Device;
 use crate::scene::{triangle_reach, Aabb, Camera, Material, Mesh, Scene, SceneError, Texture};
 use crate::Error;
@@ -41,9 +42,9 @@ pub struct GpuScene {
     /// Per material of this frame's scene, which of its textures an object samples (bit
     /// `slot` of [`slotted_textures_of`]; kept to reuse its memory).
     drawn_slots: Vec<u8>,
-    /// This frame's meshes whose second coordinate set some object's material reads (kept to
-    /// reuse its memory).
-    second_set_meshes: HashSet<usize>,
+    /// This frame's meshes whose coordinate sets some object's material reads, and which
+    /// (kept to reuse its memory).
+    uv_sets_read: HashMap<usize, UvSets>,
     /// An image past the context's texture size was said (once a renderer: a game replacing
     /// one every frame would say it every frame).
     warned_shrunk: bool,
@@ -108,11 +109,11 @@ const BASE_SLOT: u8 = 0;
 const EMISSIVE_SLOT: u8 = 2;
 
 /// The textures a material samples, each with its slot (its bit in [`GpuScene::drawn_slots`]:
-/// [`BASE_SLOT`] the base colour, then the maps) and whether a mesh can sample it: it has the
-/// coordinate set the texture reads (and tangents, for a normal map).
+/// [`BASE_SLOT`] the base colour, then the maps), whether a mesh can sample it (it has the
+/// coordinate set the texture reads, and tangents for a normal map), and that set.
 fn slotted_textures_of(
     m: &Material,
-) -> impl Iterator<Item = (u8, &Texture, impl Fn(&Mesh) -> bool + '_)> {
+) -> impl Iterator<Item = (u8, &Texture, impl Fn(&Mesh) -> bool + '_, u32)> {
     let base = (m.diffuse_texture.iter()).map(|t| (BASE_SLOT, &**t, &m.maps.base_transform, false));
     let maps = m.sampled_map_textures().map(|(name, t)| {
         let slot = match name {
@@ -127,7 +128,7 @@ fn slotted_textures_of(
         let samples = move |mesh: &Mesh| {
             transform.coordinates(mesh).is_some() && !(tangents && mesh.tangents.is_empty())
         };
-        (slot, t, samples)
+        (slot, t, samples, transform.uv_set)
     })
 }
 
@@ -168,13 +169,13 @@ impl GpuScene {
         self.note_what_objects_sample(scene);
         for (i, o) in scene.objects.iter().enumerate() {
             let key = Arc::as_ptr(&o.mesh) as usize;
-            let second = self.second_set_meshes.contains(&key);
+            let read = self.uv_sets_read.get(&key).copied().unwrap_or_default();
             match self.meshes.entry(key) {
                 Entry::Vacant(e) => {
                     o.mesh.check_shape(&format!("objects[{i}].mesh"))?;
                     let bounds = o.mesh.bounds();
                     let origin = bounds.map_or(DVec3::ZERO, |b| b.center());
-                    let gpu = GpuMesh::new_about(dev, &o.mesh, origin, second)?;
+                    let gpu = GpuMesh::new_about(dev, &o.mesh, origin, read)?;
                     bytes += gpu.gpu_bytes();
                     e.insert(CachedMesh {
                         source: o.mesh.clone(),
@@ -184,11 +185,12 @@ impl GpuScene {
                         faces_one_way: o.mesh.faces_one_way(),
                     });
                 }
-                // A material reads the second set of a mesh uploaded without it: again, with.
-                Entry::Occupied(mut e) if second && !e.get().gpu.has_second_uvs() => {
+                // A material reads a set of a mesh uploaded without it: again, with.
+                Entry::Occupied(mut e) if !e.get().gpu.uv_sets().contains(read) => {
                     let cached = e.get_mut();
                     let origin = cached.bounds.map_or(DVec3::ZERO, |b| b.center());
-                    let with = GpuMesh::new_about(dev, &cached.source, origin, true)?;
+                    let sets = cached.gpu.uv_sets().union(read);
+                    let with = GpuMesh::new_about(dev, &cached.source, origin, sets)?;
                     bytes += with.gpu_bytes();
                     std::mem::replace(&mut cached.gpu, with).destroy(dev);
                 }
@@ -196,7 +198,7 @@ impl GpuScene {
             }
         }
         for (m, &drawn) in scene.materials.iter().zip(&self.drawn_slots) {
-            for (slot, t, _) in slotted_textures_of(m) {
+            for (slot, t, _, _) in slotted_textures_of(m) {
                 if drawn & 1 << slot == 0 {
                     continue;
                 }
@@ -232,18 +234,23 @@ impl GpuScene {
     fn note_what_objects_sample(&mut self, scene: &Scene) {
         self.drawn_slots.clear();
         self.drawn_slots.resize(scene.materials.len(), 0);
-        self.second_set_meshes.clear();
+        self.uv_sets_read.clear();
         for o in &scene.objects {
             let Some(m) = scene.materials.get(o.material) else {
                 continue;
             };
-            for (slot, _, samples) in slotted_textures_of(m) {
+            let mut read = UvSets::default();
+            for (slot, _, samples, set) in slotted_textures_of(m) {
                 if samples(&o.mesh) {
                     self.drawn_slots[o.material] |= 1 << slot;
+                    read.first |= set == 0;
+                    read.second |= set == 1;
                 }
             }
-            if !o.mesh.second_uvs.is_empty() && m.reads_second_uvs() {
-                self.second_set_meshes.insert(Arc::as_ptr(&o.mesh) as usize);
+            if read != UvSets::default() {
+                let key = Arc::as_ptr(&o.mesh) as usize;
+                let sets = self.uv_sets_read.entry(key).or_default();
+                *sets = sets.union(read);
             }
         }
     }
@@ -266,7 +273,7 @@ impl GpuScene {
             .flat_map(|s| s.objects.iter().map(|o| (o, s.materials.get(o.material))))
             .flat_map(|(o, m)| {
                 let textures = m.into_iter().flat_map(slotted_textures_of);
-                textures.filter_map(|(_, t, samples)| samples(&o.mesh).then_some(t))
+                textures.filter_map(|(_, t, samples, _)| samples(&o.mesh).then_some(t))
             })
             .map(|t| Arc::as_ptr(&t.image) as usize)
             .collect();

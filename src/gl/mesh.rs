@@ -9,6 +9,7 @@ use glam::DVec3;
 use glow::HasContext;
 
 use super::absent_attributes::{ABSENT, ABSENT_BITS};
+use super::uv_sets::UvSets;
 use super::{Device, GlError};
 use crate::scene::Mesh;
 
@@ -31,14 +32,15 @@ pub struct VertexLayout {
 }
 
 impl VertexLayout {
-    /// The layout of `mesh`'s vertices, its second coordinate set where `second_uvs` (a
-    /// texture reads it).
-    pub fn of(mesh: &Mesh, second_uvs: bool) -> VertexLayout {
+    /// The layout of `mesh`'s vertices, with the coordinate sets of `uv_sets` it has (those a
+    /// texture reads).
+    pub fn of(mesh: &Mesh, uv_sets: UvSets) -> VertexLayout {
+        let uv_sets = uv_sets.on(mesh);
         VertexLayout {
-            uvs: !mesh.uvs.is_empty(),
+            uvs: uv_sets.first,
             colors: !mesh.colors.is_empty(),
             tangents: !mesh.tangents.is_empty(),
-            second_uvs: second_uvs && !mesh.second_uvs.is_empty(),
+            second_uvs: uv_sets.second,
         }
     }
 
@@ -95,14 +97,14 @@ pub struct Chunk {
 
 /// Splits a mesh into chunks whose vertices fit 16-bit indices; triangles stay whole.
 pub fn split_u16(mesh: &Mesh) -> Vec<Chunk> {
-    split_u16_about(mesh, DVec3::ZERO, true)
+    split_u16_about(mesh, DVec3::ZERO, UvSets::ALL)
 }
 
 /// [`split_u16`] with `origin` subtracted from every position (in `f64`, before the vertex
-/// becomes `f32`), and the second coordinate set only where `second_uvs`.
-pub fn split_u16_about(mesh: &Mesh, origin: DVec3, second_uvs: bool) -> Vec<Chunk> {
+/// becomes `f32`), and the coordinate sets of `uv_sets` only.
+pub fn split_u16_about(mesh: &Mesh, origin: DVec3, uv_sets: UvSets) -> Vec<Chunk> {
     const LIMIT: usize = u16::MAX as usize + 1;
-    let layout = VertexLayout::of(mesh, second_uvs);
+    let layout = VertexLayout::of(mesh, uv_sets);
     let floats = layout.floats();
     let mut chunks = Vec::new();
     let mut remap: HashMap<u32, u16> = HashMap::new();
@@ -288,35 +290,35 @@ impl BoundMesh {
 pub struct GpuMesh {
     chunks: Vec<GpuChunk>,
     bytes: usize,
-    /// Its vertices carry the mesh's second coordinate set.
-    second_uvs: bool,
+    /// The mesh's coordinate sets its vertices carry.
+    uv_sets: UvSets,
     destroyed: bool,
 }
 
 impl GpuMesh {
     /// Uploads a mesh, every attribute it has.
     pub fn new(dev: &Device, mesh: &Mesh) -> Result<GpuMesh, GlError> {
-        GpuMesh::new_about(dev, mesh, DVec3::ZERO, true)
+        GpuMesh::new_about(dev, mesh, DVec3::ZERO, UvSets::ALL)
     }
 
     /// Uploads a mesh with its positions relative to `origin` (drawn with the model matrix
-    /// translated by `origin`), and its second coordinate set only where `second_uvs`.
+    /// translated by `origin`), and of its coordinate sets those of `uv_sets` only.
     pub fn new_about(
         dev: &Device,
         mesh: &Mesh,
         origin: DVec3,
-        second_uvs: bool,
+        uv_sets: UvSets,
     ) -> Result<GpuMesh, GlError> {
         let mut out = GpuMesh {
             chunks: Vec::new(),
             bytes: 0,
-            second_uvs: second_uvs && !mesh.second_uvs.is_empty(),
+            uv_sets: uv_sets.on(mesh),
             destroyed: false,
         };
         // A failed upload (out of memory, most likely) frees what it made: the caller may try
         // again next frame.
         let uploaded = out
-            .upload_chunks(dev, mesh, origin, second_uvs)
+            .upload_chunks(dev, mesh, origin, uv_sets)
             .and_then(|()| dev.check("mesh upload"));
         match uploaded {
             Ok(()) => Ok(out),
@@ -334,18 +336,18 @@ impl GpuMesh {
         dev: &Device,
         mesh: &Mesh,
         origin: DVec3,
-        second_uvs: bool,
+        uv_sets: UvSets,
     ) -> Result<(), GlError> {
-        for chunk in split_u16_about(mesh, origin, second_uvs) {
+        for chunk in split_u16_about(mesh, origin, uv_sets) {
             self.chunks.push(GpuChunk::upload(dev, &chunk)?);
             self.bytes += chunk.vertices.len() * 4 + chunk.indices.len() * 2;
         }
         Ok(())
     }
 
-    /// Whether its vertices carry the mesh's second coordinate set.
-    pub fn has_second_uvs(&self) -> bool {
-        self.second_uvs
+    /// The mesh's coordinate sets its vertices carry.
+    pub fn uv_sets(&self) -> UvSets {
+        self.uv_sets
     }
 
     /// Draws all chunks with the bound program (attributes at [`super::program::ATTRIBUTES`]).

@@ -41,6 +41,7 @@ pub mod state;
 pub(crate) mod target_size;
 pub mod texture;
 pub mod timer;
+pub mod uv_sets;
 pub(crate) mod vertex_arrays;
 
 pub use caps::Caps;

@@ -191,12 +191,6 @@ impl Material {
         self.maps.sampled_textures().filter(read)
     }
 
-    /// True when a texture of the material reads the second coordinate set: what its meshes'
-    /// `second_uvs` are uploaded for.
-    pub(crate) fn reads_second_uvs(&self) -> bool {
-        self.texture_sets().second()
-    }
-
     /// True when the material has a non-zero Blinn-Phong specular term (never for
     /// metallic-roughness, whose specular lobe is always there).
     pub fn has_specular(&self) -> bool {

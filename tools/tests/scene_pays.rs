@@ -673,9 +673,12 @@ fn textures_no_object_samples_are_neither_uploaded_nor_kept() {
     gpu.r().render_offscreen(&drawn, 64, 36, &opts).unwrap();
     gpu.r().render_offscreen(&palette, 64, 36, &opts).unwrap();
     let freed = gpu.r().free_unused_uploads(&[&palette]).unwrap();
+    // The plane's mesh, which the palette scene still draws, keeps the coordinates the texture
+    // read (8 bytes a vertex); untextured, it was uploaded without.
+    let coordinates = 8 * base.objects[0].mesh.positions.len();
     assert_eq!(
         freed,
-        drawn_bytes - palette_bytes,
+        drawn_bytes - palette_bytes - coordinates,
         "the texture whose objects went"
     );
 }
@@ -712,7 +715,13 @@ fn mipmaps_are_made_only_for_an_image_sampled_through_them() {
     };
     let (_, untextured, _) = render(&mut Gpu::new(EsVersion::Es3), &base(&s));
     let (_, bytes, _) = render(&mut gpu, &s);
-    assert_eq!(bytes, untextured + 64 * 64 * 4, "the base level alone");
+    // And the mesh's texture coordinates, which the untextured plane does not upload.
+    let coordinates = 8 * s.objects[0].mesh.positions.len();
+    assert_eq!(
+        bytes,
+        untextured + 64 * 64 * 4 + coordinates,
+        "the base level alone"
+    );
     let mipmapped = Sampling {
         mipmap: Some(Filter::Linear),
         ..flat
@@ -721,7 +730,11 @@ fn mipmaps_are_made_only_for_an_image_sampled_through_them() {
     let texture = m.diffuse_texture.as_ref().unwrap().with_sampling(mipmapped);
     m.diffuse_texture = Some(Arc::new(texture));
     let (again, bytes, uploaded) = render(&mut gpu, &s);
-    assert_eq!(bytes, untextured + 64 * 64 * 4 * 4 / 3, "mipmaps made");
+    assert_eq!(
+        bytes,
+        untextured + 64 * 64 * 4 * 4 / 3 + coordinates,
+        "mipmaps made"
+    );
     assert_eq!(uploaded, 64 * 64 * 4 / 3, "the frame's scene upload");
     let (fresh, _, _) = render(&mut Gpu::new(EsVersion::Es3), &s);
     assert_eq!(manylight::metrics::diff(&fresh, &again).max_abs, 0);
@@ -797,6 +810,53 @@ fn a_mesh_without_texture_coordinates_uploads_none() {
             "{es}: the mesh's upload"
         );
         assert_eq!(manylight::metrics::diff(&picture, &bare).max_abs, 0, "{es}");
+    }
+}
+
+/// A mesh with texture coordinates that no texture reads (the built-ins' meshes, an OBJ with
+/// `vt` under an untextured material) uploads positions and normals alone, 24 bytes a vertex
+/// where it uploaded 32; once a textured material draws it, the same renderer uploads the
+/// coordinates and draws what a fresh renderer does.
+#[test]
+fn texture_coordinates_no_texture_reads_are_not_uploaded() {
+    let plain = scene::builtin::build("plane", Some((8, 2))).unwrap();
+    let mesh = &plain.objects[0].mesh;
+    assert!(!mesh.uvs.is_empty());
+    let (vertices, indices) = (mesh.positions.len(), mesh.indices.len());
+    let mut textured = plain.clone();
+    let texels = image::RgbaImage::from_fn(8, 8, |x, y| {
+        image::Rgba([(x * 30) as u8, (y * 30) as u8, 90, 255])
+    });
+    let m = textured.objects[0].material;
+    textured.materials[m].diffuse_texture = Some(Arc::new(scene::Texture::new("t", texels)));
+    let render = |gpu: &mut Gpu, s: &scene::Scene| {
+        (gpu.r())
+            .render_offscreen(s, 64, 36, &RenderOptions::default())
+            .unwrap()
+    };
+    for es in [EsVersion::Es3, EsVersion::Es2] {
+        let mut gpu = Gpu::new(es);
+        let (_, stats) = render(&mut gpu, &plain);
+        let meshes: usize = (plain.objects.iter())
+            .map(|o| o.mesh.positions.len() * 24 + o.mesh.indices.len() * 2)
+            .sum();
+        assert_eq!(
+            plain.objects.len(),
+            1,
+            "one mesh: {vertices} vertices, {indices} indices"
+        );
+        assert_eq!(
+            stats.memory.scene_upload_bytes, meshes,
+            "{es}: the untextured upload"
+        );
+        let (again, stats) = render(&mut gpu, &textured);
+        let (fresh, fresh_stats) = render(&mut Gpu::new(es), &textured);
+        assert_eq!(
+            stats.memory.scene_gpu_bytes, fresh_stats.memory.scene_gpu_bytes,
+            "{es}: the coordinates uploaded"
+        );
+        assert_eq!(manylight::metrics::diff(&fresh, &again).max_abs, 0, "{es}");
+        assert!(fresh_stats.memory.scene_gpu_bytes >= meshes + 8 * vertices + 8 * 8 * 4);
     }
 }
 
