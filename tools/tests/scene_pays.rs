@@ -1069,14 +1069,15 @@ fn a_second_coordinate_set_is_uploaded_once_a_texture_reads_it() {
     }
 }
 
-/// A frame uploads the texels its shaders read and no more: forward its light records,
+/// A frame uploads the records of its lights and no whole rows: forward its light records,
 /// deferred its light instances, the culled methods also one grid texel a cell (after a
 /// two-texel table a cascade, and one more where the last list ends) and the index list's
 /// texels. A record is 32 bytes (float) or 16 (RGBA8) without spots in the scene, 64 or 32
-/// with them. Packed whole rows of 1 024 texels, one light cost 16 KB; points took a spot's
-/// record.
+/// with them: a power of two texels, so a light never straddles a row, the last texels padding
+/// where the shaders read fewer (lights.rs). Packed whole rows of 1 024 texels, one light cost
+/// 16 KB; points took a spot's record.
 #[test]
-fn a_frame_uploads_only_the_texels_its_shaders_read() {
+fn a_frame_uploads_its_light_records_and_no_whole_rows() {
     let mut s = scene::builtin::build("plane", None).unwrap();
     common::each_method(|es, method, gpu| {
         // One light, then 300 (600 float texels without spots, 1 200 with: a row and part of
