@@ -223,13 +223,18 @@ pub(crate) fn shade_object<P: GeometryProgram>(
             ShaderFeatures::TEXTURE | ShaderFeatures::SPECULAR | ShaderFeatures::METALLIC_ROUGHNESS;
         ShaderFeatures(own.0 & kept)
     } else {
-        // Only a light reads the shading normal: without one the map would be compiled out.
+        // Only a light reads the shading normal, the specular lobe and the metallic-roughness
+        // terms (the ambient term is albedo's alone): without one, one variant for every
+        // lighting model, which would compile them out anyway.
         let shades = !ctx.features.has(ShaderFeatures::NO_LIGHTS)
             || ctx.features.has(ShaderFeatures::DIRECTIONAL);
-        let own = own.with(
+        let lit_only = [
             ShaderFeatures::NORMAL_MAP,
-            own.has(ShaderFeatures::NORMAL_MAP) && shades,
-        );
+            ShaderFeatures::SPECULAR,
+            ShaderFeatures::METALLIC_ROUGHNESS,
+            ShaderFeatures::MR_TEXTURE,
+        ];
+        let own = (lit_only.into_iter()).fold(own, |f, bit| f.with(bit, f.has(bit) && shades));
         if ctx.shared_surfaces {
             super::surface_variants::shared(own, units)
         } else {

@@ -1172,6 +1172,74 @@ fn an_unlit_frame_draws_each_opaque_object_once() {
     });
 }
 
+/// A frame without lights (none active, none in view) draws matte, Blinn-Phong and
+/// metallic-roughness materials, a metallic-roughness texture among them, with one program:
+/// the ambient term is the albedo's alone, and each lighting model built its own variant,
+/// the same code once compiled (three). The picture is that of the same objects with flat
+/// materials of those albedos, each in view.
+#[test]
+fn an_unlit_frame_builds_one_variant_for_every_lighting_model() {
+    use manylight::scene::surface_maps::{MapTexture, TextureTransform};
+    let mut base = scene::builtin::build("plane", None).unwrap();
+    assert!(base.lights.is_empty() && base.directional_lights.is_empty());
+    // Four quarters of the plane side by side, one for each material.
+    let plane = base.objects[0].clone();
+    base.objects = (0..4)
+        .map(|k| scene::Object {
+            transform: DMat4::from_translation(DVec3::new(k as f64 - 1.5, 0.0, 0.0))
+                * DMat4::from_scale(DVec3::splat(0.25))
+                * plane.transform,
+            ..plane.clone()
+        })
+        .collect();
+    let mut models = base.clone();
+    let mut flat = base.clone();
+    let colour = |k: usize| Vec3::new(0.2 + 0.2 * k as f32, 0.5, 0.9 - 0.2 * k as f32);
+    let texels = image::RgbaImage::from_pixel(4, 4, image::Rgba([0, 128, 255, 255]));
+    let mr_texture = Arc::new(scene::Texture::new("mr", texels));
+    for k in 0..models.objects.len() {
+        let mut m = match k % 4 {
+            0 => Material::flat("matte", colour(0)),
+            1 => {
+                let mut m = Material::flat("glossy", colour(1));
+                m.specular = Vec3::splat(0.5);
+                m.shininess = 32.0;
+                m
+            }
+            2 => Material::metallic_roughness("metal", colour(2), 1.0, 0.3),
+            _ => {
+                let mut m = Material::metallic_roughness("mapped", colour(3), 0.5, 0.6);
+                m.maps.metallic_roughness = Some(MapTexture {
+                    texture: mr_texture.clone(),
+                    transform: TextureTransform::IDENTITY,
+                });
+                m
+            }
+        };
+        m.name = format!("{}{k}", m.name);
+        models.objects[k].material = models.add_material(m);
+        flat.objects[k].material = flat.add_material(Material::flat("flat", colour(k % 4)));
+    }
+    for es in [EsVersion::Es2, EsVersion::Es3] {
+        for method in common::methods_on(es) {
+            let mut gpu = Gpu::fresh(es);
+            gpu.r().set_method_named(method).unwrap();
+            let opts = RenderOptions::default();
+            let (picture, stats) = gpu.r().render_offscreen(&models, 96, 54, &opts).unwrap();
+            assert_eq!(stats.programs_built, 1, "{es} {method}");
+            let (expected, _) = gpu.r().render_offscreen(&flat, 96, 54, &opts).unwrap();
+            let d = manylight::metrics::diff(&expected, &picture);
+            assert_eq!(d.max_abs, 0, "{es} {method}: {d:?}");
+            let colours: std::collections::HashSet<_> = picture.pixels().collect();
+            assert!(
+                colours.len() >= 4,
+                "{es} {method}: {} colours",
+                colours.len()
+            );
+        }
+    }
+}
+
 /// Objects that share a material set only their own transforms: the program, the material's
 /// values, the frame's constants and the method's light data stay set from one object to the
 /// next. 60 small boxes, each its own mesh, added to a scene cost at most three uniforms each
