@@ -7,7 +7,8 @@
 //! grid's calibration too) for [`IDLE_FRAMES_KEPT`](super::IDLE_FRAMES_KEPT) frames after its
 //! last one, then frees them: a count hovering round a limit would otherwise free and make
 //! them every other frame. Clustered is in use while a frame has too many visible lights for
-//! it (it tries every frame).
+//! it (it tries every frame); frames without lights free its textures alone, as they do when
+//! it runs by itself.
 
 use std::fmt::Write as _;
 
@@ -87,8 +88,6 @@ pub struct Auto {
     deferred: Option<Deferred>,
     /// Frames in a row each method did not draw (forward, clustered, deferred); see [`rest`].
     idle: [u32; 3],
-    /// Whether clustered drew the last frame: only its own frames' timings calibrate its grid.
-    clustered_drew_last: bool,
     /// Why this frame's method was chosen (rewritten every frame, its buffer kept).
     reason: String,
     /// Whether clustered runs on this context (asked once: the context does not change).
@@ -132,8 +131,8 @@ impl Auto {
     }
 }
 
-/// Counts a frame `method` did not draw; on the
-/// [`IDLE_FRAMES_KEPT`](super::IDLE_FRAMES_KEPT)th in a row it is freed.
+/// Counts a frame `method` did not draw; from the
+/// [`IDLE_FRAMES_KEPT`](super::IDLE_FRAMES_KEPT)th in a row on, it is freed.
 fn rest<M: ShadingMethod>(method: &mut Option<M>, idle: &mut u32, dev: &Device) {
     if method.is_some() && idle_for_long(idle) {
         if let Some(mut m) = method.take() {
@@ -223,7 +222,6 @@ impl ShadingMethod for Auto {
                     rest(&mut self.forward, forward_idle, ctx.dev);
                     rest(&mut self.deferred, deferred_idle, ctx.dev);
                     *clustered_idle = 0;
-                    self.clustered_drew_last = true;
                     stats.auto_choice = Some((choice, &self.reason));
                     return Ok(stats);
                 }
@@ -259,7 +257,6 @@ impl ShadingMethod for Auto {
             }
             // Clustered tried this frame: it is still in use.
             self.idle[1] = 0;
-            self.clustered_drew_last = false;
             let [forward_idle, _, deferred_idle] = &mut self.idle;
             let mut stats = if instead == "deferred" {
                 rest(&mut self.forward, forward_idle, ctx.dev);
@@ -281,7 +278,6 @@ impl ShadingMethod for Auto {
         rest(&mut self.clustered, clustered_idle, ctx.dev);
         rest(&mut self.deferred, deferred_idle, ctx.dev);
         *forward_idle = 0;
-        self.clustered_drew_last = false;
         let mut stats = self
             .forward
             .get_or_insert_with(Forward::default)
@@ -290,16 +286,21 @@ impl ShadingMethod for Auto {
         Ok(stats)
     }
 
+    /// A frame without lights: forward and deferred rest as on a frame another method drew;
+    /// clustered as it does alone, freeing its textures and keeping its grid's calibration.
     fn skip_frame(&mut self, dev: &Device) {
-        let [forward_idle, clustered_idle, deferred_idle] = &mut self.idle;
+        let [forward_idle, _, deferred_idle] = &mut self.idle;
         rest(&mut self.forward, forward_idle, dev);
-        rest(&mut self.clustered, clustered_idle, dev);
         rest(&mut self.deferred, deferred_idle, dev);
-        self.clustered_drew_last = false;
+        if let Some(c) = &mut self.clustered {
+            c.skip_frame(dev);
+        }
     }
 
+    /// Clustered's grid takes in only its own frames' costs (it recorded them when it drew),
+    /// and a GPU time read frames later by the frame it belongs to.
     fn observe_frame(&mut self, timing: super::FrameTiming) {
-        if let Some(c) = self.clustered.as_mut().filter(|_| self.clustered_drew_last) {
+        if let Some(c) = &mut self.clustered {
             c.observe_frame(timing);
         }
     }

@@ -228,7 +228,8 @@ pub struct Deferred {
     transparent: Forward,
     /// Frames in a row that needed no specular target (see [`SPECULAR_KEPT_FRAMES`]).
     frames_without_specular: u32,
-    /// Frames without lights in a row (see [`super::IDLE_FRAMES_KEPT`]).
+    /// Frames in a row without lights or without opaque objects: frames that draw no
+    /// G-buffer (see [`super::IDLE_FRAMES_KEPT`]).
     idle_frames: u32,
 }
 
@@ -266,6 +267,9 @@ impl Deferred {
     /// Allocates what a frame of `ctx` needs (kept while its size and specular target stay),
     /// leaving the frame's framebuffer bound (making the G-buffer binds its own).
     pub(super) fn prepare(&mut self, ctx: &FrameContext) -> Result<(), Error> {
+        if !draws_opaque(ctx) {
+            return Ok(());
+        }
         let dev = ctx.dev;
         let target = ctx.target;
         let has = self.gbuffer.as_ref().is_some_and(GBuffer::has_specular);
@@ -554,6 +558,14 @@ impl Deferred {
     }
 }
 
+/// Whether the frame draws an opaque object (cut-outs included), which the G-buffer passes
+/// are for: the objects [`sort_objects`] lists as opaque.
+fn draws_opaque(ctx: &FrameContext) -> bool {
+    let scene = ctx.scene;
+    let opaque = |o: &crate::scene::Object| !scene.materials[o.material].is_transparent();
+    !ctx.transparent_only && scene.objects.iter().any(opaque)
+}
+
 /// Whether the frame's G-buffer needs its specular target: a material it holds has a
 /// specular lobe or is metallic-roughness (every variant has them with `full_variants`). A
 /// shared variant's specular term of 0 changes nothing: its output has no target to go to.
@@ -603,12 +615,14 @@ impl ShadingMethod for Deferred {
         sort_objects(ctx);
         let mut light_pass = None;
         let mut stats = if ctx.order.opaque.is_empty() {
-            // Nothing opaque in view: a G-buffer would hold nothing and its light pass light
-            // nothing (the composite writes surfaces only). Kept a while, as without lights.
+            // Nothing opaque in the scene: a G-buffer would hold nothing and its light pass
+            // light nothing (the composite writes surfaces only). Kept a while, as without
+            // lights.
             if super::idle_for_long(&mut self.idle_frames) {
                 self.free_gbuffer_passes(dev);
             }
             MethodStats {
+                gbuffer_bytes: self.gbuffer.as_ref().map_or(0, GBuffer::gpu_bytes),
                 lists_reused: true,
                 ..MethodStats::default()
             }

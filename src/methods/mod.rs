@@ -209,13 +209,33 @@ pub trait ShadingMethod {
 /// Frames without lights after which a method frees what it holds for lights (deferred's
 /// G-buffer and instances, the culled methods' texture ring): two seconds at 60 frames a
 /// second, so a light that blinks does not allocate every time; a sun-only stretch of a day
-/// cycle gets the memory back. The next lit frame makes them again.
+/// cycle gets the memory back. The next lit frame makes them again. Deferred counts frames
+/// with nothing opaque to draw likewise, and `auto` the frames each of its methods sat out.
 pub const IDLE_FRAMES_KEPT: u32 = 120;
 
-/// Counts `skip_frame`s in a row: true on the one that reaches [`IDLE_FRAMES_KEPT`].
+/// Counts an idle frame of a row (`idle` is set to 0 by a frame that used the resources):
+/// true from the one that reaches [`IDLE_FRAMES_KEPT`] on, so what was made again after being
+/// freed, and is not used, is freed again.
 pub(crate) fn idle_for_long(idle: &mut u32) -> bool {
     *idle = idle.saturating_add(1);
-    *idle == IDLE_FRAMES_KEPT
+    *idle >= IDLE_FRAMES_KEPT
+}
+
+#[cfg(test)]
+mod idle_tests {
+    use super::*;
+
+    #[test]
+    fn idle_frames_free_from_the_kept_count_on() {
+        let mut idle = 0;
+        let freed: Vec<bool> = (0..IDLE_FRAMES_KEPT + 2)
+            .map(|_| idle_for_long(&mut idle))
+            .collect();
+        let first = IDLE_FRAMES_KEPT as usize - 1;
+        assert!(freed[..first].iter().all(|&f| !f));
+        // Made again and left unused past the count: freed again, not kept for good.
+        assert!(freed[first..].iter().all(|&f| f), "{freed:?}");
+    }
 }
 
 /// A row of the method table.

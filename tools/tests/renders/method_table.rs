@@ -157,6 +157,20 @@ fn auto_renders_with_deferred_or_forward_when_more_lights_are_visible_than_clust
         .collect();
     let freed = with_gbuffer.memory.method_gpu_bytes - unlit[unlit.len() - 1];
     assert!(freed >= gbuffer, "{unlit:?}");
+    // Transparent objects alone: deferred, which auto picks, makes no G-buffer for them (it
+    // made one before drawing none; made again after its 120 frames, it was kept for good).
+    let mut glass = all.clone();
+    for m in &mut glass.materials {
+        m.alpha = 0.5;
+    }
+    let mut fresh = Gpu::new(EsVersion::Es3);
+    fresh.r().set_method_named("auto").unwrap();
+    let (_, stats) = fresh.r().render_offscreen(&glass, w, h, &single).unwrap();
+    assert_eq!(stats.auto_choice.as_deref(), Some("deferred"));
+    assert_eq!(
+        stats.memory.gbuffer_bytes, 0,
+        "a G-buffer for transparent objects"
+    );
 }
 
 /// A light count hovering round forward's limit: `auto` alternates forward and clustered, and
