@@ -227,10 +227,9 @@ impl GpuScene {
     }
 
     /// Notes, in one pass over the objects, what they sample: which textures of each
-    /// material an object draws with on a mesh that can sample them, and the meshes whose
-    /// second coordinate set an object's material reads. Only those are uploaded (a material
-    /// palette's textures, a texture on a mesh without coordinates, a second set no texture
-    /// reads are not).
+    /// material an object draws with on a mesh that can sample them, and the coordinate sets
+    /// of each mesh those textures read. Only those are uploaded (a material palette's
+    /// textures, a texture on a mesh without coordinates, a set no texture reads are not).
     fn note_what_objects_sample(&mut self, scene: &Scene) {
         self.drawn_slots.clear();
         self.drawn_slots.resize(scene.materials.len(), 0);

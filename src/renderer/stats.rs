@@ -166,7 +166,8 @@ pub struct MemoryStats {
     /// (mipmaps included, and mipmaps made for an image first sampled without): a scene's
     /// whole content on its first frame, then 0 unless the application made one anew (a mesh
     /// rebuilt every frame, a new `Arc` of the same data, shows here every frame) or an object
-    /// first samples a texture (a material it changed to, a second coordinate set).
+    /// first samples a texture (a material it changed to, a coordinate set no texture had
+    /// read, uploaded with its mesh again).
     pub scene_upload_bytes: usize,
     /// GPU memory held by the method.
     pub method_gpu_bytes: usize,

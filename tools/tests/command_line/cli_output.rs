@@ -773,6 +773,13 @@ fn a_recording_that_would_overwrite_a_file_the_scene_reads_is_refused() {
             "{file}"
         );
     }
+    // A frame that is a symbolic link to the texture: written through it.
+    std::fs::create_dir(dir.path().join("links")).unwrap();
+    std::os::unix::fs::symlink("../t.gif", dir.path().join("links/frame_00002.png")).unwrap();
+    let out = render("links", "3");
+    let said = text(&out);
+    assert_eq!(out.status.code(), Some(1), "--record links: {said}");
+    assert!(said.contains("which the scene reads"), "{said}");
     // One frame writes frame_00000.png alone, which the scene does not read.
     let out = render("rec", "1");
     assert!(out.status.success(), "{}", text(&out));

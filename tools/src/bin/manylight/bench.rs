@@ -944,7 +944,7 @@ mod tests {
         assert!(std::path::Path::new(&found).is_file(), "{found}");
         let why = conference_in(Some(other.into())).unwrap_err();
         assert!(
-            why.contains("is not UTF-8") && why.contains("assets"),
+            why.contains("is not UTF-8") && why.contains("/assets\u{fffd}/conference/"),
             "{why}"
         );
         let why = conference_in(None).unwrap_err();

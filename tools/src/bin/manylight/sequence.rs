@@ -204,22 +204,26 @@ fn stale_frames(dir: &Path, frames: u32, digits: usize) -> usize {
 }
 
 /// The first of the files the scene `read` (as [`output::identity`] spells them) that
-/// `--record path` would overwrite: the GIF itself, or one of the folder's frame PNGs.
+/// `--record path` would overwrite: the GIF itself, or one of the folder's frame PNGs this
+/// recording writes, a symbolic link among them through to its target (the frame is written
+/// there).
 pub fn overwritten_input(path: &Path, frames: u32, read: &[PathBuf]) -> Option<PathBuf> {
-    let id = output::identity(path);
     if records_gif(path) {
+        let id = output::identity(path);
         return read.contains(&id).then_some(id);
     }
     let digits = frame_digits(frames);
-    read.iter()
-        .find(|file| {
-            file.parent() == Some(id.as_path())
-                && file
-                    .file_name()
-                    .and_then(|n| n.to_str())
-                    .is_some_and(|n| is_recorded_frame(n, frames, digits))
+    // A file the scene read exists: only the folder's existing frames can be one.
+    std::fs::read_dir(path)
+        .ok()?
+        .flatten()
+        .filter(|e| {
+            e.file_name()
+                .to_str()
+                .is_some_and(|n| is_recorded_frame(n, frames, digits))
         })
-        .cloned()
+        .map(|e| output::identity(&e.path()))
+        .find(|id| read.contains(id))
 }
 
 /// What a sequence keeps of its timed frames besides their stats.
