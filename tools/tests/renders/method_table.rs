@@ -208,9 +208,10 @@ fn auto_keeps_both_methods_while_the_count_hovers_round_forwards_limit() {
         assert_eq!(*choice, Some(expected), "frame {k}: {choices:?}");
     }
     let held: Vec<_> = hovering.iter().map(|f| f.memory.method_gpu_bytes).collect();
-    // (Clustered's ring of texture sets fills over its first frames.)
+    // After the first, a forward frame neither frees nor makes anything: clustered's
+    // textures stay. (Its own frames may resize them, as its grid calibrates.)
     assert!(
-        held[8..].windows(2).all(|w| w[0] == w[1]),
+        (3..held.len()).step_by(2).all(|k| held[k] == held[k - 1]),
         "both methods' memory is kept: {held:?}"
     );
     // Its grid's search spans frames: 20 frames of clustered's own, here 40 of auto's.
@@ -226,7 +227,7 @@ fn auto_keeps_both_methods_while_the_count_hovers_round_forwards_limit() {
         "kept while idle: {forward_only:?}"
     );
     assert!(
-        forward_only[last] < held[59] / 2,
+        forward_only[last] < held[59] / 2 && forward_only[last] > 0,
         "clustered freed on the {IDLE_FRAMES_KEPT}th forward frame: {forward_only:?}"
     );
 }
