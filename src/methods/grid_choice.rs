@@ -548,6 +548,7 @@ mod tests {
                 assign_ms: 0.1,
                 over_budget: false,
                 overflowed_lights,
+                dropped_per_pixel: 0.0,
             };
             auto.choice = Some(GridChoice {
                 config: GridConfig::fixed(16.0),

@@ -169,6 +169,7 @@ impl Assigner {
         let out = &mut self.out;
         out.visible.clear();
         out.unlisted = None;
+        out.overfull.clear();
         out.stats = AssignStats {
             clusters: grid.total_cells,
             threads: 1,

@@ -41,13 +41,18 @@ pub(super) fn apply_cap(
     // lights there, in ascending order).
     let total: usize = out.counts.iter().map(|&n| n.min(cap) as usize).sum();
     let (offsets, counts) = (&mut out.offsets, &mut out.counts);
+    let overfull = &mut out.overfull;
     let dropped = match (
         scratch.kept.prepare(total, out.visible.len()),
         out.indices.as_u16(),
         out.indices.as_u32(),
     ) {
-        (EntriesMut::Narrow(kept), Some(list), _) => compact(list, kept, offsets, counts, cap),
-        (EntriesMut::Wide(kept), _, Some(list)) => compact(list, kept, offsets, counts, cap),
+        (EntriesMut::Narrow(kept), Some(list), _) => {
+            compact(list, kept, offsets, counts, cap, overfull)
+        }
+        (EntriesMut::Wide(kept), _, Some(list)) => {
+            compact(list, kept, offsets, counts, cap, overfull)
+        }
         _ => unreachable!("a list's width follows its visible lights, the same for both"),
     };
     out.stats.overflowed_lights += dropped;
@@ -56,18 +61,23 @@ pub(super) fn apply_cap(
 }
 
 /// Copies the first `cap` entries of every cell's list of `list` into `kept` (as long as
-/// their sum), moving `offsets` and `counts` with them; the entries dropped.
+/// their sum), moving `offsets` and `counts` with them, and notes each cut cell in
+/// `overfull`; the entries dropped.
 fn compact<T: LightIndex>(
     list: &[T],
     kept: &mut [T],
     offsets: &mut [u32],
     counts: &mut [u32],
     cap: u32,
+    overfull: &mut Vec<(u32, u32)>,
 ) -> u64 {
     let (mut at, mut dropped) = (0, 0);
-    for (offset, count) in offsets.iter_mut().zip(counts.iter_mut()) {
+    for (cell, (offset, count)) in offsets.iter_mut().zip(counts.iter_mut()).enumerate() {
         let (o, n) = (*offset as usize, *count as usize);
         let keep = n.min(cap as usize);
+        if n > keep {
+            overfull.push((cell as u32, (n - keep) as u32));
+        }
         dropped += (n - keep) as u64;
         kept[at..at + keep].copy_from_slice(&list[o..o + keep]);
         *offset = at as u32;

@@ -178,6 +178,9 @@ pub struct Assignment {
     /// policy, more than [`AssignLimits::max_untrimmed`], so none were listed (every cell is empty;
     /// the lights found visible, which may stop short of all of them, count as overflowed).
     pub unlisted: Option<usize>,
+    /// The cells the overflow policy cut, ascending, with the references each lost (empty
+    /// without overflow): where in the picture the dropped lights are missing.
+    pub(crate) overfull: Vec<(u32, u32)>,
 }
 
 impl Assignment {

@@ -48,6 +48,22 @@ impl SurfaceSamples {
             .reduce(f64::min)
     }
 
+    /// Mean light references dropped per sampled surface point with `grid`'s cut cells
+    /// `overfull` (ascending, as [`Assignment`](crate::cluster::assign::Assignment) has them).
+    pub fn dropped_per_pixel(&self, grid: &ClusterGrid, overfull: &[(u32, u32)]) -> f64 {
+        if self.points.is_empty() || overfull.is_empty() {
+            return 0.0;
+        }
+        let total: u64 = (self.points.iter())
+            .map(|&[x, y, d]| {
+                let cell = grid.cell_index(grid.cell_of_fragment(x, y, d));
+                let cut = overfull.binary_search_by_key(&cell, |&(c, _)| c);
+                cut.map_or(0, |i| u64::from(overfull[i].1))
+            })
+            .sum();
+        total as f64 / self.points.len() as f64
+    }
+
     /// Mean light evaluations per sampled surface point with `grid`'s lists `counts`.
     pub fn evals_per_pixel(&self, grid: &ClusterGrid, counts: &[u32]) -> f64 {
         if self.points.is_empty() {
@@ -86,9 +102,19 @@ pub struct Candidate {
     pub over_budget: bool,
     /// Light references the overflow policy would drop with this grid.
     pub overflowed_lights: u64,
+    /// Of those, the mean a sampled surface point misses (infinite where none could be
+    /// listed): what the picture loses. A coarse grid drops fewer references than a fine one
+    /// under a per-cell cap, each from more pixels.
+    pub dropped_per_pixel: f64,
 }
 
 impl Candidate {
+    /// What its overflow costs the picture, to compare: the references a surface point
+    /// misses, then those dropped anywhere (in cells no sample fell in).
+    pub fn overflow(&self) -> (f64, u64) {
+        (self.dropped_per_pixel, self.overflowed_lights)
+    }
+
     /// Whether its predicted assignment takes more than `share` of its predicted frame (never
     /// for a NaN share): the CPU budget's test.
     pub fn assigns_over(&self, share: f64) -> bool {
@@ -170,7 +196,7 @@ pub(super) fn better(a: &Candidate, b: &Candidate) -> bool {
         } else {
             c.predicted_ms
         };
-        (c.overflowed_lights, c.over_budget, cost)
+        (c.overflow(), c.over_budget, cost)
     };
     key(a) < key(b)
 }
@@ -195,12 +221,12 @@ pub fn should_switch(current: &GridConfig, new: &GridChoice) -> bool {
             // The current grid must pass the budget clearly too, or a grid whose share sits
             // at the budget would be swapped out whenever a measurement put it a hair over.
             let clearly_over = now.assigns_over(current.assign_budget() * (1.0 + HYSTERESIS));
-            let same_overflow = best.overflowed_lights == now.overflowed_lights;
+            let same_overflow = best.overflow() == now.overflow();
             // Past the budget both: the new one must be clearly nearer it.
             let nearer_budget = now.over_budget
                 && best.over_budget
                 && best.assign_share() < now.assign_share() * (1.0 - HYSTERESIS);
-            best.overflowed_lights < now.overflowed_lights
+            best.overflow() < now.overflow()
                 || (same_overflow && clearly_over && !best.over_budget)
                 || (same_overflow && nearer_budget)
                 || best.predicted_ms < now.predicted_ms * (1.0 - HYSTERESIS)

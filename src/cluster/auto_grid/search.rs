@@ -95,6 +95,10 @@ impl ChoiceSearch {
             // Unlisted (too many references to build) is worse than any grid that lists, and
             // finer grids only list more.
             overflowed_lights: a.dropped_references(),
+            dropped_per_pixel: match a.unlisted {
+                Some(_) => f64::INFINITY,
+                None => samples.dropped_per_pixel(grid, &a.overfull),
+            },
         };
         let unlisted = a.unlisted.is_some();
         // A NaN budget (refused by the renderer) keeps every grid in.
@@ -106,11 +110,11 @@ impl ChoiceSearch {
             && self
                 .candidates
                 .iter()
-                .any(|c| !c.over_budget && c.overflowed_lights <= candidate.overflowed_lights);
+                .any(|c| !c.over_budget && c.overflow() <= candidate.overflow());
         let (rising, overflow_grew) = self.candidates.last().map_or((false, false), |last| {
             (
                 candidate.predicted_ms > last.predicted_ms,
-                candidate.overflowed_lights > last.overflowed_lights,
+                candidate.overflow() > last.overflow(),
             )
         });
         if self
@@ -171,6 +175,7 @@ impl ChoiceSearch {
                 assign_ms: 0.0,
                 over_budget: false,
                 overflowed_lights: 0,
+                dropped_per_pixel: 0.0,
             },
         };
         out.reason.clear();
@@ -206,9 +211,7 @@ impl ChoiceSearch {
             100.0 * budget
         );
         let turned_down = self.candidates.iter().find(|c| {
-            c.over_budget
-                && c.overflowed_lights <= best.overflowed_lights
-                && c.predicted_ms < best.predicted_ms
+            c.over_budget && c.overflow() <= best.overflow() && c.predicted_ms < best.predicted_ms
         });
         if best.over_budget {
             let _ = write!(out.reason, "; no grid kept within it: the smallest share");

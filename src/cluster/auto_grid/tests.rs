@@ -249,6 +249,7 @@ fn a_grid_just_over_the_budget_is_kept() {
             assign_ms,
             over_budget: false,
             overflowed_lights: 0,
+            dropped_per_pixel: 0.0,
         };
         c.over_budget = c.assigns_over(0.05);
         c
@@ -468,4 +469,30 @@ fn a_grid_too_fine_to_list_is_not_chosen() {
     assert_eq!(choice.config.footprint_px, CANDIDATE_FOOTPRINTS[0]);
     assert_eq!(choice.candidates.len(), 2, "{:?}", choice.candidates);
     assert!(choice.candidates[0].overflowed_lights > 0);
+}
+
+/// Between two grids that overflow, the one whose sampled surface points miss fewer references
+/// wins, though it drops more of them in all: a coarse grid's few dropped references each
+/// leave a larger part of the frame.
+#[test]
+fn overflow_is_weighed_by_what_the_surface_misses() {
+    let candidate = |footprint_px: f64, overflowed_lights: u64, dropped_per_pixel: f64| Candidate {
+        footprint_px,
+        cells: 100,
+        indices: 100,
+        evals_per_pixel: 1.0,
+        bytes: 100,
+        predicted_ms: 1.0,
+        assign_ms: 0.01,
+        over_budget: false,
+        overflowed_lights,
+        dropped_per_pixel,
+    };
+    let coarse = candidate(54.0, 71, 3.0);
+    let fine = candidate(9.5, 95, 0.07);
+    assert!(super::choice::better(&fine, &coarse));
+    assert!(!super::choice::better(&coarse, &fine));
+    // Equal on the surface: fewer references dropped anywhere wins.
+    let unseen = candidate(16.0, 40, 0.07);
+    assert!(super::choice::better(&unseen, &fine));
 }

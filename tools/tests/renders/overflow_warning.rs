@@ -83,3 +83,47 @@ fn the_overflow_warning_advises_for_the_limit_that_bound() {
         );
     }
 }
+
+/// Under a per-cell cap the automatic grid weighs what the picture loses (the references a
+/// sampled surface point misses), not how many references go: a coarser grid can drop fewer,
+/// each from a larger part of the frame. With the courtyard's 64 lights at most 16 a cell, the
+/// search, going finer, stopped at 32 pixels, which dropped more references (95) than 54 (71),
+/// and took 54 (94/255 from forward; helper-161's bench row). It now goes on to grids that
+/// drop fewer a pixel, and its picture loses far less than a 54-pixel grid's.
+#[test]
+fn under_a_cell_cap_the_automatic_grid_keeps_what_the_picture_needs() {
+    let s = scene::builtin::build("courtyard", Some((64, 1))).unwrap();
+    let capped = |grid: GridConfig| RenderOptions {
+        measure: manylight::MeasureOptions {
+            cell_cap: Some(16),
+            ..Default::default()
+        },
+        grid,
+        ..Default::default()
+    };
+    let (w, h) = (64, 36);
+    let mut gpu = Gpu::new(EsVersion::Es3);
+    gpu.r().set_method_named("forward").unwrap();
+    let (reference, _) = gpu
+        .r()
+        .render_offscreen(&s, w, h, &RenderOptions::default())
+        .unwrap();
+    gpu.r().set_method_named("clustered").unwrap();
+    let (coarse, _) = gpu
+        .r()
+        .render_offscreen(&s, w, h, &capped(GridConfig::fixed(54.0)))
+        .unwrap();
+    let mut fresh = Gpu::new(EsVersion::Es3);
+    fresh.r().set_method_named("clustered").unwrap();
+    let (auto, stats) = fresh
+        .r()
+        .render_offscreen(&s, w, h, &capped(GridConfig::default()))
+        .unwrap();
+    let coarse_error = manylight::metrics::diff(&reference, &coarse);
+    let auto_error = manylight::metrics::diff(&reference, &auto);
+    assert!(
+        auto_error.rmse * 4.0 < coarse_error.rmse,
+        "automatic grid {auto_error:?}, the coarse one {coarse_error:?}: {:?}",
+        stats.grid.reason
+    );
+}
