@@ -254,9 +254,10 @@ fn method_series(method: &str, points: Vec<(f64, f64)>, line: bool) -> Series {
 
 /// Error against frame time on `scene`'s knob workload (`lights` lights, every ES version):
 /// one point per configuration (each method, each knob), with the Pareto front (no other
-/// configuration both faster and more accurate) drawn through them. Other workloads differ
-/// in what they render, so their points would not trade against these; they are in the
-/// tables.
+/// configuration both faster and more accurate) drawn through those of one ES version, the
+/// highest: each version's error is against its own context's reference, so its points do
+/// not trade against another's. Other workloads differ in what they render likewise; they
+/// are in the tables.
 pub fn error_vs_time(rows: &[BenchRow], scene: &str, lights: usize) -> Chart {
     let rows: Vec<&BenchRow> = rows
         .iter()
@@ -300,13 +301,22 @@ pub fn error_vs_time(rows: &[BenchRow], scene: &str, lights: usize) -> Chart {
             series.push(s);
         }
     }
-    let all: Vec<(f64, f64)> = rows.iter().map(|r| (r.frame_ms, r.rmse)).collect();
+    let front_es = versions.iter().max().copied().unwrap_or_default();
+    let all: Vec<(f64, f64)> = (rows.iter())
+        .filter(|r| r.es == front_es)
+        .map(|r| (r.frame_ms, r.rmse))
+        .collect();
     let front = plot::pareto_front(&all)
         .into_iter()
         .map(|i| all[i])
         .collect();
+    let front_of = if versions.len() > 1 {
+        format!(", front of ES {front_es}")
+    } else {
+        String::new()
+    };
     Chart {
-        title: format!("Error against frame time: {scene}, {lights} lights"),
+        title: format!("Error against frame time: {scene}, {lights} lights{front_of}"),
         x_label: "frame time (ms, log)".into(),
         y_label: "RMSE vs reference (of 255, log)".into(),
         x_log: true,
@@ -676,6 +686,21 @@ mod tests {
         assert_eq!(labelled, ["cutoff=0.01"]);
         assert_eq!(es3.point_labels.len(), es3.points.len());
         assert!(chart.y_label.contains("of 255"), "{}", chart.y_label);
+    }
+
+    /// Each version's error is against its own reference: an ES 2.0 point faster and closer
+    /// than every ES 3.0 one does not make the front (it alone made it).
+    #[test]
+    fn the_error_charts_front_is_one_es_versions() {
+        let mut rows = rows();
+        let mut es2 = row("a", "clustered", 64, "default", 0.1, 0.001);
+        es2.es = "2.0".into();
+        rows.push(es2);
+        let chart = error_vs_time(&rows, "a", 64);
+        let front = chart.front.clone().unwrap();
+        assert!(front.len() >= 2, "{front:?}");
+        assert!(!front.contains(&(0.1, 0.001)), "{front:?}");
+        assert!(chart.title.ends_with("front of ES 3.0"), "{}", chart.title);
     }
 
     #[test]

@@ -53,7 +53,8 @@ pub struct BenchArgs {
     pub size: Option<(u32, u32)>,
     /// Timed frames per configuration after a warm-up frame (default 9: their median, the
     /// row's figure, outvotes the few slow frames a pool wake-up or the first frames after a
-    /// grid change make; 3 for a configuration whose first frame took over 100 ms, whose
+    /// grid change make; 3 for a configuration whose first frame that built no shaders (of
+    /// two untimed ones) took over 100 ms, whose
     /// frames vary little against their length: forward, tiled and deferred over hundreds of
     /// lights; 1 with `--quick`). At least 1.
     #[arg(long, value_parser = crate::render::timed_frame_count())]
@@ -142,6 +143,23 @@ enum Frames {
 
 /// A first frame slower than this makes an adaptive row time three frames, not nine.
 const SLOW_FRAME_MS: f64 = 100.0;
+
+/// The frames an adaptive row times, from an untimed frame of it: three where that frame took
+/// over [`SLOW_FRAME_MS`], else nine; `None` where it built shader programs, whose compiling
+/// says nothing of the configuration (deferred at 640×360 took 128 ms so, then 86): the next
+/// frame decides.
+fn adaptive_frames(untimed: &manylight::FrameStats) -> Option<u32> {
+    (untimed.programs_built == 0).then(|| frames_for(untimed.time.frame_ms))
+}
+
+/// Three frames for a configuration whose frame takes `ms` past [`SLOW_FRAME_MS`], else nine.
+fn frames_for(ms: f64) -> u32 {
+    if ms > SLOW_FRAME_MS {
+        3
+    } else {
+        9
+    }
+}
 
 impl Plan {
     fn from(args: &BenchArgs) -> Plan {
@@ -667,17 +685,14 @@ impl Measure<'_> {
         let (w, h) = self.size;
         let rendered = match self.frames {
             Frames::Fixed(n) => Ok(n),
-            // One untimed frame says how slow the configuration is.
+            // An untimed frame says how slow the configuration is: the first, or the second
+            // where the first built shaders.
             Frames::Adaptive => {
-                renderer
-                    .render_offscreen(self.scene, w, h, &opts)
-                    .map(|(_, first)| {
-                        if first.time.frame_ms > SLOW_FRAME_MS {
-                            3
-                        } else {
-                            9
-                        }
-                    })
+                let mut untimed = || renderer.render_offscreen(self.scene, w, h, &opts);
+                untimed().and_then(|(_, first)| match adaptive_frames(&first) {
+                    Some(n) => Ok(n),
+                    None => untimed().map(|(_, second)| frames_for(second.time.frame_ms)),
+                })
             }
         }
         .and_then(|frames| {
@@ -951,5 +966,19 @@ mod tests {
         assert!(why.contains("set MANYLIGHT_ASSETS"), "{why}");
         let why = conference_in(Some(root.path().join("none").into())).unwrap_err();
         assert!(why.contains("set MANYLIGHT_ASSETS"), "{why}");
+    }
+
+    #[test]
+    fn an_adaptive_row_is_timed_by_a_frame_that_built_no_shaders() {
+        let frame = |ms: f64, built: usize| {
+            let mut stats = manylight::FrameStats::default();
+            stats.time.frame_ms = ms;
+            stats.programs_built = built;
+            stats
+        };
+        assert_eq!(adaptive_frames(&frame(150.0, 0)), Some(3));
+        assert_eq!(adaptive_frames(&frame(50.0, 0)), Some(9));
+        // Compiling made it slow: the next frame decides.
+        assert_eq!(adaptive_frames(&frame(150.0, 3)), None);
     }
 }
