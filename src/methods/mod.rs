@@ -221,23 +221,6 @@ pub(crate) fn idle_for_long(idle: &mut u32) -> bool {
     *idle >= IDLE_FRAMES_KEPT
 }
 
-#[cfg(test)]
-mod idle_tests {
-    use super::*;
-
-    #[test]
-    fn idle_frames_free_from_the_kept_count_on() {
-        let mut idle = 0;
-        let freed: Vec<bool> = (0..IDLE_FRAMES_KEPT + 2)
-            .map(|_| idle_for_long(&mut idle))
-            .collect();
-        let first = IDLE_FRAMES_KEPT as usize - 1;
-        assert!(freed[..first].iter().all(|&f| !f));
-        // Made again and left unused past the count: freed again, not kept for good.
-        assert!(freed[first..].iter().all(|&f| f), "{freed:?}");
-    }
-}
-
 /// A row of the method table.
 pub struct MethodDesc {
     /// CLI name.
@@ -281,4 +264,21 @@ pub fn find(name: &str) -> Result<&'static MethodDesc, Error> {
                 .collect::<Vec<_>>()
                 .join(", "),
         })
+}
+
+#[cfg(test)]
+mod idle_tests {
+    use super::*;
+
+    #[test]
+    fn idle_frames_free_from_the_kept_count_on() {
+        let mut idle = 0;
+        let freed: Vec<bool> = (0..IDLE_FRAMES_KEPT + 2)
+            .map(|_| idle_for_long(&mut idle))
+            .collect();
+        let first = IDLE_FRAMES_KEPT as usize - 1;
+        assert!(freed[..first].iter().all(|&f| !f));
+        // Made again and left unused past the count: freed again, not kept for good.
+        assert!(freed[first..].iter().all(|&f| f), "{freed:?}");
+    }
 }
