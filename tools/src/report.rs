@@ -36,6 +36,11 @@ pub struct BenchRow {
     pub knob: String,
     /// Frame time: median of the timed frames, wall clock around the frame and `glFinish`.
     pub frame_ms: f64,
+    /// The timed frames the medians are of (`--frames`, or 9 or 3 as the row's pace).
+    pub timed_frames: u32,
+    /// For `auto`, the method it drew the timed frames with (the last one's); `None` else, and
+    /// for a frame without lights (ambient only, no method).
+    pub auto_choice: Option<String>,
     /// GPU time from a timer query (median), where the context has one.
     pub gpu_ms: Option<f64>,
     /// CPU light-assignment time (median; 0 for methods without one).
@@ -589,6 +594,8 @@ mod tests {
             height: 36,
             knob: knob.into(),
             frame_ms: ms,
+            timed_frames: 1,
+            auto_choice: None,
             gpu_ms: None,
             assign_ms: 0.0,
             upload_bytes: 0,

@@ -110,6 +110,11 @@ fn a_small_sweep_writes_the_report_charts_and_heatmaps() {
             (Some(64), Some(36))
         );
         assert!(row["frame_ms"].as_f64().unwrap() > 0.0);
+        // `--frames 1`; auto says what it drew with, no other method does, nor auto a frame
+        // without lights (drawn ambient-only, without a method).
+        assert_eq!(row["timed_frames"].as_u64(), Some(1), "{row}");
+        let auto = row["method"] == "auto" && row["lights"] != 0;
+        assert_eq!(row["auto_choice"].is_string(), auto, "{row}");
     }
     let row = |method: &str, lights: u64| {
         rows.iter()

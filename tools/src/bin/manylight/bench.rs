@@ -731,6 +731,8 @@ impl Measure<'_> {
             height: h,
             knob: knob.to_string(),
             frame_ms: stats.time.frame_ms,
+            timed_frames: opts.measure.timed_frames,
+            auto_choice: stats.auto_choice.clone(),
             gpu_ms: stats.time.gpu_ms,
             assign_ms: stats.time.assign_ms,
             upload_bytes: stats.memory.upload_bytes,
