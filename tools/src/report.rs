@@ -375,10 +375,10 @@ pub fn evals_vs_lights(rows: &[BenchRow], scene: &str) -> Chart {
         point_labels: Vec::new(),
     });
     Chart {
-        title: format!(
-            "Light evaluations per pixel ({scene}, ES {})",
-            es.unwrap_or("-")
-        ),
+        title: match es {
+            Some(es) => format!("Light evaluations per pixel ({scene}, ES {es})"),
+            None => format!("Light evaluations per pixel ({scene}): no run with lights"),
+        },
         x_label: "lights (log)".into(),
         y_label: "evaluations per pixel (log)".into(),
         x_log: true,
@@ -708,6 +708,23 @@ mod tests {
         assert!(front.len() >= 2, "{front:?}");
         assert!(!front.contains(&(0.1, 0.001)), "{front:?}");
         assert!(chart.title.ends_with("front of ES 3.0"), "{}", chart.title);
+    }
+
+    /// A run at 0 lights alone has no evaluations to chart: the title says so, where it read
+    /// "ES -" over empty axes.
+    #[test]
+    fn an_evals_chart_without_lights_says_so() {
+        let rows = vec![
+            row("a", "forward", 0, "default", 1.0, 0.0),
+            row("a", "clustered", 0, "default", 1.2, 0.0),
+        ];
+        let chart = evals_vs_lights(&rows, "a");
+        assert!(
+            chart.title.ends_with("no run with lights"),
+            "{}",
+            chart.title
+        );
+        assert!(chart.series.iter().all(|s| s.points.is_empty()));
     }
 
     #[test]
