@@ -64,6 +64,11 @@ impl InstanceStream {
         Ok(stream)
     }
 
+    /// `vec4` attributes an instance has.
+    pub(crate) fn attributes(&self) -> usize {
+        self.attributes
+    }
+
     /// Bytes of its buffer.
     pub(crate) fn bytes(&self) -> usize {
         self.store * self.attributes * std::mem::size_of::<Vec4>()

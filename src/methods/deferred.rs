@@ -251,6 +251,8 @@ struct InstancesKey {
     far: u64,
     rows: u32,
     scale: u32,
+    /// The instances hold spot terms (the variant has spots).
+    spots: bool,
 }
 
 /// What a light pass did.
@@ -412,6 +414,7 @@ impl Deferred {
             far: ctx.far.to_bits(),
             rows: ctx.viewport.1,
             scale: scale.to_bits(),
+            spots: features.has(ShaderFeatures::SPOT),
         };
         let reused = self.instances_key == Some(key)
             && self.lights.hold_all()
@@ -484,7 +487,8 @@ impl Deferred {
                     scale,
                 )
             });
-            uploaded += self.lights.draw(dev, slot, &mesh, instances)?;
+            let vec4s = light_instances::light_vec4s(features.has(ShaderFeatures::SPOT));
+            uploaded += self.lights.draw(dev, slot, &mesh, vec4s, instances)?;
         }
         Ok(LightPass {
             uploaded,

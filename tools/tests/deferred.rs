@@ -636,3 +636,39 @@ fn only_materials_in_the_gbuffer_give_it_a_specular_target_or_the_light_pass_its
     let matte_8x8 = 64 * gbuffer::bytes_per_pixel(gpu.r().caps(), false);
     assert_eq!(bytes, matte_8x8, "dropped after 120 frames without");
 }
+
+/// Without spots in the scene a light's instance leaves out the spot terms: 48 bytes, not 64.
+/// One renderer across frames of point lights, then with a spot, then without again, draws
+/// what forward draws each time, its instance streams made anew for each layout.
+#[test]
+fn point_lights_take_three_vec4s_an_instance_and_a_spot_four() {
+    let points = scene::builtin::build("plane", Some((24, 5))).unwrap();
+    assert!(points
+        .lights
+        .iter()
+        .all(|l| matches!(l.kind, scene::LightKind::Point)));
+    let mut with_spot = points.clone();
+    let cone = scene::Cone {
+        direction: DVec3::NEG_Z,
+        inner_deg: 15.0,
+        outer_deg: 35.0,
+    };
+    with_spot.lights[0] = scene::Light::spot(DVec3::new(0.0, 0.0, 1.0), 3.0, Vec3::ONE, 2.0, cone);
+    let opts = RenderOptions::default();
+    let mut reference = Gpu::new(EsVersion::Es3);
+    let mut gpu = Gpu::new(EsVersion::Es3);
+    gpu.r().set_method_named("deferred").unwrap();
+    for (s, instance) in [(&points, 48), (&with_spot, 64), (&points, 48)] {
+        let (expected, _) = reference.render_with("forward", s, (64, 36), &opts);
+        let (img, stats) = gpu.r().render_offscreen(s, 64, 36, &opts).unwrap();
+        assert!(stats.lights.visible > 0);
+        let what = format!("{instance}-byte instances");
+        assert_eq!(
+            stats.memory.upload_bytes,
+            stats.lights.visible * instance,
+            "{what}"
+        );
+        let d = manylight::metrics::diff(&expected, &img);
+        assert!(d.max_abs <= 2, "{what}: {d:?}");
+    }
+}

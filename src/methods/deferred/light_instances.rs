@@ -1,6 +1,7 @@
 //! Deferred's lights as instances of their proxy: each light four `vec4`s in the layout of
-//! `glsl/deferred_light_instance.glsl`, uploaded and drawn together, so a light costs its 64
-//! bytes and no GL call of its own. A still frame draws the instances the last frame uploaded.
+//! `glsl/deferred_light_instance.glsl`, three in a variant without spots (the spot terms come
+//! last), uploaded and drawn together, so a light costs its 64 or 48 bytes and no GL call of
+//! its own. A still frame draws the instances the last frame uploaded.
 
 use glam::Vec4;
 
@@ -14,21 +15,27 @@ use crate::gl::{Device, GlError};
 /// `glsl/deferred_light_instance.glsl`), after the meshes' 0 to 5.
 const LIGHT_LOCATION: u32 = 6;
 
-/// `vec4`s a light takes.
+/// `vec4`s a light takes at most: with spots; without, the last is left out.
 const LIGHT_VEC4S: usize = 4;
+
+/// `vec4`s a light takes in a variant with spots (`spots`) or without.
+pub(super) fn light_vec4s(spots: bool) -> usize {
+    if spots {
+        LIGHT_VEC4S
+    } else {
+        LIGHT_VEC4S - 1
+    }
+}
 
 /// Lights a draw takes at most, and a proxy kind's buffer holds: it grows with its lights up to
 /// 65 536 of them, 4 MiB, however many the scene has. A kind with more streams them a batch of
 /// this many at a time, so its still frames upload them again.
 const BATCH_LIGHTS: usize = 1 << 16;
 
-/// `vec4`s a full batch holds.
-const BATCH_VEC4S: usize = BATCH_LIGHTS * LIGHT_VEC4S;
-
 /// A light as its proxy's instance draws it: position and radius; radiance (times the
-/// accumulation's `scale`) and spot scale; spot axis and offset; the proxy sphere's radius,
-/// the count channel (0 to 3) it adds 1 to and the full-screen triangle's depth (`proxy`:
-/// radius and depth).
+/// accumulation's `scale`) and spot scale; the proxy sphere's radius, the count channel (0 to
+/// 3) it adds 1 to and the full-screen triangle's depth (`proxy`: radius and depth); spot
+/// axis and offset.
 pub(super) fn light_instance(
     light: &GpuLight,
     [proxy_radius, depth]: [f32; 2],
@@ -39,8 +46,8 @@ pub(super) fn light_instance(
     [
         light.position.extend(light.radius),
         (light.radiance * scale).extend(spot_scale),
-        direction.extend(spot_offset),
         Vec4::new(proxy_radius, channel as f32, depth, 0.0),
+        direction.extend(spot_offset),
     ]
 }
 
@@ -65,23 +72,28 @@ pub(super) struct LightInstances {
 
 impl LightInstances {
     /// Draws `mesh` (its arrays bound, with the light program) once for each light, in their
-    /// order, a batch at a time, through `proxy`'s stream (made on its first lights); returns
-    /// the bytes uploaded.
+    /// order, a batch at a time, through `proxy`'s stream (made on its first lights, and anew
+    /// for another layout), each light its first `vec4s` (see [`light_vec4s`]); returns the
+    /// bytes uploaded.
     pub(super) fn draw(
         &mut self,
         dev: &Device,
         proxy: usize,
         mesh: &BoundMesh,
+        vec4s: usize,
         lights: impl Iterator<Item = [Vec4; LIGHT_VEC4S]>,
     ) -> Result<usize, GlError> {
         self.held[proxy] = None;
         self.empty_passes[proxy] = 0;
+        if let Some(mut other) = self.streams[proxy].take_if(|s| s.attributes() != vec4s) {
+            other.destroy(dev);
+        }
         let stream = match &mut self.streams[proxy] {
             Some(stream) => stream,
             empty => empty.insert(InstanceStream::new(
                 dev,
                 LIGHT_LOCATION,
-                LIGHT_VEC4S,
+                vec4s,
                 BATCH_LIGHTS,
             )?),
         };
@@ -89,9 +101,10 @@ impl LightInstances {
         self.batch.clear();
         let (mut uploaded, mut drawn) = (0, 0);
         for light in lights {
-            self.batch.extend(light.map(|v| v.to_array()));
+            self.batch
+                .extend(light[..vec4s].iter().map(|v| v.to_array()));
             drawn += 1;
-            if self.batch.len() == BATCH_VEC4S {
+            if self.batch.len() == BATCH_LIGHTS * vec4s {
                 uploaded += stream.draw(dev, mesh, &self.batch);
                 self.batch.clear();
             }
