@@ -51,31 +51,28 @@ impl SurfaceSamples {
     /// Mean light references dropped per sampled surface point with `grid`'s cut cells
     /// `overfull` (ascending, as [`Assignment`](crate::cluster::assign::Assignment) has them).
     pub fn dropped_per_pixel(&self, grid: &ClusterGrid, overfull: &[(u32, u32)]) -> f64 {
-        if self.points.is_empty() || overfull.is_empty() {
+        if overfull.is_empty() {
             return 0.0;
         }
-        let total: u64 = (self.points.iter())
-            .map(|&[x, y, d]| {
-                let cell = grid.cell_index(grid.cell_of_fragment(x, y, d));
-                let cut = overfull.binary_search_by_key(&cell, |&(c, _)| c);
-                cut.map_or(0, |i| u64::from(overfull[i].1))
-            })
-            .sum();
-        total as f64 / self.points.len() as f64
+        self.mean_over_points(grid, |cell| {
+            let cut = overfull.binary_search_by_key(&cell, |&(c, _)| c);
+            cut.map_or(0, |i| overfull[i].1)
+        })
     }
 
     /// Mean light evaluations per sampled surface point with `grid`'s lists `counts`.
     pub fn evals_per_pixel(&self, grid: &ClusterGrid, counts: &[u32]) -> f64 {
+        self.mean_over_points(grid, |cell| counts.get(cell as usize).copied().unwrap_or(0))
+    }
+
+    /// Mean over the sampled surface points of `per_cell` of the `grid` cell each falls in (0
+    /// without samples).
+    fn mean_over_points(&self, grid: &ClusterGrid, per_cell: impl Fn(u32) -> u32) -> f64 {
         if self.points.is_empty() {
             return 0.0;
         }
-        let total: u64 = self
-            .points
-            .iter()
-            .map(|&[x, y, d]| {
-                let cell = grid.cell_index(grid.cell_of_fragment(x, y, d));
-                counts.get(cell as usize).copied().unwrap_or(0) as u64
-            })
+        let total: u64 = (self.points.iter())
+            .map(|&[x, y, d]| u64::from(per_cell(grid.cell_index(grid.cell_of_fragment(x, y, d)))))
             .sum();
         total as f64 / self.points.len() as f64
     }
