@@ -146,8 +146,7 @@ const SLOW_FRAME_MS: f64 = 100.0;
 
 /// The frames an adaptive row times, from an untimed frame of it: three where that frame took
 /// over [`SLOW_FRAME_MS`], else nine; `None` where it built shader programs, whose compiling
-/// says nothing of the configuration (deferred at 640×360 took 128 ms so, then 86): the next
-/// frame decides.
+/// says nothing of the configuration: the next frame decides.
 fn adaptive_frames(untimed: &manylight::FrameStats) -> Option<u32> {
     (untimed.programs_built == 0).then(|| frames_for(untimed.time.frame_ms))
 }
@@ -767,9 +766,8 @@ const ANIMATED_FPS: f64 = 30.0;
 /// The animated workload: the scene's lights moving (the lively default where the scene has
 /// no motion of its own) and the camera panning ±8° about its target every 4 s.
 struct AnimatedWorkload {
-    /// Posed by each method's run in turn, never copied: a copy a method doubled the lights'
-    /// memory, which the light count's memory check had not allowed for (4 194 304 lights
-    /// aborted under a 3 GiB limit).
+    /// Posed by each method's run in turn, never copied: a copy would double the lights'
+    /// memory, which the light count's memory check does not allow for.
     scene: Scene,
     /// The camera the pan swings about.
     start: scene::Camera,

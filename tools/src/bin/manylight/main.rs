@@ -305,8 +305,7 @@ fn check_list_length(subcommand: Option<&str>, option: &str, len: usize) {
 }
 
 /// `--scene`'s value as text: a built-in's name or a path the loaders take as UTF-8. A path
-/// that is not UTF-8 was clap's "invalid UTF-8 was detected in one or more arguments", which
-/// named no option.
+/// that is not UTF-8 is a usage error naming the option (clap's own names none).
 #[derive(Clone)]
 struct SceneSpec;
 

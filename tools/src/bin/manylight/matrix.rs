@@ -634,7 +634,7 @@ pub struct MatrixCellArgs {
     size: (u32, u32),
     #[arg(long)]
     lights: usize,
-    /// Starts each image's file name: one name, no folder (`../x` wrote outside `--out`).
+    /// Starts each image's file name: one name, no folder, so the image stays inside `--out`.
     #[arg(long, value_parser = parse_tag)]
     tag: String,
     /// The folder for the cell's images (none written without it).
