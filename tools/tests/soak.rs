@@ -563,7 +563,7 @@ fn a_warm_up_copies_none_of_the_lights() {
     let mut gpu = Gpu::new(EsVersion::Es3);
     let options = RenderOptions::default();
     let renderer = gpu.r();
-    let lights = 200_000;
+    let lights = 25_000;
     let scene = with_boxes(scene::builtin::build("courtyard", Some((lights, 5))).unwrap());
     let peak_of = |renderer: &mut Renderer, step: &dyn Fn(&mut Renderer)| {
         let before = LIVE.load(Ordering::Relaxed);

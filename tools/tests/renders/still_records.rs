@@ -10,7 +10,7 @@ use manylight::{EsVersion, FrameStats, MeasureOptions, RenderOptions};
 
 use super::common::Gpu;
 
-const SIZE: (u32, u32) = (96, 54);
+const SIZE: (u32, u32) = (48, 27);
 
 /// The methods that upload light records and no lists, on the contexts they run on.
 const RECORDS: [(&str, EsVersion); 3] = [
