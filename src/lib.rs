@@ -97,7 +97,7 @@ pub use error::Error;
 pub use gl::caps::Precision;
 pub use gl::context::EglInfo;
 pub use gl::gles_lib::select as select_gles_library;
-pub use gl::{Caps, EsVersion, GlError, HeadlessContext, Restrictions};
+pub use gl::{Caps, EsVersion, GlError, GlStateHandling, HeadlessContext, Restrictions};
 pub use methods::Support;
 pub use metrics::counts::LightCounts;
 pub use metrics::spread::Spread;

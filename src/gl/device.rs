@@ -5,6 +5,7 @@ use glow::HasContext;
 
 use super::call_state::CallState;
 pub use super::call_state::StateCalls;
+use super::host_entry::HostEntry;
 use super::vertex_arrays::VertexArrays;
 use super::{Caps, EsVersion, GlError, Restrictions};
 
@@ -26,6 +27,8 @@ pub struct Device {
     own_vertex_array: Option<(glow::VertexArray, VertexArrays)>,
     /// What the context has of the application's state each call saves.
     host: super::host_state::HostFeatures,
+    /// What each call does with the application's state (the outermost call's entry).
+    state_handling: std::cell::Cell<super::GlStateHandling>,
     /// Nesting depth of [`Device::enter_host`] (the outermost call saves the state).
     host_depth: std::cell::Cell<u32>,
     /// Calls take turns with other threads' ([`super::driver_turns`]: llvmpipe).
@@ -202,6 +205,7 @@ impl Device {
             renderbuffer_storage_multisample_ext,
             host,
             own_vertex_array,
+            state_handling: std::cell::Cell::default(),
             host_depth: std::cell::Cell::new(0),
             takes_turns,
             host_framebuffer: std::cell::Cell::new(None),
@@ -241,12 +245,13 @@ impl Device {
     }
 
     /// Starts a call of the renderer: clears GL errors the application left pending (they are
-    /// not the renderer's), saves the application's GL state and sets what the renderer
-    /// assumes ([`super::host_state`]), after waiting for its turn where calls on several
+    /// not the renderer's), saves the application's GL state ([`super::host_state`]; or reads
+    /// only its framebuffer: [`super::GlStateHandling::Reset`]) and sets what the renderer
+    /// assumes, after waiting for its turn where calls on several
     /// threads take turns ([`super::driver_turns`]); `None` inside a call already started.
     /// Pair it with [`Device::leave_host`] in a way a panic cannot skip
     /// ([`Device::host_call`]).
-    pub(crate) fn enter_host(&self) -> Option<super::host_state::HostState> {
+    pub(crate) fn enter_host(&self) -> Option<HostEntry> {
         let depth = self.host_depth.get();
         self.host_depth.set(depth + 1);
         (depth == 0).then(|| {
@@ -256,12 +261,21 @@ impl Device {
             // the last call; entering binds the renderer's own vertex array.
             self.call.forget(self.own_vertex_array.map(|(vao, _)| vao));
             self.clear_pending_errors();
-            let saved =
-                super::host_state::HostState::enter(&self.gl, &self.host, self.own_vertex_array);
+            let handling = self.state_handling.get();
+            let saved = HostEntry::enter(&self.gl, &self.host, self.own_vertex_array, handling);
             self.host_framebuffer.set(saved.draw_framebuffer());
             turn.keep();
             saved
         })
+    }
+
+    /// What calls do with the application's state from the next one on.
+    pub(crate) fn set_state_handling(&self, handling: super::GlStateHandling) {
+        self.state_handling.set(handling);
+    }
+
+    pub(crate) fn state_handling(&self) -> super::GlStateHandling {
+        self.state_handling.get()
     }
 
     /// The framebuffer the application had bound for drawing when this call started (`None`:
@@ -273,12 +287,12 @@ impl Device {
     }
 
     /// Ends a call started by [`Device::enter_host`], giving the application its state back.
-    pub(crate) fn leave_host(&self, saved: Option<super::host_state::HostState>) {
+    pub(crate) fn leave_host(&self, saved: Option<HostEntry>) {
         self.host_depth.set(self.host_depth.get().saturating_sub(1));
         if let Some(saved) = saved {
             // Given back once the state is, or should giving it back panic.
             let _turn = super::driver_turns::Turn::held(self.takes_turns);
-            saved.leave(&self.gl, self.own_vertex_array);
+            saved.leave(&self.gl, &self.host, self.own_vertex_array);
             self.call.forget(None);
         }
     }

@@ -18,14 +18,14 @@ use super::vertex_arrays::VertexArrays;
 
 /// Texture units the renderer binds: 0 to 7 (`methods::maps::UNIT_MAPS` + 3), within the
 /// 8 fragment units every ES 2.0 context has.
-const UNITS: usize = 8;
+pub(super) const UNITS: usize = 8;
 
 /// Capabilities the renderer enables and disables as each pass needs (saved and given back).
-const TOGGLED: [u32; 3] = [glow::BLEND, glow::CULL_FACE, glow::DEPTH_TEST];
+pub(super) const TOGGLED: [u32; 3] = [glow::BLEND, glow::CULL_FACE, glow::DEPTH_TEST];
 
 /// Capabilities that change what the renderer draws and that it never uses: off during its
 /// calls (a game's scissor box or stencil test would cut its frame), given back after.
-const OFF_INSIDE: [u32; 5] = [
+pub(super) const OFF_INSIDE: [u32; 5] = [
     glow::SCISSOR_TEST,
     glow::STENCIL_TEST,
     glow::POLYGON_OFFSET_FILL,
@@ -35,14 +35,14 @@ const OFF_INSIDE: [u32; 5] = [
 
 /// Pixel-store settings that move where uploads start: 0 inside. ES 3.0 state, and ES 2.0's
 /// with `GL_EXT_unpack_subimage`.
-const UNPACK_ROWS: [u32; 3] = [
+pub(super) const UNPACK_ROWS: [u32; 3] = [
     glow::UNPACK_ROW_LENGTH,
     glow::UNPACK_SKIP_ROWS,
     glow::UNPACK_SKIP_PIXELS,
 ];
 
 /// The same for read-backs: ES 3.0, and ES 2.0 with `GL_NV_pack_subimage`.
-const PACK_ROWS: [u32; 3] = [
+pub(super) const PACK_ROWS: [u32; 3] = [
     glow::PACK_ROW_LENGTH,
     glow::PACK_SKIP_ROWS,
     glow::PACK_SKIP_PIXELS,
@@ -52,22 +52,28 @@ const PACK_ROWS: [u32; 3] = [
 #[derive(Clone, Copy)]
 pub(crate) struct HostFeatures {
     /// ES 3.0 state (an ES 3.x or desktop context, whatever level the renderer plays).
-    es3: bool,
-    desktop: bool,
+    pub(super) es3: bool,
+    pub(super) desktop: bool,
     /// [`UNPACK_ROWS`] and [`PACK_ROWS`] exist.
-    unpack_rows: bool,
-    pack_rows: bool,
+    pub(super) unpack_rows: bool,
+    pub(super) pack_rows: bool,
     /// ES's `GL_EXT_sRGB_write_control`: whether writes to an sRGB attachment encode is state
     /// a game may switch off (the renderer's picture assumes they do).
-    srgb_write_control: bool,
+    pub(super) srgb_write_control: bool,
+    /// `GL_SAMPLE_MASK` exists (ES 3.1, desktop 3.2): a game's sample mask would drop samples
+    /// of the renderer's MSAA target.
+    pub(super) sample_mask: bool,
+    /// `GL_PRIMITIVE_RESTART_FIXED_INDEX` exists (ES 3.0, desktop 4.3): the renderer's 16-bit
+    /// index 65 535 is a vertex of any mesh chunk of 65 536 vertices.
+    pub(super) fixed_index_restart: bool,
     /// Without a vertex array of the renderer's own: what saves the application's arrays,
     /// and an instanced-arrays extension's divisor setter (their divisors are theirs too).
-    attrib_fns: Option<AttribPointerFns>,
-    divisor: Option<VertexAttribDivisor>,
+    pub(super) attrib_fns: Option<AttribPointerFns>,
+    pub(super) divisor: Option<VertexAttribDivisor>,
     /// Texture units saved and given back: the context's, at most [`UNITS`].
-    units: usize,
+    pub(super) units: usize,
     /// `GL_MAX_DRAW_BUFFERS` (ES 3.0 state): a framebuffer object's draw buffers saved.
-    max_draw_buffers: usize,
+    pub(super) max_draw_buffers: usize,
 }
 
 impl HostFeatures {
@@ -82,12 +88,16 @@ impl HostFeatures {
     ) -> HostFeatures {
         let es3 = caps.context_has_es3_state();
         let has = |name: &str| caps.has_extension(name);
+        let desktop = caps.desktop;
+        let version = (gl.version().major, gl.version().minor);
         HostFeatures {
             es3,
-            desktop: caps.desktop,
+            desktop,
             unpack_rows: es3 || has("GL_EXT_unpack_subimage"),
             pack_rows: es3 || has("GL_NV_pack_subimage"),
-            srgb_write_control: !caps.desktop && has("GL_EXT_sRGB_write_control"),
+            srgb_write_control: !desktop && has("GL_EXT_sRGB_write_control"),
+            sample_mask: version >= if desktop { (3, 2) } else { (3, 1) },
+            fixed_index_restart: es3 && (!desktop || version >= (4, 3)),
             attrib_fns: (!own_vertex_array)
                 .then(super::ext_fns::attrib_pointer_fns)
                 .flatten(),
@@ -207,6 +217,8 @@ impl HostState {
             unpack_rows,
             pack_rows,
             srgb_write_control,
+            sample_mask,
+            fixed_index_restart,
             attrib_fns,
             divisor,
             units,
@@ -240,7 +252,6 @@ impl HostState {
                 int(glow::BLEND_SRC_ALPHA),
                 int(glow::BLEND_DST_ALPHA),
             ];
-            let gl_version = (gl.version().major, gl.version().minor);
             let program = gl.get_parameter_program(glow::CURRENT_PROGRAM);
             let framebuffers = if es3 {
                 [
@@ -287,9 +298,8 @@ impl HostState {
                 toggled: TOGGLED.map(|c| gl.is_enabled(c)),
                 off_inside: OFF_INSIDE.map(|c| gl.is_enabled(c)),
                 rasterizer_discard: es3 && gl.is_enabled(glow::RASTERIZER_DISCARD),
-                sample_mask: (gl_version >= if desktop { (3, 2) } else { (3, 1) })
-                    .then(|| gl.is_enabled(glow::SAMPLE_MASK)),
-                fixed_index_restart: (es3 && (!desktop || gl_version >= (4, 3)))
+                sample_mask: sample_mask.then(|| gl.is_enabled(glow::SAMPLE_MASK)),
+                fixed_index_restart: fixed_index_restart
                     .then(|| gl.is_enabled(glow::PRIMITIVE_RESTART_FIXED_INDEX)),
                 blend_func,
                 blend_equation: [

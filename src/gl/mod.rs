@@ -26,6 +26,8 @@ pub mod gbuffer;
 pub mod gles_lib;
 pub(crate) mod host_attributes;
 pub(crate) mod host_draw_buffers;
+pub(crate) mod host_entry;
+pub(crate) mod host_reset;
 pub(crate) mod host_state;
 pub(crate) mod instances;
 pub(crate) mod left_objects;
@@ -47,6 +49,7 @@ pub(crate) mod vertex_arrays;
 pub use caps::Caps;
 pub use context::HeadlessContext;
 pub use device::Device;
+pub use host_entry::GlStateHandling;
 
 use serde::Serialize;
 

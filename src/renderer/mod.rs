@@ -344,6 +344,20 @@ impl Renderer {
         )
     }
 
+    /// What each call does with the GL state the application left: saves it and gives it
+    /// back (the default), or reads only the bound framebuffer and leaves GL's initial values
+    /// ([`GlStateHandling::Reset`](crate::GlStateHandling::Reset): for an engine that sets its
+    /// own state before it draws, sparing the queries a threaded driver waits on). From the
+    /// next call on.
+    pub fn set_gl_state_handling(&mut self, handling: crate::GlStateHandling) {
+        self.dev.set_state_handling(handling);
+    }
+
+    /// What calls do with the application's GL state ([`Renderer::set_gl_state_handling`]).
+    pub fn gl_state_handling(&self) -> crate::GlStateHandling {
+        self.dev.state_handling()
+    }
+
     /// Switches method. Unsupported methods are an error naming what is missing; a fallback
     /// is returned as `Some(reason)` (also logged as a warning). The previous method's GPU
     /// resources are freed.

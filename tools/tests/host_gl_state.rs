@@ -9,6 +9,8 @@ mod common;
 
 #[path = "host_gl_state/deleted_program.rs"]
 mod deleted_program;
+#[path = "host_gl_state/reset.rs"]
+mod reset;
 
 use common::game_target::game_framebuffer;
 use common::Gpu;
@@ -33,6 +35,9 @@ struct Has {
     pack_rows: bool,
     /// `GL_FRAMEBUFFER_SRGB_EXT` (`GL_EXT_sRGB_write_control`).
     srgb_write_control: bool,
+    /// 24-bit depth renderbuffers: the game's framebuffer has the depth an offscreen frame
+    /// draws with, so its picture is the same.
+    depth24: bool,
 }
 
 #[derive(Clone, Copy)]
@@ -56,6 +61,7 @@ impl Has {
             unpack_rows: es3 || has("GL_EXT_unpack_subimage"),
             pack_rows: es3 || has("GL_NV_pack_subimage"),
             srgb_write_control: has("GL_EXT_sRGB_write_control"),
+            depth24: es3 || caps.depth24,
         }
     }
 
@@ -205,6 +211,9 @@ fn snapshot(gl: &glow::Context, has: Has) -> Snapshot {
 unsafe fn set_game_state(gl: &glow::Context, has: Has, size: (i32, i32)) {
     let es3 = has.es3;
     if es3 {
+        // Set again over its own state, the game's framebuffer texture takes no pixels from
+        // its pixel buffer.
+        gl.bind_buffer(glow::PIXEL_UNPACK_BUFFER, None);
         let vao = gl.create_vertex_array().unwrap();
         gl.bind_vertex_array(Some(vao));
     }
@@ -261,7 +270,7 @@ unsafe fn set_game_state(gl: &glow::Context, has: Has, size: (i32, i32)) {
     }
     // The game's framebuffer, its colour texture bound on unit 5.
     gl.active_texture(glow::TEXTURE5);
-    game_framebuffer(gl, false, size);
+    game_framebuffer(gl, has.depth24, size);
     // Left active: a unit past those the renderer binds (a game's shadow map, say), whose
     // texture an upload bound on the active unit would replace.
     gl.active_texture(glow::TEXTURE0 + GAME_UNITS - 1);
@@ -460,6 +469,14 @@ fn every_call_gives_the_games_gl_state_back_and_draws_as_from_a_clean_one() {
             snapshot(&gl, has),
             before,
             "{es}: the precision probe changed the game's state"
+        );
+        reset::every_call_sets_what_it_needs_and_leaves_gl_initial_values(
+            &gl,
+            &mut renderer,
+            has,
+            &scene,
+            &cases,
+            &expected,
         );
         drop(renderer);
         drop(ctx);

@@ -144,7 +144,7 @@ pub unsafe fn free_game_framebuffer(gl: &glow::Context, target: GameTarget) {
 }
 
 /// The bound framebuffer's pixels, top row first (as the offscreen renders give them).
-unsafe fn read_back(gl: &glow::Context, (w, h): (u32, u32)) -> image::RgbaImage {
+pub unsafe fn read_back(gl: &glow::Context, (w, h): (u32, u32)) -> image::RgbaImage {
     let mut pixels = vec![0u8; (w * h * 4) as usize];
     gl.read_pixels(
         0,
