@@ -278,6 +278,16 @@ impl Device {
         self.state_handling.get()
     }
 
+    /// A frame is drawn into the application's framebuffer: where the call did not save the
+    /// state, this points its draw buffers at its attachment 0 alone (saving does so on entry,
+    /// and gives the list back).
+    pub(crate) fn draw_into_host_framebuffer(&self) {
+        if self.state_handling.get() == super::GlStateHandling::Reset {
+            let target = self.host_framebuffer();
+            super::host_reset::draw_into_attachment_0(&self.gl, &self.host, target);
+        }
+    }
+
     /// The framebuffer the application had bound for drawing when this call started (`None`:
     /// the default one), as the state save read it: where [`Renderer::render`] draws.
     ///

@@ -15,11 +15,12 @@ pub enum GlStateHandling {
     /// as the call returns (the default): about 70 queries a call on ES 3.0.
     #[default]
     SaveAndRestore,
-    /// Read only the bound framebuffer: a call sets what the renderer depends on, and returns
-    /// with what it changed at GL's initial values (no program, vertex array 0 bound, no
-    /// textures on units 0–7, unit 0 active, blending, depth test and culling off…), the
-    /// framebuffer the application bound still bound, and the viewport and scissor box as
-    /// the call's last pass set them. For an engine that sets its own state before it draws.
+    /// Read nothing of it but what a frame must know of the bound framebuffer: a call sets
+    /// what the renderer depends on, and returns with what it changed at GL's initial values
+    /// (no program, vertex array 0 bound, no 2D textures on units 0–7, unit 0 active,
+    /// blending, depth test and culling off…), the framebuffer the application bound still
+    /// bound, and the viewport and scissor box not set back. For an engine that sets its own
+    /// state before it draws.
     Reset,
 }
 

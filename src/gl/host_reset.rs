@@ -20,8 +20,10 @@ pub(crate) struct ResetEntry {
 }
 
 impl ResetEntry {
-    /// Reads the bound draw framebuffer and sets, without reading it, all the state that
-    /// `HostState::enter` sets (`host_state.rs` lists it).
+    /// Reads the bound draw framebuffer and sets, without reading it, the state that
+    /// `HostState::enter` sets (`host_state.rs` lists it) but the framebuffer's draw buffers:
+    /// they are the framebuffer object's own, set only by a frame drawn into it
+    /// ([`draw_into_attachment_0`]).
     pub(crate) fn enter(
         gl: &glow::Context,
         features: &HostFeatures,
@@ -41,7 +43,6 @@ impl ResetEntry {
                 gl.bind_buffer(glow::PIXEL_PACK_BUFFER, None);
                 gl.bind_buffer(glow::PIXEL_UNPACK_BUFFER, None);
                 gl.disable(glow::RASTERIZER_DISCARD);
-                draw_into_attachment_0(gl, f.desktop, draw_framebuffer);
             }
             gl.active_texture(glow::TEXTURE0);
             if f.desktop {
@@ -114,6 +115,8 @@ impl ResetEntry {
             gl.blend_func(glow::ONE, glow::ZERO);
             gl.depth_func(glow::LESS);
             gl.depth_mask(true);
+            // A call that failed between its depth prepass and its shading left it off.
+            gl.color_mask(true, true, true, true);
             gl.cull_face(glow::BACK);
             gl.clear_color(0.0, 0.0, 0.0, 0.0);
             gl.pixel_store_i32(glow::PACK_ALIGNMENT, 4);
@@ -122,18 +125,26 @@ impl ResetEntry {
     }
 }
 
-/// Points the bound draw framebuffer's draw buffer 0 at its attachment 0 and no further one
-/// (`host_draw_buffers.rs` says why): `GL_BACK` for ES's default framebuffer; desktop GL's
-/// default one is left as it is.
-unsafe fn draw_into_attachment_0(
+/// Binds `target` for drawing and points its draw buffer 0 at its attachment 0 and no further
+/// one (`host_draw_buffers.rs` says why), where the context has draw buffers (ES 3.0 state):
+/// `GL_BACK` for ES's default framebuffer; desktop GL's default one is left as it is. For a
+/// frame drawn into the application's framebuffer, whose draw buffers a reset call otherwise
+/// leaves alone: they are that framebuffer object's state, not the context's.
+pub(crate) fn draw_into_attachment_0(
     gl: &glow::Context,
-    desktop: bool,
-    bound: Option<glow::Framebuffer>,
+    f: &HostFeatures,
+    target: Option<glow::Framebuffer>,
 ) {
-    match (bound, desktop) {
-        (Some(_), _) => gl.draw_buffers(&[glow::COLOR_ATTACHMENT0]),
-        (None, false) => gl.draw_buffers(&[glow::BACK]),
-        (None, true) => {}
+    if !f.es3 {
+        return;
+    }
+    unsafe {
+        gl.bind_framebuffer(glow::DRAW_FRAMEBUFFER, target);
+        match (target, f.desktop) {
+            (Some(_), _) => gl.draw_buffers(&[glow::COLOR_ATTACHMENT0]),
+            (None, false) => gl.draw_buffers(&[glow::BACK]),
+            (None, true) => {}
+        }
     }
 }
 

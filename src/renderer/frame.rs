@@ -122,7 +122,10 @@ impl Renderer {
         // The framebuffer the frame goes to and what it is, asked once a frame: the
         // application's as the call found it bound, or the offscreen render's own.
         let target = match applications {
-            true => self.dev.host_framebuffer(),
+            true => {
+                self.dev.draw_into_host_framebuffer();
+                self.dev.host_framebuffer()
+            }
             false => self.dev.bound_framebuffer(),
         };
         let queries = TargetQueries {

@@ -17,7 +17,7 @@ use common::Gpu;
 use manylight::gl::GlError;
 use manylight::glow::{self, HasContext};
 use manylight::scene;
-use manylight::{EsVersion, HeadlessContext, RenderOptions, Renderer};
+use manylight::{EsVersion, GlStateHandling, HeadlessContext, RenderOptions, Renderer};
 
 /// Texture units the game binds: past the renderer's eight (every context here has at least
 /// 16 combined units).
@@ -116,12 +116,15 @@ fn snapshot(gl: &glow::Context, has: Has) -> Snapshot {
         glow::STENCIL_TEST,
         glow::POLYGON_OFFSET_FILL,
         glow::SAMPLE_ALPHA_TO_COVERAGE,
+        glow::SAMPLE_COVERAGE,
     ];
     if es3 {
         ints.extend([
             glow::VERTEX_ARRAY_BINDING,
             glow::READ_FRAMEBUFFER_BINDING,
             glow::PIXEL_UNPACK_BUFFER_BINDING,
+            glow::DRAW_BUFFER0,
+            glow::DRAW_BUFFER1,
         ]);
         enabled.push(glow::RASTERIZER_DISCARD);
         enabled.push(glow::PRIMITIVE_RESTART_FIXED_INDEX);
@@ -271,6 +274,36 @@ unsafe fn set_game_state(gl: &glow::Context, has: Has, size: (i32, i32)) {
     // The game's framebuffer, its colour texture bound on unit 5.
     gl.active_texture(glow::TEXTURE5);
     game_framebuffer(gl, has.depth24, size);
+    if es3 {
+        // Drawn into as a G-buffer is: a second colour texture (on unit 6) at attachment 1 in
+        // its draw buffers, which the frame must neither draw into nor change for good.
+        gl.active_texture(glow::TEXTURE6);
+        let second = gl.create_texture().unwrap();
+        gl.bind_texture(glow::TEXTURE_2D, Some(second));
+        let (w, h) = size;
+        let rgba = glow::RGBA;
+        let none = glow::PixelUnpackData::Slice(None);
+        gl.tex_image_2d(
+            glow::TEXTURE_2D,
+            0,
+            rgba as i32,
+            w,
+            h,
+            0,
+            rgba,
+            glow::UNSIGNED_BYTE,
+            none,
+        );
+        let attachment = glow::COLOR_ATTACHMENT1;
+        gl.framebuffer_texture_2d(
+            glow::FRAMEBUFFER,
+            attachment,
+            glow::TEXTURE_2D,
+            Some(second),
+            0,
+        );
+        gl.draw_buffers(&[glow::COLOR_ATTACHMENT0, attachment]);
+    }
     // Left active: a unit past those the renderer binds (a game's shadow map, say), whose
     // texture an upload bound on the active unit would replace.
     gl.active_texture(glow::TEXTURE0 + GAME_UNITS - 1);
@@ -318,9 +351,12 @@ unsafe fn set_game_state(gl: &glow::Context, has: Has, size: (i32, i32)) {
         glow::DEPTH_TEST,
         glow::POLYGON_OFFSET_FILL,
         glow::SAMPLE_ALPHA_TO_COVERAGE,
+        glow::SAMPLE_COVERAGE,
     ] {
         gl.enable(c);
     }
+    // Left on, it would drop every sample of the renderer's MSAA target.
+    gl.sample_coverage(0.0, false);
     gl.scissor(0, 0, 2, 2);
     gl.stencil_func(glow::EQUAL, 1, 0xff);
     gl.polygon_offset(50.0, 50.0);
@@ -471,14 +507,13 @@ fn every_call_gives_the_games_gl_state_back_and_draws_as_from_a_clean_one() {
             "{es}: the precision probe changed the game's state"
         );
         reset::every_call_sets_what_it_needs_and_leaves_gl_initial_values(
-            &gl,
-            &mut renderer,
+            (&ctx, &gl),
+            renderer,
             has,
             &scene,
             &cases,
-            &expected,
+            (&expected, fp16),
         );
-        drop(renderer);
         drop(ctx);
     }
 }
@@ -588,7 +623,8 @@ fn scene_with_index_65535_in_view() -> manylight::Scene {
 }
 
 /// The game's `PRIMITIVE_RESTART_FIXED_INDEX` (ES 3.0 state) does not cut the triangles of a
-/// mesh chunk that use local index 65 535: the picture equals a clean renderer's.
+/// mesh chunk that use local index 65 535: the picture equals a clean renderer's, whether the
+/// call saves the game's state or resets it.
 #[test]
 fn the_games_primitive_restart_does_not_cut_large_meshes() {
     let scene = scene_with_index_65535_in_view();
@@ -607,19 +643,31 @@ fn the_games_primitive_restart_does_not_cut_large_meshes() {
         if !renderer.caps().context_has_es3_state() {
             continue;
         }
-        unsafe { gl.enable(glow::PRIMITIVE_RESTART_FIXED_INDEX) };
-        let (img, _) = renderer
-            .render_offscreen(&scene, w, h, &RenderOptions::default())
-            .unwrap();
-        let d = manylight::metrics::diff(&expected, &img);
-        assert_eq!(d.max_abs, 0, "{es}: the game's restart cut the quad");
-        assert!(unsafe { gl.is_enabled(glow::PRIMITIVE_RESTART_FIXED_INDEX) });
+        for handling in [GlStateHandling::SaveAndRestore, GlStateHandling::Reset] {
+            renderer.set_gl_state_handling(handling);
+            unsafe { gl.enable(glow::PRIMITIVE_RESTART_FIXED_INDEX) };
+            let (img, _) = renderer
+                .render_offscreen(&scene, w, h, &RenderOptions::default())
+                .unwrap();
+            let d = manylight::metrics::diff(&expected, &img);
+            assert_eq!(
+                d.max_abs, 0,
+                "{es} {handling:?}: the game's restart cut the quad"
+            );
+            // Given back, or left at GL's initial value.
+            let on = unsafe { gl.is_enabled(glow::PRIMITIVE_RESTART_FIXED_INDEX) };
+            assert_eq!(
+                on,
+                handling == GlStateHandling::SaveAndRestore,
+                "{handling:?}"
+            );
+        }
     }
 }
 
 /// The game's sample mask (ES 3.1 state) does not drop samples of the renderer's MSAA target:
 /// with a mask that keeps none, the picture still equals a clean renderer's, and the game's
-/// mask is on again after the call.
+/// mask is on again after the call (off, where the call resets the state).
 #[test]
 fn the_games_sample_mask_does_not_drop_the_renderers_samples() {
     let scene = scene::builtin::build(scene::builtin::DEFAULT, Some((16, 3))).unwrap();
@@ -646,12 +694,24 @@ fn the_games_sample_mask_does_not_drop_the_renderers_samples() {
     assert!(!sample_mask_i.is_null(), "ES 3.1 has glSampleMaski");
     // SAFETY: glSampleMaski's type in the ES 3.1 specification.
     let sample_mask_i: extern "system" fn(u32, u32) = unsafe { std::mem::transmute(sample_mask_i) };
-    unsafe { gl.enable(glow::SAMPLE_MASK) };
-    sample_mask_i(0, 0);
-    let (img, _) = renderer.render_offscreen(&scene, w, h, &opts).unwrap();
-    let d = manylight::metrics::diff(&expected, &img);
-    assert_eq!(d.max_abs, 0, "the game's sample mask changed the frame");
-    assert!(unsafe { gl.is_enabled(glow::SAMPLE_MASK) });
+    for handling in [GlStateHandling::SaveAndRestore, GlStateHandling::Reset] {
+        renderer.set_gl_state_handling(handling);
+        unsafe { gl.enable(glow::SAMPLE_MASK) };
+        sample_mask_i(0, 0);
+        let (img, _) = renderer.render_offscreen(&scene, w, h, &opts).unwrap();
+        let d = manylight::metrics::diff(&expected, &img);
+        assert_eq!(
+            d.max_abs, 0,
+            "{handling:?}: the game's sample mask changed the frame"
+        );
+        // Given back, or left at GL's initial value.
+        let on = unsafe { gl.is_enabled(glow::SAMPLE_MASK) };
+        assert_eq!(
+            on,
+            handling == GlStateHandling::SaveAndRestore,
+            "{handling:?}"
+        );
+    }
     sample_mask_i(0, !0);
     unsafe { gl.disable(glow::SAMPLE_MASK) };
 }

@@ -8,7 +8,7 @@
 use super::{set_game_state, Has, GAME_UNITS};
 use crate::common::game_target::read_back;
 use manylight::glow::{self, HasContext};
-use manylight::{GlStateHandling, RenderOptions, Renderer, Scene};
+use manylight::{GlStateHandling, HeadlessContext, RenderOptions, Renderer, Scene};
 
 /// What the game had bound as a call started, read back after it.
 struct GameBindings {
@@ -18,6 +18,8 @@ struct GameBindings {
     /// Its attribute arrays at the renderer's locations (enabled, size, type, stride, buffer),
     /// which are vertex array 0's where the game draws with it.
     arrays: Vec<[i32; 5]>,
+    /// Its framebuffer's second draw buffer (ES 3.0): attachment 1.
+    draw_buffer_1: Option<i32>,
 }
 
 /// One attribute parameter of location `index`.
@@ -42,7 +44,7 @@ unsafe fn arrays(gl: &glow::Context) -> Vec<[i32; 5]> {
         .collect()
 }
 
-unsafe fn game_bindings(gl: &glow::Context) -> GameBindings {
+unsafe fn game_bindings(gl: &glow::Context, has: Has) -> GameBindings {
     let active = gl.get_parameter_i32(glow::ACTIVE_TEXTURE);
     gl.active_texture(glow::TEXTURE0 + GAME_UNITS - 1);
     let last_unit_texture = gl.get_parameter_i32(glow::TEXTURE_BINDING_2D);
@@ -51,6 +53,7 @@ unsafe fn game_bindings(gl: &glow::Context) -> GameBindings {
         framebuffer: gl.get_parameter_i32(glow::FRAMEBUFFER_BINDING),
         last_unit_texture,
         arrays: arrays(gl),
+        draw_buffer_1: has.es3.then(|| gl.get_parameter_i32(glow::DRAW_BUFFER1)),
     }
 }
 
@@ -68,15 +71,23 @@ unsafe fn read_drawn(gl: &glow::Context, has: Has, size: (u32, u32)) -> image::R
     read_back(gl, size)
 }
 
-/// Checks the state a call with `GlStateHandling::Reset` leaves. `own_vertex_array`: the
-/// renderer draws with a vertex array of its own (ES 3.x, `GL_OES_vertex_array_object`).
-unsafe fn assert_reset(
-    gl: &glow::Context,
-    has: Has,
-    game: &GameBindings,
+/// How the renderer under test draws, and what the call did.
+#[derive(Clone, Copy)]
+struct Call<'a> {
+    /// With a vertex array of its own (ES 3.x, `GL_OES_vertex_array_object`).
     own_vertex_array: bool,
-    what: &str,
-) {
+    /// The call drew a frame into the game's framebuffer (`render`).
+    drew_into_the_games: bool,
+    what: &'a str,
+}
+
+/// Checks the state a call with `GlStateHandling::Reset` leaves.
+unsafe fn assert_reset(gl: &glow::Context, has: Has, game: &GameBindings, call: Call) {
+    let Call {
+        own_vertex_array,
+        drew_into_the_games,
+        what,
+    } = call;
     let mut ints = vec![
         (glow::FRAMEBUFFER_BINDING, game.framebuffer),
         (glow::ARRAY_BUFFER_BINDING, 0),
@@ -114,6 +125,13 @@ unsafe fn assert_reset(
             (glow::PIXEL_UNPACK_BUFFER_BINDING, 0),
             (glow::DRAW_BUFFER0, glow::COLOR_ATTACHMENT0 as i32),
         ]);
+        // A frame drawn into the framebuffer points it at attachment 0 alone; no other call
+        // changes what is the framebuffer object's own state.
+        let second = match drew_into_the_games {
+            true => glow::NONE as i32,
+            false => game.draw_buffer_1.unwrap(),
+        };
+        ints.push((glow::DRAW_BUFFER1, second));
         disabled.extend([
             glow::RASTERIZER_DISCARD,
             glow::PRIMITIVE_RESTART_FIXED_INDEX,
@@ -182,7 +200,10 @@ unsafe fn assert_reset(
                 "{what}: array {location}"
             );
         } else if !own_vertex_array {
+            // The context's arrays: off, and no index buffer of the renderer's left bound.
             assert_eq!(array[0], 0, "{what}: array {location} enabled");
+            let indices = gl.get_parameter_i32(glow::ELEMENT_ARRAY_BUFFER_BINDING);
+            assert_eq!(indices, 0, "{what}: index buffer");
             if has.divisors.is_some() {
                 let d = attribute(gl, location, glow::VERTEX_ATTRIB_ARRAY_DIVISOR);
                 assert_eq!(d, 0, "{what}: array {location}'s divisor");
@@ -191,77 +212,81 @@ unsafe fn assert_reset(
     }
 }
 
-/// Runs `cases` again on `renderer` with `GlStateHandling::Reset`, from the hostile game state
-/// set again before each call; `expected`: a clean renderer's pictures of them.
+/// Runs `cases` again with `GlStateHandling::Reset`, on a new renderer on `ctx` that adopts
+/// `renderer`'s programs (so meshes and textures upload under the reset call's state, and no
+/// shader is compiled again), from the hostile game state set again before each call;
+/// `expected`: a clean renderer's pictures of them, `fp16` its precision probe's answer.
 pub(super) fn every_call_sets_what_it_needs_and_leaves_gl_initial_values(
-    gl: &glow::Context,
-    renderer: &mut Renderer,
+    (ctx, gl): (&HeadlessContext, &glow::Context),
+    renderer: Renderer,
     has: Has,
     scene: &Scene,
     cases: &[(&str, RenderOptions)],
-    expected: &[image::RgbaImage],
+    (expected, fp16): (&[image::RgbaImage], bool),
 ) {
-    let (w, h) = (expected[0].width(), expected[0].height());
+    let es = renderer.caps().es;
+    let programs = renderer.destroy_keeping_programs();
+    let mut renderer = Renderer::new(ctx.load_gl().unwrap(), es).unwrap();
+    renderer.adopt_programs(programs);
     renderer.set_gl_state_handling(GlStateHandling::Reset);
     assert_eq!(renderer.gl_state_handling(), GlStateHandling::Reset);
     let caps = renderer.caps();
     let own_vertex_array = has.es3 || caps.has_extension("GL_OES_vertex_array_object");
+    let (w, h) = (expected[0].width(), expected[0].height());
     let size = (w as i32, h as i32);
-    for ((m, opts), expected) in cases.iter().zip(expected) {
-        let what = format!("reset, {m} ×{}", opts.samples);
+    // Sets the game's state, runs `f`, and checks what it left.
+    let mut call = |what: &str, drew_into_the_games: bool, f: &mut dyn FnMut(&mut Renderer)| {
         let game = unsafe {
             set_game_state(gl, has, size);
-            game_bindings(gl)
+            game_bindings(gl, has)
         };
-        renderer.set_method_named(m).unwrap();
-        unsafe {
-            assert_reset(
-                gl,
-                has,
-                &game,
-                own_vertex_array,
-                &format!("{what} set_method"),
-            )
+        f(&mut renderer);
+        let call = Call {
+            own_vertex_array,
+            drew_into_the_games,
+            what,
         };
-        unsafe { set_game_state(gl, has, size) };
-        let game = unsafe { game_bindings(gl) };
-        renderer.warm_up(scene, opts).unwrap();
-        unsafe { assert_reset(gl, has, &game, own_vertex_array, &format!("{what} warm_up")) };
-        unsafe { set_game_state(gl, has, size) };
-        let game = unsafe { game_bindings(gl) };
-        let (img, _) = renderer.render_offscreen(scene, w, h, opts).unwrap();
-        let d = manylight::metrics::diff(expected, &img);
-        assert_eq!(d.max_abs, 0, "{what}: the game's state changed the picture");
-        unsafe {
-            assert_reset(
-                gl,
-                has,
-                &game,
-                own_vertex_array,
-                &format!("{what} offscreen"),
-            )
-        };
+        unsafe { assert_reset(gl, has, &game, call) };
+    };
+    for ((m, opts), expected) in cases.iter().zip(expected) {
+        let what = format!("reset, {m} ×{}", opts.samples);
+        call(&format!("{what} set_method"), false, &mut |r| {
+            r.set_method_named(m).unwrap();
+        });
+        call(&format!("{what} warm_up"), false, &mut |r| {
+            r.warm_up(scene, opts).unwrap();
+        });
+        call(&format!("{what} offscreen"), false, &mut |r| {
+            let (img, _) = r.render_offscreen(scene, w, h, opts).unwrap();
+            let d = manylight::metrics::diff(expected, &img);
+            assert_eq!(d.max_abs, 0, "{what}: the game's state changed the picture");
+        });
         // Into the game's own framebuffer, as a game draws. Where it has 16-bit depth (ES 2.0
         // without `GL_OES_depth24`), unlike an offscreen frame's, the picture to draw is the
         // state-saving call's into the same kind of framebuffer.
         let expected = match has.depth24 {
             true => expected.clone(),
             false => {
-                renderer.set_gl_state_handling(GlStateHandling::SaveAndRestore);
+                let mut saving = Renderer::new(ctx.load_gl().unwrap(), es).unwrap();
+                saving.set_method_named(m).unwrap();
                 unsafe { set_game_state(gl, has, size) };
-                renderer.render(scene, w, h, opts).unwrap();
-                renderer.set_gl_state_handling(GlStateHandling::Reset);
+                saving.render(scene, w, h, opts).unwrap();
                 unsafe { read_drawn(gl, has, (w, h)) }
             }
         };
-        unsafe { set_game_state(gl, has, size) };
-        let game = unsafe { game_bindings(gl) };
-        renderer.render(scene, w, h, opts).unwrap();
-        unsafe { assert_reset(gl, has, &game, own_vertex_array, &format!("{what} render")) };
-        // Left bound for reading, with GL's pixel-store settings: read as the game would.
-        let img = unsafe { read_back(gl, (w, h)) };
-        let d = manylight::metrics::diff(&expected, &img);
-        assert_eq!(d.max_abs, 0, "{what}: render drew another picture");
+        call(&format!("{what} render"), true, &mut |r| {
+            r.render(scene, w, h, opts).unwrap();
+            // Left bound for reading, with GL's pixel-store settings: read as the game would.
+            let img = unsafe { read_back(gl, (w, h)) };
+            let d = manylight::metrics::diff(&expected, &img);
+            assert_eq!(d.max_abs, 0, "{what}: render drew another picture");
+        });
     }
-    renderer.set_gl_state_handling(GlStateHandling::SaveAndRestore);
+    call("reset, the precision probe", false, &mut |r| {
+        let measured = r.mediump_is_fp16().unwrap();
+        assert_eq!(
+            measured, fp16,
+            "the game's state changed what the probe measured"
+        );
+    });
 }
