@@ -14,7 +14,7 @@ use glutin::display::{Display, DisplayApiPreference, GlDisplay};
 use glutin::error::ErrorKind;
 use glutin::surface::{GlSurface, Surface, SurfaceAttributesBuilder, SwapInterval, WindowSurface};
 use manylight::{builtin_scene, Method, RandomLights, Scene, DEFAULT_SCENE};
-use manylight::{Error, GlError};
+use manylight::{Error, GlError, GlStateHandling};
 use manylight::{EsVersion, FrameStats, RenderOptions, Renderer};
 use winit::application::ApplicationHandler;
 use winit::dpi::PhysicalPosition;
@@ -452,6 +452,9 @@ fn new_renderer(egl: &Egl, scene: &mut Scene) -> Result<Renderer, Failed> {
         })
     };
     let mut renderer = Renderer::new(gl, egl.es).map_err(|e| Failed::from(&e))?;
+    // The app draws nothing else, so it has no GL state to be given back: the renderer skips
+    // saving it, the queries an Android driver's thread would make each frame wait on.
+    renderer.set_gl_state_handling(GlStateHandling::Reset);
     pick_method(&mut renderer)?;
     if renderer.method() == Method::Forward && scene.lights.len() > FORWARD_LIGHTS {
         log::warn!(
