@@ -56,6 +56,9 @@ impl ResetEntry {
             if f.sample_mask {
                 gl.disable(glow::SAMPLE_MASK);
             }
+            if f.sample_shading {
+                gl.disable(glow::SAMPLE_SHADING);
+            }
             if f.srgb_write_control {
                 gl.enable(glow::FRAMEBUFFER_SRGB);
             }

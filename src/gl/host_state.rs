@@ -63,6 +63,10 @@ pub(crate) struct HostFeatures {
     /// `GL_SAMPLE_MASK` exists (ES 3.1, desktop 3.2): a game's sample mask would drop samples
     /// of the renderer's MSAA target.
     pub(super) sample_mask: bool,
+    /// `GL_SAMPLE_SHADING` exists (ES 3.2 or `GL_OES_sample_shading`, desktop 4.0): a game's
+    /// would shade each sample of the renderer's MSAA target on its own, at up to its sample
+    /// count times the cost, and at the samples' positions rather than the pixel's.
+    pub(super) sample_shading: bool,
     /// `GL_PRIMITIVE_RESTART_FIXED_INDEX` exists (ES 3.0, desktop 4.3): the renderer's 16-bit
     /// index 65 535 is a vertex of any mesh chunk of 65 536 vertices.
     pub(super) fixed_index_restart: bool,
@@ -97,6 +101,9 @@ impl HostFeatures {
             pack_rows: es3 || has("GL_NV_pack_subimage"),
             srgb_write_control: !desktop && has("GL_EXT_sRGB_write_control"),
             sample_mask: version >= if desktop { (3, 2) } else { (3, 1) },
+            sample_shading: version >= if desktop { (4, 0) } else { (3, 2) }
+                || has("GL_OES_sample_shading")
+                || has("GL_ARB_sample_shading"),
             fixed_index_restart: es3 && (!desktop || version >= (4, 3)),
             attrib_fns: (!own_vertex_array)
                 .then(super::ext_fns::attrib_pointer_fns)
@@ -140,6 +147,8 @@ pub(crate) struct HostState {
     /// `SAMPLE_MASK` (ES 3.1, desktop 3.2): a game's sample mask would drop samples of the
     /// renderer's MSAA target. `None` where the context has no such capability.
     sample_mask: Option<bool>,
+    /// `SAMPLE_SHADING` (`HostFeatures::sample_shading`), where the context has it.
+    sample_shading: Option<bool>,
     /// `PRIMITIVE_RESTART_FIXED_INDEX` (ES 3.0, desktop 4.3): the renderer's 16-bit index
     /// 65 535 is a vertex of any mesh chunk of 65 536 vertices. `None` where the context has
     /// no such capability.
@@ -201,7 +210,7 @@ impl HostState {
     /// `GL_OES_vertex_array_object`), the bound framebuffer drawing into its
     /// attachment 0 alone (`host_draw_buffers.rs`), no pixel buffer, no sampler objects on
     /// its units, the capabilities of `OFF_INSIDE` off, additive blend equations, no sample
-    /// mask, counter-clockwise front faces, the full depth range, a clear depth of 1, pixel
+    /// mask nor sample shading, counter-clockwise front faces, the full depth range, a clear depth of 1, pixel
     /// rows that start where the data does and texture unit 0 active (a game's active unit past
     /// the saved ones keeps its texture), no primitive restart, no attribute divisors; on ES
     /// with `GL_EXT_sRGB_write_control` sRGB encoding on; on desktop GL, filled polygons and
@@ -218,6 +227,7 @@ impl HostState {
             pack_rows,
             srgb_write_control,
             sample_mask,
+            sample_shading,
             fixed_index_restart,
             attrib_fns,
             divisor,
@@ -299,6 +309,7 @@ impl HostState {
                 off_inside: OFF_INSIDE.map(|c| gl.is_enabled(c)),
                 rasterizer_discard: es3 && gl.is_enabled(glow::RASTERIZER_DISCARD),
                 sample_mask: sample_mask.then(|| gl.is_enabled(glow::SAMPLE_MASK)),
+                sample_shading: sample_shading.then(|| gl.is_enabled(glow::SAMPLE_SHADING)),
                 fixed_index_restart: fixed_index_restart
                     .then(|| gl.is_enabled(glow::PRIMITIVE_RESTART_FIXED_INDEX)),
                 blend_func,
@@ -350,6 +361,7 @@ impl HostState {
                 saved.fixed_index_restart == Some(true),
             );
             off(glow::SAMPLE_MASK, saved.sample_mask == Some(true));
+            off(glow::SAMPLE_SHADING, saved.sample_shading == Some(true));
             if let Some((vao, arrays)) = vao {
                 arrays.bind(gl, Some(vao));
             }
@@ -450,6 +462,7 @@ impl HostState {
                 self.fixed_index_restart == Some(true),
             );
             on_again(glow::SAMPLE_MASK, self.sample_mask == Some(true));
+            on_again(glow::SAMPLE_SHADING, self.sample_shading == Some(true));
             let [sr, dr, sa, da] = self.blend_func.map(|v| v as u32);
             gl.blend_func_separate(sr, dr, sa, da);
             let [er, ea] = self.blend_equation.map(|v| v as u32);

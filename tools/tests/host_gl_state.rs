@@ -715,3 +715,60 @@ fn the_games_sample_mask_does_not_drop_the_renderers_samples() {
     sample_mask_i(0, !0);
     unsafe { gl.disable(glow::SAMPLE_MASK) };
 }
+
+/// The game's sample shading (ES 3.2 state) does not shade each sample of the renderer's MSAA
+/// target on its own (at four times the cost, and at the samples' positions): with every sample
+/// shaded, the picture still equals a clean renderer's, and the game's setting is on again
+/// after the call (off, where the call resets the state).
+#[test]
+fn the_games_sample_shading_does_not_shade_the_renderers_samples() {
+    let scene = scene::builtin::build(scene::builtin::DEFAULT, Some((16, 3))).unwrap();
+    let opts = RenderOptions {
+        samples: 4,
+        ..RenderOptions::default()
+    };
+    let (w, h) = (64, 36);
+    let expected = Gpu::fresh(EsVersion::Es3).render(&scene, w, h, &opts);
+    let ctx = HeadlessContext::new(EsVersion::Es3).unwrap();
+    let gl = ctx.load_gl().unwrap();
+    let mut renderer = Renderer::new(ctx.load_gl().unwrap(), EsVersion::Es3).unwrap();
+    let version = gl.version();
+    let has = (version.major, version.minor) >= (3, 2)
+        || renderer.caps().has_extension("GL_OES_sample_shading");
+    if !has {
+        // Not a skip on SwiftShader and ANGLE here: ES 3.0 has no such state. Mesa has it.
+        if !common::other_implementation_than_mesa("ES 3.2 sample shading") {
+            common::skip("this context has no sample shading to check");
+        }
+        return;
+    }
+    let library = manylight::gl::gles_lib::library().unwrap();
+    let min_sample_shading = ["glMinSampleShading", "glMinSampleShadingOES"]
+        .map(|name| library.proc_address(name))
+        .into_iter()
+        .find(|f| !f.is_null())
+        .expect("ES 3.2 has glMinSampleShading");
+    // SAFETY: glMinSampleShading's type in the ES 3.2 specification.
+    let min_sample_shading: extern "system" fn(f32) =
+        unsafe { std::mem::transmute(min_sample_shading) };
+    min_sample_shading(1.0);
+    for handling in [GlStateHandling::SaveAndRestore, GlStateHandling::Reset] {
+        renderer.set_gl_state_handling(handling);
+        unsafe { gl.enable(glow::SAMPLE_SHADING) };
+        let (img, _) = renderer.render_offscreen(&scene, w, h, &opts).unwrap();
+        let d = manylight::metrics::diff(&expected, &img);
+        assert_eq!(
+            d.max_abs, 0,
+            "{handling:?}: the game's sample shading changed the frame"
+        );
+        // Given back, or left at GL's initial value.
+        let on = unsafe { gl.is_enabled(glow::SAMPLE_SHADING) };
+        assert_eq!(
+            on,
+            handling == GlStateHandling::SaveAndRestore,
+            "{handling:?}"
+        );
+    }
+    min_sample_shading(0.0);
+    unsafe { gl.disable(glow::SAMPLE_SHADING) };
+}
