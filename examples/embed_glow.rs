@@ -16,7 +16,10 @@
 //!    is given;
 //! 3. carry on: manylight gives back the GL state it found (framebuffer, vertex array on ES 3.0,
 //!    program, textures, blend, depth, viewport, …; the README's "Sharing the context with a
-//!    game" lists it), so the application's next pass starts where it left off.
+//!    game" lists it), so the application's next pass starts where it left off. An application
+//!    that sets all its state before each pass skips that save, and the queries a threaded
+//!    driver waits on: `renderer.set_gl_state_handling(GlStateHandling::Reset)` leaves GL's
+//!    initial values instead, with the application's framebuffer still bound.
 //!
 //! `image` is manylight's re-export (`manylight::image`, the type its offscreen renders
 //! return); `rayon`, for joining its pool, is a crate of its own that a game copying this adds
