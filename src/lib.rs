@@ -118,7 +118,7 @@ pub use scene::{
     builtin::DEFAULT as DEFAULT_SCENE, builtin::NAMES as BUILTIN_SCENES, builtin_scene, load_scene,
     load_scene_with, Aabb, Camera, Cone, DirectionalLight, Light, LightKind, LoadOptions, Material,
     MaterialModel, Mesh, Object, Projection, RandomLights, Scene, SceneError, Texture,
-    MAX_DIRECTIONAL_LIGHTS,
+    MAX_DEPTH_BIAS, MAX_DIRECTIONAL_LIGHTS,
 };
 
 /// How lights move over time: a [`Motion`](motion::Motion) per light, set with

@@ -40,6 +40,8 @@ pub struct Device {
     pub(super) target_queries_refused: std::cell::Cell<bool>,
     /// What this call has bound, and the state calls made.
     call: CallState,
+    /// The polygon offset this call draws with (materials' depth bias).
+    depth_bias: super::depth_bias::DepthBias,
     /// Whether a GL error the application left pending has been reported (once a device).
     warned_pending_error: std::cell::Cell<bool>,
     /// GL said the context was lost (`GL_CONTEXT_LOST`, which a driver may say only once): every
@@ -211,6 +213,7 @@ impl Device {
             host_framebuffer: std::cell::Cell::new(None),
             target_queries_refused: std::cell::Cell::new(false),
             call: CallState::default(),
+            depth_bias: Default::default(),
             warned_pending_error: std::cell::Cell::new(false),
             lost: std::cell::Cell::new(false),
             context: ContextWatch::of_current(),
@@ -302,6 +305,8 @@ impl Device {
         if let Some(saved) = saved {
             // Given back once the state is, or should giving it back panic.
             let _turn = super::driver_turns::Turn::held(self.takes_turns);
+            // Before the state goes back: that switches the game's polygon offset on again.
+            self.depth_bias.leave(&self.gl);
             saved.leave(&self.gl, &self.host, self.own_vertex_array);
             self.call.forget(None);
         }
@@ -454,6 +459,12 @@ impl Device {
     /// constants are set again before the next mesh that lacks them.
     pub(crate) fn forget_absent_values(&self, arrays: u8) {
         self.call.forget_absent_values(arrays);
+    }
+
+    /// Draws from now on `bias` depth-buffer steps toward the camera (`Material::depth_bias`).
+    pub(crate) fn set_depth_bias(&self, bias: f32) {
+        let save = self.state_handling.get() == super::GlStateHandling::SaveAndRestore;
+        self.depth_bias.set(&self.gl, bias, save);
     }
 
     /// Counts a state call ([`StateCalls`]).

@@ -18,6 +18,7 @@ pub(crate) mod bound_size;
 pub(crate) mod call_state;
 pub mod caps;
 pub mod context;
+pub(crate) mod depth_bias;
 pub mod device;
 pub(crate) mod driver_turns;
 pub mod ext_fns;

@@ -367,6 +367,8 @@ impl Deferred {
                 break;
             }
         }
+        // The light volumes are tested against the depth where it lies.
+        ctx.dev.set_depth_bias(0.0);
         ctx.features = features;
         drawn
     }

@@ -116,10 +116,12 @@ fn depth_prepass(ctx: &mut FrameContext) -> Result<(), Error> {
     for &i in &ctx.order.opaque[..ctx.order.cut_out_from] {
         let (mesh, model) = ctx.gpu_scene.drawn(i, &ctx.scene.objects[i]);
         let view_model = ctx.view * model;
+        let material = &ctx.scene.materials[ctx.scene.objects[i].material];
         if ctx.order.single_sided {
-            let double_sided = ctx.scene.materials[ctx.scene.objects[i].material].double_sided;
-            Cull::for_surface(double_sided, is_mirroring(&view_model)).apply(dev);
+            Cull::for_surface(material.double_sided, is_mirroring(&view_model)).apply(dev);
         }
+        // The depth its shading pass tests against: biased as that pass draws it.
+        dev.set_depth_bias(material.depth_bias);
         transforms.set(dev, &view_model, &ctx.projection);
         mesh.draw(dev);
     }
@@ -192,6 +194,8 @@ pub fn draw_objects<P: GeometryProgram>(
             shade_object(ctx, i, shader, max_lights, bind_method, &mut bound)?;
         }
     }
+    // What draws next (an MSAA resolve, a method's own passes) lies where it is.
+    ctx.dev.set_depth_bias(0.0);
     crate::gl::device::gl_check!(ctx.dev, "geometry pass");
     Ok(())
 }
@@ -261,6 +265,7 @@ pub(crate) fn shade_object<P: GeometryProgram>(
     if ctx.order.single_sided && !material.is_transparent() {
         Cull::for_surface(material.double_sided, mirrored).apply(dev);
     }
+    dev.set_depth_bias(material.depth_bias);
     program.transforms().set(dev, &view_model, &ctx.projection);
     if let Some(t) = texture {
         let sampling = material

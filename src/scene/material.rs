@@ -69,6 +69,12 @@ pub struct Material {
     /// glTF's default `doubleSided: false` asks: a back face is culled, and what lies behind
     /// it shows.
     pub double_sided: bool,
+    /// How far the surface is drawn toward the camera, in steps of the depth buffer (a polygon
+    /// offset: `glPolygonOffset`'s units), so that a decal lying on another surface wins the
+    /// depth test there with every method. 0, the default, draws it where it lies; 2 lifts a
+    /// decal clear of its surface (deferred's depth may be a step off, docs/architecture.md).
+    /// Within ±1 024 (`MAX_DEPTH_BIAS`).
+    pub depth_bias: f32,
 }
 
 impl Default for Material {
@@ -82,6 +88,10 @@ impl Default for Material {
 /// stay finite there, so each factor is capped far below that; reflectances above 1 are not
 /// physical anyway (MTL files with `Kd 30000` or `Ks 1e20` exist, and turned surfaces black).
 pub const MAX_COLOR_FACTOR: f32 = 1024.0;
+
+/// Largest [`Material::depth_bias`] either way, in depth-buffer steps: a 16-bit depth buffer
+/// has 65 536, and a decal needs a few.
+pub const MAX_DEPTH_BIAS: f32 = 1024.0;
 
 /// Checks that a colour factor is finite and within [0, [`MAX_COLOR_FACTOR`]], naming
 /// `field.name` (built only when it is not).
@@ -115,6 +125,7 @@ impl Material {
             roughness: 1.0,
             maps: SurfaceMaps::default(),
             double_sided: true,
+            depth_bias: 0.0,
         }
     }
 
@@ -208,6 +219,13 @@ impl Material {
                 format!("must be in [0, 1], got {:?}", self.alpha),
             ));
         }
+        let bias = self.depth_bias;
+        if !(bias.is_finite() && bias.abs() <= MAX_DEPTH_BIAS) {
+            return Err(SceneError::invalid(
+                format!("{field}.depth_bias"),
+                format!("must be within ±{MAX_DEPTH_BIAS} depth steps, got {bias:?}"),
+            ));
+        }
         if let Some(c) = self.alpha_cutoff {
             if !(c.is_finite() && (0.0..=1.0).contains(&c)) {
                 return Err(SceneError::invalid(
@@ -294,6 +312,20 @@ mod tests {
         assert!(err.contains("materials[0].specular"), "{err}");
         m.specular = Vec3::splat(MAX_COLOR_FACTOR);
         assert!(m.validate("materials[0]").is_ok());
+    }
+
+    #[test]
+    fn a_depth_bias_past_the_limit_or_not_finite_is_refused_naming_the_field() {
+        let mut m = Material::flat("decal", Vec3::ONE);
+        for ok in [0.0, 2.0, -MAX_DEPTH_BIAS, MAX_DEPTH_BIAS] {
+            m.depth_bias = ok;
+            assert!(m.validate("materials[2]").is_ok(), "{ok}");
+        }
+        for bad in [f32::NAN, f32::INFINITY, MAX_DEPTH_BIAS * 2.0, -1e30] {
+            m.depth_bias = bad;
+            let err = m.validate("materials[2]").unwrap_err().to_string();
+            assert!(err.contains("materials[2].depth_bias"), "{bad}: {err}");
+        }
     }
 
     #[test]

@@ -74,7 +74,7 @@ pub use directional::{DirectionalLight, MAX_DIRECTIONAL_LIGHTS};
 pub use error::SceneError;
 pub use light::{Cone, Light, LightKind};
 pub use load_report::LoadReport;
-pub use material::{Material, MaterialModel, Texture};
+pub use material::{Material, MaterialModel, Texture, MAX_DEPTH_BIAS};
 pub use mesh::{Aabb, Mesh};
 pub use mesh::{MAX_SCENE_MATERIALS, MAX_SCENE_MESHES, MAX_SCENE_OBJECTS};
 pub use motion::Motion;

@@ -772,3 +772,41 @@ fn the_games_sample_shading_does_not_shade_the_renderers_samples() {
     min_sample_shading(0.0);
     unsafe { gl.disable(glow::SAMPLE_SHADING) };
 }
+
+/// A material's depth bias sets the polygon offset during the call only: the game's offset
+/// (switched on, with its own factor and units) is on again with its values after a call that
+/// drew a biased surface; with the state reset, it is off with GL's initial values. A call
+/// with no biased surface leaves the values alone even then.
+#[test]
+fn a_biased_material_gives_the_games_polygon_offset_back() {
+    let mut biased = scene::builtin::build("plane", Some((8, 1))).unwrap();
+    for material in &mut biased.materials {
+        material.depth_bias = 2.0;
+    }
+    let unbiased = scene::builtin::build("plane", Some((8, 1))).unwrap();
+    let ctx = HeadlessContext::new(EsVersion::Es3).unwrap();
+    let gl = ctx.load_gl().unwrap();
+    let mut renderer = Renderer::new(ctx.load_gl().unwrap(), EsVersion::Es3).unwrap();
+    let offset = || unsafe {
+        let on = gl.is_enabled(glow::POLYGON_OFFSET_FILL);
+        let factor = gl.get_parameter_f32(glow::POLYGON_OFFSET_FACTOR);
+        (on, factor, gl.get_parameter_f32(glow::POLYGON_OFFSET_UNITS))
+    };
+    let opts = RenderOptions::default();
+    for handling in [GlStateHandling::SaveAndRestore, GlStateHandling::Reset] {
+        renderer.set_gl_state_handling(handling);
+        for (scene, biased) in [(&unbiased, false), (&biased, true)] {
+            unsafe {
+                gl.enable(glow::POLYGON_OFFSET_FILL);
+                gl.polygon_offset(3.0, 5.0);
+            }
+            renderer.render_offscreen(scene, 32, 18, &opts).unwrap();
+            let expected = match (handling, biased) {
+                (GlStateHandling::SaveAndRestore, _) => (true, 3.0, 5.0),
+                (GlStateHandling::Reset, false) => (false, 3.0, 5.0),
+                (GlStateHandling::Reset, true) => (false, 0.0, 0.0),
+            };
+            assert_eq!(offset(), expected, "{handling:?}, biased: {biased}");
+        }
+    }
+}

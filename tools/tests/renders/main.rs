@@ -10,6 +10,7 @@ mod common;
 mod animation;
 mod background_alpha;
 mod culled_vs_forward;
+mod depth_bias;
 mod directional_lights;
 mod empty_scene;
 mod front_faces;

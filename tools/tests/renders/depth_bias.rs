@@ -1,0 +1,146 @@
+//! `Material::depth_bias`: a decal lying exactly on a wall, listed (and drawn) before it, shows
+//! over the wall with every method on ES 2.0 and 3.0 once biased — opaque, as the decal alone
+//! draws it; half transparent, as forward blends it, deferred's rewritten depth included —
+//! while without the bias the wall hides much of it, so the test can fail.
+
+use crate::common;
+
+use std::sync::Arc;
+
+use glam::{DMat4, DVec3, Vec3};
+use manylight::scene::{Light, Material, Mesh, Object, Scene};
+use manylight::{Camera, RenderOptions};
+
+const W: u32 = 96;
+const H: u32 = 54;
+
+/// A square of `w` × `h` in the z = 0 plane around the origin, facing +Z.
+fn square(w: f32, h: f32) -> Mesh {
+    let positions = [[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]]
+        .map(|[x, y]| Vec3::new(x * w / 2.0, y * h / 2.0, 0.0))
+        .to_vec();
+    Mesh::new(positions, vec![Vec3::Z; 4], vec![], vec![0, 1, 2, 0, 2, 3]).unwrap()
+}
+
+/// The red decal's bias and opacity.
+#[derive(Clone, Copy, Debug)]
+struct Decal {
+    bias: f32,
+    alpha: f32,
+}
+
+/// The grey wall (or not) with the decal (or not) on it, the decal listed first: where their
+/// depths tie, the wall, drawn later, wins an unbiased depth test.
+fn scene(decal: Option<Decal>, wall: bool) -> Scene {
+    let mut s = Scene::empty();
+    if let Some(d) = decal {
+        let red = s.add_material(Material {
+            depth_bias: d.bias,
+            alpha: d.alpha,
+            ..Material::flat("decal", Vec3::new(0.9, 0.1, 0.1))
+        });
+        s.objects.push(Object {
+            mesh: Arc::new(square(2.0, 1.4)),
+            material: red,
+            transform: DMat4::IDENTITY,
+        });
+    }
+    if wall {
+        let grey = s.add_material(Material::flat("wall", Vec3::splat(0.6)));
+        s.objects.push(Object {
+            mesh: Arc::new(square(10.0, 6.0)),
+            material: grey,
+            transform: DMat4::IDENTITY,
+        });
+    }
+    s.ambient = Vec3::splat(0.1);
+    s.camera = Camera::perspective(DVec3::new(0.4, 0.3, 3.0), DVec3::ZERO, 60.0, 0.1, 30.0);
+    s.lights = vec![Light::point(
+        DVec3::new(0.5, 0.8, 2.0),
+        10.0,
+        Vec3::ONE,
+        8.0,
+    )];
+    s.validate().unwrap();
+    s
+}
+
+/// Largest difference of any channel at a pixel.
+fn difference(a: &image::RgbaImage, b: &image::RgbaImage, x: u32, y: u32) -> u8 {
+    let (p, q) = (a.get_pixel(x, y), b.get_pixel(x, y));
+    (0..3).map(|c| p[c].abs_diff(q[c])).max().unwrap()
+}
+
+/// The pixels where `decal_alone` shows the decal (over the black background).
+fn decal_pixels(decal_alone: &image::RgbaImage) -> Vec<(u32, u32)> {
+    let pixels = (0..W).flat_map(|x| (0..H).map(move |y| (x, y)));
+    let red = |&(x, y): &(u32, u32)| decal_alone.get_pixel(x, y)[0] > 40;
+    pixels.filter(red).collect()
+}
+
+#[test]
+fn a_biased_decal_shows_over_the_surface_it_lies_on_with_every_method() {
+    let opts = RenderOptions::default();
+    let opaque = |bias| Decal { bias, alpha: 1.0 };
+    let transparent = Decal {
+        bias: 2.0,
+        alpha: 0.5,
+    };
+    let mut forward_transparent = std::collections::HashMap::new();
+    let mut hidden_unbiased = Vec::new();
+    common::each_method(|es, method, gpu| {
+        let what = format!("{es} {method}");
+        let alone = gpu.render(&scene(Some(opaque(2.0)), false), W, H, &opts);
+        let decal = decal_pixels(&alone);
+        assert!(
+            decal.len() > (W * H / 10) as usize,
+            "{what}: {} decal pixels",
+            decal.len()
+        );
+        // Biased, the decal is drawn over the wall as it is drawn alone.
+        let biased = gpu.render(&scene(Some(opaque(2.0)), true), W, H, &opts);
+        let worst = (decal.iter())
+            .map(|&(x, y)| difference(&biased, &alone, x, y))
+            .max();
+        assert!(
+            worst <= Some(2),
+            "{what}: {worst:?}/255 from the decal alone"
+        );
+        // Unbiased, the wall drawn after it wins where their depths tie.
+        let unbiased = gpu.render(&scene(Some(opaque(0.0)), true), W, H, &opts);
+        let hidden = (decal.iter())
+            .filter(|&&(x, y)| difference(&unbiased, &alone, x, y) > 40)
+            .count();
+        eprintln!(
+            "{what}: {hidden} of {} decal pixels hidden unbiased",
+            decal.len()
+        );
+        hidden_unbiased.push(hidden);
+        // Half transparent, blended over the wall as forward blends it.
+        let blended = gpu.render(&scene(Some(transparent), true), W, H, &opts);
+        let wall = gpu.render(&scene(None, true), W, H, &opts);
+        let shown = (decal.iter())
+            .filter(|&&(x, y)| difference(&blended, &wall, x, y) > 20)
+            .count();
+        assert_eq!(
+            shown,
+            decal.len(),
+            "{what}: the transparent decal is missing"
+        );
+        if method == "forward" {
+            forward_transparent.insert(es, blended.clone());
+        }
+        let forward = forward_transparent.get(&es).expect("forward runs first");
+        let d = manylight::metrics::diff(forward, &blended);
+        assert!(
+            d.max_abs <= 2,
+            "{what}: {}/255 from forward's transparent decal",
+            d.max_abs
+        );
+    });
+    // The wall and the decal's depths do tie: the bias is what draws the decal.
+    assert!(
+        hidden_unbiased.iter().all(|&n| n > 0),
+        "{hidden_unbiased:?}"
+    );
+}
