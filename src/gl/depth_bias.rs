@@ -21,28 +21,37 @@ pub(crate) struct DepthBias {
 }
 
 impl DepthBias {
-    /// Draws from now on `bias` depth steps toward the camera; `save`: read the application's
-    /// values first, to give them back.
+    /// A frame that draws a biased surface is about to start: the application's values are
+    /// read now (`save`), before its draws are queued; a read after them would wait for a
+    /// threaded driver to run them.
+    pub(super) fn prepare(&self, gl: &glow::Context, save: bool) {
+        if self.changed.get().is_none() {
+            let read = |p| unsafe { gl.get_parameter_f32(p) };
+            let saved = save.then(|| {
+                [
+                    read(glow::POLYGON_OFFSET_FACTOR),
+                    read(glow::POLYGON_OFFSET_UNITS),
+                ]
+            });
+            self.changed.set(Some(saved));
+        }
+    }
+
+    /// Draws from now on `bias` depth steps, plus `bias` times the surface's depth slope
+    /// across a pixel, toward the camera: the slope term covers the rasterizer's snapping of
+    /// the two surfaces' different vertices, which moves a surface seen at a grazing angle by
+    /// many steps. `save`: read the application's values first, to give them back.
     pub(super) fn set(&self, gl: &glow::Context, bias: f32, save: bool) {
         if bias == self.current.get() {
             return;
         }
+        self.prepare(gl, save);
         unsafe {
-            if self.changed.get().is_none() {
-                let read = |p| gl.get_parameter_f32(p);
-                let saved = save.then(|| {
-                    [
-                        read(glow::POLYGON_OFFSET_FACTOR),
-                        read(glow::POLYGON_OFFSET_UNITS),
-                    ]
-                });
-                self.changed.set(Some(saved));
-            }
             if bias == 0.0 {
                 gl.disable(glow::POLYGON_OFFSET_FILL);
             } else {
                 gl.enable(glow::POLYGON_OFFSET_FILL);
-                gl.polygon_offset(0.0, -bias);
+                gl.polygon_offset(-bias, -bias);
             }
         }
         self.current.set(bias);

@@ -467,6 +467,13 @@ impl Device {
         self.depth_bias.set(&self.gl, bias, save);
     }
 
+    /// A frame with a biased material starts: what the depth bias gives back is read now,
+    /// before the frame's draws are queued.
+    pub(crate) fn prepare_depth_bias(&self) {
+        let save = self.state_handling.get() == super::GlStateHandling::SaveAndRestore;
+        self.depth_bias.prepare(&self.gl, save);
+    }
+
     /// Counts a state call ([`StateCalls`]).
     pub(crate) fn count_state_call(&self, f: impl FnOnce(&mut StateCalls)) {
         self.call.count(f);

@@ -109,7 +109,8 @@ impl ResetEntry {
                 gl.active_texture(glow::TEXTURE0 + unit as u32);
                 gl.bind_texture(glow::TEXTURE_2D, None);
             }
-            // Its draw buffers are still those `enter` set.
+            // Its draw buffers are its own: a frame drawn into it set them
+            // (`draw_into_attachment_0`), no other call.
             gl.bind_framebuffer(glow::FRAMEBUFFER, self.draw_framebuffer);
             gl.bind_renderbuffer(glow::RENDERBUFFER, None);
             for c in TOGGLED {

@@ -347,6 +347,9 @@ impl Renderer {
             self.timer = Some(crate::gl::timer::GpuTimer::new(&self.dev));
         }
         let timer = (self.timer.as_ref().and_then(Option::as_ref)).filter(|_| options.gpu_timer);
+        if ctx.scene.materials.iter().any(|m| m.depth_bias != 0.0) {
+            self.dev.prepare_depth_bias();
+        }
         self.frame_serial += 1;
         let serial = self.frame_serial;
         if let Some(t) = timer {

@@ -69,10 +69,12 @@ pub struct Material {
     /// glTF's default `doubleSided: false` asks: a back face is culled, and what lies behind
     /// it shows.
     pub double_sided: bool,
-    /// How far the surface is drawn toward the camera, in steps of the depth buffer (a polygon
-    /// offset: `glPolygonOffset`'s units), so that a decal lying on another surface wins the
-    /// depth test there with every method. 0, the default, draws it where it lies; 2 lifts a
-    /// decal clear of its surface (deferred's depth may be a step off, docs/architecture.md).
+    /// How far the surface is drawn toward the camera, in steps of the depth buffer and as
+    /// many times its depth's change across a pixel (a polygon offset, `glPolygonOffset(−b,
+    /// −b)`), so that a decal lying on another surface wins the depth test there with every
+    /// method. 0, the default, draws it where it lies; 2 lifts a decal clear of its surface,
+    /// seen head-on or at a grazing angle (deferred's depth may be a step off,
+    /// docs/architecture.md).
     /// Within ±1 024 (`MAX_DEPTH_BIAS`).
     pub depth_bias: f32,
 }

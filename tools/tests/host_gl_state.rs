@@ -796,17 +796,28 @@ fn a_biased_material_gives_the_games_polygon_offset_back() {
     for handling in [GlStateHandling::SaveAndRestore, GlStateHandling::Reset] {
         renderer.set_gl_state_handling(handling);
         for (scene, biased) in [(&unbiased, false), (&biased, true)] {
-            unsafe {
-                gl.enable(glow::POLYGON_OFFSET_FILL);
-                gl.polygon_offset(3.0, 5.0);
+            // The game's offset switched on, and off (the renderer's must not stay on).
+            for on in [true, false] {
+                unsafe {
+                    if on {
+                        gl.enable(glow::POLYGON_OFFSET_FILL);
+                    } else {
+                        gl.disable(glow::POLYGON_OFFSET_FILL);
+                    }
+                    gl.polygon_offset(3.0, 5.0);
+                }
+                renderer.render_offscreen(scene, 32, 18, &opts).unwrap();
+                let expected = match (handling, biased) {
+                    (GlStateHandling::SaveAndRestore, _) => (on, 3.0, 5.0),
+                    (GlStateHandling::Reset, false) => (false, 3.0, 5.0),
+                    (GlStateHandling::Reset, true) => (false, 0.0, 0.0),
+                };
+                assert_eq!(
+                    offset(),
+                    expected,
+                    "{handling:?}, biased: {biased}, on: {on}"
+                );
             }
-            renderer.render_offscreen(scene, 32, 18, &opts).unwrap();
-            let expected = match (handling, biased) {
-                (GlStateHandling::SaveAndRestore, _) => (true, 3.0, 5.0),
-                (GlStateHandling::Reset, false) => (false, 3.0, 5.0),
-                (GlStateHandling::Reset, true) => (false, 0.0, 0.0),
-            };
-            assert_eq!(offset(), expected, "{handling:?}, biased: {biased}");
         }
     }
 }
