@@ -23,6 +23,19 @@ use manylight::{EsVersion, GlStateHandling, HeadlessContext, RenderOptions, Rend
 /// 16 combined units).
 const GAME_UNITS: u32 = 12;
 
+/// The ES 2.0 capabilities the game leaves on (all off by default): the renderer's picture
+/// depends on none of them.
+const GAME_CAPABILITIES: [u32; 8] = [
+    glow::BLEND,
+    glow::CULL_FACE,
+    glow::DEPTH_TEST,
+    glow::SCISSOR_TEST,
+    glow::STENCIL_TEST,
+    glow::POLYGON_OFFSET_FILL,
+    glow::SAMPLE_ALPHA_TO_COVERAGE,
+    glow::SAMPLE_COVERAGE,
+];
+
 /// What the game's context has of the state the game sets here.
 #[derive(Clone, Copy)]
 struct Has {
@@ -108,16 +121,7 @@ fn snapshot(gl: &glow::Context, has: Has) -> Snapshot {
         glow::PACK_ALIGNMENT,
         glow::UNPACK_ALIGNMENT,
     ];
-    let mut enabled = vec![
-        glow::BLEND,
-        glow::CULL_FACE,
-        glow::DEPTH_TEST,
-        glow::SCISSOR_TEST,
-        glow::STENCIL_TEST,
-        glow::POLYGON_OFFSET_FILL,
-        glow::SAMPLE_ALPHA_TO_COVERAGE,
-        glow::SAMPLE_COVERAGE,
-    ];
+    let mut enabled = GAME_CAPABILITIES.to_vec();
     if es3 {
         ints.extend([
             glow::VERTEX_ARRAY_BINDING,
@@ -343,16 +347,7 @@ unsafe fn set_game_state(gl: &glow::Context, has: Has, size: (i32, i32)) {
     gl.depth_range_f32(0.25, 0.75);
     gl.pixel_store_i32(glow::PACK_ALIGNMENT, 8);
     gl.pixel_store_i32(glow::UNPACK_ALIGNMENT, 8);
-    for c in [
-        glow::SCISSOR_TEST,
-        glow::STENCIL_TEST,
-        glow::BLEND,
-        glow::CULL_FACE,
-        glow::DEPTH_TEST,
-        glow::POLYGON_OFFSET_FILL,
-        glow::SAMPLE_ALPHA_TO_COVERAGE,
-        glow::SAMPLE_COVERAGE,
-    ] {
+    for c in GAME_CAPABILITIES {
         gl.enable(c);
     }
     // Left on, it would drop every sample of the renderer's MSAA target.
@@ -665,112 +660,95 @@ fn the_games_primitive_restart_does_not_cut_large_meshes() {
     }
 }
 
-/// The game's sample mask (ES 3.1 state) does not drop samples of the renderer's MSAA target:
-/// with a mask that keeps none, the picture still equals a clean renderer's, and the game's
-/// mask is on again after the call (off, where the call resets the state).
-#[test]
-fn the_games_sample_mask_does_not_drop_the_renderers_samples() {
-    let scene = scene::builtin::build(scene::builtin::DEFAULT, Some((16, 3))).unwrap();
-    let opts = RenderOptions {
-        samples: 4,
-        ..RenderOptions::default()
-    };
-    let (w, h) = (64, 36);
-    let expected = Gpu::fresh(EsVersion::Es3).render(&scene, w, h, &opts);
-    let ctx = HeadlessContext::new(EsVersion::Es3).unwrap();
-    let gl = ctx.load_gl().unwrap();
-    let mut renderer = Renderer::new(ctx.load_gl().unwrap(), EsVersion::Es3).unwrap();
-    let version = gl.version();
-    if (version.major, version.minor) < (3, 1) {
-        // Not a skip on SwiftShader and ANGLE here: ES 3.0 has no such state. Mesa has it.
-        if !common::other_implementation_than_mesa("an ES 3.1 sample mask") {
-            common::skip("this context is ES 3.0: no sample mask to check");
-        }
-        return;
-    }
-    let sample_mask_i = manylight::gl::gles_lib::library()
-        .unwrap()
-        .proc_address("glSampleMaski");
-    assert!(!sample_mask_i.is_null(), "ES 3.1 has glSampleMaski");
-    // SAFETY: glSampleMaski's type in the ES 3.1 specification.
-    let sample_mask_i: extern "system" fn(u32, u32) = unsafe { std::mem::transmute(sample_mask_i) };
-    for handling in [GlStateHandling::SaveAndRestore, GlStateHandling::Reset] {
-        renderer.set_gl_state_handling(handling);
-        unsafe { gl.enable(glow::SAMPLE_MASK) };
-        sample_mask_i(0, 0);
-        let (img, _) = renderer.render_offscreen(&scene, w, h, &opts).unwrap();
-        let d = manylight::metrics::diff(&expected, &img);
-        assert_eq!(
-            d.max_abs, 0,
-            "{handling:?}: the game's sample mask changed the frame"
-        );
-        // Given back, or left at GL's initial value.
-        let on = unsafe { gl.is_enabled(glow::SAMPLE_MASK) };
-        assert_eq!(
-            on,
-            handling == GlStateHandling::SaveAndRestore,
-            "{handling:?}"
-        );
-    }
-    sample_mask_i(0, !0);
-    unsafe { gl.disable(glow::SAMPLE_MASK) };
-}
-
-/// The game's sample shading (ES 3.2 state) does not shade each sample of the renderer's MSAA
-/// target on its own (at four times the cost, and at the samples' positions): with every sample
-/// shaded, the picture still equals a clean renderer's, and the game's setting is on again
-/// after the call (off, where the call resets the state).
-#[test]
-fn the_games_sample_shading_does_not_shade_the_renderers_samples() {
-    let scene = scene::builtin::build(scene::builtin::DEFAULT, Some((16, 3))).unwrap();
-    let opts = RenderOptions {
-        samples: 4,
-        ..RenderOptions::default()
-    };
-    let (w, h) = (64, 36);
-    let expected = Gpu::fresh(EsVersion::Es3).render(&scene, w, h, &opts);
-    let ctx = HeadlessContext::new(EsVersion::Es3).unwrap();
-    let gl = ctx.load_gl().unwrap();
-    let mut renderer = Renderer::new(ctx.load_gl().unwrap(), EsVersion::Es3).unwrap();
-    let version = gl.version();
-    let has = (version.major, version.minor) >= (3, 2)
-        || renderer.caps().has_extension("GL_OES_sample_shading");
-    if !has {
-        // Not a skip on SwiftShader and ANGLE here: ES 3.0 has no such state. Mesa has it.
-        if !common::other_implementation_than_mesa("ES 3.2 sample shading") {
-            common::skip("this context has no sample shading to check");
-        }
-        return;
-    }
+/// An entry point of the GLES library the context came from, which the ES version (or an
+/// extension) in question has: the first of `names` it gives.
+fn entry_point(names: &[&str]) -> *const std::ffi::c_void {
     let library = manylight::gl::gles_lib::library().unwrap();
-    let min_sample_shading = ["glMinSampleShading", "glMinSampleShadingOES"]
-        .map(|name| library.proc_address(name))
+    let found = names.iter().map(|name| library.proc_address(name));
+    found
         .into_iter()
         .find(|f| !f.is_null())
-        .expect("ES 3.2 has glMinSampleShading");
-    // SAFETY: glMinSampleShading's type in the ES 3.2 specification.
-    let min_sample_shading: extern "system" fn(f32) =
-        unsafe { std::mem::transmute(min_sample_shading) };
-    min_sample_shading(1.0);
+        .unwrap_or_else(|| panic!("no {names:?}"))
+}
+
+/// The game's `capability`, switched on after `set(true)` made it change samples (`set(false)`
+/// undoes that), changes no 4× MSAA picture of the renderer's, whether the call saves the
+/// game's state or resets it; it is on again after the call (off, where the call resets the
+/// state). Where the context lacks it (`has`), ES 3.0's SwiftShader and ANGLE, nothing is
+/// checked; Mesa's ES 3.2 context has it.
+fn an_msaa_frame_ignores_the_games(
+    capability: u32,
+    what: &str,
+    has: impl FnOnce(&glow::Context, &Renderer) -> bool,
+    set: impl Fn(bool),
+) {
+    let scene = scene::builtin::build(scene::builtin::DEFAULT, Some((16, 3))).unwrap();
+    let opts = RenderOptions {
+        samples: 4,
+        ..RenderOptions::default()
+    };
+    let (w, h) = (64, 36);
+    let expected = Gpu::fresh(EsVersion::Es3).render(&scene, w, h, &opts);
+    let ctx = HeadlessContext::new(EsVersion::Es3).unwrap();
+    let gl = ctx.load_gl().unwrap();
+    let mut renderer = Renderer::new(ctx.load_gl().unwrap(), EsVersion::Es3).unwrap();
+    if !has(&gl, &renderer) {
+        if !common::other_implementation_than_mesa(what) {
+            common::skip(&format!("this context has no {what} to check"));
+        }
+        return;
+    }
+    set(true);
     for handling in [GlStateHandling::SaveAndRestore, GlStateHandling::Reset] {
         renderer.set_gl_state_handling(handling);
-        unsafe { gl.enable(glow::SAMPLE_SHADING) };
+        unsafe { gl.enable(capability) };
         let (img, _) = renderer.render_offscreen(&scene, w, h, &opts).unwrap();
         let d = manylight::metrics::diff(&expected, &img);
         assert_eq!(
             d.max_abs, 0,
-            "{handling:?}: the game's sample shading changed the frame"
+            "{handling:?}: the game's {what} changed the frame"
         );
         // Given back, or left at GL's initial value.
-        let on = unsafe { gl.is_enabled(glow::SAMPLE_SHADING) };
+        let on = unsafe { gl.is_enabled(capability) };
         assert_eq!(
             on,
             handling == GlStateHandling::SaveAndRestore,
             "{handling:?}"
         );
     }
-    min_sample_shading(0.0);
-    unsafe { gl.disable(glow::SAMPLE_SHADING) };
+    set(false);
+    unsafe { gl.disable(capability) };
+}
+
+/// The game's sample mask (ES 3.1 state), keeping no sample, does not drop samples of the
+/// renderer's MSAA target.
+#[test]
+fn the_games_sample_mask_does_not_drop_the_renderers_samples() {
+    let has = |gl: &glow::Context, _: &Renderer| (gl.version().major, gl.version().minor) >= (3, 1);
+    an_msaa_frame_ignores_the_games(glow::SAMPLE_MASK, "ES 3.1 sample mask", has, |on| {
+        // SAFETY: glSampleMaski's type in the ES 3.1 specification.
+        let sample_mask_i: extern "system" fn(u32, u32) =
+            unsafe { std::mem::transmute(entry_point(&["glSampleMaski"])) };
+        sample_mask_i(0, if on { 0 } else { !0 });
+    });
+}
+
+/// The game's sample shading (ES 3.2 state), every sample shaded, does not shade each sample of
+/// the renderer's MSAA target on its own (at four times the cost, and at the samples'
+/// positions).
+#[test]
+fn the_games_sample_shading_does_not_shade_the_renderers_samples() {
+    let has = |gl: &glow::Context, r: &Renderer| {
+        (gl.version().major, gl.version().minor) >= (3, 2)
+            || r.caps().has_extension("GL_OES_sample_shading")
+    };
+    an_msaa_frame_ignores_the_games(glow::SAMPLE_SHADING, "ES 3.2 sample shading", has, |on| {
+        let names = ["glMinSampleShading", "glMinSampleShadingOES"];
+        // SAFETY: glMinSampleShading's type in the ES 3.2 specification.
+        let min_sample_shading: extern "system" fn(f32) =
+            unsafe { std::mem::transmute(entry_point(&names)) };
+        min_sample_shading(if on { 1.0 } else { 0.0 });
+    });
 }
 
 /// A material's depth bias sets the polygon offset during the call only: the game's offset

@@ -16,7 +16,7 @@ use std::sync::atomic::{AtomicPtr, Ordering};
 use common::game_target::game_framebuffer;
 use manylight::glow;
 use manylight::scene;
-use manylight::{EsVersion, GlStateHandling, HeadlessContext, RenderOptions, Renderer};
+use manylight::{EsVersion, GlStateHandling, HeadlessContext, RenderOptions, Renderer, Scene};
 
 thread_local! {
     /// Calls on this thread by entry point, and `glGetIntegerv` by parameter too.
@@ -178,6 +178,21 @@ fn attachment(counts: &BTreeMap<String, f64>, pname: u32) -> f64 {
     )
 }
 
+/// A game's context at `es` with its `size` framebuffer bound, a renderer whose calls are
+/// counted, and the courtyard with 64 lights; `None` (said) where there is no such context.
+fn game_loop(es: EsVersion, (w, h): (u32, u32)) -> Option<(HeadlessContext, Renderer, Scene)> {
+    let Some(ctx) = HeadlessContext::new(es).ok() else {
+        common::skip("no headless context");
+        return None;
+    };
+    let game = ctx.load_gl().unwrap();
+    let renderer = Renderer::new(counting_gl(), es).unwrap();
+    let depth24 = es == EsVersion::Es3 || renderer.caps().depth24;
+    unsafe { game_framebuffer(&game, depth24, (w as i32, h as i32)) };
+    let scene = scene::builtin::build("courtyard", Some((64, 7))).unwrap();
+    Some((ctx, renderer, scene))
+}
+
 /// A frame of moving lights into a game's framebuffer (the README's game loop: no wait for
 /// the GPU) asks the driver each piece of state once: the framebuffer bound (by the state
 /// save), a constant never, what is attached once an attachment, no framebuffer status while
@@ -194,15 +209,9 @@ fn a_frame_into_a_games_framebuffer_asks_the_driver_each_thing_once() {
     let (w, h) = (64, 36);
     for es in [EsVersion::Es3, EsVersion::Es2] {
         // Mesa hands out an ES 3.2 context for 2.0 too, unless its version is capped.
-        let Some(ctx) = HeadlessContext::new(es).ok() else {
-            common::skip("no headless context");
+        let Some((_ctx, mut renderer, mut s)) = game_loop(es, (w, h)) else {
             continue;
         };
-        let game = ctx.load_gl().unwrap();
-        let mut renderer = Renderer::new(counting_gl(), es).unwrap();
-        let depth24 = es == EsVersion::Es3 || renderer.caps().depth24;
-        unsafe { game_framebuffer(&game, depth24, (w as i32, h as i32)) };
-        let mut s = scene::builtin::build("courtyard", Some((64, 7))).unwrap();
         let methods: &[(&str, u32)] = match es {
             EsVersion::Es3 => &[
                 ("forward", 1),
@@ -265,15 +274,9 @@ fn a_frame_into_a_games_framebuffer_asks_the_driver_each_thing_once() {
 fn a_frame_with_the_state_reset_reads_only_the_games_framebuffer() {
     let (w, h) = (64, 36);
     for es in [EsVersion::Es3, EsVersion::Es2] {
-        let Some(ctx) = HeadlessContext::new(es).ok() else {
-            common::skip("no headless context");
+        let Some((_ctx, mut renderer, mut s)) = game_loop(es, (w, h)) else {
             continue;
         };
-        let game = ctx.load_gl().unwrap();
-        let mut renderer = Renderer::new(counting_gl(), es).unwrap();
-        let depth24 = es == EsVersion::Es3 || renderer.caps().depth24;
-        unsafe { game_framebuffer(&game, depth24, (w as i32, h as i32)) };
-        let mut s = scene::builtin::build("courtyard", Some((64, 7))).unwrap();
         let methods: &[&str] = match es {
             EsVersion::Es3 => &["forward", "clustered", "deferred"],
             EsVersion::Es2 => &["forward", "clustered"],

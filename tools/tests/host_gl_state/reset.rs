@@ -5,7 +5,7 @@
 //! never touches stays the game's: its texture on a unit past the eighth, and its vertex array
 //! 0 where the renderer draws with one of its own.
 
-use super::{set_game_state, Has, GAME_UNITS};
+use super::{set_game_state, Has, GAME_CAPABILITIES, GAME_UNITS};
 use crate::common::game_target::read_back;
 use manylight::glow::{self, HasContext};
 use manylight::{GlStateHandling, HeadlessContext, RenderOptions, Renderer, Scene};
@@ -107,16 +107,7 @@ unsafe fn assert_reset(gl: &glow::Context, has: Has, game: &GameBindings, call: 
         (glow::PACK_ALIGNMENT, 4),
         (glow::UNPACK_ALIGNMENT, 4),
     ];
-    let mut disabled = vec![
-        glow::BLEND,
-        glow::CULL_FACE,
-        glow::DEPTH_TEST,
-        glow::SCISSOR_TEST,
-        glow::STENCIL_TEST,
-        glow::POLYGON_OFFSET_FILL,
-        glow::SAMPLE_ALPHA_TO_COVERAGE,
-        glow::SAMPLE_COVERAGE,
-    ];
+    let mut disabled = GAME_CAPABILITIES.to_vec();
     if has.es3 {
         ints.extend([
             (glow::READ_FRAMEBUFFER_BINDING, game.framebuffer),
