@@ -281,11 +281,16 @@ impl Device {
         self.state_handling.get()
     }
 
+    /// Calls save the application's state and give it back (the default handling).
+    fn saves_state(&self) -> bool {
+        self.state_handling.get() == super::GlStateHandling::SaveAndRestore
+    }
+
     /// A frame is drawn into the application's framebuffer: where the call did not save the
     /// state, this points its draw buffers at its attachment 0 alone (saving does so on entry,
     /// and gives the list back).
     pub(crate) fn draw_into_host_framebuffer(&self) {
-        if self.state_handling.get() == super::GlStateHandling::Reset {
+        if !self.saves_state() {
             let target = self.host_framebuffer();
             super::host_reset::draw_into_attachment_0(&self.gl, &self.host, target);
         }
@@ -463,15 +468,13 @@ impl Device {
 
     /// Draws from now on `bias` depth-buffer steps toward the camera (`Material::depth_bias`).
     pub(crate) fn set_depth_bias(&self, bias: f32) {
-        let save = self.state_handling.get() == super::GlStateHandling::SaveAndRestore;
-        self.depth_bias.set(&self.gl, bias, save);
+        self.depth_bias.set(&self.gl, bias, self.saves_state());
     }
 
     /// A frame with a biased material starts: what the depth bias gives back is read now,
     /// before the frame's draws are queued.
     pub(crate) fn prepare_depth_bias(&self) {
-        let save = self.state_handling.get() == super::GlStateHandling::SaveAndRestore;
-        self.depth_bias.prepare(&self.gl, save);
+        self.depth_bias.prepare(&self.gl, self.saves_state());
     }
 
     /// Counts a state call ([`StateCalls`]).

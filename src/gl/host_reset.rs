@@ -10,7 +10,7 @@ use glow::HasContext;
 
 use super::absent_attributes::ABSENT;
 use super::host_attributes::LOCATIONS;
-use super::host_state::{HostFeatures, OFF_INSIDE, PACK_ROWS, TOGGLED, UNPACK_ROWS};
+use super::host_state::{HostFeatures, OFF_INSIDE, TOGGLED};
 use super::vertex_arrays::VertexArrays;
 
 /// A call entered with [`GlStateHandling::Reset`](super::GlStateHandling::Reset): the
@@ -66,7 +66,7 @@ impl ResetEntry {
                 Some((vao, arrays)) => arrays.bind(gl, Some(vao)),
                 None => no_divisors(f),
             }
-            for p in rows(f) {
+            for p in f.rows() {
                 gl.pixel_store_i32(p, 0);
             }
             for c in OFF_INSIDE {
@@ -161,10 +161,4 @@ fn no_divisors(f: &HostFeatures) {
             unsafe { set(location, 0) };
         }
     }
-}
-
-/// The pixel-store row lengths and skips the context has.
-fn rows(f: &HostFeatures) -> impl Iterator<Item = u32> {
-    let unpack = f.unpack_rows.then_some(UNPACK_ROWS).into_iter().flatten();
-    unpack.chain(f.pack_rows.then_some(PACK_ROWS).into_iter().flatten())
 }

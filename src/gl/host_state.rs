@@ -118,6 +118,16 @@ impl HostFeatures {
             },
         }
     }
+
+    /// The pixel-store row lengths and skips the context has ([`UNPACK_ROWS`], [`PACK_ROWS`]).
+    pub(super) fn rows(&self) -> impl Iterator<Item = u32> {
+        let unpack = self
+            .unpack_rows
+            .then_some(UNPACK_ROWS)
+            .into_iter()
+            .flatten();
+        unpack.chain(self.pack_rows.then_some(PACK_ROWS).into_iter().flatten())
+    }
 }
 
 /// The application's state on entry; [`HostState::leave`] sets it back.
@@ -210,9 +220,9 @@ impl HostState {
     /// `GL_OES_vertex_array_object`), the bound framebuffer drawing into its
     /// attachment 0 alone (`host_draw_buffers.rs`), no pixel buffer, no sampler objects on
     /// its units, the capabilities of `OFF_INSIDE` off, additive blend equations, no sample
-    /// mask nor sample shading, counter-clockwise front faces, the full depth range, a clear depth of 1, pixel
-    /// rows that start where the data does and texture unit 0 active (a game's active unit past
-    /// the saved ones keeps its texture), no primitive restart, no attribute divisors; on ES
+    /// mask nor sample shading, counter-clockwise front faces, the full depth range, a clear
+    /// depth of 1, pixel rows that start where the data does and texture unit 0 active (a
+    /// game's active unit past the saved ones keeps its texture), no primitive restart, no attribute divisors; on ES
     /// with `GL_EXT_sRGB_write_control` sRGB encoding on; on desktop GL, filled polygons and
     /// no sRGB encoding.
     pub(crate) fn enter(

@@ -74,8 +74,7 @@ pub struct Material {
     /// −b)`), so that a decal lying on another surface wins the depth test there with every
     /// method. 0, the default, draws it where it lies; 2 lifts a decal clear of its surface,
     /// seen head-on or at a grazing angle (deferred's depth may be a step off,
-    /// docs/architecture.md).
-    /// Within ±1 024 (`MAX_DEPTH_BIAS`).
+    /// docs/architecture.md). Within ±1 024 (`MAX_DEPTH_BIAS`).
     pub depth_bias: f32,
 }
 

@@ -225,6 +225,10 @@ pub(super) fn every_call_sets_what_it_needs_and_leaves_gl_initial_values(
     let own_vertex_array = has.es3 || caps.has_extension("GL_OES_vertex_array_object");
     let (w, h) = (expected[0].width(), expected[0].height());
     let size = (w as i32, h as i32);
+    // Where the game's framebuffer has 16-bit depth (ES 2.0 without `GL_OES_depth24`), unlike
+    // an offscreen frame's, the picture `render` must draw is a state-saving call's into the
+    // same kind of framebuffer: this renderer's.
+    let mut saving = (!has.depth24).then(|| Renderer::new(ctx.load_gl().unwrap(), es).unwrap());
     // Sets the game's state, runs `f`, and checks what it left.
     let mut call = |what: &str, drew_into_the_games: bool, f: &mut dyn FnMut(&mut Renderer)| {
         let game = unsafe {
@@ -252,13 +256,10 @@ pub(super) fn every_call_sets_what_it_needs_and_leaves_gl_initial_values(
             let d = manylight::metrics::diff(expected, &img);
             assert_eq!(d.max_abs, 0, "{what}: the game's state changed the picture");
         });
-        // Into the game's own framebuffer, as a game draws. Where it has 16-bit depth (ES 2.0
-        // without `GL_OES_depth24`), unlike an offscreen frame's, the picture to draw is the
-        // state-saving call's into the same kind of framebuffer.
-        let expected = match has.depth24 {
-            true => expected.clone(),
-            false => {
-                let mut saving = Renderer::new(ctx.load_gl().unwrap(), es).unwrap();
+        // Into the game's own framebuffer, as a game draws.
+        let expected = match saving.as_mut() {
+            None => expected.clone(),
+            Some(saving) => {
                 saving.set_method_named(m).unwrap();
                 unsafe { set_game_state(gl, has, size) };
                 saving.render(scene, w, h, opts).unwrap();
