@@ -8,6 +8,7 @@
 //! implementation; `manylight matrix` compares several by running one child process each.
 #![allow(unsafe_code)]
 
+use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::{Mutex, OnceLock};
 
@@ -28,6 +29,10 @@ pub struct GlesLibrary {
     /// `libGLESv2.so` it satisfies) and searched for GL entry points EGL does not hand out.
     gles: Option<libloading::Library>,
     folder: Option<PathBuf>,
+    /// Every entry point looked up so far, null ones included. EGL's addresses do not depend on
+    /// the display or context, and SwiftShader's `eglGetProcAddress` tries to load a library
+    /// on each call: glow's ~700 names took about 70 ms a context there.
+    found: Mutex<HashMap<Box<str>, usize>>,
 }
 
 /// The folder chosen by [`select`] before the first load (it wins over the variable).
@@ -174,6 +179,7 @@ impl GlesLibrary {
                 egl,
                 gles: None,
                 folder: None,
+                found: Mutex::default(),
             });
         };
         let (gles_path, egl_path) = library_files(&folder, origin)?;
@@ -187,6 +193,7 @@ impl GlesLibrary {
             egl,
             gles: Some(gles),
             folder: Some(folder),
+            found: Mutex::default(),
         })
     }
 
@@ -200,8 +207,19 @@ impl GlesLibrary {
     }
 
     /// A GL or EGL entry point: `eglGetProcAddress`, else (EGL 1.4 need not hand out core
-    /// functions) the folder's `libGLESv2` itself. Null when neither has it.
+    /// functions) the folder's `libGLESv2` itself. Null when neither has it. Each name is
+    /// looked up once per process.
     pub fn proc_address(&self, name: &str) -> *const std::ffi::c_void {
+        let mut found = self.found.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some(&address) = found.get(name) {
+            return address as *const std::ffi::c_void;
+        }
+        let address = self.look_up(name);
+        found.insert(name.into(), address as usize);
+        address
+    }
+
+    fn look_up(&self, name: &str) -> *const std::ffi::c_void {
         if let Some(f) = self.egl.get_proc_address(name) {
             return f as *const std::ffi::c_void;
         }
