@@ -19,13 +19,13 @@ const RECORDS: [(&str, EsVersion); 3] = [
     ("deferred", EsVersion::Es3),
 ];
 
-/// The pillars under 40 lights, one a spot, with one material see-through: deferred draws
-/// its objects with forward.
+/// The pillars under 40 lights, one a spot, with the floor see-through: deferred draws it
+/// with forward. (Not the pillars: their layers of blended faces made each frame cost
+/// SwiftShader about five times as much.)
 fn still_scene() -> Scene {
     let mut s = super::common::pillars_lit(40);
-    let last = s.materials.len() - 1;
-    assert!(last > 0, "the pillars have one material");
-    s.materials[last].alpha = 0.6;
+    assert_eq!(s.materials[0].name, "floor");
+    s.materials[0].alpha = 0.6;
     s
 }
 
