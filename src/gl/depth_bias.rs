@@ -3,24 +3,46 @@
 //! The offset's values are the application's state too: read the first time a call changes
 //! them, and given back as the call ends (with `GlStateHandling::Reset`, not read, and left at
 //! GL's initial 0), with `GL_POLYGON_OFFSET_FILL` off again (the state save then switches the
-//! game's back on where it was).
+//! game's back on where it was). Where `GL_EXT_polygon_offset_clamp` is listed, its clamp is
+//! the application's state too, and 0 (no clamp) during the call: a game's negative clamp
+//! would cut the bias toward the camera to nothing.
 #![allow(unsafe_code)]
 
 use std::cell::Cell;
 
 use glow::HasContext;
 
+use super::ext_fns::PolygonOffsetClamp;
+
 /// The depth bias of the call under way.
-#[derive(Default)]
 pub(crate) struct DepthBias {
     /// The bias set last: 0 (the offset off, as every call starts: `host_state::OFF_INSIDE`).
     current: Cell<f32>,
-    /// This call changed the offset, and the application's factor and units where they were
-    /// read to be given back.
-    changed: Cell<Option<Option<[f32; 2]>>>,
+    /// This call changed the offset, and the application's factor, units and clamp where they
+    /// were read to be given back.
+    changed: Cell<Option<Option<[f32; 3]>>>,
+    /// `glPolygonOffsetClampEXT`, where the context has it.
+    clamp: Option<PolygonOffsetClamp>,
 }
 
 impl DepthBias {
+    pub(crate) fn new(clamp: Option<PolygonOffsetClamp>) -> DepthBias {
+        DepthBias {
+            current: Cell::new(0.0),
+            changed: Cell::new(None),
+            clamp,
+        }
+    }
+
+    /// Sets the offset's values: its clamp too, where the context has one.
+    fn offset(&self, gl: &glow::Context, [factor, units, clamp]: [f32; 3]) {
+        match self.clamp {
+            // SAFETY: the extension's entry point, loaded for this context's implementation.
+            Some(set) => unsafe { set(factor, units, clamp) },
+            None => unsafe { gl.polygon_offset(factor, units) },
+        }
+    }
+
     /// A frame that draws a biased surface is about to start: the application's values are
     /// read now (`save`), before its draws are queued; a read after them would wait for a
     /// threaded driver to run them.
@@ -31,6 +53,10 @@ impl DepthBias {
                 [
                     read(glow::POLYGON_OFFSET_FACTOR),
                     read(glow::POLYGON_OFFSET_UNITS),
+                    match self.clamp {
+                        Some(_) => read(glow::POLYGON_OFFSET_CLAMP),
+                        None => 0.0,
+                    },
                 ]
             });
             self.changed.set(Some(saved));
@@ -46,13 +72,11 @@ impl DepthBias {
             return;
         }
         self.prepare(gl, save);
-        unsafe {
-            if bias == 0.0 {
-                gl.disable(glow::POLYGON_OFFSET_FILL);
-            } else {
-                gl.enable(glow::POLYGON_OFFSET_FILL);
-                gl.polygon_offset(-bias, -bias);
-            }
+        if bias == 0.0 {
+            unsafe { gl.disable(glow::POLYGON_OFFSET_FILL) };
+        } else {
+            unsafe { gl.enable(glow::POLYGON_OFFSET_FILL) };
+            self.offset(gl, [-bias, -bias, 0.0]);
         }
         self.current.set(bias);
     }
@@ -61,11 +85,8 @@ impl DepthBias {
     /// initial ones, where they were not read).
     pub(super) fn leave(&self, gl: &glow::Context) {
         if let Some(saved) = self.changed.take() {
-            let [factor, units] = saved.unwrap_or([0.0, 0.0]);
-            unsafe {
-                gl.disable(glow::POLYGON_OFFSET_FILL);
-                gl.polygon_offset(factor, units);
-            }
+            unsafe { gl.disable(glow::POLYGON_OFFSET_FILL) };
+            self.offset(gl, saved.unwrap_or([0.0; 3]));
         }
         self.current.set(0.0);
     }

@@ -199,6 +199,8 @@ impl Device {
         let units = unsafe { gl.get_parameter_i32(glow::MAX_COMBINED_TEXTURE_IMAGE_UNITS) };
         let host =
             super::host_state::HostFeatures::of(&gl, &caps, own_vertex_array.is_some(), units);
+        let clamp = super::ext_fns::polygon_offset_clamp_ext(|e| caps.has_extension(e));
+        let depth_bias = super::depth_bias::DepthBias::new(clamp);
         Ok(Device {
             gl,
             caps,
@@ -213,7 +215,7 @@ impl Device {
             host_framebuffer: std::cell::Cell::new(None),
             target_queries_refused: std::cell::Cell::new(false),
             call: CallState::default(),
-            depth_bias: Default::default(),
+            depth_bias,
             warned_pending_error: std::cell::Cell::new(false),
             lost: std::cell::Cell::new(false),
             context: ContextWatch::of_current(),

@@ -87,6 +87,18 @@ pub fn vertex_attrib_divisor_ext(has: impl Fn(&str) -> bool) -> Option<VertexAtt
         .map(|f| unsafe { std::mem::transmute::<*const std::ffi::c_void, VertexAttribDivisor>(f) })
 }
 
+/// `glPolygonOffsetClampEXT(factor, units, clamp)` (`GL_EXT_polygon_offset_clamp`).
+pub type PolygonOffsetClamp = unsafe extern "system" fn(factor: f32, units: f32, clamp: f32);
+
+/// `glPolygonOffsetClampEXT` where `has` lists its extension and it loads.
+pub fn polygon_offset_clamp_ext(has: impl Fn(&str) -> bool) -> Option<PolygonOffsetClamp> {
+    let f =
+        entry_point("glPolygonOffsetClampEXT").filter(|_| has("GL_EXT_polygon_offset_clamp"))?;
+    // SAFETY: the extension specifies this signature for the entry point of that name, and
+    // the library stays loaded for the whole process.
+    Some(unsafe { std::mem::transmute::<*const std::ffi::c_void, PolygonOffsetClamp>(f) })
+}
+
 /// A core ES 2.0 entry point: from the implementation manylight loaded where it did (a
 /// `HeadlessContext`'s), else from the system's `libGLESv2`, the one a window toolkit's context
 /// (glutin's, Android's) draws through. Loading manylight's own EGL here instead would tie the

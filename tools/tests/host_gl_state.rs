@@ -752,9 +752,10 @@ fn the_games_sample_shading_does_not_shade_the_renderers_samples() {
 }
 
 /// A material's depth bias sets the polygon offset during the call only: the game's offset
-/// (switched on, with its own factor and units) is on again with its values after a call that
-/// drew a biased surface; with the state reset, it is off with GL's initial values. A call
-/// with no biased surface leaves the values alone even then.
+/// (switched on, with its own factor, units and, where `GL_EXT_polygon_offset_clamp` is
+/// listed, clamp) is on again with its values after a call that drew a biased surface; with the
+/// state reset, it is off with GL's initial values. A call with no biased surface leaves the
+/// values alone even then.
 #[test]
 fn a_biased_material_gives_the_games_polygon_offset_back() {
     let mut biased = scene::builtin::build("plane", Some((8, 1))).unwrap();
@@ -765,10 +766,19 @@ fn a_biased_material_gives_the_games_polygon_offset_back() {
     let ctx = HeadlessContext::new(EsVersion::Es3).unwrap();
     let gl = ctx.load_gl().unwrap();
     let mut renderer = Renderer::new(ctx.load_gl().unwrap(), EsVersion::Es3).unwrap();
+    let clamps = renderer.caps().has_extension("GL_EXT_polygon_offset_clamp");
+    if !clamps && !common::other_implementation_than_mesa("GL_EXT_polygon_offset_clamp") {
+        common::skip("this Mesa lists no GL_EXT_polygon_offset_clamp to check");
+    }
+    // SAFETY: the extension's type for glPolygonOffsetClampEXT.
+    let set_clamp: Option<extern "system" fn(f32, f32, f32)> =
+        clamps.then(|| unsafe { std::mem::transmute(entry_point(&["glPolygonOffsetClampEXT"])) });
     let offset = || unsafe {
         let on = gl.is_enabled(glow::POLYGON_OFFSET_FILL);
         let factor = gl.get_parameter_f32(glow::POLYGON_OFFSET_FACTOR);
-        (on, factor, gl.get_parameter_f32(glow::POLYGON_OFFSET_UNITS))
+        let units = gl.get_parameter_f32(glow::POLYGON_OFFSET_UNITS);
+        let clamp = clamps.then(|| gl.get_parameter_f32(glow::POLYGON_OFFSET_CLAMP));
+        (on, factor, units, clamp)
     };
     let opts = RenderOptions::default();
     for handling in [GlStateHandling::SaveAndRestore, GlStateHandling::Reset] {
@@ -784,11 +794,15 @@ fn a_biased_material_gives_the_games_polygon_offset_back() {
                     }
                     gl.polygon_offset(3.0, 5.0);
                 }
+                if let Some(set_clamp) = set_clamp {
+                    set_clamp(3.0, 5.0, -0.25);
+                }
                 renderer.render_offscreen(scene, 32, 18, &opts).unwrap();
+                let clamp = |c| clamps.then_some(c);
                 let expected = match (handling, biased) {
-                    (GlStateHandling::SaveAndRestore, _) => (on, 3.0, 5.0),
-                    (GlStateHandling::Reset, false) => (false, 3.0, 5.0),
-                    (GlStateHandling::Reset, true) => (false, 0.0, 0.0),
+                    (GlStateHandling::SaveAndRestore, _) => (on, 3.0, 5.0, clamp(-0.25)),
+                    (GlStateHandling::Reset, false) => (false, 3.0, 5.0, clamp(-0.25)),
+                    (GlStateHandling::Reset, true) => (false, 0.0, 0.0, clamp(0.0)),
                 };
                 assert_eq!(
                     offset(),
