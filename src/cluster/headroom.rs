@@ -29,6 +29,23 @@ pub(crate) fn room_for<T>(buffer: &mut Vec<T>, len: usize) {
     }
 }
 
+/// Gives back what a burst of lights grew `buffer` to, keeping [`clear_with_room_for`]'s room
+/// for what it holds now, so the next frame of the same size allocates nothing. A buffer
+/// within twice that keeps its store (no reallocation for a small difference).
+pub(crate) fn fit<T>(buffer: &mut Vec<T>) {
+    let keep = buffer.len() + buffer.len() / 4;
+    if buffer.capacity() > 2 * keep.max(WHOLE_UP_TO) {
+        buffer.shrink_to(keep);
+    }
+}
+
+/// [`fit`] for a buffer whose contents no later frame reads (a frame's scratch): emptied
+/// first, so a burst's contents left in a path the frames no longer take go too.
+pub(crate) fn fit_empty<T>(buffer: &mut Vec<T>) {
+    buffer.clear();
+    fit(buffer);
+}
+
 /// Makes `buffer` `len` default values (zeros), with [`room_for`]'s room to grow: for
 /// per-frame buffers filled afresh, whose length wanders with the view and the lights.
 pub(crate) fn zeroed_with_room<T: Clone + Default>(buffer: &mut Vec<T>, len: usize) {
@@ -53,6 +70,32 @@ mod tests {
         let mut band: Vec<u32> = (0..10).collect();
         clear_with_room_for(&mut band, 1000);
         assert!(band.capacity() >= 1250, "{}", band.capacity());
+    }
+
+    #[test]
+    fn a_fitted_buffer_gives_back_a_bursts_room_and_keeps_its_contents_and_headroom() {
+        let mut burst: Vec<u32> = Vec::with_capacity(100_000);
+        burst.extend(0..20_000);
+        fit(&mut burst);
+        assert_eq!(burst, (0..20_000).collect::<Vec<_>>());
+        assert!(
+            (25_000..50_000).contains(&burst.capacity()),
+            "{}",
+            burst.capacity()
+        );
+        // Then a frame of the same size allocates nothing.
+        let capacity = burst.capacity();
+        clear_with_room_for(&mut burst, 0);
+        burst.extend(0..20_000);
+        assert_eq!(burst.capacity(), capacity);
+        // Small buffers, and room within twice the contents', stay as they are.
+        let mut small: Vec<u32> = Vec::with_capacity(8000);
+        fit(&mut small);
+        assert_eq!(small.capacity(), 8000);
+        // Scratch: emptied and given back.
+        let mut scratch: Vec<u32> = (0..50_000).collect();
+        fit_empty(&mut scratch);
+        assert!(scratch.is_empty() && scratch.capacity() <= 2 * WHOLE_UP_TO);
     }
 
     #[test]

@@ -288,6 +288,18 @@ impl ShadingMethod for Auto {
 
     /// A frame without lights: forward and deferred rest as on a frame another method drew;
     /// clustered as it does alone, freeing its textures and keeping its grid's calibration.
+    fn fit_buffers(&mut self) {
+        if let Some(f) = &mut self.forward {
+            f.fit_buffers();
+        }
+        if let Some(c) = &mut self.clustered {
+            c.fit_buffers();
+        }
+        if let Some(d) = &mut self.deferred {
+            d.fit_buffers();
+        }
+    }
+
     fn skip_frame(&mut self, dev: &Device) {
         let [forward_idle, _, deferred_idle] = &mut self.idle;
         rest(&mut self.forward, forward_idle, dev);

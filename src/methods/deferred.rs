@@ -677,6 +677,11 @@ impl ShadingMethod for Deferred {
             + self.transparent.gpu_bytes()
     }
 
+    fn fit_buffers(&mut self) {
+        self.lights.fit_buffers();
+        self.transparent.fit_buffers();
+    }
+
     fn skip_frame(&mut self, dev: &Device) {
         if super::idle_for_long(&mut self.idle_frames) {
             self.destroy(dev);

@@ -274,6 +274,14 @@ impl ShadingMethod for Forward {
         self.lights.as_ref().map_or(0, |(t, _)| t.gpu_bytes())
     }
 
+    fn fit_buffers(&mut self) {
+        use crate::cluster::headroom::fit;
+        fit(&mut self.packed.bytes);
+        fit(&mut self.capped);
+        fit(&mut self.cap_order);
+        fit(&mut self.seen);
+    }
+
     fn destroy(&mut self, dev: &Device) {
         if let Some((mut t, _)) = self.lights.take() {
             t.destroy(dev);

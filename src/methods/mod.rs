@@ -202,6 +202,10 @@ pub trait ShadingMethod {
     /// resources for a number of frames counts it, and frees its large ones after
     /// [`IDLE_FRAMES_KEPT`] in a row.
     fn skip_frame(&mut self, _dev: &Device) {}
+    /// Frames have needed a quarter of the lights the CPU buffers were grown for at most, long
+    /// enough: they give back what a burst of lights grew them to, keeping room for the last
+    /// frame's needs.
+    fn fit_buffers(&mut self) {}
     /// Frees the method's GPU resources.
     fn destroy(&mut self, dev: &Device);
 }

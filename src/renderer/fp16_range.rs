@@ -98,6 +98,11 @@ pub(super) struct PlacedLights {
 }
 
 impl PlacedLights {
+    /// Gives back what a burst of lights grew the kept lights to.
+    pub(super) fn fit_buffers(&mut self) {
+        crate::cluster::headroom::fit(&mut self.lights);
+    }
+
     /// Takes in this frame's gathered lights and what [`check`] returned for them. Returns
     /// whether the lights drawn may differ from the last frame's beyond the gathered ones'
     /// own changes.

@@ -84,6 +84,9 @@ impl Renderer {
             self.programs.begin_frame();
         }
         let drawn = self.render_counted(scene, size, options, origin, stats, applications);
+        if drawn.is_ok() && !self.warming_up && self.light_high_water.note(self.lights.len()) {
+            self.fit_light_buffers();
+        }
         if drawn.is_err() {
             // What the failed frame uploaded may not be there: the next one packs and uploads
             // its light data anew, whatever its method kept (each keys it on the generation).

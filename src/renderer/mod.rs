@@ -17,6 +17,7 @@ mod frame_report;
 mod frame_setup;
 #[cfg(test)]
 mod hosted_tests;
+mod light_high_water;
 mod method;
 mod offscreen;
 mod programs;
@@ -111,6 +112,8 @@ pub struct Renderer {
     shared_surfaces: shared_surfaces::SharedSurfaces,
     /// The light count whose frame memory was last asked of the allocator.
     lights_probed: usize,
+    /// When the CPU buffers a burst of lights grew are given back.
+    light_high_water: light_high_water::LightHighWater,
     /// A far plane the `f32` projection cannot clip at was announced (once per renderer).
     warned_unclipped_far: bool,
     /// Whether a light brighter than the fp16 radiance form holds was said (without fragment
@@ -216,6 +219,7 @@ impl Renderer {
             warned_nothing_to_draw: false,
             shared_surfaces: Default::default(),
             lights_probed: 0,
+            light_high_water: Default::default(),
             warned_unclipped_far: false,
             warned_capped_radiance: false,
             warned_capped_ambient: false,

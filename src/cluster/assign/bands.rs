@@ -30,6 +30,19 @@ pub(super) struct Bands {
 }
 
 impl Bands {
+    /// Gives back what a burst of lights grew the bands' buffers to (each frame fills them
+    /// afresh).
+    pub(super) fn fit(&mut self) {
+        use crate::cluster::headroom::fit_empty;
+        fit_empty(&mut self.numbers);
+        for band in &mut self.bands {
+            fit_empty(&mut band.runs);
+            fit_empty(&mut band.lights);
+            fit_empty(&mut band.ids);
+            fit_empty(&mut band.cursors);
+        }
+    }
+
     /// The last split's bands.
     fn active(&self) -> &[Band] {
         &self.bands[..self.active]

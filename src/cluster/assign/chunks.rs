@@ -22,6 +22,21 @@ pub(super) struct Chunks {
 }
 
 impl Chunks {
+    /// Gives back what a burst of lights grew the chunks' buffers to (each frame fills them
+    /// afresh).
+    pub(super) fn fit(&mut self) {
+        use crate::cluster::headroom::fit_empty;
+        for chunk in &mut self.chunks {
+            fit_empty(&mut chunk.deltas);
+            fit_empty(&mut chunk.runs);
+            fit_empty(&mut chunk.ends);
+            fit_empty(&mut chunk.visible);
+            fit_empty(&mut chunk.offsets);
+            fit_empty(&mut chunk.cursor);
+            chunk.sorted.fit_empty();
+        }
+    }
+
     /// Frees the runs a refused assignment found (see [`Bands::release_runs`](super::bands)).
     pub(super) fn release_runs(&mut self) {
         for chunk in &mut self.chunks {

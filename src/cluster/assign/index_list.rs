@@ -23,6 +23,18 @@ pub struct IndexList {
 pub const NARROW_LIGHTS: usize = 1 << 16;
 
 impl IndexList {
+    /// Gives back what a burst of lights grew the list to ([`fit`](crate::cluster::headroom::fit)).
+    pub(crate) fn fit(&mut self) {
+        crate::cluster::headroom::fit(&mut self.narrow);
+        crate::cluster::headroom::fit(&mut self.wide);
+    }
+
+    /// [`IndexList::fit`] for a scratch list: emptied first.
+    pub(crate) fn fit_empty(&mut self) {
+        crate::cluster::headroom::fit_empty(&mut self.narrow);
+        crate::cluster::headroom::fit_empty(&mut self.wide);
+    }
+
     /// Entries in the list.
     pub fn len(&self) -> usize {
         if self.is_wide {

@@ -111,6 +111,16 @@ impl Assigner {
         Assigner::default()
     }
 
+    /// Gives back what a burst of lights grew the buffers to, keeping room for what the last
+    /// assignment needed (the renderer calls it once frames have needed a quarter at most for
+    /// `SHRINK_AFTER` frames in a row, as it does its GPU stores).
+    pub fn fit_buffers(&mut self) {
+        self.bands.fit();
+        self.chunks.fit();
+        self.out.fit();
+        self.overflow.fit();
+    }
+
     /// The last result.
     pub fn assignment(&self) -> &Assignment {
         &self.out

@@ -19,6 +19,15 @@ pub(super) struct Overflow {
     packed: Vec<[f32; 4]>,
 }
 
+impl Overflow {
+    /// Gives back what a burst of lights grew the policy's buffers to.
+    pub(super) fn fit(&mut self) {
+        self.kept.fit_empty();
+        crate::cluster::headroom::fit_empty(&mut self.lists);
+        crate::cluster::headroom::fit_empty(&mut self.packed);
+    }
+}
+
 /// Applies the overflow policy in place (see the module docs); true if it dropped any light.
 pub(super) fn apply_cap(
     out: &mut Assignment,

@@ -114,6 +114,33 @@ fn reused_buffers_match_fresh_ones() {
     }
 }
 
+/// Buffers given back between frames (`Assigner::fit_buffers`, as after a burst of lights)
+/// change no list: the last result stays, and the next assignment on any path (one thread,
+/// bands, chunks of lights on a grid of few cells) matches a fresh assigner's.
+#[test]
+fn fitted_buffers_match_fresh_ones() {
+    let mut rng = Pcg64Mcg::seed_from_u64(12);
+    let mut assigner = super::Assigner::new();
+    let cases = cases();
+    for (frame, case) in cases.iter().cycle().take(16).enumerate() {
+        let (w, h) = if frame % 4 < 2 { (320, 180) } else { (32, 18) };
+        let grid = ClusterGrid::new(w, h, case.projection, case.near, case.far, &case.config);
+        let n = [9000, 40, 0, 3000, 700][frame % 5];
+        let lights = random_lights(&mut rng, n, case.far.min(200.0) * 0.5);
+        let limits = AssignLimits {
+            cell_cap: if frame % 3 == 0 { 40 } else { u32::MAX },
+            parallel_threshold: if frame % 2 == 0 { 1 } else { usize::MAX },
+            ..Default::default()
+        };
+        let fresh = assign(&grid, &lights, case.far, &limits);
+        assigner.assign(&grid, &lights, case.far, &limits);
+        assigner.fit_buffers();
+        let what = format!("{} frame {frame}, {n} lights", case.name);
+        assert_same_lists(assigner.assignment(), &fresh, &what);
+        assert_eq!(fresh.stats, assigner.assignment().stats, "{what}");
+    }
+}
+
 /// Which assignments take the pool: many lights, or a previous assignment of the same
 /// assigner that listed many indices or took long (counted in CPU time, so a parallel one that
 /// became fast stays parallel; a thread more per `PARALLEL_SECONDS` of it); never with

@@ -184,6 +184,16 @@ pub struct Assignment {
 }
 
 impl Assignment {
+    /// Gives back what a burst of lights grew the lists to ([`fit`](crate::cluster::headroom::fit)).
+    pub(crate) fn fit(&mut self) {
+        use crate::cluster::headroom::fit;
+        fit(&mut self.visible);
+        fit(&mut self.offsets);
+        fit(&mut self.counts);
+        fit(&mut self.overfull);
+        self.indices.fit();
+    }
+
     /// Light references these lists leave out: those the overflow policy dropped, or
     /// `u64::MAX` where none could be listed ([`Assignment::unlisted`]), worse than any lists.
     pub(crate) fn dropped_references(&self) -> u64 {

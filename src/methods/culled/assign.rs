@@ -28,6 +28,11 @@ pub(super) struct Assigned<'a> {
 }
 
 impl Assign {
+    /// Gives back what a burst of lights grew the assigner's buffers to.
+    pub(super) fn fit_buffers(&mut self) {
+        self.assigner.fit_buffers();
+    }
+
     /// Assigns `ctx.lights` to `grid`'s cells within `limits`: the time it took, and the
     /// assignment ([`Assign::assigned`] takes it as the frame's).
     pub(super) fn run(

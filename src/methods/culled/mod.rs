@@ -296,6 +296,11 @@ impl ShadingMethod for CulledForward {
     }
 
     /// Frees the ring after `IDLE_FRAMES_KEPT` frames without lights.
+    fn fit_buffers(&mut self) {
+        self.assign.fit_buffers();
+        self.upload.fit_buffers();
+    }
+
     fn skip_frame(&mut self, dev: &Device) {
         if super::idle_for_long(&mut self.idle_frames) {
             self.destroy(dev);

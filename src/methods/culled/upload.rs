@@ -101,6 +101,14 @@ pub(super) struct Uploaded<'a> {
 }
 
 impl Uploads {
+    /// Gives back what a burst of lights grew the packing buffers to.
+    pub(super) fn fit_buffers(&mut self) {
+        crate::cluster::headroom::fit(&mut self.visible);
+        crate::cluster::headroom::fit(&mut self.lights.bytes);
+        crate::cluster::headroom::fit(&mut self.grid.bytes);
+        crate::cluster::headroom::fit(&mut self.indices.bytes);
+    }
+
     /// Packs the frame's visible lights, cell lists and index list, and uploads them into the
     /// ring's next set (made anew when the light encoding changed).
     pub(super) fn pack_and_upload(

@@ -71,6 +71,12 @@ pub(super) struct LightInstances {
 }
 
 impl LightInstances {
+    /// Gives back what a burst of lights grew the batch buffer to (the streams shrink
+    /// themselves).
+    pub(super) fn fit_buffers(&mut self) {
+        crate::cluster::headroom::fit(&mut self.batch);
+    }
+
     /// Draws `mesh` (its arrays bound, with the light program) once for each light, in their
     /// order, a batch at a time, through `proxy`'s stream (made on its first lights, and anew
     /// for another layout), each light its first `vec4s` (see [`light_vec4s`]); returns the
