@@ -46,6 +46,14 @@ pub(crate) fn fit_empty<T>(buffer: &mut Vec<T>) {
     fit(buffer);
 }
 
+/// [`fit`] where the contents are kept (`keep`), else [`fit_empty`].
+pub(crate) fn fit_keeping<T>(buffer: &mut Vec<T>, keep: bool) {
+    if !keep {
+        buffer.clear();
+    }
+    fit(buffer);
+}
+
 /// Makes `buffer` `len` default values (zeros), with [`room_for`]'s room to grow: for
 /// per-frame buffers filled afresh, whose length wanders with the view and the lights.
 pub(crate) fn zeroed_with_room<T: Clone + Default>(buffer: &mut Vec<T>, len: usize) {

@@ -4,8 +4,11 @@
 //! them, and given back as the call ends (with `GlStateHandling::Reset`, not read, and left at
 //! GL's initial 0), with `GL_POLYGON_OFFSET_FILL` off again (the state save then switches the
 //! game's back on where it was). Where `GL_EXT_polygon_offset_clamp` is listed, its clamp is
-//! the application's state too, and 0 (no clamp) during the call: a game's negative clamp
-//! would cut the bias toward the camera to nothing.
+//! the application's state too: `glPolygonOffset` sets it to 0 (no clamp) for the call (a
+//! game's negative clamp would cut the bias toward the camera to nothing), and
+//! `glPolygonOffsetClampEXT` gives a non-zero one back. The offset itself is always set through
+//! the core entry point: the extension's is loaded through EGL, which may not reach a context
+//! made otherwise (OSMesa's).
 #![allow(unsafe_code)]
 
 use std::cell::Cell;
@@ -21,25 +24,19 @@ pub(crate) struct DepthBias {
     /// This call changed the offset, and the application's factor, units and clamp where they
     /// were read to be given back.
     changed: Cell<Option<Option<[f32; 3]>>>,
-    /// `glPolygonOffsetClampEXT`, where the context has it.
-    clamp: Option<PolygonOffsetClamp>,
+    /// The context lists `GL_EXT_polygon_offset_clamp`: the clamp is read to be given back.
+    clamp_listed: bool,
+    /// `glPolygonOffsetClampEXT`, where it loaded.
+    set_clamp: Option<PolygonOffsetClamp>,
 }
 
 impl DepthBias {
-    pub(crate) fn new(clamp: Option<PolygonOffsetClamp>) -> DepthBias {
+    pub(crate) fn new(clamp_listed: bool, set_clamp: Option<PolygonOffsetClamp>) -> DepthBias {
         DepthBias {
             current: Cell::new(0.0),
             changed: Cell::new(None),
-            clamp,
-        }
-    }
-
-    /// Sets the offset's values: its clamp too, where the context has one.
-    fn offset(&self, gl: &glow::Context, [factor, units, clamp]: [f32; 3]) {
-        match self.clamp {
-            // SAFETY: the extension's entry point, loaded for this context's implementation.
-            Some(set) => unsafe { set(factor, units, clamp) },
-            None => unsafe { gl.polygon_offset(factor, units) },
+            clamp_listed,
+            set_clamp,
         }
     }
 
@@ -53,9 +50,9 @@ impl DepthBias {
                 [
                     read(glow::POLYGON_OFFSET_FACTOR),
                     read(glow::POLYGON_OFFSET_UNITS),
-                    match self.clamp {
-                        Some(_) => read(glow::POLYGON_OFFSET_CLAMP),
-                        None => 0.0,
+                    match self.clamp_listed {
+                        true => read(glow::POLYGON_OFFSET_CLAMP),
+                        false => 0.0,
                     },
                 ]
             });
@@ -75,8 +72,10 @@ impl DepthBias {
         if bias == 0.0 {
             unsafe { gl.disable(glow::POLYGON_OFFSET_FILL) };
         } else {
-            unsafe { gl.enable(glow::POLYGON_OFFSET_FILL) };
-            self.offset(gl, [-bias, -bias, 0.0]);
+            unsafe {
+                gl.enable(glow::POLYGON_OFFSET_FILL);
+                gl.polygon_offset(-bias, -bias);
+            }
         }
         self.current.set(bias);
     }
@@ -85,8 +84,15 @@ impl DepthBias {
     /// initial ones, where they were not read).
     pub(super) fn leave(&self, gl: &glow::Context) {
         if let Some(saved) = self.changed.take() {
-            unsafe { gl.disable(glow::POLYGON_OFFSET_FILL) };
-            self.offset(gl, saved.unwrap_or([0.0; 3]));
+            let [factor, units, clamp] = saved.unwrap_or([0.0; 3]);
+            unsafe {
+                gl.disable(glow::POLYGON_OFFSET_FILL);
+                gl.polygon_offset(factor, units);
+            }
+            if let (Some(set_clamp), true) = (self.set_clamp, clamp != 0.0) {
+                // SAFETY: the extension's entry point, loaded for this context's implementation.
+                unsafe { set_clamp(factor, units, clamp) };
+            }
         }
         self.current.set(0.0);
     }

@@ -199,8 +199,16 @@ impl Device {
         let units = unsafe { gl.get_parameter_i32(glow::MAX_COMBINED_TEXTURE_IMAGE_UNITS) };
         let host =
             super::host_state::HostFeatures::of(&gl, &caps, own_vertex_array.is_some(), units);
-        let clamp = super::ext_fns::polygon_offset_clamp_ext(|e| caps.has_extension(e));
-        let depth_bias = super::depth_bias::DepthBias::new(clamp);
+        let clamp_listed = caps.has_extension("GL_EXT_polygon_offset_clamp");
+        let set_clamp = super::ext_fns::polygon_offset_clamp_ext(|e| caps.has_extension(e));
+        if clamp_listed && set_clamp.is_none() {
+            log::warn!(
+                "GL_EXT_polygon_offset_clamp is listed but glPolygonOffsetClampEXT could not be \
+                 loaded through EGL: a call that draws a biased material leaves the game's \
+                 polygon offset clamp at 0"
+            );
+        }
+        let depth_bias = super::depth_bias::DepthBias::new(clamp_listed, set_clamp);
         Ok(Device {
             gl,
             caps,

@@ -286,20 +286,22 @@ impl ShadingMethod for Auto {
         Ok(stats)
     }
 
-    /// A frame without lights: forward and deferred rest as on a frame another method drew;
-    /// clustered as it does alone, freeing its textures and keeping its grid's calibration.
-    fn fit_buffers(&mut self) {
+    /// Only the method the last frame drew with holds that frame's contents.
+    fn fit_buffers(&mut self, in_use: bool) {
+        let [forward_idle, clustered_idle, deferred_idle] = self.idle;
         if let Some(f) = &mut self.forward {
-            f.fit_buffers();
+            f.fit_buffers(in_use && forward_idle == 0);
         }
         if let Some(c) = &mut self.clustered {
-            c.fit_buffers();
+            c.fit_buffers(in_use && clustered_idle == 0);
         }
         if let Some(d) = &mut self.deferred {
-            d.fit_buffers();
+            d.fit_buffers(in_use && deferred_idle == 0);
         }
     }
 
+    /// A frame without lights: forward and deferred rest as on a frame another method drew;
+    /// clustered as it does alone, freeing its textures and keeping its grid's calibration.
     fn skip_frame(&mut self, dev: &Device) {
         let [forward_idle, _, deferred_idle] = &mut self.idle;
         rest(&mut self.forward, forward_idle, dev);

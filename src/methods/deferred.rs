@@ -677,9 +677,9 @@ impl ShadingMethod for Deferred {
             + self.transparent.gpu_bytes()
     }
 
-    fn fit_buffers(&mut self) {
+    fn fit_buffers(&mut self, in_use: bool) {
         self.lights.fit_buffers();
-        self.transparent.fit_buffers();
+        self.transparent.fit_buffers(in_use);
     }
 
     fn skip_frame(&mut self, dev: &Device) {

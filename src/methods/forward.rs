@@ -274,12 +274,17 @@ impl ShadingMethod for Forward {
         self.lights.as_ref().map_or(0, |(t, _)| t.gpu_bytes())
     }
 
-    fn fit_buffers(&mut self) {
-        use crate::cluster::headroom::fit;
-        fit(&mut self.packed.bytes);
-        fit(&mut self.capped);
-        fit(&mut self.cap_order);
-        fit(&mut self.seen);
+    /// The packed records stay where the last frame drew them (a still frame may send them
+    /// again); the cap's and RGBA8's buffers are each frame's scratch.
+    fn fit_buffers(&mut self, in_use: bool) {
+        use crate::cluster::headroom::{fit_empty, fit_keeping};
+        fit_keeping(&mut self.packed.bytes, in_use);
+        if !in_use {
+            self.uploaded = None;
+        }
+        fit_empty(&mut self.capped);
+        fit_empty(&mut self.cap_order);
+        fit_empty(&mut self.seen);
     }
 
     fn destroy(&mut self, dev: &Device) {

@@ -203,9 +203,10 @@ pub trait ShadingMethod {
     /// [`IDLE_FRAMES_KEPT`] in a row.
     fn skip_frame(&mut self, _dev: &Device) {}
     /// Frames have needed a quarter of the lights the CPU buffers were grown for at most, long
-    /// enough: they give back what a burst of lights grew them to, keeping room for the last
-    /// frame's needs.
-    fn fit_buffers(&mut self) {}
+    /// enough: they give back what a burst of lights grew them to, keeping the last frame's
+    /// contents and room for them where it drew with the method (`in_use`); where it drew
+    /// none (no light in view) they are emptied, and the next lit frame makes them anew.
+    fn fit_buffers(&mut self, _in_use: bool) {}
     /// Frees the method's GPU resources.
     fn destroy(&mut self, dev: &Device);
 }

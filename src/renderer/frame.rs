@@ -6,6 +6,7 @@
 use std::time::Instant;
 
 use super::frame_report::DrawnFrame;
+use super::light_high_water::LitWith;
 use super::{FrameStats, Renderer};
 use crate::gl::bound_framebuffer::TargetQueries;
 use crate::gl::framebuffer::ColorFormat;
@@ -376,6 +377,10 @@ impl Renderer {
         } else {
             ctx.lights_in_view(1) > 0
         };
+        self.light_high_water.lit_with = lit.then_some(match reaching_pass {
+            true => LitWith::ReachingPass,
+            false => LitWith::Method,
+        });
         let rendered = if !lit {
             method.skip_frame(&self.dev);
             methods::forward::draw_ambient_only(&mut ctx)

@@ -9,6 +9,16 @@ use crate::gl::shrink::SmallFrames;
 pub(super) struct LightHighWater {
     most: usize,
     small: SmallFrames,
+    /// Whether the last frame lit its surfaces with the renderer's method, or with the
+    /// reaching-count pass (neither: no light in view): that one's buffers hold its lights.
+    pub lit_with: Option<LitWith>,
+}
+
+/// What drew a lit frame.
+#[derive(Clone, Copy, PartialEq)]
+pub(super) enum LitWith {
+    Method,
+    ReachingPass,
 }
 
 impl LightHighWater {
@@ -27,9 +37,10 @@ impl LightHighWater {
 impl super::Renderer {
     /// Gives back what a burst of lights grew the CPU buffers to (see the module).
     pub(super) fn fit_light_buffers(&mut self) {
-        self.method.fit_buffers();
+        let lit_with = self.light_high_water.lit_with;
+        self.method.fit_buffers(lit_with == Some(LitWith::Method));
         if let Some(pass) = &mut self.reaching_pass {
-            pass.fit_buffers();
+            pass.fit_buffers(lit_with == Some(LitWith::ReachingPass));
         }
         crate::cluster::headroom::fit(&mut self.lights);
         self.placed.fit_buffers();

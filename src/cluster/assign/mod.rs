@@ -111,13 +111,14 @@ impl Assigner {
         Assigner::default()
     }
 
-    /// Gives back what a burst of lights grew the buffers to, keeping room for what the last
-    /// assignment needed (the renderer calls it once frames have needed a quarter at most for
-    /// `SHRINK_AFTER` frames in a row, as it does its GPU stores).
-    pub fn fit_buffers(&mut self) {
+    /// Gives back what a burst of lights grew the buffers to (the renderer calls it once frames
+    /// have needed a quarter at most for `SHRINK_AFTER` frames in a row, as it does its GPU
+    /// stores): the last result is kept with room for its size, or (not `keep_result`)
+    /// emptied; the scratch is emptied.
+    pub fn fit_buffers(&mut self, keep_result: bool) {
         self.bands.fit();
         self.chunks.fit();
-        self.out.fit();
+        self.out.fit(keep_result);
         self.overflow.fit();
     }
 

@@ -184,14 +184,18 @@ pub struct Assignment {
 }
 
 impl Assignment {
-    /// Gives back what a burst of lights grew the lists to ([`fit`](crate::cluster::headroom::fit)).
-    pub(crate) fn fit(&mut self) {
-        use crate::cluster::headroom::fit;
-        fit(&mut self.visible);
-        fit(&mut self.offsets);
-        fit(&mut self.counts);
-        fit(&mut self.overfull);
-        self.indices.fit();
+    /// Gives back what a burst of lights grew the lists to ([`fit`](crate::cluster::headroom::fit)),
+    /// keeping them, or (not `keep`) emptying them first.
+    pub(crate) fn fit(&mut self, keep: bool) {
+        use crate::cluster::headroom::fit_keeping;
+        fit_keeping(&mut self.visible, keep);
+        fit_keeping(&mut self.offsets, keep);
+        fit_keeping(&mut self.counts, keep);
+        fit_keeping(&mut self.overfull, keep);
+        match keep {
+            true => self.indices.fit(),
+            false => self.indices.fit_empty(),
+        }
     }
 
     /// Light references these lists leave out: those the overflow policy dropped, or

@@ -15,7 +15,8 @@ pub(super) struct Assign {
     /// `FrameStats::overflowed_lights` counts every frame's dropped references; the log says
     /// it once.
     warned_overflow: bool,
-    /// The assigner's last assignment is an automatic grid candidate's, not a frame's.
+    /// The assigner's last assignment is not a frame's: an automatic grid candidate's, or
+    /// emptied (`fit_buffers`).
     holds_candidate: bool,
 }
 
@@ -28,9 +29,14 @@ pub(super) struct Assigned<'a> {
 }
 
 impl Assign {
-    /// Gives back what a burst of lights grew the assigner's buffers to.
-    pub(super) fn fit_buffers(&mut self) {
-        self.assigner.fit_buffers();
+    /// Gives back what a burst of lights grew the assigner's buffers to; not `in_use` (the
+    /// last frame drew without the method), its assignment goes too, and is no longer the
+    /// last frame's to reuse.
+    pub(super) fn fit_buffers(&mut self, in_use: bool) {
+        self.assigner.fit_buffers(in_use);
+        if !in_use {
+            self.holds_candidate = true;
+        }
     }
 
     /// Assigns `ctx.lights` to `grid`'s cells within `limits`: the time it took, and the

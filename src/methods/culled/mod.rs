@@ -295,12 +295,15 @@ impl ShadingMethod for CulledForward {
         self.upload.gpu_bytes()
     }
 
-    /// Frees the ring after `IDLE_FRAMES_KEPT` frames without lights.
-    fn fit_buffers(&mut self) {
-        self.assign.fit_buffers();
-        self.upload.fit_buffers();
+    fn fit_buffers(&mut self, in_use: bool) {
+        self.assign.fit_buffers(in_use);
+        self.upload.fit_buffers(in_use);
+        if !in_use {
+            self.lists_key = None;
+        }
     }
 
+    /// Frees the ring after `IDLE_FRAMES_KEPT` frames without lights.
     fn skip_frame(&mut self, dev: &Device) {
         if super::idle_for_long(&mut self.idle_frames) {
             self.destroy(dev);

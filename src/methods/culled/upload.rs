@@ -101,12 +101,18 @@ pub(super) struct Uploaded<'a> {
 }
 
 impl Uploads {
-    /// Gives back what a burst of lights grew the packing buffers to.
-    pub(super) fn fit_buffers(&mut self) {
-        crate::cluster::headroom::fit(&mut self.visible);
-        crate::cluster::headroom::fit(&mut self.lights.bytes);
-        crate::cluster::headroom::fit(&mut self.grid.bytes);
-        crate::cluster::headroom::fit(&mut self.indices.bytes);
+    /// Gives back what a burst of lights grew the packing buffers to. Not `in_use` (the last
+    /// frame drew without the method), they are emptied and the last upload is not drawn
+    /// again: the next frame packs and uploads anew.
+    pub(super) fn fit_buffers(&mut self, in_use: bool) {
+        use crate::cluster::headroom::fit_keeping;
+        fit_keeping(&mut self.visible, in_use);
+        fit_keeping(&mut self.lights.bytes, in_use);
+        fit_keeping(&mut self.grid.bytes, in_use);
+        fit_keeping(&mut self.indices.bytes, in_use);
+        if !in_use {
+            self.last = None;
+        }
     }
 
     /// Packs the frame's visible lights, cell lists and index list, and uploads them into the

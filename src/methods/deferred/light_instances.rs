@@ -71,10 +71,10 @@ pub(super) struct LightInstances {
 }
 
 impl LightInstances {
-    /// Gives back what a burst of lights grew the batch buffer to (the streams shrink
-    /// themselves).
+    /// Gives back what a burst of lights grew the batch buffer to (each draw fills it afresh;
+    /// the streams shrink themselves).
     pub(super) fn fit_buffers(&mut self) {
-        crate::cluster::headroom::fit(&mut self.batch);
+        crate::cluster::headroom::fit_empty(&mut self.batch);
     }
 
     /// Draws `mesh` (its arrays bound, with the light program) once for each light, in their

@@ -988,10 +988,12 @@ mod tests {
     fn converting_to_metallic_roughness_keeps_everything_but_the_reflectance() {
         use manylight::scene::{Material, MaterialModel};
         let mut scene = Scene::empty();
-        let glossy = Material {
+        let mut glossy = Material {
             depth_bias: 2.0,
             alpha: 0.5,
             alpha_cutoff: Some(0.3),
+            alpha_texture: true,
+            alpha_vertex: true,
             double_sided: false,
             ..Material::glossy(
                 "decal",
@@ -1000,6 +1002,7 @@ mod tests {
                 30.0,
             )
         };
+        glossy.maps.emissive = glam::Vec3::new(0.1, 0.2, 0.3);
         scene.add_material(glossy.clone());
         let metal = Material::metallic_roughness("metal", glam::Vec3::ONE, 1.0, 0.4);
         scene.add_material(metal.clone());
@@ -1013,7 +1016,10 @@ mod tests {
         // Ns 30 = 2/α² − 2 with α = roughness².
         let alpha = converted.roughness.powi(2);
         assert!((2.0 / (alpha * alpha) - 2.0 - 30.0).abs() < 1e-3, "{alpha}");
-        let kept = |m: &Material| (m.depth_bias, m.alpha, m.alpha_cutoff, m.double_sided);
+        let kept = |m: &Material| {
+            let alpha = (m.alpha, m.alpha_cutoff, m.alpha_texture, m.alpha_vertex);
+            (m.depth_bias, alpha, m.double_sided, m.maps.emissive)
+        };
         assert_eq!(kept(converted), kept(&glossy));
         let reflectance = |m: &Material| (m.model, m.metallic, m.roughness);
         assert_eq!(reflectance(&scene.materials[1]), reflectance(&metal));
