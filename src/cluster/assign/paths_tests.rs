@@ -93,40 +93,23 @@ fn check_stats(a: &Assignment, uncapped_max: Option<u32>) {
 
 /// One assigner over frames of different sizes, grids and light sets gives what fresh buffers
 /// give (nothing stale survives from an earlier frame).
-#[test]
-fn reused_buffers_match_fresh_ones() {
-    let mut rng = Pcg64Mcg::seed_from_u64(11);
+/// Frames of one assigner over the cases, each against a fresh assigner's lists: grids of
+/// `sizes`, `counts` lights, on the pool or one thread, capped or not, in turn. `after` runs
+/// after each frame with the frame's number, the assigner, the fresh lists and a name.
+fn frames_against_fresh(
+    seed: u64,
+    frames: usize,
+    sizes: &[(u32, u32)],
+    counts: &[usize],
+    mut after: impl FnMut(usize, &mut super::Assigner, &Assignment, &str),
+) {
+    let mut rng = Pcg64Mcg::seed_from_u64(seed);
     let mut assigner = super::Assigner::new();
     let cases = cases();
-    for (frame, case) in cases.iter().cycle().take(12).enumerate() {
-        let grid = ClusterGrid::new(320, 180, case.projection, case.near, case.far, &case.config);
-        let n = [5000, 0, 700, 9000][frame % 4];
-        let lights = random_lights(&mut rng, n, case.far.min(200.0) * 0.5);
-        let limits = AssignLimits {
-            cell_cap: if frame % 3 == 0 { 40 } else { u32::MAX },
-            parallel_threshold: if frame % 2 == 0 { 1 } else { usize::MAX },
-            ..Default::default()
-        };
-        let fresh = assign(&grid, &lights, case.far, &limits);
-        let reused = assigner.assign(&grid, &lights, case.far, &limits);
-        assert_same_lists(reused, &fresh, case.name);
-        assert_eq!(fresh.stats, reused.stats, "{}", case.name);
-    }
-}
-
-/// Buffers given back between frames (`Assigner::fit_buffers`, as after a burst of lights)
-/// change no list: the last result stays (or, not kept, is empty), and the next assignment on
-/// any path (one thread, bands, chunks of lights on a grid of few cells) matches a fresh
-/// assigner's.
-#[test]
-fn fitted_buffers_match_fresh_ones() {
-    let mut rng = Pcg64Mcg::seed_from_u64(12);
-    let mut assigner = super::Assigner::new();
-    let cases = cases();
-    for (frame, case) in cases.iter().cycle().take(16).enumerate() {
-        let (w, h) = if frame % 4 < 2 { (320, 180) } else { (32, 18) };
+    for (frame, case) in cases.iter().cycle().take(frames).enumerate() {
+        let (w, h) = sizes[frame / 2 % sizes.len()];
         let grid = ClusterGrid::new(w, h, case.projection, case.near, case.far, &case.config);
-        let n = [9000, 40, 0, 3000, 700][frame % 5];
+        let n = counts[frame % counts.len()];
         let lights = random_lights(&mut rng, n, case.far.min(200.0) * 0.5);
         let limits = AssignLimits {
             cell_cap: if frame % 3 == 0 { 40 } else { u32::MAX },
@@ -135,18 +118,47 @@ fn fitted_buffers_match_fresh_ones() {
         };
         let fresh = assign(&grid, &lights, case.far, &limits);
         let what = format!("{} frame {frame}, {n} lights", case.name);
-        let assigned = assigner.assign(&grid, &lights, case.far, &limits);
-        assert_same_lists(assigned, &fresh, &what);
-        assert_eq!(fresh.stats, assigned.stats, "{what}");
-        let keep = frame % 3 != 1;
-        assigner.fit_buffers(keep);
-        let last = assigner.assignment();
-        if keep {
-            assert_same_lists(last, &fresh, &what);
-        } else {
-            assert!(last.visible.is_empty() && last.counts.is_empty(), "{what}");
-        }
+        let reused = assigner.assign(&grid, &lights, case.far, &limits);
+        assert_same_lists(reused, &fresh, &what);
+        assert_eq!(fresh.stats, reused.stats, "{what}");
+        after(frame, &mut assigner, &fresh, &what);
     }
+}
+
+#[test]
+fn reused_buffers_match_fresh_ones() {
+    frames_against_fresh(
+        11,
+        12,
+        &[(320, 180)],
+        &[5000, 0, 700, 9000],
+        |_, _, _, _| {},
+    );
+}
+
+/// Buffers given back between frames (`Assigner::fit_buffers`, as after a burst of lights)
+/// change no list: the last result stays (or, not kept, is empty), and the next assignment on
+/// any path (one thread, bands, chunks of lights on a grid of few cells) matches a fresh
+/// assigner's.
+#[test]
+fn fitted_buffers_match_fresh_ones() {
+    let sizes = [(320, 180), (32, 18)];
+    frames_against_fresh(
+        12,
+        16,
+        &sizes,
+        &[9000, 40, 0, 3000, 700],
+        |frame, a, fresh, what| {
+            let keep = frame % 3 != 1;
+            a.fit_buffers(keep);
+            let last = a.assignment();
+            if keep {
+                assert_same_lists(last, fresh, what);
+            } else {
+                assert!(last.visible.is_empty() && last.counts.is_empty(), "{what}");
+            }
+        },
+    );
 }
 
 /// Which assignments take the pool: many lights, or a previous assignment of the same
