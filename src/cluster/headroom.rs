@@ -42,8 +42,7 @@ pub(crate) fn fit<T>(buffer: &mut Vec<T>) {
 /// [`fit`] for a buffer whose contents no later frame reads (a frame's scratch): emptied
 /// first, so a burst's contents left in a path the frames no longer take go too.
 pub(crate) fn fit_empty<T>(buffer: &mut Vec<T>) {
-    buffer.clear();
-    fit(buffer);
+    fit_keeping(buffer, false);
 }
 
 /// [`fit`] where the contents are kept (`keep`), else [`fit_empty`].

@@ -274,14 +274,11 @@ impl ShadingMethod for Forward {
         self.lights.as_ref().map_or(0, |(t, _)| t.gpu_bytes())
     }
 
-    /// The packed records stay where the last frame drew them (a still frame may send them
-    /// again); the cap's and RGBA8's buffers are each frame's scratch.
-    fn fit_buffers(&mut self, in_use: bool) {
-        use crate::cluster::headroom::{fit_empty, fit_keeping};
-        fit_keeping(&mut self.packed.bytes, in_use);
-        if !in_use {
-            self.uploaded = None;
-        }
+    /// Every CPU buffer is the frame's scratch: a still frame draws the texture, and one that
+    /// uploads again (to shrink it) packs anew; the packed count and ranges stay.
+    fn fit_buffers(&mut self, _in_use: bool) {
+        use crate::cluster::headroom::fit_empty;
+        fit_empty(&mut self.packed.bytes);
         fit_empty(&mut self.capped);
         fit_empty(&mut self.cap_order);
         fit_empty(&mut self.seen);

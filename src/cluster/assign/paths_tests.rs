@@ -91,8 +91,6 @@ fn check_stats(a: &Assignment, uncapped_max: Option<u32>) {
     }
 }
 
-/// One assigner over frames of different sizes, grids and light sets gives what fresh buffers
-/// give (nothing stale survives from an earlier frame).
 /// Frames of one assigner over the cases, each against a fresh assigner's lists: grids of
 /// `sizes`, `counts` lights, on the pool or one thread, capped or not, in turn. `after` runs
 /// after each frame with the frame's number, the assigner, the fresh lists and a name.
@@ -125,6 +123,8 @@ fn frames_against_fresh(
     }
 }
 
+/// One assigner over frames of different sizes, grids and light sets gives what fresh buffers
+/// give (nothing stale survives from an earlier frame).
 #[test]
 fn reused_buffers_match_fresh_ones() {
     frames_against_fresh(
