@@ -33,7 +33,7 @@ impl Chunks {
             fit_empty(&mut chunk.visible);
             fit_empty(&mut chunk.offsets);
             fit_empty(&mut chunk.cursor);
-            chunk.sorted.fit_empty();
+            chunk.sorted.fit_keeping(false);
         }
     }
 

@@ -23,16 +23,11 @@ pub struct IndexList {
 pub const NARROW_LIGHTS: usize = 1 << 16;
 
 impl IndexList {
-    /// Gives back what a burst of lights grew the list to ([`fit`](crate::cluster::headroom::fit)).
-    pub(crate) fn fit(&mut self) {
-        crate::cluster::headroom::fit(&mut self.narrow);
-        crate::cluster::headroom::fit(&mut self.wide);
-    }
-
-    /// [`IndexList::fit`] for a scratch list: emptied first.
-    pub(crate) fn fit_empty(&mut self) {
-        crate::cluster::headroom::fit_empty(&mut self.narrow);
-        crate::cluster::headroom::fit_empty(&mut self.wide);
+    /// Gives back what a burst of lights grew the list to, keeping its entries (`keep`) or
+    /// not ([`fit_keeping`](crate::cluster::headroom::fit_keeping)).
+    pub(crate) fn fit_keeping(&mut self, keep: bool) {
+        crate::cluster::headroom::fit_keeping(&mut self.narrow, keep);
+        crate::cluster::headroom::fit_keeping(&mut self.wide, keep);
     }
 
     /// Entries in the list.

@@ -22,7 +22,7 @@ pub(super) struct Overflow {
 impl Overflow {
     /// Gives back what a burst of lights grew the policy's buffers to.
     pub(super) fn fit(&mut self) {
-        self.kept.fit_empty();
+        self.kept.fit_keeping(false);
         crate::cluster::headroom::fit_empty(&mut self.lists);
         crate::cluster::headroom::fit_empty(&mut self.packed);
     }

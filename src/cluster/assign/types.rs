@@ -192,10 +192,7 @@ impl Assignment {
         fit_keeping(&mut self.offsets, keep);
         fit_keeping(&mut self.counts, keep);
         fit_keeping(&mut self.overfull, keep);
-        match keep {
-            true => self.indices.fit(),
-            false => self.indices.fit_empty(),
-        }
+        self.indices.fit_keeping(keep);
     }
 
     /// Light references these lists leave out: those the overflow policy dropped, or
