@@ -50,9 +50,10 @@ impl DepthBias {
                 [
                     read(glow::POLYGON_OFFSET_FACTOR),
                     read(glow::POLYGON_OFFSET_UNITS),
-                    match self.clamp_listed {
-                        true => read(glow::POLYGON_OFFSET_CLAMP),
-                        false => 0.0,
+                    if self.clamp_listed {
+                        read(glow::POLYGON_OFFSET_CLAMP)
+                    } else {
+                        0.0
                     },
                 ]
             });

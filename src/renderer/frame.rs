@@ -377,9 +377,10 @@ impl Renderer {
         } else {
             ctx.lights_in_view(1) > 0
         };
-        self.light_high_water.lit_with = lit.then_some(match reaching_pass {
-            true => LitWith::ReachingPass,
-            false => LitWith::Method,
+        self.light_high_water.lit_with = lit.then_some(if reaching_pass {
+            LitWith::ReachingPass
+        } else {
+            LitWith::Method
         });
         let rendered = if !lit {
             method.skip_frame(&self.dev);

@@ -705,8 +705,7 @@ fn contexts_made_and_dropped_again_and_again_keep_nothing_open() {
 /// buffers by megabytes; once `SHRINK_AFTER` frames in a row have needed a quarter of them at
 /// most, they are given back: the live heap returns to within a twentieth of the burst's
 /// growth, whether 20 lights go on moving in view or none is left in view (frames the method
-/// does not draw). At 60 000 lights every method had kept all of it, 8 to 18 MB. The next lit
-/// frame draws the picture of a renderer that saw no burst.
+/// does not draw). The next lit frame draws the picture of a renderer that saw no burst.
 #[test]
 fn a_burst_of_lights_gives_its_cpu_memory_back() {
     use manylight::gl::texture::SHRINK_AFTER;
