@@ -7,23 +7,24 @@
 const SIGNATURE: &[u8; 8] = b"\x89PNG\r\n\x1a\n";
 
 /// `bytes` without their `iCCP` chunks, or `None` where there is none (or the bytes are not a
-/// PNG, or its chunks run past its end: the decoder then says what is wrong).
+/// PNG). The chunks are walked as the decoder reads them: up to `IEND`, whose trailing bytes
+/// the decoder ignores and are dropped, or up to a chunk running past the end, which is kept
+/// as it is for the decoder to refuse (a profile before it is still taken out).
 pub(crate) fn without_colour_profile(bytes: &[u8]) -> Option<Vec<u8>> {
     let chunks = bytes.strip_prefix(SIGNATURE)?;
     let mut profiles = Vec::new();
     let mut at = 0usize;
-    while at < chunks.len() {
-        let header = chunks.get(at..at.checked_add(8)?)?;
-        let length = u32::from_be_bytes(header[..4].try_into().ok()?) as usize;
-        // Length, type, data and CRC.
-        let end = at.checked_add(12)?.checked_add(length)?;
-        if end > chunks.len() {
-            return None;
+    let mut end_of_image = chunks.len();
+    while let Some(chunk) = whole_chunk(chunks, at) {
+        let kind = &chunks[at + 4..at + 8];
+        if kind == b"iCCP" {
+            profiles.push(at..chunk.end);
         }
-        if &header[4..8] == b"iCCP" {
-            profiles.push(at..end);
+        at = chunk.end;
+        if kind == b"IEND" {
+            end_of_image = at;
+            break;
         }
-        at = end;
     }
     if profiles.is_empty() {
         return None;
@@ -35,8 +36,17 @@ pub(crate) fn without_colour_profile(bytes: &[u8]) -> Option<Vec<u8>> {
         kept.extend_from_slice(&chunks[from..profile.start]);
         from = profile.end;
     }
-    kept.extend_from_slice(&chunks[from..]);
+    kept.extend_from_slice(&chunks[from..end_of_image]);
     Some(kept)
+}
+
+/// The bytes of the chunk starting at `at` (length, type, data and CRC), where all of them
+/// lie within `chunks`.
+fn whole_chunk(chunks: &[u8], at: usize) -> Option<std::ops::Range<usize>> {
+    let header = chunks.get(at..at.checked_add(8)?)?;
+    let length = u32::from_be_bytes(header[..4].try_into().ok()?) as usize;
+    let end = at.checked_add(12)?.checked_add(length)?;
+    (end <= chunks.len()).then_some(at..end)
 }
 
 #[cfg(all(test, feature = "png"))]
@@ -67,11 +77,34 @@ mod tests {
         let kept = without_colour_profile(&profiled).unwrap();
         // The same chunks as the file without a profile, each with its own checksum.
         assert_eq!(kept, plain);
-        // Not a PNG, or chunks running past the end: left to the decoder.
+        // Not a PNG: left to the decoder.
         assert_eq!(without_colour_profile(b"GIF89a"), None);
-        assert_eq!(
-            without_colour_profile(&profiled[..profiled.len() - 1]),
-            None
-        );
+    }
+
+    /// The decoder reads a profile wherever its walk of the chunks reaches it, so the walk
+    /// here must reach it too: a single byte after `IEND`, which the decoder ignores, made
+    /// the whole file "not a PNG" here and its 500 MiB profile was inflated.
+    #[test]
+    fn a_profile_is_taken_out_whatever_follows_the_last_whole_chunk() {
+        let plain = png(None);
+        let profiled = png(Some(vec![7; 5000]));
+        // Bytes after IEND: dropped with the profile.
+        for trailing in [&b"\0"[..], b"garbage after the image", &profiled[..]] {
+            let mut file = profiled.clone();
+            file.extend_from_slice(trailing);
+            assert_eq!(without_colour_profile(&file).as_deref(), Some(&plain[..]));
+        }
+        // A chunk running past the end after the profile: the profile goes, the rest is
+        // kept as it is, for the decoder to refuse.
+        let cut = &profiled[..profiled.len() - 1];
+        let kept = without_colour_profile(cut).unwrap();
+        assert_eq!(kept, plain[..plain.len() - 1]);
+        assert!(!kept.windows(4).any(|w| w == b"iCCP"));
+        // A chunk whose length runs past `usize` on the way: the same.
+        let mut huge = profiled[..profiled.len() - 12].to_vec();
+        huge.extend_from_slice(&[0xFF, 0xFF, 0xFF, 0xFF, b'I', b'E', b'N', b'D']);
+        let kept = without_colour_profile(&huge).unwrap();
+        assert!(!kept.windows(4).any(|w| w == b"iCCP"));
+        assert!(kept.ends_with(&[0xFF, 0xFF, 0xFF, 0xFF, b'I', b'E', b'N', b'D']));
     }
 }
