@@ -1,22 +1,31 @@
-//! What a JPEG's segment headers say, read before it is decoded, where the decoder holds
-//! every coefficient besides the pixels: its frame and its scans (each one walks every block
+//! What a JPEG's segment headers say, read before it is decoded: its frame, and where the
+//! decoder holds every coefficient besides the pixels, its scans (each one walks every block
 //! of its components).
 
-/// The first start-of-frame segment of a JPEG whose decoder holds its coefficients, and the
-/// scans that follow it.
+/// The start-of-frame segment the decoder decodes, and the scans after it.
 #[derive(Debug, PartialEq)]
 pub(crate) struct JpegFrame {
     pub width: u32,
     pub height: u32,
     pub components: u8,
-    /// Start-of-scan segments after the frame.
+    /// Start-of-scan segments after the frame; counted on only where the decoder holds the
+    /// coefficients ([`JpegFrame::holds_coefficients`]).
     pub scans: u32,
-    /// Progressive (SOF2, SOF6, SOF10, SOF14); else a sequential frame whose first scan holds
-    /// some of its components only.
+    /// Progressive (SOF2).
     pub progressive: bool,
+    /// Components of the first scan, where one was seen.
+    pub first_scan: Option<u8>,
 }
 
 impl JpegFrame {
+    /// Whether the decoder holds all its coefficients before it makes pixels: a progressive
+    /// frame, or a sequential one whose first scan holds fewer components than the frame
+    /// (zune-jpeg then keeps every component's coefficients). A sequential frame with no
+    /// scan was not seen to hold anything.
+    pub fn holds_coefficients(&self) -> bool {
+        self.progressive || self.first_scan.is_some_and(|n| n < self.components)
+    }
+
     /// The decoder's work for its scans: component samples times scans (each scan is taken
     /// to cover every component, as a DC scan does).
     pub fn scan_work(&self) -> u64 {
@@ -31,13 +40,14 @@ impl JpegFrame {
     }
 }
 
-/// The frame of a JPEG whose decoder holds all its coefficients before it makes pixels, with
-/// the scans after it: a progressive one, or a sequential one whose first scan holds fewer
-/// components than the frame (zune-jpeg then keeps every component's coefficients);
-/// `None` for any other JPEG. Reads the segment headers only, within the bytes, skipping what
-/// the decoder skips between segments (stray bytes, `FF 00`, fill, restart markers), so
-/// entropy-coded data hides no marker from it.
-pub(crate) fn coefficient_jpeg_frame(bytes: &[u8]) -> Option<JpegFrame> {
+/// The frame a JPEG's decoder decodes, with its scans where it holds their coefficients;
+/// `None` where the bytes hold no frame. Reads the segment headers only, within the bytes, as
+/// zune-jpeg (the `image` crate's JPEG decoder) walks them, so that no segment hides a frame
+/// or a scan from one of the two: it skips what the decoder skips between segments (stray
+/// bytes, `FF 00`, fill), knows the frames it knows (SOF0–2; it skips the others as unknown
+/// segments), and before the first scan reads every other marker as a segment with a length,
+/// as it does; after it, restart markers have none.
+pub(crate) fn jpeg_frame(bytes: &[u8]) -> Option<JpegFrame> {
     let mut frame: Option<JpegFrame> = None;
     let mut at = 2; // past SOI
     while at + 2 <= bytes.len() {
@@ -46,21 +56,22 @@ pub(crate) fn coefficient_jpeg_frame(bytes: &[u8]) -> Option<JpegFrame> {
             continue;
         }
         let marker = bytes[at + 1];
+        let scanning = frame.as_ref().is_some_and(|f| f.scans > 0);
         match marker {
             // Fill bytes before a marker, and a stuffed zero.
             0xFF => at += 1,
             0x00 => at += 2,
             // End of image.
             0xD9 => break,
-            // Markers without a length.
-            0x01 | 0xD0..=0xD8 => at += 2,
+            // Restart markers, inside a scan's entropy-coded data.
+            0xD0..=0xD7 if scanning => at += 2,
             _ => {
                 let Some(length) = bytes.get(at + 2..at + 4) else {
                     break;
                 };
                 let length = usize::from(u16::from_be_bytes([length[0], length[1]]));
                 match (marker, &mut frame) {
-                    (0xC0..=0xC3 | 0xC5..=0xC7 | 0xC9..=0xCB | 0xCD..=0xCF, None) => {
+                    (0xC0..=0xC2, None) => {
                         // Length (2), precision (1), height (2), width (2), components (1).
                         let header = bytes.get(at + 5..at + 10)?;
                         frame = Some(JpegFrame {
@@ -68,16 +79,19 @@ pub(crate) fn coefficient_jpeg_frame(bytes: &[u8]) -> Option<JpegFrame> {
                             width: u16::from_be_bytes([header[2], header[3]]).into(),
                             components: header[4],
                             scans: 0,
-                            progressive: matches!(marker, 0xC2 | 0xC6 | 0xCA | 0xCE),
+                            progressive: marker == 0xC2,
+                            first_scan: None,
                         });
                     }
                     (0xDA, Some(f)) => {
                         f.scans = f.scans.saturating_add(1);
-                        // A sequential frame whose first scan holds all its components makes
-                        // pixels as it goes.
-                        let in_scan = *bytes.get(at + 4)?;
-                        if f.scans == 1 && !f.progressive && in_scan >= f.components {
-                            return None;
+                        let Some(&in_scan) = bytes.get(at + 4) else {
+                            break;
+                        };
+                        f.first_scan.get_or_insert(in_scan);
+                        // A frame that makes pixels as its scans come is not read further.
+                        if !f.holds_coefficients() {
+                            break;
                         }
                     }
                     _ => {}
@@ -86,8 +100,7 @@ pub(crate) fn coefficient_jpeg_frame(bytes: &[u8]) -> Option<JpegFrame> {
             }
         }
     }
-    // A sequential frame with no scan was not seen to hold anything.
-    frame.filter(|f| f.progressive || f.scans > 0)
+    frame
 }
 
 #[cfg(test)]
@@ -113,7 +126,7 @@ mod tests {
         // Plain bytes, stuffed zeros, restart markers and fill inside a scan's data.
         let data = [0x12, 0xFF, 0x00, 0x34, 0xFF, 0xD3, 0xFF, 0xFF, 0x00, 0x56];
         for scans in [0, 1, 10, 100] {
-            let f = coefficient_jpeg_frame(&progressive(64, 32, scans, &data)).unwrap();
+            let f = jpeg_frame(&progressive(64, 32, scans, &data)).unwrap();
             assert_eq!((f.width, f.height, f.components), (64, 32, 1));
             assert_eq!(f.scans, scans as u32);
             assert_eq!(f.scan_work(), 64 * 32 * scans as u64);
@@ -121,11 +134,15 @@ mod tests {
         // A baseline frame whose first scan holds its one component is not read further.
         let mut baseline = progressive(64, 32, 3, &data);
         baseline[3] = 0xC0;
-        assert_eq!(coefficient_jpeg_frame(&baseline), None);
+        let f = jpeg_frame(&baseline).unwrap();
+        assert_eq!(
+            (f.scans, f.first_scan, f.holds_coefficients()),
+            (1, Some(1), false)
+        );
         // A file cut inside a segment's length ends the count there.
         let whole = progressive(64, 32, 2, &data);
         let cut = &whole[..whole.len() - data.len() - 2 - 10 + 3];
-        assert_eq!(coefficient_jpeg_frame(cut).unwrap().scans, 1);
+        assert_eq!(jpeg_frame(cut).unwrap().scans, 1);
     }
 
     /// A baseline frame of three components whose first scan holds `first` of them.
@@ -150,15 +167,17 @@ mod tests {
     /// aborted a load under a memory limit that the check of its pixels had passed.
     #[test]
     fn a_baseline_frame_in_separate_scans_holds_its_coefficients() {
-        let f = coefficient_jpeg_frame(&baseline_in_scans(12_000, 12_000, 1)).unwrap();
+        let f = jpeg_frame(&baseline_in_scans(12_000, 12_000, 1)).unwrap();
         assert_eq!(
             (f.width, f.height, f.components, f.scans),
             (12_000, 12_000, 3, 1)
         );
-        assert!(!f.progressive);
+        assert!(!f.progressive && f.holds_coefficients());
         assert_eq!(f.coefficient_bytes(), 2 * 3 * 12_000 * 12_000);
-        assert_eq!(coefficient_jpeg_frame(&baseline_in_scans(64, 64, 3)), None);
-        let two = coefficient_jpeg_frame(&baseline_in_scans(33, 1, 2)).unwrap();
+        assert!(!jpeg_frame(&baseline_in_scans(64, 64, 3))
+            .unwrap()
+            .holds_coefficients());
+        let two = jpeg_frame(&baseline_in_scans(33, 1, 2)).unwrap();
         assert_eq!((two.scans, two.coefficient_bytes()), (1, 2 * 3 * 33));
     }
 }

@@ -7,7 +7,7 @@
 use image::{DynamicImage, ImageDecoder};
 
 use super::gif_frame::first_gif_frame;
-use super::jpeg_frame::{coefficient_jpeg_frame, JpegFrame};
+use super::jpeg_frame::{jpeg_frame, JpegFrame};
 
 /// Largest side of a texture as the scene keeps it: 4096² RGBA8 is 64 MiB (85 with the GPU's
 /// mipmaps), the largest `GL_MAX_TEXTURE_SIZE` many phones have, and more texels than a 4K
@@ -92,8 +92,9 @@ pub(crate) fn decode_texture_bytes(
     // Bytes the decoder holds besides the image it gives: a JPEG's coefficients (here), a
     // GIF's frame decoded apart from its screen (below).
     let mut held = 0;
-    if format == Some(image::ImageFormat::Jpeg) {
-        if let Some(frame) = coefficient_jpeg_frame(bytes) {
+    let jpeg = (format == Some(image::ImageFormat::Jpeg)).then(|| jpeg_frame(bytes));
+    if let Some(Some(frame)) = &jpeg {
+        if frame.holds_coefficients() {
             let (w, h) = (frame.width, frame.height);
             held = frame.coefficient_bytes();
             let output = u64::from(w) * u64::from(h) * JPEG_OUTPUT_BYTES_PER_PIXEL;
@@ -109,11 +110,14 @@ pub(crate) fn decode_texture_bytes(
                     MAX_COEFFICIENT_DECODE_BYTES >> 20
                 ));
             }
-            budget.take_scans(&frame)?;
+            budget.take_scans(frame)?;
         }
     }
     let decoder = first.into_decoder().map_err(undecodable)?;
     let (w, h) = decoder.dimensions();
+    if let Some(seen) = &jpeg {
+        decodes_the_frame_seen(seen.as_ref(), (w, h))?;
+    }
     let bytes_per_pixel = decoder.color_type().bytes_per_pixel();
     drop(decoder);
     // Some decoders (GIF) give an image of no rows or columns rather than an error.
@@ -251,6 +255,26 @@ fn undecodable(e: &image::ImageError) -> String {
 /// kilobytes each) named by many materials would take gigabytes. A texture past it is left out
 /// with a warning and its material keeps its flat colour.
 pub const MAX_SCENE_TEXTURE_BYTES: u64 = 1 << 30;
+
+/// Whether the JPEG decoder, having read the headers, decodes the frame that
+/// [`jpeg_frame`]'s walk of them found (`seen`) at `decoded`: the checks of what its decode
+/// holds are only as good as that walk, so a file the two read apart is refused rather than
+/// decoded unchecked.
+fn decodes_the_frame_seen(seen: Option<&JpegFrame>, decoded: (u32, u32)) -> Result<(), String> {
+    let seen_size = seen.map(|f| (f.width, f.height));
+    if seen_size == Some(decoded) {
+        return Ok(());
+    }
+    let seen = match seen_size {
+        Some((w, h)) => format!("a frame of {w}×{h}"),
+        None => "no frame".to_string(),
+    };
+    Err(format!(
+        "could not be decoded (its segment headers read two ways: {seen} before decoding, \
+         {}×{} to the decoder)",
+        decoded.0, decoded.1
+    ))
+}
 
 /// What is left of one scene load's [`MAX_SCENE_TEXTURE_BYTES`]: every texture a load keeps
 /// takes its part before it is decoded.
@@ -401,18 +425,16 @@ mod tests {
             components: 3,
             scans: 0,
             progressive: true,
+            first_scan: None,
         };
-        assert_eq!(
-            coefficient_jpeg_frame(&progressive),
-            Some(frame(16_384, 10_922))
-        );
+        assert_eq!(jpeg_frame(&progressive), Some(frame(16_384, 10_922)));
         // Stray bytes and a stuffed zero before the frame, which the decoder skips, hide it
         // from no one.
         for junk in [&[0x00][..], &[0xFF, 0x00], &[0x12, 0xFF, 0xFF]] {
             let mut hidden = progressive[..2].to_vec();
             hidden.extend(junk);
             hidden.extend(&progressive[2..]);
-            assert_eq!(coefficient_jpeg_frame(&hidden), Some(frame(16_384, 10_922)));
+            assert_eq!(jpeg_frame(&hidden), Some(frame(16_384, 10_922)));
             let err = decode_texture_bytes(&hidden, jpeg, &mut budget).unwrap_err();
             assert!(err.contains("progressive JPEG"), "{junk:?}: {err}");
         }
@@ -424,15 +446,14 @@ mod tests {
             "refused before anything was taken"
         );
         // Small ones, and baseline ones of any size, go to the decoder.
-        assert_eq!(
-            coefficient_jpeg_frame(&jpeg_header(0xC0, 16_384, 10_922)),
-            None
-        );
+        assert!(!jpeg_frame(&jpeg_header(0xC0, 16_384, 10_922))
+            .unwrap()
+            .holds_coefficients());
         let small = jpeg_header(0xC2, 64, 64);
         let err = decode_texture_bytes(&small, jpeg, &mut budget).unwrap_err();
         assert!(!err.contains("progressive"), "{err}");
         let baseline = encoded(image::RgbImage::new(8, 8).into(), image::ImageFormat::Jpeg);
-        assert_eq!(coefficient_jpeg_frame(&baseline), None);
+        assert!(!jpeg_frame(&baseline).unwrap().holds_coefficients());
     }
 
     /// A JPEG that the decoder reads up to its first scan: a quantisation table, a frame of
@@ -535,6 +556,81 @@ mod tests {
         let interleaved = jpeg_to_first_scan(0xC0, 64, 64, 3, 3);
         let decoded = decode_texture_bytes(&interleaved, jpeg, &mut budget);
         assert_eq!(decoded.map(|i| i.width()), Ok(64));
+    }
+
+    /// `jpeg` with a segment of `marker` holding `body` after its SOI.
+    fn with_segment_first(jpeg: &[u8], marker: u8, body: &[u8]) -> Vec<u8> {
+        let mut b = jpeg[..2].to_vec();
+        b.extend([0xFF, marker]);
+        b.extend((body.len() as u16 + 2).to_be_bytes());
+        b.extend(body);
+        b.extend(&jpeg[2..]);
+        b
+    }
+
+    /// zune-jpeg reads every marker before the first scan as a segment with a length (`FF 01`
+    /// and `FF D0`–`D8` too) and skips the frames it does not decode (SOF3 and up). Walked as
+    /// markers without a length, a 199-byte progressive JPEG of 16 384² hid its frame behind a
+    /// fake 1×1 one inside such a segment, passed the coefficient check and aborted a load
+    /// under a 900 MB limit. Each such file is read as the decoder reads it.
+    #[test]
+    fn a_frame_behind_segments_the_decoder_skips_is_the_one_checked() {
+        let jpeg = Some(image::ImageFormat::Jpeg);
+        let fake_frame = [8, 0, 1, 0, 1, 1, 1, 0x11, 0];
+        let in_segment = [&[0xFF, 0xC2, 0, 11][..], &fake_frame].concat();
+        let hidings = [0x01, 0xD0, 0xD7, 0xD8, 0xF0]
+            .map(|marker| (marker, &in_segment[..]))
+            .into_iter()
+            .chain([0xC3, 0xC5, 0xCA, 0xCF].map(|marker| (marker, &fake_frame[..])));
+        for (marker, body) in hidings {
+            let what = format!("behind FF {marker:02X}");
+            // Small: the decoder decodes it, at the size the walk found.
+            let mut budget = TextureBudget::default();
+            let small = with_segment_first(&jpeg_to_first_scan(0xC0, 64, 48, 3, 3), marker, body);
+            let f = jpeg_frame(&small).unwrap();
+            assert_eq!((f.width, f.height), (64, 48), "{what}");
+            let decoded = decode_texture_bytes(&small, jpeg, &mut budget);
+            assert_eq!(
+                decoded.map(|i| (i.width(), i.height())),
+                Ok((64, 48)),
+                "{what}"
+            );
+            // Large: refused from the frame the decoder would decode.
+            let large = jpeg_to_first_scan(0xC2, 12_000, 12_000, 3, 1);
+            let large = with_segment_first(&large, marker, body);
+            let f = jpeg_frame(&large).unwrap();
+            assert_eq!((f.width, f.height), (12_000, 12_000), "{what}");
+            let err = refusal(decode_texture_bytes(&large, jpeg, &mut budget));
+            assert!(
+                err.contains("progressive JPEG of 12000×12000"),
+                "{what}: {err}"
+            );
+        }
+    }
+
+    /// A JPEG whose headers the walk and the decoder read apart is refused, not decoded
+    /// unchecked.
+    #[test]
+    fn a_jpeg_read_two_ways_is_refused() {
+        let frame = |width, height| JpegFrame {
+            width,
+            height,
+            components: 3,
+            scans: 0,
+            progressive: false,
+            first_scan: None,
+        };
+        assert_eq!(
+            decodes_the_frame_seen(Some(&frame(64, 48)), (64, 48)),
+            Ok(())
+        );
+        let err = decodes_the_frame_seen(Some(&frame(1, 1)), (16_384, 16_384)).unwrap_err();
+        assert!(
+            err.contains("a frame of 1×1 before decoding, 16384×16384 to the decoder"),
+            "{err}"
+        );
+        let err = decodes_the_frame_seen(None, (64, 48)).unwrap_err();
+        assert!(err.contains("no frame before decoding"), "{err}");
     }
 
     /// The 24 greyscale 16 384 × 10 922 progressive JPEGs of 100 scans (380 KB each) that

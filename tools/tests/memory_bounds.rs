@@ -673,7 +673,8 @@ fn flat_shaded_gltf_vertices_are_counted_before_they_are_copied() {
 /// A PNG's colour profile is never used (textures are taken as sRGB), but the decoder
 /// inflated it up to its 512 MiB limit: a 4×4 texture whose 0.3 MB profile inflates to
 /// 300 MiB aborted a render under 384 MiB. The profile is now taken out unread, and the
-/// texture's colour reaches the frame.
+/// texture's colour reaches the frame. So too with bytes after the image's end, which the
+/// decoder ignores and which once hid the profile from the code that takes it out.
 #[test]
 fn a_pngs_colour_profile_is_not_inflated() {
     use image::ImageEncoder;
@@ -690,29 +691,75 @@ fn a_pngs_colour_profile_is_not_inflated() {
         .write_image(&red, 4, 4, image::ExtendedColorType::Rgba8)
         .unwrap();
     assert!(png.len() < 1 << 20, "{} bytes", png.len());
-    std::fs::write(dir.path().join("t.png"), png).unwrap();
+    let path = textured_quad(dir.path(), "t.png");
+    for trailing in [&b""[..], b"\0"] {
+        std::fs::write(dir.path().join("t.png"), [&png[..], trailing].concat()).unwrap();
+        let out = render_within_384_mib(&prlimit, &path, dir.path());
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(0), "{trailing:?}: {stderr}");
+        assert!(
+            !stderr.contains("t.png"),
+            "no warning of the texture: {stderr}"
+        );
+        let frame = image::open(dir.path().join("x.png")).unwrap().to_rgba8();
+        let centre = frame.get_pixel(4, 4).0;
+        assert!(centre[0] > 2 * centre[1].max(centre[2]), "{centre:?}");
+    }
+}
+
+/// A progressive JPEG of 16 384² in one component (its coefficients 512 MiB) whose frame
+/// hid behind a fake 1×1 one, inside a segment the decoder skips by its length and the
+/// check read as a marker without one: its coefficients went unchecked, and it aborted a
+/// render under a 900 MB address-space limit. It is refused from its real frame's headers.
+#[test]
+fn a_jpeg_frame_hidden_from_the_check_is_still_refused() {
+    let Ok(prlimit) = which_prlimit() else {
+        common::skip("no prlimit (util-linux) to bound the child's memory");
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let mut jpeg = vec![0xFF, 0xD8];
+    // `FF 01` holding a 1×1 progressive frame.
+    jpeg.extend([
+        0xFF, 0x01, 0, 15, 0xFF, 0xC2, 0, 11, 8, 0, 1, 0, 1, 1, 1, 0x11, 0,
+    ]);
+    jpeg.extend([0xFF, 0xDB, 0, 67, 0]);
+    jpeg.extend([1; 64]);
+    jpeg.extend([0xFF, 0xC2, 0, 11, 8, 0x40, 0, 0x40, 0, 1, 1, 0x11, 0]);
+    for class in [0x00, 0x10] {
+        // One code of length 1, for symbol 0.
+        jpeg.extend([0xFF, 0xC4, 0, 20, class, 1]);
+        jpeg.extend([0; 16]);
+    }
+    jpeg.extend([0xFF, 0xDA, 0, 8, 1, 1, 0, 0, 0, 0]);
+    jpeg.extend([0; 64]);
+    jpeg.extend([0xFF, 0xD9]);
+    std::fs::write(dir.path().join("t.jpg"), jpeg).unwrap();
+    let path = textured_quad(dir.path(), "t.jpg");
+    let out = render_within_384_mib(&prlimit, &path, dir.path());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{stderr}");
+    assert!(
+        stderr.contains("a progressive JPEG of 16384×16384"),
+        "{stderr}"
+    );
+}
+
+/// An OBJ quad in `dir` whose material maps `texture` (a file name in `dir`): its path.
+fn textured_quad(dir: &Path, texture: &str) -> std::path::PathBuf {
     std::fs::write(
-        dir.path().join("m.mtl"),
-        "newmtl m\nKd 1 1 1\nmap_Kd t.png\n",
+        dir.join("m.mtl"),
+        format!("newmtl m\nKd 1 1 1\nmap_Kd {texture}\n"),
     )
     .unwrap();
-    let path = dir.path().join("m.obj");
+    let path = dir.join("m.obj");
     std::fs::write(
         &path,
         "mtllib m.mtl\nusemtl m\nv -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\n\
          vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nf 1/1 2/2 3/3 4/4\n",
     )
     .unwrap();
-    let out = render_within_384_mib(&prlimit, &path, dir.path());
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(0), "{stderr}");
-    assert!(
-        !stderr.contains("t.png"),
-        "no warning of the texture: {stderr}"
-    );
-    let frame = image::open(dir.path().join("x.png")).unwrap().to_rgba8();
-    let centre = frame.get_pixel(4, 4).0;
-    assert!(centre[0] > 2 * centre[1].max(centre[2]), "{centre:?}");
+    path
 }
 
 /// `manylight render` of `scene` (8 × 8, into `dir`) under a 384 MiB address-space limit.
