@@ -50,9 +50,38 @@ pub(super) fn warn_of_unclipped_far(camera: &Camera, warned: &mut bool) {
     }
     *warned = true;
     log::warn!(
-        "camera.far {far:e} is {:.1e} times camera.near {near:e}: past about 4e6 a 32-bit \
+        "camera.far {far:e} is {} times camera.near {near:e}: past about 4e6 a 32-bit \
          float projection has no far plane to clip at, so geometry beyond camera.far is drawn \
          and lit; a larger near plane keeps it (docs/precision.md)",
-        far / near
+        quotient(far, near)
     );
+}
+
+/// `a / b` (both positive and finite) in scientific notation, also where it passes `f64`'s
+/// range (`1e308 / 1e-300`: `1.0e608`, not `inf`).
+fn quotient(a: f64, b: f64) -> String {
+    let q = a / b;
+    if q.is_finite() {
+        return format!("{q:.1e}");
+    }
+    let exponent = a.log10() - b.log10();
+    let (mut whole, mut mantissa) = (exponent.floor(), 10f64.powf(exponent.fract()));
+    // 9.96 would print as 10.0.
+    if mantissa >= 9.95 {
+        (whole, mantissa) = (whole + 1.0, 1.0);
+    }
+    format!("{mantissa:.1}e{whole}")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::quotient;
+
+    #[test]
+    fn a_quotient_past_f64_is_written_as_one() {
+        assert_eq!(quotient(4e7, 2.0), "2.0e7");
+        assert_eq!(quotient(1e308, 1e-300), "1.0e608");
+        assert_eq!(quotient(f64::MAX, 1e-300), "1.8e608");
+        assert_eq!(quotient(9.99e300, 1e-300), "1.0e601");
+    }
 }
