@@ -484,6 +484,40 @@ fn files_tobj_accepts_are_not_refused_by_the_checks() {
     );
 }
 
+/// The JPEG checks walk a file's segments as the decoder does and refuse one the two read
+/// apart: files from a real encoder (libjpeg-turbo 2.1's `cjpeg` of a 64×48 gradient:
+/// `-progressive`, `-progressive -restart 1B`, `-grayscale -progressive`, `-restart 1`) must
+/// pass them and load at their size, with no warning.
+#[test]
+fn jpegs_from_a_real_encoder_pass_the_checks() {
+    let images = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/images");
+    for name in [
+        "progressive_420.jpg",
+        "progressive_restarts.jpg",
+        "progressive_grey.jpg",
+        "baseline_restarts.jpg",
+    ] {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::copy(images.join(name), dir.path().join(name)).unwrap();
+        write(
+            dir.path(),
+            "m.mtl",
+            format!("newmtl m\nKd 1 1 1\nmap_Kd {name}\n"),
+        );
+        let path = write(
+            dir.path(),
+            "q.obj",
+            "mtllib m.mtl\nusemtl m\nv 0 0 0\nv 1 0 0\nv 1 1 0\nvt 0 0\nvt 1 0\nvt 1 1\n\
+             f 1/1 2/2 3/3\n",
+        );
+        let (scene, report) = load_obj(&path).unwrap();
+        assert!(report.warnings.is_empty(), "{name}: {:?}", report.warnings);
+        let texture = scene.materials[0].diffuse_texture.as_ref();
+        let size = texture.map(|t| t.image.dimensions());
+        assert_eq!(size, Some((64, 48)), "{name}");
+    }
+}
+
 #[test]
 fn a_latin1_name_loads_with_a_warning_and_cr_only_lines_load_as_lf_ones() {
     let dir = tempfile::tempdir().unwrap();
