@@ -45,7 +45,7 @@ pub mod normal_matrix;
 pub mod obj;
 mod one_way;
 mod orientation;
-mod png_profile;
+mod png_metadata;
 pub mod random;
 pub mod raycast;
 mod repeated_objects;

@@ -74,8 +74,8 @@ pub(crate) fn decode_texture_bytes(
     budget: &mut TextureBudget,
 ) -> Result<image::DynamicImage, String> {
     let undecodable = |e: image::ImageError| undecodable(&e);
-    let unprofiled = super::png_profile::without_colour_profile(bytes);
-    let bytes = unprofiled.as_deref().unwrap_or(bytes);
+    let without_metadata = super::png_metadata::without_metadata(bytes)?;
+    let bytes = without_metadata.as_deref().unwrap_or(bytes);
     let reader = || {
         let mut reader = image::ImageReader::new(std::io::Cursor::new(bytes));
         if let Some(format) = format {
