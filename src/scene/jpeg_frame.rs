@@ -40,64 +40,86 @@ impl JpegFrame {
     }
 }
 
+/// One marker segment with a length: its marker, where its `FF` lies, and where it ends
+/// (`at + 2 +` its length; past the bytes where they are cut).
+pub(crate) struct Segment {
+    pub marker: u8,
+    pub at: usize,
+    pub end: usize,
+}
+
+/// A JPEG's marker segments with a length, as zune-jpeg (the `image` crate's JPEG decoder)
+/// walks them, so that no segment hides another from one of the two: stray bytes, `FF 00`
+/// and fill between segments skipped; before the first scan every marker read as a segment
+/// with a length, as the decoder reads it; after it, restart markers skipped, having none.
+/// Ends at `EOI` or where a length is cut.
+pub(crate) fn segments(bytes: &[u8]) -> impl Iterator<Item = Segment> + '_ {
+    let mut at = 2; // past SOI
+    let mut scanning = false;
+    std::iter::from_fn(move || {
+        while at + 2 <= bytes.len() {
+            if bytes[at] != 0xFF {
+                at += 1;
+                continue;
+            }
+            let marker = bytes[at + 1];
+            match marker {
+                // Fill bytes before a marker, and a stuffed zero.
+                0xFF => at += 1,
+                0x00 => at += 2,
+                // End of image.
+                0xD9 => return None,
+                // Restart markers, inside a scan's entropy-coded data.
+                0xD0..=0xD7 if scanning => at += 2,
+                _ => {
+                    let length = bytes.get(at + 2..at + 4)?;
+                    let length = usize::from(u16::from_be_bytes([length[0], length[1]]));
+                    let segment = Segment {
+                        marker,
+                        at,
+                        end: at + 2 + length,
+                    };
+                    scanning |= marker == 0xDA;
+                    at = segment.end;
+                    return Some(segment);
+                }
+            }
+        }
+        None
+    })
+}
+
 /// The frame a JPEG's decoder decodes, with its scans where it holds their coefficients;
-/// `None` where the bytes hold no frame. Reads the segment headers only, within the bytes, as
-/// zune-jpeg (the `image` crate's JPEG decoder) walks them, so that no segment hides a frame
-/// or a scan from one of the two: it skips what the decoder skips between segments (stray
-/// bytes, `FF 00`, fill), knows the frames it knows (SOF0–2; it skips the others as unknown
-/// segments), and before the first scan reads every other marker as a segment with a length,
-/// as it does; after it, restart markers have none.
+/// `None` where the bytes hold no frame. Reads the segment headers only ([`segments`]), and
+/// knows the frames the decoder knows (SOF0–2; it skips the others as unknown segments).
 pub(crate) fn jpeg_frame(bytes: &[u8]) -> Option<JpegFrame> {
     let mut frame: Option<JpegFrame> = None;
-    let mut at = 2; // past SOI
-    while at + 2 <= bytes.len() {
-        if bytes[at] != 0xFF {
-            at += 1;
-            continue;
-        }
-        let marker = bytes[at + 1];
-        let scanning = frame.as_ref().is_some_and(|f| f.scans > 0);
-        match marker {
-            // Fill bytes before a marker, and a stuffed zero.
-            0xFF => at += 1,
-            0x00 => at += 2,
-            // End of image.
-            0xD9 => break,
-            // Restart markers, inside a scan's entropy-coded data.
-            0xD0..=0xD7 if scanning => at += 2,
-            _ => {
-                let Some(length) = bytes.get(at + 2..at + 4) else {
+    for Segment { marker, at, .. } in segments(bytes) {
+        match (marker, &mut frame) {
+            (0xC0..=0xC2, None) => {
+                // Length (2), precision (1), height (2), width (2), components (1).
+                let header = bytes.get(at + 5..at + 10)?;
+                frame = Some(JpegFrame {
+                    height: u16::from_be_bytes([header[0], header[1]]).into(),
+                    width: u16::from_be_bytes([header[2], header[3]]).into(),
+                    components: header[4],
+                    scans: 0,
+                    progressive: marker == 0xC2,
+                    first_scan: None,
+                });
+            }
+            (0xDA, Some(f)) => {
+                f.scans = f.scans.saturating_add(1);
+                let Some(&in_scan) = bytes.get(at + 4) else {
                     break;
                 };
-                let length = usize::from(u16::from_be_bytes([length[0], length[1]]));
-                match (marker, &mut frame) {
-                    (0xC0..=0xC2, None) => {
-                        // Length (2), precision (1), height (2), width (2), components (1).
-                        let header = bytes.get(at + 5..at + 10)?;
-                        frame = Some(JpegFrame {
-                            height: u16::from_be_bytes([header[0], header[1]]).into(),
-                            width: u16::from_be_bytes([header[2], header[3]]).into(),
-                            components: header[4],
-                            scans: 0,
-                            progressive: marker == 0xC2,
-                            first_scan: None,
-                        });
-                    }
-                    (0xDA, Some(f)) => {
-                        f.scans = f.scans.saturating_add(1);
-                        let Some(&in_scan) = bytes.get(at + 4) else {
-                            break;
-                        };
-                        f.first_scan.get_or_insert(in_scan);
-                        // A frame that makes pixels as its scans come is not read further.
-                        if !f.holds_coefficients() {
-                            break;
-                        }
-                    }
-                    _ => {}
+                f.first_scan.get_or_insert(in_scan);
+                // A frame that makes pixels as its scans come is not read further.
+                if !f.holds_coefficients() {
+                    break;
                 }
-                at += 2 + length;
             }
+            _ => {}
         }
     }
     frame

@@ -26,6 +26,7 @@ mod gif_frame;
 pub mod gltf;
 pub mod input;
 mod jpeg_frame;
+mod jpeg_metadata;
 mod json_count;
 #[cfg(test)]
 mod left_out_tests;

@@ -74,7 +74,11 @@ pub(crate) fn decode_texture_bytes(
     budget: &mut TextureBudget,
 ) -> Result<image::DynamicImage, String> {
     let undecodable = |e: image::ImageError| undecodable(&e);
-    let without_metadata = super::png_metadata::without_metadata(bytes)?;
+    // Metadata the renderer never reads, which the decoders copy, expand or reassemble.
+    let without_metadata = match super::png_metadata::without_metadata(bytes)? {
+        None => super::jpeg_metadata::without_metadata(bytes)?,
+        png => png,
+    };
     let bytes = without_metadata.as_deref().unwrap_or(bytes);
     let reader = || {
         let mut reader = image::ImageReader::new(std::io::Cursor::new(bytes));
