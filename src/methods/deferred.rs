@@ -253,6 +253,8 @@ struct InstancesKey {
     scale: u32,
     /// The instances hold spot terms (the variant has spots).
     spots: bool,
+    /// No light took its near side ([`ProxyReach::biased_toward`]).
+    biased_toward: bool,
 }
 
 /// What a light pass did.
@@ -398,6 +400,8 @@ impl Deferred {
             projection: ctx.projection.as_dmat4(),
             eye_plane_unreliable: dev.caps().loses_triangles_crossing_the_eye_plane(),
             rows: ctx.viewport.1,
+            biased_toward: in_gbuffer_any(ctx, |m| m.depth_bias > 0.0),
+            biased_away: in_gbuffer_any(ctx, |m| m.depth_bias < 0.0),
         };
         // Lights with the same proxy drawn together, as instances of it, in their order: the
         // state, program, uniforms and arrays set once for them. `k` numbers the lights drawn,
@@ -417,6 +421,7 @@ impl Deferred {
             rows: ctx.viewport.1,
             scale: scale.to_bits(),
             spots: features.has(ShaderFeatures::SPOT),
+            biased_toward: reach.biased_toward,
         };
         let reused = self.instances_key == Some(key)
             && self.lights.hold_all()
@@ -450,7 +455,7 @@ impl Deferred {
                 continue;
             }
             RenderState {
-                depth_test: proxy.depth_test(),
+                depth_test: reach.depth_test(proxy),
                 depth_write: false,
                 blend: Blend::Additive,
                 cull: proxy.cull(),

@@ -43,7 +43,9 @@ const MAX_PROXY_SPAN_PX: f64 = (1u64 << 24) as f64;
 ///
 /// Each is one-sided (no stencil). The far side everywhere would skip more in open scenes but
 /// evaluate far more in enclosed ones (the conference room); the near side first avoids that
-/// worst case.
+/// worst case. A depth bias (`Material::depth_bias`) moves the depth the tests read: where the
+/// G-buffer holds a surface drawn toward the camera no light takes its near side, and where
+/// it holds one drawn away the far side and the bound go untested ([`ProxyReach::depth_test`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(super) enum Proxy {
     NearSide,
@@ -95,6 +97,12 @@ pub(super) struct ProxyReach<'a> {
     pub eye_plane_unreliable: bool,
     /// The frame's height in pixels.
     pub rows: u32,
+    /// The G-buffer holds a surface drawn toward the camera, off its depth: a `LEQUAL` test
+    /// of a near side in front of it would fail where the light reaches it.
+    pub biased_toward: bool,
+    /// The G-buffer holds a surface drawn away from the camera: a `GEQUAL` test of a far side
+    /// or bound behind it would fail.
+    pub biased_away: bool,
 }
 
 impl ProxyReach<'_> {
@@ -106,7 +114,7 @@ impl ProxyReach<'_> {
         let coarse = self.camera.depth_step_at(f64::from(depth + radius), 24)
             > 0.1 * f64::from(light.cull_radius);
         let wide = self.too_wide(light, radius);
-        if !coarse && depth - radius >= 2.0 * self.near && !wide {
+        if !coarse && depth - radius >= 2.0 * self.near && !wide && !self.biased_toward {
             return Proxy::NearSide;
         }
         if coarse || depth + radius >= FAR_MARGIN * self.far || wide {
@@ -123,6 +131,21 @@ impl ProxyReach<'_> {
             Proxy::Bounded
         } else {
             Proxy::FarSide
+        }
+    }
+
+    /// How `proxy` is depth tested: its own test ([`Proxy::depth_test`]), or none where a
+    /// surface drawn off its depth could fail it.
+    pub(super) fn depth_test(&self, proxy: Proxy) -> DepthTest {
+        let defeated = match proxy {
+            Proxy::NearSide => self.biased_toward,
+            Proxy::FarSide | Proxy::Bounded => self.biased_away,
+            Proxy::FullScreen => false,
+        };
+        if defeated {
+            DepthTest::Off
+        } else {
+            proxy.depth_test()
         }
     }
 
@@ -200,6 +223,40 @@ mod tests {
             projection: camera.projection_matrix(16.0 / 9.0),
             eye_plane_unreliable,
             rows: 720,
+            biased_toward: false,
+            biased_away: false,
+        }
+    }
+
+    /// A surface drawn toward the camera leaves no light its near side; one drawn away leaves
+    /// the far side and the bound untested; both, the two.
+    #[test]
+    fn surfaces_drawn_off_their_depth_take_the_tests_they_cannot_fail() {
+        let camera = camera(0.1);
+        let ahead = light(DVec3::new(0.0, 0.0, -10.0), 2.0);
+        let head_lamp = light(DVec3::ZERO, 2.0);
+        for (toward, away) in [(false, false), (true, false), (false, true), (true, true)] {
+            let r = ProxyReach {
+                biased_toward: toward,
+                biased_away: away,
+                ..reach(&camera, true)
+            };
+            let tests = [&ahead, &head_lamp].map(|l| {
+                let p = r.proxy(l);
+                (p, r.depth_test(p))
+            });
+            let (near_side, far_side) = (
+                (Proxy::NearSide, DepthTest::LessEqual),
+                (Proxy::FarSide, DepthTest::GreaterEqual),
+            );
+            let untested = |p| (p, DepthTest::Off);
+            let expected = match (toward, away) {
+                (false, false) => [near_side, (Proxy::Bounded, DepthTest::GreaterEqual)],
+                (true, false) => [far_side, (Proxy::Bounded, DepthTest::GreaterEqual)],
+                (false, true) => [near_side, untested(Proxy::Bounded)],
+                (true, true) => [untested(Proxy::FarSide), untested(Proxy::Bounded)],
+            };
+            assert_eq!(tests, expected, "toward {toward}, away {away}");
         }
     }
 
