@@ -131,6 +131,19 @@ impl Device {
             .depth_bits
     }
 
+    /// Whether `target`, a framebuffer object, holds a colour buffer of integers (`RGBA8UI`,
+    /// `RG32I`, …) at `GL_COLOR_ATTACHMENT0`: a frame's colours cannot be written there (GL
+    /// leaves the values undefined). Asked where the context has the query (ES 3.0 state).
+    pub(crate) fn bound_colour_holds_integers(&self, target: Option<glow::Framebuffer>) -> bool {
+        if target.is_none() || !self.caps().context_has_es3_state() {
+            return false;
+        }
+        let colour = [glow::COLOR_ATTACHMENT0, glow::BACK];
+        let kind = [glow::FRAMEBUFFER_ATTACHMENT_COMPONENT_TYPE];
+        let values = self.bound_attachment(target, colour, &kind, &[true], true);
+        matches!(values, Some(Some([t])) if t == glow::INT as i32 || t == glow::UNSIGNED_INT as i32)
+    }
+
     /// The `pnames` that are `wanted` of `target`'s attachment (the first of
     /// `[in_object, in_default]` for a framebuffer object, the second for the default one;
     /// those not wanted 0): `Some(None)` where nothing is attached, `None` where the driver

@@ -1,7 +1,7 @@
 //! What a frame needs of the framebuffer the application bound ([`Renderer::render`]): complete,
-//! no larger than the driver's viewport, its colour at attachment 0, and with a depth buffer
-//! when the frame is drawn in it (an MSAA frame brings its own and only resolves there); a
-//! frame reaching past its colour buffer is warned of. Forward, tiled and clustered draw
+//! no larger than the driver's viewport, its colour at attachment 0 and not of integers, and
+//! with a depth buffer when the frame is drawn in it (an MSAA frame brings its own and only
+//! resolves there); a frame reaching past its colour buffer is warned of. Forward, tiled and clustered draw
 //! with the depth test there, and so does deferred for transparent objects and for a frame
 //! without lights; deferred's opaque composite alone does not, but one rule for every method
 //! and frame is what the README asks of a game.
@@ -47,9 +47,10 @@ impl Renderer {
         // Asked again for another framebuffer, or after a failed frame: one the game made
         // incomplete since fails its draws with GL_INVALID_FRAMEBUFFER_OPERATION, and the next
         // frame names why.
-        let status = match self.complete_target.take() {
-            Some(complete) if complete == target => glow::FRAMEBUFFER_COMPLETE,
-            _ => self.dev.bound_framebuffer_status(),
+        let checked = matches!(self.complete_target.take(), Some(complete) if complete == target);
+        let status = match checked {
+            true => glow::FRAMEBUFFER_COMPLETE,
+            false => self.dev.bound_framebuffer_status(),
         };
         self.dev
             .check_status_call(status, "the bound framebuffer")?;
@@ -65,6 +66,15 @@ impl Renderer {
             return Err(GlError::BoundFramebuffer(
                 "it has no colour buffer at GL_COLOR_ATTACHMENT0, the one the frame is drawn \
                  into (a colour buffer at another attachment is not): attach it there"
+                    .to_string(),
+            )
+            .into());
+        }
+        if !checked && self.dev.bound_colour_holds_integers(target) {
+            return Err(GlError::BoundFramebuffer(
+                "its colour buffer at GL_COLOR_ATTACHMENT0 stores integers (an RGBA8UI-like \
+                 format), to which a frame's colours cannot be written: attach a normalized \
+                 (RGBA8, SRGB8_ALPHA8) or float one"
                     .to_string(),
             )
             .into());

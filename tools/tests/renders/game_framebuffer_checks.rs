@@ -110,6 +110,31 @@ fn a_framebuffer_without_depth_is_refused_and_a_shallow_one_warned_of() {
     }
 }
 
+/// A colour buffer of integers takes no frame's colours (GL leaves them undefined): drawn
+/// into, an `RGBA8UI` one read back only 0s and 255s with `Ok`, and an MSAA frame's resolve
+/// failed naming the resolve. It is refused, naming the format, either way.
+#[test]
+fn a_framebuffer_of_integer_colour_is_refused() {
+    let (_ctx, gl, mut r) = game(EsVersion::Es3);
+    for samples in [1, 4] {
+        let options = RenderOptions {
+            samples,
+            ..Default::default()
+        };
+        for format in [glow::RGBA8UI, glow::RGBA16I] {
+            unsafe { game_fbo_of(&gl, format, Some(glow::DEPTH_COMPONENT24)) };
+            let err = render(&mut r, &options).unwrap_err();
+            assert!(
+                matches!(&err, Error::Gl(GlError::BoundFramebuffer(m)) if m.contains("integers")),
+                "{format:#x} ×{samples}: {err}"
+            );
+        }
+        // A normalized one still takes the frame.
+        unsafe { game_fbo_of(&gl, glow::RGBA8, Some(glow::DEPTH_COMPONENT24)) };
+        render(&mut r, &options).unwrap();
+    }
+}
+
 /// HDR colour into a game's RGBA8 framebuffer is clamped there, which was silent: it is warned
 /// of once a renderer, and neither an LDR frame there nor HDR into a float colour buffer
 /// (where the context can draw one) is.
