@@ -421,7 +421,10 @@ impl Scene {
 
     /// Points the camera at the scene bounds from a three-quarter view that keeps all of them
     /// in the picture, with a margin, at any aspect (width / height) of at least 1: square
-    /// and landscape pictures. A scene without geometry keeps its camera.
+    /// and landscape pictures. A scene without geometry keeps its camera. A scene so large
+    /// (placed up to 10¹² out, as objects may be) that the eye would lie past
+    /// the camera's ±10¹² gets that eye all the same, and a frame refuses it naming
+    /// `camera.position`: such a scene takes a camera of its own.
     pub fn frame_camera(&mut self) {
         if let Some(b) = self.bounds() {
             self.camera = framing::framing(&b);
