@@ -450,6 +450,15 @@ fn usage_errors_exit_2_and_name_the_flags() {
             "invalid value '-inf' for '--lights",
         ),
         (&["bench-assign", "--runs", "-nan"], "for '--runs"),
+        // Nor a size or a list: each is its option's value, refused as one.
+        (
+            &["render", "--size", "-64x36"],
+            "invalid value '-64x36' for '--size",
+        ),
+        (
+            &["bench", "--lights", "-1,2"],
+            "invalid value '-1' for '--lights",
+        ),
         (&["bench-assign", "--runs", "-2"], "for '--runs"),
     ];
     for (args, needle) in cases {

@@ -455,23 +455,26 @@ pub(crate) fn version_unavailable(e: &(dyn std::error::Error + 'static)) -> bool
 }
 
 /// Every option that takes a value reads a negative number as one: `--lights -1` is then
-/// refused as a bad value of `--lights`, not as an unexpected argument `-1`; an option whose
-/// value is a number takes anything after it (`--lights -inf`: not the flags `-i`, `-n`, …).
+/// refused as a bad value of `--lights`, not as an unexpected argument `-1`; an option of one
+/// value that is not text or a path (a number, a size, a list) takes anything after it
+/// (`--lights -inf`, `--size -64x36`: not the flags `-i`, `-6`, …).
 fn negative_values(command: clap::Command) -> clap::Command {
     use std::any::TypeId;
-    let numbers = [
-        TypeId::of::<u32>(),
-        TypeId::of::<u64>(),
-        TypeId::of::<usize>(),
-        TypeId::of::<f32>(),
-        TypeId::of::<f64>(),
+    let texts = [
+        TypeId::of::<String>(),
+        TypeId::of::<std::path::PathBuf>(),
+        TypeId::of::<std::ffi::OsString>(),
     ];
     command
         .mut_args(|a| {
             let takes = a.get_action().takes_values();
-            let number = numbers.iter().any(|n| a.get_value_parser().type_id() == *n);
+            let option = a.get_long().is_some() || a.get_short().is_some();
+            let one_value = a
+                .get_num_args()
+                .is_none_or(|n| n.min_values() == 1 && n.max_values() == 1);
+            let text = texts.iter().any(|t| a.get_value_parser().type_id() == *t);
             a.allow_negative_numbers(takes)
-                .allow_hyphen_values(takes && number)
+                .allow_hyphen_values(takes && option && one_value && !text)
         })
         .mut_subcommands(negative_values)
 }
