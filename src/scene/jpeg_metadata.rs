@@ -5,7 +5,7 @@
 //! pieces among empty comments took 108 s to load, the time growing with the square of the
 //! file's size.
 
-use super::jpeg_frame::{segments, Segment};
+use super::jpeg_frame::segments;
 
 /// `APP1`, `APP2` and `APP13`.
 const METADATA: [u8; 3] = [0xE1, 0xE2, 0xED];
@@ -16,15 +16,17 @@ pub(crate) fn without_metadata(bytes: &[u8]) -> Result<Option<Vec<u8>>, String> 
     if !bytes.starts_with(&[0xFF, 0xD8]) {
         return Ok(None);
     }
-    let metadata: Vec<Segment> = segments(bytes)
-        .take_while(|s| s.marker != 0xDA)
-        .filter(|s| METADATA.contains(&s.marker) && s.end <= bytes.len())
-        .collect();
-    if metadata.is_empty() {
+    let len = bytes.len();
+    // Walked twice rather than kept: a file of tiny segments holds millions.
+    let metadata = || {
+        segments(bytes)
+            .take_while(|s| s.marker != 0xDA)
+            .filter(move |s| METADATA.contains(&s.marker) && s.end <= len)
+    };
+    if metadata().next().is_none() {
         return Ok(None);
     }
     let mut kept = Vec::new();
-    let len = bytes.len();
     if !super::alloc_probe::can_allocate(len as u64) || kept.try_reserve_exact(len).is_err() {
         return Err(format!(
             "could not be decoded (a copy of its {} MiB without its metadata cannot be \
@@ -33,7 +35,7 @@ pub(crate) fn without_metadata(bytes: &[u8]) -> Result<Option<Vec<u8>>, String> 
         ));
     }
     let mut from = 0;
-    for segment in metadata {
+    for segment in metadata() {
         kept.extend_from_slice(&bytes[from..segment.at]);
         from = segment.end;
     }

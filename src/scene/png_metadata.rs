@@ -19,21 +19,27 @@ pub(crate) fn without_metadata(bytes: &[u8]) -> Result<Option<Vec<u8>>, String> 
     let Some(chunks) = bytes.strip_prefix(SIGNATURE) else {
         return Ok(None);
     };
-    let mut metadata = Vec::new();
-    let mut at = 0usize;
+    // Walked twice rather than kept: a file of tiny chunks holds millions.
+    let walk = || {
+        let mut at = 0usize;
+        let mut ended = false;
+        std::iter::from_fn(move || {
+            let chunk = whole_chunk(chunks, at).filter(|_| !ended)?;
+            let kind = &chunks[at + 4..at + 8];
+            ended = kind == b"IEND";
+            at = chunk.end;
+            Some((chunk, METADATA.iter().any(|m| kind == &m[..])))
+        })
+    };
     let mut end_of_image = chunks.len();
-    while let Some(chunk) = whole_chunk(chunks, at) {
-        let kind = &chunks[at + 4..at + 8];
-        if METADATA.iter().any(|m| kind == &m[..]) {
-            metadata.push(at..chunk.end);
-        }
-        at = chunk.end;
-        if kind == b"IEND" {
-            end_of_image = at;
-            break;
+    let mut any = false;
+    for (chunk, metadata) in walk() {
+        any |= metadata;
+        if &chunks[chunk.start + 4..chunk.start + 8] == b"IEND" {
+            end_of_image = chunk.end;
         }
     }
-    if metadata.is_empty() {
+    if !any {
         return Ok(None);
     }
     let mut kept = Vec::new();
@@ -47,7 +53,7 @@ pub(crate) fn without_metadata(bytes: &[u8]) -> Result<Option<Vec<u8>>, String> 
     }
     kept.extend_from_slice(SIGNATURE);
     let mut from = 0;
-    for chunk in metadata {
+    for (chunk, _) in walk().filter(|(_, metadata)| *metadata) {
         kept.extend_from_slice(&chunks[from..chunk.start]);
         from = chunk.end;
     }
