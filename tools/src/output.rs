@@ -2,8 +2,8 @@
 //! buffer that is flushed and synced, the first write error is kept even where an encoder
 //! swallows it (the GIF trailer), and every error names the file.
 //!
-//! A regular file is written to a hidden temporary file beside it (`.NAME.PID.N.tmp`) that is
-//! renamed over it once complete: a failure half-way (a full disk) leaves the old file, or
+//! A regular file is written to a hidden temporary file beside it (`.NAME.PID.N.tmp`, or
+//! `.manylight.PID.N.tmp` for a name too long for that) that is renamed over it once complete: a failure half-way (a full disk) leaves the old file, or
 //! none, never a truncated one that looks valid. A device, FIFO or socket, standard output
 //! (`-`, `/dev/stdout`: from where the shell left it, whatever it is) and a name that reopens a
 //! descriptor (`/dev/fd/N`, `/proc/self/fd/N`: truncated) are written in place. A FIFO that no
@@ -301,15 +301,24 @@ fn follow_links(path: &Path) -> PathBuf {
     path
 }
 
-/// Creates `.NAME.PID.N.tmp` beside `dest`, new (never an existing file).
+/// Longest file name most file systems take, in bytes (ext4's, tmpfs's, APFS's `NAME_MAX`).
+const NAME_MAX: usize = 255;
+
+/// Creates `.NAME.PID.N.tmp` beside `dest`, new (never an existing file); `.manylight.PID.N.tmp`
+/// where NAME is too long for that, so a name the file system takes is written.
 fn create_temp(dest: &Path) -> io::Result<(PathBuf, File)> {
     let name = dest
         .file_name()
         .ok_or_else(|| io::Error::new(io::ErrorKind::InvalidInput, "the path names no file"))?;
-    let mut temp_name = OsString::from(".");
-    temp_name.push(name);
     let n = TEMP_COUNTER.fetch_add(1, Ordering::Relaxed);
-    temp_name.push(format!(".{}.{n}.tmp", std::process::id()));
+    let suffix = format!(".{}.{n}.tmp", std::process::id());
+    let mut temp_name = OsString::from(".");
+    if 1 + name.len() + suffix.len() <= NAME_MAX {
+        temp_name.push(name);
+    } else {
+        temp_name.push("manylight");
+    }
+    temp_name.push(suffix);
     let temp = dest.with_file_name(temp_name);
     let mut live = live_temporaries();
     let file = OpenOptions::new()
@@ -565,6 +574,26 @@ mod tests {
             1,
             "a temporary file is left"
         );
+    }
+
+    /// A name of up to 255 bytes, which the file system takes, is written: its temporary
+    /// file's name, 13 or more bytes longer, was refused ("File name too long").
+    #[test]
+    fn the_longest_name_the_file_system_takes_is_written() {
+        let tmp = tempfile::tempdir().unwrap();
+        let dir = tmp.path();
+        for length in [240, NAME_MAX] {
+            let path = dir.join(format!("{}.json", "a".repeat(length - 5)));
+            std::fs::write(&path, "old").unwrap();
+            write_bytes(&path, b"new").unwrap();
+            assert_eq!(std::fs::read(&path).unwrap(), b"new", "{length}");
+            std::fs::remove_file(&path).unwrap();
+            assert_eq!(
+                std::fs::read_dir(dir).unwrap().count(),
+                0,
+                "{length}: a temporary file is left"
+            );
+        }
     }
 
     #[test]

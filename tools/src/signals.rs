@@ -1,13 +1,18 @@
 //! Signals that end the command line (SIGINT, SIGTERM, SIGHUP: Ctrl-C, `kill`, a closed
 //! terminal) first remove the temporary output files being written (`output`), then end the
 //! process by the signal's default action, with the same exit status: a `--record` stopped
-//! half-way leaves no `.NAME.PID.N.tmp` behind.
+//! half-way leaves no `.NAME.PID.N.tmp` behind. A file size limit's signal is ignored.
 
 /// Starts the thread that watches the signals. A signal the process started with ignored
-/// (`nohup` ignores SIGHUP, a shell's `cmd &` SIGINT) stays ignored.
+/// (`nohup` ignores SIGHUP, a shell's `cmd &` SIGINT) stays ignored. SIGXFSZ, which a write
+/// past `ulimit -f` raises and which would end the process leaving its temporary files, is
+/// ignored: the write fails with `EFBIG` instead, an error naming the file.
 #[cfg(unix)]
 pub fn remove_temporaries_on_signals() {
     use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
+    // SAFETY: setting a signal's action to `SIG_IGN` installs no handler, and nothing else in
+    // the process sets SIGXFSZ's.
+    unsafe { libc::signal(libc::SIGXFSZ, libc::SIG_IGN) };
     let watched: Vec<i32> = [SIGINT, SIGTERM, SIGHUP]
         .into_iter()
         .filter(|&s| !is_ignored(s))

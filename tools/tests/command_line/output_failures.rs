@@ -205,10 +205,11 @@ fn standard_output_onto_a_full_disk_fails_but_a_closed_pipe_does_not() {
     }
 }
 
-/// Runs `manylight ARGS` with its file size limited to `kib` KiB (writes past it fail with
-/// EFBIG instead of killing the process).
+/// Runs `manylight ARGS` with its file size limited to `kib` KiB. SIGXFSZ keeps its default
+/// action, which ends the process (with temporary files left) unless it ignores the signal
+/// and takes the write's EFBIG as an error.
 fn with_file_size_limit(args: &[&str], cwd: &Path, kib: u32) -> std::process::Output {
-    let script = format!("trap '' XFSZ; ulimit -f {}; exec \"$0\" \"$@\"", kib * 2);
+    let script = format!("ulimit -f {}; exec \"$0\" \"$@\"", kib * 2);
     Command::new("sh")
         .arg("-c")
         .arg(script)
@@ -250,6 +251,22 @@ fn an_output_failing_half_way_leaves_the_old_file_whole_and_no_partial_one() {
     // Without the limit the same command replaces it with a whole picture.
     expect_status(&strs(&args), &[], cwd, 0);
     image::open(cwd.join("a.png")).expect("a whole PNG");
+}
+
+/// An output's name reaches a message with its control characters escaped: a file named
+/// `x⏎error: fake` given to `--record` printed a second, made-up `error:` line.
+#[test]
+fn an_output_name_reaches_messages_escaped() {
+    let dir = tempfile::tempdir().unwrap();
+    let cwd = dir.path();
+    let name = "x\nerror: fake";
+    std::fs::write(cwd.join(name), "").unwrap();
+    let args = [
+        "--size", "16x9", "--lights", "4", "--frames", "1", "--record", name,
+    ];
+    let msg = expect_status(&args, &[], cwd, 1);
+    assert!(msg.contains("x\\u{a}error: fake"), "{msg}");
+    assert!(!msg.lines().any(|l| l.starts_with("error: fake")), "{msg}");
 }
 
 #[test]

@@ -374,13 +374,13 @@ pub fn run(args: &BenchArgs) -> Result<(), Box<dyn std::error::Error>> {
     std::fs::create_dir_all(&args.out).map_err(|e| {
         format!(
             "cannot create the output folder {}: {e}",
-            args.out.display()
+            shown::path(&args.out)
         )
     })?;
     let probe = args.out.join(".manylight-write-test");
     std::fs::write(&probe, b"")
         .and_then(|()| std::fs::remove_file(&probe))
-        .map_err(|e| format!("cannot write into {}: {e}", args.out.display()))?;
+        .map_err(|e| format!("cannot write into {}: {e}", shown::path(&args.out)))?;
     // The report's own files, where something is in the way (a folder of that name, a file
     // that cannot be written): found after the whole sweep before.
     for name in ["report.json", "report.md"] {
@@ -554,7 +554,7 @@ pub fn run(args: &BenchArgs) -> Result<(), Box<dyn std::error::Error>> {
         "{} configurations in {:.0} s → {}",
         report.rows.len(),
         report.seconds,
-        args.out.display()
+        shown::path(&args.out)
     );
     Ok(())
 }

@@ -205,12 +205,12 @@ fn format_text(
         caps.implementation(),
         egl.gles_lib.as_ref().map_or_else(
             || "the system's libEGL.so.1".to_string(),
-            |d| format!("--gles-lib {}", d.display())
+            |d| format!("--gles-lib {}", manylight::scene::shown::path(d))
         )
     );
     // Read here, not at every context's creation: only `info` shows them.
     for f in &manylight::gl::gles_lib::loaded_files() {
-        w!(out, "  {}", f.display());
+        w!(out, "  {}", manylight::scene::shown::path(f));
     }
     w!(
         out,

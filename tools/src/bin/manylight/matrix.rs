@@ -232,7 +232,7 @@ pub fn run(args: &MatrixArgs, gles_libs: &[PathBuf]) -> Result<(), Box<dyn std::
     let out = args.out.as_deref();
     if let Some(out) = out {
         std::fs::create_dir_all(out)
-            .map_err(|e| format!("cannot create {}: {e}", out.display()))?;
+            .map_err(|e| format!("cannot create {}: {e}", scene::shown::path(out)))?;
     }
     let json_out = args.json.as_deref().map(JsonOut::create).transpose()?;
     // `-`, or a name of standard output (`/dev/stdout`): the table then goes to stderr.
@@ -274,7 +274,7 @@ pub fn run(args: &MatrixArgs, gles_libs: &[PathBuf]) -> Result<(), Box<dyn std::
         out.commit(&json)?;
     }
     if let (Some(file), Some(out)) = (sheet_file, out) {
-        let path = file.path().display().to_string();
+        let path = scene::shown::path(file.path());
         file.commit_png(&sheet(&rows, out))?;
         eprintln!("contact sheet: {path}");
     }
@@ -309,7 +309,7 @@ fn group_rows(
     lib: Option<&Path>,
     group: usize,
 ) -> Result<Vec<Value>, Box<dyn std::error::Error>> {
-    let label = lib.map_or_else(|| "system".to_string(), |d| d.display().to_string());
+    let label = lib.map_or_else(|| "system".to_string(), scene::shown::path);
     let mut rows = Vec::new();
     let wanted = if lib.is_none() {
         Groups::System

@@ -11,7 +11,7 @@ use image::codecs::gif::{GifEncoder, Repeat};
 use image::{Delay, Frame, RgbaImage};
 use manylight::metrics::spread::Spread;
 use manylight::renderer::FrameStats;
-use manylight::scene::Scene;
+use manylight::scene::{shown, Scene};
 use manylight::{RenderOptions, Renderer};
 use manylight_tools::output::{self, OutputFile};
 
@@ -82,14 +82,14 @@ impl Recorder {
     fn open(path: &Path, timeline: &Timeline) -> Result<Recorder, String> {
         if records_gif(path) {
             if let Some(warning) = gif_timing_warning(timeline.fps) {
-                log::warn!("--record {}: {warning}", path.display());
+                log::warn!("--record {}: {warning}", shown::path(path));
             }
             let file = OutputFile::create(path).map_err(|e| format!("--record: {e}"))?;
             let file = SharedFile(Rc::new(RefCell::new(file)));
             let mut encoder = GifEncoder::new_with_speed(file.clone(), 10);
             encoder
                 .set_repeat(Repeat::Infinite)
-                .map_err(|e| format!("--record {}: {e}", path.display()))?;
+                .map_err(|e| format!("--record {}: {e}", shown::path(path)))?;
             return Ok(Recorder::Gif(Box::new(encoder), file));
         }
         // A device or file there said only "File exists".
@@ -97,11 +97,11 @@ impl Recorder {
             return Err(format!(
                 "--record {}: not a folder (frames go into a folder as PNGs; a name ending in \
                  .gif records an animated GIF)",
-                path.display()
+                shown::path(path)
             ));
         }
         std::fs::create_dir_all(path)
-            .map_err(|e| format!("--record: cannot create {}: {e}", path.display()))?;
+            .map_err(|e| format!("--record: cannot create {}: {e}", shown::path(path)))?;
         let last = timeline.frames.saturating_sub(1);
         let digits = frame_digits(timeline.frames);
         let stale = stale_frames(path, timeline.frames, digits);
@@ -110,7 +110,7 @@ impl Recorder {
                 "--record {}: {stale} frame_*.png from before stay beside this recording's \
                  {} frames (this run writes frame_{:0digits$} to frame_{last:0digits$}): \
                  record into an empty folder",
-                path.display(),
+                shown::path(path),
                 timeline.frames,
                 0
             );
@@ -135,7 +135,7 @@ impl Recorder {
                 let frame =
                     Frame::from_parts(image, 0, 0, Delay::from_numer_denom_ms(centis * 10, 1));
                 encoder.encode_frame(frame).map_err(|e| {
-                    let path = file.0.borrow().path().display().to_string();
+                    let path = shown::path(file.0.borrow().path());
                     format!("cannot write {path}: {e}")
                 })
             }

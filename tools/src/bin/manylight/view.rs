@@ -29,7 +29,7 @@ use clap::Parser;
 use fly_camera::{FlyCamera, Move};
 use manylight::methods::METHODS;
 use manylight::renderer::CountKind;
-use manylight::scene::{self, Scene};
+use manylight::scene::{self, shown, Scene};
 use manylight::{EsVersion, FrameStats, RenderOptions};
 use window_gl::Gfx;
 use winit::application::ApplicationHandler;
@@ -495,7 +495,7 @@ impl App<'_> {
             if let Some(path) = &self.args.screenshot {
                 let image = g.read_back(size)?;
                 manylight_tools::output::save_png(path, &image).map_err(|e| e.to_string())?;
-                line += &format!(" → {}", path.display());
+                line += &format!(" → {}", shown::path(path));
             }
             say(self.args, &format!("{line}\n"))?;
             self.done = true;
