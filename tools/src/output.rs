@@ -344,6 +344,11 @@ impl OutputFile {
         P: image::PixelWithColorType,
         [P::Subpixel]: image::EncodableLayout,
     {
+        // The encoder holds the whole compressed picture, at most about its raw size.
+        let raw = std::mem::size_of_val(image.as_raw().as_slice()) as u64;
+        if let Err(e) = encoding_fits(raw, image.dimensions()) {
+            return self.outcome(Err(e));
+        }
         let encoder = image::codecs::png::PngEncoder::new(&mut self);
         match image.write_with_encoder(encoder) {
             Ok(()) => self.commit(),
@@ -363,6 +368,48 @@ impl OutputFile {
             Ok(()) => Ok(()),
         }
     }
+}
+
+/// Whether an encoder's `bytes` for a `w × h` picture can be allocated now: a refused
+/// allocation inside an encoder aborts the process (16 384² under `ulimit -v 4000000`), where
+/// this is an error naming the file.
+pub fn encoding_fits(bytes: u64, (w, h): (u32, u32)) -> io::Result<()> {
+    if can_allocate(bytes) {
+        return Ok(());
+    }
+    Err(io::Error::new(
+        io::ErrorKind::OutOfMemory,
+        format!(
+            "encoding its {w}×{h} picture takes up to {} MiB, more than this process can \
+             allocate now",
+            bytes.div_ceil(1 << 20)
+        ),
+    ))
+}
+
+/// Whether `bytes` can be allocated now: asked of the allocator and given back at once.
+fn can_allocate(bytes: u64) -> bool {
+    #[cfg(test)]
+    if ALLOCATABLE
+        .with(std::cell::Cell::get)
+        .is_some_and(|most| bytes > most)
+    {
+        return false;
+    }
+    let Ok(bytes) = usize::try_from(bytes) else {
+        return false;
+    };
+    let mut probe = Vec::<u8>::new();
+    let granted = probe.try_reserve_exact(bytes).is_ok();
+    // Kept opaque: the optimiser may otherwise drop an allocation nothing reads.
+    std::hint::black_box(&mut probe);
+    granted
+}
+
+#[cfg(test)]
+thread_local! {
+    /// Most bytes [`can_allocate`] grants on this thread (tests of a memory limit).
+    static ALLOCATABLE: std::cell::Cell<Option<u64>> = const { std::cell::Cell::new(None) };
 }
 
 /// Writes `bytes` to `path` (see the module's notes).
@@ -574,6 +621,34 @@ mod tests {
             1,
             "a temporary file is left"
         );
+    }
+
+    /// A picture whose encoding cannot be allocated is an error naming the file, the old file
+    /// whole and no temporary left.
+    #[test]
+    fn a_picture_whose_encoding_cannot_be_allocated_is_an_error() {
+        let tmp = tempfile::tempdir().unwrap();
+        let dir = tmp.path();
+        let path = dir.join("a.png");
+        std::fs::write(&path, "old").unwrap();
+        let picture = image::RgbaImage::new(64, 32);
+        ALLOCATABLE.with(|a| a.set(Some(1000)));
+        let refused = save_png(&path, &picture);
+        ALLOCATABLE.with(|a| a.set(None));
+        let message = refused.unwrap_err().to_string();
+        assert!(message.contains("a.png"), "{message}");
+        assert!(
+            message.contains("encoding its 64×32 picture takes up to 1 MiB"),
+            "{message}"
+        );
+        assert_eq!(std::fs::read(&path).unwrap(), b"old");
+        assert_eq!(
+            std::fs::read_dir(dir).unwrap().count(),
+            1,
+            "a temporary file is left"
+        );
+        save_png(&path, &picture).unwrap();
+        assert_eq!(image::open(&path).unwrap().width(), 64);
     }
 
     /// A name of up to 255 bytes, which the file system takes, is written: its temporary

@@ -132,12 +132,16 @@ impl Recorder {
                 // nearest its true end, so the rounding never adds up (30 fps: 3, 3, 4, …).
                 let end = |k: u32| (f64::from(k) * 100.0 / fps).round();
                 let centis = (end(k + 1) - end(k)).clamp(1.0, 65_535.0) as u32;
+                let path = || shown::path(file.0.borrow().path());
+                // The encoder quantizes a copy of the frame into indices and compresses them.
+                let raw = image.as_raw().len() as u64;
+                output::encoding_fits(2 * raw, image.dimensions())
+                    .map_err(|e| format!("cannot write {}: {e}", path()))?;
                 let frame =
                     Frame::from_parts(image, 0, 0, Delay::from_numer_denom_ms(centis * 10, 1));
-                encoder.encode_frame(frame).map_err(|e| {
-                    let path = shown::path(file.0.borrow().path());
-                    format!("cannot write {path}: {e}")
-                })
+                encoder
+                    .encode_frame(frame)
+                    .map_err(|e| format!("cannot write {}: {e}", path()))
             }
         }
     }
