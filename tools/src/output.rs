@@ -88,14 +88,41 @@ pub(crate) fn remove_temporaries_then(then: impl FnOnce()) {
     then();
 }
 
+/// The files the process's scenes were read from, by [`identity`]: no output replaces one.
+fn inputs() -> MutexGuard<'static, Vec<PathBuf>> {
+    static INPUTS: OnceLock<Mutex<Vec<PathBuf>>> = OnceLock::new();
+    let inputs = INPUTS.get_or_init(Mutex::default);
+    inputs.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// Keeps every output of this process off `files`, which a scene was read from
+/// (`LoadReport::files`): [`OutputFile::create`] refuses them, naming the file, so an output
+/// that a subcommand names itself (a benchmark's heat map, a matrix cell's picture) cannot
+/// replace a model or texture of the same name.
+pub fn protect_inputs(files: &[PathBuf]) {
+    let mut inputs = inputs();
+    for file in files {
+        let id = identity(file);
+        if !inputs.contains(&id) {
+            inputs.push(id);
+        }
+    }
+}
+
 impl OutputFile {
     /// Opens `path` for writing: fails now, naming it, where it cannot be written (a folder, a
-    /// missing folder, a read-only file or folder). `-` is standard output.
+    /// missing folder, a read-only file or folder, a file a scene was read from). `-` is
+    /// standard output.
     pub fn create(path: &Path) -> Result<OutputFile, WriteError> {
         let fail = |source| WriteError {
             path: path.to_path_buf(),
             source,
         };
+        if !is_stream(path) && inputs().contains(&identity(path)) {
+            return Err(fail(io::Error::other(
+                "a scene was read from it: it would be overwritten",
+            )));
+        }
         // An existing file is opened for writing (not truncated) to learn whether it may be
         // written at all and what it is; a symbolic link is followed, and its target replaced.
         let dash = path == Path::new("-");

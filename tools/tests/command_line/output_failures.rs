@@ -120,6 +120,73 @@ fn every_bench_and_matrix_output_onto_a_full_disk_fails_naming_the_file() {
     fails_naming(&[&matrix[..], &["--out", "m"]].concat(), cwd, "matrix.png");
 }
 
+/// `render` refused an output naming a file its scene was read from; `bench` and `matrix`,
+/// whose outputs' names they choose themselves, replaced them (a scene file named
+/// `report.json`, a texture named as a benchmark's reference picture). Every output refuses
+/// such a file, naming it, and leaves it as it was.
+#[test]
+fn no_output_replaces_a_file_a_scene_was_read_from() {
+    if common::checks_the_command_line_alone("outputs over a scene's files") {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let cwd = dir.path();
+    let texture = "reference-tex-es3.png";
+    image::RgbaImage::from_pixel(2, 2, image::Rgba([200, 40, 40, 255]))
+        .save(cwd.join(texture))
+        .unwrap();
+    std::fs::write(
+        cwd.join("m.mtl"),
+        format!("newmtl m\nKd 1 1 1\nmap_Kd {texture}\n"),
+    )
+    .unwrap();
+    std::fs::write(
+        cwd.join("tex.obj"),
+        "mtllib m.mtl\nusemtl m\nv 0 0 0\nv 1 0 0\nv 1 1 0\nvt 0 0\nvt 1 0\nvt 1 1\n\
+         f 1/1 2/2 3/3\n",
+    )
+    .unwrap();
+    let scene_file = br#"{"objects": [{"model": "tex.obj"}]}"#;
+    std::fs::write(cwd.join("report.json"), scene_file).unwrap();
+    let untouched = |file: &str| std::fs::read(cwd.join(file)).unwrap();
+    let (obj, png) = (untouched("tex.obj"), untouched(texture));
+    let bench = |scene: &str| {
+        [
+            "bench",
+            "--scenes",
+            scene,
+            "--lights",
+            "2",
+            "--methods",
+            "forward",
+            "--es",
+            "3",
+            "--size",
+            "16x9",
+            "--frames",
+            "1",
+            "--cpu-samples",
+            "1",
+            "--no-knobs",
+            "--animated-frames",
+            "0",
+            "--out",
+            ".",
+        ]
+        .map(String::from)
+    };
+    fails_naming(&strs(&bench("tex.obj")), cwd, texture);
+    let matrix = [
+        "matrix", "--scene", "tex.obj", "--size", "16x9", "--lights", "0",
+    ];
+    fails_naming(&[&matrix[..], &["--json", texture]].concat(), cwd, texture);
+    assert_eq!(untouched(texture), png);
+    assert_eq!(untouched("tex.obj"), obj);
+    // A scene file named as the report.
+    fails_naming(&strs(&bench("report.json")), cwd, "report.json");
+    assert_eq!(untouched("report.json"), scene_file);
+}
+
 #[test]
 fn standard_output_onto_a_full_disk_fails_but_a_closed_pipe_does_not() {
     let dir = tempfile::tempdir().unwrap();

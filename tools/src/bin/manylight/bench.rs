@@ -111,7 +111,9 @@ fn load_bench_scene(
     lights: usize,
     args: &BenchArgs,
 ) -> Result<Scene, Box<dyn std::error::Error>> {
-    let (mut scene, _) = scene::load_with(spec, Some((lights, args.seed)), &crate::load_options())?;
+    let (mut scene, report) =
+        scene::load_with(spec, Some((lights, args.seed)), &crate::load_options())?;
+    manylight_tools::output::protect_inputs(&report.files);
     if args.material_model == MaterialModelArg::MetallicRoughness {
         to_metallic_roughness(&mut scene);
     }

@@ -225,7 +225,9 @@ pub fn run(args: &MatrixArgs, gles_libs: &[PathBuf]) -> Result<(), Box<dyn std::
     };
     // What every cell would fail on is an error of the matrix, not a row of failures: a scene
     // that cannot be read, outputs that cannot be written.
-    scene::load_with(&args.scene, Some((args.lights, 1)), &crate::load_options())?;
+    let (_, report) =
+        scene::load_with(&args.scene, Some((args.lights, 1)), &crate::load_options())?;
+    output::protect_inputs(&report.files);
     for lib in gles_libs.iter().filter(|l| *l != Path::new("system")) {
         manylight::gl::gles_lib::files_in(lib)?;
     }
@@ -692,7 +694,9 @@ fn print_refusal(e: &dyn std::error::Error) -> Result<(), Box<dyn std::error::Er
 /// Renders every method in this (restricted) process and prints one JSON row.
 pub fn run_cell(args: &MatrixCellArgs) -> Result<(), Box<dyn std::error::Error>> {
     let es: EsVersion = args.es.into();
-    let (scene, _) = scene::load_with(&args.scene, Some((args.lights, 1)), &crate::load_options())?;
+    let (scene, report) =
+        scene::load_with(&args.scene, Some((args.lights, 1)), &crate::load_options())?;
+    output::protect_inputs(&report.files);
     let (w, h) = args.size;
     let opts = RenderOptions {
         measure: manylight::MeasureOptions {

@@ -344,6 +344,7 @@ pub fn run(args: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
     }
     // The loader logs each warning (at `warn`, shown by default): not printed again here.
     let (mut scene, report) = scene::load_with(&args.scene, lights, &crate::load_options())?;
+    manylight_tools::output::protect_inputs(&report.files);
     let out = match (&args.out, &args.record) {
         (Some(path), _) => Some(path.as_path()),
         (None, None) => Some(std::path::Path::new(DEFAULT_OUT)),
