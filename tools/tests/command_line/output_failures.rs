@@ -402,6 +402,9 @@ fn two_options_naming_one_file_are_a_usage_error_naming_both() {
     expect_exit(&args, &[], cwd, 2, "same file");
     let args = ["matrix", "--json", "m/matrix.png", "--out", "m"];
     expect_exit(&args, &[], cwd, 2, "same file");
+    // A cell's picture (`TAG-METHOD.png`), which the matrix names itself.
+    let args = ["matrix", "--json", "m/es3-forward.png", "--out", "m"];
+    expect_exit(&args, &[], cwd, 2, "names a cell's picture in --out m");
     assert!(!cwd.join("a.png").exists() && !cwd.join("m").exists());
     // A device takes any number of outputs; different files are fine.
     let args = tiny(&["--out", "/dev/null", "--stats", "/dev/null"]);

@@ -243,6 +243,9 @@ fn check_usage(cli: &Cli, subcommand: Option<&str>) {
             &[json, sheet.as_deref().map(|p| ("--out", p))],
             &a.scene,
         );
+        if let (Some((_, json)), Some(out)) = (json, a.out.as_deref()) {
+            check_not_a_cell_picture(subcommand, json, out);
+        }
     }
     #[cfg(feature = "window")]
     if let Some(Command::View(a)) = &cli.command {
@@ -369,6 +372,38 @@ fn check_distinct_outputs(subcommand: Option<&str>, outputs: &[Option<(&str, &Pa
                 ),
             );
         }
+    }
+}
+
+/// `matrix --json` naming a picture its `--out` folder gets, one per cell (`TAG-METHOD.png`),
+/// would be replaced by it or replace it: a usage error naming both.
+fn check_not_a_cell_picture(subcommand: Option<&str>, json: &Path, out: &Path) {
+    let in_out = json
+        .parent()
+        .map(|p| {
+            if p.as_os_str().is_empty() {
+                Path::new(".")
+            } else {
+                p
+            }
+        })
+        .is_some_and(|p| output::identity(p) == output::identity(out));
+    let name = json.file_name().map(|n| n.to_string_lossy());
+    let cell = name.is_some_and(|n| {
+        manylight::methods::METHODS
+            .iter()
+            .any(|m| n.ends_with(&format!("-{}.png", m.name)))
+    });
+    if in_out && cell {
+        usage_error(
+            subcommand,
+            ErrorKind::ArgumentConflict,
+            format!(
+                "--json {} names a cell's picture in --out {}: one would overwrite the other",
+                shown::path(json),
+                shown::path(out)
+            ),
+        );
     }
 }
 
