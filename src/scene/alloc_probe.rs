@@ -48,7 +48,7 @@ pub(crate) fn ask(bytes: u64, what: std::fmt::Arguments<'_>) -> Result<(), Strin
     }
     Err(format!(
         "{what} about {} MiB, more than this process can allocate now",
-        bytes >> 20
+        bytes.div_ceil(1 << 20)
     ))
 }
 
@@ -71,5 +71,8 @@ mod tests {
             refusal,
             "a test takes about 4398046511104 MiB, more than this process can allocate now"
         );
+        // Less than a MiB is said as one, not as 0.
+        let refusal = super::with_allocatable(0, || ask(1000, format_args!("a test takes")));
+        assert!(refusal.unwrap_err().starts_with("a test takes about 1 MiB"));
     }
 }

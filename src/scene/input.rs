@@ -316,7 +316,7 @@ pub(crate) fn light_memory_refusal(count: usize) -> Option<String> {
         format!(
             "{count} lights need about {} MiB through a frame ({BYTES_PER_LIGHT} bytes each), \
              which this process cannot allocate now",
-            bytes >> 20
+            bytes.div_ceil(1 << 20)
         )
     })
 }
