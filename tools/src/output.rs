@@ -213,6 +213,13 @@ impl OutputFile {
             if let Some(p) = permissions.take() {
                 std::fs::set_permissions(&*temp, p)?;
             }
+            // Put in place with the others by `Deferred::commit`; until then the temporary
+            // file stays live (a signal removes it).
+            let file = (temp.clone(), dest.clone());
+            if with_deferred(|d| d.as_mut().map(|waiting| waiting.push(file)).is_some()) {
+                self.target = Target::InPlace;
+                return Ok(());
+            }
             let mut live = live_temporaries();
             std::fs::rename(&*temp, &*dest)?;
             live.retain(|t| t != temp);
@@ -254,6 +261,63 @@ impl Drop for OutputFile {
             let mut live = live_temporaries();
             let _ = std::fs::remove_file(temp);
             live.retain(|t| t != temp);
+        }
+    }
+}
+
+thread_local! {
+    /// The files this thread wrote whole and synced, as (temporary, destination), whose
+    /// renames wait for [`Deferred::commit`]; `None` where its commits are not deferred.
+    static DEFERRED: std::cell::RefCell<Option<Vec<(PathBuf, PathBuf)>>> =
+        const { std::cell::RefCell::new(None) };
+}
+
+/// Runs `f` on this thread's deferred commits.
+fn with_deferred<T>(f: impl FnOnce(&mut Option<Vec<(PathBuf, PathBuf)>>) -> T) -> T {
+    DEFERRED.with_borrow_mut(f)
+}
+
+/// Defers the renames of every file this thread commits from now on to [`Deferred::commit`],
+/// so that a command writing many (a benchmark's report folder) replaces all of them or none:
+/// stopped half-way by an error or a signal, its destinations stay as they were, their
+/// temporary files removed.
+pub fn defer_commits() -> Deferred {
+    with_deferred(|d| *d = Some(Vec::new()));
+    Deferred(())
+}
+
+/// Commits deferred by [`defer_commits`]; dropped without [`Deferred::commit`], their files
+/// are removed and the destinations left as they were.
+pub struct Deferred(());
+
+impl Deferred {
+    /// Puts every deferred file in place; the first rename that fails is an error naming its
+    /// file, and the files after it are removed.
+    pub fn commit(self) -> Result<(), WriteError> {
+        let waiting = with_deferred(Option::take).unwrap_or_default();
+        let mut live = live_temporaries();
+        let mut failed = None;
+        for (temp, dest) in waiting {
+            if failed.is_none() {
+                if let Err(source) = std::fs::rename(&temp, &dest) {
+                    failed = Some(WriteError { path: dest, source });
+                }
+            }
+            let _ = std::fs::remove_file(&temp);
+            live.retain(|t| *t != temp);
+        }
+        failed.map_or(Ok(()), Err)
+    }
+}
+
+impl Drop for Deferred {
+    fn drop(&mut self) {
+        if let Some(waiting) = with_deferred(Option::take) {
+            let mut live = live_temporaries();
+            for (temp, _) in waiting {
+                let _ = std::fs::remove_file(&temp);
+                live.retain(|t| *t != temp);
+            }
         }
     }
 }
@@ -676,6 +740,43 @@ mod tests {
         );
         save_png(&path, &picture).unwrap();
         assert_eq!(image::open(&path).unwrap().width(), 64);
+    }
+
+    /// Deferred commits put every file in place together, or, dropped before, none.
+    #[test]
+    fn deferred_commits_replace_all_files_or_none() {
+        let tmp = tempfile::tempdir().unwrap();
+        let dir = tmp.path();
+        let (a, b) = (dir.join("a.json"), dir.join("b.json"));
+        std::fs::write(&a, "old").unwrap();
+        let files = || {
+            let mut names: Vec<_> = (std::fs::read_dir(dir).unwrap())
+                .map(|e| e.unwrap().file_name().into_string().unwrap())
+                .collect();
+            names.sort();
+            names
+        };
+        for commit in [false, true] {
+            let deferred = defer_commits();
+            write_bytes(&a, b"new a").unwrap();
+            write_bytes(&b, b"new b").unwrap();
+            // Written and synced, not yet in place.
+            assert_eq!(std::fs::read(&a).unwrap(), b"old");
+            assert!(!b.exists());
+            assert_eq!(files().len(), 3, "{:?}", files());
+            if commit {
+                deferred.commit().unwrap();
+            } else {
+                drop(deferred);
+                assert_eq!(files(), ["a.json"], "stopped: as it was");
+                assert_eq!(std::fs::read(&a).unwrap(), b"old");
+            }
+        }
+        assert_eq!(files(), ["a.json", "b.json"]);
+        assert_eq!(std::fs::read(&a).unwrap(), b"new a");
+        // Not deferred any more: a commit puts its file in place at once.
+        write_bytes(&b, b"newer b").unwrap();
+        assert_eq!(std::fs::read(&b).unwrap(), b"newer b");
     }
 
     /// A name of up to 255 bytes, which the file system takes, is written: its temporary

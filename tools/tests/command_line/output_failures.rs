@@ -187,6 +187,72 @@ fn no_output_replaces_a_file_a_scene_was_read_from() {
     assert_eq!(untouched("report.json"), scene_file);
 }
 
+/// A benchmark stopped half-way (an error here, a signal alike) leaves its report folder as
+/// the last run left it, not a mixture of two runs: its files are put in place together at
+/// the end (a second run's heat maps had replaced the first's beside the first's report).
+#[test]
+fn a_benchmark_stopped_half_way_leaves_the_last_report_whole() {
+    if common::checks_the_command_line_alone("a benchmark's report folder stopped half-way") {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let cwd = dir.path();
+    let bench = |lights: &'static str| {
+        [
+            "bench",
+            "--scenes",
+            "plane",
+            "--lights",
+            lights,
+            "--methods",
+            "forward",
+            "--es",
+            "3",
+            "--size",
+            "16x9",
+            "--frames",
+            "1",
+            "--cpu-samples",
+            "1",
+            "--no-knobs",
+            "--animated-frames",
+            "0",
+            "--out",
+            "b",
+        ]
+    };
+    expect_status(&bench("2"), &[], cwd, 0);
+    let folder = || {
+        let mut files: Vec<_> = (std::fs::read_dir(cwd.join("b")).unwrap())
+            .map(|e| {
+                let e = e.unwrap();
+                (e.file_name(), std::fs::read(e.path()).unwrap_or_default())
+            })
+            .collect();
+        files.sort();
+        files
+    };
+    let first = folder();
+    // The scene's last picture cannot be written: a folder is in its way.
+    let reference = cwd.join("b").join("reference-plane-es3.png");
+    std::fs::remove_file(&reference).unwrap();
+    std::fs::create_dir(&reference).unwrap();
+    let last_run = folder();
+    fails_naming(&bench("3"), cwd, "reference-plane-es3.png");
+    assert!(folder() == last_run, "the folder changed");
+    std::fs::remove_dir(&reference).unwrap();
+    expect_status(&bench("3"), &[], cwd, 0);
+    let heatmap = |files: &[(std::ffi::OsString, Vec<u8>)]| {
+        let name = std::ffi::OsStr::new("heatmap-plane-es3-forward.png");
+        files.iter().find(|(n, _)| n == name).unwrap().1.clone()
+    };
+    assert_ne!(
+        heatmap(&folder()),
+        heatmap(&first),
+        "the runs draw different maps"
+    );
+}
+
 #[test]
 fn standard_output_onto_a_full_disk_fails_but_a_closed_pipe_does_not() {
     let dir = tempfile::tempdir().unwrap();

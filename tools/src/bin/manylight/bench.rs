@@ -383,6 +383,9 @@ pub fn run(args: &BenchArgs) -> Result<(), Box<dyn std::error::Error>> {
     std::fs::write(&probe, b"")
         .and_then(|()| std::fs::remove_file(&probe))
         .map_err(|e| format!("cannot write into {}: {e}", shown::path(&args.out)))?;
+    // The whole report folder is replaced at the end or not at all: stopped half-way (an
+    // error, a signal) it stays the last run's, not a mixture of two.
+    let deferred = manylight_tools::output::defer_commits();
     // The report's own files, where something is in the way (a folder of that name, a file
     // that cannot be written): found after the whole sweep before.
     for name in ["report.json", "report.md"] {
@@ -552,6 +555,7 @@ pub fn run(args: &BenchArgs) -> Result<(), Box<dyn std::error::Error>> {
         pictures,
     };
     report::write(&report, &args.out)?;
+    deferred.commit()?;
     eprintln!(
         "{} configurations in {:.0} s → {}",
         report.rows.len(),
