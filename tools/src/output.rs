@@ -146,7 +146,18 @@ impl OutputFile {
                     (Target::InPlace, existing)
                 } else if meta.is_file() {
                     let dest = std::fs::canonicalize(path).map_err(fail)?;
-                    let (temp, file) = create_temp(&dest).map_err(fail)?;
+                    // The file itself may be written, its folder not: say which stops it.
+                    let in_folder = |e: io::Error| match e.kind() {
+                        io::ErrorKind::PermissionDenied => io::Error::new(
+                            e.kind(),
+                            format!(
+                                "its folder cannot be written ({e}): the new file is written \
+                                 beside the old one and renamed over it"
+                            ),
+                        ),
+                        _ => e,
+                    };
+                    let (temp, file) = create_temp(&dest).map_err(|e| fail(in_folder(e)))?;
                     let permissions = Some(meta.permissions());
                     (
                         Target::Replace {
