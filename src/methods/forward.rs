@@ -291,25 +291,13 @@ impl ShadingMethod for Forward {
     }
 }
 
-/// `lights` into `seen`, each light whose sphere lies wholly outside the view (the frustum up
-/// to the farthest geometry) made radius 0 at the eye: it lights no pixel either way, and the
-/// RGBA8 records' fixed-point range is then set by the lights that do. Forward still loops
+/// `lights` into `seen`, each that reaches nothing in view darkened
+/// ([`darkened_if_unseen`](super::unseen_lights::darkened_if_unseen)). Forward still loops
 /// over it, so its counts stay every light.
 fn darken_unseen_into(ctx: &FrameContext, lights: &[GpuLight], seen: &mut Vec<GpuLight>) {
     let volume = ctx.view_volume();
     seen.clear();
-    seen.extend(lights.iter().map(|l| {
-        if volume.excludes(l.position.as_dvec3(), f64::from(l.radius)) {
-            GpuLight {
-                position: glam::Vec3::ZERO,
-                radius: 0.0,
-                cull_radius: 0.0,
-                ..*l
-            }
-        } else {
-            *l
-        }
-    }));
+    seen.extend((lights.iter()).map(|l| super::unseen_lights::darkened_if_unseen(&volume, l)));
 }
 
 /// A frame without lights: ambient only, with the light loop compiled out and nothing uploaded.

@@ -22,6 +22,7 @@ pub mod maps;
 pub(crate) mod surface_variants;
 pub mod tiled;
 pub mod uniforms;
+mod unseen_lights;
 
 use crate::cluster::grid::{GridProjection, ViewVolume};
 use crate::cluster::view_light::GpuLight;

@@ -129,9 +129,16 @@ impl Uploads {
         self.frames_on_last = 1;
         self.visible.clear();
         room_for(&mut self.visible, assignment.visible.len());
-        self.visible
-            .extend(assignment.visible.iter().map(|&i| ctx.lights[i as usize]));
         let encoding = ctx.features.light_encoding();
+        let visible = assignment.visible.iter().map(|&i| &ctx.lights[i as usize]);
+        if encoding == LightEncoding::Rgba8 {
+            // The lights that set the records' shared range are forward's.
+            let volume = ctx.view_volume();
+            let darkened = |l| crate::methods::unseen_lights::darkened_if_unseen(&volume, l);
+            self.visible.extend(visible.map(darkened));
+        } else {
+            self.visible.extend(visible.copied());
+        }
         let grid_encoding = GridEncoding::for_es(dev.es());
         pack_lights_into(&self.visible, ctx.features.light_layout(), &mut self.lights);
         pack_grid_into(grid, assignment, grid_encoding, &mut self.grid);

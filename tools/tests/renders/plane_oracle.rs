@@ -147,6 +147,32 @@ fn rgba8_light_packing_stays_within_its_measured_error() {
         let err = check_scene(&scene, EsVersion::Es2, Some(method), opts.clone(), 3.0);
         eprintln!("{method} with a light 3 km behind the camera: max error {err:.2}/255");
     }
+    // Lights that reach no surface but whose spheres reach into the view: one huge beyond the
+    // plane (tiled and clustered packed it, as the assignment lists it in the empty cells
+    // there, and lost the near lights: 157/255), and a spot far beside the view whose sphere
+    // holds the view but whose cone points away (forward packed it: 157/255). Every method
+    // sets the range from the lights that reach something.
+    let (eye, target) = (scene.camera.position, scene.camera.target);
+    let ahead = (target - eye).normalize();
+    let right = ahead.cross(DVec3::Y).normalize();
+    let beyond = Light::point(target + ahead * 60_000.0, 59_500.0, Vec3::ONE, 1.0);
+    let cone = manylight::scene::Cone {
+        direction: right,
+        inner_deg: 5.0,
+        outer_deg: 10.0,
+    };
+    let aside = Light::spot(eye + right * 50_000.0, 60_000.0, Vec3::ONE, 1.0, cone);
+    for (what, light) in [
+        ("a huge light beyond the plane", beyond),
+        ("a spot aside", aside),
+    ] {
+        let mut scene = lit_plane();
+        scene.lights.push(light);
+        for method in ["forward", "tiled", "clustered"] {
+            let err = check_scene(&scene, EsVersion::Es2, Some(method), opts.clone(), 3.0);
+            eprintln!("{method} with {what}: max error {err:.2}/255");
+        }
+    }
 }
 
 /// The oracle has teeth: moving one light by 5 cm is visible against it.
