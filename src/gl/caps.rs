@@ -285,11 +285,13 @@ impl Caps {
     }
 
     /// A driver workaround: SwiftShader 4 loses parts of triangles that cross the eye's plane
-    /// (clip w = 0), which its clipper should cut at the near plane; deferred's proxy spheres
-    /// reaching behind the eye lost wedges of their light (docs/drivers.md), so there it bounds
-    /// such a light by a full-screen triangle at its far end instead.
+    /// (clip w = 0), which its clipper should cut at the near plane, and Mesa's softpipe loses
+    /// or doubles pixels of them; deferred's proxy spheres reaching behind the eye lost wedges
+    /// of their light (docs/drivers.md), so there it bounds such a light by a full-screen
+    /// triangle at its far end instead.
     pub fn loses_triangles_crossing_the_eye_plane(&self) -> bool {
-        !self.desktop && self.renderer.contains("SwiftShader")
+        !self.desktop
+            && (self.renderer.contains("SwiftShader") || self.renderer.contains("softpipe"))
     }
 
     /// A driver workaround: SwiftShader 4's `glClear` of a multisampled sRGB renderbuffer fills
