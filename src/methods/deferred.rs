@@ -39,7 +39,7 @@ use crate::gl::{Caps, Device, EsVersion};
 use crate::scene::{Material, Projection};
 use crate::Error;
 use light_instances::{light_instance, LightInstances};
-use proxy::{Proxy, ProxyReach, VOLUME_SCALE};
+use proxy::{Proxy, ProxyReach};
 
 /// The table row.
 pub const DESC: MethodDesc = MethodDesc {
@@ -489,7 +489,7 @@ impl Deferred {
                 };
                 light_instance(
                     light,
-                    [light.cull_radius * VOLUME_SCALE, bound],
+                    [reach.radius(light), bound],
                     k % COUNT_CHANNELS,
                     scale,
                 )

@@ -459,6 +459,43 @@ fn deferred_equals_forward_on_a_bright_frame_without_float_blending() {
 /// light: depth interpolated across a far side the near plane clips into huge faces (drawn
 /// full-screen past 2 048; docs/precision.md), and SwiftShader dropping far-side triangles
 /// that cross the eye's plane (bounded by a plane there; docs/drivers.md, item 16).
+/// A light smaller than a pixel where it lies: its proxy drawn at its size covered no pixel
+/// centre on SwiftShader, which snaps vertices to 1/16 pixel, and the pixel it lit stayed
+/// ambient (a light of 1/12 pixel: 221/255 from forward). Proxies are at least a pixel wide.
+#[test]
+fn lights_smaller_than_a_pixel_match_forward() {
+    let mut gpu = Gpu::new(EsVersion::Es3);
+    let mut scene = scene::builtin::build("plane", None).unwrap();
+    scene.camera =
+        manylight::Camera::perspective(DVec3::new(0.0, 0.0, 5.0), DVec3::ZERO, 60.0, 0.1, 100.0);
+    let mut rng = Pcg64Mcg::seed_from_u64(11);
+    scene.lights = (0..150)
+        .map(|i| {
+            // The first on a pixel's centre, the rest anywhere over the plane.
+            let (x, y) = if i == 0 {
+                (0.08019, -0.08019)
+            } else {
+                (rng.random_range(-3.0..3.0), rng.random_range(-1.6..1.6))
+            };
+            scene::Light::point(DVec3::new(x, y, 0.0002), 0.002, Vec3::ONE, 1.0)
+        })
+        .collect();
+    let opts = RenderOptions::default();
+    gpu.r().set_method_named("forward").unwrap();
+    let forward = gpu.render(&scene, 64, 36, &opts);
+    gpu.r().set_method_named("deferred").unwrap();
+    let deferred = gpu.render(&scene, 64, 36, &opts);
+    let lit = forward.pixels().filter(|p| p[0] > 100).count();
+    assert!(lit > 0, "no light shows");
+    let d = manylight::metrics::diff(&forward, &deferred);
+    assert!(
+        d.max_abs <= 2,
+        "deferred {}/255 from forward on {:.2} % of the pixels",
+        d.max_abs,
+        100.0 * d.over_2
+    );
+}
+
 #[test]
 fn head_lamps_match_forward_at_any_near_plane() {
     let mut gpu = Gpu::new(EsVersion::Es3);

@@ -22,6 +22,10 @@ const FAR_MARGIN: f32 = 0.999;
 /// seen to lose light (docs/precision.md).
 const FAR_SIDE_REACH: f32 = 2048.0;
 
+/// Fewest pixels a proxy's radius spans where its light lies: a disc of a pixel's radius
+/// holds a pixel centre wherever it lies (they are at most √2/2 apart from any point).
+const MIN_PROXY_PX: f64 = 1.0;
+
 /// Most pixels a proxy may span across, as scene triangles (`scene::triangle_reach`): a sphere
 /// of about 2²⁷ pixels (a 10⁻⁵-high orthographic view) lost its light on every implementation
 /// here, without an error. Past it, one in view takes the full-screen path (it covers much of
@@ -106,8 +110,26 @@ pub(super) struct ProxyReach<'a> {
 }
 
 impl ProxyReach<'_> {
+    /// The radius `light`'s proxy is drawn with: its reach, [`VOLUME_SCALE`] larger, and at
+    /// least [`MIN_PROXY_PX`] pixels where the light lies, so that a light smaller than a pixel
+    /// still covers the pixel centres it may light (SwiftShader, which snaps vertices to 1/16
+    /// pixel, lost lights a twelfth of a pixel wide: 221/255 from forward).
+    pub(super) fn radius(&self, light: &GpuLight) -> f32 {
+        let reach = light.cull_radius * VOLUME_SCALE;
+        let rows = f64::from(self.rows.max(1));
+        let half_height = 1.0 / self.projection.y_axis.y;
+        let pixel = match self.camera.projection {
+            Projection::Perspective { .. } => {
+                let depth = f64::from(-light.position.z).max(f64::from(self.near));
+                2.0 * depth * half_height / rows
+            }
+            Projection::Orthographic { .. } => 2.0 * half_height / rows,
+        };
+        reach.max((MIN_PROXY_PX * pixel) as f32)
+    }
+
     pub(super) fn proxy(&self, light: &GpuLight) -> Proxy {
-        let radius = light.cull_radius * VOLUME_SCALE;
+        let radius = self.radius(light);
         let depth = -light.position.z;
         // A proxy's one-sided depth test needs depth steps well inside the light's reach
         // where it ends (a tiny near plane makes them wider; docs/precision.md).
