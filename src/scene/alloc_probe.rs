@@ -5,7 +5,7 @@
 /// Whether `bytes` can be allocated now: asked of the allocator and given back at once.
 /// Under an address-space limit, or a kernel that refuses what it could never back, work that
 /// could not finish is refused before it starts.
-pub(crate) fn can_allocate(bytes: u64) -> bool {
+pub fn can_allocate(bytes: u64) -> bool {
     #[cfg(test)]
     if ALLOCATABLE
         .with(std::cell::Cell::get)

@@ -8,7 +8,7 @@
 
 mod aabb;
 pub mod access;
-pub(crate) mod alloc_probe;
+pub mod alloc_probe;
 pub mod brdf;
 pub mod builtin;
 pub mod camera;

@@ -489,7 +489,8 @@ pub fn encoding_fits(bytes: u64, (w, h): (u32, u32)) -> io::Result<()> {
     ))
 }
 
-/// Whether `bytes` can be allocated now: asked of the allocator and given back at once.
+/// The library's probe ([`can_allocate`](manylight::scene::alloc_probe::can_allocate)), which
+/// a test here may limit.
 fn can_allocate(bytes: u64) -> bool {
     #[cfg(test)]
     if ALLOCATABLE
@@ -498,14 +499,7 @@ fn can_allocate(bytes: u64) -> bool {
     {
         return false;
     }
-    let Ok(bytes) = usize::try_from(bytes) else {
-        return false;
-    };
-    let mut probe = Vec::<u8>::new();
-    let granted = probe.try_reserve_exact(bytes).is_ok();
-    // Kept opaque: the optimiser may otherwise drop an allocation nothing reads.
-    std::hint::black_box(&mut probe);
-    granted
+    manylight::scene::alloc_probe::can_allocate(bytes)
 }
 
 #[cfg(test)]

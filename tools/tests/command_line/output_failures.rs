@@ -32,6 +32,35 @@ fn fails_naming(args: &[&str], cwd: &Path, file: &str) -> String {
     msg
 }
 
+/// A `bench` of one tiny configuration: `scene` with `lights` random lights, forward on ES 3.0
+/// at 16×9, its report into `out`.
+fn tiny_bench(scene: &str, lights: &str, out: &str) -> Vec<String> {
+    [
+        "bench",
+        "--scenes",
+        scene,
+        "--lights",
+        lights,
+        "--methods",
+        "forward",
+        "--es",
+        "3",
+        "--size",
+        "16x9",
+        "--frames",
+        "1",
+        "--cpu-samples",
+        "1",
+        "--no-knobs",
+        "--animated-frames",
+        "0",
+        "--out",
+        out,
+    ]
+    .map(String::from)
+    .to_vec()
+}
+
 #[test]
 fn every_render_output_onto_a_full_disk_fails_naming_the_file() {
     if common::checks_the_command_line_alone("outputs onto a full disk") {
@@ -70,28 +99,8 @@ fn every_bench_and_matrix_output_onto_a_full_disk_fails_naming_the_file() {
     }
     let dir = tempfile::tempdir().unwrap();
     let cwd = dir.path();
-    let bench = [
-        "bench",
-        "--scenes",
-        "plane",
-        "--lights",
-        "0",
-        "--methods",
-        "forward",
-        "--es",
-        "3",
-        "--size",
-        "16x9",
-        "--frames",
-        "1",
-        "--cpu-samples",
-        "1",
-        "--no-knobs",
-        "--animated-frames",
-        "0",
-        "--out",
-        "b",
-    ];
+    let bench = tiny_bench("plane", "0", "b");
+    let bench = strs(&bench);
     for file in [
         "report.json",
         "report.md",
@@ -150,31 +159,7 @@ fn no_output_replaces_a_file_a_scene_was_read_from() {
     std::fs::write(cwd.join("report.json"), scene_file).unwrap();
     let untouched = |file: &str| std::fs::read(cwd.join(file)).unwrap();
     let (obj, png) = (untouched("tex.obj"), untouched(texture));
-    let bench = |scene: &str| {
-        [
-            "bench",
-            "--scenes",
-            scene,
-            "--lights",
-            "2",
-            "--methods",
-            "forward",
-            "--es",
-            "3",
-            "--size",
-            "16x9",
-            "--frames",
-            "1",
-            "--cpu-samples",
-            "1",
-            "--no-knobs",
-            "--animated-frames",
-            "0",
-            "--out",
-            ".",
-        ]
-        .map(String::from)
-    };
+    let bench = |scene| tiny_bench(scene, "2", ".");
     fails_naming(&strs(&bench("tex.obj")), cwd, texture);
     let matrix = [
         "matrix", "--scene", "tex.obj", "--size", "16x9", "--lights", "0",
@@ -197,31 +182,8 @@ fn a_benchmark_stopped_half_way_leaves_the_last_report_whole() {
     }
     let dir = tempfile::tempdir().unwrap();
     let cwd = dir.path();
-    let bench = |lights: &'static str| {
-        [
-            "bench",
-            "--scenes",
-            "plane",
-            "--lights",
-            lights,
-            "--methods",
-            "forward",
-            "--es",
-            "3",
-            "--size",
-            "16x9",
-            "--frames",
-            "1",
-            "--cpu-samples",
-            "1",
-            "--no-knobs",
-            "--animated-frames",
-            "0",
-            "--out",
-            "b",
-        ]
-    };
-    expect_status(&bench("2"), &[], cwd, 0);
+    let bench = |lights| tiny_bench("plane", lights, "b");
+    expect_status(&strs(&bench("2")), &[], cwd, 0);
     let folder = || {
         let mut files: Vec<_> = (std::fs::read_dir(cwd.join("b")).unwrap())
             .map(|e| {
@@ -238,10 +200,10 @@ fn a_benchmark_stopped_half_way_leaves_the_last_report_whole() {
     std::fs::remove_file(&reference).unwrap();
     std::fs::create_dir(&reference).unwrap();
     let last_run = folder();
-    fails_naming(&bench("3"), cwd, "reference-plane-es3.png");
+    fails_naming(&strs(&bench("3")), cwd, "reference-plane-es3.png");
     assert!(folder() == last_run, "the folder changed");
     std::fs::remove_dir(&reference).unwrap();
-    expect_status(&bench("3"), &[], cwd, 0);
+    expect_status(&strs(&bench("3")), &[], cwd, 0);
     let heatmap = |files: &[(std::ffi::OsString, Vec<u8>)]| {
         let name = std::ffi::OsStr::new("heatmap-plane-es3-forward.png");
         files.iter().find(|(n, _)| n == name).unwrap().1.clone()
