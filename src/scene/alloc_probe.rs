@@ -52,6 +52,20 @@ pub(crate) fn ask(bytes: u64, what: std::fmt::Arguments<'_>) -> Result<(), Strin
     ))
 }
 
+/// An empty buffer with room for a copy of `len` bytes of a file without its metadata (an
+/// image's, before it is decoded), or the error saying it cannot be had here.
+pub(crate) fn room_for_copy(len: usize) -> Result<Vec<u8>, String> {
+    let mut room = Vec::new();
+    if !can_allocate(len as u64) || room.try_reserve_exact(len).is_err() {
+        return Err(format!(
+            "could not be decoded (a copy of its {} MiB without its metadata cannot be \
+             allocated here)",
+            (len as u64).div_ceil(1 << 20)
+        ));
+    }
+    Ok(room)
+}
+
 #[cfg(test)]
 mod tests {
     use super::{ask, can_allocate};

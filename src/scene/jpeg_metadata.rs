@@ -26,14 +26,7 @@ pub(crate) fn without_metadata(bytes: &[u8]) -> Result<Option<Vec<u8>>, String> 
     if metadata().next().is_none() {
         return Ok(None);
     }
-    let mut kept = Vec::new();
-    if !super::alloc_probe::can_allocate(len as u64) || kept.try_reserve_exact(len).is_err() {
-        return Err(format!(
-            "could not be decoded (a copy of its {} MiB without its metadata cannot be \
-             allocated here)",
-            len >> 20
-        ));
-    }
+    let mut kept = super::alloc_probe::room_for_copy(bytes.len())?;
     let mut from = 0;
     for segment in metadata() {
         kept.extend_from_slice(&bytes[from..segment.at]);

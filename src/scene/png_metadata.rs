@@ -42,15 +42,7 @@ pub(crate) fn without_metadata(bytes: &[u8]) -> Result<Option<Vec<u8>>, String> 
     if !any {
         return Ok(None);
     }
-    let mut kept = Vec::new();
-    let len = bytes.len();
-    if !super::alloc_probe::can_allocate(len as u64) || kept.try_reserve_exact(len).is_err() {
-        return Err(format!(
-            "could not be decoded (a copy of its {} MiB without its metadata cannot be \
-             allocated here)",
-            len >> 20
-        ));
-    }
+    let mut kept = super::alloc_probe::room_for_copy(bytes.len())?;
     kept.extend_from_slice(SIGNATURE);
     let mut from = 0;
     for (chunk, _) in walk().filter(|(_, metadata)| *metadata) {
