@@ -1,8 +1,7 @@
 //! Lights that reach nothing in view, darkened before their RGBA8 records are packed: the
 //! records share one fixed-point range, set by the farthest and largest light packed, so one
-//! such light coarsened every light's steps (a far light of radius 59 500 put a near one of
-//! radius 3 out, 157/255), and forward, tiled and clustered must choose the range from the
-//! same lights to draw the same picture.
+//! such light coarsens every light's steps, and forward, tiled and clustered must choose the
+//! range from the same lights to draw the same picture.
 
 use glam::DVec3;
 

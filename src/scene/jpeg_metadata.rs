@@ -1,9 +1,8 @@
 //! A JPEG's metadata segments taken out before it is decoded: EXIF and XMP (`APP1`), ICC
 //! profiles and multi-picture data (`APP2`) and IPTC (`APP13`), none of which the renderer
 //! reads. The decoder copies each and reassembles extended XMP after every marker while
-//! any is pending, sorting and comparing all its pieces each time: a 4 MB file of such
-//! pieces among empty comments took 108 s to load, the time growing with the square of the
-//! file's size.
+//! any is pending, sorting and comparing all its pieces each time: a load's time grew with
+//! the square of such a file's size.
 
 use super::jpeg_frame::segments;
 

@@ -1,8 +1,8 @@
 //! A PNG's metadata taken out before it is decoded: its colour profile (`iCCP`) and text
 //! (`tEXt`, `zTXt`, `iTXt`). The renderer takes every texture as sRGB and reads neither, yet
-//! the decoder inflates a profile (twice: header and pixels) up to its allocation limit (a
-//! 538 KB chunk to 512 MiB on a 4×4 image), and turns Latin-1 text into UTF-8 in a string
-//! that doubles as it grows (a 250 MiB `tEXt` chunk asked for 500 MiB more).
+//! the decoder inflates a profile (twice: header and pixels) up to its allocation limit,
+//! whatever the image's size, and turns Latin-1 text into UTF-8 in a string that doubles as
+//! it grows.
 
 /// The PNG signature every file starts with.
 const SIGNATURE: &[u8; 8] = b"\x89PNG\r\n\x1a\n";

@@ -113,7 +113,7 @@ impl ProxyReach<'_> {
     /// The radius `light`'s proxy is drawn with: its reach, [`VOLUME_SCALE`] larger, and at
     /// least [`MIN_PROXY_PX`] pixels where the light lies, so that a light smaller than a pixel
     /// still covers the pixel centres it may light (SwiftShader, which snaps vertices to 1/16
-    /// pixel, lost lights a twelfth of a pixel wide: 221/255 from forward).
+    /// pixel, lost such lights at their own size).
     pub(super) fn radius(&self, light: &GpuLight) -> f32 {
         let reach = light.cull_radius * VOLUME_SCALE;
         let rows = f64::from(self.rows.max(1));
