@@ -1,10 +1,10 @@
 //! What a frame needs of the framebuffer the application bound ([`Renderer::render`]): complete,
 //! no larger than the driver's viewport, its colour at attachment 0 and not of integers, and
 //! with a depth buffer when the frame is drawn in it (an MSAA frame brings its own and only
-//! resolves there); a frame reaching past its colour buffer is warned of. Forward, tiled and clustered draw
-//! with the depth test there, and so does deferred for transparent objects and for a frame
-//! without lights; deferred's opaque composite alone does not, but one rule for every method
-//! and frame is what the README asks of a game.
+//! resolves there); a frame reaching past its colour buffer is warned of. Forward, tiled and
+//! clustered draw with the depth test there, and so does deferred for transparent objects and
+//! for a frame without lights; deferred's opaque composite alone does not, but one rule for
+//! every method and frame is what the README asks of a game.
 
 use super::Renderer;
 use crate::gl::bound_framebuffer::TargetFormat;

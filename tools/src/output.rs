@@ -3,8 +3,9 @@
 //! swallows it (the GIF trailer), and every error names the file.
 //!
 //! A regular file is written to a hidden temporary file beside it (`.NAME.PID.N.tmp`, or
-//! `.manylight.PID.N.tmp` for a name too long for that) that is renamed over it once complete: a failure half-way (a full disk) leaves the old file, or
-//! none, never a truncated one that looks valid. A device, FIFO or socket, standard output
+//! `.manylight.PID.N.tmp` for a name too long for that) that is renamed over it once
+//! complete: a failure half-way (a full disk) leaves the old file, or none, never a truncated
+//! one that looks valid. A device, FIFO or socket, standard output
 //! (`-`, `/dev/stdout`: from where the shell left it, whatever it is) and a name that reopens a
 //! descriptor (`/dev/fd/N`, `/proc/self/fd/N`: truncated) are written in place. A FIFO that no
 //! process reads is an error, not a wait.
@@ -90,9 +91,8 @@ pub(crate) fn remove_temporaries_then(then: impl FnOnce()) {
 
 /// The files the process's scenes were read from, by [`identity`]: no output replaces one.
 fn inputs() -> MutexGuard<'static, Vec<PathBuf>> {
-    static INPUTS: OnceLock<Mutex<Vec<PathBuf>>> = OnceLock::new();
-    let inputs = INPUTS.get_or_init(Mutex::default);
-    inputs.lock().unwrap_or_else(|e| e.into_inner())
+    static INPUTS: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+    INPUTS.lock().unwrap_or_else(|e| e.into_inner())
 }
 
 /// Keeps every output of this process off `files`, which a scene was read from
@@ -269,11 +269,15 @@ impl Drop for OutputFile {
     fn drop(&mut self) {
         if let Target::Replace { temp, .. } = &self.target {
             drop(self.writer.take());
-            let mut live = live_temporaries();
-            let _ = std::fs::remove_file(temp);
-            live.retain(|t| t != temp);
+            discard(&mut live_temporaries(), temp);
         }
     }
+}
+
+/// Removes the temporary file `temp` where it is still there, and takes it off `live`.
+fn discard(live: &mut Vec<PathBuf>, temp: &Path) {
+    let _ = std::fs::remove_file(temp);
+    live.retain(|t| t != temp);
 }
 
 thread_local! {
@@ -314,8 +318,7 @@ impl Deferred {
                     failed = Some(WriteError { path: dest, source });
                 }
             }
-            let _ = std::fs::remove_file(&temp);
-            live.retain(|t| *t != temp);
+            discard(&mut live, &temp);
         }
         failed.map_or(Ok(()), Err)
     }
@@ -326,8 +329,7 @@ impl Drop for Deferred {
         if let Some(waiting) = with_deferred(Option::take) {
             let mut live = live_temporaries();
             for (temp, _) in waiting {
-                let _ = std::fs::remove_file(&temp);
-                live.retain(|t| *t != temp);
+                discard(&mut live, &temp);
             }
         }
     }

@@ -116,16 +116,21 @@ impl ProxyReach<'_> {
     /// pixel, lost such lights at their own size).
     pub(super) fn radius(&self, light: &GpuLight) -> f32 {
         let reach = light.cull_radius * VOLUME_SCALE;
+        let pixel = self.pixel_at(f64::from(-light.position.z));
+        reach.max((MIN_PROXY_PX * pixel) as f32)
+    }
+
+    /// The height of a pixel at view depth `depth` (the near plane's where nearer; the same
+    /// everywhere in orthographic).
+    fn pixel_at(&self, depth: f64) -> f64 {
         let rows = f64::from(self.rows.max(1));
         let half_height = 1.0 / self.projection.y_axis.y;
-        let pixel = match self.camera.projection {
+        match self.camera.projection {
             Projection::Perspective { .. } => {
-                let depth = f64::from(-light.position.z).max(f64::from(self.near));
-                2.0 * depth * half_height / rows
+                2.0 * depth.max(f64::from(self.near)) * half_height / rows
             }
             Projection::Orthographic { .. } => 2.0 * half_height / rows,
-        };
-        reach.max((MIN_PROXY_PX * pixel) as f32)
+        }
     }
 
     pub(super) fn proxy(&self, light: &GpuLight) -> Proxy {
@@ -200,14 +205,8 @@ impl ProxyReach<'_> {
         if beside(c.x, tx) || beside(c.y, ty) {
             return false;
         }
-        let rows = f64::from(self.rows.max(1));
         // The size of a pixel where the proxy comes nearest.
-        let pixel = if perspective {
-            2.0 * (depth - r).max(near) * ty / rows
-        } else {
-            2.0 * ty / rows
-        };
-        2.0 * r > MAX_PROXY_SPAN_PX * pixel
+        2.0 * r > MAX_PROXY_SPAN_PX * self.pixel_at(depth - r)
     }
 
     /// The normalized device depth of a [`Proxy::Bounded`] light's far end (its proxy

@@ -378,16 +378,11 @@ fn check_distinct_outputs(subcommand: Option<&str>, outputs: &[Option<(&str, &Pa
 /// `matrix --json` naming a picture its `--out` folder gets, one per cell (`TAG-METHOD.png`),
 /// would be replaced by it or replace it: a usage error naming both.
 fn check_not_a_cell_picture(subcommand: Option<&str>, json: &Path, out: &Path) {
-    let in_out = json
-        .parent()
-        .map(|p| {
-            if p.as_os_str().is_empty() {
-                Path::new(".")
-            } else {
-                p
-            }
-        })
-        .is_some_and(|p| output::identity(p) == output::identity(out));
+    // A bare name's folder is the current one.
+    let folder = (json.parent())
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    let in_out = output::identity(folder) == output::identity(out);
     let name = json.file_name().map(|n| n.to_string_lossy());
     let cell = name.is_some_and(|n| {
         manylight::methods::METHODS
