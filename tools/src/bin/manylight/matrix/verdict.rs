@@ -10,7 +10,7 @@ use serde_json::{json, Value};
 /// returns one line per failure, naming its implementation, configuration and method.
 pub fn mark(rows: &mut [Value], max_error: u8) -> Vec<String> {
     let mut failures = Vec::new();
-    let places: Vec<String> = super::row_labels(rows)
+    let places: Vec<String> = super::table::row_labels(rows)
         .into_iter()
         .map(|(implementation, config)| format!("{implementation} / {config}"))
         .collect();
