@@ -6,7 +6,7 @@
 //! `LP_NUM_THREADS`), so a figure is never quoted without them.
 //!
 //! Each method has one colour and marker in every chart, from its place in
-//! [`METHODS`] (see [`method_style`]).
+//! [`METHODS`](manylight::methods::METHODS) (see [`method_style`]).
 
 mod charts;
 mod files;

@@ -25,24 +25,24 @@ pub fn join_rayon_pool() {
         .use_current_thread()
         .num_threads(threads);
     if let Err(e) = pool.build_global() {
-        log::warn!("rayon's pool of {threads} threads could not start ({e}): the counts of threads said may be wrong");
+        log::warn!(
+            "rayon's pool of {threads} threads could not start ({e}): the counts of threads \
+             said may be wrong"
+        );
     }
 }
 
 /// The pool size `name=value` asks for, as rayon reads it (`0`: one a core, `Ok(None)`
 /// here), with a warning where it is no count (`Err`: rayon ignored it without a word) or past
-/// [`MAX_POOL_THREADS`] (taken as that).
+/// [`MAX_POOL_THREADS`], a usize's included (taken as that).
 fn threads_asked(name: &str, value: &std::ffi::OsStr) -> Result<Option<usize>, ()> {
     let text = value.to_string_lossy();
+    // A count too large for a usize is still a count: past the most, as 5 000 is.
+    let too_large = |e: &std::num::ParseIntError| *e.kind() == std::num::IntErrorKind::PosOverflow;
     match text.parse::<usize>() {
         Ok(0) => Ok(None),
-        Ok(n) if n > MAX_POOL_THREADS => {
-            log::warn!(
-                "{name}={n} taken as {MAX_POOL_THREADS}, the most the pool takes (each thread \
-                 costs a stack)"
-            );
-            Ok(Some(MAX_POOL_THREADS))
-        }
+        Ok(n) if n > MAX_POOL_THREADS => Ok(Some(most_threads(name, &n.to_string()))),
+        Err(e) if too_large(&e) => Ok(Some(most_threads(name, &shown::name(&text)))),
         Ok(n) => Ok(Some(n)),
         Err(_) => {
             let value = shown::name(&text);
@@ -50,6 +50,15 @@ fn threads_asked(name: &str, value: &std::ffi::OsStr) -> Result<Option<usize>, (
             Err(())
         }
     }
+}
+
+/// [`MAX_POOL_THREADS`], with a warning that `name=asked` was taken as that.
+fn most_threads(name: &str, asked: &str) -> usize {
+    log::warn!(
+        "{name}={asked} taken as {MAX_POOL_THREADS}, the most the pool takes (each thread \
+         costs a stack)"
+    );
+    MAX_POOL_THREADS
 }
 
 #[cfg(test)]
@@ -62,7 +71,9 @@ mod tests {
         assert_eq!(asked("2"), Ok(Some(2)));
         assert_eq!(asked("0"), Ok(None));
         assert_eq!(asked("5000"), Ok(Some(MAX_POOL_THREADS)));
-        assert_eq!(asked("18446744073709551616"), Err(()));
+        // One past usize::MAX is a count too, past the most.
+        assert_eq!(asked("18446744073709551616"), Ok(Some(MAX_POOL_THREADS)));
+        assert_eq!(asked("+7"), Ok(Some(7)));
         assert_eq!(asked("-1"), Err(()));
         assert_eq!(asked("abc"), Err(()));
     }
