@@ -169,7 +169,7 @@ pub fn run(args: &InfoArgs) -> Result<(), Box<dyn std::error::Error>> {
 }
 
 /// Whether this thread, which renders and so assigns the lights, is one of rayon's pool: then a
-/// parallel assignment starts on it at once (`main`'s `join_rayon_pool`).
+/// parallel assignment starts on it at once (`thread_pool::join_rayon_pool`, called by `main`).
 fn caller_in_pool() -> bool {
     rayon::current_thread_index().is_some()
 }
