@@ -1,11 +1,10 @@
 //! Which files a model may read besides itself. A glTF file names its buffers and images by
 //! URI, an OBJ file its material libraries and their textures by path; an untrusted model must
 //! not read the user's other files through them, so by default such a name may name only a
-//! file inside the model file's own folder: no `..`, no absolute path (`/x`, `C:/x`,
-//! `\\server\x`), no link that leads out of the folder, looked at before a file is opened and
-//! once it is open (`opened_within`). [`LoadOptions`] lifts this for trusted
-//! local content. Scene files and command lines name models anywhere: they
-//! are the user's own.
+//! file inside the model file's own folder: no `..` that climbs out of it, no absolute path
+//! (`/x`, `C:/x`, `\\server\x`), no link that leads out of the folder, looked at before a file
+//! is opened and once it is open (`opened_within`). [`LoadOptions`] lifts this for trusted
+//! local content. Scene files and command lines name models anywhere: they are the user's own.
 
 use std::path::{Path, PathBuf};
 
@@ -25,27 +24,48 @@ const HOW_TO_ALLOW: &str = "a model may read only files in its own folder (for t
                             models: --allow-outside-files, or LoadOptions::allow_outside_files)";
 
 /// The path `name` (a percent-decoded URI) names relative to `dir`. Unless `allow_outside`,
-/// a name that leaves `dir` as written — absolute, or with a `..` part (`/` and `\` both
-/// separate) — is refused before anything on disk is looked at.
+/// a name that leaves `dir` as written — absolute, or with a `..` part (`/` and `\\` both
+/// separate) that climbs above `dir` — is refused before anything on disk is looked at; a
+/// `..` that stays inside (`maps/../wood.png`) is taken out, so the kernel never follows a
+/// link in the folder back up.
 pub(crate) fn join(dir: &Path, name: &str, allow_outside: bool) -> Result<PathBuf, String> {
-    if !allow_outside {
-        let bytes = name.as_bytes();
-        let drive = bytes.len() >= 2 && bytes[0].is_ascii_alphabetic() && bytes[1] == b':';
-        let why = if name.starts_with(['/', '\\']) || drive || Path::new(name).is_absolute() {
-            Some("an absolute path")
-        } else if name.split(['/', '\\']).any(|part| part == "..") {
-            Some("`..` leads out of it")
-        } else {
-            None
-        };
-        if let Some(why) = why {
-            return Err(format!(
-                "`{}` is outside the model's folder ({why}); refused: {HOW_TO_ALLOW}",
-                super::shown::name(name)
-            ));
+    if allow_outside {
+        return Ok(dir.join(name));
+    }
+    match inside(name) {
+        Ok(name) => Ok(dir.join(&*name)),
+        Err(why) => Err(format!(
+            "`{}` is outside the model's folder ({why}); refused: {HOW_TO_ALLOW}",
+            super::shown::name(name)
+        )),
+    }
+}
+
+/// Why [`inside`] refuses an absolute path.
+pub(crate) const ABSOLUTE: &str = "an absolute path";
+
+/// `name` as a path that stays in its folder: unchanged without `..` parts, else with each
+/// `..` and the part before it taken out (`/` separating); or why it leaves the folder.
+pub(crate) fn inside(name: &str) -> Result<std::borrow::Cow<'_, str>, &'static str> {
+    let bytes = name.as_bytes();
+    let drive = bytes.len() >= 2 && bytes[0].is_ascii_alphabetic() && bytes[1] == b':';
+    if name.starts_with(['/', '\\']) || drive || Path::new(name).is_absolute() {
+        return Err(ABSOLUTE);
+    }
+    if !name.split(['/', '\\']).any(|part| part == "..") {
+        return Ok(name.into());
+    }
+    let mut kept: Vec<&str> = Vec::new();
+    for part in name.split(['/', '\\']) {
+        match part {
+            "" | "." => {}
+            ".." => {
+                kept.pop().ok_or("`..` leads out of it")?;
+            }
+            part => kept.push(part),
         }
     }
-    Ok(dir.join(name))
+    Ok(kept.join("/").into())
 }
 
 /// `path` (found from `dir` through [`join`]) with its links resolved. Unless
@@ -207,7 +227,7 @@ mod tests {
         for name in [
             "../x.bin",
             "a/../../x.bin",
-            "a/..",
+            "a/../..",
             "..\\x.bin",
             "/etc/passwd",
             "\\\\server\\share\\x.bin",
@@ -221,6 +241,15 @@ mod tests {
         }
         for name in ["x.bin", "tex/a b.png", "a..b.bin", "./x.bin", "..x/y"] {
             assert_eq!(join(dir, name, false).unwrap(), dir.join(name), "{name}");
+        }
+        // A `..` that stays in the folder is taken out with the part it climbs from, so a
+        // link there is never followed back up (`maps/` leading elsewhere).
+        for (name, inside) in [
+            ("maps/../x.bin", "x.bin"),
+            ("a/b/../../tex/./x.bin", "tex/x.bin"),
+            ("maps\\..\\x.bin", "x.bin"),
+        ] {
+            assert_eq!(join(dir, name, false).unwrap(), dir.join(inside), "{name}");
         }
     }
 

@@ -52,7 +52,7 @@ pub fn load_into(
 ) -> Result<LoadReport, SceneError> {
     let mut report = LoadReport::default();
     let allow_outside = options.allow_outside_files;
-    let (models, materials, not_utf8, mtl_warnings) = parse_obj(path, allow_outside)?;
+    let (models, materials, not_utf8, mtl_warnings, mtl_folders) = parse_obj(path, allow_outside)?;
     for warning in mtl_warnings {
         report.warn(warning);
     }
@@ -103,23 +103,29 @@ pub fn load_into(
         // The caller's texture replaces the MTL's, which is then not even decoded (it would
         // take its part of the budget for nothing).
         let statement = m.diffuse_texture.as_deref().map(MapStatement::parse);
+        // Its names are relative to its library's folder.
+        let mtl_folder = mtl_folders.get(id).map_or("", String::as_str);
         let texture = match &statement {
             _ if override_tex.is_some() => None,
             Some(MapStatement { file: name, .. }) if !name.is_empty() => {
-                match finder.find(base_dir, name, allow_outside) {
+                match finder.find(base_dir, mtl_folder, name, allow_outside) {
                     Ok(Some(p)) => textures.load(&p, within, budget, &mut |w| report.warn(w)),
                     Ok(None) => {
                         // Something there that is not a file (`/dev/zero`, a folder) is named so.
-                        let what = if base_dir.join(name).exists() {
+                        let from = base_dir.join(mtl_folder);
+                        let what = if from.join(name).exists() {
                             "is not a regular file"
                         } else {
                             "not found"
                         };
+                        let next_to = match mtl_folder {
+                            "" => path.display().to_string(),
+                            _ => format!("its library in {}", from.display()),
+                        };
                         report.warn(format!(
-                            "material `{material_name}`: texture `{}` {what} next to {}; using \
-                             its flat colour",
+                            "material `{material_name}`: texture `{}` {what} next to {next_to}; \
+                             using its flat colour",
                             shown::name(name),
-                            path.display()
                         ));
                         None
                     }
@@ -332,6 +338,7 @@ type Parsed = (
     Result<Vec<tobj::Material>, tobj::LoadError>,
     bool,
     Vec<String>,
+    Vec<String>,
 );
 
 /// Asks the allocator for the `bytes` an OBJ's `step` may take: an error naming the file and
@@ -421,6 +428,8 @@ fn parse_obj(path: &Path, allow_outside: bool) -> Result<Parsed, SceneError> {
     }
     warnings.borrow_mut().extend(rewrites.warnings(path));
     let warn = |w: String| warnings.borrow_mut().push(w);
+    // Each material's library's folder, in the materials' order.
+    let mtl_folders = std::cell::RefCell::new(Vec::new());
     let load_mtl = |name: &Path| -> tobj::MTLLoadResult {
         let name = name.to_string_lossy().replace('\\', "/");
         {
@@ -444,8 +453,8 @@ fn parse_obj(path: &Path, allow_outside: bool) -> Result<Parsed, SceneError> {
         // are, or by its bare file name; else read as joined, which says it is missing:
         // there is always a path.
         let listings = &mut Listings::default();
-        let in_any_case = |joined, listings: &mut Listings| {
-            resolve_texture_in(&base_dir, &name, allow_outside, listings).or(Some(joined))
+        let in_any_case = |joined, relative: &str, listings: &mut Listings| {
+            resolve_texture_in(&base_dir, relative, allow_outside, listings).or(Some(joined))
         };
         let mtl_path = within_folder(&base_dir, &name, allow_outside, listings, in_any_case)
             .map(|found| found.unwrap_or_default())
@@ -488,7 +497,16 @@ fn parse_obj(path: &Path, allow_outside: bool) -> Result<Parsed, SceneError> {
                 return Err(tobj::LoadError::MaterialParseError);
             }
         };
-        tobj::load_mtl_buf(&mut std::io::BufReader::new(kept.as_bytes()))
+        let library = tobj::load_mtl_buf(&mut std::io::BufReader::new(kept.as_bytes()));
+        // Its materials' texture names start from its folder (tobj appends the libraries'
+        // materials in the order they are read).
+        if let Ok((materials, _)) = &library {
+            let folder = folder_in(&base_dir, &mtl_path);
+            mtl_folders
+                .borrow_mut()
+                .extend(std::iter::repeat_n(folder, materials.len()));
+        }
+        library
     };
     // tobj passes an `mtllib` line's rest as one name: one library whose name has spaces, or
     // several libraries (`mtllib a.mtl b.mtl`, as the format has it), each read in turn.
@@ -544,13 +562,23 @@ fn parse_obj(path: &Path, allow_outside: bool) -> Result<Parsed, SceneError> {
                         warnings.push(format!("{}: {w}", path.display()));
                     }
                 }
-                (models, materials, not_utf8, warnings)
+                let folders = mtl_folders.into_inner();
+                (models, materials, not_utf8, warnings, folders)
             })
             .map_err(|e| obj_error(e.to_string())),
         Err(_) => Err(obj_error(
             "the OBJ parser (tobj) failed on this file; it is malformed".into(),
         )),
     }
+}
+
+/// The folder of `library` (a material library found from `base_dir`) relative to
+/// `base_dir`, `/` separating, as texture names are written: empty for `base_dir` itself, and
+/// where it cannot be spelled so (not UTF-8).
+fn folder_in(base_dir: &Path, library: &Path) -> String {
+    let folder = library.parent().and_then(|f| f.strip_prefix(base_dir).ok());
+    let parts: Option<Vec<&str>> = folder.and_then(|f| f.iter().map(|c| c.to_str()).collect());
+    parts.map(|p| p.join("/")).unwrap_or_default()
 }
 
 /// A material library that could not be read, as its warning says it: the OBJ, the name its

@@ -4,12 +4,13 @@
 //! Real MTL files name textures with other letter case than the file on disk, with Windows
 //! backslashes, or with folders that were flattened when the model was shared. Resolution
 //! tries, in order: the path as written (backslashes turned into `/`) relative to the MTL's
-//! folder; the same path matched case-insensitively component by component; the bare file
-//! name, case-insensitively, in the MTL's folder. A name leading out of the model's folder is
-//! refused unless allowed, but its bare file name is still looked for in the folder (an
-//! exporter's `C:\Users\…\wood.png`). Each name is looked up once a load, each folder listed
-//! once a load however many names are looked for in it, and a name is matched folder by folder
-//! only so deep.
+//! folder; the same path matched case-insensitively component by component; both again from
+//! the model's folder where the MTL lies in a folder of its own; the bare file name,
+//! case-insensitively, in the MTL's folder, then in the model's. A name leading out of the
+//! model's folder is refused unless allowed (a `..` that stays inside is taken out), but its
+//! bare file name is still looked for (an exporter's `C:\Users\…\wood.png`). Each name is
+//! looked up once a load, each folder listed once a load however many names are looked for in
+//! it, and a name is matched folder by folder only so deep.
 
 use std::collections::HashMap;
 use std::ffi::OsString;
@@ -94,49 +95,59 @@ thread_local! {
 /// share one), each folder listed once.
 #[derive(Default)]
 pub(super) struct TextureFinder {
-    found: HashMap<String, Result<Option<PathBuf>, String>>,
+    /// By (the MTL's folder, the name).
+    found: HashMap<(String, String), Result<Option<PathBuf>, String>>,
     pub(super) listings: Listings,
 }
 
 impl TextureFinder {
-    /// The file an MTL texture statement's file name (after its options) names, inside
-    /// `base_dir` (links resolved) unless `allow_outside`: `Ok(None)` when none is found,
-    /// `Err` with the refusal when the name leads out of the folder and its bare file name is
-    /// not in it either. A name of several words not found is tried by its last word too (a
-    /// name written after options the MTL reader does not know). Remembered by name.
+    /// The file an MTL texture statement's file name (after its options) names, from the
+    /// MTL's folder `mtl_folder` (relative to `base_dir`, `/` separating; empty for the
+    /// model's folder itself), inside `base_dir` (links resolved) unless `allow_outside`:
+    /// `Ok(None)` when none is found, `Err` with the refusal when the name leads out of the
+    /// folder and its bare file name is not in it either. A name of several words not found
+    /// is tried by its last word too (a name written after options the MTL reader does not
+    /// know). Remembered by folder and name.
     pub(super) fn find(
         &mut self,
         base_dir: &Path,
+        mtl_folder: &str,
         name: &str,
         allow_outside: bool,
     ) -> Result<Option<PathBuf>, String> {
-        if let Some(found) = self.found.get(name) {
+        let key = (mtl_folder.to_string(), name.to_string());
+        if let Some(found) = self.found.get(&key) {
             return found.clone();
         }
-        let found = self.find_anew(base_dir, name.trim(), allow_outside);
-        self.found.insert(name.to_string(), found.clone());
+        let found = self.find_anew(base_dir, mtl_folder, name.trim(), allow_outside);
+        self.found.insert(key, found.clone());
         found
     }
 
     fn find_anew(
         &mut self,
         base_dir: &Path,
+        mtl_folder: &str,
         name: &str,
         allow_outside: bool,
     ) -> Result<Option<PathBuf>, String> {
-        let found = self.find_named(base_dir, name, allow_outside)?;
+        let found = self.find_named(base_dir, mtl_folder, name, allow_outside)?;
         match name.split_whitespace().last() {
             Some(last) if found.is_none() && last != name => {
-                self.find_named(base_dir, last, allow_outside)
+                self.find_named(base_dir, mtl_folder, last, allow_outside)
             }
             _ => Ok(found),
         }
     }
 
-    /// [`TextureFinder::find`] for the whole of `name`.
+    /// [`TextureFinder::find`] for the whole of `name`: as written from the MTL's folder
+    /// (or in other letter case), then from the model's where the MTL lies in a folder of
+    /// its own (an exporter that wrote the OBJ's paths), then by its bare file name in the
+    /// MTL's folder and the model's. The refusal, if any, is the MTL's path's.
     fn find_named(
         &mut self,
         base_dir: &Path,
+        mtl_folder: &str,
         name: &str,
         allow_outside: bool,
     ) -> Result<Option<PathBuf>, String> {
@@ -144,31 +155,79 @@ impl TextureFinder {
             return Ok(None);
         }
         let written = name.replace('\\', "/");
-        let listings = &mut self.listings;
-        within_folder(
+        let absolute = access::inside(&written) == Err(access::ABSOLUTE);
+        let from_mtl = match mtl_folder {
+            "" => written.clone(),
+            _ if absolute => written.clone(),
+            folder => format!("{folder}/{written}"),
+        };
+        let mut refusal = None;
+        let checked = |p: PathBuf, refusal: &mut Option<String>| match access::resolve(
             base_dir,
-            &written,
+            &p,
             allow_outside,
-            listings,
-            |_, listings| resolve_in(base_dir, name, allow_outside, listings),
-        )
+        ) {
+            Ok(_) => Some(p),
+            Err(r) => {
+                refusal.get_or_insert(r);
+                None
+            }
+        };
+        let model_too = from_mtl != written;
+        for (path, first) in [(from_mtl.as_str(), true), (written.as_str(), false)] {
+            if !first && !model_too {
+                break;
+            }
+            let relative = match access::join(base_dir, path, allow_outside) {
+                Ok(_) => access::inside(path).unwrap_or(path.into()),
+                Err(r) => {
+                    if first {
+                        refusal = Some(r);
+                    }
+                    continue;
+                }
+            };
+            let matched = match_in(base_dir, &relative, allow_outside, &mut self.listings);
+            let candidate = match matched {
+                Some(Matched::File(p) | Matched::Outside(p)) => p,
+                _ => continue,
+            };
+            let mut ignored = None;
+            let why = if first { &mut refusal } else { &mut ignored };
+            if let Some(found) = checked(candidate, why) {
+                return Ok(Some(found));
+            }
+        }
+        let mtl_dir = base_dir.join(mtl_folder);
+        let folders = [Some(mtl_dir.as_path()), model_too.then_some(base_dir)];
+        for dir in folders.into_iter().flatten() {
+            if let Some(p) = bare_file_in(dir, &written, &mut self.listings) {
+                if let Some(found) = checked(p, &mut refusal) {
+                    return Ok(Some(found));
+                }
+            }
+        }
+        refusal.map_or(Ok(None), Err)
     }
 }
 
-/// What `find` finds of `written` (`/` separating) from `base_dir`, given the path as joined,
-/// where the name stays in the folder; else, unless `allow_outside`, its bare file name in
-/// the folder, or the refusal when it is not there (an exporter's absolute path). What is
-/// found is checked with its links resolved and kept as found (its name in messages stays
-/// the model's).
+/// What `find` finds of `written` (`/` separating) from `base_dir`, given the path as joined
+/// and the name with any `..` inside the folder taken out, where the name stays in the
+/// folder; else, unless `allow_outside`, its bare file name in the folder, or the refusal
+/// when it is not there (an exporter's absolute path). What is found is checked with its
+/// links resolved and kept as found (its name in messages stays the model's).
 pub(super) fn within_folder(
     base_dir: &Path,
     written: &str,
     allow_outside: bool,
     listings: &mut Listings,
-    find: impl FnOnce(PathBuf, &mut Listings) -> Option<PathBuf>,
+    find: impl FnOnce(PathBuf, &str, &mut Listings) -> Option<PathBuf>,
 ) -> Result<Option<PathBuf>, String> {
     let found = match access::join(base_dir, written, allow_outside) {
-        Ok(joined) => find(joined, listings),
+        Ok(joined) => {
+            let relative = access::inside(written).unwrap_or(written.into());
+            find(joined, &relative, listings)
+        }
         Err(refusal) => Some(bare_file_in(base_dir, written, listings).ok_or(refusal)?),
     };
     found
@@ -208,9 +267,33 @@ pub(crate) fn resolve_in(
     listings: &mut Listings,
 ) -> Option<PathBuf> {
     let name = name.replace('\\', "/");
-    let as_written = base_dir.join(&name);
+    match match_in(base_dir, &name, allow_outside, listings)? {
+        Matched::File(p) => Some(p),
+        Matched::Outside(link) => bare_file_in(base_dir, &name, listings).or(Some(link)),
+        Matched::Nothing => bare_file_in(base_dir, &name, listings),
+    }
+}
+
+/// What [`match_in`] found of a name.
+enum Matched {
+    /// The file, as written or in other letter case.
+    File(PathBuf),
+    /// The path up to a link in the name's folders that leads out of the folder.
+    Outside(PathBuf),
+    Nothing,
+}
+
+/// The file `name` (`/` separating) names from `base_dir`, as written or matched in other
+/// letter case folder by folder; `None` where the folder itself cannot be resolved.
+fn match_in(
+    base_dir: &Path,
+    name: &str,
+    allow_outside: bool,
+    listings: &mut Listings,
+) -> Option<Matched> {
+    let as_written = base_dir.join(name);
     if as_written.is_file() {
-        return Some(as_written);
+        return Some(Matched::File(as_written));
     }
     let real_base = if allow_outside {
         None
@@ -226,23 +309,22 @@ pub(crate) fn resolve_in(
         .split('/')
         .filter(|p| !p.is_empty() && *p != ".")
         .collect();
+    if parts.len() > MAX_MATCHED_COMPONENTS {
+        return Some(Matched::Nothing);
+    }
     let mut dir = base_dir.to_path_buf();
-    let mut matched = parts.len() <= MAX_MATCHED_COMPONENTS;
     for part in parts {
-        if !matched {
-            break;
-        }
         match listings.find(&dir, part, real_base.as_deref()) {
             Found::Entry(p) => dir = p,
-            Found::Nothing => matched = false,
-            // The bare file name in the folder first, as for any name not matched.
-            Found::Outside => return bare_file_in(base_dir, &name, listings).or(Some(dir)),
+            Found::Nothing => return Some(Matched::Nothing),
+            Found::Outside => return Some(Matched::Outside(dir)),
         }
     }
-    if matched && dir.is_file() {
-        return Some(dir);
-    }
-    bare_file_in(base_dir, &name, listings)
+    Some(if dir.is_file() {
+        Matched::File(dir)
+    } else {
+        Matched::Nothing
+    })
 }
 
 #[cfg(test)]
@@ -264,7 +346,7 @@ mod tests {
             Some(want.clone())
         );
         assert_eq!(
-            TextureFinder::default().find(dir.path(), "-unknown 1 Textures/Brick.PNG", false),
+            TextureFinder::default().find(dir.path(), "", "-unknown 1 Textures/Brick.PNG", false),
             Ok(Some(want))
         );
         std::fs::write(dir.path().join("Textures").join("Old Brick.png"), b"x").unwrap();
@@ -292,7 +374,7 @@ mod tests {
         let absolute = secret.to_str().unwrap().to_string();
         for name in ["../secret.png", "./../secret.png", absolute.as_str()] {
             let refusal = TextureFinder::default()
-                .find(&model, name, false)
+                .find(&model, "", name, false)
                 .unwrap_err();
             assert!(
                 refusal.contains("outside the model's folder"),
@@ -300,7 +382,7 @@ mod tests {
             );
             assert!(
                 TextureFinder::default()
-                    .find(&model, name, true)
+                    .find(&model, "", name, true)
                     .unwrap()
                     .is_some(),
                 "{name}"
@@ -310,27 +392,27 @@ mod tests {
         {
             std::os::unix::fs::symlink(&secret, model.join("link.png")).unwrap();
             let refusal = TextureFinder::default()
-                .find(&model, "link.png", false)
+                .find(&model, "", "link.png", false)
                 .unwrap_err();
             assert!(refusal.contains("a link leads out"), "{refusal}");
             assert!(TextureFinder::default()
-                .find(&model, "link.png", true)
+                .find(&model, "", "link.png", true)
                 .unwrap()
                 .is_some());
         }
         // An exporter's absolute path is still found by its file name in the folder.
         std::fs::write(model.join("wood.png"), b"x").unwrap();
         let found = TextureFinder::default()
-            .find(&model, "C:\\Users\\bob\\Wood.PNG", false)
+            .find(&model, "", "C:\\Users\\bob\\Wood.PNG", false)
             .unwrap();
         assert_eq!(found, Some(model.join("wood.png")));
         let found = TextureFinder::default()
-            .find(&model, "/home/bob/maps/wood.png", false)
+            .find(&model, "", "/home/bob/maps/wood.png", false)
             .unwrap();
         assert_eq!(found, Some(model.join("wood.png")));
         assert_eq!(
             TextureFinder::default()
-                .find(&model, "missing.png", false)
+                .find(&model, "", "missing.png", false)
                 .unwrap(),
             None
         );
@@ -345,17 +427,17 @@ mod tests {
         let (root, model) = model_beside_a_secret_image();
         std::os::unix::fs::symlink(root.path(), model.join("d")).unwrap();
         let mut finder = TextureFinder::default();
-        let refusal = finder.find(&model, "D/SECRET.png", false).unwrap_err();
+        let refusal = finder.find(&model, "", "D/SECRET.png", false).unwrap_err();
         assert!(refusal.contains("`d` is outside"), "{refusal}");
         assert!(refusal.contains("a link leads out"), "{refusal}");
         assert_eq!(finder.listings.listed(), 1, "only the model's folder");
         // Its bare file name in the model's folder is still found (a flattened folder).
         std::fs::write(model.join("Secret.png"), b"x").unwrap();
-        let found = TextureFinder::default().find(&model, "D/SECRET.png", false);
+        let found = TextureFinder::default().find(&model, "", "D/SECRET.png", false);
         assert_eq!(found, Ok(Some(model.join("Secret.png"))));
         std::fs::remove_file(model.join("Secret.png")).unwrap();
         let mut finder = TextureFinder::default();
-        let found = finder.find(&model, "D/SECRET.png", true).unwrap();
+        let found = finder.find(&model, "", "D/SECRET.png", true).unwrap();
         assert_eq!(found, Some(model.join("d").join("secret.png")));
         assert_eq!(finder.listings.listed(), 2);
     }

@@ -321,7 +321,9 @@ fn locate<'d>(
                     shown::name(&name)
                 )));
             } else {
-                resolve_texture_in(base_dir, &name, allow_outside, listings)
+                // Any `..` that stays in the folder taken out, as the join did.
+                let relative = access::inside(&name).unwrap_or(name.as_str().into());
+                resolve_texture_in(base_dir, &relative, allow_outside, listings)
             };
             let path = match path {
                 Some(p) => Some(

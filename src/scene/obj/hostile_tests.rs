@@ -102,7 +102,7 @@ fn texture_lookups_list_each_folder_once_and_match_so_deep() {
     // What is found is kept as found (through the links): compared by the file it is.
     let mut find = |name: &str| {
         finder
-            .find(base, name, false)
+            .find(base, "", name, false)
             .map(|found| found.map(|p| p.canonicalize().unwrap()))
     };
     let deep = |links: usize| format!("{}SUB/T.PNG", "d/".repeat(links));

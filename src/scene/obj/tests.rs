@@ -298,3 +298,62 @@ fn an_unread_librarys_warning_names_the_obj_and_cuts_the_name() {
     assert!(said.contains("characters more"), "{said}");
     assert!(said.len() < obj.display().to_string().len() + 300, "{said}");
 }
+
+/// A library in a folder of its own names its textures from there, as MTL files do: beside
+/// itself, by `..` back into the model's folder, and (an exporter that wrote the OBJ's paths)
+/// from the model's folder where its own has no such file. A `..` that climbs out of the
+/// model's folder is still refused.
+#[test]
+fn a_library_in_a_subfolder_names_textures_from_its_own_folder() {
+    let (_root, model) = model_beside_a_secret_library();
+    for folder in ["mats", "tex"] {
+        std::fs::create_dir(model.join(folder)).unwrap();
+    }
+    let image = |path: &Path, width| {
+        image::RgbaImage::from_pixel(width, 1, image::Rgba([20, 200, 20, 255]))
+            .save(path)
+            .unwrap()
+    };
+    image(&model.join("mats/beside.png"), 1);
+    image(&model.join("tex/wood.png"), 2);
+    // In the model's folder too: a name is looked for from the library's folder first.
+    image(&model.join("beside.png"), 3);
+    image(&root_of(&model).join("out.png"), 4);
+    let faces = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nusemtl m\nf 1/1 2/2 3/3\n";
+    let width = |map_kd: &str| {
+        std::fs::write(
+            model.join("mats/l.mtl"),
+            format!("newmtl m\nmap_Kd {map_kd}\n"),
+        )
+        .unwrap();
+        let obj = model.join("m.obj");
+        std::fs::write(&obj, format!("mtllib mats/l.mtl\n{faces}")).unwrap();
+        let (scene, report) = load(&obj);
+        let texture = scene.materials[0].diffuse_texture.as_ref();
+        (texture.map(|t| t.image.dimensions().0), report.warnings)
+    };
+    assert_eq!(width("beside.png").0, Some(1), "beside the library");
+    assert_eq!(
+        width("..\\tex\\wood.png").0,
+        Some(2),
+        "back into the model's folder"
+    );
+    assert_eq!(width("tex/wood.png").0, Some(2), "from the model's folder");
+    let (found, warnings) = width("../../out.png");
+    assert_eq!(found, None);
+    assert!(
+        warnings
+            .iter()
+            .any(|w| w.contains("outside the model's folder") && w.contains("`..` leads out")),
+        "{warnings:?}"
+    );
+    let (found, warnings) = width("missing.png");
+    assert_eq!(found, None);
+    let said = "texture `missing.png` not found next to its library in";
+    assert!(warnings.iter().any(|w| w.contains(said)), "{warnings:?}");
+}
+
+/// The folder a model folder from [`model_beside_a_secret_library`] lies in.
+fn root_of(model: &Path) -> &Path {
+    model.parent().unwrap()
+}
