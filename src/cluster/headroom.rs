@@ -13,12 +13,13 @@ pub(crate) fn share_of(total: usize, parts: usize) -> usize {
 pub(crate) const WHOLE_UP_TO: usize = 4096;
 
 /// Empties `buffer` for a new frame, keeping room for a quarter more than it held or than
-/// `share`, whichever is more, so a size that wanders stops allocating at its peak.
+/// `share`, whichever is more, so a size that wanders stops allocating at its peak. Room the
+/// allocator refuses is not kept: what fills the buffer asks again for what it needs.
 pub(crate) fn clear_with_room_for<T>(buffer: &mut Vec<T>, share: usize) {
     let len = buffer.len().max(share);
     buffer.clear();
     // Grown by half again when it grows, so the peaks of a wandering size stop allocating.
-    room_for(buffer, len + len / 4);
+    let _ = try_room_for(buffer, len.saturating_add(len / 4));
 }
 
 /// Makes room in `buffer` for `len` elements, by half again when it must grow, so a grid a
@@ -27,6 +28,34 @@ pub(crate) fn room_for<T>(buffer: &mut Vec<T>, len: usize) {
     if buffer.capacity() < len {
         buffer.reserve((len + len / 2).saturating_sub(buffer.len()));
     }
+}
+
+/// Makes room in `buffer` for `more` elements past its length, asking the allocator (twice
+/// the length where it must grow, as a push would): the bytes it refused, if it did, where a
+/// push past the room would abort the process.
+pub(crate) fn try_room_for_more<T>(buffer: &mut Vec<T>, more: usize) -> Result<(), u64> {
+    if buffer.capacity() - buffer.len() >= more {
+        return Ok(());
+    }
+    let grown = more.max(buffer.len());
+    buffer.try_reserve(grown).map_err(|_| {
+        let items = buffer.len().saturating_add(grown) as u64;
+        items.saturating_mul(std::mem::size_of::<T>() as u64)
+    })
+}
+
+/// [`room_for`], asking the allocator (the least that holds `len` where half again is
+/// refused): the bytes it refused, if it did.
+pub(crate) fn try_room_for<T>(buffer: &mut Vec<T>, len: usize) -> Result<(), u64> {
+    if buffer.capacity() >= len {
+        return Ok(());
+    }
+    let roomy = len.saturating_add(len / 2).saturating_sub(buffer.len());
+    if buffer.try_reserve(roomy).is_ok() {
+        return Ok(());
+    }
+    (buffer.try_reserve_exact(len - buffer.len()))
+        .map_err(|_| (len as u64).saturating_mul(std::mem::size_of::<T>() as u64))
 }
 
 /// Gives back what a burst of lights grew `buffer` to, keeping [`clear_with_room_for`]'s room

@@ -232,6 +232,11 @@ impl ShadingMethod for Auto {
                 CulledFrame::Unlisted { references, .. } => {
                     format!("{references} or more light references, more than clustered lists")
                 }
+                CulledFrame::Unallocated(bytes) => format!(
+                    "clustered's light lists need a buffer of {} MiB, more than this process \
+                     can allocate now",
+                    bytes.div_ceil(1 << 20)
+                ),
                 CulledFrame::Overflowed(references) => format!(
                     "{references} light references past clustered's per-cell cap would be \
                      left out"

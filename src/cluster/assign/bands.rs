@@ -15,6 +15,7 @@ pub(super) use scatter::FORCED_SCATTER_BLOCKS;
 use super::cells::{for_each_run_in, SliceWindow};
 use super::types::{Assignment, Run, Tally, Totals, PARALLEL_SECONDS};
 use crate::cluster::grid::ClusterGrid;
+use crate::cluster::headroom::try_room_for_more;
 use crate::cluster::headroom::{clear_with_room_for, room_for, share_of, WHOLE_UP_TO};
 use crate::cluster::view_light::GpuLight;
 
@@ -298,7 +299,13 @@ impl Band {
         let first = self.first_cell as u32;
         let runs = &mut self.runs;
         let (mut listed, mut added) = (0usize, 0usize);
+        let most_runs = tally.most_runs;
         for (i, light) in lights.iter().enumerate() {
+            // Room for the light's runs first: no push below grows the buffer.
+            if let Err(bytes) = try_room_for_more(runs, most_runs) {
+                tally.refuse(bytes);
+                break;
+            }
             let before = runs.len();
             // Taking `first` by value and summing the indices after: the closure lives on the
             // stack (the refinement takes it), so each value it reaches by reference costs a
@@ -311,6 +318,10 @@ impl Band {
                 })
             };
             for_each_run_in(grid, &window, light, camera_far, &mut emit);
+            debug_assert!(
+                runs.len() - before <= most_runs,
+                "a light's runs past the bound"
+            );
             if runs.len() > before {
                 self.lights.push((i as u32, before as u32));
                 listed += runs[before..]
@@ -342,7 +353,7 @@ impl Band {
         out.visible.clear();
         out.visible
             .extend(self.lights.iter().map(|&(light, _)| light));
-        if self.indices > tally.limit {
+        if self.indices > tally.limit || tally.refused().is_some() {
             out.unlisted = Some(self.indices);
             self.totals = Totals::default();
             return;
@@ -351,8 +362,14 @@ impl Band {
         self.ids.extend(0..self.lights.len() as u32);
         self.base = 0;
         let cells = CellsOut::sized(&mut out.counts, &mut out.offsets, self.end_cell);
-        let list = out.indices.prepare(self.indices, out.visible.len());
-        self.count_and_scatter(None, cells, list);
+        match out.indices.prepare(self.indices, out.visible.len()) {
+            Ok(list) => self.count_and_scatter(None, cells, list),
+            Err(bytes) => {
+                tally.refuse(bytes);
+                out.unlisted = Some(self.indices);
+                self.totals = Totals::default();
+            }
+        }
     }
 }
 

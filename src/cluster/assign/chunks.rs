@@ -8,6 +8,7 @@ use super::cells::for_each_run;
 use super::index_list::{EntriesMut, IndexList, LightIndex};
 use super::types::{Assignment, Run, Tally, Totals};
 use crate::cluster::grid::ClusterGrid;
+use crate::cluster::headroom::try_room_for_more;
 use crate::cluster::headroom::{clear_with_room_for, room_for, share_of, zeroed_with_room};
 use crate::cluster::view_light::GpuLight;
 
@@ -93,7 +94,7 @@ impl Chunks {
             out.visible.extend(chunk.visible.iter().map(|&i| first + i));
         }
         let listed = (self.chunks.iter()).fold(0usize, |n, k| n.saturating_add(k.listed));
-        if listed > tally.limit {
+        if listed > tally.limit || tally.refused().is_some() {
             out.unlisted = Some(listed);
             return Totals::default();
         }
@@ -115,12 +116,23 @@ impl Chunks {
             .par_iter_mut()
             .zip(first_ids.par_iter())
             .for_each(|(chunk, &first_id)| {
-                chunk.sort_locally(first_id, cells, visible, sorted_share);
+                if let Err(bytes) = chunk.sort_locally(first_id, cells, visible, sorted_share) {
+                    tally.refuse(bytes);
+                }
             });
         let (chunks, blocks) = (&self.chunks, &mut self.blocks);
-        match out.indices.prepare(total as usize, out.visible.len()) {
-            EntriesMut::Narrow(list) => merge(chunks, &out.offsets, list, threads, blocks),
-            EntriesMut::Wide(list) => merge(chunks, &out.offsets, list, threads, blocks),
+        let list = match tally.refused() {
+            None => out.indices.prepare(total as usize, out.visible.len()),
+            Some(bytes) => Err(bytes),
+        };
+        match list {
+            Ok(EntriesMut::Narrow(list)) => merge(chunks, &out.offsets, list, threads, blocks),
+            Ok(EntriesMut::Wide(list)) => merge(chunks, &out.offsets, list, threads, blocks),
+            Err(bytes) => {
+                tally.refuse(bytes);
+                out.unlisted = Some(listed);
+                return Totals::default();
+            }
         }
         Totals {
             runs: self.chunks.iter().map(|c| c.runs.len()).sum(),
@@ -175,7 +187,13 @@ impl Chunk {
         clear_with_room_for(&mut self.visible, visible_share);
         let (deltas, runs) = (&mut self.deltas[..], &mut self.runs);
         let (mut listed, mut added) = (0usize, 0usize);
+        let most_runs = tally.most_runs;
         for (i, light) in lights.iter().enumerate() {
+            // Room for the light's runs first: no push below grows the buffer.
+            if let Err(bytes) = try_room_for_more(runs, most_runs) {
+                tally.refuse(bytes);
+                break;
+            }
             let before = runs.len();
             // The callback lives on the stack (the refinement takes it out of line): it holds
             // the difference counts as a slice, not through their `Vec`, one load less a run.
@@ -186,6 +204,10 @@ impl Chunk {
                 to.push(Run { start, len });
             };
             for_each_run(grid, light, camera_far, &mut emit);
+            debug_assert!(
+                runs.len() - before <= most_runs,
+                "a light's runs past the bound"
+            );
             if runs.len() > before {
                 self.visible.push(i as u32);
                 listed += runs[before..]
@@ -262,19 +284,28 @@ impl Chunk {
 
     /// Phase 3 of one of several chunks: scatters into the chunk's own list, at the width of
     /// a list of `visible` lights, with one spare entry at its end (see [`Chunk::scatter`]),
-    /// keeping room for `share` entries (its share of the last assignment's).
-    fn sort_locally(&mut self, first_id: u32, cells: usize, visible: usize, share: usize) {
+    /// keeping room for `share` entries (its share of the last assignment's). The bytes its
+    /// list could not grow to, if the allocator refused them.
+    fn sort_locally(
+        &mut self,
+        first_id: u32,
+        cells: usize,
+        visible: usize,
+        share: usize,
+    ) -> Result<(), u64> {
         let mut sorted = std::mem::take(&mut self.sorted);
         let len = self.offsets[cells];
         room_for(&mut self.cursor, cells + 1);
         self.cursor.clear();
         self.cursor.extend_from_slice(&self.offsets[..cells]);
         self.cursor.push(len);
-        match sorted.prepare_with_room(len as usize + 1, share, visible) {
+        let prepared = sorted.prepare_with_room(len as usize + 1, share, visible);
+        let result = prepared.map(|list| match list {
             EntriesMut::Narrow(list) => self.scatter(first_id, list),
             EntriesMut::Wide(list) => self.scatter(first_id, list),
-        }
+        });
         self.sorted = sorted;
+        result
     }
 }
 

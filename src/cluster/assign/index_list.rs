@@ -7,7 +7,7 @@
 //! renderer refuses but the CPU-only uses (`bench-assign` at a million lights) reach. Both
 //! buffers are kept, so a list that changes width allocates nothing once both have grown.
 
-use crate::cluster::headroom::room_for;
+use crate::cluster::headroom::try_room_for;
 
 /// Every cell's lights, cell after cell: positions in
 /// [`Assignment::visible`](crate::cluster::assign::Assignment::visible), 16-bit when there are at most 65 536 visible
@@ -86,7 +86,8 @@ impl IndexList {
     /// Makes the list `len` entries long, 16-bit if `visible` lights fit, and returns it to be
     /// written: every entry must then be written (growth is zero-filled, the rest keeps an
     /// earlier frame's entries).
-    pub(super) fn prepare(&mut self, len: usize, visible: usize) -> EntriesMut<'_> {
+    /// The bytes the allocator refused, if it did (the list is then to be emptied).
+    pub(super) fn prepare(&mut self, len: usize, visible: usize) -> Result<EntriesMut<'_>, u64> {
         self.prepare_with_room(len, 0, visible)
     }
 
@@ -98,18 +99,22 @@ impl IndexList {
         len: usize,
         room: usize,
         visible: usize,
-    ) -> EntriesMut<'_> {
+    ) -> Result<EntriesMut<'_>, u64> {
         self.is_wide = visible > NARROW_LIGHTS;
+        // The room kept where the allocator gives it, else `len` alone.
+        fn sized<T: Copy + Default>(v: &mut Vec<T>, len: usize, room: usize) -> Result<(), u64> {
+            try_room_for(v, len.max(room)).or_else(|_| try_room_for(v, len))?;
+            v.resize(len, T::default());
+            Ok(())
+        }
         if self.is_wide {
             self.narrow.clear();
-            room_for(&mut self.wide, len.max(room));
-            self.wide.resize(len, 0);
-            EntriesMut::Wide(&mut self.wide)
+            sized(&mut self.wide, len, room)?;
+            Ok(EntriesMut::Wide(&mut self.wide))
         } else {
             self.wide.clear();
-            room_for(&mut self.narrow, len.max(room));
-            self.narrow.resize(len, 0);
-            EntriesMut::Narrow(&mut self.narrow)
+            sized(&mut self.narrow, len, room)?;
+            Ok(EntriesMut::Narrow(&mut self.narrow))
         }
     }
 
@@ -205,14 +210,14 @@ mod tests {
     #[test]
     fn width_follows_the_visible_lights() {
         let mut list = IndexList::default();
-        match list.prepare(3, NARROW_LIGHTS) {
+        match list.prepare(3, NARROW_LIGHTS).unwrap() {
             EntriesMut::Narrow(v) => v.copy_from_slice(&[0, 7, 65_535]),
             EntriesMut::Wide(_) => panic!("65 536 visible lights fit 16 bits"),
         }
         assert_eq!(list.as_u16(), Some(&[0u16, 7, 65_535][..]));
         assert_eq!(list.to_vec(), vec![0, 7, 65_535]);
         let mut wide = IndexList::default();
-        match wide.prepare(3, NARROW_LIGHTS + 1) {
+        match wide.prepare(3, NARROW_LIGHTS + 1).unwrap() {
             EntriesMut::Wide(v) => v.copy_from_slice(&[0, 7, 65_535]),
             EntriesMut::Narrow(_) => panic!("65 537 visible lights need 32 bits"),
         }

@@ -154,6 +154,19 @@ impl Assigner {
         &self.out
     }
 
+    /// The result of an assignment that lists nothing ([`Assignment::unlisted`]): empty
+    /// cells, every visible light overflowed, the runs found given back.
+    fn nothing_listed(&mut self, cells: usize, threads: usize) -> &Assignment {
+        self.bands.release_runs();
+        self.chunks.release_runs();
+        let out = &mut self.out;
+        out.empty_lists(cells);
+        out.stats.visible_lights = out.visible.len();
+        out.stats.overflowed_lights = out.visible.len() as u64;
+        out.stats.threads = threads;
+        &self.out
+    }
+
     /// Takes the last result out (the next call allocates its output again).
     pub fn into_assignment(self) -> Assignment {
         self.out
@@ -180,6 +193,7 @@ impl Assigner {
         let out = &mut self.out;
         out.visible.clear();
         out.unlisted = None;
+        out.unallocated = None;
         out.overfull.clear();
         out.stats = AssignStats {
             clusters: grid.total_cells,
@@ -233,7 +247,7 @@ impl Assigner {
             threads,
         );
         self.last_threads = threads;
-        let tally = types::Tally::new(limits.max_untrimmed);
+        let tally = types::Tally::new(limits.max_untrimmed, most_runs_a_light(grid));
         let by_bands = threads == 1 || cells >= lights.len();
         let totals = if threads == 1 {
             self.bands.assign(grid, lights, camera_far, out, 1, &tally)
@@ -250,21 +264,19 @@ impl Assigner {
                 }
             })
         };
+        out.unallocated = tally.refused();
         if out.unlisted.is_some() {
-            // Nothing listed: empty cells, every visible light overflowed.
-            self.bands.release_runs();
-            self.chunks.release_runs();
-            out.empty_lists(cells);
-            out.stats.visible_lights = out.visible.len();
-            out.stats.overflowed_lights = out.visible.len() as u64;
-            out.stats.threads = threads;
-            return &self.out;
+            return self.nothing_listed(cells, threads);
         }
         // Overflow, then the figures.
         out.stats.max_lights_per_cluster = totals.max;
         out.stats.runs = totals.runs;
         out.stats.visible_lights = out.visible.len();
-        let nonempty = if apply_cap(out, grid, lights, limits, &mut self.overflow) {
+        let capped = apply_cap(out, grid, lights, limits, &mut self.overflow);
+        if out.unallocated.is_some() {
+            return self.nothing_listed(cells, threads);
+        }
+        let nonempty = if capped {
             Totals::of(&out.counts).nonempty
         } else {
             totals.nonempty
@@ -288,6 +300,14 @@ impl Assigner {
         }
         &self.out
     }
+}
+
+/// Most runs one light gives on `grid`: one per row of each slice at most (a light's cells in
+/// a row are contiguous), over every cascade it may span.
+fn most_runs_a_light(grid: &ClusterGrid) -> usize {
+    (grid.cascades.iter())
+        .map(|c| c.tiles_y as usize * c.slices as usize)
+        .sum()
 }
 
 /// Keeps the bands' split of the pool aside while one thread runs (`last` threads ran the

@@ -29,6 +29,7 @@ impl Overflow {
 }
 
 /// Applies the overflow policy in place (see the module docs); true if it dropped any light.
+/// Where the trimmed list cannot be allocated, nothing is listed (`out.unallocated`).
 pub(super) fn apply_cap(
     out: &mut Assignment,
     grid: &ClusterGrid,
@@ -51,11 +52,16 @@ pub(super) fn apply_cap(
     let total: usize = out.counts.iter().map(|&n| n.min(cap) as usize).sum();
     let (offsets, counts) = (&mut out.offsets, &mut out.counts);
     let overfull = &mut out.overfull;
-    let dropped = match (
-        scratch.kept.prepare(total, out.visible.len()),
-        out.indices.as_u16(),
-        out.indices.as_u32(),
-    ) {
+    let kept = match scratch.kept.prepare(total, out.visible.len()) {
+        Ok(kept) => kept,
+        // Nothing listed, as for a list too long to build.
+        Err(bytes) => {
+            out.unallocated = Some(bytes);
+            out.unlisted = Some(out.indices.len());
+            return false;
+        }
+    };
+    let dropped = match (kept, out.indices.as_u16(), out.indices.as_u32()) {
         (EntriesMut::Narrow(kept), Some(list), _) => {
             compact(list, kept, offsets, counts, cap, overfull)
         }

@@ -2,6 +2,7 @@
 //! of bands and chunks), below them all so no part imports the module that calls it.
 
 use super::index_list::IndexList;
+use crate::cluster::headroom::try_room_for;
 
 /// Most light references an assignment lists before the overflow policy trims them: a grid
 /// whose cells and overlapping lights would give more is not listed (see
@@ -18,18 +19,38 @@ pub(super) struct Tally {
     total: std::sync::atomic::AtomicUsize,
     /// The bound ([`AssignLimits::max_untrimmed`]).
     pub(super) limit: usize,
+    /// Most runs one light gives on this grid (a row of one slice holds at most one): a
+    /// worker makes room for as many before each light, asking the allocator, so that no push
+    /// of a light's runs grows its buffer (which would abort where memory runs out).
+    pub(super) most_runs: usize,
+    /// Bytes a worker's buffer could not grow to (0: none): the lists are not built
+    /// ([`Assignment::unallocated`]).
+    refused: std::sync::atomic::AtomicU64,
 }
 
 /// References a worker finds between two additions to the [`Tally`].
 const TALLY_STEP: usize = 1 << 18;
 
 impl Tally {
-    /// A tally against `limit`.
-    pub(super) fn new(limit: usize) -> Tally {
+    /// A tally against `limit`, for lights of at most `most_runs` runs each.
+    pub(super) fn new(limit: usize, most_runs: usize) -> Tally {
         Tally {
             total: std::sync::atomic::AtomicUsize::new(0),
             limit,
+            most_runs,
+            refused: std::sync::atomic::AtomicU64::new(0),
         }
+    }
+
+    /// Says that a buffer of the assignment could not grow to `bytes`.
+    pub(super) fn refuse(&self, bytes: u64) {
+        (self.refused).fetch_max(bytes.max(1), std::sync::atomic::Ordering::Relaxed);
+    }
+
+    /// The most bytes a buffer of the assignment could not grow to, if any could not.
+    pub(super) fn refused(&self) -> Option<u64> {
+        let bytes = self.refused.load(std::sync::atomic::Ordering::Relaxed);
+        (bytes > 0).then_some(bytes)
     }
 
     /// A worker's running count `listed`, of which `added` were added already: adds the rest
@@ -178,6 +199,11 @@ pub struct Assignment {
     /// policy, more than [`AssignLimits::max_untrimmed`], so none were listed (every cell is empty;
     /// the lights found visible, which may stop short of all of them, count as overflowed).
     pub unlisted: Option<usize>,
+    /// `Some(bytes)`: a buffer the lists are built in could not grow to `bytes`, more than the
+    /// allocator gave (an address-space limit, a 32-bit process); nothing was listed, as for
+    /// [`Assignment::unlisted`], which is `Some` too (`offsets` and `counts` may then be empty:
+    /// where even they cannot be allocated).
+    pub unallocated: Option<u64>,
     /// The cells the overflow policy cut, ascending, with the references each lost (empty
     /// without overflow): where in the picture the dropped lights are missing.
     pub(crate) overfull: Vec<(u32, u32)>,
@@ -204,13 +230,16 @@ impl Assignment {
         }
     }
 
-    /// No lists: every one of `cells` cells empty (offsets and counts 0), no indices.
+    /// No lists: every one of `cells` cells empty (offsets and counts 0), no indices; where
+    /// the allocator refuses even the per-cell arrays, none (nothing is listed either way).
     pub(super) fn empty_lists(&mut self, cells: usize) {
         self.indices.clear();
-        self.offsets.clear();
-        self.offsets.resize(cells, 0);
-        self.counts.clear();
-        self.counts.resize(cells, 0);
+        for per_cell in [&mut self.offsets, &mut self.counts] {
+            per_cell.clear();
+            if try_room_for(per_cell, cells).is_ok() {
+                per_cell.resize(cells, 0);
+            }
+        }
     }
 }
 

@@ -106,6 +106,17 @@ pub(super) fn too_many_references(
     ))
 }
 
+/// The error of a frame whose light lists (or the runs they are built from) needed `bytes` in
+/// one buffer, which the allocator refused: an error, where growing it would abort.
+pub(super) fn lists_unallocated(method: &str, bytes: u64) -> Error {
+    Error::Limit(format!(
+        "{method}: the frame's light lists need a buffer of {} MiB, which this process cannot \
+         allocate now: fewer or smaller lights in view, larger cells (grid.footprint_px, \
+         tile_px), or forward",
+        bytes.div_ceil(1 << 20)
+    ))
+}
+
 /// The error of a frame with more visible lights than the index list can number.
 pub(super) fn too_many_visible(visible: usize) -> Error {
     Error::Limit(format!(

@@ -54,6 +54,9 @@ pub(crate) enum CulledFrame<'a> {
     /// Not rendered: the grid's cells would list at least `references` light references
     /// before the cell cap, more than an assignment builds.
     Unlisted { cells: u32, references: usize },
+    /// Not rendered: a buffer the lists are built in could not grow to `bytes` (the
+    /// allocator refused it).
+    Unallocated(u64),
     /// Not rendered, as asked: the per-cell cap left this many light references out.
     Overflowed(u64),
 }
@@ -238,6 +241,9 @@ impl CulledForward {
 
 /// Why a frame with `assignment` is not drawn (see [`CulledFrame`]), if it is not.
 fn refused(assignment: &Assignment, refuse_overflow: bool) -> Option<CulledFrame<'static>> {
+    if let Some(bytes) = assignment.unallocated {
+        return Some(CulledFrame::Unallocated(bytes));
+    }
     if let Some(references) = assignment.unlisted {
         let cells = assignment.stats.clusters;
         return Some(CulledFrame::Unlisted { cells, references });
@@ -278,6 +284,7 @@ impl ShadingMethod for CulledForward {
             CulledFrame::Unlisted { cells, references } => Err(limits::too_many_references(
                 name, cells, references, automatic,
             )),
+            CulledFrame::Unallocated(bytes) => Err(limits::lists_unallocated(name, bytes)),
             CulledFrame::Overflowed(_) => unreachable!("overflow is refused only when asked"),
         }
     }
@@ -314,5 +321,34 @@ impl ShadingMethod for CulledForward {
     fn destroy(&mut self, dev: &Device) {
         self.lists_key = None;
         self.upload.destroy(dev);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Lists the allocator refused are a frame not drawn, whose error names the size; a list
+    /// too long to build keeps its own reason.
+    #[test]
+    fn lists_the_allocator_refused_are_an_error_naming_the_size() {
+        let mut a = Assignment {
+            unlisted: Some(5),
+            unallocated: Some(3 << 20),
+            ..Assignment::default()
+        };
+        let Some(CulledFrame::Unallocated(bytes)) = refused(&a, false) else {
+            panic!("not refused for its memory");
+        };
+        let text = limits::lists_unallocated("clustered", bytes).to_string();
+        assert!(
+            text.contains("3 MiB") && text.contains("cannot allocate"),
+            "{text}"
+        );
+        a.unallocated = None;
+        assert!(matches!(
+            refused(&a, false),
+            Some(CulledFrame::Unlisted { references: 5, .. })
+        ));
     }
 }

@@ -112,7 +112,8 @@ fn a_try_of_one_thread_leaves_the_pools_split_for_its_next_assignment() {
         let (bands, kept) = (&mut assigner.bands, &mut assigner.pool_split);
         keep_pool_split(bands, kept, 2, 1);
         let mut out = Assignment::default();
-        let tally = crate::cluster::assign::types::Tally::new(usize::MAX);
+        let most_runs = super::super::most_runs_a_light(&grid);
+        let tally = crate::cluster::assign::types::Tally::new(usize::MAX, most_runs);
         bands.assign(&grid, &lights, 80.0, &mut out, 1, &tally);
         assert_eq!(bands.active, 1, "one thread, one band");
         keep_pool_split(bands, kept, 1, 2);

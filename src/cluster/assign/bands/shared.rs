@@ -52,8 +52,7 @@ pub(super) fn assign_shared(
             if find_done.fetch_add(1, Ordering::AcqRel) + 1 == n {
                 let (out, numbers) = lock(&between).take().expect("phase 2 runs once");
                 let taken = found.each_ref().map(|band| lock(band).take());
-                let limit = tally.limit;
-                between_phases(taken, (lights.len(), limit), out, numbers, &scatters);
+                between_phases(taken, (lights.len(), tally), out, numbers, &scatters);
                 scatter_open.store(true, Ordering::Release);
             }
         }
@@ -90,7 +89,7 @@ fn on_workers(count: usize, work: &(dyn Fn() + Sync)) {
 /// phase 3's jobs: each band's parts of the per-cell arrays and of the list, in `scatters`.
 fn between_phases<'a>(
     mut taken: [Option<&'a mut Band>; MAX_BANDS],
-    (lights, limit): (usize, usize),
+    (lights, tally): (usize, &Tally),
     out: &'a mut Assignment,
     numbers: &'a mut Vec<u32>,
     scatters: &[Mutex<Option<Scatter<'a>>>; MAX_BANDS],
@@ -102,13 +101,10 @@ fn between_phases<'a>(
         band.base = indices;
         indices += band.indices;
     }
-    if indices > limit {
+    if indices > tally.limit || tally.refused().is_some() {
         // Not listed: phase 3 finds no band to scatter.
         out.unlisted = Some(indices);
-        taken
-            .iter_mut()
-            .flatten()
-            .for_each(|b| b.totals = Totals::default());
+        (taken.iter_mut().flatten()).for_each(|b| b.totals = Totals::default());
         return;
     }
     // The bands cover the grid, from cell 0 to the last band's end.
@@ -119,7 +115,15 @@ fn between_phases<'a>(
         .map_or(0, |band| band.end_cell);
     let mut rest = CellsOut::sized(&mut out.counts, &mut out.offsets, cells);
     let numbers: &[u32] = numbers;
-    let mut list = out.indices.prepare(indices, out.visible.len());
+    let mut list = match out.indices.prepare(indices, out.visible.len()) {
+        Ok(list) => list,
+        Err(bytes) => {
+            tally.refuse(bytes);
+            out.unlisted = Some(indices);
+            (taken.iter_mut().flatten()).for_each(|b| b.totals = Totals::default());
+            return;
+        }
+    };
     for (band, slot) in taken.into_iter().flatten().zip(scatters) {
         let (cells, after) = rest.split_at(band.end_cell - band.first_cell);
         let (part, tail) = list.split_at(band.indices);

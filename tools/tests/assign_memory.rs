@@ -1,0 +1,151 @@
+//! The assignment asks the allocator before a frame's lights grow its buffers: where it refuses
+//! (an address-space limit, a 32-bit process), nothing is listed and the assignment says so
+//! (`Assignment::unallocated`, which the renderer turns into an error naming the size). A
+//! buffer grown without asking aborted the process there: 3.16 M lights from a 16 MB scene
+//! file under `ulimit -v 3000000` (helper-170, 2026-12-07).
+//!
+//! This program's allocator refuses every allocation past a size the test sets, as the system
+//! does past an address-space limit: a buffer that grows without asking aborts the program,
+//! so the test fails.
+
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use manylight::cluster::assign::{AssignLimits, Assigner, Assignment};
+use manylight::cluster::grid::GridConfig;
+use manylight_tools::workload::AssignWorkload;
+
+/// The system allocator, refusing (a null pointer) any allocation larger than [`LARGEST`].
+struct Refusing;
+
+/// Largest allocation granted, in bytes.
+static LARGEST: AtomicUsize = AtomicUsize::new(usize::MAX);
+
+fn granted(bytes: usize) -> bool {
+    bytes <= LARGEST.load(Ordering::Relaxed)
+}
+
+unsafe impl GlobalAlloc for Refusing {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        match granted(layout.size()) {
+            true => unsafe { System.alloc(layout) },
+            false => std::ptr::null_mut(),
+        }
+    }
+    unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
+        match granted(layout.size()) {
+            true => unsafe { System.alloc_zeroed(layout) },
+            false => std::ptr::null_mut(),
+        }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        unsafe { System.dealloc(ptr, layout) }
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        match granted(new_size) {
+            true => unsafe { System.realloc(ptr, layout, new_size) },
+            false => std::ptr::null_mut(),
+        }
+    }
+}
+
+#[global_allocator]
+static ALLOCATOR: Refusing = Refusing;
+
+/// Every light listed, on up to `threads` threads, parallel from the first light.
+fn limits(threads: usize) -> AssignLimits {
+    AssignLimits {
+        cell_cap: u32::MAX,
+        parallel_threshold: 0,
+        max_threads: threads,
+        ..AssignLimits::default()
+    }
+}
+
+/// `workload` assigned by a fresh assigner (no buffers grown by an earlier frame) on a pool of
+/// `threads`, no allocation past `largest` bytes granted meanwhile.
+fn assigned(workload: &AssignWorkload, threads: usize, largest: usize) -> Assignment {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap();
+    pool.install(|| {
+        let mut assigner = Assigner::new();
+        LARGEST.store(largest, Ordering::Relaxed);
+        let limits = limits(threads);
+        assigner.assign(&workload.grid, &workload.lights, workload.far, &limits);
+        LARGEST.store(usize::MAX, Ordering::Relaxed);
+        assigner.into_assignment()
+    })
+}
+
+/// A few lights wide on the screen over a grid of 4-pixel cells and 4 slices: long runs, so
+/// the list takes far more bytes than the runs and the per-cell arrays.
+fn long_runs() -> AssignWorkload {
+    AssignWorkload::view_with(1024, 1, (1280, 720), |_, _| GridConfig {
+        max_slices: 4,
+        cascades: 1,
+        ..GridConfig::fixed(4.0)
+    })
+}
+
+/// Refused where its runs or its list outgrow what the allocator gives, on one thread (one
+/// band), on bands of slices and on chunks of lights: nothing listed, every cell empty, every
+/// visible light counted as dropped, and the size said. Given the memory, a fresh assigner
+/// lists as before.
+#[test]
+fn lists_the_allocator_refuses_are_not_built_and_say_so() {
+    // Bands of slices where the cells outnumber the lights, chunks of lights where not.
+    let cases = [
+        ("one band", AssignWorkload::fine_grid(4096, 1), 1),
+        ("bands", AssignWorkload::fine_grid(4096, 1), 2),
+        ("chunks", AssignWorkload::default_view(200_000, 1), 2),
+        ("one band, long runs", long_runs(), 1),
+        ("bands, long runs", long_runs(), 2),
+    ];
+    let mut lists_refused = 0;
+    for (what, workload, threads) in cases {
+        let whole = assigned(&workload, threads, usize::MAX);
+        assert!(
+            whole.unallocated.is_none() && whole.unlisted.is_none(),
+            "{what}"
+        );
+        let (runs, indices) = (whole.stats.runs, whole.indices.len());
+        let cells = workload.grid.total_cells as usize;
+        assert!(runs > 10_000, "{what}: {runs} runs");
+        // A quarter of the runs' bytes (8 a run) refuses their growth. Where the list (2 bytes
+        // an entry while the visible lights fit 16 bits) is larger than the runs grow to
+        // (twice them) and the per-cell arrays (half again their 4 bytes a cell, twice),
+        // only the list is refused.
+        let mut caps = vec![("runs", runs * 8 / 4)];
+        let all_but_the_list = (runs * 8 * 2).max(cells * 12);
+        if indices * 2 > all_but_the_list {
+            caps.push(("list", all_but_the_list));
+            lists_refused += 1;
+        }
+        for (refused, largest) in caps {
+            let a = assigned(&workload, threads, largest);
+            let bytes = a
+                .unallocated
+                .unwrap_or_else(|| panic!("{what}, {refused}: listed"));
+            assert!(
+                bytes as usize > largest,
+                "{what}, {refused}: {bytes} bytes refused"
+            );
+            assert!(a.unlisted.is_some(), "{what}, {refused}");
+            assert_eq!(a.indices.len(), 0, "{what}, {refused}");
+            // Empty cells, or none where even they could not be allocated.
+            assert!(a.counts.iter().all(|&n| n == 0), "{what}, {refused}");
+            assert!([0, cells].contains(&a.counts.len()), "{what}, {refused}");
+            assert_eq!(
+                a.stats.overflowed_lights,
+                a.visible.len() as u64,
+                "{what}, {refused}"
+            );
+        }
+        let again = assigned(&workload, threads, usize::MAX);
+        assert_eq!(again.indices, whole.indices, "{what}");
+        assert_eq!(again.counts, whole.counts, "{what}");
+    }
+    assert_eq!(lists_refused, 2, "the long runs' lists were refused alone");
+}
