@@ -82,6 +82,18 @@ pub(crate) fn fit_keeping<T>(buffer: &mut Vec<T>, keep: bool) {
     fit(buffer);
 }
 
+/// [`zeroed_with_room`], asking the allocator: the bytes it refused, if it did (`buffer` is
+/// then empty).
+pub(crate) fn try_zeroed_with_room<T: Clone + Default>(
+    buffer: &mut Vec<T>,
+    len: usize,
+) -> Result<(), u64> {
+    buffer.clear();
+    try_room_for(buffer, len)?;
+    buffer.resize(len, T::default());
+    Ok(())
+}
+
 /// Makes `buffer` `len` default values (zeros), with [`room_for`]'s room to grow: for
 /// per-frame buffers filled afresh, whose length wanders with the view and the lights.
 pub(crate) fn zeroed_with_room<T: Clone + Default>(buffer: &mut Vec<T>, len: usize) {

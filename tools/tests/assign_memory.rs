@@ -52,6 +52,12 @@ unsafe impl GlobalAlloc for Refusing {
 #[global_allocator]
 static ALLOCATOR: Refusing = Refusing;
 
+/// Held by each test for its whole run: the limit is the whole program's.
+fn serial() -> std::sync::MutexGuard<'static, ()> {
+    static SERIAL: std::sync::Mutex<()> = std::sync::Mutex::new(());
+    SERIAL.lock().unwrap_or_else(|e| e.into_inner())
+}
+
 /// Every light listed, on up to `threads` threads, parallel from the first light.
 fn limits(threads: usize) -> AssignLimits {
     AssignLimits {
@@ -95,6 +101,7 @@ fn long_runs() -> AssignWorkload {
 /// lists as before.
 #[test]
 fn lists_the_allocator_refuses_are_not_built_and_say_so() {
+    let _serial = serial();
     // Bands of slices where the cells outnumber the lights, chunks of lights where not.
     let cases = [
         ("one band", AssignWorkload::fine_grid(4096, 1), 1),
@@ -148,4 +155,31 @@ fn lists_the_allocator_refuses_are_not_built_and_say_so() {
         assert_eq!(again.counts, whole.counts, "{what}");
     }
     assert_eq!(lists_refused, 2, "the long runs' lists were refused alone");
+}
+
+/// The texels a frame uploads are packed into buffers that ask the allocator: refused, the
+/// size comes back (the renderer's error), where growing them aborted.
+#[test]
+fn texels_the_allocator_refuses_are_said() {
+    use manylight::cluster::pack::{pack_grid_into, pack_indices_into, GridEncoding, PackedTexels};
+    let _serial = serial();
+    let workload = long_runs();
+    let a = assigned(&workload, 1, usize::MAX);
+    let encoding = GridEncoding::Rgba8;
+    let (mut grid, mut indices) = (PackedTexels::empty(), PackedTexels::empty());
+    // Half the list's bytes: the grid's texels (4 bytes a cell) fit, the list's do not.
+    let largest = a.indices.len();
+    assert!(workload.grid.total_cells as usize * 4 * 2 < largest);
+    LARGEST.store(largest, Ordering::Relaxed);
+    let packed_grid = pack_grid_into(&workload.grid, &a, encoding, &mut grid);
+    let packed_list = pack_indices_into(&a.indices, encoding, &mut indices);
+    LARGEST.store(usize::MAX, Ordering::Relaxed);
+    assert_eq!(packed_grid, Ok(()));
+    let bytes = packed_list.expect_err("the list's texels were allocated");
+    assert!(bytes as usize > largest, "{bytes}");
+    assert_eq!(
+        pack_indices_into(&a.indices, encoding, &mut indices),
+        Ok(())
+    );
+    assert!(indices.bytes.len() >= 2 * a.indices.len());
 }

@@ -40,7 +40,7 @@ use super::lights::DATA_TEXTURE_WIDTH;
 use crate::cluster::assign::index_list::IndexList;
 use crate::cluster::assign::Assignment;
 use crate::cluster::grid::ClusterGrid;
-use crate::cluster::headroom::zeroed_with_room;
+use crate::cluster::headroom::try_zeroed_with_room;
 
 /// Texels per cascade in the grid texture's table.
 pub const TABLE_TEXELS_PER_CASCADE: u32 = 2;
@@ -167,23 +167,28 @@ impl PackedTexels {
 
 /// Packs the cascade table and where each cell's list starts (and, after the last cell, where
 /// its list ends).
+///
+/// # Panics
+///
+/// Where its bytes cannot be allocated (a frame uses [`pack_grid_into`], which says so).
 pub fn pack_grid(grid: &ClusterGrid, a: &Assignment, encoding: GridEncoding) -> PackedTexels {
     let mut packed = PackedTexels::empty();
-    pack_grid_into(grid, a, encoding, &mut packed);
+    pack_grid_into(grid, a, encoding, &mut packed).expect("the grid texels are allocated");
     packed
 }
 
-/// [`pack_grid`] into `packed`, reusing its bytes (no allocation once they have grown).
+/// [`pack_grid`] into `packed`, reusing its bytes (no allocation once they have grown); the
+/// bytes the allocator refused, if it did.
 pub fn pack_grid_into(
     grid: &ClusterGrid,
     a: &Assignment,
     encoding: GridEncoding,
     packed: &mut PackedTexels,
-) {
+) -> Result<(), u64> {
     let table = grid.cascades.len() * TABLE_TEXELS_PER_CASCADE as usize;
     let height = rows_for(grid_texels(grid));
     let bytes = &mut packed.bytes;
-    zeroed_with_room(bytes, grid_texels(grid) * 4);
+    try_zeroed_with_room(bytes, grid_texels(grid) * 4)?;
     let mut put =
         |texel: usize, value: [u8; 4]| bytes[texel * 4..texel * 4 + 4].copy_from_slice(&value);
     match encoding {
@@ -222,23 +227,33 @@ pub fn pack_grid_into(
     put(table + a.offsets.len(), word(end));
     packed.width = DATA_TEXTURE_WIDTH;
     packed.height = height;
+    Ok(())
 }
 
 /// Packs the index list (16-bit light numbers; entries of a 32-bit list keep their low 16
 /// bits: a renderer refuses more than [`MAX_INDEXED_LIGHTS`] visible lights before packing).
+///
+/// # Panics
+///
+/// Where its bytes cannot be allocated (a frame uses [`pack_indices_into`], which says so).
 pub fn pack_indices(indices: &IndexList, encoding: GridEncoding) -> PackedTexels {
     let mut packed = PackedTexels::empty();
-    pack_indices_into(indices, encoding, &mut packed);
+    pack_indices_into(indices, encoding, &mut packed).expect("the index texels are allocated");
     packed
 }
 
-/// [`pack_indices`] into `packed`, reusing its bytes (no allocation once they have grown).
-pub fn pack_indices_into(indices: &IndexList, encoding: GridEncoding, packed: &mut PackedTexels) {
+/// [`pack_indices`] into `packed`, reusing its bytes (no allocation once they have grown);
+/// the bytes the allocator refused, if it did.
+pub fn pack_indices_into(
+    indices: &IndexList,
+    encoding: GridEncoding,
+    packed: &mut PackedTexels,
+) -> Result<(), u64> {
     let per_texel = encoding.indices_per_texel();
     let texels = indices.len().div_ceil(per_texel);
     let height = rows_for(texels);
     let bytes = &mut packed.bytes;
-    zeroed_with_room(bytes, texels * per_texel * encoding.index_bytes());
+    try_zeroed_with_room(bytes, texels * per_texel * encoding.index_bytes())?;
     match (indices.as_u16(), indices.as_u32()) {
         (Some(list), _) => put_indices(bytes, list.iter().copied(), encoding),
         (_, Some(list)) => put_indices(bytes, list.iter().map(|&v| v as u16), encoding),
@@ -246,6 +261,7 @@ pub fn pack_indices_into(indices: &IndexList, encoding: GridEncoding, packed: &m
     }
     packed.width = DATA_TEXTURE_WIDTH;
     packed.height = height;
+    Ok(())
 }
 
 /// Writes `values` two bytes each: big-endian pairs for RGBA8 (texel i/2 holds index i in .xy

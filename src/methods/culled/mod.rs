@@ -162,9 +162,9 @@ impl CulledForward {
                 if let Some(frame) = refused(assigned.assignment, refuse_overflow) {
                     return Ok(frame);
                 }
-                let uploaded = self
-                    .upload
-                    .pack_and_upload(ctx, grid, assigned.assignment)?;
+                let uploaded =
+                    self.upload
+                        .pack_and_upload(ctx, method, grid, assigned.assignment)?;
                 self.lists_key = Some(lists.key);
                 (assigned, uploaded)
             }

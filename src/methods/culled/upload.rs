@@ -116,10 +116,12 @@ impl Uploads {
     }
 
     /// Packs the frame's visible lights, cell lists and index list, and uploads them into the
-    /// ring's next set (made anew when the light encoding changed).
+    /// ring's next set (made anew when the light encoding changed). Texels the allocator
+    /// refuses are `method`'s error naming their size.
     pub(super) fn pack_and_upload(
         &mut self,
         ctx: &FrameContext,
+        method: &str,
         grid: &ClusterGrid,
         assignment: &Assignment,
     ) -> Result<Uploaded<'_>, Error> {
@@ -141,8 +143,10 @@ impl Uploads {
         }
         let grid_encoding = GridEncoding::for_es(dev.es());
         pack_lights_into(&self.visible, ctx.features.light_layout(), &mut self.lights);
-        pack_grid_into(grid, assignment, grid_encoding, &mut self.grid);
-        pack_indices_into(&assignment.indices, grid_encoding, &mut self.indices);
+        // Refused, the frame is not drawn: the error names the size, as the assignment's does.
+        pack_grid_into(grid, assignment, grid_encoding, &mut self.grid)
+            .and_then(|()| pack_indices_into(&assignment.indices, grid_encoding, &mut self.indices))
+            .map_err(|bytes| super::limits::lists_unallocated(method, bytes))?;
 
         let slot = next_slot(&mut self.frame);
         let set = set_at(&mut self.ring, slot, dev, encoding)?;
