@@ -33,10 +33,18 @@ pub(crate) fn room_for<T>(buffer: &mut Vec<T>, len: usize) {
 /// Makes room in `buffer` for `more` elements past its length, asking the allocator (twice
 /// the length where it must grow, as a push would): the bytes it refused, if it did, where a
 /// push past the room would abort the process.
+#[inline(always)]
 pub(crate) fn try_room_for_more<T>(buffer: &mut Vec<T>, more: usize) -> Result<(), u64> {
     if buffer.capacity() - buffer.len() >= more {
         return Ok(());
     }
+    grow_by(buffer, more)
+}
+
+/// [`try_room_for_more`]'s growth, out of the line of a loop that mostly has the room.
+#[cold]
+#[inline(never)]
+fn grow_by<T>(buffer: &mut Vec<T>, more: usize) -> Result<(), u64> {
     let grown = more.max(buffer.len());
     buffer.try_reserve(grown).map_err(|_| {
         let items = buffer.len().saturating_add(grown) as u64;

@@ -300,12 +300,16 @@ impl Band {
         let runs = &mut self.runs;
         let (mut listed, mut added) = (0usize, 0usize);
         let most_runs = tally.most_runs;
-        for (i, light) in lights.iter().enumerate() {
-            // Room for the light's runs first: no push below grows the buffer.
-            if let Err(bytes) = try_room_for_more(runs, most_runs) {
+        // Room for a light's runs before it, kept after each light that took some: no push
+        // below grows the buffer.
+        let lights = match try_room_for_more(runs, most_runs) {
+            Ok(()) => lights,
+            Err(bytes) => {
                 tally.refuse(bytes);
-                break;
+                &[]
             }
+        };
+        for (i, light) in lights.iter().enumerate() {
             let before = runs.len();
             // Taking `first` by value and summing the indices after: the closure lives on the
             // stack (the refinement takes it), so each value it reaches by reference costs a
@@ -331,6 +335,10 @@ impl Band {
                 // Past the bound the list is refused anyway: the runs would go on taking
                 // memory (and past 2³² be misnumbered).
                 if listed > tally.limit || !tally.keeps_within(listed, &mut added) {
+                    break;
+                }
+                if let Err(bytes) = try_room_for_more(runs, most_runs) {
+                    tally.refuse(bytes);
                     break;
                 }
             }

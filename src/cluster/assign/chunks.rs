@@ -188,12 +188,16 @@ impl Chunk {
         let (deltas, runs) = (&mut self.deltas[..], &mut self.runs);
         let (mut listed, mut added) = (0usize, 0usize);
         let most_runs = tally.most_runs;
-        for (i, light) in lights.iter().enumerate() {
-            // Room for the light's runs first: no push below grows the buffer.
-            if let Err(bytes) = try_room_for_more(runs, most_runs) {
+        // Room for a light's runs before it, kept after each light that took some: no push
+        // below grows the buffer.
+        let lights = match try_room_for_more(runs, most_runs) {
+            Ok(()) => lights,
+            Err(bytes) => {
                 tally.refuse(bytes);
-                break;
+                &[]
             }
+        };
+        for (i, light) in lights.iter().enumerate() {
             let before = runs.len();
             // The callback lives on the stack (the refinement takes it out of line): it holds
             // the difference counts as a slice, not through their `Vec`, one load less a run.
@@ -208,14 +212,18 @@ impl Chunk {
                 runs.len() - before <= most_runs,
                 "a light's runs past the bound"
             );
+            self.ends.push(runs.len() as u32);
             if runs.len() > before {
                 self.visible.push(i as u32);
                 listed += runs[before..]
                     .iter()
                     .map(|run| run.len as usize)
                     .sum::<usize>();
+                if let Err(bytes) = try_room_for_more(runs, most_runs) {
+                    tally.refuse(bytes);
+                    break;
+                }
             }
-            self.ends.push(runs.len() as u32);
             // As a band's phase 1: past this the list is refused, so stop taking memory.
             if listed > tally.limit || !tally.keeps_within(listed, &mut added) {
                 break;
