@@ -15,7 +15,6 @@ pub(super) use scatter::FORCED_SCATTER_BLOCKS;
 use super::cells::{for_each_run_in, SliceWindow};
 use super::types::{Assignment, Run, Tally, Totals, PARALLEL_SECONDS};
 use crate::cluster::grid::ClusterGrid;
-use crate::cluster::headroom::try_room_for_more;
 use crate::cluster::headroom::{clear_with_room_for, room_for, share_of, WHOLE_UP_TO};
 use crate::cluster::view_light::GpuLight;
 
@@ -299,15 +298,12 @@ impl Band {
         let first = self.first_cell as u32;
         let runs = &mut self.runs;
         let (mut listed, mut added) = (0usize, 0usize);
-        let most_runs = tally.most_runs;
         // Room for a light's runs before it, kept after each light that took some: no push
         // below grows the buffer.
-        let lights = match try_room_for_more(runs, most_runs) {
-            Ok(()) => lights,
-            Err(bytes) => {
-                tally.refuse(bytes);
-                &[]
-            }
+        let lights = if tally.room_for_runs(runs) {
+            lights
+        } else {
+            &[]
         };
         for (i, light) in lights.iter().enumerate() {
             let before = runs.len();
@@ -323,7 +319,7 @@ impl Band {
             };
             for_each_run_in(grid, &window, light, camera_far, &mut emit);
             debug_assert!(
-                runs.len() - before <= most_runs,
+                runs.len() - before <= tally.most_runs,
                 "a light's runs past the bound"
             );
             if runs.len() > before {
@@ -333,12 +329,9 @@ impl Band {
                     .map(|run| run.len as usize)
                     .sum::<usize>();
                 // Past the bound the list is refused anyway: the runs would go on taking
-                // memory (and past 2³² be misnumbered).
-                if listed > tally.limit || !tally.keeps_within(listed, &mut added) {
-                    break;
-                }
-                if let Err(bytes) = try_room_for_more(runs, most_runs) {
-                    tally.refuse(bytes);
+                // memory (and past 2³² be misnumbered). And the next light's runs need room.
+                let within = listed <= tally.limit && tally.keeps_within(listed, &mut added);
+                if !within || !tally.room_for_runs(runs) {
                     break;
                 }
             }

@@ -8,7 +8,6 @@ use super::cells::for_each_run;
 use super::index_list::{EntriesMut, IndexList, LightIndex};
 use super::types::{Assignment, Run, Tally, Totals};
 use crate::cluster::grid::ClusterGrid;
-use crate::cluster::headroom::try_room_for_more;
 use crate::cluster::headroom::{clear_with_room_for, room_for, share_of, zeroed_with_room};
 use crate::cluster::view_light::GpuLight;
 
@@ -187,15 +186,12 @@ impl Chunk {
         clear_with_room_for(&mut self.visible, visible_share);
         let (deltas, runs) = (&mut self.deltas[..], &mut self.runs);
         let (mut listed, mut added) = (0usize, 0usize);
-        let most_runs = tally.most_runs;
         // Room for a light's runs before it, kept after each light that took some: no push
         // below grows the buffer.
-        let lights = match try_room_for_more(runs, most_runs) {
-            Ok(()) => lights,
-            Err(bytes) => {
-                tally.refuse(bytes);
-                &[]
-            }
+        let lights = if tally.room_for_runs(runs) {
+            lights
+        } else {
+            &[]
         };
         for (i, light) in lights.iter().enumerate() {
             let before = runs.len();
@@ -209,7 +205,7 @@ impl Chunk {
             };
             for_each_run(grid, light, camera_far, &mut emit);
             debug_assert!(
-                runs.len() - before <= most_runs,
+                runs.len() - before <= tally.most_runs,
                 "a light's runs past the bound"
             );
             self.ends.push(runs.len() as u32);
@@ -219,8 +215,7 @@ impl Chunk {
                     .iter()
                     .map(|run| run.len as usize)
                     .sum::<usize>();
-                if let Err(bytes) = try_room_for_more(runs, most_runs) {
-                    tally.refuse(bytes);
+                if !tally.room_for_runs(runs) {
                     break;
                 }
             }

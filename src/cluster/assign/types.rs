@@ -42,6 +42,19 @@ impl Tally {
         }
     }
 
+    /// Makes room in `runs` for one more light's, asking the allocator; false (and said) where
+    /// it refuses.
+    #[inline(always)]
+    pub(super) fn room_for_runs(&self, runs: &mut Vec<Run>) -> bool {
+        match crate::cluster::headroom::try_room_for_more(runs, self.most_runs) {
+            Ok(()) => true,
+            Err(bytes) => {
+                self.refuse(bytes);
+                false
+            }
+        }
+    }
+
     /// Says that a buffer of the assignment could not grow to `bytes`.
     pub(super) fn refuse(&self, bytes: u64) {
         (self.refused).fetch_max(bytes.max(1), std::sync::atomic::Ordering::Relaxed);
