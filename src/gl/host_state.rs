@@ -41,6 +41,11 @@ pub(super) const UNPACK_ROWS: [u32; 3] = [
     glow::UNPACK_SKIP_PIXELS,
 ];
 
+/// The same for 3D and array uploads: ES 3.0 state. GL applies them to 3D uploads alone,
+/// but SwiftShader moves a 2D upload's start by a game's `UNPACK_SKIP_IMAGES` too: it read
+/// past the renderer's light data (a dark picture, light loops that never ended).
+pub(super) const UNPACK_IMAGES: [u32; 2] = [glow::UNPACK_IMAGE_HEIGHT, glow::UNPACK_SKIP_IMAGES];
+
 /// The same for read-backs: ES 3.0, and ES 2.0 with `GL_NV_pack_subimage`.
 pub(super) const PACK_ROWS: [u32; 3] = [
     glow::PACK_ROW_LENGTH,
@@ -119,14 +124,17 @@ impl HostFeatures {
         }
     }
 
-    /// The pixel-store row lengths and skips the context has ([`UNPACK_ROWS`], [`PACK_ROWS`]).
+    /// The pixel-store row lengths and skips the context has ([`UNPACK_ROWS`],
+    /// [`UNPACK_IMAGES`], [`PACK_ROWS`]).
     pub(super) fn rows(&self) -> impl Iterator<Item = u32> {
         let unpack = self
             .unpack_rows
             .then_some(UNPACK_ROWS)
             .into_iter()
             .flatten();
-        unpack.chain(self.pack_rows.then_some(PACK_ROWS).into_iter().flatten())
+        let images = self.es3.then_some(UNPACK_IMAGES).into_iter().flatten();
+        let pack = self.pack_rows.then_some(PACK_ROWS).into_iter().flatten();
+        unpack.chain(images).chain(pack)
     }
 }
 
@@ -174,8 +182,9 @@ pub(crate) struct HostState {
     clear_color: [f32; 4],
     clear_depth: f32,
     alignment: [i32; 2],
-    /// [`UNPACK_ROWS`] and [`PACK_ROWS`], where the context has them.
+    /// [`UNPACK_ROWS`], [`UNPACK_IMAGES`] and [`PACK_ROWS`], where the context has them.
     unpack_rows: Option<[i32; 3]>,
+    unpack_images: Option<[i32; 2]>,
     pack_rows: Option<[i32; 3]>,
     /// `GL_FRAMEBUFFER_SRGB_EXT` on ES with `GL_EXT_sRGB_write_control`.
     srgb_write: Option<bool>,
@@ -337,6 +346,7 @@ impl HostState {
                 clear_depth: gl.get_parameter_f32(glow::DEPTH_CLEAR_VALUE),
                 alignment: [int(glow::PACK_ALIGNMENT), int(glow::UNPACK_ALIGNMENT)],
                 unpack_rows: unpack_rows.then(|| UNPACK_ROWS.map(int)),
+                unpack_images: es3.then(|| UNPACK_IMAGES.map(int)),
                 pack_rows: pack_rows.then(|| PACK_ROWS.map(int)),
                 srgb_write: srgb_write_control.then(|| gl.is_enabled(glow::FRAMEBUFFER_SRGB)),
                 attributes: HostAttributes::save(
@@ -403,7 +413,10 @@ impl HostState {
     /// The saved row lengths and skips (where the context has them), with their names.
     fn rows(&self) -> impl Iterator<Item = (u32, i32)> {
         let unpack = (self.unpack_rows.into_iter()).flat_map(|v| UNPACK_ROWS.into_iter().zip(v));
-        unpack.chain((self.pack_rows.into_iter()).flat_map(|v| PACK_ROWS.into_iter().zip(v)))
+        let images =
+            (self.unpack_images.into_iter()).flat_map(|v| UNPACK_IMAGES.into_iter().zip(v));
+        let pack = (self.pack_rows.into_iter()).flat_map(|v| PACK_ROWS.into_iter().zip(v));
+        unpack.chain(images).chain(pack)
     }
 
     /// The framebuffer the application had bound for drawing (`None`: the default one): the

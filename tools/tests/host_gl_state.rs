@@ -129,6 +129,8 @@ fn snapshot(gl: &glow::Context, has: Has) -> Snapshot {
             glow::PIXEL_UNPACK_BUFFER_BINDING,
             glow::DRAW_BUFFER0,
             glow::DRAW_BUFFER1,
+            glow::UNPACK_IMAGE_HEIGHT,
+            glow::UNPACK_SKIP_IMAGES,
         ]);
         enabled.push(glow::RASTERIZER_DISCARD);
         enabled.push(glow::PRIMITIVE_RESTART_FIXED_INDEX);
@@ -326,6 +328,10 @@ unsafe fn set_game_state(gl: &glow::Context, has: Has, size: (i32, i32)) {
         gl.blend_equation_separate(glow::MAX, glow::MIN);
         gl.enable(glow::RASTERIZER_DISCARD);
         gl.enable(glow::PRIMITIVE_RESTART_FIXED_INDEX);
+        // Left by a 3D or array texture's upload: SwiftShader applies the skip to 2D uploads
+        // too, and read past the renderer's light data (a dark frame, then a hang).
+        gl.pixel_store_i32(glow::UNPACK_IMAGE_HEIGHT, 3);
+        gl.pixel_store_i32(glow::UNPACK_SKIP_IMAGES, 2);
     } else {
         gl.blend_equation_separate(glow::FUNC_SUBTRACT, glow::FUNC_REVERSE_SUBTRACT);
     }

@@ -115,6 +115,8 @@ unsafe fn assert_reset(gl: &glow::Context, has: Has, game: &GameBindings, call: 
             (glow::PIXEL_PACK_BUFFER_BINDING, 0),
             (glow::PIXEL_UNPACK_BUFFER_BINDING, 0),
             (glow::DRAW_BUFFER0, glow::COLOR_ATTACHMENT0 as i32),
+            (glow::UNPACK_IMAGE_HEIGHT, 0),
+            (glow::UNPACK_SKIP_IMAGES, 0),
         ]);
         // A frame drawn into the framebuffer points it at attachment 0 alone; no other call
         // changes what is the framebuffer object's own state.
