@@ -20,8 +20,8 @@ pub(super) struct Tally {
     /// The bound ([`AssignLimits::max_untrimmed`]).
     pub(super) limit: usize,
     /// Most runs one light gives on this grid (a row of one slice holds at most one): a
-    /// worker makes room for as many before each light, asking the allocator, so that no push
-    /// of a light's runs grows its buffer (which would abort where memory runs out).
+    /// worker keeps room for as many before each light ([`Tally::room_for_runs`]), so that no
+    /// push of a light's runs grows its buffer (which would abort where memory runs out).
     pub(super) most_runs: usize,
     /// Bytes a worker's buffer could not grow to (0: none): the lists are not built
     /// ([`Assignment::unallocated`]).
