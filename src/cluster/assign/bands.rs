@@ -354,23 +354,16 @@ impl Band {
         out.visible.clear();
         out.visible
             .extend(self.lights.iter().map(|&(light, _)| light));
-        if self.indices > tally.limit || tally.refused().is_some() {
+        let Some(list) = tally.list(&mut out.indices, self.indices, out.visible.len()) else {
             out.unlisted = Some(self.indices);
             self.totals = Totals::default();
             return;
-        }
+        };
         self.ids.clear();
         self.ids.extend(0..self.lights.len() as u32);
         self.base = 0;
         let cells = CellsOut::sized(&mut out.counts, &mut out.offsets, self.end_cell);
-        match out.indices.prepare(self.indices, out.visible.len()) {
-            Ok(list) => self.count_and_scatter(None, cells, list),
-            Err(bytes) => {
-                tally.refuse(bytes);
-                out.unlisted = Some(self.indices);
-                self.totals = Totals::default();
-            }
-        }
+        self.count_and_scatter(None, cells, list);
     }
 }
 

@@ -120,15 +120,11 @@ impl Chunks {
                 }
             });
         let (chunks, blocks) = (&self.chunks, &mut self.blocks);
-        let list = match tally.refused() {
-            None => out.indices.prepare(total as usize, out.visible.len()),
-            Some(bytes) => Err(bytes),
-        };
-        match list {
-            Ok(EntriesMut::Narrow(list)) => merge(chunks, &out.offsets, list, threads, blocks),
-            Ok(EntriesMut::Wide(list)) => merge(chunks, &out.offsets, list, threads, blocks),
-            Err(bytes) => {
-                tally.refuse(bytes);
+        // A chunk's own list refused above lists nothing either.
+        match tally.list(&mut out.indices, total as usize, out.visible.len()) {
+            Some(EntriesMut::Narrow(list)) => merge(chunks, &out.offsets, list, threads, blocks),
+            Some(EntriesMut::Wide(list)) => merge(chunks, &out.offsets, list, threads, blocks),
+            None => {
                 out.unlisted = Some(listed);
                 return Totals::default();
             }

@@ -1,7 +1,7 @@
 //! The types the assignment's parts share (its limits, result and figures; the runs and totals
 //! of bands and chunks), below them all so no part imports the module that calls it.
 
-use super::index_list::IndexList;
+use super::index_list::{EntriesMut, IndexList};
 use crate::cluster::headroom::try_room_for;
 
 /// Most light references an assignment lists before the overflow policy trims them: a grid
@@ -53,6 +53,23 @@ impl Tally {
                 false
             }
         }
+    }
+
+    /// `indices` made a list of `len` entries for `visible` lights, to be written; `None` where
+    /// none is built: past the bound, after a refusal, or refused now (and said).
+    pub(super) fn list<'a>(
+        &self,
+        indices: &'a mut IndexList,
+        len: usize,
+        visible: usize,
+    ) -> Option<EntriesMut<'a>> {
+        if len > self.limit || self.refused().is_some() {
+            return None;
+        }
+        indices
+            .prepare(len, visible)
+            .map_err(|bytes| self.refuse(bytes))
+            .ok()
     }
 
     /// Says that a buffer of the assignment could not grow to `bytes`.

@@ -101,12 +101,12 @@ fn between_phases<'a>(
         band.base = indices;
         indices += band.indices;
     }
-    if indices > tally.limit || tally.refused().is_some() {
+    let Some(mut list) = tally.list(&mut out.indices, indices, out.visible.len()) else {
         // Not listed: phase 3 finds no band to scatter.
         out.unlisted = Some(indices);
         (taken.iter_mut().flatten()).for_each(|b| b.totals = Totals::default());
         return;
-    }
+    };
     // The bands cover the grid, from cell 0 to the last band's end.
     let cells = taken
         .iter()
@@ -115,15 +115,6 @@ fn between_phases<'a>(
         .map_or(0, |band| band.end_cell);
     let mut rest = CellsOut::sized(&mut out.counts, &mut out.offsets, cells);
     let numbers: &[u32] = numbers;
-    let mut list = match out.indices.prepare(indices, out.visible.len()) {
-        Ok(list) => list,
-        Err(bytes) => {
-            tally.refuse(bytes);
-            out.unlisted = Some(indices);
-            (taken.iter_mut().flatten()).for_each(|b| b.totals = Totals::default());
-            return;
-        }
-    };
     for (band, slot) in taken.into_iter().flatten().zip(scatters) {
         let (cells, after) = rest.split_at(band.end_cell - band.first_cell);
         let (part, tail) = list.split_at(band.indices);
