@@ -24,7 +24,7 @@ const HOW_TO_ALLOW: &str = "a model may read only files in its own folder (for t
                             models: --allow-outside-files, or LoadOptions::allow_outside_files)";
 
 /// The path `name` (a percent-decoded URI) names relative to `dir`. Unless `allow_outside`,
-/// a name that leaves `dir` as written — absolute, or with a `..` part (`/` and `\\` both
+/// a name that leaves `dir` as written — absolute, or with a `..` part (`/` and `\` both
 /// separate) that climbs above `dir` — is refused before anything on disk is looked at; a
 /// `..` that stays inside (`maps/../wood.png`) is taken out, so the kernel never follows a
 /// link in the folder back up.
