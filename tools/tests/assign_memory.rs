@@ -1,8 +1,7 @@
 //! The assignment asks the allocator before a frame's lights grow its buffers: where it refuses
 //! (an address-space limit, a 32-bit process), nothing is listed and the assignment says so
-//! (`Assignment::unallocated`, which the renderer turns into an error naming the size). A
-//! buffer grown without asking aborted the process there: 3.16 M lights from a 16 MB scene
-//! file under `ulimit -v 3000000` (helper-170, 2026-12-07).
+//! (`Assignment::unallocated`, which the renderer turns into an error naming the size), where
+//! a buffer grown without asking would abort the process.
 //!
 //! This program's allocator refuses every allocation past a size the test sets, as the system
 //! does past an address-space limit: a buffer that grows without asking aborts the program,
