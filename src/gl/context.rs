@@ -496,3 +496,11 @@ fn wait_for_other_threads(
     }
     Ok(live)
 }
+
+/// The other thread's contexts, in [`GlError::ContextsOnAnotherThread`]'s message.
+pub(crate) fn contexts_phrase(contexts: usize) -> String {
+    match contexts {
+        1 => "its context".into(),
+        n => format!("its {n} contexts"),
+    }
+}

@@ -5,6 +5,7 @@ use glow::HasContext;
 
 use super::call_state::CallState;
 pub use super::call_state::StateCalls;
+use super::context_watch::{ContextWatch, Witness};
 use super::host_entry::HostEntry;
 use super::vertex_arrays::VertexArrays;
 use super::{Caps, EsVersion, GlError, Restrictions};
@@ -47,43 +48,14 @@ pub struct Device {
     /// GL said the context was lost (`GL_CONTEXT_LOST`, which a driver may say only once): every
     /// later check says so too, since a lost context never comes back.
     lost: std::cell::Cell<bool>,
-    /// How the device tells whether its context is current.
+    /// How the device tells whether its context is current: EGL's handle, then the witness
+    /// (where EGL can tell).
     context: ContextWatch,
+    witness: Option<Witness>,
     /// `lab`: checks whose description contains this fail as out of memory (see
     /// [`Device::fail_checks_naming`]).
     #[cfg(feature = "lab")]
     failing_checks: std::cell::Cell<Option<&'static str>>,
-}
-
-/// Which EGL says what context is current, and the device's own context there.
-#[derive(Clone, Copy, Debug)]
-enum ContextWatch {
-    /// The EGL manylight loaded (a `HeadlessContext`'s), which reported this context current
-    /// at creation.
-    Loaded(usize),
-    /// The system's EGL, which reported this context current at creation: the application's
-    /// context came from it (glutin's, Android's).
-    System(usize),
-    /// Neither can tell (GLX, WGL, another EGL): never checked.
-    Unknown,
-}
-
-impl ContextWatch {
-    /// The watch for the context current now.
-    fn of_current() -> ContextWatch {
-        let loaded = super::gles_lib::current_context();
-        if let Some(Some(context)) = loaded {
-            return ContextWatch::Loaded(context);
-        }
-        // The EGL manylight loaded has none current (or none was loaded): the context may be a
-        // toolkit's, from the system's EGL (a process that also made a `HeadlessContext`).
-        match super::ext_fns::system_current_context() {
-            Some(Some(context)) => ContextWatch::System(context),
-            // No EGL context current while a context works: it is neither EGL's (GLX, WGL,
-            // OSMesa), and watching one that has none would refuse every call.
-            _ => ContextWatch::Unknown,
-        }
-    }
 }
 
 /// GL objects currently alive, as counted by the renderer's own create/delete calls: what
@@ -209,6 +181,11 @@ impl Device {
             );
         }
         let depth_bias = super::depth_bias::DepthBias::new(clamp_listed, set_clamp);
+        let context = ContextWatch::of_current();
+        let witness = match context {
+            ContextWatch::Unknown => None,
+            _ => Some(Witness::new(&gl)?),
+        };
         Ok(Device {
             gl,
             caps,
@@ -226,25 +203,35 @@ impl Device {
             depth_bias,
             warned_pending_error: std::cell::Cell::new(false),
             lost: std::cell::Cell::new(false),
-            context: ContextWatch::of_current(),
+            context,
+            witness,
             #[cfg(feature = "lab")]
             failing_checks: std::cell::Cell::new(None),
         })
     }
 
     /// Whether this device's context is current on this thread: an error when EGL says no
-    /// context is, or another one (its GL names would be that context's objects).
+    /// context is, or another one (its GL names would be that context's objects), also where
+    /// that one has the handle EGL gave the device's context before it was destroyed.
     pub(crate) fn check_current(&self) -> Result<(), GlError> {
-        let (now, own) = match self.context {
-            ContextWatch::Loaded(own) => (super::gles_lib::current_context(), own),
-            ContextWatch::System(own) => (super::ext_fns::system_current_context(), own),
-            ContextWatch::Unknown => return Ok(()),
-        };
-        match now {
-            Some(None) => Err(GlError::NotCurrent),
-            Some(Some(now)) if now != own => Err(GlError::OtherContext),
-            _ => Ok(()),
+        if !self.context.handle_is_current()? {
+            return Ok(());
         }
+        let Some(witness) = &self.witness else {
+            return Ok(());
+        };
+        let _turn = self.turn();
+        if witness.is_held(&self.gl) {
+            return Ok(());
+        }
+        // A lost context holds no objects either, and says so once among the pending errors.
+        self.clear_pending_errors();
+        if self.lost.get() {
+            return Err(GlError::ContextLost(
+                "the check that the renderer's context is current".into(),
+            ));
+        }
+        Err(GlError::OtherContext)
     }
 
     /// Runs `f` as one call of the renderer ([`Device::enter_host`] to
@@ -362,10 +349,14 @@ impl Device {
         }
     }
 
-    /// Deletes the renderer's vertex array object (with the renderer's other objects).
-    pub(crate) fn delete_vertex_array(&mut self) {
+    /// Deletes the device's own objects, its vertex array and witness (with the renderer's
+    /// other objects, in its context).
+    pub(crate) fn delete_own_objects(&mut self) {
         if let Some((vao, v)) = self.own_vertex_array.take() {
             v.delete(&self.gl, vao);
+        }
+        if let Some(witness) = self.witness.take() {
+            witness.delete(&self.gl);
         }
     }
 
@@ -728,6 +719,8 @@ pub fn framebuffer_status_name(status: u32) -> &'static str {
         glow::FRAMEBUFFER_INCOMPLETE_DIMENSIONS => "GL_FRAMEBUFFER_INCOMPLETE_DIMENSIONS",
         glow::FRAMEBUFFER_INCOMPLETE_MULTISAMPLE => "GL_FRAMEBUFFER_INCOMPLETE_MULTISAMPLE",
         glow::FRAMEBUFFER_UNSUPPORTED => "GL_FRAMEBUFFER_UNSUPPORTED",
+        // What the check returns where it fails itself (GL ES 3.2, 9.4.2).
+        0 => "no status: the check itself failed (a GL error, as in a lost or invalid context)",
         _ => "an unknown status",
     }
 }

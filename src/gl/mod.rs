@@ -18,6 +18,7 @@ pub(crate) mod bound_size;
 pub(crate) mod call_state;
 pub mod caps;
 pub mod context;
+mod context_watch;
 pub(crate) mod depth_bias;
 pub mod device;
 pub(crate) mod driver_turns;
@@ -175,8 +176,9 @@ pub enum GlError {
     /// seconds without dropping one. It may be asked again once they are gone.
     #[error(
         "this implementation (ANGLE) runs headless contexts on one thread at a time, and \
-         another thread kept its {contexts} for {waited_s} s without dropping one: drop them \
-         first, or make this context on that thread"
+         another thread kept {} for {waited_s:.1} s without dropping one: drop them first, or \
+         make this context on that thread",
+        context::contexts_phrase(*.contexts)
     )]
     ContextsOnAnotherThread {
         /// The other thread's contexts alive.
@@ -245,8 +247,9 @@ pub enum GlError {
     /// A [`HeadlessContext`] used on a thread where it is not current.
     #[error("this context is not current on the calling thread: call make_current here first (after release_current on the thread where it is current)")]
     ContextNotCurrent,
-    /// EGL says another context than the renderer's is current on this thread.
-    #[error("another GL context than the renderer's is current on this thread: make the renderer's context current again before using it (its objects are that context's)")]
+    /// EGL says another context than the renderer's is current on this thread (also one that
+    /// got the handle of the renderer's context, destroyed before it).
+    #[error("another GL context than the renderer's is current on this thread: make the renderer's context current again before using it (its objects are that context's), or, where that context is gone, let the renderer go with Renderer::abandon")]
     OtherContext,
     /// The driver lost the context (`GL_CONTEXT_LOST`: a GPU reset, or a power event on a
     /// phone): nothing made in it works any more. Let the renderer go with

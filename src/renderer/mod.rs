@@ -466,7 +466,7 @@ impl Renderer {
         if let Some(mut t) = self.msaa.take() {
             t.destroy(&self.dev);
         }
-        self.dev.delete_vertex_array();
+        self.dev.delete_own_objects();
     }
 }
 

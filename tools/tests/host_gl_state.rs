@@ -592,6 +592,38 @@ fn a_renderer_refuses_another_current_context_and_leaves_its_objects() {
     );
 }
 
+/// ANGLE and SwiftShader give a new context the handle of the one destroyed before it. A game
+/// that replaces its renderer on the new context (`renderer = Renderer::new(..)`) drops the old
+/// one with the new context current: the old one must neither draw with the new renderer's
+/// objects, which have its objects' names, nor delete them.
+#[test]
+fn a_renderer_whose_context_is_gone_leaves_the_next_context_alone() {
+    let scene = scene::builtin::build("plane", Some((8, 1))).unwrap();
+    let options = RenderOptions::default();
+    let mut context = HeadlessContext::new(EsVersion::Es3).unwrap();
+    let mut renderer = Renderer::new(context.load_gl().unwrap(), EsVersion::Es3).unwrap();
+    let (reference, _) = renderer.render_offscreen(&scene, 32, 18, &options).unwrap();
+    for cycle in 0..4 {
+        drop(context);
+        context = HeadlessContext::new(EsVersion::Es3).unwrap();
+        let mut fresh = Renderer::new(context.load_gl().unwrap(), EsVersion::Es3).unwrap();
+        fresh.render_offscreen(&scene, 32, 18, &options).unwrap();
+        let err = renderer
+            .render_offscreen(&scene, 32, 18, &options)
+            .unwrap_err();
+        assert!(
+            matches!(err, manylight::Error::Gl(GlError::OtherContext)),
+            "cycle {cycle}: {err}"
+        );
+        assert!(err.to_string().contains("Renderer::abandon"), "{err}");
+        renderer = fresh;
+        let (picture, _) = renderer
+            .render_offscreen(&scene, 32, 18, &options)
+            .unwrap_or_else(|e| panic!("cycle {cycle}: the new renderer after the old went: {e}"));
+        assert_eq!(manylight::metrics::diff(&reference, &picture).max_abs, 0);
+    }
+}
+
 /// A mesh whose first 16-bit chunk holds 65 536 vertices, the last of them (local index
 /// 65 535, the fixed restart index) a corner of a large triangle in view: 21 844 triangles of
 /// zero area, then a quad before the camera.

@@ -190,3 +190,25 @@ fn a_thread_waits_for_another_threads_context_within_its_patience() {
         .expect("made once the other was dropped");
     assert!(here == there, "another picture on another thread");
 }
+
+/// The wait's error reads as a sentence for one context or several (it said "kept its 1").
+#[test]
+fn the_wait_error_counts_the_other_threads_contexts_in_words() {
+    let error = |contexts| {
+        crate::gl::GlError::ContextsOnAnotherThread {
+            contexts,
+            waited_s: 60.25,
+        }
+        .to_string()
+    };
+    assert!(
+        error(1).contains("kept its context for 60.2 s"),
+        "{}",
+        error(1)
+    );
+    assert!(
+        error(3).contains("kept its 3 contexts for 60.2 s"),
+        "{}",
+        error(3)
+    );
+}

@@ -16,6 +16,13 @@ fn an_incomplete_framebuffer_names_the_target_and_the_status() {
     assert!(e.contains("0x8cd6"), "{e}");
     let unknown = framebuffer_status_name(0x1234);
     assert_eq!(unknown, "an unknown status");
+    // glCheckFramebufferStatus returns 0 where it fails itself, which is no unknown status.
+    let failed = GlError::FramebufferIncomplete {
+        what: "a 64×36 Rgba8 target".into(),
+        status: 0,
+    }
+    .to_string();
+    assert!(failed.contains("the check itself failed"), "{failed}");
 }
 
 /// A lost context is an error of its own (a game makes a new context for it) and says
