@@ -75,17 +75,18 @@ pub const HALF_FLOAT_SUMS: &str = "lights summed in half floats (RGBA16F) becaus
      equal ones: up to 9/255 from forward, 1 000: 23/255); tiled and clustered sum in the shader";
 
 /// What the light pass scales radiance by before the accumulation adds it (the composite
-/// undoes it): the exposure rounded to a power of two, so the scaling is exact, and at most 1.
-/// The accumulation is half-float without `GL_EXT_float_blend`, where a bright frame at a low
-/// exposure summed past 65 504 to Inf (a 2·10⁵ light at −15 EV: white where forward's
-/// Reinhard gives 238/255); pre-exposed it holds about the displayed range. HDR output, which
-/// takes no exposure, keeps radiance as it is (scaled, small values would fall into fp16's
-/// subnormals).
+/// undoes it): the exposure rounded to a power of two, so the scaling is exact. The
+/// accumulation is half-float without `GL_EXT_float_blend`, which holds about the displayed
+/// range only pre-exposed: at a low exposure a bright frame summed past 65 504 to Inf (a 2·10⁵
+/// light at −15 EV: white where forward's Reinhard gives 238/255), and at a high one faint
+/// lights' shares rounded to zero (eight lights of 2·10⁻⁸ a pixel at +15 EV: black where
+/// forward shows 17/255). A sum that passes 65 504 pre-exposed is white on screen anyway. HDR
+/// output, which takes no exposure, keeps radiance as it is.
 fn accumulation_scale(ctx: &FrameContext) -> f32 {
     if ctx.features.has(ShaderFeatures::OUTPUT_HDR) {
         return 1.0;
     }
-    ctx.options.exposure_ev.round().min(0.0).exp2()
+    ctx.options.exposure_ev.round().exp2()
 }
 
 /// Channels a count frame spreads its proxies over, light after light, each adding 1 to one:

@@ -429,6 +429,41 @@ fn many_lights_on_a_pixel_sum_as_forward_or_deferred_says_why_not() {
     );
 }
 
+/// Faint lights at a high exposure: eight in a ring over the plane, each adding about 2·10⁻⁸ of
+/// radiance to a pixel, shown at +15 EV (forward: 17/255 at most). A half-float accumulation
+/// (ANGLE; Mesa in the child below) held raw radiance at a positive exposure, where each
+/// light's share rounded to zero: the frame was black.
+#[test]
+fn deferred_keeps_faint_lights_at_a_high_exposure() {
+    let mut s = scene::builtin::build("plane", None).unwrap();
+    s.ambient = glam::Vec3::ZERO;
+    s.lights = (0..8)
+        .map(|i| {
+            let a = f64::from(i) * std::f64::consts::FRAC_PI_4;
+            let at = glam::DVec3::new(a.cos(), a.sin(), 2.0);
+            manylight::scene::Light::point(at, 100.0, glam::Vec3::ONE, 1.5e-7)
+        })
+        .collect();
+    let opts = RenderOptions {
+        exposure_ev: 15.0,
+        ..Default::default()
+    };
+    let mut gpu = Gpu::new(EsVersion::Es3);
+    if std::env::var_os(NO_FLOAT_BLEND).is_some() {
+        assert!(!gpu.r().caps().has_extension("GL_EXT_float_blend"));
+    }
+    let (reference, _) = gpu.render_with("forward", &s, (64, 36), &opts);
+    let brightest = reference.pixels().map(|p| p[0]).max().unwrap_or(0);
+    assert!(brightest > 10, "the lights show: {brightest} / 255 at most");
+    let (img, _) = gpu.render_with("deferred", &s, (64, 36), &opts);
+    let d = manylight::metrics::diff(&reference, &img);
+    assert!(
+        d.max_abs <= 2,
+        "deferred is {} / 255 from forward",
+        d.max_abs
+    );
+}
+
 /// The tests above on Mesa without `GL_EXT_float_blend` (a half-float accumulation, as on
 /// ANGLE), in a child process (Mesa reads its extension override once per process).
 #[test]
@@ -442,6 +477,7 @@ fn deferred_equals_forward_on_a_bright_frame_without_float_blending() {
         "deferred_holds_bright_frames_and_refuses_counts_past_what_its_accumulation_holds",
         "deferred_matches_forward_on_occluded_surfaces_under_a_bright_ambient",
         "many_lights_on_a_pixel_sum_as_forward_or_deferred_says_why_not",
+        "deferred_keeps_faint_lights_at_a_high_exposure",
     ] {
         common::child::rerun_with(
             test,
