@@ -120,6 +120,10 @@ impl Device {
         // The probe clears errors its own queries may leave: one the application left is said
         // first, as a call of the renderer says it.
         let pending = drain_errors(&gl);
+        if pending == glow::CONTEXT_LOST {
+            // Not the application's error, and the context answers no query from now on.
+            return Err(GlError::ContextLost("the renderer's creation".into()));
+        }
         if pending != glow::NO_ERROR {
             log::warn!(
                 "{} (0x{pending:04x}) was pending when the renderer was created: the \
