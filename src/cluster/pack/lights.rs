@@ -407,12 +407,25 @@ fn unorm16_down(x: f32) -> u16 {
     (x.clamp(0.0, 1.0) * 65535.0).floor() as u16
 }
 
+/// Brightest radiance channel an RGBA8 record holds: a mantissa of 255/255 at the largest
+/// exponent, 2¹²⁷. Radiance past it is taken as it, its channels scaled alike, as in
+/// [`fp16_radiance`].
+const RGBE_MAX_RADIANCE: f32 = 1.7014118e38;
+
 /// Shared-exponent RGB: the largest channel keeps 8 bits of mantissa.
 fn rgbe(c: Vec3) -> [u8; 4] {
-    let m = c.max_element();
+    let mut m = c.max_element();
     if m.is_nan() || m < 1e-30 {
         return [0, 0, 0, 0];
     }
+    // Clamped alone, the brightest channel would lose more than the others: a hue shift.
+    let c = if m > RGBE_MAX_RADIANCE {
+        let scaled = c * (RGBE_MAX_RADIANCE / m);
+        m = scaled.max_element();
+        scaled
+    } else {
+        c
+    };
     // 2^e > m, so every mantissa is ≤ 255.
     let e = (m.log2().floor() as i32 + 1).clamp(-128, 127);
     let scale = 2f32.powi(-e) * 255.0;
@@ -650,5 +663,16 @@ mod tests {
         assert!(big[0] > 127 && big[3] > 128);
         let tiny = rgbe(Vec3::splat(1e-6));
         assert!(tiny[0] > 127 && tiny[3] < 128);
+        // Past the largest exponent the channels are scaled alike, keeping the hue (red alone
+        // was clipped: 3e38 × (1, 0.5, 0.25) read as (1.7e38, 1.5e38, 0.75e38)).
+        assert_eq!(RGBE_MAX_RADIANCE, 2f32.powi(127));
+        for brightest in [RGBE_MAX_RADIANCE, 3e38, f32::MAX] {
+            let [r, g, b, e] = rgbe(Vec3::new(1.0, 0.5, 0.25) * brightest);
+            assert_eq!((r, e), (255, 255), "{brightest}");
+            assert!(
+                g.abs_diff(128) <= 1 && b.abs_diff(64) <= 1,
+                "{brightest}: {g} {b}"
+            );
+        }
     }
 }
