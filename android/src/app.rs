@@ -18,14 +18,15 @@ use manylight::{Error, GlError, GlStateHandling};
 use manylight::{EsVersion, FrameStats, RenderOptions, Renderer};
 use winit::application::ApplicationHandler;
 use winit::dpi::PhysicalPosition;
-use winit::event::{Touch, TouchPhase, WindowEvent};
+use winit::event::{ElementState, Touch, TouchPhase, WindowEvent};
 use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop};
+use winit::keyboard::{Key, NamedKey};
 use winit::platform::android::EventLoopBuilderExtAndroid;
 use winit::raw_window_handle::{HasDisplayHandle, HasWindowHandle};
 use winit::window::{Window, WindowId};
 
 use crate::orbit::Orbit;
-use crate::retry::Retry;
+use crate::retry::{Losses, Retry};
 
 /// Seeded random lights in the default scene.
 const LIGHTS: usize = 1024;
@@ -78,6 +79,7 @@ pub fn run(activity: AndroidApp) {
         since: Instant::now(),
         stats: FrameStats::default(),
         retry: Retry::default(),
+        losses: Losses::default(),
         resumed: false,
     };
     if let Err(e) = event_loop.run_app(&mut shell) {
@@ -116,6 +118,8 @@ struct Shell {
     stats: FrameStats,
     /// A frame or resume that failed, to be tried again.
     retry: Retry,
+    /// Contexts lost while shown, so that one lost every frame is not rebuilt every frame.
+    losses: Losses,
     /// Between `resumed` and `suspended`.
     resumed: bool,
 }
@@ -169,16 +173,40 @@ impl ApplicationHandler for Shell {
                 }
             }
             WindowEvent::Touch(touch) => self.touch(touch),
+            // Back, which winit marks handled so Android never sees it, leaves the app.
+            WindowEvent::KeyboardInput { event, .. }
+                if event.state == ElementState::Pressed
+                    && event.logical_key == Key::Named(NamedKey::BrowserBack) =>
+            {
+                event_loop.exit()
+            }
             WindowEvent::RedrawRequested => match self.frame() {
-                Ok(()) => {
-                    if self.retry.succeeded() {
+                Ok(drew) => {
+                    if self.retry.redrawn(drew) {
                         log::info!("rendering again");
                     }
                 }
                 Err(FrameError::ContextLost(e)) => {
-                    log::warn!("{e}: the context was lost; rebuilding it and the renderer");
+                    let now = Instant::now();
+                    let loss = self.losses.lost(now);
+                    if loss.log {
+                        log::warn!(
+                            "{e}: the context was lost ({} in a row); rebuilding it and the \
+                             renderer{}",
+                            loss.in_run,
+                            if loss.rebuild_now {
+                                ""
+                            } else {
+                                " a second from now"
+                            }
+                        );
+                    }
                     self.lose_context();
-                    self.try_show(event_loop);
+                    if loss.rebuild_now {
+                        self.try_show(event_loop);
+                    } else {
+                        self.retry.failed(&e, now);
+                    }
                 }
                 Err(FrameError::Other(e)) => self.failed(&e),
             },
@@ -366,14 +394,15 @@ impl Shell {
         }
     }
 
-    /// Renders and presents one frame, then asks for the next.
-    fn frame(&mut self) -> Result<(), FrameError> {
+    /// Renders and presents one frame, then asks for the next; false where there was nothing
+    /// to draw into (suspended, or a resume that failed, or a zero-sized window).
+    fn frame(&mut self) -> Result<bool, FrameError> {
         let (Some(live), Some(renderer)) = (&self.live, self.renderer.as_mut()) else {
-            return Ok(()); // suspended
+            return Ok(false);
         };
         let size = live.window.inner_size();
         if size.width == 0 || size.height == 0 {
-            return Ok(());
+            return Ok(false);
         }
         self.orbit.apply(&mut self.scene.camera);
         let stats = &mut self.stats;
@@ -425,7 +454,7 @@ impl Shell {
             self.frames = 0;
             self.since = Instant::now();
         }
-        Ok(())
+        Ok(true)
     }
 }
 

@@ -12,7 +12,8 @@
 //! window. If the context cannot be made current again, it is rebuilt with a fresh renderer.
 //!
 //! A frame or a resume that fails is logged (once while it fails the same way) and tried again
-//! a second later ([`retry`]); a context lost while shown is rebuilt at once.
+//! a second later ([`retry`]); a context lost while shown is rebuilt at once, unless it was lost
+//! again within seconds ([`retry::Losses`]). Back leaves the app.
 //!
 //! Only [`orbit`] and [`retry`] are built on other targets (so they are unit-tested on the
 //! host); everything else is Android-only.
