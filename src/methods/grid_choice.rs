@@ -97,6 +97,8 @@ pub(crate) struct AutoGrid {
     choice_from_priors: bool,
     /// A surface sample was cut short by its work bound, and a warning said so.
     sample_cut_said: bool,
+    /// The sample's caster left meshes out (memory refused), and a warning said so.
+    left_out_said: bool,
     /// Frames since the lights last outgrew a grid ([`AutoGrid::outgrown`]; `None`: never).
     frames_since_outgrown: Option<u32>,
 }
@@ -360,6 +362,15 @@ impl AutoGrid {
             // Moved objects keep their meshes' hierarchies: only the top level is rebuilt.
             (key, SceneRaycaster::rebuilt(previous, scene))
         });
+        let left_out = caster.left_out_triangles();
+        if left_out > 0 && !self.left_out_said {
+            self.left_out_said = true;
+            log::warn!(
+                "the automatic grid's surface sample leaves out {left_out} triangles, whose \
+                 ray-casting hierarchy this process cannot allocate now: the grid is chosen \
+                 from the other surfaces (a fixed `--grid` needs no sample)"
+            );
+        }
         self.cast_samples(ctx, &caster);
         self.caster = Some((key, caster.keep()));
     }

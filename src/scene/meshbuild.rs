@@ -34,9 +34,16 @@ impl MeshBuilder {
         Self::default()
     }
 
-    /// Runs `add` (which adds `vertices` vertices) when the builder has room for them and
-    /// keeps what it added only when every new position is finite and within range.
-    fn shape(&mut self, name: &str, vertices: u64, add: impl FnOnce(&mut Self)) -> &mut Self {
+    /// Runs `add` (which adds `vertices` vertices and at most `indices` indices) when the
+    /// builder has room for them, asked of the allocator first, and keeps what it added only
+    /// when every new position is finite and within range.
+    fn shape(
+        &mut self,
+        name: &str,
+        vertices: u64,
+        indices: u64,
+        add: impl FnOnce(&mut Self),
+    ) -> &mut Self {
         if self.refused.is_some() {
             return self;
         }
@@ -48,6 +55,18 @@ impl MeshBuilder {
                     "{vertices} vertices, past the {MAX_BUILT_VERTICES} one builder holds \
                      ({} already)",
                     start.0
+                ),
+            ));
+            return self;
+        }
+        // Below MAX_BUILT_VERTICES, so within usize; indices are at most six a vertex.
+        if let Err(bytes) = self.reserve(vertices as usize, indices as usize) {
+            self.refused = Some(SceneError::invalid(
+                format!("MeshBuilder::{name}"),
+                format!(
+                    "{vertices} vertices need about {} MiB more, which this process cannot \
+                     allocate now",
+                    bytes.div_ceil(1 << 20)
                 ),
             ));
             return self;
@@ -70,6 +89,22 @@ impl MeshBuilder {
         self
     }
 
+    /// Room for `vertices` more vertices and `indices` more indices, grown as a `Vec` grows
+    /// (exactly where that is refused); `Err` with the bytes asked for where even that is.
+    fn reserve(&mut self, vertices: usize, indices: usize) -> Result<(), u64> {
+        fn room<T>(v: &mut Vec<T>, more: usize) -> bool {
+            v.try_reserve(more).is_ok() || v.try_reserve_exact(more).is_ok()
+        }
+        let granted = room(&mut self.positions, vertices)
+            && room(&mut self.normals, vertices)
+            && room(&mut self.uvs, vertices)
+            && room(&mut self.indices, indices);
+        match granted {
+            true => Ok(()),
+            false => Err(vertices as u64 * 32 + indices as u64 * 4),
+        }
+    }
+
     /// Texture coordinates are capped at ±[`MAX_TEXCOORD`] (world lengths past it tile at no
     /// visible scale).
     fn vertex(&mut self, p: Vec3, n: Vec3, uv: Vec2) -> u32 {
@@ -84,7 +119,7 @@ impl MeshBuilder {
     /// A planar quad `a b c d` counter-clockwise when seen from the side its normal faces.
     /// Texture coordinates are in world units so textures tile at a constant scale.
     pub fn quad(&mut self, a: Vec3, b: Vec3, c: Vec3, d: Vec3) -> &mut Self {
-        self.shape("quad", 4, |s| s.add_quad(a, b, c, d))
+        self.shape("quad", 4, 6, |s| s.add_quad(a, b, c, d))
     }
 
     fn add_quad(&mut self, a: Vec3, b: Vec3, c: Vec3, d: Vec3) {
@@ -107,7 +142,7 @@ impl MeshBuilder {
             )
         };
         let (f, t) = (false, true);
-        self.shape("cuboid", 24, |s| {
+        self.shape("cuboid", 24, 36, |s| {
             s.add_quad(p(f, f, t), p(t, f, t), p(t, t, t), p(f, t, t)); // +Z
             s.add_quad(p(t, f, f), p(f, f, f), p(f, t, f), p(t, t, f)); // −Z
             s.add_quad(p(t, f, t), p(t, f, f), p(t, t, f), p(t, t, t)); // +X
@@ -119,7 +154,8 @@ impl MeshBuilder {
 
     /// A vertical cylinder standing on `base` with smooth sides and flat caps.
     pub fn cylinder(&mut self, base: Vec3, radius: f32, height: f32, segments: u32) -> &mut Self {
-        self.shape("cylinder", 10 * segments as u64, |s| {
+        let segments_64 = u64::from(segments);
+        self.shape("cylinder", 10 * segments_64, 12 * segments_64, |s| {
             s.add_cylinder(base, radius, height, segments)
         })
     }
@@ -163,7 +199,10 @@ impl MeshBuilder {
         }
         // Saturating: (2³²)² is past u64, and would wrap to 0 vertices.
         let vertices = (segments as u64 + 1).saturating_mul(rings as u64 + 1);
-        self.shape("sphere", vertices, |s| {
+        let indices = u64::from(segments)
+            .saturating_mul(u64::from(rings))
+            .saturating_mul(6);
+        self.shape("sphere", vertices, indices, |s| {
             s.add_sphere(centre, radius, segments, rings)
         })
     }
@@ -214,7 +253,8 @@ impl MeshBuilder {
         depth: f32,
         segments: u32,
     ) -> &mut Self {
-        self.shape("arch_x", 16 * segments as u64, |s| {
+        let segments_64 = u64::from(segments);
+        self.shape("arch_x", 16 * segments_64, 24 * segments_64, |s| {
             let (r0, r1) = (radius, radius + thickness);
             let dz = Vec3::Z * (depth * 0.5);
             for i in 0..segments {

@@ -11,6 +11,10 @@
 //! accepted on a double-sided material ([`Hit::face`] tells which) and the front alone on a
 //! single-sided one, as the renderer culls them; `t` is the world ray's parameter in either
 //! space, since an affine map keeps it.
+//!
+//! A hierarchy is asked of the allocator before it is built: one the process cannot allocate
+//! now leaves its mesh out (rays pass through it), counted by
+//! [`SceneRaycaster::left_out_triangles`], rather than aborting the process.
 
 mod bvh;
 
@@ -65,6 +69,9 @@ struct MeshBvh {
     mesh: Held,
     nodes: Vec<Node>,
     order: Vec<u32>,
+    /// The allocator refused the hierarchy: the mesh is left out (no nodes), and built again
+    /// by the next caster rather than kept.
+    refused: bool,
 }
 
 /// A hierarchy's mesh: its `Arc` while a [`SceneRaycaster`] casts, a `Weak` while a
@@ -165,6 +172,8 @@ pub struct SceneRaycaster {
     nodes: Vec<Node>,
     /// Mesh hierarchies built by its construction, not kept from a previous caster.
     meshes_built: usize,
+    /// [`SceneRaycaster::left_out_triangles`].
+    left_out: u64,
 }
 
 /// The best hits of one search.
@@ -239,10 +248,11 @@ impl SceneRaycaster {
         let mut meshes_built = 0;
         let mut instances = Vec::new();
         let mut boxes = Vec::new();
+        let mut left_out = 0;
         for (object, o) in scene.objects.iter().enumerate() {
             let key = Arc::as_ptr(&o.mesh);
             let mesh = *mesh_index.entry(key).or_insert_with(|| {
-                let bvh = match kept.remove(&key) {
+                let bvh = match kept.remove(&key).filter(|bvh| !bvh.refused) {
                     Some(bvh) => MeshBvh {
                         mesh: Held::Live(o.mesh.clone()),
                         ..bvh
@@ -255,8 +265,12 @@ impl SceneRaycaster {
                 meshes.push(bvh);
                 (meshes.len() - 1) as u32
             });
-            let Some(root) = meshes[mesh as usize].nodes.first() else {
-                continue; // no triangles
+            let bvh = &meshes[mesh as usize];
+            if bvh.refused {
+                left_out += o.mesh.triangle_count() as u64;
+            }
+            let Some(root) = bvh.nodes.first() else {
+                continue; // no triangles, or left out
             };
             let world = bvh::transformed_box(root.min, root.max, &o.transform);
             if !(world.0.is_finite() && world.1.is_finite()) {
@@ -273,7 +287,15 @@ impl SceneRaycaster {
                 mirrored: super::normal_matrix::mirrors(&DMat3::from_mat4(o.transform)),
             });
         }
-        let (nodes, order) = bvh::build(&boxes);
+        // Objects are few next to triangles; refused, nothing is placed.
+        let (nodes, order) = bvh::build(&boxes).unwrap_or_else(|_| {
+            left_out = scene
+                .objects
+                .iter()
+                .map(|o| o.mesh.triangle_count() as u64)
+                .sum();
+            Default::default()
+        });
         drop(boxes);
         let instances = order.iter().map(|&i| instances[i as usize]).collect();
         SceneRaycaster {
@@ -281,7 +303,15 @@ impl SceneRaycaster {
             instances,
             nodes,
             meshes_built,
+            left_out,
         }
+    }
+
+    /// Triangles the caster leaves out, each placement counted (rays pass through them):
+    /// those of meshes whose hierarchy this process could not allocate, or every one where the
+    /// placed objects' could not be. 0 normally.
+    pub fn left_out_triangles(&self) -> u64 {
+        self.left_out
     }
 
     /// How many mesh hierarchies its construction built (the rest were kept).
@@ -474,18 +504,24 @@ impl SceneRaycaster {
 }
 
 impl MeshBvh {
+    /// The mesh's hierarchy, or none (`refused`) where the allocator refuses it.
     fn new(mesh: &Arc<Mesh>) -> MeshBvh {
-        let boxes: Vec<(DVec3, DVec3)> = (0..mesh.triangle_count() as u32)
-            .map(|t| {
+        let triangles = mesh.triangle_count();
+        let mut boxes = Vec::new();
+        let built = boxes.try_reserve_exact(triangles).and_then(|()| {
+            boxes.extend((0..triangles as u32).map(|t| {
                 let [a, b, c] = corners(mesh, t).map(|i| mesh.positions[i].as_dvec3());
                 (a.min(b).min(c), a.max(b).max(c))
-            })
-            .collect();
-        let (nodes, order) = bvh::build(&boxes);
+            }));
+            bvh::build(&boxes)
+        });
+        let refused = built.is_err();
+        let (nodes, order) = built.unwrap_or_default();
         MeshBvh {
             mesh: Held::Live(mesh.clone()),
             nodes,
             order,
+            refused,
         }
     }
 

@@ -3,59 +3,20 @@
 //! (`Assignment::unallocated`, which the renderer turns into an error naming the size), where
 //! a buffer grown without asking would abort the process.
 //!
-//! This program's allocator refuses every allocation past a size the test sets, as the system
-//! does past an address-space limit: a buffer that grows without asking aborts the program,
-//! so the test fails.
-
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::sync::atomic::{AtomicUsize, Ordering};
+//! This program's allocator refuses every allocation past a size the test sets
+//! (`common/refusing_allocator.rs`): a buffer that grows without asking aborts the program, so
+//! the test fails.
 
 use manylight::cluster::assign::{AssignLimits, Assigner, Assignment};
 use manylight::cluster::grid::GridConfig;
 use manylight_tools::workload::AssignWorkload;
 
-/// The system allocator, refusing (a null pointer) any allocation larger than [`LARGEST`].
-struct Refusing;
-
-/// Largest allocation granted, in bytes.
-static LARGEST: AtomicUsize = AtomicUsize::new(usize::MAX);
-
-fn granted(bytes: usize) -> bool {
-    bytes <= LARGEST.load(Ordering::Relaxed)
-}
-
-unsafe impl GlobalAlloc for Refusing {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        match granted(layout.size()) {
-            true => unsafe { System.alloc(layout) },
-            false => std::ptr::null_mut(),
-        }
-    }
-    unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
-        match granted(layout.size()) {
-            true => unsafe { System.alloc_zeroed(layout) },
-            false => std::ptr::null_mut(),
-        }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        unsafe { System.dealloc(ptr, layout) }
-    }
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        match granted(new_size) {
-            true => unsafe { System.realloc(ptr, layout, new_size) },
-            false => std::ptr::null_mut(),
-        }
-    }
-}
+#[path = "common/refusing_allocator.rs"]
+mod refusing_allocator;
+use refusing_allocator::{refusing_past, serial, Refusing};
 
 #[global_allocator]
 static ALLOCATOR: Refusing = Refusing;
-
-/// Held by each test for its whole run: the limit is the whole program's.
-fn serial() -> std::sync::MutexGuard<'static, ()> {
-    static SERIAL: std::sync::Mutex<()> = std::sync::Mutex::new(());
-    SERIAL.lock().unwrap_or_else(|e| e.into_inner())
-}
 
 /// Every light listed, on up to `threads` threads, parallel from the first light.
 fn limits(threads: usize) -> AssignLimits {
@@ -76,10 +37,10 @@ fn assigned(workload: &AssignWorkload, threads: usize, largest: usize) -> Assign
         .unwrap();
     pool.install(|| {
         let mut assigner = Assigner::new();
-        LARGEST.store(largest, Ordering::Relaxed);
         let limits = limits(threads);
-        assigner.assign(&workload.grid, &workload.lights, workload.far, &limits);
-        LARGEST.store(usize::MAX, Ordering::Relaxed);
+        refusing_past(largest, || {
+            assigner.assign(&workload.grid, &workload.lights, workload.far, &limits)
+        });
         assigner.into_assignment()
     })
 }
@@ -169,10 +130,12 @@ fn texels_the_allocator_refuses_are_said() {
     // Half the list's bytes: the grid's texels (4 bytes a cell) fit, the list's do not.
     let largest = a.indices.len();
     assert!(workload.grid.total_cells as usize * 4 * 2 < largest);
-    LARGEST.store(largest, Ordering::Relaxed);
-    let packed_grid = pack_grid_into(&workload.grid, &a, encoding, &mut grid);
-    let packed_list = pack_indices_into(&a.indices, encoding, &mut indices);
-    LARGEST.store(usize::MAX, Ordering::Relaxed);
+    let (packed_grid, packed_list) = refusing_past(largest, || {
+        (
+            pack_grid_into(&workload.grid, &a, encoding, &mut grid),
+            pack_indices_into(&a.indices, encoding, &mut indices),
+        )
+    });
     assert_eq!(packed_grid, Ok(()));
     let bytes = packed_list.expect_err("the list's texels were allocated");
     assert!(bytes as usize > largest, "{bytes}");

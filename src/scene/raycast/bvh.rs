@@ -2,6 +2,7 @@
 //! the item centroids along the widest axis (quick to build; trace quality matters little for
 //! the few thousand rays a reference casts) and traversed iteratively, nearer child first.
 
+use std::collections::TryReserveError;
 use std::ops::Range;
 
 use glam::{DMat4, DVec3};
@@ -60,21 +61,31 @@ fn slab(min: DVec3, max: DVec3, origin: DVec3, inv_dir: DVec3, t_max: f64) -> Op
 }
 
 /// Builds the hierarchy over items given by their boxes; returns the nodes and the item order
-/// the leaves refer to. Allocates the nodes and order exactly (they are kept) and some scratch.
-pub(super) fn build(boxes: &[(DVec3, DVec3)]) -> (Vec<Node>, Vec<u32>) {
+/// the leaves refer to, or the error where the allocator refuses them. Allocates the order
+/// exactly, room for the most nodes the split can make (shrunk once built) and the centroids'
+/// scratch, each asked of the allocator first.
+pub(super) fn build(boxes: &[(DVec3, DVec3)]) -> Result<(Vec<Node>, Vec<u32>), TryReserveError> {
     let n = boxes.len();
     if n == 0 {
-        return (Vec::new(), Vec::new());
+        return Ok((Vec::new(), Vec::new()));
     }
-    let centroids: Vec<DVec3> = boxes.iter().map(|(lo, hi)| (*lo + *hi) * 0.5).collect();
-    let mut order: Vec<u32> = (0..n as u32).collect();
+    let mut centroids = Vec::new();
+    centroids.try_reserve_exact(n)?;
+    centroids.extend(boxes.iter().map(|(lo, hi)| (*lo + *hi) * 0.5));
+    let mut order = Vec::new();
+    order.try_reserve_exact(n)?;
+    order.extend(0..n as u32);
     let empty = Node {
         min: DVec3::ZERO,
         max: DVec3::ZERO,
         first: 0,
         count: 0,
     };
-    let mut nodes = vec![empty];
+    // A set of more than LEAF_SIZE items splits in halves of two or more, so leaves hold two
+    // items or more (one only where n is 1): fewer than n nodes in all.
+    let mut nodes = Vec::new();
+    nodes.try_reserve_exact(n)?;
+    nodes.push(empty);
     let mut work = vec![(0usize, 0usize, n)];
     while let Some((ni, start, end)) = work.pop() {
         let items = &mut order[start..end];
@@ -113,8 +124,9 @@ pub(super) fn build(boxes: &[(DVec3, DVec3)]) -> (Vec<Node>, Vec<u32>) {
         work.push((left, start, start + mid));
         work.push((left + 1, start + mid, end));
     }
+    debug_assert!(nodes.len() <= n, "{} nodes for {n} items", nodes.len());
     nodes.shrink_to_fit();
-    (nodes, order)
+    Ok((nodes, order))
 }
 
 /// Walks the hierarchy nearer child first, calling `leaf` with the order range of every leaf
