@@ -169,13 +169,17 @@ const INPUTS: [(&str, Change, &[&str]); 16] = [
         |_, o| o.measure.force_rgba8_lights = true,
         &["forward", "deferred"],
     ),
-    // Below 0 EV deferred's instances carry the exposure.
+    // Deferred's instances carry the exposure (rounded to a power of two), either way.
     (
         "an exposure of -2 EV",
         |_, o| o.exposure_ev = -2.0,
         &["deferred"],
     ),
-    ("an exposure of +1 EV", |_, o| o.exposure_ev = 1.0, &[]),
+    (
+        "an exposure of +1 EV",
+        |_, o| o.exposure_ev = 1.0,
+        &["deferred"],
+    ),
     (
         "the ambient light",
         |s, _| s.ambient = Vec3::new(0.2, 0.0, 0.0),
