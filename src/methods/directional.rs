@@ -25,12 +25,15 @@ pub struct DirectionalFrame {
 
 impl DirectionalFrame {
     /// The scene's shown directional lights ([`shown_directional_lights`], indices kept in
-    /// `shown`) in view space; `fp16`: in the fp16-range form. Returns the frame and how many
-    /// active lights past [`MAX_DIRECTIONAL_LIGHTS`] were left out.
+    /// `shown`) in view space, their radiance times `pre_exposure`
+    /// ([`ShaderFeatures::pre_exposure`](super::ShaderFeatures::pre_exposure)); `fp16`: in the
+    /// fp16-range form. Returns the frame and how many active lights past
+    /// [`MAX_DIRECTIONAL_LIGHTS`] were left out.
     pub fn gather(
         scene: &Scene,
         view: &DMat4,
         fp16: bool,
+        pre_exposure: f32,
         shown: &mut Vec<usize>,
     ) -> (Self, usize) {
         let dropped = shown_directional_lights(&scene.directional_lights, shown);
@@ -40,7 +43,7 @@ impl DirectionalFrame {
             let to_light = crate::scene::direction::unit(view.transform_vector3(light.to_light()))
                 .unwrap_or_default()
                 .as_vec3();
-            let radiance = light.radiance();
+            let radiance = light.radiance() * pre_exposure;
             let (radiance, k) = if fp16 {
                 fp16_radiance(radiance)
             } else {

@@ -181,6 +181,19 @@ impl ShaderFeatures {
         }
     }
 
+    /// What this variant's lights, ambient and emission are multiplied by before the shader
+    /// sums them, the exposure taking the rest: without fragment highp (`FP16_LIGHTS`) at a
+    /// positive exposure, 2 to the exposure rounded (exact), so the fp16 sum holds what is
+    /// shown rather than raw radiance, whose faint lights' shares rounded to zero (a black
+    /// frame at +15 EV where highp shows them); else 1. HDR output takes no exposure.
+    pub fn pre_exposure(self, exposure_ev: f32) -> f32 {
+        if self.has(Self::FP16_LIGHTS) && !self.has(Self::OUTPUT_HDR) {
+            exposure_ev.round().max(0.0).exp2()
+        } else {
+            1.0
+        }
+    }
+
     /// How this variant's light records are laid out.
     pub fn light_layout(self) -> LightLayout {
         LightLayout {

@@ -274,12 +274,14 @@ pub(crate) fn shade_object<P: GeometryProgram>(
             .map_or_else(Default::default, |t| t.sampling);
         t.bind(dev, UNIT_ALBEDO, &sampling);
     }
+    // The lights came pre-exposed (`ShaderFeatures::pre_exposure`); the exposure does the rest.
+    let pre_exposure = ctx.features.pre_exposure(ctx.options.exposure_ev);
     let frame = SurfaceFrame {
         ambient: super::uniforms::ambient_uniform(
-            ctx.scene.ambient,
+            ctx.scene.ambient * pre_exposure,
             ctx.features.has(ShaderFeatures::FP16_LIGHTS),
         ),
-        exposure: ctx.options.exposure_ev.exp2(),
+        exposure: ctx.options.exposure_ev.exp2() / pre_exposure,
         orthographic: ctx.orthographic,
         heat_scale: ctx.options.heat_scale.max(1.0),
     };
@@ -297,7 +299,7 @@ pub(crate) fn shade_object<P: GeometryProgram>(
     program
         .surface()
         .maps()
-        .set(dev, material, features, own, ctx.gpu_scene);
+        .set(dev, material, features, own, ctx.gpu_scene, pre_exposure);
     if *bound != Some(key) {
         bind_method(program, dev);
         *bound = Some(key);

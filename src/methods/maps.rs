@@ -183,7 +183,8 @@ impl MapUniforms {
     /// Binds the maps `features` selected and sets their uniforms. Where `features` has an
     /// input the object's `own` features lack (a shared variant:
     /// [`super::surface_variants::shared`]), the input's neutral value stands in: the white
-    /// texture, no emission, an identity transform on the first coordinate set.
+    /// texture, no emission, an identity transform on the first coordinate set. The emission
+    /// is times `pre_exposure`, as the frame's lights are ([`F::pre_exposure`]).
     pub(crate) fn set(
         &self,
         dev: &Device,
@@ -191,6 +192,7 @@ impl MapUniforms {
         features: F,
         own: F,
         scene: &GpuScene,
+        pre_exposure: f32,
     ) {
         let maps = &material.maps;
         let transformed = own.has(F::TEXTURE_TRANSFORM);
@@ -274,7 +276,7 @@ impl MapUniforms {
         }
         if features.has(F::EMISSIVE) {
             let emission = if own.has(F::EMISSIVE) {
-                maps.emissive
+                maps.emissive * pre_exposure
             } else {
                 Vec3::ZERO
             };

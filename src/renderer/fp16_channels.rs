@@ -45,27 +45,43 @@ fn radiances(scene: &Scene) -> impl Iterator<Item = ((&'static str, usize), Vec3
 }
 
 /// Without fragment `highp`: warns (once, `warned`) of the first light whose colour ×
-/// intensity is past [`FP16_MAX_RADIANCE`] (2³⁰), which its fp16 form takes as 2³⁰. Allocates
-/// nothing unless it warns.
-pub(super) fn warn_of_capped_radiance(caps: &Caps, scene: &Scene, warned: &mut bool) {
+/// intensity, times the frame's `pre_exposure`, is past [`FP16_MAX_RADIANCE`] (2³⁰), which
+/// its fp16 form takes as 2³⁰. Allocates nothing unless it warns.
+pub(super) fn warn_of_capped_radiance(
+    caps: &Caps,
+    scene: &Scene,
+    pre_exposure: f32,
+    warned: &mut bool,
+) {
     if caps.fragment_has_highp() || *warned {
         return;
     }
-    let past = |(_, r): &(_, Vec3)| r.max_element() > FP16_MAX_RADIANCE;
+    let past = |(_, r): &(_, Vec3)| r.max_element() * pre_exposure > FP16_MAX_RADIANCE;
     let Some(((list, i), radiance)) = radiances(scene).find(past) else {
         return;
     };
     *warned = true;
+    // Pre-exposed, the cap is 2³⁰ of what is shown.
+    let most = match pre_exposure > 1.0 {
+        true => format!("2³⁰ / 2^{}", pre_exposure.log2()),
+        false => "2³⁰".into(),
+    };
     log::warn!(
-        "{list}[{i}]: colour × intensity {radiance:?} is past 2³⁰, the brightest radiance a \
-         light has without fragment highp (fp16): it is drawn as 2³⁰, its channels scaled alike"
+        "{list}[{i}]: colour × intensity {radiance:?} is past {most}, the brightest radiance a \
+         light has without fragment highp (fp16) at this exposure: it is drawn as {most}, its \
+         channels scaled alike"
     );
 }
 
 /// Without fragment `highp`: warns (once, `warned`) when the ambient or its term (ambient ×
 /// the largest diffuse factor of a material; textures and vertex colours only darken) passes
-/// [`FP16_MAX_AMBIENT`], where it is drawn at that cap.
-pub(super) fn warn_of_capped_ambient(caps: &Caps, scene: &Scene, warned: &mut bool) {
+/// [`FP16_MAX_AMBIENT`] times the frame's `pre_exposure`, where it is drawn at that cap.
+pub(super) fn warn_of_capped_ambient(
+    caps: &Caps,
+    scene: &Scene,
+    pre_exposure: f32,
+    warned: &mut bool,
+) {
     if caps.fragment_has_highp() || *warned {
         return;
     }
@@ -73,33 +89,34 @@ pub(super) fn warn_of_capped_ambient(caps: &Caps, scene: &Scene, warned: &mut bo
         .map(|m| m.diffuse.max_element())
         .fold(1.0, f32::max);
     let peak = scene.ambient.max_element() * albedo;
-    if peak <= FP16_MAX_AMBIENT {
+    let most = FP16_MAX_AMBIENT / pre_exposure;
+    if peak <= most {
         return;
     }
     *warned = true;
     log::warn!(
         "ambient {:?} times a diffuse factor of up to {albedo} reaches {peak:e}, past the \
-         {FP16_MAX_AMBIENT} the ambient term holds without fragment highp (fp16): the ambient \
-         is drawn at most {FP16_MAX_AMBIENT} (its channels scaled alike), and so is each \
-         channel of its term",
+         {most} the ambient term holds without fragment highp (fp16; {FP16_MAX_AMBIENT} less \
+         the exposure's positive stops): the ambient is drawn at most {most} (its channels \
+         scaled alike), and so is each channel of its term",
         scene.ambient
     );
 }
 
 /// Without fragment `highp`: warns (once) of the first light, point, spot or directional,
-/// whose colour × intensity spans more than its fp16 form keeps. Allocates nothing unless it
-/// warns.
-pub(super) fn warn_of_lost_channels(caps: &Caps, scene: &Scene) {
+/// whose colour × intensity (times the frame's `pre_exposure`, as it is drawn) spans more
+/// than its fp16 form keeps. Allocates nothing unless it warns.
+pub(super) fn warn_of_lost_channels(caps: &Caps, scene: &Scene, pre_exposure: f32) {
     if caps.fragment_has_highp() || WARNED.load(Ordering::Relaxed) {
         return;
     }
-    let lossy = |(_, r): &(_, Vec3)| lost_channels(*r).contains(&true);
+    let lossy = |(_, r): &(_, Vec3)| lost_channels(*r * pre_exposure).contains(&true);
     let Some(((list, i), radiance)) = radiances(scene).find(lossy) else {
         return;
     };
     WARNED.store(true, Ordering::Relaxed);
     let lost: Vec<&str> = (["red", "green", "blue"].into_iter())
-        .zip(lost_channels(radiance))
+        .zip(lost_channels(radiance * pre_exposure))
         .filter_map(|(name, lost)| lost.then_some(name))
         .collect();
     log::warn!(

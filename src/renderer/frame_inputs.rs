@@ -64,18 +64,22 @@ impl Renderer {
             super::frame_setup::check_light_memory(scene.lights.len())?;
             self.lights_probed = scene.lights.len();
         }
-        if gather_lights(&mut self.lights, scene, &view, options) || self.timing_frames {
-            self.lights_generation += 1;
-        }
         let scene_features = SceneFeatures::of(scene);
         let features = shader_features(&scene_features, options, self.dev.caps()).with(
             ShaderFeatures::OUTPUT_LINEAR,
             options.linear || self.srgb_destination,
         );
+        let pre_exposure = features.pre_exposure(options.exposure_ev);
+        if gather_lights(&mut self.lights, scene, &view, options, pre_exposure)
+            || self.timing_frames
+        {
+            self.lights_generation += 1;
+        }
         let directional = gather_directional(
             scene,
             &view,
             features,
+            pre_exposure,
             &mut self.shown_directional,
             &mut self.warned_directional,
         );
@@ -101,15 +105,17 @@ impl Renderer {
         if self.placed.update(&self.lights, farthest) {
             self.lights_generation += 1;
         }
-        super::fp16_channels::warn_of_lost_channels(self.dev.caps(), scene);
+        super::fp16_channels::warn_of_lost_channels(self.dev.caps(), scene, pre_exposure);
         super::fp16_channels::warn_of_capped_radiance(
             self.dev.caps(),
             scene,
+            pre_exposure,
             &mut self.warned_capped_radiance,
         );
         super::fp16_channels::warn_of_capped_ambient(
             self.dev.caps(),
             scene,
+            pre_exposure,
             &mut self.warned_capped_ambient,
         );
         Ok(FrameSetup {

@@ -14,12 +14,14 @@ use crate::scene::{Aabb, Scene};
 
 /// Refills `lights` (keeping its buffer) with the scene's active lights in view space, each
 /// light's cull radius shortened to where it falls below `options.light_cutoff` when one is
-/// set. Returns whether the list differs, bit for bit, from the one `lights` held.
+/// set, and its radiance times `pre_exposure` ([`ShaderFeatures::pre_exposure`]). Returns
+/// whether the list differs, bit for bit, from the one `lights` held.
 pub(super) fn gather_lights(
     lights: &mut Vec<GpuLight>,
     scene: &Scene,
     view: &DMat4,
     options: &RenderOptions,
+    pre_exposure: f32,
 ) -> bool {
     let gathered = scene.lights.iter().filter(|l| l.is_active()).map(|light| {
         let mut g = GpuLight::from_light(light, view);
@@ -30,6 +32,7 @@ pub(super) fn gather_lights(
                 cutoff as f64,
             ) as f32;
         }
+        g.radiance *= pre_exposure;
         g
     });
     overwrite_lights(lights, gathered)
@@ -78,11 +81,12 @@ pub(super) fn gather_directional(
     scene: &Scene,
     view: &DMat4,
     features: ShaderFeatures,
+    pre_exposure: f32,
     shown: &mut Vec<usize>,
     warned: &mut bool,
 ) -> DirectionalFrame {
     let fp16 = features.has(ShaderFeatures::FP16_LIGHTS);
-    let (frame, dropped) = DirectionalFrame::gather(scene, view, fp16, shown);
+    let (frame, dropped) = DirectionalFrame::gather(scene, view, fp16, pre_exposure, shown);
     if dropped > 0 && !*warned {
         *warned = true;
         log::warn!(

@@ -613,6 +613,49 @@ fn a_light_whose_fp16_scale_squares_past_fp16_draws_as_with_highp() {
     }
 }
 
+/// Without fragment highp the shader sums a pixel's light in fp16. At a positive exposure that
+/// sum held raw radiance, and faint lights' shares (2·10⁻⁸ a pixel) rounded to nothing: eight
+/// of them at +15 EV drew a 17/255 darker frame than highp's. Lights, a sun, the ambient and
+/// emission now come pre-exposed, the exposure uniform taking the rest: each case draws what
+/// highp draws (one left out of the pre-exposure would be 2¹⁵ too dark).
+#[test]
+fn faint_light_at_a_high_exposure_draws_as_with_highp() {
+    let mut mediump = Gpu::without_fragment_highp();
+    let mut highp = Gpu::new(EsVersion::Es2);
+    let opts = RenderOptions {
+        exposure_ev: 15.0,
+        ..Default::default()
+    };
+    let mut ring = plane(
+        (0..8)
+            .map(|i| {
+                let a = f64::from(i) * std::f64::consts::FRAC_PI_4;
+                let at = DVec3::new(a.cos(), a.sin(), 2.0);
+                Light::point(at, 100.0, Vec3::ONE, 1.5e-7)
+            })
+            .collect(),
+    );
+    ring.ambient = Vec3::ZERO;
+    let mut sun = plane(vec![]);
+    sun.ambient = Vec3::ZERO;
+    let down = DVec3::new(0.3, 0.2, -1.0);
+    sun.directional_lights = vec![scene::DirectionalLight::new(down, Vec3::ONE, 5e-7)];
+    let mut glow = plane(vec![]);
+    glow.ambient = Vec3::splat(3e-7);
+    glow.materials[0].maps.emissive = Vec3::new(2e-7, 1e-7, 0.0);
+    for (name, s) in [("lights", ring), ("sun", sun), ("ambient, emission", glow)] {
+        let exact = highp.render(&s, 64, 36, &opts);
+        let brightest = exact.pixels().map(|p| p[0]).max().unwrap_or(0);
+        assert!(
+            brightest > 10,
+            "{name}: {brightest} / 255 at most, too dark to tell"
+        );
+        let image = mediump.render(&s, 64, 36, &opts);
+        let d = manylight::metrics::diff(&exact, &image).max_abs;
+        assert!(d <= 3, "{name}: {d} / 255 from highp");
+    }
+}
+
 /// A metal whose base colour is past glTF's [0, 1] (the loaders take up to 1 024): its Fresnel
 /// reflectance F0 grew with it, and times the capped lobe went past fp16, Inf, then NaN where
 /// the falloff or spot was 0 (black holes without fragment highp). F0 now stays at most 1, and
