@@ -158,9 +158,10 @@ impl LightTrack {
 }
 
 /// Angle `2π·(t/T + φ/360)`, reduced to one turn before scaling so a large `t` keeps its
-/// precision; `t` is reduced to one period first (exactly), so no finite `t` overflows `t/T`.
+/// precision; `t` is reduced to one period first and `φ` to one turn (both exactly), so no
+/// finite `t` overflows `t/T` and no large `φ` rounds the time's share of the turn away.
 fn angle(t: f64, period_s: f64, phase_deg: f64) -> f64 {
-    TAU * (t.rem_euclid(period_s) / period_s + phase_deg / 360.0).rem_euclid(1.0)
+    TAU * (t.rem_euclid(period_s) / period_s + phase_deg.rem_euclid(360.0) / 360.0).rem_euclid(1.0)
 }
 
 /// `sin(2π t/T + φ) − sin φ`: zero at `t = 0`, within [−2, 2].
@@ -232,9 +233,11 @@ impl Motion {
             light.intensity = rest.intensity * (1.0 - f.amount * noise as f32).max(0.0);
         }
         if let (Some(s), LightKind::Spot { direction, .. }) = (&self.sweep, &mut light.kind) {
-            if let Some(axis) = unit(s.axis) {
+            // The unit direction turned: a long one's products in the rotation overflowed
+            // (a direction past about 9·10³⁰⁷ turned into Inf and NaN).
+            if let (Some(axis), Some(unit_direction)) = (unit(s.axis), unit(*direction)) {
                 let angle = s.angle_deg.to_radians() * swing(t, s.period_s, s.phase_deg);
-                *direction = DQuat::from_axis_angle(axis, angle) * *direction;
+                *direction = DQuat::from_axis_angle(axis, angle) * unit_direction;
             }
         }
         light

@@ -131,8 +131,7 @@ struct OrbitSpec {
     #[serde(default = "up")]
     axis: [f64; 3],
     period_s: f64,
-    #[serde(default)]
-    phase_deg: f64,
+    phase_deg: Option<f64>,
 }
 
 #[derive(Deserialize)]
@@ -241,6 +240,14 @@ impl MotionSpec {
             None => None,
             Some(o) => Some(Orbit {
                 about: match (o.center, o.radius) {
+                    // The turn starts where the light is placed: a phase would be ignored.
+                    (Some(_), None) if o.phase_deg.is_some() => {
+                        return Err(SceneError::invalid(
+                            format!("{field}.orbit.phase_deg"),
+                            "an orbit about a `center` starts where the light is placed; a \
+                             start angle is for an orbit by `radius`",
+                        ))
+                    }
                     (Some(c), None) => OrbitAbout::Point(DVec3::from(c)),
                     (None, Some(r)) => OrbitAbout::Radius(r),
                     _ => {
@@ -253,7 +260,7 @@ impl MotionSpec {
                 },
                 axis: DVec3::from(o.axis),
                 period_s: o.period_s,
-                phase_deg: o.phase_deg,
+                phase_deg: o.phase_deg.unwrap_or(0.0),
             }),
         };
         let motion = Motion {

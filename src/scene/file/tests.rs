@@ -311,6 +311,11 @@ fn motion_errors_name_the_field() {
             light(r#"{"orbit": {"center": [0,0,0], "radius": 1, "period_s": 2}}"#),
             "lights[0].motion.orbit",
         ),
+        // A start angle on an orbit about a point was ignored without a word.
+        (
+            light(r#"{"orbit": {"center": [0,0,0], "period_s": 2, "phase_deg": 90}}"#),
+            "lights[0].motion.orbit.phase_deg",
+        ),
         (
             light(r#"{"bob": {"amplitude": [0,1,0], "period_s": -1}}"#),
             "lights[0].motion.bob.period_s",

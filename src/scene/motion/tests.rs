@@ -476,3 +476,76 @@ fn an_axis_of_any_finite_length_turns_as_its_direction() {
         assert!(d.abs_diff_eq(u, 1e-12), "{scale:e}: {d} against {u}");
     }
 }
+
+/// A spot's direction may have any finite length: a sweep turns it as its direction (turned
+/// as it was, a direction past about 9·10³⁰⁷ overflowed to Inf and NaN at a later time, and
+/// a recording failed part-way).
+#[test]
+fn a_sweep_turns_a_direction_of_any_finite_length() {
+    let m = Motion {
+        sweep: Some(Sweep {
+            axis: DVec3::X,
+            angle_deg: 180.0,
+            period_s: 1.0,
+            phase_deg: 0.0,
+        }),
+        ..Motion::default()
+    };
+    let mut rest = spot();
+    let LightKind::Spot { direction, .. } = &mut rest.kind else {
+        unreachable!()
+    };
+    *direction = DVec3::new(0.0, 1.6e308, -1e308);
+    let along = crate::scene::direction::unit(*direction).unwrap();
+    for t in [0.0, 0.1, 0.25, 0.6] {
+        let LightKind::Spot { direction, .. } = m.apply(&rest, t).kind else {
+            unreachable!()
+        };
+        assert!(direction.is_finite(), "t = {t}: {direction:?}");
+        let unit_rest = spot_with(along);
+        let LightKind::Spot {
+            direction: want, ..
+        } = m.apply(&unit_rest, t).kind
+        else {
+            unreachable!()
+        };
+        assert!(
+            direction.abs_diff_eq(want, 1e-12),
+            "t = {t}: {direction:?}, {want:?}"
+        );
+    }
+}
+
+/// [`spot`] pointing along `direction`.
+fn spot_with(direction: DVec3) -> Light {
+    let mut l = spot();
+    if let LightKind::Spot { direction: d, .. } = &mut l.kind {
+        *d = direction;
+    }
+    l
+}
+
+/// A phase past 2⁵³ degrees was added to the time's share of the turn before either was
+/// reduced, which rounded the time away: the light stood still.
+#[test]
+fn a_huge_phase_keeps_the_motion_moving() {
+    let bob = |phase_deg| Motion {
+        bob: Some(Bob {
+            amplitude: DVec3::Y,
+            period_s: 2.0,
+            phase_deg,
+        }),
+        ..Motion::default()
+    };
+    let rest = point();
+    // 1e19 is 360 · 27 777 777 777 777 777 + 280 (exactly, in f64): the same motion as 280°.
+    let (huge, plain) = (bob(1e19), bob(1e19f64.rem_euclid(360.0)));
+    for t in [0.3, 0.5, 1.3] {
+        let (a, b) = (
+            huge.apply(&rest, t).position,
+            plain.apply(&rest, t).position,
+        );
+        assert!(a.abs_diff_eq(b, 1e-12), "t = {t}: {a:?} against {b:?}");
+        assert!((a - rest.position).length() > 1e-3, "t = {t}: still");
+    }
+}
