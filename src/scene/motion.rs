@@ -234,10 +234,13 @@ impl Motion {
         }
         if let (Some(s), LightKind::Spot { direction, .. }) = (&self.sweep, &mut light.kind) {
             // The unit direction turned: a long one's products in the rotation overflowed
-            // (a direction past about 9·10³⁰⁷ turned into Inf and NaN).
+            // (a direction past about 9·10³⁰⁷ turned into Inf and NaN). Not turned, a light
+            // keeps its rest direction as written (at t = 0, say).
             if let (Some(axis), Some(unit_direction)) = (unit(s.axis), unit(*direction)) {
                 let angle = s.angle_deg.to_radians() * swing(t, s.period_s, s.phase_deg);
-                *direction = DQuat::from_axis_angle(axis, angle) * unit_direction;
+                if angle != 0.0 {
+                    *direction = DQuat::from_axis_angle(axis, angle) * unit_direction;
+                }
             }
         }
         light

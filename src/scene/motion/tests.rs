@@ -509,8 +509,9 @@ fn a_sweep_turns_a_direction_of_any_finite_length() {
         else {
             unreachable!()
         };
+        let turned = crate::scene::direction::unit(direction).unwrap();
         assert!(
-            direction.abs_diff_eq(want, 1e-12),
+            turned.abs_diff_eq(want, 1e-12),
             "t = {t}: {direction:?}, {want:?}"
         );
     }
