@@ -1,6 +1,8 @@
 //! The camera: right-handed, looking down −Z in view space, with a perspective (vertical field
 //! of view) or orthographic projection. Clip space follows GL conventions (z in [−1, 1]).
 
+mod placed;
+
 use glam::{DMat4, DVec3};
 use serde::{Deserialize, Serialize};
 

@@ -212,7 +212,9 @@ impl Placing<'_> {
                     return Err(only_obj_textured());
                 }
                 models.place_builtin(scene, name, transform, recolour);
-                Some(camera)
+                // Carried with the scene, as a glTF's camera is by its transform; a transform
+                // that distorts (or none valid) leaves the view to the framing.
+                camera.placed_by(&transform)
             }
             (None, Some(obj_path), None) => {
                 let tex = spec.texture.as_ref().map(|t| self.base_dir.join(t));

@@ -562,3 +562,26 @@ fn metallic_and_roughness_change_only_their_own_placement_of_a_shared_obj() {
         }
     }
 }
+
+/// A built-in placed alone by a `transform` keeps its own view, carried with it (as a glTF's
+/// camera is): the plane moved to x = 100 and turned kept the camera at the origin, and drew
+/// black. A transform that distorts leaves the view to the framing.
+#[test]
+fn a_builtin_placed_alone_carries_its_camera_with_it() {
+    let own = crate::scene::builtin::build("plane", None).unwrap().camera;
+    let moved = r#"{"objects": [{"builtin": "plane",
+                     "transform": {"translate": [100, 0, 0], "rotate_y_deg": 90}}]}"#;
+    let scene = parse_str(moved).unwrap();
+    let transform = glam::DMat4::from_translation(glam::DVec3::new(100.0, 0.0, 0.0))
+        * glam::DMat4::from_rotation_y(90f64.to_radians());
+    let want = own.placed_by(&transform).unwrap();
+    assert!(scene.camera.position.abs_diff_eq(want.position, 1e-9));
+    assert!(scene.camera.target.abs_diff_eq(want.target, 1e-9));
+    assert!((scene.camera.target - glam::DVec3::new(100.0, 0.0, 0.0)).length() < 1e-9);
+    let stretched = r#"{"objects": [{"builtin": "plane", "transform": {"scale": [1, 2, 1]}}]}"#;
+    let scene = parse_str(stretched).unwrap();
+    assert_ne!(
+        scene.camera.position, own.position,
+        "not the builtin's camera"
+    );
+}
