@@ -77,20 +77,21 @@ impl Witness {
         let k = NEXT_WITNESS.fetch_add(1, Ordering::Relaxed) % WITNESS_SIZES;
         let size = 2 * k as i32 + 1;
         let buffer = unsafe { gl.create_buffer() }.map_err(GlError::Create)?;
-        with_array_buffer(gl, buffer, || unsafe {
+        with_array_buffer(gl, buffer, true, || unsafe {
             gl.buffer_data_size(glow::ARRAY_BUFFER, size, glow::STATIC_DRAW)
         });
         Ok(Witness { buffer, size })
     }
 
     /// Whether the context current now holds this witness, leaving its `GL_ARRAY_BUFFER`
-    /// binding as it was.
-    pub(super) fn is_held(&self, gl: &glow::Context) -> bool {
+    /// binding as it was where `keep_binding`, else at 0 without reading it (a call that
+    /// resets the application's state: `GlStateHandling::Reset`).
+    pub(super) fn is_held(&self, gl: &glow::Context, keep_binding: bool) -> bool {
         // Binding a name that is no buffer of this context would make one.
         if !unsafe { gl.is_buffer(self.buffer) } {
             return false;
         }
-        let size = with_array_buffer(gl, self.buffer, || unsafe {
+        let size = with_array_buffer(gl, self.buffer, keep_binding, || unsafe {
             gl.get_buffer_parameter_i32(glow::ARRAY_BUFFER, glow::BUFFER_SIZE)
         });
         size == self.size
@@ -102,9 +103,18 @@ impl Witness {
     }
 }
 
-/// Runs `f` with `buffer` bound to `GL_ARRAY_BUFFER`, then binds back what was bound.
-fn with_array_buffer<T>(gl: &glow::Context, buffer: glow::Buffer, f: impl FnOnce() -> T) -> T {
-    let before = unsafe { gl.get_parameter_buffer(glow::ARRAY_BUFFER_BINDING) };
+/// Runs `f` with `buffer` bound to `GL_ARRAY_BUFFER`, then binds back what was bound (where
+/// `keep`; else none).
+fn with_array_buffer<T>(
+    gl: &glow::Context,
+    buffer: glow::Buffer,
+    keep: bool,
+    f: impl FnOnce() -> T,
+) -> T {
+    let before = match keep {
+        true => unsafe { gl.get_parameter_buffer(glow::ARRAY_BUFFER_BINDING) },
+        false => None,
+    };
     unsafe { gl.bind_buffer(glow::ARRAY_BUFFER, Some(buffer)) };
     let result = f();
     unsafe { gl.bind_buffer(glow::ARRAY_BUFFER, before) };

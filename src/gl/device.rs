@@ -225,7 +225,7 @@ impl Device {
             return Ok(());
         };
         let _turn = self.turn();
-        if witness.is_held(&self.gl) {
+        if witness.is_held(&self.gl, self.saves_state()) {
             return Ok(());
         }
         // A lost context holds no objects either, and says so once among the pending errors.

@@ -297,12 +297,14 @@ fn a_frame_with_the_state_reset_reads_only_the_games_framebuffer() {
             let saved = frames(GlStateHandling::SaveAndRestore);
             let counts = frames(GlStateHandling::Reset);
             let what = format!("{es} {method}: {counts:#?}");
-            // Nothing but errors, integers and what is attached: no capability, value,
-            // attribute, program, texture or renderbuffer query.
+            // Nothing but errors, integers, what is attached and the size of the renderer's
+            // own witness buffer (which context is current): no capability, value, attribute,
+            // program, texture or renderbuffer query.
             let kinds = [
                 "glGetError",
                 "glGetIntegerv",
                 "glGetFramebufferAttachmentParameteriv",
+                "glGetBufferParameteriv",
             ];
             let other = |name: &String| !kinds.iter().any(|k| name.starts_with(k));
             let others: Vec<_> = counts.keys().filter(|name| other(name)).collect();
@@ -311,6 +313,8 @@ fn a_frame_with_the_state_reset_reads_only_the_games_framebuffer() {
             // type (ES 3.0).
             let attached = of(&counts, &["glGetFramebufferAttachmentParameteriv"]);
             assert!(attached <= 4.0, "attachments: {what}");
+            let witness = of(&counts, &["glGetBufferParameteriv"]);
+            assert!(witness <= 1.0, "buffers: {what}");
             let target = [
                 glow::FRAMEBUFFER_BINDING,
                 glow::SAMPLES,
