@@ -276,7 +276,7 @@ impl MapUniforms {
         }
         if features.has(F::EMISSIVE) {
             let emission = if own.has(F::EMISSIVE) {
-                maps.emissive * pre_exposure
+                (maps.emissive * pre_exposure).min(glam::Vec3::MAX)
             } else {
                 Vec3::ZERO
             };

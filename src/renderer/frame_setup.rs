@@ -32,7 +32,9 @@ pub(super) fn gather_lights(
                 cutoff as f64,
             ) as f32;
         }
-        g.radiance *= pre_exposure;
+        // Within f32: validation allows radiance up to its largest value (Inf would be NaN
+        // in the fp16 form's scaling).
+        g.radiance = (g.radiance * pre_exposure).min(glam::Vec3::MAX);
         g
     });
     overwrite_lights(lights, gathered)

@@ -656,6 +656,36 @@ fn faint_light_at_a_high_exposure_draws_as_with_highp() {
     }
 }
 
+/// Sources at f32's largest radiance, which validation allows, at a positive exposure without
+/// fragment highp: pre-exposed they passed f32 to infinity, whose fp16 form was NaN (a debug
+/// build's assertion failed on the sun). Each draws as highp does, white where it shines.
+#[test]
+fn sources_at_f32s_largest_radiance_draw_at_a_positive_exposure() {
+    let mut mediump = Gpu::without_fragment_highp();
+    let mut highp = Gpu::new(EsVersion::Es2);
+    let opts = RenderOptions {
+        exposure_ev: 1.0,
+        ..Default::default()
+    };
+    let mut light = point(3.0);
+    light.color = Vec3::ONE;
+    light.intensity = 3e38;
+    let lit = plane(vec![light]);
+    let mut sun = plane(vec![]);
+    let down = DVec3::new(0.3, 0.2, -1.0);
+    sun.directional_lights = vec![scene::DirectionalLight::new(down, Vec3::ONE, 3e38)];
+    let mut glow = plane(vec![]);
+    glow.ambient = Vec3::splat(3e38);
+    glow.materials[0].maps.emissive = Vec3::splat(1024.0);
+    for (name, s) in [("light", lit), ("sun", sun), ("ambient, emission", glow)] {
+        let exact = highp.render(&s, 64, 36, &opts);
+        assert!(mean(&exact) > 20.0, "{name}: too dark to tell");
+        let image = mediump.render(&s, 64, 36, &opts);
+        let d = manylight::metrics::diff(&exact, &image).max_abs;
+        assert!(d <= 3, "{name}: {d} / 255 from highp");
+    }
+}
+
 /// A metal whose base colour is past glTF's [0, 1] (the loaders take up to 1 024): its Fresnel
 /// reflectance F0 grew with it, and times the capped lobe went past fp16, Inf, then NaN where
 /// the falloff or spot was 0 (black holes without fragment highp). F0 now stays at most 1, and

@@ -45,7 +45,10 @@ pub(super) fn light_instance(
     let (direction, spot_scale, spot_offset) = shader_spot_terms(light);
     [
         light.position.extend(light.radius),
-        (light.radiance * scale).extend(spot_scale),
+        // Within f32 at a positive exposure (Inf times a falloff of 0 would be NaN).
+        (light.radiance * scale)
+            .min(glam::Vec3::MAX)
+            .extend(spot_scale),
         Vec4::new(proxy_radius, channel as f32, depth, 0.0),
         direction.extend(spot_offset),
     ]
