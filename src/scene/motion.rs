@@ -381,15 +381,16 @@ impl Motion {
         if let Some(s) = &mut m.sweep {
             s.period_s = jitter(s.period_s);
         }
-        let mut phase = || rng.random_range(0.0..360.0);
+        // Added to the phase reduced to one turn: added to a huge one, it rounded away.
+        let mut phase = |written: f64| written.rem_euclid(360.0) + rng.random_range(0.0..360.0);
         if let Some(o) = &mut m.orbit {
-            o.phase_deg += phase();
+            o.phase_deg = phase(o.phase_deg);
         }
         if let Some(b) = &mut m.bob {
-            b.phase_deg += phase();
+            b.phase_deg = phase(b.phase_deg);
         }
         if let Some(s) = &mut m.sweep {
-            s.phase_deg += phase();
+            s.phase_deg = phase(s.phase_deg);
         }
         let derived = rng.random::<u64>();
         if let Some(w) = &mut m.wander {

@@ -550,3 +550,24 @@ fn a_huge_phase_keeps_the_motion_moving() {
         assert!((a - rest.position).length() > 1e-3, "t = {t}: still");
     }
 }
+
+/// A random set's lights each get a phase of their own, also where the phase written is huge
+/// (added to 10¹⁹ degrees, each light's share rounded away: the set moved in lockstep).
+#[test]
+fn varied_phases_differ_whatever_the_phase_written() {
+    let motion = Motion {
+        bob: Some(Bob {
+            amplitude: DVec3::Y,
+            period_s: 2.0,
+            phase_deg: 1e19,
+        }),
+        ..Motion::default()
+    };
+    let phases: Vec<f64> = (0..6)
+        .map(|k| motion.varied(7, k, false).bob.unwrap().phase_deg)
+        .collect();
+    for (i, a) in phases.iter().enumerate() {
+        assert!((0.0..720.0).contains(a), "{a}");
+        assert!(phases[i + 1..].iter().all(|b| b != a), "{phases:?}");
+    }
+}
