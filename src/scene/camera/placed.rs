@@ -8,10 +8,14 @@ use super::{Camera, Projection};
 impl Camera {
     /// This camera moved by `transform` with the scene it looks at: eye, target and up carried,
     /// planes (and an orthographic height) scaled. `None` where `transform` is no similarity
-    /// (a shear or an uneven scale would distort the view: frame the scene instead) or the
-    /// camera it makes is not valid (past the coordinate limit).
+    /// (a shear or an uneven scale would distort the view: frame the scene instead), mirrors
+    /// (the picture would be the mirror image) or makes no valid camera (past the coordinate
+    /// limit).
     pub fn placed_by(&self, transform: &DMat4) -> Option<Camera> {
         let m = DMat3::from_mat4(*transform);
+        if m.determinant() <= 0.0 {
+            return None;
+        }
         let scale = uniform_scale(&m)?;
         let projection = match self.projection {
             Projection::Perspective {
@@ -86,7 +90,7 @@ mod tests {
         }
     }
 
-    /// An uneven scale or a shear has no camera that keeps the view: none.
+    /// An uneven scale, a shear or a mirror has no camera that keeps the view: none.
     #[test]
     fn a_distorting_transform_places_no_camera() {
         let camera = Camera::default();
@@ -96,5 +100,8 @@ mod tests {
         shear.y_axis.x = 0.5;
         assert!(camera.placed_by(&shear).is_none());
         assert!(camera.placed_by(&DMat4::from_scale(DVec3::ZERO)).is_none());
+        // A mirror keeps every length but shows the picture the other way round.
+        let mirror = DMat4::from_scale(DVec3::new(-1.0, 1.0, 1.0));
+        assert!(camera.placed_by(&mirror).is_none());
     }
 }

@@ -1339,9 +1339,11 @@ fn info_scene_reports_a_method_that_cannot_render_it_and_the_rest() {
     let dir = tempfile::tempdir().unwrap();
     let light = r#"{"kind": "point", "position": [0, 0, 1], "radius": 1, "color": [1, 1, 1]}"#;
     let lights = vec![light; 65_600].join(",");
-    // The plane shrunk to a few pixels: few fragments loop over all 65 600 lights.
+    // The plane shrunk to a few pixels, the camera where the plane's own was: few fragments
+    // loop over all 65 600 lights.
     let plane = r#"{"builtin": "plane", "transform": {"scale": 0.02}}"#;
-    let scene = format!(r#"{{"objects": [{plane}], "lights": [{lights}]}}"#);
+    let camera = r#"{"position": [0, 0, 5], "target": [0, 0, 0]}"#;
+    let scene = format!(r#"{{"objects": [{plane}], "camera": {camera}, "lights": [{lights}]}}"#);
     std::fs::write(dir.path().join("many.json"), scene).unwrap();
     let out = manylight(&["info", "--json", "--scene", "many.json"], &[], dir.path());
     assert!(out.status.success(), "{}", text(&out));
