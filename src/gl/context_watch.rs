@@ -77,10 +77,19 @@ impl Witness {
         let k = NEXT_WITNESS.fetch_add(1, Ordering::Relaxed) % WITNESS_SIZES;
         let size = 2 * k as i32 + 1;
         let buffer = unsafe { gl.create_buffer() }.map_err(GlError::Create)?;
+        let witness = Witness { buffer, size };
         with_array_buffer(gl, buffer, true, || unsafe {
             gl.buffer_data_size(glow::ARRAY_BUFFER, size, glow::STATIC_DRAW)
         });
-        Ok(Witness { buffer, size })
+        // Without its storage (out of memory) it would say every later call is another
+        // context's.
+        if !witness.is_held(gl, true) {
+            witness.delete(gl);
+            return Err(GlError::OutOfMemory(format!(
+                "the renderer's {size}-byte context witness buffer could not be made"
+            )));
+        }
+        Ok(witness)
     }
 
     /// Whether the context current now holds this witness, leaving its `GL_ARRAY_BUFFER`

@@ -697,14 +697,18 @@ macro_rules! gl_check {
 pub(crate) use gl_check;
 
 /// Clears the context's pending GL errors (at most 17: a lost context may report errors
-/// forever) and returns the first, or `NO_ERROR`.
+/// forever) and returns the first, or `GL_CONTEXT_LOST` where any was (GL reports pending
+/// errors in any order, and a lost context says so once), or `NO_ERROR`.
 fn drain_errors(gl: &glow::Context) -> u32 {
     let first = unsafe { gl.get_error() };
-    if first != glow::NO_ERROR {
-        for _ in 0..16 {
-            if unsafe { gl.get_error() } == glow::NO_ERROR {
-                break;
-            }
+    if first == glow::NO_ERROR || first == glow::CONTEXT_LOST {
+        return first;
+    }
+    for _ in 0..16 {
+        match unsafe { gl.get_error() } {
+            glow::NO_ERROR => break,
+            glow::CONTEXT_LOST => return glow::CONTEXT_LOST,
+            _ => {}
         }
     }
     first
