@@ -110,6 +110,9 @@ pub fn parse(
             .map_err(|reason| SceneError::invalid("objects", reason))?;
     }
     let mut scene = Scene::empty();
+    // The file's own lights first, so that a light's index in the scene is its index in the
+    // file (errors name it, some at frame time); the objects' glTF lights follow.
+    add_lights(&mut scene, &file)?;
     let mut report = LoadReport::default();
     let mut models = ModelCache::new(*options);
     let mut meshes = model_cache::MeshCount::default();
@@ -129,7 +132,6 @@ pub fn parse(
     if let Some(a) = file.ambient {
         scene.ambient = narrow3("ambient", a)?;
     }
-    add_lights(&mut scene, &file)?;
     scene.camera = match (&file.camera, model_camera) {
         (Some(c), _) => c.to_camera()?,
         (None, Some(c)) if file.objects.len() == 1 => c,

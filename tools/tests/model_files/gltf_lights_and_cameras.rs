@@ -136,14 +136,30 @@ fn a_gltf_object_in_a_json_scene_brings_its_lights_and_camera_placed_by_its_tran
     assert_eq!(
         scene.lights.len(),
         4,
-        "three from the glTF, one from the JSON"
+        "one from the JSON, three from the glTF"
     );
+    // The file's own lights first, at their indices in the file.
+    assert_eq!(scene.lights[0].position, DVec3::ZERO);
     let place = DMat4::from_translation(DVec3::new(10.0, 0.0, 0.0))
         * DMat4::from_rotation_y(90f64.to_radians());
     let want = place.transform_point3(DVec3::new(1.0, 2.0, 3.0));
-    assert!((scene.lights[0].position - want).length() < 1e-9);
-    assert!((scene.lights[0].position - DVec3::new(13.0, 2.0, -1.0)).length() < 1e-9);
-    assert_eq!(scene.lights[0].radius, 7.0, "radius not scaled");
+    assert!((scene.lights[1].position - want).length() < 1e-9);
+    assert!((scene.lights[1].position - DVec3::new(13.0, 2.0, -1.0)).length() < 1e-9);
+    assert_eq!(scene.lights[1].radius, 7.0, "radius not scaled");
+    // An error about the file's light names it as the file does (it named lights[3], the
+    // index behind the glTF's three).
+    let far = write(
+        dir.path(),
+        "far.json",
+        r#"{"objects": [{"gltf": "lamps.gltf"}],
+            "lights": [{"kind": "point", "position": [9.999999995e17, 0, 0], "radius": 1,
+                        "color": [1, 1, 1],
+                        "motion": {"bob": {"amplitude": [1e9, 0, 0], "period_s": 1}}}]}"#,
+    );
+    let err = scene::load(far.to_str().unwrap(), None)
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("`lights[0].motion`"), "{err}");
     // The sun turned with the object: the quarter turn about +Y takes −Z to −X.
     let sun = scene.directional_lights[0].direction;
     assert!((sun - DVec3::NEG_X).length() < 1e-9, "{sun}");
