@@ -9,6 +9,11 @@ use crate::scene::shown;
 pub(super) fn message(e: &serde_path_to_error::Error<serde_json::Error>) -> String {
     let inner = plain_types(file_text_cut(&e.inner().to_string()));
     let mut path: Vec<&Segment> = e.path().iter().collect();
+    // Where the error came past a value's end (a comment before the last `}`), the path ends
+    // in a segment serde could not tell: the position in the reason says where.
+    while matches!(path.last(), Some(Segment::Unknown)) {
+        path.pop();
+    }
     // The reason names an unknown key itself: the path ends at the object holding it.
     if inner.starts_with("unknown field `") && matches!(path.last(), Some(Segment::Map { .. })) {
         path.pop();

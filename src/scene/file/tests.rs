@@ -585,3 +585,13 @@ fn a_builtin_placed_alone_carries_its_camera_with_it() {
         "not the builtin's camera"
     );
 }
+
+/// A syntax error past the last value of the file's object (a comment before its `}`) names no
+/// path it cannot tell: it read `?: expected `,` or `}` at line 1 column 34`.
+#[test]
+fn a_syntax_error_after_the_last_value_names_its_position_alone() {
+    let text = r#"{"objects":[{"builtin":"plane"}] /* c */}"#;
+    let err = parse_str(text).unwrap_err().to_string();
+    assert!(!err.contains('?'), "{err}");
+    assert!(err.contains("line 1 column"), "{err}");
+}
