@@ -43,7 +43,7 @@ impl DirectionalFrame {
             let to_light = crate::scene::direction::unit(view.transform_vector3(light.to_light()))
                 .unwrap_or_default()
                 .as_vec3();
-            let radiance = (light.radiance() * pre_exposure).min(glam::Vec3::MAX);
+            let radiance = super::features::pre_exposed(light.radiance(), pre_exposure);
             let (radiance, k) = if fp16 {
                 fp16_radiance(radiance)
             } else {

@@ -17,6 +17,13 @@ pub const DIRECTIONAL_FP16_CAP: f32 = 16000.0;
 /// it per channel in `glsl/surface_maps.glsl`.
 pub const FP16_MAX_AMBIENT: f32 = 60000.0;
 
+/// `radiance` times a frame's pre-exposure (`by`: [`ShaderFeatures::pre_exposure`], or
+/// deferred's accumulation scale), within f32: validation allows radiance up to f32's largest
+/// value, and Inf would be NaN further on (times a falloff of 0, or the fp16 form's scaling).
+pub(crate) fn pre_exposed(radiance: glam::Vec3, by: f32) -> glam::Vec3 {
+    (radiance * by).min(glam::Vec3::MAX)
+}
+
 /// Feature bitset of a shader variant.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub struct ShaderFeatures(pub u64);

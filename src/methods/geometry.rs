@@ -278,7 +278,7 @@ pub(crate) fn shade_object<P: GeometryProgram>(
     let pre_exposure = ctx.features.pre_exposure(ctx.options.exposure_ev);
     let frame = SurfaceFrame {
         ambient: super::uniforms::ambient_uniform(
-            (ctx.scene.ambient * pre_exposure).min(glam::Vec3::MAX),
+            super::features::pre_exposed(ctx.scene.ambient, pre_exposure),
             ctx.features.has(ShaderFeatures::FP16_LIGHTS),
         ),
         exposure: ctx.options.exposure_ev.exp2() / pre_exposure,

@@ -276,7 +276,7 @@ impl MapUniforms {
         }
         if features.has(F::EMISSIVE) {
             let emission = if own.has(F::EMISSIVE) {
-                (maps.emissive * pre_exposure).min(glam::Vec3::MAX)
+                super::features::pre_exposed(maps.emissive, pre_exposure)
             } else {
                 Vec3::ZERO
             };

@@ -32,9 +32,7 @@ pub(super) fn gather_lights(
                 cutoff as f64,
             ) as f32;
         }
-        // Within f32: validation allows radiance up to its largest value (Inf would be NaN
-        // in the fp16 form's scaling).
-        g.radiance = (g.radiance * pre_exposure).min(glam::Vec3::MAX);
+        g.radiance = crate::methods::features::pre_exposed(g.radiance, pre_exposure);
         g
     });
     overwrite_lights(lights, gathered)

@@ -10,6 +10,7 @@ use crate::cluster::view_light::GpuLight;
 use crate::gl::instances::InstanceStream;
 use crate::gl::mesh::BoundMesh;
 use crate::gl::{Device, GlError};
+use crate::methods::features::pre_exposed;
 
 /// The first of the instance attributes' locations (`layout(location = 6)` onwards in
 /// `glsl/deferred_light_instance.glsl`), after the meshes' 0 to 5.
@@ -45,10 +46,7 @@ pub(super) fn light_instance(
     let (direction, spot_scale, spot_offset) = shader_spot_terms(light);
     [
         light.position.extend(light.radius),
-        // Within f32 at a positive exposure (Inf times a falloff of 0 would be NaN).
-        (light.radiance * scale)
-            .min(glam::Vec3::MAX)
-            .extend(spot_scale),
+        pre_exposed(light.radiance, scale).extend(spot_scale),
         Vec4::new(proxy_radius, channel as f32, depth, 0.0),
         direction.extend(spot_offset),
     ]
