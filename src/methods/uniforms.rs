@@ -80,11 +80,9 @@ pub struct Surface {
 /// The ambient uniform's value: where it is fp16 (`fp16`: the `FP16_LIGHTS` tier) scaled down,
 /// its channels alike, so that none passes [`FP16_MAX_AMBIENT`].
 pub(crate) fn ambient_uniform(ambient: Vec3, fp16: bool) -> Vec3 {
-    let brightest = ambient.max_element();
-    if fp16 && brightest > FP16_MAX_AMBIENT {
-        ambient * (FP16_MAX_AMBIENT / brightest)
-    } else {
-        ambient
+    match fp16 {
+        true => crate::cluster::pack::scaled_alike_within(ambient, FP16_MAX_AMBIENT),
+        false => ambient,
     }
 }
 

@@ -381,12 +381,7 @@ pub const FP16_MAX_RADIANCE: f32 = (1u32 << 30) as f32;
 /// [`FP16_MAX_RADIANCE`]. The shader multiplies `k²` back into the falloff, which is small
 /// wherever the light is not saturating the pixel anyway (see `glsl/light_model.glsl`).
 pub fn fp16_radiance(c: Vec3) -> (Vec3, f32) {
-    let brightest = c.max_element();
-    let c = if brightest > FP16_MAX_RADIANCE {
-        c * (FP16_MAX_RADIANCE / brightest)
-    } else {
-        c
-    };
+    let c = scaled_alike_within(c, FP16_MAX_RADIANCE);
     let m = c.max_element();
     let e = if m > 1.0 {
         // At most 15 (k = 2¹⁵) however the scaling above rounded.
@@ -412,20 +407,25 @@ fn unorm16_down(x: f32) -> u16 {
 /// [`fp16_radiance`].
 const RGBE_MAX_RADIANCE: f32 = 1.7014118e38;
 
+/// `c` scaled down, its channels alike, so that none passes `most` (clamped alone, the
+/// brightest channel would lose more than the others: a hue shift).
+pub(crate) fn scaled_alike_within(c: Vec3, most: f32) -> Vec3 {
+    let brightest = c.max_element();
+    if brightest > most {
+        c * (most / brightest)
+    } else {
+        c
+    }
+}
+
 /// Shared-exponent RGB: the largest channel keeps 8 bits of mantissa.
 fn rgbe(c: Vec3) -> [u8; 4] {
-    let mut m = c.max_element();
+    let m = c.max_element();
     if m.is_nan() || m < 1e-30 {
         return [0, 0, 0, 0];
     }
-    // Clamped alone, the brightest channel would lose more than the others: a hue shift.
-    let c = if m > RGBE_MAX_RADIANCE {
-        let scaled = c * (RGBE_MAX_RADIANCE / m);
-        m = scaled.max_element();
-        scaled
-    } else {
-        c
-    };
+    let c = scaled_alike_within(c, RGBE_MAX_RADIANCE);
+    let m = c.max_element();
     // 2^e > m, so every mantissa is ≤ 255.
     let e = (m.log2().floor() as i32 + 1).clamp(-128, 127);
     let scale = 2f32.powi(-e) * 255.0;

@@ -10,8 +10,8 @@ pub use grid::{
     unpack_cell, unpack_index, GridEncoding, PackedTexels, MAX_INDEXED_LIGHTS, MAX_TABLE_CELLS,
     RGBA8_CELL_CAP, RGBA8_OFFSET_LIMIT, TABLE_TEXELS_PER_CASCADE,
 };
-pub(crate) use lights::shader_spot_terms;
 pub use lights::{
     fp16_radiance, pack_lights, pack_lights_into, unpack_light, LightEncoding, LightLayout,
     PackedLights, DATA_TEXTURE_WIDTH, FP16_MAX_RADIANCE,
 };
+pub(crate) use lights::{scaled_alike_within, shader_spot_terms};
