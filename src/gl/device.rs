@@ -153,8 +153,20 @@ impl Device {
         } else {
             None
         };
-        let own_vertex_array = match vertex_arrays {
-            Some(v) => Some((v.create(&gl).map_err(GlError::Create)?, v)),
+        let context = ContextWatch::of_current();
+        let witness = match context {
+            ContextWatch::Unknown => None,
+            _ => Some(Witness::new(&gl)?),
+        };
+        let own_vertex_array = match vertex_arrays.map(|v| (v.create(&gl), v)) {
+            Some((Ok(vao), v)) => Some((vao, v)),
+            Some((Err(e), _)) => {
+                // A creation that fails leaves nothing in the game's context.
+                if let Some(witness) = witness {
+                    witness.delete(&gl);
+                }
+                return Err(GlError::Create(e));
+            }
             None => None,
         };
         let renderbuffer_storage_multisample_ext = if caps.msaa_render_to_texture {
@@ -185,11 +197,6 @@ impl Device {
             );
         }
         let depth_bias = super::depth_bias::DepthBias::new(clamp_listed, set_clamp);
-        let context = ContextWatch::of_current();
-        let witness = match context {
-            ContextWatch::Unknown => None,
-            _ => Some(Witness::new(&gl)?),
-        };
         Ok(Device {
             gl,
             caps,

@@ -159,8 +159,9 @@ impl Renderer {
         es: EsVersion,
         restrictions: &crate::gl::Restrictions,
     ) -> Result<Renderer, Error> {
-        let dev = Device::restricted(gl, es, restrictions)?;
+        let forward = methods::find("forward")?;
         let mut desc = methods::find(methods::DEFAULT_METHOD)?;
+        let mut dev = Device::restricted(gl, es, restrictions)?;
         let mut support = (desc.supported)(dev.caps());
         let mut pending_warning = None;
         let mut replaced = None;
@@ -171,7 +172,7 @@ impl Renderer {
             );
             pending_warning = Some(format!("{why}; rendering with `forward`"));
             replaced = Some(why);
-            desc = methods::find("forward")?;
+            desc = forward;
             support = (desc.supported)(dev.caps());
         }
         if let Support::Fallback(reason) = &support {
@@ -187,7 +188,18 @@ impl Renderer {
             (Some(why), Support::Fallback(reason)) => Support::Fallback(format!("{why}; {reason}")),
             (_, support) => support,
         };
-        let method = dev.host_call(|| (desc.create)(&dev))?;
+        let method = match dev.host_call(|| (desc.create)(&dev)) {
+            Ok(method) => method,
+            Err(e) => {
+                // A creation that fails leaves nothing in the game's context (nor deletes
+                // another's objects).
+                if dev.check_current().is_ok() {
+                    let _turn = dev.turn();
+                    dev.delete_own_objects();
+                }
+                return Err(e);
+            }
+        };
         Ok(Renderer {
             dev,
             programs: ProgramCache::new(),
