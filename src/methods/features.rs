@@ -7,8 +7,8 @@ use crate::scene::light::SPOT_MIN_COS_DELTA;
 
 /// Without fragment highp, the most one directional light adds to a pixel (in the fp16-range
 /// form): four of them stay below fp16's 65 504. Only a contribution at least a quarter of
-/// this (radiance / k² > 1/4) is ever capped, so the picture is unchanged at exposures of
-/// −11 EV and up (−2 EV and up through a tone map, whose input is capped at 1 000).
+/// this (radiance / k² > 1/4) is ever capped: pre-exposed ([`ShaderFeatures::pre_exposure`]),
+/// one that shows white anyway (4 000 · 2^−½ and more; a tone map's input is capped at 1 000).
 pub const DIRECTIONAL_FP16_CAP: f32 = 16000.0;
 
 /// Without fragment highp (where they are fp16, past 65 504 infinity), the largest ambient a
@@ -189,13 +189,14 @@ impl ShaderFeatures {
     }
 
     /// What this variant's lights, ambient and emission are multiplied by before the shader
-    /// sums them, the exposure taking the rest: without fragment highp (`FP16_LIGHTS`) at a
-    /// positive exposure, 2 to the exposure rounded (exact), so the fp16 sum holds what is
-    /// shown rather than raw radiance, whose faint lights' shares rounded to zero (a black
-    /// frame at +15 EV where highp shows them); else 1. HDR output takes no exposure.
+    /// sums them, the exposure taking the rest: without fragment highp (`FP16_LIGHTS`), 2 to
+    /// the exposure rounded (exact), so the fp16 sum holds what is shown rather than raw
+    /// radiance, whose faint lights' shares rounded to zero at a positive exposure and whose
+    /// bright ones (a sun in lux) passed fp16's caps at a negative one; else 1. HDR output
+    /// takes no exposure.
     pub fn pre_exposure(self, exposure_ev: f32) -> f32 {
         if self.has(Self::FP16_LIGHTS) && !self.has(Self::OUTPUT_HDR) {
-            exposure_ev.round().max(0.0).exp2()
+            exposure_ev.round().exp2()
         } else {
             1.0
         }

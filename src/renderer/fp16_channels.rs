@@ -62,9 +62,10 @@ pub(super) fn warn_of_capped_radiance(
     };
     *warned = true;
     // Pre-exposed, the cap is 2³⁰ of what is shown.
-    let most = match pre_exposure > 1.0 {
-        true => format!("2³⁰ / 2^{}", pre_exposure.log2()),
-        false => "2³⁰".into(),
+    let stops = pre_exposure.log2();
+    let most = match stops == 0.0 {
+        true => "2³⁰".to_string(),
+        false => format!("2^{}", 30.0 - stops),
     };
     log::warn!(
         "{list}[{i}]: colour × intensity {radiance:?} is past {most}, the brightest radiance a \
@@ -96,8 +97,8 @@ pub(super) fn warn_of_capped_ambient(
     *warned = true;
     log::warn!(
         "ambient {:?} times a diffuse factor of up to {albedo} reaches {peak:e}, past the \
-         {most} the ambient term holds without fragment highp (fp16; {FP16_MAX_AMBIENT} less \
-         the exposure's positive stops): the ambient is drawn at most {most} (its channels \
+         {most} the ambient term holds without fragment highp at this exposure (fp16: \
+         {FP16_MAX_AMBIENT} of what is shown): the ambient is drawn at most {most} (its channels \
          scaled alike), and so is each channel of its term",
         scene.ambient
     );

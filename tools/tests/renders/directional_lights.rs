@@ -117,8 +117,10 @@ fn a_bright_sun_without_fragment_highp_stays_finite_and_right() {
     assert_eq!(bad, 0, "{bad} pixels Inf or NaN");
     // The picture is the model's: the same as the scene with everything 2^EV as bright, on
     // the CPU. At −10 EV the 100 000 lux sun is white, as the model says; a sun of 3 000
-    // (radiance read as 3 000 / 64², 64² folded back in) at −12 EV is in the middle.
-    for (intensity, ev) in [(bright, -10.0), (3000.0, -12.0)] {
+    // (radiance read as 3 000 / 64², 64² folded back in) at −12 EV is in the middle, and so
+    // is a daylight sun of 20 000 lux at −15 EV (pre-exposed: its fp16 cap of 4 000 drew it
+    // at a fifth).
+    for (intensity, ev) in [(bright, -10.0), (3000.0, -12.0), (20_000.0, -15.0)] {
         let mut scene = scene.clone();
         for l in &mut scene.directional_lights {
             l.intensity = intensity;
