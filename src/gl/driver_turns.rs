@@ -52,6 +52,35 @@ fn give_back() {
     }
 }
 
+/// Runs `f` with this thread's turn let go, if it holds one, then takes it back (as many times
+/// as it was held). For CPU work inside a call that waits for other threads: rayon's pool, whose
+/// workers may be waiting for the turn in renderer calls of their own (a deadlock).
+pub(crate) fn let_go_while<T>(f: impl FnOnce() -> T) -> T {
+    let here = std::thread::current().id();
+    let calls = {
+        let mut holder = lock();
+        if holder.thread != Some(here) {
+            drop(holder);
+            return f();
+        }
+        let calls = std::mem::take(&mut holder.calls);
+        holder.thread = None;
+        GIVEN_BACK.notify_all();
+        calls
+    };
+    /// Takes the turn back when dropped, panics included: the call's guards give it back.
+    struct TakeBack(u32);
+    impl Drop for TakeBack {
+        fn drop(&mut self) {
+            for _ in 0..self.0 {
+                take();
+            }
+        }
+    }
+    let _take_back = TakeBack(calls);
+    f()
+}
+
 /// A turn this thread holds (none where none was needed), given back when dropped, panics
 /// included, unless [`Turn::keep`] leaves it for a later [`give_back`].
 pub(crate) struct Turn(bool);

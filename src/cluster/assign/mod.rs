@@ -182,7 +182,22 @@ impl Assigner {
     /// built either: [`Assignment::unlisted`]
     /// says so (the renderer refuses such a frame), every cell is empty and every visible
     /// light counts as overflowed.
+    ///
+    /// Inside a renderer call on a driver whose calls take turns (llvmpipe), the turn is let go
+    /// meanwhile: the pool's workers may be waiting for it in renderer calls of their own.
     pub fn assign(
+        &mut self,
+        grid: &ClusterGrid,
+        lights: &[GpuLight],
+        camera_far: f64,
+        limits: &AssignLimits,
+    ) -> &Assignment {
+        crate::gl::driver_turns::let_go_while(move || {
+            self.assign_holding_no_turn(grid, lights, camera_far, limits)
+        })
+    }
+
+    fn assign_holding_no_turn(
         &mut self,
         grid: &ClusterGrid,
         lights: &[GpuLight],
