@@ -565,7 +565,7 @@ fn parse_obj(path: &Path, allow_outside: bool) -> Result<Parsed, SceneError> {
                 let folders = mtl_folders.into_inner();
                 (models, materials, not_utf8, warnings, folders)
             })
-            .map_err(|e| obj_error(e.to_string())),
+            .map_err(|e| obj_error(lines::located(&text, &e))),
         Err(_) => Err(obj_error(
             "the OBJ parser (tobj) failed on this file; it is malformed".into(),
         )),

@@ -73,7 +73,7 @@ pub(super) struct TransformSpec {
 }
 
 #[derive(Deserialize)]
-#[serde(untagged)]
+#[serde(untagged, expecting = "expected a number or three numbers [x, y, z]")]
 enum ScaleSpec {
     Uniform(f64),
     PerAxis([f64; 3]),

@@ -60,11 +60,17 @@ fn wrong_types_are_named_without_rust_type_names() {
             r#"{"objects": [{"builtin": "plane"}], "camera": {"fov_y_deg": "x"}}"#,
             "expected a number",
         ),
+        // An untagged enum: serde wrote `data did not match any variant of untagged enum
+        // ScaleSpec`.
+        (
+            r#"{"objects": [{"builtin": "plane", "transform": {"scale": [1, 2]}}]}"#,
+            "objects[0].transform.scale: expected a number or three numbers [x, y, z]",
+        ),
     ];
     for (json, want) in cases {
         let err = parse_str(json).unwrap_err().to_string();
         assert!(err.contains(want), "{json}: {err}");
-        for rust in ["struct ", "usize", "f64", "Spec"] {
+        for rust in ["struct ", "usize", "f64", "Spec", "enum"] {
             assert!(!err.contains(rust), "{json}: {err}");
         }
     }

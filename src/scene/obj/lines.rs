@@ -30,7 +30,24 @@ use crate::scene::mesh::{MAX_SCENE_MESHES, MAX_TEXCOORD};
 ///
 /// Returns what [`rewrite`] must change for tobj to read the file.
 pub(super) fn check_obj(text: &str) -> Result<Rewrites, String> {
-    check_obj_within(text, MAX_OBJ_CORNERS)
+    check_obj_within(text, MAX_OBJ_CORNERS, false)
+}
+
+/// tobj's error `e` on `text`, with the line and corner where it is a face index past what is
+/// defined when tobj reads it. tobj also ends an object at a change of material, which
+/// [`check_obj`] does not check (a `usemtl` naming no library's material may not end one, and
+/// the check must not refuse what tobj reads), so such a failure is located only once tobj
+/// has refused the file.
+pub(super) fn located(text: &str, e: &tobj::LoadError) -> String {
+    use tobj::LoadError::{FaceNormalOutOfBounds, FaceTexCoordOutOfBounds, FaceVertexOutOfBounds};
+    let past = matches!(
+        e,
+        FaceVertexOutOfBounds | FaceTexCoordOutOfBounds | FaceNormalOutOfBounds
+    );
+    match check_obj_within(text, MAX_OBJ_CORNERS, true) {
+        Err(reason) if past => reason,
+        _ => e.to_string(),
+    }
 }
 
 /// What a valid OBJ needs rewritten before tobj reads it.
@@ -155,7 +172,13 @@ fn long_object_name<'a>(key: Option<&str>, line: &'a str) -> Option<&'a str> {
 pub const MAX_OBJ_CORNERS: usize = 3 << 25;
 
 /// [`check_obj`] with at most `max_corners` triangle corners.
-fn check_obj_within(text: &str, max_corners: usize) -> Result<Rewrites, String> {
+/// [`check_obj`] with at most `max_corners` corners; where `materials_end_objects`, a
+/// `usemtl` naming another material ends an object too ([`located`]).
+fn check_obj_within(
+    text: &str,
+    max_corners: usize,
+    materials_end_objects: bool,
+) -> Result<Rewrites, String> {
     let kind_of = |key: Option<&str>| match key {
         Some("v") => Some(0),
         Some("vt") => Some(1),
@@ -186,8 +209,11 @@ fn check_obj_within(text: &str, max_corners: usize) -> Result<Rewrites, String> 
         let mut words = line.split_whitespace();
         let key = words.next();
         // tobj resolves an object's positive indices when it ends, at the next `o` or `g`
-        // (or a change of material, not checked here: a later check is never stricter).
-        if matches!(key, Some("o" | "g")) {
+        // (or a change of material, checked only in `located`: a later check is never
+        // stricter).
+        let material_change =
+            || key == Some("usemtl") && objects.material != Some(usemtl_name(line));
+        if matches!(key, Some("o" | "g")) || (materials_end_objects && material_change()) {
             check_pending(&mut pending, &defined, number + 1)?;
         }
         objects.read(key, line).map_err(at_line)?;
@@ -605,8 +631,8 @@ mod tests {
     #[test]
     fn faces_past_the_corner_limit_are_refused_by_line() {
         let text = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3 4\nf 1 2 3\nf 1 2 3\n";
-        assert!(check_obj_within(text, 12).is_ok());
-        let err = check_obj_within(text, 11).unwrap_err();
+        assert!(check_obj_within(text, 12, false).is_ok());
+        let err = check_obj_within(text, 11, false).unwrap_err();
         assert!(
             err.starts_with("line 7:") && err.contains("11 triangle corners"),
             "{err}"
@@ -614,7 +640,7 @@ mod tests {
         // Lines (`l`) and faces of one or two corners make no triangles, and are taken out
         // (tobj filled an `l` of four points as a quad), counted with the first's line.
         let text = "v 0 0 0\nl 1 1 1 1\nf 1\nf 1 1 1\nl 1 1\nf 1 1\n";
-        let found = check_obj_within(text, 3).unwrap();
+        let found = check_obj_within(text, 3, false).unwrap();
         assert_eq!(found.not_faces, Some((4, 2)));
         assert_eq!(rewrite(text, &found), "v 0 0 0\n\n\nf 1 1 1\n\n\n");
     }

@@ -357,3 +357,48 @@ fn a_library_in_a_subfolder_names_textures_from_its_own_folder() {
 fn root_of(model: &Path) -> &Path {
     model.parent().unwrap()
 }
+
+/// tobj ends an object at a change of material too, and reads its faces' indices there: a
+/// face naming a vertex defined after the `usemtl` is refused with the line and corner, where
+/// tobj's own message names neither (the fuzzer's case).
+#[test]
+fn a_face_past_the_vertices_before_a_change_of_material_is_located() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("m.mtl"), "newmtl m\nKd 1 1 1\n").unwrap();
+    let path = dir.path().join("d.obj");
+    let obj = "mtllib m.mtl\nv 1 1 0\nv -1 1 0\nf 3 2 1\nusemtl m\nv -1 -1 0\n";
+    std::fs::write(&path, obj).unwrap();
+    let mut scene = Scene::empty();
+    let mut budget = TextureBudget::default();
+    let options = LoadOptions::default();
+    let err = load_into(
+        &mut scene,
+        &path,
+        DMat4::IDENTITY,
+        None,
+        &options,
+        &mut budget,
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        err.contains(
+            "line 4: `f` corner 1: its vertex index is past the 2 defined before its \
+             object ends (line 5)"
+        ),
+        "{err}"
+    );
+    // The same material named again ends nothing: the file loads.
+    let obj = "mtllib m.mtl\nusemtl m\nv 1 1 0\nv -1 1 0\nf 3 2 1\nusemtl m\nv -1 -1 0\n";
+    std::fs::write(&path, obj).unwrap();
+    let mut scene = Scene::empty();
+    load_into(
+        &mut scene,
+        &path,
+        DMat4::IDENTITY,
+        None,
+        &options,
+        &mut budget,
+    )
+    .unwrap();
+}
