@@ -295,6 +295,14 @@ impl Renderer {
         if reaching_pass && self.reaching_pass.is_none() {
             self.reaching_pass = Some((methods::find("forward")?.create)(&self.dev)?);
         }
+        // Freed as a method's light resources are: it held its light texture for good.
+        if reaching_pass {
+            self.reaching_idle = 0;
+        } else if self.reaching_pass.is_some() && methods::idle_for_long(&mut self.reaching_idle) {
+            if let Some(mut pass) = self.reaching_pass.take() {
+                pass.destroy(&self.dev);
+            }
+        }
         let method_name = if reaching_pass {
             "forward"
         } else {

@@ -55,8 +55,11 @@ pub struct Renderer {
     gpu_scene: GpuScene,
     method: Box<dyn ShadingMethod>,
     /// The plain-forward pass that draws `CountKind::Reaching` frames whatever the method:
-    /// made at the first such frame, kept for the next.
+    /// made at the first such frame, kept for the next ones.
     reaching_pass: Option<Box<dyn ShadingMethod>>,
+    /// Frames without a reaching count in a row (the pass is freed after
+    /// [`methods::IDLE_FRAMES_KEPT`]).
+    reaching_idle: u32,
     support: Support,
     target: Option<OffscreenTarget>,
     /// The multisampled target `render_offscreen` draws into with `RenderOptions::samples`.
@@ -206,6 +209,7 @@ impl Renderer {
             gpu_scene: GpuScene::default(),
             method,
             reaching_pass: None,
+            reaching_idle: 0,
             support,
             target: None,
             msaa: None,

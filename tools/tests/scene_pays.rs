@@ -781,6 +781,41 @@ fn methods_free_their_light_resources_after_120_frames_without_lights() {
     }
 }
 
+/// A reaching count (`CountKind::Reaching`) draws with a plain forward pass of the renderer's
+/// own, whatever its method. 120 frames without such a count free that pass's light data, as
+/// a method's are freed (it held them for the renderer's life: 4 MiB after a count of 60 000
+/// lights), and a later count makes it again and counts the same.
+#[test]
+fn a_reaching_counts_own_pass_is_freed_after_120_frames_without_one() {
+    use manylight::methods::IDLE_FRAMES_KEPT;
+    use manylight::CountKind;
+    let lit = scene::builtin::build("plane", Some((50, 3))).unwrap();
+    let mut unlit = lit.clone();
+    unlit.truncate_lights(0);
+    let mut gpu = Gpu::new(EsVersion::Es3);
+    gpu.r().set_method_named("clustered").unwrap();
+    let opts = RenderOptions::default();
+    let count = |gpu: &mut Gpu| {
+        let (counts, stats) = (gpu.r())
+            .render_light_counts(&lit, 32, 18, &opts, CountKind::Reaching)
+            .unwrap();
+        (counts, stats.memory.method_gpu_bytes)
+    };
+    let (first, held) = count(&mut gpu);
+    assert!(held > 0, "the pass holds its lights");
+    let bytes = |gpu: &mut Gpu| {
+        let (_, stats) = gpu.r().render_offscreen(&unlit, 32, 18, &opts).unwrap();
+        stats.memory.method_gpu_bytes
+    };
+    for k in 1..IDLE_FRAMES_KEPT {
+        assert_eq!(bytes(&mut gpu), held, "kept at {k}");
+    }
+    assert_eq!(bytes(&mut gpu), 0, "{held} bytes held");
+    let (again, made) = count(&mut gpu);
+    assert_eq!(made, held, "made again");
+    assert!(first == again, "the same counts");
+}
+
 /// A mesh without texture coordinates (an OBJ without `vt`, a code-built one) uploads its
 /// positions and normals alone, 24 bytes a vertex (it uploaded 8 bytes of zeros more), and
 /// draws the picture it drew with coordinates, on ES 2.0 and 3.0, after a textured mesh that
