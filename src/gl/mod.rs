@@ -45,6 +45,7 @@ pub mod state;
 pub(crate) mod target_size;
 pub mod texture;
 pub mod timer;
+pub(crate) mod two_sizes;
 pub mod uv_sets;
 pub(crate) mod vertex_arrays;
 

@@ -220,7 +220,8 @@ impl UniformSet for CompositeProgram {
 /// Deferred's GPU state.
 #[derive(Default)]
 pub struct Deferred {
-    gbuffer: Option<GBuffer>,
+    /// The G-buffer, kept for two sizes (two views a frame).
+    gbuffer: crate::gl::two_sizes::TwoSizes<GBuffer>,
     sphere: Option<GpuMesh>,
     fullscreen: Option<GpuMesh>,
     lights: LightInstances,
@@ -277,7 +278,7 @@ impl Deferred {
         }
         let dev = ctx.dev;
         let target = ctx.target;
-        let has = self.gbuffer.as_ref().is_some_and(GBuffer::has_specular);
+        let has = self.gbuffer.get().is_some_and(GBuffer::has_specular);
         let prepared = self.ensure_resources(dev, ctx.viewport, has || needs_specular_target(ctx));
         dev.bind_framebuffer(target);
         prepared
@@ -290,7 +291,7 @@ impl Deferred {
             true => 0,
             false => self.frames_without_specular.saturating_add(1),
         };
-        let has = self.gbuffer.as_ref().is_some_and(GBuffer::has_specular);
+        let has = self.gbuffer.get().is_some_and(GBuffer::has_specular);
         needed || (has && self.frames_without_specular < SPECULAR_KEPT_FRAMES)
     }
 
@@ -302,13 +303,12 @@ impl Deferred {
         size: (u32, u32),
         specular: bool,
     ) -> Result<(), Error> {
-        let fits = |g: &GBuffer| g.size() == size && g.has_specular() == specular;
-        if !self.gbuffer.as_ref().is_some_and(fits) {
-            if let Some(mut g) = self.gbuffer.take() {
-                g.destroy(dev);
-            }
-            self.gbuffer = Some(GBuffer::new(dev, size.0, size.1, specular)?);
-        }
+        self.gbuffer.fit(
+            |g| g.size() == size && g.has_specular() == specular,
+            |g| g.size() != size,
+            || GBuffer::new(dev, size.0, size.1, specular),
+            |mut g| g.destroy(dev),
+        )?;
         if self.sphere.is_none() {
             self.sphere = Some(GpuMesh::new(dev, &proxy_sphere::unit_sphere())?);
             self.fullscreen = Some(GpuMesh::new(dev, &crate::gl::mesh::fullscreen_triangle())?);
@@ -319,7 +319,7 @@ impl Deferred {
     /// Frees what the G-buffer passes hold: the G-buffer, the proxy meshes, the light
     /// instances (the transparent objects' forward pass keeps its own).
     fn free_gbuffer_passes(&mut self, dev: &Device) {
-        if let Some(mut g) = self.gbuffer.take() {
+        for mut g in self.gbuffer.take_all() {
             g.destroy(dev);
         }
         for mut m in [self.sphere.take(), self.fullscreen.take()]
@@ -335,7 +335,7 @@ impl Deferred {
     /// Draws the opaque objects of `ctx.order` into the G-buffer.
     fn geometry_pass(&self, ctx: &mut FrameContext) -> Result<(), Error> {
         self.gbuffer
-            .as_ref()
+            .get()
             .expect("allocated")
             .begin_geometry(ctx.dev);
         // LEQUAL: where surfaces coincide, the last one drawn wins, exactly as in the forward
@@ -378,7 +378,7 @@ impl Deferred {
 
     fn light_pass(&mut self, ctx: &mut FrameContext) -> Result<LightPass, Error> {
         let dev = ctx.dev;
-        let gb = self.gbuffer.as_ref().expect("allocated");
+        let gb = self.gbuffer.get().expect("allocated");
         gb.begin_accumulation(dev);
         gb.bind_textures(dev, UNIT_G_ALBEDO);
         // Metallic-roughness compiled in only where a material uses it (the BRDF is then
@@ -529,7 +529,7 @@ impl Deferred {
         let (half, ortho) = half_extent(ctx);
         // Directional lights are shaded here, with the light pass's full material.
         let sun = ctx.features.has(ShaderFeatures::DIRECTIONAL);
-        let specular = self.gbuffer.as_ref().is_some_and(GBuffer::has_specular);
+        let specular = self.gbuffer.get().is_some_and(GBuffer::has_specular);
         let features = ctx
             .features
             .with(ShaderFeatures::SPECULAR, sun && specular)
@@ -546,7 +546,7 @@ impl Deferred {
         let p = ctx
             .programs
             .bind::<CompositeProgram>(dev, key, || features.defines(dev.es(), 1))?;
-        let gbuffer = self.gbuffer.as_ref().expect("allocated");
+        let gbuffer = self.gbuffer.get().expect("allocated");
         gbuffer.bind_textures(dev, UNIT_G_ALBEDO);
         gbuffer.bind_depth_texture(dev, UNIT_G_DEPTH);
         p.g_albedo.set(dev, UNIT_G_ALBEDO);
@@ -634,7 +634,7 @@ impl ShadingMethod for Deferred {
                 self.free_gbuffer_passes(dev);
             }
             MethodStats {
-                gbuffer_bytes: self.gbuffer.as_ref().map_or(0, GBuffer::gpu_bytes),
+                gbuffer_bytes: self.gbuffer.both().map(GBuffer::gpu_bytes).sum(),
                 lists_reused: true,
                 ..MethodStats::default()
             }
@@ -646,7 +646,7 @@ impl ShadingMethod for Deferred {
             let pass = self.light_pass(ctx)?;
             self.composite(ctx, target)?;
             let stats = MethodStats {
-                gbuffer_bytes: self.gbuffer.as_ref().map_or(0, GBuffer::gpu_bytes),
+                gbuffer_bytes: self.gbuffer.both().map(GBuffer::gpu_bytes).sum(),
                 upload_bytes: pass.uploaded,
                 lists_reused: pass.reused,
                 ..MethodStats::default()
@@ -676,7 +676,7 @@ impl ShadingMethod for Deferred {
     }
 
     fn gpu_bytes(&self) -> usize {
-        self.gbuffer.as_ref().map_or(0, GBuffer::gpu_bytes)
+        self.gbuffer.both().map(GBuffer::gpu_bytes).sum::<usize>()
             + self.sphere.as_ref().map_or(0, GpuMesh::gpu_bytes)
             + self.fullscreen.as_ref().map_or(0, GpuMesh::gpu_bytes)
             + self.lights.gpu_bytes()

@@ -200,7 +200,7 @@ impl Renderer {
         self.own_msaa_frame = samples > 1;
         if samples <= 1 {
             // A game that turned MSAA off gets the target's memory back (tens of MB at 1080p).
-            if let Some(mut m) = self.msaa.take() {
+            for mut m in self.msaa.take_all() {
                 m.destroy(&self.dev);
             }
             self.render_frame(
@@ -227,7 +227,7 @@ impl Renderer {
         // Creating the target binds (then leaves) framebuffers: the caller's comes back.
         self.dev.bind_framebuffer(destination);
         prepared?;
-        let msaa = self.msaa.as_ref().expect("created by prepare_msaa");
+        let msaa = self.msaa.get().expect("created by prepare_msaa");
         msaa.bind(&self.dev);
         let own_target = Some(msaa.fbo());
         // Drawn at the target's corner, resolved to the origin.
@@ -244,11 +244,11 @@ impl Renderer {
             Some(resolve),
             stats,
         );
-        let msaa = self.msaa.as_ref().expect("created by prepare_msaa");
+        let msaa = self.msaa.get().expect("created by prepare_msaa");
         match rendered {
             Ok(()) => {
                 stats.samples = msaa.samples_drawn();
-                stats.memory.msaa_bytes = msaa.gpu_bytes();
+                stats.memory.msaa_bytes = self.msaa.both().map(|m| m.gpu_bytes()).sum();
                 self.complete_target = applications.then_some(target);
                 Ok(())
             }
@@ -315,7 +315,7 @@ impl Renderer {
         let colour = (clear == Clear::All).then(|| self.clear_value(options));
         // MSAA frames clear everything (`Clear::All`, checked above).
         if let (Some(msaa), Some(colour)) =
-            (self.msaa.as_mut().filter(|_| resolve.is_some()), colour)
+            (self.msaa.get_mut().filter(|_| resolve.is_some()), colour)
         {
             msaa.fill(&self.dev, &mut self.programs, colour)?;
         }
@@ -397,7 +397,7 @@ impl Renderer {
             method.render(&mut ctx)
         };
         // MSAA's resolve is the frame's too: timed with it, waited for with it.
-        let rendered = match (rendered, resolve, self.msaa.as_mut()) {
+        let rendered = match (rendered, resolve, self.msaa.get_mut()) {
             (Ok(stats), Some(to), Some(msaa)) => msaa
                 .resolve(
                     &self.dev,
@@ -511,17 +511,19 @@ impl Renderer {
             ));
         }
         let shape = ((width, height), samples);
-        let kept = self.msaa.as_ref().map(|m| (m.shape(), m.is_srgb()));
         // ES 2.0's target has no sRGB form: it keeps the frame's linear values in RGBA8.
         let srgb = srgb && self.dev.es() == crate::gl::EsVersion::Es3;
-        if kept != Some((shape, srgb)) {
-            if let Some(mut m) = self.msaa.take() {
-                m.destroy(&self.dev);
-            }
-            self.msaa = Some(crate::gl::multisample::MultisampleTarget::with_encoding(
-                &self.dev, width, height, samples, srgb,
-            )?);
-        }
+        let dev = &self.dev;
+        self.msaa.fit(
+            |m| m.shape() == shape && m.is_srgb() == srgb,
+            |m| m.shape().0 != shape.0,
+            || {
+                crate::gl::multisample::MultisampleTarget::with_encoding(
+                    dev, width, height, samples, srgb,
+                )
+            },
+            |mut m| m.destroy(dev),
+        )?;
         Ok(())
     }
 }

@@ -62,8 +62,9 @@ pub struct Renderer {
     reaching_idle: u32,
     support: Support,
     target: Option<OffscreenTarget>,
-    /// The multisampled target `render_offscreen` draws into with `RenderOptions::samples`.
-    msaa: Option<crate::gl::multisample::MultisampleTarget>,
+    /// The multisampled target `render_offscreen` draws into with `RenderOptions::samples`,
+    /// kept for two sizes (two views a frame).
+    msaa: crate::gl::two_sizes::TwoSizes<crate::gl::multisample::MultisampleTarget>,
     /// The GPU timer: `None` until first needed, then `Some(None)` where the context has no
     /// timer queries.
     timer: Option<Option<crate::gl::timer::GpuTimer>>,
@@ -212,7 +213,7 @@ impl Renderer {
             reaching_idle: 0,
             support,
             target: None,
-            msaa: None,
+            msaa: Default::default(),
             timer: None,
             frame_serial: 0,
             own_msaa_frame: false,
@@ -479,7 +480,7 @@ impl Renderer {
         if let Some(mut t) = self.target.take() {
             t.destroy(&self.dev);
         }
-        if let Some(mut t) = self.msaa.take() {
+        for mut t in self.msaa.take_all() {
             t.destroy(&self.dev);
         }
         self.dev.delete_own_objects();

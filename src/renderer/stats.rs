@@ -171,9 +171,11 @@ pub struct MemoryStats {
     pub scene_upload_bytes: usize,
     /// GPU memory held by the method.
     pub method_gpu_bytes: usize,
-    /// G-buffer memory (deferred only; 0 otherwise).
+    /// G-buffer memory (deferred only; 0 otherwise), of both sizes where frames draw two
+    /// views of two sizes (a split screen: the other size's is kept for 8 calls).
     pub gbuffer_bytes: usize,
-    /// GPU memory of the multisampled target (0 without MSAA).
+    /// GPU memory of the multisampled target (0 without MSAA), of both sizes where frames
+    /// draw two views of two sizes.
     pub msaa_bytes: usize,
     /// GPU memory of the uploaded meshes and images (mipmaps included), this frame's scene's
     /// and those of earlier scenes the game still holds

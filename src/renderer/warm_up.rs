@@ -76,13 +76,13 @@ impl Renderer {
         let mut target = OffscreenTarget::new(&self.dev, width, height)?;
         target.bind(&self.dev);
         // The game's multisampled target stays as it is (a frame would make it again).
-        let kept_msaa = self.msaa.take();
+        let kept_msaa = std::mem::take(&mut self.msaa);
         self.warming_up = true;
         let drawn = self.restoring(
             |r| r.warm_up_frames(scene, &names, &options),
             move |r| {
                 r.warming_up = false;
-                if let Some(mut m) = std::mem::replace(&mut r.msaa, kept_msaa) {
+                for mut m in std::mem::replace(&mut r.msaa, kept_msaa).take_all() {
                     m.destroy(&r.dev);
                 }
                 target.destroy(&r.dev);

@@ -259,6 +259,8 @@ struct Case {
     cell_cap: Option<u32>,
     /// Frames counted with `render_reusing`.
     measured: usize,
+    /// Each frame draws a second view, half the size, with the same renderer (a split screen).
+    second_view: bool,
 }
 
 /// A case with still camera, waiting for the GPU, every method, nothing allowed. 64 lights:
@@ -276,6 +278,7 @@ const CASE: Case = Case {
     size: (16, 9),
     cell_cap: None,
     measured: MEASURED,
+    second_view: false,
 };
 
 /// Jobs rayon's global job queue (crossbeam's `Injector`) holds per block: every this many
@@ -385,6 +388,7 @@ fn allocations_per_frame(
             size: (width, height),
             cell_cap,
             measured,
+            second_view,
         } = c;
         let mut target = OffscreenTarget::new(&app, width, height).expect("application target");
         // The automatic grid's case keeps the real meshes: its choices follow the frames' measured
@@ -415,7 +419,7 @@ fn allocations_per_frame(
             let case = format!(
                 "{es}{} {name} {lights} lights wait_for_gpu={wait_for_gpu} \
                  camera_moves={camera_moves} auto_grid={auto_grid} samples={samples} \
-                 cell_cap={cell_cap:?} \
+                 cell_cap={cell_cap:?} second_view={second_view} \
                  {width}x{height} {method}",
                 if restrictions.no_fragment_highp {
                     " without fragment highp"
@@ -447,11 +451,16 @@ fn allocations_per_frame(
                 frame
             };
             let mut stats = FrameStats::default();
+            // The frame's views: the whole target, and with `second_view` half of it.
+            let views = [(width, height), (width.div_ceil(2), height.div_ceil(2))];
+            let views = &views[..1 + usize::from(second_view)];
             for _ in 0..WARM_UP {
                 let frame = next_frame(&mut scene);
-                renderer
-                    .render_reusing(&scene, width, height, &options, &mut stats)
-                    .unwrap_or_else(|e| panic!("{case} frame {frame}: {e}"));
+                for &(w, h) in views {
+                    renderer
+                        .render_reusing(&scene, w, h, &options, &mut stats)
+                        .unwrap_or_else(|e| panic!("{case} frame {frame}: {e}"));
+                }
             }
             // `render` returns its stats by value: their strings are new each frame.
             let mut expected = 0i64;
@@ -460,10 +469,12 @@ fn allocations_per_frame(
             let before = CALLS.load(Ordering::Relaxed);
             for _ in 0..MEASURED_RENDER {
                 let frame = next_frame(&mut scene);
-                let stats = renderer
-                    .render(&scene, width, height, &options)
-                    .unwrap_or_else(|e| panic!("{case} frame {frame}: {e}"));
-                expected += owned_strings(&stats) as i64;
+                for &(w, h) in views {
+                    let stats = renderer
+                        .render(&scene, w, h, &options)
+                        .unwrap_or_else(|e| panic!("{case} frame {frame}: {e}"));
+                    expected += owned_strings(&stats) as i64;
+                }
             }
             let by_render = (CALLS.load(Ordering::Relaxed) - before) as i64;
             // The game's path.
@@ -474,9 +485,11 @@ fn allocations_per_frame(
             TRACING.store(trace, Ordering::Relaxed);
             for _ in 0..measured {
                 let frame = next_frame(&mut scene);
-                renderer
-                    .render_reusing(&scene, width, height, &options, &mut stats)
-                    .unwrap_or_else(|e| panic!("{case} frame {frame}: {e}"));
+                for &(w, h) in views {
+                    renderer
+                        .render_reusing(&scene, w, h, &options, &mut stats)
+                        .unwrap_or_else(|e| panic!("{case} frame {frame}: {e}"));
+                }
             }
             TRACING.store(false, Ordering::Relaxed);
             MEASURING.store(false, Ordering::Relaxed);
@@ -519,6 +532,20 @@ fn no_heap_allocation_per_frame_in_steady_state_es3() {
         wait_for_gpu: false,
         samples: 4,
         methods: &["forward", "tiled", "clustered", "auto"],
+        ..CASE
+    });
+    // A split screen: two views of two sizes a frame, with MSAA (its target was made anew at
+    // every call) and with deferred (its G-buffer likewise).
+    cases.push(Case {
+        wait_for_gpu: false,
+        samples: 4,
+        methods: &["forward", "clustered"],
+        second_view: true,
+        ..CASE
+    });
+    cases.push(Case {
+        methods: &["deferred"],
+        second_view: true,
         ..CASE
     });
     let failures = allocations_per_frame(EsVersion::Es3, &Restrictions::default(), &cases);
