@@ -155,8 +155,8 @@ vec4 encodeOutput(vec3 color) {
     return vec4(color, u_alpha);
 #else
 #if FP16_LIGHTS
-    // A sum past fp16's largest value is infinity, white at any exposure: taken as that value
-    // instead (too dark at a low exposure, never brighter than the scene).
+    // A sum past fp16's largest value is infinity (NaN through a tone map's ∞/∞): taken as
+    // that value instead, which pre-exposed shows white anyway.
     color = min(color, vec3(65504.0));
 #endif
     HIGHP vec3 exposed = color * u_exposure;

@@ -5,6 +5,11 @@ use super::*;
 
 /// `obj` loaded at the identity with the default options and budget.
 pub(super) fn load(obj: &Path) -> (Scene, LoadReport) {
+    try_load(obj).unwrap()
+}
+
+/// [`load`], its error kept.
+fn try_load(obj: &Path) -> Result<(Scene, LoadReport), SceneError> {
     let mut scene = Scene::empty();
     let mut budget = TextureBudget::default();
     let options = LoadOptions::default();
@@ -15,9 +20,8 @@ pub(super) fn load(obj: &Path) -> (Scene, LoadReport) {
         None,
         &options,
         &mut budget,
-    )
-    .unwrap();
-    (scene, report)
+    )?;
+    Ok((scene, report))
 }
 
 /// A model folder inside a temporary root holding `secret.mtl`.
@@ -368,19 +372,7 @@ fn a_face_past_the_vertices_before_a_change_of_material_is_located() {
     let path = dir.path().join("d.obj");
     let obj = "mtllib m.mtl\nv 1 1 0\nv -1 1 0\nf 3 2 1\nusemtl m\nv -1 -1 0\n";
     std::fs::write(&path, obj).unwrap();
-    let mut scene = Scene::empty();
-    let mut budget = TextureBudget::default();
-    let options = LoadOptions::default();
-    let err = load_into(
-        &mut scene,
-        &path,
-        DMat4::IDENTITY,
-        None,
-        &options,
-        &mut budget,
-    )
-    .unwrap_err()
-    .to_string();
+    let err = try_load(&path).unwrap_err().to_string();
     assert!(
         err.contains(
             "line 4: `f` corner 1: its vertex index is past the 2 defined before its \
@@ -391,14 +383,5 @@ fn a_face_past_the_vertices_before_a_change_of_material_is_located() {
     // The same material named again ends nothing: the file loads.
     let obj = "mtllib m.mtl\nusemtl m\nv 1 1 0\nv -1 1 0\nf 3 2 1\nusemtl m\nv -1 -1 0\n";
     std::fs::write(&path, obj).unwrap();
-    let mut scene = Scene::empty();
-    load_into(
-        &mut scene,
-        &path,
-        DMat4::IDENTITY,
-        None,
-        &options,
-        &mut budget,
-    )
-    .unwrap();
+    try_load(&path).unwrap();
 }
