@@ -749,6 +749,12 @@ fn a_metal_brighter_than_white_stays_finite_and_equals_highp() {
 /// frame at an exposure takes it as 2³⁰ of what is shown) is highp's of that light at 2³⁰.
 #[test]
 fn a_light_past_what_fp16_radiance_holds_is_drawn_at_that_limit_with_a_warning() {
+    // A device played without float textures (the RGBA8 child off Mesa: SwiftShader, ANGLE)
+    // has no float render targets either, so no HDR frame to read the cap from; Mesa's child
+    // loses float textures alone and runs it.
+    if common::child::plays_rgba8_lights() {
+        return;
+    }
     common::warnings::install();
     let mut mediump = Gpu::without_fragment_highp();
     // ES 2.0, which Mesa still offers without float textures (the RGBA8 child).
@@ -785,7 +791,8 @@ fn a_light_past_what_fp16_radiance_holds_is_drawn_at_that_limit_with_a_warning()
 }
 
 /// The test above with RGBA8 light records (no `GL_OES_texture_float`), whose shader splits
-/// the shared exponent into `k` itself, in a child process.
+/// the shared exponent into `k` itself, in a child process (on Mesa; elsewhere the child has
+/// no HDR output to read the cap from).
 #[test]
 fn a_light_past_what_fp16_radiance_holds_in_rgba8_records_too() {
     common::child::rerun_with_rgba8_lights(
