@@ -257,4 +257,8 @@ pub enum GlError {
     /// [`Renderer::abandon`](crate::Renderer::abandon) and make a new one on a new context.
     #[error("the GL context was lost (GL_CONTEXT_LOST after {0}): let the renderer go with Renderer::abandon and make a new one on a new context")]
     ContextLost(String),
+    /// Another context than the renderer's, or none, is current after the light assignment
+    /// waited for rayon's pool on one of its workers, which runs other queued jobs meanwhile.
+    #[error("another GL context than the renderer's, or none, is current after the light assignment waited for rayon's pool on this worker thread, where it ran other queued jobs: renderers called inside rayon jobs set RenderOptions::max_assign_threads to 1")]
+    ContextChangedByPoolJob,
 }

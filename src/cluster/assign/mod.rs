@@ -93,6 +93,9 @@ pub struct Assigner {
     last_threads: usize,
     /// The bands' split of the last assignment on the pool, kept while one thread runs.
     pool_split: Option<bands::SplitRecord>,
+    /// An assignment entered rayon's pool from one of its workers since the last
+    /// [`Assigner::take_ran_other_jobs`].
+    may_have_run_other_jobs: bool,
 }
 
 /// What the next frame's assignment follows from the last frame's (its threads and the bands'
@@ -120,6 +123,13 @@ impl Assigner {
         self.chunks.fit();
         self.out.fit(keep_result);
         self.overflow.fit();
+    }
+
+    /// Whether an assignment since the last call entered rayon's pool from one of its
+    /// workers, which runs other queued jobs while it waits (a job that makes its own GL
+    /// context current leaves the caller's frame without its own).
+    pub fn take_ran_other_jobs(&mut self) -> bool {
+        std::mem::take(&mut self.may_have_run_other_jobs)
     }
 
     /// The last result.
@@ -262,6 +272,7 @@ impl Assigner {
             threads,
         );
         self.last_threads = threads;
+        self.may_have_run_other_jobs |= threads > 1 && rayon::current_thread_index().is_some();
         let tally = types::Tally::new(limits.max_untrimmed, most_runs_a_light(grid));
         let by_bands = threads == 1 || cells >= lights.len();
         let totals = if threads == 1 {

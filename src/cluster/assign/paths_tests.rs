@@ -553,3 +553,37 @@ fn scatter_blocks_of_any_number_give_the_same_lists() {
         FORCED_SCATTER_BLOCKS.with(|b| b.set(None));
     }
 }
+
+/// An assignment that enters rayon's pool from one of its workers may run other queued jobs
+/// there, which the renderer checks for (a job that made another GL context current): the
+/// assigner says so once, and not for one that took the pool from outside it or stayed on one
+/// thread.
+#[test]
+fn an_assignment_says_when_it_entered_the_pool_from_a_worker() {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(2)
+        .build()
+        .unwrap();
+    let grid = view_grid(&GridConfig::fixed(8.0));
+    let lights = random_lights(&mut Pcg64Mcg::seed_from_u64(23), 400, 20.0);
+    let limits = |parallel_threshold| AssignLimits {
+        parallel_threshold,
+        ..AssignLimits::default()
+    };
+    let mut assigner = super::Assigner::new();
+    let threads = pool.install(|| {
+        assigner
+            .assign(&grid, &lights, 80.0, &limits(0))
+            .stats
+            .threads
+    });
+    assert_eq!(threads, 2);
+    assert!(assigner.take_ran_other_jobs(), "in a worker, on the pool");
+    assert!(!assigner.take_ran_other_jobs(), "said once");
+    pool.install(|| assigner.assign(&grid, &lights, 80.0, &limits(usize::MAX)));
+    assert!(!assigner.take_ran_other_jobs(), "in a worker, one thread");
+    // From outside any pool (the test's thread), on the global pool.
+    assert!(rayon::current_thread_index().is_none());
+    assigner.assign(&grid, &lights, 80.0, &limits(0));
+    assert!(!assigner.take_ran_other_jobs(), "from outside the pool");
+}

@@ -95,6 +95,12 @@ impl Assign {
         (!self.holds_candidate).then(|| self.assigner.assignment())
     }
 
+    /// Whether an assignment since the last call ran other rayon jobs on this thread
+    /// ([`Assigner::take_ran_other_jobs`]).
+    pub(super) fn ran_other_jobs(&mut self) -> bool {
+        self.assigner.take_ran_other_jobs()
+    }
+
     /// The assigner, for the automatic grid's candidates: they share the frame's buffers.
     /// [`Assign::holds_candidates`] says when it assigned one.
     pub(super) fn candidates_assigner(&mut self) -> &mut Assigner {

@@ -33,7 +33,7 @@ use super::{FrameContext, MethodStats, ShadingMethod};
 use crate::cluster::assign::{AssignLimits, Assignment};
 use crate::cluster::grid::ClusterGrid;
 use crate::cluster::pack::{GridEncoding, LightLayout, MAX_INDEXED_LIGHTS, RGBA8_CELL_CAP};
-use crate::gl::Device;
+use crate::gl::{Device, GlError};
 use crate::Error;
 
 /// Which grid the method builds.
@@ -142,6 +142,11 @@ impl CulledForward {
                 self.update_grid(ctx, &limits, grid_encoding);
                 lists = self.lists(ctx, &limits)?;
             }
+        }
+        // The assignments may have run other rayon jobs on this thread while they waited for
+        // the pool: checked before the frame's first GL call goes to another job's context.
+        if self.assign.ran_other_jobs() {
+            (ctx.dev.check_current()).map_err(|_| GlError::ContextChangedByPoolJob)?;
         }
         self.write_grid_reason(ctx);
         let (grid_key, grid) = self.grid.as_ref().expect("updated above");
