@@ -26,9 +26,9 @@ impl<T> Default for TwoSizes<T> {
 
 impl<T> TwoSizes<T> {
     /// Makes the target in use one that `fits` accepts: the one in use, else the spare, else
-    /// `make`'s (the one in use becoming the spare where `other_size` says it is of another
-    /// size, else freed; the spare before it given to `free`). Where `make` fails while a
-    /// target is kept, that one is freed and `make` tried again.
+    /// `make`'s (the one in use kept as the spare where `other_size` says it is of another
+    /// size, else freed first; the spare before it given to `free`). Where `make` fails while
+    /// a target is kept, that one is freed and `make` tried again.
     pub(crate) fn fit<E>(
         &mut self,
         fits: impl Fn(&T) -> bool,
@@ -49,6 +49,9 @@ impl<T> TwoSizes<T> {
             return Ok(());
         }
         self.spare.take().map(&mut free);
+        if !self.in_use.as_ref().is_some_and(&other_size) {
+            self.in_use.take().map(&mut free);
+        }
         let made = match make() {
             Ok(made) => made,
             // Out of memory beside the other size's target, perhaps: without it.
@@ -59,9 +62,6 @@ impl<T> TwoSizes<T> {
             Err(e) => return Err(e),
         };
         self.spare = self.in_use.replace(made);
-        if !self.spare.as_ref().is_some_and(other_size) {
-            self.spare.take().map(&mut free);
-        }
         Ok(())
     }
 

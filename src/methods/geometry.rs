@@ -274,8 +274,8 @@ pub(crate) fn shade_object<P: GeometryProgram>(
             .map_or_else(Default::default, |t| t.sampling);
         t.bind(dev, UNIT_ALBEDO, &sampling);
     }
-    // The lights came pre-exposed (`ShaderFeatures::pre_exposure`); the exposure does the rest.
-    let pre_exposure = ctx.features.pre_exposure(ctx.options.exposure_ev);
+    // The lights came pre-exposed (`FrameContext::pre_exposure`); the exposure does the rest.
+    let pre_exposure = ctx.pre_exposure;
     let frame = SurfaceFrame {
         ambient: super::uniforms::ambient_uniform(
             super::features::pre_exposed(ctx.scene.ambient, pre_exposure),

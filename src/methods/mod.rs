@@ -88,6 +88,9 @@ pub struct FrameContext<'a> {
     pub directional: directional::DirectionalFrame,
     /// Scene-level shader features (spots present, output encoding, light encoding).
     pub features: ShaderFeatures,
+    /// What the frame's lights, ambient and emission are multiplied by
+    /// ([`ShaderFeatures::pre_exposure`]): `lights` and `directional` come so.
+    pub pre_exposure: f32,
     /// Viewport size in pixels.
     pub viewport: (u32, u32),
     /// The viewport's lower-left corner in the bound framebuffer (the frame's pixel (0, 0)).

@@ -337,6 +337,7 @@ impl Renderer {
             target,
             directional: setup.directional,
             features,
+            pre_exposure: setup.pre_exposure,
             viewport: (width, height),
             origin,
             near: setup.near,

@@ -24,6 +24,9 @@ pub(super) struct FrameSetup {
     pub projection: Mat4,
     pub scene_features: SceneFeatures,
     pub features: ShaderFeatures,
+    /// What the frame's lights, ambient and emission are multiplied by
+    /// ([`ShaderFeatures::pre_exposure`]).
+    pub pre_exposure: f32,
     pub directional: DirectionalFrame,
     /// The near plane, and the farthest distance the GPU may draw.
     pub near: f64,
@@ -126,6 +129,7 @@ impl Renderer {
             projection,
             scene_features,
             features,
+            pre_exposure,
             directional,
             near,
             far,

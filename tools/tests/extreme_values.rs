@@ -593,13 +593,15 @@ fn a_light_whose_fp16_scale_squares_past_fp16_draws_as_with_highp() {
         linear: true,
         ..Default::default()
     };
-    // Past 2¹⁶ the sum before exposure is itself past fp16 (docs/precision.md).
-    for intensity in [2f32.powi(15), 2f32.powi(16)] {
+    let lit_by = |intensity: f32| {
         let mut light = point(3.0);
         light.position = DVec3::new(0.0, 0.0, 0.5);
         light.color = Vec3::ONE;
         light.intensity = intensity;
-        let s = plane(vec![light]);
+        plane(vec![light])
+    };
+    for intensity in [2f32.powi(15), 2f32.powi(16)] {
+        let s = lit_by(intensity);
         let exact = highp.render(&s, 64, 36, &opts);
         let lit = exact.pixels().filter(|p| p[0] > 100).count();
         assert!(
@@ -611,11 +613,7 @@ fn a_light_whose_fp16_scale_squares_past_fp16_draws_as_with_highp() {
         let d = manylight::metrics::diff(&exact, &image).max_abs;
         assert!(d <= 3, "intensity {intensity:e}: {d} / 255 from highp");
     }
-    let mut light = point(3.0);
-    light.position = DVec3::new(0.0, 0.0, 0.5);
-    light.color = Vec3::ONE;
-    light.intensity = 2f32.powi(15);
-    let s = plane(vec![light]);
+    let s = lit_by(2f32.powi(15));
     let want = radiance(&mut highp, &s);
     let near = want.iter().filter(|p| p[0] > 1000.0).count();
     assert!(near > 30, "{near} pixels near the light, too few to tell");

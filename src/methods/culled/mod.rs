@@ -146,7 +146,9 @@ impl CulledForward {
         // The assignments may have run other rayon jobs on this thread while they waited for
         // the pool: checked before the frame's first GL call goes to another job's context.
         if self.assign.ran_other_jobs() {
-            (ctx.dev.check_current()).map_err(|_| GlError::ContextChangedByPoolJob)?;
+            ctx.dev
+                .check_current()
+                .map_err(|_| GlError::ContextChangedByPoolJob)?;
         }
         self.write_grid_reason(ctx);
         let (grid_key, grid) = self.grid.as_ref().expect("updated above");
