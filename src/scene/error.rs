@@ -65,6 +65,18 @@ pub enum SceneError {
         /// serde's message (includes line, column and the unknown or missing field).
         reason: String,
     },
+    /// A scene file's value is refused: `error` names the field and why (an [`Invalid`]
+    /// value or an [`UnknownBuiltin`] name). A model file it names reports its own errors.
+    ///
+    /// [`Invalid`]: SceneError::Invalid
+    /// [`UnknownBuiltin`]: SceneError::UnknownBuiltin
+    #[error("scene file {}: {error}", shown::path(path))]
+    InSceneFile {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong in it.
+        error: Box<SceneError>,
+    },
     /// A file whose type the loader does not read (by its extension).
     #[error("unsupported scene file type: {} (a scene is a built-in name, or a .obj, .gltf, .glb or .json file)", shown::path(path))]
     UnsupportedFile {
@@ -95,6 +107,19 @@ pub enum SceneError {
 }
 
 impl SceneError {
+    /// `error`, met in scene file `path`, naming the file where `error` names none.
+    pub(crate) fn in_scene_file(path: &std::path::Path, error: SceneError) -> Self {
+        match error {
+            SceneError::Invalid { .. } | SceneError::UnknownBuiltin { .. } => {
+                SceneError::InSceneFile {
+                    path: path.to_path_buf(),
+                    error: Box::new(error),
+                }
+            }
+            named => named,
+        }
+    }
+
     /// Shorthand for [`SceneError::Invalid`].
     pub fn invalid(field: impl Into<String>, reason: impl Into<String>) -> Self {
         SceneError::Invalid {

@@ -47,7 +47,7 @@ use super::material::check_color_factor;
 use super::model_cache::{self, ModelCache};
 use super::random::{self, LightSetStyle};
 use super::{LoadReport, MaterialModel, Scene, SceneError, Short};
-use spec::{narrow3, LightKindSpec, ObjectSpec, RandomLightsSpec, SceneFile};
+use spec::{narrow3, LightKindSpec, ObjectSpec, SceneFile};
 
 /// Parses the JSON, naming the field at fault: serde's own messages lack the path, and for an
 /// array with too many values say only "trailing characters". Anything after the scene's
@@ -102,6 +102,42 @@ pub fn parse(
         path: origin.to_path_buf(),
         reason,
     })?;
+    let in_file = |error| SceneError::in_scene_file(origin, error);
+    let (mut scene, report) = build(&file, base_dir, options).map_err(in_file)?;
+    // The command line's count is not the file's: its errors name `lights` alone.
+    let motion = file.random_lights.as_ref().and_then(|r| r.motion.as_ref());
+    // A set's sweep moves its spots only.
+    let motion = motion
+        .map(|m| m.to_motion("random_lights.motion", true))
+        .transpose()
+        .map_err(in_file)?;
+    match (random_override, &file.random_lights) {
+        // Nothing to place them in: the file is refused below for that.
+        _ if scene.objects.is_empty() => {}
+        (Some((count, seed)), _) => add_random_lights(&mut scene, count, seed, "lights", motion)?,
+        (None, Some(r)) => {
+            add_random_lights(&mut scene, r.count, r.seed, "random_lights.count", motion)
+                .map_err(in_file)?
+        }
+        (None, None) => {}
+    }
+    scene.validate().map_err(in_file)?;
+    // As for a glTF file alone: a picture of the background only is refused, not drawn black.
+    if scene.objects.is_empty() {
+        return Err(in_file(SceneError::invalid(
+            "objects",
+            "nothing to draw: no object places a triangle mesh",
+        )));
+    }
+    Ok((scene, report))
+}
+
+/// The scene the file's objects, lights, ambient and camera make, before its random lights.
+fn build(
+    file: &SceneFile,
+    base_dir: &Path,
+    options: &LoadOptions,
+) -> Result<(Scene, LoadReport), SceneError> {
     // Past the count limit, that limit's error names the object at fault.
     let count = file.objects.len();
     if count <= super::MAX_SCENE_OBJECTS {
@@ -112,7 +148,7 @@ pub fn parse(
     let mut scene = Scene::empty();
     // The file's own lights first, so that a light's index in the scene is its index in the
     // file (errors name it, some at frame time); the objects' glTF lights follow.
-    add_lights(&mut scene, &file)?;
+    add_lights(&mut scene, file)?;
     let mut report = LoadReport::default();
     let mut models = ModelCache::new(*options);
     let mut meshes = model_cache::MeshCount::default();
@@ -137,22 +173,6 @@ pub fn parse(
         (None, Some(c)) if file.objects.len() == 1 => c,
         _ => framing_camera(&mut scene)?,
     };
-    let random = match (random_override, &file.random_lights) {
-        (Some(r), _) => Some((r, "lights")),
-        (None, Some(r)) => Some(((r.count, r.seed), "random_lights.count")),
-        (None, None) => None,
-    };
-    if let Some(((count, seed), field)) = random {
-        add_random_lights(&mut scene, count, seed, field, file.random_lights.as_ref())?;
-    }
-    scene.validate()?;
-    // As for a glTF file alone: a picture of the background only is refused, not drawn black.
-    if scene.objects.is_empty() {
-        return Err(SceneError::invalid(
-            "objects",
-            "nothing to draw: no object places a triangle mesh",
-        ));
-    }
     Ok((scene, report))
 }
 
@@ -337,14 +357,14 @@ fn framing_camera(scene: &mut Scene) -> Result<Camera, SceneError> {
     Ok(scene.camera)
 }
 
-/// `count` random lights (`seed`) placed in the scene's bounds, with the motion of the file's
-/// `random_lights` if it gives one; `field` names the count in errors.
+/// `count` random lights (`seed`) placed in the scene's bounds, each moving by its own
+/// variation of `motion` if given; `field` names the count in errors.
 fn add_random_lights(
     scene: &mut Scene,
     count: usize,
     seed: u64,
     field: &str,
-    spec: Option<&RandomLightsSpec>,
+    motion: Option<super::motion::Motion>,
 ) -> Result<(), SceneError> {
     // The count alone here; memory is asked for the total below.
     super::input::light_count(count as u64, field)?;
@@ -368,9 +388,7 @@ fn add_random_lights(
     scene
         .lights
         .extend(random::lights(&volume, count, seed, LightSetStyle::Mixed));
-    if let Some(m) = spec.and_then(|r| r.motion.as_ref()) {
-        // A set's sweep moves its spots only.
-        let motion = m.to_motion("random_lights.motion", true)?;
+    if let Some(motion) = motion {
         scene.animate_lights(first..scene.lights.len(), motion, seed);
     }
     Ok(())

@@ -596,7 +596,7 @@ fn finish_load(
                 path: path.to_path_buf(),
                 reason,
             },
-            "json" => SceneError::invalid("objects", reason),
+            "json" => SceneError::in_scene_file(path, SceneError::invalid("objects", reason)),
             _ => SceneError::GltfUnsupported {
                 path: path.to_path_buf(),
                 reason,

@@ -399,7 +399,36 @@ fn errors_name_the_field() {
     for (text, needle) in cases {
         let err = parse_str(text).unwrap_err().to_string();
         assert!(err.contains(needle), "expected `{needle}` in: {err}");
+        // Syntax and value errors alike say which file they are about.
+        assert!(err.starts_with("scene file test.json: "), "{err}");
     }
+}
+
+/// A file's value past its limits names the file; the same count given in place of the
+/// file's (the command line's `--lights`) names only `lights`, which the file did not write.
+#[test]
+fn value_errors_name_the_file_and_a_count_given_in_its_place_does_not() {
+    let json =
+        r#"{"objects": [{"builtin": "plane"}], "random_lights": {"count": 18446744073709551615}}"#;
+    let err = parse_str(json).unwrap_err().to_string();
+    assert!(
+        err.starts_with("scene file test.json: invalid value for `random_lights.count`"),
+        "{err}"
+    );
+    let replaced = parse(
+        r#"{"objects": [{"builtin": "plane"}]}"#,
+        Path::new("."),
+        Path::new("test.json"),
+        Some((usize::MAX, 1)),
+        &LoadOptions::default(),
+    );
+    let err = replaced.map(|_| ()).unwrap_err().to_string();
+    assert!(err.starts_with("invalid value for `lights`"), "{err}");
+    let err = parse_str(r#"{"objects": []}"#).unwrap_err().to_string();
+    assert!(
+        err.starts_with("scene file test.json: invalid value for `objects`: nothing to draw"),
+        "{err}"
+    );
 }
 
 #[test]
