@@ -34,6 +34,7 @@
 
 mod json_error;
 mod json_size;
+mod map_only;
 mod spec;
 pub use json_size::MAX_SCENE_FILE_CONTAINERS;
 

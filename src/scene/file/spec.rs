@@ -9,9 +9,24 @@ use serde::Deserialize;
 use super::super::camera::Projection;
 use super::super::motion::{Bob, Flicker, Motion, Orbit, OrbitAbout, Sweep, Wander};
 use super::super::{Camera, DirectionalLight, Light, LightKind, SceneError};
+use super::map_only::map_only;
+
+map_only!(SceneFile, "a scene: a JSON object");
+map_only!(CameraSpec, "a camera object");
+map_only!(ObjectSpec, "an object");
+map_only!(TransformSpec, "a transform object");
+map_only!(LightSpec, "a light object");
+map_only!(DirectionalSpec, "a directional light object");
+map_only!(MotionSpec, "a motion object");
+map_only!(OrbitSpec, "an orbit object");
+map_only!(BobSpec, "a bob object");
+map_only!(WanderSpec, "a wander object");
+map_only!(FlickerSpec, "a flicker object");
+map_only!(SweepSpec, "a sweep object");
+map_only!(RandomLightsSpec, "a random lights object");
 
 #[derive(Deserialize)]
-#[serde(deny_unknown_fields, expecting = "a scene: a JSON object")]
+#[serde(deny_unknown_fields, remote = "Self")]
 pub(super) struct SceneFile {
     pub(super) camera: Option<CameraSpec>,
     #[serde(default)]
@@ -25,7 +40,7 @@ pub(super) struct SceneFile {
 }
 
 #[derive(Deserialize)]
-#[serde(deny_unknown_fields, expecting = "a camera object")]
+#[serde(deny_unknown_fields, remote = "Self")]
 pub(super) struct CameraSpec {
     position: [f64; 3],
     target: [f64; 3],
@@ -47,7 +62,7 @@ enum ProjectionKind {
 }
 
 #[derive(Deserialize)]
-#[serde(deny_unknown_fields, expecting = "an object")]
+#[serde(deny_unknown_fields, remote = "Self")]
 pub(super) struct ObjectSpec {
     pub(super) builtin: Option<String>,
     pub(super) obj: Option<PathBuf>,
@@ -63,7 +78,7 @@ pub(super) struct ObjectSpec {
 }
 
 #[derive(Deserialize)]
-#[serde(deny_unknown_fields, expecting = "a transform object")]
+#[serde(deny_unknown_fields, remote = "Self")]
 pub(super) struct TransformSpec {
     #[serde(default)]
     translate: [f64; 3],
@@ -80,7 +95,7 @@ enum ScaleSpec {
 }
 
 #[derive(Deserialize)]
-#[serde(deny_unknown_fields, expecting = "a light object")]
+#[serde(deny_unknown_fields, remote = "Self")]
 pub(super) struct LightSpec {
     pub(super) kind: LightKindSpec,
     position: [f64; 3],
@@ -96,7 +111,7 @@ pub(super) struct LightSpec {
 
 /// A sun: `direction` is the way the light travels (from it towards the scene).
 #[derive(Deserialize)]
-#[serde(deny_unknown_fields, expecting = "a directional light object")]
+#[serde(deny_unknown_fields, remote = "Self")]
 pub(super) struct DirectionalSpec {
     direction: [f64; 3],
     color: [f64; 3],
@@ -114,7 +129,7 @@ fn up() -> [f64; 3] {
 
 /// `"motion"` of a light or a random set (see [`super::super::motion`]).
 #[derive(Deserialize)]
-#[serde(deny_unknown_fields, expecting = "a motion object")]
+#[serde(deny_unknown_fields, remote = "Self")]
 pub(super) struct MotionSpec {
     orbit: Option<OrbitSpec>,
     bob: Option<BobSpec>,
@@ -124,7 +139,7 @@ pub(super) struct MotionSpec {
 }
 
 #[derive(Deserialize)]
-#[serde(deny_unknown_fields, expecting = "an orbit object")]
+#[serde(deny_unknown_fields, remote = "Self")]
 struct OrbitSpec {
     center: Option<[f64; 3]>,
     radius: Option<f64>,
@@ -135,7 +150,7 @@ struct OrbitSpec {
 }
 
 #[derive(Deserialize)]
-#[serde(deny_unknown_fields, expecting = "a bob object")]
+#[serde(deny_unknown_fields, remote = "Self")]
 struct BobSpec {
     amplitude: [f64; 3],
     period_s: f64,
@@ -144,7 +159,7 @@ struct BobSpec {
 }
 
 #[derive(Deserialize)]
-#[serde(deny_unknown_fields, expecting = "a wander object")]
+#[serde(deny_unknown_fields, remote = "Self")]
 struct WanderSpec {
     radius: f64,
     period_s: f64,
@@ -153,7 +168,7 @@ struct WanderSpec {
 }
 
 #[derive(Deserialize)]
-#[serde(deny_unknown_fields, expecting = "a flicker object")]
+#[serde(deny_unknown_fields, remote = "Self")]
 struct FlickerSpec {
     amount: f64,
     rate_hz: f64,
@@ -162,7 +177,7 @@ struct FlickerSpec {
 }
 
 #[derive(Deserialize)]
-#[serde(deny_unknown_fields, expecting = "a sweep object")]
+#[serde(deny_unknown_fields, remote = "Self")]
 struct SweepSpec {
     axis: [f64; 3],
     angle_deg: f64,
@@ -179,7 +194,7 @@ pub(super) enum LightKindSpec {
 }
 
 #[derive(Deserialize)]
-#[serde(deny_unknown_fields, expecting = "a random lights object")]
+#[serde(deny_unknown_fields, remote = "Self")]
 pub(super) struct RandomLightsSpec {
     pub(super) count: usize,
     #[serde(default)]

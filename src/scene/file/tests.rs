@@ -38,12 +38,44 @@ fn json_errors_name_the_field_and_too_many_values_say_so() {
 #[test]
 fn wrong_types_are_named_without_rust_type_names() {
     let cases = [
-        // serde reads a struct from an array too, field by field.
+        // An array is not an object, though serde's derive reads one field by field.
         (
             "[1, 2, 3]",
-            "[0]: invalid type: integer `1`, expected a camera object",
+            "invalid type: sequence, expected a scene: a JSON object",
         ),
         ("1", "expected a scene: a JSON object"),
+        (
+            r#"{"objects": [["plane"]]}"#,
+            "objects[0]: invalid type: sequence, expected an object",
+        ),
+        (
+            r#"{"objects": [{"builtin": "plane"}], "camera": [[0, 2, 8], [0, 1, 0]]}"#,
+            "camera: invalid type: sequence, expected a camera object",
+        ),
+        (
+            r#"{"objects": [{"builtin": "plane", "transform": [[1, 2, 3]]}]}"#,
+            "objects[0].transform: invalid type: sequence, expected a transform object",
+        ),
+        (
+            r#"{"objects": [{"builtin": "plane"}], "lights": [["point", [0, 1, 0], 2, [1, 1, 1]]]}"#,
+            "lights[0]: invalid type: sequence, expected a light object",
+        ),
+        (
+            r#"{"objects": [{"builtin": "plane"}], "directional_lights": [[[0, -1, 0], [1, 1, 1]]]}"#,
+            "directional_lights[0]: invalid type: sequence, expected a directional light object",
+        ),
+        (
+            r#"{"objects": [{"builtin": "plane"}], "random_lights": [8, 1]}"#,
+            "random_lights: invalid type: sequence, expected a random lights object",
+        ),
+        (
+            r#"{"objects": [{"builtin": "plane"}], "random_lights": {"count": 8, "motion": [null]}}"#,
+            "random_lights.motion: invalid type: sequence, expected a motion object",
+        ),
+        (
+            r#"{"objects": [{"builtin": "plane"}], "random_lights": {"count": 8, "motion": {"orbit": [[0, 0, 0], 6]}}}"#,
+            "random_lights.motion.orbit: invalid type: sequence, expected an orbit object",
+        ),
         (
             r#"{"objects": [{"builtin": "plane"}], "lights": [null]}"#,
             "lights[0]: invalid type: null, expected a light object",
