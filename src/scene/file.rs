@@ -105,13 +105,13 @@ pub fn parse(
     })?;
     let in_file = |error| SceneError::in_scene_file(origin, error);
     let (mut scene, report) = build(&file, base_dir, options).map_err(in_file)?;
-    // The command line's count is not the file's: its errors name `lights` alone.
     let motion = file.random_lights.as_ref().and_then(|r| r.motion.as_ref());
     // A set's sweep moves its spots only.
     let motion = motion
         .map(|m| m.to_motion("random_lights.motion", true))
         .transpose()
         .map_err(in_file)?;
+    // The command line's count is not the file's: its errors name `lights` alone.
     match (random_override, &file.random_lights) {
         // Nothing to place them in: the file is refused below for that.
         _ if scene.objects.is_empty() => {}
