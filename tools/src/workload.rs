@@ -6,7 +6,7 @@ use std::time::Instant;
 use manylight::cluster::assign::{AssignLimits, Assigner, Assignment};
 use manylight::cluster::grid::{ClusterGrid, GridConfig, GridMeasure, GridProjection};
 use manylight::cluster::view_light::GpuLight;
-use manylight::scene;
+use manylight::scene::{self, SceneError};
 
 /// Untimed assignments before [`AssignWorkload::time`] measures: a cold core (clock, caches,
 /// branch predictors) is markedly slower than a warm one.
@@ -36,12 +36,17 @@ impl AssignWorkload {
     ///
     /// # Panics
     ///
-    /// When `count` is past [`manylight::scene::input::MAX_LIGHTS`] (a benchmark helper: the
-    /// `bench-assign` command refuses such counts first).
+    /// Where [`AssignWorkload::try_default_view`] fails (a benchmark helper).
     pub fn default_view(count: usize, seed: u64) -> AssignWorkload {
+        Self::try_default_view(count, seed).expect("the default scene builds")
+    }
+
+    /// [`AssignWorkload::default_view`], or the error naming `lights` where `count` is past
+    /// [`manylight::scene::input::MAX_LIGHTS`] or its lights cannot be allocated.
+    pub fn try_default_view(count: usize, seed: u64) -> Result<AssignWorkload, SceneError> {
         // The grid this workload has always timed (64-pixel cells, never narrower than 1/64
         // of the depth range), so figures compare across versions.
-        Self::view_with(count, seed, BENCH_SIZE, |near, far| GridConfig {
+        Self::try_view_with(count, seed, BENCH_SIZE, |near, far| GridConfig {
             measure: GridMeasure {
                 min_cell_size: Some((far - near) / 64.0),
                 ..GridMeasure::default()
@@ -70,14 +75,28 @@ impl AssignWorkload {
 
     /// The default scene's camera with `count` random lights at `size` with the grid that
     /// `config` makes of the camera's near and far planes.
+    ///
+    /// # Panics
+    ///
+    /// Where [`AssignWorkload::try_view_with`] fails (a benchmark helper).
     pub fn view_with(
+        count: usize,
+        seed: u64,
+        size: (u32, u32),
+        config: impl FnOnce(f64, f64) -> GridConfig,
+    ) -> AssignWorkload {
+        Self::try_view_with(count, seed, size, config).expect("the default scene builds")
+    }
+
+    /// [`AssignWorkload::view_with`], or the error naming `lights` where the scene or its
+    /// view-space lights cannot be built.
+    pub fn try_view_with(
         count: usize,
         seed: u64,
         (w, h): (u32, u32),
         config: impl FnOnce(f64, f64) -> GridConfig,
-    ) -> AssignWorkload {
-        let scene = scene::builtin::build(scene::builtin::DEFAULT, Some((count, seed)))
-            .expect("the default scene builds");
+    ) -> Result<AssignWorkload, SceneError> {
+        let scene = scene::builtin::build(scene::builtin::DEFAULT, Some((count, seed)))?;
         let view = scene.camera.view_matrix();
         let projection = scene.camera.projection_matrix(w as f64 / h as f64);
         let (near, far) = scene.camera.near_far();
@@ -89,12 +108,16 @@ impl AssignWorkload {
             far,
             &config(near, far),
         );
-        let lights = scene
-            .lights
-            .iter()
-            .map(|l| GpuLight::from_light(l, &view))
-            .collect();
-        AssignWorkload { grid, lights, far }
+        let mut lights = Vec::new();
+        lights.try_reserve_exact(count).map_err(|_| {
+            let bytes = count as u64 * std::mem::size_of::<GpuLight>() as u64;
+            SceneError::invalid(
+                "lights",
+                format!("{count} lights take {bytes} bytes in view space, which this process cannot allocate now"),
+            )
+        })?;
+        lights.extend(scene.lights.iter().map(|l| GpuLight::from_light(l, &view)));
+        Ok(AssignWorkload { grid, lights, far })
     }
 
     /// One assignment with `assigner`'s buffers (as a renderer does every frame).

@@ -638,6 +638,34 @@ fn an_obj_larger_than_the_memory_left_is_an_error_not_an_abort() {
     );
 }
 
+/// `bench-assign` builds its workload from the default scene: lights it cannot allocate are
+/// the error `render` gives for them, where the workload's `expect` panicked.
+#[test]
+fn bench_assign_past_the_memory_left_is_an_error_not_a_panic() {
+    let Ok(prlimit) = which_prlimit() else {
+        common::skip("no prlimit (util-linux) to bound the child's memory");
+        return;
+    };
+    let max = manylight::scene::input::MAX_LIGHTS.to_string();
+    let out = std::process::Command::new(prlimit)
+        .arg("--as=402653184")
+        .arg(env!("CARGO_BIN_EXE_manylight"))
+        .env("RAYON_NUM_THREADS", "1")
+        .env("MALLOC_ARENA_MAX", "1")
+        .args(["bench-assign", "--runs", "1", "--lights"])
+        .arg(&max)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.starts_with(&format!(
+            "error: invalid value for `lights`: {max} lights need"
+        )),
+        "{stderr}"
+    );
+}
+
 /// A glTF primitive without normals is drawn flat: each triangle's corners get their own
 /// copies of the vertex colours. Those copies (16 bytes a corner) were made before the
 /// unshared vertices were counted against the file's limit, so a 12 MB strip of byte indices

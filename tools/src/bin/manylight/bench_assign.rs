@@ -79,7 +79,7 @@ pub fn run(args: &BenchAssignArgs) -> Result<(), Box<dyn std::error::Error>> {
         .collect::<Result<Vec<_>, _>>()?;
     let mut rows = Vec::new();
     for &count in &args.lights {
-        let work = AssignWorkload::default_view(count, args.seed);
+        let work = AssignWorkload::try_default_view(count, args.seed)?;
         let runs = match args.runs {
             Some(runs) => runs,
             None if count > 100_000 => 7,
