@@ -25,7 +25,7 @@ use std::path::{Path, PathBuf};
 
 pub use deferred::{defer_commits, Deferred};
 pub use memory::encoding_fits;
-pub use paths::{identity, protect_inputs};
+pub use paths::{check_writable_later, identity, protect_inputs};
 pub use stdout::{is_stream, keep_stdout_for_own_output, names_stdout, print_stdout};
 pub(crate) use temporaries::remove_temporaries_then;
 

@@ -32,6 +32,18 @@ pub fn protect_inputs(files: &[PathBuf]) {
 /// reads blocked until one came, so `--out fifo` hung before any work, saying nothing. Such a
 /// FIFO is an error now; one with a reader is opened again as usual (blocking writes).
 pub(super) fn open_without_waiting(path: &Path) -> io::Result<File> {
+    let file = open_without_waiting_once(path)?;
+    if file.metadata()?.is_file() {
+        return Ok(file);
+    }
+    // A FIFO with a reader, or a device (a terminal's writes must not fail for want of
+    // room): opened again as usual, so that writes wait rather than fail.
+    OpenOptions::new().write(true).open(path)
+}
+
+/// `path` opened for writing without blocking (and without becoming the controlling
+/// terminal); a FIFO without a reader is an error saying so.
+fn open_without_waiting_once(path: &Path) -> io::Result<File> {
     #[cfg(unix)]
     {
         use std::os::unix::fs::{FileTypeExt, OpenOptionsExt};
@@ -48,17 +60,27 @@ pub(super) fn open_without_waiting(path: &Path) -> io::Result<File> {
                     "a FIFO that no process reads: start its reader first",
                 ))
             }
-            Ok(file) if file.metadata()?.file_type().is_fifo() => {
-                OpenOptions::new().write(true).open(path)
-            }
-            Ok(file) if file.metadata()?.is_file() => Ok(file),
-            // A device (a terminal's writes must not fail for want of room): as usual.
-            Ok(_) => OpenOptions::new().write(true).open(path),
-            Err(e) => Err(e),
+            probe => probe,
         }
     }
     #[cfg(not(unix))]
     OpenOptions::new().write(true).open(path)
+}
+
+/// Whether `path`, which exists, may be written later, found without waiting and without
+/// ending a FIFO's reader: a FIFO that has one is kept open by the returned file (its reader
+/// would see its end when this check's open closed), to be dropped once the real write is
+/// done; one without a reader is an error now.
+pub fn check_writable_later(path: &Path) -> io::Result<Option<File>> {
+    let file = open_without_waiting_once(path)?;
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        if file.metadata()?.file_type().is_fifo() {
+            return Ok(Some(file));
+        }
+    }
+    Ok(None)
 }
 
 /// Whether `path` is one of the system's names for an open descriptor (`/dev/stdout`,

@@ -325,6 +325,64 @@ fn a_report_file_in_the_way_is_refused_before_the_sweep() {
     assert_eq!(std::fs::read_dir(&report).unwrap().count(), 1, "{stderr}");
 }
 
+/// A report file that is a FIFO: without a reader the sweep ends at once (its check opened
+/// it and waited for one forever); with a reader that stops at its first end of file, as
+/// `cat` does, the reader gets the whole report (the check's open and close ended it, and the
+/// report then found no reader).
+#[test]
+#[cfg(unix)]
+fn a_report_fifo_is_refused_without_a_reader_and_reaches_one_that_waits() {
+    let dir = tempfile::tempdir().unwrap();
+    let report = dir.path().join("report");
+    std::fs::create_dir_all(&report).unwrap();
+    let fifo = report.join("report.json");
+    let made = Command::new("mkfifo").arg(&fifo).status();
+    if !made.is_ok_and(|s| s.success()) {
+        eprintln!("no mkfifo here: nothing to check");
+        return;
+    }
+    let run = || {
+        let child = Command::new(env!("CARGO_BIN_EXE_manylight"))
+            .args(["bench", "--scenes", "plane", "--lights", "8", "--es", "3"])
+            .args(["--methods", "forward", "--size", "16x9", "--frames", "1"])
+            .args(["--no-knobs", "--animated-frames", "0", "--out"])
+            .arg(&report)
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        common::cli::wait_with_timeout(child, "bench", std::time::Duration::from_secs(60))
+    };
+    let out = run();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("no process reads"), "{stderr}");
+    // A reader blocked in its open until a writer comes, reading to the first end of file.
+    // Whether it is in its open when the sweep starts cannot be seen from here: a sweep that
+    // found none is tried again with a new reader.
+    for _ in 0..20 {
+        let path = fifo.clone();
+        let reader = std::thread::spawn(move || std::fs::read(path).unwrap());
+        std::thread::sleep(std::time::Duration::from_millis(200));
+        let out = run();
+        let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+        if out.status.success() {
+            let json: serde_json::Value = serde_json::from_slice(&reader.join().unwrap())
+                .unwrap_or_else(|e| panic!("the reader got no report ({e}): {stderr}"));
+            assert_eq!(json["rows"].as_array().map(Vec::len), Some(1), "{json}");
+            return;
+        }
+        assert!(stderr.contains("no process reads"), "{stderr}");
+        // The reader may still wait in its open: a writer's open and close lets it go.
+        use std::os::unix::fs::OpenOptionsExt;
+        let _ = (std::fs::OpenOptions::new().write(true))
+            .custom_flags(libc::O_NONBLOCK)
+            .open(&fifo);
+        reader.join().unwrap();
+    }
+    panic!("no sweep wrote its report to a reader waiting on the FIFO");
+}
+
 /// Edge values of the sweep: `--cpu-samples 0` (no CPU reference, documented as "—") panicked
 /// at its first reference; an output folder whose name is not Unicode panicked once every row
 /// was measured, before the report; a light count past what forward's loop holds here (no

@@ -120,7 +120,7 @@ fn load_bench_scene(
 pub fn run(args: &BenchArgs) -> Result<(), Box<dyn std::error::Error>> {
     let started = Instant::now();
     let plan = Plan::from(args);
-    check_before_rendering(args, &plan)?;
+    let _fifos_held_until_written = check_before_rendering(args, &plan)?;
     // The whole report folder is replaced at the end or not at all: stopped half-way (an
     // error, a signal) it stays the last run's, not a mixture of two.
     let deferred = manylight_tools::output::defer_commits();

@@ -10,11 +10,13 @@ use super::plan::{scene_name, Plan};
 use super::{load_bench_scene, BenchArgs};
 
 /// Checks the methods' names, the output folder and the report's files in it, the scenes'
-/// labels, every scene (loaded once) and each ES version's context and renderer.
+/// labels, every scene (loaded once) and each ES version's context and renderer. Returns the
+/// report's FIFOs held open, to be dropped after the report is written (their readers would
+/// otherwise see their end now).
 pub(super) fn check_before_rendering(
     args: &BenchArgs,
     plan: &Plan,
-) -> Result<(), Box<dyn std::error::Error>> {
+) -> Result<Vec<std::fs::File>, Box<dyn std::error::Error>> {
     // What can be checked before any rendering is: the methods' names, the output folder.
     for method in &plan.methods {
         manylight::methods::find(method)?;
@@ -31,13 +33,18 @@ pub(super) fn check_before_rendering(
         .map_err(|e| format!("cannot write into {}: {e}", shown::path(&args.out)))?;
     // The report's own files, where something is in the way (a folder of that name, a file
     // that cannot be written): found after the whole sweep before.
+    let mut held = Vec::new();
     for name in ["report.json", "report.md"] {
         let path = args.out.join(name);
         let blocked = match std::fs::symlink_metadata(&path) {
             Ok(meta) if meta.is_dir() => Some("a folder is in the way".to_string()),
-            Ok(_) => {
-                (std::fs::OpenOptions::new().write(true).open(&path).err()).map(|e| e.to_string())
-            }
+            Ok(_) => match manylight_tools::output::check_writable_later(&path) {
+                Ok(fifo) => {
+                    held.extend(fifo);
+                    None
+                }
+                Err(e) => Some(e.to_string()),
+            },
             Err(_) => None,
         };
         if let Some(why) = blocked {
@@ -69,5 +76,5 @@ pub(super) fn check_before_rendering(
         let ctx = HeadlessContext::new(es)?;
         Renderer::new(ctx.load_gl()?, es)?.destroy();
     }
-    Ok(())
+    Ok(held)
 }
