@@ -65,9 +65,10 @@ impl Axis {
     }
 
     /// At most `max` labelled ticks on an axis `len_px` long; a floor tick ("0") replaces
-    /// any tick closer to it than `glyph_px` and a half.
+    /// any tick closer to it than `glyph_px` and a half, and those below it (which would
+    /// read as values under zero).
     pub(super) fn ticks(&self, max: usize, len_px: u32, glyph_px: u32) -> Ticks {
-        let (mut major, minor) = if self.log {
+        let (mut major, mut minor) = if self.log {
             log_ticks(self.lo, self.hi, max)
         } else {
             let v = nice_ticks(self.lo, self.hi, max);
@@ -80,7 +81,8 @@ impl Axis {
         if let Some(floor) = self.floor {
             let f = floor.log10();
             let min_gap = (self.hi - self.lo) * 1.5 * glyph_px as f64 / len_px.max(1) as f64;
-            major.retain(|(t, _)| (t - f).abs() >= min_gap);
+            major.retain(|(t, _)| *t - f >= min_gap);
+            minor.retain(|&t| t > f);
             major.push((f, "0".to_string()));
         }
         (major, minor)

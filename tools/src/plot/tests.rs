@@ -113,6 +113,14 @@ fn log_axis_over_decades_has_decade_ticks_and_a_zero_floor() {
         Axis::new([1.0, 2.0].into_iter(), true, Some(0.01)).floor,
         None
     );
+    // Zeros alone: nothing is drawn below the "0" (a bench whose every error was 0 read
+    // `2e-6`, `0`, `5e-7` down its axis).
+    let zeros = Axis::new([0.0, 0.0].into_iter(), true, None);
+    let f = zeros.floor.unwrap().log10();
+    let (major, minor) = zeros.ticks(20, 400, 16);
+    assert!(major.iter().any(|t| t.1 == "0"), "{major:?}");
+    assert!(major.iter().all(|t| t.0 >= f), "{major:?}");
+    assert!(minor.iter().all(|&t| t > f), "{minor:?}");
 }
 
 fn dark_pixels(img: &RgbImage, rows: std::ops::Range<u32>) -> usize {
