@@ -72,7 +72,7 @@ pub fn markdown(rows: &[AnimatedRow]) -> String {
         let _ = writeln!(
             s,
             "| {} | {} | {} | {} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} | {:.3} | {:.3} | {:.0} | {:.0} | {} |",
-            r.scene,
+            crate::report::md_text(&r.scene),
             r.es,
             r.method,
             r.lights,

@@ -12,8 +12,8 @@ pub fn markdown(report: &Report) -> String {
     let mut s = String::from("# manylight bench\n\n");
     let _ = writeln!(
         s,
-        "`{}` — {} rows in {:.0} s on {} logical CPUs, renderer `{}`, LP_NUM_THREADS {}.\n",
-        report.command,
+        "{} — {} rows in {:.0} s on {} logical CPUs, renderer `{}`, LP_NUM_THREADS {}.\n",
+        md_code(&report.command),
         rows.len(),
         report.seconds,
         report.cpus,
@@ -38,7 +38,7 @@ pub fn markdown(report: &Report) -> String {
             if these.is_empty() {
                 continue;
             }
-            let _ = writeln!(s, "## {scene}, ES {es}\n");
+            let _ = writeln!(s, "## {}, ES {es}\n", md_text(scene));
             s += "| method | lights | frame ms | assign ms | draws | evals/px | × bound | RMSE | max | f64 max |\n\
                   |---|---|---|---|---|---|---|---|---|---|\n";
             for r in these {
@@ -69,7 +69,7 @@ pub fn markdown(report: &Report) -> String {
             let _ = writeln!(
                 s,
                 "| {} | {} | {} | {} | {} | {} | {} | {:.1} | {:.2} | {:.1} | {} | {:.3} | {} |",
-                r.scene,
+                md_text(&r.scene),
                 r.es,
                 r.method,
                 r.lights,
@@ -94,7 +94,9 @@ pub fn markdown(report: &Report) -> String {
             let _ = writeln!(
                 s,
                 "- {}, ES {}, {} lights: {reason}",
-                r.scene, r.es, r.lights
+                md_text(&r.scene),
+                r.es,
+                r.lights
             );
         }
         s += "\n";
@@ -136,18 +138,19 @@ const COLUMNS: &str = "Columns: *frame ms* and *assign ms* (CPU light assignment
 /// images.
 fn pictures_section(report: &Report, scene: &str) -> String {
     let mut s = String::new();
+    let shown = md_text(scene);
     let _ = writeln!(
         s,
-        "### {scene}\n\n\
-         ![Error against frame time, {scene}]({})\n\n\
-         ![Light evaluations per pixel, {scene}]({})\n",
+        "### {shown}\n\n\
+         ![Error against frame time, {shown}]({})\n\n\
+         ![Light evaluations per pixel, {shown}]({})\n",
         chart_file(CHARTS[0], scene),
         chart_file(CHARTS[1], scene),
     );
     for p in report.pictures.iter().filter(|p| p.scene == scene) {
         let _ = writeln!(
             s,
-            "{scene}, ES {}, {} lights. Reference (plain forward over all lights, light model \
+            "{shown}, ES {}, {} lights. Reference (plain forward over all lights, light model \
              at highp): [{}]({})\n\n\
              | method | light evaluations per pixel | difference from the reference |\n\
              |---|---|---|",
@@ -162,6 +165,36 @@ fn pictures_section(report: &Report, scene: &str) -> String {
         s += "\n";
     }
     s
+}
+
+/// `text` (a scene's file name) as Markdown shows it literally in a heading, table cell or
+/// image's alt text: control characters escaped, and the characters Markdown reads as
+/// syntax (a `|` ended a table's cell) escaped with a backslash.
+pub(crate) fn md_text(text: &str) -> String {
+    let mut out = String::new();
+    for c in manylight::scene::shown::text(text).chars() {
+        if "\\`*_[]<>|~#!".contains(c) {
+            out.push('\\');
+        }
+        out.push(c);
+    }
+    out
+}
+
+/// `text` (a command line) as a Markdown code span: control characters escaped, fenced by
+/// more backticks than any run of them inside it.
+fn md_code(text: &str) -> String {
+    let text = manylight::scene::shown::text(text);
+    let mut longest = 0;
+    for run in text.split(|c| c != '`') {
+        longest = longest.max(run.len());
+    }
+    let fence = "`".repeat(longest + 1);
+    if longest == 0 {
+        format!("{fence}{text}{fence}")
+    } else {
+        format!("{fence} {text} {fence}")
+    }
 }
 
 /// A figure with `digits` decimals, or "—" when there is none.

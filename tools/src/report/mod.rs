@@ -24,6 +24,7 @@ use crate::plot;
 pub use charts::{error_vs_time, evals_vs_lights, method_style};
 pub use files::{chart_file, diff_file, file_tag, heatmap_file, reference_file};
 pub use markdown::markdown;
+pub(crate) use markdown::md_text;
 
 /// One configuration's measurements.
 #[derive(Clone, Debug, Serialize)]

@@ -271,3 +271,53 @@ fn markdown_lists_every_picture_and_explains_the_dashes() {
         assert!(why.contains(column), "{column} not explained");
     }
 }
+
+/// A scene's file name is text in the Markdown, not syntax: `a|b.json` gave its table rows
+/// one cell too many, and a backtick in the command line ended its code span.
+#[test]
+fn scene_names_and_the_command_line_are_shown_literally() {
+    let named = "x|y*[z]";
+    let mut r = report();
+    r.command = "manylight bench --scenes `x|y*[z]`.json".into();
+    for row in &mut r.rows {
+        row.scene = named.into();
+        row.grid_reason = Some("why".into());
+    }
+    r.pictures[0].scene = named.into();
+    let spread = manylight::metrics::spread::Spread::of([1.0, 2.0]).unwrap();
+    r.animated.push(crate::animated::AnimatedRow {
+        scene: named.into(),
+        method: "clustered".into(),
+        es: "3.0".into(),
+        lights: 64,
+        width: 64,
+        height: 36,
+        frames: 2,
+        fps: 30.0,
+        frame_ms: spread,
+        assign_ms: spread,
+        upload_bytes: spread,
+        p99_over_p50: 1.0,
+        max_abs_err_vs_forward: Some(0),
+    });
+    let md = markdown(&r);
+    // Every row of a table has its header's cells: `|` not escaped by a backslash.
+    let cells = |line: &str| {
+        line.split("\\|")
+            .map(|p| p.matches('|').count())
+            .sum::<usize>()
+    };
+    let mut header = None;
+    for line in md.lines() {
+        match (line.starts_with('|'), header) {
+            (true, None) => header = Some(cells(line)),
+            (true, Some(n)) => assert_eq!(cells(line), n, "{line}\n{md}"),
+            (false, _) => header = None,
+        }
+    }
+    assert!(md.contains("x\\|y\\*\\[z\\]"), "{md}");
+    assert!(
+        md.contains("`` manylight bench --scenes `x|y*[z]`.json ``"),
+        "{md}"
+    );
+}
