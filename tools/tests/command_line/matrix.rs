@@ -416,6 +416,40 @@ fn walk(dir: &std::path::Path) -> Vec<std::path::PathBuf> {
     files
 }
 
+/// One implementation named twice (`DIR`, then `DIR/.`) runs its rows once, with a warning: it
+/// ran them twice, and `system` twice wrote both OSMesa rows' pictures under one name.
+#[test]
+fn an_implementation_named_twice_runs_once() {
+    let dir = tempfile::tempdir().unwrap();
+    for name in ["libEGL.so.1", "libGLESv2.so.2"] {
+        std::fs::write(dir.path().join(name), b"not a library").unwrap();
+    }
+    let run = |folders: &[&Path]| {
+        let mut cmd = Command::new(env!("CARGO_BIN_EXE_manylight"));
+        cmd.arg("matrix");
+        for folder in folders {
+            cmd.arg("--gles-lib").arg(folder);
+        }
+        let out = cmd
+            .args(["--size", "16x9", "--lights", "4", "--json", "-"])
+            .env_remove("MANYLIGHT_GLES_LIB")
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+        let rows: Vec<serde_json::Value> = serde_json::from_slice(&out.stdout)
+            .unwrap_or_else(|e| panic!("no JSON ({e}): {stderr}"));
+        (rows.len(), stderr)
+    };
+    let (once, said) = run(&[dir.path()]);
+    assert!(once > 0 && !said.contains("given before"), "{said}");
+    let (twice, said) = run(&[dir.path(), &dir.path().join(".")]);
+    assert_eq!(twice, once, "{said}");
+    assert!(
+        said.contains("names an implementation given before"),
+        "{said}"
+    );
+}
+
 /// Libraries that cannot load are not a configuration this machine cannot give: every cell of
 /// their group fails, unmarked, and `--max-error` fails on them (it passed a broken machine
 /// when any failure to make a context read as a refusal). `MANYLIGHT_GLES_LIB` names the

@@ -80,6 +80,27 @@ fn gles_lib_from_env(gles_libs: &[PathBuf]) -> Vec<PathBuf> {
     vec![PathBuf::from(folder)]
 }
 
+/// `libs` with each implementation once, in their first order (a folder by the files it
+/// names, however spelled); a warning where one was given twice: its rows ran twice, and
+/// `system` twice wrote both OSMesa rows' pictures under one name.
+fn once_each(libs: &[PathBuf]) -> Vec<PathBuf> {
+    let mut kept: Vec<PathBuf> = Vec::new();
+    let mut seen = Vec::new();
+    for lib in libs {
+        let same = std::fs::canonicalize(lib).unwrap_or_else(|_| lib.clone());
+        if seen.contains(&same) {
+            log::warn!(
+                "--gles-lib {} names an implementation given before: its rows run once",
+                scene::shown::path(lib)
+            );
+        } else {
+            seen.push(same);
+            kept.push(lib.clone());
+        }
+    }
+    kept
+}
+
 /// `--allow-outside-files` for a cell when the matrix was given it.
 fn outside_files_flag() -> Option<&'static str> {
     crate::load_options()
@@ -93,10 +114,11 @@ pub fn run(args: &MatrixArgs, gles_libs: &[PathBuf]) -> Result<(), Box<dyn std::
     let exe = std::env::current_exe()?;
     let from_env = gles_lib_from_env(gles_libs);
     let gles_libs = if gles_libs.is_empty() {
-        &from_env[..]
+        from_env
     } else {
-        gles_libs
+        once_each(gles_libs)
     };
+    let gles_libs = &gles_libs[..];
     // What every cell would fail on is an error of the matrix, not a row of failures: a scene
     // that cannot be read, outputs that cannot be written.
     let (_, report) =
