@@ -140,7 +140,8 @@ pub fn load_into(
             _ => None,
         };
         let mut factor = |key: &str, value: Option<[f64; 3]>, default: f32| {
-            let v = value.map_or(Vec3::splat(default), |v| DVec3::from(v).as_vec3());
+            let written = value.unwrap_or([default.into(); 3]);
+            let v = DVec3::from(written).as_vec3();
             // A NaN component takes the default's, as `Ns` and `d` do.
             let known = Vec3::select(v.is_nan_mask(), Vec3::splat(default), v);
             let clamped = known.max(Vec3::ZERO).min(Vec3::splat(MAX_COLOR_FACTOR));
@@ -148,7 +149,7 @@ pub fn load_into(
                 report.warn(format!(
                     "material `{material_name}`: {key} {} taken as {} (factors are \
                      limited to [0, {MAX_COLOR_FACTOR}], the range the fp16 colour tier holds)",
-                    short3(v),
+                    short3(written),
                     short3(clamped)
                 ));
             }

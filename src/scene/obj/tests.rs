@@ -205,7 +205,7 @@ fn textures_past_the_scenes_budget_are_left_out_with_a_warning() {
 fn out_of_range_mtl_numbers_are_warnings_naming_the_statement() {
     let dir = tempfile::tempdir().unwrap();
     let mtl = "newmtl a\nNs nan\nd -5\nKd nan nan nan\nnewmtl b\nNs 1e308\nd nan\n\
-               Ks nan 0.5 2000\nnewmtl c\nNs -1\nd 0.5\nKd 1e38 0 0\n\
+               Ks nan 0.5 2000\nnewmtl c\nNs -1\nd 0.5\nKd 1e38 0 0\nKs 1e40 0 0\n\
                newmtl e\nNs 39.999996\nd 0.3\n";
     std::fs::write(dir.path().join("m.mtl"), mtl).unwrap();
     let mut obj = String::from("mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\n");
@@ -233,6 +233,8 @@ fn out_of_range_mtl_numbers_are_warnings_naming_the_statement() {
         "`b`: Ks [NaN, 0.5, 2000] taken as [0, 0.5, 1024]",
         "`c`: Ns -1",
         "`c`: Kd [1e38, 0, 0] taken as [1024, 0, 0]",
+        // Past f32 as written, not as the infinity f32 makes of it.
+        "`c`: Ks [1e40, 0, 0] taken as [1024, 0, 0]",
     ] {
         assert!(
             report.warnings.iter().any(|w| w.contains(said)),
