@@ -12,8 +12,8 @@
 //! 3. **Composite** — ambient, occluded by the factor the geometry pass leaves in the
 //!    accumulation's alpha, plus the accumulated light, encoded like the forward methods.
 //! 4. **Transparent objects** — documented forward fallback: the composite wrote the G-buffer's
-//!    depth into the target, and transparent objects are drawn back to front with plain
-//!    forward shading.
+//!    depth into the target, the opaque objects' depth is laid over it again exactly, and
+//!    transparent objects are drawn back to front with plain forward shading.
 //!
 //! The G-buffer keeps float normals, depth and 11-bit albedo/specular, so deferred matches plain
 //! forward within 2/255 (tested); its cost is memory and bandwidth: 52 bytes per pixel, 44
@@ -515,8 +515,8 @@ impl Deferred {
         let [x, y] = ctx.origin.map(|v| v as i32);
         dev.viewport(x, y, ctx.viewport.0 as i32, ctx.viewport.1 as i32);
         // The composite also gives the target the geometry pass's depth (for the transparent
-        // objects drawn after it, and for whatever the application draws next): written by the
-        // shader, so it works into a target of any depth format, where a depth blit needs both
+        // objects drawn after it, which have it laid again exactly, and for whatever the
+        // application draws next): written by the shader, so it works into a target of any depth format, where a depth blit needs both
         // formats to match exactly (ES 3.0: GL_INVALID_OPERATION otherwise; SwiftShader's
         // DEPTH_COMPONENT24 texture and renderbuffer differ, and a game's back buffer may too).
         // Against the application's depth where the frame keeps it (its geometry hides what
@@ -572,6 +572,21 @@ impl Deferred {
 
 /// Whether the frame draws an opaque object (cut-outs included), which the G-buffer passes
 /// are for: the objects [`sort_objects`] lists as opaque.
+/// Where transparent objects follow, the opaque objects' depth laid again over the
+/// composite's copy, as forward's prepass lays it: a 24-bit depth read back as a float and
+/// written again lands a step farther at some depths on Mesa's and ANGLE's drivers, and a
+/// transparent surface on an opaque one (a highlight drawn over a mesh) then showed where
+/// forward hides it. `LESS` keeps what lies nearer (the application's geometry, a copy that
+/// came back nearer). Cut-outs keep the copy: the depth program samples no texture.
+fn exact_depth_under_transparent(ctx: &mut FrameContext) -> Result<(), Error> {
+    if ctx.order.transparent.is_empty() || ctx.order.cut_out_from == 0 || ctx.features.counting() {
+        return Ok(());
+    }
+    super::geometry::depth_prepass(ctx)?;
+    ctx.dev.set_depth_bias(0.0);
+    Ok(())
+}
+
 fn draws_opaque(ctx: &FrameContext) -> bool {
     let scene = ctx.scene;
     let opaque = |o: &crate::scene::Object| !scene.materials[o.material].is_transparent();
@@ -645,6 +660,7 @@ impl ShadingMethod for Deferred {
             self.geometry_pass(ctx)?;
             let pass = self.light_pass(ctx)?;
             self.composite(ctx, target)?;
+            exact_depth_under_transparent(ctx)?;
             let stats = MethodStats {
                 gbuffer_bytes: self.gbuffer.both().map(GBuffer::gpu_bytes).sum(),
                 upload_bytes: pass.uploaded,

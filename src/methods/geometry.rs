@@ -104,7 +104,7 @@ pub(crate) fn sort_objects(ctx: &mut FrameContext) {
 
 /// Lays down the opaque objects' depth only, so the shading pass runs its light loop once per
 /// pixel instead of once per overlapping surface.
-fn depth_prepass(ctx: &mut FrameContext) -> Result<(), Error> {
+pub(crate) fn depth_prepass(ctx: &mut FrameContext) -> Result<(), Error> {
     let dev = ctx.dev;
     RenderState::DEPTH_PREPASS.apply(dev);
     let key = ProgramKey {

@@ -208,6 +208,41 @@ fn transparent_objects_take_the_forward_fallback() {
     );
 }
 
+/// A translucent copy of an opaque surface on its very vertices (a game's highlight or ghost
+/// over a mesh) is hidden by it in forward (`LESS` on equal depths). Deferred drew it: the
+/// depth its composite copied from the G-buffer came back one step farther on Mesa's and
+/// ANGLE's drivers, so the copy passed over the whole floor (100/255 on llvmpipe).
+#[test]
+fn a_translucent_copy_on_an_opaque_surface_is_hidden_as_in_forward() {
+    let mut s = scene::builtin::build("plane", None).unwrap();
+    s.camera =
+        manylight::Camera::perspective(DVec3::new(0.0, 3.0, 4.0), DVec3::ZERO, 60.0, 0.1, 100.0);
+    s.lights = vec![scene::Light::point(
+        DVec3::new(0.0, 1.0, 0.0),
+        5.0,
+        Vec3::ONE,
+        2.0,
+    )];
+    let mut ghost = s.materials[s.objects[0].material].clone();
+    ghost.diffuse = Vec3::new(1.0, 0.0, 1.0);
+    ghost.alpha = 0.5;
+    s.materials.push(ghost);
+    let mut copy = s.objects[0].clone();
+    copy.material = s.materials.len() - 1;
+    s.objects.push(copy);
+    let mut gpu = Gpu::new(EsVersion::Es3);
+    let opts = RenderOptions::default();
+    let (forward, _) = gpu.render_with("forward", &s, (128, 72), &opts);
+    let (deferred, _) = gpu.render_with("deferred", &s, (128, 72), &opts);
+    let d = manylight::metrics::diff(&forward, &deferred);
+    assert!(
+        d.max_abs <= 2,
+        "deferred {}/255 from forward on {:.2} % of the pixels",
+        d.max_abs,
+        100.0 * d.over_2
+    );
+}
+
 #[test]
 fn deferred_is_unsupported_on_es2_with_a_reason() {
     let mut gpu = Gpu::new(EsVersion::Es2);
