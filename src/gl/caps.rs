@@ -294,6 +294,15 @@ impl Caps {
             && (self.renderer.contains("SwiftShader") || self.renderer.contains("softpipe"))
     }
 
+    /// A driver workaround: Mesa's softpipe clips two triangles sharing an edge that crosses a
+    /// side of the view into pieces that do not meet, so a pixel on that edge is drawn by
+    /// neither or both: deferred's proxy spheres crossing the frame's border lost or doubled
+    /// their light there (docs/drivers.md), so there it bounds such a light by a full-screen
+    /// triangle at its far end instead.
+    pub fn clips_shared_edges_apart(&self) -> bool {
+        !self.desktop && self.renderer.contains("softpipe")
+    }
+
     /// A driver workaround: SwiftShader 4's `glClear` of a multisampled sRGB renderbuffer fills
     /// one sample (docs/drivers.md), so the renderer's MSAA target is filled by a draw first.
     /// Elsewhere that draw would be a full-screen pass every frame for nothing.

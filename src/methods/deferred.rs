@@ -400,6 +400,7 @@ impl Deferred {
             far: ctx.scene.camera.far_clip_range().0 as f32,
             projection: ctx.projection.as_dmat4(),
             eye_plane_unreliable: dev.caps().loses_triangles_crossing_the_eye_plane(),
+            sides_unreliable: dev.caps().clips_shared_edges_apart(),
             rows: ctx.viewport.1,
             biased_toward: in_gbuffer_any(ctx, |m| m.depth_bias > 0.0),
             biased_away: in_gbuffer_any(ctx, |m| m.depth_bias < 0.0),

@@ -39,8 +39,10 @@ const MAX_PROXY_SPAN_PX: f64 = (1u64 << 24) as f64;
 ///   the far side, `GEQUAL` — surfaces behind the whole sphere are skipped;
 /// - where the implementation loses triangles crossing the eye's plane
 ///   ([`Caps::loses_triangles_crossing_the_eye_plane`](crate::gl::Caps)) and the sphere
-///   reaches behind the eye: a full-screen triangle at the depth of the light's far end,
-///   `GEQUAL` — surfaces behind that plane are skipped;
+///   reaches behind the eye, or clips a shared edge into pieces that do not meet
+///   ([`Caps::clips_shared_edges_apart`](crate::gl::Caps)) and the sphere crosses a side of
+///   the view: a full-screen triangle at the depth of the light's far end, `GEQUAL` —
+///   surfaces behind that plane are skipped;
 /// - reaching the far plane too, depth too coarse there for any test, a far side the near
 ///   plane clips into faces too large to interpolate depth over, or a sphere spanning more
 ///   than [`MAX_PROXY_SPAN_PX`]: a full-screen triangle, untested.
@@ -99,6 +101,8 @@ pub(super) struct ProxyReach<'a> {
     pub projection: DMat4,
     /// [`Caps::loses_triangles_crossing_the_eye_plane`](crate::gl::Caps).
     pub eye_plane_unreliable: bool,
+    /// [`Caps::clips_shared_edges_apart`](crate::gl::Caps).
+    pub sides_unreliable: bool,
     /// The frame's height in pixels.
     pub rows: u32,
     /// The G-buffer holds a surface drawn toward the camera, off its depth: a `LEQUAL` test
@@ -141,7 +145,13 @@ impl ProxyReach<'_> {
         let coarse = self.camera.depth_step_at(f64::from(depth + radius), 24)
             > 0.1 * f64::from(light.cull_radius);
         let wide = self.too_wide(light, radius);
-        if !coarse && depth - radius >= 2.0 * self.near && !wide && !self.biased_toward {
+        let clipped_apart = self.sides_unreliable && self.crosses_a_side(light, radius);
+        if !coarse
+            && depth - radius >= 2.0 * self.near
+            && !wide
+            && !self.biased_toward
+            && !clipped_apart
+        {
             return Proxy::NearSide;
         }
         if coarse || depth + radius >= FAR_MARGIN * self.far || wide {
@@ -155,6 +165,8 @@ impl ProxyReach<'_> {
             Proxy::FullScreen
         } else if perspective && self.eye_plane_unreliable && depth - radius < 0.0 {
             // A sphere reaching behind the eye has faces crossing its plane.
+            Proxy::Bounded
+        } else if clipped_apart {
             Proxy::Bounded
         } else {
             Proxy::FarSide
@@ -174,6 +186,31 @@ impl ProxyReach<'_> {
         } else {
             proxy.depth_test()
         }
+    }
+
+    /// Whether `light`'s proxy of `radius` crosses a side of the view (neither wholly inside
+    /// the view's four sides nor wholly beside one of them, where it covers no pixel).
+    fn crosses_a_side(&self, light: &GpuLight, radius: f32) -> bool {
+        let (c, r) = (light.position.as_dvec3(), f64::from(radius));
+        let depth = -c.z;
+        let (tx, ty) = (
+            1.0 / self.projection.x_axis.x,
+            1.0 / self.projection.y_axis.y,
+        );
+        let perspective = matches!(self.camera.projection, Projection::Perspective { .. });
+        // How far the sphere's centre lies inside the nearer of a pair of sides, in the
+        // sides' own measure, against the radius in that measure.
+        let inside_by = |v: f64, t: f64| {
+            if perspective {
+                ((t * depth - v.abs()), r * (1.0 + t * t).sqrt())
+            } else {
+                ((t - v.abs()), r)
+            }
+        };
+        let sides = [inside_by(c.x, tx), inside_by(c.y, ty)];
+        let beside = sides.iter().any(|&(d, r)| d < -r);
+        let within = sides.iter().all(|&(d, r)| d > r);
+        !beside && !within
     }
 
     /// Whether `light`'s proxy of `radius` may be in view and spans more than
@@ -243,6 +280,7 @@ mod tests {
             far: far as f32,
             projection: camera.projection_matrix(16.0 / 9.0),
             eye_plane_unreliable,
+            sides_unreliable: false,
             rows: 720,
             biased_toward: false,
             biased_away: false,
@@ -284,6 +322,29 @@ mod tests {
     fn light(at: DVec3, radius: f32) -> GpuLight {
         let l = Light::point(at, radius, Vec3::ONE, 1.0);
         GpuLight::from_light(&l, &glam::DMat4::IDENTITY)
+    }
+
+    /// Where shared edges are clipped apart, a sphere crossing a side of the view is bounded;
+    /// one wholly inside or wholly beside the view keeps its near side, as everywhere else.
+    #[test]
+    fn a_sphere_crossing_the_views_side_is_bounded_only_where_clipping_splits_edges() {
+        let camera = camera(0.1);
+        // 60° vertical at 16:9: at depth 10 the view's half extents are 5.77 and 10.3.
+        let cases = [
+            (DVec3::new(0.0, 0.0, -10.0), Proxy::NearSide),
+            (DVec3::new(0.0, 5.5, -10.0), Proxy::Bounded),
+            (DVec3::new(-10.0, 0.0, -10.0), Proxy::Bounded),
+            (DVec3::new(0.0, 9.0, -10.0), Proxy::NearSide),
+        ];
+        for (at, split_apart) in cases {
+            let l = light(at, 1.0);
+            assert_eq!(reach(&camera, true).proxy(&l), Proxy::NearSide, "{at}");
+            let r = ProxyReach {
+                sides_unreliable: true,
+                ..reach(&camera, true)
+            };
+            assert_eq!(r.proxy(&l), split_apart, "{at}");
+        }
     }
 
     #[test]
