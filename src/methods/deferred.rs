@@ -348,6 +348,19 @@ impl Deferred {
             color_write: true,
         }
         .apply(ctx.dev);
+        let drawn = self.draw_gbuffer_objects(ctx, 0..ctx.order.opaque.len());
+        // The light volumes are tested against the depth where it lies.
+        ctx.dev.set_depth_bias(0.0);
+        drawn
+    }
+
+    /// Draws the opaque objects `range` (of `ctx.order.opaque`) with the G-buffer program, in
+    /// the state the caller set.
+    fn draw_gbuffer_objects(
+        &self,
+        ctx: &mut FrameContext,
+        range: std::ops::Range<usize>,
+    ) -> Result<(), Error> {
         // The pass stores each surface point as its depth and window offset (gbuffer.frag),
         // through the same mapping the light pass reads it back with.
         let (half, _) = half_extent(ctx);
@@ -358,7 +371,7 @@ impl Deferred {
         let scale = accumulation_scale(ctx);
         let mut drawn = Ok(());
         let mut bound = None;
-        for k in 0..ctx.order.opaque.len() {
+        for k in range {
             let i = ctx.order.opaque[k];
             let mut bind = |p: &GBufferProgram, dev: &Device| {
                 p.viewport.set(dev, viewport);
@@ -370,9 +383,36 @@ impl Deferred {
                 break;
             }
         }
-        // The light volumes are tested against the depth where it lies.
-        ctx.dev.set_depth_bias(0.0);
         ctx.features = features;
+        drawn
+    }
+
+    /// Where transparent objects follow, the opaque objects' depth laid again over the
+    /// composite's copy, as forward lays it: a 24-bit depth read back as a float and written
+    /// again lands a step farther at some depths on Mesa's and ANGLE's drivers, and a
+    /// transparent surface on an opaque one (a highlight drawn over a mesh) then showed where
+    /// forward hides it. `LESS` keeps what lies nearer (the application's geometry, a copy
+    /// that came back nearer). Cut-outs take the G-buffer program, which cuts them, with
+    /// colour writes off.
+    fn exact_depth_under_transparent(&self, ctx: &mut FrameContext) -> Result<(), Error> {
+        if ctx.order.transparent.is_empty() || ctx.features.counting() {
+            return Ok(());
+        }
+        if ctx.order.cut_out_from > 0 {
+            super::geometry::depth_prepass(ctx)?;
+        }
+        let cut_outs = ctx.order.cut_out_from..ctx.order.opaque.len();
+        let drawn = if cut_outs.is_empty() {
+            Ok(())
+        } else {
+            RenderState {
+                color_write: false,
+                ..RenderState::DEPTH_PREPASS
+            }
+            .apply(ctx.dev);
+            self.draw_gbuffer_objects(ctx, cut_outs)
+        };
+        ctx.dev.set_depth_bias(0.0);
         drawn
     }
 
@@ -517,9 +557,10 @@ impl Deferred {
         dev.viewport(x, y, ctx.viewport.0 as i32, ctx.viewport.1 as i32);
         // The composite also gives the target the geometry pass's depth (for the transparent
         // objects drawn after it, which have it laid again exactly, and for whatever the
-        // application draws next): written by the shader, so it works into a target of any depth format, where a depth blit needs both
-        // formats to match exactly (ES 3.0: GL_INVALID_OPERATION otherwise; SwiftShader's
-        // DEPTH_COMPONENT24 texture and renderbuffer differ, and a game's back buffer may too).
+        // application draws next): written by the shader, so it works into a target of any
+        // depth format, where a depth blit needs both formats to match exactly (ES 3.0:
+        // GL_INVALID_OPERATION otherwise; SwiftShader's DEPTH_COMPONENT24 texture and
+        // renderbuffer differ, and a game's back buffer may too).
         // Against the application's depth where the frame keeps it (its geometry hides what
         // lies behind); over a cleared depth the test passes wherever there is a surface.
         let mut state = RenderState::FULL_SCREEN_WITH_DEPTH;
@@ -573,21 +614,6 @@ impl Deferred {
 
 /// Whether the frame draws an opaque object (cut-outs included), which the G-buffer passes
 /// are for: the objects [`sort_objects`] lists as opaque.
-/// Where transparent objects follow, the opaque objects' depth laid again over the
-/// composite's copy, as forward's prepass lays it: a 24-bit depth read back as a float and
-/// written again lands a step farther at some depths on Mesa's and ANGLE's drivers, and a
-/// transparent surface on an opaque one (a highlight drawn over a mesh) then showed where
-/// forward hides it. `LESS` keeps what lies nearer (the application's geometry, a copy that
-/// came back nearer). Cut-outs keep the copy: the depth program samples no texture.
-fn exact_depth_under_transparent(ctx: &mut FrameContext) -> Result<(), Error> {
-    if ctx.order.transparent.is_empty() || ctx.order.cut_out_from == 0 || ctx.features.counting() {
-        return Ok(());
-    }
-    super::geometry::depth_prepass(ctx)?;
-    ctx.dev.set_depth_bias(0.0);
-    Ok(())
-}
-
 fn draws_opaque(ctx: &FrameContext) -> bool {
     let scene = ctx.scene;
     let opaque = |o: &crate::scene::Object| !scene.materials[o.material].is_transparent();
@@ -661,7 +687,7 @@ impl ShadingMethod for Deferred {
             self.geometry_pass(ctx)?;
             let pass = self.light_pass(ctx)?;
             self.composite(ctx, target)?;
-            exact_depth_under_transparent(ctx)?;
+            self.exact_depth_under_transparent(ctx)?;
             let stats = MethodStats {
                 gbuffer_bytes: self.gbuffer.both().map(GBuffer::gpu_bytes).sum(),
                 upload_bytes: pass.uploaded,
