@@ -138,7 +138,7 @@ pub fn run(args: &ViewArgs) -> Result<(), Box<dyn std::error::Error>> {
     let mut app = App {
         args,
         light_count: lights.unwrap_or(scene.lights.len()),
-        good: (String::new(), lights.unwrap_or(scene.lights.len())),
+        good: None,
         heatmap: args.heatmap,
         tone_map: manylight::ToneMap::None,
         samples: args.msaa.max(1),
@@ -171,14 +171,27 @@ struct TitleStats {
     assign_ms: f64,
 }
 
+/// What the keys and the fly camera change: a frame that fails after a change goes back to
+/// the last frame's (a heatmap past forward's loop, a step into more lights than the method
+/// indexes).
+#[derive(Clone, Debug, PartialEq)]
+struct Settings {
+    method: String,
+    lights: usize,
+    heatmap: bool,
+    tone_map: manylight::ToneMap,
+    samples: u32,
+    camera: manylight::Camera,
+}
+
 /// The viewer between events: scene, input, window (once resumed) and the exit status.
 struct App<'a> {
     args: &'a ViewArgs,
     scene: Scene,
     /// Random lights asked for (`+`/`-` change it).
     light_count: usize,
-    /// Method and light count of the last frame that rendered, to undo a rejected change.
-    good: (String, usize),
+    /// What the last frame that rendered was drawn with, to undo a change that fails.
+    good: Option<Settings>,
     /// Show light evaluations per pixel instead of the image (H).
     heatmap: bool,
     /// The output stage's curve (T cycles it).
@@ -231,7 +244,6 @@ impl ApplicationHandler for App<'_> {
                         log::warn!("warm-up failed (the first frames build what it did not): {e}");
                     }
                 }
-                self.good.0 = self.args.method.clone();
                 g.window.request_redraw();
                 self.gfx = Some(g);
                 self.last_frame = Instant::now();
@@ -242,7 +254,9 @@ impl ApplicationHandler for App<'_> {
 
     fn window_event(&mut self, event_loop: &ActiveEventLoop, _: WindowId, event: WindowEvent) {
         match event {
-            WindowEvent::CloseRequested => self.quit(event_loop),
+            // Destroyed by another client (`xdotool windowclose`): its size can no longer be
+            // asked, which winit answers with a panic.
+            WindowEvent::CloseRequested | WindowEvent::Destroyed => self.quit(event_loop),
             WindowEvent::Resized(size) => {
                 if let Some(g) = &self.gfx {
                     g.resize(size);
@@ -480,9 +494,18 @@ impl App<'_> {
         };
         self.drawn_size = Some((size.width, size.height));
         self.refused_size = None;
-        if self.good.0 != stats.method || self.good.1 != self.light_count {
-            self.good = (stats.method.clone(), self.light_count);
-        }
+        let kept = (self.good.take())
+            .filter(|good| good.method == stats.method)
+            .map(|good| good.method);
+        self.good = Some(Settings {
+            // Allocated only when the method changed.
+            method: kept.unwrap_or_else(|| stats.method.clone()),
+            lights: self.light_count,
+            heatmap: self.heatmap,
+            tone_map: self.tone_map,
+            samples: self.samples,
+            camera: self.scene.camera,
+        });
         self.frames += 1;
         if Some(self.frames) == self.args.frames {
             let mut line = format!(
@@ -507,19 +530,40 @@ impl App<'_> {
         Ok(())
     }
 
-    /// A frame failed: undo the last interactive change if there was one, else give up.
+    /// A frame failed: go back to the last frame's settings where something changed since,
+    /// else give up.
     fn undo_change(&mut self, error: String) -> Result<(), String> {
-        let Some(r) = self.gfx.as_mut().and_then(|g| g.renderer.as_mut()) else {
+        let (Some(good), Some(r)) = (
+            self.good.clone(),
+            self.gfx.as_mut().and_then(|g| g.renderer.as_mut()),
+        ) else {
             return Err(error);
         };
-        let (method, lights) = self.good.clone();
-        if self.frames == 0 || (r.method().name() == method && self.light_count == lights) {
+        let now = Settings {
+            method: r.method().name().to_string(),
+            lights: self.light_count,
+            heatmap: self.heatmap,
+            tone_map: self.tone_map,
+            samples: self.samples,
+            camera: self.scene.camera,
+        };
+        if now == good {
             return Err(error);
         }
-        eprintln!("error: {error}; back to {method} with {lights} lights");
-        r.set_method_named(&method).map_err(|e| e.to_string())?;
-        if self.light_count != lights {
-            self.set_lights(lights);
+        eprintln!(
+            "error: {error}; back to the last frame's {} with {} lights",
+            good.method, good.lights
+        );
+        if now.method != good.method {
+            r.set_method_named(&good.method)
+                .map_err(|e| e.to_string())?;
+        }
+        (self.heatmap, self.tone_map, self.samples) = (good.heatmap, good.tone_map, good.samples);
+        // The camera where it drew, and the keys that moved it let go.
+        self.scene.camera = good.camera;
+        self.fly.release_all();
+        if self.light_count != good.lights {
+            self.set_lights(good.lights);
         }
         Ok(())
     }
