@@ -188,29 +188,39 @@ impl ProxyReach<'_> {
         }
     }
 
-    /// Whether `light`'s proxy of `radius` crosses a side of the view (neither wholly inside
-    /// the view's four sides nor wholly beside one of them, where it covers no pixel).
-    fn crosses_a_side(&self, light: &GpuLight, radius: f32) -> bool {
+    /// For the view's two pairs of sides (left and right, bottom and top): how far `light`'s
+    /// centre lies inside the nearer side, and the proxy's `radius`, both in that pair's own
+    /// measure (the distance from a side plane `|v| = t · depth` in perspective, scaled).
+    fn side_margins(&self, light: &GpuLight, radius: f32) -> [(f64, f64); 2] {
         let (c, r) = (light.position.as_dvec3(), f64::from(radius));
         let depth = -c.z;
+        // The view's half extents: per unit of depth in perspective, in units orthographic.
         let (tx, ty) = (
             1.0 / self.projection.x_axis.x,
             1.0 / self.projection.y_axis.y,
         );
         let perspective = matches!(self.camera.projection, Projection::Perspective { .. });
-        // How far the sphere's centre lies inside the nearer of a pair of sides, in the
-        // sides' own measure, against the radius in that measure.
         let inside_by = |v: f64, t: f64| {
             if perspective {
-                ((t * depth - v.abs()), r * (1.0 + t * t).sqrt())
+                (t * depth - v.abs(), r * (1.0 + t * t).sqrt())
             } else {
-                ((t - v.abs()), r)
+                (t - v.abs(), r)
             }
         };
-        let sides = [inside_by(c.x, tx), inside_by(c.y, ty)];
-        let beside = sides.iter().any(|&(d, r)| d < -r);
-        let within = sides.iter().all(|&(d, r)| d > r);
-        !beside && !within
+        [inside_by(c.x, tx), inside_by(c.y, ty)]
+    }
+
+    /// Whether `light`'s proxy of `radius` lies wholly beside a side of the view (it covers no
+    /// pixel).
+    fn beside_the_view(&self, light: &GpuLight, radius: f32) -> bool {
+        (self.side_margins(light, radius).iter()).any(|&(inside, r)| inside < -r)
+    }
+
+    /// Whether `light`'s proxy of `radius` crosses a side of the view (neither wholly inside
+    /// the view's four sides nor wholly beside one of them).
+    fn crosses_a_side(&self, light: &GpuLight, radius: f32) -> bool {
+        let within = (self.side_margins(light, radius).iter()).all(|&(inside, r)| inside > r);
+        !within && !self.beside_the_view(light, radius)
     }
 
     /// Whether `light`'s proxy of `radius` may be in view and spans more than
@@ -225,21 +235,7 @@ impl ProxyReach<'_> {
         if depth + r <= near {
             return false;
         }
-        // The view's half extents: per unit of depth in perspective, in units orthographic.
-        let (tx, ty) = (
-            1.0 / self.projection.x_axis.x,
-            1.0 / self.projection.y_axis.y,
-        );
-        let perspective = matches!(self.camera.projection, Projection::Perspective { .. });
-        let beside = |v: f64, t: f64| {
-            if perspective {
-                // The sphere's distance from the side plane |v| = t · depth.
-                v.abs() - t * depth > r * (1.0 + t * t).sqrt()
-            } else {
-                v.abs() - t > r
-            }
-        };
-        if beside(c.x, tx) || beside(c.y, ty) {
+        if self.beside_the_view(light, radius) {
             return false;
         }
         // The size of a pixel where the proxy comes nearest.
