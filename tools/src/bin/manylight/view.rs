@@ -494,18 +494,6 @@ impl App<'_> {
         };
         self.drawn_size = Some((size.width, size.height));
         self.refused_size = None;
-        let kept = (self.good.take())
-            .filter(|good| good.method == stats.method)
-            .map(|good| good.method);
-        self.good = Some(Settings {
-            // Allocated only when the method changed.
-            method: kept.unwrap_or_else(|| stats.method.clone()),
-            lights: self.light_count,
-            heatmap: self.heatmap,
-            tone_map: self.tone_map,
-            samples: self.samples,
-            camera: self.scene.camera,
-        });
         self.frames += 1;
         if Some(self.frames) == self.args.frames {
             let mut line = format!(
@@ -526,27 +514,38 @@ impl App<'_> {
         }
         g.swap()?;
         update_title(&mut self.title, g, &stats, dt);
+        // The method's name allocated only when it changed.
+        let kept = (self.good.take())
+            .filter(|good| good.method == stats.method)
+            .map(|good| good.method);
+        self.good = Some(self.settings(kept.unwrap_or_else(|| stats.method.clone())));
         self.stats = stats;
         Ok(())
     }
 
-    /// A frame failed: go back to the last frame's settings where something changed since,
-    /// else give up.
-    fn undo_change(&mut self, error: String) -> Result<(), String> {
-        let (Some(good), Some(r)) = (
-            self.good.clone(),
-            self.gfx.as_mut().and_then(|g| g.renderer.as_mut()),
-        ) else {
-            return Err(error);
-        };
-        let now = Settings {
-            method: r.method().name().to_string(),
+    /// The settings a frame drawn with `method` (the one the renderer ran) has.
+    fn settings(&self, method: String) -> Settings {
+        Settings {
+            method,
             lights: self.light_count,
             heatmap: self.heatmap,
             tone_map: self.tone_map,
             samples: self.samples,
             camera: self.scene.camera,
+        }
+    }
+
+    /// A frame failed: go back to the last frame's settings where something changed since,
+    /// else give up.
+    fn undo_change(&mut self, error: String) -> Result<(), String> {
+        let renderer = self.gfx.as_mut().and_then(|g| g.renderer.as_mut());
+        let (Some(good), Some(method)) = (
+            self.good.clone(),
+            renderer.map(|r| r.method().name().to_string()),
+        ) else {
+            return Err(error);
         };
+        let now = self.settings(method);
         if now == good {
             return Err(error);
         }
@@ -554,7 +553,9 @@ impl App<'_> {
             "error: {error}; back to the last frame's {} with {} lights",
             good.method, good.lights
         );
-        if now.method != good.method {
+        if let Some(r) = (self.gfx.as_mut().and_then(|g| g.renderer.as_mut()))
+            .filter(|_| now.method != good.method)
+        {
             r.set_method_named(&good.method)
                 .map_err(|e| e.to_string())?;
         }
