@@ -171,8 +171,7 @@ fn long_object_name<'a>(key: Option<&str>, line: &'a str) -> Option<&'a str> {
 /// 16 to 35 times its size (a 67 MB face of 2²⁵ corners took 2.2 GB), and this bounds it.
 pub const MAX_OBJ_CORNERS: usize = 3 << 25;
 
-/// [`check_obj`] with at most `max_corners` triangle corners.
-/// [`check_obj`] with at most `max_corners` corners; where `materials_end_objects`, a
+/// [`check_obj`] with at most `max_corners` triangle corners; where `materials_end_objects`, a
 /// `usemtl` naming another material ends an object too ([`located`]).
 fn check_obj_within(
     text: &str,

@@ -87,7 +87,7 @@ fn once_each(libs: &[PathBuf]) -> Vec<PathBuf> {
     let mut kept: Vec<PathBuf> = Vec::new();
     let mut seen = Vec::new();
     for lib in libs {
-        let same = std::fs::canonicalize(lib).unwrap_or_else(|_| lib.clone());
+        let same = output::identity(lib);
         if seen.contains(&same) {
             log::warn!(
                 "--gles-lib {} names an implementation given before: its rows run once",
